@@ -1,0 +1,5 @@
+import sys
+
+from ncpp.cli import main
+
+sys.exit(main())

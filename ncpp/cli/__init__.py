@@ -1,0 +1,58 @@
+"""The `ncpp` command.
+
+Each subcommand lives in its own module of this package and exposes
+`register(subparsers)`, which adds its parser and sets `func` to a callable
+`func(args) -> int`.  Plain `ncpp` (no subcommand) is the stdin/stdout filter.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+from ncpp.errors import NcppError
+
+# Module names under ncpp.cli, in the order `ncpp --help` lists them.
+COMMANDS: tuple[str, ...] = (
+    "filter",
+    "analyze",
+)
+
+DEFAULT_COMMAND = "filter"
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="ncpp",
+        description="Make a CNC machine tool more accurate in software.",
+    )
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    for name in COMMANDS:
+        importlib.import_module(f"ncpp.cli.{name}").register(sub)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    argv = list(sys.argv[1:] if argv is None else argv)
+    parser = build_parser()
+    known = set(parser._subparsers._group_actions[0].choices)  # type: ignore[union-attr]
+    if not argv or (argv[0] not in known and argv[0] not in ("-h", "--help")):
+        argv.insert(0, DEFAULT_COMMAND)
+    args = parser.parse_args(argv)
+    try:
+        return int(args.func(args) or 0)
+    except NcppError as err:
+        print(f"ncpp: {err}" if not err.where.file else str(err), file=sys.stderr)
+        return 2
+    except BrokenPipeError:
+        return 1
+    except KeyboardInterrupt:
+        return 130
+    except OSError as err:
+        print(f"ncpp: {err.filename or ''}: {err.strerror or err}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

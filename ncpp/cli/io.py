@@ -1,0 +1,49 @@
+"""Input and output for NC-program commands.
+
+Output goes to a spool (memory, then a temporary file past a few MB) and
+reaches its destination only when the whole program was processed: a file
+is replaced atomically, stdout receives nothing if processing failed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import shutil
+import sys
+import tempfile
+from pathlib import Path
+from typing import BinaryIO, Iterator
+
+from ncpp.fileio import atomic_output
+
+SPOOL_BYTES = 8 << 20
+
+
+def add_io_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("input", nargs="?", help="NC program (default: standard input)")
+    p.add_argument("-o", "--output", help="output file, written atomically (default: standard output)")
+    p.add_argument("--strict", action="store_true", help="refuse constructs that would pass through with a warning")
+    p.add_argument("--dialect", default=None, help="NC dialect (default: detected from the content)")
+
+
+@contextlib.contextmanager
+def open_input(path: str | None) -> Iterator[tuple[BinaryIO, str]]:
+    if path is None or path == "-":
+        yield sys.stdin.buffer, "<stdin>"
+        return
+    with open(path, "rb") as stream:
+        yield stream, path
+
+
+@contextlib.contextmanager
+def open_output(path: str | None) -> Iterator[BinaryIO]:
+    if path is not None and path != "-":
+        with atomic_output(Path(path)) as out:
+            yield out
+        return
+    with tempfile.SpooledTemporaryFile(max_size=SPOOL_BYTES) as spool:
+        yield spool  # type: ignore[misc]
+        spool.seek(0)
+        shutil.copyfileobj(spool, sys.stdout.buffer)
+        sys.stdout.buffer.flush()

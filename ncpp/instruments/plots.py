@@ -1,0 +1,167 @@
+"""Figures a metrologist expects, one panel per analysed file.
+
+* Circular tests (ball bar, cutting, circular grid): a polar plot of the
+  LSC-centred radial deviation, magnified about the nominal circle (dashed),
+  CCW and CW in two colours, with the scale (µm per division) and G, H in the
+  title, like a Renishaw ballbar plot.
+* Positioning (laser, comparator): mean deviation per direction along the
+  axis with ±2s bands, the single runs as dots, the bidirectional mean.
+* Straightness, angles and level: the mean profile and its least-squares line.
+
+matplotlib is imported inside `plot_analyses` (Agg backend) so that importing
+this module stays cheap.
+"""
+
+from __future__ import annotations
+
+import io
+import math
+import os
+from typing import Sequence
+
+import numpy as np
+
+from ncpp.fileio import write_bytes_atomic
+from ncpp.instruments import iso230_4
+from ncpp.instruments.analysis import Analysis, describe
+
+COLOURS = {"CCW": "tab:red", "CW": "tab:blue", "+": "tab:red", "-": "tab:blue"}
+
+
+def plot_analyses(analyses: Sequence[Analysis], path: str | os.PathLike[str]) -> None:
+    """Draw one panel per analysis into a PNG at `path` (written atomically)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    n = len(analyses)
+    cols = 1 if n == 1 else 2
+    rows = math.ceil(n / cols)
+    fig = plt.figure(figsize=(7.5 * cols, 6.5 * rows))
+    for k, a in enumerate(analyses, 1):
+        if a.test is not None:
+            _polar_panel(fig.add_subplot(rows, cols, k, projection="polar"), a)
+        elif a.positioning is not None:
+            _positioning_panel(fig.add_subplot(rows, cols, k), a)
+        else:
+            _profile_panel(fig.add_subplot(rows, cols, k), a)
+    fig.tight_layout()
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png", dpi=110)
+    plt.close(fig)
+    write_bytes_atomic(path, buffer.getvalue())
+
+
+def _nice_step(span: float) -> float:
+    """A 1-2-5 step that divides `span` into about four divisions."""
+    raw = max(span, 1e-3) / 4
+    power = 10 ** math.floor(math.log10(raw))
+    return next(m * power for m in (1, 2, 5, 10) if m * power >= raw)
+
+
+def _polar_panel(ax, a: Analysis) -> None:
+    test, circle = a.test, a.circle
+    assert test is not None and circle is not None
+    centred = {t.direction: (t, iso230_4.centred(t, circle.common_centre_um, test.radius_mm)) for t in test.traces}
+    extreme = max(float(np.max(np.abs(d))) for _, d in centred.values())
+    step = _nice_step(2 * extreme)
+    outer = step * math.ceil(extreme / step + 0.5)
+    # Magnify: the deviation band [-outer, outer] fills the outer half of the radius.
+    ax.set_rorigin(-3 * outer)
+    ax.set_rlim(-outer, outer)
+    full = np.linspace(0, 2 * np.pi, 361)
+    ax.plot(full, np.zeros_like(full), "k--", lw=0.8, label=f"nominal R{test.radius_mm:g} mm")
+    for direction, (t, dev) in centred.items():
+        order = np.argsort(t.angle_deg)
+        th = np.radians(np.append(t.angle_deg[order], t.angle_deg[order][0]))
+        ax.plot(th, np.append(dev[order], dev[order][0]), color=COLOURS[direction], lw=1.2, label=direction)
+    ax.set_rticks(np.arange(-outer, outer + step / 2, step))
+    ax.set_yticklabels([f"{v:+g}" for v in np.arange(-outer, outer + step / 2, step)], fontsize=7)
+    ax.set_rlabel_position(67.5)
+    p, q = test.axes
+    ax.set_xticks(np.radians([0, 90, 180, 270]))
+    ax.set_xticklabels([f"+{p}", f"+{q}", f"−{p}", f"−{q}"])
+    f = a.figures
+    parts = [f"G {f['G']:.2f} µm"]
+    if f.get("H") is not None:
+        parts.append(f"H {f['H']:.2f} µm")
+    parts.append(f"F {f['F_min']:+.2f}/{f['F_max']:+.2f} µm")
+    ax.set_title(f"{os.path.basename(a.measurement.source)}\n{describe(a.measurement)}\n" + ", ".join(parts), fontsize=9)
+    ax.text(0.0, -0.08, f"scale {step:g} µm/div (LSC centred)\n" + _diagnosis_text(a), transform=ax.transAxes, fontsize=7, va="top")
+    ax.legend(loc="upper right", bbox_to_anchor=(1.18, 1.08), fontsize=7)
+
+
+def _diagnosis_text(a: Analysis) -> str:
+    f = a.figures
+    pieces = []
+    for key, label, unit in (
+        ("squareness_um_per_m", "squareness", "µm/m"),
+        ("scale_mismatch_um_per_m", "scale mismatch", "µm/m"),
+        ("servo_mismatch_ms", "servo mismatch", "ms"),
+    ):
+        if f.get(key) is not None:
+            pieces.append(f"{label} {f[key]:+.1f} {unit}")
+    for key, value in f.items():
+        if value is not None and (key.startswith("backlash_") or key.startswith("reversal_spike_")):
+            pieces.append(f"{key.rsplit('_', 1)[0].replace('_', ' ')} {value:+.2f} µm")
+    return "; ".join(pieces[:3]) + "\n" + "; ".join(pieces[3:])
+
+
+def _positioning_panel(ax, a: Analysis) -> None:
+    m, r = a.measurement, a.positioning
+    assert r is not None
+    column = "linear_um" if m.instrument == "comparator" else m.deviation_column
+    for sign, stats, name in (("+", r.up, "↑"), ("-", r.down, "↓")):
+        ok = stats.measured
+        if not ok.any():
+            continue
+        colour = COLOURS[sign]
+        rows = m["direction"] == sign
+        ax.plot(m["target_mm"][rows], m[column][rows], ".", color=colour, alpha=0.35, ms=4)
+        ax.plot(r.targets[ok], stats.mean[ok], "-o", color=colour, ms=3, label=f"x̄{name} ({sign})")
+        band = np.nan_to_num(2 * stats.s[ok])
+        ax.fill_between(r.targets[ok], stats.mean[ok] - band, stats.mean[ok] + band, color=colour, alpha=0.15, label=f"x̄{name} ± 2s{name}")
+    if r.bidirectional:
+        ok = ~np.isnan(r.mean)
+        ax.plot(r.targets[ok], r.mean[ok], "k--", lw=1, label="x̄ bidirectional")
+    for name, profile in a.profiles.items():
+        if name != "transverse":  # the comparator's transverse reading has its own scale
+            slope, intercept = profile.line
+            ax.plot(profile.position_mm, slope * profile.position_mm + intercept, "k:", lw=1, label="least-squares line")
+    ax.axhline(0, color="grey", lw=0.6)
+    ax.set_xlabel(f"target position {m.axis or ''} (mm)")
+    unit = "µrad" if column.endswith("urad") else "µm"
+    ax.set_ylabel(f"{column.removesuffix('_um').removesuffix('_urad')}, actual − target ({unit})")
+    f = a.figures
+    if a.standard == "ISO 230-2":
+        title = "ISO 230-2 (µm): " + ", ".join(f"{k} {f[k]:.2f}" for k in ("A", "E", "M", "B", "R") if f.get(k) is not None)
+    else:
+        title = ", ".join(f"{k} {v:.2f}" for k, v in f.items() if v is not None)
+    ax.set_title(f"{os.path.basename(m.source)}\n{describe(m)}\n{title}", fontsize=9)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7)
+
+
+def _profile_panel(ax, a: Analysis) -> None:
+    m = a.measurement
+    unit = "µm/m" if m.instrument == "level" else ("µrad" if m.instrument == "laser" and m.deviation_column.endswith("urad") else "µm")
+    for k, (name, profile) in enumerate(a.profiles.items()):
+        target = ax if k == 0 else ax.twinx()
+        slope, intercept = profile.line
+        colour = f"C{k}"
+        label_unit = "µm" if name == "height" else unit
+        target.plot(profile.position_mm, profile.value, "-o", ms=3, color=colour, label=f"{name} ({label_unit})")
+        target.plot(profile.position_mm, slope * profile.position_mm + intercept, ":", color=colour, lw=1, label=f"{name}: least-squares line")
+        target.set_ylabel(f"{name} ({label_unit})")
+        target.legend(fontsize=7, loc="upper left" if k == 0 else "lower right")
+    if m.instrument == "grid":
+        p, q = (x.lower() for x in m.plane_axes)
+        ax.plot(m["s_mm"], np.hypot(m[f"dev_{p}_um"], m[f"dev_{q}_um"]), "-", label="|deviation| (µm)")
+        ax.set_xlabel("path length (mm)")
+        ax.legend(fontsize=7)
+    else:
+        ax.set_xlabel(f"position {m.axis or ''} (mm)")
+    figures = ", ".join(f"{k} {v:.2f}" for k, v in a.figures.items() if v is not None)
+    ax.set_title(f"{os.path.basename(m.source)}\n{describe(m)}\n{figures}", fontsize=9)
+    ax.grid(alpha=0.3)

@@ -1,0 +1,224 @@
+"""The 21 geometric error components of a three-axis machine (ISO 230-1).
+
+Naming (ISO 230-1): ``E`` + direction of the error + the axis that moves.
+
+============  ==========================  =======================  ===========
+ISO name      meaning                     thesis names (aliases)   file unit
+============  ==========================  =======================  ===========
+EXX EYY EZZ   positioning of X, Y, Z      xx yy zz, Xxx Yyy Zzz    µm
+EYX EZX       straightness of X in Y, Z   yx zx, Xyx Xzx           µm
+EXY EZY       straightness of Y in X, Z   xy zy, Yxy Yzy           µm
+EXZ EYZ       straightness of Z in X, Y   xz yz, Zxz Zyz           µm
+EAX EBX ECX   roll, pitch, yaw of X       ax bx cx, Xax Xbx Xcx    µrad
+EAY EBY ECY   pitch, roll, yaw of Y       ay by cy, Yay Yby Ycy    µrad
+EAZ EBZ ECZ   pitch, yaw, roll of Z       az bz cz, Zaz Zbz Zcz    µrad
+C0Y           squareness Y to X (about Z) kxy, kyx, EC0Y           µrad (= µm/m)
+B0Z           squareness Z to X (about Y) kxz, kzx, EB0Z           µrad (= µm/m)
+A0Z           squareness Z to Y (about X) kyz, kzy, EA0Z           µrad (= µm/m)
+============  ==========================  =======================  ===========
+
+The thesis (Rahman 2004) writes a linear error as <error direction><axis>
+(``yx``: Y-direction error of the X axis), optionally prefixed by the axis
+(``Xyx``), and an angular error as <rotation><axis> (``bx``: rotation about Y
+of the X axis); ``kij`` is the squareness of axes i and j.  The aliases map
+those spellings one to one and with the same sign; a file written by ncpp
+always uses the ISO names.
+
+Signs: actual minus nominal, of the tool relative to the workpiece (see
+`ncpp.machine.chain`).  Angles are small rotations about +X (A), +Y (B),
++Z (C), right-hand rule.  Squareness is the fixed rotation of the *direction*
+of an axis's motion: X is the reference, Y is turned about Z by C0Y, Z is
+turned about X by A0Z and about Y by B0Z.  So C0Y > 0 opens the X–Y angle
+beyond 90° and Y motion carries δx = −C0Y·y; B0Z gives δx = +B0Z·z;
+A0Z gives δy = −A0Z·z.
+
+Each component is a function of its own axis position: a `Table` (linear or
+smooth, i.e. monotone cubic PCHIP, interpolation; optional separate values
+for travel in the − direction, for reversal error) or a `Polynomial`.  Values
+are in model units, mm and rad.  Outside the tabulated range a table holds
+its end values (no extrapolation: an error map is a measurement, and
+extrapolating a slope beyond it invents errors).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+from typing import Literal, Union
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+AXES = "XYZ"
+ROTATIONS = "ABC"
+SQUARENESS = ("C0Y", "B0Z", "A0Z")
+
+
+@dataclass(frozen=True)
+class ComponentInfo:
+    """What an ISO name means: the axis it depends on and what it moves."""
+
+    name: str
+    axis: str  # the axis whose position the error depends on
+    kind: Literal["translation", "rotation"]
+    index: int  # 0, 1, 2: the x/y/z direction (translation) or A/B/C axis (rotation)
+
+    @property
+    def unit(self) -> str:
+        return "um" if self.kind == "translation" else "urad"
+
+
+def _component_table() -> dict[str, ComponentInfo]:
+    table = {}
+    for axis in AXES:
+        for i, d in enumerate(AXES):
+            table[f"E{d}{axis}"] = ComponentInfo(f"E{d}{axis}", axis, "translation", i)
+        for i, r in enumerate(ROTATIONS):
+            table[f"E{r}{axis}"] = ComponentInfo(f"E{r}{axis}", axis, "rotation", i)
+    return table
+
+
+COMPONENTS: dict[str, ComponentInfo] = _component_table()
+
+# Squareness: (axis whose direction is turned, rotation index A/B/C).
+SQUARENESS_AXES: dict[str, tuple[str, int]] = {"C0Y": ("Y", 2), "B0Z": ("Z", 1), "A0Z": ("Z", 0)}
+
+
+def _thesis_table() -> dict[str, str]:
+    names = {}
+    for iso, info in COMPONENTS.items():
+        letter = AXES[info.index] if info.kind == "translation" else ROTATIONS[info.index]
+        short = f"{letter.lower()}{info.axis.lower()}"
+        names[short] = iso
+        names[f"{info.axis}{short}"] = iso
+    for iso, pair in (("C0Y", "xy"), ("B0Z", "xz"), ("A0Z", "yz")):
+        names[f"k{pair}"] = names[f"k{pair[::-1]}"] = iso
+        names[f"E{iso}"] = iso
+    return names
+
+
+THESIS_NAMES: dict[str, str] = _thesis_table()
+
+
+def canonical_name(name: str) -> str:
+    """The ISO name for an ISO or thesis spelling; ValueError if unknown."""
+    if name in COMPONENTS or name in SQUARENESS:
+        return name
+    if name.upper() in COMPONENTS or name.upper() in SQUARENESS:
+        return name.upper()
+    if name in THESIS_NAMES:
+        return THESIS_NAMES[name]
+    raise ValueError(
+        f"unknown error component {name!r}; use an ISO 230-1 name "
+        f"(EXX, EYX, ..., EAX, EBX, ECX, ..., C0Y, B0Z, A0Z) or a thesis name (xx, yx, ax, kxy, ...)"
+    )
+
+
+def _floats(values: ArrayLike, what: str) -> tuple[float, ...]:
+    arr = np.asarray(values, dtype=float).ravel()
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"{what} must be finite numbers")
+    return tuple(float(v) for v in arr)
+
+
+def _select(direction: ArrayLike | None, plus: NDArray, minus: NDArray) -> NDArray:
+    """Per-point choice: + table for d > 0, − table for d < 0, their mean when
+    the direction is unknown (None) or the axis stands (0)."""
+    mean = 0.5 * (plus + minus)
+    if direction is None:
+        return mean
+    d = np.broadcast_to(np.asarray(direction), plus.shape)
+    return np.where(d > 0, plus, np.where(d < 0, minus, mean))
+
+
+@dataclass(frozen=True)
+class Table:
+    """Error values tabulated along an axis (model units: mm or rad)."""
+
+    positions: tuple[float, ...]
+    values: tuple[float, ...]
+    values_minus: tuple[float, ...] | None = None  # travel in the − direction
+    interpolation: Literal["linear", "smooth"] = "linear"
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "positions", _floats(self.positions, "positions"))
+        object.__setattr__(self, "values", _floats(self.values, "values"))
+        if self.values_minus is not None:
+            object.__setattr__(self, "values_minus", _floats(self.values_minus, "minus values"))
+        pos = np.asarray(self.positions)
+        if len(pos) < 1:
+            raise ValueError("a table needs at least one position")
+        if np.any(np.diff(pos) <= 0):
+            raise ValueError("table positions must be strictly increasing")
+        for vals, what in ((self.values, "values"), (self.values_minus, "minus values")):
+            if vals is not None and len(vals) != len(pos):
+                raise ValueError(f"{len(vals)} {what} for {len(pos)} positions")
+        if self.interpolation not in ("linear", "smooth"):
+            raise ValueError(f"interpolation must be 'linear' or 'smooth', not {self.interpolation!r}")
+
+    @property
+    def directional(self) -> bool:
+        return self.values_minus is not None
+
+    @cached_property
+    def _curves(self) -> tuple:
+        return tuple(self._curve(v) for v in (self.values, self.values_minus) if v is not None)
+
+    def _curve(self, values: tuple[float, ...]):
+        x, y = np.asarray(self.positions), np.asarray(values)
+        if self.interpolation == "linear" or len(x) < 3:
+            return lambda p: np.interp(p, x, y)  # np.interp holds the end values
+        from scipy.interpolate import PchipInterpolator
+
+        spline = PchipInterpolator(x, y, extrapolate=False)
+        return lambda p: spline(np.clip(p, x[0], x[-1]))
+
+    def __call__(self, positions: ArrayLike, direction: ArrayLike | None = None) -> NDArray:
+        p = np.asarray(positions, dtype=float)
+        curves = self._curves
+        if len(curves) == 1:
+            return curves[0](p)
+        return _select(direction, curves[0](p), curves[1](p))
+
+    def scaled(self, factor: float) -> "Table":
+        """The same table with values multiplied (unit conversion, sign flip)."""
+        minus = None if self.values_minus is None else np.multiply(self.values_minus, factor)
+        return Table(self.positions, np.multiply(self.values, factor), minus, self.interpolation)
+
+
+@dataclass(frozen=True)
+class Polynomial:
+    """sum_i c_i·(pos − reference)^i; c_i in model units per mm^i.
+
+    `limits` (lo, hi) optionally holds the value constant outside [lo, hi],
+    like a table's end values."""
+
+    coefficients: tuple[float, ...]
+    reference: float = 0.0
+    limits: tuple[float, float] | None = None
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "coefficients", _floats(self.coefficients, "coefficients"))
+        object.__setattr__(self, "reference", float(self.reference))
+        if not self.coefficients:
+            raise ValueError("a polynomial needs at least one coefficient")
+        if self.limits is not None:
+            lo, hi = _floats(self.limits, "limits")
+            if not lo < hi:
+                raise ValueError("polynomial limits must be [lo, hi] with lo < hi")
+            object.__setattr__(self, "limits", (lo, hi))
+
+    directional = False
+
+    def __call__(self, positions: ArrayLike, direction: ArrayLike | None = None) -> NDArray:
+        p = np.asarray(positions, dtype=float)
+        if self.limits is not None:
+            p = np.clip(p, *self.limits)
+        # np.polyval wants the highest power first.
+        return np.polyval(self.coefficients[::-1], p - self.reference)
+
+    def scaled(self, factor: float) -> "Polynomial":
+        return Polynomial(np.multiply(self.coefficients, factor), self.reference, self.limits)
+
+
+Component = Union[Table, Polynomial]

@@ -1,0 +1,247 @@
+"""`Machine`: chain, offsets, limits, error components and effects as one value.
+
+A Machine is immutable; `with_components` and `replace` return new ones.
+Conventions (frames, signs, the chain product) are in `ncpp.machine.chain`;
+component names in `ncpp.machine.components`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any, Mapping
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ncpp.machine.chain import (
+    Chain,
+    abbe_offset,
+    exact_deviation,
+    linear_deviation,
+    squareness_vectors,
+)
+from ncpp.machine.components import AXES, COMPONENTS, SQUARENESS, Component, canonical_name
+
+if TYPE_CHECKING:
+    from ncpp.machine.effects import Effect
+    from ncpp.machine.trajectory import Trajectory
+
+Vec3 = tuple[float, float, float]
+
+
+def _vec3(value: ArrayLike, what: str) -> Vec3:
+    arr = np.asarray(value, dtype=float).ravel()
+    if arr.shape != (3,) or not np.all(np.isfinite(arr)):
+        raise ValueError(f"{what} must be three finite numbers [x, y, z]")
+    return (float(arr[0]), float(arr[1]), float(arr[2]))
+
+
+def as_points(P: ArrayLike) -> NDArray:
+    """(n,3) float array of axis positions; a single (3,) point becomes (1,3)."""
+    arr = np.asarray(P, dtype=float)
+    if arr.ndim == 1:
+        arr = arr[None, :]
+    if arr.ndim != 2 or arr.shape[1] != 3:
+        raise ValueError(f"positions must have shape (n, 3), got {np.shape(P)}")
+    return arr
+
+
+def _shaped_like(result: NDArray, P: ArrayLike) -> NDArray:
+    return result[0] if np.ndim(P) == 1 else result
+
+
+@dataclass(frozen=True)
+class Machine:
+    """A three-axis machine's geometric error model.
+
+    Fields are in model units (mm, rad).  `components` maps ISO names
+    (EXX, ..., ECZ) to a `Table` or `Polynomial`; absent components are zero.
+    `squareness` maps C0Y, B0Z, A0Z to angles in rad."""
+
+    name: str
+    chain: str
+    tool: Vec3 = (0.0, 0.0, 0.0)
+    work: Vec3 = (0.0, 0.0, 0.0)
+    references: Mapping[str, Vec3] = field(default_factory=dict)
+    limits: Mapping[str, tuple[float, float]] = field(default_factory=dict)
+    components: Mapping[str, Component] = field(default_factory=dict)
+    squareness: Mapping[str, float] = field(default_factory=dict)
+    effects: tuple["Effect", ...] = ()
+    max_correction_mm: float = 0.5
+    meta: Mapping[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        setter = lambda name, value: object.__setattr__(self, name, value)  # noqa: E731
+        setter("chain", Chain(self.chain).text)
+        setter("tool", _vec3(self.tool, "tool offset"))
+        setter("work", _vec3(self.work, "work offset"))
+        refs = {}
+        for axis, r in self.references.items():
+            if axis not in AXES:
+                raise ValueError(f"reference point for unknown axis {axis!r}")
+            refs[axis] = _vec3(r, f"reference point of {axis}")
+        setter("references", {a: refs.get(a, (0.0, 0.0, 0.0)) for a in AXES})
+        limits = {}
+        for axis, lim in self.limits.items():
+            if axis not in AXES:
+                raise ValueError(f"limits for unknown axis {axis!r}")
+            lo, hi = (float(v) for v in lim)
+            if not lo < hi:
+                raise ValueError(f"limits of {axis} must be [lo, hi] with lo < hi")
+            limits[axis] = (lo, hi)
+        setter("limits", {a: limits.get(a, (-math.inf, math.inf)) for a in AXES})
+        comps = {}
+        for name, comp in self.components.items():
+            iso = canonical_name(name)
+            if iso not in COMPONENTS:
+                raise ValueError(f"{name} is a squareness; give it in `squareness`")
+            if comp is not None:
+                comps[iso] = comp
+        setter("components", dict(sorted(comps.items())))
+        sq = {}
+        for name, value in self.squareness.items():
+            iso = canonical_name(name)
+            if iso not in SQUARENESS:
+                raise ValueError(f"{name} is not a squareness (C0Y, B0Z, A0Z)")
+            sq[iso] = float(value)
+        setter("squareness", {k: sq.get(k, 0.0) for k in SQUARENESS})
+        setter("effects", tuple(self.effects))
+        setter("max_correction_mm", float(self.max_correction_mm))
+        if not self.max_correction_mm > 0:
+            raise ValueError("max_correction_mm must be positive")
+
+    # ----------------------------------------------------------------- shape
+    @property
+    def axes(self) -> tuple[str, ...]:
+        """Axes in chain order, workpiece to tool."""
+        return Chain(self.chain).order
+
+    def component(self, name: str) -> Component | None:
+        return self.components.get(canonical_name(name))
+
+    def within_limits(self, P: ArrayLike) -> NDArray:
+        """Boolean per point: every axis inside its travel."""
+        pts = as_points(P)
+        ok = np.ones(len(pts), dtype=bool)
+        for i, axis in enumerate(AXES):
+            lo, hi = self.limits[axis]
+            ok &= (pts[:, i] >= lo) & (pts[:, i] <= hi)
+        return _shaped_like(ok, P)
+
+    # ------------------------------------------------------------ evaluation
+    def error_motions(
+        self, P: ArrayLike, direction: ArrayLike | None = None
+    ) -> tuple[dict[str, NDArray], dict[str, NDArray]]:
+        """Per axis, the translation δ_K (n,3) mm and rotation ε_K (n,3) rad at P."""
+        pts = as_points(P)
+        dirs = None if direction is None else np.broadcast_to(np.asarray(direction, dtype=float), pts.shape)
+        n = len(pts)
+        delta = {a: np.zeros((n, 3)) for a in AXES}
+        eps = {a: np.zeros((n, 3)) for a in AXES}
+        for name, comp in self.components.items():
+            info = COMPONENTS[name]
+            i = AXES.index(info.axis)
+            d = None if dirs is None else dirs[:, i]
+            target = delta if info.kind == "translation" else eps
+            target[info.axis][:, info.index] = comp(pts[:, i], d)
+        return delta, eps
+
+    def _kinematics(self, P: ArrayLike, direction: ArrayLike | None):
+        pts = as_points(P)
+        delta, eps = self.error_motions(pts, direction)
+        refs = {a: np.asarray(r) for a, r in self.references.items()}
+        sq = squareness_vectors(self.squareness["C0Y"], self.squareness["B0Z"], self.squareness["A0Z"])
+        return Chain(self.chain), pts, np.asarray(self.tool), refs, delta, eps, sq
+
+    def deviation(self, P: ArrayLike, direction: ArrayLike | None = None) -> NDArray:
+        """Actual minus nominal tool point relative to the workpiece, mm.
+
+        P: (n,3) axis positions X, Y, Z in mm (or one (3,) point).
+        direction: optional (n,3) travel signs +1/−1/0 for direction-dependent
+        tables (None or 0: the mean of the + and − tables)."""
+        return _shaped_like(exact_deviation(*self._kinematics(P, direction)), P)
+
+    def deviation_linear(self, P: ArrayLike, direction: ArrayLike | None = None) -> NDArray:
+        """First-order deviation (thesis eqs. 28–30), mm."""
+        return _shaped_like(linear_deviation(*self._kinematics(P, direction)), P)
+
+    def abbe_offset(self, axis: str, P: ArrayLike) -> NDArray:
+        """Lever arm L_K (mm) through which axis K's rotation moves the tool point."""
+        pts = as_points(P)
+        return _shaped_like(
+            abbe_offset(Chain(self.chain), axis, pts, np.asarray(self.tool), np.asarray(self.references[axis])),
+            P,
+        )
+
+    def rotation(self, P: ArrayLike, direction: ArrayLike | None = None) -> NDArray:
+        """Rotation vector (rad) of the tool relative to the workpiece, (n,3).
+
+        What a laser's angular optics read as pitch/yaw between the two
+        members: the composition of every axis's ε in chain order."""
+        return _shaped_like(self._compose(P, direction, self.axes, sign=1.0), P)
+
+    def member_rotation(self, member: str, P: ArrayLike, direction: ArrayLike | None = None) -> NDArray:
+        """Rotation (rad) of a member relative to the frame, as a level on it reads.
+
+        member: 'work' (the workpiece/table), 'tool', or an axis letter (that
+        carriage).  A workpiece-side carriage turns by −ε (the error motions are
+        of the tool relative to the workpiece)."""
+        chain = Chain(self.chain)
+        if member == "work":
+            member = chain.work_side[0] if chain.work_side else "F"
+        elif member == "tool":
+            member = chain.tool_side[-1] if chain.tool_side else "F"
+        if member == "F":
+            return _shaped_like(np.zeros(as_points(P).shape), P)
+        if member not in AXES:
+            raise ValueError(f"member must be 'work', 'tool' or an axis letter, not {member!r}")
+        if chain.side(member) == "tool":
+            path = chain.tool_side[: chain.tool_side.index(member) + 1]
+            return _shaped_like(self._compose(P, direction, path, sign=1.0), P)
+        # Frame to carriage on the workpiece side: B_1 ... B_K with R(ε)^-1 each.
+        path = chain.work_side[chain.work_side.index(member) :][::-1]
+        return _shaped_like(self._compose(P, direction, path, sign=-1.0), P)
+
+    def _compose(self, P, direction, axes, sign: float) -> NDArray:
+        from scipy.spatial.transform import Rotation
+
+        _, eps = self.error_motions(P, direction)
+        total = Rotation.identity(len(as_points(P)))
+        for axis in axes:
+            total = total * Rotation.from_rotvec(sign * eps[axis])
+        return total.as_rotvec()
+
+    def simulate(self, trajectory: "Trajectory") -> NDArray:
+        """Actual tool positions (n,3) mm along a sampled trajectory: command +
+        geometric deviation (direction of travel from the trajectory) + effects."""
+        pts = trajectory.positions
+        actual = pts + self.deviation(pts, trajectory.directions())
+        for effect in self.effects:
+            actual = actual + effect.apply(trajectory, machine=self)
+        return actual
+
+    # ---------------------------------------------------------------- values
+    def with_components(self, **updates: Component | float | None) -> "Machine":
+        """New machine with components (ISO or thesis names) replaced; None removes.
+        Squareness names take an angle in rad."""
+        comps = dict(self.components)
+        sq = dict(self.squareness)
+        for name, value in updates.items():
+            iso = canonical_name(name)
+            if iso in SQUARENESS:
+                sq[iso] = 0.0 if value is None else float(value)  # type: ignore[arg-type]
+            elif value is None:
+                comps.pop(iso, None)
+            else:
+                comps[iso] = value  # type: ignore[assignment]
+        return dataclasses.replace(self, components=comps, squareness=sq)
+
+    def replace(self, **changes: Any) -> "Machine":
+        """New machine with fields replaced (dataclasses.replace, validated)."""
+        return dataclasses.replace(self, **changes)
+
+    def without_errors(self) -> "Machine":
+        """The same structure with no errors and no effects (the ideal machine)."""
+        return dataclasses.replace(self, components={}, squareness={}, effects=())

@@ -1,0 +1,127 @@
+"""Motion segments: what the interpreter makes of blocks, and what passes transform.
+
+The interpreter turns each block into zero or more events:
+
+* `Line`  — a straight move (rapid traverse or feed), like rs274's
+  STRAIGHT_TRAVERSE / STRAIGHT_FEED;
+* `Arc`   — a circular or helical feed move, like rs274's ARC_FEED;
+* `Pass`  — a block with no motion (comments, M/S/T words, set-up codes,
+  constructs outside the interpreter's scope), written back verbatim.
+
+Every segment points at its source `Block` and carries the modal context a
+writer needs to turn it back into NC text in the program's own style.
+Coordinates are program (work) coordinates in program units, as rs274
+reports them; `Context.to_machine` converts to machine axis positions in mm,
+where the error model lives.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+from typing import Union
+
+from ncpp.program.blocks import Block
+
+Point = tuple[float, float, float]
+# Axis letters of `Line.end` / `Arc.end` beyond XYZ, in rs274's order.
+EXTRA_AXES = ("A", "B", "C", "U", "V", "W")
+
+PLANES = {17: "XY", 18: "XZ", 19: "YZ"}
+# (first, second, normal) axis indices of each plane, as rs274 orders ARC_FEED arguments:
+# G17: X Y (Z), G18: Z X (Y), G19: Y Z (X).
+PLANE_AXES = {17: (0, 1, 2), 18: (2, 0, 1), 19: (1, 2, 0)}
+
+
+@dataclass(frozen=True, slots=True)
+class Context:
+    """Modal state a segment was made in, as far as writing it back needs."""
+
+    plane: int = 17  # 17, 18, 19
+    absolute: bool = True  # G90 / G91
+    arc_absolute: bool = False  # G90.1 / G91.1 (IJK absolute)
+    inch: bool = False  # G20 / G21
+    offset: Point = (0.0, 0.0, 0.0)  # machine minus program position (work offset, G92, tool length), program units
+
+    @property
+    def unit_mm(self) -> float:
+        return 25.4 if self.inch else 1.0
+
+    def to_machine(self, p: Point) -> Point:
+        """Machine axis position in mm of a program point."""
+        s = self.unit_mm
+        return ((p[0] + self.offset[0]) * s, (p[1] + self.offset[1]) * s, (p[2] + self.offset[2]) * s)
+
+    def to_program(self, m: Point) -> Point:
+        s = self.unit_mm
+        return (m[0] / s - self.offset[0], m[1] / s - self.offset[1], m[2] / s - self.offset[2])
+
+
+@dataclass(frozen=True, slots=True)
+class Line:
+    start: Point
+    end: Point
+    rapid: bool
+    feed: float
+    block: Block
+    context: Context = field(default_factory=Context)
+    extra: tuple[float, ...] = ()  # end positions of A B C U V W, when the program uses them
+    changed: bool = False  # set by a pass that moved the end point
+
+    def length(self) -> float:
+        return math.dist(self.start, self.end)
+
+
+@dataclass(frozen=True, slots=True)
+class Arc:
+    """A circular (or helical) arc in `context.plane`.
+
+    `turn` follows rs274's ARC_FEED rotation: +1 counter-clockwise (G3),
+    -1 clockwise (G2); |turn| > 1 adds full turns.  `center` has the
+    normal-axis coordinate of the start point.
+    """
+
+    start: Point
+    end: Point
+    center: Point
+    turn: int
+    feed: float
+    block: Block
+    context: Context = field(default_factory=Context)
+    extra: tuple[float, ...] = ()
+    changed: bool = False
+
+    @property
+    def clockwise(self) -> bool:
+        return self.turn < 0
+
+    def radius(self) -> float:
+        i, j, _ = PLANE_AXES[self.context.plane]
+        return math.hypot(self.start[i] - self.center[i], self.start[j] - self.center[j])
+
+    def sweep(self) -> float:
+        """Signed swept angle in radians (positive counter-clockwise)."""
+        i, j, _ = PLANE_AXES[self.context.plane]
+        a0 = math.atan2(self.start[j] - self.center[j], self.start[i] - self.center[i])
+        a1 = math.atan2(self.end[j] - self.center[j], self.end[i] - self.center[i])
+        full = 2 * math.pi
+        if self.turn > 0:
+            d = (a1 - a0) % full
+            d = d if d > 1e-12 else full
+            return d + full * (self.turn - 1)
+        d = (a0 - a1) % full
+        d = d if d > 1e-12 else full
+        return -(d + full * (-self.turn - 1))
+
+
+@dataclass(frozen=True, slots=True)
+class Pass:
+    """A block that makes no motion; written back as it was."""
+
+    block: Block
+
+
+Segment = Union[Line, Arc]
+Event = Union[Line, Arc, Pass]
+
+__all__ = ["Arc", "Context", "Event", "Line", "Pass", "Point", "Segment", "PLANES", "PLANE_AXES", "EXTRA_AXES", "replace"]

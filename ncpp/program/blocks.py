@@ -1,0 +1,131 @@
+"""Lossless NC blocks.
+
+A `Block` is one line of a program: its raw text, its line ending and the
+items parsed from it.  Every item keeps its span in the raw text, so a block
+that nobody changed is written back byte for byte, and a changed block keeps
+everything between and around the items it did not touch (libcst-style).
+
+Text is held as `str` decoded with Latin-1, which maps every byte to one
+character and back: any byte sequence (UTF-8 comments, Latin-1 accents, stray
+control bytes) survives the round trip.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Union
+
+# Expression nodes are nested tuples, cheap to build and easy to evaluate:
+#   ("num", float) ("param", key) ("neg", x) ("pos", x) ("bin", op, a, b)
+#   ("call", name, x) ("atan2", a, b) ("exists", param)
+# where a parameter key is an int, a "<name>" string or ("ref", expr).
+Expr = tuple
+
+
+class Item:
+    """Something parsed from a block, with its [start, end) span in the raw text."""
+
+    __slots__ = ("start", "end")
+
+    def __init__(self, start: int, end: int):
+        self.start = start
+        self.end = end
+
+    def _fields(self) -> tuple:
+        return tuple(getattr(self, name) for cls in type(self).__mro__ for name in getattr(cls, "__slots__", ()))
+
+    def __eq__(self, other: object) -> bool:
+        return type(self) is type(other) and self._fields() == other._fields()  # type: ignore[union-attr]
+
+    def __hash__(self) -> int:
+        return hash((type(self), self._fields()))
+
+    def __repr__(self) -> str:
+        names = [n for cls in reversed(type(self).__mro__) for n in getattr(cls, "__slots__", ())]
+        return f"{type(self).__name__}({', '.join(f'{n}={getattr(self, n)!r}' for n in names)})"
+
+
+class Word(Item):
+    """A letter with a number: `G1`, `Z -110`, `F100.`; `,C1.` has letter ',C'.
+
+    `number` is the number exactly as written (without letter and spaces),
+    so that a rewritten value can keep the program's number style.
+    """
+
+    __slots__ = ("letter", "value", "number")
+
+    def __init__(self, letter: str, value: float, number: str, start: int, end: int):
+        super().__init__(start, end)
+        self.letter = letter
+        self.value = value
+        self.number = number
+
+
+class ExprWord(Item):
+    """A letter whose value is an expression: `X[#1+2]`, `X#140/2`."""
+
+    __slots__ = ("letter", "expr")
+
+    def __init__(self, letter: str, expr: Expr, start: int, end: int):
+        super().__init__(start, end)
+        self.letter = letter
+        self.expr = expr
+
+
+class Comment(Item):
+    """`(text)` or `; text`; `text` excludes the delimiters."""
+
+    __slots__ = ("text", "style")
+
+    def __init__(self, text: str, style: str, start: int, end: int):
+        super().__init__(start, end)
+        self.text = text
+        self.style = style
+
+
+class Statement(Item):
+    """A construct the motion interpreter does not execute directly.
+
+    kind: 'block_delete', 'assignment', 'oword', 'program_name', 'tape',
+    'checksum', 'if', 'while', 'end', 'goto'.  `node` holds its parsed parts
+    (a tuple whose shape depends on kind).
+    """
+
+    __slots__ = ("kind", "node")
+
+    def __init__(self, kind: str, node: tuple, start: int, end: int):
+        super().__init__(start, end)
+        self.kind = kind
+        self.node = node
+
+
+AnyItem = Union[Word, ExprWord, Comment, Statement]
+
+
+@dataclass(slots=True, eq=True)
+class Block:
+    """One line: `raw` (without line ending), `eol` ('\\n', '\\r\\n' or '') and items.
+
+    `verbatim` blocks (after the closing tape mark) are kept as text only.
+    """
+
+    raw: str
+    eol: str
+    items: tuple[AnyItem, ...]
+    line: int = 0
+    verbatim: bool = False
+
+    @property
+    def text(self) -> str:
+        return self.raw + self.eol
+
+    def words(self) -> list[Word]:
+        return [item for item in self.items if type(item) is Word]
+
+    @property
+    def plain(self) -> bool:
+        """True when every item is a plain word or a comment (no expressions, no control)."""
+        return all(type(item) is Word or type(item) is Comment for item in self.items)
+
+    def source(self, item: Item) -> str:
+        return self.raw[item.start : item.end]

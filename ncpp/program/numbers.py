@@ -1,0 +1,54 @@
+"""Number style: write a new value the way the program writes its numbers.
+
+`X10.` `X010.500` `X.5` `X+1.25`: decimal places, trailing dot, leading zero
+before the point, zero padding and explicit plus sign are read from the
+number text as written, and `format_number` applies them to a new value.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True, slots=True)
+class NumberStyle:
+    decimals: int = 4  # digits after the point
+    trailing_dot: bool = False  # `10.` for a whole number with no decimals
+    leading_zero: bool = True  # `0.5` rather than `.5`
+    int_width: int = 0  # zero-padded integer digits (`X010.5` -> 3)
+    plus_sign: bool = False
+
+    @classmethod
+    def of(cls, number: str) -> "NumberStyle":
+        """The style of a number as written (sign included, letter excluded)."""
+        plus = number.startswith("+")
+        digits = number.lstrip("+-")
+        whole, dot, frac = digits.partition(".")
+        padded = len(whole) > 1 and whole.startswith("0")
+        return cls(
+            decimals=len(frac),
+            trailing_dot=bool(dot) and not frac,
+            leading_zero=bool(whole) or not dot,
+            int_width=len(whole) if padded else 0,
+            plus_sign=plus,
+        )
+
+    def at_least(self, decimals: int) -> "NumberStyle":
+        """The same style with at least `decimals` places (never lose resolution)."""
+        if decimals <= self.decimals:
+            return self
+        return NumberStyle(decimals, False, self.leading_zero, self.int_width, self.plus_sign)
+
+
+def format_number(value: float, style: NumberStyle) -> str:
+    text = f"{abs(value):.{style.decimals}f}"
+    if float(text) == 0.0:
+        value = 0.0  # no `-0.000`
+    whole, _, frac = text.partition(".")
+    if style.int_width:
+        whole = whole.zfill(style.int_width)
+    if whole == "0" and frac and not style.leading_zero:
+        whole = ""
+    body = f"{whole}.{frac}" if frac else (f"{whole}." if style.trailing_dot else whole)
+    sign = "-" if value < 0 else ("+" if style.plus_sign else "")
+    return sign + body

@@ -1,0 +1,93 @@
+"""Write blocks back to NC text.
+
+An unchanged block is its raw text.  `edit_words` rewrites the values of some
+words of a block in place, keeping every other character, and appends words
+the block did not have after its last word, separated the way the block
+separates its words.
+"""
+
+from __future__ import annotations
+
+from typing import BinaryIO, Iterable, Mapping
+
+from ncpp.program.blocks import Block, Comment, Word
+from ncpp.program.numbers import NumberStyle, format_number
+
+
+AXIS_LETTERS = frozenset("XYZABCUVWIJKR")
+
+
+def write_blocks(blocks: Iterable[Block], out: BinaryIO) -> int:
+    """Write blocks as bytes (Latin-1, the inverse of the parser's decoding)."""
+    count = 0
+    for block in blocks:
+        out.write(block.text.encode("latin-1"))
+        count += 1
+    return count
+
+
+def word_separator(block: Block) -> str:
+    """' ' when the block separates its words with spaces, '' when it packs them."""
+    words = block.words()
+    for left, right in zip(words, words[1:]):
+        return block.raw[left.end : right.start] if right.start > left.end else ""
+    return " "
+
+
+def edit_words(
+    block: Block,
+    values: Mapping[str, float],
+    style_for: Mapping[str, NumberStyle],
+    drop: Iterable[str] = (),
+) -> str:
+    """The raw text of `block` with the words of `values` set (replaced or
+    appended) and the words of `drop` removed.
+
+    The letter's case as written is kept for replaced words; spacing between
+    items is kept; comments stay where they were.
+    """
+    raw = block.raw
+    pieces: list[str] = []
+    cursor = 0
+    pending = dict(values)
+    dropped = set(drop)
+    last_word_end = None  # where appended words go: after the last axis word, else the last word
+    seen_axis = False
+    for item in block.items:
+        if type(item) is Word and (item.letter in pending or item.letter in dropped):
+            pieces.append(raw[cursor : item.start])
+            if item.letter in pending:
+                letter_as_written = raw[item.start]
+                pieces.append(letter_as_written + format_number(pending.pop(item.letter), style_for[item.letter]))
+            else:
+                # remove the word and the separator before it
+                if pieces and pieces[-1].endswith((" ", "\t")) and item.start > cursor:
+                    pieces[-1] = pieces[-1].rstrip(" \t")
+            cursor = item.end
+            last_word_end, seen_axis = len("".join(pieces)), True
+        elif type(item) is not Comment:
+            pieces.append(raw[cursor : item.end])
+            cursor = item.end
+            is_axis = type(item) is Word and item.letter in AXIS_LETTERS
+            if is_axis or not seen_axis:
+                last_word_end = len("".join(pieces))
+                seen_axis = seen_axis or is_axis
+    head = "".join(pieces)
+    tail = raw[cursor:]
+    if pending:
+        sep = word_separator(block)
+        lower = _lower_case(block)
+        extra = "".join(
+            sep + (letter.lower() if lower else letter) + format_number(value, style_for[letter])
+            for letter, value in pending.items()
+        )
+        at = last_word_end if last_word_end is not None else len(head)
+        if last_word_end is None and not head.strip():
+            extra = extra.lstrip()
+        head = head[:at] + extra + head[at:]
+    return head + tail
+
+
+def _lower_case(block: Block) -> bool:
+    words = block.words()
+    return bool(words) and all(block.raw[w.start].islower() for w in words if block.raw[w.start].isalpha())

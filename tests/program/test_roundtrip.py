@@ -1,0 +1,84 @@
+"""Lossless round trip: every ISO-family corpus program comes back byte for byte."""
+
+from __future__ import annotations
+
+import io
+import subprocess
+import sys
+
+import pytest
+
+from ncpp.errors import NcppError
+from ncpp.program.parser import LineParser, parse_stream
+from ncpp.program.writer import write_blocks
+from tests.conftest import CORPUS, corpus_files, corpus_id
+
+ISO_FOLDERS = ("iso_gcode",)
+# Malformed files that are still syntactically valid NC (their errors are semantic).
+MALFORMED = [p for p in corpus_files("malformed") if p.suffix in (".ngc", ".gcode", ".nc")]
+UNREADABLE = {"exists-1.ngc", "exists-2.ngc", "exists-4.ngc", "messed-up.gcode"}
+
+
+def roundtrip(data: bytes, name: str) -> bytes:
+    out = io.BytesIO()
+    write_blocks(parse_stream(io.BytesIO(data), name), out)
+    return out.getvalue()
+
+
+@pytest.mark.parametrize("path", corpus_files(*ISO_FOLDERS), ids=corpus_id)
+def test_corpus_program_roundtrips_byte_for_byte(path):
+    data = path.read_bytes()
+    assert roundtrip(data, str(path)) == data
+
+
+@pytest.mark.parametrize("path", [p for p in MALFORMED if p.name not in UNREADABLE], ids=corpus_id)
+def test_malformed_but_readable_programs_roundtrip(path):
+    data = path.read_bytes()
+    assert roundtrip(data, str(path)) == data
+
+
+@pytest.mark.parametrize("name", sorted(UNREADABLE))
+def test_unreadable_programs_name_file_line_and_column(name):
+    path = next(p for p in MALFORMED if p.name == name)
+    with pytest.raises(NcppError) as err:
+        roundtrip(path.read_bytes(), str(path))
+    where = err.value.where
+    assert where.file == str(path) and where.line >= 1 and where.col >= 1
+
+
+def test_fast_path_agrees_with_lalr_parser_on_corpus():
+    """The plain-line scanner must build exactly what the grammar builds."""
+    parser = LineParser("iso")
+    checked = 0
+    for path in corpus_files(*ISO_FOLDERS):
+        for block in parse_stream(io.BytesIO(path.read_bytes()), str(path)):
+            if block.line > 3000:  # the large files add nothing new past this
+                break
+            fast = parser._scan_plain(block.raw)
+            if fast is None or block.verbatim:
+                continue
+            assert fast == parser._parse_lalr(block.raw, block.line, str(path)), (path, block.line)
+            checked += 1
+    assert checked > 20_000
+
+
+def test_cli_passthrough_is_byte_identical(tmp_path):
+    path = CORPUS / "iso_gcode/cncjs_toolpath_fixtures/arc-no-plane.nc"  # CRLF
+    out = subprocess.run([sys.executable, "-m", "ncpp"], input=path.read_bytes(), capture_output=True, check=True)
+    assert out.stdout == path.read_bytes()
+    target = tmp_path / "out.nc"
+    subprocess.run([sys.executable, "-m", "ncpp", str(path), "-o", str(target)], check=True)
+    assert target.read_bytes() == path.read_bytes()
+
+
+def test_cli_error_has_location_no_traceback_and_no_output(tmp_path):
+    bad = tmp_path / "bad.nc"
+    bad.write_bytes(b"G1 X1\nG1 X2 Y(unclosed\nG1 X3\n")
+    target = tmp_path / "out.nc"
+    proc = subprocess.run([sys.executable, "-m", "ncpp", str(bad), "-o", str(target)], capture_output=True, text=True)
+    assert proc.returncode != 0
+    assert proc.stderr.startswith(f"{bad}:2:")
+    assert "Traceback" not in proc.stderr
+    assert not target.exists()
+    proc = subprocess.run([sys.executable, "-m", "ncpp"], input=bad.read_bytes(), capture_output=True)
+    assert proc.returncode != 0 and proc.stdout == b""
