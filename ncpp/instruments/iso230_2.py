@@ -25,7 +25,7 @@ B̄ are undefined (None), and the bidirectional figures reduce to those of the
 one direction (A = A↑, E = E↑, R = R↑, M = E↑), which is what the
 definitions above give when the other direction's set is empty.  With a
 single run per direction s is undefined (NaN), and so are A and R.
-Targets are matched by value (to 1 nm); a target measured in only one
+Targets are matched by value (to 1 µm); a target measured in only one
 direction of a bidirectional test is used only for the unidirectional figures.
 """
 
@@ -174,9 +174,9 @@ def evaluate_positioning(target_mm: np.ndarray, direction: np.ndarray, deviation
     deviation = np.asarray(deviation, dtype=float)
     if target_mm.size == 0:
         raise ValueError("no readings")
-    keys = np.round(target_mm * 1e6).astype(np.int64)  # match targets to 1 nm
+    keys = np.round(target_mm * 1e3).astype(np.int64)  # match targets to 1 µm
     unique, index = np.unique(keys, return_inverse=True)
-    targets = unique / 1e6
+    targets = np.bincount(index, weights=target_mm) / np.bincount(index)
     return Iso230_2(
         targets,
         _direction_stats(index, deviation, direction == "+", len(unique)),

@@ -49,6 +49,10 @@ Derivations (u = (cosθ, sinθ), ΔR ≈ u·δ for a small error δ of the movin
 
 Units of the reported figures: µm/m for squareness and scale, ms for servo
 mismatch, µm for backlash, spikes, centre offsets and radius deviation.
+`centre_offset_<axis>_um` is the centre of the path minus the fixed ball
+(the set-up error the LSC centring removes), mean of the directions;
+`radius_deviation_um` is the mean radius minus nominal (bar calibration and
+mean scale); `residual_rms_um` what the model leaves unexplained.
 """
 
 from __future__ import annotations
@@ -223,9 +227,23 @@ def _hysteresis(test: CircularTest, centre_um: np.ndarray) -> float | None:
     if ccw is None or cw is None:
         return None
     grid = np.union1d(ccw.angle_deg, cw.angle_deg)
+    grid = grid[_covered(ccw.angle_deg, grid) & _covered(cw.angle_deg, grid)]
+    if grid.size == 0:
+        return None
     a = np.interp(grid, ccw.angle_deg, centred(ccw, centre_um, test.radius_mm), period=360.0)
     b = np.interp(grid, cw.angle_deg, centred(cw, centre_um, test.radius_mm), period=360.0)
     return float(np.max(np.abs(a - b)))
+
+
+def _covered(angles: np.ndarray, at: np.ndarray) -> np.ndarray:
+    """Which angles `at` lie inside the arc a trace covers (no interpolation across a gap,
+    e.g. the open part of a partial-arc test in a vertical plane)."""
+    ordered = np.unique(angles)
+    gaps = np.diff(np.append(ordered, ordered[0] + 360.0))
+    limit = 3.0 * np.median(gaps)
+    slot = np.searchsorted(ordered, at, side="right") - 1  # gap that starts at ordered[slot]
+    on_point = np.isin(at, ordered)
+    return on_point | (gaps[slot % len(ordered)] <= limit)
 
 
 def evaluate_measurement(m: Measurement) -> Iso230_4:

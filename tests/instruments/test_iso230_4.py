@@ -140,3 +140,17 @@ def test_sample_files(samples_dir):
     assert [t.direction for t in grid.traces] == ["CCW"]  # deduced from the path order
     cutting = evaluate_measurement(read_measurement(samples_dir / "cutting_XY_R50.csv"))
     assert cutting.F_max < 0 and 2.0 < cutting.G < 5.0
+
+
+def test_partial_arcs_compare_only_where_both_were_measured(generator):
+    # Vertical-plane style partial arcs: CCW over 0..200 deg, CW over 340..180 deg.
+    ccw_a = np.arange(0.0, 201.0, 2.0)
+    cw_a = np.arange(-20.0, 181.0, 2.0) % 360
+    shape = lambda a: 2 * np.sin(np.radians(2 * a))  # noqa: E731
+    ccw = Trace("CCW", ccw_a, shape(ccw_a))
+    cw = Trace("CW", cw_a, shape(cw_a) + 0.5)
+    test = CircularTest((ccw, cw), 100.0, "ZX", 1000.0)
+    result = evaluate_circular(test)
+    assert result.H == pytest.approx(0.5, abs=0.05)  # no interpolation across the open arc
+    f = diagnose_circular(test).figures
+    assert f["squareness_um_per_m"] == pytest.approx(2 * 2 * 1000 / 100.0, rel=0.05)  # (sR/2) = 2 µm
