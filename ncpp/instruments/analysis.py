@@ -19,6 +19,7 @@ ballbar, cutting, circular     ISO 230-4    G G_cw G_ccw H F_max F_min (µm) and
 grid                                        diagnosis (see iso230_4): squareness_um_per_m,
                                             scale_mismatch_um_per_m, servo_mismatch_ms,
                                             backlash_<axis>_um, reversal_spike_<axis>_um,
+                                            cyclic_<axis>_um, cyclic_<axis>_period_mm,
                                             centre_offset_<axis>_um, radius_deviation_um,
                                             residual_rms_um
 grid (any path)                path         path_max_um, path_rms_um (length of the 2-D

@@ -30,6 +30,8 @@ axes, e.g. X, Y)::
              − b_q · σ sign(cosθ) sinθ / 2              backlash of q
              + h_p · Σ_r exp(−φ_r/φ0)                   reversal spike of p (θ_r = 0°, 180°)
              + h_q · Σ_r exp(−φ_r/φ0)                   reversal spike of q (θ_r = 90°, 270°)
+             [+ cosθ·(α sin + β cos)(2π R cosθ / P_p)]  cyclic error of p, lead P_p, if found
+             [+ sinθ·(α sin + β cos)(2π R sinθ / P_q)]  cyclic error of q
 
 Derivations (u = (cosθ, sinθ), ΔR ≈ u·δ for a small error δ of the moving point):
 
@@ -285,8 +287,60 @@ def _features(t: Trace, width_deg: float) -> dict[str, np.ndarray]:
     }
 
 
+SCREW_LEADS_MM = (4.0, 5.0, 6.0, 8.0, 10.0, 12.0, 16.0, 20.0, 25.0, 32.0, 40.0)
+
+
+def _fit(design: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Least squares: coefficients, their standard uncertainties, residual.
+    Columns that are zero everywhere (e.g. no point near a reversal) stay 0 with NaN uncertainty."""
+    usable = np.any(design != 0, axis=0)
+    coef = np.zeros(design.shape[1])
+    coef[usable], *_ = np.linalg.lstsq(design[:, usable], y, rcond=None)
+    residual = y - design @ coef
+    sigma2 = float(residual @ residual) / max(len(y) - int(usable.sum()), 1)
+    std = np.full(design.shape[1], np.nan)
+    std[usable] = np.sqrt(np.diag(sigma2 * np.linalg.pinv(design[:, usable].T @ design[:, usable])))
+    return coef, std, residual
+
+
+def _cyclic_columns(test: CircularTest, axis: int, period_mm: float) -> np.ndarray:
+    """Radial shape of a periodic positioning error of one axis: u·(sin, cos)(2π·pos/period)."""
+    cols = []
+    for t in test.traces:
+        u = np.cos(t.theta) if axis == 0 else np.sin(t.theta)
+        phase = 2 * np.pi * test.radius_mm * u / period_mm
+        cols.append(np.column_stack([u * np.sin(phase), u * np.cos(phase)]))
+    return np.vstack(cols)
+
+
+def _cyclic_search(test: CircularTest, design: np.ndarray, y: np.ndarray, significance: float = 6.0) -> dict[int, float]:
+    """Greedy forward selection of periodic axis errors: each round adds the
+    (axis, screw lead) that explains most of the residual, if its amplitude
+    exceeds `significance` standard uncertainties.  Returns {axis index: period mm}."""
+    found: dict[int, float] = {}
+    periods = [P for P in SCREW_LEADS_MM if P <= test.radius_mm / 2]
+    while len(found) < 2:
+        current = np.column_stack([design, *(_cyclic_columns(test, a, P) for a, P in sorted(found.items()))])
+        base = _fit(current, y)[2]
+        best = None
+        for axis in {0, 1} - set(found):
+            for period in periods:
+                coef, std, residual = _fit(np.column_stack([current, _cyclic_columns(test, axis, period)]), y)
+                gain = float(base @ base - residual @ residual)
+                if best is None or gain > best[0]:
+                    best = (gain, axis, period, float(np.hypot(coef[-2], coef[-1])), float(np.mean(std[-2:])))
+        if best is None or not best[3] > significance * best[4]:
+            break
+        found[best[1]] = best[2]
+    return found
+
+
 def diagnose_circular(test: CircularTest, spike_width_deg: float = 3.0) -> Diagnosis:
-    """Fit the diagnosis model (module docstring) to all traces of `test` by least squares."""
+    """Fit the diagnosis model (module docstring) to all traces of `test` by least squares.
+
+    A cyclic (ball-screw lead) error per axis is added to the model when one of
+    the usual leads (`SCREW_LEADS_MM`, up to R/2) shows clearly: δp = c·sin(2π p/P + φ),
+    reported as `cyclic_<axis>_um` (amplitude c) and `cyclic_<axis>_period_mm`."""
     R = test.radius_mm
     bidirectional = len({t.direction for t in test.traces}) == 2
     shared = ["cos2", "sin2", "backlash_p", "backlash_q", "spike_p", "spike_q"] + (["servo"] if bidirectional else [])
@@ -299,19 +353,12 @@ def diagnose_circular(test: CircularTest, spike_width_deg: float = 3.0) -> Diagn
         blocks.append(np.column_stack([nuisance] + [feats[name] for name in shared]))
         ys.append(t.deviation_um)
     design, y = np.vstack(blocks), np.concatenate(ys)
-    # Columns that are zero everywhere (e.g. no point near a reversal) cannot be fitted.
-    usable = np.any(design != 0, axis=0)
-    coef = np.zeros(design.shape[1])
-    coef[usable], *_ = np.linalg.lstsq(design[:, usable], y, rcond=None)
-    fitted = design @ coef
-    residual = y - fitted
-    dof = max(len(y) - int(usable.sum()), 1)
-    sigma2 = float(residual @ residual) / dof
-    cov = np.full((design.shape[1],) * 2, np.nan)
-    cov[np.ix_(usable, usable)] = sigma2 * np.linalg.pinv(design[:, usable].T @ design[:, usable])
-    std = np.sqrt(np.diag(cov))
+    cyclic = _cyclic_search(test, design, y)
+    extra = [_cyclic_columns(test, axis, period) for axis, period in sorted(cyclic.items())]
+    full = np.column_stack([design, *extra])
+    coef, std, residual = _fit(full, y)
+    fitted = y - residual
     named = dict(zip(shared, range(3 * n_dir, 3 * n_dir + len(shared))))
-    value = {name: (coef[i], std[i]) for name, i in named.items()}
     p, q = test.axes
     v = test.feed_mm_min / 60.0 if test.feed_mm_min else None
     scale = {  # figure name -> (model term, factor from coefficient to figure)
@@ -326,17 +373,24 @@ def diagnose_circular(test: CircularTest, spike_width_deg: float = 3.0) -> Diagn
     figures: dict[str, float | None] = {}
     uncertainty: dict[str, float | None] = {}
     for name, (term, factor) in scale.items():
-        if term not in value or factor is None or not usable[named[term]]:
+        i = named.get(term)
+        if i is None or factor is None or not np.isfinite(std[i]):
             figures[name] = uncertainty[name] = None
             continue
-        figures[name] = float(value[term][0] * factor)
-        uncertainty[name] = float(value[term][1] * factor)
-    radius = [coef[3 * k] for k in range(n_dir)]
-    cx = [coef[3 * k + 1] for k in range(n_dir)]
-    cy = [coef[3 * k + 2] for k in range(n_dir)]
-    figures[f"centre_offset_{p}_um"] = float(np.mean(cx))
-    figures[f"centre_offset_{q}_um"] = float(np.mean(cy))
-    figures["radius_deviation_um"] = float(np.mean(radius))
+        figures[name] = float(coef[i] * factor)
+        uncertainty[name] = float(std[i] * factor)
+    column = design.shape[1]
+    for axis, letter in enumerate((p, q)):
+        if axis in cyclic:
+            amplitude = float(np.hypot(coef[column], coef[column + 1]))
+            figures[f"cyclic_{letter}_um"], uncertainty[f"cyclic_{letter}_um"] = amplitude, float(np.mean(std[column : column + 2]))
+            figures[f"cyclic_{letter}_period_mm"] = cyclic[axis]
+            column += 2
+        else:
+            figures[f"cyclic_{letter}_um"] = figures[f"cyclic_{letter}_period_mm"] = uncertainty[f"cyclic_{letter}_um"] = None
+    figures[f"centre_offset_{p}_um"] = float(np.mean(coef[1 : 3 * n_dir : 3]))
+    figures[f"centre_offset_{q}_um"] = float(np.mean(coef[2 : 3 * n_dir : 3]))
+    figures["radius_deviation_um"] = float(np.mean(coef[0 : 3 * n_dir : 3]))
     figures["residual_rms_um"] = float(math.sqrt(float(residual @ residual) / len(y)))
     splits = np.cumsum([len(t.theta) for t in test.traces])[:-1]
     return Diagnosis(figures, uncertainty, figures["residual_rms_um"], tuple(np.split(fitted, splits)))

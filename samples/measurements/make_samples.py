@@ -57,6 +57,8 @@ def simulate_circle(
     lag_ms: tuple[float, float] = (0.0, 0.0),
     spike_um: tuple[float, float] = (0.0, 0.0),
     spike_width_deg: float = 3.0,
+    cyclic_um: tuple[float, float] = (0.0, 0.0),
+    cyclic_period_mm: float = 10.0,
     setup_offset_um: tuple[float, float] = (0.0, 0.0),
     noise_um: float = 0.0,
     rng: np.random.Generator | None = None,
@@ -83,8 +85,9 @@ def simulate_circle(
     q = radius_mm * np.sin(theta - lag[1])
     p = play(p, backlash_um[0] / 1000.0) + reversal_spike(p_cmd, travel, spike_um[0] / 1000.0, spike_width_deg)
     q = play(q, backlash_um[1] / 1000.0) + reversal_spike(q_cmd, travel, spike_um[1] / 1000.0, spike_width_deg)
-    p_act = p * (1 + scale_um_per_m[0] * 1e-6) + squareness_um_per_m * 1e-6 * q
-    q_act = q * (1 + scale_um_per_m[1] * 1e-6)
+    wave = 2 * np.pi / cyclic_period_mm
+    p_act = p * (1 + scale_um_per_m[0] * 1e-6) + squareness_um_per_m * 1e-6 * q + cyclic_um[0] / 1000.0 * np.sin(wave * p)
+    q_act = q * (1 + scale_um_per_m[1] * 1e-6) + cyclic_um[1] / 1000.0 * np.sin(wave * q)
     ball = np.array(setup_offset_um) / 1000.0
     length = np.hypot(p_act - ball[0], q_act - ball[1])
     keep = (index >= 0) & (index < points * fine) & (index % fine == 0)

@@ -154,3 +154,11 @@ def test_partial_arcs_compare_only_where_both_were_measured(generator):
     assert result.H == pytest.approx(0.5, abs=0.05)  # no interpolation across the open arc
     f = diagnose_circular(test).figures
     assert f["squareness_um_per_m"] == pytest.approx(2 * 2 * 1000 / 100.0, rel=0.05)  # (sR/2) = 2 µm
+
+
+def test_cyclic_error_is_found_with_its_lead(generator):
+    rng = np.random.default_rng(3)
+    f = diagnose(generator, cyclic_um=(0.0, 1.5), cyclic_period_mm=16.0, backlash_um=(2.0, 2.0), noise_um=0.2, rng=rng)
+    assert f["cyclic_Y_um"] == pytest.approx(1.5, abs=0.15) and f["cyclic_Y_period_mm"] == 16.0
+    assert f["cyclic_X_um"] is None  # nothing there, nothing reported
+    assert f["backlash_X_um"] == pytest.approx(2.0, abs=0.2)
