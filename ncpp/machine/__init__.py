@@ -20,7 +20,7 @@ from ncpp.machine.components import (
     canonical_name,
 )
 from ncpp.machine.effects import EFFECTS, Effect, effect_from_dict
-from ncpp.machine.io import load_machine, loads_machine, machine_to_dict, save_machine
+from ncpp.machine.io import dumps_machine, load_machine, loads_machine, machine_to_dict, save_machine
 from ncpp.machine.model import Machine
 from ncpp.machine.trajectory import Trajectory
 
@@ -37,6 +37,7 @@ __all__ = [
     "Table",
     "Trajectory",
     "canonical_name",
+    "dumps_machine",
     "effect_from_dict",
     "load_machine",
     "loads_machine",

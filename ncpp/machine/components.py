@@ -222,3 +222,74 @@ class Polynomial:
 
 
 Component = Union[Table, Polynomial]
+
+
+# ------------------------------------------------------------ fast evaluation
+def _cubic_pieces(table: Table, values: tuple[float, ...]) -> tuple[NDArray, NDArray]:
+    """Breakpoints x (m,) and per-interval cubic coefficients (m−1, 4), highest
+    power first in (p − x_i): the same curve `Table.__call__` evaluates."""
+    x, y = np.asarray(table.positions), np.asarray(values)
+    if len(x) == 1:
+        return np.array([x[0], x[0] + 1.0]), np.array([[0.0, 0.0, 0.0, y[0]]])
+    if table.interpolation == "linear" or len(x) < 3:
+        slope = np.diff(y) / np.diff(x)
+        zeros = np.zeros_like(slope)
+        return x, np.column_stack([zeros, zeros, slope, y[:-1]])
+    from scipy.interpolate import PchipInterpolator
+
+    return x, PchipInterpolator(x, y).c.T.copy()
+
+
+def _refine(x: NDArray, c: NDArray, grid: NDArray) -> NDArray:
+    """Re-expand a piecewise cubic on a finer breakpoint grid (which contains x);
+    outside [x0, x_end] the end values are held."""
+    left = grid[:-1]
+    i = np.clip(np.searchsorted(x, left, side="right") - 1, 0, len(x) - 2)
+    s = (left - x[i])[:, None]
+    c0, c1, c2, c3 = (c[i, k : k + 1] for k in range(4))
+    out = np.hstack([c0, 3 * c0 * s + c1, (3 * c0 * s + 2 * c1) * s + c2, ((c0 * s + c1) * s + c2) * s + c3])
+    first = np.polyval(c[0], 0.0)
+    last = np.polyval(c[-1], x[-1] - x[-2])
+    out[left >= x[-1]] = [0.0, 0.0, 0.0, last]
+    out[grid[1:] <= x[0]] = [0.0, 0.0, 0.0, first]
+    return out
+
+
+class StackedTables:
+    """All tables of one axis evaluated together: one interval search and one
+    row gather per point for every curve, instead of one per table.  Curves
+    are re-expanded on the union of the tables' breakpoints, so the result is
+    the tables' own interpolation, not a resampling."""
+
+    def __init__(self, tables: list[Table]):
+        curves = [(t, v) for t in tables for v in (t.values, t.values_minus) if v is not None]
+        pieces = [_cubic_pieces(t, v) for t, v in curves]
+        grid = np.unique(np.concatenate([x for x, _ in pieces]))
+        if len(grid) == 1:
+            grid = np.array([grid[0], grid[0] + 1.0])
+        self.grid = grid
+        # Per power, an (intervals, curves) array: a row gather fetches every curve.
+        stacked = np.stack([_refine(x, c, grid) for x, c in pieces], axis=2)
+        self.coefficients = [np.ascontiguousarray(stacked[:, k, :]) for k in range(4)]
+        self.columns: list[tuple[int, int | None]] = []  # per table: (+ column, − column)
+        col = 0
+        for t in tables:
+            self.columns.append((col, col + 1 if t.directional else None))
+            col += 2 if t.directional else 1
+
+    def __call__(self, positions: NDArray, direction: NDArray | None = None) -> list[NDArray]:
+        p = np.clip(positions, self.grid[0], self.grid[-1])
+        i = np.clip(np.searchsorted(self.grid, p, side="right") - 1, 0, len(self.grid) - 2)
+        dx = (p - self.grid[i])[:, None]
+        c0, c1, c2, c3 = self.coefficients
+        curves = c0.take(i, axis=0)  # Horner, in place
+        for c in (c1, c2, c3):
+            curves *= dx
+            curves += c.take(i, axis=0)
+        out = []
+        for plus, minus in self.columns:
+            if minus is None:
+                out.append(curves[:, plus])
+            else:
+                out.append(_select(direction, curves[:, plus], curves[:, minus]))
+        return out

@@ -354,6 +354,31 @@ def machine_to_dict(m: Machine) -> dict[str, Any]:
     return doc
 
 
+_NUMBER_ARRAY = re.compile(r"\[\n((?:[ \t]+[-+0-9.eEinfa]+,\n)+)[ \t]*\]")
+
+
+def _compact_arrays(text: str) -> str:
+    """tomli_w puts every array item on its own line; put numbers ten a line."""
+
+    def join(match: re.Match) -> str:
+        items = [line.strip().rstrip(",") for line in match.group(1).splitlines()]
+        if len(items) <= 10:
+            return "[" + ", ".join(items) + "]"
+        rows = [", ".join(items[i : i + 10]) for i in range(0, len(items), 10)]
+        return "[\n    " + ",\n    ".join(rows) + ",\n]"
+
+    return _NUMBER_ARRAY.sub(join, text)
+
+
+def dumps_machine(m: Machine) -> str:
+    """The machine file text."""
+    doc = machine_to_dict(m)
+    text = _compact_arrays(tomli_w.dumps(doc))
+    if tomllib.loads(text) != tomllib.loads(tomli_w.dumps(doc)):  # never trade meaning for looks
+        text = tomli_w.dumps(doc)
+    return text
+
+
 def save_machine(m: Machine, path: str | os.PathLike[str]) -> None:
     """Write a machine file atomically; `load_machine` reads it back equal."""
-    write_text_atomic(path, tomli_w.dumps(machine_to_dict(m)))
+    write_text_atomic(path, dumps_machine(m))

@@ -10,6 +10,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import TYPE_CHECKING, Any, Mapping
 
 import numpy as np
@@ -22,13 +23,22 @@ from ncpp.machine.chain import (
     linear_deviation,
     squareness_vectors,
 )
-from ncpp.machine.components import AXES, COMPONENTS, SQUARENESS, Component, canonical_name
+from ncpp.machine.components import (
+    AXES,
+    COMPONENTS,
+    SQUARENESS,
+    Component,
+    StackedTables,
+    Table,
+    canonical_name,
+)
 
 if TYPE_CHECKING:
     from ncpp.machine.effects import Effect
     from ncpp.machine.trajectory import Trajectory
 
 Vec3 = tuple[float, float, float]
+CHUNK = 1 << 15  # points per block: keeps the working arrays in cache
 
 
 def _vec3(value: ArrayLike, what: str) -> Vec3:
@@ -99,7 +109,8 @@ class Machine:
                 raise ValueError(f"{name} is a squareness; give it in `squareness`")
             if comp is not None:
                 comps[iso] = comp
-        setter("components", dict(sorted(comps.items())))
+        order = list(COMPONENTS)  # axis by axis: EXX EYX EZX EAX EBX ECX EXY ...
+        setter("components", dict(sorted(comps.items(), key=lambda item: order.index(item[0]))))
         sq = {}
         for name, value in self.squareness.items():
             iso = canonical_name(name)
@@ -131,6 +142,17 @@ class Machine:
         return _shaped_like(ok, P)
 
     # ------------------------------------------------------------ evaluation
+    @cached_property
+    def _evaluators(self) -> dict[str, tuple[StackedTables | None, list[str], list[tuple[str, Component]]]]:
+        """Per axis: its tables stacked for one-pass evaluation, and the rest."""
+        out = {}
+        for axis in AXES:
+            mine = [(n, c) for n, c in self.components.items() if COMPONENTS[n].axis == axis]
+            tables = [(n, c) for n, c in mine if isinstance(c, Table)]
+            stacked = StackedTables([c for _, c in tables]) if tables else None
+            out[axis] = (stacked, [n for n, _ in tables], [(n, c) for n, c in mine if not isinstance(c, Table)])
+        return out
+
     def error_motions(
         self, P: ArrayLike, direction: ArrayLike | None = None
     ) -> tuple[dict[str, NDArray], dict[str, NDArray]]:
@@ -140,20 +162,30 @@ class Machine:
         n = len(pts)
         delta = {a: np.zeros((n, 3)) for a in AXES}
         eps = {a: np.zeros((n, 3)) for a in AXES}
-        for name, comp in self.components.items():
-            info = COMPONENTS[name]
-            i = AXES.index(info.axis)
-            d = None if dirs is None else dirs[:, i]
-            target = delta if info.kind == "translation" else eps
-            target[info.axis][:, info.index] = comp(pts[:, i], d)
+        for i, axis in enumerate(AXES):
+            stacked, names, others = self._evaluators[axis]
+            p, d = pts[:, i], None if dirs is None else dirs[:, i]
+            values = list(zip(names, stacked(p, d))) if stacked is not None else []
+            values += [(name, comp(p, d)) for name, comp in others]
+            for name, value in values:
+                info = COMPONENTS[name]
+                (delta if info.kind == "translation" else eps)[axis][:, info.index] = value
         return delta, eps
 
-    def _kinematics(self, P: ArrayLike, direction: ArrayLike | None):
-        pts = as_points(P)
-        delta, eps = self.error_motions(pts, direction)
+    def _kinematics(self, pts: NDArray, dirs: NDArray | None):
+        delta, eps = self.error_motions(pts, dirs)
         refs = {a: np.asarray(r) for a, r in self.references.items()}
         sq = squareness_vectors(self.squareness["C0Y"], self.squareness["B0Z"], self.squareness["A0Z"])
         return Chain(self.chain), pts, np.asarray(self.tool), refs, delta, eps, sq
+
+    def _blockwise(self, kernel, P: ArrayLike, direction: ArrayLike | None) -> NDArray:
+        pts = as_points(P)
+        dirs = None if direction is None else np.broadcast_to(np.asarray(direction, dtype=float), pts.shape)
+        out = np.empty(pts.shape)
+        for start in range(0, len(pts), CHUNK):
+            block = slice(start, start + CHUNK)
+            out[block] = kernel(*self._kinematics(pts[block], None if dirs is None else dirs[block]))
+        return _shaped_like(out, P)
 
     def deviation(self, P: ArrayLike, direction: ArrayLike | None = None) -> NDArray:
         """Actual minus nominal tool point relative to the workpiece, mm.
@@ -161,11 +193,11 @@ class Machine:
         P: (n,3) axis positions X, Y, Z in mm (or one (3,) point).
         direction: optional (n,3) travel signs +1/−1/0 for direction-dependent
         tables (None or 0: the mean of the + and − tables)."""
-        return _shaped_like(exact_deviation(*self._kinematics(P, direction)), P)
+        return self._blockwise(exact_deviation, P, direction)
 
     def deviation_linear(self, P: ArrayLike, direction: ArrayLike | None = None) -> NDArray:
         """First-order deviation (thesis eqs. 28–30), mm."""
-        return _shaped_like(linear_deviation(*self._kinematics(P, direction)), P)
+        return self._blockwise(linear_deviation, P, direction)
 
     def abbe_offset(self, axis: str, P: ArrayLike) -> NDArray:
         """Lever arm L_K (mm) through which axis K's rotation moves the tool point."""

@@ -13,10 +13,9 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-import tomli_w
-
 from ncpp.fileio import write_text_atomic
-from ncpp.machine import Machine, Table, machine_to_dict
+from ncpp.machine import Machine, Table
+from ncpp.machine.io import dumps_machine
 from ncpp.machine.effects import Backlash, Cyclic, ReversalSpike, ServoMismatch
 
 HERE = Path(__file__).parent
@@ -128,7 +127,7 @@ def main() -> None:
         ),
     }
     for filename, (machine, note) in machines.items():
-        text = HEADER.format(title=machine.name, note=note) + "\n" + tomli_w.dumps(machine_to_dict(machine))
+        text = HEADER.format(title=machine.name, note=note) + "\n" + dumps_machine(machine)
         write_text_atomic(HERE / filename, text)
         print(f"wrote {HERE / filename}")
 
