@@ -73,9 +73,8 @@ def _polar_panel(ax, a: Analysis) -> None:
     full = np.linspace(0, 2 * np.pi, 361)
     ax.plot(full, np.zeros_like(full), "k--", lw=0.8, label=f"nominal R{test.radius_mm:g} mm")
     for direction, (t, dev) in centred.items():
-        order = np.argsort(t.angle_deg)
-        th = np.radians(np.append(t.angle_deg[order], t.angle_deg[order][0]))
-        ax.plot(th, np.append(dev[order], dev[order][0]), color=COLOURS[direction], lw=1.2, label=direction)
+        th, r = _closed_or_open(t.angle_deg, dev)
+        ax.plot(th, r, color=COLOURS[direction], lw=1.2, label=direction)
     ax.set_rticks(np.arange(-outer, outer + step / 2, step))
     ax.set_yticklabels([f"{v:+g}" for v in np.arange(-outer, outer + step / 2, step)], fontsize=7)
     ax.set_rlabel_position(67.5)
@@ -90,6 +89,18 @@ def _polar_panel(ax, a: Analysis) -> None:
     ax.set_title(f"{os.path.basename(a.measurement.source)}\n{describe(a.measurement)}\n" + ", ".join(parts), fontsize=9)
     ax.text(0.0, -0.08, f"scale {step:g} µm/div (LSC centred)\n" + _diagnosis_text(a), transform=ax.transAxes, fontsize=7, va="top")
     ax.legend(loc="upper right", bbox_to_anchor=(1.18, 1.08), fontsize=7)
+
+
+def _closed_or_open(angle_deg: np.ndarray, value: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Points in angle order; a full circle is closed, a partial arc starts after its gap."""
+    order = np.argsort(angle_deg, kind="stable")
+    a, v = angle_deg[order], value[order]
+    gaps = np.diff(np.append(a, a[0] + 360.0))
+    widest = int(np.argmax(gaps))
+    if gaps[widest] > 3 * np.median(gaps):
+        start = (widest + 1) % len(a)
+        return np.radians(np.roll(a, -start)), np.roll(v, -start)
+    return np.radians(np.append(a, a[0])), np.append(v, v[0])
 
 
 def _diagnosis_text(a: Analysis) -> str:

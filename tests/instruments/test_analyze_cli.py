@@ -76,3 +76,14 @@ def test_profiles_of_straightness_angle_and_level(samples_dir):
     level = analyze(make_measurement("level", {"quantity": "pitch"}, {"position_mm": x, "inclination_um_per_m": np.full(11, 10.0)}))
     assert level.figures["integrated_straightness_um"] == pytest.approx(0.0, abs=1e-9)
     assert level.profiles["height"].value[-1] == pytest.approx(5.0)  # 10 µm/m × 0.5 m
+
+
+def test_polar_trace_is_closed_only_for_a_full_circle():
+    from ncpp.instruments.plots import _closed_or_open
+
+    full = np.arange(0.0, 360.0, 10.0)
+    th, r = _closed_or_open(full, full)
+    assert len(th) == len(full) + 1 and r[-1] == r[0]
+    arc = np.r_[np.arange(340.0, 360.0, 10.0), np.arange(0.0, 181.0, 10.0)]
+    th, r = _closed_or_open(arc, arc)
+    assert len(th) == len(arc) and r[0] == 340.0 and r[-1] == 180.0
