@@ -179,7 +179,8 @@ def _machine_from_dict(data: dict, loc: _Locator, default_name: str) -> Machine:
                 raise ValueError(f"{name} is a squareness; put it in [squareness] as {iso}_urad")
             components[iso] = _component_from_dict(iso, spec)
         except (ValueError, TypeError) as err:
-            raise _fail(f"errors.{name}: {err}", loc.where(f"errors.{name}")) from err
+            key = _key_named_in(str(err), spec)
+            raise _fail(f"errors.{name}: {err}", loc.where(f"errors.{name}", key)) from err
     for key, value in _get_table(data, "squareness", loc).items():
         try:
             base, unit = _split_unit(key, ("_urad", "_um_per_m"))
@@ -197,7 +198,8 @@ def _machine_from_dict(data: dict, loc: _Locator, default_name: str) -> Machine:
         try:
             parsed_effects.append(effect_from_dict(spec))
         except (ValueError, TypeError) as err:
-            raise _fail(f"effects #{n + 1}: {err}", loc.where("effects", nth=n)) from err
+            key = _key_named_in(str(err), spec)
+            raise _fail(f"effects #{n + 1}: {err}", loc.where("effects", key, nth=n)) from err
     comp = _get_table(data, "compensation", loc)
     _check_keys(comp, {"max_correction_mm"}, "compensation", loc)
     try:
@@ -216,6 +218,12 @@ def _machine_from_dict(data: dict, loc: _Locator, default_name: str) -> Machine:
         )
     except (ValueError, TypeError) as err:
         raise _fail(str(err), _where_for_machine_error(str(err), loc)) from err
+
+
+def _key_named_in(message: str, spec: Any) -> str | None:
+    """The key of `spec` an error message talks about (longest match), if any."""
+    keys = sorted(spec, key=len, reverse=True) if isinstance(spec, dict) else []
+    return next((k for k in keys if k in message), None)
 
 
 def _meta(head: dict, data: dict) -> dict:
