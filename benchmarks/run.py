@@ -1,0 +1,301 @@
+"""ncpp benchmarks: throughput against pygcode and LinuxCNC's rs274, and memory.
+
+    python benchmarks/run.py [--quick]
+
+One run measures every tool on the same files and prints a table; the
+figures also go to benchmarks/out/results.json.  See benchmarks/README.md.
+
+A benchmark is a *section*: a function `(Context) -> Section` listed in
+SECTIONS.  Later benchmarks (compensation throughput, accuracy) are added
+by writing one more such function and appending it to SECTIONS.
+"""
+
+from __future__ import annotations
+
+import argparse
+import inspect
+import io
+import json
+import os
+import platform
+import subprocess
+import sys
+import tempfile
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable, Iterator
+
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parent
+sys.path.insert(0, str(ROOT))  # measure the checkout, not an installed copy
+sys.path.insert(0, str(HERE))
+
+from generate import generate  # noqa: E402
+
+SHARED = Path(os.environ.get("NCPP_SHARED", ROOT.parent / "shared"))
+STELLABEE = SHARED / "corpus/iso_gcode/linuxcnc/large/stellabee1.ngc"
+RS274 = SHARED / "tools/rs274"
+OUT = HERE / "out" / "results.json"
+
+
+@dataclass
+class Context:
+    quick: bool
+    workdir: Path  # temporary; generated programs live here and are deleted at the end
+    programs: dict[str, Path] = field(default_factory=dict)  # label -> program used by every tool
+
+    def generated(self, lines: int) -> Path:
+        """A generated program of `lines` lines (made once per run, seed fixed)."""
+        path = self.workdir / f"generated-{lines}.ngc"
+        if not path.exists():
+            generate(path, lines)
+        return path
+
+
+@dataclass
+class Section:
+    title: str
+    columns: list[str]
+    rows: list[list[Any]]
+    data: dict[str, Any]  # what goes into results.json
+    notes: list[str] = field(default_factory=list)
+
+
+# -- the tools being measured -------------------------------------------------
+
+
+def count_lines(path: Path) -> int:
+    with open(path, "rb") as f:
+        return sum(chunk.count(b"\n") for chunk in iter(lambda: f.read(1 << 20), b""))
+
+
+def interpreter() -> Callable | None:
+    """ncpp.motion.interpret, when the motion interpreter exists in this checkout."""
+    try:
+        from ncpp.motion import interpret
+    except ImportError:
+        return None
+    return interpret
+
+
+def _interpret_call(interpret: Callable, blocks: Iterator, name: str) -> Iterator:
+    from ncpp.errors import Warnings
+
+    accepted = inspect.signature(interpret).parameters
+    options = {"file": name, "warnings": Warnings(stream=open(os.devnull, "w")), "strict": False}
+    return interpret(blocks, **{k: v for k, v in options.items() if k in accepted})
+
+
+def ncpp_rate(path: Path, interpret: Callable | None) -> dict[str, Any]:
+    """Parse (and interpret) a program in this process; lines/s over the whole file."""
+    from ncpp.program.parser import parse_stream
+
+    start = time.perf_counter()
+    with open(path, "rb") as stream:
+        blocks = parse_stream(stream, str(path))
+        if interpret is None:
+            lines = sum(1 for _ in blocks)
+            events = None
+        else:
+            counted = _Counter(blocks)
+            events = sum(1 for _ in _interpret_call(interpret, counted, str(path)))
+            lines = counted.count
+    seconds = time.perf_counter() - start
+    return {"lines": lines, "seconds": seconds, "lines_per_s": lines / seconds, "events": events}
+
+
+class _Counter:
+    """Passes blocks through and counts them."""
+
+    def __init__(self, blocks: Iterator):
+        self.blocks, self.count = blocks, 0
+
+    def __iter__(self):
+        for block in self.blocks:
+            self.count += 1
+            yield block
+
+
+def pygcode_rate(path: Path) -> dict[str, Any]:
+    """pygcode `Line()` on every line; lines it refuses are counted, by error type."""
+    import pygcode
+
+    failures: dict[str, int] = {}
+    lines = 0
+    start = time.perf_counter()
+    with open(path, "rb") as stream:
+        for raw in stream:
+            lines += 1
+            try:
+                pygcode.Line(raw.decode("latin-1").rstrip("\r\n"))
+            except Exception as err:  # pygcode raises several types; all count as a refusal
+                failures[type(err).__name__] = failures.get(type(err).__name__, 0) + 1
+    seconds = time.perf_counter() - start
+    return {
+        "lines": lines,
+        "seconds": seconds,
+        "lines_per_s": lines / seconds,
+        "failed_lines": sum(failures.values()),
+        "failures": failures,
+        "version": getattr(pygcode, "__version__", "?"),
+    }
+
+
+def rs274_rate(path: Path, lines: int) -> dict[str, Any]:
+    """Wall time of the whole rs274 process (canonical calls to /dev/null)."""
+    start = time.perf_counter()
+    proc = subprocess.run([str(RS274), str(path)], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    seconds = time.perf_counter() - start
+    message = proc.stderr.decode("latin-1").replace("executing", "").strip()
+    return {
+        "lines": lines,
+        "seconds": seconds,
+        "lines_per_s": lines / seconds,
+        "completed": proc.returncode == 0,
+        "error": message if proc.returncode else "",
+    }
+
+
+def peak_rss(path: Path) -> dict[str, Any]:
+    """Peak RSS of `python -m ncpp < path > /dev/null`, from wait4's rusage of that child."""
+    start = time.perf_counter()
+    with open(path, "rb") as stdin:
+        proc = subprocess.Popen(
+            [sys.executable, "-m", "ncpp"], stdin=stdin, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, cwd=ROOT
+        )
+        stderr = proc.stderr.read()  # type: ignore[union-attr]
+        _, status, usage = os.wait4(proc.pid, 0)
+        proc.returncode = os.waitstatus_to_exitcode(status)
+    seconds = time.perf_counter() - start
+    return {
+        "rss_mb": usage.ru_maxrss / 1024,  # Linux reports kB
+        "seconds": seconds,
+        "exit": proc.returncode,
+        "stderr_tail": stderr.decode("latin-1")[-300:],
+    }
+
+
+# -- sections -----------------------------------------------------------------
+
+
+def throughput(ctx: Context) -> Section:
+    """Lines/s of ncpp, pygcode and rs274 on the same files."""
+    lines_generated = 250_000 if ctx.quick else 1_000_000
+    ctx.programs = {"stellabee1.ngc": STELLABEE, f"generated {lines_generated:,} lines": ctx.generated(lines_generated)}
+    interpret = interpreter()
+    rows, data = [], {}
+    for label, path in ctx.programs.items():
+        lines = count_lines(path)
+        parse = ncpp_rate(path, None)
+        full = ncpp_rate(path, interpret) if interpret else None
+        ours = full or parse
+        pyg = pygcode_rate(path)
+        rs = rs274_rate(path, lines)
+        data[label] = {
+            "path": str(path),
+            "lines": lines,
+            "ncpp_parse": parse,
+            "ncpp_parse_interpret": full,
+            "pygcode": pyg,
+            "rs274": rs,
+            "ratio_ncpp_pygcode": ours["lines_per_s"] / pyg["lines_per_s"],
+            "ratio_ncpp_rs274": ours["lines_per_s"] / rs["lines_per_s"],
+        }
+        rows.append([label, "ncpp parse", _rate(parse), ""])
+        if full:
+            rows.append([label, "ncpp parse+interpret", _rate(full), f"{full['events']:,} events"])
+        rows.append([label, "pygcode Line()", _rate(pyg), f"{pyg['failed_lines']:,} lines refused"])
+        rows.append([label, "rs274 (process)", _rate(rs), "completed" if rs["completed"] else f"STOPPED: {rs['error']}"])
+        what = "parse+interpret" if full else "parse"
+        rows.append([label, f"ratio ncpp {what} / pygcode", f"{data[label]['ratio_ncpp_pygcode']:.2f}x", ""])
+        rows.append([label, f"ratio ncpp {what} / rs274", f"{data[label]['ratio_ncpp_rs274']:.2f}x", ""])
+    notes = [] if interpret else ["ncpp.motion.interpret is not importable yet: ncpp figures are parse only."]
+    data["interpreter_available"] = interpret is not None
+    return Section("Throughput (lines/s, one pass over each file)", ["program", "tool", "lines/s", "note"], rows, data, notes)
+
+
+def memory(ctx: Context) -> Section:
+    """Peak RSS of the `ncpp` filter process for growing program lengths."""
+    sizes = [10_000, 1_000_000] if ctx.quick else [10_000, 1_000_000, 10_000_000]
+    rows, data = [], {}
+    for lines in sizes:
+        path = ctx.generated(lines)
+        size_mb = path.stat().st_size / 1e6
+        result = peak_rss(path)
+        if lines >= 10_000_000:
+            path.unlink()  # ~300 MB
+        data[str(lines)] = {"lines": lines, "file_mb": size_mb, **result}
+        status = "ok" if result["exit"] == 0 else f"exit {result['exit']}: {result['stderr_tail'].strip()[-120:]}"
+        rows.append([f"{lines:,}", f"{size_mb:.0f}", f"{result['rss_mb']:.1f}", f"{lines / result['seconds']:,.0f}", status])
+    rss = [v["rss_mb"] for v in data.values()]
+    data["growth_mb"] = max(rss) - min(rss)
+    notes = [f"peak RSS spread over {sizes[0]:,}..{sizes[-1]:,} lines: {data['growth_mb']:.1f} MB"]
+    return Section(
+        "Memory: `python -m ncpp < program > /dev/null`",
+        ["lines", "file MB", "peak RSS MB", "lines/s", "status"],
+        rows,
+        data,
+        notes,
+    )
+
+
+# Add later benchmarks (compensation throughput, accuracy) here.
+SECTIONS: list[Callable[[Context], Section]] = [throughput, memory]
+
+
+# -- running and reporting --------------------------------------------------------
+
+
+def _rate(result: dict[str, Any]) -> str:
+    return f"{result['lines_per_s']:,.0f}"
+
+
+def render(section: Section) -> str:
+    table = [section.columns] + [[str(c) for c in row] for row in section.rows]
+    widths = [max(len(row[i]) for row in table) for i in range(len(section.columns))]
+    lines = [f"\n## {section.title}", ""]
+    for n, row in enumerate(table):
+        lines.append("  ".join(cell.rjust(w) if cell[:1].isdigit() else cell.ljust(w) for cell, w in zip(row, widths)))
+        if n == 0:
+            lines.append("  ".join("-" * w for w in widths))
+    lines += [f"  * {note}" for note in section.notes]
+    return "\n".join(lines)
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(description="ncpp throughput and memory benchmarks")
+    p.add_argument("--quick", action="store_true", help="smaller programs, no 10M-line run (under 2 minutes)")
+    p.add_argument("--only", nargs="*", help="names of sections to run (default: all)")
+    p.add_argument("--out", type=Path, default=OUT, help=f"JSON results (default: {OUT.relative_to(ROOT)})")
+    args = p.parse_args(argv)
+
+    started = time.perf_counter()
+    results: dict[str, Any] = {
+        "quick": args.quick,
+        "python": sys.version.split()[0],
+        "machine": platform.platform(),
+        "cpus": os.cpu_count(),
+        "started": time.strftime("%Y-%m-%dT%H:%M:%S"),
+        "sections": {},
+    }
+    with tempfile.TemporaryDirectory(prefix="ncpp-bench-") as tmp:
+        ctx = Context(quick=args.quick, workdir=Path(tmp))
+        for run in SECTIONS:
+            if args.only and run.__name__ not in args.only:
+                continue
+            section = run(ctx)
+            print(render(section), flush=True)
+            results["sections"][run.__name__] = {"title": section.title, "notes": section.notes, **section.data}
+    results["seconds"] = time.perf_counter() - started
+    print(f"\ntotal {results['seconds']:.0f} s; results in {args.out}")
+
+    from ncpp.fileio import write_text_atomic
+
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    write_text_atomic(args.out, json.dumps(results, indent=2) + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
