@@ -116,9 +116,15 @@ class Chain:
         return order[order.index(axis) + 1 :]
 
 
+def columns(n: int) -> NDArray:
+    """An (n,3) array stored column by column: each coordinate contiguous,
+    which is what the column-wise vector algebra here reads and writes."""
+    return np.empty((3, n)).T
+
+
 def cross(a: NDArray, b: NDArray) -> NDArray:
     """Row-wise a × b for (n,3) arrays (np.cross is several times slower)."""
-    out = np.empty(a.shape)
+    out = columns(len(a))
     a0, a1, a2 = a[:, 0], a[:, 1], a[:, 2]
     b0, b1, b2 = b[:, 0], b[:, 1], b[:, 2]
     out[:, 0] = a1 * b2 - a2 * b1
@@ -132,7 +138,7 @@ def rotate_minus_identity(eps: NDArray, v: NDArray) -> NDArray:
 
     Rodrigues: R v = v + a ε×v + b ε×(ε×v), a = sinθ/θ, b = (1−cosθ)/θ²; the
     series below are exact in double precision for θ < 0.01 rad."""
-    th2 = np.einsum("ij,ij->i", eps, eps)[:, None]
+    th2 = (eps[:, 0] ** 2 + eps[:, 1] ** 2 + eps[:, 2] ** 2)[:, None]
     a = 1.0 - th2 * (1.0 / 6.0 - th2 / 120.0)
     b = 0.5 - th2 * (1.0 / 24.0 - th2 / 720.0)
     ev = cross(eps, v)
@@ -175,9 +181,10 @@ def exact_deviation(
     Walks the product from the tool end, carrying w = actual − nominal of the
     partial product so that microns are never the difference of metres."""
     dir_err = direction_errors(squareness)
-    nominal = np.empty(P.shape)
+    nominal = columns(len(P))
     nominal[:] = tool
-    w = np.zeros_like(nominal)
+    w = columns(len(P))
+    w[:] = 0.0
     for axis in reversed(chain.order):
         i = AXES.index(axis)
         k = P[:, i : i + 1]

@@ -160,8 +160,9 @@ class Machine:
         pts = as_points(P)
         dirs = None if direction is None else np.broadcast_to(np.asarray(direction, dtype=float), pts.shape)
         n = len(pts)
-        delta = {a: np.zeros((n, 3)) for a in AXES}
-        eps = {a: np.zeros((n, 3)) for a in AXES}
+        # Stored column by column (see chain.columns): the chain algebra is per coordinate.
+        delta = {a: np.zeros((3, n)).T for a in AXES}
+        eps = {a: np.zeros((3, n)).T for a in AXES}
         for i, axis in enumerate(AXES):
             stacked, names, others = self._evaluators[axis]
             p, d = pts[:, i], None if dirs is None else dirs[:, i]
@@ -179,7 +180,7 @@ class Machine:
         return Chain(self.chain), pts, np.asarray(self.tool), refs, delta, eps, sq
 
     def _blockwise(self, kernel, P: ArrayLike, direction: ArrayLike | None) -> NDArray:
-        pts = as_points(P)
+        pts = np.ascontiguousarray(as_points(P).T).T  # columns contiguous, like the algebra
         dirs = None if direction is None else np.broadcast_to(np.asarray(direction, dtype=float), pts.shape)
         out = np.empty(pts.shape)
         for start in range(0, len(pts), CHUNK):
