@@ -39,13 +39,18 @@ def edit_words(
     values: Mapping[str, float],
     style_for: Mapping[str, NumberStyle],
     drop: Iterable[str] = (),
+    motion: int | None = None,
 ) -> str:
     """The raw text of `block` with the words of `values` set (replaced or
     appended) and the words of `drop` removed.
 
     The letter's case as written is kept for replaced words; spacing between
-    items is kept; comments stay where they were.
+    items is kept; comments stay where they were.  `motion` (0-3) sets the
+    block's motion G word, replacing G0-G3 or inserting one before the first
+    axis word.
     """
+    if motion is not None:
+        block = _with_motion(block, motion)
     raw = block.raw
     pieces: list[str] = []
     cursor = 0
@@ -91,3 +96,35 @@ def edit_words(
 def _lower_case(block: Block) -> bool:
     words = block.words()
     return bool(words) and all(block.raw[w.start].islower() for w in words if block.raw[w.start].isalpha())
+
+
+def _with_motion(block: Block, code: int) -> Block:
+    """The block with its G0-G3 word set to `code` (items re-spanned)."""
+    from ncpp.program.numbers import NumberStyle  # local: avoid cycle at import
+
+    raw = block.raw
+    for item in block.items:
+        if type(item) is Word and item.letter == "G" and item.value in (0.0, 1.0, 2.0, 3.0):
+            text = raw[item.start] + format_number(code, NumberStyle.of(item.number))
+            new_raw = raw[: item.start] + text + raw[item.end :]
+            return _respan(block, new_raw, item.end, len(text) - (item.end - item.start))
+    first = next((i for i in block.items if type(i) is Word and i.letter in AXIS_LETTERS), None)
+    at = first.start if first is not None else len(raw.rstrip())
+    sep = word_separator(block)
+    g = ("g" if _lower_case(block) else "G") + str(code)
+    text = g + sep if first is not None else (sep if raw.strip() else "") + g
+    return _respan(block, raw[:at] + text + raw[at:], at, len(text))
+
+
+def _respan(block: Block, raw: str, after: int, shift: int) -> Block:
+    """Shift the spans of items that start at or after `after` by `shift`."""
+    import copy
+
+    items = []
+    for item in block.items:
+        if item.start >= after:
+            item = copy.copy(item)
+            item.start += shift
+            item.end += shift
+        items.append(item)
+    return Block(raw, block.eol, tuple(items), block.line)

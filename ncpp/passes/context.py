@@ -1,0 +1,37 @@
+"""What every pass is given: the error map, tolerances and where to report."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Protocol
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ncpp.errors import Warnings
+
+
+class ErrorMap(Protocol):
+    """Anything that says where the tool really goes: a `Machine`, or a map
+    built straight from one measurement (`ncpp.passes.measured`)."""
+
+    def deviation(self, P: NDArray) -> NDArray:
+        """(n,3) actual minus nominal tool point, mm, for (n,3) axis positions in mm."""
+        ...
+
+
+@dataclass(frozen=True)
+class PassContext:
+    model: ErrorMap
+    tolerance: float = 0.001  # mm: allowed deviation of the compensated path
+    arc_radius_tolerance: float = 0.0005  # mm: start/end radius agreement of emitted arcs
+    max_correction: float = 0.5  # mm: larger corrections are refused
+    limits: dict[str, tuple[float, float]] = field(default_factory=dict)  # machine axis travel, mm
+    min_line_check: float = 1.0  # mm: shorter lines are never subdivided (their error is linear to < 0.01 µm)
+    warnings: Warnings = field(default_factory=Warnings)
+    file: str = "<stdin>"
+
+    def limit_arrays(self) -> tuple[NDArray, NDArray]:
+        lo = np.array([self.limits.get(a, (-np.inf, np.inf))[0] for a in "XYZ"])
+        hi = np.array([self.limits.get(a, (-np.inf, np.inf))[1] for a in "XYZ"])
+        return lo, hi

@@ -1,0 +1,72 @@
+"""Vectorised helpers shared by the passes: chunking a stream, converting
+program points to machine positions and back, compensating many at once."""
+
+from __future__ import annotations
+
+from itertools import islice
+from typing import Iterable, Iterator, Sequence, TypeVar
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ncpp.errors import Location, NcppError
+from ncpp.motion.segments import Arc, Line
+from ncpp.passes.context import PassContext
+from ncpp.passes.inverse import command_for
+
+T = TypeVar("T")
+
+# Events per vectorised batch: large enough to amortise numpy's per-call cost,
+# small enough that memory stays flat however long the program.
+CHUNK = 2048
+
+
+def chunked(items: Iterable[T], size: int = CHUNK) -> Iterator[list[T]]:
+    it = iter(items)
+    while chunk := list(islice(it, size)):
+        yield chunk
+
+
+def frames(segments: Sequence[Line | Arc]) -> tuple[NDArray, NDArray]:
+    """(n,3) offsets (machine minus program, program units) and (n,) mm per unit."""
+    offsets = np.array([s.context.offset for s in segments], dtype=float).reshape(-1, 3)
+    scales = np.array([25.4 if s.context.inch else 1.0 for s in segments])
+    return offsets, scales
+
+
+def compensate(points: NDArray, offsets: NDArray, scales: NDArray, segments: Sequence[Line | Arc], ctx: PassContext) -> NDArray:
+    """Compensated program points for wanted program points.
+
+    points (n,m,3) or (n,3): point(s) of segment k in its program frame;
+    offsets (n,3), scales (n,).  Refuses corrections beyond the machine's
+    limit and commands outside its travel, naming the block."""
+    shape = points.shape
+    pts = points.reshape(len(segments), -1, 3)
+    wanted = (pts + offsets[:, None, :]) * scales[:, None, None]
+    command = command_for(ctx.model, wanted.reshape(-1, 3)).reshape(wanted.shape)
+    _check(wanted, command, segments, ctx)
+    return (command / scales[:, None, None] - offsets[:, None, :]).reshape(shape)
+
+
+def _check(wanted: NDArray, command: NDArray, segments: Sequence[Line | Arc], ctx: PassContext) -> None:
+    correction = np.linalg.norm(command - wanted, axis=-1).max(axis=-1)
+    bad = np.flatnonzero(correction > ctx.max_correction)
+    if bad.size:
+        k = int(bad[0])
+        raise NcppError(
+            f"correction of {correction[k]:.4f} mm exceeds the machine file's limit of {ctx.max_correction} mm",
+            Location(ctx.file, segments[k].block.line),
+        )
+    lo, hi = ctx.limit_arrays()
+    outside = ((command < lo) | (command > hi)).any(axis=-1).any(axis=-1)
+    bad = np.flatnonzero(outside)
+    if bad.size:
+        k = int(bad[0])
+        pts = command[k].reshape(-1, 3)
+        axis_index = int(np.flatnonzero(((pts < lo) | (pts > hi)).any(axis=0))[0])
+        axis = "XYZ"[axis_index]
+        value = pts[:, axis_index][(pts[:, axis_index] < lo[axis_index]) | (pts[:, axis_index] > hi[axis_index])][0]
+        raise NcppError(
+            f"command {axis}{value:.4f} mm is outside the {axis} travel [{lo[axis_index]:g}, {hi[axis_index]:g}] mm",
+            Location(ctx.file, segments[k].block.line),
+        )

@@ -1,0 +1,217 @@
+"""Pass: replace each arc by arcs through compensated points (thesis Figs. 36–37).
+
+For a piece of an arc, the compensated start and end points are fixed; the
+new centre is chosen on their perpendicular bisector, so the start and end
+radii agree exactly (a controller checks that), at the position that fits
+the compensated interior points best (an algebraic least-squares fit, closed
+form).  A piece whose fit leaves more than the tolerance is halved; a piece
+that is still off when it is shorter than `MIN_PIECE` mm becomes lines
+through compensated points.  Helical arcs: the normal axis is fitted as a
+straight ramp over the angle and checked the same way.
+
+All arcs of a chunk are processed together, piece arrays in, piece arrays out.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+from typing import Iterable, Iterator
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ncpp.motion.segments import PLANE_AXES, Arc, Event, Line
+from ncpp.passes.context import PassContext
+from ncpp.passes.geometry import chunked, compensate, frames
+
+SAMPLES = 9  # points per piece where the fit is checked (ends included)
+MIN_PIECE = 0.05  # mm of arc length below which a piece is not halved again
+MAX_ROUNDS = 24
+
+
+@dataclass
+class _Pieces:
+    """Pieces of arcs, one row each: which arc, start angle, signed sweep."""
+
+    arc: NDArray  # (p,) index into the chunk's arcs
+    a0: NDArray  # (p,) rad
+    sweep: NDArray  # (p,) rad, signed (+ counter-clockwise)
+
+
+def replace_arcs(events: Iterable[Event], ctx: PassContext) -> Iterator[Event]:
+    for chunk in chunked(events):
+        index = [k for k, e in enumerate(chunk) if type(e) is Arc and not e.changed]
+        if not index:
+            yield from chunk
+            continue
+        replaced = _replace([chunk[k] for k in index], ctx)
+        by_position = dict(zip(index, replaced))
+        for k, event in enumerate(chunk):
+            if k in by_position:
+                yield from by_position[k]
+            else:
+                yield event
+
+
+class _ArcGeometry:
+    """Plane-local geometry of a list of arcs: centre (u,v), radius, start
+    angle, total sweep, normal-axis start and rise; axis order per arc."""
+
+    def __init__(self, arcs: list[Arc]):
+        self.axes = np.array([PLANE_AXES[a.context.plane] for a in arcs])  # (n,3): u, v, w indices
+        start = np.array([a.start for a in arcs])
+        end = np.array([a.end for a in arcs])
+        centre = np.array([a.center for a in arcs])
+        local = lambda p: np.take_along_axis(p, self.axes, axis=1)  # noqa: E731
+        s, e, c = local(start), local(end), local(centre)
+        self.centre = c[:, :2]
+        self.radius = np.hypot(s[:, 0] - c[:, 0], s[:, 1] - c[:, 1])
+        self.a0 = np.arctan2(s[:, 1] - c[:, 1], s[:, 0] - c[:, 0])
+        self.sweep = np.array([a.sweep() for a in arcs])
+        self.w0 = s[:, 2]
+        self.rise = e[:, 2] - s[:, 2]
+        self.end_radius = np.hypot(e[:, 0] - c[:, 0], e[:, 1] - c[:, 1])
+
+    def points(self, arc: NDArray, angles: NDArray) -> NDArray:
+        """(p,m,3) program points at the given angles of the given arcs.
+
+        The radius blends from the start to the end radius, as controllers
+        do for arcs whose radii differ within their tolerance."""
+        frac = (angles - self.a0[arc, None]) / np.where(self.sweep[arc] == 0, 1.0, self.sweep[arc])[:, None]
+        r = self.radius[arc, None] + frac * (self.end_radius - self.radius)[arc, None]
+        local = np.stack(
+            [
+                self.centre[arc, 0, None] + r * np.cos(angles),
+                self.centre[arc, 1, None] + r * np.sin(angles),
+                self.w0[arc, None] + frac * self.rise[arc, None],
+            ],
+            axis=-1,
+        )
+        out = np.empty_like(local)
+        np.put_along_axis(out, np.broadcast_to(self.axes[arc][:, None, :], local.shape), local, axis=2)
+        return out
+
+
+def _initial_pieces(geometry: _ArcGeometry) -> _Pieces:
+    """Pieces of at most half a turn: a chord defines a centre only up to that."""
+    counts = np.maximum(1, np.ceil(np.abs(geometry.sweep) / math.pi - 1e-9)).astype(int)
+    arc = np.repeat(np.arange(len(counts)), counts)
+    step = (geometry.sweep / counts)[arc]
+    nth = np.arange(len(arc)) - np.repeat(np.cumsum(counts) - counts, counts)
+    return _Pieces(arc, geometry.a0[arc] + nth * step, step)
+
+
+def _replace(arcs: list[Arc], ctx: PassContext) -> list[list[Event]]:
+    geometry = _ArcGeometry(arcs)
+    offsets, scales = frames(arcs)
+    pending = _initial_pieces(geometry)
+    done: list[tuple[int, float, Event | list[Event]]] = []  # (arc, a0, result)
+    t = np.linspace(0.0, 1.0, SAMPLES)
+    for _ in range(MAX_ROUNDS):
+        if len(pending.arc) == 0:
+            break
+        angles = pending.a0[:, None] + t[None, :] * pending.sweep[:, None]
+        nominal = geometry.points(pending.arc, angles)
+        segs = [arcs[k] for k in pending.arc]
+        q = compensate(nominal, offsets[pending.arc], scales[pending.arc], segs, ctx)
+        centre, deviation = _fit(q, geometry.axes[pending.arc], t)
+        length = np.abs(pending.sweep) * geometry.radius[pending.arc] * scales[pending.arc]
+        ok = deviation <= ctx.tolerance / scales[pending.arc]
+        give_up = ~ok & (length < MIN_PIECE)
+        for p in np.flatnonzero(ok):
+            done.append((int(pending.arc[p]), float(pending.a0[p]), _arc_piece(arcs[pending.arc[p]], q[p], centre[p])))
+        for p in np.flatnonzero(give_up):
+            done.append((int(pending.arc[p]), float(pending.a0[p]), _line_pieces(arcs[pending.arc[p]], q[p])))
+        split = ~ok & ~give_up
+        half = pending.sweep[split] / 2
+        pending = _Pieces(
+            np.repeat(pending.arc[split], 2),
+            np.column_stack([pending.a0[split], pending.a0[split] + half]).ravel(),
+            np.repeat(half, 2),
+        )
+    return _assemble(arcs, geometry, done)
+
+
+def _fit(q: NDArray, axes: NDArray, t: NDArray) -> tuple[NDArray, NDArray]:
+    """Centre (p,3 program) on the bisector of each piece's end points, and the
+    largest deviation (p,) of the compensated samples from the fitted helix."""
+    local = np.take_along_axis(q, np.broadcast_to(axes[:, None, :], q.shape), axis=2)
+    uv, w = local[..., :2], local[..., 2]
+    q0, q1 = uv[:, 0], uv[:, -1]
+    mid = (q0 + q1) / 2
+    chord = q1 - q0
+    normal = np.stack([-chord[:, 1], chord[:, 0]], axis=-1)
+    normal /= np.linalg.norm(normal, axis=-1, keepdims=True)
+    # |q_k - c|^2 - |q_0 - c|^2 is linear in the centre's position s along the bisector.
+    d = uv - q0[:, None, :]
+    a = (uv**2).sum(-1) - (q0**2).sum(-1)[:, None] - 2 * (d * mid[:, None, :]).sum(-1)
+    b = 2 * (d * normal[:, None, :]).sum(-1)
+    s = (a * b).sum(-1) / np.maximum((b * b).sum(-1), 1e-300)
+    s = s + _minimax_step(uv, q0, mid + s[:, None] * normal, normal)
+    c = mid + s[:, None] * normal
+    radius = np.linalg.norm(q0 - c, axis=-1)
+    radial = np.linalg.norm(uv - c[:, None, :], axis=-1) - radius[:, None]
+    ramp = w[:, :1] + t[None, :] * (w[:, -1:] - w[:, :1])
+    deviation = np.hypot(radial, w - ramp).max(axis=1)
+    centre_local = np.column_stack([c, w[:, 0]])
+    centre = np.empty_like(centre_local)
+    np.put_along_axis(centre, axes, centre_local, axis=1)
+    return centre, deviation
+
+
+def _minimax_step(uv: NDArray, q0: NDArray, c: NDArray, normal: NDArray) -> NDArray:
+    """Move along the bisector that minimises the largest radial deviation.
+
+    The radial deviations r_k are linear in the move δ near the least-squares
+    centre (r_k + g_k·δ); the minimax δ of a 1-D linear family lies where two
+    of them are equal or opposite, so try every pair."""
+    to_k = uv - c[:, None, :]
+    to_0 = (q0 - c)[:, None, :]
+    dist_k = np.linalg.norm(to_k, axis=-1)
+    dist_0 = np.linalg.norm(to_0, axis=-1)
+    r = dist_k - dist_0
+    g = -(to_k * normal[:, None, :]).sum(-1) / dist_k + (to_0 * normal[:, None, :]).sum(-1) / dist_0
+    ri, rj, gi, gj = r[:, :, None], r[:, None, :], g[:, :, None], g[:, None, :]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        candidates = np.concatenate(
+            [(-(ri + rj) / (gi + gj)).reshape(len(r), -1), (-(ri - rj) / (gi - gj)).reshape(len(r), -1), np.zeros((len(r), 1))],
+            axis=1,
+        )
+    candidates = np.where(np.isfinite(candidates), candidates, 0.0)
+    worst = np.abs(r[:, None, :] + g[:, None, :] * candidates[:, :, None]).max(-1)
+    return candidates[np.arange(len(r)), worst.argmin(axis=1)]
+
+
+def _arc_piece(arc: Arc, q: NDArray, centre: NDArray) -> Arc:
+    return replace(
+        arc,
+        start=tuple(map(float, q[0])),
+        end=tuple(map(float, q[-1])),
+        center=tuple(map(float, centre)),
+        turn=1 if arc.turn > 0 else -1,
+        changed=True,
+    )
+
+
+def _line_pieces(arc: Arc, q: NDArray) -> list[Event]:
+    pts = [tuple(map(float, p)) for p in q]
+    return [
+        Line(pts[i], pts[i + 1], False, arc.feed, arc.block, arc.context, arc.extra, changed=True)
+        for i in range(len(pts) - 1)
+    ]
+
+
+def _assemble(arcs: list[Arc], geometry: _ArcGeometry, done: list) -> list[list[Event]]:
+    """Pieces of each arc in the order of travel."""
+    per_arc: list[list[tuple[float, Event | list[Event]]]] = [[] for _ in arcs]
+    for k, a0, result in done:
+        # order by progress along the sweep, whatever its sign
+        per_arc[k].append(((a0 - geometry.a0[k]) * (1 if geometry.sweep[k] >= 0 else -1), result))
+    out: list[list[Event]] = []
+    for pieces in per_arc:
+        events: list[Event] = []
+        for _, result in sorted(pieces, key=lambda item: item[0]):
+            events.extend(result if isinstance(result, list) else [result])
+        out.append(events)
+    return out

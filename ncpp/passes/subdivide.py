@@ -1,0 +1,81 @@
+"""Pass: split feed lines along which the error does not vary linearly (thesis 6.2).
+
+Compensating only a line's end points corrects the path between them by the
+straight interpolation of the end-point errors.  Where the error varies more
+than that along the line (a bow, a kink in an error table), the line is split
+into pieces short enough that the remaining deviation is below the tolerance.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+from typing import Iterable, Iterator
+
+import numpy as np
+
+from ncpp.motion.segments import Event, Line
+from ncpp.passes.context import PassContext
+from ncpp.passes.geometry import chunked, frames
+
+# Interior samples where linearity is checked.
+SAMPLES = np.linspace(0.0, 1.0, 7)
+# Sampling misses the worst point between samples; a piecewise-linear error
+# table can also kink anywhere: aim below the tolerance by this factor.
+SAFETY = 4.0
+MAX_PIECES = 10_000
+
+
+def subdivide_lines(events: Iterable[Event], ctx: PassContext) -> Iterator[Event]:
+    for chunk in chunked(events):
+        yield from _subdivide_chunk(chunk, ctx)
+
+
+def _candidates(chunk: list[Event], ctx: PassContext) -> list[int]:
+    found = []
+    for k, e in enumerate(chunk):
+        if type(e) is Line and not e.rapid and not e.changed:
+            length = math.dist(e.start, e.end) * (25.4 if e.context.inch else 1.0)
+            if length >= ctx.min_line_check:
+                found.append(k)
+    return found
+
+
+def _subdivide_chunk(chunk: list[Event], ctx: PassContext) -> list[Event]:
+    index = _candidates(chunk, ctx)
+    if not index:
+        return chunk
+    lines = [chunk[k] for k in index]
+    starts = np.array([ln.start for ln in lines])
+    ends = np.array([ln.end for ln in lines])
+    offsets, scales = frames(lines)
+    t = SAMPLES[None, :, None]
+    program = starts[:, None, :] + t * (ends - starts)[:, None, :]
+    machine = (program + offsets[:, None, :]) * scales[:, None, None]
+    error = ctx.model.deviation(machine.reshape(-1, 3)).reshape(machine.shape)
+    straight = error[:, :1] + t * (error[:, -1:] - error[:, :1])
+    deviation = np.linalg.norm(error - straight, axis=-1).max(axis=1)
+    # The deviation of piecewise-linear interpolation shrinks with the square of the piece count.
+    pieces = np.ceil(np.sqrt(SAFETY * deviation / ctx.tolerance)).astype(int).clip(1, MAX_PIECES)
+    out = list(chunk)
+    for k, line, n in zip(index, lines, pieces):
+        if n > 1:
+            out[k] = _split(line, int(n))
+    return _flatten(out)
+
+
+def _split(line: Line, n: int) -> list[Line]:
+    a, b = np.array(line.start), np.array(line.end)
+    cuts = [tuple(a + (b - a) * (i / n)) for i in range(n + 1)]
+    cuts[0], cuts[-1] = line.start, line.end
+    return [replace(line, start=cuts[i], end=cuts[i + 1]) for i in range(n)]
+
+
+def _flatten(items: list) -> list[Event]:
+    flat: list[Event] = []
+    for item in items:
+        if isinstance(item, list):
+            flat.extend(item)
+        else:
+            flat.append(item)
+    return flat
