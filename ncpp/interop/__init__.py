@@ -1,0 +1,1 @@
+"""Adapters between ncpp and other G-code libraries."""
