@@ -1,0 +1,150 @@
+"""The one NC pipeline every front end runs.
+
+    NC text -> blocks -> interpreter -> passes -> writer -> NC text
+
+`ncpp`, `ncpp compensate`, the LinuxCNC filter and the FreeCAD post all call
+`process`; the CL-data postprocessor enters at the events.  With no error
+map there are no passes and the output equals the input byte for byte.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import BinaryIO, Callable, Iterable, Iterator
+
+from ncpp.errors import Location, NcppError, Warnings
+from ncpp.motion.segments import Event
+from ncpp.passes import PASSES, PassContext, run_passes
+from ncpp.program.blocks import Block, Comment
+from ncpp.program.dialects.iso import IsoWriter
+from ncpp.program.parser import parse_stream
+
+HEADER_TAG = "ncpp compensated"
+HEADER_SCAN = 30  # blocks at the top searched for an earlier header
+
+
+@dataclass
+class ErrorSource:
+    """The error map to compensate with, and how the header names it."""
+
+    model: object  # an ErrorMap: Machine or a measured map
+    name: str
+    digest: str
+    max_correction: float = 0.5
+    limits: dict = field(default_factory=dict)
+
+    @classmethod
+    def from_machine_file(cls, path: str) -> "ErrorSource":
+        from ncpp.machine import load_machine
+
+        machine = load_machine(path)
+        limits = {a: lim for a, lim in machine.limits.items()}
+        return cls(machine, Path(path).name, _digest(path), machine.max_correction_mm, limits)
+
+    @classmethod
+    def from_measurement(cls, path: str) -> "ErrorSource":
+        from ncpp.passes.measured import map_from_file
+
+        return cls(map_from_file(path), Path(path).name, _digest(path))
+
+
+def _digest(path: str) -> str:
+    return hashlib.sha256(Path(path).read_bytes()).hexdigest()[:16]
+
+
+@dataclass
+class Stats:
+    lines_in: int = 0
+    lines_out: int = 0
+
+
+def header_text(source: ErrorSource, tolerance: float) -> str:
+    return f"{HEADER_TAG} by ncpp for {source.name} sha256:{source.digest} tolerance {tolerance:g} mm"
+
+
+def refuse_compensated(blocks: Iterable[Block], file: str) -> Iterator[Block]:
+    """Pass blocks through; stop with an error if an ncpp header is found near the top."""
+    for n, block in enumerate(blocks):
+        if n < HEADER_SCAN:
+            for item in block.items:
+                if type(item) is Comment and HEADER_TAG in item.text:
+                    raise NcppError(
+                        "program is already compensated by ncpp (use --force to compensate again)",
+                        Location(file, block.line, item.start + 1),
+                    )
+        yield block
+
+
+def _counted(blocks: Iterable[Block], stats: Stats, progress: Callable[[int], None] | None) -> Iterator[Block]:
+    for block in blocks:
+        stats.lines_in += 1
+        if progress is not None and stats.lines_in % 1000 == 0:
+            progress(stats.lines_in)
+        yield block
+
+
+def with_header(lines: Iterable[str], header: str, writer: IsoWriter) -> Iterator[str]:
+    """Put the header comment first, after a leading `%` tape mark line."""
+    it = iter(lines)
+    first = next(it, None)
+    if first is None:
+        yield writer.comment(header) + "\n"
+        return
+    eol = "\r\n" if first.endswith("\r\n") else "\n"
+    if first.lstrip().startswith("%"):
+        yield first
+        yield writer.comment(header) + eol
+    else:
+        yield writer.comment(header) + eol
+        yield first
+    yield from it
+
+
+def process(
+    stream: BinaryIO,
+    out: BinaryIO,
+    *,
+    file: str = "<stdin>",
+    source: ErrorSource | None = None,
+    tolerance: float = 0.001,
+    strict: bool = False,
+    force: bool = False,
+    warnings: Warnings | None = None,
+    progress: Callable[[int], None] | None = None,
+) -> Stats:
+    """Read, interpret, compensate (when `source` is given) and write one program."""
+    from ncpp.motion import interpret
+
+    warnings = warnings or Warnings(strict=strict)
+    stats = Stats()
+    blocks: Iterable[Block] = _counted(parse_stream(stream, file), stats, progress)
+    if source is not None and not force:
+        blocks = refuse_compensated(blocks, file)
+    events: Iterable[Event] = interpret(blocks, file=file, warnings=warnings, strict=strict)
+    writer = IsoWriter()
+    if source is None:
+        lines: Iterable[str] = (event.block.text for event in _first_per_block(events))
+    else:
+        ctx = PassContext(
+            model=source.model,
+            tolerance=tolerance,
+            max_correction=source.max_correction,
+            limits=source.limits,
+            warnings=warnings,
+            file=file,
+        )
+        lines = with_header(writer.write(run_passes(events, ctx, PASSES)), header_text(source, tolerance), writer)
+    for line in lines:
+        out.write(line.encode("latin-1"))
+        stats.lines_out += 1
+    return stats
+
+
+def _first_per_block(events: Iterable[Event]) -> Iterator[Event]:
+    last = None
+    for event in events:
+        if event.block is not last:
+            last = event.block
+            yield event
