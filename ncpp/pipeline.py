@@ -14,9 +14,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import BinaryIO, Callable, Iterable, Iterator
 
+import numpy as np
+
 from ncpp.errors import Location, NcppError, Warnings
 from ncpp.motion.segments import Event
 from ncpp.passes import PASSES, PassContext, run_passes
+from ncpp.passes.context import is_directional
 from ncpp.program.blocks import Block, Comment
 from ncpp.program.dialects.iso import IsoWriter
 from ncpp.program.parser import parse_stream
@@ -50,6 +53,30 @@ class ErrorSource:
         return cls(map_from_file(path), Path(path).name, _digest(path))
 
 
+    def shifted(self, work_offset: tuple[float, float, float] | None) -> "ErrorSource":
+        """The source seen from a program whose zero sits at `work_offset` (machine mm):
+        the work offset the controller holds, which the program does not say."""
+        if not work_offset or not any(work_offset):
+            return self
+        shift = np.asarray(work_offset, dtype=float)
+        limits = {a: (lo - shift["XYZ".index(a)], hi - shift["XYZ".index(a)]) for a, (lo, hi) in self.limits.items()}
+        return ErrorSource(ShiftedMap(self.model, shift), self.name, self.digest, self.max_correction, limits)
+
+
+@dataclass(frozen=True, eq=False)
+class ShiftedMap:
+    """An error map evaluated at program position + work offset."""
+
+    model: object
+    shift: np.ndarray
+
+    def deviation(self, P, direction=None):
+        return self.model.deviation(np.asarray(P, dtype=float) + self.shift, direction)
+
+    def __getattr__(self, name):  # effects, simulate, ...: the underlying machine's
+        return getattr(self.model, name)
+
+
 def _digest(path: str) -> str:
     return hashlib.sha256(Path(path).read_bytes()).hexdigest()[:16]
 
@@ -61,7 +88,7 @@ class Stats:
 
 
 def header_text(source: ErrorSource, tolerance: float) -> str:
-    return f"{HEADER_TAG} by ncpp for {source.name} sha256:{source.digest} tolerance {tolerance:g} mm"
+    return f"{HEADER_TAG} for {source.name} sha256:{source.digest} tolerance {tolerance:g} mm"
 
 
 def refuse_compensated(blocks: Iterable[Block], file: str) -> Iterator[Block]:
@@ -132,6 +159,7 @@ def process(
             tolerance=tolerance,
             max_correction=source.max_correction,
             limits=source.limits,
+            directional=is_directional(source.model, source.limits),
             warnings=warnings,
             file=file,
         )

@@ -17,7 +17,10 @@ from ncpp.errors import NcppError
 COMMANDS: tuple[str, ...] = (
     "filter",
     "compensate",
+    "simulate",
     "analyze",
+    "predict",
+    "fit",
 )
 
 DEFAULT_COMMAND = "filter"

@@ -27,15 +27,32 @@ def add_compensation_arguments(p: argparse.ArgumentParser) -> None:
     source.add_argument("--from", dest="from_file", metavar="FILE", help="compensate from one measurement file")
     p.add_argument("--tolerance", type=float, default=0.001, metavar="MM", help="allowed path deviation, mm (default 0.001)")
     p.add_argument("--force", action="store_true", help="compensate a program ncpp has compensated before")
+    p.add_argument(
+        "--work-offset",
+        type=parse_vector,
+        default=None,
+        metavar="X,Y,Z",
+        help="machine position (mm) of the program zero, as the control's work offset holds it (default 0,0,0)",
+    )
+
+
+def parse_vector(text: str) -> tuple[float, float, float]:
+    try:
+        values = tuple(float(v) for v in text.split(","))
+    except ValueError:
+        values = ()
+    if len(values) != 3:
+        raise argparse.ArgumentTypeError(f"expected X,Y,Z in mm, got {text!r}")
+    return values  # type: ignore[return-value]
 
 
 def error_source(args: argparse.Namespace):
     from ncpp.pipeline import ErrorSource
 
     if getattr(args, "from_file", None):
-        return ErrorSource.from_measurement(args.from_file)
+        return ErrorSource.from_measurement(args.from_file).shifted(args.work_offset)
     if getattr(args, "machine", None):
-        return ErrorSource.from_machine_file(args.machine)
+        return ErrorSource.from_machine_file(args.machine).shifted(args.work_offset)
     return None
 
 

@@ -23,16 +23,31 @@ def apply_error_map(events: Iterable[Event], ctx: PassContext) -> Iterator[Event
     for chunk in chunked(events):
         index = [k for k, e in enumerate(chunk) if type(e) is Line and not e.changed]
         new_ends: dict[int, tuple] = {}
+        new_starts: dict[int, tuple] = {}
         if index:
             lines = [chunk[k] for k in index]
             offsets, scales = frames(lines)
-            ends = compensate(np.array([ln.end for ln in lines]), offsets, scales, lines, ctx)
-            new_ends = {k: tuple(map(float, end)) for k, end in zip(index, ends)}
+            starts, ends = np.array([ln.start for ln in lines]), np.array([ln.end for ln in lines])
+            direction = np.sign(ends - starts)
+            new_ends = {k: tuple(map(float, p)) for k, p in zip(index, compensate(ends, offsets, scales, lines, ctx, direction))}
+            if ctx.directional:  # where this line must start, approached its own way
+                starts = compensate(starts, offsets, scales, lines, ctx, direction)
+                new_starts = {k: tuple(map(float, p)) for k, p in zip(index, starts)}
         for k, event in enumerate(chunk):
             if k in new_ends:
                 start = event.start if previous_end is None else previous_end
+                if k in new_starts and previous_end is not None and not event.rapid and _apart(previous_end, new_starts[k]):
+                    yield replace(event, start=previous_end, end=new_starts[k], changed=True)
+                    start = new_starts[k]
                 event = replace(event, start=start, end=new_ends[k], changed=True)
                 previous_end = event.end
             elif type(event) is Line or type(event) is Arc:
+                if event.changed and previous_end is not None and _apart(previous_end, event.start):
+                    # a reversal step between compensated pieces: move there first
+                    yield Line(previous_end, event.start, False, event.feed, event.block, event.context, event.extra, changed=True)
                 previous_end = event.end
             yield event
+
+
+def _apart(a: tuple, b: tuple, tolerance: float = 1e-7) -> bool:
+    return abs(a[0] - b[0]) > tolerance or abs(a[1] - b[1]) > tolerance or abs(a[2] - b[2]) > tolerance

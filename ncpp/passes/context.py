@@ -15,8 +15,9 @@ class ErrorMap(Protocol):
     """Anything that says where the tool really goes: a `Machine`, or a map
     built straight from one measurement (`ncpp.passes.measured`)."""
 
-    def deviation(self, P: NDArray) -> NDArray:
-        """(n,3) actual minus nominal tool point, mm, for (n,3) axis positions in mm."""
+    def deviation(self, P: NDArray, direction: NDArray | None = None) -> NDArray:
+        """(n,3) actual minus nominal tool point, mm, for (n,3) axis positions in mm
+        reached with travel signs `direction` (n,3) (None: unknown, mean of both)."""
         ...
 
 
@@ -27,6 +28,7 @@ class PassContext:
     arc_radius_tolerance: float = 0.0005  # mm: start/end radius agreement of emitted arcs
     max_correction: float = 0.5  # mm: larger corrections are refused
     limits: dict[str, tuple[float, float]] = field(default_factory=dict)  # machine axis travel, mm
+    directional: bool = False  # the model has reversal (direction-dependent) errors
     min_line_check: float = 1.0  # mm: shorter lines are never subdivided (their error is linear to < 0.01 µm)
     warnings: Warnings = field(default_factory=Warnings)
     file: str = "<stdin>"
@@ -35,3 +37,16 @@ class PassContext:
         lo = np.array([self.limits.get(a, (-np.inf, np.inf))[0] for a in "XYZ"])
         hi = np.array([self.limits.get(a, (-np.inf, np.inf))[1] for a in "XYZ"])
         return lo, hi
+
+
+def is_directional(model: ErrorMap, limits: dict[str, tuple[float, float]] | None = None) -> bool:
+    """Whether the map's errors depend on the direction of travel (probed at a few points)."""
+    lo = np.array([max((limits or {}).get(a, (-500.0, 500.0))[0], -500.0) for a in "XYZ"])
+    hi = np.array([min((limits or {}).get(a, (-500.0, 500.0))[1], 500.0) for a in "XYZ"])
+    P = lo + (hi - lo) * np.random.default_rng(0).random((16, 3))
+    try:
+        plus = model.deviation(P, np.ones_like(P))
+        minus = model.deviation(P, -np.ones_like(P))
+    except TypeError:
+        return False
+    return bool(np.abs(plus - minus).max() > 1e-7)

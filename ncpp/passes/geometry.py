@@ -34,16 +34,25 @@ def frames(segments: Sequence[Line | Arc]) -> tuple[NDArray, NDArray]:
     return offsets, scales
 
 
-def compensate(points: NDArray, offsets: NDArray, scales: NDArray, segments: Sequence[Line | Arc], ctx: PassContext) -> NDArray:
+def compensate(
+    points: NDArray,
+    offsets: NDArray,
+    scales: NDArray,
+    segments: Sequence[Line | Arc],
+    ctx: PassContext,
+    directions: NDArray | None = None,
+) -> NDArray:
     """Compensated program points for wanted program points.
 
     points (n,m,3) or (n,3): point(s) of segment k in its program frame;
-    offsets (n,3), scales (n,).  Refuses corrections beyond the machine's
+    offsets (n,3), scales (n,); directions: travel signs shaped like points, for
+    direction-dependent (reversal) error tables.  Refuses corrections beyond the machine's
     limit and commands outside its travel, naming the block."""
     shape = points.shape
     pts = points.reshape(len(segments), -1, 3)
     wanted = (pts + offsets[:, None, :]) * scales[:, None, None]
-    command = command_for(ctx.model, wanted.reshape(-1, 3)).reshape(wanted.shape)
+    signs = None if directions is None else np.asarray(directions, dtype=float).reshape(-1, 3)
+    command = command_for(ctx.model, wanted.reshape(-1, 3), signs).reshape(wanted.shape)
     _check(wanted, command, segments, ctx)
     return (command / scales[:, None, None] - offsets[:, None, :]).reshape(shape)
 

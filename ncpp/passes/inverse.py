@@ -12,12 +12,13 @@ from ncpp.passes.context import ErrorMap
 ITERATIONS = 3
 
 
-def command_for(model: ErrorMap, wanted: NDArray, iterations: int = ITERATIONS) -> NDArray:
-    """(n,3) commands, mm, that put the tool at the (n,3) wanted positions."""
+def command_for(model: ErrorMap, wanted: NDArray, direction: NDArray | None = None, iterations: int = ITERATIONS) -> NDArray:
+    """(n,3) commands, mm, that put the tool at the (n,3) wanted positions,
+    approached with the (n,3) travel signs `direction` (None: unknown)."""
     wanted = np.asarray(wanted, dtype=float)
     if len(wanted) == 0:
         return wanted.copy()
-    command = wanted - model.deviation(wanted)
+    command = wanted - model.deviation(wanted, direction)
     for _ in range(iterations - 1):
-        command = wanted - model.deviation(command)
+        command = wanted - model.deviation(command, direction)
     return command

@@ -35,7 +35,7 @@ class RadialMap:
     angle: NDArray  # (n,) rad, sorted, in [0, 2π)
     delta_r: NDArray  # (n,) mm
 
-    def deviation(self, P: NDArray) -> NDArray:
+    def deviation(self, P: NDArray, direction: NDArray | None = None) -> NDArray:
         P = np.atleast_2d(np.asarray(P, dtype=float))
         i, j = self.axes
         u, v = P[:, i] - self.centre[i], P[:, j] - self.centre[j]
@@ -57,7 +57,7 @@ class AxisMap:
     position: NDArray  # (n,) mm, ascending
     deviation_mm: NDArray  # (n,3) mm
 
-    def deviation(self, P: NDArray) -> NDArray:
+    def deviation(self, P: NDArray, direction: NDArray | None = None) -> NDArray:
         P = np.atleast_2d(np.asarray(P, dtype=float))
         x = P[:, self.axis]
         return np.column_stack([np.interp(x, self.position, self.deviation_mm[:, k]) for k in range(3)])

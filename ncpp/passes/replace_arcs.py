@@ -93,8 +93,13 @@ class _ArcGeometry:
         return out
 
 
-def _initial_pieces(geometry: _ArcGeometry) -> _Pieces:
-    """Pieces of at most half a turn: a chord defines a centre only up to that."""
+def _initial_pieces(geometry: _ArcGeometry, directional: bool) -> _Pieces:
+    """Pieces of at most half a turn: a chord defines a centre only up to that.
+
+    With reversal errors, also cut where an axis reverses (every quarter turn
+    in plane-local angle): the command must step there, which an arc cannot."""
+    if directional:
+        return _quadrant_pieces(geometry)
     counts = np.maximum(1, np.ceil(np.abs(geometry.sweep) / math.pi - 1e-9)).astype(int)
     arc = np.repeat(np.arange(len(counts)), counts)
     step = (geometry.sweep / counts)[arc]
@@ -102,10 +107,25 @@ def _initial_pieces(geometry: _ArcGeometry) -> _Pieces:
     return _Pieces(arc, geometry.a0[arc] + nth * step, step)
 
 
+def _quadrant_pieces(geometry: _ArcGeometry) -> _Pieces:
+    arcs, starts, sweeps = [], [], []
+    quarter = math.pi / 2
+    for k, (a0, sweep) in enumerate(zip(geometry.a0, geometry.sweep)):
+        a1 = a0 + sweep
+        lo, hi = min(a0, a1), max(a0, a1)
+        cuts = [quarter * n for n in range(math.floor(lo / quarter) + 1, math.ceil(hi / quarter)) if lo + 1e-9 < quarter * n < hi - 1e-9]
+        edges = [a0] + (cuts if sweep > 0 else cuts[::-1]) + [a1]
+        for e0, e1 in zip(edges, edges[1:]):
+            arcs.append(k)
+            starts.append(e0)
+            sweeps.append(e1 - e0)
+    return _Pieces(np.array(arcs, dtype=int), np.array(starts), np.array(sweeps))
+
+
 def _replace(arcs: list[Arc], ctx: PassContext) -> list[list[Event]]:
     geometry = _ArcGeometry(arcs)
     offsets, scales = frames(arcs)
-    pending = _initial_pieces(geometry)
+    pending = _initial_pieces(geometry, ctx.directional)
     done: list[tuple[int, float, Event | list[Event]]] = []  # (arc, a0, result)
     t = np.linspace(0.0, 1.0, SAMPLES)
     for _ in range(MAX_ROUNDS):
@@ -114,7 +134,10 @@ def _replace(arcs: list[Arc], ctx: PassContext) -> list[list[Event]]:
         angles = pending.a0[:, None] + t[None, :] * pending.sweep[:, None]
         nominal = geometry.points(pending.arc, angles)
         segs = [arcs[k] for k in pending.arc]
-        q = compensate(nominal, offsets[pending.arc], scales[pending.arc], segs, ctx)
+        middle = (pending.a0 + pending.sweep / 2)[:, None]
+        tangent = geometry.points(pending.arc, middle + 1e-6 * np.sign(pending.sweep)[:, None]) - geometry.points(pending.arc, middle)
+        direction = np.broadcast_to(np.sign(tangent), nominal.shape)
+        q = compensate(nominal, offsets[pending.arc], scales[pending.arc], segs, ctx, direction)
         centre, deviation = _fit(q, geometry.axes[pending.arc], t)
         length = np.abs(pending.sweep) * geometry.radius[pending.arc] * scales[pending.arc]
         ok = deviation <= ctx.tolerance / scales[pending.arc]

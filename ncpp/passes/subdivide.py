@@ -52,7 +52,8 @@ def _subdivide_chunk(chunk: list[Event], ctx: PassContext) -> list[Event]:
     t = SAMPLES[None, :, None]
     program = starts[:, None, :] + t * (ends - starts)[:, None, :]
     machine = (program + offsets[:, None, :]) * scales[:, None, None]
-    error = ctx.model.deviation(machine.reshape(-1, 3)).reshape(machine.shape)
+    direction = np.broadcast_to(np.sign(ends - starts)[:, None, :], machine.shape).reshape(-1, 3)
+    error = ctx.model.deviation(machine.reshape(-1, 3), direction).reshape(machine.shape)
     straight = error[:, :1] + t * (error[:, -1:] - error[:, :1])
     deviation = np.linalg.norm(error - straight, axis=-1).max(axis=1)
     # The deviation of piecewise-linear interpolation shrinks with the square of the piece count.

@@ -84,7 +84,7 @@ def test_lines_get_compensated_end_points():
     line = Line((0.0, 0.0, 0.0), (100.0, 0.0, 0.0), False, 500.0, block)
 
     class Offset:
-        def deviation(self, P):
+        def deviation(self, P, direction=None):
             return np.tile([0.002, -0.001, 0.0], (len(P), 1))
 
     (event,) = run_passes([line], PassContext(model=Offset()))

@@ -35,6 +35,9 @@ class IsoWriter:
         self.program_motion: int | None = None  # motion mode as the input program has it
         self.output_motion: int | None = None  # motion mode as the output has it
         self.last_written: dict[str, str] = {}  # last absolute coordinate text per axis in the output
+        # Axes the program has positioned; before that the control's position is not
+        # the interpreter's assumed zero, so a word must not be added for them.
+        self.known_axes: set[str] = set()
 
     def comment(self, text: str) -> str:
         return f"{self.comment_open}{text}{self.comment_close}"
@@ -68,6 +71,8 @@ class IsoWriter:
         for item in block.items:
             if type(item) is Word and item.letter not in ("G", "M", "N", "O"):
                 self.styles[item.letter] = NumberStyle.of(item.number)
+                if item.letter in AXES:
+                    self.known_axes.add(item.letter)
 
     def _block_motion(self, block: Block) -> int | None:
         code = None
@@ -121,7 +126,7 @@ class IsoWriter:
         for n, axis in enumerate(AXES):
             if segment.context.absolute:
                 text = self._format(axis, segment.end[n], segment)
-                if axis in present or text != self.last_written.get(axis):
+                if axis in present or (axis in self.known_axes and text != self.last_written.get(axis)):
                     values[axis] = segment.end[n]
             else:
                 delta = segment.end[n] - segment.start[n]

@@ -1,0 +1,85 @@
+"""`ncpp simulate --machine M.toml PROGRAM [--reference ORIGINAL] [--json OUT] [--plot OUT.png]`.
+
+Runs a program's motion on the modelled machine and reports the contour
+error against the nominal path: the program itself, or with `--reference`
+the original program a compensated one was made from.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+from ncpp.cli.compensate import parse_vector
+from ncpp.errors import NcppError, Warnings
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("simulate", help="run a program on the modelled machine: contour error, ball-bar trace")
+    p.add_argument("program", help="NC program to run")
+    p.add_argument("--machine", required=True, metavar="M.toml", help="machine file (the virtual machine)")
+    p.add_argument("--reference", metavar="ORIGINAL", help="nominal program (for a compensated PROGRAM)")
+    p.add_argument("--work-offset", type=parse_vector, default=(0.0, 0.0, 0.0), metavar="X,Y,Z", help="machine position (mm) of the program zero")
+    p.add_argument("--step", type=float, default=0.5, metavar="MM", help="sample spacing along the path (default 0.5)")
+    p.add_argument("--json", metavar="OUT", help="write the figures as JSON")
+    p.add_argument("--plot", metavar="OUT.png", help="plot the contour error (and circle traces)")
+    p.set_defaults(func=run)
+
+
+def program_events(path: str, warnings: Warnings) -> list:
+    from ncpp.motion import interpret
+    from ncpp.program.parser import parse_stream
+
+    with open(path, "rb") as stream:
+        return list(interpret(parse_stream(stream, path), file=path, warnings=warnings))
+
+
+def run(args: argparse.Namespace) -> int:
+    from ncpp.fileio import write_text_atomic
+    from ncpp.machine import load_machine
+    from ncpp.simulate import contour_error, sample_events
+
+    machine = load_machine(args.machine)
+    warnings = Warnings()
+    commanded = sample_events(program_events(args.program, warnings), args.step, args.work_offset)
+    nominal = sample_events(program_events(args.reference, warnings), args.step, args.work_offset) if args.reference else commanded
+    if len(commanded.points) == 0:
+        raise NcppError("the program makes no motion the interpreter could follow")
+    report = contour_error(machine, commanded, nominal)
+    print(f"contour error: max {report.max_um:.2f} µm (line {report.worst_line}), rms {report.rms_um:.2f} µm over {report.samples} samples")
+    for c in report.circles:
+        print(f"circle R{c['radius_mm']:g} in {c['plane']} at {c['centre_mm']}: circularity {c['circularity_um']:.2f} µm")
+    if args.json:
+        write_text_atomic(args.json, json.dumps(report.as_dict(), indent=2) + "\n")
+    if args.plot:
+        plot_report(report, commanded, args.plot)
+    return 0
+
+
+def plot_report(report, commanded, path: str) -> None:
+    import io
+
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    from ncpp.fileio import write_bytes_atomic
+
+    panels = 1 + len(report.circles)
+    fig = plt.figure(figsize=(6 * panels, 5))
+    ax = fig.add_subplot(1, panels, 1)
+    ax.set_title(f"contour error: max {report.max_um:.2f} µm, rms {report.rms_um:.2f} µm")
+    ax.set_xlabel("sample along the path")
+    ax.set_ylabel("µm")
+    for n, c in enumerate(report.circles, start=2):
+        angle, dr = c["trace"]
+        order = np.argsort(angle)
+        polar = fig.add_subplot(1, panels, n, projection="polar")
+        polar.plot(np.radians(angle[order]), dr[order], lw=1)
+        polar.set_title(f"R{c['radius_mm']:g} {c['plane']}: circularity {c['circularity_um']:.2f} µm")
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png", dpi=100)
+    plt.close(fig)
+    write_bytes_atomic(path, buffer.getvalue())

@@ -1,0 +1,196 @@
+"""The virtual machine: run a program's motion on a modelled machine.
+
+Every segment is sampled finely (lines by length, arcs so that the chord
+error stays below `CHORD_MM`), the samples become machine positions, the
+machine model says where the tool really goes, and the contour error is the
+distance from there to the nominal path.  The nominal path is the program
+itself, or — for a compensated program — the original it was made from.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Iterable
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ncpp.motion.segments import PLANE_AXES, Arc, Event, Line
+
+STEP_MM = 0.5  # sample spacing along lines and large arcs
+CHORD_MM = 1e-5  # largest chord error of an arc's sampled polyline (0.01 µm)
+
+
+@dataclass(frozen=True)
+class SampledPath:
+    points: NDArray  # (n,3) machine positions, mm
+    feed: NDArray  # (n,) mm/min (0 for rapids)
+    line: NDArray  # (n,) source line number
+    rapid: NDArray  # (n,) bool
+    circles: list  # full circles: (centre (3,), radius mm, plane, slice of points)
+
+
+def sample_events(events: Iterable[Event], step_mm: float = STEP_MM, work_offset=(0.0, 0.0, 0.0)) -> SampledPath:
+    """Sampled machine positions of a program's motion; `work_offset` (mm) is where
+    the program zero sits on the machine."""
+    pts: list[NDArray] = []
+    feeds, lines, rapids, circles = [], [], [], []
+    count = 0
+    for event in events:
+        if type(event) is Line:
+            p = _sample_line(event, step_mm)
+            rapid = event.rapid
+        elif type(event) is Arc:
+            p = _sample_arc(event, step_mm)
+            rapid = False
+            if abs(event.sweep()) >= 2 * math.pi - 1e-9:
+                s = event.context.unit_mm
+                centre = np.array(event.context.to_machine(event.center)) + np.asarray(work_offset)
+                circles.append((centre, event.radius() * s, event.context.plane, slice(count, count + len(p))))
+        else:
+            continue
+        pts.append(p)
+        n = len(p)
+        feeds.append(np.full(n, 0.0 if rapid else event.feed * event.context.unit_mm))
+        lines.append(np.full(n, event.block.line))
+        rapids.append(np.full(n, rapid))
+        count += n
+    if not pts:
+        empty = np.zeros((0, 3))
+        return SampledPath(empty, np.zeros(0), np.zeros(0, int), np.zeros(0, bool), [])
+    return SampledPath(np.vstack(pts) + np.asarray(work_offset, dtype=float), np.concatenate(feeds), np.concatenate(lines), np.concatenate(rapids), circles)
+
+
+def _to_machine(event: Line | Arc, program: NDArray) -> NDArray:
+    return (program + np.asarray(event.context.offset)) * event.context.unit_mm
+
+
+def _sample_line(line: Line, step_mm: float) -> NDArray:
+    a, b = np.asarray(line.start), np.asarray(line.end)
+    length = float(np.linalg.norm(b - a)) * line.context.unit_mm
+    n = max(1, int(math.ceil(length / step_mm)))
+    t = np.linspace(0.0, 1.0, n + 1)[:, None]
+    return _to_machine(line, a + t * (b - a))
+
+
+def _sample_arc(arc: Arc, step_mm: float) -> NDArray:
+    i, j, k = PLANE_AXES[arc.context.plane]
+    s, e, c = np.asarray(arc.start), np.asarray(arc.end), np.asarray(arc.center)
+    r0 = math.hypot(s[i] - c[i], s[j] - c[j])
+    r1 = math.hypot(e[i] - c[i], e[j] - c[j])
+    sweep = arc.sweep()
+    radius_mm = max(r0, 1e-9) * arc.context.unit_mm
+    step = min(step_mm, math.sqrt(8 * radius_mm * CHORD_MM))
+    n = max(2, int(math.ceil(abs(sweep) * radius_mm / step)))
+    t = np.linspace(0.0, 1.0, n + 1)
+    a0 = math.atan2(s[j] - c[j], s[i] - c[i])
+    angle = a0 + t * sweep
+    r = r0 + t * (r1 - r0)
+    p = np.empty((n + 1, 3))
+    p[:, i] = c[i] + r * np.cos(angle)
+    p[:, j] = c[j] + r * np.sin(angle)
+    p[:, k] = s[k] + t * (e[k] - s[k])
+    return _to_machine(arc, p)
+
+
+def distance_to_path(points: NDArray, path: NDArray) -> NDArray:
+    """Distance (n,) of each point to the polyline `path` (m,3)."""
+    from scipy.spatial import cKDTree
+
+    if len(path) < 2:
+        return np.linalg.norm(points - path[:1], axis=1) if len(path) else np.full(len(points), np.nan)
+    tree = cKDTree(path)
+    _, nearest = tree.query(points, k=min(4, len(path)))
+    nearest = np.atleast_2d(nearest)
+    best = np.full(len(points), np.inf)
+    for col in range(nearest.shape[1]):
+        idx = nearest[:, col]
+        for lo in (idx - 1, idx):
+            lo = np.clip(lo, 0, len(path) - 2)
+            a, b = path[lo], path[lo + 1]
+            ab = b - a
+            denom = np.maximum((ab * ab).sum(1), 1e-30)
+            t = np.clip(((points - a) * ab).sum(1) / denom, 0.0, 1.0)
+            d = np.linalg.norm(points - (a + t[:, None] * ab), axis=1)
+            best = np.minimum(best, d)
+    return best
+
+
+@dataclass(frozen=True)
+class ContourReport:
+    max_um: float
+    rms_um: float
+    worst_line: int  # source line (of the commanded program) where the error is largest
+    worst_point: tuple[float, float, float]
+    samples: int
+    circles: list  # per full circle: dict(centre, radius, circularity_um, trace)
+
+    def as_dict(self) -> dict:
+        return {
+            "contour_error_max_um": self.max_um,
+            "contour_error_rms_um": self.rms_um,
+            "worst_line": self.worst_line,
+            "worst_point_mm": list(self.worst_point),
+            "samples": self.samples,
+            "circles": [{k: v for k, v in c.items() if k != "trace"} for c in self.circles],
+        }
+
+
+def contour_error(machine, commanded: SampledPath, nominal: SampledPath, feed_effects: bool = True) -> ContourReport:
+    """Contour error of the commanded path run on `machine` against the nominal path (feed moves only)."""
+    cut = ~commanded.rapid
+    cmd = commanded.points[cut]
+    if len(cmd) == 0:
+        return ContourReport(0.0, 0.0, 0, (0.0, 0.0, 0.0), 0, [])
+    # run the whole path (rapids too: they set the direction of approach), judge the cuts
+    actual = _actual(machine, commanded.points, commanded.feed, feed_effects)[cut]
+    nominal_path = nominal.points[~nominal.rapid] if (~nominal.rapid).any() else nominal.points
+    error = distance_to_path(actual, nominal_path) * 1000.0
+    worst = int(np.argmax(error))
+    circles = _circle_traces(machine, commanded, nominal, feed_effects)
+    return ContourReport(
+        float(error.max()),
+        float(np.sqrt(np.mean(error**2))),
+        int(commanded.line[cut][worst]),
+        tuple(float(v) for v in cmd[worst]),
+        int(len(cmd)),
+        circles,
+    )
+
+
+def _actual(machine, cmd: NDArray, feed: NDArray, feed_effects: bool) -> NDArray:
+    """Where the tool goes: geometry with the direction of travel along the path, plus effects."""
+    if len(cmd) < 2:
+        return cmd + machine.deviation(cmd)
+    from ncpp.machine import Trajectory
+
+    speed = float(np.median(feed[feed > 0])) if (feed > 0).any() else 1000.0
+    machine = machine if feed_effects else machine.replace(effects=())
+    return machine.simulate(Trajectory(cmd, speed))
+
+
+def _circle_traces(machine, commanded: SampledPath, nominal: SampledPath, feed_effects: bool) -> list:
+    """For each full circle of the nominal program: the simulated ball-bar trace and circularity."""
+    out = []
+    for centre, radius, plane, _ in nominal.circles:
+        i, j, _ = PLANE_AXES[plane]
+        cut = ~commanded.rapid
+        actual = _actual(machine, commanded.points, commanded.feed, feed_effects)[cut]
+        rel = actual - centre
+        r = np.hypot(rel[:, i], rel[:, j])
+        on_circle = (np.abs(r - radius) < 0.05) & (np.abs(rel[:, 3 - i - j]) < 1e-3 + np.ptp(rel[:, 3 - i - j]))
+        if on_circle.sum() < 8:
+            continue
+        angle = np.degrees(np.arctan2(rel[on_circle, j], rel[on_circle, i])) % 360.0
+        dr = (r[on_circle] - radius) * 1000.0
+        out.append(
+            {
+                "centre_mm": [float(v) for v in centre],
+                "radius_mm": float(radius),
+                "plane": {17: "XY", 18: "ZX", 19: "YZ"}[plane],
+                "circularity_um": float(dr.max() - dr.min()),
+                "trace": (angle, dr),
+            }
+        )
+    return out
