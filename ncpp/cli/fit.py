@@ -1,0 +1,62 @@
+"""`ncpp fit FILES... -o M.toml`: a machine file from laser, comparator and level files.
+
+Each file gives one error component as a table over its axis (a comparator
+two: linear and transverse): laser position on X → EXX, straightness_y on X →
+EYX, pitch/yaw/roll → the axis's angular component (or the file's
+`component:`), level roll/pitch likewise.  The Abbe contribution of each
+file's optic offset is removed with the angular components the other files
+give (see ncpp.identify.fit).  Per-direction tables are written where the
+reversal is significant (--reversal-threshold, µm).
+
+The chain, offsets, reference points, limits, squareness and effects come
+from --base M0.toml; without it from --chain (default XYFZ) with zero
+offsets.  Components no file gives keep the base's values.
+
+    ncpp fit laser_*.csv level_*.csv --chain XZFY -o fitted.toml
+"""
+
+from __future__ import annotations
+
+import argparse
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    parser = subparsers.add_parser(
+        "fit",
+        help="build a machine file from laser / comparator / level files",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument("files", nargs="+", metavar="FILE", help="laser, comparator and level files")
+    parser.add_argument("-o", "--output", required=True, metavar="M.toml")
+    parser.add_argument("--chain", help="kinematic chain, workpiece to tool (e.g. XZFY; default XYFZ or the base's)")
+    parser.add_argument("--base", metavar="M0.toml", help="machine file whose structure and other errors are kept")
+    parser.add_argument("--name", help="machine name")
+    parser.add_argument("--interpolation", default="smooth", choices=("smooth", "linear"))
+    parser.add_argument("--reversal-threshold", type=float, default=0.5, metavar="UM", help="per-direction tables above this reversal (default 0.5 µm)")
+    parser.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from ncpp.errors import Location, NcppError
+    from ncpp.identify import fit_machine, fit_residuals
+    from ncpp.instruments.files import read_measurement
+    from ncpp.machine import load_machine, save_machine
+
+    measurements = [read_measurement(p) for p in args.files]
+    base = load_machine(args.base) if args.base else None
+    try:
+        machine = fit_machine(
+            measurements, base=base, chain=args.chain, name=args.name,
+            interpolation=args.interpolation, reversal_threshold=args.reversal_threshold,
+        )  # fmt: skip
+    except ValueError as err:
+        raise NcppError(str(err), Location("ncpp fit")) from None
+    save_machine(machine, args.output)
+    residuals = fit_residuals(machine, measurements)
+    print(f"{args.output}: {machine.name}, chain {machine.chain}, {len(residuals)} component(s) fitted")
+    for name, source in machine.meta.get("fitted", {}).items():
+        table = machine.component(name)
+        kind = "± tables" if getattr(table, "directional", False) else "table"
+        print(f"  {name:<4} {kind:<9} from {source}  (max residual {residuals[name]:.3g})")
+    return 0
