@@ -21,6 +21,7 @@ COMMANDS: tuple[str, ...] = (
     "analyze",
     "predict",
     "fit",
+    "export_table",
 )
 
 DEFAULT_COMMAND = "filter"

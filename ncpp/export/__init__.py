@@ -1,0 +1,51 @@
+"""Controller compensation tables (thesis section 6.4.3): one module per controller.
+
+    from ncpp.export import axis_error, export_table
+    text, notes = export_table(machine, "X", "linuxcnc", comp_type=0)
+
+`notes` says what had to be resampled or clipped to meet the controller's
+limits; the same sentences are in the file as comments.
+"""
+
+from __future__ import annotations
+
+from ncpp.errors import NcppError
+from ncpp.export.common import AxisError, axis_error
+from ncpp.machine import Machine
+
+FORMATS = ("linuxcnc", "fanuc", "sinumerik", "heidenhain")
+
+
+def export_table(
+    machine: Machine,
+    axis: str,
+    fmt: str,
+    *,
+    spacing: float | None = None,
+    comp_type: int = 0,
+    reference: float | None = None,
+) -> tuple[str, list[str]]:
+    """The table text for `axis` in controller format `fmt`, and the notes."""
+    error = axis_error(machine, axis)
+    if fmt == "linuxcnc":
+        from ncpp.export.linuxcnc import write_linuxcnc_comp
+
+        return write_linuxcnc_comp(error, comp_type, spacing)
+    if fmt == "fanuc":
+        from ncpp.export.fanuc import write_fanuc_pitch
+
+        return write_fanuc_pitch(error, spacing=spacing, reference=0.0 if reference is None else reference)
+    if fmt == "sinumerik":
+        from ncpp.export.sinumerik import write_sinumerik
+
+        a = error.axis
+        transverse = [axis_error(machine, a, f"E{j}{a}") for j in "XYZ" if j != a and f"E{j}{a}" in machine.components]
+        return write_sinumerik(error, transverse, spacing=spacing, reference=reference)
+    if fmt == "heidenhain":
+        from ncpp.export.heidenhain import write_heidenhain_com
+
+        return write_heidenhain_com(error, spacing=spacing)
+    raise NcppError(f"unknown format {fmt!r}: use one of {', '.join(FORMATS)}")
+
+
+__all__ = ["FORMATS", "AxisError", "axis_error", "export_table"]

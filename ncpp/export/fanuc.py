@@ -1,0 +1,136 @@
+"""FANUC stored pitch error compensation (parameters 3620–3624) and backlash (1851).
+
+FANUC's scheme (Series 0i/16i/18i/30i parameter manuals, "pitch error
+compensation"): compensation points are equidistant, every `interval`
+(3624) from the reference position, which is compensation point number 3620.
+The value stored for point n is an *incremental* correction in detection
+units, output while the axis passes the interval that ends at point n
+(between points n−1 and n); each value lies in −7..+7 and is multiplied by the
+magnification 3623 (0 or 1 → ×1, at most ×100).  3621 / 3622 are the point
+numbers at the negative and positive ends.  The correction is zero at the
+reference position: an error there is an offset of the reference position.
+
+So with C(x) = −(e(x) − e(x_ref)) the wanted correction in detection units,
+point k's value is v_k = round(C_k/M) − round(C_{k−1}/M): rounding the
+running sum, not each step, keeps the error from drifting along the axis.
+M is the smallest magnification that brings every |v_k| within 7.
+
+Reversal: the pitch table corrects travel in the + direction (reference
+return in +, ZMIx = 0); the backlash parameter 1851 takes the mean extra
+error of − travel, e₋ − e₊ (positive = lost motion).  Position-dependent
+reversal (bidirectional pitch compensation, 3605#0) is not written; its
+spread is reported.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+
+import numpy as np
+
+from ncpp.errors import NcppError
+from ncpp.export.common import AxisError
+
+MAX_POINTS = 1024  # point numbers 0..1023, shared by all axes (0i); 30i allows more
+MAX_STEP = 7
+MAX_MAGNIFICATION = 100
+
+
+def write_fanuc_pitch(
+    error: AxisError,
+    *,
+    spacing: float | None = None,
+    reference: float = 0.0,
+    detection_unit: float = 0.001,
+    first_point: int = 0,
+    axis_number: int | None = None,
+    max_points: int = MAX_POINTS,
+) -> tuple[str, list[str]]:
+    """Parameter listing (text with `(...)` comments) and the notes on what was changed."""
+    notes: list[str] = []
+    lo, hi = error.lo, error.hi
+    if not lo <= reference <= hi:
+        clipped = min(max(reference, lo), hi)
+        notes.append(f"reference position {reference:g} mm lies outside the table range; {clipped:g} mm used")
+        reference = clipped
+    du = detection_unit
+    span = hi - lo
+    finest = span / (max_points - 1)
+    interval = spacing if spacing is not None else max(finest, span / 64)  # 64 points is a usual allocation
+    if interval < finest:
+        notes.append(f"FANUC: interval {interval:g} mm needs more than {max_points} points; widened")
+        interval = finest
+    interval = math.ceil(interval / du - 1e-9) * du  # an integer number of detection units
+    k_lo = -int(math.ceil((reference - lo) / interval - 1e-9))
+    k_hi = int(math.ceil((hi - reference) / interval - 1e-9))
+    k = np.arange(k_lo, k_hi + 1)
+    x = reference + k * interval
+    fwd = error.forward(x)
+    wanted = -(fwd - error.forward(np.array([reference]))[0]) / du  # detection units, 0 at the reference
+    magnification, steps = _fit_magnification(wanted)
+    if np.any(np.abs(steps) > MAX_STEP):
+        notes.append(
+            f"FANUC: increments up to {np.max(np.abs(steps))} x{magnification} exceed +-{MAX_STEP}; "
+            "clipped (use a smaller --spacing)"
+        )
+        steps = np.clip(steps, -MAX_STEP, MAX_STEP)
+    steps[0] = 0  # the negative-end point's value would act below the table
+    achieved = np.cumsum(steps) * magnification
+    achieved -= achieved[k == 0][0]
+    residual = float(np.max(np.abs(achieved - wanted))) * du
+    reversal = (error.reverse(x) - fwd) / du
+    backlash = int(round(float(np.mean(reversal))))
+    ref_number = first_point - k_lo
+    if ref_number < 0 or first_point + len(x) - 1 >= max_points:
+        raise NcppError(f"point numbers {first_point}..{first_point + len(x) - 1} exceed 0..{max_points - 1}")
+    a = axis_number if axis_number is not None else "XYZ".index(error.axis) + 1
+    params = [
+        (3620, ref_number, f"point number of the reference position, {reference:g} mm"),
+        (3621, first_point, f"point number at the negative end, {x[0]:g} mm"),
+        (3622, first_point + len(x) - 1, f"point number at the positive end, {x[-1]:g} mm"),
+        (3623, magnification, "magnification of the values"),
+        (3624, round(interval / du), f"interval between points in detection units = {interval:g} mm"),
+        (1851, backlash, "backlash in detection units = mean of e- minus e+"),
+    ]
+    lines = [
+        f"NCPP EXPORT-TABLE {error.name} OF AXIS {error.axis} AS FANUC PITCH ERROR COMPENSATION",
+        f"parameter tape format: N<parameter> A<axis {a}> P<value>; pitch data N<10000 + point> P<value>",
+        f"detection unit {du * 1000:g} um; a point's value is the increment, times 3623,",
+        "output while the axis travels from the point before to this point",
+        f"largest residual after rounding: {residual * 1000:.2f} um at the points",
+        f"reversal varies {np.min(reversal) * du * 1000:.1f} .. {np.max(reversal) * du * 1000:.1f} um along the axis;"
+        " only its mean goes to 1851",
+        "check 3624 against the fastest feed: FANUC needs interval >= max feed / 7500",
+        *notes,
+    ]
+    out = ["%"] + [f"({_safe(line)})" for line in lines]
+    out += [f"N{number}A{a}P{value} ({_safe(what)})" for number, value, what in params]
+    out += [f"N{10000 + first_point + i}P{int(v)} ({x[i]:.3f} MM)" for i, v in enumerate(steps)]
+    return "\n".join(out + ["%"]) + "\n", notes
+
+
+def _safe(text: str) -> str:
+    """FANUC comments end at the first ')': keep them out."""
+    return text.replace("(", "").replace(")", "").upper()
+
+
+def _fit_magnification(wanted: np.ndarray) -> tuple[int, np.ndarray]:
+    """Smallest magnification M whose rounded increments stay within ±7."""
+    for m in range(1, MAX_MAGNIFICATION + 1):
+        steps = np.diff(np.round(wanted / m), prepend=np.round(wanted[0] / m)).astype(int)
+        if np.max(np.abs(steps)) <= MAX_STEP:
+            return m, steps
+    m = MAX_MAGNIFICATION
+    return m, np.diff(np.round(wanted / m), prepend=np.round(wanted[0] / m)).astype(int)
+
+
+def read_fanuc_pitch(text: str) -> tuple[dict[int, int], dict[int, int]]:
+    """(parameters, pitch values by point number) from a parameter tape."""
+    params, points = {}, {}
+    for line in text.splitlines():
+        m = re.match(r"N(\d+)(?:A\d+)?P([-+]?\d+)", line)
+        if m:
+            number, value = int(m.group(1)), int(m.group(2))
+            (points if number >= 10000 else params)[number % 10000 if number >= 10000 else number] = value
+    return params, points
