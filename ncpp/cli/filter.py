@@ -1,15 +1,21 @@
 """`ncpp [IN] [-o OUT]`: the stdin/stdout NC filter.
 
-With no passes the output is the input, byte for byte; the program is still
-read completely first, so a program with an error produces no output.
+With no passes the output is the input, byte for byte.  Every block goes
+through the motion interpreter, so a program LinuxCNC would refuse (bad arc
+radius, conflicting words...) fails with `file:line:col: message` and
+nothing is written; output is spooled until the whole program was read.
 """
 
 from __future__ import annotations
 
 import argparse
+from typing import Iterable, Iterator
 
 from ncpp.cli.io import add_io_arguments, open_input, open_output
 from ncpp.errors import Warnings
+from ncpp.motion import interpret
+from ncpp.motion.segments import Event
+from ncpp.program.blocks import Block
 from ncpp.program.parser import parse_stream
 from ncpp.program.writer import write_blocks
 
@@ -23,5 +29,16 @@ def register(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     warnings = Warnings(strict=args.strict)
     with open_input(args.input) as (stream, name), open_output(args.output) as out:
-        write_blocks(parse_stream(stream, name), out)
+        events = interpret(parse_stream(stream, name), file=name, warnings=warnings)
+        write_blocks(source_blocks(events), out)
     return 1 if warnings.count and args.strict else 0
+
+
+def source_blocks(events: Iterable[Event]) -> Iterator[Block]:
+    """Each event's block, once (a G28 block makes two moves)."""
+    last = None
+    for event in events:
+        block = event.block
+        if block is not last:
+            yield block
+            last = block

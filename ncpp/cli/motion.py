@@ -1,0 +1,74 @@
+"""`ncpp motion FILE [--format rs274|json]`: a program's motion as the interpreter reads it.
+
+`--format rs274` (default) prints one line per move, exactly as LinuxCNC's
+`rs274` prints its canonical motion calls (numbers `%.4f`, program units,
+program coordinates):
+
+    STRAIGHT_TRAVERSE(x, y, z, a, b, c)
+    STRAIGHT_FEED(x, y, z, a, b, c)
+    ARC_FEED(first_end, second_end, first_axis, second_axis, rotation, axis_end_point, a, b, c)
+
+Only these three calls are printed (no feed, unit, plane or spindle calls),
+so the output compares line by line with
+`rs274 FILE | grep -oE '(STRAIGHT_TRAVERSE|STRAIGHT_FEED|ARC_FEED)\\(.*\\)'`.
+
+`--format json` prints one JSON object per move (JSON Lines): source line,
+kind (traverse / feed / arc), start, end, centre and turn of arcs, feed,
+plane, inch, and the work offset (machine minus program position).
+"""
+
+from __future__ import annotations
+
+import argparse
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    parser = subparsers.add_parser(
+        "motion",
+        help="print a program's motion as rs274 canonical calls or JSON lines",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument("input", nargs="?", metavar="FILE", help="NC program (default: standard input)")
+    parser.add_argument("--format", choices=("rs274", "json"), default="rs274")
+    parser.add_argument("--strict", action="store_true", help="refuse constructs outside the interpreter's scope")
+    parser.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    import json
+    import sys
+
+    from ncpp.cli.io import open_input
+    from ncpp.errors import Warnings
+    from ncpp.motion import interpret
+    from ncpp.motion.canon import format_event
+    from ncpp.motion.segments import Arc, Line
+    from ncpp.program.parser import parse_stream
+
+    warnings = Warnings(strict=args.strict)
+    out = sys.stdout
+    with open_input(args.input) as (stream, name):
+        for event in interpret(parse_stream(stream, name), file=name, warnings=warnings):
+            if type(event) is not Line and type(event) is not Arc:
+                continue
+            if args.format == "rs274":
+                out.write(format_event(event) + "\n")
+                continue
+            record = {
+                "line": event.block.line,
+                "kind": "arc" if type(event) is Arc else ("traverse" if event.rapid else "feed"),
+                "start": event.start,
+                "end": event.end,
+                "feed": event.feed,
+                "plane": event.context.plane,
+                "inch": event.context.inch,
+                "offset": event.context.offset,
+            }
+            if type(event) is Arc:
+                record["center"] = event.center
+                record["turn"] = event.turn
+            if event.extra:
+                record["extra"] = event.extra
+            out.write(json.dumps(record) + "\n")
+    return 0

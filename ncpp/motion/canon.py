@@ -1,0 +1,75 @@
+"""rs274's canonical-call text for motion events, and a reader for rs274's output.
+
+LinuxCNC's stand-alone interpreter (`rs274 -g FILE`) prints one canonical
+call per line, numbers as `%.4f`, positions in program coordinates and
+program units:
+
+    STRAIGHT_TRAVERSE(x, y, z, a, b, c)
+    STRAIGHT_FEED(x, y, z, a, b, c)
+    ARC_FEED(first_end, second_end, first_axis, second_axis, rotation, axis_end_point, a, b, c)
+
+`format_event` prints a `Line` or `Arc` the same way (None for a `Pass`), so
+`ncpp motion FILE --format rs274` can be compared with
+`rs274 FILE | grep -oE '(STRAIGHT_TRAVERSE|STRAIGHT_FEED|ARC_FEED)\\(.*\\)'`
+line by line.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+from ncpp.motion.segments import PLANE_AXES, Arc, Event, Line
+
+MOTION_CALLS = ("STRAIGHT_TRAVERSE", "STRAIGHT_FEED", "ARC_FEED")
+_CALL = re.compile(r"(STRAIGHT_TRAVERSE|STRAIGHT_FEED|ARC_FEED)\(([^)]*)\)")
+
+
+def _rotary(extra: tuple[float, ...]) -> tuple[float, float, float]:
+    return (extra[0], extra[1], extra[2]) if extra else (0.0, 0.0, 0.0)
+
+
+def format_event(event: Event) -> str | None:
+    """The rs274 canonical call of a motion event; None for a Pass."""
+    if type(event) is Line:
+        name = "STRAIGHT_TRAVERSE" if event.rapid else "STRAIGHT_FEED"
+        values = (*event.end, *_rotary(event.extra))
+        return f"{name}({', '.join(f'{v:.4f}' for v in values)})"
+    if type(event) is Arc:
+        a, b, n = PLANE_AXES[event.context.plane]
+        e, c = event.end, event.center
+        head = ", ".join(f"{v:.4f}" for v in (e[a], e[b], c[a], c[b]))
+        tail = ", ".join(f"{v:.4f}" for v in (e[n], *_rotary(event.extra)))
+        return f"ARC_FEED({head}, {event.turn}, {tail})"
+    return None
+
+
+@dataclass(frozen=True, slots=True)
+class CanonCall:
+    """One motion call read from rs274 output (or from `format_event`)."""
+
+    name: str
+    args: tuple[float, ...]
+
+    @property
+    def end(self) -> tuple[float, ...]:
+        """The end point as rs274 orders it (x y z for lines; first, second, normal for arcs)."""
+        if self.name == "ARC_FEED":
+            return (self.args[0], self.args[1], self.args[5])
+        return self.args[:3]
+
+    @property
+    def center(self) -> tuple[float, float] | None:
+        return (self.args[2], self.args[3]) if self.name == "ARC_FEED" else None
+
+    @property
+    def rotation(self) -> int | None:
+        return int(self.args[4]) if self.name == "ARC_FEED" else None
+
+
+def read_canon(text: str) -> list[CanonCall]:
+    """The motion calls of rs274 output (other calls and messages are skipped)."""
+    calls = []
+    for m in _CALL.finditer(text):
+        calls.append(CanonCall(m.group(1), tuple(float(v) for v in m.group(2).split(","))))
+    return calls

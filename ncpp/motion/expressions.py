@@ -1,0 +1,213 @@
+"""Parameters and expressions, with LinuxCNC (rs274ngc) semantics.
+
+Expressions are the nested tuples the parser builds (see
+ncpp.program.blocks): ("num", v) ("param", key) ("neg", x) ("pos", x)
+("bin", op, a, b) ("call", NAME, x) ("atan2", a, b) ("exists", param).
+Angles are in degrees, comparisons use rs274ngc's 0.0001 tolerance, MOD
+is never negative, ROUND rounds half away from zero.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Callable
+
+# rs274ngc: numbered parameters 1..RS274NGC_MAX_PARAMETERS-1 (#0 is Fanuc's null, read as 0)
+MAX_PARAMETER = 5601
+EQUAL_TOLERANCE = 0.0001
+
+
+class ExpressionError(Exception):
+    """A bad expression (divide by zero, undefined parameter...); the caller adds the location."""
+
+
+class OutOfScope(Exception):
+    """Something the interpreter does not evaluate (HAL pins, INI values, machine state)."""
+
+
+def _round(x: float) -> float:
+    return float(math.floor(x + 0.5)) if x >= 0 else -float(math.floor(-x + 0.5))
+
+
+def _acos(x: float) -> float:
+    if not -1.0 <= x <= 1.0:
+        raise ExpressionError("Argument to acos out of range")
+    return math.degrees(math.acos(x))
+
+
+def _asin(x: float) -> float:
+    if not -1.0 <= x <= 1.0:
+        raise ExpressionError("Argument to asin out of range")
+    return math.degrees(math.asin(x))
+
+
+def _ln(x: float) -> float:
+    if x <= 0.0:
+        raise ExpressionError("Zero or negative argument to ln")
+    return math.log(x)
+
+
+def _sqrt(x: float) -> float:
+    if x < 0.0:
+        raise ExpressionError("Negative argument to sqrt")
+    return math.sqrt(x)
+
+
+def _bcd(x: float) -> float:  # Fanuc: binary -> binary-coded decimal
+    return float(int(str(int(x)), 16))
+
+
+def _bin(x: float) -> float:  # Fanuc: binary-coded decimal -> binary
+    return float(int(format(int(x), "x")))
+
+
+FUNCTIONS: dict[str, Callable[[float], float]] = {
+    "ABS": abs,
+    "ACOS": _acos,
+    "ASIN": _asin,
+    "COS": lambda x: math.cos(math.radians(x)),
+    "EXP": math.exp,
+    "FIX": lambda x: float(math.floor(x)),
+    "FUP": lambda x: float(math.ceil(x)),
+    "ROUND": _round,
+    "LN": _ln,
+    "SIN": lambda x: math.sin(math.radians(x)),
+    "SQRT": _sqrt,
+    "TAN": lambda x: math.tan(math.radians(x)),
+    "BIN": _bin,
+    "BCD": _bcd,
+}
+
+
+def _divide(a: float, b: float) -> float:
+    if b == 0.0:
+        raise ExpressionError("Attempt to divide by zero")
+    return a / b
+
+
+def _modulo(a: float, b: float) -> float:
+    if b == 0.0:
+        raise ExpressionError("Attempt to divide by zero")
+    r = math.fmod(a, b)
+    return r + abs(b) if r < 0.0 else r
+
+
+def _power(a: float, b: float) -> float:
+    if a < 0.0 and b != math.floor(b):
+        raise ExpressionError("Attempt to raise negative to non-integer power")
+    return math.pow(a, b)
+
+
+OPERATORS: dict[str, Callable[[float, float], float]] = {
+    "+": lambda a, b: a + b,
+    "-": lambda a, b: a - b,
+    "*": lambda a, b: a * b,
+    "/": _divide,
+    "MOD": _modulo,
+    "**": _power,
+    "EQ": lambda a, b: float(abs(a - b) < EQUAL_TOLERANCE),
+    "NE": lambda a, b: float(abs(a - b) >= EQUAL_TOLERANCE),
+    "GT": lambda a, b: float(a > b),
+    "GE": lambda a, b: float(a >= b),
+    "LT": lambda a, b: float(a < b),
+    "LE": lambda a, b: float(a <= b),
+    "AND": lambda a, b: float(a != 0.0 and b != 0.0),
+    "OR": lambda a, b: float(a != 0.0 or b != 0.0),
+    "XOR": lambda a, b: float((a != 0.0) != (b != 0.0)),
+}
+
+
+class Parameters:
+    """Numbered (`#1`) and named (`#<name>`) parameters.
+
+    `system` answers reads of LinuxCNC's predefined read-only names
+    (`#<_x>`, `#<_metric>`...) from the interpreter's state; numbered
+    parameters the interpreter keeps in machine state (work offsets, G28
+    positions, current position: 5161-5390, 5400-5428) are out of scope
+    because their values depend on the control's own files and units.
+    """
+
+    def __init__(self, system: Callable[[str], float | None] | None = None):
+        self.numbered: dict[int, float] = {}
+        self.named: dict[str, float] = {}
+        self.system = system
+
+    def key(self, key, evaluate: Callable[[tuple], float]) -> int | str:
+        if isinstance(key, tuple):  # `#[expr]`, `##1`
+            value = evaluate(key[1])
+            key = int(round(value))
+            if abs(key - value) > EQUAL_TOLERANCE:
+                raise ExpressionError("Parameter number out of range")
+        if isinstance(key, int):
+            if not 1 <= key <= MAX_PARAMETER and key != 0:
+                raise ExpressionError("Parameter number out of range")
+            return key
+        return normalise_name(key)
+
+    def read(self, key: int | str) -> float:
+        if type(key) is int:
+            if 5161 <= key <= 5390 or 5400 <= key <= 5428:
+                if key not in self.numbered:
+                    raise OutOfScope(f"machine-state parameter #{key}")
+            return self.numbered.get(key, 0.0)
+        value = self.named.get(key)
+        if value is not None:
+            return value
+        if key.startswith("_") and self.system is not None:
+            value = self.system(key)
+            if value is not None:
+                return value
+            if key.startswith(("_hal[", "_ini[")) or key in _MACHINE_STATE:
+                raise OutOfScope(f"machine-state parameter #<{key}>")
+        raise ExpressionError(f"Named parameter #<{key}> not defined")
+
+    def exists(self, key: int | str) -> bool:
+        if type(key) is int:
+            return True
+        return key in self.named or (key.startswith("_") and self.system is not None and self.system(key) is not None)
+
+    def write(self, key: int | str, value: float) -> None:
+        if type(key) is int:
+            self.numbered[key] = value
+            return
+        if key.startswith("_") and self.system is not None and self.system(key) is not None:
+            raise ExpressionError(f"Cannot assign to read-only parameter #<{key}>")
+        self.named[key] = value
+
+
+# Predefined names whose values live in the control (tool table, spindle, task state).
+_MACHINE_STATE = frozenset(
+    "_current_tool _current_pocket _selected_tool _selected_pocket _rpm _spindle_on _spindle_cw "
+    "_mist _flood _speed_override _feed_override _adaptive_feed _feed_hold _task _call_level "
+    "_remap_level _value _value_returned _vmajor _vminor _retract_r1 _retract_old_z".split()
+)
+
+
+def normalise_name(name: str) -> str:
+    """`<My Var>` -> `myvar`: rs274ngc ignores case and spaces in names."""
+    if name.startswith("<"):
+        name = name[1:-1]
+    return "".join(name.split()).lower()
+
+
+def evaluate(expr: tuple, params: Parameters) -> float:
+    """The value of an expression; raises ExpressionError or OutOfScope."""
+    kind = expr[0]
+    if kind == "num":
+        return expr[1]
+    if kind == "param":
+        return params.read(params.key(expr[1], lambda e: evaluate(e, params)))
+    if kind == "bin":
+        return OPERATORS[expr[1]](evaluate(expr[2], params), evaluate(expr[3], params))
+    if kind == "neg":
+        return -evaluate(expr[1], params)
+    if kind == "pos":
+        return evaluate(expr[1], params)
+    if kind == "call":
+        return FUNCTIONS[expr[1]](evaluate(expr[2], params))
+    if kind == "atan2":
+        return math.degrees(math.atan2(evaluate(expr[1], params), evaluate(expr[2], params)))
+    if kind == "exists":
+        target = expr[1]
+        return float(params.exists(params.key(target[1], lambda e: evaluate(e, params))))
+    raise ExpressionError(f"cannot evaluate {kind!r}")

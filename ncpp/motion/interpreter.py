@@ -1,0 +1,782 @@
+"""Blocks -> motion events, as LinuxCNC's rs274ngc interpreter reads them.
+
+`interpret(blocks)` is a generator: one event per block (`Line`, `Arc` or
+`Pass`; a G28/G30 block gives two `Line`s), state bounded whatever the
+program length.  Positions are program (work) coordinates in program units,
+exactly what rs274 prints in its canonical calls; `Context.offset` says where
+the program origin sits in machine coordinates.
+
+Scope: modal G0-G3, planes, G90/G91, G90.1/G91.1, G20/G21 (state converted
+on a switch, like LinuxCNC), G54-G59.3, G10 L2/L20 (no rotation), G92 family,
+G52, G53, G28/G30, G43 (tool lengths read as zero: the control's tool table
+is not known) / G43.1 / G49, F and inverse time, IJK and R arcs, helices,
+P turns, parameters and expressions.  Anything else (o-word and Fanuc macro
+control flow, M98/M99, canned cycles, cutter compensation, splines,
+threading, probing, polar words, Fanuc `,C`/`,R` corner rounding) makes the
+interpreter's state unknown: that block and every later block pass through
+as `Pass` after ONE warning (an error with `strict`).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Iterable, Iterator
+
+from ncpp.errors import Location, NcppError, Warnings
+from ncpp.motion.expressions import ExpressionError, OutOfScope, Parameters, evaluate, normalise_name
+from ncpp.motion.segments import PLANE_AXES, Arc, Context, Event, Line, Pass
+from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
+
+MM_PER_INCH = 25.4
+AXES = "XYZABCUVW"
+AXIS_INDEX = {letter: i for i, letter in enumerate(AXES)}
+LINEAR = (0, 1, 2, 6, 7, 8)  # axes that change with G20/G21 (not the rotary A B C)
+
+# rs274ngc tolerances (interp_internal.hh), in program units
+TOLERANCE = {False: 0.002, True: 0.0002}  # R arcs and zero-radius checks: mm, inch
+CENTER_ARC_ABS = {False: 2 * 0.01 * math.sqrt(2), True: 2 * 0.001 * math.sqrt(2)}
+CENTER_ARC_REL = 0.001
+TINY = 1e-12
+
+_GROUP_CODES = {
+    0: (4, 10, 28, 28.1, 30, 30.1, 52, 53, 92, 92.1, 92.2, 92.3),
+    1: (0, 1, 2, 3, 5, 5.1, 5.2, 5.3, 33, 33.1, 38.2, 38.3, 38.4, 38.5, 70, 71, 71.1, 71.2, 72, 72.1, 72.2,
+        73, 74, 76, 80, 81, 82, 83, 84, 85, 86, 87, 88, 89),
+    2: (17, 18, 19, 17.1, 18.1, 19.1),
+    3: (90, 91),
+    4: (90.1, 91.1),
+    5: (93, 94, 95),
+    6: (20, 21),
+    7: (40, 41, 42, 41.1, 42.1),
+    8: (43, 43.1, 43.2, 49),
+    10: (98, 99),
+    12: (54, 55, 56, 57, 58, 59, 59.1, 59.2, 59.3),
+    13: (61, 61.1, 64),
+    14: (96, 97),
+    15: (7, 8),
+    # Fanuc codes rs274ngc lacks; recognised so that they pass through as out of scope
+    16: (15, 16, 50, 51, 50.1, 51.1, 54.1, 65, 66, 67, 68, 69, 31),
+}  # fmt: skip
+G_GROUP: dict[float, int] = {float(code): group for group, codes in _GROUP_CODES.items() for code in codes}
+
+# G codes whose meaning the interpreter does not follow (the reason names them in the warning)
+OUT_OF_SCOPE_G = {
+    **{c: "canned cycle" for c in (73.0, 74.0, 76.0, 81.0, 82.0, 83.0, 84.0, 85.0, 86.0, 87.0, 88.0, 89.0)},
+    **{c: "lathe cycle" for c in (70.0, 71.0, 71.1, 71.2, 72.0, 72.1, 72.2)},
+    **{c: "spline" for c in (5.0, 5.1, 5.2, 5.3)},
+    **{c: "threading" for c in (33.0, 33.1)},
+    **{c: "probing" for c in (38.2, 38.3, 38.4, 38.5)},
+    **{c: "cutter compensation" for c in (41.0, 42.0, 41.1, 42.1)},
+    **{c: "UVW-plane arcs" for c in (17.1, 18.1, 19.1)},
+    7.0: "lathe diameter mode",
+    43.2: "additional tool length offset",
+    15.0: "polar coordinates", 16.0: "polar coordinates",
+    50.0: "scaling", 51.0: "scaling", 50.1: "mirroring", 51.1: "mirroring",
+    54.1: "extended work offsets", 65.0: "macro call", 66.0: "modal macro call", 67.0: "modal macro call",
+    68.0: "coordinate rotation", 69.0: "coordinate rotation", 31.0: "skip function",
+}  # fmt: skip
+OUT_OF_SCOPE_M = {98.0: "M98 subprogram call", 99.0: "M99 subprogram return", 70.0: "M70 modal state save",
+                  71.0: "M71 modal state invalidate", 72.0: "M72 modal state restore", 73.0: "M73 modal state save"}  # fmt: skip
+OUT_OF_SCOPE_STATEMENT = {"oword": "o-word control flow", "if": "Fanuc macro IF", "while": "Fanuc macro WHILE",
+                          "end": "Fanuc macro END", "goto": "Fanuc macro GOTO"}  # fmt: skip
+IGNORED_STATEMENTS = frozenset(("tape", "checksum", "block_delete", "program_name"))
+
+# check_other_codes: which motion codes may use a word
+_ARC_LIKE = {2.0, 3.0, 5.0, 5.1, 76.0, 87.0, 71.0}
+_CYCLES = {73.0, 81.0, 82.0, 83.0, 84.0, 85.0, 86.0, 87.0, 88.0, 89.0}
+_K_MOTIONS = {2.0, 3.0, 33.0, 33.1, 71.0, 76.0, 87.0}
+_P_MOTIONS = {76.0, 82.0, 86.0, 88.0, 89.0, 5.0, 5.2, 2.0, 3.0, 71.0, 74.0, 84.0}
+_P_MCODES = {50.0, 51.0, 52.0, 53.0, 62.0, 63.0, 64.0, 65.0, 66.0, 19.0}
+_Q_MOTIONS = {83.0, 73.0, 5.0, 71.0, 76.0}
+_R_MOTIONS = {2.0, 3.0, 76.0, 73.0, 71.0, 74.0} | _CYCLES
+_ARC_LETTERS = {17: ("I", "J", "K"), 18: ("K", "I", "J"), 19: ("J", "K", "I")}  # first, second, normal offset
+_PLANE_NAMES = {17: "xy", 18: "xz", 19: "yz"}
+
+
+class _OutOfScope(Exception):
+    def __init__(self, reason: str, col: int | None):
+        super().__init__(reason)
+        self.reason = reason
+        self.col = col
+
+
+def interpret(
+    blocks: Iterable[Block],
+    *,
+    file: str = "<stdin>",
+    warnings: Warnings | None = None,
+    strict: bool = False,
+) -> Iterator[Event]:
+    """Motion events of a program's blocks, lazily (see the module docstring).
+
+    Raises NcppError (file, line, column of the offending word) on a program
+    LinuxCNC would refuse.  Out-of-scope constructs warn once through
+    `warnings` (stderr by default) and end interpretation; with `strict`
+    (or a strict `warnings`) they raise NcppError instead.
+    """
+    if warnings is None:
+        warnings = Warnings(strict=strict)
+    elif strict and not warnings.strict:
+        warnings = Warnings(strict=True, stream=warnings.stream)
+    return Interpreter(file).run(blocks, warnings)
+
+
+class Interpreter:
+    """Modal state of one program run (program units throughout)."""
+
+    def __init__(self, file: str = "<stdin>"):
+        self.file = file
+        self.pos = [0.0] * 9  # program position of X Y Z A B C U V W
+        self.plane = 17
+        self.absolute = True
+        self.arc_absolute = False
+        self.inch = False
+        self.inverse_time = False
+        self.feed = 0.0
+        self.motion: float | None = None  # modal motion G code (0-3), None for G80 / none yet
+        self.coord_system = 1
+        self.g5x = [[0.0] * 9 for _ in range(10)]  # index 1..9: G54..G59.3
+        self.g92 = [0.0] * 9
+        self.g92_saved = [0.0] * 9
+        self.tool = [0.0] * 9
+        self.home = {28: [0.0] * 9, 30: [0.0] * 9}  # G28/G30 positions, machine coordinates
+        self.uses_extra_axes = False
+        self.params = Parameters(self._system_parameter)
+        self._context: Context | None = None
+        self._fast = False
+        self.done = False  # program end (M2/M30) reached or state unknown
+
+    # -- the event stream ---------------------------------------------------------
+    def run(self, blocks: Iterable[Block], warnings: Warnings) -> Iterator[Event]:
+        block_event = self.block
+        for block in blocks:
+            if self.done:
+                yield _pass(block)
+                continue
+            try:
+                event = block_event(block)  # verbatim blocks (after the closing %) have no items
+            except _OutOfScope as stop:
+                self.done = True
+                where = Location(self.file, block.line, stop.col)
+                warnings.warn(
+                    f"{stop.reason} is outside the motion interpreter's scope; from this line on the "
+                    "program passes through uninterpreted (its modal state is unknown)",
+                    where,
+                )
+                yield _pass(block)
+                continue
+            if type(event) is tuple:
+                yield from event
+            else:
+                yield event
+
+    def context(self) -> Context:
+        if self._context is None:
+            offset = self.g5x[self.coord_system]
+            self._context = Context(
+                self.plane,
+                self.absolute,
+                self.arc_absolute,
+                self.inch,
+                tuple(offset[i] + self.g92[i] + self.tool[i] for i in range(3)),  # type: ignore[arg-type]
+            )
+        return self._context
+
+    # -- one block ------------------------------------------------------------------
+    def block(self, block: Block) -> Event | tuple[Event, ...]:
+        """The event(s) of one block; updates the modal state."""
+        items = block.items
+        if not items:
+            return _pass(block)
+        if self._fast:  # absolute G0/G1 with a usable feed: try the plain `X.. Y.. Z..` line
+            end = self.pos[:]
+            seen = 0
+            for item in items:
+                if type(item) is not Word:
+                    break
+                slot = _XYZ_SLOT.get(item.letter)
+                if slot is None or seen & slot[1]:
+                    break
+                seen |= slot[1]
+                end[slot[0]] = item.value
+            else:
+                return self._fast_line(block, end)
+        words: dict[str, tuple[float, Word | ExprWord]] = {}
+        gcodes: dict[int, tuple[float, Word | ExprWord]] | None = None
+        mcodes: dict[float, Word | ExprWord] | None = None
+        assignments = None
+        for item in items:
+            kind = type(item)
+            if kind is Word:
+                letter = item.letter
+                if letter in _AXIS_LETTERS_F:  # the common case first
+                    if letter in words:
+                        self._fail(f"Multiple {letter.lower()} words on one line", block, item)
+                    words[letter] = (item.value, item)
+                    continue
+                value = item.value
+            elif kind is Comment:
+                continue
+            elif kind is ExprWord:
+                letter, value = item.letter, self._evaluate(item.expr, block, item)
+            else:
+                what = item.kind
+                if what == "assignment":
+                    target, expr = item.node
+                    key = self._param_key(target, block, item)
+                    assignments = assignments or []
+                    assignments.append((key, self._evaluate(expr, block, item), item))
+                elif what not in IGNORED_STATEMENTS:
+                    raise _OutOfScope(OUT_OF_SCOPE_STATEMENT.get(what, what), item.start + 1)
+                continue
+            if letter == "G":
+                group = G_GROUP.get(value)
+                if group is None:
+                    self._fail("Unknown g code used", block, item)
+                if gcodes is None:
+                    gcodes = {}
+                elif group in gcodes:
+                    if group == 1 and (value == 80.0 or gcodes[1][0] == 80.0):
+                        # rs274ngc lets G80 share a line with a motion code (`G00 G80 G90`): the motion wins
+                        if value == 80.0:
+                            continue
+                    else:
+                        self._fail("Two g codes used from same modal group", block, item)
+                gcodes[group] = (value, item)
+            elif letter == "M":
+                if mcodes is None:
+                    mcodes = {}
+                mcodes[value] = item
+            elif letter == "N" or letter == "$":
+                continue
+            else:
+                if letter in words:
+                    self._fail(f"Multiple {letter.lower()} words on one line", block, item)
+                words[letter] = (value, item)
+        if assignments is not None:  # rs274ngc: after the whole line is read
+            for key, value, item in assignments:
+                try:
+                    self.params.write(key, value)
+                except ExpressionError as err:
+                    self._fail(str(err), block, item)
+        if gcodes is None and mcodes is None:
+            if not words:
+                return _pass(block)
+            motion = self.motion
+            if motion is not None and words.keys() <= _PLAIN_LETTERS[motion] and not words.keys() <= _F_ONLY:
+                return self._modal_move(block, words, motion)
+        return self._execute(block, words, gcodes or {}, mcodes or {})
+
+    def _update_fast(self) -> None:
+        """Whether a block of plain X/Y/Z words can take the fast path (nothing to check)."""
+        motion = self.motion
+        self._fast = self.absolute and (motion == 0.0 or (motion == 1.0 and not self.inverse_time))
+
+    def _fast_line(self, block: Block, end: list[float]) -> Line:
+        pos = self.pos
+        self.pos = end
+        line = _new(Line)
+        s0, s1, s2, s3, s4, s5, s6, s7 = _LINE_SLOTS
+        s0(line, (pos[0], pos[1], pos[2]))
+        s1(line, (end[0], end[1], end[2]))
+        s2(line, self.motion == 0.0)
+        s3(line, self.feed)
+        s4(line, block)
+        s5(line, self._context or self.context())
+        s6(line, (end[3], end[4], end[5], end[6], end[7], end[8]) if self.uses_extra_axes else ())
+        s7(line, False)
+        return line
+
+    def _modal_move(self, block: Block, words: dict, motion: float) -> Event:
+        """The hot path: a block of axis words (and F) continuing the modal motion."""
+        f = words.get("F")
+        if f is not None:
+            self.feed = f[0]
+            self._update_fast()
+        if motion > 1.0:
+            return self._arc(block, words, motion, None, None)
+        if motion == 1.0 and self.inverse_time:
+            self._check_feed(block, words, "Cannot do g1 with zero feed rate", "F word missing with inverse time g1 move")
+        if not self.uses_extra_axes and not words.keys() <= _XYZF:
+            self.uses_extra_axes = True
+        pos = self.pos
+        end = pos[:]
+        if self.absolute:
+            for letter, value in words.items():
+                if letter != "F":
+                    end[AXIS_INDEX[letter]] = value[0]
+        else:
+            for letter, value in words.items():
+                if letter != "F":
+                    end[AXIS_INDEX[letter]] += value[0]
+        self.pos = end
+        line = _new(Line)  # _new_line, inlined on the hot path
+        s0, s1, s2, s3, s4, s5, s6, s7 = _LINE_SLOTS
+        s0(line, (pos[0], pos[1], pos[2]))
+        s1(line, (end[0], end[1], end[2]))
+        s2(line, motion == 0.0)
+        s3(line, self.feed)
+        s4(line, block)
+        s5(line, self._context or self.context())
+        s6(line, (end[3], end[4], end[5], end[6], end[7], end[8]) if self.uses_extra_axes else ())
+        s7(line, False)
+        return line
+
+    def _execute(self, block: Block, words: dict, gcodes: dict, mcodes: dict) -> Event | tuple[Event, ...]:
+        mode0, mode0_item = gcodes.get(0, (None, None))
+        mode1, mode1_item = gcodes.get(1, (None, None))
+        axis_item = next((item for letter, (_, item) in words.items() if letter in AXIS_INDEX), None)
+        for value, item in mcodes.items():  # subprogram calls use words (L, P) of their own
+            if value in OUT_OF_SCOPE_M:
+                raise _OutOfScope(OUT_OF_SCOPE_M[value], item.start + 1)
+        motion = self._motion_to_be(block, mode0, mode1, mode1_item, axis_item)
+        self._check_words(block, words, gcodes, mcodes, motion, mode0, mode0_item, mode1_item)
+        self._check_scope(words, gcodes)
+
+        # rs274ngc's order of execution (interp_execute.cc, convert_g)
+        if 5 in gcodes:
+            self.inverse_time = gcodes[5][0] == 93.0
+        if "F" in words:
+            self.feed = words["F"][0]
+        if 2 in gcodes:
+            self._set(plane=int(gcodes[2][0]))
+        if 6 in gcodes:
+            self._set_units(gcodes[6][0] == 20.0)
+        if 8 in gcodes:
+            self._tool_length(gcodes[8][0], words)
+        if 12 in gcodes:
+            self._coordinate_system(_COORD_SYSTEM[gcodes[12][0]])
+        if 3 in gcodes:
+            self._set(absolute=gcodes[3][0] == 90.0)
+        if 4 in gcodes:
+            self._set(arc_absolute=gcodes[4][0] == 90.1)
+        events: Event | tuple[Event, ...] | None = None
+        if mode0 is not None and mode0 not in (4.0, 53.0):
+            events = self._non_modal(block, words, mode0)
+        if mode1 is not None:
+            self.motion = None if mode1 == 80.0 else mode1
+        if motion is not None:
+            motion_word = mode1_item if mode1_item is not None else axis_item
+            if motion <= 1.0:
+                events = self._straight(block, words, motion, mode0 == 53.0)
+            else:
+                events = self._arc(block, words, motion, motion_word, mode1_item)
+        if 2.0 in mcodes or 30.0 in mcodes:
+            self._program_end()
+        self._update_fast()
+        return _pass(block) if events is None else events
+
+    # -- checks (interp_check.cc, enhance_block) ----------------------------------------
+    def _motion_to_be(self, block, mode0, mode1, mode1_item, axis_item) -> float | None:
+        covets_axes = mode0 in (10.0, 28.0, 30.0, 52.0, 92.0)
+        if mode1 is not None:
+            if mode1 == 80.0:
+                if axis_item is not None and not covets_axes:
+                    self._fail("Cannot use axis values with G80", block, axis_item)
+                if axis_item is None and mode0 in (52.0, 92.0):
+                    self._fail("All axes missing with g52 or g92", block, block.items[0])
+                return None
+            if covets_axes:
+                self._fail("Cannot use two g codes that both use axis values", block, mode1_item)
+            if axis_item is None and mode1 not in (0.0, 1.0, 2.0, 3.0):
+                self._fail("All axes missing with motion code", block, mode1_item)
+            return mode1
+        if covets_axes:
+            if axis_item is None and mode0 in (52.0, 92.0):
+                self._fail("All axes missing with g52 or g92", block, block.items[0])
+            return None
+        if axis_item is not None:
+            if self.motion is None:
+                self._fail("Cannot use axis values without a g code that uses them", block, axis_item)
+            return self.motion
+        return None
+
+    def _check_words(self, block, words, gcodes, mcodes, motion, mode0, mode0_item, mode1_item) -> None:
+        """The per-word checks of rs274ngc's check_g_codes and check_other_codes."""
+        g7 = gcodes.get(7, (None,))[0]
+        if mode0 == 4.0 and "P" not in words:
+            self._fail("Dwell time missing with G4", block, mode0_item)
+        if mode0 == 53.0:
+            if motion not in (0.0, 1.0):
+                self._fail("Must use G0 or G1 with G53", block, mode0_item)
+            distance = gcodes.get(3, (None,))[0]
+            if distance == 91.0 or (distance is None and not self.absolute):
+                self._fail("Cannot use G53 incremental", block, mode0_item)
+        if mode0 == 10.0:
+            l_number = words.get("L", (None,))[0]
+            if l_number not in (1.0, 2.0, 10.0, 11.0, 20.0):
+                self._fail("Line with G10 does not have L1, L10, L11, L2, or L20", block, mode0_item)
+            p = words.get("P", (0.0,))[0]
+            if abs(p - round(p)) > 0.0001:
+                self._fail("P value not an integer with G10", block, words["P"][1])
+            if l_number in (2.0, 20.0) and not 0 <= round(p) <= 9:
+                self._fail(f"P value out of range (0-9) with G10 L{l_number:.0f}", block, words.get("P", (0, mode0_item))[1])
+        cycle = motion in _CYCLES
+        for letter in "ABC":
+            if letter in words and cycle:
+                self._fail(f"Cannot put a{'n' if letter == 'A' else ''} {letter.lower()} in canned cycle", block, words[letter][1])
+        if "D" in words and g7 not in (41.0, 42.0, 41.1, 42.1) and gcodes.get(14, (None,))[0] != 96.0 and motion != 71.0:
+            self._fail("D word with no G41, G41.1, G42, G42.1, G71, or G96 to use it", block, words["D"][1])
+        if "E" in words and motion != 76.0 and not mcodes.keys() & {66.0, 67.0, 68.0}:
+            self._fail("E word with no G70, G76, M66, M67 or M68 to use it", block, words["E"][1])
+        if "H" in words and gcodes.get(8, (None,))[0] not in (43.0, 43.2) and motion != 76.0:
+            self._fail("H word with no G43 or G76 to use it", block, words["H"][1])
+        for letter in "IJ":
+            if letter in words and motion not in _ARC_LIKE and mode0 != 10.0:
+                self._fail(f"{letter} word with no G2, G3, G5, G5.1, G10, G71, G76, or G87 to use it", block, words[letter][1])
+        if "K" in words and motion not in _K_MOTIONS:
+            self._fail("K word with no G2, G3, G33, G33.1, G71, G76, or G87 to use it", block, words["K"][1])
+        if "L" in words and not (motion in _CYCLES or motion in (76.0, 5.2, 73.0, 71.0) or mode0 == 10.0
+                                 or g7 is not None and g7 != 40.0 or 66.0 in mcodes):  # fmt: skip
+            self._fail("L word with no G10, cutter compensation, canned cycle, digital/analog input, or NURBS code", block, words["L"][1])
+        if "P" in words:
+            p, p_item = words["P"]
+            user_m = any(100.0 <= m <= 199.0 for m in mcodes)
+            if not (mode0 in (10.0, 4.0) or gcodes.get(13, (None,))[0] == 64.0 or motion in _P_MOTIONS
+                    or mcodes.keys() & _P_MCODES or user_m):  # fmt: skip
+                self._fail("P word with no G2 G3 G4 G10 G64 G5 G5.2 G71 G76 G82 G86 G88 G89 or M50 M51 M52 M53 "
+                           "M62 M63 M64 M65 M66 or user M code to use it", block, p_item)  # fmt: skip
+            if motion in (2.0, 3.0):
+                if abs(round(p) - p) > 0.001:
+                    self._fail("P value not an integer with M19 G2 or G3", block, p_item)
+                if round(p) < 1:
+                    self._fail("P value should be 1 or greater with G2 or G3", block, p_item)
+        if "Q" in words and not (motion in _Q_MOTIONS or mode0 == 10.0 or gcodes.get(13, (None,))[0] == 64.0
+                                 or mcodes.keys() & {66.0, 67.0, 68.0, 61.0, 19.0}
+                                 or any(100.0 <= m <= 199.0 for m in mcodes)):  # fmt: skip
+            self._fail("Q word with no G5, G10, G64, G73, G76, G83, M19, M66, M67, M68 or user M code that uses it", block, words["Q"][1])
+        if "R" in words:
+            if gcodes.get(13, (None,))[0] == 64.0 and 19.0 in mcodes:
+                self._fail("R word is ambiguous on a line with both G64 and M19 - use separate lines", block, words["R"][1])
+            if motion in (0.0, 1.0) and mode0 is None:
+                raise _OutOfScope("Fanuc corner rounding (R word with G0/G1)", words["R"][1].start + 1)
+            if not (motion in _R_MOTIONS or g7 in (41.1, 42.1) or mode0 == 10.0 or 19.0 in mcodes):
+                self._fail("R word with no g code that uses it", block, words["R"][1])
+
+    def _check_scope(self, words: dict, gcodes: dict) -> None:
+        for value, item in gcodes.values():
+            reason = OUT_OF_SCOPE_G.get(value)
+            if reason is not None:
+                raise _OutOfScope(f"{reason} G{value:g}", item.start + 1)
+        for letter, (_, item) in words.items():
+            if letter in (",C", ",R"):
+                raise _OutOfScope(f"Fanuc corner {'chamfer' if letter == ',C' else 'rounding'} {letter}", item.start + 1)
+            if letter in ("@", "^"):
+                raise _OutOfScope("polar coordinates", item.start + 1)
+        g10 = gcodes.get(0, (None,))[0] == 10.0
+        if g10 and words.get("L", (None,))[0] in (1.0, 10.0, 11.0):
+            raise _OutOfScope("tool table change G10 L1/L10/L11", gcodes[0][1].start + 1)
+        if g10 and words.get("R", (0.0,))[0] != 0.0:
+            raise _OutOfScope("coordinate system rotation G10 R", words["R"][1].start + 1)
+
+    # -- modal state -------------------------------------------------------------------------
+    def _set(self, **changes) -> None:
+        for name, value in changes.items():
+            setattr(self, name, value)
+        self._context = None
+
+    def _set_units(self, inch: bool) -> None:
+        if inch == self.inch:
+            return
+        scale = 1 / MM_PER_INCH if inch else MM_PER_INCH
+        for vector in (self.pos, self.g92, self.g92_saved, self.tool, *self.g5x, *self.home.values()):
+            for i in LINEAR:
+                vector[i] *= scale
+        self._set(inch=inch)
+
+    def _shift(self, old: list[float], new: list[float]) -> None:
+        """An offset changed from `old` to `new`: the program position moves the other way."""
+        for i in range(9):
+            self.pos[i] += old[i] - new[i]
+        self._context = None
+
+    def _tool_length(self, code: float, words: dict) -> None:
+        new = [0.0] * 9
+        if code == 43.1:
+            for letter, (value, _) in words.items():
+                if letter in AXIS_INDEX:
+                    new[AXIS_INDEX[letter]] = value
+        # G43 [H]: the control's tool table is unknown; lengths read as zero like the rs274 oracle's table
+        self._shift(self.tool, new)
+        self.tool = new
+
+    def _coordinate_system(self, number: int) -> None:
+        self._shift(self.g5x[self.coord_system], self.g5x[number])
+        self.coord_system = number
+
+    def _program_end(self) -> None:
+        """M2/M30: rs274ngc resets some modes and stops reading the program."""
+        self._coordinate_system(1)
+        self._set(plane=17, absolute=True, inverse_time=False)
+        self.motion = 1.0
+        self.done = True
+
+    def _machine(self, i: int) -> float:
+        return self.pos[i] + self.g5x[self.coord_system][i] + self.g92[i] + self.tool[i]
+
+    def _non_modal(self, block: Block, words: dict, code: float) -> Event | tuple[Event, ...] | None:
+        given = [(AXIS_INDEX[letter], value) for letter, (value, _) in words.items() if letter in AXIS_INDEX]
+        self._note_axes(given)
+        if code == 92.0:
+            old = self.g92[:]
+            for i, value in given:
+                self.g92[i] = self.pos[i] + old[i] - value
+            self.g92_saved = self.g92[:]
+            self._shift(old, self.g92)
+        elif code in (92.1, 92.2):
+            old = self.g92[:]
+            self.g92 = [0.0] * 9
+            if code == 92.1:
+                self.g92_saved = [0.0] * 9
+            self._shift(old, self.g92)
+        elif code == 92.3:
+            old = self.g92[:]
+            self.g92 = self.g92_saved[:]
+            self._shift(old, self.g92)
+        elif code == 52.0:
+            old = self.g92[:]
+            for i, value in given:
+                self.g92[i] = value
+            self._shift(old, self.g92)
+        elif code == 10.0:
+            p = round(words.get("P", (0.0,))[0])
+            number = self.coord_system if p == 0 else p
+            old = self.g5x[number][:]
+            for i, value in given:
+                if words["L"][0] == 2.0:
+                    self.g5x[number][i] = value
+                else:  # L20: the current point gets the given coordinates
+                    self.g5x[number][i] = self.pos[i] + self.g5x[self.coord_system][i] - value
+            if number == self.coord_system:
+                self._shift(old, self.g5x[number])
+        elif code in (28.1, 30.1):
+            self.home[int(code)] = [self._machine(i) for i in range(9)]
+        elif code in (28.0, 30.0):
+            return self._go_home(block, given, self.home[int(code)])
+        return None
+
+    def _go_home(self, block: Block, given: list[tuple[int, float]], home: list[float]) -> tuple[Event, ...]:
+        """G28/G30: rapid to the (optional) intermediate point, then home the given axes (all if none)."""
+        middle = self._ends(given, False)
+        first = self._line(block, middle, True)
+        axes = [i for i, _ in given] or range(9)
+        end = middle[:]
+        for i in axes:
+            end[i] = home[i] - (self.g5x[self.coord_system][i] + self.g92[i] + self.tool[i])
+        return first, self._line(block, end, True)
+
+    # -- moves ---------------------------------------------------------------------------------
+    def _note_axes(self, given) -> None:
+        if not self.uses_extra_axes:
+            self.uses_extra_axes = any(i >= 3 for i, _ in given)
+
+    def _ends(self, given: list[tuple[int, float]], machine: bool) -> list[float]:
+        end = self.pos[:]
+        if machine:  # G53: machine coordinates, always absolute
+            for i, value in given:
+                end[i] = value - (self.g5x[self.coord_system][i] + self.g92[i] + self.tool[i])
+        elif self.absolute:
+            for i, value in given:
+                end[i] = value
+        else:
+            for i, value in given:
+                end[i] += value
+        return end
+
+    def _line(self, block: Block, end: list[float], rapid: bool) -> Line:
+        pos = self.pos
+        line = _new_line(
+            (pos[0], pos[1], pos[2]),
+            (end[0], end[1], end[2]),
+            rapid,
+            self.feed,
+            block,
+            self._context or self.context(),
+            tuple(end[3:]) if self.uses_extra_axes else (),
+        )
+        self.pos = end
+        return line
+
+    def _straight(self, block: Block, words: dict, motion: float, machine: bool | None) -> Line:
+        given = [(AXIS_INDEX[letter], value) for letter, (value, _) in words.items() if letter in AXIS_INDEX]
+        if not self.uses_extra_axes:
+            self._note_axes(given)
+        if motion == 1.0:
+            self._check_feed(block, words, "Cannot do g1 with zero feed rate", "F word missing with inverse time g1 move")
+        return self._line(block, self._ends(given, bool(machine)), motion == 0.0)
+
+    def _check_feed(self, block: Block, words: dict, zero: str, missing: str) -> None:
+        # A zero feed rate (`zero`) is not refused, unlike rs274ngc: program fragments often
+        # leave the feed to the control (a default feed, or one set before the program runs).
+        if self.inverse_time and "F" not in words:
+            self._fail(missing, block, block.items[0])
+
+    def _arc(self, block: Block, words: dict, motion: float, motion_item, mode1_item) -> Arc:
+        word = motion_item if motion_item is not None else next(item for _, item in words.values())
+        first_letter, second_letter, normal_letter = _ARC_LETTERS[self.plane]
+        has_r = "R" in words
+        has_ijk = "I" in words or "J" in words or "K" in words
+        if not has_r and not has_ijk:
+            self._fail("R i j k words all missing for arc", block, word)
+        if has_r and has_ijk:
+            self._fail("Mixed radius ijk format for arc", block, word)
+        self._check_feed(block, words, "Cannot make arc with zero feed rate", "F word missing with inverse time arc move")
+        if normal_letter in words:
+            self._fail(f"{normal_letter} word given for arc in {_PLANE_NAMES[self.plane]} plane", block, words[normal_letter][1])
+        given = [(AXIS_INDEX[letter], value) for letter, (value, _) in words.items() if letter in AXIS_INDEX]
+        if not self.uses_extra_axes:
+            self._note_axes(given)
+        end = self._ends(given, False)
+        a, b, _ = PLANE_AXES[self.plane]
+        start = self.pos
+        turns = round(words["P"][0]) if "P" in words else 1
+        turn = -turns if motion == 2.0 else turns
+        tolerance = TOLERANCE[self.inch]
+        if has_r:
+            ca, cb = self._center_r(block, word, start[a], start[b], end[a], end[b], words["R"][0], motion, tolerance)
+        else:
+            ia = words[first_letter][0] if first_letter in words else None
+            ib = words[second_letter][0] if second_letter in words else None
+            if self.arc_absolute:
+                ca = start[a] if ia is None else ia
+                cb = start[b] if ib is None else ib
+            else:
+                ca = start[a] + (ia or 0.0)
+                cb = start[b] + (ib or 0.0)
+            self._check_radii(block, word, start[a], start[b], end[a], end[b], ca, cb, tolerance)
+        center = [0.0, 0.0, 0.0]
+        center[a], center[b] = ca, cb
+        center[PLANE_AXES[self.plane][2]] = start[PLANE_AXES[self.plane][2]]
+        arc = Arc(
+            (start[0], start[1], start[2]),
+            (end[0], end[1], end[2]),
+            (center[0], center[1], center[2]),
+            turn,
+            self.feed,
+            block,
+            self._context or self.context(),
+            tuple(end[3:]) if self.uses_extra_axes else (),
+        )
+        self.pos = end
+        return arc
+
+    def _center_r(self, block, word, x0, y0, x1, y1, radius, motion, tolerance) -> tuple[float, float]:
+        """arc_data_r of rs274ngc: the centre of an R-format arc (negative R: the long way)."""
+        if x1 == x0 and y1 == y0:
+            self._fail("Current point same as end point of arc", block, word)
+        r = abs(radius)
+        mx, my = (x0 + x1) / 2, (y0 + y1) / 2
+        half = math.hypot(mx - x1, my - y1)
+        if half - r > tolerance:
+            self._fail("Arc radius too small to reach end point", block, word)
+        if half / r > 1 - TINY:
+            half = r  # a semicircle within tolerance
+        direction = math.atan2(y1 - y0, x1 - x0)
+        clockwise_short = (motion == 2.0) == (radius > 0)
+        theta = direction - math.pi / 2 if clockwise_short else direction + math.pi / 2
+        offset = r * math.cos(math.asin(half / r))
+        return mx + offset * math.cos(theta), my + offset * math.sin(theta)
+
+    def _check_radii(self, block, word, x0, y0, x1, y1, cx, cy, tolerance) -> None:
+        """arc_data_ijk of rs274ngc: start and end radius must agree (README.arc-radius-tolerance)."""
+        r1 = math.hypot(cx - x0, cy - y0)
+        r2 = math.hypot(cx - x1, cy - y1)
+        if r1 < tolerance or r2 < tolerance:
+            self._fail("Zero-radius arc", block, word)
+        abs_err = abs(r1 - r2)
+        rel_err = abs_err / max(r1, r2)
+        limit = CENTER_ARC_ABS[self.inch]
+        if abs_err > 100 * limit or (abs_err > limit and rel_err > CENTER_ARC_REL):
+            p, q = (_PLANE_LETTERS[self.plane])
+            self._fail(
+                "Radius to end of arc differs from radius to start: "
+                f"start=({p}{x0:.4f},{q}{y0:.4f}) center=({p}{cx:.4f},{q}{cy:.4f}) end=({p}{x1:.4f},{q}{y1:.4f}) "
+                f"r1={r1:.4f} r2={r2:.4f} abs_err={abs_err:.4g} rel_err={rel_err * 100:.4f}%",
+                block,
+                word,
+            )
+
+    # -- parameters -------------------------------------------------------------------------
+    def _evaluate(self, expr: tuple, block: Block, item) -> float:
+        try:
+            return evaluate(expr, self.params)
+        except ExpressionError as err:
+            self._fail(str(err), block, item)
+        except OutOfScope as err:
+            raise _OutOfScope(str(err), item.start + 1) from None
+        raise AssertionError("unreachable")
+
+    def _param_key(self, target: tuple, block: Block, item) -> int | str:
+        try:
+            return self.params.key(target[1], lambda e: evaluate(e, self.params))
+        except ExpressionError as err:
+            self._fail(str(err), block, item)
+        except OutOfScope as err:
+            raise _OutOfScope(str(err), item.start + 1) from None
+        raise AssertionError("unreachable")
+
+    def _system_parameter(self, name: str) -> float | None:
+        """LinuxCNC's predefined read-only named parameters that follow from the modal state."""
+        if len(name) == 2 and name[1] in "xyzabcuvw":
+            return self.pos[AXIS_INDEX[name[1].upper()]]
+        value = {
+            "_metric": float(not self.inch),
+            "_imperial": float(self.inch),
+            "_absolute": float(self.absolute),
+            "_incremental": float(not self.absolute),
+            "_inverse_time": float(self.inverse_time),
+            "_units_per_minute": float(not self.inverse_time),
+            "_feed": self.feed,
+            "_plane": self.plane * 10.0,
+            "_motion_mode": 800.0 if self.motion is None else self.motion * 10,
+            "_coord_system": _COORD_SYSTEM_CODE[self.coord_system],
+            "_ccomp": 400.0,
+        }.get(name)
+        return value
+
+    def _fail(self, message: str, block: Block, item) -> None:
+        col = item.start + 1 if item is not None else None
+        raise NcppError(message, Location(self.file, block.line, col))
+
+
+_COORD_SYSTEM = {54.0: 1, 55.0: 2, 56.0: 3, 57.0: 4, 58.0: 5, 59.0: 6, 59.1: 7, 59.2: 8, 59.3: 9}
+_COORD_SYSTEM_CODE = {n: code * 10 for code, n in _COORD_SYSTEM.items()}
+_PLANE_LETTERS = {17: "XY", 18: "ZX", 19: "YZ"}
+# words a plain modal move may carry without the full checks
+_AXIS_LETTERS_F = frozenset("XYZABCUVWFIJKR")
+_F_ONLY = frozenset("F")
+_XYZ_SLOT = {"X": (0, 1), "Y": (1, 2), "Z": (2, 4)}
+_XYZF = frozenset("XYZF")
+_PLAIN_LETTERS = {
+    0.0: frozenset("XYZABCUVWF"),
+    1.0: frozenset("XYZABCUVWF"),
+    2.0: frozenset("XYZABCUVWFIJKR"),
+    3.0: frozenset("XYZABCUVWFIJKR"),
+}
+
+
+# Frozen dataclasses set each field through object.__setattr__; the interpreter
+# builds one event per block, so it sets the slots directly (same objects, ~2x faster).
+_LINE_SLOTS = [Line.__dict__[name].__set__ for name in ("start", "end", "rapid", "feed", "block", "context", "extra", "changed")]
+_PASS_BLOCK = Pass.__dict__["block"].__set__
+_new = object.__new__
+
+
+def _new_line(start, end, rapid, feed, block, context, extra) -> Line:
+    line = object.__new__(Line)
+    s0, s1, s2, s3, s4, s5, s6, s7 = _LINE_SLOTS
+    s0(line, start)
+    s1(line, end)
+    s2(line, rapid)
+    s3(line, feed)
+    s4(line, block)
+    s5(line, context)
+    s6(line, extra)
+    s7(line, False)
+    return line
+
+
+def _pass(block: Block) -> Pass:
+    event = object.__new__(Pass)
+    _PASS_BLOCK(event, block)
+    return event
