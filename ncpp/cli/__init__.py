@@ -16,6 +16,7 @@ from ncpp.errors import NcppError
 # Module names under ncpp.cli, in the order `ncpp --help` lists them.
 COMMANDS: tuple[str, ...] = (
     "filter",
+    "motion",
     "compensate",
     "simulate",
     "analyze",
