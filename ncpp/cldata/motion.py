@@ -1,0 +1,203 @@
+"""CL records -> motion events (`Line`, `Arc`, `Pass`), the same events the NC
+interpreter makes, so that the compensation passes and writers serve both.
+
+APT semantics used here:
+* `RAPID` makes the next motion a rapid traverse only (it is not modal).
+* `CIRCLE/ x,y,z, i,j,k, r [, ...]` (Creo: 7 values; NX: 11, the extra
+  four are tolerance and tool data) announces that the following `GOTO`s run
+  on the circle with centre (x,y,z) around axis (i,j,k), turning by the right
+  hand rule about that axis.  Consecutive `GOTO`s that stay on the circle are
+  one arc (CAM systems split arcs at quadrants); the first `GOTO` off it is a
+  line again.  Axis must be ±X, ±Y or ±Z (planes G19, G18, G17).
+* `MULTAX` + `GOTO/ x,y,z,i,j,k`: a tool vector.  A 3-axis machine can follow
+  it only while it stays constant; a changing vector is refused.
+* `GOHOME` returns to the `FROM` point (rapid); `GOHOME/Z` moves Z only.
+
+Each event's block is a synthetic `Block` holding the record text (no
+items), so a writer can show it as a comment and errors can name its line.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Iterable, Iterator
+
+from ncpp.cldata.reader import Record
+from ncpp.errors import NcppError, Warnings
+from ncpp.motion.segments import PLANE_AXES, Arc, Context, Event, Line, Pass, Point, replace
+from ncpp.program.blocks import Block
+
+ON_CIRCLE_TOL = 1e-3  # mm (or inch): GOTO within this of the circle lies on it
+VECTOR_TOL = 1e-6  # tool vector components: "constant"
+AXIS_TOL = 1e-6
+
+
+def _block(record: Record) -> Block:
+    return Block(raw=record.text, eol="\n", items=(), line=record.line)
+
+
+def _plane(axis: tuple[float, float, float], record: Record) -> tuple[int, int]:
+    """(G17/18/19, rotation sign) of a CIRCLE axis vector."""
+    norm = math.sqrt(sum(a * a for a in axis))
+    if norm == 0:
+        raise NcppError("CIRCLE axis vector is zero", record.where)
+    unit = [a / norm for a in axis]
+    for plane, index in ((17, 2), (18, 1), (19, 0)):
+        if abs(abs(unit[index]) - 1.0) < AXIS_TOL:
+            return plane, (1 if unit[index] > 0 else -1)
+    raise NcppError(
+        f"CIRCLE axis ({axis[0]:g}, {axis[1]:g}, {axis[2]:g}) is not along X, Y or Z; "
+        "only arcs in the XY, XZ and YZ planes can be posted",
+        record.where,
+    )
+
+
+class _Circle:
+    """A CIRCLE record waiting for the GOTOs that run on it."""
+
+    def __init__(self, record: Record, start: Point):
+        values = record.numbers
+        if len(values) < 7:
+            raise NcppError(f"CIRCLE needs centre, axis and radius (7 values), got {len(values)}", record.where)
+        self.record = record
+        self.plane, self.sign = _plane(values[3:6], record)
+        self.i, self.j, self.n = PLANE_AXES[self.plane]
+        self.radius = values[6]
+        c = list(values[:3])
+        c[self.n] = start[self.n]  # Arc.center carries the start's normal coordinate
+        self.center: Point = (c[0], c[1], c[2])
+        self.start = start
+        r0 = self._in_plane_radius(start)
+        if abs(r0 - self.radius) > ON_CIRCLE_TOL:
+            raise NcppError(
+                f"the tool ({start[0]:g}, {start[1]:g}, {start[2]:g}) is {r0:.4f} from the CIRCLE centre, "
+                f"not on its radius {self.radius:.4f}",
+                record.where,
+            )
+        self.points: list[Point] = []
+        self.sweep = 0.0
+
+    def _in_plane_radius(self, p: Point) -> float:
+        return math.hypot(p[self.i] - self.center[self.i], p[self.j] - self.center[self.j])
+
+    def _angle(self, p: Point) -> float:
+        return math.atan2(p[self.j] - self.center[self.j], p[self.i] - self.center[self.i])
+
+    def takes(self, p: Point) -> bool:
+        """Does p continue the arc?  The first GOTO always ends it (it may be a helix)."""
+        if not self.points:
+            return True
+        last = self.points[-1]
+        flat = abs(p[self.n] - last[self.n]) <= ON_CIRCLE_TOL and abs(last[self.n] - self.start[self.n]) <= ON_CIRCLE_TOL
+        return flat and abs(self._in_plane_radius(p) - self.radius) <= ON_CIRCLE_TOL
+
+    def add(self, p: Point, record: Record) -> None:
+        if not self.points and abs(self._in_plane_radius(p) - self.radius) > ON_CIRCLE_TOL:
+            raise NcppError(
+                f"the GOTO after CIRCLE is {self._in_plane_radius(p):.4f} from the centre, not on radius {self.radius:.4f}",
+                record.where,
+            )
+        prev = self.points[-1] if self.points else self.start
+        step = (self.sign * (self._angle(p) - self._angle(prev))) % (2 * math.pi)
+        if step <= 1e-12:
+            step = 2 * math.pi  # back where it was: a full turn
+        self.sweep += step
+        self.points.append(p)
+
+    def arc(self, feed: float, context: Context) -> Arc:
+        turns = 1 + int((self.sweep - 1e-9) // (2 * math.pi))
+        return Arc(
+            start=self.start,
+            end=self.points[-1],
+            center=self.center,
+            turn=self.sign * turns,
+            feed=feed,
+            block=_block(self.record),
+            context=replace(context, plane=self.plane),
+        )
+
+
+def motion(records: Iterable[Record], warnings: Warnings | None = None) -> Iterator[Event]:
+    """Line / Arc / Pass events of a CL record stream."""
+    pos: Point | None = None
+    home: Point | None = None
+    feed = 0.0
+    rapid_next = False
+    multax = False
+    tool_vector: tuple[float, float, float] | None = None
+    vector_line = 0
+    context = Context()
+    circle: _Circle | None = None
+
+    def flush() -> Iterator[Event]:
+        nonlocal circle
+        if circle is not None:
+            if not circle.points:
+                raise NcppError("CIRCLE without a GOTO on it", circle.record.where)
+            yield circle.arc(feed, context)
+            circle = None
+
+    for rec in records:
+        major = rec.major
+        if major == "GOTO":
+            values = rec.numbers
+            if len(values) not in (3, 6):
+                raise NcppError(f"GOTO needs 3 coordinates (or 6 with a tool vector), got {len(values)}", rec.where)
+            if len(values) == 6 or multax:
+                vector = values[3:6] if len(values) == 6 else None
+                if vector is not None:
+                    if tool_vector is None:
+                        tool_vector, vector_line = vector, rec.line
+                    elif max(abs(a - b) for a, b in zip(vector, tool_vector)) > VECTOR_TOL:
+                        raise NcppError(
+                            f"the tool vector changes from ({', '.join(f'{v:g}' for v in tool_vector)}) "
+                            f"(line {vector_line}) to ({', '.join(f'{v:g}' for v in vector)}): "
+                            "5-axis motion cannot be posted for a 3-axis machine",
+                            rec.where,
+                        )
+            end: Point = (values[0], values[1], values[2])
+            if circle is not None and circle.takes(end):
+                circle.add(end, rec)
+                pos = end
+                continue
+            yield from flush()
+            yield Line(pos if pos is not None else end, end, rapid_next, feed, _block(rec), context)
+            rapid_next = False
+            pos = end
+            continue
+        yield from flush()
+        if major == "CIRCLE":
+            if pos is None:
+                raise NcppError("CIRCLE before any position (FROM or GOTO)", rec.where)
+            circle = _Circle(rec, pos)
+            yield Pass(_block(rec))  # the arc event follows with its GOTOs
+            continue
+        if major == "FROM":
+            values = rec.numbers
+            if len(values) < 3:
+                raise NcppError("FROM needs x, y, z", rec.where)
+            pos = home = (values[0], values[1], values[2])
+        elif major == "GOHOME" and home is not None and pos is not None:
+            # GOHOME/Z (and the like) sends only the named axes home.
+            named = [a for a in "XYZ" if a in rec.words] or list("XYZ")
+            target: Point = tuple(home[k] if a in named else pos[k] for k, a in enumerate("XYZ"))  # type: ignore[assignment]
+            yield Line(pos, target, True, feed, _block(rec), context)
+            pos, rapid_next = target, False
+            continue
+        elif major == "RAPID":
+            rapid_next = True
+        elif major == "FEDRAT" and rec.numbers:
+            feed = rec.numbers[0]
+        elif major == "UNITS":
+            context = replace(context, inch=bool(rec.words) and rec.words[0].startswith("INCH"))
+        elif major == "MULTAX":
+            multax = not (rec.words and rec.words[0] == "OFF")
+        elif major == "TLAXIS" and len(rec.numbers) >= 3:
+            vector = rec.numbers[:3]
+            if tool_vector is not None and max(abs(a - b) for a, b in zip(vector, tool_vector)) > VECTOR_TOL:
+                raise NcppError("TLAXIS changes the tool vector: 5-axis motion cannot be posted for a 3-axis machine", rec.where)
+            tool_vector, vector_line = vector, rec.line
+        elif rec.vendor and warnings is not None:
+            warnings.warn(f"{major}/ is not understood; passed through as a comment", rec.where)
+        yield Pass(_block(rec))
+    yield from flush()
