@@ -22,6 +22,7 @@ COMMANDS: tuple[str, ...] = (
     "analyze",
     "predict",
     "fit",
+    "diagnose",
     "export_table",
 )
 

@@ -1,0 +1,80 @@
+"""The readable account and the gap plot of a `Diagnosis`."""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+
+from ncpp.diagnose.workflow import Diagnosis
+
+
+def _params(values: dict[str, float], unc: dict[str, float]) -> str:
+    return ", ".join(
+        f"{v:.3g} ± {unc[k]:.2g} {k}" if k in unc else f"{v:.4g} {k}" for k, v in values.items()
+    )
+
+
+def account(d: Diagnosis) -> str:
+    """What was compared, where the gap sits, each step, the gap table."""
+    lines = [f"model: {d.base.name} ({len(d.base.effects)} effect(s) before diagnosis)", "", "where the gap sits (µm):"]
+    lines += [f"  {w}" for w in d.where]
+    noise = np.sqrt(np.mean(np.square(d.noise)))
+    lines += ["", f"noise (high-frequency part / repeat runs): {noise:.2f} µm rms", ""]
+    if not d.steps:
+        lines.append("no candidate effect is significant: the model explains the measurements within their noise")
+    for i, s in enumerate(d.steps, 1):
+        keys = " ".join(s.candidate.keys.values())
+        variant = f" [{s.candidate.variant}]" if s.candidate.variant else ""
+        lines.append(f"step {i}: {s.candidate.kind} {keys}{variant}: {_params(s.parameters, s.uncertainty)}")
+        lines.append(f"  evidence: {s.evidence}")
+    if d.not_observable:
+        lines += ["", "not observable with these measurements: " + ", ".join(d.not_observable)]
+    lines += ["", "gap, re-simulated (set-up offsets removed):", f"  {'model':<40} {'rms µm':>8} {'max µm':>8}"]
+    lines.append(f"  {'as given':<40} {d.gap_before.rms_um:8.2f} {d.gap_before.max_um:8.2f}")
+    for s in d.steps:
+        label = "+ " + s.candidate.kind + " " + " ".join(s.candidate.keys.values())
+        lines.append(f"  {label:<40} {s.gap_after.rms_um:8.2f} {s.gap_after.max_um:8.2f}")
+    return "\n".join(lines)
+
+
+def plot_gap(d: Diagnosis, path: str | os.PathLike[str]) -> None:
+    """Gap rms per step (top) and each file's residual before/after (below)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from ncpp.fileio import atomic_output
+
+    n = len(d.observations)
+    cols = min(n, 3)
+    rows = 1 + -(-n // cols)
+    fig = plt.figure(figsize=(4.2 * cols, 3.0 * rows))
+    ax = fig.add_subplot(rows, 1, 1)
+    labels = ["model"] + [f"+{s.candidate.kind} {' '.join(s.candidate.keys.values())}" for s in d.steps]
+    rms = [d.gap_before.rms_um] + [s.gap_after.rms_um for s in d.steps]
+    ax.bar(range(len(rms)), rms, color="tab:blue")
+    ax.axhline(float(np.sqrt(np.mean(np.square(d.noise)))), color="k", ls="--", lw=1, label="noise")
+    ax.set_xticks(range(len(rms)), labels, fontsize=8)
+    ax.set_ylabel("gap rms / µm")
+    ax.legend(fontsize=8)
+    ax.set_title("diagnosis: the gap between measurement and model, step by step", fontsize=10)
+    for i, o in enumerate(d.observations):
+        a = fig.add_subplot(rows, cols, cols + i + 1)
+        for r, colour, name in ((d.gap_before.residuals[i], "tab:red", "before"), (d.gap_after.residuals[i], "tab:blue", "after")):
+            for lab in dict.fromkeys(o.label):
+                sel = o.label == lab
+                order = np.argsort(o.position[sel])
+                a.plot(o.position[sel][order], r[sel][order], color=colour, lw=0.8,
+                       ls="-" if lab in ("CCW", "+") else ":", label=f"{name} {lab}")  # fmt: skip
+        a.set_title(f"{o.measurement.instrument} {o.measurement.plane if o.measurement.instrument == 'ballbar' else o.measurement.axis}"
+                    f" F{o.feed:g}", fontsize=8)  # fmt: skip
+        a.set_xlabel("angle / deg" if o.measurement.instrument == "ballbar" else "target / mm", fontsize=8)
+        a.tick_params(labelsize=7)
+        if i == 0:
+            a.legend(fontsize=6)
+    fig.tight_layout()
+    with atomic_output(path) as f:
+        fig.savefig(f, format="png", dpi=110)
+    plt.close(fig)
