@@ -28,7 +28,7 @@ from ncpp.instruments.analysis import Analysis, describe
 COLOURS = {"CCW": "tab:red", "CW": "tab:blue", "+": "tab:red", "-": "tab:blue"}
 
 
-def plot_analyses(analyses: Sequence[Analysis], path: str | os.PathLike[str]) -> None:
+def plot_analyses(analyses: Sequence[Analysis], path: str | os.PathLike[str], dpi: int = 110) -> None:
     """Draw one panel per analysis into a PNG at `path` (written atomically)."""
     import matplotlib
 
@@ -48,7 +48,7 @@ def plot_analyses(analyses: Sequence[Analysis], path: str | os.PathLike[str]) ->
             _profile_panel(fig.add_subplot(rows, cols, k), a)
     fig.tight_layout()
     buffer = io.BytesIO()
-    fig.savefig(buffer, format="png", dpi=110)
+    fig.savefig(buffer, format="png", dpi=dpi)
     plt.close(fig)
     write_bytes_atomic(path, buffer.getvalue())
 
