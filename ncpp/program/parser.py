@@ -13,8 +13,9 @@ from __future__ import annotations
 
 import functools
 import re
+from dataclasses import dataclass
 from pathlib import Path
-from typing import BinaryIO, Iterable, Iterator
+from typing import Iterable, Iterator
 
 import lark
 from lark import Token, Transformer, v_args
@@ -162,18 +163,45 @@ class _ItemBuilder(Transformer):
         return tuple(children)
 
 
+@dataclass(frozen=True)
+class Dialect:
+    """What the line parser needs to know about a dialect's syntax.
+
+    `fast_terminals` name the grammar terminals the plain-line scanner uses
+    (WORD / COMMA_WORD become words, PAREN_COMMENT a `(` comment, SEMI_COMMENT
+    a `;` comment); none means every block goes through the LALR parser.
+    `continuation` is the mark that, ending a line, continues its block on
+    the next line (Heidenhain `~`).
+    """
+
+    name: str
+    grammar: str
+    builder: type[Transformer]
+    fast_terminals: tuple[str, ...] = ()
+    continuation: str | None = None
+
+
+def dialect_syntax(dialect: "str | Dialect") -> Dialect:
+    if isinstance(dialect, Dialect):
+        return dialect
+    from ncpp.program.dialects import get_dialect  # the registry imports this module
+
+    return get_dialect(dialect)
+
+
 class LineParser:
-    """Parses one line of a dialect into a Block."""
+    """Parses one line (or one continued block) of a dialect into a Block."""
 
     FAST_TERMINALS = ("WORD", "COMMA_WORD", "PAREN_COMMENT", "SEMI_COMMENT")
 
-    def __init__(self, grammar: str = "iso"):
-        self.grammar = grammar
-        self._lark = lalr_parser(grammar)
-        self._builder = _ItemBuilder()
+    def __init__(self, grammar: "str | Dialect" = "iso"):
+        self.dialect = dialect_syntax(grammar)
+        self.grammar = self.dialect.grammar
+        self._lark = lalr_parser(self.grammar)
+        self._builder = self.dialect.builder()
         patterns = {t.name: t.pattern.to_regexp() for t in self._lark.terminals}
-        alternatives = "|".join(f"(?P<{name}>{patterns[name]})" for name in self.FAST_TERMINALS)
-        self._fast = re.compile(f"{_GAP}(?:{alternatives})")
+        alternatives = "|".join(f"(?P<{name}>{patterns[name]})" for name in self.dialect.fast_terminals)
+        self._fast = re.compile(f"{_GAP}(?:{alternatives})") if alternatives else None
         self._blank = re.compile(f"{_GAP}$")
 
     def parse(self, raw: str, eol: str = "", line: int = 0, file: str = "<stdin>") -> Block:
@@ -184,6 +212,8 @@ class LineParser:
 
     def _scan_plain(self, raw: str) -> tuple[AnyItem, ...] | None:
         """Items of a line made only of plain words and comments, else None."""
+        if self._fast is None:
+            return None
         items: list[AnyItem] = []
         pos = 0
         match = self._fast.match
@@ -209,6 +239,8 @@ class LineParser:
             tree = self._lark.parse(raw)
         except lark.exceptions.UnexpectedInput as err:
             col = getattr(err, "column", None)
+            # a continued block spans lines: Lark counts them from 1
+            line += max(getattr(err, "line", 1) or 1, 1) - 1
             raise NcppError(_describe(err, raw), Location(file, line, col)) from None
         items = self._builder.transform(tree)
         return tuple(item for item in _flatten(items))
@@ -223,8 +255,10 @@ def _flatten(items: Iterable) -> Iterator[AnyItem]:
 
 
 def _describe(err: lark.exceptions.UnexpectedInput, raw: str) -> str:
-    col = getattr(err, "column", 1) or 1
-    rest = raw[col - 1 :].strip()
+    pos = getattr(err, "pos_in_stream", None)
+    if pos is None:
+        pos = (getattr(err, "column", 1) or 1) - 1
+    rest = raw[pos:].strip()
     if isinstance(err, lark.exceptions.UnexpectedEOF) or not rest:
         return "unexpected end of block"
     if isinstance(err, lark.exceptions.UnexpectedToken) and err.token.type == "$END":
@@ -237,7 +271,7 @@ def _describe(err: lark.exceptions.UnexpectedInput, raw: str) -> str:
     return f"cannot read {snippet!r}"
 
 
-def iter_lines(stream: BinaryIO) -> Iterator[tuple[str, str]]:
+def iter_lines(stream: Iterable[bytes]) -> Iterator[tuple[str, str]]:
     """(content, eol) for each line of a binary stream, decoded losslessly."""
     for raw in stream:
         text = raw.decode("latin-1")
@@ -249,10 +283,29 @@ def iter_lines(stream: BinaryIO) -> Iterator[tuple[str, str]]:
             yield text, ""
 
 
-def parse_stream(stream: BinaryIO, file: str = "<stdin>", grammar: str = "iso") -> Iterator[Block]:
+def continued_lines(lines: Iterable[tuple[str, str]], mark: str) -> Iterator[tuple[int, str, str]]:
+    """(first line number, content, eol) of each block, joining a line that ends
+    with `mark` to the next one; the joined content keeps the inner line endings."""
+    pending, first, eol = "", 0, ""
+    for number, (content, eol) in enumerate(lines, start=1):
+        if not pending:
+            first = number
+        if eol and content.rstrip(" \t").endswith(mark):
+            pending += content + eol
+            continue
+        yield first, pending + content, eol
+        pending = ""
+    if pending:  # the last line ended with the mark
+        yield first, pending[: len(pending) - len(eol)], eol
+
+
+def parse_stream(stream: Iterable[bytes], file: str = "<stdin>", grammar: "str | Dialect" = "iso") -> Iterator[Block]:
     """Blocks of a program, lazily.  After the closing `%` lines are kept verbatim
-    (a control stops reading there)."""
+    (a control stops reading there).  `grammar` names the dialect (or is one)."""
     parser = LineParser(grammar)
+    if parser.dialect.continuation:
+        yield from _parse_continued(parser, stream, file)
+        return
     tape_marks = 0
     for number, (content, eol) in enumerate(iter_lines(stream), start=1):
         if tape_marks >= 2:
@@ -266,7 +319,12 @@ def parse_stream(stream: BinaryIO, file: str = "<stdin>", grammar: str = "iso") 
         yield block
 
 
-def parse_text(text: str, file: str = "<string>", grammar: str = "iso") -> list[Block]:
+def _parse_continued(parser: LineParser, stream: Iterable[bytes], file: str) -> Iterator[Block]:
+    for number, content, eol in continued_lines(iter_lines(stream), parser.dialect.continuation or ""):
+        yield parser.parse(content, eol, number, file)
+
+
+def parse_text(text: str, file: str = "<string>", grammar: "str | Dialect" = "iso") -> list[Block]:
     import io
 
     return list(parse_stream(io.BytesIO(text.encode("latin-1")), file, grammar))

@@ -1,0 +1,139 @@
+"""NC dialects: the registry, detection from content, and sniffing a stream.
+
+Each dialect brings a grammar (`grammar/<name>.lark`) and a builder that maps
+its syntax onto the common items (see `heidenhain` and `sinumerik` for their
+Statement kinds and node shapes); `parser_for(name)` gives its line parser.
+Writers live beside them (`iso.IsoWriter`).
+"""
+
+from __future__ import annotations
+
+import io
+import re
+from typing import BinaryIO, Iterable, Iterator
+
+from ncpp.errors import NcppError
+from ncpp.program.parser import Dialect, LineParser, _ItemBuilder
+
+DIALECTS = ("iso", "heidenhain", "sinumerik")
+SNIFF_BYTES = 4096
+
+ISO = Dialect("iso", "iso", _ItemBuilder, fast_terminals=LineParser.FAST_TERMINALS)
+# File name endings that name a dialect when the content does not tell.
+SUFFIXES = {".h": "heidenhain", ".mpf": "sinumerik", ".spf": "sinumerik"}
+
+
+def get_dialect(name: str) -> Dialect:
+    """The dialect called `name` (case-insensitive)."""
+    key = name.lower()
+    if key == "iso":
+        return ISO
+    if key == "heidenhain":
+        from ncpp.program.dialects.heidenhain import HEIDENHAIN
+
+        return HEIDENHAIN
+    if key == "sinumerik":
+        from ncpp.program.dialects.sinumerik import SINUMERIK
+
+        return SINUMERIK
+    raise NcppError(f"unknown dialect {name!r} (known: {', '.join(DIALECTS)})")
+
+
+def parser_for(dialect: str | Dialect) -> LineParser:
+    return LineParser(dialect)
+
+
+# ---- detection ------------------------------------------------------------------
+
+_HEIDENHAIN = re.compile(r"^[ \t]*\d*[ \t]*BEGIN[ \t]+PGM\b", re.M)
+_HEIDENHAIN_BLOCK = re.compile(
+    r"^[ \t]*\d+[ \t]+(L[ \t]|LP[ \t]|CC[ \t]|C[ \t]|CR[ \t]|CT[ \t]|CP[ \t]|RND[ \t]|TOOL[ \t]+CALL|TOOL[ \t]+DEF"
+    r"|CYCL[ \t]+DEF|CYCL[ \t]+CALL|LBL[ \t]|CALL[ \t]+LBL|FN[ \t]*\d+:|Q\d+[ \t]*=|END[ \t]+PGM)",
+    re.M,
+)
+# Constructs no ISO / Fanuc / LinuxCNC program has, on a line without its comments.
+_SINUMERIK = re.compile(
+    r"^%_N_"
+    r"|^[ \t]*(N\d+[ \t]+)?(DEF|PROC|REPEAT|ENDIF|ENDWHILE|ENDFOR|ENDLOOP|UNTIL"
+    r"|A?TRANS|A?ROTS?|A?SCALE|A?MIRROR|CIP|ASPLINE|BSPLINE|CSPLINE)\b"
+    r"|^[ \t]*(N\d+[ \t]+)?(IF|WHILE)[ \t]+[^\[\s]"
+    r"|^[ \t]*(N\d+[ \t]+)?[A-NP-Za-np-z_][A-Za-z0-9_]*[ \t]*:(?!=)"  # a label (not Fanuc `O1000:`)
+    r"|^[ \t]*(N\d+[ \t]+)?(?!GOTO)[A-NP-Za-np-z_][A-Za-z_]{2}[A-Za-z0-9_]*[ \t]*\("  # a call (not `OCIRCLE(`, `GOTO60(`)
+    r"|\bGOTO[FBC]\b|\b(AC|IC|ACP|ACN|DC)[ \t]*\(|\bMSG[ \t]*\(|\bCR[ \t]*=|\$[A-Z]{1,3}_[A-Z]"
+    r"|(?<![#\w<])[A-Za-z][A-Za-z0-9_]*[ \t]*=(?!=)",  # `X=10`, `R1=5` (LinuxCNC assigns `#1=5`)
+    re.M | re.I,
+)
+
+
+def _code_only(text: str) -> str:
+    """The text with `;` and `(...)` comments removed, line by line."""
+    lines = []
+    for line in text.splitlines():
+        line = line.split(";", 1)[0]
+        lines.append(line if _call_like(line) else re.sub(r"\([^)]*(\)|$)", "", line))
+    return "\n".join(lines)
+
+
+def _call_like(line: str) -> bool:
+    """Parentheses that call (`AC(`, `CYCLE81(`), not an ISO comment."""
+    return bool(re.search(r"\b(AC|IC|DC)[ \t]*\(|\b(?!GOTO)[A-NP-Za-np-z_][A-Za-z_]{2}[A-Za-z0-9_]*[ \t]*\(", line))
+
+
+def detect(first_bytes: bytes, name: str | None = None) -> str:
+    """'iso', 'heidenhain' or 'sinumerik' from the start of a program.
+
+    `BEGIN PGM` or numbered conversational blocks mean Heidenhain; a
+    `%_N_` header or a construct only Sinumerik has (`DEF`, `PROC`, `X=...`,
+    `CR=`, `AC(`, `MSG(`, `GOTOF`, labels, `IF` without brackets, `$AA_...`)
+    means Sinumerik.  When the content is plain ISO-looking G code, a file
+    name ending in .h / .mpf / .spf decides.
+    """
+    text = first_bytes.decode("latin-1")
+    if _HEIDENHAIN.search(text) or len(_HEIDENHAIN_BLOCK.findall(text)) >= 2:
+        return "heidenhain"
+    if _SINUMERIK.search(_code_only(text)) or text.startswith("%_N_"):
+        return "sinumerik"
+    if name:
+        for suffix, dialect in SUFFIXES.items():
+            if name.lower().endswith(suffix):
+                return dialect
+    return "iso"
+
+
+def sniff(stream: Iterable[bytes], name: str | None = None, dialect: str | None = None) -> tuple[str, Iterator[bytes]]:
+    """(dialect, lines) for a binary stream: the dialect is `dialect` when given,
+    else detected from the first SNIFF_BYTES; lines are the stream's lines from
+    the beginning, the sniffed head re-read from a buffer (stdin keeps streaming)."""
+    if dialect is not None:
+        get_dialect(dialect)  # an unknown name is an error before any reading
+        return dialect.lower(), iter(stream)
+    read = getattr(stream, "read", None)
+    if read is None:
+        lines = iter(stream)
+        head_lines = []
+        size = 0
+        for line in lines:
+            head_lines.append(line)
+            size += len(line)
+            if size >= SNIFF_BYTES:
+                break
+        head = b"".join(head_lines)
+        return detect(head, name), _chain(head_lines, lines)
+    head = read(SNIFF_BYTES)
+    head_lines = list(io.BytesIO(head))
+    if head_lines and not head_lines[-1].endswith(b"\n"):
+        head_lines[-1] += stream.readline()  # type: ignore[union-attr]
+    return detect(head, name), _chain(head_lines, stream)
+
+
+def _chain(first: list[bytes], rest: Iterable[bytes]) -> Iterator[bytes]:
+    yield from first
+    yield from rest
+
+
+def parse_program(stream: BinaryIO, file: str = "<stdin>", dialect: str | None = None):
+    """(dialect, blocks) of a program stream, the dialect detected unless given."""
+    from ncpp.program.parser import parse_stream
+
+    name, lines = sniff(stream, file, dialect)
+    return name, parse_stream(lines, file, name)

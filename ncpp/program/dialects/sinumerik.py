@@ -1,0 +1,206 @@
+"""Siemens Sinumerik 840D: items of an NC block.
+
+Blocks map onto the common item classes:
+
+* `X10` `G2` `N10` `F1000` are `Word`s (a letter and a number, nothing else);
+* `X=R1+2` `X=AC(10)` `I=AC(5)` `CR=5` `I1=5` `TURN=2` `T="MILL"` are
+  `ExprWord`s: an address (one letter, optionally with a numeric extension,
+  or a multi-letter address of ADDRESSES) with an expression;
+* `NAME = expr` for anything else (R parameters, user variables, `$` system
+  variables, array elements) is an assignment `Statement`; an interpreter
+  that knows a machine axis called `ELX` can treat ("param", "elx") as one;
+* `;` comments are `Comment`s; parentheses are arithmetic.
+
+Statement kinds and nodes (Sinumerik):
+  assignment   (target, expr)             target ("param", "r1") | ("index", "feld", (exprs))
+  label        (NAME,)                    `LABEL_1:` (upper case, no colon)
+  call         (NAME, args)               `CYCLE81(10,0,2,-5)`, `MSG("x")`, `SETAL(1)`, `BNAT`,
+                                          `MATERIAL_UPDATE`: passed through; args tuple of exprs, None if empty
+  path         (NAME,)                    CIP CT ASPLINE BSPLINE CSPLINE POLY (words follow)
+  frame        (NAME,)                    TRANS ATRANS ROT AROT SCALE ASCALE MIRROR AMIRROR ... (words follow)
+  def          (type, length, vars)       `DEF STRING[8] A="x", B` -> ('STRING', ("num", 8.0), ((target, init|None), ...))
+  proc         (NAME, params, attributes) params ((type, name, by_reference, dims|None), ...)
+  if / while / until  (condition,)       block-structured; `IF c GOTOF L` is an `if` then a `goto` in one block
+  else endif endwhile endfor repeat loop endloop   ()
+  for          (target, start, end)       `FOR I=0 TO 10`
+  goto         (KEYWORD, TARGET)          ('GOTOF' | 'GOTOB' | 'GOTOC' | 'GOTO', 'LABEL' | 'N100' | '90')
+  case         (expr, branches, default)  branches ((value_expr, KEYWORD, TARGET), ...), default (KEYWORD, TARGET) | None
+  program_name (text,)                    `%_N_PART_MPF`
+A main block number `:10` is `Word(':', 10.0, '10')`.
+Expressions: ("num", v) ("str", s) ("param", name) ("index", name, (exprs)) ("neg", x) ("not", x)
+("bnot", x) ("bin", op, a, b) with op + - * / DIV MOD == <> < > <= >= AND OR XOR B_AND B_OR B_XOR <<,
+("call", NAME, *args) for functions (SIN(30) in degrees, ATAN2(a, b), POT, ...), and the coordinate
+modes ("ac", x) ("ic", x) ("dc", x) ("acp", x) ("acn", x) for `AC(...)` `IC(...)` ...  Names are
+case-insensitive and kept lower case.
+"""
+
+from __future__ import annotations
+
+import re
+
+from lark import Token, Transformer, v_args
+
+from ncpp.program.blocks import Comment, ExprWord, Statement, Word
+from ncpp.program.parser import Dialect, _word
+
+# Multi-letter addresses that take `=`: interpolation and spline parameters, polar words.
+ADDRESSES = frozenset({"CR", "TURN", "AR", "AP", "RP", "PW", "SD", "PL", "SF", "SPOS", "OFFN", "ACC", "SR", "SRA"})
+COORDINATE_MODES = frozenset({"AC", "IC", "DC", "ACP", "ACN", "CAC", "CIC"})
+_ADDRESS = re.compile(r"[A-QS-Za-qs-z]\d*|[Rr]")
+_R_PARAMETER = re.compile(r"[Rr]\d+")
+
+
+def _is_address(name: str) -> bool:
+    return bool(_ADDRESS.fullmatch(name)) or name.upper() in ADDRESSES
+
+
+class SinumerikBuilder(Transformer):
+    """Turns a Lark tree of one Sinumerik block into items with spans."""
+
+    def start(self, children):
+        items = []
+        for child in children:
+            if isinstance(child, Token):
+                text = str(child)
+                if child.type == "MAIN_BLOCK":
+                    number = text[1:].strip()
+                    items.append(Word(":", float(number), number, child.start_pos, child.end_pos))
+                else:  # BLOCK_DELETE
+                    items.append(Statement("block_delete", (text,), child.start_pos, child.end_pos))
+            else:
+                items.append(child)
+        return tuple(items)
+
+    def word(self, children):
+        (tok,) = children
+        return _word(str(tok), tok.start_pos, tok.end_pos)
+
+    def line_comment(self, children):
+        (tok,) = children
+        return Comment(str(tok)[1:], ";", tok.start_pos, tok.end_pos)
+
+    @v_args(meta=True)
+    def assign(self, meta, children):
+        target, value = children
+        if target[0] == "param" and _is_address(target[1]) and not _R_PARAMETER.fullmatch(target[1]):
+            return ExprWord(target[1].upper(), value, meta.start_pos, meta.end_pos)
+        return Statement("assignment", (target, value), meta.start_pos, meta.end_pos)
+
+    def _statement(kind: str, shape):  # type: ignore[misc]
+        @v_args(meta=True)
+        def build(self, meta, children):
+            return Statement(kind, shape(children), meta.start_pos, meta.end_pos)
+
+        return build
+
+    def _call(children) -> tuple:  # type: ignore[misc]
+        return (str(children[0]).upper(), children[1] if len(children) > 1 else ())
+
+    def _define(children) -> tuple:  # type: ignore[misc]
+        (type_name, length), variables = children[1], children[2:]
+        return (type_name, length, tuple(variables))
+
+    def _proc(children) -> tuple:  # type: ignore[misc]
+        name = str(children[1]).upper()
+        params = tuple(c for c in children[2:] if isinstance(c, tuple))
+        attributes = tuple(str(c).upper() for c in children[2:] if isinstance(c, Token))
+        return (name, params, attributes)
+
+    def _goto(children) -> tuple:  # type: ignore[misc]
+        return (str(children[0]).upper(), str(children[1]).upper())
+
+    def _case(children) -> tuple:  # type: ignore[misc]
+        expr, rest = children[1], children[2:]
+        branches = tuple(c for c in rest if isinstance(c, tuple))
+        tokens = [c for c in rest if isinstance(c, Token) and c.type != "OF"]
+        default = (str(tokens[1]).upper(), str(tokens[2]).upper()) if tokens else None
+        return (expr, branches, default)
+
+    call = _statement("call", _call)
+    label = _statement("label", lambda c: (str(c[0])[:-1].upper(),))
+    path = _statement("path", lambda c: (str(c[0]).upper(),))
+    frame = _statement("frame", lambda c: (str(c[0]).upper(),))
+    define = _statement("def", _define)
+    proc = _statement("proc", _proc)
+    if_ = _statement("if", lambda c: (c[1],))
+    while_ = _statement("while", lambda c: (c[1],))
+    until = _statement("until", lambda c: (c[1],))
+    for_ = _statement("for", lambda c: (c[1], c[2], c[4]))
+    goto = _statement("goto", _goto)
+    case = _statement("case", _case)
+    program_name = _statement("program_name", lambda c: (str(c[0]),))
+    else_ = _statement("else", lambda c: ())
+    endif = _statement("endif", lambda c: ())
+    endwhile = _statement("endwhile", lambda c: ())
+    endfor = _statement("endfor", lambda c: ())
+    repeat = _statement("repeat", lambda c: ())
+    loop = _statement("loop", lambda c: ())
+    endloop = _statement("endloop", lambda c: ())
+    del _statement, _call, _define, _proc, _goto, _case
+
+    # -- parts -------------------------------------------------------------------
+    def def_type(self, children):
+        return (str(children[0]).upper(), children[1] if len(children) > 1 else None)
+
+    def def_var(self, children):
+        return (children[0], children[1] if len(children) > 1 else None)
+
+    def proc_param(self, children):
+        by_reference = isinstance(children[0], Token) and children[0].type == "VAR"
+        rest = children[1:] if by_reference else children
+        dims = rest[2] if len(rest) > 2 else None
+        return (str(rest[0]).upper(), str(rest[1]).lower(), by_reference, dims)
+
+    def case_branch(self, children):
+        value, keyword, target = children
+        return (value, str(keyword).upper(), str(target).upper())
+
+    def args(self, children):
+        return () if children == [None] else tuple(children)
+
+    def arg(self, children):
+        return children[0] if children else None
+
+    # -- expressions ---------------------------------------------------------------
+    def var(self, children):
+        return ("param", str(children[0]).lower())
+
+    def index(self, children):
+        name, args = children
+        return ("index", str(name).lower(), args)
+
+    def number(self, children):
+        return ("num", float(str(children[0]).upper().replace("EX", "E")))
+
+    def string(self, children):
+        return ("str", str(children[0])[1:-1])
+
+    def boolean(self, children):
+        return ("num", 1.0 if str(children[0]).upper() == "TRUE" else 0.0)
+
+    def func(self, children):
+        name, args = str(children[0]).upper(), children[1]
+        if name in COORDINATE_MODES and len(args) == 1:
+            return (name.lower(), args[0])
+        return ("call", name, *args)
+
+    def neg(self, children):
+        return ("neg", children[0])
+
+    def pos(self, children):
+        return children[0]
+
+    def not_(self, children):
+        return ("not", children[1])
+
+    def bnot(self, children):
+        return ("bnot", children[1])
+
+    def _binary(self, children):
+        a, op, b = children
+        return ("bin", str(op).upper(), a, b)
+
+    compare = concat = lor = lxor = land = bor = bxor = band = sum = product = _binary
+
+
+SINUMERIK = Dialect("sinumerik", "sinumerik", SinumerikBuilder, fast_terminals=("WORD", "SEMI_COMMENT"))
