@@ -1,0 +1,87 @@
+"""`ncpp compensate` end to end: header, refusal, limits, accuracy, valid arcs."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from tests.conftest import RS274, ROOT
+
+MACHINE = ROOT / "samples/machines/hr5b.toml"
+POCKET = ROOT / "samples/programs/pocket.ngc"
+OFFSET = "400,350,300"
+
+
+def ncpp(*args: str, input: bytes | None = None) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "ncpp", *args], input=input, capture_output=True)
+
+
+@pytest.fixture(scope="module")
+def compensated(tmp_path_factory) -> Path:
+    out = tmp_path_factory.mktemp("comp") / "pocket.ngc"
+    proc = ncpp("compensate", "--machine", str(MACHINE), "--work-offset", OFFSET, str(POCKET), "-o", str(out))
+    assert proc.returncode == 0, proc.stderr.decode()
+    return out
+
+
+def test_header_names_machine_and_hash_after_tape_mark(compensated):
+    lines = compensated.read_text().splitlines()
+    assert lines[0] == "%"
+    assert lines[1].startswith("(ncpp compensated for hr5b.toml sha256:")
+
+
+def test_untouched_blocks_are_byte_identical(compensated):
+    out = compensated.read_text().splitlines()
+    for line in ("(ncpp sample: a 60 x 40 mm pocket with R10 corners and a finishing circle)", "G21 G17 G90 G54", "M2"):
+        assert line in out
+
+
+def test_second_compensation_is_refused_unless_forced(compensated, tmp_path):
+    proc = ncpp("compensate", "--machine", str(MACHINE), "--work-offset", OFFSET, str(compensated))
+    assert proc.returncode != 0 and b"already compensated" in proc.stderr and proc.stdout == b""
+    forced = ncpp("compensate", "--force", "--machine", str(MACHINE), "--work-offset", OFFSET, str(compensated))
+    assert forced.returncode == 0
+
+
+def test_command_outside_travel_is_refused_with_line_and_no_output(tmp_path):
+    out = tmp_path / "out.ngc"
+    proc = ncpp("compensate", "--machine", str(MACHINE), str(POCKET), "-o", str(out))
+    assert proc.returncode != 0
+    assert proc.stderr.decode().startswith(f"{POCKET}:")
+    assert "outside the Y travel" in proc.stderr.decode()
+    assert not out.exists()
+
+
+def test_contour_error_shrinks_on_the_virtual_machine(compensated, tmp_path):
+    def simulate(program: Path) -> float:
+        report = tmp_path / f"{program.stem}-{len(list(tmp_path.iterdir()))}.json"
+        proc = ncpp("simulate", "--machine", str(MACHINE), "--work-offset", OFFSET, "--reference", str(POCKET), str(program), "--json", str(report))
+        assert proc.returncode == 0, proc.stderr.decode()
+        import json
+
+        return json.loads(report.read_text())["contour_error_max_um"]
+
+    before, after = simulate(POCKET), simulate(compensated)
+    assert before > 20.0
+    assert after < before / 5
+
+
+@pytest.mark.skipif(not RS274.exists(), reason="rs274 oracle not available")
+def test_linuxcnc_accepts_every_compensated_arc(compensated):
+    proc = subprocess.run([str(RS274), str(compensated)], capture_output=True, text=True)
+    assert "ARC_FEED" in proc.stdout
+    assert "error" not in (proc.stdout + proc.stderr).lower()
+
+
+def test_compensate_from_ballbar_file(tmp_path):
+    program = tmp_path / "circle.ngc"
+    program.write_text("G21 G17 G90\nG0 X550. Y-200. Z350.\nG1 F1000.\nG2 X550. Y-200. I-150. J0.\nM2\n")
+    ballbar = ROOT / "samples/measurements/ballbar_XY_R150.csv"
+    proc = ncpp("compensate", "--from", str(ballbar), str(program))
+    assert proc.returncode == 0, proc.stderr.decode()
+    text = proc.stdout.decode()
+    assert "ballbar_XY_R150.csv" in text.splitlines()[0]
+    assert text.count("G2") + text.count("G3") >= 1 and len(text.splitlines()) > 6
