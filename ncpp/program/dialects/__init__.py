@@ -123,7 +123,7 @@ def sniff(stream: Iterable[bytes], name: str | None = None, dialect: str | None 
     head_lines = list(io.BytesIO(head))
     if head_lines and not head_lines[-1].endswith(b"\n"):
         head_lines[-1] += stream.readline()  # type: ignore[union-attr]
-    return detect(head, name), _chain(head_lines, stream)
+    return detect(b"".join(head_lines), name), _chain(head_lines, stream)
 
 
 def _chain(first: list[bytes], rest: Iterable[bytes]) -> Iterator[bytes]:

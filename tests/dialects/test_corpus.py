@@ -1,0 +1,95 @@
+"""Heidenhain and Sinumerik corpus programs round-trip byte for byte; every corpus file is detected right."""
+
+from __future__ import annotations
+
+import io
+
+import pytest
+
+from ncpp.program.dialects import detect, parse_program, sniff
+from ncpp.program.parser import LineParser, parse_stream
+from ncpp.program.writer import write_blocks
+from tests.conftest import CORPUS, corpus_files, corpus_id
+
+HEIDENHAIN = corpus_files("heidenhain")
+SINUMERIK = corpus_files("sinumerik")
+OTHERS = corpus_files("iso_gcode", "malformed", "apt_cldata", "metrology")
+# Plain G code with `;` comments: nothing in it is Sinumerik-only, only its name tells.
+CONTENT_AMBIGUOUS = {"multiple_m_codes.mpf"}
+
+
+def roundtrip(data: bytes, name: str, dialect: str) -> bytes:
+    out = io.BytesIO()
+    write_blocks(parse_stream(io.BytesIO(data), name, dialect), out)
+    return out.getvalue()
+
+
+def test_corpus_has_both_dialects():
+    assert len(HEIDENHAIN) >= 2 and len(SINUMERIK) >= 30
+
+
+@pytest.mark.parametrize("path", HEIDENHAIN, ids=corpus_id)
+def test_heidenhain_program_roundtrips(path):
+    data = path.read_bytes()
+    assert roundtrip(data, str(path), "heidenhain") == data
+
+
+@pytest.mark.parametrize("path", SINUMERIK, ids=corpus_id)
+def test_sinumerik_program_roundtrips(path):
+    data = path.read_bytes()
+    assert roundtrip(data, str(path), "sinumerik") == data
+
+
+@pytest.mark.parametrize("path", HEIDENHAIN + SINUMERIK + OTHERS, ids=corpus_id)
+def test_dialect_is_detected(path):
+    want = "heidenhain" if path in HEIDENHAIN else "sinumerik" if path in SINUMERIK else "iso"
+    head = path.read_bytes()[:4096]
+    assert detect(head, path.name) == want
+    if path.name not in CONTENT_AMBIGUOUS:
+        assert detect(head) == want
+
+
+def test_heidenhain_continuation_lines_make_one_block():
+    path = CORPUS / "heidenhain/jstjst_Heidenhain-Cycles/Plan.h"
+    blocks = list(parse_stream(io.BytesIO(path.read_bytes()), str(path), "heidenhain"))
+    physical = path.read_bytes().count(b"\n")
+    assert len(blocks) == 216 and physical == 223  # blocks 0..215, three comments continued
+    third = blocks[3]
+    assert third.line == 4 and third.raw.count("\n") == 3
+    (number, comment) = third.items
+    assert number.value == 3 and comment.style == ";" and "GNU General Public License" in comment.text
+    assert blocks[-1].items[1].kind == "program_end" and blocks[-1].items[1].node == ("Plan", "MM")
+
+
+def test_sinumerik_fast_path_agrees_with_lalr_parser_on_corpus():
+    parser = LineParser("sinumerik")
+    checked = 0
+    for path in SINUMERIK:
+        for block in parse_stream(io.BytesIO(path.read_bytes()), str(path), "sinumerik"):
+            fast = parser._scan_plain(block.raw)
+            if fast is not None:
+                assert fast == parser._parse_lalr(block.raw, block.line, str(path)), (path, block.line)
+                checked += 1
+    assert checked > 100
+
+
+@pytest.mark.parametrize("size", [1, 7, 4096])
+def test_sniff_rereads_the_head_and_keeps_streaming(size, monkeypatch):
+    import ncpp.program.dialects as dialects
+
+    monkeypatch.setattr(dialects, "SNIFF_BYTES", size)
+    path = CORPUS / "heidenhain/jstjst_Heidenhain-Cycles/Plan.h"
+    data = path.read_bytes()
+    dialect, lines = sniff(io.BytesIO(data), path.name)
+    assert b"".join(lines) == data
+    if size == 4096:
+        assert dialect == "heidenhain"
+    name, blocks = parse_program(io.BytesIO(data), str(path))
+    out = io.BytesIO()
+    write_blocks(blocks, out)
+    assert out.getvalue() == data
+
+
+def test_explicit_dialect_overrides_detection():
+    dialect, _ = sniff(io.BytesIO(b"G1 X1\n"), None, "Sinumerik")
+    assert dialect == "sinumerik"

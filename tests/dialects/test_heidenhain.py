@@ -1,0 +1,142 @@
+"""Heidenhain Klartext blocks parse into the common items with the right values."""
+
+from __future__ import annotations
+
+import io
+import math
+
+import pytest
+
+from ncpp.errors import NcppError
+from ncpp.program.blocks import Comment, ExprWord, Statement, Word
+from ncpp.program.parser import LineParser, parse_stream
+from ncpp.program.writer import write_blocks
+
+PARSER = LineParser("heidenhain")
+
+
+def items(text: str) -> tuple:
+    return PARSER.parse(text).items
+
+
+def words(text: str) -> dict[str, float]:
+    return {i.letter: i.value for i in items(text) if type(i) is Word}
+
+
+def statements(text: str) -> list[tuple[str, tuple]]:
+    return [(i.kind, i.node) for i in items(text) if type(i) is Statement]
+
+
+def test_line_with_decimal_comma_and_fmax():
+    block = PARSER.parse("7 L X+10,5 Y-3 R0 FMAX")
+    assert words(block.raw) == {"N": 7.0, "X": 10.5, "Y": -3.0}
+    x = block.words()[1]
+    assert x.number == "+10,5" and block.source(x) == "X+10,5"
+    assert block.source(block.words()[0]) == "7"
+    assert statements(block.raw) == [("path", ("L",)), ("radius_comp", ("R0",)), ("feed", ("FMAX",))]
+
+
+def test_incremental_words_feed_and_m():
+    assert words("L IX+5 IY-2,25 IZ+0 RL F250 M3") == {"IX": 5.0, "IY": -2.25, "IZ": 0.0, "F": 250.0, "M": 3.0}
+    assert ("radius_comp", ("RR",)) in statements("L IX+5 RR FAUTO")
+    assert ("feed", ("FAUTO",)) in statements("L IX+5 RR FAUTO")
+
+
+def test_circle_centre_and_circles():
+    assert statements("CC X+0 Y+0") == [("path", ("CC",))] and words("CC X+0 Y+0") == {"X": 0.0, "Y": 0.0}
+    assert words("CC IX+5 Y+0") == {"IX": 5.0, "Y": 0.0}
+    assert statements("C X+10 Y+0 DR-") == [("path", ("C",)), ("rotation", ("-",))]
+    assert words("C X+10 Y+0 DR-") == {"X": 10.0, "Y": 0.0}
+    cr = "CR X+10 Y+0 R+5 DR+"
+    assert words(cr) == {"X": 10.0, "Y": 0.0, "R": 5.0} and statements(cr)[-1] == ("rotation", ("+",))
+    assert statements("CT X+20 Y+5") == [("path", ("CT",))]
+
+
+def test_rounding_chamfer_and_polar():
+    assert statements("RND R5") == [("path", ("RND",))] and words("RND R5") == {"R": 5.0}
+    assert statements("CHF 2,5") == [("path", ("CHF", 2.5))]
+    assert words("LP PR+50 PA+30 RL F200") == {"PR": 50.0, "PA": 30.0, "F": 200.0}
+    assert words("CP IPA+90 DR+") == {"IPA": 90.0}
+    assert statements("CP IPA+90 DR+") == [("path", ("CP",)), ("rotation", ("+",))]
+
+
+def test_q_parameter_words_are_expressions():
+    (n, path, x, y, comp, feed) = items("89 L  X+Q1932  Y-Q1931 R0 FQ1820")
+    assert type(x) is ExprWord and (x.letter, x.expr) == ("X", ("param", "q1932"))
+    assert y.expr == ("neg", ("param", "q1931"))
+    assert type(feed) is ExprWord and feed.letter == "F"
+    assert items("RND RQ1832")[1].expr == ("param", "q1832")
+
+
+def test_program_frame_tool_and_blank_form():
+    assert statements("0  BEGIN PGM Plan-Beispiel MM ") == [("program_begin", ("Plan-Beispiel", "MM"))]
+    assert statements("25 END PGM Plan-Beispiel INCH") == [("program_end", ("Plan-Beispiel", "INCH"))]
+    assert statements("1  BLK FORM 0.1 Z  X-200  Y-100  Z-30") == [("blk_form", ("0.1", "Z"))]
+    assert words("2  BLK FORM 0.2  X+200  Y+100  Z+0") == {"N": 2.0, "X": 200.0, "Y": 100.0, "Z": 0.0}
+    assert statements("3  TOOL CALL 1 Z S800") == [("tool_call", (1, "Z"))] and words("TOOL CALL 1 Z S800 F100")["S"] == 800
+    assert statements('TOOL CALL "MILL_D10" Z') == [("tool_call", ("MILL_D10", "Z"))]
+    assert statements("TOOL DEF 5 L+0 R+5") == [("tool_def", (5,))] and words("TOOL DEF 5 L+0 R+5") == {"L": 0.0, "R": 5.0}
+
+
+def test_labels_calls_and_cycles():
+    assert statements("LBL 1") == [("label", (1,))]
+    assert statements('LBL "Spirale1"') == [("label", ("Spirale1",))]
+    assert statements("CALL LBL 1 REP 2/2") == [("call_label", (1, 2))]
+    assert statements('CALL LBL "x"') == [("call_label", ("x", 0))]
+    assert statements("22 CALL PGM TNC:\\Plan.h") == [("call_program", ("TNC:\\Plan.h",))]
+    assert statements("CYCL DEF 1.1 ABST 2") == [("cycle_def", ("1.1", ("ABST", "2")))]
+    assert statements("CYCL DEF 7.1 IX+10") == [("cycle_def", ("7.1", ()))] and words("CYCL DEF 7.1 IX+10") == {"IX": 10.0}
+    assert statements("CYCL CALL M3") == [("cycle_call", (None,))]
+
+
+def test_multi_line_cycle_definition_is_one_block_and_roundtrips():
+    text = b"11 CYCL DEF 200 BOHREN ~\r\n    Q200=+2    ;SICHERHEITS-ABST. ~\r\n    Q201=-20,5 ;TIEFE\r\n12 CYCL CALL\r\n"
+    blocks = list(parse_stream(io.BytesIO(text), "c.h", "heidenhain"))
+    assert len(blocks) == 2 and blocks[0].eol == "\r\n" and blocks[1].line == 4
+    kinds = [(type(i).__name__, getattr(i, "kind", None)) for i in blocks[0].items]
+    assert kinds == [("Word", None), ("Statement", "cycle_def"), ("Statement", "assignment"), ("Comment", None),
+                     ("Statement", "assignment"), ("Comment", None)]
+    assert blocks[0].items[1].node == ("200", ("BOHREN",))
+    assert blocks[0].items[4].node == (("param", "q201"), ("num", -20.5))
+    assert blocks[0].items[3].text == "SICHERHEITS-ABST. "
+    out = io.BytesIO()
+    write_blocks(blocks, out)
+    assert out.getvalue() == text
+
+
+def test_q_formulas_and_fn_pass_through():
+    (_, assign, comment) = items("30 Q1951 = INT ( ( Q1950 / Q1810 ) + 0.99999999 ) ;Anzahl")
+    assert assign.node == (("param", "q1951"), ("call", "INT", ("bin", "+", ("bin", "/", ("param", "q1950"), ("param", "q1810")), ("num", 0.99999999))))
+    assert comment.text == "Anzahl"
+    assert items("Q1800 = - 200")[0].node == (("param", "q1800"), ("num", -200.0))
+    assert items("Q1 = PI * Q2 ^ 2")[0].node[1] == ("bin", "*", ("num", math.pi), ("bin", "**", ("param", "q2"), ("num", 2.0)))
+    assert statements('8  FN 12: IF +Q1840 LT +1 GOTO LBL "1042"') == [("fn", (12, 'IF +Q1840 LT +1 GOTO LBL "1042"'))]
+    assert statements("FN 14: ERROR= 1005") == [("fn", (14, "ERROR= 1005"))]
+
+
+def test_comments():
+    (n, c) = items("5  ;----- Zyklus -----")
+    assert type(c) is Comment and (c.style, c.text) == (";", "----- Zyklus -----")
+    (n, c) = items("6 * - interne Parameter")
+    assert (c.style, c.text) == ("*", " - interne Parameter")
+    assert statements("STOP M0") == [("keyword", ("STOP",))]
+
+
+def test_crlf_leading_blanks_and_continued_comment_roundtrip():
+    text = b"  0  BEGIN PGM T MM\r\n1 ;lang~\r\n weiter\r\n  2 L X+1,5 Y-0,25 R0 FMAX\r\n3 END PGM T MM\r\n"
+    blocks = list(parse_stream(io.BytesIO(text), "t.h", "heidenhain"))
+    assert [b.line for b in blocks] == [1, 2, 4, 5]
+    out = io.BytesIO()
+    write_blocks(blocks, out)
+    assert out.getvalue() == text
+
+
+@pytest.mark.parametrize(
+    "text, line, col",
+    [(b"0 BEGIN PGM T MM\n1 L X+1 Y@2\n", 2, 9), (b"0 BEGIN PGM T MM\n1 CYCL DEF 1.0 ~\n  Q1=+1 ;x ~\n  X+1 Y=\n", 4, 7)],
+)
+def test_bad_input_names_file_line_and_column(text, line, col):
+    with pytest.raises(NcppError) as err:
+        list(parse_stream(io.BytesIO(text), "bad.h", "heidenhain"))
+    where = err.value.where
+    assert (where.file, where.line, where.col) == ("bad.h", line, col)
