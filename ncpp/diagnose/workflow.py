@@ -16,8 +16,9 @@
    jointly, and the loop repeats until nothing significant is left.
 5. Two candidates whose columns (after removing nuisances and the chosen
    effects) have a canonical correlation above `ambiguity` cannot be told
-   apart by the data.  The step then keeps the better-fitting one as the
-   representative, so that the model still reproduces the measurement, and
+   apart by the data.  The step then keeps the one listed first in the effect
+   table as the representative (a prior for the simpler, more common effect,
+   not the noise, decides), so that the model still reproduces the data, and
    its evidence says "ambiguous" and names the others: a test that separates
    them (the other direction, a second feed, another plane) should decide.
 6. After each step the updated model is re-simulated through the forward
@@ -200,7 +201,7 @@ def diagnose(
         Q = _orth(np.column_stack([prob.nuisance, X]) * sw[:, None])
         dof0 = len(prob.r) - Q.shape[1]
         scored = []
-        for g in groups:
+        for order, g in enumerate(groups):
             if any(c.kind == g[0].kind and c.keys == g[0].keys for c in chosen):
                 continue
             best = None
@@ -208,7 +209,7 @@ def diagnose(
                 B = cols[id(cand)] * sw[:, None]
                 Bp = B - Q @ (Q.T @ B)
                 if np.linalg.norm(Bp) <= 1e-6 * max(np.linalg.norm(B), 1e-300):
-                    if np.linalg.norm(B) > 0:
+                    if np.linalg.norm(B) > 0 and not chosen:  # hidden by the set-up offsets alone
                         not_observable.add(g[0].name)
                     continue
                 Qb = _orth(Bp, 1e-6)
@@ -222,19 +223,19 @@ def diagnose(
             s2 = max(1.0, (rss0 - gain) / max(dof0 - p, 1))
             stat = gain / s2
             thr = float(chdtri(p, alpha / n_tests))
-            scored.append((stat / thr, cand, gain, Qb, stat, thr))
+            scored.append((stat / thr, cand, gain, Qb, stat, thr, order))
         significant = [s for s in scored if s[0] > 1.0]
         if not significant:
             break
         significant.sort(key=lambda s: -s[2])
-        _, cand, gain, Qb, stat, thr = significant[0]
+        twins = [s for s in significant[1:] if np.linalg.svd(significant[0][3].T @ s[3], compute_uv=False).max() > ambiguity]
+        # The data cannot choose among twins: the effect table's order (simpler,
+        # more common effects first) picks the representative, not the noise.
+        group = [significant[0], *twins]
+        _, cand, gain, Qb, stat, thr, _ = min(group, key=lambda s: s[6])
+        ambiguous = tuple(s[1].name for s in group if s[1] is not cand)
         if cand.kind == "cyclic":
             cand = _refine_period(cand, prob, cols, Q, e_w, sw)
-        ambiguous = tuple(
-            s[1].name for s in significant[1:]
-            if s[1].kind != cand.kind or s[1].keys != cand.keys
-            if np.linalg.svd(Qb.T @ s[3], compute_uv=False).max() > ambiguity
-        )  # fmt: skip
         chosen.append(cand)
         coef, cov, residual, chosen = _refit(prob, chosen, cols, sw)
         effects = tuple(c.build(coef[k]) for c, k in zip(chosen, _index(chosen)))
@@ -376,6 +377,6 @@ def explain(obs, slices, contribution: NDArray, stat: float, thr: float, share: 
     text = "; ".join(parts)
     if ambiguous:
         text = (f"ambiguous: cannot be told apart from {', '.join(ambiguous)} on this data "
-                f"(columns correlated > 0.98; kept the better fit as representative; a test in the other direction, "
+                f"(columns correlated > 0.98; kept the first in the effect table as representative; a test in the other direction, "
                 f"at another feed or in another plane would separate them); " + text)  # fmt: skip
     return text
