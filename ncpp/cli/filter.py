@@ -4,6 +4,9 @@ With no passes the output is the input, byte for byte.  Every block goes
 through the motion interpreter, so a program LinuxCNC would refuse (bad arc
 radius, conflicting words...) fails with `file:line:col: message` and
 nothing is written; output is spooled until the whole program was read.
+The dialect is detected from the first few KB (`--dialect` overrides);
+Heidenhain and Sinumerik programs are parsed (a syntax error fails the same
+way) and written back as read, until their interpreters exist.
 """
 
 from __future__ import annotations
@@ -16,7 +19,7 @@ from ncpp.errors import Warnings
 from ncpp.motion import interpret
 from ncpp.motion.segments import Event
 from ncpp.program.blocks import Block
-from ncpp.program.parser import parse_stream
+from ncpp.program.dialects import parse_program
 from ncpp.program.writer import write_blocks
 
 
@@ -29,8 +32,10 @@ def register(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     warnings = Warnings(strict=args.strict)
     with open_input(args.input) as (stream, name), open_output(args.output) as out:
-        events = interpret(parse_stream(stream, name), file=name, warnings=warnings)
-        write_blocks(source_blocks(events), out)
+        dialect, blocks = parse_program(stream, name, args.dialect)
+        if dialect == "iso":
+            blocks = source_blocks(interpret(blocks, file=name, warnings=warnings))
+        write_blocks(blocks, out)
     return 1 if warnings.count and args.strict else 0
 
 

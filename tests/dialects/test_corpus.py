@@ -93,3 +93,25 @@ def test_sniff_rereads_the_head_and_keeps_streaming(size, monkeypatch):
 def test_explicit_dialect_overrides_detection():
     dialect, _ = sniff(io.BytesIO(b"G1 X1\n"), None, "Sinumerik")
     assert dialect == "sinumerik"
+
+
+@pytest.mark.parametrize("path", [HEIDENHAIN[0], CORPUS / "sinumerik/CEAD_nc-gcode-interpreter/edge_cases.mpf"], ids=corpus_id)
+def test_cli_filter_roundtrips_from_stdin(path):
+    import subprocess
+    import sys
+
+    data = path.read_bytes()
+    out = subprocess.run([sys.executable, "-m", "ncpp"], input=data, capture_output=True, check=True)
+    assert out.stdout == data
+
+
+def test_cli_dialect_option_overrides_and_errors_name_the_line(tmp_path):
+    import subprocess
+    import sys
+
+    bad = tmp_path / "bad.mpf"
+    bad.write_bytes(b"G1 X1\nX=(1+\n")
+    proc = subprocess.run([sys.executable, "-m", "ncpp", "--dialect", "sinumerik", str(bad)], capture_output=True, text=True)
+    assert proc.returncode != 0 and proc.stdout == "" and proc.stderr.startswith(f"{bad}:2:")
+    proc = subprocess.run([sys.executable, "-m", "ncpp", "--dialect", "klingon", str(bad)], capture_output=True, text=True)
+    assert proc.returncode != 0 and "unknown dialect" in proc.stderr
