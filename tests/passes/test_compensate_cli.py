@@ -85,3 +85,35 @@ def test_compensate_from_ballbar_file(tmp_path):
     text = proc.stdout.decode()
     assert "ballbar_XY_R150.csv" in text.splitlines()[0]
     assert text.count("G2") + text.count("G3") >= 1 and len(text.splitlines()) > 6
+
+
+def test_thesis_reference_case_from_a_ballbar_file(tmp_path):
+    """Section 6.5.2.1 through the command: ΔR(θ) = 9.1·sin 2θ µm from a ball-bar
+    file, a full R150 circle in G91, one arc per quadrant (blocks N201-N204)."""
+    import numpy as np
+
+    angles = np.arange(0.0, 360.0, 1.0)
+    rows = [f"{d},{a:g},{9.1 * np.sin(2 * np.radians(a)):.4f}" for d in ("CCW", "CW") for a in angles]
+    ballbar = tmp_path / "bb.csv"
+    ballbar.write_text(
+        "# instrument: ballbar\n# plane: XY\n# radius_mm: 150\n# center_mm: 400,-200,350\n# feed_mm_min: 500\n"
+        "direction,angle_deg,deviation_um\n" + "\n".join(rows) + "\n"
+    )
+    program = tmp_path / "circle.ngc"
+    program.write_text("G21 G17 G90\nG0 X550.000 Y-200.000 Z350.000\nG91\nN200 G02 X0 Y0 I-150.000 J0 F500\nG90\nM2\n")
+    proc = ncpp("compensate", "--from", str(ballbar), "--tolerance", "0.004", str(program))
+    assert proc.returncode == 0, proc.stderr.decode()
+    lines = proc.stdout.decode().splitlines()
+    arcs = [ln for ln in lines if "I" in ln]
+    assert len(arcs) == 4
+    from ncpp.program.parser import parse_text
+
+    # N201 is the thesis's block; N202-N204 follow from the symmetry of sin 2θ
+    # (quadrants where ΔR > 0 get centres moved outward, radius 150.022).
+    thesis = [(-150, -150, -149.978, -0.022), (-150, 150, 0.022, 150.022), (150, 150, 149.978, 0.022), (150, -150, -0.022, -150.022)]
+    for text, (x, y, i, j) in zip(arcs, thesis):
+        words = {w.letter: w.value for w in parse_text(text + "\n")[0].words()}
+        assert (words["X"], words["Y"]) == pytest.approx((x, y), abs=0.001)
+        assert (words["I"], words["J"]) == pytest.approx((i, j), abs=0.001)
+    # at least 4 decimals (0.1 µm) whatever the input wrote, so rounding stays far below tolerance
+    assert arcs[0].startswith("N200 G02 X-150.0000 Y-150.0000 I-149.97")
