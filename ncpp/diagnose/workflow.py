@@ -20,7 +20,7 @@
    table as the representative (a prior for the simpler, more common effect,
    not the noise, decides), so that the model still reproduces the data, and
    its evidence says "ambiguous" and names the others: a test that separates
-   them (the other direction, a second feed, another plane) should decide.
+   them (the other direction, a second feed, another plane or height) should decide.
 6. After each step the updated model is re-simulated through the forward
    models and the gap (nuisances removed) is recorded.
 """
@@ -243,6 +243,8 @@ def diagnose(
         gap = _gap(updated, obs)
         params, unc = cand.parameters(coef[_index(chosen)[-1]], cov[np.ix_(_index(chosen)[-1], _index(chosen)[-1])])
         contribution = cols[id(chosen[-1])] @ coef[_index(chosen)[-1]]
+        for o, s in zip(obs, slices):  # what the set-up offsets absorb is not evidence
+            contribution[s] -= o.nuisance @ np.linalg.lstsq(o.nuisance, contribution[s], rcond=None)[0]
         evidence = explain(obs, slices, contribution, stat, thr, gain / max(rss0, 1e-300), ambiguous)
         steps.append(Step(chosen[-1], effects[-1], params, unc, gap, evidence, stat, thr, ambiguous))
     # Final joint values for every step (later steps refine earlier estimates).
@@ -378,5 +380,5 @@ def explain(obs, slices, contribution: NDArray, stat: float, thr: float, share: 
     if ambiguous:
         text = (f"ambiguous: cannot be told apart from {', '.join(ambiguous)} on this data "
                 f"(columns correlated > 0.98; kept the first in the effect table as representative; a test in the other direction, "
-                f"at another feed or in another plane would separate them); " + text)  # fmt: skip
+                f"at another feed, in another plane or at another height would separate them); " + text)  # fmt: skip
     return text
