@@ -29,21 +29,6 @@ def _rotary(extra: tuple[float, ...]) -> tuple[float, float, float]:
     return (extra[0], extra[1], extra[2]) if extra else (0.0, 0.0, 0.0)
 
 
-def format_event(event: Event) -> str | None:
-    """The rs274 canonical call of a motion event; None for a Pass."""
-    if type(event) is Line:
-        name = "STRAIGHT_TRAVERSE" if event.rapid else "STRAIGHT_FEED"
-        values = (*event.end, *_rotary(event.extra))
-        return f"{name}({', '.join(f'{v:.4f}' for v in values)})"
-    if type(event) is Arc:
-        a, b, n = PLANE_AXES[event.context.plane]
-        e, c = event.end, event.center
-        head = ", ".join(f"{v:.4f}" for v in (e[a], e[b], c[a], c[b]))
-        tail = ", ".join(f"{v:.4f}" for v in (e[n], *_rotary(event.extra)))
-        return f"ARC_FEED({head}, {event.turn}, {tail})"
-    return None
-
-
 @dataclass(frozen=True, slots=True)
 class CanonCall:
     """One motion call read from rs274 output (or from `format_event`)."""
@@ -73,3 +58,25 @@ def read_canon(text: str) -> list[CanonCall]:
     for m in _CALL.finditer(text):
         calls.append(CanonCall(m.group(1), tuple(float(v) for v in m.group(2).split(","))))
     return calls
+
+
+def canon_call(event: Event) -> CanonCall | None:
+    """The rs274 canonical call of a motion event, at full precision; None for a Pass."""
+    if type(event) is Line:
+        return CanonCall("STRAIGHT_TRAVERSE" if event.rapid else "STRAIGHT_FEED", (*event.end, *_rotary(event.extra)))
+    if type(event) is Arc:
+        a, b, n = PLANE_AXES[event.context.plane]
+        e, c = event.end, event.center
+        return CanonCall("ARC_FEED", (e[a], e[b], c[a], c[b], float(event.turn), e[n], *_rotary(event.extra)))
+    return None
+
+
+def format_event(event: Event) -> str | None:
+    """The rs274 text of a motion event (`%.4f` numbers, integer rotation); None for a Pass."""
+    call = canon_call(event)
+    if call is None:
+        return None
+    values = [f"{v:.4f}" for v in call.args]
+    if call.name == "ARC_FEED":
+        values[4] = str(int(call.args[4]))
+    return f"{call.name}({', '.join(values)})"

@@ -1,0 +1,184 @@
+"""The interpreter against LinuxCNC's own (`../shared/tools/rs274`), call by call.
+
+For every ISO-family corpus program (and the good arcs of malformed/), the
+end points, arc centres, rotations and rotary positions of every
+STRAIGHT_TRAVERSE, STRAIGHT_FEED and ARC_FEED must agree within 1e-4
+(program units).  A program either
+
+* is in scope and agrees completely (rs274's output for a file without a
+  final `%`/M2 still counts), or
+* leaves the interpreter's scope: it is listed in OUT_OF_SCOPE with the
+  construct the interpreter's warning names, and the moves before that
+  point must still agree, or
+* is refused by rs274: ncpp refuses it too, on the same line, after the same
+  moves; or it is listed in RS274_ONLY_REFUSES with the reason the
+  difference is right.
+
+A program in none of these cases fails.
+"""
+
+from __future__ import annotations
+
+import functools
+import io
+import subprocess
+
+import pytest
+
+from ncpp.errors import NcppError, Warnings
+from ncpp.motion import interpret
+from ncpp.motion.canon import CanonCall, canon_call, read_canon
+from ncpp.program.parser import parse_stream
+from tests.conftest import CORPUS, RS274, corpus_files, corpus_id
+
+TOLERANCE = 1e-4
+PROGRAMS = corpus_files("iso_gcode") + sorted((CORPUS / "malformed/linuxcnc_interp_good").glob("*.ngc"))
+EOF_NOTE = "File ended with no percent sign or program end"
+
+# file name -> the construct the interpreter's out-of-scope warning names
+OUT_OF_SCOPE = {
+    "iso_gcode/camotics_tests/oCodeTests__ElseIfTest__data__stdin": "o-word control flow",
+    "iso_gcode/camotics_tests/offsetTests__ToolOffsetTest__data__stdin": "tool table change G10 L1/L10/L11",
+    "iso_gcode/camotics_tests/offsetTests__ToolRelativeOffsetTest__data__stdin": "tool table change G10 L1/L10/L11",
+    "iso_gcode/camotics_tests/varRefTests__GlobalNamedTest__data__stdin": "o-word control flow",
+    "iso_gcode/camotics_tests/varRefTests__GlobalNumericTest__data__stdin": "o-word control flow",
+    "iso_gcode/camotics_tests/varRefTests__LocalNamedTest__data__stdin": "o-word control flow",
+    "iso_gcode/camotics_tests/varRefTests__LocalNumericTest__data__stdin": "o-word control flow",
+    "iso_gcode/cncjs/helical-thread-milling.gcode": "cutter compensation G42",
+    "iso_gcode/cncjs_toolpath_fixtures/helical-thread-milling.nc": "cutter compensation G42",
+    "iso_gcode/fanuc_macroB_sheet/7997A.NC": "Fanuc macro IF",
+    "iso_gcode/fanuc_macroB_sheet/CIRCLE.NC": "Fanuc macro IF",
+    "iso_gcode/fanuc_macroB_sheet/RECTANGLE.NC": "Fanuc macro IF",
+    "iso_gcode/fanuc_macroB_sheet/WASHER.NC": "M98 subprogram call",
+    "iso_gcode/haas_fanuc_macroB/O9250-DynamicOffsetRotation.nc": "Fanuc macro IF",
+    "iso_gcode/linuxcnc/comp.ngc": "cutter compensation G42",
+    "iso_gcode/linuxcnc/factorial.ngc": "o-word control flow",
+    "iso_gcode/linuxcnc/g76.ngc": "o-word control flow",
+    "iso_gcode/linuxcnc/g881.ngc": "o-word control flow",
+    "iso_gcode/linuxcnc/g882.ngc": "o-word control flow",
+    "iso_gcode/linuxcnc/mmount.ngc": "o-word control flow",
+    "iso_gcode/linuxcnc/ngcgui_arc1.ngc": "o-word control flow",
+    "iso_gcode/linuxcnc/ngcgui_helix.ngc": "o-word control flow",
+    "iso_gcode/linuxcnc/ngcgui_qpocket.ngc": "o-word control flow",
+    "iso_gcode/linuxcnc/nurbs_G5_butterfly-xy.ngc": "spline G5.2",
+    "iso_gcode/linuxcnc/plasmac_metric_pipe.ngc": "probing G38.2",
+    "iso_gcode/linuxcnc/polar.ngc": "canned cycle G81",
+    "iso_gcode/linuxcnc/systems.ngc": "spline G5.1",
+    "iso_gcode/linuxcnc/threading.ngc": "o-word control flow",
+    "iso_gcode/linuxcnc/useful-subroutines.ngc": "o-word control flow",
+    "iso_gcode/linuxcnc_fanuc_subs/01-basics__test.ngc": "M98 subprogram call",
+    "iso_gcode/linuxcnc_fanuc_subs/02-variables__test.ngc": "M98 subprogram call",
+    "iso_gcode/linuxcnc_fanuc_subs/05-M98-loops__test.ngc": "M98 subprogram call",
+    "iso_gcode/linuxcnc_fanuc_subs/07-nested-subs__test.ngc": "M98 subprogram call",
+    "iso_gcode/linuxcnc_fanuc_subs/08-sub-follows-main__test.ngc": "M98 subprogram call",
+    "iso_gcode/linuxcnc_fanuc_subs/09-disable-fanuc-subs__test-fanuc.ngc": "M98 subprogram call",
+    "iso_gcode/linuxcnc_fanuc_subs/09-disable-fanuc-subs__test-rs274ngc.ngc": "o-word control flow",
+    "iso_gcode/linuxcnc_fanuc_subs/10-M98-P001__test.ngc": "M98 subprogram call",
+    "iso_gcode/linuxcnc_fanuc_subs/11-main-program-oword__test-legal-end-main-with-m02.ngc": "o-word control flow",
+    "iso_gcode/linuxcnc_fanuc_subs/11-main-program-oword__test-legal-end-main-with-m2.ngc": "o-word control flow",
+    "iso_gcode/linuxcnc_fanuc_subs/11-main-program-oword__test-legal-end-main-with-m30.ngc": "o-word control flow",
+    "iso_gcode/linuxcnc_fanuc_subs/11-main-program-oword__test-legal-end-main-with-percent.ngc": "o-word control flow",
+    "iso_gcode/linuxcnc_fanuc_subs/12-M99-endless-main-program__test.ngc": "o-word control flow",
+    "iso_gcode/linuxcnc_fanuc_subs/13-named-program__test-named.ngc": "o-word control flow",
+    "iso_gcode/linuxcnc_fanuc_subs/14-o-expression-call__test.ngc": "o-word control flow",
+    "iso_gcode/linuxcnc_interp_oracle/ccomp__lathe-comp/test.ngc": "cutter compensation G41",
+    "iso_gcode/linuxcnc_interp_oracle/ccomp__mill-line-arc-entry/test.ngc": "cutter compensation G41",
+    "iso_gcode/linuxcnc_interp_oracle/ccomp__mill-zchanges/test.ngc": "cutter compensation G41",
+    "iso_gcode/linuxcnc_interp_oracle/interp__cam-nisley/cam.ngc": "cutter compensation G42",
+    "iso_gcode/linuxcnc_interp_oracle/interp__do-while-break/bug.ngc": "o-word control flow",
+    "iso_gcode/linuxcnc_interp_oracle/interp__do-while-break/test.ngc": "o-word control flow",
+    "iso_gcode/linuxcnc_interp_oracle/interp__g10__g10-l1-l10/test.ngc": "tool table change G10 L1/L10/L11",
+    "iso_gcode/linuxcnc_interp_oracle/interp__g81/g17-g98-g81.ngc": "canned cycle G81",
+    "iso_gcode/linuxcnc_interp_oracle/interp__g81/g17-g99-g81.ngc": "canned cycle G81",
+    "iso_gcode/linuxcnc_interp_oracle/interp__g81/g18-g98-g81.ngc": "canned cycle G81",
+    "iso_gcode/linuxcnc_interp_oracle/interp__g81/g18-g99-g81.ngc": "canned cycle G81",
+    "iso_gcode/linuxcnc_interp_oracle/interp__g81/g19-g98-g81.ngc": "canned cycle G81",
+    "iso_gcode/linuxcnc_interp_oracle/interp__g81/g19-g99-g81.ngc": "canned cycle G81",
+    "iso_gcode/linuxcnc_interp_oracle/interp__inverse-time-with-comp/inverse.ngc": "o-word control flow",
+    "iso_gcode/linuxcnc_interp_oracle/interp__rotation__abs-pts/test.ngc": "o-word control flow",
+}
+
+# file name -> why rs274 refuses a program that ncpp reads
+RS274_ONLY_REFUSES = {
+    "iso_gcode/camotics/botomata_bottom.nc": "the oracle's tool table holds only T1; ncpp does not read tool tables (T2 M6)",
+    "iso_gcode/linuxcnc/large/130207LZW.ngc": "the oracle's rs274 build has no U V W axes; ncpp moves W like the other axes",
+    "iso_gcode/linuxcnc/large/impeller-7bl-xyzac.ngc": "M428 is a machine's own M code (> 199), which rs274 refuses; ncpp passes M codes through",
+}
+
+
+@functools.lru_cache(maxsize=None)
+def rs274(path: str) -> tuple[str, str]:
+    """rs274's (canonical calls, messages) for a program, cached for this test session only."""
+    try:
+        proc = subprocess.run([str(RS274), path], capture_output=True, text=True, errors="replace", timeout=300, stdin=subprocess.DEVNULL)
+    except (OSError, subprocess.TimeoutExpired) as err:
+        pytest.skip(f"rs274 oracle unavailable: {err}")
+    if "executing" not in proc.stderr:
+        pytest.skip(f"rs274 oracle did not run: {proc.stderr.strip()[:200]}")
+    return proc.stdout, proc.stderr
+
+
+def rs274_error(messages: str) -> tuple[str, str] | None:
+    """(message, source text) of the error rs274 stopped at, if any (rs274 prints both on stderr)."""
+    lines = [line for line in messages.splitlines() if line.strip() and line != "executing"]
+    if len(lines) < 2 or lines[0] == EOF_NOTE:
+        return None
+    return lines[0], lines[1]
+
+
+def ours(path) -> tuple[list[CanonCall], NcppError | None, str]:
+    stream = io.StringIO()
+    calls: list[CanonCall] = []
+    error = None
+    with open(path, "rb") as f:
+        try:
+            for event in interpret(parse_stream(f, str(path)), file=str(path), warnings=Warnings(stream=stream)):
+                call = canon_call(event)
+                if call is not None:
+                    calls.append(call)
+        except NcppError as err:
+            error = err
+    return calls, error, stream.getvalue()
+
+
+def assert_same_moves(path, reference: list[CanonCall], mine: list[CanonCall]) -> None:
+    for index, (want, got) in enumerate(zip(reference, mine)):
+        same = want.name == got.name and all(abs(a - b) <= TOLERANCE for a, b in zip(want.args, got.args))
+        assert same, f"{corpus_id(path)}: move {index + 1}: rs274 {want} but ncpp {got}"
+
+
+@pytest.mark.parametrize("path", PROGRAMS, ids=corpus_id)
+def test_motion_agrees_with_linuxcnc(path):
+    calls, messages = rs274(str(path))
+    reference = read_canon(calls)
+    refused = rs274_error(messages)
+    mine, error, warning = ours(path)
+    name = corpus_id(path)
+    assert_same_moves(path, reference, mine)
+    if warning:
+        assert name in OUT_OF_SCOPE, f"{corpus_id(path)} left the interpreter's scope but is not listed: {warning}"
+        assert OUT_OF_SCOPE[name] in warning, warning
+        return
+    assert name not in OUT_OF_SCOPE, f"{corpus_id(path)} is listed as out of scope but is interpreted"
+    if refused is None:
+        assert error is None, f"rs274 accepts {corpus_id(path)} but ncpp refuses it: {error}"
+        assert name not in RS274_ONLY_REFUSES
+        assert len(mine) == len(reference), f"{corpus_id(path)}: rs274 made {len(reference)} moves, ncpp {len(mine)}"
+        return
+    message, source = refused
+    if error is not None:
+        block_text = _line_text(path, error.where.line)
+        assert block_text.strip() == source.strip(), f"rs274 refused {source!r} ({message}), ncpp {error}"
+        assert len(mine) == len(reference)
+        return
+    assert name in RS274_ONLY_REFUSES, f"rs274 refuses {corpus_id(path)} ({message} at {source!r}), ncpp does not"
+    assert len(mine) >= len(reference)
+
+
+def _line_text(path, line: int) -> str:
+    return path.read_bytes().decode("latin-1").splitlines()[line - 1]
+
+
+def test_every_listed_file_exists():
+    names = {corpus_id(p) for p in PROGRAMS}
+    assert set(OUT_OF_SCOPE) <= names and set(RS274_ONLY_REFUSES) <= names
