@@ -44,7 +44,7 @@ class ErrorSource:
 
         machine = load_machine(path)
         limits = {a: lim for a, lim in machine.limits.items()}
-        return cls(machine, Path(path).name, _digest(path), machine.max_correction_mm, limits)
+        return cls(MachineMap(machine), Path(path).name, _digest(path), machine.max_correction_mm, limits)
 
     @classmethod
     def from_measurement(cls, path: str) -> "ErrorSource":
@@ -64,6 +64,17 @@ class ErrorSource:
 
 
 @dataclass(frozen=True, eq=False)
+class MachineMap:
+    """A machine as compensation sees it: geometry plus its position-only effects
+    (backlash, servo lag and spikes depend on the motion and are left to the control)."""
+
+    machine: object
+
+    def deviation(self, P, direction=None):
+        return self.machine.static_deviation(P, direction)
+
+
+@dataclass(frozen=True, eq=False)
 class ShiftedMap:
     """An error map evaluated at program position + work offset."""
 
@@ -72,9 +83,6 @@ class ShiftedMap:
 
     def deviation(self, P, direction=None):
         return self.model.deviation(np.asarray(P, dtype=float) + self.shift, direction)
-
-    def __getattr__(self, name):  # effects, simulate, ...: the underlying machine's
-        return getattr(self.model, name)
 
 
 def _digest(path: str) -> str:
@@ -129,6 +137,19 @@ def with_header(lines: Iterable[str], header: str, writer: IsoWriter) -> Iterato
     yield from it
 
 
+def make_context(source: ErrorSource, tolerance: float, warnings: Warnings, file: str) -> PassContext:
+    """The pass context every front end (filter, compensate, post) compensates with."""
+    return PassContext(
+        model=source.model,
+        tolerance=tolerance,
+        max_correction=source.max_correction,
+        limits=source.limits,
+        directional=is_directional(source.model, source.limits),
+        warnings=warnings,
+        file=file,
+    )
+
+
 def process(
     stream: BinaryIO,
     out: BinaryIO,
@@ -154,15 +175,7 @@ def process(
     if source is None:
         lines: Iterable[str] = (event.block.text for event in _first_per_block(events))
     else:
-        ctx = PassContext(
-            model=source.model,
-            tolerance=tolerance,
-            max_correction=source.max_correction,
-            limits=source.limits,
-            directional=is_directional(source.model, source.limits),
-            warnings=warnings,
-            file=file,
-        )
+        ctx = make_context(source, tolerance, warnings, file)
         lines = with_header(writer.write(run_passes(events, ctx, PASSES)), header_text(source, tolerance), writer)
     for line in lines:
         out.write(line.encode("latin-1"))

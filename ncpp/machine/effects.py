@@ -57,6 +57,9 @@ class Effect:
     """Base: dict round trip and the shared `apply` signature."""
 
     kind: ClassVar[str]
+    # True when the effect depends on position alone (not on time, feed or the
+    # direction of travel): compensation can cancel it like a geometric error.
+    static: ClassVar[bool] = False
 
     def apply(self, trajectory: Trajectory, machine: "Machine | None" = None) -> NDArray:
         raise NotImplementedError
@@ -99,6 +102,7 @@ def _zeros(trajectory: Trajectory) -> NDArray:
 @dataclass(frozen=True)
 class Scale(Effect):
     kind: ClassVar[str] = "scale"
+    static: ClassVar[bool] = True
     axis: str
     um_per_m: float
     ref_mm: float = 0.0
@@ -238,6 +242,7 @@ class ServoMismatch(Effect):
 @dataclass(frozen=True)
 class Squareness(Effect):
     kind: ClassVar[str] = "squareness"
+    static: ClassVar[bool] = True
     plane: str
     um_per_m: float
 
@@ -255,6 +260,7 @@ class Squareness(Effect):
 @dataclass(frozen=True)
 class Straightness(Effect):
     kind: ClassVar[str] = "straightness"
+    static: ClassVar[bool] = True
     axis: str
     direction: str
     um: float
@@ -282,6 +288,7 @@ class Straightness(Effect):
 @dataclass(frozen=True)
 class Cyclic(Effect):
     kind: ClassVar[str] = "cyclic"
+    static: ClassVar[bool] = True
     axis: str
     um: float
     period_mm: float
@@ -303,6 +310,7 @@ class Cyclic(Effect):
 @dataclass(frozen=True)
 class Angular(Effect):
     kind: ClassVar[str] = "angular"
+    static: ClassVar[bool] = True
     component: str
     urad_per_m: float
     ref_mm: float = 0.0

@@ -196,6 +196,27 @@ class Machine:
         tables (None or 0: the mean of the + and − tables)."""
         return self._blockwise(exact_deviation, P, direction)
 
+    def static_deviation(self, P: ArrayLike, direction: ArrayLike | None = None) -> NDArray:
+        """Geometric deviation plus the effects that depend on position alone
+        (scale, squareness, straightness, cyclic, angular), mm: what
+        compensation can cancel.  A straightness bow without `range_mm` spans
+        the axis travel."""
+        from ncpp.machine.trajectory import Trajectory
+
+        pts = as_points(P)
+        total = self.deviation(pts, direction)
+        static = [e for e in self.effects if e.static]
+        if static and len(pts):
+            padded = pts if len(pts) >= 2 else np.vstack([pts, pts])
+            trajectory = Trajectory(padded, 1000.0)
+            for effect in static:
+                if effect.kind == "straightness" and effect.range_mm is None:
+                    lo, hi = self.limits.get(effect.axis, (-math.inf, math.inf))
+                    if math.isfinite(lo) and math.isfinite(hi):
+                        effect = dataclasses.replace(effect, range_mm=(lo, hi))
+                total = total + effect.apply(trajectory, machine=self)[: len(pts)]
+        return _shaped_like(total, P)
+
     def deviation_linear(self, P: ArrayLike, direction: ArrayLike | None = None) -> NDArray:
         """First-order deviation (thesis eqs. 28–30), mm."""
         return self._blockwise(linear_deviation, P, direction)
