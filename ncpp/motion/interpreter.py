@@ -329,7 +329,8 @@ class Interpreter:
         for value, item in mcodes.items():  # subprogram calls use words (L, P) of their own
             if value in OUT_OF_SCOPE_M:
                 raise _OutOfScope(OUT_OF_SCOPE_M[value], item.start + 1)
-        motion = self._motion_to_be(block, mode0, mode1, mode1_item, axis_item)
+        tool_axes = gcodes.get(8, (None,))[0] == 43.1  # G43.1's axis words are offsets, not a move
+        motion = self._motion_to_be(block, 43.1 if tool_axes and mode0 is None else mode0, mode1, mode1_item, axis_item)
         self._check_words(block, words, gcodes, mcodes, motion, mode0, mode0_item, mode1_item)
         self._check_scope(words, gcodes)
 
@@ -368,7 +369,7 @@ class Interpreter:
 
     # -- checks (interp_check.cc, enhance_block) ----------------------------------------
     def _motion_to_be(self, block, mode0, mode1, mode1_item, axis_item) -> float | None:
-        covets_axes = mode0 in (10.0, 28.0, 30.0, 52.0, 92.0)
+        covets_axes = mode0 in (10.0, 28.0, 30.0, 52.0, 92.0, 43.1)
         if mode1 is not None:
             if mode1 == 80.0:
                 if axis_item is not None and not covets_axes:
