@@ -179,7 +179,8 @@ def _circle_traces(machine, commanded: SampledPath, nominal: SampledPath, feed_e
         actual = _actual(machine, commanded.points, commanded.feed, feed_effects)[cut]
         rel = actual - centre
         r = np.hypot(rel[:, i], rel[:, j])
-        on_circle = (np.abs(r - radius) < 0.05) & (np.abs(rel[:, 3 - i - j]) < 1e-3 + np.ptp(rel[:, 3 - i - j]))
+        near = 0.05  # mm: the tool within this of the nominal circle is on it (errors are µm)
+        on_circle = (np.abs(r - radius) < near) & (np.abs(rel[:, 3 - i - j]) < near)
         if on_circle.sum() < 8:
             continue
         angle = np.degrees(np.arctan2(rel[on_circle, j], rel[on_circle, i])) % 360.0

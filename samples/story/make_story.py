@@ -9,8 +9,10 @@ Writes into samples/story/:
   diagnosis.txt            the account `ncpp diagnose` prints
   diagnosis.json           its report;  diagnosis.png  its plot
   updated_model.toml       the cold model plus the effect the diagnosis added
-  compensation.txt         simulated contour error of a circle on the warm machine:
-                           uncompensated, compensated with the cold model, with the updated model
+  warm_machine.toml        the simulated truth (the virtual machine the circle runs on)
+  circle.ngc, circle_*.ngc a circle program and its compensations (`ncpp compensate`)
+  compensation.txt         `ncpp simulate` of each on the warm machine: contour error and
+                           circularity, uncompensated, with the cold model, with the updated model
 
 The "real" machine is simulated: the HR5B sample's geometry (cold) plus, once
 warm, thermal growth of X = 25 µm/m (a `scale` effect from the X reference).
@@ -20,6 +22,7 @@ from __future__ import annotations
 
 import contextlib
 import io
+import json
 from pathlib import Path
 
 import numpy as np
@@ -29,7 +32,7 @@ from ncpp.fileio import write_text_atomic
 from ncpp.identify.fit import fit_machine
 from ncpp.instruments.files import read_measurement, write_measurement
 from ncpp.instruments.forward import predict_ballbar, predict_laser
-from ncpp.machine import Machine, Trajectory, load_machine, save_machine
+from ncpp.machine import Machine, load_machine, save_machine
 from ncpp.machine.effects import Scale
 
 HERE = Path(__file__).resolve().parent
@@ -66,37 +69,43 @@ def ballbar_files(warm: Machine) -> list[Path]:
     return paths
 
 
-class WithEffects:
-    """The model as an error map for compensation, its position-only effects
-    (scale, squareness, straightness, cyclic, angular) included.  (`ncpp
-    compensate` uses `Machine.deviation`, which leaves [[effects]] out.)"""
-
-    STATIC = ("scale", "squareness", "straightness", "cyclic", "angular")
-
-    def __init__(self, machine: Machine) -> None:
-        self.machine = machine
-
-    def deviation(self, P, direction=None):
-        d = self.machine.deviation(P, direction)
-        trajectory = Trajectory(np.atleast_2d(P), 1000.0)
-        for e in self.machine.effects:
-            if e.kind in self.STATIC:
-                d = d + e.apply(trajectory, self.machine)
-        return d
+CIRCLE = """%
+(ncpp story: XY circle R150 about the program zero, placed at the ball-bar centre)
+G21 G17 G90
+G0 X150. Y0. Z0.
+G1 F1000.
+G3 X150. Y0. I-150. J0.
+G0 Z10.
+M2
+%
+"""
 
 
-def contour_error(warm: Machine, model: Machine | None) -> float:
-    """Max radial error (µm) of an XY circle R150 cut on the warm machine with
-    commands compensated by `model` (None: not compensated)."""
-    wanted = Trajectory.circle("XY", CENTRE, 150.0, "CCW", 1000.0, step_deg=1.0).positions
-    command = wanted.copy()
-    if model is not None:
-        emap = WithEffects(model)
-        for _ in range(3):  # C <- P − E(C): E is microns
-            command = wanted - emap.deviation(command)
-    actual = warm.simulate(Trajectory(command, 1000.0))
-    radial = np.linalg.norm((actual - np.asarray(CENTRE))[:, :2], axis=1) - 150.0
-    return float(np.ptp(radial) * 1e3)
+def run_quietly(*args: str) -> str:
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        assert main(list(args)) == 0
+    return out.getvalue()
+
+
+def contour_errors(models: dict[str, Path]) -> list[tuple[str, dict]]:
+    """The circle program compensated with each model (`ncpp compensate`) and run
+    on the warm machine (`ncpp simulate`): its contour error against the circle."""
+    offset = ",".join(f"{v:g}" for v in CENTRE)
+    program = HERE / "circle.ngc"
+    write_text_atomic(program, CIRCLE)
+    rows = []
+    for label, model in models.items():
+        target = program
+        if model is not None:
+            target = HERE / f"circle_{model.stem}.ngc"
+            run_quietly("compensate", "--machine", str(model), "--work-offset", offset, str(program), "-o", str(target))
+        report = HERE / "simulate.json"
+        run_quietly("simulate", "--machine", str(HERE / "warm_machine.toml"), "--work-offset", offset,
+                    "--reference", str(program), str(target), "--json", str(report))  # fmt: skip
+        rows.append((label, json.loads(report.read_text())))
+        report.unlink()
+    return rows
 
 
 def main_story() -> None:
@@ -119,14 +128,18 @@ def main_story() -> None:
     for name in ("diagnosis.json", "updated_model.toml"):
         path = HERE / name
         write_text_atomic(path, path.read_text().replace(str(HERE) + "/", "").replace(str(ROOT) + "/", ""))
-    updated = load_machine(HERE / "updated_model.toml")
-    rows = [
-        ("not compensated", contour_error(warm, None)),
-        ("compensated with the cold model", contour_error(warm, model)),
-        ("compensated with the updated model", contour_error(warm, updated)),
-    ]
-    table = "XY circle R150 on the warm machine, radial error range (µm)\n" + "".join(
-        f"  {label:<38} {value:6.2f}\n" for label, value in rows
+    save_machine(warm.replace(name="HR5B warm (the simulated truth)"), HERE / "warm_machine.toml")
+    rows = contour_errors(
+        {
+            "not compensated": None,
+            "compensated with the cold model": HERE / "cold_model.toml",
+            "compensated with the updated model": HERE / "updated_model.toml",
+        }
+    )
+    table = "circle.ngc (XY R150) run on the warm machine: contour error and circularity (µm)\n" + "".join(
+        f"  {label:<38} max {r['contour_error_max_um']:6.2f}  rms {r['contour_error_rms_um']:6.2f}"
+        f"  circularity {r['circles'][0]['circularity_um']:6.2f}\n"
+        for label, r in rows
     )
     write_text_atomic(HERE / "compensation.txt", table)
     print(text)
