@@ -82,3 +82,32 @@ def test_cli_error_has_location_no_traceback_and_no_output(tmp_path):
     assert not target.exists()
     proc = subprocess.run([sys.executable, "-m", "ncpp"], input=bad.read_bytes(), capture_output=True)
     assert proc.returncode != 0 and proc.stdout == b""
+
+
+# Programs LinuxCNC's interpreter refuses too (rs274 prints the same error):
+# `ncpp` refuses them rather than pass a program it cannot make sense of.
+REFUSED_LIKE_LINUXCNC = {
+    "iso_gcode/cncjs/Circle_Diamond_Square_Calibration.gcode": "Radius to end of arc differs",
+    "iso_gcode/freecad_grbl/drilltest01.nc": "K word given for arc in xy plane",
+    "iso_gcode/freecad_grbl/platteyz-pass-1-profile.nc": "K word given for arc in xy plane",
+    "iso_gcode/cncjs/full-circle-without-xyz.gcode": "R i j k words all missing for arc",
+    "iso_gcode/cncjs_toolpath_fixtures/arc-r.nc": "R i j k words all missing for arc",
+    "iso_gcode/cncjs_toolpath_fixtures/g92offset.nc": "All axes missing with g52 or g92",
+}
+
+
+@pytest.mark.parametrize("path", corpus_files(*ISO_FOLDERS), ids=corpus_id)
+def test_ncpp_command_passes_corpus_program_through_unchanged(path, tmp_path, capsys):
+    """The whole filter (parse, interpret, write), in-process: byte for byte, or a located refusal."""
+    from ncpp.cli import main
+
+    out = tmp_path / "out"
+    status = main([str(path), "-o", str(out)])
+    expected = REFUSED_LIKE_LINUXCNC.get(corpus_id(path))
+    if expected is None:
+        assert status == 0, capsys.readouterr().err
+        assert out.read_bytes() == path.read_bytes()
+    else:
+        err = capsys.readouterr().err
+        assert status != 0 and expected in err and err.startswith(f"{path}:")
+        assert not out.exists()
