@@ -24,6 +24,7 @@ COMMANDS: tuple[str, ...] = (
     "fit",
     "diagnose",
     "export_table",
+    "post",
 )
 
 DEFAULT_COMMAND = "filter"

@@ -1,0 +1,87 @@
+"""The CL-data postprocessor: APT CL data -> events -> compensation passes -> NC.
+
+    post(stream, out, file="part.cls", dialect="heidenhain", source=ErrorSource...)
+
+The events are the ones the NC interpreter makes (`ncpp.cldata.motion`), run
+through the same pass tuple as the filter (`ncpp.pipeline.make_context`), and
+written by a generator per dialect that writes whole programs from scratch
+(`ncpp.post.iso`, `.heidenhain`, `.sinumerik`).
+"""
+
+from __future__ import annotations
+
+from typing import BinaryIO, Callable, Iterable, Iterator, TextIO
+
+from ncpp.cldata import Record, motion, read_cldata
+from ncpp.errors import NcppError, Warnings
+from ncpp.motion.segments import Event
+from ncpp.post.generator import Generator
+from ncpp.post.heidenhain import HeidenhainGenerator
+from ncpp.post.iso import FanucGenerator, IsoGenerator, LinuxCncGenerator
+from ncpp.post.sinumerik import SinumerikGenerator
+
+GENERATORS: dict[str, type[Generator]] = {
+    "iso": IsoGenerator,
+    "linuxcnc": LinuxCncGenerator,
+    "fanuc": FanucGenerator,
+    "heidenhain": HeidenhainGenerator,
+    "sinumerik": SinumerikGenerator,
+}
+
+
+class _RecordIndex:
+    """Remembers the non-motion records by line so the generator can spell them;
+    an entry leaves when its event is written, so memory stays bounded."""
+
+    def __init__(self, progress: Callable[[int], None] | None = None):
+        self.by_line: dict[int, Record] = {}
+        self.progress = progress
+        self.count = 0
+
+    def watch(self, records: Iterable[Record]) -> Iterator[Record]:
+        for record in records:
+            self.count += 1
+            if self.progress is not None and self.count % 1000 == 0:
+                self.progress(self.count)
+            if record.major != "GOTO":
+                self.by_line[record.line] = record
+            yield record
+
+    def __call__(self, event: Event) -> Record | None:
+        return self.by_line.pop(event.block.line, None)
+
+
+def post(
+    stream: TextIO,
+    out: BinaryIO,
+    *,
+    file: str = "<stdin>",
+    dialect: str = "iso",
+    source=None,
+    tolerance: float = 0.001,
+    warnings: Warnings | None = None,
+    progress: Callable[[int], None] | None = None,
+) -> int:
+    """Post one CL file as a `dialect` program (compensated when `source` is an
+    `ncpp.pipeline.ErrorSource`); returns the number of lines written."""
+    from ncpp.passes import PASSES, run_passes
+    from ncpp.pipeline import header_text, make_context
+
+    if dialect not in GENERATORS:
+        raise NcppError(f"unknown dialect {dialect!r} (known: {', '.join(GENERATORS)})")
+    warnings = warnings or Warnings()
+    index = _RecordIndex(progress)
+    events: Iterable[Event] = motion(index.watch(read_cldata(stream, file)), warnings)
+    header = None
+    if source is not None:
+        events = run_passes(events, make_context(source, tolerance, warnings, file), PASSES)
+        header = header_text(source, tolerance)
+    generator = GENERATORS[dialect](warnings, header, file)
+    written = 0
+    for line in generator.write(events, index):
+        out.write((line + "\n").encode("latin-1", errors="replace"))
+        written += 1
+    return written
+
+
+__all__ = ["GENERATORS", "Generator", "post"]

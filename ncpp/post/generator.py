@@ -1,0 +1,247 @@
+"""The part every dialect's generator shares: walking the events, keeping the
+modal state, and turning CL set-up records into machine functions.
+
+A generator writes complete programs from scratch (no source blocks to keep):
+`Generator.write(events, setup)` yields NC lines; `setup(event)` returns the
+CL `Record` behind a non-motion event (tool, spindle, coolant, comments) or
+None.  Subclasses say how each thing is spelled in their dialect.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass
+from typing import Callable, Iterable, Iterator
+
+from ncpp.cldata.reader import Record
+from ncpp.errors import Location, NcppError, Warnings
+from ncpp.motion.segments import PLANE_AXES, Arc, Event, Line, Pass, Point, replace
+
+SetupLookup = Callable[[Event], "Record | None"]
+# Records that only set the interpretation of later motion: nothing to write.
+SILENT = frozenset("FROM RAPID FEDRAT CIRCLE MULTAX TLAXIS INDIRV MACHIN UNITS PARTNO GOHOME GOTO".split())
+COOLANT = {"ON": 8, "FLOOD": 8, "MIST": 7, "OFF": 9}
+
+
+@dataclass
+class Job:
+    """What the program header needs, gathered from the records before the first motion."""
+
+    name: str = "NCPP"
+    inch: bool = False
+    header: str | None = None  # the ncpp compensation header, when compensated
+
+
+def number(value: float, decimals: int, keep_point: bool = False) -> str:
+    """`value` with at most `decimals` places, trailing zeros dropped ("12.5", "12" or "12.")."""
+    text = f"{value:.{decimals}f}".rstrip("0")
+    if text in ("-.", "-0.", "."):
+        text = "0."
+    text = text.removeprefix("-") if float(text) == 0 else text
+    return text if keep_point else text.rstrip(".")
+
+
+def single_turns(arc: Arc) -> Iterator[Arc]:
+    """The arc as pieces that turn at most once (Fanuc, Heidenhain and Sinumerik
+    have no turn count word); a helix keeps its pitch."""
+    turns = abs(arc.turn)
+    if turns <= 1:
+        yield arc
+        return
+    i, j, n = PLANE_AXES[arc.context.plane]
+    sweep = abs(arc.sweep())
+    rise = arc.end[n] - arc.start[n]
+    start = arc.start
+    for k in range(1, turns):
+        end = list(start)
+        end[n] = arc.start[n] + rise * (2 * math.pi * k) / sweep
+        piece_end: Point = (end[0], end[1], end[2])
+        centre = list(arc.center)
+        centre[n] = start[n]
+        yield replace(arc, start=start, end=piece_end, center=(centre[0], centre[1], centre[2]), turn=1 if arc.turn > 0 else -1)
+        start = piece_end
+    centre = list(arc.center)
+    centre[n] = start[n]
+    yield replace(arc, start=start, center=(centre[0], centre[1], centre[2]), turn=1 if arc.turn > 0 else -1)
+
+
+def program_name(text: str, default: str = "NCPP") -> str:
+    """A program name every control accepts: letters, digits, `_`, at most 24 characters."""
+    name = re.sub(r"[^A-Za-z0-9_]+", "_", text.strip()).strip("_")[:24]
+    return name or default
+
+
+class Generator:
+    """Base generator; a dialect overrides the `emit_*` spellings."""
+
+    decimals_mm = 4
+    decimals_inch = 5
+
+    def __init__(self, warnings: Warnings | None = None, header: str | None = None, file: str = "<stdin>"):
+        self.warnings = warnings or Warnings()
+        self.file = file
+        self.job = Job(header=header)
+        self.cycle_feed: float | None = None  # the feed a vendor CYCLE/ record names
+        self.position: list[str | None] = [None, None, None]  # coordinate text last written per axis
+        self.feed: float | None = None
+        self.tool: int | None = None
+
+    # -- the stream -------------------------------------------------------------
+    def write(self, events: Iterable[Event], setup: SetupLookup) -> Iterator[str]:
+        it = iter(events)
+        prelude: list[tuple[Event, Record | None]] = []
+        first_motion: Event | None = None
+        for event in it:
+            record = setup(event)
+            if type(event) is Pass and (record is None or record.major in ("PARTNO", "UNITS", "MACHIN", "$$")):
+                self._absorb(record)
+                prelude.append((event, record))
+                continue
+            first_motion = event
+            first_record = record
+            break
+        yield from self.emit_header()
+        for event, record in prelude:
+            yield from self._event(event, record)
+        if first_motion is not None:
+            yield from self._event(first_motion, first_record)
+            for event in it:
+                yield from self._event(event, setup(event))
+        yield from self.emit_footer()
+
+    def _absorb(self, record: Record | None) -> None:
+        if record is None:
+            return
+        if record.major == "PARTNO" and record.args:
+            self.job.name = program_name(str(record.args[0]), self.job.name)
+        elif record.major == "UNITS":
+            self.job.inch = bool(record.words) and record.words[0].startswith("INCH")
+
+    def _event(self, event: Event, record: Record | None) -> Iterator[str]:
+        if type(event) is Line:
+            yield from self.emit_line(event)
+        elif type(event) is Arc:
+            for piece in single_turns(event):
+                yield from self.emit_arc(piece)
+        elif record is not None:
+            yield from self._setup(record)
+
+    def _setup(self, rec: Record) -> Iterator[str]:
+        major = rec.major
+        if major in SILENT:
+            if major == "PARTNO" and rec.args:
+                yield from self.emit_comment(f"PARTNO {rec.args[0]}")
+            return
+        if major == "$$":
+            text = str(rec.args[0]) if rec.args else ""
+            if text:
+                yield from self.emit_comment(text)
+        elif major in ("LOADTL", "LOAD"):
+            numbers = rec.numbers
+            if numbers:
+                self.tool = int(numbers[0])
+                yield from self.emit_tool(self.tool)
+        elif major == "SPINDL":
+            yield from self._spindle(rec)
+        elif major == "COOLNT":
+            mode = rec.words[0] if rec.words else "ON"
+            if mode in COOLANT:
+                yield from self.emit_m(COOLANT[mode])
+            else:
+                self.warnings.warn(f"COOLNT/{mode} has no machine function; passed through as a comment", rec.where)
+                yield from self.emit_comment(_one_line(rec.text))
+        elif major == "CUTTER":
+            yield from self.emit_comment("CUTTER " + ", ".join(f"{v:g}" for v in rec.numbers))
+        elif major in ("PPRINT", "REMARK", "TITLE", "OPERATOR"):
+            yield from self.emit_comment(" ".join(str(a) for a in rec.args))
+        elif major == "INSERT":
+            yield " ".join(str(a) for a in rec.args)  # APT: literal NC text for the control
+        elif major == "STOP":
+            yield from self.emit_m(0)
+        elif major == "OPSTOP":
+            yield from self.emit_m(1)
+        elif major in ("FINI", "END"):
+            return  # the footer ends the program
+        elif major == "CYCLE":
+            self.cycle_feed = None if "OFF" in rec.words else _named_number(rec, ("MMPM", "IPM"))
+            yield from self.emit_comment(_one_line(rec.text))
+        else:  # vendor words: ncpp.cldata.motion has warned already
+            yield from self.emit_comment(_one_line(rec.text))
+
+    def _spindle(self, rec: Record) -> Iterator[str]:
+        words = rec.words
+        if "OFF" in words:
+            yield from self.emit_m(5)
+            return
+        numbers = rec.numbers
+        if not numbers:
+            if "ON" in words:
+                yield from self.emit_m(3)
+            return
+        yield from self.emit_spindle(numbers[0], "CCLW" not in words)
+
+    # -- helpers for dialects ----------------------------------------------------
+    @property
+    def decimals(self) -> int:
+        return self.decimals_inch if self.job.inch else self.decimals_mm
+
+    def moved_axes(self, end: Point, always: str = "") -> list[tuple[str, str]]:
+        """(letter, text) of the axes whose written coordinate changes (and `always`)."""
+        words = []
+        for k, letter in enumerate("XYZ"):
+            text = self.coordinate(end[k])
+            if text != self.position[k] or letter in always:
+                words.append((letter, text))
+                self.position[k] = text
+        return words
+
+    def coordinate(self, value: float) -> str:
+        return number(value, self.decimals)
+
+    def feed_of(self, segment: Line | Arc) -> float:
+        """The segment's feed; under a vendor CYCLE/ (whose GOTOs are posted as
+        feed moves to the hole tops, not as drilling) the cycle's own feed."""
+        if segment.feed > 0:
+            return segment.feed
+        if self.cycle_feed:
+            return self.cycle_feed
+        raise NcppError("a feed move before any FEDRAT: the CL data gives no feed rate", Location(self.file, segment.block.line, 1))
+
+    # -- what dialects spell -------------------------------------------------------
+    def emit_header(self) -> Iterator[str]:
+        raise NotImplementedError
+
+    def emit_footer(self) -> Iterator[str]:
+        raise NotImplementedError
+
+    def emit_comment(self, text: str) -> Iterator[str]:
+        raise NotImplementedError
+
+    def emit_line(self, line: Line) -> Iterator[str]:
+        raise NotImplementedError
+
+    def emit_arc(self, arc: Arc) -> Iterator[str]:
+        raise NotImplementedError
+
+    def emit_tool(self, tool: int) -> Iterator[str]:
+        raise NotImplementedError
+
+    def emit_spindle(self, rpm: float, clockwise: bool) -> Iterator[str]:
+        raise NotImplementedError
+
+    def emit_m(self, code: int) -> Iterator[str]:
+        raise NotImplementedError
+
+
+def _named_number(rec: Record, names: tuple[str, ...]) -> float | None:
+    """The number after the first of `names` among the record's arguments (`MMPM, 50`)."""
+    args = rec.args
+    for k, arg in enumerate(args[:-1]):
+        if arg in names and isinstance(args[k + 1], float):
+            return args[k + 1]
+    return None
+
+
+def _one_line(text: str) -> str:
+    return " ".join(part.strip().rstrip("$").strip() for part in text.splitlines())

@@ -1,0 +1,158 @@
+"""`ncpp post`: APT CL data of the corpus posted in every dialect, checked
+against LinuxCNC's interpreter and the dialect parsers."""
+
+from __future__ import annotations
+
+import io
+import math
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from ncpp.cldata import motion, read_cldata
+from ncpp.errors import NcppError, Warnings
+from ncpp.motion.segments import Arc, Context, Line
+from ncpp.post import GENERATORS, post
+from ncpp.post.generator import single_turns
+from ncpp.program.blocks import Block
+from tests.conftest import CORPUS, ROOT, corpus_files, corpus_id
+from tests.shop.rs274 import end_points, run_rs274
+
+CL_FILES = corpus_files("apt_cldata")
+MACHINE = ROOT / "samples/machines/hr5b.toml"
+OFFSET = (400.0, 350.0, 300.0)
+
+
+def posted(path, dialect: str, source=None) -> str:
+    out = io.BytesIO()
+    with open(path, encoding="latin-1") as stream:
+        post(stream, out, file=str(path), dialect=dialect, source=source, warnings=Warnings(stream=io.StringIO()))
+    return out.getvalue().decode("latin-1")
+
+
+def cl_end_points(path) -> list[tuple[float, float, float]]:
+    """End points of the CL motion (GOTOs, arcs collapsed to their last GOTO)."""
+    with open(path, encoding="latin-1") as stream:
+        events = list(motion(read_cldata(stream, str(path)), Warnings(stream=io.StringIO())))
+    return [e.end for e in events if type(e) in (Line, Arc)]
+
+
+def distinct(points, tol=1e-4):
+    """Points with repeats of the previous one removed (a zero-length move writes nothing)."""
+    kept = []
+    for p in points:
+        if not kept or max(abs(a - b) for a, b in zip(p, kept[-1])) > tol:
+            kept.append(p)
+    return kept
+
+
+def test_corpus_holds_cl_files():
+    assert len(CL_FILES) >= 4
+
+
+@pytest.mark.parametrize("dialect", tuple(GENERATORS))
+@pytest.mark.parametrize("path", CL_FILES, ids=corpus_id)
+def test_every_cl_file_posts_in_every_dialect(path, dialect):
+    text = posted(path, dialect)
+    moves = [ln for ln in text.splitlines() if any(w in ln.split() for w in ("G0", "G1", "L"))]
+    assert moves, "no motion written"
+    if dialect in ("heidenhain", "sinumerik"):
+        from ncpp.program.dialects import parse_program
+
+        name, blocks = parse_program(io.BytesIO(text.encode("latin-1")), "posted", dialect)
+        assert len(list(blocks)) == len(text.splitlines())
+
+
+@pytest.mark.parametrize("dialect", ("iso", "linuxcnc", "fanuc"))
+@pytest.mark.parametrize("path", CL_FILES, ids=corpus_id)
+def test_linuxcnc_runs_the_post_to_the_cl_end_points(path, dialect, tmp_path):
+    program = tmp_path / "posted.ngc"
+    program.write_text(posted(path, dialect))
+    got = distinct(end_points(run_rs274(program)))
+    want = distinct(cl_end_points(path))
+    assert len(got) == len(want)
+    assert np.abs(np.array(got) - np.array(want)).max() <= 1e-4
+
+
+def test_arcs_are_posted_as_arcs():
+    path = CORPUS / "apt_cldata/creo_ncl/profilfraesen_2.ncl.1"
+    circles = path.read_text(encoding="latin-1").count("CIRCLE")
+    iso = posted(path, "linuxcnc")
+    assert sum(" I" in ln and " J" in ln for ln in iso.splitlines()) == circles
+    klartext = posted(path, "heidenhain").splitlines()
+    cc = [n for n, ln in enumerate(klartext) if ln.split()[1] == "CC"]
+    assert len(cc) == circles
+    assert all(klartext[n + 1].split()[1] == "C" and klartext[n + 1].split()[-1] in ("DR-", "DR+") for n in cc)
+    assert klartext[0] == "0 BEGIN PGM MFG0004 MM" and klartext[-1].endswith("END PGM MFG0004 MM")
+    assert [int(ln.split()[0]) for ln in klartext] == list(range(len(klartext)))
+    sinumerik = posted(path, "sinumerik")
+    assert sum(" I" in ln and " J" in ln for ln in sinumerik.splitlines()) == circles and "\n; PARTNO MFG0004" in sinumerik
+
+
+@pytest.mark.parametrize("path", CL_FILES[:2] + CL_FILES[-1:], ids=corpus_id)
+def test_posted_with_a_machine_file_is_compensated(path, tmp_path):
+    from ncpp.pipeline import HEADER_TAG, ErrorSource
+
+    source = ErrorSource.from_machine_file(str(MACHINE)).shifted(OFFSET)
+    text = posted(path, "linuxcnc", source)
+    assert text.splitlines()[0].startswith(f"({HEADER_TAG} for hr5b.toml")
+    program = tmp_path / "compensated.ngc"
+    program.write_text(text)
+    got = np.array(end_points(run_rs274(program)))
+    want = np.array(distinct(cl_end_points(path)))
+    # Compensated lines may be subdivided: every CL end point is still reached, moved by the correction.
+    nearest = np.array([np.abs(got - w).max(axis=1).min() for w in want])
+    assert nearest.max() < 0.1  # within the machine's correction
+    assert nearest.max() > 1e-3  # and really moved (HR5B errors are tens of µm)
+
+
+def test_post_command_writes_a_file(tmp_path):
+    out = tmp_path / "part.h"
+    path = CORPUS / "apt_cldata/rybakov25/test.apt"
+    proc = subprocess.run(
+        [sys.executable, "-m", "ncpp", "post", str(path), "--dialect", "heidenhain", "-o", str(out)],
+        capture_output=True, text=True, cwd=ROOT,
+    )
+    assert proc.returncode == 0, proc.stderr
+    assert "DELAY/ is not understood; passed through as a comment" in proc.stderr
+    lines = out.read_text().splitlines()
+    assert lines[0] == "0 BEGIN PGM TEST_MACRO_LOAD MM"
+    assert any("; DELAY / 2.5" in ln for ln in lines)
+
+
+def test_changing_tool_vector_is_refused():
+    cl = "MULTAX\nFEDRAT / 100\nGOTO / 0, 0, 10, 0, 0, 1\nGOTO / 5, 0, 10, 0, 0.6, 0.8\nFINI\n"
+    with pytest.raises(NcppError, match="tool vector changes"):
+        post(io.StringIO(cl), io.BytesIO(), file="five.cls", dialect="iso")
+    constant = "MULTAX\nFEDRAT / 100\nGOTO / 0, 0, 10, 0, 0, 1\nGOTO / 5, 0, 10, 0, 0, 1\nFINI\n"
+    out = io.BytesIO()
+    post(io.StringIO(constant), out, dialect="iso")
+    assert out.getvalue().decode().splitlines()[3:5] == ["G1 X0. Y0. Z10. F100.", "X5."]
+
+
+def test_feed_move_without_feed_rate_is_refused():
+    with pytest.raises(NcppError, match="no feed rate"):
+        post(io.StringIO("GOTO / 0, 0, 10\nGOTO / 5, 0, 10\n"), io.BytesIO(), file="nofeed.cls", dialect="sinumerik")
+
+
+def test_error_stops_the_command_with_no_output(tmp_path):
+    bad = tmp_path / "bad.cls"
+    bad.write_text("FROM / 0, 0, 0\nCIRCLE / 0, 0, 0, 0, 0, 1, 5\nGOTO / 5, 0, 0\n")
+    out = tmp_path / "out.ngc"
+    proc = subprocess.run([sys.executable, "-m", "ncpp", "post", str(bad), "--dialect", "iso", "-o", str(out)], capture_output=True, text=True, cwd=ROOT)
+    assert proc.returncode == 2 and f"{bad}:2:1:" in proc.stderr
+    assert not out.exists()
+
+
+def test_multi_turn_helix_splits_into_single_turns_keeping_the_pitch():
+    block = Block(raw="", eol="\n", items=(), line=1)
+    helix = Arc(start=(5, 0, 0), end=(0, 5, -9), center=(0, 0, 0), turn=3, feed=100, block=block, context=Context())
+    pieces = list(single_turns(helix))
+    assert len(pieces) == 3 and all(p.turn == 1 for p in pieces)
+    assert pieces[-1].end == helix.end
+    total = sum(p.sweep() for p in pieces)
+    assert math.isclose(total, helix.sweep())
+    rises = [p.end[2] - p.start[2] for p in pieces]
+    assert all(math.isclose(r / p.sweep(), -9 / helix.sweep()) for r, p in zip(rises, pieces))
