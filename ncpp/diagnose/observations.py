@@ -28,12 +28,12 @@ from ncpp.instruments.files import PLANES, Measurement
 from ncpp.machine.components import AXES
 from ncpp.machine.effects import Effect
 from ncpp.machine.model import Machine
+from ncpp.instruments.forward import iso230_2_cycle
 from ncpp.machine.trajectory import Trajectory
 
 BALLBAR_STEP_DEG = 0.25  # simulation step; the file's angles are interpolated from it
 FEED_IN_DEG = 45.0  # lead-in and lead-out arcs of a ball-bar run
-OVERTRAVEL_MM = 5.0  # positioning cycle: beyond the last target before reversing
-DWELL_S = 0.5
+OVERTRAVEL_MM = 5.0  # positioning cycle: beyond the last target before reversing (as forward.py's default)
 ANGLES = ("pitch", "yaw", "roll")
 USED = ("ballbar", "laser", "comparator")
 
@@ -150,30 +150,6 @@ def _ballbar(machine: Machine, m: Measurement, name: str) -> Observation:
 
 
 # ------------------------------------------------------------- positioning
-def _cycle(axis: str, targets: NDArray, runs: int, both: bool, fixed: dict, feed: float):
-    """ISO 230-2 stop-and-go cycle (as the forward model): the trajectory, the
-    sample index of each reading (standstill) and its (target, run, direction)."""
-    lo, hi = targets[0] - OVERTRAVEL_MM, targets[-1] + OVERTRAVEL_MM
-    stops, labels = [lo], [None]
-    for run in range(1, runs + 1):
-        stops += list(targets)
-        labels += [(t, run, "+") for t in targets]
-        if both:
-            stops.append(hi)
-            labels.append(None)
-            stops += list(targets[::-1])
-            labels += [(t, run, "-") for t in targets[::-1]]
-        stops.append(lo)
-        labels.append(None)
-    values = np.repeat(np.asarray(stops, dtype=float), 3)
-    travel = np.abs(np.diff(values))
-    t = np.concatenate([[0.0], np.cumsum(np.where(travel > 0, travel / (feed / 60.0), DWELL_S))])
-    P = np.tile([fixed.get(a, 0.0) for a in AXES], (len(values), 1))
-    P[:, AXES.index(axis)] = values
-    at = np.array([3 * k + 1 for k, lab in enumerate(labels) if lab is not None])
-    return Trajectory(P, feed, t), at, [lab for lab in labels if lab is not None]
-
-
 def _component_index(m: Measurement) -> tuple[list[int], bool, str | None]:
     """Which deviation components the file reads, whether they are angles, and
     for angles the ISO component name."""
@@ -198,7 +174,7 @@ def _positioning(machine: Machine, m: Measurement, name: str) -> Observation:
     targets = np.unique(np.asarray(m["target_mm"], dtype=float))
     runs = int(np.max(m["run"]))
     both = set(m["direction"]) == {"+", "-"}
-    traj, at, labels = _cycle(axis, targets, runs, both, m.fixed, m.feed_mm_min or 1000.0)
+    traj, at, labels = iso230_2_cycle(axis, targets, runs, both, m.fixed, m.feed_mm_min or 1000.0, OVERTRAVEL_MM)
     key = {(round(t, 6), int(r), d): i for i, (t, r, d) in enumerate(labels)}
     sample = np.array([
         at[key[(round(float(t), 6), int(r), str(d))]] for t, r, d in zip(m["target_mm"], m["run"], m["direction"])

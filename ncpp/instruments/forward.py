@@ -145,7 +145,7 @@ def _rounded(values: NDArray, digits: int = 4) -> NDArray:
 
 
 # ------------------------------------------------------------- positioning cycles
-def _cycle(
+def iso230_2_cycle(
     axis: str, targets: NDArray, runs: int, bidirectional: bool, fixed: Mapping[str, float],
     feed_mm_min: float, overtravel_mm: float,
 ) -> tuple[Trajectory, NDArray, list[tuple[float, int, str]]]:
@@ -189,7 +189,7 @@ def _positioning_readings(
     m = functional_point(machine, offset_mm)
     if not effects:
         m = m.replace(effects=())
-    trajectory, at, labels = _cycle(axis, targets, runs, bidirectional, fixed, feed_mm_min, overtravel_mm)
+    trajectory, at, labels = iso230_2_cycle(axis, targets, runs, bidirectional, fixed, feed_mm_min, overtravel_mm)
     P = trajectory.positions[at]
     if angular:
         values = m.rotation(P, trajectory.directions()[at])
