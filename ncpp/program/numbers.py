@@ -1,8 +1,9 @@
 """Number style: write a new value the way the program writes its numbers.
 
-`X10.` `X010.500` `X.5` `X+1.25`: decimal places, trailing dot, leading zero
-before the point, zero padding and explicit plus sign are read from the
-number text as written, and `format_number` applies them to a new value.
+`X10.` `X010.500` `X.5` `X+1.25` `X+10,5`: decimal places, trailing dot,
+leading zero before the point, zero padding, explicit plus sign and decimal
+comma (Heidenhain) are read from the number text as written, and
+`format_number` applies them to a new value.
 """
 
 from __future__ import annotations
@@ -17,13 +18,15 @@ class NumberStyle:
     leading_zero: bool = True  # `0.5` rather than `.5`
     int_width: int = 0  # zero-padded integer digits (`X010.5` -> 3)
     plus_sign: bool = False
+    comma: bool = False  # `10,5`: a decimal comma instead of the point
 
     @classmethod
     def of(cls, number: str) -> "NumberStyle":
         """The style of a number as written (sign included, letter excluded)."""
         plus = number.startswith("+")
-        digits = number.lstrip("+-")
-        whole, dot, frac = digits.partition(".")
+        digits = number.lstrip("+-").lstrip(" \t")
+        comma = "," in digits
+        whole, dot, frac = digits.partition("," if comma else ".")
         padded = len(whole) > 1 and whole.startswith("0")
         return cls(
             decimals=len(frac),
@@ -31,13 +34,14 @@ class NumberStyle:
             leading_zero=bool(whole) or not dot,
             int_width=len(whole) if padded else 0,
             plus_sign=plus,
+            comma=comma,
         )
 
     def at_least(self, decimals: int) -> "NumberStyle":
         """The same style with at least `decimals` places (never lose resolution)."""
         if decimals <= self.decimals:
             return self
-        return NumberStyle(decimals, False, self.leading_zero, self.int_width, self.plus_sign)
+        return NumberStyle(decimals, False, self.leading_zero, self.int_width, self.plus_sign, self.comma)
 
 
 def format_number(value: float, style: NumberStyle) -> str:
@@ -49,6 +53,7 @@ def format_number(value: float, style: NumberStyle) -> str:
         whole = whole.zfill(style.int_width)
     if whole == "0" and frac and not style.leading_zero:
         whole = ""
-    body = f"{whole}.{frac}" if frac else (f"{whole}." if style.trailing_dot else whole)
+    point = "," if style.comma else "."
+    body = f"{whole}{point}{frac}" if frac else (f"{whole}{point}" if style.trailing_dot else whole)
     sign = "-" if value < 0 else ("+" if style.plus_sign else "")
     return sign + body

@@ -1,0 +1,265 @@
+"""What the Heidenhain and Sinumerik interpreters share.
+
+`ModalInterpreter` holds the position, plane, units and feed, runs the event
+stream (one warning and pass-through from the first out-of-scope construct
+on, as the ISO interpreter does) and builds `Line` / `Arc` events; the
+dialect subclasses only read their blocks.  `evaluate` computes the
+expression trees both dialect builders produce (angles in degrees).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Callable, Iterable, Iterator
+
+from ncpp.errors import Location, NcppError, Warnings
+from ncpp.motion.segments import PLANE_AXES, Arc, Context, Event, Line, Pass, Point
+from ncpp.program.blocks import Block
+
+MM_PER_INCH = 25.4
+RADIUS_TOLERANCE = 0.01  # mm: start and end radius of a centre-format arc may differ this much (controller default)
+PLANE_OF_TOOL_AXIS = {"Z": 17, "Y": 18, "X": 19}
+
+
+class OutOfScope(Exception):
+    """A construct after which the interpreter no longer knows the position."""
+
+    def __init__(self, reason: str, col: int | None = None):
+        super().__init__(reason)
+        self.reason = reason
+        self.col = col
+
+
+def resolve_warnings(warnings: Warnings | None, strict: bool) -> Warnings:
+    """The warnings to report through: strict when asked, whatever was passed."""
+    if warnings is None:
+        return Warnings(strict=strict)
+    if strict and not warnings.strict:
+        return Warnings(strict=True, stream=warnings.stream)
+    return warnings
+
+
+class ModalInterpreter:
+    """Position and modal state of one program run (program units throughout)."""
+
+    def __init__(self, file: str = "<stdin>"):
+        self.file = file
+        self.pos: list[float] = [0.0, 0.0, 0.0]
+        self.plane = 17
+        self.inch = False
+        self.feed = 0.0
+        self.offset: list[float] = [0.0, 0.0, 0.0]  # machine minus program position (frames), program units
+        self.tangent: tuple[float, float, float] | None = None  # direction at the end of the last move
+        self.done = False
+        self._context: Context | None = None
+
+    # -- the event stream -------------------------------------------------------------
+    def run(self, blocks: Iterable[Block], warnings: Warnings) -> Iterator[Event]:
+        for block in blocks:
+            if self.done or not block.items:
+                yield Pass(block)
+                continue
+            try:
+                events = self.block(block)
+            except OutOfScope as stop:
+                self.done = True
+                warnings.warn(
+                    f"{stop.reason} is outside the motion interpreter's scope; from this line on the "
+                    "program passes through uninterpreted (its modal state is unknown)",
+                    Location(self.file, block.line, stop.col),
+                )
+                yield Pass(block)
+                continue
+            yield from events or (Pass(block),)
+
+    def block(self, block: Block) -> list[Event]:
+        raise NotImplementedError
+
+    # -- modal state --------------------------------------------------------------------
+    def context(self, plane: int | None = None, absolute: bool = True) -> Context:
+        plane = plane or self.plane
+        if self._context is None or self._context.plane != plane or self._context.absolute != absolute:
+            self._context = Context(plane, absolute, False, self.inch, tuple(self.offset))  # type: ignore[arg-type]
+        return self._context
+
+    def set_units(self, inch: bool) -> None:
+        """Switch units; the position is kept in the new program units."""
+        if inch != self.inch:
+            scale = 1 / MM_PER_INCH if inch else MM_PER_INCH
+            self.pos = [v * scale for v in self.pos]
+            self.offset = [v * scale for v in self.offset]
+            self.inch = inch
+            self._context = None
+
+    def set_offset(self, offset: list[float]) -> None:
+        """A frame moved the program origin: the same machine point gets new program coordinates."""
+        self.pos = [p + old - new for p, old, new in zip(self.pos, self.offset, offset)]
+        self.offset = list(offset)
+        self._context = None
+
+    def fail(self, message: str, block: Block, item=None) -> None:
+        raise NcppError(message, Location(self.file, block.line, item.start + 1 if item is not None else None))
+
+    # -- events ---------------------------------------------------------------------------
+    def line(self, block: Block, end: list[float], rapid: bool, absolute: bool = True) -> Line:
+        start = tuple(self.pos)
+        d = [e - s for e, s in zip(end, start)]
+        length = math.sqrt(sum(v * v for v in d))
+        if length > 0:
+            self.tangent = (d[0] / length, d[1] / length, d[2] / length)
+        self.pos = list(end)
+        return Line(start, tuple(end), rapid, self.feed, block, self.context(absolute=absolute))  # type: ignore[arg-type]
+
+    def arc(self, block: Block, end: list[float], centre: list[float], turn: int, plane: int | None = None,
+            absolute: bool = True) -> Arc:
+        """An arc from the position to `end` about `centre` (its plane coordinates count)."""
+        plane = plane or self.plane
+        a, b, n = PLANE_AXES[plane]
+        start = tuple(self.pos)
+        c = list(centre)
+        c[n] = start[n]
+        event = Arc(start, tuple(end), tuple(c), turn, self.feed, block, self.context(plane, absolute))  # type: ignore[arg-type]
+        # tangent at the end: perpendicular to the radius, turning with the arc, plus the helix rise
+        ra, rb = end[a] - c[a], end[b] - c[b]
+        sign = 1.0 if turn > 0 else -1.0
+        t = [0.0, 0.0, 0.0]
+        t[a], t[b] = -sign * rb, sign * ra
+        sweep = abs(event.sweep())
+        t[n] = (end[n] - start[n]) / sweep if sweep > 0 else 0.0
+        norm = math.sqrt(sum(v * v for v in t)) or 1.0
+        self.tangent = (t[0] / norm, t[1] / norm, t[2] / norm)
+        self.pos = list(end)
+        return event
+
+    def check_radii(self, block: Block, item, end: list[float], centre: list[float], plane: int | None = None) -> None:
+        a, b, _ = PLANE_AXES[plane or self.plane]
+        r1 = math.hypot(self.pos[a] - centre[a], self.pos[b] - centre[b])
+        r2 = math.hypot(end[a] - centre[a], end[b] - centre[b])
+        tolerance = RADIUS_TOLERANCE / (MM_PER_INCH if self.inch else 1.0)
+        if r1 < tolerance or r2 < tolerance:
+            self.fail("zero-radius arc", block, item)
+        if abs(r1 - r2) > max(tolerance, 1e-3 * max(r1, r2)):
+            self.fail(f"radius to the end of the arc ({r2:.4f}) differs from the radius to its start ({r1:.4f})", block, item)
+
+    def centre_from_radius(self, block: Block, item, end: list[float], radius: float, clockwise: bool) -> list[float]:
+        """The centre of an arc of signed radius (negative: more than a half circle), as G2/G3 R."""
+        a, b, _ = PLANE_AXES[self.plane]
+        x0, y0, x1, y1 = self.pos[a], self.pos[b], end[a], end[b]
+        if x0 == x1 and y0 == y1:
+            self.fail("the start point of the arc is its end point", block, item)
+        r = abs(radius)
+        mx, my = (x0 + x1) / 2, (y0 + y1) / 2
+        half = math.hypot(x1 - mx, y1 - my)
+        tolerance = RADIUS_TOLERANCE / (MM_PER_INCH if self.inch else 1.0)
+        if half - r > tolerance:
+            self.fail("arc radius too small to reach the end point", block, item)
+        half = min(half, r)
+        direction = math.atan2(y1 - y0, x1 - x0)
+        theta = direction - math.pi / 2 if clockwise == (radius > 0) else direction + math.pi / 2
+        offset = math.sqrt(max(r * r - half * half, 0.0))
+        centre = list(self.pos)
+        centre[a], centre[b] = mx + offset * math.cos(theta), my + offset * math.sin(theta)
+        return centre
+
+    def tangential(self, block: Block, end: list[float], absolute: bool = True) -> Line | Arc:
+        """The arc from the position to `end` tangent to the last move (a line when they are in line)."""
+        a, b, _ = PLANE_AXES[self.plane]
+        if self.tangent is None:
+            raise OutOfScope("a tangential arc with no previous move", None)
+        ta, tb = self.tangent[a], self.tangent[b]
+        norm = math.hypot(ta, tb)
+        if norm < 1e-12:
+            raise OutOfScope("a tangential arc after a move along the tool axis", None)
+        ta, tb = ta / norm, tb / norm
+        da, db = end[a] - self.pos[a], end[b] - self.pos[b]
+        across = -tb * da + ta * db  # component of the chord along the left normal
+        if abs(across) < 1e-9 * max(1.0, math.hypot(da, db)):
+            return self.line(block, end, False, absolute)
+        s = (da * da + db * db) / (2 * across)  # signed distance of the centre along the left normal
+        centre = list(self.pos)
+        centre[a], centre[b] = self.pos[a] - tb * s, self.pos[b] + ta * s
+        return self.arc(block, end, centre, 1 if s > 0 else -1, absolute=absolute)
+
+
+def plane_of(points: list[Point]) -> int | None:
+    """The principal plane (17, 18, 19) containing all points, if any (a shared normal coordinate)."""
+    for plane, (_, _, n) in PLANE_AXES.items():
+        if max(p[n] for p in points) - min(p[n] for p in points) < 1e-9:
+            return plane
+    return None
+
+
+def circle_through(p0: Point, p1: Point, p2: Point, plane: int) -> tuple[list[float], int] | None:
+    """Centre and turn (+1 counter-clockwise) of the arc from p0 through p1 to p2 in `plane`."""
+    a, b, _ = PLANE_AXES[plane]
+    ax, ay, bx, by, cx, cy = p0[a], p0[b], p1[a], p1[b], p2[a], p2[b]
+    d = 2 * (ax * (by - cy) + bx * (cy - ay) + cx * (ay - by))
+    if abs(d) < 1e-12:
+        return None
+    ux = ((ax * ax + ay * ay) * (by - cy) + (bx * bx + by * by) * (cy - ay) + (cx * cx + cy * cy) * (ay - by)) / d
+    uy = ((ax * ax + ay * ay) * (cx - bx) + (bx * bx + by * by) * (ax - cx) + (cx * cx + cy * cy) * (bx - ax)) / d
+    centre = list(p0)
+    centre[a], centre[b] = ux, uy
+    # the turn that passes the intermediate point: the sign of the triangle's orientation
+    turn = 1 if (bx - ax) * (cy - ay) - (by - ay) * (cx - ax) > 0 else -1
+    return centre, turn
+
+
+# ---- expressions --------------------------------------------------------------------------
+
+def _div(a: float, b: float) -> float:
+    return float(math.trunc(a / b))
+
+
+_BINARY: dict[str, Callable[[float, float], float]] = {
+    "+": lambda a, b: a + b, "-": lambda a, b: a - b, "*": lambda a, b: a * b, "/": lambda a, b: a / b,
+    "**": lambda a, b: a ** b, "DIV": _div, "MOD": math.fmod,
+    "==": lambda a, b: float(a == b), "<>": lambda a, b: float(a != b), "<": lambda a, b: float(a < b),
+    ">": lambda a, b: float(a > b), "<=": lambda a, b: float(a <= b), ">=": lambda a, b: float(a >= b),
+    "AND": lambda a, b: float(bool(a) and bool(b)), "OR": lambda a, b: float(bool(a) or bool(b)),
+    "XOR": lambda a, b: float(bool(a) != bool(b)),
+    "B_AND": lambda a, b: float(int(a) & int(b)), "B_OR": lambda a, b: float(int(a) | int(b)),
+    "B_XOR": lambda a, b: float(int(a) ^ int(b)),
+}  # fmt: skip
+_DEG = math.pi / 180
+_FUNCTIONS: dict[str, Callable[..., float]] = {
+    "SIN": lambda x: math.sin(x * _DEG), "COS": lambda x: math.cos(x * _DEG), "TAN": lambda x: math.tan(x * _DEG),
+    "ASIN": lambda x: math.asin(x) / _DEG, "ACOS": lambda x: math.acos(x) / _DEG, "ATAN": lambda x: math.atan(x) / _DEG,
+    "ATAN2": lambda y, x: math.atan2(y, x) / _DEG, "SQRT": math.sqrt, "POT": lambda x: x * x, "SQ": lambda x: x * x,
+    "ABS": abs, "TRUNC": lambda x: float(math.trunc(x)), "INT": lambda x: float(math.trunc(x)),
+    "FRAC": lambda x: x - math.trunc(x), "ROUND": lambda x: float(math.floor(x + 0.5)), "LN": math.log,
+    "LOG": math.log10, "EXP": math.exp, "NEG": lambda x: -x, "SGN": lambda x: float((x > 0) - (x < 0)),
+    "MINVAL": min, "MAXVAL": max,
+}  # fmt: skip
+
+
+def evaluate(expr: tuple, lookup: Callable[[str], float]) -> float:
+    """The value of an expression tree (`("num", v)`, `("param", name)`, `("bin", op, a, b)` ...).
+
+    `lookup(name)` gives a variable's value or raises OutOfScope; anything
+    this evaluator does not know (arrays, strings, system functions) is out
+    of scope, a division by zero an NcppError-worthy ValueError.
+    """
+    kind = expr[0]
+    if kind == "num":
+        return expr[1]
+    if kind == "param":
+        return lookup(expr[1])
+    if kind == "neg":
+        return -evaluate(expr[1], lookup)
+    if kind == "not":
+        return float(not evaluate(expr[1], lookup))
+    if kind == "bin":
+        op = _BINARY.get(expr[1])
+        if op is None:
+            raise OutOfScope(f"the operator {expr[1]}")
+        try:
+            return op(evaluate(expr[2], lookup), evaluate(expr[3], lookup))
+        except ZeroDivisionError:
+            raise ValueError("division by zero") from None
+    if kind == "call":
+        function = _FUNCTIONS.get(expr[1])
+        if function is None:
+            raise OutOfScope(f"the function {expr[1]}")
+        return float(function(*(evaluate(arg, lookup) for arg in expr[2:])))
+    raise OutOfScope(f"the expression {kind!r}")

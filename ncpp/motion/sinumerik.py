@@ -1,0 +1,259 @@
+"""Sinumerik 840D blocks -> motion events (`Line`, `Arc`, `Pass`), like `ncpp.motion.interpret`.
+
+Scope: G0-G3 with I/J/K (incremental, `I=AC(..)` absolute) or `CR=` (negative:
+more than a half circle), `TURN=` extra helix turns, `CIP` with `I1=/J1=/K1=`
+(an arc through an intermediate point, in a principal plane), `CT` (tangential
+arc), G90/G91 and `AC()`/`IC()` per word, G17/G18/G19, G70/G71/G700/G710,
+`TRANS`/`ATRANS` (translation only), R parameters and `DEF` variables with
+arithmetic, labels, `MSG`, G4 dwell, M2/M17/M30 (end).  Control flow (GOTO*,
+IF, WHILE, FOR, REPEAT, CASE), calls of cycles and subprograms, splines, other
+frames, cutter compensation (G41/G42) and unknown G codes make the position
+unknown: one warning (an error with `strict`) and the rest passes through.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Iterable, Iterator
+
+from ncpp.errors import Warnings
+from ncpp.motion.modal import ModalInterpreter, OutOfScope, circle_through, evaluate, plane_of, resolve_warnings
+from ncpp.motion.segments import PLANE_AXES, Event
+from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
+
+AXES = "XYZ"
+CENTRE_LETTERS = "IJK"
+INTERMEDIATE = ("I1", "J1", "K1")
+# G codes that change nothing the motion depends on (exact stop, continuous path, feed types, work offsets
+# the control holds, spindle modes, acceleration, G40 compensation off)
+NEUTRAL_G = frozenset((9.0, 40.0, 54.0, 55.0, 56.0, 57.0, 500.0, 60.0, 64.0, 601.0, 602.0, 603.0, 641.0, 642.0,
+                       643.0, 644.0, 645.0, 94.0, 95.0, 96.0, 97.0, 153.0, 450.0, 451.0, 961.0, 971.0))  # fmt: skip
+UNITS_G = {70.0: True, 700.0: True, 71.0: False, 710.0: False}
+HARMLESS_CALLS = frozenset(("MSG", "BNAT", "ENAT", "BTAN", "ETAN", "BAUTO", "EAUTO", "FFWON", "FFWOF", "SOFT",
+                            "BRISK", "CFC", "CFTCP", "CFIN", "M"))  # fmt: skip
+END_M = frozenset((2.0, 17.0, 30.0))
+# Frame instructions followed: translations; a bare substituting ROT / SCALE / MIRROR resets the frame.
+FRAMES = frozenset(("TRANS", "ATRANS", "ROT", "SCALE", "MIRROR"))
+
+
+def interpret(blocks: Iterable[Block], *, file: str = "<stdin>", warnings: Warnings | None = None,
+              strict: bool = False) -> Iterator[Event]:
+    """Motion events of a Sinumerik program's blocks, lazily (see the module docstring)."""
+    return SinumerikInterpreter(file).run(blocks, resolve_warnings(warnings, strict))
+
+
+class SinumerikInterpreter(ModalInterpreter):
+    def __init__(self, file: str = "<stdin>"):
+        super().__init__(file)
+        self.motion: float | str = 0.0  # 0-3, 'CIP' or 'CT' (G0 after power on)
+        self.absolute = True
+        self.variables: dict[str, float | str] = {}
+        self.integers: set[str] = set()  # DEF INT variables round on assignment
+        # A frame's offset is traversed with the axis's next incremental move (MD 42440
+        # FRAME_OFFSET_INCR_PROG = 1): IC(d) after TRANS goes d from the old program position.
+        self.frame_shift = [0.0, 0.0, 0.0]
+
+    # -- variables --------------------------------------------------------------------
+    def lookup(self, name: str) -> float:
+        value = self.variables.get(name)
+        if value is None:
+            if name[0] == "r" and name[1:].isdigit():
+                return 0.0  # R parameters exist on every control, zero until set
+            raise OutOfScope(f"the variable {name.upper()} (not defined in the program)")
+        if isinstance(value, str):
+            raise OutOfScope(f"the string variable {name.upper()} in arithmetic")
+        return value
+
+    def value(self, expr: tuple, block: Block, item) -> float:
+        try:
+            return evaluate(expr, self.lookup)
+        except OutOfScope as stop:
+            stop.col = item.start + 1
+            raise
+        except (ValueError, OverflowError) as err:
+            self.fail(str(err), block, item)
+        raise AssertionError("unreachable")
+
+    def assign(self, target: tuple, expr: tuple, block: Block, item) -> None:
+        if target[0] != "param" or target[1].startswith("$"):
+            raise OutOfScope(f"the assignment to {target[1].upper()}", item.start + 1)
+        name = target[1]
+        if expr[0] == "str":
+            self.variables[name] = expr[1]
+            return
+        value = self.value(expr, block, item)
+        self.variables[name] = float(round(value)) if name in self.integers else value
+
+    def define(self, node: tuple, block: Block, item) -> None:
+        type_name, _, variables = node
+        for target, init in variables:
+            name = target[1]
+            if target[0] != "param":
+                raise OutOfScope(f"the array {name.upper()}", item.start + 1)
+            if type_name == "INT":
+                self.integers.add(name)
+            if init is None:
+                self.variables[name] = "" if type_name == "STRING" else 0.0
+            else:
+                self.assign(target, init, block, item)
+
+    # -- one block ------------------------------------------------------------------------
+    def block(self, block: Block) -> list[Event]:
+        words: dict[str, tuple[float, str | None, object]] = {}  # letter -> (value, 'ac' | 'ic' | None, item)
+        gcodes: list[tuple[float, Word]] = []
+        path: str | None = None
+        frame: Statement | None = None
+        end = False
+        for item in block.items:
+            kind = type(item)
+            if kind is Comment:
+                continue
+            if kind is Statement:
+                what = item.kind
+                if what == "assignment":
+                    self.assign(*item.node, block, item)
+                elif what == "def":
+                    self.define(item.node, block, item)
+                elif what == "path" and item.node[0] in ("CIP", "CT"):
+                    path = item.node[0]
+                elif what == "frame" and item.node[0] in FRAMES:
+                    frame = item
+                elif what == "call" and item.node[0] in HARMLESS_CALLS:
+                    pass
+                elif what not in ("label", "program_name", "block_delete"):
+                    name = item.node[0] if what in ("call", "path", "frame") else what.upper()
+                    raise OutOfScope(f"{what} {name}" if what in ("call", "path", "frame") else name, item.start + 1)
+                continue
+            if kind is Word:
+                letter, value, mode = item.letter, item.value, None
+            else:
+                letter, (value, mode) = item.letter, self._word_value(item, block)
+            if letter == "G":
+                gcodes.append((value, item))
+            elif letter == "M":
+                end = end or value in END_M
+            elif letter in ("N", ":"):
+                continue
+            else:
+                if letter in words:
+                    self.fail(f"the address {letter} twice in one block", block, item)
+                words[letter] = (value, mode, item)
+        dwell = self._modal_codes(gcodes, block)
+        if path is not None:
+            self.motion = path
+        if frame is not None:
+            self._frame(frame, words)
+            return []
+        events: list[Event] = []
+        if not dwell:
+            if "F" in words:
+                self.feed = words["F"][0]
+            events = self._move(block, words)
+        if end:
+            self.done = True
+        return events
+
+    def _word_value(self, item: ExprWord, block: Block) -> tuple[float, str | None]:
+        expr = item.expr
+        if expr[0] in ("ac", "ic"):
+            return self.value(expr[1], block, item), expr[0]
+        if expr[0] in ("dc", "acp", "acn", "cac", "cic"):
+            raise OutOfScope(f"the rotary-axis mode {expr[0].upper()}()", item.start + 1)
+        if expr[0] == "str":
+            return 0.0, None  # `T="MILL"`: a name, no motion
+        return self.value(expr, block, item), None
+
+    def _modal_codes(self, gcodes: list[tuple[float, Word]], block: Block) -> bool:
+        """Apply the block's G codes; True for a dwell block (its F is a time)."""
+        dwell = False
+        for code, item in gcodes:
+            if code in (0.0, 1.0, 2.0, 3.0):
+                self.motion = code
+            elif code in (17.0, 18.0, 19.0):
+                self.plane = int(code)
+            elif code in (90.0, 91.0):
+                self.absolute = code == 90.0
+            elif code in UNITS_G:
+                self.set_units(UNITS_G[code])
+            elif code == 4.0:
+                dwell = True
+            elif code not in NEUTRAL_G:
+                reason = {41.0: "cutter compensation", 42.0: "cutter compensation", 53.0: "machine coordinates",
+                          33.0: "thread cutting", 93.0: "inverse time feed"}.get(code, "the G code")  # fmt: skip
+                raise OutOfScope(f"{reason} G{code:g}", item.start + 1)
+        return dwell
+
+    def _frame(self, frame: Statement, words: dict) -> None:
+        name = frame.node[0]
+        if name not in ("TRANS", "ATRANS") and words:
+            raise OutOfScope(f"frame {name}", frame.start + 1)
+        offset = list(self.offset) if name == "ATRANS" else [0.0, 0.0, 0.0]
+        for letter, (value, _, item) in words.items():
+            if letter not in AXES:
+                raise OutOfScope(f"{frame.node[0]} of the {letter} axis", item.start + 1)
+            offset[AXES.index(letter)] += value
+        self.frame_shift = [s + new - old for s, new, old in zip(self.frame_shift, offset, self.offset)]
+        self.set_offset(offset)
+
+    def _target(self, words: dict) -> list[float]:
+        end = list(self.pos)
+        for n, axis in enumerate(AXES):
+            if axis in words:
+                value, mode, _ = words[axis]
+                absolute = mode == "ac" or (mode is None and self.absolute)
+                end[n] = value if absolute else self.pos[n] + self.frame_shift[n] + value
+                self.frame_shift[n] = 0.0
+        return end
+
+    def _move(self, block: Block, words: dict) -> list[Event]:
+        motion = self.motion
+        has_axes = any(a in words for a in AXES)
+        arc_words = any(k in words for k in ("I", "J", "K", "CR", "TURN", *INTERMEDIATE))
+        if not has_axes and not (arc_words and motion in (2.0, 3.0)):
+            return []
+        end = self._target(words)
+        absolute = self.absolute and not any(words[a][1] == "ic" for a in AXES if a in words)
+        if motion in (0.0, 1.0):
+            return [self.line(block, end, motion == 0.0, absolute)]
+        if motion == "CT":
+            return [self.tangential(block, end, absolute)]
+        if motion == "CIP":
+            return [self._cip(block, words, end, absolute)]
+        return [self._arc(block, words, end, motion == 2.0, absolute)]
+
+    def _arc(self, block: Block, words: dict, end: list[float], clockwise: bool, absolute: bool):
+        a, b, _ = PLANE_AXES[self.plane]
+        item = next(iter(words.values()))[2]
+        turns = 1 + round(words["TURN"][0]) if "TURN" in words else 1
+        if "CR" in words:
+            centre = self.centre_from_radius(block, words["CR"][2], end, words["CR"][0], clockwise)
+        else:
+            letters = [CENTRE_LETTERS[a], CENTRE_LETTERS[b]]
+            if not any(letter in words for letter in letters):
+                self.fail("circular interpolation without I/J/K, CR= or an intermediate point", block, item)
+            centre = list(self.pos)
+            for axis, letter in zip((a, b), letters):
+                if letter in words:
+                    value, mode, _ = words[letter]
+                    centre[axis] = value if mode == "ac" else self.pos[axis] + value
+            self.check_radii(block, item, end, centre)
+        return self.arc(block, end, centre, -turns if clockwise else turns, absolute=absolute)
+
+    def _cip(self, block: Block, words: dict, end: list[float], absolute: bool):
+        middle = list(self.pos)
+        for n, letter in enumerate(INTERMEDIATE):
+            if letter in words:
+                value, mode, _ = words[letter]
+                middle[n] = value if mode == "ac" or (mode is None and self.absolute) else self.pos[n] + value
+        points = [tuple(self.pos), tuple(middle), tuple(end)]
+        item = next(iter(words.values()))[2]
+        plane = plane_of(points)
+        if plane is None:
+            raise OutOfScope("CIP in a plane other than XY, ZX, YZ", item.start + 1)
+        if plane != self.plane:
+            raise OutOfScope(f"CIP outside the working plane G{self.plane}", item.start + 1)
+        found = circle_through(*points, plane)
+        if found is None or math.dist(points[0], points[2]) < 1e-9:
+            self.fail("CIP points in a line (or a full circle): no arc through them", block, item)
+        centre, turn = found  # type: ignore[misc]
+        return self.arc(block, end, centre, turn, plane, absolute)
