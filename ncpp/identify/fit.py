@@ -1,4 +1,8 @@
-"""Build a machine's error tables from laser, comparator and level files.
+"""Build a machine's error tables from laser, comparator, level and ball-bar files.
+
+Ball-bar files are fitted after the others, by regularised least squares
+over all of them (`ncpp.identify.ballbar`); the components the other files
+give are held.  The rest of this docstring is about the other files.
 
 Each file gives one component (a comparator two) as a table over its axis:
 
@@ -53,6 +57,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ncpp.errors import Location, NcppError
+from ncpp.identify.ballbar import BallbarFit, fit_ballbar
 from ncpp.instruments import iso230_2
 from ncpp.instruments.files import ANGULAR_QUANTITIES, Measurement
 from ncpp.instruments.forward import ANGLE_COMPONENTS, level_member, predict_like, reading_component
@@ -110,7 +115,7 @@ def sources_of(m: Measurement, chain: str) -> list[Source]:
             found = [Source(m, name, "inclination_um_per_m", _level_sign(chain, member, axis))]
         else:
             raise NcppError(
-                f"fit builds tables from laser, comparator and level files; {m.instrument} files are "
+                f"fit uses laser, comparator, level and ball-bar files; {m.instrument} files are "
                 "explained by the model (ncpp predict / diagnose), not fitted here",
                 where,
             )
@@ -202,13 +207,39 @@ def fit_machine(
     reversal_threshold: float = 0.5,
     sweeps: int = 6,
     tolerance: float = 1e-4,
+    knots: int = 9,
+    smoothing: float | None = None,
 ) -> Machine:
-    """A machine whose forward predictions reproduce the files (see the module docstring).
+    """A machine whose forward predictions reproduce the files (see the module docstring
+    and `identify`)."""
+    return identify(
+        measurements, base, chain, name=name, interpolation=interpolation, reversal_threshold=reversal_threshold,
+        sweeps=sweeps, tolerance=tolerance, knots=knots, smoothing=smoothing,
+    )[0]  # fmt: skip
 
-    measurements: laser, comparator and level files; base: the machine whose
-    structure, squareness, effects and other components are kept; chain:
-    overrides the base's chain (default ``XYFZ`` without a base).
-    `tolerance` (µm, µrad) ends the sweeps."""
+
+def identify(
+    measurements: Sequence[Measurement],
+    base: Machine | None = None,
+    chain: str | None = None,
+    *,
+    name: str | None = None,
+    interpolation: str = "smooth",
+    reversal_threshold: float = 0.5,
+    sweeps: int = 6,
+    tolerance: float = 1e-4,
+    knots: int = 9,
+    smoothing: float | None = None,
+) -> tuple[Machine, BallbarFit | None]:
+    """The fitted machine and, when ball-bar files were given, the ball-bar fit's account.
+
+    measurements: laser, comparator and level files (tables, as the module
+    docstring says) and ball-bar files (`ncpp.identify.ballbar`: the remaining
+    components and the squareness by regularised least squares, with the
+    tables of the other files held); base: the machine whose structure,
+    squareness, effects and other components are kept; chain: overrides the
+    base's chain (default ``XYFZ`` without a base).  `tolerance` (µm, µrad)
+    ends the sweeps; `knots`, `smoothing`: the ball-bar tables (λ None: GCV)."""
     if not measurements:
         raise NcppError("no measurement files to fit", Location("ncpp fit"))
     if base is None:
@@ -217,7 +248,21 @@ def fit_machine(
         machine = base.replace(chain=chain) if chain else base
         if name:
             machine = machine.replace(name=name)
-    sources = [s for m in measurements for s in sources_of(m, machine.chain)]
+    ballbars = [m for m in measurements if m.instrument == "ballbar"]
+    direct = [m for m in measurements if m.instrument != "ballbar"]
+    sources = [s for m in direct for s in sources_of(m, machine.chain)]
+    if direct:
+        machine = _fit_tables(machine, sources, interpolation, reversal_threshold, sweeps, tolerance)
+    if not ballbars:
+        return machine, None
+    fit = fit_ballbar(machine, ballbars, knots=knots, fixed=[s.component for s in sources], smoothing=smoothing)
+    return fit.machine, fit
+
+
+def _fit_tables(
+    machine: Machine, sources: Sequence[Source], interpolation: str, reversal_threshold: float, sweeps: int,
+    tolerance: float,
+) -> Machine:  # fmt: skip
     taken: dict[str, Source] = {}
     for s in sources:
         if s.component in taken:
@@ -246,6 +291,8 @@ def fit_residuals(machine: Machine, measurements: Sequence[Measurement]) -> dict
     how well the machine reproduces the files (0 up to noise and interpolation)."""
     out = {}
     for m in measurements:
+        if m.instrument == "ballbar":
+            continue  # explained by the ball-bar fit's account
         for s in sources_of(m, machine.chain):
             measured, predicted = _per_target(s, m), _per_target(s, predict_like(machine, m))
             gaps = np.concatenate([measured.up.mean - predicted.up.mean, measured.down.mean - predicted.down.mean])

@@ -12,7 +12,7 @@ from ncpp.errors import NcppError
 from ncpp.identify import fit_machine, fit_residuals
 from ncpp.instruments.analysis import analyze
 from ncpp.instruments.files import read_measurement, write_measurement
-from ncpp.instruments.forward import ANGLE_COMPONENTS, predict_ballbar, predict_comparator, predict_laser, predict_level
+from ncpp.instruments.forward import ANGLE_COMPONENTS, predict_ballbar, predict_comparator, predict_grid, predict_laser, predict_level
 from ncpp.machine import Machine, Polynomial, Table, load_machine
 from ncpp.machine.effects import Backlash
 
@@ -91,8 +91,8 @@ def test_fitted_sample_machine_predicts_the_same_ballbar():
 
 def test_files_the_fit_cannot_use():
     true = true_machine()
-    with pytest.raises(NcppError, match="ballbar"):
-        fit_machine([predict_ballbar(true, "XY", 100, (400, 0, 0), step_deg=10.0)])
+    with pytest.raises(NcppError, match="grid"):
+        fit_machine([predict_grid(true, "XY", "circle", (400, 0, 0), 100, step_deg=10.0)])
     one = predict_laser(true, "X", "position", TARGETS)
     two = predict_comparator(true, "X", "Y", TARGETS)
     with pytest.raises(NcppError, match="EXX is given by both"):
@@ -124,9 +124,9 @@ def test_fit_and_predict_commands(tmp_path):
 
 def test_command_errors_are_messages(tmp_path, capsys):
     bad = tmp_path / "x.csv"
-    write_measurement(predict_ballbar(true_machine(), "XY", 100, (400, 0, 0), step_deg=30.0), bad)
+    write_measurement(predict_grid(true_machine(), "XY", "circle", (400, 0, 0), 100, step_deg=30.0), bad)
     assert main(["fit", str(bad), "-o", str(tmp_path / "m.toml")]) == 2
-    assert "ballbar" in capsys.readouterr().err
+    assert "grid" in capsys.readouterr().err
     args = ["predict", "--machine", str(ROOT / "samples/machines/hr5b.toml"), "--instrument", "laser", "--targets", "5:1", "-o", str(tmp_path / "o.csv")]
     assert main(args) == 2
     assert "--targets" in capsys.readouterr().err
