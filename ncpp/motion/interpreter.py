@@ -10,9 +10,11 @@ Scope: modal G0-G3, planes, G90/G91, G90.1/G91.1, G20/G21 (state converted
 on a switch, like LinuxCNC), G54-G59.3, G10 L2/L20 (no rotation), G92 family,
 G52, G53, G28/G30, G43 (tool lengths read as zero: the control's tool table
 is not known) / G43.1 / G49, F and inverse time, IJK and R arcs, helices,
-P turns, parameters and expressions.  Anything else (o-word and Fanuc macro
+P turns, parameters and expressions, and Fanuc corner rounding and
+chamfering between two lines (`,R` `,C`, `G1 ... R`: a one-move look-ahead).
+Anything else (o-word and Fanuc macro
 control flow, M98/M99, canned cycles, cutter compensation, splines,
-threading, probing, polar words, Fanuc `,C`/`,R` corner rounding) makes the
+threading, probing, polar words) makes the
 interpreter's state unknown: that block and every later block pass through
 as `Pass` after ONE warning (an error with `strict`).
 """
@@ -20,6 +22,7 @@ as `Pass` after ONE warning (an error with `strict`).
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from typing import Iterable, Iterator
 
 from ncpp.errors import Location, NcppError, Warnings
@@ -145,12 +148,22 @@ class Interpreter:
         self._context: Context | None = None
         self._fast = False
         self.done = False  # program end (M2/M30) reached or state unknown
+        self.corner: tuple[str, float, Word | ExprWord] | None = None  # Fanuc ,R / ,C of the last block
 
     # -- the event stream ---------------------------------------------------------
     def run(self, blocks: Iterable[Block], warnings: Warnings) -> Iterator[Event]:
+        """Events block by block.  A line with a Fanuc corner word (`,R` `,C`,
+        `G1 ... R`) waits for the next move, which decides the corner; the
+        blocks in between wait with it (bounded by the program's own layout)."""
         block_event = self.block
+        pending: Line | None = None  # the line whose end corner is rounded
+        corner = None
+        held: list[Event] = []  # non-moving events after it
         for block in blocks:
             if self.done:
+                if pending is not None:
+                    yield from self._unrounded(pending, held)
+                    pending = None
                 yield _pass(block)
                 continue
             try:
@@ -163,12 +176,81 @@ class Interpreter:
                     "program passes through uninterpreted (its modal state is unknown)",
                     where,
                 )
+                if pending is not None:
+                    yield from self._unrounded(pending, held)
+                    pending = None
                 yield _pass(block)
                 continue
-            if type(event) is tuple:
-                yield from event
-            else:
-                yield event
+            events = event if type(event) is tuple else (event,)
+            new_corner, self.corner = self.corner, None
+            for ev in events:
+                if pending is not None:
+                    if type(ev) is Pass:
+                        held.append(ev)
+                        continue
+                    rounded = self._round_corner(pending, corner, ev, warnings)
+                    if rounded is None:  # out of scope: everything from the corner on passes
+                        yield from self._unrounded(pending, held)
+                        pending = None
+                        yield _pass(ev.block)
+                        break
+                    yield from rounded[:-1]
+                    yield from held
+                    ev = rounded[-1]
+                    pending, held = None, []
+                if new_corner is not None and type(ev) is Line and ev.block is block:
+                    pending, corner = ev, new_corner
+                    continue
+                yield ev
+        if pending is not None:
+            _, _, item = corner
+            raise NcppError("corner rounding/chamfer has no following move", Location(self.file, pending.block.line, item.start + 1))
+
+    def _unrounded(self, pending: Line, held: list[Event]) -> Iterator[Event]:
+        """A held corner line whose corner cannot be made: it passes through, uninterpreted."""
+        yield _pass(pending.block)
+        yield from held
+        held.clear()
+
+    def _round_corner(self, first: Line, corner: tuple, second: Event, warnings: Warnings) -> list[Event] | None:
+        """[shortened first line, fillet arc or chamfer line, second line from the tangent point]."""
+        kind, size, item = corner
+        where = Location(self.file, first.block.line, item.start + 1)
+        i, j, k = PLANE_AXES[first.context.plane]
+        if type(second) is not Line or second.rapid or first.rapid:
+            self.done = True
+            warnings.warn("Fanuc corner rounding next to an arc or a rapid move is outside the motion "
+                          "interpreter's scope; from this line on the program passes through uninterpreted", where)  # fmt: skip
+            return None
+        if abs(first.end[k] - first.start[k]) > TINY or abs(second.end[k] - second.start[k]) > TINY:
+            raise NcppError("corner rounding/chamfer needs both moves in the active plane", where)
+        u = (first.end[i] - first.start[i], first.end[j] - first.start[j])
+        v = (second.end[i] - second.start[i], second.end[j] - second.start[j])
+        lu, lv = math.hypot(*u), math.hypot(*v)
+        if lu < TINY or lv < TINY:
+            raise NcppError("corner rounding/chamfer next to a zero-length move", where)
+        u, v = (u[0] / lu, u[1] / lu), (v[0] / lv, v[1] / lv)
+        cross, dot = u[0] * v[1] - u[1] * v[0], u[0] * v[0] + u[1] * v[1]
+        if abs(cross) < 1e-9:  # straight on (or back): no corner to round
+            return [first, second]
+        turn = math.atan2(abs(cross), dot)  # direction change, 0..pi
+        distance = size if kind == "C" else size * math.tan(turn / 2)
+        if distance > lu + TINY or distance > lv + TINY:
+            raise NcppError(f"corner {'chamfer' if kind == 'C' else 'radius'} {size:g} does not fit between the moves", where)
+        corner_point = first.end
+        t1, t2 = list(corner_point), list(corner_point)
+        t1[i], t1[j] = corner_point[i] - distance * u[0], corner_point[j] - distance * u[1]
+        t2[i], t2[j] = corner_point[i] + distance * v[0], corner_point[j] + distance * v[1]
+        t1, t2 = tuple(t1), tuple(t2)
+        shortened = replace(first, end=t1)
+        moved = replace(second, start=t2)
+        if kind == "C":
+            return [shortened, replace(first, start=t1, end=t2), moved]
+        side = 1.0 if cross > 0 else -1.0  # the centre lies on the inside of the turn
+        centre = list(t1)
+        centre[i], centre[j] = t1[i] - side * size * u[1], t1[j] + side * size * u[0]
+        fillet = Arc(t1, t2, tuple(centre), 1 if cross > 0 else -1, first.feed, first.block, first.context, first.extra)
+        return [shortened, fillet, moved]
 
     def context(self) -> Context:
         if self._context is None:
@@ -360,6 +442,7 @@ class Interpreter:
             motion_word = mode1_item if mode1_item is not None else axis_item
             if motion <= 1.0:
                 events = self._straight(block, words, motion, mode0 == 53.0)
+                self.corner = _corner_word(words, motion)
             else:
                 events = self._arc(block, words, motion, motion_word, mode1_item)
         if 2.0 in mcodes or 30.0 in mcodes:
@@ -449,9 +532,11 @@ class Interpreter:
         if "R" in words:
             if gcodes.get(13, (None,))[0] == 64.0 and 19.0 in mcodes:
                 self._fail("R word is ambiguous on a line with both G64 and M19 - use separate lines", block, words["R"][1])
-            if motion in (0.0, 1.0) and mode0 is None:
-                raise _OutOfScope("Fanuc corner rounding (R word with G0/G1)", words["R"][1].start + 1)
-            if not (motion in _R_MOTIONS or g7 in (41.1, 42.1) or mode0 == 10.0 or 19.0 in mcodes):
+            if motion == 0.0 and mode0 is None:
+                raise _OutOfScope("R word with G0", words["R"][1].start + 1)
+            if motion == 1.0 and mode0 is None:
+                pass  # Fanuc corner rounding `G1 X.. Y.. R..` (rs274ngc refuses it)
+            elif not (motion in _R_MOTIONS or g7 in (41.1, 42.1) or mode0 == 10.0 or 19.0 in mcodes):
                 self._fail("R word with no g code that uses it", block, words["R"][1])
 
     def _check_scope(self, words: dict, gcodes: dict) -> None:
@@ -460,8 +545,6 @@ class Interpreter:
             if reason is not None:
                 raise _OutOfScope(f"{reason} G{value:g}", item.start + 1)
         for letter, (_, item) in words.items():
-            if letter in (",C", ",R"):
-                raise _OutOfScope(f"Fanuc corner {'chamfer' if letter == ',C' else 'rounding'} {letter}", item.start + 1)
             if letter in ("@", "^"):
                 raise _OutOfScope("polar coordinates", item.start + 1)
         g10 = gcodes.get(0, (None,))[0] == 10.0
@@ -775,6 +858,15 @@ def _new_line(start, end, rapid, feed, block, context, extra) -> Line:
     s6(line, extra)
     s7(line, False)
     return line
+
+
+def _corner_word(words: dict, motion: float) -> tuple[str, float, Word | ExprWord] | None:
+    """Fanuc corner rounding / chamfer at the end of a G1 move: `,R` `,C` or `R`."""
+    for letter, kind in ((",R", "R"), (",C", "C"), ("R", "R")):
+        if letter in words and (motion == 1.0 or letter != "R"):
+            value, item = words[letter]
+            return kind, value, item
+    return None
 
 
 def _pass(block: Block) -> Pass:

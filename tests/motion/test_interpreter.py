@@ -220,8 +220,6 @@ def test_arc_radius_tolerance_matches_linuxcnc_files():
         ("M98 P100\n", "M98 subprogram call"),
         ("G81 X0 Y0 Z-1 R1 F10\n", "canned cycle G81"),
         ("G41 D1 G1 X1 F1\n", "cutter compensation G41"),
-        ("G1 X10 ,C1 F1\n", "Fanuc corner chamfer ,C"),
-        ("G1 X10 R2 F1\n", "Fanuc corner rounding"),
         ("G0 @10 ^45\n", "polar coordinates"),
         ("G0 X#<_hal[x.y]>\n", "machine-state parameter"),
     ],

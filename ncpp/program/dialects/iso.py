@@ -10,10 +10,11 @@ with at least the resolution needed for compensation.
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Iterable, Iterator
 
 from ncpp.motion.segments import PLANE_AXES, Arc, Event, Line
-from ncpp.program.blocks import Block, Word
+from ncpp.program.blocks import Block, ExprWord, Word
 from ncpp.program.numbers import NumberStyle, format_number
 from ncpp.program.writer import edit_words, word_separator
 
@@ -21,6 +22,7 @@ AXES = "XYZ"
 CENTRE_LETTERS = {17: "IJ", 18: "IK", 19: "JK"}  # as written; order of I J K words
 MOTION_CODES = {0.0: 0, 1.0: 1, 2.0: 2, 3.0: 3}
 DEFAULT_STYLE = NumberStyle(decimals=4)
+GEOMETRY_LETTERS = "XYZIJKR"  # words a pass rewrites in a changed block
 
 
 class IsoWriter:
@@ -63,6 +65,7 @@ class IsoWriter:
             yield block.text
             self._after_verbatim(block, motion)
             return
+        block = _literal_geometry(block)
         for n, segment in enumerate(motion):
             yield (self._edit_block(block, segment) if n == 0 else self._new_block(block, segment)) + block.eol
 
@@ -83,6 +86,10 @@ class IsoWriter:
                 elif 73 <= item.value <= 89:
                     code = None
         return code
+
+    def _arc_block(self, block: Block) -> bool:
+        """The block programs an arc (its P, if any, is the arc's turn count)."""
+        return (self._block_motion(block) if self._has_motion_word(block) else self.program_motion) in (2, 3)
 
     def _has_motion_word(self, block: Block) -> bool:
         return any(type(i) is Word and i.letter == "G" and (i.value in MOTION_CODES or 73 <= i.value <= 89) for i in block.items)
@@ -158,7 +165,10 @@ class IsoWriter:
         values = self._words(block, segment)
         styles = {letter: self._style(letter, segment) for letter in values}
         code = self._motion_code(segment)
-        drop = [letter for letter in "IJKRP" if letter not in values]
+        # centre words of the old arc, and Fanuc corner words: the corner is now explicit
+        drop = [letter for letter in ("I", "J", "K", "R", "P", ",R", ",C") if letter not in values]
+        if not self._arc_block(block):  # P is a dwell time (G4) or blending tolerance (G64) there
+            drop = [letter for letter in drop if letter != "P"]
         raw = edit_words(block, values, styles, drop=drop, motion=code if code != self.output_motion or self._has_motion_word(block) else None)
         if self._has_motion_word(block) or code != self.output_motion:
             self.output_motion = code
@@ -180,3 +190,12 @@ class IsoWriter:
         self._remember_end(segment)
         text = sep.join(parts) if sep else "".join(parts)
         return text.lower() if lower else text
+
+
+def _literal_geometry(block: Block) -> Block:
+    """The block with expression-valued geometry words (`Z[-#<depth>]`) as plain
+    words: a pass changed what they evaluate to, so new numbers replace them."""
+    if not any(type(i) is ExprWord and i.letter in GEOMETRY_LETTERS for i in block.items):
+        return block
+    items = [Word(i.letter, 0.0, "0", i.start, i.end) if type(i) is ExprWord and i.letter in GEOMETRY_LETTERS else i for i in block.items]
+    return replace(block, items=items)
