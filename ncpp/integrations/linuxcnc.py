@@ -1,0 +1,85 @@
+"""The LinuxCNC `[FILTER]` program: `ncpp-linuxcnc-filter PROGRAM.ngc`.
+
+LinuxCNC runs the filter named for a file's extension with the file's path
+as its only argument, loads what the filter writes to stdout, shows a
+progress bar from `FILTER_PROGRESS=N` lines (percent) on stderr, and shows
+stderr as an error when the exit status is not 0.  The machine file comes
+from `$NCPP_MACHINE` or the config files (`ncpp.integrations.config`); with
+none, or for a program ncpp compensated already, the program is loaded as it
+is.  Output is spooled, so a failed run sends LinuxCNC nothing.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import shutil
+import sys
+from typing import BinaryIO, TextIO
+
+from ncpp.errors import NcppError, Warnings
+
+
+class FilterProgress:
+    """`FILTER_PROGRESS=N` on stderr whenever the percentage of the file read changes."""
+
+    def __init__(self, stream: BinaryIO, size: int, out: TextIO):
+        self.stream, self.size, self.out = stream, max(size, 1), out
+        self.last = -1
+
+    def __call__(self, _lines: int = 0) -> None:
+        self.report(min(99, 100 * self.stream.tell() // self.size))
+
+    def report(self, percent: int) -> None:
+        if percent != self.last:
+            self.last = percent
+            print(f"FILTER_PROGRESS={percent}", file=self.out, flush=True)
+
+
+def already_compensated(path: str) -> bool:
+    from ncpp.pipeline import HEADER_SCAN, HEADER_TAG
+
+    with open(path, "rb") as f:
+        head = [f.readline() for _ in range(HEADER_SCAN)]
+    return any(HEADER_TAG.encode() in line for line in head)
+
+
+def run(path: str, err: TextIO, machine: str | None = None) -> None:
+    """Write the compensated program to stdout (nothing on error), progress to `err`."""
+    from ncpp.cli.io import open_output
+    from ncpp.integrations.config import find_settings
+    from ncpp.pipeline import ErrorSource, process
+
+    settings = find_settings(machine)
+    with open(path, "rb") as stream:
+        progress = FilterProgress(stream, os.fstat(stream.fileno()).st_size, err)
+        progress.report(0)
+        with open_output(None) as spool:
+            if settings.machine is None or already_compensated(path):
+                shutil.copyfileobj(stream, spool)
+            else:
+                if not os.path.isfile(settings.machine):
+                    raise NcppError(f"machine file {settings.machine} (from {settings.origin}) does not exist")
+                source = ErrorSource.from_machine_file(settings.machine).shifted(settings.work_offset)
+                process(stream, spool, file=path, source=source, tolerance=settings.tolerance, warnings=Warnings(stream=err), progress=progress)
+        progress.report(100)
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="ncpp-linuxcnc-filter", description="LinuxCNC [FILTER] program: compensate the program named on the command line")
+    parser.add_argument("program", help="the NC program LinuxCNC opens")
+    parser.add_argument("--machine", help="machine file (default: $NCPP_MACHINE, then the ncpp config files)")
+    args = parser.parse_args(argv)
+    try:
+        run(args.program, sys.stderr, args.machine)
+    except NcppError as error:
+        print(str(error), file=sys.stderr)
+        return 2
+    except OSError as error:
+        print(f"ncpp-linuxcnc-filter: {error.filename or ''}: {error.strerror or error}", file=sys.stderr)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

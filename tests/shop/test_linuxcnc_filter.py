@@ -1,0 +1,84 @@
+"""The LinuxCNC [FILTER] program, run the way LinuxCNC runs it; its output goes to rs274."""
+
+from __future__ import annotations
+
+import configparser
+import io
+import os
+import re
+import subprocess
+
+import pytest
+
+from ncpp.errors import Warnings
+from ncpp.post import post
+from tests.conftest import CORPUS, ROOT
+from tests.shop.rs274 import end_points, run_rs274
+
+FILTER = ROOT / "plugins/linuxcnc/ncpp-linuxcnc-filter"
+MACHINE = ROOT / "samples/machines/hr5b.toml"
+
+
+@pytest.fixture(scope="module")
+def program(tmp_path_factory):
+    """A long LinuxCNC program: the Creo roughing CL data posted plainly (8 000+ lines)."""
+    path = tmp_path_factory.mktemp("linuxcnc") / "schruppen.ngc"
+    out = io.BytesIO()
+    cl = CORPUS / "apt_cldata/creo_ncl/schruppen_1.ncl.1"
+    with open(cl, encoding="latin-1") as stream:
+        post(stream, out, file=str(cl), dialect="linuxcnc", warnings=Warnings(stream=io.StringIO()))
+    path.write_bytes(out.getvalue())
+    return path
+
+
+def run_filter(path, tmp_path, **env):
+    home = tmp_path / "home"
+    home.mkdir(exist_ok=True)
+    base = {k: v for k, v in os.environ.items() if k not in ("NCPP_MACHINE", "XDG_CONFIG_HOME")}
+    base.update(HOME=str(home), PYTHONPATH=str(ROOT), **env)
+    return subprocess.run([str(FILTER), str(path)], capture_output=True, cwd=tmp_path, env=base, timeout=300)
+
+
+def test_ini_lines_name_the_filter_for_ngc_and_nc():
+    ini = configparser.ConfigParser()
+    ini.optionxform = str
+    ini.read(ROOT / "plugins/linuxcnc/filter.ini")
+    assert ini["FILTER"]["PROGRAM_EXTENSION"] == ".ngc,.nc ncpp-compensated G-code"
+    assert ini["FILTER"]["ngc"] == ini["FILTER"]["nc"] == FILTER.name
+
+
+def test_filter_compensates_reports_progress_and_rs274_accepts_it(program, tmp_path):
+    (tmp_path / "ncpp.toml").write_text(f'machine = "{MACHINE}"\nwork_offset = [400, 350, 300]\n')
+    proc = run_filter(program, tmp_path)
+    assert proc.returncode == 0, proc.stderr.decode()
+    progress = [int(n) for n in re.findall(r"^FILTER_PROGRESS=(\d+)$", proc.stderr.decode(), re.M)]
+    assert progress[0] == 0 and progress[-1] == 100 and len(progress) >= 4
+    assert progress == sorted(progress)
+    out = tmp_path / "compensated.ngc"
+    out.write_bytes(proc.stdout)
+    assert proc.stdout.startswith(b"(ncpp compensated for hr5b.toml")
+    compensated, plain = end_points(run_rs274(out)), end_points(run_rs274(program))
+    assert len(compensated) >= len(plain) and compensated != plain
+
+
+def test_without_machine_file_the_program_loads_unchanged(program, tmp_path):
+    proc = run_filter(program, tmp_path)
+    assert proc.returncode == 0 and proc.stdout == program.read_bytes()
+
+
+def test_a_compensated_program_is_not_compensated_again(program, tmp_path):
+    (tmp_path / "ncpp.toml").write_text(f'machine = "{MACHINE}"\nwork_offset = [400, 350, 300]\n')
+    first = run_filter(program, tmp_path)
+    assert first.returncode == 0, first.stderr.decode()
+    again_in = tmp_path / "again.ngc"
+    again_in.write_bytes(first.stdout)
+    again = run_filter(again_in, tmp_path)
+    assert again.returncode == 0 and again.stdout == first.stdout
+
+
+def test_an_error_reaches_linuxcnc_as_exit_status_and_message(tmp_path):
+    bad = tmp_path / "bad.ngc"
+    bad.write_text("G21 G90\nG0 X5000 Y0 Z0\nM2\n")
+    proc = run_filter(bad, tmp_path, NCPP_MACHINE=str(MACHINE))
+    assert proc.returncode != 0 and proc.stdout == b""
+    assert f"{bad}:2:" in proc.stderr.decode() and "outside the X travel" in proc.stderr.decode()
