@@ -13,7 +13,6 @@ by writing one more such function and appending it to SECTIONS.
 from __future__ import annotations
 
 import argparse
-import inspect
 import io
 import json
 import os
@@ -24,7 +23,7 @@ import tempfile
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable, Iterator
+from typing import Any, Callable, Iterable
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
@@ -79,36 +78,42 @@ def interpreter() -> Callable | None:
     return interpret
 
 
-def _interpret_call(interpret: Callable, blocks: Iterator, name: str) -> Iterator:
-    from ncpp.errors import Warnings
-
-    accepted = inspect.signature(interpret).parameters
-    options = {"file": name, "warnings": Warnings(stream=open(os.devnull, "w")), "strict": False}
-    return interpret(blocks, **{k: v for k, v in options.items() if k in accepted})
-
-
 def ncpp_rate(path: Path, interpret: Callable | None) -> dict[str, Any]:
-    """Parse (and interpret) a program in this process; lines/s over the whole file."""
+    """Parse (and interpret) a program in this process; lines/s over the lines read.
+
+    The interpreter stops at a construct outside its scope (with a warning):
+    `lines` then counts the lines it consumed, and `warnings` says so.
+    """
+    from ncpp.errors import NcppError, Warnings
     from ncpp.program.parser import parse_stream
 
+    warnings, events, error = io.StringIO(), None, ""
     start = time.perf_counter()
     with open(path, "rb") as stream:
-        blocks = parse_stream(stream, str(path))
-        if interpret is None:
-            lines = sum(1 for _ in blocks)
-            events = None
-        else:
-            counted = _Counter(blocks)
-            events = sum(1 for _ in _interpret_call(interpret, counted, str(path)))
-            lines = counted.count
+        counted = _Counter(parse_stream(stream, str(path)))
+        try:
+            if interpret is None:
+                for _ in counted:
+                    pass
+            else:
+                events = sum(1 for _ in interpret(counted, file=str(path), warnings=Warnings(stream=warnings)))
+        except NcppError as err:
+            error = str(err)
     seconds = time.perf_counter() - start
-    return {"lines": lines, "seconds": seconds, "lines_per_s": lines / seconds, "events": events}
+    return {
+        "lines": counted.count,
+        "seconds": seconds,
+        "lines_per_s": counted.count / seconds,
+        "events": events,
+        "warnings": warnings.getvalue().splitlines()[:5],
+        "error": error,
+    }
 
 
 class _Counter:
     """Passes blocks through and counts them."""
 
-    def __init__(self, blocks: Iterator):
+    def __init__(self, blocks: Iterable):
         self.blocks, self.count = blocks, 0
 
     def __iter__(self):
@@ -162,7 +167,12 @@ def peak_rss(path: Path) -> dict[str, Any]:
     start = time.perf_counter()
     with open(path, "rb") as stdin:
         proc = subprocess.Popen(
-            [sys.executable, "-m", "ncpp"], stdin=stdin, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, cwd=ROOT
+            [sys.executable, "-m", "ncpp"],
+            stdin=stdin,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.PIPE,
+            cwd=path.parent,  # no ./ncpp.toml there: the filter passes the program through (after interpreting it)
+            env={**{k: v for k, v in os.environ.items() if k != "NCPP_MACHINE"}, "PYTHONPATH": str(ROOT)},
         )
         stderr = proc.stderr.read()  # type: ignore[union-attr]
         _, status, usage = os.wait4(proc.pid, 0)
@@ -202,9 +212,9 @@ def throughput(ctx: Context) -> Section:
             "ratio_ncpp_pygcode": ours["lines_per_s"] / pyg["lines_per_s"],
             "ratio_ncpp_rs274": ours["lines_per_s"] / rs["lines_per_s"],
         }
-        rows.append([label, "ncpp parse", _rate(parse), ""])
+        rows.append([label, "ncpp parse", _rate(parse), _stopped(parse, lines).lstrip("; ")])
         if full:
-            rows.append([label, "ncpp parse+interpret", _rate(full), f"{full['events']:,} events"])
+            rows.append([label, "ncpp parse+interpret", _rate(full), f"{full['events'] or 0:,} events" + _stopped(full, lines)])
         rows.append([label, "pygcode Line()", _rate(pyg), f"{pyg['failed_lines']:,} lines refused"])
         rows.append([label, "rs274 (process)", _rate(rs), "completed" if rs["completed"] else f"STOPPED: {rs['error']}"])
         what = "parse+interpret" if full else "parse"
@@ -244,7 +254,24 @@ def memory(ctx: Context) -> Section:
 SECTIONS: list[Callable[[Context], Section]] = [throughput, memory]
 
 
+def _compensation_sections() -> list[Callable[[Context], Section]]:
+    from accuracy import accuracy
+    from compensate_speed import compensate_speed
+
+    return [compensate_speed, accuracy]
+
+
+SECTIONS += _compensation_sections()
+
+
 # -- running and reporting --------------------------------------------------------
+
+
+def _stopped(result: dict[str, Any], lines: int) -> str:
+    if result["lines"] >= lines and not result["error"]:
+        return ""
+    why = result["error"] or (result["warnings"] or ["?"])[0]
+    return f"; STOPPED after {result['lines']:,} lines: {why}"
 
 
 def _rate(result: dict[str, Any]) -> str:

@@ -1,0 +1,106 @@
+"""Compensation throughput and memory (issue 4, item 7): a section of `benchmarks/run.py`.
+
+On the core benchmark's files (stellabee1.ngc and the generated G1/G2/G3
+program), one run times, in this process: `ncpp` passthrough (no machine),
+`ncpp compensate` with the HR5B sample machine at 1 µm, pygcode's `Line()`
+parse and LinuxCNC's rs274.  Floor: compensation at least as fast as
+pygcode's parse.  Memory: peak RSS of the `ncpp compensate` process on two
+program lengths (1M and 10M lines; 100k and 250k with --quick).
+"""
+
+from __future__ import annotations
+
+import io
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parent
+MACHINE = ROOT / "samples/machines/hr5b.toml"
+TOLERANCE = 0.001
+
+
+def work_offset(path: Path) -> tuple[float, float, float]:
+    """Centre of HR5B's travel minus the centre of the program's extent (first 20k lines suffice:
+    the generated program stays in a fixed box; stellabee's extent is the file's)."""
+    import numpy as np
+
+    from accuracy import events_of, machine, placement
+    from ncpp.simulate import sample_events
+
+    with open(path, "rb") as f:
+        head = b"".join(line for _, line in zip(range(20_000), f))
+    offset = placement(sample_events(events_of(head, str(path)), step_mm=5.0), machine("hr5b"))
+    return tuple(float(v) for v in np.asarray(offset))  # type: ignore[return-value]
+
+
+def ncpp_process_rate(path: Path, offset: tuple[float, float, float] | None) -> dict[str, Any]:
+    """`process` over the whole file into a null sink: passthrough (offset None) or compensation."""
+    from accuracy import QUIET
+    from ncpp.pipeline import ErrorSource, process
+
+    source = None if offset is None else ErrorSource.from_machine_file(str(MACHINE)).shifted(offset)
+    sink = open(os.devnull, "wb")
+    start = time.perf_counter()
+    with open(path, "rb") as stream:
+        stats = process(stream, sink, file=str(path), source=source, tolerance=TOLERANCE, warnings=QUIET)
+    seconds = time.perf_counter() - start
+    return {"lines": stats.lines_in, "lines_out": stats.lines_out, "seconds": seconds, "lines_per_s": stats.lines_in / seconds}
+
+
+def compensate_rss(path: Path, offset: tuple[float, float, float]) -> dict[str, Any]:
+    """Peak RSS (MB) of `python -m ncpp compensate ... < path > /dev/null`, from wait4."""
+    command = [sys.executable, "-m", "ncpp", "compensate", "--machine", str(MACHINE), "--work-offset", ",".join(map(str, offset))]
+    start = time.perf_counter()
+    with open(path, "rb") as stdin:
+        proc = subprocess.Popen(command, stdin=stdin, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, cwd=ROOT)
+        stderr = proc.stderr.read()  # type: ignore[union-attr]
+        _, status, usage = os.wait4(proc.pid, 0)
+    return {
+        "rss_mb": usage.ru_maxrss / 1024,
+        "seconds": time.perf_counter() - start,
+        "exit": os.waitstatus_to_exitcode(status),
+        "stderr_tail": stderr.decode("latin-1")[-300:],
+    }
+
+
+def compensate_speed(ctx):
+    import run as bench
+
+    lines_generated = 250_000 if ctx.quick else 1_000_000
+    programs = ctx.programs or {"stellabee1.ngc": bench.STELLABEE, f"generated {lines_generated:,} lines": ctx.generated(lines_generated)}
+    rows, data = [], {}
+    for label, path in programs.items():
+        offset = work_offset(path)
+        lines = bench.count_lines(path)
+        passthrough = ncpp_process_rate(path, None)
+        compensated = ncpp_process_rate(path, offset)
+        pyg = bench.pygcode_rate(path)
+        rs = bench.rs274_rate(path, lines)
+        ratio = compensated["lines_per_s"] / pyg["lines_per_s"]
+        data[label] = {"work_offset_mm": offset, "passthrough": passthrough, "compensate": compensated, "pygcode": pyg, "rs274": rs, "ratio_compensate_pygcode": ratio}
+        growth = compensated["lines_out"] / max(compensated["lines"], 1)
+        rows += [
+            [label, "ncpp passthrough", f"{passthrough['lines_per_s']:,.0f}", ""],
+            [label, "ncpp compensate 1 µm (HR5B)", f"{compensated['lines_per_s']:,.0f}", f"lines out/in {growth:.2f}"],
+            [label, "pygcode Line()", f"{pyg['lines_per_s']:,.0f}", ""],
+            [label, "rs274 (process)", f"{rs['lines_per_s']:,.0f}", "completed" if rs["completed"] else "STOPPED"],
+            [label, "ratio compensate / pygcode", f"{ratio:.2f}x", "floor 1.00x: " + ("met" if ratio >= 1 else "SHORT")],
+        ]
+    sizes = [100_000, 250_000] if ctx.quick else [1_000_000, 10_000_000]
+    memory = {}
+    for n in sizes:
+        path = ctx.generated(n)
+        memory[str(n)] = result = compensate_rss(path, work_offset(path))
+        if n >= 10_000_000:
+            path.unlink()
+        status = "ok" if result["exit"] == 0 else f"exit {result['exit']}: {result['stderr_tail'].strip()[-100:]}"
+        rows.append([f"generated {n:,} lines", "peak RSS, ncpp compensate", f"{result['rss_mb']:.1f} MB", f"{n / result['seconds']:,.0f} lines/s; {status}"])
+    rss = [m["rss_mb"] for m in memory.values()]
+    data["memory"] = memory
+    notes = [f"peak RSS of `ncpp compensate` grows by {max(rss) - min(rss):.1f} MB from {sizes[0]:,} to {sizes[-1]:,} lines"]
+    return bench.Section("Compensation throughput (lines in/s) and memory", ["program", "tool", "rate", "note"], rows, data, notes)

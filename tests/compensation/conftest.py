@@ -1,0 +1,40 @@
+"""Helpers for the compensation tests: place a program in a machine's travel and compensate it."""
+
+from __future__ import annotations
+
+import io
+import os
+
+import numpy as np
+
+from ncpp.errors import Warnings
+from ncpp.motion import interpret
+from ncpp.pipeline import ErrorSource, process
+from ncpp.program.parser import parse_stream
+from ncpp.simulate import SampledPath, sample_events
+
+QUIET = Warnings(stream=open(os.devnull, "w"))
+MARGIN_MM = 1.0
+
+
+def events_of(data: bytes, name: str = "<test>") -> list:
+    return list(interpret(parse_stream(io.BytesIO(data), name), file=name, warnings=QUIET))
+
+
+def placement(path: SampledPath, limits) -> np.ndarray | None:
+    """Work offset (mm) centring the program's extent in the travel; None if it does not fit."""
+    if len(path.points) == 0:
+        return None
+    lo_p, hi_p = path.points.min(axis=0), path.points.max(axis=0)
+    lo_m = np.array([limits[a][0] for a in "XYZ"])
+    hi_m = np.array([limits[a][1] for a in "XYZ"])
+    if np.any(hi_p - lo_p > hi_m - lo_m - 2 * MARGIN_MM):
+        return None
+    return np.round((lo_m + hi_m) / 2 - (lo_p + hi_p) / 2, 3)
+
+
+def compensate(data: bytes, model, offset, tolerance: float = 0.001, name: str = "<test>") -> bytes:
+    source = ErrorSource(model, "model", "0" * 16, model.max_correction_mm, dict(model.limits)).shifted(tuple(offset))
+    out = io.BytesIO()
+    process(io.BytesIO(data), out, file=name, source=source, tolerance=tolerance, warnings=QUIET)
+    return out.getvalue()

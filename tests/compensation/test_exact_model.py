@@ -1,0 +1,51 @@
+"""Item 4's guarantee as a test: compensated with the exact model of the machine's
+repeatable geometric errors (the HR5B sample with its reversal tables replaced by
+their mean: see benchmarks/accuracy.py for why), the simulated contour error is
+within the tolerance + 0.5 µm everywhere, for lines, G17/G18/G19 arcs, helices, inch."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from ncpp.machine import load_machine
+from ncpp.machine.components import Table
+from ncpp.simulate import contour_error, sample_events
+from tests.compensation.conftest import compensate, events_of, placement
+from tests.conftest import CORPUS, ROOT
+
+START = b"G0 X0 Y0 Z0\n"  # these short programs feed before positioning every axis
+PROGRAMS = {
+    "pocket": (ROOT / "samples/programs/pocket.ngc", b""),
+    "arc-xz (G18)": (CORPUS / "iso_gcode/cncjs/arc-xz-plane.gcode", START),
+    "arc-yz (G19)": (CORPUS / "iso_gcode/cncjs/arc-yz-plane.gcode", START),
+    "platteyz helix": (CORPUS / "iso_gcode/freecad_grbl/platteyz-pass-3-helix.nc", b""),
+    "arcspiral (inch)": (CORPUS / "iso_gcode/linuxcnc/arcspiral.ngc", b""),
+}
+
+
+@pytest.fixture(scope="module")
+def machine():
+    true = load_machine(ROOT / "samples/machines/hr5b.toml").replace(effects=())
+    comps = {}
+    for name, c in true.components.items():
+        if isinstance(c, Table) and c.values_minus is not None:
+            c = Table(c.positions, (np.asarray(c.values) + np.asarray(c.values_minus)) / 2, None, c.interpolation)
+        comps[name] = c
+    return true.replace(components=comps)
+
+
+@pytest.mark.parametrize("tolerance", [0.001, 0.005])
+@pytest.mark.parametrize("name", list(PROGRAMS))
+def test_contour_error_within_tolerance(name, tolerance, machine):
+    path, start = PROGRAMS[name]
+    if not path.exists():
+        pytest.skip("corpus not available")
+    data = start + path.read_bytes()
+    offset = placement(sample_events(events_of(data)), machine.limits)
+    nominal = sample_events(events_of(data), work_offset=offset)
+    before = contour_error(machine, nominal, nominal, feed_effects=False)
+    commanded = sample_events(events_of(compensate(data, machine, offset, tolerance)), work_offset=offset)
+    after = contour_error(machine, commanded, nominal, feed_effects=False)
+    assert before.max_um > 20.0  # the machine is wrong enough for the check to mean something
+    assert after.max_um <= tolerance * 1000 + 0.5, f"{after.max_um:.2f} µm at line {after.worst_line}"
