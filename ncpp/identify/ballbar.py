@@ -408,10 +408,24 @@ def fit_ballbar(
         FileFit(o.name, _setup(o.measurement), s, b0, a0) for o, s, b0, a0 in zip(obs, sigma, before, after)
     )
     flat = _profiled(obs, r[:, None], [1.0] * len(obs))[:, 0]
-    fitted = _named(current, blocks, null)
+    # A table no value of which the data fix is not written (its min-norm values are ~0 anyway).
+    written, col = np.zeros(len(theta), dtype=bool), 0
+    for b in blocks:
+        written[col : col + b.size] = bool(np.any(null[col : col + b.size] <= 0.5))
+        col += b.size
+    kept = [b for b, s in zip(blocks, _slices(blocks)) if written[s].all()]
+    fitted = _named(apply(machine, kept, theta[written]), blocks, null)
     return BallbarFit(
         fitted, tuple(blocks), theta, u, groups, files, float(lam), trace, float(np.sqrt(np.mean(flat**2)))
     )
+
+
+def _slices(blocks: Sequence[Block]) -> list[slice]:
+    out, col = [], 0
+    for b in blocks:
+        out.append(slice(col, col + b.size))
+        col += b.size
+    return out
 
 
 def _named(machine: Machine, blocks: Sequence[Block], null: NDArray) -> Machine:
