@@ -42,7 +42,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     source = parser.add_mutually_exclusive_group(required=True)
     source.add_argument("--machine", metavar="M.toml", help="machine file")
-    source.add_argument("--from", dest="sources", nargs="+", metavar="FILE", help="laser / comparator / level files to fit first")
+    source.add_argument("--from", dest="sources", nargs="+", metavar="FILE", help="laser / comparator / level / ball-bar files to fit first (ncpp fit)")
     parser.add_argument("--chain", help="chain for --from when there is no --base (default XYFZ)")
     parser.add_argument("--base", metavar="M0.toml", help="machine whose structure --from keeps")
     parser.add_argument("--save-machine", metavar="M.toml", help="with --from: also write the fitted machine")
