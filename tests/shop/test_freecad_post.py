@@ -1,0 +1,68 @@
+"""The FreeCAD post processor run by real FreeCAD (`freecadcmd`, headless):
+a box, a Path Job, a profile, posted with `ncpp` from the macro directory."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from tests.conftest import ROOT
+from tests.shop.rs274 import end_points, run_rs274
+
+FREECADCMD = shutil.which("freecadcmd")
+MACHINE = ROOT / "samples/machines/hr5b.toml"
+pytestmark = pytest.mark.skipif(FREECADCMD is None, reason="freecadcmd (Debian package freecad) is not installed")
+
+
+@pytest.fixture(scope="module")
+def posted(tmp_path_factory):
+    """(compensated, plain) programs posted by FreeCAD through ncpp_post."""
+    tmp = tmp_path_factory.mktemp("freecad")
+    home = tmp / "home"
+    macros = home / ".local/share/FreeCAD/Macro"  # FreeCAD's user macro directory under $HOME
+    macros.mkdir(parents=True)
+    shutil.copy(ROOT / "plugins/freecad/ncpp_post.py", macros)
+    ncpp = tmp / "ncpp"  # the ncpp command of this checkout (an installed one is on PATH as `ncpp`)
+    ncpp.write_text(f"#!/bin/sh\nPYTHONPATH={ROOT} exec {sys.executable} -m ncpp \"$@\"\n")
+    ncpp.chmod(0o755)
+    env = {k: v for k, v in os.environ.items() if k not in ("NCPP_MACHINE", "XDG_CONFIG_HOME", "PYTHONPATH")}
+    env.update(
+        HOME=str(home),
+        NCPP_OUT=str(tmp / "compensated.ngc"),
+        NCPP_POST_ARGS=f"--ncpp {ncpp} --machine {MACHINE} --work-offset 400,350,300 --precision 4",
+        NCPP_PLAIN_OUT=str(tmp / "plain.ngc"),
+        NCPP_PLAIN_ARGS=f"--ncpp {ncpp} --precision 4",
+    )
+    proc = subprocess.run([FREECADCMD, str(ROOT / "tests/shop/freecad/post_job.py")], capture_output=True, text=True, errors="replace", cwd=tmp, env=env, timeout=600)
+    if "NCPP_POSTED" not in proc.stdout:
+        pytest.fail("FreeCAD did not post:\n" + proc.stdout[-3000:] + proc.stderr[-2000:])
+    return tmp / "compensated.ngc", tmp / "plain.ngc"
+
+
+def test_freecad_posts_a_compensated_program(posted):
+    compensated, _ = posted
+    lines = compensated.read_text().splitlines()
+    assert lines[0].startswith("(ncpp compensated for hr5b.toml sha256:")
+    assert "(Exported by FreeCAD)" in lines[:5] and any("linuxcnc_post" in ln for ln in lines[:5])
+    assert any(ln.startswith(("G2", "G3")) for ln in lines)  # the profile's corner arcs stay arcs
+
+
+def test_linuxcnc_accepts_it_and_the_path_is_corrected_by_microns(posted):
+    compensated, plain = posted
+    plain_ends = np.array(end_points(run_rs274(plain)))
+    compensated_ends = np.array(end_points(run_rs274(compensated)))
+    assert len(plain_ends) > 10
+    # Every programmed end point is reached within the correction (lines may be subdivided).
+    nearest = np.array([np.abs(compensated_ends - p).max(axis=1).min() for p in plain_ends[1:]])
+    assert 1e-3 < nearest.max() < 0.1
+
+
+def test_without_a_machine_file_the_post_is_freecads_own(posted):
+    _, plain = posted
+    text = plain.read_text()
+    assert "ncpp compensated" not in text and text.startswith("(Exported by FreeCAD)")
