@@ -21,8 +21,8 @@ from ncpp.motion.segments import Event
 from ncpp.passes import PASSES, PassContext, run_passes
 from ncpp.passes.context import is_directional
 from ncpp.program.blocks import Block, Comment
+from ncpp.program.dialects import parse_program
 from ncpp.program.dialects.iso import IsoWriter
-from ncpp.program.parser import parse_stream
 
 HEADER_TAG = "ncpp compensated"
 HEADER_SCAN = 30  # blocks at the top searched for an earlier header
@@ -120,8 +120,29 @@ def _counted(blocks: Iterable[Block], stats: Stats, progress: Callable[[int], No
         yield block
 
 
+# Per dialect: the module of its interpreter (an `interpret` function) and its writer class.
+DIALECT_TOOLS = {
+    "iso": ("ncpp.motion.interpreter", "ncpp.program.dialects.iso", "IsoWriter"),
+    "heidenhain": ("ncpp.motion.heidenhain", "ncpp.program.dialects.heidenhain", "HeidenhainWriter"),
+    "sinumerik": ("ncpp.motion.sinumerik", "ncpp.program.dialects.sinumerik", "SinumerikWriter"),
+}
+
+
+def dialect_tools(name: str) -> tuple[Callable, type]:
+    """(interpret, Writer) of a dialect."""
+    import importlib
+
+    interpreter, writer_module, writer = DIALECT_TOOLS[name]
+    return importlib.import_module(interpreter).interpret, getattr(importlib.import_module(writer_module), writer)
+
+
 def with_header(lines: Iterable[str], header: str, writer: IsoWriter) -> Iterator[str]:
-    """Put the header comment first, after a leading `%` tape mark line."""
+    """Put the header comment first, after a leading `%` tape mark line (or where the
+    dialect's writer puts it: Heidenhain after `BEGIN PGM`)."""
+    own = getattr(writer, "with_header", None)
+    if own is not None:
+        yield from own(lines, header)
+        return
     it = iter(lines)
     first = next(it, None)
     if first is None:
@@ -161,17 +182,21 @@ def process(
     force: bool = False,
     warnings: Warnings | None = None,
     progress: Callable[[int], None] | None = None,
+    dialect: str | None = None,
 ) -> Stats:
-    """Read, interpret, compensate (when `source` is given) and write one program."""
-    from ncpp.motion import interpret
+    """Read, interpret, compensate (when `source` is given) and write one program.
 
+    The dialect is detected from the content (and the file name) unless given;
+    it picks the interpreter and the writer (DIALECT_TOOLS)."""
     warnings = warnings or Warnings(strict=strict)
     stats = Stats()
-    blocks: Iterable[Block] = _counted(parse_stream(stream, file), stats, progress)
+    name, parsed = parse_program(stream, file, dialect)
+    interpret, writer_class = dialect_tools(name)
+    blocks: Iterable[Block] = _counted(parsed, stats, progress)
     if source is not None and not force:
         blocks = refuse_compensated(blocks, file)
     events: Iterable[Event] = interpret(blocks, file=file, warnings=warnings, strict=strict)
-    writer = IsoWriter()
+    writer = writer_class()
     if source is None:
         lines: Iterable[str] = (event.block.text for event in _first_per_block(events))
     else:

@@ -66,7 +66,10 @@ def run(args: argparse.Namespace) -> int:
         raise NcppError("--tolerance must be positive")
     warnings = Warnings(strict=args.strict)
     with open_input(args.input) as (stream, name), open_output(args.output) as out:
-        stats = process(stream, out, file=name, source=source, tolerance=args.tolerance, strict=args.strict, force=args.force, warnings=warnings)
+        stats = process(
+            stream, out, file=name, source=source, tolerance=args.tolerance, strict=args.strict, force=args.force,
+            warnings=warnings, dialect=args.dialect,
+        )
     if sys.stderr.isatty():
         print(f"ncpp: {stats.lines_in} lines in, {stats.lines_out} lines out", file=sys.stderr)
     return 0

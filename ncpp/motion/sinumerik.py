@@ -212,7 +212,7 @@ class SinumerikInterpreter(ModalInterpreter):
         if not has_axes and not (arc_words and motion in (2.0, 3.0)):
             return []
         end = self._target(words)
-        absolute = self.absolute and not any(words[a][1] == "ic" for a in AXES if a in words)
+        absolute = self.absolute  # the modal mode: a rewritten word is written plain, in that mode
         if motion in (0.0, 1.0):
             return [self.line(block, end, motion == 0.0, absolute)]
         if motion == "CT":

@@ -211,3 +211,210 @@ class HeidenhainBuilder(Transformer):
 
 
 HEIDENHAIN = Dialect("heidenhain", "heidenhain", HeidenhainBuilder, fast_terminals=(), continuation="~")
+
+
+# ---- writer ------------------------------------------------------------------------------
+
+from dataclasses import replace  # noqa: E402  (the writer half of the module)
+
+from ncpp.motion.segments import PLANE_AXES, Arc, Line  # noqa: E402
+from ncpp.program.blocks import Block  # noqa: E402
+from ncpp.program.dialects.editing import splice  # noqa: E402
+from ncpp.program.dialects.iso import IsoWriter  # noqa: E402
+from ncpp.program.numbers import NumberStyle, format_number  # noqa: E402
+
+_AXES = "XYZ"
+_POLAR_WORDS = frozenset(("R", "PR", "PA", "IPR", "IPA"))
+_POLE_FUNCTIONS = frozenset(("C", "CP", "LP", "CTP", "CRP"))  # path functions that use the pole
+ANGLE_STYLE = NumberStyle(decimals=6, plus_sign=True)
+
+
+def _function(block: Block) -> tuple[int, str] | tuple[None, None]:
+    for n, item in enumerate(block.items):
+        if type(item) is Statement and item.kind == "path":
+            return n, item.node[0]
+    return None, None
+
+
+class HeidenhainWriter(IsoWriter):
+    """Klartext writer.  Every block after an inserted one is renumbered (the
+    number plus the blocks inserted so far), `END PGM` included.  A changed
+    line edits its block (X/Y/Z absolute, IX/IY/IZ incremental as written; `LP`
+    becomes `L`); a changed arc writes its own `CC` and then `C ... DR±` (`CP
+    IPA ... IZ ... DR±` for a helix), and a verbatim block that relies on the
+    program's pole gets that pole back in a `CC` block first."""
+
+    comment_open, comment_close = "; ", ""
+
+    def __init__(self, mm_decimals: int = 4, inch_decimals: int = 5):
+        super().__init__(mm_decimals, inch_decimals)
+        self.shift = 0  # blocks inserted so far: added to every later block number
+        self.last_number = -1
+        self.header: str | None = None
+        self.program_pole: tuple | None = None  # (centre, plane) as the program set it
+        self.output_pole: tuple | None = None  # what the output's last CC says
+        self.changed_any = False
+        self.eol = "\n"
+
+    def with_header(self, lines, header: str):
+        """The header goes after `BEGIN PGM` as a numbered comment block (set before writing)."""
+        self.header = header
+        return lines
+
+    # -- numbering ------------------------------------------------------------------------
+    def _numbered(self, block: Block, raw: str) -> str:
+        """`raw` (the block's text, edited or not) with the block's number shifted."""
+        number = next((i for i in block.items if type(i) is Word and i.letter == "N"), None)
+        if number is None:
+            return raw + block.eol
+        self.last_number = int(number.value) + self.shift
+        if self.shift:
+            raw = raw[: number.start] + str(self.last_number) + raw[number.end :]
+        return raw + block.eol
+
+    def _inserted(self, text: str) -> str:
+        self.shift += 1
+        self.last_number += 1
+        return f"{self.last_number} {text}{self.eol}"
+
+    # -- the stream -----------------------------------------------------------------------
+    def _write_group(self, group):
+        from ncpp.motion.heidenhain import Pole
+
+        block = group[0].block
+        self.eol = block.eol or self.eol
+        if self.header is not None and self.last_number < 0 and not any(
+            type(i) is Statement and i.kind == "program_begin" for i in block.items
+        ):
+            yield self._header_first(block)
+        self._learn_styles(block)
+        motion = [e for e in group if type(e) is Line or type(e) is Arc]
+        pole = next((e for e in group if type(e) is Pole), None)
+        _, function = _function(block)
+        if not any(e.changed for e in motion):
+            if pole is not None:
+                self.program_pole = self.output_pole = (pole.center, pole.plane)
+                incremental = any(type(i) is Word and i.letter in ("IX", "IY", "IZ") for i in block.items)
+                if incremental and self.changed_any:  # relative to a position the output moved
+                    yield self._inserted_replacing(block, self._cc_text(pole.center, pole.plane))
+                    return
+            elif function in _POLE_FUNCTIONS and self.program_pole and self.output_pole != self.program_pole:
+                yield self._inserted(self._cc_text(*self.program_pole))
+                self.output_pole = self.program_pole
+            yield self._numbered(block, block.raw)
+            if self.header is not None and any(type(i) is Statement and i.kind == "program_begin" for i in block.items):
+                yield self._inserted(self.comment(self.header))
+                self.header = None
+            for segment in motion:
+                self._remember_end(segment)
+            return
+        self.changed_any = True
+        # the block itself says the first segment of its own kind; steps before and pieces after are new blocks
+        own_kind = Line if function in ("L", "LP") else Arc
+        own = next((n for n, e in enumerate(motion) if type(e) is own_kind), 0)
+        for n, segment in enumerate(motion):
+            if type(segment) is Arc:
+                centre_plane = (segment.center, segment.context.plane)
+                yield self._inserted(self._cc_text(*centre_plane))
+                self.output_pole = centre_plane
+            if n == own:
+                yield self._numbered(block, self._edit(block, segment))
+            else:
+                yield self._inserted(self._fresh(segment))
+            self._remember_end(segment)
+
+    def _header_first(self, block: Block) -> str:
+        self.last_number = -1
+        line = self._inserted(self.comment(self.header))  # numbered 0; the program shifts by one
+        self.header = None
+        return line
+
+    def _inserted_replacing(self, block: Block, text: str) -> str:
+        number = next((i for i in block.items if type(i) is Word and i.letter == "N"), None)
+        self.last_number = (int(number.value) if number is not None else self.last_number + 1) + self.shift
+        return f"{self.last_number} {text}{block.eol}"
+
+    # -- text -----------------------------------------------------------------------------
+    def _style(self, letter: str, segment: Line | Arc) -> NumberStyle:
+        base = letter[-1] if letter.startswith("I") and len(letter) == 2 else letter
+        style = self.styles.get(letter) or self.styles.get(base) or self.styles.get("X") or NumberStyle(decimals=3)
+        style = style.at_least(self.inch_decimals if segment.context.inch else self.mm_decimals)
+        return replace(style, plus_sign=True)  # Klartext signs every coordinate
+
+    def _word(self, letter: str, value: float, segment: Line | Arc) -> str:
+        return letter + format_number(value, self._style(letter, segment))
+
+    def _cc_text(self, centre, plane: int) -> str:
+        a, b, _ = PLANE_AXES[plane]
+        first, second = sorted((a, b))
+        style = replace((self.styles.get("X") or NumberStyle(decimals=3)).at_least(self.mm_decimals), plus_sign=True)
+        return f"CC {_AXES[first]}{format_number(centre[first], style)} {_AXES[second]}{format_number(centre[second], style)}"
+
+    def _is_helix(self, segment: Arc) -> bool:
+        n = PLANE_AXES[segment.context.plane][2]
+        return float(self._format(_AXES[n], segment.end[n] - segment.start[n], segment)) != 0.0
+
+    def _fresh(self, segment: Line | Arc) -> str:
+        """A new block for a further piece of a changed block."""
+        if type(segment) is Line:
+            words = [self._word(_AXES[n], segment.end[n], segment) for n in range(3)
+                     if self._format(_AXES[n], segment.end[n], segment) != self.last_written.get(_AXES[n])]
+            return "L " + " ".join(words) + (" FMAX" if segment.rapid else "")
+        return self._arc_text(segment)
+
+    def _arc_text(self, segment: Arc) -> str:
+        rotation = "DR+" if segment.turn > 0 else "DR-"
+        a, b, n = PLANE_AXES[segment.context.plane]
+        if self._is_helix(segment):
+            sweep = format_number(segment.sweep() * 180 / 3.141592653589793, ANGLE_STYLE)
+            return f"CP IPA{sweep} {self._word('I' + _AXES[n], segment.end[n] - segment.start[n], segment)} {rotation}"
+        first, second = sorted((a, b))
+        return f"C {self._word(_AXES[first], segment.end[first], segment)} {self._word(_AXES[second], segment.end[second], segment)} {rotation}"
+
+    def _edit(self, block: Block, segment: Line | Arc) -> str:
+        """The block's raw text made to say `segment` (its other words, F, M, comments kept)."""
+        index, function = _function(block)
+        arc = type(segment) is Arc
+        helix = arc and self._is_helix(segment)
+        if arc and (helix or function not in ("C",)):
+            # another arc form (CR, CT, CP, a helix): the block becomes C/CP, its words replaced
+            texts = {n: None for n, i in enumerate(block.items)
+                     if (type(i) in (Word, ExprWord) and (i.letter in _POLAR_WORDS or i.letter.lstrip("I") in _AXES))
+                     or (type(i) is Statement and i.kind == "rotation")}  # fmt: skip
+            texts[index] = self._arc_text(segment)
+            return splice(block, texts)
+        texts: dict[int, str | None] = {}
+        if not arc and function != "L":  # LP, or a line where the program had an arc: the block becomes L
+            texts[index] = "L"
+            texts.update({n: None for n, i in enumerate(block.items)
+                          if (type(i) in (Word, ExprWord) and i.letter in _POLAR_WORDS)
+                          or (type(i) is Statement and i.kind == "rotation")})  # fmt: skip
+        plane_axes = PLANE_AXES[segment.context.plane][:2] if arc else ()
+        written = set()
+        anchor = block.items[index] if index is not None else None
+        for n, item in enumerate(block.items):
+            if type(item) in (Word, ExprWord) and item.letter.lstrip("I") in _AXES and len(item.letter) <= 2:
+                axis = _AXES.index(item.letter[-1])
+                incremental = item.letter.startswith("I")
+                value = segment.end[axis] - segment.start[axis] if incremental else segment.end[axis]
+                texts[n] = self._word(item.letter, value, segment)
+                written.add(axis)
+                anchor = item
+            elif type(item) is Statement and item.kind == "rotation" and arc:
+                texts[n] = "DR+" if segment.turn > 0 else "DR-"
+        extra = [self._word(_AXES[k], segment.end[k], segment) for k in range(3) if k not in written and (
+            k in plane_axes or (k in self.known_axes_idx() and self._format(_AXES[k], segment.end[k], segment) != self.last_written.get(_AXES[k])))]  # fmt: skip
+        if arc and not any(type(i) is Statement and i.kind == "rotation" for i in block.items):
+            extra.append("DR+" if segment.turn > 0 else "DR-")
+        return splice(block, texts, "".join(" " + w for w in extra), after=anchor)
+
+    def known_axes_idx(self) -> set[int]:
+        return {_AXES.index(a) for a in self.known_axes if a in _AXES}
+
+    def _learn_styles(self, block: Block) -> None:
+        for item in block.items:
+            if type(item) is Word and item.letter not in ("M", "N", "S", "PA", "IPA"):
+                self.styles[item.letter] = NumberStyle.of(item.number)
+                axis = item.letter[-1]
+                if axis in _AXES and item.letter.lstrip("I") == axis:
+                    self.known_axes.add(axis)

@@ -204,3 +204,102 @@ class SinumerikBuilder(Transformer):
 
 
 SINUMERIK = Dialect("sinumerik", "sinumerik", SinumerikBuilder, fast_terminals=("WORD", "SEMI_COMMENT"))
+
+
+# ---- writer ------------------------------------------------------------------------------
+
+from ncpp.motion.segments import Arc, Line  # noqa: E402  (the writer half of the module)
+from ncpp.program.blocks import Block  # noqa: E402
+from ncpp.program.dialects.editing import splice  # noqa: E402
+from ncpp.program.dialects.iso import IsoWriter  # noqa: E402
+from ncpp.program.writer import edit_words, word_separator  # noqa: E402
+
+_ARC_ONLY = ("CR", "TURN", "I1", "J1", "K1")
+_MOTION_PATHS = ("CIP", "CT")
+
+
+class SinumerikWriter(IsoWriter):
+    """ISO writer with Sinumerik spelling: `;` comments, `X=..` for words written as
+    expressions, `CR=` arcs when the program wrote `CR=`, and `CIP` / `CT` blocks
+    rewritten as G2/G3 with I/J/K (the modal `CIP` / `CT` restored for verbatim
+    blocks that rely on it)."""
+
+    comment_open, comment_close = "; ", ""
+
+    @staticmethod
+    def _path(block: Block) -> str | None:
+        return next((i.node[0] for i in block.items if type(i) is Statement and i.kind == "path" and i.node[0] in _MOTION_PATHS), None)
+
+    def _has_motion_word(self, block: Block) -> bool:
+        return super()._has_motion_word(block) or self._path(block) is not None
+
+    def _block_motion(self, block: Block):
+        return self._path(block) or super()._block_motion(block)
+
+    def _restore_mode_line(self, block: Block) -> str:
+        self.output_motion = self.program_motion
+        mode = self.program_motion
+        return f"{mode if isinstance(mode, str) else f'G{mode}'}{block.eol}"
+
+    @staticmethod
+    def _uses_cr(block: Block) -> bool:
+        return any(type(i) is ExprWord and i.letter == "CR" for i in block.items)
+
+    def _words(self, block: Block, segment: Line | Arc) -> dict[str, float]:
+        values = super()._words(block, segment)
+        if type(segment) is Arc and self._uses_cr(block) and abs(segment.sweep()) < 2 * 3.141592653589793 - 1e-9:
+            for letter in "IJK":
+                values.pop(letter, None)
+            values["CR"] = segment.radius() if abs(segment.sweep()) <= 3.141592653589793 else -segment.radius()
+        return values
+
+    def _text(self, letter: str, value: float, segment: Line | Arc) -> str:
+        return f"{letter}={self._format(letter, value, segment)}" if len(letter) > 1 else letter + self._format(letter, value, segment)
+
+    def _edit_block(self, block: Block, segment: Line | Arc) -> str:
+        values = self._words(block, segment)
+        texts: dict[int, str | None] = {}
+        for n, item in enumerate(block.items):
+            if type(item) is ExprWord and item.letter in values:
+                texts[n] = f"{item.letter}={self._format(item.letter, values.pop(item.letter), segment)}"
+            elif type(item) is ExprWord and item.letter in _ARC_ONLY + tuple("IJK"):
+                texts[n] = None
+            elif type(item) is Statement and item.kind == "path" and item.node[0] in _MOTION_PATHS:
+                texts[n] = None
+        had_motion = self._has_motion_word(block)
+        program_motion = self._block_motion(block)
+        code = self._motion_code(segment)
+        if texts:
+            block = _reparse(Block(splice(block, texts), block.eol, (), block.line))
+        styles = {letter: self._style(letter, segment) for letter in values}
+        drop = [letter for letter in "IJK" if letter not in values]
+        raw = edit_words(block, values, styles, drop=drop, motion=code if code != self.output_motion or had_motion else None)
+        if had_motion or code != self.output_motion:
+            self.output_motion = code
+        if had_motion:
+            self.program_motion = program_motion
+        self._remember_end(segment)
+        return raw
+
+    def _new_block(self, block: Block, segment: Line | Arc) -> str:
+        values = self._words(block, segment)
+        code = self._motion_code(segment)
+        parts = []
+        if code != self.output_motion:
+            parts.append(f"G{code}")
+            self.output_motion = code
+        parts += [self._text(letter, value, segment) for letter, value in values.items()]
+        self._remember_end(segment)
+        sep = word_separator(block)
+        return (sep if sep and not sep.strip() else " ").join(parts)
+
+
+_PARSERS: dict[str, object] = {}
+
+
+def _reparse(block: Block) -> Block:
+    """A spliced block read again, so that its items' spans are right."""
+    from ncpp.program.parser import LineParser
+
+    parser = _PARSERS.get("sinumerik") or _PARSERS.setdefault("sinumerik", LineParser(SINUMERIK))
+    return parser.parse(block.raw, block.eol, block.line)  # type: ignore[attr-defined]

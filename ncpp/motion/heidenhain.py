@@ -1,0 +1,238 @@
+"""Heidenhain Klartext blocks -> motion events (`Line`, `Arc`, `Pass`), like `ncpp.motion.interpret`.
+
+Scope: `BEGIN PGM ... MM|INCH`, `TOOL CALL n Z` (the tool axis gives the working
+plane), `L` with X/Y/Z (absolute) and IX/IY/IZ (incremental) per word, `R0`,
+`F`, `FMAX` (rapid, this block only), `FAUTO`, `CC` (the pole; its plane from
+the axes written), `C ... DR±` about the pole, `CR ... R± DR±` (R+: less than a
+half circle), `CT` (tangential arc), `LP`/`CP` polar with PR/IPR/PA/IPA (a
+helix with IZ, several turns with |IPA| > 360), Q parameters with arithmetic,
+labels, `TOOL DEF`, `CYCL DEF` of machining cycles (they only define), M2/M30
+and `END PGM` (end).  Radius compensation RL/RR, RND/CHF, FK free contours,
+APPR/DEP, `CALL LBL`, `CALL PGM`, `CYCL CALL`, M99, FN functions and cycles
+that move the datum make the position unknown: one warning (an error with
+`strict`) and the rest passes through.
+
+A `CC` block yields a `Pole` event (a `Pass` that carries the pole) so that a
+writer can keep the program's pole where compensated arcs need their own.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Iterable, Iterator
+
+from ncpp.errors import Warnings
+from ncpp.motion.modal import PLANE_OF_TOOL_AXIS, ModalInterpreter, OutOfScope, evaluate, resolve_warnings
+from ncpp.motion.segments import PLANE_AXES, Event, Pass, Point
+from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
+
+AXES = "XYZ"
+# Cycles that move or turn the datum (datum shift, mirror, rotation, scaling, working plane, presets)
+DATUM_CYCLES = frozenset(("7", "8", "10", "11", "19", "26", "247"))
+END_M = frozenset((2.0, 30.0))
+HARMLESS_KEYWORDS = frozenset(("STOP",))
+
+
+@dataclass(frozen=True, slots=True)
+class Pole(Pass):
+    """A `CC` block: the pole (circle centre) it sets, in `plane`."""
+
+    center: Point = (0.0, 0.0, 0.0)
+    plane: int = 17
+
+
+def interpret(blocks: Iterable[Block], *, file: str = "<stdin>", warnings: Warnings | None = None,
+              strict: bool = False) -> Iterator[Event]:
+    """Motion events of a Heidenhain program's blocks, lazily (see the module docstring)."""
+    return HeidenhainInterpreter(file).run(blocks, resolve_warnings(warnings, strict))
+
+
+def _plane_of_axes(axes: set[int], default: int) -> int:
+    for plane, (a, b, _) in PLANE_AXES.items():
+        if axes == {a, b}:
+            return plane
+    return default
+
+
+class HeidenhainInterpreter(ModalInterpreter):
+    def __init__(self, file: str = "<stdin>"):
+        super().__init__(file)
+        self.q: dict[str, float] = {}
+        self.pole: list[float] | None = None
+        self.pole_plane = 17
+        self.auto_feed = 0.0
+
+    def lookup(self, name: str) -> float:
+        if name not in self.q:
+            raise OutOfScope(f"the parameter {name.upper()} (not set in the program)")
+        return self.q[name]
+
+    def value(self, expr: tuple, block: Block, item) -> float:
+        try:
+            return evaluate(expr, self.lookup)
+        except OutOfScope as stop:
+            stop.col = item.start + 1
+            raise
+        except (ValueError, OverflowError) as err:
+            self.fail(str(err), block, item)
+        raise AssertionError("unreachable")
+
+    # -- one block ------------------------------------------------------------------------
+    def block(self, block: Block) -> list[Event]:
+        function: str | None = None
+        function_item = None
+        words: dict[str, tuple[float, object]] = {}
+        rapid = False
+        rotation: str | None = None
+        end = False
+        for item in block.items:
+            kind = type(item)
+            if kind is Comment:
+                continue
+            if kind is Word or kind is ExprWord:
+                letter = item.letter
+                value = item.value if kind is Word else self.value(item.expr, block, item)
+                if letter == "N":
+                    continue
+                if letter == "M":
+                    if value in (89.0, 99.0):
+                        raise OutOfScope(f"the cycle call M{value:g}", item.start + 1)
+                    end = end or value in END_M
+                    continue
+                words[letter] = (value, item)
+                continue
+            what, node = item.kind, item.node
+            if what == "path":
+                function, function_item = node[0], item
+            elif what == "program_begin":
+                self.set_units(node[1] == "INCH")
+            elif what == "program_end":
+                end = True
+            elif what == "tool_call":
+                if node[1] is not None:
+                    self.plane = PLANE_OF_TOOL_AXIS[node[1]]
+                    self._context = None
+                return self._tool_call(block)
+            elif what == "radius_comp":
+                if node[0] != "R0":
+                    raise OutOfScope(f"radius compensation {node[0]}", item.start + 1)
+            elif what == "feed":
+                rapid = node[0] == "FMAX"
+                if node[0] == "FAUTO":
+                    self.feed = self.auto_feed
+            elif what == "rotation":
+                rotation = node[0]
+            elif what == "assignment":
+                if node[1][0] != "str":
+                    self.q[node[0][1]] = self.value(node[1], block, item)
+            elif what == "cycle_def":
+                if node[0] in DATUM_CYCLES:
+                    raise OutOfScope(f"CYCL DEF {node[0]} (it moves the datum)", item.start + 1)
+                return []
+            elif what == "keyword" and node and node[0] in HARMLESS_KEYWORDS:
+                continue
+            elif what in ("blk_form", "tool_def"):
+                return []  # their words describe the blank or the tool, not a move
+            elif what != "label":
+                reason = {"call_label": "CALL LBL", "call_program": "CALL PGM", "cycle_call": "CYCL CALL",
+                          "fn": f"FN {node[0]}", "keyword": " ".join(map(str, node))}.get(what, what)  # fmt: skip
+                raise OutOfScope(reason, item.start + 1)
+        if "F" in words and function is not None:
+            self.feed = words["F"][0]
+        events = self._path(block, function, function_item, words, rapid, rotation) if function else []
+        if end:
+            self.done = True
+        return events
+
+    def _tool_call(self, block: Block) -> list[Event]:
+        for item in block.items:
+            if type(item) is Word and item.letter == "F":
+                self.auto_feed = item.value
+        return []
+
+    # -- path functions ---------------------------------------------------------------------
+    def _target(self, words: dict) -> tuple[list[float], set[int]]:
+        """End point of X/Y/Z (absolute) and IX/IY/IZ (incremental) words, and the axes written."""
+        end = list(self.pos)
+        written = set()
+        for n, axis in enumerate(AXES):
+            if axis in words:
+                end[n] = words[axis][0]
+                written.add(n)
+            elif "I" + axis in words:
+                end[n] = self.pos[n] + words["I" + axis][0]
+                written.add(n)
+        return end, written
+
+    def _path(self, block: Block, function: str, item, words: dict, rapid: bool, rotation: str | None) -> list[Event]:
+        end, written = self._target(words)
+        if function == "L":
+            return [self.line(block, end, rapid)] if written else []
+        if function == "CC":
+            return [self._set_pole(block, end, written)]
+        if function == "C":
+            return [self._circle(block, item, end, rotation)]
+        if function == "CR":
+            if "R" not in words:
+                self.fail("CR without a radius R", block, item)
+            clockwise = rotation != "+"
+            centre = self.centre_from_radius(block, words["R"][1], end, words["R"][0], clockwise)
+            return [self.arc(block, end, centre, -1 if clockwise else 1)]
+        if function == "CT":
+            return [self.tangential(block, end)]
+        if function == "LP":
+            return [self.line(block, self._polar(block, item, words, end), rapid)]
+        if function == "CP":
+            return [self._polar_arc(block, item, words, end, rotation)]
+        raise OutOfScope(f"the path function {function}", item.start + 1)
+
+    def _set_pole(self, block: Block, end: list[float], written: set[int]) -> Pole:
+        self.pole = end
+        self.pole_plane = _plane_of_axes(written, self.plane)
+        return Pole(block, tuple(end), self.pole_plane)  # type: ignore[arg-type]
+
+    def _need_pole(self, block: Block, item) -> list[float]:
+        if self.pole is None:
+            self.fail("a circle or polar move with no pole: program CC first", block, item)
+        return self.pole  # type: ignore[return-value]
+
+    def _circle(self, block: Block, item, end: list[float], rotation: str | None):
+        centre = list(self._need_pole(block, item))
+        plane = self.pole_plane
+        self.check_radii(block, item, end, centre, plane)
+        return self.arc(block, end, centre, 1 if rotation == "+" else -1, plane)
+
+    def _polar(self, block: Block, item, words: dict, end: list[float]) -> list[float]:
+        """End point of PR/IPR/PA/IPA about the pole (the third axis from Z/IZ-type words)."""
+        pole = self._need_pole(block, item)
+        a, b, _ = PLANE_AXES[self.pole_plane]
+        radius = math.hypot(self.pos[a] - pole[a], self.pos[b] - pole[b])
+        angle = math.degrees(math.atan2(self.pos[b] - pole[b], self.pos[a] - pole[a]))
+        if "PR" in words:
+            radius = words["PR"][0]
+        elif "IPR" in words:
+            radius += words["IPR"][0]
+        if "PA" in words:
+            angle = words["PA"][0]
+        elif "IPA" in words:
+            angle += words["IPA"][0]
+        end = list(end)
+        end[a] = pole[a] + radius * math.cos(math.radians(angle))
+        end[b] = pole[b] + radius * math.sin(math.radians(angle))
+        return end
+
+    def _polar_arc(self, block: Block, item, words: dict, end: list[float], rotation: str | None):
+        if "PR" in words or "IPR" in words:
+            self.fail("CP takes no radius (it circles the pole at the current distance)", block, item)
+        end = self._polar(block, item, words, end)
+        centre = list(self._need_pole(block, item))
+        turn = 1 if rotation == "+" else -1
+        if "IPA" in words:
+            sweep = abs(words["IPA"][0])
+            if (words["IPA"][0] > 0) != (turn > 0):
+                self.fail("the sign of IPA and the direction DR disagree", block, words["IPA"][1])
+            full, rest = divmod(sweep, 360.0)
+            turns = int(full) + (1 if rest > 1e-9 or full == 0 else 0)
+            turn *= turns
+        return self.arc(block, end, centre, turn, self.pole_plane)
