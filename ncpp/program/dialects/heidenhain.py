@@ -226,7 +226,7 @@ from ncpp.program.numbers import NumberStyle, format_number  # noqa: E402
 _AXES = "XYZ"
 _POLAR_WORDS = frozenset(("R", "PR", "PA", "IPR", "IPA"))
 _POLE_FUNCTIONS = frozenset(("C", "CP", "LP", "CTP", "CRP"))  # path functions that use the pole
-ANGLE_STYLE = NumberStyle(decimals=6, plus_sign=True)
+ANGLE_STYLE = NumberStyle(decimals=7, plus_sign=True)
 
 
 def _function(block: Block) -> tuple[int, str] | tuple[None, None]:
@@ -347,7 +347,8 @@ class HeidenhainWriter(IsoWriter):
     def _cc_text(self, centre, plane: int) -> str:
         a, b, _ = PLANE_AXES[plane]
         first, second = sorted((a, b))
-        style = replace((self.styles.get("X") or NumberStyle(decimals=3)).at_least(self.mm_decimals), plus_sign=True)
+        # two digits more than coordinates: a rounded pole would move the end of a CP helix off the exact point
+        style = replace((self.styles.get("X") or NumberStyle(decimals=3)).at_least(self.mm_decimals + 2), plus_sign=True)
         return f"CC {_AXES[first]}{format_number(centre[first], style)} {_AXES[second]}{format_number(centre[second], style)}"
 
     def _is_helix(self, segment: Arc) -> bool:
