@@ -36,6 +36,7 @@ SHARED = Path(os.environ.get("NCPP_SHARED", ROOT.parent / "shared"))
 STELLABEE = SHARED / "corpus/iso_gcode/linuxcnc/large/stellabee1.ngc"
 RS274 = SHARED / "tools/rs274"
 OUT = HERE / "out" / "results.json"
+PYGCODE_FLOOR = 2.0  # issue 2: ncpp parse+interpret at least twice pygcode's parse rate
 
 
 @dataclass
@@ -218,7 +219,9 @@ def throughput(ctx: Context) -> Section:
         rows.append([label, "pygcode Line()", _rate(pyg), f"{pyg['failed_lines']:,} lines refused"])
         rows.append([label, "rs274 (process)", _rate(rs), "completed" if rs["completed"] else f"STOPPED: {rs['error']}"])
         what = "parse+interpret" if full else "parse"
-        rows.append([label, f"ratio ncpp {what} / pygcode", f"{data[label]['ratio_ncpp_pygcode']:.2f}x", ""])
+        ratio = data[label]["ratio_ncpp_pygcode"]
+        floor = f"floor {PYGCODE_FLOOR:.2f}x: " + ("ok" if ratio >= PYGCODE_FLOOR else "SHORT") if full else ""
+        rows.append([label, f"ratio ncpp {what} / pygcode", f"{ratio:.2f}x", floor])
         rows.append([label, f"ratio ncpp {what} / rs274", f"{data[label]['ratio_ncpp_rs274']:.2f}x", ""])
     notes = [] if interpret else ["ncpp.motion.interpret is not importable yet: ncpp figures are parse only."]
     data["interpreter_available"] = interpret is not None
@@ -311,9 +314,12 @@ def main(argv: list[str] | None = None) -> int:
         for run in SECTIONS:
             if args.only and run.__name__ not in args.only:
                 continue
+            began = time.perf_counter()
             section = run(ctx)
+            took = time.perf_counter() - began
+            section.notes.append(f"section took {took:.0f} s")
             print(render(section), flush=True)
-            results["sections"][run.__name__] = {"title": section.title, "notes": section.notes, **section.data}
+            results["sections"][run.__name__] = {"title": section.title, "notes": section.notes, "seconds": took, **section.data}
     results["seconds"] = time.perf_counter() - started
     print(f"\ntotal {results['seconds']:.0f} s; results in {args.out}")
 
