@@ -53,6 +53,8 @@ def test_any_input_parses_and_roundtrips_or_raises_ncpp_error(data):
     except NcppError as err:
         assert err.where.file == "prop.nc"
         assert err.where.line is not None and 1 <= err.where.line <= data.count(b"\n") + 1
+        line = data.split(b"\n")[err.where.line - 1].removesuffix(b"\r")
+        assert err.where.col is not None and 1 <= err.where.col <= len(line) + 1
         return
     assert written == data
 
