@@ -202,9 +202,15 @@ def process(
     else:
         ctx = make_context(source, tolerance, warnings, file)
         lines = with_header(writer.write(run_passes(events, ctx, PASSES)), header_text(source, tolerance), writer)
+    batch: list[str] = []
     for line in lines:
-        out.write(line.encode("latin-1"))
-        stats.lines_out += 1
+        batch.append(line)
+        if len(batch) == 4096:
+            out.write("".join(batch).encode("latin-1"))
+            stats.lines_out += len(batch)
+            batch.clear()
+    out.write("".join(batch).encode("latin-1"))
+    stats.lines_out += len(batch)
     return stats
 
 

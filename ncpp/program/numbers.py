@@ -37,6 +37,11 @@ class NumberStyle:
             comma=comma,
         )
 
+    @property
+    def plain(self) -> bool:
+        """`-12.345`: what `f"{v:.{decimals}f}"` writes (the writer's fast path)."""
+        return self.decimals > 0 and self.leading_zero and not (self.int_width or self.plus_sign or self.comma)
+
     def at_least(self, decimals: int) -> "NumberStyle":
         """The same style with at least `decimals` places (never lose resolution)."""
         if decimals <= self.decimals:
@@ -45,6 +50,9 @@ class NumberStyle:
 
 
 def format_number(value: float, style: NumberStyle) -> str:
+    if style.plain:  # the common style: Python's own fixed-point format is exactly it
+        text = f"{value:.{style.decimals}f}"
+        return text[1:] if text[0] == "-" and not text.strip("-0.") else text
     text = f"{abs(value):.{style.decimals}f}"
     if float(text) == 0.0:
         value = 0.0  # no `-0.000`

@@ -53,29 +53,34 @@ def edit_words(
         block = _with_motion(block, motion)
     raw = block.raw
     pieces: list[str] = []
+    size = 0  # length of what `pieces` holds
     cursor = 0
     pending = dict(values)
     dropped = set(drop)
     last_word_end = None  # where appended words go: after the last axis word, else the last word
     seen_axis = False
     for item in block.items:
-        if type(item) is Word and (item.letter in pending or item.letter in dropped):
-            pieces.append(raw[cursor : item.start])
+        kind = type(item)
+        if kind is Word and (item.letter in pending or item.letter in dropped):
+            gap = raw[cursor : item.start]
             if item.letter in pending:
-                letter_as_written = raw[item.start]
-                pieces.append(letter_as_written + format_number(pending.pop(item.letter), style_for[item.letter]))
-            else:
-                # remove the word and the separator before it
-                if pieces and pieces[-1].endswith((" ", "\t")) and item.start > cursor:
-                    pieces[-1] = pieces[-1].rstrip(" \t")
+                text = raw[item.start] + format_number(pending.pop(item.letter), style_for[item.letter])
+                pieces += (gap, text)
+                size += len(gap) + len(text)
+            else:  # remove the word and the separator before it
+                gap = gap.rstrip(" \t")
+                pieces.append(gap)
+                size += len(gap)
             cursor = item.end
-            last_word_end, seen_axis = len("".join(pieces)), True
-        elif type(item) is not Comment:
-            pieces.append(raw[cursor : item.end])
+            last_word_end, seen_axis = size, True
+        elif kind is not Comment:
+            text = raw[cursor : item.end]
+            pieces.append(text)
+            size += len(text)
             cursor = item.end
-            is_axis = type(item) is Word and item.letter in AXIS_LETTERS
+            is_axis = kind is Word and item.letter in AXIS_LETTERS
             if is_axis or not seen_axis:
-                last_word_end = len("".join(pieces))
+                last_word_end = size
                 seen_axis = seen_axis or is_axis
     head = "".join(pieces)
     tail = raw[cursor:]
@@ -94,6 +99,7 @@ def edit_words(
 
 
 def _lower_case(block: Block) -> bool:
+    """The block writes its letters in lower case."""
     words = block.words()
     return bool(words) and all(block.raw[w.start].islower() for w in words if block.raw[w.start].isalpha())
 
@@ -105,6 +111,8 @@ def _with_motion(block: Block, code: int) -> Block:
     raw = block.raw
     for item in block.items:
         if type(item) is Word and item.letter == "G" and item.value in (0.0, 1.0, 2.0, 3.0):
+            if item.value == code:
+                return block
             text = raw[item.start] + format_number(code, NumberStyle.of(item.number))
             new_raw = raw[: item.start] + text + raw[item.end :]
             return _respan(block, new_raw, item.end, len(text) - (item.end - item.start))

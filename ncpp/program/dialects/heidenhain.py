@@ -359,7 +359,7 @@ class HeidenhainWriter(IsoWriter):
         """A new block for a further piece of a changed block."""
         if type(segment) is Line:
             words = [self._word(_AXES[n], segment.end[n], segment) for n in range(3)
-                     if self._format(_AXES[n], segment.end[n], segment) != self.last_written.get(_AXES[n])]
+                     if self._moved(_AXES[n], segment.end[n], segment)]
             return "L " + " ".join(words) + (" FMAX" if segment.rapid else "")
         return self._arc_text(segment)
 
@@ -404,7 +404,7 @@ class HeidenhainWriter(IsoWriter):
             elif type(item) is Statement and item.kind == "rotation" and arc:
                 texts[n] = "DR+" if segment.turn > 0 else "DR-"
         extra = [self._word(_AXES[k], segment.end[k], segment) for k in range(3) if k not in written and (
-            k in plane_axes or (k in self.known_axes_idx() and self._format(_AXES[k], segment.end[k], segment) != self.last_written.get(_AXES[k])))]  # fmt: skip
+            k in plane_axes or (k in self.known_axes_idx() and self._moved(_AXES[k], segment.end[k], segment)))]  # fmt: skip
         if arc and not any(type(i) is Statement and i.kind == "rotation" for i in block.items):
             extra.append("DR+" if segment.turn > 0 else "DR-")
         return splice(block, texts, "".join(" " + w for w in extra), after=anchor)

@@ -13,16 +13,17 @@ from __future__ import annotations
 from dataclasses import replace
 from typing import Iterable, Iterator
 
-from ncpp.motion.segments import PLANE_AXES, Arc, Event, Line
+from ncpp.motion.segments import PLANE_AXES, Arc, Context, Event, Line
 from ncpp.program.blocks import Block, ExprWord, Word
 from ncpp.program.numbers import NumberStyle, format_number
-from ncpp.program.writer import edit_words, word_separator
+from ncpp.program.writer import _lower_case, edit_words, word_separator
 
 AXES = "XYZ"
 CENTRE_LETTERS = {17: "IJ", 18: "IK", 19: "JK"}  # as written; order of I J K words
 MOTION_CODES = {0.0: 0, 1.0: 1, 2.0: 2, 3.0: 3}
 DEFAULT_STYLE = NumberStyle(decimals=4)
 GEOMETRY_LETTERS = "XYZIJKR"  # words a pass rewrites in a changed block
+DROPPED = ("I", "J", "K", "R", "P", ",R", ",C")  # words of the old geometry a changed block loses
 
 
 class IsoWriter:
@@ -36,10 +37,14 @@ class IsoWriter:
         self.styles: dict[str, NumberStyle] = {}
         self.program_motion: int | None = None  # motion mode as the input program has it
         self.output_motion: int | None = None  # motion mode as the output has it
-        self.last_written: dict[str, str] = {}  # last absolute coordinate text per axis in the output
+        self.last_written: dict[str, float] = {}  # last absolute coordinate per axis in the output, as rounded there
+        self._shapes: dict[str, tuple] = {}  # per letter: the shape of the number its style was read from
+        self._resolved: dict[tuple[str, bool], NumberStyle] = {}  # (letter, inch) -> style to write
         # Axes the program has positioned; before that the control's position is not
         # the interpreter's assumed zero, so a word must not be added for them.
         self.known_axes: set[str] = set()
+        self._memo_block: Block | None = None
+        self._memo: dict = {}
 
     def comment(self, text: str) -> str:
         return f"{self.comment_open}{text}{self.comment_close}"
@@ -57,6 +62,7 @@ class IsoWriter:
 
     def _write_group(self, group: list[Event]) -> Iterator[str]:
         block = group[0].block
+        self._memo_block, self._memo = block, {}  # facts about this block, computed once
         self._learn_styles(block)
         motion = [e for e in group if type(e) is Line or type(e) is Arc]
         if not any(e.changed for e in motion):
@@ -73,9 +79,14 @@ class IsoWriter:
     def _learn_styles(self, block: Block) -> None:
         for item in block.items:
             if type(item) is Word and item.letter not in ("G", "M", "N", "O"):
-                self.styles[item.letter] = NumberStyle.of(item.number)
-                if item.letter in AXES:
-                    self.known_axes.add(item.letter)
+                letter, number = item.letter, item.number
+                shape = (len(number), number.find("."), number[:1])  # cheap: styles rarely change
+                if self._shapes.get(letter) != shape:
+                    self._shapes[letter] = shape
+                    self.styles[letter] = NumberStyle.of(number)
+                    self._resolved.clear()
+                    if letter in AXES:
+                        self.known_axes.add(letter)
 
     def _block_motion(self, block: Block) -> int | None:
         code = None
@@ -92,7 +103,20 @@ class IsoWriter:
         return (self._block_motion(block) if self._has_motion_word(block) else self.program_motion) in (2, 3)
 
     def _has_motion_word(self, block: Block) -> bool:
-        return any(type(i) is Word and i.letter == "G" and (i.value in MOTION_CODES or 73 <= i.value <= 89) for i in block.items)
+        return self._fact(block, "has_motion", lambda: any(
+            type(i) is Word and i.letter == "G" and (i.value in MOTION_CODES or 73 <= i.value <= 89) for i in block.items))
+
+    def _fact(self, block: Block, name: str, compute):
+        """A fact about the block being written, computed once per block."""
+        if block is not self._memo_block:
+            return compute()
+        memo = self._memo
+        if name not in memo:
+            memo[name] = compute()
+        return memo[name]
+
+    def _present(self, block: Block) -> set[str]:
+        return self._fact(block, "present", lambda: {w.letter for w in block.words()})
 
     def _needs_mode_restore(self, block: Block) -> bool:
         """A verbatim block relying on a modal motion the output changed (an arc written as lines)."""
@@ -114,30 +138,50 @@ class IsoWriter:
         for segment in motion:
             self._remember_end(segment)
 
+    def _moved(self, axis: str, value: float, segment: Line | Arc) -> bool:
+        """Whether writing `value` for the axis changes what the output last said."""
+        return round(value, self._style(axis, segment).decimals) != self.last_written.get(axis)
+
     def _remember_end(self, segment: Line | Arc) -> None:
-        for axis, value in zip(AXES, segment.end):
-            self.last_written[axis] = self._format(axis, value, segment)
+        last, end = self.last_written, segment.end
+        dx, dy, dz = self._axis_decimals(segment.context.inch)
+        last["X"], last["Y"], last["Z"] = round(end[0], dx), round(end[1], dy), round(end[2], dz)
+
+    def _axis_decimals(self, inch: bool) -> tuple[int, int, int]:
+        key = ("XYZ", inch)
+        found = self._resolved.get(key)
+        if found is None:
+            found = self._resolved[key] = tuple(self._style(a, _INCH if inch else _MM).decimals for a in AXES)
+        return found
 
     # -- changed blocks ---------------------------------------------------------
     def _format(self, letter: str, value: float, segment: Line | Arc) -> str:
         return format_number(value, self._style(letter, segment))
 
     def _style(self, letter: str, segment: Line | Arc) -> NumberStyle:
-        style = self.styles.get(letter) or self.styles.get("X") or DEFAULT_STYLE
-        return style.at_least(self.inch_decimals if segment.context.inch else self.mm_decimals)
+        key = (letter, segment.context.inch)
+        style = self._resolved.get(key)
+        if style is None:
+            style = self.styles.get(letter) or self.styles.get("X") or DEFAULT_STYLE
+            style = self._resolved[key] = style.at_least(self.inch_decimals if key[1] else self.mm_decimals)
+        return style
 
     def _targets(self, block: Block, segment: Line | Arc) -> dict[str, float]:
         """Axis words to write: what the block had, and whatever moved in the output."""
-        present = {w.letter for w in block.words()}
+        present = self._present(block)
         values: dict[str, float] = {}
-        for n, axis in enumerate(AXES):
-            if segment.context.absolute:
-                text = self._format(axis, segment.end[n], segment)
-                if axis in present or (axis in self.known_axes and text != self.last_written.get(axis)):
-                    values[axis] = segment.end[n]
-            else:
-                delta = segment.end[n] - segment.start[n]
-                if axis in present or float(self._format(axis, delta, segment)) != 0.0:
+        decimals = self._axis_decimals(segment.context.inch)
+        end = segment.end
+        if segment.context.absolute:
+            last, known = self.last_written, self.known_axes
+            for n, axis in enumerate(AXES):
+                if axis in present or (axis in known and round(end[n], decimals[n]) != last.get(axis)):
+                    values[axis] = end[n]
+        else:
+            start = segment.start
+            for n, axis in enumerate(AXES):
+                delta = end[n] - start[n]
+                if axis in present or round(delta, decimals[n]) != 0.0:
                     values[axis] = delta
         return values
 
@@ -165,14 +209,17 @@ class IsoWriter:
         values = self._words(block, segment)
         styles = {letter: self._style(letter, segment) for letter in values}
         code = self._motion_code(segment)
-        # centre words of the old arc, and Fanuc corner words: the corner is now explicit
-        drop = [letter for letter in ("I", "J", "K", "R", "P", ",R", ",C") if letter not in values]
-        if not self._arc_block(block):  # P is a dwell time (G4) or blending tolerance (G64) there
-            drop = [letter for letter in drop if letter != "P"]
-        raw = edit_words(block, values, styles, drop=drop, motion=code if code != self.output_motion or self._has_motion_word(block) else None)
-        if self._has_motion_word(block) or code != self.output_motion:
+        has_motion = self._has_motion_word(block)
+        present = self._present(block)
+        # centre words of the old arc, and Fanuc corner words: the corner is now explicit;
+        # P is an arc's turn count, but a dwell time (G4) or blending tolerance (G64) elsewhere
+        drop = [letter for letter in DROPPED if letter in present and letter not in values]
+        if "P" in drop and not self._arc_block(block):
+            drop.remove("P")
+        raw = edit_words(block, values, styles, drop=drop, motion=code if code != self.output_motion or has_motion else None)
+        if has_motion or code != self.output_motion:
             self.output_motion = code
-        if self._has_motion_word(block):
+        if has_motion:
             self.program_motion = self._block_motion(block)
         self._remember_end(segment)
         return raw
@@ -180,8 +227,8 @@ class IsoWriter:
     def _new_block(self, block: Block, segment: Line | Arc) -> str:
         values = self._words(block, segment)
         code = self._motion_code(segment)
-        sep = word_separator(block)
-        lower = bool(block.words()) and all(block.raw[w.start].islower() for w in block.words() if block.raw[w.start].isalpha())
+        sep = self._fact(block, "separator", lambda: word_separator(block))
+        lower = self._fact(block, "lower", lambda: _lower_case(block))
         parts = []
         if code != self.output_motion:
             parts.append(f"G{code}")
@@ -190,6 +237,16 @@ class IsoWriter:
         self._remember_end(segment)
         text = sep.join(parts) if sep else "".join(parts)
         return text.lower() if lower else text
+
+
+class _Units:
+    """Stands in for a segment where only its units matter (style look-ups)."""
+
+    def __init__(self, inch: bool):
+        self.context = Context(inch=inch)
+
+
+_MM, _INCH = _Units(False), _Units(True)
 
 
 def _literal_geometry(block: Block) -> Block:
