@@ -91,6 +91,8 @@ def _sample_arc(arc: Arc, step_mm: float) -> NDArray:
     p[:, i] = c[i] + r * np.cos(angle)
     p[:, j] = c[j] + r * np.sin(angle)
     p[:, k] = s[k] + t * (e[k] - s[k])
+    # the ends exactly: cos/sin round-off would be a 1e-15 mm "motion" whose sign sets the direction of travel
+    p[0], p[-1] = s, e
     return _to_machine(arc, p)
 
 

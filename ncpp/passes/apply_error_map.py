@@ -3,7 +3,15 @@
 For the wanted point P the command is C with C + E(C) = P (`inverse.py`).
 Rapid moves are compensated too, so that positions stay consistent in
 incremental (G91) programs.  Arcs arrive here already replaced by
-`replace_arcs`; they only move the current position.
+`replace_arcs`; they move the current position and, with reversal errors,
+are shifted for the direction their normal axis really travels in.
+
+With direction-dependent (reversal) tables, an axis's direction is the one
+the machine will see (`travel.py`): the sign of the compensated motion as
+written, or the held direction of an axis that stands.  The command depends
+on that direction and the direction on the commands, so a chunk is solved by
+a few rounds of fixed-point iteration.  Where an axis reverses, the line's
+start is compensated with its own direction and a step move is inserted.
 """
 
 from __future__ import annotations
@@ -12,31 +20,31 @@ from dataclasses import replace
 from typing import Iterable, Iterator
 
 import numpy as np
+from numpy.typing import NDArray
 
-from ncpp.motion.segments import Arc, Event, Line
+from ncpp.motion.segments import PLANE_AXES, Arc, Event, Line
 from ncpp.passes.context import PassContext
 from ncpp.passes.geometry import chunked, compensate, frames
+from ncpp.passes.travel import Travel, grid, hold, quantize, steps
+
+# Compensations per line at most: each changes a direction only where a
+# correction of the previous round flipped a µm motion; two rounds settle almost all.
+ROUNDS = 4
 
 
 def apply_error_map(events: Iterable[Event], ctx: PassContext) -> Iterator[Event]:
     last = None  # the last segment written: its compensated end, in its own program frame
+    travel = Travel()
     for chunk in chunked(events):
-        index = [k for k, e in enumerate(chunk) if type(e) is Line and not e.changed]
-        new_ends: dict[int, tuple] = {}
-        new_starts: dict[int, tuple] = {}
-        if index:
-            lines = [chunk[k] for k in index]
-            offsets, scales = frames(lines)
-            starts, ends = np.array([ln.start for ln in lines]), np.array([ln.end for ln in lines])
-            direction = np.sign(ends - starts)
-            new_ends = {k: tuple(map(float, p)) for k, p in zip(index, compensate(ends, offsets, scales, lines, ctx, direction))}
-            if ctx.directional:  # where this line must start, approached its own way
-                starts = compensate(starts, offsets, scales, lines, ctx, direction)
-                new_starts = {k: tuple(map(float, p)) for k, p in zip(index, starts)}
+        if ctx.directional:
+            new_ends, new_starts, new_arcs = _directional(chunk, ctx, travel)
+        else:
+            new_ends, new_starts, new_arcs = _plain(chunk, ctx), {}, {}
         for k, event in enumerate(chunk):
             if type(event) is not Line and type(event) is not Arc:
                 yield event
                 continue
+            event = new_arcs.get(k, event)
             previous_end = _end_in_frame_of(last, event)
             if k in new_ends:
                 start = event.start if previous_end is None else previous_end
@@ -49,6 +57,115 @@ def apply_error_map(events: Iterable[Event], ctx: PassContext) -> Iterator[Event
                 yield Line(previous_end, event.start, False, event.feed, event.block, event.context, event.extra, changed=True)
             last = event
             yield event
+
+
+def _plain(chunk: list[Event], ctx: PassContext) -> dict[int, tuple]:
+    """Compensated ends of the chunk's lines, for a map without reversal errors."""
+    index = [k for k, e in enumerate(chunk) if type(e) is Line and not e.changed]
+    if not index:
+        return {}
+    lines = [chunk[k] for k in index]
+    offsets, scales = frames(lines)
+    starts, ends = np.array([ln.start for ln in lines]), np.array([ln.end for ln in lines])
+    ends = compensate(ends, offsets, scales, lines, ctx, np.sign(ends - starts))
+    return {k: tuple(map(float, p)) for k, p in zip(index, ends)}
+
+
+def _directional(chunk: list[Event], ctx: PassContext, travel: Travel) -> tuple[dict, dict, dict]:
+    """Compensated line ends and starts, and shifted arcs, of one chunk, with the
+    directions the machine will travel in; advances `travel` past the chunk."""
+    index = [k for k, e in enumerate(chunk) if type(e) is Line or type(e) is Arc]
+    if not index:
+        return {}, {}, {}
+    segs = [chunk[k] for k in index]
+    offsets, scales = frames(segs)
+    step = grid(ctx, scales)
+    threshold = step * scales / 2  # mm: half the output resolution
+    machine = lambda p, rows=slice(None): (p + offsets[rows]) * scales[rows, None]  # noqa: E731
+    free = np.array([type(e) is Line and not e.changed for e in segs])
+    arc = np.array([type(e) is Arc and e.changed for e in segs])
+    start_p, end_p = np.array([e.start for e in segs]), np.array([e.end for e in segs])
+    start_m, end_m = machine(start_p), machine(end_p)
+    first = travel.last if travel.last is not None else start_m[0]
+
+    out_start, out_end = start_p.copy(), end_p.copy()
+    assumed = _arc_assumed(segs, arc)  # the directions replace_arcs compensated the arcs with
+    used = np.full(start_p.shape, np.nan)  # the directions each row is compensated with
+    used[arc] = assumed[arc]
+    # start from the nominal motion, standing axes holding their direction
+    d = hold(steps(end_m - start_m, threshold), travel.held)
+    for _ in range(ROUNDS):
+        redo = np.flatnonzero(free & (d != used).any(axis=1))
+        if redo.size:
+            c = compensate(end_p[redo], offsets[redo], scales[redo], [segs[i] for i in redo], ctx, d[redo])
+            out_end[redo] = quantize(c, step[redo])
+        shift = np.flatnonzero(arc & (d != used).any(axis=1))
+        if shift.size:
+            _shift_arcs(shift, start_p, end_p, offsets, scales, d, assumed, step, ctx, out_start, out_end)
+        used[redo], used[shift] = d[redo], d[shift]
+        cur_end, cur_start = machine(out_end), machine(out_start)
+        previous = np.vstack([first[None, :], cur_end[:-1]])
+        motion = np.where(free[:, None], cur_end - previous, cur_end - cur_start)
+        d_new = hold(steps(motion, threshold), travel.held)
+        if np.array_equal(d_new, d):
+            break
+        d = d_new
+
+    new_ends = {index[i]: tuple(map(float, out_end[i])) for i in np.flatnonzero(free)}
+    new_arcs = {index[i]: _moved_arc(segs[i], out_start[i], out_end[i], start_p[i], end_p[i]) for i in np.flatnonzero(arc)}
+    # where an axis reverses, the line must start where its own direction puts the tool
+    before = np.vstack([travel.held[None, :], d[:-1]])
+    turn = np.flatnonzero(free & ((d != before) & (before != 0)).any(axis=1))
+    new_starts = {}
+    if turn.size:
+        s = compensate(start_p[turn], offsets[turn], scales[turn], [segs[i] for i in turn], ctx, d[turn])
+        s = quantize(s, step[turn])
+        new_starts = {index[i]: tuple(map(float, p)) for i, p in zip(turn, s)}
+    travel.held = d[-1].copy()
+    travel.last = machine(out_end[-1:], slice(len(segs) - 1, None))[0]
+    return new_ends, new_starts, new_arcs
+
+
+def _arc_assumed(segs: list, arc: NDArray) -> NDArray:
+    """Directions replace_arcs compensated each arc piece with: the sign of the
+    tangent at the middle in the plane, the mean (0) on the normal axis."""
+    out = np.zeros((len(segs), 3))
+    rows = np.flatnonzero(arc)
+    if rows.size == 0:
+        return out
+    arcs = [segs[i] for i in rows]
+    axes = np.array([PLANE_AXES[a.context.plane] for a in arcs])
+    s, e, c = (np.take_along_axis(np.array([getattr(a, f) for a in arcs]), axes, axis=1) for f in ("start", "end", "center"))
+    u0, u1 = s[:, :2] - c[:, :2], e[:, :2] - c[:, :2]
+    mid = u0 / np.linalg.norm(u0, axis=1, keepdims=True) + u1 / np.linalg.norm(u1, axis=1, keepdims=True)
+    turn = np.sign([a.turn for a in arcs])[:, None]
+    tangent = turn * np.column_stack([-mid[:, 1], mid[:, 0]])
+    local = np.column_stack([np.sign(tangent), np.zeros(len(arcs))])
+    sub = np.zeros((len(rows), 3))
+    np.put_along_axis(sub, axes, local, axis=1)
+    out[rows] = sub
+    return out
+
+
+def _shift_arcs(rows, start_p, end_p, offsets, scales, d, assumed, step, ctx, out_start, out_end) -> None:
+    """Move arc pieces by the change of the error between the directions they
+    were compensated with (`assumed`) and those they are travelled in (`d`)."""
+    pts = np.stack([start_p[rows], end_p[rows]], axis=1)  # (r,2,3) program
+    scale = scales[rows, None, None]
+    pairs = ((pts + offsets[rows, None, :]) * scale).reshape(-1, 3)
+    act, was = np.repeat(d[rows], 2, axis=0), np.repeat(assumed[rows], 2, axis=0)
+    delta = (ctx.model.deviation(pairs, act) - ctx.model.deviation(pairs, was)).reshape(pts.shape) / scale
+    out_start[rows] = quantize(pts[:, 0] - delta[:, 0], step[rows])
+    out_end[rows] = quantize(pts[:, 1] - delta[:, 1], step[rows])
+
+
+def _moved_arc(arc: Arc, start, end, old_start, old_end) -> Arc:
+    if np.array_equal(start, old_start) and np.array_equal(end, old_end):
+        return arc
+    # the centre moves with the mean shift of the ends (equal for planar arcs: radii still agree)
+    move = ((start - old_start) + (end - old_end)) / 2
+    centre = tuple(float(c + m) for c, m in zip(arc.center, move))
+    return replace(arc, start=tuple(map(float, start)), end=tuple(map(float, end)), center=centre)
 
 
 def _end_in_frame_of(last: Line | Arc | None, event: Line | Arc) -> tuple | None:

@@ -29,6 +29,8 @@ class PassContext:
     max_correction: float = 0.5  # mm: larger corrections are refused
     limits: dict[str, tuple[float, float]] = field(default_factory=dict)  # machine axis travel, mm
     directional: bool = False  # the model has reversal (direction-dependent) errors
+    resolution: float = 1e-4  # mm: the output grid of mm programs (every writer writes at least 4 decimals)
+    resolution_inch: float = 1e-5  # inch: the same for inch programs (5 decimals)
     min_line_check: float = 1.0  # mm: shorter lines are never subdivided (their error is linear to < 0.01 µm)
     warnings: Warnings = field(default_factory=Warnings)
     file: str = "<stdin>"

@@ -24,6 +24,7 @@ from numpy.typing import NDArray
 from ncpp.motion.segments import PLANE_AXES, Arc, Event, Line
 from ncpp.passes.context import PassContext
 from ncpp.passes.geometry import chunked, compensate, frames
+from ncpp.passes.travel import grid, quantize
 
 SAMPLES = 9  # points per piece where the fit is checked (ends included)
 MIN_PIECE = 0.05  # mm of arc length below which a piece is not halved again
@@ -136,9 +137,16 @@ def _replace(arcs: list[Arc], ctx: PassContext) -> list[list[Event]]:
         segs = [arcs[k] for k in pending.arc]
         middle = (pending.a0 + pending.sweep / 2)[:, None]
         tangent = geometry.points(pending.arc, middle + 1e-6 * np.sign(pending.sweep)[:, None]) - geometry.points(pending.arc, middle)
-        direction = np.broadcast_to(np.sign(tangent), nominal.shape)
+        direction = np.sign(tangent)
+        # the normal axis's direction is the one the machine holds when it gets
+        # here: apply_error_map knows it and shifts the piece; use the mean here
+        np.put_along_axis(direction, geometry.axes[pending.arc, None, 2:], 0.0, axis=2)
+        direction = np.broadcast_to(direction, nominal.shape)
         q = compensate(nominal, offsets[pending.arc], scales[pending.arc], segs, ctx, direction)
         centre, deviation = _fit(q, geometry.axes[pending.arc], t)
+        if ctx.directional:  # ends on the output grid (after the fit: a short piece's chord fixes the bisector)
+            step = grid(ctx, scales[pending.arc])
+            q[:, 0], q[:, -1] = quantize(q[:, 0], step), quantize(q[:, -1], step)
         length = np.abs(pending.sweep) * geometry.radius[pending.arc] * scales[pending.arc]
         ok = deviation <= ctx.tolerance / scales[pending.arc]
         give_up = ~ok & (length < MIN_PIECE)
