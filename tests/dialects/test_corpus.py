@@ -115,3 +115,26 @@ def test_cli_dialect_option_overrides_and_errors_name_the_line(tmp_path):
     assert proc.returncode != 0 and proc.stdout == "" and proc.stderr.startswith(f"{bad}:2:")
     proc = subprocess.run([sys.executable, "-m", "ncpp", "--dialect", "klingon", str(bad)], capture_output=True, text=True)
     assert proc.returncode != 0 and "unknown dialect" in proc.stderr
+
+
+# Programs a control would refuse: `ncpp` refuses them too, with a location.
+REFUSED = {
+    "sinumerik/CEAD_nc-gcode-interpreter/simple.mpf": "circular interpolation without I/J/K",
+}
+
+
+@pytest.mark.parametrize("path", corpus_files("heidenhain", "sinumerik"), ids=corpus_id)
+def test_ncpp_command_passes_dialect_program_through_unchanged(path, tmp_path, capsys):
+    """Parse, interpret (each dialect's interpreter) and write: byte for byte, or a located refusal."""
+    from ncpp.cli import main
+
+    out = tmp_path / "out"
+    status = main([str(path), "-o", str(out)])
+    expected = REFUSED.get(corpus_id(path))
+    err = capsys.readouterr().err
+    if expected is None:
+        assert status == 0, err
+        assert out.read_bytes() == path.read_bytes()
+    else:
+        assert status != 0 and expected in err and err.startswith(f"{path}:")
+        assert not out.exists()
