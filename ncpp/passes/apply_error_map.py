@@ -37,9 +37,9 @@ def apply_error_map(events: Iterable[Event], ctx: PassContext) -> Iterator[Event
     travel = Travel()
     for chunk in chunked(events):
         if ctx.directional:
-            new_ends, new_starts, new_arcs = _directional(chunk, ctx, travel)
+            new_ends, new_starts, new_arcs, steady = _directional(chunk, ctx, travel)
         else:
-            new_ends, new_starts, new_arcs = _plain(chunk, ctx), {}, {}
+            new_ends, new_starts, new_arcs, steady = _plain(chunk, ctx), {}, {}, {}
         for k, event in enumerate(chunk):
             if type(event) is not Line and type(event) is not Arc:
                 yield event
@@ -48,9 +48,11 @@ def apply_error_map(events: Iterable[Event], ctx: PassContext) -> Iterator[Event
             previous_end = _end_in_frame_of(last, event)
             if k in new_ends:
                 start = event.start if previous_end is None else previous_end
-                if k in new_starts and previous_end is not None and not event.rapid and _apart(previous_end, new_starts[k]):
-                    yield replace(event, start=previous_end, end=new_starts[k], changed=True)
-                    start = new_starts[k]
+                if k in new_starts and previous_end is not None and not event.rapid:
+                    wanted = _snap(new_starts[k], previous_end, *steady[k])
+                    if _apart(previous_end, wanted):
+                        yield replace(event, start=previous_end, end=wanted, changed=True)
+                        start = wanted
                 event = replace(event, start=start, end=new_ends[k], changed=True)
             elif event.changed and previous_end is not None and _apart(previous_end, event.start):
                 # a reversal step between compensated pieces: move there first
@@ -76,7 +78,7 @@ def _directional(chunk: list[Event], ctx: PassContext, travel: Travel) -> tuple[
     directions the machine will travel in; advances `travel` past the chunk."""
     index = [k for k, e in enumerate(chunk) if type(e) is Line or type(e) is Arc]
     if not index:
-        return {}, {}, {}
+        return {}, {}, {}, {}
     segs = [chunk[k] for k in index]
     offsets, scales = frames(segs)
     step = grid(ctx, scales)
@@ -103,6 +105,7 @@ def _directional(chunk: list[Event], ctx: PassContext, travel: Travel) -> tuple[
         if shift.size:
             _shift_arcs(shift, start_p, end_p, offsets, scales, d, assumed, step, ctx, out_start, out_end)
         used[redo], used[shift] = d[redo], d[shift]
+        _join_arcs(arc, offsets, scales, step, out_start, out_end)
         cur_end, cur_start = machine(out_end), machine(out_start)
         previous = np.vstack([first[None, :], cur_end[:-1]])
         motion = np.where(free[:, None], cur_end - previous, cur_end - cur_start)
@@ -115,7 +118,10 @@ def _directional(chunk: list[Event], ctx: PassContext, travel: Travel) -> tuple[
     new_arcs = {index[i]: _moved_arc(segs[i], out_start[i], out_end[i], start_p[i], end_p[i]) for i in np.flatnonzero(arc)}
     # where an axis reverses, the line must start where its own direction puts the tool
     before = np.vstack([travel.held[None, :], d[:-1]])
-    turn = np.flatnonzero(free & ((d != before) & (before != 0)).any(axis=1))
+    flips = (d != before) & (before != 0)
+    turn = np.flatnonzero(free & flips.any(axis=1))
+    # axes that keep their direction must not move in a reversal step (see _snap)
+    steady = {index[i]: (tuple(~flips[i]), float(step[i])) for i in np.flatnonzero(flips.any(axis=1))}
     new_starts = {}
     if turn.size:
         s = compensate(start_p[turn], offsets[turn], scales[turn], [segs[i] for i in turn], ctx, d[turn])
@@ -123,7 +129,7 @@ def _directional(chunk: list[Event], ctx: PassContext, travel: Travel) -> tuple[
         new_starts = {index[i]: tuple(map(float, p)) for i, p in zip(turn, s)}
     travel.held = d[-1].copy()
     travel.last = machine(out_end[-1:], slice(len(segs) - 1, None))[0]
-    return new_ends, new_starts, new_arcs
+    return new_ends, new_starts, new_arcs, steady
 
 
 def _arc_assumed(segs: list, arc: NDArray) -> NDArray:
@@ -159,6 +165,19 @@ def _shift_arcs(rows, start_p, end_p, offsets, scales, d, assumed, step, ctx, ou
     out_end[rows] = quantize(pts[:, 1] - delta[:, 1], step[rows])
 
 
+def _join_arcs(arc: NDArray, offsets: NDArray, scales: NDArray, step: NDArray, out_start: NDArray, out_end: NDArray) -> None:
+    """Move an arc piece that starts within a rounding step of the previous
+    segment's end rigidly onto it: a one-digit step there would reverse that
+    axis on the machine.  A rigid move keeps the radii equal."""
+    rows = np.flatnonzero(arc[1:]) + 1
+    same = (offsets[rows] == offsets[rows - 1]).all(axis=1) & (scales[rows] == scales[rows - 1])
+    rows = rows[same]
+    gap = out_end[rows - 1] - out_start[rows]
+    move = np.where(np.abs(gap) <= 1.01 * step[rows, None], gap, 0.0)
+    out_start[rows] += move
+    out_end[rows] += move
+
+
 def _moved_arc(arc: Arc, start, end, old_start, old_end) -> Arc:
     if np.array_equal(start, old_start) and np.array_equal(end, old_end):
         return arc
@@ -166,6 +185,13 @@ def _moved_arc(arc: Arc, start, end, old_start, old_end) -> Arc:
     move = ((start - old_start) + (end - old_end)) / 2
     centre = tuple(float(c + m) for c, m in zip(arc.center, move))
     return replace(arc, start=tuple(map(float, start)), end=tuple(map(float, end)), center=centre)
+
+
+def _snap(start: tuple, previous_end: tuple, steady: tuple, step: float) -> tuple:
+    """A reversal step's target with the axes that keep their direction left
+    where they are, when they differ only by output rounding: a one-digit move
+    there would reverse that axis on the machine."""
+    return tuple(p if keep and abs(s - p) <= step * 1.01 else s for s, p, keep in zip(start, previous_end, steady))
 
 
 def _end_in_frame_of(last: Line | Arc | None, event: Line | Arc) -> tuple | None:

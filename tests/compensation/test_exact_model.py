@@ -49,3 +49,22 @@ def test_contour_error_within_tolerance(name, tolerance, machine):
     after = contour_error(machine, commanded, nominal, feed_effects=False)
     assert before.max_um > 20.0  # the machine is wrong enough for the check to mean something
     assert after.max_um <= tolerance * 1000 + 0.5, f"{after.max_um:.2f} µm at line {after.worst_line}"
+
+
+@pytest.mark.parametrize("name", ["pocket", "arc-yz (G19)", "platteyz helix"])
+def test_reversal_tables_compensated_for_the_direction_travelled(name):
+    """With its reversal tables, the machine takes each axis's direction from the
+    commands it gets, compensation's own µm moves on still axes included: the
+    passes must predict that direction, or the error stays at ~4 µm (9x)."""
+    path, start = PROGRAMS[name]
+    if not path.exists():
+        pytest.skip("corpus not available")
+    machine = load_machine(ROOT / "samples/machines/hr5b.toml").replace(effects=())
+    data = start + path.read_bytes()
+    offset = placement(sample_events(events_of(data)), machine.limits)
+    nominal = sample_events(events_of(data), work_offset=offset)
+    before = contour_error(machine, nominal, nominal, feed_effects=False)
+    commanded = sample_events(events_of(compensate(data, machine, offset, 0.001)), work_offset=offset)
+    after = contour_error(machine, commanded, nominal, feed_effects=False)
+    assert after.max_um <= 1.5, f"{after.max_um:.2f} µm at line {after.worst_line}"
+    assert before.max_um / after.max_um >= 20
