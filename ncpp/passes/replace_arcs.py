@@ -143,7 +143,7 @@ def _replace(arcs: list[Arc], ctx: PassContext) -> list[list[Event]]:
         np.put_along_axis(direction, geometry.axes[pending.arc, None, 2:], 0.0, axis=2)
         direction = np.broadcast_to(direction, nominal.shape)
         q = compensate(nominal, offsets[pending.arc], scales[pending.arc], segs, ctx, direction)
-        centre, deviation = _fit(q, geometry.axes[pending.arc], t)
+        centre, deviation = _fit(q, geometry.axes[pending.arc], t, ctx.tolerance / scales[pending.arc])
         if ctx.directional:  # ends on the output grid (after the fit: a short piece's chord fixes the bisector)
             step = grid(ctx, scales[pending.arc])
             q[:, 0], q[:, -1] = quantize(q[:, 0], step), quantize(q[:, -1], step)
@@ -164,9 +164,10 @@ def _replace(arcs: list[Arc], ctx: PassContext) -> list[list[Event]]:
     return _assemble(arcs, geometry, done)
 
 
-def _fit(q: NDArray, axes: NDArray, t: NDArray) -> tuple[NDArray, NDArray]:
+def _fit(q: NDArray, axes: NDArray, t: NDArray, tolerance: NDArray) -> tuple[NDArray, NDArray]:
     """Centre (p,3 program) on the bisector of each piece's end points, and the
-    largest deviation (p,) of the compensated samples from the fitted helix."""
+    largest deviation (p,) of the compensated samples from the fitted helix
+    (tolerance (p,) in program units)."""
     local = np.take_along_axis(q, np.broadcast_to(axes[:, None, :], q.shape), axis=2)
     uv, w = local[..., :2], local[..., 2]
     q0, q1 = uv[:, 0], uv[:, -1]
@@ -179,10 +180,17 @@ def _fit(q: NDArray, axes: NDArray, t: NDArray) -> tuple[NDArray, NDArray]:
     a = (uv**2).sum(-1) - (q0**2).sum(-1)[:, None] - 2 * (d * mid[:, None, :]).sum(-1)
     b = 2 * (d * normal[:, None, :]).sum(-1)
     s = (a * b).sum(-1) / np.maximum((b * b).sum(-1), 1e-300)
-    s = s + _minimax_step(uv, q0, mid + s[:, None] * normal, normal)
     c = mid + s[:, None] * normal
     radius = np.linalg.norm(q0 - c, axis=-1)
     radial = np.linalg.norm(uv - c[:, None, :], axis=-1) - radius[:, None]
+    # Where least squares leaves much of the tolerance unused, its centre stands;
+    # elsewhere move it to the smallest largest deviation (which is what is judged).
+    tight = np.flatnonzero(np.abs(radial).max(axis=1) > tolerance / 2)
+    if tight.size:
+        s[tight] += _minimax_step(uv[tight], q0[tight], c[tight], normal[tight])
+        c[tight] = mid[tight] + s[tight, None] * normal[tight]
+        radius[tight] = np.linalg.norm(q0[tight] - c[tight], axis=-1)
+        radial[tight] = np.linalg.norm(uv[tight] - c[tight, None, :], axis=-1) - radius[tight, None]
     ramp = w[:, :1] + t[None, :] * (w[:, -1:] - w[:, :1])
     deviation = np.hypot(radial, w - ramp).max(axis=1)
     centre_local = np.column_stack([c, w[:, 0]])
@@ -215,14 +223,10 @@ def _minimax_step(uv: NDArray, q0: NDArray, c: NDArray, normal: NDArray) -> NDAr
 
 
 def _arc_piece(arc: Arc, q: NDArray, centre: NDArray) -> Arc:
-    return replace(
-        arc,
-        start=tuple(map(float, q[0])),
-        end=tuple(map(float, q[-1])),
-        center=tuple(map(float, centre)),
-        turn=1 if arc.turn > 0 else -1,
-        changed=True,
-    )
+    start, end, c = q[0].tolist(), q[-1].tolist(), centre.tolist()
+    turn = 1 if arc.turn > 0 else -1
+    return Arc((start[0], start[1], start[2]), (end[0], end[1], end[2]), (c[0], c[1], c[2]), turn,
+               arc.feed, arc.block, arc.context, arc.extra, True)  # fmt: skip
 
 
 def _line_pieces(arc: Arc, q: NDArray) -> list[Event]:
