@@ -243,7 +243,7 @@ def throughput(ctx: Context) -> Section:
 
 def memory(ctx: Context) -> Section:
     """Peak RSS of the `ncpp` filter process for growing program lengths."""
-    sizes = [10_000, 1_000_000] if ctx.quick else [10_000, 1_000_000, 10_000_000]
+    sizes = [10_000, 300_000, 1_000_000] if ctx.quick else [10_000, 1_000_000, 10_000_000]
     rows, data = [], {}
     for lines in sizes:
         path = ctx.generated(lines)
