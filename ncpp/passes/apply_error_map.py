@@ -85,7 +85,7 @@ def _directional(chunk: list[Event], ctx: PassContext, travel: Travel) -> tuple[
     threshold = step * scales / 2  # mm: half the output resolution
     machine = lambda p, rows=slice(None): (p + offsets[rows]) * scales[rows, None]  # noqa: E731
     free = np.array([type(e) is Line and not e.changed for e in segs])
-    arc = np.array([type(e) is Arc and e.changed for e in segs])
+    arc = np.array([e.changed for e in segs])  # pieces replace_arcs made: arcs, and lines for slivers
     start_p, end_p = np.array([e.start for e in segs]), np.array([e.end for e in segs])
     start_m, end_m = machine(start_p), machine(end_p)
     first = travel.last if travel.last is not None else start_m[0]
@@ -141,11 +141,14 @@ def _arc_assumed(segs: list, arc: NDArray) -> NDArray:
         return out
     arcs = [segs[i] for i in rows]
     axes = np.array([PLANE_AXES[a.context.plane] for a in arcs])
-    s, e, c = (np.take_along_axis(np.array([getattr(a, f) for a in arcs]), axes, axis=1) for f in ("start", "end", "center"))
+    is_arc = np.array([type(a) is Arc for a in arcs])
+    s, e, c = (np.take_along_axis(np.array([getattr(a, f, a.end) for a in arcs]), axes, axis=1) for f in ("start", "end", "center"))
     u0, u1 = s[:, :2] - c[:, :2], e[:, :2] - c[:, :2]
-    mid = u0 / np.linalg.norm(u0, axis=1, keepdims=True) + u1 / np.linalg.norm(u1, axis=1, keepdims=True)
-    turn = np.sign([a.turn for a in arcs])[:, None]
-    tangent = turn * np.column_stack([-mid[:, 1], mid[:, 0]])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        mid = u0 / np.linalg.norm(u0, axis=1, keepdims=True) + u1 / np.linalg.norm(u1, axis=1, keepdims=True)
+    turn = np.sign([getattr(a, "turn", 1) for a in arcs])[:, None]
+    # arcs: the tangent at the middle; lines (slivers): the chord
+    tangent = np.where(is_arc[:, None], turn * np.column_stack([-mid[:, 1], mid[:, 0]]), e[:, :2] - s[:, :2])
     local = np.column_stack([np.sign(tangent), np.zeros(len(arcs))])
     sub = np.zeros((len(rows), 3))
     np.put_along_axis(sub, axes, local, axis=1)
@@ -178,10 +181,12 @@ def _join_arcs(arc: NDArray, offsets: NDArray, scales: NDArray, step: NDArray, o
     out_end[rows] += move
 
 
-def _moved_arc(arc: Arc, start, end, old_start, old_end) -> Arc:
+def _moved_arc(arc: Arc | Line, start, end, old_start, old_end) -> Arc:
     if np.array_equal(start, old_start) and np.array_equal(end, old_end):
         return arc
     # the centre moves with the mean shift of the ends (equal for planar arcs: radii still agree)
+    if type(arc) is Line:
+        return replace(arc, start=tuple(map(float, start)), end=tuple(map(float, end)))
     move = ((start - old_start) + (end - old_end)) / 2
     centre = tuple(float(c + m) for c, m in zip(arc.center, move))
     return replace(arc, start=tuple(map(float, start)), end=tuple(map(float, end)), center=centre)

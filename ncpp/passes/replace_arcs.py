@@ -29,6 +29,7 @@ from ncpp.passes.travel import grid, quantize
 SAMPLES = 9  # points per piece where the fit is checked (ends included)
 MIN_PIECE = 0.05  # mm of arc length below which a piece is not halved again
 MAX_ROUNDS = 24
+SLIVER = 0.01  # mm of arc length below which a piece becomes a line (its bulge is < 0.1 µm for radii over 0.1 mm)
 
 
 @dataclass
@@ -149,12 +150,17 @@ def _replace(arcs: list[Arc], ctx: PassContext) -> list[list[Event]]:
             q[:, 0], q[:, -1] = quantize(q[:, 0], step), quantize(q[:, -1], step)
         length = np.abs(pending.sweep) * geometry.radius[pending.arc] * scales[pending.arc]
         ok = deviation <= ctx.tolerance / scales[pending.arc]
-        give_up = ~ok & (length < MIN_PIECE)
+        # a sliver (a quadrant cut next to an arc's end) is a line: on the output grid its
+        # chord fixes no centre, and equal ends would be read as a full circle
+        for p in np.flatnonzero(length < SLIVER):
+            done.append((int(pending.arc[p]), float(pending.a0[p]), _line_pieces(arcs[pending.arc[p]], q[p, [0, -1]])))
+        ok &= length >= SLIVER
+        give_up = ~ok & (length < MIN_PIECE) & (length >= SLIVER)
         for p in np.flatnonzero(ok):
             done.append((int(pending.arc[p]), float(pending.a0[p]), _arc_piece(arcs[pending.arc[p]], q[p], centre[p])))
         for p in np.flatnonzero(give_up):
             done.append((int(pending.arc[p]), float(pending.a0[p]), _line_pieces(arcs[pending.arc[p]], q[p])))
-        split = ~ok & ~give_up
+        split = ~ok & ~give_up & (length >= SLIVER)
         half = pending.sweep[split] / 2
         pending = _Pieces(
             np.repeat(pending.arc[split], 2),
