@@ -10,10 +10,7 @@ program lengths (1M and 10M lines; 20k and 60k with --quick).
 
 from __future__ import annotations
 
-import io
 import os
-import subprocess
-import sys
 import time
 from pathlib import Path
 from typing import Any
@@ -53,19 +50,11 @@ def ncpp_process_rate(path: Path, offset: tuple[float, float, float] | None) -> 
 
 
 def compensate_rss(path: Path, offset: tuple[float, float, float]) -> dict[str, Any]:
-    """Peak RSS (MB) of `python -m ncpp compensate ... < path > /dev/null`, from wait4."""
-    command = [sys.executable, "-m", "ncpp", "compensate", "--machine", str(MACHINE), "--work-offset", ",".join(map(str, offset))]
-    start = time.perf_counter()
-    with open(path, "rb") as stdin:
-        proc = subprocess.Popen(command, stdin=stdin, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, cwd=ROOT)
-        stderr = proc.stderr.read()  # type: ignore[union-attr]
-        _, status, usage = os.wait4(proc.pid, 0)
-    return {
-        "rss_mb": usage.ru_maxrss / 1024,
-        "seconds": time.perf_counter() - start,
-        "exit": os.waitstatus_to_exitcode(status),
-        "stderr_tail": stderr.decode("latin-1")[-300:],
-    }
+    """Peak RSS (MB) of `ncpp compensate ... < path > /dev/null`, through run.peak_rss's probe
+    (a child's ru_maxrss would inherit this big benchmark process's own)."""
+    import run as bench
+
+    return bench.peak_rss(path, ["compensate", "--machine", str(MACHINE), "--work-offset", ",".join(map(str, offset))])
 
 
 def compensate_speed(ctx):
