@@ -62,6 +62,10 @@ def _word(text: str, start: int, end: int) -> Word:
     return Word(letter, float(number), number, start, end)
 
 
+_UPPER = {chr(c): chr(c).upper() for c in range(256)}  # str.upper of one Latin-1 character
+_new_word = Word.__new__
+
+
 class _ItemBuilder(Transformer):
     """Turns a Lark tree of one line into items with spans."""
 
@@ -215,6 +219,7 @@ class LineParser:
         if self._fast is None:
             return None
         items: list[AnyItem] = []
+        append = items.append
         pos = 0
         match = self._fast.match
         while True:
@@ -222,13 +227,24 @@ class LineParser:
             if m is None:
                 break
             kind = m.lastgroup
-            start, end = m.start(kind), m.end(kind)
-            if kind == "WORD" or kind == "COMMA_WORD":
-                items.append(_word(m.group(kind), start, end))
+            text = m[kind]
+            end = m.end()
+            start = end - len(text)
+            if kind == "WORD":
+                if " " in text or "\t" in text:
+                    append(_word(text, start, end))
+                else:  # `_word` inlined for the common compact word: one per word of the program
+                    number = text[1:]
+                    word = _new_word(Word)
+                    word.letter, word.value, word.number = _UPPER[text[0]], float(number), number
+                    word.start, word.end = start, end
+                    append(word)
+            elif kind == "COMMA_WORD":
+                append(_word(text, start, end))
             elif kind == "PAREN_COMMENT":
-                items.append(Comment(raw[start + 1 : end - 1], "(", start, end))
+                append(Comment(text[1:-1], "(", start, end))
             else:
-                items.append(Comment(raw[start + 1 : end], ";", start, end))
+                append(Comment(text[1:], ";", start, end))
             pos = end
         if pos == len(raw) or self._blank.match(raw, pos):
             return tuple(items)
