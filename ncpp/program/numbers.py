@@ -8,7 +8,7 @@ comma (Heidenhain) are read from the number text as written, and
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 
 @dataclass(frozen=True, slots=True)
@@ -19,6 +19,12 @@ class NumberStyle:
     int_width: int = 0  # zero-padded integer digits (`X010.5` -> 3)
     plus_sign: bool = False
     comma: bool = False  # `10,5`: a decimal comma instead of the point
+    # `.4f` when `f"{v:.4f}"` writes the style exactly (the common case), else '': set once, read per number
+    spec: str = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        plain = self.decimals > 0 and self.leading_zero and not (self.int_width or self.plus_sign or self.comma)
+        object.__setattr__(self, "spec", f".{self.decimals}f" if plain else "")
 
     @classmethod
     def of(cls, number: str) -> "NumberStyle":
@@ -40,7 +46,7 @@ class NumberStyle:
     @property
     def plain(self) -> bool:
         """`-12.345`: what `f"{v:.{decimals}f}"` writes (the writer's fast path)."""
-        return self.decimals > 0 and self.leading_zero and not (self.int_width or self.plus_sign or self.comma)
+        return bool(self.spec)
 
     def at_least(self, decimals: int) -> "NumberStyle":
         """The same style with at least `decimals` places (never lose resolution)."""
@@ -50,8 +56,9 @@ class NumberStyle:
 
 
 def format_number(value: float, style: NumberStyle) -> str:
-    if style.plain:  # the common style: Python's own fixed-point format is exactly it
-        text = f"{value:.{style.decimals}f}"
+    spec = style.spec
+    if spec:  # the common style: Python's own fixed-point format is exactly it
+        text = format(value, spec)
         return text[1:] if text[0] == "-" and not text.strip("-0.") else text
     text = f"{abs(value):.{style.decimals}f}"
     if float(text) == 0.0:

@@ -8,7 +8,7 @@ separates its words.
 
 from __future__ import annotations
 
-from typing import BinaryIO, Iterable, Mapping
+from typing import BinaryIO, Collection, Iterable, Mapping
 
 from ncpp.program.blocks import Block, Comment, Word
 from ncpp.program.numbers import NumberStyle, format_number
@@ -26,12 +26,30 @@ def write_blocks(blocks: Iterable[Block], out: BinaryIO) -> int:
     return count
 
 
+def spelling(block: Block) -> tuple[str, bool]:
+    """How the block spells its words: (separator, lower case).
+
+    The separator is what stands between its first two words ('' when packed,
+    ' ' when it has fewer than two); lower case when it has words and none of
+    their letters is a capital.
+    """
+    raw = block.raw
+    separator = None
+    previous_end = -1
+    capital = False
+    for item in block.items:
+        if type(item) is Word:
+            if separator is None and previous_end >= 0:
+                separator = raw[previous_end : item.start]
+            previous_end = item.end
+            first = raw[item.start]
+            capital = capital or (first.isalpha() and not first.islower())
+    return (" " if separator is None else separator), previous_end >= 0 and not capital
+
+
 def word_separator(block: Block) -> str:
     """' ' when the block separates its words with spaces, '' when it packs them."""
-    words = block.words()
-    for left, right in zip(words, words[1:]):
-        return block.raw[left.end : right.start] if right.start > left.end else ""
-    return " "
+    return spelling(block)[0]
 
 
 def edit_words(
@@ -51,20 +69,32 @@ def edit_words(
     """
     if motion is not None:
         block = _with_motion(block, motion)
+    texts = {letter: format_number(value, style_for[letter]) for letter, value in values.items()}
+    return set_words(block, texts, frozenset(drop))
+
+
+def set_words(
+    block: Block,
+    texts: Mapping[str, str],
+    drop: Collection[str] = (),
+    spelled: tuple[str, bool] | None = None,
+) -> str:
+    """`edit_words` with the numbers already written (`texts`: letter -> number text)
+    and no motion word to set.  `spelled` is the block's `spelling` when the caller
+    knows it already (it only matters for appended words)."""
     raw = block.raw
     pieces: list[str] = []
     size = 0  # length of what `pieces` holds
     cursor = 0
-    pending = dict(values)
-    dropped = set(drop)
+    pending = dict(texts)
     last_word_end = None  # where appended words go: after the last axis word, else the last word
     seen_axis = False
     for item in block.items:
         kind = type(item)
-        if kind is Word and (item.letter in pending or item.letter in dropped):
+        if kind is Word and (item.letter in pending or item.letter in drop):
             gap = raw[cursor : item.start]
             if item.letter in pending:
-                text = raw[item.start] + format_number(pending.pop(item.letter), style_for[item.letter])
+                text = raw[item.start] + pending.pop(item.letter)
                 pieces += (gap, text)
                 size += len(gap) + len(text)
             else:  # remove the word and the separator before it
@@ -85,12 +115,8 @@ def edit_words(
     head = "".join(pieces)
     tail = raw[cursor:]
     if pending:
-        sep = word_separator(block)
-        lower = _lower_case(block)
-        extra = "".join(
-            sep + (letter.lower() if lower else letter) + format_number(value, style_for[letter])
-            for letter, value in pending.items()
-        )
+        sep, lower = spelled or spelling(block)
+        extra = "".join(sep + (letter.lower() if lower else letter) + text for letter, text in pending.items())
         at = last_word_end if last_word_end is not None else len(head)
         if last_word_end is None and not head.strip():
             extra = extra.lstrip()
@@ -100,8 +126,7 @@ def edit_words(
 
 def _lower_case(block: Block) -> bool:
     """The block writes its letters in lower case."""
-    words = block.words()
-    return bool(words) and all(block.raw[w.start].islower() for w in words if block.raw[w.start].isalpha())
+    return spelling(block)[1]
 
 
 def _with_motion(block: Block, code: int) -> Block:

@@ -14,15 +14,18 @@ from dataclasses import replace
 from typing import Iterable, Iterator
 
 from ncpp.motion.segments import PLANE_AXES, Arc, Context, Event, Line
-from ncpp.program.blocks import Block, ExprWord, Word
+from ncpp.program.blocks import Block, Comment, ExprWord, Word
 from ncpp.program.numbers import NumberStyle, format_number
-from ncpp.program.writer import _lower_case, edit_words, word_separator
+from ncpp.program.writer import _with_motion, set_words, spelling
 
 AXES = "XYZ"
-CENTRE_LETTERS = {17: "IJ", 18: "IK", 19: "JK"}  # as written; order of I J K words
+CENTRE_WORDS = {17: (("I", 0), ("J", 1)), 18: (("I", 0), ("K", 2)), 19: (("J", 1), ("K", 2))}  # (letter, axis), as written
 MOTION_CODES = {0.0: 0, 1.0: 1, 2.0: 2, 3.0: 3}
 DEFAULT_STYLE = NumberStyle(decimals=4)
 GEOMETRY_LETTERS = "XYZIJKR"  # words a pass rewrites in a changed block
+WRITTEN_LETTERS = "XYZIJK"  # the letters the writer writes numbers for
+MOVING_LETTERS = "XYZABCUVWIJKR"  # words that make a block move (with the modal motion)
+UNSTYLED = ("G", "M", "N", "O")  # letters whose numbers say nothing about coordinate style
 DROPPED = ("I", "J", "K", "R", "P", ",R", ",C")  # words of the old geometry a changed block loses
 
 
@@ -38,13 +41,15 @@ class IsoWriter:
         self.program_motion: int | None = None  # motion mode as the input program has it
         self.output_motion: int | None = None  # motion mode as the output has it
         self.last_written: dict[str, float] = {}  # last absolute coordinate per axis in the output, as rounded there
-        self._shapes: dict[str, tuple] = {}  # per letter: the shape of the number its style was read from
-        self._resolved: dict[tuple[str, bool], NumberStyle] = {}  # (letter, inch) -> style to write
         # Axes the program has positioned; before that the control's position is not
         # the interpreter's assumed zero, so a word must not be added for them.
         self.known_axes: set[str] = set()
-        self._memo_block: Block | None = None
-        self._memo: dict = {}
+        self._shapes: dict[str, tuple] = {}  # per letter: the shape of the number its style was read from
+        # Derived from `styles`, emptied when a style changes: (letter, inch) -> style to write,
+        # ("XYZ", inch) -> axis decimals, inch -> {letter: style} for WRITTEN_LETTERS.
+        self._resolved: dict = {}
+        self._facts_of: tuple[Block | None, _Facts | None] = (None, None)  # the last block asked about
+        self._rounded: tuple = (None, ())  # (segment, its end rounded as written)
 
     def comment(self, text: str) -> str:
         return f"{self.comment_open}{text}{self.comment_close}"
@@ -62,7 +67,6 @@ class IsoWriter:
 
     def _write_group(self, group: list[Event]) -> Iterator[str]:
         block = group[0].block
-        self._memo_block, self._memo = block, {}  # facts about this block, computed once
         self._learn_styles(block)
         motion = [e for e in group if type(e) is Line or type(e) is Arc]
         if not any(e.changed for e in motion):
@@ -71,58 +75,60 @@ class IsoWriter:
             yield block.text
             self._after_verbatim(block, motion)
             return
-        block = _literal_geometry(block)
+        if not self._facts(block).plain:
+            block = _literal_geometry(block)
         for n, segment in enumerate(motion):
             yield (self._edit_block(block, segment) if n == 0 else self._new_block(block, segment)) + block.eol
 
-    # -- verbatim blocks ------------------------------------------------------
+    # -- what a block says --------------------------------------------------------
+    def _facts(self, block: Block) -> "_Facts":
+        """The facts of `block`, read once while it is being written."""
+        last, facts = self._facts_of
+        if block is not last:
+            facts = _Facts(block)
+            self._facts_of = (block, facts)
+        return facts  # type: ignore[return-value]
+
     def _learn_styles(self, block: Block) -> None:
+        shapes = self._shapes
         for item in block.items:
-            if type(item) is Word and item.letter not in ("G", "M", "N", "O"):
-                letter, number = item.letter, item.number
+            if type(item) is Word and item.letter not in UNSTYLED:
+                number = item.number
                 shape = (len(number), number.find("."), number[:1])  # cheap: styles rarely change
-                if self._shapes.get(letter) != shape:
-                    self._shapes[letter] = shape
-                    self.styles[letter] = NumberStyle.of(number)
-                    self._resolved.clear()
-                    if letter in AXES:
-                        self.known_axes.add(letter)
+                if shapes.get(item.letter) != shape:
+                    shapes[item.letter] = shape
+                    self._learn_style(item.letter, NumberStyle.of(number))
+
+    def _learn_style(self, letter: str, style: NumberStyle) -> None:
+        if self.styles.get(letter) != style:
+            self.styles[letter] = style
+            self._resolved.clear()
+            self._rounded = (None, ())
+        if letter in AXES:
+            self.known_axes.add(letter)
 
     def _block_motion(self, block: Block) -> int | None:
-        code = None
-        for item in block.items:
-            if type(item) is Word and item.letter == "G":
-                if item.value in MOTION_CODES:
-                    code = MOTION_CODES[item.value]
-                elif 73 <= item.value <= 89:
-                    code = None
-        return code
+        return self._facts(block).motion
+
+    def _has_motion_word(self, block: Block) -> bool:
+        return self._facts(block).motion_word
 
     def _arc_block(self, block: Block) -> bool:
         """The block programs an arc (its P, if any, is the arc's turn count)."""
         return (self._block_motion(block) if self._has_motion_word(block) else self.program_motion) in (2, 3)
 
-    def _has_motion_word(self, block: Block) -> bool:
-        return self._fact(block, "has_motion", lambda: any(
-            type(i) is Word and i.letter == "G" and (i.value in MOTION_CODES or 73 <= i.value <= 89) for i in block.items))
+    def _spelling(self, block: Block) -> tuple[str, bool]:
+        """How the block spells its words: (separator, lower case)."""
+        facts = self._facts(block)
+        if facts.spelling is None:
+            facts.spelling = spelling(block)
+        return facts.spelling
 
-    def _fact(self, block: Block, name: str, compute):
-        """A fact about the block being written, computed once per block."""
-        if block is not self._memo_block:
-            return compute()
-        memo = self._memo
-        if name not in memo:
-            memo[name] = compute()
-        return memo[name]
-
-    def _present(self, block: Block) -> set[str]:
-        return self._fact(block, "present", lambda: {w.letter for w in block.words()})
-
+    # -- verbatim blocks ------------------------------------------------------
     def _needs_mode_restore(self, block: Block) -> bool:
         """A verbatim block relying on a modal motion the output changed (an arc written as lines)."""
-        moves = any(type(i) is Word and i.letter in "XYZABCUVWIJKR" for i in block.items)
         return (
-            moves
+            self._facts(block).moves
             and not self._has_motion_word(block)
             and self.program_motion is not None
             and self.output_motion != self.program_motion
@@ -138,14 +144,24 @@ class IsoWriter:
         for segment in motion:
             self._remember_end(segment)
 
+    # -- numbers as written -----------------------------------------------------
     def _moved(self, axis: str, value: float, segment: Line | Arc) -> bool:
         """Whether writing `value` for the axis changes what the output last said."""
         return round(value, self._style(axis, segment).decimals) != self.last_written.get(axis)
 
+    def _rounded_end(self, segment: Line | Arc) -> tuple[float, float, float]:
+        """The segment's end as the output writes it (asked twice per segment: moved axes, then remembered)."""
+        last, rounded = self._rounded
+        if segment is not last:
+            end = segment.end
+            dx, dy, dz = self._axis_decimals(segment.context.inch)
+            rounded = (round(end[0], dx), round(end[1], dy), round(end[2], dz))
+            self._rounded = (segment, rounded)
+        return rounded  # type: ignore[return-value]
+
     def _remember_end(self, segment: Line | Arc) -> None:
-        last, end = self.last_written, segment.end
-        dx, dy, dz = self._axis_decimals(segment.context.inch)
-        last["X"], last["Y"], last["Z"] = round(end[0], dx), round(end[1], dy), round(end[2], dz)
+        last = self.last_written
+        last["X"], last["Y"], last["Z"] = self._rounded_end(segment)
 
     def _axis_decimals(self, inch: bool) -> tuple[int, int, int]:
         key = ("XYZ", inch)
@@ -154,7 +170,6 @@ class IsoWriter:
             found = self._resolved[key] = tuple(self._style(a, _INCH if inch else _MM).decimals for a in AXES)
         return found
 
-    # -- changed blocks ---------------------------------------------------------
     def _format(self, letter: str, value: float, segment: Line | Arc) -> str:
         return format_number(value, self._style(letter, segment))
 
@@ -166,18 +181,28 @@ class IsoWriter:
             style = self._resolved[key] = style.at_least(self.inch_decimals if key[1] else self.mm_decimals)
         return style
 
+    def _written_styles(self, inch: bool) -> dict[str, NumberStyle]:
+        """`_style` of every letter the writer writes, resolved once per change of styles."""
+        found = self._resolved.get(inch)
+        if found is None:
+            units = _INCH if inch else _MM
+            found = self._resolved[inch] = {letter: self._style(letter, units) for letter in WRITTEN_LETTERS}
+        return found
+
+    # -- changed blocks ---------------------------------------------------------
     def _targets(self, block: Block, segment: Line | Arc) -> dict[str, float]:
         """Axis words to write: what the block had, and whatever moved in the output."""
-        present = self._present(block)
+        present = self._facts(block).letters
         values: dict[str, float] = {}
-        decimals = self._axis_decimals(segment.context.inch)
         end = segment.end
         if segment.context.absolute:
             last, known = self.last_written, self.known_axes
+            rounded = self._rounded_end(segment)
             for n, axis in enumerate(AXES):
-                if axis in present or (axis in known and round(end[n], decimals[n]) != last.get(axis)):
+                if axis in present or (axis in known and rounded[n] != last.get(axis)):
                     values[axis] = end[n]
         else:
+            decimals = self._axis_decimals(segment.context.inch)
             start = segment.start
             for n, axis in enumerate(AXES):
                 delta = end[n] - start[n]
@@ -186,13 +211,10 @@ class IsoWriter:
         return values
 
     def _centre_words(self, segment: Arc) -> dict[str, float]:
-        i, j, _ = PLANE_AXES[segment.context.plane]
-        letters = {0: "I", 1: "J", 2: "K"}
-        words = {}
-        for axis in sorted((i, j)):
-            origin = 0.0 if segment.context.arc_absolute else segment.start[axis]
-            words[letters[axis]] = segment.center[axis] - origin
-        return words
+        centre, start = segment.center, segment.start
+        if segment.context.arc_absolute:
+            return {letter: centre[axis] for letter, axis in CENTRE_WORDS[segment.context.plane]}
+        return {letter: centre[axis] - start[axis] for letter, axis in CENTRE_WORDS[segment.context.plane]}
 
     def _motion_code(self, segment: Line | Arc) -> int:
         if type(segment) is Arc:
@@ -205,38 +227,70 @@ class IsoWriter:
             values.update(self._centre_words(segment))
         return values
 
+    def _texts(self, block: Block, segment: Line | Arc) -> dict[str, str]:
+        """`_words` as the output writes their numbers."""
+        styles = self._written_styles(segment.context.inch)
+        return {letter: format_number(value, styles[letter]) for letter, value in self._words(block, segment).items()}
+
     def _edit_block(self, block: Block, segment: Line | Arc) -> str:
-        values = self._words(block, segment)
-        styles = {letter: self._style(letter, segment) for letter in values}
+        facts = self._facts(block)
+        texts = self._texts(block, segment)
         code = self._motion_code(segment)
-        has_motion = self._has_motion_word(block)
-        present = self._present(block)
         # centre words of the old arc, and Fanuc corner words: the corner is now explicit;
         # P is an arc's turn count, but a dwell time (G4) or blending tolerance (G64) elsewhere
-        drop = [letter for letter in DROPPED if letter in present and letter not in values]
+        drop = [] if facts.letters.isdisjoint(DROPPED) else [l for l in DROPPED if l in facts.letters and l not in texts]
         if "P" in drop and not self._arc_block(block):
             drop.remove("P")
-        raw = edit_words(block, values, styles, drop=drop, motion=code if code != self.output_motion or has_motion else None)
-        if has_motion or code != self.output_motion:
+        edited = block
+        if code != self.output_motion or facts.motion_word:
+            edited = _with_motion(block, code)  # the same block when its G word already says `code`
+        # the common case (the block's own words, its spelling known) skips re-reading the spelling
+        raw = set_words(edited, texts, drop, self._spelling(block) if edited is block else None)
+        if facts.motion_word or code != self.output_motion:
             self.output_motion = code
-        if has_motion:
-            self.program_motion = self._block_motion(block)
+        if facts.motion_word:
+            self.program_motion = facts.motion
         self._remember_end(segment)
         return raw
 
     def _new_block(self, block: Block, segment: Line | Arc) -> str:
-        values = self._words(block, segment)
+        sep, lower = self._spelling(block)
         code = self._motion_code(segment)
-        sep = self._fact(block, "separator", lambda: word_separator(block))
-        lower = self._fact(block, "lower", lambda: _lower_case(block))
-        parts = []
+        words = [letter + text for letter, text in self._texts(block, segment).items()]
         if code != self.output_motion:
-            parts.append(f"G{code}")
+            words.insert(0, f"G{code}")
             self.output_motion = code
-        parts += [letter + self._format(letter, value, segment) for letter, value in values.items()]
         self._remember_end(segment)
-        text = sep.join(parts) if sep else "".join(parts)
+        text = sep.join(words)
         return text.lower() if lower else text
+
+
+class _Facts:
+    """What the writer asks about a block, read in one pass over its items."""
+
+    __slots__ = ("letters", "motion_word", "motion", "moves", "plain", "spelling")
+
+    def __init__(self, block: Block):
+        self.letters: set[str] = set()  # letters of its plain words
+        self.motion_word = False  # it has a motion G word (G0-G3, a canned cycle)
+        self.motion: int | None = None  # the motion mode it sets (None: a canned cycle or none)
+        self.moves = False  # it has words that move with the modal motion
+        self.plain = True  # only words and comments
+        self.spelling: tuple[str, bool] | None = None  # (word separator, lower case) once asked for
+        for item in block.items:
+            kind = type(item)
+            if kind is Word:
+                letter = item.letter
+                self.letters.add(letter)
+                if letter == "G":
+                    if item.value in MOTION_CODES:
+                        self.motion_word, self.motion = True, MOTION_CODES[item.value]
+                    elif 73 <= item.value <= 89:
+                        self.motion_word, self.motion = True, None
+                elif letter in MOVING_LETTERS:
+                    self.moves = True
+            elif kind is not Comment:
+                self.plain = False
 
 
 class _Units:
