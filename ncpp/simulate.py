@@ -71,7 +71,11 @@ def _sample_line(line: Line, step_mm: float) -> NDArray:
     length = float(np.linalg.norm(b - a)) * line.context.unit_mm
     n = max(1, int(math.ceil(length / step_mm)))
     t = np.linspace(0.0, 1.0, n + 1)[:, None]
-    return _to_machine(line, a + t * (b - a))
+    p = a + t * (b - a)
+    # the end exactly: a + 1·(b − a) can miss b by a unit in the last place, a
+    # "motion" whose sign would set (and reverse) the direction of travel
+    p[-1] = b
+    return _to_machine(line, p)
 
 
 def _sample_arc(arc: Arc, step_mm: float) -> NDArray:

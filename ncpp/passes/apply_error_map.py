@@ -16,6 +16,7 @@ start is compensated with its own direction and a step move is inserted.
 
 from __future__ import annotations
 
+import heapq
 from dataclasses import replace
 from typing import Iterable, Iterator
 
@@ -86,11 +87,13 @@ def _directional(chunk: list[Event], ctx: PassContext, travel: Travel) -> tuple[
     machine = lambda p, rows=slice(None): (p + offsets[rows]) * scales[rows, None]  # noqa: E731
     free = np.array([type(e) is Line and not e.changed for e in segs])
     arc = np.array([e.changed for e in segs])  # pieces replace_arcs made: arcs, and lines for slivers
+    pieces = arc & np.array([type(e) is Line for e in segs])  # the lines among them
     start_p, end_p = np.array([e.start for e in segs]), np.array([e.end for e in segs])
     start_m, end_m = machine(start_p), machine(end_p)
     first = travel.last if travel.last is not None else start_m[0]
 
     out_start, out_end = start_p.copy(), end_p.copy()
+    compensated = end_p.copy()  # line ends before _hold_still leaves axes standing
     assumed = _arc_assumed(segs, arc)  # the directions replace_arcs compensated the arcs with
     used = np.full(start_p.shape, np.nan)  # the directions each row is compensated with
     used[arc] = assumed[arc]
@@ -100,16 +103,21 @@ def _directional(chunk: list[Event], ctx: PassContext, travel: Travel) -> tuple[
         redo = np.flatnonzero(free & (d != used).any(axis=1))
         if redo.size:
             c = compensate(end_p[redo], offsets[redo], scales[redo], [segs[i] for i in redo], ctx, d[redo])
-            out_end[redo] = quantize(c, step[redo])
+            compensated[redo] = quantize(c, step[redo])
         shift = np.flatnonzero(arc & (d != used).any(axis=1))
         if shift.size:
             _shift_arcs(shift, start_p, end_p, offsets, scales, d, assumed, step, ctx, out_start, out_end)
         used[redo], used[shift] = d[redo], d[shift]
-        _join_arcs(arc, offsets, scales, step, out_start, out_end)
+        out_end[free] = compensated[free]
+        _hold_still(free, d, offsets, scales, step, ctx.tolerance, out_end)
+        _hold_pieces_still(pieces, d, travel.held, _snap_limit(step, scales, ctx.tolerance), out_start, out_end)
+        _join_arcs(arc, offsets, scales, _snap_limit(step, scales, ctx.tolerance), out_start, out_end)
         cur_end, cur_start = machine(out_end), machine(out_start)
         previous = np.vstack([first[None, :], cur_end[:-1]])
-        motion = np.where(free[:, None], cur_end - previous, cur_end - cur_start)
-        d_new = hold(steps(motion, threshold), travel.held)
+        # a piece moves from the previous end to its start first (a connecting step), then along itself
+        own = steps(np.where(free[:, None], cur_end - previous, cur_end - cur_start), threshold)
+        moved = np.where(arc[:, None] & (own == 0), steps(cur_start - previous, threshold), own)
+        d_new = _own_motion(moved, hold(moved, travel.held), free, start_p, end_p, offsets, scales, segs, step, threshold, ctx, travel)
         if np.array_equal(d_new, d):
             break
         d = d_new
@@ -121,7 +129,8 @@ def _directional(chunk: list[Event], ctx: PassContext, travel: Travel) -> tuple[
     flips = (d != before) & (before != 0)
     turn = np.flatnonzero(free & flips.any(axis=1))
     # axes that keep their direction must not move in a reversal step (see _snap)
-    steady = {index[i]: (tuple(~flips[i]), float(step[i])) for i in np.flatnonzero(flips.any(axis=1))}
+    limit = _snap_limit(step, scales, ctx.tolerance)
+    steady = {index[i]: (tuple(~flips[i]), float(limit[i])) for i in np.flatnonzero(flips.any(axis=1))}
     new_starts = {}
     if turn.size:
         s = compensate(start_p[turn], offsets[turn], scales[turn], [segs[i] for i in turn], ctx, d[turn])
@@ -132,23 +141,91 @@ def _directional(chunk: list[Event], ctx: PassContext, travel: Travel) -> tuple[
     return new_ends, new_starts, new_arcs, steady
 
 
+def _hold_still(free, d, offsets, scales, step, tolerance, out_end) -> None:
+    """Leave an axis where it is when its compensated motion goes a rounding
+    step or so against the direction it holds.
+
+    Such a motion (the error drifting along an axis that does not move) would
+    reverse the axis for a fraction of a micron; the reversal's jump is larger.
+    In order of travel, so that a drift accumulated over many lines is bounded."""
+    rows = np.flatnonzero(free[1:]) + 1
+    same = (offsets[rows] == offsets[rows - 1]).all(axis=1) & (scales[rows] == scales[rows - 1])
+    rows = rows[same]
+    limit = _snap_limit(step, scales, tolerance)
+    motion = out_end[rows] - out_end[rows - 1]
+    # only lines compensated for the held direction: a line compensated for the new one reverses anyway
+    against = (np.sign(motion) == -d[rows - 1]) & (d[rows] == d[rows - 1]) & (np.abs(motion) <= limit[rows, None])
+    todo = rows[against.any(axis=1)].tolist()
+    if not todo:
+        return
+    stills = set(rows.tolist())
+    heapq.heapify(todo)
+    done = set()
+    while todo:
+        k = heapq.heappop(todo)
+        if k in done:
+            continue
+        done.add(k)
+        motion_k = out_end[k] - out_end[k - 1]
+        keep = (np.sign(motion_k) == -d[k - 1]) & (d[k] == d[k - 1]) & (np.abs(motion_k) <= limit[k])
+        if keep.any():
+            out_end[k] = np.where(keep, out_end[k - 1], out_end[k])
+            if k + 1 in stills:
+                heapq.heappush(todo, k + 1)
+
+
+def _hold_pieces_still(pieces, d, held, limit, out_start, out_end) -> None:
+    """The same for the lines replace_arcs made (slivers): an axis they move by
+    less than `limit` against the held direction stays where the piece starts."""
+    rows = np.flatnonzero(pieces)
+    if rows.size == 0:
+        return
+    before = np.vstack([held[None, :], d[:-1]])[rows]
+    motion = out_end[rows] - out_start[rows]
+    keep = (np.sign(motion) == -before) & (d[rows] == before) & (np.abs(motion) <= limit[rows, None])
+    out_end[rows] = np.where(keep, out_start[rows], out_end[rows])
+
+
+def _own_motion(moved, d, free, start_p, end_p, offsets, scales, segs, step, threshold, ctx, travel) -> NDArray:
+    """Directions (n,3) with the lines that reverse an axis judged by their own motion.
+
+    Such a line starts with a step to its start compensated for the new
+    direction; if the line then moves that axis the other way (the error
+    varies along it), the machine ends up travelling the old way and the
+    reversal was not one: the line keeps the old direction instead."""
+    before = np.vstack([travel.held[None, :], d[:-1]])
+    flips = (d != before) & (before != 0) & free[:, None]
+    rows = np.flatnonzero(flips.any(axis=1))
+    if rows.size == 0:
+        return d
+    ends = np.stack([start_p[rows], end_p[rows]], axis=1)
+    ends = compensate(ends, offsets[rows], scales[rows], [segs[i] for i in rows], ctx, np.repeat(d[rows, None], 2, axis=1))
+    ends = quantize(ends, step[rows])
+    own = steps((ends[:, 1] - ends[:, 0]) * scales[rows, None], threshold[rows])
+    contrary = flips[rows] & (own != 0) & (own != d[rows])
+    if not contrary.any():
+        return d
+    moved = moved.copy()
+    moved[rows] = np.where(contrary, own, moved[rows])
+    return hold(moved, travel.held)
+
+
 def _arc_assumed(segs: list, arc: NDArray) -> NDArray:
     """Directions replace_arcs compensated each arc piece with: the sign of the
-    tangent at the middle in the plane, the mean (0) on the normal axis."""
+    tangent at the middle in the plane, the mean (0) on the normal axis; and
+    the mean on every axis for the lines it made."""
     out = np.zeros((len(segs), 3))
-    rows = np.flatnonzero(arc)
+    rows = np.flatnonzero(arc & np.array([type(e) is Arc for e in segs]))
     if rows.size == 0:
         return out
     arcs = [segs[i] for i in rows]
     axes = np.array([PLANE_AXES[a.context.plane] for a in arcs])
-    is_arc = np.array([type(a) is Arc for a in arcs])
-    s, e, c = (np.take_along_axis(np.array([getattr(a, f, a.end) for a in arcs]), axes, axis=1) for f in ("start", "end", "center"))
+    s, e, c = (np.take_along_axis(np.array([getattr(a, f) for a in arcs]), axes, axis=1) for f in ("start", "end", "center"))
     u0, u1 = s[:, :2] - c[:, :2], e[:, :2] - c[:, :2]
     with np.errstate(invalid="ignore", divide="ignore"):
         mid = u0 / np.linalg.norm(u0, axis=1, keepdims=True) + u1 / np.linalg.norm(u1, axis=1, keepdims=True)
-    turn = np.sign([getattr(a, "turn", 1) for a in arcs])[:, None]
-    # arcs: the tangent at the middle; lines (slivers): the chord
-    tangent = np.where(is_arc[:, None], turn * np.column_stack([-mid[:, 1], mid[:, 0]]), e[:, :2] - s[:, :2])
+    turn = np.sign([a.turn for a in arcs])[:, None]
+    tangent = turn * np.column_stack([-mid[:, 1], mid[:, 0]])
     local = np.column_stack([np.sign(tangent), np.zeros(len(arcs))])
     sub = np.zeros((len(rows), 3))
     np.put_along_axis(sub, axes, local, axis=1)
@@ -168,17 +245,37 @@ def _shift_arcs(rows, start_p, end_p, offsets, scales, d, assumed, step, ctx, ou
     out_end[rows] = quantize(pts[:, 1] - delta[:, 1], step[rows])
 
 
-def _join_arcs(arc: NDArray, offsets: NDArray, scales: NDArray, step: NDArray, out_start: NDArray, out_end: NDArray) -> None:
-    """Move an arc piece that starts within a rounding step of the previous
-    segment's end rigidly onto it: a one-digit step there would reverse that
-    axis on the machine.  A rigid move keeps the radii equal."""
+def _snap_limit(step: NDArray, scales: NDArray, tolerance: float) -> NDArray:
+    """(n,) program units an axis may be left off its compensated position
+    rather than reversed: a rounding step, or a quarter of the tolerance."""
+    return np.maximum(1.01 * step, tolerance / 4 / scales)
+
+
+def _join_arcs(arc: NDArray, offsets: NDArray, scales: NDArray, limit: NDArray, out_start: NDArray, out_end: NDArray) -> None:
+    """Move an arc piece that starts within `limit` (n,) of the previous
+    segment's end rigidly onto it: a µm step there would reverse that axis
+    on the machine.  A rigid move keeps the radii equal.  In order of
+    travel: a moved piece moves the end the next one must meet."""
     rows = np.flatnonzero(arc[1:]) + 1
     same = (offsets[rows] == offsets[rows - 1]).all(axis=1) & (scales[rows] == scales[rows - 1])
     rows = rows[same]
     gap = out_end[rows - 1] - out_start[rows]
-    move = np.where(np.abs(gap) <= 1.01 * step[rows, None], gap, 0.0)
-    out_start[rows] += move
-    out_end[rows] += move
+    todo = rows[((np.abs(gap) <= limit[rows, None]) & (gap != 0)).any(axis=1)].tolist()
+    joinable = set(rows.tolist())
+    heapq.heapify(todo)
+    done = set()
+    while todo:
+        k = heapq.heappop(todo)
+        if k in done:
+            continue
+        done.add(k)
+        gap_k = out_end[k - 1] - out_start[k]
+        move = np.where(np.abs(gap_k) <= limit[k], gap_k, 0.0)
+        if move.any():
+            out_start[k] += move
+            out_end[k] += move
+            if k + 1 in joinable:
+                heapq.heappush(todo, k + 1)
 
 
 def _moved_arc(arc: Arc | Line, start, end, old_start, old_end) -> Arc:
@@ -192,11 +289,11 @@ def _moved_arc(arc: Arc | Line, start, end, old_start, old_end) -> Arc:
     return replace(arc, start=tuple(map(float, start)), end=tuple(map(float, end)), center=centre)
 
 
-def _snap(start: tuple, previous_end: tuple, steady: tuple, step: float) -> tuple:
+def _snap(start: tuple, previous_end: tuple, steady: tuple, limit: float) -> tuple:
     """A reversal step's target with the axes that keep their direction left
     where they are, when they differ only by output rounding: a one-digit move
     there would reverse that axis on the machine."""
-    return tuple(p if keep and abs(s - p) <= step * 1.01 else s for s, p, keep in zip(start, previous_end, steady))
+    return tuple(p if keep and abs(s - p) <= limit else s for s, p, keep in zip(start, previous_end, steady))
 
 
 def _end_in_frame_of(last: Line | Arc | None, event: Line | Arc) -> tuple | None:

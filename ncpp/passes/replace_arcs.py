@@ -145,22 +145,34 @@ def _replace(arcs: list[Arc], ctx: PassContext) -> list[list[Event]]:
         direction = np.broadcast_to(direction, nominal.shape)
         q = compensate(nominal, offsets[pending.arc], scales[pending.arc], segs, ctx, direction)
         centre, deviation = _fit(q, geometry.axes[pending.arc], t, ctx.tolerance / scales[pending.arc])
+        length = np.abs(pending.sweep) * geometry.radius[pending.arc] * scales[pending.arc]
+        ok = deviation <= ctx.tolerance / scales[pending.arc]
         if ctx.directional:  # ends on the output grid (after the fit: a short piece's chord fixes the bisector)
             step = grid(ctx, scales[pending.arc])
             q[:, 0], q[:, -1] = quantize(q[:, 0], step), quantize(q[:, -1], step)
-        length = np.abs(pending.sweep) * geometry.radius[pending.arc] * scales[pending.arc]
-        ok = deviation <= ctx.tolerance / scales[pending.arc]
+            one_way = _one_way(q, centre, geometry.axes[pending.arc], direction[:, 0], np.sign(pending.sweep), step)
+        else:
+            one_way = np.ones(len(ok), dtype=bool)
         # a sliver (a quadrant cut next to an arc's end) is a line: on the output grid its
-        # chord fixes no centre, and equal ends would be read as a full circle
-        for p in np.flatnonzero(length < SLIVER):
+        # chord fixes no centre, and equal ends would be read as a full circle; so is a
+        # piece that reverses an axis inside but bulges less than a quarter of the tolerance
+        chord = np.linalg.norm(q[:, -1] - q[:, 0], axis=1) * scales[pending.arc]
+        flat = chord**2 / (8 * np.maximum(geometry.radius[pending.arc] * scales[pending.arc], 1e-12)) <= ctx.tolerance / 4
+        straight = (length < SLIVER) | (~one_way & flat)
+        ok &= one_way & ~straight
+        give_up = ~ok & ~straight & (length < MIN_PIECE)
+        lines = np.flatnonzero(straight | give_up)
+        if lines.size and ctx.directional:
+            # lines are compensated for the mean direction: apply_error_map moves them to the real one
+            q[lines] = _mean_compensated(nominal[lines], offsets[pending.arc[lines]],
+                                         scales[pending.arc[lines]], [segs[i] for i in lines], ctx)  # fmt: skip
+        for p in np.flatnonzero(straight):
             done.append((int(pending.arc[p]), float(pending.a0[p]), _line_pieces(arcs[pending.arc[p]], q[p, [0, -1]])))
-        ok &= length >= SLIVER
-        give_up = ~ok & (length < MIN_PIECE) & (length >= SLIVER)
         for p in np.flatnonzero(ok):
             done.append((int(pending.arc[p]), float(pending.a0[p]), _arc_piece(arcs[pending.arc[p]], q[p], centre[p])))
         for p in np.flatnonzero(give_up):
             done.append((int(pending.arc[p]), float(pending.a0[p]), _line_pieces(arcs[pending.arc[p]], q[p])))
-        split = ~ok & ~give_up & (length >= SLIVER)
+        split = ~ok & ~give_up & ~straight
         half = pending.sweep[split] / 2
         pending = _Pieces(
             np.repeat(pending.arc[split], 2),
@@ -168,6 +180,44 @@ def _replace(arcs: list[Arc], ctx: PassContext) -> list[list[Event]]:
             np.repeat(half, 2),
         )
     return _assemble(arcs, geometry, done)
+
+
+def _one_way(q: NDArray, centre: NDArray, axes: NDArray, direction: NDArray, sign: NDArray, step: NDArray) -> NDArray:
+    """(p,) whether each compensated piece (ends `q` on the output grid, `centre`) moves
+    every plane axis one way only, in the `direction` (p,3) it was compensated for
+    (`sign` (p,): +1 counter-clockwise).
+
+    Quadrant cuts are made on the nominal arc; compensation moves the centre, so a
+    piece next to a cut can pass the axis's extreme just inside its end and reverse
+    the axis there, where no step can follow.  An extreme within one output step
+    of an end is rounding of the written centre, not a reversal."""
+    local = lambda p: np.take_along_axis(p, axes, axis=1)  # noqa: E731
+    c, s0, s1 = local(centre)[:, :2], local(q[:, 0])[:, :2], local(q[:, -1])[:, :2]
+    want = np.take_along_axis(direction, axes, axis=1)[:, :2]
+    a0 = np.arctan2(s0[:, 1] - c[:, 1], s0[:, 0] - c[:, 0])
+    a1 = np.arctan2(s1[:, 1] - c[:, 1], s1[:, 0] - c[:, 0])
+    span = np.mod(sign * (a1 - a0), 2 * np.pi)  # angle travelled, whatever the wrap
+    r0, r1 = np.hypot(*(s0 - c).T), np.hypot(*(s1 - c).T)
+    radius = np.maximum(r0, 1e-12)
+    # controllers blend the radius from start to end: that moves each extreme
+    # by (dr/dangle)/r, a lot on a short piece whose ends were rounded
+    with np.errstate(divide="ignore", invalid="ignore"):
+        blend = np.where(span > 0, (r1 - r0) / (span * radius), 0.0)
+    quarter = np.pi / 2
+    ahead = quarter - np.mod(sign * a0, quarter)  # angle to the first extreme ahead, (0, π/2]
+    margin = step / radius
+    at = ahead[:, None] + quarter * np.arange(-1, 2)[None, :] + blend[:, None]
+    inside = ((at > margin[:, None]) & (at < (span - margin)[:, None])).any(axis=1)
+    mid = a0 + sign * span / 2
+    tangent = sign[:, None] * np.column_stack([-np.sin(mid), np.cos(mid)])
+    agrees = (np.sign(tangent) == want).all(axis=1)
+    return ~inside & agrees & (span < np.pi) & (np.abs(blend) < quarter / 2)
+
+
+def _mean_compensated(nominal, offsets, scales, segs, ctx) -> NDArray:
+    """Compensated samples (p,m,3) for the mean direction.  Not on the output
+    grid: apply_error_map moves them for the real direction, then rounds once."""
+    return compensate(nominal, offsets, scales, segs, ctx, np.zeros_like(nominal))
 
 
 def _fit(q: NDArray, axes: NDArray, t: NDArray, tolerance: NDArray) -> tuple[NDArray, NDArray]:
