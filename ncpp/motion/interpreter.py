@@ -181,6 +181,9 @@ class Interpreter:
                     pending = None
                 yield _pass(block)
                 continue
+            if pending is None and self.corner is None and type(event) is not tuple:
+                yield event  # the common case: no corner waits, none starts
+                continue
             events = event if type(event) is tuple else (event,)
             new_corner, self.corner = self.corner, None
             for ev in events:
@@ -341,12 +344,18 @@ class Interpreter:
                     self.params.write(key, value)
                 except ExpressionError as err:
                     self._fail(str(err), block, item)
-        if gcodes is None and mcodes is None:
-            if not words:
-                return _pass(block)
-            motion = self.motion
-            if motion is not None and words.keys() <= _PLAIN_LETTERS[motion] and not words.keys() <= _F_ONLY:
-                return self._modal_move(block, words, motion)
+        if mcodes is None:
+            if gcodes is None:
+                if not words:
+                    return _pass(block)
+                motion = self.motion
+                if motion is not None and words.keys() <= _PLAIN_LETTERS[motion] and not words.keys() <= _F_ONLY:
+                    return self._modal_move(block, words, motion)
+            elif len(gcodes) == 1 and 1 in gcodes:
+                motion, motion_item = gcodes[1]
+                plain = _PLAIN_LETTERS.get(motion)
+                if plain is not None and words.keys() <= plain:
+                    return self._motion_move(block, words, motion, motion_item)
         return self._execute(block, words, gcodes or {}, mcodes or {})
 
     def _update_fast(self) -> None:
@@ -403,6 +412,20 @@ class Interpreter:
         s6(line, (end[3], end[4], end[5], end[6], end[7], end[8]) if self.uses_extra_axes else ())
         s7(line, False)
         return line
+
+    def _motion_move(self, block: Block, words: dict, motion: float, motion_item: Word | ExprWord) -> Event:
+        """`G0`-`G3` and words that need no check: what `_execute` does with such a block."""
+        f = words.get("F")
+        if f is not None:
+            self.feed = f[0]
+        self.motion = motion
+        if motion > 1.0:
+            event: Event = self._arc(block, words, motion, motion_item, motion_item)
+        else:
+            event = self._straight(block, words, motion, False)
+            self.corner = None  # plain words hold no corner word
+        self._update_fast()
+        return event
 
     def _execute(self, block: Block, words: dict, gcodes: dict, mcodes: dict) -> Event | tuple[Event, ...]:
         mode0, mode0_item = gcodes.get(0, (None, None))
@@ -681,13 +704,30 @@ class Interpreter:
         self.pos = end
         return line
 
+    def _move_end(self, words: dict) -> list[float]:
+        """`_ends` of the block's axis words in program coordinates (what G0-G3 move to)."""
+        end = self.pos[:]
+        absolute = self.absolute
+        for letter, (value, _) in words.items():
+            i = AXIS_INDEX.get(letter)
+            if i is None:
+                continue
+            if absolute:
+                end[i] = value
+            else:
+                end[i] += value
+            if i >= 3:
+                self.uses_extra_axes = True
+        return end
+
     def _straight(self, block: Block, words: dict, motion: float, machine: bool | None) -> Line:
-        given = [(AXIS_INDEX[letter], value) for letter, (value, _) in words.items() if letter in AXIS_INDEX]
-        if not self.uses_extra_axes:
-            self._note_axes(given)
         if motion == 1.0:
             self._check_feed(block, words, "Cannot do g1 with zero feed rate", "F word missing with inverse time g1 move")
-        return self._line(block, self._ends(given, bool(machine)), motion == 0.0)
+        if not machine:
+            return self._line(block, self._move_end(words), motion == 0.0)
+        given = [(AXIS_INDEX[letter], value) for letter, (value, _) in words.items() if letter in AXIS_INDEX]
+        self._note_axes(given)
+        return self._line(block, self._ends(given, True), motion == 0.0)
 
     def _check_feed(self, block: Block, words: dict, zero: str, missing: str) -> None:
         # A zero feed rate (`zero`) is not refused, unlike rs274ngc: program fragments often
@@ -697,51 +737,48 @@ class Interpreter:
 
     def _arc(self, block: Block, words: dict, motion: float, motion_item, mode1_item) -> Arc:
         word = motion_item if motion_item is not None else next(item for _, item in words.values())
-        first_letter, second_letter, normal_letter = _ARC_LETTERS[self.plane]
-        has_r = "R" in words
+        plane = self.plane
+        first_letter, second_letter, normal_letter = _ARC_LETTERS[plane]
+        radius = words.get("R")
         has_ijk = "I" in words or "J" in words or "K" in words
-        if not has_r and not has_ijk:
+        if radius is None and not has_ijk:
             self._fail("R i j k words all missing for arc", block, word)
-        if has_r and has_ijk:
+        if radius is not None and has_ijk:
             self._fail("Mixed radius ijk format for arc", block, word)
         self._check_feed(block, words, "Cannot make arc with zero feed rate", "F word missing with inverse time arc move")
         if normal_letter in words:
-            self._fail(f"{normal_letter} word given for arc in {_PLANE_NAMES[self.plane]} plane", block, words[normal_letter][1])
-        given = [(AXIS_INDEX[letter], value) for letter, (value, _) in words.items() if letter in AXIS_INDEX]
-        if not self.uses_extra_axes:
-            self._note_axes(given)
-        end = self._ends(given, False)
-        a, b, _ = PLANE_AXES[self.plane]
+            self._fail(f"{normal_letter} word given for arc in {_PLANE_NAMES[plane]} plane", block, words[normal_letter][1])
+        end = self._move_end(words)
+        a, b, c = PLANE_AXES[plane]
         start = self.pos
         turns = round(words["P"][0]) if "P" in words else 1
-        turn = -turns if motion == 2.0 else turns
         tolerance = TOLERANCE[self.inch]
-        if has_r:
-            ca, cb = self._center_r(block, word, start[a], start[b], end[a], end[b], words["R"][0], motion, tolerance)
+        if radius is not None:
+            ca, cb = self._center_r(block, word, start[a], start[b], end[a], end[b], radius[0], motion, tolerance)
         else:
-            ia = words[first_letter][0] if first_letter in words else None
-            ib = words[second_letter][0] if second_letter in words else None
+            ia = words.get(first_letter)
+            ib = words.get(second_letter)
             if self.arc_absolute:
-                ca = start[a] if ia is None else ia
-                cb = start[b] if ib is None else ib
+                ca = start[a] if ia is None else ia[0]
+                cb = start[b] if ib is None else ib[0]
             else:
-                ca = start[a] + (ia or 0.0)
-                cb = start[b] + (ib or 0.0)
+                ca = start[a] + (0.0 if ia is None else ia[0])  # + 0.0 as before: -0.0 becomes 0.0
+                cb = start[b] + (0.0 if ib is None else ib[0])
             self._check_radii(block, word, start[a], start[b], end[a], end[b], ca, cb, tolerance)
         center = [0.0, 0.0, 0.0]
-        center[a], center[b] = ca, cb
-        center[PLANE_AXES[self.plane][2]] = start[PLANE_AXES[self.plane][2]]
-        arc = Arc(
-            (start[0], start[1], start[2]),
-            (end[0], end[1], end[2]),
-            (center[0], center[1], center[2]),
-            turn,
-            self.feed,
-            block,
-            self._context or self.context(),
-            tuple(end[3:]) if self.uses_extra_axes else (),
-        )
+        center[a], center[b], center[c] = ca, cb, start[c]
         self.pos = end
+        arc = _new(Arc)  # Arc(...) with its slots set directly, as `_new_line`
+        s_start, s_end, s_center, s_turn, s_feed, s_block, s_context, s_extra, s_changed = _ARC_SLOTS
+        s_start(arc, (start[0], start[1], start[2]))
+        s_end(arc, (end[0], end[1], end[2]))
+        s_center(arc, (center[0], center[1], center[2]))
+        s_turn(arc, -turns if motion == 2.0 else turns)
+        s_feed(arc, self.feed)
+        s_block(arc, block)
+        s_context(arc, self._context or self.context())
+        s_extra(arc, (end[3], end[4], end[5], end[6], end[7], end[8]) if self.uses_extra_axes else ())
+        s_changed(arc, False)
         return arc
 
     def _center_r(self, block, word, x0, y0, x1, y1, radius, motion, tolerance) -> tuple[float, float]:
@@ -842,6 +879,7 @@ _PLAIN_LETTERS = {
 # Frozen dataclasses set each field through object.__setattr__; the interpreter
 # builds one event per block, so it sets the slots directly (same objects, ~2x faster).
 _LINE_SLOTS = [Line.__dict__[name].__set__ for name in ("start", "end", "rapid", "feed", "block", "context", "extra", "changed")]
+_ARC_SLOTS = [Arc.__dict__[name].__set__ for name in ("start", "end", "center", "turn", "feed", "block", "context", "extra", "changed")]
 _PASS_BLOCK = Pass.__dict__["block"].__set__
 _new = object.__new__
 
