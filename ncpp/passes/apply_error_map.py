@@ -91,6 +91,8 @@ def _directional(chunk: list[Event], ctx: PassContext, travel: Travel) -> tuple[
     start_p, end_p = np.array([e.start for e in segs]), np.array([e.end for e in segs])
     start_m, end_m = machine(start_p), machine(end_p)
     first = travel.last if travel.last is not None else start_m[0]
+    before = None if travel.last is None else travel.last / scales[0] - offsets[0]  # in the first row's frame
+    limit = _snap_limit(step, scales, ctx.tolerance)
 
     out_start, out_end = start_p.copy(), end_p.copy()
     compensated = end_p.copy()  # line ends before _hold_still leaves axes standing
@@ -109,9 +111,9 @@ def _directional(chunk: list[Event], ctx: PassContext, travel: Travel) -> tuple[
             _shift_arcs(shift, start_p, end_p, offsets, scales, d, assumed, step, ctx, out_start, out_end)
         used[redo], used[shift] = d[redo], d[shift]
         out_end[free] = compensated[free]
-        _hold_still(free, d, offsets, scales, step, ctx.tolerance, out_end)
-        _hold_pieces_still(pieces, d, travel.held, _snap_limit(step, scales, ctx.tolerance), out_start, out_end)
-        _join_arcs(arc, offsets, scales, _snap_limit(step, scales, ctx.tolerance), out_start, out_end)
+        _hold_still(free, d, travel.held, offsets, scales, limit, out_end, before)
+        _hold_pieces_still(pieces, d, travel.held, limit, out_start, out_end)
+        _join_arcs(arc, d, travel.held, offsets, scales, limit, out_start, out_end, before)
         cur_end, cur_start = machine(out_end), machine(out_start)
         previous = np.vstack([first[None, :], cur_end[:-1]])
         # a piece moves from the previous end to its start first (a connecting step), then along itself
@@ -129,7 +131,6 @@ def _directional(chunk: list[Event], ctx: PassContext, travel: Travel) -> tuple[
     flips = (d != before) & (before != 0)
     turn = np.flatnonzero(free & flips.any(axis=1))
     # axes that keep their direction must not move in a reversal step (see _snap)
-    limit = _snap_limit(step, scales, ctx.tolerance)
     steady = {index[i]: (tuple(~flips[i]), float(limit[i])) for i in np.flatnonzero(flips.any(axis=1))}
     new_starts = {}
     if turn.size:
@@ -141,23 +142,20 @@ def _directional(chunk: list[Event], ctx: PassContext, travel: Travel) -> tuple[
     return new_ends, new_starts, new_arcs, steady
 
 
-def _hold_still(free, d, offsets, scales, step, tolerance, out_end) -> None:
-    """Leave an axis where it is when its compensated motion goes a rounding
-    step or so against the direction it holds.
+def _hold_still(free, d, held, offsets, scales, limit, out_end, before) -> None:
+    """Leave an axis where it is when its compensated motion goes less than
+    `limit` against the direction it holds.
 
     Such a motion (the error drifting along an axis that does not move) would
     reverse the axis for a fraction of a micron; the reversal's jump is larger.
-    In order of travel, so that a drift accumulated over many lines is bounded."""
-    rows = np.flatnonzero(free[1:]) + 1
-    same = (offsets[rows] == offsets[rows - 1]).all(axis=1) & (scales[rows] == scales[rows - 1])
-    rows = rows[same]
-    limit = _snap_limit(step, scales, tolerance)
-    motion = out_end[rows] - out_end[rows - 1]
+    In order of travel, so that a drift accumulated over many lines is bounded.
+    `before`: the previous chunk's last end in the first row's frame (or None)."""
+    ends, dirs, ok = _with_previous(out_end, d, held, offsets, scales, before)
+    rows = np.flatnonzero(free & ok) + 1  # rows of `ends`
+    motion = ends[rows] - ends[rows - 1]
     # only lines compensated for the held direction: a line compensated for the new one reverses anyway
-    against = (np.sign(motion) == -d[rows - 1]) & (d[rows] == d[rows - 1]) & (np.abs(motion) <= limit[rows, None])
+    against = (np.sign(motion) == -dirs[rows - 1]) & (dirs[rows] == dirs[rows - 1]) & (np.abs(motion) <= limit[rows - 1, None])
     todo = rows[against.any(axis=1)].tolist()
-    if not todo:
-        return
     stills = set(rows.tolist())
     heapq.heapify(todo)
     done = set()
@@ -166,12 +164,23 @@ def _hold_still(free, d, offsets, scales, step, tolerance, out_end) -> None:
         if k in done:
             continue
         done.add(k)
-        motion_k = out_end[k] - out_end[k - 1]
-        keep = (np.sign(motion_k) == -d[k - 1]) & (d[k] == d[k - 1]) & (np.abs(motion_k) <= limit[k])
+        motion_k = ends[k] - ends[k - 1]
+        keep = (np.sign(motion_k) == -dirs[k - 1]) & (dirs[k] == dirs[k - 1]) & (np.abs(motion_k) <= limit[k - 1])
         if keep.any():
-            out_end[k] = np.where(keep, out_end[k - 1], out_end[k])
+            ends[k] = out_end[k - 1] = np.where(keep, ends[k - 1], ends[k])
             if k + 1 in stills:
                 heapq.heappush(todo, k + 1)
+
+
+def _with_previous(out_end, d, held, offsets, scales, before) -> tuple[NDArray, NDArray, NDArray]:
+    """Ends and directions with the previous chunk's last row in front, and
+    (n,) whether each row's predecessor is in the same program frame."""
+    ends = np.vstack([before if before is not None else np.full(3, np.nan), out_end])
+    dirs = np.vstack([held, d])
+    ok = np.ones(len(out_end), dtype=bool)
+    ok[1:] = (offsets[1:] == offsets[:-1]).all(axis=1) & (scales[1:] == scales[:-1])
+    ok[0] = before is not None
+    return ends, dirs, ok
 
 
 def _hold_pieces_still(pieces, d, held, limit, out_start, out_end) -> None:
@@ -251,15 +260,14 @@ def _snap_limit(step: NDArray, scales: NDArray, tolerance: float) -> NDArray:
     return np.maximum(1.01 * step, tolerance / 4 / scales)
 
 
-def _join_arcs(arc: NDArray, offsets: NDArray, scales: NDArray, limit: NDArray, out_start: NDArray, out_end: NDArray) -> None:
+def _join_arcs(arc, d, held, offsets, scales, limit, out_start, out_end, before) -> None:
     """Move an arc piece that starts within `limit` (n,) of the previous
     segment's end rigidly onto it: a µm step there would reverse that axis
     on the machine.  A rigid move keeps the radii equal.  In order of
     travel: a moved piece moves the end the next one must meet."""
-    rows = np.flatnonzero(arc[1:]) + 1
-    same = (offsets[rows] == offsets[rows - 1]).all(axis=1) & (scales[rows] == scales[rows - 1])
-    rows = rows[same]
-    gap = out_end[rows - 1] - out_start[rows]
+    ends, _, ok = _with_previous(out_end, d, held, offsets, scales, before)
+    rows = np.flatnonzero(arc & ok)  # rows of the chunk; their predecessor's end is ends[row]
+    gap = ends[rows] - out_start[rows]
     todo = rows[((np.abs(gap) <= limit[rows, None]) & (gap != 0)).any(axis=1)].tolist()
     joinable = set(rows.tolist())
     heapq.heapify(todo)
@@ -269,11 +277,12 @@ def _join_arcs(arc: NDArray, offsets: NDArray, scales: NDArray, limit: NDArray, 
         if k in done:
             continue
         done.add(k)
-        gap_k = out_end[k - 1] - out_start[k]
+        gap_k = ends[k] - out_start[k]
         move = np.where(np.abs(gap_k) <= limit[k], gap_k, 0.0)
         if move.any():
             out_start[k] += move
             out_end[k] += move
+            ends[k + 1] = out_end[k]
             if k + 1 in joinable:
                 heapq.heappush(todo, k + 1)
 
