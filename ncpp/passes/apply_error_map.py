@@ -95,13 +95,13 @@ def _directional(chunk: list[Event], ctx: PassContext, travel: Travel) -> tuple[
     limit = _snap_limit(step, scales, ctx.tolerance)
 
     out_start, out_end = start_p.copy(), end_p.copy()
-    compensated = end_p.copy()  # line ends before _hold_still leaves axes standing
+    compensated = end_p.copy()  # line ends before _settle leaves axes standing
     assumed = _arc_assumed(segs, arc)  # the directions replace_arcs compensated the arcs with
     used = np.full(start_p.shape, np.nan)  # the directions each row is compensated with
     used[arc] = assumed[arc]
     # start from the nominal motion, standing axes holding their direction
     d = hold(steps(end_m - start_m, threshold), travel.held)
-    for _ in range(ROUNDS):
+    for round_ in range(ROUNDS):
         redo = np.flatnonzero(free & (d != used).any(axis=1))
         if redo.size:
             c = compensate(end_p[redo], offsets[redo], scales[redo], [segs[i] for i in redo], ctx, d[redo])
@@ -111,17 +111,16 @@ def _directional(chunk: list[Event], ctx: PassContext, travel: Travel) -> tuple[
             _shift_arcs(shift, start_p, end_p, offsets, scales, d, assumed, step, ctx, out_start, out_end)
         used[redo], used[shift] = d[redo], d[shift]
         out_end[free] = compensated[free]
-        _hold_still(free, d, travel.held, offsets, scales, limit, out_end, before)
         _hold_pieces_still(pieces, d, travel.held, limit, out_start, out_end)
-        _join_arcs(arc, d, travel.held, offsets, scales, limit, out_start, out_end, before)
+        _settle(free, arc, d, travel.held, offsets, scales, limit, out_start, out_end, before)
         cur_end, cur_start = machine(out_end), machine(out_start)
         previous = np.vstack([first[None, :], cur_end[:-1]])
         # a piece moves from the previous end to its start first (a connecting step), then along itself
         own = steps(np.where(free[:, None], cur_end - previous, cur_end - cur_start), threshold)
         moved = np.where(arc[:, None] & (own == 0), steps(cur_start - previous, threshold), own)
         d_new = _own_motion(moved, hold(moved, travel.held), free, start_p, end_p, offsets, scales, segs, step, threshold, ctx, travel)
-        if np.array_equal(d_new, d):
-            break
+        if np.array_equal(d_new, d) or round_ == ROUNDS - 1:
+            break  # unsettled: keep the directions the ends were computed for
         d = d_new
 
     new_ends = {index[i]: tuple(map(float, out_end[i])) for i in np.flatnonzero(free)}
@@ -142,21 +141,24 @@ def _directional(chunk: list[Event], ctx: PassContext, travel: Travel) -> tuple[
     return new_ends, new_starts, new_arcs, steady
 
 
-def _hold_still(free, d, held, offsets, scales, limit, out_end, before) -> None:
-    """Leave an axis where it is when its compensated motion goes less than
-    `limit` against the direction it holds.
+def _settle(free, arc, d, held, offsets, scales, limit, out_start, out_end, before) -> None:
+    """Keep axes from reversing by less than `limit` (n,), in order of travel.
 
-    Such a motion (the error drifting along an axis that does not move) would
-    reverse the axis for a fraction of a micron; the reversal's jump is larger.
-    In order of travel, so that a drift accumulated over many lines is bounded.
+    A line whose compensated end moves an axis a little against the direction
+    it holds (the error drifting along an axis that does not move) leaves that
+    axis where it is: the reversal's jump would be larger.  An arc piece that
+    starts within `limit` of the previous end moves rigidly onto it (radii stay
+    equal), so that no µm connecting step reverses an axis.  In order, because
+    each moved end is the next row's start and a drift over many rows stays bounded.
     `before`: the previous chunk's last end in the first row's frame (or None)."""
     ends, dirs, ok = _with_previous(out_end, d, held, offsets, scales, before)
-    rows = np.flatnonzero(free & ok) + 1  # rows of `ends`
-    motion = ends[rows] - ends[rows - 1]
-    # only lines compensated for the held direction: a line compensated for the new one reverses anyway
-    against = (np.sign(motion) == -dirs[rows - 1]) & (dirs[rows] == dirs[rows - 1]) & (np.abs(motion) <= limit[rows - 1, None])
-    todo = rows[against.any(axis=1)].tolist()
-    stills = set(rows.tolist())
+    rows = np.flatnonzero(ok)  # the predecessor of row k ends at ends[k]
+    line_gap = out_end[rows] - ends[rows]
+    lines = free[rows] & ((np.sign(line_gap) == -dirs[rows]) & (dirs[rows + 1] == dirs[rows]) & (np.abs(line_gap) <= limit[rows, None])).any(axis=1)
+    arc_gap = ends[rows] - out_start[rows]
+    pieces = arc[rows] & ((np.abs(arc_gap) <= limit[rows, None]) & (arc_gap != 0)).any(axis=1)
+    todo = rows[lines | pieces].tolist()
+    settle = set(rows[free[rows] | arc[rows]].tolist())
     heapq.heapify(todo)
     done = set()
     while todo:
@@ -164,11 +166,22 @@ def _hold_still(free, d, held, offsets, scales, limit, out_end, before) -> None:
         if k in done:
             continue
         done.add(k)
-        motion_k = ends[k] - ends[k - 1]
-        keep = (np.sign(motion_k) == -dirs[k - 1]) & (dirs[k] == dirs[k - 1]) & (np.abs(motion_k) <= limit[k - 1])
-        if keep.any():
-            ends[k] = out_end[k - 1] = np.where(keep, ends[k - 1], ends[k])
-            if k + 1 in stills:
+        if free[k]:
+            gap = out_end[k] - ends[k]
+            keep = (np.sign(gap) == -dirs[k]) & (dirs[k + 1] == dirs[k]) & (np.abs(gap) <= limit[k])
+            changed = bool(keep.any())
+            if changed:
+                out_end[k] = np.where(keep, ends[k], out_end[k])
+        else:
+            gap = ends[k] - out_start[k]
+            move = np.where(np.abs(gap) <= limit[k], gap, 0.0)
+            changed = bool(move.any())
+            if changed:
+                out_start[k] += move
+                out_end[k] += move
+        if changed:
+            ends[k + 1] = out_end[k]
+            if k + 1 in settle:
                 heapq.heappush(todo, k + 1)
 
 
@@ -258,33 +271,6 @@ def _snap_limit(step: NDArray, scales: NDArray, tolerance: float) -> NDArray:
     """(n,) program units an axis may be left off its compensated position
     rather than reversed: a rounding step, or a quarter of the tolerance."""
     return np.maximum(1.01 * step, tolerance / 4 / scales)
-
-
-def _join_arcs(arc, d, held, offsets, scales, limit, out_start, out_end, before) -> None:
-    """Move an arc piece that starts within `limit` (n,) of the previous
-    segment's end rigidly onto it: a µm step there would reverse that axis
-    on the machine.  A rigid move keeps the radii equal.  In order of
-    travel: a moved piece moves the end the next one must meet."""
-    ends, _, ok = _with_previous(out_end, d, held, offsets, scales, before)
-    rows = np.flatnonzero(arc & ok)  # rows of the chunk; their predecessor's end is ends[row]
-    gap = ends[rows] - out_start[rows]
-    todo = rows[((np.abs(gap) <= limit[rows, None]) & (gap != 0)).any(axis=1)].tolist()
-    joinable = set(rows.tolist())
-    heapq.heapify(todo)
-    done = set()
-    while todo:
-        k = heapq.heappop(todo)
-        if k in done:
-            continue
-        done.add(k)
-        gap_k = ends[k] - out_start[k]
-        move = np.where(np.abs(gap_k) <= limit[k], gap_k, 0.0)
-        if move.any():
-            out_start[k] += move
-            out_end[k] += move
-            ends[k + 1] = out_end[k]
-            if k + 1 in joinable:
-                heapq.heappush(todo, k + 1)
 
 
 def _moved_arc(arc: Arc | Line, start, end, old_start, old_end) -> Arc:
