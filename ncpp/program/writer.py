@@ -84,44 +84,36 @@ def set_words(
     knows it already (it only matters for appended words)."""
     raw = block.raw
     pieces: list[str] = []
-    size = 0  # length of what `pieces` holds
     cursor = 0
     pending = dict(texts)
-    last_word_end = None  # where appended words go: after the last axis word, else the last word
+    at = None  # where appended words go (an index into `pieces`): after the last axis word, else the last word
     seen_axis = False
     for item in block.items:
         kind = type(item)
-        if kind is Word and (item.letter in pending or item.letter in drop):
-            gap = raw[cursor : item.start]
-            if item.letter in pending:
-                text = raw[item.start] + pending.pop(item.letter)
-                pieces += (gap, text)
-                size += len(gap) + len(text)
-            else:  # remove the word and the separator before it
-                gap = gap.rstrip(" \t")
-                pieces.append(gap)
-                size += len(gap)
-            cursor = item.end
-            last_word_end, seen_axis = size, True
-        elif kind is not Comment:
-            text = raw[cursor : item.end]
-            pieces.append(text)
-            size += len(text)
+        if kind is Comment:
+            continue
+        if kind is Word and item.letter in pending:
+            pieces += (raw[cursor : item.start + 1], pending.pop(item.letter))  # gap, letter as written, number
+        elif kind is Word and item.letter in drop:  # remove the word and the separator before it
+            pieces.append(raw[cursor : item.start].rstrip(" \t"))
+        else:
+            pieces.append(raw[cursor : item.end])
             cursor = item.end
             is_axis = kind is Word and item.letter in AXIS_LETTERS
             if is_axis or not seen_axis:
-                last_word_end = size
+                at = len(pieces)
                 seen_axis = seen_axis or is_axis
-    head = "".join(pieces)
-    tail = raw[cursor:]
+            continue
+        cursor = item.end
+        at, seen_axis = len(pieces), True
     if pending:
         sep, lower = spelled or spelling(block)
         extra = "".join(sep + (letter.lower() if lower else letter) + text for letter, text in pending.items())
-        at = last_word_end if last_word_end is not None else len(head)
-        if last_word_end is None and not head.strip():
+        if at is None and not "".join(pieces).strip():
             extra = extra.lstrip()
-        head = head[:at] + extra + head[at:]
-    return head + tail
+        pieces.insert(len(pieces) if at is None else at, extra)
+    pieces.append(raw[cursor:])
+    return "".join(pieces)
 
 
 def _lower_case(block: Block) -> bool:

@@ -48,8 +48,10 @@ class IsoWriter:
         # Derived from `styles`, emptied when a style changes: (letter, inch) -> style to write,
         # ("XYZ", inch) -> axis decimals, inch -> {letter: style} for WRITTEN_LETTERS.
         self._resolved: dict = {}
-        self._facts_of: tuple[Block | None, _Facts | None] = (None, None)  # the last block asked about
-        self._rounded: tuple = (None, ())  # (segment, its end rounded as written)
+        self._facts_block: Block | None = None  # the last block asked about, and its facts
+        self._facts_value: _Facts | None = None
+        self._rounded_segment: Line | Arc | None = None  # the last segment asked about, and its end as written
+        self._rounded: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
     def comment(self, text: str) -> str:
         return f"{self.comment_open}{text}{self.comment_close}"
@@ -83,11 +85,9 @@ class IsoWriter:
     # -- what a block says --------------------------------------------------------
     def _facts(self, block: Block) -> "_Facts":
         """The facts of `block`, read once while it is being written."""
-        last, facts = self._facts_of
-        if block is not last:
-            facts = _Facts(block)
-            self._facts_of = (block, facts)
-        return facts  # type: ignore[return-value]
+        if block is not self._facts_block:
+            self._facts_block, self._facts_value = block, _Facts(block)
+        return self._facts_value  # type: ignore[return-value]
 
     def _learn_styles(self, block: Block) -> None:
         shapes = self._shapes
@@ -103,7 +103,7 @@ class IsoWriter:
         if self.styles.get(letter) != style:
             self.styles[letter] = style
             self._resolved.clear()
-            self._rounded = (None, ())
+            self._rounded_segment = None
         if letter in AXES:
             self.known_axes.add(letter)
 
@@ -151,13 +151,11 @@ class IsoWriter:
 
     def _rounded_end(self, segment: Line | Arc) -> tuple[float, float, float]:
         """The segment's end as the output writes it (asked twice per segment: moved axes, then remembered)."""
-        last, rounded = self._rounded
-        if segment is not last:
+        if segment is not self._rounded_segment:
             end = segment.end
             dx, dy, dz = self._axis_decimals(segment.context.inch)
-            rounded = (round(end[0], dx), round(end[1], dy), round(end[2], dz))
-            self._rounded = (segment, rounded)
-        return rounded  # type: ignore[return-value]
+            self._rounded_segment, self._rounded = segment, (round(end[0], dx), round(end[1], dy), round(end[2], dz))
+        return self._rounded
 
     def _remember_end(self, segment: Line | Arc) -> None:
         last = self.last_written
@@ -190,47 +188,43 @@ class IsoWriter:
         return found
 
     # -- changed blocks ---------------------------------------------------------
-    def _targets(self, block: Block, segment: Line | Arc) -> dict[str, float]:
-        """Axis words to write: what the block had, and whatever moved in the output."""
-        present = self._facts(block).letters
-        values: dict[str, float] = {}
-        end = segment.end
-        if segment.context.absolute:
-            last, known = self.last_written, self.known_axes
-            rounded = self._rounded_end(segment)
-            for n, axis in enumerate(AXES):
-                if axis in present or (axis in known and rounded[n] != last.get(axis)):
-                    values[axis] = end[n]
-        else:
-            decimals = self._axis_decimals(segment.context.inch)
-            start = segment.start
-            for n, axis in enumerate(AXES):
-                delta = end[n] - start[n]
-                if axis in present or round(delta, decimals[n]) != 0.0:
-                    values[axis] = delta
-        return values
-
-    def _centre_words(self, segment: Arc) -> dict[str, float]:
-        centre, start = segment.center, segment.start
-        if segment.context.arc_absolute:
-            return {letter: centre[axis] for letter, axis in CENTRE_WORDS[segment.context.plane]}
-        return {letter: centre[axis] - start[axis] for letter, axis in CENTRE_WORDS[segment.context.plane]}
-
     def _motion_code(self, segment: Line | Arc) -> int:
         if type(segment) is Arc:
             return 3 if segment.turn > 0 else 2
         return 0 if segment.rapid else 1
 
     def _words(self, block: Block, segment: Line | Arc) -> dict[str, float]:
-        values = self._targets(block, segment)
+        """Words to write for the segment: the axes the block had and whatever moved in
+        the output, then an arc's centre."""
+        present = self._facts(block).letters
+        values: dict[str, float] = {}
+        context, end = segment.context, segment.end
+        if context.absolute:
+            last, known = self.last_written, self.known_axes
+            rounded = self._rounded_end(segment)
+            for n, axis in enumerate(AXES):
+                if axis in present or (axis in known and rounded[n] != last.get(axis)):
+                    values[axis] = end[n]
+        else:
+            decimals = self._axis_decimals(context.inch)
+            start = segment.start
+            for n, axis in enumerate(AXES):
+                delta = end[n] - start[n]
+                if axis in present or round(delta, decimals[n]) != 0.0:
+                    values[axis] = delta
         if type(segment) is Arc:
-            values.update(self._centre_words(segment))
+            centre, origin = segment.center, (0.0, 0.0, 0.0) if context.arc_absolute else segment.start
+            for letter, axis in CENTRE_WORDS[context.plane]:
+                values[letter] = centre[axis] - origin[axis]
         return values
 
     def _texts(self, block: Block, segment: Line | Arc) -> dict[str, str]:
         """`_words` as the output writes their numbers."""
         styles = self._written_styles(segment.context.inch)
-        return {letter: format_number(value, styles[letter]) for letter, value in self._words(block, segment).items()}
+        words = self._words(block, segment)
+        for letter, value in words.items():
+            words[letter] = format_number(value, styles[letter])  # type: ignore[assignment]  # in place: one dict less
+        return words  # type: ignore[return-value]
 
     def _edit_block(self, block: Block, segment: Line | Arc) -> str:
         facts = self._facts(block)
