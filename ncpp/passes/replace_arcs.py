@@ -29,6 +29,10 @@ from ncpp.passes.travel import grid, quantize
 SAMPLES = 9  # points per piece where the fit is checked (ends included)
 MIN_PIECE = 0.05  # mm of arc length below which a piece is not halved again
 MAX_ROUNDS = 24
+# An axis reversing this close (mm of path) to a piece's end moves back by
+# r·θ²/2 < 0.2 nm (r ≥ 10 mm) to 20 nm (r = 0.1 mm): a rounding of the written centre,
+# not a reversal a step must prepare for.
+REVERSAL_WINDOW = 0.002
 SLIVER = 0.01  # mm of arc length below which a piece becomes a line (its bulge is < 0.1 µm for radii over 0.1 mm)
 
 
@@ -150,7 +154,7 @@ def _replace(arcs: list[Arc], ctx: PassContext) -> list[list[Event]]:
         if ctx.directional:  # ends on the output grid (after the fit: a short piece's chord fixes the bisector)
             step = grid(ctx, scales[pending.arc])
             q[:, 0], q[:, -1] = quantize(q[:, 0], step), quantize(q[:, -1], step)
-            one_way = _one_way(q, centre, geometry.axes[pending.arc], direction[:, 0], np.sign(pending.sweep), step)
+            one_way = _one_way(q, centre, geometry.axes[pending.arc], direction[:, 0], np.sign(pending.sweep), np.maximum(step, REVERSAL_WINDOW / scales[pending.arc]))
         else:
             one_way = np.ones(len(ok), dtype=bool)
         # a sliver (a quadrant cut next to an arc's end) is a line: on the output grid its
@@ -182,15 +186,15 @@ def _replace(arcs: list[Arc], ctx: PassContext) -> list[list[Event]]:
     return _assemble(arcs, geometry, done)
 
 
-def _one_way(q: NDArray, centre: NDArray, axes: NDArray, direction: NDArray, sign: NDArray, step: NDArray) -> NDArray:
+def _one_way(q: NDArray, centre: NDArray, axes: NDArray, direction: NDArray, sign: NDArray, window: NDArray) -> NDArray:
     """(p,) whether each compensated piece (ends `q` on the output grid, `centre`) moves
     every plane axis one way only, in the `direction` (p,3) it was compensated for
     (`sign` (p,): +1 counter-clockwise).
 
     Quadrant cuts are made on the nominal arc; compensation moves the centre, so a
     piece next to a cut can pass the axis's extreme just inside its end and reverse
-    the axis there, where no step can follow.  An extreme within one output step
-    of an end is rounding of the written centre, not a reversal."""
+    the axis there, where no step can follow.  An extreme within `window` (p,)
+    (program units of path) of an end is rounding, not a reversal."""
     local = lambda p: np.take_along_axis(p, axes, axis=1)  # noqa: E731
     c, s0, s1 = local(centre)[:, :2], local(q[:, 0])[:, :2], local(q[:, -1])[:, :2]
     want = np.take_along_axis(direction, axes, axis=1)[:, :2]
@@ -205,7 +209,7 @@ def _one_way(q: NDArray, centre: NDArray, axes: NDArray, direction: NDArray, sig
         blend = np.where(span > 0, (r1 - r0) / (span * radius), 0.0)
     quarter = np.pi / 2
     ahead = quarter - np.mod(sign * a0, quarter)  # angle to the first extreme ahead, (0, π/2]
-    margin = step / radius
+    margin = window / radius
     at = ahead[:, None] + quarter * np.arange(-1, 2)[None, :] + blend[:, None]
     inside = ((at > margin[:, None]) & (at < (span - margin)[:, None])).any(axis=1)
     mid = a0 + sign * span / 2
