@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import hashlib
 from dataclasses import dataclass, field
+from itertools import islice
 from pathlib import Path
 from typing import BinaryIO, Callable, Iterable, Iterator
 
@@ -202,15 +203,10 @@ def process(
     else:
         ctx = make_context(source, tolerance, warnings, file)
         lines = with_header(writer.write(run_passes(events, ctx, PASSES)), header_text(source, tolerance), writer)
-    batch: list[str] = []
-    for line in lines:
-        batch.append(line)
-        if len(batch) == 4096:
-            out.write("".join(batch).encode("latin-1"))
-            stats.lines_out += len(batch)
-            batch.clear()
-    out.write("".join(batch).encode("latin-1"))
-    stats.lines_out += len(batch)
+    lines = iter(lines)
+    while batch := list(islice(lines, 4096)):  # written in batches: one encode and write per 4096 lines
+        out.write("".join(batch).encode("latin-1"))
+        stats.lines_out += len(batch)
     return stats
 
 

@@ -67,20 +67,23 @@ class IsoWriter:
         if group:
             yield from self._write_group(group)
 
-    def _write_group(self, group: list[Event]) -> Iterator[str]:
+    def _write_group(self, group: list[Event]) -> Iterable[str]:
+        """The lines of one block's events (a list: cheaper than a generator per block)."""
         block = group[0].block
         self._learn_styles(block)
         motion = [e for e in group if type(e) is Line or type(e) is Arc]
-        if not any(e.changed for e in motion):
-            if self._needs_mode_restore(block):
-                yield self._restore_mode_line(block)
-            yield block.text
+        if not any([e.changed for e in motion]):
+            lines = [self._restore_mode_line(block)] if self._needs_mode_restore(block) else []
+            lines.append(block.text)
             self._after_verbatim(block, motion)
-            return
+            return lines
         if not self._facts(block).plain:
             block = _literal_geometry(block)
-        for n, segment in enumerate(motion):
-            yield (self._edit_block(block, segment) if n == 0 else self._new_block(block, segment)) + block.eol
+        eol = block.eol
+        lines = [self._edit_block(block, motion[0]) + eol]
+        for segment in motion[1:]:
+            lines.append(self._new_block(block, segment) + eol)
+        return lines
 
     # -- what a block says --------------------------------------------------------
     def _facts(self, block: Block) -> "_Facts":
