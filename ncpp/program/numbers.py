@@ -9,6 +9,7 @@ comma (Heidenhain) are read from the number text as written, and
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import lru_cache
 
 
 @dataclass(frozen=True, slots=True)
@@ -29,6 +30,11 @@ class NumberStyle:
     @classmethod
     def of(cls, number: str) -> "NumberStyle":
         """The style of a number as written (sign included, letter excluded)."""
+        # Signs, point and zeros make the style, the other digits do not: read once per pattern.
+        return _style_of(number.translate(_NONZERO_DIGITS))
+
+    @classmethod
+    def _read(cls, number: str) -> "NumberStyle":
         plus = number.startswith("+")
         digits = number.lstrip("+-").lstrip(" \t")
         comma = "," in digits
@@ -53,6 +59,14 @@ class NumberStyle:
         if decimals <= self.decimals:
             return self
         return NumberStyle(decimals, False, self.leading_zero, self.int_width, self.plus_sign, self.comma)
+
+
+_NONZERO_DIGITS = str.maketrans("23456789", "11111111")
+
+
+@lru_cache(maxsize=4096)
+def _style_of(pattern: str) -> NumberStyle:
+    return NumberStyle._read(pattern)
 
 
 def format_number(value: float, style: NumberStyle) -> str:
