@@ -17,7 +17,6 @@ start is compensated with its own direction and a step move is inserted.
 from __future__ import annotations
 
 import heapq
-from dataclasses import replace
 from typing import Iterable, Iterator
 
 import numpy as np
@@ -31,6 +30,8 @@ from ncpp.passes.travel import Travel, grid, hold, quantize, steps
 # Compensations per line at most: each changes a direction only where a
 # correction of the previous round flipped a µm motion; two rounds settle almost all.
 ROUNDS = 4
+# mm: a line moving an axis this far moves it that way whatever its compensation (errors are µm)
+NEAR_STILL = 0.05
 
 
 def apply_error_map(events: Iterable[Event], ctx: PassContext) -> Iterator[Event]:
@@ -47,17 +48,18 @@ def apply_error_map(events: Iterable[Event], ctx: PassContext) -> Iterator[Event
                 continue
             event = new_arcs.get(k, event)
             previous_end = _end_in_frame_of(last, event)
-            if k in new_ends:
+            end = new_ends.get(k)
+            if end is not None:
                 start = event.start if previous_end is None else previous_end
                 if k in new_starts and previous_end is not None and not event.rapid:
                     wanted = _snap(new_starts[k], previous_end, *steady[k])
                     if _apart(previous_end, wanted):
-                        yield replace(event, start=previous_end, end=wanted, changed=True)
+                        yield Line(previous_end, wanted, event.rapid, event.feed, event.block, event.context, event.extra, True)
                         start = wanted
-                event = replace(event, start=start, end=new_ends[k], changed=True)
+                event = Line(start, end, event.rapid, event.feed, event.block, event.context, event.extra, True)
             elif event.changed and previous_end is not None and _apart(previous_end, event.start):
                 # a reversal step between compensated pieces: move there first
-                yield Line(previous_end, event.start, False, event.feed, event.block, event.context, event.extra, changed=True)
+                yield Line(previous_end, event.start, False, event.feed, event.block, event.context, event.extra, True)
             last = event
             yield event
 
@@ -123,19 +125,23 @@ def _directional(chunk: list[Event], ctx: PassContext, travel: Travel) -> tuple[
             break  # unsettled: keep the directions the ends were computed for
         d = d_new
 
-    new_ends = {index[i]: tuple(map(float, out_end[i])) for i in np.flatnonzero(free)}
-    new_arcs = {index[i]: _moved_arc(segs[i], out_start[i], out_end[i], start_p[i], end_p[i]) for i in np.flatnonzero(arc)}
+    ends = out_end.tolist()
+    new_ends = {index[i]: tuple(ends[i]) for i in np.flatnonzero(free).tolist()}
+    moved = np.flatnonzero(arc & ((out_start != start_p) | (out_end != end_p)).any(axis=1)).tolist()
+    starts = out_start.tolist()
+    new_arcs = {index[i]: _moved_arc(segs[i], starts[i], ends[i]) for i in moved}
     # where an axis reverses, the line must start where its own direction puts the tool
     before = np.vstack([travel.held[None, :], d[:-1]])
     flips = (d != before) & (before != 0)
     turn = np.flatnonzero(free & flips.any(axis=1))
     # axes that keep their direction must not move in a reversal step (see _snap)
-    steady = {index[i]: (tuple(~flips[i]), float(limit[i])) for i in np.flatnonzero(flips.any(axis=1))}
+    keeps, limits = (~flips).tolist(), limit.tolist()
+    steady = {index[i]: (keeps[i], limits[i]) for i in turn.tolist()}
     new_starts = {}
     if turn.size:
         s = compensate(start_p[turn], offsets[turn], scales[turn], [segs[i] for i in turn], ctx, d[turn])
-        s = quantize(s, step[turn])
-        new_starts = {index[i]: tuple(map(float, p)) for i, p in zip(turn, s)}
+        s = quantize(s, step[turn]).tolist()
+        new_starts = {index[i]: tuple(p) for i, p in zip(turn.tolist(), s)}
     travel.held = d[-1].copy()
     travel.last = machine(out_end[-1:], slice(len(segs) - 1, None))[0]
     return new_ends, new_starts, new_arcs, steady
@@ -158,7 +164,12 @@ def _settle(free, arc, d, held, offsets, scales, limit, out_start, out_end, befo
     arc_gap = ends[rows] - out_start[rows]
     pieces = arc[rows] & ((np.abs(arc_gap) <= limit[rows, None]) & (arc_gap != 0)).any(axis=1)
     todo = rows[lines | pieces].tolist()
+    if not todo:
+        return
+    # in order, on flat lists of Python floats: a numpy call per row would cost more than the row
     settle = set(rows[free[rows] | arc[rows]].tolist())
+    is_line, lim = free.tolist(), limit.tolist()
+    e_, s_, o_, d_ = ends.ravel().tolist(), out_start.ravel().tolist(), out_end.ravel().tolist(), dirs.ravel().tolist()
     heapq.heapify(todo)
     done = set()
     while todo:
@@ -166,21 +177,24 @@ def _settle(free, arc, d, held, offsets, scales, limit, out_start, out_end, befo
         if k in done:
             continue
         done.add(k)
-        if free[k]:
-            gap = out_end[k] - ends[k]
-            keep = (np.sign(gap) == -dirs[k]) & (dirs[k + 1] == dirs[k]) & (np.abs(gap) <= limit[k])
-            changed = bool(keep.any())
-            if changed:
-                out_end[k] = np.where(keep, ends[k], out_end[k])
-        else:
-            gap = ends[k] - out_start[k]
-            move = np.where(np.abs(gap) <= limit[k], gap, 0.0)
-            changed = bool(move.any())
-            if changed:
-                out_start[k] += move
-                out_end[k] += move
+        i, limit_k, changed = 3 * k, lim[k], False
+        for a in range(i, i + 3):
+            p = e_[a]
+            if is_line[k]:  # e_[a] ends row k-1, d_[a] its direction; d_[a + 3] is row k's
+                gap = o_[a] - p
+                if gap * d_[a] < 0 and d_[a + 3] == d_[a] and abs(gap) <= limit_k:
+                    o_[a], changed = p, True
+            else:
+                move = p - s_[a]
+                if move != 0 and abs(move) <= limit_k:
+                    s_[a] += move
+                    o_[a] += move
+                    changed = True
         if changed:
-            ends[k + 1] = out_end[k]
+            out_end[k] = o_[i : i + 3]
+            if not is_line[k]:
+                out_start[k] = s_[i : i + 3]
+            e_[i + 3 : i + 6] = o_[i : i + 3]
             if k + 1 in settle:
                 heapq.heappush(todo, k + 1)
 
@@ -216,7 +230,9 @@ def _own_motion(moved, d, free, start_p, end_p, offsets, scales, segs, step, thr
     varies along it), the machine ends up travelling the old way and the
     reversal was not one: the line keeps the old direction instead."""
     before = np.vstack([travel.held[None, :], d[:-1]])
-    flips = (d != before) & (before != 0) & free[:, None]
+    # only where the line itself moves that axis by less than any error could turn round
+    short = np.abs(end_p - start_p) * scales[:, None] < NEAR_STILL
+    flips = (d != before) & (before != 0) & free[:, None] & short
     rows = np.flatnonzero(flips.any(axis=1))
     if rows.size == 0:
         return d
@@ -273,15 +289,14 @@ def _snap_limit(step: NDArray, scales: NDArray, tolerance: float) -> NDArray:
     return np.maximum(1.01 * step, tolerance / 4 / scales)
 
 
-def _moved_arc(arc: Arc | Line, start, end, old_start, old_end) -> Arc:
-    if np.array_equal(start, old_start) and np.array_equal(end, old_end):
-        return arc
-    # the centre moves with the mean shift of the ends (equal for planar arcs: radii still agree)
+def _moved_arc(arc: Arc | Line, start: list, end: list) -> Arc | Line:
+    """The piece with new ends; an arc's centre moves with the mean shift of the
+    ends (equal for planar arcs: radii still agree)."""
     if type(arc) is Line:
-        return replace(arc, start=tuple(map(float, start)), end=tuple(map(float, end)))
-    move = ((start - old_start) + (end - old_end)) / 2
-    centre = tuple(float(c + m) for c, m in zip(arc.center, move))
-    return replace(arc, start=tuple(map(float, start)), end=tuple(map(float, end)), center=centre)
+        return Line(tuple(start), tuple(end), arc.rapid, arc.feed, arc.block, arc.context, arc.extra, True)
+    (s0, s1, s2), (e0, e1, e2), (c0, c1, c2) = arc.start, arc.end, arc.center
+    centre = (c0 + (start[0] - s0 + end[0] - e0) / 2, c1 + (start[1] - s1 + end[1] - e1) / 2, c2 + (start[2] - s2 + end[2] - e2) / 2)
+    return Arc(tuple(start), tuple(end), centre, arc.turn, arc.feed, arc.block, arc.context, arc.extra, True)
 
 
 def _snap(start: tuple, previous_end: tuple, steady: tuple, limit: float) -> tuple:
