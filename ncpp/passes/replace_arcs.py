@@ -26,7 +26,10 @@ from ncpp.passes.context import PassContext
 from ncpp.passes.geometry import chunked, compensate, frames
 from ncpp.passes.travel import grid, quantize
 
-SAMPLES = 9  # points per piece where the fit is checked (ends included)
+# Points per piece where the fit is checked (ends included).  Fewer on short
+# pieces: over a few mm the error's curvature bends the path by far less than
+# the tolerance, and a kink of an error table between samples by ~slope change × length / 8.
+SAMPLES = 9
 MIN_PIECE = 0.05  # mm of arc length below which a piece is not halved again
 MAX_ROUNDS = 24
 # An axis reversing this close (mm of path) to a piece's end moves back by
@@ -133,50 +136,16 @@ def _replace(arcs: list[Arc], ctx: PassContext) -> list[list[Event]]:
     offsets, scales = frames(arcs)
     pending = _initial_pieces(geometry, ctx.directional)
     done: list[tuple[int, float, Event | list[Event]]] = []  # (arc, a0, result)
-    t = np.linspace(0.0, 1.0, SAMPLES)
     for _ in range(MAX_ROUNDS):
         if len(pending.arc) == 0:
             break
-        angles = pending.a0[:, None] + t[None, :] * pending.sweep[:, None]
-        nominal = geometry.points(pending.arc, angles)
-        segs = [arcs[k] for k in pending.arc]
-        middle = (pending.a0 + pending.sweep / 2)[:, None]
-        tangent = geometry.points(pending.arc, middle + 1e-6 * np.sign(pending.sweep)[:, None]) - geometry.points(pending.arc, middle)
-        direction = np.sign(tangent)
-        # the normal axis's direction is the one the machine holds when it gets
-        # here: apply_error_map knows it and shifts the piece; use the mean here
-        np.put_along_axis(direction, geometry.axes[pending.arc, None, 2:], 0.0, axis=2)
-        direction = np.broadcast_to(direction, nominal.shape)
-        q = compensate(nominal, offsets[pending.arc], scales[pending.arc], segs, ctx, direction)
-        centre, deviation = _fit(q, geometry.axes[pending.arc], t, ctx.tolerance / scales[pending.arc])
         length = np.abs(pending.sweep) * geometry.radius[pending.arc] * scales[pending.arc]
-        ok = deviation <= ctx.tolerance / scales[pending.arc]
-        if ctx.directional:  # ends on the output grid (after the fit: a short piece's chord fixes the bisector)
-            step = grid(ctx, scales[pending.arc])
-            q[:, 0], q[:, -1] = quantize(q[:, 0], step), quantize(q[:, -1], step)
-            one_way = _one_way(q, centre, geometry.axes[pending.arc], direction[:, 0], np.sign(pending.sweep), np.maximum(step, REVERSAL_WINDOW / scales[pending.arc]))
-        else:
-            one_way = np.ones(len(ok), dtype=bool)
-        # a sliver (a quadrant cut next to an arc's end) is a line: on the output grid its
-        # chord fixes no centre, and equal ends would be read as a full circle; so is a
-        # piece that reverses an axis inside but bulges less than a quarter of the tolerance
-        chord = np.linalg.norm(q[:, -1] - q[:, 0], axis=1) * scales[pending.arc]
-        flat = chord**2 / (8 * np.maximum(geometry.radius[pending.arc] * scales[pending.arc], 1e-12)) <= ctx.tolerance / 4
-        straight = (length < SLIVER) | (~one_way & flat)
-        ok &= one_way & ~straight
-        give_up = ~ok & ~straight & (length < MIN_PIECE)
-        lines = np.flatnonzero(straight | give_up)
-        if lines.size and ctx.directional:
-            # lines are compensated for the mean direction: apply_error_map moves them to the real one
-            q[lines] = _mean_compensated(nominal[lines], offsets[pending.arc[lines]],
-                                         scales[pending.arc[lines]], [segs[i] for i in lines], ctx)  # fmt: skip
-        for p in np.flatnonzero(straight):
-            done.append((int(pending.arc[p]), float(pending.a0[p]), _line_pieces(arcs[pending.arc[p]], q[p, [0, -1]])))
-        for p in np.flatnonzero(ok):
-            done.append((int(pending.arc[p]), float(pending.a0[p]), _arc_piece(arcs[pending.arc[p]], q[p], centre[p])))
-        for p in np.flatnonzero(give_up):
-            done.append((int(pending.arc[p]), float(pending.a0[p]), _line_pieces(arcs[pending.arc[p]], q[p])))
-        split = ~ok & ~give_up & ~straight
+        counts = np.select([length < 2.0, length < 10.0], [3, 5], SAMPLES)  # see SAMPLES
+        split = np.zeros(len(pending.arc), dtype=bool)
+        for m in np.unique(counts).tolist():
+            rows = np.flatnonzero(counts == m)
+            some = _Pieces(pending.arc[rows], pending.a0[rows], pending.sweep[rows])
+            split[rows] = _round(some, length[rows], np.linspace(0.0, 1.0, m), arcs, geometry, offsets, scales, ctx, done)
         half = pending.sweep[split] / 2
         pending = _Pieces(
             np.repeat(pending.arc[split], 2),
@@ -184,6 +153,53 @@ def _replace(arcs: list[Arc], ctx: PassContext) -> list[list[Event]]:
             np.repeat(half, 2),
         )
     return _assemble(arcs, geometry, done)
+
+
+def _round(pending: _Pieces, length: NDArray, t: NDArray, arcs, geometry, offsets, scales, ctx, done: list) -> NDArray:
+    """Compensate and fit pieces sampled at `t`; append the finished ones to
+    `done` and return (p,) which to halve."""
+    angles = pending.a0[:, None] + t[None, :] * pending.sweep[:, None]
+    nominal = geometry.points(pending.arc, angles)
+    segs = [arcs[k] for k in pending.arc]
+    middle = (pending.a0 + pending.sweep / 2)[:, None]
+    tangent = geometry.points(pending.arc, middle + 1e-6 * np.sign(pending.sweep)[:, None]) - geometry.points(pending.arc, middle)
+    direction = np.sign(tangent)
+    # the normal axis's direction is the one the machine holds when it gets
+    # here: apply_error_map knows it and shifts the piece; use the mean here
+    np.put_along_axis(direction, geometry.axes[pending.arc, None, 2:], 0.0, axis=2)
+    direction = np.broadcast_to(direction, nominal.shape)
+    scale = scales[pending.arc]
+    q = compensate(nominal, offsets[pending.arc], scale, segs, ctx, direction)
+    centre, deviation = _fit(q, geometry.axes[pending.arc], t, ctx.tolerance / scale)
+    ok = deviation <= ctx.tolerance / scale
+    if ctx.directional:  # ends on the output grid (after the fit: a short piece's chord fixes the bisector)
+        step = grid(ctx, scale)
+        q[:, 0], q[:, -1] = quantize(q[:, 0], step), quantize(q[:, -1], step)
+        window = np.maximum(step, REVERSAL_WINDOW / scale)
+        one_way = _one_way(q, centre, geometry.axes[pending.arc], direction[:, 0], np.sign(pending.sweep), window)
+    else:
+        one_way = np.ones(len(ok), dtype=bool)
+    # a sliver (a quadrant cut next to an arc's end) is a line: on the output grid its
+    # chord fixes no centre, and equal ends would be read as a full circle; so is a
+    # piece that reverses an axis inside but bulges less than a quarter of the tolerance
+    chord = np.linalg.norm(q[:, -1] - q[:, 0], axis=1) * scale
+    flat = chord**2 / (8 * np.maximum(geometry.radius[pending.arc] * scale, 1e-12)) <= ctx.tolerance / 4
+    straight = (length < SLIVER) | (~one_way & flat)
+    ok &= one_way & ~straight
+    give_up = ~ok & ~straight & (length < MIN_PIECE)
+    lines = np.flatnonzero(straight | give_up)
+    if lines.size and ctx.directional:
+        # lines are compensated for the mean direction: apply_error_map moves them to the real one
+        q[lines] = _mean_compensated(nominal[lines], offsets[pending.arc[lines]], scale[lines], [segs[i] for i in lines], ctx)
+    arc_of, a0 = pending.arc.tolist(), pending.a0.tolist()
+    for p in np.flatnonzero(straight).tolist():
+        done.append((arc_of[p], a0[p], _line_pieces(arcs[arc_of[p]], q[p, [0, -1]])))
+    fitted = np.flatnonzero(ok)
+    for p, start, end, c in zip(fitted.tolist(), q[fitted, 0].tolist(), q[fitted, -1].tolist(), centre[fitted].tolist()):
+        done.append((arc_of[p], a0[p], _arc_piece(arcs[arc_of[p]], start, end, c)))
+    for p in np.flatnonzero(give_up).tolist():
+        done.append((arc_of[p], a0[p], _line_pieces(arcs[arc_of[p]], q[p])))
+    return ~ok & ~give_up & ~straight
 
 
 def _one_way(q: NDArray, centre: NDArray, axes: NDArray, direction: NDArray, sign: NDArray, window: NDArray) -> NDArray:
@@ -282,31 +298,29 @@ def _minimax_step(uv: NDArray, q0: NDArray, c: NDArray, normal: NDArray) -> NDAr
     return candidates[np.arange(len(r)), worst.argmin(axis=1)]
 
 
-def _arc_piece(arc: Arc, q: NDArray, centre: NDArray) -> Arc:
-    start, end, c = q[0].tolist(), q[-1].tolist(), centre.tolist()
-    turn = 1 if arc.turn > 0 else -1
-    return Arc((start[0], start[1], start[2]), (end[0], end[1], end[2]), (c[0], c[1], c[2]), turn,
+def _arc_piece(arc: Arc, start: list, end: list, centre: list) -> Arc:
+    return Arc(tuple(start), tuple(end), tuple(centre), 1 if arc.turn > 0 else -1,
                arc.feed, arc.block, arc.context, arc.extra, True)  # fmt: skip
 
 
 def _line_pieces(arc: Arc, q: NDArray) -> list[Event]:
-    pts = [tuple(map(float, p)) for p in q]
-    return [
-        Line(pts[i], pts[i + 1], False, arc.feed, arc.block, arc.context, arc.extra, changed=True)
-        for i in range(len(pts) - 1)
-    ]
+    pts = [tuple(p) for p in q.tolist()]
+    return [Line(a, b, False, arc.feed, arc.block, arc.context, arc.extra, True) for a, b in zip(pts, pts[1:])]
 
 
 def _assemble(arcs: list[Arc], geometry: _ArcGeometry, done: list) -> list[list[Event]]:
     """Pieces of each arc in the order of travel."""
     per_arc: list[list[tuple[float, Event | list[Event]]]] = [[] for _ in arcs]
+    start, sign = geometry.a0.tolist(), np.where(geometry.sweep >= 0, 1.0, -1.0).tolist()
     for k, a0, result in done:
         # order by progress along the sweep, whatever its sign
-        per_arc[k].append(((a0 - geometry.a0[k]) * (1 if geometry.sweep[k] >= 0 else -1), result))
+        per_arc[k].append(((a0 - start[k]) * sign[k], result))
     out: list[list[Event]] = []
     for pieces in per_arc:
+        if len(pieces) > 1:
+            pieces.sort(key=lambda item: item[0])
         events: list[Event] = []
-        for _, result in sorted(pieces, key=lambda item: item[0]):
+        for _, result in pieces:
             events.extend(result if isinstance(result, list) else [result])
         out.append(events)
     return out
