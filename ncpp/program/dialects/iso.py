@@ -242,7 +242,7 @@ class IsoWriter:
         if code != self.output_motion or facts.motion_word:
             edited = _with_motion(block, code)  # the same block when its G word already says `code`
         # the common case (the block's own words, its spelling known) skips re-reading the spelling
-        raw = set_words(edited, texts, drop, self._spelling(block) if edited is block else None)
+        raw = set_words(edited, texts, drop, self._spelling(block))  # spelled as the block was read
         if facts.motion_word or code != self.output_motion:
             self.output_motion = code
         if facts.motion_word:
