@@ -30,6 +30,9 @@ from ncpp.passes.travel import Travel, grid, hold, quantize, steps
 # Compensations per line at most: each changes a direction only where a
 # correction of the previous round flipped a µm motion; two rounds settle almost all.
 ROUNDS = 4
+# mm an axis may stay off its compensated position rather than reverse for a
+# fraction of a micron (the reversal's jump is several microns)
+STILL_MM = 0.00025
 # mm: a line moving an axis this far moves it that way whatever its compensation (errors are µm)
 NEAR_STILL = 0.05
 
@@ -94,7 +97,7 @@ def _directional(chunk: list[Event], ctx: PassContext, travel: Travel) -> tuple[
     start_m, end_m = machine(start_p), machine(end_p)
     first = travel.last if travel.last is not None else start_m[0]
     before = None if travel.last is None else travel.last / scales[0] - offsets[0]  # in the first row's frame
-    limit = _snap_limit(step, scales, ctx.tolerance)
+    limit = _snap_limit(step, scales)
 
     out_start, out_end = start_p.copy(), end_p.copy()
     compensated = end_p.copy()  # line ends before _settle leaves axes standing
@@ -283,10 +286,11 @@ def _shift_arcs(rows, start_p, end_p, offsets, scales, d, assumed, step, ctx, ou
     out_end[rows] = quantize(pts[:, 1] - delta[:, 1], step[rows])
 
 
-def _snap_limit(step: NDArray, scales: NDArray, tolerance: float) -> NDArray:
+def _snap_limit(step: NDArray, scales: NDArray) -> NDArray:
     """(n,) program units an axis may be left off its compensated position
-    rather than reversed: a rounding step, or a quarter of the tolerance."""
-    return np.maximum(1.01 * step, tolerance / 4 / scales)
+    rather than reversed: a rounding step, or STILL_MM (whatever the tolerance:
+    within the 0.5 µm the guarantee allows beyond it)."""
+    return np.maximum(1.01 * step, STILL_MM / scales)
 
 
 def _moved_arc(arc: Arc | Line, start: list, end: list) -> Arc | Line:
