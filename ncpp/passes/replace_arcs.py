@@ -36,6 +36,9 @@ MAX_ROUNDS = 24
 # r·θ²/2 < 0.2 nm (r ≥ 10 mm) to 20 nm (r = 0.1 mm): a rounding of the written centre,
 # not a reversal a step must prepare for.
 REVERSAL_WINDOW = 0.002
+# mm: nor is one that takes the axis back by less than this (a 10⁻⁵ rad rotation
+# of the compensated frame moves a quadrant's extreme a µm past its end)
+REVERSAL_HEIGHT = 1e-7
 SLIVER = 0.01  # mm of arc length below which a piece becomes a line (its bulge is < 0.1 µm for radii over 0.1 mm)
 
 
@@ -176,7 +179,7 @@ def _round(pending: _Pieces, length: NDArray, t: NDArray, arcs, geometry, offset
         step = grid(ctx, scale)
         q[:, 0], q[:, -1] = quantize(q[:, 0], step), quantize(q[:, -1], step)
         window = np.maximum(step, REVERSAL_WINDOW / scale)
-        one_way = _one_way(q, centre, geometry.axes[pending.arc], direction[:, 0], np.sign(pending.sweep), window)
+        one_way = _one_way(q, centre, geometry.axes[pending.arc], direction[:, 0], np.sign(pending.sweep), window, REVERSAL_HEIGHT / scale)
     else:
         one_way = np.ones(len(ok), dtype=bool)
     # a sliver (a quadrant cut next to an arc's end) is a line: on the output grid its
@@ -202,7 +205,7 @@ def _round(pending: _Pieces, length: NDArray, t: NDArray, arcs, geometry, offset
     return ~ok & ~give_up & ~straight
 
 
-def _one_way(q: NDArray, centre: NDArray, axes: NDArray, direction: NDArray, sign: NDArray, window: NDArray) -> NDArray:
+def _one_way(q: NDArray, centre: NDArray, axes: NDArray, direction: NDArray, sign: NDArray, window: NDArray, height: NDArray) -> NDArray:
     """(p,) whether each compensated piece (ends `q` on the output grid, `centre`) moves
     every plane axis one way only, in the `direction` (p,3) it was compensated for
     (`sign` (p,): +1 counter-clockwise).
@@ -210,7 +213,8 @@ def _one_way(q: NDArray, centre: NDArray, axes: NDArray, direction: NDArray, sig
     Quadrant cuts are made on the nominal arc; compensation moves the centre, so a
     piece next to a cut can pass the axis's extreme just inside its end and reverse
     the axis there, where no step can follow.  An extreme within `window` (p,)
-    (program units of path) of an end is rounding, not a reversal."""
+    (program units of path) of an end, or from which the axis goes back by less
+    than `height` (p,), is rounding or a rotation of the compensated frame, not a reversal."""
     local = lambda p: np.take_along_axis(p, axes, axis=1)  # noqa: E731
     c, s0, s1 = local(centre)[:, :2], local(q[:, 0])[:, :2], local(q[:, -1])[:, :2]
     want = np.take_along_axis(direction, axes, axis=1)[:, :2]
@@ -227,7 +231,10 @@ def _one_way(q: NDArray, centre: NDArray, axes: NDArray, direction: NDArray, sig
     ahead = quarter - np.mod(sign * a0, quarter)  # angle to the first extreme ahead, (0, π/2]
     margin = window / radius
     at = ahead[:, None] + quarter * np.arange(-1, 2)[None, :] + blend[:, None]
-    inside = ((at > margin[:, None]) & (at < (span - margin)[:, None])).any(axis=1)
+    from_end = np.minimum(at, span[:, None] - at)  # angle between the extreme and the nearer end
+    # the axis goes back by r·(1 - cos) from the extreme to that end
+    back = radius[:, None] * from_end**2 / 2 > height[:, None]
+    inside = ((at > margin[:, None]) & (at < (span - margin)[:, None]) & back).any(axis=1)
     mid = a0 + sign * span / 2
     tangent = sign[:, None] * np.column_stack([-np.sin(mid), np.cos(mid)])
     agrees = (np.sign(tangent) == want).all(axis=1)
