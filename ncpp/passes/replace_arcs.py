@@ -120,18 +120,23 @@ def _initial_pieces(geometry: _ArcGeometry, directional: bool) -> _Pieces:
 
 
 def _quadrant_pieces(geometry: _ArcGeometry) -> _Pieces:
-    arcs, starts, sweeps = [], [], []
     quarter = math.pi / 2
-    for k, (a0, sweep) in enumerate(zip(geometry.a0, geometry.sweep)):
-        a1 = a0 + sweep
-        lo, hi = min(a0, a1), max(a0, a1)
-        cuts = [quarter * n for n in range(math.floor(lo / quarter) + 1, math.ceil(hi / quarter)) if lo + 1e-9 < quarter * n < hi - 1e-9]
-        edges = [a0] + (cuts if sweep > 0 else cuts[::-1]) + [a1]
-        for e0, e1 in zip(edges, edges[1:]):
-            arcs.append(k)
-            starts.append(e0)
-            sweeps.append(e1 - e0)
-    return _Pieces(np.array(arcs, dtype=int), np.array(starts), np.array(sweeps))
+    a0, sweep = geometry.a0, geometry.sweep
+    lo, hi = np.minimum(a0, a0 + sweep), np.maximum(a0, a0 + sweep)
+    # multiples of a quarter strictly inside (lo, hi), 1e-9 away from the ends
+    first = np.floor(lo / quarter) + 1
+    last = np.ceil(hi / quarter) - 1
+    first = np.where(quarter * first <= lo + 1e-9, first + 1, first)
+    last = np.where(quarter * last >= hi - 1e-9, last - 1, last)
+    cuts = np.maximum(last - first + 1, 0).astype(int)
+    arc = np.repeat(np.arange(len(a0)), cuts + 1)
+    nth = np.arange(len(arc)) - np.repeat(np.cumsum(cuts + 1) - (cuts + 1), cuts + 1)  # piece within its arc
+    forward = sweep[arc] > 0
+    # the j-th cut in the order of travel
+    cut = lambda j: quarter * np.where(forward, first[arc] + j - 1, last[arc] - j + 1)  # noqa: E731
+    start = np.where(nth == 0, a0[arc], cut(nth))
+    end = np.where(nth == cuts[arc], a0[arc] + sweep[arc], cut(nth + 1))
+    return _Pieces(arc, start, end - start)
 
 
 def _replace(arcs: list[Arc], ctx: PassContext) -> list[list[Event]]:
