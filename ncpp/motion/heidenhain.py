@@ -7,7 +7,10 @@ the axes written), `C ... DR±` about the pole, `CR ... R± DR±` (R+: less than
 half circle), `CT` (tangential arc), `LP`/`CP` polar with PR/IPR/PA/IPA (a
 helix with IZ, several turns with |IPA| > 360), Q parameters with arithmetic,
 labels, `TOOL DEF`, `CYCL DEF` of machining cycles (they only define), M2/M30
-and `END PGM` (end).  Radius compensation RL/RR, RND/CHF, FK free contours,
+and `END PGM` (end), and `RND R..` / `CHF ..` between two feed lines in the
+working plane (the fillet arc or chamfer line is the RND/CHF block's event; a
+feed line waits for the next move to know whether its corner is cut).
+Radius compensation RL/RR, RND/CHF next to an arc or a rapid, FK free contours,
 APPR/DEP, `CALL LBL`, `CALL PGM`, `CYCL CALL`, M99, FN functions and cycles
 that move the datum make the position unknown: one warning (an error with
 `strict`) and the rest passes through.
@@ -22,9 +25,10 @@ import math
 from dataclasses import dataclass
 from typing import Iterable, Iterator
 
-from ncpp.errors import Warnings
+from ncpp.errors import Location, NcppError, Warnings
+from ncpp.motion.corners import CornerError, round_corner
 from ncpp.motion.modal import PLANE_OF_TOOL_AXIS, ModalInterpreter, OutOfScope, evaluate, resolve_warnings
-from ncpp.motion.segments import PLANE_AXES, Event, Pass, Point
+from ncpp.motion.segments import PLANE_AXES, Arc, Event, Line, Pass, Point
 from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
 
 AXES = "XYZ"
@@ -40,6 +44,16 @@ class Pole(Pass):
 
     center: Point = (0.0, 0.0, 0.0)
     plane: int = 17
+
+
+@dataclass(frozen=True, slots=True)
+class Corner(Pass):
+    """An `RND` (kind 'R', size the radius) or `CHF` (kind 'C', size the leg) block, until the next move."""
+
+    kind: str = "R"
+    size: float = 0.0
+    feed: float | None = None  # `RND R5 F200`: the feed of the fillet only
+    col: int | None = None
 
 
 def interpret(blocks: Iterable[Block], *, file: str = "<stdin>", warnings: Warnings | None = None,
@@ -62,6 +76,57 @@ class HeidenhainInterpreter(ModalInterpreter):
         self.pole: list[float] | None = None
         self.pole_plane = 17
         self.auto_feed = 0.0
+        self.last_move: Line | Arc | None = None
+        self.corner_waits = False  # an RND/CHF block came after the last move
+
+    def run(self, blocks: Iterable[Block], warnings: Warnings) -> Iterator[Event]:
+        """Events as `ModalInterpreter.run`; a feed line waits (with the events after it)
+        for the next move, which an RND/CHF block in between makes round or cut."""
+        held: list[Event] = []  # the last feed line and the events after it
+        corner: Corner | None = None
+        for event in super().run(blocks, warnings):
+            if isinstance(event, Pass):
+                if type(event) is Corner:
+                    corner = event
+                if held:
+                    held.append(event)
+                else:
+                    yield event
+                continue
+            if corner is not None:
+                made = self._cut(held, corner, event, warnings)  # type: ignore[arg-type]
+                if made is None:  # out of scope: the line, the corner and this move pass through
+                    yield from (e if type(e) is Pass else Pass(e.block) for e in held)
+                    yield Pass(event.block)
+                    held, corner = [], None
+                    continue
+                held[0], event = made[0], made[-1]
+                piece = made[1] if len(made) == 3 else Pass(corner.block)
+                held = [piece if e is corner else e for e in held]
+                corner = None
+            yield from held
+            held = []
+            if type(event) is Line and not event.rapid:
+                held.append(event)
+            else:
+                yield event
+        if corner is not None:
+            raise NcppError(f"{'RND' if corner.kind == 'R' else 'CHF'} has no following move",
+                            Location(self.file, corner.block.line, corner.col))
+        yield from held
+
+    def _cut(self, held: list[Event], corner: Corner, second: Line | Arc, warnings: Warnings) -> list[Event] | None:
+        """[first line shortened, fillet or chamfer, second line] or None when out of scope."""
+        where = Location(self.file, corner.block.line, corner.col)
+        if type(second) is not Line or second.rapid:
+            self.done = True
+            warnings.warn("RND/CHF next to an arc or a rapid move is outside the motion interpreter's scope; "
+                          "from this line on the program passes through uninterpreted", where)  # fmt: skip
+            return None
+        try:
+            return round_corner(held[0], second, corner.kind, corner.size, corner.block, corner.feed)  # type: ignore[arg-type]
+        except CornerError as err:
+            raise NcppError(str(err), where) from None
 
     def lookup(self, name: str) -> float:
         if name not in self.q:
@@ -138,9 +203,13 @@ class HeidenhainInterpreter(ModalInterpreter):
                 reason = {"call_label": "CALL LBL", "call_program": "CALL PGM", "cycle_call": "CYCL CALL",
                           "fn": f"FN {node[0]}", "keyword": " ".join(map(str, node))}.get(what, what)  # fmt: skip
                 raise OutOfScope(reason, item.start + 1)
+        if function in ("RND", "CHF"):
+            return [self._corner(block, function_item, words)]
         if "F" in words and function is not None:
             self.feed = words["F"][0]
         events = self._path(block, function, function_item, words, rapid, rotation) if function else []
+        if events and type(events[-1]) in (Line, Arc):
+            self.last_move, self.corner_waits = events[-1], False  # type: ignore[assignment]
         if end:
             self.done = True
         return events
@@ -150,6 +219,25 @@ class HeidenhainInterpreter(ModalInterpreter):
             if type(item) is Word and item.letter == "F":
                 self.auto_feed = item.value
         return []
+
+    def _corner(self, block: Block, item, words: dict) -> Corner:
+        function = item.node[0]
+        if self.corner_waits:
+            self.fail(f"{function} right after another RND/CHF block", block, item)
+        previous = self.last_move
+        if type(previous) is not Line or previous.rapid:
+            raise OutOfScope(f"{function} after {'no move' if previous is None else 'an arc or a rapid move'}",
+                             item.start + 1)
+        if function == "RND":
+            if "R" not in words:
+                self.fail("RND without a radius R", block, item)
+            kind, size = "R", words["R"][0]
+        else:
+            kind, size = "C", item.node[1]
+        if size <= 0:
+            self.fail(f"{function} needs a positive size", block, item)
+        self.corner_waits = True
+        return Corner(block, kind, size, words["F"][0] if "F" in words else None, item.start + 1)
 
     # -- path functions ---------------------------------------------------------------------
     def _target(self, words: dict) -> tuple[list[float], set[int]]:

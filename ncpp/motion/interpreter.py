@@ -22,10 +22,10 @@ as `Pass` after ONE warning (an error with `strict`).
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 from typing import Iterable, Iterator
 
 from ncpp.errors import Location, NcppError, Warnings
+from ncpp.motion.corners import CornerError, round_corner
 from ncpp.motion.expressions import ExpressionError, OutOfScope, Parameters, evaluate, normalise_name
 from ncpp.motion.segments import PLANE_AXES, Arc, Context, Event, Line, Pass
 from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
@@ -219,41 +219,15 @@ class Interpreter:
         """[shortened first line, fillet arc or chamfer line, second line from the tangent point]."""
         kind, size, item = corner
         where = Location(self.file, first.block.line, item.start + 1)
-        i, j, k = PLANE_AXES[first.context.plane]
         if type(second) is not Line or second.rapid or first.rapid:
             self.done = True
             warnings.warn("Fanuc corner rounding next to an arc or a rapid move is outside the motion "
                           "interpreter's scope; from this line on the program passes through uninterpreted", where)  # fmt: skip
             return None
-        if abs(first.end[k] - first.start[k]) > TINY or abs(second.end[k] - second.start[k]) > TINY:
-            raise NcppError("corner rounding/chamfer needs both moves in the active plane", where)
-        u = (first.end[i] - first.start[i], first.end[j] - first.start[j])
-        v = (second.end[i] - second.start[i], second.end[j] - second.start[j])
-        lu, lv = math.hypot(*u), math.hypot(*v)
-        if lu < TINY or lv < TINY:
-            raise NcppError("corner rounding/chamfer next to a zero-length move", where)
-        u, v = (u[0] / lu, u[1] / lu), (v[0] / lv, v[1] / lv)
-        cross, dot = u[0] * v[1] - u[1] * v[0], u[0] * v[0] + u[1] * v[1]
-        if abs(cross) < 1e-9:  # straight on (or back): no corner to round
-            return [first, second]
-        turn = math.atan2(abs(cross), dot)  # direction change, 0..pi
-        distance = size if kind == "C" else size * math.tan(turn / 2)
-        if distance > lu + TINY or distance > lv + TINY:
-            raise NcppError(f"corner {'chamfer' if kind == 'C' else 'radius'} {size:g} does not fit between the moves", where)
-        corner_point = first.end
-        t1, t2 = list(corner_point), list(corner_point)
-        t1[i], t1[j] = corner_point[i] - distance * u[0], corner_point[j] - distance * u[1]
-        t2[i], t2[j] = corner_point[i] + distance * v[0], corner_point[j] + distance * v[1]
-        t1, t2 = tuple(t1), tuple(t2)
-        shortened = replace(first, end=t1)
-        moved = replace(second, start=t2)
-        if kind == "C":
-            return [shortened, replace(first, start=t1, end=t2), moved]
-        side = 1.0 if cross > 0 else -1.0  # the centre lies on the inside of the turn
-        centre = list(t1)
-        centre[i], centre[j] = t1[i] - side * size * u[1], t1[j] + side * size * u[0]
-        fillet = Arc(t1, t2, tuple(centre), 1 if cross > 0 else -1, first.feed, first.block, first.context, first.extra)
-        return [shortened, fillet, moved]
+        try:
+            return round_corner(first, second, kind, size)
+        except CornerError as err:
+            raise NcppError(str(err), where) from None
 
     def context(self) -> Context:
         if self._context is None:

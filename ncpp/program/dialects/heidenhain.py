@@ -242,7 +242,9 @@ class HeidenhainWriter(IsoWriter):
     line edits its block (X/Y/Z absolute, IX/IY/IZ incremental as written; `LP`
     becomes `L`); a changed arc writes its own `CC` and then `C ... DR±` (`CP
     IPA ... IZ ... DR±` for a helix), and a verbatim block that relies on the
-    program's pole gets that pole back in a `CC` block first."""
+    program's pole gets that pole back in a `CC` block first.  An `RND`/`CHF`
+    block after an edited line (which then ends at the tangent point) becomes
+    `CC` + `C ... DR±` or an `L` to the end of its fillet or chamfer."""
 
     comment_open, comment_close = "; ", ""
 
@@ -255,6 +257,8 @@ class HeidenhainWriter(IsoWriter):
         self.output_pole: tuple | None = None  # what the output's last CC says
         self.changed_any = False
         self.eol = "\n"
+        self.restore_feed = False  # an edited corner block's F: the next move gets the program's feed back
+        self.edited_last = False  # the last block was written edited (an RND/CHF after it must be too)
 
     def with_header(self, lines, header: str):
         """The header goes after `BEGIN PGM` as a numbered comment block (set before writing)."""
@@ -291,7 +295,14 @@ class HeidenhainWriter(IsoWriter):
         motion = [e for e in group if type(e) is Line or type(e) is Arc]
         pole = next((e for e in group if type(e) is Pole), None)
         _, function = _function(block)
-        if not any(e.changed for e in motion):
+        edited_before = self.edited_last
+        if motion:
+            self.edited_last = False
+        # a corner piece follows the line before it: that line's output ends at the corner
+        # itself (RND/CHF verbatim) or, edited, at the tangent point (the piece written out)
+        corner = function in ("RND", "CHF")
+        feed = self._restored_feed(block, motion) if motion and not corner else ""
+        if (not corner and not any(e.changed for e in motion)) or (corner and not (motion and edited_before)):
             if pole is not None:
                 self.program_pole = self.output_pole = (pole.center, pole.plane)
                 incremental = any(type(i) is Word and i.letter in ("IX", "IY", "IZ") for i in block.items)
@@ -301,16 +312,18 @@ class HeidenhainWriter(IsoWriter):
             elif function in _POLE_FUNCTIONS and self.program_pole and self.output_pole != self.program_pole:
                 yield self._inserted(self._cc_text(*self.program_pole))
                 self.output_pole = self.program_pole
-            yield self._numbered(block, block.raw)
+            yield self._numbered(block, splice(block, {}, feed) if feed else block.raw)
             if self.header is not None and any(type(i) is Statement and i.kind == "program_begin" for i in block.items):
                 yield self._inserted(self.comment(self.header))
                 self.header = None
             for segment in motion:
                 self._remember_end(segment)
             return
-        self.changed_any = True
+        self.changed_any = self.edited_last = True
+        if corner and any(type(i) in (Word, ExprWord) and i.letter == "F" for i in block.items):
+            self.restore_feed = True  # `RND R5 F200`: F200 holds for the fillet only, a C block's F is modal
         # the block itself says the first segment of its own kind; steps before and pieces after are new blocks
-        own_kind = Line if function in ("L", "LP") else Arc
+        own_kind = Line if function in ("L", "LP", "CHF") else Arc
         own = next((n for n, e in enumerate(motion) if type(e) is own_kind), 0)
         for n, segment in enumerate(motion):
             if type(segment) is Arc:
@@ -318,10 +331,24 @@ class HeidenhainWriter(IsoWriter):
                 yield self._inserted(self._cc_text(*centre_plane))
                 self.output_pole = centre_plane
             if n == own:
-                yield self._numbered(block, self._edit(block, segment))
+                yield self._numbered(block, self._edit(block, segment, feed))
             else:
-                yield self._inserted(self._fresh(segment))
+                yield self._inserted(self._fresh(segment) + feed)
+            feed = ""  # on the first block written
             self._remember_end(segment)
+
+    def _restored_feed(self, block: Block, motion: list) -> str:
+        """` F500` for the first move after an edited `RND ... F`, unless it sets its own feed."""
+        if not self.restore_feed:
+            return ""
+        feeds = [i for i in block.items if (type(i) in (Word, ExprWord) and i.letter == "F") or (
+            type(i) is Statement and i.kind == "feed")]  # fmt: skip
+        if any(type(i) is Statement and i.node[0] == "FMAX" for i in feeds):
+            return ""  # a rapid: the feed comes back with the move after it
+        self.restore_feed = False
+        if feeds:
+            return ""
+        return " F" + format_number(motion[0].feed, self.styles.get("F") or NumberStyle(decimals=3))
 
     def _header_first(self, block: Block) -> str:
         self.last_number = -1
@@ -372,8 +399,9 @@ class HeidenhainWriter(IsoWriter):
         first, second = sorted((a, b))
         return f"C {self._word(_AXES[first], segment.end[first], segment)} {self._word(_AXES[second], segment.end[second], segment)} {rotation}"
 
-    def _edit(self, block: Block, segment: Line | Arc) -> str:
-        """The block's raw text made to say `segment` (its other words, F, M, comments kept)."""
+    def _edit(self, block: Block, segment: Line | Arc, feed: str = "") -> str:
+        """The block's raw text made to say `segment` (its other words, F, M, comments kept;
+        `feed` added)."""
         index, function = _function(block)
         arc = type(segment) is Arc
         helix = arc and self._is_helix(segment)
@@ -383,7 +411,7 @@ class HeidenhainWriter(IsoWriter):
                      if (type(i) in (Word, ExprWord) and (i.letter in _POLAR_WORDS or i.letter.lstrip("I") in _AXES))
                      or (type(i) is Statement and i.kind == "rotation")}  # fmt: skip
             texts[index] = self._arc_text(segment)
-            return splice(block, texts)
+            return splice(block, texts, feed)
         texts: dict[int, str | None] = {}
         if not arc and function != "L":  # LP, or a line where the program had an arc: the block becomes L
             texts[index] = "L"
@@ -407,7 +435,7 @@ class HeidenhainWriter(IsoWriter):
             k in plane_axes or (k in self.known_axes_idx() and self._moved(_AXES[k], segment.end[k], segment)))]  # fmt: skip
         if arc and not any(type(i) is Statement and i.kind == "rotation" for i in block.items):
             extra.append("DR+" if segment.turn > 0 else "DR-")
-        return splice(block, texts, "".join(" " + w for w in extra), after=anchor)
+        return splice(block, texts, "".join(" " + w for w in extra) + feed, after=anchor)
 
     def known_axes_idx(self) -> set[int]:
         return {_AXES.index(a) for a in self.known_axes if a in _AXES}
