@@ -27,9 +27,9 @@ from typing import Iterable, Iterator
 
 from ncpp.errors import Location, NcppError, Warnings
 from ncpp.motion.corners import CornerError, round_corner
-from ncpp.motion.modal import PLANE_OF_TOOL_AXIS, ModalInterpreter, OutOfScope, evaluate, resolve_warnings
+from ncpp.motion.modal import PLANE_OF_TOOL_AXIS, ModalInterpreter, OutOfScope, resolve_warnings
 from ncpp.motion.segments import PLANE_AXES, Arc, Event, Line, Pass, Point
-from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
+from ncpp.program.blocks import Block, Comment, ExprWord, Word
 
 AXES = "XYZ"
 # Cycles that move or turn the datum (datum shift, mirror, rotation, scaling, working plane, presets)
@@ -132,16 +132,6 @@ class HeidenhainInterpreter(ModalInterpreter):
         if name not in self.q:
             raise OutOfScope(f"the parameter {name.upper()} (not set in the program)")
         return self.q[name]
-
-    def value(self, expr: tuple, block: Block, item) -> float:
-        try:
-            return evaluate(expr, self.lookup)
-        except OutOfScope as stop:
-            stop.col = item.start + 1
-            raise
-        except (ValueError, OverflowError) as err:
-            self.fail(str(err), block, item)
-        raise AssertionError("unreachable")
 
     # -- one block ------------------------------------------------------------------------
     def block(self, block: Block) -> list[Event]:

@@ -26,9 +26,9 @@ from typing import Iterable, Iterator
 
 from ncpp.errors import Location, NcppError, Warnings
 from ncpp.motion.corners import CornerError, round_corner
-from ncpp.motion.expressions import ExpressionError, OutOfScope, Parameters, evaluate, normalise_name
+from ncpp.motion.expressions import ExpressionError, OutOfScope, Parameters, evaluate
 from ncpp.motion.segments import PLANE_AXES, Arc, Context, Event, Line, Pass
-from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
+from ncpp.program.blocks import Block, Comment, ExprWord, Word
 
 MM_PER_INCH = 25.4
 AXES = "XYZABCUVW"

@@ -97,6 +97,21 @@ class ModalInterpreter:
         self.offset = list(offset)
         self._context = None
 
+    def lookup(self, name: str) -> float:
+        """The value of a program parameter (Q, R, DEF variable); each dialect says how."""
+        raise NotImplementedError
+
+    def value(self, expr: tuple, block: Block, item) -> float:
+        """An expression's value; an unknown parameter ends interpretation (out of scope)."""
+        try:
+            return evaluate(expr, self.lookup)
+        except OutOfScope as stop:
+            stop.col = item.start + 1
+            raise
+        except (ValueError, OverflowError) as err:
+            self.fail(str(err), block, item)
+        raise AssertionError("unreachable")
+
     def fail(self, message: str, block: Block, item=None) -> None:
         raise NcppError(message, Location(self.file, block.line, item.start + 1 if item is not None else None))
 

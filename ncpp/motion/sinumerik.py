@@ -17,7 +17,7 @@ import math
 from typing import Iterable, Iterator
 
 from ncpp.errors import Warnings
-from ncpp.motion.modal import ModalInterpreter, OutOfScope, circle_through, evaluate, plane_of, resolve_warnings
+from ncpp.motion.modal import ModalInterpreter, OutOfScope, circle_through, plane_of, resolve_warnings
 from ncpp.motion.segments import PLANE_AXES, Event
 from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
 
@@ -63,16 +63,6 @@ class SinumerikInterpreter(ModalInterpreter):
         if isinstance(value, str):
             raise OutOfScope(f"the string variable {name.upper()} in arithmetic")
         return value
-
-    def value(self, expr: tuple, block: Block, item) -> float:
-        try:
-            return evaluate(expr, self.lookup)
-        except OutOfScope as stop:
-            stop.col = item.start + 1
-            raise
-        except (ValueError, OverflowError) as err:
-            self.fail(str(err), block, item)
-        raise AssertionError("unreachable")
 
     def assign(self, target: tuple, expr: tuple, block: Block, item) -> None:
         if target[0] != "param" or target[1].startswith("$"):

@@ -15,7 +15,7 @@ All arcs of a chunk are processed together, piece arrays in, piece arrays out.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Iterable, Iterator
 
 import numpy as np

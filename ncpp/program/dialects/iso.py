@@ -13,7 +13,7 @@ from __future__ import annotations
 from dataclasses import replace
 from typing import Iterable, Iterator
 
-from ncpp.motion.segments import PLANE_AXES, Arc, Context, Event, Line
+from ncpp.motion.segments import Arc, Context, Event, Line
 from ncpp.program.blocks import Block, Comment, ExprWord, Word
 from ncpp.program.numbers import NumberStyle, format_number
 from ncpp.program.writer import _with_motion, set_words, spelling
