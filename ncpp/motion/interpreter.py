@@ -338,6 +338,8 @@ class Interpreter:
         self._fast = self.absolute and (motion == 0.0 or (motion == 1.0 and not self.inverse_time))
 
     def _fast_line(self, block: Block, end: list[float]) -> Line:
+        """A Line of the modal motion (G0/G1) from the current position to `end`, built
+        slot by slot (the hot path: ~2x faster than the frozen dataclass's constructor)."""
         pos = self.pos
         self.pos = end
         line = _new(Line)
@@ -364,8 +366,7 @@ class Interpreter:
             self._check_feed(block, words, "Cannot do g1 with zero feed rate", "F word missing with inverse time g1 move")
         if not self.uses_extra_axes and not words.keys() <= _XYZF:
             self.uses_extra_axes = True
-        pos = self.pos
-        end = pos[:]
+        end = self.pos[:]
         if self.absolute:
             for letter, value in words.items():
                 if letter != "F":
@@ -374,18 +375,7 @@ class Interpreter:
             for letter, value in words.items():
                 if letter != "F":
                     end[AXIS_INDEX[letter]] += value[0]
-        self.pos = end
-        line = _new(Line)  # _new_line, inlined on the hot path
-        s0, s1, s2, s3, s4, s5, s6, s7 = _LINE_SLOTS
-        s0(line, (pos[0], pos[1], pos[2]))
-        s1(line, (end[0], end[1], end[2]))
-        s2(line, motion == 0.0)
-        s3(line, self.feed)
-        s4(line, block)
-        s5(line, self._context or self.context())
-        s6(line, (end[3], end[4], end[5], end[6], end[7], end[8]) if self.uses_extra_axes else ())
-        s7(line, False)
-        return line
+        return self._fast_line(block, end)  # motion is the modal motion here
 
     def _motion_move(self, block: Block, words: dict, motion: float, motion_item: Word | ExprWord) -> Event:
         """`G0`-`G3` and words that need no check: what `_execute` does with such a block."""
