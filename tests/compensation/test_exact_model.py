@@ -24,6 +24,16 @@ PROGRAMS = {
 }
 
 
+def before_after(machine, data: bytes, tolerance: float):
+    """Contour error reports of the program uncompensated and compensated, run on
+    `machine` placed at the centre of its travel."""
+    offset = placement(sample_events(events_of(data)), machine.limits)
+    nominal = sample_events(events_of(data), work_offset=offset)
+    before = contour_error(machine, nominal, nominal, feed_effects=False)
+    commanded = sample_events(events_of(compensate(data, machine, offset, tolerance)), work_offset=offset)
+    return before, contour_error(machine, commanded, nominal, feed_effects=False)
+
+
 @pytest.fixture(scope="module")
 def machine():
     true = load_machine(ROOT / "samples/machines/hr5b.toml").replace(effects=())
@@ -42,11 +52,7 @@ def test_contour_error_within_tolerance(name, tolerance, machine):
     if not path.exists():
         pytest.skip("corpus not available")
     data = start + path.read_bytes()
-    offset = placement(sample_events(events_of(data)), machine.limits)
-    nominal = sample_events(events_of(data), work_offset=offset)
-    before = contour_error(machine, nominal, nominal, feed_effects=False)
-    commanded = sample_events(events_of(compensate(data, machine, offset, tolerance)), work_offset=offset)
-    after = contour_error(machine, commanded, nominal, feed_effects=False)
+    before, after = before_after(machine, data, tolerance)
     assert before.max_um > 20.0  # the machine is wrong enough for the check to mean something
     assert after.max_um <= tolerance * 1000 + 0.5, f"{after.max_um:.2f} µm at line {after.worst_line}"
 
@@ -61,11 +67,7 @@ def test_reversal_tables_compensated_for_the_direction_travelled(name):
         pytest.skip("corpus not available")
     machine = load_machine(ROOT / "samples/machines/hr5b.toml").replace(effects=())
     data = start + path.read_bytes()
-    offset = placement(sample_events(events_of(data)), machine.limits)
-    nominal = sample_events(events_of(data), work_offset=offset)
-    before = contour_error(machine, nominal, nominal, feed_effects=False)
-    commanded = sample_events(events_of(compensate(data, machine, offset, 0.001)), work_offset=offset)
-    after = contour_error(machine, commanded, nominal, feed_effects=False)
+    before, after = before_after(machine, data, 0.001)
     assert after.max_um <= 1.5, f"{after.max_um:.2f} µm at line {after.worst_line}"
     assert before.max_um / after.max_um >= 20
 
@@ -91,10 +93,6 @@ def test_reversal_spots_within_tolerance(name):
     inch = data.startswith(b"G20\n")
     data = data.replace(b"G20\n", b"G20\n" + START, 1) if inch else START + data
     machine = load_machine(ROOT / "samples/machines/hr5b.toml").replace(effects=())
-    offset = placement(sample_events(events_of(data)), machine.limits)
-    nominal = sample_events(events_of(data), work_offset=offset)
-    before = contour_error(machine, nominal, nominal, feed_effects=False)
-    commanded = sample_events(events_of(compensate(data, machine, offset, 0.001)), work_offset=offset)
-    after = contour_error(machine, commanded, nominal, feed_effects=False)
+    before, after = before_after(machine, data, 0.001)
     assert after.max_um <= 1.5, f"{after.max_um:.2f} µm at line {after.worst_line}"
     assert before.max_um / after.max_um >= 20
