@@ -17,6 +17,7 @@ start is compensated with its own direction and a step move is inserted.
 from __future__ import annotations
 
 import heapq
+from dataclasses import dataclass
 from typing import Iterable, Iterator
 
 import numpy as np
@@ -38,55 +39,102 @@ NEAR_STILL = 0.05
 
 
 def apply_error_map(events: Iterable[Event], ctx: PassContext) -> Iterator[Event]:
-    last = None  # the last segment written: its compensated end, in its own program frame
     travel = Travel()
+    last = None  # the last segment written: its compensated end, in its own program frame
     for chunk in chunked(events):
+        segs = [e for e in chunk if type(e) is Line or type(e) is Arc]
+        if not segs:
+            yield from chunk
+            continue
+        offsets, scales = frames(segs)
         if ctx.directional:
-            new_ends, new_starts, new_arcs, steady = _directional(chunk, ctx, travel)
+            solved = _directional(segs, offsets, scales, ctx, travel)
         else:
-            new_ends, new_starts, new_arcs, steady = _plain(chunk, ctx), {}, {}, {}
-        for k, event in enumerate(chunk):
-            if type(event) is not Line and type(event) is not Arc:
-                yield event
-                continue
-            event = new_arcs.get(k, event)
-            previous_end = _end_in_frame_of(last, event)
-            end = new_ends.get(k)
-            if end is not None:
-                start = event.start if previous_end is None else previous_end
-                if k in new_starts and previous_end is not None and not event.rapid:
-                    wanted = _snap(new_starts[k], previous_end, *steady[k])
-                    if _apart(previous_end, wanted):
-                        yield Line(previous_end, wanted, event.rapid, event.feed, event.block, event.context, event.extra, True)
-                        start = wanted
-                event = Line(start, end, event.rapid, event.feed, event.block, event.context, event.extra, True)
-            elif event.changed and previous_end is not None and _apart(previous_end, event.start):
-                # a reversal step between compensated pieces: move there first
-                yield Line(previous_end, event.start, False, event.feed, event.block, event.context, event.extra, True)
-            last = event
-            yield event
+            solved = _plain(segs, offsets, scales, ctx)
+        written = _written(segs, solved, offsets, scales, last)
+        last = written[-1][-1]
+        replacing = iter(written)
+        out: list[Event] = []
+        for event in chunk:
+            if type(event) is Line or type(event) is Arc:
+                out += next(replacing)
+            else:
+                out.append(event)
+        yield from out
 
 
-def _plain(chunk: list[Event], ctx: PassContext) -> dict[int, tuple]:
+@dataclass
+class _Solved:
+    """A chunk's segments (rows) as compensation leaves them, program units."""
+
+    start: NDArray  # (n,3) where each piece starts (replace_arcs' pieces may have moved)
+    end: NDArray  # (n,3) where each segment ends
+    free: NDArray  # (n,) the lines whose end was compensated here (the others came compensated)
+    moved: NDArray  # (n,) replace_arcs' pieces moved here for the direction they really travel in
+    turn: NDArray  # (n,) lines that reverse an axis: they start with a step to `turn_start`
+    turn_start: NDArray  # (n,3) their start compensated for the new direction
+    keep: NDArray  # (n,3) axes that keep their direction (they must not move in that step)
+    limit: NDArray  # (n,) program units an axis may be left off its compensated position
+
+
+def _written(segs: list, solved: _Solved, offsets: NDArray, scales: NDArray, last) -> list[list[Event]]:
+    """Per segment, the events that replace it: a connecting or reversal step where
+    needed, then the segment with its compensated ends, starting where the previous
+    one ended."""
+    previous = np.empty_like(solved.end)
+    previous[1:] = solved.end[:-1]
+    has_previous = np.ones(len(segs), dtype=bool)
+    # where units or offsets change, the previous end is seen from the new frame
+    reframed = np.flatnonzero((offsets[1:] != offsets[:-1]).any(axis=1) | (scales[1:] != scales[:-1])) + 1
+    for i, before in [(0, last), *((i, None) for i in reframed.tolist())]:
+        p = _end_in_frame_of(before if i == 0 else _ended(segs[i - 1], solved.end[i - 1]), segs[i])
+        has_previous[i] = p is not None
+        previous[i] = p if p is not None else np.nan
+    # A reversal step's target, with the axes that keep their direction left where they
+    # are when they differ only by output rounding: a one-digit move there would reverse
+    # that axis on the machine.
+    rapid = np.array([type(e) is Line and e.rapid for e in segs])
+    turning = solved.turn & has_previous & ~rapid
+    target = np.where(solved.keep & (np.abs(solved.turn_start - previous) <= solved.limit[:, None]), previous, solved.turn_start)
+    turning &= _apart(previous, target)
+    # replace_arcs' pieces start where they start: a step from the previous end first
+    connect = ~solved.free & has_previous & np.array([e.changed for e in segs]) & _apart(previous, solved.start)
+    previous_l, target_l, start_l, end_l = previous.tolist(), target.tolist(), solved.start.tolist(), solved.end.tolist()
+    out = []
+    for i, (seg, free, moved, has_prev, turns, connects) in enumerate(
+        zip(segs, solved.free.tolist(), solved.moved.tolist(), has_previous.tolist(), turning.tolist(), connect.tolist())
+    ):
+        here: list[Event] = []
+        if free:
+            start = tuple(previous_l[i]) if has_prev else seg.start
+            if turns:
+                here.append(Line(start, tuple(target_l[i]), seg.rapid, seg.feed, seg.block, seg.context, seg.extra, True))
+                start = tuple(target_l[i])
+            here.append(Line(start, tuple(end_l[i]), seg.rapid, seg.feed, seg.block, seg.context, seg.extra, True))
+        else:
+            if moved:
+                seg = _moved_arc(seg, start_l[i], end_l[i])
+            if connects:
+                here.append(Line(tuple(previous_l[i]), seg.start, False, seg.feed, seg.block, seg.context, seg.extra, True))
+            here.append(seg)
+        out.append(here)
+    return out
+
+
+def _plain(segs: list, offsets: NDArray, scales: NDArray, ctx: PassContext) -> _Solved:
     """Compensated ends of the chunk's lines, for a map without reversal errors."""
-    index = [k for k, e in enumerate(chunk) if type(e) is Line and not e.changed]
-    if not index:
-        return {}
-    lines = [chunk[k] for k in index]
-    offsets, scales = frames(lines)
-    starts, ends = np.array([ln.start for ln in lines]), np.array([ln.end for ln in lines])
-    ends = compensate(ends, offsets, scales, lines, ctx, np.sign(ends - starts))
-    return {k: tuple(map(float, p)) for k, p in zip(index, ends)}
+    start, end = np.array([e.start for e in segs]), np.array([e.end for e in segs])
+    free = np.array([type(e) is Line and not e.changed for e in segs])
+    rows = np.flatnonzero(free)
+    if rows.size:
+        end[rows] = compensate(end[rows], offsets[rows], scales[rows], [segs[i] for i in rows], ctx, np.sign(end[rows] - start[rows]))
+    none = np.zeros(len(segs), dtype=bool)
+    return _Solved(start, end, free, none, none, start, np.ones(start.shape, dtype=bool), np.zeros(len(segs)))
 
 
-def _directional(chunk: list[Event], ctx: PassContext, travel: Travel) -> tuple[dict, dict, dict]:
+def _directional(segs: list, offsets: NDArray, scales: NDArray, ctx: PassContext, travel: Travel) -> _Solved:
     """Compensated line ends and starts, and shifted arcs, of one chunk, with the
     directions the machine will travel in; advances `travel` past the chunk."""
-    index = [k for k, e in enumerate(chunk) if type(e) is Line or type(e) is Arc]
-    if not index:
-        return {}, {}, {}, {}
-    segs = [chunk[k] for k in index]
-    offsets, scales = frames(segs)
     step = grid(ctx, scales)
     threshold = step * scales / 2  # mm: half the output resolution
     machine = lambda p, rows=slice(None): (p + offsets[rows]) * scales[rows, None]  # noqa: E731
@@ -128,26 +176,19 @@ def _directional(chunk: list[Event], ctx: PassContext, travel: Travel) -> tuple[
             break  # unsettled: keep the directions the ends were computed for
         d = d_new
 
-    ends = out_end.tolist()
-    new_ends = {index[i]: tuple(ends[i]) for i in np.flatnonzero(free).tolist()}
-    moved = np.flatnonzero(arc & ((out_start != start_p) | (out_end != end_p)).any(axis=1)).tolist()
-    starts = out_start.tolist()
-    new_arcs = {index[i]: _moved_arc(segs[i], starts[i], ends[i]) for i in moved}
+    moved = arc & ((out_start != start_p) | (out_end != end_p)).any(axis=1)
     # where an axis reverses, the line must start where its own direction puts the tool
     before = np.vstack([travel.held[None, :], d[:-1]])
     flips = (d != before) & (before != 0)
-    turn = np.flatnonzero(free & flips.any(axis=1))
-    # axes that keep their direction must not move in a reversal step (see _snap)
-    keeps, limits = (~flips).tolist(), limit.tolist()
-    steady = {index[i]: (keeps[i], limits[i]) for i in turn.tolist()}
-    new_starts = {}
-    if turn.size:
-        s = compensate(start_p[turn], offsets[turn], scales[turn], [segs[i] for i in turn], ctx, d[turn])
-        s = quantize(s, step[turn]).tolist()
-        new_starts = {index[i]: tuple(p) for i, p in zip(turn.tolist(), s)}
+    turn = free & flips.any(axis=1)
+    turn_start = np.full(start_p.shape, np.nan)
+    rows = np.flatnonzero(turn)
+    if rows.size:
+        s = compensate(start_p[rows], offsets[rows], scales[rows], [segs[i] for i in rows], ctx, d[rows])
+        turn_start[rows] = quantize(s, step[rows])
     travel.held = d[-1].copy()
     travel.last = machine(out_end[-1:], slice(len(segs) - 1, None))[0]
-    return new_ends, new_starts, new_arcs, steady
+    return _Solved(out_start, out_end, free, moved, turn, turn_start, ~flips, limit)
 
 
 def _settle(free, arc, d, held, offsets, scales, limit, out_start, out_end, before) -> None:
@@ -303,13 +344,6 @@ def _moved_arc(arc: Arc | Line, start: list, end: list) -> Arc | Line:
     return Arc(tuple(start), tuple(end), centre, arc.turn, arc.feed, arc.block, arc.context, arc.extra, True)
 
 
-def _snap(start: tuple, previous_end: tuple, steady: tuple, limit: float) -> tuple:
-    """A reversal step's target with the axes that keep their direction left
-    where they are, when they differ only by output rounding: a one-digit move
-    there would reverse that axis on the machine."""
-    return tuple(p if keep and abs(s - p) <= limit else s for s, p, keep in zip(start, previous_end, steady))
-
-
 def _end_in_frame_of(last: Line | Arc | None, event: Line | Arc) -> tuple | None:
     """The last segment's end in `event`'s program frame: units (G20/G21) and
     offsets (G92, G54.., tool length) may have changed between them."""
@@ -321,5 +355,11 @@ def _end_in_frame_of(last: Line | Arc | None, event: Line | Arc) -> tuple | None
     return b.to_program(a.to_machine(last.end))
 
 
-def _apart(a: tuple, b: tuple, tolerance: float = 1e-7) -> bool:
-    return abs(a[0] - b[0]) > tolerance or abs(a[1] - b[1]) > tolerance or abs(a[2] - b[2]) > tolerance
+def _ended(segment: Line | Arc, end: NDArray) -> Line:
+    """Stands in for a written segment where only its end and frame matter."""
+    return Line(segment.start, tuple(end.tolist()), False, 0.0, segment.block, segment.context)
+
+
+def _apart(a: NDArray, b: NDArray, tolerance: float = 1e-7) -> NDArray:
+    """(n,) whether the points differ by more than `tolerance` on some axis."""
+    return (np.abs(a - b) > tolerance).any(axis=1)
