@@ -38,7 +38,7 @@ END_M = frozenset((2.0, 30.0))
 HARMLESS_KEYWORDS = frozenset(("STOP",))
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)
 class Pole(Pass):
     """A `CC` block: the pole (circle centre) it sets, in `plane`."""
 
@@ -46,7 +46,7 @@ class Pole(Pass):
     plane: int = 17
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)
 class Corner(Pass):
     """An `RND` (kind 'R', size the radius) or `CHF` (kind 'C', size the leg) block, until the next move."""
 

@@ -164,7 +164,7 @@ class Interpreter:
                 if pending is not None:
                     yield from self._unrounded(pending, held)
                     pending = None
-                yield _pass(block)
+                yield Pass(block)
                 continue
             try:
                 event = block_event(block)  # verbatim blocks (after the closing %) have no items
@@ -179,7 +179,7 @@ class Interpreter:
                 if pending is not None:
                     yield from self._unrounded(pending, held)
                     pending = None
-                yield _pass(block)
+                yield Pass(block)
                 continue
             if pending is None and self.corner is None and type(event) is not tuple:
                 yield event  # the common case: no corner waits, none starts
@@ -195,7 +195,7 @@ class Interpreter:
                     if rounded is None:  # out of scope: everything from the corner on passes
                         yield from self._unrounded(pending, held)
                         pending = None
-                        yield _pass(ev.block)
+                        yield Pass(ev.block)
                         break
                     yield from rounded[:-1]
                     yield from held
@@ -211,7 +211,7 @@ class Interpreter:
 
     def _unrounded(self, pending: Line, held: list[Event]) -> Iterator[Event]:
         """A held corner line whose corner cannot be made: it passes through, uninterpreted."""
-        yield _pass(pending.block)
+        yield Pass(pending.block)
         yield from held
         held.clear()
 
@@ -246,7 +246,7 @@ class Interpreter:
         """The event(s) of one block; updates the modal state."""
         items = block.items
         if not items:
-            return _pass(block)
+            return Pass(block)
         if self._fast:  # absolute G0/G1 with a usable feed: try the plain `X.. Y.. Z..` line
             end = self.pos[:]
             seen = 0
@@ -321,7 +321,7 @@ class Interpreter:
         if mcodes is None:
             if gcodes is None:
                 if not words:
-                    return _pass(block)
+                    return Pass(block)
                 motion = self.motion
                 if motion is not None and words.keys() <= _PLAIN_LETTERS[motion] and not words.keys() <= _F_ONLY:
                     return self._modal_move(block, words, motion)
@@ -338,21 +338,18 @@ class Interpreter:
         self._fast = self.absolute and (motion == 0.0 or (motion == 1.0 and not self.inverse_time))
 
     def _fast_line(self, block: Block, end: list[float]) -> Line:
-        """A Line of the modal motion (G0/G1) from the current position to `end`, built
-        slot by slot (the hot path: ~2x faster than the frozen dataclass's constructor)."""
+        """A Line of the modal motion (G0/G1) from the current position to `end` (the hot path)."""
         pos = self.pos
         self.pos = end
-        line = _new(Line)
-        s0, s1, s2, s3, s4, s5, s6, s7 = _LINE_SLOTS
-        s0(line, (pos[0], pos[1], pos[2]))
-        s1(line, (end[0], end[1], end[2]))
-        s2(line, self.motion == 0.0)
-        s3(line, self.feed)
-        s4(line, block)
-        s5(line, self._context or self.context())
-        s6(line, (end[3], end[4], end[5], end[6], end[7], end[8]) if self.uses_extra_axes else ())
-        s7(line, False)
-        return line
+        return Line(
+            (pos[0], pos[1], pos[2]),
+            (end[0], end[1], end[2]),
+            self.motion == 0.0,
+            self.feed,
+            block,
+            self._context or self.context(),
+            (end[3], end[4], end[5], end[6], end[7], end[8]) if self.uses_extra_axes else (),
+        )
 
     def _modal_move(self, block: Block, words: dict, motion: float) -> Event:
         """The hot path: a block of axis words (and F) continuing the modal motion."""
@@ -435,7 +432,7 @@ class Interpreter:
         if 2.0 in mcodes or 30.0 in mcodes:
             self._program_end()
         self._update_fast()
-        return _pass(block) if events is None else events
+        return Pass(block) if events is None else events
 
     # -- checks (interp_check.cc, enhance_block) ----------------------------------------
     def _motion_to_be(self, block, mode0, mode1, mode1_item, axis_item) -> float | None:
@@ -656,7 +653,7 @@ class Interpreter:
 
     def _line(self, block: Block, end: list[float], rapid: bool) -> Line:
         pos = self.pos
-        line = _new_line(
+        line = Line(
             (pos[0], pos[1], pos[2]),
             (end[0], end[1], end[2]),
             rapid,
@@ -732,18 +729,16 @@ class Interpreter:
         center = [0.0, 0.0, 0.0]
         center[a], center[b], center[c] = ca, cb, start[c]
         self.pos = end
-        arc = _new(Arc)  # Arc(...) with its slots set directly, as `_new_line`
-        s_start, s_end, s_center, s_turn, s_feed, s_block, s_context, s_extra, s_changed = _ARC_SLOTS
-        s_start(arc, (start[0], start[1], start[2]))
-        s_end(arc, (end[0], end[1], end[2]))
-        s_center(arc, (center[0], center[1], center[2]))
-        s_turn(arc, -turns if motion == 2.0 else turns)
-        s_feed(arc, self.feed)
-        s_block(arc, block)
-        s_context(arc, self._context or self.context())
-        s_extra(arc, (end[3], end[4], end[5], end[6], end[7], end[8]) if self.uses_extra_axes else ())
-        s_changed(arc, False)
-        return arc
+        return Arc(
+            (start[0], start[1], start[2]),
+            (end[0], end[1], end[2]),
+            (center[0], center[1], center[2]),
+            -turns if motion == 2.0 else turns,
+            self.feed,
+            block,
+            self._context or self.context(),
+            (end[3], end[4], end[5], end[6], end[7], end[8]) if self.uses_extra_axes else (),
+        )
 
     def _center_r(self, block, word, x0, y0, x1, y1, radius, motion, tolerance) -> tuple[float, float]:
         """arc_data_r of rs274ngc: the centre of an R-format arc (negative R: the long way)."""
@@ -840,28 +835,6 @@ _PLAIN_LETTERS = {
 }
 
 
-# Frozen dataclasses set each field through object.__setattr__; the interpreter
-# builds one event per block, so it sets the slots directly (same objects, ~2x faster).
-_LINE_SLOTS = [Line.__dict__[name].__set__ for name in ("start", "end", "rapid", "feed", "block", "context", "extra", "changed")]
-_ARC_SLOTS = [Arc.__dict__[name].__set__ for name in ("start", "end", "center", "turn", "feed", "block", "context", "extra", "changed")]
-_PASS_BLOCK = Pass.__dict__["block"].__set__
-_new = object.__new__
-
-
-def _new_line(start, end, rapid, feed, block, context, extra) -> Line:
-    line = object.__new__(Line)
-    s0, s1, s2, s3, s4, s5, s6, s7 = _LINE_SLOTS
-    s0(line, start)
-    s1(line, end)
-    s2(line, rapid)
-    s3(line, feed)
-    s4(line, block)
-    s5(line, context)
-    s6(line, extra)
-    s7(line, False)
-    return line
-
-
 def _corner_word(words: dict, motion: float) -> tuple[str, float, Word | ExprWord] | None:
     """Fanuc corner rounding / chamfer at the end of a G1 move: `,R` `,C` or `R`."""
     for letter, kind in ((",R", "R"), (",C", "C"), ("R", "R")):
@@ -869,9 +842,3 @@ def _corner_word(words: dict, motion: float) -> tuple[str, float, Word | ExprWor
             value, item = words[letter]
             return kind, value, item
     return None
-
-
-def _pass(block: Block) -> Pass:
-    event = object.__new__(Pass)
-    _PASS_BLOCK(event, block)
-    return event

@@ -57,7 +57,10 @@ class Context:
         return (m[0] / s - self.offset[0], m[1] / s - self.offset[1], m[2] / s - self.offset[2])
 
 
-@dataclass(frozen=True, slots=True)
+# Events are not frozen: a pipeline makes several per output line, and a frozen
+# dataclass sets each field through object.__setattr__ (5x slower to build).
+# Treat them as values all the same: a pass that changes one makes a new one.
+@dataclass(slots=True)
 class Line:
     start: Point
     end: Point
@@ -72,7 +75,7 @@ class Line:
         return math.dist(self.start, self.end)
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)
 class Arc:
     """A circular (or helical) arc in `context.plane`.
 
@@ -114,7 +117,7 @@ class Arc:
         return -(d + full * (-self.turn - 1))
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)
 class Pass:
     """A block that makes no motion; written back as it was."""
 

@@ -9,7 +9,6 @@ into pieces short enough that the remaining deviation is below the tolerance.
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 from typing import Iterable, Iterator
 
 import numpy as np
@@ -69,7 +68,7 @@ def _split(line: Line, n: int) -> list[Line]:
     a, b = np.array(line.start), np.array(line.end)
     cuts = [tuple(a + (b - a) * (i / n)) for i in range(n + 1)]
     cuts[0], cuts[-1] = line.start, line.end
-    return [replace(line, start=cuts[i], end=cuts[i + 1]) for i in range(n)]
+    return [Line(cuts[i], cuts[i + 1], line.rapid, line.feed, line.block, line.context, line.extra, line.changed) for i in range(n)]
 
 
 def _flatten(items: list) -> list[Event]:
