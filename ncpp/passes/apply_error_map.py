@@ -16,7 +16,6 @@ start is compensated with its own direction and a step move is inserted.
 
 from __future__ import annotations
 
-import heapq
 from dataclasses import dataclass
 from typing import Iterable, Iterator
 
@@ -211,16 +210,14 @@ def _settle(free, arc, d, held, offsets, scales, limit, out_start, out_end, befo
     if not todo:
         return
     # in order, on flat lists of Python floats: a numpy call per row would cost more than the row
-    settle = set(rows[free[rows] | arc[rows]].tolist())
-    is_line, lim = free.tolist(), limit.tolist()
+    is_line, lim, settles = free.tolist(), limit.tolist(), (ok & (free | arc)).tolist()
     e_, s_, o_, d_ = ends.ravel().tolist(), out_start.ravel().tolist(), out_end.ravel().tolist(), dirs.ravel().tolist()
-    heapq.heapify(todo)
-    done = set()
-    while todo:
-        k = heapq.heappop(todo)
-        if k in done:
+    visit = set(todo)  # rows to look at; a row whose predecessor's end moved is looked at too
+    carry = False
+    for k in range(todo[0], len(is_line)):
+        if not (carry or k in visit) or not settles[k]:
+            carry = False
             continue
-        done.add(k)
         i, limit_k, changed = 3 * k, lim[k], False
         for a in range(i, i + 3):
             p = e_[a]
@@ -235,12 +232,10 @@ def _settle(free, arc, d, held, offsets, scales, limit, out_start, out_end, befo
                     o_[a] += move
                     changed = True
         if changed:
-            out_end[k] = o_[i : i + 3]
-            if not is_line[k]:
-                out_start[k] = s_[i : i + 3]
             e_[i + 3 : i + 6] = o_[i : i + 3]
-            if k + 1 in settle:
-                heapq.heappush(todo, k + 1)
+        carry = changed
+    out_end[:] = np.reshape(o_, out_end.shape)
+    out_start[:] = np.reshape(s_, out_start.shape)
 
 
 def _with_previous(out_end, d, held, offsets, scales, before) -> tuple[NDArray, NDArray, NDArray]:
