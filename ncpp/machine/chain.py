@@ -175,12 +175,14 @@ def exact_deviation(
     delta: dict[str, NDArray],
     eps: dict[str, NDArray],
     squareness: dict[str, NDArray],
+    directions: dict[str, NDArray] | None = None,
 ) -> NDArray:
     """Full homogeneous-transform chain: actual minus nominal tool point, (n,3) mm.
 
     Walks the product from the tool end, carrying w = actual − nominal of the
-    partial product so that microns are never the difference of metres."""
-    dir_err = direction_errors(squareness)
+    partial product so that microns are never the difference of metres.
+    `directions`: `direction_errors(squareness)`, when the caller keeps them."""
+    dir_err = direction_errors(squareness) if directions is None else directions
     nominal = columns(len(P))
     nominal[:] = tool
     w = columns(len(P))

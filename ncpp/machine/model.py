@@ -10,7 +10,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass, field
-from functools import cached_property
+from functools import cached_property, partial
 from typing import TYPE_CHECKING, Any, Mapping
 
 import numpy as np
@@ -19,6 +19,7 @@ from numpy.typing import ArrayLike, NDArray
 from ncpp.machine.chain import (
     Chain,
     abbe_offset,
+    direction_errors,
     exact_deviation,
     linear_deviation,
     squareness_vectors,
@@ -175,9 +176,20 @@ class Machine:
 
     def _kinematics(self, pts: NDArray, dirs: NDArray | None):
         delta, eps = self.error_motions(pts, dirs)
+        chain, tool, refs, sq = self._frame
+        return chain, pts, tool, refs, delta, eps, sq
+
+    @cached_property
+    def _frame(self) -> tuple:
+        """The parts of the kinematics that do not depend on the position."""
         refs = {a: np.asarray(r) for a, r in self.references.items()}
         sq = squareness_vectors(self.squareness["C0Y"], self.squareness["B0Z"], self.squareness["A0Z"])
-        return Chain(self.chain), pts, np.asarray(self.tool), refs, delta, eps, sq
+        return Chain(self.chain), np.asarray(self.tool), refs, sq
+
+    @cached_property
+    def _directions(self) -> dict[str, NDArray]:
+        """The axes' direction errors from squareness (chain.direction_errors), once."""
+        return direction_errors(self._frame[3])
 
     def _blockwise(self, kernel, P: ArrayLike, direction: ArrayLike | None) -> NDArray:
         pts = np.ascontiguousarray(as_points(P).T).T  # columns contiguous, like the algebra
@@ -194,7 +206,7 @@ class Machine:
         P: (n,3) axis positions X, Y, Z in mm (or one (3,) point).
         direction: optional (n,3) travel signs +1/−1/0 for direction-dependent
         tables (None or 0: the mean of the + and − tables)."""
-        return self._blockwise(exact_deviation, P, direction)
+        return self._blockwise(partial(exact_deviation, directions=self._directions), P, direction)
 
     def static_deviation(self, P: ArrayLike, direction: ArrayLike | None = None) -> NDArray:
         """Geometric deviation plus the effects that depend on position alone
