@@ -131,6 +131,27 @@ def _plain(segs: list, offsets: NDArray, scales: NDArray, ctx: PassContext) -> _
     return _Solved(start, end, free, none, none, start, np.ones(start.shape, dtype=bool), np.zeros(len(segs)))
 
 
+class _Commands:
+    """Compensated line starts and ends of a chunk on the output grid, per row for
+    the direction last asked: the rounds ask again for rows whose direction is
+    unchanged, and the reversal check and the reversal steps ask for the same."""
+
+    def __init__(self, segs: list, points: dict[str, NDArray], offsets: NDArray, scales: NDArray, step: NDArray, ctx: PassContext):
+        self.segs, self.points, self.offsets, self.scales, self.step, self.ctx = segs, points, offsets, scales, step, ctx
+        self.values = {which: np.empty_like(p) for which, p in points.items()}
+        self.directions = {which: np.full(p.shape, np.nan) for which, p in points.items()}
+
+    def __call__(self, which: str, rows: NDArray, d: NDArray) -> NDArray:
+        """(r,3) commands for the `which` ("start"/"end") points of `rows` travelled in `d` (r,3)."""
+        stale = (self.directions[which][rows] != d).any(axis=1)
+        todo, d_todo = rows[stale], d[stale]
+        if todo.size:
+            c = compensate(self.points[which][todo], self.offsets[todo], self.scales[todo], [self.segs[i] for i in todo], self.ctx, d_todo)
+            self.values[which][todo] = quantize(c, self.step[todo])
+            self.directions[which][todo] = d_todo
+        return self.values[which][rows]
+
+
 def _directional(segs: list, offsets: NDArray, scales: NDArray, ctx: PassContext, travel: Travel) -> _Solved:
     """Compensated line ends and starts, and shifted arcs, of one chunk, with the
     directions the machine will travel in; advances `travel` past the chunk."""
@@ -148,6 +169,7 @@ def _directional(segs: list, offsets: NDArray, scales: NDArray, ctx: PassContext
 
     out_start, out_end = start_p.copy(), end_p.copy()
     compensated = end_p.copy()  # line ends before _settle leaves axes standing
+    commands = _Commands(segs, {"start": start_p, "end": end_p}, offsets, scales, step, ctx)
     assumed = _arc_assumed(segs, arc)  # the directions replace_arcs compensated the arcs with
     used = np.full(start_p.shape, np.nan)  # the directions each row is compensated with
     used[arc] = assumed[arc]
@@ -156,8 +178,7 @@ def _directional(segs: list, offsets: NDArray, scales: NDArray, ctx: PassContext
     for round_ in range(ROUNDS):
         redo = np.flatnonzero(free & (d != used).any(axis=1))
         if redo.size:
-            c = compensate(end_p[redo], offsets[redo], scales[redo], [segs[i] for i in redo], ctx, d[redo])
-            compensated[redo] = quantize(c, step[redo])
+            compensated[redo] = commands("end", redo, d[redo])
         shift = np.flatnonzero(arc & (d != used).any(axis=1))
         if shift.size:
             _shift_arcs(shift, start_p, end_p, offsets, scales, d, assumed, step, ctx, out_start, out_end)
@@ -170,7 +191,7 @@ def _directional(segs: list, offsets: NDArray, scales: NDArray, ctx: PassContext
         # a piece moves from the previous end to its start first (a connecting step), then along itself
         own = steps(np.where(free[:, None], cur_end - previous, cur_end - cur_start), threshold)
         moved = np.where(arc[:, None] & (own == 0), steps(cur_start - previous, threshold), own)
-        d_new = _own_motion(moved, hold(moved, travel.held), free, start_p, end_p, offsets, scales, segs, step, threshold, ctx, travel)
+        d_new = _own_motion(moved, hold(moved, travel.held), free, start_p, end_p, scales, threshold, commands, travel)
         if np.array_equal(d_new, d) or round_ == ROUNDS - 1:
             break  # unsettled: keep the directions the ends were computed for
         d = d_new
@@ -183,8 +204,7 @@ def _directional(segs: list, offsets: NDArray, scales: NDArray, ctx: PassContext
     turn_start = np.full(start_p.shape, np.nan)
     rows = np.flatnonzero(turn)
     if rows.size:
-        s = compensate(start_p[rows], offsets[rows], scales[rows], [segs[i] for i in rows], ctx, d[rows])
-        turn_start[rows] = quantize(s, step[rows])
+        turn_start[rows] = commands("start", rows, d[rows])
     travel.held = d[-1].copy()
     travel.last = machine(out_end[-1:], slice(len(segs) - 1, None))[0]
     return _Solved(out_start, out_end, free, moved, turn, turn_start, ~flips, limit)
@@ -261,7 +281,7 @@ def _hold_pieces_still(pieces, d, held, limit, out_start, out_end) -> None:
     out_end[rows] = np.where(keep, out_start[rows], out_end[rows])
 
 
-def _own_motion(moved, d, free, start_p, end_p, offsets, scales, segs, step, threshold, ctx, travel) -> NDArray:
+def _own_motion(moved, d, free, start_p, end_p, scales, threshold, commands: _Commands, travel) -> NDArray:
     """Directions (n,3) with the lines that reverse an axis judged by their own motion.
 
     Such a line starts with a step to its start compensated for the new
@@ -275,10 +295,7 @@ def _own_motion(moved, d, free, start_p, end_p, offsets, scales, segs, step, thr
     rows = np.flatnonzero(flips.any(axis=1))
     if rows.size == 0:
         return d
-    ends = np.stack([start_p[rows], end_p[rows]], axis=1)
-    ends = compensate(ends, offsets[rows], scales[rows], [segs[i] for i in rows], ctx, np.repeat(d[rows, None], 2, axis=1))
-    ends = quantize(ends, step[rows])
-    own = steps((ends[:, 1] - ends[:, 0]) * scales[rows, None], threshold[rows])
+    own = steps((commands("end", rows, d[rows]) - commands("start", rows, d[rows])) * scales[rows, None], threshold[rows])
     contrary = flips[rows] & (own != 0) & (own != d[rows])
     if not contrary.any():
         return d
