@@ -8,6 +8,7 @@ into pieces short enough that the remaining deviation is below the tolerance.
 
 from __future__ import annotations
 
+import math
 from typing import Iterable, Iterator
 
 import numpy as np
@@ -29,19 +30,24 @@ def subdivide_lines(events: Iterable[Event], ctx: PassContext) -> Iterator[Event
         yield from _subdivide_chunk(chunk, ctx)
 
 
+def _candidates(chunk: list[Event], ctx: PassContext) -> list[int]:
+    found = []
+    for k, e in enumerate(chunk):
+        if type(e) is Line and not e.rapid and not e.changed:
+            length = math.dist(e.start, e.end) * (25.4 if e.context.inch else 1.0)
+            if length >= ctx.min_line_check:
+                found.append(k)
+    return found
+
+
 def _subdivide_chunk(chunk: list[Event], ctx: PassContext) -> list[Event]:
-    index = [k for k, e in enumerate(chunk) if type(e) is Line and not e.rapid and not e.changed]
+    index = _candidates(chunk, ctx)
     if not index:
         return chunk
     lines = [chunk[k] for k in index]
     starts = np.array([ln.start for ln in lines])
     ends = np.array([ln.end for ln in lines])
     offsets, scales = frames(lines)
-    # shorter lines are never split: their error is linear to far below the tolerance
-    long = np.flatnonzero(np.linalg.norm(ends - starts, axis=1) * scales >= ctx.min_line_check)
-    if not long.size:
-        return chunk
-    starts, ends, offsets, scales = starts[long], ends[long], offsets[long], scales[long]
     t = SAMPLES[None, :, None]
     program = starts[:, None, :] + t * (ends - starts)[:, None, :]
     machine = (program + offsets[:, None, :]) * scales[:, None, None]
@@ -51,12 +57,10 @@ def _subdivide_chunk(chunk: list[Event], ctx: PassContext) -> list[Event]:
     deviation = np.linalg.norm(error - straight, axis=-1).max(axis=1)
     # The deviation of piecewise-linear interpolation shrinks with the square of the piece count.
     pieces = np.ceil(np.sqrt(SAFETY * deviation / ctx.tolerance)).astype(int).clip(1, MAX_PIECES)
-    split = np.flatnonzero(pieces > 1)
-    if not split.size:
-        return chunk
-    out: list = list(chunk)
-    for i, n in zip(long[split].tolist(), pieces[split].tolist()):
-        out[index[i]] = _split(lines[i], n)
+    out = list(chunk)
+    for k, line, n in zip(index, lines, pieces):
+        if n > 1:
+            out[k] = _split(line, int(n))
     return _flatten(out)
 
 
