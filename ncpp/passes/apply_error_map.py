@@ -24,7 +24,7 @@ from numpy.typing import NDArray
 
 from ncpp.motion.segments import PLANE_AXES, Arc, Event, Line
 from ncpp.passes.context import PassContext
-from ncpp.passes.geometry import chunked, compensate, frames
+from ncpp.passes.geometry import chunked, compensate, frames, points
 from ncpp.passes.travel import Travel, grid, hold, quantize, steps
 
 # Compensations per line at most: each changes a direction only where a
@@ -122,7 +122,7 @@ def _written(segs: list, solved: _Solved, offsets: NDArray, scales: NDArray, las
 
 def _plain(segs: list, offsets: NDArray, scales: NDArray, ctx: PassContext) -> _Solved:
     """Compensated ends of the chunk's lines, for a map without reversal errors."""
-    start, end = np.array([e.start for e in segs]), np.array([e.end for e in segs])
+    start, end = points([e.start for e in segs]), points([e.end for e in segs])
     free = np.array([type(e) is Line and not e.changed for e in segs])
     rows = np.flatnonzero(free)
     if rows.size:
@@ -161,7 +161,7 @@ def _directional(segs: list, offsets: NDArray, scales: NDArray, ctx: PassContext
     free = np.array([type(e) is Line and not e.changed for e in segs])
     arc = np.array([e.changed for e in segs])  # pieces replace_arcs made: arcs, and lines for slivers
     pieces = arc & np.array([type(e) is Line for e in segs])  # the lines among them
-    start_p, end_p = np.array([e.start for e in segs]), np.array([e.end for e in segs])
+    start_p, end_p = points([e.start for e in segs]), points([e.end for e in segs])
     start_m, end_m = machine(start_p), machine(end_p)
     first = travel.last if travel.last is not None else start_m[0]
     before = None if travel.last is None else travel.last / scales[0] - offsets[0]  # in the first row's frame

@@ -23,7 +23,7 @@ from numpy.typing import NDArray
 
 from ncpp.motion.segments import PLANE_AXES, Arc, Event, Line
 from ncpp.passes.context import PassContext
-from ncpp.passes.geometry import chunked, compensate, frames
+from ncpp.passes.geometry import chunked, compensate, frames, points
 from ncpp.passes.travel import grid, quantize
 
 # Points per piece where the fit is checked (ends included).  Fewer on short
@@ -72,9 +72,9 @@ class _ArcGeometry:
 
     def __init__(self, arcs: list[Arc]):
         self.axes = np.array([PLANE_AXES[a.context.plane] for a in arcs])  # (n,3): u, v, w indices
-        start = np.array([a.start for a in arcs])
-        end = np.array([a.end for a in arcs])
-        centre = np.array([a.center for a in arcs])
+        start = points([a.start for a in arcs])
+        end = points([a.end for a in arcs])
+        centre = points([a.center for a in arcs])
         local = lambda p: np.take_along_axis(p, self.axes, axis=1)  # noqa: E731
         s, e, c = local(start), local(end), local(centre)
         self.centre = c[:, :2]
