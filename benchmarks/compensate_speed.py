@@ -49,6 +49,47 @@ def ncpp_process_rate(path: Path, offset: tuple[float, float, float] | None) -> 
     return {"lines": stats.lines_in, "lines_out": stats.lines_out, "seconds": seconds, "lines_per_s": stats.lines_in / seconds}
 
 
+STAGES = ("parse", "interpret", "subdivide_lines", "replace_arcs", "apply_error_map", "writer")
+
+
+def stage_seconds(path: Path, offset: tuple[float, float, float], lines: int = 200_000) -> dict[str, float]:
+    """CPU seconds each stage of compensation adds on the program's first `lines`
+    lines, measured by running the pipeline up to that stage (parse; + interpret;
+    + each pass; + writer): where the time goes, for whoever makes it faster."""
+    import gc
+    import io
+    from itertools import islice
+
+    from accuracy import QUIET
+    from ncpp.passes import PASSES
+    from ncpp.pipeline import ErrorSource, dialect_tools, make_context
+    from ncpp.program.dialects import parse_program
+
+    source = ErrorSource.from_machine_file(str(MACHINE)).shifted(offset)
+    with open(path, "rb") as stream:
+        head = b"".join(islice(stream, lines))
+    totals = []
+    for depth in range(len(STAGES)):
+        with io.BytesIO(head) as stream:
+            name, stage = parse_program(stream, str(path), None)
+            interpret, writer = dialect_tools(name)
+            ctx = make_context(source, TOLERANCE, QUIET, str(path))
+            if depth >= 1:
+                stage = interpret(stage, file=str(path), warnings=QUIET)
+            for step in PASSES[: max(depth - 1, 0)]:
+                stage = step(stage, ctx)
+            if depth == len(STAGES) - 1:
+                stage = writer().write(stage)
+            old = gc.get_threshold()
+            gc.set_threshold(50_000, *old[1:])  # as `process` runs
+            start = time.process_time()
+            for _ in stage:
+                pass
+            totals.append(time.process_time() - start)
+            gc.set_threshold(*old)
+    return {name: totals[k] - (totals[k - 1] if k else 0.0) for k, name in enumerate(STAGES)}
+
+
 def compensate_rss(path: Path, offset: tuple[float, float, float]) -> dict[str, Any]:
     """Peak RSS (MB) of `ncpp compensate ... < path > /dev/null`, through run.peak_rss's probe
     (a child's ru_maxrss would inherit this big benchmark process's own)."""
@@ -71,7 +112,8 @@ def compensate_speed(ctx):
         pyg = bench.pygcode_rate(path)
         rs = bench.rs274_rate(path, lines)
         ratio = compensated["lines_per_s"] / pyg["lines_per_s"]
-        data[label] = {"work_offset_mm": offset, "passthrough": passthrough, "compensate": compensated, "pygcode": pyg, "rs274": rs, "ratio_compensate_pygcode": ratio}
+        stages = stage_seconds(path, offset)
+        data[label] = {"work_offset_mm": offset, "passthrough": passthrough, "compensate": compensated, "pygcode": pyg, "rs274": rs, "ratio_compensate_pygcode": ratio, "stage_cpu_seconds": stages}
         growth = compensated["lines_out"] / max(compensated["lines"], 1)
         rows += [
             [label, "ncpp passthrough", f"{passthrough['lines_per_s']:,.0f}", ""],
@@ -79,6 +121,7 @@ def compensate_speed(ctx):
             [label, "pygcode Line()", f"{pyg['lines_per_s']:,.0f}", ""],
             [label, "rs274 (process)", f"{rs['lines_per_s']:,.0f}", "completed" if rs["completed"] else "STOPPED"],
             [label, "ratio compensate / pygcode", f"{ratio:.2f}x", "floor 1.00x: " + ("met" if ratio >= 1 else "SHORT")],
+            [label, "compensate CPU s by stage", f"{sum(stages.values()):.2f} s", f"first {min(lines, 200_000):,} lines: " + ", ".join(f"{k} {v:.2f}" for k, v in stages.items())],
         ]
     sizes = [20_000, 60_000] if ctx.quick else [1_000_000, 10_000_000]  # quick: keep the run short
     memory = {}
