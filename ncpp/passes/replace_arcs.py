@@ -39,6 +39,9 @@ REVERSAL_WINDOW = 0.002
 # mm: nor is one that takes the axis back by less than this (a 10⁻⁵ rad rotation
 # of the compensated frame moves a quadrant's extreme a µm past its end)
 REVERSAL_HEIGHT = 1e-7
+# Events per batch: arcs are replaced independently, so a batch only has to be large
+# enough that programs with few arcs among their lines do not pay numpy's per-call cost per arc.
+ARC_CHUNK = 16384
 SLIVER = 0.01  # mm of arc length below which a piece becomes a line (its bulge is < 0.1 µm for radii over 0.1 mm)
 
 
@@ -52,7 +55,7 @@ class _Pieces:
 
 
 def replace_arcs(events: Iterable[Event], ctx: PassContext) -> Iterator[Event]:
-    for chunk in chunked(events):
+    for chunk in chunked(events, ARC_CHUNK):
         index = [k for k, e in enumerate(chunk) if type(e) is Arc and not e.changed]
         if not index:
             yield from chunk
