@@ -22,10 +22,13 @@ class NumberStyle:
     comma: bool = False  # `10,5`: a decimal comma instead of the point
     # `.4f` when `f"{v:.4f}"` writes the style exactly (the common case), else '': set once, read per number
     spec: str = field(init=False, repr=False, compare=False)
+    # what `spec` writes for a negative number that rounds to zero (`-0.0000`), written without the sign
+    negative_zero: str = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         plain = self.decimals > 0 and self.leading_zero and not (self.int_width or self.plus_sign or self.comma)
         object.__setattr__(self, "spec", f".{self.decimals}f" if plain else "")
+        object.__setattr__(self, "negative_zero", f"-0.{'0' * self.decimals}" if plain else "")
 
     @classmethod
     def of(cls, number: str) -> "NumberStyle":
@@ -66,14 +69,20 @@ _NONZERO_DIGITS = str.maketrans("23456789", "11111111")
 
 @lru_cache(maxsize=4096)
 def _style_of(pattern: str) -> NumberStyle:
-    return NumberStyle._read(pattern)
+    style = NumberStyle._read(pattern)
+    return _INTERNED.setdefault(style, style)
+
+
+# One instance per distinct style read from numbers: equal styles read are the same object,
+# so a writer tells a changed style by identity (`X10.5` then `X12.5`: no change)
+_INTERNED: dict[NumberStyle, NumberStyle] = {}
 
 
 def format_number(value: float, style: NumberStyle) -> str:
     spec = style.spec
     if spec:  # the common style: Python's own fixed-point format is exactly it
         text = format(value, spec)
-        return text[1:] if text[0] == "-" and not text.strip("-0.") else text
+        return text[1:] if text == style.negative_zero else text
     text = f"{abs(value):.{style.decimals}f}"
     if float(text) == 0.0:
         value = 0.0  # no `-0.000`

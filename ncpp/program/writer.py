@@ -68,10 +68,15 @@ def edit_words(
     block's motion G word, replacing G0-G3 or inserting one before the first
     axis word.
     """
+    texts = {letter: format_number(value, style_for[letter]) for letter, value in values.items()}
+    return edit_texts(block, texts, drop, motion)
+
+
+def edit_texts(block: Block, texts: Mapping[str, str], drop: Iterable[str] = (), motion: int | None = None) -> str:
+    """`edit_words` with the numbers already written (`texts`: letter -> number text)."""
     spelled = spelling(block)  # before a G word is inserted between the words
     if motion is not None:
         block = _with_motion(block, motion)
-    texts = {letter: format_number(value, style_for[letter]) for letter, value in values.items()}
     return set_words(block, texts, frozenset(drop), spelled)
 
 
