@@ -49,8 +49,11 @@ class IsoWriter:
         self._resolved: dict = {}
         self._facts_block: Block | None = None  # the last block asked about, and its facts
         self._facts_value: _Facts | None = None
-        self._last: _End | None = None  # the end of the last segment written: where the output is
-        self._current: _End | None = None  # the segment being written, its end as the output writes it
+        # The end of the last segment written (where the output is, once rounded to the decimal
+        # places of X, Y and Z it was written with): rounded only when compared, and most
+        # axes a block does not write are exactly where they were.
+        self._last_end: tuple[float, float, float] | None = None
+        self._last_places: tuple[int, int, int] = (0, 0, 0)
 
     def comment(self, text: str) -> str:
         return f"{self.comment_open}{text}{self.comment_close}"
@@ -75,7 +78,10 @@ class IsoWriter:
         block = group[0].block
         facts = self._read_block(block)
         motion = [e for e in group if type(e) is Line or type(e) is Arc]
-        if not any([e.changed for e in motion]):
+        for segment in motion:
+            if segment.changed:
+                break
+        else:  # nothing changed
             lines = [self._restore_mode_line(block)] if self._needs_mode_restore(block) else []
             lines.append(block.text)
             self._after_verbatim(block, motion)
@@ -84,8 +90,9 @@ class IsoWriter:
             block = _literal_geometry(block)
         eol = block.eol
         lines = [self._edit_block(block, motion[0]) + eol]
-        for segment in motion[1:]:
-            lines.append(self._new_block(block, segment) + eol)
+        if len(motion) > 1:
+            new_block = self._new_block
+            lines += [new_block(block, segment) + eol for segment in motion[1:]]
         return lines
 
     # -- what a block says --------------------------------------------------------
@@ -105,7 +112,6 @@ class IsoWriter:
         if known is not style and known != style:  # styles read from numbers are interned: mostly `is`
             self.styles[letter] = style
             self._resolved.clear()
-            self._current = None
         if letter in AXES:
             self.known_axes.add(letter)
 
@@ -149,18 +155,11 @@ class IsoWriter:
     # -- numbers as written -----------------------------------------------------
     def _moved(self, axis: str, value: float, segment: Line | Arc) -> bool:
         """Whether writing `value` for the axis changes what the output last said."""
-        last = self._last
-        return last is None or round(value, self._style(axis, segment).decimals) != last.rounded(AXES.index(axis))
-
-    def _end(self, segment: Line | Arc) -> "_End":
-        """The segment's end as the output writes it (asked twice per segment: moved axes, then remembered)."""
-        current = self._current
-        if current is None or current.segment is not segment:
-            current = self._current = _End(segment, self._units(segment.context.inch).places)
-        return current
+        last, n = self._last_end, AXES.index(axis)
+        return last is None or round(value, self._style(axis, segment).decimals) != round(last[n], self._last_places[n])
 
     def _remember_end(self, segment: Line | Arc) -> None:
-        self._last = self._end(segment)
+        self._last_end, self._last_places = segment.end, self._units(segment.context.inch).places
 
     def _format(self, letter: str, value: float, segment: Line | Arc) -> str:
         return format_number(value, self._style(letter, segment))
@@ -190,7 +189,7 @@ class IsoWriter:
     def _texts(self, block: Block, segment: Line | Arc) -> dict[str, str]:
         """The words to write for the segment, letter -> number as the output writes it:
         the axes the block had and whatever moved in the output, then an arc's centre."""
-        # runs once per line written: the cached look-ups of `_facts`, `_units` and `_end` are inlined
+        # runs once per line written: the cached look-ups of `_facts` and `_units` are inlined
         facts = self._facts_value if block is self._facts_block else self._facts(block)
         present = facts.letters  # type: ignore[union-attr]
         context, end = segment.context, segment.end
@@ -198,18 +197,13 @@ class IsoWriter:
         styles = units.styles
         texts: dict[str, str] = {}
         if context.absolute:
-            last, known = self._last, self.known_axes
-            here = self._current
-            if here is None or here.segment is not segment:
-                here = self._current = _End(segment, units.places)
+            known, places, last, last_places = self.known_axes, units.places, self._last_end, self._last_places
             for n, axis in enumerate(AXES):
-                if axis in present or (axis in known and (last is None or here.differs(last, n))):
-                    style = styles[axis]
-                    if style.spec:  # `format_number`'s common case, inlined
-                        text = format(end[n], style.spec)
-                        texts[axis] = text[1:] if text == style.negative_zero else text
-                    else:
-                        texts[axis] = format_number(end[n], style)
+                if axis in present or (
+                    axis in known and (last is None or _written_apart(end[n], places[n], last[n], last_places[n]))
+                ):
+                    style = styles[axis]  # `format_number`, its common case inlined:
+                    texts[axis] = format(end[n], style.spec) if style.spec else format_number(end[n], style)
         else:
             decimals = units.places
             start = segment.start
@@ -249,12 +243,13 @@ class IsoWriter:
         texts = self._texts(block, segment)
         sep, lower = self._facts(block).spelling or self._spelling(block)
         code = self._motion_code(segment)
+        words = map(str.__add__, texts, texts.values())  # letter + number, no Python frame per word
         if code == self.output_motion:
-            text = sep.join([letter + text for letter, text in texts.items()])
+            text = sep.join(words)
         else:
-            text = sep.join([f"G{code}", *[letter + text for letter, text in texts.items()]])
+            text = sep.join([f"G{code}", *words])
             self.output_motion = code
-        self._last = self._end(segment)
+        self._remember_end(segment)
         return text.lower() if lower else text
 
 
@@ -300,6 +295,11 @@ class _Facts:
                 self.plain = False
 
 
+def _written_apart(a: float, a_places: int, b: float, b_places: int) -> bool:
+    """Whether `a` and `b` are written as different numbers (rounded only when they are not the same number)."""
+    return (a != b or a_places != b_places) and round(a, a_places) != round(b, b_places)
+
+
 class _Written:
     """How the output writes numbers in one system of units: the style of each letter
     it writes, and the decimal places of X, Y and Z."""
@@ -309,31 +309,6 @@ class _Written:
     def __init__(self, styles: dict[str, NumberStyle]):
         self.styles = styles
         self.places: tuple[int, int, int] = tuple(styles[axis].decimals for axis in AXES)  # type: ignore[assignment]
-
-
-class _End:
-    """A segment's end as the output writes it: each axis rounded to its decimals
-    when first asked (most segments are compared on one axis only)."""
-
-    __slots__ = ("segment", "point", "places", "_rounded")
-
-    def __init__(self, segment: Line | Arc, places: tuple[int, int, int]):
-        self.segment = segment
-        self.point = segment.end
-        self.places = places
-        self._rounded: list[float | None] = [None, None, None]
-
-    def rounded(self, n: int) -> float:
-        value = self._rounded[n]
-        if value is None:
-            value = self._rounded[n] = round(self.point[n], self.places[n])
-        return value
-
-    def differs(self, other: "_End", n: int) -> bool:
-        """Whether the output writes axis `n` differently here than at `other`."""
-        if self.point[n] == other.point[n] and self.places[n] == other.places[n]:
-            return False  # the same number rounded alike: no need to round
-        return self.rounded(n) != other.rounded(n)
 
 
 class _Units:
