@@ -19,14 +19,18 @@ from ncpp.program.numbers import NumberStyle, format_number
 from ncpp.program.writer import _with_motion, set_words, spelling
 
 AXES = "XYZ"
+_NUMBERED_AXES = tuple(enumerate(AXES))  # ((0, "X"), ...): no enumerate object per line written
 CENTRE_WORDS = {17: (("I", 0), ("J", 1)), 18: (("I", 0), ("K", 2)), 19: (("J", 1), ("K", 2))}  # (letter, axis), as written
 MOTION_CODES = {0.0: 0, 1.0: 1, 2.0: 2, 3.0: 3}
 DEFAULT_STYLE = NumberStyle(decimals=4)
 GEOMETRY_LETTERS = "XYZIJKR"  # words a pass rewrites in a changed block
 WRITTEN_LETTERS = "XYZIJK"  # the letters the writer writes numbers for
 MOVING_LETTERS = "XYZABCUVWIJKR"  # words that make a block move (with the modal motion)
-UNSTYLED = ("G", "M", "N", "O")  # letters whose numbers say nothing about coordinate style
+# Letters whose number styles the writer uses: it writes XYZIJK (and CR, with X's style,
+# for Sinumerik); the styles of other words (F, S, R, ...) are never asked for, so not learnt.
+STYLED_LETTERS = frozenset(WRITTEN_LETTERS)
 DROPPED = ("I", "J", "K", "R", "P", ",R", ",C")  # words of the old geometry a changed block loses
+_DROPPED = frozenset(DROPPED)
 
 
 class IsoWriter:
@@ -45,7 +49,7 @@ class IsoWriter:
         self.known_axes: set[str] = set()
         self._shapes: dict[str, tuple] = {}  # per letter: the shape of the number its style was read from
         # Derived from `styles`, emptied when a style changes: (letter, inch) -> style to write,
-        # ("XYZ", inch) -> axis decimals, inch -> {letter: style} for WRITTEN_LETTERS.
+        # inch -> `_Written` (the styles of WRITTEN_LETTERS and the decimal places of X, Y, Z).
         self._resolved: dict = {}
         self._facts_block: Block | None = None  # the last block asked about, and its facts
         self._facts_value: _Facts | None = None
@@ -198,7 +202,7 @@ class IsoWriter:
         texts: dict[str, str] = {}
         if context.absolute:
             known, places, last, last_places = self.known_axes, units.places, self._last_end, self._last_places
-            for n, axis in enumerate(AXES):
+            for n, axis in _NUMBERED_AXES:
                 if axis in present or (
                     axis in known and (last is None or _written_apart(end[n], places[n], last[n], last_places[n]))
                 ):
@@ -207,7 +211,7 @@ class IsoWriter:
         else:
             decimals = units.places
             start = segment.start
-            for n, axis in enumerate(AXES):
+            for n, axis in _NUMBERED_AXES:
                 delta = end[n] - start[n]
                 if axis in present or round(delta, decimals[n]) != 0.0:
                     texts[axis] = format_number(delta, styles[axis])
@@ -223,7 +227,7 @@ class IsoWriter:
         code = self._motion_code(segment)
         # centre words of the old arc, and Fanuc corner words: the corner is now explicit;
         # P is an arc's turn count, but a dwell time (G4) or blending tolerance (G64) elsewhere
-        drop = [] if facts.letters.isdisjoint(DROPPED) else [l for l in DROPPED if l in facts.letters and l not in texts]
+        drop = [] if facts.letters.isdisjoint(_DROPPED) else [l for l in DROPPED if l in facts.letters and l not in texts]
         if "P" in drop and not self._arc_block(block):
             drop.remove("P")
         edited = block
@@ -269,6 +273,7 @@ class _Facts:
         self.plain = True  # only words and comments
         self.spelling: tuple[str, bool] | None = None  # (word separator, lower case) once asked for
         shapes = learner._shapes if learner is not None else None
+        moves = False
         for item in block.items:
             kind = type(item)
             if kind is Word:
@@ -282,17 +287,17 @@ class _Facts:
                             self.first_motion = code
                     elif 73 <= item.value <= 89:
                         self.motion_word, self.motion = True, None
-                    continue
-                if letter in MOVING_LETTERS:
-                    self.moves = True
-                if shapes is not None and letter not in UNSTYLED:
-                    number = item.number
-                    shape = (len(number), number.find("."), number[:1])  # cheap: styles rarely change
-                    if shapes.get(letter) != shape:
-                        shapes[letter] = shape
-                        learner._learn_style(letter, NumberStyle.of(number))  # type: ignore[union-attr]
+                elif letter in MOVING_LETTERS:
+                    moves = True
+                    if shapes is not None and letter in STYLED_LETTERS:  # (styled letters all move)
+                        number = item.number
+                        shape = (len(number), number.find("."), number[:1])  # cheap: styles rarely change
+                        if shapes.get(letter) != shape:
+                            shapes[letter] = shape
+                            learner._learn_style(letter, NumberStyle.of(number))  # type: ignore[union-attr]
             elif kind is not Comment:
                 self.plain = False
+        self.moves = moves
 
 
 def _written_apart(a: float, a_places: int, b: float, b_places: int) -> bool:
