@@ -20,12 +20,13 @@ class NumberStyle:
     int_width: int = 0  # zero-padded integer digits (`X010.5` -> 3)
     plus_sign: bool = False
     comma: bool = False  # `10,5`: a decimal comma instead of the point
-    # `.4f` when `f"{v:.4f}"` writes the style exactly (the common case), else '': set once, read per number
+    # `z.4f` when `format(v, "z.4f")` writes the style exactly (the common case), else '': set once, read
+    # per number.  `z` (Python 3.11) writes a negative number that rounds to zero without its sign.
     spec: str = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         plain = self.decimals > 0 and self.leading_zero and not (self.int_width or self.plus_sign or self.comma)
-        object.__setattr__(self, "spec", f".{self.decimals}f" if plain else "")
+        object.__setattr__(self, "spec", f"z.{self.decimals}f" if plain else "")
 
     @classmethod
     def of(cls, number: str) -> "NumberStyle":
@@ -66,14 +67,23 @@ _NONZERO_DIGITS = str.maketrans("23456789", "11111111")
 
 @lru_cache(maxsize=4096)
 def _style_of(pattern: str) -> NumberStyle:
-    return NumberStyle._read(pattern)
+    style = NumberStyle._read(pattern)
+    return _INTERNED.setdefault(style, style)
+
+
+# One instance per distinct style read from numbers: equal styles read are the same object,
+# so a writer tells a changed style by identity (`X10.5` then `X12.5`: no change)
+_INTERNED: dict[NumberStyle, NumberStyle] = {}
 
 
 def format_number(value: float, style: NumberStyle) -> str:
-    spec = style.spec
-    if spec:  # the common style: Python's own fixed-point format is exactly it
-        text = format(value, spec)
-        return text[1:] if text[0] == "-" and not text.strip("-0.") else text
+    if style.spec:  # the common style: Python's own fixed-point format is exactly it
+        return format(value, style.spec)
+    return _format_any(value, style)
+
+
+def _format_any(value: float, style: NumberStyle) -> str:
+    """`format_number` for every style."""
     text = f"{abs(value):.{style.decimals}f}"
     if float(text) == 0.0:
         value = 0.0  # no `-0.000`

@@ -68,10 +68,15 @@ def edit_words(
     block's motion G word, replacing G0-G3 or inserting one before the first
     axis word.
     """
+    texts = {letter: format_number(value, style_for[letter]) for letter, value in values.items()}
+    return edit_texts(block, texts, drop, motion)
+
+
+def edit_texts(block: Block, texts: Mapping[str, str], drop: Iterable[str] = (), motion: int | None = None) -> str:
+    """`edit_words` with the numbers already written (`texts`: letter -> number text)."""
     spelled = spelling(block)  # before a G word is inserted between the words
     if motion is not None:
         block = _with_motion(block, motion)
-    texts = {letter: format_number(value, style_for[letter]) for letter, value in values.items()}
     return set_words(block, texts, frozenset(drop), spelled)
 
 
@@ -92,22 +97,28 @@ def set_words(
     seen_axis = False
     for item in block.items:
         kind = type(item)
-        if kind is Comment:
-            continue
-        if kind is Word and item.letter in pending:
-            pieces += (raw[cursor : item.start + 1], pending.pop(item.letter))  # gap, letter as written, number
-        elif kind is Word and item.letter in drop:  # remove the word and the separator before it
-            pieces.append(raw[cursor : item.start].rstrip(" \t"))
-        else:
+        if kind is Word:
+            letter = item.letter
+            text = pending.pop(letter, None)
+            if text is not None:  # gap, letter as written, number
+                pieces += (raw[cursor : item.start + 1], text)
+            elif letter in drop:  # remove the word and the separator before it
+                pieces.append(raw[cursor : item.start].rstrip(" \t"))
+            else:
+                pieces.append(raw[cursor : item.end])
+                cursor = item.end
+                if letter in AXIS_LETTERS:
+                    at, seen_axis = len(pieces), True
+                elif not seen_axis:
+                    at = len(pieces)
+                continue
+            cursor = item.end
+            at, seen_axis = len(pieces), True
+        elif kind is not Comment:  # comments stay in the gap before the next item
             pieces.append(raw[cursor : item.end])
             cursor = item.end
-            is_axis = kind is Word and item.letter in AXIS_LETTERS
-            if is_axis or not seen_axis:
+            if not seen_axis:
                 at = len(pieces)
-                seen_axis = seen_axis or is_axis
-            continue
-        cursor = item.end
-        at, seen_axis = len(pieces), True
     if pending:
         sep, lower = spelled or spelling(block)
         extra = "".join(sep + (letter.lower() if lower else letter) + text for letter, text in pending.items())

@@ -19,14 +19,18 @@ from ncpp.program.numbers import NumberStyle, format_number
 from ncpp.program.writer import _with_motion, set_words, spelling
 
 AXES = "XYZ"
+_NUMBERED_AXES = tuple(enumerate(AXES))  # ((0, "X"), ...): no enumerate object per line written
 CENTRE_WORDS = {17: (("I", 0), ("J", 1)), 18: (("I", 0), ("K", 2)), 19: (("J", 1), ("K", 2))}  # (letter, axis), as written
 MOTION_CODES = {0.0: 0, 1.0: 1, 2.0: 2, 3.0: 3}
 DEFAULT_STYLE = NumberStyle(decimals=4)
 GEOMETRY_LETTERS = "XYZIJKR"  # words a pass rewrites in a changed block
 WRITTEN_LETTERS = "XYZIJK"  # the letters the writer writes numbers for
 MOVING_LETTERS = "XYZABCUVWIJKR"  # words that make a block move (with the modal motion)
-UNSTYLED = ("G", "M", "N", "O")  # letters whose numbers say nothing about coordinate style
+# Letters whose number styles the writer uses: it writes XYZIJK (and CR, with X's style,
+# for Sinumerik); the styles of other words (F, S, R, ...) are never asked for, so not learnt.
+STYLED_LETTERS = frozenset(WRITTEN_LETTERS)
 DROPPED = ("I", "J", "K", "R", "P", ",R", ",C")  # words of the old geometry a changed block loses
+_DROPPED = frozenset(DROPPED)
 
 
 class IsoWriter:
@@ -40,18 +44,20 @@ class IsoWriter:
         self.styles: dict[str, NumberStyle] = {}
         self.program_motion: int | None = None  # motion mode as the input program has it
         self.output_motion: int | None = None  # motion mode as the output has it
-        self.last_written: dict[str, float] = {}  # last absolute coordinate per axis in the output, as rounded there
         # Axes the program has positioned; before that the control's position is not
         # the interpreter's assumed zero, so a word must not be added for them.
         self.known_axes: set[str] = set()
         self._shapes: dict[str, tuple] = {}  # per letter: the shape of the number its style was read from
         # Derived from `styles`, emptied when a style changes: (letter, inch) -> style to write,
-        # ("XYZ", inch) -> axis decimals, inch -> {letter: style} for WRITTEN_LETTERS.
+        # inch -> `_Written` (the styles of WRITTEN_LETTERS and the decimal places of X, Y, Z).
         self._resolved: dict = {}
         self._facts_block: Block | None = None  # the last block asked about, and its facts
         self._facts_value: _Facts | None = None
-        self._rounded_segment: Line | Arc | None = None  # the last segment asked about, and its end as written
-        self._rounded: tuple[float, float, float] = (0.0, 0.0, 0.0)
+        # The end of the last segment written (where the output is, once rounded to the decimal
+        # places of X, Y and Z it was written with): rounded only when compared, and most
+        # axes a block does not write are exactly where they were.
+        self._last_end: tuple[float, float, float] | None = None
+        self._last_places: tuple[int, int, int] = (0, 0, 0)
 
     def comment(self, text: str) -> str:
         return f"{self.comment_open}{text}{self.comment_close}"
@@ -59,30 +65,38 @@ class IsoWriter:
     # -- the stream -----------------------------------------------------------
     def write(self, events: Iterable[Event]) -> Iterator[str]:
         group: list[Event] = []
+        block = None
+        write_group = self._write_group
         for event in events:
-            if group and event.block is not group[0].block:
-                yield from self._write_group(group)
-                group = []
-            group.append(event)
+            if event.block is block:
+                group.append(event)
+                continue
+            if group:
+                yield from write_group(group)
+            block, group = event.block, [event]
         if group:
-            yield from self._write_group(group)
+            yield from write_group(group)
 
     def _write_group(self, group: list[Event]) -> Iterable[str]:
         """The lines of one block's events (a list: cheaper than a generator per block)."""
         block = group[0].block
-        self._learn_styles(block)
+        facts = self._read_block(block)
         motion = [e for e in group if type(e) is Line or type(e) is Arc]
-        if not any([e.changed for e in motion]):
+        for segment in motion:
+            if segment.changed:
+                break
+        else:  # nothing changed
             lines = [self._restore_mode_line(block)] if self._needs_mode_restore(block) else []
             lines.append(block.text)
             self._after_verbatim(block, motion)
             return lines
-        if not self._facts(block).plain:
+        if not facts.plain:
             block = _literal_geometry(block)
         eol = block.eol
         lines = [self._edit_block(block, motion[0]) + eol]
-        for segment in motion[1:]:
-            lines.append(self._new_block(block, segment) + eol)
+        if len(motion) > 1:
+            new_block = self._new_block
+            lines += [new_block(block, segment) + eol for segment in motion[1:]]
         return lines
 
     # -- what a block says --------------------------------------------------------
@@ -92,21 +106,16 @@ class IsoWriter:
             self._facts_block, self._facts_value = block, _Facts(block)
         return self._facts_value  # type: ignore[return-value]
 
-    def _learn_styles(self, block: Block) -> None:
-        shapes = self._shapes
-        for item in block.items:
-            if type(item) is Word and item.letter not in UNSTYLED:
-                number = item.number
-                shape = (len(number), number.find("."), number[:1])  # cheap: styles rarely change
-                if shapes.get(item.letter) != shape:
-                    shapes[item.letter] = shape
-                    self._learn_style(item.letter, NumberStyle.of(number))
+    def _read_block(self, block: Block) -> "_Facts":
+        """The facts of a block about to be written, its number styles learnt in the same walk."""
+        self._facts_block, self._facts_value = block, _Facts(block, self)
+        return self._facts_value
 
     def _learn_style(self, letter: str, style: NumberStyle) -> None:
-        if self.styles.get(letter) != style:
+        known = self.styles.get(letter)
+        if known is not style and known != style:  # styles read from numbers are interned: mostly `is`
             self.styles[letter] = style
             self._resolved.clear()
-            self._rounded_segment = None
         if letter in AXES:
             self.known_axes.add(letter)
 
@@ -150,26 +159,11 @@ class IsoWriter:
     # -- numbers as written -----------------------------------------------------
     def _moved(self, axis: str, value: float, segment: Line | Arc) -> bool:
         """Whether writing `value` for the axis changes what the output last said."""
-        return round(value, self._style(axis, segment).decimals) != self.last_written.get(axis)
-
-    def _rounded_end(self, segment: Line | Arc) -> tuple[float, float, float]:
-        """The segment's end as the output writes it (asked twice per segment: moved axes, then remembered)."""
-        if segment is not self._rounded_segment:
-            end = segment.end
-            dx, dy, dz = self._axis_decimals(segment.context.inch)
-            self._rounded_segment, self._rounded = segment, (round(end[0], dx), round(end[1], dy), round(end[2], dz))
-        return self._rounded
+        last, n = self._last_end, AXES.index(axis)
+        return last is None or round(value, self._style(axis, segment).decimals) != round(last[n], self._last_places[n])
 
     def _remember_end(self, segment: Line | Arc) -> None:
-        last = self.last_written
-        last["X"], last["Y"], last["Z"] = self._rounded_end(segment)
-
-    def _axis_decimals(self, inch: bool) -> tuple[int, int, int]:
-        key = ("XYZ", inch)
-        found = self._resolved.get(key)
-        if found is None:
-            found = self._resolved[key] = tuple(self._style(a, _INCH if inch else _MM).decimals for a in AXES)
-        return found
+        self._last_end, self._last_places = segment.end, self._units(segment.context.inch).places
 
     def _format(self, letter: str, value: float, segment: Line | Arc) -> str:
         return format_number(value, self._style(letter, segment))
@@ -182,12 +176,12 @@ class IsoWriter:
             style = self._resolved[key] = style.at_least(self.inch_decimals if key[1] else self.mm_decimals)
         return style
 
-    def _written_styles(self, inch: bool) -> dict[str, NumberStyle]:
-        """`_style` of every letter the writer writes, resolved once per change of styles."""
+    def _units(self, inch: bool) -> "_Written":
+        """How the output writes numbers in these units, resolved once per change of styles."""
         found = self._resolved.get(inch)
         if found is None:
             units = _INCH if inch else _MM
-            found = self._resolved[inch] = {letter: self._style(letter, units) for letter in WRITTEN_LETTERS}
+            found = self._resolved[inch] = _Written({letter: self._style(letter, units) for letter in WRITTEN_LETTERS})
         return found
 
     # -- changed blocks ---------------------------------------------------------
@@ -196,38 +190,36 @@ class IsoWriter:
             return 3 if segment.turn > 0 else 2
         return 0 if segment.rapid else 1
 
-    def _words(self, block: Block, segment: Line | Arc) -> dict[str, float]:
-        """Words to write for the segment: the axes the block had and whatever moved in
-        the output, then an arc's centre."""
-        present = self._facts(block).letters
-        values: dict[str, float] = {}
+    def _texts(self, block: Block, segment: Line | Arc) -> dict[str, str]:
+        """The words to write for the segment, letter -> number as the output writes it:
+        the axes the block had and whatever moved in the output, then an arc's centre."""
+        # runs once per line written: the cached look-ups of `_facts` and `_units` are inlined
+        facts = self._facts_value if block is self._facts_block else self._facts(block)
+        present = facts.letters  # type: ignore[union-attr]
         context, end = segment.context, segment.end
+        units = self._resolved.get(context.inch) or self._units(context.inch)
+        styles = units.styles
+        texts: dict[str, str] = {}
         if context.absolute:
-            last, known = self.last_written, self.known_axes
-            rounded = self._rounded_end(segment)
-            for n, axis in enumerate(AXES):
-                if axis in present or (axis in known and rounded[n] != last.get(axis)):
-                    values[axis] = end[n]
+            known, places, last, last_places = self.known_axes, units.places, self._last_end, self._last_places
+            for n, axis in _NUMBERED_AXES:
+                if axis in present or (
+                    axis in known and (last is None or _written_apart(end[n], places[n], last[n], last_places[n]))
+                ):
+                    style = styles[axis]  # `format_number`, its common case inlined:
+                    texts[axis] = format(end[n], style.spec) if style.spec else format_number(end[n], style)
         else:
-            decimals = self._axis_decimals(context.inch)
+            decimals = units.places
             start = segment.start
-            for n, axis in enumerate(AXES):
+            for n, axis in _NUMBERED_AXES:
                 delta = end[n] - start[n]
                 if axis in present or round(delta, decimals[n]) != 0.0:
-                    values[axis] = delta
+                    texts[axis] = format_number(delta, styles[axis])
         if type(segment) is Arc:
             centre, origin = segment.center, (0.0, 0.0, 0.0) if context.arc_absolute else segment.start
             for letter, axis in CENTRE_WORDS[context.plane]:
-                values[letter] = centre[axis] - origin[axis]
-        return values
-
-    def _texts(self, block: Block, segment: Line | Arc) -> dict[str, str]:
-        """`_words` as the output writes their numbers."""
-        styles = self._written_styles(segment.context.inch)
-        words = self._words(block, segment)
-        for letter, value in words.items():
-            words[letter] = format_number(value, styles[letter])  # type: ignore[assignment]  # in place: one dict less
-        return words  # type: ignore[return-value]
+                texts[letter] = format_number(centre[axis] - origin[axis], styles[letter])
+        return texts
 
     def _edit_block(self, block: Block, segment: Line | Arc) -> str:
         facts = self._facts(block)
@@ -235,14 +227,15 @@ class IsoWriter:
         code = self._motion_code(segment)
         # centre words of the old arc, and Fanuc corner words: the corner is now explicit;
         # P is an arc's turn count, but a dwell time (G4) or blending tolerance (G64) elsewhere
-        drop = [] if facts.letters.isdisjoint(DROPPED) else [l for l in DROPPED if l in facts.letters and l not in texts]
+        drop = [] if facts.letters.isdisjoint(_DROPPED) else [l for l in DROPPED if l in facts.letters and l not in texts]
         if "P" in drop and not self._arc_block(block):
             drop.remove("P")
         edited = block
-        if code != self.output_motion or facts.motion_word:
-            edited = _with_motion(block, code)  # the same block when its G word already says `code`
-        # the common case (the block's own words, its spelling known) skips re-reading the spelling
-        raw = set_words(edited, texts, drop, self._spelling(block))  # spelled as the block was read
+        if facts.first_motion != code and (code != self.output_motion or facts.motion_word):
+            edited = _with_motion(block, code)
+        # words the block lacks are appended spelled as the block was read (before a G word is inserted)
+        spelled = None if facts.letters.issuperset(texts) else self._spelling(block)
+        raw = set_words(edited, texts, drop, spelled)
         if facts.motion_word or code != self.output_motion:
             self.output_motion = code
         if facts.motion_word:
@@ -251,43 +244,76 @@ class IsoWriter:
         return raw
 
     def _new_block(self, block: Block, segment: Line | Arc) -> str:
-        sep, lower = self._spelling(block)
+        texts = self._texts(block, segment)
+        sep, lower = self._facts(block).spelling or self._spelling(block)
         code = self._motion_code(segment)
-        words = [letter + text for letter, text in self._texts(block, segment).items()]
-        if code != self.output_motion:
-            words.insert(0, f"G{code}")
+        words = map(str.__add__, texts, texts.values())  # letter + number, no Python frame per word
+        if code == self.output_motion:
+            text = sep.join(words)
+        else:
+            text = sep.join([f"G{code}", *words])
             self.output_motion = code
         self._remember_end(segment)
-        text = sep.join(words)
         return text.lower() if lower else text
 
 
 class _Facts:
     """What the writer asks about a block, read in one pass over its items."""
 
-    __slots__ = ("letters", "motion_word", "motion", "moves", "plain", "spelling")
+    __slots__ = ("letters", "motion_word", "motion", "first_motion", "moves", "plain", "spelling")
 
-    def __init__(self, block: Block):
-        self.letters: set[str] = set()  # letters of its plain words
+    def __init__(self, block: Block, learner: IsoWriter | None = None):
+        """`learner`: a writer that learns the number styles of the block's words on the way."""
+        letters: set[str] = set()
+        self.letters = letters  # letters of its plain words
         self.motion_word = False  # it has a motion G word (G0-G3, a canned cycle)
         self.motion: int | None = None  # the motion mode it sets (None: a canned cycle or none)
+        self.first_motion: int | None = None  # the code of its first G0-G3 word (the one `_with_motion` sets)
         self.moves = False  # it has words that move with the modal motion
         self.plain = True  # only words and comments
         self.spelling: tuple[str, bool] | None = None  # (word separator, lower case) once asked for
+        shapes = learner._shapes if learner is not None else None
+        moves = False
         for item in block.items:
             kind = type(item)
             if kind is Word:
                 letter = item.letter
-                self.letters.add(letter)
+                letters.add(letter)
                 if letter == "G":
-                    if item.value in MOTION_CODES:
-                        self.motion_word, self.motion = True, MOTION_CODES[item.value]
+                    code = MOTION_CODES.get(item.value)
+                    if code is not None:
+                        self.motion_word, self.motion = True, code
+                        if self.first_motion is None:
+                            self.first_motion = code
                     elif 73 <= item.value <= 89:
                         self.motion_word, self.motion = True, None
                 elif letter in MOVING_LETTERS:
-                    self.moves = True
+                    moves = True
+                    if shapes is not None and letter in STYLED_LETTERS:  # (styled letters all move)
+                        number = item.number
+                        shape = (len(number), number.find("."), number[:1])  # cheap: styles rarely change
+                        if shapes.get(letter) != shape:
+                            shapes[letter] = shape
+                            learner._learn_style(letter, NumberStyle.of(number))  # type: ignore[union-attr]
             elif kind is not Comment:
                 self.plain = False
+        self.moves = moves
+
+
+def _written_apart(a: float, a_places: int, b: float, b_places: int) -> bool:
+    """Whether `a` and `b` are written as different numbers (rounded only when they are not the same number)."""
+    return (a != b or a_places != b_places) and round(a, a_places) != round(b, b_places)
+
+
+class _Written:
+    """How the output writes numbers in one system of units: the style of each letter
+    it writes, and the decimal places of X, Y and Z."""
+
+    __slots__ = ("styles", "places")
+
+    def __init__(self, styles: dict[str, NumberStyle]):
+        self.styles = styles
+        self.places: tuple[int, int, int] = tuple(styles[axis].decimals for axis in AXES)  # type: ignore[assignment]
 
 
 class _Units:

@@ -212,7 +212,7 @@ from ncpp.motion.segments import Arc, Line  # noqa: E402  (the writer half of th
 from ncpp.program.blocks import Block  # noqa: E402
 from ncpp.program.dialects.editing import splice  # noqa: E402
 from ncpp.program.dialects.iso import IsoWriter  # noqa: E402
-from ncpp.program.writer import edit_words, word_separator  # noqa: E402
+from ncpp.program.writer import edit_texts, word_separator  # noqa: E402
 
 _ARC_ONLY = ("CR", "TURN", "I1", "J1", "K1")
 _MOTION_PATHS = ("CIP", "CT")
@@ -245,23 +245,21 @@ class SinumerikWriter(IsoWriter):
     def _uses_cr(block: Block) -> bool:
         return any(type(i) is ExprWord and i.letter == "CR" for i in block.items)
 
-    def _words(self, block: Block, segment: Line | Arc) -> dict[str, float]:
-        values = super()._words(block, segment)
+    def _texts(self, block: Block, segment: Line | Arc) -> dict[str, str]:
+        texts = super()._texts(block, segment)
         if type(segment) is Arc and self._uses_cr(block) and abs(segment.sweep()) < 2 * 3.141592653589793 - 1e-9:
             for letter in "IJK":
-                values.pop(letter, None)
-            values["CR"] = segment.radius() if abs(segment.sweep()) <= 3.141592653589793 else -segment.radius()
-        return values
-
-    def _text(self, letter: str, value: float, segment: Line | Arc) -> str:
-        return f"{letter}={self._format(letter, value, segment)}" if len(letter) > 1 else letter + self._format(letter, value, segment)
+                texts.pop(letter, None)
+            radius = segment.radius() if abs(segment.sweep()) <= 3.141592653589793 else -segment.radius()
+            texts["CR"] = self._format("CR", radius, segment)
+        return texts
 
     def _edit_block(self, block: Block, segment: Line | Arc) -> str:
-        values = self._words(block, segment)
+        words = self._texts(block, segment)
         texts: dict[int, str | None] = {}
         for n, item in enumerate(block.items):
-            if type(item) is ExprWord and item.letter in values:
-                texts[n] = f"{item.letter}={self._format(item.letter, values.pop(item.letter), segment)}"
+            if type(item) is ExprWord and item.letter in words:
+                texts[n] = f"{item.letter}={words.pop(item.letter)}"
             elif type(item) is ExprWord and item.letter in _ARC_ONLY + tuple("IJK"):
                 texts[n] = None
             elif type(item) is Statement and item.kind == "path" and item.node[0] in _MOTION_PATHS:
@@ -271,9 +269,8 @@ class SinumerikWriter(IsoWriter):
         code = self._motion_code(segment)
         if texts:
             block = _reparse(Block(splice(block, texts), block.eol, (), block.line))
-        styles = {letter: self._style(letter, segment) for letter in values}
-        drop = [letter for letter in "IJK" if letter not in values]
-        raw = edit_words(block, values, styles, drop=drop, motion=code if code != self.output_motion or had_motion else None)
+        drop = [letter for letter in "IJK" if letter not in words]
+        raw = edit_texts(block, words, drop=drop, motion=code if code != self.output_motion or had_motion else None)
         if had_motion or code != self.output_motion:
             self.output_motion = code
         if had_motion:
@@ -282,13 +279,13 @@ class SinumerikWriter(IsoWriter):
         return raw
 
     def _new_block(self, block: Block, segment: Line | Arc) -> str:
-        values = self._words(block, segment)
+        words = self._texts(block, segment)
         code = self._motion_code(segment)
         parts = []
         if code != self.output_motion:
             parts.append(f"G{code}")
             self.output_motion = code
-        parts += [self._text(letter, value, segment) for letter, value in values.items()]
+        parts += [f"{letter}={text}" if len(letter) > 1 else letter + text for letter, text in words.items()]
         self._remember_end(segment)
         sep = word_separator(block)
         return (sep if sep and not sep.strip() else " ").join(parts)
