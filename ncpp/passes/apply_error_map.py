@@ -229,9 +229,10 @@ def _settle(free, arc, d, held, offsets, scales, limit, out_start, out_end, befo
     todo = rows[lines | pieces].tolist()
     if not todo:
         return
-    # in order, on flat lists of Python floats: a numpy call per row would cost more than the row
+    # in order, on flat lists of Python floats: a numpy call per row would cost more than the row;
+    # `ends` has the predecessor of row 0 in front: row k's x is at 3k + 3, its predecessor's at 3k
     is_line, lim, settles = free.tolist(), limit.tolist(), (ok & (free | arc)).tolist()
-    e_, s_, o_, d_ = ends.ravel().tolist(), out_start.ravel().tolist(), out_end.ravel().tolist(), dirs.ravel().tolist()
+    e_, s_, d_ = ends.ravel().tolist(), out_start.ravel().tolist(), dirs.ravel().tolist()
     visit = set(todo)  # rows to look at; a row whose predecessor's end moved is looked at too
     carry = False
     for k in range(todo[0], len(is_line)):
@@ -239,22 +240,22 @@ def _settle(free, arc, d, held, offsets, scales, limit, out_start, out_end, befo
             carry = False
             continue
         i, limit_k, changed = 3 * k, lim[k], False
-        for a in range(i, i + 3):
-            p = e_[a]
-            if is_line[k]:  # e_[a] ends row k-1, d_[a] its direction; d_[a + 3] is row k's
-                gap = o_[a] - p
-                if gap * d_[a] < 0 and d_[a + 3] == d_[a] and abs(gap) <= limit_k:
-                    o_[a], changed = p, True
-            else:
-                move = p - s_[a]
-                if move != 0 and abs(move) <= limit_k:
-                    s_[a] += move
-                    o_[a] += move
+        if is_line[k]:
+            for a in (i, i + 1, i + 2):  # d_[a] is the predecessor's direction, d_[a + 3] row k's
+                p, held = e_[a], d_[a]
+                gap = e_[a + 3] - p
+                if gap * held < 0 and d_[a + 3] == held and -limit_k <= gap <= limit_k:
+                    e_[a + 3] = p
                     changed = True
-        if changed:
-            e_[i + 3 : i + 6] = o_[i : i + 3]
+        else:
+            for a in (i, i + 1, i + 2):
+                move = e_[a] - s_[a]
+                if move != 0 and -limit_k <= move <= limit_k:
+                    s_[a] += move
+                    e_[a + 3] += move
+                    changed = True
         carry = changed
-    out_end[:] = np.reshape(o_, out_end.shape)
+    out_end[:] = np.reshape(e_[3:], out_end.shape)
     out_start[:] = np.reshape(s_, out_start.shape)
 
 
