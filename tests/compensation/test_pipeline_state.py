@@ -1,0 +1,20 @@
+"""`pipeline.process` leaves the interpreter's global state as it found it."""
+
+import gc
+import io
+from pathlib import Path
+
+from ncpp.pipeline import ErrorSource, process
+
+MACHINE = Path(__file__).resolve().parents[2] / "samples/machines/hr5b.toml"
+
+PROGRAM = b"G21 G90 G17\nG0 X0 Y0 Z5\nG1 Z-1 F300\nG1 X40 Y10\nG2 X60 Y30 I0 J20\nM2\n"
+
+
+def test_the_garbage_collector_threshold_is_restored():
+    before = gc.get_threshold()
+    source = ErrorSource.from_machine_file(str(MACHINE)).shifted((400.0, 350.0, 300.0))
+    out = io.BytesIO()
+    process(io.BytesIO(PROGRAM), out, file="t.ngc", source=source)
+    assert gc.get_threshold() == before
+    assert out.getvalue().count(b"\n") >= PROGRAM.count(b"\n")
