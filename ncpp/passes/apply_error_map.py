@@ -98,25 +98,26 @@ def _written(segs: list, solved: _Solved, offsets: NDArray, scales: NDArray, las
     turning &= _apart(previous, target)
     # replace_arcs' pieces start where they start: a step from the previous end first
     connect = ~solved.free & has_previous & np.array([e.changed for e in segs]) & _apart(previous, solved.start)
-    previous_l, target_l, start_l, end_l = previous.tolist(), target.tolist(), solved.start.tolist(), solved.end.tolist()
+    previous_t, target_t, end_t = (list(map(tuple, a.tolist())) for a in (previous, target, solved.end))
+    start_l = solved.start.tolist()
     out = []
     for i, (seg, free, moved, has_prev, turns, connects) in enumerate(
         zip(segs, solved.free.tolist(), solved.moved.tolist(), has_previous.tolist(), turning.tolist(), connect.tolist())
     ):
-        here: list[Event] = []
         if free:
-            start = tuple(previous_l[i]) if has_prev else seg.start
-            if turns:
-                here.append(Line(start, tuple(target_l[i]), seg.rapid, seg.feed, seg.block, seg.context, seg.extra, True))
-                start = tuple(target_l[i])
-            here.append(Line(start, tuple(end_l[i]), seg.rapid, seg.feed, seg.block, seg.context, seg.extra, True))
+            start = previous_t[i] if has_prev else seg.start
+            if turns:  # the reversal step, then the line from where it ends
+                step = Line(start, target_t[i], seg.rapid, seg.feed, seg.block, seg.context, seg.extra, True)
+                out.append([step, Line(target_t[i], end_t[i], seg.rapid, seg.feed, seg.block, seg.context, seg.extra, True)])
+            else:
+                out.append([Line(start, end_t[i], seg.rapid, seg.feed, seg.block, seg.context, seg.extra, True)])
         else:
             if moved:
-                seg = _moved_arc(seg, start_l[i], end_l[i])
+                seg = _moved_arc(seg, start_l[i], end_t[i])
             if connects:
-                here.append(Line(tuple(previous_l[i]), seg.start, False, seg.feed, seg.block, seg.context, seg.extra, True))
-            here.append(seg)
-        out.append(here)
+                out.append([Line(previous_t[i], seg.start, False, seg.feed, seg.block, seg.context, seg.extra, True), seg])
+            else:
+                out.append([seg])
     return out
 
 
