@@ -89,11 +89,11 @@ def _written(segs: list, solved: _Solved, offsets: NDArray, scales: NDArray, las
         p = _end_in_frame_of(before if i == 0 else _ended(segs[i - 1], solved.end[i - 1]), segs[i])
         has_previous[i] = p is not None
         previous[i] = p if p is not None else np.nan
+    rapid = np.array([type(e) is Line and e.rapid for e in segs])
+    turning = solved.turn & has_previous & ~rapid
     # A reversal step's target, with the axes that keep their direction left where they
     # are when they differ only by output rounding: a one-digit move there would reverse
     # that axis on the machine.
-    rapid = np.array([type(e) is Line and e.rapid for e in segs])
-    turning = solved.turn & has_previous & ~rapid
     target = np.where(solved.keep & (np.abs(solved.turn_start - previous) <= solved.limit[:, None]), previous, solved.turn_start)
     turning &= _apart(previous, target)
     # replace_arcs' pieces start where they start: a step from the previous end first
