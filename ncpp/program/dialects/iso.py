@@ -53,6 +53,8 @@ class IsoWriter:
         self._resolved: dict = {}
         self._facts_block: Block | None = None  # the last block asked about, and its facts
         self._facts_value: _Facts | None = None
+        self._letters_facts: dict[str, _Facts] = {}  # the facts of plain blocks without G words, by their letters
+        self._spelled: tuple[Block | None, tuple[str, bool]] = (None, (" ", False))  # a block and its `spelling`
         # The end of the last segment written (where the output is, once rounded to the decimal
         # places of X, Y and Z it was written with): rounded only when compared, and most
         # axes a block does not write are exactly where they were.
@@ -107,9 +109,27 @@ class IsoWriter:
         return self._facts_value  # type: ignore[return-value]
 
     def _read_block(self, block: Block) -> "_Facts":
-        """The facts of a block about to be written, its number styles learnt in the same walk."""
-        self._facts_block, self._facts_value = block, _Facts(block, self)
-        return self._facts_value
+        """The facts of a block about to be written; its number styles are learnt."""
+        letters = block.letters
+        if letters is None or "G" in letters:  # G words: their numbers matter, walk the items
+            facts = _Facts(block)
+        else:  # the parser's letters say it all (most blocks: `X3.182 Z-0.1569`)
+            facts = self._letters_facts.get(letters) or self._letters_facts.setdefault(letters, _Facts.of_letters(letters))
+        self._facts_block, self._facts_value = block, facts
+        if facts.styled:
+            self._learn_word_styles(block)
+        return facts
+
+    def _learn_word_styles(self, block: Block) -> None:
+        """Learn the number styles of the block's words (only when the shape of a number changes)."""
+        shapes = self._shapes
+        for item in block.items:
+            if type(item) is Word and item.letter in STYLED_LETTERS:
+                number = item.number
+                shape = (len(number), number.find("."), number[:1])  # cheap: styles rarely change
+                if shapes.get(item.letter) != shape:
+                    shapes[item.letter] = shape
+                    self._learn_style(item.letter, NumberStyle.of(number))
 
     def _learn_style(self, letter: str, style: NumberStyle) -> None:
         known = self.styles.get(letter)
@@ -131,10 +151,11 @@ class IsoWriter:
 
     def _spelling(self, block: Block) -> tuple[str, bool]:
         """How the block spells its words: (separator, lower case)."""
-        facts = self._facts(block)
-        if facts.spelling is None:
-            facts.spelling = spelling(block)
-        return facts.spelling
+        spelled_block, spelled = self._spelled
+        if spelled_block is not block:
+            spelled = spelling(block)
+            self._spelled = (block, spelled)
+        return spelled
 
     # -- verbatim blocks ------------------------------------------------------
     def _needs_mode_restore(self, block: Block) -> bool:
@@ -245,7 +266,7 @@ class IsoWriter:
 
     def _new_block(self, block: Block, segment: Line | Arc) -> str:
         texts = self._texts(block, segment)
-        sep, lower = self._facts(block).spelling or self._spelling(block)
+        sep, lower = self._spelling(block)
         code = self._motion_code(segment)
         words = map(str.__add__, texts, texts.values())  # letter + number, no Python frame per word
         if code == self.output_motion:
@@ -258,46 +279,47 @@ class IsoWriter:
 
 
 class _Facts:
-    """What the writer asks about a block, read in one pass over its items."""
+    """What the writer asks about a block."""
 
-    __slots__ = ("letters", "motion_word", "motion", "first_motion", "moves", "plain", "spelling")
+    __slots__ = ("letters", "motion_word", "motion", "first_motion", "moves", "plain", "styled")
 
-    def __init__(self, block: Block, learner: IsoWriter | None = None):
-        """`learner`: a writer that learns the number styles of the block's words on the way."""
-        letters: set[str] = set()
-        self.letters = letters  # letters of its plain words
+    def __init__(self, block: Block | None = None):
+        """The facts of `block`, read in one walk over its items (none: a block without words)."""
+        self.letters: set[str] = set()  # letters of its plain words
         self.motion_word = False  # it has a motion G word (G0-G3, a canned cycle)
         self.motion: int | None = None  # the motion mode it sets (None: a canned cycle or none)
         self.first_motion: int | None = None  # the code of its first G0-G3 word (the one `_with_motion` sets)
         self.moves = False  # it has words that move with the modal motion
         self.plain = True  # only words and comments
-        self.spelling: tuple[str, bool] | None = None  # (word separator, lower case) once asked for
-        shapes = learner._shapes if learner is not None else None
-        moves = False
-        for item in block.items:
+        self.styled = False  # it has words whose number styles the writer learns
+        for item in block.items if block is not None else ():
             kind = type(item)
             if kind is Word:
-                letter = item.letter
-                letters.add(letter)
-                if letter == "G":
-                    code = MOTION_CODES.get(item.value)
-                    if code is not None:
-                        self.motion_word, self.motion = True, code
-                        if self.first_motion is None:
-                            self.first_motion = code
-                    elif 73 <= item.value <= 89:
-                        self.motion_word, self.motion = True, None
-                elif letter in MOVING_LETTERS:
-                    moves = True
-                    if shapes is not None and letter in STYLED_LETTERS:  # (styled letters all move)
-                        number = item.number
-                        shape = (len(number), number.find("."), number[:1])  # cheap: styles rarely change
-                        if shapes.get(letter) != shape:
-                            shapes[letter] = shape
-                            learner._learn_style(letter, NumberStyle.of(number))  # type: ignore[union-attr]
+                self._read_word(item.letter, item.value)
             elif kind is not Comment:
                 self.plain = False
-        self.moves = moves
+
+    @classmethod
+    def of_letters(cls, letters: str) -> "_Facts":
+        """The facts of a plain block whose words have these letters, none of them G."""
+        facts = cls()
+        for letter in letters:
+            facts._read_word(letter, 0.0)
+        return facts
+
+    def _read_word(self, letter: str, value: float) -> None:
+        self.letters.add(letter)
+        if letter == "G":
+            code = MOTION_CODES.get(value)
+            if code is not None:
+                self.motion_word, self.motion = True, code
+                if self.first_motion is None:
+                    self.first_motion = code
+            elif 73 <= value <= 89:
+                self.motion_word, self.motion = True, None
+        elif letter in MOVING_LETTERS:
+            self.moves = True
+            self.styled = self.styled or letter in STYLED_LETTERS
 
 
 def _written_apart(a: float, a_places: int, b: float, b_places: int) -> bool:
