@@ -107,10 +107,10 @@ class Block:
     """One line: `raw` (without line ending), `eol` ('\\n', '\\r\\n' or '') and items.
 
     `verbatim` blocks (after the closing tape mark) are kept as text only.
-    `letters`, when known, are the letters of its words in order, one character each,
-    for a block of only such words and comments (what the parser's fast path reads):
-    the writer reads its facts from them instead of walking the items.  Whoever
-    changes the items of a block builds a new Block without them.
+    `signature`, when known, is the letters of its words in order, each G word with
+    its number as written (`G1XYF`), for a block of only one-letter words and
+    comments (what the parser's fast path reads): the writer reads its facts from it
+    instead of walking the items.  Whoever changes the items builds a Block without it.
     """
 
     raw: str
@@ -118,7 +118,7 @@ class Block:
     items: tuple[AnyItem, ...]
     line: int = 0
     verbatim: bool = False
-    letters: str | None = field(default=None, compare=False, repr=False)
+    signature: str | None = field(default=None, compare=False, repr=False)
 
     @property
     def text(self) -> str:

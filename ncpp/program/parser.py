@@ -212,17 +212,17 @@ class LineParser:
         plain = self._scan_plain(raw)
         if plain is None:
             return Block(raw, eol, self._parse_lalr(raw, line, file), line)
-        items, letters = plain
-        return Block(raw, eol, items, line, False, letters)
+        items, signature = plain
+        return Block(raw, eol, items, line, False, signature)
 
     def _scan_plain(self, raw: str) -> tuple[tuple[AnyItem, ...], str | None] | None:
-        """(items, letters of its words) of a line made only of plain words and
-        comments, else None; letters are None when a word has two (`,R`)."""
+        """(items, `Block.signature`) of a line made only of plain words and
+        comments, else None; the signature is None when a word has two letters (`,R`)."""
         if self._fast is None:
             return None
         items: list[AnyItem] = []
         append = items.append
-        letters = ""  # built here, where the words are: the writer needs them
+        signature = ""  # built here, where the words are: the writer reads its facts from it
         two_letters = False
         pos = 0
         match = self._fast.match
@@ -236,15 +236,15 @@ class LineParser:
             start = end - len(text)
             if kind == "WORD":
                 letter = _UPPER[text[0]]
-                letters += letter
                 if " " in text or "\t" in text:
-                    append(_word(text, start, end))
+                    word = _word(text, start, end)
                 else:  # `_word` inlined for the common compact word: one per word of the program
                     number = text[1:]
                     word = _new_word(Word)
                     word.letter, word.value, word.number = letter, float(number), number
                     word.start, word.end = start, end
-                    append(word)
+                append(word)
+                signature += letter if letter != "G" else "G" + word.number
             elif kind == "COMMA_WORD":
                 append(_word(text, start, end))
                 two_letters = True
@@ -254,7 +254,7 @@ class LineParser:
                 append(Comment(text[1:], ";", start, end))
             pos = end
         if pos == len(raw) or self._blank.match(raw, pos):
-            return tuple(items), (None if two_letters else letters)
+            return tuple(items), (None if two_letters else signature)
         return None
 
     def _parse_lalr(self, raw: str, line: int, file: str) -> tuple[AnyItem, ...]:

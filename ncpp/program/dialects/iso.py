@@ -10,6 +10,7 @@ with at least the resolution needed for compensation.
 
 from __future__ import annotations
 
+import re
 from dataclasses import replace
 from typing import Iterable, Iterator
 
@@ -31,6 +32,7 @@ MOVING_LETTERS = "XYZABCUVWIJKR"  # words that make a block move (with the modal
 STYLED_LETTERS = frozenset(WRITTEN_LETTERS)
 DROPPED = ("I", "J", "K", "R", "P", ",R", ",C")  # words of the old geometry a changed block loses
 _DROPPED = frozenset(DROPPED)
+_SIGNATURE_WORD = re.compile(r"(.)([-+.\d]*)")  # a letter, and a G word's number
 
 
 class IsoWriter:
@@ -53,7 +55,7 @@ class IsoWriter:
         self._resolved: dict = {}
         self._facts_block: Block | None = None  # the last block asked about, and its facts
         self._facts_value: _Facts | None = None
-        self._letters_facts: dict[str, _Facts] = {}  # the facts of plain blocks without G words, by their letters
+        self._signature_facts: dict[str, _Facts] = {}  # the facts of plain blocks, by their `signature`
         self._spelled: tuple[Block | None, tuple[str, bool]] = (None, (" ", False))  # a block and its `spelling`
         # The end of the last segment written (where the output is, once rounded to the decimal
         # places of X, Y and Z it was written with): rounded only when compared, and most
@@ -110,26 +112,30 @@ class IsoWriter:
 
     def _read_block(self, block: Block) -> "_Facts":
         """The facts of a block about to be written; its number styles are learnt."""
-        letters = block.letters
-        if letters is None or "G" in letters:  # G words: their numbers matter, walk the items
+        signature = block.signature
+        if signature is None:
             facts = _Facts(block)
-        else:  # the parser's letters say it all (most blocks: `X3.182 Z-0.1569`)
-            facts = self._letters_facts.get(letters) or self._letters_facts.setdefault(letters, _Facts.of_letters(letters))
+        else:  # a handful of signatures make most blocks (`XZ`, `G1XY`): read each once
+            facts = self._signature_facts.get(signature)
+            if facts is None:
+                facts = self._signature_facts[signature] = _Facts.of_signature(signature)
         self._facts_block, self._facts_value = block, facts
         if facts.styled:
-            self._learn_word_styles(block)
+            self._learn_word_styles(block, facts)
         return facts
 
-    def _learn_word_styles(self, block: Block) -> None:
-        """Learn the number styles of the block's words (only when the shape of a number changes)."""
+    def _learn_word_styles(self, block: Block, facts: "_Facts") -> None:
+        """Learn the number styles of the block's styled words (when the shape of a number changes)."""
+        words = block.items
+        if len(words) != facts.words:  # comments (or statements) among the words
+            words = tuple(item for item in words if type(item) is Word)
         shapes = self._shapes
-        for item in block.items:
-            if type(item) is Word and item.letter in STYLED_LETTERS:
-                number = item.number
-                shape = (len(number), number.find("."), number[:1])  # cheap: styles rarely change
-                if shapes.get(item.letter) != shape:
-                    shapes[item.letter] = shape
-                    self._learn_style(item.letter, NumberStyle.of(number))
+        for n, letter in facts.styled:
+            number = words[n].number  # type: ignore[union-attr]
+            shape = (len(number), number.find("."), number[:1])  # cheap: styles rarely change
+            if shapes.get(letter) != shape:
+                shapes[letter] = shape
+                self._learn_style(letter, NumberStyle.of(number))
 
     def _learn_style(self, letter: str, style: NumberStyle) -> None:
         known = self.styles.get(letter)
@@ -281,7 +287,7 @@ class IsoWriter:
 class _Facts:
     """What the writer asks about a block."""
 
-    __slots__ = ("letters", "motion_word", "motion", "first_motion", "moves", "plain", "styled")
+    __slots__ = ("letters", "motion_word", "motion", "first_motion", "moves", "plain", "words", "styled")
 
     def __init__(self, block: Block | None = None):
         """The facts of `block`, read in one walk over its items (none: a block without words)."""
@@ -291,7 +297,8 @@ class _Facts:
         self.first_motion: int | None = None  # the code of its first G0-G3 word (the one `_with_motion` sets)
         self.moves = False  # it has words that move with the modal motion
         self.plain = True  # only words and comments
-        self.styled = False  # it has words whose number styles the writer learns
+        self.words = 0  # how many plain words it has
+        self.styled: tuple[tuple[int, str], ...] = ()  # (n, letter) of its n-th word when the writer learns its style
         for item in block.items if block is not None else ():
             kind = type(item)
             if kind is Word:
@@ -300,15 +307,18 @@ class _Facts:
                 self.plain = False
 
     @classmethod
-    def of_letters(cls, letters: str) -> "_Facts":
-        """The facts of a plain block whose words have these letters, none of them G."""
+    def of_signature(cls, signature: str) -> "_Facts":
+        """The facts of a plain block with this `Block.signature`."""
         facts = cls()
-        for letter in letters:
-            facts._read_word(letter, 0.0)
+        for letter, number in _SIGNATURE_WORD.findall(signature):
+            facts._read_word(letter, float(number) if number else 0.0)
         return facts
 
     def _read_word(self, letter: str, value: float) -> None:
         self.letters.add(letter)
+        if letter in STYLED_LETTERS:
+            self.styled += ((self.words, letter),)
+        self.words += 1
         if letter == "G":
             code = MOTION_CODES.get(value)
             if code is not None:
@@ -319,7 +329,6 @@ class _Facts:
                 self.motion_word, self.motion = True, None
         elif letter in MOVING_LETTERS:
             self.moves = True
-            self.styled = self.styled or letter in STYLED_LETTERS
 
 
 def _written_apart(a: float, a_places: int, b: float, b_places: int) -> bool:
@@ -354,4 +363,4 @@ def _literal_geometry(block: Block) -> Block:
     if not any(type(i) is ExprWord and i.letter in GEOMETRY_LETTERS for i in block.items):
         return block
     items = [Word(i.letter, 0.0, "0", i.start, i.end) if type(i) is ExprWord and i.letter in GEOMETRY_LETTERS else i for i in block.items]
-    return replace(block, items=items)
+    return replace(block, items=items, signature=None)  # the signature is that of the old items
