@@ -190,7 +190,8 @@ class IsoWriter:
         return last is None or round(value, self._style(axis, segment).decimals) != round(last[n], self._last_places[n])
 
     def _remember_end(self, segment: Line | Arc) -> None:
-        self._last_end, self._last_places = segment.end, self._units(segment.context.inch).places
+        inch = segment.context.inch  # once per line written: `_units`' cached look-up inlined
+        self._last_end, self._last_places = segment.end, (self._resolved.get(inch) or self._units(inch)).places
 
     def _format(self, letter: str, value: float, segment: Line | Arc) -> str:
         return format_number(value, self._style(letter, segment))
