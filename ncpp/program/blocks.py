@@ -12,7 +12,7 @@ control bytes) survives the round trip.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Union
 
 # Expression nodes are nested tuples, cheap to build and easy to evaluate:
@@ -107,6 +107,10 @@ class Block:
     """One line: `raw` (without line ending), `eol` ('\\n', '\\r\\n' or '') and items.
 
     `verbatim` blocks (after the closing tape mark) are kept as text only.
+    `signature`, when known, is the letters of its words in order, each G word with
+    its number as written (`G1XYF`), for a block of only one-letter words and
+    comments (what the parser's fast path reads): the writer reads its facts from it
+    instead of walking the items.  Whoever changes the items builds a Block without it.
     """
 
     raw: str
@@ -114,6 +118,7 @@ class Block:
     items: tuple[AnyItem, ...]
     line: int = 0
     verbatim: bool = False
+    signature: str | None = field(default=None, compare=False, repr=False)
 
     @property
     def text(self) -> str:

@@ -209,17 +209,21 @@ class LineParser:
         self._blank = re.compile(f"{_GAP}$")
 
     def parse(self, raw: str, eol: str = "", line: int = 0, file: str = "<stdin>") -> Block:
-        items = self._scan_plain(raw)
-        if items is None:
-            items = self._parse_lalr(raw, line, file)
-        return Block(raw, eol, items, line)
+        plain = self._scan_plain(raw)
+        if plain is None:
+            return Block(raw, eol, self._parse_lalr(raw, line, file), line)
+        items, signature = plain
+        return Block(raw, eol, items, line, False, signature)
 
-    def _scan_plain(self, raw: str) -> tuple[AnyItem, ...] | None:
-        """Items of a line made only of plain words and comments, else None."""
+    def _scan_plain(self, raw: str) -> tuple[tuple[AnyItem, ...], str | None] | None:
+        """(items, `Block.signature`) of a line made only of plain words and
+        comments, else None; the signature is None when a word has two letters (`,R`)."""
         if self._fast is None:
             return None
         items: list[AnyItem] = []
         append = items.append
+        signature = ""  # built here, where the words are: the writer reads its facts from it
+        two_letters = False
         pos = 0
         match = self._fast.match
         while True:
@@ -231,23 +235,26 @@ class LineParser:
             end = m.end()
             start = end - len(text)
             if kind == "WORD":
+                letter = _UPPER[text[0]]
                 if " " in text or "\t" in text:
-                    append(_word(text, start, end))
+                    word = _word(text, start, end)
                 else:  # `_word` inlined for the common compact word: one per word of the program
                     number = text[1:]
                     word = _new_word(Word)
-                    word.letter, word.value, word.number = _UPPER[text[0]], float(number), number
+                    word.letter, word.value, word.number = letter, float(number), number
                     word.start, word.end = start, end
-                    append(word)
+                append(word)
+                signature += letter if letter != "G" else "G" + word.number
             elif kind == "COMMA_WORD":
                 append(_word(text, start, end))
+                two_letters = True
             elif kind == "PAREN_COMMENT":
                 append(Comment(text[1:-1], "(", start, end))
             else:
                 append(Comment(text[1:], ";", start, end))
             pos = end
         if pos == len(raw) or self._blank.match(raw, pos):
-            return tuple(items)
+            return tuple(items), (None if two_letters else signature)
         return None
 
     def _parse_lalr(self, raw: str, line: int, file: str) -> tuple[AnyItem, ...]:

@@ -10,6 +10,7 @@ with at least the resolution needed for compensation.
 
 from __future__ import annotations
 
+import re
 from dataclasses import replace
 from typing import Iterable, Iterator
 
@@ -31,6 +32,7 @@ MOVING_LETTERS = "XYZABCUVWIJKR"  # words that make a block move (with the modal
 STYLED_LETTERS = frozenset(WRITTEN_LETTERS)
 DROPPED = ("I", "J", "K", "R", "P", ",R", ",C")  # words of the old geometry a changed block loses
 _DROPPED = frozenset(DROPPED)
+_SIGNATURE_WORD = re.compile(r"(.)([-+.\d]*)")  # a letter, and a G word's number
 
 
 class IsoWriter:
@@ -53,6 +55,8 @@ class IsoWriter:
         self._resolved: dict = {}
         self._facts_block: Block | None = None  # the last block asked about, and its facts
         self._facts_value: _Facts | None = None
+        self._signature_facts: dict[str, _Facts] = {}  # the facts of plain blocks, by their `signature`
+        self._spelled: tuple[Block | None, tuple[str, bool]] = (None, (" ", False))  # a block and its `spelling`
         # The end of the last segment written (where the output is, once rounded to the decimal
         # places of X, Y and Z it was written with): rounded only when compared, and most
         # axes a block does not write are exactly where they were.
@@ -107,9 +111,31 @@ class IsoWriter:
         return self._facts_value  # type: ignore[return-value]
 
     def _read_block(self, block: Block) -> "_Facts":
-        """The facts of a block about to be written, its number styles learnt in the same walk."""
-        self._facts_block, self._facts_value = block, _Facts(block, self)
-        return self._facts_value
+        """The facts of a block about to be written; its number styles are learnt."""
+        signature = block.signature
+        if signature is None:
+            facts = _Facts(block)
+        else:  # a handful of signatures make most blocks (`XZ`, `G1XY`): read each once
+            facts = self._signature_facts.get(signature)
+            if facts is None:
+                facts = self._signature_facts[signature] = _Facts.of_signature(signature)
+        self._facts_block, self._facts_value = block, facts
+        if facts.styled:
+            self._learn_word_styles(block, facts)
+        return facts
+
+    def _learn_word_styles(self, block: Block, facts: "_Facts") -> None:
+        """Learn the number styles of the block's styled words (when the shape of a number changes)."""
+        words = block.items
+        if len(words) != facts.words:  # comments (or statements) among the words
+            words = tuple(item for item in words if type(item) is Word)
+        shapes = self._shapes
+        for n, letter in facts.styled:
+            number = words[n].number  # type: ignore[union-attr]
+            shape = (len(number), number.find("."), number[:1])  # cheap: styles rarely change
+            if shapes.get(letter) != shape:
+                shapes[letter] = shape
+                self._learn_style(letter, NumberStyle.of(number))
 
     def _learn_style(self, letter: str, style: NumberStyle) -> None:
         known = self.styles.get(letter)
@@ -131,10 +157,11 @@ class IsoWriter:
 
     def _spelling(self, block: Block) -> tuple[str, bool]:
         """How the block spells its words: (separator, lower case)."""
-        facts = self._facts(block)
-        if facts.spelling is None:
-            facts.spelling = spelling(block)
-        return facts.spelling
+        spelled_block, spelled = self._spelled
+        if spelled_block is not block:
+            spelled = spelling(block)
+            self._spelled = (block, spelled)
+        return spelled
 
     # -- verbatim blocks ------------------------------------------------------
     def _needs_mode_restore(self, block: Block) -> bool:
@@ -163,7 +190,8 @@ class IsoWriter:
         return last is None or round(value, self._style(axis, segment).decimals) != round(last[n], self._last_places[n])
 
     def _remember_end(self, segment: Line | Arc) -> None:
-        self._last_end, self._last_places = segment.end, self._units(segment.context.inch).places
+        inch = segment.context.inch  # once per line written: `_units`' cached look-up inlined
+        self._last_end, self._last_places = segment.end, (self._resolved.get(inch) or self._units(inch)).places
 
     def _format(self, letter: str, value: float, segment: Line | Arc) -> str:
         return format_number(value, self._style(letter, segment))
@@ -245,7 +273,7 @@ class IsoWriter:
 
     def _new_block(self, block: Block, segment: Line | Arc) -> str:
         texts = self._texts(block, segment)
-        sep, lower = self._facts(block).spelling or self._spelling(block)
+        sep, lower = self._spelling(block)
         code = self._motion_code(segment)
         words = map(str.__add__, texts, texts.values())  # letter + number, no Python frame per word
         if code == self.output_motion:
@@ -258,46 +286,50 @@ class IsoWriter:
 
 
 class _Facts:
-    """What the writer asks about a block, read in one pass over its items."""
+    """What the writer asks about a block."""
 
-    __slots__ = ("letters", "motion_word", "motion", "first_motion", "moves", "plain", "spelling")
+    __slots__ = ("letters", "motion_word", "motion", "first_motion", "moves", "plain", "words", "styled")
 
-    def __init__(self, block: Block, learner: IsoWriter | None = None):
-        """`learner`: a writer that learns the number styles of the block's words on the way."""
-        letters: set[str] = set()
-        self.letters = letters  # letters of its plain words
+    def __init__(self, block: Block | None = None):
+        """The facts of `block`, read in one walk over its items (none: a block without words)."""
+        self.letters: set[str] = set()  # letters of its plain words
         self.motion_word = False  # it has a motion G word (G0-G3, a canned cycle)
         self.motion: int | None = None  # the motion mode it sets (None: a canned cycle or none)
         self.first_motion: int | None = None  # the code of its first G0-G3 word (the one `_with_motion` sets)
         self.moves = False  # it has words that move with the modal motion
         self.plain = True  # only words and comments
-        self.spelling: tuple[str, bool] | None = None  # (word separator, lower case) once asked for
-        shapes = learner._shapes if learner is not None else None
-        moves = False
-        for item in block.items:
+        self.words = 0  # how many plain words it has
+        self.styled: tuple[tuple[int, str], ...] = ()  # (n, letter) of its n-th word when the writer learns its style
+        for item in block.items if block is not None else ():
             kind = type(item)
             if kind is Word:
-                letter = item.letter
-                letters.add(letter)
-                if letter == "G":
-                    code = MOTION_CODES.get(item.value)
-                    if code is not None:
-                        self.motion_word, self.motion = True, code
-                        if self.first_motion is None:
-                            self.first_motion = code
-                    elif 73 <= item.value <= 89:
-                        self.motion_word, self.motion = True, None
-                elif letter in MOVING_LETTERS:
-                    moves = True
-                    if shapes is not None and letter in STYLED_LETTERS:  # (styled letters all move)
-                        number = item.number
-                        shape = (len(number), number.find("."), number[:1])  # cheap: styles rarely change
-                        if shapes.get(letter) != shape:
-                            shapes[letter] = shape
-                            learner._learn_style(letter, NumberStyle.of(number))  # type: ignore[union-attr]
+                self._read_word(item.letter, item.value)
             elif kind is not Comment:
                 self.plain = False
-        self.moves = moves
+
+    @classmethod
+    def of_signature(cls, signature: str) -> "_Facts":
+        """The facts of a plain block with this `Block.signature`."""
+        facts = cls()
+        for letter, number in _SIGNATURE_WORD.findall(signature):
+            facts._read_word(letter, float(number) if number else 0.0)
+        return facts
+
+    def _read_word(self, letter: str, value: float) -> None:
+        self.letters.add(letter)
+        if letter in STYLED_LETTERS:
+            self.styled += ((self.words, letter),)
+        self.words += 1
+        if letter == "G":
+            code = MOTION_CODES.get(value)
+            if code is not None:
+                self.motion_word, self.motion = True, code
+                if self.first_motion is None:
+                    self.first_motion = code
+            elif 73 <= value <= 89:
+                self.motion_word, self.motion = True, None
+        elif letter in MOVING_LETTERS:
+            self.moves = True
 
 
 def _written_apart(a: float, a_places: int, b: float, b_places: int) -> bool:
@@ -332,4 +364,4 @@ def _literal_geometry(block: Block) -> Block:
     if not any(type(i) is ExprWord and i.letter in GEOMETRY_LETTERS for i in block.items):
         return block
     items = [Word(i.letter, 0.0, "0", i.start, i.end) if type(i) is ExprWord and i.letter in GEOMETRY_LETTERS else i for i in block.items]
-    return replace(block, items=items)
+    return replace(block, items=items, signature=None)  # the signature is that of the old items
