@@ -137,17 +137,17 @@ class _Commands:
     the direction last asked: the rounds ask again for rows whose direction is
     unchanged, and the reversal check and the reversal steps ask for the same."""
 
-    def __init__(self, segs: list, points: dict[str, NDArray], offsets: NDArray, scales: NDArray, step: NDArray, ctx: PassContext):
-        self.segs, self.points, self.offsets, self.scales, self.step, self.ctx = segs, points, offsets, scales, step, ctx
-        self.values = {which: np.empty_like(p) for which, p in points.items()}
-        self.directions = {which: np.full(p.shape, np.nan) for which, p in points.items()}
+    def __init__(self, segs: list, wanted: dict[str, NDArray], offsets: NDArray, scales: NDArray, step: NDArray, ctx: PassContext):
+        self.segs, self.wanted, self.offsets, self.scales, self.step, self.ctx = segs, wanted, offsets, scales, step, ctx
+        self.values = {which: np.empty_like(p) for which, p in wanted.items()}
+        self.directions = {which: np.full(p.shape, np.nan) for which, p in wanted.items()}
 
     def __call__(self, which: str, rows: NDArray, d: NDArray) -> NDArray:
         """(r,3) commands for the `which` ("start"/"end") points of `rows` travelled in `d` (r,3)."""
         stale = (self.directions[which][rows] != d).any(axis=1)
         todo, d_todo = rows[stale], d[stale]
         if todo.size:
-            c = compensate(self.points[which][todo], self.offsets[todo], self.scales[todo], [self.segs[i] for i in todo], self.ctx, d_todo)
+            c = compensate(self.wanted[which][todo], self.offsets[todo], self.scales[todo], [self.segs[i] for i in todo], self.ctx, d_todo)
             self.values[which][todo] = quantize(c, self.step[todo])
             self.directions[which][todo] = d_todo
         return self.values[which][rows]
