@@ -129,11 +129,6 @@ def set_words(
     return "".join(pieces)
 
 
-def _lower_case(block: Block) -> bool:
-    """The block writes its letters in lower case."""
-    return spelling(block)[1]
-
-
 def _with_motion(block: Block, code: int) -> Block:
     """The block with its G0-G3 word set to `code` (items re-spanned)."""
     raw = block.raw
