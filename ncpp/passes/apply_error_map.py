@@ -50,15 +50,8 @@ def apply_error_map(events: Iterable[Event], ctx: PassContext) -> Iterator[Event
             solved = _directional(segs, offsets, scales, ctx, travel)
         else:
             solved = _plain(segs, offsets, scales, ctx)
-        written = _written(segs, solved, offsets, scales, last)
-        last = written[-1][-1]
-        replacing = iter(written)
-        out: list[Event] = []
-        for event in chunk:
-            if type(event) is Line or type(event) is Arc:
-                out += next(replacing)
-            else:
-                out.append(event)
+        out = _written(chunk, segs, solved, offsets, scales, last)
+        last = next(e for e in reversed(out) if type(e) is Line or type(e) is Arc)
         yield from out
 
 
@@ -76,19 +69,25 @@ class _Solved:
     limit: NDArray  # (n,) program units an axis may be left off its compensated position
 
 
-def _written(segs: list, solved: _Solved, offsets: NDArray, scales: NDArray, last) -> list[list[Event]]:
-    """Per segment, the events that replace it: a connecting or reversal step where
-    needed, then the segment with its compensated ends, starting where the previous
-    one ended."""
+# What `_written` does with a segment (bits of its row's code)
+_FREE, _MOVED, _TURNS, _CONNECTS = 1, 2, 4, 8
+
+
+def _written(chunk: list[Event], segs: list, solved: _Solved, offsets: NDArray, scales: NDArray, last) -> list[Event]:
+    """The chunk's events with each segment replaced: a connecting or reversal
+    step where needed, then the segment with its compensated ends, starting where
+    the previous one ended."""
     previous = np.empty_like(solved.end)
     previous[1:] = solved.end[:-1]
     has_previous = np.ones(len(segs), dtype=bool)
     # where units or offsets change, the previous end is seen from the new frame
     reframed = np.flatnonzero((offsets[1:] != offsets[:-1]).any(axis=1) | (scales[1:] != scales[:-1])) + 1
+    starts_from: dict[int, tuple | None] = {}  # rows whose start is not the previous row's end
     for i, before in [(0, last), *((i, None) for i in reframed.tolist())]:
         p = _end_in_frame_of(before if i == 0 else _ended(segs[i - 1], solved.end[i - 1]), segs[i])
         has_previous[i] = p is not None
         previous[i] = p if p is not None else np.nan
+        starts_from[i] = None if p is None else tuple(map(float, p))
     rapid = np.array([type(e) is Line and e.rapid for e in segs])
     turning = solved.turn & has_previous & ~rapid
     # A reversal step's target, with the axes that keep their direction left where they
@@ -98,26 +97,33 @@ def _written(segs: list, solved: _Solved, offsets: NDArray, scales: NDArray, las
     turning &= _apart(previous, target)
     # replace_arcs' pieces start where they start: a step from the previous end first
     connect = ~solved.free & has_previous & np.array([e.changed for e in segs]) & _apart(previous, solved.start)
-    previous_t, target_t, end_t = (list(map(tuple, a.tolist())) for a in (previous, target, solved.end))
-    start_l = solved.start.tolist()
-    out = []
-    for i, (seg, free, moved, has_prev, turns, connects) in enumerate(
-        zip(segs, solved.free.tolist(), solved.moved.tolist(), has_previous.tolist(), turning.tolist(), connect.tolist())
-    ):
-        if free:
-            start = previous_t[i] if has_prev else seg.start
-            if turns:  # the reversal step, then the line from where it ends
-                step = Line(start, target_t[i], seg.rapid, seg.feed, seg.block, seg.context, seg.extra, True)
-                out.append([step, Line(target_t[i], end_t[i], seg.rapid, seg.feed, seg.block, seg.context, seg.extra, True)])
-            else:
-                out.append([Line(start, end_t[i], seg.rapid, seg.feed, seg.block, seg.context, seg.extra, True)])
+    code = (solved.free * _FREE + (solved.moved & ~solved.free) * _MOVED + turning * _TURNS + connect * _CONNECTS).tolist()
+    ends = list(map(tuple, solved.end.tolist()))
+    targets = {i: tuple(target[i].tolist()) for i in np.flatnonzero(turning & solved.free).tolist()}
+    moved_starts = {i: solved.start[i].tolist() for i in np.flatnonzero(solved.moved & ~solved.free).tolist()}
+    out: list[Event] = []
+    start = None  # where the output is: the previous segment's compensated end
+    i = 0
+    for event in chunk:
+        if type(event) is not Line and type(event) is not Arc:
+            out.append(event)
+            continue
+        start = starts_from[i] if i in starts_from else start
+        row = code[i]
+        if row & _FREE:
+            seg = event
+            begin = seg.start if start is None else start
+            if row & _TURNS:  # the reversal step, then the line from where it ends
+                out.append(Line(begin, targets[i], seg.rapid, seg.feed, seg.block, seg.context, seg.extra, True))
+                begin = targets[i]
+            out.append(Line(begin, ends[i], seg.rapid, seg.feed, seg.block, seg.context, seg.extra, True))
         else:
-            if moved:
-                seg = _moved_arc(seg, start_l[i], end_t[i])
-            if connects:
-                out.append([Line(previous_t[i], seg.start, False, seg.feed, seg.block, seg.context, seg.extra, True), seg])
-            else:
-                out.append([seg])
+            seg = _moved_arc(event, moved_starts[i], ends[i]) if row & _MOVED else event
+            if row & _CONNECTS:
+                out.append(Line(start, seg.start, False, seg.feed, seg.block, seg.context, seg.extra, True))
+            out.append(seg)
+        start = ends[i]
+        i += 1
     return out
 
 
@@ -234,28 +240,30 @@ def _settle(free, arc, d, held, offsets, scales, limit, out_start, out_end, befo
     # `ends` has the predecessor of row 0 in front: row k's x is at 3k + 3, its predecessor's at 3k
     is_line, lim, settles = free.tolist(), limit.tolist(), (ok & (free | arc)).tolist()
     e_, s_, d_ = ends.ravel().tolist(), out_start.ravel().tolist(), dirs.ravel().tolist()
-    visit = set(todo)  # rows to look at; a row whose predecessor's end moved is looked at too
-    carry = False
-    for k in range(todo[0], len(is_line)):
-        if not (carry or k in visit) or not settles[k]:
-            carry = False
+    k = -1  # the last row looked at
+    for first in todo:  # each row to look at, then the rows after it while their predecessor's end moves
+        if first <= k:
             continue
-        i, limit_k, changed = 3 * k, lim[k], False
-        if is_line[k]:
-            for a in (i, i + 1, i + 2):  # d_[a] is the predecessor's direction, d_[a + 3] row k's
-                p, held = e_[a], d_[a]
-                gap = e_[a + 3] - p
-                if gap * held < 0 and d_[a + 3] == held and -limit_k <= gap <= limit_k:
-                    e_[a + 3] = p
-                    changed = True
-        else:
-            for a in (i, i + 1, i + 2):
-                move = e_[a] - s_[a]
-                if move != 0 and -limit_k <= move <= limit_k:
-                    s_[a] += move
-                    e_[a + 3] += move
-                    changed = True
-        carry = changed
+        k = first
+        while k < len(is_line) and settles[k]:
+            i, limit_k, changed = 3 * k, lim[k], False
+            if is_line[k]:
+                for a in (i, i + 1, i + 2):  # d_[a] is the predecessor's direction, d_[a + 3] row k's
+                    p, held = e_[a], d_[a]
+                    gap = e_[a + 3] - p
+                    if gap * held < 0 and d_[a + 3] == held and -limit_k <= gap <= limit_k:
+                        e_[a + 3] = p
+                        changed = True
+            else:
+                for a in (i, i + 1, i + 2):
+                    move = e_[a] - s_[a]
+                    if move != 0 and -limit_k <= move <= limit_k:
+                        s_[a] += move
+                        e_[a + 3] += move
+                        changed = True
+            if not changed:
+                break
+            k += 1
     out_end[:] = np.reshape(e_[3:], out_end.shape)
     out_start[:] = np.reshape(s_, out_start.shape)
 
