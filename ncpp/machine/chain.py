@@ -138,7 +138,8 @@ def rotate_minus_identity(eps: NDArray, v: NDArray) -> NDArray:
 
     Rodrigues: R v = v + a ε×v + b ε×(ε×v), a = sinθ/θ, b = (1−cosθ)/θ²; the
     series below are exact in double precision for θ < 0.01 rad."""
-    th2 = (eps[:, 0] ** 2 + eps[:, 1] ** 2 + eps[:, 2] ** 2)[:, None]
+    squares = eps * eps
+    th2 = (squares[:, 0] + squares[:, 1] + squares[:, 2])[:, None]
     a = 1.0 - th2 * (1.0 / 6.0 - th2 / 120.0)
     b = 0.5 - th2 * (1.0 / 24.0 - th2 / 720.0)
     ev = cross(eps, v)

@@ -124,11 +124,23 @@ def _floats(values: ArrayLike, what: str) -> tuple[float, ...]:
 def _select(direction: ArrayLike | None, plus: NDArray, minus: NDArray) -> NDArray:
     """Per-point choice: + table for d > 0, − table for d < 0, their mean when
     the direction is unknown (None) or the axis stands (0)."""
-    mean = 0.5 * (plus + minus)
+    return _chosen(_signs(direction), plus, minus)
+
+
+def _signs(direction: ArrayLike | None) -> tuple[NDArray, NDArray] | None:
+    """(d > 0, d < 0) of travel directions, read once for every table of an axis."""
     if direction is None:
+        return None
+    d = np.asarray(direction)
+    return d > 0, d < 0
+
+
+def _chosen(signs: tuple[NDArray, NDArray] | None, plus: NDArray, minus: NDArray) -> NDArray:
+    mean = 0.5 * (plus + minus)
+    if signs is None:
         return mean
-    d = np.broadcast_to(np.asarray(direction), plus.shape)
-    return np.where(d > 0, plus, np.where(d < 0, minus, mean))
+    forward, backward = signs
+    return np.where(forward, plus, np.where(backward, minus, mean))
 
 
 @dataclass(frozen=True)
@@ -312,18 +324,14 @@ class StackedTables:
             col += 2 if t.directional else 1
 
     def __call__(self, positions: NDArray, direction: NDArray | None = None) -> list[NDArray]:
-        p = np.clip(positions, self.grid[0], self.grid[-1])
-        i = np.clip(np.searchsorted(self.grid, p, side="right") - 1, 0, len(self.grid) - 2)
+        # np.minimum/np.maximum: np.clip's own overhead is most of the time on a few points
+        p = np.minimum(np.maximum(positions, self.grid[0]), self.grid[-1])
+        i = np.minimum(np.maximum(np.searchsorted(self.grid, p, side="right") - 1, 0), len(self.grid) - 2)
         dx = (p - self.grid[i])[:, None]
         c0, c1, c2, c3 = self.coefficients
         curves = c0.take(i, axis=0)  # Horner, in place
         for c in (c1, c2, c3):
             curves *= dx
             curves += c.take(i, axis=0)
-        out = []
-        for plus, minus in self.columns:
-            if minus is None:
-                out.append(curves[:, plus])
-            else:
-                out.append(_select(direction, curves[:, plus], curves[:, minus]))
-        return out
+        signs = _signs(direction)
+        return [curves[:, plus] if minus is None else _chosen(signs, curves[:, plus], curves[:, minus]) for plus, minus in self.columns]

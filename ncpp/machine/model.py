@@ -59,6 +59,12 @@ def as_points(P: ArrayLike) -> NDArray:
     return arr
 
 
+def _motion_row(name: str) -> int:
+    """The row of a component in `Machine.error_motions`' (6, n) motions: δx δy δz εx εy εz."""
+    info = COMPONENTS[name]
+    return info.index + (0 if info.kind == "translation" else 3)
+
+
 def _shaped_like(result: NDArray, P: ArrayLike) -> NDArray:
     return result[0] if np.ndim(P) == 1 else result
 
@@ -144,14 +150,15 @@ class Machine:
 
     # ------------------------------------------------------------ evaluation
     @cached_property
-    def _evaluators(self) -> dict[str, tuple[StackedTables | None, list[str], list[tuple[str, Component]]]]:
-        """Per axis: its tables stacked for one-pass evaluation, and the rest."""
+    def _evaluators(self) -> dict[str, tuple[StackedTables | None, list[int], list[tuple[int, Component]]]]:
+        """Per axis: its tables stacked for one-pass evaluation with the row of each
+        in `error_motions`' (6, n) motions, and the other components with theirs."""
         out = {}
         for axis in AXES:
-            mine = [(n, c) for n, c in self.components.items() if COMPONENTS[n].axis == axis]
-            tables = [(n, c) for n, c in mine if isinstance(c, Table)]
+            mine = [(_motion_row(n), c) for n, c in self.components.items() if COMPONENTS[n].axis == axis]
+            tables = [(row, c) for row, c in mine if isinstance(c, Table)]
             stacked = StackedTables([c for _, c in tables]) if tables else None
-            out[axis] = (stacked, [n for n, _ in tables], [(n, c) for n, c in mine if not isinstance(c, Table)])
+            out[axis] = (stacked, [row for row, _ in tables], [(row, c) for row, c in mine if not isinstance(c, Table)])
         return out
 
     def error_motions(
@@ -160,18 +167,17 @@ class Machine:
         """Per axis, the translation δ_K (n,3) mm and rotation ε_K (n,3) rad at P."""
         pts = as_points(P)
         dirs = None if direction is None else np.broadcast_to(np.asarray(direction, dtype=float), pts.shape)
-        n = len(pts)
-        # Stored column by column (see chain.columns): the chain algebra is per coordinate.
-        delta = {a: np.zeros((3, n)).T for a in AXES}
-        eps = {a: np.zeros((3, n)).T for a in AXES}
+        delta, eps = {}, {}
         for i, axis in enumerate(AXES):
-            stacked, names, others = self._evaluators[axis]
+            stacked, rows, others = self._evaluators[axis]
             p, d = pts[:, i], None if dirs is None else dirs[:, i]
-            values = list(zip(names, stacked(p, d))) if stacked is not None else []
-            values += [(name, comp(p, d)) for name, comp in others]
-            for name, value in values:
-                info = COMPONENTS[name]
-                (delta if info.kind == "translation" else eps)[axis][:, info.index] = value
+            motions = np.zeros((6, len(pts)))  # δx δy δz εx εy εz, each row contiguous (see chain.columns)
+            if stacked is not None:
+                for row, values in zip(rows, stacked(p, d)):
+                    motions[row] = values
+            for row, component in others:
+                motions[row] = component(p, d)
+            delta[axis], eps[axis] = motions[:3].T, motions[3:].T
         return delta, eps
 
     def _kinematics(self, pts: NDArray, dirs: NDArray | None):
