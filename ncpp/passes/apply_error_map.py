@@ -99,8 +99,8 @@ def _written(chunk: list[Event], segs: list, solved: _Solved, offsets: NDArray, 
     connect = ~solved.free & has_previous & np.array([e.changed for e in segs]) & _apart(previous, solved.start)
     code = (solved.free * _FREE + (solved.moved & ~solved.free) * _MOVED + turning * _TURNS + connect * _CONNECTS).tolist()
     ends = list(map(tuple, solved.end.tolist()))
-    targets = {i: tuple(target[i].tolist()) for i in np.flatnonzero(turning & solved.free).tolist()}
-    moved_starts = {i: solved.start[i].tolist() for i in np.flatnonzero(solved.moved & ~solved.free).tolist()}
+    targets = _by_row(target, turning & solved.free)
+    moved_starts = _by_row(solved.start, solved.moved & ~solved.free)
     out: list[Event] = []
     start = None  # where the output is: the previous segment's compensated end
     i = 0
@@ -125,6 +125,12 @@ def _written(chunk: list[Event], segs: list, solved: _Solved, offsets: NDArray, 
         start = ends[i]
         i += 1
     return out
+
+
+def _by_row(points: NDArray, rows: NDArray) -> dict[int, tuple]:
+    """{row: (x, y, z)} of the (n,3) points at the rows where `rows` (n,) is true."""
+    index = np.flatnonzero(rows)
+    return dict(zip(index.tolist(), map(tuple, points[index].tolist())))
 
 
 def _plain(segs: list, offsets: NDArray, scales: NDArray, ctx: PassContext) -> _Solved:
@@ -356,14 +362,14 @@ def _snap_limit(step: NDArray, scales: NDArray) -> NDArray:
     return np.maximum(1.01 * step, STILL_MM / scales)
 
 
-def _moved_arc(arc: Arc | Line, start: list, end: list) -> Arc | Line:
+def _moved_arc(arc: Arc | Line, start: tuple, end: tuple) -> Arc | Line:
     """The piece with new ends; an arc's centre moves with the mean shift of the
     ends (equal for planar arcs: radii still agree)."""
     if type(arc) is Line:
-        return Line(tuple(start), tuple(end), arc.rapid, arc.feed, arc.block, arc.context, arc.extra, True)
+        return Line(start, end, arc.rapid, arc.feed, arc.block, arc.context, arc.extra, True)
     (s0, s1, s2), (e0, e1, e2), (c0, c1, c2) = arc.start, arc.end, arc.center
     centre = (c0 + (start[0] - s0 + end[0] - e0) / 2, c1 + (start[1] - s1 + end[1] - e1) / 2, c2 + (start[2] - s2 + end[2] - e2) / 2)
-    return Arc(tuple(start), tuple(end), centre, arc.turn, arc.feed, arc.block, arc.context, arc.extra, True)
+    return Arc(start, end, centre, arc.turn, arc.feed, arc.block, arc.context, arc.extra, True)
 
 
 def _end_in_frame_of(last: Line | Arc | None, event: Line | Arc) -> tuple | None:

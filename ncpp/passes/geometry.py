@@ -27,6 +27,21 @@ def chunked(items: Iterable[T], size: int = CHUNK) -> Iterator[list[T]]:
         yield chunk
 
 
+def spliced(items: list[T], at: list[int], replacements: list[list[T]]) -> list[T]:
+    """`items` with the item at each index of `at` (ascending) replaced by the
+    items of its replacement: whole runs of untouched items are copied at once."""
+    if not at:
+        return items
+    out: list[T] = []
+    done = 0
+    for k, replacement in zip(at, replacements):
+        out += items[done:k]
+        out += replacement
+        done = k + 1
+    out += items[done:]
+    return out
+
+
 def frames(segments: Sequence[Line | Arc]) -> tuple[NDArray, NDArray]:
     """(n,3) offsets (machine minus program, program units) and (n,) mm per unit."""
     # a program has few contexts and consecutive segments share one: look each up once

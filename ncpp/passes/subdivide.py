@@ -15,7 +15,7 @@ import numpy as np
 
 from ncpp.motion.segments import Event, Line
 from ncpp.passes.context import PassContext
-from ncpp.passes.geometry import chunked, frames
+from ncpp.passes.geometry import chunked, frames, points, spliced
 
 # Interior samples where linearity is checked.
 SAMPLES = np.linspace(0.0, 1.0, 7)
@@ -45,8 +45,8 @@ def _subdivide_chunk(chunk: list[Event], ctx: PassContext) -> list[Event]:
     if not index:
         return chunk
     lines = [chunk[k] for k in index]
-    starts = np.array([ln.start for ln in lines])
-    ends = np.array([ln.end for ln in lines])
+    starts = points([ln.start for ln in lines])
+    ends = points([ln.end for ln in lines])
     offsets, scales = frames(lines)
     t = SAMPLES[None, :, None]
     program = starts[:, None, :] + t * (ends - starts)[:, None, :]
@@ -57,11 +57,8 @@ def _subdivide_chunk(chunk: list[Event], ctx: PassContext) -> list[Event]:
     deviation = np.linalg.norm(error - straight, axis=-1).max(axis=1)
     # The deviation of piecewise-linear interpolation shrinks with the square of the piece count.
     pieces = np.ceil(np.sqrt(SAFETY * deviation / ctx.tolerance)).astype(int).clip(1, MAX_PIECES)
-    out = list(chunk)
-    for k, line, n in zip(index, lines, pieces):
-        if n > 1:
-            out[k] = _split(line, int(n))
-    return _flatten(out)
+    split = np.flatnonzero(pieces > 1).tolist()
+    return spliced(chunk, [index[i] for i in split], [_split(lines[i], int(pieces[i])) for i in split])
 
 
 def _split(line: Line, n: int) -> list[Line]:
@@ -69,13 +66,3 @@ def _split(line: Line, n: int) -> list[Line]:
     cuts = [tuple(a + (b - a) * (i / n)) for i in range(n + 1)]
     cuts[0], cuts[-1] = line.start, line.end
     return [Line(cuts[i], cuts[i + 1], line.rapid, line.feed, line.block, line.context, line.extra, line.changed) for i in range(n)]
-
-
-def _flatten(items: list) -> list[Event]:
-    flat: list[Event] = []
-    for item in items:
-        if isinstance(item, list):
-            flat.extend(item)
-        else:
-            flat.append(item)
-    return flat
