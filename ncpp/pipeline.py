@@ -104,15 +104,16 @@ def header_text(source: ErrorSource, tolerance: float) -> str:
 
 def refuse_compensated(blocks: Iterable[Block], file: str) -> Iterator[Block]:
     """Pass blocks through; stop with an error if an ncpp header is found near the top."""
-    for n, block in enumerate(blocks):
-        if n < HEADER_SCAN:
-            for item in block.items:
-                if type(item) is Comment and HEADER_TAG in item.text:
-                    raise NcppError(
-                        "program is already compensated by ncpp (use --force to compensate again)",
-                        Location(file, block.line, item.start + 1),
-                    )
+    blocks = iter(blocks)
+    for block in islice(blocks, HEADER_SCAN):
+        for item in block.items:
+            if type(item) is Comment and HEADER_TAG in item.text:
+                raise NcppError(
+                    "program is already compensated by ncpp (use --force to compensate again)",
+                    Location(file, block.line, item.start + 1),
+                )
         yield block
+    yield from blocks
 
 
 def _counted(blocks: Iterable[Block], stats: Stats, progress: Callable[[int], None] | None) -> Iterator[Block]:
