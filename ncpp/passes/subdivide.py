@@ -8,7 +8,6 @@ into pieces short enough that the remaining deviation is below the tolerance.
 
 from __future__ import annotations
 
-import math
 from typing import Iterable, Iterator
 
 import numpy as np
@@ -30,24 +29,19 @@ def subdivide_lines(events: Iterable[Event], ctx: PassContext) -> Iterator[Event
         yield from _subdivide_chunk(chunk, ctx)
 
 
-def _candidates(chunk: list[Event], ctx: PassContext) -> list[int]:
-    found = []
-    for k, e in enumerate(chunk):
-        if type(e) is Line and not e.rapid and not e.changed:
-            length = math.dist(e.start, e.end) * (25.4 if e.context.inch else 1.0)
-            if length >= ctx.min_line_check:
-                found.append(k)
-    return found
-
-
 def _subdivide_chunk(chunk: list[Event], ctx: PassContext) -> list[Event]:
-    index = _candidates(chunk, ctx)
+    index = [k for k, e in enumerate(chunk) if type(e) is Line and not e.rapid and not e.changed]
     if not index:
         return chunk
     lines = [chunk[k] for k in index]
     starts = points([ln.start for ln in lines])
     ends = points([ln.end for ln in lines])
     offsets, scales = frames(lines)
+    long = np.flatnonzero(np.linalg.norm(ends - starts, axis=1) * scales >= ctx.min_line_check)
+    if long.size == 0:
+        return chunk
+    index, lines = [index[i] for i in long.tolist()], [lines[i] for i in long.tolist()]
+    starts, ends, offsets, scales = starts[long], ends[long], offsets[long], scales[long]
     t = SAMPLES[None, :, None]
     program = starts[:, None, :] + t * (ends - starts)[:, None, :]
     machine = (program + offsets[:, None, :]) * scales[:, None, None]
