@@ -101,30 +101,40 @@ def _written(chunk: list[Event], segs: list, solved: _Solved, offsets: NDArray, 
     ends = list(map(tuple, solved.end.tolist()))
     targets = _by_row(target, turning & solved.free)
     moved_starts = _by_row(solved.start, solved.moved & ~solved.free)
+    between = _between(chunk) if len(chunk) > len(segs) else {}
     out: list[Event] = []
     start = None  # where the output is: the previous segment's compensated end
-    i = 0
-    for event in chunk:
-        if type(event) is not Line and type(event) is not Arc:
-            out.append(event)
-            continue
-        start = starts_from[i] if i in starts_from else start
-        row = code[i]
+    for i, seg, row, end in zip(range(len(segs)), segs, code, ends):
+        if i in between:
+            out += between[i]
+        start = starts_from.get(i, start)
         if row & _FREE:
-            seg = event
             begin = seg.start if start is None else start
             if row & _TURNS:  # the reversal step, then the line from where it ends
                 out.append(Line(begin, targets[i], seg.rapid, seg.feed, seg.block, seg.context, seg.extra, True))
                 begin = targets[i]
-            out.append(Line(begin, ends[i], seg.rapid, seg.feed, seg.block, seg.context, seg.extra, True))
+            out.append(Line(begin, end, seg.rapid, seg.feed, seg.block, seg.context, seg.extra, True))
         else:
-            seg = _moved_arc(event, moved_starts[i], ends[i]) if row & _MOVED else event
+            if row & _MOVED:
+                seg = _moved_arc(seg, moved_starts[i], end)
             if row & _CONNECTS:
                 out.append(Line(start, seg.start, False, seg.feed, seg.block, seg.context, seg.extra, True))
             out.append(seg)
-        start = ends[i]
-        i += 1
+        start = end
+    out += between.get(len(segs), ())
     return out
+
+
+def _between(chunk: list[Event]) -> dict[int, list[Event]]:
+    """The chunk's other events by the segment they stand before (n: after the last of n)."""
+    found: dict[int, list[Event]] = {}
+    i = 0
+    for event in chunk:
+        if type(event) is Line or type(event) is Arc:
+            i += 1
+        else:
+            found.setdefault(i, []).append(event)
+    return found
 
 
 def _by_row(points: NDArray, rows: NDArray) -> dict[int, tuple]:

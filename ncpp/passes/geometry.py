@@ -44,6 +44,10 @@ def spliced(items: list[T], at: list[int], replacements: list[list[T]]) -> list[
 
 def frames(segments: Sequence[Line | Arc]) -> tuple[NDArray, NDArray]:
     """(n,3) offsets (machine minus program, program units) and (n,) mm per unit."""
+    every = [s.context for s in segments]
+    if every and every.count(every[0]) == len(every):  # one context (mostly one object: `count` tries `is` first)
+        c = every[0]
+        return np.tile(np.asarray(c.offset, dtype=float), (len(every), 1)), np.full(len(every), 25.4 if c.inch else 1.0)
     # a program has few contexts and consecutive segments share one: look each up once
     known: dict[int, int] = {}
     contexts, rows = [], []
