@@ -22,6 +22,7 @@ as `Pass` after ONE warning (an error with `strict`).
 from __future__ import annotations
 
 import math
+import re
 from typing import Iterable, Iterator
 
 from ncpp.errors import Location, NcppError, Warnings
@@ -260,6 +261,14 @@ class Interpreter:
                 end[slot[0]] = item.value
             else:
                 return self._fast_line(block, end)
+        try:
+            move = _PLAIN_MOVES[block.signature]
+        except KeyError:
+            move = _plain_move(block.signature)
+        if move is not None and len(items) == move[0]:  # no comment among the words
+            event = self._plain_move(block, move)
+            if event is not None:
+                return event
         words: dict[str, tuple[float, Word | ExprWord]] = {}
         gcodes: dict[int, tuple[float, Word | ExprWord]] | None = None
         mcodes: dict[float, Word | ExprWord] | None = None
@@ -336,6 +345,33 @@ class Interpreter:
         """Whether a block of plain X/Y/Z words can take the fast path (nothing to check)."""
         motion = self.motion
         self._fast = self.absolute and (motion == 0.0 or (motion == 1.0 and not self.inverse_time))
+
+    def _plain_move(self, block: Block, move: tuple) -> Event | None:
+        """A block `_plain_move` read (G0-G3 or the modal motion with distinct
+        axis / F / IJKR words) without the checks; None leaves it to them."""
+        _, code, letters, xyz = move
+        items = block.items
+        words_from = len(items) - len(letters)  # after N and G
+        if xyz is not None and code is not None and self._straight_plain(code):
+            end = self.pos[:]
+            for i, item in zip(xyz, items[words_from:]):
+                end[i] = item.value
+            return self._fast_line(block, end)
+        words = {letter: (item.value, item) for letter, item in zip(letters, items[words_from:])}
+        if code is not None:
+            return self._motion_move(block, words, code, items[words_from - 1])
+        motion = self.motion
+        if motion is not None and words.keys() <= _PLAIN_LETTERS[motion] and letters != "F":
+            return self._modal_move(block, words, motion)
+        return None
+
+    def _straight_plain(self, code: float) -> bool:
+        """`G0` / `G1` of axis words that need no check: the motion becomes modal (`_motion_move`)."""
+        if not self.absolute or code > 1.0 or (code == 1.0 and self.inverse_time):
+            return False
+        self.motion = code
+        self._fast = True
+        return True
 
     def _fast_line(self, block: Block, end: list[float]) -> Line:
         """A Line of the modal motion (G0/G1) from the current position to `end` (the hot path)."""
@@ -842,3 +878,34 @@ def _corner_word(words: dict, motion: float) -> tuple[str, float, Word | ExprWor
             value, item = words[letter]
             return kind, value, item
     return None
+
+
+_SIGNATURE = re.compile(r"(N?)(?:G(\d+\.?\d*|\.\d+))?([XYZABCUVWFIJKR]+)")
+_XYZ_INDEX = {"X": 0, "Y": 1, "Z": 2}
+
+
+_PLAIN_MOVES: dict[str | None, tuple | None] = {}  # what `_plain_move` said of the signatures seen
+
+
+def _plain_move(signature: str | None) -> tuple[int, float | None, str, tuple[int, ...] | None] | None:
+    """(number of words, G0-G3 code or None, letters after it, their XYZ indices when
+    all are X Y Z) of a `Block.signature` like `N G01 X Y F`, when each letter is there
+    once: what the interpreter's hot path reads; None for any other block."""
+    move = _read_signature(signature)
+    if len(_PLAIN_MOVES) < 4096:  # a program has few distinct signatures; the memory stays bounded
+        _PLAIN_MOVES[signature] = move
+    return move
+
+
+def _read_signature(signature: str | None) -> tuple[int, float | None, str, tuple[int, ...] | None] | None:
+    found = _SIGNATURE.fullmatch(signature or "")
+    if found is None:
+        return None
+    n, number, letters = found.groups()
+    code = None if number is None else float(number)
+    if code not in (None, 0.0, 1.0, 2.0, 3.0) or len(set(letters)) < len(letters):
+        return None
+    if code is not None and not set(letters) <= _PLAIN_LETTERS[code]:
+        return None
+    xyz = tuple(_XYZ_INDEX[letter] for letter in letters) if set(letters) <= _XYZ_INDEX.keys() else None
+    return len(n) + (number is not None) + len(letters), code, letters, xyz

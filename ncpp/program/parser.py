@@ -203,9 +203,7 @@ class LineParser:
         self.grammar = self.dialect.grammar
         self._lark = lalr_parser(self.grammar)
         self._builder = self.dialect.builder()
-        patterns = {t.name: t.pattern.to_regexp() for t in self._lark.terminals}
-        alternatives = "|".join(f"(?P<{name}>{patterns[name]})" for name in self.dialect.fast_terminals)
-        self._fast = re.compile(f"{_GAP}(?:{alternatives})") if alternatives else None
+        self._items = _PlainItems(self._lark, self.dialect.fast_terminals) if self.dialect.fast_terminals else None
         self._blank = re.compile(f"{_GAP}$")
 
     def parse(self, raw: str, eol: str = "", line: int = 0, file: str = "<stdin>") -> Block:
@@ -218,41 +216,43 @@ class LineParser:
     def _scan_plain(self, raw: str) -> tuple[tuple[AnyItem, ...], str | None] | None:
         """(items, `Block.signature`) of a line made only of plain words and
         comments, else None; the signature is None when a word has two letters (`,R`)."""
-        if self._fast is None:
+        scanner = self._items
+        if scanner is None:
             return None
         items: list[AnyItem] = []
         append = items.append
         signature = ""  # built here, where the words are: the writer reads its facts from it
         two_letters = False
-        pos = 0
-        match = self._fast.match
-        while True:
-            m = match(raw, pos)
-            if m is None:
-                break
-            kind = m.lastgroup
-            text = m[kind]
-            end = m.end()
-            start = end - len(text)
-            if kind == "WORD":
-                letter = _UPPER[text[0]]
-                if " " in text or "\t" in text:
-                    word = _word(text, start, end)
-                else:  # `_word` inlined for the common compact word: one per word of the program
-                    number = text[1:]
-                    word = _new_word(Word)
-                    word.letter, word.value, word.number = letter, float(number), number
-                    word.start, word.end = start, end
+        comma, paren, semi = scanner.comma, scanner.paren, scanner.semi
+        pos = 0  # the items are consecutive (checked below): their spans follow from their lengths
+        for found in scanner.findall(raw):
+            start = pos + len(found[0])
+            letter = found[1]
+            if letter:  # a WORD, one per word of the program: built inline
+                number = found[2]
+                pos = start + 1 + len(number)
+                letter = _UPPER[letter]
+                if " " in number or "\t" in number:  # `X - 5`
+                    number = number.replace(" ", "").replace("\t", "")
+                word = _new_word(Word)
+                word.letter, word.value, word.number, word.start, word.end = letter, float(number), number, start, pos
                 append(word)
-                signature += letter if letter != "G" else "G" + word.number
-            elif kind == "COMMA_WORD":
-                append(_word(text, start, end))
+                signature += letter if letter != "G" else "G" + number
+                continue
+            if found[comma]:
+                text = found[comma]
+                pos = start + len(text)
+                append(_word(text, start, pos))
                 two_letters = True
-            elif kind == "PAREN_COMMENT":
-                append(Comment(text[1:-1], "(", start, end))
+            elif found[paren]:
+                text = found[paren]
+                pos = start + len(text)
+                append(Comment(text[1:-1], "(", start, pos))
             else:
-                append(Comment(text[1:], ";", start, end))
-            pos = end
+                text = found[semi]
+                pos = start + len(text)
+                append(Comment(text[1:], ";", start, pos))
+        # findall skips what no item matches: then `pos` falls short of a non-blank rest
         if pos == len(raw) or self._blank.match(raw, pos):
             return tuple(items), (None if two_letters else signature)
         return None
@@ -267,6 +267,27 @@ class LineParser:
             raise NcppError(_describe(err, raw), Location(file, line, col)) from None
         items = self._builder.transform(tree)
         return tuple(item for item in _flatten(items))
+
+
+class _PlainItems:
+    """The plain-line scanner: `findall(raw)` gives one tuple per item, compiled from
+    the grammar's fast terminals.  Its fields: [0] the blanks before the item,
+    [1] [2] the letter and the number (as written) of a WORD, split after the
+    character class WORD starts with, and at `comma` / `paren` / `semi` the text
+    of a COMMA_WORD / PAREN_COMMENT / SEMI_COMMENT (a never-matching group
+    stands for a terminal the dialect does not take)."""
+
+    OTHERS = ("COMMA_WORD", "PAREN_COMMENT", "SEMI_COMMENT")
+
+    def __init__(self, lark_parser: lark.Lark, names: tuple[str, ...]):
+        patterns = {t.name: t.pattern.to_regexp() for t in lark_parser.terminals}
+        split = re.fullmatch(r"(\[[^\]]*\])(.*)", patterns["WORD"], re.S) if "WORD" in names else None
+        if split is None:
+            raise ValueError("the plain-line scanner needs a WORD that starts with a one-letter class")
+        others = [f"(?P<{name}>{patterns[name] if name in names else '(?!)'})" for name in self.OTHERS]
+        pattern = re.compile(f"({_GAP})(?:({split[1]})({split[2]})|{'|'.join(others)})")
+        self.findall = pattern.findall
+        self.comma, self.paren, self.semi = (pattern.groupindex[name] - 1 for name in self.OTHERS)
 
 
 def _flatten(items: Iterable) -> Iterator[AnyItem]:

@@ -75,3 +75,29 @@ def test_direct_motion_path_fails_like_execute(monkeypatch, bad):
     assert isinstance(direct, str)  # an error message with file:line:col
     _through_execute(monkeypatch)
     assert _outcome(text) == direct
+
+
+SIGNED = PROGRAM + """G90 G17 G0 X0 Y0
+N10 G01 X1 Y2 F300
+N11 X2 Y3
+G2 X3 Y4 I1 J0
+X4 Y3 I0 J-1
+X5 Y4 R1 (a comment keeps the checks)
+G1.0 Z-1
+G0 Z2
+F200
+G3 X5 Y4 I1 J0 P2 F100
+"""
+FAILING = ["G0 Z1 Z2", "G1 X1 Y1 K1", "G3 X5 Y0 I1 J0", "G2 X1 Y1", "G0 X1 R2"]
+
+
+@pytest.mark.parametrize("program", [PROGRAM, SIGNED] + [f"G21 G90 F100\nG0 X0 Y0\n{bad}\n" for bad in FAILING])
+def test_signature_path_agrees_with_the_checks(monkeypatch, program):
+    """Blocks the interpreter reads from their signature give what the full checks give."""
+    import ncpp.motion.interpreter as interpreter
+
+    fast = _outcome(program)
+    assert isinstance(fast, list) or program not in (PROGRAM, SIGNED)  # these run to the end
+    monkeypatch.setattr(interpreter, "_PLAIN_MOVES", {})
+    monkeypatch.setattr(interpreter, "_plain_move", lambda signature: None)
+    assert _outcome(program) == fast
