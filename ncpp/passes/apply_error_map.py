@@ -340,7 +340,7 @@ def _arc_assumed(segs: list, arc: NDArray) -> NDArray:
         return out
     arcs = [segs[i] for i in rows]
     axes = np.array([PLANE_AXES[a.context.plane] for a in arcs])
-    s, e, c = (np.take_along_axis(np.array([getattr(a, f) for a in arcs]), axes, axis=1) for f in ("start", "end", "center"))
+    s, e, c = (np.take_along_axis(points([getattr(a, f) for a in arcs]), axes, axis=1) for f in ("start", "end", "center"))
     u0, u1 = s[:, :2] - c[:, :2], e[:, :2] - c[:, :2]
     with np.errstate(invalid="ignore", divide="ignore"):
         mid = u0 / np.linalg.norm(u0, axis=1, keepdims=True) + u1 / np.linalg.norm(u1, axis=1, keepdims=True)
