@@ -205,8 +205,11 @@ def _round(pending: _Pieces, length: NDArray, t: NDArray, arcs, geometry, offset
     for p in np.flatnonzero(straight).tolist():
         done.append((arc_of[p], a0[p], _line_pieces(arcs[arc_of[p]], q[p, [0, -1]])))
     fitted = np.flatnonzero(ok)
-    for p, start, end, c in zip(fitted.tolist(), q[fitted, 0].tolist(), q[fitted, -1].tolist(), centre[fitted].tolist()):
-        done.append((arc_of[p], a0[p], _arc_piece(arcs[arc_of[p]], start, end, c)))
+    starts, ends, centres = (map(tuple, a.tolist()) for a in (q[fitted, 0], q[fitted, -1], centre[fitted]))
+    for p, start, end, c in zip(fitted.tolist(), starts, ends, centres):
+        arc = arcs[arc_of[p]]
+        piece = Arc(start, end, c, 1 if arc.turn > 0 else -1, arc.feed, arc.block, arc.context, arc.extra, True)
+        done.append((arc_of[p], a0[p], piece))
     for p in np.flatnonzero(give_up).tolist():
         done.append((arc_of[p], a0[p], _line_pieces(arcs[arc_of[p]], q[p])))
     return ~ok & ~give_up & ~straight
@@ -310,11 +313,6 @@ def _minimax_step(uv: NDArray, q0: NDArray, c: NDArray, normal: NDArray) -> NDAr
     candidates = np.where(np.isfinite(candidates), candidates, 0.0)
     worst = np.abs(r[:, None, :] + g[:, None, :] * candidates[:, :, None]).max(-1)
     return candidates[np.arange(len(r)), worst.argmin(axis=1)]
-
-
-def _arc_piece(arc: Arc, start: list, end: list, centre: list) -> Arc:
-    return Arc(tuple(start), tuple(end), tuple(centre), 1 if arc.turn > 0 else -1,
-               arc.feed, arc.block, arc.context, arc.extra, True)  # fmt: skip
 
 
 def _line_pieces(arc: Arc, q: NDArray) -> list[Event]:
