@@ -171,3 +171,20 @@ def test_planned_lines_are_the_general_lines(moves):
         else:
             moved.append(event)
     assert list(IsoWriter().write(moved)) == list(_unplanned_writer().write(moved))
+
+
+_digits = st.text("0123456789", max_size=3)
+_number = st.builds(lambda sign, whole, dot, frac: sign + whole + dot + frac, st.sampled_from(["", "-", "+"]), _digits, st.sampled_from(["", "."]), _digits)
+
+
+@PLAN_EXAMPLES
+@given(st.lists(_number.filter(lambda n: any(c.isdigit() for c in n) and ("." in n or not n.endswith(".")))))
+def test_a_letter_is_written_in_the_style_of_its_last_number(numbers):
+    """The styles learnt once per layout of a block (`X1.1`) are those read from each number (`X010.5`)."""
+    from ncpp.program.dialects.iso import IsoWriter
+
+    writer = IsoWriter()
+    for number in numbers:
+        block = parse_text(f"G1 X{number} Y{number}\n")[0]
+        writer._read_block(block)
+        assert writer.styles["X"] == writer.styles["Y"] == NumberStyle.of(number)

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import replace
+from operator import itemgetter
 from typing import Iterable, Iterator
 
 from ncpp.motion.segments import Arc, Context, Event, Line
@@ -44,6 +45,8 @@ _AXIS_BITS = _BIT["X"] | _BIT["Y"] | _BIT["Z"]
 _ANY_CENTRE = _BIT["I"] | _BIT["J"] | _BIT["K"]
 _UNKNOWN = object()  # a plan not compiled yet
 _SIGNATURE_WORD = re.compile(r"(.)([-+.\d]*)")  # a letter, and a G word's number
+_DIGITS_AS_ONE = bytes.maketrans(b"0123456789", b"1111111111")  # a block's layout: its text with every digit '1'
+_MAX_LAYOUTS = 10000  # layouts remembered (comments can make every layout new)
 
 
 class IsoWriter:
@@ -60,7 +63,10 @@ class IsoWriter:
         # Axes the program has positioned; before that the control's position is not
         # the interpreter's assumed zero, so a word must not be added for them.
         self.known_axes: set[str] = set()
-        self._shapes: dict[str, tuple] = {}  # per letter: the shape of the number its style was read from
+        # Per layout of a plain block's text (`_DIGITS_AS_ONE`): what its numbers teach, see `_read_layout`.
+        self._layouts: dict[bytes, tuple] = {}
+        self._interned_lessons: dict[tuple, tuple] = {}  # equal (letter, style) tuples are one
+        self._last_lesson: tuple | None = None  # the (letter, style) learnt last (learning them again changes nothing)
         # Derived from `styles`, emptied when a style changes: (letter, inch) -> style to write,
         # inch -> `_Written` (the styles of WRITTEN_LETTERS and the decimal places of X, Y, Z).
         self._resolved: dict = {}
@@ -133,21 +139,53 @@ class IsoWriter:
                 facts = self._signature_facts[signature] = _Facts.of_signature(signature)
         self._facts_block, self._facts_value = block, facts
         if facts.styled:
-            self._learn_word_styles(block, facts)
+            if signature is None:
+                self._learn_word_styles(block, facts)
+            else:
+                self._learn_layout_styles(block, facts)
         return facts
 
     def _learn_word_styles(self, block: Block, facts: "_Facts") -> None:
-        """Learn the number styles of the block's styled words (when the shape of a number changes)."""
-        words = block.items
-        if len(words) != facts.words:  # comments (or statements) among the words
-            words = tuple(item for item in words if type(item) is Word)
-        shapes = self._shapes
+        """Learn the number styles of the block's styled words, reading each number."""
+        words = _words(block, facts)
         for n, letter in facts.styled:
-            number = words[n].number  # type: ignore[union-attr]
-            shape = (len(number), number.find("."), number[:1])  # cheap: styles rarely change
-            if shapes.get(letter) != shape:
-                shapes[letter] = shape
-                self._learn_style(letter, NumberStyle.of(number))
+            self._learn_style(letter, NumberStyle.of(words[n].number))  # type: ignore[union-attr]
+        self._last_lesson = None
+
+    def _learn_layout_styles(self, block: Block, facts: "_Facts") -> None:
+        """Learn the number styles of a plain block's styled words: the styles are those of
+        its layout's numbers, read once per layout, unless a number is zero-padded."""
+        raw = block.raw
+        layout = raw.encode("latin-1").translate(_DIGITS_AS_ONE)
+        lesson = self._layouts.get(layout)
+        if lesson is None:
+            lesson = self._read_layout(block, facts, layout)
+        styles, firsts = lesson
+        if firsts is not None and "0" in firsts(raw):  # `X010.5`: the layout does not say the padding
+            self._learn_word_styles(block, facts)
+        elif styles is not self._last_lesson:
+            known = self.styles
+            for letter, style in styles:
+                if known.get(letter) is not style:
+                    self._learn_style(letter, style)
+            self._last_lesson = styles
+
+    def _read_layout(self, block: Block, facts: "_Facts", layout: bytes) -> tuple:
+        """(the (letter, style) of each styled word of the layout, a getter of the first digits of
+        its numbers with more than one digit before the point, None if there are none)."""
+        if len(self._layouts) >= _MAX_LAYOUTS:
+            self._layouts.clear()
+        text, words = layout.decode("latin-1"), _words(block, facts)
+        styles, firsts = [], []
+        for n, letter in facts.styled:
+            word = words[n]
+            number = text[word.end - len(word.number) : word.end]  # type: ignore[union-attr]
+            styles.append((letter, NumberStyle.of(number)))
+            digits = number.lstrip("+-").lstrip(" \t")
+            if len(digits.partition("," if "," in digits else ".")[0]) > 1:
+                firsts.append(word.end - len(digits))
+        lesson = self._layouts[layout] = (self._interned_lessons.setdefault(tuple(styles), tuple(styles)), itemgetter(*firsts) if firsts else None)
+        return lesson
 
     def _learn_style(self, letter: str, style: NumberStyle) -> None:
         known = self.styles.get(letter)
@@ -307,10 +345,7 @@ class IsoWriter:
             )
         if plan is None:
             return None
-        words = block.items
-        if len(words) != facts.words:  # comments among the words
-            words = tuple(item for item in words if type(item) is Word)
-        return plan.apply(block.raw, words, self._numbers(segment))
+        return plan.apply(block.raw, _words(block, facts), self._numbers(segment))
 
     def _general_edit(self, block: Block, facts: "_Facts", segment: Line | Arc, motion: int | None) -> str:
         texts = self._texts(block, segment)
@@ -410,6 +445,12 @@ class _Facts:
                 self.motion_word, self.motion = True, None
         elif letter in MOVING_LETTERS:
             self.moves = True
+
+
+def _words(block: Block, facts: _Facts) -> tuple[Word, ...]:
+    """The plain words of the block, in order."""
+    items = block.items
+    return items if len(items) == facts.words else tuple(item for item in items if type(item) is Word)  # type: ignore[return-value]
 
 
 def _written_apart(a: float, a_places: int, b: float, b_places: int) -> bool:
