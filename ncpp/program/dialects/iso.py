@@ -23,6 +23,7 @@ from ncpp.program.writer import EditPlan, _literal, _with_motion, set_words, spe
 AXES = "XYZ"
 _NUMBERED_AXES = tuple(enumerate(AXES))  # ((0, "X"), ...): no enumerate object per line written
 CENTRE_WORDS = {17: (("I", 0), ("J", 1)), 18: (("I", 0), ("K", 2)), 19: (("J", 1), ("K", 2))}  # (letter, axis), as written
+_CENTRE_AXES = {plane: (a, b) for plane, ((_, a), (_, b)) in CENTRE_WORDS.items()}
 MOTION_CODES = {0.0: 0, 1.0: 1, 2.0: 2, 3.0: 3}
 DEFAULT_STYLE = NumberStyle(decimals=4)
 GEOMETRY_LETTERS = "XYZIJKR"  # words a pass rewrites in a changed block
@@ -160,7 +161,9 @@ class IsoWriter:
         lesson = self._layouts.get(layout)
         if lesson is None:
             lesson = self._read_layout(block, facts, layout)
-        styles, firsts = lesson
+        styles, firsts, spelled = lesson
+        if spelled is not None:
+            self._spelled = (block, spelled)
         if firsts is not None and "0" in firsts(raw):  # `X010.5`: the layout does not say the padding
             self._learn_word_styles(block, facts)
         elif styles is not self._last_lesson:
@@ -172,7 +175,8 @@ class IsoWriter:
 
     def _read_layout(self, block: Block, facts: "_Facts", layout: bytes) -> tuple:
         """(the (letter, style) of each styled word of the layout, a getter of the first digits of
-        its numbers with more than one digit before the point, None if there are none)."""
+        its numbers with more than one digit before the point or None if there are none, its
+        `spelling` or None if its separator has digits, in a comment)."""
         if len(self._layouts) >= _MAX_LAYOUTS:
             self._layouts.clear()
         text, words = layout.decode("latin-1"), _words(block, facts)
@@ -184,7 +188,12 @@ class IsoWriter:
             digits = number.lstrip("+-").lstrip(" \t")
             if len(digits.partition("," if "," in digits else ".")[0]) > 1:
                 firsts.append(word.end - len(digits))
-        lesson = self._layouts[layout] = (self._interned_lessons.setdefault(tuple(styles), tuple(styles)), itemgetter(*firsts) if firsts else None)
+        spelled = spelling(block)
+        lesson = self._layouts[layout] = (
+            self._interned_lessons.setdefault(tuple(styles), tuple(styles)),
+            itemgetter(*firsts) if firsts else None,
+            None if any(map(str.isdigit, spelled[0])) else spelled,
+        )
         return lesson
 
     def _learn_style(self, letter: str, style: NumberStyle) -> None:
@@ -276,11 +285,16 @@ class IsoWriter:
         whatever moved in the output, then an arc's centre."""
         bits = facts.axis_bits
         end = segment.end
-        if segment.context.absolute:
+        if not facts.absent_axes:
+            pass
+        elif segment.context.absolute:
             known, last = self.known_axes, self._last_end
             places, last_places = units.places, self._last_places
             for n, axis, bit in facts.absent_axes:
-                if axis in known and (last is None or _written_apart(end[n], places[n], last[n], last_places[n])):
+                # written apart from the output's last end: rounded only when the numbers differ
+                if axis in known and (last is None or (
+                    (end[n] != last[n] or places[n] != last_places[n]) and round(end[n], places[n]) != round(last[n], last_places[n])
+                )):  # fmt: skip
                     bits |= bit
         else:
             start = segment.start
@@ -300,9 +314,11 @@ class IsoWriter:
             end = (end[0] - start[0], end[1] - start[1], end[2] - start[2])
         if type(segment) is not Arc:
             return end
-        centre, origin = segment.center, (0.0, 0.0, 0.0) if context.arc_absolute else segment.start
-        (_, a), (_, b) = CENTRE_WORDS[context.plane]
-        return (*end, centre[a] - origin[a], centre[b] - origin[b])
+        centre, (a, b) = segment.center, _CENTRE_AXES[context.plane]
+        if context.arc_absolute:
+            return (*end, centre[a], centre[b])
+        start = segment.start
+        return (*end, centre[a] - start[a], centre[b] - start[b])
 
     def _texts(self, block: Block, segment: Line | Arc) -> dict[str, str]:
         """The words to write for the segment, letter -> number as the output writes it."""
@@ -359,13 +375,16 @@ class IsoWriter:
         return set_words(block if motion is None else _with_motion(block, motion), texts, drop, spelled)
 
     def _new_block(self, block: Block, segment: Line | Arc) -> str:
-        facts = self._facts(block)
+        # once per line written: the cached look-ups of `_facts`, `_units` and `_spelling` inlined
+        facts = self._facts_value if block is self._facts_block else self._facts(block)
         inch = segment.context.inch
         units = self._resolved.get(inch) or self._units(inch)
         code = self._motion_code(segment)
         motion = code if code != self.output_motion else None
         bits = self._written_bits(facts, segment, units)
-        spelled = self._spelling(block)
+        spelled_block, spelled = self._spelled
+        if spelled_block is not block:
+            spelled = self._spelling(block)
         if units.plain:
             key = (bits, motion, spelled)
             template = units.new_templates.get(key)
@@ -451,11 +470,6 @@ def _words(block: Block, facts: _Facts) -> tuple[Word, ...]:
     """The plain words of the block, in order."""
     items = block.items
     return items if len(items) == facts.words else tuple(item for item in items if type(item) is Word)  # type: ignore[return-value]
-
-
-def _written_apart(a: float, a_places: int, b: float, b_places: int) -> bool:
-    """Whether `a` and `b` are written as different numbers (rounded only when they are not the same number)."""
-    return (a != b or a_places != b_places) and round(a, a_places) != round(b, b_places)
 
 
 class _Written:
