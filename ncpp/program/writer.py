@@ -137,20 +137,21 @@ _AFTER = 3  # after it (something is appended there)
 
 
 class EditPlan:
-    """`edit_texts` compiled for one shape of block, so that an edit is one walk over
-    the words it touches and one `str.format`.
+    """`edit_texts` compiled for one shape of block: the words it cuts the raw text at,
+    and what goes between the pieces it keeps.
 
     The shape is the letters of the block's words (no other items but comments) and,
     when the motion code is set, its first G0-G3 word.  `fields` maps each letter to
-    write to its number as a format field (`{0:z.4f}`) of `apply`'s `numbers`; the
-    template takes the kept raw text as the fields after them.
+    write to its number as a format field (`{0:z.4f}`) of the numbers `apply` is given.
     """
 
-    __slots__ = ("cuts", "template")
+    __slots__ = ("cuts", "parts", "template", "keeps_numbers")
 
-    def __init__(self, cuts: tuple[tuple[int, int], ...], template: str):
+    def __init__(self, cuts: tuple[tuple[int, int], ...], parts: tuple[str | int, ...], count: int, keeps_numbers: bool):
         self.cuts = cuts  # (word index, how to cut): see _REPLACE ...
-        self.template = template
+        self.parts = parts  # template text, and the index of each kept piece where it goes
+        self.template = "".join(part if type(part) is str else "{%d}" % (count + part) for part in parts)
+        self.keeps_numbers = keeps_numbers  # it keeps words other than G words (`F100`), whose number can be any
 
     @classmethod
     def compile(
@@ -199,10 +200,10 @@ class EditPlan:
             return None
         appended = "".join(_literal(sep) + (letter.lower() if lower else letter) + field for letter, field in pending.items())
         cuts: list[tuple[int, int]] = []
-        parts: list[str] = []
+        parts: list[str | int] = []
 
         def cut(n: int, how: int) -> None:
-            parts.append("{%d}" % (count + len(cuts)))
+            parts.append(len(cuts))
             cuts.append((n, how))
 
         for n in range(len(letters)):
@@ -218,29 +219,42 @@ class EditPlan:
                 if n not in replace and n not in dropped:
                     cut(n, _AFTER)
                 parts.append(appended)
-        parts.append("{%d}" % (count + len(cuts)))
-        return cls(tuple(cuts), "".join(parts))
+        parts.append(len(cuts))
+        kept = {n for n, letter in enumerate(letters) if letter != "G"} - replace.keys() - dropped
+        return cls(tuple(cuts), tuple(parts), count, bool(kept))
 
     def apply(self, raw: str, words: Sequence[Word], numbers: Sequence[float]) -> str:
         """The edited text of a block of this shape (`words`: its words, in order)."""
-        pieces = []
+        return self.template.format(*numbers, *self._kept(raw, words))
+
+    def template_for(self, raw: str, words: Sequence[Word]) -> str:
+        """`apply`'s template with the pieces of `raw` it keeps as its text: the template of every
+        block with the same layout (other digits) and G words, when it keeps no other numbers
+        (`keeps_numbers`, comments)."""
+        kept = self._kept(raw, words)
+        return "".join(part if type(part) is str else _literal(kept[part]) for part in self.parts)
+
+    def _kept(self, raw: str, words: Sequence[Word]) -> list[str]:
+        """The pieces of `raw` it keeps."""
+        pieces: list[str] = []
+        keep = pieces.append
         cursor = 0
         for n, how in self.cuts:
             word = words[n]
             if how == _REPLACE:
-                pieces.append(raw[cursor : word.start + 1])
+                keep(raw[cursor : word.start + 1])
                 cursor = word.end
             elif how == _DROP:
-                pieces.append(raw[cursor : word.start].rstrip(" \t"))
+                keep(raw[cursor : word.start].rstrip(" \t"))
                 cursor = word.end
             elif how == _BEFORE:
-                pieces.append(raw[cursor : word.start])
+                keep(raw[cursor : word.start])
                 cursor = word.start
             else:
-                pieces.append(raw[cursor : word.end])
+                keep(raw[cursor : word.end])
                 cursor = word.end
-        pieces.append(raw[cursor:])
-        return self.template.format(*numbers, *pieces)
+        keep(raw[cursor:])
+        return pieces
 
 
 def _literal(text: str) -> str:

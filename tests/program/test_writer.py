@@ -96,28 +96,38 @@ def _blocks(draw) -> str:
     return text + draw(st.sampled_from(["", "(end)", " ; tail"]))
 
 
+def _other_digits(text: str, seed: int) -> str:
+    """The text with other digits (the same layout)."""
+    return "".join(str((int(c) * 7 + seed) % 10) if c.isdigit() else c for c in text)
+
+
 @PLAN_EXAMPLES
 @given(
     _blocks(),
+    st.integers(0, 9),
     st.lists(st.sampled_from("XYZIJK"), unique=True),
     st.sets(st.sampled_from("IJKRPX")),
     st.sampled_from([None, 0, 1, 2, 3]),
 )
-def test_edit_plan_writes_what_edit_texts_writes(text, letters, drop, motion):
-    """A compiled edit gives the general edit's text, for every shape it compiles."""
+def test_edit_plan_writes_what_edit_texts_writes(text, seed, letters, drop, motion):
+    """A compiled edit gives the general edit's text; so does its template for a block's layout,
+    for every block of that layout and G words, when it keeps no other numbers and comments."""
     block = parse_text(text + "\n")[0]
     words = block.words()
-    assert len(words) == len([i for i in block.items if type(i).__name__ != "Comment"])
-    texts = {letter: f"{n}.5" for n, letter in enumerate(letters)}
     first_g = next(((n, w.number) for n, w in enumerate(words) if w.letter == "G" and w.value in (0, 1, 2, 3)), None)
-    plan = EditPlan.compile(
-        [w.letter for w in words], {letter: "{%d}" % n for n, letter in enumerate(letters)}, len(letters),
-        drop, motion if first_g is None or motion != int(words[first_g[0]].value) else None, first_g, spelling(block),
-    )  # fmt: skip
     if motion is not None and first_g is not None and motion == int(words[first_g[0]].value):
         motion = None  # `_with_motion` leaves the word: the plan is compiled without it
-    if plan is not None:
-        assert plan.apply(block.raw, words, list(texts.values())) == edit_texts(block, texts, drop, motion)
+    fields = {letter: "{%d}" % n for n, letter in enumerate(letters)}
+    plan = EditPlan.compile([w.letter for w in words], fields, len(letters), drop, motion, first_g, spelling(block))
+    if plan is None:
+        return
+    texts = {letter: f"{n}.5" for n, letter in enumerate(letters)}
+    assert plan.apply(block.raw, words, list(texts.values())) == edit_texts(block, texts, drop, motion)
+    sibling = parse_text(_other_digits(text, seed) + "\n")[0]
+    same_g = [w.number for w in sibling.words() if w.letter == "G"] == [w.number for w in words if w.letter == "G"]
+    if same_g and not plan.keeps_numbers and len(words) == len(block.items):
+        template = plan.template_for(block.raw, words)
+        assert template.format(*texts.values()) == edit_texts(sibling, texts, drop, motion)
 
 
 PLANNED_PROGRAM = """G20 G90 G18

@@ -283,22 +283,19 @@ class IsoWriter:
     def _written_bits(self, facts: "_Facts", segment: Line | Arc, units: "_Written") -> int:
         """The letters the segment writes (a mask of `_BIT`): the axes the block has and
         whatever moved in the output, then an arc's centre."""
-        bits = facts.axis_bits
-        end = segment.end
-        if not facts.absent_axes:
-            pass
-        elif segment.context.absolute:
+        bits, absent, end = facts.axis_bits, facts.absent_axes, segment.end
+        if absent and segment.context.absolute:
             known, last = self.known_axes, self._last_end
             places, last_places = units.places, self._last_places
-            for n, axis, bit in facts.absent_axes:
+            for n, axis, bit in absent:
                 # written apart from the output's last end: rounded only when the numbers differ
                 if axis in known and (last is None or (
                     (end[n] != last[n] or places[n] != last_places[n]) and round(end[n], places[n]) != round(last[n], last_places[n])
                 )):  # fmt: skip
                     bits |= bit
-        else:
+        elif absent:
             start = segment.start
-            for n, axis, bit in facts.absent_axes:
+            for n, axis, bit in absent:
                 if round(end[n] - start[n], units.places[n]) != 0.0:
                     bits |= bit
         if type(segment) is Arc:
@@ -328,7 +325,7 @@ class IsoWriter:
         return {letter: format_number(numbers[n], styles[letter]) for letter, n in _WRITTEN[self._written_bits(self._facts(block), segment, units)]}
 
     def _edit_block(self, block: Block, segment: Line | Arc) -> str:
-        facts = self._facts(block)
+        facts = self._facts_value if block is self._facts_block else self._facts(block)  # `_facts`, inlined
         code = self._motion_code(segment)
         # the block's motion word is set when it says another motion, or when the output's mode is another
         motion = code if facts.first_motion != code and (code != self.output_motion or facts.motion_word) else None
@@ -352,6 +349,26 @@ class IsoWriter:
         bits = self._written_bits(facts, segment, units)
         # words the block lacks are appended spelled as the block was read
         spelled = self._spelling(block) if bits & ~facts.bits or (motion is not None and facts.motion_at is None) else None
+        raw = block.raw
+        # the block's layout, and a plan: blocks of one layout without comments whose numbers the
+        # plan writes or drops all (but G words', in the signature) are its template with their numbers
+        key = (raw.encode("latin-1").translate(_DIGITS_AS_ONE), signature, bits, motion, spelled)
+        edit = units.edits.get(key)
+        if edit is None:
+            plan = self._edit_plan(facts, signature, bits, motion, spelled, units)
+            if plan is None:
+                return None
+            if len(units.edits) >= _MAX_LAYOUTS:
+                units.edits.clear()
+            comments = len(block.items) != facts.words
+            edit = units.edits[key] = plan if plan.keeps_numbers or comments else plan.template_for(raw, block.items)  # type: ignore[arg-type]
+        if type(edit) is str:
+            return edit.format(*self._numbers(segment))
+        return edit.apply(raw, _words(block, facts), self._numbers(segment))
+
+    @staticmethod
+    def _edit_plan(facts: "_Facts", signature: str, bits: int, motion: int | None, spelled: tuple[str, bool] | None, units: "_Written") -> EditPlan | None:
+        """The plan of an edit of a block with this signature, compiled once."""
         key = (signature, bits, motion, spelled)
         plan = units.edit_plans.get(key, _UNKNOWN)
         if plan is _UNKNOWN:
@@ -359,9 +376,7 @@ class IsoWriter:
             plan = units.edit_plans[key] = EditPlan.compile(
                 facts.word_letters, units.fields(bits), 5 if bits & _ANY_CENTRE else 3, dropped, motion, facts.motion_at, spelled or (" ", False)
             )
-        if plan is None:
-            return None
-        return plan.apply(block.raw, _words(block, facts), self._numbers(segment))
+        return plan  # type: ignore[return-value]
 
     def _general_edit(self, block: Block, facts: "_Facts", segment: Line | Arc, motion: int | None) -> str:
         texts = self._texts(block, segment)
@@ -476,15 +491,17 @@ class _Written:
     """How the output writes numbers in one system of units: the style of each letter
     it writes, and the decimal places of X, Y and Z."""
 
-    __slots__ = ("styles", "places", "plain", "edit_plans", "new_templates")
+    __slots__ = ("styles", "places", "plain", "edit_plans", "edits", "new_templates")
 
     def __init__(self, styles: dict[str, NumberStyle]):
         self.styles = styles
         self.places: tuple[int, int, int] = tuple(styles[axis].decimals for axis in AXES)  # type: ignore[assignment]
         self.plain = all(style.plain for style in styles.values())  # every number one `format` spec: plans apply
         # Compiled lines: (signature, written bits, motion, spelling) -> `EditPlan` (None: none applies),
+        # (layout, signature, ...) -> that plan, or the format template it makes of such blocks,
         # (written bits, motion, spelling) -> the format template of a new block.
         self.edit_plans: dict[tuple, EditPlan | None] = {}
+        self.edits: dict[tuple, EditPlan | str] = {}
         self.new_templates: dict[tuple, str] = {}
 
     def fields(self, bits: int) -> dict[str, str]:
