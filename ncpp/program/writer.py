@@ -9,7 +9,7 @@ separates its words.
 from __future__ import annotations
 
 import copy
-from typing import BinaryIO, Collection, Iterable, Mapping
+from typing import BinaryIO, Collection, Iterable, Mapping, Sequence
 
 from ncpp.program.blocks import Block, Comment, Item, Word
 from ncpp.program.numbers import NumberStyle, format_number
@@ -127,6 +127,139 @@ def set_words(
         pieces.insert(len(pieces) if at is None else at, extra)
     pieces.append(raw[cursor:])
     return "".join(pieces)
+
+
+# How an `EditPlan` cuts the raw text at a word (the text between two cuts is kept):
+_REPLACE = 0  # before its number (its letter kept), again after it
+_DROP = 1  # before it, the separator before it stripped, again after it
+_BEFORE = 2  # before it (something is inserted there)
+_AFTER = 3  # after it (something is appended there)
+
+
+class EditPlan:
+    """`edit_texts` compiled for one shape of block: the words it cuts the raw text at,
+    and what goes between the pieces it keeps.
+
+    The shape is the letters of the block's words (no other items but comments) and,
+    when the motion code is set, its first G0-G3 word.  `fields` maps each letter to
+    write to its number as a format field (`{0:z.4f}`) of the numbers `apply` is given.
+    """
+
+    __slots__ = ("cuts", "parts", "template", "keeps_numbers")
+
+    def __init__(self, cuts: tuple[tuple[int, int], ...], parts: tuple[str | int, ...], count: int, keeps_numbers: bool):
+        self.cuts = cuts  # (word index, how to cut): see _REPLACE ...
+        self.parts = parts  # template text, and the index of each kept piece where it goes
+        self.template = "".join(part if type(part) is str else "{%d}" % (count + part) for part in parts)
+        self.keeps_numbers = keeps_numbers  # it keeps words other than G words (`F100`), whose number can be any
+
+    @classmethod
+    def compile(
+        cls,
+        letters: Sequence[str],
+        fields: Mapping[str, str],
+        count: int,
+        drop: Collection[str] = (),
+        motion: int | None = None,
+        motion_word: tuple[int, str] | None = None,
+        spelled: tuple[str, bool] = (" ", False),
+    ) -> "EditPlan | None":
+        """The plan of `edit_texts(block, texts, drop, motion)` for blocks whose words have
+        these `letters`, `motion_word` (its index and number as written) being the first
+        G0-G3 word; `count` numbers fill `fields`.  None for the shapes it does not cover
+        (no words; a G word to insert where there is no axis word, or before a dropped one)."""
+        sep, lower = spelled
+        before: dict[int, str] = {}  # word index -> text inserted before it
+        replace: dict[int, str] = {}  # word index -> its new number (a field or a G code)
+        if motion is not None:
+            if motion_word is not None:
+                n, number = motion_word
+                replace[n] = format_number(motion, NumberStyle.of(number))
+            else:
+                first = next((n for n, letter in enumerate(letters) if letter in AXIS_LETTERS), None)
+                if first is None or letters[first] in drop:
+                    return None
+                before[first] = ("g" if lower else "G") + str(motion) + _literal(sep)
+        pending = dict(fields)
+        dropped: set[int] = set()
+        at = None  # the word after which appended words go (as `set_words` places them)
+        seen_axis = False
+        for n, letter in enumerate(letters):
+            field = pending.pop(letter, None) if n not in replace else None
+            if field is not None or letter in drop:
+                if field is not None:
+                    replace[n] = field
+                else:
+                    dropped.add(n)
+                at, seen_axis = n, True
+            elif letter in AXIS_LETTERS:
+                at, seen_axis = n, True
+            elif not seen_axis:
+                at = n
+        if at is None:
+            return None
+        appended = "".join(_literal(sep) + (letter.lower() if lower else letter) + field for letter, field in pending.items())
+        cuts: list[tuple[int, int]] = []
+        parts: list[str | int] = []
+
+        def cut(n: int, how: int) -> None:
+            parts.append(len(cuts))
+            cuts.append((n, how))
+
+        for n in range(len(letters)):
+            if n in before:
+                cut(n, _BEFORE)
+                parts.append(before[n])
+            if n in replace:
+                cut(n, _REPLACE)
+                parts.append(replace[n])
+            elif n in dropped:
+                cut(n, _DROP)
+            if n == at and appended:
+                if n not in replace and n not in dropped:
+                    cut(n, _AFTER)
+                parts.append(appended)
+        parts.append(len(cuts))
+        kept = {n for n, letter in enumerate(letters) if letter != "G"} - replace.keys() - dropped
+        return cls(tuple(cuts), tuple(parts), count, bool(kept))
+
+    def apply(self, raw: str, words: Sequence[Word], numbers: Sequence[float]) -> str:
+        """The edited text of a block of this shape (`words`: its words, in order)."""
+        return self.template.format(*numbers, *self._kept(raw, words))
+
+    def template_for(self, raw: str, words: Sequence[Word]) -> str:
+        """`apply`'s template with the pieces of `raw` it keeps as its text: the template of every
+        block with the same layout (other digits) and G words, when it keeps no other numbers
+        (`keeps_numbers`, comments)."""
+        kept = self._kept(raw, words)
+        return "".join(part if type(part) is str else _literal(kept[part]) for part in self.parts)
+
+    def _kept(self, raw: str, words: Sequence[Word]) -> list[str]:
+        """The pieces of `raw` it keeps."""
+        pieces: list[str] = []
+        keep = pieces.append
+        cursor = 0
+        for n, how in self.cuts:
+            word = words[n]
+            if how == _REPLACE:
+                keep(raw[cursor : word.start + 1])
+                cursor = word.end
+            elif how == _DROP:
+                keep(raw[cursor : word.start].rstrip(" \t"))
+                cursor = word.end
+            elif how == _BEFORE:
+                keep(raw[cursor : word.start])
+                cursor = word.start
+            else:
+                keep(raw[cursor : word.end])
+                cursor = word.end
+        keep(raw[cursor:])
+        return pieces
+
+
+def _literal(text: str) -> str:
+    """`text` as literal text of a format template."""
+    return text.replace("{", "{{").replace("}", "}}")
 
 
 def _with_motion(block: Block, code: int) -> Block:

@@ -70,3 +70,131 @@ def replace_signature(block):
     from dataclasses import replace
 
     return replace(block, signature=None)
+
+
+# -- compiled edits and lines: the same text as the general path ----------------------
+
+from hypothesis import HealthCheck, given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+from ncpp.program.writer import EditPlan, edit_texts, spelling  # noqa: E402
+
+PLAN_EXAMPLES = settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+_NUMBERS = ["1", "-2.5", "10.", ".5", "+3", "007.25", "0"]
+_word = st.tuples(st.sampled_from("GXYZIJKRPFNMS"), st.sampled_from(_NUMBERS + ["0", "1", "2", "3", "01"]))
+_gap = st.sampled_from(["", " ", "  ", "\t", " (c) ", " (c{}) "])
+
+
+@st.composite
+def _blocks(draw) -> str:
+    """A line of plain words and comments, some of them lower case."""
+    words = draw(st.lists(_word, min_size=1, max_size=7))
+    lower = draw(st.booleans())
+    text = draw(st.sampled_from(["", "  "]))
+    for letter, number in words:
+        text += (letter.lower() if lower else letter) + number + draw(_gap)
+    return text + draw(st.sampled_from(["", "(end)", " ; tail"]))
+
+
+def _other_digits(text: str, seed: int) -> str:
+    """The text with other digits (the same layout)."""
+    return "".join(str((int(c) * 7 + seed) % 10) if c.isdigit() else c for c in text)
+
+
+@PLAN_EXAMPLES
+@given(
+    _blocks(),
+    st.integers(0, 9),
+    st.lists(st.sampled_from("XYZIJK"), unique=True),
+    st.sets(st.sampled_from("IJKRPX")),
+    st.sampled_from([None, 0, 1, 2, 3]),
+)
+def test_edit_plan_writes_what_edit_texts_writes(text, seed, letters, drop, motion):
+    """A compiled edit gives the general edit's text; so does its template for a block's layout,
+    for every block of that layout and G words, when it keeps no other numbers and comments."""
+    block = parse_text(text + "\n")[0]
+    words = block.words()
+    first_g = next(((n, w.number) for n, w in enumerate(words) if w.letter == "G" and w.value in (0, 1, 2, 3)), None)
+    if motion is not None and first_g is not None and motion == int(words[first_g[0]].value):
+        motion = None  # `_with_motion` leaves the word: the plan is compiled without it
+    fields = {letter: "{%d}" % n for n, letter in enumerate(letters)}
+    plan = EditPlan.compile([w.letter for w in words], fields, len(letters), drop, motion, first_g, spelling(block))
+    if plan is None:
+        return
+    texts = {letter: f"{n}.5" for n, letter in enumerate(letters)}
+    assert plan.apply(block.raw, words, list(texts.values())) == edit_texts(block, texts, drop, motion)
+    sibling = parse_text(_other_digits(text, seed) + "\n")[0]
+    same_g = [w.number for w in sibling.words() if w.letter == "G"] == [w.number for w in words if w.letter == "G"]
+    if same_g and not plan.keeps_numbers and len(words) == len(block.items):
+        template = plan.template_for(block.raw, words)
+        assert template.format(*texts.values()) == edit_texts(sibling, texts, drop, motion)
+
+
+PLANNED_PROGRAM = """G20 G90 G18
+G0 X0 Y0 Z0
+G1 X1.2345 Z-0.5
+x1.3z-.5
+X1.4 (c) Z-0.45 F10.
+G3 X1.5 Z-0.45 I0.05 K0
+G2 X1.6 Y0.1 Z-0.3 R0.2
+G17 G91 G1 X0.1 Y0.1
+G90.1 G90 G3 X2 Y0.5 I1.7 J0.5
+G21
+G19 G91.1 G2 Y14.7 Z-7.62 J1 K0
+N10 G01 X5.000 Y6.000 Z-1.000
+X+5.5 Y-2.
+G17 G2 X5.5 Y-1. I0 J0.5 P2
+"""
+
+
+def _unplanned_writer():
+    """The writer with every line by its general path (no compiled plans)."""
+    from ncpp.program.dialects.iso import IsoWriter
+
+    class Unplanned(IsoWriter):
+        def _units(self, inch):
+            units = super()._units(inch)
+            units.plain = False
+            return units
+
+    return Unplanned()
+
+
+@PLAN_EXAMPLES
+@given(st.lists(st.tuples(st.integers(0, 2), st.floats(-0.01, 0.01)), min_size=1, max_size=40))
+def test_planned_lines_are_the_general_lines(moves):
+    """Edits and new blocks written by compiled plans equal those of the general path."""
+    from dataclasses import replace
+
+    from ncpp.motion.interpreter import interpret
+    from ncpp.motion.segments import Arc, Line
+    from ncpp.program.dialects.iso import IsoWriter
+
+    events = list(interpret(parse_text(PLANNED_PROGRAM)))
+    moved = []
+    for n, event in enumerate(events):
+        pieces, shift = moves[n % len(moves)]
+        if type(event) is Line or type(event) is Arc:
+            end = tuple(v + shift for v in event.end)
+            steps = [Line(event.start, tuple(v - shift for v in end), False, 1.0, event.block, event.context, changed=True)]
+            moved += steps[:pieces] + [replace(event, end=end, changed=bool(shift) or pieces > 0)] + steps[:pieces // 2]
+        else:
+            moved.append(event)
+    assert list(IsoWriter().write(moved)) == list(_unplanned_writer().write(moved))
+
+
+_digits = st.text("0123456789", max_size=3)
+_number = st.builds(lambda sign, whole, dot, frac: sign + whole + dot + frac, st.sampled_from(["", "-", "+"]), _digits, st.sampled_from(["", "."]), _digits)
+
+
+@PLAN_EXAMPLES
+@given(st.lists(_number.filter(lambda n: any(c.isdigit() for c in n) and ("." in n or not n.endswith(".")))))
+def test_a_letter_is_written_in_the_style_of_its_last_number(numbers):
+    """The styles learnt once per layout of a block (`X1.1`) are those read from each number (`X010.5`)."""
+    from ncpp.program.dialects.iso import IsoWriter
+
+    writer = IsoWriter()
+    for number in numbers:
+        block = parse_text(f"G1 X{number} Y{number}\n")[0]
+        writer._read_block(block)
+        assert writer.styles["X"] == writer.styles["Y"] == NumberStyle.of(number)

@@ -12,16 +12,18 @@ from __future__ import annotations
 
 import re
 from dataclasses import replace
+from operator import itemgetter
 from typing import Iterable, Iterator
 
 from ncpp.motion.segments import Arc, Context, Event, Line
 from ncpp.program.blocks import Block, Comment, ExprWord, Word
 from ncpp.program.numbers import NumberStyle, format_number
-from ncpp.program.writer import _with_motion, set_words, spelling
+from ncpp.program.writer import EditPlan, _literal, _with_motion, set_words, spelling
 
 AXES = "XYZ"
 _NUMBERED_AXES = tuple(enumerate(AXES))  # ((0, "X"), ...): no enumerate object per line written
 CENTRE_WORDS = {17: (("I", 0), ("J", 1)), 18: (("I", 0), ("K", 2)), 19: (("J", 1), ("K", 2))}  # (letter, axis), as written
+_CENTRE_AXES = {plane: (a, b) for plane, ((_, a), (_, b)) in CENTRE_WORDS.items()}
 MOTION_CODES = {0.0: 0, 1.0: 1, 2.0: 2, 3.0: 3}
 DEFAULT_STYLE = NumberStyle(decimals=4)
 GEOMETRY_LETTERS = "XYZIJKR"  # words a pass rewrites in a changed block
@@ -32,7 +34,20 @@ MOVING_LETTERS = "XYZABCUVWIJKR"  # words that make a block move (with the modal
 STYLED_LETTERS = frozenset(WRITTEN_LETTERS)
 DROPPED = ("I", "J", "K", "R", "P", ",R", ",C")  # words of the old geometry a changed block loses
 _DROPPED = frozenset(DROPPED)
+_BIT = {letter: 1 << n for n, letter in enumerate(WRITTEN_LETTERS)}  # a set of written letters is a bit mask
+_CENTRE_BITS = {plane: _BIT[a] | _BIT[b] for plane, ((a, _), (b, _)) in CENTRE_WORDS.items()}
+# Per bit mask: the letters written, in order, each with the index of its number in `_numbers`
+# (X Y Z: 0 1 2; an arc's two centre words: 3 4).
+_WRITTEN = tuple(
+    tuple((letter, n if n < 3 else 3 + sum(bool(bits & _BIT[c]) for c in WRITTEN_LETTERS[3:n])) for n, letter in enumerate(WRITTEN_LETTERS) if bits & _BIT[letter])
+    for bits in range(1 << len(WRITTEN_LETTERS))
+)
+_AXIS_BITS = _BIT["X"] | _BIT["Y"] | _BIT["Z"]
+_ANY_CENTRE = _BIT["I"] | _BIT["J"] | _BIT["K"]
+_UNKNOWN = object()  # a plan not compiled yet
 _SIGNATURE_WORD = re.compile(r"(.)([-+.\d]*)")  # a letter, and a G word's number
+_DIGITS_AS_ONE = bytes.maketrans(b"0123456789", b"1111111111")  # a block's layout: its text with every digit '1'
+_MAX_LAYOUTS = 10000  # layouts remembered (comments can make every layout new)
 
 
 class IsoWriter:
@@ -49,10 +64,14 @@ class IsoWriter:
         # Axes the program has positioned; before that the control's position is not
         # the interpreter's assumed zero, so a word must not be added for them.
         self.known_axes: set[str] = set()
-        self._shapes: dict[str, tuple] = {}  # per letter: the shape of the number its style was read from
+        # Per layout of a plain block's text (`_DIGITS_AS_ONE`): what its numbers teach, see `_read_layout`.
+        self._layouts: dict[bytes, tuple] = {}
+        self._interned_lessons: dict[tuple, tuple] = {}  # equal (letter, style) tuples are one
+        self._last_lesson: tuple | None = None  # the (letter, style) learnt last (learning them again changes nothing)
         # Derived from `styles`, emptied when a style changes: (letter, inch) -> style to write,
         # inch -> `_Written` (the styles of WRITTEN_LETTERS and the decimal places of X, Y, Z).
         self._resolved: dict = {}
+        self._interned_units: dict[tuple, _Written] = {}  # styles -> their `_Written`, so its plans outlive a style change
         self._facts_block: Block | None = None  # the last block asked about, and its facts
         self._facts_value: _Facts | None = None
         self._signature_facts: dict[str, _Facts] = {}  # the facts of plain blocks, by their `signature`
@@ -121,21 +140,61 @@ class IsoWriter:
                 facts = self._signature_facts[signature] = _Facts.of_signature(signature)
         self._facts_block, self._facts_value = block, facts
         if facts.styled:
-            self._learn_word_styles(block, facts)
+            if signature is None:
+                self._learn_word_styles(block, facts)
+            else:
+                self._learn_layout_styles(block, facts)
         return facts
 
     def _learn_word_styles(self, block: Block, facts: "_Facts") -> None:
-        """Learn the number styles of the block's styled words (when the shape of a number changes)."""
-        words = block.items
-        if len(words) != facts.words:  # comments (or statements) among the words
-            words = tuple(item for item in words if type(item) is Word)
-        shapes = self._shapes
+        """Learn the number styles of the block's styled words, reading each number."""
+        words = _words(block, facts)
         for n, letter in facts.styled:
-            number = words[n].number  # type: ignore[union-attr]
-            shape = (len(number), number.find("."), number[:1])  # cheap: styles rarely change
-            if shapes.get(letter) != shape:
-                shapes[letter] = shape
-                self._learn_style(letter, NumberStyle.of(number))
+            self._learn_style(letter, NumberStyle.of(words[n].number))  # type: ignore[union-attr]
+        self._last_lesson = None
+
+    def _learn_layout_styles(self, block: Block, facts: "_Facts") -> None:
+        """Learn the number styles of a plain block's styled words: the styles are those of
+        its layout's numbers, read once per layout, unless a number is zero-padded."""
+        raw = block.raw
+        layout = raw.encode("latin-1").translate(_DIGITS_AS_ONE)
+        lesson = self._layouts.get(layout)
+        if lesson is None:
+            lesson = self._read_layout(block, facts, layout)
+        styles, firsts, spelled = lesson
+        if spelled is not None:
+            self._spelled = (block, spelled)
+        if firsts is not None and "0" in firsts(raw):  # `X010.5`: the layout does not say the padding
+            self._learn_word_styles(block, facts)
+        elif styles is not self._last_lesson:
+            known = self.styles
+            for letter, style in styles:
+                if known.get(letter) is not style:
+                    self._learn_style(letter, style)
+            self._last_lesson = styles
+
+    def _read_layout(self, block: Block, facts: "_Facts", layout: bytes) -> tuple:
+        """(the (letter, style) of each styled word of the layout, a getter of the first digits of
+        its numbers with more than one digit before the point or None if there are none, its
+        `spelling` or None if its separator has digits, in a comment)."""
+        if len(self._layouts) >= _MAX_LAYOUTS:
+            self._layouts.clear()
+        text, words = layout.decode("latin-1"), _words(block, facts)
+        styles, firsts = [], []
+        for n, letter in facts.styled:
+            word = words[n]
+            number = text[word.end - len(word.number) : word.end]  # type: ignore[union-attr]
+            styles.append((letter, NumberStyle.of(number)))
+            digits = number.lstrip("+-").lstrip(" \t")
+            if len(digits.partition("," if "," in digits else ".")[0]) > 1:
+                firsts.append(word.end - len(digits))
+        spelled = spelling(block)
+        lesson = self._layouts[layout] = (
+            self._interned_lessons.setdefault(tuple(styles), tuple(styles)),
+            itemgetter(*firsts) if firsts else None,
+            None if any(map(str.isdigit, spelled[0])) else spelled,
+        )
+        return lesson
 
     def _learn_style(self, letter: str, style: NumberStyle) -> None:
         known = self.styles.get(letter)
@@ -209,7 +268,10 @@ class IsoWriter:
         found = self._resolved.get(inch)
         if found is None:
             units = _INCH if inch else _MM
-            found = self._resolved[inch] = _Written({letter: self._style(letter, units) for letter in WRITTEN_LETTERS})
+            styles = {letter: self._style(letter, units) for letter in WRITTEN_LETTERS}
+            key = tuple(styles.values())
+            found = self._interned_units.get(key) or self._interned_units.setdefault(key, _Written(styles))
+            self._resolved[inch] = found
         return found
 
     # -- changed blocks ---------------------------------------------------------
@@ -218,52 +280,58 @@ class IsoWriter:
             return 3 if segment.turn > 0 else 2
         return 0 if segment.rapid else 1
 
-    def _texts(self, block: Block, segment: Line | Arc) -> dict[str, str]:
-        """The words to write for the segment, letter -> number as the output writes it:
-        the axes the block had and whatever moved in the output, then an arc's centre."""
-        # runs once per line written: the cached look-ups of `_facts` and `_units` are inlined
-        facts = self._facts_value if block is self._facts_block else self._facts(block)
-        present = facts.letters  # type: ignore[union-attr]
-        context, end = segment.context, segment.end
-        units = self._resolved.get(context.inch) or self._units(context.inch)
-        styles = units.styles
-        texts: dict[str, str] = {}
-        if context.absolute:
-            known, places, last, last_places = self.known_axes, units.places, self._last_end, self._last_places
-            for n, axis in _NUMBERED_AXES:
-                if axis in present or (
-                    axis in known and (last is None or _written_apart(end[n], places[n], last[n], last_places[n]))
-                ):
-                    style = styles[axis]  # `format_number`, its common case inlined:
-                    texts[axis] = format(end[n], style.spec) if style.spec else format_number(end[n], style)
-        else:
-            decimals = units.places
+    def _written_bits(self, facts: "_Facts", segment: Line | Arc, units: "_Written") -> int:
+        """The letters the segment writes (a mask of `_BIT`): the axes the block has and
+        whatever moved in the output, then an arc's centre."""
+        bits, absent, end = facts.axis_bits, facts.absent_axes, segment.end
+        if absent and segment.context.absolute:
+            known, last = self.known_axes, self._last_end
+            places, last_places = units.places, self._last_places
+            for n, axis, bit in absent:
+                # written apart from the output's last end: rounded only when the numbers differ
+                if axis in known and (last is None or (
+                    (end[n] != last[n] or places[n] != last_places[n]) and round(end[n], places[n]) != round(last[n], last_places[n])
+                )):  # fmt: skip
+                    bits |= bit
+        elif absent:
             start = segment.start
-            for n, axis in _NUMBERED_AXES:
-                delta = end[n] - start[n]
-                if axis in present or round(delta, decimals[n]) != 0.0:
-                    texts[axis] = format_number(delta, styles[axis])
+            for n, axis, bit in absent:
+                if round(end[n] - start[n], units.places[n]) != 0.0:
+                    bits |= bit
         if type(segment) is Arc:
-            centre, origin = segment.center, (0.0, 0.0, 0.0) if context.arc_absolute else segment.start
-            for letter, axis in CENTRE_WORDS[context.plane]:
-                texts[letter] = format_number(centre[axis] - origin[axis], styles[letter])
-        return texts
+            bits |= _CENTRE_BITS[segment.context.plane]
+        return bits
+
+    @staticmethod
+    def _numbers(segment: Line | Arc) -> tuple[float, ...]:
+        """The numbers the segment writes, indexed as in `_WRITTEN`."""
+        context, end = segment.context, segment.end
+        if not context.absolute:
+            start = segment.start
+            end = (end[0] - start[0], end[1] - start[1], end[2] - start[2])
+        if type(segment) is not Arc:
+            return end
+        centre, (a, b) = segment.center, _CENTRE_AXES[context.plane]
+        if context.arc_absolute:
+            return (*end, centre[a], centre[b])
+        start = segment.start
+        return (*end, centre[a] - start[a], centre[b] - start[b])
+
+    def _texts(self, block: Block, segment: Line | Arc) -> dict[str, str]:
+        """The words to write for the segment, letter -> number as the output writes it."""
+        units = self._units(segment.context.inch)
+        numbers = self._numbers(segment)
+        styles = units.styles
+        return {letter: format_number(numbers[n], styles[letter]) for letter, n in _WRITTEN[self._written_bits(self._facts(block), segment, units)]}
 
     def _edit_block(self, block: Block, segment: Line | Arc) -> str:
-        facts = self._facts(block)
-        texts = self._texts(block, segment)
+        facts = self._facts_value if block is self._facts_block else self._facts(block)  # `_facts`, inlined
         code = self._motion_code(segment)
-        # centre words of the old arc, and Fanuc corner words: the corner is now explicit;
-        # P is an arc's turn count, but a dwell time (G4) or blending tolerance (G64) elsewhere
-        drop = [] if facts.letters.isdisjoint(_DROPPED) else [l for l in DROPPED if l in facts.letters and l not in texts]
-        if "P" in drop and not self._arc_block(block):
-            drop.remove("P")
-        edited = block
-        if facts.first_motion != code and (code != self.output_motion or facts.motion_word):
-            edited = _with_motion(block, code)
-        # words the block lacks are appended spelled as the block was read (before a G word is inserted)
-        spelled = None if facts.letters.issuperset(texts) else self._spelling(block)
-        raw = set_words(edited, texts, drop, spelled)
+        # the block's motion word is set when it says another motion, or when the output's mode is another
+        motion = code if facts.first_motion != code and (code != self.output_motion or facts.motion_word) else None
+        raw = self._planned_edit(block, facts, segment, motion)
+        if raw is None:
+            raw = self._general_edit(block, facts, segment, motion)
         if facts.motion_word or code != self.output_motion:
             self.output_motion = code
         if facts.motion_word:
@@ -271,24 +339,95 @@ class IsoWriter:
         self._remember_end(segment)
         return raw
 
-    def _new_block(self, block: Block, segment: Line | Arc) -> str:
+    def _planned_edit(self, block: Block, facts: "_Facts", segment: Line | Arc, motion: int | None) -> str | None:
+        """The edit by a plan compiled for the block's signature (None: a block no plan covers)."""
+        inch = segment.context.inch
+        units = self._resolved.get(inch) or self._units(inch)
+        signature = block.signature
+        if signature is None or not units.plain or "P" in facts.letters:  # P: a turn count or not, see `_general_edit`
+            return None
+        bits = self._written_bits(facts, segment, units)
+        # words the block lacks are appended spelled as the block was read
+        spelled = self._spelling(block) if bits & ~facts.bits or (motion is not None and facts.motion_at is None) else None
+        raw = block.raw
+        # the block's layout, and a plan: blocks of one layout without comments whose numbers the
+        # plan writes or drops all (but G words', in the signature) are its template with their numbers
+        key = (raw.encode("latin-1").translate(_DIGITS_AS_ONE), signature, bits, motion, spelled)
+        edit = units.edits.get(key)
+        if edit is None:
+            plan = self._edit_plan(facts, signature, bits, motion, spelled, units)
+            if plan is None:
+                return None
+            if len(units.edits) >= _MAX_LAYOUTS:
+                units.edits.clear()
+            comments = len(block.items) != facts.words
+            edit = units.edits[key] = plan if plan.keeps_numbers or comments else plan.template_for(raw, block.items)  # type: ignore[arg-type]
+        if type(edit) is str:
+            return edit.format(*self._numbers(segment))
+        return edit.apply(raw, _words(block, facts), self._numbers(segment))
+
+    @staticmethod
+    def _edit_plan(facts: "_Facts", signature: str, bits: int, motion: int | None, spelled: tuple[str, bool] | None, units: "_Written") -> EditPlan | None:
+        """The plan of an edit of a block with this signature, compiled once."""
+        key = (signature, bits, motion, spelled)
+        plan = units.edit_plans.get(key, _UNKNOWN)
+        if plan is _UNKNOWN:
+            dropped = [letter for letter in DROPPED if letter in facts.letters and not bits & _BIT.get(letter, 0)]
+            plan = units.edit_plans[key] = EditPlan.compile(
+                facts.word_letters, units.fields(bits), 5 if bits & _ANY_CENTRE else 3, dropped, motion, facts.motion_at, spelled or (" ", False)
+            )
+        return plan  # type: ignore[return-value]
+
+    def _general_edit(self, block: Block, facts: "_Facts", segment: Line | Arc, motion: int | None) -> str:
         texts = self._texts(block, segment)
-        sep, lower = self._spelling(block)
+        # centre words of the old arc, and Fanuc corner words: the corner is now explicit;
+        # P is an arc's turn count, but a dwell time (G4) or blending tolerance (G64) elsewhere
+        drop = [] if facts.letters.isdisjoint(_DROPPED) else [l for l in DROPPED if l in facts.letters and l not in texts]
+        if "P" in drop and not self._arc_block(block):
+            drop.remove("P")
+        # words the block lacks are appended spelled as the block was read (before a G word is inserted)
+        spelled = None if facts.letters.issuperset(texts) else self._spelling(block)
+        return set_words(block if motion is None else _with_motion(block, motion), texts, drop, spelled)
+
+    def _new_block(self, block: Block, segment: Line | Arc) -> str:
+        # once per line written: the cached look-ups of `_facts`, `_units` and `_spelling` inlined
+        facts = self._facts_value if block is self._facts_block else self._facts(block)
+        inch = segment.context.inch
+        units = self._resolved.get(inch) or self._units(inch)
         code = self._motion_code(segment)
-        words = map(str.__add__, texts, texts.values())  # letter + number, no Python frame per word
-        if code == self.output_motion:
-            text = sep.join(words)
+        motion = code if code != self.output_motion else None
+        bits = self._written_bits(facts, segment, units)
+        spelled_block, spelled = self._spelled
+        if spelled_block is not block:
+            spelled = self._spelling(block)
+        if units.plain:
+            key = (bits, motion, spelled)
+            template = units.new_templates.get(key)
+            if template is None:
+                template = units.new_templates[key] = _new_block_text(units.fields(bits), motion, (_literal(spelled[0]), spelled[1]))
+            text = template.format(*self._numbers(segment))
         else:
-            text = sep.join([f"G{code}", *words])
+            numbers, styles = self._numbers(segment), units.styles
+            texts = {letter: format_number(numbers[n], styles[letter]) for letter, n in _WRITTEN[bits]}
+            text = _new_block_text(texts, motion, spelled)
+        if motion is not None:
             self.output_motion = code
         self._remember_end(segment)
-        return text.lower() if lower else text
+        return text
+
+
+def _new_block_text(words: dict[str, str], motion: int | None, spelled: tuple[str, bool]) -> str:
+    """A new block of `words` (letter -> number text, or a format field), after `G<motion>` when it is set."""
+    sep, lower = spelled
+    text = sep.join([letter + number for letter, number in words.items()] if motion is None else [f"G{motion}", *(letter + number for letter, number in words.items())])
+    return text.lower() if lower else text
 
 
 class _Facts:
     """What the writer asks about a block."""
 
-    __slots__ = ("letters", "motion_word", "motion", "first_motion", "moves", "plain", "words", "styled")
+    __slots__ = ("letters", "motion_word", "motion", "first_motion", "moves", "plain", "words", "styled",
+                 "word_letters", "motion_at", "bits", "axis_bits", "absent_axes")  # fmt: skip
 
     def __init__(self, block: Block | None = None):
         """The facts of `block`, read in one walk over its items (none: a block without words)."""
@@ -300,23 +439,33 @@ class _Facts:
         self.plain = True  # only words and comments
         self.words = 0  # how many plain words it has
         self.styled: tuple[tuple[int, str], ...] = ()  # (n, letter) of its n-th word when the writer learns its style
+        self.word_letters: list[str] = []  # the letters of its plain words, in order
+        self.motion_at: tuple[int, str] | None = None  # (n, number as written) of its first G0-G3 word, the n-th word
         for item in block.items if block is not None else ():
             kind = type(item)
             if kind is Word:
-                self._read_word(item.letter, item.value)
+                self._read_word(item.letter, item.value, item.number)
             elif kind is not Comment:
                 self.plain = False
+        self._sum_up()
 
     @classmethod
     def of_signature(cls, signature: str) -> "_Facts":
         """The facts of a plain block with this `Block.signature`."""
         facts = cls()
         for letter, number in _SIGNATURE_WORD.findall(signature):
-            facts._read_word(letter, float(number) if number else 0.0)
+            facts._read_word(letter, float(number) if number else 0.0, number)
+        facts._sum_up()
         return facts
 
-    def _read_word(self, letter: str, value: float) -> None:
+    def _sum_up(self) -> None:
+        self.bits = sum(bit for letter, bit in _BIT.items() if letter in self.letters)  # the written letters it has
+        self.axis_bits = self.bits & _AXIS_BITS
+        self.absent_axes = tuple((n, axis, _BIT[axis]) for n, axis in _NUMBERED_AXES if axis not in self.letters)
+
+    def _read_word(self, letter: str, value: float, number: str) -> None:
         self.letters.add(letter)
+        self.word_letters.append(letter)
         if letter in STYLED_LETTERS:
             self.styled += ((self.words, letter),)
         self.words += 1
@@ -325,27 +474,39 @@ class _Facts:
             if code is not None:
                 self.motion_word, self.motion = True, code
                 if self.first_motion is None:
-                    self.first_motion = code
+                    self.first_motion, self.motion_at = code, (self.words - 1, number)
             elif 73 <= value <= 89:
                 self.motion_word, self.motion = True, None
         elif letter in MOVING_LETTERS:
             self.moves = True
 
 
-def _written_apart(a: float, a_places: int, b: float, b_places: int) -> bool:
-    """Whether `a` and `b` are written as different numbers (rounded only when they are not the same number)."""
-    return (a != b or a_places != b_places) and round(a, a_places) != round(b, b_places)
+def _words(block: Block, facts: _Facts) -> tuple[Word, ...]:
+    """The plain words of the block, in order."""
+    items = block.items
+    return items if len(items) == facts.words else tuple(item for item in items if type(item) is Word)  # type: ignore[return-value]
 
 
 class _Written:
     """How the output writes numbers in one system of units: the style of each letter
     it writes, and the decimal places of X, Y and Z."""
 
-    __slots__ = ("styles", "places")
+    __slots__ = ("styles", "places", "plain", "edit_plans", "edits", "new_templates")
 
     def __init__(self, styles: dict[str, NumberStyle]):
         self.styles = styles
         self.places: tuple[int, int, int] = tuple(styles[axis].decimals for axis in AXES)  # type: ignore[assignment]
+        self.plain = all(style.plain for style in styles.values())  # every number one `format` spec: plans apply
+        # Compiled lines: (signature, written bits, motion, spelling) -> `EditPlan` (None: none applies),
+        # (layout, signature, ...) -> that plan, or the format template it makes of such blocks,
+        # (written bits, motion, spelling) -> the format template of a new block.
+        self.edit_plans: dict[tuple, EditPlan | None] = {}
+        self.edits: dict[tuple, EditPlan | str] = {}
+        self.new_templates: dict[tuple, str] = {}
+
+    def fields(self, bits: int) -> dict[str, str]:
+        """The written letters of the mask, each with its number as a field of `IsoWriter._numbers`."""
+        return {letter: "{%d:%s}" % (n, self.styles[letter].spec) for letter, n in _WRITTEN[bits]}
 
 
 class _Units:
