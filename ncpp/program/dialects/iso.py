@@ -66,6 +66,7 @@ class IsoWriter:
         self.known_axes: set[str] = set()
         # Per layout of a plain block's text (`_DIGITS_AS_ONE`): what its numbers teach, see `_read_layout`.
         self._layouts: dict[bytes, tuple] = {}
+        self._layout: tuple[Block | None, bytes] = (None, b"")  # the last block whose layout was read, and it
         self._interned_lessons: dict[tuple, tuple] = {}  # equal (letter, style) tuples are one
         self._last_lesson: tuple | None = None  # the (letter, style) learnt last (learning them again changes nothing)
         # Derived from `styles`, emptied when a style changes: (letter, inch) -> style to write,
@@ -157,7 +158,7 @@ class IsoWriter:
         """Learn the number styles of a plain block's styled words: the styles are those of
         its layout's numbers, read once per layout, unless a number is zero-padded."""
         raw = block.raw
-        layout = raw.encode("latin-1").translate(_DIGITS_AS_ONE)
+        layout = self._layout_of(block)
         lesson = self._layouts.get(layout)
         if lesson is None:
             lesson = self._read_layout(block, facts, layout)
@@ -172,6 +173,14 @@ class IsoWriter:
                 if known.get(letter) is not style:
                     self._learn_style(letter, style)
             self._last_lesson = styles
+
+    def _layout_of(self, block: Block) -> bytes:
+        """The block's raw text with every digit '1' (read once per block: styles and edits ask)."""
+        known, layout = self._layout
+        if known is not block:
+            layout = block.raw.encode("latin-1").translate(_DIGITS_AS_ONE)
+            self._layout = (block, layout)
+        return layout
 
     def _read_layout(self, block: Block, facts: "_Facts", layout: bytes) -> tuple:
         """(the (letter, style) of each styled word of the layout, a getter of the first digits of
@@ -352,7 +361,7 @@ class IsoWriter:
         raw = block.raw
         # the block's layout, and a plan: blocks of one layout without comments whose numbers the
         # plan writes or drops all (but G words', in the signature) are its template with their numbers
-        key = (raw.encode("latin-1").translate(_DIGITS_AS_ONE), signature, bits, motion, spelled)
+        key = (self._layout_of(block), signature, bits, motion, spelled)
         edit = units.edits.get(key)
         if edit is None:
             plan = self._edit_plan(facts, signature, bits, motion, spelled, units)
