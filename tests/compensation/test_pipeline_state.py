@@ -18,3 +18,13 @@ def test_the_garbage_collector_threshold_is_restored():
     process(io.BytesIO(PROGRAM), out, file="t.ngc", source=source)
     assert gc.get_threshold() == before
     assert out.getvalue().count(b"\n") >= PROGRAM.count(b"\n")
+
+
+def test_lines_in_are_counted_with_and_without_progress():
+    program = b"G21 G90\n" + b"G1 X1 Y2 F100\nX2 Y3\n" * 1500 + b"M2"  # 3002 lines, the last without a newline
+    reported: list[int] = []
+    quiet = process(io.BytesIO(program), io.BytesIO(), file="t.ngc")
+    told = process(io.BytesIO(program), io.BytesIO(), file="t.ngc", progress=reported.append)
+    assert quiet.lines_in == told.lines_in == 3002
+    assert reported == [1000, 2000, 3000]
+    assert quiet.lines_out == 3002
