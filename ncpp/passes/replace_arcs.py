@@ -23,7 +23,7 @@ from numpy.typing import NDArray
 
 from ncpp.motion.segments import PLANE_AXES, Arc, Event, Line
 from ncpp.passes.context import PassContext
-from ncpp.passes.geometry import chunked, compensate, frames, points, spliced
+from ncpp.passes.geometry import compensate, frames, points, spliced
 from ncpp.passes.travel import grid, quantize
 
 # Points per piece where the fit is checked (ends included).  Fewer on short
@@ -39,9 +39,9 @@ REVERSAL_WINDOW = 0.002
 # mm: nor is one that takes the axis back by less than this (a 10⁻⁵ rad rotation
 # of the compensated frame moves a quadrant's extreme a µm past its end)
 REVERSAL_HEIGHT = 1e-7
-# Arcs are replaced independently, BATCH_ARCS at a time (their sample arrays bound
-# the memory), from batches of BATCH_EVENTS events, so that programs with few arcs
-# among their lines do not pay numpy's per-call cost per arc.
+# Arcs are replaced independently, a batch at a time: a batch holds up to BATCH_ARCS
+# arcs (their events and sample arrays bound the memory) and up to BATCH_EVENTS events,
+# so that programs with few arcs among their lines do not pay numpy's per-call cost per arc.
 BATCH_ARCS = 1024
 BATCH_EVENTS = 16384
 SLIVER = 0.01  # mm of arc length below which a piece becomes a line (its bulge is < 0.1 µm for radii over 0.1 mm)
@@ -57,15 +57,24 @@ class _Pieces:
 
 
 def replace_arcs(events: Iterable[Event], ctx: PassContext) -> Iterator[Event]:
-    for batch in chunked(events, BATCH_EVENTS):
+    for batch in _batches(events):
         index = [k for k, e in enumerate(batch) if type(e) is Arc and not e.changed]
-        done = 0  # events of the batch written so far
-        for first in range(0, len(index), BATCH_ARCS):
-            arcs = index[first : first + BATCH_ARCS]
-            replaced = _replace([batch[k] for k in arcs], ctx)
-            yield from spliced(batch[done : arcs[-1] + 1], [k - done for k in arcs], replaced)
-            done = arcs[-1] + 1
-        yield from batch[done:]
+        yield from spliced(batch, index, _replace([batch[k] for k in index], ctx) if index else [])
+
+
+def _batches(events: Iterable[Event]) -> Iterator[list[Event]]:
+    """Lists of up to BATCH_EVENTS events holding up to BATCH_ARCS arcs."""
+    batch: list[Event] = []
+    arcs = 0
+    for event in events:
+        batch.append(event)
+        if type(event) is Arc:
+            arcs += 1
+        if arcs == BATCH_ARCS or len(batch) == BATCH_EVENTS:
+            yield batch
+            batch, arcs = [], 0
+    if batch:
+        yield batch
 
 
 class _ArcGeometry:
