@@ -52,10 +52,15 @@ def ncpp_process_rate(path: Path, offset: tuple[float, float, float] | None) -> 
 REPEATS = 3  # runs per tool; the fastest counts (the same for every tool: this machine's timing is noisy)
 
 
-def fastest(run: Callable[[], dict[str, Any]], repeats: int = REPEATS) -> dict[str, Any]:
-    """The run with the fewest seconds of `repeats` runs, with how many were made."""
-    best = min((run() for _ in range(repeats)), key=lambda result: result["seconds"])
-    return {**best, "runs": repeats}
+def fastest(runs: dict[str, Callable[[], dict[str, Any]]], repeats: int = REPEATS) -> dict[str, dict[str, Any]]:
+    """Per tool, the run with the fewest seconds of `repeats` runs, with how many were made.
+    The tools take turns (round robin): this shared machine's speed drifts over minutes,
+    and a tool whose runs all fell in a slow spell would be judged by it."""
+    results: dict[str, list[dict[str, Any]]] = {name: [] for name in runs}
+    for _ in range(repeats):
+        for name, run in runs.items():
+            results[name].append(run())
+    return {name: {**min(done, key=lambda result: result["seconds"]), "runs": repeats} for name, done in results.items()}
 
 
 STAGES = ("parse", "interpret", "subdivide_lines", "replace_arcs", "apply_error_map", "writer")
@@ -116,9 +121,12 @@ def compensate_speed(ctx):
     for label, path in programs.items():
         offset = work_offset(path)
         lines = bench.count_lines(path)
-        passthrough = fastest(lambda: ncpp_process_rate(path, None))
-        compensated = fastest(lambda: ncpp_process_rate(path, offset))
-        pyg = fastest(lambda: bench.pygcode_rate(path))
+        best = fastest({
+            "passthrough": lambda: ncpp_process_rate(path, None),
+            "compensate": lambda: ncpp_process_rate(path, offset),
+            "pygcode": lambda: bench.pygcode_rate(path),
+        })  # fmt: skip
+        passthrough, compensated, pyg = best["passthrough"], best["compensate"], best["pygcode"]
         rs = bench.rs274_rate(path, lines)
         ratio = compensated["lines_per_s"] / pyg["lines_per_s"]
         stages = stage_seconds(path, offset)
