@@ -352,7 +352,7 @@ class Interpreter:
         _, code, letters, xyz = move
         items = block.items
         words_from = len(items) - len(letters)  # after N and G
-        if xyz is not None and code is not None and self._straight_plain(code):
+        if xyz is not None and code is not None and self._enter_straight_motion(code):
             end = self.pos[:]
             for i, item in zip(xyz, items[words_from:]):
                 end[i] = item.value
@@ -365,8 +365,9 @@ class Interpreter:
             return self._modal_move(block, words, motion)
         return None
 
-    def _straight_plain(self, code: float) -> bool:
-        """`G0` / `G1` of axis words that need no check: the motion becomes modal (`_motion_move`)."""
+    def _enter_straight_motion(self, code: float) -> bool:
+        """Make `code` the modal motion when it is a `G0` / `G1` whose axis words need no
+        check (as `_motion_move` would); False (nothing changed) leaves the block to the checks."""
         if not self.absolute or code > 1.0 or (code == 1.0 and self.inverse_time):
             return False
         self.motion = code
