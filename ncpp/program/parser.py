@@ -23,7 +23,8 @@ from lark import Token, Transformer, v_args
 from ncpp.errors import Location, NcppError
 from ncpp.program.blocks import AnyItem, Block, Comment, ExprWord, Statement, Word
 
-_GAP = "[ \\t\\r\\f\\v\\x1a]*"
+_GAP_CHARS = " \\t\\r\\f\\v\\x1a"  # blanks between items (as a regex class body)
+_GAP = f"[{_GAP_CHARS}]*"
 
 
 def grammar_path(name: str) -> Path:
@@ -248,11 +249,13 @@ class LineParser:
                 text = found[paren]
                 pos = start + len(text)
                 append(Comment(text[1:-1], "(", start, pos))
-            else:
+            elif found[semi]:
                 text = found[semi]
                 pos = start + len(text)
                 append(Comment(text[1:], ";", start, pos))
-        # findall skips what no item matches: then `pos` falls short of a non-blank rest
+            else:  # a character no item starts with: the LALR parser says what is wrong
+                return None
+        # nothing was skipped (any non-blank is an item or the stray character above): only blanks may follow
         if pos == len(raw) or self._blank.match(raw, pos):
             return tuple(items), (None if two_letters else signature)
         return None
@@ -275,7 +278,9 @@ class _PlainItems:
     [1] [2] the letter and the number (as written) of a WORD, split after the
     character class WORD starts with, and at `comma` / `paren` / `semi` the text
     of a COMMA_WORD / PAREN_COMMENT / SEMI_COMMENT (a never-matching group
-    stands for a terminal the dialect does not take)."""
+    stands for a terminal the dialect does not take); else a stray character.
+    The stray character matters: findall would skip it, and the spans, which
+    follow from the lengths of what it found, would be wrong."""
 
     OTHERS = ("COMMA_WORD", "PAREN_COMMENT", "SEMI_COMMENT")
 
@@ -285,7 +290,7 @@ class _PlainItems:
         if split is None:
             raise ValueError("the plain-line scanner needs a WORD that starts with a one-letter class")
         others = [f"(?P<{name}>{patterns[name] if name in names else '(?!)'})" for name in self.OTHERS]
-        pattern = re.compile(f"({_GAP})(?:({split[1]})({split[2]})|{'|'.join(others)})")
+        pattern = re.compile(f"({_GAP})(?:({split[1]})({split[2]})|{'|'.join(others)}|[^{_GAP_CHARS}])")
         self.findall = pattern.findall
         self.comma, self.paren, self.semi = (pattern.groupindex[name] - 1 for name in self.OTHERS)
 

@@ -66,6 +66,16 @@ def test_fast_path_agrees_with_lalr_parser_on_corpus():
     assert checked > 20_000
 
 
+@pytest.mark.parametrize("raw", ["X1 @;c   ", "G1 X1 $;comment    ", "@@(;;)@;c   ", "X1 @ Y2", "X1 Y2 #"])
+def test_a_stray_character_is_left_to_the_lalr_parser(raw):
+    """The scanner's spans follow from the lengths of what it read: a character it
+    skipped would shift them (and hide the error); the grammar must see the line."""
+    parser = LineParser("iso")
+    assert parser._scan_plain(raw) is None
+    with pytest.raises(NcppError):
+        parser.parse(raw, "", 1, "t.ngc")
+
+
 def test_cli_passthrough_is_byte_identical(tmp_path):
     path = CORPUS / "iso_gcode/cncjs_toolpath_fixtures/arc-no-plane.nc"  # CRLF
     out = subprocess.run([sys.executable, "-m", "ncpp"], input=path.read_bytes(), capture_output=True, check=True)
