@@ -48,6 +48,7 @@ _UNKNOWN = object()  # a plan not compiled yet
 _SIGNATURE_WORD = re.compile(r"(.)([-+.\d]*)")  # a letter, and a G word's number
 _DIGITS_AS_ONE = bytes.maketrans(b"0123456789", b"1111111111")  # a block's layout: its text with every digit '1'
 _MAX_LAYOUTS = 10000  # layouts remembered (comments can make every layout new)
+_MAX_UNITS = 64  # sets of number styles remembered with their compiled lines (a program uses a few)
 
 
 class IsoWriter:
@@ -279,7 +280,11 @@ class IsoWriter:
             units = _INCH if inch else _MM
             styles = {letter: self._style(letter, units) for letter in WRITTEN_LETTERS}
             key = tuple(styles.values())
-            found = self._interned_units.get(key) or self._interned_units.setdefault(key, _Written(styles))
+            found = self._interned_units.get(key)
+            if found is None:
+                if len(self._interned_units) >= _MAX_UNITS:  # each holds compiled lines: keep memory flat
+                    self._interned_units.clear()
+                found = self._interned_units[key] = _Written(styles)
             self._resolved[inch] = found
         return found
 
