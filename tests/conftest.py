@@ -35,3 +35,14 @@ def corpus() -> Path:
     if not CORPUS.is_dir():
         pytest.skip(f"corpus not found at {CORPUS}")
     return CORPUS
+
+
+def expected_signature(items) -> str | None:
+    """`Block.signature` of a plain line's items: its word letters in order, each G word
+    with its number as written; None when a word has two letters (`,R`)."""
+    from ncpp.program.blocks import Word
+
+    words = [i for i in items if type(i) is Word]
+    if any(len(w.letter) > 1 for w in words):
+        return None
+    return "".join(w.letter + w.number * (w.letter == "G") for w in words)
