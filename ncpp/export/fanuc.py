@@ -1,25 +1,35 @@
 """FANUC stored pitch error compensation (parameters 3620–3624) and backlash (1851).
 
-FANUC's scheme (Series 0i/16i/18i/30i parameter manuals, "pitch error
-compensation"): compensation points are equidistant, every `interval`
-(3624) from the reference position, which is compensation point number 3620.
-The value stored for point n is an *incremental* correction in detection
-units, output while the axis passes the interval that ends at point n
-(between points n−1 and n); each value lies in −7..+7 and is multiplied by the
-magnification 3623 (0 or 1 → ×1, at most ×100).  3621 / 3622 are the point
-numbers at the negative and positive ends.  The correction is zero at the
-reference position: an error there is an offset of the reference position.
+Checked against (see tests/export/test_tables.py for where each is used):
+  * FANUC Series 0i-PB parameter manual B-63980EN/01, p. 100
+    (http://cncmanuals.com/fanuc/217/series-0i-pb-parameter-manual/page/108):
+    "The compensation value is output at the compensation position No.
+    corresponding to each section between the coordinates"; the example's
+    values are small signed integers, an *increment* per section, whose
+    running sum is the "pitch error compensation amount (absolute value)".
+  * FANUC technical report A-77810E (16i/18i bidirectional pitch error
+    compensation) lists 3620 reference point number, 3621 / 3622 most
+    distant point on the − / + side, 3623 magnification, 3624 interval,
+    3605#0 bidirectional, 3626 / 3627 for the − direction.
 
-So with C(x) = −(e(x) − e(x_ref)) the wanted correction in detection units,
-point k's value is v_k = round(C_k/M) − round(C_{k−1}/M): rounding the
-running sum, not each step, keeps the error from drifting along the axis.
-M is the smallest magnification that brings every |v_k| within 7.
+So point number n stands for a *section*: the interval that ends at
+x_ref + (n − 3620)·3624.  3620 is the section that ends at the reference
+position; 3621 the first section of the table (no point is spent below the
+table start), 3622 the last.  With C(x) = −(e(x) − e(x_ref)) the wanted
+correction in detection units, section k gets v_k = round(C_k/M) −
+round(C_{k−1}/M): rounding the running sum, not each step, keeps the error
+from drifting along the axis.  M (3623) is the smallest magnification that
+brings every |v_k| within 7.
+
+NOT verified (no primary source found; from memory): the ±7 range of a
+value, 0..1023 point numbers, that a value is the correction to *add*
+(−Δe, not the error), the tape syntax `N<param>A<axis>P<value>` and
+`N<10000+point>P<value>`, and backlash parameter 1851 in detection units.
 
 Reversal: the pitch table corrects travel in the + direction (reference
-return in +, ZMIx = 0); the backlash parameter 1851 takes the mean extra
-error of − travel, e₋ − e₊ (positive = lost motion).  Position-dependent
-reversal (bidirectional pitch compensation, 3605#0) is not written; its
-spread is reported.
+return in +); 1851 takes the mean extra error of − travel, e₋ − e₊
+(positive = lost motion).  Position-dependent reversal (bidirectional pitch
+compensation, 3605#0, 3626, 3627) is not written; its spread is reported.
 """
 
 from __future__ import annotations
@@ -43,11 +53,14 @@ def write_fanuc_pitch(
     spacing: float | None = None,
     reference: float = 0.0,
     detection_unit: float = 0.001,
-    first_point: int = 0,
+    reference_number: int | None = None,
     axis_number: int | None = None,
     max_points: int = MAX_POINTS,
 ) -> tuple[str, list[str]]:
-    """Parameter listing (text with `(...)` comments) and the notes on what was changed."""
+    """Parameter listing (text with `(...)` comments) and the notes on what was changed.
+
+    `reference_number` is 3620; by default the lowest that keeps every
+    section number >= 0."""
     notes: list[str] = []
     lo, hi = error.lo, error.hi
     if not lo <= reference <= hi:
@@ -56,15 +69,15 @@ def write_fanuc_pitch(
         reference = clipped
     du = detection_unit
     span = hi - lo
-    finest = span / (max_points - 1)
-    interval = spacing if spacing is not None else max(finest, span / 64)  # 64 points is a usual allocation
+    finest = span / max_points  # max_points sections
+    interval = spacing if spacing is not None else max(finest, span / 64)  # 64 sections is a usual allocation
     if interval < finest:
         notes.append(f"FANUC: interval {interval:g} mm needs more than {max_points} points; widened")
         interval = finest
     interval = math.ceil(interval / du - 1e-9) * du  # an integer number of detection units
     k_lo = -int(math.ceil((reference - lo) / interval - 1e-9))
     k_hi = int(math.ceil((hi - reference) / interval - 1e-9))
-    k = np.arange(k_lo, k_hi + 1)
+    k = np.arange(k_lo, k_hi + 1)  # section k ends at x_k; k_lo is only the start of the first one
     x = reference + k * interval
     fwd = error.forward(x)
     wanted = -(fwd - error.forward(np.array([reference]))[0]) / du  # detection units, 0 at the reference
@@ -75,20 +88,21 @@ def write_fanuc_pitch(
             "clipped (use a smaller --spacing)"
         )
         steps = np.clip(steps, -MAX_STEP, MAX_STEP)
-    steps[0] = 0  # the negative-end point's value would act below the table
-    achieved = np.cumsum(steps) * magnification
+    steps = steps[1:]  # one value per section, sections k_lo+1 .. k_hi
+    achieved = np.concatenate([[0], np.cumsum(steps)]) * magnification
     achieved -= achieved[k == 0][0]
     residual = float(np.max(np.abs(achieved - wanted))) * du
     reversal = (error.reverse(x) - fwd) / du
     backlash = int(round(float(np.mean(reversal))))
-    ref_number = first_point - k_lo
-    if ref_number < 0 or first_point + len(x) - 1 >= max_points:
-        raise NcppError(f"point numbers {first_point}..{first_point + len(x) - 1} exceed 0..{max_points - 1}")
+    ref_number = max(0, -k_lo - 1) if reference_number is None else reference_number
+    first, last = ref_number + k_lo + 1, ref_number + k_hi
+    if first < 0 or last >= max_points:
+        raise NcppError(f"point numbers {first}..{last} exceed 0..{max_points - 1}")
     a = axis_number if axis_number is not None else "XYZ".index(error.axis) + 1
     params = [
-        (3620, ref_number, f"point number of the reference position, {reference:g} mm"),
-        (3621, first_point, f"point number at the negative end, {x[0]:g} mm"),
-        (3622, first_point + len(x) - 1, f"point number at the positive end, {x[-1]:g} mm"),
+        (3620, ref_number, f"number of the section ending at the reference position, {reference:g} mm"),
+        (3621, first, f"most negative section, {x[0]:g} .. {x[1]:g} mm"),
+        (3622, last, f"most positive section, {x[-2]:g} .. {x[-1]:g} mm"),
         (3623, magnification, "magnification of the values"),
         (3624, round(interval / du), f"interval between points in detection units = {interval:g} mm"),
         (1851, backlash, "backlash in detection units = mean of e- minus e+"),
@@ -97,16 +111,19 @@ def write_fanuc_pitch(
         f"NCPP EXPORT-TABLE {error.name} OF AXIS {error.axis} AS FANUC PITCH ERROR COMPENSATION",
         f"parameter tape format: N<parameter> A<axis {a}> P<value>; pitch data N<10000 + point> P<value>",
         f"detection unit {du * 1000:g} um; a point's value is the increment, times 3623,",
-        "output while the axis travels from the point before to this point",
+        "output while the axis travels through its section",
         f"largest residual after rounding: {residual * 1000:.2f} um at the points",
         f"reversal varies {np.min(reversal) * du * 1000:.1f} .. {np.max(reversal) * du * 1000:.1f} um along the axis;"
         " only its mean goes to 1851",
         "check 3624 against the fastest feed: FANUC needs interval >= max feed / 7500",
+        "unverified: value range +-7, sign = correction to add, tape syntax; check one point on the machine",
         *notes,
     ]
     out = ["%"] + [f"({_safe(line)})" for line in lines]
     out += [f"N{number}A{a}P{value} ({_safe(what)})" for number, value, what in params]
-    out += [f"N{10000 + first_point + i}P{int(v)} ({x[i]:.3f} MM)" for i, v in enumerate(steps)]
+    out += [
+        f"N{10000 + first + i}P{int(v)} ({x[i]:.3f} .. {x[i + 1]:.3f} MM)" for i, v in enumerate(steps)
+    ]
     return "\n".join(out + ["%"]) + "\n", notes
 
 

@@ -1,27 +1,43 @@
 """SINUMERIK 840D compensation tables in archive (tape) format.
 
-Following the K3 "Compensations" function manual (6FC5397-1BP40-3BA1,
-section 4.4, interpolatory compensation):
+Checked against (see tests/export/test_tables.py for where each is used):
+  * K3 "Compensations", Function Manual Extended Functions 03/2013,
+    6FC5397-1BP40-3BA1, section 4.4.2 (measuring system error compensation):
+    table parameters p. 240 (https://www.easymanua.ls/siemens/sinumerik-series/manual/275710?p=240)
+    and the worked example p. 242
+    (https://manual.onestart.ai/manuals/Siemens-SINUMERIK-Series-Function-Manual-5628364?page=242):
+    `%_N_AX_EEC_INI`, `CHANDATA(1)`, `$AA_ENC_COMP[0,N,X1]=0.003` (mm),
+    `$AA_ENC_COMP_STEP/_MIN/_MAX/_IS_MODULO[0,X1]`, `M17`; 0 ≤ N ≤
+    MD38000 $MA_MM_ENC_COMP_MAX_POINTS − 1; the first and last values stay
+    active beyond the table.
+  * SINUMERIK 808D Function Manual 01/2017, p. 106
+    (https://www.easymanua.ls/siemens/sinumerik-808d/manual/217421?p=106):
+    MSEC alters the *actual value*, "A positive compensation value causes
+    the corresponding machine axis to move in the negative direction" — so
+    the value is the error itself, e = actual − nominal; and the value at the
+    reference point should be zero (no jump on activation).
+  * K3 4.4.3, table parameters p. 248-249
+    (https://www.easymanua.ls/siemens/sinumerik-series/manual/275710?p=248,
+    https://manual.onestart.ai/manuals/Siemens-SINUMERIK-Series-Function-Manual-5628364?page=249):
+    `$AN_CEC[t,N]`, `_INPUT_AXIS` (base axis), `_OUTPUT_AXIS` (compensation
+    axis), `_STEP`, `_MIN`, `_MAX`, `_DIRECTION` (0 both, 1 +, −1 −;
+    "position-dependent backlash compensation can be implemented using two
+    tables"), `_MULT_BY_TABLE`, `_IS_MODULO`; 0 ≤ N ≤ MD18342 − 1; general
+    axis names AX1 ... in `(AXn)`; the 802D sl K3 example
+    (https://www.easymanua.ls/siemens/sinumerik-802d-sl/manual/592298?p=222)
+    shows `%_N_NC_CEC_INI`, `CHANDATA(1)`, `$AN_CEC_INPUT_AXIS[0]=(AX2)`.
 
-* Leadscrew / measuring system error compensation `%_N_AX_EEC_INI`:
-  `$AA_ENC_COMP[e,N,AXn]` values at `$AA_ENC_COMP_MIN + N·_STEP` up to
-  `_MAX`, e = encoder 0.  MSEC modifies the *actual value*: "a positive
-  compensation value causes the machine axis to move in the negative
-  direction", so the value is the error itself, e = actual − nominal.
-  Points 0 ≤ N < MD38000 $MA_MM_ENC_COMP_MAX_POINTS.
-* Sag / cross compensation `%_N_NC_CEC_INI`: `$AN_CEC[t,N]`,
-  `$AN_CEC_INPUT_AXIS[t]` (base axis), `$AN_CEC_OUTPUT_AXIS[t]`
-  (compensation axis), `_STEP`, `_MIN`, `_MAX`, `_DIRECTION`.  CEC adds its
-  value to the compensation axis, so the value is −e.  Points
-  0 ≤ N < MD18342 $MN_MM_CEC_MAX_POINTS[t].
-* Reversal: MSEC acts in both directions, so it gets the mean of e₊ and e₋;
-  two direction-dependent CEC tables (`_DIRECTION` = 1 / −1, base axis =
-  compensation axis, "position-dependent backlash compensation" in K3) add
-  −(e₊ − mean) and −(e₋ − mean).
+NOT verified: the sign of a CEC value (we write −e, a value *added* to the
+compensation axis; no sentence saying so was found); that the general name
+AXn is accepted in `$AA_ENC_COMP` (the manual's example uses the machine
+axis name X1; we write AX1..AX3 so that renamed machine axes still match);
+the upper limits of MD38000 (5000 here) and MD18342 (2000 here) on 840D sl
+(808D: 200 MSEC points; 828D: 8 CEC tables of 200 points).
 
-Axis names: machine axes AX1, AX2, AX3 for X, Y, Z.  The manual asks for a
-zero value at the reference point (no jump on activation): `reference`
-shifts the leadscrew table by its value there.
+Reversal: MSEC acts in both directions, so it gets the mean of e₊ and e₋;
+two direction-dependent CEC tables (`_DIRECTION` = 1 / −1, base axis =
+compensation axis) add −(e₊ − mean) and −(e₋ − mean).  `reference` shifts
+the leadscrew table to 0 at the reference point.
 """
 
 from __future__ import annotations
@@ -58,6 +74,8 @@ def write_sinumerik(
     ]
     if reference is not None:
         lines.append(f"; shifted by {shift * 1000:+.1f} um so that the value at the reference {reference:g} mm is 0")
+    else:
+        lines.append("; not shifted: Siemens asks for 0 at the reference point (give --reference)")
     lines += [f"; {note}" for note in grid.notes]
     enc = ["%_N_AX_EEC_INI", "CHANDATA(1)", *lines]
     enc += [f"$AA_ENC_COMP[0,{i},{ax}]={_mm(v)}" for i, v in enumerate(values)]
@@ -77,7 +95,7 @@ def write_sinumerik(
         tables.append((MACHINE_AXES[t.axis], MACHINE_AXES[t.name[1]], 0, t, lambda p, t=t: -t.mean(p), "straightness"))
     if not tables:
         return "\n".join(enc) + "\n", notes
-    cec = ["%_N_NC_CEC_INI", "CHANDATA(1)"]
+    cec = ["%_N_NC_CEC_INI", "CHANDATA(1)", "; unverified: sign of the CEC values (-e written); check one point on the machine"]
     for index, (inp, out, direction, comp, correction, kind) in enumerate(tables):
         g = uniform_grid(comp.lo, comp.hi, max_points=MAX_CEC_POINTS, spacing=spacing, what=f"SINUMERIK CEC {index}")
         notes += [n_ for n_ in g.notes if n_ not in notes]
@@ -86,7 +104,10 @@ def write_sinumerik(
             f"; table {index}: {kind} {comp.name}, correction -e on {out} as a function of {inp}"
             + (f", direction {direction:+d} only" if direction else "")
         )
-        cec.append(f"; needs MD18342 $MN_MM_CEC_MAX_POINTS[{index}] >= {len(p)}, MD32710 CEC_TABLE_ENABLE[{index}] = 1")
+        cec.append(
+            f"; needs MD18342 $MN_MM_CEC_MAX_POINTS[{index}] >= {len(p)}, MD32710 $MA_CEC_ENABLE = 1 on {out}"
+            f" and the table enabled (SD41300 $SN_CEC_TABLE_ENABLE[{index}] = 1, unverified)"
+        )
         cec += [f"; {note}" for note in g.notes]
         cec += [f"$AN_CEC[{index},{i}]={_mm(v)}" for i, v in enumerate(correction(p))]
         cec += [
