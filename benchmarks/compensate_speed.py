@@ -10,10 +10,12 @@ program lengths (1M and 10M lines; 20k and 60k with --quick).
 
 from __future__ import annotations
 
+import io
+import math
 import os
 import time
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any, Callable, Iterable
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
@@ -63,15 +65,16 @@ def fastest(runs: dict[str, Callable[[], dict[str, Any]]], repeats: int = REPEAT
     return {name: {**min(done, key=lambda result: result["seconds"]), "runs": repeats} for name, done in results.items()}
 
 
-STAGES = ("parse", "interpret", "subdivide_lines", "replace_arcs", "apply_error_map", "writer")
+def stage_seconds(path: Path, offset: tuple[float, float, float], lines: int = 100_000, repeats: int = 2) -> dict[str, float]:
+    """CPU seconds of each stage of compensation alone on the program's first `lines`
+    lines: where the time goes, for whoever makes it faster.
 
-
-def stage_seconds(path: Path, offset: tuple[float, float, float], lines: int = 200_000) -> dict[str, float]:
-    """CPU seconds each stage of compensation adds on the program's first `lines`
-    lines, measured by running the pipeline up to that stage (parse; + interpret;
-    + each pass; + writer): where the time goes, for whoever makes it faster."""
+    Each stage reads the previous stage's output from a list and runs `repeats`
+    times; the fastest run counts.  The collector is off while a stage runs (its
+    cost depends on how much the lists hold, not on the stage).  Differences of
+    whole pipeline runs were tried first: on a shared machine whose speed drifts
+    they came out negative."""
     import gc
-    import io
     from itertools import islice
 
     from accuracy import QUIET
@@ -82,26 +85,32 @@ def stage_seconds(path: Path, offset: tuple[float, float, float], lines: int = 2
     source = ErrorSource.from_machine_file(str(MACHINE)).shifted(offset)
     with open(path, "rb") as stream:
         head = b"".join(islice(stream, lines))
-    totals = []
-    for depth in range(len(STAGES)):
-        with io.BytesIO(head) as stream:
-            name, stage = parse_program(stream, str(path), None)
-            interpret, writer = dialect_tools(name)
-            ctx = make_context(source, TOLERANCE, QUIET, str(path))
-            if depth >= 1:
-                stage = interpret(stage, file=str(path), warnings=QUIET)
-            for step in PASSES[: max(depth - 1, 0)]:
-                stage = step(stage, ctx)
-            if depth == len(STAGES) - 1:
-                stage = writer().write(stage)
-            old = gc.get_threshold()
-            gc.set_threshold(50_000, *old[1:])  # as `process` runs
-            start = time.process_time()
-            for _ in stage:
-                pass
-            totals.append(time.process_time() - start)
-            gc.set_threshold(*old)
-    return {name: totals[k] - (totals[k - 1] if k else 0.0) for k, name in enumerate(STAGES)}
+
+    def parse() -> Iterable:
+        return parse_program(io.BytesIO(head), str(path), None)[1]
+
+    interpret, writer = dialect_tools(parse_program(io.BytesIO(head[:4096]), str(path), None)[0])
+    stages: list[tuple[str, Callable[[list], Iterable]]] = [
+        ("parse", lambda _: parse()),
+        ("interpret", lambda blocks: interpret(iter(blocks), file=str(path), warnings=QUIET)),
+        *((step.__name__, lambda events, step=step: step(events, make_context(source, TOLERANCE, QUIET, str(path)))) for step in PASSES),
+        ("writer", lambda events: writer().write(events)),
+    ]
+    seconds: dict[str, float] = {}
+    previous: list = []
+    for name, stage in stages:
+        best = math.inf
+        for _ in range(repeats):
+            gc.collect()
+            gc.disable()
+            try:
+                start = time.process_time()
+                out = list(stage(previous))
+                best = min(best, time.process_time() - start)
+            finally:
+                gc.enable()
+        seconds[name], previous = best, out
+    return seconds
 
 
 def compensate_rss(path: Path, offset: tuple[float, float, float]) -> dict[str, Any]:
@@ -138,7 +147,7 @@ def compensate_speed(ctx):
             [label, "pygcode Line()", f"{pyg['lines_per_s']:,.0f}", ""],
             [label, "rs274 (process)", f"{rs['lines_per_s']:,.0f}", "completed" if rs["completed"] else "STOPPED"],
             [label, "ratio compensate / pygcode", f"{ratio:.2f}x", "floor 1.00x: " + ("met" if ratio >= 1 else "SHORT")],
-            [label, "compensate CPU s by stage", f"{sum(stages.values()):.2f} s", f"first {min(lines, 200_000):,} lines: " + ", ".join(f"{k} {v:.2f}" for k, v in stages.items())],
+            [label, "compensate CPU s by stage", f"{sum(stages.values()):.2f} s", f"each alone, first {min(lines, 100_000):,} lines: " + ", ".join(f"{k} {v:.2f}" for k, v in stages.items())],
         ]
     sizes = [20_000, 60_000] if ctx.quick else [1_000_000, 10_000_000]  # quick: keep the run short
     memory = {}
