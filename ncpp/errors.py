@@ -38,6 +38,9 @@ class NcppError(Exception):
     def __str__(self) -> str:
         return f"{self.where}: {self.message}"
 
+    def __reduce__(self):  # pickled with its location (it may come from a worker process)
+        return (type(self), (self.message, self.where))
+
 
 class Warnings:
     """Collects and prints warnings; in strict mode a warning is an error."""

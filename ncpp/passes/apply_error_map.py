@@ -16,6 +16,7 @@ start is compensated with its own direction and a step move is inserted.
 
 from __future__ import annotations
 
+from collections import deque
 from dataclasses import dataclass
 from typing import Iterable, Iterator
 
@@ -38,21 +39,70 @@ NEAR_STILL = 0.05
 
 
 def apply_error_map(events: Iterable[Event], ctx: PassContext) -> Iterator[Event]:
-    travel = Travel()
+    solve = ctx.kernels.bind(Solve(ctx.for_kernels()))
     last = None  # the last segment written: its compensated end, in its own program frame
+    # chunks whose solve is under way: with a worker process, the next chunk is read
+    # (parsed, interpreted, its arcs replaced) while this one is solved
+    pending: deque = deque()
     for chunk in chunked(events):
         segs = [e for e in chunk if type(e) is Line or type(e) is Arc]
-        if not segs:
-            yield from chunk
-            continue
-        offsets, scales = frames(segs)
-        if ctx.directional:
-            solved = _directional(segs, offsets, scales, ctx, travel)
-        else:
-            solved = _plain(segs, offsets, scales, ctx)
-        out = _written(chunk, segs, solved, offsets, scales, last)
-        last = next(e for e in reversed(out) if type(e) is Line or type(e) is Arc)
-        yield from out
+        rows = _rows(segs, ctx.directional) if segs else None
+        pending.append((chunk, segs, rows, solve(rows) if segs else None))
+        if len(pending) > 1:
+            last = yield from _finish(*pending.popleft(), last)
+    while pending:
+        last = yield from _finish(*pending.popleft(), last)
+
+
+def _finish(chunk: list[Event], segs: list, rows: "_Rows | None", solving, last) -> Iterator[Event]:
+    """Yields the chunk's events as written; returns the last segment written."""
+    if rows is None:
+        yield from chunk
+        return last
+    out = _written(chunk, segs, rows, solving.result(), last)
+    yield from out
+    return next(e for e in reversed(out) if type(e) is Line or type(e) is Arc)
+
+
+@dataclass
+class _Rows:
+    """A chunk's segments (rows) as the solve needs them: arrays, no events
+    (the solve may run in a worker process)."""
+
+    start: NDArray  # (n,3) program units
+    end: NDArray  # (n,3)
+    offsets: NDArray  # (n,3) machine minus program, program units
+    scales: NDArray  # (n,) mm per program unit
+    free: NDArray  # (n,) lines no pass has changed: their ends are compensated here
+    arc: NDArray  # (n,) pieces replace_arcs made (arcs, and lines for slivers)
+    pieces: NDArray  # (n,) the lines among them
+    assumed: NDArray | None  # (n,3) directions replace_arcs compensated the pieces with (reversal errors only)
+    lines: NDArray  # (n,) the line of each segment's block, for messages
+
+
+def _rows(segs: list, directional: bool) -> _Rows:
+    offsets, scales = frames(segs)
+    line = np.array([type(e) is Line for e in segs])
+    changed = np.array([e.changed for e in segs])
+    free = line & ~changed
+    return _Rows(
+        points([e.start for e in segs]), points([e.end for e in segs]), offsets, scales, free, changed, changed & line,
+        _arc_assumed(segs, changed) if directional else None, np.array([e.block.line for e in segs]),
+    )  # fmt: skip
+
+
+class Solve:
+    """The numbers of the pass, chunk after chunk: compensated ends, reversal steps
+    and shifted arc pieces.  Keeps what the machine has done so far (`Travel`),
+    so chunks must come in order."""
+
+    def __init__(self, ctx: PassContext):
+        self.ctx, self.travel = ctx, Travel()
+
+    def __call__(self, rows: _Rows) -> "_Solved":
+        if self.ctx.directional:
+            return _directional(rows, self.ctx, self.travel)
+        return _plain(rows, self.ctx)
 
 
 @dataclass
@@ -73,10 +123,11 @@ class _Solved:
 _FREE, _MOVED, _TURNS, _CONNECTS = 1, 2, 4, 8
 
 
-def _written(chunk: list[Event], segs: list, solved: _Solved, offsets: NDArray, scales: NDArray, last) -> list[Event]:
+def _written(chunk: list[Event], segs: list, rows: _Rows, solved: _Solved, last) -> list[Event]:
     """The chunk's events with each segment replaced: a connecting or reversal
     step where needed, then the segment with its compensated ends, starting where
     the previous one ended."""
+    offsets, scales = rows.offsets, rows.scales
     previous = np.empty_like(solved.end)
     previous[1:] = solved.end[:-1]
     has_previous = np.ones(len(segs), dtype=bool)
@@ -96,7 +147,7 @@ def _written(chunk: list[Event], segs: list, solved: _Solved, offsets: NDArray, 
     target = np.where(solved.keep & (np.abs(solved.turn_start - previous) <= solved.limit[:, None]), previous, solved.turn_start)
     turning &= _apart(previous, target)
     # replace_arcs' pieces start where they start: a step from the previous end first
-    connect = ~solved.free & has_previous & np.array([e.changed for e in segs]) & _apart(previous, solved.start)
+    connect = ~solved.free & has_previous & rows.arc & _apart(previous, solved.start)
     code = (solved.free * _FREE + (solved.moved & ~solved.free) * _MOVED + turning * _TURNS + connect * _CONNECTS).tolist()
     ends = list(map(tuple, solved.end.tolist()))
     targets = _by_row(target, turning & solved.free)
@@ -143,15 +194,14 @@ def _by_row(points: NDArray, rows: NDArray) -> dict[int, tuple]:
     return dict(zip(index.tolist(), map(tuple, points[index].tolist())))
 
 
-def _plain(segs: list, offsets: NDArray, scales: NDArray, ctx: PassContext) -> _Solved:
+def _plain(rows: _Rows, ctx: PassContext) -> _Solved:
     """Compensated ends of the chunk's lines, for a map without reversal errors."""
-    start, end = points([e.start for e in segs]), points([e.end for e in segs])
-    free = np.array([type(e) is Line and not e.changed for e in segs])
-    rows = np.flatnonzero(free)
-    if rows.size:
-        end[rows] = compensate(end[rows], offsets[rows], scales[rows], [segs[i] for i in rows], ctx, np.sign(end[rows] - start[rows]))
-    none = np.zeros(len(segs), dtype=bool)
-    return _Solved(start, end, free, none, none, start, np.ones(start.shape, dtype=bool), np.zeros(len(segs)))
+    start, end, free, offsets, scales = rows.start, rows.end.copy(), rows.free, rows.offsets, rows.scales
+    at = np.flatnonzero(free)
+    if at.size:
+        end[at] = compensate(end[at], offsets[at], scales[at], rows.lines[at], ctx, np.sign(end[at] - start[at]))
+    none = np.zeros(len(free), dtype=bool)
+    return _Solved(start, end, free, none, none, start, np.ones(start.shape, dtype=bool), np.zeros(len(free)))
 
 
 class _Commands:
@@ -159,8 +209,8 @@ class _Commands:
     the direction last asked: the rounds ask again for rows whose direction is
     unchanged, and the reversal check and the reversal steps ask for the same."""
 
-    def __init__(self, segs: list, wanted: dict[str, NDArray], offsets: NDArray, scales: NDArray, step: NDArray, ctx: PassContext):
-        self.segs, self.wanted, self.offsets, self.scales, self.step, self.ctx = segs, wanted, offsets, scales, step, ctx
+    def __init__(self, lines: NDArray, wanted: dict[str, NDArray], offsets: NDArray, scales: NDArray, step: NDArray, ctx: PassContext):
+        self.lines, self.wanted, self.offsets, self.scales, self.step, self.ctx = lines, wanted, offsets, scales, step, ctx
         self.values = {which: np.empty_like(p) for which, p in wanted.items()}
         self.directions = {which: np.full(p.shape, np.nan) for which, p in wanted.items()}
 
@@ -169,22 +219,20 @@ class _Commands:
         stale = (self.directions[which][rows] != d).any(axis=1)
         todo, d_todo = rows[stale], d[stale]
         if todo.size:
-            c = compensate(self.wanted[which][todo], self.offsets[todo], self.scales[todo], [self.segs[i] for i in todo], self.ctx, d_todo)
+            c = compensate(self.wanted[which][todo], self.offsets[todo], self.scales[todo], self.lines[todo], self.ctx, d_todo)
             self.values[which][todo] = quantize(c, self.step[todo])
             self.directions[which][todo] = d_todo
         return self.values[which][rows]
 
 
-def _directional(segs: list, offsets: NDArray, scales: NDArray, ctx: PassContext, travel: Travel) -> _Solved:
+def _directional(rows: _Rows, ctx: PassContext, travel: Travel) -> _Solved:
     """Compensated line ends and starts, and shifted arcs, of one chunk, with the
     directions the machine will travel in; advances `travel` past the chunk."""
+    offsets, scales = rows.offsets, rows.scales
     step = grid(ctx, scales)
     threshold = step * scales / 2  # mm: half the output resolution
     machine = lambda p, rows=slice(None): (p + offsets[rows]) * scales[rows, None]  # noqa: E731
-    free = np.array([type(e) is Line and not e.changed for e in segs])
-    arc = np.array([e.changed for e in segs])  # pieces replace_arcs made: arcs, and lines for slivers
-    pieces = arc & np.array([type(e) is Line for e in segs])  # the lines among them
-    start_p, end_p = points([e.start for e in segs]), points([e.end for e in segs])
+    free, arc, pieces, start_p, end_p = rows.free, rows.arc, rows.pieces, rows.start, rows.end
     start_m, end_m = machine(start_p), machine(end_p)
     first = travel.last if travel.last is not None else start_m[0]
     before = None if travel.last is None else travel.last / scales[0] - offsets[0]  # in the first row's frame
@@ -192,8 +240,8 @@ def _directional(segs: list, offsets: NDArray, scales: NDArray, ctx: PassContext
 
     out_start, out_end = start_p.copy(), end_p.copy()
     compensated = end_p.copy()  # line ends before _settle leaves axes standing
-    commands = _Commands(segs, {"start": start_p, "end": end_p}, offsets, scales, step, ctx)
-    assumed = _arc_assumed(segs, arc)  # the directions replace_arcs compensated the arcs with
+    commands = _Commands(rows.lines, {"start": start_p, "end": end_p}, offsets, scales, step, ctx)
+    assumed = rows.assumed
     used = np.full(start_p.shape, np.nan)  # the directions each row is compensated with
     used[arc] = assumed[arc]
     # start from the nominal motion, standing axes holding their direction
@@ -229,7 +277,7 @@ def _directional(segs: list, offsets: NDArray, scales: NDArray, ctx: PassContext
     if rows.size:
         turn_start[rows] = commands("start", rows, d[rows])
     travel.held = d[-1].copy()
-    travel.last = machine(out_end[-1:], slice(len(segs) - 1, None))[0]
+    travel.last = machine(out_end[-1:], slice(len(free) - 1, None))[0]
     return _Solved(out_start, out_end, free, moved, turn, turn_start, ~flips, limit)
 
 

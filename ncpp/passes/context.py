@@ -2,13 +2,15 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+import io
+from dataclasses import dataclass, field, replace
 from typing import Protocol
 
 import numpy as np
 from numpy.typing import NDArray
 
 from ncpp.errors import Warnings
+from ncpp.passes.kernels import INLINE, Kernels
 
 
 class ErrorMap(Protocol):
@@ -34,6 +36,11 @@ class PassContext:
     min_line_check: float = 1.0  # mm: shorter lines are never subdivided (their error is linear to < 0.01 µm)
     warnings: Warnings = field(default_factory=Warnings)
     file: str = "<stdin>"
+    kernels: Kernels = INLINE  # where the passes' numeric kernels run (kernels.py)
+
+    def for_kernels(self) -> "PassContext":
+        """This context as a kernel holds it: picklable (no output stream, no worker)."""
+        return replace(self, warnings=Warnings(self.warnings.strict, io.StringIO()), kernels=INLINE)
 
     def limit_arrays(self) -> tuple[NDArray, NDArray]:
         lo = np.array([self.limits.get(a, (-np.inf, np.inf))[0] for a in "XYZ"])

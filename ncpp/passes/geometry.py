@@ -73,33 +73,34 @@ def compensate(
     points: NDArray,
     offsets: NDArray,
     scales: NDArray,
-    segments: Sequence[Line | Arc],
+    lines: NDArray,
     ctx: PassContext,
     directions: NDArray | None = None,
 ) -> NDArray:
     """Compensated program points for wanted program points.
 
     points (n,m,3) or (n,3): point(s) of segment k in its program frame;
-    offsets (n,3), scales (n,); directions: travel signs shaped like points, for
-    direction-dependent (reversal) error tables.  Refuses corrections beyond the machine's
-    limit and commands outside its travel, naming the block."""
+    offsets (n,3), scales (n,); lines (n,): the line of segment k's block (numbers,
+    not events: this runs in a worker process too); directions: travel signs shaped
+    like points, for direction-dependent (reversal) error tables.  Refuses corrections
+    beyond the machine's limit and commands outside its travel, naming the line."""
     shape = points.shape
-    pts = points.reshape(len(segments), -1, 3)
+    pts = points.reshape(len(lines), -1, 3)
     wanted = (pts + offsets[:, None, :]) * scales[:, None, None]
     signs = None if directions is None else np.asarray(directions, dtype=float).reshape(-1, 3)
     command = command_for(ctx.model, wanted.reshape(-1, 3), signs).reshape(wanted.shape)
-    _check(wanted, command, segments, ctx)
+    _check(wanted, command, lines, ctx)
     return (command / scales[:, None, None] - offsets[:, None, :]).reshape(shape)
 
 
-def _check(wanted: NDArray, command: NDArray, segments: Sequence[Line | Arc], ctx: PassContext) -> None:
+def _check(wanted: NDArray, command: NDArray, lines: NDArray, ctx: PassContext) -> None:
     correction = np.linalg.norm(command - wanted, axis=-1).max(axis=-1)
     bad = np.flatnonzero(correction > ctx.max_correction)
     if bad.size:
         k = int(bad[0])
         raise NcppError(
             f"correction of {correction[k]:.4f} mm exceeds the machine file's limit of {ctx.max_correction} mm",
-            Location(ctx.file, segments[k].block.line),
+            Location(ctx.file, int(lines[k])),
         )
     lo, hi = ctx.limit_arrays()
     outside = ((command < lo) | (command > hi)).any(axis=-1).any(axis=-1)
@@ -112,5 +113,5 @@ def _check(wanted: NDArray, command: NDArray, segments: Sequence[Line | Arc], ct
         value = pts[:, axis_index][(pts[:, axis_index] < lo[axis_index]) | (pts[:, axis_index] > hi[axis_index])][0]
         raise NcppError(
             f"command {axis}{value:.4f} mm is outside the {axis} travel [{lo[axis_index]:g}, {hi[axis_index]:g}] mm",
-            Location(ctx.file, segments[k].block.line),
+            Location(ctx.file, int(lines[k])),
         )

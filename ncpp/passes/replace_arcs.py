@@ -153,6 +153,7 @@ def _quadrant_pieces(geometry: _ArcGeometry) -> _Pieces:
 def _replace(arcs: list[Arc], ctx: PassContext) -> list[list[Event]]:
     geometry = _ArcGeometry(arcs)
     offsets, scales = frames(arcs)
+    line_of = np.array([a.block.line for a in arcs])
     pending = _initial_pieces(geometry, ctx.directional)
     done: list[tuple[int, float, Event | list[Event]]] = []  # (arc, a0, result)
     for _ in range(MAX_ROUNDS):
@@ -164,7 +165,7 @@ def _replace(arcs: list[Arc], ctx: PassContext) -> list[list[Event]]:
         for m in np.unique(counts).tolist():
             rows = np.flatnonzero(counts == m)
             some = _Pieces(pending.arc[rows], pending.a0[rows], pending.sweep[rows])
-            split[rows] = _round(some, length[rows], np.linspace(0.0, 1.0, m), arcs, geometry, offsets, scales, ctx, done)
+            split[rows] = _round(some, length[rows], np.linspace(0.0, 1.0, m), arcs, geometry, offsets, scales, line_of, ctx, done)
         half = pending.sweep[split] / 2
         pending = _Pieces(
             np.repeat(pending.arc[split], 2),
@@ -174,12 +175,11 @@ def _replace(arcs: list[Arc], ctx: PassContext) -> list[list[Event]]:
     return _assemble(arcs, geometry, done)
 
 
-def _round(pending: _Pieces, length: NDArray, t: NDArray, arcs, geometry, offsets, scales, ctx, done: list) -> NDArray:
+def _round(pending: _Pieces, length: NDArray, t: NDArray, arcs, geometry, offsets, scales, line_of, ctx, done: list) -> NDArray:
     """Compensate and fit pieces sampled at `t`; append the finished ones to
     `done` and return (p,) which to halve."""
     angles = pending.a0[:, None] + t[None, :] * pending.sweep[:, None]
     nominal = geometry.points(pending.arc, angles)
-    segs = [arcs[k] for k in pending.arc]
     middle = (pending.a0 + pending.sweep / 2)[:, None]
     tangent = geometry.points(pending.arc, middle + 1e-6 * np.sign(pending.sweep)[:, None]) - geometry.points(pending.arc, middle)
     direction = np.sign(tangent)
@@ -188,7 +188,7 @@ def _round(pending: _Pieces, length: NDArray, t: NDArray, arcs, geometry, offset
     np.put_along_axis(direction, geometry.axes[pending.arc, None, 2:], 0.0, axis=2)
     direction = np.broadcast_to(direction, nominal.shape)
     scale = scales[pending.arc]
-    q = compensate(nominal, offsets[pending.arc], scale, segs, ctx, direction)
+    q = compensate(nominal, offsets[pending.arc], scale, line_of[pending.arc], ctx, direction)
     centre, deviation = _fit(q, geometry.axes[pending.arc], t, ctx.tolerance / scale)
     ok = deviation <= ctx.tolerance / scale
     if ctx.directional:  # ends on the output grid (after the fit: a short piece's chord fixes the bisector)
@@ -209,7 +209,7 @@ def _round(pending: _Pieces, length: NDArray, t: NDArray, arcs, geometry, offset
     lines = np.flatnonzero(straight | give_up)
     if lines.size and ctx.directional:
         # lines are compensated for the mean direction: apply_error_map moves them to the real one
-        q[lines] = _mean_compensated(nominal[lines], offsets[pending.arc[lines]], scale[lines], [segs[i] for i in lines], ctx)
+        q[lines] = _mean_compensated(nominal[lines], offsets[pending.arc[lines]], scale[lines], line_of[pending.arc[lines]], ctx)
     arc_of, a0 = pending.arc.tolist(), pending.a0.tolist()
     for p in np.flatnonzero(straight).tolist():
         done.append((arc_of[p], a0[p], _line_pieces(arcs[arc_of[p]], q[p, [0, -1]])))
@@ -260,10 +260,10 @@ def _one_way(q: NDArray, centre: NDArray, axes: NDArray, direction: NDArray, sig
     return ~inside & agrees & (span < np.pi) & (np.abs(blend) < quarter / 2)
 
 
-def _mean_compensated(nominal, offsets, scales, segs, ctx) -> NDArray:
+def _mean_compensated(nominal, offsets, scales, line_of, ctx) -> NDArray:
     """Compensated samples (p,m,3) for the mean direction.  Not on the output
     grid: apply_error_map moves them for the real direction, then rounds once."""
-    return compensate(nominal, offsets, scales, segs, ctx, np.zeros_like(nominal))
+    return compensate(nominal, offsets, scales, line_of, ctx, np.zeros_like(nominal))
 
 
 def _fit(q: NDArray, axes: NDArray, t: NDArray, tolerance: NDArray) -> tuple[NDArray, NDArray]:
