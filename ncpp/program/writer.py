@@ -102,8 +102,16 @@ def set_words(
             text = pending.pop(letter, None)
             if text is not None:  # gap, letter as written, number
                 pieces += (raw[cursor : item.start + 1], text)
-            elif letter in drop:  # remove the word and the separator before it
-                pieces.append(raw[cursor : item.start].rstrip(" \t"))
+            elif letter in drop:  # remove the word and the separator before it (after it, when it leads)
+                gap = raw[cursor : item.start]
+                if _leads(pieces, gap):
+                    pieces.append(gap)
+                    cursor = _past_blanks(raw, item.end)
+                else:
+                    pieces.append(gap.rstrip(" \t"))
+                    cursor = item.end
+                at, seen_axis = len(pieces), True
+                continue
             else:
                 pieces.append(raw[cursor : item.end])
                 cursor = item.end
@@ -122,8 +130,11 @@ def set_words(
     if pending:
         sep, lower = spelled or spelling(block)
         extra = "".join(sep + (letter.lower() if lower else letter) + text for letter, text in pending.items())
-        if at is None and not "".join(pieces).strip():
-            extra = extra.lstrip()
+        if at is None:
+            if not "".join(pieces).strip():
+                extra = extra.lstrip()
+        elif _bare("".join(pieces[:at])):  # after dropped words that led the block: in their place
+            extra = extra.lstrip() + (sep if "".join(pieces[at:]).strip() or raw[cursor:].strip() else "")
         pieces.insert(len(pieces) if at is None else at, extra)
     pieces.append(raw[cursor:])
     return "".join(pieces)
@@ -132,6 +143,7 @@ def set_words(
 # How an `EditPlan` cuts the raw text at a word (the text between two cuts is kept):
 _REPLACE = 0  # before its number (its letter kept), again after it
 _DROP = 1  # before it, the separator before it stripped, again after it
+_DROP_LEADING = 4  # as _DROP, but when only blanks are kept before it: the separator after it stripped
 _BEFORE = 2  # before it (something is inserted there)
 _AFTER = 3  # after it (something is appended there)
 
@@ -196,7 +208,10 @@ class EditPlan:
                 at, seen_axis = n, True
             elif not seen_axis:
                 at = n
-        if at is None:
+        leading = 0  # the words before the first one kept or replaced: dropped, they may lead the block
+        while leading < len(letters) and leading in dropped:
+            leading += 1
+        if at is None or (pending and at < leading):  # words appended where the dropped words led: `set_words`
             return None
         appended = "".join(_literal(sep) + (letter.lower() if lower else letter) + field for letter, field in pending.items())
         cuts: list[tuple[int, int]] = []
@@ -214,7 +229,7 @@ class EditPlan:
                 cut(n, _REPLACE)
                 parts.append(replace[n])
             elif n in dropped:
-                cut(n, _DROP)
+                cut(n, _DROP_LEADING if n < leading else _DROP)
             if n == at and appended:
                 if n not in replace and n not in dropped:
                     cut(n, _AFTER)
@@ -247,6 +262,14 @@ class EditPlan:
             elif how == _DROP:
                 keep(raw[cursor : word.start].rstrip(" \t"))
                 cursor = word.end
+            elif how == _DROP_LEADING:
+                gap = raw[cursor : word.start]
+                if _leads(pieces, gap):
+                    keep(gap)
+                    cursor = _past_blanks(raw, word.end)
+                else:
+                    keep(gap.rstrip(" \t"))
+                    cursor = word.end
             elif how == _BEFORE:
                 keep(raw[cursor : word.start])
                 cursor = word.start
@@ -255,6 +278,22 @@ class EditPlan:
                 cursor = word.end
         keep(raw[cursor:])
         return pieces
+
+
+def _leads(kept: Sequence[str], gap: str) -> bool:
+    """A word after the `kept` pieces and `gap` leads its block: no separator before it
+    but blanks that stay (an indent, the blank of a `/ ` block delete)."""
+    return not gap.strip() and _bare("".join(kept))
+
+
+def _bare(text: str) -> bool:
+    """Nothing but blanks, or ending in one: a word after it needs no separator."""
+    return not text.strip() or text[-1] in " \t"
+
+
+def _past_blanks(raw: str, at: int) -> int:
+    """The index after the spaces and tabs of `raw` from `at`."""
+    return len(raw) - len(raw[at:].lstrip(" \t"))
 
 
 def _literal(text: str) -> str:

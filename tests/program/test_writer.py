@@ -6,7 +6,7 @@ import pytest
 
 from ncpp.program.numbers import NumberStyle
 from ncpp.program.parser import parse_text
-from ncpp.program.writer import edit_words
+from ncpp.program.writer import EditPlan, edit_words, spelling
 
 
 def edit(text: str, values: dict, drop=(), motion=None, style: str = "1.000") -> str:
@@ -26,6 +26,63 @@ def edit(text: str, values: dict, drop=(), motion=None, style: str = "1.000") ->
 )
 def test_edit_words(text, values, drop, motion, expected):
     assert edit(text, values, drop, motion) == expected
+
+
+@pytest.mark.parametrize(
+    "text, values, drop, expected",
+    [
+        (",R1 X10", {"X": 7.25}, (",R",), "X7.250"),
+        ("N10 ,R1 X10", {"X": 7.25}, (",R",), "N10 X7.250"),
+        ("P2 X1", {"X": 3.0}, ("P",), "X3.000"),
+        ("R5\tX1 Y2", {"X": 2.0}, ("R",), "X2.000 Y2"),
+        ("  I5 J0 X10 (cut)", {"X": 1.0}, "IJ", "  X1.000 (cut)"),  # the indent stays
+        ("(c) I5 X1", {"X": 2.0}, "I", "(c) X2.000"),
+        ("/ I5 X1", {"X": 3.0}, "I", "/ X3.000"),
+        ("I5 J0 F100", {"X": 1.0, "Y": 2.0}, "IJ", "X1.000 Y2.000 F100"),  # in the place of the words dropped
+        ("i5j0f100", {"X": 1.0, "Y": 2.0}, "IJ", "x1.000y2.000f100"),
+        ("I5 J0 ; arc", {"X": 1.0, "Y": 2.0}, "IJ", "X1.000 Y2.000 ; arc"),
+        ("I5 J0", {"X": 1.0, "Y": 2.0}, "IJ", "X1.000 Y2.000"),
+    ],
+)
+def test_a_dropped_leading_word_takes_the_separator_after_it(text, values, drop, expected):
+    """A word dropped at the start of a block leaves no blank where it was: the blank
+    after it goes instead of the (absent) one before it; so does a compiled edit."""
+    assert edit(text, values, drop) == expected
+    block = parse_text(text + "\n")[0]
+    if block.signature is not None:
+        words = block.words()
+        fields = {letter: "{%d:.3f}" % n for n, letter in enumerate(values)}
+        plan = EditPlan.compile([w.letter for w in words], fields, len(values), drop, spelled=spelling(block))
+        assert plan is None or plan.apply(block.raw, words, list(values.values())) == expected
+
+
+def _compensated_lines(program: bytes, name: str) -> list[str]:
+    import io
+    from pathlib import Path
+
+    from ncpp.pipeline import ErrorSource, process
+
+    machine = Path(__file__).resolve().parents[2] / "samples/machines/hr5b.toml"
+    source = ErrorSource.from_machine_file(str(machine)).shifted((400.0, 350.0, 300.0))
+    out = io.BytesIO()
+    process(io.BytesIO(program), out, file=name, source=source)
+    return out.getvalue().decode().splitlines()
+
+
+def test_a_compensated_corner_block_starts_with_its_first_word():
+    """`,R1 X10`: compensation writes the corner out and drops `,R`; the line keeps no blank for it."""
+    lines = _compensated_lines(b"G21 G90\nG1 X0 Y0 F100\n,R1 X10\nN20 ,R1 X4 Y5\nX0\nM2\n", "t.ngc")
+    assert not [line for line in lines if line[:1].isspace() or "  " in line or ",R" in line]
+    assert lines[3].startswith("X") and any(line.startswith("N20 G1 X") for line in lines)  # G1: after the corner arc
+
+
+
+def test_sinumerik_blocks_losing_their_leading_word_start_with_the_next():
+    """`CIP` / `CR=` / `CT` leading a block are removed (G2/G3 and I/J/K say the arc) with the blank after them."""
+    program = b"G71 G90\nG1 X0 Y0 F100\nCIP X10 Y0 I1=5 J1=5\nG1 X20\nCR=5 X25 Y5 G2\nCT X30 Y10\nM30\n"
+    lines = _compensated_lines(program, "t.mpf")
+    assert not [line for line in lines if line[:1].isspace() or "  " in line]
+    assert any(line.startswith("G2 X") for line in lines[3:5]) and lines[-2].startswith("G3 X")
 
 
 PROGRAM = """%
@@ -77,7 +134,7 @@ def replace_signature(block):
 from hypothesis import HealthCheck, given, settings  # noqa: E402
 from hypothesis import strategies as st  # noqa: E402
 
-from ncpp.program.writer import EditPlan, edit_texts, spelling  # noqa: E402
+from ncpp.program.writer import edit_texts  # noqa: E402
 
 PLAN_EXAMPLES = settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 _NUMBERS = ["1", "-2.5", "10.", ".5", "+3", "007.25", "0"]
@@ -137,8 +194,12 @@ x1.3z-.5
 X1.4 (c) Z-0.45 F10.
 G3 X1.5 Z-0.45 I0.05 K0
 G2 X1.6 Y0.1 Z-0.3 R0.2
+R0.25 X1.6 Z-0.1
+R0.25 X1.6 Z-0.3
 G17 G91 G1 X0.1 Y0.1
 G90.1 G90 G3 X2 Y0.5 I1.7 J0.5
+I2 J0.75 X2.25 Y0.75
+I2 J0.75 X2 Y0.5
 G21
 G19 G91.1 G2 Y14.7 Z-7.62 J1 K0
 N10 G01 X5.000 Y6.000 Z-1.000

@@ -5,12 +5,14 @@ from __future__ import annotations
 from typing import Mapping
 
 from ncpp.program.blocks import Block, Item
+from ncpp.program.writer import _leads, _past_blanks
 
 
 def splice(block: Block, texts: Mapping[int, str | None], append: str = "", after: Item | None = None) -> str:
     """The raw text of `block` with the item at each index of `texts` replaced by
-    its text (None: removed with the blanks before it), and `append` inserted
-    after the item `after` (default: the last item that is not a comment)."""
+    its text (None: removed with the blanks before it, or after it when it leads the
+    block), and `append` inserted after the item `after` (default: the last item
+    that is not a comment)."""
     raw = block.raw
     anchor = after
     if anchor is None and append:
@@ -21,10 +23,12 @@ def splice(block: Block, texts: Mapping[int, str | None], append: str = "", afte
         if index in texts:
             before = raw[cursor : item.start]
             text = texts[index]
-            if text is None:
-                before = before.rstrip(" \t") if cursor < item.start or not pieces else before
-            pieces.append(before + (text or ""))
             cursor = item.end
+            if text is None and _leads(pieces, before):  # no separator before it: the one after it goes
+                cursor = _past_blanks(raw, item.end)
+            elif text is None:
+                before = before.rstrip(" \t")
+            pieces.append(before + (text or ""))
         else:
             pieces.append(raw[cursor : item.end])
             cursor = item.end

@@ -443,7 +443,9 @@ class HeidenhainWriter(IsoWriter):
     def _learn_styles(self, block: Block) -> None:
         for item in block.items:
             if type(item) is Word and item.letter not in ("M", "N", "S", "PA", "IPA"):
-                self.styles[item.letter] = NumberStyle.of(item.number)
+                # by `_learn_style`: a new style drops the resolved ones (the decimal places the
+                # output's position is remembered with), else they stay those of the first move
+                self._learn_style(item.letter, NumberStyle.of(item.number))
                 axis = item.letter[-1]
                 if axis in _AXES and item.letter.lstrip("I") == axis:
                     self.known_axes.add(axis)

@@ -1,0 +1,41 @@
+"""The Klartext writer remembers where the output is at the decimal places each block was
+written with, not those of the program's first move."""
+
+from __future__ import annotations
+
+import io
+from dataclasses import replace
+
+from ncpp.motion.segments import Arc, Line
+from ncpp.pipeline import dialect_tools
+from ncpp.program.dialects import parse_program
+
+
+def written(program: str, moved: dict[int, tuple[float, float, float]]) -> list[str]:
+    """The program written with the moves of the blocks on the lines of `moved` shifted by it."""
+    interpret, writer = dialect_tools("heidenhain")
+    _, blocks = parse_program(io.BytesIO(program.encode()), "t.h", "heidenhain")
+    events = []
+    for event in interpret(blocks, file="t.h"):
+        shift = moved.get(event.block.line) if type(event) in (Line, Arc) else None
+        if shift is not None:
+            event = replace(event, end=tuple(v + d for v, d in zip(event.end, shift)), changed=True)
+        events.append(event)
+    return "".join(writer().write(events)).splitlines()
+
+
+def test_an_axis_moved_below_the_first_moves_resolution_is_written():
+    """Y+0.000004 then a compensated block moving Y to 0: the output says Y+0.000000, in the
+    six places the program wrote Y with (not the four of its first move, where 4 µm vanish)."""
+    program = "0 BEGIN PGM T MM\n1 L X+0 Y+0 Z+0 R0 F500\n2 L X+10.123456 Y+0.000004\n3 L X+20.123456\n4 END PGM T MM\n"
+    lines = written(program, {4: (0.000002, -0.000004, 0.0)})
+    assert lines[3] == "3 L X+20.123458 Y+0.000000"
+
+
+def test_an_axis_where_the_last_block_left_it_is_not_written_again():
+    """A first move in six places, then blocks in one: a compensated block without Y whose Y is
+    exactly where the block before left it adds no Y word (the end is compared at four places,
+    as the block before wrote it, not at the first move's six)."""
+    program = "0 BEGIN PGM T MM\n1 L X+0.123456 Y+0.123456 Z+0.123456 R0 F500\n2 L X+10.5 Y+5.5\n3 L X+20.5\n4 END PGM T MM\n"
+    lines = written(program, {3: (0.00002, 0.00003, 0.0), 4: (0.00002, 0.00003, 0.0)})
+    assert lines[2:4] == ["2 L X+10.5000 Y+5.5000", "3 L X+20.5000"]
