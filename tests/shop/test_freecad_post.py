@@ -41,7 +41,7 @@ def posted(tmp_path_factory):
     env.update(
         HOME=str(home),
         NCPP_OUT=str(tmp / "compensated.ngc"),
-        NCPP_POST_ARGS=f"--ncpp {ncpp} --machine {MACHINE} --work-offset 400,350,300 --precision 4",
+        NCPP_POST_ARGS=f"--ncpp {ncpp} --machine {MACHINE} --work-offset 400,350,300 --precision 4 --no-comments",
         NCPP_PLAIN_OUT=str(tmp / "plain.ngc"),
         NCPP_PLAIN_ARGS=f"--ncpp {ncpp} --precision 4",
     )
@@ -57,6 +57,7 @@ def test_freecad_posts_a_compensated_program(posted):
     assert lines[0].startswith("(ncpp compensated for hr5b.toml sha256:")
     assert "(Exported by FreeCAD)" in lines[:5] and any("linuxcnc_post" in ln for ln in lines[:5])
     assert any(ln.startswith(("G2", "G3")) for ln in lines)  # the profile's corner arcs stay arcs
+    assert not any(ln.startswith("(begin") for ln in lines)  # --no-comments reached linuxcnc_post
 
 
 def test_linuxcnc_accepts_it_and_the_path_is_corrected_by_microns(posted):
@@ -73,6 +74,8 @@ def test_without_a_machine_file_the_post_is_freecads_own(posted):
     _, plain, _ = posted
     text = plain.read_text()
     assert "ncpp compensated" not in text and text.startswith("(Exported by FreeCAD)")
+    # Posted after the compensated one: its --no-comments did not stick in linuxcnc_post.
+    assert "(begin preamble)" in text
 
 
 def test_freecad_1_uses_the_class_and_the_legacy_script_api_agrees(posted):
