@@ -118,7 +118,7 @@ if _PostProcessor is not None:
         """`ncpp` for FreeCAD 1.x: each output section posted by linuxcnc_post, then compensated."""
 
         def __init__(self, job):
-            super().__init__(job, tooltip=TOOLTIP, tooltipargs=TOOLTIP_ARGS, units="Metric")
+            super().__init__(job, tooltip=TOOLTIP, tooltipargs=TOOLTIP_ARGS, units=None)  # the units property
 
         @property
         def tooltip(self):
@@ -128,6 +128,14 @@ if _PostProcessor is not None:
         def tooltipArgs(self):
             return TOOLTIP_ARGS
 
+        @property
+        def units(self):
+            """What linuxcnc_post writes: G20 (Inch) for --inches, else G21 (Metric)."""
+            return "Inch" if "--inches" in shlex.split(self._argstring()) else "Metric"
+
+        def _argstring(self):
+            return getattr(self._job, "PostProcessorArgs", "") or ""  # no job in the Preferences dialog
+
         def export(self):
-            argstring = getattr(self._job, "PostProcessorArgs", "") or ""
+            argstring = self._argstring()
             return [(name, compensate_text(linuxcnc_text(objects, argstring), argstring)) for name, objects in self._buildPostList()]

@@ -23,7 +23,7 @@ def _freecadcmd() -> str | None:
 
 FREECADCMD = _freecadcmd()
 MACHINE = ROOT / "samples/machines/hr5b.toml"
-pytestmark = pytest.mark.skipif(FREECADCMD is None, reason="freecadcmd (Debian package freecad) is not installed, nor $NCPP_FREECADCMD")
+pytestmark = pytest.mark.skipif(FREECADCMD is None, reason=f"{os.environ.get('NCPP_FREECADCMD') or 'freecadcmd (Debian package freecad)'} is not installed")
 
 
 @pytest.fixture(scope="module")

@@ -42,6 +42,8 @@ try:
             PathPostProcessor.PostProcessor.load("ncpp").export(objects, filename, argstring)
             return
         job.PostProcessor, job.PostProcessorArgs = "ncpp", argstring
+        unbound = PostProcessorFactory.get_post_processor(None, "ncpp")  # as the Preferences dialog asks
+        assert "--machine" in unbound.tooltipArgs and unbound.units == "Metric", (unbound.tooltipArgs, unbound.units)
         processor = PostProcessorFactory.get_post_processor(job, "ncpp")
         print("NCPP_PROCESSOR", type(processor).__name__)
         sections = processor.export()  # [(subpart, gcode)], one "allitems" unless split
