@@ -20,6 +20,7 @@
 # the class named after the file (`Ncpp`) and calls its export().
 
 import argparse
+import importlib.util
 import os
 import shlex
 import shutil
@@ -40,11 +41,17 @@ TOOLTIP_ARGS = parser.format_help() + "\nOther arguments are passed to linuxcnc_
 
 
 def _linuxcnc_post():
+    """A fresh copy of FreeCAD's linuxcnc_post.  It keeps its options in module
+    globals that only its flags change (--no-comments, --inches, ... stay set
+    for the rest of the session), so each post starts from a new module."""
     try:  # FreeCAD 1.x
         from Path.Post.scripts import linuxcnc_post
-    except ImportError:  # FreeCAD 0.19-0.21
+    except ImportError:  # FreeCAD 0.19-0.21 (Path is only the C++ module)
         from PathScripts.post import linuxcnc_post
-    return linuxcnc_post
+    spec = importlib.util.spec_from_file_location(linuxcnc_post.__name__, linuxcnc_post.__file__)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
 
 
 def _ncpp_command(options):
@@ -111,7 +118,7 @@ if _PostProcessor is not None:
         """`ncpp` for FreeCAD 1.x: each output section posted by linuxcnc_post, then compensated."""
 
         def __init__(self, job):
-            super().__init__(job, tooltip=TOOLTIP, tooltipargs=TOOLTIP_ARGS, units="Metric")
+            super().__init__(job, tooltip=TOOLTIP, tooltipargs=TOOLTIP_ARGS, units=None)  # the units property
 
         @property
         def tooltip(self):
@@ -121,6 +128,14 @@ if _PostProcessor is not None:
         def tooltipArgs(self):
             return TOOLTIP_ARGS
 
+        @property
+        def units(self):
+            """What linuxcnc_post writes: G20 (Inch) for --inches, else G21 (Metric)."""
+            return "Inch" if "--inches" in shlex.split(self._argstring()) else "Metric"
+
+        def _argstring(self):
+            return getattr(self._job, "PostProcessorArgs", "") or ""  # no job in the Preferences dialog
+
         def export(self):
-            argstring = getattr(self._job, "PostProcessorArgs", "") or ""
+            argstring = self._argstring()
             return [(name, compensate_text(linuxcnc_text(objects, argstring), argstring)) for name, objects in self._buildPostList()]

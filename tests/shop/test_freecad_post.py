@@ -14,14 +14,21 @@ import pytest
 from tests.conftest import ROOT
 from tests.shop.rs274 import end_points, run_rs274
 
-FREECADCMD = shutil.which("freecadcmd")
+
+def _freecadcmd() -> str | None:
+    """$NCPP_FREECADCMD (another FreeCAD, e.g. tests/shop/freecadcmd-chroot), else freecadcmd on PATH."""
+    found = shutil.which(os.environ.get("NCPP_FREECADCMD") or "freecadcmd")
+    return os.path.abspath(found) if found else None
+
+
+FREECADCMD = _freecadcmd()
 MACHINE = ROOT / "samples/machines/hr5b.toml"
-pytestmark = pytest.mark.skipif(FREECADCMD is None, reason="freecadcmd (Debian package freecad) is not installed")
+pytestmark = pytest.mark.skipif(FREECADCMD is None, reason=f"{os.environ.get('NCPP_FREECADCMD') or 'freecadcmd (Debian package freecad)'} is not installed")
 
 
 @pytest.fixture(scope="module")
 def posted(tmp_path_factory):
-    """(compensated, plain) programs posted by FreeCAD through ncpp_post."""
+    """(compensated, plain) programs posted by FreeCAD through ncpp_post, and FreeCAD's output."""
     tmp = tmp_path_factory.mktemp("freecad")
     home = tmp / "home"
     macros = home / ".local/share/FreeCAD/Macro"  # FreeCAD's user macro directory under $HOME
@@ -34,26 +41,27 @@ def posted(tmp_path_factory):
     env.update(
         HOME=str(home),
         NCPP_OUT=str(tmp / "compensated.ngc"),
-        NCPP_POST_ARGS=f"--ncpp {ncpp} --machine {MACHINE} --work-offset 400,350,300 --precision 4",
+        NCPP_POST_ARGS=f"--ncpp {ncpp} --machine {MACHINE} --work-offset 400,350,300 --precision 4 --no-comments",
         NCPP_PLAIN_OUT=str(tmp / "plain.ngc"),
         NCPP_PLAIN_ARGS=f"--ncpp {ncpp} --precision 4",
     )
     proc = subprocess.run([FREECADCMD, str(ROOT / "tests/shop/freecad/post_job.py")], capture_output=True, text=True, errors="replace", cwd=tmp, env=env, timeout=600)
     if "NCPP_POSTED" not in proc.stdout:
         pytest.fail("FreeCAD did not post:\n" + proc.stdout[-3000:] + proc.stderr[-2000:])
-    return tmp / "compensated.ngc", tmp / "plain.ngc"
+    return tmp / "compensated.ngc", tmp / "plain.ngc", proc.stdout
 
 
 def test_freecad_posts_a_compensated_program(posted):
-    compensated, _ = posted
+    compensated, _, _ = posted
     lines = compensated.read_text().splitlines()
     assert lines[0].startswith("(ncpp compensated for hr5b.toml sha256:")
     assert "(Exported by FreeCAD)" in lines[:5] and any("linuxcnc_post" in ln for ln in lines[:5])
     assert any(ln.startswith(("G2", "G3")) for ln in lines)  # the profile's corner arcs stay arcs
+    assert not any(ln.startswith("(begin") for ln in lines)  # --no-comments reached linuxcnc_post
 
 
 def test_linuxcnc_accepts_it_and_the_path_is_corrected_by_microns(posted):
-    compensated, plain = posted
+    compensated, plain, _ = posted
     plain_ends = np.array(end_points(run_rs274(plain)))
     compensated_ends = np.array(end_points(run_rs274(compensated)))
     assert len(plain_ends) > 10
@@ -63,6 +71,16 @@ def test_linuxcnc_accepts_it_and_the_path_is_corrected_by_microns(posted):
 
 
 def test_without_a_machine_file_the_post_is_freecads_own(posted):
-    _, plain = posted
+    _, plain, _ = posted
     text = plain.read_text()
     assert "ncpp compensated" not in text and text.startswith("(Exported by FreeCAD)")
+    # Posted after the compensated one: its --no-comments did not stick in linuxcnc_post.
+    assert "(begin preamble)" in text
+
+
+def test_freecad_1_uses_the_class_and_the_legacy_script_api_agrees(posted):
+    *_, output = posted
+    if "NCPP_PROCESSOR" not in output:
+        pytest.skip("FreeCAD before 1.0 has only the legacy export()")
+    assert "NCPP_PROCESSOR Ncpp" in output  # PostProcessorFactory found the class, not WrapperPost
+    assert output.count("NCPP_LEGACY_SAME True") == 2
