@@ -24,6 +24,7 @@ from ncpp.errors import Location, NcppError, Warnings
 from ncpp.motion.segments import Event
 from ncpp.passes import PASSES, PassContext, run_passes
 from ncpp.passes.context import is_directional
+from ncpp.passes.kernels import INLINE, Kernels, Worker
 from ncpp.program.blocks import Block, Comment
 from ncpp.program.dialects import parse_program
 from ncpp.program.dialects.iso import IsoWriter
@@ -170,9 +171,10 @@ def with_header(lines: Iterable[str], header: str, writer: IsoWriter) -> Iterato
     yield from it
 
 
-def make_context(source: ErrorSource, tolerance: float, warnings: Warnings, file: str) -> PassContext:
+def make_context(source: ErrorSource, tolerance: float, warnings: Warnings, file: str, kernels: Kernels = INLINE) -> PassContext:
     """The pass context every front end (filter, compensate, post) compensates with."""
     return PassContext(
+        kernels=kernels,
         model=source.model,
         tolerance=tolerance,
         max_correction=source.max_correction,
@@ -195,11 +197,22 @@ def process(
     warnings: Warnings | None = None,
     progress: Callable[[int], None] | None = None,
     dialect: str | None = None,
+    jobs: int = 1,
 ) -> Stats:
     """Read, interpret, compensate (when `source` is given) and write one program.
 
     The dialect is detected from the content (and the file name) unless given;
-    it picks the interpreter and the writer (DIALECT_TOOLS)."""
+    it picks the interpreter and the writer (DIALECT_TOOLS).  `jobs` 2 or more:
+    compensation's numeric kernels run in a worker process (passes/kernels.py),
+    the same output on two cores."""
+    kernels: Kernels = Worker() if source is not None and jobs > 1 else INLINE  # started first: it starts while we parse
+    try:
+        return _process(stream, out, file, source, tolerance, strict, force, warnings, progress, dialect, kernels)
+    finally:
+        kernels.close()
+
+
+def _process(stream, out, file, source, tolerance, strict, force, warnings, progress, dialect, kernels: Kernels) -> Stats:
     warnings = warnings or Warnings(strict=strict)
     stats = Stats()
     name, parsed = parse_program(stream, file, dialect)
@@ -213,7 +226,7 @@ def process(
     if source is None:
         lines: Iterable[str] = (event.block.text for event in _first_per_block(events))
     else:
-        ctx = make_context(source, tolerance, warnings, file)
+        ctx = make_context(source, tolerance, warnings, file, kernels)
         lines = with_header(writer.write(run_passes(events, ctx, PASSES)), header_text(source, tolerance), writer)
     lines = iter(lines)
     with _rare_collections():

@@ -46,6 +46,7 @@ def already_compensated(path: str) -> bool:
 
 def run(path: str, err: TextIO, machine: str | None = None) -> None:
     """Write the compensated program to stdout (nothing on error), progress to `err`."""
+    from ncpp.cli.compensate import jobs_for
     from ncpp.cli.io import open_output
     from ncpp.integrations.config import find_settings
     from ncpp.pipeline import ErrorSource, process
@@ -61,7 +62,8 @@ def run(path: str, err: TextIO, machine: str | None = None) -> None:
                 if not os.path.isfile(settings.machine):
                     raise NcppError(f"machine file {settings.machine} (from {settings.origin}) does not exist")
                 source = ErrorSource.from_machine_file(settings.machine).shifted(settings.work_offset)
-                process(stream, spool, file=path, source=source, tolerance=settings.tolerance, warnings=Warnings(stream=err), progress=progress)
+                jobs = jobs_for(None, stream)  # LinuxCNC runs the filter as its own process: a worker is safe
+                process(stream, spool, file=path, source=source, tolerance=settings.tolerance, warnings=Warnings(stream=err), progress=progress, jobs=jobs)
         progress.report(100)
 
 

@@ -1,0 +1,102 @@
+"""Compensation's numeric kernels in a worker process (`--jobs 2`): the same
+output as in one process, byte for byte; the same errors; no hang when the
+worker dies."""
+
+import io
+import os
+from pathlib import Path
+
+import pytest
+
+from ncpp.cli.compensate import AUTO_JOBS_BYTES, jobs_for
+from ncpp.errors import NcppError
+from ncpp.passes.kernels import Worker, WorkerError
+from ncpp.pipeline import ErrorSource, process
+
+ROOT = Path(__file__).resolve().parents[2]
+CORPUS = ROOT.parent / "shared/corpus/iso_gcode/linuxcnc"
+OFFSET = (400.0, 350.0, 300.0)
+
+
+def _pattern(k: int) -> str:
+    """A few lines of every kind the passes treat apart: long lines, arcs in
+    three planes (IJK and R), a helix, incremental moves, inch, a rapid."""
+    x, y = 10 + k % 50, 5 + k % 30
+    return (
+        f"G17 G90 G0 X{x} Y{y}\nG1 Z-1\nX{x + 30}\nG2 X{x + 50} Y{y} I10 J0\nG3 X{x + 40} Y{y + 10} R10\n"
+        f"G18 G2 X{x + 44} Z-5 I2 K-2\nG19 G3 Y{y + 14} Z-1 J2 K2 X{x + 46}\n"
+        f"G17 G91 G1 X-3 Y2\nX1.5 Y-0.5 Z0.2\nG90\nG20 G1 X{(x + 3) / 25.4:.4f} Y{y / 25.4:.4f}\nG21\nG0 Z5\n"
+    )
+
+
+PROGRAM = ("G21 G90 G17 F600\n" + "".join(_pattern(k) for k in range(400)) + "M2\n").encode()
+
+
+def _compensated(data: bytes, source: ErrorSource, jobs: int) -> bytes:
+    out = io.BytesIO()
+    process(io.BytesIO(data), out, file="t.ngc", source=source, jobs=jobs)
+    return out.getvalue()
+
+
+@pytest.mark.parametrize("machine", ["hr5b", "tl_tuotanto"])  # with and without reversal errors
+def test_a_worker_writes_the_same_program(machine):
+    source = ErrorSource.from_machine_file(str(ROOT / f"samples/machines/{machine}.toml")).shifted(OFFSET)
+    inline = _compensated(PROGRAM, source, jobs=1)
+    assert inline.count(b"\n") > 5200  # several chunks of the passes
+    assert _compensated(PROGRAM, source, jobs=2) == inline
+
+
+def test_a_worker_compensates_a_corpus_program_from_a_measurement_the_same():
+    data = (CORPUS / "arcspiral.ngc").read_bytes()
+    source = ErrorSource.from_measurement(str(ROOT / "samples/measurements/ballbar_XY_R150.csv")).shifted(OFFSET)
+    assert _compensated(data, source, jobs=2) == _compensated(data, source, jobs=1)
+
+
+def test_an_error_in_the_worker_names_the_line():
+    source = ErrorSource.from_machine_file(str(ROOT / "samples/machines/hr5b.toml")).shifted(OFFSET)
+    data = PROGRAM.replace(b"M2\n", b"G1 X900\nM2\n")  # beyond X travel (800 mm - 400 offset)
+    messages = []
+    for jobs in (1, 2):
+        with pytest.raises(NcppError) as err:
+            _compensated(data, source, jobs)
+        messages.append(str(err.value))
+    assert messages[0] == messages[1]
+    line = data.count(b"\n") - 1  # the G1 X900
+    assert f"t.ngc:{line}:" in messages[0] and "outside the X travel" in messages[0]
+
+
+def _die(code: int) -> None:
+    os._exit(code)
+
+
+def test_a_worker_that_dies_is_an_error_not_a_hang():
+    with Worker() as worker:
+        call = worker.bind(_die)
+        with pytest.raises(WorkerError, match="exit code 3"):
+            call(3).result()
+
+
+def _fail() -> None:
+    raise ValueError("a bug")
+
+
+def test_a_bug_in_the_worker_comes_back_with_its_traceback():
+    with Worker() as worker:
+        with pytest.raises(WorkerError, match="ValueError: a bug"):
+            worker.bind(_fail)().result()
+
+
+def test_jobs_follow_the_input_size_unless_given(tmp_path):
+    big, small = tmp_path / "big.ngc", tmp_path / "small.ngc"
+    big.write_bytes(b"G1 X1\n" * (AUTO_JOBS_BYTES // 6 + 1))
+    small.write_bytes(b"G1 X1\n")
+    cores = len(os.sched_getaffinity(0))
+    with open(big, "rb") as b, open(small, "rb") as s:
+        assert jobs_for(None, b) == (2 if cores >= 2 else 1)
+        assert jobs_for(None, s) == 1
+        assert jobs_for(1, b) == 1 and jobs_for(2, s) == 2
+    assert jobs_for(None, io.BytesIO(b"G1 X1\n")) == 1  # no file behind it
+    read, write = os.pipe()
+    with os.fdopen(read, "rb") as pipe:
+        os.close(write)
+        assert jobs_for(None, pipe) == 1
