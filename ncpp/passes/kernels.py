@@ -14,8 +14,12 @@ copy, so the numbers (and the output) are the same as inline, bit for bit.
 
 from __future__ import annotations
 
-import multiprocessing
+import os
+import pickle
 import queue
+import subprocess
+import sys
+import threading
 import traceback
 from typing import Any, Callable, Protocol
 
@@ -56,50 +60,74 @@ INLINE = Inline()
 
 
 class WorkerError(RuntimeError):
-    """A kernel failed in the worker with something other than an NcppError."""
+    """A kernel failed in the worker with something other than an NcppError,
+    or the worker stopped."""
 
 
 class Worker:
-    """Kernels run in one spawned worker process, in call order.
+    """Kernels run in one worker process, in call order.
 
-    Spawned, not forked: a fork copies whatever threads and locks this process
-    holds (BLAS pools, FreeCAD's) into a child that cannot use them safely.
-    The queues' feeder threads keep either side from blocking on a full pipe
-    while the other is blocked too."""
-
-    POLL_S = 1.0  # how often a wait checks that the worker is still alive
+    A fresh interpreter (`python -c`), not a fork: a fork copies whatever
+    threads and locks this process holds (BLAS pools, a host application's)
+    into a child that cannot use them safely.  Nor multiprocessing's spawn:
+    it re-runs the calling script in the child, which an unguarded script
+    does not survive.  Requests and replies are pickles on the child's stdin
+    and stdout, written and read here by two threads: neither process ever
+    waits on a full pipe, and the worker runs ahead of the results asked for."""
 
     def __init__(self) -> None:
-        context = multiprocessing.get_context("spawn")
-        self._requests = context.Queue()
-        self._replies = context.Queue()
-        self._process = context.Process(target=_serve, args=(self._requests, self._replies), daemon=True, name="ncpp-kernels")
-        self._process.start()
+        self._process = subprocess.Popen(
+            [sys.executable, "-c", "from ncpp.passes.kernels import _serve; _serve()"],
+            stdin=subprocess.PIPE, stdout=subprocess.PIPE, env={**os.environ, "PYTHONPATH": os.pathsep.join(p for p in sys.path if p)},
+        )  # fmt: skip
+        self._outbox: queue.SimpleQueue = queue.SimpleQueue()
+        self._inbox: queue.SimpleQueue = queue.SimpleQueue()
+        self._sender = threading.Thread(target=self._send, daemon=True, name="ncpp-kernels-send")
+        self._receiver = threading.Thread(target=self._receive, daemon=True, name="ncpp-kernels-receive")
+        self._sender.start()
+        self._receiver.start()
         self._kernels = 0
         self._calls = 0
         self._received: dict[int, tuple[bool, Any]] = {}
 
+    def _send(self) -> None:
+        pipe = self._process.stdin
+        try:
+            while (request := self._outbox.get()) is not None:
+                pickle.dump(request, pipe, protocol=pickle.HIGHEST_PROTOCOL)
+                pipe.flush()
+            pipe.close()
+        except (BrokenPipeError, OSError):  # the worker stopped: `_result` says so
+            pass
+
+    def _receive(self) -> None:
+        pipe = self._process.stdout
+        try:
+            while True:
+                self._inbox.put(pickle.load(pipe))
+        except (EOFError, OSError, pickle.UnpicklingError, ValueError):
+            self._inbox.put(None)  # the worker stopped
+
     def bind(self, kernel: Callable) -> Callable[..., Handle]:
         key = self._kernels
         self._kernels += 1
-        self._requests.put(("bind", key, kernel))
+        self._outbox.put(("bind", key, kernel))
 
         def call(*args: Any) -> Handle:
             number = self._calls
             self._calls += 1
-            self._requests.put(("call", key, args))
+            self._outbox.put(("call", key, args))
             return _Remote(self, number)
 
         return call
 
     def _result(self, number: int) -> Any:
         while number not in self._received:
-            try:
-                done, ok, value = self._replies.get(timeout=self.POLL_S)
-            except queue.Empty:
-                if not self._process.is_alive():
-                    raise WorkerError(f"the compensation worker stopped (exit code {self._process.exitcode})") from None
-                continue
+            reply = self._inbox.get()
+            if reply is None:
+                self._inbox.put(None)  # for whoever asks next
+                raise WorkerError(f"the compensation worker stopped (exit code {self._process.wait()})")
+            done, ok, value = reply
             self._received[done] = (ok, value)
         ok, value = self._received.pop(number)
         if not ok:
@@ -108,14 +136,13 @@ class Worker:
 
     def close(self) -> None:
         """Stops the worker (at once if calls are still under way: their results are not wanted)."""
-        if self._process.is_alive():
-            self._requests.put(None)
-            self._process.join(timeout=2.0)
-        if self._process.is_alive():
+        self._outbox.put(None)
+        self._sender.join(timeout=2.0)
+        if self._process.poll() is None:
             self._process.terminate()
-            self._process.join()
-        self._requests.close()
-        self._replies.close()
+        self._process.wait()
+        self._receiver.join(timeout=2.0)
+        self._process.stdout.close()
 
     def __enter__(self) -> "Worker":
         return self
@@ -134,22 +161,29 @@ class _Remote:
         return self.worker._result(self.number)
 
 
-def _serve(requests: Any, replies: Any) -> None:
+def _serve() -> None:
     """The worker's loop: bind kernels, run calls in order, send back results or errors."""
+    requests, replies = sys.stdin.buffer, sys.stdout.buffer
+    sys.stdout = sys.stderr  # a stray print must not corrupt the replies
     kernels: dict[int, Callable] = {}
     done = 0
     try:
-        while (request := requests.get()) is not None:
-            kind, key, payload = request
+        while True:
+            try:
+                kind, key, payload = pickle.load(requests)
+            except EOFError:
+                return
             if kind == "bind":
                 kernels[key] = payload
                 continue
             try:
-                replies.put((done, True, kernels[key](*payload)))
-            except NcppError as err:  # the user's input: reported as if it ran here
-                replies.put((done, False, err))
+                reply = (done, True, kernels[key](*payload))
+            except NcppError as err:  # the user's input: reported as if it ran in the caller
+                reply = (done, False, err)
             except Exception:  # a bug: its traceback, as text (it may not pickle)
-                replies.put((done, False, WorkerError(traceback.format_exc())))
+                reply = (done, False, WorkerError(traceback.format_exc()))
+            pickle.dump(reply, replies, protocol=pickle.HIGHEST_PROTOCOL)
+            replies.flush()
             done += 1
-    except KeyboardInterrupt:  # the main process is stopping too and says so
+    except (KeyboardInterrupt, BrokenPipeError):  # the caller is stopping and says why
         pass

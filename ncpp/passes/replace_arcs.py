@@ -15,7 +15,8 @@ All arcs of a chunk are processed together, piece arrays in, piece arrays out.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from collections import deque
+from dataclasses import dataclass, field
 from typing import Iterable, Iterator
 
 import numpy as np
@@ -45,6 +46,9 @@ REVERSAL_HEIGHT = 1e-7
 BATCH_ARCS = 1024
 BATCH_EVENTS = 16384
 SLIVER = 0.01  # mm of arc length below which a piece becomes a line (its bulge is < 0.1 µm for radii over 0.1 mm)
+# Chunks handed to the kernel before the first is written: with a worker process,
+# how far the stream may run ahead of it (memory: AHEAD + 1 chunks in flight)
+AHEAD = 2
 
 
 @dataclass
@@ -57,9 +61,21 @@ class _Pieces:
 
 
 def replace_arcs(events: Iterable[Event], ctx: PassContext) -> Iterator[Event]:
+    fit = ctx.kernels.bind(FitArcs(ctx.for_kernels()))
+    # batches whose fit is under way: with a worker process, the next batch is read meanwhile
+    pending: deque = deque()
     for batch in _batches(events):
         index = [k for k, e in enumerate(batch) if type(e) is Arc and not e.changed]
-        yield from spliced(batch, index, _replace([batch[k] for k in index], ctx) if index else [])
+        arcs = [batch[k] for k in index]
+        pending.append((batch, index, arcs, fit(_ArcRows.of(arcs)) if arcs else None))
+        if len(pending) > AHEAD:
+            yield from _finish(*pending.popleft())
+    while pending:
+        yield from _finish(*pending.popleft())
+
+
+def _finish(batch: list[Event], index: list[int], arcs: list[Arc], fitting) -> list[Event]:
+    return spliced(batch, index, _assemble(arcs, fitting.result())) if arcs else batch
 
 
 def _batches(events: Iterable[Event]) -> Iterator[list[Event]]:
@@ -77,21 +93,63 @@ def _batches(events: Iterable[Event]) -> Iterator[list[Event]]:
         yield batch
 
 
+@dataclass
+class _ArcRows:
+    """A batch's arcs as the fit needs them: arrays, no events (the fit may run
+    in a worker process)."""
+
+    start: NDArray  # (n,3) program units
+    end: NDArray  # (n,3)
+    centre: NDArray  # (n,3)
+    axes: NDArray  # (n,3) indices of the plane's u, v and normal axis
+    sweep: NDArray  # (n,) rad, signed (+ counter-clockwise), full turns included
+    offsets: NDArray  # (n,3) machine minus program, program units
+    scales: NDArray  # (n,) mm per program unit
+    lines: NDArray  # (n,) the line of each arc's block, for messages
+
+    @classmethod
+    def of(cls, arcs: list[Arc]) -> "_ArcRows":
+        offsets, scales = frames(arcs)
+        return cls(
+            points([a.start for a in arcs]), points([a.end for a in arcs]), points([a.center for a in arcs]),
+            np.array([PLANE_AXES[a.context.plane] for a in arcs]), np.array([a.sweep() for a in arcs]),
+            offsets, scales, np.array([a.block.line for a in arcs]),
+        )  # fmt: skip
+
+
+@dataclass
+class _Fitted:
+    """What the fit makes of a batch's arcs, as numbers: pieces in no particular
+    order, each with its arc and start angle (`_assemble` orders them)."""
+
+    a0: NDArray  # (n,) each arc's start angle
+    sign: NDArray  # (n,) +1 counter-clockwise, -1 clockwise
+    arcs: list[tuple[NDArray, ...]] = field(default_factory=list)  # (arc, a0, start, end, centre) per round
+    lines: list[tuple[NDArray, ...]] = field(default_factory=list)  # (arc, a0, points (p,m,3)): lines through the points
+
+
+class FitArcs:
+    """The numbers of the pass: compensated pieces of each arc of a batch."""
+
+    def __init__(self, ctx: PassContext):
+        self.ctx = ctx
+
+    def __call__(self, rows: _ArcRows) -> _Fitted:
+        return _replace(rows, self.ctx)
+
+
 class _ArcGeometry:
     """Plane-local geometry of a list of arcs: centre (u,v), radius, start
     angle, total sweep, normal-axis start and rise; axis order per arc."""
 
-    def __init__(self, arcs: list[Arc]):
-        self.axes = np.array([PLANE_AXES[a.context.plane] for a in arcs])  # (n,3): u, v, w indices
-        start = points([a.start for a in arcs])
-        end = points([a.end for a in arcs])
-        centre = points([a.center for a in arcs])
+    def __init__(self, rows: _ArcRows):
+        self.axes = rows.axes
         local = lambda p: np.take_along_axis(p, self.axes, axis=1)  # noqa: E731
-        s, e, c = local(start), local(end), local(centre)
+        s, e, c = local(rows.start), local(rows.end), local(rows.centre)
         self.centre = c[:, :2]
         self.radius = np.hypot(s[:, 0] - c[:, 0], s[:, 1] - c[:, 1])
         self.a0 = np.arctan2(s[:, 1] - c[:, 1], s[:, 0] - c[:, 0])
-        self.sweep = np.array([a.sweep() for a in arcs])
+        self.sweep = rows.sweep
         self.w0 = s[:, 2]
         self.rise = e[:, 2] - s[:, 2]
         self.end_radius = np.hypot(e[:, 0] - c[:, 0], e[:, 1] - c[:, 1])
@@ -150,12 +208,11 @@ def _quadrant_pieces(geometry: _ArcGeometry) -> _Pieces:
     return _Pieces(arc, start, end - start)
 
 
-def _replace(arcs: list[Arc], ctx: PassContext) -> list[list[Event]]:
-    geometry = _ArcGeometry(arcs)
-    offsets, scales = frames(arcs)
-    line_of = np.array([a.block.line for a in arcs])
+def _replace(rows: _ArcRows, ctx: PassContext) -> _Fitted:
+    geometry = _ArcGeometry(rows)
+    offsets, scales, line_of = rows.offsets, rows.scales, rows.lines
     pending = _initial_pieces(geometry, ctx.directional)
-    done: list[tuple[int, float, Event | list[Event]]] = []  # (arc, a0, result)
+    done = _Fitted(geometry.a0, np.where(geometry.sweep >= 0, 1.0, -1.0))
     for _ in range(MAX_ROUNDS):
         if len(pending.arc) == 0:
             break
@@ -165,17 +222,17 @@ def _replace(arcs: list[Arc], ctx: PassContext) -> list[list[Event]]:
         for m in np.unique(counts).tolist():
             rows = np.flatnonzero(counts == m)
             some = _Pieces(pending.arc[rows], pending.a0[rows], pending.sweep[rows])
-            split[rows] = _round(some, length[rows], np.linspace(0.0, 1.0, m), arcs, geometry, offsets, scales, line_of, ctx, done)
+            split[rows] = _round(some, length[rows], np.linspace(0.0, 1.0, m), geometry, offsets, scales, line_of, ctx, done)
         half = pending.sweep[split] / 2
         pending = _Pieces(
             np.repeat(pending.arc[split], 2),
             np.column_stack([pending.a0[split], pending.a0[split] + half]).ravel(),
             np.repeat(half, 2),
         )
-    return _assemble(arcs, geometry, done)
+    return done
 
 
-def _round(pending: _Pieces, length: NDArray, t: NDArray, arcs, geometry, offsets, scales, line_of, ctx, done: list) -> NDArray:
+def _round(pending: _Pieces, length: NDArray, t: NDArray, geometry, offsets, scales, line_of, ctx, done: _Fitted) -> NDArray:
     """Compensate and fit pieces sampled at `t`; append the finished ones to
     `done` and return (p,) which to halve."""
     angles = pending.a0[:, None] + t[None, :] * pending.sweep[:, None]
@@ -210,17 +267,12 @@ def _round(pending: _Pieces, length: NDArray, t: NDArray, arcs, geometry, offset
     if lines.size and ctx.directional:
         # lines are compensated for the mean direction: apply_error_map moves them to the real one
         q[lines] = _mean_compensated(nominal[lines], offsets[pending.arc[lines]], scale[lines], line_of[pending.arc[lines]], ctx)
-    arc_of, a0 = pending.arc.tolist(), pending.a0.tolist()
-    for p in np.flatnonzero(straight).tolist():
-        done.append((arc_of[p], a0[p], _line_pieces(arcs[arc_of[p]], q[p, [0, -1]])))
+    for rows, pts in ((np.flatnonzero(straight), lambda r: q[r][:, [0, -1]]), (np.flatnonzero(give_up), lambda r: q[r])):
+        if rows.size:
+            done.lines.append((pending.arc[rows], pending.a0[rows], pts(rows)))
     fitted = np.flatnonzero(ok)
-    starts, ends, centres = (map(tuple, a.tolist()) for a in (q[fitted, 0], q[fitted, -1], centre[fitted]))
-    for p, start, end, c in zip(fitted.tolist(), starts, ends, centres):
-        arc = arcs[arc_of[p]]
-        piece = Arc(start, end, c, 1 if arc.turn > 0 else -1, arc.feed, arc.block, arc.context, arc.extra, True)
-        done.append((arc_of[p], a0[p], piece))
-    for p in np.flatnonzero(give_up).tolist():
-        done.append((arc_of[p], a0[p], _line_pieces(arcs[arc_of[p]], q[p])))
+    if fitted.size:
+        done.arcs.append((pending.arc[fitted], pending.a0[fitted], q[fitted, 0], q[fitted, -1], centre[fitted]))
     return ~ok & ~give_up & ~straight
 
 
@@ -324,18 +376,23 @@ def _minimax_step(uv: NDArray, q0: NDArray, c: NDArray, normal: NDArray) -> NDAr
     return candidates[np.arange(len(r)), worst.argmin(axis=1)]
 
 
-def _line_pieces(arc: Arc, q: NDArray) -> list[Event]:
-    pts = [tuple(p) for p in q.tolist()]
+def _line_pieces(arc: Arc, q: list[list[float]]) -> list[Event]:
+    pts = [tuple(p) for p in q]
     return [Line(a, b, False, arc.feed, arc.block, arc.context, arc.extra, True) for a, b in zip(pts, pts[1:])]
 
 
-def _assemble(arcs: list[Arc], geometry: _ArcGeometry, done: list) -> list[list[Event]]:
-    """Pieces of each arc in the order of travel."""
+def _assemble(arcs: list[Arc], fitted: _Fitted) -> list[list[Event]]:
+    """The events of each arc's pieces in the order of travel."""
     per_arc: list[list[tuple[float, Event | list[Event]]]] = [[] for _ in arcs]
-    start, sign = geometry.a0.tolist(), np.where(geometry.sweep >= 0, 1.0, -1.0).tolist()
-    for k, a0, result in done:
-        # order by progress along the sweep, whatever its sign
-        per_arc[k].append(((a0 - start[k]) * sign[k], result))
+    start, sign = fitted.a0.tolist(), fitted.sign.tolist()
+    for of, a0, starts, ends, centres in fitted.arcs:
+        for k, a, s, e, c in zip(of.tolist(), a0.tolist(), map(tuple, starts.tolist()), map(tuple, ends.tolist()), map(tuple, centres.tolist())):
+            arc = arcs[k]
+            # order by progress along the sweep, whatever its sign
+            per_arc[k].append(((a - start[k]) * sign[k], Arc(s, e, c, 1 if arc.turn > 0 else -1, arc.feed, arc.block, arc.context, arc.extra, True)))
+    for of, a0, pts in fitted.lines:
+        for k, a, q in zip(of.tolist(), a0.tolist(), pts.tolist()):
+            per_arc[k].append(((a - start[k]) * sign[k], _line_pieces(arcs[k], q)))
     out: list[list[Event]] = []
     for pieces in per_arc:
         if len(pieces) > 1:
