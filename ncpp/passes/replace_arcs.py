@@ -46,8 +46,8 @@ REVERSAL_HEIGHT = 1e-7
 BATCH_ARCS = 1024
 BATCH_EVENTS = 16384
 SLIVER = 0.01  # mm of arc length below which a piece becomes a line (its bulge is < 0.1 µm for radii over 0.1 mm)
-# Chunks handed to the kernel before the first is written: with a worker process,
-# how far the stream may run ahead of it (memory: AHEAD + 1 chunks in flight)
+# Batches handed to the fit before the first is written: with a worker process,
+# how far the stream may run ahead of it (memory: AHEAD + 1 batches in flight)
 AHEAD = 2
 
 
@@ -134,8 +134,8 @@ class FitArcs:
     def __init__(self, ctx: PassContext):
         self.ctx = ctx
 
-    def __call__(self, rows: _ArcRows) -> _Fitted:
-        return _replace(rows, self.ctx)
+    def __call__(self, arcs: _ArcRows) -> _Fitted:
+        return _replace(arcs, self.ctx)
 
 
 class _ArcGeometry:
@@ -208,9 +208,9 @@ def _quadrant_pieces(geometry: _ArcGeometry) -> _Pieces:
     return _Pieces(arc, start, end - start)
 
 
-def _replace(rows: _ArcRows, ctx: PassContext) -> _Fitted:
-    geometry = _ArcGeometry(rows)
-    offsets, scales, line_of = rows.offsets, rows.scales, rows.lines
+def _replace(arcs: _ArcRows, ctx: PassContext) -> _Fitted:
+    geometry = _ArcGeometry(arcs)
+    offsets, scales, line_of = arcs.offsets, arcs.scales, arcs.lines
     pending = _initial_pieces(geometry, ctx.directional)
     done = _Fitted(geometry.a0, np.where(geometry.sweep >= 0, 1.0, -1.0))
     for _ in range(MAX_ROUNDS):
