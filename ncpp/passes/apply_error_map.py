@@ -36,13 +36,11 @@ ROUNDS = 4
 STILL_MM = 0.00025
 # mm: a line moving an axis this far moves it that way whatever its compensation (errors are µm)
 NEAR_STILL = 0.05
-# Chunks handed to the kernel before the first is written: with a worker process,
-# how far the stream may run ahead of it (memory: AHEAD + 1 chunks in flight)
-AHEAD = 2
 
 
 def apply_error_map(events: Iterable[Event], ctx: PassContext) -> Iterator[Event]:
     solve = ctx.kernels.bind(Solve(ctx.for_kernels()))
+    ahead = ctx.kernels.ahead
     last = None  # the last segment written: its compensated end, in its own program frame
     # chunks whose solve is under way: with a worker process, the next chunk is read
     # (parsed, interpreted, its arcs replaced) while this one is solved
@@ -51,7 +49,7 @@ def apply_error_map(events: Iterable[Event], ctx: PassContext) -> Iterator[Event
         segs = [e for e in chunk if type(e) is Line or type(e) is Arc]
         rows = _rows(segs, ctx.directional) if segs else None
         pending.append((chunk, segs, rows, solve(rows) if segs else None))
-        if len(pending) > AHEAD:
+        if len(pending) > ahead:
             last = yield from _finish(*pending.popleft(), last)
     while pending:
         last = yield from _finish(*pending.popleft(), last)

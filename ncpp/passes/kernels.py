@@ -31,6 +31,8 @@ class Handle(Protocol):
 
 
 class Kernels(Protocol):
+    ahead: int  # calls a pass makes before it asks for the first result
+
     def bind(self, kernel: Callable) -> Callable[..., Handle]: ...
 
     def close(self) -> None: ...
@@ -48,6 +50,8 @@ class _Done:
 
 class Inline:
     """Kernels run where they are called."""
+
+    ahead = 0  # nothing runs meanwhile: a chunk ahead would only hold memory
 
     def bind(self, kernel: Callable) -> Callable[..., Handle]:
         return lambda *args: _Done(kernel(*args))
@@ -74,6 +78,10 @@ class Worker:
     does not survive.  Requests and replies are pickles on the child's stdin
     and stdout, written and read here by two threads: neither process ever
     waits on a full pipe, and the worker runs ahead of the results asked for."""
+
+    # Two chunks ahead keep the worker busy while this process writes one chunk and
+    # reads the next (one ahead left it waiting a sixth of the time); memory: three chunks.
+    ahead = 2
 
     def __init__(self) -> None:
         self._process = subprocess.Popen(

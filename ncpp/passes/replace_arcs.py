@@ -46,9 +46,6 @@ REVERSAL_HEIGHT = 1e-7
 BATCH_ARCS = 1024
 BATCH_EVENTS = 16384
 SLIVER = 0.01  # mm of arc length below which a piece becomes a line (its bulge is < 0.1 µm for radii over 0.1 mm)
-# Batches handed to the fit before the first is written: with a worker process,
-# how far the stream may run ahead of it (memory: AHEAD + 1 batches in flight)
-AHEAD = 2
 
 
 @dataclass
@@ -62,13 +59,14 @@ class _Pieces:
 
 def replace_arcs(events: Iterable[Event], ctx: PassContext) -> Iterator[Event]:
     fit = ctx.kernels.bind(FitArcs(ctx.for_kernels()))
+    ahead = ctx.kernels.ahead
     # batches whose fit is under way: with a worker process, the next batch is read meanwhile
     pending: deque = deque()
     for batch in _batches(events):
         index = [k for k, e in enumerate(batch) if type(e) is Arc and not e.changed]
         arcs = [batch[k] for k in index]
         pending.append((batch, index, arcs, fit(_ArcRows.of(arcs)) if arcs else None))
-        if len(pending) > AHEAD:
+        if len(pending) > ahead:
             yield from _finish(*pending.popleft())
     while pending:
         yield from _finish(*pending.popleft())
