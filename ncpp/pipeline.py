@@ -212,7 +212,19 @@ def process(
         kernels.close()
 
 
-def _process(stream, out, file, source, tolerance, strict, force, warnings, progress, dialect, kernels: Kernels) -> Stats:
+def _process(
+    stream: BinaryIO,
+    out: BinaryIO,
+    file: str,
+    source: ErrorSource | None,
+    tolerance: float,
+    strict: bool,
+    force: bool,
+    warnings: Warnings | None,
+    progress: Callable[[int], None] | None,
+    dialect: str | None,
+    kernels: Kernels,
+) -> Stats:
     warnings = warnings or Warnings(strict=strict)
     stats = Stats()
     name, parsed = parse_program(stream, file, dialect)
