@@ -11,7 +11,7 @@ from ncpp.errors import Warnings
 from ncpp.motion import interpret
 from ncpp.pipeline import ErrorSource, process
 from ncpp.program.parser import parse_stream
-from ncpp.simulate import SampledPath, sample_events
+from ncpp.simulate import SampledPath
 
 QUIET = Warnings(stream=open(os.devnull, "w"))
 MARGIN_MM = 1.0

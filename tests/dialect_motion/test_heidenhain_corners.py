@@ -16,7 +16,6 @@ import numpy as np
 import pytest
 
 from ncpp.errors import NcppError, Warnings
-from ncpp.motion.heidenhain import interpret
 from ncpp.motion.segments import Arc, Line, Pass
 from ncpp.pipeline import dialect_tools
 from ncpp.program.dialects import parse_program

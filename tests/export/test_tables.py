@@ -13,7 +13,7 @@ from ncpp.errors import NcppError
 from ncpp.export import axis_error, export_table
 from ncpp.export.fanuc import read_fanuc_pitch, write_fanuc_pitch
 from ncpp.export.heidenhain import read_heidenhain_com
-from ncpp.export.linuxcnc import flag_outliers, read_linuxcnc_comp, write_linuxcnc_comp
+from ncpp.export.linuxcnc import flag_outliers, read_linuxcnc_comp
 from ncpp.export.sinumerik import read_sinumerik
 from ncpp.machine import Machine, Table, load_machine
 

@@ -6,7 +6,6 @@ import numpy as np
 import pytest
 
 from ncpp.machine import Machine, Polynomial, Table, load_machine
-from ncpp.machine.chain import Chain
 
 SAMPLES = "samples/machines"
 
