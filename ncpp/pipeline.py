@@ -25,7 +25,7 @@ from ncpp.motion.segments import Event
 from ncpp.passes import PASSES, PassContext, run_passes
 from ncpp.passes.context import is_directional
 from ncpp.passes.kernels import INLINE, Kernels, Worker
-from ncpp.program.blocks import Block, Comment
+from ncpp.program.blocks import Block, Comment, Word
 from ncpp.program.dialects import parse_program
 from ncpp.program.dialects.iso import IsoWriter
 
@@ -116,6 +116,29 @@ def refuse_compensated(blocks: Iterable[Block], file: str) -> Iterator[Block]:
                 )
         yield block
     yield from blocks
+
+
+# Work offsets other than G54: the control holds where they are; ncpp is told one (--work-offset)
+OTHER_WORK_OFFSETS = {55.0: "G55", 56.0: "G56", 57.0: "G57", 58.0: "G58", 59.0: "G59", 59.1: "G59.1", 59.2: "G59.2", 59.3: "G59.3"}
+
+
+def warn_other_work_offsets(blocks: Iterable[Block], warnings: Warnings, file: str) -> Iterator[Block]:
+    """Pass blocks through; warn once per work offset other than G54 that the program
+    selects (refused with --strict): its machine position is the control's, and the
+    errors it is compensated for are those at the one position ncpp was given."""
+    told: set[float] = set()
+    for block in blocks:
+        signature = block.signature  # the words' letters and G numbers: most blocks are passed on here
+        if signature is None or "G5" in signature:
+            for item in block.items:
+                if type(item) is Word and item.letter == "G" and item.value in OTHER_WORK_OFFSETS and item.value not in told:
+                    told.add(item.value)
+                    warnings.warn(
+                        f"{OTHER_WORK_OFFSETS[item.value]} selects a work offset whose machine position ncpp is not told: "
+                        "compensated as if its zero were at --work-offset (G54's)",
+                        Location(file, block.line, item.start + 1),
+                    )
+        yield block
 
 
 def _counted(blocks: Iterable[Block], counter: Iterator[int], progress: Callable[[int], None] | None) -> Iterator[Block]:
@@ -233,6 +256,8 @@ def _process(
     blocks: Iterable[Block] = _counted(parsed, counter, progress)
     if source is not None and not force:
         blocks = refuse_compensated(blocks, file)
+    if source is not None:
+        blocks = warn_other_work_offsets(blocks, warnings, file)
     events: Iterable[Event] = interpret(blocks, file=file, warnings=warnings, strict=strict)
     writer = writer_class()
     if source is None:

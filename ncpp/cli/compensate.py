@@ -35,7 +35,8 @@ def add_compensation_arguments(p: argparse.ArgumentParser) -> None:
         type=parse_vector,
         default=None,
         metavar="X,Y,Z",
-        help="machine position (mm) of the program zero, as the control's work offset holds it (default 0,0,0)",
+        help="machine position (mm) of the program zero, as the control's work offset (G54) holds it (default 0,0,0); "
+        "G55-G59.3 in the program get a warning: they are compensated as if their zero were here too",
     )
     p.add_argument(
         "--jobs",
