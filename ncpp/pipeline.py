@@ -118,26 +118,28 @@ def refuse_compensated(blocks: Iterable[Block], file: str) -> Iterator[Block]:
     yield from blocks
 
 
-# Work offsets other than G54: the control holds where they are; ncpp is told one (--work-offset)
-OTHER_WORK_OFFSETS = {55.0: "G55", 56.0: "G56", 57.0: "G57", 58.0: "G58", 59.0: "G59", 59.1: "G59.1", 59.2: "G59.2", 59.3: "G59.3"}
+# G words whose coordinates are placed by the control, not by the one work offset ncpp is told
+# (--work-offset, the G54 zero): compensated all the same, at the position that one implies
+UNPLACED = {
+    53.0: "G53 moves in machine coordinates, which ncpp reads as program coordinates from --work-offset",
+    **{
+        value: f"{name} selects a work offset whose machine position ncpp is not told: compensated as if its zero were at --work-offset (G54's)"
+        for value, name in ((55.0, "G55"), (56.0, "G56"), (57.0, "G57"), (58.0, "G58"), (59.0, "G59"), (59.1, "G59.1"), (59.2, "G59.2"), (59.3, "G59.3"))
+    },
+}
 
 
-def warn_other_work_offsets(blocks: Iterable[Block], warnings: Warnings, file: str) -> Iterator[Block]:
-    """Pass blocks through; warn once per work offset other than G54 that the program
-    selects (refused with --strict): its machine position is the control's, and the
-    errors it is compensated for are those at the one position ncpp was given."""
+def warn_unplaced(blocks: Iterable[Block], warnings: Warnings, file: str) -> Iterator[Block]:
+    """Pass blocks through; warn once per G word of `UNPLACED` the program uses, where it
+    first does (refused with --strict): the errors compensated there are those of another place."""
     told: set[float] = set()
     for block in blocks:
         signature = block.signature  # the words' letters and G numbers: most blocks are passed on here
         if signature is None or "G5" in signature:
             for item in block.items:
-                if type(item) is Word and item.letter == "G" and item.value in OTHER_WORK_OFFSETS and item.value not in told:
+                if type(item) is Word and item.letter == "G" and item.value in UNPLACED and item.value not in told:
                     told.add(item.value)
-                    warnings.warn(
-                        f"{OTHER_WORK_OFFSETS[item.value]} selects a work offset whose machine position ncpp is not told: "
-                        "compensated as if its zero were at --work-offset (G54's)",
-                        Location(file, block.line, item.start + 1),
-                    )
+                    warnings.warn(UNPLACED[item.value], Location(file, block.line, item.start + 1))
         yield block
 
 
@@ -257,7 +259,7 @@ def _process(
     if source is not None and not force:
         blocks = refuse_compensated(blocks, file)
     if source is not None:
-        blocks = warn_other_work_offsets(blocks, warnings, file)
+        blocks = warn_unplaced(blocks, warnings, file)
     events: Iterable[Event] = interpret(blocks, file=file, warnings=warnings, strict=strict)
     writer = writer_class()
     if source is None:

@@ -1,5 +1,6 @@
 """A program that selects another work offset (G55-G59.3) than the one ncpp is
-told gets a warning naming the line, once per offset; --strict refuses it."""
+told, or moves in machine coordinates (G53), gets a warning naming the line,
+once per G word; --strict refuses it."""
 
 import io
 from pathlib import Path
@@ -29,6 +30,11 @@ def test_each_other_work_offset_is_named_once_where_it_is_first_selected():
 def test_strict_mode_refuses_another_work_offset():
     with pytest.raises(NcppError, match="G55 selects a work offset"):
         _run(PROGRAM, strict=True)
+
+
+def test_a_move_in_machine_coordinates_is_named():
+    lines = _run(b"G21 G90\nG0 X10 Y10 Z5\nG53 G0 Z0\nG53 G0 Z0\nM2\n").splitlines()
+    assert len(lines) == 1 and lines[0].startswith("t.ngc:3:1: warning: G53 moves in machine coordinates")
 
 
 def test_g54_alone_and_no_compensation_say_nothing():
