@@ -230,11 +230,21 @@ def process(
     it picks the interpreter and the writer (DIALECT_TOOLS).  `jobs` 2 or more:
     compensation's numeric kernels run in a worker process (passes/kernels.py),
     the same output on two cores."""
-    kernels: Kernels = Worker() if source is not None and jobs > 1 else INLINE  # started first: it starts while we parse
+    kernels = _kernels(source is not None and jobs > 1)  # started first: the worker starts while we parse
     try:
         return _process(stream, out, file, source, tolerance, strict, force, warnings, progress, dialect, kernels)
     finally:
         kernels.close()
+
+
+def _kernels(worker: bool) -> Kernels:
+    """A worker process when asked for and one can be started, else inline (the same output)."""
+    if worker:
+        try:
+            return Worker()
+        except OSError:  # no interpreter to start (an embedding host): one process it is
+            pass
+    return INLINE
 
 
 def _process(
