@@ -16,7 +16,6 @@ start is compensated with its own direction and a step move is inserted.
 
 from __future__ import annotations
 
-from collections import deque
 from dataclasses import dataclass
 from typing import Iterable, Iterator
 
@@ -25,6 +24,7 @@ from numpy.typing import NDArray
 
 from ncpp.motion.segments import PLANE_AXES, Arc, Event, Line
 from ncpp.passes.context import PassContext
+from ncpp.passes.kernels import run_ahead
 from ncpp.passes.geometry import chunked, compensate, frames, points
 from ncpp.passes.travel import Travel, grid, hold, quantize, steps
 
@@ -40,29 +40,22 @@ NEAR_STILL = 0.05
 
 def apply_error_map(events: Iterable[Event], ctx: PassContext) -> Iterator[Event]:
     solve = ctx.kernels.bind(Solve(ctx.for_kernels()))
-    ahead = ctx.kernels.ahead
     last = None  # the last segment written: its compensated end, in its own program frame
-    # chunks whose solve is under way: with a worker process, the next chunk is read
-    # (parsed, interpreted, its arcs replaced) while this one is solved
-    pending: deque = deque()
-    for chunk in chunked(events):
-        segs = [e for e in chunk if type(e) is Line or type(e) is Arc]
-        rows = _rows(segs, ctx.directional) if segs else None
-        pending.append((chunk, segs, rows, solve(rows) if segs else None))
-        if len(pending) > ahead:
-            last = yield from _finish(*pending.popleft(), last)
-    while pending:
-        last = yield from _finish(*pending.popleft(), last)
+    chunks = (_with_rows(chunk, ctx.directional) for chunk in chunked(events))
+    # with a worker process, the next chunks are read (parsed, interpreted, their arcs replaced) while one is solved
+    for (chunk, segs, rows), solving in run_ahead(chunks, lambda c: None if c[2] is None else solve(c[2]), ctx.kernels.ahead):
+        if solving is None:  # no segments
+            yield from chunk
+            continue
+        out = _written(chunk, segs, rows, solving.result(), last)
+        last = next(e for e in reversed(out) if type(e) is Line or type(e) is Arc)
+        yield from out
 
 
-def _finish(chunk: list[Event], segs: list, rows: "_Rows | None", solving, last) -> Iterator[Event]:
-    """Yields the chunk's events as written; returns the last segment written."""
-    if rows is None:
-        yield from chunk
-        return last
-    out = _written(chunk, segs, rows, solving.result(), last)
-    yield from out
-    return next(e for e in reversed(out) if type(e) is Line or type(e) is Arc)
+def _with_rows(chunk: list[Event], directional: bool) -> tuple[list[Event], list, "_Rows | None"]:
+    """The chunk, its segments, and their rows (None without segments)."""
+    segs = [e for e in chunk if type(e) is Line or type(e) is Arc]
+    return chunk, segs, _rows(segs, directional) if segs else None
 
 
 @dataclass

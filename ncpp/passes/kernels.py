@@ -2,9 +2,9 @@
 
 A kernel is a picklable callable that takes and returns arrays (and may keep
 state from call to call, like the direction each axis holds).  A pass binds
-it once and calls it a chunk ahead of the events it writes; the call returns
-a handle whose `result()` it asks for when it writes that chunk.  Inline, the
-kernel runs at the call.  With a `Worker`, it runs in a second process while
+it once and calls it `ahead` chunks before it writes the first of them
+(`run_ahead`); the call returns a handle whose `result()` it asks for when it
+writes that chunk.  Inline, the kernel runs at the call and nothing runs ahead.  With a `Worker`, it runs in a second process while
 this one parses, interprets and writes the neighbouring chunks: the numpy work
 of compensation and the Python work of the stream overlap on two cores.
 
@@ -21,7 +21,8 @@ import subprocess
 import sys
 import threading
 import traceback
-from typing import Any, Callable, Protocol
+from collections import deque
+from typing import Any, Callable, Iterable, Iterator, Protocol, TypeVar
 
 from ncpp.errors import NcppError
 
@@ -36,6 +37,20 @@ class Kernels(Protocol):
     def bind(self, kernel: Callable) -> Callable[..., Handle]: ...
 
     def close(self) -> None: ...
+
+
+T = TypeVar("T")
+
+
+def run_ahead(items: Iterable[T], start: Callable[[T], Handle | None], ahead: int) -> Iterator[tuple[T, Handle | None]]:
+    """Each item with the handle `start(item)` gave, `start` having been called for up to
+    `ahead` items after it: with a worker the stream reads that far ahead of the results."""
+    started: deque = deque()
+    for item in items:
+        started.append((item, start(item)))
+        if len(started) > ahead:
+            yield started.popleft()
+    yield from started
 
 
 class _Done:

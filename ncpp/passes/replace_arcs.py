@@ -15,7 +15,6 @@ All arcs of a chunk are processed together, piece arrays in, piece arrays out.
 from __future__ import annotations
 
 import math
-from collections import deque
 from dataclasses import dataclass, field
 from typing import Iterable, Iterator
 
@@ -24,6 +23,7 @@ from numpy.typing import NDArray
 
 from ncpp.motion.segments import PLANE_AXES, Arc, Event, Line
 from ncpp.passes.context import PassContext
+from ncpp.passes.kernels import run_ahead
 from ncpp.passes.geometry import compensate, frames, points, spliced
 from ncpp.passes.travel import grid, quantize
 
@@ -59,21 +59,16 @@ class _Pieces:
 
 def replace_arcs(events: Iterable[Event], ctx: PassContext) -> Iterator[Event]:
     fit = ctx.kernels.bind(FitArcs(ctx.for_kernels()))
-    ahead = ctx.kernels.ahead
-    # batches whose fit is under way: with a worker process, the next batch is read meanwhile
-    pending: deque = deque()
-    for batch in _batches(events):
-        index = [k for k, e in enumerate(batch) if type(e) is Arc and not e.changed]
-        arcs = [batch[k] for k in index]
-        pending.append((batch, index, arcs, fit(_ArcRows.of(arcs)) if arcs else None))
-        if len(pending) > ahead:
-            yield from _finish(*pending.popleft())
-    while pending:
-        yield from _finish(*pending.popleft())
+    batches = (_with_arcs(batch) for batch in _batches(events))
+    # with a worker process, the next batches are read while one is fitted
+    for (batch, index, arcs), fitting in run_ahead(batches, lambda b: fit(_ArcRows.of(b[2])) if b[2] else None, ctx.kernels.ahead):
+        yield from spliced(batch, index, _assemble(arcs, fitting.result())) if fitting is not None else batch
 
 
-def _finish(batch: list[Event], index: list[int], arcs: list[Arc], fitting) -> list[Event]:
-    return spliced(batch, index, _assemble(arcs, fitting.result())) if arcs else batch
+def _with_arcs(batch: list[Event]) -> tuple[list[Event], list[int], list[Arc]]:
+    """The batch, where its arcs to replace are, and those arcs."""
+    index = [k for k, e in enumerate(batch) if type(e) is Arc and not e.changed]
+    return batch, index, [batch[k] for k in index]
 
 
 def _batches(events: Iterable[Event]) -> Iterator[list[Event]]:

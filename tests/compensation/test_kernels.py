@@ -10,7 +10,7 @@ import pytest
 
 from ncpp.cli.compensate import AUTO_JOBS_BYTES, jobs_for
 from ncpp.errors import NcppError
-from ncpp.passes.kernels import Worker, WorkerError
+from ncpp.passes.kernels import Worker, WorkerError, run_ahead
 from ncpp.pipeline import ErrorSource, process
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -100,3 +100,13 @@ def test_jobs_follow_the_input_size_unless_given(tmp_path):
     with os.fdopen(read, "rb") as pipe:
         os.close(write)
         assert jobs_for(None, pipe) == 1
+
+
+def test_run_ahead_starts_that_many_items_before_giving_the_first():
+    started: list[int] = []
+    given = []
+    for item, handle in run_ahead(range(5), lambda n: started.append(n) or -n, ahead=2):
+        given.append((item, handle, len(started)))
+    assert given == [(0, 0, 3), (1, -1, 4), (2, -2, 5), (3, -3, 5), (4, -4, 5)]
+    started.clear()  # inline: each item is started just before it is given
+    assert [(n, len(started)) for n, _ in run_ahead(range(3), started.append, ahead=0)] == [(0, 1), (1, 2), (2, 3)]
