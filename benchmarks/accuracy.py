@@ -40,6 +40,7 @@ sys.path.insert(0, str(ROOT))
 from ncpp.errors import Warnings  # noqa: E402
 from ncpp.machine import Machine, load_machine  # noqa: E402
 from ncpp.machine.components import Table  # noqa: E402
+from ncpp.motion.offsets import WorkOffsets  # noqa: E402
 from ncpp.pipeline import ErrorSource, process  # noqa: E402
 from ncpp.simulate import ContourReport, SampledPath, contour_error, sample_events  # noqa: E402
 
@@ -117,19 +118,23 @@ def machine(name: str) -> Machine:
     return load_machine(MACHINES[name])
 
 
-def source_for(model: Machine, work_offset: np.ndarray, label: str = "model") -> ErrorSource:
-    limits = dict(model.limits)
-    return ErrorSource(model, label, "0" * 16, model.max_correction_mm, limits).shifted(tuple(work_offset))
+def source_for(model: Machine, label: str = "model") -> ErrorSource:
+    return ErrorSource(model, label, "0" * 16, model.max_correction_mm, dict(model.limits))
+
+
+def at(offset) -> WorkOffsets:
+    """The control's zeros with G54 at `offset` (machine mm)."""
+    return WorkOffsets.of({"G54": tuple(float(v) for v in offset)})
 
 
 # -- programs ------------------------------------------------------------------------------------
 
 
-def events_of(data: bytes, name: str) -> list:
+def events_of(data: bytes, name: str, offsets: WorkOffsets | None = None) -> list:
     from ncpp.motion import interpret
     from ncpp.program.parser import parse_stream
 
-    return list(interpret(parse_stream(io.BytesIO(data), name), file=name, warnings=QUIET))
+    return list(interpret(parse_stream(io.BytesIO(data), name), file=name, warnings=QUIET, offsets=offsets))
 
 
 def placement(path: SampledPath, model: Machine) -> np.ndarray | None:
@@ -144,11 +149,11 @@ def placement(path: SampledPath, model: Machine) -> np.ndarray | None:
     return np.round((lo_m + hi_m) / 2 - (lo_p + hi_p) / 2, 3)
 
 
-def compensate(data: bytes, source: ErrorSource, tolerance: float, name: str) -> tuple[bytes, int, int, float]:
+def compensate(data: bytes, source: ErrorSource, tolerance: float, name: str, offsets: WorkOffsets) -> tuple[bytes, int, int, float]:
     """Compensated program text, lines in, lines out, seconds."""
     out = io.BytesIO()
     start = time.perf_counter()
-    stats = process(io.BytesIO(data), out, file=name, source=source, tolerance=tolerance, warnings=QUIET)
+    stats = process(io.BytesIO(data), out, file=name, source=source, tolerance=tolerance, warnings=QUIET, offsets=offsets)
     return out.getvalue(), stats.lines_in, stats.lines_out, time.perf_counter() - start
 
 
@@ -189,22 +194,22 @@ def prepare(label: str, path: Path, model: Machine) -> Run | None:
     offset = placement(at_zero, model)
     if offset is None:
         return None
-    return Run(label, data, offset, sample_events(events_of(data, str(path)), work_offset=offset))
+    return Run(label, data, offset, sample_events(events_of(data, str(path), at(offset))))
 
 
 def simulate(run: Run, model: Machine, program: bytes | None = None) -> ContourReport:
     """Contour error of `program` (default: the original) against the nominal path, on `model` (geometry)."""
-    commanded = run.nominal if program is None else sample_events(events_of(program, run.label), work_offset=run.offset)
+    commanded = run.nominal if program is None else sample_events(events_of(program, run.label, at(run.offset)))
     return contour_error(model, commanded, run.nominal, feed_effects=False)
 
 
 def evaluate(run: Run, truth: Machine, compensation_model: Machine, tolerances=TOLERANCES_MM) -> dict[str, Any]:
     """Before/after figures of one program: compensated with one model, run on another."""
     before = simulate(run, truth)
-    source = source_for(compensation_model, run.offset)
+    source = source_for(compensation_model)
     result: dict[str, Any] = {"before_max_um": before.max_um, "before_rms_um": before.rms_um, "offset_mm": run.offset.tolist(), "after": {}}
     for tol in tolerances:
-        text, lines_in, lines_out, seconds = compensate(run.data, source, tol, run.label)
+        text, lines_in, lines_out, seconds = compensate(run.data, source, tol, run.label, at(run.offset))
         after = simulate(run, truth, text)
         result["after"][f"{tol * 1000:g}"] = {
             "max_um": after.max_um,

@@ -42,13 +42,15 @@ def work_offset(path: Path) -> tuple[float, float, float]:
 def ncpp_process_rate(path: Path, offset: tuple[float, float, float] | None, jobs: int = 1) -> dict[str, Any]:
     """`process` over the whole file into a null sink: passthrough (offset None) or compensation."""
     from accuracy import QUIET
+    from ncpp.motion.offsets import WorkOffsets
     from ncpp.pipeline import ErrorSource, process
 
-    source = None if offset is None else ErrorSource.from_machine_file(str(MACHINE)).shifted(offset)
+    source = None if offset is None else ErrorSource.from_machine_file(str(MACHINE))
+    offsets = None if offset is None else WorkOffsets.of({"G54": offset})
     sink = open(os.devnull, "wb")
     start = time.perf_counter()
     with open(path, "rb") as stream:
-        stats = process(stream, sink, file=str(path), source=source, tolerance=TOLERANCE, warnings=QUIET, jobs=jobs)
+        stats = process(stream, sink, file=str(path), source=source, tolerance=TOLERANCE, warnings=QUIET, jobs=jobs, offsets=offsets)
     seconds = time.perf_counter() - start
     return {"lines": stats.lines_in, "lines_out": stats.lines_out, "seconds": seconds, "lines_per_s": stats.lines_in / seconds}
 
@@ -91,10 +93,12 @@ def stage_seconds(path: Path, offset: tuple[float, float, float], lines: int = 1
 
     from accuracy import QUIET
     from ncpp.passes import PASSES
+    from ncpp.motion.offsets import WorkOffsets
     from ncpp.pipeline import ErrorSource, dialect_tools, make_context
     from ncpp.program.dialects import parse_program
 
-    source = ErrorSource.from_machine_file(str(MACHINE)).shifted(offset)
+    source = ErrorSource.from_machine_file(str(MACHINE))
+    offsets = WorkOffsets.of({"G54": offset})
     with open(path, "rb") as stream:
         head = b"".join(islice(stream, lines))
 
@@ -104,7 +108,7 @@ def stage_seconds(path: Path, offset: tuple[float, float, float], lines: int = 1
     interpret, writer = dialect_tools(parse_program(io.BytesIO(head[:4096]), str(path), None)[0])
     stages: list[tuple[str, Callable[[list], Iterable]]] = [
         ("parse", lambda _: parse()),
-        ("interpret", lambda blocks: interpret(iter(blocks), file=str(path), warnings=QUIET)),
+        ("interpret", lambda blocks: interpret(iter(blocks), file=str(path), warnings=QUIET, offsets=offsets)),
         *((step.__name__, lambda events, step=step: step(events, make_context(source, TOLERANCE, QUIET, str(path)))) for step in PASSES),
         ("writer", lambda events: writer().write(events)),
     ]

@@ -18,9 +18,8 @@ from operator import itemgetter
 from pathlib import Path
 from typing import BinaryIO, Callable, Iterable, Iterator
 
-import numpy as np
-
 from ncpp.errors import Location, NcppError, Warnings
+from ncpp.motion.offsets import WorkOffsets
 from ncpp.motion.segments import Event
 from ncpp.passes import PASSES, PassContext, run_passes
 from ncpp.passes.context import is_directional
@@ -58,16 +57,6 @@ class ErrorSource:
         return cls(map_from_file(path), Path(path).name, _digest(path))
 
 
-    def shifted(self, work_offset: tuple[float, float, float] | None) -> "ErrorSource":
-        """The source seen from a program whose zero sits at `work_offset` (machine mm):
-        the work offset the controller holds, which the program does not say."""
-        if not work_offset or not any(work_offset):
-            return self
-        shift = np.asarray(work_offset, dtype=float)
-        limits = {a: (lo - shift["XYZ".index(a)], hi - shift["XYZ".index(a)]) for a, (lo, hi) in self.limits.items()}
-        return ErrorSource(ShiftedMap(self.model, shift), self.name, self.digest, self.max_correction, limits)
-
-
 @dataclass(frozen=True, eq=False)
 class MachineMap:
     """A machine as compensation sees it: geometry plus its position-only effects
@@ -77,17 +66,6 @@ class MachineMap:
 
     def deviation(self, P, direction=None):
         return self.machine.static_deviation(P, direction)
-
-
-@dataclass(frozen=True, eq=False)
-class ShiftedMap:
-    """An error map evaluated at program position + work offset."""
-
-    model: object
-    shift: np.ndarray
-
-    def deviation(self, P, direction=None):
-        return self.model.deviation(np.asarray(P, dtype=float) + self.shift, direction)
 
 
 def _digest(path: str) -> str:
@@ -118,28 +96,26 @@ def refuse_compensated(blocks: Iterable[Block], file: str) -> Iterator[Block]:
     yield from blocks
 
 
-# G words whose coordinates are placed by the control, not by the one work offset ncpp is told
-# (--work-offset, the G54 zero): compensated all the same, at the position that one implies
-UNPLACED = {
-    53.0: "G53 moves in machine coordinates, which ncpp reads as program coordinates from --work-offset",
-    **{
-        value: f"{name} selects a work offset whose machine position ncpp is not told: compensated as if its zero were at --work-offset (G54's)"
-        for value, name in ((55.0, "G55"), (56.0, "G56"), (57.0, "G57"), (58.0, "G58"), (59.0, "G59"), (59.1, "G59.1"), (59.2, "G59.2"), (59.3, "G59.3"))
-    },
+# G words that select a work offset a one-zero dialect's interpreter does not follow (Sinumerik's
+# settable frames G54-G57 are the program zero the control holds, whichever is selected)
+OTHER_ZEROS = {
+    value: f"{name} selects another work offset: ncpp compensates this dialect at one program zero, "
+    "the work offset in effect when the program starts (--work-offset)"
+    for value, name in ((55.0, "G55"), (56.0, "G56"), (57.0, "G57"), (58.0, "G58"), (59.0, "G59"))
 }
 
 
-def warn_unplaced(blocks: Iterable[Block], warnings: Warnings, file: str) -> Iterator[Block]:
-    """Pass blocks through; warn once per G word of `UNPLACED` the program uses, where it
+def warn_other_zeros(blocks: Iterable[Block], warnings: Warnings, file: str) -> Iterator[Block]:
+    """Pass blocks through; warn once per G word of `OTHER_ZEROS` the program uses, where it
     first does (refused with --strict): the errors compensated there are those of another place."""
     told: set[float] = set()
     for block in blocks:
         signature = block.signature  # the words' letters and G numbers: most blocks are passed on here
         if signature is None or "G5" in signature:
             for item in block.items:
-                if type(item) is Word and item.letter == "G" and item.value in UNPLACED and item.value not in told:
+                if type(item) is Word and item.letter == "G" and item.value in OTHER_ZEROS and item.value not in told:
                     told.add(item.value)
-                    warnings.warn(UNPLACED[item.value], Location(file, block.line, item.start + 1))
+                    warnings.warn(OTHER_ZEROS[item.value], Location(file, block.line, item.start + 1))
         yield block
 
 
@@ -223,16 +199,19 @@ def process(
     progress: Callable[[int], None] | None = None,
     dialect: str | None = None,
     jobs: int = 1,
+    offsets: WorkOffsets | None = None,
 ) -> Stats:
     """Read, interpret, compensate (when `source` is given) and write one program.
 
     The dialect is detected from the content (and the file name) unless given;
     it picks the interpreter and the writer (DIALECT_TOOLS).  `jobs` 2 or more:
     compensation's numeric kernels run in a worker process (passes/kernels.py),
-    the same output on two cores."""
+    the same output on two cores.  `offsets`: the zeros the control holds (machine
+    mm; none: the program zero is the machine zero), which place the program on
+    the machine whose errors are compensated."""
     kernels = _kernels(source is not None and jobs > 1)  # started first: the worker starts while we parse
     try:
-        return _process(stream, out, file, source, tolerance, strict, force, warnings, progress, dialect, kernels)
+        return _process(stream, out, file, source, tolerance, strict, force, warnings, progress, dialect, kernels, offsets)
     finally:
         kernels.close()
 
@@ -259,6 +238,7 @@ def _process(
     progress: Callable[[int], None] | None,
     dialect: str | None,
     kernels: Kernels,
+    offsets: WorkOffsets | None,
 ) -> Stats:
     warnings = warnings or Warnings(strict=strict)
     stats = Stats()
@@ -268,9 +248,11 @@ def _process(
     blocks: Iterable[Block] = _counted(parsed, counter, progress)
     if source is not None and not force:
         blocks = refuse_compensated(blocks, file)
-    if source is not None:
-        blocks = warn_unplaced(blocks, warnings, file)
-    events: Iterable[Event] = interpret(blocks, file=file, warnings=warnings, strict=strict)
+    if source is not None and name != "iso":  # the ISO interpreter follows every work offset
+        blocks = warn_other_zeros(blocks, warnings, file)
+    # the control's zeros place the program on the machine; passthrough places nothing
+    offsets = (offsets or WorkOffsets.of({"G54": (0.0, 0.0, 0.0)})) if source is not None else None
+    events: Iterable[Event] = interpret(blocks, file=file, warnings=warnings, strict=strict, offsets=offsets)
     writer = writer_class()
     if source is None:
         lines: Iterable[str] = (event.block.text for event in _first_per_block(events))

@@ -31,9 +31,9 @@ class SampledPath:
     circles: list  # full circles: (centre (3,), radius mm, plane, slice of points)
 
 
-def sample_events(events: Iterable[Event], step_mm: float = STEP_MM, work_offset=(0.0, 0.0, 0.0)) -> SampledPath:
-    """Sampled machine positions of a program's motion; `work_offset` (mm) is where
-    the program zero sits on the machine."""
+def sample_events(events: Iterable[Event], step_mm: float = STEP_MM) -> SampledPath:
+    """Sampled machine positions of a program's motion (placed on the machine by the
+    work offsets the events were interpreted with: `Context.offset`)."""
     pts: list[NDArray] = []
     feeds, lines, rapids, circles = [], [], [], []
     count = 0
@@ -46,7 +46,7 @@ def sample_events(events: Iterable[Event], step_mm: float = STEP_MM, work_offset
             rapid = False
             if abs(event.sweep()) >= 2 * math.pi - 1e-9:
                 s = event.context.unit_mm
-                centre = np.array(event.context.to_machine(event.center)) + np.asarray(work_offset)
+                centre = np.array(event.context.to_machine(event.center))
                 circles.append((centre, event.radius() * s, event.context.plane, slice(count, count + len(p))))
         else:
             continue
@@ -59,7 +59,7 @@ def sample_events(events: Iterable[Event], step_mm: float = STEP_MM, work_offset
     if not pts:
         empty = np.zeros((0, 3))
         return SampledPath(empty, np.zeros(0), np.zeros(0, int), np.zeros(0, bool), [])
-    return SampledPath(np.vstack(pts) + np.asarray(work_offset, dtype=float), np.concatenate(feeds), np.concatenate(lines), np.concatenate(rapids), circles)
+    return SampledPath(np.vstack(pts), np.concatenate(feeds), np.concatenate(lines), np.concatenate(rapids), circles)
 
 
 def _to_machine(event: Line | Arc, program: NDArray) -> NDArray:

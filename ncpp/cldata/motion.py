@@ -117,8 +117,9 @@ class _Circle:
         )
 
 
-def motion(records: Iterable[Record], warnings: Warnings | None = None) -> Iterator[Event]:
-    """Line / Arc / Pass events of a CL record stream."""
+def motion(records: Iterable[Record], warnings: Warnings | None = None, zero: Point = (0.0, 0.0, 0.0)) -> Iterator[Event]:
+    """Line / Arc / Pass events of a CL record stream; `zero`: the machine position (mm)
+    of the CL data's origin, the work offset the control will hold."""
     pos: Point | None = None
     home: Point | None = None
     feed = 0.0
@@ -126,7 +127,7 @@ def motion(records: Iterable[Record], warnings: Warnings | None = None) -> Itera
     multax = False
     tool_vector: tuple[float, float, float] | None = None
     vector_line = 0
-    context = Context()
+    context = Context(offset=zero)
     circle: _Circle | None = None
 
     def flush() -> Iterator[Event]:
@@ -189,7 +190,8 @@ def motion(records: Iterable[Record], warnings: Warnings | None = None) -> Itera
         elif major == "FEDRAT" and rec.numbers:
             feed = rec.numbers[0]
         elif major == "UNITS":
-            context = replace(context, inch=bool(rec.words) and rec.words[0].startswith("INCH"))
+            inch = bool(rec.words) and rec.words[0].startswith("INCH")
+            context = replace(context, inch=inch, offset=tuple(v / 25.4 for v in zero) if inch else zero)  # program units
         elif major == "MULTAX":
             multax = not (rec.words and rec.words[0] == "OFF")
         elif major == "TLAXIS" and len(rec.numbers) >= 3:

@@ -30,14 +30,7 @@ def add_compensation_arguments(p: argparse.ArgumentParser) -> None:
     source.add_argument("--from", dest="from_file", metavar="FILE", help="compensate from one measurement file")
     p.add_argument("--tolerance", type=float, default=0.001, metavar="MM", help="allowed path deviation, mm (default 0.001)")
     p.add_argument("--force", action="store_true", help="compensate a program ncpp has compensated before")
-    p.add_argument(
-        "--work-offset",
-        type=parse_vector,
-        default=None,
-        metavar="X,Y,Z",
-        help="machine position (mm) of the program zero, as the control's work offset (G54) holds it (default 0,0,0); "
-        "G55-G59.3 in the program get a warning: they are compensated as if their zero were here too",
-    )
+    add_placement_arguments(p)
     p.add_argument(
         "--jobs",
         type=int,
@@ -46,6 +39,26 @@ def add_compensation_arguments(p: argparse.ArgumentParser) -> None:
         help="processes: 2 runs compensation's numeric work in a second process beside the reading and writing "
         "(same output); default 2 for a program file over 2 MB on a machine with two or more cores, else 1",
     )
+
+
+def add_placement_arguments(p: argparse.ArgumentParser) -> None:
+    """Where the program sits on the machine: the zeros the control holds."""
+    p.add_argument(
+        "--work-offset",
+        type=zero_argument,
+        action="append",
+        default=[],
+        metavar="[G5x=]X,Y,Z",
+        help="machine position (mm) of a coordinate system's zero, as the control holds it; without G5x= it is G54's "
+        "(default 0,0,0); repeat for G55-G59.3.  A program selecting a system nobody gave gets a warning",
+    )
+    p.add_argument(
+        "--var-file",
+        metavar="FILE",
+        help="LinuxCNC parameter file (linuxcnc.var) holding the control's G54-G59.3 zeros, the system in effect, "
+        "G92 and the G28/G30 positions; --work-offset overrides its systems",
+    )
+    p.add_argument("--var-units", choices=("mm", "inch"), default="mm", help="units of --var-file: the INI's [TRAJ]LINEAR_UNITS (default mm)")
 
 
 # A worker process pays off from about this size: it costs ~0.3 s to start (overlapped
@@ -65,23 +78,29 @@ def jobs_for(requested: int | None, stream: BinaryIO) -> int:
     return 2 if cores >= 2 and size >= AUTO_JOBS_BYTES else 1
 
 
-def parse_vector(text: str) -> tuple[float, float, float]:
+def zero_argument(text: str) -> tuple[str, tuple[float, float, float]]:
+    from ncpp.motion.offsets import parse_zero
+
     try:
-        values = tuple(float(v) for v in text.split(","))
-    except ValueError:
-        values = ()
-    if len(values) != 3:
-        raise argparse.ArgumentTypeError(f"expected X,Y,Z in mm, got {text!r}")
-    return values  # type: ignore[return-value]
+        return parse_zero(text)
+    except ValueError as err:
+        raise argparse.ArgumentTypeError(str(err)) from None
+
+
+def work_offsets(args: argparse.Namespace):
+    """The control's zeros from --var-file and --work-offset."""
+    from ncpp.motion.offsets import WorkOffsets
+
+    return WorkOffsets.given(dict(args.work_offset), args.var_file, 25.4 if args.var_units == "inch" else 1.0)
 
 
 def error_source(args: argparse.Namespace):
     from ncpp.pipeline import ErrorSource
 
     if getattr(args, "from_file", None):
-        return ErrorSource.from_measurement(args.from_file).shifted(args.work_offset)
+        return ErrorSource.from_measurement(args.from_file)
     if getattr(args, "machine", None):
-        return ErrorSource.from_machine_file(args.machine).shifted(args.work_offset)
+        return ErrorSource.from_machine_file(args.machine)
     return None
 
 
@@ -97,7 +116,7 @@ def run(args: argparse.Namespace) -> int:
     with open_input(args.input) as (stream, name), open_output(args.output) as out:
         stats = process(
             stream, out, file=name, source=source, tolerance=args.tolerance, strict=args.strict, force=args.force,
-            warnings=warnings, dialect=args.dialect, jobs=jobs_for(args.jobs, stream),
+            warnings=warnings, dialect=args.dialect, jobs=jobs_for(args.jobs, stream), offsets=work_offsets(args),
         )
     if sys.stderr.isatty():
         print(f"ncpp: {stats.lines_in} lines in, {stats.lines_out} lines out", file=sys.stderr)

@@ -36,29 +36,30 @@ def run(args: argparse.Namespace) -> int:
     from ncpp.pipeline import process
 
     warnings = Warnings(strict=args.strict)
-    source, tolerance = configured_source(args)
+    source, tolerance, offsets = configured_source(args)
     progress = progress_printer("filter")
     with open_input(args.input) as (stream, name), open_output(args.output) as out:
         process(stream, out, file=name, source=source, tolerance=tolerance, strict=args.strict, force=args.force,
-                warnings=warnings, progress=progress, dialect=args.dialect, jobs=jobs_for(args.jobs, stream))  # fmt: skip
+                warnings=warnings, progress=progress, dialect=args.dialect, jobs=jobs_for(args.jobs, stream), offsets=offsets)  # fmt: skip
     if progress is not None:
         progress.done()
     return 1 if warnings.count and args.strict else 0
 
 
 def configured_source(args: argparse.Namespace):
-    """(ErrorSource or None, tolerance) from the command line, $NCPP_MACHINE and the config file."""
+    """(ErrorSource or None, tolerance, WorkOffsets) from the command line, $NCPP_MACHINE and the config file."""
     from ncpp.integrations.config import find_settings
 
-    settings = find_settings(args.machine, args.tolerance, args.work_offset)
+    var_units = args.var_units if args.var_file else None  # the config's when the file is the config's
+    settings = find_settings(args.machine, args.tolerance, dict(args.work_offset), args.var_file, var_units)
     if not settings.tolerance > 0:
         raise NcppError("--tolerance must be positive")
     if not (args.from_file or settings.machine):
-        return None, settings.tolerance
+        return None, settings.tolerance, None
     from ncpp.pipeline import ErrorSource
 
     if args.from_file:
-        return ErrorSource.from_measurement(args.from_file).shifted(settings.work_offset), settings.tolerance
+        return ErrorSource.from_measurement(args.from_file), settings.tolerance, settings.offsets()
     if not Path(settings.machine).is_file():
         raise NcppError(f"machine file {settings.machine} does not exist", Location(settings.origin))
-    return ErrorSource.from_machine_file(settings.machine).shifted(settings.work_offset), settings.tolerance
+    return ErrorSource.from_machine_file(settings.machine), settings.tolerance, settings.offsets()

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import argparse
 
-from ncpp.cli.compensate import add_compensation_arguments, error_source
+from ncpp.cli.compensate import add_compensation_arguments, error_source, work_offsets
 from ncpp.cli.io import open_output
 from ncpp.errors import NcppError, Warnings
 
@@ -36,14 +36,15 @@ def run(args: argparse.Namespace) -> int:
     if not args.tolerance > 0:
         raise NcppError("--tolerance must be positive")
     source = error_source(args)
+    offsets = work_offsets(args)
     warnings = Warnings(strict=args.strict)
     progress = progress_printer("post")
     with open_output(args.output) as out:
         if args.input == "-":
-            post(sys.stdin, out, file="<stdin>", dialect=args.dialect, source=source, tolerance=args.tolerance, warnings=warnings, progress=progress)
+            post(sys.stdin, out, file="<stdin>", dialect=args.dialect, source=source, tolerance=args.tolerance, warnings=warnings, progress=progress, offsets=offsets)
         else:
             with open(args.input, encoding="latin-1") as stream:
-                post(stream, out, file=args.input, dialect=args.dialect, source=source, tolerance=args.tolerance, warnings=warnings, progress=progress)
+                post(stream, out, file=args.input, dialect=args.dialect, source=source, tolerance=args.tolerance, warnings=warnings, progress=progress, offsets=offsets)
     if progress is not None:
         progress.done()
     return 0

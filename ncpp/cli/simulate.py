@@ -10,7 +10,7 @@ from __future__ import annotations
 import argparse
 import json
 
-from ncpp.cli.compensate import parse_vector
+from ncpp.cli.compensate import add_placement_arguments, work_offsets
 from ncpp.errors import NcppError, Warnings
 
 
@@ -19,19 +19,22 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("program", help="NC program to run")
     p.add_argument("--machine", required=True, metavar="M.toml", help="machine file (the virtual machine)")
     p.add_argument("--reference", metavar="ORIGINAL", help="nominal program (for a compensated PROGRAM)")
-    p.add_argument("--work-offset", type=parse_vector, default=(0.0, 0.0, 0.0), metavar="X,Y,Z", help="machine position (mm) of the program zero")
+    add_placement_arguments(p)
     p.add_argument("--step", type=float, default=0.5, metavar="MM", help="sample spacing along the path (default 0.5)")
     p.add_argument("--json", metavar="OUT", help="write the figures as JSON")
     p.add_argument("--plot", metavar="OUT.png", help="plot the contour error (and circle traces)")
     p.set_defaults(func=run)
 
 
-def program_events(path: str, warnings: Warnings) -> list:
-    from ncpp.motion import interpret
-    from ncpp.program.parser import parse_stream
+def program_events(path: str, warnings: Warnings, offsets=None) -> list:
+    """The events of a program (any dialect), placed on the machine by `offsets`."""
+    from ncpp.pipeline import dialect_tools
+    from ncpp.program.dialects import parse_program
 
     with open(path, "rb") as stream:
-        return list(interpret(parse_stream(stream, path), file=path, warnings=warnings))
+        name, blocks = parse_program(stream, path, None)
+        interpret, _ = dialect_tools(name)
+        return list(interpret(blocks, file=path, warnings=warnings, offsets=offsets))
 
 
 def run(args: argparse.Namespace) -> int:
@@ -41,8 +44,9 @@ def run(args: argparse.Namespace) -> int:
 
     machine = load_machine(args.machine)
     warnings = Warnings()
-    commanded = sample_events(program_events(args.program, warnings), args.step, args.work_offset)
-    nominal = sample_events(program_events(args.reference, warnings), args.step, args.work_offset) if args.reference else commanded
+    offsets = work_offsets(args)
+    commanded = sample_events(program_events(args.program, warnings, offsets), args.step)
+    nominal = sample_events(program_events(args.reference, warnings, offsets), args.step) if args.reference else commanded
     if len(commanded.points) == 0:
         raise NcppError("the program makes no motion the interpreter could follow")
     report = contour_error(machine, commanded, nominal)

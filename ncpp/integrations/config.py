@@ -8,28 +8,34 @@ The machine file, first found wins:
    `./ncpp.toml`, then `$XDG_CONFIG_HOME/ncpp/config.toml`
    (`~/.config/ncpp/config.toml` when XDG_CONFIG_HOME is unset).
 
-`tolerance` (mm) and `work_offset` ([x, y, z] mm) come from the command
-line, else from that config file, else the defaults.  A relative `machine`
-path in a config file is relative to the file's folder.  With no machine
-file anywhere the filter passes programs through unchanged.
+`tolerance` (mm) and where the program sits on the machine come from the
+command line, else from that config file, else the defaults: `work_offset`
+is G54's zero ([x, y, z] machine mm) or a table of zeros by G word;
+`var_file` names LinuxCNC's parameter file (`var_units` "mm" or "inch", the
+INI's [TRAJ]LINEAR_UNITS), which `work_offset` overrides.  A relative
+`machine` or `var_file` path in a config file is relative to the file's
+folder.  With no machine file anywhere the filter passes programs through
+unchanged.
 
     # ncpp.toml
     machine = "machines/hr5b.toml"
     tolerance = 0.001
-    work_offset = [400.0, 350.0, 300.0]
+    work_offset = [400.0, 350.0, 300.0]          # or: work_offset = {G54 = [...], G55 = [...]}
+    # var_file = "~/linuxcnc/configs/mill/linuxcnc.var"
 """
 
 from __future__ import annotations
 
 import os
 import tomllib
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Mapping
 
 from ncpp.errors import Location, NcppError
+from ncpp.motion.offsets import Vector, WorkOffsets, system_number
 
-KEYS = ("machine", "tolerance", "work_offset")
+KEYS = ("machine", "tolerance", "work_offset", "var_file", "var_units")
 DEFAULT_TOLERANCE = 0.001
 
 
@@ -37,8 +43,14 @@ DEFAULT_TOLERANCE = 0.001
 class Settings:
     machine: str | None = None
     tolerance: float = DEFAULT_TOLERANCE
-    work_offset: tuple[float, float, float] | None = None
+    zeros: Mapping[str, Vector] = field(default_factory=dict)  # G word -> machine mm (work_offset)
+    var_file: str | None = None
+    var_units: str = "mm"
     origin: str = "defaults"  # where the machine file was named: "--machine", "NCPP_MACHINE" or a config path
+
+    def offsets(self) -> WorkOffsets:
+        """The zeros the control holds, as these settings say them."""
+        return WorkOffsets.given(self.zeros, self.var_file, 25.4 if self.var_units == "inch" else 1.0)
 
 
 def config_paths(cwd: Path | None = None, env: Mapping[str, str] | None = None) -> list[Path]:
@@ -69,17 +81,39 @@ def read_config(path: Path) -> dict:
             raise NcppError("`tolerance` must be a positive number of mm", Location(str(path)))
         config["tolerance"] = float(tolerance)
     if "work_offset" in data:
-        offset = data["work_offset"]
-        if not (isinstance(offset, list) and len(offset) == 3 and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in offset)):
-            raise NcppError("`work_offset` must be [x, y, z] in mm", Location(str(path)))
-        config["work_offset"] = tuple(float(v) for v in offset)
+        config["zeros"] = _zeros(data["work_offset"], path)
+    if "var_file" in data:
+        if not isinstance(data["var_file"], str):
+            raise NcppError("`var_file` must be a path string", Location(str(path)))
+        config["var_file"] = str((path.parent / Path(data["var_file"]).expanduser()).resolve())
+    if "var_units" in data:
+        if data["var_units"] not in ("mm", "inch"):
+            raise NcppError('`var_units` must be "mm" or "inch"', Location(str(path)))
+        config["var_units"] = data["var_units"]
     return config
+
+
+def _zeros(value, path: Path) -> dict[str, Vector]:
+    """`work_offset`: [x, y, z] (G54's) or {G54 = [x, y, z], G55 = ...}."""
+    table = value if isinstance(value, dict) else {"G54": value}
+    zeros = {}
+    for name, zero in table.items():
+        if not (isinstance(zero, list) and len(zero) == 3 and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in zero)):
+            raise NcppError("`work_offset` must be [x, y, z] in mm, or a table of them by G word (G54 = [x, y, z])", Location(str(path)))
+        try:
+            system_number(name)
+        except ValueError as err:
+            raise NcppError(f"`work_offset`: {err}", Location(str(path))) from None
+        zeros[name.upper()] = tuple(float(v) for v in zero)
+    return zeros  # type: ignore[return-value]
 
 
 def find_settings(
     machine: str | None = None,
     tolerance: float | None = None,
-    work_offset: tuple[float, float, float] | None = None,
+    zeros: Mapping[str, Vector] | None = None,
+    var_file: str | None = None,
+    var_units: str | None = None,
     *,
     cwd: Path | None = None,
     env: Mapping[str, str] | None = None,
@@ -101,6 +135,8 @@ def find_settings(
     return Settings(
         machine=machine,
         tolerance=tolerance if tolerance is not None else config.get("tolerance", DEFAULT_TOLERANCE),
-        work_offset=work_offset if work_offset is not None else config.get("work_offset"),
+        zeros=zeros or config.get("zeros", {}),
+        var_file=var_file or config.get("var_file"),
+        var_units=var_units or config.get("var_units", "mm"),
         origin=origin,
     )

@@ -61,9 +61,10 @@ def run(path: str, err: TextIO, machine: str | None = None) -> None:
             else:
                 if not os.path.isfile(settings.machine):
                     raise NcppError(f"machine file {settings.machine} (from {settings.origin}) does not exist")
-                source = ErrorSource.from_machine_file(settings.machine).shifted(settings.work_offset)
+                source = ErrorSource.from_machine_file(settings.machine)
                 jobs = jobs_for(None, stream)  # LinuxCNC runs the filter as its own process: a worker is safe
-                process(stream, spool, file=path, source=source, tolerance=settings.tolerance, warnings=Warnings(stream=err), progress=progress, jobs=jobs)
+                process(stream, spool, file=path, source=source, tolerance=settings.tolerance, warnings=Warnings(stream=err),
+                        progress=progress, jobs=jobs, offsets=settings.offsets())  # fmt: skip
         progress.report(100)
 
 

@@ -28,6 +28,7 @@ from typing import Iterable, Iterator
 from ncpp.errors import Location, NcppError, Warnings
 from ncpp.motion.corners import CornerError, round_corner
 from ncpp.motion.modal import PLANE_OF_TOOL_AXIS, ModalInterpreter, OutOfScope, resolve_warnings
+from ncpp.motion.offsets import WorkOffsets
 from ncpp.motion.segments import PLANE_AXES, Arc, Event, Line, Pass, Point
 from ncpp.program.blocks import Block, Comment, ExprWord, Word
 
@@ -57,9 +58,10 @@ class Corner(Pass):
 
 
 def interpret(blocks: Iterable[Block], *, file: str = "<stdin>", warnings: Warnings | None = None,
-              strict: bool = False) -> Iterator[Event]:
+              strict: bool = False, offsets: WorkOffsets | None = None) -> Iterator[Event]:
     """Motion events of a Heidenhain program's blocks, lazily (see the module docstring)."""
-    return HeidenhainInterpreter(file).run(blocks, resolve_warnings(warnings, strict))
+    zero = offsets.program_zero() if offsets is not None else (0.0, 0.0, 0.0)  # one program zero: the system in effect
+    return HeidenhainInterpreter(file, zero).run(blocks, resolve_warnings(warnings, strict))
 
 
 def _plane_of_axes(axes: set[int], default: int) -> int:
@@ -70,8 +72,8 @@ def _plane_of_axes(axes: set[int], default: int) -> int:
 
 
 class HeidenhainInterpreter(ModalInterpreter):
-    def __init__(self, file: str = "<stdin>"):
-        super().__init__(file)
+    def __init__(self, file: str = "<stdin>", zero: tuple[float, float, float] = (0.0, 0.0, 0.0)):
+        super().__init__(file, zero)
         self.q: dict[str, float] = {}
         self.pole: list[float] | None = None
         self.pole_plane = 17

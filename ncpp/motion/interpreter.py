@@ -28,6 +28,7 @@ from typing import Iterable, Iterator
 from ncpp.errors import Location, NcppError, Warnings
 from ncpp.motion.corners import CornerError, round_corner
 from ncpp.motion.expressions import ExpressionError, OutOfScope, Parameters, evaluate
+from ncpp.motion.offsets import SYSTEMS, WorkOffsets
 from ncpp.motion.segments import PLANE_AXES, Arc, Context, Event, Line, Pass
 from ncpp.program.blocks import Block, Comment, ExprWord, Word
 
@@ -110,8 +111,13 @@ def interpret(
     file: str = "<stdin>",
     warnings: Warnings | None = None,
     strict: bool = False,
+    offsets: WorkOffsets | None = None,
 ) -> Iterator[Event]:
     """Motion events of a program's blocks, lazily (see the module docstring).
+
+    `offsets`: the zeros the control holds at the start (none: all zero, as
+    rs274's default parameter file).  Given, a coordinate system selected
+    whose zero they do not tell gets a warning where it is first selected.
 
     Raises NcppError (file, line, column of the offending word) on a program
     LinuxCNC would refuse.  Out-of-scope constructs warn once through
@@ -122,13 +128,13 @@ def interpret(
         warnings = Warnings(strict=strict)
     elif strict and not warnings.strict:
         warnings = Warnings(strict=True, stream=warnings.stream)
-    return Interpreter(file).run(blocks, warnings)
+    return Interpreter(file, offsets).run(blocks, warnings)
 
 
 class Interpreter:
     """Modal state of one program run (program units throughout)."""
 
-    def __init__(self, file: str = "<stdin>"):
+    def __init__(self, file: str = "<stdin>", offsets: WorkOffsets | None = None):
         self.file = file
         self.pos = [0.0] * 9  # program position of X Y Z A B C U V W
         self.plane = 17
@@ -150,6 +156,20 @@ class Interpreter:
         self._fast = False
         self.done = False  # program end (M2/M30) reached or state unknown
         self.corner: tuple[str, float, Word | ExprWord] | None = None  # Fanuc ,R / ,C of the last block
+        self.untold: set[int] = set()  # coordinate systems whose zero nobody said (warned when selected)
+        self.warnings: Warnings | None = None
+        if offsets is not None:
+            self._start_from(offsets)
+
+    def _start_from(self, offsets: WorkOffsets) -> None:
+        """The control's zeros (mm, the interpreter starts in mm) and its system in effect."""
+        for n in range(1, 10):
+            self.g5x[n][:3] = offsets.zero(n)
+        self.coord_system = offsets.active
+        self.g92[:3] = offsets.g92
+        self.g92_saved = self.g92[:]
+        self.home[28][:3], self.home[30][:3] = offsets.g28, offsets.g30
+        self.untold = {n for n in range(1, 10) if not offsets.told(n)}
 
     # -- the event stream ---------------------------------------------------------
     def run(self, blocks: Iterable[Block], warnings: Warnings) -> Iterator[Event]:
@@ -157,6 +177,7 @@ class Interpreter:
         `G1 ... R`) waits for the next move, which decides the corner; the
         blocks in between wait with it (bounded by the program's own layout)."""
         block_event = self.block
+        self.warnings = warnings
         pending: Line | None = None  # the line whose end corner is rounded
         corner = None
         held: list[Event] = []  # non-moving events after it
@@ -449,7 +470,10 @@ class Interpreter:
         if 8 in gcodes:
             self._tool_length(gcodes[8][0], words)
         if 12 in gcodes:
-            self._coordinate_system(_COORD_SYSTEM[gcodes[12][0]])
+            number = _COORD_SYSTEM[gcodes[12][0]]
+            if number in self.untold:
+                self._warn_untold(number, block, gcodes[12][1])
+            self._coordinate_system(number)
         if 3 in gcodes:
             self._set(absolute=gcodes[3][0] == 90.0)
         if 4 in gcodes:
@@ -605,6 +629,16 @@ class Interpreter:
         self._shift(self.tool, new)
         self.tool = new
 
+    def _warn_untold(self, number: int, block: Block, item) -> None:
+        """Once per system: its zero is taken as the machine zero, which is likely wrong."""
+        self.untold.discard(number)
+        if self.warnings is not None:
+            self.warnings.warn(
+                f"{SYSTEMS[number - 1]} selects a work offset ncpp is not told: compensated as if its zero were "
+                f"at the machine zero (give --work-offset {SYSTEMS[number - 1]}=X,Y,Z or --var-file)",
+                Location(self.file, block.line, item.start + 1),
+            )
+
     def _coordinate_system(self, number: int) -> None:
         self._shift(self.g5x[self.coord_system], self.g5x[number])
         self.coord_system = number
@@ -647,6 +681,8 @@ class Interpreter:
             p = round(words.get("P", (0.0,))[0])
             number = self.coord_system if p == 0 else p
             old = self.g5x[number][:]
+            if {0, 1, 2} <= {i for i, _ in given}:  # the program says where it is
+                self.untold.discard(number)
             for i, value in given:
                 if words["L"][0] == 2.0:
                     self.g5x[number][i] = value

@@ -42,13 +42,14 @@ def resolve_warnings(warnings: Warnings | None, strict: bool) -> Warnings:
 class ModalInterpreter:
     """Position and modal state of one program run (program units throughout)."""
 
-    def __init__(self, file: str = "<stdin>"):
+    def __init__(self, file: str = "<stdin>", zero: tuple[float, float, float] = (0.0, 0.0, 0.0)):
         self.file = file
         self.pos: list[float] = [0.0, 0.0, 0.0]
         self.plane = 17
         self.inch = False
         self.feed = 0.0
         self.offset: list[float] = [0.0, 0.0, 0.0]  # machine minus program position (frames), program units
+        self.zero: list[float] = list(zero)  # the program zero the control holds (preset, settable frame), program units
         self.tangent: tuple[float, float, float] | None = None  # direction at the end of the last move
         self.done = False
         self._context: Context | None = None
@@ -79,7 +80,8 @@ class ModalInterpreter:
     def context(self, plane: int | None = None, absolute: bool = True) -> Context:
         plane = plane or self.plane
         if self._context is None or self._context.plane != plane or self._context.absolute != absolute:
-            self._context = Context(plane, absolute, False, self.inch, tuple(self.offset))  # type: ignore[arg-type]
+            offset = tuple(z + o for z, o in zip(self.zero, self.offset))
+            self._context = Context(plane, absolute, False, self.inch, offset)  # type: ignore[arg-type]
         return self._context
 
     def set_units(self, inch: bool) -> None:
@@ -88,6 +90,7 @@ class ModalInterpreter:
             scale = 1 / MM_PER_INCH if inch else MM_PER_INCH
             self.pos = [v * scale for v in self.pos]
             self.offset = [v * scale for v in self.offset]
+            self.zero = [v * scale for v in self.zero]
             self.inch = inch
             self._context = None
 

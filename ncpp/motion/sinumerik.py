@@ -18,6 +18,7 @@ from typing import Iterable, Iterator
 
 from ncpp.errors import Warnings
 from ncpp.motion.modal import ModalInterpreter, OutOfScope, circle_through, plane_of, resolve_warnings
+from ncpp.motion.offsets import WorkOffsets
 from ncpp.motion.segments import PLANE_AXES, Event
 from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
 
@@ -37,14 +38,15 @@ FRAMES = frozenset(("TRANS", "ATRANS", "ROT", "SCALE", "MIRROR"))
 
 
 def interpret(blocks: Iterable[Block], *, file: str = "<stdin>", warnings: Warnings | None = None,
-              strict: bool = False) -> Iterator[Event]:
+              strict: bool = False, offsets: WorkOffsets | None = None) -> Iterator[Event]:
     """Motion events of a Sinumerik program's blocks, lazily (see the module docstring)."""
-    return SinumerikInterpreter(file).run(blocks, resolve_warnings(warnings, strict))
+    zero = offsets.program_zero() if offsets is not None else (0.0, 0.0, 0.0)  # one program zero: the system in effect
+    return SinumerikInterpreter(file, zero).run(blocks, resolve_warnings(warnings, strict))
 
 
 class SinumerikInterpreter(ModalInterpreter):
-    def __init__(self, file: str = "<stdin>"):
-        super().__init__(file)
+    def __init__(self, file: str = "<stdin>", zero: tuple[float, float, float] = (0.0, 0.0, 0.0)):
+        super().__init__(file, zero)
         self.motion: float | str = 0.0  # 0-3, 'CIP' or 'CT' (G0 after power on)
         self.absolute = True
         self.variables: dict[str, float | str] = {}

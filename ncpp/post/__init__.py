@@ -14,6 +14,7 @@ from typing import BinaryIO, Callable, Iterable, Iterator, TextIO
 
 from ncpp.cldata import Record, motion, read_cldata
 from ncpp.errors import NcppError, Warnings
+from ncpp.motion.offsets import WorkOffsets
 from ncpp.motion.segments import Event
 from ncpp.post.generator import Generator
 from ncpp.post.heidenhain import HeidenhainGenerator
@@ -61,9 +62,11 @@ def post(
     tolerance: float = 0.001,
     warnings: Warnings | None = None,
     progress: Callable[[int], None] | None = None,
+    offsets: WorkOffsets | None = None,
 ) -> int:
     """Post one CL file as a `dialect` program (compensated when `source` is an
-    `ncpp.pipeline.ErrorSource`); returns the number of lines written."""
+    `ncpp.pipeline.ErrorSource`, the CL origin at `offsets`' G54 zero);
+    returns the number of lines written."""
     from ncpp.passes import PASSES, run_passes
     from ncpp.pipeline import header_text, make_context
 
@@ -71,7 +74,8 @@ def post(
         raise NcppError(f"unknown dialect {dialect!r} (known: {', '.join(GENERATORS)})")
     warnings = warnings or Warnings()
     index = _RecordIndex(progress)
-    events: Iterable[Event] = motion(index.watch(read_cldata(stream, file)), warnings)
+    zero = offsets.program_zero() if offsets is not None else (0.0, 0.0, 0.0)
+    events: Iterable[Event] = motion(index.watch(read_cldata(stream, file)), warnings, zero)
     header = None
     if source is not None:
         events = run_passes(events, make_context(source, tolerance, warnings, file), PASSES)

@@ -9,6 +9,7 @@ import numpy as np
 
 from ncpp.errors import Warnings
 from ncpp.motion import interpret
+from ncpp.motion.offsets import WorkOffsets
 from ncpp.pipeline import ErrorSource, process
 from ncpp.program.parser import parse_stream
 from ncpp.simulate import SampledPath
@@ -17,8 +18,13 @@ QUIET = Warnings(stream=open(os.devnull, "w"))
 MARGIN_MM = 1.0
 
 
-def events_of(data: bytes, name: str = "<test>") -> list:
-    return list(interpret(parse_stream(io.BytesIO(data), name), file=name, warnings=QUIET))
+def at(offset) -> WorkOffsets:
+    """The control's zeros with G54 at `offset` (machine mm)."""
+    return WorkOffsets.of({"G54": tuple(float(v) for v in offset)})
+
+
+def events_of(data: bytes, name: str = "<test>", offsets: WorkOffsets | None = None) -> list:
+    return list(interpret(parse_stream(io.BytesIO(data), name), file=name, warnings=QUIET, offsets=offsets))
 
 
 def placement(path: SampledPath, limits) -> np.ndarray | None:
@@ -33,8 +39,25 @@ def placement(path: SampledPath, limits) -> np.ndarray | None:
     return np.round((lo_m + hi_m) / 2 - (lo_p + hi_p) / 2, 3)
 
 
-def compensate(data: bytes, model, offset, tolerance: float = 0.001, name: str = "<test>") -> bytes:
-    source = ErrorSource(model, "model", "0" * 16, model.max_correction_mm, dict(model.limits)).shifted(tuple(offset))
+def compensate(data: bytes, model, offset, tolerance: float = 0.001, name: str = "<test>", warnings: Warnings = QUIET) -> bytes:
+    """`data` compensated for `model`, the program placed by `offset`: G54's zero, or WorkOffsets."""
+    source = ErrorSource(model, "model", "0" * 16, model.max_correction_mm, dict(model.limits))
+    offsets = offset if isinstance(offset, WorkOffsets) else at(offset)
     out = io.BytesIO()
-    process(io.BytesIO(data), out, file=name, source=source, tolerance=tolerance, warnings=QUIET)
+    process(io.BytesIO(data), out, file=name, source=source, tolerance=tolerance, warnings=warnings, offsets=offsets)
     return out.getvalue()
+
+
+def repeatable_machine(path):
+    """A sample machine's repeatable geometric errors, exactly: no thermal or servo effects,
+    its reversal tables replaced by their mean (benchmarks/accuracy.py says why)."""
+    from ncpp.machine import load_machine
+    from ncpp.machine.components import Table
+
+    true = load_machine(path).replace(effects=())
+    comps = {}
+    for name, c in true.components.items():
+        if isinstance(c, Table) and c.values_minus is not None:
+            c = Table(c.positions, (np.asarray(c.values) + np.asarray(c.values_minus)) / 2, None, c.interpolation)
+        comps[name] = c
+    return true.replace(components=comps)

@@ -10,6 +10,7 @@ import pytest
 
 from ncpp.cli.compensate import AUTO_JOBS_BYTES, jobs_for
 from ncpp.errors import NcppError
+from ncpp.motion.offsets import WorkOffsets
 from ncpp.passes.kernels import Worker, WorkerError, run_ahead
 from ncpp.pipeline import ErrorSource, process
 
@@ -34,13 +35,13 @@ PROGRAM = ("G21 G90 G17 F600\n" + "".join(_pattern(k) for k in range(400)) + "M2
 
 def _compensated(data: bytes, source: ErrorSource, jobs: int) -> bytes:
     out = io.BytesIO()
-    process(io.BytesIO(data), out, file="t.ngc", source=source, jobs=jobs)
+    process(io.BytesIO(data), out, file="t.ngc", source=source, jobs=jobs, offsets=WorkOffsets.of({"G54": OFFSET}))
     return out.getvalue()
 
 
 @pytest.mark.parametrize("machine", ["hr5b", "tl_tuotanto"])  # with and without reversal errors
 def test_a_worker_writes_the_same_program(machine):
-    source = ErrorSource.from_machine_file(str(ROOT / f"samples/machines/{machine}.toml")).shifted(OFFSET)
+    source = ErrorSource.from_machine_file(str(ROOT / f"samples/machines/{machine}.toml"))
     inline = _compensated(PROGRAM, source, jobs=1)
     assert inline.count(b"\n") > 5200  # several chunks of the passes
     assert _compensated(PROGRAM, source, jobs=2) == inline
@@ -48,12 +49,12 @@ def test_a_worker_writes_the_same_program(machine):
 
 def test_a_worker_compensates_a_corpus_program_from_a_measurement_the_same():
     data = (CORPUS / "arcspiral.ngc").read_bytes()
-    source = ErrorSource.from_measurement(str(ROOT / "samples/measurements/ballbar_XY_R150.csv")).shifted(OFFSET)
+    source = ErrorSource.from_measurement(str(ROOT / "samples/measurements/ballbar_XY_R150.csv"))
     assert _compensated(data, source, jobs=2) == _compensated(data, source, jobs=1)
 
 
 def test_an_error_in_the_worker_names_the_line():
-    source = ErrorSource.from_machine_file(str(ROOT / "samples/machines/hr5b.toml")).shifted(OFFSET)
+    source = ErrorSource.from_machine_file(str(ROOT / "samples/machines/hr5b.toml"))
     data = PROGRAM.replace(b"M2\n", b"G1 X900\nM2\n")  # beyond X travel (800 mm - 400 offset)
     messages = []
     for jobs in (1, 2):

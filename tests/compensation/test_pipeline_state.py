@@ -4,6 +4,7 @@ import gc
 import io
 from pathlib import Path
 
+from ncpp.motion.offsets import WorkOffsets
 from ncpp.pipeline import ErrorSource, process
 
 MACHINE = Path(__file__).resolve().parents[2] / "samples/machines/hr5b.toml"
@@ -13,9 +14,9 @@ PROGRAM = b"G21 G90 G17\nG0 X0 Y0 Z5\nG1 Z-1 F300\nG1 X40 Y10\nG2 X60 Y30 I0 J20
 
 def test_the_garbage_collector_threshold_is_restored():
     before = gc.get_threshold()
-    source = ErrorSource.from_machine_file(str(MACHINE)).shifted((400.0, 350.0, 300.0))
+    source = ErrorSource.from_machine_file(str(MACHINE))
     out = io.BytesIO()
-    process(io.BytesIO(PROGRAM), out, file="t.ngc", source=source)
+    process(io.BytesIO(PROGRAM), out, file="t.ngc", source=source, offsets=WorkOffsets.of({"G54": (400.0, 350.0, 300.0)}))
     assert gc.get_threshold() == before
     assert out.getvalue().count(b"\n") >= PROGRAM.count(b"\n")
 

@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 
 from ncpp.errors import Warnings
+from ncpp.motion.offsets import WorkOffsets
 from ncpp.pipeline import ErrorSource, dialect_tools, process
 from ncpp.program.dialects import parse_program
 from ncpp.simulate import sample_events
@@ -76,7 +77,7 @@ STEP = 0.05  # mm between samples
 
 @pytest.fixture(scope="module")
 def source() -> ErrorSource:
-    return ErrorSource.from_machine_file(str(ROOT / "samples" / "machines" / "hr5b.toml")).shifted(WORK_OFFSET)
+    return ErrorSource.from_machine_file(str(ROOT / "samples" / "machines" / "hr5b.toml"))
 
 
 def _path(text: str, dialect: str) -> np.ndarray:
@@ -88,7 +89,7 @@ def _path(text: str, dialect: str) -> np.ndarray:
 def _compensated(text: str, dialect: str, source: ErrorSource) -> str:
     out = io.BytesIO()
     process(io.BytesIO(text.encode("latin-1")), out, file="part", source=source, strict=True,
-            warnings=Warnings(strict=True), dialect=dialect)
+            warnings=Warnings(strict=True), dialect=dialect, offsets=WorkOffsets.of({"G54": WORK_OFFSET}))
     return out.getvalue().decode("latin-1")
 
 

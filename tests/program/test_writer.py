@@ -60,12 +60,13 @@ def _compensated_lines(program: bytes, name: str) -> list[str]:
     import io
     from pathlib import Path
 
+    from ncpp.motion.offsets import WorkOffsets
     from ncpp.pipeline import ErrorSource, process
 
     machine = Path(__file__).resolve().parents[2] / "samples/machines/hr5b.toml"
-    source = ErrorSource.from_machine_file(str(machine)).shifted((400.0, 350.0, 300.0))
+    source = ErrorSource.from_machine_file(str(machine))
     out = io.BytesIO()
-    process(io.BytesIO(program), out, file=name, source=source)
+    process(io.BytesIO(program), out, file=name, source=source, offsets=WorkOffsets.of({"G54": (400.0, 350.0, 300.0)}))
     return out.getvalue().decode().splitlines()
 
 

@@ -13,6 +13,7 @@ import pytest
 
 from ncpp.cldata import motion, read_cldata
 from ncpp.errors import NcppError, Warnings
+from ncpp.motion.offsets import WorkOffsets
 from ncpp.motion.segments import Arc, Context, Line
 from ncpp.post import GENERATORS, post
 from ncpp.post.generator import single_turns
@@ -28,7 +29,8 @@ OFFSET = (400.0, 350.0, 300.0)
 def posted(path, dialect: str, source=None) -> str:
     out = io.BytesIO()
     with open(path, encoding="latin-1") as stream:
-        post(stream, out, file=str(path), dialect=dialect, source=source, warnings=Warnings(stream=io.StringIO()))
+        post(stream, out, file=str(path), dialect=dialect, source=source, warnings=Warnings(stream=io.StringIO()),
+             offsets=WorkOffsets.of({"G54": OFFSET}))
     return out.getvalue().decode("latin-1")
 
 
@@ -95,7 +97,7 @@ def test_arcs_are_posted_as_arcs():
 def test_posted_with_a_machine_file_is_compensated(path, tmp_path):
     from ncpp.pipeline import HEADER_TAG, ErrorSource
 
-    source = ErrorSource.from_machine_file(str(MACHINE)).shifted(OFFSET)
+    source = ErrorSource.from_machine_file(str(MACHINE))
     text = posted(path, "linuxcnc", source)
     assert text.splitlines()[0].startswith(f"({HEADER_TAG} for hr5b.toml")
     program = tmp_path / "compensated.ngc"

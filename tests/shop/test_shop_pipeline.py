@@ -47,13 +47,13 @@ def test_lookup_order_option_then_environment_then_local_then_user_config(shop):
     (work / "ncpp.toml").write_text('machine = "m/hr5b.toml"\nwork_offset = [400, 350, 300]\n')
     local = find_settings(cwd=work, env=env)
     assert local.machine == str(work / "m/hr5b.toml")  # relative to the config file
-    assert local.work_offset == (400.0, 350.0, 300.0) and local.tolerance == 0.001  # only the first file is read
+    assert local.zeros == {"G54": (400.0, 350.0, 300.0)} and local.tolerance == 0.001  # only the first file is read
     assert local.origin == str(work / "ncpp.toml")
     env["NCPP_MACHINE"] = "/env/m.toml"
     assert find_settings(cwd=work, env=env).machine == "/env/m.toml"
     chosen = find_settings("cli.toml", 0.002, None, cwd=work, env=env)
     assert (chosen.machine, chosen.tolerance, chosen.origin) == ("cli.toml", 0.002, "--machine")
-    assert chosen.work_offset == (400.0, 350.0, 300.0)  # not given on the command line: the config's
+    assert chosen.zeros == {"G54": (400.0, 350.0, 300.0)}  # not given on the command line: the config's
 
 
 def test_no_machine_anywhere(shop):

@@ -338,12 +338,20 @@ class IsoWriter:
         styles = units.styles
         return {letter: format_number(numbers[n], styles[letter]) for letter, n in _WRITTEN[self._written_bits(self._facts(block), segment, units)]}
 
+    def _machine_texts(self, facts: "_Facts", segment: Line) -> dict[str, str]:
+        """`_texts` of a G53 line, whose numbers are machine coordinates (in program units):
+        what it writes is decided in program coordinates, like every other block's."""
+        units = self._units(segment.context.inch)
+        end, offset = segment.end, segment.context.offset
+        machine = (end[0] + offset[0], end[1] + offset[1], end[2] + offset[2])
+        return {letter: format_number(machine[n], units.styles[letter]) for letter, n in _WRITTEN[self._written_bits(facts, segment, units)]}
+
     def _edit_block(self, block: Block, segment: Line | Arc) -> str:
         facts = self._facts_value if block is self._facts_block else self._facts(block)  # `_facts`, inlined
         code = self._motion_code(segment)
         # the block's motion word is set when it says another motion, or when the output's mode is another
         motion = code if facts.first_motion != code and (code != self.output_motion or facts.motion_word) else None
-        raw = self._planned_edit(block, facts, segment, motion)
+        raw = None if facts.machine else self._planned_edit(block, facts, segment, motion)
         if raw is None:
             raw = self._general_edit(block, facts, segment, motion)
         if facts.motion_word or code != self.output_motion:
@@ -393,7 +401,7 @@ class IsoWriter:
         return plan  # type: ignore[return-value]
 
     def _general_edit(self, block: Block, facts: "_Facts", segment: Line | Arc, motion: int | None) -> str:
-        texts = self._texts(block, segment)
+        texts = self._machine_texts(facts, segment) if facts.machine else self._texts(block, segment)
         # centre words of the old arc, and Fanuc corner words: the corner is now explicit;
         # P is an arc's turn count, but a dwell time (G4) or blending tolerance (G64) elsewhere
         drop = [] if facts.letters.isdisjoint(_DROPPED) else [l for l in DROPPED if l in facts.letters and l not in texts]
@@ -441,7 +449,7 @@ class _Facts:
     """What the writer asks about a block."""
 
     __slots__ = ("letters", "motion_word", "motion", "first_motion", "moves", "plain", "words", "styled",
-                 "word_letters", "motion_at", "bits", "axis_bits", "absent_axes")  # fmt: skip
+                 "word_letters", "motion_at", "bits", "axis_bits", "absent_axes", "machine")  # fmt: skip
 
     def __init__(self, block: Block | None = None):
         """The facts of `block`, read in one walk over its items (none: a block without words)."""
@@ -455,6 +463,7 @@ class _Facts:
         self.styled: tuple[tuple[int, str], ...] = ()  # (n, letter) of its n-th word when the writer learns its style
         self.word_letters: list[str] = []  # the letters of its plain words, in order
         self.motion_at: tuple[int, str] | None = None  # (n, number as written) of its first G0-G3 word, the n-th word
+        self.machine = False  # it moves in machine coordinates (G53)
         for item in block.items if block is not None else ():
             kind = type(item)
             if kind is Word:
@@ -491,6 +500,8 @@ class _Facts:
                     self.first_motion, self.motion_at = code, (self.words - 1, number)
             elif 73 <= value <= 89:
                 self.motion_word, self.motion = True, None
+            elif value == 53.0:
+                self.machine = True
         elif letter in MOVING_LETTERS:
             self.moves = True
 

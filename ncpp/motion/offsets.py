@@ -1,0 +1,155 @@
+"""Where the control holds a program's zeros when the program starts.
+
+A program says its moves in program coordinates; the machine's errors are a
+function of machine position.  The control adds the work offset of the
+coordinate system in effect (G54-G59.3), the G92 offset and the tool length;
+the program itself does not say them (unless it sets them with G10 L2/L20 or
+G92).  `WorkOffsets` is what the control holds, as the operator set it: the
+interpreter starts from it, so every event's `Context.offset` is the true
+machine minus program position and G53 moves land where the control puts
+them.
+
+    WorkOffsets.of({"G54": (400, 350, 300), "G55": (600, 350, 300)})
+    WorkOffsets.from_var_file("linuxcnc.var")      # LinuxCNC's parameter file
+
+Positions are machine mm (X, Y, Z).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Mapping
+
+from ncpp.errors import Location, NcppError
+
+Vector = tuple[float, float, float]
+SYSTEMS = ("G54", "G55", "G56", "G57", "G58", "G59", "G59.1", "G59.2", "G59.3")  # rs274ngc's numbers 1..9
+MM_PER_INCH = 25.4
+
+# LinuxCNC's parameter file (rs274ngc interp_parameter_def.hh): the systems' X at 5221 + 20 (n - 1),
+# Y and Z after it; the system in effect at 5220; G92 at 5211-5213, applied when 5210 is 1;
+# the G28 and G30 positions (machine coordinates) at 5161 and 5181.
+_ACTIVE_SYSTEM, _G92_ON, _G92_X, _G28_X, _G30_X = 5220, 5210, 5211, 5161, 5181
+
+
+def _system_x(number: int) -> int:
+    return 5201 + 20 * number
+
+
+@dataclass(frozen=True)
+class WorkOffsets:
+    """The zeros the control holds: per coordinate system (1..9: G54..G59.3) its
+    machine position in mm, None when ncpp is not told it; the system in effect at
+    the program's start; the G92 offset in effect; the G28 and G30 positions."""
+
+    systems: tuple[Vector | None, ...] = (None,) * 9
+    active: int = 1
+    g92: Vector = (0.0, 0.0, 0.0)
+    g28: Vector = (0.0, 0.0, 0.0)
+    g30: Vector = (0.0, 0.0, 0.0)
+
+    @classmethod
+    def of(cls, zeros: Mapping[str, Vector], active: str = "G54") -> "WorkOffsets":
+        """From G word -> machine mm (`{"G54": (400, 350, 300)}`)."""
+        systems: list[Vector | None] = [None] * 9
+        for name, zero in zeros.items():
+            systems[system_number(name) - 1] = _vector(zero)
+        return cls(tuple(systems), system_number(active))
+
+    @classmethod
+    def from_var_file(cls, path: str | Path, unit_mm: float = 1.0) -> "WorkOffsets":
+        """LinuxCNC's parameter file (`linuxcnc.var`: `number value` lines), its values in
+        the machine's units (`[TRAJ]LINEAR_UNITS`: 25.4 mm for inch)."""
+        values = read_var_file(path)
+        systems = tuple(_from_var(values, _system_x(n), unit_mm) for n in range(1, 10))
+        active = int(values.get(_ACTIVE_SYSTEM, 1.0) + 0.0001)
+        g92 = _from_var(values, _G92_X, unit_mm) if values.get(_G92_ON) == 1.0 else None
+        zero = (0.0, 0.0, 0.0)
+        homes = (_from_var(values, _G28_X, unit_mm) or zero, _from_var(values, _G30_X, unit_mm) or zero)
+        return cls(systems, active if 1 <= active <= 9 else 1, g92 or zero, *homes)
+
+    @classmethod
+    def given(cls, zeros: Mapping[str, Vector], var_file: str | Path | None = None, unit_mm: float = 1.0) -> "WorkOffsets":
+        """What a user says: a parameter file, if any (else G54 at the machine zero), with
+        `zeros` (G word -> machine mm) over it."""
+        base = cls.from_var_file(var_file, unit_mm) if var_file else cls.of({"G54": (0.0, 0.0, 0.0)})
+        return base.with_zeros(zeros)
+
+    def with_zeros(self, zeros: Mapping[str, Vector]) -> "WorkOffsets":
+        """These systems' zeros replaced (the command line over a parameter file)."""
+        systems = list(self.systems)
+        for name, zero in zeros.items():
+            systems[system_number(name) - 1] = _vector(zero)
+        return replace(self, systems=tuple(systems))
+
+    def told(self, number: int) -> bool:
+        """Whether system `number` (1..9) has a known zero."""
+        return self.systems[number - 1] is not None
+
+    def zero(self, number: int) -> Vector:
+        """System `number`'s zero in machine mm (the machine zero when not told)."""
+        return self.systems[number - 1] or (0.0, 0.0, 0.0)
+
+    def program_zero(self) -> Vector:
+        """Machine mm of the program zero at the start: the system in effect plus G92
+        (dialects with one program zero, Heidenhain's preset, Sinumerik's settable frame)."""
+        zero = self.zero(self.active)
+        return (zero[0] + self.g92[0], zero[1] + self.g92[1], zero[2] + self.g92[2])
+
+    def told_any(self) -> bool:
+        return any(zero is not None for zero in self.systems)
+
+
+NONE = WorkOffsets()
+
+
+def parse_zero(text: str) -> tuple[str, Vector]:
+    """`G55=600,350,300` -> ("G55", (600, 350, 300)); without `G5x=` it is G54's."""
+    name, _, numbers = text.rpartition("=")
+    name = name.strip().upper() or "G54"
+    system_number(name)
+    try:
+        values = tuple(float(v) for v in numbers.split(","))
+    except ValueError:
+        values = ()
+    if len(values) != 3:
+        raise ValueError(f"expected [G5x=]X,Y,Z in mm, got {text!r}")
+    return name, values  # type: ignore[return-value]
+
+
+def system_number(name: str) -> int:
+    """`G55` -> 2 (rs274ngc's numbering, 1..9)."""
+    key = name.strip().upper()
+    if key not in SYSTEMS:
+        raise ValueError(f"not a work coordinate system: {name!r} (one of {', '.join(SYSTEMS)})")
+    return SYSTEMS.index(key) + 1
+
+
+def read_var_file(path: str | Path) -> dict[int, float]:
+    """`number value` lines; other lines are comments (as rs274ngc reads it)."""
+    values: dict[int, float] = {}
+    try:
+        text = Path(path).read_text(encoding="latin-1")
+    except OSError as err:
+        raise NcppError(f"cannot read the parameter file: {err.strerror}", Location(str(path))) from None
+    for n, line in enumerate(text.splitlines(), 1):
+        fields = line.split()
+        if len(fields) < 2 or not fields[0].isdigit():
+            continue
+        try:
+            values[int(fields[0])] = float(fields[1])
+        except ValueError:
+            raise NcppError(f"parameter {fields[0]} has no number: {fields[1]!r}", Location(str(path), n, line.index(fields[1]) + 1)) from None
+    return values
+
+
+def _from_var(values: Mapping[int, float], x: int, unit_mm: float) -> Vector | None:
+    if not any(k in values for k in (x, x + 1, x + 2)):
+        return None
+    return (values.get(x, 0.0) * unit_mm, values.get(x + 1, 0.0) * unit_mm, values.get(x + 2, 0.0) * unit_mm)
+
+
+def _vector(zero) -> Vector:
+    x, y, z = (float(v) for v in zero)
+    return (x, y, z)
