@@ -82,3 +82,18 @@ def test_an_error_reaches_linuxcnc_as_exit_status_and_message(tmp_path):
     proc = run_filter(bad, tmp_path, NCPP_MACHINE=str(MACHINE))
     assert proc.returncode != 0 and proc.stdout == b""
     assert f"{bad}:2:" in proc.stderr.decode() and "outside the X travel" in proc.stderr.decode()
+
+
+def test_the_parameter_file_places_the_program_as_linuxcnc_does(tmp_path):
+    """`var_file` in the config: G54 from LinuxCNC's parameter file, the same output as
+    `work_offset` saying the same zero."""
+    pocket = ROOT / "samples/programs/pocket.ngc"
+    (tmp_path / "linuxcnc.var").write_text("5220\t1.000000\n5221\t400.000000\n5222\t350.000000\n5223\t300.000000\n")
+    (tmp_path / "ncpp.toml").write_text(f'machine = "{MACHINE}"\nvar_file = "linuxcnc.var"\n')
+    from_var = run_filter(pocket, tmp_path)
+    (tmp_path / "ncpp.toml").write_text(f'machine = "{MACHINE}"\nwork_offset = [400, 350, 300]\n')
+    given = run_filter(pocket, tmp_path)
+    assert from_var.returncode == 0 and given.returncode == 0, from_var.stderr.decode()
+    assert from_var.stdout == given.stdout and from_var.stdout.startswith(b"%\n(ncpp compensated")
+    (tmp_path / "ncpp.toml").write_text(f'machine = "{MACHINE}"\n')  # G54 at the machine zero: outside the travel
+    assert run_filter(pocket, tmp_path).returncode == 2
