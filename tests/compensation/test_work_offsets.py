@@ -175,3 +175,64 @@ def test_a_one_zero_dialect_names_another_system():
     process(io.BytesIO(SINUMERIK), io.BytesIO(), file="t.mpf", source=ErrorSource.from_machine_file(str(MACHINE)),
             warnings=Warnings(stream=said), dialect="sinumerik", offsets=WorkOffsets.of({"G54": G54}))  # fmt: skip
     assert said.getvalue().startswith("t.mpf:4:1: warning: G55 selects another work offset")
+
+
+# -- the oracle: LinuxCNC's rs274 started from the same parameter file ---------------------------
+
+ORACLE_PROGRAM = b"""G21 G90
+G0 X10 Y10 Z5
+G1 X20 F100
+G55
+G1 Y30
+G10 L2 P3 X-100 Y-50 Z-20
+G56 G0 X1 Y2
+G53 G0 Z0
+G92 X0 Y0
+G1 X5 Y5
+G92.1
+G28 X3
+G54 G1 X7 Y8 Z9
+M2
+"""
+ORACLE_VAR = "5161 1.0\n5162 2.0\n5163 3.0\n5220 2.0\n5221 10.0\n5222 20.0\n5223 -5.0\n5241 11.5\n5242 7.25\n5243 -2.0\n"
+
+
+def _rs274_with(var_file: Path, program: Path) -> str:
+    """rs274's canonical calls, started from `var_file` (the tools/rs274 wrapper fixes its own)."""
+    import os
+
+    from tests.conftest import RS274
+    from tests.shop.rs274 import run_rs274
+
+    run_rs274(program)  # the wrapper downloads rs274 once (or skips the test)
+    home = Path(os.environ.get("RS274_HOME") or Path.home() / ".cache/ncpp-rs274") / "root"
+    env = {**os.environ, "LD_LIBRARY_PATH": f"{home}/usr/lib:{home}/usr/lib/x86_64-linux-gnu"}
+    table = var_file.with_suffix(".tbl")
+    table.write_text("T1 P1 D6.0 Z0\n")
+    proc = subprocess.run([str(home / "usr/bin/rs274"), "-t", str(table), "-v", str(var_file), "-g", str(program)],
+                          capture_output=True, text=True, env=env, stdin=subprocess.DEVNULL, timeout=60)  # fmt: skip
+    assert proc.returncode == 0 and RS274.exists(), proc.stderr
+    return proc.stdout
+
+
+def test_placement_agrees_with_linuxcnc_started_from_the_same_parameter_file(tmp_path):
+    """The stand-alone rs274 reads its parameter file in inches: G55 in effect at the start,
+    G10 L2, G53, G92 and G28 from the file's G28 position all land where LinuxCNC puts them."""
+    import re
+
+    from tests.shop.rs274 import end_points
+
+    var, program = tmp_path / "sim.var", tmp_path / "p.ngc"
+    var.write_text(ORACLE_VAR)
+    program.write_bytes(ORACLE_PROGRAM)
+    offsets = WorkOffsets.from_var_file(var, 25.4)  # read first: rs274 writes the file back when it exits
+    canon = _rs274_with(var, program)
+    want = end_points(canon)
+    events = [e for e in events_of(ORACLE_PROGRAM, offsets=offsets) if type(e).__name__ in ("Line", "Arc")]
+    assert len(events) == len(want) == 9
+    for event, point in zip(events, want):
+        assert event.end == pytest.approx(point, abs=1e-4)
+    # the zeros rs274 announces are those the events are placed with
+    g5x = [tuple(float(v) for v in m.split(",")[1:4]) for m in re.findall(r"SET_G5X_OFFSET\((.*)\)", canon)]
+    assert g5x[0] == pytest.approx((11.5 * 25.4, 7.25 * 25.4, -2.0 * 25.4))
+    assert events[0].context.offset == pytest.approx(g5x[0])
