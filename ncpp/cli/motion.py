@@ -15,11 +15,17 @@ so the output compares line by line with
 `--format json` prints one JSON object per move (JSON Lines): source line,
 kind (traverse / feed / arc), start, end, centre and turn of arcs, feed,
 plane, inch, and the work offset (machine minus program position).
+
+`--var-file linuxcnc.var` / `--work-offset [G5x=]X,Y,Z` start the
+interpreter from the control's zeros, as `rs274 -v FILE` does (default: all
+zero, rs274's default parameter file).
 """
 
 from __future__ import annotations
 
 import argparse
+
+from ncpp.cli.compensate import add_placement_arguments, work_offsets
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -32,6 +38,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("input", nargs="?", metavar="FILE", help="NC program (default: standard input)")
     parser.add_argument("--format", choices=("rs274", "json"), default="rs274")
     parser.add_argument("--strict", action="store_true", help="refuse constructs outside the interpreter's scope")
+    add_placement_arguments(parser)
     parser.set_defaults(func=run)
 
 
@@ -47,9 +54,10 @@ def run(args: argparse.Namespace) -> int:
     from ncpp.program.parser import parse_stream
 
     warnings = Warnings(strict=args.strict)
+    offsets = work_offsets(args) if args.work_offset or args.var_file else None
     out = sys.stdout
     with open_input(args.input) as (stream, name):
-        for event in interpret(parse_stream(stream, name), file=name, warnings=warnings):
+        for event in interpret(parse_stream(stream, name), file=name, warnings=warnings, offsets=offsets):
             if type(event) is not Line and type(event) is not Arc:
                 continue
             if args.format == "rs274":

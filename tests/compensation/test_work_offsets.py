@@ -215,7 +215,7 @@ def _rs274_with(var_file: Path, program: Path) -> str:
     return proc.stdout
 
 
-def test_placement_agrees_with_linuxcnc_started_from_the_same_parameter_file(tmp_path):
+def test_placement_agrees_with_linuxcnc_started_from_the_same_parameter_file(tmp_path, capsys):
     """The stand-alone rs274 reads its parameter file in inches: G55 in effect at the start,
     G10 L2, G53, G92 and G28 from the file's G28 position all land where LinuxCNC puts them."""
     import re
@@ -226,7 +226,12 @@ def test_placement_agrees_with_linuxcnc_started_from_the_same_parameter_file(tmp
     var.write_text(ORACLE_VAR)
     program.write_bytes(ORACLE_PROGRAM)
     offsets = WorkOffsets.from_var_file(var, 25.4)  # read first: rs274 writes the file back when it exits
+    from ncpp.cli import main
+
+    assert main(["motion", str(program), "--var-file", str(var), "--var-units", "inch"]) == 0
+    listed = capsys.readouterr().out.splitlines()
     canon = _rs274_with(var, program)
+    assert listed == re.findall(r"(?:STRAIGHT_TRAVERSE|STRAIGHT_FEED|ARC_FEED)\(.*\)", canon)  # `ncpp motion` says the same
     want = end_points(canon)
     events = [e for e in events_of(ORACLE_PROGRAM, offsets=offsets) if type(e).__name__ in ("Line", "Arc")]
     assert len(events) == len(want) == 9
