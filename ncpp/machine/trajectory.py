@@ -15,6 +15,9 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 PLANES = {"XY": (0, 1, 2), "YZ": (1, 2, 0), "ZX": (2, 0, 1)}  # first, second, normal axis index
+# A step this small is floating-point noise (a position converted between frames and units),
+# not motion: it must not reverse an axis (a reversal error is µm) in the simulation.
+NOISE_MM = 1e-9
 
 
 @dataclass(frozen=True, eq=False)
@@ -125,7 +128,8 @@ class Trajectory:
         """Direction of travel per axis (n,3) in {−1, 0, +1}: the sign of the
         last motion that axis made (held through stops); a sample gets the
         direction it was approached in, the first sample that of the first move."""
-        step = np.sign(np.diff(self.positions, axis=0))
+        delta = np.diff(self.positions, axis=0)
+        step = np.sign(np.where(np.abs(delta) > NOISE_MM, delta, 0.0))
         out = np.zeros_like(self.positions)
         for i in range(3):
             s = step[:, i]

@@ -157,3 +157,12 @@ def test_trajectory_constructors():
     line = Trajectory.line([0, 0, 0], [10, 0, 0], 600.0, 1.0)
     assert len(line) == 11 and np.allclose(line.velocity[:, 0], 10.0)
     assert list(there_and_back(step=25.0).directions()[:, 0]) == [1, 1, 1, 1, 1, -1, -1, -1, -1]
+
+
+def test_floating_point_noise_is_not_motion():
+    """A still axis whose position went through another frame (400 mm = 15.748... in + its
+    offset, back to mm) may differ by 1e-13 mm: that must not reverse it."""
+    y = np.array([350.0, 350.0, 350.0 + 5.7e-14, 350.0 - 5.7e-14, 350.0, 351.0])
+    path = Trajectory(np.column_stack([np.linspace(0.0, 10.0, 6), y, np.zeros(6)]), 1000.0)
+    assert list(path.directions()[:, 1]) == [1, 1, 1, 1, 1, 1]
+    assert len(path.reversals(1)) == 0
