@@ -269,13 +269,16 @@ def _process(
 
 
 @contextmanager
-def _rare_collections(threshold: int = 50_000) -> Iterator[None]:
+def _rare_collections(threshold: int = 1_000_000) -> Iterator[None]:
     """Run the cyclic garbage collector less often while a program streams through.
 
     Every line makes a few short-lived objects (a block, its words, events, strings)
-    that reference counting frees; with the default gen-0 threshold (700) the
-    collector would walk the young objects every few lines for nothing (~10% of
-    the run).  Memory stays flat: nothing here lives on in cycles."""
+    that reference counting frees; the collector runs when allocations outnumber
+    frees by the threshold, and that count includes the objects in flight: up to
+    ~400k with a worker (three `replace_arcs` batches of 16384 events, with their
+    blocks and words).  Below that the collector would walk them again and again
+    for nothing (with 50k: 6% of the main process on stellabee1.ngc).  Memory stays
+    flat: a whole program leaves a few thousand objects in cycles at most."""
     old = gc.get_threshold()
     gc.set_threshold(max(old[0], threshold), *old[1:])
     try:

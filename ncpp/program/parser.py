@@ -23,7 +23,7 @@ from lark import Token, Transformer, v_args
 from ncpp.errors import Location, NcppError
 from ncpp.program.blocks import AnyItem, Block, Comment, ExprWord, Statement, Word
 
-_GAP_CHARS = " \\t\\r\\f\\v\\x1a"  # blanks between items (as a regex class body)
+_GAP_CHARS = " \t\r\f\v\x1a"  # blanks between items (a regex class body: SUB as itself, no digit in the pattern)
 _GAP = f"[{_GAP_CHARS}]*"
 
 
@@ -206,6 +206,9 @@ class LineParser:
         self._builder = self.dialect.builder()
         self._items = _PlainItems(self._lark, self.dialect.fast_terminals) if self.dialect.fast_terminals else None
         self._blank = re.compile(f"{_GAP}$")
+        # plain lines by their layout (`_DIGITS_AS_ONE`): what `_scan_plain` reads of them, see `_shape`
+        self._shapes: dict[bytes, object] = {}
+        self._by_layout = self._items is not None and self._items.digit_blind
 
     def parse(self, raw: str, eol: str = "", line: int = 0, file: str = "<stdin>") -> Block:
         plain = self._scan_plain(raw)
@@ -217,6 +220,42 @@ class LineParser:
     def _scan_plain(self, raw: str) -> tuple[tuple[AnyItem, ...], str | None] | None:
         """(items, `Block.signature`) of a line made only of plain words and
         comments, else None; the signature is None when a word has two letters (`,R`)."""
+        if not self._by_layout:
+            return self._scan_items(raw)
+        # Most lines of a program share a few layouts (` X1.1111 Z-1.1111`): their words are
+        # cut where the first line of the layout had them, without the scanner.
+        try:
+            layout = raw.encode("latin-1").translate(_DIGITS_AS_ONE)
+        except UnicodeEncodeError:  # text not read from bytes (`parse("X1 (€)")`): no layout
+            return self._scan_items(raw)
+        shape = self._shapes.get(layout)
+        if shape is None:
+            shape = self._learn_shape(raw, layout)
+        if type(shape) is not tuple:  # not plain, or a plain line cutting cannot read
+            return None if shape is _NOT_PLAIN else self._scan_items(raw)
+        spans, signature, g_words = shape
+        items = []
+        append = items.append
+        for letter, start, number_at, end in spans:
+            number = raw[number_at:end]
+            word = _new_word(Word)  # built inline: one per word of the program
+            word.letter, word.value, word.number, word.start, word.end = letter, float(number), number, start, end
+            append(word)
+        if g_words:  # the signature has the G words' numbers as written
+            signature = signature.format(*[items[n].number for n in g_words])
+        return tuple(items), signature
+
+    def _learn_shape(self, raw: str, layout: bytes) -> object:
+        """The shape of the line's layout, scanned from the line and remembered."""
+        scanned = self._scan_items(raw)
+        shape = _NOT_PLAIN if scanned is None else _shape(raw, *scanned)
+        if len(self._shapes) >= _MAX_SHAPES:  # comments can make every layout new: keep memory flat
+            self._shapes.clear()
+        self._shapes[layout] = shape
+        return shape
+
+    def _scan_items(self, raw: str) -> tuple[tuple[AnyItem, ...], str | None] | None:
+        """`_scan_plain` by the scanner."""
         scanner = self._items
         if scanner is None:
             return None
@@ -272,6 +311,31 @@ class LineParser:
         return tuple(item for item in _flatten(items))
 
 
+# A line's layout: its bytes with every digit '1'.  The fast terminals tell no digit from
+# another (`_PlainItems.digit_blind`), so lines of one layout scan into the same items at
+# the same spans, only their numbers differ.
+_DIGITS_AS_ONE = bytes.maketrans(b"0123456789", b"1111111111")
+_MAX_SHAPES = 10_000  # layouts remembered
+_NOT_PLAIN = "not plain"  # the shape of a layout the scanner does not read (the LALR parser does)
+_SCAN = "scan"  # the shape of a plain layout whose items cutting cannot build: scanned each time
+
+
+def _shape(raw: str, items: tuple[AnyItem, ...], signature: str | None) -> object:
+    """How to build the items of a line of this layout: (spans, signature, g_words) for a
+    line of one-letter words whose numbers are written without blanks, else `_SCAN`.
+    spans: (letter, start, start of the number, end) of each word; the signature is a
+    format template when the line has G words, whose numbers fill it (`g_words`: their indices)."""
+    words = [item for item in items if type(item) is Word]
+    if signature is None or len(words) != len(items) or "{" in signature or "}" in signature:
+        return _SCAN  # a comma word (`,R`), a comment
+    spans = tuple((w.letter, w.start, w.end - len(w.number), w.end) for w in words)
+    if any(raw[number_at:end] != w.number for (_, _, number_at, end), w in zip(spans, words)):
+        return _SCAN  # `X - 5`: the number is written with blanks
+    g_words = tuple(n for n, w in enumerate(words) if w.letter == "G")
+    template = "".join("G{}" if w.letter == "G" else w.letter for w in words) if g_words else signature
+    return spans, template, g_words
+
+
 class _PlainItems:
     """The plain-line scanner: `findall(raw)` gives one tuple per item, compiled from
     the grammar's fast terminals.  Its fields: [0] the blanks before the item,
@@ -293,6 +357,8 @@ class _PlainItems:
         pattern = re.compile(f"({_GAP})(?:({split[1]})({split[2]})|{'|'.join(others)}|[^{_GAP_CHARS}])")
         self.findall = pattern.findall
         self.comma, self.paren, self.semi = (pattern.groupindex[name] - 1 for name in self.OTHERS)
+        # a pattern without digit characters (`\\d`, ranges of letters) treats all digits alike
+        self.digit_blind = not any(c.isdigit() for c in pattern.pattern)
 
 
 def _flatten(items: Iterable) -> Iterator[AnyItem]:

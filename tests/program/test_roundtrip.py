@@ -65,6 +65,15 @@ def test_fast_path_agrees_with_lalr_parser_on_corpus():
     assert checked > 20_000
 
 
+def test_lines_of_one_layout_are_read_as_the_scanner_reads_each():
+    """Lines differing only in their digits are cut where the first one had its words:
+    numbers, G numbers in the signature, blanks inside a number, text not from bytes."""
+    parser, scanner = LineParser("iso"), LineParser("iso")
+    for raw in ["G1 X1.5 Y-2", "G0 X7.0 Y-9", "G90G1X1", "G91G0X2", " X - 5", " X - 6", "X1 (a)", "X2 (b)", "X1 (\u20ac)"]:
+        assert parser._scan_plain(raw) == scanner._scan_items(raw), raw
+    assert parser._scan_plain("G0 X7.0 Y-9")[1] == "G0XY"
+
+
 @pytest.mark.parametrize("raw", ["X1 @;c   ", "G1 X1 $;comment    ", "@@(;;)@;c   ", "X1 @ Y2", "X1 Y2 #"])
 def test_a_stray_character_is_left_to_the_lalr_parser(raw):
     """The scanner's spans follow from the lengths of what it read: a character it
