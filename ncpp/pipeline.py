@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import BinaryIO, Callable, Iterable, Iterator
 
 from ncpp.errors import Location, NcppError, Warnings
-from ncpp.motion.offsets import WorkOffsets
+from ncpp.motion.offsets import AT_MACHINE_ZERO, WorkOffsets
 from ncpp.motion.segments import Event
 from ncpp.passes import PASSES, PassContext, run_passes
 from ncpp.passes.context import is_directional
@@ -251,7 +251,7 @@ def _process(
     if source is not None and name != "iso":  # the ISO interpreter follows every work offset
         blocks = warn_other_zeros(blocks, warnings, file)
     # the control's zeros place the program on the machine; passthrough places nothing
-    offsets = (offsets or WorkOffsets.of({"G54": (0.0, 0.0, 0.0)})) if source is not None else None
+    offsets = (offsets or AT_MACHINE_ZERO) if source is not None else None
     events: Iterable[Event] = interpret(blocks, file=file, warnings=warnings, strict=strict, offsets=offsets)
     writer = writer_class()
     if source is None:

@@ -89,9 +89,9 @@ def zero_argument(text: str) -> tuple[str, tuple[float, float, float]]:
 
 def work_offsets(args: argparse.Namespace):
     """The control's zeros from --var-file and --work-offset."""
-    from ncpp.motion.offsets import WorkOffsets
+    from ncpp.motion.offsets import UNIT_MM, WorkOffsets
 
-    return WorkOffsets.given(dict(args.work_offset), args.var_file, 25.4 if args.var_units == "inch" else 1.0)
+    return WorkOffsets.given(dict(args.work_offset), args.var_file, UNIT_MM[args.var_units])
 
 
 def error_source(args: argparse.Namespace):

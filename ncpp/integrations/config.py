@@ -33,7 +33,7 @@ from pathlib import Path
 from typing import Mapping
 
 from ncpp.errors import Location, NcppError
-from ncpp.motion.offsets import Vector, WorkOffsets, system_number
+from ncpp.motion.offsets import UNIT_MM, Vector, WorkOffsets, system_number
 
 KEYS = ("machine", "tolerance", "work_offset", "var_file", "var_units")
 DEFAULT_TOLERANCE = 0.001
@@ -50,7 +50,7 @@ class Settings:
 
     def offsets(self) -> WorkOffsets:
         """The zeros the control holds, as these settings say them."""
-        return WorkOffsets.given(self.zeros, self.var_file, 25.4 if self.var_units == "inch" else 1.0)
+        return WorkOffsets.given(self.zeros, self.var_file, UNIT_MM[self.var_units])
 
 
 def config_paths(cwd: Path | None = None, env: Mapping[str, str] | None = None) -> list[Path]:
@@ -87,7 +87,7 @@ def read_config(path: Path) -> dict:
             raise NcppError("`var_file` must be a path string", Location(str(path)))
         config["var_file"] = str((path.parent / Path(data["var_file"]).expanduser()).resolve())
     if "var_units" in data:
-        if data["var_units"] not in ("mm", "inch"):
+        if data["var_units"] not in UNIT_MM:
             raise NcppError('`var_units` must be "mm" or "inch"', Location(str(path)))
         config["var_units"] = data["var_units"]
     return config

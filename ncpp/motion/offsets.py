@@ -25,7 +25,7 @@ from ncpp.errors import Location, NcppError
 
 Vector = tuple[float, float, float]
 SYSTEMS = ("G54", "G55", "G56", "G57", "G58", "G59", "G59.1", "G59.2", "G59.3")  # rs274ngc's numbers 1..9
-MM_PER_INCH = 25.4
+UNIT_MM = {"mm": 1.0, "inch": 25.4}  # a parameter file's units (the INI's [TRAJ]LINEAR_UNITS) in mm
 
 # LinuxCNC's parameter file (rs274ngc interp_parameter_def.hh): the systems' X at 5221 + 20 (n - 1),
 # Y and Z after it; the system in effect at 5220; G92 at 5211-5213, applied when 5210 is 1;
@@ -73,7 +73,7 @@ class WorkOffsets:
     def given(cls, zeros: Mapping[str, Vector], var_file: str | Path | None = None, unit_mm: float = 1.0) -> "WorkOffsets":
         """What a user says: a parameter file, if any (else G54 at the machine zero), with
         `zeros` (G word -> machine mm) over it."""
-        base = cls.from_var_file(var_file, unit_mm) if var_file else cls.of({"G54": (0.0, 0.0, 0.0)})
+        base = cls.from_var_file(var_file, unit_mm) if var_file else AT_MACHINE_ZERO
         return base.with_zeros(zeros)
 
     def with_zeros(self, zeros: Mapping[str, Vector]) -> "WorkOffsets":
@@ -97,11 +97,7 @@ class WorkOffsets:
         zero = self.zero(self.active)
         return (zero[0] + self.g92[0], zero[1] + self.g92[1], zero[2] + self.g92[2])
 
-    def told_any(self) -> bool:
-        return any(zero is not None for zero in self.systems)
 
-
-NONE = WorkOffsets()
 
 
 def parse_zero(text: str) -> tuple[str, Vector]:
@@ -153,3 +149,6 @@ def _from_var(values: Mapping[int, float], x: int, unit_mm: float) -> Vector | N
 def _vector(zero) -> Vector:
     x, y, z = (float(v) for v in zero)
     return (x, y, z)
+
+
+AT_MACHINE_ZERO = WorkOffsets.of({"G54": (0.0, 0.0, 0.0)})  # nobody said otherwise: program zero = machine zero

@@ -241,3 +241,8 @@ def test_placement_agrees_with_linuxcnc_started_from_the_same_parameter_file(tmp
     g5x = [tuple(float(v) for v in m.split(",")[1:4]) for m in re.findall(r"SET_G5X_OFFSET\((.*)\)", canon)]
     assert g5x[0] == pytest.approx((11.5 * 25.4, 7.25 * 25.4, -2.0 * 25.4))
     assert events[0].context.offset == pytest.approx(g5x[0])
+
+
+def test_a_missing_parameter_file_is_a_located_error(tmp_path):
+    with pytest.raises(NcppError, match=r"nowhere.var: cannot read the parameter file"):
+        WorkOffsets.from_var_file(tmp_path / "nowhere.var")
