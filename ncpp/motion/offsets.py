@@ -98,8 +98,6 @@ class WorkOffsets:
         return (zero[0] + self.g92[0], zero[1] + self.g92[1], zero[2] + self.g92[2])
 
 
-
-
 def parse_zero(text: str) -> tuple[str, Vector]:
     """`G55=600,350,300` -> ("G55", (600, 350, 300)); without `G5x=` it is G54's."""
     name, _, numbers = text.rpartition("=")
