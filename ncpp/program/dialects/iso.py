@@ -351,6 +351,7 @@ class IsoWriter:
         code = self._motion_code(segment)
         # the block's motion word is set when it says another motion, or when the output's mode is another
         motion = code if facts.first_motion != code and (code != self.output_motion or facts.motion_word) else None
+        # a G53 line's numbers are machine coordinates: no plan compiled for program coordinates
         raw = None if facts.machine else self._planned_edit(block, facts, segment, motion)
         if raw is None:
             raw = self._general_edit(block, facts, segment, motion)
