@@ -12,7 +12,9 @@
 #                         config files ./ncpp.toml, ~/.config/ncpp/config.toml)
 #   --from FILE           compensate from one measurement file instead
 #   --tolerance MM        allowed path deviation (default 0.001 or the config's)
-#   --work-offset X,Y,Z   machine position of the program zero (G54)
+#   --work-offset [G5x=]X,Y,Z  machine position of a fixture's zero (G54 without
+#                         G5x=; repeat it for the Job's other fixtures G55...)
+#   --var-file FILE       LinuxCNC parameter file holding the zeros (--var-units inch)
 #   --ncpp PATH           the ncpp program (default: $NCPP, then `ncpp` on PATH)
 # Any other argument goes to linuxcnc_post (e.g. --no-comments, --precision 4).
 #
@@ -34,7 +36,9 @@ parser = argparse.ArgumentParser(prog="ncpp", add_help=False)
 parser.add_argument("--machine", help="machine file (default: $NCPP_MACHINE or the ncpp config)")
 parser.add_argument("--from", dest="from_file", help="compensate from one measurement file")
 parser.add_argument("--tolerance", help="allowed path deviation in mm")
-parser.add_argument("--work-offset", help="X,Y,Z machine position of the program zero, mm")
+parser.add_argument("--work-offset", action="append", default=[], help="[G5x=]X,Y,Z machine position of a fixture's zero, mm (repeat)")
+parser.add_argument("--var-file", help="LinuxCNC parameter file holding the zeros")
+parser.add_argument("--var-units", help="units of --var-file: mm or inch")
 parser.add_argument("--ncpp", help="the ncpp program (default: $NCPP, then ncpp on PATH)")
 
 TOOLTIP_ARGS = parser.format_help() + "\nOther arguments are passed to linuxcnc_post.\n"
@@ -63,9 +67,12 @@ def _ncpp_command(options):
 
 def _ncpp_arguments(options):
     args = []
-    for flag, value in (("--machine", options.machine), ("--from", options.from_file), ("--tolerance", options.tolerance), ("--work-offset", options.work_offset)):
+    for flag, value in (("--machine", options.machine), ("--from", options.from_file), ("--tolerance", options.tolerance),
+                        ("--var-file", options.var_file), ("--var-units", options.var_units)):  # fmt: skip
         if value:
             args += [flag, value]
+    for zero in options.work_offset:
+        args += ["--work-offset", zero]
     return args
 
 

@@ -84,3 +84,31 @@ def test_freecad_1_uses_the_class_and_the_legacy_script_api_agrees(posted):
         pytest.skip("FreeCAD before 1.0 has only the legacy export()")
     assert "NCPP_PROCESSOR Ncpp" in output  # PostProcessorFactory found the class, not WrapperPost
     assert output.count("NCPP_LEGACY_SAME True") == 2
+
+
+def test_the_post_passes_every_fixture_zero_to_ncpp(tmp_path):
+    """A Job with two fixtures: `--work-offset` repeated (and `--var-file`) reach ncpp as
+    given (the plugin needs no FreeCAD for this part)."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("ncpp_post", ROOT / "plugins/freecad/ncpp_post.py")
+    plugin = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(plugin)
+    options, rest = plugin.parser.parse_known_args(
+        ["--machine", "m.toml", "--work-offset", "250,300,300", "--work-offset", "G55=550,400,250", "--var-file", "l.var", "--no-comments"]
+    )
+    assert plugin._ncpp_arguments(options) == [
+        "--machine", "m.toml", "--var-file", "l.var", "--work-offset", "250,300,300", "--work-offset", "G55=550,400,250",
+    ]  # fmt: skip
+    assert rest == ["--no-comments"]  # for FreeCAD's linuxcnc_post
+    ncpp = tmp_path / "ncpp"
+    ncpp.write_text(f"#!/bin/sh\nPYTHONPATH={ROOT} exec {sys.executable} -m ncpp \"$@\"\n")
+    ncpp.chmod(0o755)
+    program = "G21 G90 G54\nG0 X10 Y10 Z5\nG1 Z-1 F100\nG55\nG1 X20 Y20\nM2\n"
+    both = f"--ncpp {ncpp} --machine {MACHINE} --work-offset 250,300,300 --work-offset G55=550,400,250"
+    text = plugin.compensate_text(program, both)
+    assert "G55" in text and text.startswith("(ncpp compensated")
+    only_g54 = plugin.compensate_text(program, f"--ncpp {ncpp} --machine {MACHINE} --work-offset 250,300,300")
+    g55_part = lambda text: text[text.index("G55"):]  # noqa: E731
+    assert g55_part(text) != g55_part(only_g54)  # compensated where G55 really is
+    assert text[: text.index("G55")] == only_g54[: only_g54.index("G55")]
