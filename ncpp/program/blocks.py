@@ -15,6 +15,10 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Union
 
+# A line's layout: its Latin-1 bytes with every digit '1'.  Lines of one layout differ only in
+# their digits: the parser cuts them into words at the same places, the writer edits them alike.
+DIGITS_AS_ONE = bytes.maketrans(b"0123456789", b"1111111111")
+
 # Expression nodes are nested tuples, cheap to build and easy to evaluate:
 #   ("num", float) ("param", key) ("neg", x) ("pos", x) ("bin", op, a, b)
 #   ("call", name, x) ("atan2", a, b) ("exists", param)

@@ -21,7 +21,7 @@ import lark
 from lark import Token, Transformer, v_args
 
 from ncpp.errors import Location, NcppError
-from ncpp.program.blocks import AnyItem, Block, Comment, ExprWord, Statement, Word
+from ncpp.program.blocks import DIGITS_AS_ONE, AnyItem, Block, Comment, ExprWord, Statement, Word
 
 _GAP_CHARS = " \t\r\f\v\x1a"  # blanks between items (a regex class body: SUB as itself, no digit in the pattern)
 _GAP = f"[{_GAP_CHARS}]*"
@@ -206,7 +206,7 @@ class LineParser:
         self._builder = self.dialect.builder()
         self._items = _PlainItems(self._lark, self.dialect.fast_terminals) if self.dialect.fast_terminals else None
         self._blank = re.compile(f"{_GAP}$")
-        # plain lines by their layout (`_DIGITS_AS_ONE`): what `_scan_plain` reads of them, see `_shape`
+        # plain lines by their layout (`DIGITS_AS_ONE`): what `_scan_plain` reads of them, see `_shape`
         self._shapes: dict[bytes, object] = {}
         self._by_layout = self._items is not None and self._items.digit_blind
 
@@ -225,7 +225,7 @@ class LineParser:
         # Most lines of a program share a few layouts (` X1.1111 Z-1.1111`): their words are
         # cut where the first line of the layout had them, without the scanner.
         try:
-            layout = raw.encode("latin-1").translate(_DIGITS_AS_ONE)
+            layout = raw.encode("latin-1").translate(DIGITS_AS_ONE)
         except UnicodeEncodeError:  # text not read from bytes (`parse("X1 (€)")`): no layout
             return self._scan_items(raw)
         shape = self._shapes.get(layout)
@@ -311,10 +311,8 @@ class LineParser:
         return tuple(item for item in _flatten(items))
 
 
-# A line's layout: its bytes with every digit '1'.  The fast terminals tell no digit from
-# another (`_PlainItems.digit_blind`), so lines of one layout scan into the same items at
-# the same spans, only their numbers differ.
-_DIGITS_AS_ONE = bytes.maketrans(b"0123456789", b"1111111111")
+# Lines of one layout (`DIGITS_AS_ONE`): the fast terminals tell no digit from another
+# (`_PlainItems.digit_blind`), so they scan into the same items at the same spans.
 _MAX_SHAPES = 10_000  # layouts remembered
 _NOT_PLAIN = "not plain"  # the shape of a layout the scanner does not read (the LALR parser does)
 _SCAN = "scan"  # the shape of a plain layout whose items cutting cannot build: scanned each time

@@ -16,7 +16,7 @@ from operator import itemgetter
 from typing import Iterable, Iterator
 
 from ncpp.motion.segments import Arc, Context, Event, Line
-from ncpp.program.blocks import Block, Comment, ExprWord, Word
+from ncpp.program.blocks import DIGITS_AS_ONE, Block, Comment, ExprWord, Word
 from ncpp.program.numbers import NumberStyle, format_number
 from ncpp.program.writer import EditPlan, _literal, _with_motion, set_words, spelling
 
@@ -46,7 +46,6 @@ _AXIS_BITS = _BIT["X"] | _BIT["Y"] | _BIT["Z"]
 _ANY_CENTRE = _BIT["I"] | _BIT["J"] | _BIT["K"]
 _UNKNOWN = object()  # a plan not compiled yet
 _SIGNATURE_WORD = re.compile(r"(.)([-+.\d]*)")  # a letter, and a G word's number
-_DIGITS_AS_ONE = bytes.maketrans(b"0123456789", b"1111111111")  # a block's layout: its text with every digit '1'
 _MAX_LAYOUTS = 10000  # layouts remembered (comments can make every layout new)
 _MAX_UNITS = 64  # sets of number styles remembered with their compiled lines (a program uses a few)
 
@@ -65,7 +64,7 @@ class IsoWriter:
         # Axes the program has positioned; before that the control's position is not
         # the interpreter's assumed zero, so a word must not be added for them.
         self.known_axes: set[str] = set()
-        # Per layout of a plain block's text (`_DIGITS_AS_ONE`): what its numbers teach, see `_read_layout`.
+        # Per layout of a plain block's text (`DIGITS_AS_ONE`): what its numbers teach, see `_read_layout`.
         self._layouts: dict[bytes, tuple] = {}
         self._layout: tuple[Block | None, bytes] = (None, b"")  # the last block whose layout was read, and it
         self._interned_lessons: dict[tuple, tuple] = {}  # equal (letter, style) tuples are one
@@ -179,7 +178,7 @@ class IsoWriter:
         """The block's raw text with every digit '1' (read once per block: styles and edits ask)."""
         known, layout = self._layout
         if known is not block:
-            layout = block.raw.encode("latin-1").translate(_DIGITS_AS_ONE)
+            layout = block.raw.encode("latin-1").translate(DIGITS_AS_ONE)
             self._layout = (block, layout)
         return layout
 
