@@ -122,11 +122,6 @@ def source_for(model: Machine, label: str = "model") -> ErrorSource:
     return ErrorSource(model, label, "0" * 16, model.max_correction_mm, dict(model.limits))
 
 
-def at(offset) -> WorkOffsets:
-    """The control's zeros with G54 at `offset` (machine mm)."""
-    return WorkOffsets.of({"G54": tuple(float(v) for v in offset)})
-
-
 # -- programs ------------------------------------------------------------------------------------
 
 
@@ -194,12 +189,12 @@ def prepare(label: str, path: Path, model: Machine) -> Run | None:
     offset = placement(at_zero, model)
     if offset is None:
         return None
-    return Run(label, data, offset, sample_events(events_of(data, str(path), at(offset))))
+    return Run(label, data, offset, sample_events(events_of(data, str(path), WorkOffsets.at(offset))))
 
 
 def simulate(run: Run, model: Machine, program: bytes | None = None) -> ContourReport:
     """Contour error of `program` (default: the original) against the nominal path, on `model` (geometry)."""
-    commanded = run.nominal if program is None else sample_events(events_of(program, run.label, at(run.offset)))
+    commanded = run.nominal if program is None else sample_events(events_of(program, run.label, WorkOffsets.at(run.offset)))
     return contour_error(model, commanded, run.nominal, feed_effects=False)
 
 
@@ -209,7 +204,7 @@ def evaluate(run: Run, truth: Machine, compensation_model: Machine, tolerances=T
     source = source_for(compensation_model)
     result: dict[str, Any] = {"before_max_um": before.max_um, "before_rms_um": before.rms_um, "offset_mm": run.offset.tolist(), "after": {}}
     for tol in tolerances:
-        text, lines_in, lines_out, seconds = compensate(run.data, source, tol, run.label, at(run.offset))
+        text, lines_in, lines_out, seconds = compensate(run.data, source, tol, run.label, WorkOffsets.at(run.offset))
         after = simulate(run, truth, text)
         result["after"][f"{tol * 1000:g}"] = {
             "max_um": after.max_um,

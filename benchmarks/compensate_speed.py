@@ -46,7 +46,7 @@ def ncpp_process_rate(path: Path, offset: tuple[float, float, float] | None, job
     from ncpp.pipeline import ErrorSource, process
 
     source = None if offset is None else ErrorSource.from_machine_file(str(MACHINE))
-    offsets = None if offset is None else WorkOffsets.of({"G54": offset})
+    offsets = None if offset is None else WorkOffsets.at(offset)
     sink = open(os.devnull, "wb")
     start = time.perf_counter()
     with open(path, "rb") as stream:
@@ -98,7 +98,7 @@ def stage_seconds(path: Path, offset: tuple[float, float, float], lines: int = 1
     from ncpp.program.dialects import parse_program
 
     source = ErrorSource.from_machine_file(str(MACHINE))
-    offsets = WorkOffsets.of({"G54": offset})
+    offsets = WorkOffsets.at(offset)
     with open(path, "rb") as stream:
         head = b"".join(islice(stream, lines))
 

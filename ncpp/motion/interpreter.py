@@ -892,7 +892,7 @@ class Interpreter:
         raise NcppError(message, Location(self.file, block.line, col))
 
 
-_COORD_SYSTEM = {54.0: 1, 55.0: 2, 56.0: 3, 57.0: 4, 58.0: 5, 59.0: 6, 59.1: 7, 59.2: 8, 59.3: 9}
+_COORD_SYSTEM = {float(name[1:]): n for n, name in enumerate(SYSTEMS, 1)}  # 54.0: 1 ... 59.3: 9
 _COORD_SYSTEM_CODE = {n: code * 10 for code, n in _COORD_SYSTEM.items()}
 _PLANE_LETTERS = {17: "XY", 18: "ZX", 19: "YZ"}
 # words a plain modal move may carry without the full checks

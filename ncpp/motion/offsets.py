@@ -10,6 +10,7 @@ machine minus program position and G53 moves land where the control puts
 them.
 
     WorkOffsets.of({"G54": (400, 350, 300), "G55": (600, 350, 300)})
+    WorkOffsets.at((400, 350, 300))                 # G54 only
     WorkOffsets.from_var_file("linuxcnc.var")      # LinuxCNC's parameter file
 
 Positions are machine mm (X, Y, Z).
@@ -56,6 +57,11 @@ class WorkOffsets:
         for name, zero in zeros.items():
             systems[system_number(name) - 1] = _vector(zero)
         return cls(tuple(systems), system_number(active))
+
+    @classmethod
+    def at(cls, zero: Vector) -> "WorkOffsets":
+        """G54's zero at `zero` (machine mm), the other systems not told."""
+        return cls.of({"G54": zero})
 
     @classmethod
     def from_var_file(cls, path: str | Path, unit_mm: float = 1.0) -> "WorkOffsets":
@@ -149,4 +155,4 @@ def _vector(zero) -> Vector:
     return (x, y, z)
 
 
-AT_MACHINE_ZERO = WorkOffsets.of({"G54": (0.0, 0.0, 0.0)})  # nobody said otherwise: program zero = machine zero
+AT_MACHINE_ZERO = WorkOffsets.at((0.0, 0.0, 0.0))  # nobody said otherwise: program zero = machine zero

@@ -18,11 +18,6 @@ QUIET = Warnings(stream=open(os.devnull, "w"))
 MARGIN_MM = 1.0
 
 
-def at(offset) -> WorkOffsets:
-    """The control's zeros with G54 at `offset` (machine mm)."""
-    return WorkOffsets.of({"G54": tuple(float(v) for v in offset)})
-
-
 def events_of(data: bytes, name: str = "<test>", offsets: WorkOffsets | None = None) -> list:
     return list(interpret(parse_stream(io.BytesIO(data), name), file=name, warnings=QUIET, offsets=offsets))
 
@@ -42,7 +37,7 @@ def placement(path: SampledPath, limits) -> np.ndarray | None:
 def compensate(data: bytes, model, offset, tolerance: float = 0.001, name: str = "<test>", warnings: Warnings = QUIET) -> bytes:
     """`data` compensated for `model`, the program placed by `offset`: G54's zero, or WorkOffsets."""
     source = ErrorSource(model, "model", "0" * 16, model.max_correction_mm, dict(model.limits))
-    offsets = offset if isinstance(offset, WorkOffsets) else at(offset)
+    offsets = offset if isinstance(offset, WorkOffsets) else WorkOffsets.at(offset)
     out = io.BytesIO()
     process(io.BytesIO(data), out, file=name, source=source, tolerance=tolerance, warnings=warnings, offsets=offsets)
     return out.getvalue()

@@ -9,7 +9,8 @@ import pytest
 
 from ncpp.machine import load_machine
 from ncpp.simulate import contour_error, sample_events
-from tests.compensation.conftest import at, compensate, events_of, placement, repeatable_machine
+from ncpp.motion.offsets import WorkOffsets
+from tests.compensation.conftest import compensate, events_of, placement, repeatable_machine
 from tests.conftest import CORPUS, ROOT
 
 START = b"G0 X0 Y0 Z0\n"  # these short programs feed before positioning every axis
@@ -26,9 +27,9 @@ def before_after(machine, data: bytes, tolerance: float):
     """Contour error reports of the program uncompensated and compensated, run on
     `machine` placed at the centre of its travel."""
     offset = placement(sample_events(events_of(data)), machine.limits)
-    nominal = sample_events(events_of(data, offsets=at(offset)))
+    nominal = sample_events(events_of(data, offsets=WorkOffsets.at(offset)))
     before = contour_error(machine, nominal, nominal, feed_effects=False)
-    commanded = sample_events(events_of(compensate(data, machine, offset, tolerance), offsets=at(offset)))
+    commanded = sample_events(events_of(compensate(data, machine, offset, tolerance), offsets=WorkOffsets.at(offset)))
     return before, contour_error(machine, commanded, nominal, feed_effects=False)
 
 

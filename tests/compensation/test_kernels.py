@@ -35,7 +35,7 @@ PROGRAM = ("G21 G90 G17 F600\n" + "".join(_pattern(k) for k in range(400)) + "M2
 
 def _compensated(data: bytes, source: ErrorSource, jobs: int) -> bytes:
     out = io.BytesIO()
-    process(io.BytesIO(data), out, file="t.ngc", source=source, jobs=jobs, offsets=WorkOffsets.of({"G54": OFFSET}))
+    process(io.BytesIO(data), out, file="t.ngc", source=source, jobs=jobs, offsets=WorkOffsets.at(OFFSET))
     return out.getvalue()
 
 

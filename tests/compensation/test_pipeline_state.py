@@ -16,7 +16,7 @@ def test_the_garbage_collector_threshold_is_restored():
     before = gc.get_threshold()
     source = ErrorSource.from_machine_file(str(MACHINE))
     out = io.BytesIO()
-    process(io.BytesIO(PROGRAM), out, file="t.ngc", source=source, offsets=WorkOffsets.of({"G54": (400.0, 350.0, 300.0)}))
+    process(io.BytesIO(PROGRAM), out, file="t.ngc", source=source, offsets=WorkOffsets.at((400.0, 350.0, 300.0)))
     assert gc.get_threshold() == before
     assert out.getvalue().count(b"\n") >= PROGRAM.count(b"\n")
 

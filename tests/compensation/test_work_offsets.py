@@ -25,7 +25,7 @@ G54 = (400.0, 350.0, 300.0)
 def _warnings(program: bytes, offsets: WorkOffsets | None = None, strict: bool = False, source: bool = True) -> str:
     said = io.StringIO()
     src = ErrorSource.from_machine_file(str(MACHINE)) if source else None
-    process(io.BytesIO(program), io.BytesIO(), file="t.ngc", source=src, warnings=Warnings(strict, said), offsets=offsets or WorkOffsets.of({"G54": G54}))
+    process(io.BytesIO(program), io.BytesIO(), file="t.ngc", source=src, warnings=Warnings(strict, said), offsets=offsets or WorkOffsets.at(G54))
     return said.getvalue()
 
 
@@ -61,7 +61,7 @@ def _compensated_lines(program: bytes, offsets: WorkOffsets) -> list[str]:
 
 def test_a_g53_move_is_written_in_machine_coordinates():
     program = b"G21 G90 G54\nG0 X10 Y10 Z5\nG53 G0 Z650\nG0 X20\nM2\n"
-    lines = _compensated_lines(program, WorkOffsets.of({"G54": G54}))
+    lines = _compensated_lines(program, WorkOffsets.at(G54))
     g53 = next(line for line in lines if line.startswith("G53"))
     z = float(g53.split("Z")[1].split()[0])
     assert abs(z - 650.0) < 0.1 and z != 650.0  # machine Z, corrected by the machine's error there
@@ -70,7 +70,7 @@ def test_a_g53_move_is_written_in_machine_coordinates():
 
 def test_the_error_message_names_machine_coordinates_and_the_real_travel():
     with pytest.raises(NcppError, match=r"t.ngc:2: command X\d+\.\d+ mm is outside the X travel \[0, 800\] mm") as err:
-        _compensated_lines(b"G21 G90\nG1 X900 F100\nM2\n", WorkOffsets.of({"G54": G54}))  # to machine X1300
+        _compensated_lines(b"G21 G90\nG1 X900 F100\nM2\n", WorkOffsets.at(G54))  # to machine X1300
     assert 800 < float(str(err.value).split("command X")[1].split()[0]) <= 1300.1
 
 
@@ -94,7 +94,7 @@ def test_two_fixtures_are_each_compensated_at_their_own_place():
     assert before > 20.0 and after <= 1.5, (before, after)
     # G55 not given: its zero is taken as the machine zero, where the pocket leaves the travel
     said = io.StringIO()
-    only_g54 = WorkOffsets.of({"G54": (250.0, 300.0, 300.0)})
+    only_g54 = WorkOffsets.at((250.0, 300.0, 300.0))
     with pytest.raises(NcppError, match="outside the . travel") as err:
         compensate(TWO_FIXTURES, machine, only_g54, warnings=Warnings(stream=said))
     g55_line = TWO_FIXTURES.splitlines().index(b"G55") + 1
@@ -173,7 +173,7 @@ SINUMERIK = b"G54\nG0 X10 Y10 Z5\nG1 X20 F100\nG55\nG1 X30\nM30\n"
 def test_a_one_zero_dialect_names_another_system():
     said = io.StringIO()
     process(io.BytesIO(SINUMERIK), io.BytesIO(), file="t.mpf", source=ErrorSource.from_machine_file(str(MACHINE)),
-            warnings=Warnings(stream=said), dialect="sinumerik", offsets=WorkOffsets.of({"G54": G54}))  # fmt: skip
+            warnings=Warnings(stream=said), dialect="sinumerik", offsets=WorkOffsets.at(G54))  # fmt: skip
     assert said.getvalue().startswith("t.mpf:4:1: warning: G55 selects another work offset")
 
 

@@ -89,7 +89,7 @@ def _path(text: str, dialect: str) -> np.ndarray:
 def _compensated(text: str, dialect: str, source: ErrorSource) -> str:
     out = io.BytesIO()
     process(io.BytesIO(text.encode("latin-1")), out, file="part", source=source, strict=True,
-            warnings=Warnings(strict=True), dialect=dialect, offsets=WorkOffsets.of({"G54": WORK_OFFSET}))
+            warnings=Warnings(strict=True), dialect=dialect, offsets=WorkOffsets.at(WORK_OFFSET))
     return out.getvalue().decode("latin-1")
 
 

@@ -66,7 +66,7 @@ def _compensated_lines(program: bytes, name: str) -> list[str]:
     machine = Path(__file__).resolve().parents[2] / "samples/machines/hr5b.toml"
     source = ErrorSource.from_machine_file(str(machine))
     out = io.BytesIO()
-    process(io.BytesIO(program), out, file=name, source=source, offsets=WorkOffsets.of({"G54": (400.0, 350.0, 300.0)}))
+    process(io.BytesIO(program), out, file=name, source=source, offsets=WorkOffsets.at((400.0, 350.0, 300.0)))
     return out.getvalue().decode().splitlines()
 
 

@@ -30,7 +30,7 @@ def posted(path, dialect: str, source=None) -> str:
     out = io.BytesIO()
     with open(path, encoding="latin-1") as stream:
         post(stream, out, file=str(path), dialect=dialect, source=source, warnings=Warnings(stream=io.StringIO()),
-             offsets=WorkOffsets.of({"G54": OFFSET}))
+             offsets=WorkOffsets.at(OFFSET))
     return out.getvalue().decode("latin-1")
 
 
