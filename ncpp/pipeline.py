@@ -96,12 +96,13 @@ def refuse_compensated(blocks: Iterable[Block], file: str) -> Iterator[Block]:
     yield from blocks
 
 
-# G words that select a work offset a one-zero dialect's interpreter does not follow (Sinumerik's
-# settable frames G54-G57 are the program zero the control holds, whichever is selected)
+# G words that change the work offset where a one-zero dialect's interpreter does not follow:
+# Sinumerik's settable frames G54-G57 (G58/G59 are its programmable offsets: out of the
+# interpreter's scope, warned there) and G500, which deselects them
+_ONE_ZERO = "ncpp compensates this dialect at one program zero, the work offset in effect when the program starts (--work-offset)"
 OTHER_ZEROS = {
-    value: f"{name} selects another work offset: ncpp compensates this dialect at one program zero, "
-    "the work offset in effect when the program starts (--work-offset)"
-    for value, name in ((55.0, "G55"), (56.0, "G56"), (57.0, "G57"), (58.0, "G58"), (59.0, "G59"))
+    **{value: f"{name} selects another work offset: {_ONE_ZERO}" for value, name in ((55.0, "G55"), (56.0, "G56"), (57.0, "G57"))},
+    500.0: f"G500 deselects the work offset: {_ONE_ZERO}",
 }
 
 

@@ -167,14 +167,16 @@ def test_parse_zero():
             parse_zero(bad)
 
 
-SINUMERIK = b"G54\nG0 X10 Y10 Z5\nG1 X20 F100\nG55\nG1 X30\nM30\n"
+SINUMERIK = b"G54\nG0 X10 Y10 Z5\nG1 X20 F100\nG55\nG1 X30\nG500\nG1 X40\nM30\n"
 
 
 def test_a_one_zero_dialect_names_another_system():
     said = io.StringIO()
     process(io.BytesIO(SINUMERIK), io.BytesIO(), file="t.mpf", source=ErrorSource.from_machine_file(str(MACHINE)),
             warnings=Warnings(stream=said), dialect="sinumerik", offsets=WorkOffsets.at(G54))  # fmt: skip
-    assert said.getvalue().startswith("t.mpf:4:1: warning: G55 selects another work offset")
+    lines = said.getvalue().splitlines()
+    assert lines[0].startswith("t.mpf:4:1: warning: G55 selects another work offset")
+    assert lines[1].startswith("t.mpf:6:1: warning: G500 deselects the work offset") and len(lines) == 2
 
 
 # -- the oracle: LinuxCNC's rs274 started from the same parameter file ---------------------------
