@@ -199,30 +199,12 @@ M2
 ORACLE_VAR = "5161 1.0\n5162 2.0\n5163 3.0\n5220 2.0\n5221 10.0\n5222 20.0\n5223 -5.0\n5241 11.5\n5242 7.25\n5243 -2.0\n"
 
 
-def _rs274_with(var_file: Path, program: Path) -> str:
-    """rs274's canonical calls, started from `var_file` (the tools/rs274 wrapper fixes its own)."""
-    import os
-
-    from tests.conftest import RS274
-    from tests.shop.rs274 import run_rs274
-
-    run_rs274(program)  # the wrapper downloads rs274 once (or skips the test)
-    home = Path(os.environ.get("RS274_HOME") or Path.home() / ".cache/ncpp-rs274") / "root"
-    env = {**os.environ, "LD_LIBRARY_PATH": f"{home}/usr/lib:{home}/usr/lib/x86_64-linux-gnu"}
-    table = var_file.with_suffix(".tbl")
-    table.write_text("T1 P1 D6.0 Z0\n")
-    proc = subprocess.run([str(home / "usr/bin/rs274"), "-t", str(table), "-v", str(var_file), "-g", str(program)],
-                          capture_output=True, text=True, env=env, stdin=subprocess.DEVNULL, timeout=60)  # fmt: skip
-    assert proc.returncode == 0 and RS274.exists(), proc.stderr
-    return proc.stdout
-
-
 def test_placement_agrees_with_linuxcnc_started_from_the_same_parameter_file(tmp_path, capsys):
     """The stand-alone rs274 reads its parameter file in inches: G55 in effect at the start,
     G10 L2, G53, G92 and G28 from the file's G28 position all land where LinuxCNC puts them."""
     import re
 
-    from tests.shop.rs274 import end_points
+    from tests.shop.rs274 import end_points, run_rs274_from
 
     var, program = tmp_path / "sim.var", tmp_path / "p.ngc"
     var.write_text(ORACLE_VAR)
@@ -232,7 +214,7 @@ def test_placement_agrees_with_linuxcnc_started_from_the_same_parameter_file(tmp
 
     assert main(["motion", str(program), "--var-file", str(var), "--var-units", "inch"]) == 0
     listed = capsys.readouterr().out.splitlines()
-    canon = _rs274_with(var, program)
+    canon = run_rs274_from(var, program)
     assert listed == re.findall(r"(?:STRAIGHT_TRAVERSE|STRAIGHT_FEED|ARC_FEED)\(.*\)", canon)  # `ncpp motion` says the same
     want = end_points(canon)
     events = [e for e in events_of(ORACLE_PROGRAM, offsets=offsets) if type(e).__name__ in ("Line", "Arc")]

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import re
 import subprocess
 from pathlib import Path
@@ -24,6 +25,22 @@ def run_rs274(path: Path) -> str:
         pytest.skip(f"rs274 oracle did not run: {proc.stderr.strip()[:200]}")
     messages = [line for line in proc.stderr.splitlines() if line.strip() and line.strip() != "executing"]
     assert proc.returncode == 0 and not messages, f"rs274 refused {path.name}: {messages[:3]}"
+    return proc.stdout
+
+
+def run_rs274_from(var_file: Path, program: Path, tool_table: str = "T1 P1 D6.0 Z0\n") -> str:
+    """rs274's canonical calls, started from `var_file` and this tool table (the tools/rs274
+    wrapper fixes its own).  The stand-alone rs274 reads both in inches."""
+    empty = var_file.with_name("empty.ngc")
+    empty.write_text("M2\n")
+    run_rs274(empty)  # the wrapper downloads rs274 once (or skips the test)
+    home = Path(os.environ.get("RS274_HOME") or Path.home() / ".cache/ncpp-rs274") / "root"
+    env = {**os.environ, "LD_LIBRARY_PATH": f"{home}/usr/lib:{home}/usr/lib/x86_64-linux-gnu"}
+    table = var_file.with_suffix(".tbl")
+    table.write_text(tool_table)
+    proc = subprocess.run([str(home / "usr/bin/rs274"), "-t", str(table), "-v", str(var_file), "-g", str(program)],
+                          capture_output=True, text=True, env=env, stdin=subprocess.DEVNULL, timeout=60)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
     return proc.stdout
 
 
