@@ -64,8 +64,8 @@ class MachineMap:
 
     machine: object
 
-    def deviation(self, P, direction=None):
-        return self.machine.static_deviation(P, direction)
+    def deviation(self, P, direction=None, tool_offset=None):
+        return self.machine.static_deviation(P, direction, tool_offset)
 
 
 def _digest(path: str) -> str:

@@ -29,13 +29,14 @@ class SampledPath:
     line: NDArray  # (n,) source line number
     rapid: NDArray  # (n,) bool
     circles: list  # full circles: (centre (3,), radius mm, plane, slice of points)
+    tools: NDArray | None = None  # (n,3) tool length offsets in effect, mm (None: none)
 
 
 def sample_events(events: Iterable[Event], step_mm: float = STEP_MM) -> SampledPath:
     """Sampled machine positions of a program's motion (placed on the machine by the
     work offsets the events were interpreted with: `Context.offset`)."""
     pts: list[NDArray] = []
-    feeds, lines, rapids, circles = [], [], [], []
+    feeds, lines, rapids, circles, tools = [], [], [], [], []
     count = 0
     for event in events:
         if type(event) is Line:
@@ -55,11 +56,19 @@ def sample_events(events: Iterable[Event], step_mm: float = STEP_MM) -> SampledP
         feeds.append(np.full(n, 0.0 if rapid else event.feed * event.context.unit_mm))
         lines.append(np.full(n, event.block.line))
         rapids.append(np.full(n, rapid))
+        tools.append((event.context.tool_mm, n))
         count += n
     if not pts:
         empty = np.zeros((0, 3))
         return SampledPath(empty, np.zeros(0), np.zeros(0, int), np.zeros(0, bool), [])
-    return SampledPath(np.vstack(pts), np.concatenate(feeds), np.concatenate(lines), np.concatenate(rapids), circles)
+    return SampledPath(np.vstack(pts), np.concatenate(feeds), np.concatenate(lines), np.concatenate(rapids), circles, _tools(tools))
+
+
+def _tools(runs: list[tuple[tuple[float, float, float], int]]) -> NDArray | None:
+    """(n,3) tool length offsets of the samples from (offset, count) per event; None if all zero."""
+    if all(tool == (0.0, 0.0, 0.0) for tool, _ in runs):
+        return None
+    return np.repeat(np.array([tool for tool, _ in runs]), [n for _, n in runs], axis=0)
 
 
 def _to_machine(event: Line | Arc, program: NDArray) -> NDArray:
@@ -150,7 +159,7 @@ def contour_error(machine, commanded: SampledPath, nominal: SampledPath, feed_ef
     if len(cmd) == 0:
         return ContourReport(0.0, 0.0, 0, (0.0, 0.0, 0.0), 0, [])
     # run the whole path (rapids too: they set the direction of approach), judge the cuts
-    actual = _actual(machine, commanded.points, commanded.feed, feed_effects)[cut]
+    actual = _actual(machine, commanded, feed_effects)[cut]
     nominal_path = nominal.points[~nominal.rapid] if (~nominal.rapid).any() else nominal.points
     error = distance_to_path(actual, nominal_path) * 1000.0
     worst = int(np.argmax(error))
@@ -165,15 +174,16 @@ def contour_error(machine, commanded: SampledPath, nominal: SampledPath, feed_ef
     )
 
 
-def _actual(machine, cmd: NDArray, feed: NDArray, feed_effects: bool) -> NDArray:
+def _actual(machine, commanded: SampledPath, feed_effects: bool) -> NDArray:
     """Where the tool goes: geometry with the direction of travel along the path, plus effects."""
+    cmd, feed = commanded.points, commanded.feed
     if len(cmd) < 2:
-        return cmd + machine.deviation(cmd)
+        return cmd + machine.deviation(cmd, None, commanded.tools)
     from ncpp.machine import Trajectory
 
     speed = float(np.median(feed[feed > 0])) if (feed > 0).any() else 1000.0
     machine = machine if feed_effects else machine.replace(effects=())
-    return machine.simulate(Trajectory(cmd, speed))
+    return machine.simulate(Trajectory(cmd, speed), commanded.tools)
 
 
 def _circle_traces(machine, commanded: SampledPath, nominal: SampledPath, feed_effects: bool) -> list:
@@ -182,7 +192,7 @@ def _circle_traces(machine, commanded: SampledPath, nominal: SampledPath, feed_e
     for centre, radius, plane, _ in nominal.circles:
         i, j, _ = PLANE_AXES[plane]
         cut = ~commanded.rapid
-        actual = _actual(machine, commanded.points, commanded.feed, feed_effects)[cut]
+        actual = _actual(machine, commanded, feed_effects)[cut]
         rel = actual - centre
         r = np.hypot(rel[:, i], rel[:, j])
         near = 0.05  # mm: the tool within this of the nominal circle is on it (errors are µm)

@@ -58,7 +58,15 @@ def add_placement_arguments(p: argparse.ArgumentParser) -> None:
         help="LinuxCNC parameter file (linuxcnc.var) holding the control's G54-G59.3 zeros, the system in effect, "
         "G92 and the G28/G30 positions; --work-offset overrides its systems",
     )
-    p.add_argument("--var-units", choices=("mm", "inch"), default="mm", help="units of --var-file: the INI's [TRAJ]LINEAR_UNITS (default mm)")
+    p.add_argument(
+        "--tool-table",
+        metavar="FILE",
+        help="LinuxCNC tool table (tool.tbl): the tool lengths G43 applies, which move the axes and lengthen the Abbe arm; "
+        "without it G43 applies length 0, with a warning",
+    )
+    p.add_argument(
+        "--var-units", choices=("mm", "inch"), default="mm", help="units of --var-file and --tool-table: the INI's [TRAJ]LINEAR_UNITS (default mm)"
+    )
 
 
 # A worker process pays off from about this size: it costs ~0.3 s to start (overlapped
@@ -88,10 +96,10 @@ def zero_argument(text: str) -> tuple[str, tuple[float, float, float]]:
 
 
 def work_offsets(args: argparse.Namespace):
-    """The control's zeros from --var-file and --work-offset."""
+    """The control's zeros and tool table from --var-file, --work-offset and --tool-table."""
     from ncpp.motion.offsets import UNIT_MM, WorkOffsets
 
-    return WorkOffsets.given(dict(args.work_offset), args.var_file, UNIT_MM[args.var_units])
+    return WorkOffsets.given(dict(args.work_offset), args.var_file, UNIT_MM[args.var_units], args.tool_table)
 
 
 def error_source(args: argparse.Namespace):

@@ -54,7 +54,7 @@ def run(args: argparse.Namespace) -> int:
     from ncpp.program.parser import parse_stream
 
     warnings = Warnings(strict=args.strict)
-    offsets = work_offsets(args) if args.work_offset or args.var_file else None
+    offsets = work_offsets(args) if args.work_offset or args.var_file or args.tool_table else None
     out = sys.stdout
     with open_input(args.input) as (stream, name):
         for event in interpret(parse_stream(stream, name), file=name, warnings=warnings, offsets=offsets):

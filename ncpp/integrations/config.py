@@ -12,8 +12,9 @@ The machine file, first found wins:
 command line, else from that config file, else the defaults: `work_offset`
 is G54's zero ([x, y, z] machine mm) or a table of zeros by G word;
 `var_file` names LinuxCNC's parameter file (`var_units` "mm" or "inch", the
-INI's [TRAJ]LINEAR_UNITS), which `work_offset` overrides.  A relative
-`machine` or `var_file` path in a config file is relative to the file's
+INI's [TRAJ]LINEAR_UNITS), which `work_offset` overrides, and `tool_table` its
+tool table (the INI's [EMCIO]TOOL_TABLE, same units).  A relative `machine`,
+`var_file` or `tool_table` path in a config file is relative to the file's
 folder.  With no machine file anywhere the filter passes programs through
 unchanged.
 
@@ -22,6 +23,7 @@ unchanged.
     tolerance = 0.001
     work_offset = [400.0, 350.0, 300.0]          # or: work_offset = {G54 = [...], G55 = [...]}
     # var_file = "~/linuxcnc/configs/mill/linuxcnc.var"
+    # tool_table = "~/linuxcnc/configs/mill/tool.tbl"
 """
 
 from __future__ import annotations
@@ -35,7 +37,8 @@ from typing import Mapping
 from ncpp.errors import Location, NcppError
 from ncpp.motion.offsets import UNIT_MM, Vector, WorkOffsets, system_number
 
-KEYS = ("machine", "tolerance", "work_offset", "var_file", "var_units")
+KEYS = ("machine", "tolerance", "work_offset", "var_file", "var_units", "tool_table")
+PATH_KEYS = ("machine", "var_file", "tool_table")  # relative to the config file's folder
 DEFAULT_TOLERANCE = 0.001
 
 
@@ -46,11 +49,12 @@ class Settings:
     zeros: Mapping[str, Vector] = field(default_factory=dict)  # G word -> machine mm (work_offset)
     var_file: str | None = None
     var_units: str = "mm"
+    tool_table: str | None = None
     origin: str = "defaults"  # where the machine file was named: "--machine", "NCPP_MACHINE" or a config path
 
     def offsets(self) -> WorkOffsets:
         """The zeros the control holds, as these settings say them."""
-        return WorkOffsets.given(self.zeros, self.var_file, UNIT_MM[self.var_units])
+        return WorkOffsets.given(self.zeros, self.var_file, UNIT_MM[self.var_units], self.tool_table)
 
 
 def config_paths(cwd: Path | None = None, env: Mapping[str, str] | None = None) -> list[Path]:
@@ -71,10 +75,11 @@ def read_config(path: Path) -> dict:
     if unknown:
         raise NcppError(f"unknown key(s) {', '.join(unknown)} (known: {', '.join(KEYS)})", Location(str(path)))
     config: dict = {}
-    if "machine" in data:
-        if not isinstance(data["machine"], str):
-            raise NcppError("`machine` must be a path string", Location(str(path)))
-        config["machine"] = str((path.parent / Path(data["machine"]).expanduser()).resolve())
+    for key in PATH_KEYS:
+        if key in data:
+            if not isinstance(data[key], str):
+                raise NcppError(f"`{key}` must be a path string", Location(str(path)))
+            config[key] = str((path.parent / Path(data[key]).expanduser()).resolve())
     if "tolerance" in data:
         tolerance = data["tolerance"]
         if isinstance(tolerance, bool) or not isinstance(tolerance, (int, float)) or not tolerance > 0:
@@ -82,10 +87,6 @@ def read_config(path: Path) -> dict:
         config["tolerance"] = float(tolerance)
     if "work_offset" in data:
         config["zeros"] = _zeros(data["work_offset"], path)
-    if "var_file" in data:
-        if not isinstance(data["var_file"], str):
-            raise NcppError("`var_file` must be a path string", Location(str(path)))
-        config["var_file"] = str((path.parent / Path(data["var_file"]).expanduser()).resolve())
     if "var_units" in data:
         if data["var_units"] not in UNIT_MM:
             raise NcppError('`var_units` must be "mm" or "inch"', Location(str(path)))
@@ -114,6 +115,7 @@ def find_settings(
     zeros: Mapping[str, Vector] | None = None,
     var_file: str | None = None,
     var_units: str | None = None,
+    tool_table: str | None = None,
     *,
     cwd: Path | None = None,
     env: Mapping[str, str] | None = None,
@@ -138,5 +140,6 @@ def find_settings(
         zeros=zeros or config.get("zeros", {}),
         var_file=var_file or config.get("var_file"),
         var_units=var_units or config.get("var_units", "mm"),
+        tool_table=tool_table or config.get("tool_table"),
         origin=origin,
     )

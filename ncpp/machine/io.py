@@ -8,7 +8,8 @@ A complete example::
     chain = "XZFY"                 # workpiece ... F ... tool
 
     [offsets]
-    tool = [0.0, 0.0, -200.0]      # tool point in the tool carriage, mm
+    tool = [0.0, 0.0, -200.0]      # tool point in the tool carriage, mm, with no tool length
+                                   # offset (G49); G43's offset T puts the tip at tool - T
     work = [0.0, 0.0, 0.0]         # work point in the workpiece carriage, mm
 
     [offsets.reference]            # axis reference points (where measured), mm

@@ -79,7 +79,7 @@ class Machine:
 
     name: str
     chain: str
-    tool: Vec3 = (0.0, 0.0, 0.0)
+    tool: Vec3 = (0.0, 0.0, 0.0)  # the tool point with no tool length offset in effect (G49): the gauge point
     work: Vec3 = (0.0, 0.0, 0.0)
     references: Mapping[str, Vec3] = field(default_factory=dict)
     limits: Mapping[str, tuple[float, float]] = field(default_factory=dict)
@@ -180,10 +180,11 @@ class Machine:
             delta[axis], eps[axis] = motions[:3].T, motions[3:].T
         return delta, eps
 
-    def _kinematics(self, pts: NDArray, dirs: NDArray | None):
+    def _kinematics(self, pts: NDArray, dirs: NDArray | None, tool_offset: NDArray | None = None):
         delta, eps = self.error_motions(pts, dirs)
         chain, tool, refs, sq = self._frame
-        return chain, pts, tool, refs, delta, eps, sq
+        # the control's tool length offset: the axes are that much further, the tip that much nearer
+        return chain, pts, tool if tool_offset is None else tool - tool_offset, refs, delta, eps, sq
 
     @cached_property
     def _frame(self) -> tuple:
@@ -197,24 +198,27 @@ class Machine:
         """The axes' direction errors from squareness (chain.direction_errors), once."""
         return direction_errors(self._frame[3])
 
-    def _blockwise(self, kernel, P: ArrayLike, direction: ArrayLike | None) -> NDArray:
+    def _blockwise(self, kernel, P: ArrayLike, direction: ArrayLike | None, tool_offset: ArrayLike | None = None) -> NDArray:
         pts = np.ascontiguousarray(as_points(P).T).T  # columns contiguous, like the algebra
         dirs = None if direction is None else np.broadcast_to(np.asarray(direction, dtype=float), pts.shape)
+        tools = None if tool_offset is None else np.broadcast_to(np.asarray(tool_offset, dtype=float), pts.shape)
         out = np.empty(pts.shape)
         for start in range(0, len(pts), CHUNK):
             block = slice(start, start + CHUNK)
-            out[block] = kernel(*self._kinematics(pts[block], None if dirs is None else dirs[block]))
+            out[block] = kernel(*self._kinematics(pts[block], None if dirs is None else dirs[block], None if tools is None else tools[block]))
         return _shaped_like(out, P)
 
-    def deviation(self, P: ArrayLike, direction: ArrayLike | None = None) -> NDArray:
+    def deviation(self, P: ArrayLike, direction: ArrayLike | None = None, tool_offset: ArrayLike | None = None) -> NDArray:
         """Actual minus nominal tool point relative to the workpiece, mm.
 
         P: (n,3) axis positions X, Y, Z in mm (or one (3,) point).
         direction: optional (n,3) travel signs +1/−1/0 for direction-dependent
-        tables (None or 0: the mean of the + and − tables)."""
-        return self._blockwise(partial(exact_deviation, directions=self._directions), P, direction)
+        tables (None or 0: the mean of the + and − tables).
+        tool_offset: optional (n,3) tool length offsets in effect (the control's
+        G43), mm: the tool point is `tool` minus it, a longer Abbe arm for a longer tool."""
+        return self._blockwise(partial(exact_deviation, directions=self._directions), P, direction, tool_offset)
 
-    def static_deviation(self, P: ArrayLike, direction: ArrayLike | None = None) -> NDArray:
+    def static_deviation(self, P: ArrayLike, direction: ArrayLike | None = None, tool_offset: ArrayLike | None = None) -> NDArray:
         """Geometric deviation plus the effects that depend on position alone
         (scale, squareness, straightness, cyclic, angular), mm: what
         compensation can cancel.  A straightness bow without `range_mm` spans
@@ -222,7 +226,7 @@ class Machine:
         from ncpp.machine.trajectory import Trajectory
 
         pts = as_points(P)
-        total = self.deviation(pts, direction)
+        total = self.deviation(pts, direction, tool_offset)
         static = [e for e in self.effects if e.static]
         if static and len(pts):
             padded = pts if len(pts) >= 2 else np.vstack([pts, pts])
@@ -285,11 +289,12 @@ class Machine:
             total = total * Rotation.from_rotvec(sign * eps[axis])
         return total.as_rotvec()
 
-    def simulate(self, trajectory: "Trajectory") -> NDArray:
+    def simulate(self, trajectory: "Trajectory", tool_offset: ArrayLike | None = None) -> NDArray:
         """Actual tool positions (n,3) mm along a sampled trajectory: command +
-        geometric deviation (direction of travel from the trajectory) + effects."""
+        geometric deviation (direction of travel from the trajectory; `tool_offset`
+        (n,3): the tool length offsets in effect, as in `deviation`) + effects."""
         pts = trajectory.positions
-        actual = pts + self.deviation(pts, trajectory.directions())
+        actual = pts + self.deviation(pts, trajectory.directions(), tool_offset)
         for effect in self.effects:
             actual = actual + effect.apply(trajectory, machine=self)
         return actual

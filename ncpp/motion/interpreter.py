@@ -8,8 +8,8 @@ the program origin sits in machine coordinates.
 
 Scope: modal G0-G3, planes, G90/G91, G90.1/G91.1, G20/G21 (state converted
 on a switch, like LinuxCNC), G54-G59.3, G10 L2/L20 (no rotation), G92 family,
-G52, G53, G28/G30, G43 (tool lengths read as zero: the control's tool table
-is not known) / G43.1 / G49, F and inverse time, IJK and R arcs, helices,
+G52, G53, G28/G30, T, M6, M61, G43 / G43.1 / G43.2 H / G49 (lengths from the
+control's tool table, `tools.py`; zero when it is not told), F and inverse time, IJK and R arcs, helices,
 P turns, parameters and expressions, and Fanuc corner rounding and
 chamfering between two lines (`,R` `,C`, `G1 ... R`: a one-move look-ahead).
 Anything else (o-word and Fanuc macro
@@ -74,7 +74,7 @@ OUT_OF_SCOPE_G = {
     **{c: "cutter compensation" for c in (41.0, 42.0, 41.1, 42.1)},
     **{c: "UVW-plane arcs" for c in (17.1, 18.1, 19.1)},
     7.0: "lathe diameter mode",
-    43.2: "additional tool length offset",
+    43.2: "additional tool length offset without H",
     15.0: "polar coordinates", 16.0: "polar coordinates",
     50.0: "scaling", 51.0: "scaling", 50.1: "mirroring", 51.1: "mirroring",
     54.1: "extended work offsets", 65.0: "macro call", 66.0: "modal macro call", 67.0: "modal macro call",
@@ -148,7 +148,11 @@ class Interpreter:
         self.g5x = [[0.0] * 9 for _ in range(10)]  # index 1..9: G54..G59.3
         self.g92 = [0.0] * 9
         self.g92_saved = [0.0] * 9
-        self.tool = [0.0] * 9
+        self.tool = [0.0] * 9  # the tool length offset in effect, program units
+        self.tools = offsets.tools if offsets is not None else None  # the control's tool table
+        self.selected_tool = 0  # T
+        self.spindle_tool = 0  # M6, M61 (0: none)
+        self.untold_tools = offsets is not None and offsets.tools is None  # warned at the first G43 that reads the table
         self.home = {28: [0.0] * 9, 30: [0.0] * 9}  # G28/G30 positions, machine coordinates
         self.uses_extra_axes = False
         self.params = Parameters(self._system_parameter)
@@ -260,6 +264,7 @@ class Interpreter:
                 self.arc_absolute,
                 self.inch,
                 tuple(offset[i] + self.g92[i] + self.tool[i] for i in range(3)),  # type: ignore[arg-type]
+                tuple(self.tool[:3]),  # type: ignore[arg-type]
             )
         return self._context
 
@@ -467,8 +472,14 @@ class Interpreter:
             self._set(plane=int(gcodes[2][0]))
         if 6 in gcodes:
             self._set_units(gcodes[6][0] == 20.0)
+        if "T" in words:
+            self.selected_tool = self._tool_number(words["T"], block)
+        if 6.0 in mcodes:
+            self.spindle_tool = self.selected_tool
+        if 61.0 in mcodes and "Q" in words:
+            self.spindle_tool = self._tool_number(words["Q"], block)
         if 8 in gcodes:
-            self._tool_length(gcodes[8][0], words)
+            self._tool_length(gcodes[8], words, block)
         if 12 in gcodes:
             number = _COORD_SYSTEM[gcodes[12][0]]
             if number in self.untold:
@@ -587,7 +598,7 @@ class Interpreter:
     def _check_scope(self, words: dict, gcodes: dict) -> None:
         for value, item in gcodes.values():
             reason = OUT_OF_SCOPE_G.get(value)
-            if reason is not None:
+            if reason is not None and not (value == 43.2 and "H" in words):
                 raise _OutOfScope(f"{reason} G{value:g}", item.start + 1)
         for letter, (_, item) in words.items():
             if letter in ("@", "^"):
@@ -619,15 +630,46 @@ class Interpreter:
             self.pos[i] += old[i] - new[i]
         self._context = None
 
-    def _tool_length(self, code: float, words: dict) -> None:
+    def _tool_length(self, code_item: tuple, words: dict, block: Block) -> None:
+        """G43 [H]: the offsets of tool H (0 or none: the tool in the spindle); G43.2 H: those
+        added; G43.1: the axis words; G49: none.  In program units, as the control applies them."""
+        code, item = code_item
         new = [0.0] * 9
         if code == 43.1:
             for letter, (value, _) in words.items():
                 if letter in AXIS_INDEX:
                     new[AXIS_INDEX[letter]] = value
-        # G43 [H]: the control's tool table is unknown; lengths read as zero like the rs274 oracle's table
+        elif code in (43.0, 43.2):
+            number = self._tool_number(words["H"], block) if "H" in words else 0
+            table = self._table_offsets(number or self.spindle_tool, words.get("H", (0, item))[1], block)
+            scale = 1 / MM_PER_INCH if self.inch else 1.0
+            new = [value * scale if i in LINEAR else value for i, value in enumerate(table)]
+            if code == 43.2:
+                new = [old + added for old, added in zip(self.tool, new)]
         self._shift(self.tool, new)
         self.tool = new
+
+    def _tool_number(self, word: tuple, block: Block) -> int:
+        value, item = word
+        if value != int(value) or value < 0:
+            self._fail(f"{item.letter} word is not a tool number", block, item)
+        number = int(value)
+        if self.tools is not None and self.tools.offset(number) is None:
+            self._fail(f"Requested tool {number} not found in the tool table", block, item)
+        return number
+
+    def _table_offsets(self, number: int, item, block: Block) -> tuple[float, ...]:
+        """Tool `number`'s offsets in mm; zero when ncpp is not told the table (warned once)."""
+        if self.tools is None:
+            if self.untold_tools and self.warnings is not None:
+                self.untold_tools = False
+                self.warnings.warn(
+                    "G43 applies a tool length from the control's tool table, which ncpp is not told: "
+                    "compensated with length 0 (give --tool-table)",
+                    Location(self.file, block.line, item.start + 1),
+                )
+            return (0.0,) * 9
+        return self.tools.offset(number)  # type: ignore[return-value]  # checked by `_tool_number`
 
     def _warn_untold(self, number: int, block: Block, item) -> None:
         """Once per system: its zero is taken as the machine zero, which is likely wrong."""

@@ -4,7 +4,8 @@ A program says its moves in program coordinates; the machine's errors are a
 function of machine position.  The control adds the work offset of the
 coordinate system in effect (G54-G59.3), the G92 offset and the tool length;
 the program itself does not say them (unless it sets them with G10 L2/L20 or
-G92).  `WorkOffsets` is what the control holds, as the operator set it: the
+G92) and takes the tool lengths from the control's tool table (`tools.py`).
+`WorkOffsets` is what the control holds, as the operator set it: the
 interpreter starts from it, so every event's `Context.offset` is the true
 machine minus program position and G53 moves land where the control puts
 them.
@@ -12,6 +13,7 @@ them.
     WorkOffsets.of({"G54": (400, 350, 300), "G55": (600, 350, 300)})
     WorkOffsets.at((400, 350, 300))                 # G54 only
     WorkOffsets.from_var_file("linuxcnc.var")      # LinuxCNC's parameter file
+    WorkOffsets.given({}, "linuxcnc.var", tool_table="tool.tbl")  # and its tool table
 
 Positions are machine mm (X, Y, Z).
 """
@@ -23,6 +25,7 @@ from pathlib import Path
 from typing import Mapping
 
 from ncpp.errors import Location, NcppError
+from ncpp.motion.tools import ToolTable
 
 Vector = tuple[float, float, float]
 SYSTEMS = ("G54", "G55", "G56", "G57", "G58", "G59", "G59.1", "G59.2", "G59.3")  # rs274ngc's numbers 1..9
@@ -42,13 +45,15 @@ def _system_x(number: int) -> int:
 class WorkOffsets:
     """The zeros the control holds: per coordinate system (1..9: G54..G59.3) its
     machine position in mm, None when ncpp is not told it; the system in effect at
-    the program's start; the G92 offset in effect; the G28 and G30 positions."""
+    the program's start; the G92 offset in effect; the G28 and G30 positions; and
+    its tool table (None: not told, G43 applies length 0)."""
 
     systems: tuple[Vector | None, ...] = (None,) * 9
     active: int = 1
     g92: Vector = (0.0, 0.0, 0.0)
     g28: Vector = (0.0, 0.0, 0.0)
     g30: Vector = (0.0, 0.0, 0.0)
+    tools: ToolTable | None = None
 
     @classmethod
     def of(cls, zeros: Mapping[str, Vector], active: str = "G54") -> "WorkOffsets":
@@ -76,11 +81,15 @@ class WorkOffsets:
         return cls(systems, active if 1 <= active <= 9 else 1, g92 or zero, *homes)
 
     @classmethod
-    def given(cls, zeros: Mapping[str, Vector], var_file: str | Path | None = None, unit_mm: float = 1.0) -> "WorkOffsets":
+    def given(
+        cls, zeros: Mapping[str, Vector], var_file: str | Path | None = None, unit_mm: float = 1.0, tool_table: str | Path | None = None
+    ) -> "WorkOffsets":
         """What a user says: a parameter file, if any (else G54 at the machine zero), with
-        `zeros` (G word -> machine mm) over it."""
+        `zeros` (G word -> machine mm) over it, and a tool table, if any (LinuxCNC's
+        files are both in the machine's units, `unit_mm`)."""
         base = cls.from_var_file(var_file, unit_mm) if var_file else AT_MACHINE_ZERO
-        return base.with_zeros(zeros)
+        tools = ToolTable.from_file(tool_table, unit_mm) if tool_table else None
+        return replace(base.with_zeros(zeros), tools=tools)
 
     def with_zeros(self, zeros: Mapping[str, Vector]) -> "WorkOffsets":
         """These systems' zeros replaced (the command line over a parameter file)."""

@@ -42,6 +42,12 @@ class Context:
     arc_absolute: bool = False  # G90.1 / G91.1 (IJK absolute)
     inch: bool = False  # G20 / G21
     offset: Point = (0.0, 0.0, 0.0)  # machine minus program position (work offset, G92, tool length), program units
+    tool: Point = (0.0, 0.0, 0.0)  # the tool length offset (in `offset`): the tool tip is this far from the gauge point
+
+    @property
+    def tool_mm(self) -> Point:
+        s = self.unit_mm
+        return (self.tool[0] * s, self.tool[1] * s, self.tool[2] * s)
 
     @property
     def unit_mm(self) -> float:

@@ -23,9 +23,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ncpp.motion.segments import PLANE_AXES, Arc, Event, Line
-from ncpp.passes.context import PassContext
+from ncpp.passes.context import PassContext, deviation
 from ncpp.passes.kernels import run_ahead
-from ncpp.passes.geometry import chunked, compensate, frames, points
+from ncpp.passes.geometry import chunked, compensate, frames, points, rows_of
 from ncpp.passes.travel import Travel, grid, hold, quantize, steps
 
 # Compensations per line at most: each changes a direction only where a
@@ -67,6 +67,7 @@ class _Rows:
     end: NDArray  # (n,3)
     offsets: NDArray  # (n,3) machine minus program, program units
     scales: NDArray  # (n,) mm per program unit
+    tools: NDArray | None  # (n,3) tool length offsets, mm (None: none)
     free: NDArray  # (n,) lines no pass has changed: their ends are compensated here
     arc: NDArray  # (n,) pieces replace_arcs made (arcs, and lines for slivers)
     pieces: NDArray  # (n,) the lines among them
@@ -75,12 +76,12 @@ class _Rows:
 
 
 def _rows(segs: list, directional: bool) -> _Rows:
-    offsets, scales = frames(segs)
+    offsets, scales, tools = frames(segs)
     line = np.array([type(e) is Line for e in segs])
     changed = np.array([e.changed for e in segs])
     free = line & ~changed
     return _Rows(
-        points([e.start for e in segs]), points([e.end for e in segs]), offsets, scales, free, changed, changed & line,
+        points([e.start for e in segs]), points([e.end for e in segs]), offsets, scales, tools, free, changed, changed & line,
         _arc_assumed(segs, changed) if directional else None, np.array([e.block.line for e in segs]),
     )  # fmt: skip
 
@@ -193,7 +194,7 @@ def _plain(rows: _Rows, ctx: PassContext) -> _Solved:
     start, end, free, offsets, scales = rows.start, rows.end.copy(), rows.free, rows.offsets, rows.scales
     at = np.flatnonzero(free)
     if at.size:
-        end[at] = compensate(end[at], offsets[at], scales[at], rows.lines[at], ctx, np.sign(end[at] - start[at]))
+        end[at] = compensate(end[at], offsets[at], scales[at], rows.lines[at], ctx, np.sign(end[at] - start[at]), rows_of(rows.tools, at))
     none = np.zeros(len(free), dtype=bool)
     return _Solved(start, end, free, none, none, start, np.ones(start.shape, dtype=bool), np.zeros(len(free)))
 
@@ -203,8 +204,8 @@ class _Commands:
     the direction last asked: the rounds ask again for rows whose direction is
     unchanged, and the reversal check and the reversal steps ask for the same."""
 
-    def __init__(self, lines: NDArray, wanted: dict[str, NDArray], offsets: NDArray, scales: NDArray, step: NDArray, ctx: PassContext):
-        self.lines, self.wanted, self.offsets, self.scales, self.step, self.ctx = lines, wanted, offsets, scales, step, ctx
+    def __init__(self, rows: _Rows, wanted: dict[str, NDArray], step: NDArray, ctx: PassContext):
+        self.rows, self.wanted, self.step, self.ctx = rows, wanted, step, ctx
         self.values = {which: np.empty_like(p) for which, p in wanted.items()}
         self.directions = {which: np.full(p.shape, np.nan) for which, p in wanted.items()}
 
@@ -213,7 +214,8 @@ class _Commands:
         stale = (self.directions[which][rows] != d).any(axis=1)
         todo, d_todo = rows[stale], d[stale]
         if todo.size:
-            c = compensate(self.wanted[which][todo], self.offsets[todo], self.scales[todo], self.lines[todo], self.ctx, d_todo)
+            segs = self.rows
+            c = compensate(self.wanted[which][todo], segs.offsets[todo], segs.scales[todo], segs.lines[todo], self.ctx, d_todo, rows_of(segs.tools, todo))
             self.values[which][todo] = quantize(c, self.step[todo])
             self.directions[which][todo] = d_todo
         return self.values[which][rows]
@@ -234,7 +236,7 @@ def _directional(rows: _Rows, ctx: PassContext, travel: Travel) -> _Solved:
 
     out_start, out_end = start_p.copy(), end_p.copy()
     compensated = end_p.copy()  # line ends before _settle leaves axes standing
-    commands = _Commands(rows.lines, {"start": start_p, "end": end_p}, offsets, scales, step, ctx)
+    commands = _Commands(rows, {"start": start_p, "end": end_p}, step, ctx)
     assumed = rows.assumed
     used = np.full(start_p.shape, np.nan)  # the directions each row is compensated with
     used[arc] = assumed[arc]
@@ -246,7 +248,7 @@ def _directional(rows: _Rows, ctx: PassContext, travel: Travel) -> _Solved:
             compensated[redo] = commands("end", redo, d[redo])
         shift = np.flatnonzero(arc & (d != used).any(axis=1))
         if shift.size:
-            _shift_arcs(shift, start_p, end_p, offsets, scales, d, assumed, step, ctx, out_start, out_end)
+            _shift_arcs(shift, rows, d, assumed, step, ctx, out_start, out_end)
         used[redo], used[shift] = d[redo], d[shift]
         out_end[free] = compensated[free]
         _hold_pieces_still(pieces, d, travel.held, limit, out_start, out_end)
@@ -395,16 +397,18 @@ def _arc_assumed(segs: list, arc: NDArray) -> NDArray:
     return out
 
 
-def _shift_arcs(rows, start_p, end_p, offsets, scales, d, assumed, step, ctx, out_start, out_end) -> None:
-    """Move arc pieces by the change of the error between the directions they
-    were compensated with (`assumed`) and those they are travelled in (`d`)."""
-    pts = np.stack([start_p[rows], end_p[rows]], axis=1)  # (r,2,3) program
-    scale = scales[rows, None, None]
-    pairs = ((pts + offsets[rows, None, :]) * scale).reshape(-1, 3)
-    act, was = np.repeat(d[rows], 2, axis=0), np.repeat(assumed[rows], 2, axis=0)
-    delta = (ctx.model.deviation(pairs, act) - ctx.model.deviation(pairs, was)).reshape(pts.shape) / scale
-    out_start[rows] = quantize(pts[:, 0] - delta[:, 0], step[rows])
-    out_end[rows] = quantize(pts[:, 1] - delta[:, 1], step[rows])
+def _shift_arcs(at, rows: _Rows, d, assumed, step, ctx, out_start, out_end) -> None:
+    """Move arc pieces (rows `at`) by the change of the error between the directions
+    they were compensated with (`assumed`) and those they are travelled in (`d`)."""
+    pts = np.stack([rows.start[at], rows.end[at]], axis=1)  # (r,2,3) program
+    scale = rows.scales[at, None, None]
+    pairs = ((pts + rows.offsets[at, None, :]) * scale).reshape(-1, 3)
+    act, was = np.repeat(d[at], 2, axis=0), np.repeat(assumed[at], 2, axis=0)
+    tool = None if rows.tools is None else np.repeat(rows.tools[at], 2, axis=0)
+    change = deviation(ctx.model, pairs, act, tool) - deviation(ctx.model, pairs, was, tool)
+    delta = change.reshape(pts.shape) / scale
+    out_start[at] = quantize(pts[:, 0] - delta[:, 0], step[at])
+    out_end[at] = quantize(pts[:, 1] - delta[:, 1], step[at])
 
 
 def _snap_limit(step: NDArray, scales: NDArray) -> NDArray:

@@ -17,10 +17,19 @@ class ErrorMap(Protocol):
     """Anything that says where the tool really goes: a `Machine`, or a map
     built straight from one measurement (`ncpp.passes.measured`)."""
 
-    def deviation(self, P: NDArray, direction: NDArray | None = None) -> NDArray:
+    def deviation(self, P: NDArray, direction: NDArray | None = None, tool_offset: NDArray | None = None) -> NDArray:
         """(n,3) actual minus nominal tool point, mm, for (n,3) axis positions in mm
-        reached with travel signs `direction` (n,3) (None: unknown, mean of both)."""
+        reached with travel signs `direction` (n,3) (None: unknown, mean of both),
+        with the (n,3) tool length offsets `tool_offset` in effect, mm (None: none)."""
         ...
+
+
+def deviation(model: ErrorMap, P: NDArray, direction: NDArray | None, tool_offset: NDArray | None) -> NDArray:
+    """The map's deviation, told the tool length offsets when there are any (a map
+    that knows no tools, such as a test's, is asked without them)."""
+    if tool_offset is None:
+        return model.deviation(P, direction)
+    return model.deviation(P, direction, tool_offset)
 
 
 @dataclass(frozen=True)

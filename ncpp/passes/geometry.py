@@ -16,6 +16,7 @@ from ncpp.passes.inverse import command_for
 
 T = TypeVar("T")
 
+_NO_TOOL = (0.0, 0.0, 0.0)
 # Events per vectorised batch: large enough to amortise numpy's per-call cost,
 # small enough that memory stays flat however long the program.
 CHUNK = 2048
@@ -42,12 +43,15 @@ def spliced(items: list[T], at: list[int], replacements: list[list[T]]) -> list[
     return out
 
 
-def frames(segments: Sequence[Line | Arc]) -> tuple[NDArray, NDArray]:
-    """(n,3) offsets (machine minus program, program units) and (n,) mm per unit."""
+def frames(segments: Sequence[Line | Arc]) -> tuple[NDArray, NDArray, NDArray | None]:
+    """(n,3) offsets (machine minus program, program units), (n,) mm per unit, and
+    (n,3) tool length offsets in mm (None when no segment has one)."""
     every = [s.context for s in segments]
     if every and every.count(every[0]) == len(every):  # one context (mostly one object: `count` tries `is` first)
         c = every[0]
-        return np.tile(np.asarray(c.offset, dtype=float), (len(every), 1)), np.full(len(every), 25.4 if c.inch else 1.0)
+        n, scale = len(every), 25.4 if c.inch else 1.0
+        tools = None if c.tool == _NO_TOOL else np.tile(np.asarray(c.tool, dtype=float) * scale, (n, 1))
+        return np.tile(np.asarray(c.offset, dtype=float), (n, 1)), np.full(n, scale), tools
     # a program has few contexts and consecutive segments share one: look each up once
     known: dict[int, int] = {}
     contexts, rows = [], []
@@ -61,7 +65,14 @@ def frames(segments: Sequence[Line | Arc]) -> tuple[NDArray, NDArray]:
     index = np.array(rows, dtype=np.intp)
     offsets = np.array([c.offset for c in contexts], dtype=float).reshape(-1, 3)[index]
     scales = np.array([25.4 if c.inch else 1.0 for c in contexts])[index]
-    return offsets, scales
+    if all(c.tool == _NO_TOOL for c in contexts):
+        return offsets, scales, None
+    return offsets, scales, np.array([c.tool for c in contexts], dtype=float).reshape(-1, 3)[index] * scales[:, None]
+
+
+def rows_of(tools: NDArray | None, rows) -> NDArray | None:
+    """`tools[rows]` of `frames`' tool offsets (None stays None)."""
+    return None if tools is None else tools[rows]
 
 
 def points(coordinates: Sequence[tuple[float, float, float]]) -> NDArray:
@@ -76,19 +87,22 @@ def compensate(
     lines: NDArray,
     ctx: PassContext,
     directions: NDArray | None = None,
+    tools: NDArray | None = None,
 ) -> NDArray:
     """Compensated program points for wanted program points.
 
     points (n,m,3) or (n,3): point(s) of segment k in its program frame;
     offsets (n,3), scales (n,); lines (n,): the line of segment k's block (numbers,
     not events: this runs in a worker process too); directions: travel signs shaped
-    like points, for direction-dependent (reversal) error tables.  Refuses corrections
+    like points, for direction-dependent (reversal) error tables; tools (n,3): the tool length
+    offsets in effect, mm (`frames`; None: none).  Refuses corrections
     beyond the machine's limit and commands outside its travel, naming the line."""
     shape = points.shape
     pts = points.reshape(len(lines), -1, 3)
     wanted = (pts + offsets[:, None, :]) * scales[:, None, None]
     signs = None if directions is None else np.asarray(directions, dtype=float).reshape(-1, 3)
-    command = command_for(ctx.model, wanted.reshape(-1, 3), signs).reshape(wanted.shape)
+    tool = None if tools is None else np.broadcast_to(tools[:, None, :], wanted.shape).reshape(-1, 3)
+    command = command_for(ctx.model, wanted.reshape(-1, 3), signs, tool).reshape(wanted.shape)
     _check(wanted, command, lines, ctx)
     return (command / scales[:, None, None] - offsets[:, None, :]).reshape(shape)
 

@@ -11,6 +11,9 @@
   transverse) deviation along its axis, from the ISO 230-2 mean
   bidirectional deviation per target, interpolated linearly and held
   constant beyond the measured range.
+
+Both were measured with one tool; they hold whatever tool length offset the
+program applies (they know no Abbe arm to lengthen).
 """
 
 from __future__ import annotations
@@ -35,7 +38,7 @@ class RadialMap:
     angle: NDArray  # (n,) rad, sorted, in [0, 2π)
     delta_r: NDArray  # (n,) mm
 
-    def deviation(self, P: NDArray, direction: NDArray | None = None) -> NDArray:
+    def deviation(self, P: NDArray, direction: NDArray | None = None, tool_offset: NDArray | None = None) -> NDArray:
         P = np.atleast_2d(np.asarray(P, dtype=float))
         i, j = self.axes
         u, v = P[:, i] - self.centre[i], P[:, j] - self.centre[j]
@@ -57,7 +60,7 @@ class AxisMap:
     position: NDArray  # (n,) mm, ascending
     deviation_mm: NDArray  # (n,3) mm
 
-    def deviation(self, P: NDArray, direction: NDArray | None = None) -> NDArray:
+    def deviation(self, P: NDArray, direction: NDArray | None = None, tool_offset: NDArray | None = None) -> NDArray:
         P = np.atleast_2d(np.asarray(P, dtype=float))
         x = P[:, self.axis]
         return np.column_stack([np.interp(x, self.position, self.deviation_mm[:, k]) for k in range(3)])

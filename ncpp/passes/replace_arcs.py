@@ -24,7 +24,7 @@ from numpy.typing import NDArray
 from ncpp.motion.segments import PLANE_AXES, Arc, Event, Line
 from ncpp.passes.context import PassContext
 from ncpp.passes.kernels import run_ahead
-from ncpp.passes.geometry import compensate, frames, points, spliced
+from ncpp.passes.geometry import compensate, frames, points, rows_of, spliced
 from ncpp.passes.travel import grid, quantize
 
 # Points per piece where the fit is checked (ends included).  Fewer on short
@@ -98,15 +98,16 @@ class _ArcRows:
     sweep: NDArray  # (n,) rad, signed (+ counter-clockwise), full turns included
     offsets: NDArray  # (n,3) machine minus program, program units
     scales: NDArray  # (n,) mm per program unit
+    tools: NDArray | None  # (n,3) tool length offsets, mm (None: none)
     lines: NDArray  # (n,) the line of each arc's block, for messages
 
     @classmethod
     def of(cls, arcs: list[Arc]) -> "_ArcRows":
-        offsets, scales = frames(arcs)
+        offsets, scales, tools = frames(arcs)
         return cls(
             points([a.start for a in arcs]), points([a.end for a in arcs]), points([a.center for a in arcs]),
             np.array([PLANE_AXES[a.context.plane] for a in arcs]), np.array([a.sweep() for a in arcs]),
-            offsets, scales, np.array([a.block.line for a in arcs]),
+            offsets, scales, tools, np.array([a.block.line for a in arcs]),
         )  # fmt: skip
 
 
@@ -203,7 +204,7 @@ def _quadrant_pieces(geometry: _ArcGeometry) -> _Pieces:
 
 def _replace(arcs: _ArcRows, ctx: PassContext) -> _Fitted:
     geometry = _ArcGeometry(arcs)
-    offsets, scales, line_of = arcs.offsets, arcs.scales, arcs.lines
+    offsets, scales, tools, line_of = arcs.offsets, arcs.scales, arcs.tools, arcs.lines
     pending = _initial_pieces(geometry, ctx.directional)
     done = _Fitted(geometry.a0, np.where(geometry.sweep >= 0, 1.0, -1.0))
     for _ in range(MAX_ROUNDS):
@@ -215,7 +216,7 @@ def _replace(arcs: _ArcRows, ctx: PassContext) -> _Fitted:
         for m in np.unique(counts).tolist():
             rows = np.flatnonzero(counts == m)
             some = _Pieces(pending.arc[rows], pending.a0[rows], pending.sweep[rows])
-            split[rows] = _round(some, length[rows], np.linspace(0.0, 1.0, m), geometry, offsets, scales, line_of, ctx, done)
+            split[rows] = _round(some, length[rows], np.linspace(0.0, 1.0, m), geometry, offsets, scales, tools, line_of, ctx, done)
         half = pending.sweep[split] / 2
         pending = _Pieces(
             np.repeat(pending.arc[split], 2),
@@ -225,7 +226,7 @@ def _replace(arcs: _ArcRows, ctx: PassContext) -> _Fitted:
     return done
 
 
-def _round(pending: _Pieces, length: NDArray, t: NDArray, geometry, offsets, scales, line_of, ctx, done: _Fitted) -> NDArray:
+def _round(pending: _Pieces, length: NDArray, t: NDArray, geometry, offsets, scales, tools, line_of, ctx, done: _Fitted) -> NDArray:
     """Compensate and fit pieces sampled at `t`; append the finished ones to
     `done` and return (p,) which to halve."""
     angles = pending.a0[:, None] + t[None, :] * pending.sweep[:, None]
@@ -238,7 +239,7 @@ def _round(pending: _Pieces, length: NDArray, t: NDArray, geometry, offsets, sca
     np.put_along_axis(direction, geometry.axes[pending.arc, None, 2:], 0.0, axis=2)
     direction = np.broadcast_to(direction, nominal.shape)
     scale = scales[pending.arc]
-    q = compensate(nominal, offsets[pending.arc], scale, line_of[pending.arc], ctx, direction)
+    q = compensate(nominal, offsets[pending.arc], scale, line_of[pending.arc], ctx, direction, rows_of(tools, pending.arc))
     centre, deviation = _fit(q, geometry.axes[pending.arc], t, ctx.tolerance / scale)
     ok = deviation <= ctx.tolerance / scale
     if ctx.directional:  # ends on the output grid (after the fit: a short piece's chord fixes the bisector)
@@ -259,7 +260,8 @@ def _round(pending: _Pieces, length: NDArray, t: NDArray, geometry, offsets, sca
     lines = np.flatnonzero(straight | give_up)
     if lines.size and ctx.directional:
         # lines are compensated for the mean direction: apply_error_map moves them to the real one
-        q[lines] = _mean_compensated(nominal[lines], offsets[pending.arc[lines]], scale[lines], line_of[pending.arc[lines]], ctx)
+        arc = pending.arc[lines]
+        q[lines] = _mean_compensated(nominal[lines], offsets[arc], scale[lines], line_of[arc], ctx, rows_of(tools, arc))
     for rows, pts in ((np.flatnonzero(straight), lambda r: q[r][:, [0, -1]]), (np.flatnonzero(give_up), lambda r: q[r])):
         if rows.size:
             done.lines.append((pending.arc[rows], pending.a0[rows], pts(rows)))
@@ -305,10 +307,10 @@ def _one_way(q: NDArray, centre: NDArray, axes: NDArray, direction: NDArray, sig
     return ~inside & agrees & (span < np.pi) & (np.abs(blend) < quarter / 2)
 
 
-def _mean_compensated(nominal, offsets, scales, line_of, ctx) -> NDArray:
+def _mean_compensated(nominal, offsets, scales, line_of, ctx, tools) -> NDArray:
     """Compensated samples (p,m,3) for the mean direction.  Not on the output
     grid: apply_error_map moves them for the real direction, then rounds once."""
-    return compensate(nominal, offsets, scales, line_of, ctx, np.zeros_like(nominal))
+    return compensate(nominal, offsets, scales, line_of, ctx, np.zeros_like(nominal), tools)
 
 
 def _fit(q: NDArray, axes: NDArray, t: NDArray, tolerance: NDArray) -> tuple[NDArray, NDArray]:

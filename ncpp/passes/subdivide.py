@@ -13,8 +13,8 @@ from typing import Iterable, Iterator
 import numpy as np
 
 from ncpp.motion.segments import Event, Line
-from ncpp.passes.context import PassContext
-from ncpp.passes.geometry import chunked, frames, points, spliced
+from ncpp.passes.context import PassContext, deviation
+from ncpp.passes.geometry import chunked, frames, points, rows_of, spliced
 
 # Interior samples where linearity is checked.
 SAMPLES = np.linspace(0.0, 1.0, 7)
@@ -36,21 +36,22 @@ def _subdivide_chunk(chunk: list[Event], ctx: PassContext) -> list[Event]:
     lines = [chunk[k] for k in index]
     starts = points([ln.start for ln in lines])
     ends = points([ln.end for ln in lines])
-    offsets, scales = frames(lines)
+    offsets, scales, tools = frames(lines)
     long = np.flatnonzero(np.linalg.norm(ends - starts, axis=1) * scales >= ctx.min_line_check)
     if long.size == 0:
         return chunk
     index, lines = [index[i] for i in long.tolist()], [lines[i] for i in long.tolist()]
-    starts, ends, offsets, scales = starts[long], ends[long], offsets[long], scales[long]
+    starts, ends, offsets, scales, tools = starts[long], ends[long], offsets[long], scales[long], rows_of(tools, long)
     t = SAMPLES[None, :, None]
     program = starts[:, None, :] + t * (ends - starts)[:, None, :]
     machine = (program + offsets[:, None, :]) * scales[:, None, None]
     direction = np.broadcast_to(np.sign(ends - starts)[:, None, :], machine.shape).reshape(-1, 3)
-    error = ctx.model.deviation(machine.reshape(-1, 3), direction).reshape(machine.shape)
+    tool = None if tools is None else np.broadcast_to(tools[:, None, :], machine.shape).reshape(-1, 3)
+    error = deviation(ctx.model, machine.reshape(-1, 3), direction, tool).reshape(machine.shape)
     straight = error[:, :1] + t * (error[:, -1:] - error[:, :1])
-    deviation = np.linalg.norm(error - straight, axis=-1).max(axis=1)
+    bow = np.linalg.norm(error - straight, axis=-1).max(axis=1)
     # The deviation of piecewise-linear interpolation shrinks with the square of the piece count.
-    pieces = np.ceil(np.sqrt(SAFETY * deviation / ctx.tolerance)).astype(int).clip(1, MAX_PIECES)
+    pieces = np.ceil(np.sqrt(SAFETY * bow / ctx.tolerance)).astype(int).clip(1, MAX_PIECES)
     split = np.flatnonzero(pieces > 1).tolist()
     return spliced(chunk, [index[i] for i in split], [_split(lines[i], int(pieces[i])) for i in split])
 

@@ -15,6 +15,7 @@
 #   --work-offset [G5x=]X,Y,Z  machine position of a fixture's zero (G54 without
 #                         G5x=; repeat it for the Job's other fixtures G55...)
 #   --var-file FILE       LinuxCNC parameter file holding the zeros (--var-units inch)
+#   --tool-table FILE     LinuxCNC tool table: the lengths the program's G43 applies
 #   --ncpp PATH           the ncpp program (default: $NCPP, then `ncpp` on PATH)
 # Any other argument goes to linuxcnc_post (e.g. --no-comments, --precision 4).
 #
@@ -38,7 +39,8 @@ parser.add_argument("--from", dest="from_file", help="compensate from one measur
 parser.add_argument("--tolerance", help="allowed path deviation in mm")
 parser.add_argument("--work-offset", action="append", default=[], help="[G5x=]X,Y,Z machine position of a fixture's zero, mm (repeat)")
 parser.add_argument("--var-file", help="LinuxCNC parameter file holding the zeros")
-parser.add_argument("--var-units", help="units of --var-file: mm or inch")
+parser.add_argument("--tool-table", help="LinuxCNC tool table: the lengths the program's G43 applies")
+parser.add_argument("--var-units", help="units of --var-file and --tool-table: mm or inch")
 parser.add_argument("--ncpp", help="the ncpp program (default: $NCPP, then ncpp on PATH)")
 
 TOOLTIP_ARGS = parser.format_help() + "\nOther arguments are passed to linuxcnc_post.\n"
@@ -68,7 +70,7 @@ def _ncpp_command(options):
 def _ncpp_arguments(options):
     args = []
     for flag, value in (("--machine", options.machine), ("--from", options.from_file), ("--tolerance", options.tolerance),
-                        ("--var-file", options.var_file), ("--var-units", options.var_units)):  # fmt: skip
+                        ("--var-file", options.var_file), ("--tool-table", options.tool_table), ("--var-units", options.var_units)):  # fmt: skip
         if value:
             args += [flag, value]
     for zero in options.work_offset:

@@ -87,18 +87,19 @@ def test_freecad_1_uses_the_class_and_the_legacy_script_api_agrees(posted):
 
 
 def test_the_post_passes_every_fixture_zero_to_ncpp(tmp_path):
-    """A Job with two fixtures: `--work-offset` repeated (and `--var-file`) reach ncpp as
-    given (the plugin needs no FreeCAD for this part)."""
+    """A Job with two fixtures: `--work-offset` repeated (and `--var-file`, `--tool-table`)
+    reach ncpp as given (the plugin needs no FreeCAD for this part)."""
     import importlib.util
 
     spec = importlib.util.spec_from_file_location("ncpp_post", ROOT / "plugins/freecad/ncpp_post.py")
     plugin = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(plugin)
     options, rest = plugin.parser.parse_known_args(
-        ["--machine", "m.toml", "--work-offset", "250,300,300", "--work-offset", "G55=550,400,250", "--var-file", "l.var", "--no-comments"]
+        ["--machine", "m.toml", "--work-offset", "250,300,300", "--work-offset", "G55=550,400,250", "--var-file", "l.var",
+         "--tool-table", "t.tbl", "--no-comments"]  # fmt: skip
     )
     assert plugin._ncpp_arguments(options) == [
-        "--machine", "m.toml", "--var-file", "l.var", "--work-offset", "250,300,300", "--work-offset", "G55=550,400,250",
+        "--machine", "m.toml", "--var-file", "l.var", "--tool-table", "t.tbl", "--work-offset", "250,300,300", "--work-offset", "G55=550,400,250",
     ]  # fmt: skip
     assert rest == ["--no-comments"]  # for FreeCAD's linuxcnc_post
     ncpp = tmp_path / "ncpp"

@@ -97,3 +97,20 @@ def test_the_parameter_file_places_the_program_as_linuxcnc_does(tmp_path):
     assert from_var.stdout == given.stdout and from_var.stdout.startswith(b"%\n(ncpp compensated")
     (tmp_path / "ncpp.toml").write_text(f'machine = "{MACHINE}"\n')  # G54 at the machine zero: outside the travel
     assert run_filter(pocket, tmp_path).returncode == 2
+
+
+def test_the_tool_table_gives_the_lengths_g43_applies(tmp_path):
+    """`tool_table` in the config (relative to it, like `var_file`): the program's G43 H1
+    applies tool 1's length; without it, length 0 and a warning."""
+    lines = (ROOT / "samples/programs/pocket.ngc").read_text().splitlines()
+    program = tmp_path / "tool.ngc"
+    program.write_text("\n".join([lines[0], "T1 M6", "G43 H1", *lines[1:]]) + "\n")
+    (tmp_path / "tool.tbl").write_text("T1 P1 Z+120.0 D6.0\n")
+    config = f'machine = "{MACHINE}"\nwork_offset = [400, 350, 300]\n'
+    (tmp_path / "ncpp.toml").write_text(config + 'tool_table = "tool.tbl"\n')
+    told = run_filter(program, tmp_path)
+    (tmp_path / "ncpp.toml").write_text(config)
+    untold = run_filter(program, tmp_path)
+    assert told.returncode == 0 and untold.returncode == 0, told.stderr.decode()
+    assert b"G43 applies a tool length" in untold.stderr and b"G43" not in told.stderr
+    assert told.stdout != untold.stdout
