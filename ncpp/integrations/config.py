@@ -28,9 +28,10 @@ unchanged.
 
 from __future__ import annotations
 
+import configparser
 import os
 import tomllib
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Mapping
 
@@ -142,4 +143,40 @@ def find_settings(
         var_units=var_units or config.get("var_units", "mm"),
         tool_table=tool_table or config.get("tool_table"),
         origin=origin,
+    )
+
+
+# [TRAJ]LINEAR_UNITS spellings LinuxCNC accepts for its machine units
+_INI_UNITS = {"mm": "mm", "metric": "mm", "inch": "inch", "in": "inch", "imperial": "inch"}
+
+
+def with_linuxcnc_ini(settings: Settings, ini: str | Path | None) -> Settings:
+    """The settings with LinuxCNC's own files where they name none: the INI's
+    [RS274NGC]PARAMETER_FILE and [EMCIO]TOOL_TABLE (relative to the INI's folder),
+    in its [TRAJ]LINEAR_UNITS.  LinuxCNC exports the INI's path as $INI_FILE_NAME
+    to the programs it runs, the filter among them."""
+    if not ini or (settings.var_file and settings.tool_table):
+        return settings
+    path = Path(ini)
+    parser = configparser.ConfigParser(strict=False, interpolation=None)  # LinuxCNC INIs repeat keys (HALFILE)
+    parser.optionxform = str  # type: ignore[assignment,method-assign]
+    try:
+        parser.read_string(path.read_text(encoding="latin-1"), str(path))
+    except (OSError, configparser.Error) as err:
+        raise NcppError(f"cannot read the LinuxCNC INI file: {err}", Location(str(path))) from None
+
+    def named(section: str, key: str) -> str | None:
+        """The file the INI names, if it exists (LinuxCNC makes a missing parameter file)."""
+        value = parser.get(section, key, fallback="").strip()
+        found = (path.parent / Path(value).expanduser()).resolve()
+        return str(found) if value and found.is_file() else None
+
+    var_file, tool_table = named("RS274NGC", "PARAMETER_FILE"), named("EMCIO", "TOOL_TABLE")
+    units = _INI_UNITS.get(parser.get("TRAJ", "LINEAR_UNITS", fallback="mm").strip().lower(), "mm")
+    own_units = settings.var_file or settings.tool_table  # the config's files: its units
+    return replace(
+        settings,
+        var_file=settings.var_file or var_file,
+        tool_table=settings.tool_table or tool_table,
+        var_units=settings.var_units if own_units else units,
     )

@@ -4,7 +4,9 @@ LinuxCNC runs the filter named for a file's extension with the file's path
 as its only argument, loads what the filter writes to stdout, shows a
 progress bar from `FILTER_PROGRESS=N` lines (percent) on stderr, and shows
 stderr as an error when the exit status is not 0.  The machine file comes
-from `$NCPP_MACHINE` or the config files (`ncpp.integrations.config`); with
+from `$NCPP_MACHINE` or the config files (`ncpp.integrations.config`), the
+work offsets and tool lengths from the parameter file and tool table of the
+configuration LinuxCNC runs ($INI_FILE_NAME) unless the config names others; with
 none, or for a program ncpp compensated already, the program is loaded as it
 is.  Output is spooled, so a failed run sends LinuxCNC nothing.
 """
@@ -48,10 +50,10 @@ def run(path: str, err: TextIO, machine: str | None = None) -> None:
     """Write the compensated program to stdout (nothing on error), progress to `err`."""
     from ncpp.cli.compensate import jobs_for
     from ncpp.cli.io import open_output
-    from ncpp.integrations.config import find_settings
+    from ncpp.integrations.config import find_settings, with_linuxcnc_ini
     from ncpp.pipeline import ErrorSource, process
 
-    settings = find_settings(machine)
+    settings = with_linuxcnc_ini(find_settings(machine), os.environ.get("INI_FILE_NAME"))
     with open(path, "rb") as stream:
         progress = FilterProgress(stream, os.fstat(stream.fileno()).st_size, err)
         progress.report(0)

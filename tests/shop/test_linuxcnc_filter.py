@@ -114,3 +114,41 @@ def test_the_tool_table_gives_the_lengths_g43_applies(tmp_path):
     assert told.returncode == 0 and untold.returncode == 0, told.stderr.decode()
     assert b"G43 applies a tool length" in untold.stderr and b"G43" not in told.stderr
     assert told.stdout != untold.stdout
+
+
+INI = """[EMC]
+MACHINE = mill
+[HAL]
+HALFILE = core_sim.hal
+HALFILE = axis_manualtoolchange.hal
+[TRAJ]
+LINEAR_UNITS = mm
+[RS274NGC]
+PARAMETER_FILE = sim.var
+[EMCIO]
+TOOL_TABLE = tool.tbl
+"""
+
+
+def test_the_configuration_linuxcnc_runs_gives_its_parameter_file_and_tool_table(tmp_path):
+    """LinuxCNC exports $INI_FILE_NAME: the filter reads the INI's PARAMETER_FILE and
+    TOOL_TABLE (relative to it) when the ncpp config names none, and gets the same
+    output as a config naming the zero and the table itself."""
+    lines = (ROOT / "samples/programs/pocket.ngc").read_text().splitlines()
+    program = tmp_path / "tool.ngc"
+    program.write_text("\n".join([lines[0], "T1 M6", "G43 H1", *lines[1:]]) + "\n")
+    lcnc = tmp_path / "configs" / "mill"
+    lcnc.mkdir(parents=True)
+    (lcnc / "mill.ini").write_text(INI)
+    (lcnc / "sim.var").write_text("5220\t1.000000\n5221\t400.000000\n5222\t350.000000\n5223\t300.000000\n")
+    (lcnc / "tool.tbl").write_text("T1 P1 Z+120.0 D6.0\n")
+    (tmp_path / "ncpp.toml").write_text(f'machine = "{MACHINE}"\n')
+    from_ini = run_filter(program, tmp_path, INI_FILE_NAME=str(lcnc / "mill.ini"))
+    (tmp_path / "ncpp.toml").write_text(f'machine = "{MACHINE}"\nwork_offset = [400, 350, 300]\ntool_table = "configs/mill/tool.tbl"\n')
+    given = run_filter(program, tmp_path)
+    assert from_ini.returncode == 0 and from_ini.stderr.count(b"FILTER_PROGRESS") == len(from_ini.stderr.splitlines()), from_ini.stderr
+    assert from_ini.stdout == given.stdout and from_ini.stdout.startswith(b"%\n(ncpp compensated")
+    (lcnc / "sim.var").unlink()  # a fresh configuration: LinuxCNC starts with all zeros, and so does ncpp
+    (tmp_path / "ncpp.toml").write_text(f'machine = "{MACHINE}"\n')
+    fresh = run_filter(program, tmp_path, INI_FILE_NAME=str(lcnc / "mill.ini"))
+    assert fresh.returncode == 2 and b"outside the" in fresh.stderr  # G54 at the machine zero: the pocket leaves the travel

@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from ncpp.errors import NcppError
-from ncpp.integrations.config import config_paths, find_settings
+from ncpp.integrations.config import config_paths, find_settings, with_linuxcnc_ini
 from tests.conftest import ROOT
 
 MACHINE = ROOT / "samples/machines/hr5b.toml"
@@ -71,6 +71,25 @@ def test_bad_config_is_an_error_naming_the_file(shop, text, message):
     with pytest.raises(NcppError, match=message) as err:
         find_settings(cwd=shop / "work", env=env_of(shop))
     assert err.value.where.file.endswith("ncpp.toml")
+
+
+def test_config_paths_and_the_linuxcnc_ini_files(shop):
+    """`var_file` and `tool_table` are relative to the config; the INI's files fill what it
+    leaves unnamed, in the INI's units, and only when they exist."""
+    work = shop / "work"
+    (work / "ncpp.toml").write_text('tool_table = "lcnc/tool.tbl"\nvar_units = "inch"\n')
+    settings = find_settings(cwd=work, env=env_of(shop))
+    assert settings.tool_table == str(work / "lcnc/tool.tbl") and settings.var_file is None
+    ini = work / "lcnc/mill.ini"
+    ini.parent.mkdir()
+    ini.write_text("[TRAJ]\nLINEAR_UNITS = imperial\n[RS274NGC]\nPARAMETER_FILE = sim.var\n[EMCIO]\nTOOL_TABLE = other.tbl\n")
+    assert with_linuxcnc_ini(settings, ini).var_file is None  # no sim.var yet: LinuxCNC starts from zeros
+    (ini.parent / "sim.var").write_text("5220 1\n")
+    merged = with_linuxcnc_ini(settings, ini)
+    assert merged.var_file == str(ini.parent / "sim.var") and merged.tool_table == settings.tool_table and merged.var_units == "inch"
+    plain = with_linuxcnc_ini(find_settings(cwd=shop, env=env_of(shop)), ini)
+    assert plain.var_units == "inch" and plain.tool_table is None  # other.tbl does not exist
+    assert with_linuxcnc_ini(settings, None) is settings
 
 
 def ncpp(shop: Path, *args: str, stdin: str = PROGRAM, **env: str) -> subprocess.CompletedProcess:
