@@ -24,7 +24,7 @@ from ncpp.motion.segments import Event
 from ncpp.passes import PASSES, PassContext, run_passes
 from ncpp.passes.context import is_directional
 from ncpp.passes.kernels import INLINE, Kernels, Worker
-from ncpp.program.blocks import Block, Comment, Word
+from ncpp.program.blocks import Block, Comment, Statement, Word
 from ncpp.program.dialects import parse_program
 from ncpp.program.dialects.iso import IsoWriter
 
@@ -96,28 +96,51 @@ def refuse_compensated(blocks: Iterable[Block], file: str) -> Iterator[Block]:
     yield from blocks
 
 
-# G words that change the work offset where a one-zero dialect's interpreter does not follow:
+# What the one-zero dialects' interpreters do not place (the ISO interpreter places it all):
 # Sinumerik's settable frames G54-G57 (G58/G59 are its programmable offsets: out of the
-# interpreter's scope, warned there) and G500, which deselects them
+# interpreter's scope, warned there) and G500, which deselects them; and the tool lengths
+# the control applies from its tool data (Heidenhain TOOL CALL; Sinumerik's tool change,
+# which activates cutting edge D1, and D words), which ncpp does not read for these dialects.
 _ONE_ZERO = "ncpp compensates this dialect at one program zero, the work offset in effect when the program starts (--work-offset)"
+_NO_LENGTH = "ncpp does not read this dialect's tool data: compensated with tool length 0"
 OTHER_ZEROS = {
     **{value: f"{name} selects another work offset: {_ONE_ZERO}" for value, name in ((55.0, "G55"), (56.0, "G56"), (57.0, "G57"))},
     500.0: f"G500 deselects the work offset: {_ONE_ZERO}",
 }
+TOOL_LENGTHS = {
+    "heidenhain": f"TOOL CALL applies the tool's length from the control's tool table: {_NO_LENGTH}",
+    "sinumerik": f"the tool change (M6) or D word applies a tool length from the control's tool data: {_NO_LENGTH}",
+}
 
 
-def warn_other_zeros(blocks: Iterable[Block], warnings: Warnings, file: str) -> Iterator[Block]:
-    """Pass blocks through; warn once per G word of `OTHER_ZEROS` the program uses, where it
-    first does (refused with --strict): the errors compensated there are those of another place."""
-    told: set[float] = set()
+def warn_unplaced(blocks: Iterable[Block], warnings: Warnings, file: str, dialect: str) -> Iterator[Block]:
+    """Pass blocks through; warn once per `OTHER_ZEROS` G word and once for `TOOL_LENGTHS`,
+    where the program first uses them (refused with --strict): the errors compensated
+    there are those of another place."""
+    told: set = set()
     for block in blocks:
         signature = block.signature  # the words' letters and G numbers: most blocks are passed on here
-        if signature is None or "G5" in signature:
-            for item in block.items:
-                if type(item) is Word and item.letter == "G" and item.value in OTHER_ZEROS and item.value not in told:
-                    told.add(item.value)
-                    warnings.warn(OTHER_ZEROS[item.value], Location(file, block.line, item.start + 1))
+        if signature is not None and "G5" not in signature and "M" not in signature and "D" not in signature:
+            yield block
+            continue
+        for item in block.items:
+            kind = type(item)
+            if kind is Word and item.letter == "G" and item.value in OTHER_ZEROS:
+                key, message = item.value, OTHER_ZEROS[item.value]
+            elif _applies_tool_length(item, kind, dialect):
+                key, message = "tool", TOOL_LENGTHS[dialect]
+            else:
+                continue
+            if key not in told:
+                told.add(key)
+                warnings.warn(message, Location(file, block.line, item.start + 1))
         yield block
+
+
+def _applies_tool_length(item, kind: type, dialect: str) -> bool:
+    if dialect == "heidenhain":
+        return kind is Statement and item.kind == "tool_call"
+    return kind is Word and ((item.letter == "M" and item.value == 6.0) or (item.letter == "D" and item.value != 0.0))
 
 
 def _counted(blocks: Iterable[Block], counter: Iterator[int], progress: Callable[[int], None] | None) -> Iterator[Block]:
@@ -249,8 +272,8 @@ def _process(
     blocks: Iterable[Block] = _counted(parsed, counter, progress)
     if source is not None and not force:
         blocks = refuse_compensated(blocks, file)
-    if source is not None and name != "iso":  # the ISO interpreter follows every work offset
-        blocks = warn_other_zeros(blocks, warnings, file)
+    if source is not None and name != "iso":  # the ISO interpreter places every work offset and tool length
+        blocks = warn_unplaced(blocks, warnings, file, name)
     # the control's zeros place the program on the machine; passthrough places nothing
     offsets = (offsets or AT_MACHINE_ZERO) if source is not None else None
     events: Iterable[Event] = interpret(blocks, file=file, warnings=warnings, strict=strict, offsets=offsets)
