@@ -48,11 +48,29 @@ def ncpp_process_rate(path: Path, offset: tuple[float, float, float] | None, job
     source = None if offset is None else ErrorSource.from_machine_file(str(MACHINE))
     offsets = None if offset is None else WorkOffsets.at(offset)
     sink = open(os.devnull, "wb")
-    start = time.perf_counter()
+    children = _children_cpu()
+    cpu, start = time.process_time(), time.perf_counter()
     with open(path, "rb") as stream:
         stats = process(stream, sink, file=str(path), source=source, tolerance=TOLERANCE, warnings=QUIET, jobs=jobs, offsets=offsets)
-    seconds = time.perf_counter() - start
-    return {"lines": stats.lines_in, "lines_out": stats.lines_out, "seconds": seconds, "lines_per_s": stats.lines_in / seconds}
+    seconds, cpu = time.perf_counter() - start, time.process_time() - cpu
+    worker = _children_cpu() - children  # the worker has exited (process() closes it): its CPU is counted
+    return {"lines": stats.lines_in, "lines_out": stats.lines_out, "seconds": seconds, "lines_per_s": stats.lines_in / seconds,
+            "main_cpu_s": cpu, "worker_cpu_s": worker}  # fmt: skip
+
+
+def _children_cpu() -> float:
+    import resource
+
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
+
+
+def _cpu_split(result: dict[str, Any], pygcode: dict[str, Any]) -> str:
+    """CPU per input line of each process beside pygcode's: what the floor asks of each (both
+    processes at or below pygcode's time per line)."""
+    per_line = lambda seconds: 1e6 * seconds / max(result["lines"], 1)  # noqa: E731
+    return (f"CPU µs per line in: main {per_line(result['main_cpu_s']):.0f}, worker {per_line(result['worker_cpu_s']):.0f}; "
+            f"pygcode {per_line(pygcode['seconds']):.0f}")  # fmt: skip
 
 
 REPEATS = 3  # runs per tool; the fastest counts (the same for every tool: this machine's timing is noisy)
@@ -176,6 +194,7 @@ def compensate_speed(ctx):
             [label, "pygcode Line()", f"{pyg['lines_per_s']:,.0f}", ""],
             [label, "rs274 (process)", f"{rs['lines_per_s']:,.0f}", "completed" if rs["completed"] else "STOPPED"],
             [label, "ratio compensate --jobs 2 / pygcode", f"{ratio:.2f}x", _verdict(ratio, paired["compensate"])],
+            [label, "compensate --jobs 2, CPU by process", "", _cpu_split(compensated, pyg)],
             [label, "ratio compensate --jobs 1 / pygcode", f"{ratio_alone:.2f}x", _verdict(ratio_alone, paired["compensate, one process"])],
             [label, "compensate CPU s by stage", f"{sum(stages.values()):.2f} s", f"each alone, first {min(lines, 100_000):,} lines: " + ", ".join(f"{k} {v:.2f}" for k, v in stages.items())],
         ]
