@@ -140,7 +140,9 @@ def warn_unplaced(blocks: Iterable[Block], warnings: Warnings, file: str, dialec
 def _applies_tool_length(item, kind: type, dialect: str) -> bool:
     if dialect == "heidenhain":
         return kind is Statement and item.kind == "tool_call"
-    return kind is Word and ((item.letter == "M" and item.value == 6.0) or (item.letter == "D" and item.value != 0.0))
+    if dialect == "sinumerik":
+        return kind is Word and ((item.letter == "M" and item.value == 6.0) or (item.letter == "D" and item.value != 0.0))
+    return False
 
 
 def _counted(blocks: Iterable[Block], counter: Iterator[int], progress: Callable[[int], None] | None) -> Iterator[Block]:

@@ -115,9 +115,10 @@ def interpret(
 ) -> Iterator[Event]:
     """Motion events of a program's blocks, lazily (see the module docstring).
 
-    `offsets`: the zeros the control holds at the start (none: all zero, as
-    rs274's default parameter file).  Given, a coordinate system selected
-    whose zero they do not tell gets a warning where it is first selected.
+    `offsets`: the zeros and the tool table the control holds at the start
+    (none: all zero, as rs274's default parameter file).  Given, a coordinate
+    system selected whose zero they do not tell gets a warning where it is
+    first selected, and so does the first G43 when they hold no tool table.
 
     Raises NcppError (file, line, column of the offending word) on a program
     LinuxCNC would refuse.  Out-of-scope constructs warn once through
