@@ -24,7 +24,7 @@ from ncpp.motion.segments import Event
 from ncpp.passes import PASSES, PassContext, run_passes
 from ncpp.passes.context import is_directional
 from ncpp.passes.kernels import INLINE, Kernels, Worker
-from ncpp.program.blocks import Block, Comment, Statement, Word
+from ncpp.program.blocks import Block, Comment, Word
 from ncpp.program.dialects import parse_program
 from ncpp.program.dialects.iso import IsoWriter
 
@@ -99,8 +99,8 @@ def refuse_compensated(blocks: Iterable[Block], file: str) -> Iterator[Block]:
 # What the one-zero dialects' interpreters do not place (the ISO interpreter places it all):
 # Sinumerik's settable frames G54-G57 (G58/G59 are its programmable offsets: out of the
 # interpreter's scope, warned there) and G500, which deselects them; and the tool lengths
-# the control applies from its tool data (Heidenhain TOOL CALL; Sinumerik's tool change,
-# which activates cutting edge D1, and D words), which ncpp does not read for these dialects.
+# the control applies from its tool data (Sinumerik's tool change, which activates cutting
+# edge D1, and D words), which ncpp does not read.  (The Heidenhain interpreter places TOOL CALL.)
 _ONE_ZERO = "ncpp compensates this dialect at one program zero, the work offset in effect when the program starts (--work-offset)"
 _NO_LENGTH = "ncpp does not read this dialect's tool data: compensated with tool length 0"
 OTHER_ZEROS = {
@@ -108,7 +108,6 @@ OTHER_ZEROS = {
     500.0: f"G500 deselects the work offset: {_ONE_ZERO}",
 }
 TOOL_LENGTHS = {
-    "heidenhain": f"TOOL CALL applies the tool's length from the control's tool table: {_NO_LENGTH}",
     "sinumerik": f"the tool change (M6) or D word applies a tool length from the control's tool data: {_NO_LENGTH}",
 }
 
@@ -138,8 +137,6 @@ def warn_unplaced(blocks: Iterable[Block], warnings: Warnings, file: str, dialec
 
 
 def _applies_tool_length(item, kind: type, dialect: str) -> bool:
-    if dialect == "heidenhain":
-        return kind is Statement and item.kind == "tool_call"
     if dialect == "sinumerik":
         return kind is Word and ((item.letter == "M" and item.value == 6.0) or (item.letter == "D" and item.value != 0.0))
     return False

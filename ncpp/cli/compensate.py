@@ -61,11 +61,11 @@ def add_placement_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--tool-table",
         metavar="FILE",
-        help="LinuxCNC tool table (tool.tbl): the tool lengths G43 applies, which move the axes and lengthen the Abbe arm; "
-        "without it G43 applies length 0, with a warning",
+        help="the control's tool table, LinuxCNC's tool.tbl or Heidenhain's TOOL.T: the tool lengths G43 or TOOL CALL apply, "
+        "which move the axes and lengthen the Abbe arm; without it they apply length 0, with a warning",
     )
     p.add_argument(
-        "--var-units", choices=("mm", "inch"), default="mm", help="units of --var-file and --tool-table: the INI's [TRAJ]LINEAR_UNITS (default mm)"
+        "--var-units", choices=("mm", "inch"), default="mm", help="units of --var-file and of a LinuxCNC --tool-table: the INI's [TRAJ]LINEAR_UNITS (default mm; TOOL.T says its own)"
     )
 
 

@@ -1,12 +1,13 @@
 """Heidenhain Klartext blocks -> motion events (`Line`, `Arc`, `Pass`), like `ncpp.motion.interpret`.
 
-Scope: `BEGIN PGM ... MM|INCH`, `TOOL CALL n Z` (the tool axis gives the working
-plane), `L` with X/Y/Z (absolute) and IX/IY/IZ (incremental) per word, `R0`,
+Scope: `BEGIN PGM ... MM|INCH`, `TOOL CALL n|"NAME" Z DL..` (the tool axis gives the
+working plane; the tool's length L + DL from the tool table, TOOL.T, or from the
+program's `TOOL DEF n L..`, plus the call's DL, along that axis), `L` with X/Y/Z (absolute) and IX/IY/IZ (incremental) per word, `R0`,
 `F`, `FMAX` (rapid, this block only), `FAUTO`, `CC` (the pole; its plane from
 the axes written), `C ... DR±` about the pole, `CR ... R± DR±` (R+: less than a
 half circle), `CT` (tangential arc), `LP`/`CP` polar with PR/IPR/PA/IPA (a
 helix with IZ, several turns with |IPA| > 360), Q parameters with arithmetic,
-labels, `TOOL DEF`, `CYCL DEF` of machining cycles (they only define), M2/M30
+labels, `CYCL DEF` of machining cycles (they only define), M2/M30
 and `END PGM` (end), and `RND R..` / `CHF ..` between two feed lines in the
 working plane (the fillet arc or chamfer line is the RND/CHF block's event; a
 feed line waits for the next move to know whether its corner is cut).
@@ -27,9 +28,10 @@ from typing import Iterable, Iterator
 
 from ncpp.errors import Location, NcppError, Warnings
 from ncpp.motion.corners import CornerError, round_corner
-from ncpp.motion.modal import PLANE_OF_TOOL_AXIS, ModalInterpreter, OutOfScope, resolve_warnings
+from ncpp.motion.modal import MM_PER_INCH, PLANE_OF_TOOL_AXIS, ModalInterpreter, OutOfScope, resolve_warnings
 from ncpp.motion.offsets import WorkOffsets
 from ncpp.motion.segments import PLANE_AXES, Arc, Event, Line, Pass, Point
+from ncpp.motion.tools import ToolTable
 from ncpp.program.blocks import Block, Comment, ExprWord, Word
 
 AXES = "XYZ"
@@ -61,7 +63,9 @@ def interpret(blocks: Iterable[Block], *, file: str = "<stdin>", warnings: Warni
               strict: bool = False, offsets: WorkOffsets | None = None) -> Iterator[Event]:
     """Motion events of a Heidenhain program's blocks, lazily (see the module docstring)."""
     zero = offsets.program_zero() if offsets is not None else (0.0, 0.0, 0.0)  # one program zero: the system in effect
-    return HeidenhainInterpreter(file, zero).run(blocks, resolve_warnings(warnings, strict))
+    interpreter = HeidenhainInterpreter(file, zero, offsets.tools if offsets is not None else None)
+    interpreter.untold_tools = offsets is not None and offsets.tools is None  # placing the program: say what it cannot place
+    return interpreter.run(blocks, resolve_warnings(warnings, strict))
 
 
 def _plane_of_axes(axes: set[int], default: int) -> int:
@@ -72,8 +76,15 @@ def _plane_of_axes(axes: set[int], default: int) -> int:
 
 
 class HeidenhainInterpreter(ModalInterpreter):
-    def __init__(self, file: str = "<stdin>", zero: tuple[float, float, float] = (0.0, 0.0, 0.0)):
+    def __init__(self, file: str = "<stdin>", zero: tuple[float, float, float] = (0.0, 0.0, 0.0), tools: ToolTable | None = None):
         super().__init__(file, zero)
+        self.tools = tools  # the control's tool table (TOOL.T), if told
+        self.defined: dict[float, float] = {}  # tool lengths the program defines (TOOL DEF n L..), program units
+        self.tool_number: float | None = 0.0  # the tool TOOL CALL put in the spindle (None: one named, no table)
+        self.tool_axis = 2  # the axis its length is along (TOOL CALL's axis)
+        self.call_dl = 0.0  # the last TOOL CALL's DL (an oversize), program units
+        self.untold_tools = False  # warn, once, at a TOOL CALL whose tool length nothing tells
+        self.warnings: Warnings | None = None
         self.q: dict[str, float] = {}
         self.pole: list[float] | None = None
         self.pole_plane = 17
@@ -84,6 +95,7 @@ class HeidenhainInterpreter(ModalInterpreter):
     def run(self, blocks: Iterable[Block], warnings: Warnings) -> Iterator[Event]:
         """Events as `ModalInterpreter.run`; a feed line waits (with the events after it)
         for the next move, which an RND/CHF block in between makes round or cut."""
+        self.warnings = warnings  # TOOL CALL's, if it cannot place the tool
         held: list[Event] = []  # the last feed line and the events after it
         corner: Corner | None = None
         for event in super().run(blocks, warnings):
@@ -169,8 +181,9 @@ class HeidenhainInterpreter(ModalInterpreter):
             elif what == "tool_call":
                 if node[1] is not None:
                     self.plane = PLANE_OF_TOOL_AXIS[node[1]]
+                    self.tool_axis = AXES.index(node[1])
                     self._context = None
-                return self._tool_call(block)
+                return self._tool_call(block, item)
             elif what == "radius_comp":
                 if node[0] != "R0":
                     raise OutOfScope(f"radius compensation {node[0]}", item.start + 1)
@@ -189,8 +202,10 @@ class HeidenhainInterpreter(ModalInterpreter):
                 return []
             elif what == "keyword" and node and node[0] in HARMLESS_KEYWORDS:
                 continue
-            elif what in ("blk_form", "tool_def"):
-                return []  # their words describe the blank or the tool, not a move
+            elif what == "tool_def":
+                return self._tool_def(block, item)
+            elif what == "blk_form":
+                return []  # its words describe the blank, not a move
             elif what != "label":
                 reason = {"call_label": "CALL LBL", "call_program": "CALL PGM", "cycle_call": "CYCL CALL",
                           "fn": f"FN {node[0]}", "keyword": " ".join(map(str, node))}.get(what, what)  # fmt: skip
@@ -206,11 +221,70 @@ class HeidenhainInterpreter(ModalInterpreter):
             self.done = True
         return events
 
-    def _tool_call(self, block: Block) -> list[Event]:
+    def _tool_def(self, block: Block, statement) -> list[Event]:
+        """`TOOL DEF n L.. R..`: the program defines tool n's length (without L: it only prepares the tool)."""
+        for item in block.items:
+            number = self._tool_number(statement.node[0], block, statement)
+            if (type(item) is Word or type(item) is ExprWord) and item.letter == "L" and number is not None:
+                self.defined[number] = self._word_value(item, block)
+        return []
+
+    def _tool_call(self, block: Block, statement) -> list[Event]:
+        """`TOOL CALL n|"NAME" [axis] [DL..]`: tool n's length L + DL (table) + DL (call) along
+        the tool axis; without a tool, the tool stays and so does its DL unless the call gives one."""
+        dl = None
         for item in block.items:
             if type(item) is Word and item.letter == "F":
                 self.auto_feed = item.value
+            elif (type(item) is Word or type(item) is ExprWord) and item.letter == "DL":
+                dl = self._word_value(item, block)
+        called = statement.node[0]
+        if called is not None:
+            self.tool_number = self._tool_number(called, block, statement)
+            self.call_dl = 0.0
+        if dl is not None:
+            self.call_dl = dl
+        tool = [0.0, 0.0, 0.0]
+        tool[self.tool_axis] = self._length(self.tool_number, block, statement) + self.call_dl
+        self.set_tool(tool)
         return []
+
+    def _tool_number(self, called, block: Block, statement) -> float | None:
+        """The number of a tool called or defined by number, Q parameter or name (a tool
+        table's names; None: a name and no table to look it up in)."""
+        if type(called) is tuple:  # ("param", q)
+            return float(self.value(called, block, statement))
+        if type(called) is not str:
+            return float(called)
+        if self.tools is None:
+            return None
+        number = self.tools.names.get(called)
+        if number is None:
+            self.fail(f'tool "{called}" is not in {self.tools.source}', block, statement)
+        return number
+
+    def _length(self, number: float | None, block: Block, statement) -> float:
+        """Tool `number`'s length L + DL, program units: defined by the program, else the table's."""
+        if number == 0:
+            return 0.0
+        if number in self.defined:
+            return self.defined[number]
+        if self.tools is None or number is None:
+            if self.untold_tools and self.warnings is not None:
+                self.untold_tools = False
+                self.warnings.warn(
+                    "TOOL CALL applies the tool's length from the control's tool table, which ncpp is not told: "
+                    "compensated with tool length 0 (give --tool-table TOOL.T)",
+                    Location(self.file, block.line, statement.start + 1),
+                )
+            return 0.0
+        offsets = self.tools.offset(number)
+        if offsets is None:
+            self.fail(f"tool {number:g} is not defined: neither in {self.tools.source} nor by TOOL DEF", block, statement)
+        return offsets[2] / (MM_PER_INCH if self.inch else 1.0)  # type: ignore[index]
+
+    def _word_value(self, item, block: Block) -> float:
+        return item.value if type(item) is Word else self.value(item.expr, block, item)
 
     def _corner(self, block: Block, item, words: dict) -> Corner:
         function = item.node[0]

@@ -48,7 +48,8 @@ class ModalInterpreter:
         self.plane = 17
         self.inch = False
         self.feed = 0.0
-        self.offset: list[float] = [0.0, 0.0, 0.0]  # machine minus program position (frames), program units
+        self.offset: list[float] = [0.0, 0.0, 0.0]  # machine minus program position (frames, tool length), program units
+        self.tool: list[float] = [0.0, 0.0, 0.0]  # the tool length offset in effect (in `offset`), program units
         self.zero: list[float] = list(zero)  # the program zero the control holds (preset, settable frame), program units
         self.tangent: tuple[float, float, float] | None = None  # direction at the end of the last move
         self.done = False
@@ -81,7 +82,7 @@ class ModalInterpreter:
         plane = plane or self.plane
         if self._context is None or self._context.plane != plane or self._context.absolute != absolute:
             offset = tuple(z + o for z, o in zip(self.zero, self.offset))
-            self._context = Context(plane, absolute, False, self.inch, offset)  # type: ignore[arg-type]
+            self._context = Context(plane, absolute, False, self.inch, offset, tuple(self.tool))  # type: ignore[arg-type]
         return self._context
 
     def set_units(self, inch: bool) -> None:
@@ -90,6 +91,7 @@ class ModalInterpreter:
             scale = 1 / MM_PER_INCH if inch else MM_PER_INCH
             self.pos = [v * scale for v in self.pos]
             self.offset = [v * scale for v in self.offset]
+            self.tool = [v * scale for v in self.tool]
             self.zero = [v * scale for v in self.zero]
             self.inch = inch
             self._context = None
@@ -99,6 +101,12 @@ class ModalInterpreter:
         self.pos = [p + old - new for p, old, new in zip(self.pos, self.offset, offset)]
         self.offset = list(offset)
         self._context = None
+
+    def set_tool(self, tool: list[float]) -> None:
+        """A tool length offset (program units) takes effect: the machine's controlled point
+        moves by it, so the same machine point gets new program coordinates."""
+        self.set_offset([o - old + new for o, old, new in zip(self.offset, self.tool, tool)])
+        self.tool = list(tool)
 
     def lookup(self, name: str) -> float:
         """The value of a program parameter (Q, R, DEF variable); each dialect says how."""

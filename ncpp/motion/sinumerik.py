@@ -179,7 +179,7 @@ class SinumerikInterpreter(ModalInterpreter):
         name = frame.node[0]
         if name not in ("TRANS", "ATRANS") and words:
             raise OutOfScope(f"frame {name}", frame.start + 1)
-        offset = list(self.offset) if name == "ATRANS" else [0.0, 0.0, 0.0]
+        offset = list(self.offset) if name == "ATRANS" else list(self.tool)  # TRANS replaces the frame, not the tool length
         for letter, (value, _, item) in words.items():
             if letter not in AXES:
                 raise OutOfScope(f"{frame.node[0]} of the {letter} axis", item.start + 1)

@@ -1,4 +1,4 @@
-"""The control's tool table: where each tool's tip is, as G43 applies it.
+"""The control's tool table: where each tool's tip is, as G43 (or Heidenhain's TOOL CALL) applies it.
 
 A program that says `G43 H1` (or `T1 M6` and `G43`) moves with the tool tip
 as its controlled point: the control adds the tool's offset from its tool
@@ -14,6 +14,17 @@ LinuxCNC's tool table, one tool per line (`tool.tbl`):
 T is the tool number, P its pocket, X Y Z A B C U V W its offsets, D I J Q
 lathe and cutter data (not used here); a `;` starts the comment.  Values are
 in the machine's units ([TRAJ]LINEAR_UNITS).
+
+Heidenhain's tool table (`TOOL.T`), fixed columns under a header line, its
+units in the first line:
+
+    BEGIN TOOL    .T       MM
+    T    NAME             L          R          DL      DR      TL RT
+    1    D10_ENDMILL      +150,000   +5,000     -0,020  +0,000
+    [END]
+
+A tool's length is L + DL along the tool axis (kept as its Z offset here: the
+axis is the one TOOL CALL names); numbers may have a decimal comma.
 """
 
 from __future__ import annotations
@@ -33,21 +44,28 @@ _WORD = re.compile(r"\S+")
 
 @dataclass(frozen=True)
 class ToolTable:
-    """Per tool number, its offsets X Y Z A B C U V W (mm and degrees)."""
+    """Per tool number, its offsets X Y Z A B C U V W (mm and degrees); a tool's Z offset
+    is its length along the tool axis.  Tools may have names (Heidenhain's TOOL CALL "NAME")."""
 
-    offsets: Mapping[int, tuple[float, ...]] = field(default_factory=dict, hash=False)
+    offsets: Mapping[float, tuple[float, ...]] = field(default_factory=dict, hash=False)
     source: str = "<tool table>"
+    names: Mapping[str, float] = field(default_factory=dict, hash=False)  # name -> tool number (the first listed)
 
     @classmethod
     def from_file(cls, path: str | Path, unit_mm: float = 1.0) -> "ToolTable":
-        """LinuxCNC's tool table, its lengths in the machine's units (`unit_mm` mm each)."""
+        """LinuxCNC's tool table, its lengths in the machine's units (`unit_mm` mm each),
+        or Heidenhain's TOOL.T (its units in its first line)."""
         try:
             text = Path(path).read_text(encoding="latin-1")
         except OSError as err:
             raise NcppError(f"cannot read the tool table: {err.strerror}", Location(str(path))) from None
-        return cls(read_tool_lines(text.splitlines(), str(path), unit_mm), str(path))
+        lines = text.splitlines()
+        if lines and lines[0].lstrip().upper().startswith("BEGIN"):
+            offsets, names = read_tool_t(lines, str(path))
+            return cls(offsets, str(path), names)
+        return cls(read_tool_lines(lines, str(path), unit_mm), str(path))
 
-    def offset(self, number: int) -> tuple[float, ...] | None:
+    def offset(self, number: float) -> tuple[float, ...] | None:
         """Tool `number`'s offsets (tool 0, no tool: all zero), None when the table has no such tool."""
         if number == 0:
             return (0.0,) * len(OFFSET_LETTERS)
@@ -94,3 +112,49 @@ def _integer(text: str, where: Location) -> int:
     if value != int(value) or value < 0:
         raise NcppError(f"a tool number is a whole number, got {text!r}", where)
     return int(value)
+
+
+def read_tool_t(lines: list[str], file: str) -> tuple[dict[float, tuple[float, ...]], dict[str, float]]:
+    """Heidenhain's TOOL.T: per tool its offsets (length L + DL as the Z offset, mm), and the names."""
+    unit_mm = 25.4 if "INCH" in lines[0].upper().split() else 1.0
+    if len(lines) < 2:
+        raise NcppError("TOOL.T without its column header", Location(file, 1, 1))
+    columns = _columns(lines[1], file)
+    tools: dict[float, tuple[float, ...]] = {}
+    names: dict[str, float] = {}
+    for n, line in enumerate(lines[2:], 3):
+        if line.strip().upper().startswith("[END]"):
+            break
+        if not line.strip():
+            continue
+        field_of = lambda name: _field(line, columns, name)  # noqa: E731  (text, column) of a column
+        text, col = field_of("T")
+        number = _number(text.replace(",", "."), Location(file, n, col))
+        if number < 0:
+            raise NcppError(f"a tool number is not negative, got {text!r}", Location(file, n, col))
+        if number in tools:
+            raise NcppError(f"tool {text} is listed twice", Location(file, n, col))
+        length = sum(_number(text.replace(",", ".") or "0", Location(file, n, col)) for text, col in map(field_of, ("L", "DL")))
+        tools[number] = (0.0, 0.0, length * unit_mm, *(0.0,) * (len(OFFSET_LETTERS) - 3))
+        name = field_of("NAME")[0]
+        if name:
+            names.setdefault(name, number)
+    return tools, names
+
+
+def _columns(header: str, file: str) -> dict[str, tuple[int, int]]:
+    """Each column's (start, end) in the lines: from its name to the next column's name."""
+    found = list(_WORD.finditer(header))
+    columns = {m.group().upper(): (m.start(), found[k + 1].start() if k + 1 < len(found) else None) for k, m in enumerate(found)}
+    for needed in ("T", "L"):
+        if needed not in columns:
+            raise NcppError(f"TOOL.T header without a {needed} column", Location(file, 2, 1))
+    return columns  # type: ignore[return-value]
+
+
+def _field(line: str, columns: dict[str, tuple[int, int]], name: str) -> tuple[str, int]:
+    """The stripped text of a column in a line ('' where the table has no such column), and its 1-based column."""
+    if name not in columns:
+        return "", 1
+    start, end = columns[name]
+    return line[start:end].strip(), start + 1

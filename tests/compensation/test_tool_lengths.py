@@ -191,12 +191,11 @@ def test_command_line_tool_table(tmp_path):
 @pytest.mark.parametrize(
     "dialect, program, where",
     [
-        ("heidenhain", b"0 BEGIN PGM P MM\n1 TOOL CALL 1 Z S800\n2 L X+10 Y+10 FMAX\n3 TOOL CALL 2 Z\n4 END PGM P MM\n", "t:2:3"),
         ("sinumerik", b"G0 X10 Y10\nT=\"MILL\" M6\nD1\nG1 X20 F100\nM30\n", "t:2:10"),
         ("sinumerik", b"G0 X10 Y10\nD0\nG1 X20 D2 F100\nM30\n", "t:3:8"),
     ],
 )
-def test_dialects_whose_tool_data_ncpp_does_not_read_say_so_once(dialect, program, where):
+def test_sinumerik_whose_tool_data_ncpp_does_not_read_says_so_once(dialect, program, where):
     said = io.StringIO()
     process(io.BytesIO(program), io.BytesIO(), file="t", source=ErrorSource.from_machine_file(str(MACHINE)),
             warnings=Warnings(stream=said), dialect=dialect, offsets=WorkOffsets.at(G54))  # fmt: skip

@@ -87,7 +87,7 @@ def _path(text: str, dialect: str) -> np.ndarray:
 
 
 def _compensated(text: str, dialect: str, source: ErrorSource) -> str:
-    """Compensated, every warning refused but the Heidenhain TOOL CALL's: ncpp does not read the
+    """Compensated, every warning refused but the Heidenhain TOOL CALL's: ncpp is not told the
     TNC's tool table, so it places the tool at length 0, as the ISO and Sinumerik parts say."""
     out, said = io.BytesIO(), io.StringIO()
     process(io.BytesIO(text.encode("latin-1")), out, file="part", source=source,
