@@ -98,48 +98,29 @@ def refuse_compensated(blocks: Iterable[Block], file: str) -> Iterator[Block]:
 
 # What the one-zero dialects' interpreters do not place (the ISO interpreter places it all):
 # Sinumerik's settable frames G54-G57 (G58/G59 are its programmable offsets: out of the
-# interpreter's scope, warned there) and G500, which deselects them; and the tool lengths
-# the control applies from its tool data (Sinumerik's tool change, which activates cutting
-# edge D1, and D words), which ncpp does not read.  (The Heidenhain interpreter places TOOL CALL.)
+# interpreter's scope, warned there) and G500, which deselects them.  (Tool lengths each
+# interpreter places itself, from the tool table it is told.)
 _ONE_ZERO = "ncpp compensates this dialect at one program zero, the work offset in effect when the program starts (--work-offset)"
-_NO_LENGTH = "ncpp does not read this dialect's tool data: compensated with tool length 0"
 OTHER_ZEROS = {
     **{value: f"{name} selects another work offset: {_ONE_ZERO}" for value, name in ((55.0, "G55"), (56.0, "G56"), (57.0, "G57"))},
     500.0: f"G500 deselects the work offset: {_ONE_ZERO}",
 }
-TOOL_LENGTHS = {
-    "sinumerik": f"the tool change (M6) or D word applies a tool length from the control's tool data: {_NO_LENGTH}",
-}
 
 
-def warn_unplaced(blocks: Iterable[Block], warnings: Warnings, file: str, dialect: str) -> Iterator[Block]:
-    """Pass blocks through; warn once per `OTHER_ZEROS` G word and once for `TOOL_LENGTHS`,
-    where the program first uses them (refused with --strict): the errors compensated
-    there are those of another place."""
+def warn_unplaced(blocks: Iterable[Block], warnings: Warnings, file: str) -> Iterator[Block]:
+    """Pass blocks through; warn once per `OTHER_ZEROS` G word where the program first uses
+    it (refused with --strict): the errors compensated there are those of another place."""
     told: set = set()
     for block in blocks:
         signature = block.signature  # the words' letters and G numbers: most blocks are passed on here
-        if signature is not None and "G5" not in signature and "M" not in signature and "D" not in signature:
+        if signature is not None and "G5" not in signature:
             yield block
             continue
         for item in block.items:
-            kind = type(item)
-            if kind is Word and item.letter == "G" and item.value in OTHER_ZEROS:
-                key, message = item.value, OTHER_ZEROS[item.value]
-            elif _applies_tool_length(item, kind, dialect):
-                key, message = "tool", TOOL_LENGTHS[dialect]
-            else:
-                continue
-            if key not in told:
-                told.add(key)
-                warnings.warn(message, Location(file, block.line, item.start + 1))
+            if type(item) is Word and item.letter == "G" and item.value in OTHER_ZEROS and item.value not in told:
+                told.add(item.value)
+                warnings.warn(OTHER_ZEROS[item.value], Location(file, block.line, item.start + 1))
         yield block
-
-
-def _applies_tool_length(item, kind: type, dialect: str) -> bool:
-    if dialect == "sinumerik":
-        return kind is Word and ((item.letter == "M" and item.value == 6.0) or (item.letter == "D" and item.value != 0.0))
-    return False
 
 
 def _counted(blocks: Iterable[Block], counter: Iterator[int], progress: Callable[[int], None] | None) -> Iterator[Block]:
@@ -272,7 +253,7 @@ def _process(
     if source is not None and not force:
         blocks = refuse_compensated(blocks, file)
     if source is not None and name != "iso":  # the ISO interpreter places every work offset and tool length
-        blocks = warn_unplaced(blocks, warnings, file, name)
+        blocks = warn_unplaced(blocks, warnings, file)
     # the control's zeros place the program on the machine; passthrough places nothing
     offsets = (offsets or AT_MACHINE_ZERO) if source is not None else None
     events: Iterable[Event] = interpret(blocks, file=file, warnings=warnings, strict=strict, offsets=offsets)

@@ -61,7 +61,7 @@ def add_placement_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--tool-table",
         metavar="FILE",
-        help="the control's tool table, LinuxCNC's tool.tbl or Heidenhain's TOOL.T: the tool lengths G43 or TOOL CALL apply, "
+        help="the control's tool table (LinuxCNC's tool.tbl, Heidenhain's TOOL.T, Sinumerik's _N_TO_INI): the tool lengths G43, TOOL CALL or M6/D apply, "
         "which move the axes and lengthen the Abbe arm; without it they apply length 0, with a warning",
     )
     p.add_argument(

@@ -5,7 +5,10 @@ more than a half circle), `TURN=` extra helix turns, `CIP` with `I1=/J1=/K1=`
 (an arc through an intermediate point, in a principal plane), `CT` (tangential
 arc), G90/G91 and `AC()`/`IC()` per word, G17/G18/G19, G70/G71/G700/G710,
 `TRANS`/`ATRANS` (translation only), R parameters and `DEF` variables with
-arithmetic, labels, `MSG`, G4 dwell, M2/M17/M30 (end).  Control flow (GOTO*,
+arithmetic, labels, `MSG`, G4 dwell, M2/M17/M30 (end), and tool lengths: `T n`
+or `T="NAME"` selects, M6 loads it with cutting edge D1, `D n` picks an edge
+(D0 none); the edge's lengths 1-3 from the control's tool offsets (`_N_TO_INI`,
+`tools.py`) act along the plane's axes (G17: length 1 along Z).  Control flow (GOTO*,
 IF, WHILE, FOR, REPEAT, CASE), calls of cycles and subprograms, splines, other
 frames, cutter compensation (G41/G42) and unknown G codes make the position
 unknown: one warning (an error with `strict`) and the rest passes through.
@@ -16,10 +19,11 @@ from __future__ import annotations
 import math
 from typing import Iterable, Iterator
 
-from ncpp.errors import Warnings
-from ncpp.motion.modal import ModalInterpreter, OutOfScope, circle_through, plane_of, resolve_warnings
+from ncpp.errors import Location, Warnings
+from ncpp.motion.modal import MM_PER_INCH, ModalInterpreter, OutOfScope, circle_through, plane_of, resolve_warnings
 from ncpp.motion.offsets import WorkOffsets
 from ncpp.motion.segments import PLANE_AXES, Event
+from ncpp.motion.tools import ToolTable
 from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
 
 AXES = "XYZ"
@@ -41,12 +45,27 @@ def interpret(blocks: Iterable[Block], *, file: str = "<stdin>", warnings: Warni
               strict: bool = False, offsets: WorkOffsets | None = None) -> Iterator[Event]:
     """Motion events of a Sinumerik program's blocks, lazily (see the module docstring)."""
     zero = offsets.program_zero() if offsets is not None else (0.0, 0.0, 0.0)  # one program zero: the system in effect
-    return SinumerikInterpreter(file, zero).run(blocks, resolve_warnings(warnings, strict))
+    interpreter = SinumerikInterpreter(file, zero, offsets.tools if offsets is not None else None)
+    interpreter.untold_tools = offsets is not None and offsets.tools is None  # placing the program: say what it cannot place
+    warnings = resolve_warnings(warnings, strict)
+    interpreter.warnings = warnings
+    return interpreter.run(blocks, warnings)
+
+
+# The axis (X, Y, Z index) that lengths 1, 2 and 3 of a milling tool act along, per plane
+LENGTH_AXES = {17: (2, 1, 0), 18: (1, 0, 2), 19: (0, 2, 1)}
+TOOL_CHANGE = 6.0  # M6 loads the tool T selected, with its cutting edge D1 unless the block says another
 
 
 class SinumerikInterpreter(ModalInterpreter):
-    def __init__(self, file: str = "<stdin>", zero: tuple[float, float, float] = (0.0, 0.0, 0.0)):
+    def __init__(self, file: str = "<stdin>", zero: tuple[float, float, float] = (0.0, 0.0, 0.0), tools: ToolTable | None = None):
         super().__init__(file, zero)
+        self.tools = tools  # the control's tool offsets (_N_TO_INI), if told
+        self.selected: float | str = 0.0  # the tool T selected: a number, or a name
+        self.loaded: float | str = 0.0  # the tool M6 loaded (0: none)
+        self.edge = 0  # the cutting edge D in effect (0: no tool offset)
+        self.untold_tools = False  # warn, once, where a tool length would apply that nothing tells
+        self.warnings: Warnings | None = None
         self.motion: float | str = 0.0  # 0-3, 'CIP' or 'CT' (G0 after power on)
         self.absolute = True
         self.variables: dict[str, float | str] = {}
@@ -96,6 +115,7 @@ class SinumerikInterpreter(ModalInterpreter):
         path: str | None = None
         frame: Statement | None = None
         end = False
+        tool_words: list = []  # the block's T, M6 and D words, in order
         for item in block.items:
             kind = type(item)
             if kind is Comment:
@@ -116,6 +136,9 @@ class SinumerikInterpreter(ModalInterpreter):
                     name = item.node[0] if what in ("call", "path", "frame") else what.upper()
                     raise OutOfScope(f"{what} {name}" if what in ("call", "path", "frame") else name, item.start + 1)
                 continue
+            if item.letter == "T" and kind is ExprWord and item.expr[0] == "str":  # T="NAME"
+                tool_words.append((item, item.expr[1]))
+                continue
             if kind is Word:
                 letter, value, mode = item.letter, item.value, None
             else:
@@ -124,13 +147,20 @@ class SinumerikInterpreter(ModalInterpreter):
                 gcodes.append((value, item))
             elif letter == "M":
                 end = end or value in END_M
+                if value == TOOL_CHANGE:
+                    tool_words.append((item, value))
+            elif letter in ("T", "D"):
+                tool_words.append((item, value))
             elif letter in ("N", ":"):
                 continue
             else:
                 if letter in words:
                     self.fail(f"the address {letter} twice in one block", block, item)
                 words[letter] = (value, mode, item)
+        plane = self.plane
         dwell = self._modal_codes(gcodes, block)
+        if tool_words or (self.plane != plane and self.edge):
+            self._place_tool(block, tool_words)
         if path is not None:
             self.motion = path
         if frame is not None:
@@ -144,6 +174,45 @@ class SinumerikInterpreter(ModalInterpreter):
         if end:
             self.done = True
         return events
+
+    # -- tool lengths -----------------------------------------------------------------------
+    def _place_tool(self, block: Block, tool_words: list) -> None:
+        """Follow T, M6 and D (in that order, wherever they stand in the block: M6 loads the T
+        of its block, D picks that tool's edge), then apply the lengths of the loaded tool's
+        edge along the plane's axes."""
+        changed = False
+        for item, value in sorted(tool_words, key=lambda word: "TMD".index(word[0].letter)):
+            if item.letter == "T":
+                self.selected = value
+            elif item.letter == "M":
+                self.loaded, self.edge, changed = self.selected, 1, True
+            else:
+                self.edge, changed = int(value), True
+            if changed and self.tools is None and self.untold_tools and self.edge and self.warnings is not None:
+                self.untold_tools = False
+                self.warnings.warn(
+                    "the tool change (M6) or D word applies a tool length from the control's tool offsets, which ncpp "
+                    "is not told: compensated with tool length 0 (give --tool-table _N_TO_INI)",
+                    Location(self.file, block.line, item.start + 1),
+                )
+        lengths = self._edge_lengths(block, tool_words[-1][0] if tool_words else None)
+        tool = [0.0, 0.0, 0.0]
+        for length, axis in zip(lengths, LENGTH_AXES[self.plane]):
+            tool[axis] = length / (MM_PER_INCH if self.inch else 1.0)
+        self.set_tool(tool)
+
+    def _edge_lengths(self, block: Block, item) -> tuple[float, float, float]:
+        """Lengths 1-3 (mm) of the loaded tool's cutting edge in effect (none: D0, no tool, no table)."""
+        if self.tools is None or not self.edge or self.loaded in (0.0, ""):
+            return (0.0, 0.0, 0.0)
+        number = self.loaded if type(self.loaded) is float else self.tools.names.get(self.loaded)  # type: ignore[arg-type]
+        if number is None:
+            self.fail(f'tool "{self.loaded}" is not in {self.tools.source}', block, item)
+        lengths = self.tools.edges.get((number, self.edge))  # type: ignore[arg-type]
+        if lengths is None:
+            self.fail(f"tool {self.loaded if type(self.loaded) is str else f'{number:g}'} has no cutting edge D{self.edge} in {self.tools.source}",
+                      block, item)  # fmt: skip
+        return lengths  # type: ignore[return-value]
 
     def _word_value(self, item: ExprWord, block: Block) -> tuple[float, str | None]:
         expr = item.expr

@@ -1,4 +1,4 @@
-"""The control's tool table: where each tool's tip is, as G43 (or Heidenhain's TOOL CALL) applies it.
+"""The control's tool table: where each tool's tip is, as G43 (Heidenhain's TOOL CALL, Sinumerik's D) applies it.
 
 A program that says `G43 H1` (or `T1 M6` and `G43`) moves with the tool tip
 as its controlled point: the control adds the tool's offset from its tool
@@ -25,6 +25,19 @@ units in the first line:
 
 A tool's length is L + DL along the tool axis (kept as its Z offset here: the
 axis is the one TOOL CALL names); numbers may have a decimal comma.
+
+Sinumerik's tool offsets, as the control saves them (`_N_TO_INI`), per tool T
+and cutting edge D:
+
+    $TC_TP2[1]="D10_ENDMILL"
+    $TC_DP1[1,1]=120
+    $TC_DP3[1,1]=150.0   ; length 1 (geometry), + $TC_DP12 (wear) + $TC_DP21 (adapter)
+    $TC_DP4[1,1]=0.0     ; length 2, + $TC_DP13 + $TC_DP22
+    $TC_DP5[1,1]=0.0     ; length 3, + $TC_DP14 + $TC_DP23
+
+Its lengths are in the machine's units; which axis each acts along depends on
+the plane (G17: length 1 along Z, 2 along Y, 3 along X), so they are kept per
+edge, not as axis offsets.
 """
 
 from __future__ import annotations
@@ -50,6 +63,7 @@ class ToolTable:
     offsets: Mapping[float, tuple[float, ...]] = field(default_factory=dict, hash=False)
     source: str = "<tool table>"
     names: Mapping[str, float] = field(default_factory=dict, hash=False)  # name -> tool number (the first listed)
+    edges: Mapping[tuple[float, int], tuple[float, float, float]] = field(default_factory=dict, hash=False)  # Sinumerik (T, D) -> lengths 1-3, mm
 
     @classmethod
     def from_file(cls, path: str | Path, unit_mm: float = 1.0) -> "ToolTable":
@@ -60,6 +74,9 @@ class ToolTable:
         except OSError as err:
             raise NcppError(f"cannot read the tool table: {err.strerror}", Location(str(path))) from None
         lines = text.splitlines()
+        if "$TC_DP" in text.upper():
+            edges, names = read_to_ini(lines, str(path), unit_mm)
+            return cls({}, str(path), names, edges)
         if lines and lines[0].lstrip().upper().startswith("BEGIN"):
             offsets, names = read_tool_t(lines, str(path))
             return cls(offsets, str(path), names)
@@ -158,3 +175,29 @@ def _field(line: str, columns: dict[str, tuple[int, int]], name: str) -> tuple[s
         return "", 1
     start, end = columns[name]
     return line[start:end].strip(), start + 1
+
+
+_TC_DP = re.compile(r"\$TC_DP(\d+)\[\s*(\d+)\s*,\s*(\d+)\s*\]\s*=\s*(\S*)", re.IGNORECASE)
+_TC_TP2 = re.compile(r"\$TC_TP2\[\s*(\d+)\s*\]\s*=\s*\"([^\"]*)\"", re.IGNORECASE)
+# lengths 1-3 of an edge: geometry, wear and adapter parameters, added
+_LENGTH_PARAMETERS = {3: 0, 12: 0, 21: 0, 4: 1, 13: 1, 22: 1, 5: 2, 14: 2, 23: 2}
+
+
+def read_to_ini(lines: list[str], file: str, unit_mm: float) -> tuple[dict[tuple[float, int], tuple[float, float, float]], dict[str, float]]:
+    """Sinumerik's tool offsets: per (T, D) its lengths 1-3 in mm, and the tools' names."""
+    lengths: dict[tuple[float, int], list[float]] = {}
+    names: dict[str, float] = {}
+    for n, line in enumerate(lines, 1):
+        data = line.split(";", 1)[0]
+        if (named := _TC_TP2.search(data)) is not None:
+            names.setdefault(named.group(2), float(named.group(1)))
+            continue
+        found = _TC_DP.search(data)
+        if found is None:
+            continue
+        parameter, tool, edge = (int(found.group(k)) for k in (1, 2, 3))
+        value = _number(found.group(4), Location(file, n, found.start(4) + 1))
+        edge_lengths = lengths.setdefault((float(tool), edge), [0.0, 0.0, 0.0])
+        if parameter in _LENGTH_PARAMETERS:
+            edge_lengths[_LENGTH_PARAMETERS[parameter]] += value * unit_mm
+    return {key: (a, b, c) for key, (a, b, c) in lengths.items()}, names

@@ -186,18 +186,3 @@ def test_command_line_tool_table(tmp_path):
     assert told.stdout != untold.stdout
     missing = run("--tool-table", str(tmp_path / "nowhere.tbl"))
     assert missing.returncode != 0 and b"nowhere.tbl: cannot read the tool table" in missing.stderr
-
-
-@pytest.mark.parametrize(
-    "dialect, program, where",
-    [
-        ("sinumerik", b"G0 X10 Y10\nT=\"MILL\" M6\nD1\nG1 X20 F100\nM30\n", "t:2:10"),
-        ("sinumerik", b"G0 X10 Y10\nD0\nG1 X20 D2 F100\nM30\n", "t:3:8"),
-    ],
-)
-def test_sinumerik_whose_tool_data_ncpp_does_not_read_says_so_once(dialect, program, where):
-    said = io.StringIO()
-    process(io.BytesIO(program), io.BytesIO(), file="t", source=ErrorSource.from_machine_file(str(MACHINE)),
-            warnings=Warnings(stream=said), dialect=dialect, offsets=WorkOffsets.at(G54))  # fmt: skip
-    lines = said.getvalue().splitlines()
-    assert len(lines) == 1 and lines[0].startswith(f"{where}: warning: ") and "tool length 0" in lines[0], lines
