@@ -31,7 +31,7 @@ from ncpp.motion.corners import CornerError, round_corner
 from ncpp.motion.modal import MM_PER_INCH, PLANE_OF_TOOL_AXIS, ModalInterpreter, OutOfScope, resolve_warnings
 from ncpp.motion.offsets import WorkOffsets
 from ncpp.motion.segments import PLANE_AXES, Arc, Event, Line, Pass, Point
-from ncpp.motion.tools import ToolTable
+from ncpp.motion.tools import ToolTable, UntoldLengths
 from ncpp.program.blocks import Block, Comment, ExprWord, Word
 
 AXES = "XYZ"
@@ -64,7 +64,7 @@ def interpret(blocks: Iterable[Block], *, file: str = "<stdin>", warnings: Warni
     """Motion events of a Heidenhain program's blocks, lazily (see the module docstring)."""
     zero = offsets.program_zero() if offsets is not None else (0.0, 0.0, 0.0)  # one program zero: the system in effect
     interpreter = HeidenhainInterpreter(file, zero, offsets.tools if offsets is not None else None)
-    interpreter.untold_tools = offsets is not None and offsets.tools is None  # placing the program: say what it cannot place
+    interpreter.untold_lengths.armed = offsets is not None and offsets.tools is None  # placing the program: say what it cannot place
     return interpreter.run(blocks, resolve_warnings(warnings, strict))
 
 
@@ -83,8 +83,7 @@ class HeidenhainInterpreter(ModalInterpreter):
         self.tool_number: float | None = 0.0  # the tool TOOL CALL put in the spindle (None: one named, no table)
         self.tool_axis = 2  # the axis its length is along (TOOL CALL's axis)
         self.call_dl = 0.0  # the last TOOL CALL's DL (an oversize), program units
-        self.untold_tools = False  # warn, once, at a TOOL CALL whose tool length nothing tells
-        self.warnings: Warnings | None = None
+        self.untold_lengths = UntoldLengths()  # warns at a TOOL CALL whose tool length nothing tells
         self.q: dict[str, float] = {}
         self.pole: list[float] | None = None
         self.pole_plane = 17
@@ -95,7 +94,7 @@ class HeidenhainInterpreter(ModalInterpreter):
     def run(self, blocks: Iterable[Block], warnings: Warnings) -> Iterator[Event]:
         """Events as `ModalInterpreter.run`; a feed line waits (with the events after it)
         for the next move, which an RND/CHF block in between makes round or cut."""
-        self.warnings = warnings  # TOOL CALL's, if it cannot place the tool
+        self.untold_lengths.warnings = warnings
         held: list[Event] = []  # the last feed line and the events after it
         corner: Corner | None = None
         for event in super().run(blocks, warnings):
@@ -270,13 +269,7 @@ class HeidenhainInterpreter(ModalInterpreter):
         if number in self.defined:
             return self.defined[number]
         if self.tools is None or number is None:
-            if self.untold_tools and self.warnings is not None:
-                self.untold_tools = False
-                self.warnings.warn(
-                    "TOOL CALL applies the tool's length from the control's tool table, which ncpp is not told: "
-                    "compensated with tool length 0 (give --tool-table TOOL.T)",
-                    Location(self.file, block.line, statement.start + 1),
-                )
+            self.untold_lengths("TOOL CALL", "TOOL.T", Location(self.file, block.line, statement.start + 1))
             return 0.0
         offsets = self.tools.offset(number)
         if offsets is None:

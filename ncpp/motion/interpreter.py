@@ -30,6 +30,7 @@ from ncpp.motion.corners import CornerError, round_corner
 from ncpp.motion.expressions import ExpressionError, OutOfScope, Parameters, evaluate
 from ncpp.motion.offsets import SYSTEMS, WorkOffsets
 from ncpp.motion.segments import PLANE_AXES, Arc, Context, Event, Line, Pass
+from ncpp.motion.tools import UntoldLengths
 from ncpp.program.blocks import Block, Comment, ExprWord, Word
 
 MM_PER_INCH = 25.4
@@ -153,7 +154,7 @@ class Interpreter:
         self.tools = offsets.tools if offsets is not None else None  # the control's tool table
         self.selected_tool = 0  # T
         self.spindle_tool = 0  # M6, M61 (0: none)
-        self.untold_tools = offsets is not None and offsets.tools is None  # warned at the first G43 that reads the table
+        self.untold_lengths = UntoldLengths(offsets is not None and offsets.tools is None)  # warned at the first G43 that reads the table
         self.home = {28: [0.0] * 9, 30: [0.0] * 9}  # G28/G30 positions, machine coordinates
         self.uses_extra_axes = False
         self.params = Parameters(self._system_parameter)
@@ -182,7 +183,7 @@ class Interpreter:
         `G1 ... R`) waits for the next move, which decides the corner; the
         blocks in between wait with it (bounded by the program's own layout)."""
         block_event = self.block
-        self.warnings = warnings
+        self.warnings = self.untold_lengths.warnings = warnings
         pending: Line | None = None  # the line whose end corner is rounded
         corner = None
         held: list[Event] = []  # non-moving events after it
@@ -662,13 +663,7 @@ class Interpreter:
     def _table_offsets(self, number: int, item, block: Block) -> tuple[float, ...]:
         """Tool `number`'s offsets in mm; zero when ncpp is not told the table (warned once)."""
         if self.tools is None:
-            if self.untold_tools and self.warnings is not None:
-                self.untold_tools = False
-                self.warnings.warn(
-                    "G43 applies a tool length from the control's tool table, which ncpp is not told: "
-                    "compensated with length 0 (give --tool-table)",
-                    Location(self.file, block.line, item.start + 1),
-                )
+            self.untold_lengths("G43", "tool.tbl", Location(self.file, block.line, item.start + 1))
             return (0.0,) * 9
         return self.tools.offset(number)  # type: ignore[return-value]  # checked by `_tool_number`
 

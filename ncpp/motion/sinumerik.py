@@ -23,7 +23,7 @@ from ncpp.errors import Location, Warnings
 from ncpp.motion.modal import MM_PER_INCH, ModalInterpreter, OutOfScope, circle_through, plane_of, resolve_warnings
 from ncpp.motion.offsets import WorkOffsets
 from ncpp.motion.segments import PLANE_AXES, Event
-from ncpp.motion.tools import ToolTable
+from ncpp.motion.tools import ToolTable, UntoldLengths
 from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
 
 AXES = "XYZ"
@@ -46,9 +46,8 @@ def interpret(blocks: Iterable[Block], *, file: str = "<stdin>", warnings: Warni
     """Motion events of a Sinumerik program's blocks, lazily (see the module docstring)."""
     zero = offsets.program_zero() if offsets is not None else (0.0, 0.0, 0.0)  # one program zero: the system in effect
     interpreter = SinumerikInterpreter(file, zero, offsets.tools if offsets is not None else None)
-    interpreter.untold_tools = offsets is not None and offsets.tools is None  # placing the program: say what it cannot place
     warnings = resolve_warnings(warnings, strict)
-    interpreter.warnings = warnings
+    interpreter.untold_lengths = UntoldLengths(offsets is not None and offsets.tools is None, warnings)  # placing the program
     return interpreter.run(blocks, warnings)
 
 
@@ -64,8 +63,7 @@ class SinumerikInterpreter(ModalInterpreter):
         self.selected: float | str = 0.0  # the tool T selected: a number, or a name
         self.loaded: float | str = 0.0  # the tool M6 loaded (0: none)
         self.edge = 0  # the cutting edge D in effect (0: no tool offset)
-        self.untold_tools = False  # warn, once, where a tool length would apply that nothing tells
-        self.warnings: Warnings | None = None
+        self.untold_lengths = UntoldLengths()  # warns where a tool length applies that nothing tells
         self.motion: float | str = 0.0  # 0-3, 'CIP' or 'CT' (G0 after power on)
         self.absolute = True
         self.variables: dict[str, float | str] = {}
@@ -188,13 +186,8 @@ class SinumerikInterpreter(ModalInterpreter):
                 self.loaded, self.edge, changed = self.selected, 1, True
             else:
                 self.edge, changed = int(value), True
-            if changed and self.tools is None and self.untold_tools and self.edge and self.warnings is not None:
-                self.untold_tools = False
-                self.warnings.warn(
-                    "the tool change (M6) or D word applies a tool length from the control's tool offsets, which ncpp "
-                    "is not told: compensated with tool length 0 (give --tool-table _N_TO_INI)",
-                    Location(self.file, block.line, item.start + 1),
-                )
+            if changed and self.tools is None and self.edge:
+                self.untold_lengths(f"{item.letter}{value:g}", "_N_TO_INI", Location(self.file, block.line, item.start + 1))
         lengths = self._edge_lengths(block, tool_words[-1][0] if tool_words else None)
         tool = [0.0, 0.0, 0.0]
         for length, axis in zip(lengths, LENGTH_AXES[self.plane]):

@@ -47,7 +47,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Mapping
 
-from ncpp.errors import Location, NcppError
+from ncpp.errors import Location, NcppError, Warnings
 
 OFFSET_LETTERS = "XYZABCUVW"  # a tool's offsets, in the interpreter's axis order
 _LINEAR = frozenset("XYZUVW")  # the offsets in length units (A B C are degrees)
@@ -87,6 +87,24 @@ class ToolTable:
         if number == 0:
             return (0.0,) * len(OFFSET_LETTERS)
         return self.offsets.get(number)
+
+
+class UntoldLengths:
+    """The one warning of a program run placed without a tool table (`armed`), where the
+    program first applies a tool length: ncpp compensates it at length 0."""
+
+    def __init__(self, armed: bool = False, warnings: Warnings | None = None):
+        self.armed, self.warnings = armed, warnings
+
+    def __call__(self, what: str, table: str, where: Location) -> None:
+        """`what` (G43, TOOL CALL ...) applies a length from `table`, which ncpp is not told."""
+        if self.armed and self.warnings is not None:
+            self.armed = False
+            self.warnings.warn(
+                f"{what} applies a tool length from the control's tool table, which ncpp is not told: "
+                f"compensated with tool length 0 (give --tool-table {table})",
+                where,
+            )
 
 
 def read_tool_lines(lines: list[str], file: str, unit_mm: float) -> dict[int, tuple[float, ...]]:

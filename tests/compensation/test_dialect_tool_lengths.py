@@ -114,11 +114,11 @@ UNTOLD = b"0 BEGIN PGM P MM\n1 TOOL CALL 1 Z S800\n2 L X+10 Y+10 FMAX\n3 TOOL CA
 
 def test_without_a_tool_table_tool_call_is_warned_once(tmp_path):
     lines = _warnings(UNTOLD, WorkOffsets.at(ZERO)).splitlines()
-    assert len(lines) == 1 and lines[0].startswith("t:2:3: warning: TOOL CALL applies the tool's length") and "tool length 0" in lines[0]
+    assert len(lines) == 1 and lines[0].startswith("t:2:3: warning: TOOL CALL applies a tool length") and "tool length 0" in lines[0]
     assert _warnings(UNTOLD, replace(WorkOffsets.at(ZERO), tools=_table(tmp_path))) == ""
     defined = UNTOLD.replace(b"1 TOOL CALL", b"1 TOOL DEF 1 L+100 R+5\n1 TOOL DEF 2 L+50 R+3\n1 TOOL CALL")
     assert _warnings(defined, WorkOffsets.at(ZERO)) == ""  # the program says its tools' lengths
-    with pytest.raises(NcppError, match=r"t:2:3: TOOL CALL applies the tool's length"):
+    with pytest.raises(NcppError, match=r"t:2:3: TOOL CALL applies a tool length"):
         _warnings(UNTOLD, WorkOffsets.at(ZERO), strict=True)
 
 
