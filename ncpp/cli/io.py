@@ -24,7 +24,11 @@ def add_io_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("input", nargs="?", help="NC program (default: standard input)")
     p.add_argument("-o", "--output", help="output file, written atomically (default: standard output)")
     p.add_argument("--strict", action="store_true", help="refuse constructs that would pass through with a warning")
-    p.add_argument("--dialect", default=None, help="NC dialect (default: detected from the content)")
+    add_dialect_argument(p)
+
+
+def add_dialect_argument(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--dialect", default=None, help="NC dialect: iso, heidenhain or sinumerik (default: detected from the content)")
 
 
 @contextlib.contextmanager

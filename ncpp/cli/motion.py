@@ -18,7 +18,10 @@ plane, inch, and the work offset (machine minus program position).
 
 `--var-file linuxcnc.var` / `--work-offset [G5x=]X,Y,Z` start the
 interpreter from the control's zeros, as `rs274 -v FILE` does (default: all
-zero, rs274's default parameter file).
+zero, rs274's default parameter file), and `--tool-table` from its tool
+table (`rs274 -t`); the JSON records carry the tool length offset too.
+Heidenhain and Sinumerik programs print the same records (`--dialect`, or
+detected from the content).
 """
 
 from __future__ import annotations
@@ -26,6 +29,7 @@ from __future__ import annotations
 import argparse
 
 from ncpp.cli.compensate import add_placement_arguments, work_offsets
+from ncpp.cli.io import add_dialect_argument
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -38,6 +42,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("input", nargs="?", metavar="FILE", help="NC program (default: standard input)")
     parser.add_argument("--format", choices=("rs274", "json"), default="rs274")
     parser.add_argument("--strict", action="store_true", help="refuse constructs outside the interpreter's scope")
+    add_dialect_argument(parser)
     add_placement_arguments(parser)
     parser.set_defaults(func=run)
 
@@ -48,16 +53,18 @@ def run(args: argparse.Namespace) -> int:
 
     from ncpp.cli.io import open_input
     from ncpp.errors import Warnings
-    from ncpp.motion import interpret
     from ncpp.motion.canon import format_event
     from ncpp.motion.segments import Arc, Line
-    from ncpp.program.parser import parse_stream
+    from ncpp.pipeline import dialect_tools
+    from ncpp.program.dialects import parse_program
 
     warnings = Warnings(strict=args.strict)
     offsets = work_offsets(args) if args.work_offset or args.var_file or args.tool_table else None
     out = sys.stdout
     with open_input(args.input) as (stream, name):
-        for event in interpret(parse_stream(stream, name), file=name, warnings=warnings, offsets=offsets):
+        dialect, blocks = parse_program(stream, name, args.dialect)
+        interpret, _ = dialect_tools(dialect)
+        for event in interpret(blocks, file=name, warnings=warnings, offsets=offsets):
             if type(event) is not Line and type(event) is not Arc:
                 continue
             if args.format == "rs274":
@@ -72,6 +79,7 @@ def run(args: argparse.Namespace) -> int:
                 "plane": event.context.plane,
                 "inch": event.context.inch,
                 "offset": event.context.offset,
+                "tool": event.context.tool,
             }
             if type(event) is Arc:
                 record["center"] = event.center

@@ -11,6 +11,7 @@ import argparse
 import json
 
 from ncpp.cli.compensate import add_placement_arguments, work_offsets
+from ncpp.cli.io import add_dialect_argument
 from ncpp.errors import NcppError, Warnings
 
 
@@ -20,19 +21,20 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--machine", required=True, metavar="M.toml", help="machine file (the virtual machine)")
     p.add_argument("--reference", metavar="ORIGINAL", help="nominal program (for a compensated PROGRAM)")
     add_placement_arguments(p)
+    add_dialect_argument(p)
     p.add_argument("--step", type=float, default=0.5, metavar="MM", help="sample spacing along the path (default 0.5)")
     p.add_argument("--json", metavar="OUT", help="write the figures as JSON")
     p.add_argument("--plot", metavar="OUT.png", help="plot the contour error (and circle traces)")
     p.set_defaults(func=run)
 
 
-def program_events(path: str, warnings: Warnings, offsets=None) -> list:
-    """The events of a program (any dialect), placed on the machine by `offsets`."""
+def program_events(path: str, warnings: Warnings, offsets=None, dialect: str | None = None) -> list:
+    """The events of a program (its dialect detected unless given), placed on the machine by `offsets`."""
     from ncpp.pipeline import dialect_tools
     from ncpp.program.dialects import parse_program
 
     with open(path, "rb") as stream:
-        name, blocks = parse_program(stream, path, None)
+        name, blocks = parse_program(stream, path, dialect)
         interpret, _ = dialect_tools(name)
         return list(interpret(blocks, file=path, warnings=warnings, offsets=offsets))
 
@@ -45,8 +47,8 @@ def run(args: argparse.Namespace) -> int:
     machine = load_machine(args.machine)
     warnings = Warnings()
     offsets = work_offsets(args)
-    commanded = sample_events(program_events(args.program, warnings, offsets), args.step)
-    nominal = sample_events(program_events(args.reference, warnings, offsets), args.step) if args.reference else commanded
+    commanded = sample_events(program_events(args.program, warnings, offsets, args.dialect), args.step)
+    nominal = sample_events(program_events(args.reference, warnings, offsets, args.dialect), args.step) if args.reference else commanded
     if len(commanded.points) == 0:
         raise NcppError("the program makes no motion the interpreter could follow")
     report = contour_error(machine, commanded, nominal)

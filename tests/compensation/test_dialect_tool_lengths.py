@@ -261,3 +261,20 @@ def test_command_line_tool_table(tmp_path, dialect, suffix):
     assert told.returncode == 0 and told.stderr == b"", told.stderr
     assert untold.returncode == 0 and b"tool length 0" in untold.stderr
     assert told.stdout != untold.stdout
+
+
+def test_motion_and_simulate_take_the_dialect_and_its_tool_table(tmp_path):
+    """The Sinumerik pocket reads as ISO G code too (nothing in it is Sinumerik's alone): --dialect says."""
+    import json
+
+    program, name, text = TWO_TOOLS["sinumerik"]
+    (tmp_path / name).write_text(text)
+    (tmp_path / "pocket.mpf").write_bytes(program)
+    placed = ["--work-offset", "400,350,300", "--tool-table", str(tmp_path / name), "--dialect", "sinumerik", str(tmp_path / "pocket.mpf")]
+    motion = subprocess.run([sys.executable, "-m", "ncpp", "motion", "--format", "json", *placed], capture_output=True, cwd=ROOT)
+    assert motion.returncode == 0, motion.stderr
+    tools = {tuple(json.loads(line)["tool"]) for line in motion.stdout.splitlines()}
+    assert tools == {(0.0, 0.0, 150.0), (0.0, 1.5, 40.5)}
+    simulated = subprocess.run([sys.executable, "-m", "ncpp", "simulate", "--machine", str(MACHINE), *placed], capture_output=True, cwd=ROOT)
+    assert simulated.returncode == 0, simulated.stderr
+    assert b"at [400.0, 350.0, 448.0]" in simulated.stdout and b"at [400.0, 351.5, 338.5]" in simulated.stdout  # each tool's circle
