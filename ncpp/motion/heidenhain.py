@@ -222,8 +222,8 @@ class HeidenhainInterpreter(ModalInterpreter):
 
     def _tool_def(self, block: Block, statement) -> list[Event]:
         """`TOOL DEF n L.. R..`: the program defines tool n's length (without L: it only prepares the tool)."""
+        number = self._tool_number(statement.node[0], block, statement)
         for item in block.items:
-            number = self._tool_number(statement.node[0], block, statement)
             if (type(item) is Word or type(item) is ExprWord) and item.letter == "L" and number is not None:
                 self.defined[number] = self._word_value(item, block)
         return []
