@@ -64,8 +64,9 @@ def interpret(blocks: Iterable[Block], *, file: str = "<stdin>", warnings: Warni
     """Motion events of a Heidenhain program's blocks, lazily (see the module docstring)."""
     zero = offsets.program_zero() if offsets is not None else (0.0, 0.0, 0.0)  # one program zero: the system in effect
     interpreter = HeidenhainInterpreter(file, zero, offsets.tools if offsets is not None else None)
-    interpreter.untold_lengths.armed = offsets is not None and offsets.tools is None  # placing the program: say what it cannot place
-    return interpreter.run(blocks, resolve_warnings(warnings, strict))
+    warnings = resolve_warnings(warnings, strict)
+    interpreter.untold_lengths = UntoldLengths(offsets is not None and offsets.tools is None, warnings)  # placing the program
+    return interpreter.run(blocks, warnings)
 
 
 def _plane_of_axes(axes: set[int], default: int) -> int:
@@ -94,7 +95,6 @@ class HeidenhainInterpreter(ModalInterpreter):
     def run(self, blocks: Iterable[Block], warnings: Warnings) -> Iterator[Event]:
         """Events as `ModalInterpreter.run`; a feed line waits (with the events after it)
         for the next move, which an RND/CHF block in between makes round or cut."""
-        self.untold_lengths.warnings = warnings
         held: list[Event] = []  # the last feed line and the events after it
         corner: Corner | None = None
         for event in super().run(blocks, warnings):
@@ -271,10 +271,10 @@ class HeidenhainInterpreter(ModalInterpreter):
         if self.tools is None or number is None:
             self.untold_lengths("TOOL CALL", "TOOL.T", Location(self.file, block.line, statement.start + 1))
             return 0.0
-        offsets = self.tools.offset(number)
-        if offsets is None:
+        lengths = self.tools.edges.get((number, 1))
+        if lengths is None:
             self.fail(f"tool {number:g} is not defined: neither in {self.tools.source} nor by TOOL DEF", block, statement)
-        return offsets[2] / (MM_PER_INCH if self.inch else 1.0)  # type: ignore[index]
+        return lengths[0] / (MM_PER_INCH if self.inch else 1.0)  # type: ignore[index]
 
     def _word_value(self, item, block: Block) -> float:
         return item.value if type(item) is Word else self.value(item.expr, block, item)

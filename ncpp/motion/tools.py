@@ -23,8 +23,8 @@ units in the first line:
     1    D10_ENDMILL      +150,000   +5,000     -0,020  +0,000
     [END]
 
-A tool's length is L + DL along the tool axis (kept as its Z offset here: the
-axis is the one TOOL CALL names); numbers may have a decimal comma.
+A tool's length is L + DL along the tool axis (the axis TOOL CALL names): its
+one cutting edge's length 1, as Sinumerik's below; numbers may have a decimal comma.
 
 Sinumerik's tool offsets, as the control saves them (`_N_TO_INI`), per tool T
 and cutting edge D:
@@ -57,18 +57,20 @@ _WORD = re.compile(r"\S+")
 
 @dataclass(frozen=True)
 class ToolTable:
-    """Per tool number, its offsets X Y Z A B C U V W (mm and degrees); a tool's Z offset
-    is its length along the tool axis.  Tools may have names (Heidenhain's TOOL CALL "NAME")."""
+    """A control's tool data: LinuxCNC's per tool number offsets X Y Z A B C U V W along the
+    machine's axes (mm and degrees, as G43 adds them), or Heidenhain's and Sinumerik's per
+    tool and cutting edge lengths 1-3 relative to the tool axis (length 1 along it, mm: the
+    control turns them onto the machine's axes), and the tools' names."""
 
-    offsets: Mapping[float, tuple[float, ...]] = field(default_factory=dict, hash=False)
+    offsets: Mapping[int, tuple[float, ...]] = field(default_factory=dict, hash=False)
     source: str = "<tool table>"
     names: Mapping[str, float] = field(default_factory=dict, hash=False)  # name -> tool number (the first listed)
-    edges: Mapping[tuple[float, int], tuple[float, float, float]] = field(default_factory=dict, hash=False)  # Sinumerik (T, D) -> lengths 1-3, mm
+    edges: Mapping[tuple[float, int], tuple[float, float, float]] = field(default_factory=dict, hash=False)  # (T, D) -> lengths 1-3
 
     @classmethod
     def from_file(cls, path: str | Path, unit_mm: float = 1.0) -> "ToolTable":
-        """LinuxCNC's tool table, its lengths in the machine's units (`unit_mm` mm each),
-        or Heidenhain's TOOL.T (its units in its first line)."""
+        """LinuxCNC's tool table or Sinumerik's tool offsets, their lengths in the machine's
+        units (`unit_mm` mm each), or Heidenhain's TOOL.T (its units in its first line)."""
         try:
             text = Path(path).read_text(encoding="latin-1")
         except OSError as err:
@@ -78,11 +80,11 @@ class ToolTable:
             edges, names = read_to_ini(lines, str(path), unit_mm)
             return cls({}, str(path), names, edges)
         if lines and lines[0].lstrip().upper().startswith("BEGIN"):
-            offsets, names = read_tool_t(lines, str(path))
-            return cls(offsets, str(path), names)
+            edges, names = read_tool_t(lines, str(path))
+            return cls({}, str(path), names, edges)
         return cls(read_tool_lines(lines, str(path), unit_mm), str(path))
 
-    def offset(self, number: float) -> tuple[float, ...] | None:
+    def offset(self, number: int) -> tuple[float, ...] | None:
         """Tool `number`'s offsets (tool 0, no tool: all zero), None when the table has no such tool."""
         if number == 0:
             return (0.0,) * len(OFFSET_LETTERS)
@@ -149,29 +151,28 @@ def _integer(text: str, where: Location) -> int:
     return int(value)
 
 
-def read_tool_t(lines: list[str], file: str) -> tuple[dict[float, tuple[float, ...]], dict[str, float]]:
-    """Heidenhain's TOOL.T: per tool its offsets (length L + DL as the Z offset, mm), and the names."""
+def read_tool_t(lines: list[str], file: str) -> tuple[dict[tuple[float, int], tuple[float, float, float]], dict[str, float]]:
+    """Heidenhain's TOOL.T: per (tool, its one edge) its lengths (L + DL, 0, 0) in mm, and the names."""
     unit_mm = 25.4 if "INCH" in lines[0].upper().split() else 1.0
     if len(lines) < 2:
         raise NcppError("TOOL.T without its column header", Location(file, 1, 1))
     columns = _columns(lines[1], file)
-    tools: dict[float, tuple[float, ...]] = {}
+    tools: dict[tuple[float, int], tuple[float, float, float]] = {}
     names: dict[str, float] = {}
     for n, line in enumerate(lines[2:], 3):
         if line.strip().upper().startswith("[END]"):
             break
         if not line.strip():
             continue
-        field_of = lambda name: _field(line, columns, name)  # noqa: E731  (text, column) of a column
-        text, col = field_of("T")
-        number = _number(text.replace(",", "."), Location(file, n, col))
+        decimal = lambda name: _decimal(*_field(line, columns, name), Location(file, n))  # noqa: E731  a column's number
+        text, col = _field(line, columns, "T")
+        number = decimal("T")
         if number < 0:
             raise NcppError(f"a tool number is not negative, got {text!r}", Location(file, n, col))
-        if number in tools:
+        if (number, 1) in tools:
             raise NcppError(f"tool {text} is listed twice", Location(file, n, col))
-        length = sum(_number(text.replace(",", ".") or "0", Location(file, n, col)) for text, col in map(field_of, ("L", "DL")))
-        tools[number] = (0.0, 0.0, length * unit_mm, *(0.0,) * (len(OFFSET_LETTERS) - 3))
-        name = field_of("NAME")[0]
+        tools[number, 1] = ((decimal("L") + decimal("DL")) * unit_mm, 0.0, 0.0)
+        name = _field(line, columns, "NAME")[0]
         if name:
             names.setdefault(name, number)
     return tools, names
@@ -185,6 +186,11 @@ def _columns(header: str, file: str) -> dict[str, tuple[int, int]]:
         if needed not in columns:
             raise NcppError(f"TOOL.T header without a {needed} column", Location(file, 2, 1))
     return columns  # type: ignore[return-value]
+
+
+def _decimal(text: str, col: int, line: Location) -> float:
+    """A TOOL.T number (a decimal comma or point; an empty field is 0) at column `col` of `line`."""
+    return _number(text.replace(",", ".") or "0", Location(line.file, line.line, col))
 
 
 def _field(line: str, columns: dict[str, tuple[int, int]], name: str) -> tuple[str, int]:

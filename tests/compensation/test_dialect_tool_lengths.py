@@ -43,12 +43,11 @@ def _table(tmp_path: Path, text: str = TOOL_T) -> ToolTable:
 
 
 def test_tool_t_lengths_are_l_plus_dl_in_its_units(tmp_path):
-    tools = _table(tmp_path)
-    assert tools.offset(1)[2] == pytest.approx(150.0) and tools.offset(2)[2] == pytest.approx(40.5)
-    assert tools.offset(1)[:2] == (0.0, 0.0) and tools.offset(4) is None
+    tools = _table(tmp_path)  # each tool one edge, its length 1 along the tool axis
+    assert tools.edges == {(0, 1): (0, 0, 0), (1, 1): (pytest.approx(150.0), 0, 0), (2, 1): (40.5, 0, 0), (3, 1): (90.0, 0, 0)}
     assert tools.names == {"D10_ENDMILL": 1.0, "DRILL_6": 2.0}  # a name listed twice: its first tool
     inch = _table(tmp_path, TOOL_T.replace("MM\n", "INCH\n", 1).replace("+40,5 ", "+2,0  "))
-    assert inch.offset(2)[2] == pytest.approx(50.8)
+    assert inch.edges[2, 1][0] == pytest.approx(50.8)
     header = TOOL_T.splitlines()[:2]
     for lines, message in (
         ([*header, "1                     +1,0", "1                     +2,0"], r"TOOL.T:4:1: tool 1 is listed twice"),
