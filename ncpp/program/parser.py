@@ -6,7 +6,9 @@ syntax.  Most lines of real programs are plain words and comments
 compiled from the grammar's own WORD / COMMA_WORD / PAREN_COMMENT /
 SEMI_COMMENT terminals, which yields the same items the LALR parser would
 (a test checks that on the whole corpus).  Everything else goes through the
-Lark LALR parser.
+Lark LALR parser, once per layout of a line (`Y[#<ys>*-56.12]`, `L X+1.5 R0
+F800`): a line of a layout parsed before takes that line's tree with its own
+token texts (`_TreeLayouts`).
 """
 
 from __future__ import annotations
@@ -15,10 +17,10 @@ import functools
 import re
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Iterable, Iterator
+from typing import Callable, Iterable, Iterator
 
 import lark
-from lark import Token, Transformer, v_args
+from lark import Discard, Token, Transformer, v_args
 
 from ncpp.errors import Location, NcppError
 from ncpp.program.blocks import DIGITS_AS_ONE, AnyItem, Block, Comment, ExprWord, Statement, Word
@@ -209,6 +211,7 @@ class LineParser:
         # plain lines by their layout (`DIGITS_AS_ONE`): what `_scan_plain` reads of them, see `_shape`
         self._shapes: dict[bytes, object] = {}
         self._by_layout = self._items is not None and self._items.digit_blind
+        self._trees = _TreeLayouts.of(self._lark)
 
     def parse(self, raw: str, eol: str = "", line: int = 0, file: str = "<stdin>") -> Block:
         plain = self._scan_plain(raw)
@@ -300,6 +303,10 @@ class LineParser:
         return None
 
     def _parse_lalr(self, raw: str, line: int, file: str) -> tuple[AnyItem, ...]:
+        trees = self._trees
+        replay = None if trees is None else trees.replay(raw)
+        if replay is not None:
+            return tuple(_flatten(replay.run(raw)))
         try:
             tree = self._lark.parse(raw)
         except lark.exceptions.UnexpectedInput as err:
@@ -308,7 +315,142 @@ class LineParser:
             line += max(getattr(err, "line", 1) or 1, 1) - 1
             raise NcppError(_describe(err, raw), Location(file, line, col)) from None
         items = self._builder.transform(tree)
-        return tuple(item for item in _flatten(items))
+        if trees is not None:
+            trees.learn(raw, _Replay(tree, self._builder))
+        return tuple(_flatten(items))
+
+
+class _TreeLayouts:
+    """What the builder makes of LALR-parsed lines, by layout: a line whose layout was
+    parsed before is built from that line's tree with its own token texts, without
+    the parser (ten times the cost of the rest).
+
+    The layout is the line with its digits as `1`.  Lines of one layout lex into
+    the same terminals at the same spans when no terminal tells one digit from
+    another (`\\d`, `0-9`): the same tokens, so the same tree, but for the tokens'
+    texts.  A grammar whose terminals do name digits (Heidenhain's `DR2`, `R0`)
+    names them right after a letter: there the layout keeps the digit."""
+
+    MAX = 1024  # layouts remembered (each holds one line's tree and its steps): memory stays flat
+
+    def __init__(self, layout: Callable[[str], str]):
+        self.layout = layout
+        self.known: dict[str, _Replay] = {}
+
+    @classmethod
+    def of(cls, parser: lark.Lark) -> "_TreeLayouts | None":
+        """The layouts of the grammar's lines (None: its terminals name digits elsewhere)."""
+        named = [_digits_named(t.pattern.to_regexp()) for t in parser.terminals]
+        if any(found is None for found in named):
+            return None
+        if not any(named):
+            return cls(lambda raw: raw.translate(_ALL_DIGITS_AS_ONE))
+        return cls(functools.partial(_DIGITS_NOT_AFTER_A_LETTER.sub, "1"))
+
+    def replay(self, raw: str) -> "_Replay | None":
+        return self.known.get(self.layout(raw))
+
+    def learn(self, raw: str, replay: "_Replay") -> None:
+        if len(self.known) >= self.MAX:
+            self.known.clear()
+        self.known[self.layout(raw)] = replay
+
+
+class _Replay:
+    """A builder's transform of one tree, compiled for trees of its layout: in post-order,
+    each token (with what Lark's Transformer calls on it) and each rule (with its
+    callable and how many results it takes), without the Transformer's look-ups per node."""
+
+    def __init__(self, tree: lark.Tree, builder: Transformer):
+        self.tree, self.builder = tree, builder
+        self.steps: list[tuple] = []
+        self._compile(tree)
+
+    def _compile(self, tree: lark.Tree) -> None:
+        builder = self.builder
+        for child in tree.children:
+            if isinstance(child, Token):
+                visit = getattr(builder, child.type, None) if builder.__visit_tokens__ else None
+                self.steps.append((child, visit))
+            else:
+                self._compile(child)
+        self.steps.append((len(tree.children), _rule_call(builder, tree)))
+
+    def run(self, raw: str) -> object:
+        """What `builder.transform` gives for the line `raw` of this layout."""
+        results: list = []
+        try:
+            for first, call in self.steps:
+                if type(first) is int:  # a rule of `first` children
+                    children = results[len(results) - first :] if first else []
+                    del results[len(results) - first :]
+                    result = call([c for c in children if c is not Discard])
+                else:  # a token: the template's, with this line's text
+                    token = Token.new_borrow_pos(first.type, raw[first.start_pos : first.end_pos], first)
+                    result = token if call is None else call(token)
+                results.append(result)
+        except Exception:  # raised as the Transformer raises it (a VisitError)
+            return self.builder.transform(_retokened(self.tree, raw))
+        return None if results[0] is Discard else results[0]
+
+
+def _rule_call(builder: Transformer, tree: lark.Tree) -> Callable[[list], object]:
+    """The call `Transformer._call_userfunc` makes for the rule of `tree` on its children."""
+    data, meta = tree.data, tree.meta
+    f = getattr(builder, data, None)
+    if f is None:
+        return lambda children: builder.__default__(data, children, meta)
+    wrapper = getattr(f, "visit_wrapper", None)
+    if wrapper is None:
+        return f
+    return lambda children: wrapper(f, data, children, meta)
+
+
+_ALL_DIGITS_AS_ONE = str.maketrans("0123456789", "1111111111")
+_DIGITS_NOT_AFTER_A_LETTER = re.compile(r"(?<![A-Za-z])[0-9]")
+_REPEAT = re.compile(r"\{\d+(?:,\d*)?\}")  # a repeat count: its digits are no text's
+
+
+def _digits_named(pattern: str) -> bool | None:
+    """Whether a terminal's regular expression names digits (a digit, or a class with
+    some digits but not all), each right after a letter (`DR2`, `R[0LR]`); None when it
+    names one anywhere else (`[1-9]` after a blank, `R?2`)."""
+    named, previous, i = False, "", 0
+    while i < len(pattern):
+        c = pattern[i]
+        if c == "\\":
+            atom, i = pattern[i : i + 2], i + 2
+        elif c == "[":
+            end = _class_end(pattern, i)
+            atom, i = pattern[i:end], end
+        elif repeat := _REPEAT.match(pattern, i):
+            atom, i = repeat.group(), repeat.end()
+        else:
+            atom, i = c, i + 1
+        if atom.isdigit() or (atom[0] == "[" and re.search(r"[0-9]", atom.replace("\\d", "").replace("0-9", ""))):
+            if not (len(previous) == 1 and previous.isascii() and previous.isalpha()):
+                return None
+            named = True
+        previous = atom
+    return named
+
+
+def _class_end(pattern: str, start: int) -> int:
+    """Where the character class opened at `start` ends (after its `]`)."""
+    i = start + 2 if pattern.startswith("[^", start) else start + 1
+    i += pattern[i] == "]"  # a `]` first is itself
+    while pattern[i] != "]":
+        i += 2 if pattern[i] == "\\" else 1
+    return i + 1
+
+
+def _retokened(tree: lark.Tree, raw: str) -> lark.Tree:
+    """`tree` (of a line of raw's layout) with every token's text read from `raw`."""
+    children = [
+        Token.new_borrow_pos(child.type, raw[child.start_pos : child.end_pos], child) if type(child) is Token else _retokened(child, raw)
+        for child in tree.children
+    ]
+    return lark.Tree(tree.data, children, tree.meta)
 
 
 # Lines of one layout (`DIGITS_AS_ONE`): the fast terminals tell no digit from another
