@@ -39,3 +39,20 @@ def test_an_axis_where_the_last_block_left_it_is_not_written_again():
     program = "0 BEGIN PGM T MM\n1 L X+0.123456 Y+0.123456 Z+0.123456 R0 F500\n2 L X+10.5 Y+5.5\n3 L X+20.5\n4 END PGM T MM\n"
     lines = written(program, {3: (0.00002, 0.00003, 0.0), 4: (0.00002, 0.00003, 0.0)})
     assert lines[2:4] == ["2 L X+10.5000 Y+5.5000", "3 L X+20.5000"]
+
+
+def test_signs_teach_no_new_style_and_the_feed_keeps_its_own():
+    """Klartext signs every coordinate it writes: `X+1.5` and `X-1.5` are one style, so
+    the styles resolved from it are kept (not worked out again per block), and `F500`
+    stays unsigned."""
+    from ncpp.program.dialects.heidenhain import HeidenhainWriter
+    from ncpp.program.dialects.iso import _MM
+
+    _, blocks = parse_program(io.BytesIO(b"1 L X+1.500 Y-2.500 F500\n2 L X-1.500 Y+2.500\n"), "t.h", "heidenhain")
+    writer = HeidenhainWriter()
+    first, second = blocks
+    writer._learn_styles(first)
+    x = writer._style("X", _MM)
+    writer._learn_styles(second)
+    assert writer._resolved.get(("X", False)) is x and x.plus_sign and x.decimals == 4  # at least the writer's 4
+    assert writer.styles["X"] == writer.styles["Y"] and not writer.styles["F"].plus_sign

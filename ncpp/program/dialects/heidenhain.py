@@ -41,6 +41,7 @@ Expressions: ("num", v) ("param", "q12"|"ql1"|"qr1"|"qs1") ("neg", x) ("bin", op
 
 from __future__ import annotations
 
+import functools
 import math
 
 from lark import Token, Transformer, v_args
@@ -363,10 +364,15 @@ class HeidenhainWriter(IsoWriter):
 
     # -- text -----------------------------------------------------------------------------
     def _style(self, letter: str, segment: Line | Arc) -> NumberStyle:
-        base = letter[-1] if letter.startswith("I") and len(letter) == 2 else letter
-        style = self.styles.get(letter) or self.styles.get(base) or self.styles.get("X") or NumberStyle(decimals=3)
-        style = style.at_least(self.inch_decimals if segment.context.inch else self.mm_decimals)
-        return replace(style, plus_sign=True)  # Klartext signs every coordinate
+        # resolved once per letter and units, as IsoWriter's (`_learn_style` empties `_resolved`)
+        key = (letter, segment.context.inch)
+        style = self._resolved.get(key)
+        if style is None:
+            base = letter[-1] if letter.startswith("I") and len(letter) == 2 else letter
+            style = self.styles.get(letter) or self.styles.get(base) or self.styles.get("X") or NumberStyle(decimals=3)
+            style = style.at_least(self.inch_decimals if key[1] else self.mm_decimals)
+            style = self._resolved[key] = replace(style, plus_sign=True)  # Klartext signs every coordinate
+        return style
 
     def _word(self, letter: str, value: float, segment: Line | Arc) -> str:
         return letter + format_number(value, self._style(letter, segment))
@@ -445,7 +451,16 @@ class HeidenhainWriter(IsoWriter):
             if type(item) is Word and item.letter not in ("M", "N", "S", "PA", "IPA"):
                 # by `_learn_style`: a new style drops the resolved ones (the decimal places the
                 # output's position is remembered with), else they stay those of the first move
-                self._learn_style(item.letter, NumberStyle.of(item.number))
+                style = NumberStyle.of(item.number)
+                self._learn_style(item.letter, style if item.letter == "F" else _signed(style))
                 axis = item.letter[-1]
                 if axis in _AXES and item.letter.lstrip("I") == axis:
                     self.known_axes.add(axis)
+
+
+@functools.lru_cache(maxsize=256)
+def _signed(style: NumberStyle) -> NumberStyle:
+    """The style with its plus sign: every letter but F (written as read) is written
+    signed (`_style`), so `X+1.5` and `X-1.5` teach one style, and the styles
+    resolved from it stay."""
+    return replace(style, plus_sign=True)
