@@ -211,3 +211,52 @@ def compensate_speed(ctx):
     data["memory"] = memory
     notes = [f"peak RSS of `ncpp compensate` grows by {max(rss) - min(rss):.1f} MB from {sizes[0]:,} to {sizes[-1]:,} lines"]
     return bench.Section("Compensation throughput (lines in/s) and memory", ["program", "tool", "rate", "note"], rows, data, notes)
+
+
+def posted(source: Path, lines: int, dialect: str, workdir: Path) -> Path:
+    """The first `lines` lines of an ISO program written as a `dialect` program by ncpp's
+    own post generator (the same moves, spelled as that control's CAM output would)."""
+    from itertools import islice
+
+    from accuracy import QUIET
+    from ncpp.motion import interpret
+    from ncpp.post import GENERATORS
+    from ncpp.program.parser import parse_stream
+
+    path = workdir / f"{source.stem}-{lines}.{ {'heidenhain': 'h', 'sinumerik': 'mpf'}[dialect] }"
+    with open(source, "rb") as stream, open(path, "w", encoding="latin-1") as out:
+        events = interpret(parse_stream(islice(stream, lines), str(source)), file=str(source), warnings=QUIET)
+        out.writelines(line + "\n" for line in GENERATORS[dialect](QUIET).write(events, lambda event: None))
+    return path
+
+
+def dialect_speed(ctx):
+    """Compensation throughput in the other dialects and on expression lines (no floor: pygcode
+    reads none of them): the generated program posted as Klartext and as Sinumerik, and
+    LinuxCNC's 3D_Chips sample (a parameter expression in every line)."""
+    import run as bench
+
+    lines = 40_000 if ctx.quick else 100_000
+    generated = ctx.generated(250_000 if ctx.quick else 1_000_000)
+    offset = work_offset(generated)  # the posted programs make the same moves
+    programs = {
+        f"generated, first {lines:,} lines, as Klartext": (posted(generated, lines, "heidenhain", ctx.workdir), offset),
+        f"generated, first {lines:,} lines, as Sinumerik": (posted(generated, lines, "sinumerik", ctx.workdir), offset),
+        "LinuxCNC 3D_Chips_abort.ngc (expressions)": (bench.PARAMETRIC, work_offset(bench.PARAMETRIC)),
+    }
+    rows, data = [], {}
+    for label, (path, placed) in programs.items():
+        best = fastest({
+            "passthrough": lambda: ncpp_process_rate(path, None),
+            "compensate": lambda: ncpp_process_rate(path, placed, jobs=2),
+        }, repeats=2)  # fmt: skip
+        compensated = best["compensate"]
+        per_line = lambda seconds: 1e6 * seconds / max(compensated["lines"], 1)  # noqa: E731
+        data[label] = {"work_offset_mm": placed, **best}
+        rows += [
+            [label, "ncpp passthrough", f"{best['passthrough']['lines_per_s']:,.0f}", ""],
+            [label, "ncpp compensate 1 µm (HR5B), --jobs 2", f"{compensated['lines_per_s']:,.0f}",
+             f"lines out/in {compensated['lines_out'] / max(compensated['lines'], 1):.2f}; CPU µs per line in: "
+             f"main {per_line(compensated['main_cpu_s']):.0f}, worker {per_line(compensated['worker_cpu_s']):.0f}"],
+        ]  # fmt: skip
+    return bench.Section("Compensation throughput in other dialects (lines in/s, no floor)", ["program", "tool", "rate", "note"], rows, data)

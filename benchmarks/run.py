@@ -279,9 +279,9 @@ SECTIONS: list[Callable[[Context], Section]] = [throughput, memory]
 
 def _compensation_sections() -> list[Callable[[Context], Section]]:
     from accuracy import accuracy
-    from compensate_speed import compensate_speed
+    from compensate_speed import compensate_speed, dialect_speed
 
-    return [compensate_speed, accuracy]
+    return [compensate_speed, dialect_speed, accuracy]
 
 
 SECTIONS += _compensation_sections()
