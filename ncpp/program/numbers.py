@@ -20,13 +20,13 @@ class NumberStyle:
     int_width: int = 0  # zero-padded integer digits (`X010.5` -> 3)
     plus_sign: bool = False
     comma: bool = False  # `10,5`: a decimal comma instead of the point
-    # `z.4f` when `format(v, "z.4f")` writes the style exactly (the common case), else '': set once, read
-    # per number.  `z` (Python 3.11) writes a negative number that rounds to zero without its sign.
+    # `z.4f` (`+z.4f` signed) when `format(v, spec)` writes the style exactly (the common case), else '':
+    # set once, read per number.  `z` (Python 3.11) writes a number that rounds to zero without a minus.
     spec: str = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
-        plain = self.decimals > 0 and self.leading_zero and not (self.int_width or self.plus_sign or self.comma)
-        object.__setattr__(self, "spec", f"z.{self.decimals}f" if plain else "")
+        plain = self.decimals > 0 and self.leading_zero and not (self.int_width or self.comma)
+        object.__setattr__(self, "spec", f"{'+' if self.plus_sign else ''}z.{self.decimals}f" if plain else "")
 
     @classmethod
     def of(cls, number: str) -> "NumberStyle":
@@ -52,7 +52,7 @@ class NumberStyle:
 
     @property
     def plain(self) -> bool:
-        """`-12.345`: what `f"{v:.{decimals}f}"` writes (the writer's fast path)."""
+        """`-12.345`, `+12.345`: what one `format` spec writes (the writer's fast path)."""
         return bool(self.spec)
 
     def at_least(self, decimals: int) -> "NumberStyle":

@@ -1,4 +1,5 @@
-"""The writer's fast number format is the general one for the styles it takes it for."""
+"""The writer's fast number format is the general one for the styles it takes it for
+(signed ones, `X+1.5`, included: Klartext writes every coordinate so)."""
 
 from __future__ import annotations
 
@@ -15,7 +16,7 @@ values = st.one_of(
 )
 
 
-@given(values, st.sampled_from(["1.5", "-1.5", "10.000", "0.0001", "-0.25000000", "123.45678"]))
+@given(values, st.sampled_from(["1.5", "-1.5", "10.000", "0.0001", "-0.25000000", "123.45678", "+1.5", "+10.000", "+0.0001"]))
 def test_fast_format_is_the_general_one(value, written):
     style = NumberStyle.of(written)
     assert style.plain

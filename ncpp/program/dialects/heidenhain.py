@@ -370,8 +370,7 @@ class HeidenhainWriter(IsoWriter):
         if style is None:
             base = letter[-1] if letter.startswith("I") and len(letter) == 2 else letter
             style = self.styles.get(letter) or self.styles.get(base) or self.styles.get("X") or NumberStyle(decimals=3)
-            style = style.at_least(self.inch_decimals if key[1] else self.mm_decimals)
-            style = self._resolved[key] = replace(style, plus_sign=True)  # Klartext signs every coordinate
+            style = self._resolved[key] = _signed(style.at_least(self.inch_decimals if key[1] else self.mm_decimals))
         return style
 
     def _word(self, letter: str, value: float, segment: Line | Arc) -> str:
@@ -381,7 +380,7 @@ class HeidenhainWriter(IsoWriter):
         a, b, _ = PLANE_AXES[plane]
         first, second = sorted((a, b))
         # two digits more than coordinates: a rounded pole would move the end of a CP helix off the exact point
-        style = replace((self.styles.get("X") or NumberStyle(decimals=3)).at_least(self.mm_decimals + 2), plus_sign=True)
+        style = _signed((self.styles.get("X") or NumberStyle(decimals=3)).at_least(self.mm_decimals + 2))
         return f"CC {_AXES[first]}{format_number(centre[first], style)} {_AXES[second]}{format_number(centre[second], style)}"
 
     def _is_helix(self, segment: Arc) -> bool:
@@ -458,7 +457,7 @@ class HeidenhainWriter(IsoWriter):
                     self.known_axes.add(axis)
 
 
-@functools.lru_cache(maxsize=256)
+@functools.lru_cache(maxsize=1024)
 def _signed(style: NumberStyle) -> NumberStyle:
     """The style with its plus sign: every letter but F (written as read) is written
     signed (`_style`), so `X+1.5` and `X-1.5` teach one style, and the styles
