@@ -65,12 +65,12 @@ def _children_cpu() -> float:
     return usage.ru_utime + usage.ru_stime
 
 
-def _cpu_split(result: dict[str, Any], pygcode: dict[str, Any]) -> str:
-    """CPU per input line of each process beside pygcode's: what the floor asks of each (both
-    processes at or below pygcode's time per line)."""
+def _cpu_split(result: dict[str, Any], pygcode: dict[str, Any] | None = None) -> str:
+    """CPU per input line of each process, beside pygcode's when given: what the floor asks
+    of each (both processes at or below pygcode's time per line)."""
     per_line = lambda seconds: 1e6 * seconds / max(result["lines"], 1)  # noqa: E731
-    return (f"CPU µs per line in: main {per_line(result['main_cpu_s']):.0f}, worker {per_line(result['worker_cpu_s']):.0f}; "
-            f"pygcode {per_line(pygcode['seconds']):.0f}")  # fmt: skip
+    split = f"CPU µs per line in: main {per_line(result['main_cpu_s']):.0f}, worker {per_line(result['worker_cpu_s']):.0f}"
+    return split if pygcode is None else f"{split}; pygcode {per_line(pygcode['seconds']):.0f}"
 
 
 REPEATS = 3  # runs per tool; the fastest counts (the same for every tool: this machine's timing is noisy)
@@ -251,12 +251,10 @@ def dialect_speed(ctx):
             "compensate": lambda: ncpp_process_rate(path, placed, jobs=2),
         }, repeats=2)  # fmt: skip
         compensated = best["compensate"]
-        per_line = lambda seconds: 1e6 * seconds / max(compensated["lines"], 1)  # noqa: E731
         data[label] = {"work_offset_mm": placed, **best}
         rows += [
             [label, "ncpp passthrough", f"{best['passthrough']['lines_per_s']:,.0f}", ""],
             [label, "ncpp compensate 1 µm (HR5B), --jobs 2", f"{compensated['lines_per_s']:,.0f}",
-             f"lines out/in {compensated['lines_out'] / max(compensated['lines'], 1):.2f}; CPU µs per line in: "
-             f"main {per_line(compensated['main_cpu_s']):.0f}, worker {per_line(compensated['worker_cpu_s']):.0f}"],
+             f"lines out/in {compensated['lines_out'] / max(compensated['lines'], 1):.2f}; {_cpu_split(compensated)}"],
         ]  # fmt: skip
     return bench.Section("Compensation throughput in other dialects (lines in/s, no floor)", ["program", "tool", "rate", "note"], rows, data)

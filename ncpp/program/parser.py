@@ -304,7 +304,8 @@ class LineParser:
 
     def _parse_lalr(self, raw: str, line: int, file: str) -> tuple[AnyItem, ...]:
         trees = self._trees
-        replay = None if trees is None else trees.replay(raw)
+        layout = None if trees is None else trees.layout(raw)
+        replay = None if layout is None else trees.known.get(layout)
         if replay is not None:
             return tuple(_flatten(replay.run(raw)))
         try:
@@ -315,15 +316,15 @@ class LineParser:
             line += max(getattr(err, "line", 1) or 1, 1) - 1
             raise NcppError(_describe(err, raw), Location(file, line, col)) from None
         items = self._builder.transform(tree)
-        if trees is not None:
-            trees.learn(raw, _Replay(tree, self._builder))
+        if layout is not None:
+            trees.learn(layout, _Replay(tree, self._builder))
         return tuple(_flatten(items))
 
 
 class _TreeLayouts:
     """What the builder makes of LALR-parsed lines, by layout: a line whose layout was
     parsed before is built from that line's tree with its own token texts, without
-    the parser (ten times the cost of the rest).
+    the parser (about six times the cost of the builder's transform).
 
     The layout is the line with its digits as `1`.  Lines of one layout lex into
     the same terminals at the same spans when no terminal tells one digit from
@@ -347,13 +348,10 @@ class _TreeLayouts:
             return cls(lambda raw: raw.translate(_ALL_DIGITS_AS_ONE))
         return cls(functools.partial(_DIGITS_NOT_AFTER_A_LETTER.sub, "1"))
 
-    def replay(self, raw: str) -> "_Replay | None":
-        return self.known.get(self.layout(raw))
-
-    def learn(self, raw: str, replay: "_Replay") -> None:
+    def learn(self, layout: str, replay: "_Replay") -> None:
         if len(self.known) >= self.MAX:
             self.known.clear()
-        self.known[self.layout(raw)] = replay
+        self.known[layout] = replay
 
 
 class _Replay:
@@ -497,8 +495,8 @@ class _PlainItems:
         pattern = re.compile(f"({_GAP})(?:({split[1]})({split[2]})|{'|'.join(others)}|[^{_GAP_CHARS}])")
         self.findall = pattern.findall
         self.comma, self.paren, self.semi = (pattern.groupindex[name] - 1 for name in self.OTHERS)
-        # a pattern without digit characters (`\\d`, ranges of letters) treats all digits alike
-        self.digit_blind = not any(c.isdigit() for c in pattern.pattern)
+        # a pattern naming no digit (`\\d`, `0-9` and ranges of letters only) treats all digits alike
+        self.digit_blind = _digits_named(pattern.pattern) is False
 
 
 def _flatten(items: Iterable) -> Iterator[AnyItem]:
