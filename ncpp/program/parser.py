@@ -22,6 +22,7 @@ from typing import Callable, Iterable, Iterator
 import lark
 from lark import Discard, Token, Transformer, v_args
 
+from ncpp.cache import cached_build
 from ncpp.errors import Location, NcppError
 from ncpp.program.blocks import DIGITS_AS_ONE, AnyItem, Block, Comment, ExprWord, Statement, Word
 
@@ -39,15 +40,16 @@ def grammar_path(name: str) -> Path:
     raise FileNotFoundError(f"grammar {name}.lark not found beside the ncpp package")
 
 
+_LARK_OPTIONS = {"parser": "lalr", "propagate_positions": True, "maybe_placeholders": False}
+
+
 @functools.lru_cache(maxsize=None)
 def lalr_parser(name: str) -> lark.Lark:
-    return lark.Lark(
-        grammar_path(name).read_text(encoding="utf-8"),
-        parser="lalr",
-        propagate_positions=True,
-        maybe_placeholders=False,
-        cache=False,
-    )
+    """The dialect's Lark parser, loaded from the user's cache when it was built before
+    (building the LALR tables takes 50-120 ms, loading them 5-20: every `ncpp` run pays it,
+    and the LinuxCNC filter runs whenever a program is opened)."""
+    text = grammar_path(name).read_text(encoding="utf-8")
+    return cached_build(f"{name}-lark", f"{text}\n{_LARK_OPTIONS}\n{lark.__version__}", lambda: lark.Lark(text, **_LARK_OPTIONS), lark.Lark.load)
 
 
 def _number_value(number: str) -> float:

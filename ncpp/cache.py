@@ -1,0 +1,63 @@
+"""Built once per user, loaded after: things that take a while to build from files
+that ship with ncpp (the grammars' LALR tables).
+
+The cache is a folder of the user's own (`$NCPP_CACHE`, else `$XDG_CACHE_HOME/ncpp`,
+else `~/.cache/ncpp`; `NCPP_CACHE=` empty turns it off): what it holds is
+unpickled, so it is never a shared folder such as /tmp.  An entry's name carries a
+digest of everything it was built from, so a changed grammar or library version
+builds anew; entries are written atomically, and one that cannot be read or
+written is built in memory as if there were no cache.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import sys
+import tempfile
+from pathlib import Path
+from typing import BinaryIO, Callable, TypeVar
+
+T = TypeVar("T")
+
+
+def cache_folder() -> Path | None:
+    """Where entries are kept (None: nowhere)."""
+    chosen = os.environ.get("NCPP_CACHE")
+    if chosen is not None:
+        return Path(chosen) if chosen else None
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return Path(base) / "ncpp"
+
+
+def cached_build(name: str, source: str, build: Callable[[], T], load: Callable[[BinaryIO], T]) -> T:
+    """The object `build()` makes from `source` (text), kept under `name`; `load` reads
+    back what the object's `save(file)` wrote."""
+    folder = cache_folder()
+    if folder is None:
+        return build()
+    version = ".".join(map(str, sys.version_info[:2]))
+    path = folder / f"{name}-{hashlib.sha256(f'{source}{version}'.encode()).hexdigest()[:20]}.pickle"
+    try:
+        with open(path, "rb") as f:
+            return load(f)
+    except Exception:  # missing, or unreadable (another version's pickle): build it
+        pass
+    made = build()
+    _save(made, path)
+    return made
+
+
+def _save(made: object, path: Path) -> None:
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        handle, temporary = tempfile.mkstemp(dir=path.parent, prefix=path.name, suffix=".part")
+        try:
+            with os.fdopen(handle, "wb") as f:
+                made.save(f)  # type: ignore[attr-defined]
+            os.replace(temporary, path)
+        except BaseException:
+            os.unlink(temporary)
+            raise
+    except OSError:  # a read-only home: no cache, same results
+        pass
