@@ -61,6 +61,14 @@ class NumberStyle:
             return self
         return NumberStyle(decimals, False, self.leading_zero, self.int_width, self.plus_sign, self.comma)
 
+    def resolves_like(self, other: "NumberStyle", decimals: int) -> bool:
+        """`self.at_least(decimals) == other.at_least(decimals)`, without making either."""
+        return (
+            max(self.decimals, decimals) == max(other.decimals, decimals)
+            and (self.trailing_dot and self.decimals >= decimals) == (other.trailing_dot and other.decimals >= decimals)
+            and (self.leading_zero, self.int_width, self.plus_sign, self.comma) == (other.leading_zero, other.int_width, other.plus_sign, other.comma)
+        )
+
 
 _NONZERO_DIGITS = str.maketrans("23456789", "11111111")
 

@@ -26,3 +26,26 @@ def test_fast_format_is_the_general_one(value, written):
 def test_negative_zero_is_written_without_sign():
     assert format_number(-0.00001, NumberStyle.of("1.000")) == "0.000"
     assert format_number(-0.0005, NumberStyle.of("1.000")) == "-0.001"  # rounds away from zero: signed
+
+
+styles = st.builds(
+    NumberStyle,
+    decimals=st.integers(0, 8),
+    trailing_dot=st.booleans(),
+    leading_zero=st.booleans(),
+    int_width=st.sampled_from([0, 0, 3]),
+    plus_sign=st.booleans(),
+    comma=st.booleans(),
+)
+
+
+@given(styles, styles, st.integers(0, 8))
+def test_resolves_like_is_equality_of_the_resolved_styles(a, b, decimals):
+    assert a.resolves_like(b, decimals) == (a.at_least(decimals) == b.at_least(decimals))
+
+
+def test_styles_that_drop_trailing_zeros_resolve_alike():
+    """cameo.nc writes `X1.125`, `X0.` and `X-4.52`: each is another style, all written with 4 places."""
+    one, dot, two = NumberStyle.of("1.125"), NumberStyle.of("0."), NumberStyle.of("-4.52")
+    assert one != dot != two
+    assert one.resolves_like(dot, 4) and dot.resolves_like(two, 4) and not one.resolves_like(dot, 0)

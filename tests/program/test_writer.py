@@ -260,3 +260,32 @@ def test_a_letter_is_written_in_the_style_of_its_last_number(numbers):
         block = parse_text(f"G1 X{number} Y{number}\n")[0]
         writer._read_block(block)
         assert writer.styles["X"] == writer.styles["Y"] == NumberStyle.of(number)
+
+
+@PLAN_EXAMPLES
+@given(st.lists(_number.filter(lambda n: any(c.isdigit() for c in n) and ("." in n or not n.endswith("."))), min_size=1))
+def test_the_styles_kept_resolved_are_those_the_styles_learnt_resolve_to(numbers):
+    """A new style that writes alike (`X1.125` then `X0.`) keeps what was resolved:
+    it is what the styles learnt so far resolve to, in mm and in inch."""
+    from ncpp.program.dialects.iso import IsoWriter
+
+    writer = IsoWriter()
+    for number in numbers:
+        writer._read_block(parse_text(f"G1 X{number} Y{number}\n")[0])
+        for inch in (False, True):
+            fresh = IsoWriter()
+            fresh.styles = dict(writer.styles)
+            assert writer._units(inch).styles == fresh._units(inch).styles
+
+
+def test_numbers_without_trailing_zeros_keep_the_resolved_styles():
+    from ncpp.program.dialects.iso import IsoWriter
+
+    writer = IsoWriter()
+    writer._read_block(parse_text("N1 X1.125 Z-4.52\n")[0])
+    units = writer._units(False)
+    for text in ("N2 X0. Z-4.473\n", "N3 X75. Z-6.\n", "N4 X-0.375 Z-4.5\n"):
+        writer._read_block(parse_text(text)[0])
+        assert writer._resolved.get(False) is units  # not worked out again
+    writer._read_block(parse_text("N5 X1.12345\n")[0])  # five places: written with five now
+    assert writer._units(False) is not units and writer._units(False).styles["X"].decimals == 5

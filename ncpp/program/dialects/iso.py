@@ -209,7 +209,10 @@ class IsoWriter:
         known = self.styles.get(letter)
         if known is not style and known != style:  # styles read from numbers are interned: mostly `is`
             self.styles[letter] = style
-            self._resolved.clear()
+            # what is resolved from styles is written with at least mm_decimals / inch_decimals places:
+            # `X1.125` then `X0.` (trailing zeros dropped, cameo.nc: 29k changes in 35k lines) write alike
+            if known is None or not (known.resolves_like(style, self.mm_decimals) and known.resolves_like(style, self.inch_decimals)):
+                self._resolved.clear()
         if letter in AXES:
             self.known_axes.add(letter)
 
