@@ -7,8 +7,9 @@ compiled from the grammar's own WORD / COMMA_WORD / PAREN_COMMENT /
 SEMI_COMMENT terminals, which yields the same items the LALR parser would
 (a test checks that on the whole corpus).  Everything else goes through the
 Lark LALR parser, once per layout of a line (`Y[#<ys>*-56.12]`, `L X+1.5 R0
-F800`): a line of a layout parsed before takes that line's tree with its own
-token texts (`_TreeLayouts`).
+F800`): a line of a layout parsed before has its items cut from it where that
+line's items were (`_Cut`: most Klartext blocks) or takes that line's tree with
+its own token texts (`_Replay`).
 """
 
 from __future__ import annotations
@@ -307,9 +308,9 @@ class LineParser:
     def _parse_lalr(self, raw: str, line: int, file: str) -> tuple[AnyItem, ...]:
         trees = self._trees
         layout = None if trees is None else trees.layout(raw)
-        replay = None if layout is None else trees.known.get(layout)
-        if replay is not None:
-            return tuple(_flatten(replay.run(raw)))
+        known = None if layout is None else trees.known.get(layout)
+        if known is not None:
+            return known.items(raw)
         try:
             tree = self._lark.parse(raw)
         except lark.exceptions.UnexpectedInput as err:
@@ -317,10 +318,10 @@ class LineParser:
             # a continued block spans lines: Lark counts them from 1
             line += max(getattr(err, "line", 1) or 1, 1) - 1
             raise NcppError(_describe(err, raw), Location(file, line, col)) from None
-        items = self._builder.transform(tree)
+        items = tuple(_flatten(self._builder.transform(tree)))
         if layout is not None:
-            trees.learn(layout, _Replay(tree, self._builder))
-        return tuple(_flatten(items))
+            trees.learn(layout, _Cut.of(raw, items, trees.layout) or _Replay(tree, self._builder))
+        return items
 
 
 class _TreeLayouts:
@@ -350,10 +351,68 @@ class _TreeLayouts:
             return cls(lambda raw: raw.translate(_ALL_DIGITS_AS_ONE))
         return cls(functools.partial(_DIGITS_NOT_AFTER_A_LETTER.sub, "1"))
 
-    def learn(self, layout: str, replay: "_Replay") -> None:
+    def learn(self, layout: str, known: "_Cut | _Replay") -> None:
         if len(self.known) >= self.MAX:
             self.known.clear()
-        self.known[layout] = replay
+        self.known[layout] = known
+
+
+class _Cut:
+    """The items of the lines of one layout cut from the line, without the builder: for a
+    layout whose items are each the same on every line of it (no digit the layout
+    turns to `1` in its span: `L`, `R0`, `FMAX`) or a plain word (`X-47.4002`, `N12`: its
+    number as written and read by `float`), as most Klartext blocks are."""
+
+    def __init__(self, steps: tuple):
+        self.steps = steps  # per item: the item itself, or (letter, start, start of the number, end)
+
+    @classmethod
+    def of(cls, raw: str, items: tuple[AnyItem, ...], layout: Callable[[str], str]) -> "_Cut | None":
+        varying = _varying(raw, layout)
+        steps: list = []
+        for item in items:
+            if not any(varying[item.start : item.end]):
+                steps.append(item)  # the same text on every line of the layout: the same item
+                continue
+            if type(item) is not Word:
+                return None
+            number_at = item.end - len(item.number)
+            if any(varying[item.start : number_at]) or raw[number_at : item.end] != item.number or not _reads_as(item.number, item.value):
+                return None  # `X+10,5`, `X - 5`: the builder reads such numbers its own way
+            steps.append((item.letter, item.start, number_at, item.end))
+        return cls(tuple(steps))
+
+    def items(self, raw: str) -> tuple[AnyItem, ...]:
+        items = []
+        append = items.append
+        for step in self.steps:
+            if type(step) is tuple:
+                letter, start, number_at, end = step
+                number = raw[number_at:end]
+                word = _new_word(Word)
+                word.letter, word.value, word.number, word.start, word.end = letter, float(number), number, start, end
+                append(word)
+            else:
+                append(step)
+        return tuple(items)
+
+
+_NEXT_DIGIT = str.maketrans("0123456789", "1234567890")
+
+
+def _varying(raw: str, layout: Callable[[str], str]) -> list[bool]:
+    """Per character of `raw`: whether lines of its layout may have another there (a digit
+    the layout turns to `1`; a digit it keeps stays when every digit is changed)."""
+    kept = layout(raw.translate(_NEXT_DIGIT))
+    return [c.isdigit() and k == "1" == l for c, k, l in zip(raw, kept, layout(raw))]
+
+
+def _reads_as(number: str, value: float) -> bool:
+    """Whether `float` reads the number text as the builder did."""
+    try:
+        return float(number) == value and number.strip() == number
+    except ValueError:
+        return False
 
 
 class _Replay:
@@ -375,6 +434,9 @@ class _Replay:
             else:
                 self._compile(child)
         self.steps.append((len(tree.children), _rule_call(builder, tree)))
+
+    def items(self, raw: str) -> tuple[AnyItem, ...]:
+        return tuple(_flatten(self.run(raw)))
 
     def run(self, raw: str) -> object:
         """What `builder.transform` gives for the line `raw` of this layout."""

@@ -10,7 +10,7 @@ import re
 import pytest
 
 from ncpp.errors import NcppError
-from ncpp.program.parser import LineParser, _digits_named, _flatten, _TreeLayouts, lalr_parser, parse_stream
+from ncpp.program.parser import LineParser, _Cut, _digits_named, _flatten, _TreeLayouts, lalr_parser, parse_stream
 from tests.conftest import corpus_files
 
 DIALECT_FOLDERS = {"iso": ("iso_gcode", "malformed"), "heidenhain": ("heidenhain",), "sinumerik": ("sinumerik",)}
@@ -84,7 +84,7 @@ def test_replayed_lines_build_what_their_own_parse_builds(dialect):
 
 @pytest.mark.parametrize("dialect", sorted(DIALECT_FOLDERS))
 def test_replay_agrees_with_the_lalr_parser_on_corpus(dialect):
-    parser, checked, replays = LineParser(dialect), 0, 0
+    parser, checked, replays, cuts = LineParser(dialect), 0, 0, 0
     for path in corpus_files(*DIALECT_FOLDERS[dialect]):
         try:
             blocks = list(parse_stream(io.BytesIO(path.read_bytes()), str(path), dialect))
@@ -93,11 +93,26 @@ def test_replay_agrees_with_the_lalr_parser_on_corpus(dialect):
         for block in blocks:
             if block.verbatim or parser._scan_plain(block.raw) is not None:
                 continue
-            replays += parser._trees.layout(block.raw) in parser._trees.known
+            known = parser._trees.known.get(parser._trees.layout(block.raw))
+            replays += known is not None
+            cuts += type(known) is _Cut
             assert replayed(parser, block.raw) == fresh(parser, block.raw), (path, block.line)
             checked += 1
     assert checked > {"iso": 5000, "heidenhain": 200, "sinumerik": 100}[dialect]
     assert replays > {"iso": 10000, "heidenhain": 50, "sinumerik": 15}[dialect]  # lines built by the replay itself
+    assert cuts >= {"iso": 0, "heidenhain": 4, "sinumerik": 0}[dialect]  # and of those, cut from the line
+
+
+def test_plain_klartext_blocks_are_cut_from_the_line():
+    """`L X+1.5 Y+2 R0 F800`: the items are the constant ones (`L`, `R0`) and plain words;
+    numbers with a decimal comma are left to the builder's own reading (the replay)."""
+    parser = LineParser("heidenhain")
+    lines = ["4 L X+1.5 Y+2 R0 F800", "5 L X-2.5 Y+7 R0 F900", "6 L X+10,5 Y+2 R0 F800", "7 L X+11,5 Y+3 R0 F800", "8 L X+1.5 Y+2 R1 F800"]
+    for line in lines:
+        assert replayed(parser, line) == fresh(parser, line), line
+    kinds = [type(parser._trees.known[parser._trees.layout(line)]).__name__ for line in lines]
+    assert kinds == ["_Cut", "_Cut", "_Replay", "_Replay", "_Cut"]
+    assert replayed(parser, "9 L X+1.5 Y+2 R1 F800")[4] == fresh(parser, "9 L X+1.5 Y+2 R1 F800")[4]  # R1 kept: not R0's items
 
 
 def test_grammars_name_digits_only_right_after_a_letter():
