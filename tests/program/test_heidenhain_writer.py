@@ -56,3 +56,29 @@ def test_signs_teach_no_new_style_and_the_feed_keeps_its_own():
     writer._learn_styles(second)
     assert writer._resolved.get(("X", False)) is x and x.plus_sign and x.decimals == 4  # at least the writer's 4
     assert writer.styles["X"] == writer.styles["Y"] and not writer.styles["F"].plus_sign
+
+
+from hypothesis import given  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+_klartext_numbers = st.builds(
+    lambda sign, whole, frac: sign + whole + frac, st.sampled_from(["", "+", "-"]), st.text("0123456789", min_size=1, max_size=3),
+    st.sampled_from(["", "."]).flatmap(lambda dot: st.text("0123456789", max_size=4).map(lambda d: dot + d if dot else "")),
+)
+
+
+@given(st.lists(st.tuples(_klartext_numbers, _klartext_numbers), min_size=1, max_size=6))
+def test_styles_learnt_per_number_pattern_are_each_numbers_own(pairs):
+    """`_learn_styles` keeps what a (letter, number pattern) teaches: the style is the number's own
+    (signed, but F), learnt in order, and the block's axes become known."""
+    from ncpp.program.dialects.heidenhain import HeidenhainWriter, _signed
+    from ncpp.program.numbers import NumberStyle
+
+    writer = HeidenhainWriter()
+    text = "".join(f"{n} L X{x} IY{y} F{y.lstrip('+-')} M3\n" for n, (x, y) in enumerate(pairs, 1))
+    _, blocks = parse_program(io.BytesIO(text.encode()), "t.h", "heidenhain")
+    for block, (x, y) in zip(blocks, pairs):
+        writer._learn_styles(block)
+        assert writer.styles["X"] == _signed(NumberStyle.of(x)) and writer.styles["IY"] == _signed(NumberStyle.of(y))
+        assert writer.styles["F"] == NumberStyle.of(y.lstrip("+-")) and "M" not in writer.styles and "N" not in writer.styles
+    assert writer.known_axes == {"X", "Y"}

@@ -260,6 +260,7 @@ class HeidenhainWriter(IsoWriter):
         self.eol = "\n"
         self.restore_feed = False  # an edited corner block's F: the next move gets the program's feed back
         self.edited_last = False  # the last block was written edited (an RND/CHF after it must be too)
+        self._lessons: dict[tuple[str, str], tuple] = {}  # by (letter, number pattern): see `_learn_styles`
 
     def with_header(self, lines, header: str):
         """The header goes after `BEGIN PGM` as a numbered comment block (set before writing)."""
@@ -380,7 +381,10 @@ class HeidenhainWriter(IsoWriter):
         a, b, _ = PLANE_AXES[plane]
         first, second = sorted((a, b))
         # two digits more than coordinates: a rounded pole would move the end of a CP helix off the exact point
-        style = _signed((self.styles.get("X") or NumberStyle(decimals=3)).at_least(self.mm_decimals + 2))
+        # (kept with the resolved styles: X's styles that resolve alike at mm and inch places do so here too)
+        style = self._resolved.get("CC")
+        if style is None:
+            style = self._resolved["CC"] = _signed((self.styles.get("X") or NumberStyle(decimals=3)).at_least(self.mm_decimals + 2))
         return f"CC {_AXES[first]}{format_number(centre[first], style)} {_AXES[second]}{format_number(centre[second], style)}"
 
     def _is_helix(self, segment: Arc) -> bool:
@@ -389,11 +393,18 @@ class HeidenhainWriter(IsoWriter):
 
     def _fresh(self, segment: Line | Arc) -> str:
         """A new block for a further piece of a changed block."""
-        if type(segment) is Line:
-            words = [self._word(_AXES[n], segment.end[n], segment) for n in range(3)
-                     if self._moved(_AXES[n], segment.end[n], segment)]
-            return "L " + " ".join(words) + (" FMAX" if segment.rapid else "")
-        return self._arc_text(segment)
+        if type(segment) is not Line:
+            return self._arc_text(segment)
+        # the axes that moved in the output (`_moved`, one per output line: compared as numbers first)
+        inch, end, last, last_places = segment.context.inch, segment.end, self._last_end, self._last_places
+        units = self._resolved.get(inch) or self._units(inch)
+        places, styles = units.places, units.styles
+        words = [
+            axis + format_number(end[n], styles[axis])
+            for n, axis in enumerate(_AXES)
+            if last is None or ((end[n] != last[n] or places[n] != last_places[n]) and round(end[n], places[n]) != round(last[n], last_places[n]))
+        ]
+        return "L " + " ".join(words) + (" FMAX" if segment.rapid else "")
 
     def _arc_text(self, segment: Arc) -> str:
         rotation = "DR+" if segment.turn > 0 else "DR-"
@@ -437,24 +448,42 @@ class HeidenhainWriter(IsoWriter):
             elif type(item) is Statement and item.kind == "rotation" and arc:
                 texts[n] = "DR+" if segment.turn > 0 else "DR-"
         extra = [self._word(_AXES[k], segment.end[k], segment) for k in range(3) if k not in written and (
-            k in plane_axes or (k in self.known_axes_idx() and self._moved(_AXES[k], segment.end[k], segment)))]  # fmt: skip
+            k in plane_axes or (_AXES[k] in self.known_axes and self._moved(_AXES[k], segment.end[k], segment)))]  # fmt: skip
         if arc and not any(type(i) is Statement and i.kind == "rotation" for i in block.items):
             extra.append("DR+" if segment.turn > 0 else "DR-")
         return splice(block, texts, "".join(" " + w for w in extra) + feed, after=anchor)
 
-    def known_axes_idx(self) -> set[int]:
-        return {_AXES.index(a) for a in self.known_axes if a in _AXES}
-
     def _learn_styles(self, block: Block) -> None:
+        lessons = self._lessons
         for item in block.items:
-            if type(item) is Word and item.letter not in ("M", "N", "S", "PA", "IPA"):
-                # by `_learn_style`: a new style drops the resolved ones (the decimal places the
-                # output's position is remembered with), else they stay those of the first move
-                style = NumberStyle.of(item.number)
-                self._learn_style(item.letter, style if item.letter == "F" else _signed(style))
-                axis = item.letter[-1]
-                if axis in _AXES and item.letter.lstrip("I") == axis:
-                    self.known_axes.add(axis)
+            if type(item) is Word:
+                # (letter, the number's signs, point and zeros): the style it teaches, and whether it is an axis
+                key = (item.letter, item.number.translate(_NONZERO_DIGITS))
+                lesson = lessons.get(key)
+                if lesson is None:
+                    if len(lessons) >= 4096:  # zeros and ones make the patterns: keep memory flat
+                        lessons.clear()
+                    lesson = lessons[key] = _lesson(item.letter, item.number)
+                if lesson is not _NO_LESSON:
+                    # by `_learn_style`: a new style drops the resolved ones (the decimal places the
+                    # output's position is remembered with), else they stay those of the first move
+                    letter, style, axis = lesson
+                    self._learn_style(letter, style)
+                    if axis:
+                        self.known_axes.add(axis)
+
+
+_NONZERO_DIGITS = str.maketrans("23456789", "11111111")  # what NumberStyle.of reads of a number is kept
+_NO_LESSON = ()
+
+
+def _lesson(letter: str, number: str) -> tuple:
+    """What a word teaches `_learn_styles`: (letter, style, its axis or ''), or nothing."""
+    if letter in ("M", "N", "S", "PA", "IPA"):
+        return _NO_LESSON
+    style = NumberStyle.of(number)
+    axis = letter[-1] if letter[-1] in _AXES and letter.lstrip("I") == letter[-1] else ""
+    return (letter, style if letter == "F" else _signed(style), axis)
 
 
 @functools.lru_cache(maxsize=1024)
