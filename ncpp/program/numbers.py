@@ -31,8 +31,7 @@ class NumberStyle:
     @classmethod
     def of(cls, number: str) -> "NumberStyle":
         """The style of a number as written (sign included, letter excluded)."""
-        # Signs, point and zeros make the style, the other digits do not: read once per pattern.
-        return _style_of(number.translate(_NONZERO_DIGITS))
+        return _style_of(style_pattern(number))  # read once per pattern
 
     @classmethod
     def _read(cls, number: str) -> "NumberStyle":
@@ -71,6 +70,11 @@ class NumberStyle:
 
 
 _NONZERO_DIGITS = str.maketrans("23456789", "11111111")
+
+
+def style_pattern(number: str) -> str:
+    """What a number's style is read from: its signs, point and zeros (the other digits as 1)."""
+    return number.translate(_NONZERO_DIGITS)
 
 
 @lru_cache(maxsize=4096)

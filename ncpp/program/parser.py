@@ -401,8 +401,9 @@ _NEXT_DIGIT = str.maketrans("0123456789", "1234567890")
 
 
 def _varying(raw: str, layout: Callable[[str], str]) -> list[bool]:
-    """Per character of `raw`: whether lines of its layout may have another there (a digit
-    the layout turns to `1`; a digit it keeps stays when every digit is changed)."""
+    """Per character of `raw`: whether lines of its layout may have another there: a digit
+    the layout turns to `1` (it is `1` in the layout of the line with every digit changed
+    too; a digit the layout keeps changes there)."""
     kept = layout(raw.translate(_NEXT_DIGIT))
     return [c.isdigit() and k == "1" == l for c, k, l in zip(raw, kept, layout(raw))]
 

@@ -222,7 +222,7 @@ from ncpp.motion.segments import PLANE_AXES, Arc, Line  # noqa: E402
 from ncpp.program.blocks import Block  # noqa: E402
 from ncpp.program.dialects.editing import splice  # noqa: E402
 from ncpp.program.dialects.iso import IsoWriter  # noqa: E402
-from ncpp.program.numbers import NumberStyle, format_number  # noqa: E402
+from ncpp.program.numbers import NumberStyle, format_number, style_pattern  # noqa: E402
 
 _AXES = "XYZ"
 _POLAR_WORDS = frozenset(("R", "PR", "PA", "IPR", "IPA"))
@@ -458,7 +458,7 @@ class HeidenhainWriter(IsoWriter):
         for item in block.items:
             if type(item) is Word:
                 # (letter, the number's signs, point and zeros): the style it teaches, and whether it is an axis
-                key = (item.letter, item.number.translate(_NONZERO_DIGITS))
+                key = (item.letter, style_pattern(item.number))
                 lesson = lessons.get(key)
                 if lesson is None:
                     if len(lessons) >= 4096:  # zeros and ones make the patterns: keep memory flat
@@ -473,7 +473,6 @@ class HeidenhainWriter(IsoWriter):
                         self.known_axes.add(axis)
 
 
-_NONZERO_DIGITS = str.maketrans("23456789", "11111111")  # what NumberStyle.of reads of a number is kept
 _NO_LESSON = ()
 
 
