@@ -48,11 +48,6 @@ def spelling(block: Block) -> tuple[str, bool]:
     return (" " if separator is None else separator), previous_end >= 0 and not capital
 
 
-def word_separator(block: Block) -> str:
-    """' ' when the block separates its words with spaces, '' when it packs them."""
-    return spelling(block)[0]
-
-
 def edit_words(
     block: Block,
     values: Mapping[str, float],

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import io
+
 import pytest
 
 from ncpp.program.numbers import NumberStyle
@@ -289,3 +291,47 @@ def test_numbers_without_trailing_zeros_keep_the_resolved_styles():
         assert writer._resolved.get(False) is units  # not worked out again
     writer._read_block(parse_text("N5 X1.12345\n")[0])  # five places: written with five now
     assert writer._units(False) is not units and writer._units(False).styles["X"].decimals == 5
+
+
+SINUMERIK_PROGRAM = """\
+N10 G17 G90 G71
+N20 G0 X0 Y0 Z5
+N30 G1 Z-1 F300
+X10.5 Y2.25
+N40 G2 X20 Y2.25 I4.75 J0
+G3 X30 Y2.25 CR=5
+G1	X40	Y10 Z-2
+N50 G91 X1 Y1
+G90 X0 Y0 Z5
+"""
+
+
+@PLAN_EXAMPLES
+@given(st.lists(st.tuples(st.integers(0, 2), st.floats(-0.01, 0.01)), min_size=1, max_size=40))
+def test_sinumerik_new_blocks_by_template_are_the_general_ones(moves):
+    """The Sinumerik writer's new blocks written by a compiled template equal those of its general path."""
+    from dataclasses import replace
+
+    from ncpp.motion.segments import Arc, Line
+    from ncpp.pipeline import dialect_tools
+    from ncpp.program.dialects import parse_program
+
+    interpret, writer = dialect_tools("sinumerik")
+
+    class General(writer):  # type: ignore[misc, valid-type]
+        def _units(self, inch):
+            units = super()._units(inch)
+            units.plain = False
+            return units
+
+    _, blocks = parse_program(io.BytesIO(SINUMERIK_PROGRAM.encode()), "t.mpf", "sinumerik")
+    moved = []
+    for n, event in enumerate(interpret(blocks, file="t.mpf")):
+        pieces, shift = moves[n % len(moves)]
+        if type(event) is Line or type(event) is Arc:
+            end = tuple(v + shift for v in event.end)
+            steps = [Line(event.start, tuple(v - shift for v in end), n % 3 == 0, 1.0, event.block, event.context, changed=True)]
+            moved += steps[:pieces] + [replace(event, end=end, changed=bool(shift) or pieces > 0)] + steps[:pieces // 2]
+        else:
+            moved.append(event)
+    assert list(writer().write(moved)) == list(General().write(moved))

@@ -212,7 +212,7 @@ from ncpp.motion.segments import Arc, Line  # noqa: E402  (the writer half of th
 from ncpp.program.blocks import Block  # noqa: E402
 from ncpp.program.dialects.editing import splice  # noqa: E402
 from ncpp.program.dialects.iso import IsoWriter  # noqa: E402
-from ncpp.program.writer import edit_texts, word_separator  # noqa: E402
+from ncpp.program.writer import edit_texts  # noqa: E402
 
 _ARC_ONLY = ("CR", "TURN", "I1", "J1", "K1")
 _MOTION_PATHS = ("CIP", "CT")
@@ -279,16 +279,30 @@ class SinumerikWriter(IsoWriter):
         return raw
 
     def _new_block(self, block: Block, segment: Line | Arc) -> str:
-        words = self._texts(block, segment)
+        inch = segment.context.inch
+        units = self._resolved.get(inch) or self._units(inch)
         code = self._motion_code(segment)
-        parts = []
-        if code != self.output_motion:
-            parts.append(f"G{code}")
+        motion = code if code != self.output_motion else None
+        sep = self._spelling(block)[0]  # packed blocks: new ones are spaced (`X1=...` needs it)
+        sep = sep if sep and not sep.strip() else " "
+        if units.plain and (type(segment) is Line or not self._uses_cr(block)):
+            # one template per letters written, motion and separator: `G1 X{0:z.4f} Y{1:z.4f}`
+            bits = self._written_bits(self._facts(block), segment, units)
+            key = ("sinumerik", bits, motion, sep)
+            template = units.new_templates.get(key)
+            if template is None:
+                fields = [f"G{motion}"] if motion is not None else []
+                template = units.new_templates[key] = sep.join(fields + [letter + field for letter, field in units.fields(bits).items()])
+            text = template.format(*self._numbers(segment))
+        else:
+            words = self._texts(block, segment)
+            parts = [f"G{motion}"] if motion is not None else []
+            parts += [f"{letter}={text}" if len(letter) > 1 else letter + text for letter, text in words.items()]
+            text = sep.join(parts)
+        if motion is not None:
             self.output_motion = code
-        parts += [f"{letter}={text}" if len(letter) > 1 else letter + text for letter, text in words.items()]
         self._remember_end(segment)
-        sep = word_separator(block)
-        return (sep if sep and not sep.strip() else " ").join(parts)
+        return text
 
 
 _PARSERS: dict[str, object] = {}
