@@ -300,33 +300,45 @@ N30 G1 Z-1 F300
 X10.5 Y2.25
 N40 G2 X20 Y2.25 I4.75 J0
 G3 X30 Y2.25 CR=5
-G1	X40	Y10 Z-2
+G1\tX40\tY10 Z-2
 N50 G91 X1 Y1
-G90 X0 Y0 Z5
+G90 X0 Y0 Z5 ; back
+G01 X1.5 F200
+N60 G0 Z10
+X2 Y3
+g1 x4 y5
+G2 X8 Y5 I2 J0 ; arc
 """
 
 
-@PLAN_EXAMPLES
-@given(st.lists(st.tuples(st.integers(0, 2), st.floats(-0.01, 0.01)), min_size=1, max_size=40))
-def test_sinumerik_new_blocks_by_template_are_the_general_ones(moves):
-    """The Sinumerik writer's new blocks written by a compiled template equal those of its general path."""
+def _sinumerik_writers():
+    """The Sinumerik writer, and one writing every line by its general path."""
+    from ncpp.pipeline import dialect_tools
+
+    writer = dialect_tools("sinumerik")[1]
+
+    class General(writer):  # type: ignore[misc, valid-type]
+        _edit_block = writer._edit_in_general
+
+        def _units(self, inch):
+            units = super()._units(inch)
+            units.plain = False
+            return units
+
+    return writer(), General()
+
+
+def _sinumerik_moved(moves) -> list:
+    """SINUMERIK_PROGRAM's events with their ends shifted and steps before and after them."""
     from dataclasses import replace
 
     from ncpp.motion.segments import Arc, Line
     from ncpp.pipeline import dialect_tools
     from ncpp.program.dialects import parse_program
 
-    interpret, writer = dialect_tools("sinumerik")
-
-    class General(writer):  # type: ignore[misc, valid-type]
-        def _units(self, inch):
-            units = super()._units(inch)
-            units.plain = False
-            return units
-
     _, blocks = parse_program(io.BytesIO(SINUMERIK_PROGRAM.encode()), "t.mpf", "sinumerik")
     moved = []
-    for n, event in enumerate(interpret(blocks, file="t.mpf")):
+    for n, event in enumerate(dialect_tools("sinumerik")[0](blocks, file="t.mpf")):
         pieces, shift = moves[n % len(moves)]
         if type(event) is Line or type(event) is Arc:
             end = tuple(v + shift for v in event.end)
@@ -334,4 +346,14 @@ def test_sinumerik_new_blocks_by_template_are_the_general_ones(moves):
             moved += steps[:pieces] + [replace(event, end=end, changed=bool(shift) or pieces > 0)] + steps[:pieces // 2]
         else:
             moved.append(event)
-    assert list(writer().write(moved)) == list(General().write(moved))
+    return moved
+
+
+@PLAN_EXAMPLES
+@given(st.lists(st.tuples(st.integers(0, 2), st.floats(-0.01, 0.01)), min_size=1, max_size=40))
+def test_sinumerik_lines_by_plans_and_templates_are_the_general_ones(moves):
+    """The Sinumerik writer's plain blocks edited by ISO's compiled plans and its new blocks
+    by templates equal those its general path writes."""
+    moved = _sinumerik_moved(moves)
+    fast, general = _sinumerik_writers()
+    assert list(fast.write(moved)) == list(general.write(moved))

@@ -255,6 +255,13 @@ class SinumerikWriter(IsoWriter):
         return texts
 
     def _edit_block(self, block: Block, segment: Line | Arc) -> str:
+        facts = self._facts(block)
+        if block.signature is not None and not facts.machine and facts.letters.isdisjoint(_ISO_ONLY):
+            # one-letter words and comments only (`X10.5 Y2.25`): ISO's edit, by compiled plans, says the same
+            return super()._edit_block(block, segment)
+        return self._edit_in_general(block, segment)
+
+    def _edit_in_general(self, block: Block, segment: Line | Arc) -> str:
         words = self._texts(block, segment)
         texts: dict[int, str | None] = {}
         for n, item in enumerate(block.items):
@@ -305,6 +312,9 @@ class SinumerikWriter(IsoWriter):
         return text
 
 
+# Letters ISO's edit reads as its own (G53: machine coordinates; R, P: an arc's radius and turns,
+# dropped when the arc changes) where Sinumerik means other things
+_ISO_ONLY = frozenset({"R", "P"})
 _PARSERS: dict[str, object] = {}
 
 
