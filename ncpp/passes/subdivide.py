@@ -4,17 +4,22 @@ Compensating only a line's end points corrects the path between them by the
 straight interpolation of the end-point errors.  Where the error varies more
 than that along the line (a bow, a kink in an error table), the line is split
 into pieces short enough that the remaining deviation is below the tolerance.
+The error is sampled by a kernel (`PieceCounts`), in the worker process when
+there is one.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Iterable, Iterator
 
 import numpy as np
+from numpy.typing import NDArray
 
 from ncpp.motion.segments import Event, Line
 from ncpp.passes.context import PassContext, deviation
 from ncpp.passes.geometry import chunked, frames, points, rows_of, spliced
+from ncpp.passes.kernels import run_ahead
 
 # Interior samples where linearity is checked.
 SAMPLES = np.linspace(0.0, 1.0, 7)
@@ -25,23 +30,60 @@ MAX_PIECES = 10_000
 
 
 def subdivide_lines(events: Iterable[Event], ctx: PassContext) -> Iterator[Event]:
-    for chunk in chunked(events):
-        yield from _subdivide_chunk(chunk, ctx)
+    count = ctx.kernels.bind(PieceCounts(ctx.for_kernels()))
+    chunks = (_with_rows(chunk, ctx) for chunk in chunked(events))
+    # with a worker process, the error along the next chunks' lines is evaluated while one is split
+    for (chunk, index, lines, _), counting in run_ahead(chunks, lambda c: None if c[3] is None else count(c[3]), ctx.kernels.ahead):
+        if counting is None:
+            yield from chunk
+            continue
+        pieces = counting.result().tolist()
+        split = [i for i, n in enumerate(pieces) if n > 1]
+        yield from spliced(chunk, [index[i] for i in split], [_split(lines[i], pieces[i]) for i in split])
 
 
-def _subdivide_chunk(chunk: list[Event], ctx: PassContext) -> list[Event]:
+@dataclass
+class _LineRows:
+    """A chunk's feed lines of at least `min_line_check` as the kernel needs them (no events)."""
+
+    starts: NDArray  # (n,3) program units
+    ends: NDArray  # (n,3)
+    offsets: NDArray  # (n,3) machine minus program, program units
+    scales: NDArray  # (n,) mm per program unit
+    tools: NDArray | None  # (n,3) tool length offsets, mm (None: none)
+
+
+def _with_rows(chunk: list[Event], ctx: PassContext) -> tuple[list[Event], list[int], list[Line], _LineRows | None]:
+    """The chunk, where its lines to check are, those lines, and their rows (None: none)."""
     index = [k for k, e in enumerate(chunk) if type(e) is Line and not e.rapid and not e.changed]
     if not index:
-        return chunk
+        return chunk, [], [], None
     lines = [chunk[k] for k in index]
     starts = points([ln.start for ln in lines])
     ends = points([ln.end for ln in lines])
     offsets, scales, tools = frames(lines)
     long = np.flatnonzero(np.linalg.norm(ends - starts, axis=1) * scales >= ctx.min_line_check)
     if long.size == 0:
-        return chunk
-    index, lines = [index[i] for i in long.tolist()], [lines[i] for i in long.tolist()]
-    starts, ends, offsets, scales, tools = starts[long], ends[long], offsets[long], scales[long], rows_of(tools, long)
+        return chunk, [], [], None
+    keep = long.tolist()
+    rows = _LineRows(starts[long], ends[long], offsets[long], scales[long], rows_of(tools, long))
+    return chunk, [index[i] for i in keep], [lines[i] for i in keep], rows
+
+
+class PieceCounts:
+    """The numbers of the pass: into how many pieces each line must be split."""
+
+    def __init__(self, ctx: PassContext):
+        self.ctx = ctx
+
+    def __call__(self, rows: _LineRows) -> NDArray:
+        return _piece_counts(rows, self.ctx)
+
+
+def _piece_counts(rows: _LineRows, ctx: PassContext) -> NDArray:
+    """(n,) pieces per line: the error along it, sampled, bows from the straight
+    interpolation of its end errors by less than the tolerance in each piece."""
+    starts, ends, offsets, scales, tools = rows.starts, rows.ends, rows.offsets, rows.scales, rows.tools
     t = SAMPLES[None, :, None]
     program = starts[:, None, :] + t * (ends - starts)[:, None, :]
     machine = (program + offsets[:, None, :]) * scales[:, None, None]
@@ -51,9 +93,7 @@ def _subdivide_chunk(chunk: list[Event], ctx: PassContext) -> list[Event]:
     straight = error[:, :1] + t * (error[:, -1:] - error[:, :1])
     bow = np.linalg.norm(error - straight, axis=-1).max(axis=1)
     # The deviation of piecewise-linear interpolation shrinks with the square of the piece count.
-    pieces = np.ceil(np.sqrt(SAFETY * bow / ctx.tolerance)).astype(int).clip(1, MAX_PIECES)
-    split = np.flatnonzero(pieces > 1).tolist()
-    return spliced(chunk, [index[i] for i in split], [_split(lines[i], int(pieces[i])) for i in split])
+    return np.ceil(np.sqrt(SAFETY * bow / ctx.tolerance)).astype(int).clip(1, MAX_PIECES)
 
 
 def _split(line: Line, n: int) -> list[Line]:

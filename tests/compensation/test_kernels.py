@@ -47,6 +47,24 @@ def test_a_worker_writes_the_same_program(machine):
     assert _compensated(PROGRAM, source, jobs=2) == inline
 
 
+def test_with_a_worker_this_process_evaluates_the_error_map_only_to_probe_it(monkeypatch):
+    """Every pass's numbers (subdivide's samples, the arc fit, the solve) run in the worker:
+    this process parses, interprets, glues and writes (and probes whether the map has
+    reversal errors: 2 x 16 points, `is_directional`)."""
+    import numpy as np
+
+    from ncpp.machine.model import Machine
+
+    points = []
+    original = Machine.deviation
+    monkeypatch.setattr(Machine, "deviation", lambda self, P, *a, **k: points.append(len(np.atleast_2d(P))) or original(self, P, *a, **k))
+    source = ErrorSource.from_machine_file(str(ROOT / "samples/machines/hr5b.toml"))
+    program = b"".join(PROGRAM.splitlines(keepends=True)[:1500])
+    assert _compensated(program, source, jobs=1) and sum(points) > 10_000  # inline: here
+    points.clear()
+    assert _compensated(program, source, jobs=2) and points == [16, 16]
+
+
 def test_a_worker_compensates_a_corpus_program_from_a_measurement_the_same():
     data = (CORPUS / "arcspiral.ngc").read_bytes()
     source = ErrorSource.from_measurement(str(ROOT / "samples/measurements/ballbar_XY_R150.csv"))
