@@ -16,9 +16,14 @@ import os
 import sys
 import tempfile
 from pathlib import Path
-from typing import BinaryIO, Callable, TypeVar
+from typing import BinaryIO, Callable, Protocol, TypeVar
 
-T = TypeVar("T")
+
+class Savable(Protocol):
+    def save(self, f: BinaryIO) -> None: ...
+
+
+T = TypeVar("T", bound=Savable)
 
 
 def cache_folder() -> Path | None:
@@ -48,13 +53,13 @@ def cached_build(name: str, source: str, build: Callable[[], T], load: Callable[
     return made
 
 
-def _save(made: object, path: Path) -> None:
+def _save(made: Savable, path: Path) -> None:
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
         handle, temporary = tempfile.mkstemp(dir=path.parent, prefix=path.name, suffix=".part")
         try:
             with os.fdopen(handle, "wb") as f:
-                made.save(f)  # type: ignore[attr-defined]
+                made.save(f)
             os.replace(temporary, path)
         except BaseException:
             os.unlink(temporary)
