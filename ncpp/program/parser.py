@@ -239,17 +239,11 @@ class LineParser:
             shape = self._learn_shape(raw, layout)
         if type(shape) is not tuple:  # not plain, or a plain line cutting cannot read
             return None if shape is _NOT_PLAIN else self._scan_items(raw)
-        spans, signature, g_words = shape
-        items = []
-        append = items.append
-        for letter, start, number_at, end in spans:
-            number = raw[number_at:end]
-            word = _new_word(Word)  # built inline: one per word of the program
-            word.letter, word.value, word.number, word.start, word.end = letter, float(number), number, start, end
-            append(word)
+        cut, signature, g_words = shape
+        items = cut.items(raw)
         if g_words:  # the signature has the G words' numbers as written
             signature = signature.format(*[items[n].number for n in g_words])
-        return tuple(items), signature
+        return items, signature
 
     def _learn_shape(self, raw: str, layout: bytes) -> object:
         """The shape of the line's layout, scanned from the line and remembered."""
@@ -326,8 +320,9 @@ class LineParser:
 
 class _TreeLayouts:
     """What the builder makes of LALR-parsed lines, by layout: a line whose layout was
-    parsed before is built from that line's tree with its own token texts, without
-    the parser (about six times the cost of the builder's transform).
+    parsed before is cut where that line's items were (`_Cut`) or built from that line's
+    tree with its own token texts (`_Replay`), without the parser (about six times the
+    cost of the builder's transform).
 
     The layout is the line with its digits as `1`.  Lines of one layout lex into
     the same terminals at the same spans when no terminal tells one digit from
@@ -339,7 +334,7 @@ class _TreeLayouts:
 
     def __init__(self, layout: Callable[[str], str]):
         self.layout = layout
-        self.known: dict[str, _Replay] = {}
+        self.known: dict[str, _Cut | _Replay] = {}
 
     @classmethod
     def of(cls, parser: lark.Lark) -> "_TreeLayouts | None":
@@ -358,10 +353,10 @@ class _TreeLayouts:
 
 
 class _Cut:
-    """The items of the lines of one layout cut from the line, without the builder: for a
-    layout whose items are each the same on every line of it (no digit the layout
+    """The items of the lines of one layout cut from the line, without scanner or builder:
+    for a layout whose items are each the same on every line of it (no digit the layout
     turns to `1` in its span: `L`, `R0`, `FMAX`) or a plain word (`X-47.4002`, `N12`: its
-    number as written and read by `float`), as most Klartext blocks are."""
+    number as written and read by `float`), as most Klartext blocks and plain ISO lines are."""
 
     def __init__(self, steps: tuple):
         self.steps = steps  # per item: the item itself, or (letter, start, start of the number, end)
@@ -389,7 +384,7 @@ class _Cut:
             if type(step) is tuple:
                 letter, start, number_at, end = step
                 number = raw[number_at:end]
-                word = _new_word(Word)
+                word = _new_word(Word)  # built inline: one per word of the program
                 word.letter, word.value, word.number, word.start, word.end = letter, float(number), number, start, end
                 append(word)
             else:
@@ -537,10 +532,10 @@ _SCAN = "scan"  # the shape of a plain layout whose items cutting cannot build: 
 
 
 def _shape(raw: str, items: tuple[AnyItem, ...], signature: str | None) -> object:
-    """How to build the items of a line of this layout: (spans, signature, g_words) for a
-    line of one-letter words whose numbers are written without blanks, else `_SCAN`.
-    spans: (letter, start, start of the number, end) of each word; the signature is a
-    format template when the line has G words, whose numbers fill it (`g_words`: their indices)."""
+    """How to build the items of a line of this layout: (a `_Cut` of its words, signature,
+    g_words) for a line of one-letter words whose numbers are written without blanks, else
+    `_SCAN`.  The signature is a format template when the line has G words, whose numbers
+    fill it (`g_words`: their indices)."""
     words = [item for item in items if type(item) is Word]
     if signature is None or len(words) != len(items) or "{" in signature or "}" in signature:
         return _SCAN  # a comma word (`,R`), a comment
@@ -549,7 +544,7 @@ def _shape(raw: str, items: tuple[AnyItem, ...], signature: str | None) -> objec
         return _SCAN  # `X - 5`: the number is written with blanks
     g_words = tuple(n for n, w in enumerate(words) if w.letter == "G")
     template = "".join("G{}" if w.letter == "G" else w.letter for w in words) if g_words else signature
-    return spans, template, g_words
+    return _Cut(spans), template, g_words
 
 
 class _PlainItems:
