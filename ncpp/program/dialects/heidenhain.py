@@ -221,7 +221,7 @@ from dataclasses import replace  # noqa: E402  (the writer half of the module)
 from ncpp.motion.segments import PLANE_AXES, Arc, Line  # noqa: E402
 from ncpp.program.blocks import Block  # noqa: E402
 from ncpp.program.dialects.editing import splice  # noqa: E402
-from ncpp.program.dialects.iso import IsoWriter  # noqa: E402
+from ncpp.program.dialects.iso import IsoWriter, written_apart  # noqa: E402
 from ncpp.program.numbers import NumberStyle, format_number, style_pattern  # noqa: E402
 
 _AXES = "XYZ"
@@ -395,14 +395,14 @@ class HeidenhainWriter(IsoWriter):
         """A new block for a further piece of a changed block."""
         if type(segment) is not Line:
             return self._arc_text(segment)
-        # the axes that moved in the output (`_moved`, one per output line: compared as numbers first)
+        # the axes that moved in the output (`_moved`, with the units' places read once per line)
         inch, end, last, last_places = segment.context.inch, segment.end, self._last_end, self._last_places
         units = self._resolved.get(inch) or self._units(inch)
         places, styles = units.places, units.styles
         words = [
             axis + format_number(end[n], styles[axis])
             for n, axis in enumerate(_AXES)
-            if last is None or ((end[n] != last[n] or places[n] != last_places[n]) and round(end[n], places[n]) != round(last[n], last_places[n]))
+            if last is None or written_apart(end[n], places[n], last[n], last_places[n])
         ]
         return "L " + " ".join(words) + (" FMAX" if segment.rapid else "")
 

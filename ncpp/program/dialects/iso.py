@@ -258,7 +258,7 @@ class IsoWriter:
     def _moved(self, axis: str, value: float, segment: Line | Arc) -> bool:
         """Whether writing `value` for the axis changes what the output last said."""
         last, n = self._last_end, AXES.index(axis)
-        return last is None or round(value, self._style(axis, segment).decimals) != round(last[n], self._last_places[n])
+        return last is None or written_apart(value, self._style(axis, segment).decimals, last[n], self._last_places[n])
 
     def _remember_end(self, segment: Line | Arc) -> None:
         inch = segment.context.inch  # once per line written: `_units`' cached look-up inlined
@@ -304,10 +304,7 @@ class IsoWriter:
             known, last = self.known_axes, self._last_end
             places, last_places = units.places, self._last_places
             for n, axis, bit in absent:
-                # written apart from the output's last end: rounded only when the numbers differ
-                if axis in known and (last is None or (
-                    (end[n] != last[n] or places[n] != last_places[n]) and round(end[n], places[n]) != round(last[n], last_places[n])
-                )):  # fmt: skip
+                if axis in known and (last is None or written_apart(end[n], places[n], last[n], last_places[n])):
                     bits |= bit
         elif absent:
             start = segment.start
@@ -513,6 +510,13 @@ def _words(block: Block, facts: _Facts) -> tuple[Word, ...]:
     """The plain words of the block, in order."""
     items = block.items
     return items if len(items) == facts.words else tuple(item for item in items if type(item) is Word)  # type: ignore[return-value]
+
+
+def written_apart(value: float, places: int, last: float, last_places: int) -> bool:
+    """Whether `value` written with `places` decimals says another number than `last` written
+    with `last_places` (compared as numbers first: most axes a block does not write are
+    exactly where the output left them)."""
+    return (value != last or places != last_places) and round(value, places) != round(last, last_places)
 
 
 class _Written:
