@@ -110,7 +110,7 @@ OTHER_ZEROS = {
 def warn_unplaced(blocks: Iterable[Block], warnings: Warnings, file: str) -> Iterator[Block]:
     """Pass blocks through; warn once per `OTHER_ZEROS` G word where the program first uses
     it (refused with --strict): the errors compensated there are those of another place."""
-    told: set = set()
+    told: set[float] = set()
     for block in blocks:
         signature = block.signature  # the words' letters and G numbers: most blocks are passed on here
         if signature is not None and "G5" not in signature:

@@ -312,8 +312,8 @@ class SinumerikWriter(IsoWriter):
         return text
 
 
-# Letters ISO's edit reads as its own (G53: machine coordinates; R, P: an arc's radius and turns,
-# dropped when the arc changes) where Sinumerik means other things
+# Letters ISO's edit reads as its own (R, P: an arc's radius and turns, dropped when the arc
+# changes) where Sinumerik means other things; G53 (ISO: machine coordinates) is `_Facts.machine`
 _ISO_ONLY = frozenset({"R", "P"})
 _PARSERS: dict[str, object] = {}
 
