@@ -20,7 +20,7 @@ from typing import BinaryIO, Callable, Iterable, Iterator
 
 from ncpp.errors import Location, NcppError, Warnings
 from ncpp.motion.offsets import AT_MACHINE_ZERO, WorkOffsets
-from ncpp.motion.segments import Event
+from ncpp.motion.segments import Event, Line, Pass
 from ncpp.passes import PASSES, PassContext, run_passes
 from ncpp.passes.context import is_directional
 from ncpp.passes.kernels import INLINE, Kernels, Worker
@@ -121,6 +121,27 @@ def warn_unplaced(blocks: Iterable[Block], warnings: Warnings, file: str) -> Ite
                 told.add(item.value)
                 warnings.warn(OTHER_ZEROS[item.value], Location(file, block.line, item.start + 1))
         yield block
+
+
+UNCOMPENSATED_CYCLE = (
+    "drilling cycle: its moves pass through uncompensated (the holes are where the program puts them, "
+    "with the machine's errors); compensation resumes with the next move"
+)
+
+
+def warn_fixed(events: Iterable[Event], warnings: Warnings, file: str) -> Iterator[Event]:
+    """Pass events through; warn where a series of drilling-cycle blocks starts (refused
+    with --strict): the interpreter marks their moves `fixed` and the passes leave them."""
+    in_series = False
+    for event in events:
+        kind = type(event)
+        if kind is Line and event.fixed:  # type: ignore[union-attr]
+            if not in_series:
+                in_series = True
+                warnings.warn(UNCOMPENSATED_CYCLE, Location(file, event.block.line, 1))
+        elif kind is not Pass:
+            in_series = False
+        yield event
 
 
 def _counted(blocks: Iterable[Block], counter: Iterator[int], progress: Callable[[int], None] | None) -> Iterator[Block]:
@@ -257,6 +278,8 @@ def _process(
     # the control's zeros place the program on the machine; passthrough places nothing
     offsets = (offsets or AT_MACHINE_ZERO) if source is not None else None
     events: Iterable[Event] = interpret(blocks, file=file, warnings=warnings, strict=strict, offsets=offsets)
+    if source is not None and name == "iso":  # the ISO interpreter's drilling cycles
+        events = warn_fixed(events, warnings, file)
     writer = writer_class()
     if source is None:
         lines: Iterable[str] = (event.block.text for event in _first_per_block(events))

@@ -10,10 +10,12 @@ Scope: modal G0-G3, planes, G90/G91, G90.1/G91.1, G20/G21 (state converted
 on a switch, like LinuxCNC), G54-G59.3, G10 L2/L20 (no rotation), G92 family,
 G52, G53, G28/G30, T, M6, M61, G43 / G43.1 / G43.2 H / G49 (lengths from the
 control's tool table, `tools.py`; zero when it is not told), F and inverse time, IJK and R arcs, helices,
-P turns, parameters and expressions, and Fanuc corner rounding and
-chamfering between two lines (`,R` `,C`, `G1 ... R`: a one-move look-ahead).
+P turns, parameters and expressions, Fanuc corner rounding and
+chamfering between two lines (`,R` `,C`, `G1 ... R`: a one-move look-ahead),
+and the drilling cycles G73 G81 G82 G83 G85 G89 with G98/G99 (`cycles.py`;
+their moves are `Line`s marked `fixed`: compensation leaves them as programmed).
 Anything else (o-word and Fanuc macro
-control flow, M98/M99, canned cycles, cutter compensation, splines,
+control flow, M98/M99, the other canned cycles, cutter compensation, splines,
 threading, probing, polar words) makes the
 interpreter's state unknown: that block and every later block pass through
 as `Pass` after ONE warning (an error with `strict`).
@@ -27,6 +29,7 @@ from typing import Iterable, Iterator
 
 from ncpp.errors import Location, NcppError, Warnings
 from ncpp.motion.corners import CornerError, round_corner
+from ncpp.motion.cycles import DRILLING, DWELLING, PECKING, RAPID_DELTA_INCH, hole
 from ncpp.motion.expressions import ExpressionError, OutOfScope, Parameters, evaluate
 from ncpp.motion.offsets import SYSTEMS, WorkOffsets
 from ncpp.motion.segments import PLANE_AXES, Arc, Context, Event, Line, Pass
@@ -67,7 +70,7 @@ G_GROUP: dict[float, int] = {float(code): group for group, codes in _GROUP_CODES
 
 # G codes whose meaning the interpreter does not follow (the reason names them in the warning)
 OUT_OF_SCOPE_G = {
-    **{c: "canned cycle" for c in (73.0, 74.0, 76.0, 81.0, 82.0, 83.0, 84.0, 85.0, 86.0, 87.0, 88.0, 89.0)},
+    **{c: "canned cycle" for c in (74.0, 76.0, 84.0, 86.0, 87.0, 88.0)},
     **{c: "lathe cycle" for c in (70.0, 71.0, 71.1, 71.2, 72.0, 72.1, 72.2)},
     **{c: "spline" for c in (5.0, 5.1, 5.2, 5.3)},
     **{c: "threading" for c in (33.0, 33.1)},
@@ -145,7 +148,11 @@ class Interpreter:
         self.inch = False
         self.inverse_time = False
         self.feed = 0.0
-        self.motion: float | None = None  # modal motion G code (0-3), None for G80 / none yet
+        self.motion: float | None = None  # modal motion G code (0-3, a drilling cycle), None for G80 / none yet
+        self.retract_to_r = True  # G99 (rs274ngc's default) / G98: where a cycle retracts to
+        # A drilling cycle's sticky words and the normal-axis position its series of cycles
+        # started from (G98 retracts there; a series ends with any other motion)
+        self.cycle_r = self.cycle_cc = self.cycle_p = self.cycle_q = self.cycle_il = 0.0
         self.coord_system = 1
         self.g5x = [[0.0] * 9 for _ in range(10)]  # index 1..9: G54..G59.3
         self.g92 = [0.0] * 9
@@ -491,7 +498,10 @@ class Interpreter:
             self._set(absolute=gcodes[3][0] == 90.0)
         if 4 in gcodes:
             self._set(arc_absolute=gcodes[4][0] == 90.1)
+        if 10 in gcodes:
+            self.retract_to_r = gcodes[10][0] == 99.0
         events: Event | tuple[Event, ...] | None = None
+        previous = self.motion
         if mode0 is not None and mode0 not in (4.0, 53.0):
             events = self._non_modal(block, words, mode0)
         if mode1 is not None:
@@ -501,6 +511,8 @@ class Interpreter:
             if motion <= 1.0:
                 events = self._straight(block, words, motion, mode0 == 53.0)
                 self.corner = _corner_word(words, motion)
+            elif motion in DRILLING:
+                events = self._cycle(block, words, motion, previous, motion_word)
             else:
                 events = self._arc(block, words, motion, motion_word, mode1_item)
         if 2.0 in mcodes or 30.0 in mcodes:
@@ -801,6 +813,97 @@ class Interpreter:
         self._note_axes(given)
         return self._line(block, self._ends(given, True), motion == 0.0)
 
+    def _cycle(self, block: Block, words: dict, motion: float, previous: float | None, item) -> tuple[Line, ...]:
+        """A drilling cycle's moves (rs274ngc's convert_cycle and convert_cycle_xy, in any plane):
+        `Line`s marked `fixed`, which compensation leaves as programmed."""
+        first, second, normal = PLANE_AXES[self.plane]
+        a_letter, b_letter, c_letter = "XYZ"[first], "XYZ"[second], "XYZ"[normal]
+        plane = _PLANE_NAMES[self.plane].upper()
+        again = previous == motion  # the same cycle again: R, the normal-axis word, P and Q are sticky
+        if self.feed == 0.0:
+            self._fail("Cannot feed with zero feed rate", block, item)
+        if self.inverse_time:
+            self._fail("Cannot use inverse time feed with canned cycles", block, item)
+        if "R" not in words and not again:
+            self._fail("R clearance plane unspecified in cycle", block, item)
+        r_word = words["R"][0] if "R" in words else self.cycle_r
+        repeats = self._repeats(block, words)
+        if c_letter not in words and not again:
+            self._fail(f"{c_letter} value unspecified in {plane} plane canned cycle", block, item)
+        c_word = words[c_letter][0] if c_letter in words else self.cycle_cc
+        if previous not in DRILLING:  # a new series: G98 retracts to where it started
+            self.cycle_il = self.pos[normal]
+        old = self.cycle_il
+        pos = self.pos
+        if self.absolute:
+            aa = words[a_letter][0] if a_letter in words else pos[first]
+            bb = words[b_letter][0] if b_letter in words else pos[second]
+            step_a = step_b = 0.0
+            r, bottom = r_word, c_word
+        else:  # X Y R are increments from where the tool is (R from the series' start), Z from R
+            aa, bb = pos[first], pos[second]
+            step_a = words[a_letter][0] if a_letter in words else 0.0
+            step_b = words[b_letter][0] if b_letter in words else 0.0
+            r = r_word + old
+            bottom = r + c_word
+        if r < bottom:
+            self._fail(f"R less than {c_letter} in cycle in {plane} plane", block, words.get("R", (0, item))[1])
+        peck = self._cycle_word(block, words, motion, again, item)
+        moves: list[tuple[float, float, float, bool]] = []
+        if old < r:  # the series started below the R plane: straight up to it first
+            moves.append((pos[first], pos[second], r, True))
+            old = r
+        elif self.retract_to_r:  # G99 crosses to the hole where the tool is (as rs274ngc does)
+            old = pos[normal]
+        clear = r if self.retract_to_r else old
+        rapid_delta = RAPID_DELTA_INCH if self.inch else RAPID_DELTA_INCH * MM_PER_INCH
+        for _ in range(repeats):
+            aa, bb = aa + step_a, bb + step_b
+            moves.append((aa, bb, old, True))
+            if old != r:
+                moves.append((aa, bb, r, True))
+            moves += hole(motion, aa, bb, r, clear, bottom, peck, rapid_delta)
+            old = clear
+        self.cycle_r, self.cycle_cc = r_word, c_word
+        lines = []
+        for a, b, c, rapid in moves:
+            end = self.pos[:]
+            end[first], end[second], end[normal] = a, b, c
+            line = self._line(block, end, rapid)
+            line.fixed = True
+            lines.append(line)
+        return tuple(lines)
+
+    def _repeats(self, block: Block, words: dict) -> int:
+        """A cycle's L: how many times it runs (1 without L)."""
+        if "L" not in words:
+            return 1
+        value, item = words["L"]
+        if value != round(value):
+            self._fail("Non integer value for integer", block, item)
+        if value < 0:
+            self._fail("Negative L word used", block, item)
+        if value == 0:
+            self._fail("Cannot do zero repeats of cycle", block, item)
+        return int(value)
+
+    def _cycle_word(self, block: Block, words: dict, motion: float, again: bool, item) -> float:
+        """The cycle's peck depth (G73 G83: Q, sticky); sets a dwelling cycle's sticky P."""
+        code = f"G{motion:g}"
+        if motion in DWELLING:
+            if "P" not in words and not again:
+                self._fail(f"Dwell time P word missing with {code}", block, item)
+            self.cycle_p = words["P"][0] if "P" in words else self.cycle_p
+        if motion not in PECKING:
+            return 0.0
+        if "Q" not in words and not again:
+            self._fail(f"Q word missing with {code}", block, item)
+        peck = words["Q"][0] if "Q" in words else self.cycle_q
+        if peck <= 0.0:
+            self._fail("Negative or zero Q value used", block, words.get("Q", (0, item))[1])
+        self.cycle_q = peck
+        return peck
+
     def _check_feed(self, block: Block, words: dict, zero: str, missing: str) -> None:
         # A zero feed rate (`zero`) is not refused, unlike rs274ngc: program fragments often
         # leave the feed to the control (a default feed, or one set before the program runs).
@@ -943,6 +1046,7 @@ _PLAIN_LETTERS = {
     1.0: frozenset("XYZABCUVWF"),
     2.0: frozenset("XYZABCUVWFIJKR"),
     3.0: frozenset("XYZABCUVWFIJKR"),
+    **{code: frozenset() for code in DRILLING},  # a cycle's words are checked in full
 }
 
 

@@ -77,7 +77,7 @@ class _Rows:
 
 def _rows(segs: list, directional: bool) -> _Rows:
     offsets, scales, tools = frames(segs)
-    line = np.array([type(e) is Line for e in segs])
+    line = np.array([type(e) is Line and not e.fixed for e in segs])  # fixed: moves left as programmed
     changed = np.array([e.changed for e in segs])
     free = line & ~changed
     return _Rows(

@@ -55,7 +55,7 @@ class _LineRows:
 
 def _with_rows(chunk: list[Event], ctx: PassContext) -> tuple[list[Event], list[int], list[Line], _LineRows | None]:
     """The chunk, where its lines to check are, those lines, and their rows (None: none)."""
-    index = [k for k, e in enumerate(chunk) if type(e) is Line and not e.rapid and not e.changed]
+    index = [k for k, e in enumerate(chunk) if type(e) is Line and not e.rapid and not e.changed and not e.fixed]
     if not index:
         return chunk, [], [], None
     lines = [chunk[k] for k in index]

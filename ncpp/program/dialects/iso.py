@@ -253,6 +253,10 @@ class IsoWriter:
             self.program_motion = self.output_motion = self._block_motion(block)
         for segment in motion:
             self._remember_end(segment)
+        if motion and type(motion[-1]) is Line and motion[-1].fixed:
+            # a drilling cycle: where it leaves the tool is the control's (G98 retracts to the
+            # compensated level it started from), so the next block writes every axis it knows
+            self._last_end = None
 
     # -- numbers as written -----------------------------------------------------
     def _moved(self, axis: str, value: float, segment: Line | Arc) -> bool:

@@ -1,0 +1,132 @@
+"""Drilling cycles (G73 G81 G82 G83 G85 G89) against LinuxCNC's rs274, and in compensation.
+
+The corpus has LinuxCNC's own G81 tests (three planes, G98 and G99, run by
+test_oracle.py); these cover the other cycles, sticky words, repeats,
+incremental mode, inch pecks and the errors rs274 stops at.
+"""
+
+from __future__ import annotations
+
+import io
+
+import pytest
+
+from ncpp.errors import NcppError, Warnings
+from ncpp.motion import interpret
+from ncpp.motion.segments import Line
+from ncpp.pipeline import ErrorSource, process
+from ncpp.program.parser import parse_stream
+from tests.conftest import RS274, ROOT
+from tests.motion.test_oracle import ours, read_canon, rs274, rs274_error
+
+HEAD = "G21 G90 G17 G54\nG0 X0 Y0 Z10 F200\n"
+
+AGREE = {
+    "g81 g98 series": HEAD + "G98 G81 X10 Y5 Z-3 R2\nX20\nY15\nG80\nG0 X0\n",
+    "g99 from below r": "G21 G90\nG0 X1 Y1 Z1 F100\nG99 G81 X5 Y5 Z-3 R2\nX6\nM2\n",
+    "g82 dwell, g85, g89": HEAD + "G99 G82 X1 Y1 Z-3 R2 P0.5\nX2\nG98 G85 X3 Z-4 R2\nG89 X4 Z-3 R1 P1\nX5\nG80\n",
+    "g83 peck, sticky q": HEAD + "G83 X1 Y1 Z-7 R1 Q2.5\nX2 Q1.5\nX3 Z-2\nG80\n",
+    "g73 chip break": HEAD + "G98 G73 X5 Y1 Z-3 R2 Q1\nX6\nG80\n",
+    "inch peck": "G20 G90\nG0 X0 Y0 Z1 F10\nG83 X1 Y1 Z-0.3 R0.1 Q0.1\nG80\n",
+    "incremental repeats": HEAD + "G0 Z1\nG91 G81 X5 Y5 Z-3 R2 L3\nG90 G80\nG0 X0 Y0\nG91 G98 G83 X-2 Z-4 R3 Q1.5 L2\nG90 G80\n",
+    "absolute repeats": HEAD + "G81 X3 Y3 Z-1 R0.5 L2\nG80\n",
+    "g18 and g19": HEAD + "G18 G98 G81 X1 Z1 Y-3 R2\nG19 G83 Y1 Z1 X-3 R2 Q1\nG17 G80\n",
+    "a series across cycles": HEAD + "G98 G81 X1 Y1 Z-3 R2\nG99 G83 X2 Z-3 R1 Q1\nG98 G82 X3 Z-3 R2 P1\nG80\n",
+    "arcs after a cycle": HEAD + "G81 X10 Y10 Z-2 R1\nG0 X20\nG1 Z-1\nG2 X30 Y20 I10 J0\nG3 X20 Y10 R10\nM2\n",
+}
+
+REFUSED = {
+    "r missing": (HEAD + "G81 X1 Y1 Z-3\n", 3),
+    "r not sticky across cycles": (HEAD + "G81 X1 Y1 Z-3 R2\nG82 X2 P1\n", 4),
+    "z missing": (HEAD + "G81 X1 Y1 R2\n", 3),
+    "r below z": (HEAD + "G81 X1 Y1 Z3 R2\n", 3),
+    "y missing in g18": (HEAD + "G18 G81 X1 Z1 R2\n", 3),
+    "zero repeats": (HEAD + "G81 X1 Y1 Z-3 R2 L0\n", 3),
+    "negative repeats": (HEAD + "G81 X1 Y1 Z-3 R2 L-2\n", 3),
+    "fractional repeats": (HEAD + "G81 X1 Y1 Z-3 R2 L2.5\n", 3),
+    "zero feed": ("G21 G90\nG0 Z1\nG81 X1 Y1 Z-3 R2\n", 3),
+    "inverse time": (HEAD + "G93 G81 X1 Y1 Z-3 R2\n", 3),
+    "p missing": (HEAD + "G82 X1 Y1 Z-3 R2\n", 3),
+    "q missing": (HEAD + "G73 X1 Y1 Z-3 R2\n", 3),
+    "axes with g80": (HEAD + "G81 X1 Y1 Z-3 R2\nG80 X2\n", 4),
+}
+
+
+def _program(tmp_path, text: str):
+    path = tmp_path / "cycle.ngc"
+    path.write_text(text + ("" if text.rstrip().endswith("M2") else "M2\n"))
+    return path
+
+
+@pytest.mark.parametrize("name", AGREE)
+def test_cycles_move_as_rs274_does(tmp_path, name):
+    path = _program(tmp_path, AGREE[name])
+    calls, messages = rs274(str(path))
+    reference = read_canon(calls)
+    assert rs274_error(messages) is None, messages
+    mine, error, warning = ours(path)
+    assert error is None and not warning, (error, warning)
+    assert len(mine) == len(reference)
+    for want, got in zip(reference, mine):
+        assert want.name == got.name and all(abs(a - b) <= 1e-4 for a, b in zip(want.args, got.args)), (want, got)
+
+
+@pytest.mark.parametrize("name", REFUSED)
+def test_cycles_refused_where_rs274_refuses(tmp_path, name):
+    text, line = REFUSED[name]
+    path = _program(tmp_path, text)
+    _, messages = rs274(str(path))
+    refused = rs274_error(messages)
+    assert refused is not None and refused[1].strip() == text.splitlines()[line - 1].strip(), messages
+    _, error, _ = ours(path)
+    assert error is not None and error.where.line == line, error
+
+
+def test_cycle_moves_are_fixed():
+    events = list(interpret(parse_stream(io.BytesIO((HEAD + "G81 X1 Y1 Z-3 R2\nG80\nG1 X5\n").encode()), "t.ngc")))
+    lines = [e for e in events if type(e) is Line]
+    assert [e.fixed for e in lines] == [False, True, True, True, True, False]
+
+
+@pytest.fixture(scope="module")
+def hr5b():
+    return ErrorSource.from_machine_file(str(ROOT / "samples/machines/hr5b.toml"))
+
+
+def _compensate(text: str, source, strict: bool = False) -> tuple[str, str]:
+    from ncpp.motion.offsets import WorkOffsets
+
+    warned, out = io.StringIO(), io.BytesIO()
+    process(io.BytesIO(text.encode()), out, file="drill.ngc", source=source, warnings=Warnings(stream=warned, strict=strict),
+            offsets=WorkOffsets.at((400.0, 350.0, 350.0)))  # fmt: skip
+    return out.getvalue().decode(), warned.getvalue()
+
+
+DRILL = HEAD + "G1 Z-1\nX40 Y12\nG0 Z5\nG98 G81 X20 Y20 Z-3 R2\nX30\n(between)\nX40 Y25\nG80\nG0 X50 Y50\nG1 Z-1\nX70 Y40\nG3 X80 Y60 R15\nG0 Z10\nM2\n"
+
+
+def test_cycles_pass_through_and_compensation_resumes(hr5b):
+    out, warned = _compensate(DRILL, hr5b)
+    lines = out.splitlines()
+    cycle = ["G98 G81 X20 Y20 Z-3 R2", "X30", "(between)", "X40 Y25", "G80"]
+    start = lines.index(cycle[0])
+    assert lines[start : start + len(cycle)] == cycle  # verbatim
+    # one warning, naming the line where the series starts
+    assert warned.count("warning") == 1 and "drill.ngc:6:1: warning: drilling cycle" in warned
+    after = lines[start + len(cycle) :]
+    assert after[0].startswith("G0 X50.0") and "Z" in after[0]  # compensated, every axis said after the cycle
+    assert any(line.startswith("G3 ") and "I" in line for line in after)  # the arc after it is replaced too
+
+
+def test_strict_refuses_cycles(hr5b):
+    with pytest.raises(NcppError, match="drill.ngc:6:1: drilling cycle"):
+        _compensate(DRILL, hr5b, strict=True)
+
+
+@pytest.mark.skipif(not RS274.exists(), reason="no rs274")
+def test_rs274_accepts_the_compensated_cycles(tmp_path, hr5b):
+    out, _ = _compensate(DRILL, hr5b)
+    path = tmp_path / "out.ngc"
+    path.write_text(out)
+    _, messages = rs274(str(path))
+    assert rs274_error(messages) is None, messages
