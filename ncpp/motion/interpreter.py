@@ -150,9 +150,9 @@ class Interpreter:
         self.feed = 0.0
         self.motion: float | None = None  # modal motion G code (0-3, a drilling cycle), None for G80 / none yet
         self.retract_to_r = True  # G99 (rs274ngc's default) / G98: where a cycle retracts to
-        # A drilling cycle's sticky words and the normal-axis position its series of cycles
-        # started from (G98 retracts there; a series ends with any other motion)
-        self.cycle_r = self.cycle_cc = self.cycle_p = self.cycle_q = self.cycle_il = 0.0
+        # A drilling cycle's sticky words (R, the normal axis's, Q; P is a dwell: no move) and the
+        # normal-axis position its series of cycles started from (a series ends with any other motion)
+        self.cycle_r = self.cycle_cc = self.cycle_q = self.cycle_il = 0.0
         self.coord_system = 1
         self.g5x = [[0.0] * 9 for _ in range(10)]  # index 1..9: G54..G59.3
         self.g92 = [0.0] * 9
@@ -888,12 +888,10 @@ class Interpreter:
         return int(value)
 
     def _cycle_word(self, block: Block, words: dict, motion: float, again: bool, item) -> float:
-        """The cycle's peck depth (G73 G83: Q, sticky); sets a dwelling cycle's sticky P."""
+        """The cycle's peck depth (G73 G83: Q, sticky); checks a dwelling cycle's P (sticky too)."""
         code = f"G{motion:g}"
-        if motion in DWELLING:
-            if "P" not in words and not again:
-                self._fail(f"Dwell time P word missing with {code}", block, item)
-            self.cycle_p = words["P"][0] if "P" in words else self.cycle_p
+        if motion in DWELLING and "P" not in words and not again:
+            self._fail(f"Dwell time P word missing with {code}", block, item)
         if motion not in PECKING:
             return 0.0
         if "Q" not in words and not again:
