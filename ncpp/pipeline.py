@@ -124,13 +124,13 @@ def warn_unplaced(blocks: Iterable[Block], warnings: Warnings, file: str) -> Ite
 
 
 UNCOMPENSATED_CYCLE = (
-    "drilling cycle: its moves pass through uncompensated (the holes are where the program puts them, "
+    "canned cycle: its moves pass through uncompensated (the holes are where the program puts them, "
     "with the machine's errors); compensation resumes with the next move"
 )
 
 
 def warn_fixed(events: Iterable[Event], warnings: Warnings, file: str) -> Iterator[Event]:
-    """Pass events through; warn where a series of drilling-cycle blocks starts (refused
+    """Pass events through; warn where a series of canned-cycle blocks starts (refused
     with --strict): the interpreter marks their moves `fixed` and the passes leave them."""
     in_series = False
     for event in events:
@@ -278,7 +278,7 @@ def _process(
     # the control's zeros place the program on the machine; passthrough places nothing
     offsets = (offsets or AT_MACHINE_ZERO) if source is not None else None
     events: Iterable[Event] = interpret(blocks, file=file, warnings=warnings, strict=strict, offsets=offsets)
-    if source is not None and name == "iso":  # the ISO interpreter's drilling cycles
+    if source is not None and name == "iso":  # the ISO interpreter's canned cycles
         events = warn_fixed(events, warnings, file)
     writer = writer_class()
     if source is None:

@@ -1,17 +1,20 @@
-"""Drilling canned cycles as rs274ngc moves them (interp_cycles.cc).
+"""Canned cycles as rs274ngc moves them (interp_cycles.cc).
 
-G73 (chip-breaking peck), G81 (drill), G82 (drill, dwell), G83 (peck),
-G85 (bore, feed out) and G89 (bore, dwell, feed out), in the G17, G18 or
-G19 plane.  Coordinates here are those of the plane, as rs274ngc names them:
-`aa` and `bb` in the plane, `cc` along its normal (the drilling axis).
-The cycles that stop, reverse or orient the spindle (G74 G84 G86 G87 G88)
-stay outside the interpreter's scope: they depend on the spindle's state.
+G73 (chip-breaking peck), G74/G84 (left/right-hand tapping), G81 (drill),
+G82 (drill, dwell), G83 (peck), G85 (bore, feed out), G86 (bore, spindle
+stop, rapid out), G87 (back bore, G17 only) and G89 (bore, dwell, feed out),
+in the G17, G18 or G19 plane.  Coordinates here are those of the plane, as
+rs274ngc names them: `aa` and `bb` in the plane, `cc` along its normal (the
+drilling axis).  G88 stays outside the interpreter's scope: the operator
+retracts the spindle by hand, so where the tool is afterwards is unknown.
 """
 
 from __future__ import annotations
 
-DRILLING = frozenset({73.0, 81.0, 82.0, 83.0, 85.0, 89.0})
-DWELLING = frozenset({82.0, 89.0})  # P: a dwell time, sticky within the cycle
+CANNED = frozenset({73.0, 74.0, 81.0, 82.0, 83.0, 84.0, 85.0, 86.0, 87.0, 89.0})
+DWELLING = frozenset({82.0, 86.0, 89.0})  # P: a dwell time, required (sticky within the cycle)
+# the spindle direction (M3 1, M4 -1) each cycle needs, and its refusal otherwise (any turning: 0)
+SPINDLE = {84.0: (1, "G84"), 74.0: (-1, "G74"), 86.0: (0, "g86"), 87.0: (0, "g87")}
 PECKING = frozenset({73.0, 83.0})  # Q: the peck depth, sticky within the cycle
 # G73/G83: the rapid back into the hole stops this far above the last peck (rs274ngc's
 # G83_RAPID_DELTA, in inch; 0.254 mm)
@@ -34,5 +37,15 @@ def hole(motion: float, aa: float, bb: float, r: float, clear: float, bottom: fl
     moves.append((aa, bb, bottom, False))
     if motion == 85.0:
         moves.append((aa, bb, r, False))
-    moves.append((aa, bb, clear, motion != 89.0))  # G89 feeds out
+    moves.append((aa, bb, clear, motion not in (74.0, 84.0, 89.0)))  # taps and G89 feed out
     return moves
+
+
+def back_bore(aa: float, bb: float, off_a: float, off_b: float, r: float, clear: float, middle: float, bottom: float) -> list[Move]:
+    """G87: in beside the hole (`off_a`, `off_b`) with the spindle oriented, feed up to
+    `middle` and back from the bottom, out the same way."""
+    return [
+        (off_a, off_b, r, True), (off_a, off_b, bottom, True), (aa, bb, bottom, True),
+        (aa, bb, middle, False), (aa, bb, bottom, False),
+        (off_a, off_b, bottom, True), (off_a, off_b, clear, True), (aa, bb, clear, True),
+    ]  # fmt: skip

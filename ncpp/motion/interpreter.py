@@ -12,10 +12,10 @@ G52, G53, G28/G30, T, M6, M61, G43 / G43.1 / G43.2 H / G49 (lengths from the
 control's tool table, `tools.py`; zero when it is not told), F and inverse time, IJK and R arcs, helices,
 P turns, parameters and expressions, Fanuc corner rounding and
 chamfering between two lines (`,R` `,C`, `G1 ... R`: a one-move look-ahead),
-and the drilling cycles G73 G81 G82 G83 G85 G89 with G98/G99 (`cycles.py`;
+and the canned cycles G73 G74 G81-G87 G89 with G98/G99 (`cycles.py`;
 their moves are `Line`s marked `fixed`: compensation leaves them as programmed).
 Anything else (o-word and Fanuc macro
-control flow, M98/M99, the other canned cycles, cutter compensation, splines,
+control flow, M98/M99, G88 (a manual retract) and the lathe cycles, cutter compensation, splines,
 threading, probing, polar words) makes the
 interpreter's state unknown: that block and every later block pass through
 as `Pass` after ONE warning (an error with `strict`).
@@ -29,7 +29,7 @@ from typing import Iterable, Iterator
 
 from ncpp.errors import Location, NcppError, Warnings
 from ncpp.motion.corners import CornerError, round_corner
-from ncpp.motion.cycles import DRILLING, DWELLING, PECKING, RAPID_DELTA_INCH, hole
+from ncpp.motion.cycles import CANNED, DWELLING, PECKING, RAPID_DELTA_INCH, SPINDLE, back_bore, hole
 from ncpp.motion.expressions import ExpressionError, OutOfScope, Parameters, evaluate
 from ncpp.motion.offsets import SYSTEMS, WorkOffsets
 from ncpp.motion.segments import PLANE_AXES, Arc, Context, Event, Line, Pass
@@ -70,7 +70,7 @@ G_GROUP: dict[float, int] = {float(code): group for group, codes in _GROUP_CODES
 
 # G codes whose meaning the interpreter does not follow (the reason names them in the warning)
 OUT_OF_SCOPE_G = {
-    **{c: "canned cycle" for c in (74.0, 76.0, 84.0, 86.0, 87.0, 88.0)},
+    **{c: "canned cycle" for c in (76.0, 88.0)},
     **{c: "lathe cycle" for c in (70.0, 71.0, 71.1, 71.2, 72.0, 72.1, 72.2)},
     **{c: "spline" for c in (5.0, 5.1, 5.2, 5.3)},
     **{c: "threading" for c in (33.0, 33.1)},
@@ -148,11 +148,13 @@ class Interpreter:
         self.inch = False
         self.inverse_time = False
         self.feed = 0.0
-        self.motion: float | None = None  # modal motion G code (0-3, a drilling cycle), None for G80 / none yet
+        self.motion: float | None = None  # modal motion G code (0-3, a canned cycle), None for G80 / none yet
         self.retract_to_r = True  # G99 (rs274ngc's default) / G98: where a cycle retracts to
-        # A drilling cycle's sticky words (R, the normal axis's, Q; P is a dwell: no move) and the
+        # A canned cycle's sticky words (R, the normal axis's, Q; P is a dwell: no move) and the
         # normal-axis position its series of cycles started from (a series ends with any other motion)
         self.cycle_r = self.cycle_cc = self.cycle_q = self.cycle_il = 0.0
+        self.cycle_ijk = (0.0, 0.0, 0.0)  # G87's sticky I J K
+        self.spindle = 0  # M3 1, M4 -1, stopped 0 (tapping and boring cycles check it)
         self.coord_system = 1
         self.g5x = [[0.0] * 9 for _ in range(10)]  # index 1..9: G54..G59.3
         self.g92 = [0.0] * 9
@@ -483,6 +485,9 @@ class Interpreter:
             self._set_units(gcodes[6][0] == 20.0)
         if "T" in words:
             self.selected_tool = self._tool_number(words["T"], block)
+        for code, turning in ((3.0, 1), (4.0, -1), (5.0, 0), (19.0, 0)):  # M19 orients: stopped
+            if code in mcodes:
+                self.spindle = turning
         if 6.0 in mcodes:
             self.spindle_tool = self.selected_tool
         if 61.0 in mcodes and "Q" in words:
@@ -511,7 +516,7 @@ class Interpreter:
             if motion <= 1.0:
                 events = self._straight(block, words, motion, mode0 == 53.0)
                 self.corner = _corner_word(words, motion)
-            elif motion in DRILLING:
+            elif motion in CANNED:
                 events = self._cycle(block, words, motion, previous, motion_word)
             else:
                 events = self._arc(block, words, motion, motion_word, mode1_item)
@@ -814,7 +819,7 @@ class Interpreter:
         return self._line(block, self._ends(given, True), motion == 0.0)
 
     def _cycle(self, block: Block, words: dict, motion: float, previous: float | None, item) -> tuple[Line, ...]:
-        """A drilling cycle's moves (rs274ngc's convert_cycle and convert_cycle_xy, in any plane):
+        """A canned cycle's moves (rs274ngc's convert_cycle and convert_cycle_xy, in any plane):
         `Line`s marked `fixed`, which compensation leaves as programmed."""
         first, second, normal = PLANE_AXES[self.plane]
         a_letter, b_letter, c_letter = "XYZ"[first], "XYZ"[second], "XYZ"[normal]
@@ -831,7 +836,7 @@ class Interpreter:
         if c_letter not in words and not again:
             self._fail(f"{c_letter} value unspecified in {plane} plane canned cycle", block, item)
         c_word = words[c_letter][0] if c_letter in words else self.cycle_cc
-        if previous not in DRILLING:  # a new series: G98 retracts to where it started
+        if previous not in CANNED:  # a new series: G98 retracts to where it started
             self.cycle_il = self.pos[normal]
         old = self.cycle_il
         pos = self.pos
@@ -849,6 +854,11 @@ class Interpreter:
         if r < bottom:
             self._fail(f"R less than {c_letter} in cycle in {plane} plane", block, words.get("R", (0, item))[1])
         peck = self._cycle_word(block, words, motion, again, item)
+        if motion in SPINDLE:
+            self._check_spindle(block, motion, item)
+        if motion == 87.0:
+            i, j, k = self._back_bore_words(block, words, again, item)
+            middle = bottom + k if not self.absolute else k
         moves: list[tuple[float, float, float, bool]] = []
         if old < r:  # the series started below the R plane: straight up to it first
             moves.append((pos[first], pos[second], r, True))
@@ -862,7 +872,10 @@ class Interpreter:
             moves.append((aa, bb, old, True))
             if old != r:
                 moves.append((aa, bb, r, True))
-            moves += hole(motion, aa, bb, r, clear, bottom, peck, rapid_delta)
+            if motion == 87.0:
+                moves += back_bore(aa, bb, aa + i, bb + j, r, clear, middle, bottom)
+            else:
+                moves += hole(motion, aa, bb, r, clear, bottom, peck, rapid_delta)
             old = clear
         self.cycle_r, self.cycle_cc = r_word, c_word
         lines = []
@@ -873,6 +886,26 @@ class Interpreter:
             line.fixed = True
             lines.append(line)
         return tuple(lines)
+
+    def _check_spindle(self, block: Block, motion: float, item) -> None:
+        """Tapping wants the spindle turning its way (G84 M3, G74 M4), boring turning at all."""
+        wanted, name = SPINDLE[motion]
+        if self.spindle == 0:
+            self._fail(f"Spindle not turning in {name}", block, item)
+        if wanted and self.spindle != wanted:
+            self._fail(f"Spindle turning {'counterclockwise' if wanted > 0 else 'clockwise'} in {name}", block, item)
+
+    def _back_bore_words(self, block: Block, words: dict, again: bool, item) -> tuple[float, float, float]:
+        """G87's I J (offsets in the plane) and K (the top of the bore), sticky within the cycle."""
+        if self.plane != 17:  # rs274ngc swaps I J K about in the other planes; not followed here
+            raise _OutOfScope("canned cycle G87 outside the XY plane", item.start + 1)
+        values = []
+        for letter, kept in zip("IJK", self.cycle_ijk):
+            if letter not in words and not again:
+                self._fail(f"{letter} word missing with G87", block, item)
+            values.append(words[letter][0] if letter in words else kept)
+        self.cycle_ijk = (values[0], values[1], values[2])
+        return self.cycle_ijk
 
     def _repeats(self, block: Block, words: dict) -> int:
         """A cycle's L: how many times it runs (1 without L)."""
@@ -1044,7 +1077,7 @@ _PLAIN_LETTERS = {
     1.0: frozenset("XYZABCUVWF"),
     2.0: frozenset("XYZABCUVWFIJKR"),
     3.0: frozenset("XYZABCUVWFIJKR"),
-    **{code: frozenset() for code in DRILLING},  # a cycle's words are checked in full
+    **{code: frozenset() for code in CANNED},  # a cycle's words are checked in full
 }
 
 

@@ -76,7 +76,7 @@ class Line:
     context: Context = field(default_factory=Context)
     extra: tuple[float, ...] = ()  # end positions of A B C U V W, when the program uses them
     changed: bool = False  # set by a pass that moved the end point
-    fixed: bool = False  # a move passes leave as programmed (a drilling cycle's)
+    fixed: bool = False  # a move passes leave as programmed (a canned cycle's)
 
     def length(self) -> float:
         return math.dist(self.start, self.end)

@@ -1,8 +1,9 @@
-"""Drilling cycles (G73 G81 G82 G83 G85 G89) against LinuxCNC's rs274, and in compensation.
+"""Canned cycles (G73 G74 G81-G87 G89) against LinuxCNC's rs274, and in compensation.
 
 The corpus has LinuxCNC's own G81 tests (three planes, G98 and G99, run by
 test_oracle.py); these cover the other cycles, sticky words, repeats,
-incremental mode, inch pecks and the errors rs274 stops at.
+incremental mode, inch pecks, the spindle the tapping and boring cycles
+need, and the errors rs274 stops at.
 """
 
 from __future__ import annotations
@@ -33,6 +34,8 @@ AGREE = {
     "g18 and g19": HEAD + "G18 G98 G81 X1 Z1 Y-3 R2\nG19 G83 Y1 Z1 X-3 R2 Q1\nG17 G80\n",
     "a series across cycles": HEAD + "G98 G81 X1 Y1 Z-3 R2\nG99 G83 X2 Z-3 R1 Q1\nG98 G82 X3 Z-3 R2 P1\nG80\n",
     "arcs after a cycle": HEAD + "G81 X10 Y10 Z-2 R1\nG0 X20\nG1 Z-1\nG2 X30 Y20 I10 J0\nG3 X20 Y10 R10\nM2\n",
+    "tapping and boring": HEAD + "S500 M3\nG99 G84 X1 Y1 Z-3 R2\nX2\nG98 G86 X3 Z-3 R2 P1\nG87 X4 Y4 Z-5 R2 I1 J0 K-3\nX6\nG80\nM4\nG74 X5 Y5 Z-2 R1\nG80\nM5\n",
+    "incremental back bore, g18 boring": HEAD + "M3\nG91 G87 X1 Y1 Z-3 R2 I1 J1 K1 L2\nG90 G80\nG18 G86 X1 Z1 Y-3 R2 P1\nG17 G80\n",
 }
 
 REFUSED = {
@@ -49,6 +52,12 @@ REFUSED = {
     "p missing": (HEAD + "G82 X1 Y1 Z-3 R2\n", 3),
     "q missing": (HEAD + "G73 X1 Y1 Z-3 R2\n", 3),
     "axes with g80": (HEAD + "G81 X1 Y1 Z-3 R2\nG80 X2\n", 4),
+    "tapping, spindle stopped": (HEAD + "G84 X1 Y1 Z-3 R2\n", 3),
+    "right-hand tap, spindle reversed": (HEAD + "M4\nG84 X1 Y1 Z-3 R2\n", 4),
+    "left-hand tap, spindle forward": (HEAD + "M3\nG74 X1 Y1 Z-3 R2\n", 4),
+    "boring, spindle oriented": (HEAD + "M3\nM19\nG86 X1 Y1 Z-3 R2 P1\n", 5),
+    "back bore without j": (HEAD + "M3\nG87 X1 Y1 Z-3 R2 I1 K-1\n", 4),
+    "boring without p": (HEAD + "M3\nG86 X1 Y1 Z-3 R2\n", 4),
 }
 
 
@@ -112,14 +121,14 @@ def test_cycles_pass_through_and_compensation_resumes(hr5b):
     start = lines.index(cycle[0])
     assert lines[start : start + len(cycle)] == cycle  # verbatim
     # one warning, naming the line where the series starts
-    assert warned.count("warning") == 1 and "drill.ngc:6:1: warning: drilling cycle" in warned
+    assert warned.count("warning") == 1 and "drill.ngc:6:1: warning: canned cycle" in warned
     after = lines[start + len(cycle) :]
     assert after[0].startswith("G0 X50.0") and "Z" in after[0]  # compensated, every axis said after the cycle
     assert any(line.startswith("G3 ") and "I" in line for line in after)  # the arc after it is replaced too
 
 
 def test_strict_refuses_cycles(hr5b):
-    with pytest.raises(NcppError, match="drill.ngc:6:1: drilling cycle"):
+    with pytest.raises(NcppError, match="drill.ngc:6:1: canned cycle"):
         _compensate(DRILL, hr5b, strict=True)
 
 

@@ -218,7 +218,7 @@ def test_arc_radius_tolerance_matches_linuxcnc_files():
         ("o100 sub\n", "o-word control flow"),
         ("IF [#1 EQ 1] GOTO 10\n", "Fanuc macro IF"),
         ("M98 P100\n", "M98 subprogram call"),
-        ("G84 X0 Y0 Z-1 R1 F10\n", "canned cycle G84"),  # tapping: the drilling cycles are interpreted
+        ("G88 X0 Y0 Z-1 R1 P1 F10\n", "canned cycle G88"),  # a manual retract: the other cycles are interpreted
         ("G41 D1 G1 X1 F1\n", "cutter compensation G41"),
         ("G0 @10 ^45\n", "polar coordinates"),
         ("G0 X#<_hal[x.y]>\n", "machine-state parameter"),

@@ -254,7 +254,7 @@ class IsoWriter:
         for segment in motion:
             self._remember_end(segment)
         if motion and type(motion[-1]) is Line and motion[-1].fixed:
-            # a drilling cycle: where it leaves the tool is the control's (G98 retracts to the
+            # a canned cycle: where it leaves the tool is the control's (G98 retracts to the
             # compensated level it started from), so the next block writes every axis it knows
             self._last_end = None
 
