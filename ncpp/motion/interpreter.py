@@ -154,6 +154,7 @@ class Interpreter:
         # normal-axis position its series of cycles started from (a series ends with any other motion)
         self.cycle_r = self.cycle_cc = self.cycle_q = self.cycle_il = 0.0
         self.cycle_ijk = (0.0, 0.0, 0.0)  # G87's sticky I J K
+        self.cycle_last_r = 0.0  # the R plane of the series' last cycle
         self.spindle = 0  # M3 1, M4 -1, stopped 0 (tapping and boring cycles check it)
         self.coord_system = 1
         self.g5x = [[0.0] * 9 for _ in range(10)]  # index 1..9: G54..G59.3
@@ -836,7 +837,8 @@ class Interpreter:
         if c_letter not in words and not again:
             self._fail(f"{c_letter} value unspecified in {plane} plane canned cycle", block, item)
         c_word = words[c_letter][0] if c_letter in words else self.cycle_cc
-        if previous not in CANNED:  # a new series: G98 retracts to where it started
+        new_series = previous not in CANNED
+        if new_series:  # G98 retracts to where the series started
             self.cycle_il = self.pos[normal]
         old = self.cycle_il
         pos = self.pos
@@ -845,26 +847,35 @@ class Interpreter:
             bb = words[b_letter][0] if b_letter in words else pos[second]
             step_a = step_b = 0.0
             r, bottom = r_word, c_word
-        else:  # X Y R are increments from where the tool is (R from the series' start), Z from R
+        else:  # X Y are increments from where the tool is, R from the series' start level, Z from R
             aa, bb = pos[first], pos[second]
             step_a = words[a_letter][0] if a_letter in words else 0.0
             step_b = words[b_letter][0] if b_letter in words else 0.0
-            r = r_word + old
+            r = r_word + self.cycle_il
             bottom = r + c_word
         if r < bottom:
             self._fail(f"R less than {c_letter} in cycle in {plane} plane", block, words.get("R", (0, item))[1])
+        if not (new_series or self.retract_to_r) and r < self.cycle_last_r:
+            # the levels rs274ngc then crosses and retracts at depend on more than this follows
+            raise _OutOfScope("a G98 series of canned cycles lowering its R plane", words.get("R", (0, item))[1].start + 1)
+        self.cycle_last_r = r
         peck = self._cycle_word(block, words, motion, again, item)
+        if motion in (74.0, 84.0) and self.plane != 17:  # rs274ngc's taps move other axes there
+            raise _OutOfScope(f"canned cycle G{motion:g} outside the XY plane", item.start + 1)
         if motion in SPINDLE:
             self._check_spindle(block, motion, item)
         if motion == 87.0:
             i, j, k = self._back_bore_words(block, words, again, item)
             middle = bottom + k if not self.absolute else k
         moves: list[tuple[float, float, float, bool]] = []
-        if old < r:  # the series started below the R plane: straight up to it first
+        # The level the tool crosses to the hole at (and G98 retracts to): where the tool is, but
+        # not below R (G99) or the series' start level (G98); a series that started below R goes
+        # up to R first.  rs274ngc as LinuxCNC 2.9 runs it, found by probing it (test_cycles.py).
+        if old < r:
             moves.append((pos[first], pos[second], r, True))
             old = r
-        elif self.retract_to_r:  # G99 crosses to the hole where the tool is (as rs274ngc does)
-            old = pos[normal]
+        else:
+            old = max(pos[normal], r if self.retract_to_r else old)
         clear = r if self.retract_to_r else old
         rapid_delta = RAPID_DELTA_INCH if self.inch else RAPID_DELTA_INCH * MM_PER_INCH
         for _ in range(repeats):

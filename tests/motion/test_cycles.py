@@ -9,6 +9,7 @@ need, and the errors rs274 stops at.
 from __future__ import annotations
 
 import io
+import random
 
 import pytest
 
@@ -25,7 +26,7 @@ HEAD = "G21 G90 G17 G54\nG0 X0 Y0 Z10 F200\n"
 AGREE = {
     "g81 g98 series": HEAD + "G98 G81 X10 Y5 Z-3 R2\nX20\nY15\nG80\nG0 X0\n",
     "g99 from below r": "G21 G90\nG0 X1 Y1 Z1 F100\nG99 G81 X5 Y5 Z-3 R2\nX6\nM2\n",
-    "g82 dwell, g85, g89": HEAD + "G99 G82 X1 Y1 Z-3 R2 P0.5\nX2\nG98 G85 X3 Z-4 R2\nG89 X4 Z-3 R1 P1\nX5\nG80\n",
+    "g82 dwell, g85, g89": HEAD + "G99 G82 X1 Y1 Z-3 R2 P0.5\nX2\nG98 G85 X3 Z-4 R2\nG89 X4 Z-3 R2 P1\nX5\nG80\n",
     "g83 peck, sticky q": HEAD + "G83 X1 Y1 Z-7 R1 Q2.5\nX2 Q1.5\nX3 Z-2\nG80\n",
     "g73 chip break": HEAD + "G98 G73 X5 Y1 Z-3 R2 Q1\nX6\nG80\n",
     "inch peck": "G20 G90\nG0 X0 Y0 Z1 F10\nG83 X1 Y1 Z-0.3 R0.1 Q0.1\nG80\n",
@@ -36,6 +37,17 @@ AGREE = {
     "arcs after a cycle": HEAD + "G81 X10 Y10 Z-2 R1\nG0 X20\nG1 Z-1\nG2 X30 Y20 I10 J0\nG3 X20 Y10 R10\nM2\n",
     "tapping and boring": HEAD + "S500 M3\nG99 G84 X1 Y1 Z-3 R2\nX2\nG98 G86 X3 Z-3 R2 P1\nG87 X4 Y4 Z-5 R2 I1 J0 K-3\nX6\nG80\nM4\nG74 X5 Y5 Z-2 R1\nG80\nM5\n",
     "incremental back bore, g18 boring": HEAD + "M3\nG91 G87 X1 Y1 Z-3 R2 I1 J1 K1 L2\nG90 G80\nG18 G86 X1 Z1 Y-3 R2 P1\nG17 G80\n",
+    # the levels a series crosses at and retracts to (found by probing rs274)
+    "g99 series changing r": "G21 G90\nG0 X0 Y0 Z7.077 F100\nG89 G99 X1 Y-1 R1.541 Z-2.5 P0.3\nG83 X-3 Y-1 R2.271 Z-1.2 Q1.2\nX-2 R1\nM2\n",
+    "g98 after g99, higher r": "G21 G90\nG0 X0 Y0 Z10 F100\nG99 G81 X1 Z-3 R2\nG98 G82 X3 Z-3 R5 P1\nX4\nM2\n",
+    "g98 series from below r": "G21 G90\nG0 X0 Y0 Z1 F100\nG98 G81 X1 Z-3 R2\nG82 X3 Z-3 R2 P1\nX4\nM2\n",
+}
+
+OUT_OF_SCOPE = {
+    "g98 series lowering r": (HEAD + "G98 G81 X1 Y1 Z-3 R2\nG82 X2 Z-3 R1 P1\n", 4, "lowering its R plane"),
+    "tapping in g18": (HEAD + "M3 G18\nG84 X1 Z1 Y-3 R2\n", 4, "G84 outside the XY plane"),
+    "back bore in g19": (HEAD + "M3 G19\nG87 Y1 Z1 X-3 R2 I1 J1 K-1\n", 4, "G87 outside the XY plane"),
+    "manual retract": (HEAD + "M3\nG88 X1 Y1 Z-3 R2 P1\n", 4, "canned cycle G88"),
 }
 
 REFUSED = {
@@ -89,6 +101,60 @@ def test_cycles_refused_where_rs274_refuses(tmp_path, name):
     assert refused is not None and refused[1].strip() == text.splitlines()[line - 1].strip(), messages
     _, error, _ = ours(path)
     assert error is not None and error.where.line == line, error
+
+
+@pytest.mark.parametrize("name", OUT_OF_SCOPE)
+def test_cycles_out_of_scope(name):
+    text, line, reason = OUT_OF_SCOPE[name]
+    warned = io.StringIO()
+    list(interpret(parse_stream(io.BytesIO(text.encode()), "t.ngc"), file="t.ngc", warnings=Warnings(stream=warned)))
+    assert f"t.ngc:{line}:" in warned.getvalue() and reason in warned.getvalue(), warned.getvalue()
+
+
+def _random_program(rng: random.Random) -> str:
+    """Cycles of every kind with random words, repeats, G91, G98/G99 and plane changes."""
+    lines, plane = [rng.choice(["G21", "G20"]) + " G90 G17", f"G0 X0 Y0 Z{rng.uniform(-2, 12):.3f} F100", "M3"], 17
+    for _ in range(rng.randint(2, 7)):
+        if rng.random() < 0.2:
+            extra = rng.choice(["G80", "G0 X1 Y-2", "G80 G0 Z4", "G90", "G91", "G98", "G99", "G80 G18", "G80 G19", "G80 G17"])
+            plane = {"G80 G18": 18, "G80 G19": 19, "G80 G17": 17}.get(extra, plane)
+            lines.append(extra)
+            continue
+        code = rng.choice(["G73", "G81", "G82", "G83", "G85", "G86", "G89"] + (["G84", "G87"] if plane == 17 else []))
+        normal = {17: "Z", 18: "Y", 19: "X"}[plane]
+        incremental, r = rng.random() < 0.3, rng.uniform(0, 4)
+        words = [code, rng.choice(["", "G98", "G99"]), "G91" if incremental else "G90"]
+        words += [a + f"{rng.uniform(-5, 5):.3f}" for a in "XYZ" if a != normal and rng.random() < 0.8]
+        words.append(f"R{rng.uniform(-1, 3) if incremental else r:.3f}")
+        words.append(normal + f"{-rng.uniform(0.5, 5) if incremental else r - rng.uniform(0.5, 6):.3f}")
+        words += {"G73": ["Q0.9"], "G83": ["Q1.3"], "G82": ["P0.2"], "G86": ["P0.2"], "G89": ["P0.2"], "G87": ["I0.6", "J-0.4", "K" + ("0.5" if incremental else "-1")]}.get(code, [])
+        if rng.random() < 0.25:
+            words.append(f"L{rng.randint(1, 3)}")
+        lines.append(" ".join(w for w in words if w))
+        lines += [" ".join(a + f"{rng.uniform(-5, 5):.3f}" for a in "XYZ" if a != normal) for _ in range(rng.randint(0, 2))]
+    return "\n".join(lines + ["M2"]) + "\n"
+
+
+def test_random_cycle_programs_agree_with_rs274(tmp_path):
+    """40 random programs: in scope ones move as rs274 does, refused ones on the same line."""
+    rng, compared = random.Random(20261122), 0
+    for n in range(40):
+        text = _random_program(rng)
+        path = tmp_path / f"random{n}.ngc"
+        path.write_text(text)
+        calls, messages = rs274(str(path))
+        reference, refused = read_canon(calls), rs274_error(messages)
+        mine, error, warning = ours(path)
+        for want, got in zip(reference, mine):
+            assert want.name == got.name and all(abs(a - b) <= 1e-4 for a, b in zip(want.args, got.args)), (text, want, got)
+        if warning:
+            continue
+        if refused is None:
+            assert error is None and len(mine) == len(reference), (text, error)
+            compared += 1
+        else:
+            assert error is not None and text.splitlines()[error.where.line - 1].strip() == refused[1].strip(), (text, refused, error)
+    assert compared >= 10  # enough programs stay in scope to mean something
 
 
 def test_cycle_moves_are_fixed():
