@@ -13,7 +13,7 @@ import gc
 import hashlib
 from contextlib import contextmanager
 from dataclasses import dataclass, field
-from itertools import count, islice
+from itertools import chain, count, islice
 from operator import itemgetter
 from pathlib import Path
 from typing import BinaryIO, Callable, Iterable, Iterator
@@ -129,19 +129,47 @@ UNCOMPENSATED_CYCLE = (
 )
 
 
+INCREMENTAL_CYCLE = (
+    "a canned cycle in G91, or a G91 move after one: the control moves from the compensated "
+    "position there, which ncpp does not follow; from this line on the program passes through uncompensated"
+)
+
+
 def warn_fixed(events: Iterable[Event], warnings: Warnings, file: str) -> Iterator[Event]:
     """Pass events through; warn where a series of canned-cycle blocks starts (refused
-    with --strict): the interpreter marks their moves `fixed` and the passes leave them."""
+    with --strict): the interpreter marks their moves `fixed` and the passes leave them.
+
+    In G91 a cycle starts from where the control is (the compensated position), and a
+    G98 retract ends at the compensated level the series started at: the nominal moves
+    of a G91 cycle, and a G91 move right after a cycle, would be off by a correction.
+    There the rest of the program passes through, as after an out-of-scope construct."""
+    events = iter(events)
     in_series = False
     for event in events:
         kind = type(event)
         if kind is Line and event.fixed:  # type: ignore[union-attr]
+            if not event.context.absolute:  # type: ignore[union-attr]
+                yield from _passed_on(event, events, warnings, file)
+                return
             if not in_series:
                 in_series = True
                 warnings.warn(UNCOMPENSATED_CYCLE, Location(file, event.block.line, 1))
         elif kind is not Pass:
+            if in_series and not event.context.absolute:  # type: ignore[union-attr]
+                yield from _passed_on(event, events, warnings, file)
+                return
             in_series = False
         yield event
+
+
+def _passed_on(first: Event, rest: Iterator[Event], warnings: Warnings, file: str) -> Iterator[Pass]:
+    """`first`'s block (none of its events went by yet) and every later one, as `Pass`."""
+    warnings.warn(INCREMENTAL_CYCLE, Location(file, first.block.line, 1))
+    last = None
+    for event in chain((first,), rest):
+        if event.block is not last:
+            last = event.block
+            yield Pass(event.block)
 
 
 def _counted(blocks: Iterable[Block], counter: Iterator[int], progress: Callable[[int], None] | None) -> Iterator[Block]:

@@ -198,6 +198,23 @@ def test_strict_refuses_cycles(hr5b):
         _compensate(DRILL, hr5b, strict=True)
 
 
+@pytest.mark.parametrize(
+    "text, line",
+    [
+        (HEAD + "G1 Z-1\nX40 Y12\nG0 Z5\nG91 G81 X10 Y10 Z-3 R-3 L2\nG90 G80\nG1 X50 Y50\n", 6),  # a G91 cycle
+        (HEAD + "G1 Z-1\nX40 Y12\nG0 Z5\nG98 G81 X20 Y20 Z-3 R2\nG80\nG91 G1 X5\nX5 Y5\n", 8),  # G91 after a G98 retract
+    ],
+)
+def test_incremental_cycles_end_compensation(hr5b, text, line):
+    out, warned = _compensate(text, hr5b)
+    assert f"drill.ngc:{line}:1: warning: a canned cycle in G91" in warned
+    original, written = text.splitlines(), out.splitlines()
+    assert written[-(len(original) - line + 1) :] == original[line - 1 :]  # the rest verbatim
+    assert written[3] != original[2]  # compensated before it
+    with pytest.raises(NcppError, match="drill.ngc:6:1: .*canned cycle"):
+        _compensate(text, hr5b, strict=True)
+
+
 @pytest.mark.skipif(not RS274.exists(), reason="no rs274")
 def test_rs274_accepts_the_compensated_cycles(tmp_path, hr5b):
     out, _ = _compensate(DRILL, hr5b)
