@@ -823,39 +823,12 @@ class Interpreter:
         """A canned cycle's moves (rs274ngc's convert_cycle and convert_cycle_xy, in any plane):
         `Line`s marked `fixed`, which compensation leaves as programmed."""
         first, second, normal = PLANE_AXES[self.plane]
-        a_letter, b_letter, c_letter = "XYZ"[first], "XYZ"[second], "XYZ"[normal]
-        plane = _PLANE_NAMES[self.plane].upper()
         again = previous == motion  # the same cycle again: R, the normal-axis word, P and Q are sticky
-        if self.feed == 0.0:
-            self._fail("Cannot feed with zero feed rate", block, item)
-        if self.inverse_time:
-            self._fail("Cannot use inverse time feed with canned cycles", block, item)
-        if "R" not in words and not again:
-            self._fail("R clearance plane unspecified in cycle", block, item)
-        r_word = words["R"][0] if "R" in words else self.cycle_r
-        repeats = self._repeats(block, words)
-        if c_letter not in words and not again:
-            self._fail(f"{c_letter} value unspecified in {plane} plane canned cycle", block, item)
-        c_word = words[c_letter][0] if c_letter in words else self.cycle_cc
-        new_series = previous not in CANNED
-        if new_series:  # G98 retracts to where the series started
+        if previous not in CANNED:  # a new series: G98 retracts to where it started
             self.cycle_il = self.pos[normal]
-        old = self.cycle_il
-        pos = self.pos
-        if self.absolute:
-            aa = words[a_letter][0] if a_letter in words else pos[first]
-            bb = words[b_letter][0] if b_letter in words else pos[second]
-            step_a = step_b = 0.0
-            r, bottom = r_word, c_word
-        else:  # X Y are increments from where the tool is, R from the series' start level, Z from R
-            aa, bb = pos[first], pos[second]
-            step_a = words[a_letter][0] if a_letter in words else 0.0
-            step_b = words[b_letter][0] if b_letter in words else 0.0
-            r = r_word + self.cycle_il
-            bottom = r + c_word
-        if r < bottom:
-            self._fail(f"R less than {c_letter} in cycle in {plane} plane", block, words.get("R", (0, item))[1])
-        if not (new_series or self.retract_to_r) and r < self.cycle_last_r:
+        aa, bb, step_a, step_b, r, bottom = self._cycle_geometry(block, words, again, item)
+        repeats = self._repeats(block, words)
+        if previous in CANNED and not self.retract_to_r and r < self.cycle_last_r:
             # the levels rs274ngc then crosses and retracts at depend on more than this follows
             raise _OutOfScope("a G98 series of canned cycles lowering its R plane", words.get("R", (0, item))[1].start + 1)
         self.cycle_last_r = r
@@ -866,37 +839,74 @@ class Interpreter:
             self._check_spindle(block, motion, item)
         if motion == 87.0:
             i, j, k = self._back_bore_words(block, words, again, item)
-            middle = bottom + k if not self.absolute else k
+            middle = k if self.absolute else bottom + k
+        pos = self.pos
         moves: list[tuple[float, float, float, bool]] = []
         # The level the tool crosses to the hole at (and G98 retracts to): where the tool is, but
         # not below R (G99) or the series' start level (G98); a series that started below R goes
         # up to R first.  rs274ngc as LinuxCNC 2.9 runs it, found by probing it (test_cycles.py).
-        if old < r:
+        level = self.cycle_il
+        if level < r:
             moves.append((pos[first], pos[second], r, True))
-            old = r
+            level = r
         else:
-            old = max(pos[normal], r if self.retract_to_r else old)
-        clear = r if self.retract_to_r else old
+            level = max(pos[normal], r if self.retract_to_r else level)
+        clear = r if self.retract_to_r else level
         rapid_delta = RAPID_DELTA_INCH if self.inch else RAPID_DELTA_INCH * MM_PER_INCH
         for _ in range(repeats):
             aa, bb = aa + step_a, bb + step_b
-            moves.append((aa, bb, old, True))
-            if old != r:
+            moves.append((aa, bb, level, True))
+            if level != r:
                 moves.append((aa, bb, r, True))
             if motion == 87.0:
                 moves += back_bore(aa, bb, aa + i, bb + j, r, clear, middle, bottom)
             else:
                 moves += hole(motion, aa, bb, r, clear, bottom, peck, rapid_delta)
-            old = clear
+            level = clear
+        return tuple(self._fixed_line(block, (first, second, normal), move) for move in moves)
+
+    def _cycle_geometry(self, block: Block, words: dict, again: bool, item) -> tuple[float, ...]:
+        """(aa, bb, their step per repeat, R, bottom) of a cycle in plane coordinates; keeps the
+        sticky R and normal-axis words.  X Y (G91: increments), R (G91: from the series' start
+        level) and the normal axis (G91: from R), as rs274ngc reads them."""
+        first, second, normal = PLANE_AXES[self.plane]
+        a_letter, b_letter, c_letter = "XYZ"[first], "XYZ"[second], "XYZ"[normal]
+        plane = _PLANE_NAMES[self.plane].upper()
+        if self.feed == 0.0:
+            self._fail("Cannot feed with zero feed rate", block, item)
+        if self.inverse_time:
+            self._fail("Cannot use inverse time feed with canned cycles", block, item)
+        if "R" not in words and not again:
+            self._fail("R clearance plane unspecified in cycle", block, item)
+        if c_letter not in words and not again:
+            self._fail(f"{c_letter} value unspecified in {plane} plane canned cycle", block, item)
+        r_word = words["R"][0] if "R" in words else self.cycle_r
+        c_word = words[c_letter][0] if c_letter in words else self.cycle_cc
         self.cycle_r, self.cycle_cc = r_word, c_word
-        lines = []
-        for a, b, c, rapid in moves:
-            end = self.pos[:]
-            end[first], end[second], end[normal] = a, b, c
-            line = self._line(block, end, rapid)
-            line.fixed = True
-            lines.append(line)
-        return tuple(lines)
+        pos = self.pos
+        if self.absolute:
+            aa = words[a_letter][0] if a_letter in words else pos[first]
+            bb = words[b_letter][0] if b_letter in words else pos[second]
+            step_a = step_b = 0.0
+            r, bottom = r_word, c_word
+        else:
+            aa, bb = pos[first], pos[second]
+            step_a = words[a_letter][0] if a_letter in words else 0.0
+            step_b = words[b_letter][0] if b_letter in words else 0.0
+            r = r_word + self.cycle_il
+            bottom = r + c_word
+        if r < bottom:
+            self._fail(f"R less than {c_letter} in cycle in {plane} plane", block, words.get("R", (0, item))[1])
+        return aa, bb, step_a, step_b, r, bottom
+
+    def _fixed_line(self, block: Block, axes: tuple[int, int, int], move: tuple[float, float, float, bool]) -> Line:
+        """A cycle's move (plane coordinates) as a `Line` from the current position, marked `fixed`."""
+        a, b, c, rapid = move
+        end = self.pos[:]
+        end[axes[0]], end[axes[1]], end[axes[2]] = a, b, c
+        line = self._line(block, end, rapid)
+        line.fixed = True
+        return line
 
     def _check_spindle(self, block: Block, motion: float, item) -> None:
         """Tapping wants the spindle turning its way (G84 M3, G74 M4), boring turning at all."""
