@@ -13,8 +13,8 @@ from __future__ import annotations
 
 CANNED = frozenset({73.0, 74.0, 81.0, 82.0, 83.0, 84.0, 85.0, 86.0, 87.0, 89.0})
 DWELLING = frozenset({82.0, 86.0, 89.0})  # P: a dwell time, required (sticky within the cycle)
-# the spindle direction (M3 1, M4 -1) each cycle needs, and its refusal otherwise (any turning: 0)
-SPINDLE = {84.0: (1, "G84"), 74.0: (-1, "G74"), 86.0: (0, "g86"), 87.0: (0, "g87")}
+# the spindle direction (M3 1, M4 -1) each cycle needs (0: turning either way)
+SPINDLE = {84.0: 1, 74.0: -1, 86.0: 0, 87.0: 0}
 PECKING = frozenset({73.0, 83.0})  # Q: the peck depth, sticky within the cycle
 # G73/G83: the rapid back into the hole stops this far above the last peck (rs274ngc's
 # G83_RAPID_DELTA, in inch; 0.254 mm)

@@ -910,7 +910,7 @@ class Interpreter:
 
     def _check_spindle(self, block: Block, motion: float, item) -> None:
         """Tapping wants the spindle turning its way (G84 M3, G74 M4), boring turning at all."""
-        wanted, name = SPINDLE[motion]
+        wanted, name = SPINDLE[motion], f"G{motion:g}"
         if self.spindle == 0:
             self._fail(f"Spindle not turning in {name}", block, item)
         if wanted and self.spindle != wanted:

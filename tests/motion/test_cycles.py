@@ -193,6 +193,17 @@ def test_cycles_pass_through_and_compensation_resumes(hr5b):
     assert any(line.startswith("G3 ") and "I" in line for line in after)  # the arc after it is replaced too
 
 
+def test_the_block_after_a_cycle_says_every_axis():
+    """Even an axis whose compensated target writes as the cycle's nominal end: the control may
+    be elsewhere (G98 retracts to the compensated level the series started at)."""
+    from ncpp.program.dialects.iso import IsoWriter
+
+    events = list(interpret(parse_stream(io.BytesIO((HEAD + "G81 X1 Y1 Z-3 R2\nG80\nG1 X5\n").encode()), "t.ngc")))
+    move = events[-1]
+    events[-1] = Line(move.start, (5.00001, 1.0, 2.0), False, move.feed, move.block, move.context, changed=True)
+    assert list(IsoWriter().write(events))[-1] == "G1 X5.0000 Y1.0000 Z2.0000\n"
+
+
 def test_strict_refuses_cycles(hr5b):
     with pytest.raises(NcppError, match="drill.ngc:6:1: canned cycle"):
         _compensate(DRILL, hr5b, strict=True)
