@@ -20,7 +20,7 @@ from typing import BinaryIO, Callable, Iterable, Iterator
 
 from ncpp.errors import Location, NcppError, Warnings
 from ncpp.motion.offsets import AT_MACHINE_ZERO, WorkOffsets
-from ncpp.motion.segments import Event, Line, Pass
+from ncpp.motion.segments import CYCLE, FLOW, Event, Pass
 from ncpp.passes import PASSES, PassContext, run_passes
 from ncpp.passes.context import is_directional
 from ncpp.passes.kernels import INLINE, Kernels, Worker
@@ -123,48 +123,48 @@ def warn_unplaced(blocks: Iterable[Block], warnings: Warnings, file: str) -> Ite
         yield block
 
 
-UNCOMPENSATED_CYCLE = (
-    "canned cycle: its moves pass through uncompensated (the holes are where the program puts them, "
-    "with the machine's errors); compensation resumes with the next move"
-)
-
-
-INCREMENTAL_CYCLE = (
-    "a canned cycle in G91, or a G91 move after one: the control moves from the compensated "
+# Why moves are left as programmed (`Line.fixed`), as the warning says it
+UNCOMPENSATED = {
+    CYCLE: "canned cycle: its moves pass through uncompensated (the holes are where the program puts them, "
+    "with the machine's errors); compensation resumes with the next move",
+    FLOW: "o-word loop or subroutine: its moves pass through uncompensated (one text runs several times, "
+    "or away from where it stands, so it cannot carry one correction); compensation resumes with the next move after it",
+}
+INCREMENTAL_FIXED = (
+    "{} in G91, or a G91 move after it: the control moves from the compensated "
     "position there, which ncpp does not follow; from this line on the program passes through uncompensated"
 )
 
 
-def warn_fixed(events: Iterable[Event], warnings: Warnings, file: str) -> Iterator[Event]:
-    """Pass events through; warn where a series of canned-cycle blocks starts (refused
-    with --strict): the interpreter marks their moves `fixed` and the passes leave them.
+_ARTICLED = {CYCLE: "a canned cycle", FLOW: "an o-word loop or subroutine"}
 
-    In G91 a cycle starts from where the control is (the compensated position), and a
+
+def warn_fixed(events: Iterable[Event], warnings: Warnings, file: str) -> Iterator[Event]:
+    """Pass events through; warn where a series of moves the passes leave as programmed
+    (`fixed`: a canned cycle's, a loop's or a subroutine's) starts (refused with --strict).
+
+    In G91 such a move starts from where the control is (the compensated position), and a
     G98 retract ends at the compensated level the series started at: the nominal moves
-    of a G91 cycle, and a G91 move right after a cycle, would be off by a correction.
+    of a G91 cycle, and a G91 move right after a series, would be off by a correction.
     There the rest of the program passes through, as after an out-of-scope construct."""
     events = iter(events)
-    in_series = False
+    series = ""  # why the moves of the series under way are fixed ("": none is)
     for event in events:
         kind = type(event)
-        if kind is Line and event.fixed:  # type: ignore[union-attr]
-            if not event.context.absolute:  # type: ignore[union-attr]
-                yield from _passed_on(event, events, warnings, file)
+        if kind is not Pass:
+            fixed = event.fixed  # type: ignore[union-attr]
+            if (fixed or series) and not event.context.absolute:  # type: ignore[union-attr]
+                yield from _passed_on(event, events, warnings, file, fixed or series)
                 return
-            if not in_series:
-                in_series = True
-                warnings.warn(UNCOMPENSATED_CYCLE, Location(file, event.block.line, 1))
-        elif kind is not Pass:
-            if in_series and not event.context.absolute:  # type: ignore[union-attr]
-                yield from _passed_on(event, events, warnings, file)
-                return
-            in_series = False
+            if fixed and fixed != series:
+                warnings.warn(UNCOMPENSATED[fixed], Location(file, event.block.line, 1))
+            series = fixed
         yield event
 
 
-def _passed_on(first: Event, rest: Iterator[Event], warnings: Warnings, file: str) -> Iterator[Pass]:
+def _passed_on(first: Event, rest: Iterator[Event], warnings: Warnings, file: str, why: str) -> Iterator[Pass]:
     """`first`'s block (none of its events went by yet) and every later one, as `Pass`."""
-    warnings.warn(INCREMENTAL_CYCLE, Location(file, first.block.line, 1))
+    warnings.warn(INCREMENTAL_FIXED.format(_ARTICLED[why]), Location(file, first.block.line, 1))
     last = None
     for event in chain((first,), rest):
         if event.block is not last:

@@ -14,6 +14,7 @@ from typing import Callable
 
 # rs274ngc: numbered parameters 1..RS274NGC_MAX_PARAMETERS-1 (#0 is Fanuc's null, read as 0)
 MAX_PARAMETER = 5601
+SUBROUTINE_PARAMETERS = 30  # #1..#30: a subroutine's arguments, local to each call
 EQUAL_TOLERANCE = 0.0001
 
 
@@ -25,7 +26,8 @@ class OutOfScope(Exception):
     """Something the interpreter does not evaluate (HAL pins, INI values, machine state)."""
 
 
-def _round(x: float) -> float:
+def round_half_away(x: float) -> float:
+    """rs274ngc's ROUND: half away from zero."""
     return float(math.floor(x + 0.5)) if x >= 0 else -float(math.floor(-x + 0.5))
 
 
@@ -69,7 +71,7 @@ FUNCTIONS: dict[str, Callable[[float], float]] = {
     "EXP": math.exp,
     "FIX": lambda x: float(math.floor(x)),
     "FUP": lambda x: float(math.ceil(x)),
-    "ROUND": _round,
+    "ROUND": round_half_away,
     "LN": _ln,
     "SIN": lambda x: math.sin(math.radians(x)),
     "SQRT": _sqrt,
@@ -129,8 +131,29 @@ class Parameters:
 
     def __init__(self, system: Callable[[str], float | None] | None = None):
         self.numbered: dict[int, float] = {}
-        self.named: dict[str, float] = {}
+        self.named: dict[str, float] = {"_value": 0.0, "_value_returned": 0.0}  # what the last subroutine returned
         self.system = system
+        self._callers: list[tuple[list[float], dict[str, float]]] = []  # per call level: the caller's #1..#30 and local names
+
+    def enter(self, arguments: list[float]) -> None:
+        """A subroutine call: #1..#30 are its arguments (0 past the last), and names
+        without a leading underscore are its own (the caller's come back at `leave`)."""
+        saved = [self.numbered.get(n, 0.0) for n in range(1, SUBROUTINE_PARAMETERS + 1)]
+        local = {k: v for k, v in self.named.items() if not k.startswith("_")}
+        for k in local:
+            del self.named[k]
+        self._callers.append((saved, local))
+        for n in range(1, SUBROUTINE_PARAMETERS + 1):
+            self.numbered[n] = arguments[n - 1] if n <= len(arguments) else 0.0
+
+    def leave(self, value: float | None) -> None:
+        """The subroutine returns (`value`: what its return or endsub gave, if anything)."""
+        saved, local = self._callers.pop()
+        for k in [k for k in self.named if not k.startswith("_")]:
+            del self.named[k]
+        self.named.update(local)
+        self.numbered.update(zip(range(1, SUBROUTINE_PARAMETERS + 1), saved))
+        self.named["_value"], self.named["_value_returned"] = (0.0, 0.0) if value is None else (value, 1.0)
 
     def key(self, key, evaluate: Callable[[tuple], float]) -> int | str:
         if isinstance(key, tuple):  # `#[expr]`, `##1`
@@ -179,7 +202,7 @@ class Parameters:
 _MACHINE_STATE = frozenset(
     "_current_tool _current_pocket _selected_tool _selected_pocket _rpm _spindle_on _spindle_cw "
     "_mist _flood _speed_override _feed_override _adaptive_feed _feed_hold _task _call_level "
-    "_remap_level _value _value_returned _vmajor _vminor _retract_r1 _retract_old_z".split()
+    "_remap_level _vmajor _vminor _retract_r1 _retract_old_z".split()
 )
 
 

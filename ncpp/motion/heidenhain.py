@@ -296,7 +296,7 @@ class HeidenhainInterpreter(ModalInterpreter):
         if size <= 0:
             self.fail(f"{function} needs a positive size", block, item)
         self.corner_waits = True
-        return Corner(block, kind, size, words["F"][0] if "F" in words else None, item.start + 1)
+        return Corner(block, kind=kind, size=size, feed=words["F"][0] if "F" in words else None, col=item.start + 1)
 
     # -- path functions ---------------------------------------------------------------------
     def _target(self, words: dict) -> tuple[list[float], set[int]]:

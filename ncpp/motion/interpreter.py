@@ -1,8 +1,8 @@
 """Blocks -> motion events, as LinuxCNC's rs274ngc interpreter reads them.
 
 `interpret(blocks)` is a generator: one event per block (`Line`, `Arc` or
-`Pass`; a G28/G30 block gives two `Line`s), state bounded whatever the
-program length.  Positions are program (work) coordinates in program units,
+`Pass`; a G28/G30 block gives two `Line`s), in the order the blocks run
+(o-word control flow, `flow.py`), state bounded whatever the program length.  Positions are program (work) coordinates in program units,
 exactly what rs274 prints in its canonical calls; `Context.offset` says where
 the program origin sits in machine coordinates.
 
@@ -12,9 +12,10 @@ G52, G53, G28/G30, T, M6, M61, G43 / G43.1 / G43.2 H / G49 (lengths from the
 control's tool table, `tools.py`; zero when it is not told), F and inverse time, IJK and R arcs, helices,
 P turns, parameters and expressions, Fanuc corner rounding and
 chamfering between two lines (`,R` `,C`, `G1 ... R`: a one-move look-ahead),
-and the canned cycles G73 G74 G81-G87 G89 with G98/G99 (`cycles.py`;
-their moves are `Line`s marked `fixed`: compensation leaves them as programmed).
-Anything else (o-word and Fanuc macro
+the canned cycles G73 G74 G81-G87 G89 with G98/G99 (`cycles.py`), and
+o-word subroutines, branches and loops (`flow.py`); the moves of cycles,
+loops and subroutines are marked `fixed`: compensation leaves them as programmed.
+Anything else (subroutine files, Fanuc macro
 control flow, M98/M99, G88 (a manual retract) and the lathe cycles, cutter compensation, splines,
 threading, probing, polar words) makes the
 interpreter's state unknown: that block and every later block pass through
@@ -32,7 +33,8 @@ from ncpp.motion.corners import CornerError, round_corner
 from ncpp.motion.cycles import CANNED, DWELLING, PECKING, RAPID_DELTA_INCH, SPINDLE, back_bore, hole
 from ncpp.motion.expressions import ExpressionError, OutOfScope, Parameters, evaluate
 from ncpp.motion.offsets import SYSTEMS, WorkOffsets
-from ncpp.motion.segments import PLANE_AXES, Arc, Context, Event, Line, Pass
+from ncpp.motion.flow import FIXED, RUN, SKIP, Flow
+from ncpp.motion.segments import CYCLE, FLOW, PLANE_AXES, Arc, Context, Event, Line, Pass
 from ncpp.motion.tools import UntoldLengths
 from ncpp.program.blocks import Block, Comment, ExprWord, Word
 
@@ -189,35 +191,35 @@ class Interpreter:
 
     # -- the event stream ---------------------------------------------------------
     def run(self, blocks: Iterable[Block], warnings: Warnings) -> Iterator[Event]:
-        """Events block by block.  A line with a Fanuc corner word (`,R` `,C`,
-        `G1 ... R`) waits for the next move, which decides the corner; the
-        blocks in between wait with it (bounded by the program's own layout)."""
+        """Events block by block, in the order the blocks run (o-word control flow,
+        `flow.py`).  A line with a Fanuc corner word (`,R` `,C`, `G1 ... R`) waits
+        for the next move, which decides the corner; the blocks in between wait
+        with it (bounded by the program's own layout)."""
         block_event = self.block
         self.warnings = self.untold_lengths.warnings = warnings
         pending: Line | None = None  # the line whose end corner is rounded
         corner = None
         held: list[Event] = []  # non-moving events after it
-        for block in blocks:
-            if self.done:
+        flow = Flow(self.file, self._evaluate, self.params, lambda: self.done, self._leave_scope)
+        for block, kind, owner in flow.steps(blocks):
+            if kind is not RUN and kind is not FIXED:  # text that does not run here
+                ev = Pass(block, kind is SKIP, None if self.done else self.motion)  # (after the end: no mode the control is in)
                 if pending is not None:
-                    yield from self._unrounded(pending, held)
-                    pending = None
-                yield Pass(block)
+                    held.append(ev)
+                else:
+                    yield ev
                 continue
             try:
                 event = block_event(block)  # verbatim blocks (after the closing %) have no items
+                if kind is FIXED:
+                    event = self._in_flow(event, owner)
             except _OutOfScope as stop:
-                self.done = True
-                where = Location(self.file, block.line, stop.col)
-                warnings.warn(
-                    f"{stop.reason} is outside the motion interpreter's scope; from this line on the "
-                    "program passes through uninterpreted (its modal state is unknown)",
-                    where,
-                )
+                self._leave_scope(stop.reason, block, stop.col, owner)
                 if pending is not None:
                     yield from self._unrounded(pending, held)
                     pending = None
-                yield Pass(block)
+                if owner is None:  # (a block that runs out of the text's order is written in its place)
+                    yield Pass(block)
                 continue
             if pending is None and self.corner is None and type(event) is not tuple:
                 yield event  # the common case: no corner waits, none starts
@@ -246,6 +248,35 @@ class Interpreter:
         if pending is not None:
             _, _, item = corner
             raise NcppError("corner rounding/chamfer has no following move", Location(self.file, pending.block.line, item.start + 1))
+
+    def _leave_scope(self, reason: str, block: Block, col: int | None, owner: Block | None = None) -> None:
+        """A construct outside the scope: the state is unknown from here on (an error with strict).
+        `owner`: the line that ran the block (a call, a loop's end), from which the rest passes."""
+        self.done = True
+        where = "this line" if owner is None else f"line {owner.line}, which runs it,"
+        self.warnings.warn(  # type: ignore[union-attr]
+            f"{reason} is outside the motion interpreter's scope; from {where} on the "
+            "program passes through uninterpreted (its modal state is unknown)",
+            Location(self.file, block.line, col),
+        )
+
+    def _in_flow(self, event: Event | tuple[Event, ...], owner: Block | None) -> Event | tuple[Event, ...]:
+        """A block's events inside a loop or a subroutine: its moves are left as programmed
+        and, where it runs out of the text's order, belong to `owner` (its text is elsewhere)."""
+        if self.corner is not None:
+            raise _OutOfScope("Fanuc corner rounding in an o-word loop or subroutine", None)
+        events = event if type(event) is tuple else (event,)
+        out = []
+        for ev in events:
+            if type(ev) is Pass:
+                if owner is None:
+                    out.append(ev)
+                continue
+            ev.fixed = ev.fixed or FLOW
+            if owner is not None:
+                ev.block = owner
+            out.append(ev)
+        return tuple(out) if len(out) != 1 else out[0]
 
     def _unrounded(self, pending: Line, held: list[Event]) -> Iterator[Event]:
         """A held corner line whose corner cannot be made: it passes through, uninterpreted."""
@@ -332,6 +363,8 @@ class Interpreter:
                     key = self._param_key(target, block, item)
                     assignments = assignments or []
                     assignments.append((key, self._evaluate(expr, block, item), item))
+                elif what == "oword" and len(item.node) == 1:  # `O<name>` alone: a program's name
+                    pass
                 elif what not in IGNORED_STATEMENTS:
                     raise _OutOfScope(OUT_OF_SCOPE_STATEMENT.get(what, what), item.start + 1)
                 continue
@@ -905,7 +938,7 @@ class Interpreter:
         end = self.pos[:]
         end[axes[0]], end[axes[1]], end[axes[2]] = a, b, c
         line = self._line(block, end, rapid)
-        line.fixed = True
+        line.fixed = CYCLE
         return line
 
     def _check_spindle(self, block: Block, motion: float, item) -> None:

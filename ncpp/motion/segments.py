@@ -24,6 +24,9 @@ from typing import Union
 from ncpp.program.blocks import Block
 
 Point = tuple[float, float, float]
+# Why a segment is `fixed`: passes leave it as programmed
+CYCLE = "canned cycle"  # a hole is drilled where the program puts it
+FLOW = "o-word loop or subroutine"  # one text runs many times (or out of the text's order)
 # Axis letters of `Line.end` / `Arc.end` beyond XYZ, in rs274's order.
 EXTRA_AXES = ("A", "B", "C", "U", "V", "W")
 
@@ -76,7 +79,7 @@ class Line:
     context: Context = field(default_factory=Context)
     extra: tuple[float, ...] = ()  # end positions of A B C U V W, when the program uses them
     changed: bool = False  # set by a pass that moved the end point
-    fixed: bool = False  # a move passes leave as programmed (a canned cycle's)
+    fixed: str = ""  # why passes leave the move as programmed (CYCLE, FLOW), "" if they may change it
 
     def length(self) -> float:
         return math.dist(self.start, self.end)
@@ -100,6 +103,7 @@ class Arc:
     context: Context = field(default_factory=Context)
     extra: tuple[float, ...] = ()
     changed: bool = False
+    fixed: str = ""  # as `Line.fixed`
 
     @property
     def clockwise(self) -> bool:
@@ -129,9 +133,11 @@ class Pass:
     """A block that makes no motion; written back as it was."""
 
     block: Block
+    skipped: bool = False  # the program does not run it (an untaken branch, a subroutine's definition)
+    motion: float | None = None  # an o-word control line's: the modal motion (G0-G3, a cycle) where it runs
 
 
 Segment = Union[Line, Arc]
 Event = Union[Line, Arc, Pass]
 
-__all__ = ["Arc", "Context", "Event", "Line", "Pass", "Point", "Segment", "PLANES", "PLANE_AXES", "EXTRA_AXES", "replace"]
+__all__ = ["CYCLE", "FLOW", "Arc", "Context", "Event", "Line", "Pass", "Point", "Segment", "PLANES", "PLANE_AXES", "EXTRA_AXES", "replace"]

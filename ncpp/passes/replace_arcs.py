@@ -67,7 +67,7 @@ def replace_arcs(events: Iterable[Event], ctx: PassContext) -> Iterator[Event]:
 
 def _with_arcs(batch: list[Event]) -> tuple[list[Event], list[int], list[Arc]]:
     """The batch, where its arcs to replace are, and those arcs."""
-    index = [k for k, e in enumerate(batch) if type(e) is Arc and not e.changed]
+    index = [k for k, e in enumerate(batch) if type(e) is Arc and not e.changed and not e.fixed]
     return batch, index, [batch[k] for k in index]
 
 

@@ -15,7 +15,7 @@ import pytest
 
 from ncpp.errors import NcppError, Warnings
 from ncpp.motion import interpret
-from ncpp.motion.segments import Line
+from ncpp.motion.segments import CYCLE, Line
 from ncpp.pipeline import ErrorSource, process
 from ncpp.program.parser import parse_stream
 from tests.conftest import RS274, ROOT
@@ -160,7 +160,7 @@ def test_random_cycle_programs_agree_with_rs274(tmp_path):
 def test_cycle_moves_are_fixed():
     events = list(interpret(parse_stream(io.BytesIO((HEAD + "G81 X1 Y1 Z-3 R2\nG80\nG1 X5\n").encode()), "t.ngc")))
     lines = [e for e in events if type(e) is Line]
-    assert [e.fixed for e in lines] == [False, True, True, True, True, False]
+    assert [e.fixed for e in lines] == ["", CYCLE, CYCLE, CYCLE, CYCLE, ""]
 
 
 @pytest.fixture(scope="module")

@@ -215,7 +215,7 @@ def test_arc_radius_tolerance_matches_linuxcnc_files():
 @pytest.mark.parametrize(
     "text, construct",
     [
-        ("o100 sub\n", "o-word control flow"),
+        ("o<probe> call\n", "o<probe>, which the program does not define (a subroutine file)"),
         ("IF [#1 EQ 1] GOTO 10\n", "Fanuc macro IF"),
         ("M98 P100\n", "M98 subprogram call"),
         ("G88 X0 Y0 Z-1 R1 P1 F10\n", "canned cycle G88"),  # a manual retract: the other cycles are interpreted

@@ -15,8 +15,8 @@ from dataclasses import replace
 from operator import itemgetter
 from typing import Iterable, Iterator
 
-from ncpp.motion.segments import Arc, Context, Event, Line
-from ncpp.program.blocks import DIGITS_AS_ONE, Block, Comment, ExprWord, Word
+from ncpp.motion.segments import Arc, Context, Event, Line, Pass
+from ncpp.program.blocks import DIGITS_AS_ONE, Block, Comment, ExprWord, Statement, Word
 from ncpp.program.numbers import NumberStyle, format_number
 from ncpp.program.writer import EditPlan, _literal, _with_motion, set_words, spelling
 
@@ -103,14 +103,19 @@ class IsoWriter:
 
     def _write_group(self, group: list[Event]) -> Iterable[str]:
         """The lines of one block's events (a list: cheaper than a generator per block)."""
-        block = group[0].block
+        first = group[0]
+        block = first.block
+        if type(first) is Pass and first.skipped:  # text the program does not run: it teaches nothing
+            return [block.text]
         facts = self._read_block(block)
+        if facts.flow:
+            return self._write_control(block, first, group)
         motion = [e for e in group if type(e) is Line or type(e) is Arc]
         for segment in motion:
             if segment.changed:
                 break
         else:  # nothing changed
-            lines = [self._restore_mode_line(block)] if self._needs_mode_restore(block) else []
+            lines = [self._restore_mode_line(block)] if self._needs_mode_restore(block, motion) else []
             lines.append(block.text)
             self._after_verbatim(block, motion)
             return lines
@@ -235,14 +240,14 @@ class IsoWriter:
         return spelled
 
     # -- verbatim blocks ------------------------------------------------------
-    def _needs_mode_restore(self, block: Block) -> bool:
+    def _needs_mode_restore(self, block: Block, motion: list[Event]) -> bool:
         """A verbatim block relying on a modal motion the output changed (an arc written as lines)."""
-        return (
-            self._facts(block).moves
-            and not self._has_motion_word(block)
-            and self.program_motion is not None
-            and self.output_motion != self.program_motion
-        )
+        if not self._facts(block).moves or self._has_motion_word(block):
+            return False
+        if self.program_motion is None and self.output_motion is not None and motion and not motion[0].fixed:
+            # the output's mode is known, the program's is not (after an o-word line): it is the one this block runs in
+            self.program_motion = self._motion_code(motion[0])  # type: ignore[arg-type]
+        return self.program_motion is not None and self.output_motion != self.program_motion
 
     def _restore_mode_line(self, block: Block) -> str:
         self.output_motion = self.program_motion
@@ -253,10 +258,24 @@ class IsoWriter:
             self.program_motion = self.output_motion = self._block_motion(block)
         for segment in motion:
             self._remember_end(segment)
-        if motion and type(motion[-1]) is Line and motion[-1].fixed:
-            # a canned cycle: where it leaves the tool is the control's (G98 retracts to the
-            # compensated level it started from), so the next block writes every axis it knows
+        if motion and motion[-1].fixed:
+            # a canned cycle, a loop or a subroutine: where it leaves the tool is the control's (G98
+            # retracts to the compensated level it started from), so the next block writes every axis it knows
             self._last_end = None
+
+    # -- o-word control lines ---------------------------------------------------
+    def _write_control(self, block: Block, line: Pass, group: list[Event]) -> list[str]:
+        """An o-word line (`o100 call`, `o100 endwhile`), with the moves it runs (the
+        subroutine's, the loop's next iterations): verbatim text that runs as programmed.
+        The control must be in the program's motion mode there (the lines it runs may rely
+        on it); after it the mode is the program's, unknown here, and nowhere else: the
+        next edited block writes its motion word, and every axis it knows."""
+        program = MOTION_CODES.get(line.motion)  # type: ignore[arg-type]
+        restore = program is not None and self.output_motion is not None and self.output_motion != program
+        lines = [f"G{program}{block.eol}", block.text] if restore else [block.text]
+        self.program_motion = self.output_motion = None
+        self._last_end = None
+        return lines
 
     # -- numbers as written -----------------------------------------------------
     def _moved(self, axis: str, value: float, segment: Line | Arc) -> bool:
@@ -453,7 +472,7 @@ class _Facts:
     """What the writer asks about a block."""
 
     __slots__ = ("letters", "motion_word", "motion", "first_motion", "moves", "plain", "words", "styled",
-                 "word_letters", "motion_at", "bits", "axis_bits", "absent_axes", "machine")  # fmt: skip
+                 "word_letters", "motion_at", "bits", "axis_bits", "absent_axes", "machine", "flow")  # fmt: skip
 
     def __init__(self, block: Block | None = None):
         """The facts of `block`, read in one walk over its items (none: a block without words)."""
@@ -468,12 +487,15 @@ class _Facts:
         self.word_letters: list[str] = []  # the letters of its plain words, in order
         self.motion_at: tuple[int, str] | None = None  # (n, number as written) of its first G0-G3 word, the n-th word
         self.machine = False  # it moves in machine coordinates (G53)
+        self.flow = False  # an o-word control line (not `O<name>` alone, a program's name)
         for item in block.items if block is not None else ():
             kind = type(item)
             if kind is Word:
                 self._read_word(item.letter, item.value, item.number)
             elif kind is not Comment:
                 self.plain = False
+                if kind is Statement and item.kind == "oword" and len(item.node) >= 2:
+                    self.flow = True
         self._sum_up()
 
     @classmethod

@@ -1,0 +1,432 @@
+"""O-word control flow, as LinuxCNC runs it: the order a program's blocks run in.
+
+`Flow.steps(blocks)` reads the blocks once, in order, and yields each block
+with what the interpreter is to do with it (`kind`):
+
+* RUN   — execute it in its place in the text;
+* FIXED — execute it as part of a loop or a subroutine: its moves are left
+  as programmed (a body runs many times from one text);
+* SKIP  — write its text; it does not run (an untaken branch, a subroutine's
+  definition, a loop that runs no time);
+* TEXT  — write its text: a control line this module has executed
+  (`o100 if`, `o100 call`), or a line after the program's end.
+
+A subroutine runs where it is called and a loop's second iteration where
+its end line sends the program back: out of the text's order.  Their blocks
+come again as FIXED with an `owner`, the line whose text the output is at
+(the call, the `endwhile`): the interpreter gives their moves to that line,
+so that every block's text is written once, where it stands.  Control lines
+that run out of the text's order yield nothing.
+
+Subroutines are those of the program's own text (defined before or after the
+call, like LinuxCNC, which searches the rest of the file); subroutine files
+on the control's search path are outside the scope.  Blocks stay in memory
+only while a loop may go back to them, and subroutine bodies for the call.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable, Iterable, Iterator
+
+from ncpp.errors import Location, NcppError
+from ncpp.motion.expressions import SUBROUTINE_PARAMETERS, normalise_name, round_half_away
+from ncpp.program.blocks import Block, Comment, Statement, Word
+
+RUN, FIXED, SKIP, TEXT = "run", "fixed", "skip", "text"
+_TRIM = 4096  # blocks no loop can go back to are dropped in runs of this many
+
+
+@dataclass(frozen=True, slots=True)
+class Control:
+    """The o-word of a control line: `o100 while [#1 LT 3]` is ("100", "while", (expr,))."""
+
+    name: str | tuple  # a tuple: `o[expr]`, an expression evaluated where the line runs
+    keyword: str
+    arguments: tuple
+    item: Statement
+
+
+@dataclass
+class _Label:
+    """A loop's opening line, where its end (and `continue`) send the program back."""
+
+    kind: str  # while, do, repeat
+    start: int  # the line's index in its frame's space
+    count: int = -1  # repeat: iterations still to run (-1: not counted yet)
+
+
+@dataclass
+class _Frame:
+    """A level of calls: the main program (space None: the stream) or a subroutine's body."""
+
+    space: list[Block] | None
+    pc: int  # the next block to run: an index into the space (the main program: a line number from 0)
+    labels: dict[str, _Label] = field(default_factory=dict)  # its loops under way
+
+
+class Flow:
+    """The blocks of a program in the order they run (see the module docstring).
+
+    `evaluate(expr, block, item)` is the interpreter's (its parameters, its
+    errors); `parameters` gets `enter(args)` and `leave(value)` at calls and
+    returns; `done()` says the program has ended (M2, M30, or a construct
+    outside the interpreter's scope), after which the rest is text;
+    `stop(reason, block, col)` ends it where the flow leaves the scope."""
+
+    def __init__(self, file: str, evaluate: Callable, parameters, done: Callable[[], bool], stop: Callable):
+        self.file, self.evaluate, self.parameters, self.done, self.stop = file, evaluate, parameters, done, stop
+        self.buffer: list[Block] = []  # main-program blocks read and still wanted, from line `base`
+        self.base = 0
+        self.read = 0  # main-program blocks read from the stream
+        self.written = 0  # main-program blocks yielded in text order (the next one written is this)
+        self.owner: Block | None = None  # the last block yielded in text order
+        self.subroutines: dict[str, list[Block]] = {}  # name -> its lines, `sub` to `endsub`
+        self._defining: tuple[str, list[Block]] | None = None  # a definition being read
+        self.frames = [_Frame(None, 0)]
+        self.stream: Iterator[Block] = iter(())
+        # rs274ngc's state, global as there (its quirks come with it: a `break` out of a while loop
+        # stops the next do-while end from looping, a `continue` in a do loop makes the next
+        # skipped-to endwhile loop once more)
+        self.skipping: str | None = None  # the o-word the lines up to its next line are skipped for
+        self.executed_if = False  # a branch of the if chain under way has run
+        self.doing_break = self.doing_continue = False
+
+    # -- the stream ------------------------------------------------------------
+    def steps(self, blocks: Iterable[Block]) -> Iterator[tuple[Block, str, Block | None]]:
+        """(block, kind, owner): see the module docstring; owner is None but for
+        blocks that run out of the text's order."""
+        self.stream = iter(blocks)
+        main = self.frames[0]
+        while not self.done():
+            frame = self.frames[-1]
+            if frame is main and main.pc == self.read and not main.labels and self.skipping is None:
+                # the common case, nothing read ahead and no loop to go back to: straight from the stream
+                self.buffer.clear()
+                for block in self.stream:
+                    if block.signature is None and control_of(block) is not None:
+                        self.base = self.read
+                        self._keep(block)
+                        break
+                    self.owner, self.read = block, self.read + 1
+                    self.written = main.pc = self.read
+                    yield block, RUN, None
+                    if self.done():
+                        break
+                else:
+                    return
+                continue
+            block = self._block(frame, frame.pc)
+            if block is None:  # the end of the text (a subroutine's ends with its endsub)
+                if frame.space is not None:  # skipped past its endsub
+                    raise NcppError(f"o{_shown(self.skipping or '')} is not closed in its subroutine", Location(self.file, frame.space[-1].line, None))
+                return  # LinuxCNC too ends a program whose file ends, in a loop or skipping
+            control = control_of(block)
+            if self.skipping is not None and (control is None or control.name != self.skipping):
+                if self._in_place(frame):
+                    yield block, SKIP, None
+                self._advance(frame)
+                continue
+            if control is None:
+                yield block, *self._kind(frame)
+                self._advance(frame)
+                continue
+            yield from self._control(frame, block, control)
+        yield from self._rest()
+
+    def _kind(self, frame: _Frame) -> tuple[str, Block | None]:
+        if self._in_place(frame):
+            return (FIXED if frame.labels else RUN), None
+        return FIXED, self.owner
+
+    def _in_place(self, frame: _Frame) -> bool:
+        return frame.space is None and frame.pc == self.written
+
+    def _advance(self, frame: _Frame) -> None:
+        if self._in_place(frame):
+            self._wrote(frame.pc)
+        frame.pc += 1
+
+    def _wrote(self, line: int) -> None:
+        self.owner = self.buffer[line - self.base]
+        self.written = line + 1
+        if len(self.buffer) > 2 * _TRIM and not self.frames[0].labels:
+            keep = self.written - self.base  # nothing before the next block is read again
+            if keep > _TRIM:
+                del self.buffer[:keep]
+                self.base += keep
+
+    def _rest(self) -> Iterator[tuple[Block, str, Block | None]]:
+        """After the program's end: every block not yet written, as text."""
+        for line in range(self.written, self.read):
+            yield self.buffer[line - self.base], TEXT, None
+        self.buffer.clear()
+        for block in self.stream:
+            yield block, TEXT, None
+
+    def _block(self, frame: _Frame, index: int) -> Block | None:
+        """The frame's block at `index` (None: past the end)."""
+        if frame.space is not None:
+            return frame.space[index] if index < len(frame.space) else None
+        while index >= self.read:
+            if not self._read():
+                return None
+        return self.buffer[index - self.base]
+
+    def _read(self) -> bool:
+        """Read the next main-program block (False: the stream has ended); subroutine
+        definitions are kept as they go by, for calls before and after them."""
+        block = next(self.stream, None)
+        if block is None:
+            return False
+        self._keep(block)
+        return True
+
+    def _keep(self, block: Block) -> None:
+        """A main-program block read: in the buffer, and in the definition being read."""
+        self.buffer.append(block)
+        self.read += 1
+        control = control_of(block)
+        if self._defining is not None:
+            name, lines = self._defining
+            lines.append(block)
+            if control is not None and control.keyword == "endsub" and control.name == name:
+                self.subroutines.setdefault(name, lines)  # the first definition counts
+                self._defining = None
+        elif control is not None and control.keyword == "sub":
+            self._defining = (control.name, [block])
+
+    # -- control lines -----------------------------------------------------------
+    def _control(self, frame: _Frame, block: Block, control: Control) -> Iterator[tuple[Block, str, Block | None]]:
+        """Run one control line: decide (errors point at it), write it, then jump."""
+        if type(control.name) is tuple:
+            value = self.evaluate(control.name, block, control.item)
+            control = Control(str(int(round_half_away(value))), control.keyword, control.arguments, control.item)
+        keyword = control.keyword
+        act = getattr(self, "_" + keyword)
+        arrived, self.skipping = self.skipping is not None, None  # (skipping to this line: it runs)
+        jump = act(frame, block, control, arrived)  # a function that moves the frame(s) on, or a generator doing so
+        if self._in_place(frame):
+            yield block, (SKIP if keyword == "sub" else TEXT), None
+            self._wrote(frame.pc)
+        result = jump()
+        if result is not None:
+            yield from result
+
+    # Each handler decides (evaluates, checks) and returns what moves the program on, run once
+    # the line is written; `arrived`: the program was skipping to this line (rs274ngc's skipping_o).
+    def _sub(self, frame, block, control, arrived):
+        """A definition in the way: it does not run (its lines are text)."""
+        return lambda: self._skip_definition(frame, control.name)
+
+    def _endsub(self, frame, block, control, arrived):
+        return self._return(frame, block, control, arrived)
+
+    def _return(self, frame, block, control, arrived):
+        if frame.space is None:
+            raise self._error(f"{control.keyword} outside a subroutine", block, control)
+        value = self._value(block, control)
+
+        def leave():
+            self.frames.pop()
+            self.parameters.leave(value)
+
+        return leave
+
+    def _call(self, frame, block, control, arrived):
+        arguments = [self.evaluate(a, block, control.item) for a in control.arguments]
+        if len(arguments) > SUBROUTINE_PARAMETERS:
+            raise self._error(f"more than {SUBROUTINE_PARAMETERS} arguments to a subroutine", block, control)
+        body = self._subroutine(control.name)
+        if body is None:
+            self.stop(f"a call of o{_shown(control.name)}, which the program does not define (a subroutine file)", block, control.item.start + 1)
+            return lambda: None
+
+        def call():
+            frame.pc += 1
+            self.parameters.enter(arguments)
+            self.frames.append(_Frame(body, 1))
+
+        return call
+
+    def _subroutine(self, name: str) -> list[Block] | None:
+        """The lines of `o<name>`, read on for if it comes later in the text (None: nowhere)."""
+        while name not in self.subroutines:
+            if not self._read():
+                return None
+        return self.subroutines[name]
+
+    def _if(self, frame, block, control, arrived):
+        self.executed_if = self._condition(block, control)
+        return self._on(frame, None if self.executed_if else control.name)
+
+    def _elseif(self, frame, block, control, arrived):
+        if not self.executed_if and self._condition(block, control):
+            self.executed_if = True
+            return self._on(frame, None)
+        return self._on(frame, control.name)
+
+    def _else(self, frame, block, control, arrived):
+        if self.executed_if:
+            return self._on(frame, control.name)
+        self.executed_if = True  # (reached running, not skipping, only from a chain it did not see start)
+        return self._on(frame, None)
+
+    def _endif(self, frame, block, control, arrived):
+        self.executed_if = True  # the chain around this one ran, or this line would be skipped
+        return self._on(frame, None)
+
+    def _while(self, frame, block, control, arrived):
+        label = frame.labels.get(control.name)
+        again = self._condition(block, control)
+        if label is not None and label.kind == "do":  # the end of a do loop
+            if again and not self.doing_break:
+                return lambda: setattr(frame, "pc", label.start)
+            self.doing_break = False
+            return self._ended(frame, control.name)
+
+        def test():
+            if label is None:
+                frame.labels[control.name] = _Label("while", frame.pc)
+            self._on(frame, None if again else control.name)()
+
+        return test
+
+    def _endwhile(self, frame, block, control, arrived):
+        return self._loop_end(frame, block, control, arrived, "while")
+
+    def _endrepeat(self, frame, block, control, arrived):
+        return self._loop_end(frame, block, control, arrived, "repeat")
+
+    def _loop_end(self, frame, block, control, arrived, kind):
+        """Back to the loop's opening line, or, skipping to here (a false test, a `break`), past it."""
+        label = self._label(frame, block, control, (kind,))
+        if arrived and not self.doing_continue:
+            return self._ended(frame, control.name)
+        self.doing_continue = False
+        return lambda: setattr(frame, "pc", label.start)
+
+    def _do(self, frame, block, control, arrived):
+        def enter():
+            frame.labels.setdefault(control.name, _Label("do", frame.pc))
+            frame.pc += 1
+
+        return enter
+
+    def _repeat(self, frame, block, control, arrived):
+        (count,) = self._arguments(block, control, 1)
+
+        def test():
+            label = frame.labels.setdefault(control.name, _Label("repeat", frame.pc))
+            if label.count == -1:  # counted where the loop starts
+                label.count = int(round_half_away(count))
+            if label.count > 0:
+                label.count -= 1
+                self._on(frame, None)()
+            else:
+                label.count = -1
+                self._on(frame, control.name)()
+
+        return test
+
+    def _break(self, frame, block, control, arrived):
+        self._label(frame, block, control, ("while", "do"))
+        self.doing_break = True
+        return self._on(frame, control.name)
+
+    def _continue(self, frame, block, control, arrived):
+        self._label(frame, block, control, ("while", "do"))
+        if not arrived:
+            self.doing_continue = True
+        return self._on(frame, control.name)
+
+    # -- helpers ---------------------------------------------------------------
+    def _on(self, frame: _Frame, skipping: str | None) -> Callable[[], None]:
+        """On to the next line, skipping to the next line of o-word `skipping` (None: not)."""
+
+        def step():
+            self.skipping = skipping
+            frame.pc += 1
+
+        return step
+
+    def _ended(self, frame: _Frame, name: str) -> Callable[[], None]:
+        """Past a loop's end: no line goes back to it."""
+
+        def step():
+            frame.labels.pop(name, None)
+            frame.pc += 1
+
+        return step
+
+    def _skip_definition(self, frame: _Frame, name: str) -> Iterator[tuple[Block, str, Block | None]]:
+        """Past a subroutine's definition to its endsub: lines that do not run."""
+        while True:
+            block = self._block(frame, frame.pc)
+            if block is None:
+                raise NcppError(f"o{_shown(name)} sub has no o{_shown(name)} endsub", Location(self.file, self._opening_line(frame), None))
+            control = control_of(block)
+            if self._in_place(frame):
+                yield block, SKIP, None
+                self._wrote(frame.pc)
+            frame.pc += 1
+            if control is not None and control.name == name and control.keyword == "endsub":
+                return
+
+    def _opening_line(self, frame: _Frame) -> int:
+        """The line a construct left open at the end of the text started at (for messages)."""
+        if frame.space is not None:
+            return frame.space[0].line
+        return self.owner.line if self.owner is not None else 1
+
+    def _label(self, frame: _Frame, block: Block, control: Control, kinds: tuple[str, ...]) -> _Label:
+        """The running loop the line names, of one of `kinds` (rs274ngc: no other)."""
+        label = frame.labels.get(control.name)
+        if label is None or label.kind not in kinds:
+            found = "no loop" if label is None else f"a {label.kind} loop"
+            raise self._error(f"{control.keyword} names {found}, not a {' or '.join(kinds)} loop", block, control)
+        return label
+
+    def _condition(self, block: Block, control: Control) -> bool:
+        (value,) = self._arguments(block, control, 1)
+        return value != 0.0
+
+    def _value(self, block: Block, control: Control) -> float | None:
+        values = self._arguments(block, control, None)
+        return values[0] if values else None
+
+    def _arguments(self, block: Block, control: Control, wanted: int | None) -> list[float]:
+        if wanted is not None and len(control.arguments) != wanted:
+            raise self._error(f"{control.keyword} wants {'an expression' if wanted == 1 else f'{wanted} expressions'} in [ ]", block, control)
+        if wanted is None and len(control.arguments) > 1:
+            raise self._error(f"{control.keyword} takes one value", block, control)
+        return [self.evaluate(a, block, control.item) for a in control.arguments]
+
+    def _error(self, message: str, block: Block, control: Control) -> NcppError:
+        return NcppError(f"o{_shown(control.name)} {message}", Location(self.file, block.line, control.item.start + 1))
+
+
+def control_of(block: Block) -> Control | None:
+    """The block's o-word control line, if it is one (`O<name>` alone, a program name, is not)."""
+    for item in block.items:
+        if type(item) is Statement and item.kind == "oword" and len(item.node) >= 2:
+            head, rest = item.node[0], item.node[1:]
+            if head.endswith("["):  # o[expr] keyword ...: the name is evaluated where the line runs
+                head, rest = rest[0], rest[1:]
+                return Control(head, rest[0].lower(), tuple(rest[1:]), item) if rest else None
+            return Control(oword_name(head), rest[0].lower(), tuple(rest[1:]), item)
+        if type(item) is not Comment and not (type(item) is Word and item.letter == "N"):
+            return None
+    return None
+
+
+def oword_name(text: str) -> str:
+    """`o100`, `O0100` -> "100"; `o<My Sub>` -> "mysub" (rs274ngc ignores case and spaces)."""
+    label = text[1:].strip()
+    if label.startswith("<"):
+        return normalise_name(label)
+    return str(int(label))
+
+
+def _shown(name: str) -> str:
+    return name if name.isdigit() else f"<{name}>"
