@@ -127,7 +127,7 @@ def warn_unplaced(blocks: Iterable[Block], warnings: Warnings, file: str) -> Ite
 UNCOMPENSATED = {
     CYCLE: "canned cycle: its moves pass through uncompensated (the holes are where the program puts them, "
     "with the machine's errors); compensation resumes with the next move",
-    FLOW: "o-word loop or subroutine: its moves pass through uncompensated (one text runs several times, "
+    FLOW: "loop or subroutine: its moves pass through uncompensated (one text runs several times, "
     "or away from where it stands, so it cannot carry one correction); compensation resumes with the next move after it",
 }
 INCREMENTAL_FIXED = (
@@ -136,7 +136,7 @@ INCREMENTAL_FIXED = (
 )
 
 
-_ARTICLED = {CYCLE: "a canned cycle", FLOW: "an o-word loop or subroutine"}
+_ARTICLED = {CYCLE: "a canned cycle", FLOW: "a loop or subroutine"}
 
 
 def warn_fixed(events: Iterable[Event], warnings: Warnings, file: str) -> Iterator[Event]:

@@ -67,6 +67,14 @@ def add_placement_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--var-units", choices=("mm", "inch"), default="mm", help="units of --var-file and of a LinuxCNC --tool-table: the INI's [TRAJ]LINEAR_UNITS (default mm; TOOL.T says its own)"
     )
+    p.add_argument(
+        "--subroutine-path",
+        metavar="DIR[:DIR...]",
+        type=lambda text: [d for d in text.split(os.pathsep) if d],
+        default=[],
+        help="folders of subroutine files, as the INI's [RS274NGC]SUBROUTINE_PATH: `o<name> call` of a subroutine the "
+        "program does not define runs DIR/name.ngc (without it, such a call ends interpretation with a warning)",
+    )
 
 
 # A worker process pays off from about this size: it costs ~0.3 s to start (overlapped
@@ -99,7 +107,7 @@ def work_offsets(args: argparse.Namespace):
     """The control's zeros and tool table from --var-file, --work-offset and --tool-table."""
     from ncpp.motion.offsets import UNIT_MM, WorkOffsets
 
-    return WorkOffsets.given(dict(args.work_offset), args.var_file, UNIT_MM[args.var_units], args.tool_table)
+    return WorkOffsets.given(dict(args.work_offset), args.var_file, UNIT_MM[args.var_units], args.tool_table, args.subroutine_path)
 
 
 def error_source(args: argparse.Namespace):

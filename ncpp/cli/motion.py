@@ -59,7 +59,7 @@ def run(args: argparse.Namespace) -> int:
     from ncpp.program.dialects import parse_program
 
     warnings = Warnings(strict=args.strict)
-    offsets = work_offsets(args) if args.work_offset or args.var_file or args.tool_table else None
+    offsets = work_offsets(args) if args.work_offset or args.var_file or args.tool_table or args.subroutine_path else None
     out = sys.stdout
     with open_input(args.input) as (stream, name):
         dialect, blocks = parse_program(stream, name, args.dialect)

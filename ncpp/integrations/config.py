@@ -52,10 +52,11 @@ class Settings:
     var_units: str = "mm"
     tool_table: str | None = None
     origin: str = "defaults"  # where the machine file was named: "--machine", "NCPP_MACHINE" or a config path
+    subroutine_path: tuple[str, ...] = ()  # folders of subroutine files (LinuxCNC's [RS274NGC]SUBROUTINE_PATH)
 
     def offsets(self) -> WorkOffsets:
         """The zeros the control holds, as these settings say them."""
-        return WorkOffsets.given(self.zeros, self.var_file, UNIT_MM[self.var_units], self.tool_table)
+        return WorkOffsets.given(self.zeros, self.var_file, UNIT_MM[self.var_units], self.tool_table, self.subroutine_path)
 
 
 def config_paths(cwd: Path | None = None, env: Mapping[str, str] | None = None) -> list[Path]:
@@ -153,9 +154,9 @@ _INI_UNITS = {"mm": "mm", "metric": "mm", "inch": "inch", "in": "inch", "imperia
 def with_linuxcnc_ini(settings: Settings, ini: str | Path | None) -> Settings:
     """The settings with LinuxCNC's own files where they name none: the INI's
     [RS274NGC]PARAMETER_FILE and [EMCIO]TOOL_TABLE (relative to the INI's folder),
-    in its [TRAJ]LINEAR_UNITS.  LinuxCNC exports the INI's path as $INI_FILE_NAME
-    to the programs it runs, the filter among them."""
-    if not ini or (settings.var_file and settings.tool_table):
+    in its [TRAJ]LINEAR_UNITS, and its [RS274NGC]SUBROUTINE_PATH.  LinuxCNC exports
+    the INI's path as $INI_FILE_NAME to the programs it runs, the filter among them."""
+    if not ini:
         return settings
     path = Path(ini)
     parser = configparser.ConfigParser(strict=False, interpolation=None)  # LinuxCNC INIs repeat keys (HALFILE)
@@ -172,6 +173,8 @@ def with_linuxcnc_ini(settings: Settings, ini: str | Path | None) -> Settings:
         return str(found) if value and found.is_file() else None
 
     var_file, tool_table = named("RS274NGC", "PARAMETER_FILE"), named("EMCIO", "TOOL_TABLE")
+    folders = parser.get("RS274NGC", "SUBROUTINE_PATH", fallback="").split(":")  # LinuxCNC's separator
+    subroutine_path = tuple(str((path.parent / Path(f.strip()).expanduser()).resolve()) for f in folders if f.strip())
     units = _INI_UNITS.get(parser.get("TRAJ", "LINEAR_UNITS", fallback="mm").strip().lower(), "mm")
     own_units = settings.var_file or settings.tool_table  # the config's files: its units
     return replace(
@@ -179,4 +182,5 @@ def with_linuxcnc_ini(settings: Settings, ini: str | Path | None) -> Settings:
         var_file=settings.var_file or var_file,
         tool_table=settings.tool_table or tool_table,
         var_units=settings.var_units if own_units else units,
+        subroutine_path=settings.subroutine_path or subroutine_path,
     )

@@ -133,18 +133,20 @@ class Parameters:
         self.numbered: dict[int, float] = {}
         self.named: dict[str, float] = {"_value": 0.0, "_value_returned": 0.0}  # what the last subroutine returned
         self.system = system
-        self._callers: list[tuple[list[float], dict[str, float]]] = []  # per call level: the caller's #1..#30 and local names
+        self._callers: list[tuple[list[float] | None, dict[str, float]]] = []  # per call level: the caller's #1..#30 and local names
 
-    def enter(self, arguments: list[float]) -> None:
-        """A subroutine call: #1..#30 are its arguments (0 past the last), and names
-        without a leading underscore are its own (the caller's come back at `leave`)."""
-        saved = [self.numbered.get(n, 0.0) for n in range(1, SUBROUTINE_PARAMETERS + 1)]
+    def enter(self, arguments: list[float] | None) -> None:
+        """A subroutine call: #1..#30 are its arguments (0 past the last; None, a Fanuc
+        M98 call: the caller's, shared), and names without a leading underscore are
+        its own (the caller's come back at `leave`)."""
+        saved = None if arguments is None else [self.numbered.get(n, 0.0) for n in range(1, SUBROUTINE_PARAMETERS + 1)]
         local = {k: v for k, v in self.named.items() if not k.startswith("_")}
         for k in local:
             del self.named[k]
         self._callers.append((saved, local))
-        for n in range(1, SUBROUTINE_PARAMETERS + 1):
-            self.numbered[n] = arguments[n - 1] if n <= len(arguments) else 0.0
+        if arguments is not None:
+            for n in range(1, SUBROUTINE_PARAMETERS + 1):
+                self.numbered[n] = arguments[n - 1] if n <= len(arguments) else 0.0
 
     def leave(self, value: float | None) -> None:
         """The subroutine returns (`value`: what its return or endsub gave, if anything)."""
@@ -152,7 +154,8 @@ class Parameters:
         for k in [k for k in self.named if not k.startswith("_")]:
             del self.named[k]
         self.named.update(local)
-        self.numbered.update(zip(range(1, SUBROUTINE_PARAMETERS + 1), saved))
+        if saved is not None:
+            self.numbered.update(zip(range(1, SUBROUTINE_PARAMETERS + 1), saved))
         self.named["_value"], self.named["_value_returned"] = (0.0, 0.0) if value is None else (value, 1.0)
 
     def key(self, key, evaluate: Callable[[tuple], float]) -> int | str:

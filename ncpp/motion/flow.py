@@ -18,6 +18,10 @@ come again as FIXED with an `owner`, the line whose text the output is at
 so that every block's text is written once, where it stands.  Control lines
 that run out of the text's order yield nothing.
 
+Fanuc subprograms run the same way: `M98 P<n> [L<repeats>]` calls the
+program `O<n>` of the file, which ends with `M99` (#1-#30 are the caller's,
+as in LinuxCNC; the other scoping is a call's).
+
 Subroutines are those of the program's own text (defined before or after the
 call, like LinuxCNC, which searches the rest of the file); subroutine files
 on the control's search path are outside the scope.  Blocks stay in memory
@@ -26,25 +30,31 @@ only while a loop may go back to them, and subroutine bodies for the call.
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass, field
-from typing import Callable, Iterable, Iterator
+from pathlib import Path
+from typing import Callable, Iterable, Iterator, Sequence
 
 from ncpp.errors import Location, NcppError
 from ncpp.motion.expressions import SUBROUTINE_PARAMETERS, normalise_name, round_half_away
-from ncpp.program.blocks import Block, Comment, Statement, Word
+from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
+from ncpp.program.parser import parse_stream
 
 RUN, FIXED, SKIP, TEXT = "run", "fixed", "skip", "text"
 _TRIM = 4096  # blocks no loop can go back to are dropped in runs of this many
+# Blocks after an `O<n>` line kept as Fanuc subprogram `n` until its M99: a longer one is a
+# program's own number (`O1000` at its top), not a subprogram, and memory stays bounded.
+MAX_SUBPROGRAM = 20_000
 
 
 @dataclass(frozen=True, slots=True)
 class Control:
     """The o-word of a control line: `o100 while [#1 LT 3]` is ("100", "while", (expr,))."""
 
-    name: str | tuple  # a tuple: `o[expr]`, an expression evaluated where the line runs
-    keyword: str
-    arguments: tuple
-    item: Statement
+    name: str | tuple | None  # a tuple: `o[expr]`, an expression evaluated where the line runs; None: M98, M99
+    keyword: str  # sub, call, while, ...; m98, m99
+    arguments: tuple  # expressions; M98's P and L words
+    item: Statement | Word | ExprWord  # where messages point
 
 
 @dataclass
@@ -63,6 +73,8 @@ class _Frame:
     space: list[Block] | None
     pc: int  # the next block to run: an index into the space (the main program: a line number from 0)
     labels: dict[str, _Label] = field(default_factory=dict)  # its loops under way
+    repeats: int = 0  # a Fanuc subprogram (M98): the runs still to make after this one; -1: an o-word call
+    source: str | None = None  # the subroutine file its lines are from (None: the program's)
 
 
 class Flow:
@@ -72,17 +84,20 @@ class Flow:
     errors); `parameters` gets `enter(args)` and `leave(value)` at calls and
     returns; `done()` says the program has ended (M2, M30, or a construct
     outside the interpreter's scope), after which the rest is text;
-    `stop(reason, block, col)` ends it where the flow leaves the scope."""
+    `stop(reason, block, col)` ends it where the flow leaves the scope;
+    `path`: the folders of subroutine files."""
 
-    def __init__(self, file: str, evaluate: Callable, parameters, done: Callable[[], bool], stop: Callable):
-        self.file, self.evaluate, self.parameters, self.done, self.stop = file, evaluate, parameters, done, stop
+    def __init__(self, file: str, evaluate: Callable, parameters, done: Callable[[], bool], stop: Callable, path: Sequence[Path] = ()):
+        self.file, self.evaluate, self.parameters, self.done, self.stop, self.path = file, evaluate, parameters, done, stop, tuple(path)
+        self.files: dict[str, str] = {}  # subroutine name -> the file it was read from
         self.buffer: list[Block] = []  # main-program blocks read and still wanted, from line `base`
         self.base = 0
         self.read = 0  # main-program blocks read from the stream
         self.written = 0  # main-program blocks yielded in text order (the next one written is this)
         self.owner: Block | None = None  # the last block yielded in text order
         self.subroutines: dict[str, list[Block]] = {}  # name -> its lines, `sub` to `endsub`
-        self._defining: tuple[str, list[Block]] | None = None  # a definition being read
+        self.subprograms: dict[str, list[Block]] = {}  # Fanuc: number -> its lines, `O<n>` to `M99`
+        self._defining: tuple[dict, str, list[Block]] | None = None  # a definition being read: where it goes, its name, lines
         self.frames = [_Frame(None, 0)]
         self.stream: Iterator[Block] = iter(())
         # rs274ngc's state, global as there (its quirks come with it: a `break` out of a while loop
@@ -100,11 +115,12 @@ class Flow:
         main = self.frames[0]
         while not self.done():
             frame = self.frames[-1]
-            if frame is main and main.pc == self.read and not main.labels and self.skipping is None:
+            if frame is main and main.pc == self.read and not main.labels and self.skipping is None and self._defining is None:
                 # the common case, nothing read ahead and no loop to go back to: straight from the stream
                 self.buffer.clear()
                 for block in self.stream:
-                    if block.signature is None and control_of(block) is not None:
+                    signature = block.signature
+                    if (signature is None or "M" in signature or "O" in signature) and _notable(block):
                         self.base = self.read
                         self._keep(block)
                         break
@@ -122,7 +138,7 @@ class Flow:
                     raise NcppError(f"o{_shown(self.skipping or '')} is not closed in its subroutine", Location(self.file, frame.space[-1].line, None))
                 return  # LinuxCNC too ends a program whose file ends, in a loop or skipping
             control = control_of(block)
-            if self.skipping is not None and (control is None or control.name != self.skipping):
+            if self.skipping is not None and (control is None or control.name != self.skipping):  # (M98, M99: None)
                 if self._in_place(frame):
                     yield block, SKIP, None
                 self._advance(frame)
@@ -187,14 +203,23 @@ class Flow:
         self.buffer.append(block)
         self.read += 1
         control = control_of(block)
+        number = program_number(block) if control is None else None
         if self._defining is not None:
-            name, lines = self._defining
-            lines.append(block)
-            if control is not None and control.keyword == "endsub" and control.name == name:
-                self.subroutines.setdefault(name, lines)  # the first definition counts
-                self._defining = None
-        elif control is not None and control.keyword == "sub":
-            self._defining = (control.name, [block])
+            found, name, lines = self._defining
+            fanuc = found is self.subprograms
+            if not fanuc or (number is None and (control is None or control.keyword != "sub")):
+                lines.append(block)
+                if control is not None and (control.keyword == "m99" if fanuc else control.keyword == "endsub" and control.name == name):
+                    found.setdefault(name, lines)  # the first definition counts (LinuxCNC finds it first)
+                    self._defining = None
+                elif fanuc and len(lines) > MAX_SUBPROGRAM:
+                    self._defining = None
+                return
+            self._defining = None  # that `O<n>` was a program's number: what starts here is another definition
+        if control is not None and control.keyword == "sub":
+            self._defining = (self.subroutines, control.name, [block])
+        elif number is not None:
+            self._defining = (self.subprograms, number, [block])
 
     # -- control lines -----------------------------------------------------------
     def _control(self, frame: _Frame, block: Block, control: Control) -> Iterator[tuple[Block, str, Block | None]]:
@@ -237,24 +262,84 @@ class Flow:
         arguments = [self.evaluate(a, block, control.item) for a in control.arguments]
         if len(arguments) > SUBROUTINE_PARAMETERS:
             raise self._error(f"more than {SUBROUTINE_PARAMETERS} arguments to a subroutine", block, control)
-        body = self._subroutine(control.name)
+        name = control.name
+        body = self.subroutines.get(name) or self._from_file(name) or self._defined(self.subroutines, name)
         if body is None:
-            self.stop(f"a call of o{_shown(control.name)}, which the program does not define (a subroutine file)", block, control.item.start + 1)
+            where = f" nor is o{_shown(name)}.ngc in {os.pathsep.join(map(str, self.path))}" if self.path else ""
+            self.stop(f"a call of o{_shown(name)}, which the program does not define (a subroutine file: "
+                      f"give its folder with --subroutine-path){where}", block, control.item.start + 1)  # fmt: skip
             return lambda: None
 
         def call():
             frame.pc += 1
             self.parameters.enter(arguments)
-            self.frames.append(_Frame(body, 1))
+            self.frames.append(_Frame(body, 1, repeats=-1, source=self.files.get(name)))
 
         return call
 
-    def _subroutine(self, name: str) -> list[Block] | None:
-        """The lines of `o<name>`, read on for if it comes later in the text (None: nowhere)."""
-        while name not in self.subroutines:
+    def _from_file(self, name: str) -> list[Block] | None:
+        """Subroutine `name` from `name.ngc` in the first folder of the path that has it (as LinuxCNC)."""
+        for folder in self.path:
+            path = folder / f"{name}.ngc"
+            if not path.is_file():
+                continue
+            lines: list[Block] = []
+            with open(path, "rb") as stream:
+                for block in parse_stream(stream, str(path)):
+                    control = control_of(block)
+                    if lines or (control is not None and control.keyword == "sub" and control.name == name):
+                        lines.append(block)
+                        if control is not None and control.keyword == "endsub" and control.name == name:
+                            self.subroutines[name], self.files[name] = lines, str(path)
+                            return lines
+            raise NcppError(f"o<{name}> sub ... o<{name}> endsub is not in the file", Location(str(path)))
+        return None
+
+    def source(self) -> str | None:
+        """The subroutine file the running block is from (None: the program)."""
+        return self.frames[-1].source
+
+    def _m98(self, frame, block, control, arrived):
+        """A Fanuc subprogram call: `M98 P<n> L<repeats>`."""
+        number, repeats = (None if item is None else self._number(item, block) for item in control.arguments)
+        name, runs = str(int(round_half_away(number))), 1 if repeats is None else int(round_half_away(repeats))
+        body = self._defined(self.subprograms, name)
+        if body is None:
+            self.stop(f"M98 P{name}: a subprogram the program does not define (O{name} to M99)", block, control.item.start + 1)
+            return lambda: None
+
+        def call():
+            frame.pc += 1
+            if runs > 0:  # L0: no run
+                self.parameters.enter(None)
+                self.frames.append(_Frame(body, 1, repeats=runs - 1))
+
+        return call
+
+    def _m99(self, frame, block, control, arrived):
+        if frame.space is None:
+            self.stop("M99 in the main program (an endless main program)", block, control.item.start + 1)
+            return lambda: None
+        if frame.repeats < 0:
+            raise NcppError("an o-word subroutine ends with o... endsub or o... return, not M99", Location(self.file, block.line, control.item.start + 1))
+
+        def leave():
+            self.parameters.leave(None)
+            if frame.repeats > 0:  # L: once more
+                frame.repeats -= 1
+                frame.pc, frame.labels = 1, {}
+                self.parameters.enter(None)
+            else:
+                self.frames.pop()
+
+        return leave
+
+    def _defined(self, found: dict[str, list[Block]], name: str) -> list[Block] | None:
+        """The lines of subroutine (or subprogram) `name`, read on for if it comes later in the text (None: nowhere)."""
+        while name not in found:
             if not self._read():
                 return None
-        return self.subroutines[name]
+        return found[name]
 
     def _if(self, frame, block, control, arrived):
         self.executed_if = self._condition(block, control)
@@ -402,22 +487,57 @@ class Flow:
             raise self._error(f"{control.keyword} takes one value", block, control)
         return [self.evaluate(a, block, control.item) for a in control.arguments]
 
+    def _number(self, item: Word | ExprWord, block: Block) -> float:
+        return item.value if type(item) is Word else self.evaluate(item.expr, block, item)
+
     def _error(self, message: str, block: Block, control: Control) -> NcppError:
         return NcppError(f"o{_shown(control.name)} {message}", Location(self.file, block.line, control.item.start + 1))
 
 
 def control_of(block: Block) -> Control | None:
-    """The block's o-word control line, if it is one (`O<name>` alone, a program name, is not)."""
+    """The block's control line, if it is one: an o-word (`O<name>` alone, a program
+    name, is not), or a line of only M98 P.. L.. or M99 (N and comments aside)."""
+    words: dict[str, Word | ExprWord] = {}
     for item in block.items:
-        if type(item) is Statement and item.kind == "oword" and len(item.node) >= 2:
+        kind = type(item)
+        if kind is Statement:
+            if item.kind != "oword" or len(item.node) < 2 or words:
+                return None
             head, rest = item.node[0], item.node[1:]
             if head.endswith("["):  # o[expr] keyword ...: the name is evaluated where the line runs
                 head, rest = rest[0], rest[1:]
                 return Control(head, rest[0].lower(), tuple(rest[1:]), item) if rest else None
             return Control(oword_name(head), rest[0].lower(), tuple(rest[1:]), item)
-        if type(item) is not Comment and not (type(item) is Word and item.letter == "N"):
+        if kind is Word or kind is ExprWord:
+            if item.letter not in "NMPL" or item.letter in words:  # (most lines end here, at their first word)
+                return None
+            words[item.letter] = item
+        elif kind is not Comment:
+            return None
+    words.pop("N", None)
+    m = words.get("M")
+    if m is None or type(m) is not Word:
+        return None
+    if m.value == 98.0 and "P" in words and words.keys() <= {"M", "P", "L"}:
+        return Control(None, "m98", (words["P"], words.get("L")), m)
+    if m.value == 99.0 and len(words) == 1:
+        return Control(None, "m99", (), m)
+    return None
+
+
+def program_number(block: Block) -> str | None:
+    """`n` of a line `O<n>` (a Fanuc program number, or a subprogram's start), else None."""
+    for item in block.items:
+        if type(item) is Word and item.letter == "O":
+            return str(int(round_half_away(item.value)))
+        if type(item) is not Comment:
             return None
     return None
+
+
+def _notable(block: Block) -> bool:
+    """A control line, or where a Fanuc subprogram may start."""
+    return control_of(block) is not None or program_number(block) is not None
 
 
 def oword_name(text: str) -> str:

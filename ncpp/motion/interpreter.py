@@ -13,10 +13,11 @@ control's tool table, `tools.py`; zero when it is not told), F and inverse time,
 P turns, parameters and expressions, Fanuc corner rounding and
 chamfering between two lines (`,R` `,C`, `G1 ... R`: a one-move look-ahead),
 the canned cycles G73 G74 G81-G87 G89 with G98/G99 (`cycles.py`), and
-o-word subroutines, branches and loops (`flow.py`); the moves of cycles,
-loops and subroutines are marked `fixed`: compensation leaves them as programmed.
+o-word subroutines, branches and loops and Fanuc M98/M99 subprograms
+(`flow.py`); the moves of cycles, loops and subroutines are marked `fixed`:
+compensation leaves them as programmed.
 Anything else (subroutine files, Fanuc macro
-control flow, M98/M99, G88 (a manual retract) and the lathe cycles, cutter compensation, splines,
+control flow, M99 in the main program, G88 (a manual retract) and the lathe cycles, cutter compensation, splines,
 threading, probing, polar words) makes the
 interpreter's state unknown: that block and every later block pass through
 as `Pass` after ONE warning (an error with `strict`).
@@ -176,6 +177,8 @@ class Interpreter:
         self.corner: tuple[str, float, Word | ExprWord] | None = None  # Fanuc ,R / ,C of the last block
         self.untold: set[int] = set()  # coordinate systems whose zero nobody said (warned when selected)
         self.warnings: Warnings | None = None
+        self.flow: Flow | None = None  # while `run` runs
+        self.subroutine_path = offsets.subroutine_path if offsets is not None else ()
         if offsets is not None:
             self._start_from(offsets)
 
@@ -200,7 +203,7 @@ class Interpreter:
         pending: Line | None = None  # the line whose end corner is rounded
         corner = None
         held: list[Event] = []  # non-moving events after it
-        flow = Flow(self.file, self._evaluate, self.params, lambda: self.done, self._leave_scope)
+        flow = self.flow = Flow(self.file, self._evaluate, self.params, lambda: self.done, self._leave_scope, self.subroutine_path)
         for block, kind, owner in flow.steps(blocks):
             if kind is not RUN and kind is not FIXED:  # text that does not run here
                 ev = Pass(block, kind is SKIP, None if self.done else self.motion)  # (after the end: no mode the control is in)
@@ -213,6 +216,11 @@ class Interpreter:
                 event = block_event(block)  # verbatim blocks (after the closing %) have no items
                 if kind is FIXED:
                     event = self._in_flow(event, owner)
+            except NcppError as err:
+                source = flow.source()
+                if source is None or err.where is None or err.where.file != self.file:
+                    raise
+                raise NcppError(f"{err.message} (in the subroutine line {owner.line} calls)", Location(source, err.where.line, err.where.col)) from None  # type: ignore[union-attr]
             except _OutOfScope as stop:
                 self._leave_scope(stop.reason, block, stop.col, owner)
                 if pending is not None:
@@ -254,17 +262,18 @@ class Interpreter:
         `owner`: the line that ran the block (a call, a loop's end), from which the rest passes."""
         self.done = True
         where = "this line" if owner is None else f"line {owner.line}, which runs it,"
+        source = self.flow.source() if self.flow is not None else None
         self.warnings.warn(  # type: ignore[union-attr]
             f"{reason} is outside the motion interpreter's scope; from {where} on the "
             "program passes through uninterpreted (its modal state is unknown)",
-            Location(self.file, block.line, col),
+            Location(source or self.file, block.line, col),
         )
 
     def _in_flow(self, event: Event | tuple[Event, ...], owner: Block | None) -> Event | tuple[Event, ...]:
         """A block's events inside a loop or a subroutine: its moves are left as programmed
         and, where it runs out of the text's order, belong to `owner` (its text is elsewhere)."""
         if self.corner is not None:
-            raise _OutOfScope("Fanuc corner rounding in an o-word loop or subroutine", None)
+            raise _OutOfScope("Fanuc corner rounding in a loop or subroutine", None)
         events = event if type(event) is tuple else (event,)
         out = []
         for ev in events:

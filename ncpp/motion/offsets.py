@@ -22,7 +22,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Mapping
+from typing import Mapping, Sequence
 
 from ncpp.errors import Location, NcppError
 from ncpp.motion.tools import ToolTable
@@ -45,8 +45,10 @@ def _system_x(number: int) -> int:
 class WorkOffsets:
     """The zeros the control holds: per coordinate system (1..9: G54..G59.3) its
     machine position in mm, None when ncpp is not told it; the system in effect at
-    the program's start; the G92 offset in effect; the G28 and G30 positions; and
-    its tool table (None: not told, G43 applies length 0)."""
+    the program's start; the G92 offset in effect; the G28 and G30 positions; its
+    tool table (None: not told, G43 applies length 0); and the folders it finds
+    subroutine files in (LinuxCNC's [RS274NGC]SUBROUTINE_PATH: `o<name> call` of a
+    subroutine the program does not define runs `name.ngc`)."""
 
     systems: tuple[Vector | None, ...] = (None,) * 9
     active: int = 1
@@ -54,6 +56,7 @@ class WorkOffsets:
     g28: Vector = (0.0, 0.0, 0.0)
     g30: Vector = (0.0, 0.0, 0.0)
     tools: ToolTable | None = None
+    subroutine_path: tuple[Path, ...] = ()
 
     @classmethod
     def of(cls, zeros: Mapping[str, Vector], active: str = "G54") -> "WorkOffsets":
@@ -82,14 +85,15 @@ class WorkOffsets:
 
     @classmethod
     def given(
-        cls, zeros: Mapping[str, Vector], var_file: str | Path | None = None, unit_mm: float = 1.0, tool_table: str | Path | None = None
+        cls, zeros: Mapping[str, Vector], var_file: str | Path | None = None, unit_mm: float = 1.0, tool_table: str | Path | None = None,
+        subroutine_path: Sequence[str | Path] = (),
     ) -> "WorkOffsets":
         """What a user says: a parameter file, if any (else G54 at the machine zero), with
-        `zeros` (G word -> machine mm) over it, and a tool table, if any (LinuxCNC's
-        files are both in the machine's units, `unit_mm`)."""
+        `zeros` (G word -> machine mm) over it, a tool table, if any (LinuxCNC's
+        files are both in the machine's units, `unit_mm`), and subroutine folders."""
         base = cls.from_var_file(var_file, unit_mm) if var_file else AT_MACHINE_ZERO
         tools = ToolTable.from_file(tool_table, unit_mm) if tool_table else None
-        return replace(base.with_zeros(zeros), tools=tools)
+        return replace(base.with_zeros(zeros), tools=tools, subroutine_path=tuple(Path(p) for p in subroutine_path))
 
     def with_zeros(self, zeros: Mapping[str, Vector]) -> "WorkOffsets":
         """These systems' zeros replaced (the command line over a parameter file)."""

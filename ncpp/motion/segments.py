@@ -26,7 +26,7 @@ from ncpp.program.blocks import Block
 Point = tuple[float, float, float]
 # Why a segment is `fixed`: passes leave it as programmed
 CYCLE = "canned cycle"  # a hole is drilled where the program puts it
-FLOW = "o-word loop or subroutine"  # one text runs many times (or out of the text's order)
+FLOW = "loop or subroutine"  # one text runs many times (or out of the text's order)
 # Axis letters of `Line.end` / `Arc.end` beyond XYZ, in rs274's order.
 EXTRA_AXES = ("A", "B", "C", "U", "V", "W")
 

@@ -46,6 +46,10 @@ AGREE = {
     "a call in a loop": HEAD + SQUARE + "#<k> = 0\no5 while [#<k> LT 3]\n o<square> call [#<k>*10] [0] [4]\n #<k> = [#<k> + 1]\no5 endwhile\nG0 X0 Y0\n",
     "o[expr] call": HEAD + "o100 sub\n G0 X7\no100 endsub\n#2 = 10\no[#2 * 10] call\n",
     "a loop in the main program after a subroutine definition": HEAD + "o9 sub\n G0 Z#1\no9 endsub\no8 repeat [2]\n o9 call [2]\n G1 X5\no8 endrepeat\n",
+    "fanuc subprogram, repeats": HEAD + "M98 P1 L3\nG0 X0\nM30\nO1\nG91 G1 X1 Y0.5\nG90\nM99\n",
+    "fanuc: a program number, P expression, L0": "O1000\n" + HEAD + "M98 P2000 L2\nM98 P[1000*2]\nM98 P2000 L0\nG0 X9\nM30\nO2000\nG91 G1 X1 F100\nG90\nM99\n",
+    "fanuc: nested, #1-#30 shared, names scoped": HEAD + "#1 = 3\n#<a> = 5\nM98 P10 L2\nG0 X#1 Y#<_bb>\nG0 Z#<a>\nM30\nO10\n#1 = [#1 + 1]\n#<_bb> = 7\nM98 P11\nM99\nO11\n#<a> = 1\nG0 X#1 Y#<a>\nM99\n",
+    "fanuc: the first of two definitions": HEAD + "M98 P0002\nM30\nO0002\nG0 X1\nM99\nO2\nG0 X2\nM99\n",
     "modes a subroutine leaves": HEAD + "o1 sub\n G91 G1 X1\n G18\no1 endsub\nG1 X5 Y5\no1 call\nX1 Z1\nG2 X2 Z0 I1 K0\nG90\n",
 }
 
@@ -53,6 +57,7 @@ REFUSED = {
     "a subroutine's name is not the caller's": (HEAD + "#<m> = 7\no1 sub\n G0 X#<m>\no1 endsub\no1 call\n", 5),
     "break out of a repeat": (HEAD + "o1 repeat [2]\n G0 X1\n o1 break\no1 endrepeat\n", 5),
     "continue in an if": (HEAD + "o1 if [1]\n o1 continue\no1 endif\n", 4),
+    "an o-word subroutine ended by M99": (HEAD + "o1 sub\nG0 X1\nM99\no1 endsub\no1 call\n", 5),
     "endwhile outside a loop": (HEAD + "G0 X1\no1 endwhile\n", 4),
 }
 
@@ -152,6 +157,19 @@ def test_memory_stays_flat_around_loops_and_calls():
     assert max(seen) <= 3 * _TRIM
 
 
+def test_a_programs_own_number_holds_no_memory():
+    """`O1000` at the top of a long program starts no subprogram for ever: kept up to MAX_SUBPROGRAM blocks."""
+    from ncpp.motion.flow import MAX_SUBPROGRAM
+
+    body = "".join(f"G1 X{i % 50} Y{i % 7}\n" for i in range(MAX_SUBPROGRAM + 5000))
+    flow = Flow("t", lambda e, b, i: 0.0, _Params(), lambda: False, None)
+    steps = flow.steps(parse_stream(io.BytesIO(("O1000\n" + HEAD + body).encode()), "t.ngc"))
+    for n, _ in enumerate(steps):
+        if n == MAX_SUBPROGRAM + 100:
+            break
+    assert flow._defining is None and len(flow.buffer) <= 3 * _TRIM and not flow.subprograms
+
+
 class _Params:
     def enter(self, arguments):
         pass
@@ -225,6 +243,70 @@ def test_random_flow_programs_agree_with_rs274(tmp_path):
     assert moves > 200
 
 
+# -- subroutine files ----------------------------------------------------------------------------
+def _library(tmp_path):
+    folder = tmp_path / "subs"
+    folder.mkdir()
+    (folder / "square.ngc").write_text("(a square)\n" + SQUARE.replace("o<square> endsub", "o<mark> call [#1]\no<square> endsub") + "M2\n")
+    (folder / "mark.ngc").write_text("o<mark> sub\n G0 Z[#1 / 10]\n G0 Z10\no<mark> endsub\n")
+    (folder / "bad.ngc").write_text("o<bad> sub\n G1 X#<nope>\no<bad> endsub\n")
+    ini = tmp_path / "machine.ini"
+    ini.write_text("[RS274NGC]\nSUBROUTINE_PATH = subs\n")
+    return folder, ini
+
+
+@pytest.mark.skipif(not RS274.exists(), reason="no rs274")
+def test_subroutine_files_move_as_rs274_does(tmp_path):
+    import subprocess
+
+    from ncpp.motion.offsets import WorkOffsets
+
+    folder, ini = _library(tmp_path)
+    path = _program(tmp_path, HEAD + "o<square> call [1] [2] [5]\nG0 X0 Y0\no<square> call [10] [10] [2]\n")
+    proc = subprocess.run([str(RS274), "-i", str(ini), str(path)], capture_output=True, text=True, cwd=tmp_path)
+    reference = read_canon(proc.stdout)
+    assert rs274_error(proc.stderr) is None and len(reference) == 16, proc.stderr
+    events = interpret(parse_stream(open(path, "rb"), str(path)), file=str(path), offsets=WorkOffsets.given({}, subroutine_path=[folder]))
+    from ncpp.motion.canon import canon_call
+
+    mine = [c for c in map(canon_call, events) if c is not None]
+    assert len(mine) == len(reference)
+    for want, got in zip(reference, mine):
+        assert want.name == got.name and all(abs(a - b) <= 1e-4 for a, b in zip(want.args, got.args)), (want, got)
+
+
+def test_an_error_in_a_subroutine_file_names_that_file(tmp_path):
+    from ncpp.motion.offsets import WorkOffsets
+
+    folder, _ = _library(tmp_path)
+    with pytest.raises(NcppError) as err:
+        _events(HEAD + "o<bad> call\n", offsets=WorkOffsets.given({}, subroutine_path=[folder]))
+    assert str(err.value) == f"{folder / 'bad.ngc'}:2:5: Named parameter #<nope> not defined (in the subroutine line 3 calls)"
+
+
+def test_the_linuxcnc_ini_names_the_subroutine_folders(tmp_path):
+    from ncpp.integrations.config import Settings, with_linuxcnc_ini
+
+    folder, ini = _library(tmp_path)
+    settings = with_linuxcnc_ini(Settings(), ini)
+    assert settings.offsets().subroutine_path == (folder.resolve(),)
+
+
+def test_compensate_with_a_subroutine_path(tmp_path):
+    import subprocess
+    import sys
+
+    folder, _ = _library(tmp_path)
+    path = tmp_path / "part.ngc"
+    path.write_text(HEAD + "G1 Z-1\nG1 X40 Y12\no<square> call [1] [2] [5]\nG1 X50 Y50\nM2\n")
+    command = [sys.executable, "-m", "ncpp", "compensate", "--machine", str(ROOT / "samples/machines/hr5b.toml"), "--work-offset", "400,350,350", str(path)]
+    without = subprocess.run(command, capture_output=True, text=True)
+    assert "give its folder with --subroutine-path" in without.stderr and without.stdout.endswith("o<square> call [1] [2] [5]\nG1 X50 Y50\nM2\n")
+    found = subprocess.run(command + ["--subroutine-path", str(folder)], capture_output=True, text=True)
+    assert found.returncode == 0 and "part.ngc:5:1: warning: loop or subroutine" in found.stderr, found.stderr
+    assert "\nG1 X50 Y50\n" not in found.stdout and "X50.0" in found.stdout  # compensated after the call
+
+
 # -- compensation ---------------------------------------------------------------------------------
 @pytest.fixture(scope="module")
 def hr5b():
@@ -257,18 +339,30 @@ def test_subroutines_and_loops_pass_through_and_compensation_resumes(hr5b):
     assert after[1].startswith("X50.0") and "Z" in after[1]  # compensated, every axis said after the loop
     assert any(line.startswith("G3 ") and "I" in line for line in after)
     # one warning: the subroutine's moves and the loop's make one series
-    assert warned.count("warning") == 1 and "flow.ngc:12:1: warning: o-word loop or subroutine" in warned
+    assert warned.count("warning") == 1 and "flow.ngc:12:1: warning: loop or subroutine" in warned
 
 
 def test_strict_refuses_subroutine_moves(hr5b):
-    with pytest.raises(NcppError, match="flow.ngc:12:1: o-word loop or subroutine"):
+    with pytest.raises(NcppError, match="flow.ngc:12:1: loop or subroutine"):
         _compensate(POCKET, hr5b, strict=True)
+
+
+FANUC = "O1000\n" + HEAD + "G1 Z-1\nG1 X40 Y12\nM98 P2000 L3\nG1 X50 Y50\nG0 Z10\nM30\nO2000\nG1 X[#<_x> + 2] Y[#<_y> + 1]\nM99\n"
+
+
+def test_fanuc_subprograms_pass_through_and_compensation_resumes(hr5b):
+    out, warned = _compensate(FANUC, hr5b)
+    lines = out.splitlines()
+    call = lines.index("M98 P2000 L3")
+    assert lines[call - 1].startswith("X40.0") and lines[call + 1].startswith("G1 X")  # compensated around it
+    assert lines[-4:] == FANUC.splitlines()[-4:]  # after M30: the subprogram, verbatim
+    assert "flow.ngc:6:1: warning: loop or subroutine" in warned
 
 
 def test_a_subroutine_in_g91_ends_compensation(hr5b):
     text = HEAD + "o1 sub\n G91 G1 X1\n G90\no1 endsub\nG1 X40 Y12\no1 call\nG1 X50\n"
     out, warned = _compensate(text, hr5b)
-    assert "flow.ngc:8:1: warning: an o-word loop or subroutine in G91" in warned
+    assert "flow.ngc:8:1: warning: a loop or subroutine in G91" in warned
     assert out.splitlines()[-2:] == ["o1 call", "G1 X50"]
 
 

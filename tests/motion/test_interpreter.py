@@ -215,9 +215,9 @@ def test_arc_radius_tolerance_matches_linuxcnc_files():
 @pytest.mark.parametrize(
     "text, construct",
     [
-        ("o<probe> call\n", "o<probe>, which the program does not define (a subroutine file)"),
+        ("o<probe> call\n", "o<probe>, which the program does not define (a subroutine file"),
         ("IF [#1 EQ 1] GOTO 10\n", "Fanuc macro IF"),
-        ("M98 P100\n", "M98 subprogram call"),
+        ("M98 P100\n", "M98 P100: a subprogram the program does not define"),
         ("G88 X0 Y0 Z-1 R1 P1 F10\n", "canned cycle G88"),  # a manual retract: the other cycles are interpreted
         ("G41 D1 G1 X1 F1\n", "cutter compensation G41"),
         ("G0 @10 ^45\n", "polar coordinates"),

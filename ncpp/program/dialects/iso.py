@@ -487,7 +487,7 @@ class _Facts:
         self.word_letters: list[str] = []  # the letters of its plain words, in order
         self.motion_at: tuple[int, str] | None = None  # (n, number as written) of its first G0-G3 word, the n-th word
         self.machine = False  # it moves in machine coordinates (G53)
-        self.flow = False  # an o-word control line (not `O<name>` alone, a program's name)
+        self.flow = False  # a control line: an o-word (not `O<name>` alone, a program's name), M98, M99
         for item in block.items if block is not None else ():
             kind = type(item)
             if kind is Word:
@@ -513,6 +513,8 @@ class _Facts:
         self.absent_axes = tuple((n, axis, _BIT[axis]) for n, axis in _NUMBERED_AXES if axis not in self.letters)
 
     def _read_word(self, letter: str, value: float, number: str) -> None:
+        if letter == "M" and (value == 98.0 or value == 99.0):
+            self.flow = True
         self.letters.add(letter)
         self.word_letters.append(letter)
         if letter in STYLED_LETTERS:
