@@ -45,6 +45,9 @@ _TRIM = 4096  # blocks no loop can go back to are dropped in runs of this many
 # Blocks after an `O<n>` line kept as Fanuc subprogram `n` until its M99: a longer one is a
 # program's own number (`O1000` at its top), not a subprogram, and memory stays bounded.
 MAX_SUBPROGRAM = 20_000
+# Lines run (or skipped) out of the text's order, loop iterations and calls, before a program
+# counts as one that never ends (LinuxCNC would run it for ever; a pass over it must end): ~1 minute
+MAX_RERUN = 5_000_000
 
 
 @dataclass(frozen=True, slots=True)
@@ -73,6 +76,7 @@ class _Frame:
     space: list[Block] | None
     pc: int  # the next block to run: an index into the space (the main program: a line number from 0)
     labels: dict[str, _Label] = field(default_factory=dict)  # its loops under way
+    ifs: set[str] = field(default_factory=set)  # the if chains it has started (their elseif, else and endif may follow)
     repeats: int = 0  # a Fanuc subprogram (M98): the runs still to make after this one; -1: an o-word call
     source: str | None = None  # the subroutine file its lines are from (None: the program's)
 
@@ -106,6 +110,10 @@ class Flow:
         self.skipping: str | None = None  # the o-word the lines up to its next line are skipped for
         self.executed_if = False  # a branch of the if chain under way has run
         self.doing_break = self.doing_continue = False
+        self.rerun = 0  # blocks run out of the text's order so far
+        # Control lines of the blocks held (a loop goes over them again and again), by id: an
+        # entry leaves with its block (`_drop`), so an id is never that of another block
+        self._controls: dict[int, Control | None] = {}
 
     # -- the stream ------------------------------------------------------------
     def steps(self, blocks: Iterable[Block]) -> Iterator[tuple[Block, str, Block | None]]:
@@ -117,7 +125,7 @@ class Flow:
             frame = self.frames[-1]
             if frame is main and main.pc == self.read and not main.labels and self.skipping is None and self._defining is None:
                 # the common case, nothing read ahead and no loop to go back to: straight from the stream
-                self.buffer.clear()
+                self._drop(len(self.buffer))
                 for block in self.stream:
                     signature = block.signature
                     if (signature is None or "M" in signature or "O" in signature) and _notable(block):
@@ -137,7 +145,12 @@ class Flow:
                 if frame.space is not None:  # skipped past its endsub
                     raise NcppError(f"o{_shown(self.skipping or '')} is not closed in its subroutine", Location(self.file, frame.space[-1].line, None))
                 return  # LinuxCNC too ends a program whose file ends, in a loop or skipping
-            control = control_of(block)
+            if not self._in_place(frame):
+                self.rerun += 1
+                if self.rerun > MAX_RERUN:
+                    self.stop(f"a loop that does not end ({MAX_RERUN:,} lines run again)", self.owner, None)
+                    break
+            control = self._control_of(block)
             if self.skipping is not None and (control is None or control.name != self.skipping):  # (M98, M99: None)
                 if self._in_place(frame):
                     yield block, SKIP, None
@@ -169,8 +182,22 @@ class Flow:
         if len(self.buffer) > 2 * _TRIM and not self.frames[0].labels:
             keep = self.written - self.base  # nothing before the next block is read again
             if keep > _TRIM:
-                del self.buffer[:keep]
-                self.base += keep
+                self._drop(keep)
+
+    def _drop(self, n: int) -> None:
+        """The first `n` blocks of the buffer, no longer wanted."""
+        for block in self.buffer[:n]:
+            self._controls.pop(id(block), None)
+        del self.buffer[:n]
+        self.base += n
+
+    def _control_of(self, block: Block) -> Control | None:
+        key = id(block)
+        try:
+            return self._controls[key]
+        except KeyError:
+            found = self._controls[key] = control_of(block)
+            return found
 
     def _rest(self) -> Iterator[tuple[Block, str, Block | None]]:
         """After the program's end: every block not yet written, as text."""
@@ -202,7 +229,7 @@ class Flow:
         """A main-program block read: in the buffer, and in the definition being read."""
         self.buffer.append(block)
         self.read += 1
-        control = control_of(block)
+        control = self._control_of(block)
         number = program_number(block) if control is None else None
         if self._defining is not None:
             found, name, lines = self._defining
@@ -310,9 +337,12 @@ class Flow:
 
         def call():
             frame.pc += 1
-            if runs > 0:  # L0: no run
-                self.parameters.enter(None)
+            self.parameters.enter(None)
+            if runs > 0:
                 self.frames.append(_Frame(body, 1, repeats=runs - 1))
+            else:  # L0: rs274ngc runs nothing but stays a call level deeper: the caller's names, loops and ifs are gone
+                frame.labels.clear()
+                frame.ifs.clear()
 
         return call
 
@@ -342,24 +372,32 @@ class Flow:
         return found[name]
 
     def _if(self, frame, block, control, arrived):
+        frame.ifs.add(control.name)
         self.executed_if = self._condition(block, control)
         return self._on(frame, None if self.executed_if else control.name)
 
     def _elseif(self, frame, block, control, arrived):
+        self._started(frame, block, control)
         if not self.executed_if and self._condition(block, control):
             self.executed_if = True
             return self._on(frame, None)
         return self._on(frame, control.name)
 
     def _else(self, frame, block, control, arrived):
+        self._started(frame, block, control)
         if self.executed_if:
             return self._on(frame, control.name)
         self.executed_if = True  # (reached running, not skipping, only from a chain it did not see start)
         return self._on(frame, None)
 
     def _endif(self, frame, block, control, arrived):
+        self._started(frame, block, control)
         self.executed_if = True  # the chain around this one ran, or this line would be skipped
         return self._on(frame, None)
+
+    def _started(self, frame: _Frame, block: Block, control: Control) -> None:
+        if control.name not in frame.ifs:
+            raise self._error(f"{control.keyword} without o{_shown(control.name)} if", block, control)
 
     def _while(self, frame, block, control, arrived):
         label = frame.labels.get(control.name)
@@ -386,9 +424,10 @@ class Flow:
     def _loop_end(self, frame, block, control, arrived, kind):
         """Back to the loop's opening line, or, skipping to here (a false test, a `break`), past it."""
         label = self._label(frame, block, control, (kind,))
-        if arrived and not self.doing_continue:
-            return self._ended(frame, control.name)
-        self.doing_continue = False
+        if arrived:
+            if not self.doing_continue:
+                return self._ended(frame, control.name)
+            self.doing_continue = False  # (only here: a `continue` in a do loop leaves it set)
         return lambda: setattr(frame, "pc", label.start)
 
     def _do(self, frame, block, control, arrived):
@@ -450,7 +489,7 @@ class Flow:
             block = self._block(frame, frame.pc)
             if block is None:
                 raise NcppError(f"o{_shown(name)} sub has no o{_shown(name)} endsub", Location(self.file, self._opening_line(frame), None))
-            control = control_of(block)
+            control = self._control_of(block)
             if self._in_place(frame):
                 yield block, SKIP, None
                 self._wrote(frame.pc)

@@ -47,8 +47,9 @@ AGREE = {
     "o[expr] call": HEAD + "o100 sub\n G0 X7\no100 endsub\n#2 = 10\no[#2 * 10] call\n",
     "a loop in the main program after a subroutine definition": HEAD + "o9 sub\n G0 Z#1\no9 endsub\no8 repeat [2]\n o9 call [2]\n G1 X5\no8 endrepeat\n",
     "fanuc subprogram, repeats": HEAD + "M98 P1 L3\nG0 X0\nM30\nO1\nG91 G1 X1 Y0.5\nG90\nM99\n",
-    "fanuc: a program number, P expression, L0": "O1000\n" + HEAD + "M98 P2000 L2\nM98 P[1000*2]\nM98 P2000 L0\nG0 X9\nM30\nO2000\nG91 G1 X1 F100\nG90\nM99\n",
+    "fanuc: a program number, P expression": "O1000\n" + HEAD + "M98 P2000 L2\nM98 P[1000*2]\nG0 X9\nM30\nO2000\nG91 G1 X1 F100\nG90\nM99\n",
     "fanuc: nested, #1-#30 shared, names scoped": HEAD + "#1 = 3\n#<a> = 5\nM98 P10 L2\nG0 X#1 Y#<_bb>\nG0 Z#<a>\nM30\nO10\n#1 = [#1 + 1]\n#<_bb> = 7\nM98 P11\nM99\nO11\n#<a> = 1\nG0 X#1 Y#<a>\nM99\n",
+    "fanuc: L0 runs nothing": HEAD + "#1 = 1\nM98 P9 L0\nG0 X#1\nM30\nO9\nG0 Y1\nM99\n",
     "fanuc: the first of two definitions": HEAD + "M98 P0002\nM30\nO0002\nG0 X1\nM99\nO2\nG0 X2\nM99\n",
     "modes a subroutine leaves": HEAD + "o1 sub\n G91 G1 X1\n G18\no1 endsub\nG1 X5 Y5\no1 call\nX1 Z1\nG2 X2 Z0 I1 K0\nG90\n",
 }
@@ -58,6 +59,8 @@ REFUSED = {
     "break out of a repeat": (HEAD + "o1 repeat [2]\n G0 X1\n o1 break\no1 endrepeat\n", 5),
     "continue in an if": (HEAD + "o1 if [1]\n o1 continue\no1 endif\n", 4),
     "an o-word subroutine ended by M99": (HEAD + "o1 sub\nG0 X1\nM99\no1 endsub\no1 call\n", 5),
+    "M98 L0 (rs274ngc stays a call level deeper): the caller's names": (HEAD + "#<a> = 1\nM98 P9 L0\nG0 X#<a>\nM30\nO9\nG0 Y1\nM99\n", 5),
+    "M98 L0: the caller's loops": (HEAD + "#1 = 0\no1 while [#1 LT 2]\n#1 = [#1 + 1]\nM98 P9 L0\no1 endwhile\nM30\nO9\nG0 Y1\nM99\n", 7),
     "endwhile outside a loop": (HEAD + "G0 X1\no1 endwhile\n", 4),
 }
 
@@ -143,6 +146,17 @@ def test_out_of_scope_inside_a_subroutine_names_the_call():
     assert "t.ngc:4:" in warned.getvalue() and "from line 7, which runs it," in warned.getvalue()
     assert [e.block.line for e in events if type(e) is Line] == [2, 6]
     assert "".join(e.block.text for e in events if type(e) is not Line).count("o1 call") == 1
+
+
+def test_a_loop_that_does_not_end_ends_interpretation(monkeypatch):
+    """LinuxCNC would run it for ever; a pass over the program must end."""
+    import ncpp.motion.flow as flow
+
+    monkeypatch.setattr(flow, "MAX_RERUN", 1000)
+    warned = io.StringIO()
+    events = _events(HEAD + "o1 while [1]\n G0 X1\n G0 X2\no1 endwhile\nG0 Y5\n", warnings=Warnings(stream=warned))
+    assert "t.ngc:6: warning: a loop that does not end (1,000 lines run again)" in warned.getvalue()
+    assert events[-1].block.text == "G0 Y5\n" and type(events[-1]) is Pass
 
 
 def test_memory_stays_flat_around_loops_and_calls():
