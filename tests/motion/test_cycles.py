@@ -19,7 +19,7 @@ from ncpp.motion.segments import CYCLE, Line
 from ncpp.pipeline import ErrorSource, process
 from ncpp.program.parser import parse_stream
 from tests.conftest import RS274, ROOT
-from tests.motion.test_oracle import ours, read_canon, rs274, rs274_error
+from tests.motion.test_oracle import assert_agrees_with_rs274, assert_refused_like_rs274, ours, read_canon, rs274, rs274_error, same_calls, write_program
 
 HEAD = "G21 G90 G17 G54\nG0 X0 Y0 Z10 F200\n"
 
@@ -73,34 +73,15 @@ REFUSED = {
 }
 
 
-def _program(tmp_path, text: str):
-    path = tmp_path / "cycle.ngc"
-    path.write_text(text + ("" if text.rstrip().endswith("M2") else "M2\n"))
-    return path
-
-
 @pytest.mark.parametrize("name", AGREE)
 def test_cycles_move_as_rs274_does(tmp_path, name):
-    path = _program(tmp_path, AGREE[name])
-    calls, messages = rs274(str(path))
-    reference = read_canon(calls)
-    assert rs274_error(messages) is None, messages
-    mine, error, warning = ours(path)
-    assert error is None and not warning, (error, warning)
-    assert len(mine) == len(reference)
-    for want, got in zip(reference, mine):
-        assert want.name == got.name and all(abs(a - b) <= 1e-4 for a, b in zip(want.args, got.args)), (want, got)
+    assert_agrees_with_rs274(write_program(tmp_path, AGREE[name], "cycle.ngc"))
 
 
 @pytest.mark.parametrize("name", REFUSED)
 def test_cycles_refused_where_rs274_refuses(tmp_path, name):
     text, line = REFUSED[name]
-    path = _program(tmp_path, text)
-    _, messages = rs274(str(path))
-    refused = rs274_error(messages)
-    assert refused is not None and refused[1].strip() == text.splitlines()[line - 1].strip(), messages
-    _, error, _ = ours(path)
-    assert error is not None and error.where.line == line, error
+    assert_refused_like_rs274(write_program(tmp_path, text, "cycle.ngc"), line)
 
 
 @pytest.mark.parametrize("name", OUT_OF_SCOPE)
@@ -145,8 +126,7 @@ def test_random_cycle_programs_agree_with_rs274(tmp_path):
         calls, messages = rs274(str(path))
         reference, refused = read_canon(calls), rs274_error(messages)
         mine, error, warning = ours(path)
-        for want, got in zip(reference, mine):
-            assert want.name == got.name and all(abs(a - b) <= 1e-4 for a, b in zip(want.args, got.args)), (text, want, got)
+        assert same_calls(reference, mine), text
         if warning:
             continue
         if refused is None:

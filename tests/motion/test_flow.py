@@ -21,7 +21,7 @@ from ncpp.motion.segments import FLOW, Arc, Line, Pass
 from ncpp.pipeline import ErrorSource, process
 from ncpp.program.parser import parse_stream
 from tests.conftest import ROOT, RS274
-from tests.motion.test_oracle import ours, read_canon, rs274, rs274_error
+from tests.motion.test_oracle import assert_agrees_with_rs274, assert_refused_like_rs274, ours, read_canon, rs274, rs274_error, same_calls, write_program
 
 HEAD = "G21 G90 G17\nG0 X0 Y0 Z10 F200\n"
 SQUARE = "o<square> sub\n  G1 X#1 Y#2\n  G1 X[#1+#3]\n  G1 Y[#2+#3]\n  G1 X#1\n  G1 Y#2\no<square> endsub\n"
@@ -66,9 +66,7 @@ REFUSED = {
 
 
 def _program(tmp_path, text: str, name: str = "flow.ngc"):
-    path = tmp_path / name
-    path.write_text(text + ("" if text.rstrip().endswith("M2") else "M2\n"))
-    return path
+    return write_program(tmp_path, text, name)
 
 
 def _events(text: str, **kwargs) -> list:
@@ -77,26 +75,13 @@ def _events(text: str, **kwargs) -> list:
 
 @pytest.mark.parametrize("name", AGREE)
 def test_flow_moves_as_rs274_does(tmp_path, name):
-    path = _program(tmp_path, AGREE[name])
-    calls, messages = rs274(str(path))
-    reference = read_canon(calls)
-    assert rs274_error(messages) is None, messages
-    mine, error, warning = ours(path)
-    assert error is None and not warning, (error, warning)
-    assert len(mine) == len(reference) > 0
-    for want, got in zip(reference, mine):
-        assert want.name == got.name and all(abs(a - b) <= 1e-4 for a, b in zip(want.args, got.args)), (want, got)
+    assert assert_agrees_with_rs274(_program(tmp_path, AGREE[name]))
 
 
 @pytest.mark.parametrize("name", REFUSED)
 def test_flow_refused_where_rs274_refuses(tmp_path, name):
     text, line = REFUSED[name]
-    path = _program(tmp_path, text)
-    _, messages = rs274(str(path))
-    refused = rs274_error(messages)
-    assert refused is not None and refused[1].strip() == text.splitlines()[line - 1].strip(), messages
-    _, error, _ = ours(path)
-    assert error is not None and error.where.line == line, error
+    assert_refused_like_rs274(_program(tmp_path, text), line)
 
 
 @pytest.mark.parametrize("name", AGREE)
@@ -212,7 +197,7 @@ def _random_program(rng: random.Random) -> str:
                 out.append(f"#<_n> = [#<_n> + {rng.randint(1, 3)}]")
             elif kind == "call" and subs:
                 out.append(f"{rng.choice(subs)} call [{rng.randint(0, 6)}] [#<_n>]")
-                out.append(f"G0 Y#<_value>")
+                out.append("G0 Y#<_value>")
             elif kind == "if":
                 n = next(label)
                 out += [f"o{n} if [[#<_n> MOD 3] EQ {rng.randint(0, 2)}]", *statements(depth + 1)]
@@ -250,9 +235,7 @@ def test_random_flow_programs_agree_with_rs274(tmp_path):
         reference = read_canon(calls)
         assert rs274_error(messages) is None, (text, messages)
         mine, error, warning = ours(path)
-        assert error is None and not warning and len(mine) == len(reference), (text, error, warning)
-        for want, got in zip(reference, mine):
-            assert want.name == got.name and all(abs(a - b) <= 1e-4 for a, b in zip(want.args, got.args)), (text, want, got)
+        assert error is None and not warning and len(mine) == len(reference) and same_calls(reference, mine), (text, error, warning)
         moves += len(mine)
     assert moves > 200
 
@@ -284,9 +267,7 @@ def test_subroutine_files_move_as_rs274_does(tmp_path):
     from ncpp.motion.canon import canon_call
 
     mine = [c for c in map(canon_call, events) if c is not None]
-    assert len(mine) == len(reference)
-    for want, got in zip(reference, mine):
-        assert want.name == got.name and all(abs(a - b) <= 1e-4 for a, b in zip(want.args, got.args)), (want, got)
+    assert len(mine) == len(reference) and same_calls(reference, mine)
 
 
 def test_an_error_in_a_subroutine_file_names_that_file(tmp_path):

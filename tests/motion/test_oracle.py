@@ -108,6 +108,39 @@ def ours(path) -> tuple[list[CanonCall], NcppError | None, str]:
     return calls, error, stream.getvalue()
 
 
+def write_program(folder, text: str, name: str = "program.ngc"):
+    """A program file for rs274 (ending with M2 unless it does)."""
+    path = folder / name
+    path.write_text(text + ("" if text.rstrip().endswith("M2") else "M2\n"))
+    return path
+
+
+def same_calls(reference: list[CanonCall], mine: list[CanonCall]) -> bool:
+    """The calls they have in common agree (names, and arguments within TOLERANCE)."""
+    return all(want.name == got.name and all(abs(a - b) <= TOLERANCE for a, b in zip(want.args, got.args)) for want, got in zip(reference, mine))
+
+
+def assert_agrees_with_rs274(path) -> list[CanonCall]:
+    """rs274 accepts the program; ncpp reads it without error or warning, the same moves."""
+    calls, messages = rs274(str(path))
+    assert rs274_error(messages) is None, messages
+    reference = read_canon(calls)
+    mine, error, warning = ours(path)
+    assert error is None and not warning, (error, warning)
+    assert len(mine) == len(reference) and same_calls(reference, mine), (reference, mine)
+    return mine
+
+
+def assert_refused_like_rs274(path, line: int) -> None:
+    """rs274 and ncpp both refuse the program, on line `line`."""
+    _, messages = rs274(str(path))
+    refused = rs274_error(messages)
+    text = path.read_text().splitlines()
+    assert refused is not None and refused[1].strip() == text[line - 1].strip(), messages
+    _, error, _ = ours(path)
+    assert error is not None and error.where.line == line, error
+
+
 def assert_same_moves(path, reference: list[CanonCall], mine: list[CanonCall]) -> None:
     for index, (want, got) in enumerate(zip(reference, mine)):
         same = want.name == got.name and all(abs(a - b) <= TOLERANCE for a, b in zip(want.args, got.args))
