@@ -16,9 +16,9 @@ import pytest
 from ncpp.errors import NcppError, Warnings
 from ncpp.motion import interpret
 from ncpp.motion.segments import CYCLE, Line
-from ncpp.pipeline import ErrorSource, process
 from ncpp.program.parser import parse_stream
-from tests.conftest import RS274, ROOT
+from tests.conftest import RS274
+from tests.motion.compensating import compensate
 from tests.motion.test_oracle import assert_agrees_with_rs274, assert_refused_like_rs274, ours, read_canon, rs274, rs274_error, same_calls, write_program
 
 HEAD = "G21 G90 G17 G54\nG0 X0 Y0 Z10 F200\n"
@@ -143,25 +143,15 @@ def test_cycle_moves_are_fixed():
     assert [e.fixed for e in lines] == ["", CYCLE, CYCLE, CYCLE, CYCLE, ""]
 
 
-@pytest.fixture(scope="module")
-def hr5b():
-    return ErrorSource.from_machine_file(str(ROOT / "samples/machines/hr5b.toml"))
-
-
-def _compensate(text: str, source, strict: bool = False) -> tuple[str, str]:
-    from ncpp.motion.offsets import WorkOffsets
-
-    warned, out = io.StringIO(), io.BytesIO()
-    process(io.BytesIO(text.encode()), out, file="drill.ngc", source=source, warnings=Warnings(stream=warned, strict=strict),
-            offsets=WorkOffsets.at((400.0, 350.0, 350.0)))  # fmt: skip
-    return out.getvalue().decode(), warned.getvalue()
+def _compensate(text: str, strict: bool = False) -> tuple[str, str]:
+    return compensate(text, "drill.ngc", strict)
 
 
 DRILL = HEAD + "G1 Z-1\nX40 Y12\nG0 Z5\nG98 G81 X20 Y20 Z-3 R2\nX30\n(between)\nX40 Y25\nG80\nG0 X50 Y50\nG1 Z-1\nX70 Y40\nG3 X80 Y60 R15\nG0 Z10\nM2\n"
 
 
-def test_cycles_pass_through_and_compensation_resumes(hr5b):
-    out, warned = _compensate(DRILL, hr5b)
+def test_cycles_pass_through_and_compensation_resumes():
+    out, warned = _compensate(DRILL)
     lines = out.splitlines()
     cycle = ["G98 G81 X20 Y20 Z-3 R2", "X30", "(between)", "X40 Y25", "G80"]
     start = lines.index(cycle[0])
@@ -184,9 +174,9 @@ def test_the_block_after_a_cycle_says_every_axis():
     assert list(IsoWriter().write(events))[-1] == "G1 X5.0000 Y1.0000 Z2.0000\n"
 
 
-def test_strict_refuses_cycles(hr5b):
+def test_strict_refuses_cycles():
     with pytest.raises(NcppError, match="drill.ngc:6:1: canned cycle"):
-        _compensate(DRILL, hr5b, strict=True)
+        _compensate(DRILL, strict=True)
 
 
 @pytest.mark.parametrize(
@@ -196,19 +186,19 @@ def test_strict_refuses_cycles(hr5b):
         (HEAD + "G1 Z-1\nX40 Y12\nG0 Z5\nG98 G81 X20 Y20 Z-3 R2\nG80\nG91 G1 X5\nX5 Y5\n", 8),  # G91 after a G98 retract
     ],
 )
-def test_incremental_cycles_end_compensation(hr5b, text, line):
-    out, warned = _compensate(text, hr5b)
+def test_incremental_cycles_end_compensation(text, line):
+    out, warned = _compensate(text)
     assert f"drill.ngc:{line}:1: warning: a canned cycle in G91" in warned
     original, written = text.splitlines(), out.splitlines()
     assert written[-(len(original) - line + 1) :] == original[line - 1 :]  # the rest verbatim
     assert written[3] != original[2]  # compensated before it
     with pytest.raises(NcppError, match="drill.ngc:6:1: .*canned cycle"):
-        _compensate(text, hr5b, strict=True)
+        _compensate(text, strict=True)
 
 
 @pytest.mark.skipif(not RS274.exists(), reason="no rs274")
-def test_rs274_accepts_the_compensated_cycles(tmp_path, hr5b):
-    out, _ = _compensate(DRILL, hr5b)
+def test_rs274_accepts_the_compensated_cycles(tmp_path):
+    out, _ = _compensate(DRILL)
     path = tmp_path / "out.ngc"
     path.write_text(out)
     _, messages = rs274(str(path))

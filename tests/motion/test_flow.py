@@ -18,9 +18,9 @@ from ncpp.errors import NcppError, Warnings
 from ncpp.motion import interpret
 from ncpp.motion.flow import _TRIM, Flow
 from ncpp.motion.segments import FLOW, Arc, Line, Pass
-from ncpp.pipeline import ErrorSource, process
 from ncpp.program.parser import parse_stream
 from tests.conftest import ROOT, RS274
+from tests.motion.compensating import compensate
 from tests.motion.test_oracle import assert_agrees_with_rs274, assert_refused_like_rs274, ours, read_canon, rs274, rs274_error, same_calls, write_program
 
 HEAD = "G21 G90 G17\nG0 X0 Y0 Z10 F200\n"
@@ -303,25 +303,15 @@ def test_compensate_with_a_subroutine_path(tmp_path):
 
 
 # -- compensation ---------------------------------------------------------------------------------
-@pytest.fixture(scope="module")
-def hr5b():
-    return ErrorSource.from_machine_file(str(ROOT / "samples/machines/hr5b.toml"))
-
-
-def _compensate(text: str, source, strict: bool = False) -> tuple[str, str]:
-    from ncpp.motion.offsets import WorkOffsets
-
-    warned, out = io.StringIO(), io.BytesIO()
-    process(io.BytesIO(text.encode()), out, file="flow.ngc", source=source, warnings=Warnings(stream=warned, strict=strict),
-            offsets=WorkOffsets.at((400.0, 350.0, 350.0)))  # fmt: skip
-    return out.getvalue().decode(), warned.getvalue()
+def _compensate(text: str, strict: bool = False) -> tuple[str, str]:
+    return compensate(text, "flow.ngc", strict)
 
 
 POCKET = HEAD + SQUARE + "G1 Z-1\nG1 X40 Y12\no<square> call [1] [2] [5]\n#1 = 0\no7 while [#1 LT 2]\n G1 X[20+#1] Y20\n #1 = [#1 + 1]\no7 endwhile\nG1 X50 Y50\nG3 X70 Y40 R15\nG0 Z10\n"
 
 
-def test_subroutines_and_loops_pass_through_and_compensation_resumes(hr5b):
-    out, warned = _compensate(POCKET, hr5b)
+def test_subroutines_and_loops_pass_through_and_compensation_resumes():
+    out, warned = _compensate(POCKET)
     original, lines = POCKET.splitlines(), out.splitlines()
     start = lines.index("o<square> sub")
     assert lines[start : start + 7] == original[2:9]  # the definition verbatim
@@ -337,16 +327,16 @@ def test_subroutines_and_loops_pass_through_and_compensation_resumes(hr5b):
     assert warned.count("warning") == 1 and "flow.ngc:12:1: warning: loop or subroutine" in warned
 
 
-def test_strict_refuses_subroutine_moves(hr5b):
+def test_strict_refuses_subroutine_moves():
     with pytest.raises(NcppError, match="flow.ngc:12:1: loop or subroutine"):
-        _compensate(POCKET, hr5b, strict=True)
+        _compensate(POCKET, strict=True)
 
 
 FANUC = "O1000\n" + HEAD + "G1 Z-1\nG1 X40 Y12\nM98 P2000 L3\nG1 X50 Y50\nG0 Z10\nM30\nO2000\nG1 X[#<_x> + 2] Y[#<_y> + 1]\nM99\n"
 
 
-def test_fanuc_subprograms_pass_through_and_compensation_resumes(hr5b):
-    out, warned = _compensate(FANUC, hr5b)
+def test_fanuc_subprograms_pass_through_and_compensation_resumes():
+    out, warned = _compensate(FANUC)
     lines = out.splitlines()
     call = lines.index("M98 P2000 L3")
     assert lines[call - 1].startswith("X40.0") and lines[call + 1].startswith("G1 X")  # compensated around it
@@ -354,16 +344,16 @@ def test_fanuc_subprograms_pass_through_and_compensation_resumes(hr5b):
     assert "flow.ngc:6:1: warning: loop or subroutine" in warned
 
 
-def test_a_subroutine_in_g91_ends_compensation(hr5b):
+def test_a_subroutine_in_g91_ends_compensation():
     text = HEAD + "o1 sub\n G91 G1 X1\n G90\no1 endsub\nG1 X40 Y12\no1 call\nG1 X50\n"
-    out, warned = _compensate(text, hr5b)
+    out, warned = _compensate(text)
     assert "flow.ngc:8:1: warning: a loop or subroutine in G91" in warned
     assert out.splitlines()[-2:] == ["o1 call", "G1 X50"]
 
 
 @pytest.mark.skipif(not RS274.exists(), reason="no rs274")
-def test_rs274_runs_the_compensated_program_with_the_same_subroutine_moves(tmp_path, hr5b):
-    out, _ = _compensate(POCKET, hr5b)
+def test_rs274_runs_the_compensated_program_with_the_same_subroutine_moves(tmp_path):
+    out, _ = _compensate(POCKET)
     path = tmp_path / "out.ngc"
     path.write_text(out)
     calls, messages = rs274(str(path))
