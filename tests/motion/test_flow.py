@@ -88,12 +88,17 @@ def test_flow_refused_where_rs274_refuses(tmp_path, name):
 def test_every_block_is_written_once_where_it_stands(name):
     """The events, block by block, are the program's text in order: passthrough is byte for byte."""
     text = AGREE[name]
+    assert _text_of(_events(text)) == text
+
+
+def _text_of(events) -> str:
+    """The text of each run of events of one block: what passthrough writes."""
     groups, last = [], None
-    for event in _events(text):
+    for event in events:
         if event.block is not last:
             groups.append(event.block.text)
             last = event.block
-    assert "".join(groups) == text
+    return "".join(groups)
 
 
 def test_what_runs_out_of_order_belongs_to_the_line_that_runs_it():
@@ -236,6 +241,7 @@ def test_random_flow_programs_agree_with_rs274(tmp_path):
         assert rs274_error(messages) is None, (text, messages)
         mine, error, warning = ours(path)
         assert error is None and not warning and len(mine) == len(reference) and same_calls(reference, mine), (text, error, warning)
+        assert _text_of(_events(text)) == text
         moves += len(mine)
     assert moves > 200
 
