@@ -293,8 +293,8 @@ class Flow:
         body = self.subroutines.get(name) or self._from_file(name) or self._defined(self.subroutines, name)
         if body is None:
             where = f" nor is o{_shown(name)}.ngc in {os.pathsep.join(map(str, self.path))}" if self.path else ""
-            self.stop(f"a call of o{_shown(name)}, which the program does not define (a subroutine file: "
-                      f"give its folder with --subroutine-path){where}", block, control.item.start + 1)  # fmt: skip
+            self.stop(f"a call of o{_shown(name)}, which the program does not define (a subroutine file: give its folder "
+                      f"with --subroutine-path; the LinuxCNC filter reads the INI's SUBROUTINE_PATH){where}", block, control.item.start + 1)  # fmt: skip
             return lambda: None
 
         def call():

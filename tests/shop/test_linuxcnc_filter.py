@@ -152,3 +152,23 @@ def test_the_configuration_linuxcnc_runs_gives_its_parameter_file_and_tool_table
     (tmp_path / "ncpp.toml").write_text(f'machine = "{MACHINE}"\n')
     fresh = run_filter(program, tmp_path, INI_FILE_NAME=str(lcnc / "mill.ini"))
     assert fresh.returncode == 2 and b"outside the" in fresh.stderr  # G54 at the machine zero: the pocket leaves the travel
+
+
+def test_the_filter_runs_subroutine_files_from_the_ini_subroutine_path(tmp_path):
+    """An ngcgui-style program calls a subroutine file: the filter finds it through the INI's
+    [RS274NGC]SUBROUTINE_PATH, leaves its moves as LinuxCNC will run them and compensates the
+    program's own moves after the call; without the path the rest would pass uncompensated."""
+    lcnc = tmp_path / "configs" / "mill"
+    (lcnc / "subs").mkdir(parents=True)
+    (lcnc / "mill.ini").write_text(INI.replace("PARAMETER_FILE = sim.var", "PARAMETER_FILE = sim.var\nSUBROUTINE_PATH = subs"))
+    (lcnc / "sim.var").write_text("5220\t1.000000\n5221\t400.000000\n5222\t350.000000\n5223\t300.000000\n")
+    (lcnc / "subs" / "slot.ngc").write_text("o<slot> sub\nG1 X[#1 + #3] F200\nG1 X#1\no<slot> endsub\n")
+    program = tmp_path / "part.ngc"
+    program.write_text("G21 G90 G17\nG0 X0 Y0 Z5\nG1 Z-1 F200\nG1 X20 Y10\no<slot> call [20] [10] [15]\nG1 X40 Y30\nG0 Z5\nM2\n")
+    (tmp_path / "ncpp.toml").write_text(f'machine = "{MACHINE}"\n')
+    proc = run_filter(program, tmp_path, INI_FILE_NAME=str(lcnc / "mill.ini"))
+    assert proc.returncode == 0, proc.stderr
+    lines = proc.stdout.decode().splitlines()
+    call = lines.index("o<slot> call [20] [10] [15]")
+    assert lines[call - 1].startswith("X20.0") and lines[call + 1].startswith("G1 X")  # compensated on both sides
+    assert b"loop or subroutine" in proc.stderr and b"outside the motion interpreter" not in proc.stderr
