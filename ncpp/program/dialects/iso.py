@@ -109,7 +109,7 @@ class IsoWriter:
             return [block.text]
         facts = self._read_block(block)
         if facts.flow:
-            return self._write_control(block, first, group)
+            return self._write_control(block, first)
         motion = [e for e in group if type(e) is Line or type(e) is Arc]
         for segment in motion:
             if segment.changed:
@@ -264,13 +264,14 @@ class IsoWriter:
             self._last_end = None
 
     # -- o-word control lines ---------------------------------------------------
-    def _write_control(self, block: Block, line: Pass, group: list[Event]) -> list[str]:
-        """An o-word line (`o100 call`, `o100 endwhile`), with the moves it runs (the
-        subroutine's, the loop's next iterations): verbatim text that runs as programmed.
-        The control must be in the program's motion mode there (the lines it runs may rely
-        on it); after it the mode is the program's, unknown here, and nowhere else: the
-        next edited block writes its motion word, and every axis it knows."""
-        program = MOTION_CODES.get(line.motion)  # type: ignore[arg-type]
+    def _write_control(self, block: Block, first: Event) -> list[str]:
+        """A control line (`o100 call`, `o100 endwhile`, `M98 P100`) with the moves it runs
+        (the subroutine's, the loop's next iterations, left as programmed): its text.  The
+        control must be in the program's motion mode there (the lines it runs may rely on
+        it; the interpreter tells it on the line's `Pass`); after it the mode is the
+        program's, unknown here, and nowhere else: the next edited block writes its motion
+        word, and every axis it knows."""
+        program = MOTION_CODES.get(first.motion) if type(first) is Pass else None  # type: ignore[arg-type]
         restore = program is not None and self.output_motion is not None and self.output_motion != program
         lines = [f"G{program}{block.eol}", block.text] if restore else [block.text]
         self.program_motion = self.output_motion = None
