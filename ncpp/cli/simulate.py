@@ -12,7 +12,7 @@ import json
 
 from ncpp.cli.compensate import add_placement_arguments, work_offsets
 from ncpp.cli.io import add_dialect_argument
-from ncpp.errors import NcppError, Warnings
+from ncpp.errors import Location, NcppError, Warnings
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -50,7 +50,7 @@ def run(args: argparse.Namespace) -> int:
     commanded = sample_events(program_events(args.program, warnings, offsets, args.dialect), args.step)
     nominal = sample_events(program_events(args.reference, warnings, offsets, args.dialect), args.step) if args.reference else commanded
     if len(commanded.points) == 0:
-        raise NcppError("the program makes no motion the interpreter could follow")
+        raise NcppError("the program makes no motion the interpreter could follow (a file of subroutines only runs where a program calls it)", Location(args.program))
     report = contour_error(machine, commanded, nominal)
     print(f"contour error: max {report.max_um:.2f} µm (line {report.worst_line}), rms {report.rms_um:.2f} µm over {report.samples} samples")
     for c in report.circles:

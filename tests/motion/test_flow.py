@@ -389,3 +389,15 @@ def test_the_output_is_in_the_programs_motion_mode_at_a_control_line():
     call = lines.index("o1 call\n")
     assert lines[call - 1] == "G2\n" and lines[call - 2].startswith("G1 ")
     assert lines[-1].startswith("G2 X6.0000 Y0.0000") and "Z10.0000" in lines[-1]  # its mode said, and every axis
+
+
+def test_simulating_a_file_of_subroutines_only_names_the_file(tmp_path):
+    """An ngcgui subroutine file makes no motion by itself: `ncpp simulate` says so, naming the file."""
+    import subprocess
+    import sys
+
+    folder, _ = _library(tmp_path)
+    proc = subprocess.run([sys.executable, "-m", "ncpp", "simulate", "--machine", str(ROOT / "samples/machines/hr5b.toml"), str(folder / "mark.ngc")],
+                          capture_output=True, text=True)  # fmt: skip
+    assert proc.returncode != 0 and proc.stderr.startswith(f"{folder / 'mark.ngc'}: the program makes no motion"), proc.stderr
+    assert "Traceback" not in proc.stderr
