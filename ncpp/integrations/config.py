@@ -154,7 +154,8 @@ _INI_UNITS = {"mm": "mm", "metric": "mm", "inch": "inch", "in": "inch", "imperia
 def with_linuxcnc_ini(settings: Settings, ini: str | Path | None) -> Settings:
     """The settings with LinuxCNC's own files where they name none: the INI's
     [RS274NGC]PARAMETER_FILE and [EMCIO]TOOL_TABLE (relative to the INI's folder),
-    in its [TRAJ]LINEAR_UNITS, and its [RS274NGC]SUBROUTINE_PATH.  LinuxCNC exports
+    in its [TRAJ]LINEAR_UNITS, and the folders of subroutine files in LinuxCNC's order:
+    [DISPLAY]PROGRAM_PREFIX, [RS274NGC]SUBROUTINE_PATH, [WIZARD]WIZARD_ROOT.  LinuxCNC exports
     the INI's path as $INI_FILE_NAME to the programs it runs, the filter among them."""
     if not ini:
         return settings
@@ -173,7 +174,8 @@ def with_linuxcnc_ini(settings: Settings, ini: str | Path | None) -> Settings:
         return str(found) if value and found.is_file() else None
 
     var_file, tool_table = named("RS274NGC", "PARAMETER_FILE"), named("EMCIO", "TOOL_TABLE")
-    folders = parser.get("RS274NGC", "SUBROUTINE_PATH", fallback="").split(":")  # LinuxCNC's separator
+    folders = [parser.get("DISPLAY", "PROGRAM_PREFIX", fallback=""), *parser.get("RS274NGC", "SUBROUTINE_PATH", fallback="").split(":"),
+               parser.get("WIZARD", "WIZARD_ROOT", fallback="")]  # fmt: skip
     subroutine_path = tuple(str((path.parent / Path(f.strip()).expanduser()).resolve()) for f in folders if f.strip())
     units = _INI_UNITS.get(parser.get("TRAJ", "LINEAR_UNITS", fallback="mm").strip().lower(), "mm")
     own_units = settings.var_file or settings.tool_table  # the config's files: its units

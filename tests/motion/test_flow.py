@@ -291,6 +291,10 @@ def test_the_linuxcnc_ini_names_the_subroutine_folders(tmp_path):
     folder, ini = _library(tmp_path)
     settings = with_linuxcnc_ini(Settings(), ini)
     assert settings.offsets().subroutine_path == (folder.resolve(),)
+    # searched in LinuxCNC's order: the program folder, SUBROUTINE_PATH (":"-separated), the wizard root
+    ini.write_text("[DISPLAY]\nPROGRAM_PREFIX = nc_files\n[RS274NGC]\nSUBROUTINE_PATH = subs:more\n[WIZARD]\nWIZARD_ROOT = wizard\n")
+    found = with_linuxcnc_ini(Settings(), ini).offsets().subroutine_path
+    assert found == tuple((tmp_path / f).resolve() for f in ("nc_files", "subs", "more", "wizard"))
 
 
 def test_compensate_with_a_subroutine_path(tmp_path):
