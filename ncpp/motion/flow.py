@@ -231,22 +231,21 @@ class Flow:
         self.read += 1
         control = self._control_of(block)
         number = program_number(block) if control is None else None
-        if self._defining is not None:
-            found, name, lines = self._defining
-            fanuc = found is self.subprograms
-            if not fanuc or (number is None and (control is None or control.keyword != "sub")):
-                lines.append(block)
-                if control is not None and (control.keyword == "m99" if fanuc else control.keyword == "endsub" and control.name == name):
-                    found.setdefault(name, lines)  # the first definition counts (LinuxCNC finds it first)
-                    self._defining = None
-                elif fanuc and len(lines) > MAX_SUBPROGRAM:
-                    self._defining = None
-                return
-            self._defining = None  # that `O<n>` was a program's number: what starts here is another definition
-        if control is not None and control.keyword == "sub":
-            self._defining = (self.subroutines, control.name, [block])
-        elif number is not None:
-            self._defining = (self.subprograms, number, [block])
+        starts = number is not None or (control is not None and control.keyword == "sub")
+        if self._defining is not None and not (starts and self._defining[0] is self.subprograms):
+            self._extend_definition(block, control)
+        elif starts:  # (a Fanuc definition under way was a program's own number)
+            self._defining = (self.subroutines, control.name, [block]) if number is None else (self.subprograms, number, [block])  # type: ignore[union-attr]
+
+    def _extend_definition(self, block: Block, control: Control | None) -> None:
+        found, name, lines = self._defining  # type: ignore[misc]
+        lines.append(block)
+        fanuc = found is self.subprograms
+        if control is not None and (control.keyword == "m99" if fanuc else control.keyword == "endsub" and control.name == name):
+            found.setdefault(name, lines)  # the first definition counts (LinuxCNC finds it first)
+            self._defining = None
+        elif fanuc and len(lines) > MAX_SUBPROGRAM:  # a program's own number, not a subprogram
+            self._defining = None
 
     # -- control lines -----------------------------------------------------------
     def _control(self, frame: _Frame, block: Block, control: Control) -> Iterator[tuple[Block, str, Block | None]]:

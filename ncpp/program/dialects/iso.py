@@ -115,7 +115,8 @@ class IsoWriter:
             if segment.changed:
                 break
         else:  # nothing changed
-            lines = [self._restore_mode_line(block)] if self._needs_mode_restore(block, motion) else []
+            self._learn_program_motion(block, motion)
+            lines = [self._restore_mode_line(block)] if self._needs_mode_restore(block) else []
             lines.append(block.text)
             self._after_verbatim(block, motion)
             return lines
@@ -240,14 +241,21 @@ class IsoWriter:
         return spelled
 
     # -- verbatim blocks ------------------------------------------------------
-    def _needs_mode_restore(self, block: Block, motion: list[Event]) -> bool:
-        """A verbatim block relying on a modal motion the output changed (an arc written as lines)."""
-        if not self._facts(block).moves or self._has_motion_word(block):
-            return False
+    def _learn_program_motion(self, block: Block, motion: list[Event]) -> None:
+        """After a control line the program's mode is unknown here (and the output's known once
+        a block was edited): a verbatim block moving without a motion word runs in it."""
         if self.program_motion is None and self.output_motion is not None and motion and not motion[0].fixed:
-            # the output's mode is known, the program's is not (after an o-word line): it is the one this block runs in
-            self.program_motion = self._motion_code(motion[0])  # type: ignore[arg-type]
-        return self.program_motion is not None and self.output_motion != self.program_motion
+            if self._facts(block).moves and not self._has_motion_word(block):
+                self.program_motion = self._motion_code(motion[0])  # type: ignore[arg-type]
+
+    def _needs_mode_restore(self, block: Block) -> bool:
+        """A verbatim block relying on a modal motion the output changed (an arc written as lines)."""
+        return (
+            self._facts(block).moves
+            and not self._has_motion_word(block)
+            and self.program_motion is not None
+            and self.output_motion != self.program_motion
+        )
 
     def _restore_mode_line(self, block: Block) -> str:
         self.output_motion = self.program_motion
