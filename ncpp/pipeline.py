@@ -23,6 +23,7 @@ from ncpp.motion.offsets import AT_MACHINE_ZERO, WorkOffsets
 from ncpp.motion.segments import CYCLE, FLOW, Event, Pass
 from ncpp.passes import PASSES, PassContext, run_passes
 from ncpp.passes.context import is_directional
+from ncpp.passes.inverse import iterations_for
 from ncpp.passes.kernels import INLINE, Kernels, Worker
 from ncpp.program.blocks import Block, Comment, Word
 from ncpp.program.dialects import parse_program
@@ -225,6 +226,11 @@ def with_header(lines: Iterable[str], header: str, writer: IsoWriter) -> Iterato
     yield from it
 
 
+# mm: the inverse map's residual allowed in a command, a quarter of the last digit mm
+# programs are written with (the rounding to it is up to twice as large)
+INVERSE_BUDGET = 0.000025
+
+
 def make_context(source: ErrorSource, tolerance: float, warnings: Warnings, file: str, kernels: Kernels = INLINE) -> PassContext:
     """The pass context every front end (filter, compensate, post) compensates with."""
     return PassContext(
@@ -234,6 +240,7 @@ def make_context(source: ErrorSource, tolerance: float, warnings: Warnings, file
         max_correction=source.max_correction,
         limits=source.limits,
         directional=is_directional(source.model, source.limits),
+        iterations=iterations_for(source.model, source.limits, INVERSE_BUDGET),
         warnings=warnings,
         file=file,
     )

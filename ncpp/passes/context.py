@@ -43,6 +43,7 @@ class PassContext:
     resolution: float = 1e-4  # mm: the output grid of mm programs (every writer writes at least 4 decimals)
     resolution_inch: float = 1e-5  # inch: the same for inch programs (5 decimals)
     min_line_check: float = 1.0  # mm: shorter lines are never subdivided (their error is linear to < 0.01 µm)
+    iterations: int = 2  # fixed-point steps of the inverse map (`inverse.iterations_for` picks the fewest that suffice)
     warnings: Warnings = field(default_factory=Warnings)
     file: str = "<stdin>"
     kernels: Kernels = INLINE  # where the passes' numeric kernels run (kernels.py)

@@ -102,7 +102,7 @@ def compensate(
     wanted = (pts + offsets[:, None, :]) * scales[:, None, None]
     signs = None if directions is None else np.asarray(directions, dtype=float).reshape(-1, 3)
     tool = None if tools is None else np.broadcast_to(tools[:, None, :], wanted.shape).reshape(-1, 3)
-    command = command_for(ctx.model, wanted.reshape(-1, 3), signs, tool).reshape(wanted.shape)
+    command = command_for(ctx.model, wanted.reshape(-1, 3), signs, tool, ctx.iterations).reshape(wanted.shape)
     _check(wanted, command, lines, ctx)
     return (command / scales[:, None, None] - offsets[:, None, :]).reshape(shape)
 

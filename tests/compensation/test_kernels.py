@@ -49,11 +49,13 @@ def test_a_worker_writes_the_same_program(machine):
 
 def test_with_a_worker_this_process_evaluates_the_error_map_only_to_probe_it(monkeypatch):
     """Every pass's numbers (subdivide's samples, the arc fit, the solve) run in the worker:
-    this process parses, interprets, glues and writes (and probes whether the map has
-    reversal errors: 2 x 16 points, `is_directional`)."""
+    this process parses, interprets, glues and writes (and probes the map: whether it has
+    reversal errors, 2 x 16 points, `is_directional`, and how many steps its inverse needs,
+    2 x 4096 on HR5B, whose first step already suffices, `iterations_for`)."""
     import numpy as np
 
     from ncpp.machine.model import Machine
+    from ncpp.passes.inverse import RESIDUAL_SAMPLES
 
     points = []
     original = Machine.deviation
@@ -62,7 +64,7 @@ def test_with_a_worker_this_process_evaluates_the_error_map_only_to_probe_it(mon
     program = b"".join(PROGRAM.splitlines(keepends=True)[:1500])
     assert _compensated(program, source, jobs=1) and sum(points) > 10_000  # inline: here
     points.clear()
-    assert _compensated(program, source, jobs=2) and points == [16, 16]
+    assert _compensated(program, source, jobs=2) and points == [16, 16, RESIDUAL_SAMPLES, RESIDUAL_SAMPLES]
 
 
 def test_a_worker_compensates_a_corpus_program_from_a_measurement_the_same():
