@@ -77,12 +77,14 @@ class _Rows:
 
 def _rows(segs: list, directional: bool) -> _Rows:
     offsets, scales, tools = frames(segs)
-    line = np.array([type(e) is Line and not e.fixed for e in segs])  # fixed: moves left as programmed
+    start, end = points([e.start for e in segs]), points([e.end for e in segs])
+    arc = np.array([type(e) is Arc for e in segs])
+    line = ~arc & np.array([not e.fixed for e in segs])  # fixed: moves left as programmed
     changed = np.array([e.changed for e in segs])
     free = line & ~changed
     return _Rows(
-        points([e.start for e in segs]), points([e.end for e in segs]), offsets, scales, tools, free, changed, changed & line,
-        _arc_assumed(segs, changed) if directional else None, np.array([e.block.line for e in segs]),
+        start, end, offsets, scales, tools, free, changed, changed & line,
+        _arc_assumed(segs, np.flatnonzero(changed & arc), start, end) if directional else None, np.array([e.block.line for e in segs]),
     )  # fmt: skip
 
 
@@ -374,17 +376,16 @@ def _own_motion(moved, d, free, start_p, end_p, scales, threshold, commands: _Co
     return hold(moved, travel.held)
 
 
-def _arc_assumed(segs: list, arc: NDArray) -> NDArray:
-    """Directions replace_arcs compensated each arc piece with: the sign of the
-    tangent at the middle in the plane, the mean (0) on the normal axis; and
-    the mean on every axis for the lines it made."""
+def _arc_assumed(segs: list, rows: NDArray, start: NDArray, end: NDArray) -> NDArray:
+    """Directions replace_arcs compensated each arc piece (`rows`, with the chunk's
+    `start` and `end` points) with: the sign of the tangent at the middle in the plane,
+    the mean (0) on the normal axis; and the mean on every axis for the lines it made."""
     out = np.zeros((len(segs), 3))
-    rows = np.flatnonzero(arc & np.array([type(e) is Arc for e in segs]))
     if rows.size == 0:
         return out
-    arcs = [segs[i] for i in rows]
+    arcs = [segs[i] for i in rows.tolist()]
     axes = np.array([PLANE_AXES[a.context.plane] for a in arcs])
-    s, e, c = (np.take_along_axis(points([getattr(a, f) for a in arcs]), axes, axis=1) for f in ("start", "end", "center"))
+    s, e, c = (np.take_along_axis(p, axes, axis=1) for p in (start[rows], end[rows], points([a.center for a in arcs])))
     u0, u1 = s[:, :2] - c[:, :2], e[:, :2] - c[:, :2]
     with np.errstate(invalid="ignore", divide="ignore"):
         mid = u0 / np.linalg.norm(u0, axis=1, keepdims=True) + u1 / np.linalg.norm(u1, axis=1, keepdims=True)
