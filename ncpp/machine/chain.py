@@ -125,11 +125,10 @@ def columns(n: int) -> NDArray:
 def cross(a: NDArray, b: NDArray) -> NDArray:
     """Row-wise a × b for (n,3) arrays (np.cross is several times slower)."""
     out = columns(len(a))
-    a0, a1, a2 = a[:, 0], a[:, 1], a[:, 2]
-    b0, b1, b2 = b[:, 0], b[:, 1], b[:, 2]
-    out[:, 0] = a1 * b2 - a2 * b1
-    out[:, 1] = a2 * b0 - a0 * b2
-    out[:, 2] = a0 * b1 - a1 * b0
+    scratch = np.empty(len(a))
+    for k, (i, j) in enumerate(((1, 2), (2, 0), (0, 1))):
+        np.multiply(a[:, i], b[:, j], out=out[:, k])
+        np.subtract(out[:, k], np.multiply(a[:, j], b[:, i], out=scratch), out=out[:, k])
     return out
 
 
@@ -143,7 +142,11 @@ def rotate_minus_identity(eps: NDArray, v: NDArray) -> NDArray:
     a = 1.0 - th2 * (1.0 / 6.0 - th2 / 120.0)
     b = 0.5 - th2 * (1.0 / 24.0 - th2 / 720.0)
     ev = cross(eps, v)
-    return a * ev + b * cross(eps, ev)
+    out = cross(eps, ev)
+    out *= b
+    ev *= a
+    out += ev  # a·ε×v + b·ε×(ε×v)
+    return out
 
 
 def squareness_vectors(c0y: float, b0z: float, a0z: float) -> dict[str, NDArray]:
@@ -188,11 +191,17 @@ def exact_deviation(
     nominal[:] = tool
     w = columns(len(P))
     w[:] = 0.0
+    lever = columns(len(P))
     for axis in reversed(chain.order):
         i = AXES.index(axis)
-        k = P[:, i : i + 1]
-        lever = nominal - references[axis] + w
-        w = w + k * dir_err[axis] + delta[axis] + rotate_minus_identity(eps[axis], lever)
+        np.subtract(nominal, references[axis], out=lever)
+        lever += w
+        # w + k·e' + δ + (R(ε) − I)·lever, summed in that order
+        step = np.multiply(P[:, i : i + 1], dir_err[axis], out=columns(len(P)))
+        step += w
+        step += delta[axis]
+        step += rotate_minus_identity(eps[axis], lever)
+        w = step
         nominal[:, i] += P[:, i]
     return w
 
