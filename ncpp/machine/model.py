@@ -65,6 +65,9 @@ def _motion_row(name: str) -> int:
     return info.index + (0 if info.kind == "translation" else 3)
 
 
+MOTION_ROWS = list(range(6))  # the rows of an axis whose six components are all tables
+
+
 def _shaped_like(result: NDArray, P: ArrayLike) -> NDArray:
     return result[0] if np.ndim(P) == 1 else result
 
@@ -171,12 +174,15 @@ class Machine:
         for i, axis in enumerate(AXES):
             stacked, rows, others = self._evaluators[axis]
             p, d = pts[:, i], None if dirs is None else dirs[:, i]
-            motions = np.zeros((6, len(pts)))  # δx δy δz εx εy εz, each row contiguous (see chain.columns)
-            if stacked is not None:
-                for row, values in zip(rows, stacked(p, d)):
-                    motions[row] = values
-            for row, component in others:
-                motions[row] = component(p, d)
+            values = None if stacked is None else stacked(p, d)
+            if rows == MOTION_ROWS:
+                motions = values  # all six are tables: their values are the motions, as they are
+            else:
+                motions = np.zeros((6, len(pts)))  # δx δy δz εx εy εz, each row contiguous (see chain.columns)
+                if values is not None:
+                    motions[rows] = values
+                for row, component in others:
+                    motions[row] = component(p, d)
             delta[axis], eps[axis] = motions[:3].T, motions[3:].T
         return delta, eps
 
