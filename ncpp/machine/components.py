@@ -329,7 +329,7 @@ class StackedTables:
         """(tables, n): each table's value, of its − curve, + curve or their mean as `_chosen`."""
         # np.minimum/np.maximum: np.clip's own overhead is most of the time on a few points
         p = np.minimum(np.maximum(positions, self.grid[0]), self.grid[-1])
-        i = np.searchsorted(self.inner, p, side="right")  # NaN sorts last: the last interval
+        i = self.inner.searchsorted(p, side="right")  # NaN sorts last: the last interval
         dx = p - self.grid.take(i)
         c0, c1, c2, c3 = self.coefficients
         curves = c0.take(i, axis=1)  # (curves, n), Horner in place
