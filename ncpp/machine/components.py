@@ -326,7 +326,8 @@ class StackedTables:
         self.columns = [(k, next(minus) if t.directional else None) for k, t in enumerate(tables)]  # (+, − column)
 
     def __call__(self, positions: NDArray, direction: NDArray | None = None) -> NDArray:
-        """(tables, n): each table's value, of its − curve, + curve or their mean as `_chosen`."""
+        """(tables, n), row k table k's values: a directional table's + or − curve, or
+        their mean, as `_chosen` picks them by direction."""
         # np.minimum/np.maximum: np.clip's own overhead is most of the time on a few points
         p = np.minimum(np.maximum(positions, self.grid[0]), self.grid[-1])
         i = self.inner.searchsorted(p, side="right")  # NaN sorts last: the last interval

@@ -8,7 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from numpy.typing import NDArray
 
-from ncpp.machine import load_machine
+from ncpp.machine import Polynomial, load_machine
 from ncpp.machine.chain import AXES, Chain, direction_errors, exact_deviation, squareness_vectors
 from ncpp.machine.components import StackedTables, Table, _chosen, _signs
 from tests.conftest import ROOT
@@ -121,3 +121,18 @@ def test_machine_deviation_equals_the_plain_evaluation(seed, n):
     chain, tool, refs, squareness = MACHINE._frame
     want = _plain_exact_deviation(chain, P, tool if tools is None else tool - tools, refs, delta, eps, squareness)
     assert np.allclose(MACHINE.deviation(P, d, tools), want, rtol=0, atol=1e-12)
+
+
+def test_error_motions_of_an_axis_with_missing_and_polynomial_components():
+    """Motions are the stacked tables' rows as they are only when all six are tables."""
+    poly = Polynomial([1e-3, 2e-6])
+    partial = MACHINE.with_components(EYX=None, EZY=poly)
+    rng = np.random.default_rng(3)
+    P, d = rng.uniform(0.0, 700.0, (500, 3)), rng.choice([-1.0, 0.0, 1.0], (500, 3))
+    full_delta, full_eps = MACHINE.error_motions(P, d)
+    delta, eps = partial.error_motions(P, d)
+    assert np.array_equal(delta["X"][:, 1], np.zeros(500)) and np.array_equal(delta["X"][:, [0, 2]], full_delta["X"][:, [0, 2]])
+    assert np.array_equal(delta["Y"][:, 2], poly(P[:, 1])) and np.array_equal(delta["Y"][:, :2], full_delta["Y"][:, :2])
+    for axis in AXES:
+        assert np.array_equal(eps[axis], full_eps[axis])
+    assert np.array_equal(delta["Z"], full_delta["Z"])
