@@ -122,28 +122,66 @@ def columns(n: int) -> NDArray:
     return np.empty((3, n)).T
 
 
-def cross(a: NDArray, b: NDArray) -> NDArray:
-    """Row-wise a × b for (n,3) arrays (np.cross is several times slower)."""
-    out = columns(len(a))
-    a0, a1, a2 = a[:, 0], a[:, 1], a[:, 2]
-    b0, b1, b2 = b[:, 0], b[:, 1], b[:, 2]
-    out[:, 0] = a1 * b2 - a2 * b1
-    out[:, 1] = a2 * b0 - a0 * b2
-    out[:, 2] = a0 * b1 - a1 * b0
+def cyclic(n: int) -> NDArray:
+    """An empty (n,5) array for x y z x y, stored column by column: once `wrap`ped,
+    [:, 1:4] and [:, 2:5] are the components turned by one and by two places, as views."""
+    return np.empty((5, n)).T
+
+
+def wrap(v: NDArray) -> NDArray:
+    """Copy the x, y of a `cyclic` array after its z; return it."""
+    v[:, 3:] = v[:, :2]
+    return v
+
+
+def as_cyclic(v: NDArray) -> NDArray:
+    """An (n,3) array copied into a `wrap`ped `cyclic` one."""
+    out = cyclic(len(v))
+    out[:, :3] = v
+    return wrap(out)
+
+
+def cyclic_cross(a: NDArray, b: NDArray, out: NDArray) -> NDArray:
+    """a × b of `cyclic` a and b into (n,3) out: each component a_j·b_k − a_k·b_j,
+    the three at once (numpy's call overhead, not the arithmetic, is most of the time)."""
+    np.multiply(a[:, 1:4], b[:, 2:5], out=out)
+    out -= a[:, 2:5] * b[:, 1:4]
     return out
 
 
-def rotate_minus_identity(eps: NDArray, v: NDArray) -> NDArray:
-    """(R(ε) − I)·v for rotation vectors ε, row-wise, without cancellation.
+def cross(a: NDArray, b: NDArray) -> NDArray:
+    """Row-wise a × b for (n,3) arrays (np.cross is several times slower)."""
+    return cyclic_cross(as_cyclic(a), as_cyclic(b), columns(len(a)))
 
-    Rodrigues: R v = v + a ε×v + b ε×(ε×v), a = sinθ/θ, b = (1−cosθ)/θ²; the
-    series below are exact in double precision for θ < 0.01 rad."""
+
+def rotate_minus_identity(eps: NDArray, v: NDArray) -> NDArray:
+    """(R(ε) − I)·v for rotation vectors ε, row-wise, without cancellation."""
+    a, b = rodrigues(eps.T)
+    return rotate_cyclic(as_cyclic(eps), as_cyclic(v), a[:, None], b[:, None])
+
+
+def rodrigues(eps: NDArray) -> tuple[NDArray, NDArray]:
+    """The factors a = sinθ/θ and b = (1−cosθ)/θ² of rotation vectors ε (…, 3, n), (…, n).
+
+    Rodrigues: R v = v + a ε×v + b ε×(ε×v); the series below are exact in
+    double precision for θ < 0.01 rad."""
     squares = eps * eps
-    th2 = (squares[:, 0] + squares[:, 1] + squares[:, 2])[:, None]
-    a = 1.0 - th2 * (1.0 / 6.0 - th2 / 120.0)
-    b = 0.5 - th2 * (1.0 / 24.0 - th2 / 720.0)
-    ev = cross(eps, v)
-    return a * ev + b * cross(eps, ev)
+    th2 = squares[..., 0, :] + squares[..., 1, :] + squares[..., 2, :]
+    return 1.0 - th2 * (1.0 / 6.0 - th2 / 120.0), 0.5 - th2 * (1.0 / 24.0 - th2 / 720.0)
+
+
+def rotate_cyclic(eps: NDArray, v: NDArray, a: NDArray, b: NDArray) -> NDArray:
+    """(R(ε) − I)·v = a ε×v + b ε×(ε×v) of `cyclic` ε and v, with ε's `rodrigues`
+    factors as (n,1); (n,3)."""
+    ev = cyclic(len(v))
+    cyclic_cross(eps, v, ev[:, :3])
+    wrap(ev)
+    out = cyclic_cross(eps, ev, columns(len(v)))
+    out *= b
+    ev = ev[:, :3]
+    ev *= a
+    out += ev
+    return out
 
 
 def squareness_vectors(c0y: float, b0z: float, a0z: float) -> dict[str, NDArray]:
@@ -184,16 +222,33 @@ def exact_deviation(
     partial product so that microns are never the difference of metres.
     `directions`: `direction_errors(squareness)`, when the caller keeps them."""
     dir_err = direction_errors(squareness) if directions is None else directions
-    nominal = columns(len(P))
+    n = len(P)
+    # What does not depend on the walk, for the three axes at once (numpy's per-call overhead
+    # is much of the time on a few thousand points): each axis's ε made `cyclic`, its Rodrigues
+    # factors, and k·(e'_K − e_K), each axis's (3, n) block seen as (n,3) by `.T`.
+    e = np.empty((3, 5, n))
+    for k, axis in enumerate(AXES):
+        e[k, :3] = eps[axis].T
+    e[:, 3:] = e[:, :2]
+    a, b = rodrigues(e[:, :3])
+    moved = P.T[:, None, :] * np.array([dir_err[axis] for axis in AXES])[:, :, None]
+    nominal = columns(n)
     nominal[:] = tool
-    w = columns(len(P))
+    w = columns(n)
     w[:] = 0.0
+    lever = cyclic(n)
+    arm = lever[:, :3]
     for axis in reversed(chain.order):
-        i = AXES.index(axis)
-        k = P[:, i : i + 1]
-        lever = nominal - references[axis] + w
-        w = w + k * dir_err[axis] + delta[axis] + rotate_minus_identity(eps[axis], lever)
-        nominal[:, i] += P[:, i]
+        k = AXES.index(axis)
+        np.subtract(nominal, references[axis], out=arm)
+        arm += w
+        # w + k·e' + δ + (R(ε) − I)·lever, summed in that order
+        step = moved[k].T
+        step += w
+        step += delta[axis]
+        step += rotate_cyclic(e[k].T, wrap(lever), a[k, :, None], b[k, :, None])
+        w = step
+        nominal[:, k] += P[:, k]
     return w
 
 

@@ -308,33 +308,37 @@ class StackedTables:
     the tables' own interpolation, not a resampling."""
 
     def __init__(self, tables: list[Table]):
-        curves = [(t, v) for t in tables for v in (t.values, t.values_minus) if v is not None]
+        # Curve rows: each table's + (or only) curve in table order, then the − curves, so the
+        # first rows are the tables' values once the direction has chosen (no copy).
+        curves = [(t, t.values) for t in tables] + [(t, t.values_minus) for t in tables if t.directional]
         pieces = [_cubic_pieces(t, v) for t, v in curves]
         grid = np.unique(np.concatenate([x for x, _ in pieces]))
         if len(grid) == 1:
             grid = np.array([grid[0], grid[0] + 1.0])
         self.grid = grid
+        self.inner = grid[1:-1].copy()  # the interval of p in [grid[0], grid[-1]] is how many of these are <= p
         # Per power, a (curves, intervals) array: one gather along the intervals fetches every
         # curve, and each curve's values come out as a contiguous row (numpy's loops then run
         # along the points, not along a handful of curves: 8% faster on 1400 points, 20% on 20k)
         stacked = np.stack([_refine(x, c, grid) for x, c in pieces], axis=0)
         self.coefficients = [np.ascontiguousarray(stacked[:, :, k]) for k in range(4)]
-        self.columns: list[tuple[int, int | None]] = []  # per table: (+ column, − column)
-        col = 0
-        for t in tables:
-            self.columns.append((col, col + 1 if t.directional else None))
-            col += 2 if t.directional else 1
+        minus = iter(range(len(tables), len(curves)))
+        self.columns = [(k, next(minus) if t.directional else None) for k, t in enumerate(tables)]  # (+, − column)
 
-    def __call__(self, positions: NDArray, direction: NDArray | None = None) -> list[NDArray]:
+    def __call__(self, positions: NDArray, direction: NDArray | None = None) -> NDArray:
+        """(tables, n), row k table k's values: a directional table's + or − curve, or
+        their mean, as `_chosen` picks them by direction."""
         # np.minimum/np.maximum: np.clip's own overhead is most of the time on a few points
         p = np.minimum(np.maximum(positions, self.grid[0]), self.grid[-1])
-        # p >= grid[0] (NaN sorts last): the interval is never below 0
-        i = np.minimum(np.searchsorted(self.grid, p, side="right") - 1, len(self.grid) - 2)
-        dx = p - self.grid[i]
+        i = self.inner.searchsorted(p, side="right")  # NaN sorts last: the last interval
+        dx = p - self.grid.take(i)
         c0, c1, c2, c3 = self.coefficients
         curves = c0.take(i, axis=1)  # (curves, n), Horner in place
         for c in (c1, c2, c3):
             curves *= dx
             curves += c.take(i, axis=1)
         signs = _signs(direction)
-        return [curves[plus] if minus is None else _chosen(signs, curves[plus], curves[minus]) for plus, minus in self.columns]
+        for plus, minus in self.columns:
+            if minus is not None:
+                curves[plus] = _chosen(signs, curves[plus], curves[minus])
+        return curves[: len(self.columns)]

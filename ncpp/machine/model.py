@@ -65,6 +65,16 @@ def _motion_row(name: str) -> int:
     return info.index + (0 if info.kind == "translation" else 3)
 
 
+MOTION_ROWS = list(range(6))  # the rows of an axis whose six components are all tables
+
+
+def _per_point(values: ArrayLike, shape: tuple[int, ...]) -> NDArray:
+    """Values as a float array of `shape`, broadcast (not copied) if they are not that
+    shape already: np.broadcast_to's own overhead shows on calls of a few points."""
+    arr = np.asarray(values, dtype=float)
+    return arr if arr.shape == shape else np.broadcast_to(arr, shape)
+
+
 def _shaped_like(result: NDArray, P: ArrayLike) -> NDArray:
     return result[0] if np.ndim(P) == 1 else result
 
@@ -166,17 +176,20 @@ class Machine:
     ) -> tuple[dict[str, NDArray], dict[str, NDArray]]:
         """Per axis, the translation δ_K (n,3) mm and rotation ε_K (n,3) rad at P."""
         pts = as_points(P)
-        dirs = None if direction is None else np.broadcast_to(np.asarray(direction, dtype=float), pts.shape)
+        dirs = None if direction is None else _per_point(direction, pts.shape)
         delta, eps = {}, {}
         for i, axis in enumerate(AXES):
             stacked, rows, others = self._evaluators[axis]
             p, d = pts[:, i], None if dirs is None else dirs[:, i]
-            motions = np.zeros((6, len(pts)))  # δx δy δz εx εy εz, each row contiguous (see chain.columns)
-            if stacked is not None:
-                for row, values in zip(rows, stacked(p, d)):
-                    motions[row] = values
-            for row, component in others:
-                motions[row] = component(p, d)
+            values = None if stacked is None else stacked(p, d)
+            if rows == MOTION_ROWS:
+                motions = values  # all six are tables: their values are the motions, as they are
+            else:
+                motions = np.zeros((6, len(pts)))  # δx δy δz εx εy εz, each row contiguous (see chain.columns)
+                if values is not None:
+                    motions[rows] = values
+                for row, component in others:
+                    motions[row] = component(p, d)
             delta[axis], eps[axis] = motions[:3].T, motions[3:].T
         return delta, eps
 
@@ -200,8 +213,8 @@ class Machine:
 
     def _blockwise(self, kernel, P: ArrayLike, direction: ArrayLike | None, tool_offset: ArrayLike | None = None) -> NDArray:
         pts = np.ascontiguousarray(as_points(P).T).T  # columns contiguous, like the algebra
-        dirs = None if direction is None else np.broadcast_to(np.asarray(direction, dtype=float), pts.shape)
-        tools = None if tool_offset is None else np.broadcast_to(np.asarray(tool_offset, dtype=float), pts.shape)
+        dirs = None if direction is None else _per_point(direction, pts.shape)
+        tools = None if tool_offset is None else _per_point(tool_offset, pts.shape)
         out = np.empty(pts.shape)
         for start in range(0, len(pts), CHUNK):
             block = slice(start, start + CHUNK)
