@@ -19,7 +19,7 @@ T = TypeVar("T")
 _NO_TOOL = (0.0, 0.0, 0.0)
 # Events per vectorised batch: large enough to amortise numpy's per-call cost,
 # small enough that memory stays flat however long the program.
-CHUNK = 8192
+CHUNK = 2048
 
 
 def chunked(items: Iterable[T], size: int = CHUNK) -> Iterator[list[T]]:
