@@ -53,10 +53,10 @@ def iterations_for(model: ErrorMap, limits: dict[str, tuple[float, float]], budg
     lo, hi = np.array(travel).T
     wanted = lo + (hi - lo) * rng.random((RESIDUAL_SAMPLES, 3))
     direction = rng.choice([-1.0, 1.0], size=wanted.shape)
-    command = wanted
+    error = deviation(model, wanted, direction, None)
     for steps in range(1, MAX_ITERATIONS + 1):
-        command = wanted - deviation(model, command, direction, None)
-        residual = np.abs(command + deviation(model, command, direction, None) - wanted).max()
-        if RESIDUAL_SAFETY * residual <= budget:
+        command = wanted - error  # `command_for` after `steps` steps
+        error = deviation(model, command, direction, None)  # its residual's, and the next step's
+        if RESIDUAL_SAFETY * np.abs(command + error - wanted).max() <= budget:
             return steps
     return MAX_ITERATIONS
