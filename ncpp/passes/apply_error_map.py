@@ -25,7 +25,7 @@ from numpy.typing import NDArray
 from ncpp.motion.segments import PLANE_AXES, Arc, Event, Line
 from ncpp.passes.context import PassContext, deviation
 from ncpp.passes.kernels import run_ahead
-from ncpp.passes.geometry import chunked, compensate, frames, points, rows_of
+from ncpp.passes.geometry import compensate, frames, line_chunks, points, rows_of
 from ncpp.passes.travel import Travel, grid, hold, quantize, steps
 
 # Compensations per line at most: each changes a direction only where a
@@ -41,7 +41,7 @@ NEAR_STILL = 0.05
 def apply_error_map(events: Iterable[Event], ctx: PassContext) -> Iterator[Event]:
     solve = ctx.kernels.bind(Solve(ctx.for_kernels()))
     last = None  # the last segment written: its compensated end, in its own program frame
-    chunks = (_with_rows(chunk, ctx.directional) for chunk in chunked(events))
+    chunks = (_with_rows(chunk, ctx.directional) for chunk in line_chunks(events))
     # with a worker process, the next chunks are read (parsed, interpreted, their arcs replaced) while one is solved
     for (chunk, segs, rows), solving in run_ahead(chunks, lambda c: None if c[2] is None else solve(c[2]), ctx.kernels.ahead):
         if solving is None:  # no segments

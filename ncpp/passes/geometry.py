@@ -3,14 +3,16 @@ program points to machine positions and back, compensating many at once."""
 
 from __future__ import annotations
 
+from bisect import bisect_left
 from itertools import chain, islice
+from operator import attrgetter
 from typing import Iterable, Iterator, Sequence, TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
 
 from ncpp.errors import Location, NcppError
-from ncpp.motion.segments import Arc, Line
+from ncpp.motion.segments import Arc, Event, Line
 from ncpp.passes.context import PassContext
 from ncpp.passes.inverse import command_for
 
@@ -22,10 +24,34 @@ _NO_TOOL = (0.0, 0.0, 0.0)
 CHUNK = 2048
 
 
+# A pass that settles a chunk as a whole (apply_error_map's directional solve) takes chunks
+# of whole windows of this many input lines, at most LINE_CHUNK_CAP events.
+LINE_CHUNK = 1024
+LINE_CHUNK_CAP = 4096
+_line_of = attrgetter("block.line")
+
+
 def chunked(items: Iterable[T], size: int = CHUNK) -> Iterator[list[T]]:
     it = iter(items)
     while chunk := list(islice(it, size)):
         yield chunk
+
+
+def line_chunks(events: Iterable[Event], lines: int = LINE_CHUNK, size: int = LINE_CHUNK_CAP) -> Iterator[list[Event]]:
+    """Lists of the events of one window of `lines` input lines each (windows start at
+    multiples of `lines`), cut short at `size` events.  Where a chunk ends depends on
+    the program, not on where the stream started: compensating a program from a later
+    line on (with the state there) settles the same chunks the same way."""
+    it = iter(events)
+    chunk: list[Event] = []
+    while True:
+        chunk += islice(it, size - len(chunk))
+        if not chunk:
+            return
+        end = (_line_of(chunk[0]) // lines + 1) * lines
+        k = bisect_left(chunk, end, key=_line_of)  # events come in line order; k >= 1
+        yield chunk[:k]
+        chunk = chunk[k:]
 
 
 def spliced(items: list[T], at: list[int], replacements: list[list[T]]) -> list[T]:
