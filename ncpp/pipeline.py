@@ -12,7 +12,7 @@ from __future__ import annotations
 import gc
 import hashlib
 from contextlib import contextmanager
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from itertools import chain, count, islice
 from operator import itemgetter
 from pathlib import Path
@@ -260,6 +260,7 @@ def process(
     dialect: str | None = None,
     jobs: int = 1,
     offsets: WorkOffsets | None = None,
+    part: "Part | None" = None,
 ) -> Stats:
     """Read, interpret, compensate (when `source` is given) and write one program.
 
@@ -269,11 +270,40 @@ def process(
     the same output on two cores.  `offsets`: the zeros the control holds (machine
     mm; none: the program zero is the machine zero), which place the program on
     the machine whose errors are compensated."""
+    if source is not None and jobs > 1 and part is None:
+        split = _two_parts(stream, file, dialect)
+        if split is not None:  # an ISO program file long enough: two parts, one process each (parts.py)
+            from ncpp.parts import process_in_two_parts
+
+            path, cut = split
+            return process_in_two_parts(path, out, cut, file=file, source=source, tolerance=tolerance, strict=strict, force=force,
+                                        warnings=warnings or Warnings(strict=strict), progress=progress, dialect=dialect, offsets=offsets)  # fmt: skip
     kernels = _kernels(source is not None and jobs > 1)  # started first: the worker starts while we parse
     try:
-        return _process(stream, out, file, source, tolerance, strict, force, warnings, progress, dialect, kernels, offsets)
+        return _process(stream, out, file, source, tolerance, strict, force, warnings, progress, dialect, kernels, offsets, part)
     finally:
         kernels.close()
+
+
+def _two_parts(stream: BinaryIO, file: str, dialect: str | None) -> tuple[str, int] | None:
+    """(path, cut) when the stream is an unread ISO program file that pays for two
+    processes (`parts.py`); else None (a pipe, another dialect, a short program)."""
+    import os
+
+    from ncpp.parts import cut_for
+    from ncpp.program.dialects import SNIFF_BYTES, detect
+
+    path = getattr(stream, "name", None)
+    try:
+        if not isinstance(path, str) or not os.path.isfile(path) or stream.tell() != 0:
+            return None
+    except (OSError, ValueError):
+        return None
+    with open(path, "rb") as f:
+        if (dialect or detect(f.read(SNIFF_BYTES), file)).lower() != "iso":
+            return None
+    cut = cut_for(path)
+    return None if cut is None else (path, cut)
 
 
 def _kernels(worker: bool) -> Kernels:
@@ -299,6 +329,7 @@ def _process(
     dialect: str | None,
     kernels: Kernels,
     offsets: WorkOffsets | None,
+    part: "Part | None" = None,
 ) -> Stats:
     warnings = warnings or Warnings(strict=strict)
     stats = Stats()
@@ -320,7 +351,21 @@ def _process(
         lines: Iterable[str] = (event.block.text for event in _first_per_block(events))
     else:
         ctx = make_context(source, tolerance, warnings, file, kernels)
-        lines = with_header(writer.write(run_passes(events, ctx, PASSES)), header_text(source, tolerance), writer)
+        if part is None:
+            lines = with_header(writer.write(run_passes(events, ctx, PASSES)), header_text(source, tolerance), writer)
+        elif not part.second:  # the first part: up to the cut, where it records the state
+            ctx = replace(ctx, cut=part.cut)
+            done = _stopped_at(run_passes(events, ctx, PASSES), part, ctx, writer)
+            lines = with_header(writer.write(done), header_text(source, tolerance), writer)
+        elif part.resume is not None:  # the second part: from the cut on, from the state recorded there
+            pass_state, writer_state = part.resume
+            writer.restore(writer_state)
+            later = (event for event in events if event.block.line >= part.cut)
+            lines = writer.write(run_passes(later, replace(ctx, resume=pass_state), PASSES))
+        else:  # the second part, guessing the state at the cut: what a window of lines before it leads to
+            ctx = replace(ctx, cut=part.cut)
+            window = _learnt_before(events, part.cut - part.window, writer)
+            lines = _after_mark(writer.write(_marked_at(run_passes(window, ctx, PASSES), part, ctx, writer)))
     lines = iter(lines)
     with _rare_collections():
         while batch := list(islice(lines, 4096)):  # written in batches: one encode and write per 4096 lines
@@ -328,6 +373,69 @@ def _process(
             stats.lines_out += len(batch)
     stats.lines_in = next(counter)
     return stats
+
+
+@dataclass
+class Part:
+    """One of a program's two parts, compensated apart (one process each): the first
+    ends before input line `cut` (a multiple of `geometry.LINE_CHUNK`) and records
+    the passes' and the writer's state there in `reached`; the second starts at the
+    cut from such a state (`resume`).  Together they write what one run writes."""
+
+    cut: int
+    resume: tuple | None = None  # (apply_error_map.PassState, iso.WriterState)
+    reached: tuple | None = None
+    second: bool = False  # a second part (without `resume`: it guesses the state from `window`)
+    window: int = 2048  # input lines before the cut that a second part compensates to find its state
+
+
+_MARK = "\x00ncpp: the cut\x00"  # the text of the line that marks the cut in a second part's output
+
+
+def _learnt_before(events: Iterable[Event], line: int, writer: IsoWriter) -> Iterator[Event]:
+    """The events from input line `line` on; the writer learns the number styles of the blocks before."""
+    last = None
+    for event in events:
+        if event.block.line >= line:
+            yield event
+            break
+        if event.block is not last:
+            last = event.block
+            if not (type(event) is Pass and event.skipped):
+                writer._read_block(last)
+    yield from events
+
+
+def _marked_at(events: Iterable[Event], part: Part, ctx: PassContext, writer: IsoWriter) -> Iterator[Event]:
+    """The events, with a marked empty line before the cut; the state there goes to `part.reached`."""
+    for event in events:
+        if event.block.line >= part.cut:
+            yield Pass(Block(_MARK, "", (), part.cut, True), True)
+            part.reached = (ctx.at_cut[0], writer.state())
+            yield event
+            break
+        yield event
+    yield from events
+
+
+def _after_mark(lines: Iterable[str]) -> Iterator[str]:
+    """The lines after the mark."""
+    lines = iter(lines)
+    for line in lines:
+        if line == _MARK:
+            break
+    yield from lines
+
+
+def _stopped_at(events: Iterable[Event], part: Part, ctx: PassContext, writer: IsoWriter) -> Iterator[Event]:
+    """The events before the cut; the state there goes to `part.reached`."""
+    for event in events:
+        if event.block.line >= part.cut:
+            # the writer writes what came before on taking this empty line, and asks for more
+            yield Pass(Block("", "", (), part.cut, True), True)
+            part.reached = (ctx.at_cut[0], writer.state())
+            return
+        yield event
 
 
 @contextmanager

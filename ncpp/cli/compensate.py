@@ -36,8 +36,9 @@ def add_compensation_arguments(p: argparse.ArgumentParser) -> None:
         type=int,
         choices=(1, 2),
         default=None,
-        help="processes: 2 runs compensation's numeric work in a second process beside the reading and writing "
-        "(same output); default 2 for a program file over 2 MB on a machine with two or more cores, else 1",
+        help="processes: 2 compensates an ISO program file of 8192 lines or more in two parts, one process each, and "
+        "other input with its numeric work in a second process (the same output either way); "
+        "default 2 for a program file over 2 MB on a machine with two or more cores, else 1",
     )
 
 

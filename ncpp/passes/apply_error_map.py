@@ -39,17 +39,54 @@ NEAR_STILL = 0.05
 
 
 def apply_error_map(events: Iterable[Event], ctx: PassContext) -> Iterator[Event]:
-    solve = ctx.kernels.bind(Solve(ctx.for_kernels()))
-    last = None  # the last segment written: its compensated end, in its own program frame
+    resume = ctx.resume
+    solver = Solve(ctx.for_kernels(), None if resume is None else resume.travel)
+    solve = ctx.kernels.bind(solver)
+    last = None if resume is None else resume.last  # the last segment written: its compensated end, in its own program frame
     chunks = (_with_rows(chunk, ctx.directional) for chunk in line_chunks(events))
+    cut = _Cut(ctx.cut, solver) if ctx.cut is not None else None
+
+    def start(c):
+        if cut is not None:
+            cut.before_solving(c[0])
+        return None if c[2] is None else solve(c[2])
+
     # with a worker process, the next chunks are read (parsed, interpreted, their arcs replaced) while one is solved
-    for (chunk, segs, rows), solving in run_ahead(chunks, lambda c: None if c[2] is None else solve(c[2]), ctx.kernels.ahead):
+    for (chunk, segs, rows), solving in run_ahead(chunks, start, ctx.kernels.ahead):
+        if cut is not None:
+            cut.before_writing(chunk, last, ctx.at_cut)
         if solving is None:  # no segments
             yield from chunk
             continue
         out = _written(chunk, segs, rows, solving.result(), last)
         last = next(e for e in reversed(out) if type(e) is Line or type(e) is Arc)
         yield from out
+
+
+@dataclass
+class PassState:
+    """Where the pass stands between two chunks: what the machine has done, and the
+    last segment written (what a run resumed there starts from)."""
+
+    travel: Travel
+    last: Line | Arc | None
+
+
+class _Cut:
+    """Records the pass's state at the first chunk from input line `line` on
+    (a window's first line: a chunk starts there, `line_chunks`), in one process."""
+
+    def __init__(self, line: int, solver: "Solve"):
+        self.line, self.solver, self.travel = line, solver, None
+
+    def before_solving(self, chunk: list[Event]) -> None:
+        if self.travel is None and chunk[0].block.line >= self.line:
+            held, last = self.solver.travel.held, self.solver.travel.last
+            self.travel = Travel(held.copy(), None if last is None else last.copy())
+
+    def before_writing(self, chunk: list[Event], last, at_cut: list) -> None:
+        if self.travel is not None and not at_cut and chunk[0].block.line >= self.line:
+            at_cut.append(PassState(self.travel, last))
 
 
 def _with_rows(chunk: list[Event], directional: bool) -> tuple[list[Event], list, "_Rows | None"]:
@@ -93,8 +130,9 @@ class Solve:
     and shifted arc pieces.  Keeps what the machine has done so far (`Travel`),
     so chunks must come in order."""
 
-    def __init__(self, ctx: PassContext):
-        self.ctx, self.travel = ctx, Travel()
+    def __init__(self, ctx: PassContext, travel: Travel | None = None):
+        self.ctx = ctx
+        self.travel = Travel() if travel is None else Travel(travel.held.copy(), None if travel.last is None else travel.last.copy())
 
     def __call__(self, rows: _Rows) -> "_Solved":
         if self.ctx.directional:

@@ -47,10 +47,15 @@ class PassContext:
     warnings: Warnings = field(default_factory=Warnings)
     file: str = "<stdin>"
     kernels: Kernels = INLINE  # where the passes' numeric kernels run (kernels.py)
+    # A run in two parts (one process each): the input line where the second starts, where
+    # the first records the passes' state (`at_cut`), and the state the second resumes from
+    cut: int | None = None
+    at_cut: list = field(default_factory=list)
+    resume: object | None = None  # apply_error_map.PassState
 
     def for_kernels(self) -> "PassContext":
         """This context as a kernel holds it: picklable (no output stream, no worker)."""
-        return replace(self, warnings=Warnings(self.warnings.strict, io.StringIO()), kernels=INLINE)
+        return replace(self, warnings=Warnings(self.warnings.strict, io.StringIO()), kernels=INLINE, cut=None, at_cut=[], resume=None)
 
     def limit_arrays(self) -> tuple[NDArray, NDArray]:
         lo = np.array([self.limits.get(a, (-np.inf, np.inf))[0] for a in "XYZ"])

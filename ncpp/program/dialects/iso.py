@@ -11,7 +11,7 @@ with at least the resolution needed for compensation.
 from __future__ import annotations
 
 import re
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from operator import itemgetter
 from typing import Iterable, Iterator
 
@@ -85,6 +85,20 @@ class IsoWriter:
 
     def comment(self, text: str) -> str:
         return f"{self.comment_open}{text}{self.comment_close}"
+
+    # -- a run in two parts ---------------------------------------------------
+    def state(self) -> "WriterState":
+        """What decides how the next block is written (the rest is caches)."""
+        return WriterState(tuple(sorted(self.styles.items())), self.program_motion, self.output_motion,
+                           frozenset(self.known_axes), self._last_end, self._last_places)  # fmt: skip
+
+    def restore(self, state: "WriterState") -> None:
+        """Continue as a writer in `state` would."""
+        for letter, style in state.styles:
+            self._learn_style(letter, style)
+        self.program_motion, self.output_motion = state.program_motion, state.output_motion
+        self.known_axes = set(state.known_axes)
+        self._last_end, self._last_places = state.last_end, state.last_places
 
     # -- the stream -----------------------------------------------------------
     def write(self, events: Iterable[Event]) -> Iterator[str]:
@@ -554,6 +568,18 @@ def written_apart(value: float, places: int, last: float, last_places: int) -> b
     with `last_places` (compared as numbers first: most axes a block does not write are
     exactly where the output left them)."""
     return (value != last or places != last_places) and round(value, places) != round(last, last_places)
+
+
+@dataclass(frozen=True)
+class WriterState:
+    """`IsoWriter.state`: equal states write the same blocks the same way."""
+
+    styles: tuple
+    program_motion: int | None
+    output_motion: int | None
+    known_axes: frozenset
+    last_end: tuple | None
+    last_places: tuple
 
 
 class _Written:

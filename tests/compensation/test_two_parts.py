@@ -1,0 +1,74 @@
+"""`--jobs 2` on a long ISO program file: two parts, one process each (`ncpp/parts.py`).
+The output is one run's, byte for byte: when the second process reaches the state
+the first has at the cut, and when it does not or fails (the first then does it)."""
+
+import io
+import subprocess
+import sys
+
+import pytest
+
+import ncpp.parts as parts
+from ncpp.errors import Warnings
+from ncpp.motion.offsets import WorkOffsets
+from ncpp.pipeline import ErrorSource, process
+
+from .test_kernels import OFFSET, ROOT, _pattern
+
+# long enough for two parts; a canned cycle warns (once per series) before the cut and after it
+LINES = [_pattern(k) for k in range(2 * parts.MIN_LINES // 13)]
+LINES[40] += "G81 X20 Y20 Z-2 R1 F100\nG80\n"
+LINES[-40] += "G81 X20 Y20 Z-2 R1 F100\nG80\n"
+PROGRAM = ("G21 G90 G17 F600\n" + "".join(LINES) + "M2\n").encode()
+
+
+@pytest.fixture(scope="module")
+def program(tmp_path_factory):
+    path = tmp_path_factory.mktemp("parts") / "long.ngc"
+    path.write_bytes(PROGRAM)
+    return path
+
+
+@pytest.fixture(scope="module")
+def source():
+    return ErrorSource.from_machine_file(str(ROOT / "samples/machines/hr5b.toml"))
+
+
+def _compensated(path, source, jobs: int) -> tuple[bytes, str, object]:
+    out, said = io.BytesIO(), io.StringIO()
+    with open(path, "rb") as stream:
+        stats = process(stream, out, file="long.ngc", source=source, jobs=jobs, warnings=Warnings(stream=said), offsets=WorkOffsets.at(OFFSET))
+    return out.getvalue(), said.getvalue(), stats
+
+
+@pytest.fixture(scope="module")
+def one_run(program, source):
+    return _compensated(program, source, jobs=1)
+
+
+def test_two_parts_write_what_one_run_writes(program, source, one_run, monkeypatch):
+    split, same = [], parts._same
+    monkeypatch.setattr(parts, "_same", lambda a, b: split.append(same(a, b)) or split[-1])
+    assert _compensated(program, source, jobs=2) == one_run
+    assert split == [True]  # the second process's part was taken
+
+
+def test_when_the_states_differ_the_first_process_writes_the_rest(program, source, one_run, monkeypatch):
+    monkeypatch.setattr(parts, "_same", lambda a, b: False)
+    assert _compensated(program, source, jobs=2) == one_run
+
+
+def test_when_the_second_process_fails_the_first_writes_the_rest(program, source, one_run, monkeypatch):
+    monkeypatch.setattr(parts, "_start", lambda job: subprocess.Popen([sys.executable, "-c", "raise SystemExit(3)"], stdout=subprocess.PIPE))
+    assert _compensated(program, source, jobs=2) == one_run
+
+
+def test_the_warnings_are_one_runs(one_run):
+    _, said, _ = one_run
+    assert said.count("canned cycle") == 2  # which the comparisons above check are given once each
+
+
+def test_a_short_program_stays_in_one_process(tmp_path):
+    path = tmp_path / "short.ngc"
+    path.write_bytes(b"G1 X1 F100\n" * (parts.MIN_LINES - 10))
+    assert parts.cut_for(str(path)) is None
