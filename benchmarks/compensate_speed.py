@@ -2,12 +2,12 @@
 
 On the core benchmark's files (stellabee1.ngc and the generated G1/G2/G3
 program), one run times, in this process: `ncpp` passthrough (no machine),
-`ncpp compensate` with the HR5B sample machine at 1 µm (with a worker
-process, as `ncpp compensate` runs a program over 2 MB on two cores, and in
-one process), pygcode's `Line()` parse and LinuxCNC's rs274.  Floor:
-compensation at least as fast as pygcode's parse.  Memory: peak RSS of
-`ncpp compensate --jobs 2` on two program lengths (1M and 10M lines; 20k and
-60k with --quick).
+`ncpp compensate` with the HR5B sample machine at 1 µm (`--jobs 2`, as
+`ncpp compensate` runs a program file over 2 MB on two cores: two parts, one
+process each, `ncpp/parts.py`; and in one process), pygcode's `Line()` parse
+and LinuxCNC's rs274.  Floor: compensation at least as fast as pygcode's
+parse.  Memory: peak RSS of `ncpp compensate --jobs 2 FILE` on two program
+lengths (1M and 10M lines; 20k and 60k with --quick).
 """
 
 from __future__ import annotations
@@ -53,7 +53,7 @@ def ncpp_process_rate(path: Path, offset: tuple[float, float, float] | None, job
     with open(path, "rb") as stream:
         stats = process(stream, sink, file=str(path), source=source, tolerance=TOLERANCE, warnings=QUIET, jobs=jobs, offsets=offsets)
     seconds, cpu = time.perf_counter() - start, time.process_time() - cpu
-    worker = _children_cpu() - children  # the worker has exited (process() closes it): its CPU is counted
+    worker = _children_cpu() - children  # the second process has exited (process() waits for it): its CPU is counted
     return {"lines": stats.lines_in, "lines_out": stats.lines_out, "seconds": seconds, "lines_per_s": stats.lines_in / seconds,
             "main_cpu_s": cpu, "worker_cpu_s": worker}  # fmt: skip
 
@@ -69,7 +69,7 @@ def _cpu_split(result: dict[str, Any], pygcode: dict[str, Any] | None = None) ->
     """CPU per input line of each process, beside pygcode's when given: what the floor asks
     of each (both processes at or below pygcode's time per line)."""
     per_line = lambda seconds: 1e6 * seconds / max(result["lines"], 1)  # noqa: E731
-    split = f"CPU µs per line in: main {per_line(result['main_cpu_s']):.0f}, worker {per_line(result['worker_cpu_s']):.0f}"
+    split = f"CPU µs per line in: this process {per_line(result['main_cpu_s']):.0f}, the second {per_line(result['worker_cpu_s']):.0f}"
     return split if pygcode is None else f"{split}; pygcode {per_line(pygcode['seconds']):.0f}"
 
 
@@ -152,12 +152,12 @@ def _verdict(ratio: float, paired: list[float]) -> str:
 
 
 def compensate_rss(path: Path, offset: tuple[float, float, float]) -> dict[str, Any]:
-    """Peak RSS (MB) of `ncpp compensate --jobs 2 ... < path > /dev/null`, through run.peak_rss's
+    """Peak RSS (MB) of `ncpp compensate --jobs 2 ... path > /dev/null`, through run.peak_rss's
     probe (a child's ru_maxrss would inherit this big benchmark process's own).  Linux gives
-    the larger of the two processes' peaks (the worker is waited for)."""
+    the larger of the two processes' peaks (the second is waited for)."""
     import run as bench
 
-    return bench.peak_rss(path, ["compensate", "--jobs", "2", "--machine", str(MACHINE), "--work-offset", ",".join(map(str, offset))])
+    return bench.peak_rss(path, ["compensate", "--jobs", "2", "--machine", str(MACHINE), "--work-offset", ",".join(map(str, offset)), str(path)])
 
 
 def compensate_speed(ctx):
@@ -189,7 +189,7 @@ def compensate_speed(ctx):
         growth = compensated["lines_out"] / max(compensated["lines"], 1)
         rows += [
             [label, "ncpp passthrough", f"{passthrough['lines_per_s']:,.0f}", ""],
-            [label, "ncpp compensate 1 µm (HR5B), --jobs 2", f"{compensated['lines_per_s']:,.0f}", f"lines out/in {growth:.2f}; a worker process on the second core"],
+            [label, "ncpp compensate 1 µm (HR5B), --jobs 2", f"{compensated['lines_per_s']:,.0f}", f"lines out/in {growth:.2f}; two parts, one process each"],
             [label, "ncpp compensate 1 µm (HR5B), --jobs 1", f"{alone['lines_per_s']:,.0f}", "one process"],
             [label, "pygcode Line()", f"{pyg['lines_per_s']:,.0f}", ""],
             [label, "rs274 (process)", f"{rs['lines_per_s']:,.0f}", "completed" if rs["completed"] else "STOPPED"],
