@@ -84,6 +84,7 @@ def cut_for(path: str) -> int | None:
 
 
 def process_in_two_parts(
+    stream: BinaryIO,
     path: str,
     out: BinaryIO,
     cut: int,
@@ -98,7 +99,8 @@ def process_in_two_parts(
     dialect: str | None,
     offsets,
 ):
-    """`pipeline.process` of the program at `path` in two parts split at input line `cut`."""
+    """`pipeline.process` of the program `stream` (unread; the file at `path`) in two parts
+    split at input line `cut` (the first part reads `stream`: its progress is the file's)."""
     from ncpp.pipeline import Part, Stats, process
 
     options = dict(file=file, source=source, tolerance=tolerance, strict=strict, force=force, dialect=dialect, offsets=offsets)
@@ -107,8 +109,7 @@ def process_in_two_parts(
         second = _start(Job(path, file, source, tolerance, strict, force, dialect, offsets, cut, spool))
         try:
             first = Part(cut)
-            with open(path, "rb") as stream:
-                stats = process(stream, out, warnings=warnings, progress=progress, part=first, **options)  # type: ignore[arg-type]
+            stats = process(stream, out, warnings=warnings, progress=progress, part=first, **options)  # type: ignore[arg-type]
             if first.reached is None:  # the program ended before the cut
                 return stats
             reply = _reply(second)

@@ -276,7 +276,7 @@ def process(
             from ncpp.parts import process_in_two_parts
 
             path, cut = split
-            return process_in_two_parts(path, out, cut, file=file, source=source, tolerance=tolerance, strict=strict, force=force,
+            return process_in_two_parts(stream, path, out, cut, file=file, source=source, tolerance=tolerance, strict=strict, force=force,
                                         warnings=warnings or Warnings(strict=strict), progress=progress, dialect=dialect, offsets=offsets)  # fmt: skip
     kernels = _kernels(source is not None and jobs > 1)  # started first: the worker starts while we parse
     try:

@@ -72,3 +72,12 @@ def test_a_short_program_stays_in_one_process(tmp_path):
     path = tmp_path / "short.ngc"
     path.write_bytes(b"G1 X1 F100\n" * (parts.MIN_LINES - 10))
     assert parts.cut_for(str(path)) is None
+
+
+def test_the_first_part_reads_the_stream_it_is_given(program, source):
+    """Progress by the file's position (the LinuxCNC filter's) moves while the first part runs."""
+    seen = []
+    with open(program, "rb") as stream:
+        process(stream, io.BytesIO(), file="long.ngc", source=source, jobs=2, warnings=Warnings(stream=io.StringIO()),
+                offsets=WorkOffsets.at(OFFSET), progress=lambda lines: seen.append(stream.tell()))  # fmt: skip
+    assert seen and 0 < max(seen) < len(PROGRAM)
