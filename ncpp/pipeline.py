@@ -393,7 +393,7 @@ _MARK = "\x00ncpp: the cut\x00"  # the text of the line that marks the cut in a 
 
 
 def _learnt_before(events: Iterable[Event], line: int, writer: IsoWriter) -> Iterator[Event]:
-    """The events from input line `line` on; the writer learns the number styles of the blocks before."""
+    """The events from input line `line` on; the writer learns from the blocks before (`IsoWriter.learn`)."""
     last = None
     for event in events:
         if event.block.line >= line:
@@ -402,7 +402,7 @@ def _learnt_before(events: Iterable[Event], line: int, writer: IsoWriter) -> Ite
         if event.block is not last:
             last = event.block
             if not (type(event) is Pass and event.skipped):
-                writer._read_block(last)
+                writer.learn(last)
     yield from events
 
 

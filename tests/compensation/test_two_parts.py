@@ -81,3 +81,14 @@ def test_the_first_part_reads_the_stream_it_is_given(program, source):
         process(stream, io.BytesIO(), file="long.ngc", source=source, jobs=2, warnings=Warnings(stream=io.StringIO()),
                 offsets=WorkOffsets.at(OFFSET), progress=lambda lines: seen.append(stream.tell()))  # fmt: skip
     assert seen and 0 < max(seen) < len(PROGRAM)
+
+
+def test_a_motion_mode_set_once_at_the_top_is_known_at_the_cut(tmp_path, source, monkeypatch):
+    """The second part's writer learns the lines before its window: the program's G1 too."""
+    moves = "".join(f"X{10 + (k * 7) % 40}.{k % 10} Y{5 + (k * 3) % 30}\n" for k in range(parts.MIN_LINES + 100))
+    path = tmp_path / "modal.ngc"
+    path.write_bytes(("G21 G90 G17\nG1 F600\n" + moves + "M2\n").encode())
+    split, same = [], parts._same
+    monkeypatch.setattr(parts, "_same", lambda a, b: split.append(same(a, b)) or split[-1])
+    assert _compensated(path, source, jobs=2)[:2] == _compensated(path, source, jobs=1)[:2]
+    assert split == [True]

@@ -92,6 +92,16 @@ class IsoWriter:
         return WriterState(tuple(sorted(self.styles.items())), self.program_motion, self.output_motion,
                            frozenset(self.known_axes), self._last_end, self._last_places)  # fmt: skip
 
+    def learn(self, block: Block) -> None:
+        """What writing the block would teach about the program, without writing it: its
+        number styles and motion mode (a second part's writer reads the lines before its
+        window so, `ncpp/parts.py`)."""
+        facts = self._read_block(block)
+        if facts.flow:  # after a control line the program's mode is unknown here (`_write_control`)
+            self.program_motion = None
+        elif facts.motion_word:
+            self.program_motion = facts.motion
+
     def restore(self, state: "WriterState") -> None:
         """Continue as a writer in `state` would."""
         for letter, style in state.styles:
