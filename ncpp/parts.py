@@ -20,12 +20,15 @@ import subprocess
 import sys
 import tempfile
 from dataclasses import dataclass
-from typing import BinaryIO, Callable
+from typing import TYPE_CHECKING, BinaryIO, Callable
 
 import numpy as np
 
 from ncpp.errors import Location, NcppError, Warnings
 from ncpp.passes.geometry import LINE_CHUNK
+
+if TYPE_CHECKING:
+    from ncpp.pipeline import Stats
 
 # The first part's share of the lines: the second part also starts a Python,
 # interprets the first part's lines and compensates a window before the cut, so it
@@ -98,7 +101,7 @@ def process_in_two_parts(
     progress: Callable[[int], None] | None,
     dialect: str | None,
     offsets,
-):
+) -> "Stats":
     """`pipeline.process` of the program `stream` (unread; the file at `path`) in two parts
     split at input line `cut` (the first part reads `stream`: its progress is the file's)."""
     from ncpp.pipeline import Part, Stats, process
