@@ -129,7 +129,7 @@ def process_in_two_parts(
     for said in later["said"]:
         if said.where.line is not None and said.where.line >= cut:  # the first part gave those before
             warnings.warn(said.message, said.where)
-    return Stats(later["lines_in"], stats.lines_out - 1 + later["lines_out"])  # - 1: the first part's empty last line at the cut
+    return Stats(later["lines_in"], stats.lines_out + later["lines_out"])
 
 
 def _rest_here(path: str, out: BinaryIO, cut: int, reached: tuple, strict: bool, options: dict) -> dict:

@@ -355,8 +355,8 @@ def _process(
             lines = with_header(writer.write(run_passes(events, ctx, PASSES)), header_text(source, tolerance), writer)
         elif not part.second:  # the first part: up to the cut, where it records the state
             ctx = replace(ctx, cut=part.cut)
-            done = _stopped_at(run_passes(events, ctx, PASSES), part, ctx, writer)
-            lines = with_header(writer.write(done), header_text(source, tolerance), writer)
+            done = _cut_at(run_passes(events, ctx, PASSES), part, ctx, writer, stop=True)
+            lines = with_header(_before_mark(writer.write(done)), header_text(source, tolerance), writer)
         elif part.resume is not None:  # the second part: from the cut on, from the state recorded there
             pass_state, writer_state = part.resume
             writer.restore(writer_state)
@@ -365,7 +365,7 @@ def _process(
         else:  # the second part, guessing the state at the cut: what a window of lines before it leads to
             ctx = replace(ctx, cut=part.cut)
             window = _learnt_before(events, part.cut - part.window, writer)
-            lines = _after_mark(writer.write(_marked_at(run_passes(window, ctx, PASSES), part, ctx, writer)))
+            lines = _after_mark(writer.write(_cut_at(run_passes(window, ctx, PASSES), part, ctx, writer, stop=False)))
     lines = iter(lines)
     with _rare_collections():
         while batch := list(islice(lines, 4096)):  # written in batches: one encode and write per 4096 lines
@@ -389,7 +389,7 @@ class Part:
     window: int = 2048  # input lines before the cut that a second part compensates to find its state
 
 
-_MARK = "\x00ncpp: the cut\x00"  # the text of the line that marks the cut in a second part's output
+_MARK = "\x00ncpp: the cut\x00"  # the text of the line that marks the cut in a part's output
 
 
 def _learnt_before(events: Iterable[Event], line: int, writer: IsoWriter) -> Iterator[Event]:
@@ -406,16 +406,28 @@ def _learnt_before(events: Iterable[Event], line: int, writer: IsoWriter) -> Ite
     yield from events
 
 
-def _marked_at(events: Iterable[Event], part: Part, ctx: PassContext, writer: IsoWriter) -> Iterator[Event]:
-    """The events, with a marked empty line before the cut; the state there goes to `part.reached`."""
+def _cut_at(events: Iterable[Event], part: Part, ctx: PassContext, writer: IsoWriter, stop: bool) -> Iterator[Event]:
+    """The events, with a marked empty line before the cut (the writer writes what came
+    before on taking it, then asks for more: the state there goes to `part.reached`);
+    with `stop`, none after it."""
     for event in events:
         if event.block.line >= part.cut:
             yield Pass(Block(_MARK, "", (), part.cut, True), True)
             part.reached = (ctx.at_cut[0], writer.state())
+            if stop:
+                return
             yield event
             break
         yield event
     yield from events
+
+
+def _before_mark(lines: Iterable[str]) -> Iterator[str]:
+    """The lines before the mark."""
+    for line in lines:
+        if line == _MARK:
+            return
+        yield line
 
 
 def _after_mark(lines: Iterable[str]) -> Iterator[str]:
@@ -425,17 +437,6 @@ def _after_mark(lines: Iterable[str]) -> Iterator[str]:
         if line == _MARK:
             break
     yield from lines
-
-
-def _stopped_at(events: Iterable[Event], part: Part, ctx: PassContext, writer: IsoWriter) -> Iterator[Event]:
-    """The events before the cut; the state there goes to `part.reached`."""
-    for event in events:
-        if event.block.line >= part.cut:
-            # the writer writes what came before on taking this empty line, and asks for more
-            yield Pass(Block("", "", (), part.cut, True), True)
-            part.reached = (ctx.at_cut[0], writer.state())
-            return
-        yield event
 
 
 @contextmanager

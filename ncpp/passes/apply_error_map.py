@@ -81,8 +81,7 @@ class _Cut:
 
     def before_solving(self, chunk: list[Event]) -> None:
         if self.travel is None and chunk[0].block.line >= self.line:
-            held, last = self.solver.travel.held, self.solver.travel.last
-            self.travel = Travel(held.copy(), None if last is None else last.copy())
+            self.travel = self.solver.travel.copy()
 
     def before_writing(self, chunk: list[Event], last, at_cut: list) -> None:
         if self.travel is not None and not at_cut and chunk[0].block.line >= self.line:
@@ -132,7 +131,7 @@ class Solve:
 
     def __init__(self, ctx: PassContext, travel: Travel | None = None):
         self.ctx = ctx
-        self.travel = Travel() if travel is None else Travel(travel.held.copy(), None if travel.last is None else travel.last.copy())
+        self.travel = Travel() if travel is None else travel.copy()
 
     def __call__(self, rows: _Rows) -> "_Solved":
         if self.ctx.directional:

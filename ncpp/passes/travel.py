@@ -27,6 +27,9 @@ class Travel:
     held: NDArray = field(default_factory=lambda: np.zeros(3))
     last: NDArray | None = None
 
+    def copy(self) -> "Travel":
+        return Travel(self.held.copy(), None if self.last is None else self.last.copy())
+
 
 def grid(ctx: PassContext, scales: NDArray) -> NDArray:
     """(n,) output resolution per segment in its program units."""

@@ -92,3 +92,9 @@ def test_a_motion_mode_set_once_at_the_top_is_known_at_the_cut(tmp_path, source,
     monkeypatch.setattr(parts, "_same", lambda a, b: split.append(same(a, b)) or split[-1])
     assert _compensated(path, source, jobs=2)[:2] == _compensated(path, source, jobs=1)[:2]
     assert split == [True]
+
+
+def test_the_parts_count_the_lines_one_run_writes(program, source, one_run):
+    _, _, stats = _compensated(program, source, jobs=2)
+    _, _, alone = one_run
+    assert (stats.lines_in, stats.lines_out) == (alone.lines_in, alone.lines_out)
