@@ -22,8 +22,6 @@ import tempfile
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, BinaryIO, Callable
 
-import numpy as np
-
 from ncpp.errors import Location, NcppError, Warnings
 from ncpp.passes.geometry import LINE_CHUNK
 
@@ -144,18 +142,7 @@ def _rest_here(path: str, out: BinaryIO, cut: int, reached: tuple, strict: bool,
 
 def _same(a: tuple, b: tuple) -> bool:
     """Whether two states at the cut (apply_error_map.PassState, iso.WriterState) write the rest alike."""
-    (pass_a, writer_a), (pass_b, writer_b) = a, b
-    travel_a, travel_b = pass_a.travel, pass_b.travel
-    if not np.array_equal(travel_a.held, travel_b.held) or (travel_a.last is None) != (travel_b.last is None):
-        return False
-    if travel_a.last is not None and not np.array_equal(travel_a.last, travel_b.last):
-        return False
-    last_a, last_b = pass_a.last, pass_b.last
-    if (last_a is None) != (last_b is None):
-        return False
-    if last_a is not None and (last_a.end != last_b.end or last_a.context != last_b.context):
-        return False
-    return writer_a == writer_b
+    return a == b
 
 
 # -- the second process ---------------------------------------------------------------

@@ -63,13 +63,27 @@ def apply_error_map(events: Iterable[Event], ctx: PassContext) -> Iterator[Event
         yield from out
 
 
-@dataclass
+@dataclass(eq=False)
 class PassState:
     """Where the pass stands between two chunks: what the machine has done, and the
     last segment written (what a run resumed there starts from)."""
 
     travel: Travel
     last: Line | Arc | None
+
+    def __eq__(self, other: object) -> bool:
+        """Equal states compensate the chunks after them alike: the same held directions
+        and last command, and a last segment ending at the same point of the same frame."""
+        if not isinstance(other, PassState):
+            return NotImplemented
+        a, b = self.travel, other.travel
+        if not np.array_equal(a.held, b.held) or (a.last is None) != (b.last is None):
+            return False
+        if a.last is not None and not np.array_equal(a.last, b.last):
+            return False
+        if self.last is None or other.last is None:
+            return self.last is other.last
+        return self.last.end == other.last.end and self.last.context == other.last.context
 
 
 class _Cut:

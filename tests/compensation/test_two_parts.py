@@ -98,3 +98,21 @@ def test_the_parts_count_the_lines_one_run_writes(program, source, one_run):
     _, _, stats = _compensated(program, source, jobs=2)
     _, _, alone = one_run
     assert (stats.lines_in, stats.lines_out) == (alone.lines_in, alone.lines_out)
+
+
+def test_states_at_the_cut_differ_where_the_rest_would():
+    import numpy as np
+
+    from ncpp.motion.segments import Line
+    from ncpp.passes.apply_error_map import PassState
+    from ncpp.passes.travel import Travel
+    from ncpp.program.blocks import Block
+
+    block = Block("X1", "\n", (), 1)
+    state = lambda held=(1.0, -1.0, 0.0), last=(1.0, 2.0, 3.0), end=(1.0, 2.0, 0.0): PassState(  # noqa: E731
+        Travel(np.array(held), np.array(last)), Line((0.0, 0.0, 0.0), end, False, 100.0, block)
+    )
+    assert state() == state()
+    assert state(held=(1.0, 1.0, 0.0)) != state()
+    assert state(last=(1.0, 2.0, 3.0001)) != state()
+    assert state(end=(1.0, 2.0, 0.0001)) != state()
