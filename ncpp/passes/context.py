@@ -4,13 +4,16 @@ from __future__ import annotations
 
 import io
 from dataclasses import dataclass, field, replace
-from typing import Protocol
+from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
 from numpy.typing import NDArray
 
 from ncpp.errors import Warnings
 from ncpp.passes.kernels import INLINE, Kernels
+
+if TYPE_CHECKING:
+    from ncpp.passes.apply_error_map import PassState
 
 
 class ErrorMap(Protocol):
@@ -50,8 +53,8 @@ class PassContext:
     # A run in two parts (one process each): the input line where the second starts, where
     # the first records the passes' state (`at_cut`), and the state the second resumes from
     cut: int | None = None
-    at_cut: list = field(default_factory=list)
-    resume: object | None = None  # apply_error_map.PassState
+    at_cut: list[PassState] = field(default_factory=list)
+    resume: PassState | None = None
 
     def for_kernels(self) -> "PassContext":
         """This context as a kernel holds it: picklable (no output stream, no worker)."""
