@@ -106,6 +106,31 @@ def points(coordinates: Sequence[tuple[float, float, float]]) -> NDArray:
     return np.fromiter(chain.from_iterable(coordinates), dtype=float, count=3 * len(coordinates)).reshape(-1, 3)
 
 
+def in_plane(q: NDArray, axes: NDArray) -> tuple[NDArray, NDArray, NDArray]:
+    """The u, v and normal coordinates of points `q` (p,...,3), each shaped like q[..., 0],
+    in each row's plane (`axes` (p,3): its u, v and normal axis, `PLANE_AXES`).
+    Three arrays, not one (p,...,2): numpy reduces over a last axis of two slowly."""
+    if len(axes) and (axes == axes[0]).all():  # one plane (almost every chunk): slices
+        a, b, c = axes[0].tolist()
+        return q[..., a], q[..., b], q[..., c]
+    index = axes.reshape(len(axes), *([1] * (q.ndim - 2)), 3)
+    local = np.take_along_axis(q, np.broadcast_to(index, q.shape), axis=-1)
+    return local[..., 0], local[..., 1], local[..., 2]
+
+
+def from_plane(u: NDArray, v: NDArray, w: NDArray, axes: NDArray) -> NDArray:
+    """Points (p,...,3) from their coordinates in each row's plane (`in_plane`'s inverse)."""
+    out = np.empty((*u.shape, 3))
+    if len(axes) and (axes == axes[0]).all():
+        a, b, c = axes[0].tolist()
+        out[..., a], out[..., b], out[..., c] = u, v, w
+        return out
+    local = np.stack([u, v, w], axis=-1)
+    index = axes.reshape(len(axes), *([1] * (u.ndim - 1)), 3)
+    np.put_along_axis(out, np.broadcast_to(index, local.shape), local, axis=-1)
+    return out
+
+
 def compensate(
     points: NDArray,
     offsets: NDArray,

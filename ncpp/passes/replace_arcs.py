@@ -24,7 +24,7 @@ from numpy.typing import NDArray
 from ncpp.motion.segments import PLANE_AXES, Arc, Event, Line
 from ncpp.passes.context import PassContext
 from ncpp.passes.kernels import run_ahead
-from ncpp.passes.geometry import compensate, frames, points, rows_of, spliced
+from ncpp.passes.geometry import compensate, frames, from_plane, in_plane, points, rows_of, spliced
 from ncpp.passes.travel import grid, quantize
 
 # Points per piece where the fit is checked (ends included).  Fewer on short
@@ -138,34 +138,26 @@ class _ArcGeometry:
 
     def __init__(self, rows: _ArcRows):
         self.axes = rows.axes
-        local = lambda p: np.take_along_axis(p, self.axes, axis=1)  # noqa: E731
-        s, e, c = local(rows.start), local(rows.end), local(rows.centre)
-        self.centre = c[:, :2]
-        self.radius = np.hypot(s[:, 0] - c[:, 0], s[:, 1] - c[:, 1])
-        self.a0 = np.arctan2(s[:, 1] - c[:, 1], s[:, 0] - c[:, 0])
+        (su, sv, sw), (eu, ev, ew), (cu, cv, _) = (in_plane(p, self.axes) for p in (rows.start, rows.end, rows.centre))
+        self.centre_u, self.centre_v = cu, cv
+        self.radius = np.hypot(su - cu, sv - cv)
+        self.a0 = np.arctan2(sv - cv, su - cu)
         self.sweep = rows.sweep
-        self.w0 = s[:, 2]
-        self.rise = e[:, 2] - s[:, 2]
-        self.end_radius = np.hypot(e[:, 0] - c[:, 0], e[:, 1] - c[:, 1])
+        self.w0 = sw
+        self.rise = ew - sw
+        self.end_radius = np.hypot(eu - cu, ev - cv)
 
     def points(self, arc: NDArray, angles: NDArray) -> NDArray:
         """(p,m,3) program points at the given angles of the given arcs.
 
         The radius blends from the start to the end radius, as controllers
         do for arcs whose radii differ within their tolerance."""
-        frac = (angles - self.a0[arc, None]) / np.where(self.sweep[arc] == 0, 1.0, self.sweep[arc])[:, None]
+        sweep = self.sweep[arc]
+        frac = (angles - self.a0[arc, None]) / np.where(sweep == 0, 1.0, sweep)[:, None]
         r = self.radius[arc, None] + frac * (self.end_radius - self.radius)[arc, None]
-        local = np.stack(
-            [
-                self.centre[arc, 0, None] + r * np.cos(angles),
-                self.centre[arc, 1, None] + r * np.sin(angles),
-                self.w0[arc, None] + frac * self.rise[arc, None],
-            ],
-            axis=-1,
-        )
-        out = np.empty_like(local)
-        np.put_along_axis(out, np.broadcast_to(self.axes[arc][:, None, :], local.shape), local, axis=2)
-        return out
+        u = self.centre_u[arc, None] + r * np.cos(angles)
+        v = self.centre_v[arc, None] + r * np.sin(angles)
+        return from_plane(u, v, self.w0[arc, None] + frac * self.rise[arc, None], self.axes[arc])
 
 
 def _initial_pieces(geometry: _ArcGeometry, directional: bool) -> _Pieces:
@@ -232,8 +224,8 @@ def _round(pending: _Pieces, length: NDArray, t: NDArray, geometry, offsets, sca
     angles = pending.a0[:, None] + t[None, :] * pending.sweep[:, None]
     nominal = geometry.points(pending.arc, angles)
     middle = (pending.a0 + pending.sweep / 2)[:, None]
-    tangent = geometry.points(pending.arc, middle + 1e-6 * np.sign(pending.sweep)[:, None]) - geometry.points(pending.arc, middle)
-    direction = np.sign(tangent)
+    ahead = geometry.points(pending.arc, np.hstack([middle + 1e-6 * np.sign(pending.sweep)[:, None], middle]))
+    direction = np.sign(ahead[:, :1] - ahead[:, 1:])  # of the tangent in the middle
     # the normal axis's direction is the one the machine holds when it gets
     # here: apply_error_map knows it and shifts the piece; use the mean here
     np.put_along_axis(direction, geometry.axes[pending.arc, None, 2:], 0.0, axis=2)
@@ -281,13 +273,12 @@ def _one_way(q: NDArray, centre: NDArray, axes: NDArray, direction: NDArray, sig
     the axis there, where no step can follow.  An extreme within `window` (p,)
     (program units of path) of an end, or from which the axis goes back by less
     than `height` (p,), is rounding or a rotation of the compensated frame, not a reversal."""
-    local = lambda p: np.take_along_axis(p, axes, axis=1)  # noqa: E731
-    c, s0, s1 = local(centre)[:, :2], local(q[:, 0])[:, :2], local(q[:, -1])[:, :2]
-    want = np.take_along_axis(direction, axes, axis=1)[:, :2]
-    a0 = np.arctan2(s0[:, 1] - c[:, 1], s0[:, 0] - c[:, 0])
-    a1 = np.arctan2(s1[:, 1] - c[:, 1], s1[:, 0] - c[:, 0])
+    (cu, cv, _), (u0, v0, _), (u1, v1, _) = in_plane(centre, axes), in_plane(q[:, 0], axes), in_plane(q[:, -1], axes)
+    want_u, want_v, _ = in_plane(direction, axes)
+    a0 = np.arctan2(v0 - cv, u0 - cu)
+    a1 = np.arctan2(v1 - cv, u1 - cu)
     span = np.mod(sign * (a1 - a0), 2 * np.pi)  # angle travelled, whatever the wrap
-    r0, r1 = np.hypot(*(s0 - c).T), np.hypot(*(s1 - c).T)
+    r0, r1 = np.hypot(u0 - cu, v0 - cv), np.hypot(u1 - cu, v1 - cv)
     radius = np.maximum(r0, 1e-12)
     # controllers blend the radius from start to end: that moves each extreme
     # by (dr/dangle)/r, a lot on a short piece whose ends were rounded
@@ -302,8 +293,7 @@ def _one_way(q: NDArray, centre: NDArray, axes: NDArray, direction: NDArray, sig
     back = radius[:, None] * from_end**2 / 2 > height[:, None]
     inside = ((at > margin[:, None]) & (at < (span - margin)[:, None]) & back).any(axis=1)
     mid = a0 + sign * span / 2
-    tangent = sign[:, None] * np.column_stack([-np.sin(mid), np.cos(mid)])
-    agrees = (np.sign(tangent) == want).all(axis=1)
+    agrees = (np.sign(sign * -np.sin(mid)) == want_u) & (np.sign(sign * np.cos(mid)) == want_v)  # the tangent's signs
     return ~inside & agrees & (span < np.pi) & (np.abs(blend) < quarter / 2)
 
 
@@ -317,35 +307,38 @@ def _fit(q: NDArray, axes: NDArray, t: NDArray, tolerance: NDArray) -> tuple[NDA
     """Centre (p,3 program) on the bisector of each piece's end points, and the
     largest deviation (p,) of the compensated samples from the fitted helix
     (tolerance (p,) in program units)."""
-    local = np.take_along_axis(q, np.broadcast_to(axes[:, None, :], q.shape), axis=2)
-    uv, w = local[..., :2], local[..., 2]
-    q0, q1 = uv[:, 0], uv[:, -1]
-    mid = (q0 + q1) / 2
-    chord = q1 - q0
-    normal = np.stack([-chord[:, 1], chord[:, 0]], axis=-1)
-    normal /= np.linalg.norm(normal, axis=-1, keepdims=True)
+    u, v, w = in_plane(q, axes)
+    u0, v0, u1, v1 = u[:, 0], v[:, 0], u[:, -1], v[:, -1]
+    mu, mv = (u0 + u1) / 2, (v0 + v1) / 2
+    nu, nv = -(v1 - v0), u1 - u0  # the chord turned a quarter
+    length = np.sqrt(nu * nu + nv * nv)
+    nu, nv = nu / length, nv / length
     # |q_k - c|^2 - |q_0 - c|^2 is linear in the centre's position s along the bisector.
-    d = uv - q0[:, None, :]
-    a = (uv**2).sum(-1) - (q0**2).sum(-1)[:, None] - 2 * (d * mid[:, None, :]).sum(-1)
-    b = 2 * (d * normal[:, None, :]).sum(-1)
+    du, dv = u - u0[:, None], v - v0[:, None]
+    a = (u * u + v * v) - (u0 * u0 + v0 * v0)[:, None] - 2 * (du * mu[:, None] + dv * mv[:, None])
+    b = 2 * (du * nu[:, None] + dv * nv[:, None])
     s = (a * b).sum(-1) / np.maximum((b * b).sum(-1), 1e-300)
-    c = mid + s[:, None] * normal
-    radius = np.linalg.norm(q0 - c, axis=-1)
-    radial = np.linalg.norm(uv - c[:, None, :], axis=-1) - radius[:, None]
+    cu, cv = mu + s * nu, mv + s * nv
+    ru, rv = u0 - cu, v0 - cv
+    radius = np.sqrt(ru * ru + rv * rv)
+    eu, ev = u - cu[:, None], v - cv[:, None]
+    radial = np.sqrt(eu * eu + ev * ev) - radius[:, None]
     # Where least squares leaves much of the tolerance unused, its centre stands;
     # elsewhere move it to the smallest largest deviation (which is what is judged).
     tight = np.flatnonzero(np.abs(radial).max(axis=1) > tolerance / 2)
     if tight.size:
-        s[tight] += _minimax_step(uv[tight], q0[tight], c[tight], normal[tight])
-        c[tight] = mid[tight] + s[tight, None] * normal[tight]
-        radius[tight] = np.linalg.norm(q0[tight] - c[tight], axis=-1)
-        radial[tight] = np.linalg.norm(uv[tight] - c[tight, None, :], axis=-1) - radius[tight, None]
+        uv = np.stack([u[tight], v[tight]], axis=-1)
+        q0, c = uv[:, 0], np.column_stack([cu[tight], cv[tight]])
+        normal = np.column_stack([nu[tight], nv[tight]])
+        s[tight] += _minimax_step(uv, q0, c, normal)
+        cu[tight], cv[tight] = mu[tight] + s[tight] * nu[tight], mv[tight] + s[tight] * nv[tight]
+        ru, rv = u0[tight] - cu[tight], v0[tight] - cv[tight]
+        radius[tight] = np.sqrt(ru * ru + rv * rv)
+        eu, ev = u[tight] - cu[tight, None], v[tight] - cv[tight, None]
+        radial[tight] = np.sqrt(eu * eu + ev * ev) - radius[tight, None]
     ramp = w[:, :1] + t[None, :] * (w[:, -1:] - w[:, :1])
     deviation = np.hypot(radial, w - ramp).max(axis=1)
-    centre_local = np.column_stack([c, w[:, 0]])
-    centre = np.empty_like(centre_local)
-    np.put_along_axis(centre, axes, centre_local, axis=1)
-    return centre, deviation
+    return from_plane(cu, cv, w[:, 0], axes), deviation
 
 
 def _minimax_step(uv: NDArray, q0: NDArray, c: NDArray, normal: NDArray) -> NDArray:
