@@ -22,10 +22,10 @@ from typing import Iterable, Iterator
 import numpy as np
 from numpy.typing import NDArray
 
-from ncpp.motion.segments import PLANE_AXES, Arc, Event, Line
+from ncpp.motion.segments import Arc, Event, Line
 from ncpp.passes.context import PassContext, deviation
 from ncpp.passes.kernels import run_ahead
-from ncpp.passes.geometry import compensate, frames, line_chunks, points, rows_of
+from ncpp.passes.geometry import compensate, frames, from_plane, in_plane, line_chunks, plane_axes, points, rows_of
 from ncpp.passes.travel import Travel, grid, hold, quantize, steps
 
 # Compensations per line at most: each changes a direction only where a
@@ -128,13 +128,15 @@ class _Rows:
 def _rows(segs: list, directional: bool) -> _Rows:
     offsets, scales, tools = frames(segs)
     start, end = points([e.start for e in segs]), points([e.end for e in segs])
-    arc = np.array([type(e) is Arc for e in segs])
-    line = ~arc & np.array([not e.fixed for e in segs])  # fixed: moves left as programmed
-    changed = np.array([e.changed for e in segs])
+    # one walk over the events for three flags (1 arc, 2 fixed: a move left as programmed, 4 changed)
+    kind = np.fromiter([(type(e) is Arc) + 2 * bool(e.fixed) + 4 * bool(e.changed) for e in segs], dtype=np.int8, count=len(segs))
+    arc, changed = (kind & 1) != 0, (kind & 4) != 0
+    line = (kind & 3) == 0
     free = line & ~changed
     return _Rows(
         start, end, offsets, scales, tools, free, changed, changed & line,
-        _arc_assumed(segs, np.flatnonzero(changed & arc), start, end) if directional else None, np.array([e.block.line for e in segs]),
+        _arc_assumed(segs, np.flatnonzero(changed & arc), start, end) if directional else None,
+        np.fromiter([e.block.line for e in segs], dtype=np.int64, count=len(segs)),
     )  # fmt: skip
 
 
@@ -341,30 +343,32 @@ def _settle(free, arc, d, held, offsets, scales, limit, out_start, out_end, befo
     each moved end is the next row's start and a drift over many rows stays bounded.
     `before`: the previous chunk's last end in the first row's frame (or None)."""
     ends, dirs, ok = _with_previous(out_end, d, held, offsets, scales, before)
-    rows = np.flatnonzero(ok)  # the predecessor of row k ends at ends[k]
-    line_gap = out_end[rows] - ends[rows]
-    lines = free[rows] & ((np.sign(line_gap) == -dirs[rows]) & (dirs[rows + 1] == dirs[rows]) & (np.abs(line_gap) <= limit[rows, None])).any(axis=1)
-    arc_gap = ends[rows] - out_start[rows]
-    pieces = arc[rows] & ((np.abs(arc_gap) <= limit[rows, None]) & (arc_gap != 0)).any(axis=1)
-    todo = rows[lines | pieces].tolist()
+    pred_end, pred_dir = ends[:-1], dirs[:-1]  # row k's predecessor's end and direction
+    lim = limit[:, None]
+    line_gap = out_end - pred_end
+    lines = free & ok & ((line_gap * pred_dir < 0) & (dirs[1:] == pred_dir) & (np.abs(line_gap) <= lim)).any(axis=1)
+    arc_gap = pred_end - out_start
+    pieces = arc & ok & ((np.abs(arc_gap) <= lim) & (arc_gap != 0)).any(axis=1)
+    todo = np.flatnonzero(lines | pieces).tolist()
     if not todo:
         return
     # in order, on flat lists of Python floats: a numpy call per row would cost more than the row;
     # `ends` has the predecessor of row 0 in front: row k's x is at 3k + 3, its predecessor's at 3k
-    is_line, lim, settles = free.tolist(), limit.tolist(), (ok & (free | arc)).tolist()
+    is_line, lim_, settles = free.tolist(), limit.tolist(), (ok & (free | arc)).tolist()
     e_, s_, d_ = ends.ravel().tolist(), out_start.ravel().tolist(), dirs.ravel().tolist()
+    moved: list[int] = []  # the rows changed, in order
     k = -1  # the last row looked at
     for first in todo:  # each row to look at, then the rows after it while their predecessor's end moves
         if first <= k:
             continue
         k = first
         while k < len(is_line) and settles[k]:
-            i, limit_k, changed = 3 * k, lim[k], False
+            i, limit_k, changed = 3 * k, lim_[k], False
             if is_line[k]:
                 for a in (i, i + 1, i + 2):  # d_[a] is the predecessor's direction, d_[a + 3] row k's
-                    p, held = e_[a], d_[a]
+                    p, held_a = e_[a], d_[a]
                     gap = e_[a + 3] - p
-                    if gap * held < 0 and d_[a + 3] == held and -limit_k <= gap <= limit_k:
+                    if gap * held_a < 0 and d_[a + 3] == held_a and -limit_k <= gap <= limit_k:
                         e_[a + 3] = p
                         changed = True
             else:
@@ -376,9 +380,10 @@ def _settle(free, arc, d, held, offsets, scales, limit, out_start, out_end, befo
                         changed = True
             if not changed:
                 break
+            moved.append(k)
             k += 1
-    out_end[:] = np.reshape(e_[3:], out_end.shape)
-    out_start[:] = np.reshape(s_, out_start.shape)
+    out_end[moved] = np.reshape([e_[3 * k + 3 : 3 * k + 6] for k in moved], (-1, 3))
+    out_start[moved] = np.reshape([s_[3 * k : 3 * k + 3] for k in moved], (-1, 3))
 
 
 def _with_previous(out_end, d, held, offsets, scales, before) -> tuple[NDArray, NDArray, NDArray]:
@@ -435,17 +440,15 @@ def _arc_assumed(segs: list, rows: NDArray, start: NDArray, end: NDArray) -> NDA
     if rows.size == 0:
         return out
     arcs = [segs[i] for i in rows.tolist()]
-    axes = np.array([PLANE_AXES[a.context.plane] for a in arcs])
-    s, e, c = (np.take_along_axis(p, axes, axis=1) for p in (start[rows], end[rows], points([a.center for a in arcs])))
-    u0, u1 = s[:, :2] - c[:, :2], e[:, :2] - c[:, :2]
+    axes = plane_axes(arcs)
+    (su, sv, _), (eu, ev, _), (cu, cv, _) = (in_plane(p, axes) for p in (start[rows], end[rows], points([a.center for a in arcs])))
+    u0, v0, u1, v1 = su - cu, sv - cv, eu - cu, ev - cv
     with np.errstate(invalid="ignore", divide="ignore"):
-        mid = u0 / np.linalg.norm(u0, axis=1, keepdims=True) + u1 / np.linalg.norm(u1, axis=1, keepdims=True)
-    turn = np.sign([a.turn for a in arcs])[:, None]
-    tangent = turn * np.column_stack([-mid[:, 1], mid[:, 0]])
-    local = np.column_stack([np.sign(tangent), np.zeros(len(arcs))])
-    sub = np.zeros((len(rows), 3))
-    np.put_along_axis(sub, axes, local, axis=1)
-    out[rows] = sub
+        r0, r1 = np.sqrt(u0 * u0 + v0 * v0), np.sqrt(u1 * u1 + v1 * v1)
+        mid_u, mid_v = u0 / r0 + u1 / r1, v0 / r0 + v1 / r1
+    turn = np.sign(np.fromiter((a.turn for a in arcs), dtype=float, count=len(arcs)))
+    # the tangent is the middle's radius turned a quarter the way the arc turns
+    out[rows] = from_plane(np.sign(turn * -mid_v), np.sign(turn * mid_u), np.zeros(len(arcs)), axes)
     return out
 
 

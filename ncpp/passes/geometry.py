@@ -12,7 +12,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ncpp.errors import Location, NcppError
-from ncpp.motion.segments import Arc, Event, Line
+from ncpp.motion.segments import PLANE_AXES, Arc, Event, Line
 from ncpp.passes.context import PassContext
 from ncpp.passes.inverse import command_for
 
@@ -104,6 +104,17 @@ def rows_of(tools: NDArray | None, rows) -> NDArray | None:
 def points(coordinates: Sequence[tuple[float, float, float]]) -> NDArray:
     """(n,3) array of n (x, y, z) tuples (twice as fast as np.array on the list)."""
     return np.fromiter(chain.from_iterable(coordinates), dtype=float, count=3 * len(coordinates)).reshape(-1, 3)
+
+
+# PLANE_AXES as an array indexed by the plane's G code
+_PLANE_AXES = np.zeros((max(PLANE_AXES) + 1, 3), dtype=np.intp)
+for _plane, _axes in PLANE_AXES.items():
+    _PLANE_AXES[_plane] = _axes
+
+
+def plane_axes(arcs: Sequence[Arc]) -> NDArray:
+    """(n,3) the u, v and normal axis of each arc's plane (`PLANE_AXES`)."""
+    return _PLANE_AXES[np.fromiter((a.context.plane for a in arcs), dtype=np.intp, count=len(arcs))]
 
 
 def in_plane(q: NDArray, axes: NDArray) -> tuple[NDArray, NDArray, NDArray]:

@@ -21,10 +21,10 @@ from typing import Iterable, Iterator
 import numpy as np
 from numpy.typing import NDArray
 
-from ncpp.motion.segments import PLANE_AXES, Arc, Event, Line
+from ncpp.motion.segments import Arc, Event, Line
 from ncpp.passes.context import PassContext
 from ncpp.passes.kernels import run_ahead
-from ncpp.passes.geometry import compensate, frames, from_plane, in_plane, points, rows_of, spliced
+from ncpp.passes.geometry import compensate, frames, from_plane, in_plane, plane_axes, points, rows_of, spliced
 from ncpp.passes.travel import grid, quantize
 
 # Points per piece where the fit is checked (ends included).  Fewer on short
@@ -106,8 +106,8 @@ class _ArcRows:
         offsets, scales, tools = frames(arcs)
         return cls(
             points([a.start for a in arcs]), points([a.end for a in arcs]), points([a.center for a in arcs]),
-            np.array([PLANE_AXES[a.context.plane] for a in arcs]), np.array([a.sweep() for a in arcs]),
-            offsets, scales, tools, np.array([a.block.line for a in arcs]),
+            plane_axes(arcs), np.fromiter([a.sweep() for a in arcs], dtype=float, count=len(arcs)),
+            offsets, scales, tools, np.fromiter([a.block.line for a in arcs], dtype=np.int64, count=len(arcs)),
         )  # fmt: skip
 
 
