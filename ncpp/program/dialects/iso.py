@@ -149,8 +149,7 @@ class IsoWriter:
         eol = block.eol
         lines = [self._edit_block(block, motion[0]) + eol]
         if len(motion) > 1:
-            new_block = self._new_block
-            lines += [new_block(block, segment) + eol for segment in motion[1:]]
+            lines += self._new_blocks(block, motion[1:], eol)
         return lines
 
     # -- what a block says --------------------------------------------------------
@@ -467,31 +466,34 @@ class IsoWriter:
         spelled = None if facts.letters.issuperset(texts) else self._spelling(block)
         return set_words(block if motion is None else _with_motion(block, motion), texts, drop, spelled)
 
-    def _new_block(self, block: Block, segment: Line | Arc) -> str:
-        # once per line written: the cached look-ups of `_facts`, `_units` and `_spelling` inlined
-        facts = self._facts_value if block is self._facts_block else self._facts(block)
-        inch = segment.context.inch
-        units = self._resolved.get(inch) or self._units(inch)
-        code = self._motion_code(segment)
-        motion = code if code != self.output_motion else None
-        bits = self._written_bits(facts, segment, units)
-        spelled_block, spelled = self._spelled
-        if spelled_block is not block:
-            spelled = self._spelling(block)
-        if units.plain:
-            key = (bits, motion, spelled)
-            template = units.new_templates.get(key)
-            if template is None:
-                template = units.new_templates[key] = _new_block_text(units.fields(bits), motion, (_literal(spelled[0]), spelled[1]))
-            text = template.format(*self._numbers(segment))
-        else:
-            numbers, styles = self._numbers(segment), units.styles
-            texts = {letter: format_number(numbers[n], styles[letter]) for letter, n in _WRITTEN[bits]}
-            text = _new_block_text(texts, motion, spelled)
-        if motion is not None:
-            self.output_motion = code
-        self._remember_end(segment)
-        return text
+    def _new_blocks(self, block: Block, segments: list[Event], eol: str) -> list[str]:
+        """The lines of the segments a block makes after its first (arc pieces, reversal
+        steps, subdivisions): new blocks, spelled as the block is.  Once per line written:
+        what is the same for all of them is read once, `_motion_code` and `_remember_end` inlined."""
+        facts = self._facts(block)
+        spelled = self._spelling(block)
+        written_bits, numbers = self._written_bits, self._numbers
+        lines = []
+        for segment in segments:
+            inch = segment.context.inch
+            units = self._resolved.get(inch) or self._units(inch)
+            code = (3 if segment.turn > 0 else 2) if type(segment) is Arc else (0 if segment.rapid else 1)  # type: ignore[union-attr]
+            motion = code if code != self.output_motion else None
+            bits = written_bits(facts, segment, units)
+            if units.plain:
+                key = (bits, motion, spelled)
+                template = units.new_templates.get(key)
+                if template is None:
+                    template = units.new_templates[key] = _new_block_text(units.fields(bits), motion, (_literal(spelled[0]), spelled[1]))
+                lines.append(template.format(*numbers(segment)) + eol)
+            else:
+                values, styles = numbers(segment), units.styles
+                texts = {letter: format_number(values[n], styles[letter]) for letter, n in _WRITTEN[bits]}
+                lines.append(_new_block_text(texts, motion, spelled) + eol)
+            if motion is not None:
+                self.output_motion = code
+            self._last_end, self._last_places = segment.end, units.places
+        return lines
 
 
 def _new_block_text(words: dict[str, str], motion: int | None, spelled: tuple[str, bool]) -> str:

@@ -285,6 +285,9 @@ class SinumerikWriter(IsoWriter):
         self._remember_end(segment)
         return raw
 
+    def _new_blocks(self, block: Block, segments: list, eol: str) -> list[str]:
+        return [self._new_block(block, segment) + eol for segment in segments]
+
     def _new_block(self, block: Block, segment: Line | Arc) -> str:
         inch = segment.context.inch
         units = self._resolved.get(inch) or self._units(inch)
