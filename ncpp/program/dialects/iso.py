@@ -10,6 +10,8 @@ with at least the resolution needed for compensation.
 
 from __future__ import annotations
 
+import math
+
 import re
 from dataclasses import dataclass, replace
 from operator import itemgetter
@@ -579,7 +581,22 @@ def written_apart(value: float, places: int, last: float, last_places: int) -> b
     """Whether `value` written with `places` decimals says another number than `last` written
     with `last_places` (compared as numbers first: most axes a block does not write are
     exactly where the output left them)."""
-    return (value != last or places != last_places) and round(value, places) != round(last, last_places)
+    if value == last and places == last_places:
+        return False
+    if places == last_places and places < len(_STEPS):
+        # on the grid of the written decimals: away from a tie (a product's error is ~1e-16
+        # of it), the nearest grid points are those `round` picks, at a fraction of its cost
+        a, b = value * _STEPS[places], last * _STEPS[places]
+        if -_EXACT < a < _EXACT and -_EXACT < b < _EXACT:
+            na, nb = math.floor(a + 0.5), math.floor(b + 0.5)
+            if abs(a - na) < _CLEAR and abs(b - nb) < _CLEAR:
+                return na != nb
+    return round(value, places) != round(last, last_places)
+
+
+_STEPS = tuple(10.0**k for k in range(10))  # grid points per unit, by decimal places
+_EXACT = 2.0**40  # scaled values this small: their product's error is < 2**-12 of a grid step
+_CLEAR = 0.5 - 2.0**-10  # how far from a grid point a scaled value may be: clear of the ties
 
 
 @dataclass(frozen=True)
