@@ -371,22 +371,23 @@ def _line_pieces(arc: Arc, q: list[list[float]]) -> list[Event]:
 
 def _assemble(arcs: list[Arc], fitted: _Fitted) -> list[list[Event]]:
     """The events of each arc's pieces in the order of travel."""
-    per_arc: list[list[tuple[float, Event | list[Event]]]] = [[] for _ in arcs]
-    start, sign = fitted.a0.tolist(), fitted.sign.tolist()
-    for of, a0, starts, ends, centres in fitted.arcs:
-        for k, a, s, e, c in zip(of.tolist(), a0.tolist(), map(tuple, starts.tolist()), map(tuple, ends.tolist()), map(tuple, centres.tolist())):
-            arc = arcs[k]
-            # order by progress along the sweep, whatever its sign
-            per_arc[k].append(((a - start[k]) * sign[k], Arc(s, e, c, 1 if arc.turn > 0 else -1, arc.feed, arc.block, arc.context, arc.extra, True)))
-    for of, a0, pts in fitted.lines:
-        for k, a, q in zip(of.tolist(), a0.tolist(), pts.tolist()):
-            per_arc[k].append(((a - start[k]) * sign[k], _line_pieces(arcs[k], q)))
-    out: list[list[Event]] = []
-    for pieces in per_arc:
-        if len(pieces) > 1:
-            pieces.sort(key=lambda item: item[0])
-        events: list[Event] = []
-        for _, result in pieces:
-            events.extend(result if isinstance(result, list) else [result])
-        out.append(events)
+    found = fitted.arcs + fitted.lines  # each (arc, a0, ...) per piece: fitted arcs first, then runs of lines
+    if not found:
+        return [[] for _ in arcs]
+    of = np.concatenate([f[0] for f in found])
+    # by arc, then by progress along its sweep whatever its sign (stable: ties keep the order found)
+    progress = (np.concatenate([f[1] for f in found]) - fitted.a0[of]) * fitted.sign[of]
+    order = np.lexsort((progress, of)).tolist()
+    of_list = of.tolist()
+    ends = [list(map(tuple, np.concatenate([f[k] for f in fitted.arcs]).tolist())) if fitted.arcs else [] for k in (2, 3, 4)]
+    runs = [q for _, _, pts in fitted.lines for q in pts.tolist()]  # the points of each run of lines
+    fitted_count = len(ends[0])
+    out: list[list[Event]] = [[] for _ in arcs]
+    for j in order:
+        k = of_list[j]
+        arc = arcs[k]
+        if j < fitted_count:
+            out[k].append(Arc(ends[0][j], ends[1][j], ends[2][j], 1 if arc.turn > 0 else -1, arc.feed, arc.block, arc.context, arc.extra, True))
+        else:
+            out[k] += _line_pieces(arc, runs[j - fitted_count])
     return out
