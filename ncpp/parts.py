@@ -1,40 +1,54 @@
 """A long program compensated in two parts, one process each (`--jobs 2`).
 
 This process compensates the lines before a cut.  A second process reads the
-whole program too: it interprets the lines before the cut (a fifth of the cost
-of compensating them), compensates a window of lines before the cut to reach the
-state the passes and the writer are in there, and compensates the rest into a
-spool file.  Where its state at the cut equals this process's, its output is what
-one run writes from the cut on (chunks end at the same input lines,
+whole program too: it interprets the lines before the cut (a fifth to a third of
+the cost of compensating them), compensates a window of lines before the cut to
+reach the state the passes and the writer are in there, and compensates the rest
+into a spool file.  Where its state at the cut equals this process's, its output
+is what one run writes from the cut on (chunks end at the same input lines,
 `geometry.line_chunks`), and is appended; where it does not (or the second
 process failed), this process compensates the rest itself from its own state.
-The output is that of one run, byte for byte, either way.
+The output is that of one run, byte for byte, either way, wherever the cut is.
+
+The cut is where both parts end together.  On a long program it is chosen while
+they run, from their measured paces (`share`): the second process reports how
+fast it interprets when it reaches the earliest line the cut may be near, and
+waits there for the cut; this process, which has measured how fast it
+compensates by then, sends it.
 """
 
 from __future__ import annotations
 
+import math
 import os
 import pickle
+import select
 import shutil
 import subprocess
 import sys
 import tempfile
+import time
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, BinaryIO, Callable
 
 from ncpp.errors import Location, NcppError, Warnings
+from ncpp.passes.context import UNDECIDED, CutLine
 from ncpp.passes.geometry import LINE_CHUNK
 
 if TYPE_CHECKING:
     from ncpp.pipeline import Stats
 
-# The first part's share of the lines: the second part also starts a Python,
-# interprets the first part's lines and compensates a window before the cut, so it
-# takes less than half (both end together on the generated benchmark program and
-# on stellabee1.ngc).
+# The first part's share of the lines where the paces are not measured: the second part
+# also starts a Python, interprets the first part's lines and compensates a window
+# before the cut, so it takes less than half.
 FIRST_SHARE = 0.58
+SHARES = (0.45, 0.75)  # the first part's share stays within these, measured or not
 WINDOW = 2 * LINE_CHUNK  # lines before the cut the second part compensates to find its state
 MIN_LINES = 4 * WINDOW  # shorter programs stay in one process
+# From this many lines on, the cut is chosen from the parts' paces, this process's measured
+# from line PACE_FROM on (after the start's one-off costs) until the second's report comes
+PACED_LINES = 64 * LINE_CHUNK
+PACE_FROM = 2 * LINE_CHUNK
 
 
 @dataclass
@@ -49,8 +63,10 @@ class Job:
     force: bool
     dialect: str | None
     offsets: object  # WorkOffsets | None
-    cut: int
+    cut: int | None  # None: sent when the second process reaches `floor` (`_Pacer`)
+    floor: int
     spool: str
+    started: float  # time.time() when this process started the second
 
 
 @dataclass
@@ -74,21 +90,34 @@ class _Kept(Warnings):
         self.said.append(_Said(message, where))
 
 
-def cut_for(path: str) -> int | None:
-    """The input line where the second part starts (a multiple of LINE_CHUNK), or None
-    when the program is too short to pay for a second process."""
+def lines_for(path: str) -> int | None:
+    """The program's line count, or None when it is too short to pay for a second process."""
     with open(path, "rb") as f:
         lines = sum(chunk.count(b"\n") for chunk in iter(lambda: f.read(1 << 20), b""))
-    if lines < MIN_LINES:
-        return None
-    return round(FIRST_SHARE * lines / LINE_CHUNK) * LINE_CHUNK
+    return lines if lines >= MIN_LINES else None
+
+
+def share(lines: int, compensating: float, interpreting: float, late: float) -> float:
+    """The first part's share of `lines` with which both parts end together.
+
+    `compensating`: lines per second this process compensates (what each part does
+    after its start); `interpreting`: lines per second the second process interprets
+    before its window; `late`: seconds after this process the second started reading.
+    The first part ends at x·N/c, the second at late + (x·N − W)/i + ((1 − x)·N + W)/c."""
+    r = compensating / interpreting
+    x = (late * compensating + lines + WINDOW * (1 - r)) / (lines * (2 - r))
+    return min(max(x, SHARES[0]), SHARES[1])
+
+
+def _rounded(lines: int, x: float) -> int:
+    return max(round(x * lines / LINE_CHUNK), 1) * LINE_CHUNK
 
 
 def process_in_two_parts(
     stream: BinaryIO,
     path: str,
     out: BinaryIO,
-    cut: int,
+    lines: int,
     *,
     file: str,
     source,
@@ -100,17 +129,22 @@ def process_in_two_parts(
     dialect: str | None,
     offsets,
 ) -> "Stats":
-    """`pipeline.process` of the program `stream` (unread; the file at `path`) in two parts
-    split at input line `cut` (the first part reads `stream`: its progress is the file's)."""
+    """`pipeline.process` of the program `stream` (unread; the file at `path`, `lines` long)
+    in two parts (the first part reads `stream`: its progress is the file's)."""
     from ncpp.pipeline import Part, Stats, process
 
     options = dict(file=file, source=source, tolerance=tolerance, strict=strict, force=force, dialect=dialect, offsets=offsets)
+    paced = lines >= PACED_LINES
+    lowest = math.ceil(SHARES[0] * lines / LINE_CHUNK) * LINE_CHUNK  # no cut comes earlier
     with tempfile.TemporaryDirectory(prefix="ncpp-part-") as folder:
         spool = os.path.join(folder, "second.nc")
-        second = _start(Job(path, file, source, tolerance, strict, force, dialect, offsets, cut, spool))
+        cut = CutLine(UNDECIDED if paced else _rounded(lines, FIRST_SHARE))
+        job = Job(path, file, source, tolerance, strict, force, dialect, offsets, None if paced else cut.line, lowest - WINDOW, spool, time.time())
+        second = _start(job)
         try:
             first = Part(cut)
-            stats = process(stream, out, warnings=warnings, progress=progress, part=first, **options)  # type: ignore[arg-type]
+            pacer = _Pacer(second, job, lines, first, progress) if paced else progress
+            stats = process(stream, out, warnings=warnings, progress=pacer, part=first, **options)  # type: ignore[arg-type]
             if first.reached is None:  # the program ended before the cut
                 return stats
             reply = _reply(second)
@@ -125,12 +159,70 @@ def process_in_two_parts(
                 second.kill()
             second.wait()
     for said in later["said"]:
-        if said.where.line is not None and said.where.line >= cut:  # the first part gave those before
+        if said.where.line is not None and said.where.line >= cut.line:  # the first part gave those before
             warnings.warn(said.message, said.where)
     return Stats(later["lines_in"], stats.lines_out + later["lines_out"])
 
 
-def _rest_here(path: str, out: BinaryIO, cut: int, reached: tuple, strict: bool, options: dict) -> dict:
+class _Pacer:
+    """This process's progress callback (every 1000 input lines read) while the cut is
+    undecided: it measures how fast this process compensates (by the lines its part has
+    passed to the writer: reading runs ahead by a batch), takes the second's report of
+    how fast it interprets, and then decides the cut and sends it."""
+
+    def __init__(self, child: subprocess.Popen, job: Job, lines: int, part, progress: Callable[[int], None] | None):
+        self.child, self.job, self.lines, self.part, self.progress = child, job, lines, part, progress
+        self.since: tuple[int, float] | None = None  # (line written, time) this process's pace is measured from
+
+    def __call__(self, read: int) -> None:
+        if self.progress is not None:
+            self.progress(read)
+        cut = self.part.cut
+        if cut.line != UNDECIDED:
+            return
+        now, written = time.time(), self.part.written
+        if self.since is None:
+            if written >= PACE_FROM:
+                self.since = (written, now)
+            elif read + LINE_CHUNK < self.job.floor:
+                return
+        report = _pace_report(self.child)
+        if report is _PENDING and read + LINE_CHUNK < self.job.floor:
+            return
+        x = FIRST_SHARE
+        if isinstance(report, tuple) and self.since is not None and written > self.since[0]:
+            late, interpreting = report
+            x = share(self.lines, (written - self.since[0]) / (now - self.since[1]), interpreting, late)
+        # after every line read so far (their events may be on their way to the writer)
+        cut.line = max(_rounded(self.lines, x), self.job.floor + WINDOW, (read // LINE_CHUNK + 2) * LINE_CHUNK)
+        _send(self.child, cut.line)
+
+
+_PENDING = object()  # no report yet
+
+
+def _pace_report(child: subprocess.Popen) -> tuple[float, float] | None | object:
+    """The second process's (late, interpreting) once it has sent them; _PENDING before;
+    None if it ended without (it failed, or it does not report on this platform)."""
+    try:
+        ready, _, _ = select.select([child.stdout], [], [], 0)
+        if not ready:
+            return _PENDING
+        said = pickle.load(child.stdout)  # type: ignore[arg-type]
+    except (OSError, ValueError, EOFError, pickle.UnpicklingError):
+        return None
+    return said[1:] if isinstance(said, tuple) and said[0] == "pace" else None
+
+
+def _send(child: subprocess.Popen, cut: int) -> None:
+    try:
+        pickle.dump(cut, child.stdin, protocol=pickle.HIGHEST_PROTOCOL)  # type: ignore[arg-type]
+        child.stdin.close()  # type: ignore[union-attr]
+    except (OSError, ValueError):  # the second process ended: this one does the rest (`_reply`)
+        pass
+
+
+def _rest_here(path: str, out: BinaryIO, cut: CutLine, reached: tuple, strict: bool, options: dict) -> dict:
     """The second part, compensated in this process from the first part's state."""
     from ncpp.pipeline import Part, process
 
@@ -153,17 +245,22 @@ def _start(job: Job) -> subprocess.Popen:
         stdin=subprocess.PIPE, stdout=subprocess.PIPE, env={**os.environ, "PYTHONPATH": os.pathsep.join(p for p in sys.path if p)},
     )  # fmt: skip
     pickle.dump(job, child.stdin, protocol=pickle.HIGHEST_PROTOCOL)  # type: ignore[arg-type]
-    child.stdin.close()  # type: ignore[union-attr]
+    child.stdin.flush()  # type: ignore[union-attr]
+    if job.cut is not None:
+        child.stdin.close()  # type: ignore[union-attr]
     return child
 
 
 def _reply(child: subprocess.Popen) -> dict | None:
-    """What the second process did (None: it failed; this process does its part then)."""
+    """What the second process did (None: it failed; this process does its part then).
+    A pace report this process did not wait for comes first: it is passed over."""
     try:
         reply = pickle.load(child.stdout)  # type: ignore[arg-type]
+        if isinstance(reply, tuple):
+            reply = pickle.load(child.stdout)  # type: ignore[arg-type]
     except (EOFError, OSError, pickle.UnpicklingError):
         return None
-    return reply if reply.get("reached") is not None else None
+    return reply if isinstance(reply, dict) and reply.get("reached") is not None else None
 
 
 def _serve() -> None:
@@ -177,7 +274,17 @@ def _serve() -> None:
     try:
         job: Job = pickle.load(sys.stdin.buffer)
         kept = _Kept(job.strict)
-        part = Part(job.cut, second=True, window=WINDOW)
+        begun = time.time()
+
+        def ask() -> int:
+            """At `job.floor` with no cut yet: how fast this process interprets, then the cut."""
+            interpreting = job.floor / max(time.time() - begun, 1e-3)
+            pickle.dump(("pace", begun - job.started, interpreting), replies, protocol=pickle.HIGHEST_PROTOCOL)
+            replies.flush()
+            return int(pickle.load(sys.stdin.buffer))
+
+        cut = CutLine(UNDECIDED if job.cut is None else job.cut)
+        part = Part(cut, second=True, window=WINDOW, floor=job.floor, ask=ask)
         with open(job.path, "rb") as stream, open(job.spool, "wb") as spool:
             stats = process(stream, spool, file=job.file, source=job.source, tolerance=job.tolerance, strict=job.strict,  # type: ignore[arg-type]
                             force=job.force, warnings=kept, dialect=job.dialect, offsets=job.offsets, part=part)  # fmt: skip

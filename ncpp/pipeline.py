@@ -22,7 +22,7 @@ from ncpp.errors import Location, NcppError, Warnings
 from ncpp.motion.offsets import AT_MACHINE_ZERO, WorkOffsets
 from ncpp.motion.segments import CYCLE, FLOW, Event, Pass
 from ncpp.passes import PASSES, PassContext, run_passes
-from ncpp.passes.context import is_directional
+from ncpp.passes.context import UNDECIDED, CutLine, is_directional
 from ncpp.passes.inverse import iterations_for
 from ncpp.passes.kernels import INLINE, Kernels, Worker
 from ncpp.program.blocks import Block, Comment, Word
@@ -275,8 +275,8 @@ def process(
         if split is not None:  # an ISO program file long enough: two parts, one process each (parts.py)
             from ncpp.parts import process_in_two_parts
 
-            path, cut = split
-            return process_in_two_parts(stream, path, out, cut, file=file, source=source, tolerance=tolerance, strict=strict, force=force,
+            path, lines = split
+            return process_in_two_parts(stream, path, out, lines, file=file, source=source, tolerance=tolerance, strict=strict, force=force,
                                         warnings=warnings or Warnings(strict=strict), progress=progress, dialect=dialect, offsets=offsets)  # fmt: skip
     kernels = _kernels(source is not None and jobs > 1)  # started first: the worker starts while we parse
     try:
@@ -286,11 +286,11 @@ def process(
 
 
 def _two_parts(stream: BinaryIO, file: str, dialect: str | None) -> tuple[str, int] | None:
-    """(path, cut) when the stream is an unread ISO program file that pays for two
+    """(path, lines) when the stream is an unread ISO program file that pays for two
     processes (`parts.py`); else None (a pipe, another dialect, a short program)."""
     import os
 
-    from ncpp.parts import cut_for
+    from ncpp.parts import lines_for
     from ncpp.program.dialects import SNIFF_BYTES, detect
 
     path = getattr(stream, "name", None)
@@ -302,8 +302,8 @@ def _two_parts(stream: BinaryIO, file: str, dialect: str | None) -> tuple[str, i
     with open(path, "rb") as f:
         if (dialect or detect(f.read(SNIFF_BYTES), file)).lower() != "iso":
             return None
-    cut = cut_for(path)
-    return None if cut is None else (path, cut)
+    lines = lines_for(path)
+    return None if lines is None else (path, lines)
 
 
 def _kernels(worker: bool) -> Kernels:
@@ -360,11 +360,11 @@ def _process(
         elif part.resume is not None:  # the second part: from the cut on, from the state recorded there
             pass_state, writer_state = part.resume
             writer.restore(writer_state)
-            later = (event for event in events if event.block.line >= part.cut)
+            later = (event for event in events if event.block.line >= part.cut.line)
             lines = writer.write(run_passes(later, replace(ctx, resume=pass_state), PASSES))
         else:  # the second part, guessing the state at the cut: what a window of lines before it leads to
             ctx = replace(ctx, cut=part.cut)
-            window = _learnt_before(events, part.cut - part.window, writer)
+            window = _learnt_before(events, part, writer)
             lines = _after_mark(writer.write(_cut_at(run_passes(window, ctx, PASSES), part, ctx, writer, stop=False)))
     lines = iter(lines)
     with _rare_collections():
@@ -382,21 +382,29 @@ class Part:
     the passes' and the writer's state there in `reached`; the second starts at the
     cut from such a state (`resume`).  Together they write what one run writes."""
 
-    cut: int
+    cut: CutLine
     resume: tuple | None = None  # (apply_error_map.PassState, iso.WriterState)
     reached: tuple | None = None
     second: bool = False  # a second part (without `resume`: it guesses the state from `window`)
     window: int = 2048  # input lines before the cut that a second part compensates to find its state
+    # A second part whose cut is undecided asks for it (`ask` returns it) on reading line `floor`
+    floor: int = 0
+    ask: Callable[[], int] | None = None
+    written: int = 0  # the input line of the last event the first part has passed to its writer
 
 
 _MARK = "\x00ncpp: the cut\x00"  # the text of the line that marks the cut in a part's output
 
 
-def _learnt_before(events: Iterable[Event], line: int, writer: IsoWriter) -> Iterator[Event]:
-    """The events from input line `line` on; the writer learns from the blocks before (`IsoWriter.learn`)."""
+def _learnt_before(events: Iterable[Event], part: Part, writer: IsoWriter) -> Iterator[Event]:
+    """The events from the second part's window on (`part.window` lines before its cut);
+    the writer learns from the blocks before (`IsoWriter.learn`)."""
     last = None
     for event in events:
-        if event.block.line >= line:
+        line = event.block.line
+        if line >= part.floor and part.cut.line == UNDECIDED and part.ask is not None:
+            part.cut.line = part.ask()
+        if line >= part.cut.line - part.window:
             yield event
             break
         if event.block is not last:
@@ -411,13 +419,15 @@ def _cut_at(events: Iterable[Event], part: Part, ctx: PassContext, writer: IsoWr
     before on taking it, then asks for more: the state there goes to `part.reached`);
     with `stop`, none after it."""
     for event in events:
-        if event.block.line >= part.cut:
-            yield Pass(Block(_MARK, "", (), part.cut, True), True)
+        line = event.block.line
+        if line >= part.cut.line:
+            yield Pass(Block(_MARK, "", (), part.cut.line, True), True)
             part.reached = (ctx.at_cut[0], writer.state())
             if stop:
                 return
             yield event
             break
+        part.written = line
         yield event
     yield from events
 

@@ -23,7 +23,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ncpp.motion.segments import Arc, Event, Line
-from ncpp.passes.context import PassContext, deviation
+from ncpp.passes.context import CutLine, PassContext, deviation
 from ncpp.passes.kernels import run_ahead
 from ncpp.passes.geometry import compensate, frames, from_plane, in_plane, line_chunks, plane_axes, points, rows_of
 from ncpp.passes.travel import Travel, grid, hold, quantize, steps
@@ -87,18 +87,18 @@ class PassState:
 
 
 class _Cut:
-    """Records the pass's state at the first chunk from input line `line` on
+    """Records the pass's state at the first chunk from the cut's input line on
     (a window's first line: a chunk starts there, `line_chunks`), in one process."""
 
-    def __init__(self, line: int, solver: "Solve"):
-        self.line, self.solver, self.travel = line, solver, None
+    def __init__(self, cut: CutLine, solver: "Solve"):
+        self.cut, self.solver, self.travel = cut, solver, None
 
     def before_solving(self, chunk: list[Event]) -> None:
-        if self.travel is None and chunk[0].block.line >= self.line:
+        if self.travel is None and chunk[0].block.line >= self.cut.line:
             self.travel = self.solver.travel.copy()
 
     def before_writing(self, chunk: list[Event], last, at_cut: list) -> None:
-        if self.travel is not None and not at_cut and chunk[0].block.line >= self.line:
+        if self.travel is not None and not at_cut and chunk[0].block.line >= self.cut.line:
             at_cut.append(PassState(self.travel, last))
 
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import io
+import sys
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Protocol
 
@@ -35,6 +36,17 @@ def deviation(model: ErrorMap, P: NDArray, direction: NDArray | None, tool_offse
     return model.deviation(P, direction, tool_offset)
 
 
+UNDECIDED = sys.maxsize  # a cut's line until it is decided: no input line reaches it
+
+
+@dataclass
+class CutLine:
+    """The input line where a run in two parts is cut (`ncpp/parts.py`): decided while
+    the parts run, before either reads that far."""
+
+    line: int = UNDECIDED
+
+
 @dataclass(frozen=True)
 class PassContext:
     model: ErrorMap
@@ -52,7 +64,7 @@ class PassContext:
     kernels: Kernels = INLINE  # where the passes' numeric kernels run (kernels.py)
     # A run in two parts (one process each): the input line where the second starts, where
     # the first records the passes' state (`at_cut`), and the state the second resumes from
-    cut: int | None = None
+    cut: CutLine | None = None
     at_cut: list[PassState] = field(default_factory=list)
     resume: PassState | None = None
 

@@ -71,7 +71,7 @@ def test_the_warnings_are_one_runs(one_run):
 def test_a_short_program_stays_in_one_process(tmp_path):
     path = tmp_path / "short.ngc"
     path.write_bytes(b"G1 X1 F100\n" * (parts.MIN_LINES - 10))
-    assert parts.cut_for(str(path)) is None
+    assert parts.lines_for(str(path)) is None
 
 
 def test_the_first_part_reads_the_stream_it_is_given(program, source):
@@ -116,3 +116,46 @@ def test_states_at_the_cut_differ_where_the_rest_would():
     assert state(held=(1.0, 1.0, 0.0)) != state()
     assert state(last=(1.0, 2.0, 3.0001)) != state()
     assert state(end=(1.0, 2.0, 0.0001)) != state()
+
+
+def test_a_cut_from_the_parts_paces_writes_what_one_run_writes(program, source, one_run, monkeypatch):
+    """On a long program the cut is chosen while the parts run (`parts._Pacer`): the second
+    process reports its pace and waits for the cut there; the output is one run's wherever it is."""
+    monkeypatch.setattr(parts, "PACED_LINES", parts.MIN_LINES)
+    monkeypatch.setattr(parts, "PACE_FROM", 1000)
+    sent, split, same = [], [], parts._same
+    send = parts._send
+    monkeypatch.setattr(parts, "_send", lambda child, cut: sent.append(cut) or send(child, cut))
+    monkeypatch.setattr(parts, "_same", lambda a, b: split.append(same(a, b)) or split[-1])
+    assert _compensated(program, source, jobs=2) == one_run
+    lines = PROGRAM.count(b"\n")
+    assert len(sent) == 1 and sent[0] % parts.LINE_CHUNK == 0
+    assert parts.SHARES[0] * lines - parts.LINE_CHUNK <= sent[0] <= parts.SHARES[1] * lines + parts.LINE_CHUNK
+    assert split == [True]  # the second process's part, from the cut it was sent
+
+
+def test_without_the_second_process_pace_the_cut_is_the_usual_share(program, source, one_run, monkeypatch):
+    """A second process that ends before it reports: this process decides the cut alone
+    when its reading nears the earliest cut, and writes the rest itself."""
+    monkeypatch.setattr(parts, "PACED_LINES", parts.MIN_LINES)
+    monkeypatch.setattr(parts, "_start", lambda job: subprocess.Popen([sys.executable, "-c", "raise SystemExit(3)"], stdin=subprocess.PIPE, stdout=subprocess.PIPE))
+    sent, send = [], parts._send
+    monkeypatch.setattr(parts, "_send", lambda child, cut: sent.append(cut) or send(child, cut))
+    assert _compensated(program, source, jobs=2) == one_run
+    lines = PROGRAM.count(b"\n")
+    assert sent == [parts._rounded(lines, parts.FIRST_SHARE)]
+
+
+@pytest.mark.parametrize(
+    "compensating, interpreting, late",
+    [(10_000.0, 50_000.0, 0.7), (35_000.0, 100_000.0, 0.7), (10_000.0, 10_000.0, 0.0), (10_000.0, 1e9, 0.0)],
+)
+def test_the_share_ends_both_parts_together(compensating, interpreting, late):
+    lines = 250_000
+    x = parts.share(lines, compensating, interpreting, late)
+    first = x * lines / compensating
+    second = late + (x * lines - parts.WINDOW) / interpreting + ((1 - x) * lines + parts.WINDOW) / compensating
+    if parts.SHARES[0] < x < parts.SHARES[1]:
+        assert first == pytest.approx(second, rel=1e-9)
+    else:  # beyond the bounds: the nearer one
+        assert x in parts.SHARES
