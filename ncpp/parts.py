@@ -46,9 +46,10 @@ SHARES = (0.45, 0.75)  # the first part's share stays within these, measured or 
 WINDOW = 2 * LINE_CHUNK  # lines before the cut the second part compensates to find its state
 MIN_LINES = 4 * WINDOW  # shorter programs stay in one process
 # From this many lines on, the cut is chosen from the parts' paces, this process's measured
-# from line PACE_FROM on (after the start's one-off costs) until the second's report comes
+# from line PACE_FROM on (after the start's one-off costs), over PACE_SPAN lines at least
 PACED_LINES = 64 * LINE_CHUNK
 PACE_FROM = 2 * LINE_CHUNK
+PACE_SPAN = 4 * LINE_CHUNK
 
 
 @dataclass
@@ -173,6 +174,7 @@ class _Pacer:
     def __init__(self, child: subprocess.Popen, job: Job, lines: int, part, progress: Callable[[int], None] | None):
         self.child, self.job, self.lines, self.part, self.progress = child, job, lines, part, progress
         self.since: tuple[int, float] | None = None  # (line written, time) this process's pace is measured from
+        self.report: object = _PENDING  # the second's (late, interpreting), None if it ended without
 
     def __call__(self, read: int) -> None:
         if self.progress is not None:
@@ -181,18 +183,19 @@ class _Pacer:
         if cut.line != UNDECIDED:
             return
         now, written = time.time(), self.part.written
-        if self.since is None:
-            if written >= PACE_FROM:
-                self.since = (written, now)
-            elif read + LINE_CHUNK < self.job.floor:
-                return
-        report = _pace_report(self.child)
-        if report is _PENDING and read + LINE_CHUNK < self.job.floor:
+        if self.since is None and written >= PACE_FROM:
+            self.since = (written, now)
+        if self.report is _PENDING:
+            self.report = _pace_report(self.child)
+        # the writer takes a chunk (LINE_CHUNK lines) at a time: a pace over PACE_SPAN of them
+        measured = self.since is not None and written - self.since[0] >= PACE_SPAN
+        waiting = read + LINE_CHUNK >= self.job.floor  # the second process may be waiting for the cut
+        if not waiting and (self.report is _PENDING or (isinstance(self.report, tuple) and not measured)):
             return
         x = FIRST_SHARE
-        if isinstance(report, tuple) and self.since is not None and written > self.since[0]:
-            late, interpreting = report
-            x = share(self.lines, (written - self.since[0]) / (now - self.since[1]), interpreting, late)
+        if isinstance(self.report, tuple) and measured:
+            late, interpreting = self.report
+            x = share(self.lines, (written - self.since[0]) / (now - self.since[1]), interpreting, late)  # type: ignore[index]
         # after every line read so far (their events may be on their way to the writer)
         cut.line = max(_rounded(self.lines, x), self.job.floor + WINDOW, (read // LINE_CHUNK + 2) * LINE_CHUNK)
         _send(self.child, cut.line)

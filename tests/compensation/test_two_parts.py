@@ -123,6 +123,7 @@ def test_a_cut_from_the_parts_paces_writes_what_one_run_writes(program, source, 
     process reports its pace and waits for the cut there; the output is one run's wherever it is."""
     monkeypatch.setattr(parts, "PACED_LINES", parts.MIN_LINES)
     monkeypatch.setattr(parts, "PACE_FROM", 1000)
+    monkeypatch.setattr(parts, "PACE_SPAN", 1000)
     sent, split, same = [], [], parts._same
     send = parts._send
     monkeypatch.setattr(parts, "_send", lambda child, cut: sent.append(cut) or send(child, cut))
