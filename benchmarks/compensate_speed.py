@@ -49,13 +49,56 @@ def ncpp_process_rate(path: Path, offset: tuple[float, float, float] | None, job
     offsets = None if offset is None else WorkOffsets.at(offset)
     sink = open(os.devnull, "wb")
     children = _children_cpu()
-    cpu, start = time.process_time(), time.perf_counter()
-    with open(path, "rb") as stream:
-        stats = process(stream, sink, file=str(path), source=source, tolerance=TOLERANCE, warnings=QUIET, jobs=jobs, offsets=offsets)
-    seconds, cpu = time.perf_counter() - start, time.process_time() - cpu
+    with _instructions() as count:
+        cpu, start = time.process_time(), time.perf_counter()
+        with open(path, "rb") as stream:
+            stats = process(stream, sink, file=str(path), source=source, tolerance=TOLERANCE, warnings=QUIET, jobs=jobs, offsets=offsets)
+        seconds, cpu = time.perf_counter() - start, time.process_time() - cpu
     worker = _children_cpu() - children  # the second process has exited (process() waits for it): its CPU is counted
     return {"lines": stats.lines_in, "lines_out": stats.lines_out, "seconds": seconds, "lines_per_s": stats.lines_in / seconds,
-            "main_cpu_s": cpu, "worker_cpu_s": worker}  # fmt: skip
+            "main_cpu_s": cpu, "worker_cpu_s": worker, **count}  # fmt: skip
+
+
+class _instructions:
+    """`with _instructions() as count:` fills `count` with the instructions this process
+    ("main_instructions") and the processes it started ("worker_instructions") ran
+    meanwhile (counters.py); empty where the kernel does not count them."""
+
+    def __enter__(self) -> dict[str, int]:
+        from counters import counters
+
+        self.count: dict[str, int] = {}
+        self.counters = counters()
+        self.start = None if self.counters is None else [c.read() for c in self.counters]
+        return self.count
+
+    def __exit__(self, *exc) -> None:
+        if self.counters is None:
+            return
+        own, everything = (c.read() - s for c, s in zip(self.counters, self.start))
+        self.count.update(main_instructions=own, worker_instructions=everything - own)
+        for c in self.counters:
+            c.close()
+
+
+def pygcode_rate(path: Path) -> dict[str, Any]:
+    """run.pygcode_rate, with the instructions it ran where they are counted."""
+    import run as bench
+
+    with _instructions() as count:
+        result = bench.pygcode_rate(path)
+    return {**result, **count}
+
+
+def _instruction_split(result: dict[str, Any], pygcode: dict[str, Any]) -> tuple[str, str]:
+    """(ratio, note): instructions per input line of each process beside pygcode's, and
+    pygcode's over the larger (what the floor asks of each process, without the machine's load)."""
+    if "main_instructions" not in result or "main_instructions" not in pygcode:
+        return "", "not counted here (perf_event_open refused)"
+    per_line = lambda n, of: n / max(of["lines"], 1) / 1000  # noqa: E731
+    main, second = per_line(result["main_instructions"], result), per_line(result["worker_instructions"], result)
+    theirs = per_line(pygcode["main_instructions"], pygcode)
+    return f"{theirs / max(main, second):.2f}x", f"k per line in: this process {main:.0f}, the second {second:.0f}; pygcode {theirs:.0f} (pygcode / the larger)"
 
 
 def _children_cpu() -> float:
@@ -173,7 +216,7 @@ def compensate_speed(ctx):
             "passthrough": lambda: ncpp_process_rate(path, None),
             "compensate": lambda: ncpp_process_rate(path, offset, jobs=2),
             "compensate, one process": lambda: ncpp_process_rate(path, offset, jobs=1),
-            "pygcode": lambda: bench.pygcode_rate(path),
+            "pygcode": lambda: pygcode_rate(path),
         })  # fmt: skip
         passthrough, compensated, alone, pyg = best["passthrough"], best["compensate"], best["compensate, one process"], best["pygcode"]
         rs = bench.rs274_rate(path, lines)
@@ -195,6 +238,7 @@ def compensate_speed(ctx):
             [label, "rs274 (process)", f"{rs['lines_per_s']:,.0f}", "completed" if rs["completed"] else "STOPPED"],
             [label, "ratio compensate --jobs 2 / pygcode", f"{ratio:.2f}x", _verdict(ratio, paired["compensate"])],
             [label, "compensate --jobs 2, CPU by process", "", _cpu_split(compensated, pyg)],
+            [label, "compensate --jobs 2, instructions", *_instruction_split(compensated, pyg)],
             [label, "ratio compensate --jobs 1 / pygcode", f"{ratio_alone:.2f}x", _verdict(ratio_alone, paired["compensate, one process"])],
             [label, "compensate CPU s by stage", f"{sum(stages.values()):.2f} s", f"each alone, first {min(lines, 100_000):,} lines: " + ", ".join(f"{k} {v:.2f}" for k, v in stages.items())],
         ]
