@@ -36,7 +36,7 @@ from ncpp.passes.context import UNDECIDED, CutLine
 from ncpp.passes.geometry import LINE_CHUNK
 
 if TYPE_CHECKING:
-    from ncpp.pipeline import Stats
+    from ncpp.pipeline import Part, Stats
 
 # The first part's share of the lines where the paces are not measured: the second part
 # also starts a Python, interprets the first part's lines and compensates a window
@@ -65,7 +65,7 @@ class Job:
     dialect: str | None
     offsets: object  # WorkOffsets | None
     cut: int | None  # None: sent when the second process reaches `floor` (`_Pacer`)
-    floor: int
+    floor: int  # the earliest cut less WINDOW: where the second process waits for an undecided cut
     spool: str
     started: float  # time.time() when this process started the second
 
@@ -171,7 +171,7 @@ class _Pacer:
     passed to the writer: reading runs ahead by a batch), takes the second's report of
     how fast it interprets, and then decides the cut and sends it."""
 
-    def __init__(self, child: subprocess.Popen, job: Job, lines: int, part, progress: Callable[[int], None] | None):
+    def __init__(self, child: subprocess.Popen, job: Job, lines: int, part: Part, progress: Callable[[int], None] | None):
         self.child, self.job, self.lines, self.part, self.progress = child, job, lines, part, progress
         self.since: tuple[int, float] | None = None  # (line written, time) this process's pace is measured from
         self.report: object = _PENDING  # the second's (late, interpreting), None if it ended without

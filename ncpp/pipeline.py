@@ -378,9 +378,10 @@ def _process(
 @dataclass
 class Part:
     """One of a program's two parts, compensated apart (one process each): the first
-    ends before input line `cut` (a multiple of `geometry.LINE_CHUNK`) and records
-    the passes' and the writer's state there in `reached`; the second starts at the
-    cut from such a state (`resume`).  Together they write what one run writes."""
+    ends before the input line `cut` holds (a multiple of `geometry.LINE_CHUNK`, on a
+    long program decided while the parts run: `parts._Pacer`) and records the passes'
+    and the writer's state there in `reached`; the second starts at the cut from such
+    a state (`resume`).  Together they write what one run writes."""
 
     cut: CutLine
     resume: tuple | None = None  # (apply_error_map.PassState, iso.WriterState)
