@@ -239,11 +239,14 @@ class LineParser:
             shape = self._learn_shape(raw, layout)
         if type(shape) is not tuple:  # not plain, or a plain line cutting cannot read
             return None if shape is _NOT_PLAIN else self._scan_items(raw)
-        cut, signature, g_words = shape
-        items = cut.items(raw)
-        if g_words:  # the signature has the G words' numbers as written
-            signature = signature.format(*[items[n].number for n in g_words])
-        return items, signature
+        cut, signature, g_numbers = shape
+        if g_numbers:  # the signature has the G words' numbers as written (one, mostly: `G1XY`)
+            pieces = signature
+            (a, b), *more = g_numbers
+            signature = pieces[0] + raw[a:b] + pieces[1]
+            for n, (a, b) in enumerate(more, start=2):
+                signature += raw[a:b] + pieces[n]
+        return cut.items(raw), signature
 
     def _learn_shape(self, raw: str, layout: bytes) -> object:
         """The shape of the line's layout, scanned from the line and remembered."""
@@ -532,19 +535,45 @@ _SCAN = "scan"  # the shape of a plain layout whose items cutting cannot build: 
 
 
 def _shape(raw: str, items: tuple[AnyItem, ...], signature: str | None) -> object:
-    """How to build the items of a line of this layout: (a `_Cut` of its words, signature,
-    g_words) for a line of one-letter words whose numbers are written without blanks, else
-    `_SCAN`.  The signature is a format template when the line has G words, whose numbers
-    fill it (`g_words`: their indices)."""
+    """How to build the items of a line of this layout: (a `_Words` of its words, signature,
+    g_numbers) for a line of one-letter words whose numbers are written without blanks, else
+    `_SCAN`.  When the line has G words, the signature is the pieces around their numbers,
+    which the line's text fills (`g_numbers`: their spans)."""
     words = [item for item in items if type(item) is Word]
-    if signature is None or len(words) != len(items) or "{" in signature or "}" in signature:
+    if signature is None or len(words) != len(items):
         return _SCAN  # a comma word (`,R`), a comment
     spans = tuple((w.letter, w.start, w.end - len(w.number), w.end) for w in words)
     if any(raw[number_at:end] != w.number for (_, _, number_at, end), w in zip(spans, words)):
         return _SCAN  # `X - 5`: the number is written with blanks
-    g_words = tuple(n for n, w in enumerate(words) if w.letter == "G")
-    template = "".join("G{}" if w.letter == "G" else w.letter for w in words) if g_words else signature
-    return _Cut(spans), template, g_words
+    g_numbers = tuple((number_at, end) for letter, _, number_at, end in spans if letter == "G")
+    if not g_numbers:
+        return _Words(spans), signature, ()
+    pieces, piece = [], ""
+    for w in words:
+        if w.letter == "G":
+            pieces.append(piece + "G")
+            piece = ""
+        else:
+            piece += w.letter
+    return _Words(spans), (*pieces, piece), g_numbers
+
+
+class _Words(_Cut):
+    """`_Cut` of a layout of plain words only (most lines): every step a word."""
+
+    def items(self, raw: str) -> tuple[AnyItem, ...]:
+        items = []
+        append = items.append
+        for letter, start, number_at, end in self.steps:
+            number = raw[number_at:end]
+            word = _new_word(Word)  # built inline: one per word of the program
+            word.letter = letter
+            word.value = float(number)
+            word.number = number
+            word.start = start
+            word.end = end
+            append(word)
+        return tuple(items)
 
 
 class _PlainItems:
