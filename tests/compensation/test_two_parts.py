@@ -160,3 +160,17 @@ def test_the_share_ends_both_parts_together(compensating, interpreting, late):
         assert first == pytest.approx(second, rel=1e-9)
     else:  # beyond the bounds: the nearer one
         assert x in parts.SHARES
+
+
+def test_the_paced_first_part_still_tells_progress(program, source, one_run, monkeypatch):
+    """The pace is measured through the progress callback: the caller's (the LinuxCNC
+    filter's FILTER_PROGRESS) is still told every 1000 lines."""
+    monkeypatch.setattr(parts, "PACED_LINES", parts.MIN_LINES)
+    monkeypatch.setattr(parts, "PACE_FROM", 1000)
+    monkeypatch.setattr(parts, "PACE_SPAN", 1000)
+    seen, out = [], io.BytesIO()
+    with open(program, "rb") as stream:
+        process(stream, out, file="long.ngc", source=source, jobs=2, warnings=Warnings(stream=io.StringIO()),
+                offsets=WorkOffsets.at(OFFSET), progress=seen.append)  # fmt: skip
+    assert out.getvalue() == one_run[0]
+    assert seen[:3] == [1000, 2000, 3000] and len(seen) >= 8
