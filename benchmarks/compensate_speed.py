@@ -16,8 +16,9 @@ import io
 import math
 import os
 import time
+from contextlib import contextmanager
 from pathlib import Path
-from typing import Any, Callable, Iterable
+from typing import Any, Callable, Iterable, Iterator
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
@@ -59,26 +60,24 @@ def ncpp_process_rate(path: Path, offset: tuple[float, float, float] | None, job
             "main_cpu_s": cpu, "worker_cpu_s": worker, **count}  # fmt: skip
 
 
-class _instructions:
+@contextmanager
+def _instructions() -> Iterator[dict[str, int]]:
     """`with _instructions() as count:` fills `count` with the instructions this process
     ("main_instructions") and the processes it started ("worker_instructions") ran
     meanwhile (counters.py); empty where the kernel does not count them."""
+    from counters import counters
 
-    def __enter__(self) -> dict[str, int]:
-        from counters import counters
-
-        self.count: dict[str, int] = {}
-        self.counters = counters()
-        self.start = None if self.counters is None else [c.read() for c in self.counters]
-        return self.count
-
-    def __exit__(self, *exc) -> None:
-        if self.counters is None:
-            return
-        own, everything = (c.read() - s for c, s in zip(self.counters, self.start))
-        self.count.update(main_instructions=own, worker_instructions=everything - own)
-        for c in self.counters:
-            c.close()
+    count: dict[str, int] = {}
+    both = counters()
+    start = None if both is None else [c.read() for c in both]
+    try:
+        yield count
+    finally:
+        if both is not None:
+            own, everything = (c.read() - s for c, s in zip(both, start))  # type: ignore[arg-type]
+            count.update(main_instructions=own, worker_instructions=everything - own)
+            for c in both:
+                c.close()
 
 
 def pygcode_rate(path: Path) -> dict[str, Any]:

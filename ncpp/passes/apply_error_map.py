@@ -344,17 +344,17 @@ def _settle(free, arc, d, held, offsets, scales, limit, out_start, out_end, befo
     `before`: the previous chunk's last end in the first row's frame (or None)."""
     ends, dirs, ok = _with_previous(out_end, d, held, offsets, scales, before)
     pred_end, pred_dir = ends[:-1], dirs[:-1]  # row k's predecessor's end and direction
-    lim = limit[:, None]
+    within = limit[:, None]
     line_gap = out_end - pred_end
-    lines = free & ok & ((line_gap * pred_dir < 0) & (dirs[1:] == pred_dir) & (np.abs(line_gap) <= lim)).any(axis=1)
+    lines = free & ok & ((line_gap * pred_dir < 0) & (dirs[1:] == pred_dir) & (np.abs(line_gap) <= within)).any(axis=1)
     arc_gap = pred_end - out_start
-    pieces = arc & ok & ((np.abs(arc_gap) <= lim) & (arc_gap != 0)).any(axis=1)
+    pieces = arc & ok & ((np.abs(arc_gap) <= within) & (arc_gap != 0)).any(axis=1)
     todo = np.flatnonzero(lines | pieces).tolist()
     if not todo:
         return
     # in order, on flat lists of Python floats: a numpy call per row would cost more than the row;
     # `ends` has the predecessor of row 0 in front: row k's x is at 3k + 3, its predecessor's at 3k
-    is_line, lim_, settles = free.tolist(), limit.tolist(), (ok & (free | arc)).tolist()
+    is_line, limits, settles = free.tolist(), limit.tolist(), (ok & (free | arc)).tolist()
     e_, s_, d_ = ends.ravel().tolist(), out_start.ravel().tolist(), dirs.ravel().tolist()
     moved: list[int] = []  # the rows changed, in order
     k = -1  # the last row looked at
@@ -363,7 +363,7 @@ def _settle(free, arc, d, held, offsets, scales, limit, out_start, out_end, befo
             continue
         k = first
         while k < len(is_line) and settles[k]:
-            i, limit_k, changed = 3 * k, lim_[k], False
+            i, limit_k, changed = 3 * k, limits[k], False
             if is_line[k]:
                 for a in (i, i + 1, i + 2):  # d_[a] is the predecessor's direction, d_[a + 3] row k's
                     p, held_a = e_[a], d_[a]
@@ -460,7 +460,7 @@ def _shift_arcs(at, rows: _Rows, d, assumed, step, ctx, out_start, out_end) -> N
     pairs = ((pts + rows.offsets[at, None, :]) * scale).reshape(-1, 3)
     act, was = np.repeat(d[at], 2, axis=0), np.repeat(assumed[at], 2, axis=0)
     tool = None if rows.tools is None else np.tile(np.repeat(rows.tools[at], 2, axis=0), (2, 1))
-    # both directions in one call (the map's cost per call is that of a thousand points)
+    # both directions in one call (the map's cost per call is that of some 500 points)
     both = deviation(ctx.model, np.vstack([pairs, pairs]), np.vstack([act, was]), tool)
     change = both[: len(pairs)] - both[len(pairs) :]
     delta = change.reshape(pts.shape) / scale

@@ -108,8 +108,7 @@ def points(coordinates: Sequence[tuple[float, float, float]]) -> NDArray:
 
 # PLANE_AXES as an array indexed by the plane's G code
 _PLANE_AXES = np.zeros((max(PLANE_AXES) + 1, 3), dtype=np.intp)
-for _plane, _axes in PLANE_AXES.items():
-    _PLANE_AXES[_plane] = _axes
+_PLANE_AXES[list(PLANE_AXES)] = list(PLANE_AXES.values())
 
 
 def plane_axes(arcs: Sequence[Arc]) -> NDArray:

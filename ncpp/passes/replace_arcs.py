@@ -319,10 +319,7 @@ def _fit(q: NDArray, axes: NDArray, t: NDArray, tolerance: NDArray) -> tuple[NDA
     b = 2 * (du * nu[:, None] + dv * nv[:, None])
     s = (a * b).sum(-1) / np.maximum((b * b).sum(-1), 1e-300)
     cu, cv = mu + s * nu, mv + s * nv
-    ru, rv = u0 - cu, v0 - cv
-    radius = np.sqrt(ru * ru + rv * rv)
-    eu, ev = u - cu[:, None], v - cv[:, None]
-    radial = np.sqrt(eu * eu + ev * ev) - radius[:, None]
+    radial = _radial(u, v, cu, cv)
     # Where least squares leaves much of the tolerance unused, its centre stands;
     # elsewhere move it to the smallest largest deviation (which is what is judged).
     tight = np.flatnonzero(np.abs(radial).max(axis=1) > tolerance / 2)
@@ -332,13 +329,17 @@ def _fit(q: NDArray, axes: NDArray, t: NDArray, tolerance: NDArray) -> tuple[NDA
         normal = np.column_stack([nu[tight], nv[tight]])
         s[tight] += _minimax_step(uv, q0, c, normal)
         cu[tight], cv[tight] = mu[tight] + s[tight] * nu[tight], mv[tight] + s[tight] * nv[tight]
-        ru, rv = u0[tight] - cu[tight], v0[tight] - cv[tight]
-        radius[tight] = np.sqrt(ru * ru + rv * rv)
-        eu, ev = u[tight] - cu[tight, None], v[tight] - cv[tight, None]
-        radial[tight] = np.sqrt(eu * eu + ev * ev) - radius[tight, None]
+        radial[tight] = _radial(u[tight], v[tight], cu[tight], cv[tight])
     ramp = w[:, :1] + t[None, :] * (w[:, -1:] - w[:, :1])
     deviation = np.hypot(radial, w - ramp).max(axis=1)
     return from_plane(cu, cv, w[:, 0], axes), deviation
+
+
+def _radial(u: NDArray, v: NDArray, cu: NDArray, cv: NDArray) -> NDArray:
+    """(p,m) distance of the samples (u, v) from each centre (cu, cv) less the first sample's."""
+    ru, rv = u[:, 0] - cu, v[:, 0] - cv
+    eu, ev = u - cu[:, None], v - cv[:, None]
+    return np.sqrt(eu * eu + ev * ev) - np.sqrt(ru * ru + rv * rv)[:, None]
 
 
 def _minimax_step(uv: NDArray, q0: NDArray, c: NDArray, normal: NDArray) -> NDArray:

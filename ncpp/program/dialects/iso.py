@@ -11,7 +11,6 @@ with at least the resolution needed for compensation.
 from __future__ import annotations
 
 import math
-
 import re
 from dataclasses import dataclass, replace
 from operator import itemgetter
@@ -317,9 +316,13 @@ class IsoWriter:
         last, n = self._last_end, AXES.index(axis)
         return last is None or written_apart(value, self._style(axis, segment).decimals, last[n], self._last_places[n])
 
-    def _remember_end(self, segment: Line | Arc) -> None:
-        inch = segment.context.inch  # once per line written: `_units`' cached look-up inlined
-        self._last_end, self._last_places = segment.end, (self._resolved.get(inch) or self._units(inch)).places
+    def _remember_end(self, segment: Line | Arc, units: "_Written | None" = None) -> None:
+        """The segment's end is where the output is now, written with `units`' places
+        (the segment's units, looked up unless the caller has them)."""
+        if units is None:
+            inch = segment.context.inch  # once per line written: `_units`' cached look-up inlined
+            units = self._resolved.get(inch) or self._units(inch)
+        self._last_end, self._last_places = segment.end, units.places
 
     def _format(self, letter: str, value: float, segment: Line | Arc) -> str:
         return format_number(value, self._style(letter, segment))
@@ -471,7 +474,7 @@ class IsoWriter:
     def _new_blocks(self, block: Block, segments: list[Event], eol: str) -> list[str]:
         """The lines of the segments a block makes after its first (arc pieces, reversal
         steps, subdivisions): new blocks, spelled as the block is.  Once per line written:
-        what is the same for all of them is read once, `_motion_code` and `_remember_end` inlined."""
+        what is the same for all of them is read once."""
         facts = self._facts(block)
         spelled = self._spelling(block)
         written_bits, numbers = self._written_bits, self._numbers
@@ -479,7 +482,7 @@ class IsoWriter:
         for segment in segments:
             inch = segment.context.inch
             units = self._resolved.get(inch) or self._units(inch)
-            code = (3 if segment.turn > 0 else 2) if type(segment) is Arc else (0 if segment.rapid else 1)  # type: ignore[union-attr]
+            code = self._motion_code(segment)
             motion = code if code != self.output_motion else None
             bits = written_bits(facts, segment, units)
             if units.plain:
@@ -494,7 +497,7 @@ class IsoWriter:
                 lines.append(_new_block_text(texts, motion, spelled) + eol)
             if motion is not None:
                 self.output_motion = code
-            self._last_end, self._last_places = segment.end, units.places
+            self._remember_end(segment, units)
         return lines
 
 
