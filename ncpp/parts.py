@@ -1,20 +1,22 @@
 """A long program compensated in two parts, one process each (`--jobs 2`).
 
 This process compensates the lines before a cut.  A second process reads the
-whole program too: it interprets the lines before the cut (a fifth to a third of
-the cost of compensating them), compensates a window of lines before the cut to
-reach the state the passes and the writer are in there, and compensates the rest
-into a spool file.  Where its state at the cut equals this process's, its output
-is what one run writes from the cut on (chunks end at the same input lines,
-`geometry.line_chunks`), and is appended; where it does not (or the second
-process failed), this process compensates the rest itself from its own state.
-The output is that of one run, byte for byte, either way, wherever the cut is.
+whole program too: it reads the lines before the cut for the state there (runs of
+plain lines it leaves unread, telling their effect: `motion/skim.py`; the others
+it interprets, a fifth to a third of the cost of compensating them), compensates a
+window of lines before the cut to reach the state the passes and the writer are in
+there, and compensates the rest into a spool file.  Where its state at the cut
+equals this process's (the interpreter's too, where it left lines unread), its
+output is what one run writes from the cut on (chunks end at the same input lines,
+`geometry.line_chunks`), and is appended; where it does not (or the second process
+failed), this process compensates the rest itself from its own state.  The output
+is that of one run, byte for byte, either way, wherever the cut is.
 
 The cut is where both parts end together.  On a long program it is chosen while
 they run, from their measured paces (`share`): the second process reports how
-fast it interprets when it reaches the earliest line the cut may be near, and
-waits there for the cut; this process, which has measured how fast it
-compensates by then, sends it.
+fast it reads when it reaches the earliest line the cut may be near, and waits
+there for the cut; this process, which has measured how fast it compensates by
+then, sends it.
 """
 
 from __future__ import annotations
@@ -98,15 +100,16 @@ def lines_for(path: str) -> int | None:
     return lines if lines >= MIN_LINES else None
 
 
-def share(lines: int, compensating: float, interpreting: float, late: float) -> float:
+def share(lines: int, compensating: float, interpreting: float, now: float, floor: int) -> float:
     """The first part's share of `lines` with which both parts end together.
 
     `compensating`: lines per second this process compensates (what each part does
-    after its start); `interpreting`: lines per second the second process interprets
-    before its window; `late`: seconds after this process the second started reading.
-    The first part ends at x·N/c, the second at late + (x·N − W)/i + ((1 − x)·N + W)/c."""
+    after its start); `interpreting`: lines per second the second process reads before
+    its window (interpreting them, or leaving plain ones unread: `motion/skim.py`);
+    `now`: seconds since this process started the second, which waits at line `floor`.
+    The first part ends at x·N/c, the second at now + (x·N − W − floor)/i + ((1 − x)·N + W)/c."""
     r = compensating / interpreting
-    x = (late * compensating + lines + WINDOW * (1 - r)) / (lines * (2 - r))
+    x = (now * compensating + lines + WINDOW - r * (WINDOW + floor)) / (lines * (2 - r))
     return min(max(x, SHARES[0]), SHARES[1])
 
 
@@ -149,7 +152,7 @@ def process_in_two_parts(
             if first.reached is None:  # the program ended before the cut
                 return stats
             reply = _reply(second)
-            if reply is not None and _same(first.reached, reply["reached"]):
+            if reply is not None and _same(first, reply):
                 with open(spool, "rb") as rest:
                     shutil.copyfileobj(rest, out, 1 << 20)
                 later = reply
@@ -174,7 +177,7 @@ class _Pacer:
     def __init__(self, child: subprocess.Popen, job: Job, lines: int, part: Part, progress: Callable[[int], None] | None):
         self.child, self.job, self.lines, self.part, self.progress = child, job, lines, part, progress
         self.since: tuple[int, float] | None = None  # (line written, time) this process's pace is measured from
-        self.report: object = _PENDING  # the second's (late, interpreting), None if it ended without
+        self.report: object = _PENDING  # the second's pace (lines read a second), None if it ended without
 
     def __call__(self, read: int) -> None:
         if self.progress is not None:
@@ -190,12 +193,12 @@ class _Pacer:
         # the writer takes a chunk (LINE_CHUNK lines) at a time: a pace over PACE_SPAN of them
         measured = self.since is not None and written - self.since[0] >= PACE_SPAN
         waiting = read + LINE_CHUNK >= self.job.floor  # the second process may be waiting for the cut
-        if not waiting and (self.report is _PENDING or (isinstance(self.report, tuple) and not measured)):
+        if not waiting and (self.report is _PENDING or (isinstance(self.report, float) and not measured)):
             return
         x = FIRST_SHARE
-        if isinstance(self.report, tuple) and measured:
-            late, interpreting = self.report
-            x = share(self.lines, (written - self.since[0]) / (now - self.since[1]), interpreting, late)  # type: ignore[index]
+        if isinstance(self.report, float) and measured:
+            compensating = (written - self.since[0]) / (now - self.since[1])  # type: ignore[index]
+            x = share(self.lines, compensating, self.report, now - self.job.started, self.job.floor)  # type: ignore[arg-type]
         # after every line read so far (their events may be on their way to the writer)
         cut.line = max(_rounded(self.lines, x), self.job.floor + WINDOW, (read // LINE_CHUNK + 2) * LINE_CHUNK)
         _send(self.child, cut.line)
@@ -204,9 +207,9 @@ class _Pacer:
 _PENDING = object()  # no report yet
 
 
-def _pace_report(child: subprocess.Popen) -> tuple[float, float] | None | object:
-    """The second process's (late, interpreting) once it has sent them; _PENDING before;
-    None if it ended without (it failed, or it does not report on this platform)."""
+def _pace_report(child: subprocess.Popen) -> float | None | object:
+    """The second process's pace (lines read a second before its floor) once it has sent it;
+    _PENDING before; None if it ended without (it failed, or it does not report on this platform)."""
     try:
         ready, _, _ = select.select([child.stdout], [], [], 0)
         if not ready:
@@ -214,7 +217,7 @@ def _pace_report(child: subprocess.Popen) -> tuple[float, float] | None | object
         said = pickle.load(child.stdout)  # type: ignore[arg-type]
     except (OSError, ValueError, EOFError, pickle.UnpicklingError):
         return None
-    return said[1:] if isinstance(said, tuple) and said[0] == "pace" else None
+    return float(said[1]) if isinstance(said, tuple) and said[0] == "pace" else None
 
 
 def _send(child: subprocess.Popen, cut: int) -> None:
@@ -235,9 +238,13 @@ def _rest_here(path: str, out: BinaryIO, cut: CutLine, reached: tuple, strict: b
     return {"lines_in": stats.lines_in, "lines_out": stats.lines_out, "said": kept.said}
 
 
-def _same(a: tuple, b: tuple) -> bool:
-    """Whether two states at the cut (apply_error_map.PassState, iso.WriterState) write the rest alike."""
-    return a == b
+def _same(first: "Part", reply: dict) -> bool:
+    """Whether the second part wrote the rest as the first would have: its state at the cut
+    (apply_error_map.PassState, iso.WriterState) is the first's, and so is its interpreter's
+    where it left lines unread (`motion/skim.py`; else it read what the first read)."""
+    if first.reached != reply["reached"] or first.reached[0] is None:  # (None: the second's window did not move)
+        return False
+    return not reply["skipped"] or (first.interpreted is not None and first.interpreted == reply["interpreted"])
 
 
 # -- the second process ---------------------------------------------------------------
@@ -281,8 +288,8 @@ def _serve() -> None:
 
         def ask() -> int:
             """At `job.floor` with no cut yet: how fast this process interprets, then the cut."""
-            interpreting = job.floor / max(time.time() - begun, 1e-3)
-            pickle.dump(("pace", begun - job.started, interpreting), replies, protocol=pickle.HIGHEST_PROTOCOL)
+            pace = job.floor / max(time.time() - begun, 1e-3)
+            pickle.dump(("pace", pace), replies, protocol=pickle.HIGHEST_PROTOCOL)
             replies.flush()
             return int(pickle.load(sys.stdin.buffer))
 
@@ -291,7 +298,8 @@ def _serve() -> None:
         with open(job.path, "rb") as stream, open(job.spool, "wb") as spool:
             stats = process(stream, spool, file=job.file, source=job.source, tolerance=job.tolerance, strict=job.strict,  # type: ignore[arg-type]
                             force=job.force, warnings=kept, dialect=job.dialect, offsets=job.offsets, part=part)  # fmt: skip
-        reply = {"reached": part.reached, "lines_in": stats.lines_in, "lines_out": stats.lines_out, "said": kept.said}
+        reply = {"reached": part.reached, "interpreted": part.interpreted, "skipped": part.skipped,
+                 "lines_in": stats.lines_in + part.skipped, "lines_out": stats.lines_out, "said": kept.said}  # fmt: skip
     except Exception:  # noqa: BLE001 - an error is the first process's to report, when it gets there itself
         reply = {"reached": None}
     pickle.dump(reply, replies, protocol=pickle.HIGHEST_PROTOCOL)

@@ -19,7 +19,9 @@ from pathlib import Path
 from typing import BinaryIO, Callable, Iterable, Iterator
 
 from ncpp.errors import Location, NcppError, Warnings
+from ncpp.motion.interpreter import Interpreter
 from ncpp.motion.offsets import AT_MACHINE_ZERO, WorkOffsets
+from ncpp.motion.skim import Skim
 from ncpp.motion.segments import CYCLE, FLOW, Event, Pass
 from ncpp.passes import PASSES, PassContext, run_passes
 from ncpp.passes.context import UNDECIDED, CutLine, is_directional
@@ -333,7 +335,9 @@ def _process(
 ) -> Stats:
     warnings = warnings or Warnings(strict=strict)
     stats = Stats()
-    name, parsed = parse_program(stream, file, dialect)
+    # a second part reaches its window leaving plain lines unread where it can
+    skim = Skim(part, first=HEADER_SCAN + 1) if part is not None and part.second and part.resume is None else None
+    name, parsed = parse_program(stream, file, dialect, numbered=skim)
     interpret, writer_class = dialect_tools(name)
     counter = count()
     blocks: Iterable[Block] = _counted(parsed, counter, progress)
@@ -343,10 +347,18 @@ def _process(
         blocks = warn_unplaced(blocks, warnings, file)
     # the control's zeros place the program on the machine; passthrough places nothing
     offsets = (offsets or AT_MACHINE_ZERO) if source is not None else None
-    events: Iterable[Event] = interpret(blocks, file=file, warnings=warnings, strict=strict, offsets=offsets)
+    interpreter = None
+    if part is not None:  # (parts are ISO programs', `_two_parts`) its state at the cut is compared
+        interpreter = Interpreter(file, offsets)
+        blocks = _state_at_cut(blocks, part, interpreter)
+        events: Iterable[Event] = interpret(blocks, file=file, warnings=warnings, strict=strict, interpreter=interpreter)
+    else:
+        events = interpret(blocks, file=file, warnings=warnings, strict=strict, offsets=offsets)
     if source is not None and name == "iso":  # the ISO interpreter's canned cycles
         events = warn_fixed(events, warnings, file)
     writer = writer_class()
+    if skim is not None:  # (before it reads a line: parsing starts when the writer asks for events)
+        skim.interpreter, skim.writer = interpreter, writer
     if source is None:
         lines: Iterable[str] = (event.block.text for event in _first_per_block(events))
     else:
@@ -392,9 +404,24 @@ class Part:
     floor: int = 0
     ask: Callable[[], int] | None = None
     written: int = 0  # the input line of the last event the first part has passed to its writer
+    interpreted: tuple | None = None  # the interpreter's state as it read the cut's line (`Interpreter.state`)
+    skipped: int = 0  # lines a second part left unread (`motion/skim.py`)
 
 
 _MARK = "\x00ncpp: the cut\x00"  # the text of the line that marks the cut in a part's output
+
+
+def _state_at_cut(blocks: Iterable[Block], part: Part, interpreter: Interpreter) -> Iterator[Block]:
+    """The blocks; the interpreter's state as it reads the cut's goes to `part.interpreted`."""
+    blocks = iter(blocks)
+    cut = part.cut
+    for block in blocks:
+        if block.line >= cut.line:
+            part.interpreted = interpreter.state()
+            yield block
+            break
+        yield block
+    yield from blocks
 
 
 def _learnt_before(events: Iterable[Event], part: Part, writer: IsoWriter) -> Iterator[Event]:
@@ -423,7 +450,7 @@ def _cut_at(events: Iterable[Event], part: Part, ctx: PassContext, writer: IsoWr
         line = event.block.line
         if line >= part.cut.line:
             yield Pass(Block(_MARK, "", (), part.cut.line, True), True)
-            part.reached = (ctx.at_cut[0], writer.state())
+            part.reached = (ctx.at_cut[0] if ctx.at_cut else None, writer.state())  # (None: no move yet, in the window)
             if stop:
                 return
             yield event

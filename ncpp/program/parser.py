@@ -654,15 +654,25 @@ def continued_lines(lines: Iterable[tuple[str, str]], mark: str) -> Iterator[tup
         yield first, pending[: len(pending) - len(eol)], eol
 
 
-def parse_stream(stream: Iterable[bytes], file: str = "<stdin>", grammar: "str | Dialect" = "iso") -> Iterator[Block]:
+NumberedLines = Callable[[Iterable[bytes]], Iterable[tuple[int, tuple[str, str]]]]
+
+
+def numbered_lines(stream: Iterable[bytes]) -> Iterator[tuple[int, tuple[str, str]]]:
+    """(number, (content, eol)) of each line of a binary stream, from 1."""
+    return enumerate(iter_lines(stream), start=1)
+
+
+def parse_stream(stream: Iterable[bytes], file: str = "<stdin>", grammar: "str | Dialect" = "iso", numbered: NumberedLines = numbered_lines) -> Iterator[Block]:
     """Blocks of a program, lazily.  After the closing `%` lines are kept verbatim
-    (a control stops reading there).  `grammar` names the dialect (or is one)."""
+    (a control stops reading there).  `grammar` names the dialect (or is one).
+    `numbered` reads the stream's lines (another one may leave lines out: `motion/skim.py`;
+    a dialect with continued lines reads them all)."""
     parser = LineParser(grammar)
     if parser.dialect.continuation:
         yield from _parse_continued(parser, stream, file)
         return
     tape_marks = 0
-    for number, (content, eol) in enumerate(iter_lines(stream), start=1):
+    for number, (content, eol) in numbered(stream):
         if tape_marks >= 2:
             yield Block(content, eol, (), number, verbatim=True)
             continue

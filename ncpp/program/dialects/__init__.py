@@ -13,7 +13,7 @@ import re
 from typing import BinaryIO, Iterable, Iterator
 
 from ncpp.errors import NcppError
-from ncpp.program.parser import Dialect, LineParser, _ItemBuilder
+from ncpp.program.parser import Dialect, LineParser, NumberedLines, _ItemBuilder
 
 DIALECTS = ("iso", "heidenhain", "sinumerik")
 SNIFF_BYTES = 4096
@@ -131,9 +131,10 @@ def _chain(first: list[bytes], rest: Iterable[bytes]) -> Iterator[bytes]:
     yield from rest
 
 
-def parse_program(stream: BinaryIO, file: str = "<stdin>", dialect: str | None = None):
-    """(dialect, blocks) of a program stream, the dialect detected unless given."""
-    from ncpp.program.parser import parse_stream
+def parse_program(stream: BinaryIO, file: str = "<stdin>", dialect: str | None = None, numbered: NumberedLines | None = None):
+    """(dialect, blocks) of a program stream, the dialect detected unless given;
+    `numbered` reads its lines when given (`parser.parse_stream`)."""
+    from ncpp.program.parser import numbered_lines, parse_stream
 
     name, lines = sniff(stream, file, dialect)
-    return name, parse_stream(lines, file, name)
+    return name, parse_stream(lines, file, name, numbered or numbered_lines)

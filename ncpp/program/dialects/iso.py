@@ -103,6 +103,16 @@ class IsoWriter:
         elif facts.motion_word:
             self.program_motion = facts.motion
 
+    def skimmed(self, motion: int | None, numbers: dict[str, str]) -> None:
+        """What learning plain lines left unread would teach (`motion/skim.py`): their last
+        motion word's code (None: none) and each letter's last number as written."""
+        for letter, number in numbers.items():
+            if letter in STYLED_LETTERS:
+                self._learn_style(letter, NumberStyle.of(number))
+        self._last_lesson = None
+        if motion is not None:
+            self.program_motion = motion
+
     def restore(self, state: "WriterState") -> None:
         """Continue as a writer in `state` would."""
         for letter, style in state.styles:

@@ -1,0 +1,133 @@
+"""Plain lines left unread: how a second part reaches its window fast (`ncpp/parts.py`).
+
+A second part's lines before its window are read only to reach the state the
+interpreter and the writer are in there.  Most of a CAM program is plain lines:
+an optional N, one G0-G3, axis and arc words and F, a trailing comment.  In
+absolute G90 such lines leave a state a regular expression can tell: each axis
+at its last word, the last motion code, the last feed; the writer has seen the
+last motion word and each letter's last number.  `Skim` reads the program's lines
+for the parser (`parser.parse_stream`'s `numbered`) and leaves out runs of them
+when the interpreter is in a state that allows it (`Interpreter.skimmable`),
+telling their effect instead (`Interpreter.skipped`, `IsoWriter.skimmed`).
+
+What is left out is checked, not trusted: the first part compares the
+interpreter's state at the cut with the second part's (`Interpreter.state`), and
+the writer's and the passes' as before; a second part whose state differs is not
+used.
+"""
+
+from __future__ import annotations
+
+import re
+from typing import TYPE_CHECKING, Iterable, Iterator
+
+from ncpp.passes.context import UNDECIDED
+from ncpp.program.parser import iter_lines
+
+if TYPE_CHECKING:
+    from ncpp.motion.interpreter import Interpreter
+    from ncpp.pipeline import Part
+    from ncpp.program.dialects.iso import IsoWriter
+
+_NUMBER = rb"[ \t]*([-+]?(?:\d+\.?\d*|\.\d+))[ \t]*"
+LETTERS = "XYZIJKRF"  # the words of a plain line, in this order
+# N, a G0-G3 (not G00.1, G10...), the words each at most once in LETTERS' order, a comment
+PLAIN_LINE = re.compile(
+    rb"[ \t]*(?:[Nn][ \t]*\d+[ \t]*)?(?:[Gg]0*([0-3])(?![\d.])[ \t]*)?"
+    + b"".join(b"(?:[" + c.encode() + c.lower().encode() + b"]" + _NUMBER + b")?" for c in LETTERS)
+    + rb"(?:\([^()\r\n]*\)[ \t]*)?\r?\n?"
+)
+_AXES = (0, 1, 2)  # X Y Z: their words come first in LETTERS, as their program position indices
+_I, _J, _K, _R, _F = 3, 4, 5, 6, 7  # the other words' places in LETTERS
+
+
+class Skim:
+    """`numbered` for `parse_stream`: a second part's lines, runs of plain lines before its
+    window left out where `interpreter` may skip them (from line `first` on).
+
+    The window starts `part.window` lines before the cut; with the cut undecided a run
+    stops at `part.floor`, where the cut is asked for (`part.ask`) as the part would."""
+
+    def __init__(self, part: "Part", first: int):
+        self.part, self.first = part, first
+        self.interpreter: Interpreter | None = None  # given before the first line is read
+        self.writer: IsoWriter | None = None
+
+    def __call__(self, stream: Iterable[bytes]) -> Iterator[tuple[int, tuple[str, str]]]:
+        lines = iter(stream)
+        number = 0
+        begun = False  # a line with text went by (the parser knows then whether the program has tape marks)
+        for raw in lines:
+            number += 1
+            if number >= self._window(number):
+                yield number, _text(raw)
+                break
+            if begun and number >= self.first and self.interpreter.skimmable():  # type: ignore[union-attr]
+                found = PLAIN_LINE.fullmatch(raw)
+                if found is not None:
+                    raw, number = self._skim(raw, found, lines, number)
+                    if raw is None:
+                        return
+            begun = begun or not raw.isspace() and raw != b""
+            yield number, _text(raw)
+        yield from enumerate(iter_lines(lines), start=number + 1)
+
+    def _window(self, number: int) -> int:
+        """The window's first line; the floor while the cut is undecided before it (there it
+        is asked for)."""
+        part = self.part
+        if part.cut.line == UNDECIDED:
+            if number < part.floor:
+                return part.floor
+            part.cut.line = part.ask()  # type: ignore[misc]
+        return part.cut.line - part.window
+
+    def _skim(self, raw: bytes, found: re.Match, lines: Iterator[bytes], number: int) -> tuple[bytes | None, int]:
+        """Leave out the run of plain lines from line `number` (`raw`, its match `found`):
+        the first line not left out and its number (None: the program ended)."""
+        motion = self.interpreter.motion  # type: ignore[union-attr]
+        written_motion = None  # the last motion word's code
+        numbers: list[bytes | None] = [None] * len(LETTERS)  # each letter's last number
+        first, window = number, self._window(number)
+        while True:
+            code, *words = found.groups()
+            moving = motion if code is None else float(code)
+            if moving is None or moving < 2.0:
+                if words[_R] is not None or words[_I] is not None or words[_J] is not None or words[_K] is not None:
+                    break  # R with G0/G1 is a (Fanuc) corner, IJK an error: the interpreter's to read
+                if moving is None and (words[0] is not None or words[1] is not None or words[2] is not None):
+                    break  # axis words with no motion mode: an error
+            if code is not None:
+                motion = written_motion = moving
+            for i, text in enumerate(words):
+                if text is not None:
+                    numbers[i] = text
+            raw = next(lines, None)  # type: ignore[assignment]
+            number += 1
+            if raw is None:
+                break
+            if number >= window:
+                window = self._window(number)
+                if number >= window:
+                    break
+            found = PLAIN_LINE.fullmatch(raw)  # type: ignore[assignment]
+            if found is None:
+                break
+        if number > first:
+            self._tell(number - first, motion, written_motion, numbers)
+        return raw, number
+
+    def _tell(self, lines: int, motion: float | None, written_motion: float | None, numbers: list[bytes | None]) -> None:
+        """The interpreter and the writer as the `lines` left out would have left them."""
+        interpreter = self.interpreter
+        ends = {axis: float(numbers[axis]) for axis in _AXES if numbers[axis] is not None}  # type: ignore[arg-type]
+        feed = interpreter.feed if numbers[_F] is None else float(numbers[_F])  # type: ignore[union-attr, arg-type]
+        interpreter.skipped(lines, ends, motion, feed)  # type: ignore[union-attr]
+        self.writer.skimmed(None if written_motion is None else int(written_motion),  # type: ignore[union-attr]
+                            {LETTERS[i]: text.decode("latin-1") for i, text in enumerate(numbers) if text is not None})  # fmt: skip
+        self.part.skipped += lines
+
+
+def _text(raw: bytes) -> tuple[str, str]:
+    """(content, eol) of one line, as `parser.iter_lines` reads it."""
+    return next(iter_lines((raw,)))
