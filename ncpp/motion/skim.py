@@ -29,16 +29,23 @@ if TYPE_CHECKING:
     from ncpp.pipeline import Part
     from ncpp.program.dialects.iso import IsoWriter
 
-_NUMBER = rb"[ \t]*([-+]?(?:\d+\.?\d*|\.\d+))[ \t]*"
+def _word(letter: str) -> bytes:
+    return b"(?:[" + letter.encode() + letter.lower().encode() + rb"][ \t]*([-+]?(?:\d+\.?\d*|\.\d+))[ \t]*)?"
+
+
 LETTERS = "XYZIJKRF"  # the words of a plain line, in this order
-# N, a G0-G3 (not G00.1, G10...), the words each at most once in LETTERS' order, a comment
+# N, a G0-G3 (not G00.1, G10...), the words each at most once in LETTERS' order, a comment.
+# Groups: the G code, the text of the axis words and each of them, of the arc words and each, F.
 PLAIN_LINE = re.compile(
     rb"[ \t]*(?:[Nn][ \t]*\d+[ \t]*)?(?:[Gg]0*([0-3])(?![\d.])[ \t]*)?"
-    + b"".join(b"(?:[" + c.encode() + c.lower().encode() + b"]" + _NUMBER + b")?" for c in LETTERS)
+    + b"(" + b"".join(map(_word, "XYZ")) + b")(" + b"".join(map(_word, "IJKR")) + b")" + _word("F")
     + rb"(?:\([^()\r\n]*\)[ \t]*)?\r?\n?"
 )
-_AXES = (0, 1, 2)  # X Y Z: their words come first in LETTERS, as their program position indices
-_I, _J, _K, _R, _F = 3, 4, 5, 6, 7  # the other words' places in LETTERS
+_CODE, _AXIS_WORDS, _ARC_WORDS = 0, 1, 5  # groups() indices
+_NUMBERS = (2, 3, 4, 6, 7, 8, 9, 10)  # groups() index of each letter's number, in LETTERS' order
+_F = 7  # F's place in LETTERS (the axes are 0-2: their program position indices)
+_MOTION = {b"0": 0.0, b"1": 1.0, b"2": 2.0, b"3": 3.0}
+_RESOLVED = 4096  # plain lines whose matches are kept before their last numbers are picked out
 
 
 class Skim:
@@ -86,22 +93,19 @@ class Skim:
         """Leave out the run of plain lines from line `number` (`raw`, its match `found`):
         the first line not left out and its number (None: the program ended)."""
         motion = self.interpreter.motion  # type: ignore[union-attr]
-        written_motion = None  # the last motion word's code
-        numbers: list[bytes | None] = [None] * len(LETTERS)  # each letter's last number
-        first, window = number, self._window(number)
+        last: list[bytes | None] = [None] * (len(LETTERS) + 1)  # the last motion code, then each letter's last number
+        matched: list[tuple] = []  # the groups of the lines since `last` was brought up to date
+        first, window, fullmatch = number, self._window(number), PLAIN_LINE.fullmatch
         while True:
-            code, *words = found.groups()
-            moving = motion if code is None else float(code)
-            if moving is None or moving < 2.0:
-                if words[_R] is not None or words[_I] is not None or words[_J] is not None or words[_K] is not None:
-                    break  # R with G0/G1 is a (Fanuc) corner, IJK an error: the interpreter's to read
-                if moving is None and (words[0] is not None or words[1] is not None or words[2] is not None):
-                    break  # axis words with no motion mode: an error
-            if code is not None:
-                motion = written_motion = moving
-            for i, text in enumerate(words):
-                if text is not None:
-                    numbers[i] = text
+            groups = found.groups()
+            code = groups[_CODE]
+            moving = motion if code is None else _MOTION[code]
+            if (moving is None or moving < 2.0) and (groups[_ARC_WORDS] or (moving is None and groups[_AXIS_WORDS])):
+                break  # R with G0/G1 is a (Fanuc) corner, IJK an error, axis words with no mode too: the interpreter's
+            motion = moving
+            matched.append(groups)
+            if len(matched) == _RESOLVED:
+                _bring_up_to_date(last, matched)
             raw = next(lines, None)  # type: ignore[assignment]
             number += 1
             if raw is None:
@@ -110,22 +114,34 @@ class Skim:
                 window = self._window(number)
                 if number >= window:
                     break
-            found = PLAIN_LINE.fullmatch(raw)  # type: ignore[assignment]
+            found = fullmatch(raw)  # type: ignore[assignment]
             if found is None:
                 break
         if number > first:
-            self._tell(number - first, motion, written_motion, numbers)
+            _bring_up_to_date(last, matched)
+            self._tell(number - first, motion, last)
         return raw, number
 
-    def _tell(self, lines: int, motion: float | None, written_motion: float | None, numbers: list[bytes | None]) -> None:
+    def _tell(self, lines: int, motion: float | None, last: list[bytes | None]) -> None:
         """The interpreter and the writer as the `lines` left out would have left them."""
-        interpreter = self.interpreter
-        ends = {axis: float(numbers[axis]) for axis in _AXES if numbers[axis] is not None}  # type: ignore[arg-type]
+        interpreter, numbers = self.interpreter, last[1:]
+        ends = {axis: float(numbers[axis]) for axis in (0, 1, 2) if numbers[axis] is not None}  # type: ignore[arg-type]
         feed = interpreter.feed if numbers[_F] is None else float(numbers[_F])  # type: ignore[union-attr, arg-type]
         interpreter.skipped(lines, ends, motion, feed)  # type: ignore[union-attr]
-        self.writer.skimmed(None if written_motion is None else int(written_motion),  # type: ignore[union-attr]
+        self.writer.skimmed(None if last[0] is None else int(last[0]),  # type: ignore[union-attr]
                             {LETTERS[i]: text.decode("latin-1") for i, text in enumerate(numbers) if text is not None})  # fmt: skip
         self.part.skipped += lines
+
+
+def _bring_up_to_date(last: list[bytes | None], matched: list[tuple]) -> None:
+    """`last` (the motion code, each letter's number) after the lines `matched`, which it
+    forgets: each is looked for from the end (most are on the last line or so)."""
+    for k, column in enumerate((_CODE, *_NUMBERS)):
+        for groups in reversed(matched):
+            if groups[column] is not None:
+                last[k] = groups[column]
+                break
+    matched.clear()
 
 
 def _text(raw: bytes) -> tuple[str, str]:
