@@ -373,8 +373,10 @@ class IsoWriter:
         if absent and segment.context.absolute:
             known, last = self.known_axes, self._last_end
             places, last_places = units.places, self._last_places
+            same_places = places == last_places
             for n, axis, bit in absent:
-                if axis in known and (last is None or written_apart(end[n], places[n], last[n], last_places[n])):
+                # (`written_apart`'s first test first: most such axes are where the output left them)
+                if axis in known and (last is None or not (same_places and end[n] == last[n]) and written_apart(end[n], places[n], last[n], last_places[n])):
                     bits |= bit
         elif absent:
             start = segment.start
@@ -487,27 +489,31 @@ class IsoWriter:
         what is the same for all of them is read once."""
         facts = self._facts(block)
         spelled = self._spelling(block)
-        written_bits, numbers = self._written_bits, self._numbers
+        written_bits, numbers, resolved = self._written_bits, self._numbers, self._resolved
         lines = []
         for segment in segments:
-            inch = segment.context.inch
-            units = self._resolved.get(inch) or self._units(inch)
-            code = self._motion_code(segment)
+            context = segment.context
+            inch = context.inch
+            units = resolved.get(inch) or self._units(inch)
+            # `_motion_code` and, for an absolute line, `_numbers`, inlined: once per line written
+            kind = type(segment)
+            code = (3 if segment.turn > 0 else 2) if kind is Arc else 0 if segment.rapid else 1
             motion = code if code != self.output_motion else None
             bits = written_bits(facts, segment, units)
+            values = segment.end if kind is not Arc and context.absolute else numbers(segment)
             if units.plain:
                 key = (bits, motion, spelled)
                 template = units.new_templates.get(key)
                 if template is None:
                     template = units.new_templates[key] = _new_block_text(units.fields(bits), motion, (_literal(spelled[0]), spelled[1]))
-                lines.append(template.format(*numbers(segment)) + eol)
+                lines.append(template.format(*values) + eol)
             else:
-                values, styles = numbers(segment), units.styles
+                styles = units.styles
                 texts = {letter: format_number(values[n], styles[letter]) for letter, n in _WRITTEN[bits]}
                 lines.append(_new_block_text(texts, motion, spelled) + eol)
             if motion is not None:
                 self.output_motion = code
-            self._remember_end(segment, units)
+            self._last_end, self._last_places = segment.end, units.places  # `_remember_end`
         return lines
 
 
