@@ -29,7 +29,9 @@ if TYPE_CHECKING:
     from ncpp.pipeline import Part
     from ncpp.program.dialects.iso import IsoWriter
 
+
 def _word(letter: str) -> bytes:
+    """An optional word of `letter` (either case), its number a group."""
     return b"(?:[" + letter.encode() + letter.lower().encode() + rb"][ \t]*([-+]?(?:\d+\.?\d*|\.\d+))[ \t]*)?"
 
 

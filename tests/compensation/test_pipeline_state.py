@@ -29,3 +29,18 @@ def test_lines_in_are_counted_with_and_without_progress():
     assert quiet.lines_in == told.lines_in == 3002
     assert reported == [1000, 2000, 3000]
     assert quiet.lines_out == 3002
+
+
+def test_an_earlier_lines_error_is_told_before_a_later_parse_error():
+    """The first error in the program is the one told, whichever stage finds it."""
+    from ncpp.errors import NcppError
+
+    good = b"G1 X1 Y2 F100\n" * 200
+    for program, line in ((b"G21 G90\n" + good + b"G1 X1 X2\n" + good + b"G1 X(unclosed\n" + good, 202),
+                          (b"G21 G90\n" + good * 30 + b"G1 X(unclosed\n" + good, 6002)):  # fmt: skip
+        try:
+            process(io.BytesIO(program), io.BytesIO(), file="t.ngc")
+        except NcppError as err:
+            assert err.where.line == line
+        else:
+            raise AssertionError("no error")
