@@ -124,8 +124,10 @@ def interpret(
 ) -> Iterator[Event]:
     """Motion events of a program's blocks, lazily (see the module docstring).
 
-    `interpreter`: the one to run (made from `file` and `offsets`), its state the
-    caller's to look at between blocks (`ncpp/parts.py`).  `offsets`: the zeros and the tool table the control holds at the start
+    `interpreter`: the one to run (else one is made from `file` and `offsets`), its
+    state the caller's to look at between blocks (`ncpp/parts.py`).
+
+    `offsets`: the zeros and the tool table the control holds at the start
     (none: all zero, as rs274's default parameter file).  Given, a coordinate
     system selected whose zero they do not tell gets a warning where it is
     first selected, and so does the first G43 when they hold no tool table.
