@@ -172,7 +172,7 @@ class _Pacer:
     """This process's progress callback (every 1000 input lines read) while the cut is
     undecided: it measures how fast this process compensates (by the lines its part has
     passed to the writer: reading runs ahead by a batch), takes the second's report of
-    how fast it interprets, and then decides the cut and sends it."""
+    how fast it reads its lines, and then decides the cut and sends it."""
 
     def __init__(self, child: subprocess.Popen, job: Job, lines: int, part: Part, progress: Callable[[int], None] | None):
         self.child, self.job, self.lines, self.part, self.progress = child, job, lines, part, progress
@@ -287,7 +287,7 @@ def _serve() -> None:
         begun = time.time()
 
         def ask() -> int:
-            """At `job.floor` with no cut yet: how fast this process interprets, then the cut."""
+            """At `job.floor` with no cut yet: how fast this process reads its lines, then the cut."""
             pace = job.floor / max(time.time() - begun, 1e-3)
             pickle.dump(("pace", pace), replies, protocol=pickle.HIGHEST_PROTOCOL)
             replies.flush()
