@@ -41,8 +41,8 @@ if TYPE_CHECKING:
     from ncpp.pipeline import Part, Stats
 
 # The first part's share of the lines where the paces are not measured: the second part
-# also starts a Python, interprets the first part's lines and compensates a window
-# before the cut, so it takes less than half.
+# also starts a Python, reads the first part's lines (`motion/skim.py`) and compensates a
+# window before the cut, so it takes less than half.
 FIRST_SHARE = 0.58
 SHARES = (0.45, 0.75)  # the first part's share stays within these, measured or not
 WINDOW = 2 * LINE_CHUNK  # lines before the cut the second part compensates to find its state

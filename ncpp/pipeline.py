@@ -24,7 +24,7 @@ from ncpp.motion.offsets import AT_MACHINE_ZERO, WorkOffsets
 from ncpp.motion.skim import Skim
 from ncpp.motion.segments import CYCLE, FLOW, Event, Pass
 from ncpp.passes import PASSES, PassContext, run_passes
-from ncpp.passes.context import UNDECIDED, CutLine, is_directional
+from ncpp.passes.context import CutLine, is_directional
 from ncpp.passes.inverse import iterations_for
 from ncpp.passes.kernels import INLINE, Kernels, Worker
 from ncpp.program.blocks import Block, Comment, Word
@@ -430,9 +430,7 @@ def _learnt_before(events: Iterable[Event], part: Part, writer: IsoWriter) -> It
     last = None
     for event in events:
         line = event.block.line
-        if line >= part.floor and part.cut.line == UNDECIDED and part.ask is not None:
-            part.cut.line = part.ask()
-        if line >= part.cut.line - part.window:
+        if line >= part.cut.line - part.window:  # (an undecided cut was asked for as its lines were read: `Skim`)
             yield event
             break
         if event.block is not last:

@@ -1167,8 +1167,8 @@ _PLANE_LETTERS = {17: "XY", 18: "ZX", 19: "YZ"}
 # words a plain modal move may carry without the full checks
 _AXIS_LETTERS_F = frozenset("XYZABCUVWFIJKR")
 # Not the interpreter's state (`Interpreter.state`): where it reports and what it was told,
-# caches, its flow and parameters (told apart), callbacks
-_NOT_STATE = frozenset({"file", "warnings", "untold_lengths", "tools", "subroutine_path", "flow", "params", "_context", "holding", "system"})
+# a cache, its flow and parameters (told apart); callbacks compare as None (`snapshot.py`)
+_NOT_STATE = frozenset({"file", "warnings", "untold_lengths", "tools", "subroutine_path", "flow", "params", "_context", "holding"})
 _F_ONLY = frozenset("F")
 _XYZ_SLOT = {"X": (0, 1), "Y": (1, 2), "Z": (2, 4)}
 _XYZF = frozenset("XYZF")
