@@ -36,6 +36,7 @@ from typing import TYPE_CHECKING, BinaryIO, Callable
 from ncpp.errors import Location, NcppError, Warnings
 from ncpp.passes.context import UNDECIDED, CutLine
 from ncpp.passes.geometry import LINE_CHUNK
+from ncpp.passes.kernels import child_environment
 
 if TYPE_CHECKING:
     from ncpp.pipeline import Part, Stats
@@ -252,7 +253,7 @@ def _start(job: Job) -> subprocess.Popen:
     """The second process, started at once: it works while this one compensates."""
     child = subprocess.Popen(
         [sys.executable, "-c", "from ncpp.parts import _serve; _serve()"],
-        stdin=subprocess.PIPE, stdout=subprocess.PIPE, env={**os.environ, "PYTHONPATH": os.pathsep.join(p for p in sys.path if p)},
+        stdin=subprocess.PIPE, stdout=subprocess.PIPE, env=child_environment(),
     )  # fmt: skip
     pickle.dump(job, child.stdin, protocol=pickle.HIGHEST_PROTOCOL)  # type: ignore[arg-type]
     child.stdin.flush()  # type: ignore[union-attr]

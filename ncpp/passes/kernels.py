@@ -83,6 +83,15 @@ class WorkerError(RuntimeError):
     or the worker stopped."""
 
 
+def child_environment() -> dict[str, str]:
+    """The environment of a process ncpp starts with `python -c`: this one's, with its
+    import path, and one BLAS thread unless the user says otherwise (numpy's OpenBLAS
+    starts a thread per core that spins for 0.1 s of CPU after the import, taken from
+    the other process of a run on two cores; ncpp's arrays are too small to share out)."""
+    return {**os.environ, "PYTHONPATH": os.pathsep.join(p for p in sys.path if p),
+            "OPENBLAS_NUM_THREADS": os.environ.get("OPENBLAS_NUM_THREADS", "1")}  # fmt: skip
+
+
 class Worker:
     """Kernels run in one worker process, in call order.
 
@@ -101,7 +110,7 @@ class Worker:
     def __init__(self) -> None:
         self._process = subprocess.Popen(
             [sys.executable, "-c", "from ncpp.passes.kernels import _serve; _serve()"],
-            stdin=subprocess.PIPE, stdout=subprocess.PIPE, env={**os.environ, "PYTHONPATH": os.pathsep.join(p for p in sys.path if p)},
+            stdin=subprocess.PIPE, stdout=subprocess.PIPE, env=child_environment(),
         )  # fmt: skip
         self._outbox: queue.SimpleQueue = queue.SimpleQueue()
         self._inbox: queue.SimpleQueue = queue.SimpleQueue()
@@ -186,6 +195,9 @@ class _Remote:
 
 def _serve() -> None:
     """The worker's loop: bind kernels, run calls in order, send back results or errors."""
+    from ncpp.heap import keep_freed_memory
+
+    keep_freed_memory()  # the kernels are numpy's: their temporaries reuse the heap (heap.py)
     requests, replies = sys.stdin.buffer, sys.stdout.buffer
     sys.stdout = sys.stderr  # a stray print must not corrupt the replies
     kernels: dict[int, Callable] = {}
