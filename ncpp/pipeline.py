@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import BinaryIO, Callable, Iterable, Iterator
 
 from ncpp.errors import Location, NcppError, Warnings
-from ncpp.heap import keep_freed_memory
+from ncpp.runtime import keep_freed_memory
 from ncpp.motion.interpreter import Interpreter
 from ncpp.motion.offsets import AT_MACHINE_ZERO, WorkOffsets
 from ncpp.motion.skim import Skim
@@ -363,7 +363,7 @@ def _process(
     if source is None:
         lines: Iterable[str] = (event.block.text for event in _first_per_block(events))
     else:
-        keep_freed_memory()  # numpy's temporaries reuse the heap, not fresh pages (heap.py)
+        keep_freed_memory()  # numpy's temporaries reuse the heap, not fresh pages (runtime.py)
         ctx = make_context(source, tolerance, warnings, file, kernels)
         if part is None:
             lines = with_header(writer.write(run_passes(events, ctx, PASSES)), header_text(source, tolerance), writer)

@@ -12,6 +12,7 @@ import importlib
 import sys
 
 from ncpp.errors import NcppError
+from ncpp.runtime import one_blas_thread
 
 # Module names under ncpp.cli, in the order `ncpp --help` lists them.
 COMMANDS: tuple[str, ...] = (
@@ -43,6 +44,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
+    one_blas_thread()  # before the commands import numpy (runtime.py)
     parser = build_parser()
     known = set(parser._subparsers._group_actions[0].choices)  # type: ignore[union-attr]
     if not argv or (argv[0] not in known and argv[0] not in ("-h", "--help")):

@@ -20,6 +20,7 @@ import sys
 from typing import BinaryIO, TextIO
 
 from ncpp.errors import NcppError, Warnings
+from ncpp.runtime import one_blas_thread
 
 
 class FilterProgress:
@@ -75,6 +76,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("program", help="the NC program LinuxCNC opens")
     parser.add_argument("--machine", help="machine file (default: $NCPP_MACHINE, then the ncpp config files)")
     args = parser.parse_args(argv)
+    one_blas_thread()  # before `run` imports numpy (runtime.py)
     try:
         run(args.program, sys.stderr, args.machine)
     except NcppError as error:

@@ -25,6 +25,7 @@ from collections import deque
 from typing import Any, Callable, Iterable, Iterator, Protocol, TypeVar
 
 from ncpp.errors import NcppError
+from ncpp.runtime import keep_freed_memory, one_blas_thread
 
 
 class Handle(Protocol):
@@ -85,11 +86,8 @@ class WorkerError(RuntimeError):
 
 def child_environment() -> dict[str, str]:
     """The environment of a process ncpp starts with `python -c`: this one's, with its
-    import path, and one BLAS thread unless the user says otherwise (numpy's OpenBLAS
-    starts a thread per core that spins for 0.1 s of CPU after the import, taken from
-    the other process of a run on two cores; ncpp's arrays are too small to share out)."""
-    return {**os.environ, "PYTHONPATH": os.pathsep.join(p for p in sys.path if p),
-            "OPENBLAS_NUM_THREADS": os.environ.get("OPENBLAS_NUM_THREADS", "1")}  # fmt: skip
+    import path, and one BLAS thread unless the user said otherwise (`runtime.py`)."""
+    return one_blas_thread({**os.environ, "PYTHONPATH": os.pathsep.join(p for p in sys.path if p)})  # type: ignore[return-value]
 
 
 class Worker:
@@ -195,9 +193,7 @@ class _Remote:
 
 def _serve() -> None:
     """The worker's loop: bind kernels, run calls in order, send back results or errors."""
-    from ncpp.heap import keep_freed_memory
-
-    keep_freed_memory()  # the kernels are numpy's: their temporaries reuse the heap (heap.py)
+    keep_freed_memory()  # the kernels are numpy's: their temporaries reuse the heap (runtime.py)
     requests, replies = sys.stdin.buffer, sys.stdout.buffer
     sys.stdout = sys.stderr  # a stray print must not corrupt the replies
     kernels: dict[int, Callable] = {}

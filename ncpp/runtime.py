@@ -1,0 +1,66 @@
+"""Process-wide settings for compensation's runs: the C heap and BLAS's threads.
+
+Nothing here imports numpy: `one_blas_thread` must act before numpy is loaded.
+
+The heap (glibc).  Compensation makes numpy arrays of 0.1-2 MB many times a
+second (a chunk's samples and rows, and their temporaries).  By default glibc
+serves arrays over its mmap threshold with fresh pages from the kernel, and hands
+memory at the top of the heap back to the kernel once more than its trim
+threshold is free; it adjusts both as it goes, but not enough for this mix of
+sizes.  Either way such an array costs page faults and the zeroing of its pages
+again and again: 2.4 faults per input line and 8% of the CPU time of compensating
+a generated program (0.5 s of system time in 6 s, 60k lines).  Higher thresholds
+keep freed memory in the heap for the next chunk: 22k faults in all instead of
+146k, the same peak size.  The setting is process-wide and stays (glibc has no
+way back to its adjusting thresholds): what it costs a host process (FreeCAD
+running the post) is freed memory kept for reuse; the peak, which is what the
+host sees, stays flat in program length.
+
+BLAS.  numpy's OpenBLAS starts a thread per core that spins for 0.1 s of CPU
+after the import, taken from the other process of a run on two cores; ncpp's
+arrays are too small to share out among threads.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import os
+import sys
+from typing import MutableMapping
+
+MMAP_THRESHOLD = 16 << 20  # bytes: arrays up to this size come from the heap
+TRIM_THRESHOLD = 64 << 20  # bytes: free memory at the heap's top kept for reuse
+_M_TRIM_THRESHOLD, _M_MMAP_THRESHOLD = -1, -3  # mallopt's parameters (malloc.h)
+
+_kept: bool | None = None  # the outcome, once asked
+
+
+def keep_freed_memory() -> bool:
+    """Raise glibc's mmap and trim thresholds (once per process); False where the C
+    library is not glibc or refuses, and nothing changes."""
+    global _kept
+    if _kept is None:
+        _kept = _raise_thresholds()
+    return _kept
+
+
+def _raise_thresholds() -> bool:
+    if not sys.platform.startswith("linux"):
+        return False
+    try:
+        libc = ctypes.CDLL(None)
+        version = libc.gnu_get_libc_version  # glibc's own: musl's mallopt does nothing
+        mallopt = libc.mallopt
+    except (OSError, AttributeError):
+        return False
+    version.restype = ctypes.c_char_p
+    mallopt.argtypes = (ctypes.c_int, ctypes.c_int)
+    # the mmap threshold first: setting either ends glibc's adjusting of both
+    return bool(mallopt(_M_MMAP_THRESHOLD, MMAP_THRESHOLD)) and bool(mallopt(_M_TRIM_THRESHOLD, TRIM_THRESHOLD))
+
+
+def one_blas_thread(environ: MutableMapping[str, str] = os.environ) -> MutableMapping[str, str]:
+    """`environ` set for one OpenBLAS thread, unless it names a count already (the
+    user's choice); numpy reads it when it is imported.  Returns `environ`."""
+    environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+    return environ
