@@ -49,7 +49,7 @@ def ncpp_process_rate(path: Path, offset: tuple[float, float, float] | None, job
     source = None if offset is None else ErrorSource.from_machine_file(str(MACHINE))
     offsets = None if offset is None else WorkOffsets.at(offset)
     sink = open(os.devnull, "wb")
-    children = _children_cpu()
+    children, faults = _children_cpu(), _faults()
     with _instructions() as count:
         cpu, start = time.process_time(), time.perf_counter()
         with open(path, "rb") as stream:
@@ -57,7 +57,7 @@ def ncpp_process_rate(path: Path, offset: tuple[float, float, float] | None, job
         seconds, cpu = time.perf_counter() - start, time.process_time() - cpu
     worker = _children_cpu() - children  # the second process has exited (process() waits for it): its CPU is counted
     return {"lines": stats.lines_in, "lines_out": stats.lines_out, "seconds": seconds, "lines_per_s": stats.lines_in / seconds,
-            "main_cpu_s": cpu, "worker_cpu_s": worker, **count}  # fmt: skip
+            "main_cpu_s": cpu, "worker_cpu_s": worker, "page_faults": _faults() - faults, **count}  # fmt: skip
 
 
 @contextmanager
@@ -107,12 +107,21 @@ def _children_cpu() -> float:
     return usage.ru_utime + usage.ru_stime
 
 
+def _faults() -> int:
+    """Minor page faults of this process and of its children that have ended (a fault
+    is a fresh page: ncpp/runtime.py keeps numpy's freed memory for reuse)."""
+    import resource
+
+    return sum(resource.getrusage(who).ru_minflt for who in (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN))
+
+
 def _cpu_split(result: dict[str, Any], pygcode: dict[str, Any] | None = None) -> str:
     """CPU per input line of each process, beside pygcode's when given: what the floor asks
-    of each (both processes at or below pygcode's time per line)."""
+    of each (both processes at or below pygcode's time per line); and page faults per line."""
     per_line = lambda seconds: 1e6 * seconds / max(result["lines"], 1)  # noqa: E731
     split = f"CPU µs per line in: this process {per_line(result['main_cpu_s']):.0f}, the second {per_line(result['worker_cpu_s']):.0f}"
-    return split if pygcode is None else f"{split}; pygcode {per_line(pygcode['seconds']):.0f}"
+    faults = f"; page faults per line in {result['page_faults'] / max(result['lines'], 1):.2f}"
+    return (split if pygcode is None else f"{split}; pygcode {per_line(pygcode['seconds']):.0f}") + faults
 
 
 REPEATS = 3  # runs per tool; the fastest counts (the same for every tool: this machine's timing is noisy)
