@@ -19,7 +19,6 @@ from pathlib import Path
 from typing import BinaryIO, Callable, Iterable, Iterator
 
 from ncpp.errors import Location, NcppError, Warnings
-from ncpp.runtime import keep_freed_memory
 from ncpp.motion.interpreter import Interpreter
 from ncpp.motion.offsets import AT_MACHINE_ZERO, WorkOffsets
 from ncpp.motion.skim import Skim
@@ -31,6 +30,7 @@ from ncpp.passes.kernels import INLINE, Kernels, Worker
 from ncpp.program.blocks import Block, Comment, Word
 from ncpp.program.dialects import parse_program
 from ncpp.program.dialects.iso import IsoWriter
+from ncpp.runtime import keep_freed_memory
 
 HEADER_TAG = "ncpp compensated"
 HEADER_SCAN = 30  # blocks at the top searched for an earlier header

@@ -26,7 +26,7 @@ from __future__ import annotations
 import ctypes
 import os
 import sys
-from typing import MutableMapping
+from typing import MutableMapping, TypeVar
 
 MMAP_THRESHOLD = 16 << 20  # bytes: arrays up to this size come from the heap
 TRIM_THRESHOLD = 64 << 20  # bytes: free memory at the heap's top kept for reuse
@@ -49,17 +49,20 @@ def _raise_thresholds() -> bool:
         return False
     try:
         libc = ctypes.CDLL(None)
-        version = libc.gnu_get_libc_version  # glibc's own: musl's mallopt does nothing
+        libc.gnu_get_libc_version  # glibc's own (musl's mallopt does nothing)
         mallopt = libc.mallopt
     except (OSError, AttributeError):
         return False
-    version.restype = ctypes.c_char_p
     mallopt.argtypes = (ctypes.c_int, ctypes.c_int)
-    # the mmap threshold first: setting either ends glibc's adjusting of both
+    # both: setting either ends glibc's adjusting of both, and one alone is worse than
+    # none (the mmap threshold alone: twice the faults, trimming at 128 kB)
     return bool(mallopt(_M_MMAP_THRESHOLD, MMAP_THRESHOLD)) and bool(mallopt(_M_TRIM_THRESHOLD, TRIM_THRESHOLD))
 
 
-def one_blas_thread(environ: MutableMapping[str, str] = os.environ) -> MutableMapping[str, str]:
+Environ = TypeVar("Environ", bound=MutableMapping[str, str])
+
+
+def one_blas_thread(environ: Environ = os.environ) -> Environ:  # type: ignore[assignment]
     """`environ` set for one OpenBLAS thread, unless it names a count already (the
     user's choice); numpy reads it when it is imported.  Returns `environ`."""
     environ.setdefault("OPENBLAS_NUM_THREADS", "1")

@@ -87,7 +87,7 @@ class WorkerError(RuntimeError):
 def child_environment() -> dict[str, str]:
     """The environment of a process ncpp starts with `python -c`: this one's, with its
     import path, and one BLAS thread unless the user said otherwise (`runtime.py`)."""
-    return one_blas_thread({**os.environ, "PYTHONPATH": os.pathsep.join(p for p in sys.path if p)})  # type: ignore[return-value]
+    return one_blas_thread({**os.environ, "PYTHONPATH": os.pathsep.join(p for p in sys.path if p)})
 
 
 class Worker:
