@@ -36,10 +36,6 @@ def test_freed_memory_is_reused_not_faulted_in_again():
     assert with_kept < default / 4
 
 
-def test_asking_again_changes_nothing():
-    assert keep_freed_memory() == keep_freed_memory()
-
-
 def test_one_blas_thread_unless_the_user_chose():
     from ncpp.runtime import one_blas_thread
 
