@@ -101,15 +101,15 @@ def lines_for(path: str) -> int | None:
     return lines if lines >= MIN_LINES else None
 
 
-def share(lines: int, compensating: float, interpreting: float, now: float, floor: int) -> float:
+def share(lines: int, compensating: float, reading: float, now: float, floor: int) -> float:
     """The first part's share of `lines` with which both parts end together.
 
     `compensating`: lines per second this process compensates (what each part does
-    after its start); `interpreting`: lines per second the second process reads before
+    after its start); `reading`: lines per second the second process reads before
     its window (interpreting them, or leaving plain ones unread: `motion/skim.py`);
     `now`: seconds since this process started the second, which waits at line `floor`.
     The first part ends at x·N/c, the second at now + (x·N − W − floor)/i + ((1 − x)·N + W)/c."""
-    r = compensating / interpreting
+    r = compensating / reading
     x = (now * compensating + lines + WINDOW - r * (WINDOW + floor)) / (lines * (2 - r))
     return min(max(x, SHARES[0]), SHARES[1])
 

@@ -49,10 +49,11 @@ def _raise_thresholds() -> bool:
         return False
     try:
         libc = ctypes.CDLL(None)
-        libc.gnu_get_libc_version  # glibc's own (musl's mallopt does nothing)
-        mallopt = libc.mallopt
-    except (OSError, AttributeError):
+    except OSError:
         return False
+    if not hasattr(libc, "gnu_get_libc_version") or not hasattr(libc, "mallopt"):  # not glibc (musl's mallopt does nothing)
+        return False
+    mallopt = libc.mallopt
     mallopt.argtypes = (ctypes.c_int, ctypes.c_int)
     # both: setting either ends glibc's adjusting of both, and one alone is worse than
     # none (the mmap threshold alone: twice the faults, trimming at 128 kB)

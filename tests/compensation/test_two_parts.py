@@ -148,15 +148,15 @@ def test_without_the_second_process_pace_the_cut_is_the_usual_share(program, sou
 
 
 @pytest.mark.parametrize(
-    "compensating, interpreting, now",
+    "compensating, reading, now",
     [(10_000.0, 50_000.0, 3.0), (35_000.0, 100_000.0, 1.2), (10_000.0, 10_000.0, 11.0), (10_000.0, 1e9, 0.6), (15_000.0, 400_000.0, 0.8)],
 )
-def test_the_share_ends_both_parts_together(compensating, interpreting, now):
+def test_the_share_ends_both_parts_together(compensating, reading, now):
     """The second process waits at its floor from `now` on (it has reported its pace there)."""
     lines, floor = 250_000, 110_000
-    x = parts.share(lines, compensating, interpreting, now, floor)
+    x = parts.share(lines, compensating, reading, now, floor)
     first = x * lines / compensating
-    second = now + (x * lines - parts.WINDOW - floor) / interpreting + ((1 - x) * lines + parts.WINDOW) / compensating
+    second = now + (x * lines - parts.WINDOW - floor) / reading + ((1 - x) * lines + parts.WINDOW) / compensating
     if parts.SHARES[0] < x < parts.SHARES[1]:
         assert first == pytest.approx(second, rel=1e-9)
     else:  # beyond the bounds: the nearer one
