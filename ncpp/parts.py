@@ -1,22 +1,22 @@
 """A long program compensated in two parts, one process each (`--jobs 2`).
 
-This process compensates the lines before a cut.  A second process reads the
-whole program too: it reads the lines before the cut for the state there (runs of
-plain lines it leaves unread, telling their effect: `motion/skim.py`; the others
-it interprets, a fifth to a third of the cost of compensating them), compensates a
-window of lines before the cut to reach the state the passes and the writer are in
-there, and compensates the rest into a spool file.  Where its state at the cut
-equals this process's (the interpreter's too, where it left lines unread), its
-output is what one run writes from the cut on (chunks end at the same input lines,
+This process compensates the lines before a cut.  A second process (a fork of this
+one where that is safe, `_may_fork`; else a new interpreter) reads the whole program
+too: it reads the lines before the cut for the state there (runs of plain lines it
+leaves unread, telling their effect: `motion/skim.py`; the others it interprets, a
+fifth to a third of the cost of compensating them), compensates a window of lines
+before the cut to reach the state the passes and the writer are in there, and
+compensates the rest into a spool file.  Where its state at the cut equals this
+process's (the interpreter's too, where it left lines unread), its output is what one
+run writes from the cut on (chunks end at the same input lines,
 `geometry.line_chunks`), and is appended; where it does not (or the second process
-failed), this process compensates the rest itself from its own state.  The output
-is that of one run, byte for byte, either way, wherever the cut is.
+failed), this process compensates the rest itself from its own state.  The output is
+that of one run, byte for byte, either way, wherever the cut is.
 
-The cut is where both parts end together.  On a long program it is chosen while
-they run, from their measured paces (`share`): the second process reports how
-fast it reads when it reaches the earliest line the cut may be near, and waits
-there for the cut; this process, which has measured how fast it compensates by
-then, sends it.
+The cut is where both parts end together.  On a long program it is chosen while they
+run (`share`): the second process waits at the earliest line the cut may be near and
+says how fast it read its lines; this process then splits what is left between them
+by how far it has got, and sends the cut.
 """
 
 from __future__ import annotations
@@ -26,6 +26,7 @@ import os
 import pickle
 import select
 import shutil
+import signal
 import subprocess
 import sys
 import tempfile
@@ -41,18 +42,13 @@ from ncpp.passes.kernels import child_environment
 if TYPE_CHECKING:
     from ncpp.pipeline import Part, Stats
 
-# The first part's share of the lines where the paces are not measured: the second part
-# also starts a Python, reads the first part's lines (`motion/skim.py`) and compensates a
+# The first part's share of the lines where the cut is not decided while they run: the
+# second part also starts, reads the first part's lines (`motion/skim.py`) and compensates a
 # window before the cut, so it takes less than half.
-FIRST_SHARE = 0.58
+FIRST_SHARE = 0.54
 SHARES = (0.45, 0.75)  # the first part's share stays within these, measured or not
 WINDOW = 2 * LINE_CHUNK  # lines before the cut the second part compensates to find its state
 MIN_LINES = 4 * WINDOW  # shorter programs stay in one process
-# From this many lines on, the cut is chosen from the parts' paces, this process's measured
-# from line PACE_FROM on (after the start's one-off costs), over PACE_SPAN lines at least
-PACED_LINES = 64 * LINE_CHUNK
-PACE_FROM = 2 * LINE_CHUNK
-PACE_SPAN = 4 * LINE_CHUNK
 
 
 @dataclass
@@ -67,8 +63,7 @@ class Job:
     force: bool
     dialect: str | None
     offsets: object  # WorkOffsets | None
-    cut: int | None  # None: sent when the second process reaches `floor` (`_Pacer`)
-    floor: int  # the earliest cut less WINDOW: where the second process waits for an undecided cut
+    floor: int  # the earliest cut less WINDOW: where the second process waits for the cut (`_Pacer`)
     spool: str
     started: float  # time.time() when this process started the second
 
@@ -101,16 +96,15 @@ def lines_for(path: str) -> int | None:
     return lines if lines >= MIN_LINES else None
 
 
-def share(lines: int, compensating: float, reading: float, now: float, floor: int) -> float:
-    """The first part's share of `lines` with which both parts end together.
+def share(lines: int, done: int, ratio: float, floor: int) -> float:
+    """The first part's share of `lines` with which both parts end together, decided when
+    the second process waits at line `floor` and this process has compensated `done` lines.
 
-    `compensating`: lines per second this process compensates (what each part does
-    after its start); `reading`: lines per second the second process reads before
-    its window (interpreting them, or leaving plain ones unread: `motion/skim.py`);
-    `now`: seconds since this process started the second, which waits at line `floor`.
-    The first part ends at x·N/c, the second at now + (x·N − W − floor)/i + ((1 − x)·N + W)/c."""
-    r = compensating / reading
-    x = (now * compensating + lines + WINDOW - r * (WINDOW + floor)) / (lines * (2 - r))
+    Both parts compensate at one pace, c; the second reads the lines between its floor
+    and its window `ratio` times as fast as it would compensate them (c over its reading
+    pace: it interprets them, or leaves plain ones unread, `motion/skim.py`).  From now on
+    the first part takes x·N − done lines, the second (x·N − W − floor)·ratio + (1 − x)·N + W."""
+    x = (done + lines + WINDOW - ratio * (WINDOW + floor)) / (lines * (2 - ratio))
     return min(max(x, SHARES[0]), SHARES[1])
 
 
@@ -139,17 +133,15 @@ def process_in_two_parts(
     from ncpp.pipeline import Part, Stats, process
 
     options = dict(file=file, source=source, tolerance=tolerance, strict=strict, force=force, dialect=dialect, offsets=offsets)
-    paced = lines >= PACED_LINES
     lowest = math.ceil(SHARES[0] * lines / LINE_CHUNK) * LINE_CHUNK  # no cut comes earlier
     with tempfile.TemporaryDirectory(prefix="ncpp-part-") as folder:
         spool = os.path.join(folder, "second.nc")
-        cut = CutLine(UNDECIDED if paced else _rounded(lines, FIRST_SHARE))
-        job = Job(path, file, source, tolerance, strict, force, dialect, offsets, None if paced else cut.line, lowest - WINDOW, spool, time.time())
+        cut = CutLine(UNDECIDED)  # decided while the parts run (`_Pacer`)
+        job = Job(path, file, source, tolerance, strict, force, dialect, offsets, lowest - WINDOW, spool, time.time())
         second = _start(job)
         try:
             first = Part(cut)
-            pacer = _Pacer(second, job, lines, first, progress) if paced else progress
-            stats = process(stream, out, warnings=warnings, progress=pacer, part=first, **options)  # type: ignore[arg-type]
+            stats = process(stream, out, warnings=warnings, progress=_Pacer(second, job, lines, first, progress), part=first, **options)  # type: ignore[arg-type]
             if first.reached is None:  # the program ended before the cut
                 return stats
             reply = _reply(second)
@@ -171,13 +163,12 @@ def process_in_two_parts(
 
 class _Pacer:
     """This process's progress callback (every 1000 input lines read) while the cut is
-    undecided: it measures how fast this process compensates (by the lines its part has
-    passed to the writer: reading runs ahead by a batch), takes the second's report of
-    how fast it reads its lines, and then decides the cut and sends it."""
+    undecided: once the second process reports that it waits at its floor (and how fast
+    it read its lines there), or this process's reading nears that floor, it decides the
+    cut from the lines this process has compensated by then (`share`) and sends it."""
 
-    def __init__(self, child: subprocess.Popen, job: Job, lines: int, part: Part, progress: Callable[[int], None] | None):
+    def __init__(self, child: "subprocess.Popen | _Forked", job: Job, lines: int, part: Part, progress: Callable[[int], None] | None):
         self.child, self.job, self.lines, self.part, self.progress = child, job, lines, part, progress
-        self.since: tuple[int, float] | None = None  # (line written, time) this process's pace is measured from
         self.report: object = _PENDING  # the second's pace (lines read a second), None if it ended without
 
     def __call__(self, read: int) -> None:
@@ -186,20 +177,18 @@ class _Pacer:
         cut = self.part.cut
         if cut.line != UNDECIDED:
             return
-        now, written = time.time(), self.part.written
-        if self.since is None and written >= PACE_FROM:
-            self.since = (written, now)
         if self.report is _PENDING:
             self.report = _pace_report(self.child)
-        # the writer takes a chunk (LINE_CHUNK lines) at a time: a pace over PACE_SPAN of them
-        measured = self.since is not None and written - self.since[0] >= PACE_SPAN
-        waiting = read + LINE_CHUNK >= self.job.floor  # the second process may be waiting for the cut
-        if not waiting and (self.report is _PENDING or (isinstance(self.report, float) and not measured)):
+        # the second waits; its share is decided once this part has written a chunk (its own
+        # start is behind it: from then on both parts compensate at one pace)
+        done = self.part.written  # (the writer takes a chunk of LINE_CHUNK lines at a time)
+        reported = isinstance(self.report, float)
+        if not (reported and done > 0) and read + LINE_CHUNK < self.job.floor:
             return
-        x = FIRST_SHARE
-        if isinstance(self.report, float) and measured:
-            compensating = (written - self.since[0]) / (now - self.since[1])  # type: ignore[index]
-            x = share(self.lines, compensating, self.report, now - self.job.started, self.job.floor)  # type: ignore[arg-type]
+        x = FIRST_SHARE  # the second is not waiting yet, though this part nears its floor (or it failed)
+        if reported and done > 0:
+            compensating = done / max(time.time() - self.job.started, 1e-3)
+            x = share(self.lines, done, compensating / self.report, self.job.floor)
         # after every line read so far (their events may be on their way to the writer)
         cut.line = max(_rounded(self.lines, x), self.job.floor + WINDOW, (read // LINE_CHUNK + 2) * LINE_CHUNK)
         _send(self.child, cut.line)
@@ -208,7 +197,7 @@ class _Pacer:
 _PENDING = object()  # no report yet
 
 
-def _pace_report(child: subprocess.Popen) -> float | None | object:
+def _pace_report(child: "subprocess.Popen | _Forked") -> float | None | object:
     """The second process's pace (lines read a second before its floor) once it has sent it;
     _PENDING before; None if it ended without (it failed, or it does not report on this platform)."""
     try:
@@ -221,7 +210,7 @@ def _pace_report(child: subprocess.Popen) -> float | None | object:
     return float(said[1]) if isinstance(said, tuple) and said[0] == "pace" else None
 
 
-def _send(child: subprocess.Popen, cut: int) -> None:
+def _send(child: "subprocess.Popen | _Forked", cut: int) -> None:
     try:
         pickle.dump(cut, child.stdin, protocol=pickle.HIGHEST_PROTOCOL)  # type: ignore[arg-type]
         child.stdin.close()  # type: ignore[union-attr]
@@ -249,20 +238,74 @@ def _same(first: "Part", reply: dict) -> bool:
 
 
 # -- the second process ---------------------------------------------------------------
-def _start(job: Job) -> subprocess.Popen:
-    """The second process, started at once: it works while this one compensates."""
+def _start(job: Job) -> "subprocess.Popen | _Forked":
+    """The second process, started at once: it works while this one compensates.  A fork
+    of this process where that is safe (`_may_fork`): it has the imports and the machine
+    already (a new interpreter spends 1.6G instructions on them); else a new interpreter."""
+    if _may_fork():
+        return _Forked(job)
     child = subprocess.Popen(
         [sys.executable, "-c", "from ncpp.parts import _serve; _serve()"],
         stdin=subprocess.PIPE, stdout=subprocess.PIPE, env=child_environment(),
     )  # fmt: skip
     pickle.dump(job, child.stdin, protocol=pickle.HIGHEST_PROTOCOL)  # type: ignore[arg-type]
     child.stdin.flush()  # type: ignore[union-attr]
-    if job.cut is not None:
-        child.stdin.close()  # type: ignore[union-attr]
     return child
 
 
-def _reply(child: subprocess.Popen) -> dict | None:
+def _may_fork() -> bool:
+    """Whether a fork is safe: on Linux, with this process's one thread (no other thread's
+    lock, a BLAS pool's or a host application's, is copied held into the child)."""
+    try:
+        return sys.platform.startswith("linux") and len(os.listdir("/proc/self/task")) == 1
+    except OSError:
+        return False
+
+
+class _Forked:
+    """The second process as a fork of this one, driven like a `subprocess.Popen`: the
+    cut goes to its `stdin`, its pace and reply come from its `stdout` (pipes)."""
+
+    def __init__(self, job: Job):
+        cut_read, cut_write = os.pipe()
+        reply_read, reply_write = os.pipe()
+        self.pid = os.fork()
+        if self.pid == 0:  # the child: it never returns, nor flushes or cleans up what it shares with this process
+            code = 1
+            try:
+                os.close(cut_write)
+                os.close(reply_read)
+                os.dup2(2, 1)  # a stray write must not reach the output, nor hold its pipe open
+                with os.fdopen(cut_read, "rb") as requests, os.fdopen(reply_write, "wb") as replies:
+                    _serve_job(job, requests, replies)
+                code = 0
+            finally:
+                os._exit(code)
+        os.close(cut_read)
+        os.close(reply_write)
+        self.stdin, self.stdout = os.fdopen(cut_write, "wb"), os.fdopen(reply_read, "rb")
+        self.returncode: int | None = None
+
+    def poll(self) -> int | None:
+        if self.returncode is None:
+            pid, status = os.waitpid(self.pid, os.WNOHANG)
+            if pid:
+                self.returncode = os.waitstatus_to_exitcode(status)
+        return self.returncode
+
+    def kill(self) -> None:
+        if self.poll() is None:
+            os.kill(self.pid, signal.SIGKILL)
+
+    def wait(self) -> int:
+        if self.returncode is None:
+            self.returncode = os.waitstatus_to_exitcode(os.waitpid(self.pid, 0)[1])
+        for pipe in (self.stdin, self.stdout):
+            pipe.close()
+        return self.returncode
+
+
+def _reply(child: "subprocess.Popen | _Forked") -> dict | None:
     """What the second process did (None: it failed; this process does its part then).
     A pace report this process did not wait for comes first: it is passed over."""
     try:
@@ -275,15 +318,20 @@ def _reply(child: subprocess.Popen) -> dict | None:
 
 
 def _serve() -> None:
+    """The second process in a new interpreter: the job comes as a pickle on stdin."""
+    requests, replies = sys.stdin.buffer, sys.stdout.buffer
+    sys.stdout = sys.stderr  # a stray print must not corrupt the reply
+    _serve_job(pickle.load(requests), requests, replies)
+
+
+def _serve_job(job: Job, requests: BinaryIO, replies: BinaryIO) -> None:
     """The second process: the second part into the spool, then its state at the cut,
-    stats and warnings (none if anything failed: the first process does the part then)."""
+    stats and warnings (none if anything failed: the first process does the part then).
+    `requests`: where the cut comes from when undecided; `replies`: where pace and reply go."""
     from ncpp.pipeline import Part, process
 
-    replies = sys.stdout.buffer
-    sys.stdout = sys.stderr  # a stray print must not corrupt the reply
     reply: dict = {"reached": None}
     try:
-        job: Job = pickle.load(sys.stdin.buffer)
         kept = _Kept(job.strict)
         begun = time.time()
 
@@ -292,10 +340,9 @@ def _serve() -> None:
             pace = job.floor / max(time.time() - begun, 1e-3)
             pickle.dump(("pace", pace), replies, protocol=pickle.HIGHEST_PROTOCOL)
             replies.flush()
-            return int(pickle.load(sys.stdin.buffer))
+            return int(pickle.load(requests))
 
-        cut = CutLine(UNDECIDED if job.cut is None else job.cut)
-        part = Part(cut, second=True, window=WINDOW, floor=job.floor, ask=ask)
+        part = Part(CutLine(UNDECIDED), second=True, window=WINDOW, floor=job.floor, ask=ask)
         with open(job.path, "rb") as stream, open(job.spool, "wb") as spool:
             stats = process(stream, spool, file=job.file, source=job.source, tolerance=job.tolerance, strict=job.strict,  # type: ignore[arg-type]
                             force=job.force, warnings=kept, dialect=job.dialect, offsets=job.offsets, part=part)  # fmt: skip

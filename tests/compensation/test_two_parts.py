@@ -3,8 +3,10 @@ The output is one run's, byte for byte: when the second process reaches the stat
 the first has at the cut, and when it does not or fails (the first then does it)."""
 
 import io
+import os
 import subprocess
 import sys
+import threading
 
 import pytest
 
@@ -59,8 +61,49 @@ def test_when_the_states_differ_the_first_process_writes_the_rest(program, sourc
 
 
 def test_when_the_second_process_fails_the_first_writes_the_rest(program, source, one_run, monkeypatch):
-    monkeypatch.setattr(parts, "_start", lambda job: subprocess.Popen([sys.executable, "-c", "raise SystemExit(3)"], stdout=subprocess.PIPE))
+    monkeypatch.setattr(parts, "_start", lambda job: subprocess.Popen([sys.executable, "-c", "raise SystemExit(3)"], stdin=subprocess.PIPE, stdout=subprocess.PIPE))
     assert _compensated(program, source, jobs=2) == one_run
+
+
+# Run in a new interpreter with one BLAS thread (as `ncpp` runs): one thread, so the second
+# process is a fork.  Output written before and not yet flushed must reach the file once.
+FORKED = """
+import io, sys
+import ncpp.parts as parts
+from ncpp.errors import Warnings
+from ncpp.motion.offsets import WorkOffsets
+from ncpp.pipeline import ErrorSource, process
+program, machine, result, offset = sys.argv[1:5]
+forked, fork = [], parts._Forked
+parts._Forked = lambda job: forked.append(job) or fork(job)
+source = ErrorSource.from_machine_file(machine)
+with open(program, "rb") as stream, open(result, "wb") as out:
+    out.write(b"(before)\\n")
+    process(stream, out, file="long.ngc", source=source, jobs=2, warnings=Warnings(stream=io.StringIO()),
+            offsets=WorkOffsets.at(tuple(map(float, offset.split(",")))))
+print(len(forked))
+"""
+
+
+def test_a_forked_second_process_writes_what_one_run_writes(program, source, one_run, tmp_path):
+    result = tmp_path / "out.ngc"
+    env = {**os.environ, "OPENBLAS_NUM_THREADS": "1"}
+    done = subprocess.run([sys.executable, "-c", FORKED, str(program), str(ROOT / "samples/machines/hr5b.toml"), str(result), ",".join(map(str, OFFSET))],
+                          capture_output=True, text=True, env=env, check=True)  # fmt: skip
+    assert done.stdout.split() == ["1"]  # the second process was a fork
+    assert result.read_bytes() == b"(before)\n" + one_run[0]
+
+
+def test_a_process_with_another_thread_starts_a_new_interpreter():
+    """A fork would copy whatever the other thread holds (a lock, a BLAS pool) held."""
+    stop = threading.Event()
+    other = threading.Thread(target=stop.wait)
+    other.start()
+    try:
+        assert not parts._may_fork()
+    finally:
+        stop.set()
+        other.join()
 
 
 def test_the_warnings_are_one_runs(one_run):
@@ -121,9 +164,6 @@ def test_states_at_the_cut_differ_where_the_rest_would():
 def test_a_cut_from_the_parts_paces_writes_what_one_run_writes(program, source, one_run, monkeypatch):
     """On a long program the cut is chosen while the parts run (`parts._Pacer`): the second
     process reports its pace and waits for the cut there; the output is one run's wherever it is."""
-    monkeypatch.setattr(parts, "PACED_LINES", parts.MIN_LINES)
-    monkeypatch.setattr(parts, "PACE_FROM", 1000)
-    monkeypatch.setattr(parts, "PACE_SPAN", 1000)
     sent, split, same = [], [], parts._same
     send = parts._send
     monkeypatch.setattr(parts, "_send", lambda child, cut: sent.append(cut) or send(child, cut))
@@ -138,7 +178,6 @@ def test_a_cut_from_the_parts_paces_writes_what_one_run_writes(program, source, 
 def test_without_the_second_process_pace_the_cut_is_the_usual_share(program, source, one_run, monkeypatch):
     """A second process that ends before it reports: this process decides the cut alone
     when its reading nears the earliest cut, and writes the rest itself."""
-    monkeypatch.setattr(parts, "PACED_LINES", parts.MIN_LINES)
     monkeypatch.setattr(parts, "_start", lambda job: subprocess.Popen([sys.executable, "-c", "raise SystemExit(3)"], stdin=subprocess.PIPE, stdout=subprocess.PIPE))
     sent, send = [], parts._send
     monkeypatch.setattr(parts, "_send", lambda child, cut: sent.append(cut) or send(child, cut))
@@ -147,16 +186,15 @@ def test_without_the_second_process_pace_the_cut_is_the_usual_share(program, sou
     assert sent == [parts._rounded(lines, parts.FIRST_SHARE)]
 
 
-@pytest.mark.parametrize(
-    "compensating, reading, now",
-    [(10_000.0, 50_000.0, 3.0), (35_000.0, 100_000.0, 1.2), (10_000.0, 10_000.0, 11.0), (10_000.0, 1e9, 0.6), (15_000.0, 400_000.0, 0.8)],
-)
-def test_the_share_ends_both_parts_together(compensating, reading, now):
-    """The second process waits at its floor from `now` on (it has reported its pace there)."""
+@pytest.mark.parametrize("done, ratio", [(3_000, 0.2), (10_000, 0.3), (2_000, 0.0), (40_000, 0.9), (6_000, 0.04)])
+def test_the_share_ends_both_parts_together(done, ratio):
+    """Decided when the second process waits at its floor and this one has compensated
+    `done` lines: from then on both take as long, at one pace (lines to compensate, and
+    lines the second reads at `ratio` of their cost)."""
     lines, floor = 250_000, 110_000
-    x = parts.share(lines, compensating, reading, now, floor)
-    first = x * lines / compensating
-    second = now + (x * lines - parts.WINDOW - floor) / reading + ((1 - x) * lines + parts.WINDOW) / compensating
+    x = parts.share(lines, done, ratio, floor)
+    first = x * lines - done
+    second = (x * lines - parts.WINDOW - floor) * ratio + (1 - x) * lines + parts.WINDOW
     if parts.SHARES[0] < x < parts.SHARES[1]:
         assert first == pytest.approx(second, rel=1e-9)
     else:  # beyond the bounds: the nearer one
@@ -166,9 +204,6 @@ def test_the_share_ends_both_parts_together(compensating, reading, now):
 def test_the_paced_first_part_still_tells_progress(program, source, one_run, monkeypatch):
     """The pace is measured through the progress callback: the caller's (the LinuxCNC
     filter's FILTER_PROGRESS) is still told every 1000 lines."""
-    monkeypatch.setattr(parts, "PACED_LINES", parts.MIN_LINES)
-    monkeypatch.setattr(parts, "PACE_FROM", 1000)
-    monkeypatch.setattr(parts, "PACE_SPAN", 1000)
     seen, out = [], io.BytesIO()
     with open(program, "rb") as stream:
         process(stream, out, file="long.ngc", source=source, jobs=2, warnings=Warnings(stream=io.StringIO()),
