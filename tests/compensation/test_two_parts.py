@@ -6,7 +6,6 @@ import io
 import os
 import subprocess
 import sys
-import threading
 
 import pytest
 
@@ -95,15 +94,22 @@ def test_a_forked_second_process_writes_what_one_run_writes(program, source, one
 
 
 def test_a_process_with_another_thread_starts_a_new_interpreter():
-    """A fork would copy whatever the other thread holds (a lock, a BLAS pool) held."""
-    stop = threading.Event()
-    other = threading.Thread(target=stop.wait)
-    other.start()
-    try:
-        assert not parts._may_fork()
-    finally:
-        stop.set()
-        other.join()
+    """A fork would copy whatever the other thread holds (a lock, a BLAS pool) held.
+    (In a new interpreter with one BLAS thread: this one may have a BLAS pool already.)"""
+    script = """
+import threading
+import numpy
+import ncpp.parts as parts
+alone = parts._may_fork()
+stop = threading.Event()
+other = threading.Thread(target=stop.wait)
+other.start()
+print(alone, parts._may_fork())
+stop.set()
+other.join()
+"""
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, env={**os.environ, "OPENBLAS_NUM_THREADS": "1"}, check=True)
+    assert done.stdout.split() == ["True", "False"]
 
 
 def test_the_warnings_are_one_runs(one_run):
