@@ -32,16 +32,18 @@ if TYPE_CHECKING:
 
 def _word(letter: str) -> bytes:
     """An optional word of `letter` (either case), its number a group."""
-    return b"(?:[" + letter.encode() + letter.lower().encode() + rb"][ \t]*([-+]?(?:\d+\.?\d*|\.\d+))[ \t]*)?"
+    return b"(?:[" + letter.encode() + letter.lower().encode() + rb"][ \t]*+([-+]?+(?>\d++\.?+\d*+|\.\d++))[ \t]*+)?"
 
 
 LETTERS = "XYZIJKRF"  # the words of a plain line, in this order
 # N, a G0-G3 (not G00.1, G10...), the words each at most once in LETTERS' order, a comment.
 # Groups: the G code, the text of the axis words and each of them, of the arc words and each, F.
+# Possessive: what a word or a blank run takes is never given back (a sixth fewer instructions
+# a line), but G's zeros, which may leave the code's own digit (`G00`).
 PLAIN_LINE = re.compile(
-    rb"[ \t]*(?:[Nn][ \t]*\d+[ \t]*)?(?:[Gg]0*([0-3])(?![\d.])[ \t]*)?"
+    rb"[ \t]*+(?:[Nn][ \t]*+\d++[ \t]*+)?(?:[Gg]0*([0-3])(?![\d.])[ \t]*+)?"
     + b"(" + b"".join(map(_word, "XYZ")) + b")(" + b"".join(map(_word, "IJKR")) + b")" + _word("F")
-    + rb"(?:\([^()\r\n]*\)[ \t]*)?\r?\n?"
+    + rb"(?:\([^()\r\n]*+\)[ \t]*+)?\r?\n?"
 )
 _CODE, _AXIS_WORDS, _ARC_WORDS = 0, 1, 5  # groups() indices
 _NUMBERS = (2, 3, 4, 6, 7, 8, 9, 10)  # groups() index of each letter's number, in LETTERS' order
