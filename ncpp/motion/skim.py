@@ -9,6 +9,8 @@ last motion word and each letter's last number.  `Skim` reads the program's line
 for the parser (`parser.parse_stream`'s `numbered`) and leaves out runs of them
 when the interpreter is in a state that allows it (`Interpreter.skimmable`),
 telling their effect instead (`Interpreter.skipped`, `IsoWriter.skimmed`).
+The expression runs once per shape of line (`_Shapes`: 8k instructions a line
+left out, not 18k).
 
 What is left out is checked, not trusted: the first part compares the
 interpreter's state at the cut with the second part's (`Interpreter.state`), and
@@ -19,7 +21,7 @@ used.
 from __future__ import annotations
 
 import re
-from typing import TYPE_CHECKING, Iterable, Iterator
+from typing import TYPE_CHECKING, Iterable, Iterator, NamedTuple
 
 from ncpp.passes.context import UNDECIDED
 from ncpp.program.parser import iter_lines
@@ -45,11 +47,57 @@ PLAIN_LINE = re.compile(
     + b"(" + b"".join(map(_word, "XYZ")) + b")(" + b"".join(map(_word, "IJKR")) + b")" + _word("F")
     + rb"(?:\([^()\r\n]*+\)[ \t]*+)?\r?\n?"
 )
-_CODE, _AXIS_WORDS, _ARC_WORDS = 0, 1, 5  # groups() indices
-_NUMBERS = (2, 3, 4, 6, 7, 8, 9, 10)  # groups() index of each letter's number, in LETTERS' order
+_CODE, _AXIS_WORDS, _ARC_WORDS = 1, 2, 6  # group numbers
+_NUMBERS = (3, 4, 5, 7, 8, 9, 10, 11)  # the group of each letter's number, in LETTERS' order
 _F = 7  # F's place in LETTERS (the axes are 0-2: their program position indices)
-_MOTION = {b"0": 0.0, b"1": 1.0, b"2": 2.0, b"3": 3.0}
-_RESOLVED = 4096  # plain lines whose matches are kept before their last numbers are picked out
+_RESOLVED = 4096  # plain lines kept before their last numbers are picked out
+_SHAPES = 8192  # shapes known at most: memory stays flat (the generated program has 3231)
+_ALIKE = bytes.maketrans(b"0123456789", b"0" * 10)  # a line's shape: every digit alike
+
+
+class _Plain(NamedTuple):
+    """What PLAIN_LINE finds in the lines of one shape: where the motion code's digit and
+    each letter's number are (`at`: (start, end) or None, in `_last`'s order), where G's
+    digits start (-1: no G word), and whether there are arc words and axis words."""
+
+    at: tuple
+    zeros: int
+    arc: bool
+    axis: bool
+
+
+class _Shapes:
+    """PLAIN_LINE's verdict on a line by its shape, the regular expression run once per shape
+    (most lines of a CAM program share a few hundred).  Digits differ only in G's `0*[0-3]`
+    within a shape (elsewhere the expression asks `\\d`), which is checked line by line."""
+
+    def __init__(self) -> None:
+        self.known: dict[bytes, _Plain | None] = {}
+
+    def plain(self, raw: bytes) -> _Plain | None:
+        shape = raw.translate(_ALIKE)
+        plain = self.known.get(shape, _Plain)  # (the class: not known yet)
+        if plain is _Plain:
+            plain = self._learn(raw, shape)
+        if plain is not None and plain.zeros >= 0:  # `G0*[0-3]`: zeros, then a code of 0-3 (0x30-0x33)
+            code = plain.at[0][0]
+            if raw[code] > 0x33 or raw.count(0x30, plain.zeros, code) != code - plain.zeros:
+                return None
+        return plain
+
+    def _learn(self, raw: bytes, shape: bytes) -> _Plain | None:
+        """The verdict on `raw`'s shape from `raw` (not plain: for all of them, the safe side)."""
+        if len(self.known) >= _SHAPES:
+            self.known.clear()
+        found = PLAIN_LINE.fullmatch(raw)
+        plain = None
+        if found is not None:
+            code = found.start(_CODE)
+            zeros = -1 if code < 0 else len(raw[:code].rstrip(b"0"))
+            at = tuple(None if found.start(g) < 0 else found.span(g) for g in (_CODE, *_NUMBERS))
+            plain = _Plain(at, zeros, bool(found.group(_ARC_WORDS)), bool(found.group(_AXIS_WORDS)))
+        self.known[shape] = plain
+        return plain
 
 
 class Skim:
@@ -63,6 +111,7 @@ class Skim:
         self.part, self.first = part, first
         self.interpreter: Interpreter | None = None  # given before the first line is read
         self.writer: IsoWriter | None = None
+        self.shapes = _Shapes()
 
     def __call__(self, stream: Iterable[bytes]) -> Iterator[tuple[int, tuple[str, str]]]:
         lines = iter(stream)
@@ -74,9 +123,9 @@ class Skim:
                 yield number, _text(raw)
                 break
             if begun and number >= self.first and self.interpreter.skimmable():  # type: ignore[union-attr]
-                found = PLAIN_LINE.fullmatch(raw)
-                if found is not None:
-                    raw, number = self._skim(raw, found, lines, number)
+                plain = self.shapes.plain(raw)
+                if plain is not None:
+                    raw, number = self._skim(raw, plain, lines, number)
                     if raw is None:
                         return
             begun = begun or not raw.isspace() and raw != b""
@@ -93,21 +142,20 @@ class Skim:
             part.cut.line = part.ask()  # type: ignore[misc]
         return part.cut.line - part.window
 
-    def _skim(self, raw: bytes, found: re.Match, lines: Iterator[bytes], number: int) -> tuple[bytes | None, int]:
-        """Leave out the run of plain lines from line `number` (`raw`, its match `found`):
-        the first line not left out and its number (None: the program ended)."""
+    def _skim(self, raw: bytes, plain: _Plain, lines: Iterator[bytes], number: int) -> tuple[bytes | None, int]:
+        """Leave out the run of plain lines from line `number` (`raw`, what its shape holds
+        `plain`): the first line not left out and its number (None: the program ended)."""
         motion = self.interpreter.motion  # type: ignore[union-attr]
         last: list[bytes | None] = [None] * (len(LETTERS) + 1)  # the last motion code, then each letter's last number
-        matched: list[tuple] = []  # the groups of the lines since `last` was brought up to date
-        first, window, fullmatch = number, self._window(number), PLAIN_LINE.fullmatch
+        matched: list[tuple[bytes, _Plain]] = []  # the lines since `last` was brought up to date
+        first, window, shaped = number, self._window(number), self.shapes.plain
         while True:
-            groups = found.groups()
-            code = groups[_CODE]
-            moving = motion if code is None else _MOTION[code]
-            if (moving is None or moving < 2.0) and (groups[_ARC_WORDS] or (moving is None and groups[_AXIS_WORDS])):
+            code = plain.at[0]
+            moving = motion if code is None else float(raw[code[0]] - 0x30)
+            if (moving is None or moving < 2.0) and (plain.arc or (moving is None and plain.axis)):
                 break  # R with G0/G1 is a (Fanuc) corner, IJK an error, axis words with no mode too: the interpreter's
             motion = moving
-            matched.append(groups)
+            matched.append((raw, plain))
             if len(matched) == _RESOLVED:
                 _bring_up_to_date(last, matched)
             raw = next(lines, None)  # type: ignore[assignment]
@@ -118,8 +166,8 @@ class Skim:
                 window = self._window(number)
                 if number >= window:
                     break
-            found = fullmatch(raw)  # type: ignore[assignment]
-            if found is None:
+            plain = shaped(raw)  # type: ignore[assignment, arg-type]
+            if plain is None:
                 break
         if number > first:
             _bring_up_to_date(last, matched)
@@ -137,13 +185,14 @@ class Skim:
         self.part.skipped += lines
 
 
-def _bring_up_to_date(last: list[bytes | None], matched: list[tuple]) -> None:
+def _bring_up_to_date(last: list[bytes | None], matched: list[tuple[bytes, _Plain]]) -> None:
     """`last` (the motion code, each letter's number) after the lines `matched`, which it
     forgets: each is looked for from the end (most are on the last line or so)."""
-    for k, column in enumerate((_CODE, *_NUMBERS)):
-        for groups in reversed(matched):
-            if groups[column] is not None:
-                last[k] = groups[column]
+    for k in range(len(last)):
+        for raw, plain in reversed(matched):
+            span = plain.at[k]
+            if span is not None:
+                last[k] = raw[span[0] : span[1]]
                 break
     matched.clear()
 
