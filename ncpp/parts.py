@@ -13,10 +13,10 @@ run writes from the cut on (chunks end at the same input lines,
 failed), this process compensates the rest itself from its own state.  The output is
 that of one run, byte for byte, either way, wherever the cut is.
 
-The cut is where both parts end together.  On a long program it is chosen while they
-run (`share`): the second process waits at the earliest line the cut may be near and
-says how fast it read its lines; this process then splits what is left between them
-by how far it has got, and sends the cut.
+The cut is where both parts end together, chosen while they run (`share`): the
+second process waits at the earliest line the cut may be near and says how fast it
+read its lines; this process then splits what is left between them by how far it
+has got, and sends the cut.
 """
 
 from __future__ import annotations
@@ -42,9 +42,9 @@ from ncpp.passes.kernels import child_environment
 if TYPE_CHECKING:
     from ncpp.pipeline import Part, Stats
 
-# The first part's share of the lines where the cut is not decided while they run: the
-# second part also starts, reads the first part's lines (`motion/skim.py`) and compensates a
-# window before the cut, so it takes less than half.
+# The first part's share of the lines when the second has not said it waits by the time the
+# first nears the floor (it reads slowly, or failed): the second part also reads the first
+# part's lines (`motion/skim.py`) and compensates a window before the cut, so it takes less.
 FIRST_SHARE = 0.54
 SHARES = (0.45, 0.75)  # the first part's share stays within these, measured or not
 WINDOW = 2 * LINE_CHUNK  # lines before the cut the second part compensates to find its state
@@ -243,7 +243,10 @@ def _start(job: Job) -> "subprocess.Popen | _Forked":
     of this process where that is safe (`_may_fork`): it has the imports and the machine
     already (a new interpreter spends 1.6G instructions on them); else a new interpreter."""
     if _may_fork():
-        return _Forked(job)
+        try:
+            return _Forked(job)
+        except OSError:  # no fork now (a process limit): a new interpreter may still start
+            pass
     child = subprocess.Popen(
         [sys.executable, "-c", "from ncpp.parts import _serve; _serve()"],
         stdin=subprocess.PIPE, stdout=subprocess.PIPE, env=child_environment(),
@@ -269,7 +272,12 @@ class _Forked:
     def __init__(self, job: Job):
         cut_read, cut_write = os.pipe()
         reply_read, reply_write = os.pipe()
-        self.pid = os.fork()
+        try:
+            self.pid = os.fork()
+        except OSError:
+            for fd in (cut_read, cut_write, reply_read, reply_write):
+                os.close(fd)
+            raise
         if self.pid == 0:  # the child: it never returns, nor flushes or cleans up what it shares with this process
             code = 1
             try:
@@ -327,7 +335,7 @@ def _serve() -> None:
 def _serve_job(job: Job, requests: BinaryIO, replies: BinaryIO) -> None:
     """The second process: the second part into the spool, then its state at the cut,
     stats and warnings (none if anything failed: the first process does the part then).
-    `requests`: where the cut comes from when undecided; `replies`: where pace and reply go."""
+    `requests`: where the cut comes from; `replies`: where the pace and the reply go."""
     from ncpp.pipeline import Part, process
 
     reply: dict = {"reached": None}

@@ -57,13 +57,16 @@ _ALIKE = bytes.maketrans(b"0123456789", b"0" * 10)  # a line's shape: every digi
 
 class _Plain(NamedTuple):
     """What PLAIN_LINE finds in the lines of one shape: where the motion code's digit and
-    each letter's number are (`at`: (start, end) or None, in `_last`'s order), where G's
+    each letter's number are (`at`: (start, end) or None; the code, then LETTERS), where G's
     digits start (-1: no G word), and whether there are arc words and axis words."""
 
     at: tuple
     zeros: int
     arc: bool
     axis: bool
+
+
+_UNKNOWN = _Plain((), -1, False, False)  # a shape not seen yet
 
 
 class _Shapes:
@@ -76,8 +79,8 @@ class _Shapes:
 
     def plain(self, raw: bytes) -> _Plain | None:
         shape = raw.translate(_ALIKE)
-        plain = self.known.get(shape, _Plain)  # (the class: not known yet)
-        if plain is _Plain:
+        plain = self.known.get(shape, _UNKNOWN)
+        if plain is _UNKNOWN:
             plain = self._learn(raw, shape)
         if plain is not None and plain.zeros >= 0:  # `G0*[0-3]`: zeros, then a code of 0-3 (0x30-0x33)
             code = plain.at[0][0]
