@@ -13,7 +13,7 @@ import ncpp.pipeline as pipeline
 from ncpp.errors import NcppError, Warnings
 from ncpp.motion.interpreter import Interpreter
 from ncpp.motion.offsets import WorkOffsets
-from ncpp.motion.skim import PLAIN_LINE, _Shapes
+from ncpp.motion.skim import _CODE, _NUMBERS, PLAIN_LINE, _Shapes
 from ncpp.passes.context import CutLine
 from ncpp.passes.geometry import LINE_CHUNK
 from ncpp.pipeline import ErrorSource, Part, process
@@ -87,7 +87,7 @@ def test_plain_lines_are_those_the_skim_can_tell():
 
 def test_a_lines_shape_says_what_the_expression_says_of_it():
     """The verdict is kept per shape (digits alike); G's digits are checked line by line:
-    G01 and G21, G02 and G12 share a shape.  A shape first seen not plain stays so (safe:
+    G01 and G21, G03 and G13, G2 and G5 share a shape.  A shape first seen not plain stays so (safe:
     its lines are read)."""
     shapes = _Shapes()
     lines = [b"G01 X1.5 Y-2\n", b"G21 X1.5 Y-2\n", b"G03 X7.5 Y-9\n", b"G13 X7.5 Y-9\n", b"G2 X1 R5\n", b"G5 X1 R5\n",
@@ -96,7 +96,7 @@ def test_a_lines_shape_says_what_the_expression_says_of_it():
         found, plain = PLAIN_LINE.fullmatch(line), shapes.plain(line)
         assert (plain is None) == (found is None), line
         if plain is not None:
-            assert [None if at is None else line[at[0] : at[1]] for at in plain.at] == [found.group(1), *(found.group(g) for g in range(3, 12) if g != 6)]
+            assert [None if at is None else line[at[0] : at[1]] for at in plain.at] == [found.group(g) for g in (_CODE, *_NUMBERS)]
     assert shapes.plain(b"G10 X1\n") is None and shapes.plain(b"G01 X1\n") is None  # the shape learnt from G10
 
 
