@@ -173,7 +173,7 @@ def fastest(runs: dict[str, Callable[[], dict[str, Any]]], repeats: int = REPEAT
 
 
 def paired_ratios(best: dict[str, dict[str, Any]], tool: str, baseline: str) -> list[float]:
-    """Rate ratio tool / baseline of each round, the two runs minutes apart at most
+    """Rate ratio tool / baseline of each round, from two runs next to each other in the round
     (they read the same lines: the ratio of their seconds inverted).  Their median
     is steadier than the ratio of the fastest runs when the machine's speed drifts."""
     return [b / t for t, b in zip(best[tool]["all_seconds"], best[baseline]["all_seconds"])]
@@ -251,11 +251,13 @@ def compensate_speed(ctx):
     for label, path in programs.items():
         offset = work_offset(path)
         lines = bench.count_lines(path)
+        # in this order each round: pygcode runs right after compensation and right before it in
+        # one process, so each pair of runs a round's ratio compares is seconds apart, not a minute
         best = fastest({
             "passthrough": lambda: in_fresh_process("ncpp_process_rate", path, None),
             "compensate": lambda: in_fresh_process("ncpp_process_rate", path, offset, 2),
-            "compensate, one process": lambda: in_fresh_process("ncpp_process_rate", path, offset, 1),
             "pygcode": lambda: in_fresh_process("pygcode_rate", path),
+            "compensate, one process": lambda: in_fresh_process("ncpp_process_rate", path, offset, 1),
         })  # fmt: skip
         passthrough, compensated, alone, pyg = best["passthrough"], best["compensate"], best["compensate, one process"], best["pygcode"]
         rs = bench.rs274_rate(path, lines)
