@@ -313,6 +313,17 @@ def render(section: Section) -> str:
     return "\n".join(lines)
 
 
+def cpu() -> str:
+    """The processor as Linux names it, with its family and model: a VM may name only the
+    vendor, and the same code's ratio to pygcode differs from one processor to another."""
+    try:
+        facts = dict(line.split(":", 1) for line in Path("/proc/cpuinfo").read_text().splitlines() if ":" in line)
+    except OSError:
+        return platform.processor() or platform.machine()
+    facts = {key.strip(): value.strip() for key, value in facts.items()}
+    return f"{facts.get('model name', '?')} (family {facts.get('cpu family', '?')}, model {facts.get('model', '?')})"
+
+
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description="ncpp throughput and memory benchmarks")
     p.add_argument("--quick", action="store_true", help="smaller programs, no 10M-line run (under 2 minutes)")
@@ -325,10 +336,12 @@ def main(argv: list[str] | None = None) -> int:
         "quick": args.quick,
         "python": sys.version.split()[0],
         "machine": platform.platform(),
+        "cpu": cpu(),
         "cpus": os.cpu_count(),
         "started": time.strftime("%Y-%m-%dT%H:%M:%S"),
         "sections": {},
     }
+    print(f"{results['cpu']}, {results['cpus']} cores; Python {results['python']}", flush=True)
     with tempfile.TemporaryDirectory(prefix="ncpp-bench-") as tmp:
         ctx = Context(quick=args.quick, workdir=Path(tmp))
         for run in SECTIONS:
