@@ -291,22 +291,47 @@ def process(
 def _two_parts(stream: BinaryIO, file: str, dialect: str | None) -> tuple[str, int] | None:
     """(path, lines) when the stream is an unread ISO program file that pays for two
     processes (`parts.py`); else None (a pipe, another dialect, a short program)."""
-    import os
-
     from ncpp.parts import lines_for
     from ncpp.program.dialects import SNIFF_BYTES, detect
 
-    path = getattr(stream, "name", None)
-    try:
-        if not isinstance(path, str) or not os.path.isfile(path) or stream.tell() != 0:
-            return None
-    except (OSError, ValueError):
+    path = program_file(stream)
+    if path is None:
         return None
     with open(path, "rb") as f:
         if (dialect or detect(f.read(SNIFF_BYTES), file)).lower() != "iso":
             return None
     lines = lines_for(path)
     return None if lines is None else (path, lines)
+
+
+def program_file(stream: BinaryIO) -> str | None:
+    """The path of the regular file `stream` reads, not read yet: its name, or for standard
+    input redirected from a file (`ncpp compensate ... < in.nc`, no name) the file Linux
+    says the descriptor holds; None for a pipe, a terminal, a file read from elsewhere
+    than its start, or a file no path names any more."""
+    import os
+    import stat
+
+    try:
+        if stream.tell() != 0:
+            return None
+        fd = stream.fileno()
+        held = os.fstat(fd)
+    except (OSError, ValueError, AttributeError):  # (io.UnsupportedOperation is an OSError)
+        return None
+    if not stat.S_ISREG(held.st_mode):
+        return None
+    named = getattr(stream, "name", None)
+    candidates = [named] if isinstance(named, str) else []
+    candidates.append(f"/proc/self/fd/{fd}")  # (Linux: a link to the file the descriptor holds)
+    for candidate in candidates:
+        path = os.path.realpath(candidate)
+        try:
+            if os.path.samestat(os.stat(path), held):  # (a deleted file's link names no file)
+                return path
+        except OSError:
+            pass
+    return None
 
 
 def _kernels(worker: bool) -> Kernels:

@@ -12,7 +12,7 @@ import pytest
 import ncpp.parts as parts
 from ncpp.errors import Warnings
 from ncpp.motion.offsets import WorkOffsets
-from ncpp.pipeline import ErrorSource, process
+from ncpp.pipeline import ErrorSource, process, program_file
 
 from .test_kernels import OFFSET, ROOT, _pattern
 
@@ -216,3 +216,41 @@ def test_the_paced_first_part_still_tells_progress(program, source, one_run, mon
                 offsets=WorkOffsets.at(OFFSET), progress=seen.append)  # fmt: skip
     assert out.getvalue() == one_run[0]
     assert seen[:3] == [1000, 2000, 3000] and len(seen) >= 8
+
+
+def test_standard_input_redirected_from_a_program_file_is_read_in_two_parts(program, source, one_run, monkeypatch):
+    """`ncpp compensate ... < long.ngc`: standard input has no name, but it holds the file."""
+    started, start = [], parts._start
+    monkeypatch.setattr(parts, "_start", lambda job: started.append(job.path) or start(job))
+    with open(program, "rb") as named, open(os.dup(named.fileno()), "rb") as stdin:  # a descriptor, no name
+        assert not isinstance(stdin.name, str)
+        out, said = io.BytesIO(), io.StringIO()
+        process(stdin, out, file="long.ngc", source=source, jobs=2, warnings=Warnings(stream=said), offsets=WorkOffsets.at(OFFSET))
+    assert started == [os.path.realpath(program)]
+    assert (out.getvalue(), said.getvalue()) == one_run[:2]
+
+
+def test_the_program_file_behind_a_stream(program, tmp_path):
+    with open(program, "rb") as named:
+        assert program_file(named) == os.path.realpath(program)
+        with open(os.dup(named.fileno()), "rb") as unnamed:
+            assert program_file(unnamed) == os.path.realpath(program)
+        named.read(10)
+        assert program_file(named) is None  # read from elsewhere than its start: the parts could not both start there
+    gone = tmp_path / "gone.ngc"
+    gone.write_bytes(PROGRAM)
+    with open(gone, "rb") as stream:
+        gone.unlink()
+        assert program_file(stream) is None  # no path names it: the second process could not open it
+    read, write = os.pipe()
+    with open(read, "rb") as pipe, open(write, "wb"):
+        assert program_file(pipe) is None
+    assert program_file(io.BytesIO(PROGRAM)) is None
+
+
+def test_the_command_with_standard_input_redirected_writes_one_runs_output(program, one_run):
+    offset = ",".join(map(str, OFFSET))
+    with open(program, "rb") as stdin:
+        done = subprocess.run([sys.executable, "-m", "ncpp", "compensate", "--machine", str(ROOT / "samples/machines/hr5b.toml"),
+                               "--work-offset", offset, "--jobs", "2"], stdin=stdin, capture_output=True, check=True)  # fmt: skip
+    assert done.stdout == one_run[0]
