@@ -37,8 +37,9 @@ def add_compensation_arguments(p: argparse.ArgumentParser) -> None:
         choices=(1, 2),
         default=None,
         help="processes: 2 compensates an ISO program file of 8192 lines or more in two parts, one process each, and "
-        "other input with its numeric work in a second process (the same output either way); "
-        "default 2 for a program file over 2 MB on a machine with two or more cores, else 1",
+        "other input with its numeric work in a second process (the same output either way; a piped program is "
+        "copied to a temporary file first); default 2 for a program file or piped program over 2 MB on a machine "
+        "with two or more cores, else 1 (a pipe then streams)",
     )
 
 
@@ -87,12 +88,24 @@ def jobs_for(requested: int | None, stream: BinaryIO) -> int:
     """--jobs, or what suits this input on this machine."""
     if requested is not None:
         return requested
-    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
     try:
-        size = os.fstat(stream.fileno()).st_size  # a pipe says 0: it stays in one process
+        size = os.fstat(stream.fileno()).st_size  # a pipe says 0 (`spool_from` copies a long one to a file)
     except (OSError, ValueError, io.UnsupportedOperation):
         return 1
-    return 2 if cores >= 2 and size >= AUTO_JOBS_BYTES else 1
+    return 2 if _cores() >= 2 and size >= AUTO_JOBS_BYTES else 1
+
+
+def spool_from(requested: int | None) -> int | None:
+    """From how many bytes a program piped to standard input is copied to a file before it
+    is compensated (`open_input`), where two processes can read it: any with --jobs 2,
+    none with --jobs 1, else from the size at which `jobs_for` gives a file two."""
+    if requested is not None:
+        return 0 if requested >= 2 else None
+    return AUTO_JOBS_BYTES if _cores() >= 2 else None
+
+
+def _cores() -> int:
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
 
 
 def zero_argument(text: str) -> tuple[str, tuple[float, float, float]]:
@@ -130,7 +143,7 @@ def run(args: argparse.Namespace) -> int:
     if not args.tolerance > 0:
         raise NcppError("--tolerance must be positive")
     warnings = Warnings(strict=args.strict)
-    with open_input(args.input) as (stream, name), open_output(args.output) as out:
+    with open_input(args.input, spool_from(args.jobs)) as (stream, name), open_output(args.output) as out:
         stats = process(
             stream, out, file=name, source=source, tolerance=args.tolerance, strict=args.strict, force=args.force,
             warnings=warnings, dialect=args.dialect, jobs=jobs_for(args.jobs, stream), offsets=work_offsets(args),

@@ -9,7 +9,10 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import io
+import os
 import shutil
+import stat
 import sys
 import tempfile
 from pathlib import Path
@@ -32,12 +35,42 @@ def add_dialect_argument(p: argparse.ArgumentParser) -> None:
 
 
 @contextlib.contextmanager
-def open_input(path: str | None) -> Iterator[tuple[BinaryIO, str]]:
+def open_input(path: str | None, spool_from: int | None = None) -> Iterator[tuple[BinaryIO, str]]:
+    """The program to read and its name for messages.  `spool_from`: standard input that
+    is not a file (a pipe) and holds at least this many bytes is copied to a temporary
+    file first, which can be compensated in two parts (`ncpp/parts.py`; the output is
+    written at the end either way); less is read from memory."""
     if path is None or path == "-":
-        yield sys.stdin.buffer, "<stdin>"
+        stdin = sys.stdin.buffer
+        if spool_from is None or _is_file(stdin):
+            yield stdin, "<stdin>"
+            return
+        with _spooled(stdin, spool_from) as stream:
+            yield stream, "<stdin>"
         return
     with open(path, "rb") as stream:
         yield stream, path
+
+
+def _is_file(stream: BinaryIO) -> bool:
+    try:
+        return stat.S_ISREG(os.fstat(stream.fileno()).st_mode)
+    except (OSError, ValueError):
+        return False
+
+
+@contextlib.contextmanager
+def _spooled(stream: BinaryIO, spool_from: int) -> Iterator[BinaryIO]:
+    head = stream.read(spool_from) if spool_from else b""
+    if spool_from and len(head) < spool_from:  # the whole program, and short
+        yield io.BytesIO(head)
+        return
+    with tempfile.TemporaryDirectory(prefix="ncpp-input-") as folder:
+        with open(os.path.join(folder, "stdin.nc"), "w+b") as spool:
+            spool.write(head)
+            shutil.copyfileobj(stream, spool, 1 << 20)
+            spool.seek(0)
+            yield spool
 
 
 @contextlib.contextmanager

@@ -4,11 +4,14 @@ worker dies."""
 
 import io
 import os
+import sys
+import threading
 from pathlib import Path
 
 import pytest
 
-from ncpp.cli.compensate import AUTO_JOBS_BYTES, jobs_for
+from ncpp.cli.compensate import AUTO_JOBS_BYTES, jobs_for, spool_from
+from ncpp.cli.io import open_input
 from ncpp.errors import NcppError
 from ncpp.motion.offsets import WorkOffsets
 from ncpp.passes.kernels import Worker, WorkerError, run_ahead
@@ -121,6 +124,28 @@ def test_jobs_follow_the_input_size_unless_given(tmp_path):
     with os.fdopen(read, "rb") as pipe:
         os.close(write)
         assert jobs_for(None, pipe) == 1
+
+
+def _feed(fd: int, text: bytes) -> None:
+    with os.fdopen(fd, "wb") as pipe:
+        pipe.write(text)
+
+
+def test_a_piped_program_is_read_from_memory_or_from_a_file_by_its_size(monkeypatch):
+    """`open_input`'s spool: from `spool_from` bytes on the pipe is copied to a file, which
+    `jobs_for` gives two processes by default; a shorter program is read from memory."""
+    for size, spool, kind in ((100, AUTO_JOBS_BYTES, io.BytesIO), (AUTO_JOBS_BYTES + 100, AUTO_JOBS_BYTES, io.BufferedRandom), (100, 0, io.BufferedRandom)):
+        text = (b"G1 X1 F100\n" * (size // 11 + 1))[:size]
+        read, write = os.pipe()
+        with os.fdopen(read, "rb") as pipe:
+            writer = threading.Thread(target=_feed, args=(write, text))  # (a pipe holds 64 kB: written while read)
+            writer.start()
+            monkeypatch.setattr(sys, "stdin", io.TextIOWrapper(pipe))
+            with open_input(None, spool) as (stream, name):
+                assert (type(stream), name, stream.read()) == (kind, "<stdin>", text)
+                assert jobs_for(None, stream) == (2 if kind is io.BufferedRandom and size >= AUTO_JOBS_BYTES and len(os.sched_getaffinity(0)) >= 2 else 1)
+            writer.join()
+    assert spool_from(1) is None and spool_from(2) == 0
 
 
 def test_run_ahead_starts_that_many_items_before_giving_the_first():

@@ -254,3 +254,26 @@ def test_the_command_with_standard_input_redirected_writes_one_runs_output(progr
         done = subprocess.run([sys.executable, "-m", "ncpp", "compensate", "--machine", str(ROOT / "samples/machines/hr5b.toml"),
                                "--work-offset", offset, "--jobs", "2"], stdin=stdin, capture_output=True, check=True)  # fmt: skip
     assert done.stdout == one_run[0]
+
+
+# The command, its input piped: `process_in_two_parts` is told how often it ran
+PIPED = """
+import sys
+import ncpp.parts as parts
+from ncpp.cli import main
+runs, two_parts = [], parts.process_in_two_parts
+parts.process_in_two_parts = lambda *a, **k: runs.append(a[1]) or two_parts(*a, **k)
+code = main(sys.argv[1:])
+print(len(runs), file=sys.stderr)
+raise SystemExit(code)
+"""
+
+
+@pytest.mark.parametrize("jobs", [["--jobs", "2"], ["--jobs", "1"]])
+def test_a_piped_program_is_copied_to_a_file_and_read_in_two_parts(program, one_run, jobs):
+    """With --jobs 2 (or, by default, from 2 MB on) a piped program is read to its end into
+    a temporary file first, which two processes can read; with --jobs 1 it streams."""
+    args = ["compensate", "--machine", str(ROOT / "samples/machines/hr5b.toml"), "--work-offset", ",".join(map(str, OFFSET)), *jobs]
+    done = subprocess.run([sys.executable, "-c", PIPED, *args], input=PROGRAM, capture_output=True, check=True)
+    assert done.stdout == one_run[0]
+    assert done.stderr.split()[-1] == (b"1" if jobs[1] == "2" else b"0")
