@@ -1,6 +1,6 @@
 """Atomic output files: written to a temporary file beside the target and
 renamed into place only when complete, so a failed run never leaves a
-partial program or table behind."""
+partial program or table behind.  And a program file's line count."""
 
 from __future__ import annotations
 
@@ -40,3 +40,13 @@ def write_text_atomic(path: str | os.PathLike[str], text: str, encoding: str = "
 def write_bytes_atomic(path: str | os.PathLike[str], data: bytes) -> None:
     with atomic_output(path) as out:
         out.write(data)
+
+
+def count_lines(path: str | os.PathLike[str]) -> int:
+    """The lines of a file (its newlines, and a last line without one), read a megabyte at a time."""
+    count, last = 0, b"\n"
+    with open(path, "rb") as f:
+        for chunk in iter(lambda: f.read(1 << 20), b""):
+            count += chunk.count(b"\n")
+            last = chunk[-1:]
+    return count + (last != b"\n")

@@ -35,6 +35,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, BinaryIO, Callable
 
 from ncpp.errors import Location, NcppError, Warnings
+from ncpp.fileio import count_lines
 from ncpp.passes.context import UNDECIDED, CutLine
 from ncpp.passes.geometry import LINE_CHUNK
 from ncpp.passes.kernels import child_environment
@@ -91,8 +92,7 @@ class _Kept(Warnings):
 
 def lines_for(path: str) -> int | None:
     """The program's line count, or None when it is too short to pay for a second process."""
-    with open(path, "rb") as f:
-        lines = sum(chunk.count(b"\n") for chunk in iter(lambda: f.read(1 << 20), b""))
+    lines = count_lines(path)
     return lines if lines >= MIN_LINES else None
 
 
@@ -129,7 +129,8 @@ def process_in_two_parts(
     offsets,
 ) -> "Stats":
     """`pipeline.process` of the program `stream` (unread; the file at `path`, `lines` long)
-    in two parts (the first part reads `stream`: its progress is the file's)."""
+    in two parts (the first part reads `stream`; `progress` is told the program's lines
+    done, `_Pacer`)."""
     from ncpp.pipeline import Part, Stats, process
 
     options = dict(file=file, source=source, tolerance=tolerance, strict=strict, force=force, dialect=dialect, offsets=offsets)
@@ -165,16 +166,20 @@ class _Pacer:
     """This process's progress callback (every 1000 input lines read) while the cut is
     undecided: once the second process reports that it waits at its floor (and how fast
     it read its lines there), or this process's reading nears that floor, it decides the
-    cut from the lines this process has compensated by then (`share`) and sends it."""
+    cut from the lines this process has compensated by then (`share`) and sends it.
+
+    The caller's callback is told the program's lines done: the lines read, and once the
+    cut is decided, as many of the program's as this part's are of its own (the parts end
+    together), so that a progress bar reaches the end with the run, not halfway."""
 
     def __init__(self, child: "subprocess.Popen | _Forked", job: Job, lines: int, part: Part, progress: Callable[[int], None] | None):
         self.child, self.job, self.lines, self.part, self.progress = child, job, lines, part, progress
         self.report: object = _PENDING  # the second's pace (lines read a second), None if it ended without
 
     def __call__(self, read: int) -> None:
-        if self.progress is not None:
-            self.progress(read)
         cut = self.part.cut
+        if self.progress is not None:
+            self.progress(read if cut.line == UNDECIDED else min(read * self.lines // cut.line, self.lines))
         if cut.line != UNDECIDED:
             return
         if self.report is _PENDING:

@@ -14,6 +14,7 @@ import sys
 from typing import BinaryIO
 
 from ncpp.cli.io import add_io_arguments, open_input, open_output
+from ncpp.cli.progress import progress_printer
 from ncpp.errors import NcppError, Warnings
 
 
@@ -143,11 +144,13 @@ def run(args: argparse.Namespace) -> int:
     if not args.tolerance > 0:
         raise NcppError("--tolerance must be positive")
     warnings = Warnings(strict=args.strict)
+    progress = progress_printer("compensate")
     with open_input(args.input, spool_from(args.jobs)) as (stream, name), open_output(args.output) as out:
         stats = process(
             stream, out, file=name, source=source, tolerance=args.tolerance, strict=args.strict, force=args.force,
-            warnings=warnings, dialect=args.dialect, jobs=jobs_for(args.jobs, stream), offsets=work_offsets(args),
+            warnings=warnings, progress=progress, dialect=args.dialect, jobs=jobs_for(args.jobs, stream), offsets=work_offsets(args),
         )
-    if sys.stderr.isatty():
+    if progress is not None:
+        progress.done()
         print(f"ncpp: {stats.lines_in} lines in, {stats.lines_out} lines out", file=sys.stderr)
     return 0

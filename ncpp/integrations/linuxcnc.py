@@ -17,21 +17,23 @@ import argparse
 import os
 import shutil
 import sys
-from typing import BinaryIO, TextIO
+from typing import TextIO
 
 from ncpp.errors import NcppError, Warnings
+from ncpp.fileio import count_lines
 from ncpp.runtime import one_blas_thread
 
 
 class FilterProgress:
-    """`FILTER_PROGRESS=N` on stderr whenever the percentage of the file read changes."""
+    """`FILTER_PROGRESS=N` on stderr whenever the percentage of the program's lines done
+    changes (`pipeline.process`'s progress: in two parts, the program's lines, `parts._Pacer`)."""
 
-    def __init__(self, stream: BinaryIO, size: int, out: TextIO):
-        self.stream, self.size, self.out = stream, max(size, 1), out
+    def __init__(self, lines: int, out: TextIO):
+        self.lines, self.out = max(lines, 1), out
         self.last = -1
 
-    def __call__(self, _lines: int = 0) -> None:
-        self.report(min(99, 100 * self.stream.tell() // self.size))
+    def __call__(self, lines: int) -> None:
+        self.report(min(99, 100 * lines // self.lines))
 
     def report(self, percent: int) -> None:
         if percent != self.last:
@@ -56,7 +58,7 @@ def run(path: str, err: TextIO, machine: str | None = None) -> None:
 
     settings = with_linuxcnc_ini(find_settings(machine), os.environ.get("INI_FILE_NAME"))
     with open(path, "rb") as stream:
-        progress = FilterProgress(stream, os.fstat(stream.fileno()).st_size, err)
+        progress = FilterProgress(count_lines(path), err)
         progress.report(0)
         with open_output(None) as spool:
             if settings.machine is None or already_compensated(path):

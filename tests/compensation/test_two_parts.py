@@ -11,6 +11,8 @@ import pytest
 
 import ncpp.parts as parts
 from ncpp.errors import Warnings
+from ncpp.fileio import count_lines
+from ncpp.integrations.linuxcnc import FilterProgress
 from ncpp.motion.offsets import WorkOffsets
 from ncpp.pipeline import ErrorSource, process, program_file
 
@@ -209,13 +211,27 @@ def test_the_share_ends_both_parts_together(done, ratio):
 
 def test_the_paced_first_part_still_tells_progress(program, source, one_run, monkeypatch):
     """The pace is measured through the progress callback: the caller's (the LinuxCNC
-    filter's FILTER_PROGRESS) is still told every 1000 lines."""
-    seen, out = [], io.BytesIO()
+    filter's FILTER_PROGRESS) is still told every 1000 lines, the program's lines done:
+    the first part's, scaled to the whole program once the cut is decided."""
+    seen, out, cuts = [], io.BytesIO(), []
+    send = parts._send
+    monkeypatch.setattr(parts, "_send", lambda child, cut: cuts.append(cut) or send(child, cut))
     with open(program, "rb") as stream:
-        process(stream, out, file="long.ngc", source=source, jobs=2, warnings=Warnings(stream=io.StringIO()),
-                offsets=WorkOffsets.at(OFFSET), progress=seen.append)  # fmt: skip
+        stats = process(stream, out, file="long.ngc", source=source, jobs=2, warnings=Warnings(stream=io.StringIO()),
+                        offsets=WorkOffsets.at(OFFSET), progress=seen.append)  # fmt: skip
     assert out.getvalue() == one_run[0]
-    assert seen[:3] == [1000, 2000, 3000] and len(seen) >= 8
+    assert seen[0] == 1000 and seen == sorted(seen) and len(seen) >= 8
+    assert cuts[0] < 0.6 * stats.lines_in and seen[-1] == stats.lines_in  # a bar does not stop at the cut
+
+
+def test_filter_progress_is_the_percentage_of_the_programs_lines_done(program, source):
+    said = io.StringIO()
+    progress = FilterProgress(count_lines(program), said)
+    with open(program, "rb") as stream:
+        process(stream, io.BytesIO(), file="long.ngc", source=source, jobs=2, warnings=Warnings(stream=io.StringIO()),
+                offsets=WorkOffsets.at(OFFSET), progress=progress)  # fmt: skip
+    percents = [int(line.split("=")[1]) for line in said.getvalue().split()]
+    assert percents == sorted(percents) and percents[0] <= 10 and 90 <= percents[-1] <= 99
 
 
 def test_standard_input_redirected_from_a_program_file_is_read_in_two_parts(program, source, one_run, monkeypatch):
