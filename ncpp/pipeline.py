@@ -308,7 +308,7 @@ def program_file(stream: BinaryIO) -> str | None:
     """The path of the regular file `stream` reads, not read yet: its name, or for standard
     input redirected from a file (`ncpp compensate ... < in.nc`, no name) the file Linux
     says the descriptor holds; None for a pipe, a terminal, a file read from elsewhere
-    than its start, or a file no path names any more."""
+    than its start, or a file no path names any more or this process may not open."""
     import os
     import stat
 
@@ -327,7 +327,8 @@ def program_file(stream: BinaryIO) -> str | None:
     for candidate in candidates:
         path = os.path.realpath(candidate)
         try:
-            if os.path.samestat(os.stat(path), held):  # (a deleted file's link names no file)
+            # (a deleted file's link names no file; the parts open the path, so it must be readable)
+            if os.path.samestat(os.stat(path), held) and os.access(path, os.R_OK):
                 return path
         except OSError:
             pass

@@ -264,6 +264,14 @@ def test_the_program_file_behind_a_stream(program, tmp_path):
     assert program_file(io.BytesIO(PROGRAM)) is None
 
 
+def test_a_file_this_process_may_not_open_by_name_is_not_a_program_file(program, monkeypatch):
+    """`sudo -u nc ncpp < /root/in.nc`: the shell opened it; the parts could not (root may
+    open anything, so the refusal is told here)."""
+    monkeypatch.setattr(os, "access", lambda path, mode: False)
+    with open(program, "rb") as stream:
+        assert program_file(stream) is None
+
+
 def test_the_command_with_standard_input_redirected_writes_one_runs_output(program, one_run):
     offset = ",".join(map(str, OFFSET))
     with open(program, "rb") as stdin:
