@@ -2,9 +2,9 @@
 
 This process compensates the lines before a cut.  A second process (a fork of this
 one where that is safe, `_may_fork`; else a new interpreter) reads the whole program
-too: it reads the lines before the cut for the state there (runs of plain lines it
-leaves unread, telling their effect: `motion/skim.py`; the others it interprets, a
-fifth to a third of the cost of compensating them), compensates a window of lines
+too: it reads the lines before the cut for the state there (in an ISO program, runs of
+plain lines it leaves unread, telling their effect: `motion/skim.py`; the others it
+interprets, a fifth to a third of the cost of compensating them), compensates a window of lines
 before the cut to reach the state the passes and the writer are in there, and
 compensates the rest into a spool file.  Where its state at the cut equals this
 process's (the interpreter's too, where it left lines unread), its output is what one

@@ -199,6 +199,11 @@ DIALECT_TOOLS = {
 }
 
 
+# The dialects compensated in two parts (`parts.py`): Heidenhain's writer numbers every block
+# after an inserted one anew, which a second part, not knowing the first's insertions, cannot.
+IN_TWO_PARTS = ("iso", "sinumerik")
+
+
 def dialect_tools(name: str) -> tuple[Callable, type]:
     """(interpret, Writer) of a dialect."""
     import importlib
@@ -275,7 +280,7 @@ def process(
     the machine whose errors are compensated."""
     if source is not None and jobs > 1 and part is None:
         split = _two_parts(stream, file, dialect)
-        if split is not None:  # an ISO program file long enough: two parts, one process each (parts.py)
+        if split is not None:  # an ISO or Sinumerik program file long enough: two parts, one process each (parts.py)
             from ncpp.parts import process_in_two_parts
 
             path, lines = split
@@ -289,8 +294,8 @@ def process(
 
 
 def _two_parts(stream: BinaryIO, file: str, dialect: str | None) -> tuple[str, int] | None:
-    """(path, lines) when the stream is an unread ISO program file that pays for two
-    processes (`parts.py`); else None (a pipe, another dialect, a short program)."""
+    """(path, lines) when the stream is an unread program file of a dialect `IN_TWO_PARTS` that
+    pays for two processes (`parts.py`); else None (a pipe, Heidenhain, a short program)."""
     from ncpp.parts import lines_for
     from ncpp.program.dialects import SNIFF_BYTES, detect
 
@@ -298,7 +303,7 @@ def _two_parts(stream: BinaryIO, file: str, dialect: str | None) -> tuple[str, i
     if path is None:
         return None
     with open(path, "rb") as f:
-        if (dialect or detect(f.read(SNIFF_BYTES), file)).lower() != "iso":
+        if (dialect or detect(f.read(SNIFF_BYTES), file)).lower() not in IN_TWO_PARTS:
             return None
     lines = lines_for(path)
     return None if lines is None else (path, lines)
@@ -375,7 +380,7 @@ def _process(
     # the control's zeros place the program on the machine; passthrough places nothing
     offsets = (offsets or AT_MACHINE_ZERO) if source is not None else None
     interpreter = None
-    if part is not None:  # (parts are ISO programs', `_two_parts`) its state at the cut is compared
+    if part is not None and name == "iso":  # its state at the cut is compared where a second part skims (`Skim`)
         interpreter = Interpreter(file, offsets)
         blocks = _state_at_cut(blocks, part, interpreter)
         events: Iterable[Event] = interpret(blocks, file=file, warnings=warnings, strict=strict, interpreter=interpreter)
@@ -384,7 +389,7 @@ def _process(
     if source is not None and name == "iso":  # the ISO interpreter's canned cycles
         events = warn_fixed(events, warnings, file)
     writer = writer_class()
-    if skim is not None:  # (before it reads a line: parsing starts when the writer asks for events)
+    if skim is not None:  # (before it reads a line: parsing starts when the writer asks for events; no interpreter: no skimming)
         skim.interpreter, skim.writer = interpreter, writer
     if source is None:
         lines: Iterable[str] = (event.block.text for event in _first_per_block(events))

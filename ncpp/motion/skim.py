@@ -108,7 +108,8 @@ class Skim:
     window left out where `interpreter` may skip them (from line `first` on).
 
     The window starts `part.window` lines before the cut; with the cut undecided a run
-    stops at `part.floor`, where the cut is asked for (`part.ask`) as the part would."""
+    stops at `part.floor`, where the cut is asked for (`part.ask`) as the part would.
+    Without an interpreter (another dialect's part) no line is left out: it only asks."""
 
     def __init__(self, part: "Part", first: int):
         self.part, self.first = part, first
@@ -125,7 +126,7 @@ class Skim:
             if number >= self._window(number):
                 yield number, _text(raw)
                 break
-            if begun and number >= self.first and self.interpreter.skimmable():  # type: ignore[union-attr]
+            if begun and number >= self.first and self.interpreter is not None and self.interpreter.skimmable():
                 plain = self.shapes.plain(raw)
                 if plain is not None:
                     raw, number = self._skim(raw, plain, lines, number)

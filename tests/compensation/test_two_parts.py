@@ -14,7 +14,7 @@ from ncpp.errors import Warnings
 from ncpp.fileio import count_lines
 from ncpp.integrations.linuxcnc import FilterProgress
 from ncpp.motion.offsets import WorkOffsets
-from ncpp.pipeline import ErrorSource, process, program_file
+from ncpp.pipeline import ErrorSource, _two_parts, process, program_file
 
 from .test_kernels import OFFSET, ROOT, _pattern
 
@@ -39,8 +39,8 @@ def source():
 
 def _compensated(path, source, jobs: int) -> tuple[bytes, str, object]:
     out, said = io.BytesIO(), io.StringIO()
-    with open(path, "rb") as stream:
-        stats = process(stream, out, file="long.ngc", source=source, jobs=jobs, warnings=Warnings(stream=said), offsets=WorkOffsets.at(OFFSET))
+    with open(path, "rb") as stream:  # (the dialect is told by the content and the file's name)
+        stats = process(stream, out, file=f"long{path.suffix}", source=source, jobs=jobs, warnings=Warnings(stream=said), offsets=WorkOffsets.at(OFFSET))
     return out.getvalue(), said.getvalue(), stats
 
 
@@ -301,3 +301,46 @@ def test_a_piped_program_is_copied_to_a_file_and_read_in_two_parts(program, one_
     done = subprocess.run([sys.executable, "-c", PIPED, *args], input=PROGRAM, capture_output=True, check=True)
     assert done.stdout == one_run[0]
     assert done.stderr.split()[-1] == (b"1" if jobs[1] == "2" else b"0")
+
+
+def _posted(dialect: str) -> bytes:
+    """The long program written as a `dialect` program by ncpp's own post generator (the same moves)."""
+    from ncpp.motion import interpret
+    from ncpp.post import GENERATORS
+    from ncpp.program.parser import parse_stream
+
+    quiet = Warnings(stream=io.StringIO())
+    events = interpret(parse_stream(io.BytesIO(PROGRAM), "long.ngc"), file="long.ngc", warnings=quiet)
+    return "".join(line + "\n" for line in GENERATORS[dialect](quiet).write(events, lambda event: None)).encode("latin-1")
+
+
+def test_a_sinumerik_program_in_two_parts_writes_what_one_run_writes(tmp_path, source, monkeypatch):
+    path = tmp_path / "long.mpf"
+    path.write_bytes(_posted("sinumerik"))
+    split, same = [], parts._same
+    monkeypatch.setattr(parts, "_same", lambda a, b: split.append(same(a, b)) or split[-1])
+    assert parts.lines_for(str(path)) is not None
+    assert _compensated(path, source, jobs=2) == _compensated(path, source, jobs=1)
+    assert split == [True]  # the second process's part was taken
+
+
+def test_a_heidenhain_program_stays_in_one_process(tmp_path):
+    """Its writer numbers every block after an inserted one anew: a second part cannot know how."""
+    path = tmp_path / "long.h"
+    path.write_bytes(_posted("heidenhain"))
+    with open(path, "rb") as stream:
+        assert parts.lines_for(str(path)) is not None and _two_parts(stream, "long.h", None) is None
+
+
+def test_a_sinumerik_writer_learns_the_modal_cip_and_ct():
+    """A second part's writer learns the program's motion mode from the lines before its
+    window: Sinumerik's CIP and CT are motion modes too."""
+    from ncpp.program.dialects import parse_program
+    from ncpp.program.dialects.sinumerik import SinumerikWriter
+
+    _, blocks = parse_program(io.BytesIO(b"G1 X0 Y0 F100\nCIP X10 Y10 I1=5 J1=8\nCT X20 Y5\nX30\n"), "t.mpf", "sinumerik")
+    writer, learnt = SinumerikWriter(), []
+    for block in blocks:
+        writer.learn(block)
+        learnt.append(writer.program_motion)
+    assert learnt == [1, "CIP", "CT", "CT"]

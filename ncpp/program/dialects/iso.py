@@ -100,8 +100,8 @@ class IsoWriter:
         facts = self._read_block(block)
         if facts.flow:  # after a control line the program's mode is unknown here (`_write_control`)
             self.program_motion = None
-        elif facts.motion_word:
-            self.program_motion = facts.motion
+        elif self._has_motion_word(block):  # (a dialect's own motion words too: Sinumerik's CIP, CT)
+            self.program_motion = self._block_motion(block)
 
     def skimmed(self, motion: int | None, numbers: dict[str, str]) -> None:
         """What learning plain lines left unread would teach (`motion/skim.py`): their last
