@@ -25,7 +25,6 @@ import math
 import os
 import pickle
 import select
-import shutil
 import signal
 import subprocess
 import sys
@@ -147,8 +146,8 @@ def process_in_two_parts(
                 return stats
             reply = _reply(second)
             if reply is not None and _same(first, reply):
-                with open(spool, "rb") as rest:
-                    shutil.copyfileobj(rest, out, 1 << 20)
+                with open(spool, "rb") as rest:  # (as the first part's writer would have: `WriterState.append`)
+                    first.reached[1].append(reply["reached"][1], rest, out)  # type: ignore[index]
                 later = reply
             else:  # the second part guessed another state: the rest from this part's own
                 later = _rest_here(path, out, cut, first.reached, strict, options)

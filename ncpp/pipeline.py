@@ -199,9 +199,8 @@ DIALECT_TOOLS = {
 }
 
 
-# The dialects compensated in two parts (`parts.py`): Heidenhain's writer numbers every block
-# after an inserted one anew, which a second part, not knowing the first's insertions, cannot.
-IN_TWO_PARTS = ("iso", "sinumerik")
+# The dialects compensated in two parts (`parts.py`)
+IN_TWO_PARTS = ("iso", "sinumerik", "heidenhain")
 
 
 def dialect_tools(name: str) -> tuple[Callable, type]:
@@ -280,7 +279,7 @@ def process(
     the machine whose errors are compensated."""
     if source is not None and jobs > 1 and part is None:
         split = _two_parts(stream, file, dialect)
-        if split is not None:  # an ISO or Sinumerik program file long enough: two parts, one process each (parts.py)
+        if split is not None:  # a program file long enough: two parts, one process each (parts.py)
             from ncpp.parts import process_in_two_parts
 
             path, lines = split
@@ -295,7 +294,7 @@ def process(
 
 def _two_parts(stream: BinaryIO, file: str, dialect: str | None) -> tuple[str, int] | None:
     """(path, lines) when the stream is an unread program file of a dialect `IN_TWO_PARTS` that
-    pays for two processes (`parts.py`); else None (a pipe, Heidenhain, a short program)."""
+    pays for two processes (`parts.py`); else None (a pipe, a short program)."""
     from ncpp.parts import lines_for
     from ncpp.program.dialects import SNIFF_BYTES, detect
 

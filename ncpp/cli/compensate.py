@@ -37,7 +37,7 @@ def add_compensation_arguments(p: argparse.ArgumentParser) -> None:
         type=int,
         choices=(1, 2),
         default=None,
-        help="processes: 2 compensates an ISO or Sinumerik program file of 8192 lines or more in two parts, one process each, and "
+        help="processes: 2 compensates a program file of 8192 lines or more in two parts, one process each, and "
         "other input with its numeric work in a second process (the same output either way; a piped program is "
         "copied to a temporary file first); default 2 for a program file or piped program over 2 MB on a machine "
         "with two or more cores, else 1 (a pipe then streams)",

@@ -668,8 +668,8 @@ def parse_stream(stream: Iterable[bytes], file: str = "<stdin>", grammar: "str |
     `numbered` reads the stream's lines (another one may leave lines out: `motion/skim.py`;
     a dialect with continued lines reads them all)."""
     parser = LineParser(grammar)
-    if parser.dialect.continuation:
-        yield from _parse_continued(parser, stream, file)
+    if parser.dialect.continuation:  # (`numbered` leaves no line out here: it reads them, or asks at them)
+        yield from _parse_continued(parser, (text for _, text in numbered(stream)), file)
         return
     tape_marks = 0
     for number, (content, eol) in numbered(stream):
@@ -684,8 +684,8 @@ def parse_stream(stream: Iterable[bytes], file: str = "<stdin>", grammar: "str |
         yield block
 
 
-def _parse_continued(parser: LineParser, stream: Iterable[bytes], file: str) -> Iterator[Block]:
-    for number, content, eol in continued_lines(iter_lines(stream), parser.dialect.continuation or ""):
+def _parse_continued(parser: LineParser, lines: Iterable[tuple[str, str]], file: str) -> Iterator[Block]:
+    for number, content, eol in continued_lines(lines, parser.dialect.continuation or ""):
         yield parser.parse(content, eol, number, file)
 
 

@@ -14,7 +14,7 @@ from ncpp.errors import Warnings
 from ncpp.fileio import count_lines
 from ncpp.integrations.linuxcnc import FilterProgress
 from ncpp.motion.offsets import WorkOffsets
-from ncpp.pipeline import ErrorSource, _two_parts, process, program_file
+from ncpp.pipeline import ErrorSource, process, program_file
 
 from .test_kernels import OFFSET, ROOT, _pattern
 
@@ -314,22 +314,31 @@ def _posted(dialect: str) -> bytes:
     return "".join(line + "\n" for line in GENERATORS[dialect](quiet).write(events, lambda event: None)).encode("latin-1")
 
 
-def test_a_sinumerik_program_in_two_parts_writes_what_one_run_writes(tmp_path, source, monkeypatch):
-    path = tmp_path / "long.mpf"
-    path.write_bytes(_posted("sinumerik"))
+@pytest.mark.parametrize("dialect, suffix", [("sinumerik", ".mpf"), ("heidenhain", ".h")])
+def test_other_dialects_in_two_parts_write_what_one_run_writes(tmp_path, source, monkeypatch, dialect, suffix):
+    """Their second parts read every line before the window; a Klartext second part's block
+    numbers are put right by the blocks the first part inserted (`HeidenhainState.append`)."""
+    path = tmp_path / f"long{suffix}"
+    path.write_bytes(_posted(dialect))
+    one = _compensated(path, source, jobs=1)
     split, same = [], parts._same
     monkeypatch.setattr(parts, "_same", lambda a, b: split.append(same(a, b)) or split[-1])
     assert parts.lines_for(str(path)) is not None
-    assert _compensated(path, source, jobs=2) == _compensated(path, source, jobs=1)
+    assert _compensated(path, source, jobs=2) == one
     assert split == [True]  # the second process's part was taken
+    monkeypatch.setattr(parts, "_same", lambda a, b: False)  # the first process does the rest from its state
+    assert _compensated(path, source, jobs=2) == one
 
 
-def test_a_heidenhain_program_stays_in_one_process(tmp_path):
-    """Its writer numbers every block after an inserted one anew: a second part cannot know how."""
-    path = tmp_path / "long.h"
-    path.write_bytes(_posted("heidenhain"))
-    with open(path, "rb") as stream:
-        assert parts.lines_for(str(path)) is not None and _two_parts(stream, "long.h", None) is None
+def test_a_klartext_second_part_is_renumbered_by_the_first_parts_insertions():
+    from ncpp.program.dialects.heidenhain import HeidenhainWriter
+
+    first, second = HeidenhainWriter(), HeidenhainWriter()
+    first.shift, first.last_number, second.shift, second.last_number = 7, 507, 2, 502
+    assert first.state() == second.state()  # the numbering is carried, not compared
+    out = io.BytesIO()
+    first.state().append(second.state(), io.BytesIO(b"503 L X+1 R0\n504 CC X+0 Y+0\n  505 C X+2 Y+0 DR+\n; 12 a comment\n506 L X+1 ~\n5 Y+2\n"), out)
+    assert out.getvalue() == b"508 L X+1 R0\n509 CC X+0 Y+0\n  510 C X+2 Y+0 DR+\n; 12 a comment\n511 L X+1 ~\n5 Y+2\n"
 
 
 def test_a_sinumerik_writer_learns_the_modal_cip_and_ct():

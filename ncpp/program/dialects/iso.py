@@ -12,9 +12,10 @@ from __future__ import annotations
 
 import math
 import re
+import shutil
 from dataclasses import dataclass, replace
 from operator import itemgetter
-from typing import Iterable, Iterator
+from typing import BinaryIO, Iterable, Iterator
 
 from ncpp.motion.segments import Arc, Context, Event, Line, Pass
 from ncpp.program.blocks import DIGITS_AS_ONE, Block, Comment, ExprWord, Statement, Word
@@ -628,6 +629,11 @@ class WriterState:
     known_axes: frozenset
     last_end: tuple | None
     last_places: tuple
+
+    def append(self, second: "WriterState", rest: BinaryIO, out: BinaryIO) -> None:
+        """Append to `out` the lines `rest` a second part wrote from `second` (a state equal
+        to this one, `parts.py`): as they are."""
+        shutil.copyfileobj(rest, out, 1 << 20)
 
 
 class _Written:
