@@ -22,7 +22,7 @@ from ncpp.errors import Location, NcppError, Warnings
 from ncpp.motion.interpreter import Interpreter
 from ncpp.motion.offsets import AT_MACHINE_ZERO, WorkOffsets
 from ncpp.motion.skim import Skim
-from ncpp.motion.segments import CYCLE, FLOW, Event, Pass
+from ncpp.motion.segments import CYCLE, FLOW, Arc, Event, Line, Pass
 from ncpp.passes import PASSES, PassContext, run_passes
 from ncpp.passes.context import CutLine, is_directional
 from ncpp.passes.inverse import iterations_for
@@ -458,17 +458,21 @@ def _state_at_cut(blocks: Iterable[Block], part: Part, interpreter: Interpreter)
 
 def _learnt_before(events: Iterable[Event], part: Part, writer: IsoWriter) -> Iterator[Event]:
     """The events from the second part's window on (`part.window` lines before its cut);
-    the writer learns from the blocks before (`IsoWriter.learn`)."""
+    the writer learns from the blocks before (`IsoWriter.learn`) and from a dialect's own
+    events there (`IsoWriter.learn_event`: a Klartext pole)."""
     last = None
     for event in events:
         line = event.block.line
         if line >= part.cut.line - part.window:  # (an undecided cut was asked for as its lines were read: `Skim`)
             yield event
             break
+        kind = type(event)
         if event.block is not last:
             last = event.block
-            if not (type(event) is Pass and event.skipped):
+            if not (kind is Pass and event.skipped):
                 writer.learn(last)
+        if kind is not Pass and kind is not Line and kind is not Arc:
+            writer.learn_event(event)
     yield from events
 
 

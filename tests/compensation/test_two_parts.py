@@ -330,6 +330,20 @@ def test_other_dialects_in_two_parts_write_what_one_run_writes(tmp_path, source,
     assert _compensated(path, source, jobs=2) == one
 
 
+def test_a_klartext_pole_set_before_the_window_is_learnt(tmp_path, source, monkeypatch):
+    """A `CC` at the top and polar moves after it: the second part's writer learns the pole
+    from the lines before its window (`learn_event`), so its part is taken."""
+    moves = [f"LP PR+{10 + k % 40} PA+{(37 * k) % 360}" if k % 2 else f"L X+{k % 50} Y+{(3 * k) % 50} Z-{2 + k % 3}" for k in range(parts.MIN_LINES + 2000)]
+    text = ["BEGIN PGM POLAR MM", "L Z+5 R0 FMAX", "CC X+0 Y+0", "L X+10 Y+0 R0 F500", "L Z-2 R0 F300", *moves, "END PGM POLAR MM"]
+    path = tmp_path / "long.h"
+    path.write_text("".join(f"{n} {line}\n" for n, line in enumerate(text)))
+    one = _compensated(path, source, jobs=1)
+    split, same = [], parts._same
+    monkeypatch.setattr(parts, "_same", lambda a, b: split.append(same(a, b)) or split[-1])
+    assert _compensated(path, source, jobs=2) == one
+    assert split == [True]
+
+
 def test_a_klartext_second_part_is_renumbered_by_the_first_parts_insertions():
     from ncpp.program.dialects.heidenhain import HeidenhainWriter
 

@@ -277,9 +277,18 @@ class HeidenhainWriter(IsoWriter):
 
     def learn(self, block: Block) -> None:
         """What writing the block would teach, without writing it: its number styles and
-        line end (the pole is the interpreter's: a second part's window sets it again)."""
+        line end (its pole: `learn_event`)."""
         self.eol = block.eol or self.eol
         self._learn_styles(block)
+
+    def learn_event(self, event) -> None:
+        """A `CC` block's pole, which the block written as it is sets in the output too (an
+        arc piece written since, with a `CC` of its own, would have moved the output's
+        pole: the parts' states then differ, and the first part writes the rest)."""
+        from ncpp.motion.heidenhain import Pole
+
+        if type(event) is Pole:
+            self.program_pole = self.output_pole = (event.center, event.plane)
 
     def with_header(self, lines, header: str):
         """The header goes after `BEGIN PGM` as a numbered comment block (set before writing)."""

@@ -104,6 +104,10 @@ class IsoWriter:
         elif self._has_motion_word(block):  # (a dialect's own motion words too: Sinumerik's CIP, CT)
             self.program_motion = self._block_motion(block)
 
+    def learn_event(self, event: Event) -> None:
+        """What a dialect's own event (neither a move nor a `Pass`) before a second part's
+        window teaches its writer: nothing here."""
+
     def skimmed(self, motion: int | None, numbers: dict[str, str]) -> None:
         """What learning plain lines left unread would teach (`motion/skim.py`): their last
         motion word's code (None: none) and each letter's last number as written."""
