@@ -6,12 +6,13 @@ too: it reads the lines before the cut for the state there (in an ISO program, r
 plain lines it leaves unread, telling their effect: `motion/skim.py`; the others it
 interprets, a fifth to a third of the cost of compensating them), compensates a window of lines
 before the cut to reach the state the passes and the writer are in there, and
-compensates the rest into a spool file.  Where its state at the cut equals this
-process's (the interpreter's too, where it left lines unread), its output is what one
-run writes from the cut on (chunks end at the same input lines,
-`geometry.line_chunks`), and is appended; where it does not (or the second process
-failed), this process compensates the rest itself from its own state.  The output is
-that of one run, byte for byte, either way, wherever the cut is.
+compensates the rest into a spool file.  It tells its state at the cut as it gets
+there; where that equals this process's (the interpreter's too, where it left lines
+unread), its output is what one run writes from the cut on (chunks end at the same
+input lines, `geometry.line_chunks`), and is appended; where it does not (or the second
+process failed before), this process goes on from its cut and writes the rest itself,
+taking about the time of one process.  The output is that of one run, byte for byte,
+either way, wherever the cut is.
 
 The cut is where both parts end together, chosen while they run (`share`): the
 second process waits at the earliest line the cut may be near and says how fast it
@@ -141,15 +142,17 @@ def process_in_two_parts(
         second = _start(job)
         try:
             first = Part(cut)
+            taken: list[dict] = []  # the second's state at the cut, where it is the first's
+            first.decide = lambda: _decided(first, second, taken)
             stats = process(stream, out, warnings=warnings, progress=_Pacer(second, job, lines, first, progress), part=first, **options)  # type: ignore[arg-type]
-            if first.reached is None:  # the program ended before the cut
+            if first.reached is None or first.continued:  # the program ended before the cut, or this part wrote it all
                 return stats
             reply = _reply(second)
-            if reply is not None and _same(first, reply):
+            if reply is not None:
                 with open(spool, "rb") as rest:  # (as the first part's writer would have: `WriterState.append`)
-                    first.reached[1].append(reply["reached"][1], rest, out)  # type: ignore[index]
+                    first.reached[1].append(taken[0]["reached"][1], rest, out)  # type: ignore[index]
                 later = reply
-            else:  # the second part guessed another state: the rest from this part's own
+            else:  # the second process failed after its cut: the rest from this part's own state
                 later = _rest_here(path, out, cut, first.reached, strict, options)
         finally:
             if second.poll() is None:
@@ -177,8 +180,8 @@ class _Pacer:
 
     def __call__(self, read: int) -> None:
         cut = self.part.cut
-        if self.progress is not None:
-            self.progress(read if cut.line == UNDECIDED else min(read * self.lines // cut.line, self.lines))
+        if self.progress is not None:  # (past the cut, where this part writes the rest itself, its own lines)
+            self.progress(read if cut.line == UNDECIDED or self.part.continued else min(read * self.lines // cut.line, self.lines))
         if cut.line != UNDECIDED:
             return
         if self.report is _PENDING:
@@ -317,16 +320,34 @@ class _Forked:
         return self.returncode
 
 
-def _reply(child: "subprocess.Popen | _Forked") -> dict | None:
-    """What the second process did (None: it failed; this process does its part then).
-    A pace report this process did not wait for comes first: it is passed over."""
+def _decided(first: "Part", child: "subprocess.Popen | _Forked", taken: list) -> bool:
+    """At the first part's cut: whether the second's state there (its first report of it,
+    waited for) is the first's, so that its output is taken (into `taken`).  If not, or the
+    second failed before, it is stopped, and the first part writes the rest itself."""
+    report = _report(child, "reached")
+    if report is not None and _same(first, report):
+        taken.append(report)
+        return True
+    child.kill()
+    return False
+
+
+def _report(child: "subprocess.Popen | _Forked", kind: str) -> dict | None:
+    """The second process's next report of `kind` (the reports before it passed over), or
+    None if it ended without."""
     try:
-        reply = pickle.load(child.stdout)  # type: ignore[arg-type]
-        if isinstance(reply, tuple):
-            reply = pickle.load(child.stdout)  # type: ignore[arg-type]
+        while True:
+            said = pickle.load(child.stdout)  # type: ignore[arg-type]
+            if isinstance(said, tuple) and said[0] == kind:
+                return said[1]
     except (EOFError, OSError, pickle.UnpicklingError):
         return None
-    return reply if isinstance(reply, dict) and reply.get("reached") is not None else None
+
+
+def _reply(child: "subprocess.Popen | _Forked") -> dict | None:
+    """What the second process did (None: it failed; this process does its part then)."""
+    reply = _report(child, "done")
+    return reply if reply is not None and reply.get("reached") is not None else None
 
 
 def _serve() -> None:
@@ -354,7 +375,13 @@ def _serve_job(job: Job, requests: BinaryIO, replies: BinaryIO) -> None:
             replies.flush()
             return int(pickle.load(requests))
 
-        part = Part(CutLine(UNDECIDED), second=True, window=WINDOW, floor=job.floor, ask=ask)
+        def tell() -> None:
+            """At the cut: this part's state there, which the first part compares with its own (`_decided`)."""
+            pickle.dump(("reached", {"reached": part.reached, "interpreted": part.interpreted, "skipped": part.skipped}),
+                        replies, protocol=pickle.HIGHEST_PROTOCOL)  # fmt: skip
+            replies.flush()
+
+        part = Part(CutLine(UNDECIDED), second=True, window=WINDOW, floor=job.floor, ask=ask, tell=tell)
         with open(job.path, "rb") as stream, open(job.spool, "wb") as spool:
             stats = process(stream, spool, file=job.file, source=job.source, tolerance=job.tolerance, strict=job.strict,  # type: ignore[arg-type]
                             force=job.force, warnings=kept, dialect=job.dialect, offsets=job.offsets, part=part)  # fmt: skip
@@ -362,5 +389,5 @@ def _serve_job(job: Job, requests: BinaryIO, replies: BinaryIO) -> None:
                  "lines_in": stats.lines_in + part.skipped, "lines_out": stats.lines_out, "said": kept.said}  # fmt: skip
     except Exception:  # noqa: BLE001 - an error is the first process's to report, when it gets there itself
         reply = {"reached": None}
-    pickle.dump(reply, replies, protocol=pickle.HIGHEST_PROTOCOL)
+    pickle.dump(("done", reply), replies, protocol=pickle.HIGHEST_PROTOCOL)
     replies.flush()

@@ -397,10 +397,10 @@ def _process(
         ctx = make_context(source, tolerance, warnings, file, kernels)
         if part is None:
             lines = with_header(writer.write(run_passes(events, ctx, PASSES)), header_text(source, tolerance), writer)
-        elif not part.second:  # the first part: up to the cut, where it records the state
+        elif not part.second:  # the first part: up to the cut, where it records the state (and on, where it must)
             ctx = replace(ctx, cut=part.cut)
             done = _cut_at(run_passes(events, ctx, PASSES), part, ctx, writer, stop=True)
-            lines = with_header(_before_mark(writer.write(done)), header_text(source, tolerance), writer)
+            lines = with_header(_before_mark(writer.write(done), part), header_text(source, tolerance), writer)
         elif part.resume is not None:  # the second part: from the cut on, from the state recorded there
             pass_state, writer_state = part.resume
             writer.restore(writer_state)
@@ -425,7 +425,8 @@ class Part:
     ends before the input line `cut` holds (a multiple of `geometry.LINE_CHUNK`, on a
     long program decided while the parts run: `parts._Pacer`) and records the passes'
     and the writer's state there in `reached`; the second starts at the cut from such
-    a state (`resume`).  Together they write what one run writes."""
+    a state (`resume`).  Together they write what one run writes.  Where the second's
+    state at the cut is not the first's (`decide`), the first writes the rest itself."""
 
     cut: CutLine
     resume: tuple | None = None  # (apply_error_map.PassState, iso.WriterState)
@@ -438,6 +439,11 @@ class Part:
     written: int = 0  # the input line of the last event the first part has passed to its writer
     interpreted: tuple | None = None  # the interpreter's state as it read the cut's line (`Interpreter.state`)
     skipped: int = 0  # lines a second part left unread (`motion/skim.py`)
+    # At the cut, with `reached` recorded: a second part tells it (`tell`); the first asks
+    # whether to stop there (`decide`: false, it writes the rest itself: `continued`)
+    tell: Callable[[], None] | None = None
+    decide: Callable[[], bool] | None = None
+    continued: bool = False
 
 
 _MARK = "\x00ncpp: the cut\x00"  # the text of the line that marks the cut in a part's output
@@ -478,15 +484,20 @@ def _learnt_before(events: Iterable[Event], part: Part, writer: IsoWriter) -> It
 
 def _cut_at(events: Iterable[Event], part: Part, ctx: PassContext, writer: IsoWriter, stop: bool) -> Iterator[Event]:
     """The events, with a marked empty line before the cut (the writer writes what came
-    before on taking it, then asks for more: the state there goes to `part.reached`);
-    with `stop`, none after it."""
+    before on taking it, then asks for more: the state there goes to `part.reached`,
+    and is told, `part.tell`); with `stop`, none after it unless `part.decide` says
+    the part goes on (`part.continued`)."""
     for event in events:
         line = event.block.line
         if line >= part.cut.line:
             yield Pass(Block(_MARK, "", (), part.cut.line, True), True)
             part.reached = (ctx.at_cut[0] if ctx.at_cut else None, writer.state())  # (None: no move yet, in the window)
+            if part.tell is not None:
+                part.tell()
             if stop:
-                return
+                if part.decide is None or part.decide():
+                    return
+                part.continued = True
             yield event
             break
         part.written = line
@@ -494,11 +505,13 @@ def _cut_at(events: Iterable[Event], part: Part, ctx: PassContext, writer: IsoWr
     yield from events
 
 
-def _before_mark(lines: Iterable[str]) -> Iterator[str]:
-    """The lines before the mark."""
+def _before_mark(lines: Iterable[str], part: Part) -> Iterator[str]:
+    """The lines before the mark (and after it, but for the mark, where the part goes on)."""
     for line in lines:
         if line == _MARK:
-            return
+            if not part.continued:
+                return
+            continue
         yield line
 
 

@@ -57,8 +57,20 @@ def test_two_parts_write_what_one_run_writes(program, source, one_run, monkeypat
 
 
 def test_when_the_states_differ_the_first_process_writes_the_rest(program, source, one_run, monkeypatch):
+    """It goes on from its cut (it has the state there): no line is read twice."""
     monkeypatch.setattr(parts, "_same", lambda a, b: False)
+    monkeypatch.setattr(parts, "_rest_here", lambda *a: pytest.fail("the rest read again"))
     assert _compensated(program, source, jobs=2) == one_run
+
+
+def test_when_the_second_process_fails_after_its_cut_the_first_writes_the_rest(program, source, one_run, monkeypatch):
+    """Its state there was the first's, but it wrote no part: the first reads the program
+    again to its cut and writes the rest from its own state (`_rest_here`)."""
+    again, rest_here = [], parts._rest_here
+    monkeypatch.setattr(parts, "_reply", lambda child: None)
+    monkeypatch.setattr(parts, "_rest_here", lambda *a: again.append(1) or rest_here(*a))
+    assert _compensated(program, source, jobs=2) == one_run
+    assert again == [1]
 
 
 def test_when_the_second_process_fails_the_first_writes_the_rest(program, source, one_run, monkeypatch):
