@@ -142,15 +142,14 @@ def process_in_two_parts(
         second = _start(job)
         try:
             first = Part(cut)
-            taken: list[dict] = []  # the second's state at the cut, where it is the first's
-            first.decide = lambda: _decided(first, second, taken)
+            first.decide = decision = _Decision(first, second)
             stats = process(stream, out, warnings=warnings, progress=_Pacer(second, job, lines, first, progress), part=first, **options)  # type: ignore[arg-type]
             if first.reached is None or first.continued:  # the program ended before the cut, or this part wrote it all
                 return stats
             reply = _reply(second)
             if reply is not None:
                 with open(spool, "rb") as rest:  # (as the first part's writer would have: `WriterState.append`)
-                    first.reached[1].append(taken[0]["reached"][1], rest, out)  # type: ignore[index]
+                    first.reached[1].append(decision.taken[1], rest, out)  # type: ignore[index]
                 later = reply
             else:  # the second process failed after its cut: the rest from this part's own state
                 later = _rest_here(path, out, cut, first.reached, strict, options)
@@ -320,16 +319,22 @@ class _Forked:
         return self.returncode
 
 
-def _decided(first: "Part", child: "subprocess.Popen | _Forked", taken: list) -> bool:
-    """At the first part's cut: whether the second's state there (its first report of it,
-    waited for) is the first's, so that its output is taken (into `taken`).  If not, or the
-    second failed before, it is stopped, and the first part writes the rest itself."""
-    report = _report(child, "reached")
-    if report is not None and _same(first, report):
-        taken.append(report)
-        return True
-    child.kill()
-    return False
+class _Decision:
+    """The first part's `decide`, at its cut: whether the second's state there (its report,
+    waited for) is the first's, so that its output is taken (`taken`: that state).  If
+    not, or the second failed before, it is stopped, and the first part writes the rest."""
+
+    def __init__(self, first: "Part", child: "subprocess.Popen | _Forked"):
+        self.first, self.child = first, child
+        self.taken: tuple | None = None
+
+    def __call__(self) -> bool:
+        report = _report(self.child, "reached")
+        if report is not None and _same(self.first, report):
+            self.taken = report["reached"]
+            return True
+        self.child.kill()
+        return False
 
 
 def _report(child: "subprocess.Popen | _Forked", kind: str) -> dict | None:
@@ -345,9 +350,9 @@ def _report(child: "subprocess.Popen | _Forked", kind: str) -> dict | None:
 
 
 def _reply(child: "subprocess.Popen | _Forked") -> dict | None:
-    """What the second process did (None: it failed; this process does its part then)."""
-    reply = _report(child, "done")
-    return reply if reply is not None and reply.get("reached") is not None else None
+    """What the second process did after its cut: its lines and warnings (None: it failed;
+    this process does its part then)."""
+    return _report(child, "done")
 
 
 def _serve() -> None:
@@ -358,12 +363,13 @@ def _serve() -> None:
 
 
 def _serve_job(job: Job, requests: BinaryIO, replies: BinaryIO) -> None:
-    """The second process: the second part into the spool, then its state at the cut,
-    stats and warnings (none if anything failed: the first process does the part then).
-    `requests`: where the cut comes from; `replies`: where the pace and the reply go."""
+    """The second process: the second part into the spool, telling its state at the cut
+    as it gets there, then its stats and warnings (None if anything failed, or it never
+    got to its cut: the first process does the part then).  `requests`: where the cut
+    comes from; `replies`: where the pace and the reports go."""
     from ncpp.pipeline import Part, process
 
-    reply: dict = {"reached": None}
+    reply: dict | None = None
     try:
         kept = _Kept(job.strict)
         begun = time.time()
@@ -376,7 +382,7 @@ def _serve_job(job: Job, requests: BinaryIO, replies: BinaryIO) -> None:
             return int(pickle.load(requests))
 
         def tell() -> None:
-            """At the cut: this part's state there, which the first part compares with its own (`_decided`)."""
+            """At the cut: this part's state there, which the first part compares with its own (`_Decision`)."""
             pickle.dump(("reached", {"reached": part.reached, "interpreted": part.interpreted, "skipped": part.skipped}),
                         replies, protocol=pickle.HIGHEST_PROTOCOL)  # fmt: skip
             replies.flush()
@@ -385,9 +391,9 @@ def _serve_job(job: Job, requests: BinaryIO, replies: BinaryIO) -> None:
         with open(job.path, "rb") as stream, open(job.spool, "wb") as spool:
             stats = process(stream, spool, file=job.file, source=job.source, tolerance=job.tolerance, strict=job.strict,  # type: ignore[arg-type]
                             force=job.force, warnings=kept, dialect=job.dialect, offsets=job.offsets, part=part)  # fmt: skip
-        reply = {"reached": part.reached, "interpreted": part.interpreted, "skipped": part.skipped,
-                 "lines_in": stats.lines_in + part.skipped, "lines_out": stats.lines_out, "said": kept.said}  # fmt: skip
+        if part.reached is not None:
+            reply = {"lines_in": stats.lines_in + part.skipped, "lines_out": stats.lines_out, "said": kept.said}
     except Exception:  # noqa: BLE001 - an error is the first process's to report, when it gets there itself
-        reply = {"reached": None}
+        reply = None
     pickle.dump(("done", reply), replies, protocol=pickle.HIGHEST_PROTOCOL)
     replies.flush()
