@@ -1,11 +1,13 @@
 """Atomic output files: written to a temporary file beside the target and
 renamed into place only when complete, so a failed run never leaves a
-partial program or table behind.  And a program file's line count."""
+partial program or table behind.  And what the program files read are: their
+paths (`program_file`) and line counts."""
 
 from __future__ import annotations
 
 import contextlib
 import os
+import stat
 import tempfile
 from pathlib import Path
 from typing import BinaryIO, Iterator
@@ -50,3 +52,31 @@ def count_lines(path: str | os.PathLike[str]) -> int:
             count += chunk.count(b"\n")
             last = chunk[-1:]
     return count + (last != b"\n")
+
+
+def program_file(stream: BinaryIO) -> str | None:
+    """The path of the regular file `stream` reads, not read yet: its name, or for standard
+    input redirected from a file (`ncpp compensate ... < in.nc`, no name) the file Linux
+    says the descriptor holds; None for a pipe, a terminal, a file read from elsewhere
+    than its start, or a file no path names any more or this process may not open."""
+    try:
+        if stream.tell() != 0:
+            return None
+        fd = stream.fileno()
+        held = os.fstat(fd)
+    except (OSError, ValueError, AttributeError):  # (io.UnsupportedOperation is an OSError)
+        return None
+    if not stat.S_ISREG(held.st_mode):
+        return None
+    named = getattr(stream, "name", None)
+    candidates = [named] if isinstance(named, str) else []
+    candidates.append(f"/proc/self/fd/{fd}")  # (Linux: a link to the file the descriptor holds)
+    for candidate in candidates:
+        path = os.path.realpath(candidate)
+        try:
+            # (a deleted file's link names no file; the parts open the path, so it must be readable)
+            if os.path.samestat(os.stat(path), held) and os.access(path, os.R_OK):
+                return path
+        except OSError:
+            pass
+    return None

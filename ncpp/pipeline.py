@@ -19,6 +19,7 @@ from pathlib import Path
 from typing import BinaryIO, Callable, Iterable, Iterator
 
 from ncpp.errors import Location, NcppError, Warnings
+from ncpp.fileio import program_file
 from ncpp.motion.interpreter import Interpreter
 from ncpp.motion.offsets import AT_MACHINE_ZERO, WorkOffsets
 from ncpp.motion.skim import Skim
@@ -306,37 +307,6 @@ def _two_parts(stream: BinaryIO, file: str, dialect: str | None) -> tuple[str, i
             return None
     lines = lines_for(path)
     return None if lines is None else (path, lines)
-
-
-def program_file(stream: BinaryIO) -> str | None:
-    """The path of the regular file `stream` reads, not read yet: its name, or for standard
-    input redirected from a file (`ncpp compensate ... < in.nc`, no name) the file Linux
-    says the descriptor holds; None for a pipe, a terminal, a file read from elsewhere
-    than its start, or a file no path names any more or this process may not open."""
-    import os
-    import stat
-
-    try:
-        if stream.tell() != 0:
-            return None
-        fd = stream.fileno()
-        held = os.fstat(fd)
-    except (OSError, ValueError, AttributeError):  # (io.UnsupportedOperation is an OSError)
-        return None
-    if not stat.S_ISREG(held.st_mode):
-        return None
-    named = getattr(stream, "name", None)
-    candidates = [named] if isinstance(named, str) else []
-    candidates.append(f"/proc/self/fd/{fd}")  # (Linux: a link to the file the descriptor holds)
-    for candidate in candidates:
-        path = os.path.realpath(candidate)
-        try:
-            # (a deleted file's link names no file; the parts open the path, so it must be readable)
-            if os.path.samestat(os.stat(path), held) and os.access(path, os.R_OK):
-                return path
-        except OSError:
-            pass
-    return None
 
 
 def _kernels(worker: bool) -> Kernels:

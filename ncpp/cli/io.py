@@ -12,13 +12,12 @@ import contextlib
 import io
 import os
 import shutil
-import stat
 import sys
 import tempfile
 from pathlib import Path
 from typing import BinaryIO, Iterator
 
-from ncpp.fileio import atomic_output
+from ncpp.fileio import atomic_output, program_file
 
 SPOOL_BYTES = 8 << 20
 
@@ -37,12 +36,12 @@ def add_dialect_argument(p: argparse.ArgumentParser) -> None:
 @contextlib.contextmanager
 def open_input(path: str | None, spool_from: int | None = None) -> Iterator[tuple[BinaryIO, str]]:
     """The program to read and its name for messages.  `spool_from`: standard input that
-    is not a file (a pipe) and holds at least this many bytes is copied to a temporary
-    file first, which can be compensated in two parts (`ncpp/parts.py`; the output is
-    written at the end either way); less is read from memory."""
+    is not a program file (a pipe, `fileio.program_file`) and holds at least this many
+    bytes is copied to a temporary file first, which can be compensated in two parts
+    (`ncpp/parts.py`; the output is written at the end either way); less is read from memory."""
     if path is None or path == "-":
         stdin = sys.stdin.buffer
-        if spool_from is None or _is_file(stdin):
+        if spool_from is None or program_file(stdin) is not None:  # (a file the parts can read themselves)
             yield stdin, "<stdin>"
             return
         with _spooled(stdin, spool_from) as stream:
@@ -50,13 +49,6 @@ def open_input(path: str | None, spool_from: int | None = None) -> Iterator[tupl
         return
     with open(path, "rb") as stream:
         yield stream, path
-
-
-def _is_file(stream: BinaryIO) -> bool:
-    try:
-        return stat.S_ISREG(os.fstat(stream.fileno()).st_mode)
-    except (OSError, ValueError):
-        return False
 
 
 @contextlib.contextmanager

@@ -11,10 +11,10 @@ import pytest
 
 import ncpp.parts as parts
 from ncpp.errors import Warnings
-from ncpp.fileio import count_lines
+from ncpp.fileio import count_lines, program_file
 from ncpp.integrations.linuxcnc import FilterProgress
 from ncpp.motion.offsets import WorkOffsets
-from ncpp.pipeline import ErrorSource, process, program_file
+from ncpp.pipeline import ErrorSource, process
 
 from .test_kernels import OFFSET, ROOT, _pattern
 
