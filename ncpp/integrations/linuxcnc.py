@@ -17,6 +17,7 @@ import argparse
 import os
 import shutil
 import sys
+from functools import cached_property
 from typing import TextIO
 
 from ncpp.errors import NcppError, Warnings
@@ -28,9 +29,14 @@ class FilterProgress:
     """`FILTER_PROGRESS=N` on stderr whenever the percentage of the program's lines done
     changes (`pipeline.process`'s progress: in two parts, the program's lines, `parts._Pacer`)."""
 
-    def __init__(self, lines: int, out: TextIO):
-        self.lines, self.out = max(lines, 1), out
+    def __init__(self, path: str, out: TextIO):
+        self.path, self.out = path, out
         self.last = -1
+
+    @cached_property
+    def lines(self) -> int:
+        """The program's lines (counted when progress is first told: a program loaded as it is needs none)."""
+        return max(count_lines(self.path), 1)
 
     def __call__(self, lines: int) -> None:
         self.report(min(99, 100 * lines // self.lines))
@@ -58,7 +64,7 @@ def run(path: str, err: TextIO, machine: str | None = None) -> None:
 
     settings = with_linuxcnc_ini(find_settings(machine), os.environ.get("INI_FILE_NAME"))
     with open(path, "rb") as stream:
-        progress = FilterProgress(count_lines(path), err)
+        progress = FilterProgress(path, err)
         progress.report(0)
         with open_output(None) as spool:
             if settings.machine is None or already_compensated(path):

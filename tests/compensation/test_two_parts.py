@@ -11,7 +11,7 @@ import pytest
 
 import ncpp.parts as parts
 from ncpp.errors import Warnings
-from ncpp.fileio import count_lines, program_file
+from ncpp.fileio import program_file
 from ncpp.integrations.linuxcnc import FilterProgress
 from ncpp.motion.offsets import WorkOffsets
 from ncpp.pipeline import ErrorSource, process
@@ -238,7 +238,7 @@ def test_the_paced_first_part_still_tells_progress(program, source, one_run, mon
 
 def test_filter_progress_is_the_percentage_of_the_programs_lines_done(program, source):
     said = io.StringIO()
-    progress = FilterProgress(count_lines(program), said)
+    progress = FilterProgress(str(program), said)
     with open(program, "rb") as stream:
         process(stream, io.BytesIO(), file="long.ngc", source=source, jobs=2, warnings=Warnings(stream=io.StringIO()),
                 offsets=WorkOffsets.at(OFFSET), progress=progress)  # fmt: skip
