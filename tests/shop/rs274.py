@@ -28,13 +28,19 @@ def run_rs274(path: Path) -> str:
     return proc.stdout
 
 
+def linuxcnc_root(scratch: Path) -> Path:
+    """Where the tools/rs274 wrapper unpacked Debian's linuxcnc-uspace (rs274, AXIS, QtVCP):
+    it downloads the package on its first run (or the test is skipped)."""
+    empty = scratch / "empty.ngc"
+    empty.write_text("M2\n")
+    run_rs274(empty)
+    return Path(os.environ.get("RS274_HOME") or Path.home() / ".cache/ncpp-rs274") / "root"
+
+
 def run_rs274_from(var_file: Path, program: Path, tool_table: str = "T1 P1 D6.0 Z0\n") -> str:
     """rs274's canonical calls, started from `var_file` and this tool table (the tools/rs274
     wrapper fixes its own).  The stand-alone rs274 reads both in inches."""
-    empty = var_file.with_name("empty.ngc")
-    empty.write_text("M2\n")
-    run_rs274(empty)  # the wrapper downloads rs274 once (or skips the test)
-    home = Path(os.environ.get("RS274_HOME") or Path.home() / ".cache/ncpp-rs274") / "root"
+    home = linuxcnc_root(var_file.parent)
     env = {**os.environ, "LD_LIBRARY_PATH": f"{home}/usr/lib:{home}/usr/lib/x86_64-linux-gnu"}
     table = var_file.with_suffix(".tbl")
     table.write_text(tool_table)

@@ -10,9 +10,11 @@ import subprocess
 
 import pytest
 
+from ncpp.cli.compensate import AUTO_JOBS_BYTES
 from ncpp.errors import Warnings
 from ncpp.post import post
 from tests.conftest import CORPUS, ROOT
+from tests.shop.axis import filter_program
 from tests.shop.rs274 import end_points, run_rs274
 
 FILTER = ROOT / "plugins/linuxcnc/ncpp-linuxcnc-filter"
@@ -172,3 +174,66 @@ def test_the_filter_runs_subroutine_files_from_the_ini_subroutine_path(tmp_path)
     call = lines.index("o<slot> call [20] [10] [15]")
     assert lines[call - 1].startswith("X20.0") and lines[call + 1].startswith("G1 X")  # compensated on both sides
     assert b"loop or subroutine" in proc.stderr and b"outside the motion interpreter" not in proc.stderr
+
+
+@pytest.fixture
+def axis(tmp_path, monkeypatch):
+    """`axis(program, out)`: AXIS's own filter_program runs the filter as filter.ini names it
+    (found on PATH, as LinuxCNC finds it), in the environment `run_filter` gives."""
+    run = filter_program(tmp_path)
+    home = tmp_path / "home"
+    home.mkdir(exist_ok=True)
+    for name in ("NCPP_MACHINE", "XDG_CONFIG_HOME"):
+        monkeypatch.delenv(name, raising=False)
+    monkeypatch.setenv("HOME", str(home))
+    monkeypatch.setenv("PYTHONPATH", str(ROOT))
+    monkeypatch.setenv("PATH", f"{FILTER.parent}{os.pathsep}{os.environ['PATH']}")
+    monkeypatch.chdir(tmp_path)
+    ini = configparser.ConfigParser()
+    ini.optionxform = str
+    ini.read(ROOT / "plugins/linuxcnc/filter.ini")
+    return lambda program, out: run(ini["FILTER"]["ngc"], program, out)
+
+
+def _configure(folder):
+    """An ncpp config placing the program, with the tool its G43 H1 applies (no warning)."""
+    (folder / "tool.tbl").write_text("T1 P1 Z+50.0 D3.0\n")
+    (folder / "ncpp.toml").write_text(f'machine = "{MACHINE}"\nwork_offset = [400, 350, 300]\ntool_table = "tool.tbl"\n')
+
+
+def test_axis_loads_the_program_the_filter_compensated(program, tmp_path, axis):
+    _configure(tmp_path)
+    out = tmp_path / "loaded.ngc"
+    filtered = axis(program, out)
+    assert filtered.exit_code == 0 and filtered.message == "", filtered.message
+    assert filtered.progress[0] == 0 and filtered.progress[-1] == 100 and filtered.progress == sorted(filtered.progress)
+    assert filtered.closed
+    assert out.read_bytes() == run_filter(program, tmp_path).stdout  # AXIS's closed standard input changes nothing
+
+
+def test_axis_shows_the_filters_error_and_loads_nothing(tmp_path, axis):
+    bad = tmp_path / "bad.ngc"
+    bad.write_text("G21 G90\nG0 X5000 Y0 Z0\nM2\n")
+    (tmp_path / "ncpp.toml").write_text(f'machine = "{MACHINE}"\n')
+    out = tmp_path / "loaded.ngc"
+    filtered = axis(bad, out)
+    assert filtered.exit_code == 2 and out.read_bytes() == b""
+    assert filtered.message.startswith(f"{bad}:2: ") and "outside the X travel" in filtered.message
+
+
+def test_axis_filters_a_program_large_enough_for_two_parts(program, tmp_path, axis):
+    """Over AUTO_JOBS_BYTES the filter compensates in two processes: AXIS reads standard
+    error to its end after the filter exits, so neither may keep it open; the bar moves
+    on past the cut."""
+    body = program.read_bytes().removesuffix(b"M2\n")
+    large = tmp_path / "large.ngc"
+    large.write_bytes(body * (AUTO_JOBS_BYTES // len(body) + 1) + b"M2\n")
+    _configure(tmp_path)
+    out = tmp_path / "loaded.ngc"
+    filtered = axis(large, out)
+    assert filtered.exit_code == 0 and filtered.message == "", filtered.message
+    assert filtered.progress == sorted(filtered.progress) and filtered.progress[-1] == 100
+    assert len({p // 10 for p in filtered.progress}) >= 8, filtered.progress  # every tenth of the way shows
+    written = out.read_bytes()
+    assert written.startswith(b"(ncpp compensated for hr5b.toml") and written.endswith(b"M2\n")
+    assert written.count(b"\n") > large.read_bytes().count(b"\n")
