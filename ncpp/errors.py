@@ -42,16 +42,43 @@ class NcppError(Exception):
         return (type(self), (self.message, self.where))
 
 
+# Warnings of one text printed before the rest are only counted: a drilling program warns
+# at each of its cycle series, hundreds of times, which buries the other warnings on a
+# terminal and fills the pipe a LinuxCNC screen reads a line at a time (QtVCP: one a tick).
+SHOWN_PER_TEXT = 5
+_TEXTS_COUNTED = 1000  # texts whose repeats are counted (memory stays flat in program length)
+
+
 class Warnings:
-    """Collects and prints warnings; in strict mode a warning is an error."""
+    """Collects and prints warnings; in strict mode a warning is an error.
+
+    The same text is printed SHOWN_PER_TEXT times, the last saying that more are
+    counted; `finish` tells how many were not printed and where the last was."""
 
     def __init__(self, strict: bool = False, stream: TextIO | None = None):
         self.strict = strict
         self.stream = stream if stream is not None else sys.stderr
         self.count = 0
+        self._times: dict[str, int] = {}  # how often each text was warned
+        self._hidden: dict[str, tuple[Location, Location]] = {}  # where each text was first and last not printed
 
     def warn(self, message: str, where: Location) -> None:
         if self.strict:
             raise NcppError(f"{message} (refused in strict mode)", where)
         self.count += 1
-        print(f"{where}: warning: {message}", file=self.stream)
+        times = self._times.get(message, 0) + 1
+        if times > 1 or len(self._times) < _TEXTS_COUNTED:
+            self._times[message] = times
+        if times < SHOWN_PER_TEXT:
+            print(f"{where}: warning: {message}", file=self.stream)
+        elif times == SHOWN_PER_TEXT:
+            print(f"{where}: warning: {message} (warned {times} times: more of these are counted, not printed)", file=self.stream)
+        else:
+            self._hidden[message] = (self._hidden.get(message, (where,))[0], where)
+
+    def finish(self) -> None:
+        """At the end of a run: how many warnings of each text were not printed, and where."""
+        for message, (first, last) in self._hidden.items():
+            hidden = self._times[message] - SHOWN_PER_TEXT
+            print(f"{last}: warning: {message} ({hidden} not printed, from line {first.line} to this one)", file=self.stream)
+        self._hidden.clear()

@@ -278,19 +278,25 @@ def process(
     the same output on two cores.  `offsets`: the zeros the control holds (machine
     mm; none: the program zero is the machine zero), which place the program on
     the machine whose errors are compensated."""
+    warnings = warnings or Warnings(strict=strict)
     if source is not None and jobs > 1 and part is None:
         split = _two_parts(stream, file, dialect)
         if split is not None:  # a program file long enough: two parts, one process each (parts.py)
             from ncpp.parts import process_in_two_parts
 
             path, lines = split
-            return process_in_two_parts(stream, path, out, lines, file=file, source=source, tolerance=tolerance, strict=strict, force=force,
-                                        warnings=warnings or Warnings(strict=strict), progress=progress, dialect=dialect, offsets=offsets)  # fmt: skip
+            stats = process_in_two_parts(stream, path, out, lines, file=file, source=source, tolerance=tolerance, strict=strict, force=force,
+                                         warnings=warnings, progress=progress, dialect=dialect, offsets=offsets)  # fmt: skip
+            warnings.finish()
+            return stats
     kernels = _kernels(source is not None and jobs > 1)  # started first: the worker starts while we parse
     try:
-        return _process(stream, out, file, source, tolerance, strict, force, warnings, progress, dialect, kernels, offsets, part)
+        stats = _process(stream, out, file, source, tolerance, strict, force, warnings, progress, dialect, kernels, offsets, part)
     finally:
         kernels.close()
+    if part is None:  # (a part's warnings are the whole run's to finish)
+        warnings.finish()
+    return stats
 
 
 def _two_parts(stream: BinaryIO, file: str, dialect: str | None) -> tuple[str, int] | None:

@@ -87,4 +87,5 @@ def run(args: argparse.Namespace) -> int:
             if event.extra:
                 record["extra"] = event.extra
             out.write(json.dumps(record) + "\n")
+    warnings.finish()
     return 0

@@ -49,6 +49,7 @@ def run(args: argparse.Namespace) -> int:
     offsets = work_offsets(args)
     commanded = sample_events(program_events(args.program, warnings, offsets, args.dialect), args.step)
     nominal = sample_events(program_events(args.reference, warnings, offsets, args.dialect), args.step) if args.reference else commanded
+    warnings.finish()
     if len(commanded.points) == 0:
         raise NcppError("the program makes no motion the interpreter could follow (a file of subroutines only runs where a program calls it)", Location(args.program))
     report = contour_error(machine, commanded, nominal)

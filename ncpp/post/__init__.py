@@ -85,6 +85,7 @@ def post(
     for line in generator.write(events, index):
         out.write((line + "\n").encode("latin-1", errors="replace"))
         written += 1
+    warnings.finish()
     return written
 
 

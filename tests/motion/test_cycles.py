@@ -13,7 +13,7 @@ import random
 
 import pytest
 
-from ncpp.errors import NcppError, Warnings
+from ncpp.errors import Location, NcppError, Warnings
 from ncpp.motion import interpret
 from ncpp.motion.segments import CYCLE, Line
 from ncpp.program.parser import parse_stream
@@ -161,6 +161,33 @@ def test_cycles_pass_through_and_compensation_resumes():
     after = lines[start + len(cycle) :]
     assert after[0].startswith("G0 X50.0") and "Z" in after[0]  # compensated, every axis said after the cycle
     assert any(line.startswith("G3 ") and "I" in line for line in after)  # the arc after it is replaced too
+
+
+def test_a_warning_repeated_hundreds_of_times_is_printed_five_times_then_counted():
+    """A drilling program warns at each of its 300 cycle series: five are printed (the fifth
+    says the rest are counted), then one line at the end tells how many and where."""
+    holes = "".join(f"G0 X{k % 20 * 5} Y{k // 20 * 5}\nG81 X{k % 20 * 5 + 1} Y{k // 20 * 5} Z-3 R2 F100\nG80\nG1 X{k % 20 * 5 + 2}\n" for k in range(300))
+    out, warned = _compensate(HEAD + holes + "M2\n")
+    said = warned.splitlines()
+    series = [n + 1 for n, line in enumerate((HEAD + holes).splitlines()) if line.startswith("G81")]
+    assert [line.split(": warning: ")[0] for line in said] == [f"drill.ngc:{n}:1" for n in (*series[:5], series[-1])]
+    assert said[4].endswith("(warned 5 times: more of these are counted, not printed)")
+    assert said[5].endswith(f"(295 not printed, from line {series[5]} to this one)")
+    assert out.count("G81") == 300
+
+
+def test_warnings_of_other_texts_are_printed_whatever_one_text_repeats():
+    stream = io.StringIO()
+    warnings = Warnings(stream=stream)
+    for n in range(1, 21):
+        warnings.warn("again", Location("t.ngc", n))
+    warnings.warn("once", Location("t.ngc", 21))
+    warnings.finish()
+    said = stream.getvalue().splitlines()
+    assert warnings.count == 21 and len(said) == 7
+    assert said[5] == "t.ngc:21: warning: once" and said[6] == "t.ngc:20: warning: again (15 not printed, from line 6 to this one)"
+    with pytest.raises(NcppError, match="refused in strict mode"):
+        Warnings(strict=True, stream=stream).warn("again", Location("t.ngc", 1))
 
 
 def test_the_block_after_a_cycle_says_every_axis():
