@@ -90,6 +90,32 @@ class _Kept(Warnings):
         self.said.append(_Said(message, where))
 
 
+class _BeforeCut(Warnings):
+    """The first part's warnings: those of lines from its cut on (it reads ahead past the
+    cut) are held, the second part gives them (its replies' `said`), unless this part
+    writes the rest itself (`Part.continued`): then they are given, in order."""
+
+    def __init__(self, warnings: Warnings, part: "Part"):
+        super().__init__(warnings.strict, warnings.stream)
+        self.inner, self.part = warnings, part
+        self.held: list[_Said] = []
+
+    def warn(self, message: str, where: Location) -> None:
+        if self.part.continued:
+            self.give_held()
+        elif where.line is not None and where.line >= self.part.cut.line:
+            if self.strict:
+                raise NcppError(f"{message} (refused in strict mode)", where)
+            self.held.append(_Said(message, where))
+            return
+        self.inner.warn(message, where)
+
+    def give_held(self) -> None:
+        for said in self.held:
+            self.inner.warn(said.message, said.where)
+        self.held.clear()
+
+
 def lines_for(path: str) -> int | None:
     """The program's line count, or None when it is too short to pay for a second process."""
     lines = count_lines(path)
@@ -143,8 +169,10 @@ def process_in_two_parts(
         try:
             first = Part(cut)
             first.decide = decision = _Decision(first, second)
-            stats = process(stream, out, warnings=warnings, progress=_Pacer(second, job, lines, first, progress), part=first, **options)  # type: ignore[arg-type]
+            mine = _BeforeCut(warnings, first)
+            stats = process(stream, out, warnings=mine, progress=_Pacer(second, job, lines, first, progress), part=first, **options)  # type: ignore[arg-type]
             if first.reached is None or first.continued:  # the program ended before the cut, or this part wrote it all
+                mine.give_held()
                 return stats
             reply = _reply(second)
             if reply is not None:
