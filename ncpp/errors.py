@@ -53,7 +53,8 @@ class Warnings:
     """Collects and prints warnings; in strict mode a warning is an error.
 
     The same text is printed SHOWN_PER_TEXT times, the last saying that more are
-    counted; `finish` tells how many were not printed and where the last was."""
+    counted; `finish` tells how many were not printed and where the last was.
+    Subclasses that keep warnings instead override `say`."""
 
     def __init__(self, strict: bool = False, stream: TextIO | None = None):
         self.strict = strict
@@ -66,6 +67,10 @@ class Warnings:
         if self.strict:
             raise NcppError(f"{message} (refused in strict mode)", where)
         self.count += 1
+        self.say(message, where)
+
+    def say(self, message: str, where: Location) -> None:
+        """Print a warning (or count it): what a collector that keeps them replaces."""
         times = self._times.get(message, 0) + 1
         if times > 1 or len(self._times) < _TEXTS_COUNTED:
             self._times[message] = times

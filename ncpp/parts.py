@@ -34,7 +34,7 @@ import time
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, BinaryIO, Callable
 
-from ncpp.errors import Location, NcppError, Warnings
+from ncpp.errors import Location, Warnings
 from ncpp.fileio import count_lines
 from ncpp.passes.context import UNDECIDED, CutLine
 from ncpp.passes.geometry import LINE_CHUNK
@@ -84,9 +84,7 @@ class _Kept(Warnings):
         super().__init__(strict)
         self.said: list[_Said] = []
 
-    def warn(self, message: str, where: Location) -> None:
-        if self.strict:
-            raise NcppError(f"{message} (refused in strict mode)", where)
+    def say(self, message: str, where: Location) -> None:
         self.said.append(_Said(message, where))
 
 
@@ -100,12 +98,10 @@ class _BeforeCut(Warnings):
         self.inner, self.part = warnings, part
         self.held: list[_Said] = []
 
-    def warn(self, message: str, where: Location) -> None:
+    def say(self, message: str, where: Location) -> None:
         if self.part.continued:
             self.give_held()
         elif where.line is not None and where.line >= self.part.cut.line:
-            if self.strict:
-                raise NcppError(f"{message} (refused in strict mode)", where)
             self.held.append(_Said(message, where))
             return
         self.inner.warn(message, where)

@@ -279,22 +279,21 @@ def process(
     mm; none: the program zero is the machine zero), which place the program on
     the machine whose errors are compensated."""
     warnings = warnings or Warnings(strict=strict)
-    if source is not None and jobs > 1 and part is None:
-        split = _two_parts(stream, file, dialect)
-        if split is not None:  # a program file long enough: two parts, one process each (parts.py)
-            from ncpp.parts import process_in_two_parts
+    # a program file long enough: two parts, one process each (parts.py)
+    split = _two_parts(stream, file, dialect) if source is not None and jobs > 1 and part is None else None
+    if split is not None:
+        from ncpp.parts import process_in_two_parts
 
-            path, lines = split
-            stats = process_in_two_parts(stream, path, out, lines, file=file, source=source, tolerance=tolerance, strict=strict, force=force,
-                                         warnings=warnings, progress=progress, dialect=dialect, offsets=offsets)  # fmt: skip
-            warnings.finish()
-            return stats
-    kernels = _kernels(source is not None and jobs > 1)  # started first: the worker starts while we parse
-    try:
-        stats = _process(stream, out, file, source, tolerance, strict, force, warnings, progress, dialect, kernels, offsets, part)
-    finally:
-        kernels.close()
-    if part is None:  # (a part's warnings are the whole run's to finish)
+        path, lines = split
+        stats = process_in_two_parts(stream, path, out, lines, file=file, source=source, tolerance=tolerance, strict=strict, force=force,
+                                     warnings=warnings, progress=progress, dialect=dialect, offsets=offsets)  # fmt: skip
+    else:
+        kernels = _kernels(source is not None and jobs > 1)  # started first: the worker starts while we parse
+        try:
+            stats = _process(stream, out, file, source, tolerance, strict, force, warnings, progress, dialect, kernels, offsets, part)
+        finally:
+            kernels.close()
+    if part is None:  # a part's warnings are finished by the run it is part of
         warnings.finish()
     return stats
 
@@ -333,14 +332,13 @@ def _process(
     tolerance: float,
     strict: bool,
     force: bool,
-    warnings: Warnings | None,
+    warnings: Warnings,
     progress: Callable[[int], None] | None,
     dialect: str | None,
     kernels: Kernels,
     offsets: WorkOffsets | None,
     part: "Part | None" = None,
 ) -> Stats:
-    warnings = warnings or Warnings(strict=strict)
     stats = Stats()
     # a second part reaches its window leaving plain lines unread where it can
     skim = Skim(part, first=HEADER_SCAN + 1) if part is not None and part.second and part.resume is None else None
