@@ -33,12 +33,16 @@ def program(tmp_path_factory):
     return path
 
 
-def run_filter(path, tmp_path, **env):
+def filter_environment(tmp_path) -> dict[str, str]:
+    """This environment without an ncpp machine or config of the user's, HOME in `tmp_path`."""
     home = tmp_path / "home"
     home.mkdir(exist_ok=True)
     base = {k: v for k, v in os.environ.items() if k not in ("NCPP_MACHINE", "XDG_CONFIG_HOME")}
-    base.update(HOME=str(home), PYTHONPATH=str(ROOT), **env)
-    return subprocess.run([str(FILTER), str(path)], capture_output=True, cwd=tmp_path, env=base, timeout=300)
+    return {**base, "HOME": str(home), "PYTHONPATH": str(ROOT)}
+
+
+def run_filter(path, tmp_path, **env):
+    return subprocess.run([str(FILTER), str(path)], capture_output=True, cwd=tmp_path, env={**filter_environment(tmp_path), **env}, timeout=300)
 
 
 def test_ini_lines_name_the_filter_for_ngc_and_nc():
@@ -181,12 +185,11 @@ def axis(tmp_path, monkeypatch):
     """`axis(program, out)`: AXIS's own filter_program runs the filter as filter.ini names it
     (found on PATH, as LinuxCNC finds it), in the environment `run_filter` gives."""
     run = filter_program(tmp_path)
-    home = tmp_path / "home"
-    home.mkdir(exist_ok=True)
-    for name in ("NCPP_MACHINE", "XDG_CONFIG_HOME"):
-        monkeypatch.delenv(name, raising=False)
-    monkeypatch.setenv("HOME", str(home))
-    monkeypatch.setenv("PYTHONPATH", str(ROOT))
+    environment = filter_environment(tmp_path)
+    for name in set(os.environ) - set(environment):
+        monkeypatch.delenv(name)
+    for name, value in environment.items():
+        monkeypatch.setenv(name, value)
     monkeypatch.setenv("PATH", f"{FILTER.parent}{os.pathsep}{os.environ['PATH']}")
     monkeypatch.chdir(tmp_path)
     ini = configparser.ConfigParser()
