@@ -34,7 +34,7 @@ import time
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, BinaryIO, Callable
 
-from ncpp.errors import Location, Warnings
+from ncpp.errors import _TEXTS_COUNTED, SHOWN_PER_TEXT, Location, Warnings
 from ncpp.fileio import count_lines
 from ncpp.passes.context import UNDECIDED, CutLine
 from ncpp.passes.geometry import LINE_CHUNK
@@ -77,15 +77,53 @@ class _Said:
     where: Location
 
 
-class _Kept(Warnings):
-    """Warnings kept instead of printed; strict ones raise as usual."""
+@dataclass
+class _Repeats:
+    """A second part's warnings of one text after the first SHOWN_PER_TEXT: how many, the first
+    and the last (the first part counts them, `Warnings.warn_repeats`; it prints none)."""
 
-    def __init__(self, strict: bool):
+    message: str
+    times: int
+    first: Location
+    last: Location
+
+
+class _Kept(Warnings):
+    """The second part's warnings from its cut on, kept for the first part to give after its
+    own (strict ones raise as usual): of each text the first SHOWN_PER_TEXT, then its repeats
+    as one `_Repeats`, so memory stays flat however often a long program warns.  Before the
+    cut is decided, the lines before `lowest` (the earliest cut) are the first part's."""
+
+    def __init__(self, strict: bool, cut: CutLine, lowest: int = 0):
         super().__init__(strict)
-        self.said: list[_Said] = []
+        self.cut, self.lowest = cut, lowest
+        self.said: list[_Said | _Repeats] = []
+        self._kept: dict[str, int | _Repeats] = {}  # per text: how many kept, or its repeats
 
     def say(self, message: str, where: Location) -> None:
-        self.said.append(_Said(message, where))
+        line, cut = where.line, self.cut.line
+        if line is None or line < (self.lowest if cut == UNDECIDED else cut):
+            return  # the first part's line: it has given that warning
+        kept = self._kept.get(message, 0)
+        if type(kept) is _Repeats:
+            kept.times += 1
+            kept.last = where
+        elif kept < SHOWN_PER_TEXT:
+            if kept or len(self._kept) < _TEXTS_COUNTED:  # (the others are kept each: each is printed)
+                self._kept[message] = kept + 1
+            self.said.append(_Said(message, where))
+        else:
+            self._kept[message] = repeats = _Repeats(message, 1, where, where)
+            self.said.append(repeats)
+
+
+def _give(kept: list[_Said | _Repeats], warnings: Warnings) -> None:
+    """Give the second part's kept warnings (`_Kept.said`) to `warnings`, in the order they came."""
+    for said in kept:
+        if type(said) is _Said:
+            warnings.warn(said.message, said.where)
+        else:
+            warnings.warn_repeats(said.message, said.times, said.first, said.last)
 
 
 class _BeforeCut(Warnings):
@@ -181,9 +219,7 @@ def process_in_two_parts(
             if second.poll() is None:
                 second.kill()
             second.wait()
-    for said in later["said"]:
-        if said.where.line is not None and said.where.line >= cut.line:  # the first part gave those before
-            warnings.warn(said.message, said.where)
+    _give(later["said"], warnings)
     return Stats(later["lines_in"], stats.lines_out + later["lines_out"])
 
 
@@ -252,7 +288,7 @@ def _rest_here(path: str, out: BinaryIO, cut: CutLine, reached: tuple, strict: b
     """The second part, compensated in this process from the first part's state."""
     from ncpp.pipeline import Part, process
 
-    kept = _Kept(strict)
+    kept = _Kept(strict, cut)
     with open(path, "rb") as stream:
         stats = process(stream, out, warnings=kept, part=Part(cut, resume=reached, second=True), **options)
     return {"lines_in": stats.lines_in, "lines_out": stats.lines_out, "said": kept.said}
@@ -395,7 +431,8 @@ def _serve_job(job: Job, requests: BinaryIO, replies: BinaryIO) -> None:
 
     reply: dict | None = None
     try:
-        kept = _Kept(job.strict)
+        cut = CutLine(UNDECIDED)  # decided at `job.floor` (`ask`)
+        kept = _Kept(job.strict, cut, lowest=job.floor + WINDOW)
         begun = time.time()
 
         def ask() -> int:
@@ -411,7 +448,7 @@ def _serve_job(job: Job, requests: BinaryIO, replies: BinaryIO) -> None:
                         replies, protocol=pickle.HIGHEST_PROTOCOL)  # fmt: skip
             replies.flush()
 
-        part = Part(CutLine(UNDECIDED), second=True, window=WINDOW, floor=job.floor, ask=ask, tell=tell)
+        part = Part(cut, second=True, window=WINDOW, floor=job.floor, ask=ask, tell=tell)
         with open(job.path, "rb") as stream, open(job.spool, "wb") as spool:
             stats = process(stream, spool, file=job.file, source=job.source, tolerance=job.tolerance, strict=job.strict,  # type: ignore[arg-type]
                             force=job.force, warnings=kept, dialect=job.dialect, offsets=job.offsets, part=part)  # fmt: skip

@@ -8,6 +8,8 @@ import subprocess
 import sys
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import ncpp.parts as parts
 from ncpp.errors import Warnings
@@ -381,3 +383,55 @@ def test_a_sinumerik_writer_learns_the_modal_cip_and_ct():
         writer.learn(block)
         learnt.append(writer.program_motion)
     assert learnt == [1, "CIP", "CT", "CT"]
+
+
+def _given_in_two_parts(warned: list[tuple[str, int]], cut: int) -> tuple[str, int]:
+    """What a run in two parts prints of `warned` ((text, line), in order) and its count: the
+    first part's lines before `cut`, then the second part's, kept (`_Kept`) and given."""
+    from ncpp.errors import Location
+    from ncpp.passes.context import CutLine
+
+    out = io.StringIO()
+    first, second = Warnings(stream=out), parts._Kept(False, CutLine(cut))
+    for text, line in warned:
+        where = Location("p.ngc", line, 1)
+        if line < cut:
+            first.warn(text, where)
+        second.warn(text, where)  # the second part reads the lines before its cut too
+    parts._give(second.said, first)
+    first.finish()
+    return out.getvalue(), first.count
+
+
+def _given_in_one_run(warned: list[tuple[str, int]]) -> tuple[str, int]:
+    from ncpp.errors import Location
+
+    out = io.StringIO()
+    one = Warnings(stream=out)
+    for text, line in warned:
+        one.warn(text, Location("p.ngc", line, 1))
+    one.finish()
+    return out.getvalue(), one.count
+
+
+@given(st.lists(st.tuples(st.sampled_from("abc"), st.integers(1, 40)), max_size=60), st.integers(1, 41))
+@settings(max_examples=300, deadline=None)
+def test_warnings_given_in_two_parts_are_one_runs(warned, cut):
+    warned = sorted(warned, key=lambda w: w[1])  # a program warns in line order
+    assert _given_in_two_parts(warned, cut) == _given_in_one_run(warned)
+
+
+def test_the_second_part_keeps_a_few_warnings_of_each_text_however_many_it_gives():
+    from ncpp.errors import SHOWN_PER_TEXT
+    from ncpp.passes.context import UNDECIDED, CutLine
+
+    cut = CutLine(UNDECIDED)
+    kept = parts._Kept(False, cut, lowest=1000)
+    for line in range(1, 200_001):
+        if line == 1000:
+            cut.line = 5000  # decided: before it, the first part's lines
+        kept.warn("canned cycle" if line % 2 else "other", parts.Location("p.ngc", line, 1))
+    assert len(kept.said) == 2 * (SHOWN_PER_TEXT + 1)
+    assert kept.said[0].where.line == 5000 and kept.said[-1].times == (200_000 - 5000) // 2 - SHOWN_PER_TEXT
+    warned = [("canned cycle" if line % 2 else "other", line) for line in range(1, 200_001)]
+    assert _given_in_two_parts(warned, 5000) == _given_in_one_run(warned)
