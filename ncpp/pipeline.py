@@ -25,7 +25,7 @@ from ncpp.motion.offsets import AT_MACHINE_ZERO, WorkOffsets
 from ncpp.motion.skim import Skim
 from ncpp.motion.segments import CYCLE, FLOW, Arc, Event, Line, Pass
 from ncpp.passes import PASSES, PassContext, run_passes
-from ncpp.passes.context import CutLine, is_directional
+from ncpp.passes.context import UNDECIDED, CutLine, is_directional
 from ncpp.passes.inverse import iterations_for
 from ncpp.passes.kernels import INLINE, Kernels, Worker
 from ncpp.program.blocks import Block, Comment, Word
@@ -419,6 +419,15 @@ class Part:
     decide: Callable[[], bool] | None = None
     continued: bool = False
 
+    def window_start(self, line: int) -> int:
+        """A second part's window's first line, as its lines are read up to `line`: while
+        the cut is undecided, the floor before it, and at the floor the cut is asked for."""
+        if self.cut.line == UNDECIDED:
+            if line < self.floor:
+                return self.floor
+            self.cut.line = self.ask()  # type: ignore[misc]
+        return self.cut.line - self.window
+
 
 _MARK = "\x00ncpp: the cut\x00"  # the text of the line that marks the cut in a part's output
 
@@ -443,7 +452,7 @@ def _learnt_before(events: Iterable[Event], part: Part, writer: IsoWriter) -> It
     last = None
     for event in events:
         line = event.block.line
-        if line >= part.cut.line - part.window:  # (an undecided cut was asked for as its lines were read: `Skim`)
+        if line >= part.cut.line - part.window:  # (an undecided cut was asked for as its lines were read: `window_start`)
             yield event
             break
         kind = type(event)

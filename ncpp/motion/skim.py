@@ -23,7 +23,6 @@ from __future__ import annotations
 import re
 from typing import TYPE_CHECKING, Iterable, Iterator, NamedTuple
 
-from ncpp.passes.context import UNDECIDED
 from ncpp.program.parser import iter_lines
 
 if TYPE_CHECKING:
@@ -107,9 +106,9 @@ class Skim:
     """`numbered` for `parse_stream`: a second part's lines, runs of plain lines before its
     window left out where `interpreter` may skip them (from line `first` on).
 
-    The window starts `part.window` lines before the cut; with the cut undecided a run
-    stops at `part.floor`, where the cut is asked for (`part.ask`) as the part would.
-    Without an interpreter (another dialect's part) no line is left out: it only asks."""
+    A run stops where the window starts (`Part.window_start`: with the cut undecided, at
+    the floor, where the part asks for it).  Without an interpreter (another dialect's
+    part) no line is left out."""
 
     def __init__(self, part: "Part", first: int):
         self.part, self.first = part, first
@@ -123,7 +122,7 @@ class Skim:
         begun = False  # a line with text went by (the parser knows then whether the program has tape marks)
         for raw in lines:
             number += 1
-            if number >= self._window(number):
+            if number >= self.part.window_start(number):
                 yield number, _text(raw)
                 break
             if begun and number >= self.first and self.interpreter is not None and self.interpreter.skimmable():
@@ -136,23 +135,13 @@ class Skim:
             yield number, _text(raw)
         yield from enumerate(iter_lines(lines), start=number + 1)
 
-    def _window(self, number: int) -> int:
-        """The window's first line; the floor while the cut is undecided before it (there it
-        is asked for)."""
-        part = self.part
-        if part.cut.line == UNDECIDED:
-            if number < part.floor:
-                return part.floor
-            part.cut.line = part.ask()  # type: ignore[misc]
-        return part.cut.line - part.window
-
     def _skim(self, raw: bytes, plain: _Plain, lines: Iterator[bytes], number: int) -> tuple[bytes | None, int]:
         """Leave out the run of plain lines from line `number` (`raw`, what its shape holds
         `plain`): the first line not left out and its number (None: the program ended)."""
         motion = self.interpreter.motion  # type: ignore[union-attr]
         last: list[bytes | None] = [None] * (len(LETTERS) + 1)  # the last motion code, then each letter's last number
         matched: list[tuple[bytes, _Plain]] = []  # the lines since `last` was brought up to date
-        first, window, shaped = number, self._window(number), self.shapes.plain
+        first, window, shaped = number, self.part.window_start(number), self.shapes.plain
         while True:
             code = plain.at[0]
             moving = motion if code is None else float(raw[code[0]] - 0x30)
@@ -167,7 +156,7 @@ class Skim:
             if raw is None:
                 break
             if number >= window:
-                window = self._window(number)
+                window = self.part.window_start(number)
                 if number >= window:
                     break
             plain = shaped(raw)  # type: ignore[assignment, arg-type]
