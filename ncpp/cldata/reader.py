@@ -7,6 +7,7 @@ the record.  Each joined record is parsed by grammar/apt.lark.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Iterable, Iterator, TextIO
 
@@ -135,4 +136,6 @@ def read_cldata(stream: TextIO | Iterable[str], file: str = "<stdin>") -> Iterat
         except lark.exceptions.UnexpectedInput as err:
             col = getattr(err, "column", 1) or 1
             raise NcppError(f"cannot read this CL record: {statement.strip()!r}", Location(file, line, col)) from None
+        if any(type(a) is float and not math.isfinite(a) for a in args):  # more digits than a float holds
+            raise NcppError(f"number out of range in this CL record: {statement.strip()[:60]!r}", Location(file, line))
         yield Record(major, args, text, line, file)

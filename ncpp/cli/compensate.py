@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 import io
+import math
 import os
 import sys
 from typing import BinaryIO
@@ -29,7 +30,7 @@ def add_compensation_arguments(p: argparse.ArgumentParser) -> None:
     source = p.add_mutually_exclusive_group()
     source.add_argument("--machine", metavar="M.toml", help="machine file with the error model")
     source.add_argument("--from", dest="from_file", metavar="FILE", help="compensate from one measurement file")
-    p.add_argument("--tolerance", type=float, default=0.001, metavar="MM", help="allowed path deviation, mm (default 0.001)")
+    p.add_argument("--tolerance", type=tolerance_mm, default=0.001, metavar="MM", help="allowed path deviation, mm (default 0.001)")
     p.add_argument("--force", action="store_true", help="compensate a program ncpp has compensated before")
     add_placement_arguments(p)
     p.add_argument(
@@ -109,6 +110,17 @@ def _cores() -> int:
     return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
 
 
+def tolerance_mm(text: str) -> float:
+    """--tolerance: a positive, finite number of mm."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not 0 < value < math.inf:
+        raise argparse.ArgumentTypeError(f"expected a positive number of mm, got {text!r}")
+    return value
+
+
 def zero_argument(text: str) -> tuple[str, tuple[float, float, float]]:
     from ncpp.motion.offsets import parse_zero
 
@@ -141,8 +153,6 @@ def run(args: argparse.Namespace) -> int:
     source = error_source(args)
     if source is None:
         raise NcppError("no error model: give --machine M.toml or --from MEASUREMENT")
-    if not args.tolerance > 0:
-        raise NcppError("--tolerance must be positive")
     warnings = Warnings(strict=args.strict)
     progress = progress_printer("compensate")
     with open_input(args.input, spool_from(args.jobs)) as (stream, name), open_output(args.output) as out:

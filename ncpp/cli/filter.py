@@ -53,8 +53,6 @@ def configured_source(args: argparse.Namespace):
 
     var_units = args.var_units if args.var_file or args.tool_table else None  # the config's when the files are the config's
     settings = find_settings(args.machine, args.tolerance, dict(args.work_offset), args.var_file, var_units, args.tool_table)
-    if not settings.tolerance > 0:
-        raise NcppError("--tolerance must be positive")
     if not (args.from_file or settings.machine):
         return None, settings.tolerance, None
     from ncpp.pipeline import ErrorSource

@@ -11,7 +11,7 @@ import argparse
 
 from ncpp.cli.compensate import add_compensation_arguments, error_source, work_offsets
 from ncpp.cli.io import open_output
-from ncpp.errors import NcppError, Warnings
+from ncpp.errors import Warnings
 
 
 DIALECTS = ("iso", "linuxcnc", "fanuc", "heidenhain", "sinumerik")  # = ncpp.post.GENERATORS, without importing it
@@ -33,8 +33,6 @@ def run(args: argparse.Namespace) -> int:
     from ncpp.cli.progress import progress_printer
     from ncpp.post import post
 
-    if not args.tolerance > 0:
-        raise NcppError("--tolerance must be positive")
     source = error_source(args)
     offsets = work_offsets(args)
     warnings = Warnings(strict=args.strict)

@@ -9,10 +9,26 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 
 from ncpp.cli.compensate import add_placement_arguments, work_offsets
 from ncpp.cli.io import add_dialect_argument
 from ncpp.errors import Location, NcppError, Warnings
+
+
+# Contour errors are microns: finer sampling shows nothing more, and costs memory by the path's length.
+MIN_STEP_MM = 0.001
+
+
+def step_mm(text: str) -> float:
+    """--step: a finite number of mm, at least MIN_STEP_MM."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not MIN_STEP_MM <= value < math.inf:
+        raise argparse.ArgumentTypeError(f"expected a number of mm from {MIN_STEP_MM} on, got {text!r}")
+    return value
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -22,7 +38,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--reference", metavar="ORIGINAL", help="nominal program (for a compensated PROGRAM)")
     add_placement_arguments(p)
     add_dialect_argument(p)
-    p.add_argument("--step", type=float, default=0.5, metavar="MM", help="sample spacing along the path (default 0.5)")
+    p.add_argument("--step", type=step_mm, default=0.5, metavar="MM", help=f"sample spacing along the path (default 0.5, at least {MIN_STEP_MM})")
     p.add_argument("--json", metavar="OUT", help="write the figures as JSON")
     p.add_argument("--plot", metavar="OUT.png", help="plot the contour error (and circle traces)")
     p.set_defaults(func=run)

@@ -29,6 +29,7 @@ unchanged.
 from __future__ import annotations
 
 import configparser
+import math
 import os
 import tomllib
 from dataclasses import dataclass, field, replace
@@ -84,7 +85,7 @@ def read_config(path: Path) -> dict:
             config[key] = str((path.parent / Path(data[key]).expanduser()).resolve())
     if "tolerance" in data:
         tolerance = data["tolerance"]
-        if isinstance(tolerance, bool) or not isinstance(tolerance, (int, float)) or not tolerance > 0:
+        if isinstance(tolerance, bool) or not isinstance(tolerance, (int, float)) or not 0 < tolerance < math.inf:
             raise NcppError("`tolerance` must be a positive number of mm", Location(str(path)))
         config["tolerance"] = float(tolerance)
     if "work_offset" in data:
@@ -101,8 +102,8 @@ def _zeros(value, path: Path) -> dict[str, Vector]:
     table = value if isinstance(value, dict) else {"G54": value}
     zeros = {}
     for name, zero in table.items():
-        if not (isinstance(zero, list) and len(zero) == 3 and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in zero)):
-            raise NcppError("`work_offset` must be [x, y, z] in mm, or a table of them by G word (G54 = [x, y, z])", Location(str(path)))
+        if not (isinstance(zero, list) and len(zero) == 3 and all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in zero)):
+            raise NcppError("`work_offset` must be [x, y, z] in mm (finite numbers), or a table of them by G word (G54 = [x, y, z])", Location(str(path)))
         try:
             system_number(name)
         except ValueError as err:

@@ -218,6 +218,19 @@ def normalise_name(name: str) -> str:
 
 def evaluate(expr: tuple, params: Parameters) -> float:
     """The value of an expression; raises ExpressionError or OutOfScope."""
+    if expr[0] == "num":  # (most expressions are a number)
+        value = expr[1]
+    else:
+        try:
+            value = _value(expr, params)
+        except OverflowError:  # math.exp, math.pow, ** past the largest float
+            raise ExpressionError("Number out of range") from None
+    if not math.isfinite(value):  # a sum or product past the largest float, or a number too long
+        raise ExpressionError("Number out of range")
+    return value
+
+
+def _value(expr: tuple, params: Parameters) -> float:
     kind = expr[0]
     if kind == "num":
         return expr[1]

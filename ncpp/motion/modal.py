@@ -115,13 +115,17 @@ class ModalInterpreter:
     def value(self, expr: tuple, block: Block, item) -> float:
         """An expression's value; an unknown parameter ends interpretation (out of scope)."""
         try:
-            return evaluate(expr, self.lookup)
+            value = evaluate(expr, self.lookup)
         except OutOfScope as stop:
             stop.col = item.start + 1
             raise
-        except (ValueError, OverflowError) as err:
+        except OverflowError:  # exp, ** past the largest float
+            value = math.inf
+        except ValueError as err:
             self.fail(str(err), block, item)
-        raise AssertionError("unreachable")
+        if not math.isfinite(value):  # (a sum or product past the largest float too)
+            self.fail("number out of range", block, item)
+        return value
 
     def fail(self, message: str, block: Block, item=None) -> None:
         raise NcppError(message, Location(self.file, block.line, item.start + 1 if item is not None else None))

@@ -20,6 +20,7 @@ Positions are machine mm (X, Y, Z).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Mapping, Sequence
@@ -126,8 +127,8 @@ def parse_zero(text: str) -> tuple[str, Vector]:
         values = tuple(float(v) for v in numbers.split(","))
     except ValueError:
         values = ()
-    if len(values) != 3:
-        raise ValueError(f"expected [G5x=]X,Y,Z in mm, got {text!r}")
+    if len(values) != 3 or not all(math.isfinite(v) for v in values):
+        raise ValueError(f"expected [G5x=]X,Y,Z in mm (three finite numbers), got {text!r}")
     return name, values  # type: ignore[return-value]
 
 
@@ -150,10 +151,14 @@ def read_var_file(path: str | Path) -> dict[int, float]:
         fields = line.split()
         if len(fields) < 2 or not fields[0].isdigit():
             continue
+        where = Location(str(path), n, line.index(fields[1]) + 1)
         try:
-            values[int(fields[0])] = float(fields[1])
+            value = float(fields[1])
         except ValueError:
-            raise NcppError(f"parameter {fields[0]} has no number: {fields[1]!r}", Location(str(path), n, line.index(fields[1]) + 1)) from None
+            raise NcppError(f"parameter {fields[0]} has no number: {fields[1]!r}", where) from None
+        if not math.isfinite(value):
+            raise NcppError(f"parameter {fields[0]} is not a finite number: {fields[1]!r}", where)
+        values[int(fields[0])] = value
     return values
 
 

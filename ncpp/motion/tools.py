@@ -42,6 +42,7 @@ edge, not as axis offsets.
 
 from __future__ import annotations
 
+import math
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -139,9 +140,12 @@ def read_tool_lines(lines: list[str], file: str, unit_mm: float) -> dict[int, tu
 
 def _number(text: str, where: Location) -> float:
     try:
-        return float(text)
+        value = float(text)
     except ValueError:
         raise NcppError(f"expected a number, got {text!r}", where) from None
+    if not math.isfinite(value):
+        raise NcppError(f"expected a finite number, got {text!r}", where)
+    return value
 
 
 def _integer(text: str, where: Location) -> int:

@@ -169,6 +169,12 @@ def compensate(
 
 
 def _check(wanted: NDArray, command: NDArray, lines: NDArray, ctx: PassContext) -> None:
+    # NaN compares false with every limit: a point or a model that is not a number would pass
+    broken = np.flatnonzero(~np.isfinite(command).all(axis=-1).all(axis=-1))
+    if broken.size:
+        k = int(broken[0])
+        what = "the program point" if not np.isfinite(wanted[k]).all() else "the machine model's correction"
+        raise NcppError(f"{what} is not a finite number: nothing to command", Location(ctx.file, int(lines[k])))
     correction = np.linalg.norm(command - wanted, axis=-1).max(axis=-1)
     bad = np.flatnonzero(correction > ctx.max_correction)
     if bad.size:

@@ -15,6 +15,7 @@ its own token texts (`_Replay`).
 from __future__ import annotations
 
 import functools
+import math
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -199,6 +200,17 @@ def dialect_syntax(dialect: "str | Dialect") -> Dialect:
     return get_dialect(dialect)
 
 
+# A number of more digits than a float holds reads as infinity (`X999...9`): refused, as
+# rs274 refuses the line ("Command too long"); shorter lines cannot hold one.
+_FINITE_LINE = 300
+
+
+def _refuse_infinite(block: Block, file: str) -> None:
+    for item in block.items:
+        if type(item) is Word and not math.isfinite(item.value):
+            raise NcppError(f"number out of range: {item.letter}{item.number[:20]}... ({len(item.number)} characters)", Location(file, block.line, item.start + 1))
+
+
 class LineParser:
     """Parses one line (or one continued block) of a dialect into a Block."""
 
@@ -219,9 +231,13 @@ class LineParser:
     def parse(self, raw: str, eol: str = "", line: int = 0, file: str = "<stdin>") -> Block:
         plain = self._scan_plain(raw)
         if plain is None:
-            return Block(raw, eol, self._parse_lalr(raw, line, file), line)
-        items, signature = plain
-        return Block(raw, eol, items, line, False, signature)
+            block = Block(raw, eol, self._parse_lalr(raw, line, file), line)
+        else:
+            items, signature = plain
+            block = Block(raw, eol, items, line, False, signature)
+        if len(raw) > _FINITE_LINE:  # only such a line can hold a number of more than 308 digits
+            _refuse_infinite(block, file)
+        return block
 
     def _scan_plain(self, raw: str) -> tuple[tuple[AnyItem, ...], str | None] | None:
         """(items, `Block.signature`) of a line made only of plain words and
@@ -310,12 +326,14 @@ class LineParser:
             return known.items(raw)
         try:
             tree = self._lark.parse(raw)
+            items = tuple(_flatten(self._builder.transform(tree)))
         except lark.exceptions.UnexpectedInput as err:
             col = getattr(err, "column", None)
             # a continued block spans lines: Lark counts them from 1
             line += max(getattr(err, "line", 1) or 1, 1) - 1
             raise NcppError(_describe(err, raw), Location(file, line, col)) from None
-        items = tuple(_flatten(self._builder.transform(tree)))
+        except RecursionError:  # the builder walks the tree recursively: brackets hundreds deep
+            raise NcppError("expression nested too deeply", Location(file, line)) from None
         if layout is not None:
             trees.learn(layout, _Cut.of(raw, items, trees.layout) or _Replay(tree, self._builder))
         return items
