@@ -200,6 +200,10 @@ def dialect_syntax(dialect: "str | Dialect") -> Dialect:
     return get_dialect(dialect)
 
 
+# A UTF-8 byte order mark (a Windows editor's), as the latin-1 text a program is read as
+_BOM = "\xef\xbb\xbf"
+BOM_MESSAGE = "the file starts with a UTF-8 byte order mark (bytes EF BB BF), which NC controls do not expect (rs274 refuses it): save the program without it"
+
 # A number of more digits than a float holds reads as infinity (`X999...9`): refused, as
 # rs274 refuses the line ("Command too long"); shorter lines cannot hold one.
 _FINITE_LINE = 300
@@ -331,6 +335,8 @@ class LineParser:
             col = getattr(err, "column", None)
             # a continued block spans lines: Lark counts them from 1
             line += max(getattr(err, "line", 1) or 1, 1) - 1
+            if raw.startswith(_BOM):
+                raise NcppError(BOM_MESSAGE, Location(file, line, 1)) from None
             raise NcppError(_describe(err, raw), Location(file, line, col)) from None
         except RecursionError:  # the builder walks the tree recursively: brackets hundreds deep
             raise NcppError("expression nested too deeply", Location(file, line)) from None

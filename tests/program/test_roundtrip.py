@@ -9,6 +9,7 @@ import sys
 import pytest
 
 from ncpp.errors import NcppError
+from ncpp.program.dialects import parse_program
 from ncpp.program.parser import LineParser, parse_stream
 from ncpp.program.writer import write_blocks
 from tests.conftest import CORPUS, corpus_files, corpus_id, expected_signature
@@ -104,6 +105,13 @@ def test_cli_error_has_location_no_traceback_and_no_output(tmp_path):
     assert not target.exists()
     proc = subprocess.run([sys.executable, "-m", "ncpp"], input=bad.read_bytes(), capture_output=True)
     assert proc.returncode != 0 and proc.stdout == b""
+
+
+@pytest.mark.parametrize("program, name", [(b"%\nG1 X1 F100\n%\n", "p.ngc"), (b"BEGIN PGM X MM\nL X+1 R0 FMAX\nEND PGM X MM\n", "p.h")])
+def test_a_byte_order_mark_is_named_not_shown_as_latin_1(program, name):
+    with pytest.raises(NcppError) as err:
+        list(parse_program(io.BytesIO(b"\xef\xbb\xbf" + program), name, None)[1])
+    assert str(err.value).startswith(f"{name}:1:1: the file starts with a UTF-8 byte order mark")
 
 
 # Programs LinuxCNC's interpreter refuses too (rs274 prints the same error):
