@@ -215,6 +215,17 @@ def _refuse_infinite(block: Block, file: str) -> None:
             raise NcppError(f"number out of range: {item.letter}{item.number[:20]}... ({len(item.number)} characters)", Location(file, block.line, item.start + 1))
 
 
+def _refuse_cr_line_ends(raw: str, line: int, file: str) -> None:
+    """Text after a CR: lines ended by CR alone (classic Mac OS), which the grammar would
+    read as blanks, running every line of the program into one."""
+    bare = _TEXT_AFTER_CR.search(raw)  # (a continued block holds the CR LF of its lines)
+    if bare is not None:
+        raise NcppError("the program's lines end in a carriage return (CR) alone: convert them to LF or CR LF", Location(file, line, bare.start() + 1))
+
+
+_TEXT_AFTER_CR = re.compile(r"\r[ \t\f\v\x1a\r]*[^ \t\f\v\x1a\r\n]")
+
+
 class LineParser:
     """Parses one line (or one continued block) of a dialect into a Block."""
 
@@ -241,6 +252,8 @@ class LineParser:
             block = Block(raw, eol, items, line, False, signature)
         if len(raw) > _FINITE_LINE:  # only such a line can hold a number of more than 308 digits
             _refuse_infinite(block, file)
+        if "\r" in raw:  # (a CR before the LF is the line's end, not in `raw`)
+            _refuse_cr_line_ends(raw, line, file)
         return block
 
     def _scan_plain(self, raw: str) -> tuple[tuple[AnyItem, ...], str | None] | None:

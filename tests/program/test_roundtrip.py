@@ -114,6 +114,13 @@ def test_a_byte_order_mark_is_named_not_shown_as_latin_1(program, name):
     assert str(err.value).startswith(f"{name}:1:1: the file starts with a UTF-8 byte order mark")
 
 
+def test_lines_ended_by_cr_alone_are_refused_not_read_as_one_line():
+    with pytest.raises(NcppError, match=r"^p\.ngc:1:2: the program's lines end in a carriage return \(CR\) alone"):
+        list(parse_program(io.BytesIO(b"%\rG21 G90\rG1 X10 F100\r%\r"), "p.ngc", None)[1])
+    blank_crs = b"G21\r\r\nG1 X1 F100 \r\r\n"  # a CR doubled before the LF ends the line still
+    assert b"".join(b.raw.encode() + b.eol.encode() for b in parse_program(io.BytesIO(blank_crs), "p.ngc", None)[1]) == blank_crs
+
+
 # Programs LinuxCNC's interpreter refuses too (rs274 prints the same error):
 # `ncpp` refuses them rather than pass a program it cannot make sense of.
 REFUSED_LIKE_LINUXCNC = {
