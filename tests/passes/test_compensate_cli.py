@@ -117,3 +117,15 @@ def test_thesis_reference_case_from_a_ballbar_file(tmp_path):
         assert (words["I"], words["J"]) == pytest.approx((i, j), abs=0.001)
     # at least 4 decimals (0.1 µm) whatever the input wrote, so rounding stays far below tolerance
     assert arcs[0].startswith("N200 G02 X-150.0000 Y-150.0000 I-149.97")
+
+
+@pytest.mark.parametrize("program, turns", [("G2 X0 Y0 I10 J0 Z1 P10001 F100", "10,001"), ("G2 X0 Y0 I10 J0 Z1 P10000 F100", None)])
+def test_an_arc_of_more_turns_than_compensation_holds_is_refused_with_its_line(tmp_path, program, turns):
+    path = tmp_path / "helix.ngc"
+    path.write_text(f"G17 G21 G90\nG0 X0 Y0 Z0\n{program}\nM2\n")
+    proc = subprocess.run([sys.executable, "-m", "ncpp", "compensate", "--machine", str(MACHINE), "--work-offset", "400,350,300", str(path)],
+                          capture_output=True, text=True)  # fmt: skip
+    if turns is None:  # (10,000 turns: 80,000 lines)
+        assert proc.returncode == 0 and proc.stdout.count("\n") > 80_000
+    else:
+        assert proc.returncode == 2 and proc.stdout == "" and proc.stderr.startswith(f"{path}:3: an arc of {turns} turns")
