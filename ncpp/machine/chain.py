@@ -72,6 +72,7 @@ from numpy.typing import NDArray
 from ncpp.machine.components import AXES
 
 UNIT = np.eye(3)
+SMALL_ANGLE = 0.01  # rad: the rotation series (`rodrigues`) are exact in double precision below it
 
 
 @dataclass(frozen=True)
@@ -164,7 +165,7 @@ def rodrigues(eps: NDArray) -> tuple[NDArray, NDArray]:
     """The factors a = sinθ/θ and b = (1−cosθ)/θ² of rotation vectors ε (…, 3, n), (…, n).
 
     Rodrigues: R v = v + a ε×v + b ε×(ε×v); the series below are exact in
-    double precision for θ < 0.01 rad."""
+    double precision for θ < SMALL_ANGLE (0.01 rad)."""
     squares = eps * eps
     th2 = squares[..., 0, :] + squares[..., 1, :] + squares[..., 2, :]
     return 1.0 - th2 * (1.0 / 6.0 - th2 / 120.0), 0.5 - th2 * (1.0 / 24.0 - th2 / 720.0)

@@ -31,6 +31,9 @@ angular               rotation ε(k) = urad_per_m·(k − ref_mm) about the
 from __future__ import annotations
 
 import dataclasses
+import math
+import numbers
+import typing
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, ClassVar, Mapping
 
@@ -48,7 +51,7 @@ LATERAL_DEFAULT = {"X": "Y", "Y": "X", "Z": "X"}
 
 
 def _axis(name: str, what: str = "axis") -> int:
-    if name not in AXES:
+    if name not in tuple(AXES):  # a tuple: "XY" and "" are substrings of "XYZ", a list is not hashable
         raise ValueError(f"{what} must be X, Y or Z, not {name!r}")
     return AXES.index(name)
 
@@ -75,24 +78,42 @@ class Effect:
 
 def effect_from_dict(data: Mapping[str, Any]) -> Effect:
     """Build an effect from its dict (``kind`` plus parameters); ValueError if bad."""
+    if not isinstance(data, Mapping):
+        raise ValueError(f'must be a table such as {{ kind = "backlash", axis = "X", um = 3.0 }}, not {data!r}')
     kind = data.get("kind")
-    cls = EFFECTS.get(kind)  # type: ignore[arg-type]
+    cls = EFFECTS.get(kind) if isinstance(kind, str) else None
     if cls is None:
         raise ValueError(f"unknown effect kind {kind!r}; known: {', '.join(EFFECTS)}")
-    names = {f.name for f in dataclasses.fields(cls)}
+    fields = {f.name: f for f in dataclasses.fields(cls)}
     params = {k: v for k, v in data.items() if k != "kind"}
-    unknown = sorted(set(params) - names)
+    unknown = sorted(set(params) - set(fields))
     if unknown:
-        raise ValueError(f"effect {kind}: unknown key(s) {', '.join(unknown)}; expected {', '.join(sorted(names))}")
-    try:
-        return cls(**{k: tuple(v) if isinstance(v, list) else v for k, v in params.items()})
-    except TypeError as err:
-        missing = sorted(
-            f.name
-            for f in dataclasses.fields(cls)
-            if f.name not in params and f.default is dataclasses.MISSING
-        )
-        raise ValueError(f"effect {kind}: missing key(s) {', '.join(missing)}") from err
+        raise ValueError(f"effect {kind}: unknown key(s) {', '.join(unknown)}; expected {', '.join(sorted(fields))}")
+    missing = sorted(n for n, f in fields.items() if n not in params and f.default is dataclasses.MISSING)
+    if missing:
+        raise ValueError(f"effect {kind}: missing key(s) {', '.join(missing)}")
+    hints = typing.get_type_hints(cls)
+    return cls(**{k: _param(f"effect {kind}: {k}", hints[k], v) for k, v in params.items()})
+
+
+def _is_number(value: Any) -> bool:
+    return isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_)) and math.isfinite(value)
+
+
+def _param(what: str, hint: Any, value: Any) -> Any:
+    """A number or [lo, hi] parameter checked against its field's type: a string "3"
+    would pass here and fail only when the effect is applied.  Text parameters are
+    left to the effect's own check, which names the values it takes."""
+    want = next(a for a in typing.get_args(hint) or (hint,) if a is not type(None))
+    if want is float:
+        if not _is_number(value):
+            raise ValueError(f"{what} must be a finite number, not {value!r}")
+        return float(value)
+    if typing.get_origin(want) is tuple:  # tuple[float, float]: a range
+        if not (isinstance(value, (list, tuple)) and len(value) == 2 and all(map(_is_number, value))):
+            raise ValueError(f"{what} must be [lo, hi], two finite numbers, not {value!r}")
+        return tuple(float(v) for v in value)
+    return value
 
 
 def _zeros(trajectory: Trajectory) -> NDArray:
@@ -225,7 +246,7 @@ class ServoMismatch(Effect):
     ms: float
 
     def __post_init__(self) -> None:
-        if len(self.axes) != 2 or self.axes[0] == self.axes[1]:
+        if not isinstance(self.axes, str) or len(self.axes) != 2 or self.axes[0] == self.axes[1]:
             raise ValueError(f"servo_mismatch: axes must name two different axes, e.g. XY, not {self.axes!r}")
         _axis(self.axes[0], "axes"), _axis(self.axes[1], "axes")
 
@@ -247,7 +268,7 @@ class Squareness(Effect):
     um_per_m: float
 
     def __post_init__(self) -> None:
-        if self.plane not in PLANE_TERMS:
+        if self.plane not in tuple(PLANE_TERMS):
             raise ValueError(f"squareness: plane must be XY, YZ or ZX, not {self.plane!r}")
 
     def apply(self, trajectory: Trajectory, machine: "Machine | None" = None) -> NDArray:
@@ -316,7 +337,7 @@ class Angular(Effect):
     ref_mm: float = 0.0
 
     def __post_init__(self) -> None:
-        info = COMPONENTS.get(self.component)
+        info = COMPONENTS.get(self.component) if isinstance(self.component, str) else None
         if info is None or info.kind != "rotation":
             raise ValueError(f"angular: component must be an angular error such as ECZ, not {self.component!r}")
 

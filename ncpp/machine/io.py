@@ -57,8 +57,10 @@ A complete example::
     source = "laser 2004-03-02"
 
 Component names may be ISO (EXX, EBX, C0Y) or the thesis's (xx, Xxx, bx,
-kxy); the file is written back with ISO names.  Errors point at the file and
-line.
+kxy); the file is written back with ISO names.  The file is UTF-8 (a byte
+order mark is skipped); every number in it must be finite (no nan or inf, [meta]
+aside), and angles small (within ±10000 µrad, where the model's rotation series
+are exact).  Errors point at the file and line, and name the key.
 """
 
 from __future__ import annotations
@@ -67,19 +69,24 @@ import math
 import os
 import re
 import tomllib
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import tomli_w
 
 from ncpp.errors import Location, NcppError
 from ncpp.fileio import write_text_atomic
-from ncpp.machine.components import COMPONENTS, SQUARENESS, Polynomial, Table, canonical_name
+from ncpp.machine.chain import SMALL_ANGLE
+from ncpp.machine.components import AXES, COMPONENTS, SQUARENESS, Polynomial, Table, canonical_name
 from ncpp.machine.effects import effect_from_dict
 from ncpp.machine.model import Machine
 
 SECTIONS = {"machine", "offsets", "limits", "errors", "squareness", "effects", "compensation", "meta"}
 SCALE = {"um": 1e-3, "urad": 1e-6}  # file unit -> model unit (mm, rad)
+MULTI_LINE_QUOTES = ('"""', "'''")
+NUMBERS = {2: "two", 3: "three"}  # how many, in messages
 
 
 class _Locator:
@@ -114,10 +121,64 @@ class _Locator:
                     return Location(self.file, i + 1)
         return Location(self.file, start + 1)
 
+    def item(self, key: str, nth: int, inner: str | None = None) -> Location | None:
+        """Where item `nth` of a top-level array ``key = [...]`` begins, or its key `inner`
+        (an inline table is on one line); None if there is no such array or item."""
+        opening = re.compile(r"^\s*\"?" + re.escape(key) + r"\"?\s*=\s*\[")
+        ends = (i for i, line in enumerate(self.lines) if opening.match(line) or line.lstrip().startswith("["))
+        row = next(ends, None)
+        if row is None or not opening.match(self.lines[row]):  # top-level keys come before the first table
+            return None
+        for n, (line, col) in enumerate(_array_items(self.lines, row)):
+            if n == nth:
+                found = inner and re.compile(r"\b" + re.escape(inner) + r"\s*=").search(self.lines[line], col)
+                return Location(self.file, line + 1, (found.start() if found else col) + 1)
+        return None
 
-def _parse_error_location(err: tomllib.TOMLDecodeError, file: str) -> Location:
+
+def _array_items(lines: list[str], start: int) -> Iterator[tuple[int, int]]:
+    """(line, column), 0-based, where each item of the array opened after the `=` on
+    line `start` begins; stops at the array's end or at a multi-line string (rare in
+    a machine file: not worth following)."""
+    depth, quote, expect = 0, "", False
+    for row in range(start, len(lines)):
+        line, col = lines[row], (lines[start].index("=") + 1 if row == start else 0)
+        while col < len(line):
+            c = line[col]
+            if quote:
+                if c == quote:
+                    quote = ""
+                elif c == "\\" and quote == '"':
+                    col += 1  # an escaped character
+            elif c == "#":
+                break
+            elif not c.isspace():
+                if depth == 1 and expect and c != "]":
+                    yield row, col
+                    expect = False
+                if line.startswith(MULTI_LINE_QUOTES, col):
+                    return
+                if c in "\"'":
+                    quote = c
+                elif c in "[{":
+                    depth += 1
+                    expect = depth == 1
+                elif c in "]}":
+                    depth -= 1
+                    if depth == 0:
+                        return
+                elif c == "," and depth == 1:
+                    expect = True
+            col += 1
+
+
+def _parse_error_location(err: tomllib.TOMLDecodeError, text: str, file: str) -> Location:
     m = re.search(r"at line (\d+), column (\d+)", str(err))
-    return Location(file, int(m.group(1)), int(m.group(2))) if m else Location(file)
+    if m:
+        return Location(file, int(m.group(1)), int(m.group(2)))
+    if "at end of document" in str(err):  # a truncated file: its last line
+        return Location(file, max(1, len(text.splitlines())))
+    return Location(file)
 
 
 def load_machine(path: str | os.PathLike[str]) -> Machine:
@@ -127,15 +188,31 @@ def load_machine(path: str | os.PathLike[str]) -> Machine:
         text = Path(path).read_text(encoding="utf-8")
     except OSError as err:
         raise NcppError(f"cannot read machine file: {err.strerror}", Location(file)) from err
+    except UnicodeDecodeError as err:
+        raise _not_utf8(Path(path).read_bytes(), file) from err
     return loads_machine(text, file)
 
 
+def _not_utf8(data: bytes, file: str) -> NcppError:
+    """The first byte that is not UTF-8, at its line and column (read again whole: the
+    text reader decodes in chunks, so the offset in its error is not the file's)."""
+    try:
+        data.decode("utf-8")
+        return NcppError("not UTF-8 text; save the machine file as UTF-8", Location(file))
+    except UnicodeDecodeError as err:
+        start = err.start
+    line_start = data.rfind(b"\n", 0, start) + 1
+    where = Location(file, data.count(b"\n", 0, start) + 1, len(data[line_start:start].decode("utf-8")) + 1)
+    return NcppError(f"not UTF-8 text (byte 0x{data[start]:02x}); save the machine file as UTF-8", where)
+
+
 def loads_machine(text: str, file: str = "<string>") -> Machine:
+    text = text.removeprefix("\ufeff")  # a byte order mark, as some Windows editors write: not TOML
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as err:
-        msg = re.sub(r"\s*\(at line \d+, column \d+\)", "", str(err))
-        raise NcppError(f"not valid TOML: {msg}", _parse_error_location(err, file)) from err
+        msg = re.sub(r"\s*\(at (?:line \d+, column \d+|end of document)\)", "", str(err))
+        raise NcppError(f"not valid TOML: {msg}", _parse_error_location(err, text, file)) from err
     loc = _Locator(text, file)
     return _machine_from_dict(data, loc, default_name=Path(file).stem)
 
@@ -164,61 +241,157 @@ def _machine_from_dict(data: dict, loc: _Locator, default_name: str) -> Machine:
     for key in data:
         if key not in SECTIONS:
             raise _fail(f"unknown section [{key}]; expected {', '.join(sorted(SECTIONS))}", loc.where(key))
+    _refuse_non_finite(data, loc)
     head = _get_table(data, "machine", loc)
     _check_keys(head, {"name", "chain", "description"}, "machine", loc)
     if "chain" not in head:
         raise _fail("[machine] needs chain, e.g. chain = \"XZFY\"", loc.where("machine"))
     offsets = _get_table(data, "offsets", loc)
     _check_keys(offsets, {"tool", "work", "reference"}, "offsets", loc)
-    references = offsets.get("reference", {})
-    components, squareness = {}, {}
-    errors = _get_table(data, "errors", loc)
-    for name, spec in errors.items():
-        try:
-            iso = canonical_name(name)
-            if iso in SQUARENESS:
-                raise ValueError(f"{name} is a squareness; put it in [squareness] as {iso}_urad")
-            components[iso] = _component_from_dict(iso, spec)
-        except (ValueError, TypeError) as err:
-            key = _key_named_in(str(err), spec)
-            raise _fail(f"errors.{name}: {err}", loc.where(f"errors.{name}", key)) from err
-    for key, value in _get_table(data, "squareness", loc).items():
-        try:
-            base, unit = _split_unit(key, ("_urad", "_um_per_m"))
-            iso = canonical_name(base)
-            if iso not in SQUARENESS:
-                raise ValueError(f"{base} is not a squareness (C0Y, B0Z, A0Z)")
-            squareness[iso] = _number(value, key) * 1e-6
-        except ValueError as err:
-            raise _fail(f"squareness: {err}", loc.where("squareness", key)) from err
-    effects = data.get("effects", [])
-    if not isinstance(effects, list):
-        raise _fail("effects must be an array of tables: [[effects]]", loc.where(key="effects"))
-    parsed_effects = []
-    for n, spec in enumerate(effects):
-        try:
-            parsed_effects.append(effect_from_dict(spec))
-        except (ValueError, TypeError) as err:
-            key = _key_named_in(str(err), spec)
-            raise _fail(f"effects #{n + 1}: {err}", loc.where("effects", key, nth=n)) from err
+    tool_work = _vectors({k: v for k, v in offsets.items() if k != "reference"}, "offsets", "x, y, z", loc)
+    limits = _get_table(data, "limits", loc)
+    _check_keys(limits, set(AXES), "limits", loc)
+    travel = _vectors(limits, "limits", "lo, hi", loc)
     comp = _get_table(data, "compensation", loc)
     _check_keys(comp, {"max_correction_mm"}, "compensation", loc)
     try:
         return Machine(
             name=str(head.get("name", default_name)),
             chain=str(head["chain"]),
-            tool=offsets.get("tool", (0.0, 0.0, 0.0)),
-            work=offsets.get("work", (0.0, 0.0, 0.0)),
-            references=references,
-            limits=_get_table(data, "limits", loc),
-            components=components,
-            squareness=squareness,
-            effects=tuple(parsed_effects),
-            max_correction_mm=comp.get("max_correction_mm", 0.5),
-            meta=_meta(head, data),
+            tool=tool_work.get("tool", (0.0, 0.0, 0.0)),
+            work=tool_work.get("work", (0.0, 0.0, 0.0)),
+            references=_references(offsets, loc),
+            limits=travel,
+            components=_components(_get_table(data, "errors", loc), travel, loc),
+            squareness=_squareness(_get_table(data, "squareness", loc), loc),
+            effects=_effects(data, loc),
+            max_correction_mm=_max_correction(comp, loc),
+            meta=_meta(head, data, loc),
         )
     except (ValueError, TypeError) as err:
         raise _fail(str(err), _where_for_machine_error(str(err), loc)) from err
+
+
+def _non_finite(value: Any, path: tuple = ()) -> Iterator[tuple[tuple, float]]:
+    """(path, value) of each NaN or infinite number in a parsed TOML value."""
+    if isinstance(value, float) and not math.isfinite(value):
+        yield path, value
+    items = value.items() if isinstance(value, dict) else enumerate(value) if isinstance(value, list) else ()
+    for key, item in items:
+        yield from _non_finite(item, (*path, key))
+
+
+def _refuse_non_finite(data: dict, loc: _Locator) -> None:
+    """NaN or infinity (TOML's nan and inf, or a literal beyond 1.8e308) would come out
+    as NaN commands: refuse it at its key.  [meta] is free-form and not computed with;
+    a top-level value of the wrong shape is left to the check that names its shape."""
+    for path, value in _non_finite({k: v for k, v in data.items() if k != "meta"}):
+        last = max(i for i, p in enumerate(path) if isinstance(p, str))
+        if last == 0:
+            continue
+        table, key, items = path[:last], path[last], path[last + 1 :]
+        name = "".join(f" #{p + 1}" if isinstance(p, int) else f".{p}" for p in table)[1:]
+        what = f"finite numbers, not {value} (item {items[0] + 1})" if items else f"a finite number, not {value}"
+        if table[0] == "effects" and len(table) == 2:
+            where = _effect_where(loc, table[1], key)
+        else:
+            where = loc.where(".".join(p for p in table if isinstance(p, str)), key)
+        raise _fail(f"{name}: {key} must be {what}", where)
+
+
+def _vectors(table: dict, section: str, names: str, loc: _Locator) -> dict[str, list[float]]:
+    """Each key's array of numbers in mm, as many as `names` names ("lo, hi")."""
+    out = {}
+    for key, value in table.items():
+        try:
+            out[key] = _vector(value, key, names)
+        except ValueError as err:
+            raise _fail(f"{section}: {err}", loc.where(section, key)) from err
+    return out
+
+
+def _vector(value: Any, key: str, names: str) -> list[float]:
+    size = names.count(",") + 1
+    if not (isinstance(value, list) and len(value) == size and all(map(_is_number, value))):
+        raise ValueError(f"{key} must be {NUMBERS.get(size, size)} numbers [{names}] in mm, not {_shown(value)}")
+    return [float(v) for v in value]
+
+
+def _references(offsets: dict, loc: _Locator) -> dict[str, list[float]]:
+    refs = offsets.get("reference", {})
+    if not isinstance(refs, dict):
+        message = "offsets: reference must be a table of axis reference points, e.g. reference.X = [0.0, 350.0, 100.0]"
+        raise _fail(message, loc.where("offsets", "reference"))
+    _check_keys(refs, set(AXES), "offsets.reference", loc)
+    return _vectors(refs, "offsets.reference", "x, y, z", loc)
+
+
+def _components(errors: dict, travel: dict[str, list[float]], loc: _Locator) -> dict[str, Table | Polynomial]:
+    components, names = {}, {}
+    for name, spec in errors.items():
+        try:
+            iso = canonical_name(name)
+            if iso in SQUARENESS:
+                raise ValueError(f"{name} is a squareness; put it in [squareness] as {iso}_urad")
+            if iso in names:  # a thesis name and the ISO one: the second would silently win
+                raise ValueError(f"{iso} is given twice, as {names[iso]} and {name}")
+            components[iso] = _component_from_dict(iso, spec, travel.get(COMPONENTS[iso].axis))
+            names[iso] = name
+        except (ValueError, TypeError) as err:
+            key = _key_named_in(str(err), spec)
+            raise _fail(f"errors.{name}: {err}", loc.where(f"errors.{name}", key)) from err
+    return components
+
+
+def _squareness(table: dict, loc: _Locator) -> dict[str, float]:
+    angles, keys = {}, {}
+    for key, value in table.items():
+        try:
+            base, unit = _split_unit(key, ("_urad", "_um_per_m"))
+            iso = canonical_name(base)
+            if iso not in SQUARENESS:
+                raise ValueError(f"{base} is not a squareness (C0Y, B0Z, A0Z)")
+            if iso in keys:  # in µrad and in µm/m: the second would silently win
+                raise ValueError(f"{iso} is given twice, as {keys[iso]} and {key}")
+            angles[iso], keys[iso] = _number(value, key) * 1e-6, key
+            _small_angles([angles[iso]], key)
+        except ValueError as err:
+            raise _fail(f"squareness: {err}", loc.where("squareness", key)) from err
+    return angles
+
+
+def _small_angles(angles: Any, key: str) -> None:
+    """Angles (rad) past SMALL_ANGLE leave the rotation series the model is exact with."""
+    worst = float(np.max(np.abs(angles), initial=0.0))
+    if not worst < SMALL_ANGLE:
+        limit = f"±{SMALL_ANGLE * 1e6:g} µrad (the model's small angles)"
+        raise ValueError(f"{key} must be within {limit}, not {worst * 1e6:g}")
+
+
+def _effects(data: dict, loc: _Locator) -> tuple:
+    effects = data.get("effects", [])
+    if not isinstance(effects, list):
+        raise _fail("effects must be an array of tables: [[effects]]", loc.where(key="effects"))
+    parsed = []
+    for n, spec in enumerate(effects):
+        try:
+            parsed.append(effect_from_dict(spec))
+        except (ValueError, TypeError) as err:
+            raise _fail(f"effects #{n + 1}: {err}", _effect_where(loc, n, _key_named_in(str(err), spec))) from err
+    return tuple(parsed)
+
+
+def _effect_where(loc: _Locator, n: int, key: str | None) -> Location:
+    """Effect n's [[effects]] table (at `key`), else its item in ``effects = [...]``."""
+    where = loc.where("effects", key, nth=n)
+    return where if where.line is not None else loc.item("effects", n, key) or loc.where(key="effects")
+
+
+def _max_correction(comp: dict, loc: _Locator) -> float:
+    try:
+        return _number(comp.get("max_correction_mm", 0.5), "max_correction_mm")
+    except ValueError as err:
+        raise _fail(f"compensation: {err}", loc.where("compensation", "max_correction_mm")) from err
 
 
 def _key_named_in(message: str, spec: Any) -> str | None:
@@ -227,8 +400,8 @@ def _key_named_in(message: str, spec: Any) -> str | None:
     return next((k for k in keys if k in message), None)
 
 
-def _meta(head: dict, data: dict) -> dict:
-    meta = dict(data.get("meta", {}))
+def _meta(head: dict, data: dict, loc: _Locator) -> dict:
+    meta = dict(_get_table(data, "meta", loc))
     if "description" in head:
         meta["description"] = head["description"]
     return meta
@@ -257,13 +430,23 @@ def _split_unit(key: str, units: tuple[str, ...]) -> tuple[str, str]:
     raise ValueError(f"{key!r} must end in a unit: {' or '.join(units)}")
 
 
+def _shown(value: Any, width: int = 60) -> str:
+    """A value for a message, cut short (a table can hold hundreds of numbers)."""
+    text = repr(value)
+    return text if len(text) <= width else text[: width - 3] + "..."
+
+
+def _is_number(value: Any) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+
+
 def _number(value: Any, key: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise ValueError(f"{key} must be a finite number")
+    if not _is_number(value):
+        raise ValueError(f"{key} must be a finite number, not {_shown(value)}")
     return float(value)
 
 
-def _component_from_dict(iso: str, spec: Any):
+def _component_from_dict(iso: str, spec: Any, travel: list[float] | None) -> Table | Polynomial:
     if not isinstance(spec, dict):
         raise ValueError("must be a table with kind = \"table\" or \"polynomial\"")
     unit = COMPONENTS[iso].unit
@@ -271,24 +454,46 @@ def _component_from_dict(iso: str, spec: Any):
     for key in spec:
         if other in key.split("_"):
             raise ValueError(f"{key}: {iso} is {'an angle' if unit == 'urad' else 'a length'}, give values in {unit}")
-    scale = SCALE[unit]
     kind = spec.get("kind", "polynomial" if f"coefficients_{unit}" in spec else "table")
     if kind == "table":
-        allowed = {"kind", "positions", f"values_{unit}", f"values_{unit}_minus", "interpolation"}
-        _require(spec, allowed, {"positions", f"values_{unit}"})
-        minus = spec.get(f"values_{unit}_minus")
-        return Table(
-            spec["positions"],
-            [v * scale for v in _numbers(spec[f"values_{unit}"], f"values_{unit}")],
-            None if minus is None else [v * scale for v in _numbers(minus, f"values_{unit}_minus")],
-            spec.get("interpolation", "linear"),
-        )
+        return _table(spec, unit)
     if kind == "polynomial":
-        allowed = {"kind", f"coefficients_{unit}", "reference_mm", "range_mm"}
-        _require(spec, allowed, {f"coefficients_{unit}"})
-        coeffs = [c * scale for c in _numbers(spec[f"coefficients_{unit}"], f"coefficients_{unit}")]
-        return Polynomial(coeffs, spec.get("reference_mm", 0.0), spec.get("range_mm"))
+        return _polynomial(spec, unit, travel)
     raise ValueError(f"kind must be \"table\" or \"polynomial\", not {kind!r}")
+
+
+def _table(spec: dict, unit: str) -> Table:
+    allowed = {"kind", "positions", f"values_{unit}", f"values_{unit}_minus", "interpolation"}
+    _require(spec, allowed, {"positions", f"values_{unit}"})
+    scale, minus = SCALE[unit], spec.get(f"values_{unit}_minus")
+    table = Table(
+        _numbers(spec["positions"], "positions"),
+        [v * scale for v in _numbers(spec[f"values_{unit}"], f"values_{unit}")],
+        None if minus is None else [v * scale for v in _numbers(minus, f"values_{unit}_minus")],
+        spec.get("interpolation", "linear"),
+    )
+    if unit == "urad":  # both interpolations stay within the tabulated values (PCHIP keeps their shape)
+        _small_angles(table.values + (table.values_minus or ()), f"values_{unit}")
+    return table
+
+
+def _polynomial(spec: dict, unit: str, travel: list[float] | None) -> Polynomial:
+    key = f"coefficients_{unit}"
+    _require(spec, {"kind", key, "reference_mm", "range_mm"}, {key})
+    poly = Polynomial(
+        [c * SCALE[unit] for c in _numbers(spec[key], key)],
+        _number(spec.get("reference_mm", 0.0), "reference_mm"),
+        None if "range_mm" not in spec else _vector(spec["range_mm"], "range_mm", "lo, hi"),
+    )
+    span = poly.limits or travel  # where it is evaluated; with neither, anywhere: nothing to check
+    if span is not None:
+        with np.errstate(all="ignore"):
+            values = poly(np.linspace(*span, 101))
+        if not np.all(np.isfinite(values)):
+            raise ValueError(f"{key} overflow between {span[0]:g} and {span[1]:g} mm: they are too large")
+        if unit == "urad":
+            _small_angles(values, f"{key} between {span[0]:g} and {span[1]:g} mm")
+    return poly
 
 
 def _require(spec: dict, allowed: set[str], required: set[str]) -> None:
@@ -302,7 +507,7 @@ def _require(spec: dict, allowed: set[str], required: set[str]) -> None:
 
 def _numbers(values: Any, key: str) -> list[float]:
     if not isinstance(values, list):
-        raise ValueError(f"{key} must be a list of numbers")
+        raise ValueError(f"{key} must be a list of numbers, not {_shown(values)}")
     return [_number(v, key) for v in values]
 
 
