@@ -32,6 +32,17 @@ VECTOR_TOL = 1e-6  # tool vector components: "constant"
 AXIS_TOL = 1e-6
 
 
+def units_inch(record: Record) -> bool:
+    """UNITS/INCHES (or INCH) or UNITS/MM; any other unit is refused: posted as mm, it
+    would cut the part at the wrong size."""
+    unit = record.words[0] if record.words else ""
+    if unit.startswith("INCH"):
+        return True
+    if unit in ("MM", "MILLIMETERS", "MILLIMETRES"):
+        return False
+    raise NcppError(f"UNITS/{unit or '?'}: expected MM or INCHES", record.where)
+
+
 def _block(record: Record) -> Block:
     return Block(raw=record.text, eol="\n", items=(), line=record.line)
 
@@ -190,7 +201,7 @@ def motion(records: Iterable[Record], warnings: Warnings | None = None, zero: Po
         elif major == "FEDRAT" and rec.numbers:
             feed = rec.numbers[0]
         elif major == "UNITS":
-            inch = bool(rec.words) and rec.words[0].startswith("INCH")
+            inch = units_inch(rec)
             context = replace(context, inch=inch, offset=tuple(v / 25.4 for v in zero) if inch else zero)  # program units
         elif major == "MULTAX":
             multax = not (rec.words and rec.words[0] == "OFF")

@@ -14,6 +14,7 @@ import re
 from dataclasses import dataclass
 from typing import Callable, Iterable, Iterator
 
+from ncpp.cldata.motion import units_inch
 from ncpp.cldata.reader import Record
 from ncpp.errors import Location, NcppError, Warnings
 from ncpp.motion.segments import PLANE_AXES, Arc, Event, Line, Pass, Point, replace
@@ -116,7 +117,7 @@ class Generator:
         if record.major == "PARTNO" and record.args:
             self.job.name = program_name(str(record.args[0]), self.job.name)
         elif record.major == "UNITS":
-            self.job.inch = bool(record.words) and record.words[0].startswith("INCH")
+            self.job.inch = units_inch(record)
 
     def _event(self, event: Event, record: Record | None) -> Iterator[str]:
         if type(event) is Line:
@@ -138,10 +139,8 @@ class Generator:
             if text:
                 yield from self.emit_comment(text)
         elif major in ("LOADTL", "LOAD"):
-            numbers = rec.numbers
-            if numbers:
-                self.tool = int(numbers[0])
-                yield from self.emit_tool(self.tool)
+            self.tool = _tool_number(rec)
+            yield from self.emit_tool(self.tool)
         elif major == "SPINDL":
             yield from self._spindle(rec)
         elif major == "COOLNT":
@@ -232,6 +231,18 @@ class Generator:
 
     def emit_m(self, code: int) -> Iterator[str]:
         raise NotImplementedError
+
+
+# Tool numbers a control takes (Fanuc and LinuxCNC: up to 8 digits)
+MAX_TOOL = 99_999_999
+
+
+def _tool_number(rec: Record) -> int:
+    """LOADTL/n: n a whole number a control takes (LOADTL/1.5 was tool 1, LOADTL/abc nothing)."""
+    numbers = rec.numbers
+    if not numbers or numbers[0] != int(numbers[0]) or not 0 <= numbers[0] <= MAX_TOOL:
+        raise NcppError(f"{rec.major}: expected a tool number from 0 to {MAX_TOOL:,}", rec.where)
+    return int(numbers[0])
 
 
 def _named_number(rec: Record, names: tuple[str, ...]) -> float | None:

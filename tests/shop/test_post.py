@@ -158,3 +158,24 @@ def test_multi_turn_helix_splits_into_single_turns_keeping_the_pitch():
     assert math.isclose(total, helix.sweep())
     rises = [p.end[2] - p.start[2] for p in pieces]
     assert all(math.isclose(r / p.sweep(), -9 / helix.sweep()) for r, p in zip(rises, pieces))
+
+
+@pytest.mark.parametrize(
+    "record, message",
+    [
+        ("UNITS / FURLONG", r"p\.cls:1:1: UNITS/FURLONG: expected MM or INCHES"),
+        ("LOADTL / 1.5", r"p\.cls:1:1: LOADTL: expected a tool number"),
+        ("LOADTL / abc", r"p\.cls:1:1: LOADTL: expected a tool number"),
+        ("LOADTL / 1e300", r"p\.cls:1:1: LOADTL: expected a tool number"),
+    ],
+)
+def test_a_unit_or_tool_the_post_cannot_write_is_refused(record, message):
+    with pytest.raises(NcppError, match=message):
+        post(io.StringIO(f"{record}\nFEDRAT / 100\nGOTO / 1, 2, 3\nFINI\n"), io.BytesIO(), file="p.cls", dialect="iso")
+
+
+def test_units_inches_and_mm_are_read():
+    for unit in ("MM", "INCHES"):
+        out = io.BytesIO()
+        post(io.StringIO(f"UNITS / {unit}\nLOADTL / 3\nFEDRAT / 100\nGOTO / 1, 2, 3\nFINI\n"), out, file="p.cls", dialect="iso")
+        assert b"G20" in out.getvalue() if unit == "INCHES" else b"G21" in out.getvalue()
