@@ -17,6 +17,8 @@ from __future__ import annotations
 
 import argparse
 
+from ncpp.cli.options import between
+
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
@@ -29,10 +31,17 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--json", metavar="OUT", help="write the figures as JSON")
     parser.add_argument("--plot", metavar="OUT.png", help="draw the standard plots into a PNG")
     parser.add_argument(
-        "--spike-width", type=float, default=3.0, metavar="DEG",
-        help="decay angle of the reversal-spike shape in the ball-bar diagnosis (default 3 deg)",
+        "--spike-width", type=spike_width, default=3.0, metavar="DEG",
+        help="decay angle of the reversal-spike shape in the ball-bar diagnosis (default 3 deg; "
+        "the spike must die out before the axis reverses again)",
     )  # fmt: skip
     parser.set_defaults(func=run)
+
+
+def spike_width(text: str) -> float:
+    from ncpp.instruments.iso230_4 import MAX_SPIKE_WIDTH_DEG  # (numpy: only when the option is given)
+
+    return between(0.0, MAX_SPIKE_WIDTH_DEG, "(]")(text)
 
 
 def run(args: argparse.Namespace) -> int:

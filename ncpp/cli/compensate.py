@@ -9,12 +9,12 @@ from __future__ import annotations
 
 import argparse
 import io
-import math
 import os
 import sys
 from typing import BinaryIO
 
 from ncpp.cli.io import add_io_arguments, open_input, open_output
+from ncpp.cli.options import positive
 from ncpp.cli.progress import progress_printer
 from ncpp.errors import NcppError, Warnings
 
@@ -113,12 +113,9 @@ def _cores() -> int:
 def tolerance_mm(text: str) -> float:
     """--tolerance: a positive, finite number of mm."""
     try:
-        value = float(text)
-    except ValueError:
-        value = math.nan
-    if not 0 < value < math.inf:
-        raise argparse.ArgumentTypeError(f"expected a positive number of mm, got {text!r}")
-    return value
+        return positive(text)
+    except argparse.ArgumentTypeError:
+        raise argparse.ArgumentTypeError(f"expected a positive number of mm, got {text!r}") from None
 
 
 def zero_argument(text: str) -> tuple[str, tuple[float, float, float]]:

@@ -19,6 +19,8 @@ from __future__ import annotations
 
 import argparse
 
+from ncpp.cli.options import between
+
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
@@ -32,7 +34,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--json", metavar="REPORT", help="write the diagnosis report (JSON)")
     parser.add_argument("--plot", metavar="GAP.png", help="plot the gap per step and the residuals")
     parser.add_argument("-o", "--output", metavar="UPDATED.toml", help="write the model with the new effects")
-    parser.add_argument("--alpha", type=float, default=1e-3,
+    parser.add_argument("--alpha", type=between(0.0, 1.0, "()"), default=1e-3,
                         help="family-wise false-alarm probability of adding an effect (default 1e-3)")  # fmt: skip
     parser.set_defaults(func=run)
 
@@ -42,13 +44,10 @@ def run(args: argparse.Namespace) -> int:
 
     from ncpp.diagnose import diagnose
     from ncpp.diagnose.report import account, plot_gap
-    from ncpp.errors import NcppError
     from ncpp.fileio import write_text_atomic
     from ncpp.instruments.files import read_measurement
     from ncpp.machine import load_machine, save_machine
 
-    if not 0 < args.alpha < 1:
-        raise NcppError("--alpha must be between 0 and 1")
     machine = load_machine(args.machine)
     measurements = [read_measurement(p) for p in args.files]
     result = diagnose(machine, measurements, alpha=args.alpha)

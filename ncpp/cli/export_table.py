@@ -20,6 +20,8 @@ from __future__ import annotations
 import argparse
 import sys
 
+from ncpp.cli.options import finite, positive
+
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
@@ -32,24 +34,30 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--axis", required=True, choices=("X", "Y", "Z", "x", "y", "z"), help="axis to tabulate")
     parser.add_argument("--format", required=True, choices=("linuxcnc", "fanuc", "sinumerik", "heidenhain"))
     parser.add_argument("-o", "--output", metavar="FILE", help="output file (default: stdout)")
-    parser.add_argument("--spacing", type=float, metavar="MM", help="distance between table points")
+    parser.add_argument("--spacing", type=positive, metavar="MM", help="distance between table points")
     parser.add_argument("--type", type=int, choices=(0, 1), default=0, help="LinuxCNC COMP_FILE_TYPE (default 0)")
     parser.add_argument(
-        "--reference", type=float, metavar="MM",
+        "--reference", type=finite, metavar="MM",
         help="reference position: FANUC's zero-correction point (default 0); SINUMERIK shifts its table to 0 there",
     )  # fmt: skip
     parser.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
+    from ncpp.errors import Location, NcppError
     from ncpp.export import export_table
     from ncpp.fileio import write_text_atomic
     from ncpp.machine import load_machine
 
     machine = load_machine(args.machine)
-    text, notes = export_table(
-        machine, args.axis.upper(), args.format, spacing=args.spacing, comp_type=args.type, reference=args.reference
-    )
+    try:
+        text, notes = export_table(
+            machine, args.axis.upper(), args.format, spacing=args.spacing, comp_type=args.type, reference=args.reference
+        )
+    except NcppError as err:  # what the machine file lacks or holds: name it (not <stdin>)
+        if err.where != Location():
+            raise
+        raise NcppError(err.message, Location(args.machine)) from None
     for note in notes:
         print(f"ncpp export-table: {note}", file=sys.stderr)
     if args.output:

@@ -31,6 +31,8 @@ from __future__ import annotations
 
 import argparse
 
+from ncpp.cli.options import at_least, non_negative, positive
+
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
@@ -45,9 +47,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--base", metavar="M0.toml", help="machine file whose structure and other errors are kept")
     parser.add_argument("--name", help="machine name")
     parser.add_argument("--interpolation", default="smooth", choices=("smooth", "linear"))
-    parser.add_argument("--reversal-threshold", type=float, default=0.5, metavar="UM", help="per-direction tables above this reversal (default 0.5 µm)")
-    parser.add_argument("--knots", type=int, default=9, help="ball bar: values per fitted table (default 9)")
-    parser.add_argument("--smoothing", type=float, metavar="LAMBDA", help="ball bar: penalty weight (default: by GCV)")
+    parser.add_argument("--reversal-threshold", type=non_negative, default=0.5, metavar="UM", help="per-direction tables above this reversal (default 0.5 µm)")
+    parser.add_argument("--knots", type=at_least(2), default=9, help="ball bar: values per fitted table (default 9)")
+    parser.add_argument("--smoothing", type=positive, metavar="LAMBDA", help="ball bar: penalty weight (default: by GCV)")
     parser.set_defaults(func=run)
 
 

@@ -30,6 +30,8 @@ from __future__ import annotations
 import argparse
 import math
 
+from ncpp.cli.options import at_least, between, finite, non_negative, positive
+
 INSTRUMENTS = ("ballbar", "laser", "comparator", "level", "grid", "cutting")
 
 
@@ -51,13 +53,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--plot", metavar="OUT.png", help="draw the standard plot of the prediction")
     g = parser.add_argument_group("set-up")
     g.add_argument("--plane", default="XY", type=str.upper, choices=("XY", "YZ", "ZX"))
-    g.add_argument("--radius", type=float, help="mm (default ballbar 150, grid 100, cutting 50)")
+    g.add_argument("--radius", type=positive, help="mm (default ballbar 150, grid 100, cutting 50)")
     g.add_argument("--center", metavar="X,Y,Z", help="centre, command mm (default: middle of the travel)")
-    g.add_argument("--feed", type=float, help="mm/min (default 1000; cutting 500)")
+    g.add_argument("--feed", type=positive, help="mm/min (default 1000; cutting 500)")
     g.add_argument("--direction", type=str.upper, choices=("CW", "CCW", "BOTH"), help="circular tests (ballbar default BOTH)")
-    g.add_argument("--start", type=float, default=0.0, metavar="DEG", help="start angle of the data arc")
-    g.add_argument("--overshoot", type=float, default=45.0, metavar="DEG", help="feed-in/feed-out arc (default 45)")
-    g.add_argument("--step", type=float, metavar="STEP", help="deg between circle points (ballbar 1, grid 2, cutting probes 2); mm for a square")
+    g.add_argument("--start", type=finite, default=0.0, metavar="DEG", help="start angle of the data arc")
+    g.add_argument("--overshoot", type=between(0.0, 360.0), default=45.0, metavar="DEG", help="feed-in/feed-out arc, 0 to 360 (default 45)")
+    g.add_argument("--step", type=positive, metavar="STEP", help="deg between circle points, at most 120 (ballbar 1, grid 2, cutting probes 2); mm for a square")
     g.add_argument("--path", default="circle", choices=("circle", "square"), help="grid encoder path")
     g.add_argument("--axis", type=str.upper, default="X", choices=("X", "Y", "Z"))
     g.add_argument("--quantity", default=None, help="laser: position|straightness_x|_y|_z|pitch|yaw|roll; level: roll|pitch")
@@ -67,9 +69,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     g.add_argument("--offset", default="0,0,0", metavar="x,y,z", help="functional point from the tool point, mm")
     g.add_argument("--fixed", default="", metavar='"Y=0 Z=0"', help="positions of the axes held still (default: middle of travel or 0)")
     g.add_argument("--targets", metavar="A:B:STEP | a,b,c", help="laser/comparator targets, level positions (default: the travel in 20 steps)")
-    g.add_argument("--runs", type=int, default=5, help="laser/comparator runs (default 5)")
+    g.add_argument("--runs", type=at_least(1), default=5, help="laser/comparator runs (default 5)")
     g.add_argument("--unidirectional", action="store_true", help="laser/comparator: + approach only")
-    g.add_argument("--noise", type=float, default=0.0, help="standard deviation of added noise (file unit)")
+    g.add_argument("--noise", type=non_negative, default=0.0, help="standard deviation of added noise (file unit)")
     g.add_argument("--seed", type=int, default=None)
     g.add_argument("--no-effects", action="store_true", help="leave out the non-geometric effects")
     g.add_argument("--no-zero", action="store_true", help="laser/comparator: absolute readings, not zeroed at the first")
@@ -87,6 +89,8 @@ def _vector(text: str, what: str):
         raise NcppError(f"{what}: {text!r} is not x,y,z numbers", Location("ncpp predict")) from None
     if len(values) != 3:
         raise NcppError(f"{what} needs three numbers x,y,z, got {text!r}", Location("ncpp predict"))
+    if not all(math.isfinite(v) for v in values):
+        raise NcppError(f"{what} needs three finite numbers x,y,z, got {text!r}", Location("ncpp predict"))
     return np.array(values)
 
 
@@ -95,17 +99,27 @@ def parse_targets(text: str):
     import numpy as np
 
     from ncpp.errors import Location, NcppError
+    from ncpp.instruments.forward import MAX_READINGS
 
+    where = Location("ncpp predict")
     try:
         if ":" in text:
             a, b, step = (float(v) for v in text.split(":"))
-            if step <= 0 or b < a:
+            if not (math.isfinite(a) and math.isfinite(b) and 0 < step < math.inf and a <= b):
                 raise ValueError
-            n = int(math.floor((b - a) / step + 1e-9))
-            return a + step * np.arange(n + 1)
-        return np.array(sorted(float(v) for v in text.split(",") if v.strip()))
+            count = math.floor((b - a) / step + 1e-9) + 1
+            if count > MAX_READINGS:  # before the array is made
+                raise NcppError(f"--targets {text}: {count:,} targets; at most {MAX_READINGS:,}", where)
+            targets = a + step * np.arange(count)
+        else:
+            targets = np.array(sorted(float(v) for v in text.split(",") if v.strip()))
+            if not np.all(np.isfinite(targets)):
+                raise ValueError
     except ValueError:
-        raise NcppError(f"--targets: expected A:B:STEP (A <= B, STEP > 0) or a,b,c, got {text!r}", Location("ncpp predict")) from None
+        raise NcppError(f"--targets: expected A:B:STEP (A <= B, STEP > 0) or a,b,c, finite, got {text!r}", where) from None
+    if np.any(np.diff(np.unique(targets)) < 1e-3):  # ISO 230-2 matches targets to 1 µm
+        raise NcppError(f"--targets {text}: targets closer than 1 µm are one target", where)
+    return targets
 
 
 def _middle(machine, axis: str) -> float:
@@ -154,10 +168,10 @@ def setup_from_args(args: argparse.Namespace, machine) -> dict[str, object]:
         return {
             **common, "radius_mm": args.radius or 150.0, "feed_mm_min": args.feed or 1000.0,
             "directions": directions[args.direction or "BOTH"], "start_deg": args.start,
-            "overshoot_deg": args.overshoot, "step_deg": args.step or 1.0,
+            "overshoot_deg": args.overshoot, "step_deg": _circle_step(args, 1.0),
         }  # fmt: skip
     if inst == "grid":
-        step = {"step_mm": args.step or 5.0} if args.path == "square" else {"step_deg": args.step or 2.0}
+        step = {"step_mm": args.step or 5.0} if args.path == "square" else {"step_deg": _circle_step(args, 2.0)}
         return {
             **common, "path": args.path, "radius_mm": args.radius or 100.0, "feed_mm_min": args.feed or 1000.0,
             "directions": directions[args.direction or "CCW"], "start_deg": args.start, "overshoot_deg": args.overshoot, **step,
@@ -166,8 +180,22 @@ def setup_from_args(args: argparse.Namespace, machine) -> dict[str, object]:
         raise NcppError("a cutting test cuts one direction: --direction CW or CCW", Location("ncpp predict"))
     return {
         **common, "radius_mm": args.radius or 50.0, "feed_mm_min": args.feed or 500.0,
-        "direction": args.direction or "CCW", "probe_step_deg": args.step or 2.0,
+        "direction": args.direction or "CCW", "probe_step_deg": _circle_step(args, 2.0),
     }  # fmt: skip
+
+
+def _circle_step(args: argparse.Namespace, default: float) -> float:
+    """--step of a circular test (deg), or its default."""
+    from ncpp.errors import Location, NcppError
+    from ncpp.instruments.forward import MAX_CIRCLE_STEP_DEG
+
+    step = args.step or default
+    if step > MAX_CIRCLE_STEP_DEG:
+        raise NcppError(
+            f"--step {step:g}: a circular test needs three points a revolution (step <= {MAX_CIRCLE_STEP_DEG:g} deg)",
+            Location("ncpp predict"),
+        )
+    return step
 
 
 def machine_from_args(args: argparse.Namespace):
@@ -176,12 +204,16 @@ def machine_from_args(args: argparse.Namespace):
 
     if args.machine:
         return load_machine(args.machine)
+    from ncpp.errors import Location, NcppError
     from ncpp.identify import fit_machine
     from ncpp.instruments.files import read_measurement
 
     base = load_machine(args.base) if args.base else None
     measurements = [read_measurement(p) for p in args.sources]
-    return fit_machine(measurements, base=base, chain=args.chain)
+    try:
+        return fit_machine(measurements, base=base, chain=args.chain)
+    except ValueError as err:  # as `ncpp fit` reports it (a bad --chain)
+        raise NcppError(str(err), Location("ncpp predict")) from None
 
 
 def run(args: argparse.Namespace) -> int:

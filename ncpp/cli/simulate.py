@@ -13,6 +13,7 @@ import math
 
 from ncpp.cli.compensate import add_placement_arguments, work_offsets
 from ncpp.cli.io import add_dialect_argument
+from ncpp.cli.options import between
 from ncpp.errors import Location, NcppError, Warnings
 
 
@@ -23,12 +24,9 @@ MIN_STEP_MM = 0.001
 def step_mm(text: str) -> float:
     """--step: a finite number of mm, at least MIN_STEP_MM."""
     try:
-        value = float(text)
-    except ValueError:
-        value = math.nan
-    if not MIN_STEP_MM <= value < math.inf:
-        raise argparse.ArgumentTypeError(f"expected a number of mm from {MIN_STEP_MM} on, got {text!r}")
-    return value
+        return between(MIN_STEP_MM, math.inf, "[)")(text)
+    except argparse.ArgumentTypeError:
+        raise argparse.ArgumentTypeError(f"expected a number of mm from {MIN_STEP_MM} on, got {text!r}") from None
 
 
 def register(sub: argparse._SubParsersAction) -> None:

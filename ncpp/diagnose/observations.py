@@ -29,6 +29,7 @@ from ncpp.machine.components import AXES
 from ncpp.machine.effects import Effect
 from ncpp.machine.model import Machine
 from ncpp.instruments.forward import iso230_2_cycle
+from ncpp.instruments.iso230_4 import circular_test
 from ncpp.machine.trajectory import Trajectory
 
 BALLBAR_STEP_DEG = 0.25  # simulation step; the file's angles are interpolated from it
@@ -114,6 +115,7 @@ def observe(machine: Machine, m: Measurement, name: str = "") -> Observation:
 def _ballbar(machine: Machine, m: Measurement, name: str) -> Observation:
     if m.radius_mm is None:
         raise NcppError("ballbar file without radius_mm", Location(m.source))
+    circular_test(m)  # refuses what analyze refuses (fewer than three points a direction)
     centre = m.center_mm if m.center_mm is not None else np.zeros(3)
     radius = m.radius_mm
     first, second = (AXES.index(a) for a in PLANES[m.plane])
@@ -175,7 +177,7 @@ def _positioning(machine: Machine, m: Measurement, name: str) -> Observation:
     runs = int(np.max(m["run"]))
     both = set(m["direction"]) == {"+", "-"}
     traj, at, labels = iso230_2_cycle(axis, targets, runs, both, m.fixed, m.feed_mm_min or 1000.0, OVERTRAVEL_MM)
-    key = {(round(t, 6), int(r), d): i for i, (t, r, d) in enumerate(labels)}
+    key = {(round(float(t), 6), int(r), d): i for i, (t, r, d) in enumerate(labels)}  # float(t): numpy's round may differ
     sample = np.array([
         at[key[(round(float(t), 6), int(r), str(d))]] for t, r, d in zip(m["target_mm"], m["run"], m["direction"])
     ])  # fmt: skip

@@ -9,6 +9,10 @@ limits; the same sentences are in the file as comments.
 
 from __future__ import annotations
 
+import math
+
+import numpy as np
+
 from ncpp.errors import NcppError
 from ncpp.export.common import AxisError, axis_error
 from ncpp.machine import Machine
@@ -26,7 +30,12 @@ def export_table(
     reference: float | None = None,
 ) -> tuple[str, list[str]]:
     """The table text for `axis` in controller format `fmt`, and the notes."""
+    if spacing is not None and not 0 < spacing < math.inf:
+        raise NcppError(f"--spacing must be a positive number of mm, not {spacing!r}")
+    if reference is not None and not math.isfinite(reference):
+        raise NcppError(f"--reference must be a finite number of mm, not {reference!r}")
     error = axis_error(machine, axis)
+    _check_size(machine, error)
     if fmt == "linuxcnc":
         from ncpp.export.linuxcnc import write_linuxcnc_comp
 
@@ -40,12 +49,28 @@ def export_table(
 
         a = error.axis
         transverse = [axis_error(machine, a, f"E{j}{a}") for j in "XYZ" if j != a and f"E{j}{a}" in machine.components]
+        for t in transverse:
+            _check_size(machine, t)
         return write_sinumerik(error, transverse, spacing=spacing, reference=reference)
     if fmt == "heidenhain":
         from ncpp.export.heidenhain import write_heidenhain_com
 
         return write_heidenhain_com(error, spacing=spacing)
     raise NcppError(f"unknown format {fmt!r}: use one of {', '.join(FORMATS)}")
+
+
+def _check_size(machine: Machine, error: AxisError) -> None:
+    """A controller applies a table's values as corrections: the machine file bounds
+    those (max_correction_mm), as `ncpp compensate` does."""
+    own = error.own_positions()
+    x = np.linspace(error.lo, error.hi, 2001) if own is None else np.union1d(np.linspace(error.lo, error.hi, 2001), own)
+    values = np.concatenate([error.forward(x), error.reverse(x)])
+    worst = int(np.argmax(np.where(np.isfinite(values), np.abs(values), np.inf)))
+    if not abs(values[worst]) <= machine.max_correction_mm:
+        raise NcppError(
+            f"{error.name} reaches {values[worst]:.4g} mm at {error.axis} = {x[worst % len(x)]:g} mm, more than the "
+            f"machine file's max_correction_mm = {machine.max_correction_mm:g} mm that a table may correct"
+        )
 
 
 __all__ = ["FORMATS", "AxisError", "axis_error", "export_table"]

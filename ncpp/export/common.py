@@ -107,7 +107,7 @@ def uniform_grid(
     if spacing is None:
         step = finest
     else:
-        if spacing <= 0:
+        if not 0 < spacing < math.inf:
             raise NcppError("--spacing must be positive")
         step = spacing
         if spacing < finest:

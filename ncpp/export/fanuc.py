@@ -62,6 +62,10 @@ def write_fanuc_pitch(
     `reference_number` is 3620; by default the lowest that keeps every
     section number >= 0."""
     notes: list[str] = []
+    if spacing is not None and not 0 < spacing < math.inf:
+        raise NcppError(f"--spacing must be a positive number of mm, not {spacing!r}")
+    if not math.isfinite(reference):
+        raise NcppError(f"--reference must be a finite number of mm, not {reference!r}")
     lo, hi = error.lo, error.hi
     if not lo <= reference <= hi:
         clipped = min(max(reference, lo), hi)
@@ -69,7 +73,9 @@ def write_fanuc_pitch(
         reference = clipped
     du = detection_unit
     span = hi - lo
-    finest = span / max_points  # max_points sections
+    # The sections from the reference outwards, each end rounded up, take up to span/interval + 2
+    # point numbers: so many, and no more, fit max_points (0 .. max_points - 1).
+    finest = span / (max_points - 2)
     interval = spacing if spacing is not None else max(finest, span / 64)  # 64 sections is a usual allocation
     if interval < finest:
         notes.append(f"FANUC: interval {interval:g} mm needs more than {max_points} points; widened")

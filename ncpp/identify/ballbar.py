@@ -144,6 +144,7 @@ class BallbarFit:
     smoothing: float  # λ
     effective_parameters: float  # tr H
     rms_um: float  # all files after the fit
+    by_gcv: bool = True  # λ chosen by GCV (else given)
 
     def block(self, name: str) -> tuple[Block, NDArray, NDArray]:
         """A block with its values and uncertainties."""
@@ -365,7 +366,10 @@ def fit_ballbar(
             raise NcppError(f"fit_ballbar takes ball-bar files, not {m.instrument}", Location(m.source))
     if knots < 2:
         raise NcppError("--knots must be at least 2", Location("ncpp fit"))
+    if smoothing is not None and not 0 < smoothing < np.inf:
+        raise NcppError(f"--smoothing must be a positive number, not {smoothing!r}", Location("ncpp fit"))
     obs = [observe(machine, m) for m in measurements]
+    _check_knots(measurements, knots)
     blocks = unknowns(obs, knots, fixed)
     if not blocks:
         raise NcppError("the ball-bar files move no axis whose errors could be fitted", Location(measurements[0].source))
@@ -396,6 +400,7 @@ def fit_ballbar(
     assert lam is not None
     # Statistics in noise units at the solution.
     e = _profiled(obs, r[:, None], sigma)[:, 0]
+    _check_converged(e, _profiled(obs, r0[:, None], sigma)[:, 0], lam, smoothing is None)
     trace = float(f @ np.sum(reg.AW**2, axis=0))
     s2 = float(e @ e) / max(n - trace, 1.0)
     G = reg.W * f  # θ = G (AW)ᵀ b
@@ -416,7 +421,38 @@ def fit_ballbar(
     kept = [b for b, s in zip(blocks, _slices(blocks)) if written[s].all()]
     fitted = _named(apply(machine, kept, theta[written]), blocks, null)
     return BallbarFit(
-        fitted, tuple(blocks), theta, u, groups, files, float(lam), trace, float(np.sqrt(np.mean(flat**2)))
+        fitted, tuple(blocks), theta, u, groups, files, float(lam), trace, float(np.sqrt(np.mean(flat**2))),
+        by_gcv=smoothing is None,
+    )
+
+
+def _check_knots(measurements: Sequence[Measurement], knots: int) -> None:
+    """A table cannot have more values than the positions its axis is read at (1 µm
+    apart): the values between readings would be set by the penalty alone."""
+    read: dict[str, set[float]] = {}
+    for m in measurements:
+        centre = m.center_mm if m.center_mm is not None else np.zeros(3)
+        theta = np.radians(m["angle_deg"])
+        for axis, along in zip(m.plane_axes, (np.cos(theta), np.sin(theta))):
+            read.setdefault(axis, set()).update(np.round(centre[AXES.index(axis)] + m.radius_mm * along, 3))
+    most = max(len(positions) for positions in read.values())
+    if knots > most:
+        raise NcppError(
+            f"--knots {knots}: the ball-bar files read an axis at {most} positions at most; "
+            f"a table cannot have more values than that", Location("ncpp fit"),
+        )  # fmt: skip
+
+
+def _check_converged(after: NDArray, before: NDArray, lam: float, by_gcv: bool) -> None:
+    """A least-squares fit explains the files at least as well as no change (up to a
+    little nonlinearity); worse, the steps diverged: λ too small to hold the tables."""
+    if after @ after <= 1.01 * (before @ before):
+        return
+    hint = "" if by_gcv else " (leave out --smoothing to choose λ by GCV)"
+    raise NcppError(
+        f"the ball-bar fit diverged: its residual is {np.sqrt(np.mean(after**2)):.3g} noise units, "
+        f"{np.sqrt(np.mean(before**2)):.3g} without it; smoothing λ = {lam:.3g} is too small{hint}",
+        Location("ncpp fit"),
     )
 
 
@@ -515,7 +551,8 @@ def _hint(blocks: Sequence[Block], null: NDArray, cols: NDArray) -> str:
 def account(fit: BallbarFit) -> str:
     """The printed account: files, each parameter ± uncertainty, what cannot be separated."""
     lines = [f"ball-bar fit: {len(fit.files)} file(s), {sum(b.size for b in fit.blocks)} parameters "
-             f"({fit.effective_parameters:.1f} effective), smoothing λ = {fit.smoothing:.3g} (GCV), "
+             f"({fit.effective_parameters:.1f} effective), smoothing λ = {fit.smoothing:.3g} "
+             f"({'GCV' if fit.by_gcv else 'given'}), "
              f"rms after {fit.rms_um:.3f} µm"]  # fmt: skip
     lines.append("  file                                  set-up                               noise   rms before → after (µm)")
     for f in fit.files:

@@ -121,11 +121,20 @@ def sources_of(m: Measurement, chain: str) -> list[Source]:
             )
     except (KeyError, ValueError) as err:
         raise NcppError(str(err), where) from None
+    _check_targets(m)
     for s in found:
         info = COMPONENTS.get(s.component)
         if info is None or info.axis != axis:
             raise NcppError(f"component {s.component} is not an error of the measured axis {axis}", where)
     return found
+
+
+def _check_targets(m: Measurement) -> None:
+    """A table is a curve along its axis: one target (to 1 µm) would set the whole axis."""
+    column, what = ("position_mm", "positions") if m.instrument == "level" else ("target_mm", "targets")
+    count = len(np.unique(np.round(m[column] * 1e3)))
+    if count < 2:
+        raise NcppError(f"a table needs readings at two or more {what}; the file has {count}", Location(m.source))
 
 
 def _level_sign(chain: str, member: str, axis: str) -> float:

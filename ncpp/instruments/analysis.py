@@ -112,7 +112,10 @@ def _positioning(m: Measurement) -> Analysis:
     if m.instrument == "comparator" and "transverse_um" in m.columns:
         transverse = _mean_profile(m, "transverse_um")
         profiles["transverse"] = transverse
-        figures |= {"straightness_um": transverse.straightness, "slope_um_per_m": transverse.line[0] * 1000.0}
+        if len(transverse.position_mm) >= 2:  # a line needs two targets; one target: no straightness (None)
+            figures |= {"straightness_um": transverse.straightness, "slope_um_per_m": transverse.line[0] * 1000.0}
+        else:
+            figures |= {"straightness_um": None, "slope_um_per_m": None}
     return Analysis(m, "ISO 230-2", _clean(figures), positioning=result, profiles=profiles)
 
 
@@ -123,9 +126,17 @@ def _mean_profile(m: Measurement, column: str) -> Profile:
     return Profile(result.targets[ok], result.mean[ok])
 
 
+def _line_fits(m: Measurement, profile: Profile, what: str, where: str = "targets") -> Profile:
+    """`profile`, to which a line is fitted: that needs two positions (NcppError if not)."""
+    count = len(np.unique(profile.position_mm))
+    if count < 2:
+        raise NcppError(f"a {what} profile needs at least two {where}; the file has {count}", Location(m.source))
+    return profile
+
+
 def _laser_profile(m: Measurement) -> Analysis:
     column = m.deviation_column
-    profile = _mean_profile(m, column)
+    profile = _line_fits(m, _mean_profile(m, column), m.quantity)
     result = iso230_2.evaluate_measurement(m, column)
     if m.quantity in ANGULAR_QUANTITIES:
         figures = {
@@ -145,7 +156,7 @@ def _laser_profile(m: Measurement) -> Analysis:
 def _level(m: Measurement) -> Analysis:
     order = np.argsort(m["position_mm"], kind="stable")
     x, incl = m["position_mm"][order], m["inclination_um_per_m"][order]
-    profile = Profile(x, incl)
+    profile = _line_fits(m, Profile(x, incl), f"level {m.quantity}", "positions")
     figures: dict[str, float | None] = {
         "range_um_per_m": profile.range,
         "mean_um_per_m": float(incl.mean()),

@@ -70,6 +70,17 @@ LASER_QUANTITIES = ("position", "straightness_x", "straightness_y", "straightnes
 ANGULAR_QUANTITIES = ("pitch", "yaw", "roll")
 LEVEL_QUANTITIES = ("roll", "pitch")
 
+# Targets are matched, and readings evaluated, to 1 µm: beyond 2**53 µm a double cannot hold 1 µm.
+MAX_LENGTH_UM = 2.0**53
+# An angle past half a turn is no angular error: a rotation vector beyond π names a smaller turn.
+MAX_ANGLE_URAD = math.pi * 1e6
+_RANGES = {  # column name ending: (largest magnitude, unit, what lies beyond)
+    "_mm": (MAX_LENGTH_UM / 1e3, "mm", "a number no longer resolves 1 µm"),
+    "_um": (MAX_LENGTH_UM, "µm", "a number no longer resolves 1 µm"),
+    "_urad": (MAX_ANGLE_URAD, "µrad", "(half a turn) a reading is no angular error"),
+    "_um_per_m": (MAX_ANGLE_URAD, "µm/m", "(half a turn) a reading is no angular error"),
+}
+
 _KEY_LINE = re.compile(r"#\s*([A-Za-z][A-Za-z0-9_]*)\s*:(.*)$")
 _REMARK = re.compile(r"\s+\(.*\)\s*$")
 
@@ -369,7 +380,18 @@ def _convert_column(
             raise fail(k, f"{name}: {value!r} is not a finite number")
         if name == "angle_deg" and not 0.0 <= numbers[k] < 360.0:
             raise fail(k, f"angle_deg must be in [0, 360), got {value}")
+        problem = _out_of_range(name, numbers[k])
+        if problem:
+            raise fail(k, f"{name}: {value} is out of range: {problem}")
     return numbers
+
+
+def _out_of_range(name: str, value: float) -> str | None:
+    """Why a length or angle column's value is beyond what the evaluations can use, or None."""
+    for ending, (limit, unit, beyond) in _RANGES.items():
+        if name.endswith(ending) and abs(value) > limit:
+            return f"beyond ±{limit:.4g} {unit} {beyond}"
+    return None
 
 
 def _check_meta(m: Measurement, header_line: int, meta_lines: Mapping[str, int]) -> None:
@@ -387,6 +409,9 @@ def _check_meta(m: Measurement, header_line: int, meta_lines: Mapping[str, int])
         wanted = "deviation_urad" if quantity in ANGULAR_QUANTITIES else "deviation_um"
         if wanted not in m.columns:
             raise NcppError(f"a laser {quantity} file has the column {wanted}", where)
+        component, angles = m.text("component"), [f"E{r}{m.axis or 'X'}" for r in "ABC"]
+        if quantity in ANGULAR_QUANTITIES and component and component.upper() not in angles:
+            raise NcppError(f"component must be an angle of the axis, {', '.join(angles)}; got {component!r}", at("component"))
     if m.instrument == "level" and m.quantity not in LEVEL_QUANTITIES:
         raise NcppError(f"level quantity must be roll or pitch, got {m.quantity!r}", at("quantity"))
     if m.instrument in ("ballbar", "grid", "cutting"):

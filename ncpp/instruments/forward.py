@@ -66,6 +66,9 @@ ANGLE_COMPONENTS: dict[tuple[str, str], str] = {
 }  # fmt: skip
 INSTRUMENTS = ("laser", "comparator", "level", "ballbar", "grid", "cutting")
 DWELL_S = 0.5  # standstill per stop of a positioning cycle (the reading is taken there)
+# Readings (path points) of one prediction: a million take seconds and half a GB; no real test has as many.
+MAX_READINGS = 1_000_000
+MAX_CIRCLE_STEP_DEG = 120.0  # a circular test needs three points a revolution (iso230_4.circular_test)
 
 
 # --------------------------------------------------------------------------- helpers
@@ -128,6 +131,12 @@ def _points(fixed: Mapping[str, float], axis: str, values: ArrayLike) -> NDArray
     return P
 
 
+def _check_count(count: int, what: str) -> None:
+    """Refuse a prediction of more than MAX_READINGS readings before it is built."""
+    if count > MAX_READINGS:
+        raise ValueError(f"{what}: {count:,} readings; at most {MAX_READINGS:,}")
+
+
 def _noise(values: NDArray, noise: float, rng: np.random.Generator) -> NDArray:
     return values + rng.normal(0.0, noise, values.shape) if noise > 0 else values
 
@@ -186,6 +195,8 @@ def _positioning_readings(
         raise ValueError("no targets")
     if runs < 1:
         raise ValueError("runs must be at least 1")
+    directions = 2 if bidirectional else 1
+    _check_count(targets.size * runs * directions, f"{targets.size} targets × {runs} runs × {directions} direction(s)")
     m = functional_point(machine, offset_mm)
     if not effects:
         m = m.replace(effects=())
@@ -208,6 +219,18 @@ def _angular_effects(machine: Machine, P: NDArray) -> NDArray:
             i = AXES.index(info[2])
             out[:, "ABC".index(info[1])] += effect.urad_per_m * 1e-9 * (P[:, i] - effect.ref_mm)
     return out
+
+
+def _laser_component(axis: str, quantity: str, component: str | None) -> str:
+    """The ISO component a laser reads: `component` may name another angle of the axis."""
+    name = reading_component(axis, quantity)
+    if component is None or component.upper() == name:
+        return name
+    angles = [f"E{r}{axis}" for r in "ABC"]
+    if quantity not in ("pitch", "yaw", "roll") or component.upper() not in angles:
+        allowed = f"one of {', '.join(angles)}" if quantity in ("pitch", "yaw", "roll") else name
+        raise ValueError(f"component {component!r} is not what a laser reads for {quantity} of {axis}: use {allowed}")
+    return component.upper()
 
 
 def _layout_columns(labels: list[tuple[float, int, str]]) -> dict[str, object]:
@@ -243,8 +266,8 @@ def predict_laser(
     Readings are µm (µrad for angles), zeroed at the first reading when `zero`."""
     axis = _axis_name(axis)
     fixed = parse_fixed(fixed)
-    name = component.upper() if component else reading_component(axis, quantity)
     angular = quantity in ("pitch", "yaw", "roll")
+    name = _laser_component(axis, quantity, component)
     values, labels = _positioning_readings(
         machine, axis, targets, runs, bidirectional, fixed, offset_mm, feed_mm_min, overtravel_mm, effects, angular
     )
@@ -344,8 +367,16 @@ def _circle_commands(
     """Command points of one direction of a circular test with lead-in and
     lead-out arcs: (positions (n,3), angle of each point in deg, mask of the data arc)."""
     sign = {"CCW": 1.0, "CW": -1.0}[direction]
+    if not radius > 0:
+        raise ValueError(f"radius must be positive, not {radius:g}")
+    if not (np.all(np.isfinite(centre)) and np.isfinite(start_deg)):
+        raise ValueError("the centre and the start angle must be finite numbers")
+    _check_step(step_deg)
+    if not 0.0 <= overshoot_deg <= 360.0:
+        raise ValueError(f"overshoot must be 0 to 360 deg (a feed-in arc of up to a turn), not {overshoot_deg:g}")
     n_rev = int(round(360.0 / step_deg))
     n_over = int(round(overshoot_deg / step_deg))
+    _check_count(n_rev + 2 * n_over + 1, f"a step of {step_deg:g} deg and {overshoot_deg:g} deg of overshoot")
     index = np.arange(-n_over, n_rev + n_over + 1)
     angle = start_deg + sign * index * (360.0 / n_rev)
     first, second = (AXES.index(a) for a in PLANES[plane])
@@ -353,6 +384,13 @@ def _circle_commands(
     P[:, first] += radius * np.cos(np.radians(angle))
     P[:, second] += radius * np.sin(np.radians(angle))
     return P, angle, (index >= 0) & (index < n_rev)
+
+
+def _check_step(step_deg: float) -> None:
+    if not 0.0 < step_deg <= MAX_CIRCLE_STEP_DEG:
+        raise ValueError(
+            f"step {step_deg:g} deg: a circular test needs three points a revolution (0 < step <= {MAX_CIRCLE_STEP_DEG:g} deg)"
+        )
 
 
 def _simulated_deviation(machine: Machine, P: NDArray, feed_mm_min: float, effects: bool) -> NDArray:
@@ -428,7 +466,10 @@ def _square_commands(plane: str, centre: NDArray, half: float, direction: str, s
     corners = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1], [-1, -1]], dtype=float) * half
     if direction == "CW":
         corners = corners[::-1]
+    if not (half > 0 and step_mm > 0):
+        raise ValueError("the square's size and step must be positive")
     n = max(1, int(round(2 * half / step_mm)))
+    _check_count(4 * n + 1, f"a step of {step_mm:g} mm along a side of {2 * half:g} mm")
     s = np.arange(n) / n
     pq = np.vstack([a + s[:, None] * (b - a) for a, b in zip(corners[:-1], corners[1:])] + [corners[-1:]])
     first, second = (AXES.index(a) for a in PLANES[plane])
@@ -522,6 +563,8 @@ def predict_cutting(
     plane = _check_plane(plane)
     direction = _directions(direction)[0]
     centre = np.asarray(center_mm, dtype=float)
+    _check_step(probe_step_deg)
+    _check_count(int(360.0 / probe_step_deg) + 1, f"a probe step of {probe_step_deg:g} deg")
     m = functional_point(machine, offset_mm)
     P, _, data = _circle_commands(plane, centre, radius_mm, direction, 0.0, overshoot_deg, 0.25)
     d = _simulated_deviation(m, P, feed_mm_min, effects) - m.deviation(centre)

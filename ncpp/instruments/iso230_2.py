@@ -37,7 +37,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ncpp.errors import Location, NcppError
-from ncpp.instruments.files import Measurement
+from ncpp.instruments.files import MAX_LENGTH_UM, Measurement
 
 SYMBOLS = ("A", "A_up", "A_down", "E", "E_up", "E_down", "M", "B", "B_mean", "R", "R_up", "R_down")
 
@@ -174,7 +174,9 @@ def evaluate_positioning(target_mm: np.ndarray, direction: np.ndarray, deviation
     deviation = np.asarray(deviation, dtype=float)
     if target_mm.size == 0:
         raise ValueError("no readings")
-    keys = np.round(target_mm * 1e3).astype(np.int64)  # match targets to 1 µm
+    if not np.all(np.abs(target_mm) <= MAX_LENGTH_UM / 1e3):  # (read files are checked so: files.py)
+        raise ValueError(f"targets must be finite and within ±{MAX_LENGTH_UM / 1e3:.4g} mm, where 1 µm is resolved")
+    keys = np.round(target_mm * 1e3).astype(np.int64)  # match targets to 1 µm (fits: |keys| <= 2**53)
     unique, index = np.unique(keys, return_inverse=True)
     targets = np.bincount(index, weights=target_mm) / np.bincount(index)
     return Iso230_2(

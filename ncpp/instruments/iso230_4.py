@@ -69,6 +69,10 @@ from ncpp.instruments.files import PLANES, Measurement
 
 SYMBOLS = ("G", "G_cw", "G_ccw", "H", "F_max", "F_min")
 SIGN = {"CCW": 1.0, "CW": -1.0}
+SPIKE_SPAN = 8  # a spike is cut off after 8 widths of travel (_spike)
+# The widest spike that dies out before the same axis reverses again, 180° later: wider, the
+# spikes of the two reversals overlap and a very wide one is the constant the set-up takes.
+MAX_SPIKE_WIDTH_DEG = 180.0 / SPIKE_SPAN
 
 
 @dataclass(frozen=True, eq=False)
@@ -267,7 +271,7 @@ class Diagnosis:
 
 def _spike(theta: np.ndarray, sigma: float, reversal_deg: float, width_deg: float) -> np.ndarray:
     travel = (sigma * (np.degrees(theta) - reversal_deg)) % 360.0
-    return np.where(travel < 8 * width_deg, np.exp(-travel / width_deg), 0.0)
+    return np.where(travel < SPIKE_SPAN * width_deg, np.exp(-travel / width_deg), 0.0)
 
 
 def _features(t: Trace, width_deg: float) -> dict[str, np.ndarray]:
@@ -341,6 +345,8 @@ def diagnose_circular(test: CircularTest, spike_width_deg: float = 3.0) -> Diagn
     A cyclic (ball-screw lead) error per axis is added to the model when one of
     the usual leads (`SCREW_LEADS_MM`, up to R/2) shows clearly: δp = c·sin(2π p/P + φ),
     reported as `cyclic_<axis>_um` (amplitude c) and `cyclic_<axis>_period_mm`."""
+    if not 0 < spike_width_deg <= MAX_SPIKE_WIDTH_DEG:
+        raise ValueError(f"spike width must be in (0, {MAX_SPIKE_WIDTH_DEG:g}] deg, not {spike_width_deg!r}")
     R = test.radius_mm
     bidirectional = len({t.direction for t in test.traces}) == 2
     shared = ["cos2", "sin2", "backlash_p", "backlash_q", "spike_p", "spike_q"] + (["servo"] if bidirectional else [])
