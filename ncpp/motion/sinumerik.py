@@ -114,10 +114,12 @@ class SinumerikInterpreter(ModalInterpreter):
         frame: Statement | None = None
         end = False
         tool_words: list = []  # the block's T, M6 and D words, in order
+        previous = None
         for item in block.items:
             kind = type(item)
             if kind is Comment:
                 continue
+            before, previous = previous, item
             if kind is Statement:
                 what = item.kind
                 if what == "assignment":
@@ -139,6 +141,8 @@ class SinumerikInterpreter(ModalInterpreter):
                 continue
             if kind is Word:
                 letter, value, mode = item.letter, item.value, None
+                if letter == "E" and type(before) is not Word and before is not None and before.end == item.start:
+                    self._exponent(block, before, item)
             else:
                 letter, (value, mode) = item.letter, self._word_value(item, block)
             if letter == "G":
@@ -172,6 +176,12 @@ class SinumerikInterpreter(ModalInterpreter):
         if end:
             self.done = True
         return events
+
+    def _exponent(self, block: Block, expression, word: Word) -> None:
+        """Refuse `X=1e3`: the grammar reads `X=1` and an address E, as a Sinumerik would."""
+        value, written = block.raw[expression.start : word.start], block.raw[word.start : word.end]
+        self.fail(f"{value}{written}: a Sinumerik writes an exponent as EX ({value}EX{word.number}); "
+                  f"as written this is {value} and an address E", block, word)  # fmt: skip
 
     # -- tool lengths -----------------------------------------------------------------------
     def _place_tool(self, block: Block, tool_words: list) -> None:

@@ -128,3 +128,30 @@ def test_bad_input_names_file_line_and_column():
     with pytest.raises(NcppError) as err:
         list(parse_stream(io.BytesIO(b"G1 X1\r\nIF\r\n"), "bad.mpf", "sinumerik"))
     assert str(err.value).startswith("bad.mpf:2:")
+
+
+@pytest.mark.parametrize(
+    "block, column, message",
+    [
+        ("G1 X=1e3 Y10", 7, "X=1e3: a Sinumerik writes an exponent as EX (X=1EX3); as written this is X=1 and an address E"),
+        ("G1 X=2*1E-3", 9, "X=2*1E-3: a Sinumerik writes an exponent as EX (X=2*1EX-3)"),
+        ("R1=5e2", 5, "R1=5e2: a Sinumerik writes an exponent as EX (R1=5EX2)"),
+    ],
+)
+def test_an_exponent_written_with_e_is_refused_not_read_as_an_address(block, column, message):
+    """`X=1e3` parses as `X=1` and a word E3 (as on the control, where E is no exponent): moving
+    to X1 would be a silently wrong program."""
+    from ncpp.motion.sinumerik import interpret
+
+    blocks = parse_stream(io.BytesIO(f"G0 X100\n{block}\nM30\n".encode()), "e.mpf", "sinumerik")
+    with pytest.raises(NcppError) as err:
+        list(interpret(blocks, file="e.mpf"))
+    assert (err.value.where.line, err.value.where.col) == (2, column) and message in str(err.value)
+
+
+def test_an_exponent_written_with_ex_is_a_number():
+    from ncpp.motion.sinumerik import interpret
+
+    blocks = parse_stream(io.BytesIO(b"G0 X100\nG1 X=1EX2 F100\nX=1 E3\nM30\n"), "e.mpf", "sinumerik")
+    ends = [e.end[0] for e in interpret(blocks, file="e.mpf") if hasattr(e, "end")]
+    assert ends == [100.0, 100.0, 1.0]  # `X=1 E3` apart: an address E, as the control reads it
