@@ -128,6 +128,43 @@ class _Circle:
         )
 
 
+# Numbers an F or S word takes on a control (Fanuc and LinuxCNC: up to 8 digits before the point)
+MAX_WORD = 99_999_999.0
+
+
+def feed_rate(rec: Record) -> float:
+    """FEDRAT/f: a feed above 0 (a negative one was written as an F word; 0 stops no move)."""
+    f = rec.numbers[0]
+    if not 0 < f <= MAX_WORD:
+        raise NcppError(f"{rec.major}: expected a feed rate above 0 and at most {MAX_WORD:,.0f}, got {f:g}", rec.where)
+    return f
+
+
+def spindle_speed(rec: Record) -> float:
+    """SPINDL/n: a speed from 0 on (the direction is CLW or CCLW, not a sign)."""
+    n = rec.numbers[0]
+    if not 0 <= n <= MAX_WORD:
+        raise NcppError(f"{rec.major}: expected a spindle speed from 0 to {MAX_WORD:,.0f} (turning CLW or CCLW), got {n:g}", rec.where)
+    return n
+
+
+def _unit(vector: tuple[float, ...]) -> tuple[float, ...]:
+    """The tool vector's direction (CL data need not give a unit vector); zero stays zero."""
+    length = math.sqrt(sum(v * v for v in vector))
+    return tuple(v / length for v in vector) if length > 0 else tuple(vector)
+
+
+def _check_along_z(vector: tuple[float, ...], rec: Record) -> None:
+    """A 3-axis machine holds its tool along +Z: CL data for a tool along another vector
+    (a horizontal spindle, a tilted head) puts the tool's length elsewhere."""
+    if not all(abs(v - z) <= AXIS_TOL for v, z in zip(_unit(vector), (0.0, 0.0, 1.0))):
+        raise NcppError(
+            f"the tool vector ({', '.join(f'{v:g}' for v in vector)}) is not along +Z: "
+            "the post drives a 3-axis machine whose tool points along Z (0, 0, 1)",
+            rec.where,
+        )
+
+
 def motion(records: Iterable[Record], warnings: Warnings | None = None, zero: Point = (0.0, 0.0, 0.0)) -> Iterator[Event]:
     """Line / Arc / Pass events of a CL record stream; `zero`: the machine position (mm)
     of the CL data's origin, the work offset the control will hold."""
@@ -156,9 +193,10 @@ def motion(records: Iterable[Record], warnings: Warnings | None = None, zero: Po
             if len(values) not in (3, 6):
                 raise NcppError(f"GOTO needs 3 coordinates (or 6 with a tool vector), got {len(values)}", rec.where)
             if len(values) == 6 or multax:
-                vector = values[3:6] if len(values) == 6 else None
+                vector = _unit(values[3:6]) if len(values) == 6 else None
                 if vector is not None:
                     if tool_vector is None:
+                        _check_along_z(vector, rec)
                         tool_vector, vector_line = vector, rec.line
                     elif max(abs(a - b) for a, b in zip(vector, tool_vector)) > VECTOR_TOL:
                         raise NcppError(
@@ -199,16 +237,17 @@ def motion(records: Iterable[Record], warnings: Warnings | None = None, zero: Po
         elif major == "RAPID":
             rapid_next = True
         elif major == "FEDRAT" and rec.numbers:
-            feed = rec.numbers[0]
+            feed = feed_rate(rec)
         elif major == "UNITS":
             inch = units_inch(rec)
             context = replace(context, inch=inch, offset=tuple(v / 25.4 for v in zero) if inch else zero)  # program units
         elif major == "MULTAX":
             multax = not (rec.words and rec.words[0] == "OFF")
         elif major == "TLAXIS" and len(rec.numbers) >= 3:
-            vector = rec.numbers[:3]
+            vector = _unit(rec.numbers[:3])
             if tool_vector is not None and max(abs(a - b) for a, b in zip(vector, tool_vector)) > VECTOR_TOL:
                 raise NcppError("TLAXIS changes the tool vector: 5-axis motion cannot be posted for a 3-axis machine", rec.where)
+            _check_along_z(vector, rec)
             tool_vector, vector_line = vector, rec.line
         elif rec.vendor and warnings is not None:
             warnings.warn(f"{major}/ is not understood; passed through as a comment", rec.where)

@@ -14,7 +14,7 @@ import re
 from dataclasses import dataclass
 from typing import Callable, Iterable, Iterator
 
-from ncpp.cldata.motion import units_inch
+from ncpp.cldata.motion import spindle_speed, units_inch
 from ncpp.cldata.reader import Record
 from ncpp.errors import Location, NcppError, Warnings
 from ncpp.motion.segments import PLANE_AXES, Arc, Event, Line, Pass, Point, replace
@@ -178,7 +178,7 @@ class Generator:
             if "ON" in words:
                 yield from self.emit_m(3)
             return
-        yield from self.emit_spindle(numbers[0], "CCLW" not in words)
+        yield from self.emit_spindle(spindle_speed(rec), "CCLW" not in words)
 
     # -- helpers for dialects ----------------------------------------------------
     @property

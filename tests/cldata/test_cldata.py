@@ -117,6 +117,27 @@ def test_constant_tool_vector_posts_changing_vector_is_refused():
     assert err.value.where.line == 3 and "line 2" in err.value.message
 
 
+@pytest.mark.parametrize(
+    "cl, line",
+    [
+        ("MULTAX\nGOTO/0,0,5,1,0,0\n", 2),  # a horizontal spindle
+        ("MULTAX\nGOTO/0,0,5,0,0,-1\n", 2),  # the tool pointing up
+        ("MULTAX\nGOTO/0,0,5,0,0,0\n", 2),  # no vector
+        ("TLAXIS/0,0.6,0.8\nGOTO/0,0,5\n", 1),
+    ],
+)
+def test_a_tool_vector_not_along_z_is_refused(cl, line):
+    """A 3-axis post drives a tool along +Z: posting CL data for another tool axis as is would
+    put the tool's length, and so the part, elsewhere."""
+    with pytest.raises(NcppError, match="is not along [+]Z") as err:
+        events_of(cl)
+    assert err.value.where.line == line
+
+
+def test_a_tool_vector_along_z_of_any_length_posts():
+    assert sum(isinstance(e, Line) for e in events_of("MULTAX\nGOTO/0,0,5,0,0,2\nTLAXIS/0,0,1\nGOTO/1,0,5\n")) == 2
+
+
 def test_vendor_words_pass_with_a_warning():
     out = io.StringIO()
     events = events_of((CORPUS / "rybakov25/test.apt").read_text(), Warnings(stream=out))

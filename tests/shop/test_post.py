@@ -167,6 +167,10 @@ def test_multi_turn_helix_splits_into_single_turns_keeping_the_pitch():
         ("LOADTL / 1.5", r"p\.cls:1:1: LOADTL: expected a tool number"),
         ("LOADTL / abc", r"p\.cls:1:1: LOADTL: expected a tool number"),
         ("LOADTL / 1e300", r"p\.cls:1:1: LOADTL: expected a tool number"),
+        ("SPINDL / -1e308, CLW", r"p\.cls:1:1: SPINDL: expected a spindle speed from 0"),
+        ("SPINDL / -1200, CCLW", r"p\.cls:1:1: SPINDL: expected a spindle speed from 0"),
+        ("FEDRAT / -100", r"p\.cls:1:1: FEDRAT: expected a feed rate above 0"),
+        ("FEDRAT / 0", r"p\.cls:1:1: FEDRAT: expected a feed rate above 0"),
     ],
 )
 def test_a_unit_or_tool_the_post_cannot_write_is_refused(record, message):
