@@ -46,6 +46,8 @@ from ncpp.machine.trajectory import Trajectory
 if TYPE_CHECKING:
     from ncpp.machine.model import Machine
 
+# The largest error a machine file may give, in its µm (a metre), µm/m or µrad/m
+LARGEST_ERROR = 1e6
 PLANE_TERMS = {"XY": (0, 1), "YZ": (1, 2), "ZX": (2, 0)}  # (deviating axis, driving axis)
 LATERAL_DEFAULT = {"X": "Y", "Y": "X", "Z": "X"}
 
@@ -93,11 +95,19 @@ def effect_from_dict(data: Mapping[str, Any]) -> Effect:
     if missing:
         raise ValueError(f"effect {kind}: missing key(s) {', '.join(missing)}")
     hints = typing.get_type_hints(cls)
-    return cls(**{k: _param(f"effect {kind}: {k}", hints[k], v) for k, v in params.items()})
+    return cls(**{k: _size(f"effect {kind}: {k}", k, _param(f"effect {kind}: {k}", hints[k], v)) for k, v in params.items()})
 
 
 def _is_number(value: Any) -> bool:
     return isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_)) and math.isfinite(value)
+
+
+def _size(what: str, key: str, value: Any) -> Any:
+    """An error's size (µm, µm/m, µrad/m) past LARGEST_ERROR is a typing error, not a machine's:
+    1e300 µm of backlash made simulations report 'inf µm'."""
+    if key.split("_")[0] in ("um", "urad") and isinstance(value, float) and not abs(value) <= LARGEST_ERROR:
+        raise ValueError(f"{what} must be within ±{LARGEST_ERROR:g} (an error of a metre is no machine's), not {value:g}")
+    return value
 
 
 def _param(what: str, hint: Any, value: Any) -> Any:

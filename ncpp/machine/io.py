@@ -80,7 +80,7 @@ from ncpp.errors import Location, NcppError
 from ncpp.fileio import write_text_atomic
 from ncpp.machine.chain import SMALL_ANGLE
 from ncpp.machine.components import AXES, COMPONENTS, SQUARENESS, Polynomial, Table, canonical_name
-from ncpp.machine.effects import effect_from_dict
+from ncpp.machine.effects import LARGEST_ERROR, effect_from_dict
 from ncpp.machine.model import Machine
 
 SECTIONS = {"machine", "offsets", "limits", "errors", "squareness", "effects", "compensation", "meta"}
@@ -368,6 +368,13 @@ def _small_angles(angles: Any, key: str) -> None:
         raise ValueError(f"{key} must be within {limit}, not {worst * 1e6:g}")
 
 
+def _small_lengths(errors: Any, key: str) -> None:
+    """Linear errors (mm) past LARGEST_ERROR µm are a typing error, not a machine's."""
+    worst = float(np.max(np.abs(errors), initial=0.0)) * 1e3
+    if not worst <= LARGEST_ERROR:
+        raise ValueError(f"{key} must be within ±{LARGEST_ERROR:g} µm (a metre), not {worst:g}")
+
+
 def _effects(data: dict, loc: _Locator) -> tuple:
     effects = data.get("effects", [])
     if not isinstance(effects, list):
@@ -472,8 +479,11 @@ def _table(spec: dict, unit: str) -> Table:
         None if minus is None else [v * scale for v in _numbers(minus, f"values_{unit}_minus")],
         spec.get("interpolation", "linear"),
     )
-    if unit == "urad":  # both interpolations stay within the tabulated values (PCHIP keeps their shape)
+    # both interpolations stay within the tabulated values (PCHIP keeps their shape)
+    if unit == "urad":
         _small_angles(table.values + (table.values_minus or ()), f"values_{unit}")
+    else:
+        _small_lengths(table.values + (table.values_minus or ()), f"values_{unit}")
     return table
 
 
@@ -491,8 +501,7 @@ def _polynomial(spec: dict, unit: str, travel: list[float] | None) -> Polynomial
             values = poly(np.linspace(*span, 101))
         if not np.all(np.isfinite(values)):
             raise ValueError(f"{key} overflow between {span[0]:g} and {span[1]:g} mm: they are too large")
-        if unit == "urad":
-            _small_angles(values, f"{key} between {span[0]:g} and {span[1]:g} mm")
+        (_small_angles if unit == "urad" else _small_lengths)(values, f"{key} between {span[0]:g} and {span[1]:g} mm")
     return poly
 
 

@@ -114,6 +114,11 @@ POLY_OVERFLOW = "coefficients_um = [" + ", ".join(["1e-3"] * 400) + "]"
         ("positions = [0.0, 400.0, 800.0]", 'positions = ["0", "400", "800"]', 14, "positions must be a finite number, not '0'"),
         ("values_urad = [5.0, 5.0]", "values_urad = [5.0, 2e4]", 25, "values_urad must be within ±10000 µrad"),
         ("[compensation]", "[errors.xx]\npositions = [0.0]\nvalues_um = [1.0]\n\n[compensation]", 41, "EXX is given twice, as EXX and xx"),
+        # errors of a metre and more are typing errors (1e300 µm of backlash simulated as 'inf µm')
+        ("um = 2.0", "um = 1e300", 39, "effects #2: effect straightness: um must be within ±1e+06"),
+        ("um_per_m = 5.0", "um_per_m = -2e6", 33, "effect scale: um_per_m must be within ±1e+06"),
+        ("values_um = [0.0, 2.0, 3.0]", "values_um = [0.0, 2e6, 3.0]", 15, "errors.EXX: values_um must be within ±1e+06 µm (a metre), not 2e+06"),
+        ("coefficients_um = [0.0, 0.01]", "coefficients_um = [0.0, 1e4]", 19, "coefficients_um between 0 and 500 mm must be within ±1e+06 µm"),
         # squareness: one value each, and a small angle
         ("C0Y_urad = 20.0", "C0Y_urad = 1e300", 28, "C0Y_urad must be within ±10000 µrad (the model's small angles), not 1e+300"),
         ("C0Y_urad = 20.0", "C0Y_urad = 20.0\nC0Y_um_per_m = 3.0", 29, "C0Y is given twice, as C0Y_urad and C0Y_um_per_m"),
