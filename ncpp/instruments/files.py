@@ -70,6 +70,8 @@ LASER_QUANTITIES = ("position", "straightness_x", "straightness_y", "straightnes
 ANGULAR_QUANTITIES = ("pitch", "yaw", "roll")
 LEVEL_QUANTITIES = ("roll", "pitch")
 
+# Runs of a positioning test: ISO 230-2 asks for 5; the diagnosis simulates every run up to the file's last
+MAX_RUNS = 1000
 # Targets are matched, and readings evaluated, to 1 µm: beyond 2**53 µm a double cannot hold 1 µm.
 MAX_LENGTH_UM = 2.0**53
 # An angle past half a turn is no angular error: a rotation vector beyond π names a smaller turn.
@@ -366,8 +368,8 @@ def _convert_column(
                 run = int(value)
             except ValueError:
                 raise fail(k, f"run must be a whole number counting from 1, got {value!r}") from None
-            if run < 1:
-                raise fail(k, f"run counts from 1, got {run}")
+            if not 1 <= run <= MAX_RUNS:
+                raise fail(k, f"run counts from 1 to {MAX_RUNS} (ISO 230-2 asks for 5), got {value}")
             runs.append(run)
         return np.array(runs, dtype=np.int64)
     numbers = np.empty(len(values))

@@ -114,6 +114,7 @@ def test_own_instruments_grid_and_cutting():
         (LASER.replace("50,1,+,1.8", "50,1,+"), 9, 1, "expected 4 columns"),
         (LASER.replace("50,1,-,2.4", "50,1,up,2.4"), 10, 6, "direction must be + or -"),
         (LASER.replace("50,1,-,2.4", "50,0,-,2.4"), 10, 4, "run counts from 1"),
+        (LASER.replace("50,1,-,2.4", "50,99999999999999999999,-,2.4"), 10, 4, "run counts from 1 to 1000"),
         (LASER.replace("position", "speed"), 3, 1, "quantity"),
         (LASER.replace("0,0,120", "0,120"), 5, 1, "three numbers"),
         (LASER.replace("Y=-250", "Y-250"), 4, 1, "AXIS=value"),
