@@ -36,7 +36,9 @@ class Job:
 
 def number(value: float, decimals: int, keep_point: bool = False) -> str:
     """`value` with at most `decimals` places, trailing zeros dropped ("12.5", "12" or "12.")."""
-    text = f"{value:.{decimals}f}".rstrip("0")
+    text = f"{value:.{decimals}f}"
+    if decimals > 0:  # zeros after the point only: "1000" stays 1000
+        text = text.rstrip("0")
     if text in ("-.", "-0.", "."):
         text = "0."
     text = text.removeprefix("-") if float(text) == 0 else text
@@ -130,6 +132,9 @@ class Generator:
 
     def _setup(self, rec: Record) -> Iterator[str]:
         major = rec.major
+        if major == "UNITS" and units_inch(rec) != self.job.inch:  # the header has set the program's unit
+            raise NcppError(f"UNITS/{rec.words[0]} after the first motion: a posted program has one unit "
+                            f"(the CL data's first, {'INCHES' if self.job.inch else 'MM'})", rec.where)  # fmt: skip
         if major in SILENT:
             if major == "PARTNO" and rec.args:
                 yield from self.emit_comment(f"PARTNO {rec.args[0]}")

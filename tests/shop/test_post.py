@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import io
 import math
+import re
 import subprocess
 import sys
 
@@ -183,3 +184,27 @@ def test_units_inches_and_mm_are_read():
         out = io.BytesIO()
         post(io.StringIO(f"UNITS / {unit}\nLOADTL / 3\nFEDRAT / 100\nGOTO / 1, 2, 3\nFINI\n"), out, file="p.cls", dialect="iso")
         assert b"G20" in out.getvalue() if unit == "INCHES" else b"G21" in out.getvalue()
+
+
+@pytest.mark.parametrize("dialect", sorted(GENERATORS))
+@pytest.mark.parametrize("rpm", ["1000", "9000", "0", "12500"])
+def test_spindle_speed_is_written_as_given(dialect, rpm):
+    """`SPINDL / 1000` was posted as S1 (trailing zeros dropped from a whole number)."""
+    out = io.BytesIO()
+    post(io.StringIO(f"UNITS / MM\nSPINDL / RPM, {rpm}, CLW\nFEDRAT / 100\nGOTO / 0, 0, 0\nFINI\n"), out, file="s.cls", dialect=dialect)
+    assert re.search(rf"\bS{rpm}\b", out.getvalue().decode()), out.getvalue().decode()
+
+
+def test_the_corpus_spindle_speeds_are_posted():
+    text = posted(CORPUS / "apt_cldata/creo_ncl/bohren_1.ncl.8", "iso")
+    assert "S9000 M3" in text
+
+
+def test_a_change_of_units_after_the_first_motion_is_refused():
+    """The header sets the program's unit: GOTO / 1,0,0 after UNITS / INCHES was posted as X1. under G21."""
+    cl = "FEDRAT / 20\nGOTO / 0, 0, 0\nUNITS / INCHES\nGOTO / 1, 0, 0\nFINI\n"
+    with pytest.raises(NcppError, match=r"u\.cls:3:1: UNITS/INCHES after the first motion"):
+        post(io.StringIO(cl), io.BytesIO(), file="u.cls", dialect="iso")
+    out = io.BytesIO()  # the same unit again changes nothing
+    post(io.StringIO("UNITS / INCHES\n" + cl), out, file="u.cls", dialect="iso")
+    assert b"G20" in out.getvalue() and b"X1." in out.getvalue()
