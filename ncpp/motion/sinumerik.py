@@ -10,7 +10,8 @@ or `T="NAME"` selects, M6 loads it with cutting edge D1, `D n` picks an edge
 (D0 none); the edge's lengths 1-3 from the control's tool offsets (`_N_TO_INI`,
 `tools.py`) act along the plane's axes (G17: length 1 along Z).  Control flow (GOTO*,
 IF, WHILE, FOR, REPEAT, CASE), calls of cycles and subprograms, splines, other
-frames, cutter compensation (G41/G42) and unknown G codes make the position
+frames, polar coordinates (AP=, RP=), arcs by opening angle (AR=), cutter
+compensation (G41/G42) and unknown G codes make the position
 unknown: one warning (an error with `strict`) and the rest passes through.
 """
 
@@ -37,6 +38,8 @@ UNITS_G = {70.0: True, 700.0: True, 71.0: False, 710.0: False}
 HARMLESS_CALLS = frozenset(("MSG", "BNAT", "ENAT", "BTAN", "ETAN", "BAUTO", "EAUTO", "FFWON", "FFWOF", "SOFT",
                             "BRISK", "CFC", "CFTCP", "CFIN", "M"))  # fmt: skip
 END_M = frozenset((2.0, 17.0, 30.0))
+# Addresses that say where the tool goes in a way this interpreter does not follow
+UNREAD_GEOMETRY = {"AR": "the opening angle", "AP": "the polar angle", "RP": "the polar radius"}
 # Frame instructions followed: translations; a bare substituting ROT / SCALE / MIRROR resets the frame.
 FRAMES = frozenset(("TRANS", "ATRANS", "ROT", "SCALE", "MIRROR"))
 
@@ -156,6 +159,8 @@ class SinumerikInterpreter(ModalInterpreter):
             elif letter in ("N", ":"):
                 continue
             else:
+                if letter in UNREAD_GEOMETRY:
+                    raise OutOfScope(f"{UNREAD_GEOMETRY[letter]} {letter}=", item.start + 1)
                 if letter in words:
                     self.fail(f"the address {letter} twice in one block", block, item)
                 words[letter] = (value, mode, item)
