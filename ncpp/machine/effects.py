@@ -98,8 +98,14 @@ def effect_from_dict(data: Mapping[str, Any]) -> Effect:
     return cls(**{k: _size(f"effect {kind}: {k}", k, _param(f"effect {kind}: {k}", hints[k], v)) for k, v in params.items()})
 
 
-def _is_number(value: Any) -> bool:
-    return isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_)) and math.isfinite(value)
+def is_finite_number(value: Any) -> bool:
+    """A real number a float holds: not a bool, nan, inf, nor an integer of 400 digits (TOML has those)."""
+    if not isinstance(value, numbers.Real) or isinstance(value, (bool, np.bool_)):
+        return False
+    try:
+        return math.isfinite(value)
+    except OverflowError:
+        return False
 
 
 def _size(what: str, key: str, value: Any) -> Any:
@@ -116,11 +122,11 @@ def _param(what: str, hint: Any, value: Any) -> Any:
     left to the effect's own check, which names the values it takes."""
     want = next(a for a in typing.get_args(hint) or (hint,) if a is not type(None))
     if want is float:
-        if not _is_number(value):
+        if not is_finite_number(value):
             raise ValueError(f"{what} must be a finite number, not {value!r}")
         return float(value)
     if typing.get_origin(want) is tuple:  # tuple[float, float]: a range
-        if not (isinstance(value, (list, tuple)) and len(value) == 2 and all(map(_is_number, value))):
+        if not (isinstance(value, (list, tuple)) and len(value) == 2 and all(map(is_finite_number, value))):
             raise ValueError(f"{what} must be [lo, hi], two finite numbers, not {value!r}")
         return tuple(float(v) for v in value)
     return value

@@ -80,7 +80,7 @@ from ncpp.errors import Location, NcppError
 from ncpp.fileio import write_text_atomic
 from ncpp.machine.chain import SMALL_ANGLE
 from ncpp.machine.components import AXES, COMPONENTS, SQUARENESS, Polynomial, Table, canonical_name
-from ncpp.machine.effects import LARGEST_ERROR, effect_from_dict
+from ncpp.machine.effects import LARGEST_ERROR, effect_from_dict, is_finite_number
 from ncpp.machine.model import Machine
 
 SECTIONS = {"machine", "offsets", "limits", "errors", "squareness", "effects", "compensation", "meta"}
@@ -312,7 +312,7 @@ def _vectors(table: dict, section: str, names: str, loc: _Locator) -> dict[str, 
 
 def _vector(value: Any, key: str, names: str) -> list[float]:
     size = names.count(",") + 1
-    if not (isinstance(value, list) and len(value) == size and all(map(_is_number, value))):
+    if not (isinstance(value, list) and len(value) == size and all(map(is_finite_number, value))):
         raise ValueError(f"{key} must be {NUMBERS.get(size, size)} numbers [{names}] in mm, not {_shown(value)}")
     return [float(v) for v in value]
 
@@ -443,12 +443,8 @@ def _shown(value: Any, width: int = 60) -> str:
     return text if len(text) <= width else text[: width - 3] + "..."
 
 
-def _is_number(value: Any) -> bool:
-    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
-
-
 def _number(value: Any, key: str) -> float:
-    if not _is_number(value):
+    if not is_finite_number(value):
         raise ValueError(f"{key} must be a finite number, not {_shown(value)}")
     return float(value)
 

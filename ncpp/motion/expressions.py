@@ -97,6 +97,8 @@ def _modulo(a: float, b: float) -> float:
 def _power(a: float, b: float) -> float:
     if a < 0.0 and b != math.floor(b):
         raise ExpressionError("Attempt to raise negative to non-integer power")
+    if a == 0.0 and b < 0.0:  # 1 / 0**|b|
+        raise ExpressionError("Attempt to divide by zero (zero to a negative power)")
     return math.pow(a, b)
 
 

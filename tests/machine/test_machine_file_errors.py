@@ -119,6 +119,10 @@ POLY_OVERFLOW = "coefficients_um = [" + ", ".join(["1e-3"] * 400) + "]"
         ("um_per_m = 5.0", "um_per_m = -2e6", 33, "effect scale: um_per_m must be within ±1e+06"),
         ("values_um = [0.0, 2.0, 3.0]", "values_um = [0.0, 2e6, 3.0]", 15, "errors.EXX: values_um must be within ±1e+06 µm (a metre), not 2e+06"),
         ("coefficients_um = [0.0, 0.01]", "coefficients_um = [0.0, 1e4]", 19, "coefficients_um between 0 and 500 mm must be within ±1e+06 µm"),
+        # an integer a float cannot hold (TOML has them): was an OverflowError
+        ("X = [0.0, 800.0]", "X = [0.0, 1" + "0" * 310 + "]", 10, "limits: X must be two numbers [lo, hi] in mm"),
+        ("values_um = [0.0, 2.0, 3.0]", "values_um = [0.0, 1" + "0" * 310 + ", 3.0]", 15, "errors.EXX: values_um must be a finite number"),
+        ("um = 2.0", "um = 1" + "0" * 310, 39, "effects #2: effect straightness: um must be a finite number"),
         # squareness: one value each, and a small angle
         ("C0Y_urad = 20.0", "C0Y_urad = 1e300", 28, "C0Y_urad must be within ±10000 µrad (the model's small angles), not 1e+300"),
         ("C0Y_urad = 20.0", "C0Y_urad = 20.0\nC0Y_um_per_m = 3.0", 29, "C0Y is given twice, as C0Y_urad and C0Y_um_per_m"),

@@ -168,6 +168,11 @@ def test_divide_by_zero_is_an_error():
     assert (err.where.line, err.where.col, err.message) == (2, 4, "Attempt to divide by zero")
 
 
+def test_zero_to_a_negative_power_is_an_error():
+    err = error("G0 X0\n#1=[0**-1]\n")  # was a traceback (math.pow: math domain error)
+    assert (err.where.line, err.message) == (2, "Attempt to divide by zero (zero to a negative power)")
+
+
 # -- bad input: file, line, column, LinuxCNC's message -------------------------------------------
 @pytest.mark.parametrize(
     "text, line, col, message",
