@@ -51,6 +51,8 @@ MAX_SUBPROGRAM = 20_000
 # Lines run (or skipped) out of the text's order, loop iterations and calls, before a program
 # counts as one that never ends (LinuxCNC would run it for ever; a pass over it must end): ~1 minute
 MAX_RERUN = 5_000_000
+# Subroutine levels (o-word calls and M98 together) as rs274ngc counts them: the tenth call is refused
+MAX_CALL_LEVELS = 10
 
 
 @dataclass(frozen=True, slots=True)
@@ -320,6 +322,8 @@ class Flow:
                       f"with --subroutine-path; the LinuxCNC filter reads the INI's SUBROUTINE_PATH){where}", block, control.item.start + 1)  # fmt: skip
             return lambda: None
 
+        self._check_level(block, control)
+
         def call():
             frame.pc += 1
             self.parameters.enter(arguments)
@@ -358,6 +362,8 @@ class Flow:
             self.stop(f"M98 P{name}: a subprogram the program does not define (O{name} to M99)", block, control.item.start + 1)
             return lambda: None
 
+        self._check_level(block, control)
+
         def call():
             frame.pc += 1
             self.parameters.enter(None)
@@ -368,6 +374,12 @@ class Flow:
                 frame.ifs.clear()
 
         return call
+
+    def _check_level(self, block: Block, control: Control) -> None:
+        """Refuse a call past MAX_CALL_LEVELS, as rs274ngc does (a call of itself would nest for ever)."""
+        if len(self.frames) >= MAX_CALL_LEVELS:  # frames: the program's, then one per call
+            raise NcppError(f"Too many subroutine levels: calls nest at most {MAX_CALL_LEVELS - 1} deep (as in rs274ngc)",
+                            Location(self.file, block.line, control.item.start + 1))  # fmt: skip
 
     def _m99(self, frame, block, control, arrived):
         if frame.space is None:

@@ -51,6 +51,7 @@ AGREE = {
     "fanuc: nested, #1-#30 shared, names scoped": HEAD + "#1 = 3\n#<a> = 5\nM98 P10 L2\nG0 X#1 Y#<_bb>\nG0 Z#<a>\nM30\nO10\n#1 = [#1 + 1]\n#<_bb> = 7\nM98 P11\nM99\nO11\n#<a> = 1\nG0 X#1 Y#<a>\nM99\n",
     "fanuc: L0 runs nothing": HEAD + "#1 = 1\nM98 P9 L0\nG0 X#1\nM30\nO9\nG0 Y1\nM99\n",
     "fanuc: the first of two definitions": HEAD + "M98 P0002\nM30\nO0002\nG0 X1\nM99\nO2\nG0 X2\nM99\n",
+    "calls nine levels deep": HEAD + "o<f> sub\n o1 if [#1 GT 0]\n  G0 X#1\n  o<f> call [#1 - 1]\n o1 endif\no<f> endsub\no<f> call [8]\n",
     "modes a subroutine leaves": HEAD + "o1 sub\n G91 G1 X1\n G18\no1 endsub\nG1 X5 Y5\no1 call\nX1 Z1\nG2 X2 Z0 I1 K0\nG90\n",
 }
 
@@ -62,6 +63,9 @@ REFUSED = {
     "M98 L0 (rs274ngc stays a call level deeper): the caller's names": (HEAD + "#<a> = 1\nM98 P9 L0\nG0 X#<a>\nM30\nO9\nG0 Y1\nM99\n", 5),
     "M98 L0: the caller's loops": (HEAD + "#1 = 0\no1 while [#1 LT 2]\n#1 = [#1 + 1]\nM98 P9 L0\no1 endwhile\nM30\nO9\nG0 Y1\nM99\n", 7),
     "endwhile outside a loop": (HEAD + "G0 X1\no1 endwhile\n", 4),
+    "calls ten levels deep": (HEAD + "o<f> sub\n o1 if [#1 GT 0]\n  G0 X#1\n  o<f> call [#1 - 1]\n o1 endif\no<f> endsub\no<f> call [9]\n", 6),
+    "a subroutine that calls itself for ever (was: memory without end)": (HEAD + "o100 sub\nG1 X1 F100\no100 call\no100 endsub\no100 call\n", 5),
+    "a Fanuc subprogram that calls itself": (HEAD + "M98 P1\nM30\nO1\nG1 X1 F100\nM98 P1\nM99\n", 7),
 }
 
 
