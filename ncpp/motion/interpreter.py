@@ -50,6 +50,8 @@ TOLERANCE = {False: 0.002, True: 0.0002}  # R arcs and zero-radius checks: mm, i
 CENTER_ARC_ABS = {False: 2 * 0.01 * math.sqrt(2), True: 2 * 0.001 * math.sqrt(2)}
 CENTER_ARC_REL = 0.001
 TINY = 1e-12
+# Moves of one canned-cycle block (L repeats, pecks): held at once, so bounded; a real one makes thousands
+MAX_CYCLE_MOVES = 1_000_000
 
 _GROUP_CODES = {
     0: (4, 10, 28, 28.1, 30, 30.1, 52, 53, 92, 92.1, 92.2, 92.3),
@@ -913,6 +915,7 @@ class Interpreter:
             raise _OutOfScope(f"canned cycle G{motion:g} outside the XY plane", item.start + 1)
         if motion in SPINDLE:
             self._check_spindle(block, motion, item)
+        self._check_cycle_size(block, words, repeats, (r - bottom) / peck if motion in PECKING else 0.0, item)
         if motion == 87.0:
             i, j, k = self._back_bore_words(block, words, again, item)
             middle = k if self.absolute else bottom + k
@@ -1003,6 +1006,15 @@ class Interpreter:
             values.append(words[letter][0] if letter in words else kept)
         self.cycle_ijk = (values[0], values[1], values[2])
         return self.cycle_ijk
+
+    def _check_cycle_size(self, block: Block, words: dict, repeats: int, pecks: float, item) -> None:
+        """Refuse a cycle block of more than MAX_CYCLE_MOVES moves before making them (`G81 ... L99999999`,
+        `G83 ... Q0.0000001`: rs274ngc would drill for days; the moves of one block are held at once)."""
+        pecks = max(pecks, 0.0)
+        if not repeats * (3 * pecks + 10) <= MAX_CYCLE_MOVES:  # per hole: 3 moves a peck (G83), 10 more at most (G87)
+            what = f"{repeats:,} hole(s)" + (f" of {pecks:,.0f} pecks each" if pecks >= 1 else "")
+            self._fail(f"a canned cycle of {what}: ncpp takes {MAX_CYCLE_MOVES:,} moves in one block at most",
+                       block, words.get("L", words.get("Q", (0, item)))[1])  # fmt: skip
 
     def _repeats(self, block: Block, words: dict) -> int:
         """A cycle's L: how many times it runs (1 without L)."""

@@ -230,3 +230,20 @@ def test_rs274_accepts_the_compensated_cycles(tmp_path):
     path.write_text(out)
     _, messages = rs274(str(path))
     assert rs274_error(messages) is None, messages
+
+
+@pytest.mark.parametrize(
+    "cycle, col, what",
+    [
+        ("G81 X10 Y10 Z-5 R1 L99999999", 20, "99,999,999 hole(s)"),
+        ("G83 X10 Y10 Z-5 R1 Q0.0000001", 20, "1 hole(s) of 60,000,000 pecks each"),
+        ("G73 X10 Y10 Z-500 R1 Q0.0001", 22, "1 hole(s) of 5,010,000 pecks each"),
+    ],
+)
+def test_a_cycle_of_millions_of_moves_is_refused_before_they_are_made(cycle, col, what):
+    """rs274ngc would drill for days; these took 3 GB and a MemoryError (or, with a peck below
+    the float resolution, looped for ever)."""
+    with pytest.raises(NcppError) as err:
+        list(interpret(parse_stream(io.BytesIO(f"G21 G90 G17 F100\nG0 X0 Y0 Z10\n{cycle}\n".encode()), "c.ngc"), file="c.ngc"))
+    assert (err.value.where.line, err.value.where.col) == (3, col)
+    assert err.value.message == f"a canned cycle of {what}: ncpp takes 1,000,000 moves in one block at most"
