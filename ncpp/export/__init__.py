@@ -35,6 +35,8 @@ def export_table(
     if reference is not None and not math.isfinite(reference):
         raise NcppError(f"--reference must be a finite number of mm, not {reference!r}")
     error = axis_error(machine, axis)
+    if spacing is not None and spacing > error.hi - error.lo:  # a table needs two points on the travel
+        raise NcppError(f"--spacing {spacing:g} mm is longer than the {axis} travel, {error.lo:g} to {error.hi:g} mm")
     _check_size(machine, error)
     if fmt == "linuxcnc":
         from ncpp.export.linuxcnc import write_linuxcnc_comp

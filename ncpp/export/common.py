@@ -86,6 +86,15 @@ class Grid:
     notes: list[str] = field(default_factory=list)
 
 
+def reference_on_travel(error: AxisError, reference: float, notes: list[str]) -> float:
+    """The reference position, moved onto the table's range with a note when it lies outside."""
+    if error.lo <= reference <= error.hi:
+        return reference
+    clipped = min(max(reference, error.lo), error.hi)
+    notes.append(f"reference position {reference:g} mm lies outside the table range; {clipped:g} mm used")
+    return clipped
+
+
 def uniform_grid(
     lo: float,
     hi: float,

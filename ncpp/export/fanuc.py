@@ -40,7 +40,7 @@ import re
 import numpy as np
 
 from ncpp.errors import NcppError
-from ncpp.export.common import AxisError
+from ncpp.export.common import AxisError, reference_on_travel
 
 MAX_POINTS = 1024  # point numbers 0..1023, shared by all axes (0i); 30i allows more
 MAX_STEP = 7
@@ -67,10 +67,7 @@ def write_fanuc_pitch(
     if not math.isfinite(reference):
         raise NcppError(f"--reference must be a finite number of mm, not {reference!r}")
     lo, hi = error.lo, error.hi
-    if not lo <= reference <= hi:
-        clipped = min(max(reference, lo), hi)
-        notes.append(f"reference position {reference:g} mm lies outside the table range; {clipped:g} mm used")
-        reference = clipped
+    reference = reference_on_travel(error, reference, notes)
     du = detection_unit
     span = hi - lo
     # The sections from the reference outwards, each end rounded up, take up to span/interval + 2

@@ -44,7 +44,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ncpp.export.common import AxisError, interpolation_residual, uniform_grid
+from ncpp.export.common import AxisError, interpolation_residual, reference_on_travel, uniform_grid
 
 MAX_ENC_POINTS = 5000  # MD38000 upper limit (840D sl)
 MAX_CEC_POINTS = 2000  # MD18342 per table, a usual upper limit
@@ -64,6 +64,8 @@ def write_sinumerik(
     grid = uniform_grid(error.lo, error.hi, max_points=MAX_ENC_POINTS, spacing=spacing, what="SINUMERIK MSEC")
     x = grid.positions
     mean = error.mean(x)
+    placed: list[str] = []  # the reference's note, when it is moved onto the travel
+    reference = None if reference is None else reference_on_travel(error, reference, placed)
     shift = 0.0 if reference is None else float(error.mean(np.array([reference]))[0])
     values = mean - shift
     n = len(x)
@@ -76,7 +78,7 @@ def write_sinumerik(
         lines.append(f"; shifted by {shift * 1000:+.1f} um so that the value at the reference {reference:g} mm is 0")
     else:
         lines.append("; not shifted: Siemens asks for 0 at the reference point (give --reference)")
-    lines += [f"; {note}" for note in grid.notes]
+    lines += [f"; {note}" for note in placed + grid.notes]
     enc = ["%_N_AX_EEC_INI", "CHANDATA(1)", *lines]
     enc += [f"$AA_ENC_COMP[0,{i},{ax}]={_mm(v)}" for i, v in enumerate(values)]
     enc += [
@@ -86,7 +88,7 @@ def write_sinumerik(
         f"$AA_ENC_COMP_IS_MODULO[0,{ax}]=0",
         "M17",
     ]
-    notes = list(grid.notes)
+    notes = placed + list(grid.notes)
     tables: list[tuple] = []  # (input axis, output axis, direction, component, correction(p), kind)
     if error.directional:
         for sign, curve in ((1, error.forward), (-1, error.reverse)):

@@ -174,3 +174,17 @@ def test_export_error_beyond_the_machines_correction_limit(tmp_path, capsys):
     machine.write_text(text)
     err = refused(["export-table", "--machine", str(machine), "--axis", "X", "--format", "linuxcnc"], capsys)
     assert f"{machine}: EXX reaches" in err and "max_correction_mm" in err
+
+
+@pytest.mark.parametrize("fmt", ["linuxcnc", "fanuc", "sinumerik", "heidenhain"])
+def test_export_spacing_longer_than_the_travel(fmt, capsys):
+    """--spacing 1e308 was an OverflowError in the FANUC writer."""
+    err = refused(["export-table", "--machine", MACHINE, "--axis", "X", "--format", fmt, "--spacing", "1e308"], capsys)
+    assert "--spacing 1e+308 mm is longer than the X travel, 0 to 800 mm" in err
+
+
+@pytest.mark.parametrize("fmt", ["fanuc", "sinumerik"])
+def test_export_reference_outside_the_travel_is_moved_onto_it_with_a_note(fmt, tmp_path, capsys):
+    out = tmp_path / "table"
+    assert main(["export-table", "--machine", MACHINE, "--axis", "X", "--format", fmt, "--reference", "1e308", "-o", str(out)]) == 0
+    assert "reference position 1e+308 mm lies outside the table range; 800 mm used" in capsys.readouterr().err
