@@ -162,7 +162,9 @@ def _extent(obs: list[Observation]) -> dict[str, tuple[float, float]]:
         vals = [p.trajectory.positions[:, i] for o in obs for p in o.parts if np.ptp(p.trajectory.positions[:, i]) > 0]
         if vals:
             v = np.concatenate(vals)
-            out[a] = (round(float(v.min()), 3), round(float(v.max()), 3))
+            lo, hi = round(float(v.min()), 3), round(float(v.max()), 3)
+            if lo < hi:  # (a test moving the axis less than 1 µm has no extent to bow over)
+                out[a] = (lo, hi)
     return out
 
 

@@ -148,6 +148,15 @@ def test_fit_table_of_one_target(tmp_path, capsys):
     assert f"{path}: a table needs readings at two or more targets" in refused(["fit", path, "-o", str(tmp_path / "m.toml")], capsys)
 
 
+def test_diagnose_a_circle_of_less_than_a_micron(tmp_path, capsys):
+    """A grid encoder reads circles of a micron: the straightness candidates had an extent of lo == hi
+    (rounded to 1 µm) and ended in a ValueError."""
+    path = tmp_path / "tiny.csv"
+    path.write_text(Path(BALLBAR).read_text().replace("# radius_mm: 150", "# radius_mm: 0.0001"))
+    assert main(["diagnose", "--machine", MACHINE, str(path)]) == 0
+    assert "Traceback" not in capsys.readouterr().err
+
+
 def test_diagnose_alpha(capsys):
     assert "argument --alpha" in refused(["diagnose", "--machine", MACHINE, "--alpha", "1", BALLBAR], capsys)
 
