@@ -74,7 +74,7 @@ class _Circle:
         self.plane, self.sign = _plane(values[3:6], record)
         self.i, self.j, self.n = PLANE_AXES[self.plane]
         self.radius = values[6]
-        c = list(values[:3])
+        c = list(_position(record, values))
         c[self.n] = start[self.n]  # Arc.center carries the start's normal coordinate
         self.center: Point = (c[0], c[1], c[2])
         self.start = start
@@ -148,6 +148,14 @@ def spindle_speed(rec: Record) -> float:
     return n
 
 
+def _position(rec: Record, values: list[float]) -> Point:
+    """The record's x, y, z: numbers an NC word can hold (GOTO / 1e308 was posted as 309 digits)."""
+    x, y, z = values[:3]
+    if not max(abs(x), abs(y), abs(z)) <= MAX_WORD:
+        raise NcppError(f"{rec.major}: a coordinate beyond ±{MAX_WORD:,.0f}, what an NC word holds: {x:g}, {y:g}, {z:g}", rec.where)
+    return (x, y, z)
+
+
 def _unit(vector: tuple[float, ...]) -> tuple[float, ...]:
     """The tool vector's direction (CL data need not give a unit vector); zero stays zero."""
     length = math.sqrt(sum(v * v for v in vector))
@@ -205,7 +213,7 @@ def motion(records: Iterable[Record], warnings: Warnings | None = None, zero: Po
                             "5-axis motion cannot be posted for a 3-axis machine",
                             rec.where,
                         )
-            end: Point = (values[0], values[1], values[2])
+            end: Point = _position(rec, values)
             if circle is not None and circle.takes(end):
                 circle.add(end, rec)
                 pos = end
@@ -226,7 +234,7 @@ def motion(records: Iterable[Record], warnings: Warnings | None = None, zero: Po
             values = rec.numbers
             if len(values) < 3:
                 raise NcppError("FROM needs x, y, z", rec.where)
-            pos = home = (values[0], values[1], values[2])
+            pos = home = _position(rec, values)
         elif major == "GOHOME" and home is not None and pos is not None:
             # GOHOME/Z (and the like) sends only the named axes home.
             named = [a for a in "XYZ" if a in rec.words] or list("XYZ")

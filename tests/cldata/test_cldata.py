@@ -138,6 +138,17 @@ def test_a_tool_vector_along_z_of_any_length_posts():
     assert sum(isinstance(e, Line) for e in events_of("MULTAX\nGOTO/0,0,5,0,0,2\nTLAXIS/0,0,1\nGOTO/1,0,5\n")) == 2
 
 
+@pytest.mark.parametrize(
+    "cl, line",
+    [("GOTO/0,0,0\nGOTO/1e308,0,0\n", 2), ("FROM/0,0,-1e9\n", 1), ("GOTO/0,0,0\nCIRCLE/1e200,0,0,0,0,1,5\nGOTO/5,0,0\n", 2)],
+)
+def test_a_coordinate_no_nc_word_holds_is_refused(cl, line):
+    """GOTO / 1e308 was posted as an X word of 309 digits."""
+    with pytest.raises(NcppError, match="a coordinate beyond ±99,999,999") as err:
+        events_of(cl)
+    assert err.value.where.line == line
+
+
 def test_vendor_words_pass_with_a_warning():
     out = io.StringIO()
     events = events_of((CORPUS / "rybakov25/test.apt").read_text(), Warnings(stream=out))
