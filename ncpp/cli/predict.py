@@ -53,7 +53,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--plot", metavar="OUT.png", help="draw the standard plot of the prediction")
     g = parser.add_argument_group("set-up")
     g.add_argument("--plane", default="XY", type=str.upper, choices=("XY", "YZ", "ZX"))
-    g.add_argument("--radius", type=positive, help="mm (default ballbar 150, grid 100, cutting 50)")
+    g.add_argument("--radius", type=radius_mm, help="mm (default ballbar 150, grid 100, cutting 50)")
     g.add_argument("--center", metavar="X,Y,Z", help="centre, command mm (default: middle of the travel)")
     g.add_argument("--feed", type=positive, help="mm/min (default 1000; cutting 500)")
     g.add_argument("--direction", type=str.upper, choices=("CW", "CCW", "BOTH"), help="circular tests (ballbar default BOTH)")
@@ -78,10 +78,17 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.set_defaults(func=run)
 
 
+def radius_mm(text: str) -> float:
+    from ncpp.instruments.forward import MAX_EXTENT_MM  # (numpy: only when the option is given)
+
+    return between(0.0, MAX_EXTENT_MM, "(]")(text)
+
+
 def _vector(text: str, what: str):
     import numpy as np
 
     from ncpp.errors import Location, NcppError
+    from ncpp.instruments.forward import check_extent
 
     try:
         values = [float(v) for v in text.replace(" ", ",").split(",") if v]
@@ -89,8 +96,10 @@ def _vector(text: str, what: str):
         raise NcppError(f"{what}: {text!r} is not x,y,z numbers", Location("ncpp predict")) from None
     if len(values) != 3:
         raise NcppError(f"{what} needs three numbers x,y,z, got {text!r}", Location("ncpp predict"))
-    if not all(math.isfinite(v) for v in values):
-        raise NcppError(f"{what} needs three finite numbers x,y,z, got {text!r}", Location("ncpp predict"))
+    try:
+        check_extent(values, what)
+    except ValueError as err:
+        raise NcppError(str(err), Location("ncpp predict")) from None
     return np.array(values)
 
 
@@ -99,13 +108,13 @@ def parse_targets(text: str):
     import numpy as np
 
     from ncpp.errors import Location, NcppError
-    from ncpp.instruments.forward import MAX_READINGS
+    from ncpp.instruments.forward import MAX_EXTENT_MM, MAX_READINGS
 
     where = Location("ncpp predict")
     try:
         if ":" in text:
             a, b, step = (float(v) for v in text.split(":"))
-            if not (math.isfinite(a) and math.isfinite(b) and 0 < step < math.inf and a <= b):
+            if not (abs(a) <= MAX_EXTENT_MM and abs(b) <= MAX_EXTENT_MM and 0 < step < math.inf and a <= b):
                 raise ValueError
             count = math.floor((b - a) / step + 1e-9) + 1
             if count > MAX_READINGS:  # before the array is made
@@ -113,10 +122,10 @@ def parse_targets(text: str):
             targets = a + step * np.arange(count)
         else:
             targets = np.array(sorted(float(v) for v in text.split(",") if v.strip()))
-            if not np.all(np.isfinite(targets)):
+            if not np.all(np.abs(targets) <= MAX_EXTENT_MM):
                 raise ValueError
     except ValueError:
-        raise NcppError(f"--targets: expected A:B:STEP (A <= B, STEP > 0) or a,b,c, finite, got {text!r}", where) from None
+        raise NcppError(f"--targets: expected A:B:STEP (A <= B, STEP > 0) or a,b,c, within ±{MAX_EXTENT_MM:g} mm, got {text!r}", where) from None
     if np.any(np.diff(np.unique(targets)) < 1e-3):  # ISO 230-2 matches targets to 1 µm
         raise NcppError(f"--targets {text}: targets closer than 1 µm are one target", where)
     return targets

@@ -86,6 +86,8 @@ LASER_SETUP = ["predict", "--machine", MACHINE, "--instrument", "laser", "--axis
         (["--step", "1000"], "--step"),
         (["--step", "0"], "--step"),
         (["--radius", "0"], "--radius"),
+        (["--radius", "1e308"], "--radius"),
+        (["--center", "1e9,0,0"], "--center must be finite numbers within"),
         (["--feed", "0"], "--feed"),
         (["--center", "nan,350,350"], "--center"),
         (["--start", "nan"], "--start"),
@@ -102,7 +104,11 @@ def test_predict_ballbar_options(args, option, tmp_path, capsys):
 @pytest.mark.parametrize(
     "args, expected",
     [
-        (["--targets", "0:1e12:1"], "--targets 0:1e12:1: 1,000,000,000,001 targets"),
+        (["--targets", "0:1e6:0.001"], "--targets 0:1e6:0.001: 1,000,000,001 targets"),
+        (["--targets", "0,1e308"], "within ±1e+06 mm"),
+        (["--fixed", "Y=nan"], "--fixed: fixed positions must be finite numbers within ±1e+06 mm, got [nan]"),
+        (["--fixed", "Y=1e7"], "--fixed: fixed positions must be finite numbers"),
+        (["--offset", "1e308,0,0"], "--offset must be finite numbers within ±1e+06 mm"),
         (["--targets", "nan,1,2"], "--targets"),
         (["--targets", "0:1:0.0001"], "closer than 1 µm"),
         (["--runs", "0"], "--runs"),
