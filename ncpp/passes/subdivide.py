@@ -93,7 +93,8 @@ def _piece_counts(rows: _LineRows, ctx: PassContext) -> NDArray:
     straight = error[:, :1] + t * (error[:, -1:] - error[:, :1])
     bow = np.linalg.norm(error - straight, axis=-1).max(axis=1)
     # The deviation of piecewise-linear interpolation shrinks with the square of the piece count.
-    return np.ceil(np.sqrt(SAFETY * bow / ctx.tolerance)).astype(int).clip(1, MAX_PIECES)
+    # (capped before the cast: a tolerance of 1e-300 makes the ratio inf, which casts to a negative int)
+    return np.minimum(np.ceil(np.sqrt(SAFETY * bow / ctx.tolerance)), MAX_PIECES).astype(int).clip(1, None)
 
 
 def _split(line: Line, n: int) -> list[Line]:

@@ -101,3 +101,15 @@ def test_a_cl_record_with_a_number_out_of_range_is_refused():
     records = read_cldata(io.StringIO(f"UNITS / MM\nFEDRAT / 100\nGOTO / {TOO_LONG}, 0, 0\nFINI\n"), "p.cl")
     with pytest.raises(NcppError, match=r"p\.cl:3: number out of range in this CL record"):
         list(records)
+
+
+def test_a_tolerance_of_1e_300_subdivides_as_finely_as_1e_30(tmp_path, capsys, recwarn):
+    """The piece count's ratio was inf and cast to a negative int (a numpy warning, then 1 piece)."""
+    outputs = []
+    for tolerance in ("1e-30", "1e-300"):
+        out = tmp_path / f"{tolerance}.ngc"
+        argv = ["compensate", "--machine", str(MACHINE), "--work-offset", "400,350,300", "--tolerance", tolerance]
+        assert main([*argv, str(POCKET), "-o", str(out)]) == 0
+        outputs.append(out.read_bytes().splitlines()[2:])  # after the header, which names the tolerance
+    assert outputs[0] == outputs[1] and len(outputs[0]) > 90_000
+    assert not [w for w in recwarn if issubclass(w.category, RuntimeWarning)]
