@@ -9,7 +9,7 @@ arithmetic, labels, `MSG`, G4 dwell, M2/M17/M30 (end), and tool lengths: `T n`
 or `T="NAME"` selects, M6 loads it with cutting edge D1, `D n` picks an edge
 (D0 none); the edge's lengths 1-3 from the control's tool offsets (`_N_TO_INI`,
 `tools.py`) act along the plane's axes (G17: length 1 along Z).  Control flow (GOTO*,
-IF, WHILE, FOR, REPEAT, CASE), calls of cycles and subprograms, splines, other
+IF, WHILE, FOR, REPEAT, CASE), calls of cycles and subprograms (by name or `L<n>`), splines, other
 frames, polar coordinates (AP=, RP=), arcs by opening angle (AR=), cutter
 compensation (G41/G42) and unknown G codes make the position
 unknown: one warning (an error with `strict`) and the rest passes through.
@@ -161,6 +161,8 @@ class SinumerikInterpreter(ModalInterpreter):
             else:
                 if letter in UNREAD_GEOMETRY:
                     raise OutOfScope(f"{UNREAD_GEOMETRY[letter]} {letter}=", item.start + 1)
+                if letter == "L":  # `L100`: runs subprogram L100.SPF, which may move the tool anywhere
+                    raise OutOfScope(f"the subprogram call L{value:g}", item.start + 1)
                 if letter in words:
                     self.fail(f"the address {letter} twice in one block", block, item)
                 words[letter] = (value, mode, item)
