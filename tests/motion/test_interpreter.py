@@ -168,6 +168,12 @@ def test_divide_by_zero_is_an_error():
     assert (err.where.line, err.where.col, err.message) == (2, 4, "Attempt to divide by zero")
 
 
+def test_powers_group_left_to_right_as_in_rs274ngc():
+    """2**3**2 is (2**3)**2 = 64 in rs274ngc (the grammar grouped it 2**(3**2) = 512)."""
+    (line,) = moves("G1 F100 X[2 ** 3 ** 2] Y[-2 ** 2] Z[4 ** 0.5 ** 2]\n")
+    assert line.end == (64.0, 4.0, 4.0)
+
+
 def test_zero_to_a_negative_power_is_an_error():
     err = error("G0 X0\n#1=[0**-1]\n")  # was a traceback (math.pow: math domain error)
     assert (err.where.line, err.message) == (2, "Attempt to divide by zero (zero to a negative power)")
