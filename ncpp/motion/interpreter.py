@@ -46,7 +46,9 @@ AXIS_INDEX = {letter: i for i, letter in enumerate(AXES)}
 LINEAR = (0, 1, 2, 6, 7, 8)  # axes that change with G20/G21 (not the rotary A B C)
 
 # rs274ngc tolerances (interp_internal.hh), in program units
-TOLERANCE = {False: 0.002, True: 0.0002}  # R arcs and zero-radius checks: mm, inch
+TOLERANCE = {False: 0.002, True: 0.0002}  # zero-radius checks: mm, inch
+# how far an R arc's chord may exceed its diameter (rs274ngc's RADIUS_TOLERANCE_INCH, 0.00005 in): mm, inch
+RADIUS_TOLERANCE = {False: 0.00005 * 25.4, True: 0.00005}
 CENTER_ARC_ABS = {False: 2 * 0.01 * math.sqrt(2), True: 2 * 0.001 * math.sqrt(2)}
 CENTER_ARC_REL = 0.001
 TINY = 1e-12
@@ -1069,7 +1071,7 @@ class Interpreter:
         turns = round(words["P"][0]) if "P" in words else 1
         tolerance = TOLERANCE[self.inch]
         if radius is not None:
-            ca, cb = self._center_r(block, word, start[a], start[b], end[a], end[b], radius[0], motion, tolerance)
+            ca, cb = self._center_r(block, word, start[a], start[b], end[a], end[b], radius[0], motion)
         else:
             ia = words.get(first_letter)
             ib = words.get(second_letter)
@@ -1094,14 +1096,14 @@ class Interpreter:
             (end[3], end[4], end[5], end[6], end[7], end[8]) if self.uses_extra_axes else (),
         )
 
-    def _center_r(self, block, word, x0, y0, x1, y1, radius, motion, tolerance) -> tuple[float, float]:
+    def _center_r(self, block, word, x0, y0, x1, y1, radius, motion) -> tuple[float, float]:
         """arc_data_r of rs274ngc: the centre of an R-format arc (negative R: the long way)."""
         if x1 == x0 and y1 == y0:
             self._fail("Current point same as end point of arc", block, word)
         r = abs(radius)
         mx, my = (x0 + x1) / 2, (y0 + y1) / 2
         half = math.hypot(mx - x1, my - y1)
-        if half - r > tolerance:
+        if half - r > RADIUS_TOLERANCE[self.inch]:
             self._fail("Arc radius too small to reach end point", block, word)
         if half / r > 1 - TINY:
             half = r  # a semicircle within tolerance

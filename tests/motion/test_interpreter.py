@@ -186,6 +186,9 @@ def test_zero_to_a_negative_power_is_an_error():
         ("G0 X1\nG2 X10 F1\n", 2, 1, "R i j k words all missing for arc"),
         ("G2 X10 I5 R5 F1\n", 1, 1, "Mixed radius ijk format for arc"),
         ("G2 X10 R3 F1\n", 1, 1, "Arc radius too small to reach end point"),
+        # rs274ngc's RADIUS_TOLERANCE_INCH (0.00005 in, 0.00127 mm), not the 0.002 mm of other checks
+        ("G21 G2 X20.0026 R10 F1\n", 1, 5, "Arc radius too small to reach end point"),
+        ("G20 G2 X20.00011 R10 F1\n", 1, 5, "Arc radius too small to reach end point"),
         ("G2 X0 R3 F1\n", 1, 1, "Current point same as end point of arc"),
         ("G1 F1\nG2 X10 I5 K3\n", 2, 11, "K word given for arc in xy plane"),
         ("G18 G2 X10 I5 J3 F1\n", 1, 15, "J word given for arc in xz plane"),
@@ -210,6 +213,11 @@ def test_zero_to_a_negative_power_is_an_error():
 def test_bad_input_names_line_column_and_linuxcnc_message(text, line, col, message):
     err = error(text)
     assert (err.where.file, err.where.line, err.where.col, err.message) == ("t.nc", line, col, message)
+
+
+def test_an_r_arc_within_rs274s_tolerance_is_read():
+    (arc,) = moves("G21 G2 X20.0024 R10 F1\n")  # half chord 10.0012: 0.0012 mm past R (rs274: within)
+    assert arc.end[0] == 20.0024
 
 
 def test_arc_radius_tolerance_matches_linuxcnc_files():
