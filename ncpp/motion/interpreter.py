@@ -459,6 +459,11 @@ class Interpreter:
                     return self._motion_move(block, words, motion, motion_item)
         return self._execute(block, words, gcodes or {}, mcodes or {})
 
+    def _set_feed(self, block: Block, word: tuple) -> None:
+        if word[0] < 0.0:
+            self._fail("Negative f word used", block, word[1])
+        self.feed = word[0]
+
     def _update_fast(self) -> None:
         """Whether a block of plain X/Y/Z words can take the fast path (nothing to check)."""
         motion = self.motion
@@ -510,7 +515,7 @@ class Interpreter:
         """The hot path: a block of axis words (and F) continuing the modal motion."""
         f = words.get("F")
         if f is not None:
-            self.feed = f[0]
+            self._set_feed(block, f)
             self._update_fast()
         if motion > 1.0:
             return self._arc(block, words, motion, None, None)
@@ -533,7 +538,7 @@ class Interpreter:
         """`G0`-`G3` and words that need no check: what `_execute` does with such a block."""
         f = words.get("F")
         if f is not None:
-            self.feed = f[0]
+            self._set_feed(block, f)
         self.motion = motion
         if motion > 1.0:
             event: Event = self._arc(block, words, motion, motion_item, motion_item)
@@ -559,7 +564,7 @@ class Interpreter:
         if 5 in gcodes:
             self.inverse_time = gcodes[5][0] == 93.0
         if "F" in words:
-            self.feed = words["F"][0]
+            self._set_feed(block, words["F"])
         if 2 in gcodes:
             self._set(plane=int(gcodes[2][0]))
         if 6 in gcodes:
@@ -649,7 +654,7 @@ class Interpreter:
             p = words.get("P", (0.0,))[0]
             if abs(p - round(p)) > 0.0001:
                 self._fail("P value not an integer with G10", block, words["P"][1])
-            if l_number in (2.0, 20.0) and not 0 <= round(p) <= 9:
+            if l_number in (2.0, 20.0) and ("P" not in words or not 0 <= round(p) <= 9):  # P0: the current system
                 self._fail(f"P value out of range (0-9) with G10 L{l_number:.0f}", block, words.get("P", (0, mode0_item))[1])
         cycle = motion in _CYCLES
         for letter in "ABC":

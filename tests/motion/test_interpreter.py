@@ -186,6 +186,10 @@ def test_zero_to_a_negative_power_is_an_error():
         ("G0 X1\nG2 X10 F1\n", 2, 1, "R i j k words all missing for arc"),
         ("G2 X10 I5 R5 F1\n", 1, 1, "Mixed radius ijk format for arc"),
         ("G2 X10 R3 F1\n", 1, 1, "Arc radius too small to reach end point"),
+        ("G1 X1 F-5\n", 1, 7, "Negative f word used"),
+        ("G1 F100\nX1 F-5\n", 2, 4, "Negative f word used"),
+        ("G10 L2 X3\n", 1, 1, "P value out of range (0-9) with G10 L2"),
+        ("G10 L20 X3\n", 1, 1, "P value out of range (0-9) with G10 L20"),
         # rs274ngc's RADIUS_TOLERANCE_INCH (0.00005 in, 0.00127 mm), not the 0.002 mm of other checks
         ("G21 G2 X20.0026 R10 F1\n", 1, 5, "Arc radius too small to reach end point"),
         ("G20 G2 X20.00011 R10 F1\n", 1, 5, "Arc radius too small to reach end point"),
