@@ -740,10 +740,12 @@ class Interpreter:
         added; G43.1: the axis words; G49: none.  In program units, as the control applies them."""
         code, item = code_item
         new = [0.0] * 9
-        if code == 43.1:
-            for letter, (value, _) in words.items():
-                if letter in AXIS_INDEX:
-                    new[AXIS_INDEX[letter]] = value
+        if code == 43.1:  # the axes it names; the others keep their offset (rs274ngc)
+            new = self.tool[:]
+            given = [(AXIS_INDEX[letter], value) for letter, (value, _) in words.items() if letter in AXIS_INDEX]
+            for i, value in given:
+                new[i] = value
+            self._note_axes(given)
         elif code in (43.0, 43.2):
             number = self._tool_number(words["H"], block) if "H" in words else 0
             table = self._table_offsets(number or self.spindle_tool, words.get("H", (0, item))[1], block)

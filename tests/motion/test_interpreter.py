@@ -126,6 +126,12 @@ def test_tool_length_g43_1_shifts_the_program_position():
     assert events[2].context.offset[2] == 0.0
 
 
+def test_g43_1_sets_the_axes_it_names_and_keeps_the_others():
+    """As rs274ngc: `G43.1 Z2` then `G43.1 X1` is an offset of X1 Z2 (was X1 Z0)."""
+    events = moves("G43.1 Z2\nG43.1 X1\nG53 G0 Z0\n")
+    assert events[-1].context.offset[:3] == (1.0, 0.0, 2.0)
+
+
 def test_fractional_line_numbers_and_block_delete_are_read():
     assert len(moves("N10.5 G0 X1\n/G0 X2\n")) == 2
 
