@@ -225,6 +225,14 @@ class Flow:
             found = self._controls[key] = control_of(block)
             return found
 
+    def _nothing_after(self, block: Block, control: Control) -> None:
+        """rs274ngc reads nothing after an o-word's arguments but a comment (`o1 if [1] G1 X1`
+        would otherwise run the if and drop the move)."""
+        items = block.items
+        for item in items[items.index(control.item) + 1 :]:
+            if type(item) is not Comment:
+                raise NcppError("Unexpected character after O-word", Location(self.file, block.line, item.start + 1))
+
     def _rest(self) -> Iterator[tuple[Block, str, Block | None]]:
         """After the program's end: every block not yet written, as text."""
         for line in range(self.written, self.read):
@@ -276,6 +284,8 @@ class Flow:
     # -- control lines -----------------------------------------------------------
     def _control(self, frame: _Frame, block: Block, control: Control) -> Iterator[tuple[Block, str, Block | None]]:
         """Run one control line: decide (errors point at it), write it, then jump."""
+        if control.keyword not in ("m98", "m99"):
+            self._nothing_after(block, control)
         if type(control.name) is tuple:
             value = self.evaluate(control.name, block, control.item)
             control = Control(str(int(round_half_away(value))), control.keyword, control.arguments, control.item)

@@ -63,6 +63,7 @@ REFUSED = {
     "M98 L0 (rs274ngc stays a call level deeper): the caller's names": (HEAD + "#<a> = 1\nM98 P9 L0\nG0 X#<a>\nM30\nO9\nG0 Y1\nM99\n", 5),
     "M98 L0: the caller's loops": (HEAD + "#1 = 0\no1 while [#1 LT 2]\n#1 = [#1 + 1]\nM98 P9 L0\no1 endwhile\nM30\nO9\nG0 Y1\nM99\n", 7),
     "endwhile outside a loop": (HEAD + "G0 X1\no1 endwhile\n", 4),
+    "a move after an o-word (was: the if ran, the move was dropped)": (HEAD + "o1 if [1] G1 X1\no1 endif\n", 3),
     "calls ten levels deep": (HEAD + "o<f> sub\n o1 if [#1 GT 0]\n  G0 X#1\n  o<f> call [#1 - 1]\n o1 endif\no<f> endsub\no<f> call [9]\n", 6),
     "a subroutine that calls itself for ever (was: memory without end)": (HEAD + "o100 sub\nG1 X1 F100\no100 call\no100 endsub\no100 call\n", 5),
     "a Fanuc subprogram that calls itself": (HEAD + "M98 P1\nM30\nO1\nG1 X1 F100\nM98 P1\nM99\n", 7),
