@@ -128,7 +128,7 @@ class _Circle:
         )
 
 
-# Numbers an F or S word takes on a control (Fanuc and LinuxCNC: up to 8 digits before the point)
+# The largest number an NC word holds (Fanuc and LinuxCNC: up to 8 digits before the point)
 MAX_WORD = 99_999_999.0
 
 
@@ -138,14 +138,6 @@ def feed_rate(rec: Record) -> float:
     if not 0 < f <= MAX_WORD:
         raise NcppError(f"{rec.major}: expected a feed rate above 0 and at most {MAX_WORD:,.0f}, got {f:g}", rec.where)
     return f
-
-
-def spindle_speed(rec: Record) -> float:
-    """SPINDL/n: a speed from 0 on (the direction is CLW or CCLW, not a sign)."""
-    n = rec.numbers[0]
-    if not 0 <= n <= MAX_WORD:
-        raise NcppError(f"{rec.major}: expected a spindle speed from 0 to {MAX_WORD:,.0f} (turning CLW or CCLW), got {n:g}", rec.where)
-    return n
 
 
 def _position(rec: Record, values: list[float]) -> Point:
@@ -162,12 +154,12 @@ def _unit(vector: tuple[float, ...]) -> tuple[float, ...]:
     return tuple(v / length for v in vector) if length > 0 else tuple(vector)
 
 
-def _check_along_z(vector: tuple[float, ...], rec: Record) -> None:
-    """A 3-axis machine holds its tool along +Z: CL data for a tool along another vector
-    (a horizontal spindle, a tilted head) puts the tool's length elsewhere."""
-    if not all(abs(v - z) <= AXIS_TOL for v, z in zip(_unit(vector), (0.0, 0.0, 1.0))):
+def _check_along_z(unit: tuple[float, ...], rec: Record) -> None:
+    """A 3-axis machine holds its tool along +Z: CL data for a tool along another `unit`
+    vector (a horizontal spindle, a tilted head) puts the tool's length elsewhere."""
+    if not all(abs(v - z) <= AXIS_TOL for v, z in zip(unit, (0.0, 0.0, 1.0))):
         raise NcppError(
-            f"the tool vector ({', '.join(f'{v:g}' for v in vector)}) is not along +Z: "
+            f"the tool vector ({', '.join(f'{v:g}' for v in unit)}) is not along +Z: "
             "the post drives a 3-axis machine whose tool points along Z (0, 0, 1)",
             rec.where,
         )

@@ -116,7 +116,7 @@ def uniform_grid(
     if spacing is None:
         step = finest
     else:
-        if not 0 < spacing < math.inf:
+        if spacing <= 0:
             raise NcppError("--spacing must be positive")
         step = spacing
         if spacing < finest:

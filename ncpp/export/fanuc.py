@@ -62,10 +62,6 @@ def write_fanuc_pitch(
     `reference_number` is 3620; by default the lowest that keeps every
     section number >= 0."""
     notes: list[str] = []
-    if spacing is not None and not 0 < spacing < math.inf:
-        raise NcppError(f"--spacing must be a positive number of mm, not {spacing!r}")
-    if not math.isfinite(reference):
-        raise NcppError(f"--reference must be a finite number of mm, not {reference!r}")
     lo, hi = error.lo, error.hi
     reference = reference_on_travel(error, reference, notes)
     du = detection_unit

@@ -373,6 +373,7 @@ def _convert_column(
             runs.append(run)
         return np.array(runs, dtype=np.int64)
     numbers = np.empty(len(values))
+    limit, unit, beyond = _range_of(name)
     for k, value in enumerate(values):
         try:
             numbers[k] = float(value)
@@ -382,18 +383,14 @@ def _convert_column(
             raise fail(k, f"{name}: {value!r} is not a finite number")
         if name == "angle_deg" and not 0.0 <= numbers[k] < 360.0:
             raise fail(k, f"angle_deg must be in [0, 360), got {value}")
-        problem = _out_of_range(name, numbers[k])
-        if problem:
-            raise fail(k, f"{name}: {value} is out of range: {problem}")
+        if abs(numbers[k]) > limit:
+            raise fail(k, f"{name}: {value} is out of range: beyond ±{limit:.4g} {unit} {beyond}")
     return numbers
 
 
-def _out_of_range(name: str, value: float) -> str | None:
-    """Why a length or angle column's value is beyond what the evaluations can use, or None."""
-    for ending, (limit, unit, beyond) in _RANGES.items():
-        if name.endswith(ending) and abs(value) > limit:
-            return f"beyond ±{limit:.4g} {unit} {beyond}"
-    return None
+def _range_of(name: str) -> tuple[float, str, str]:
+    """(largest magnitude, unit, what lies beyond) of a length or angle column; no limit for others."""
+    return next((r for ending, r in _RANGES.items() if name.endswith(ending)), (math.inf, "", ""))
 
 
 def _check_meta(m: Measurement, header_line: int, meta_lines: Mapping[str, int]) -> None:

@@ -14,7 +14,7 @@ import re
 from dataclasses import dataclass
 from typing import Callable, Iterable, Iterator
 
-from ncpp.cldata.motion import spindle_speed, units_inch
+from ncpp.cldata.motion import MAX_WORD, units_inch
 from ncpp.cldata.reader import Record
 from ncpp.errors import Location, NcppError, Warnings
 from ncpp.motion.segments import PLANE_AXES, Arc, Event, Line, Pass, Point, replace
@@ -183,7 +183,7 @@ class Generator:
             if "ON" in words:
                 yield from self.emit_m(3)
             return
-        yield from self.emit_spindle(spindle_speed(rec), "CCLW" not in words)
+        yield from self.emit_spindle(_spindle_speed(rec), "CCLW" not in words)
 
     # -- helpers for dialects ----------------------------------------------------
     @property
@@ -238,8 +238,7 @@ class Generator:
         raise NotImplementedError
 
 
-# Tool numbers a control takes (Fanuc and LinuxCNC: up to 8 digits)
-MAX_TOOL = 99_999_999
+MAX_TOOL = int(MAX_WORD)  # tool numbers a control takes
 
 
 def _tool_number(rec: Record) -> int:
@@ -248,6 +247,14 @@ def _tool_number(rec: Record) -> int:
     if not numbers or numbers[0] != int(numbers[0]) or not 0 <= numbers[0] <= MAX_TOOL:
         raise NcppError(f"{rec.major}: expected a tool number from 0 to {MAX_TOOL:,}", rec.where)
     return int(numbers[0])
+
+
+def _spindle_speed(rec: Record) -> float:
+    """SPINDL/n: a speed from 0 on (the direction is CLW or CCLW, not a sign)."""
+    n = rec.numbers[0]
+    if not 0 <= n <= MAX_WORD:
+        raise NcppError(f"{rec.major}: expected a spindle speed from 0 to {MAX_WORD:,.0f} (turning CLW or CCLW), got {n:g}", rec.where)
+    return n
 
 
 def _named_number(rec: Record, names: tuple[str, ...]) -> float | None:

@@ -6,7 +6,9 @@ import io
 
 import pytest
 
-from ncpp.errors import NcppError
+from ncpp.errors import NcppError, Warnings
+from ncpp.motion.segments import Pass
+from ncpp.motion.sinumerik import interpret
 from ncpp.program.blocks import Comment, ExprWord, Statement, Word
 from ncpp.program.parser import LineParser, parse_stream
 
@@ -141,8 +143,6 @@ def test_bad_input_names_file_line_and_column():
 def test_an_exponent_written_with_e_is_refused_not_read_as_an_address(block, column, message):
     """`X=1e3` parses as `X=1` and a word E3 (as on the control, where E is no exponent): moving
     to X1 would be a silently wrong program."""
-    from ncpp.motion.sinumerik import interpret
-
     blocks = parse_stream(io.BytesIO(f"G0 X100\n{block}\nM30\n".encode()), "e.mpf", "sinumerik")
     with pytest.raises(NcppError) as err:
         list(interpret(blocks, file="e.mpf"))
@@ -150,8 +150,6 @@ def test_an_exponent_written_with_e_is_refused_not_read_as_an_address(block, col
 
 
 def test_an_exponent_written_with_ex_is_a_number():
-    from ncpp.motion.sinumerik import interpret
-
     blocks = parse_stream(io.BytesIO(b"G0 X100\nG1 X=1EX2 F100\nX=1 E3\nM30\n"), "e.mpf", "sinumerik")
     ends = [e.end[0] for e in interpret(blocks, file="e.mpf") if hasattr(e, "end")]
     assert ends == [100.0, 100.0, 1.0]  # `X=1 E3` apart: an address E, as the control reads it
@@ -167,12 +165,8 @@ def test_an_exponent_written_with_ex_is_a_number():
 )
 def test_geometry_the_interpreter_does_not_follow_ends_interpretation(block, what):
     """`G2 AR=90 I5` was read as a full circle about I5 (AR ignored), and AR=90 copied into every piece."""
-    from ncpp.errors import Warnings
-    from ncpp.motion.segments import Pass
-    from ncpp.motion.sinumerik import interpret
-
     said = io.StringIO()
     blocks = parse_stream(io.BytesIO(f"G0 X0 Y0 Z0\n{block}\nG1 X3\nM30\n".encode()), "a.mpf", "sinumerik")
     events = list(interpret(blocks, file="a.mpf", warnings=Warnings(stream=said)))
-    assert f"a.mpf:2:" in said.getvalue() and f"warning: {what} is outside" in said.getvalue()
+    assert "a.mpf:2:" in said.getvalue() and f"warning: {what} is outside" in said.getvalue()
     assert all(type(e) is Pass for e in events if e.block.line >= 2)
