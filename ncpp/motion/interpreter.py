@@ -408,6 +408,10 @@ class Interpreter:
                 if what == "assignment":
                     target, expr = item.node
                     key = self._param_key(target, block, item)
+                    if type(key) is str and not self.params.exists(key):
+                        # rs274ngc creates the name (at 0) as it reads it: the rest of the line,
+                        # the value's expression too, reads 0; the value is set after the line
+                        self.params.write(key, 0.0)
                     assignments = assignments or []
                     assignments.append((key, self._evaluate(expr, block, item), item))
                 elif what == "oword" and len(item.node) == 1:  # `O<name>` alone: a program's name

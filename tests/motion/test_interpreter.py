@@ -169,6 +169,15 @@ def test_undefined_named_parameter_is_an_error():
     assert (err.where.line, err.where.col, err.message) == (1, 4, "Named parameter #<nothing> not defined")
 
 
+def test_a_name_assigned_on_a_line_reads_0_there_as_in_rs274ngc():
+    """rs274ngc creates a name as it reads its assignment: the rest of the line (the value's
+    expression too) reads 0, the next line the value (was: refused as not defined)."""
+    events = moves("#<r> = [#<r> + 5] G0 X#<r>\nG0 X#<r>\n#<_g> = 3 #<_g> = 7 G0 Y#<_g>\nG0 Y#<_g>\n")
+    assert [e.end[:2] for e in events] == [(0.0, 0.0), (5.0, 0.0), (5.0, 0.0), (5.0, 7.0)]
+    err = error("G0 X#<q> #<q> = 5\n")  # read before the assignment: not defined yet
+    assert (err.where.line, err.where.col, err.message) == (1, 4, "Named parameter #<q> not defined")
+
+
 def test_divide_by_zero_is_an_error():
     err = error("G0 X0\nG0 X[1/0]\n")
     assert (err.where.line, err.where.col, err.message) == (2, 4, "Attempt to divide by zero")
