@@ -580,11 +580,13 @@ class Flow:
 
 def control_of(block: Block) -> Control | None:
     """The block's control line, if it is one: an o-word (`O<name>` alone, a program
-    name, is not), or a line of only M98 P.. L.. or M99 (N and comments aside)."""
+    name, is not), or a line of only M98 P.. L.. or M99 (N, comments and a leading `/` aside)."""
     words: dict[str, Word | ExprWord] = {}
     for item in block.items:
         kind = type(item)
         if kind is Statement:
+            if item.kind == "block_delete" and not words:  # `/o1 endsub`: with the switch off (rs274's) the line runs
+                continue
             if item.kind != "oword" or len(item.node) < 2 or words:
                 return None
             head, rest = item.node[0], item.node[1:]

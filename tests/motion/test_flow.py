@@ -52,6 +52,7 @@ AGREE = {
     "fanuc: L0 runs nothing": HEAD + "#1 = 1\nM98 P9 L0\nG0 X#1\nM30\nO9\nG0 Y1\nM99\n",
     "fanuc: the first of two definitions": HEAD + "M98 P0002\nM30\nO0002\nG0 X1\nM99\nO2\nG0 X2\nM99\n",
     "calls nine levels deep": HEAD + "o<f> sub\n o1 if [#1 GT 0]\n  G0 X#1\n  o<f> call [#1 - 1]\n o1 endif\no<f> endsub\no<f> call [8]\n",
+    "block-deleted control lines run (the switch is off; was: o-word lines passed through)": HEAD + "#1 = 1\n/o1 sub\nG1 X1\n/o1 endsub\n/o2 if [#1 EQ 1]\n/o1 call\n/o2 endif\n/M98 P9\nG1 Y2\nM30\nO9\nG1 Z3\nM99\n",
     "modes a subroutine leaves": HEAD + "o1 sub\n G91 G1 X1\n G18\no1 endsub\nG1 X5 Y5\no1 call\nX1 Z1\nG2 X2 Z0 I1 K0\nG90\n",
 }
 
