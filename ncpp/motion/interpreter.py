@@ -38,7 +38,7 @@ from ncpp.motion.flow import FIXED, RUN, SKIP, Flow
 from ncpp.motion.segments import CYCLE, FLOW, PLANE_AXES, Arc, Context, Event, Line, Pass
 from ncpp.motion.snapshot import attributes
 from ncpp.motion.tools import UntoldLengths
-from ncpp.program.blocks import Block, Comment, ExprWord, Word
+from ncpp.program.blocks import UNREADABLE, Block, Comment, ExprWord, Statement, Word
 
 MM_PER_INCH = 25.4
 AXES = "XYZABCUVW"
@@ -216,6 +216,8 @@ class Interpreter:
         flow = self.flow = Flow(self.file, self._evaluate, self.params, lambda: self.done, self._leave_scope, self.subroutine_path)
         for block, kind, owner in flow.steps(blocks):
             if kind is not RUN and kind is not FIXED:  # text that does not run here
+                if block.signature is None:
+                    _warn_unreadable(block, warnings)
                 ev = Pass(block, kind is SKIP, None if self.done else self.motion)  # (after the end: no mode the control is in)
                 if pending is not None:
                     held.append(ev)
@@ -416,6 +418,8 @@ class Interpreter:
                     assignments.append((key, self._evaluate(expr, block, item), item))
                 elif what == "oword" and len(item.node) == 1:  # `O<name>` alone: a program's name
                     pass
+                elif what == UNREADABLE:  # read where it runs, as rs274ngc reads it
+                    raise item.node[0]
                 elif what not in IGNORED_STATEMENTS:
                     raise _OutOfScope(OUT_OF_SCOPE_STATEMENT.get(what, what), item.start + 1)
                 continue
@@ -1204,6 +1208,15 @@ _PLAIN_LETTERS = {
     3.0: frozenset("XYZABCUVWFIJKR"),
     **{code: frozenset() for code in CANNED},  # a cycle's words are checked in full
 }
+
+
+def _warn_unreadable(block: Block, warnings: Warnings) -> None:
+    """A line the grammar cannot read that does not run here (an uncalled subroutine, an untaken
+    branch, the text after M2) passes through as it is, as LinuxCNC leaves it unread: a warning."""
+    items = block.items
+    if len(items) == 1 and type(items[0]) is Statement and items[0].kind == UNREADABLE:
+        err = items[0].node[0]
+        warnings.warn(f"{err.message}; the line does not run here and passes through as it is", err.where)
 
 
 def _corner_word(words: dict, motion: float) -> tuple[str, float, Word | ExprWord] | None:

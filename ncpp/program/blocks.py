@@ -91,8 +91,9 @@ class Statement(Item):
     """A construct the motion interpreter does not execute directly.
 
     kind: 'block_delete', 'assignment', 'oword', 'program_name', 'tape',
-    'checksum', 'if', 'while', 'end', 'goto'.  `node` holds its parsed parts
-    (a tuple whose shape depends on kind).
+    'checksum', 'if', 'while', 'end', 'goto', 'unreadable' (a line the grammar
+    cannot read: `node` holds the error, raised where the line runs).  `node`
+    holds its parsed parts (a tuple whose shape depends on kind).
     """
 
     __slots__ = ("kind", "node")
@@ -102,6 +103,8 @@ class Statement(Item):
         self.kind = kind
         self.node = node
 
+
+UNREADABLE = "unreadable"  # the kind of a `Statement` standing for a line the grammar cannot read
 
 AnyItem = Union[Word, ExprWord, Comment, Statement]
 

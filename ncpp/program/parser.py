@@ -26,7 +26,7 @@ from lark import Discard, Token, Transformer, v_args
 
 from ncpp.cache import cached_build
 from ncpp.errors import Location, NcppError
-from ncpp.program.blocks import DIGITS_AS_ONE, AnyItem, Block, Comment, ExprWord, Statement, Word
+from ncpp.program.blocks import DIGITS_AS_ONE, UNREADABLE, AnyItem, Block, Comment, ExprWord, Statement, Word
 
 _GAP_CHARS = " \t\r\f\v\x1a"  # blanks between items (a regex class body: SUB as itself, no digit in the pattern)
 _GAP = f"[{_GAP_CHARS}]*"
@@ -182,7 +182,10 @@ class Dialect:
     (WORD / COMMA_WORD become words, PAREN_COMMENT a `(` comment, SEMI_COMMENT
     a `;` comment); none means every block goes through the LALR parser.
     `continuation` is the mark that, ending a line, continues its block on
-    the next line (Heidenhain `~`).
+    the next line (Heidenhain `~`).  `read_where_run`: a line the grammar cannot
+    read is an error where it runs, not where it stands (rs274ngc reads only the
+    lines it runs: an uncalled subroutine, an untaken branch, the text after M2
+    may hold anything): it becomes a block of one `unreadable` statement.
     """
 
     name: str
@@ -190,6 +193,7 @@ class Dialect:
     builder: type[Transformer]
     fast_terminals: tuple[str, ...] = ()
     continuation: str | None = None
+    read_where_run: bool = False
 
 
 def dialect_syntax(dialect: "str | Dialect") -> Dialect:
@@ -246,7 +250,7 @@ class LineParser:
     def parse(self, raw: str, eol: str = "", line: int = 0, file: str = "<stdin>") -> Block:
         plain = self._scan_plain(raw)
         if plain is None:
-            block = Block(raw, eol, self._parse_lalr(raw, line, file), line)
+            block = Block(raw, eol, self._read_lalr(raw, line, file), line)
         else:
             items, signature = plain
             block = Block(raw, eol, items, line, False, signature)
@@ -334,6 +338,18 @@ class LineParser:
         if pos == len(raw) or self._blank.match(raw, pos):
             return tuple(items), (None if two_letters else signature)
         return None
+
+    def _read_lalr(self, raw: str, line: int, file: str) -> tuple[AnyItem, ...]:
+        """`_parse_lalr`; where the dialect reads lines where they run, a line it cannot
+        read is one `unreadable` statement holding the error (`Dialect.read_where_run`)."""
+        if not self.dialect.read_where_run:
+            return self._parse_lalr(raw, line, file)
+        try:
+            return self._parse_lalr(raw, line, file)
+        except NcppError as err:
+            if err.message == BOM_MESSAGE:  # the file's, not a line's
+                raise
+            return (Statement(UNREADABLE, (err,), 0, len(raw)),)
 
     def _parse_lalr(self, raw: str, line: int, file: str) -> tuple[AnyItem, ...]:
         trees = self._trees

@@ -10,6 +10,7 @@ import re
 import pytest
 
 from ncpp.errors import NcppError
+from ncpp.program.blocks import UNREADABLE
 from ncpp.program.parser import LineParser, _Cut, _digits_named, _flatten, _TreeLayouts, lalr_parser, parse_stream
 from tests.conftest import corpus_files
 
@@ -96,7 +97,8 @@ def test_replay_agrees_with_the_lalr_parser_on_corpus(dialect):
             known = parser._trees.known.get(parser._trees.layout(block.raw))
             replays += known is not None
             cuts += type(known) is _Cut
-            assert replayed(parser, block.raw) == fresh(parser, block.raw), (path, block.line)
+            want, got = fresh(parser, block.raw), replayed(parser, block.raw)
+            assert got == want if isinstance(want, tuple) else not isinstance(got, tuple), (path, block.line)
             checked += 1
     assert checked > {"iso": 5000, "heidenhain": 200, "sinumerik": 100}[dialect]
     assert replays > {"iso": 10000, "heidenhain": 50, "sinumerik": 15}[dialect]  # lines built by the replay itself
@@ -144,6 +146,5 @@ def test_layouts_keep_digits_after_letters_only_where_the_grammar_names_them():
 def test_a_replayed_line_with_an_error_is_reported_as_its_own_parse_reports_it():
     parser = LineParser("iso")
     parser.parse("G1 X[1+2]", "", 1, "t.ngc")
-    with pytest.raises(NcppError) as err:
-        parser.parse("G1 X[1+2", "", 7, "t.ngc")
-    assert err.value.where.line == 7
+    (unreadable,) = parser.parse("G1 X[1+2", "", 7, "t.ngc").items  # (an error where the line runs)
+    assert unreadable.kind == UNREADABLE and unreadable.node[0].where.line == 7

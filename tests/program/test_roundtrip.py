@@ -8,7 +8,8 @@ import sys
 
 import pytest
 
-from ncpp.errors import NcppError
+from ncpp.errors import NcppError, Warnings
+from ncpp.pipeline import process
 from ncpp.program.dialects import parse_program
 from ncpp.program.parser import LineParser, parse_stream
 from ncpp.program.writer import write_blocks
@@ -40,11 +41,35 @@ def test_malformed_but_readable_programs_roundtrip(path):
 
 @pytest.mark.parametrize("name", sorted(UNREADABLE))
 def test_unreadable_programs_name_file_line_and_column(name):
+    """A line the grammar cannot read is read as it stands (byte for byte) and refused
+    where it runs, as rs274ngc reads it (`Dialect.read_where_run`)."""
     path = next(p for p in MALFORMED if p.name == name)
-    with pytest.raises(NcppError) as err:
-        roundtrip(path.read_bytes(), str(path))
+    assert roundtrip(path.read_bytes(), str(path)) == path.read_bytes()
+    with pytest.raises(NcppError) as err, open(path, "rb") as stream:
+        process(stream, io.BytesIO(), file=str(path))
     where = err.value.where
     assert where.file == str(path) and where.line >= 1 and where.col >= 1
+
+
+def test_unreadable_lines_that_do_not_run_pass_through_with_a_warning(tmp_path):
+    """rs274 reads only the lines it runs: a broken line in an uncalled subroutine, an untaken
+    branch or after M2 is no error there (was refused); it passes through with a warning,
+    refused with --strict, and one that runs is refused with its own line and column."""
+    text = "G21 G90\no1 sub\nG1 X1 F100 Q\no1 endsub\nG1 Y2 F100\no2 if [0]\nG1 X[1+\no2 endif\nM2\nX?3 (notes)\n"
+    path = tmp_path / "dead.ngc"
+    path.write_text(text)
+    said = io.StringIO()
+    out = io.BytesIO()
+    with open(path, "rb") as stream:
+        process(stream, out, file=str(path), warnings=Warnings(stream=said))
+    assert out.getvalue() == text.encode()
+    assert [line.split(": warning")[0] for line in said.getvalue().splitlines()] == [f"{path}:3:12", f"{path}:7:7", f"{path}:10:2"]
+    with pytest.raises(NcppError, match="the line does not run here"), open(path, "rb") as stream:
+        process(stream, io.BytesIO(), file=str(path), strict=True)
+    path.write_text(text.replace("o2 if [0]", "o2 if [1]"))
+    with pytest.raises(NcppError) as err, open(path, "rb") as stream:
+        process(stream, io.BytesIO(), file=str(path))
+    assert (err.value.where.line, err.value.where.col) == (7, 7)
 
 
 def test_fast_path_agrees_with_lalr_parser_on_corpus():
@@ -82,7 +107,7 @@ def test_a_stray_character_is_left_to_the_lalr_parser(raw):
     parser = LineParser("iso")
     assert parser._scan_plain(raw) is None
     with pytest.raises(NcppError):
-        parser.parse(raw, "", 1, "t.ngc")
+        parser._parse_lalr(raw, 1, "t.ngc")
 
 
 def test_cli_passthrough_is_byte_identical(tmp_path):

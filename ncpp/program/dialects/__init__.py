@@ -18,7 +18,7 @@ from ncpp.program.parser import Dialect, LineParser, NumberedLines, _ItemBuilder
 DIALECTS = ("iso", "heidenhain", "sinumerik")
 SNIFF_BYTES = 4096
 
-ISO = Dialect("iso", "iso", _ItemBuilder, fast_terminals=LineParser.FAST_TERMINALS)
+ISO = Dialect("iso", "iso", _ItemBuilder, fast_terminals=LineParser.FAST_TERMINALS, read_where_run=True)
 # File name endings that name a dialect when the content does not tell.
 SUFFIXES = {".h": "heidenhain", ".mpf": "sinumerik", ".spf": "sinumerik"}
 
