@@ -6,8 +6,12 @@ few of the large ones (3D_Chips, systems, spiral_tangent_test); the other
 large files (bear, cameo, tball-pocket, 3D_Chips_abort: 5-13 s each, same
 constructs) are left to the benchmark.  A program rs274 refuses only for a
 missing program end (the short cncjs arc samples, G18/G19 among them) gets
-`M2` appended.  Each is placed in the HR5B's travel (the Valmet's when it is
-too large) and compensated at 1 µm with the HR5B's model, reversal included.
+`M2` appended.  rs274 reads a tool table of tools 1-99 (0.01 mm diameter,
+length 0), so that programs changing tools or compensating the cutter radius
+are checked too (the wrapper's table has T1 alone: 8 programs more).  Each is
+placed in the HR5B's travel (the Valmet's when it is too large), every work
+system at one zero (mmount.ngc cuts in G55), and compensated at 1 µm with the
+HR5B's model, reversal included.
 """
 
 from __future__ import annotations
@@ -17,6 +21,7 @@ import subprocess
 import pytest
 
 from ncpp.machine import load_machine
+from ncpp.motion.offsets import SYSTEMS, WorkOffsets
 from ncpp.simulate import sample_events
 from tests.compensation.conftest import compensate, events_of, placement
 from tests.conftest import CORPUS, ROOT, RS274, corpus_files, corpus_id
@@ -32,8 +37,16 @@ def programs() -> list:
     return small + [CORPUS / "iso_gcode" / name for name in LARGE]
 
 
-def rs274(path) -> subprocess.CompletedProcess:
-    return subprocess.run([str(RS274), str(path)], capture_output=True, text=True, timeout=120)
+def rs274(path, tools) -> subprocess.CompletedProcess:
+    return subprocess.run([str(RS274), "-t", str(tools), str(path)], capture_output=True, text=True, timeout=120)
+
+
+@pytest.fixture(scope="module")
+def tools(tmp_path_factory):
+    """A tool table of tools 1-99 (rs274's last -t is the one it reads)."""
+    path = tmp_path_factory.mktemp("tools") / "tools.tbl"
+    path.write_text("".join(f"T{n} P{n} D0.01 Z0\n" for n in range(1, 100)))
+    return path
 
 
 @pytest.fixture(scope="module")
@@ -43,13 +56,13 @@ def machines():
 
 @pytest.mark.skipif(not RS274.exists(), reason="rs274 oracle not available")
 @pytest.mark.parametrize("path", programs(), ids=corpus_id)
-def test_rs274_accepts_compensated_program(path, machines, tmp_path):
+def test_rs274_accepts_compensated_program(path, machines, tools, tmp_path):
     data = path.read_bytes()
-    before = rs274(path)
+    before = rs274(path, tools)
     if before.returncode != 0 and MISSING_END in before.stderr:
         data += b"\nM2\n"
         (tmp_path / "original.ngc").write_bytes(data)
-        before = rs274(tmp_path / "original.ngc")
+        before = rs274(tmp_path / "original.ngc", tools)
     if before.returncode != 0:
         pytest.skip(f"rs274 refuses the original: {before.stderr.strip().splitlines()[-2:]}")
     nominal = sample_events(events_of(data, str(path)), step_mm=5.0)
@@ -60,7 +73,7 @@ def test_rs274_accepts_compensated_program(path, machines, tmp_path):
     else:
         pytest.skip("no motion, or too large for the sample machines' travel")
     out = tmp_path / "compensated.ngc"
-    out.write_bytes(compensate(data, machine, offset, name=str(path)))
-    after = rs274(out)
+    out.write_bytes(compensate(data, machine, WorkOffsets.of(dict.fromkeys(SYSTEMS, offset)), name=str(path)))  # (G55.. at G54's zero)
+    after = rs274(out, tools)
     assert after.returncode == 0, after.stderr[-500:]
     assert "error" not in (after.stdout + after.stderr).lower()
