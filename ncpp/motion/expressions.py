@@ -127,8 +127,9 @@ class Parameters:
     `system` answers reads of LinuxCNC's predefined read-only names
     (`#<_x>`, `#<_metric>`...) from the interpreter's state; numbered
     parameters the interpreter keeps in machine state (work offsets, G28
-    positions, current position: 5161-5390, 5400-5428) are out of scope
-    because their values depend on the control's own files and units.
+    positions, current position: 5161-5390, 5400-5428) are out of scope,
+    read or written, because their values depend on the control's own files
+    and units.
     """
 
     def __init__(self, system: Callable[[str], float | None] | None = None):
@@ -174,9 +175,8 @@ class Parameters:
 
     def read(self, key: int | str) -> float:
         if type(key) is int:
-            if 5161 <= key <= 5390 or 5400 <= key <= 5428:
-                if key not in self.numbered:
-                    raise OutOfScope(f"machine-state parameter #{key}")
+            if _machine_state(key):
+                raise OutOfScope(f"machine-state parameter #{key}")
             return self.numbered.get(key, 0.0)
         value = self.named.get(key)
         if value is not None:
@@ -196,11 +196,19 @@ class Parameters:
 
     def write(self, key: int | str, value: float) -> None:
         if type(key) is int:
+            if _machine_state(key):  # the control's zeros follow it, in its own units: not the interpreter's
+                raise OutOfScope(f"a write to the machine-state parameter #{key}")
             self.numbered[key] = value
             return
         if key.startswith("_") and self.system is not None and self.system(key) is not None:
             raise ExpressionError(f"Cannot assign to read-only parameter #<{key}>")
         self.named[key] = value
+
+
+def _machine_state(key: int) -> bool:
+    """Numbered parameters the control keeps: G28/G30 positions, G92, the work offsets
+    (5161-5390) and the tool in the spindle (5400-5428)."""
+    return 5161 <= key <= 5390 or 5400 <= key <= 5428
 
 
 # Predefined names whose values live in the control (tool table, spindle, task state).

@@ -453,6 +453,8 @@ class Interpreter:
                     self.params.write(key, value)
                 except ExpressionError as err:
                     self._fail(str(err), block, item)
+                except OutOfScope as err:
+                    raise _OutOfScope(str(err), item.start + 1) from None
         if mcodes is None:
             if gcodes is None:
                 if not words:

@@ -260,6 +260,9 @@ def test_arc_radius_tolerance_matches_linuxcnc_files():
         ("G41 D1 G1 X1 F1\n", "cutter compensation G41"),
         ("G0 @10 ^45\n", "polar coordinates"),
         ("G0 X#<_hal[x.y]>\n", "machine-state parameter"),
+        ("G0 X#5221\n", "machine-state parameter #5221"),
+        # the control's G55 zero, in its own units: was stored and not followed (G55 then ran at the zero ncpp was told)
+        ("#5241 = 10 G55\n", "a write to the machine-state parameter #5241"),
     ],
 )
 def test_out_of_scope_passes_through_with_one_warning_then_stops(text, construct):
