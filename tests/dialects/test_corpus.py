@@ -92,6 +92,15 @@ def test_sniff_rereads_the_head_and_keeps_streaming(size, monkeypatch):
     assert out.getvalue() == data
 
 
+def test_linuxcnc_constructs_outweigh_a_line_that_reads_like_a_label():
+    """A note after M2 (`Tools: ...`) reads like a Sinumerik label; o-words and `#<name>` are
+    LinuxCNC's alone (was: Sinumerik, and G21 was out of its interpreter's scope)."""
+    program = b"G21\no100 sub\nG1 X#1 F100\no100 endsub\no100 call [2]\nM2\nTools: T1 6mm\n"
+    assert detect(program) == "iso"
+    assert detect(b"#<depth> = 2\nG1 Z-#<depth>\nM2\nnote: deburr\n") == "iso"
+    assert detect(b"G21\nG1 X1 F100\nM2\nTools: T1 6mm\n") == "sinumerik"  # (no LinuxCNC construct: a label it is)
+
+
 def test_explicit_dialect_overrides_detection():
     dialect, _ = sniff(io.BytesIO(b"G1 X1\n"), None, "Sinumerik")
     assert dialect == "sinumerik"

@@ -65,6 +65,15 @@ _SINUMERIK = re.compile(
 )
 
 
+# Constructs only LinuxCNC has (o-word control lines, named parameters): they outweigh what
+# looks like Sinumerik elsewhere (a note `Tools: ...` after M2 reads like a label).
+_LINUXCNC = re.compile(
+    r"^[ \t]*(N\d+[ \t]+)?O(<[^>\n]*>|\d+)[ \t]*(SUB|ENDSUB|CALL|RETURN|IF|ELSEIF|ELSE|ENDIF|WHILE|ENDWHILE|DO|REPEAT|ENDREPEAT|BREAK|CONTINUE)\b"
+    r"|#<[A-Za-z_]",
+    re.M | re.I,
+)
+
+
 def _code_only(text: str) -> str:
     """The text with `;` and `(...)` comments removed, line by line."""
     lines = []
@@ -85,13 +94,15 @@ def detect(first_bytes: bytes, name: str | None = None) -> str:
     `BEGIN PGM` or numbered conversational blocks mean Heidenhain; a
     `%_N_` header or a construct only Sinumerik has (`DEF`, `PROC`, `X=...`,
     `CR=`, `AC(`, `MSG(`, `GOTOF`, labels, `IF` without brackets, `$AA_...`)
-    means Sinumerik.  When the content is plain ISO-looking G code, a file
-    name ending in .h / .mpf / .spf decides.
+    means Sinumerik, unless LinuxCNC's o-word lines or `#<name>` parameters
+    are there too.  When the content is plain ISO-looking G code, a file name
+    ending in .h / .mpf / .spf decides.
     """
     text = first_bytes.decode("latin-1")
     if _HEIDENHAIN.search(text) or len(_HEIDENHAIN_BLOCK.findall(text)) >= 2:
         return "heidenhain"
-    if _SINUMERIK.search(_code_only(text)) or text.startswith("%_N_"):
+    code = _code_only(text)
+    if text.startswith("%_N_") or (_SINUMERIK.search(code) and not _LINUXCNC.search(code)):
         return "sinumerik"
     if name:
         for suffix, dialect in SUFFIXES.items():
