@@ -82,6 +82,9 @@ class _Frame:
     pc: int  # the next block to run: an index into the space (the main program: a line number from 0)
     labels: dict[str, _Label] = field(default_factory=dict)  # its loops under way
     ifs: set[str] = field(default_factory=set)  # the if chains it has started (their elseif, else and endif may follow)
+    # Per label, (index, keyword, line) of the first if, while, repeat or do it ran: rs274ngc
+    # refuses a label that opens one of these at another line (`_opens`)
+    opened: dict[str, tuple[int, str, int]] = field(default_factory=dict)
     repeats: int = 0  # a Fanuc subprogram (M98): the runs still to make after this one; -1: an o-word call
     source: str | None = None  # the subroutine file its lines are from (None: the program's)
 
@@ -417,6 +420,7 @@ class Flow:
         return found[name]
 
     def _if(self, frame, block, control, arrived):
+        self._opens(frame, block, control)
         frame.ifs.add(control.name)
         self.executed_if = self._condition(block, control)
         return self._on(frame, None if self.executed_if else control.name)
@@ -445,6 +449,7 @@ class Flow:
             raise self._error(f"{control.keyword} without o{_shown(control.name)} if", block, control)
 
     def _while(self, frame, block, control, arrived):
+        self._opens(frame, block, control)
         label = frame.labels.get(control.name)
         again = self._condition(block, control)
         if label is not None and label.kind == "do":  # the end of a do loop
@@ -476,6 +481,8 @@ class Flow:
         return lambda: setattr(frame, "pc", label.start)
 
     def _do(self, frame, block, control, arrived):
+        frame.opened.setdefault(control.name, (frame.pc, "do", block.line))
+
         def enter():
             frame.labels.setdefault(control.name, _Label("do", frame.pc))
             frame.pc += 1
@@ -483,6 +490,7 @@ class Flow:
         return enter
 
     def _repeat(self, frame, block, control, arrived):
+        self._opens(frame, block, control)
         (count,) = self._arguments(block, control, 1)
 
         def test():
@@ -510,6 +518,13 @@ class Flow:
         return self._on(frame, control.name)
 
     # -- helpers ---------------------------------------------------------------
+    def _opens(self, frame: _Frame, block: Block, control: Control) -> None:
+        """An if, while or repeat line opens its label: as rs274ngc, the first line of its frame to
+        run one (the `while` of a do loop closes it), else a duplicate label (a reused `o1 if`)."""
+        first = frame.opened.setdefault(control.name, (frame.pc, control.keyword, block.line))
+        if first[0] != frame.pc and not (first[1] == "do" and control.keyword == "while"):
+            raise self._error(f"is a duplicate O-word label: already defined in line {first[2]}", block, control)
+
     def _on(self, frame: _Frame, skipping: str | None) -> Callable[[], None]:
         """On to the next line, skipping to the next line of o-word `skipping` (None: not)."""
 

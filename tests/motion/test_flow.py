@@ -53,6 +53,7 @@ AGREE = {
     "fanuc: the first of two definitions": HEAD + "M98 P0002\nM30\nO0002\nG0 X1\nM99\nO2\nG0 X2\nM99\n",
     "calls nine levels deep": HEAD + "o<f> sub\n o1 if [#1 GT 0]\n  G0 X#1\n  o<f> call [#1 - 1]\n o1 endif\no<f> endsub\no<f> call [8]\n",
     "block-deleted control lines run (the switch is off; was: o-word lines passed through)": HEAD + "#1 = 1\n/o1 sub\nG1 X1\n/o1 endsub\n/o2 if [#1 EQ 1]\n/o1 call\n/o2 endif\n/M98 P9\nG1 Y2\nM30\nO9\nG1 Z3\nM99\n",
+    "labels: one per frame, an untaken branch's not used, do loops reopen theirs": HEAD + "o100 sub\no1 if [1]\nG1 X1\no1 endif\no100 endsub\no1 if [1]\nG1 X2\no1 endif\no100 call\no100 call\no2 if [0]\no3 if [1]\no3 endif\no2 endif\no3 repeat [2]\nG1 Y1\no3 endrepeat\no4 do\no4 while [0]\no4 do\nG1 Z1\no4 while [0]\n",
     "modes a subroutine leaves": HEAD + "o1 sub\n G91 G1 X1\n G18\no1 endsub\nG1 X5 Y5\no1 call\nX1 Z1\nG2 X2 Z0 I1 K0\nG90\n",
 }
 
@@ -67,6 +68,10 @@ REFUSED = {
     "a move after an o-word (was: the if ran, the move was dropped)": (HEAD + "o1 if [1] G1 X1\no1 endif\n", 3),
     "calls ten levels deep": (HEAD + "o<f> sub\n o1 if [#1 GT 0]\n  G0 X#1\n  o<f> call [#1 - 1]\n o1 endif\no<f> endsub\no<f> call [9]\n", 6),
     "a subroutine that calls itself for ever (was: memory without end)": (HEAD + "o100 sub\nG1 X1 F100\no100 call\no100 endsub\no100 call\n", 5),
+    "a label used by a second if (was: both ran)": (HEAD + "o1 if [1]\nG1 X1\no1 endif\no1 if [1]\nG1 X2\no1 endif\n", 6),
+    "an if's label reused by a while": (HEAD + "o1 if [1]\no1 endif\no1 while [0]\no1 endwhile\n", 5),
+    "a repeat's label reused by a repeat": (HEAD + "o1 repeat [1]\nG1 X1\no1 endrepeat\no1 repeat [1]\no1 endrepeat\n", 6),
+    "an if's label closing a do loop": (HEAD + "o1 if [1]\no1 endif\no1 do\nG1 X1\no1 while [0]\n", 7),
     "a Fanuc subprogram that calls itself": (HEAD + "M98 P1\nM30\nO1\nG1 X1 F100\nM98 P1\nM99\n", 7),
 }
 
