@@ -109,6 +109,8 @@ class Flow:
         self.owner: Block | None = None  # the last block yielded in text order
         self.subroutines: dict[str, list[Block]] = {}  # name -> its lines, `sub` to `endsub`
         self.subprograms: dict[str, list[Block]] = {}  # Fanuc: number -> its lines, `O<n>` to `M99`
+        self.defined_at: dict[str, int] = {}  # subroutine name -> the line of the definition the program met (run or called)
+        self._definitions: dict[int, list[Block]] = {}  # every o-word definition read, by the line of its `sub`
         self._defining: tuple[dict, str, list[Block]] | None = None  # a definition being read: where it goes, its name, lines
         self.frames = [_Frame(None, 0)]
         self.stream: Iterator[Block] = iter(())
@@ -279,7 +281,9 @@ class Flow:
         lines.append(block)
         fanuc = found is self.subprograms
         if control is not None and (control.keyword == "m99" if fanuc else control.keyword == "endsub" and control.name == name):
-            found.setdefault(name, lines)  # the first definition counts (LinuxCNC finds it first)
+            found.setdefault(name, lines)  # the first definition counts, until the program meets another (`_sub`)
+            if not fanuc:
+                self._definitions[lines[0].line] = lines
             self._defining = None
         elif fanuc and len(lines) > MAX_SUBPROGRAM:  # a program's own number, not a subprogram
             self._defining = None
@@ -306,8 +310,23 @@ class Flow:
     # Each handler decides (evaluates, checks) and returns what moves the program on, run once
     # the line is written; `arrived`: the program was skipping to this line (rs274ngc's skipping_o).
     def _sub(self, frame, block, control, arrived):
-        """A definition in the way: it does not run (its lines are text)."""
-        return lambda: self._skip_definition(frame, control.name)
+        """A definition in the way: it does not run (its lines are text).  As rs274ngc, another
+        definition of a name the program has met is refused."""
+        if frame.space is None:
+            first = self.defined_at.setdefault(control.name, -1)  # (-1: none before)
+            if first == block.line:  # called ahead of it, or met in a loop before
+                raise self._error("sub found in illegal location: the program met this definition before (a call ahead of it, a loop)", block, control)
+            if first != -1:
+                raise self._error(f"sub redefines the subroutine defined in line {first}", block, control)
+            self.defined_at[control.name] = block.line
+
+        def skip():
+            yield from self._skip_definition(frame, control.name)
+            met = self._definitions.get(block.line) if frame.space is None else None
+            if met is not None:  # rs274ngc calls the definition the program met (one in an untaken branch it did not)
+                self.subroutines[control.name] = met
+
+        return skip
 
     def _endsub(self, frame, block, control, arrived):
         return self._return(frame, block, control, arrived)
@@ -336,6 +355,8 @@ class Flow:
             return lambda: None
 
         self._check_level(block, control)
+        if name not in self.files:  # (a file's definition is no line of the program)
+            self.defined_at.setdefault(name, body[0].line)
 
         def call():
             frame.pc += 1
@@ -545,11 +566,14 @@ class Flow:
 
     def _skip_definition(self, frame: _Frame, name: str) -> Iterator[tuple[Block, str, Block | None]]:
         """Past a subroutine's definition to its endsub: lines that do not run."""
+        opening = frame.pc
         while True:
             block = self._block(frame, frame.pc)
             if block is None:
                 raise NcppError(f"o{_shown(name)} sub has no o{_shown(name)} endsub", Location(self.file, self._opening_line(frame), None))
             control = self._control_of(block)
+            if control is not None and control.keyword == "sub" and frame.pc != opening:  # (rs274ngc: none in another)
+                raise NcppError("Nested subroutine definition", Location(self.file, block.line, control.item.start + 1))
             if self._in_place(frame):
                 yield block, SKIP, None
                 self._wrote(frame.pc)
