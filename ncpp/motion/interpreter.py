@@ -420,6 +420,8 @@ class Interpreter:
                     pass
                 elif what == UNREADABLE:  # read where it runs, as rs274ngc reads it
                     raise item.node[0]
+                elif what == "stray_tape":  # a `%` after the program's first line that was not one
+                    self._fail("Bad character '%' used (a tape mark only where the program starts with one)", block, item)
                 elif what not in IGNORED_STATEMENTS:
                     raise _OutOfScope(OUT_OF_SCOPE_STATEMENT.get(what, what), item.start + 1)
                 continue

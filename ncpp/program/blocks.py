@@ -91,7 +91,8 @@ class Statement(Item):
     """A construct the motion interpreter does not execute directly.
 
     kind: 'block_delete', 'assignment', 'oword', 'program_name', 'tape',
-    'checksum', 'if', 'while', 'end', 'goto', 'unreadable' (a line the grammar
+    'checksum', 'if', 'while', 'end', 'goto', 'stray_tape' (a `%` line in a
+    program that does not start with one), 'unreadable' (a line the grammar
     cannot read: `node` holds the error, raised where the line runs).  `node`
     holds its parsed parts (a tuple whose shape depends on kind).
     """

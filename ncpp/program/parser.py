@@ -17,7 +17,7 @@ from __future__ import annotations
 import functools
 import math
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Callable, Iterable, Iterator
 
@@ -732,9 +732,17 @@ def parse_stream(stream: Iterable[bytes], file: str = "<stdin>", grammar: "str |
         block = parser.parse(content, eol, number, file)
         if block.items and type(block.items[0]) is Statement and block.items[0].kind == "tape":
             tape_marks += 1
+            if tape_marks < 0 and parser.dialect.read_where_run:  # rs274ngc: a bad character where it runs
+                block = _stray_tape_mark(block)
         elif tape_marks == 0 and block.items:
             tape_marks = -10**9  # material before any `%`: the program has no tape marks
         yield block
+
+
+def _stray_tape_mark(block: Block) -> Block:
+    """A `%` line in a program that did not start with one: a `stray_tape` statement."""
+    mark, *rest = block.items
+    return replace(block, items=(Statement("stray_tape", mark.node, mark.start, mark.end), *rest))  # type: ignore[union-attr]
 
 
 def _parse_continued(parser: LineParser, lines: Iterable[tuple[str, str]], file: str) -> Iterator[Block]:

@@ -55,6 +55,8 @@ AGREE = {
     "block-deleted control lines run (the switch is off; was: o-word lines passed through)": HEAD + "#1 = 1\n/o1 sub\nG1 X1\n/o1 endsub\n/o2 if [#1 EQ 1]\n/o1 call\n/o2 endif\n/M98 P9\nG1 Y2\nM30\nO9\nG1 Z3\nM99\n",
     "labels: one per frame, an untaken branch's not used, do loops reopen theirs": HEAD + "o100 sub\no1 if [1]\nG1 X1\no1 endif\no100 endsub\no1 if [1]\nG1 X2\no1 endif\no100 call\no100 call\no2 if [0]\no3 if [1]\no3 endif\no2 endif\no3 repeat [2]\nG1 Y1\no3 endrepeat\no4 do\no4 while [0]\no4 do\nG1 Z1\no4 while [0]\n",
     "definitions the program does not meet: after M2, in an untaken branch": HEAD + "o2 if [0]\no1 sub\nG1 X1\no1 endsub\no2 endif\no1 sub\nG1 X2\no1 endsub\no1 call\no3 call\nM2\no3 sub\nG1 Y1\no3 endsub\no3 sub\nG1 Y2\no3 endsub\n",
+    "tape marks after a blank first line": "\n%\n" + HEAD + "G1 X1\n%\n",
+    "a stray % after M2": HEAD + "G1 X1\nM2\n%\n",
     "modes a subroutine leaves": HEAD + "o1 sub\n G91 G1 X1\n G18\no1 endsub\nG1 X5 Y5\no1 call\nX1 Z1\nG2 X2 Z0 I1 K0\nG90\n",
 }
 
@@ -77,6 +79,7 @@ REFUSED = {
     "a definition met after a call ahead of it": (HEAD + "o1 call\no1 sub\nG1 X1\no1 endsub\n", 4),
     "a definition in a loop": (HEAD + "#1 = 0\no9 while [#1 LT 2]\n#1 = [#1 + 1]\no1 sub\nG1 X1\no1 endsub\no9 endwhile\n", 6),
     "a definition in a definition": (HEAD + "o1 sub\no2 sub\no2 endsub\no1 endsub\n", 4),
+    "a % line in a program that does not start with one (was: read as a tape mark)": ("(setup)\n%\n" + HEAD + "G1 X1\n%\n", 2),
     "a Fanuc subprogram that calls itself": (HEAD + "M98 P1\nM30\nO1\nG1 X1 F100\nM98 P1\nM99\n", 7),
 }
 
