@@ -16,10 +16,13 @@ from typing import Iterable
 import numpy as np
 from numpy.typing import NDArray
 
+from ncpp.errors import Location, NcppError
 from ncpp.motion.segments import PLANE_AXES, Arc, Event, Line
 
 STEP_MM = 0.5  # sample spacing along lines and large arcs
 CHORD_MM = 1e-5  # largest chord error of an arc's sampled polyline (0.01 µm)
+# Samples of one path at most (~1 GB with their arrays): a move of 10^13 mm asked for 146 TiB
+MAX_SAMPLES = 20_000_000
 
 
 @dataclass(frozen=True)
@@ -32,18 +35,19 @@ class SampledPath:
     tools: NDArray | None = None  # (n,3) tool length offsets in effect, mm (None: none)
 
 
-def sample_events(events: Iterable[Event], step_mm: float = STEP_MM) -> SampledPath:
+def sample_events(events: Iterable[Event], step_mm: float = STEP_MM, file: str = "<stdin>") -> SampledPath:
     """Sampled machine positions of a program's motion (placed on the machine by the
-    work offsets the events were interpreted with: `Context.offset`)."""
+    work offsets the events were interpreted with: `Context.offset`); more than
+    MAX_SAMPLES is an error naming the line (of `file`) where the path passes them."""
     pts: list[NDArray] = []
     feeds, lines, rapids, circles, tools = [], [], [], [], []
     count = 0
     for event in events:
         if type(event) is Line:
-            p = _sample_line(event, step_mm)
+            p = _sample_line(event, step_mm, MAX_SAMPLES - count, file)
             rapid = event.rapid
         elif type(event) is Arc:
-            p = _sample_arc(event, step_mm)
+            p = _sample_arc(event, step_mm, MAX_SAMPLES - count, file)
             rapid = False
             if abs(event.sweep()) >= 2 * math.pi - 1e-9:
                 s = event.context.unit_mm
@@ -75,10 +79,19 @@ def _to_machine(event: Line | Arc, program: NDArray) -> NDArray:
     return (program + np.asarray(event.context.offset)) * event.context.unit_mm
 
 
-def _sample_line(line: Line, step_mm: float) -> NDArray:
+def _samples(event: Line | Arc, spans: float, least: int, left: int, step_mm: float, file: str) -> int:
+    """Samples for the event: `spans` (a length over a step) rounded up, at least `least`,
+    when `left` remain of MAX_SAMPLES (a length may overflow to inf: compared first)."""
+    if not spans < left:
+        raise NcppError(f"the path needs more than {MAX_SAMPLES:,} samples at {step_mm:g} mm spacing (this move alone "
+                        f"{spans:,.0f}): run part of the program, or a larger --step", Location(file, event.block.line))  # fmt: skip
+    return max(least, math.ceil(spans))
+
+
+def _sample_line(line: Line, step_mm: float, left: int = MAX_SAMPLES, file: str = "<stdin>") -> NDArray:
     a, b = np.asarray(line.start), np.asarray(line.end)
     length = float(np.linalg.norm(b - a)) * line.context.unit_mm
-    n = max(1, int(math.ceil(length / step_mm)))
+    n = _samples(line, length / step_mm, 1, left, step_mm, file)
     t = np.linspace(0.0, 1.0, n + 1)[:, None]
     p = a + t * (b - a)
     # the end exactly: a + 1·(b − a) can miss b by a unit in the last place, a
@@ -87,7 +100,7 @@ def _sample_line(line: Line, step_mm: float) -> NDArray:
     return _to_machine(line, p)
 
 
-def _sample_arc(arc: Arc, step_mm: float) -> NDArray:
+def _sample_arc(arc: Arc, step_mm: float, left: int = MAX_SAMPLES, file: str = "<stdin>") -> NDArray:
     i, j, k = PLANE_AXES[arc.context.plane]
     s, e, c = np.asarray(arc.start), np.asarray(arc.end), np.asarray(arc.center)
     r0 = math.hypot(s[i] - c[i], s[j] - c[j])
@@ -95,7 +108,7 @@ def _sample_arc(arc: Arc, step_mm: float) -> NDArray:
     sweep = arc.sweep()
     radius_mm = max(r0, 1e-9) * arc.context.unit_mm
     step = min(step_mm, math.sqrt(8 * radius_mm * CHORD_MM))
-    n = max(2, int(math.ceil(abs(sweep) * radius_mm / step)))
+    n = _samples(arc, abs(sweep) * radius_mm / step, 2, left, step_mm, file)
     t = np.linspace(0.0, 1.0, n + 1)
     a0 = math.atan2(s[j] - c[j], s[i] - c[i])
     angle = a0 + t * sweep

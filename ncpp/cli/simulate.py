@@ -61,11 +61,12 @@ def run(args: argparse.Namespace) -> int:
     machine = load_machine(args.machine)
     warnings = Warnings()
     offsets = work_offsets(args)
-    commanded = sample_events(program_events(args.program, warnings, offsets, args.dialect), args.step)
-    nominal = sample_events(program_events(args.reference, warnings, offsets, args.dialect), args.step) if args.reference else commanded
+    commanded = sample_events(program_events(args.program, warnings, offsets, args.dialect), args.step, args.program)
+    nominal = sample_events(program_events(args.reference, warnings, offsets, args.dialect), args.step, args.reference) if args.reference else commanded
     warnings.finish()
     if len(commanded.points) == 0:
         raise NcppError("the program makes no motion the interpreter could follow (a file of subroutines only runs where a program calls it)", Location(args.program))
+    check_travel(commanded, machine.limits, args.program)
     report = contour_error(machine, commanded, nominal)
     print(f"contour error: max {report.max_um:.2f} µm (line {report.worst_line}), rms {report.rms_um:.2f} µm over {report.samples} samples")
     for c in report.circles:
@@ -75,6 +76,21 @@ def run(args: argparse.Namespace) -> int:
     if args.plot:
         plot_report(report, commanded, args.plot)
     return 0
+
+
+def check_travel(path, limits, file: str, slack_mm: float = 1e-6) -> None:
+    """Refuse a path (`simulate.SampledPath`) that leaves the machine's travel: the machine cannot
+    run it, and its error tables end there (the message names the first sample's line)."""
+    import numpy as np
+
+    for n, axis in enumerate("XYZ"):
+        lo, hi = limits.get(axis, (-math.inf, math.inf))
+        values = path.points[:, n]
+        outside = np.flatnonzero((values < lo - slack_mm) | (values > hi + slack_mm))
+        if outside.size:
+            k = int(outside[0])
+            raise NcppError(f"the motion reaches {axis}{values[k]:.4f} mm, outside the {axis} travel [{lo:g}, {hi:g}] mm "
+                            "(place the program with --work-offset or --var-file)", Location(file, int(path.line[k])))  # fmt: skip
 
 
 def plot_report(report, commanded, path: str) -> None:

@@ -129,3 +129,17 @@ def test_an_arc_of_more_turns_than_compensation_holds_is_refused_with_its_line(t
         assert proc.returncode == 0 and proc.stdout.count("\n") > 80_000
     else:
         assert proc.returncode == 2 and proc.stdout == "" and proc.stderr.startswith(f"{path}:3: an arc of {turns} turns")
+
+
+def test_simulate_refuses_motion_outside_the_travel_and_paths_past_its_sample_budget(tmp_path):
+    """The virtual machine cannot run a move past its travel (it reported a contour error
+    from tables held past their ends), nor sample one of 10^13 mm (a 146 TiB array)."""
+    program = tmp_path / "far.ngc"
+    program.write_text("G21 G90\nG0 X0 Y0 Z0\nG1 X5000 F100\nM2\n")
+    proc = ncpp("simulate", "--machine", str(MACHINE), "--work-offset", "400,350,370", str(program))
+    assert proc.returncode == 2 and b"Traceback" not in proc.stderr
+    assert f"{program}:3: the motion reaches X800.5000 mm, outside the X travel [0, 800] mm".encode() in proc.stderr
+    program.write_text("G21 G90\nG0 X10 Y10\nG0 X9999999999999 Y10\n")
+    proc = ncpp("simulate", "--machine", str(MACHINE), "--work-offset", "400,350,370", str(program))
+    assert proc.returncode == 2 and b"Traceback" not in proc.stderr
+    assert f"{program}:3: the path needs more than 20,000,000 samples".encode() in proc.stderr
