@@ -38,7 +38,7 @@ from ncpp.motion.flow import FIXED, RUN, SKIP, Flow
 from ncpp.motion.segments import CYCLE, FLOW, PLANE_AXES, Arc, Context, Event, Line, Pass
 from ncpp.motion.snapshot import attributes
 from ncpp.motion.tools import UntoldLengths
-from ncpp.program.blocks import UNREADABLE, Block, Comment, ExprWord, Statement, Word
+from ncpp.program.blocks import STRAY_TAPE, UNREADABLE, Block, Comment, ExprWord, Statement, Word
 
 MM_PER_INCH = 25.4
 AXES = "XYZABCUVW"
@@ -420,7 +420,7 @@ class Interpreter:
                     pass
                 elif what == UNREADABLE:  # read where it runs, as rs274ngc reads it
                     raise item.node[0]
-                elif what == "stray_tape":  # a `%` after the program's first line that was not one
+                elif what == STRAY_TAPE:  # a `%` after the program's first line that was not one
                     self._fail("Bad character '%' used (a tape mark only where the program starts with one)", block, item)
                 elif what not in IGNORED_STATEMENTS:
                     raise _OutOfScope(OUT_OF_SCOPE_STATEMENT.get(what, what), item.start + 1)

@@ -106,6 +106,7 @@ class Statement(Item):
 
 
 UNREADABLE = "unreadable"  # the kind of a `Statement` standing for a line the grammar cannot read
+STRAY_TAPE = "stray_tape"  # the kind of a `%` line in a program that did not start with one
 
 AnyItem = Union[Word, ExprWord, Comment, Statement]
 

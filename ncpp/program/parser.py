@@ -26,7 +26,7 @@ from lark import Discard, Token, Transformer, v_args
 
 from ncpp.cache import cached_build
 from ncpp.errors import Location, NcppError
-from ncpp.program.blocks import DIGITS_AS_ONE, UNREADABLE, AnyItem, Block, Comment, ExprWord, Statement, Word
+from ncpp.program.blocks import DIGITS_AS_ONE, STRAY_TAPE, UNREADABLE, AnyItem, Block, Comment, ExprWord, Statement, Word
 
 _GAP_CHARS = " \t\r\f\v\x1a"  # blanks between items (a regex class body: SUB as itself, no digit in the pattern)
 _GAP = f"[{_GAP_CHARS}]*"
@@ -742,7 +742,7 @@ def parse_stream(stream: Iterable[bytes], file: str = "<stdin>", grammar: "str |
 def _stray_tape_mark(block: Block) -> Block:
     """A `%` line in a program that did not start with one: a `stray_tape` statement."""
     mark, *rest = block.items
-    return replace(block, items=(Statement("stray_tape", mark.node, mark.start, mark.end), *rest))  # type: ignore[union-attr]
+    return replace(block, items=(Statement(STRAY_TAPE, mark.node, mark.start, mark.end), *rest))  # type: ignore[union-attr]
 
 
 def _parse_continued(parser: LineParser, lines: Iterable[tuple[str, str]], file: str) -> Iterator[Block]:
