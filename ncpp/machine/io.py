@@ -314,7 +314,14 @@ def _vector(value: Any, key: str, names: str) -> list[float]:
     size = names.count(",") + 1
     if not (isinstance(value, list) and len(value) == size and all(map(is_finite_number, value))):
         raise ValueError(f"{key} must be {NUMBERS.get(size, size)} numbers [{names}] in mm, not {_shown(value)}")
+    if any(abs(v) > LARGEST_LENGTH_MM for v in value):
+        raise ValueError(f"{key} must be within ±{LARGEST_LENGTH_MM:g} mm (a kilometre), not {_shown(value)}")
     return [float(v) for v in value]
+
+
+# mm: offsets, reference points and travel past a kilometre are typing errors, not a machine's
+# (a reference point of 1e308 mm simulated a contour error of 'inf µm')
+LARGEST_LENGTH_MM = 1e6
 
 
 def _references(offsets: dict, loc: _Locator) -> dict[str, list[float]]:

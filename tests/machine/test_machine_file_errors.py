@@ -119,6 +119,10 @@ POLY_OVERFLOW = "coefficients_um = [" + ", ".join(["1e-3"] * 400) + "]"
         ("um_per_m = 5.0", "um_per_m = -2e6", 33, "effect scale: um_per_m must be within ±1e+06"),
         ("values_um = [0.0, 2.0, 3.0]", "values_um = [0.0, 2e6, 3.0]", 15, "errors.EXX: values_um must be within ±1e+06 µm (a metre), not 2e+06"),
         ("coefficients_um = [0.0, 0.01]", "coefficients_um = [0.0, 1e4]", 19, "coefficients_um between 0 and 500 mm must be within ±1e+06 µm"),
+        # offsets, reference points and travel past a kilometre (a reference of 1e308 mm simulated 'inf µm')
+        ("tool = [0.0, 0.0, -200.0]", "tool = [0.0, 0.0, -2e6]", 6, "offsets: tool must be within ±1e+06 mm (a kilometre)"),
+        ("reference.X = [0.0, 100.0, 0.0]", "reference.X = [0.0, 1e308, 0.0]", 7, "offsets.reference: X must be within ±1e+06 mm"),
+        ("X = [0.0, 800.0]", "X = [0.0, 8e300]", 10, "limits: X must be within ±1e+06 mm"),
         # an integer a float cannot hold (TOML has them): was an OverflowError
         ("X = [0.0, 800.0]", "X = [0.0, 1" + "0" * 310 + "]", 10, "limits: X must be two numbers [lo, hi] in mm"),
         ("values_um = [0.0, 2.0, 3.0]", "values_um = [0.0, 1" + "0" * 310 + ", 3.0]", 15, "errors.EXX: values_um must be a finite number"),
