@@ -342,12 +342,10 @@ class LineParser:
     def _read_lalr(self, raw: str, line: int, file: str) -> tuple[AnyItem, ...]:
         """`_parse_lalr`; where the dialect reads lines where they run, a line it cannot
         read is one `unreadable` statement holding the error (`Dialect.read_where_run`)."""
-        if not self.dialect.read_where_run:
-            return self._parse_lalr(raw, line, file)
         try:
             return self._parse_lalr(raw, line, file)
         except NcppError as err:
-            if err.message == BOM_MESSAGE:  # the file's, not a line's
+            if not self.dialect.read_where_run or err.message == BOM_MESSAGE:  # (a byte order mark: the file's, not a line's)
                 raise
             return (Statement(UNREADABLE, (err,), 0, len(raw)),)
 
