@@ -79,9 +79,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def radius_mm(text: str) -> float:
-    from ncpp.instruments.forward import MAX_EXTENT_MM  # (numpy: only when the option is given)
+    from ncpp.machine.effects import LARGEST_LENGTH_MM  # (numpy: only when the option is given)
 
-    return between(0.0, MAX_EXTENT_MM, "(]")(text)
+    return between(0.0, LARGEST_LENGTH_MM, "(]")(text)
 
 
 def _vector(text: str, what: str):
@@ -108,13 +108,14 @@ def parse_targets(text: str):
     import numpy as np
 
     from ncpp.errors import Location, NcppError
-    from ncpp.instruments.forward import MAX_EXTENT_MM, MAX_READINGS
+    from ncpp.instruments.forward import MAX_READINGS
+    from ncpp.machine.effects import LARGEST_LENGTH_MM
 
     where = Location("ncpp predict")
     try:
         if ":" in text:
             a, b, step = (float(v) for v in text.split(":"))
-            if not (abs(a) <= MAX_EXTENT_MM and abs(b) <= MAX_EXTENT_MM and 0 < step < math.inf and a <= b):
+            if not (abs(a) <= LARGEST_LENGTH_MM and abs(b) <= LARGEST_LENGTH_MM and 0 < step < math.inf and a <= b):
                 raise ValueError
             count = math.floor((b - a) / step + 1e-9) + 1
             if count > MAX_READINGS:  # before the array is made
@@ -122,10 +123,10 @@ def parse_targets(text: str):
             targets = a + step * np.arange(count)
         else:
             targets = np.array(sorted(float(v) for v in text.split(",") if v.strip()))
-            if not np.all(np.abs(targets) <= MAX_EXTENT_MM):
+            if not np.all(np.abs(targets) <= LARGEST_LENGTH_MM):
                 raise ValueError
     except ValueError:
-        raise NcppError(f"--targets: expected A:B:STEP (A <= B, STEP > 0) or a,b,c, within ±{MAX_EXTENT_MM:g} mm, got {text!r}", where) from None
+        raise NcppError(f"--targets: expected A:B:STEP (A <= B, STEP > 0) or a,b,c, within ±{LARGEST_LENGTH_MM:g} mm, got {text!r}", where) from None
     if np.any(np.diff(np.unique(targets)) < 1e-3):  # ISO 230-2 matches targets to 1 µm
         raise NcppError(f"--targets {text}: targets closer than 1 µm are one target", where)
     return targets

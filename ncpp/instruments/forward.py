@@ -55,6 +55,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ncpp.instruments.files import PLANES, Measurement, make_measurement
 from ncpp.machine.components import AXES
+from ncpp.machine.effects import LARGEST_LENGTH_MM
 from ncpp.machine.model import Machine
 from ncpp.machine.trajectory import Trajectory
 
@@ -68,8 +69,6 @@ INSTRUMENTS = ("laser", "comparator", "level", "ballbar", "grid", "cutting")
 DWELL_S = 0.5  # standstill per stop of a positioning cycle (the reading is taken there)
 # Readings (path points) of one prediction: a million take seconds and half a GB; no real test has as many.
 MAX_READINGS = 1_000_000
-# Positions and lengths of a set-up (mm): a kilometre is no machine's travel (1e308 gave inf readings)
-MAX_EXTENT_MM = 1e6
 MAX_CIRCLE_STEP_DEG = 120.0  # a circular test needs three points a revolution (iso230_4.circular_test)
 
 
@@ -116,9 +115,9 @@ def parse_fixed(fixed: Mapping[str, float] | str | None) -> dict[str, float]:
 
 
 def check_extent(values: ArrayLike, what: str) -> None:
-    """Refuse positions or lengths (mm) that are not finite or beyond MAX_EXTENT_MM."""
-    if not np.all(np.abs(np.asarray(values, dtype=float)) <= MAX_EXTENT_MM):
-        raise ValueError(f"{what} must be finite numbers within ±{MAX_EXTENT_MM:g} mm, got {values}")
+    """Refuse positions or lengths (mm) that are not finite or beyond LARGEST_LENGTH_MM."""
+    if not np.all(np.abs(np.asarray(values, dtype=float)) <= LARGEST_LENGTH_MM):
+        raise ValueError(f"{what} must be finite numbers within ±{LARGEST_LENGTH_MM:g} mm, got {values}")
 
 
 def _fixed_text(fixed: Mapping[str, float]) -> str:

@@ -48,6 +48,9 @@ if TYPE_CHECKING:
 
 # The largest error a machine file may give, in its µm (a metre), µm/m or µrad/m
 LARGEST_ERROR = 1e6
+# mm: positions, offsets and travel past a kilometre are typing errors, no machine's (a reference
+# point of 1e308 mm simulated a contour error of 'inf µm'; a set-up there, inf readings)
+LARGEST_LENGTH_MM = 1e6
 PLANE_TERMS = {"XY": (0, 1), "YZ": (1, 2), "ZX": (2, 0)}  # (deviating axis, driving axis)
 LATERAL_DEFAULT = {"X": "Y", "Y": "X", "Z": "X"}
 

@@ -80,7 +80,7 @@ from ncpp.errors import Location, NcppError
 from ncpp.fileio import write_text_atomic
 from ncpp.machine.chain import SMALL_ANGLE
 from ncpp.machine.components import AXES, COMPONENTS, SQUARENESS, Polynomial, Table, canonical_name
-from ncpp.machine.effects import LARGEST_ERROR, effect_from_dict, is_finite_number
+from ncpp.machine.effects import LARGEST_ERROR, LARGEST_LENGTH_MM, effect_from_dict, is_finite_number
 from ncpp.machine.model import Machine
 
 SECTIONS = {"machine", "offsets", "limits", "errors", "squareness", "effects", "compensation", "meta"}
@@ -317,11 +317,6 @@ def _vector(value: Any, key: str, names: str) -> list[float]:
     if any(abs(v) > LARGEST_LENGTH_MM for v in value):
         raise ValueError(f"{key} must be within ±{LARGEST_LENGTH_MM:g} mm (a kilometre), not {_shown(value)}")
     return [float(v) for v in value]
-
-
-# mm: offsets, reference points and travel past a kilometre are typing errors, not a machine's
-# (a reference point of 1e308 mm simulated a contour error of 'inf µm')
-LARGEST_LENGTH_MM = 1e6
 
 
 def _references(offsets: dict, loc: _Locator) -> dict[str, list[float]]:
