@@ -38,7 +38,7 @@ from ncpp.errors import _TEXTS_COUNTED, SHOWN_PER_TEXT, Location, Warnings
 from ncpp.fileio import count_lines
 from ncpp.passes.context import UNDECIDED, CutLine
 from ncpp.passes.geometry import LINE_CHUNK
-from ncpp.passes.kernels import child_environment
+from ncpp.passes.kernels import child_command, child_environment
 
 if TYPE_CHECKING:
     from ncpp.pipeline import Part, Stats
@@ -314,7 +314,7 @@ def _start(job: Job) -> "subprocess.Popen | _Forked":
         except OSError:  # no fork now (a process limit): a new interpreter may still start
             pass
     child = subprocess.Popen(
-        [sys.executable, "-c", "from ncpp.parts import _serve; _serve()"],
+        child_command("from ncpp.parts import _serve; _serve()"),
         stdin=subprocess.PIPE, stdout=subprocess.PIPE, env=child_environment(),
     )  # fmt: skip
     pickle.dump(job, child.stdin, protocol=pickle.HIGHEST_PROTOCOL)  # type: ignore[arg-type]

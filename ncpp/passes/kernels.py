@@ -22,6 +22,7 @@ import sys
 import threading
 import traceback
 from collections import deque
+from pathlib import Path
 from typing import Any, Callable, Iterable, Iterator, Protocol, TypeVar
 
 from ncpp.errors import NcppError
@@ -84,10 +85,21 @@ class WorkerError(RuntimeError):
     or the worker stopped."""
 
 
+def child_command(code: str) -> list[str]:
+    """`python -c code` as ncpp starts a process of its own (with `child_environment`).
+    `-P`: no working folder first on the child's import path.  A folder holding another
+    ncpp (a checkout of another version) would give the child that one's code: its part
+    of a program compensated otherwise, or a worker's numbers, silently."""
+    return [sys.executable, "-P", "-c", code]
+
+
 def child_environment() -> dict[str, str]:
-    """The environment of a process ncpp starts with `python -c`: this one's, with its
-    import path, and one BLAS thread unless the user said otherwise (`runtime.py`)."""
-    return one_blas_thread({**os.environ, "PYTHONPATH": os.pathsep.join(p for p in sys.path if p)})
+    """The environment of a process ncpp starts (`child_command`): this one's, with its
+    import path behind the folder this process's ncpp is in (the child imports the same
+    ncpp), and one BLAS thread unless the user said otherwise (`runtime.py`)."""
+    home = str(Path(__file__).resolve().parents[2])  # ncpp/passes/kernels.py: the folder holding ncpp
+    path = [home, *(p for p in sys.path if p)]
+    return one_blas_thread({**os.environ, "PYTHONPATH": os.pathsep.join(path)})
 
 
 class Worker:
@@ -107,7 +119,7 @@ class Worker:
 
     def __init__(self) -> None:
         self._process = subprocess.Popen(
-            [sys.executable, "-c", "from ncpp.passes.kernels import _serve; _serve()"],
+            child_command("from ncpp.passes.kernels import _serve; _serve()"),
             stdin=subprocess.PIPE, stdout=subprocess.PIPE, env=child_environment(),
         )  # fmt: skip
         self._outbox: queue.SimpleQueue = queue.SimpleQueue()

@@ -156,3 +156,30 @@ def test_run_ahead_starts_that_many_items_before_giving_the_first():
     assert given == [(0, 0, 3), (1, -1, 4), (2, -2, 5), (3, -3, 5), (4, -4, 5)]
     started.clear()  # inline: each item is started just before it is given
     assert [(n, len(started)) for n, _ in run_ahead(range(3), started.append, ahead=0)] == [(0, 1), (1, 2), (2, 3)]
+
+
+def _shadowing_checkout(folder: Path) -> None:
+    """A folder holding another ncpp, as a checkout of another version does."""
+    (folder / "ncpp" / "passes").mkdir(parents=True)
+    (folder / "ncpp" / "__init__.py").write_text("")
+    (folder / "ncpp" / "passes" / "__init__.py").write_text("")
+    (folder / "ncpp" / "passes" / "kernels.py").write_text("raise ImportError('the working folder\\'s ncpp')\n")
+    (folder / "ncpp" / "parts.py").write_text("raise ImportError('the working folder\\'s ncpp')\n")
+
+
+def test_a_child_process_imports_this_ncpp_not_the_working_folders(tmp_path, monkeypatch):
+    """The second part (`parts.py`) and the worker start `python -c`, which puts the working
+    folder first on the import path: run in a checkout of another version, they imported it
+    (a part compensated by other code, found comparing two parts with one run)."""
+    import subprocess
+
+    import ncpp
+    from ncpp.passes.kernels import child_command, child_environment
+
+    _shadowing_checkout(tmp_path)
+    monkeypatch.chdir(tmp_path)
+    found = subprocess.run(child_command("import ncpp.parts, ncpp.passes.kernels; print(ncpp.__file__)"), env=child_environment(),
+                           capture_output=True, text=True, check=True)  # fmt: skip
+    assert Path(found.stdout.strip()) == Path(ncpp.__file__)
+    with Worker() as worker:  # and a worker started there does its work
+        assert worker.bind(abs)(-2.5).result() == 2.5
