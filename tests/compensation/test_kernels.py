@@ -4,17 +4,19 @@ worker dies."""
 
 import io
 import os
+import subprocess
 import sys
 import threading
 from pathlib import Path
 
 import pytest
 
+import ncpp
 from ncpp.cli.compensate import AUTO_JOBS_BYTES, jobs_for, spool_from
 from ncpp.cli.io import open_input
 from ncpp.errors import NcppError
 from ncpp.motion.offsets import WorkOffsets
-from ncpp.passes.kernels import Worker, WorkerError, run_ahead
+from ncpp.passes.kernels import Worker, WorkerError, child_command, child_environment, run_ahead
 from ncpp.pipeline import ErrorSource, process
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -171,11 +173,6 @@ def test_a_child_process_imports_this_ncpp_not_the_working_folders(tmp_path, mon
     """The second part (`parts.py`) and the worker start `python -c`, which puts the working
     folder first on the import path: run in a checkout of another version, they imported it
     (a part compensated by other code, found comparing two parts with one run)."""
-    import subprocess
-
-    import ncpp
-    from ncpp.passes.kernels import child_command, child_environment
-
     _shadowing_checkout(tmp_path)
     monkeypatch.chdir(tmp_path)
     found = subprocess.run(child_command("import ncpp.parts, ncpp.passes.kernels; print(ncpp.__file__)"), env=child_environment(),
