@@ -123,20 +123,22 @@ class _Rows:
     pieces: NDArray  # (n,) the lines among them
     assumed: NDArray | None  # (n,3) directions replace_arcs compensated the pieces with (reversal errors only)
     lines: NDArray  # (n,) the line of each segment's block, for messages
+    rapid: NDArray  # (n,) rapid moves (G0): no reversal step before them
 
 
 def _rows(segs: list, directional: bool) -> _Rows:
     offsets, scales, tools = frames(segs)
     start, end = points([e.start for e in segs]), points([e.end for e in segs])
-    # one walk over the events for three flags (1 arc, 2 fixed: a move left as programmed, 4 changed)
-    kind = np.fromiter([(type(e) is Arc) + 2 * bool(e.fixed) + 4 * bool(e.changed) for e in segs], dtype=np.int8, count=len(segs))
+    # one walk over the events for four flags (1 arc, 2 fixed: a move left as programmed, 4 changed, 8 rapid)
+    kind = np.fromiter([(type(e) is Arc) + 2 * bool(e.fixed) + 4 * bool(e.changed) + 8 * (type(e) is Line and e.rapid) for e in segs],
+                       dtype=np.int8, count=len(segs))  # fmt: skip
     arc, changed = (kind & 1) != 0, (kind & 4) != 0
     line = (kind & 3) == 0
     free = line & ~changed
     return _Rows(
         start, end, offsets, scales, tools, free, changed, changed & line,
         _arc_assumed(segs, np.flatnonzero(changed & arc), start, end) if directional else None,
-        np.fromiter([e.block.line for e in segs], dtype=np.int64, count=len(segs)),
+        np.fromiter([e.block.line for e in segs], dtype=np.int64, count=len(segs)), (kind & 8) != 0,
     )  # fmt: skip
 
 
@@ -189,8 +191,7 @@ def _written(chunk: list[Event], segs: list, rows: _Rows, solved: _Solved, last)
         has_previous[i] = p is not None
         previous[i] = p if p is not None else np.nan
         starts_from[i] = None if p is None else tuple(map(float, p))
-    rapid = np.array([type(e) is Line and e.rapid for e in segs])
-    turning = solved.turn & has_previous & ~rapid
+    turning = solved.turn & has_previous & ~rows.rapid
     # A reversal step's target, with the axes that keep their direction left where they
     # are when they differ only by output rounding: a one-digit move there would reverse
     # that axis on the machine.
@@ -352,38 +353,52 @@ def _settle(free, arc, d, held, offsets, scales, limit, out_start, out_end, befo
     todo = np.flatnonzero(lines | pieces).tolist()
     if not todo:
         return
-    # in order, on flat lists of Python floats: a numpy call per row would cost more than the row;
-    # `ends` has the predecessor of row 0 in front: row k's x is at 3k + 3, its predecessor's at 3k
+    # in order, on Python floats: a numpy call per row would cost more than the row.  Only the
+    # rows looked at are read (a few in ten); `ends` has the predecessor of row 0 in front:
+    # row k's end is ends[k + 1], its predecessor's ends[k].  A run's first row's predecessor
+    # is as it was: a row changed is followed by the next, so a run ends after an unchanged row
+    # or before one that does not settle (never in `todo`).
+    n = len(free)
     is_line, limits, settles = free.tolist(), limit.tolist(), (ok & (free | arc)).tolist()
-    e_, s_, d_ = ends.ravel().tolist(), out_start.ravel().tolist(), dirs.ravel().tolist()
-    moved: list[int] = []  # the rows changed, in order
+    moved: list[int] = []  # the rows changed, in order, with their new ends and starts (None: kept)
+    moved_ends: list[list[float]] = []
+    moved_starts: list[list[float] | None] = []
     k = -1  # the last row looked at
     for first in todo:  # each row to look at, then the rows after it while their predecessor's end moves
         if first <= k:
             continue
         k = first
-        while k < len(is_line) and settles[k]:
-            i, limit_k, changed = 3 * k, limits[k], False
+        pred = ends[k].tolist()
+        while k < n and settles[k]:
+            limit_k, changed, end, start = limits[k], False, ends[k + 1].tolist(), None
             if is_line[k]:
-                for a in (i, i + 1, i + 2):  # d_[a] is the predecessor's direction, d_[a + 3] row k's
-                    p, held_a = e_[a], d_[a]
-                    gap = e_[a + 3] - p
-                    if gap * held_a < 0 and d_[a + 3] == held_a and -limit_k <= gap <= limit_k:
-                        e_[a + 3] = p
+                held_k, own = dirs[k].tolist(), dirs[k + 1].tolist()  # the predecessor's direction, row k's
+                for a in (0, 1, 2):
+                    p, held_a = pred[a], held_k[a]
+                    gap = end[a] - p
+                    if gap * held_a < 0 and own[a] == held_a and -limit_k <= gap <= limit_k:
+                        end[a] = p
                         changed = True
             else:
-                for a in (i, i + 1, i + 2):
-                    move = e_[a] - s_[a]
+                start = out_start[k].tolist()
+                for a in (0, 1, 2):
+                    move = pred[a] - start[a]
                     if move != 0 and -limit_k <= move <= limit_k:
-                        s_[a] += move
-                        e_[a + 3] += move
+                        start[a] += move
+                        end[a] += move
                         changed = True
             if not changed:
                 break
             moved.append(k)
+            moved_ends.append(end)
+            moved_starts.append(start)
+            pred = end
             k += 1
-    out_end[moved] = np.reshape([e_[3 * k + 3 : 3 * k + 6] for k in moved], (-1, 3))
-    out_start[moved] = np.reshape([s_[3 * k : 3 * k + 3] for k in moved], (-1, 3))
+    if moved:
+        out_end[moved] = moved_ends
+        pieces_moved = [k for k, start in zip(moved, moved_starts) if start is not None]
+        if pieces_moved:
+            out_start[pieces_moved] = [start for start in moved_starts if start is not None]
 
 
 def _with_previous(out_end, d, held, offsets, scales, before) -> tuple[NDArray, NDArray, NDArray]:
