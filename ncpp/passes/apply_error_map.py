@@ -202,7 +202,7 @@ def _written(chunk: list[Event], segs: list, rows: _Rows, solved: _Solved, last)
     code = (solved.free * _FREE + (solved.moved & ~solved.free) * _MOVED + turning * _TURNS + connect * _CONNECTS).tolist()
     ends = list(map(tuple, solved.end.tolist()))
     targets = _by_row(target, turning & solved.free)
-    moved_starts = _by_row(solved.start, solved.moved & ~solved.free)
+    moved = _moved_pieces(segs, np.flatnonzero(solved.moved & ~solved.free), rows, solved)
     between = _between(chunk) if len(chunk) > len(segs) else {}
     out: list[Event] = []
     start = None  # where the output is: the previous segment's compensated end
@@ -218,7 +218,11 @@ def _written(chunk: list[Event], segs: list, rows: _Rows, solved: _Solved, last)
             out.append(Line(begin, end, seg.rapid, seg.feed, seg.block, seg.context, seg.extra, True))
         else:
             if row & _MOVED:
-                seg = _moved_arc(seg, moved_starts[i], end)
+                begin, centre = moved[i]
+                if centre is None:
+                    seg = Line(begin, end, seg.rapid, seg.feed, seg.block, seg.context, seg.extra, True)
+                else:
+                    seg = Arc(begin, end, centre, seg.turn, seg.feed, seg.block, seg.context, seg.extra, True)
             if row & _CONNECTS:
                 out.append(Line(start, seg.start, False, seg.feed, seg.block, seg.context, seg.extra, True))
             out.append(seg)
@@ -490,14 +494,20 @@ def _snap_limit(step: NDArray, scales: NDArray) -> NDArray:
     return np.maximum(1.01 * step, STILL_MM / scales)
 
 
-def _moved_arc(arc: Arc | Line, start: tuple, end: tuple) -> Arc | Line:
-    """The piece with new ends; an arc's centre moves with the mean shift of the
-    ends (equal for planar arcs: radii still agree)."""
-    if type(arc) is Line:
-        return Line(start, end, arc.rapid, arc.feed, arc.block, arc.context, arc.extra, True)
-    (s0, s1, s2), (e0, e1, e2), (c0, c1, c2) = arc.start, arc.end, arc.center
-    centre = (c0 + (start[0] - s0 + end[0] - e0) / 2, c1 + (start[1] - s1 + end[1] - e1) / 2, c2 + (start[2] - s2 + end[2] - e2) / 2)
-    return Arc(start, end, centre, arc.turn, arc.feed, arc.block, arc.context, arc.extra, True)
+def _moved_pieces(segs: list, at: NDArray, rows: _Rows, solved: _Solved) -> dict[int, tuple[tuple, tuple | None]]:
+    """{row: (start, centre)} of the pieces at rows `at` that apply_error_map moved (centre
+    None: a line).  An arc's centre moves with the mean shift of its ends (equal for planar
+    arcs: radii still agree); for all of them at once, the sums in the order one would write
+    them per piece: ((new start - start) + new end - end) / 2."""
+    if at.size == 0:
+        return {}
+    pieces = [segs[i] for i in at.tolist()]
+    is_arc = [type(piece) is Arc for piece in pieces]
+    centre = points([piece.center if arc else (0.0, 0.0, 0.0) for piece, arc in zip(pieces, is_arc)])
+    start = solved.start[at]
+    centre += (start - rows.start[at] + solved.end[at] - rows.end[at]) / 2
+    centres = [c if arc else None for c, arc in zip(map(tuple, centre.tolist()), is_arc)]
+    return dict(zip(at.tolist(), zip(map(tuple, start.tolist()), centres)))
 
 
 def _end_in_frame_of(last: Line | Arc | None, event: Line | Arc) -> tuple | None:

@@ -104,7 +104,7 @@ class _ArcRows:
     end: NDArray  # (n,3)
     centre: NDArray  # (n,3)
     axes: NDArray  # (n,3) indices of the plane's u, v and normal axis
-    sweep: NDArray  # (n,) rad, signed (+ counter-clockwise), full turns included
+    turn: NDArray  # (n,) `Arc.turn`: +1 counter-clockwise, -1 clockwise, more for full turns
     offsets: NDArray  # (n,3) machine minus program, program units
     scales: NDArray  # (n,) mm per program unit
     tools: NDArray | None  # (n,3) tool length offsets, mm (None: none)
@@ -115,7 +115,7 @@ class _ArcRows:
         offsets, scales, tools = frames(arcs)
         return cls(
             points([a.start for a in arcs]), points([a.end for a in arcs]), points([a.center for a in arcs]),
-            plane_axes(arcs), np.fromiter([a.sweep() for a in arcs], dtype=float, count=len(arcs)),
+            plane_axes(arcs), np.fromiter([a.turn for a in arcs], dtype=float, count=len(arcs)),
             offsets, scales, tools, np.fromiter([a.block.line for a in arcs], dtype=np.int64, count=len(arcs)),
         )  # fmt: skip
 
@@ -151,7 +151,7 @@ class _ArcGeometry:
         self.centre_u, self.centre_v = cu, cv
         self.radius = np.hypot(su - cu, sv - cv)
         self.a0 = np.arctan2(sv - cv, su - cu)
-        self.sweep = rows.sweep
+        self.sweep = _sweeps(self.a0, np.arctan2(ev - cv, eu - cu), rows.turn)
         self.w0 = sw
         self.rise = ew - sw
         self.end_radius = np.hypot(eu - cu, ev - cv)
@@ -167,6 +167,16 @@ class _ArcGeometry:
         u = self.centre_u[arc, None] + r * np.cos(angles)
         v = self.centre_v[arc, None] + r * np.sin(angles)
         return from_plane(u, v, self.w0[arc, None] + frac * self.rise[arc, None], self.axes[arc])
+
+
+def _sweeps(a0: NDArray, a1: NDArray, turn: NDArray) -> NDArray:
+    """(n,) signed sweeps, rad (+ counter-clockwise), of arcs from angle a0 to a1 turning `turn`:
+    `Arc.sweep` for all of them at once, step for step."""
+    full = 2 * math.pi
+    ccw = turn > 0
+    d = np.mod(np.where(ccw, a1 - a0, a0 - a1), full)
+    d = np.where(d > 1e-12, d, full)
+    return np.where(ccw, d + full * (turn - 1), -(d + full * (-turn - 1)))
 
 
 def _initial_pieces(geometry: _ArcGeometry, directional: bool) -> _Pieces:
