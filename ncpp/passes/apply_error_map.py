@@ -358,10 +358,10 @@ def _settle(free, arc, d, held, offsets, scales, limit, out_start, out_end, befo
     if not todo:
         return
     # in order, on Python floats: a numpy call per row would cost more than the row.  Only the
-    # rows looked at are read (a few in ten); `ends` has the predecessor of row 0 in front:
-    # row k's end is ends[k + 1], its predecessor's ends[k].  A run's first row's predecessor
-    # is as it was: a row changed is followed by the next, so a run ends after an unchanged row
-    # or before one that does not settle (never in `todo`).
+    # rows looked at are read (about one in five on a generated program); `ends` has the
+    # predecessor of row 0 in front: row k's end is ends[k + 1], its predecessor's ends[k].
+    # A run's first row's predecessor is as it was: a row changed is followed by the next, so
+    # a run ends after an unchanged row or before one that does not settle (never in `todo`).
     n = len(free)
     is_line, limits, settles = free.tolist(), limit.tolist(), (ok & (free | arc)).tolist()
     moved: list[int] = []  # the rows changed, in order, with their new ends and starts (None: kept)
