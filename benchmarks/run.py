@@ -280,8 +280,9 @@ SECTIONS: list[Callable[[Context], Section]] = [throughput, memory]
 def _compensation_sections() -> list[Callable[[Context], Section]]:
     from accuracy import accuracy
     from compensate_speed import compensate_speed, dialect_speed
+    from instructions import instructions
 
-    return [compensate_speed, dialect_speed, accuracy]
+    return [compensate_speed, instructions, dialect_speed, accuracy]
 
 
 SECTIONS += _compensation_sections()

@@ -1,0 +1,109 @@
+"""Instructions per input line under callgrind: a section of `benchmarks/run.py`.
+
+Time on a shared machine swings by a fifth from one minute to the next, and with it
+every ratio of rates; the instructions a program runs do not.  Where the kernel
+counts them (`counters.py`) the throughput rows say so; where it refuses, this
+section counts them with valgrind's callgrind, which repeats to the instruction
+whatever the machine's load: `ncpp compensate` in one process (HR5B, 1 µm, placed as
+`compensate_speed` places it) and pygcode's `Line()` on the first LINES lines of each
+core file.  A run of SHORT lines is subtracted, so that the start, the imports and the
+grammar cancel; each tool runs once untimed first, so that no bytecode is compiled in
+a counted run (an edited module compiled there counted as 2% of the work).
+
+Callgrind runs 50-100 times slower than the program: 10k lines take a minute or two.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+from itertools import islice
+from pathlib import Path
+from typing import Any
+
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parent
+LINES = 10_000
+SHORT = 60
+
+# The child: one tool over one file (argv: tool, path, work offset x,y,z)
+_CHILD = """
+import sys
+sys.path[:0] = {path!r}
+tool, path = sys.argv[1], sys.argv[2]
+if tool == "pygcode":
+    import run
+    from pathlib import Path
+    run.pygcode_rate(Path(path))
+else:
+    import os
+    from accuracy import QUIET
+    from compensate_speed import MACHINE, TOLERANCE
+    from ncpp.motion.offsets import WorkOffsets
+    from ncpp.pipeline import ErrorSource, process
+    offsets = WorkOffsets.at(tuple(map(float, sys.argv[3].split(","))))
+    with open(path, "rb") as stream, open(os.devnull, "wb") as sink:
+        process(stream, sink, file=path, source=ErrorSource.from_machine_file(str(MACHINE)), tolerance=TOLERANCE,
+                warnings=QUIET, jobs=1, offsets=offsets)
+"""
+
+
+def counted(tool: str, path: Path, offset: str, workdir: Path) -> int:
+    """Instructions callgrind counts for `tool` ("ncpp" or "pygcode") over `path`, the whole process."""
+    code = _CHILD.format(path=[str(HERE), str(ROOT)])
+    command = [sys.executable, "-P", "-c", code, tool, str(path), offset]
+    env = {**os.environ, "PYTHONHASHSEED": "0", "OPENBLAS_NUM_THREADS": "1"}
+    out = workdir / "callgrind.out"
+    done = subprocess.run(["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}", *command],
+                          capture_output=True, text=True, env=env, check=False)  # fmt: skip
+    out.unlink(missing_ok=True)
+    found = re.search(r"Collected : (\d+)", done.stderr)
+    if done.returncode != 0 or found is None:
+        raise RuntimeError(f"callgrind {tool} {path.name}: exit {done.returncode}: {done.stderr[-1500:]}")
+    return int(found.group(1))
+
+
+def per_line(tool: str, path: Path, offset: str, workdir: Path, lines: int = LINES) -> dict[str, Any]:
+    """Instructions per input line of `tool` on the first `lines` lines of `path`: the
+    difference of a run over them and one over the first SHORT, over the lines between."""
+    heads = {}
+    with open(path, "rb") as f:
+        text = list(islice(f, lines))
+    for n in (len(text), SHORT):
+        heads[n] = workdir / f"head-{n}-{path.name}"
+        heads[n].write_bytes(b"".join(text[:n]))
+    command = [sys.executable, "-P", "-c", _CHILD.format(path=[str(HERE), str(ROOT)]), tool, str(heads[SHORT]), offset]
+    subprocess.run(command, capture_output=True, check=True, env={**os.environ, "OPENBLAS_NUM_THREADS": "1"})  # compiles, caches
+    long, short = (counted(tool, heads[n], offset, workdir) for n in (len(text), SHORT))
+    return {"lines": len(text) - SHORT, "instructions": long - short, "per_line": (long - short) / (len(text) - SHORT)}
+
+
+def instructions(ctx):
+    import run as bench
+    from compensate_speed import work_offset
+
+    Section = bench.Section
+    if shutil.which("valgrind") is None:
+        return Section("Instructions per input line (callgrind)", ["program", "tool", "k per line", "note"], [], {},
+                       ["valgrind is not installed here: nothing counted"])  # fmt: skip
+    programs = ctx.programs or ({} if ctx.quick else {"stellabee1.ngc": bench.STELLABEE}) | {"generated": ctx.generated(LINES)}
+    rows, data = [], {}
+    with tempfile.TemporaryDirectory(prefix="ncpp-callgrind-") as tmp:
+        for label, path in programs.items():
+            offset = ",".join(map(str, work_offset(path)))
+            ncpp = per_line("ncpp", path, offset, Path(tmp))
+            pygcode = per_line("pygcode", path, offset, Path(tmp))
+            data[label] = {"ncpp_compensate_one_process": ncpp, "pygcode": pygcode}
+            ratio = pygcode["per_line"] / ncpp["per_line"]
+            rows += [
+                [label, "ncpp compensate 1 µm (HR5B), one process", f"{ncpp['per_line'] / 1000:.0f}", f"lines {SHORT + 1:,}-{SHORT + ncpp['lines']:,}"],
+                [label, "pygcode Line()", f"{pygcode['per_line'] / 1000:.0f}", ""],
+                [label, "pygcode / (ncpp / 2), an estimate for --jobs 2", f"{2 * ratio:.2f}x",
+                 "two parts halve each process's lines and add a few percent (the window, the skim, the read-ahead)"],  # fmt: skip
+            ]
+    notes = [f"the first {LINES:,} lines, less a run over the first {SHORT}; valgrind's callgrind, PYTHONHASHSEED=0"]
+    return Section("Instructions per input line (callgrind)", ["program", "tool", "k per line", "note"], rows, data, notes)
