@@ -202,7 +202,7 @@ def _written(chunk: list[Event], segs: list, rows: _Rows, solved: _Solved, last)
     code = (solved.free * _FREE + (solved.moved & ~solved.free) * _MOVED + turning * _TURNS + connect * _CONNECTS).tolist()
     ends = list(map(tuple, solved.end.tolist()))
     targets = _by_row(target, turning & solved.free)
-    moved = _moved_pieces(segs, np.flatnonzero(solved.moved & ~solved.free), rows, solved)
+    moved_starts = _by_row(solved.start, solved.moved & ~solved.free)
     between = _between(chunk) if len(chunk) > len(segs) else {}
     out: list[Event] = []
     start = None  # where the output is: the previous segment's compensated end
@@ -218,11 +218,7 @@ def _written(chunk: list[Event], segs: list, rows: _Rows, solved: _Solved, last)
             out.append(Line(begin, end, seg.rapid, seg.feed, seg.block, seg.context, seg.extra, True))
         else:
             if row & _MOVED:
-                begin, centre = moved[i]
-                if centre is None:
-                    seg = Line(begin, end, seg.rapid, seg.feed, seg.block, seg.context, seg.extra, True)
-                else:
-                    seg = Arc(begin, end, centre, seg.turn, seg.feed, seg.block, seg.context, seg.extra, True)
+                seg = _moved_arc(seg, moved_starts[i], end)
             if row & _CONNECTS:
                 out.append(Line(start, seg.start, False, seg.feed, seg.block, seg.context, seg.extra, True))
             out.append(seg)
@@ -364,9 +360,8 @@ def _settle(free, arc, d, held, offsets, scales, limit, out_start, out_end, befo
     # a run ends after an unchanged row or before one that does not settle (never in `todo`).
     n = len(free)
     is_line, limits, settles = free.tolist(), limit.tolist(), (ok & (free | arc)).tolist()
-    moved: list[int] = []  # the rows changed, in order, with their new ends and starts (None: kept)
-    moved_ends: list[list[float]] = []
-    moved_starts: list[list[float] | None] = []
+    moved, moved_ends = [], []  # the rows changed, in order, and their new ends
+    shifted, shifted_starts = [], []  # the arc pieces among them, and their new starts
     k = -1  # the last row looked at
     for first in todo:  # each row to look at, then the rows after it while their predecessor's end moves
         if first <= k:
@@ -374,7 +369,7 @@ def _settle(free, arc, d, held, offsets, scales, limit, out_start, out_end, befo
         k = first
         pred = ends[k].tolist()
         while k < n and settles[k]:
-            limit_k, changed, end, start = limits[k], False, ends[k + 1].tolist(), None
+            limit_k, changed, end = limits[k], False, ends[k + 1].tolist()
             if is_line[k]:
                 held_k, own = dirs[k].tolist(), dirs[k + 1].tolist()  # the predecessor's direction, row k's
                 for a in (0, 1, 2):
@@ -391,18 +386,19 @@ def _settle(free, arc, d, held, offsets, scales, limit, out_start, out_end, befo
                         start[a] += move
                         end[a] += move
                         changed = True
+                if changed:
+                    shifted.append(k)
+                    shifted_starts.append(start)
             if not changed:
                 break
             moved.append(k)
             moved_ends.append(end)
-            moved_starts.append(start)
             pred = end
             k += 1
     if moved:
         out_end[moved] = moved_ends
-        pieces_moved = [k for k, start in zip(moved, moved_starts) if start is not None]
-        if pieces_moved:
-            out_start[pieces_moved] = [start for start in moved_starts if start is not None]
+    if shifted:
+        out_start[shifted] = shifted_starts
 
 
 def _with_previous(out_end, d, held, offsets, scales, before) -> tuple[NDArray, NDArray, NDArray]:
@@ -494,20 +490,14 @@ def _snap_limit(step: NDArray, scales: NDArray) -> NDArray:
     return np.maximum(1.01 * step, STILL_MM / scales)
 
 
-def _moved_pieces(segs: list, at: NDArray, rows: _Rows, solved: _Solved) -> dict[int, tuple[tuple, tuple | None]]:
-    """{row: (start, centre)} of the pieces at rows `at` that apply_error_map moved (centre
-    None: a line).  An arc's centre moves with the mean shift of its ends (equal for planar
-    arcs: radii still agree); for all of them at once, the sums in the order one would write
-    them per piece: ((new start - start) + new end - end) / 2."""
-    if at.size == 0:
-        return {}
-    pieces = [segs[i] for i in at.tolist()]
-    is_arc = [type(piece) is Arc for piece in pieces]
-    centre = points([piece.center if arc else (0.0, 0.0, 0.0) for piece, arc in zip(pieces, is_arc)])
-    start = solved.start[at]
-    centre += (start - rows.start[at] + solved.end[at] - rows.end[at]) / 2
-    centres = [c if arc else None for c, arc in zip(map(tuple, centre.tolist()), is_arc)]
-    return dict(zip(at.tolist(), zip(map(tuple, start.tolist()), centres)))
+def _moved_arc(arc: Arc | Line, start: tuple, end: tuple) -> Arc | Line:
+    """The piece with new ends; an arc's centre moves with the mean shift of the
+    ends (equal for planar arcs: radii still agree)."""
+    if type(arc) is Line:
+        return Line(start, end, arc.rapid, arc.feed, arc.block, arc.context, arc.extra, True)
+    (s0, s1, s2), (e0, e1, e2), (c0, c1, c2) = arc.start, arc.end, arc.center
+    centre = (c0 + (start[0] - s0 + end[0] - e0) / 2, c1 + (start[1] - s1 + end[1] - e1) / 2, c2 + (start[2] - s2 + end[2] - e2) / 2)
+    return Arc(start, end, centre, arc.turn, arc.feed, arc.block, arc.context, arc.extra, True)
 
 
 def _end_in_frame_of(last: Line | Arc | None, event: Line | Arc) -> tuple | None:
