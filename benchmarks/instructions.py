@@ -19,7 +19,6 @@ import os
 import re
 import shutil
 import subprocess
-import sys
 import tempfile
 from itertools import islice
 from pathlib import Path
@@ -52,14 +51,20 @@ else:
 """
 
 
+def _run(tool: str, path: Path, offset: str, valgrind: tuple[str, ...] = ()) -> subprocess.CompletedProcess:
+    """The child that runs `tool` ("ncpp" or "pygcode") over `path`, started as ncpp starts its
+    own (one BLAS thread), with a fixed hash seed; under `valgrind` when given."""
+    from ncpp.passes.kernels import child_command  # (imported when the section runs, as compensate_speed's)
+    from ncpp.runtime import one_blas_thread
+
+    command = [*valgrind, *child_command(_CHILD.format(path=[str(HERE), str(ROOT)])), tool, str(path), offset]
+    return subprocess.run(command, capture_output=True, text=True, env=one_blas_thread({**os.environ, "PYTHONHASHSEED": "0"}), check=False)
+
+
 def counted(tool: str, path: Path, offset: str, workdir: Path) -> int:
-    """Instructions callgrind counts for `tool` ("ncpp" or "pygcode") over `path`, the whole process."""
-    code = _CHILD.format(path=[str(HERE), str(ROOT)])
-    command = [sys.executable, "-P", "-c", code, tool, str(path), offset]
-    env = {**os.environ, "PYTHONHASHSEED": "0", "OPENBLAS_NUM_THREADS": "1"}
+    """Instructions callgrind counts for `tool` over `path`, the whole process."""
     out = workdir / "callgrind.out"
-    done = subprocess.run(["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}", *command],
-                          capture_output=True, text=True, env=env, check=False)  # fmt: skip
+    done = _run(tool, path, offset, ("valgrind", "--tool=callgrind", f"--callgrind-out-file={out}"))
     out.unlink(missing_ok=True)
     found = re.search(r"Collected : (\d+)", done.stderr)
     if done.returncode != 0 or found is None:
@@ -76,8 +81,9 @@ def per_line(tool: str, path: Path, offset: str, workdir: Path, lines: int = LIN
     for n in (len(text), SHORT):
         heads[n] = workdir / f"head-{n}-{path.name}"
         heads[n].write_bytes(b"".join(text[:n]))
-    command = [sys.executable, "-P", "-c", _CHILD.format(path=[str(HERE), str(ROOT)]), tool, str(heads[SHORT]), offset]
-    subprocess.run(command, capture_output=True, check=True, env={**os.environ, "OPENBLAS_NUM_THREADS": "1"})  # compiles, caches
+    warm = _run(tool, heads[SHORT], offset)  # compiles the bytecode, fills the grammar cache
+    if warm.returncode != 0:
+        raise RuntimeError(f"{tool} {path.name}: exit {warm.returncode}: {warm.stderr[-1500:]}")
     long, short = (counted(tool, heads[n], offset, workdir) for n in (len(text), SHORT))
     return {"lines": len(text) - SHORT, "instructions": long - short, "per_line": (long - short) / (len(text) - SHORT)}
 
