@@ -331,6 +331,9 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--only", nargs="*", help="names of sections to run (default: all)")
     p.add_argument("--out", type=Path, default=OUT, help=f"JSON results (default: {OUT.relative_to(ROOT)})")
     args = p.parse_args(argv)
+    unknown = sorted(set(args.only or ()) - {run.__name__ for run in SECTIONS})
+    if unknown:  # a misspelt name would run nothing and say nothing
+        p.error(f"no section named {', '.join(unknown)} (sections: {', '.join(run.__name__ for run in SECTIONS)})")
 
     started = time.perf_counter()
     results: dict[str, Any] = {
