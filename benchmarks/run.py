@@ -327,7 +327,7 @@ def cpu() -> str:
 
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description="ncpp throughput and memory benchmarks")
-    p.add_argument("--quick", action="store_true", help="smaller programs, no 10M-line run (under 2 minutes)")
+    p.add_argument("--quick", action="store_true", help="smaller programs, no 10M-line run (throughput and memory in about 2 minutes; compensate_speed about 5)")
     p.add_argument("--only", nargs="*", help="names of sections to run (default: all)")
     p.add_argument("--out", type=Path, default=OUT, help=f"JSON results (default: {OUT.relative_to(ROOT)})")
     args = p.parse_args(argv)
