@@ -175,3 +175,28 @@ def test_ncpp_command_passes_corpus_program_through_unchanged(path, tmp_path, ca
         err = capsys.readouterr().err
         assert status != 0 and expected in err and err.startswith(f"{path}:")
         assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    ("raw", "words"),
+    [
+        ("G1 X1 5 Y2", [("G", 1.0, "1"), ("X", 15.0, "15"), ("Y", 2.0, "2")]),
+        ("X 2 0 . 5 Y- 1 2", [("X", 20.5, "20.5"), ("Y", -12.0, "-12")]),
+        ("G 0 1 X3", [("G", 1.0, "01"), ("X", 3.0, "3")]),
+        ("X1 . 5 Z. 2 F100 .", [("X", 1.5, "1.5"), ("Z", 0.2, ".2"), ("F", 100.0, "100.")]),
+        ("G1 X9 0 ,R2 . 5", [("G", 1.0, "1"), ("X", 90.0, "90"), (",R", 2.5, "2.5")]),
+    ],
+)
+def test_blanks_between_a_numbers_digits_are_read_as_rs274_reads_them(raw, words):
+    """rs274ngc reads a line with its blanks removed: `X1 5` is X15.  The word's span
+    covers its digits and the blanks between them, not a blank after the last one."""
+    parser = LineParser("iso")
+    for _ in range(2):  # the first read learns the line's layout, the second is read by it
+        found = parser.parse(raw).words()
+        assert [(w.letter, w.value, w.number) for w in found] == words
+        assert all(not raw[w.start : w.end].endswith(" ") for w in found)
+    assert parser._scan_plain(raw)[0] == parser._parse_lalr(raw, 1, "t.ngc")
+    program = f"G1 F100\n{raw}\nG1 Y9\n".encode()
+    out = io.BytesIO()
+    process(io.BytesIO(program), out, file="t.ngc")
+    assert out.getvalue() == program
