@@ -135,7 +135,7 @@ class _ItemBuilder(Transformer):
 
     # -- expressions -----------------------------------------------------------
     def number(self, children):
-        return ("num", float(children[0]))
+        return ("num", float(str(children[0]).replace(" ", "").replace("\t", "")))  # `1 0` is 10, as in a word
 
     def param(self, children):
         (key,) = children
