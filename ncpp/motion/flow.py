@@ -666,11 +666,11 @@ def _notable(block: Block) -> bool:
 
 
 def oword_name(text: str) -> str:
-    """`o100`, `O0100` -> "100"; `o<My Sub>` -> "mysub" (rs274ngc ignores case and spaces)."""
+    """`o100`, `O0100`, `o1 00` -> "100"; `o<My Sub>` -> "mysub" (rs274ngc ignores case and spaces)."""
     label = text[1:].strip()
     if label.startswith("<"):
         return normalise_name(label)
-    return str(int(label))
+    return str(int(label.replace(" ", "").replace("\t", "")))
 
 
 def _shown(name: str) -> str:

@@ -54,10 +54,6 @@ def lalr_parser(name: str) -> lark.Lark:
     return cached_build(f"{name}-lark", f"{text}\n{_LARK_OPTIONS}\n{lark.__version__}", lambda: lark.Lark(text, **_LARK_OPTIONS), lark.Lark.load)
 
 
-def _number_value(number: str) -> float:
-    return float(number.replace(" ", "").replace("\t", ""))
-
-
 def _word(text: str, start: int, end: int) -> Word:
     """`Z -110` -> Word('Z', -110.0, '-110'); `,c1.` -> Word(',C', 1.0, '1.')."""
     if text[0] == ",":
@@ -65,8 +61,13 @@ def _word(text: str, start: int, end: int) -> Word:
         letter, number = "," + body[0].upper(), body[1:]
     else:
         letter, number = text[0].upper(), text[1:]
-    number = number.replace(" ", "").replace("\t", "")
+    number = _digits(number)
     return Word(letter, float(number), number, start, end)
+
+
+def _digits(text: str) -> str:
+    """A number as rs274ngc reads it, without the blanks written between its digits (`1 0` is 10)."""
+    return str(text).replace(" ", "").replace("\t", "")
 
 
 _UPPER = {chr(c): chr(c).upper() for c in range(256)}  # str.upper of one Latin-1 character
@@ -135,12 +136,12 @@ class _ItemBuilder(Transformer):
 
     # -- expressions -----------------------------------------------------------
     def number(self, children):
-        return ("num", float(str(children[0]).replace(" ", "").replace("\t", "")))  # `1 0` is 10, as in a word
+        return ("num", float(_digits(children[0])))
 
     def param(self, children):
         (key,) = children
         if isinstance(key, Token):
-            return ("param", int(key) if key.type == "INT" else str(key).lower())
+            return ("param", int(_digits(key)) if key.type == "INT" else str(key).lower())
         return ("param", ("ref", key))
 
     def group(self, children):
@@ -312,8 +313,8 @@ class LineParser:
                 number = found[2]
                 pos = start + 1 + len(number)
                 letter = _UPPER[letter]
-                if " " in number or "\t" in number:  # `X - 5`
-                    number = number.replace(" ", "").replace("\t", "")
+                if " " in number or "\t" in number:  # `X - 5`, `X1 5`
+                    number = _digits(number)
                 word = _new_word(Word)
                 word.letter, word.value, word.number, word.start, word.end = letter, float(number), number, start, pos
                 append(word)

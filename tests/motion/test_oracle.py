@@ -185,8 +185,12 @@ def test_every_listed_file_exists():
 
 
 def test_blanks_inside_numbers_move_as_rs274_reads_them(tmp_path):
-    """`X1 5` is X15, `X 2 0 . 5` is X20.5, `G 0 1` is G1, `[1 0]` is 10: rs274ngc drops a line's blanks."""
-    program = "G21 G90 G17 F100\nG1 X1 5 Y2\nG1 X 2 0 . 5 Y- 1 2\nG 0 1 X3\nG2 X1 3 Y-1 2 I5 J0\nG 0 X1 . 5\n#1 = 1 0\nG1 X[#1 + 2 0] Y[1 . 5]\n"
+    """`X1 5` is X15, `X 2 0 . 5` is X20.5, `G 0 1` is G1, `[1 0]` is 10, `#3 1` is #31 and
+    `o1 00` is o100: rs274ngc drops a line's blanks."""
+    program = (
+        "G21 G90 G17 F100\nG1 X1 5 Y2\nG1 X 2 0 . 5 Y- 1 2\nG 0 1 X3\nG2 X1 3 Y-1 2 I5 J0\nG 0 X1 . 5\n"
+        "#1 = 1 0\nG1 X[#1 + 2 0] Y[1 . 5]\n#3 1 = 7\no1 00 sub\nG1 X#31\no100 endsub\no 100 call\n"
+    )
     assert [call.args[:2] for call in assert_agrees_with_rs274(write_program(tmp_path, program))] == [
-        (15.0, 2.0), (20.5, -12.0), (3.0, -12.0), (13.0, -12.0), (1.5, -12.0), (30.0, 1.5)
+        (15.0, 2.0), (20.5, -12.0), (3.0, -12.0), (13.0, -12.0), (1.5, -12.0), (30.0, 1.5), (7.0, 1.5)
     ]  # fmt: skip
