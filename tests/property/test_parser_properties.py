@@ -83,10 +83,13 @@ def number_texts(draw) -> str:
 
 @st.composite
 def words(draw) -> tuple[str, str, float]:
-    """(text, letter, value) of one word, letter in either case, spaces allowed inside."""
+    """(text, letter, value) of one word, letter in either case, spaces allowed inside,
+    between the number's digits too (rs274ngc reads `X1 5` as X15)."""
     letter = draw(st.sampled_from(LETTERS))
     number = draw(number_texts())
     sign, digits = (number[0], number[1:]) if number[0] in "+-" else ("", number)
+    if draw(st.integers(0, 3)) == 0:
+        digits = "".join(c + draw(gap) for c in digits[:-1]) + digits[-1]
     text = (letter if draw(st.booleans()) else letter.lower()) + draw(gap) + sign + draw(gap) + digits
     return text, letter, float(number)
 
