@@ -668,9 +668,8 @@ def _notable(block: Block) -> bool:
 def oword_name(text: str) -> str:
     """`o100`, `O0100`, `o1 00` -> "100"; `o<My Sub>` -> "mysub" (rs274ngc ignores case and spaces)."""
     label = text[1:].strip()
-    if label.startswith("<"):
-        return normalise_name(label)
-    return str(int(label.replace(" ", "").replace("\t", "")))
+    name = normalise_name(label)  # without case and blanks, a number's too (`o1 00`)
+    return name if label.startswith("<") else str(int(name))
 
 
 def _shown(name: str) -> str:

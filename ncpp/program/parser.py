@@ -67,7 +67,7 @@ def _word(text: str, start: int, end: int) -> Word:
 
 def _digits(text: str) -> str:
     """A number as rs274ngc reads it, without the blanks written between its digits (`1 0` is 10)."""
-    return str(text).replace(" ", "").replace("\t", "")
+    return text.replace(" ", "").replace("\t", "")
 
 
 _UPPER = {chr(c): chr(c).upper() for c in range(256)}  # str.upper of one Latin-1 character

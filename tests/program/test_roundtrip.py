@@ -191,7 +191,7 @@ def test_blanks_between_a_numbers_digits_are_read_as_rs274_reads_them(raw, words
     """rs274ngc reads a line with its blanks removed: `X1 5` is X15.  The word's span
     covers its digits and the blanks between them, not a blank after the last one."""
     parser = LineParser("iso")
-    for _ in range(2):  # the first read learns the line's layout, the second is read by it
+    for _ in range(2):  # the first read learns the line's layout; the second goes as it says (to the scanner again: blanks in a number)
         found = parser.parse(raw).words()
         assert [(w.letter, w.value, w.number) for w in found] == words
         assert all(not raw[w.start : w.end].endswith(" ") for w in found)
