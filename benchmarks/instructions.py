@@ -33,21 +33,14 @@ SHORT = 60
 _CHILD = """
 import sys
 sys.path[:0] = {path!r}
-tool, path = sys.argv[1], sys.argv[2]
+from pathlib import Path
+tool, path = sys.argv[1], Path(sys.argv[2])
 if tool == "pygcode":
     import run
-    from pathlib import Path
-    run.pygcode_rate(Path(path))
+    run.pygcode_rate(path)
 else:
-    import os
-    from accuracy import QUIET
-    from compensate_speed import MACHINE, TOLERANCE
-    from ncpp.motion.offsets import WorkOffsets
-    from ncpp.pipeline import ErrorSource, process
-    offsets = WorkOffsets.at(tuple(map(float, sys.argv[3].split(","))))
-    with open(path, "rb") as stream, open(os.devnull, "wb") as sink:
-        process(stream, sink, file=path, source=ErrorSource.from_machine_file(str(MACHINE)), tolerance=TOLERANCE,
-                warnings=QUIET, jobs=1, offsets=offsets)
+    import compensate_speed
+    compensate_speed.ncpp_process_rate(path, tuple(map(float, sys.argv[3].split(","))), 1)
 """
 
 
