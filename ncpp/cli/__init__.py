@@ -11,6 +11,7 @@ import argparse
 import importlib
 import sys
 
+from ncpp import __version__
 from ncpp.errors import NcppError
 from ncpp.runtime import one_blas_thread
 
@@ -36,6 +37,7 @@ def build_parser() -> argparse.ArgumentParser:
         prog="ncpp",
         description="Make a CNC machine tool more accurate in software.",
     )
+    parser.add_argument("--version", action="version", version=f"ncpp {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     for name in COMMANDS:
         importlib.import_module(f"ncpp.cli.{name}").register(sub)
@@ -47,7 +49,7 @@ def main(argv: list[str] | None = None) -> int:
     one_blas_thread()  # before the commands import numpy (runtime.py)
     parser = build_parser()
     known = set(parser._subparsers._group_actions[0].choices)  # type: ignore[union-attr]
-    if not argv or (argv[0] not in known and argv[0] not in ("-h", "--help")):
+    if not argv or (argv[0] not in known and argv[0] not in ("-h", "--help", "--version")):
         argv.insert(0, DEFAULT_COMMAND)
     args = parser.parse_args(argv)
     try:

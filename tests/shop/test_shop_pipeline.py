@@ -103,6 +103,14 @@ def test_without_a_machine_file_the_filter_passes_through(shop):
     assert proc.returncode == 0 and proc.stdout.decode() == PROGRAM
 
 
+def test_version_is_printed_and_reads_no_program(shop):
+    import ncpp as package
+
+    proc = ncpp(shop, "--version", stdin="G1 X(\n")  # a program it would refuse, were it read
+    assert proc.returncode == 0, proc.stderr.decode()
+    assert proc.stdout.decode().strip() == f"ncpp {package.__version__}"
+
+
 def test_machine_from_the_environment_compensates(shop):
     proc = ncpp(shop, "--work-offset", "400,350,300", NCPP_MACHINE=str(MACHINE))
     assert proc.returncode == 0, proc.stderr.decode()
