@@ -12,7 +12,10 @@ unread), its output is what one run writes from the cut on (chunks end at the sa
 input lines, `geometry.line_chunks`), and is appended; where it does not (or the second
 process failed before), this process goes on from its cut and writes the rest itself,
 taking about the time of one process.  The output is that of one run, byte for byte,
-either way, wherever the cut is.
+either way, wherever the cut is.  So is an error of the program (`file:line: message`):
+one the second process finds past its cut, from this process's state there, is reported
+here once this part's lines are done (an error among them comes first), without the
+second part's lines compensated again.
 
 The cut is where both parts end together, chosen while they run (`share`): the
 second process waits at the earliest line the cut may be near and says how fast it
@@ -34,7 +37,7 @@ import time
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, BinaryIO, Callable
 
-from ncpp.errors import _TEXTS_COUNTED, SHOWN_PER_TEXT, Location, Warnings
+from ncpp.errors import _TEXTS_COUNTED, SHOWN_PER_TEXT, Location, NcppError, Warnings
 from ncpp.fileio import count_lines
 from ncpp.passes.context import UNDECIDED, CutLine
 from ncpp.passes.geometry import LINE_CHUNK
@@ -212,6 +215,9 @@ def process_in_two_parts(
             if reply is not None:
                 with open(spool, "rb") as rest:  # (as the first part's writer would have: `WriterState.append`)
                     first.reached[1].append(decision.taken[1], rest, out)  # type: ignore[index]
+                if "error" in reply:  # the program's first error, after the cut: as one run stops there
+                    _give(reply["said"], warnings)
+                    raise reply["error"]
                 later = reply
             else:  # the second process failed after its cut: the rest from this part's own state
                 later = _rest_here(path, out, cut, first.reached, strict, options)
@@ -410,8 +416,9 @@ def _report(child: "subprocess.Popen | _Forked", kind: str) -> dict | None:
 
 
 def _reply(child: "subprocess.Popen | _Forked") -> dict | None:
-    """What the second process did after its cut: its lines and warnings (None: it failed;
-    this process does its part then)."""
+    """What the second process did after its cut: its lines and warnings, or the program's
+    error it stopped at ("error") and the warnings before it (None: it failed; this process
+    does its part then)."""
     return _report(child, "done")
 
 
@@ -450,10 +457,16 @@ def _serve_job(job: Job, requests: BinaryIO, replies: BinaryIO) -> None:
 
         part = Part(cut, second=True, window=WINDOW, floor=job.floor, ask=ask, tell=tell)
         with open(job.path, "rb") as stream, open(job.spool, "wb") as spool:
-            stats = process(stream, spool, file=job.file, source=job.source, tolerance=job.tolerance, strict=job.strict,  # type: ignore[arg-type]
-                            force=job.force, warnings=kept, dialect=job.dialect, offsets=job.offsets, part=part)  # fmt: skip
-        if part.reached is not None:
-            reply = {"lines_in": stats.lines_in + part.skipped, "lines_out": stats.lines_out, "said": kept.said}
+            try:
+                stats = process(stream, spool, file=job.file, source=job.source, tolerance=job.tolerance, strict=job.strict,  # type: ignore[arg-type]
+                                force=job.force, warnings=kept, dialect=job.dialect, offsets=job.offsets, part=part)  # fmt: skip
+            except NcppError as error:  # the program's: past the cut, from the first part's state, one run's error
+                if part.reached is None or error.where.line is None or error.where.line < cut.line:
+                    raise
+                reply = {"error": error, "said": kept.said}
+            else:
+                if part.reached is not None:
+                    reply = {"lines_in": stats.lines_in + part.skipped, "lines_out": stats.lines_out, "said": kept.said}
     except Exception:  # noqa: BLE001 - an error is the first process's to report, when it gets there itself
         reply = None
     pickle.dump(("done", reply), replies, protocol=pickle.HIGHEST_PROTOCOL)

@@ -12,7 +12,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import ncpp.parts as parts
-from ncpp.errors import Warnings
+from ncpp.errors import NcppError, Warnings
 from ncpp.fileio import program_file
 from ncpp.integrations.linuxcnc import FilterProgress
 from ncpp.motion.offsets import WorkOffsets
@@ -79,6 +79,34 @@ def test_when_the_second_process_fails_after_its_cut_the_first_writes_the_rest(p
 def test_when_the_second_process_fails_the_first_writes_the_rest(program, source, one_run, monkeypatch):
     monkeypatch.setattr(parts, "_start", lambda job: subprocess.Popen([sys.executable, "-c", "raise SystemExit(3)"], stdin=subprocess.PIPE, stdout=subprocess.PIPE))
     assert _compensated(program, source, jobs=2) == one_run
+
+
+def _error_of(path, source, jobs: int) -> tuple[str, str]:
+    """The error compensating the program stops at, and the warnings given before it."""
+    said = io.StringIO()
+    with open(path, "rb") as stream, pytest.raises(NcppError) as stopped:
+        process(stream, io.BytesIO(), file="long.ngc", source=source, jobs=jobs, warnings=Warnings(stream=said), offsets=WorkOffsets.at(OFFSET))
+    return str(stopped.value), said.getvalue()
+
+
+@pytest.mark.parametrize("bad", ["G1 X10 (unclosed\n", "G1 X5000\n"])  # unreadable; outside the X travel
+def test_an_error_past_the_cut_is_one_runs_without_the_rest_compensated_again(tmp_path, source, monkeypatch, bad):
+    """The second process finds it from the first part's state: the first part reports it
+    once its own lines are done, with the warnings given before it (none of the lines after
+    the cut compensated again)."""
+    # twice as long as PROGRAM: the error lies further past the cut than the second part reads ahead
+    lines = "".join(LINES * 2).splitlines(keepends=True)
+    late = len(lines) * 9 // 10
+    while "G81" not in lines[late]:  # before a warning: the warnings before the error are given
+        late += 1
+    path = tmp_path / "late-error.ngc"
+    path.write_text("G21 G90 G17 F600\n" + "".join(lines[:late]) + bad + "".join(lines[late:]) + "M2\n")
+    one = _error_of(path, source, jobs=1)
+    errors, same = [], parts._same
+    monkeypatch.setattr(parts, "_same", lambda a, b: errors.append(same(a, b)) or errors[-1])
+    monkeypatch.setattr(parts, "_rest_here", lambda *a: pytest.fail("the rest compensated again"))
+    assert _error_of(path, source, jobs=2) == one
+    assert errors == [True] and one[0].startswith(f"long.ngc:{late + 2}:")
 
 
 # Run in a new interpreter with one BLAS thread (as `ncpp` runs): one thread, so the second
