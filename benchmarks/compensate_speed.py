@@ -152,7 +152,10 @@ def _cpu_split(result: dict[str, Any], pygcode: dict[str, Any] | None = None) ->
     per_line = lambda seconds: 1e6 * seconds / max(result["lines"], 1)  # noqa: E731
     split = f"CPU µs per line in: the first process {per_line(result['main_cpu_s']):.0f}, the second {per_line(result['worker_cpu_s']):.0f}"
     faults = f"; page faults per line in {result['page_faults'] / max(result['lines'], 1):.2f}"
-    return (split if pygcode is None else f"{split}; pygcode {per_line(pygcode['seconds']):.0f}") + faults
+    apart = ""
+    if "all_cpu_s" in result:  # how far apart the two processes' CPU was in each round: a run ends with the slower
+        apart = "; the two apart per round " + ", ".join(f"{100 * (max(a, b) / min(a, b) - 1):.0f}%" for a, b in result["all_cpu_s"])
+    return (split if pygcode is None else f"{split}; pygcode {per_line(pygcode['seconds']):.0f}") + apart + faults
 
 
 REPEATS = 3  # runs per tool; the fastest counts (the same for every tool: this machine's timing is noisy)
@@ -166,10 +169,15 @@ def fastest(runs: dict[str, Callable[[], dict[str, Any]]], repeats: int = REPEAT
     for _ in range(repeats):
         for name, run in runs.items():
             results[name].append(run())
-    return {
-        name: {**min(done, key=lambda result: result["seconds"]), "runs": repeats, "all_seconds": [r["seconds"] for r in done]}
-        for name, done in results.items()
-    }
+    return {name: {**min(done, key=lambda result: result["seconds"]), "runs": repeats, **_every_round(done)} for name, done in results.items()}
+
+
+def _every_round(done: list[dict[str, Any]]) -> dict[str, list]:
+    """Each round's seconds, and each round's CPU of the two processes where the tool ran two."""
+    rounds: dict[str, list] = {"all_seconds": [r["seconds"] for r in done]}
+    if all(r.get("worker_cpu_s") for r in done):
+        rounds["all_cpu_s"] = [[r["main_cpu_s"], r["worker_cpu_s"]] for r in done]
+    return rounds
 
 
 def paired_ratios(best: dict[str, dict[str, Any]], tool: str, baseline: str) -> list[float]:

@@ -84,3 +84,15 @@ def test_an_unknown_section_is_refused(capsys):
         bench.main(["--only", "throughput", "no_such_section"])
     assert stop.value.code == 2
     assert "no_such_section" in capsys.readouterr().err
+
+
+def test_each_rounds_cpu_of_two_processes_is_kept_and_told_apart():
+    rounds = iter([(3.0, 10.0, 11.0), (2.0, 10.0, 10.0), (2.5, 12.0, 9.0)])
+
+    def two_processes():
+        seconds, main, worker = next(rounds)
+        return {"seconds": seconds, "main_cpu_s": main, "worker_cpu_s": worker, "lines": 10, "page_faults": 0}
+
+    best = speed.fastest({"ncpp": two_processes, "pygcode": lambda: {"seconds": 1.0}}, repeats=3)
+    assert best["ncpp"]["all_cpu_s"] == [[10.0, 11.0], [10.0, 10.0], [12.0, 9.0]] and "all_cpu_s" not in best["pygcode"]
+    assert "the two apart per round 10%, 0%, 33%" in speed._cpu_split(best["ncpp"])
