@@ -18,6 +18,7 @@ from operator import itemgetter
 from pathlib import Path
 from typing import BinaryIO, Callable, Iterable, Iterator
 
+from ncpp import __version__
 from ncpp.errors import Location, NcppError, Warnings
 from ncpp.fileio import program_file
 from ncpp.motion.interpreter import Interpreter
@@ -84,7 +85,8 @@ class Stats:
 
 
 def header_text(source: ErrorSource, tolerance: float) -> str:
-    return f"{HEADER_TAG} for {source.name} sha256:{source.digest} tolerance {tolerance:g} mm"
+    """The output's first comment: what compensated it, for which machine file (its hash), how closely."""
+    return f"{HEADER_TAG} for {source.name} sha256:{source.digest} tolerance {tolerance:g} mm by ncpp {__version__}"
 
 
 def refuse_compensated(blocks: Iterable[Block], file: str) -> Iterator[Block]:

@@ -9,6 +9,7 @@ from pathlib import Path
 
 import pytest
 
+from ncpp import __version__ as package_version
 from ncpp.errors import NcppError
 from ncpp.integrations.config import config_paths, find_settings, with_linuxcnc_ini
 from tests.conftest import ROOT
@@ -104,11 +105,9 @@ def test_without_a_machine_file_the_filter_passes_through(shop):
 
 
 def test_version_is_printed_and_reads_no_program(shop):
-    import ncpp as package
-
     proc = ncpp(shop, "--version", stdin="G1 X(\n")  # a program it would refuse, were it read
     assert proc.returncode == 0, proc.stderr.decode()
-    assert proc.stdout.decode().strip() == f"ncpp {package.__version__}"
+    assert proc.stdout.decode().strip() == f"ncpp {package_version}"
 
 
 def test_machine_from_the_environment_compensates(shop):
@@ -122,7 +121,8 @@ def test_machine_from_the_local_config_compensates(shop):
     (shop / "work/ncpp.toml").write_text(f'machine = "{MACHINE}"\nwork_offset = [400, 350, 300]\ntolerance = 0.002\n')
     proc = ncpp(shop)
     assert proc.returncode == 0, proc.stderr.decode()
-    assert proc.stdout.decode().splitlines()[0] == "(ncpp compensated for hr5b.toml sha256:" + proc.stdout.decode().split("sha256:")[1].split()[0] + " tolerance 0.002 mm)"
+    digest = proc.stdout.decode().split("sha256:")[1].split()[0]
+    assert proc.stdout.decode().splitlines()[0] == f"(ncpp compensated for hr5b.toml sha256:{digest} tolerance 0.002 mm by ncpp {package_version})"
 
 
 @pytest.mark.parametrize(
