@@ -215,7 +215,7 @@ def process_in_two_parts(
             if reply is not None:
                 with open(spool, "rb") as rest:  # (as the first part's writer would have: `WriterState.append`)
                     first.reached[1].append(decision.taken[1], rest, out)  # type: ignore[index]
-                if "error" in reply:  # the program's first error, after the cut: as one run stops there
+                if "error" in reply:  # the program's error past the cut (this part's lines had none): the run stops there
                     _give(reply["said"], warnings)
                     raise reply["error"]
                 later = reply
@@ -460,7 +460,7 @@ def _serve_job(job: Job, requests: BinaryIO, replies: BinaryIO) -> None:
             try:
                 stats = process(stream, spool, file=job.file, source=job.source, tolerance=job.tolerance, strict=job.strict,  # type: ignore[arg-type]
                                 force=job.force, warnings=kept, dialect=job.dialect, offsets=job.offsets, part=part)  # fmt: skip
-            except NcppError as error:  # the program's: past the cut, from the first part's state, one run's error
+            except NcppError as error:  # the program's, past the cut, met from the first part's state: the first reports it
                 if part.reached is None or error.where.line is None or error.where.line < cut.line:
                     raise
                 reply = {"error": error, "said": kept.said}
