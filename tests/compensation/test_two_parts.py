@@ -40,8 +40,8 @@ def source():
     return ErrorSource.from_machine_file(str(ROOT / "samples/machines/hr5b.toml"))
 
 
-def _compensated(path, source, jobs: int) -> tuple[bytes, str, object]:
-    out, said = io.BytesIO(), io.StringIO()
+def _compensated(path, source, jobs: int, said: io.StringIO | None = None) -> tuple[bytes, str, object]:
+    out, said = io.BytesIO(), said if said is not None else io.StringIO()
     with open(path, "rb") as stream:  # (the dialect is told by the content and the file's name)
         stats = process(stream, out, file=f"long{path.suffix}", source=source, jobs=jobs, warnings=Warnings(stream=said), offsets=WorkOffsets.at(OFFSET))
     return out.getvalue(), said.getvalue(), stats
@@ -84,8 +84,8 @@ def test_when_the_second_process_fails_the_first_writes_the_rest(program, source
 def _error_of(path, source, jobs: int) -> tuple[str, str]:
     """The error compensating the program stops at, and the warnings given before it."""
     said = io.StringIO()
-    with open(path, "rb") as stream, pytest.raises(NcppError) as stopped:
-        process(stream, io.BytesIO(), file="long.ngc", source=source, jobs=jobs, warnings=Warnings(stream=said), offsets=WorkOffsets.at(OFFSET))
+    with pytest.raises(NcppError) as stopped:
+        _compensated(path, source, jobs, said)
     return str(stopped.value), said.getvalue()
 
 
@@ -102,11 +102,11 @@ def test_an_error_past_the_cut_is_one_runs_without_the_rest_compensated_again(tm
     path = tmp_path / "late-error.ngc"
     path.write_text("G21 G90 G17 F600\n" + "".join(lines[:late]) + bad + "".join(lines[late:]) + "M2\n")
     one = _error_of(path, source, jobs=1)
-    errors, same = [], parts._same
-    monkeypatch.setattr(parts, "_same", lambda a, b: errors.append(same(a, b)) or errors[-1])
+    decided, same = [], parts._same
+    monkeypatch.setattr(parts, "_same", lambda a, b: decided.append(same(a, b)) or decided[-1])
     monkeypatch.setattr(parts, "_rest_here", lambda *a: pytest.fail("the rest compensated again"))
     assert _error_of(path, source, jobs=2) == one
-    assert errors == [True] and one[0].startswith(f"long.ngc:{late + 2}:")
+    assert decided == [True] and one[0].startswith(f"long.ngc:{late + 2}:")  # the second part was taken, up to its error
 
 
 # Run in a new interpreter with one BLAS thread (as `ncpp` runs): one thread, so the second
