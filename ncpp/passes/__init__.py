@@ -3,6 +3,11 @@
 Composed in one tuple, like sqlglot's optimizer rules, and run by every
 front end (the filter, `ncpp compensate`, the CL-data postprocessor, the
 FreeCAD post and the LinuxCNC filter) through `run_passes`.
+
+The functions imported below take their modules' names here: `ncpp.passes.replace_arcs`
+is the function, and `import ncpp.passes.replace_arcs as m` binds the function too.  A
+module's constants are reached through `sys.modules["ncpp.passes.replace_arcs"]` (or
+`importlib.import_module`); setting them on the function changes nothing.
 """
 
 from __future__ import annotations
