@@ -434,9 +434,8 @@ def _serve_job(job: Job, requests: BinaryIO, replies: BinaryIO) -> None:
     as it gets there, then its stats and warnings (None if anything failed, or it never
     got to its cut: the first process does the part then).  `requests`: where the cut
     comes from; `replies`: where the pace and the reports go."""
-    from ncpp.pipeline import Part, process
+    from ncpp.pipeline import Part
 
-    reply: dict | None = None
     try:
         cut = CutLine(UNDECIDED)  # decided at `job.floor` (`ask`)
         kept = _Kept(job.strict, cut, lowest=job.floor + WINDOW)
@@ -456,18 +455,26 @@ def _serve_job(job: Job, requests: BinaryIO, replies: BinaryIO) -> None:
             replies.flush()
 
         part = Part(cut, second=True, window=WINDOW, floor=job.floor, ask=ask, tell=tell)
-        with open(job.path, "rb") as stream, open(job.spool, "wb") as spool:
-            try:
-                stats = process(stream, spool, file=job.file, source=job.source, tolerance=job.tolerance, strict=job.strict,  # type: ignore[arg-type]
-                                force=job.force, warnings=kept, dialect=job.dialect, offsets=job.offsets, part=part)  # fmt: skip
-            except NcppError as error:  # the program's, past the cut, met from the first part's state: the first reports it
-                if part.reached is None or error.where.line is None or error.where.line < cut.line:
-                    raise
-                reply = {"error": error, "said": kept.said}
-            else:
-                if part.reached is not None:
-                    reply = {"lines_in": stats.lines_in + part.skipped, "lines_out": stats.lines_out, "said": kept.said}
+        reply = _second_part(job, part, kept)
     except Exception:  # noqa: BLE001 - an error is the first process's to report, when it gets there itself
         reply = None
     pickle.dump(("done", reply), replies, protocol=pickle.HIGHEST_PROTOCOL)
     replies.flush()
+
+
+def _second_part(job: Job, part: "Part", kept: _Kept) -> dict | None:
+    """The second part compensated into the spool (closed before the reply is sent): its
+    stats and warnings, or the program's error past the cut; None if it never got to its cut."""
+    from ncpp.pipeline import process
+
+    with open(job.path, "rb") as stream, open(job.spool, "wb") as spool:
+        try:
+            stats = process(stream, spool, file=job.file, source=job.source, tolerance=job.tolerance, strict=job.strict,  # type: ignore[arg-type]
+                            force=job.force, warnings=kept, dialect=job.dialect, offsets=job.offsets, part=part)  # fmt: skip
+        except NcppError as error:  # the program's, past the cut, met from the first part's state: the first reports it
+            if part.reached is None or error.where.line is None or error.where.line < part.cut.line:
+                raise
+            return {"error": error, "said": kept.said}
+    if part.reached is None:
+        return None
+    return {"lines_in": stats.lines_in + part.skipped, "lines_out": stats.lines_out, "said": kept.said}
