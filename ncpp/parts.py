@@ -33,6 +33,7 @@ import signal
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, BinaryIO, Callable
@@ -51,6 +52,10 @@ if TYPE_CHECKING:
 # part's lines (`motion/skim.py`) and compensates a window before the cut, so it takes less.
 FIRST_SHARE = 0.54
 SHARES = (0.45, 0.75)  # the first part's share stays within these, measured or not
+# The two CPUs of a shared host run at speeds that differ and change (the same pure-Python
+# work, run on both at once, took 1.1-1.7x as long on one as on the other, either one):
+# the parts trade CPUs this often, each running as long on each, so that they end together.
+TRADE_S = 0.25
 WINDOW = 2 * LINE_CHUNK  # lines before the cut the second part compensates to find its state
 MIN_LINES = 4 * WINDOW  # shorter programs stay in one process
 
@@ -203,11 +208,13 @@ def process_in_two_parts(
         cut = CutLine(UNDECIDED)  # decided while the parts run (`_Pacer`)
         job = Job(path, file, source, tolerance, strict, force, dialect, offsets, lowest - WINDOW, spool, time.time())
         second = _start(job)
+        trading = _TradedCpus(second.pid)
         try:
             first = Part(cut)
             first.decide = decision = _Decision(first, second)
             mine = _BeforeCut(warnings, first)
             stats = process(stream, out, warnings=mine, progress=_Pacer(second, job, lines, first, progress), part=first, **options)  # type: ignore[arg-type]
+            trading.stop()  # this part is done: the second runs where the scheduler puts it
             if first.reached is None or first.continued:  # the program ended before the cut, or this part wrote it all
                 mine.give_held()
                 return stats
@@ -222,11 +229,50 @@ def process_in_two_parts(
             else:  # the second process failed after its cut: the rest from this part's own state
                 later = _rest_here(path, out, cut, first.reached, strict, options)
         finally:
+            trading.stop()
             if second.poll() is None:
                 second.kill()
             second.wait()
     _give(later["said"], warnings)
     return Stats(later["lines_in"], stats.lines_out + later["lines_out"])
+
+
+class _TradedCpus:
+    """While both parts run on a machine that gives this process two CPUs (`cpus`: those
+    two, for a test), the two processes swap them every TRADE_S, from a thread of this
+    one; with more CPUs, or where affinities cannot be set, the scheduler's choice stands."""
+
+    def __init__(self, second: int, cpus: list[int] | None = None):
+        allowed = sorted(os.sched_getaffinity(0)) if hasattr(os, "sched_setaffinity") else []
+        self.cpus = cpus if cpus is not None else allowed
+        self.pids = (os.getpid(), second)
+        self.done = threading.Event()
+        self.thread = threading.Thread(target=self._trade, name="ncpp-trade-cpus", daemon=True) if len(self.cpus) == 2 else None
+        if self.thread is not None:
+            self.thread.start()
+
+    def _trade(self) -> None:
+        turn = 0
+        while True:
+            try:
+                os.sched_setaffinity(self.pids[0], {self.cpus[turn]})
+                os.sched_setaffinity(self.pids[1], {self.cpus[1 - turn]})
+            except OSError:  # the second process has gone, or this host refuses
+                break
+            turn = 1 - turn
+            if self.done.wait(TRADE_S):
+                break
+        for pid in self.pids:  # both free again (a process that has gone is no matter)
+            try:
+                os.sched_setaffinity(pid, self.cpus)
+            except OSError:
+                pass
+
+    def stop(self) -> None:
+        """Stop trading, both processes free to run on either CPU (again and again: no matter)."""
+        if self.thread is not None:
+            self.done.set()
+            self.thread.join()
 
 
 class _Pacer:

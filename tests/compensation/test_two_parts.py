@@ -6,6 +6,7 @@ import io
 import os
 import subprocess
 import sys
+import time
 
 import pytest
 from hypothesis import given, settings
@@ -155,6 +156,34 @@ other.join()
 """
     done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, env={**os.environ, "OPENBLAS_NUM_THREADS": "1"}, check=True)
     assert done.stdout.split() == ["True", "False"]
+
+
+@pytest.mark.skipif(not hasattr(os, "sched_setaffinity") or len(os.sched_getaffinity(0)) < 2, reason="two CPUs to trade")
+def test_the_two_processes_trade_their_cpus_until_stopped(monkeypatch):
+    original = os.sched_getaffinity(0)
+    cpus = sorted(original)[:2]
+    monkeypatch.setattr(parts, "TRADE_S", 0.02)
+    other = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"])
+    try:
+        trading = parts._TradedCpus(other.pid, cpus)
+        seen, deadline = set(), time.time() + 10
+        while len(seen) < 2 and time.time() < deadline:
+            mine, theirs = os.sched_getaffinity(0), os.sched_getaffinity(other.pid)
+            if len(mine) == 1 and len(theirs) == 1 and mine != theirs:
+                seen |= mine
+            time.sleep(0.002)
+        trading.stop()
+        assert seen == set(cpus)  # this process ran on each CPU, the other on the other one
+        assert os.sched_getaffinity(0) == os.sched_getaffinity(other.pid) == set(cpus)  # both free again
+        trading.stop()  # (twice: no matter)
+    finally:
+        os.sched_setaffinity(0, original)
+        other.kill()
+        other.wait()
+
+
+def test_with_more_than_two_cpus_the_scheduler_places_the_parts():
+    assert parts._TradedCpus(os.getpid(), [0, 1, 2]).thread is None
 
 
 def test_the_warnings_are_one_runs(one_run):
