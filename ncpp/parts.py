@@ -20,7 +20,8 @@ second part's lines compensated again.
 The cut is where both parts end together, chosen while they run (`share`): the
 second process waits at the earliest line the cut may be near and says how fast it
 read its lines; this process then splits what is left between them by how far it
-has got, and sends the cut.
+has got, and sends the cut.  So that a CPU its host slows down slows both parts
+alike, the two processes trade two CPUs while both run (`_TradedCpus`).
 """
 
 from __future__ import annotations
