@@ -244,13 +244,23 @@ class _TradedCpus:
     one; with more CPUs, or where affinities cannot be set, the scheduler's choice stands."""
 
     def __init__(self, second: int, cpus: list[int] | None = None):
-        allowed = sorted(os.sched_getaffinity(0)) if hasattr(os, "sched_setaffinity") else []
+        try:
+            allowed = sorted(os.sched_getaffinity(0)) if hasattr(os, "sched_setaffinity") else []
+        except OSError:
+            allowed = []
         self.cpus = cpus if cpus is not None else allowed
-        self.pids = (os.getpid(), second)
+        # this thread's id, not the process's: the thread that compensates (in a host
+        # application not always the main one); the second process's main thread
+        self.pids = (threading.get_native_id(), second)
         self.done = threading.Event()
-        self.thread = threading.Thread(target=self._trade, name="ncpp-trade-cpus", daemon=True) if len(self.cpus) == 2 else None
-        if self.thread is not None:
-            self.thread.start()
+        self.thread: threading.Thread | None = None
+        if len(self.cpus) == 2:
+            thread = threading.Thread(target=self._trade, name="ncpp-trade-cpus", daemon=True)
+            try:
+                thread.start()
+            except RuntimeError:  # no thread to be had: the scheduler's choice stands
+                return
+            self.thread = thread
 
     def _trade(self) -> None:
         turn = 0
