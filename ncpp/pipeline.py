@@ -516,7 +516,7 @@ def _rare_collections(threshold: int = 1_000_000) -> Iterator[None]:
     Every line makes a few short-lived objects (a block, its words, events, strings)
     that reference counting frees; the collector runs when allocations outnumber
     frees by the threshold, and that count includes the objects in flight: up to
-    ~400k with a worker (three `replace_arcs` batches of 16384 events, with their
+    ~100k with a worker (three `replace_arcs` batches of 4096 events, with their
     blocks and words).  Below that the collector would walk them again and again
     for nothing (with 50k: 6% of the main process on stellabee1.ngc).  Memory stays
     flat: a whole program leaves a few thousand objects in cycles at most."""

@@ -44,8 +44,12 @@ REVERSAL_HEIGHT = 1e-7
 # Arcs are replaced independently, a batch at a time: a batch holds up to BATCH_ARCS
 # arcs (their events and sample arrays bound the memory) and up to BATCH_EVENTS events,
 # so that programs with few arcs among their lines do not pay numpy's per-call cost per arc.
+# No more events than that: nothing is written before a batch is full, and in two parts
+# (`ncpp/parts.py`) the cut waits for the first lines written (with 16384, the first 13k
+# lines of stellabee1.ngc, 0.8 s: the second process waited half a second; 0.6% more
+# instructions with 4096)
 BATCH_ARCS = 1024
-BATCH_EVENTS = 16384
+BATCH_EVENTS = 4096
 # Turns of one arc at most: an arc's pieces are made at once (~8 kB a turn: 10,000 turns take
 # 170 MB; a helix of 10⁸ turns ran out of 24 GB).
 MAX_TURNS = 10_000
