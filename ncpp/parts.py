@@ -255,9 +255,9 @@ class _TradedCpus:
         except OSError:
             allowed = []
         self.cpus = cpus if cpus is not None else allowed
-        # this thread's id, not the process's: the thread that compensates (in a host
-        # application not always the main one); the second process's main thread
-        self.pids = (threading.get_native_id(), second)
+        # the tasks pinned: this thread (the one that compensates, in a host application
+        # not always the main one), and the second process's main thread
+        self.tasks = (threading.get_native_id(), second)
         self.done = threading.Event()
         self.thread: threading.Thread | None = None
         if len(self.cpus) == 2:
@@ -272,16 +272,16 @@ class _TradedCpus:
         turn = 0
         while True:
             try:
-                os.sched_setaffinity(self.pids[0], {self.cpus[turn]})
-                os.sched_setaffinity(self.pids[1], {self.cpus[1 - turn]})
+                os.sched_setaffinity(self.tasks[0], {self.cpus[turn]})
+                os.sched_setaffinity(self.tasks[1], {self.cpus[1 - turn]})
             except OSError:  # the second process has gone, or this host refuses
                 break
             turn = 1 - turn
             if self.done.wait(TRADE_S):
                 break
-        for pid in self.pids:  # both free again (a process that has gone is no matter)
+        for task in self.tasks:  # both free again (a process that has gone is no matter)
             try:
-                os.sched_setaffinity(pid, self.cpus)
+                os.sched_setaffinity(task, self.cpus)
             except OSError:
                 pass
 
