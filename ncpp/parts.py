@@ -250,11 +250,7 @@ class _TradedCpus:
     one; with more CPUs, or where affinities cannot be set, the scheduler's choice stands."""
 
     def __init__(self, second: int, cpus: list[int] | None = None):
-        try:
-            allowed = sorted(os.sched_getaffinity(0)) if hasattr(os, "sched_setaffinity") else []
-        except OSError:
-            allowed = []
-        self.cpus = cpus if cpus is not None else allowed
+        self.cpus = cpus if cpus is not None else _allowed_cpus()
         # the tasks pinned: this thread (the one that compensates, in a host application
         # not always the main one), and the second process's main thread
         self.tasks = (threading.get_native_id(), second)
@@ -290,6 +286,14 @@ class _TradedCpus:
         if self.thread is not None:
             self.done.set()
             self.thread.join()
+
+
+def _allowed_cpus() -> list[int]:
+    """The CPUs this thread may run on (none where affinities are not to be had)."""
+    try:
+        return sorted(os.sched_getaffinity(0)) if hasattr(os, "sched_setaffinity") else []
+    except OSError:
+        return []
 
 
 class _Pacer:
