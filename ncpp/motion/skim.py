@@ -115,6 +115,7 @@ class Skim:
         self.interpreter: Interpreter | None = None  # given before the first line is read
         self.writer: IsoWriter | None = None
         self.shapes = _Shapes()
+        self.done = False  # the window has begun: no line is left out from here on
 
     def __call__(self, stream: Iterable[bytes]) -> Iterator[tuple[int, tuple[str, str]]]:
         lines = iter(stream)
@@ -123,6 +124,7 @@ class Skim:
         for raw in lines:
             number += 1
             if number >= self.part.window_start(number):
+                self.done = True
                 yield number, _text(raw)
                 break
             if begun and number >= self.first and self.interpreter is not None and self.interpreter.skimmable():
@@ -133,6 +135,7 @@ class Skim:
                         return
             begun = begun or not raw.isspace() and raw != b""
             yield number, _text(raw)
+        self.done = True
         yield from enumerate(iter_lines(lines), start=number + 1)
 
     def _skim(self, raw: bytes, plain: _Plain, lines: Iterator[bytes], number: int) -> tuple[bytes | None, int]:
