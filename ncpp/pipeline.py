@@ -208,11 +208,13 @@ def _parsed_ahead(blocks: Iterable[Block], ready: Callable[[], bool] = lambda: T
     benchmarks/README.md, session 31).  A run that meets a line the parser refuses is passed
     on first: a fault in an earlier line is reported first, as without runs."""
     blocks, most = iter(blocks), PARSED_AHEAD if most is None else most
+    last = 0  # the line of the last block handed on
     for block in blocks:
+        last = block.line
         yield block
         if ready():
             break
-    size, last = FIRST_RUN, 0
+    size = FIRST_RUN
     while True:
         run: list[Block] = []
         try:
