@@ -395,13 +395,26 @@ def _start(job: Job) -> "subprocess.Popen | _Forked":
     return child
 
 
+# s: how long a fork waits for a thread that Python has joined but the kernel still lists
+# (1% of joins here; a trading thread of the run before, `_TradedCpus`), and between looks
+EXITING_WAIT, EXITING_LOOK = 0.01, 0.0002
+
+
 def _may_fork() -> bool:
     """Whether a fork is safe: on Linux, with this process's one thread (no other thread's
     lock, a BLAS pool's or a host application's, is copied held into the child)."""
+    if not sys.platform.startswith("linux"):
+        return False
+    deadline = time.monotonic() + EXITING_WAIT
     try:
-        return sys.platform.startswith("linux") and len(os.listdir("/proc/self/task")) == 1
+        while len(os.listdir("/proc/self/task")) > 1:
+            # a thread Python runs, or one not Python's that outlives the wait, is there to stay
+            if threading.active_count() > 1 or time.monotonic() > deadline:
+                return False
+            time.sleep(EXITING_LOOK)
     except OSError:
         return False
+    return True
 
 
 class _Forked:

@@ -158,6 +158,24 @@ other.join()
     assert done.stdout.split() == ["True", "False"]
 
 
+def test_a_thread_just_joined_does_not_stop_a_fork():
+    """The kernel lists a joined thread a moment longer (1% of joins here): a run right after
+    a two-part run (its trading thread joined) still forks."""
+    script = """
+import threading
+import ncpp.parts as parts
+refused = 0
+for _ in range(3000):
+    thread = threading.Thread(target=lambda: None)
+    thread.start()
+    thread.join()
+    refused += not parts._may_fork()
+print(refused)
+"""
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, env={**os.environ, "OPENBLAS_NUM_THREADS": "1"}, check=True)
+    assert done.stdout.split() == ["0"]
+
+
 @pytest.mark.skipif(not hasattr(os, "sched_setaffinity") or len(os.sched_getaffinity(0)) < 2, reason="two CPUs to trade")
 def test_the_two_processes_trade_their_cpus_until_stopped(monkeypatch):
     original = os.sched_getaffinity(0)
