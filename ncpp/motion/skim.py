@@ -115,7 +115,7 @@ class Skim:
         self.interpreter: Interpreter | None = None  # given before the first line is read
         self.writer: IsoWriter | None = None
         self.shapes = _Shapes()
-        self.done = False  # the window has begun: no line is left out from here on
+        self.done = False  # past the window's first line: no line is left out from here on
 
     def __call__(self, stream: Iterable[bytes]) -> Iterator[tuple[int, tuple[str, str]]]:
         lines = iter(stream)
@@ -124,7 +124,6 @@ class Skim:
         for raw in lines:
             number += 1
             if number >= self.part.window_start(number):
-                self.done = True
                 yield number, _text(raw)
                 break
             if begun and number >= self.first and self.interpreter is not None and self.interpreter.skimmable():
