@@ -8,6 +8,12 @@ Each pass lives in its own module (`ncpp.passes.replace_arcs.replace_arcs`).  Th
 package binds the modules, not the functions, under those names: a function bound
 here would hide its module, and `ncpp.passes.replace_arcs.BATCH_ARCS = ...` would
 set an attribute of the function and change nothing.
+
+A pass that reads events in batches hands on the events it holds when an earlier
+stage refuses a line (`geometry.chunked`, `kernels.run_ahead`), and a pass that refuses a line
+of a batch hands on the batch's lines before it first, compensated: a later pass may
+refuse one of those.  So the fault reported is the program's first, whatever the
+batch sizes, a worker process or the parts a program is compensated in.
 """
 
 from __future__ import annotations

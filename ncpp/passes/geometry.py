@@ -32,8 +32,19 @@ _line_of = attrgetter("block.line")
 
 
 def chunked(items: Iterable[T], size: int = CHUNK) -> Iterator[list[T]]:
+    """Lists of `size` items, the last shorter.  Where reading them raises an NcppError (an
+    earlier stage refused a line), the items read before it are handed on first."""
     it = iter(items)
-    while chunk := list(islice(it, size)):
+    while True:
+        chunk: list[T] = []
+        try:
+            chunk += islice(it, size)  # (what it appended before the error stays)
+        except NcppError:
+            if chunk:
+                yield chunk
+            raise
+        if not chunk:
+            return
         yield chunk
 
 
@@ -41,17 +52,34 @@ def line_chunks(events: Iterable[Event], lines: int = LINE_CHUNK, size: int = LI
     """Lists of the events of one window of `lines` input lines each (windows start at
     multiples of `lines`), cut short at `size` events.  Where a chunk ends depends on
     the program, not on where the stream started: compensating a program from a later
-    line on (with the state there) settles the same chunks the same way."""
+    line on (with the state there) settles the same chunks the same way.  Where reading
+    the events raises an NcppError, the events read before it are handed on first."""
     it = iter(events)
     chunk: list[Event] = []
     while True:
-        chunk += islice(it, size - len(chunk))
+        try:
+            chunk += islice(it, size - len(chunk))
+        except NcppError:
+            while chunk:
+                k = _window_end(chunk, lines)
+                yield chunk[:k]
+                chunk = chunk[k:]
+            raise
         if not chunk:
             return
-        end = (_line_of(chunk[0]) // lines + 1) * lines
-        k = bisect_left(chunk, end, key=_line_of)  # events come in line order; k >= 1
+        k = _window_end(chunk, lines)
         yield chunk[:k]
         chunk = chunk[k:]
+
+
+def _window_end(chunk: list[Event], lines: int) -> int:
+    """How many of the events (in line order) are in the window of `lines` lines of the first (>= 1)."""
+    return bisect_left(chunk, (_line_of(chunk[0]) // lines + 1) * lines, key=_line_of)
+
+
+def before_line(events: list[T], line: int | None) -> list[T]:
+    """The events of the lines before `line` (events in line order; None: none)."""
+    return [] if line is None else events[: bisect_left(events, line, key=_line_of)]
 
 
 def spliced(items: list[T], at: list[int], replacements: list[list[T]]) -> list[T]:

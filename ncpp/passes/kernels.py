@@ -4,7 +4,8 @@ A kernel is a picklable callable that takes and returns arrays (and may keep
 state from call to call, like the direction each axis holds).  A pass binds
 it once and calls it `ahead` chunks before it writes the first of them
 (`run_ahead`); the call returns a handle whose `result()` it asks for when it
-writes that chunk.  Inline, the kernel runs at the call and nothing runs ahead.  With a `Worker`, it runs in a second process while
+writes that chunk.  Inline, the kernel runs at the call and nothing runs ahead; either way an
+NcppError it raises is raised by `result()`.  With a `Worker`, it runs in a second process while
 this one parses, interprets and writes the neighbouring chunks: the numpy work
 of compensation and the Python work of the stream overlap on two cores.
 
@@ -46,22 +47,32 @@ T = TypeVar("T")
 
 def run_ahead(items: Iterable[T], start: Callable[[T], Handle | None], ahead: int) -> Iterator[tuple[T, Handle | None]]:
     """Each item with the handle `start(item)` gave, `start` having been called for up to
-    `ahead` items after it: with a worker the stream reads that far ahead of the results."""
+    `ahead` items after it: with a worker the stream reads that far ahead of the results.
+    Where reading an item raises an NcppError, the items before it are handed on first."""
     started: deque = deque()
-    for item in items:
-        started.append((item, start(item)))
-        if len(started) > ahead:
-            yield started.popleft()
+    try:
+        for item in items:
+            started.append((item, start(item)))
+            if len(started) > ahead:
+                yield started.popleft()
+    except NcppError:
+        yield from started
+        raise
     yield from started
 
 
 class _Done:
-    __slots__ = ("value",)
+    """A kernel's result, or the NcppError it raised: raised when the result is asked for,
+    as a worker's is (the pass hands on the lines before the refused one first)."""
 
-    def __init__(self, value: Any):
-        self.value = value
+    __slots__ = ("value", "error")
+
+    def __init__(self, value: Any, error: NcppError | None = None):
+        self.value, self.error = value, error
 
     def result(self) -> Any:
+        if self.error is not None:
+            raise self.error
         return self.value
 
 
@@ -71,7 +82,13 @@ class Inline:
     ahead = 0  # nothing runs meanwhile: a chunk ahead would only hold memory
 
     def bind(self, kernel: Callable) -> Callable[..., Handle]:
-        return lambda *args: _Done(kernel(*args))
+        def call(*args: Any) -> Handle:
+            try:
+                return _Done(kernel(*args))
+            except NcppError as error:
+                return _Done(None, error)
+
+        return call
 
     def close(self) -> None:
         pass

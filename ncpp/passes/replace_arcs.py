@@ -25,7 +25,7 @@ from ncpp.errors import Location, NcppError
 from ncpp.motion.segments import Arc, Event, Line
 from ncpp.passes.context import PassContext
 from ncpp.passes.kernels import run_ahead
-from ncpp.passes.geometry import compensate, frames, from_plane, in_plane, plane_axes, points, rows_of, spliced
+from ncpp.passes.geometry import before_line, compensate, frames, from_plane, in_plane, plane_axes, points, rows_of, spliced
 from ncpp.passes.travel import grid, quantize
 
 # Points per piece where the fit is checked (ends included).  Fewer on short
@@ -67,34 +67,43 @@ class _Pieces:
 
 def replace_arcs(events: Iterable[Event], ctx: PassContext) -> Iterator[Event]:
     fit = ctx.kernels.bind(FitArcs(ctx.for_kernels()))
-    batches = (_with_arcs(batch, ctx.file) for batch in _batches(events))
+    batches = (_with_arcs(batch) for batch in _batches(events))
     # with a worker process, the next batches are read while one is fitted
     for (batch, index, arcs), fitting in run_ahead(batches, lambda b: fit(_ArcRows.of(b[2])) if b[2] else None, ctx.kernels.ahead):
-        yield from spliced(batch, index, _assemble(arcs, fitting.result())) if fitting is not None else batch
+        if fitting is None:
+            yield from batch
+            continue
+        try:
+            fitted = fitting.result()
+        except NcppError as error:  # the lines before the refused one go on first: a later pass may refuse one of them
+            yield from replace_arcs(before_line(batch, error.where.line), ctx)
+            raise
+        yield from spliced(batch, index, _assemble(arcs, fitted))
 
 
-def _with_arcs(batch: list[Event], file: str) -> tuple[list[Event], list[int], list[Arc]]:
+def _with_arcs(batch: list[Event]) -> tuple[list[Event], list[int], list[Arc]]:
     """The batch, where its arcs to replace are, and those arcs."""
     index = [k for k, e in enumerate(batch) if type(e) is Arc and not e.changed and not e.fixed]
-    arcs = [batch[k] for k in index]
-    for arc in arcs:
-        if abs(arc.turn) > MAX_TURNS:
-            raise NcppError(f"an arc of {abs(arc.turn):,} turns: ncpp compensates {MAX_TURNS:,} at most (its pieces, 8 a turn, are held at once)",
-                            Location(file, arc.block.line))  # fmt: skip
-    return batch, index, arcs
+    return batch, index, [batch[k] for k in index]
 
 
 def _batches(events: Iterable[Event]) -> Iterator[list[Event]]:
-    """Lists of up to BATCH_EVENTS events holding up to BATCH_ARCS arcs."""
+    """Lists of up to BATCH_EVENTS events holding up to BATCH_ARCS arcs.  Where reading
+    the events raises an NcppError, the events read before it are handed on first."""
     batch: list[Event] = []
     arcs = 0
-    for event in events:
-        batch.append(event)
-        if type(event) is Arc:
-            arcs += 1
-        if arcs == BATCH_ARCS or len(batch) == BATCH_EVENTS:
+    try:
+        for event in events:
+            batch.append(event)
+            if type(event) is Arc:
+                arcs += 1
+            if arcs == BATCH_ARCS or len(batch) == BATCH_EVENTS:
+                yield batch
+                batch, arcs = [], 0
+    except NcppError:
+        if batch:
             yield batch
-            batch, arcs = [], 0
+        raise
     if batch:
         yield batch
 
@@ -218,6 +227,10 @@ def _quadrant_pieces(geometry: _ArcGeometry) -> _Pieces:
 
 
 def _replace(arcs: _ArcRows, ctx: PassContext) -> _Fitted:
+    many = np.flatnonzero(np.abs(arcs.turn) > MAX_TURNS)
+    if many.size:
+        turns, line = int(abs(arcs.turn[many[0]])), int(arcs.lines[many[0]])
+        raise NcppError(f"an arc of {turns:,} turns: ncpp compensates {MAX_TURNS:,} at most (its pieces, 8 a turn, are held at once)", Location(ctx.file, line))
     geometry = _ArcGeometry(arcs)
     offsets, scales, tools, line_of = arcs.offsets, arcs.scales, arcs.tools, arcs.lines
     pending = _initial_pieces(geometry, ctx.directional)

@@ -50,8 +50,9 @@ def test_command_outside_travel_is_refused_with_line_and_no_output(tmp_path):
     out = tmp_path / "out.ngc"
     proc = ncpp("compensate", "--machine", str(MACHINE), str(POCKET), "-o", str(out))
     assert proc.returncode != 0
-    assert proc.stderr.decode().startswith(f"{POCKET}:")
-    assert "outside the Y travel" in proc.stderr.decode()
+    # at machine zero (no work offset) the first move's X (0, line 4) is commanded at -0.002 mm:
+    # the program's first fault, before the arc of line 8 that leaves the Y travel
+    assert proc.stderr.decode().startswith(f"{POCKET}:4: command X-0.0020 mm is outside the X travel")
     assert not out.exists()
 
 

@@ -1,0 +1,87 @@
+"""The fault reported is the program's first, whichever stage finds it: a pass that reads
+events in batches hands on the events it holds when an earlier stage refuses a later line,
+and `replace_arcs` hands on the lines before an arc it refuses (`ncpp/passes/__init__.py`);
+the same in one process, with a worker and in two parts."""
+
+import io
+
+import pytest
+
+import ncpp.parts as parts
+import ncpp.passes.replace_arcs as replace_arcs
+from ncpp.errors import NcppError, Warnings
+from ncpp.motion.offsets import WorkOffsets
+from ncpp.pipeline import ErrorSource, process
+
+from .test_kernels import OFFSET, ROOT
+
+# Program X runs from -400 to 400 on HR5B's X travel [0, 800] with OFFSET
+OUTSIDE = "G0 X3000\nG0 X0\n"  # the solve refuses the first line (apply_error_map, the last pass)
+UNREADABLE_ARC = "G2 X10 Y0 I1 J0\n"  # the interpreter refuses it: its radii differ
+BULGING_ARC = "G0 X392 Y-10\nG3 X392 Y10 I0 J10\n"  # its ends lie inside the travel, its middle (X402) does not: replace_arcs refuses it
+
+
+@pytest.fixture(scope="module")
+def source():
+    return ErrorSource.from_machine_file(str(ROOT / "samples/machines/hr5b.toml"))
+
+
+def _moves(n: int) -> str:
+    return "".join(f"G1 X{(k % 7) * 3:.3f} Y{(k % 5) * 2:.3f}\n" for k in range(n))
+
+
+def _program(*parts_: str) -> bytes:
+    return ("G21 G90 G17\nG0 X0 Y0 Z5\nG1 Z-1 F300\n" + "".join(parts_) + "M2\n").encode()
+
+
+def _line_of(text: bytes, piece: str) -> int:
+    return text.decode().splitlines().index(piece.splitlines()[0]) + 1
+
+
+def _refused(data: bytes, source, jobs: int = 1, path=None) -> NcppError:
+    out = io.BytesIO()
+    with pytest.raises(NcppError) as error:
+        if path is None:  # a stream: with jobs 2 its kernels run in a worker process
+            process(io.BytesIO(data), out, file="t.ngc", source=source, jobs=jobs, warnings=Warnings(stream=io.StringIO()), offsets=WorkOffsets.at(OFFSET))
+        else:
+            path.write_bytes(data)
+            with open(path, "rb") as stream:
+                process(stream, out, file="t.ngc", source=source, jobs=jobs, warnings=Warnings(stream=io.StringIO()), offsets=WorkOffsets.at(OFFSET))
+    return error.value
+
+
+@pytest.mark.parametrize("jobs", [1, 2])
+def test_a_pass_refusing_a_line_is_heard_before_the_interpreter_refusing_a_later_one(source, jobs):
+    data = _program(_moves(100), OUTSIDE, _moves(500), UNREADABLE_ARC)
+    assert _refused(data, source, jobs).where.line == _line_of(data, OUTSIDE)
+    alone = _program(_moves(100), "G0 X0\n", _moves(500), UNREADABLE_ARC)
+    assert _refused(alone, source, jobs).where.line == _line_of(alone, UNREADABLE_ARC)  # the interpreter's fault is found
+
+
+@pytest.mark.parametrize("jobs", [1, 2])
+def test_a_line_before_an_arc_replace_arcs_refuses_is_heard_first(source, jobs):
+    data = _program(_moves(50), OUTSIDE, _moves(50), BULGING_ARC, _moves(50))
+    assert _refused(data, source, jobs).where.line == _line_of(data, OUTSIDE)
+    alone = _program(_moves(50), "G0 X0\n", _moves(50), BULGING_ARC, _moves(50))
+    error = _refused(alone, source, jobs)
+    assert error.where.line == _line_of(alone, BULGING_ARC) + 1 and "outside the X travel" in error.message
+
+
+@pytest.mark.parametrize("arcs, events", [(1024, 4096), (1, 4096), (3, 7), (1024, 2)])
+def test_the_first_fault_whatever_the_batches(source, monkeypatch, arcs, events):
+    monkeypatch.setattr(replace_arcs, "BATCH_ARCS", arcs)
+    monkeypatch.setattr(replace_arcs, "BATCH_EVENTS", events)
+    data = _program(_moves(20), BULGING_ARC, _moves(3), OUTSIDE, _moves(30), UNREADABLE_ARC, OUTSIDE)
+    assert _refused(data, source).where.line == _line_of(data, BULGING_ARC) + 1
+    data = _program(_moves(20), OUTSIDE, BULGING_ARC, _moves(30), UNREADABLE_ARC)
+    assert _refused(data, source).where.line == _line_of(data, OUTSIDE)
+
+
+def test_in_two_parts_the_first_fault_of_the_second_part(source, tmp_path):
+    """Both faults lie past the cut: the second process finds them, the first reports its."""
+    n = parts.MIN_LINES * 2
+    late = n * 3 // 4
+    data = _program(_moves(late), OUTSIDE, _moves(400), UNREADABLE_ARC, _moves(n - late))
+    one = _refused(data, source, 1)
+    assert one.where.line == _line_of(data, OUTSIDE)
+    assert str(_refused(data, source, 2, tmp_path / "long.ngc")) == str(one)
