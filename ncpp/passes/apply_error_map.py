@@ -16,12 +16,13 @@ start is compensated with its own direction and a step move is inserted.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from typing import Iterable, Iterator
 
 import numpy as np
 from numpy.typing import NDArray
 
+from ncpp.errors import NcppError
 from ncpp.motion.segments import Arc, Event, Line
 from ncpp.passes.context import CutLine, PassContext, deviation
 from ncpp.passes.kernels import run_ahead
@@ -126,6 +127,14 @@ class _Rows:
     rapid: NDArray  # (n,) rapid moves (G0): no reversal step before them
 
 
+def _rows_before(rows: _Rows, line: int | None) -> _Rows | None:
+    """The rows of the lines before `line` (None: none)."""
+    k = 0 if line is None else int(np.searchsorted(rows.lines, line))
+    if k == 0:
+        return None
+    return _Rows(**{f.name: None if (v := getattr(rows, f.name)) is None else v[:k] for f in fields(_Rows)})
+
+
 def _rows(segs: list, directional: bool) -> _Rows:
     offsets, scales, tools = frames(segs)
     start, end = points([e.start for e in segs]), points([e.end for e in segs])
@@ -152,9 +161,18 @@ class Solve:
         self.travel = Travel() if travel is None else travel.copy()
 
     def __call__(self, rows: _Rows) -> "_Solved":
-        if self.ctx.directional:
-            return _directional(rows, self.ctx, self.travel)
-        return _plain(rows, self.ctx)
+        return self._solve(rows, self.travel)
+
+    def _solve(self, rows: _Rows, travel: Travel) -> "_Solved":
+        try:
+            return _directional(rows, self.ctx, travel) if self.ctx.directional else _plain(rows, self.ctx)
+        except NcppError as error:  # (`travel` is advanced only once a chunk is solved)
+            # the chunk's line ends are checked before its reversal steps: an earlier line's fault
+            # among these is found solving the rows before the refused line alone, and raised instead
+            head = _rows_before(rows, error.where.line)
+            if head is not None:
+                self._solve(head, travel.copy())
+            raise
 
 
 @dataclass

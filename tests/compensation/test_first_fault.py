@@ -5,6 +5,8 @@ the same in one process, with a worker and in two parts."""
 
 import io
 
+import numpy as np
+
 import pytest
 
 import ncpp.parts as parts
@@ -85,3 +87,28 @@ def test_in_two_parts_the_first_fault_of_the_second_part(source, tmp_path):
     one = _refused(data, source, 1)
     assert one.where.line == _line_of(data, OUTSIDE)
     assert str(_refused(data, source, 2, tmp_path / "long.ngc")) == str(one)
+
+
+class _Kinked:
+    """A map with 0.5 µm of reversal error in X, and 0.6 mm more travelling -X between machine
+    Y 359.5 and 360.5, program Y 9.5 and 10.5 (a correction there exceeds the 0.5 mm allowed)."""
+
+    def deviation(self, P, direction=None):
+        sign = np.zeros(len(P)) if direction is None else np.asarray(direction, dtype=float)[:, 0]
+        error = np.zeros_like(P)
+        error[:, 0] = 0.0005 * sign + np.where((sign < 0) & (np.abs(P[:, 1] - 360) < 0.5), 0.6, 0.0)
+        return error
+
+
+@pytest.mark.parametrize("jobs", [1, 2])
+def test_a_reversal_step_refused_before_a_line_end_in_the_same_chunk_is_heard_first(jobs):
+    """The solve checks a chunk's line ends before its reversal steps' starts.  Line 4 reverses X
+    at Y10: it starts with a step there travelling -X (refused), and ends outside the band (too
+    short, 0.6 mm, to be split); line 41 ends in the band travelling -X (refused)."""
+    source = ErrorSource(model=_Kinked(), name="kinked", digest="0", max_correction=0.5)
+    fillers = "".join(f"G1 Y{k % 2}\n" for k in range(35))
+    data = f"G21 G90 G17\nG0 X0 Y0 Z0\nG1 X5 Y10 F100\nG1 X4.9 Y10.6\n{fillers}G1 X10\nG1 X5 Y10\nM2\n".encode()
+    error = _refused(data, source, jobs)
+    assert error.where.line == 4 and "exceeds the machine file's limit" in error.message
+    outside = data.replace(b"G1 X5 Y10 F100\nG1 X4.9 Y10.6\n", b"G1 X5 Y11 F100\nG1 X4.9 Y11.6\n")  # the step at Y11
+    assert _refused(outside, source, jobs).where.line == 41
