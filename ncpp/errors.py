@@ -17,6 +17,9 @@ class Location:
     file: str = "<stdin>"
     line: int | None = None
     col: int | None = None
+    # A pass's fault, whose kernel knows the line but not its text: the letter of the word it
+    # is at (None: the block), until the pass finds the column (`passes.geometry.locate`)
+    word: str | None = None
 
     def __str__(self) -> str:
         parts = [self.file]

@@ -12,7 +12,7 @@ unread), its output is what one run writes from the cut on (chunks end at the sa
 input lines, `geometry.line_chunks`), and is appended; where it does not (or the second
 process failed before), this process goes on from its cut and writes the rest itself,
 taking about the time of one process.  The output is that of one run, byte for byte,
-either way, wherever the cut is.  An error of the program (`file:line: message`) that
+either way, wherever the cut is.  An error of the program (`file:line:col: message`) that
 the second process finds past its cut, from this process's state there, is reported
 here once this part's lines are done (an error among them comes first), without the
 second part's lines compensated again.

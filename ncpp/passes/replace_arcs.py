@@ -25,7 +25,7 @@ from ncpp.errors import Location, NcppError
 from ncpp.motion.segments import Arc, Event, Line
 from ncpp.passes.context import PassContext
 from ncpp.passes.kernels import run_ahead
-from ncpp.passes.geometry import before_line, compensate, frames, from_plane, in_plane, plane_axes, points, rows_of, spliced
+from ncpp.passes.geometry import before_line, compensate, frames, from_plane, in_plane, locate, plane_axes, points, rows_of, spliced
 from ncpp.passes.travel import grid, quantize
 
 # Points per piece where the fit is checked (ends included).  Fewer on short
@@ -76,6 +76,7 @@ def replace_arcs(events: Iterable[Event], ctx: PassContext) -> Iterator[Event]:
         try:
             fitted = fitting.result()
         except NcppError as error:  # the lines before the refused one go on first: a later pass may refuse one of them
+            locate(error, batch)
             yield from replace_arcs(before_line(batch, error.where.line), ctx)
             raise
         yield from spliced(batch, index, _assemble(arcs, fitted))
@@ -230,7 +231,7 @@ def _replace(arcs: _ArcRows, ctx: PassContext) -> _Fitted:
     many = np.flatnonzero(np.abs(arcs.turn) > MAX_TURNS)
     if many.size:
         turns, line = int(abs(arcs.turn[many[0]])), int(arcs.lines[many[0]])
-        raise NcppError(f"an arc of {turns:,} turns: ncpp compensates {MAX_TURNS:,} at most (its pieces, 8 a turn, are held at once)", Location(ctx.file, line))
+        raise NcppError(f"an arc of {turns:,} turns: ncpp compensates {MAX_TURNS:,} at most (its pieces, 8 a turn, are held at once)", Location(ctx.file, line, word="P"))
     geometry = _ArcGeometry(arcs)
     offsets, scales, tools, line_of = arcs.offsets, arcs.scales, arcs.tools, arcs.lines
     pending = _initial_pieces(geometry, ctx.directional)

@@ -55,7 +55,8 @@ def _refused(data: bytes, source, jobs: int = 1, path=None) -> NcppError:
 @pytest.mark.parametrize("jobs", [1, 2])
 def test_a_pass_refusing_a_line_is_heard_before_the_interpreter_refusing_a_later_one(source, jobs):
     data = _program(_moves(100), OUTSIDE, _moves(500), UNREADABLE_ARC)
-    assert _refused(data, source, jobs).where.line == _line_of(data, OUTSIDE)
+    error = _refused(data, source, jobs)
+    assert (error.where.line, error.where.col) == (_line_of(data, OUTSIDE), 4)  # at its X word
     alone = _program(_moves(100), "G0 X0\n", _moves(500), UNREADABLE_ARC)
     assert _refused(alone, source, jobs).where.line == _line_of(alone, UNREADABLE_ARC)  # the interpreter's fault is found
 
@@ -67,6 +68,7 @@ def test_a_line_before_an_arc_replace_arcs_refuses_is_heard_first(source, jobs):
     alone = _program(_moves(50), "G0 X0\n", _moves(50), BULGING_ARC, _moves(50))
     error = _refused(alone, source, jobs)
     assert error.where.line == _line_of(alone, BULGING_ARC) + 1 and "outside the X travel" in error.message
+    assert error.where.col == 4  # `G3 X392 ...`: at its X word
 
 
 @pytest.mark.parametrize("arcs, events", [(1024, 4096), (1, 4096), (3, 7), (1024, 2)])
@@ -112,3 +114,17 @@ def test_a_reversal_step_refused_before_a_line_end_in_the_same_chunk_is_heard_fi
     assert error.where.line == 4 and "exceeds the machine file's limit" in error.message
     outside = data.replace(b"G1 X5 Y10 F100\nG1 X4.9 Y10.6\n", b"G1 X5 Y11 F100\nG1 X4.9 Y11.6\n")  # the step at Y11
     assert _refused(outside, source, jobs).where.line == 41
+
+
+@pytest.mark.parametrize("block, col", [("G0 X3000", 4), ("n10 g0 y0 x3000", 11)])
+def test_a_pass_names_the_column_of_the_word_it_refuses(source, block, col):
+    error = _refused(_program(_moves(10), block + "\nG0 X0\n", _moves(10)), source)
+    assert error.where.col == col and "outside the X travel" in error.message
+
+
+def test_a_block_without_the_word_a_pass_refuses_is_named_by_its_first_column(source):
+    """At machine zero (no work offset) the X of the first move, G0 Z5, is commanded at
+    -0.002 mm: outside the X travel, on a line with no X word."""
+    with pytest.raises(NcppError) as error:
+        process(io.BytesIO(b"G21 G90\n  G0 Z5\nM2\n"), io.BytesIO(), file="t.ngc", source=source, warnings=Warnings(stream=io.StringIO()))
+    assert str(error.value).startswith("t.ngc:2:1: command X-0.0020 mm is outside the X travel")

@@ -69,7 +69,7 @@ def test_a_g53_move_is_written_in_machine_coordinates():
 
 
 def test_the_error_message_names_machine_coordinates_and_the_real_travel():
-    with pytest.raises(NcppError, match=r"t.ngc:2: command X\d+\.\d+ mm is outside the X travel \[0, 800\] mm") as err:
+    with pytest.raises(NcppError, match=r"t.ngc:2:4: command X\d+\.\d+ mm is outside the X travel \[0, 800\] mm") as err:
         _compensated_lines(b"G21 G90\nG1 X900 F100\nM2\n", WorkOffsets.at(G54))  # to machine X1300
     assert 800 < float(str(err.value).split("command X")[1].split()[0]) <= 1300.1
 

@@ -51,8 +51,9 @@ def test_command_outside_travel_is_refused_with_line_and_no_output(tmp_path):
     proc = ncpp("compensate", "--machine", str(MACHINE), str(POCKET), "-o", str(out))
     assert proc.returncode != 0
     # at machine zero (no work offset) the first move's X (0, line 4) is commanded at -0.002 mm:
-    # the program's first fault, before the arc of line 8 that leaves the Y travel
-    assert proc.stderr.decode().startswith(f"{POCKET}:4: command X-0.0020 mm is outside the X travel")
+    # the program's first fault, before the arc of line 8 that leaves the Y travel; the block
+    # (`G0 Z5.`) has no X word, so the column is the block's
+    assert proc.stderr.decode().startswith(f"{POCKET}:4:1: command X-0.0020 mm is outside the X travel")
     assert not out.exists()
 
 
@@ -129,7 +130,7 @@ def test_an_arc_of_more_turns_than_compensation_holds_is_refused_with_its_line(t
     if turns is None:  # (10,000 turns: 80,000 lines)
         assert proc.returncode == 0 and proc.stdout.count("\n") > 80_000
     else:
-        assert proc.returncode == 2 and proc.stdout == "" and proc.stderr.startswith(f"{path}:3: an arc of {turns} turns")
+        assert proc.returncode == 2 and proc.stdout == "" and proc.stderr.startswith(f"{path}:3:20: an arc of {turns} turns")  # at its P word
 
 
 def test_simulate_refuses_motion_outside_the_travel_and_paths_past_its_sample_budget(tmp_path):

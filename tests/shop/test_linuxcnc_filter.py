@@ -221,7 +221,7 @@ def test_axis_shows_the_filters_error_and_loads_nothing(tmp_path, axis):
     out = tmp_path / "loaded.ngc"
     filtered = axis(bad, out)
     assert filtered.exit_code == 2 and out.read_bytes() == b""
-    assert filtered.message.startswith(f"{bad}:2: ") and "outside the X travel" in filtered.message
+    assert filtered.message.startswith(f"{bad}:2:4: ")  # at the X word and "outside the X travel" in filtered.message
 
 
 # Put before the filter's import path: the filter's Python then notes in NCPP_TEST_PARTS
