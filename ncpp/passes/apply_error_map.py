@@ -133,9 +133,9 @@ class _Rows:
 
 
 def _rows_before(rows: _Rows, line: int | None) -> _Rows | None:
-    """The rows of the lines before `line` (None: none)."""
+    """The rows of the lines before `line` (None: none, or all of them: nothing to solve again)."""
     k = 0 if line is None else int(np.searchsorted(rows.lines, line))
-    if k == 0:
+    if k == 0 or k == len(rows.lines):
         return None
     return _Rows(**{f.name: None if (v := getattr(rows, f.name)) is None else v[:k] for f in fields(_Rows)})
 

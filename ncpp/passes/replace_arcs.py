@@ -77,7 +77,9 @@ def replace_arcs(events: Iterable[Event], ctx: PassContext) -> Iterator[Event]:
             fitted = fitting.result()
         except NcppError as error:  # the lines before the refused one go on first: a later pass may refuse one of them
             locate(error, batch)
-            yield from replace_arcs(before_line(batch, error.where.line), ctx)
+            earlier = before_line(batch, error.where.line)
+            if len(earlier) < len(batch):
+                yield from replace_arcs(earlier, ctx)
             raise
         yield from spliced(batch, index, _assemble(arcs, fitted))
 

@@ -128,3 +128,19 @@ def test_a_block_without_the_word_a_pass_refuses_is_named_by_its_first_column(so
     with pytest.raises(NcppError) as error:
         process(io.BytesIO(b"G21 G90\n  G0 Z5\nM2\n"), io.BytesIO(), file="t.ngc", source=source, warnings=Warnings(stream=io.StringIO()))
     assert str(error.value).startswith("t.ngc:2:1: command X-0.0020 mm is outside the X travel")
+
+
+def test_a_fault_named_past_its_batch_is_raised_without_solving_the_batch_again(source, monkeypatch):
+    """A kernel's fault at a line its batch does not hold (none does so today) is raised as it
+    is: the lines before it are the whole batch, which just failed."""
+    import ncpp.passes.apply_error_map as apply_error_map
+    from ncpp.errors import Location
+
+    def refuse(*args):
+        raise NcppError("refused", Location("t.ngc", 10**6))
+
+    data = _program(_moves(30), "G0 X0 Y0\nG3 X0 Y20 I0 J10\n")  # an arc: replace_arcs fits a batch
+    for module, name in ((replace_arcs, "_replace"), (apply_error_map, "_directional")):
+        with monkeypatch.context() as patch:
+            patch.setattr(module, name, refuse)
+            assert _refused(data, source).where.line == 10**6
