@@ -61,12 +61,13 @@ def run(args: argparse.Namespace) -> int:
     machine = load_machine(args.machine)
     warnings = Warnings()
     offsets = work_offsets(args)
-    commanded = sample_events(program_events(args.program, warnings, offsets, args.dialect), args.step, args.program)
+    events = program_events(args.program, warnings, offsets, args.dialect)
+    commanded = sample_events(events, args.step, args.program)
     nominal = sample_events(program_events(args.reference, warnings, offsets, args.dialect), args.step, args.reference) if args.reference else commanded
     warnings.finish()
     if len(commanded.points) == 0:
         raise NcppError("the program makes no motion the interpreter could follow (a file of subroutines only runs where a program calls it)", Location(args.program))
-    check_travel(commanded, machine.limits, args.program)
+    check_travel(commanded, machine.limits, args.program, events)
     report = contour_error(machine, commanded, nominal)
     print(f"contour error: max {report.max_um:.2f} µm (line {report.worst_line}), rms {report.rms_um:.2f} µm over {report.samples} samples")
     for c in report.circles:
@@ -78,19 +79,25 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def check_travel(path, limits, file: str, slack_mm: float = 1e-6) -> None:
+def check_travel(path, limits, file: str, events: list, slack_mm: float = 1e-6) -> None:
     """Refuse a path (`simulate.SampledPath`) that leaves the machine's travel: the machine cannot
-    run it, and its error tables end there (the message names the first sample's line)."""
+    run it, and its error tables end there.  The message names the first sample outside, of
+    any axis: its line, and the column of its axis word among the path's `events`."""
     import numpy as np
 
-    for n, axis in enumerate("XYZ"):
-        lo, hi = limits.get(axis, (-math.inf, math.inf))
-        values = path.points[:, n]
-        outside = np.flatnonzero((values < lo - slack_mm) | (values > hi + slack_mm))
-        if outside.size:
-            k = int(outside[0])
-            raise NcppError(f"the motion reaches {axis}{values[k]:.4f} mm, outside the {axis} travel [{lo:g}, {hi:g}] mm "
-                            "(place the program with --work-offset or --var-file)", Location(file, int(path.line[k])))  # fmt: skip
+    from ncpp.passes.geometry import locate
+
+    lo, hi = (np.array([limits.get(axis, (-math.inf, math.inf))[end] for axis in "XYZ"]) for end in (0, 1))
+    outside = (path.points < lo - slack_mm) | (path.points > hi + slack_mm)
+    rows = np.flatnonzero(outside.any(axis=1))
+    if rows.size:
+        k = int(rows[0])
+        n = int(np.flatnonzero(outside[k])[0])
+        axis = "XYZ"[n]
+        error = NcppError(f"the motion reaches {axis}{path.points[k, n]:.4f} mm, outside the {axis} travel [{lo[n]:g}, {hi[n]:g}] mm "
+                          "(place the program with --work-offset or --var-file)", Location(file, int(path.line[k]), word=axis))  # fmt: skip
+        locate(error, events)
+        raise error
 
 
 def plot_report(report, commanded, path: str) -> None:

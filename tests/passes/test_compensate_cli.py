@@ -140,7 +140,10 @@ def test_simulate_refuses_motion_outside_the_travel_and_paths_past_its_sample_bu
     program.write_text("G21 G90\nG0 X0 Y0 Z0\nG1 X5000 F100\nM2\n")
     proc = ncpp("simulate", "--machine", str(MACHINE), "--work-offset", "400,350,370", str(program))
     assert proc.returncode == 2 and b"Traceback" not in proc.stderr
-    assert f"{program}:3: the motion reaches X800.5000 mm, outside the X travel [0, 800] mm".encode() in proc.stderr
+    assert f"{program}:3:4: the motion reaches X800.5000 mm, outside the X travel [0, 800] mm".encode() in proc.stderr
+    program.write_text("G21 G90\nG0 X0 Y0 Z0\nG1 Z-50 Y5000 F100\nG1 X5000\nM2\n")  # the first line out, whichever axis
+    proc = ncpp("simulate", "--machine", str(MACHINE), "--work-offset", "400,350,370", str(program))
+    assert f"{program}:3:9: the motion reaches Y700.".encode() in proc.stderr and b"outside the Y travel" in proc.stderr
     program.write_text("G21 G90\nG0 X10 Y10\nG0 X9999999999999 Y10\n")
     proc = ncpp("simulate", "--machine", str(MACHINE), "--work-offset", "400,350,370", str(program))
     assert proc.returncode == 2 and b"Traceback" not in proc.stderr
