@@ -219,7 +219,7 @@ def _parsed_ahead(blocks: Iterable[Block], ready: Callable[[], bool] = lambda: T
         run: list[Block] = []
         try:
             run.extend(islice(blocks, max(1, min(size, until() - last))))
-        except Exception:
+        except NcppError:  # (as the passes' batches: `ncpp/passes/__init__.py`)
             yield from run
             raise
         if not run:
