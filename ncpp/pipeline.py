@@ -24,7 +24,7 @@ from ncpp.fileio import program_file
 from ncpp.motion.interpreter import Interpreter
 from ncpp.motion.offsets import AT_MACHINE_ZERO, WorkOffsets
 from ncpp.motion.skim import Skim
-from ncpp.motion.segments import CYCLE, FLOW, Arc, Event, Line, Pass
+from ncpp.motion.segments import COMP, CYCLE, FLOW, Arc, Event, Line, Pass
 from ncpp.passes import PASSES, PassContext, run_passes
 from ncpp.passes.context import UNDECIDED, CutLine, is_directional
 from ncpp.passes.inverse import iterations_for
@@ -141,6 +141,8 @@ UNCOMPENSATED = {
     "with the machine's errors); compensation resumes with the next move",
     FLOW: "loop or subroutine: its moves pass through uncompensated (one text runs several times, "
     "or away from where it stands, so it cannot carry one correction); compensation resumes with the next move after it",
+    COMP: "cutter compensation: its moves pass through uncompensated (the control offsets them by the tool radius, "
+    "so the tool is not where their points are); compensation resumes after the first move with it off (after G40, or R0)",
 }
 INCREMENTAL_FIXED = (
     "{} in G91, or a G91 move after it: the control moves from the compensated "
@@ -148,12 +150,13 @@ INCREMENTAL_FIXED = (
 )
 
 
-_ARTICLED = {CYCLE: "a canned cycle", FLOW: "a loop or subroutine"}
+_ARTICLED = {CYCLE: "a canned cycle", FLOW: "a loop or subroutine", COMP: "cutter compensation"}
 
 
 def warn_fixed(events: Iterable[Event], warnings: Warnings, file: str) -> Iterator[Event]:
     """Pass events through; warn where a series of moves the passes leave as programmed
-    (`fixed`: a canned cycle's, a loop's or a subroutine's) starts (refused with --strict).
+    (`fixed`: a canned cycle's, a loop's or a subroutine's, or those under cutter compensation)
+    starts (refused with --strict).
 
     In G91 such a move starts from where the control is (the compensated position), and a
     G98 retract ends at the compensated level the series started at: the nominal moves
@@ -163,7 +166,7 @@ def warn_fixed(events: Iterable[Event], warnings: Warnings, file: str) -> Iterat
     series = ""  # why the moves of the series under way are fixed ("": none is)
     for event in events:
         kind = type(event)
-        if kind is not Pass:
+        if kind is Line or kind is Arc:  # (not a Pass, nor a dialect's own: Klartext's pole)
             fixed = event.fixed  # type: ignore[union-attr]
             if (fixed or series) and not event.context.absolute:  # type: ignore[union-attr]
                 yield from _passed_on(event, events, warnings, file, fixed or series)
@@ -411,7 +414,7 @@ def _process(
         events: Iterable[Event] = interpret(blocks, file=file, warnings=warnings, strict=strict, interpreter=interpreter)
     else:
         events = interpret(blocks, file=file, warnings=warnings, strict=strict, offsets=offsets)
-    if source is not None and name == "iso":  # the ISO interpreter's canned cycles
+    if source is not None:  # canned cycles, loops, subroutines (ISO), cutter compensation (every dialect)
         events = warn_fixed(events, warnings, file)
     writer = writer_class()
     if skim is not None:  # (before it reads a line: parsing starts when the writer asks for events; no interpreter: no skimming)

@@ -14,7 +14,9 @@ so the output compares line by line with
 
 `--format json` prints one JSON object per move (JSON Lines): source line,
 kind (traverse / feed / arc), start, end, centre and turn of arcs, feed,
-plane, inch, and the work offset (machine minus program position).
+plane, inch, the work offset (machine minus program position), and why
+compensation leaves a move as programmed ("fixed": a canned cycle, a loop or
+subroutine, cutter compensation), where it does.
 
 `--var-file linuxcnc.var` / `--work-offset [G5x=]X,Y,Z` start the
 interpreter from the control's zeros, as `rs274 -v FILE` does (default: all
@@ -22,11 +24,20 @@ zero, rs274's default parameter file), and `--tool-table` from its tool
 table (`rs274 -t`); the JSON records carry the tool length offset too.
 Heidenhain and Sinumerik programs print the same records (`--dialect`, or
 detected from the content).
+
+Under cutter compensation (G41/G42 or RL/RR, to the first move after G40 or R0) the moves
+printed are the programmed contour; rs274 prints the tool centre, offset by the
+radius from it.  A warning names the line where each such series starts
+(`--strict` refuses it).
 """
 
 from __future__ import annotations
 
 import argparse
+from typing import Iterable, Iterator
+
+from ncpp.errors import Location, Warnings
+from ncpp.motion.segments import COMP, Arc, Event, Line
 
 from ncpp.cli.compensate import add_placement_arguments, work_offsets
 from ncpp.cli.io import add_dialect_argument
@@ -54,7 +65,6 @@ def run(args: argparse.Namespace) -> int:
     from ncpp.cli.io import open_input
     from ncpp.errors import Warnings
     from ncpp.motion.canon import format_event
-    from ncpp.motion.segments import Arc, Line
     from ncpp.pipeline import dialect_tools
     from ncpp.program.dialects import parse_program
 
@@ -64,7 +74,8 @@ def run(args: argparse.Namespace) -> int:
     with open_input(args.input) as (stream, name):
         dialect, blocks = parse_program(stream, name, args.dialect)
         interpret, _ = dialect_tools(dialect)
-        for event in interpret(blocks, file=name, warnings=warnings, offsets=offsets):
+        events = interpret(blocks, file=name, warnings=warnings, offsets=offsets)
+        for event in warn_off_path(events, warnings, name, "printed as programmed (rs274 prints the tool centre, offset by the radius)"):
             if type(event) is not Line and type(event) is not Arc:
                 continue
             if args.format == "rs274":
@@ -86,6 +97,21 @@ def run(args: argparse.Namespace) -> int:
                 record["turn"] = event.turn
             if event.extra:
                 record["extra"] = event.extra
+            if event.fixed:  # why compensation leaves it as programmed (a canned cycle, cutter compensation, ...)
+                record["fixed"] = event.fixed
             out.write(json.dumps(record) + "\n")
     warnings.finish()
     return 0
+
+
+def warn_off_path(events: Iterable[Event], warnings: Warnings, file: str, consequence: str) -> Iterator[Event]:
+    """Pass events through; warn where a series of moves under cutter compensation starts
+    (`COMP`: the tool centre is off the programmed contour), saying `consequence`."""
+    off = False
+    for event in events:
+        if (type(event) is Line or type(event) is Arc) and (event.fixed == COMP) != off:
+            off = not off
+            if off:
+                warnings.warn(f"cutter compensation: up to the first move after it is off (G40, R0) the tool centre is off the programmed contour; its moves are {consequence}",
+                              Location(file, event.block.line, 1))  # fmt: skip
+        yield event

@@ -44,13 +44,15 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def program_events(path: str, warnings: Warnings, offsets=None, dialect: str | None = None) -> list:
     """The events of a program (its dialect detected unless given), placed on the machine by `offsets`."""
+    from ncpp.cli.motion import warn_off_path
     from ncpp.pipeline import dialect_tools
     from ncpp.program.dialects import parse_program
 
     with open(path, "rb") as stream:
         name, blocks = parse_program(stream, path, dialect)
         interpret, _ = dialect_tools(name)
-        return list(interpret(blocks, file=path, warnings=warnings, offsets=offsets))
+        events = interpret(blocks, file=path, warnings=warnings, offsets=offsets)
+        return list(warn_off_path(events, warnings, path, "simulated as programmed"))
 
 
 def run(args: argparse.Namespace) -> int:

@@ -14,10 +14,14 @@ P turns, parameters and expressions, Fanuc corner rounding and
 chamfering between two lines (`,R` `,C`, `G1 ... R`: a one-move look-ahead),
 the canned cycles G73 G74 G81-G87 G89 with G98/G99 (`cycles.py`), and
 o-word subroutines, branches and loops and Fanuc M98/M99 subprograms
-(`flow.py`); the moves of cycles, loops and subroutines are marked `fixed`:
-compensation leaves them as programmed.
+(`flow.py`), and cutter compensation G40-G42.1 (`_in_comp`): where the control
+offsets the path by the tool radius the moves are the programmed contour, not
+the tool centre, and after G40 the position is the program's again, as in
+rs274ngc.  The moves of cycles, loops and subroutines, and those the tool
+makes off the programmed path (from the first move under G41/G42 to the first
+after G40), are marked `fixed`: compensation leaves them as programmed.
 Anything else (subroutine files, Fanuc macro
-control flow, M99 in the main program, G88 (a manual retract) and the lathe cycles, cutter compensation, splines,
+control flow, M99 in the main program, G88 (a manual retract) and the lathe cycles, splines,
 threading, probing, polar words) makes the
 interpreter's state unknown: that block and every later block pass through
 as `Pass` after ONE warning (an error with `strict`).
@@ -35,7 +39,7 @@ from ncpp.motion.cycles import CANNED, DWELLING, PECKING, RAPID_DELTA_INCH, SPIN
 from ncpp.motion.expressions import ExpressionError, OutOfScope, Parameters, evaluate
 from ncpp.motion.offsets import SYSTEMS, WorkOffsets
 from ncpp.motion.flow import FIXED, RUN, SKIP, Flow
-from ncpp.motion.segments import CYCLE, FLOW, PLANE_AXES, Arc, Context, Event, Line, Pass
+from ncpp.motion.segments import COMP, CYCLE, FLOW, PLANE_AXES, Arc, Context, Event, Line, Pass
 from ncpp.motion.snapshot import attributes
 from ncpp.motion.tools import UntoldLengths
 from ncpp.program.blocks import STRAY_TAPE, UNREADABLE, Block, Comment, ExprWord, Statement, Word
@@ -83,7 +87,6 @@ OUT_OF_SCOPE_G = {
     **{c: "spline" for c in (5.0, 5.1, 5.2, 5.3)},
     **{c: "threading" for c in (33.0, 33.1)},
     **{c: "probing" for c in (38.2, 38.3, 38.4, 38.5)},
-    **{c: "cutter compensation" for c in (41.0, 42.0, 41.1, 42.1)},
     **{c: "UVW-plane arcs" for c in (17.1, 18.1, 19.1)},
     7.0: "lathe diameter mode",
     43.2: "additional tool length offset without H",
@@ -108,6 +111,24 @@ _Q_MOTIONS = {83.0, 73.0, 5.0, 71.0, 76.0}
 _R_MOTIONS = {2.0, 3.0, 76.0, 73.0, 71.0, 74.0} | _CYCLES
 _ARC_LETTERS = {17: ("I", "J", "K"), 18: ("K", "I", "J"), 19: ("J", "K", "I")}  # first, second, normal offset
 _PLANE_NAMES = {17: "xy", 18: "xz", 19: "yz"}
+# What rs274ngc refuses with cutter compensation on (`Interpreter._check_with_comp`): modal groups,
+# non-modal codes, motions
+_REFUSED_WITH_COMP = {
+    8: "Cannot change tool offset with cutter radius compensation on",
+    12: "Cannot change coordinate systems with cutter radius compensation on",
+    13: "Cannot change control mode with cutter radius compensation on",
+}
+_MODE0_WITH_COMP = {
+    **{c: "Cannot change axis offsets with cutter radius comp" for c in (52.0, 92.0)},
+    **{c: "Cannot use g28 or g30 with cutter radius comp" for c in (28.0, 30.0)},
+    **{c: "Cannot set reference point with cutter compensation in effect" for c in (28.1, 30.1)},
+    53.0: "Cannot use g53 with cutter radius comp",
+}
+_MOTION_WITH_COMP = {
+    **{c: "Cannot use canned cycles with cutter compensation on" for c in (73.0, 74.0, 76.0, 81.0, 82.0, 83.0, 84.0, 85.0, 86.0, 87.0, 88.0, 89.0)},
+    **{c: "Cannot probe with cutter radius comp on" for c in (38.2, 38.3, 38.4, 38.5)},
+    **{c: "Cannot convert spline with cutter radius compensation" for c in (5.0, 5.1, 5.2, 5.3)},
+}
 
 
 class _OutOfScope(Exception):
@@ -184,6 +205,8 @@ class Interpreter:
         self._fast = False
         self.done = False  # program end (M2/M30) reached or state unknown
         self.corner: tuple[str, float, Word | ExprWord] | None = None  # Fanuc ,R / ,C of the last block
+        self.cutter_comp: float | None = None  # G41, G41.1, G42 or G42.1 in effect (None: G40)
+        self.off_path = False  # the tool centre is off the programmed path: from the first move under comp to the first after G40
         self.untold: set[int] = set()  # coordinate systems whose zero nobody said (warned when selected)
         self.warnings: Warnings | None = None
         self.flow: Flow | None = None  # while `run` runs
@@ -228,6 +251,8 @@ class Interpreter:
                 event = block_event(block)  # verbatim blocks (after the closing %) have no items
                 if kind is FIXED:
                     event = self._in_flow(event, owner)
+                if self.off_path or self.cutter_comp is not None:
+                    event = self._in_comp(event, block)
             except NcppError as err:
                 source = flow.source()
                 if source is None or err.where is None or err.where.file != self.file:
@@ -285,7 +310,7 @@ class Interpreter:
         told by `skipped`: in absolute G90 without inverse time, no corner waiting, and the
         flow reading the main program in order."""
         return (self.absolute and not self.inverse_time and self.corner is None and self.holding is None
-                and not self.done and self.flow is not None and self.flow.streaming())  # fmt: skip
+                and self.cutter_comp is None and not self.off_path and not self.done and self.flow is not None and self.flow.streaming())  # fmt: skip
 
     def skipped(self, lines: int, ends: dict[int, float], motion: float | None, feed: float) -> None:
         """`lines` plain lines ran unread (`skimmable` was true): they moved the axes
@@ -327,6 +352,24 @@ class Interpreter:
             out.append(ev)
         return tuple(out) if len(out) != 1 else out[0]
 
+    def _in_comp(self, event: Event | tuple[Event, ...], block: Block) -> Event | tuple[Event, ...]:
+        """A block's events with cutter compensation on, or the first move after G40: its
+        moves are marked `fixed` (the tool is off the programmed path, by the radius the
+        control applies).  The first move after G40 brings it back to the programmed end
+        point, and must be straight, as rs274ngc says."""
+        events = event if type(event) is tuple else (event,)
+        moves = [ev for ev in events if type(ev) is not Pass]
+        if not moves:
+            return event
+        if self.corner is not None:
+            raise _OutOfScope("Fanuc corner rounding with cutter compensation", self.corner[2].start + 1)
+        if self.cutter_comp is None and type(moves[0]) is Arc:
+            self._fail("The move just after exiting cutter compensation mode must be straight, not an arc", block, None)
+        for ev in moves:  # (a loop's or a cycle's too: that the tool is off the path matters more)
+            ev.fixed = COMP
+        self.off_path = self.cutter_comp is not None
+        return event
+
     def _unrounded(self, pending: Line, held: list[Event]) -> Iterator[Event]:
         """A held corner line whose corner cannot be made: it passes through, uninterpreted."""
         yield Pass(pending.block)
@@ -337,9 +380,10 @@ class Interpreter:
         """[shortened first line, fillet arc or chamfer line, second line from the tangent point]."""
         kind, size, item = corner
         where = Location(self.file, first.block.line, item.start + 1)
-        if type(second) is not Line or second.rapid or first.rapid:
+        if type(second) is not Line or second.rapid or first.rapid or second.fixed == COMP:
             self.done = True
-            warnings.warn("Fanuc corner rounding next to an arc or a rapid move is outside the motion "
+            next_to = "cutter compensation" if type(second) is Line and second.fixed == COMP else "an arc or a rapid move"
+            warnings.warn(f"Fanuc corner rounding next to {next_to} is outside the motion "
                           "interpreter's scope; from this line on the program passes through uninterpreted", where)  # fmt: skip
             return None
         try:
@@ -570,6 +614,8 @@ class Interpreter:
         tool_axes = gcodes.get(8, (None,))[0] == 43.1  # G43.1's axis words are offsets, not a move
         motion = self._motion_to_be(block, 43.1 if tool_axes and mode0 is None else mode0, mode1, mode1_item, axis_item)
         self._check_words(block, words, gcodes, mcodes, motion, mode0, mode0_item, mode1_item)
+        if self.cutter_comp is not None or 7 in gcodes:
+            self._check_with_comp(block, words, gcodes, mcodes, motion, mode1_item or axis_item)
         self._check_scope(words, gcodes)
 
         # rs274ngc's order of execution (interp_execute.cc, convert_g)
@@ -581,6 +627,8 @@ class Interpreter:
             self._set(plane=int(gcodes[2][0]))
         if 6 in gcodes:
             self._set_units(gcodes[6][0] == 20.0)
+        if 7 in gcodes:
+            self._cutter_compensation(block, gcodes[7], words)
         if "T" in words:
             self.selected_tool = self._tool_number(words["T"], block)
         for code, turning in ((3.0, 1), (4.0, -1), (5.0, 0), (19.0, 0)):  # M19 orients: stopped
@@ -712,6 +760,56 @@ class Interpreter:
             elif not (motion in _R_MOTIONS or g7 in (41.1, 42.1) or mode0 == 10.0 or 19.0 in mcodes):
                 self._fail("R word with no g code that uses it", block, words["R"][1])
 
+    def _check_with_comp(self, block, words, gcodes, mcodes, motion, motion_item) -> None:
+        """What rs274ngc refuses with cutter compensation on, in its order of execution: a tool
+        change and a plane change (before G40-G42 on the line take effect), then, with the
+        compensation the line leaves on, G41/G42 again, tool length, coordinate system and
+        path control changes, G10 L2/L20 of the active system, G28/G30, G53, G52/G92, and
+        canned cycles, probing and splines."""
+        if self.cutter_comp is not None:
+            if 6.0 in mcodes:
+                self._fail("Cannot change tools with cutter radius compensation on", block, mcodes[6.0])
+            if 2 in gcodes and gcodes[2][0] != self.plane:
+                self._fail("Cannot change planes with cutter radius compensation on", block, gcodes[2][1])
+        code, item = gcodes.get(7, (None, None))
+        if code is not None and code != 40.0 and self.cutter_comp is not None:
+            self._fail("Cannot turn cutter radius comp on when on", block, item)
+        if code == 40.0 or (code is None and self.cutter_comp is None):
+            return  # off from this line's G40 on
+        for group, message in _REFUSED_WITH_COMP.items():
+            if group in gcodes:
+                self._fail(message, block, gcodes[group][1])
+        mode0, mode0_item = gcodes.get(0, (None, None))
+        message = _MODE0_WITH_COMP.get(mode0)  # type: ignore[arg-type]
+        if mode0 == 10.0 and words.get("L", (None,))[0] in (2.0, 20.0) and round(words["P"][0]) in (0, self.coord_system):
+            message = "Cannot change the active coordinate system with cutter radius compensation on"
+        if message is not None:
+            self._fail(message, block, mode0_item)
+        message = _MOTION_WITH_COMP.get(motion)  # type: ignore[arg-type]
+        if message is not None:
+            self._fail(message, block, motion_item)
+
+    def _cutter_compensation(self, block: Block, code_item: tuple, words: dict) -> None:
+        """G40 off; G41/G42 (the radius of tool D, or of the tool in the spindle) and G41.1/G42.1
+        (D the diameter) on, in the XY or XZ plane.  The radius does not matter here: the
+        moves are followed as programmed (`_in_comp`)."""
+        code, item = code_item
+        if code == 40.0:
+            self.cutter_comp = None
+            return
+        if self.plane not in (17, 18):
+            self._fail("Cutter radius compensation allowed only in XY, XZ planes", block, item)
+        d = words.get("D")
+        if code in (41.1, 42.1):
+            if d is None:
+                self._fail(f"G{code:g} with no D word", block, item)
+        elif d is not None:
+            if d[0] < 0.0 or abs(d[0] - round(d[0])) > 0.0001:
+                self._fail(f"G{code:g} requires D word to be a whole number", block, d[1])
+            if self.tools is not None and round(d[0]) != 0 and self.tools.offset(round(d[0])) is None:
+                self._fail(f"Requested tool {round(d[0])} not found in the tool table", block, d[1])
+        self.cutter_comp = code
+
     def _check_scope(self, words: dict, gcodes: dict) -> None:
         for value, item in gcodes.values():
             reason = OUT_OF_SCOPE_G.get(value)
@@ -803,6 +901,7 @@ class Interpreter:
         self._coordinate_system(1)
         self._set(plane=17, absolute=True, inverse_time=False)
         self.motion = 1.0
+        self.cutter_comp, self.off_path = None, False
         self.done = True
 
     def _machine(self, i: int) -> float:
@@ -1185,7 +1284,7 @@ class Interpreter:
             "_plane": self.plane * 10.0,
             "_motion_mode": 800.0 if self.motion is None else self.motion * 10,
             "_coord_system": _COORD_SYSTEM_CODE[self.coord_system],
-            "_ccomp": 400.0,
+            "_ccomp": 400.0 if self.cutter_comp is None else self.cutter_comp * 10,
         }.get(name)
         return value
 

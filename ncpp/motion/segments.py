@@ -27,6 +27,7 @@ Point = tuple[float, float, float]
 # Why a segment is `fixed`: passes leave it as programmed
 CYCLE = "canned cycle"  # a hole is drilled where the program puts it
 FLOW = "loop or subroutine"  # one text runs many times (or out of the text's order)
+COMP = "cutter compensation"  # the control offsets the path by the tool's radius: the tool is not on it
 # Axis letters of `Line.end` / `Arc.end` beyond XYZ, in rs274's order.
 EXTRA_AXES = ("A", "B", "C", "U", "V", "W")
 
@@ -79,7 +80,7 @@ class Line:
     context: Context = field(default_factory=Context)
     extra: tuple[float, ...] = ()  # end positions of A B C U V W, when the program uses them
     changed: bool = False  # set by a pass that moved the end point
-    fixed: str = ""  # why passes leave the move as programmed (CYCLE, FLOW), "" if they may change it
+    fixed: str = ""  # why passes leave the move as programmed (CYCLE, FLOW, COMP), "" if they may change it
 
     def length(self) -> float:
         return math.dist(self.start, self.end)
@@ -140,4 +141,4 @@ class Pass:
 Segment = Union[Line, Arc]
 Event = Union[Line, Arc, Pass]
 
-__all__ = ["CYCLE", "FLOW", "Arc", "Context", "Event", "Line", "Pass", "Point", "Segment", "PLANES", "PLANE_AXES", "EXTRA_AXES", "replace"]
+__all__ = ["COMP", "CYCLE", "FLOW", "Arc", "Context", "Event", "Line", "Pass", "Point", "Segment", "PLANES", "PLANE_AXES", "EXTRA_AXES", "replace"]

@@ -151,7 +151,7 @@ def test_a_call_of_a_subroutine_the_program_does_not_define_passes_the_rest():
 
 def test_out_of_scope_inside_a_subroutine_names_the_call():
     warned = io.StringIO()
-    events = _events(HEAD + "o1 sub\n G41 G1 X1\no1 endsub\nG0 X5\no1 call\nG0 X6\n", warnings=Warnings(stream=warned))
+    events = _events(HEAD + "o1 sub\n G38.2 X1 F10\no1 endsub\nG0 X5\no1 call\nG0 X6\n", warnings=Warnings(stream=warned))
     assert "t.ngc:4:" in warned.getvalue() and "from line 7, which runs it," in warned.getvalue()
     assert [e.block.line for e in events if type(e) is Line] == [2, 6]
     assert "".join(e.block.text for e in events if type(e) is not Line).count("o1 call") == 1

@@ -257,7 +257,7 @@ def test_arc_radius_tolerance_matches_linuxcnc_files():
         ("IF [#1 EQ 1] GOTO 10\n", "Fanuc macro IF"),
         ("M98 P100\n", "M98 P100: a subprogram the program does not define"),
         ("G88 X0 Y0 Z-1 R1 P1 F10\n", "canned cycle G88"),  # a manual retract: the other cycles are interpreted
-        ("G41 D1 G1 X1 F1\n", "cutter compensation G41"),
+        ("G38.2 X1 F1\n", "probing G38.2"),
         ("G0 @10 ^45\n", "polar coordinates"),
         ("G0 X#<_hal[x.y]>\n", "machine-state parameter"),
         ("G0 X#5221\n", "machine-state parameter #5221"),

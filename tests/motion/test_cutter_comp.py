@@ -1,0 +1,210 @@
+"""Cutter compensation (G40-G42.1) against LinuxCNC's rs274: the interpreter follows the
+programmed positions through it, marks the moves the tool makes off the programmed path
+(`COMP`), is back on the program's positions after the first move after G40, and refuses
+what rs274 refuses with compensation on, on the same line."""
+
+from __future__ import annotations
+
+import io
+import math
+
+import pytest
+
+from ncpp.errors import NcppError, Warnings
+from ncpp.motion import interpret
+from ncpp.motion.segments import COMP, Arc, Line
+from ncpp.program.parser import parse_stream
+from tests.conftest import RS274
+from tests.motion.compensating import compensate
+from tests.motion.test_oracle import assert_refused_like_rs274, ours, read_canon, rs274, rs274_error, same_calls, without_comp, write_program
+
+needs_rs274 = pytest.mark.skipif(not RS274.exists(), reason="rs274 oracle not available")
+
+HEAD = "G21 G90 G17 G94 G64\nG0 X0 Y0 Z5\nG1 Z-1 F100\n"
+CONTOUR = HEAD + "G41.1 D10\nG1 X10 Y0\nG1 X10 Y10\nG2 X20 Y20 R10\nG1 Y30\nG40\nG1 X30\nG1 Y40 Z2\nG2 X40 Y50 I10\nM2\n"
+
+
+def events_of(text: str, **kwargs) -> list:
+    return list(interpret(parse_stream(io.BytesIO(text.encode()), "t.ngc"), file="t.ngc", **kwargs))
+
+
+def moves(events) -> list:
+    return [e for e in events if type(e) is Line or type(e) is Arc]
+
+
+def test_moves_off_the_path_are_marked_from_the_first_under_comp_to_the_first_after_g40():
+    lines = [(e.block.line, e.fixed) for e in moves(events_of(CONTOUR))]
+    assert lines == [(2, ""), (3, ""), (5, COMP), (6, COMP), (7, COMP), (8, COMP), (10, COMP), (11, ""), (12, "")]
+
+
+def test_after_g40_the_position_is_the_programs():
+    """rs274 takes an axis the exit move does not name from the programmed contour, not from the
+    tool centre: `G1 X30` after the contour's `G1 Y30` ends at (30, 30)."""
+    exit_move = moves(events_of(CONTOUR))[6]
+    assert exit_move.end[:2] == (30.0, 30.0)
+
+
+@needs_rs274
+@pytest.mark.parametrize(
+    "body",
+    [
+        CONTOUR[len(HEAD) :],
+        "G42.1 D4\nG0 X10 Y10\nG0 X20\nG40 G0 X30\nG1 Y5\nG3 X40 Y15 J10\n",  # rapids, G40 with the exit move
+        "G18\nG41.1 D2\nG1 X10 Z-5\nG1 X20\nG40\nG1 X30 Z0\nG2 X40 Z10 I10\n",  # the XZ plane
+        "G41.1 D2\nG91 G1 X10\nG1 Y10\nG90\nG40\nG1 X30 Y5\nG1 X0\n",  # increments under compensation
+        "G41.1 D2\nG1 X10 Y10\nG40 G55\nG1 X20 Y20\nG54 G1 X0\n",  # G40 first, then the system: allowed
+        "G41.1 D2\nG1 X10\nG10 L2 P2 X3\nG92.1\nG20\nG1 X1\nG21\nG40\nG0 Z5\nG0 X0 Y0\n",  # allowed under compensation
+        "G41.1 D2\nG40\nG2 X10 I5\n",  # no move under compensation: an arc may follow G40
+        "G41.1 D0\nG1 X10\nG1 Y10\nG40\nG1 X0\nG1 X5 Y5\n",  # radius 0: rs274's moves are the programmed ones
+    ],
+    ids=["contour", "rapids", "xz", "g91", "g40-g55", "allowed", "no-move", "d0"],
+)
+def test_moves_after_compensation_agree_with_rs274(tmp_path, body):
+    path = write_program(tmp_path, HEAD + body)
+    calls, messages = rs274(str(path))
+    assert rs274_error(messages) is None, messages
+    off_path: list[bool] = []
+    mine, error, warning = ours(path, off_path)
+    assert error is None and not warning, (error, warning)
+    theirs, kept = without_comp(read_canon(calls), mine, off_path)
+    assert not off_path[-1] and len(kept) == len(theirs), (theirs, kept)  # the last move is compared
+    assert same_calls(theirs, kept), (theirs, kept)
+
+
+@needs_rs274
+@pytest.mark.parametrize(
+    "body, line",
+    [
+        ("G41.1 D2\nG1 X10\nT1 M6\n", 6),
+        ("G41.1 D2\nG1 X10\nG81 X20 Z-2 R1\n", 6),
+        ("G41.1 D2\nG1 X10\nG18\n", 6),
+        ("G41.1 D2\nG1 X10\nG55\n", 6),
+        ("G41.1 D2\nG1 X10\nG54\n", 6),  # the system in effect too
+        ("G41.1 D2\nG1 X10\nG92 X0\n", 6),
+        ("G41.1 D2\nG1 X10\nG52 X1\n", 6),
+        ("G41.1 D2\nG1 X10\nG28\n", 6),
+        ("G41.1 D2\nG1 X10\nG30.1\n", 6),
+        ("G41.1 D2\nG1 X10\nG53 G1 X20\n", 6),
+        ("G41.1 D2\nG1 X10\nG43 H1\n", 6),
+        ("G41.1 D2\nG1 X10\nG49\n", 6),
+        ("G41.1 D2\nG1 X10\nG10 L2 P1 X3\n", 6),
+        ("G41.1 D2\nG1 X10\nG64\n", 6),
+        ("G41.1 D2\nG1 X10\nG38.2 X20\n", 6),
+        ("G41.1 D2\nG1 X10\nG5 X20 I1 J1 P1 Q1\n", 6),
+        ("G41.1 D2\nG1 X10\nG42.1 D2\n", 6),
+        ("G41.1 D2\nG1 X10\nM6 T1 G40\n", 6),  # the tool change comes before G40 takes effect
+        ("G19\nG41.1 D2\n", 5),
+        ("G41.1\n", 4),
+        ("G41 D-1\n", 4),
+        ("G41.1 D2\nG1 X10\nG1 Y5\nG40\nG2 X20 I5\n", 8),
+        ("G41.1 D2\nG1 X10\nG40 G2 X20 I5\n", 6),
+    ],
+)
+def test_refused_with_compensation_as_rs274_refuses(tmp_path, body, line):
+    path = write_program(tmp_path, HEAD + body)
+    assert_refused_like_rs274(path, line)
+    _, error, _ = ours(path)
+    assert rs274_error(rs274(str(path))[1])[0] == error.message  # type: ignore[index,union-attr]
+
+
+def test_the_ccomp_parameter_says_the_mode():
+    text = HEAD + "#1 = #<_ccomp>\nG42.1 D2\n#2 = #<_ccomp>\nG40\n#3 = #<_ccomp>\nG1 X#1 Y#2 Z#3\n"
+    assert moves(events_of(text))[-1].end == (400.0, 421.0, 400.0)
+
+
+def test_program_end_ends_compensation():
+    events = moves(events_of(HEAD + "G41.1 D2\nG1 X10\nM2\n"))
+    assert events[-1].fixed == COMP
+    from ncpp.motion.interpreter import Interpreter
+
+    interpreter = Interpreter("t.ngc")
+    list(interpreter.run(parse_stream(io.BytesIO((HEAD + "G41.1 D2\nG1 X10\nM2\n").encode()), "t.ngc"), Warnings()))
+    assert interpreter.cutter_comp is None and not interpreter.off_path
+
+
+def test_plain_lines_are_not_skimmed_under_compensation():
+    """The second part of `--jobs 2` may leave plain lines unread (`skim.py`): not while the tool is off the path."""
+    from ncpp.motion.interpreter import Interpreter
+
+    interpreter = Interpreter("t.ngc")
+    for event in interpreter.run(parse_stream(io.BytesIO((HEAD + "G41.1 D2\nG1 X10\nG40\nG1 X20\nG1 X30\n").encode()), "t.ngc"), Warnings()):
+        line = event.block.line
+        assert interpreter.skimmable() == (line not in (4, 5, 6)), line
+
+
+def test_corner_rounding_under_compensation_is_out_of_scope():
+    warned = io.StringIO()
+    events = events_of(HEAD + "G41.1 D2\nG1 X10 ,R1\nG1 Y10\nG40\nG1 X0\n", warnings=Warnings(stream=warned))
+    assert "Fanuc corner rounding with cutter compensation" in warned.getvalue()
+    with pytest.raises(NcppError):
+        events_of(HEAD + "G41.1 D2\nG1 X10 ,R1\nG1 Y10\n", strict=True)
+    assert [e.block.line for e in moves(events)] == [2, 3]
+
+
+# -- compensation ---------------------------------------------------------------------------------
+POCKET = HEAD + "G1 X-20 Y-20\nG1 X-5\nG41.1 D6\nG1 X0 Y0\nG1 X40\nG3 X50 Y10 R10\nG1 Y40\nG40\nG1 X55 Y45\nG1 X70\nG2 X80 Y55 R10\nG0 Z10\nM2\n"
+
+
+def test_moves_off_the_path_pass_through_and_compensation_resumes_after_the_exit_move():
+    out, warned = compensate(POCKET, "comp.ngc")
+    original, lines = POCKET.splitlines(), out.splitlines()[1:]  # (the header)
+    start = lines.index("G41.1 D6")
+    assert lines[start - 1].startswith("X-4.97")  # `G1 X-5` compensated before it
+    assert lines[start : start + 7] == original[5:12]  # from G41.1 to the exit move: verbatim
+    after = lines[start + 7 :]
+    # from the exit move's end (as programmed) to the compensated start of the next line, every axis said; then that line
+    assert after[0].startswith("G1 X55.0") and "Y45.0" in after[0] and "Z-0.9" in after[0] and after[1].startswith("X70.0")
+    assert any(line.startswith("G2 ") and "I" in line for line in after)  # the arc after it replaced
+    assert warned.count("warning") == 1 and "comp.ngc:7:1: warning: cutter compensation: its moves pass through uncompensated" in warned
+
+
+def test_strict_refuses_moves_under_compensation():
+    with pytest.raises(NcppError, match="comp.ngc:7:1: cutter compensation"):
+        compensate(POCKET, "comp.ngc", strict=True)
+
+
+def test_compensation_in_g91_ends_compensation():
+    text = HEAD + "G1 X-20 Y-20\nG41.1 D6\nG91 G1 X20\nG1 Y20\nG90\nG40\nG1 X10 Y10\nG1 X30\n"
+    out, warned = compensate(text, "comp.ngc")
+    assert "comp.ngc:6:1: warning: cutter compensation in G91" in warned
+    assert out.splitlines()[-6:] == text.splitlines()[-6:]
+
+
+@needs_rs274
+def test_rs274_runs_the_compensated_program_with_the_same_moves_under_compensation(tmp_path):
+    out, _ = compensate(POCKET, "comp.ngc")
+    before, after = write_program(tmp_path, POCKET, "in.ngc"), write_program(tmp_path, out, "out.ngc")
+    calls, messages = rs274(str(after))
+    assert rs274_error(messages) is None, messages
+    original, compensated = read_canon(rs274(str(before))[0]), read_canon(calls)
+    # the tool centre's moves from the corner after the entry move to the exit move: the same
+    # (their Z is where the compensated line before them left it); the entry move's end moves a
+    # little with its start (rs274 offsets it square to the move), which compensation moved
+    k, n = (next(i for i, c in enumerate(calls) if c.name == "ARC_FEED") for calls in (original, compensated))
+    plane = [(a.name, a.args[:4] if a.name == "ARC_FEED" else a.args[:2]) for a in original[k : k + 5]]
+    assert plane == [(a.name, a.args[:4] if a.name == "ARC_FEED" else a.args[:2]) for a in compensated[n : n + 5]]
+    assert math.dist(original[k - 1].args[:2], compensated[n - 1].args[:2]) < 0.005
+    assert compensated[n + 5].args[:2] != original[k + 5].args[:2]  # compensated again after the exit move
+
+
+def test_motion_and_simulate_say_where_the_tool_leaves_the_programmed_contour(tmp_path):
+    import subprocess
+    import sys
+
+    from tests.conftest import ROOT
+
+    path = write_program(tmp_path, CONTOUR.replace("G0 X0 Y0 Z5", "G0 X0 Y0 Z5\nG10 L2 P1 X400 Y350 Z400"))
+    run = [sys.executable, "-m", "ncpp"]
+    motion = subprocess.run([*run, "motion", str(path)], capture_output=True, text=True)
+    assert motion.returncode == 0 and motion.stderr.count("warning") == 1 and "program.ngc:6:1: warning: cutter compensation" in motion.stderr
+    assert "printed as programmed" in motion.stderr and "STRAIGHT_FEED(30.0000, 30.0000, -1.0000" in motion.stdout
+    assert subprocess.run([*run, "motion", "--strict", str(path)], capture_output=True, text=True).returncode != 0
+    simulate = subprocess.run([*run, "simulate", "--machine", str(ROOT / "samples/machines/hr5b.toml"), str(path)], capture_output=True, text=True)
+    assert simulate.returncode == 0 and "program.ngc:6:1: warning: cutter compensation" in simulate.stderr and "simulated as programmed" in simulate.stderr
+
+
+def test_corner_rounding_into_cutter_compensation_is_out_of_scope():
+    warned = io.StringIO()
+    events = events_of(HEAD + "G1 X10 ,R1\nG41.1 D2 G1 Y10\nG40\nG1 X0\n", warnings=Warnings(stream=warned))
+    assert "t.ngc:4:" in warned.getvalue() and "Fanuc corner rounding next to cutter compensation" in warned.getvalue()
+    assert [e.block.line for e in moves(events)] == [2, 3]
