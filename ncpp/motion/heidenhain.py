@@ -11,7 +11,10 @@ labels, `CYCL DEF` of machining cycles (they only define), M2/M30
 and `END PGM` (end), and `RND R..` / `CHF ..` between two feed lines in the
 working plane (the fillet arc or chamfer line is the RND/CHF block's event; a
 feed line waits for the next move to know whether its corner is cut).
-Radius compensation RL/RR, RND/CHF next to an arc or a rapid, FK free contours,
+Radius compensation RL/RR is followed to R0: the moves from the first with RL/RR
+to the R0 block's are the programmed contour, the tool centre off it by the radius,
+and are marked `fixed` (`ModalInterpreter.radius_compensation`).  Paraxial R+/R-,
+RND/CHF next to an arc or a rapid, FK free contours,
 APPR/DEP, `CALL LBL`, `CALL PGM`, `CYCL CALL`, M99, FN functions and cycles
 that move the datum make the position unknown: one warning (an error with
 `strict`) and the rest passes through.
@@ -30,7 +33,7 @@ from ncpp.errors import Location, NcppError, Warnings
 from ncpp.motion.corners import CornerError, round_corner
 from ncpp.motion.modal import MM_PER_INCH, PLANE_OF_TOOL_AXIS, ModalInterpreter, OutOfScope, resolve_warnings
 from ncpp.motion.offsets import WorkOffsets
-from ncpp.motion.segments import PLANE_AXES, Arc, Event, Line, Pass, Point
+from ncpp.motion.segments import COMP, PLANE_AXES, Arc, Event, Line, Pass, Point
 from ncpp.motion.tools import ToolTable, UntoldLengths
 from ncpp.program.blocks import Block, Comment, ExprWord, Word
 
@@ -115,6 +118,8 @@ class HeidenhainInterpreter(ModalInterpreter):
                     continue
                 held[0], event = made[0], made[-1]
                 piece = made[1] if len(made) == 3 else Pass(corner.block)
+                if COMP in (made[0].fixed, made[-1].fixed) and type(piece) is not Pass:  # (the rounding is the contour's)
+                    piece.fixed = COMP  # type: ignore[attr-defined]
                 held = [piece if e is corner else e for e in held]
                 corner = None
             yield from held
@@ -153,6 +158,7 @@ class HeidenhainInterpreter(ModalInterpreter):
         words: dict[str, tuple[float, object]] = {}
         rapid = False
         rotation: str | None = None
+        comp: str | None = None  # RL, RR or R0
         end = False
         for item in block.items:
             kind = type(item)
@@ -184,8 +190,7 @@ class HeidenhainInterpreter(ModalInterpreter):
                     self._context = None
                 return self._tool_call(block, item)
             elif what == "radius_comp":
-                if node[0] != "R0":
-                    raise OutOfScope(f"radius compensation {node[0]}", item.start + 1)
+                comp = node[0]
             elif what == "feed":
                 rapid = node[0] == "FMAX"
                 if node[0] == "FAUTO":
@@ -218,7 +223,7 @@ class HeidenhainInterpreter(ModalInterpreter):
             self.last_move, self.corner_waits = events[-1], False  # type: ignore[assignment]
         if end:
             self.done = True
-        return events
+        return self.radius_compensation(events, None if comp is None else comp != "R0")
 
     def _tool_def(self, block: Block, statement) -> list[Event]:
         """`TOOL DEF n L.. R..`: the program defines tool n's length (without L: it only prepares the tool)."""

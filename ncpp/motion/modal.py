@@ -13,7 +13,7 @@ import math
 from typing import Callable, Iterable, Iterator
 
 from ncpp.errors import Location, NcppError, Warnings
-from ncpp.motion.segments import PLANE_AXES, Arc, Context, Event, Line, Pass, Point
+from ncpp.motion.segments import COMP, PLANE_AXES, Arc, Context, Event, Line, Pass, Point
 from ncpp.program.blocks import Block
 
 MM_PER_INCH = 25.4
@@ -53,6 +53,8 @@ class ModalInterpreter:
         self.zero: list[float] = list(zero)  # the program zero the control holds (preset, settable frame), program units
         self.tangent: tuple[float, float, float] | None = None  # direction at the end of the last move
         self.done = False
+        self.radius_comp = False  # tool radius compensation on (G41/G42, RL/RR)
+        self.off_path = False  # the tool centre off the programmed path: from the first move with it on to the first after
         self._context: Context | None = None
 
     # -- the event stream -------------------------------------------------------------
@@ -76,6 +78,21 @@ class ModalInterpreter:
 
     def block(self, block: Block) -> list[Event]:
         raise NotImplementedError
+
+    def radius_compensation(self, events: list[Event], turn: bool | None) -> list[Event]:
+        """A block's events, `turn`ing tool radius compensation on (True), off (False) or
+        neither (None).  The control offsets the path by the tool radius: the moves from the
+        first with it on to the first after it is off (which ends on its programmed point)
+        are marked `fixed` (COMP); positions stay the programmed ones, as the control's do."""
+        if turn is not None:
+            self.radius_comp = turn
+        if self.radius_comp or self.off_path:
+            moves = [e for e in events if type(e) is Line or type(e) is Arc]
+            for move in moves:
+                move.fixed = COMP
+            if moves:
+                self.off_path = self.radius_comp
+        return events
 
     # -- modal state --------------------------------------------------------------------
     def context(self, plane: int | None = None, absolute: bool = True) -> Context:

@@ -10,9 +10,11 @@ or `T="NAME"` selects, M6 loads it with cutting edge D1, `D n` picks an edge
 (D0 none); the edge's lengths 1-3 from the control's tool offsets (`_N_TO_INI`,
 `tools.py`) act along the plane's axes (G17: length 1 along Z).  Control flow (GOTO*,
 IF, WHILE, FOR, REPEAT, CASE), calls of cycles and subprograms (by name or `L<n>`), splines, other
-frames, polar coordinates (AP=, RP=), arcs by opening angle (AR=), cutter
-compensation (G41/G42) and unknown G codes make the position
-unknown: one warning (an error with `strict`) and the rest passes through.
+frames, polar coordinates (AP=, RP=), arcs by opening angle (AR=) and unknown G
+codes make the position unknown: one warning (an error with `strict`) and the
+rest passes through.  Under cutter compensation (G41/G42 to the first move after
+G40) the moves are the programmed contour, the tool centre off it by the radius:
+they are marked `fixed` (`ModalInterpreter.radius_compensation`).
 """
 
 from __future__ import annotations
@@ -31,8 +33,8 @@ AXES = "XYZ"
 CENTRE_LETTERS = "IJK"
 INTERMEDIATE = ("I1", "J1", "K1")
 # G codes that change nothing the motion depends on (exact stop, continuous path, feed types, work offsets
-# the control holds, spindle modes, acceleration, G40 compensation off)
-NEUTRAL_G = frozenset((9.0, 40.0, 54.0, 55.0, 56.0, 57.0, 500.0, 60.0, 64.0, 601.0, 602.0, 603.0, 641.0, 642.0,
+# the control holds, spindle modes, acceleration; G40-G42 are read apart: `block`)
+NEUTRAL_G = frozenset((9.0, 40.0, 41.0, 42.0, 54.0, 55.0, 56.0, 57.0, 500.0, 60.0, 64.0, 601.0, 602.0, 603.0, 641.0, 642.0,
                        643.0, 644.0, 645.0, 94.0, 95.0, 96.0, 97.0, 153.0, 450.0, 451.0, 961.0, 971.0))  # fmt: skip
 UNITS_G = {70.0: True, 700.0: True, 71.0: False, 710.0: False}
 HARMLESS_CALLS = frozenset(("MSG", "BNAT", "ENAT", "BTAN", "ETAN", "BAUTO", "EAUTO", "FFWON", "FFWOF", "SOFT",
@@ -167,6 +169,8 @@ class SinumerikInterpreter(ModalInterpreter):
                     self.fail(f"the address {letter} twice in one block", block, item)
                 words[letter] = (value, mode, item)
         plane = self.plane
+        codes = {code for code, _ in gcodes}
+        turn = True if codes & {41.0, 42.0} else False if 40.0 in codes else None  # cutter compensation
         dwell = self._modal_codes(gcodes, block)
         if tool_words or (self.plane != plane and self.edge):
             self._place_tool(block, tool_words)
@@ -182,7 +186,7 @@ class SinumerikInterpreter(ModalInterpreter):
             events = self._move(block, words)
         if end:
             self.done = True
-        return events
+        return self.radius_compensation(events, turn)
 
     def _exponent(self, block: Block, expression, word: Word) -> None:
         """Refuse `X=1e3`: the grammar reads `X=1` and an address E, as a Sinumerik would."""
@@ -249,8 +253,7 @@ class SinumerikInterpreter(ModalInterpreter):
             elif code == 4.0:
                 dwell = True
             elif code not in NEUTRAL_G:
-                reason = {41.0: "cutter compensation", 42.0: "cutter compensation", 53.0: "machine coordinates",
-                          33.0: "thread cutting", 93.0: "inverse time feed"}.get(code, "the G code")  # fmt: skip
+                reason = {53.0: "machine coordinates", 33.0: "thread cutting", 93.0: "inverse time feed"}.get(code, "the G code")
                 raise OutOfScope(f"{reason} G{code:g}", item.start + 1)
         return dwell
 
