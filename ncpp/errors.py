@@ -8,8 +8,11 @@ traceback.
 from __future__ import annotations
 
 import sys
-from dataclasses import dataclass
-from typing import TextIO
+from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING, Iterable, TextIO
+
+if TYPE_CHECKING:
+    from ncpp.program.blocks import Block
 
 
 @dataclass(frozen=True, slots=True)
@@ -18,7 +21,7 @@ class Location:
     line: int | None = None
     col: int | None = None
     # A pass's fault, whose kernel knows the line but not its text: the letter of the word it
-    # is at (None: the block), until the pass finds the column (`passes.geometry.locate`)
+    # is at (None: the block), until the pass finds the column (`NcppError.locate`)
     word: str | None = None
 
     def __str__(self) -> str:
@@ -37,6 +40,21 @@ class NcppError(Exception):
         super().__init__(message)
         self.message = message
         self.where = where or Location()
+
+    def locate(self, blocks: Iterable["Block"]) -> None:
+        """Give an error that names its line but no column (a pass's, a path's) the column of
+        its word in the block of that line among `blocks`: that of the word its location
+        names, else 1 (the block)."""
+        from ncpp.program.blocks import Word
+
+        where = self.where
+        if where.col is not None or where.line is None:
+            return
+        block = next((b for b in blocks if b.line == where.line), None)
+        if block is None:
+            return
+        word = next((item for item in block.items if type(item) is Word and item.letter == where.word), None)
+        self.where = replace(where, col=1 if word is None else word.start + 1, word=None)
 
     def __str__(self) -> str:
         return f"{self.where}: {self.message}"

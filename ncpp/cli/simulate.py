@@ -87,8 +87,6 @@ def check_travel(path, limits, file: str, events: list, slack_mm: float = 1e-6) 
     any axis: its line, and the column of its axis word among the path's `events`."""
     import numpy as np
 
-    from ncpp.passes.geometry import locate
-
     lo, hi = (np.array([limits.get(axis, (-math.inf, math.inf))[end] for axis in "XYZ"]) for end in (0, 1))
     outside = (path.points < lo - slack_mm) | (path.points > hi + slack_mm)
     rows = np.flatnonzero(outside.any(axis=1))
@@ -98,7 +96,7 @@ def check_travel(path, limits, file: str, events: list, slack_mm: float = 1e-6) 
         axis = "XYZ"[n]
         error = NcppError(f"the motion reaches {axis}{path.points[k, n]:.4f} mm, outside the {axis} travel [{lo[n]:g}, {hi[n]:g}] mm "
                           "(place the program with --work-offset or --var-file)", Location(file, int(path.line[k]), word=axis))  # fmt: skip
-        locate(error, events)
+        error.locate(e.block for e in events)
         raise error
 
 

@@ -15,7 +15,7 @@ line of a batch deals with the batch's lines before it first: `replace_arcs` han
 on compensated (a later pass may refuse one of those), `apply_error_map` solves them
 again (it checks a chunk's line ends before its reversal steps).  So the fault reported
 is the program's first, whatever the batch sizes, a worker process or the parts a
-program is compensated in; `geometry.locate` then names its column.
+program is compensated in; `NcppError.locate` then names its column.
 """
 
 from __future__ import annotations

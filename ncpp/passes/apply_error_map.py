@@ -26,7 +26,7 @@ from ncpp.errors import NcppError
 from ncpp.motion.segments import Arc, Event, Line
 from ncpp.passes.context import CutLine, PassContext, deviation
 from ncpp.passes.kernels import run_ahead
-from ncpp.passes.geometry import compensate, frames, from_plane, in_plane, line_chunks, locate, plane_axes, points, rows_of
+from ncpp.passes.geometry import compensate, frames, from_plane, in_plane, line_chunks, plane_axes, points, rows_of
 from ncpp.passes.travel import Travel, grid, hold, quantize, steps
 
 # Compensations per line at most: each changes a direction only where a
@@ -62,7 +62,7 @@ def apply_error_map(events: Iterable[Event], ctx: PassContext) -> Iterator[Event
         try:
             solved = solving.result()
         except NcppError as error:
-            locate(error, chunk)
+            error.locate(e.block for e in chunk)
             raise
         out = _written(chunk, segs, rows, solved, last)
         last = next(e for e in reversed(out) if type(e) is Line or type(e) is Arc)

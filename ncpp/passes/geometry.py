@@ -4,7 +4,6 @@ program points to machine positions and back, compensating many at once."""
 from __future__ import annotations
 
 from bisect import bisect_left
-from dataclasses import replace
 from itertools import chain, islice
 from operator import attrgetter
 from typing import Iterable, Iterator, Sequence, TypeVar
@@ -14,7 +13,6 @@ from numpy.typing import NDArray
 
 from ncpp.errors import Location, NcppError
 from ncpp.motion.segments import PLANE_AXES, Arc, Event, Line
-from ncpp.program.blocks import Word
 from ncpp.passes.context import PassContext
 from ncpp.passes.inverse import command_for
 
@@ -62,10 +60,7 @@ def line_chunks(events: Iterable[Event], lines: int = LINE_CHUNK, size: int = LI
         try:
             chunk += islice(it, size - len(chunk))
         except NcppError:
-            while chunk:
-                k = _window_end(chunk, lines)
-                yield chunk[:k]
-                chunk = chunk[k:]
+            yield from _windows(chunk, lines)
             raise
         if not chunk:
             return
@@ -74,22 +69,17 @@ def line_chunks(events: Iterable[Event], lines: int = LINE_CHUNK, size: int = LI
         chunk = chunk[k:]
 
 
+def _windows(events: list[Event], lines: int) -> Iterator[list[Event]]:
+    """All of `events` (in line order), a window of `lines` input lines at a time."""
+    while events:
+        k = _window_end(events, lines)
+        yield events[:k]
+        events = events[k:]
+
+
 def _window_end(chunk: list[Event], lines: int) -> int:
     """How many of the events (in line order) are in the window of `lines` lines of the first (>= 1)."""
     return bisect_left(chunk, (_line_of(chunk[0]) // lines + 1) * lines, key=_line_of)
-
-
-def locate(error: NcppError, events: Iterable[Event]) -> None:
-    """Give a pass's error (its line, no column) the column of its word in the block of that
-    line among `events`: that of the word its location names, else 1 (the block)."""
-    where = error.where
-    if where.col is not None or where.line is None:
-        return
-    block = next((e.block for e in events if e.block.line == where.line), None)
-    if block is None:
-        return
-    word = next((item for item in block.items if type(item) is Word and item.letter == where.word), None)
-    error.where = replace(where, col=1 if word is None else word.start + 1, word=None)
 
 
 def before_line(events: list[T], line: int | None) -> list[T]:

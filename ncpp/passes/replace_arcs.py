@@ -25,7 +25,7 @@ from ncpp.errors import Location, NcppError
 from ncpp.motion.segments import Arc, Event, Line
 from ncpp.passes.context import PassContext
 from ncpp.passes.kernels import run_ahead
-from ncpp.passes.geometry import before_line, compensate, frames, from_plane, in_plane, locate, plane_axes, points, rows_of, spliced
+from ncpp.passes.geometry import before_line, compensate, frames, from_plane, in_plane, plane_axes, points, rows_of, spliced
 from ncpp.passes.travel import grid, quantize
 
 # Points per piece where the fit is checked (ends included).  Fewer on short
@@ -76,7 +76,7 @@ def replace_arcs(events: Iterable[Event], ctx: PassContext) -> Iterator[Event]:
         try:
             fitted = fitting.result()
         except NcppError as error:  # the lines before the refused one go on first: a later pass may refuse one of them
-            locate(error, batch)
+            error.locate(e.block for e in batch)
             earlier = before_line(batch, error.where.line)
             if len(earlier) < len(batch):
                 yield from replace_arcs(earlier, ctx)
