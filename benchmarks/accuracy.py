@@ -4,7 +4,9 @@ For each sample machine and program: place the program inside the machine's
 travel (work offset = centre of travel minus the centre of the program's
 sampled bounding box, in mm), run the program on the modelled machine
 (`ncpp.simulate`), compensate it at 1, 2 and 5 µm, run the result, and
-compare both with the nominal path.  Two model cases:
+compare both with the nominal path, over the moves compensation answers for
+(`answerable`: not those it leaves as programmed with a warning, such as the
+moves under cutter compensation; a note says how many).  Two model cases:
 
 * exact: compensate with the very model that simulates the machine
   (geometry only: the effects are not in the compensation model).  The
@@ -41,6 +43,7 @@ from ncpp.errors import Warnings  # noqa: E402
 from ncpp.machine import Machine, load_machine  # noqa: E402
 from ncpp.machine.components import Table  # noqa: E402
 from ncpp.motion.offsets import WorkOffsets  # noqa: E402
+from ncpp.motion.segments import Arc, Line  # noqa: E402
 from ncpp.pipeline import ErrorSource, process  # noqa: E402
 from ncpp.simulate import ContourReport, SampledPath, contour_error, sample_events  # noqa: E402
 
@@ -152,14 +155,30 @@ def compensate(data: bytes, source: ErrorSource, tolerance: float, name: str, of
     return out.getvalue(), stats.lines_in, stats.lines_out, time.perf_counter() - start
 
 
+def answerable(events: list) -> list:
+    """The moves compensation answers for: not those it leaves as programmed, with a warning
+    (`fixed`: canned cycles, loops and subroutines, and the moves under cutter compensation,
+    which the control offsets by the tool radius), nor, in G91, the moves after them."""
+    out = []
+    for event in events:
+        fixed = event.fixed if type(event) is Line or type(event) is Arc else ""
+        if fixed and not event.context.absolute:
+            break  # (`pipeline.warn_fixed`: from there on the program passes through)
+        if not fixed:
+            out.append(event)
+    return out
+
+
 @dataclass
 class Run:
-    """One program on one machine: nominal path, placement and the error before compensation."""
+    """One program on one machine: nominal path (the moves compensation answers for, `answerable`),
+    placement, and how many moves it leaves as programmed."""
 
     label: str
     data: bytes
     offset: np.ndarray
     nominal: SampledPath
+    left: int = 0
 
 
 def with_start_block(data: bytes, name: str) -> bytes:
@@ -169,8 +188,6 @@ def with_start_block(data: bytes, name: str) -> bytes:
     zero, but a control starts it wherever it stands, so the writer never adds
     a word for an axis the program has not positioned: its error could not be
     compensated.  The start block makes the program say what was assumed."""
-    from ncpp.motion.segments import Arc, Line
-
     seen: set[str] = set()
     for event in events_of(data, name):
         if type(event) is Arc or (type(event) is Line and not event.rapid):
@@ -189,12 +206,15 @@ def prepare(label: str, path: Path, model: Machine) -> Run | None:
     offset = placement(at_zero, model)
     if offset is None:
         return None
-    return Run(label, data, offset, sample_events(events_of(data, str(path), WorkOffsets.at(offset))))
+    events = events_of(data, str(path), WorkOffsets.at(offset))
+    kept = answerable(events)
+    left = sum(1 for e in events if type(e) in (Line, Arc)) - sum(1 for e in kept if type(e) in (Line, Arc))
+    return Run(label, data, offset, sample_events(kept), left)
 
 
 def simulate(run: Run, model: Machine, program: bytes | None = None) -> ContourReport:
     """Contour error of `program` (default: the original) against the nominal path, on `model` (geometry)."""
-    commanded = run.nominal if program is None else sample_events(events_of(program, run.label, WorkOffsets.at(run.offset)))
+    commanded = run.nominal if program is None else sample_events(answerable(events_of(program, run.label, WorkOffsets.at(run.offset))))
     return contour_error(model, commanded, run.nominal, feed_effects=False)
 
 
@@ -258,6 +278,10 @@ def accuracy(ctx):
                         notes.append(f"{label} does not fit in the {name} travel: skipped")
                     continue
                 r = data[key] = evaluate(run, truth, model)
+                r["moves_left_as_programmed"] = run.left
+                left = f"{label}: {run.left} moves left as programmed (cutter compensation, canned cycles, loops) are not in its figures"
+                if run.left and left not in notes:
+                    notes.append(left)
                 after = r["after"]
                 rows.append(
                     [
