@@ -206,6 +206,7 @@ class Interpreter:
         self.done = False  # program end (M2/M30) reached or state unknown
         self.corner: tuple[str, float, Word | ExprWord] | None = None  # Fanuc ,R / ,C of the last block
         self.cutter_comp: float | None = None  # G41, G41.1, G42 or G42.1 in effect (None: G40)
+        self.comp_radius: float | None = None  # its tool radius, program units, where known (G41.1/G42.1 D: the diameter)
         self.off_path = False  # the tool centre is off the programmed path: from the first move under comp to the first after G40
         self.untold: set[int] = set()  # coordinate systems whose zero nobody said (warned when selected)
         self.warnings: Warnings | None = None
@@ -364,11 +365,30 @@ class Interpreter:
         if self.corner is not None:
             raise _OutOfScope("Fanuc corner rounding with cutter compensation", self.corner[2].start + 1)
         if self.cutter_comp is None and type(moves[0]) is Arc:
-            self._fail("The move just after exiting cutter compensation mode must be straight, not an arc", block, None)
+            self._fail("The move just after exiting cutter compensation mode must be straight, not an arc", block, block.items[0])
+        if self.cutter_comp is not None and self.comp_radius:
+            self._check_radius(moves, block)
         for ev in moves:  # (a loop's or a cycle's too: that the tool is off the path matters more)
             ev.fixed = COMP
         self.off_path = self.cutter_comp is not None
         return event
+
+    def _check_radius(self, moves: list, block: Block) -> None:
+        """rs274ngc's checks of moves under compensation against the tool radius: the entry move
+        (the first) longer than it in the plane, an entry arc's chord too, and no arc on the
+        side the tool is on (G41 and G3, G42 and G2) of a radius not above it.  (The gouging
+        checks of later moves need the offset path, which ncpp does not make.)"""
+        radius, item = self.comp_radius, block.items[0]
+        a, b, _ = PLANE_AXES[self.plane]
+        first = moves[0]
+        if not self.off_path and math.hypot(first.end[a] - first.start[a], first.end[b] - first.start[b]) <= radius:
+            what = "Radius of cutter compensation entry arc" if type(first) is Arc else "Length of cutter compensation entry move"
+            self._fail(f"{what} is not greater than the tool radius", block, item)
+        left = self.cutter_comp in (41.0, 41.1)
+        for arc in moves:
+            if type(arc) is Arc and (arc.turn > 0) == left:
+                if math.hypot(arc.start[a] - arc.center[a], arc.start[b] - arc.center[b]) <= radius:  # type: ignore[operator]
+                    self._fail("Tool radius not less than arc radius with comp", block, item)
 
     def _unrounded(self, pending: Line, held: list[Event]) -> Iterator[Event]:
         """A held corner line whose corner cannot be made: it passes through, uninterpreted."""
@@ -795,7 +815,7 @@ class Interpreter:
         moves are followed as programmed (`_in_comp`)."""
         code, item = code_item
         if code == 40.0:
-            self.cutter_comp = None
+            self.cutter_comp = self.comp_radius = None
             return
         if self.plane not in (17, 18):
             self._fail("Cutter radius compensation allowed only in XY, XZ planes", block, item)
@@ -803,11 +823,14 @@ class Interpreter:
         if code in (41.1, 42.1):
             if d is None:
                 self._fail(f"G{code:g} with no D word", block, item)
+            self.comp_radius = abs(d[0]) / 2
         elif d is not None:
             if d[0] < 0.0 or abs(d[0] - round(d[0])) > 0.0001:
                 self._fail(f"G{code:g} requires D word to be a whole number", block, d[1])
             if self.tools is not None and round(d[0]) != 0 and self.tools.offset(round(d[0])) is None:
                 self._fail(f"Requested tool {round(d[0])} not found in the tool table", block, d[1])
+        if code in (41.0, 42.0):
+            self.comp_radius = None  # (the tool table's diameters are not read)
         self.cutter_comp = code
 
     def _check_scope(self, words: dict, gcodes: dict) -> None:
@@ -837,6 +860,8 @@ class Interpreter:
         for vector in (self.pos, self.g92, self.g92_saved, self.tool, *self.g5x, *self.home.values()):
             for i in LINEAR:
                 vector[i] *= scale
+        if self.comp_radius is not None:
+            self.comp_radius *= scale
         self._set(inch=inch)
 
     def _shift(self, old: list[float], new: list[float]) -> None:
@@ -901,7 +926,7 @@ class Interpreter:
         self._coordinate_system(1)
         self._set(plane=17, absolute=True, inverse_time=False)
         self.motion = 1.0
-        self.cutter_comp, self.off_path = None, False
+        self.cutter_comp, self.comp_radius, self.off_path = None, None, False
         self.done = True
 
     def _machine(self, i: int) -> float:
