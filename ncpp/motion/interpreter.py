@@ -206,7 +206,7 @@ class Interpreter:
         self.done = False  # program end (M2/M30) reached or state unknown
         self.corner: tuple[str, float, Word | ExprWord] | None = None  # Fanuc ,R / ,C of the last block
         self.cutter_comp: float | None = None  # G41, G41.1, G42 or G42.1 in effect (None: G40)
-        self.comp_radius: float | None = None  # its tool radius, program units, where known (G41.1/G42.1 D: the diameter)
+        self.comp_radius: float | None = None  # its tool radius, program units, where known (G41.1/G42.1's D; G41/G42: the tool table's)
         self.off_path = False  # the tool centre is off the programmed path: from the first move under comp to the first after G40
         self.untold: set[int] = set()  # coordinate systems whose zero nobody said (warned when selected)
         self.warnings: Warnings | None = None
@@ -829,8 +829,9 @@ class Interpreter:
                 self._fail(f"G{code:g} requires D word to be a whole number", block, d[1])
             if self.tools is not None and round(d[0]) != 0 and self.tools.offset(round(d[0])) is None:
                 self._fail(f"Requested tool {round(d[0])} not found in the tool table", block, d[1])
-        if code in (41.0, 42.0):
-            self.comp_radius = None  # (the tool table's diameters are not read)
+        if code in (41.0, 42.0):  # the radius of tool D, or of the tool in the spindle, from the table ncpp is told
+            number = self.spindle_tool if d is None else round(d[0])
+            self.comp_radius = None if self.tools is None else self.tools.diameter(number) / 2 / (MM_PER_INCH if self.inch else 1.0)
         self.cutter_comp = code
 
     def _check_scope(self, words: dict, gcodes: dict) -> None:

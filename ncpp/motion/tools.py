@@ -11,9 +11,10 @@ LinuxCNC's tool table, one tool per line (`tool.tbl`):
     T1 P1 Z+50.000 D6.000 ;6 mm end mill
     T2 P2 X0.100 Z-1.500 D3.000
 
-T is the tool number, P its pocket, X Y Z A B C U V W its offsets, D I J Q
-lathe and cutter data (not used here); a `;` starts the comment.  Values are
-in the machine's units ([TRAJ]LINEAR_UNITS).
+T is the tool number, P its pocket, X Y Z A B C U V W its offsets, D its
+diameter (cutter compensation G41/G42 checks moves against its radius), I J Q
+lathe data (not used here); a `;` starts the comment.  Values are in the
+machine's units ([TRAJ]LINEAR_UNITS).
 
 Heidenhain's tool table (`TOOL.T`), fixed columns under a header line, its
 units in the first line:
@@ -52,7 +53,7 @@ from ncpp.errors import Location, NcppError, Warnings
 
 OFFSET_LETTERS = "XYZABCUVW"  # a tool's offsets, in the interpreter's axis order
 _LINEAR = frozenset("XYZUVW")  # the offsets in length units (A B C are degrees)
-_OTHER_LETTERS = frozenset("PDIJQ")  # pocket, diameter, lathe angles and orientation
+_OTHER_LETTERS = frozenset("PIJQ")  # pocket, lathe angles and orientation
 _WORD = re.compile(r"\S+")
 
 
@@ -67,6 +68,7 @@ class ToolTable:
     source: str = "<tool table>"
     names: Mapping[str, float] = field(default_factory=dict, hash=False)  # name -> tool number (the first listed)
     edges: Mapping[tuple[float, int], tuple[float, float, float]] = field(default_factory=dict, hash=False)  # (T, D) -> lengths 1-3
+    diameters: Mapping[int, float] = field(default_factory=dict, hash=False)  # LinuxCNC's D per tool number, mm
 
     @classmethod
     def from_file(cls, path: str | Path, unit_mm: float = 1.0) -> "ToolTable":
@@ -83,13 +85,18 @@ class ToolTable:
         if lines and lines[0].lstrip().upper().startswith("BEGIN"):
             edges, names = read_tool_t(lines, str(path))
             return cls({}, str(path), names, edges)
-        return cls(read_tool_lines(lines, str(path), unit_mm), str(path))
+        diameters: dict[int, float] = {}
+        return cls(read_tool_lines(lines, str(path), unit_mm, diameters), str(path), diameters=diameters)
 
     def offset(self, number: int) -> tuple[float, ...] | None:
         """Tool `number`'s offsets (tool 0, no tool: all zero), None when the table has no such tool."""
         if number == 0:
             return (0.0,) * len(OFFSET_LETTERS)
         return self.offsets.get(number)
+
+    def diameter(self, number: int) -> float:
+        """Tool `number`'s diameter in mm (0: no tool, or none in the table)."""
+        return self.diameters.get(number, 0.0)
 
 
 class UntoldLengths:
@@ -110,12 +117,13 @@ class UntoldLengths:
             )
 
 
-def read_tool_lines(lines: list[str], file: str, unit_mm: float) -> dict[int, tuple[float, ...]]:
+def read_tool_lines(lines: list[str], file: str, unit_mm: float, diameters: dict[int, float] | None = None) -> dict[int, tuple[float, ...]]:
+    """Per tool number its offsets (mm and degrees); its diameters (mm) into `diameters`."""
     tools: dict[int, tuple[float, ...]] = {}
     for n, line in enumerate(lines, 1):
         data = line.split(";", 1)[0]
         offsets = [0.0] * len(OFFSET_LETTERS)
-        number = None
+        number, diameter = None, 0.0
         for word in _WORD.finditer(data):
             letter, value = word.group()[0].upper(), word.group()[1:]
             where = Location(file, n, word.start() + 1)
@@ -124,6 +132,8 @@ def read_tool_lines(lines: list[str], file: str, unit_mm: float) -> dict[int, tu
             elif letter in OFFSET_LETTERS:
                 scale = unit_mm if letter in _LINEAR else 1.0
                 offsets[OFFSET_LETTERS.index(letter)] = _number(value, where) * scale
+            elif letter == "D":
+                diameter = _number(value, where) * unit_mm
             elif letter in _OTHER_LETTERS:
                 _number(value, where)
             else:
@@ -135,6 +145,8 @@ def read_tool_lines(lines: list[str], file: str, unit_mm: float) -> dict[int, tu
         if number in tools:
             raise NcppError(f"tool {number} is listed twice", Location(file, n, 1))
         tools[number] = tuple(offsets)
+        if diameters is not None and diameter:
+            diameters[number] = diameter
     return tools
 
 

@@ -225,3 +225,41 @@ def test_corner_rounding_into_cutter_compensation_is_out_of_scope():
     events = events_of(HEAD + "G1 X10 ,R1\nG41.1 D2 G1 Y10\nG40\nG1 X0\n", warnings=Warnings(stream=warned))
     assert "t.ngc:4:" in warned.getvalue() and "Fanuc corner rounding next to cutter compensation" in warned.getvalue()
     assert [e.block.line for e in moves(events)] == [2, 3]
+
+
+@needs_rs274
+@pytest.mark.parametrize(
+    "body, refused",
+    [
+        ("T1 M6\nG41\nG1 X126.99\n", 6),  # the spindle tool's radius, 5 in
+        ("T1 M6\nG41 D2\nG1 X38.09\n", 6),  # tool 2's, 1.5 in
+        ("T1 M6\nG41\nG1 X127.001\nG40\nG1 X0\n", None),
+        ("T1 M6\nG41 D2\nG1 X38.11\nG40\nG1 X0\n", None),
+        ("G20\nT1 M6\nG41\nG1 X4.99\n", 7),
+        ("G20\nT1 M6\nG41\nG1 X5.001\nG40\nG1 X0\n", None),
+    ],
+)
+def test_g41_checks_against_the_radius_of_the_tool_table_ncpp_is_told(tmp_path, body, refused):
+    """With `--tool-table` the radius of G41/G42 is the table's D over 2, in the machine's units,
+    as rs274 reads it (the stand-alone rs274's are inches: `--var-units inch`)."""
+    import subprocess
+    from dataclasses import replace
+
+    from ncpp.motion.offsets import WorkOffsets
+    from ncpp.motion.tools import ToolTable
+
+    table = tmp_path / "tool.tbl"
+    table.write_text("T1 P1 D10 Z0\nT2 P2 D3 Z0\n")
+    path = write_program(tmp_path, HEAD + body)
+    proc = subprocess.run([str(RS274), "-t", str(table), str(path)], capture_output=True, text=True, timeout=60)
+    theirs = rs274_error(proc.stderr)
+    offsets = replace(WorkOffsets.at((0.0, 0.0, 0.0)), tools=ToolTable.from_file(table, unit_mm=25.4))
+    try:
+        events_of(HEAD + body, offsets=offsets, warnings=Warnings(stream=io.StringIO()))
+        error = None
+    except NcppError as err:
+        error = err
+    if refused is None:
+        assert theirs is None and error is None, (theirs, error)
+    else:
+        assert theirs is not None and error is not None and theirs[0] == error.message and error.where.line == refused, (theirs, error)
