@@ -208,6 +208,7 @@ class Interpreter:
         self.cutter_comp: float | None = None  # G41, G41.1, G42 or G42.1 in effect (None: G40)
         self.comp_radius: float | None = None  # its tool radius, program units, where known (G41.1/G42.1's D; G41/G42: the tool table's)
         self.off_path = False  # the tool centre is off the programmed path: from the first move under comp to the first after G40
+        self.arc_refused = False  # after G40 ended compensation that moved the tool off the path: until a G0/G1 move (rs274ngc)
         self.untold: set[int] = set()  # coordinate systems whose zero nobody said (warned when selected)
         self.warnings: Warnings | None = None
         self.flow: Flow | None = None  # while `run` runs
@@ -252,7 +253,7 @@ class Interpreter:
                 event = block_event(block)  # verbatim blocks (after the closing %) have no items
                 if kind is FIXED:
                     event = self._in_flow(event, owner)
-                if self.off_path or self.cutter_comp is not None:
+                if self.off_path or self.cutter_comp is not None or self.arc_refused:
                     event = self._in_comp(event, block)
             except NcppError as err:
                 source = flow.source()
@@ -311,7 +312,7 @@ class Interpreter:
         told by `skipped`: in absolute G90 without inverse time, no corner waiting, and the
         flow reading the main program in order."""
         return (self.absolute and not self.inverse_time and self.corner is None and self.holding is None
-                and self.cutter_comp is None and not self.off_path and not self.done and self.flow is not None and self.flow.streaming())  # fmt: skip
+                and self.cutter_comp is None and not self.off_path and not self.arc_refused and not self.done and self.flow is not None and self.flow.streaming())  # fmt: skip
 
     def skipped(self, lines: int, ends: dict[int, float], motion: float | None, feed: float) -> None:
         """`lines` plain lines ran unread (`skimmable` was true): they moved the axes
@@ -357,20 +358,26 @@ class Interpreter:
         """A block's events with cutter compensation on, or the first move after G40: its
         moves are marked `fixed` (the tool is off the programmed path, by the radius the
         control applies).  The first move after G40 brings it back to the programmed end
-        point, and must be straight, as rs274ngc says."""
+        point.  As rs274ngc says, no arc may come after G40 before a G0/G1 move (a G28/G30
+        or a canned cycle is not one)."""
+        if self.comp_radius == 0.0:  # a radius of 0: the tool stays on the programmed path (rs274ngc checks nothing either)
+            return event
         events = event if type(event) is tuple else (event,)
         moves = [ev for ev in events if type(ev) is not Pass]
         if not moves:
             return event
         if self.corner is not None:
             raise _OutOfScope("Fanuc corner rounding with cutter compensation", self.corner[2].start + 1)
-        if self.cutter_comp is None and type(moves[0]) is Arc:
-            self._fail("The move just after exiting cutter compensation mode must be straight, not an arc", block, block.items[0])
+        if self.arc_refused:
+            if type(moves[0]) is Arc:
+                self._fail("The move just after exiting cutter compensation mode must be straight, not an arc", block, block.items[0])
+            self.arc_refused = moves[0].fixed == CYCLE or _homes(block)
         if self.cutter_comp is not None and self.comp_radius:
             self._check_radius(moves, block)
-        for ev in moves:  # (a loop's or a cycle's too: that the tool is off the path matters more)
-            ev.fixed = COMP
-        self.off_path = self.cutter_comp is not None
+        if self.off_path or self.cutter_comp is not None:
+            for ev in moves:  # (a loop's or a cycle's too: that the tool is off the path matters more)
+                ev.fixed = COMP
+            self.off_path = self.cutter_comp is not None
         return event
 
     def _check_radius(self, moves: list, block: Block) -> None:
@@ -726,7 +733,7 @@ class Interpreter:
                 self._fail("Must use G0 or G1 with G53", block, mode0_item)
             distance = gcodes.get(3, (None,))[0]
             if distance == 91.0 or (distance is None and not self.absolute):
-                self._fail("Cannot use G53 incremental", block, mode0_item)
+                self._fail("Cannot use g53 incremental", block, mode0_item)
         if mode0 == 10.0:
             l_number = words.get("L", (None,))[0]
             if l_number not in (1.0, 2.0, 10.0, 11.0, 20.0):
@@ -801,6 +808,8 @@ class Interpreter:
                 self._fail(message, block, gcodes[group][1])
         mode0, mode0_item = gcodes.get(0, (None, None))
         message = _MODE0_WITH_COMP.get(mode0)  # type: ignore[arg-type]
+        if mode0 == 53.0 and self.comp_radius == 0.0:  # (G53 only with a radius; the others with any)
+            message = None
         if mode0 == 10.0 and words.get("L", (None,))[0] in (2.0, 20.0) and round(words["P"][0]) in (0, self.coord_system):
             message = "Cannot change the active coordinate system with cutter radius compensation on"
         if message is not None:
@@ -815,6 +824,7 @@ class Interpreter:
         moves are followed as programmed (`_in_comp`)."""
         code, item = code_item
         if code == 40.0:
+            self.arc_refused = self.arc_refused or self.off_path
             self.cutter_comp = self.comp_radius = None
             return
         if self.plane not in (17, 18):
@@ -927,7 +937,7 @@ class Interpreter:
         self._coordinate_system(1)
         self._set(plane=17, absolute=True, inverse_time=False)
         self.motion = 1.0
-        self.cutter_comp, self.comp_radius, self.off_path = None, None, False
+        self.cutter_comp, self.comp_radius, self.off_path, self.arc_refused = None, None, False, False
         self.done = True
 
     def _machine(self, i: int) -> float:
@@ -1096,7 +1106,7 @@ class Interpreter:
         level) and the normal axis (G91: from R), as rs274ngc reads them."""
         first, second, normal = PLANE_AXES[self.plane]
         a_letter, b_letter, c_letter = "XYZ"[first], "XYZ"[second], "XYZ"[normal]
-        plane = _PLANE_NAMES[self.plane].upper()
+        plane = _PLANE_NAMES[self.plane]  # (rs274ngc's messages: `Z value unspecified in xy plane`, `R less than z`)
         if self.feed == 0.0:
             self._fail("Cannot feed with zero feed rate", block, item)
         if self.inverse_time:
@@ -1121,7 +1131,7 @@ class Interpreter:
             r = r_word + self.cycle_il
             bottom = r + c_word
         if r < bottom:
-            self._fail(f"R less than {c_letter} in cycle in {plane} plane", block, words.get("R", (0, item))[1])
+            self._fail(f"R less than {c_letter.lower()} in cycle in {plane} plane", block, words.get("R", (0, item))[1])
         return aa, bb, step_a, step_b, r, bottom
 
     def _fixed_line(self, block: Block, axes: tuple[int, int, int], move: tuple[float, float, float, bool]) -> Line:
@@ -1337,6 +1347,11 @@ _PLAIN_LETTERS = {
     3.0: frozenset("XYZABCUVWFIJKR"),
     **{code: frozenset() for code in CANNED},  # a cycle's words are checked in full
 }
+
+
+def _homes(block: Block) -> bool:
+    """The block says G28 or G30 (its moves are not the straight move rs274ngc's rules ask for)."""
+    return any(type(item) is Word and item.letter == "G" and item.value in (28.0, 30.0) for item in block.items)
 
 
 def _warn_unreadable(block: Block, warnings: Warnings) -> None:

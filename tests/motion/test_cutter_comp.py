@@ -55,12 +55,13 @@ def test_after_g40_the_position_is_the_programs():
         "G41.1 D2\nG1 X10 Y10\nG40 G55\nG1 X20 Y20\nG54 G1 X0\n",  # G40 first, then the system: allowed
         "G41.1 D2\nG1 X10\nG10 L2 P2 X3\nG92.1\nG20\nG1 X1\nG21\nG40\nG0 Z5\nG0 X0 Y0\n",  # allowed under compensation
         "G41.1 D2\nG40\nG2 X10 I5\n",  # no move under compensation: an arc may follow G40
+        "G41.1 D0\nG1 X10 Y10\nG40\nG3 X-2 Y-16 R32\nG1 X0\n",  # nor with a radius of 0
         "G41.1 D0\nG1 X10\nG1 Y10\nG40\nG1 X0\nG1 X5 Y5\n",
         "G41.1 D10\nG1 X5.001\nG2 X15.001 I5\nG1 Y-20\nG40\nG1 X0\nG1 Y5\n",  # longer than the radius; an arc off the tool's side
-        "G41.1 D0\nG1 Z-2\nG1 X10\nG40\nG1 X0\nG1 Y5\n",  # radius 0: no check
+        "G41.1 D0\nG1 Z-2\nG1 X10\nG53 G0 X0\nG40\nG1 X0\nG1 Y5\n",  # radius 0: no check, and G53 allowed
         "G41.1 D10\nG1 X20\nG20\nG1 X1\nG3 X1.6 R0.3\nG40\nG1 X0\nG1 Y5\n",  # the radius follows G20 (0.197 in)  # radius 0: rs274's moves are the programmed ones
     ],
-    ids=["contour", "rapids", "xz", "g91", "g40-g55", "allowed", "no-move", "d0", "radius", "d0-z", "units"],
+    ids=["contour", "rapids", "xz", "g91", "g40-g55", "allowed", "no-move", "d0-arc", "d0", "radius", "d0-z", "units"],
 )
 def test_moves_after_compensation_agree_with_rs274(tmp_path, body):
     path = write_program(tmp_path, HEAD + body)
@@ -101,6 +102,8 @@ def test_moves_after_compensation_agree_with_rs274(tmp_path, body):
         ("G41 D-1\n", 4),
         ("G41.1 D2\nG1 X10\nG1 Y5\nG40\nG2 X20 I5\n", 8),
         ("G41.1 D2\nG1 X10\nG40 G2 X20 I5\n", 6),
+        ("G41.1 D2\nG1 X10 Y10\nG40\nG28\nG3 X-2 Y-16 R32\n", 8),  # a G28 is not the straight move
+        ("G41.1 D2\nG1 X10 Y10\nG40\nG81 X1 Y1 Z-2 R1\nG80\nG3 X-2 Y-16 R32\n", 9),  # nor a canned cycle
         # the tool radius of G41.1/G42.1 (D: the diameter) against the entry move and arcs on the tool's side
         ("G41.1 D10\nG1 X3\n", 5),
         ("G41.1 D10\nG1 X5\n", 5),  # not greater

@@ -222,7 +222,7 @@ def test_zero_to_a_negative_power_is_an_error():
         ("G61 R0.5\n", 1, 5, "R word with no g code that uses it"),
         ("G0 X1 I2\n", 1, 7, "I word with no G2, G3, G5, G5.1, G10, G71, G76, or G87 to use it"),
         ("G2 X1 I0.5 P0 F1\n", 1, 12, "P value should be 1 or greater with G2 or G3"),
-        ("G91 G53 G0 X1\n", 1, 5, "Cannot use G53 incremental"),
+        ("G91 G53 G0 X1\n", 1, 5, "Cannot use g53 incremental"),
         ("G4\n", 1, 1, "Dwell time missing with G4"),
         ("G81 X0 Y0 Z-1 R0 A90 F12\n", 1, 18, "Cannot put an a in canned cycle"),
         ("G2 X1 I0.0001 F1\n", 1, 1, "Zero-radius arc"),
