@@ -510,3 +510,28 @@ def test_the_second_part_keeps_a_few_warnings_of_each_text_however_many_it_gives
     assert kept.said[0].where.line == 5000 and kept.said[-1].times == (200_000 - 5000) // 2 - SHOWN_PER_TEXT
     warned = [("canned cycle" if line % 2 else "other", line) for line in range(1, 200_001)]
     assert _given_in_two_parts(warned, 5000) == _given_in_one_run(warned)
+
+
+def test_a_cut_under_cutter_compensation_writes_what_one_run_writes(tmp_path, source, monkeypatch):
+    """Every input line a cut may fall on (a multiple of LINE_CHUNK) lies under G41.1, between the
+    entry move and the exit move after G40: the parts' states there (the interpreter's
+    compensation, the passes' last segment) must still be one run's."""
+    from ncpp.passes.geometry import LINE_CHUNK
+
+    lines = ["G21 G90 G17 G94 G0 X0 Y0 Z5", "G1 Z-1 F600"]
+    while len(lines) < 2 * parts.MIN_LINES + 100:
+        n = len(lines) + 1  # the line about to be written
+        if (n + 40) % LINE_CHUNK == 0:
+            lines += ["G41.1 D4", "G1 X20 Y0"]
+        elif (n - 40) % LINE_CHUNK == 0:
+            lines += ["G40", "G1 X10 Y10"]
+        else:
+            lines.append(f"G1 X{10 + n % 11 * 3} Y{n % 13 * 2}")
+    path = tmp_path / "comp.ngc"
+    path.write_text("\n".join(lines) + "\nG40\nM2\n")
+    split, same = [], parts._same
+    monkeypatch.setattr(parts, "_same", lambda a, b: split.append(same(a, b)) or split[-1])
+    one, said, _ = _compensated(path, source, jobs=1)
+    assert "cutter compensation" in said
+    assert _compensated(path, source, jobs=2)[:2] == (one, said)
+    assert split == [True]
