@@ -366,8 +366,6 @@ class Interpreter:
         moves = [ev for ev in events if type(ev) is not Pass]
         if not moves:
             return event
-        if self.corner is not None:
-            raise _OutOfScope("Fanuc corner rounding with cutter compensation", self.corner[2].start + 1)
         if self.arc_refused:
             if type(moves[0]) is Arc:
                 self._fail("The move just after exiting cutter compensation mode must be straight, not an arc", block, block.items[0])
@@ -407,16 +405,18 @@ class Interpreter:
         """[shortened first line, fillet arc or chamfer line, second line from the tangent point]."""
         kind, size, item = corner
         where = Location(self.file, first.block.line, item.start + 1)
-        if type(second) is not Line or second.rapid or first.rapid or second.fixed == COMP:
+        if type(second) is not Line or second.rapid or first.rapid:
             self.done = True
-            next_to = "cutter compensation" if type(second) is Line and second.fixed == COMP else "an arc or a rapid move"
-            warnings.warn(f"Fanuc corner rounding next to {next_to} is outside the motion "
+            warnings.warn("Fanuc corner rounding next to an arc or a rapid move is outside the motion "
                           "interpreter's scope; from this line on the program passes through uninterpreted", where)  # fmt: skip
             return None
         try:
-            return round_corner(first, second, kind, size)
+            pieces = round_corner(first, second, kind, size)
         except CornerError as err:
             raise NcppError(str(err), where) from None
+        if first.fixed == COMP or second.fixed == COMP:  # the control rounds the contour, then offsets it
+            pieces[1].fixed = COMP  # type: ignore[union-attr]  (the lines keep their own)
+        return pieces
 
     def context(self) -> Context:
         if self._context is None:

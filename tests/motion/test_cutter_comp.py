@@ -152,13 +152,18 @@ def test_plain_lines_are_not_skimmed_under_compensation():
         assert interpreter.skimmable() == (line not in (4, 5, 6)), line
 
 
-def test_corner_rounding_under_compensation_is_out_of_scope():
-    warned = io.StringIO()
-    events = events_of(HEAD + "G41.1 D2\nG1 X10 ,R1\nG1 Y10\nG40\nG1 X0\n", warnings=Warnings(stream=warned))
-    assert "Fanuc corner rounding with cutter compensation" in warned.getvalue()
-    with pytest.raises(NcppError):
-        events_of(HEAD + "G41.1 D2\nG1 X10 ,R1\nG1 Y10\n", strict=True)
-    assert [e.block.line for e in moves(events)] == [2, 3]
+def test_fanuc_corners_under_compensation_are_the_controls_and_the_position_is_followed():
+    """A Fanuc `,R` / `,C` corner under G41/G42: the control rounds the contour, then offsets it.
+    Every piece is left as programmed; after the exit move the moves are those of the same
+    program without the corners."""
+    body = "G41.1 D2\nG1 X10 ,R1\nG1 Y10 ,C1\nG1 X0\nG40\nG1 X-5 Y-5 ,R1\nG1 X-20\nG1 Y20\n"
+    rounded = moves(events_of(HEAD + body))
+    plain = moves(events_of(HEAD + body.replace(" ,R1", "").replace(" ,C1", "")))
+    assert [e.fixed for e in rounded] == ["", ""] + [COMP] * 7 + [""] * 2  # (the exit move's fillet too)
+    assert [e.end for e in rounded[-2:]] == [e.end for e in plain[-2:]]
+    out, warned = compensate(HEAD + body, "corner.ngc")
+    lines, start = out.splitlines(), out.splitlines().index("G41.1 D2")
+    assert lines[start : start + 6] == body.splitlines()[:6] and warned.count("cutter compensation") == 1  # to the exit move
 
 
 # -- compensation ---------------------------------------------------------------------------------
@@ -221,13 +226,6 @@ def test_motion_and_simulate_say_where_the_tool_leaves_the_programmed_contour(tm
     assert subprocess.run([*run, "motion", "--strict", str(path)], capture_output=True, text=True).returncode != 0
     simulate = subprocess.run([*run, "simulate", "--machine", str(ROOT / "samples/machines/hr5b.toml"), str(path)], capture_output=True, text=True)
     assert simulate.returncode == 0 and "program.ngc:6:1: warning: cutter compensation" in simulate.stderr and "simulated as programmed" in simulate.stderr
-
-
-def test_corner_rounding_into_cutter_compensation_is_out_of_scope():
-    warned = io.StringIO()
-    events = events_of(HEAD + "G1 X10 ,R1\nG41.1 D2 G1 Y10\nG40\nG1 X0\n", warnings=Warnings(stream=warned))
-    assert "t.ngc:4:" in warned.getvalue() and "Fanuc corner rounding next to cutter compensation" in warned.getvalue()
-    assert [e.block.line for e in moves(events)] == [2, 3]
 
 
 @needs_rs274
