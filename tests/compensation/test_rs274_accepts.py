@@ -6,8 +6,8 @@ few of the large ones (3D_Chips, systems, spiral_tangent_test); the other
 large files (bear, cameo, tball-pocket, 3D_Chips_abort: 5-13 s each, same
 constructs) are left to the benchmark.  A program rs274 refuses only for a
 missing program end (the short cncjs arc samples, G18/G19 among them) gets
-`M2` appended.  rs274 reads a tool table of tools 1-99 (0.01 mm diameter,
-length 0), so that programs changing tools or compensating the cutter radius
+`M2` appended.  rs274 reads a tool table of tools 1-99 (0.01 across, in the
+stand-alone rs274's inches; length 0), so that programs changing tools or compensating the cutter radius
 are checked too (the wrapper's table has T1 alone: 8 programs more).  Each is
 placed in the HR5B's travel (the Valmet's when it is too large), every work
 system at one zero (mmount.ngc cuts in G55), and compensated at 1 µm with the

@@ -76,9 +76,10 @@ RS274_ONLY_REFUSES = {
 
 @functools.lru_cache(maxsize=None)
 def tool_table() -> Path:
-    """A tool table of tools 1-99 (0.01 diameter, length 0) for rs274 (its last -t is the one it
-    reads; the wrapper's holds T1 alone, of 6 mm): programs changing tools, and the entry moves
-    of cutter compensation, which rs274 refuses where they are not longer than the radius."""
+    """A tool table of tools 1-99 (0.01 across, in the stand-alone rs274's inches; length 0) for
+    rs274 (its last -t is the one it reads; the wrapper's holds T1 alone, 6 across): programs
+    changing tools, and the entry moves of cutter compensation, which rs274 refuses where they
+    are not longer than the radius."""
     path = Path(tempfile.mkdtemp(prefix="ncpp-oracle-")) / "tools.tbl"
     path.write_text("".join(f"T{n} P{n} D0.01 Z0\n" for n in range(1, 100)))
     return path
