@@ -158,11 +158,14 @@ def compensate(data: bytes, source: ErrorSource, tolerance: float, name: str, of
 def answerable(events: list) -> list:
     """The moves compensation answers for: not those it leaves as programmed, with a warning
     (`fixed`: canned cycles, loops and subroutines, and the moves under cutter compensation,
-    which the control offsets by the tool radius), nor, in G91, the moves after them."""
+    which the control offsets by the tool radius), nor, in G91, the moves after a cycle, loop
+    or subroutine."""
+    from ncpp.motion.segments import COMP
+
     out = []
     for event in events:
         fixed = event.fixed if type(event) is Line or type(event) is Arc else ""
-        if fixed and not event.context.absolute:
+        if fixed and fixed != COMP and not event.context.absolute:
             break  # (`pipeline.warn_fixed`: from there on the program passes through)
         if not fixed:
             out.append(event)

@@ -65,7 +65,7 @@ def apply_error_map(events: Iterable[Event], ctx: PassContext) -> Iterator[Event
             error.locate(e.block for e in chunk)
             raise
         out = _written(chunk, segs, rows, solved, last)
-        last = next(e for e in reversed(out) if type(e) is Line or type(e) is Arc)
+        last = _ended(segs[-1], solved.end[-1])  # (a carried row's end is not its event's: `_carry`)
         yield from out
 
 
@@ -130,6 +130,7 @@ class _Rows:
     assumed: NDArray | None  # (n,3) directions replace_arcs compensated the pieces with (reversal errors only)
     lines: NDArray  # (n,) the line of each segment's block, for messages
     rapid: NDArray  # (n,) rapid moves (G0): no reversal step before them
+    carried: NDArray  # (n,) moves left as programmed in G91: they start where the control is (`_carry`)
 
 
 def _rows_before(rows: _Rows, line: int | None) -> _Rows | None:
@@ -144,15 +145,15 @@ def _rows(segs: list, directional: bool) -> _Rows:
     offsets, scales, tools = frames(segs)
     start, end = points([e.start for e in segs]), points([e.end for e in segs])
     # one walk over the events for four flags (1 arc, 2 fixed: a move left as programmed, 4 changed, 8 rapid)
-    kind = np.fromiter([(type(e) is Arc) + 2 * bool(e.fixed) + 4 * bool(e.changed) + 8 * (type(e) is Line and e.rapid) for e in segs],
-                       dtype=np.int8, count=len(segs))  # fmt: skip
+    kind = np.fromiter([(type(e) is Arc) + 2 * bool(e.fixed) + 4 * bool(e.changed) + 8 * (type(e) is Line and e.rapid)
+                        + 16 * (bool(e.fixed) and not e.context.absolute) for e in segs], dtype=np.int8, count=len(segs))  # fmt: skip
     arc, changed = (kind & 1) != 0, (kind & 4) != 0
     line = (kind & 3) == 0
     free = line & ~changed
     return _Rows(
         start, end, offsets, scales, tools, free, changed, changed & line,
         _arc_assumed(segs, np.flatnonzero(changed & arc), start, end) if directional else None,
-        np.fromiter([e.block.line for e in segs], dtype=np.int64, count=len(segs)), (kind & 8) != 0,
+        np.fromiter([e.block.line for e in segs], dtype=np.int64, count=len(segs)), (kind & 8) != 0, (kind & 16) != 0,
     )  # fmt: skip
 
 
@@ -170,7 +171,7 @@ class Solve:
 
     def _solve(self, rows: _Rows, travel: Travel) -> "_Solved":
         try:
-            return _directional(rows, self.ctx, travel) if self.ctx.directional else _plain(rows, self.ctx)
+            return _directional(rows, self.ctx, travel) if self.ctx.directional else _plain(rows, self.ctx, travel)
         except NcppError as error:  # (`travel` is advanced only once a chunk is solved)
             # the chunk's line ends are checked before its reversal steps: an earlier line's fault
             # among these is found solving the rows before the refused line alone, and raised instead
@@ -268,12 +269,16 @@ def _by_row(points: NDArray, rows: NDArray) -> dict[int, tuple]:
     return dict(zip(index.tolist(), map(tuple, points[index].tolist())))
 
 
-def _plain(rows: _Rows, ctx: PassContext) -> _Solved:
-    """Compensated ends of the chunk's lines, for a map without reversal errors."""
+def _plain(rows: _Rows, ctx: PassContext, travel: Travel) -> _Solved:
+    """Compensated ends of the chunk's lines, for a map without reversal errors; advances
+    `travel.last` (where the carried G91 moves start from, `_carry`)."""
     start, end, free, offsets, scales = rows.start, rows.end.copy(), rows.free, rows.offsets, rows.scales
     at = np.flatnonzero(free)
     if at.size:
         end[at] = compensate(end[at], offsets[at], scales[at], rows.lines[at], ctx, np.sign(end[at] - start[at]), rows_of(rows.tools, at))
+    if rows.carried.any():
+        _carry(rows, end, None if travel.last is None else travel.last / scales[0] - offsets[0])
+    travel.last = (end[-1] + offsets[-1]) * scales[-1]
     none = np.zeros(len(free), dtype=bool)
     return _Solved(start, end, free, none, none, start, np.ones(start.shape, dtype=bool), np.zeros(len(free)))
 
@@ -332,6 +337,8 @@ def _directional(rows: _Rows, ctx: PassContext, travel: Travel) -> _Solved:
         out_end[free] = compensated[free]
         _hold_pieces_still(pieces, d, travel.held, limit, out_start, out_end)
         _settle(free, arc, d, travel.held, offsets, scales, limit, out_start, out_end, before)
+        if rows.carried.any():
+            _carry(rows, out_end, before)
         cur_end, cur_start = machine(out_end), machine(out_start)
         previous = np.vstack([first[None, :], cur_end[:-1]])
         # a piece moves from the previous end to its start first (a connecting step), then along itself
@@ -354,6 +361,27 @@ def _directional(rows: _Rows, ctx: PassContext, travel: Travel) -> _Solved:
     travel.held = d[-1].copy()
     travel.last = machine(out_end[-1:], slice(len(free) - 1, None))[0]
     return _Solved(out_start, out_end, free, moved, turn, turn_start, ~flips, limit)
+
+
+def _carry(rows: _Rows, out_end: NDArray, before: NDArray | None) -> None:
+    """Move the ends of the carried rows (left as programmed, in G91: the moves under cutter
+    compensation) by where the control stands when each run of them starts: the program's
+    increments run from the compensated end before them, which is off their programmed start
+    by that end's correction.  `before`: the previous chunk's last end, in the first row's frame."""
+    carried, offsets, scales = rows.carried, rows.offsets, rows.scales
+    reframed = np.concatenate([[True], (offsets[1:] != offsets[:-1]).any(axis=1) | (scales[1:] != scales[:-1])])
+    # a run starts after a row not carried, or where the frame changes (G20/G21 in it)
+    starts = np.flatnonzero(carried & (reframed | ~np.concatenate([[False], carried[:-1]]))).tolist()
+    for n, k in enumerate(starts):
+        if k == 0:
+            previous = before
+        else:  # the end before, seen from this row's frame
+            previous = (out_end[k - 1] + offsets[k - 1]) * scales[k - 1] / scales[k] - offsets[k]
+        if previous is None:
+            continue
+        stop = starts[n + 1] if n + 1 < len(starts) else len(carried)
+        run = k + int(np.argmin(carried[k:stop])) if not carried[k:stop].all() else stop
+        out_end[k:run] = rows.end[k:run] + (previous - rows.start[k])
 
 
 def _settle(free, arc, d, held, offsets, scales, limit, out_start, out_end, before) -> None:

@@ -92,3 +92,72 @@ def test_reversal_spots_within_tolerance(name):
     before, after = before_after(machine, data, 0.001)
     assert after.max_um <= 1.5, f"{after.max_um:.2f} µm at line {after.worst_line}"
     assert before.max_um / after.max_um >= 20
+
+
+G91_COMP = b"""G21 G17 G90 G94 F500
+G0 X0 Y0 Z0
+G91
+G1 X30 Y5
+G1 X10 Y20
+G2 X20 Y0 R15
+G41.1 D6
+G1 X10 Y10
+G1 X40
+G3 X10 Y10 R10
+G1 Y30
+G40
+G1 X-10 Y10
+G1 X-40 Y5
+G2 X-20 Y0 R12
+G1 X-5 Y-60 Z-2
+M2
+"""
+
+
+def test_in_g91_the_moves_after_cutter_compensation_are_compensated(machine):
+    """The moves under G41.1 run as programmed from where the compensated move before them
+    left the tool (G91: increments): those after G40's exit move must start from there too.
+    The first of them starts where the exit move left the tool, off by how much the
+    correction changed along the moves left as programmed (as after a canned cycle in G90);
+    from its end on the moves are within the tolerance."""
+    from ncpp.motion.segments import COMP, Arc, Line
+
+    def after(events):  # the moves past the first one after the exit move
+        moves = [e for e in events if type(e) in (Line, Arc)]
+        last = max(k for k, e in enumerate(moves) if e.fixed == COMP)
+        return moves[last + 2 :]
+
+    offset = placement(sample_events(events_of(G91_COMP)), machine.limits)
+    nominal = sample_events(after(events_of(G91_COMP, offsets=WorkOffsets.at(offset))))
+    text = compensate(G91_COMP, machine, offset, 0.001)
+    before = contour_error(machine, nominal, nominal, feed_effects=False)
+    result = contour_error(machine, sample_events(after(events_of(text, offsets=WorkOffsets.at(offset)))), nominal, feed_effects=False)
+    assert before.max_um > 20.0 and result.max_um <= 1.5, f"{result.max_um:.2f} µm at line {result.worst_line}"
+
+
+def test_in_g91_the_carry_crosses_the_passes_windows():
+    """apply_error_map solves windows of 1024 input lines: an exit move that ends a window
+    hands on where the control stands, not its programmed end (which would lose a correction)."""
+    from ncpp.motion.segments import Arc, Line
+
+    series = ["G1 X3 Y1", "G1 X1 Y2", "G41.1 D4", "G1 X2 Y2", "G1 X3", "G40", "G1 X-2 Y1", "G1 X-4 Y-3", "G1 X-3 Y-3"]  # nets 0
+    head = ["G21 G17 G90 G94 F500", "G0 X0 Y0 Z0", "G91"]
+    filler = ["G1 X1", "G1 X-1"] * ((1016 - len(head) - len(series)) // 2)
+    lines = head + series + filler + series + series + ["G90", "M2"]
+    assert lines.index("G1 X-2 Y1", len(head) + len(series) + len(filler)) + 1 == 1023  # the exit move ends the first window
+    data = ("\n".join(lines) + "\n").encode()
+    model = load_machine(ROOT / "samples/machines/hr5b.toml")
+    offset = (400.0, 350.0, 400.0)
+    out = compensate(data, model, offset, 0.001)
+
+    def before_comp(text: bytes) -> list:  # where each series' G41.1 finds the tool
+        found, last = [], None
+        for e in events_of(text, offsets=WorkOffsets.at(offset)):
+            if type(e) in (Line, Arc):
+                last = e.end
+            elif e.block.text.startswith("G41.1"):
+                found.append(last)
+        return found
+
+    corrections = [tuple(round(b - a, 7) for a, b in zip(p, q)) for p, q in zip(before_comp(data), before_comp(out))]
+    assert len(corrections) == 3 and corrections[0] == corrections[1] == corrections[2] and max(map(abs, corrections[0])) > 0.01
