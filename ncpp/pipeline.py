@@ -161,17 +161,18 @@ def warn_fixed(events: Iterable[Event], warnings: Warnings, file: str) -> Iterat
     In G91 such a move starts from where the control is (the compensated position), and a
     G98 retract ends at the compensated level the series started at: the nominal moves
     of a G91 cycle, and a G91 move right after a series, would be off by a correction.
-    There the rest of the program passes through, as after an out-of-scope construct;
-    but for the moves under cutter compensation, plain moves whose increments
-    apply_error_map follows from there (`_carry`)."""
+    There, after a cycle, the rest of the program passes through, as after an
+    out-of-scope construct; the plain moves of loops and subroutines and those under
+    cutter compensation run their increments from there, which apply_error_map follows
+    (`_carry`)."""
     events = iter(events)
     series = ""  # why the moves of the series under way are fixed ("": none is)
     for event in events:
         kind = type(event)
         if kind is Line or kind is Arc:  # (not a Pass, nor a dialect's own: Klartext's pole)
             fixed = event.fixed  # type: ignore[union-attr]
-            # (in G91 the moves under cutter compensation start where the control is: apply_error_map carries that)
-            if (fixed or series) and (fixed or series) != COMP and not event.context.absolute:  # type: ignore[union-attr]
+            # (other moves left as programmed in G91 start where the control is: apply_error_map carries that)
+            if (fixed or series) == CYCLE and not event.context.absolute:  # type: ignore[union-attr]
                 yield from _passed_on(event, events, warnings, file, fixed or series)
                 return
             if fixed and fixed != series:

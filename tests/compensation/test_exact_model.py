@@ -161,3 +161,43 @@ def test_in_g91_the_carry_crosses_the_passes_windows():
 
     corrections = [tuple(round(b - a, 7) for a, b in zip(p, q)) for p, q in zip(before_comp(data), before_comp(out))]
     assert len(corrections) == 3 and corrections[0] == corrections[1] == corrections[2] and max(map(abs, corrections[0])) > 0.01
+
+
+G91_FLOW = b"""G21 G17 G90 G94 F500
+o1 sub
+ G91 G1 X10 Y5
+ G1 X5 Y10
+o1 endsub
+G0 X0 Y0 Z0
+G91
+G1 X30 Y5
+G1 X10 Y20
+o1 call
+o2 repeat [2]
+ G1 X4 Y1
+o2 endrepeat
+G1 X-10 Y10
+G1 X-40 Y5
+G2 X-20 Y0 R12
+G1 X-5 Y-60 Z-2
+M2
+"""
+
+
+def test_in_g91_the_moves_after_a_subroutine_and_a_loop_are_compensated(machine):
+    """As under cutter compensation: the moves of a subroutine and a loop in G91 run from the
+    compensated point before them; from the end of the first move after them the moves are
+    within the tolerance."""
+    from ncpp.motion.segments import FLOW, Arc, Line
+
+    def after(events):
+        moves = [e for e in events if type(e) in (Line, Arc)]
+        last = max(k for k, e in enumerate(moves) if e.fixed == FLOW)
+        return moves[last + 2 :]
+
+    offset = placement(sample_events(events_of(G91_FLOW)), machine.limits)
+    nominal = sample_events(after(events_of(G91_FLOW, offsets=WorkOffsets.at(offset))))
+    text = compensate(G91_FLOW, machine, offset, 0.001)
+    before = contour_error(machine, nominal, nominal, feed_effects=False)
+    result = contour_error(machine, sample_events(after(events_of(text, offsets=WorkOffsets.at(offset)))), nominal, feed_effects=False)
+    assert before.max_um > 20.0 and result.max_um <= 1.5, f"{result.max_um:.2f} µm at line {result.worst_line}"
