@@ -201,3 +201,22 @@ def test_in_g91_the_moves_after_a_subroutine_and_a_loop_are_compensated(machine)
     before = contour_error(machine, nominal, nominal, feed_effects=False)
     result = contour_error(machine, sample_events(after(events_of(text, offsets=WorkOffsets.at(offset)))), nominal, feed_effects=False)
     assert before.max_um > 20.0 and result.max_um <= 1.5, f"{result.max_um:.2f} µm at line {result.worst_line}"
+
+
+def test_in_g91_the_carry_follows_a_change_of_units_among_the_moves_left_as_programmed(machine):
+    """G20 and back among the moves under G41.1 in G91: each run of them is carried in its own
+    units (`_carry` converts the end before it)."""
+    from ncpp.motion.segments import COMP, Arc, Line
+
+    program = G91_COMP.replace(b"G1 X40\n", b"G20\nG1 X1.5\nG21\n")
+
+    def after(events):
+        moves = [e for e in events if type(e) in (Line, Arc)]
+        last = max(k for k, e in enumerate(moves) if e.fixed == COMP)
+        return moves[last + 2 :]
+
+    offset = placement(sample_events(events_of(program)), machine.limits)
+    nominal = sample_events(after(events_of(program, offsets=WorkOffsets.at(offset))))
+    text = compensate(program, machine, offset, 0.001)
+    result = contour_error(machine, sample_events(after(events_of(text, offsets=WorkOffsets.at(offset)))), nominal, feed_effects=False)
+    assert result.max_um <= 1.5, f"{result.max_um:.2f} µm at line {result.worst_line}"
