@@ -144,13 +144,10 @@ UNCOMPENSATED = {
     COMP: "cutter compensation: its moves pass through uncompensated (the control offsets them by the tool radius, "
     "so the tool is not where their points are); compensation resumes after the first move with it off (after G40, or R0)",
 }
-INCREMENTAL_FIXED = (
-    "{} in G91, or a G91 move after it: the control moves from the compensated "
+INCREMENTAL_CYCLE = (
+    "a canned cycle in G91, or a G91 move after it: the control moves from the compensated "
     "position there, which ncpp does not follow; from this line on the program passes through uncompensated"
 )
-
-
-_ARTICLED = {CYCLE: "a canned cycle", FLOW: "a loop or subroutine", COMP: "cutter compensation"}
 
 
 def warn_fixed(events: Iterable[Event], warnings: Warnings, file: str) -> Iterator[Event]:
@@ -158,22 +155,20 @@ def warn_fixed(events: Iterable[Event], warnings: Warnings, file: str) -> Iterat
     (`fixed`: a canned cycle's, a loop's or a subroutine's, or those under cutter compensation)
     starts (refused with --strict).
 
-    In G91 such a move starts from where the control is (the compensated position), and a
-    G98 retract ends at the compensated level the series started at: the nominal moves
-    of a G91 cycle, and a G91 move right after a series, would be off by a correction.
-    There, after a cycle, the rest of the program passes through, as after an
-    out-of-scope construct; the plain moves of loops and subroutines and those under
-    cutter compensation run their increments from there, which apply_error_map follows
-    (`_carry`)."""
+    In G91 such a move starts from where the control is (the compensated position).  The
+    plain moves of loops and subroutines and those under cutter compensation run their
+    increments from there, which apply_error_map follows (`_carry`); but a cycle's G98
+    retract ends at the compensated level the series started at, so from a G91 cycle, or
+    a G91 move right after one, the rest of the program passes through, as after an
+    out-of-scope construct."""
     events = iter(events)
     series = ""  # why the moves of the series under way are fixed ("": none is)
     for event in events:
         kind = type(event)
         if kind is Line or kind is Arc:  # (not a Pass, nor a dialect's own: Klartext's pole)
             fixed = event.fixed  # type: ignore[union-attr]
-            # (other moves left as programmed in G91 start where the control is: apply_error_map carries that)
             if (fixed or series) == CYCLE and not event.context.absolute:  # type: ignore[union-attr]
-                yield from _passed_on(event, events, warnings, file, fixed or series)
+                yield from _passed_on(event, events, warnings, file)
                 return
             if fixed and fixed != series:
                 warnings.warn(UNCOMPENSATED[fixed], Location(file, event.block.line, 1))
@@ -181,9 +176,9 @@ def warn_fixed(events: Iterable[Event], warnings: Warnings, file: str) -> Iterat
         yield event
 
 
-def _passed_on(first: Event, rest: Iterator[Event], warnings: Warnings, file: str, why: str) -> Iterator[Pass]:
+def _passed_on(first: Event, rest: Iterator[Event], warnings: Warnings, file: str) -> Iterator[Pass]:
     """`first`'s block (none of its events went by yet) and every later one, as `Pass`."""
-    warnings.warn(INCREMENTAL_FIXED.format(_ARTICLED[why]), Location(file, first.block.line, 1))
+    warnings.warn(INCREMENTAL_CYCLE, Location(file, first.block.line, 1))
     last = None
     for event in chain((first,), rest):
         if event.block is not last:

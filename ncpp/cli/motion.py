@@ -63,7 +63,6 @@ def run(args: argparse.Namespace) -> int:
     import sys
 
     from ncpp.cli.io import open_input
-    from ncpp.errors import Warnings
     from ncpp.motion.canon import format_event
     from ncpp.pipeline import dialect_tools
     from ncpp.program.dialects import parse_program

@@ -39,7 +39,7 @@ from ncpp.motion.cycles import CANNED, DWELLING, PECKING, RAPID_DELTA_INCH, SPIN
 from ncpp.motion.expressions import ExpressionError, OutOfScope, Parameters, evaluate
 from ncpp.motion.offsets import SYSTEMS, WorkOffsets
 from ncpp.motion.flow import FIXED, RUN, SKIP, Flow
-from ncpp.motion.segments import COMP, CYCLE, FLOW, PLANE_AXES, Arc, Context, Event, Line, Pass
+from ncpp.motion.segments import COMP, CYCLE, FLOW, PLANE_AXES, Arc, Context, Event, Line, Pass, mark_off_path
 from ncpp.motion.snapshot import attributes
 from ncpp.motion.tools import UntoldLengths
 from ncpp.program.blocks import STRAY_TAPE, UNREADABLE, Block, Comment, ExprWord, Statement, Word
@@ -372,10 +372,8 @@ class Interpreter:
             self.arc_refused = moves[0].fixed == CYCLE or _homes(block)
         if self.cutter_comp is not None and self.comp_radius:
             self._check_radius(moves, block)
-        if self.off_path or self.cutter_comp is not None:
-            for ev in moves:  # (a loop's or a cycle's too: that the tool is off the path matters more)
-                ev.fixed = COMP
-            self.off_path = self.cutter_comp is not None
+        # (a loop's or a cycle's moves too: that the tool is off the path matters more)
+        self.off_path = mark_off_path(moves, self.cutter_comp is not None, self.off_path)
         return event
 
     def _check_radius(self, moves: list, block: Block) -> None:
@@ -819,9 +817,10 @@ class Interpreter:
             self._fail(message, block, motion_item)
 
     def _cutter_compensation(self, block: Block, code_item: tuple, words: dict) -> None:
-        """G40 off; G41/G42 (the radius of tool D, or of the tool in the spindle) and G41.1/G42.1
-        (D the diameter) on, in the XY or XZ plane.  The radius does not matter here: the
-        moves are followed as programmed (`_in_comp`)."""
+        """G40 off; G41/G42 (the radius of tool D, or of the tool in the spindle, where ncpp is
+        told the tool table) and G41.1/G42.1 (D the diameter) on, in the XY or XZ plane.  The
+        moves are followed as programmed (`_in_comp`); the radius is what rs274ngc checks
+        them against (`_check_radius`), and a radius of 0 leaves the tool on the path."""
         code, item = code_item
         if code == 40.0:
             self.arc_refused = self.arc_refused or self.off_path

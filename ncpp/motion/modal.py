@@ -13,7 +13,7 @@ import math
 from typing import Callable, Iterable, Iterator
 
 from ncpp.errors import Location, NcppError, Warnings
-from ncpp.motion.segments import COMP, PLANE_AXES, Arc, Context, Event, Line, Pass, Point
+from ncpp.motion.segments import PLANE_AXES, Arc, Context, Event, Line, Pass, Point, mark_off_path
 from ncpp.program.blocks import Block
 
 MM_PER_INCH = 25.4
@@ -87,11 +87,7 @@ class ModalInterpreter:
         if turn is not None:
             self.radius_comp = turn
         if self.radius_comp or self.off_path:
-            moves = [e for e in events if type(e) is Line or type(e) is Arc]
-            for move in moves:
-                move.fixed = COMP
-            if moves:
-                self.off_path = self.radius_comp
+            self.off_path = mark_off_path([e for e in events if type(e) is Line or type(e) is Arc], self.radius_comp, self.off_path)
         return events
 
     # -- modal state --------------------------------------------------------------------

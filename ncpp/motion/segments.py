@@ -141,4 +141,15 @@ class Pass:
 Segment = Union[Line, Arc]
 Event = Union[Line, Arc, Pass]
 
-__all__ = ["COMP", "CYCLE", "FLOW", "Arc", "Context", "Event", "Line", "Pass", "Point", "Segment", "PLANES", "PLANE_AXES", "EXTRA_AXES", "replace"]
+
+def mark_off_path(moves: list, compensating: bool, off_path: bool) -> bool:
+    """Under tool radius compensation (G41/G42, RL/RR) the control offsets the path by the
+    radius: mark a block's `moves` made with it on, or the first after it is off (which ends
+    on its programmed point), `fixed` (COMP).  Whether the tool is off the path after them."""
+    if not moves or not (compensating or off_path):
+        return off_path
+    for move in moves:
+        move.fixed = COMP
+    return compensating
+
+__all__ = ["COMP", "CYCLE", "FLOW", "mark_off_path", "Arc", "Context", "Event", "Line", "Pass", "Point", "Segment", "PLANES", "PLANE_AXES", "EXTRA_AXES", "replace"]

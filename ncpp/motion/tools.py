@@ -85,8 +85,8 @@ class ToolTable:
         if lines and lines[0].lstrip().upper().startswith("BEGIN"):
             edges, names = read_tool_t(lines, str(path))
             return cls({}, str(path), names, edges)
-        diameters: dict[int, float] = {}
-        return cls(read_tool_lines(lines, str(path), unit_mm, diameters), str(path), diameters=diameters)
+        offsets, diameters = read_tool_lines(lines, str(path), unit_mm)
+        return cls(offsets, str(path), diameters=diameters)
 
     def offset(self, number: int) -> tuple[float, ...] | None:
         """Tool `number`'s offsets (tool 0, no tool: all zero), None when the table has no such tool."""
@@ -117,9 +117,10 @@ class UntoldLengths:
             )
 
 
-def read_tool_lines(lines: list[str], file: str, unit_mm: float, diameters: dict[int, float] | None = None) -> dict[int, tuple[float, ...]]:
-    """Per tool number its offsets (mm and degrees); its diameters (mm) into `diameters`."""
+def read_tool_lines(lines: list[str], file: str, unit_mm: float) -> tuple[dict[int, tuple[float, ...]], dict[int, float]]:
+    """Per tool number its offsets (mm and degrees), and the diameters the table gives (mm)."""
     tools: dict[int, tuple[float, ...]] = {}
+    diameters: dict[int, float] = {}
     for n, line in enumerate(lines, 1):
         data = line.split(";", 1)[0]
         offsets = [0.0] * len(OFFSET_LETTERS)
@@ -145,9 +146,9 @@ def read_tool_lines(lines: list[str], file: str, unit_mm: float, diameters: dict
         if number in tools:
             raise NcppError(f"tool {number} is listed twice", Location(file, n, 1))
         tools[number] = tuple(offsets)
-        if diameters is not None and diameter:
+        if diameter:
             diameters[number] = diameter
-    return tools
+    return tools, diameters
 
 
 def _number(text: str, where: Location) -> float:

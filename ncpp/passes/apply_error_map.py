@@ -144,9 +144,10 @@ def _rows_before(rows: _Rows, line: int | None) -> _Rows | None:
 def _rows(segs: list, directional: bool) -> _Rows:
     offsets, scales, tools = frames(segs)
     start, end = points([e.start for e in segs]), points([e.end for e in segs])
-    # one walk over the events for four flags (1 arc, 2 fixed: a move left as programmed, 4 changed, 8 rapid)
-    kind = np.fromiter([(type(e) is Arc) + 2 * bool(e.fixed) + 4 * bool(e.changed) + 8 * (type(e) is Line and e.rapid)
-                        + 16 * (bool(e.fixed) and not e.context.absolute) for e in segs], dtype=np.int8, count=len(segs))  # fmt: skip
+    # one walk over the events for five flags (1 arc, 2 fixed: a move left as programmed, 4 changed, 8 rapid,
+    # 16 carried: fixed in G91)
+    kind = np.fromiter([(type(e) is Arc) + (0 if not e.fixed else 2 if e.context.absolute else 18) + 4 * bool(e.changed)
+                        + 8 * (type(e) is Line and e.rapid) for e in segs], dtype=np.int8, count=len(segs))  # fmt: skip
     arc, changed = (kind & 1) != 0, (kind & 4) != 0
     line = (kind & 3) == 0
     free = line & ~changed
@@ -364,10 +365,11 @@ def _directional(rows: _Rows, ctx: PassContext, travel: Travel) -> _Solved:
 
 
 def _carry(rows: _Rows, out_end: NDArray, before: NDArray | None) -> None:
-    """Move the ends of the carried rows (left as programmed, in G91: the moves under cutter
-    compensation) by where the control stands when each run of them starts: the program's
-    increments run from the compensated end before them, which is off their programmed start
-    by that end's correction.  `before`: the previous chunk's last end, in the first row's frame."""
+    """Move the ends of the carried rows (left as programmed, in G91: the moves of loops and
+    subroutines, and under cutter compensation) by where the control stands when each run of
+    them starts: the program's increments run from the compensated end before them, which is
+    off their programmed start by that end's correction.  `before`: the previous chunk's last
+    end, in the first row's frame."""
     carried, offsets, scales = rows.carried, rows.offsets, rows.scales
     reframed = np.concatenate([[True], (offsets[1:] != offsets[:-1]).any(axis=1) | (scales[1:] != scales[:-1])])
     # a run starts after a row not carried, or where the frame changes (G20/G21 in it)
@@ -379,8 +381,10 @@ def _carry(rows: _Rows, out_end: NDArray, before: NDArray | None) -> None:
             previous = (out_end[k - 1] + offsets[k - 1]) * scales[k - 1] / scales[k] - offsets[k]
         if previous is None:
             continue
+        # the run: up to the next run's start or the first row not carried, whichever comes first
         stop = starts[n + 1] if n + 1 < len(starts) else len(carried)
-        run = k + int(np.argmin(carried[k:stop])) if not carried[k:stop].all() else stop
+        rest = carried[k:stop]
+        run = stop if rest.all() else k + int(np.argmin(rest))
         out_end[k:run] = rows.end[k:run] + (previous - rows.start[k])
 
 
