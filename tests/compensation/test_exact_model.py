@@ -114,25 +114,40 @@ M2
 """
 
 
+def residual_after(machine, program: bytes, reason: str):
+    """Contour error reports, uncompensated and compensated, of the moves of `program` in G91
+    past the first one after its last move left as programmed for `reason` (COMP, FLOW).
+    That first one starts where the moves left as programmed left the tool: off by how much
+    the correction changed along them (as after a canned cycle in G90); from its end on the
+    moves must be within the tolerance."""
+    from ncpp.motion.segments import Arc, Line
+
+    def after(events):
+        moves = [e for e in events if type(e) in (Line, Arc)]
+        return moves[max(k for k, e in enumerate(moves) if e.fixed == reason) + 2 :]
+
+    offset = placement(sample_events(events_of(program)), machine.limits)
+    nominal = sample_events(after(events_of(program, offsets=WorkOffsets.at(offset))))
+    commanded = sample_events(after(events_of(compensate(program, machine, offset, 0.001), offsets=WorkOffsets.at(offset))))
+    return contour_error(machine, nominal, nominal, feed_effects=False), contour_error(machine, commanded, nominal, feed_effects=False)
+
+
 def test_in_g91_the_moves_after_cutter_compensation_are_compensated(machine):
     """The moves under G41.1 run as programmed from where the compensated move before them
-    left the tool (G91: increments): those after G40's exit move must start from there too.
-    The first of them starts where the exit move left the tool, off by how much the
-    correction changed along the moves left as programmed (as after a canned cycle in G90);
-    from its end on the moves are within the tolerance."""
-    from ncpp.motion.segments import COMP, Arc, Line
+    left the tool (G91: increments): those after G40's exit move start from there too."""
+    from ncpp.motion.segments import COMP
 
-    def after(events):  # the moves past the first one after the exit move
-        moves = [e for e in events if type(e) in (Line, Arc)]
-        last = max(k for k, e in enumerate(moves) if e.fixed == COMP)
-        return moves[last + 2 :]
+    before, after = residual_after(machine, G91_COMP, COMP)
+    assert before.max_um > 20.0 and after.max_um <= 1.5, f"{after.max_um:.2f} µm at line {after.worst_line}"
 
-    offset = placement(sample_events(events_of(G91_COMP)), machine.limits)
-    nominal = sample_events(after(events_of(G91_COMP, offsets=WorkOffsets.at(offset))))
-    text = compensate(G91_COMP, machine, offset, 0.001)
-    before = contour_error(machine, nominal, nominal, feed_effects=False)
-    result = contour_error(machine, sample_events(after(events_of(text, offsets=WorkOffsets.at(offset)))), nominal, feed_effects=False)
-    assert before.max_um > 20.0 and result.max_um <= 1.5, f"{result.max_um:.2f} µm at line {result.worst_line}"
+
+def test_in_g91_the_carry_follows_a_change_of_units_among_the_moves_left_as_programmed(machine):
+    """G20 and back among the moves under G41.1 in G91: each run of them is carried in its own
+    units (`_carry` converts the end before it)."""
+    from ncpp.motion.segments import COMP
+
+    _, after = residual_after(machine, G91_COMP.replace(b"G1 X40\n", b"G20\nG1 X1.5\nG21\n"), COMP)
+    assert after.max_um <= 1.5, f"{after.max_um:.2f} µm at line {after.worst_line}"
 
 
 def test_in_g91_the_carry_crosses_the_passes_windows():
@@ -186,37 +201,8 @@ M2
 
 def test_in_g91_the_moves_after_a_subroutine_and_a_loop_are_compensated(machine):
     """As under cutter compensation: the moves of a subroutine and a loop in G91 run from the
-    compensated point before them; from the end of the first move after them the moves are
-    within the tolerance."""
-    from ncpp.motion.segments import FLOW, Arc, Line
+    compensated point before them."""
+    from ncpp.motion.segments import FLOW
 
-    def after(events):
-        moves = [e for e in events if type(e) in (Line, Arc)]
-        last = max(k for k, e in enumerate(moves) if e.fixed == FLOW)
-        return moves[last + 2 :]
-
-    offset = placement(sample_events(events_of(G91_FLOW)), machine.limits)
-    nominal = sample_events(after(events_of(G91_FLOW, offsets=WorkOffsets.at(offset))))
-    text = compensate(G91_FLOW, machine, offset, 0.001)
-    before = contour_error(machine, nominal, nominal, feed_effects=False)
-    result = contour_error(machine, sample_events(after(events_of(text, offsets=WorkOffsets.at(offset)))), nominal, feed_effects=False)
-    assert before.max_um > 20.0 and result.max_um <= 1.5, f"{result.max_um:.2f} µm at line {result.worst_line}"
-
-
-def test_in_g91_the_carry_follows_a_change_of_units_among_the_moves_left_as_programmed(machine):
-    """G20 and back among the moves under G41.1 in G91: each run of them is carried in its own
-    units (`_carry` converts the end before it)."""
-    from ncpp.motion.segments import COMP, Arc, Line
-
-    program = G91_COMP.replace(b"G1 X40\n", b"G20\nG1 X1.5\nG21\n")
-
-    def after(events):
-        moves = [e for e in events if type(e) in (Line, Arc)]
-        last = max(k for k, e in enumerate(moves) if e.fixed == COMP)
-        return moves[last + 2 :]
-
-    offset = placement(sample_events(events_of(program)), machine.limits)
-    nominal = sample_events(after(events_of(program, offsets=WorkOffsets.at(offset))))
-    text = compensate(program, machine, offset, 0.001)
-    result = contour_error(machine, sample_events(after(events_of(text, offsets=WorkOffsets.at(offset)))), nominal, feed_effects=False)
-    assert result.max_um <= 1.5, f"{result.max_um:.2f} µm at line {result.worst_line}"
+    before, after = residual_after(machine, G91_FLOW, FLOW)
+    assert before.max_um > 20.0 and after.max_um <= 1.5, f"{after.max_um:.2f} µm at line {after.worst_line}"

@@ -42,19 +42,7 @@ HEIDENHAIN = """0 BEGIN PGM COMP MM
 12 L Z+50 R0 FMAX M30
 13 END PGM COMP MM
 """
-SINUMERIK = """G90 G17 G71
-G0 X-20 Y-20 Z5
-G1 Z-5 F500
-G41 G1 X0 Y0 F200
-G1 X40
-G3 X50 Y10 I0 J10
-G1 Y40
-G40 G1 X55 Y45
-G1 X70
-G2 X80 Y55 I0 J10
-G0 Z50
-M30
-"""
+SINUMERIK = ISO.replace("G21 G90 G17", "G90 G17 G71").replace("G41 D1", "G41")  # (D is a tool edge there)
 # dialect: (program, file name, the line compensation starts on, the lines to the exit move's)
 PROGRAMS = {"iso": (ISO, "part.ngc", 4, 5), "heidenhain": (HEIDENHAIN, "part.h", 4, 6), "sinumerik": (SINUMERIK, "part.mpf", 4, 5)}
 
@@ -92,5 +80,7 @@ def test_the_same_part_compensates_alike_after_compensation_in_every_dialect():
         out, _ = compensate(text, name)
         compensated = [e for e in moves(out, name) if e.fixed != COMP]
         after[dialect] = [e.end for e in compensated[-4:]]  # from the exit move's end: connecting step, line, arc, rapid
+        programmed = [e.end for e in moves(text, name)[-3:]]
+        assert len(after[dialect]) == 4 and all(max(abs(a - b) for a, b in zip(p, q)) > 0.001 for p, q in zip(after[dialect][1:], programmed))
     for dialect in ("heidenhain", "sinumerik"):
         assert all(max(abs(a - b) for a, b in zip(p, q)) < 2e-4 for p, q in zip(after["iso"], after[dialect])), (dialect, after)
