@@ -145,8 +145,9 @@ UNCOMPENSATED = {
     "so the tool is not where their points are); compensation resumes after the first move with it off (after G40, or R0)",
 }
 INCREMENTAL_CYCLE = (
-    "a canned cycle in G91, or a G91 move after it: the control moves from the compensated "
-    "position there, which ncpp does not follow; from this line on the program passes through uncompensated"
+    "a G91 move right after a canned cycle in G90: it starts where the cycle left the tool (a G98 retract "
+    "ends at the compensated level the cycle started from), which ncpp does not follow; from this line on "
+    "the program passes through uncompensated"
 )
 
 
@@ -155,24 +156,26 @@ def warn_fixed(events: Iterable[Event], warnings: Warnings, file: str) -> Iterat
     (`fixed`: a canned cycle's, a loop's or a subroutine's, or those under cutter compensation)
     starts (refused with --strict).
 
-    In G91 such a move starts from where the control is (the compensated position).  The
-    plain moves of loops and subroutines and those under cutter compensation run their
-    increments from there, which apply_error_map follows (`_carry`); but a cycle's G98
-    retract ends at the compensated level the series started at, so from a G91 cycle, or
-    a G91 move right after one, the rest of the program passes through, as after an
+    In G91 such a move starts from where the control is (the compensated position): the
+    moves of cycles, loops and subroutines and those under cutter compensation run their
+    increments from there, which apply_error_map follows (`_carry`; a G91 cycle's G98
+    retract, to the level it started from, is one of them).  A cycle in G90 goes to its
+    programmed points, but its G98 retract ends at the compensated level it started from:
+    from a G91 move right after one, the rest of the program passes through, as after an
     out-of-scope construct."""
     events = iter(events)
     series = ""  # why the moves of the series under way are fixed ("": none is)
+    absolute = True  # whether the series' last move was in G90
     for event in events:
         kind = type(event)
         if kind is Line or kind is Arc:  # (not a Pass, nor a dialect's own: Klartext's pole)
             fixed = event.fixed  # type: ignore[union-attr]
-            if (fixed or series) == CYCLE and not event.context.absolute:  # type: ignore[union-attr]
+            if not fixed and series == CYCLE and absolute and not event.context.absolute:  # type: ignore[union-attr]
                 yield from _passed_on(event, events, warnings, file)
                 return
             if fixed and fixed != series:
                 warnings.warn(UNCOMPENSATED[fixed], Location(file, event.block.line, 1))
-            series = fixed
+            series, absolute = fixed, event.context.absolute  # type: ignore[union-attr]
         yield event
 
 

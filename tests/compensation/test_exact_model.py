@@ -116,7 +116,7 @@ M2
 
 def residual_after(machine, program: bytes, reason: str):
     """Contour error reports, uncompensated and compensated, of the moves of `program` in G91
-    past the first one after its last move left as programmed for `reason` (COMP, FLOW).
+    past the first one after its last move left as programmed for `reason` (COMP, FLOW, CYCLE).
     That first one starts where the moves left as programmed left the tool: off by how much
     the correction changed along them (as after a canned cycle in G90); from its end on the
     moves must be within the tolerance."""
@@ -205,4 +205,33 @@ def test_in_g91_the_moves_after_a_subroutine_and_a_loop_are_compensated(machine)
     from ncpp.motion.segments import FLOW
 
     before, after = residual_after(machine, G91_FLOW, FLOW)
+    assert before.max_um > 20.0 and after.max_um <= 1.5, f"{after.max_um:.2f} µm at line {after.worst_line}"
+
+
+# a G91 cycle's holes walk from where the control stands; G98 retracts to that level, G99 to R's
+G91_CYCLE = b"""G21 G17 G90 G94 F500
+G0 X0 Y0 Z5
+G91
+G1 X30 Y5
+G1 X10 Y20 Z-1
+G98 G81 X10 Y10 Z-3 R-1 L3
+G99 G83 X10 Y-5 Z-3 R-1 Q1 L2
+G80
+G1 X-10 Y10
+G1 X-40 Y5
+G2 X-20 Y0 R12
+G1 X-5 Y-60 Z-2
+G90 G1 X10 Y80
+G1 X70 Y5
+M2
+"""
+
+
+def test_in_g91_the_moves_after_a_canned_cycle_are_compensated(machine):
+    """As after a subroutine: the cycles run from the compensated point before them (in G91
+    all their levels are relative to it), and the moves after them, in G91 and then in G90,
+    are compensated."""
+    from ncpp.motion.segments import CYCLE
+
+    before, after = residual_after(machine, G91_CYCLE, CYCLE)
     assert before.max_um > 20.0 and after.max_um <= 1.5, f"{after.max_um:.2f} µm at line {after.worst_line}"

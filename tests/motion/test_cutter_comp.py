@@ -191,7 +191,7 @@ def test_strict_refuses_moves_under_compensation():
 def test_in_g91_compensation_resumes_from_where_the_moves_left_as_programmed_leave_the_tool():
     """G91 under compensation: its increments run from the compensated point before them, and
     the moves after the exit move are compensated from there (`apply_error_map._carry`;
-    test_exact_model measures them on the machine).  A canned cycle in G91 still ends it."""
+    test_exact_model measures them on the machine)."""
     text = HEAD + "G1 X-20 Y-20\nG41.1 D6\nG91 G1 X20\nG1 Y20\nG40\nG1 X10 Y10\nG1 X30\nG90\nG1 X0 Y0\n"
     out, warned = compensate(text, "comp.ngc")
     lines = out.splitlines()
@@ -199,8 +199,6 @@ def test_in_g91_compensation_resumes_from_where_the_moves_left_as_programmed_lea
     assert lines[start : start + 5] == text.splitlines()[4:9]  # to the exit move: as written
     assert lines[start + 5] != "G1 X30" and lines[start + 5].startswith("G1 X30.0")  # compensated, an increment
     assert "in G91" not in warned and warned.count("cutter compensation") == 1
-    _, cycled = compensate(HEAD + "G91 G81 X5 Y5 Z-2 R1\nG80\nG1 X5\n", "cycle.ngc")
-    assert "cycle.ngc:4:1: warning: a canned cycle in G91" in cycled
 
 
 @needs_rs274

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import io
 import random
+import re
 
 import pytest
 
@@ -206,21 +207,31 @@ def test_strict_refuses_cycles():
         _compensate(DRILL, strict=True)
 
 
-@pytest.mark.parametrize(
-    "text, line",
-    [
-        (HEAD + "G1 Z-1\nX40 Y12\nG0 Z5\nG91 G81 X10 Y10 Z-3 R-3 L2\nG90 G80\nG1 X50 Y50\n", 6),  # a G91 cycle
-        (HEAD + "G1 Z-1\nX40 Y12\nG0 Z5\nG98 G81 X20 Y20 Z-3 R2\nG80\nG91 G1 X5\nX5 Y5\n", 8),  # G91 after a G98 retract
-    ],
-)
-def test_incremental_cycles_end_compensation(text, line):
+def test_a_g91_move_right_after_a_g90_cycle_ends_compensation():
+    """The G90 cycle's G98 retract ends at the compensated level it started from, not at its
+    programmed one: the increments after it would carry that difference."""
+    text, line = HEAD + "G1 Z-1\nX40 Y12\nG0 Z5\nG98 G81 X20 Y20 Z-3 R2\nG80\nG91 G1 X5\nX5 Y5\n", 8
     out, warned = _compensate(text)
-    assert f"drill.ngc:{line}:1: warning: a canned cycle in G91" in warned
+    assert f"drill.ngc:{line}:1: warning: a G91 move right after a canned cycle in G90" in warned
     original, written = text.splitlines(), out.splitlines()
     assert written[-(len(original) - line + 1) :] == original[line - 1 :]  # the rest verbatim
     assert written[3] != original[2]  # compensated before it
     with pytest.raises(NcppError, match="drill.ngc:6:1: .*canned cycle"):
         _compensate(text, strict=True)
+
+
+@pytest.mark.parametrize("after", ["G90 G80\nG1 X50 Y50\n", "G80\nG1 X-5 Y5\nX5\n"])
+def test_compensation_goes_on_after_a_g91_cycle(after):
+    """A G91 cycle runs its increments from where the control stands, its G98 retract to the
+    level it started from: apply_error_map carries it (test_exact_model measures the moves
+    after it on the machine), and compensates the moves after it, in G90 or G91."""
+    text = HEAD + "G1 Z-1\nX40 Y12\nG0 Z5\nG91 G98 G81 X10 Y10 Z-3 R-3 L2\n" + after
+    out, warned = _compensate(text)
+    assert "in G91" not in warned and "G91 move" not in warned and "drill.ngc:6:1: warning: canned cycle" in warned
+    original, written = text.splitlines(), out.splitlines()
+    last = re.search(r"X(-?[\d.]+)", written[-1])  # compensated: the X the block says, moved by microns
+    assert written[-1] != original[-1] and 0 < abs(float(last[1]) - float(original[-1].split("X")[1].split()[0])) < 0.1
+    assert "G91 G98 G81 X10 Y10 Z-3 R-3 L2" in written
 
 
 @pytest.mark.skipif(not RS274.exists(), reason="no rs274")

@@ -375,7 +375,7 @@ def test_fanuc_subprograms_pass_through_and_compensation_resumes():
 
 def test_a_subroutine_in_g91_runs_from_where_the_control_is_and_compensation_goes_on():
     """Its increments run from the compensated point before the call (`apply_error_map._carry`;
-    test_exact_model measures the moves after it on the machine).  A cycle in G91 still ends it."""
+    test_exact_model measures the moves after it on the machine)."""
     text = HEAD + "o1 sub\n G91 G1 X1\n G1 Y1\no1 endsub\nG1 X40 Y12\no1 call\nG1 X3\nG90 G1 X50\n"
     out, warned = _compensate(text)
     lines = out.splitlines()
