@@ -22,7 +22,7 @@ makes off the programmed path (from the first move under G41/G42 to the first
 after G40), are marked `fixed`: compensation leaves them as programmed.
 Anything else (subroutine files, Fanuc macro
 control flow, M99 in the main program, G88 (a manual retract) and the lathe cycles, splines,
-threading, probing, polar words) makes the
+threading, probing) makes the
 interpreter's state unknown: that block and every later block pass through
 as `Pass` after ONE warning (an error with `strict`).
 """
@@ -633,11 +633,14 @@ class Interpreter:
         mode0, mode0_item = gcodes.get(0, (None, None))
         mode1, mode1_item = gcodes.get(1, (None, None))
         axis_item = next((item for letter, (_, item) in words.items() if letter in AXIS_INDEX), None)
+        polar_item = (words.get("@") or words.get("^") or (None, None))[1]
+        if polar_item is not None:
+            self._check_polar(block, words, polar_item)
         for value, item in mcodes.items():  # subprogram calls use words (L, P) of their own
             if value in OUT_OF_SCOPE_M:
                 raise _OutOfScope(OUT_OF_SCOPE_M[value], item.start + 1)
         tool_axes = gcodes.get(8, (None,))[0] == 43.1  # G43.1's axis words are offsets, not a move
-        motion = self._motion_to_be(block, 43.1 if tool_axes and mode0 is None else mode0, mode1, mode1_item, axis_item)
+        motion = self._motion_to_be(block, 43.1 if tool_axes and mode0 is None else mode0, mode1, mode1_item, axis_item, polar_item)
         self._check_words(block, words, gcodes, mcodes, motion, mode0, mode0_item, mode1_item)
         if self.cutter_comp is not None or 7 in gcodes:
             self._check_with_comp(block, words, gcodes, mcodes, motion, mode1_item or axis_item)
@@ -697,29 +700,51 @@ class Interpreter:
         return Pass(block) if events is None else events
 
     # -- checks (interp_check.cc, enhance_block) ----------------------------------------
-    def _motion_to_be(self, block, mode0, mode1, mode1_item, axis_item) -> float | None:
+    def _motion_to_be(self, block, mode0, mode1, mode1_item, axis_item, polar_item=None) -> float | None:
+        """The motion the block makes (enhance_block): polar words (`@` `^`) count as axis
+        words, but for G52 and G92, which take axis words only."""
+        motion = self._motion_of_words(block, mode0, mode1, mode1_item, axis_item, polar_item)
+        if polar_item is not None and motion is None:
+            self._fail("Polar coordinates can only be used for motion", block, polar_item)
+        return motion
+
+    def _motion_of_words(self, block, mode0, mode1, mode1_item, axis_item, polar_item) -> float | None:
         covets_axes = mode0 in (10.0, 28.0, 30.0, 52.0, 92.0, 43.1)
+        any_item = axis_item or polar_item
+        if polar_item is not None and mode0 == 92.0 and (mode1 is None or mode1 == 80.0):
+            self._fail("Polar coordinates can only be used for motion", block, polar_item)
         if mode1 is not None:
             if mode1 == 80.0:
-                if axis_item is not None and not covets_axes:
-                    self._fail("Cannot use axis values with G80", block, axis_item)
+                if any_item is not None and not covets_axes:
+                    self._fail("Cannot use axis values with G80", block, any_item)
                 if axis_item is None and mode0 in (52.0, 92.0):
                     self._fail("All axes missing with g52 or g92", block, block.items[0])
                 return None
             if covets_axes:
                 self._fail("Cannot use two g codes that both use axis values", block, mode1_item)
-            if axis_item is None and mode1 not in (0.0, 1.0, 2.0, 3.0):
+            if any_item is None and mode1 not in (0.0, 1.0, 2.0, 3.0):
                 self._fail("All axes missing with motion code", block, mode1_item)
             return mode1
         if covets_axes:
             if axis_item is None and mode0 in (52.0, 92.0):
                 self._fail("All axes missing with g52 or g92", block, block.items[0])
             return None
-        if axis_item is not None:
+        if any_item is not None:
             if self.motion is None:
-                self._fail("Cannot use axis values without a g code that uses them", block, axis_item)
+                self._fail("Cannot use axis values without a g code that uses them", block, any_item)
             return self.motion
         return None
+
+    def _check_polar(self, block: Block, words: dict, item) -> None:
+        """enhance_block's checks of polar words (`@` radius, `^` angle, LinuxCNC): in the XY
+        plane in effect before the line, without X and Y; and what ncpp does not follow."""
+        if self.plane != 17:
+            self._fail("Cannot use polar coordinate except in G17 plane", block, item)
+        for letter in "XY":
+            if letter in words:
+                self._fail(f"Cannot specify both polar coordinate and {letter} word", block, words[letter][1])
+        if self.cutter_comp is not None:  # rs274ngc then starts from the programmed point, not the tool's
+            raise _OutOfScope("polar coordinates under cutter compensation", item.start + 1)
 
     def _check_words(self, block, words, gcodes, mcodes, motion, mode0, mode0_item, mode1_item) -> None:
         """The per-word checks of rs274ngc's check_g_codes and check_other_codes."""
@@ -729,6 +754,8 @@ class Interpreter:
         if mode0 == 53.0:
             if motion not in (0.0, 1.0):
                 self._fail("Must use G0 or G1 with G53", block, mode0_item)
+            if "@" in words or "^" in words:
+                self._fail("Cannot use polar coordinates with G53", block, mode0_item)
             distance = gcodes.get(3, (None,))[0]
             if distance == 91.0 or (distance is None and not self.absolute):
                 self._fail("Cannot use g53 incremental", block, mode0_item)
@@ -848,9 +875,6 @@ class Interpreter:
             reason = OUT_OF_SCOPE_G.get(value)
             if reason is not None and not (value == 43.2 and "H" in words):
                 raise _OutOfScope(f"{reason} G{value:g}", item.start + 1)
-        for letter, (_, item) in words.items():
-            if letter in ("@", "^"):
-                raise _OutOfScope("polar coordinates", item.start + 1)
         g10 = gcodes.get(0, (None,))[0] == 10.0
         if g10 and words.get("L", (None,))[0] in (1.0, 10.0, 11.0):
             raise _OutOfScope("tool table change G10 L1/L10/L11", gcodes[0][1].start + 1)
@@ -1027,7 +1051,7 @@ class Interpreter:
         self.pos = end
         return line
 
-    def _move_end(self, words: dict) -> list[float]:
+    def _move_end(self, block: Block, words: dict) -> list[float]:
         """`_ends` of the block's axis words in program coordinates (what G0-G3 move to)."""
         end = self.pos[:]
         absolute = self.absolute
@@ -1041,13 +1065,40 @@ class Interpreter:
                 end[i] += value
             if i >= 3:
                 self.uses_extra_axes = True
+        if "@" in words or "^" in words:
+            self._polar_end(block, end, words)
         return end
+
+    def _polar_end(self, block: Block, end: list[float], words: dict) -> None:
+        """X and Y of a move given by polar words, about the program's XY zero (find_ends):
+        in G90 `@` is the radius and `^` the angle (degrees, from +X counter-clockwise), each
+        the current one's when not given; in G91 `@` adds to the radius, then `^` to the angle."""
+        radius, theta = words.get("@"), words.get("^")
+        x, y = end[0], end[1]
+        if self.absolute:
+            if radius is not None and theta is None and x == 0.0 and y == 0.0:
+                self._fail("Must specify angle in polar coordinate if at the origin", block, radius[1])
+            r = radius[0] if radius is not None else math.hypot(y, x)
+            a = math.radians(theta[0]) if theta is not None else math.atan2(y, x)
+            x, y = r * math.cos(a), r * math.sin(a)
+        else:
+            if radius is not None:
+                if x == 0.0 and y == 0.0:
+                    self._fail("Incremental motion with polar coordinates is indeterminate when at the origin", block, radius[1])
+                r, a = math.hypot(y, x) + radius[0], math.atan2(y, x)
+                x, y = r * math.cos(a), r * math.sin(a)
+            if theta is not None:
+                if x == 0.0 and y == 0.0:
+                    self._fail("G91 motion with polar coordinates is indeterminate when at the origin", block, theta[1])
+                r, a = math.hypot(y, x), math.atan2(y, x) + math.radians(theta[0])
+                x, y = r * math.cos(a), r * math.sin(a)
+        end[0], end[1] = x, y
 
     def _straight(self, block: Block, words: dict, motion: float, machine: bool | None) -> Line:
         if motion == 1.0:
             self._check_feed(block, words, "Cannot do g1 with zero feed rate", "F word missing with inverse time g1 move")
         if not machine:
-            return self._line(block, self._move_end(words), motion == 0.0)
+            return self._line(block, self._move_end(block, words), motion == 0.0)
         given = [(AXIS_INDEX[letter], value) for letter, (value, _) in words.items() if letter in AXIS_INDEX]
         self._note_axes(given)
         return self._line(block, self._ends(given, True), motion == 0.0)
@@ -1087,8 +1138,11 @@ class Interpreter:
             level = max(pos[normal], r if self.retract_to_r else level)
         clear = r if self.retract_to_r else level
         rapid_delta = RAPID_DELTA_INCH if self.inch else RAPID_DELTA_INCH * MM_PER_INCH
+        polar = not self.absolute and ("@" in words or "^" in words)
         for _ in range(repeats):
             aa, bb = aa + step_a, bb + step_b
+            if polar:
+                aa, bb = self._polar_step(block, words, aa, bb)
             moves.append((aa, bb, level, True))
             if level != r:
                 moves.append((aa, bb, r, True))
@@ -1101,8 +1155,9 @@ class Interpreter:
 
     def _cycle_geometry(self, block: Block, words: dict, again: bool, item) -> tuple[float, ...]:
         """(aa, bb, their step per repeat, R, bottom) of a cycle in plane coordinates; keeps the
-        sticky R and normal-axis words.  X Y (G91: increments), R (G91: from the series' start
-        level) and the normal axis (G91: from R), as rs274ngc reads them."""
+        sticky R and normal-axis words.  X Y or polar `@` `^` (G91: increments, `_polar_step`),
+        R (G91: from the series' start level) and the normal axis (G91: from R), as rs274ngc
+        reads them."""
         first, second, normal = PLANE_AXES[self.plane]
         a_letter, b_letter, c_letter = "XYZ"[first], "XYZ"[second], "XYZ"[normal]
         plane = _PLANE_NAMES[self.plane]  # (rs274ngc's messages: `Z value unspecified in xy plane`, `R less than z`)
@@ -1121,6 +1176,10 @@ class Interpreter:
         if self.absolute:
             aa = words[a_letter][0] if a_letter in words else pos[first]
             bb = words[b_letter][0] if b_letter in words else pos[second]
+            if "@" in words or "^" in words:  # (G17 only: `_check_polar`) the hole about XY zero
+                radius = words["@"][0] if "@" in words else math.hypot(bb, aa)
+                theta = math.radians(words["^"][0]) if "^" in words else math.atan2(bb, aa)
+                aa, bb = radius * math.cos(theta), radius * math.sin(theta)
             step_a = step_b = 0.0
             r, bottom = r_word, c_word
         else:
@@ -1132,6 +1191,19 @@ class Interpreter:
         if r < bottom:
             self._fail(f"R less than {c_letter.lower()} in cycle in {plane} plane", block, words.get("R", (0, item))[1])
         return aa, bb, step_a, step_b, r, bottom
+
+    def _polar_step(self, block: Block, words: dict, x: float, y: float) -> tuple[float, float]:
+        """The next hole of a G91 cycle with polar words (CYCLE_MACRO): `@` adds to the radius
+        about XY zero, then `^` to the angle (a zero word adds nothing)."""
+        for letter in "@^":
+            step = words.get(letter, (0.0,))[0]
+            if step:
+                if x == 0.0 and y == 0.0:
+                    self._fail("Incremental motion with polar coordinates is indeterminate when at the origin", block, words[letter][1])
+                radius, theta = math.hypot(y, x), math.atan2(y, x)
+                radius, theta = (radius + step, theta) if letter == "@" else (radius, theta + math.radians(step))
+                x, y = radius * math.cos(theta), radius * math.sin(theta)
+        return x, y
 
     def _fixed_line(self, block: Block, axes: tuple[int, int, int], move: tuple[float, float, float, bool]) -> Line:
         """A cycle's move (plane coordinates) as a `Line` from the current position, marked `fixed`."""
@@ -1218,7 +1290,7 @@ class Interpreter:
         self._check_feed(block, words, "Cannot make arc with zero feed rate", "F word missing with inverse time arc move")
         if normal_letter in words:
             self._fail(f"{normal_letter} word given for arc in {_PLANE_NAMES[plane]} plane", block, words[normal_letter][1])
-        end = self._move_end(words)
+        end = self._move_end(block, words)
         a, b, c = PLANE_AXES[plane]
         start = self.pos
         turns = round(words["P"][0]) if "P" in words else 1

@@ -27,25 +27,27 @@ def write_blocks(blocks: Iterable[Block], out: BinaryIO) -> int:
     return count
 
 
-def spelling(block: Block) -> tuple[str, bool]:
+def spelling(block: Block) -> tuple[str, bool | None]:
     """How the block spells its words: (separator, lower case).
 
     The separator is what stands between its first two words ('' when packed,
     ' ' when it has fewer than two); lower case when it has words and none of
-    their letters is a capital.
+    their letters is a capital; None when no word has a letter to tell (`^60`:
+    LinuxCNC's polar words).
     """
     raw = block.raw
     separator = None
     previous_end = -1
-    capital = False
+    letters = capital = False
     for item in block.items:
         if type(item) is Word:
             if separator is None and previous_end >= 0:
                 separator = raw[previous_end : item.start]
             previous_end = item.end
             first = raw[item.start]
-            capital = capital or (first.isalpha() and not first.islower())
-    return (" " if separator is None else separator), previous_end >= 0 and not capital
+            if first.isalpha():
+                letters, capital = True, capital or not first.islower()
+    return (" " if separator is None else separator), (not capital if letters else None if previous_end >= 0 else False)
 
 
 def edit_words(

@@ -235,3 +235,21 @@ def test_in_g91_the_moves_after_a_canned_cycle_are_compensated(machine):
 
     before, after = residual_after(machine, G91_CYCLE, CYCLE)
     assert before.max_um > 20.0 and after.max_um <= 1.5, f"{after.max_um:.2f} µm at line {after.worst_line}"
+
+
+# LinuxCNC's polar words, in G90 and G91, for lines and an arc: written as X and Y
+POLAR = b"""G21 G17 G90 G94 F500
+G0 X30 Y0 Z0
+G1 @60 ^20
+^50
+G91 @-15
+^30
+G90 G3 @45 ^150 R45
+G1 @20 ^170
+M2
+"""
+
+
+def test_polar_moves_are_compensated_within_tolerance(machine):
+    before, after = before_after(machine, POLAR, 0.001)
+    assert before.max_um > 20.0 and after.max_um <= 1.5, f"{after.max_um:.2f} µm at line {after.worst_line}"

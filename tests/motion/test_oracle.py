@@ -57,7 +57,6 @@ OUT_OF_SCOPE = {
     "iso_gcode/linuxcnc/mmount.ngc": "threading G33.1",
     "iso_gcode/linuxcnc/nurbs_G5_butterfly-xy.ngc": "spline G5.2",
     "iso_gcode/linuxcnc/plasmac_metric_pipe.ngc": "probing G38.2",
-    "iso_gcode/linuxcnc/polar.ngc": "polar coordinates",
     "iso_gcode/linuxcnc/systems.ngc": "spline G5.1",
     "iso_gcode/linuxcnc/threading.ngc": "threading G33",
     "iso_gcode/linuxcnc_fanuc_subs/12-M99-endless-main-program__test.ngc": "M99 in the main program",

@@ -34,7 +34,7 @@ MOVING_LETTERS = "XYZABCUVWIJKR"  # words that make a block move (with the modal
 # Letters whose number styles the writer uses: it writes XYZIJK (and CR, with X's style,
 # for Sinumerik); the styles of other words (F, S, R, ...) are never asked for, so not learnt.
 STYLED_LETTERS = frozenset(WRITTEN_LETTERS)
-DROPPED = ("I", "J", "K", "R", "P", ",R", ",C")  # words of the old geometry a changed block loses
+DROPPED = ("I", "J", "K", "R", "P", ",R", ",C", "@", "^")  # words of the old geometry a changed block loses (`@` `^`: polar)
 _DROPPED = frozenset(DROPPED)
 _BIT = {letter: 1 << n for n, letter in enumerate(WRITTEN_LETTERS)}  # a set of written letters is a bit mask
 _CENTRE_BITS = {plane: _BIT[a] | _BIT[b] for plane, ((a, _), (b, _)) in CENTRE_WORDS.items()}
@@ -78,7 +78,7 @@ class IsoWriter:
         self._facts_block: Block | None = None  # the last block asked about, and its facts
         self._facts_value: _Facts | None = None
         self._signature_facts: dict[str, _Facts] = {}  # the facts of plain blocks, by their `signature`
-        self._spelled: tuple[Block | None, tuple[str, bool]] = (None, (" ", False))  # a block and its `spelling`
+        self._spelled: tuple[Block | None, tuple[str, bool | None]] = (None, (" ", False))  # a block and its `spelling`
         # The end of the last segment written (where the output is, once rounded to the decimal
         # places of X, Y and Z it was written with): rounded only when compared, and most
         # axes a block does not write are exactly where they were.
@@ -272,12 +272,13 @@ class IsoWriter:
         return (self._block_motion(block) if self._has_motion_word(block) else self.program_motion) in (2, 3)
 
     def _spelling(self, block: Block) -> tuple[str, bool]:
-        """How the block spells its words: (separator, lower case)."""
+        """How the block spells its words: (separator, lower case; capitals where no word has a
+        letter to tell, `^60`: stateless, so a second part writes it as one run does)."""
         spelled_block, spelled = self._spelled
         if spelled_block is not block:
             spelled = spelling(block)
             self._spelled = (block, spelled)
-        return spelled
+        return spelled[0], bool(spelled[1])
 
     # -- verbatim blocks ------------------------------------------------------
     def _learn_program_motion(self, block: Block, motion: list[Event]) -> None:
