@@ -1082,17 +1082,24 @@ class Interpreter:
             a = math.radians(theta[0]) if theta is not None else math.atan2(y, x)
             x, y = r * math.cos(a), r * math.sin(a)
         else:
-            if radius is not None:
-                if x == 0.0 and y == 0.0:
-                    self._fail("Incremental motion with polar coordinates is indeterminate when at the origin", block, radius[1])
-                r, a = math.hypot(y, x) + radius[0], math.atan2(y, x)
-                x, y = r * math.cos(a), r * math.sin(a)
-            if theta is not None:
-                if x == 0.0 and y == 0.0:
-                    self._fail("G91 motion with polar coordinates is indeterminate when at the origin", block, theta[1])
-                r, a = math.hypot(y, x), math.atan2(y, x) + math.radians(theta[0])
-                x, y = r * math.cos(a), r * math.sin(a)
+            x, y = self._polar_added(block, x, y, radius, theta, "G91 motion with polar coordinates is indeterminate when at the origin")
         end[0], end[1] = x, y
+
+    def _polar_added(self, block: Block, x: float, y: float, radius, theta, at_origin: str) -> tuple[float, float]:
+        """(x, y) with the word `radius` added to their radius about XY zero, then the word
+        `theta` (degrees) to their angle (None: not added), as rs274ngc adds them; refused at
+        XY zero, where the angle is not defined (`at_origin`: the angle's message)."""
+        if radius is not None:
+            if x == 0.0 and y == 0.0:
+                self._fail("Incremental motion with polar coordinates is indeterminate when at the origin", block, radius[1])
+            r, a = math.hypot(y, x) + radius[0], math.atan2(y, x)
+            x, y = r * math.cos(a), r * math.sin(a)
+        if theta is not None:
+            if x == 0.0 and y == 0.0:
+                self._fail(at_origin, block, theta[1])
+            r, a = math.hypot(y, x), math.atan2(y, x) + math.radians(theta[0])
+            x, y = r * math.cos(a), r * math.sin(a)
+        return x, y
 
     def _straight(self, block: Block, words: dict, motion: float, machine: bool | None) -> Line:
         if motion == 1.0:
@@ -1193,17 +1200,10 @@ class Interpreter:
         return aa, bb, step_a, step_b, r, bottom
 
     def _polar_step(self, block: Block, words: dict, x: float, y: float) -> tuple[float, float]:
-        """The next hole of a G91 cycle with polar words (CYCLE_MACRO): `@` adds to the radius
-        about XY zero, then `^` to the angle (a zero word adds nothing)."""
-        for letter in "@^":
-            step = words.get(letter, (0.0,))[0]
-            if step:
-                if x == 0.0 and y == 0.0:
-                    self._fail("Incremental motion with polar coordinates is indeterminate when at the origin", block, words[letter][1])
-                radius, theta = math.hypot(y, x), math.atan2(y, x)
-                radius, theta = (radius + step, theta) if letter == "@" else (radius, theta + math.radians(step))
-                x, y = radius * math.cos(theta), radius * math.sin(theta)
-        return x, y
+        """The next hole of a G91 cycle with polar words (CYCLE_MACRO): as a G91 move's, but a
+        zero word adds nothing, and one message at XY zero."""
+        radius, theta = ((words[k] if words.get(k, (0.0,))[0] else None) for k in "@^")
+        return self._polar_added(block, x, y, radius, theta, "Incremental motion with polar coordinates is indeterminate when at the origin")
 
     def _fixed_line(self, block: Block, axes: tuple[int, int, int], move: tuple[float, float, float, bool]) -> Line:
         """A cycle's move (plane coordinates) as a `Line` from the current position, marked `fixed`."""
