@@ -1078,9 +1078,7 @@ class Interpreter:
         if self.absolute:
             if radius is not None and theta is None and x == 0.0 and y == 0.0:
                 self._fail("Must specify angle in polar coordinate if at the origin", block, radius[1])
-            r = radius[0] if radius is not None else math.hypot(y, x)
-            a = math.radians(theta[0]) if theta is not None else math.atan2(y, x)
-            x, y = r * math.cos(a), r * math.sin(a)
+            x, y = _about_zero(x, y, radius, theta)
         else:
             x, y = self._polar_added(block, x, y, radius, theta, "G91 motion with polar coordinates is indeterminate when at the origin")
         end[0], end[1] = x, y
@@ -1184,9 +1182,7 @@ class Interpreter:
             aa = words[a_letter][0] if a_letter in words else pos[first]
             bb = words[b_letter][0] if b_letter in words else pos[second]
             if "@" in words or "^" in words:  # (G17 only: `_check_polar`) the hole about XY zero
-                radius = words["@"][0] if "@" in words else math.hypot(bb, aa)
-                theta = math.radians(words["^"][0]) if "^" in words else math.atan2(bb, aa)
-                aa, bb = radius * math.cos(theta), radius * math.sin(theta)
+                aa, bb = _about_zero(aa, bb, words.get("@"), words.get("^"))
             step_a = step_b = 0.0
             r, bottom = r_word, c_word
         else:
@@ -1405,6 +1401,8 @@ _COORD_SYSTEM_CODE = {n: code * 10 for code, n in _COORD_SYSTEM.items()}
 _PLANE_LETTERS = {17: "XY", 18: "ZX", 19: "YZ"}
 # words a plain modal move may carry without the full checks
 _AXIS_LETTERS_F = frozenset("XYZABCUVWFIJKR")
+
+
 # Not the interpreter's state (`Interpreter.state`): where it reports and what it was told,
 # a cache, its flow and parameters (told apart); callbacks compare as None (`snapshot.py`)
 _NOT_STATE = frozenset({"file", "warnings", "untold_lengths", "tools", "subroutine_path", "flow", "params", "_context", "holding"})
@@ -1472,3 +1470,11 @@ def _read_signature(signature: str | None) -> tuple[int, float | None, str, tupl
         return None
     xyz = tuple(_XYZ_INDEX[letter] for letter in letters) if set(letters) <= _XYZ_INDEX.keys() else None
     return len(n) + (number is not None) + len(letters), code, letters, xyz
+
+
+def _about_zero(x: float, y: float, radius: tuple | None, theta: tuple | None) -> tuple[float, float]:
+    """The point at the words `radius` and `theta` (degrees) about XY zero, G90's polar words;
+    one not given (None) is that of (x, y)."""
+    r = radius[0] if radius is not None else math.hypot(y, x)
+    a = math.radians(theta[0]) if theta is not None else math.atan2(y, x)
+    return r * math.cos(a), r * math.sin(a)

@@ -27,13 +27,12 @@ def write_blocks(blocks: Iterable[Block], out: BinaryIO) -> int:
     return count
 
 
-def spelling(block: Block) -> tuple[str, bool | None]:
+def spelling(block: Block) -> tuple[str, bool]:
     """How the block spells its words: (separator, lower case).
 
     The separator is what stands between its first two words ('' when packed,
-    ' ' when it has fewer than two); lower case when it has words and none of
-    their letters is a capital; None when no word has a letter to tell (`^60`:
-    LinuxCNC's polar words).
+    ' ' when it has fewer than two); lower case when a word has a letter and none
+    of their letters is a capital (`^60`, LinuxCNC's polar words, has none: capitals).
     """
     raw = block.raw
     separator = None
@@ -47,7 +46,7 @@ def spelling(block: Block) -> tuple[str, bool | None]:
             first = raw[item.start]
             if first.isalpha():
                 letters, capital = True, capital or not first.islower()
-    return (" " if separator is None else separator), (not capital if letters else None if previous_end >= 0 else False)
+    return (" " if separator is None else separator), letters and not capital
 
 
 def edit_words(

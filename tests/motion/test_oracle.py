@@ -104,15 +104,15 @@ def rs274_error(messages: str) -> tuple[str, str] | None:
     return lines[0], lines[1]
 
 
-def ours(path, off_path: list[bool] | None = None) -> tuple[list[CanonCall], NcppError | None, str]:
-    """ncpp's calls, error and warnings; `off_path` gets, call by call, whether it is a move
-    under cutter compensation."""
+def ours(path, off_path: list[bool] | None = None, offsets=None) -> tuple[list[CanonCall], NcppError | None, str]:
+    """ncpp's calls, error and warnings (from `offsets`, a `WorkOffsets`, if given); `off_path`
+    gets, call by call, whether it is a move under cutter compensation."""
     stream = io.StringIO()
     calls: list[CanonCall] = []
     error = None
     with open(path, "rb") as f:
         try:
-            for event in interpret(parse_stream(f, str(path)), file=str(path), warnings=Warnings(stream=stream)):
+            for event in interpret(parse_stream(f, str(path)), file=str(path), warnings=Warnings(stream=stream), offsets=offsets):
                 call = canon_call(event)
                 if call is not None:
                     calls.append(call)
@@ -121,6 +121,15 @@ def ours(path, off_path: list[bool] | None = None) -> tuple[list[CanonCall], Ncp
         except NcppError as err:
             error = err
     return calls, error, stream.getvalue()
+
+
+def refused_alike(refused: tuple[str, str] | None, error: NcppError | None) -> bool:
+    """Whether rs274 (its `rs274_error`) and ncpp both refused the program, asserting that
+    they agree: both accept, or both refuse with the same message."""
+    assert (refused is None) == (error is None), (refused, error)
+    if refused is not None:
+        assert refused[0] == error.message, (refused, error)  # type: ignore[union-attr]
+    return refused is not None
 
 
 def without_comp(reference: list[CanonCall], mine: list[CanonCall], off_path: list[bool]) -> tuple[list[CanonCall], list[CanonCall]]:

@@ -9,7 +9,6 @@ difference allowed: they need the tool centre's path, which ncpp does not make.
 
 from __future__ import annotations
 
-import io
 import os
 import subprocess
 from dataclasses import replace
@@ -18,15 +17,11 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from ncpp.errors import NcppError, Warnings
-from ncpp.motion import interpret
-from ncpp.motion.canon import canon_call, read_canon
+from ncpp.motion.canon import read_canon
 from ncpp.motion.offsets import WorkOffsets
-from ncpp.motion.segments import COMP
 from ncpp.motion.tools import ToolTable
-from ncpp.program.parser import parse_stream
 from tests.conftest import RS274
-from tests.motion.test_oracle import rs274_error, same_calls, tool_table, without_comp
+from tests.motion.test_oracle import ours, refused_alike, rs274_error, same_calls, tool_table, without_comp
 
 # Each example runs rs274 (about 50 ms); NCPP_HYPOTHESIS_EXAMPLES=600 for a deeper search.
 EXAMPLES = max(int(os.environ.get("NCPP_HYPOTHESIS_EXAMPLES", "300")) // 8, 20)
@@ -57,20 +52,11 @@ def test_cutter_compensation_agrees_with_rs274(tmp_path, text):
         return
     # rs274's stand-alone machine is in inches: its tool table's D too
     offsets = replace(WorkOffsets.at((0.0, 0.0, 0.0)), tools=ToolTable.from_file(tool_table(), unit_mm=25.4))
-    warned, mine, off_path, error = io.StringIO(), [], [], None
-    try:
-        for event in interpret(parse_stream(io.BytesIO(text.encode()), str(path)), file=str(path), warnings=Warnings(stream=warned), offsets=offsets):
-            call = canon_call(event)
-            if call is not None:
-                mine.append(call)
-                off_path.append(event.fixed == COMP)  # type: ignore[union-attr]
-    except NcppError as err:
-        error = err
-    if "outside the motion interpreter's scope" in warned.getvalue():
+    off_path: list[bool] = []
+    mine, error, warned = ours(path, off_path, offsets)
+    if "outside the motion interpreter's scope" in warned:
         return  # (an arc in G18 with R, ...: compared by the corpus oracle, not here)
-    assert (refused is None) == (error is None), (refused, error)
-    if refused is not None:
-        assert refused[0] == error.message, (refused, error)  # type: ignore[union-attr]
+    if refused_alike(refused, error):
         return
     theirs, kept = without_comp(read_canon(proc.stdout), mine, off_path)
     assert len(theirs) == len(kept) and same_calls(theirs, kept), (theirs, kept)

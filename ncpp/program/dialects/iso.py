@@ -78,7 +78,7 @@ class IsoWriter:
         self._facts_block: Block | None = None  # the last block asked about, and its facts
         self._facts_value: _Facts | None = None
         self._signature_facts: dict[str, _Facts] = {}  # the facts of plain blocks, by their `signature`
-        self._spelled: tuple[Block | None, tuple[str, bool | None]] = (None, (" ", False))  # a block and its `spelling`
+        self._spelled: tuple[Block | None, tuple[str, bool]] = (None, (" ", False))  # a block and its `spelling`
         # The end of the last segment written (where the output is, once rounded to the decimal
         # places of X, Y and Z it was written with): rounded only when compared, and most
         # axes a block does not write are exactly where they were.
@@ -272,13 +272,12 @@ class IsoWriter:
         return (self._block_motion(block) if self._has_motion_word(block) else self.program_motion) in (2, 3)
 
     def _spelling(self, block: Block) -> tuple[str, bool]:
-        """How the block spells its words: (separator, lower case; capitals where no word has a
-        letter to tell, `^60`: stateless, so a second part writes it as one run does)."""
+        """How the block spells its words: (separator, lower case)."""
         spelled_block, spelled = self._spelled
         if spelled_block is not block:
             spelled = spelling(block)
             self._spelled = (block, spelled)
-        return spelled[0], bool(spelled[1])
+        return spelled
 
     # -- verbatim blocks ------------------------------------------------------
     def _learn_program_motion(self, block: Block, motion: list[Event]) -> None:
