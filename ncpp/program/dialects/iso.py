@@ -46,6 +46,7 @@ _WRITTEN = tuple(
 )
 _AXIS_BITS = _BIT["X"] | _BIT["Y"] | _BIT["Z"]
 _ANY_CENTRE = _BIT["I"] | _BIT["J"] | _BIT["K"]
+_MOTION_SHIFT = len(WRITTEN_LETTERS)  # a new block's template key: its written bits, then its motion code + 1 above them
 _UNKNOWN = object()  # a plan not compiled yet
 _SIGNATURE_WORD = re.compile(r"(.)([-+.\d]*)")  # a letter, and a G word's number
 _MAX_LAYOUTS = 10000  # layouts remembered (comments can make every layout new)
@@ -491,34 +492,52 @@ class IsoWriter:
     def _new_blocks(self, block: Block, segments: list[Event], eol: str) -> list[str]:
         """The lines of the segments a block makes after its first (arc pieces, reversal
         steps, subdivisions): new blocks, spelled as the block is.  Once per line written:
-        what is the same for all of them is read once."""
+        what is the same for all of them is read once, and `_written_bits`, `_motion_code`,
+        `_numbers` (for an absolute line) and `_remember_end` are inlined."""
         facts = self._facts(block)
         spelled = self._spelling(block)
-        written_bits, numbers, resolved = self._written_bits, self._numbers, self._resolved
-        lines = []
+        known, absent, axis_bits = self.known_axes, facts.absent_axes, facts.axis_bits
+        output_motion, last, last_places = self.output_motion, self._last_end, self._last_places
+        lines: list[str] = []
+        context = None
         for segment in segments:
-            context = segment.context
-            inch = context.inch
-            units = resolved.get(inch) or self._units(inch)
-            # `_motion_code` and, for an absolute line, `_numbers`, inlined: once per line written
-            kind = type(segment)
-            code = (3 if segment.turn > 0 else 2) if kind is Arc else 0 if segment.rapid else 1
-            motion = code if code != self.output_motion else None
-            bits = written_bits(facts, segment, units)
-            values = segment.end if kind is not Arc and context.absolute else numbers(segment)
-            if units.plain:
-                key = (bits, motion, spelled)
-                template = units.new_templates.get(key)
+            if segment.context is not context:  # (the segments of a block share their context, mostly)
+                context = segment.context
+                inch, absolute = context.inch, context.absolute
+                units = self._resolved.get(inch) or self._units(inch)
+                places = units.places
+                templates = units.new_lines.setdefault((spelled, eol), {}) if units.plain else None
+            end = segment.end
+            code = (3 if segment.turn > 0 else 2) if type(segment) is Arc else 0 if segment.rapid else 1
+            bits = axis_bits  # the axes the block has and whatever moved in the output, then an arc's centre
+            if absent and absolute:
+                same_places = places == last_places
+                for n, axis, bit in absent:
+                    if axis in known and (last is None or not (same_places and end[n] == last[n]) and written_apart(end[n], places[n], last[n], last_places[n])):
+                        bits |= bit
+            elif absent:
+                start = segment.start
+                for n, axis, bit in absent:
+                    if round(end[n] - start[n], places[n]) != 0.0:
+                        bits |= bit
+            if code > 1:
+                bits |= _CENTRE_BITS[context.plane]
+            motion = code if code != output_motion else None
+            values = end if code < 2 and absolute else self._numbers(segment)
+            if templates is not None:
+                key = bits if motion is None else bits | (code + 1) << _MOTION_SHIFT
+                template = templates.get(key)
                 if template is None:
-                    template = units.new_templates[key] = _new_block_text(units.fields(bits), motion, (_literal(spelled[0]), spelled[1]))
-                lines.append(template.format(*values) + eol)
+                    template = templates[key] = _new_block_text(units.fields(bits), motion, (_literal(spelled[0]), spelled[1])) + eol
+                lines.append(template.format(*values))
             else:
                 styles = units.styles
                 texts = {letter: format_number(values[n], styles[letter]) for letter, n in _WRITTEN[bits]}
                 lines.append(_new_block_text(texts, motion, spelled) + eol)
             if motion is not None:
-                self.output_motion = code
-            self._last_end, self._last_places = segment.end, units.places  # `_remember_end`
+                output_motion = code
+            last, last_places = end, places
+        self.output_motion, self._last_end, self._last_places = output_motion, last, last_places
         return lines
 
 
@@ -644,7 +663,7 @@ class _Written:
     """How the output writes numbers in one system of units: the style of each letter
     it writes, and the decimal places of X, Y and Z."""
 
-    __slots__ = ("styles", "places", "plain", "edit_plans", "edits", "new_templates")
+    __slots__ = ("styles", "places", "plain", "edit_plans", "edits", "new_templates", "new_lines")
 
     def __init__(self, styles: dict[str, NumberStyle]):
         self.styles = styles
@@ -652,9 +671,11 @@ class _Written:
         self.plain = all(style.plain for style in styles.values())  # every number one `format` spec: plans apply
         # Compiled lines: (signature, written bits, motion, spelling) -> `EditPlan` (None: none applies),
         # (layout, signature, ...) -> that plan, or the format template it makes of such blocks,
-        # (written bits, motion, spelling) -> the format template of a new block.
+        # (spelling, line end) -> {written bits | (motion + 1) << _MOTION_SHIFT: the format
+        # template of a new block's line}, and a dialect's own keys -> a new block's template.
         self.edit_plans: dict[tuple, EditPlan | None] = {}
         self.edits: dict[tuple, EditPlan | str] = {}
+        self.new_lines: dict[tuple, dict[int, str]] = {}
         self.new_templates: dict[tuple, str] = {}
 
     def fields(self, bits: int) -> dict[str, str]:
