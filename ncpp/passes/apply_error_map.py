@@ -26,7 +26,7 @@ from ncpp.errors import NcppError
 from ncpp.motion.segments import Arc, Event, Line
 from ncpp.passes.context import CutLine, PassContext, deviation
 from ncpp.passes.kernels import run_ahead
-from ncpp.passes.geometry import compensate, frames, from_plane, in_plane, line_chunks, plane_axes, points, rows_of
+from ncpp.passes.geometry import all3, any3, compensate, frames, from_plane, in_plane, line_chunks, plane_axes, points, rows_of
 from ncpp.passes.travel import Travel, grid, hold, quantize, steps
 
 # Compensations per line at most: each changes a direction only where a
@@ -209,7 +209,7 @@ def _written(chunk: list[Event], segs: list, rows: _Rows, solved: _Solved, last)
     previous[1:] = solved.end[:-1]
     has_previous = np.ones(len(segs), dtype=bool)
     # where units or offsets change, the previous end is seen from the new frame
-    reframed = np.flatnonzero((offsets[1:] != offsets[:-1]).any(axis=1) | (scales[1:] != scales[:-1])) + 1
+    reframed = np.flatnonzero(any3(offsets[1:] != offsets[:-1]) | (scales[1:] != scales[:-1])) + 1
     starts_from: dict[int, tuple | None] = {}  # rows whose start is not the previous row's end
     for i, before in [(0, last), *((i, None) for i in reframed.tolist())]:
         p = _end_in_frame_of(before if i == 0 else _ended(segs[i - 1], solved.end[i - 1]), segs[i])
@@ -296,7 +296,7 @@ class _Commands:
 
     def __call__(self, which: str, rows: NDArray, d: NDArray) -> NDArray:
         """(r,3) commands for the `which` ("start"/"end") points of `rows` travelled in `d` (r,3)."""
-        stale = (self.directions[which][rows] != d).any(axis=1)
+        stale = any3(self.directions[which][rows] != d)
         todo, d_todo = rows[stale], d[stale]
         if todo.size:
             segs = self.rows
@@ -328,10 +328,10 @@ def _directional(rows: _Rows, ctx: PassContext, travel: Travel) -> _Solved:
     # start from the nominal motion, standing axes holding their direction
     d = hold(steps(end_m - start_m, threshold), travel.held)
     for round_ in range(ROUNDS):
-        redo = np.flatnonzero(free & (d != used).any(axis=1))
+        redo = np.flatnonzero(free & any3(d != used))
         if redo.size:
             compensated[redo] = commands("end", redo, d[redo])
-        shift = np.flatnonzero(arc & (d != used).any(axis=1))
+        shift = np.flatnonzero(arc & any3(d != used))
         if shift.size:
             _shift_arcs(shift, rows, d, assumed, step, ctx, out_start, out_end)
         used[redo], used[shift] = d[redo], d[shift]
@@ -350,11 +350,11 @@ def _directional(rows: _Rows, ctx: PassContext, travel: Travel) -> _Solved:
             break  # unsettled: keep the directions the ends were computed for
         d = d_new
 
-    moved = arc & ((out_start != start_p) | (out_end != end_p)).any(axis=1)
+    moved = arc & any3((out_start != start_p) | (out_end != end_p))
     # where an axis reverses, the line must start where its own direction puts the tool
     before = np.vstack([travel.held[None, :], d[:-1]])
     flips = (d != before) & (before != 0)
-    turn = free & flips.any(axis=1)
+    turn = free & any3(flips)
     turn_start = np.full(start_p.shape, np.nan)
     rows = np.flatnonzero(turn)
     if rows.size:
@@ -371,7 +371,7 @@ def _carry(rows: _Rows, out_end: NDArray, before: NDArray | None) -> None:
     off their programmed start by that end's correction.  `before`: the previous chunk's last
     end, in the first row's frame."""
     carried, offsets, scales = rows.carried, rows.offsets, rows.scales
-    reframed = np.concatenate([[True], (offsets[1:] != offsets[:-1]).any(axis=1) | (scales[1:] != scales[:-1])])
+    reframed = np.concatenate([[True], any3(offsets[1:] != offsets[:-1]) | (scales[1:] != scales[:-1])])
     # a run starts after a row not carried, or where the frame changes (G20/G21 in it)
     starts = np.flatnonzero(carried & (reframed | ~np.concatenate([[False], carried[:-1]]))).tolist()
     for n, k in enumerate(starts):
@@ -402,9 +402,9 @@ def _settle(free, arc, d, held, offsets, scales, limit, out_start, out_end, befo
     pred_end, pred_dir = ends[:-1], dirs[:-1]  # row k's predecessor's end and direction
     within = limit[:, None]
     line_gap = out_end - pred_end
-    lines = free & ok & ((line_gap * pred_dir < 0) & (dirs[1:] == pred_dir) & (np.abs(line_gap) <= within)).any(axis=1)
+    lines = free & ok & any3((line_gap * pred_dir < 0) & (dirs[1:] == pred_dir) & (np.abs(line_gap) <= within))
     arc_gap = pred_end - out_start
-    pieces = arc & ok & ((np.abs(arc_gap) <= within) & (arc_gap != 0)).any(axis=1)
+    pieces = arc & ok & any3((np.abs(arc_gap) <= within) & (arc_gap != 0))
     todo = np.flatnonzero(lines | pieces).tolist()
     if not todo:
         return
@@ -462,7 +462,7 @@ def _with_previous(out_end, d, held, offsets, scales, before) -> tuple[NDArray, 
     ends = np.vstack([before if before is not None else np.full(3, np.nan), out_end])
     dirs = np.vstack([held, d])
     ok = np.ones(len(out_end), dtype=bool)
-    ok[1:] = (offsets[1:] == offsets[:-1]).all(axis=1) & (scales[1:] == scales[:-1])
+    ok[1:] = all3(offsets[1:] == offsets[:-1]) & (scales[1:] == scales[:-1])
     ok[0] = before is not None
     return ends, dirs, ok
 
@@ -490,7 +490,7 @@ def _own_motion(moved, d, free, start_p, end_p, scales, threshold, commands: _Co
     # only where the line itself moves that axis by less than any error could turn round
     short = np.abs(end_p - start_p) * scales[:, None] < NEAR_STILL
     flips = (d != before) & (before != 0) & free[:, None] & short
-    rows = np.flatnonzero(flips.any(axis=1))
+    rows = np.flatnonzero(any3(flips))
     if rows.size == 0:
         return d
     own = steps((commands("end", rows, d[rows]) - commands("start", rows, d[rows])) * scales[rows, None], threshold[rows])
@@ -573,4 +573,4 @@ def _ended(segment: Line | Arc, end: NDArray) -> Line:
 
 def _apart(a: NDArray, b: NDArray, tolerance: float = 1e-7) -> NDArray:
     """(n,) whether the points differ by more than `tolerance` on some axis."""
-    return (np.abs(a - b) > tolerance).any(axis=1)
+    return any3(np.abs(a - b) > tolerance)

@@ -134,6 +134,17 @@ def rows_of(tools: NDArray | None, rows) -> NDArray | None:
     return None if tools is None else tools[rows]
 
 
+def any3(flags: NDArray) -> NDArray:
+    """Whether any of the three along the last axis is true: `flags.any(axis=-1)`, which
+    numpy walks three at a time (50 µs on 2048 rows, these three operations 7.5)."""
+    return flags[..., 0] | flags[..., 1] | flags[..., 2]
+
+
+def all3(flags: NDArray) -> NDArray:
+    """Whether all three along the last axis are true (`any3`'s counterpart)."""
+    return flags[..., 0] & flags[..., 1] & flags[..., 2]
+
+
 def points(coordinates: Sequence[tuple[float, float, float]]) -> NDArray:
     """(n,3) array of n (x, y, z) tuples (twice as fast as np.array on the list)."""
     return np.fromiter(chain.from_iterable(coordinates), dtype=float, count=3 * len(coordinates)).reshape(-1, 3)

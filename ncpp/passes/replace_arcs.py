@@ -25,7 +25,7 @@ from ncpp.errors import Location, NcppError
 from ncpp.motion.segments import Arc, Event, Line
 from ncpp.passes.context import PassContext
 from ncpp.passes.kernels import run_ahead
-from ncpp.passes.geometry import before_line, compensate, frames, from_plane, in_plane, plane_axes, points, rows_of, spliced
+from ncpp.passes.geometry import any3, before_line, compensate, frames, from_plane, in_plane, plane_axes, points, rows_of, spliced
 from ncpp.passes.travel import grid, quantize
 
 # Points per piece where the fit is checked (ends included).  Fewer on short
@@ -330,7 +330,7 @@ def _one_way(q: NDArray, centre: NDArray, axes: NDArray, direction: NDArray, sig
     from_end = np.minimum(at, span[:, None] - at)  # angle between the extreme and the nearer end
     # the axis goes back by r·(1 - cos) from the extreme to that end
     back = radius[:, None] * from_end**2 / 2 > height[:, None]
-    inside = ((at > margin[:, None]) & (at < (span - margin)[:, None]) & back).any(axis=1)
+    inside = any3((at > margin[:, None]) & (at < (span - margin)[:, None]) & back)
     mid = a0 + sign * span / 2
     agrees = (np.sign(sign * -np.sin(mid)) == want_u) & (np.sign(sign * np.cos(mid)) == want_v)  # the tangent's signs
     return ~inside & agrees & (span < np.pi) & (np.abs(blend) < quarter / 2)

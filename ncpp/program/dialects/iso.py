@@ -425,24 +425,25 @@ class IsoWriter:
 
     def _edit_block(self, block: Block, segment: Line | Arc) -> str:
         facts = self._facts_value if block is self._facts_block else self._facts(block)  # `_facts`, inlined
-        code = self._motion_code(segment)
+        code = (3 if segment.turn > 0 else 2) if type(segment) is Arc else 0 if segment.rapid else 1  # `_motion_code`
+        output_motion = self.output_motion
         # the block's motion word is set when it says another motion, or when the output's mode is another
-        motion = code if facts.first_motion != code and (code != self.output_motion or facts.motion_word) else None
-        # a G53 line's numbers are machine coordinates: no plan compiled for program coordinates
-        raw = None if facts.machine else self._planned_edit(block, facts, segment, motion)
-        if raw is None:
-            raw = self._general_edit(block, facts, segment, motion)
-        if facts.motion_word or code != self.output_motion:
-            self.output_motion = code
-        if facts.motion_word:
-            self.program_motion = facts.motion
-        self._remember_end(segment)
-        return raw
-
-    def _planned_edit(self, block: Block, facts: "_Facts", segment: Line | Arc, motion: int | None) -> str | None:
-        """The edit by a plan compiled for the block's signature (None: a block no plan covers)."""
+        motion = code if facts.first_motion != code and (code != output_motion or facts.motion_word) else None
         inch = segment.context.inch
         units = self._resolved.get(inch) or self._units(inch)
+        # a G53 line's numbers are machine coordinates: no plan compiled for program coordinates
+        raw = None if facts.machine else self._planned_edit(block, facts, segment, motion, units)
+        if raw is None:
+            raw = self._general_edit(block, facts, segment, motion)
+        if facts.motion_word:
+            self.output_motion, self.program_motion = code, facts.motion
+        elif code != output_motion:
+            self.output_motion = code
+        self._last_end, self._last_places = segment.end, units.places  # `_remember_end`
+        return raw
+
+    def _planned_edit(self, block: Block, facts: "_Facts", segment: Line | Arc, motion: int | None, units: "_Written") -> str | None:
+        """The edit by a plan compiled for the block's signature (None: a block no plan covers)."""
         signature = block.signature
         if signature is None or not units.plain or "P" in facts.letters:  # P: a turn count or not, see `_general_edit`
             return None
@@ -452,7 +453,8 @@ class IsoWriter:
         raw = block.raw
         # the block's layout, and a plan: blocks of one layout without comments whose numbers the
         # plan writes or drops all (but G words', in the signature) are its template with their numbers
-        key = (self._layout_of(block), signature, bits, motion, spelled)
+        known, layout = self._layout
+        key = (layout if known is block else self._layout_of(block), signature, bits, motion, spelled)
         edit = units.edits.get(key)
         if edit is None:
             plan = self._edit_plan(facts, signature, bits, motion, spelled, units)
@@ -462,9 +464,11 @@ class IsoWriter:
                 units.edits.clear()
             comments = len(block.items) != facts.words
             edit = units.edits[key] = plan if plan.keeps_numbers or comments else plan.template_for(raw, block.items)  # type: ignore[arg-type]
+        # (`_numbers`, inlined for an absolute line)
+        numbers = segment.end if type(segment) is Line and segment.context.absolute else self._numbers(segment)
         if type(edit) is str:
-            return edit.format(*self._numbers(segment))
-        return edit.apply(raw, _words(block, facts), self._numbers(segment))
+            return edit.format(*numbers)
+        return edit.apply(raw, _words(block, facts), numbers)
 
     @staticmethod
     def _edit_plan(facts: "_Facts", signature: str, bits: int, motion: int | None, spelled: tuple[str, bool] | None, units: "_Written") -> EditPlan | None:
