@@ -134,6 +134,28 @@ def rows_of(tools: NDArray | None, rows) -> NDArray | None:
     return None if tools is None else tools[rows]
 
 
+def norm3(vectors: NDArray) -> NDArray:
+    """Lengths of (..., 3) vectors: `np.linalg.norm(vectors, axis=-1)` (bit for bit: the same
+    sum in the same order), without its reduction over a short last axis (5x slower)."""
+    squares = vectors * vectors
+    return np.sqrt((squares[..., 0] + squares[..., 1]) + squares[..., 2])
+
+
+def row_max(values: NDArray) -> NDArray:
+    """`values.max(axis=-1)` for a short last axis, one column at a time (numpy's reduction
+    walks a short last axis a few at a time: 130 µs on (2500, 9), this 25)."""
+    out = values[..., 0].copy()
+    for k in range(1, values.shape[-1]):
+        np.maximum(out, values[..., k], out=out)
+    return out
+
+
+def tuples(rows: NDArray) -> list[tuple[float, float, float]]:
+    """The (n,3) rows as n (x, y, z) tuples: by columns, a third faster than a tuple of each
+    row's list (no list made per row)."""
+    return list(zip(*rows.T.tolist()))
+
+
 def any3(flags: NDArray) -> NDArray:
     """Whether any of the three along the last axis is true: `flags.any(axis=-1)`, which
     numpy walks three at a time (50 µs on 2048 rows, these three operations 7.5)."""
@@ -217,9 +239,11 @@ def _check(wanted: NDArray, command: NDArray, lines: NDArray, ctx: PassContext) 
     flat = command.reshape(-1, 3)
     if not len(flat):
         return
-    # the common case in four reductions: every command inside the travel and every correction,
-    # however it points, within the limit (NaN fails each test: the full checks below find it)
-    if (flat.min(axis=0) >= lo).all() and (flat.max(axis=0) <= hi).all() and np.abs(command - wanted).max() * 3**0.5 <= ctx.max_correction:
+    # the common case in seven reductions: every command inside the travel (axis by axis: numpy's
+    # min(axis=0) over (n,3) walks three at a time, 18x slower) and every correction, however it
+    # points, within the limit (NaN fails each test: the full checks below find it)
+    inside = all(flat[:, k].min() >= lo[k] and flat[:, k].max() <= hi[k] for k in range(3))
+    if inside and np.abs(command - wanted).max() * 3**0.5 <= ctx.max_correction:
         return
     # NaN compares false with every limit: a point or a model that is not a number would pass
     broken = np.flatnonzero(~np.isfinite(command).all(axis=-1).all(axis=-1))

@@ -25,7 +25,7 @@ from ncpp.errors import Location, NcppError
 from ncpp.motion.segments import Arc, Event, Line
 from ncpp.passes.context import PassContext
 from ncpp.passes.kernels import run_ahead
-from ncpp.passes.geometry import any3, before_line, compensate, frames, from_plane, in_plane, plane_axes, points, rows_of, spliced
+from ncpp.passes.geometry import any3, before_line, compensate, frames, from_plane, in_plane, norm3, plane_axes, points, row_max, rows_of, spliced, tuples
 from ncpp.passes.travel import grid, quantize
 
 # Points per piece where the fit is checked (ends included).  Fewer on short
@@ -283,7 +283,7 @@ def _round(pending: _Pieces, length: NDArray, t: NDArray, geometry, offsets, sca
     # a sliver (a quadrant cut next to an arc's end) is a line: on the output grid its
     # chord fixes no centre, and equal ends would be read as a full circle; so is a
     # piece that reverses an axis inside but bulges less than a quarter of the tolerance
-    chord = np.linalg.norm(q[:, -1] - q[:, 0], axis=1) * scale
+    chord = norm3(q[:, -1] - q[:, 0]) * scale
     flat = chord**2 / (8 * np.maximum(geometry.radius[pending.arc] * scale, 1e-12)) <= ctx.tolerance / 4
     straight = (length < SLIVER) | (~one_way & flat)
     ok &= one_way & ~straight
@@ -361,7 +361,7 @@ def _fit(q: NDArray, axes: NDArray, t: NDArray, tolerance: NDArray) -> tuple[NDA
     radial = _radial(u, v, cu, cv)
     # Where least squares leaves much of the tolerance unused, its centre stands;
     # elsewhere move it to the smallest largest deviation (which is what is judged).
-    tight = np.flatnonzero(np.abs(radial).max(axis=1) > tolerance / 2)
+    tight = np.flatnonzero(row_max(np.abs(radial)) > tolerance / 2)
     if tight.size:
         uv = np.stack([u[tight], v[tight]], axis=-1)
         q0, c = uv[:, 0], np.column_stack([cu[tight], cv[tight]])
@@ -370,7 +370,7 @@ def _fit(q: NDArray, axes: NDArray, t: NDArray, tolerance: NDArray) -> tuple[NDA
         cu[tight], cv[tight] = mu[tight] + s[tight] * nu[tight], mv[tight] + s[tight] * nv[tight]
         radial[tight] = _radial(u[tight], v[tight], cu[tight], cv[tight])
     ramp = w[:, :1] + t[None, :] * (w[:, -1:] - w[:, :1])
-    deviation = np.hypot(radial, w - ramp).max(axis=1)
+    deviation = row_max(np.hypot(radial, w - ramp))
     return from_plane(cu, cv, w[:, 0], axes), deviation
 
 
@@ -400,7 +400,7 @@ def _minimax_step(uv: NDArray, q0: NDArray, c: NDArray, normal: NDArray) -> NDAr
             axis=1,
         )
     candidates = np.where(np.isfinite(candidates), candidates, 0.0)
-    worst = np.abs(r[:, None, :] + g[:, None, :] * candidates[:, :, None]).max(-1)
+    worst = row_max(np.abs(r[:, None, :] + g[:, None, :] * candidates[:, :, None]))
     return candidates[np.arange(len(r)), worst.argmin(axis=1)]
 
 
@@ -419,7 +419,7 @@ def _assemble(arcs: list[Arc], fitted: _Fitted) -> list[list[Event]]:
     progress = (np.concatenate([f[1] for f in found]) - fitted.a0[of]) * fitted.sign[of]
     order = np.lexsort((progress, of)).tolist()
     of_list = of.tolist()
-    ends = [list(map(tuple, np.concatenate([f[k] for f in fitted.arcs]).tolist())) if fitted.arcs else [] for k in (2, 3, 4)]
+    ends = [tuples(np.concatenate([f[k] for f in fitted.arcs])) if fitted.arcs else [] for k in (2, 3, 4)]
     runs = [q for _, _, pts in fitted.lines for q in pts.tolist()]  # the points of each run of lines
     fitted_count = len(ends[0])
     out: list[list[Event]] = [[] for _ in arcs]

@@ -18,7 +18,7 @@ from numpy.typing import NDArray
 
 from ncpp.motion.segments import Event, Line
 from ncpp.passes.context import PassContext, deviation
-from ncpp.passes.geometry import chunked, frames, points, rows_of, spliced
+from ncpp.passes.geometry import chunked, frames, norm3, points, row_max, rows_of, spliced
 from ncpp.passes.kernels import run_ahead
 
 # Interior samples where linearity is checked.
@@ -62,7 +62,7 @@ def _with_rows(chunk: list[Event], ctx: PassContext) -> tuple[list[Event], list[
     starts = points([ln.start for ln in lines])
     ends = points([ln.end for ln in lines])
     offsets, scales, tools = frames(lines)
-    long = np.flatnonzero(np.linalg.norm(ends - starts, axis=1) * scales >= ctx.min_line_check)
+    long = np.flatnonzero(norm3(ends - starts) * scales >= ctx.min_line_check)
     if long.size == 0:
         return chunk, [], [], None
     keep = long.tolist()
@@ -91,7 +91,7 @@ def _piece_counts(rows: _LineRows, ctx: PassContext) -> NDArray:
     tool = None if tools is None else np.broadcast_to(tools[:, None, :], machine.shape).reshape(-1, 3)
     error = deviation(ctx.model, machine.reshape(-1, 3), direction, tool).reshape(machine.shape)
     straight = error[:, :1] + t * (error[:, -1:] - error[:, :1])
-    bow = np.linalg.norm(error - straight, axis=-1).max(axis=1)
+    bow = row_max(norm3(error - straight))
     # The deviation of piecewise-linear interpolation shrinks with the square of the piece count.
     # (capped before the cast: a tolerance of 1e-300 makes the ratio inf, which casts to a negative int)
     return np.minimum(np.ceil(np.sqrt(SAFETY * bow / ctx.tolerance)), MAX_PIECES).astype(int).clip(1, None)
