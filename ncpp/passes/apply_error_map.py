@@ -228,7 +228,6 @@ def _written(chunk: list[Event], segs: list, rows: _Rows, solved: _Solved, last)
     ends = tuples(solved.end)
     targets = _by_row(target, turning & solved.free)
     moved_starts = _by_row(solved.start, solved.moved & ~solved.free)
-    centres = _moved_centres(segs, rows, solved, moved_starts)
     between = _between(chunk) if len(chunk) > len(segs) else {}
     out: list[Event] = []
     start = None  # where the output is: the previous segment's compensated end
@@ -244,7 +243,7 @@ def _written(chunk: list[Event], segs: list, rows: _Rows, solved: _Solved, last)
             out.append(Line(begin, end, seg.rapid, seg.feed, seg.block, seg.context, seg.extra, True))
         else:
             if row & _MOVED:
-                seg = _moved_arc(seg, moved_starts[i], end, centres.get(i))
+                seg = _moved_arc(seg, moved_starts[i], end)
             if row & _CONNECTS:
                 out.append(Line(start, seg.start, False, seg.feed, seg.block, seg.context, seg.extra, True))
             out.append(seg)
@@ -546,21 +545,14 @@ def _snap_limit(step: NDArray, scales: NDArray) -> NDArray:
     return np.maximum(1.01 * step, STILL_MM / scales)
 
 
-def _moved_centres(segs: list, rows: _Rows, solved: _Solved, moved: dict[int, tuple]) -> dict[int, tuple]:
-    """{row: new centre} of the moved arc pieces (`moved`: their rows' new starts): each
-    centre moves with the mean shift of its ends (equal for planar arcs: radii still agree)."""
-    at = [i for i in moved if type(segs[i]) is Arc]
-    if not at:
-        return {}
-    shift = (((solved.start[at] - rows.start[at]) + solved.end[at]) - rows.end[at]) / 2
-    return dict(zip(at, tuples(points([segs[i].center for i in at]) + shift)))
-
-
-def _moved_arc(arc: Arc | Line, start: tuple, end: tuple, centre: tuple | None) -> Arc | Line:
-    """The piece with new ends (an arc with its `_moved_centres` centre)."""
+def _moved_arc(arc: Arc | Line, start: tuple, end: tuple) -> Arc | Line:
+    """The piece with new ends; an arc's centre moves with the mean shift of the
+    ends (equal for planar arcs: radii still agree)."""
     if type(arc) is Line:
         return Line(start, end, arc.rapid, arc.feed, arc.block, arc.context, arc.extra, True)
-    return Arc(start, end, centre, arc.turn, arc.feed, arc.block, arc.context, arc.extra, True)  # type: ignore[arg-type]
+    (s0, s1, s2), (e0, e1, e2), (c0, c1, c2) = arc.start, arc.end, arc.center
+    centre = (c0 + (start[0] - s0 + end[0] - e0) / 2, c1 + (start[1] - s1 + end[1] - e1) / 2, c2 + (start[2] - s2 + end[2] - e2) / 2)
+    return Arc(start, end, centre, arc.turn, arc.feed, arc.block, arc.context, arc.extra, True)
 
 
 def _end_in_frame_of(last: Line | Arc | None, event: Line | Arc) -> tuple | None:
