@@ -373,25 +373,8 @@ class IsoWriter:
         return 0 if segment.rapid else 1
 
     def _written_bits(self, facts: "_Facts", segment: Line | Arc, units: "_Written") -> int:
-        """The letters the segment writes (a mask of `_BIT`): the axes the block has and
-        whatever moved in the output, then an arc's centre."""
-        bits, absent, end = facts.axis_bits, facts.absent_axes, segment.end
-        if absent and segment.context.absolute:
-            known, last = self.known_axes, self._last_end
-            places, last_places = units.places, self._last_places
-            same_places = places == last_places
-            for n, axis, bit in absent:
-                # (`written_apart`'s first test first: most such axes are where the output left them)
-                if axis in known and (last is None or not (same_places and end[n] == last[n]) and written_apart(end[n], places[n], last[n], last_places[n])):
-                    bits |= bit
-        elif absent:
-            start = segment.start
-            for n, axis, bit in absent:
-                if round(end[n] - start[n], units.places[n]) != 0.0:
-                    bits |= bit
-        if type(segment) is Arc:
-            bits |= _CENTRE_BITS[segment.context.plane]
-        return bits
+        """`_bits_written` where the output is now."""
+        return _bits_written(facts, segment, units.places, self.known_axes, self._last_end, self._last_places)
 
     @staticmethod
     def _numbers(segment: Line | Arc) -> tuple[float, ...]:
@@ -496,11 +479,12 @@ class IsoWriter:
     def _new_blocks(self, block: Block, segments: list[Event], eol: str) -> list[str]:
         """The lines of the segments a block makes after its first (arc pieces, reversal
         steps, subdivisions): new blocks, spelled as the block is.  Once per line written:
-        what is the same for all of them is read once, and `_written_bits`, `_motion_code`,
-        `_numbers` (for an absolute line) and `_remember_end` are inlined."""
+        what is the same for all of them is read once, the output's state is kept in locals
+        (`_written_bits` with it), and `_motion_code`, `_numbers` (for an absolute line) and
+        `_remember_end` are inlined."""
         facts = self._facts(block)
         spelled = self._spelling(block)
-        known, absent, axis_bits = self.known_axes, facts.absent_axes, facts.axis_bits
+        known = self.known_axes
         output_motion, last, last_places = self.output_motion, self._last_end, self._last_places
         lines: list[str] = []
         context = None
@@ -511,23 +495,10 @@ class IsoWriter:
                 units = self._resolved.get(inch) or self._units(inch)
                 places = units.places
                 templates = units.new_lines.setdefault((spelled, eol), {}) if units.plain else None
-            end = segment.end
             code = (3 if segment.turn > 0 else 2) if type(segment) is Arc else 0 if segment.rapid else 1
-            bits = axis_bits  # the axes the block has and whatever moved in the output, then an arc's centre
-            if absent and absolute:
-                same_places = places == last_places
-                for n, axis, bit in absent:
-                    if axis in known and (last is None or not (same_places and end[n] == last[n]) and written_apart(end[n], places[n], last[n], last_places[n])):
-                        bits |= bit
-            elif absent:
-                start = segment.start
-                for n, axis, bit in absent:
-                    if round(end[n] - start[n], places[n]) != 0.0:
-                        bits |= bit
-            if code > 1:
-                bits |= _CENTRE_BITS[context.plane]
+            bits = _bits_written(facts, segment, places, known, last, last_places)
             motion = code if code != output_motion else None
-            values = end if code < 2 and absolute else self._numbers(segment)
+            values = segment.end if code < 2 and absolute else self._numbers(segment)
             if templates is not None:
                 key = bits if motion is None else bits | (code + 1) << _MOTION_SHIFT
                 template = templates.get(key)
@@ -540,9 +511,30 @@ class IsoWriter:
                 lines.append(_new_block_text(texts, motion, spelled) + eol)
             if motion is not None:
                 output_motion = code
-            last, last_places = end, places
+            last, last_places = segment.end, places
         self.output_motion, self._last_end, self._last_places = output_motion, last, last_places
         return lines
+
+
+def _bits_written(facts: "_Facts", segment: Line | Arc, places: tuple, known: set[str], last: tuple | None, last_places: tuple) -> int:
+    """The letters the segment writes (a mask of `_BIT`): the axes its block has and whatever
+    moved in the output (which is at `last`, written with `last_places`; `known`: the axes it
+    has written), then an arc's centre; `places`: the decimals the segment is written with."""
+    bits, absent, end = facts.axis_bits, facts.absent_axes, segment.end
+    if absent and segment.context.absolute:
+        same_places = places == last_places
+        for n, axis, bit in absent:
+            # (`written_apart`'s first test first: most such axes are where the output left them)
+            if axis in known and (last is None or not (same_places and end[n] == last[n]) and written_apart(end[n], places[n], last[n], last_places[n])):
+                bits |= bit
+    elif absent:
+        start = segment.start
+        for n, axis, bit in absent:
+            if round(end[n] - start[n], places[n]) != 0.0:
+                bits |= bit
+    if type(segment) is Arc:
+        bits |= _CENTRE_BITS[segment.context.plane]
+    return bits
 
 
 def _new_block_text(words: dict[str, str], motion: int | None, spelled: tuple[str, bool]) -> str:
