@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import functools
 import io
+import os
 import subprocess
 import tempfile
 from pathlib import Path
@@ -74,26 +75,38 @@ RS274_ONLY_REFUSES = {
 
 
 @functools.lru_cache(maxsize=None)
+@functools.lru_cache(maxsize=None)
 def tool_table() -> Path:
     """A tool table of tools 1-99 (0.01 across, in the stand-alone rs274's inches; length 0) for
     rs274 (its last -t is the one it reads; the wrapper's holds T1 alone, 6 across): programs
     changing tools, and the entry moves of cutter compensation, which rs274 refuses where they
-    are not longer than the radius."""
+    are not longer than the radius.  Written once per test session."""
     path = Path(tempfile.mkdtemp(prefix="ncpp-oracle-")) / "tools.tbl"
     path.write_text("".join(f"T{n} P{n} D0.01 Z0\n" for n in range(1, 100)))
     return path
 
 
-@functools.lru_cache(maxsize=None)
-def rs274(path: str) -> tuple[str, str]:
-    """rs274's (canonical calls, messages) for a program, cached for this test session only."""
+# Examples of a property test against rs274: each runs it (about 50 ms); NCPP_HYPOTHESIS_EXAMPLES=600
+# for a deeper search.
+ORACLE_EXAMPLES = max(int(os.environ.get("NCPP_HYPOTHESIS_EXAMPLES", "300")) // 8, 20)
+
+
+def run_rs274(path) -> tuple[str, str]:
+    """rs274's (canonical calls, messages) for the program at `path`, with `tool_table`."""
     try:
-        proc = subprocess.run([str(RS274), "-t", str(tool_table()), path], capture_output=True, text=True, errors="replace", timeout=300, stdin=subprocess.DEVNULL)
+        proc = subprocess.run([str(RS274), "-t", str(tool_table()), str(path)], capture_output=True, text=True, errors="replace", timeout=300, stdin=subprocess.DEVNULL)
     except (OSError, subprocess.TimeoutExpired) as err:
         pytest.skip(f"rs274 oracle unavailable: {err}")
     if "executing" not in proc.stderr:
         pytest.skip(f"rs274 oracle did not run: {proc.stderr.strip()[:200]}")
     return proc.stdout, proc.stderr
+
+
+@functools.lru_cache(maxsize=None)
+def rs274(path: str) -> tuple[str, str]:
+    """`run_rs274`, cached for this test session (the corpus's programs do not change; a
+    property test rewrites one file, and runs `run_rs274` itself)."""
+    return run_rs274(path)
 
 
 def rs274_error(messages: str) -> tuple[str, str] | None:

@@ -7,9 +7,7 @@ from __future__ import annotations
 
 import io
 import math
-import os
 import re
-import subprocess
 
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -22,7 +20,7 @@ from ncpp.motion.segments import Pass
 from ncpp.program.parser import parse_stream
 from tests.conftest import RS274
 from tests.motion.compensating import compensate
-from tests.motion.test_oracle import ours, refused_alike, rs274_error, same_calls
+from tests.motion.test_oracle import ORACLE_EXAMPLES, ours, refused_alike, rs274_error, run_rs274, same_calls
 
 HEAD = "G21 G90 G17 G94\nG0 X0 Y0 Z5\n"
 
@@ -120,16 +118,14 @@ def test_rs274_runs_the_compensated_polar_program(tmp_path):
     out, _ = compensate(PROGRAM, "polar.ngc")
     path = tmp_path / "out.ngc"
     path.write_text(out)
-    proc = subprocess.run([str(RS274), str(path)], capture_output=True, text=True, timeout=60)
-    assert rs274_error(proc.stderr) is None, proc.stderr
+    calls, messages = run_rs274(path)
+    assert rs274_error(messages) is None, messages
     mine, error, _ = ours(path)
-    theirs = read_canon(proc.stdout)
+    theirs = read_canon(calls)
     assert error is None and len(theirs) == len(mine) > 10 and same_calls(theirs, mine)
 
 
 # -- random programs against rs274 -------------------------------------------------------------
-# Each example runs rs274 (about 50 ms); NCPP_HYPOTHESIS_EXAMPLES=600 for a deeper search.
-EXAMPLES = max(int(os.environ.get("NCPP_HYPOTHESIS_EXAMPLES", "300")) // 8, 20)
 number = st.integers(-40_000, 40_000).map(lambda n: f"{n / 1000:g}")
 angle = st.integers(-720_000, 720_000).map(lambda n: f"{n / 1000:g}")
 polar = st.builds(
@@ -148,16 +144,16 @@ programs = st.lists(st.one_of(polar, polar, plain, arc, cycle, codes), min_size=
 
 
 @pytest.mark.skipif(not RS274.exists(), reason="rs274 oracle not available")
-@settings(max_examples=EXAMPLES, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
+@settings(max_examples=ORACLE_EXAMPLES, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
 @given(programs)
 def test_polar_programs_agree_with_rs274(tmp_path, text):
     path = tmp_path / "polar.ngc"
     path.write_text(text)
-    proc = subprocess.run([str(RS274), str(path)], capture_output=True, text=True, timeout=60)
+    calls, messages = run_rs274(path)
     mine, error, warned = ours(path)
     if "outside the motion interpreter's scope" in warned:
         return  # (an arc in G18 with R, a G98 series lowering its R plane: the corpus oracle's)
-    if refused_alike(rs274_error(proc.stderr), error):
+    if refused_alike(rs274_error(messages), error):
         return
-    theirs = read_canon(proc.stdout)
+    theirs = read_canon(calls)
     assert len(theirs) == len(mine) and same_calls(theirs, mine), (theirs, mine)

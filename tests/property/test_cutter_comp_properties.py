@@ -9,8 +9,6 @@ difference allowed: they need the tool centre's path, which ncpp does not make.
 
 from __future__ import annotations
 
-import os
-import subprocess
 from dataclasses import replace
 
 import pytest
@@ -21,10 +19,7 @@ from ncpp.motion.canon import read_canon
 from ncpp.motion.offsets import WorkOffsets
 from ncpp.motion.tools import ToolTable
 from tests.conftest import RS274
-from tests.motion.test_oracle import ours, refused_alike, rs274_error, same_calls, tool_table, without_comp
-
-# Each example runs rs274 (about 50 ms); NCPP_HYPOTHESIS_EXAMPLES=600 for a deeper search.
-EXAMPLES = max(int(os.environ.get("NCPP_HYPOTHESIS_EXAMPLES", "300")) // 8, 20)
+from tests.motion.test_oracle import ORACLE_EXAMPLES, ours, refused_alike, rs274_error, run_rs274, same_calls, tool_table, without_comp
 
 coordinate = st.integers(-40_000, 40_000).map(lambda n: f"{n / 1000:g}")
 line = st.builds(lambda g, x, y: f"G{g} X{x} Y{y}", st.sampled_from([0, 1, 1]), coordinate, coordinate)
@@ -41,13 +36,13 @@ programs = st.lists(st.one_of(line, line, arc, plunge, codes), min_size=3, max_s
 
 
 @pytest.mark.skipif(not RS274.exists(), reason="rs274 oracle not available")
-@settings(max_examples=EXAMPLES, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
+@settings(max_examples=ORACLE_EXAMPLES, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
 @given(programs)
 def test_cutter_compensation_agrees_with_rs274(tmp_path, text):
     path = tmp_path / "comp.ngc"
     path.write_text(text)
-    proc = subprocess.run([str(RS274), "-t", str(tool_table()), str(path)], capture_output=True, text=True, timeout=60)
-    refused = rs274_error(proc.stderr)
+    calls, messages = run_rs274(path)
+    refused = rs274_error(messages)
     if refused is not None and "gouging" in refused[0]:
         return
     # rs274's stand-alone machine is in inches: its tool table's D too
@@ -58,5 +53,5 @@ def test_cutter_compensation_agrees_with_rs274(tmp_path, text):
         return  # (an arc in G18 with R, ...: compared by the corpus oracle, not here)
     if refused_alike(refused, error):
         return
-    theirs, kept = without_comp(read_canon(proc.stdout), mine, off_path)
+    theirs, kept = without_comp(read_canon(calls), mine, off_path)
     assert len(theirs) == len(kept) and same_calls(theirs, kept), (theirs, kept)
