@@ -1401,8 +1401,6 @@ _COORD_SYSTEM_CODE = {n: code * 10 for code, n in _COORD_SYSTEM.items()}
 _PLANE_LETTERS = {17: "XY", 18: "ZX", 19: "YZ"}
 # words a plain modal move may carry without the full checks
 _AXIS_LETTERS_F = frozenset("XYZABCUVWFIJKR")
-
-
 # Not the interpreter's state (`Interpreter.state`): where it reports and what it was told,
 # a cache, its flow and parameters (told apart); callbacks compare as None (`snapshot.py`)
 _NOT_STATE = frozenset({"file", "warnings", "untold_lengths", "tools", "subroutine_path", "flow", "params", "_context", "holding"})

@@ -152,4 +152,5 @@ def mark_off_path(moves: list, compensating: bool, off_path: bool) -> bool:
         move.fixed = COMP
     return compensating
 
+
 __all__ = ["COMP", "CYCLE", "FLOW", "mark_off_path", "Arc", "Context", "Event", "Line", "Pass", "Point", "Segment", "PLANES", "PLANE_AXES", "EXTRA_AXES", "replace"]

@@ -46,7 +46,6 @@ _WRITTEN = tuple(
 )
 _AXIS_BITS = _BIT["X"] | _BIT["Y"] | _BIT["Z"]
 _ANY_CENTRE = _BIT["I"] | _BIT["J"] | _BIT["K"]
-_MOTION_SHIFT = len(WRITTEN_LETTERS)  # a new block's template key: its written bits, then its motion code + 1 above them
 _UNKNOWN = object()  # a plan not compiled yet
 _SIGNATURE_WORD = re.compile(r"(.)([-+.\d]*)")  # a letter, and a G word's number
 _MAX_LAYOUTS = 10000  # layouts remembered (comments can make every layout new)
@@ -500,7 +499,7 @@ class IsoWriter:
             motion = code if code != output_motion else None
             values = segment.end if code < 2 and absolute else self._numbers(segment)
             if templates is not None:
-                key = bits if motion is None else bits | (code + 1) << _MOTION_SHIFT
+                key = new_block_key(bits, motion)
                 template = templates.get(key)
                 if template is None:
                     template = templates[key] = _new_block_text(units.fields(bits), motion, (_literal(spelled[0]), spelled[1])) + eol
@@ -514,6 +513,12 @@ class IsoWriter:
             last, last_places = segment.end, places
         self.output_motion, self._last_end, self._last_places = output_motion, last, last_places
         return lines
+
+
+def new_block_key(bits: int, motion: int | None) -> int:
+    """A new block's template key among those of one spelling (`_Written.new_lines`): its
+    written letters (`_BIT`), and above them its motion word's code + 1 (0: none)."""
+    return bits if motion is None else bits | (motion + 1) << len(WRITTEN_LETTERS)
 
 
 def _bits_written(facts: "_Facts", segment: Line | Arc, places: tuple, known: set[str], last: tuple | None, last_places: tuple) -> int:
@@ -659,7 +664,7 @@ class _Written:
     """How the output writes numbers in one system of units: the style of each letter
     it writes, and the decimal places of X, Y and Z."""
 
-    __slots__ = ("styles", "places", "plain", "edit_plans", "edits", "new_templates", "new_lines")
+    __slots__ = ("styles", "places", "plain", "edit_plans", "edits", "new_lines")
 
     def __init__(self, styles: dict[str, NumberStyle]):
         self.styles = styles
@@ -667,12 +672,11 @@ class _Written:
         self.plain = all(style.plain for style in styles.values())  # every number one `format` spec: plans apply
         # Compiled lines: (signature, written bits, motion, spelling) -> `EditPlan` (None: none applies),
         # (layout, signature, ...) -> that plan, or the format template it makes of such blocks,
-        # (spelling, line end) -> {written bits | (motion + 1) << _MOTION_SHIFT: the format
-        # template of a new block's line}, and a dialect's own keys -> a new block's template.
+        # and per spelling (a dialect's: (spelling, line end) here) {`new_block_key`: the format
+        # template of a new block}.
         self.edit_plans: dict[tuple, EditPlan | None] = {}
         self.edits: dict[tuple, EditPlan | str] = {}
         self.new_lines: dict[tuple, dict[int, str]] = {}
-        self.new_templates: dict[tuple, str] = {}
 
     def fields(self, bits: int) -> dict[str, str]:
         """The written letters of the mask, each with its number as a field of `IsoWriter._numbers`."""

@@ -211,7 +211,7 @@ SINUMERIK = Dialect("sinumerik", "sinumerik", SinumerikBuilder, fast_terminals=(
 from ncpp.motion.segments import Arc, Line  # noqa: E402  (the writer half of the module)
 from ncpp.program.blocks import Block  # noqa: E402
 from ncpp.program.dialects.editing import splice  # noqa: E402
-from ncpp.program.dialects.iso import IsoWriter  # noqa: E402
+from ncpp.program.dialects.iso import IsoWriter, new_block_key  # noqa: E402
 from ncpp.program.writer import edit_texts  # noqa: E402
 
 _ARC_ONLY = ("CR", "TURN", "I1", "J1", "K1")
@@ -298,11 +298,12 @@ class SinumerikWriter(IsoWriter):
         if units.plain and (type(segment) is Line or not self._uses_cr(block)):
             # one template per letters written, motion and separator: `G1 X{0:z.4f} Y{1:z.4f}`
             bits = self._written_bits(self._facts(block), segment, units)
-            key = ("sinumerik", bits, motion, sep)
-            template = units.new_templates.get(key)
+            templates = units.new_lines.setdefault(("sinumerik", sep), {})
+            key = new_block_key(bits, motion)
+            template = templates.get(key)
             if template is None:
                 fields = [f"G{motion}"] if motion is not None else []
-                template = units.new_templates[key] = sep.join(fields + [letter + field for letter, field in units.fields(bits).items()])
+                template = templates[key] = sep.join(fields + [letter + field for letter, field in units.fields(bits).items()])
             text = template.format(*self._numbers(segment))
         else:
             words = self._texts(block, segment)
