@@ -105,6 +105,9 @@ class Arc:
     extra: tuple[float, ...] = ()
     changed: bool = False
     fixed: str = ""  # as `Line.fixed`
+    # a piece replace_arcs made: the direction its plane's normal axis was compensated for
+    # (+1, -1: the one that axis last moved in, which the machine holds it in; 0: the mean)
+    normal: int = 0
 
     @property
     def clockwise(self) -> bool:

@@ -55,7 +55,7 @@ def apply_error_map(events: Iterable[Event], ctx: PassContext) -> Iterator[Event
     # with a worker process, the next chunks are read (parsed, interpreted, their arcs replaced) while one is solved
     for (chunk, segs, rows), solving in run_ahead(chunks, start, ctx.kernels.ahead):
         if cut is not None:
-            cut.before_writing(chunk, last, ctx.at_cut)
+            cut.before_writing(chunk, last, ctx)
         if solving is None:  # no segments
             yield from chunk
             continue
@@ -76,12 +76,15 @@ class PassState:
 
     travel: Travel
     last: Line | Arc | None
+    motion: tuple | None = None  # replace_arcs.Motion's state there (None: not recorded: never equal)
 
     def __eq__(self, other: object) -> bool:
-        """Equal states compensate the chunks after them alike: the same held directions
-        and last command, and a last segment ending at the same point of the same frame."""
+        """Equal states compensate the chunks after them alike: the same held directions,
+        last command and programmed motion, and a last segment ending at the same point of the same frame."""
         if not isinstance(other, PassState):
             return NotImplemented
+        if self.motion is None or self.motion != other.motion:
+            return False
         a, b = self.travel, other.travel
         if not np.array_equal(a.held, b.held) or (a.last is None) != (b.last is None):
             return False
@@ -103,9 +106,9 @@ class _Cut:
         if self.travel is None and chunk[0].block.line >= self.cut.line:
             self.travel = self.solver.travel.copy()
 
-    def before_writing(self, chunk: list[Event], last, at_cut: list) -> None:
-        if self.travel is not None and not at_cut and chunk[0].block.line >= self.cut.line:
-            at_cut.append(PassState(self.travel, last))
+    def before_writing(self, chunk: list[Event], last, ctx: PassContext) -> None:
+        if self.travel is not None and not ctx.at_cut and chunk[0].block.line >= self.cut.line:
+            ctx.at_cut.append(PassState(self.travel, last, ctx.motion_at_cut[0] if ctx.motion_at_cut else None))
 
 
 def _with_rows(chunk: list[Event], directional: bool) -> tuple[list[Event], list, "_Rows | None"]:
@@ -505,7 +508,7 @@ def _own_motion(moved, d, free, start_p, end_p, scales, threshold, commands: _Co
 def _arc_assumed(segs: list, rows: NDArray, start: NDArray, end: NDArray) -> NDArray:
     """Directions replace_arcs compensated each arc piece (`rows`, with the chunk's
     `start` and `end` points) with: the sign of the tangent at the middle in the plane,
-    the mean (0) on the normal axis; and the mean on every axis for the lines it made."""
+    `Arc.normal` on the normal axis; and the mean on every axis for the lines it made."""
     out = np.zeros((len(segs), 3))
     if rows.size == 0:
         return out
@@ -518,7 +521,8 @@ def _arc_assumed(segs: list, rows: NDArray, start: NDArray, end: NDArray) -> NDA
         mid_u, mid_v = u0 / r0 + u1 / r1, v0 / r0 + v1 / r1
     turn = np.sign(np.fromiter((a.turn for a in arcs), dtype=float, count=len(arcs)))
     # the tangent is the middle's radius turned a quarter the way the arc turns
-    out[rows] = from_plane(np.sign(turn * -mid_v), np.sign(turn * mid_u), np.zeros(len(arcs)), axes)
+    normal = np.fromiter((a.normal for a in arcs), dtype=float, count=len(arcs))
+    out[rows] = from_plane(np.sign(turn * -mid_v), np.sign(turn * mid_u), normal, axes)
     return out
 
 

@@ -66,11 +66,12 @@ class PassContext:
     # the first records the passes' state (`at_cut`), and the state the second resumes from
     cut: CutLine | None = None
     at_cut: list[PassState] = field(default_factory=list)
+    motion_at_cut: list[tuple] = field(default_factory=list)  # replace_arcs.Motion's state there, for `at_cut`
     resume: PassState | None = None
 
     def for_kernels(self) -> "PassContext":
         """This context as a kernel holds it: picklable (no output stream, no worker)."""
-        return replace(self, warnings=Warnings(self.warnings.strict, io.StringIO()), kernels=INLINE, cut=None, at_cut=[], resume=None)
+        return replace(self, warnings=Warnings(self.warnings.strict, io.StringIO()), kernels=INLINE, cut=None, at_cut=[], motion_at_cut=[], resume=None)
 
     def limit_arrays(self) -> tuple[NDArray, NDArray]:
         lo = np.array([self.limits.get(a, (-np.inf, np.inf))[0] for a in "XYZ"])

@@ -22,8 +22,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ncpp.errors import Location, NcppError
-from ncpp.motion.segments import Arc, Event, Line
-from ncpp.passes.context import PassContext
+from ncpp.motion.segments import PLANE_AXES, Arc, Event, Line
+from ncpp.passes.context import CutLine, PassContext
 from ncpp.passes.kernels import run_ahead
 from ncpp.passes.geometry import any3, before_line, compensate, frames, from_plane, in_plane, norm3, plane_axes, points, row_max, rows_of, spliced, tuples
 from ncpp.passes.travel import grid, quantize
@@ -54,6 +54,9 @@ BATCH_EVENTS = 4096
 # 170 MB; a helix of 10⁸ turns ran out of 24 GB).
 MAX_TURNS = 10_000
 SLIVER = 0.01  # mm of arc length below which a piece becomes a line (its bulge is < 0.1 µm for radii over 0.1 mm)
+# Lines back that an arc's guess of its normal axis's direction looks (`Motion`): within a
+# two-part run's window (`parts.WINDOW`, 2048 lines)
+HELD_LINES = 1024
 
 
 @dataclass
@@ -67,9 +70,10 @@ class _Pieces:
 
 def replace_arcs(events: Iterable[Event], ctx: PassContext) -> Iterator[Event]:
     fit = ctx.kernels.bind(FitArcs(ctx.for_kernels()))
-    batches = (_with_arcs(batch) for batch in _batches(events))
+    motion = Motion(ctx.resume.motion if ctx.resume is not None else None, ctx.cut, ctx.motion_at_cut, ctx.directional)
+    batches = (_with_arcs(batch, motion) for batch in _batches(events))
     # with a worker process, the next batches are read while one is fitted
-    for (batch, index, arcs), fitting in run_ahead(batches, lambda b: fit(_ArcRows.of(b[2])) if b[2] else None, ctx.kernels.ahead):
+    for (batch, index, arcs, normals), fitting in run_ahead(batches, lambda b: fit(_ArcRows.of(b[2], b[3])) if b[2] else None, ctx.kernels.ahead):
         if fitting is None:
             yield from batch
             continue
@@ -81,13 +85,76 @@ def replace_arcs(events: Iterable[Event], ctx: PassContext) -> Iterator[Event]:
             if len(earlier) < len(batch):
                 yield from replace_arcs(earlier, ctx)
             raise
-        yield from spliced(batch, index, _assemble(arcs, fitted))
+        yield from spliced(batch, index, _assemble(arcs, fitted, normals))
 
 
-def _with_arcs(batch: list[Event]) -> tuple[list[Event], list[int], list[Arc]]:
-    """The batch, where its arcs to replace are, and those arcs."""
+def _with_arcs(batch: list[Event], motion: "Motion") -> tuple[list[Event], list[int], list[Arc], list[int]]:
+    """The batch, where its arcs to replace are, those arcs, and the direction each one's
+    normal axis is compensated for (`Motion`)."""
     index = [k for k, e in enumerate(batch) if type(e) is Arc and not e.changed and not e.fixed]
-    return batch, index, [batch[k] for k in index]
+    return batch, index, [batch[k] for k in index], motion.normals(batch) if motion.directional else [0] * len(index)
+
+
+class Motion:
+    """The sign of each axis's last programmed move (+1, -1), and its line, event after event.
+
+    An arc leaves its plane's normal axis standing, and the machine holds that axis in the
+    direction it last moved in, whose reversal error applies: an arc's pieces are compensated
+    for it (a helix's for its rise).  It is a guess, from the program's motion, of the
+    direction apply_error_map finds from the compensated motion: that pass shifts a piece
+    whose guess was wrong (`Arc.normal`).  A move more than HELD_LINES lines before the arc
+    is not used (the mean, 0, instead): so the second of a run's two parts (`ncpp/parts.py`),
+    which compensates a window of lines before its cut, makes the same guesses after it.  The
+    state is part of the passes' state at the cut: recorded at the first move from the cut's
+    line on (`record`; nothing where the cut was decided after the moves passed it)."""
+
+    def __init__(self, state: tuple | None, cut: CutLine | None, record: list, directional: bool = True):
+        self.state = state or (0, 0, 0, 0, 0, 0)  # x, y, z signs (0: none yet), and their lines
+        self.cut, self.record = cut, record
+        self.line = -1  # the line of the last move read
+        self.directional = directional
+        if not directional and cut is not None:  # no guesses wanted (the map has no reversal errors): none made
+            record.append(self.state)
+
+    def normals(self, batch: list[Event]) -> list[int]:
+        """The direction of each arc to replace's normal axis, in order; reads the batch's moves
+        (only where the map has reversal errors)."""
+        out: list[int] = []
+        x, y, z, lx, ly, lz = self.state
+        line, cut = self.line, self.cut
+        for event in batch:
+            kind = type(event)
+            if kind is not Line and kind is not Arc:
+                continue
+            at = event.block.line
+            if cut is not None and line < cut.line <= at:
+                self.record.append(_recorded((x, y, z, lx, ly, lz), cut.line))
+            line = at
+            (s0, s1, s2), (e0, e1, e2) = event.start, event.end
+            if kind is Arc and not event.changed and not event.fixed:
+                w = PLANE_AXES[event.context.plane][2]
+                rise = (e0 - s0, e1 - s1, e2 - s2)[w]
+                if rise:
+                    out.append(1 if rise > 0 else -1)
+                else:
+                    held, since = (x, y, z)[w], (lx, ly, lz)[w]
+                    out.append(held if at - since <= HELD_LINES else 0)
+            if e0 != s0:
+                x, lx = 1 if e0 > s0 else -1, at
+            if e1 != s1:
+                y, ly = 1 if e1 > s1 else -1, at
+            if e2 != s2:
+                z, lz = 1 if e2 > s2 else -1, at
+        self.state, self.line = (x, y, z, lx, ly, lz), line
+        return out
+
+
+def _recorded(state: tuple, cut: int) -> tuple:
+    """`Motion`'s state at the cut without what no guess from the cut on uses (moves older
+    than HELD_LINES lines), which the second part may not have seen."""
+    signs, lines = state[:3], state[3:]
+    kept = [cut - since <= HELD_LINES for since in lines]
+    return (*(s if k else 0 for s, k in zip(signs, kept)), *(n if k else 0 for n, k in zip(lines, kept)))
 
 
 def _batches(events: Iterable[Event]) -> Iterator[list[Event]]:
@@ -125,14 +192,16 @@ class _ArcRows:
     scales: NDArray  # (n,) mm per program unit
     tools: NDArray | None  # (n,3) tool length offsets, mm (None: none)
     lines: NDArray  # (n,) the line of each arc's block, for messages
+    normal: NDArray  # (n,) the direction each arc's normal axis is compensated for (`Motion`)
 
     @classmethod
-    def of(cls, arcs: list[Arc]) -> "_ArcRows":
+    def of(cls, arcs: list[Arc], normals: list[int]) -> "_ArcRows":
         offsets, scales, tools = frames(arcs)
         return cls(
             points([a.start for a in arcs]), points([a.end for a in arcs]), points([a.center for a in arcs]),
             plane_axes(arcs), np.fromiter([a.turn for a in arcs], dtype=float, count=len(arcs)),
             offsets, scales, tools, np.fromiter([a.block.line for a in arcs], dtype=np.int64, count=len(arcs)),
+            np.array(normals, dtype=float),
         )  # fmt: skip
 
 
@@ -171,6 +240,7 @@ class _ArcGeometry:
         self.w0 = sw
         self.rise = ew - sw
         self.end_radius = np.hypot(eu - cu, ev - cv)
+        self.normal = rows.normal
 
     def points(self, arc: NDArray, angles: NDArray) -> NDArray:
         """(p,m,3) program points at the given angles of the given arcs.
@@ -265,9 +335,9 @@ def _round(pending: _Pieces, length: NDArray, t: NDArray, geometry, offsets, sca
     middle = (pending.a0 + pending.sweep / 2)[:, None]
     ahead = geometry.points(pending.arc, np.hstack([middle + 1e-6 * np.sign(pending.sweep)[:, None], middle]))
     direction = np.sign(ahead[:, :1] - ahead[:, 1:])  # of the tangent in the middle
-    # the normal axis's direction is the one the machine holds when it gets
-    # here: apply_error_map knows it and shifts the piece; use the mean here
-    np.put_along_axis(direction, geometry.axes[pending.arc, None, 2:], 0.0, axis=2)
+    # the normal axis's direction is the one the machine holds when it gets here, as
+    # `Motion` guesses it: apply_error_map knows it and shifts the piece where it differs
+    np.put_along_axis(direction, geometry.axes[pending.arc, None, 2:], geometry.normal[pending.arc, None, None], axis=2)
     direction = np.broadcast_to(direction, nominal.shape)
     scale = scales[pending.arc]
     q = compensate(nominal, offsets[pending.arc], scale, line_of[pending.arc], ctx, direction, rows_of(tools, pending.arc))
@@ -409,7 +479,7 @@ def _line_pieces(arc: Arc, q: list[list[float]]) -> list[Event]:
     return [Line(a, b, False, arc.feed, arc.block, arc.context, arc.extra, True) for a, b in zip(pts, pts[1:])]
 
 
-def _assemble(arcs: list[Arc], fitted: _Fitted) -> list[list[Event]]:
+def _assemble(arcs: list[Arc], fitted: _Fitted, normals: list[int]) -> list[list[Event]]:
     """The events of each arc's pieces in the order of travel."""
     found = fitted.arcs + fitted.lines  # each (arc, a0, ...) per piece: fitted arcs first, then runs of lines
     if not found:
@@ -427,7 +497,7 @@ def _assemble(arcs: list[Arc], fitted: _Fitted) -> list[list[Event]]:
         k = of_list[j]
         arc = arcs[k]
         if j < fitted_count:
-            out[k].append(Arc(ends[0][j], ends[1][j], ends[2][j], 1 if arc.turn > 0 else -1, arc.feed, arc.block, arc.context, arc.extra, True))
+            out[k].append(Arc(ends[0][j], ends[1][j], ends[2][j], 1 if arc.turn > 0 else -1, arc.feed, arc.block, arc.context, arc.extra, True, "", normals[k]))
         else:
             out[k] += _line_pieces(arc, runs[j - fitted_count])
     return out

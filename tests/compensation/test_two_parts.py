@@ -251,13 +251,16 @@ def test_states_at_the_cut_differ_where_the_rest_would():
     from ncpp.program.blocks import Block
 
     block = Block("X1", "\n", (), 1)
-    state = lambda held=(1.0, -1.0, 0.0), last=(1.0, 2.0, 3.0), end=(1.0, 2.0, 0.0): PassState(  # noqa: E731
-        Travel(np.array(held), np.array(last)), Line((0.0, 0.0, 0.0), end, False, 100.0, block)
+    motion = (1, -1, 0, 7, 9, 0)
+    state = lambda held=(1.0, -1.0, 0.0), last=(1.0, 2.0, 3.0), end=(1.0, 2.0, 0.0), motion=motion: PassState(  # noqa: E731
+        Travel(np.array(held), np.array(last)), Line((0.0, 0.0, 0.0), end, False, 100.0, block), motion
     )
     assert state() == state()
     assert state(held=(1.0, 1.0, 0.0)) != state()
     assert state(last=(1.0, 2.0, 3.0001)) != state()
     assert state(end=(1.0, 2.0, 0.0001)) != state()
+    assert state(motion=(1, 1, 0, 7, 9, 0)) != state()  # replace_arcs' guesses from the cut on would differ
+    assert state(motion=None) != state(motion=None)  # not recorded (the cut was decided late): never the same
 
 
 def test_a_cut_from_the_parts_paces_writes_what_one_run_writes(program, source, one_run, monkeypatch):

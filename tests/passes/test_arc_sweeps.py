@@ -30,7 +30,7 @@ def _arc(plane: int, centre: tuple, radius: float, a0: float, a1: float, turn: i
 def _geometry(arcs: list[Arc]) -> _ArcGeometry:
     n = len(arcs)
     rows = _ArcRows(points([a.start for a in arcs]), points([a.end for a in arcs]), points([a.center for a in arcs]), plane_axes(arcs),
-                    np.array([a.turn for a in arcs], dtype=float), np.zeros((n, 3)), np.ones(n), None, np.ones(n, dtype=np.int64))  # fmt: skip
+                    np.array([a.turn for a in arcs], dtype=float), np.zeros((n, 3)), np.ones(n), None, np.ones(n, dtype=np.int64), np.zeros(n))  # fmt: skip
     return _ArcGeometry(rows)
 
 
