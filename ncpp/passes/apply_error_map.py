@@ -17,6 +17,7 @@ start is compensated with its own direction and a step move is inserted.
 from __future__ import annotations
 
 from dataclasses import dataclass, fields
+from itertools import chain
 from typing import Iterable, Iterator
 
 import numpy as np
@@ -40,6 +41,12 @@ NEAR_STILL = 0.05
 
 
 def apply_error_map(events: Iterable[Event], ctx: PassContext) -> Iterator[Event]:
+    # the events a chunk at a time, handed on by `chain` (in C): no generator's step per event
+    return chain.from_iterable(_chunks(events, ctx))
+
+
+def _chunks(events: Iterable[Event], ctx: PassContext) -> Iterator[list[Event]]:
+    """The compensated events, a list per chunk."""
     resume = ctx.resume
     solver = Solve(ctx.for_kernels(), None if resume is None else resume.travel)
     solve = ctx.kernels.bind(solver)
@@ -57,7 +64,7 @@ def apply_error_map(events: Iterable[Event], ctx: PassContext) -> Iterator[Event
         if cut is not None:
             cut.before_writing(chunk, last, ctx)
         if solving is None:  # no segments
-            yield from chunk
+            yield chunk
             continue
         try:
             solved = solving.result()
@@ -66,7 +73,7 @@ def apply_error_map(events: Iterable[Event], ctx: PassContext) -> Iterator[Event
             raise
         out = _written(chunk, segs, rows, solved, last)
         last = _ended(segs[-1], solved.end[-1])  # (a carried row's end is not its event's: `_carry`)
-        yield from out
+        yield out
 
 
 @dataclass(eq=False)
