@@ -78,6 +78,11 @@ class MachineMap:
     def deviation(self, P, direction=None, tool_offset=None):
         return self.machine.static_deviation(P, direction, tool_offset)
 
+    @property
+    def bow_bound(self):
+        """`Machine.bow_bound`: what keeps lines whole unsampled (`passes/subdivide.py`)."""
+        return self.machine.bow_bound
+
 
 def _digest(path: str) -> str:
     return hashlib.sha256(Path(path).read_bytes()).hexdigest()[:16]

@@ -36,6 +36,7 @@ from ncpp.machine.components import (
 
 if TYPE_CHECKING:
     from ncpp.machine.effects import Effect
+    from ncpp.machine.curvature import BowBound
     from ncpp.machine.trajectory import Trajectory
 
 Vec3 = tuple[float, float, float]
@@ -172,6 +173,14 @@ class Machine:
             stacked = StackedTables([c for _, c in tables]) if tables else None
             out[axis] = (stacked, [row for row, _ in tables], [(row, c) for row, c in mine if not isinstance(c, Table)])
         return out
+
+    @cached_property
+    def bow_bound(self) -> "BowBound | None":
+        """Bounds of the second derivative of `static_deviation` along segments
+        (`curvature.BowBound`), or None where the errors may not be smooth."""
+        from ncpp.machine.curvature import BowBound
+
+        return BowBound.of(self)
 
     def error_motions(
         self, P: ArrayLike, direction: ArrayLike | None = None

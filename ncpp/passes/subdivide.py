@@ -5,7 +5,8 @@ straight interpolation of the end-point errors.  Where the error varies more
 than that along the line (a bow, a kink in an error table), the line is split
 into pieces short enough that the remaining deviation is below the tolerance.
 The error is sampled by a kernel (`PieceCounts`), in the worker process when
-there is one.
+there is one; not along a line that a bound of the error's curvature already keeps
+whole (`ncpp.machine.curvature`, where the map gives one: its `bow_bound`).
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ from typing import Iterable, Iterator
 import numpy as np
 from numpy.typing import NDArray
 
+from ncpp.machine.curvature import BowBound
 from ncpp.motion.segments import Event, Line
 from ncpp.passes.context import PassContext, deviation
 from ncpp.passes.geometry import chunked, frames, norm3, points, row_max, rows_of, spliced
@@ -27,11 +29,15 @@ SAMPLES = np.linspace(0.0, 1.0, 7)
 # table can also kink anywhere: aim below the tolerance by this factor.
 SAFETY = 4.0
 MAX_PIECES = 10_000
+# A line is kept whole unsampled where SAFETY times its bound of the bow is within this part
+# of the tolerance: below it, rounding in the samples could not make them split it
+SURE = 0.99
 
 
 def subdivide_lines(events: Iterable[Event], ctx: PassContext) -> Iterator[Event]:
     count = ctx.kernels.bind(PieceCounts(ctx.for_kernels()))
-    chunks = (_with_rows(chunk, ctx) for chunk in chunked(events))
+    bound = getattr(ctx.model, "bow_bound", None)
+    chunks = (_with_rows(chunk, ctx, bound) for chunk in chunked(events))
     # with a worker process, the error along the next chunks' lines is evaluated while one is split
     for (chunk, index, lines, _), counting in run_ahead(chunks, lambda c: None if c[3] is None else count(c[3]), ctx.kernels.ahead):
         if counting is None:
@@ -53,7 +59,7 @@ class _LineRows:
     tools: NDArray | None  # (n,3) tool length offsets, mm (None: none)
 
 
-def _with_rows(chunk: list[Event], ctx: PassContext) -> tuple[list[Event], list[int], list[Line], _LineRows | None]:
+def _with_rows(chunk: list[Event], ctx: PassContext, bound: BowBound | None = None) -> tuple[list[Event], list[int], list[Line], _LineRows | None]:
     """The chunk, where its lines to check are, those lines, and their rows (None: none)."""
     index = [k for k, e in enumerate(chunk) if type(e) is Line and not e.rapid and not e.changed and not e.fixed]
     if not index:
@@ -62,7 +68,12 @@ def _with_rows(chunk: list[Event], ctx: PassContext) -> tuple[list[Event], list[
     starts = points([ln.start for ln in lines])
     ends = points([ln.end for ln in lines])
     offsets, scales, tools = frames(lines)
-    long = np.flatnonzero(norm3(ends - starts) * scales >= ctx.min_line_check)
+    length = norm3(ends - starts) * scales
+    long = np.flatnonzero(length >= ctx.min_line_check)
+    if long.size and bound is not None:  # and not kept whole by the bound (the samples would find less bow than it)
+        machine = lambda p: (p[long] + offsets[long]) * scales[long, None]  # noqa: E731
+        bow = length[long] ** 2 / 8 * bound(machine(starts), machine(ends), rows_of(tools, long))
+        long = long[SAFETY * bow > SURE * ctx.tolerance]
     if long.size == 0:
         return chunk, [], [], None
     keep = long.tolist()
