@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import io
 import re
+from itertools import chain
 from typing import BinaryIO, Iterable, Iterator
 
 from ncpp.errors import NcppError
@@ -129,17 +130,12 @@ def sniff(stream: Iterable[bytes], name: str | None = None, dialect: str | None 
             if size >= SNIFF_BYTES:
                 break
         head = b"".join(head_lines)
-        return detect(head, name), _chain(head_lines, lines)
+        return detect(head, name), chain(head_lines, lines)
     head = read(SNIFF_BYTES)
     head_lines = list(io.BytesIO(head))
     if head_lines and not head_lines[-1].endswith(b"\n"):
         head_lines[-1] += stream.readline()  # type: ignore[union-attr]
-    return detect(b"".join(head_lines), name), _chain(head_lines, stream)
-
-
-def _chain(first: list[bytes], rest: Iterable[bytes]) -> Iterator[bytes]:
-    yield from first
-    yield from rest
+    return detect(b"".join(head_lines), name), chain(head_lines, stream)  # (in C: no generator's step per line)
 
 
 def parse_program(stream: BinaryIO, file: str = "<stdin>", dialect: str | None = None, numbered: NumberedLines | None = None):
