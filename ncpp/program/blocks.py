@@ -120,6 +120,8 @@ class Block:
     its number as written (`G1XYF`), for a block of only one-letter words and
     comments (what the parser's fast path reads): the writer reads its facts from it
     instead of walking the items.  Whoever changes the items builds a Block without it.
+    `layout`, when known, is `raw` with every digit '1' (`DIGITS_AS_ONE`), as the parser's
+    fast path read it: the writer's key for what a layout teaches and how it is edited.
     """
 
     raw: str
@@ -128,6 +130,7 @@ class Block:
     line: int = 0
     verbatim: bool = False
     signature: str | None = field(default=None, compare=False, repr=False)
+    layout: bytes | None = field(default=None, compare=False, repr=False)
 
     @property
     def text(self) -> str:

@@ -253,30 +253,31 @@ class LineParser:
         if plain is None:
             block = Block(raw, eol, self._read_lalr(raw, line, file), line)
         else:
-            items, signature = plain
-            block = Block(raw, eol, items, line, False, signature)
+            items, signature, layout = plain
+            block = Block(raw, eol, items, line, False, signature, layout)
         if len(raw) > _FINITE_LINE:  # only such a line can hold a number of more than 308 digits
             _refuse_infinite(block, file)
         if "\r" in raw:  # (a CR before the LF is the line's end, not in `raw`)
             _refuse_cr_line_ends(raw, line, file)
         return block
 
-    def _scan_plain(self, raw: str) -> tuple[tuple[AnyItem, ...], str | None] | None:
-        """(items, `Block.signature`) of a line made only of plain words and
-        comments, else None; the signature is None when a word has two letters (`,R`)."""
+    def _scan_plain(self, raw: str) -> tuple | None:
+        """(items, `Block.signature`, `Block.layout`) of a line made only of plain words and
+        comments, else None; the signature is None when a word has two letters (`,R`), the
+        layout where the scanner read the line."""
         if not self._by_layout:
-            return self._scan_items(raw)
+            return _without_layout(self._scan_items(raw))
         # Most lines of a program share a few layouts (` X1.1111 Z-1.1111`): their words are
         # cut where the first line of the layout had them, without the scanner.
         try:
             layout = raw.encode("latin-1").translate(DIGITS_AS_ONE)
         except UnicodeEncodeError:  # text not read from bytes (`parse("X1 (€)")`): no layout
-            return self._scan_items(raw)
+            return _without_layout(self._scan_items(raw))
         shape = self._shapes.get(layout)
         if shape is None:
             shape = self._learn_shape(raw, layout)
         if type(shape) is not tuple:  # not plain, or a plain line cutting cannot read
-            return None if shape is _NOT_PLAIN else self._scan_items(raw)
+            return None if shape is _NOT_PLAIN else _without_layout(self._scan_items(raw))
         cut, signature, g_numbers = shape
         if g_numbers:  # the signature has the G words' numbers as written (one, mostly: `G1XY`)
             pieces = signature
@@ -284,7 +285,7 @@ class LineParser:
             signature = pieces[0] + raw[a:b] + pieces[1]
             for n, (a, b) in enumerate(more, start=2):
                 signature += raw[a:b] + pieces[n]
-        return cut.items(raw), signature
+        return cut.items(raw), signature, layout
 
     def _learn_shape(self, raw: str, layout: bytes) -> object:
         """The shape of the line's layout, scanned from the line and remembered."""
@@ -707,6 +708,11 @@ def continued_lines(lines: Iterable[tuple[str, str]], mark: str) -> Iterator[tup
 
 
 NumberedLines = Callable[[Iterable[bytes]], Iterable[tuple[int, tuple[str, str]]]]
+
+
+def _without_layout(scanned: tuple | None) -> tuple | None:
+    """The scanner's (items, signature) with no layout (`LineParser._scan_plain`)."""
+    return None if scanned is None else (*scanned, None)
 
 
 def numbered_lines(stream: Iterable[bytes]) -> Iterator[tuple[int, tuple[str, str]]]:

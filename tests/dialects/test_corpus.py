@@ -6,6 +6,7 @@ import io
 
 import pytest
 
+from ncpp.program.blocks import DIGITS_AS_ONE
 from ncpp.program.dialects import detect, parse_program, sniff
 from ncpp.program.parser import LineParser, parse_stream
 from ncpp.program.writer import write_blocks
@@ -68,9 +69,10 @@ def test_sinumerik_fast_path_agrees_with_lalr_parser_on_corpus():
         for block in parse_stream(io.BytesIO(path.read_bytes()), str(path), "sinumerik"):
             fast = parser._scan_plain(block.raw)
             if fast is not None:
-                items, signature = fast
+                items, signature, layout = fast
                 assert items == parser._parse_lalr(block.raw, block.line, str(path)), (path, block.line)
                 assert signature == expected_signature(items), (path, block.line)
+                assert layout in (None, block.raw.encode("latin-1").translate(DIGITS_AS_ONE)), (path, block.line)
                 checked += 1
     assert checked > 100
 

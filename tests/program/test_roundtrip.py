@@ -10,6 +10,7 @@ import pytest
 
 from ncpp.errors import NcppError, Warnings
 from ncpp.pipeline import process
+from ncpp.program.blocks import DIGITS_AS_ONE
 from ncpp.program.dialects import parse_program
 from ncpp.program.parser import LineParser, parse_stream
 from ncpp.program.writer import write_blocks
@@ -83,10 +84,11 @@ def test_fast_path_agrees_with_lalr_parser_on_corpus():
             fast = parser._scan_plain(block.raw)
             if fast is None or block.verbatim:
                 continue
-            items, signature = fast
+            items, signature, layout = fast
             assert items == parser._parse_lalr(block.raw, block.line, str(path)), (path, block.line)
-            # the signature the writer reads its facts from is that of the words
+            # the signature the writer reads its facts from is that of the words, the layout that of the text
             assert signature == expected_signature(items), (path, block.line)
+            assert layout in (None, block.raw.encode("latin-1").translate(DIGITS_AS_ONE)), (path, block.line)
             checked += 1
     assert checked > 20_000
 
@@ -96,8 +98,9 @@ def test_lines_of_one_layout_are_read_as_the_scanner_reads_each():
     numbers, G numbers in the signature, blanks inside a number, text not from bytes."""
     parser, scanner = LineParser("iso"), LineParser("iso")
     for raw in ["G1 X1.5 Y-2", "G0 X7.0 Y-9", "G90G1X1", "G91G0X2", " X - 5", " X - 6", "X1 (a)", "X2 (b)", "X1 (\u20ac)"]:
-        assert parser._scan_plain(raw) == scanner._scan_items(raw), raw
-    assert parser._scan_plain("G0 X7.0 Y-9")[1] == "G0XY"
+        assert parser._scan_plain(raw)[:2] == scanner._scan_items(raw), raw
+    assert parser._scan_plain("G0 X7.0 Y-9")[1:] == ("G0XY", b"G1 X1.1 Y-1")
+    assert parser._scan_plain("X1 (\u20ac)")[2] is None  # (text not from bytes: no layout)
 
 
 @pytest.mark.parametrize("raw", ["X1 @;c   ", "G1 X1 $;comment    ", "@@(;;)@;c   ", "X1 @ Y2", "X1 Y2 #"])

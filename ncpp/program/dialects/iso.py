@@ -220,11 +220,14 @@ class IsoWriter:
             self._last_lesson = styles
 
     def _layout_of(self, block: Block) -> bytes:
-        """The block's raw text with every digit '1' (read once per block: styles and edits ask)."""
-        known, layout = self._layout
-        if known is not block:
-            layout = block.raw.encode("latin-1").translate(DIGITS_AS_ONE)
-            self._layout = (block, layout)
+        """The block's raw text with every digit '1' (`Block.layout` where the parser read it;
+        else made once per block: styles and edits ask)."""
+        layout = block.layout
+        if layout is None:
+            known, layout = self._layout
+            if known is not block:
+                layout = block.raw.encode("latin-1").translate(DIGITS_AS_ONE)
+                self._layout = (block, layout)
         return layout
 
     def _read_layout(self, block: Block, facts: "_Facts", layout: bytes) -> tuple:
@@ -435,8 +438,7 @@ class IsoWriter:
         raw = block.raw
         # the block's layout, and a plan: blocks of one layout without comments whose numbers the
         # plan writes or drops all (but G words', in the signature) are its template with their numbers
-        known, layout = self._layout
-        key = (layout if known is block else self._layout_of(block), signature, bits, motion, spelled)
+        key = (block.layout or self._layout_of(block), signature, bits, motion, spelled)
         edit = units.edits.get(key)
         if edit is None:
             plan = self._edit_plan(facts, signature, bits, motion, spelled, units)
