@@ -150,6 +150,13 @@ def cyclic_cross(a: NDArray, b: NDArray, out: NDArray) -> NDArray:
     return out
 
 
+def norm3(vectors: NDArray) -> NDArray:
+    """Lengths of (..., 3) vectors: `np.linalg.norm(vectors, axis=-1)` (bit for bit: the same
+    sum in the same order), without its reduction over a short last axis (5x slower)."""
+    squares = vectors * vectors
+    return np.sqrt((squares[..., 0] + squares[..., 1]) + squares[..., 2])
+
+
 def cross(a: NDArray, b: NDArray) -> NDArray:
     """Row-wise a × b for (n,3) arrays (np.cross is several times slower)."""
     return cyclic_cross(as_cyclic(a), as_cyclic(b), columns(len(a)))

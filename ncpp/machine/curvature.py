@@ -23,7 +23,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from ncpp.machine.chain import AXES, Chain, abbe_offset
+from ncpp.machine.chain import AXES, Chain, abbe_offset, norm3
 from ncpp.machine.components import COMPONENTS, StackedTables, Table
 
 MARGIN = 1.25  # over the first-order bound: the exact chain's terms of second order in the angles
@@ -69,7 +69,7 @@ class BowBound:
         for axis, bound in self.axes.items():
             k = AXES.index(axis)
             reference = self.references[axis]
-            lever = np.maximum(_norm(abbe_offset(self.chain, axis, start, tool, reference)), _norm(abbe_offset(self.chain, axis, end, tool, reference)))
+            lever = np.maximum(norm3(abbe_offset(self.chain, axis, start, tool, reference)), norm3(abbe_offset(self.chain, axis, end, tool, reference)))
             total += bound(np.minimum(start[:, k], end[:, k]), np.maximum(start[:, k], end[:, k]), lever)
         return MARGIN * total
 
@@ -127,6 +127,3 @@ def _run_maxima(values: NDArray) -> NDArray:
         out[i, i:] = np.maximum.accumulate(values[i:])
     return out
 
-
-def _norm(v: NDArray) -> NDArray:
-    return np.sqrt(v[:, 0] * v[:, 0] + v[:, 1] * v[:, 1] + v[:, 2] * v[:, 2])

@@ -134,13 +134,6 @@ def rows_of(tools: NDArray | None, rows) -> NDArray | None:
     return None if tools is None else tools[rows]
 
 
-def norm3(vectors: NDArray) -> NDArray:
-    """Lengths of (..., 3) vectors: `np.linalg.norm(vectors, axis=-1)` (bit for bit: the same
-    sum in the same order), without its reduction over a short last axis (5x slower)."""
-    squares = vectors * vectors
-    return np.sqrt((squares[..., 0] + squares[..., 1]) + squares[..., 2])
-
-
 def row_max(values: NDArray) -> NDArray:
     """`values.max(axis=-1)` for a short last axis, one column at a time (numpy's reduction
     walks a short last axis a few at a time: 130 µs on (2500, 9), this 25)."""

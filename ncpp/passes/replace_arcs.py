@@ -22,10 +22,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ncpp.errors import Location, NcppError
+from ncpp.machine.chain import norm3
 from ncpp.motion.segments import PLANE_AXES, Arc, Event, Line
 from ncpp.passes.context import CutLine, PassContext
 from ncpp.passes.kernels import run_ahead
-from ncpp.passes.geometry import any3, before_line, compensate, frames, from_plane, in_plane, norm3, plane_axes, points, row_max, rows_of, spliced, tuples
+from ncpp.passes.geometry import any3, before_line, compensate, frames, from_plane, in_plane, plane_axes, points, row_max, rows_of, spliced, tuples
 from ncpp.passes.travel import grid, quantize
 
 # Points per piece where the fit is checked (ends included).  Fewer on short

@@ -17,10 +17,11 @@ from typing import Iterable, Iterator
 import numpy as np
 from numpy.typing import NDArray
 
+from ncpp.machine.chain import norm3
 from ncpp.machine.curvature import BowBound
 from ncpp.motion.segments import Event, Line
 from ncpp.passes.context import PassContext, deviation
-from ncpp.passes.geometry import chunked, frames, norm3, points, row_max, rows_of, spliced
+from ncpp.passes.geometry import chunked, frames, points, row_max, rows_of, spliced
 from ncpp.passes.kernels import run_ahead
 
 # Interior samples where linearity is checked.
