@@ -19,7 +19,9 @@ if TYPE_CHECKING:
 
 class ErrorMap(Protocol):
     """Anything that says where the tool really goes: a `Machine`, or a map
-    built straight from one measurement (`ncpp.passes.measured`)."""
+    built straight from one measurement (`ncpp.passes.measured`).  A map may also
+    have a `bow_bound` (`ncpp.machine.curvature.BowBound`, or None): with one,
+    subdivide_lines leaves unsampled the lines it keeps whole."""
 
     def deviation(self, P: NDArray, direction: NDArray | None = None, tool_offset: NDArray | None = None) -> NDArray:
         """(n,3) actual minus nominal tool point, mm, for (n,3) axis positions in mm

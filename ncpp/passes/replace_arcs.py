@@ -93,7 +93,8 @@ def _with_arcs(batch: list[Event], motion: "Motion") -> tuple[list[Event], list[
     """The batch, where its arcs to replace are, those arcs, and the direction each one's
     normal axis is compensated for (`Motion`)."""
     index = [k for k, e in enumerate(batch) if type(e) is Arc and not e.changed and not e.fixed]
-    return batch, index, [batch[k] for k in index], motion.normals(batch) if motion.directional else [0] * len(index)
+    arcs = [batch[k] for k in index]
+    return batch, index, arcs, motion.normals(batch, arcs)
 
 
 class Motion:
@@ -117,10 +118,14 @@ class Motion:
         if not directional and cut is not None:  # no guesses wanted (the map has no reversal errors): none made
             record.append(self.state)
 
-    def normals(self, batch: list[Event]) -> list[int]:
-        """The direction of each arc to replace's normal axis, in order; reads the batch's moves
-        (only where the map has reversal errors)."""
+    def normals(self, batch: list[Event], arcs: list[Arc]) -> list[int]:
+        """The direction of the normal axis of each of `arcs` (the batch's arcs to replace, in
+        order); reads the batch's moves (where the map has reversal errors: else all 0)."""
+        if not self.directional:
+            return [0] * len(arcs)
         out: list[int] = []
+        pending = iter(arcs)
+        arc = next(pending, None)
         x, y, z, lx, ly, lz = self.state
         line, cut = self.line, self.cut
         for event in batch:
@@ -132,7 +137,8 @@ class Motion:
                 self.record.append(_recorded((x, y, z, lx, ly, lz), cut.line))
             line = at
             (s0, s1, s2), (e0, e1, e2) = event.start, event.end
-            if kind is Arc and not event.changed and not event.fixed:
+            if event is arc:
+                arc = next(pending, None)
                 w = PLANE_AXES[event.context.plane][2]
                 rise = (e0 - s0, e1 - s1, e2 - s2)[w]
                 if rise:

@@ -12,7 +12,7 @@ from ncpp.machine.components import Table
 from ncpp.machine.effects import Scale
 from ncpp.motion.segments import Context, Line
 from ncpp.passes.context import PassContext
-from ncpp.passes.subdivide import SAFETY, PieceCounts, _with_rows
+from ncpp.passes.subdivide import PieceCounts, _with_rows
 from ncpp.pipeline import MachineMap
 from ncpp.program.blocks import Block
 from tests.conftest import ROOT
@@ -95,4 +95,3 @@ def test_lines_the_bound_keeps_whole_are_those_the_samples_keep_whole(bumpy):
     assert 0 < len(kept) < len(sampled[1])  # some left unsampled, some not
     assert all(counts[k] == 1 for k in kept)
     assert any(n > 1 for n in counts.values())  # (lines that the samples split are sampled)
-    assert SAFETY > 1

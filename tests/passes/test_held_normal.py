@@ -25,6 +25,10 @@ def _arc(start, end, centre, line, plane=17):
     return Arc(start, end, centre, -1, 500.0, Block("G2", "\n", (), line), Context(plane=plane))
 
 
+def _arcs(batch):
+    return [e for e in batch if type(e) is Arc]
+
+
 def test_an_arc_takes_the_direction_its_normal_axis_last_moved_in():
     motion = Motion(None, None, [])
     batch = [
@@ -36,20 +40,20 @@ def test_an_arc_takes_the_direction_its_normal_axis_last_moved_in():
         _arc((30.0, 0.0, -1.0), (40.0, 0.0, -1.0), (35.0, 0.0, -1.0), 6),  # after it Z is held up
         _arc((40.0, 0.0, -1.0), (40.0, 0.0, -1.0), (40.0, 5.0, -1.0), 7, plane=18),  # XZ: Y's, down in line 3's arc
     ]
-    assert motion.normals(batch) == [0, -1, 1, 1, -1]
+    assert motion.normals(batch, _arcs(batch)) == [0, -1, 1, 1, -1]
     # a batch later, the state goes on; a move older than HELD_LINES lines is not used
     later = _arc((40.0, 0.0, -1.0), (50.0, 0.0, -1.0), (45.0, 0.0, -1.0), 5 + HELD_LINES)  # Z last moved in line 5
-    assert Motion(motion.state, None, []).normals([later]) == [1]
+    assert Motion(motion.state, None, []).normals([later], [later]) == [1]
     stale = _arc((40.0, 0.0, -1.0), (50.0, 0.0, -1.0), (45.0, 0.0, -1.0), 6 + HELD_LINES)
-    assert motion.normals([stale]) == [0]
+    assert motion.normals([stale], [stale]) == [0]
 
 
 def test_the_state_at_a_cut_is_recorded_without_stale_moves():
     record: list = []
     motion = Motion(None, CutLine(2000), record)
-    motion.normals([_line((0.0, 0.0, 0.0), (1.0, 0.0, -1.0), 10), _line((1.0, 0.0, -1.0), (1.0, 2.0, -1.0), 1990)])
+    motion.normals([_line((0.0, 0.0, 0.0), (1.0, 0.0, -1.0), 10), _line((1.0, 0.0, -1.0), (1.0, 2.0, -1.0), 1990)], [])
     assert record == []
-    motion.normals([_line((1.0, 2.0, -1.0), (0.0, 2.0, -1.0), 2001)])
+    motion.normals([_line((1.0, 2.0, -1.0), (0.0, 2.0, -1.0), 2001)], [])
     # X moved (line 10) too long before the cut for a guess after it: left out; Y at line 1990 kept
     assert record == [(0, 1, 0, 0, 1990, 0)] == [_recorded((1, 1, -1, 10, 1990, 10), 2000)]
 
@@ -78,7 +82,7 @@ def test_pieces_of_arcs_after_a_plunge_are_shifted_less_often(source, monkeypatc
         return sum(shifted), len(re.findall(r"\bG2(?![\d.])", out.getvalue().decode()))
 
     guessed, pieces = shifted_pieces()
-    monkeypatch.setattr(replace_arcs.Motion, "normals", lambda self, batch: [0] * sum(type(e) is Arc for e in batch))
+    monkeypatch.setattr(replace_arcs.Motion, "normals", lambda self, batch, arcs: [0] * len(arcs))
     mean, _ = shifted_pieces()
     assert pieces >= 80  # four quadrants a circle
     assert mean == pieces

@@ -438,7 +438,7 @@ class IsoWriter:
         raw = block.raw
         # the block's layout, and a plan: blocks of one layout without comments whose numbers the
         # plan writes or drops all (but G words', in the signature) are its template with their numbers
-        key = (block.layout or self._layout_of(block), signature, bits, motion, spelled)
+        key = (self._layout_of(block), signature, bits, motion, spelled)
         edit = units.edits.get(key)
         if edit is None:
             plan = self._edit_plan(facts, signature, bits, motion, spelled, units)
