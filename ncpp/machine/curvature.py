@@ -92,10 +92,11 @@ class _AxisBound:
         c0, c1, c2, c3 = stacked.coefficients  # (curves, intervals), highest power first in (p − x_i)
         second = np.maximum(np.abs(2 * c1), np.abs(6 * c0 * h + 2 * c1))  # f'' is linear on an interval
         first = np.maximum(np.abs(c2), np.abs((3 * c0 * h + 2 * c1) * h + c2))
-        with np.errstate(divide="ignore", invalid="ignore"):  # f' has its extreme inside at −c1 / 3c0
-            vertex = np.where(c0 != 0, -c1 / (3 * c0), 0.0)
-        inside = (vertex > 0) & (vertex < h)
-        first = np.where(inside, np.maximum(first, np.abs(c2 - c1 * c1 / (3 * np.where(c0 != 0, c0, 1.0)))), first)
+        cubic = c0 != 0
+        safe = np.where(cubic, c0, 1.0)
+        vertex = -c1 / (3 * safe)  # where f' has its extreme, c2 − c1²/3c0, on a cubic piece
+        inside = cubic & (vertex > 0) & (vertex < h)
+        first = np.where(inside, np.maximum(first, np.abs(c2 - c1 * c1 / (3 * safe))), first)
         ends = ((c0 * h + c1) * h + c2) * h + c3
         delta2, eps2, eps1 = np.zeros(len(h)), np.zeros(len(h)), np.zeros(len(h))
         angle = 0.0
