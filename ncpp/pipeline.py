@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import gc
 import hashlib
+import shutil
+import tempfile
 from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
 from itertools import chain, count, islice
@@ -331,8 +333,13 @@ def process(
     jobs: int = 1,
     offsets: WorkOffsets | None = None,
     part: "Part | None" = None,
+    verify: bool = True,
 ) -> Stats:
     """Read, interpret, compensate (when `source` is given) and write one program.
+
+    A compensated program is verified before a byte of it reaches `out` (`ncpp/verify.py`):
+    it is written to a temporary file, read back and compared with the input, which is
+    read again (from its file, or from a copy of a piped stream).  `verify=False` skips it.
 
     The dialect is detected from the content (and the file name) unless given;
     it picks the interpreter and the writer (DIALECT_TOOLS).  `jobs` 2 or more:
@@ -341,6 +348,11 @@ def process(
     mm; none: the program zero is the machine zero), which place the program on
     the machine whose errors are compensated."""
     warnings = warnings or Warnings(strict=strict)
+    if source is not None and verify and part is None:
+        return _verified(stream, out, file, dialect, offsets, source, tolerance,
+                         lambda given, written: process(given, written, file=file, source=source, tolerance=tolerance,
+                                                        strict=strict, force=force, warnings=warnings, progress=progress,
+                                                        dialect=dialect, jobs=jobs, offsets=offsets, verify=False))  # fmt: skip
     # a program file long enough: two parts, one process each (parts.py)
     split = _two_parts(stream, file, dialect) if source is not None and jobs > 1 and part is None else None
     if split is not None:
@@ -358,6 +370,37 @@ def process(
     if part is None:  # a part's warnings are finished by the run it is part of
         warnings.finish()
     return stats
+
+
+def _verified(stream: BinaryIO, out: BinaryIO, file: str, dialect: str | None, offsets: WorkOffsets | None,
+              source: ErrorSource, tolerance: float, run: Callable[[BinaryIO, BinaryIO], Stats]) -> Stats:
+    """`run(stream, written)` to a temporary file, then the written program verified against
+    the input and copied to `out`: nothing is written when verification fails."""
+    from ncpp.verify import Bound, verify
+
+    with _again(stream) as (given, original), tempfile.TemporaryFile() as written:
+        stats = run(given, written)
+        written.seek(0)
+        verify(original, written, file=file, dialect=dialect, offsets=offsets,
+               bound=Bound(source.max_correction + tolerance))  # fmt: skip
+        written.seek(0)
+        shutil.copyfileobj(written, out, 1 << 20)
+    return stats
+
+
+@contextmanager
+def _again(stream: BinaryIO) -> Iterator[tuple[BinaryIO, BinaryIO]]:
+    """(the stream to compensate, the same program to read again): a program file is opened
+    a second time; anything else (a pipe) is copied to a temporary file read twice."""
+    path = program_file(stream)
+    if path is not None:
+        with open(path, "rb") as again:
+            yield stream, again
+        return
+    with tempfile.TemporaryFile() as copy:
+        shutil.copyfileobj(stream, copy, 1 << 20)
+        copy.seek(0)
+        yield copy, copy
 
 
 def _two_parts(stream: BinaryIO, file: str, dialect: str | None) -> tuple[str, int] | None:

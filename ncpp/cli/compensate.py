@@ -32,6 +32,13 @@ def add_compensation_arguments(p: argparse.ArgumentParser) -> None:
     source.add_argument("--from", dest="from_file", metavar="FILE", help="compensate from one measurement file")
     p.add_argument("--tolerance", type=tolerance_mm, default=0.001, metavar="MM", help="allowed path deviation, mm (default 0.001)")
     p.add_argument("--force", action="store_true", help="compensate a program ncpp has compensated before")
+    p.add_argument(
+        "--no-verify",
+        dest="verify",
+        action="store_false",
+        help="write the compensated program without reading it back and comparing it with the input "
+        "(by default a program whose actions or path differ from the input's is refused, and nothing is written)",
+    )
     add_placement_arguments(p)
     p.add_argument(
         "--jobs",
@@ -155,7 +162,7 @@ def run(args: argparse.Namespace) -> int:
     with open_input(args.input, spool_from(args.jobs)) as (stream, name), open_output(args.output) as out:
         stats = process(
             stream, out, file=name, source=source, tolerance=args.tolerance, strict=args.strict, force=args.force,
-            warnings=warnings, progress=progress, dialect=args.dialect, jobs=jobs_for(args.jobs, stream), offsets=work_offsets(args),
+            warnings=warnings, progress=progress, dialect=args.dialect, jobs=jobs_for(args.jobs, stream), offsets=work_offsets(args), verify=args.verify,
         )
     if progress is not None:
         progress.done()

@@ -41,7 +41,7 @@ def run(args: argparse.Namespace) -> int:
     spooled = spool_from(args.jobs) if source is not None else None  # (passthrough streams)
     with open_input(args.input, spooled) as (stream, name), open_output(args.output) as out:
         process(stream, out, file=name, source=source, tolerance=tolerance, strict=args.strict, force=args.force,
-                warnings=warnings, progress=progress, dialect=args.dialect, jobs=jobs_for(args.jobs, stream), offsets=offsets)  # fmt: skip
+                warnings=warnings, progress=progress, dialect=args.dialect, jobs=jobs_for(args.jobs, stream), offsets=offsets, verify=args.verify)  # fmt: skip
     if progress is not None:
         progress.done()
     return 1 if warnings.count and args.strict else 0

@@ -1,0 +1,130 @@
+"""The verifier judges a written program against the original by their motion and actions.
+
+Each test hands `verify` a program and a rewritten one by hand (no compensation runs):
+what the verifier must let through (corrections within the bound) and what it must stop.
+"""
+
+from __future__ import annotations
+
+import io
+
+import pytest
+
+from ncpp.errors import NcppError
+from ncpp.verify import Bound, verify
+
+ORIGINAL = """\
+G21 G90 G17
+T1 M6
+S1000 M3
+G0 X0 Y0 Z5
+G1 Z-1 F200
+X50 Y0
+G2 X60 Y10 I0 J10
+G1 Y40 F400
+G0 Z5
+M5
+M30
+"""
+
+
+def check(original: str, written: str, bound: float = 0.05, dialect: str = "iso") -> int:
+    return verify(io.BytesIO(original.encode()), io.BytesIO(written.encode()), file="part.ngc", dialect=dialect,
+                  offsets=None, bound=Bound(bound))  # fmt: skip
+
+
+def refused(original: str, written: str, bound: float = 0.05) -> NcppError:
+    with pytest.raises(NcppError) as caught:
+        check(original, written, bound)
+    return caught.value
+
+
+def test_the_same_program_passes():
+    assert check(ORIGINAL, ORIGINAL) >= 4  # sections: between T1, M6, S1000, M3, M5, M30
+
+
+def test_corrections_within_the_bound_and_pieces_pass():
+    written = ORIGINAL.replace("X50 Y0", "X25.01 Y0.01\nX50.02 Y0.01").replace("G1 Y40 F400", "G1 Y40.02 F400")
+    check(ORIGINAL, written)
+
+
+def test_a_point_beyond_the_bound_is_refused_at_its_line():
+    err = refused(ORIGINAL, ORIGINAL.replace("X50 Y0", "X50 Y0.2"))
+    assert err.where.line == 6 and "leaves" in err.message
+
+
+def test_a_missing_move_is_refused():
+    err = refused(ORIGINAL, ORIGINAL.replace("G1 Y40 F400\n", "F400\n"))
+    assert "path" in err.message and err.where.line in (7, 8, 9)
+
+
+def test_an_action_moved_along_the_path_is_refused():
+    written = ORIGINAL.replace("M5\n", "").replace("G0 Z5\nM30", "G0 Z5\nM5\nM30").replace("G1 Y40 F400", "G1 Y40 F400 M5")
+    err = refused(ORIGINAL, written)  # the path before M5 is not the original's
+    assert err.where.line in (8, 9, 10)
+
+
+def test_a_changed_action_is_refused():
+    err = refused(ORIGINAL, ORIGINAL.replace("S1000 M3", "S1000 M4"))
+    assert "'M4'" in err.message and "'M3'" in err.message and err.where.line == 3
+
+
+def test_a_changed_feed_rate_is_refused():
+    err = refused(ORIGINAL, ORIGINAL.replace("F400", "F401"))
+    assert "401" in err.message and err.where.line == 8
+
+
+def test_a_rapid_where_the_original_cuts_is_refused():
+    err = refused(ORIGINAL, ORIGINAL.replace("X50 Y0", "G0 X50 Y0\nG1"))
+    assert "rapid" in err.message
+
+
+def test_a_feed_where_the_original_rapids_is_refused():
+    err = refused(ORIGINAL, ORIGINAL.replace("G0 Z5\nM5", "G1 Z5\nM5"))
+    assert "feed move where the original rapids" in err.message
+
+
+def test_the_wrong_arc_direction_is_refused():
+    err = refused(ORIGINAL, ORIGINAL.replace("G2 X60", "G3 X60"))
+    assert err.where.line == 7
+
+
+def test_a_rotation_carried_by_one_piece_is_refused():
+    original = "G21 G90\nG0 X0 Y0 Z0 A0\nG1 X10 A90 F100\nM2\n"
+    pieces = "G21 G90\nG0 X0 Y0 Z0 A0\nG1 X5 A45 F100\nX10 A90\nM2\n"
+    check(original, pieces)
+    err = refused(original, "G21 G90\nG0 X0 Y0 Z0 A0\nG1 X0.001 A90 F100\nX10\nM2\n")
+    assert err.where.line == 3
+
+
+def test_inverse_time_pieces_share_the_moves_time():
+    original = "G21 G90\nG0 X0 Y0 Z0\nG93 G1 X10 F2\nG94\nM2\n"
+    check(original, "G21 G90\nG0 X0 Y0 Z0\nG93 G1 X5 F4\nX10 F4\nG94\nM2\n")
+    err = refused(original, "G21 G90\nG0 X0 Y0 Z0\nG93 G1 X5 F2\nX10 F2\nG94\nM2\n")
+    assert "inverse-time" in err.message
+
+
+def test_a_written_program_ncpp_cannot_read_is_refused_with_its_text():
+    err = refused(ORIGINAL, ORIGINAL.replace("X50 Y0", "G28 G0 X50 Y0"))
+    assert "G28 G0 X50 Y0" in err.message
+
+
+def test_a_written_program_that_ends_early_is_refused():
+    err = refused(ORIGINAL, ORIGINAL.replace("M5\nM30\n", ""))
+    assert "M5" in err.message
+
+
+def test_units_are_compared_in_mm():
+    inch = ORIGINAL.replace("G21", "G20")
+    check(inch, inch.replace("X50 Y0", "X50.0008 Y0"))  # 0.02 mm
+    err = refused(inch, inch.replace("G1 Y40", "G1 X60.004 Y40"))  # 0.1 mm
+    assert err.where.line == 8
+
+
+def test_heidenhain_tool_calls_are_actions():
+    original = ("0 BEGIN PGM P MM\n1 TOOL CALL 1 Z S2000\n2 L X+0 Y+0 Z+5 R0 FMAX M3\n3 L Z-1 F200\n"
+                "4 L X+50\n5 TOOL CALL 2 Z S3000\n6 L X+0\n7 END PGM P MM\n")
+    check(original, original, dialect="heidenhain")
+    with pytest.raises(NcppError) as caught:
+        check(original, original.replace("TOOL CALL 2 Z S3000", "TOOL CALL 3 Z S3000"), dialect="heidenhain")
+    assert "TOOLCALL3" in caught.value.message
