@@ -15,9 +15,11 @@ the passes' state) and compares it with the input program's motion:
   rate; in inverse time (G93) the pieces of a move take its time together.
 
 Paths are compared in machine coordinates (mm, tool length and work offsets
-applied), sampled every quarter of the bound: a point found within the bound
-less half a step of a sample is within the bound of the path.  A violation is
-an `NcppError` at the input line where it happens.
+applied), sampled every quarter of the bound: a written program passes when
+each sample of either path lies within the bound and half a step of a sample
+of the other's (so no correction within the bound is refused, and every point
+passed is within 1.25 times the bound).  A violation is an `NcppError` at the
+input line where it happens.
 """
 
 from __future__ import annotations
@@ -35,7 +37,6 @@ from ncpp.motion.offsets import AT_MACHINE_ZERO, WorkOffsets
 from ncpp.motion.segments import EXTRA_AXES, PLANE_AXES, Arc, Event, Line, Pass
 from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
 
-WIDTH = 3 + len(EXTRA_AXES)  # a sample's coordinates: X Y Z, then A B C U V W
 # G codes whose block is an action: dwell, tool length offsets
 ACTION_G = {4.0, 43.0, 43.1, 43.2, 49.0}
 # Word letters that are actions wherever they stand: M functions, tools, spindle speed,
@@ -60,7 +61,7 @@ class Action:
 class Section:
     """The motion between two actions, sampled; `action` is the one that ends it."""
 
-    points: np.ndarray  # (n, WIDTH) machine mm (extra axes in their own unit)
+    points: np.ndarray  # (n, 3) machine mm, or (n, 9) with A B C U V W (each in its own unit)
     rapid: np.ndarray  # (n,) bool
     lines: np.ndarray  # (n,) source line of each sample
     feeds: list[tuple[float, int]]  # G94/G95 feed rates in order, each once per run, with its first line
@@ -69,74 +70,86 @@ class Section:
     first_line: int
 
 
+NO_EXTRA = (0.0,) * len(EXTRA_AXES)
+
+
 @dataclass
 class _Moves:
     """Moves collected for one section, sampled when it closes."""
 
     step: float
-    starts: list = field(default_factory=list)
-    ends: list = field(default_factory=list)
+    ends: list = field(default_factory=list)  # per move: (x0, y0, z0, x1, y1, z1) machine mm
+    extra: list = field(default_factory=list)  # per move: its extra axes' start and end (NO_EXTRA twice: none)
     rapid: list = field(default_factory=list)
     lines: list = field(default_factory=list)
-    arcs: list = field(default_factory=list)  # per move: None or (plane, centre i, centre j, turn)
+    arcs: list = field(default_factory=list)  # (move, plane, centre's first, centre's second coordinate, turn)
     feeds: list = field(default_factory=list)
     inverse_time: float = 0.0
 
     def sample(self, action: Action | None, first_line: int) -> Section:
-        if not self.starts:
-            empty = np.zeros((0, WIDTH))
+        """The moves sampled every `step` (each from its start to its end, both included)."""
+        if not self.ends:
+            empty = np.zeros((0, 3))
             return Section(empty, np.zeros(0, bool), np.zeros(0, int), self.feeds, self.inverse_time, action, first_line)
-        starts, ends = np.array(self.starts), np.array(self.ends)
-        lengths = np.array([_length(s, e, arc) for s, e, arc in zip(self.starts, self.ends, self.arcs)])
+        ends = np.array(self.ends)
+        starts, ends = ends[:, :3], ends[:, 3:]
+        if any(e is not NO_EXTRA for pair in self.extra for e in pair):
+            extra = np.array([s + e for s, e in self.extra])
+            starts = np.hstack((starts, extra[:, : len(EXTRA_AXES)]))
+            ends = np.hstack((ends, extra[:, len(EXTRA_AXES) :]))
+        lengths = np.sqrt(((ends - starts) ** 2).sum(axis=1))
+        arcs = _Arcs(self.arcs, starts, ends) if self.arcs else None
+        if arcs is not None:
+            lengths[arcs.move] += arcs.length
         counts = np.maximum(1, np.ceil(lengths / self.step).astype(np.int64))
         move = np.repeat(np.arange(len(counts)), counts + 1)
         first = np.concatenate(([0], np.cumsum(counts + 1)[:-1]))
         t = (np.arange(len(move)) - first[move]) / counts[move]
         points = starts[move] + t[:, None] * (ends - starts)[move]
-        for k, arc in enumerate(self.arcs):
-            if arc is not None:
-                rows = slice(first[k], first[k] + counts[k] + 1)
-                _bend(points[rows], t[rows], starts[k], ends[k], arc)
-        rapid = np.array(self.rapid)[move]
-        lines = np.array(self.lines)[move]
-        return Section(points, rapid, lines, self.feeds, self.inverse_time, action, first_line)
+        if arcs is not None:
+            arcs.bend(points, move, t)
+        return Section(points, np.array(self.rapid)[move], np.array(self.lines)[move], self.feeds, self.inverse_time,
+                       action, first_line)  # fmt: skip
 
 
-def _length(start: np.ndarray, end: np.ndarray, arc: tuple | None) -> float:
-    chord = float(np.linalg.norm(end - start))
-    if arc is None:
-        return chord
-    plane, ci, cj, turn = arc
-    i, j, _ = PLANE_AXES[plane]
-    radius = max(math.hypot(start[i] - ci, start[j] - cj), math.hypot(end[i] - ci, end[j] - cj))
-    return abs(_sweep(start, end, arc)) * radius + chord
+class _Arcs:
+    """A section's arcs, as arrays: what their samples need to lie on them."""
+
+    def __init__(self, arcs: list, starts: np.ndarray, ends: np.ndarray):
+        table = np.array([(m, *PLANE_AXES[plane][:2], ci, cj, turn) for m, plane, ci, cj, turn in arcs])
+        self.move = table[:, 0].astype(np.int64)
+        i, j = table[:, 1].astype(np.int64), table[:, 2].astype(np.int64)
+        self.i, self.j, self.ci, self.cj = i, j, table[:, 3], table[:, 4]
+        rows = self.move
+        s_i, s_j = starts[rows, i] - self.ci, starts[rows, j] - self.cj
+        e_i, e_j = ends[rows, i] - self.ci, ends[rows, j] - self.cj
+        self.a0 = np.arctan2(s_j, s_i)
+        self.r0, self.r1 = np.hypot(s_i, s_j), np.hypot(e_i, e_j)
+        self.sweep = _sweeps(self.a0, np.arctan2(e_j, e_i), table[:, 5])
+        self.length = np.abs(self.sweep) * np.maximum(self.r0, self.r1)
+
+    def bend(self, points: np.ndarray, move: np.ndarray, t: np.ndarray) -> None:
+        """Put the arcs' samples (made along their chords) on the arcs, in place; the radius
+        changes linearly from start to end, as rs274 interpolates an arc whose radii differ."""
+        which = np.full(int(move.max()) + 1, -1)
+        which[self.move] = np.arange(len(self.move))
+        k = which[move]
+        on = np.flatnonzero(k >= 0)
+        k = k[on]
+        angle = self.a0[k] + self.sweep[k] * t[on]
+        radius = self.r0[k] + (self.r1[k] - self.r0[k]) * t[on]
+        points[on, self.i[k]] = self.ci[k] + radius * np.cos(angle)
+        points[on, self.j[k]] = self.cj[k] + radius * np.sin(angle)
 
 
-def _sweep(start: np.ndarray, end: np.ndarray, arc: tuple) -> float:
-    """Signed angle an arc turns (rs274's ARC_FEED rotation: +1 counter-clockwise)."""
-    plane, ci, cj, turn = arc
-    i, j, _ = PLANE_AXES[plane]
-    a0 = math.atan2(start[j] - cj, start[i] - ci)
-    a1 = math.atan2(end[j] - cj, end[i] - ci)
-    full = 2 * math.pi
-    if turn > 0:
-        d = (a1 - a0) % full
-        return (d if d > 1e-12 else full) + full * (turn - 1)
-    d = (a0 - a1) % full
-    return -((d if d > 1e-12 else full) + full * (-turn - 1))
-
-
-def _bend(points: np.ndarray, t: np.ndarray, start: np.ndarray, end: np.ndarray, arc: tuple) -> None:
-    """Put an arc's samples (made along its chord) on the arc, in place; the radius changes
-    linearly from start to end, as rs274 interpolates an arc whose radii differ."""
-    plane, ci, cj, _ = arc
-    i, j, _ = PLANE_AXES[plane]
-    a0 = math.atan2(start[j] - cj, start[i] - ci)
-    r0, r1 = math.hypot(start[i] - ci, start[j] - cj), math.hypot(end[i] - ci, end[j] - cj)
-    angle = a0 + _sweep(start, end, arc) * t
-    radius = r0 + (r1 - r0) * t
-    points[:, i] = ci + radius * np.cos(angle)
-    points[:, j] = cj + radius * np.sin(angle)
+def _sweeps(a0: np.ndarray, a1: np.ndarray, turn: np.ndarray) -> np.ndarray:
+    """Signed angles arcs turn (rs274's ARC_FEED rotation: +1 counter-clockwise, |turn| > 1 adds turns)."""
+    full = 2 * np.pi
+    ccw = (a1 - a0) % full
+    cw = (a0 - a1) % full
+    ccw = np.where(ccw > 1e-12, ccw, full) + full * (turn - 1)
+    cw = -(np.where(cw > 1e-12, cw, full) + full * (-turn - 1))
+    return np.where(turn > 0, ccw, cw)
 
 
 def actions_of(block: Block) -> tuple[list[str], list[str]]:
@@ -165,8 +178,7 @@ def actions_of(block: Block) -> tuple[list[str], list[str]]:
 def sections(events: Iterable[Event], step: float) -> Iterator[Section]:
     """The motion of a program's events between its actions, in the order it runs."""
     moves = _Moves(step)
-    position: np.ndarray | None = None
-    extra = np.zeros(len(EXTRA_AXES))
+    extra: tuple[float, ...] = NO_EXTRA
     last: Block | None = None
     after: list[str] = []
     first_line = 1
@@ -180,48 +192,51 @@ def sections(events: Iterable[Event], step: float) -> Iterator[Section]:
                 moves, first_line = _Moves(step), last.line  # type: ignore[union-attr]
             after = []
             last = block
-            if not (kind is Pass and event.skipped):  # type: ignore[union-attr]
+            if not (kind is Pass and event.skipped) and _may_act(block.signature):  # type: ignore[union-attr]
                 before, after = actions_of(block)
                 inverse_time = _inverse_time(block, inverse_time)
                 for text in before:
                     yield moves.sample(Action(text, block.line), first_line)
                     moves, first_line = _Moves(step), block.line
-        if kind is not Line and kind is not Arc:
-            continue
-        ctx = event.context  # type: ignore[union-attr]
-        if event.extra:  # type: ignore[union-attr]
-            extra = np.zeros(len(EXTRA_AXES))
-            extra[: len(event.extra)] = event.extra  # type: ignore[union-attr]
-        start = np.concatenate((ctx.to_machine(event.start), position[3:] if position is not None else extra))  # type: ignore[union-attr]
-        end = np.concatenate((ctx.to_machine(event.end), extra))  # type: ignore[union-attr]
-        arc = None
-        if kind is Arc:
-            i, j, _ = PLANE_AXES[ctx.plane]
-            centre = ctx.to_machine(event.center)  # type: ignore[union-attr]
-            arc = (ctx.plane, centre[i], centre[j], event.turn)  # type: ignore[union-attr]
-        _add(moves, start, end, arc, event, inverse_time)  # type: ignore[arg-type]
-        position = end
+        if kind is Line or kind is Arc:
+            extra = _add(moves, event, extra, inverse_time)  # type: ignore[arg-type]
     for text in after:
         yield moves.sample(Action(text, last.line), first_line)  # type: ignore[union-attr]
         moves = _Moves(step)
     yield moves.sample(None, first_line)
 
 
-def _add(moves: _Moves, start: np.ndarray, end: np.ndarray, arc: tuple | None, event: Line | Arc, inverse_time: bool) -> None:
+def _may_act(signature: str | None) -> bool:
+    """Whether a block may hold an action or a feed mode: its signature (the letters of a plain
+    block's words, G words with their numbers) names one; None (not a plain block) may."""
+    return signature is None or any(c in signature for c in "MTSHDP") or "G4" in signature or "G9" in signature
+
+
+def _add(moves: _Moves, event: Line | Arc, extra: tuple[float, ...], inverse_time: bool) -> tuple[float, ...]:
+    """Add a move; return the extra axes' positions after it."""
+    ctx = event.context
+    (ox, oy, oz), u = ctx.offset, ctx.unit_mm
+    (x0, y0, z0), (x1, y1, z1) = event.start, event.end
+    moves.ends.append(((x0 + ox) * u, (y0 + oy) * u, (z0 + oz) * u, (x1 + ox) * u, (y1 + oy) * u, (z1 + oz) * u))
+    end_extra = (tuple(event.extra) + NO_EXTRA)[: len(EXTRA_AXES)] if event.extra else extra
+    moves.extra.append((extra, end_extra))
     rapid = type(event) is Line and event.rapid  # type: ignore[union-attr]
-    moves.starts.append(start)
-    moves.ends.append(end)
     moves.rapid.append(rapid)
-    moves.lines.append(event.block.line)
-    moves.arcs.append(arc)
-    if rapid:
-        return
-    if inverse_time:
-        moves.inverse_time += 1.0 / event.feed if event.feed > 0 else math.inf
-        return
-    feed = event.feed * event.context.unit_mm
-    if not moves.feeds or not math.isclose(moves.feeds[-1][0], feed, rel_tol=1e-9, abs_tol=1e-9):
-        moves.feeds.append((feed, event.block.line))
+    line = event.block.line
+    moves.lines.append(line)
+    if type(event) is Arc:
+        i, j, _ = PLANE_AXES[ctx.plane]
+        cx, cy, cz = event.center
+        centre = ((cx + ox) * u, (cy + oy) * u, (cz + oz) * u)
+        moves.arcs.append((len(moves.ends) - 1, ctx.plane, centre[i], centre[j], event.turn))
+    if not rapid:
+        if inverse_time:
+            moves.inverse_time += 1.0 / event.feed if event.feed > 0 else math.inf
+        else:
+            feed = event.feed * u
+            if not moves.feeds or not math.isclose(moves.feeds[-1][0], feed, rel_tol=1e-9, abs_tol=1e-9):
+                moves.feeds.append((feed, line))
+    return end_extra
 
 
 def _inverse_time(block: Block, now: bool) -> bool:
@@ -306,10 +321,10 @@ def compare(original: Section, written: Section, bound: Bound, file: str) -> Non
     if (a is None) != (b is None) or (a is not None and a.text != b.text):  # type: ignore[union-attr]
         where = a.line if a is not None else original.first_line
         raise NcppError(f"verification: the written program does {_what(b)} where the original does {_what(a)}", Location(file, where, 1))
-    within = bound.distance - bound.step / 2
-    _follows(written, original, within, file, "the written path leaves the original's", True)
-    _follows(original, written, within, file, "the written path does not follow the original's", False)
-    _same_kind(original, written, within, file)
+    within = bound.distance + bound.step / 2  # a point of either path lies within `step` / 2 of a sample
+    width = max(original.points.shape[1], written.points.shape[1])
+    _follows(written, original, within, width, file, "the written path leaves the original's", True)
+    _follows(original, written, within, width, file, "the written path does not follow the original's", False)
     _same_feeds(original, written, file)
 
 
@@ -317,37 +332,42 @@ def _what(action: Action | None) -> str:
     return f"'{action.text}'" if action is not None else "nothing more"
 
 
-def _follows(path: Section, along: Section, within: float, file: str, message: str, report_nearest: bool) -> None:
-    """Raise where a sample of `path` lies further than `within` from every sample of `along`."""
+def _follows(path: Section, along: Section, within: float, width: int, file: str, message: str, written: bool) -> None:
+    """Raise where a sample of `path` lies further than `within` from every sample of `along`
+    of its kind (rapid or feed).  A written path's fault is told at the original's nearest line."""
     if not len(path.points):
         return
     if not len(along.points):
-        line = along.first_line if report_nearest else int(path.lines[0])
+        line = along.first_line if written else int(path.lines[0])
         raise NcppError(f"verification: {message}: it has no move here", Location(file, line, 1))
-    tree = cKDTree(along.points)
-    distance, _ = tree.query(path.points, distance_upper_bound=within)
+    apart = 4 * within  # a rapid's samples lie this far from a feed's along an extra coordinate
+    tree = cKDTree(_coordinates(along, width, apart))
+    distance, _ = tree.query(_coordinates(path, width, apart), distance_upper_bound=within)
     far = np.flatnonzero(np.isinf(distance))
-    if len(far):
-        k = int(far[0])
-        line = int(along.lines[tree.query(path.points[k])[1]]) if report_nearest else int(path.lines[k])
-        raise NcppError(f"verification: {message} by more than {within:.4f} mm", Location(file, line, 1))
+    if not len(far):
+        return
+    k = int(far[0])
+    point = _coordinates(path, width, 0.0)[k]
+    gap, near = cKDTree(_coordinates(along, width, 0.0)).query(point)
+    line = int(along.lines[near]) if written else int(path.lines[k])
+    if gap <= within and written:
+        message = "the written program makes a " + ("rapid move where the original cuts" if path.rapid[k] else "feed move where the original rapids")
+    elif gap <= within:
+        message = "the written program " + ("feeds where the original rapids" if path.rapid[k] else "rapids where the original cuts")
+    else:
+        message = f"{message} by more than {within:.4f} mm"
+    raise NcppError(f"verification: {message}", Location(file, line, 1))
 
 
-def _same_kind(original: Section, written: Section, within: float, file: str) -> None:
-    """Feeds only where the original feeds, rapids only where it rapids."""
-    for rapid, label in ((False, "a feed move where the original rapids"), (True, "a rapid move where the original cuts")):
-        mine = written.points[written.rapid == rapid]
-        if not len(mine):
-            continue
-        theirs = original.points[original.rapid == rapid]
-        if not len(theirs):
-            raise NcppError(f"verification: the written program makes {label}", Location(file, original.first_line, 1))
-        distance, _ = cKDTree(theirs).query(mine, distance_upper_bound=within)
-        far = np.flatnonzero(np.isinf(distance))
-        if len(far):
-            point = mine[int(far[0])]
-            _, near = cKDTree(original.points).query(point)
-            raise NcppError(f"verification: the written program makes {label}", Location(file, int(original.lines[near]), 1))
+def _coordinates(section: Section, width: int, apart: float) -> np.ndarray:
+    """A section's samples as `width` coordinates (extra axes zero where it has none), and,
+    with `apart`, one more that keeps rapids' and feeds' samples that far apart."""
+    points = section.points
+    if points.shape[1] < width:
+        points = np.hstack((points, np.zeros((len(points), width - points.shape[1]))))
+    if apart:
+        points = np.hstack((points, (section.rapid * apart)[:, None]))
+    return points
 
 
 def _same_feeds(original: Section, written: Section, file: str) -> None:

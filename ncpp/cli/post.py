@@ -39,10 +39,10 @@ def run(args: argparse.Namespace) -> int:
     progress = progress_printer("post")
     with open_output(args.output) as out:
         if args.input == "-":
-            post(sys.stdin, out, file="<stdin>", dialect=args.dialect, source=source, tolerance=args.tolerance, warnings=warnings, progress=progress, offsets=offsets)
+            post(sys.stdin, out, file="<stdin>", dialect=args.dialect, source=source, tolerance=args.tolerance, warnings=warnings, progress=progress, offsets=offsets, verify=args.verify)
         else:
             with open(args.input, encoding="latin-1") as stream:
-                post(stream, out, file=args.input, dialect=args.dialect, source=source, tolerance=args.tolerance, warnings=warnings, progress=progress, offsets=offsets)
+                post(stream, out, file=args.input, dialect=args.dialect, source=source, tolerance=args.tolerance, warnings=warnings, progress=progress, offsets=offsets, verify=args.verify)
     if progress is not None:
         progress.done()
     return 0

@@ -63,10 +63,61 @@ def post(
     warnings: Warnings | None = None,
     progress: Callable[[int], None] | None = None,
     offsets: WorkOffsets | None = None,
+    verify: bool = True,
 ) -> int:
     """Post one CL file as a `dialect` program (compensated when `source` is an
     `ncpp.pipeline.ErrorSource`, the CL origin at `offsets`' G54 zero);
-    returns the number of lines written."""
+    returns the number of lines written.
+
+    A compensated program is verified before it is written (`ncpp/verify.py`): the CL
+    data is posted a second time without compensation, and the compensated program
+    must do what that one does (`verify=False` skips it)."""
+    if source is not None and verify:
+        return _verified(stream, out, file=file, dialect=dialect, source=source, tolerance=tolerance,
+                         warnings=warnings, progress=progress, offsets=offsets)  # fmt: skip
+    return _post(stream, out, file=file, dialect=dialect, source=source, tolerance=tolerance,
+                 warnings=warnings, progress=progress, offsets=offsets)  # fmt: skip
+
+
+def _verified(stream: TextIO, out: BinaryIO, *, file: str, dialect: str, source, tolerance: float, warnings: Warnings | None,
+              progress: Callable[[int], None] | None, offsets: WorkOffsets | None) -> int:  # fmt: skip
+    """Post compensated and uncompensated to temporary files; verify, then copy to `out`."""
+    import io
+    import shutil
+    import tempfile
+
+    from ncpp.verify import Bound, verify
+
+    with tempfile.TemporaryFile("w+", encoding="latin-1") as cl, tempfile.TemporaryFile() as plain, \
+            tempfile.TemporaryFile() as written:  # fmt: skip
+        shutil.copyfileobj(stream, cl)
+        cl.seek(0)
+        count = _post(cl, written, file=file, dialect=dialect, source=source, tolerance=tolerance, warnings=warnings,
+                      progress=progress, offsets=offsets)  # fmt: skip
+        cl.seek(0)
+        _post(cl, plain, file=file, dialect=dialect, source=None, warnings=Warnings(stream=io.StringIO()), offsets=offsets)
+        plain.seek(0)
+        written.seek(0)
+        nc = "iso" if dialect in ("linuxcnc", "fanuc") else dialect
+        verify(plain, written, file=f"{file} (posted uncompensated)", dialect=nc, offsets=offsets,
+               bound=Bound(source.max_correction + tolerance))  # fmt: skip
+        written.seek(0)
+        shutil.copyfileobj(written, out)
+    return count
+
+
+def _post(
+    stream: TextIO,
+    out: BinaryIO,
+    *,
+    file: str,
+    dialect: str,
+    source=None,
+    tolerance: float = 0.001,
+    warnings: Warnings | None = None,
+    progress: Callable[[int], None] | None = None,
+    offsets: WorkOffsets | None = None,
+) -> int:
     from ncpp.passes import PASSES, run_passes
     from ncpp.pipeline import header_text, make_context
 
