@@ -1,0 +1,77 @@
+"""Every ISO program of the corpus that LinuxCNC runs, compensated on the wide test machine,
+judged by an oracle ncpp did not write: `shared/tools/pathcheck` runs LinuxCNC's rs274 on the
+original and on ncpp's output and checks the same actions in the same order, the path within
+its tolerance, rapids as rapids and feeds as feeds.
+
+No program is skipped for not fitting a machine: wide.toml's travel holds them all at work
+offset 0.  A program rs274 runs that ncpp refuses fails the test, unless the refusal is one of
+ncpp's documented scope limits (`SCOPE_LIMITS`, matched by its message).
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from tests.conftest import CORPUS, RS274, SHARED, corpus_files, corpus_id
+
+pytestmark = [pytest.mark.oracle, pytest.mark.slow]
+
+PATHCHECK = SHARED / "tools" / "pathcheck"
+WIDE = SHARED / "machines" / "wide.toml"
+# Refusals that are ncpp's documented scope, not faults (docs/conformance.md): the message
+# ncpp gives, matched against its error line.
+SCOPE_LIMITS: dict[str, str] = {}
+
+
+def tool_table(folder: Path) -> Path:
+    """Tools 1-99 with lengths of 10.7-60.5 mm and diameters of 0.5-1 mm, for rs274 and ncpp
+    alike (in inches: the stand-alone rs274 reads its tool table so, ncpp is told --var-units inch)."""
+    path = folder / "tools.tbl"
+    if not path.exists():
+        path.write_text("".join(f"T{n} P{n} Z{0.4 + 0.02 * n:.2f} D{0.02 + 0.005 * (n % 5):.3f} ;tool {n}\n" for n in range(1, 100)))
+    return path
+
+
+def rs274_runs(program: Path, tools: Path) -> bool:
+    env = dict(os.environ, RS274_TOOL_TABLE=str(tools))
+    proc = subprocess.run([str(RS274), str(program)], capture_output=True, text=True, errors="replace", timeout=600,
+                          cwd=program.parent, env=env, stdin=subprocess.DEVNULL)  # fmt: skip
+    if "executing" not in proc.stderr:
+        pytest.skip(f"rs274 oracle did not run: {proc.stderr.strip()[:200]}")
+    errors = [line for line in proc.stderr.splitlines() if line.strip() and line.strip() != "executing"]
+    return not errors or errors[0].startswith("File ended with no percent sign or program end")
+
+
+def programs() -> list[Path]:
+    return corpus_files("iso_gcode") if CORPUS.is_dir() else []
+
+
+@pytest.fixture(scope="module")
+def tools(tmp_path_factory) -> Path:
+    return tool_table(tmp_path_factory.mktemp("tools"))
+
+
+@pytest.mark.parametrize("program", programs(), ids=corpus_id)
+def test_pathcheck_passes_on_the_compensated_program(program: Path, tools: Path, tmp_path: Path):
+    if not (PATHCHECK.exists() and WIDE.exists()):
+        pytest.skip(f"pathcheck or wide.toml not found under {SHARED}")
+    if not rs274_runs(program, tools):
+        pytest.skip("rs274 refuses the original: nothing to compare")
+    written = tmp_path / (program.name + ".out.ngc")
+    proc = subprocess.run([sys.executable, "-m", "ncpp", "compensate", "--machine", str(WIDE), "--tool-table", str(tools),
+                           "--var-units", "inch", str(program), "-o", str(written)],
+                          capture_output=True, text=True, errors="replace", timeout=1800, stdin=subprocess.DEVNULL)  # fmt: skip
+    if proc.returncode != 0:
+        error = next((line for line in proc.stderr.splitlines() if ": warning: " not in line), proc.stderr)
+        limit = next((name for name, pattern in SCOPE_LIMITS.items() if re.search(pattern, error)), None)
+        assert limit is not None, f"ncpp refuses a program rs274 runs: {error}"
+        return
+    check = subprocess.run([sys.executable, str(PATHCHECK), str(program), str(written), "--tool-table", str(tools)],
+                           capture_output=True, text=True, timeout=1800)  # fmt: skip
+    assert check.returncode == 0, check.stdout + check.stderr
