@@ -12,7 +12,8 @@ the passes' state) and compares it with the input program's motion:
   written path (rotary and other extra axes count their unit as a mm, so a
   rotation carried by the wrong piece leaves the path);
 * rapids where the input rapids and feeds where it feeds, at the same feed
-  rate; in inverse time (G93) the pieces of a move take its time together.
+  rates in the same order; in inverse time (G93) the pieces of a move take
+  its time together.
 
 Paths are compared in machine coordinates (mm, tool length and work offsets
 applied), sampled every quarter of the bound: a written program passes when
@@ -20,14 +21,22 @@ each sample of either path lies within the bound and half a step of a sample
 of the other's (so no correction within the bound is refused, and every point
 passed is within 1.25 times the bound).  A violation is an `NcppError` at the
 input line where it happens.
+
+A long run of moves between two actions is compared in chunks of about
+`CHUNK_MOVES` moves (memory stays flat in program length).  The pipeline tags
+each written line with the input line the writer had reached (`verified`), and
+the written program's chunk ends where the input's does by those tags; as a
+writer may be a block ahead of the lines it hands out, each side of a chunk is
+also compared with the other side's samples just across the cut.
 """
 
 from __future__ import annotations
 
 import math
+from collections import deque
 from dataclasses import dataclass, field
-from itertools import zip_longest
-from typing import BinaryIO, Iterable, Iterator
+from itertools import chain
+from typing import BinaryIO, Callable, Iterable, Iterator
 
 import numpy as np
 from scipy.spatial import cKDTree
@@ -35,7 +44,7 @@ from scipy.spatial import cKDTree
 from ncpp.errors import Location, NcppError, Warnings
 from ncpp.motion.offsets import AT_MACHINE_ZERO, WorkOffsets
 from ncpp.motion.segments import EXTRA_AXES, PLANE_AXES, Arc, Event, Line, Pass
-from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
+from ncpp.program.blocks import Block, ExprWord, Statement, Word
 
 # G codes whose block is an action: dwell, tool length offsets
 ACTION_G = {4.0, 43.0, 43.1, 43.2, 49.0}
@@ -47,6 +56,8 @@ ACTION_LETTERS = {"M", "T", "S", "H", "D"}
 AFTER_MOTION = {0.0, 1.0, 2.0, 30.0, 60.0}
 # Statements that are actions: Klartext's TOOL CALL, CYCL CALL and END PGM
 ACTION_STATEMENTS = {"tool_call", "cycle_call", "program_end"}
+CHUNK_MOVES = 16384  # moves of the input compared at a time between two actions
+ACROSS = 0.25  # the share of a neighbouring chunk's samples each side is also compared with
 
 
 @dataclass(frozen=True)
@@ -59,7 +70,8 @@ class Action:
 
 @dataclass
 class Section:
-    """The motion between two actions, sampled; `action` is the one that ends it."""
+    """The motion between two actions (or a chunk of it, `cut`), sampled; `action` is the
+    one that ends it (None at a cut and at the program's end)."""
 
     points: np.ndarray  # (n, 3) machine mm, or (n, 9) with A B C U V W (each in its own unit)
     rapid: np.ndarray  # (n,) bool
@@ -68,6 +80,7 @@ class Section:
     inverse_time: float  # minutes the G93 moves take
     action: Action | None
     first_line: int
+    cut: int = 0  # a chunk's end: the input line the next chunk starts at (0: not a chunk)
 
 
 NO_EXTRA = (0.0,) * len(EXTRA_AXES)
@@ -152,6 +165,7 @@ def _sweeps(a0: np.ndarray, a1: np.ndarray, turn: np.ndarray) -> np.ndarray:
     return np.where(turn > 0, ccw, cw)
 
 
+
 def actions_of(block: Block) -> tuple[list[str], list[str]]:
     """The actions of a block: (before its motion, after it), each as normalised text."""
     before: list[str] = []
@@ -175,8 +189,12 @@ def actions_of(block: Block) -> tuple[list[str], list[str]]:
     return before, after
 
 
-def sections(events: Iterable[Event], step: float) -> Iterator[Section]:
-    """The motion of a program's events between its actions, in the order it runs."""
+Cut = Callable[[Block, int], int]  # (a block, the chunk's moves so far) -> the input line to cut at (0: none)
+
+
+def sections(events: Iterable[Event], step: float, cut: Cut = lambda block, moves: 0) -> Iterator[Section]:
+    """The motion of a program's events between its actions, in the order it runs; a chunk
+    ends before a block where `cut` says."""
     moves = _Moves(step)
     extra: tuple[float, ...] = NO_EXTRA
     last: Block | None = None
@@ -192,6 +210,11 @@ def sections(events: Iterable[Event], step: float) -> Iterator[Section]:
                 moves, first_line = _Moves(step), last.line  # type: ignore[union-attr]
             after = []
             last = block
+            if moves.ends and (at := cut(block, len(moves.ends))):
+                chunk = moves.sample(None, first_line)
+                chunk.cut = at
+                yield chunk
+                moves, first_line = _Moves(step), block.line
             if not (kind is Pass and event.skipped) and _may_act(block.signature):  # type: ignore[union-attr]
                 before, after = actions_of(block)
                 inverse_time = _inverse_time(block, inverse_time)
@@ -247,23 +270,6 @@ def _inverse_time(block: Block, now: bool) -> bool:
     return now
 
 
-def read_sections(stream: BinaryIO, file: str, dialect: str, offsets: WorkOffsets | None, step: float) -> Iterator[Section]:
-    """A program's sections as ncpp's parser and interpreter read its text afresh."""
-    from ncpp.pipeline import dialect_tools
-    from ncpp.program.dialects import parse_program
-
-    name, blocks = parse_program(stream, file, dialect)
-    interpret, _ = dialect_tools(name)
-    quiet = Warnings(stream=_Discard())
-    events = interpret(blocks, file=file, warnings=quiet, offsets=offsets or AT_MACHINE_ZERO)
-    return sections(events, step)
-
-
-class _Discard:
-    def write(self, text: str) -> int:
-        return len(text)
-
-
 @dataclass(frozen=True)
 class Bound:
     """How far a written path may lie from the programmed one (mm)."""
@@ -274,89 +280,265 @@ class Bound:
     def step(self) -> float:
         return self.distance / 4
 
+    @property
+    def within(self) -> float:
+        """How far a sample may lie from the other path's samples: a point of either path lies
+        within half a step of a sample of its own."""
+        return self.distance + self.step / 2
+
+
+def _interpreted(blocks: Iterable[Block], file: str, dialect: str, offsets: WorkOffsets | None) -> Iterator[Event]:
+    """A program's events as ncpp's interpreter reads its blocks, its warnings unsaid."""
+    from ncpp.pipeline import dialect_tools
+
+    interpret, _ = dialect_tools(dialect)
+    return interpret(blocks, file=file, warnings=Warnings(stream=_Discard()), offsets=offsets or AT_MACHINE_ZERO)
+
+
+class _Discard:
+    def write(self, text: str) -> int:
+        return len(text)
+
 
 def verify(original: BinaryIO, written: BinaryIO, *, file: str, dialect: str | None, offsets: WorkOffsets | None,
            bound: Bound) -> int:  # fmt: skip
-    """Compare the written program with the original, section by section; raise NcppError
-    at the original's line where they part.  Returns the number of sections compared."""
+    """Compare a written program file with the original, both read afresh; raise NcppError at
+    the original's line where they part.  Returns the number of sections compared."""
+    from ncpp.program.dialects import parse_program
+
     if dialect is None:
         from ncpp.program.dialects import SNIFF_BYTES, detect
 
         dialect = detect(original.read(SNIFF_BYTES), file)
         original.seek(0)
-    mine = read_sections(original, file, dialect, offsets, bound.step)
-    theirs = read_sections(written, file, dialect, offsets, bound.step)
-    count, line = 0, 1
-    while True:
-        a = next(mine, None)
+    mine = sections(_interpreted(parse_program(original, file, dialect)[1], file, dialect, offsets), bound.step)
+    theirs = sections(_interpreted(parse_program(written, file, dialect)[1], file, dialect, offsets), bound.step)
+    return _Comparison(file, bound, lambda number: _line_text(written, number)).run(mine, theirs)
+
+
+def verified(lines: Iterable[str], reached: Callable[[], int], original: Iterable[Event], *, file: str, dialect: str,
+             offsets: WorkOffsets | None, bound: Bound) -> Iterator[str]:  # fmt: skip
+    """The written program's `lines`, handed on as they are verified against the `original`
+    events (the interpreter's reading of the input): each chunk of the input's motion is
+    compared with the written lines read back up to where the writer had reached the same
+    input line (`reached()` as it hands out a line).  Raises NcppError where they part."""
+    from ncpp.program.parser import parse_stream
+
+    feed = _Feed(lines, reached)
+    state = {"cut": 0}  # where the input's chunk under way ends (0: at an action)
+    mine = sections(original, bound.step, lambda block, moves: block.line if moves >= CHUNK_MOVES else 0)
+    theirs = sections(_interpreted(parse_stream(feed, file, dialect), file, dialect, offsets), bound.step,
+                      lambda block, moves: state["cut"] if state["cut"] and feed.tag(block.line) >= state["cut"] else 0)  # fmt: skip
+    comparison = _Comparison(file, bound, feed.text)
+    for a in mine:
+        state["cut"] = a.cut
+        comparison.step(a, theirs)
+        yield from feed.handed()
+    comparison.end(theirs)
+    yield from feed.handed()
+    yield from feed.rest()
+
+
+class _Feed:
+    """Written lines as the parser reads them (bytes), each remembered with the input line the
+    writer had reached when it handed the line out (its tag), until the lines are handed on."""
+
+    def __init__(self, lines: Iterable[str], reached: Callable[[], int]):
+        self.lines = iter(lines)
+        self.reached = reached
+        self.pending: list[str] = []
+        self.tags: deque[tuple[int, int]] = deque()  # (last written line of a text, its tag)
+        self.count = 0  # written lines read so far
+        self.recent: deque[tuple[int, str]] = deque(maxlen=64)  # for messages
+
+    def __iter__(self) -> Iterator[bytes]:
+        for text in self.lines:
+            tag = self.reached()
+            self.pending.append(text)
+            self.count += text.count("\n") or 1
+            self.tags.append((self.count, tag))
+            self.recent.append((self.count, text))
+            yield text.encode("latin-1")
+
+    def tag(self, number: int) -> int:
+        """The tag of written line `number` (asked in increasing order)."""
+        while len(self.tags) > 1 and self.tags[0][0] < number:
+            self.tags.popleft()
+        return self.tags[0][1] if self.tags else 0
+
+    def handed(self) -> list[str]:
+        done, self.pending = self.pending, []
+        return done
+
+    def rest(self) -> Iterator[str]:
+        """Lines after the parser's last (after the program's end: it reads no further)."""
+        return self.lines
+
+    def text(self, number: int | None) -> str:
+        return next((t.strip()[:120] for n, t in self.recent if n == number), "")
+
+
+class _Comparison:
+    """Sections of the original and the written program compared pairwise, in order."""
+
+    def __init__(self, file: str, bound: Bound, written_text: Callable[[int | None], str]):
+        self.file, self.bound, self.written_text = file, bound, written_text
+        self.before: Section | None = None  # the last original chunk, when it ended at a cut
+        self.owed: tuple[Section, Section] | None = None  # an original chunk not yet checked against the written
+        self.feeds: tuple[deque, deque] = (deque(), deque())  # feed rates not yet matched (original, written)
+        self.times = [0.0, 0.0]  # inverse-time minutes since the last action (original, written)
+        self.count = 0
+
+    def run(self, mine: Iterator[Section], theirs: Iterator[Section]) -> int:
+        for a in mine:
+            self.step(a, theirs)
+        self.end(theirs)
+        return self.count
+
+    def step(self, a: Section, theirs: Iterator[Section]) -> None:
+        b = self._next(theirs, a.first_line)
+        if b is None:
+            raise NcppError("verification: the written program ends before the original", Location(self.file, a.first_line, 1))
+        self.count += 1
+        self._actions(a, b)
+        across = _tail(self.before) if self.before is not None else None
+        self._follows(b, _joined(a, across), "the written path leaves the original's", written=True)
+        if self.owed is not None:
+            pa, pb = self.owed
+            self._follows(pa, _joined(pb, _head(b)), "the written path does not follow the original's", written=False)
+            self.owed = None
+        if a.cut:
+            self.owed = (a, b)
+        else:
+            self._follows(a, b, "the written path does not follow the original's", written=False)
+        self.before = a if a.cut else None
+        self._feeds(a, b)
+
+    def end(self, theirs: Iterator[Section]) -> None:
+        if self.owed is not None:
+            pa, pb = self.owed
+            self._follows(pa, pb, "the written path does not follow the original's", written=False)
+        extra = self._next(theirs, 0)
+        if extra is not None and (len(extra.points) or extra.action is not None):
+            raise NcppError("verification: the written program goes on after the original ends",
+                            Location(self.file, extra.first_line, 1))  # fmt: skip
+
+    def _next(self, theirs: Iterator[Section], line: int) -> Section | None:
         try:
-            b = next(theirs, None)
+            return next(theirs, None)
         except NcppError as err:
-            text = _line_text(written, err.where.line)
+            number = err.where.line
             raise NcppError(f"verification: ncpp cannot read back the program it wrote: {err.message}, "
-                            f"at its line {err.where.line} {text!r}", Location(file, a.first_line if a else line, 1)) from None
-        if a is None and b is None:
-            return count
-        if a is None or b is None:
-            raise NcppError("verification: the written program does not end its actions where the original does",
-                            Location(file, a.first_line if a else line, 1))
-        compare(a, b, bound, file)
-        count, line = count + 1, a.action.line if a.action else a.first_line
+                            f"at its line {number} {self.written_text(number)!r}", Location(self.file, line or 1, 1)) from None
+
+    def _actions(self, a: Section, b: Section) -> None:
+        if (a.action is None) != (b.action is None) or (a.action is not None and a.action.text != b.action.text):  # type: ignore[union-attr]
+            where = a.action.line if a.action is not None else a.first_line
+            raise NcppError(f"verification: the written program does {_what(b)} where the original does {_what(a)}",
+                            Location(self.file, where, 1))  # fmt: skip
+
+    def _follows(self, path: Section, along: Section, message: str, written: bool) -> None:
+        """Raise where a sample of `path` lies further than the bound from every sample of
+        `along` of its kind (rapid or feed); a written path's fault is told at the original's
+        nearest line."""
+        if not len(path.points):
+            return
+        file = self.file
+        if not len(along.points):
+            line = along.first_line if written else int(path.lines[0])
+            raise NcppError(f"verification: {message}: it has no move here", Location(file, line, 1))
+        within = self.bound.within
+        width = max(path.points.shape[1], along.points.shape[1])
+        apart = 4 * within  # a rapid's samples lie this far from a feed's along an extra coordinate
+        tree = cKDTree(_coordinates(along, width, apart))
+        distance, _ = tree.query(_coordinates(path, width, apart), distance_upper_bound=within)
+        far = np.flatnonzero(np.isinf(distance))
+        if not len(far):
+            return
+        k = int(far[0])
+        gap, near = cKDTree(_coordinates(along, width, 0.0)).query(_coordinates(path, width, 0.0)[k])
+        line = int(along.lines[near]) if written else int(path.lines[k])
+        if gap > within:
+            message = f"{message} by more than {within:.4f} mm"
+        elif written:
+            message = "the written program makes a " + ("rapid move where the original cuts" if path.rapid[k] else "feed move where the original rapids")
+        else:
+            message = "the written program " + ("feeds where the original rapids" if path.rapid[k] else "rapids where the original cuts")
+        raise NcppError(f"verification: {message}", Location(file, line, 1))
+
+    def _feeds(self, a: Section, b: Section) -> None:
+        """Feed rates matched in order across chunks; at an action (or the end) none may be left,
+        and the inverse-time moves since the last action must take the original's time."""
+        mine, theirs = self.feeds
+        for queue, section in ((mine, a), (theirs, b)):
+            for rate, line in section.feeds:
+                if not (queue and _same_rate(queue[-1][0], rate)):
+                    queue.append((rate, line))
+        while mine and theirs:
+            (rate, line), (other, _) = mine[0], theirs[0]
+            if not _same_rate(rate, other):
+                self._feed_fault(rate, other, line)
+            if len(mine) == 1 or len(theirs) == 1:  # the last run may go on in the next chunk
+                break
+            mine.popleft()
+            theirs.popleft()
+        self.times[0] += a.inverse_time
+        self.times[1] += b.inverse_time
+        if a.cut:
+            return
+        if len(mine) != len(theirs):
+            rate, line = (mine[-1] if len(mine) > len(theirs) else (None, a.first_line))
+            self._feed_fault(rate, theirs[-1][0] if len(theirs) > len(mine) else None, line)
+        mine.clear()
+        theirs.clear()
+        t0, t1 = self.times
+        if not math.isclose(t0, t1, rel_tol=1e-4, abs_tol=1e-7):
+            raise NcppError(f"verification: the written program's inverse-time moves take {t1:.6g} min where "
+                            f"the original's take {t0:.6g} min", Location(self.file, a.first_line, 1))  # fmt: skip
+        self.times = [0.0, 0.0]
+
+    def _feed_fault(self, rate: float | None, other: float | None, line: int) -> None:
+        raise NcppError(f"verification: the written program feeds at {_rate(other)} where the original feeds at {_rate(rate)}",
+                        Location(self.file, line, 1))  # fmt: skip
 
 
-def _line_text(stream: BinaryIO, number: int | None) -> str:
-    """Line `number` of a program file, stripped, for a message (at most 120 characters)."""
-    if number is None:
-        return ""
-    stream.seek(0)
-    for n, raw in enumerate(stream, 1):
-        if n == number:
-            return raw.decode("latin-1").strip()[:120]
-    return ""
+def _same_rate(a: float, b: float) -> bool:
+    return math.isclose(a, b, rel_tol=1e-6, abs_tol=1e-9)
 
 
-def compare(original: Section, written: Section, bound: Bound, file: str) -> None:
-    """Raise NcppError where the written section does not do what the original does."""
-    a, b = original.action, written.action
-    if (a is None) != (b is None) or (a is not None and a.text != b.text):  # type: ignore[union-attr]
-        where = a.line if a is not None else original.first_line
-        raise NcppError(f"verification: the written program does {_what(b)} where the original does {_what(a)}", Location(file, where, 1))
-    within = bound.distance + bound.step / 2  # a point of either path lies within `step` / 2 of a sample
-    width = max(original.points.shape[1], written.points.shape[1])
-    _follows(written, original, within, width, file, "the written path leaves the original's", True)
-    _follows(original, written, within, width, file, "the written path does not follow the original's", False)
-    _same_feeds(original, written, file)
+def _rate(value: float | None) -> str:
+    return "nothing" if value is None else f"{value:g} mm/min"
 
 
-def _what(action: Action | None) -> str:
-    return f"'{action.text}'" if action is not None else "nothing more"
+def _what(section: Section) -> str:
+    if section.action is not None:
+        return f"'{section.action.text}'"
+    return "no action" if section.cut else "nothing more"
 
 
-def _follows(path: Section, along: Section, within: float, width: int, file: str, message: str, written: bool) -> None:
-    """Raise where a sample of `path` lies further than `within` from every sample of `along`
-    of its kind (rapid or feed).  A written path's fault is told at the original's nearest line."""
-    if not len(path.points):
-        return
-    if not len(along.points):
-        line = along.first_line if written else int(path.lines[0])
-        raise NcppError(f"verification: {message}: it has no move here", Location(file, line, 1))
-    apart = 4 * within  # a rapid's samples lie this far from a feed's along an extra coordinate
-    tree = cKDTree(_coordinates(along, width, apart))
-    distance, _ = tree.query(_coordinates(path, width, apart), distance_upper_bound=within)
-    far = np.flatnonzero(np.isinf(distance))
-    if not len(far):
-        return
-    k = int(far[0])
-    point = _coordinates(path, width, 0.0)[k]
-    gap, near = cKDTree(_coordinates(along, width, 0.0)).query(point)
-    line = int(along.lines[near]) if written else int(path.lines[k])
-    if gap <= within and written:
-        message = "the written program makes a " + ("rapid move where the original cuts" if path.rapid[k] else "feed move where the original rapids")
-    elif gap <= within:
-        message = "the written program " + ("feeds where the original rapids" if path.rapid[k] else "rapids where the original cuts")
-    else:
-        message = f"{message} by more than {within:.4f} mm"
-    raise NcppError(f"verification: {message}", Location(file, line, 1))
+def _tail(section: Section) -> Section:
+    """The last `ACROSS` of a chunk's samples."""
+    n = len(section.points)
+    return _part(section, slice(n - int(math.ceil(n * ACROSS)), n))
+
+
+def _head(section: Section) -> Section:
+    """The first `ACROSS` of a chunk's samples."""
+    return _part(section, slice(0, int(math.ceil(len(section.points) * ACROSS))))
+
+
+def _part(section: Section, rows: slice) -> Section:
+    return Section(section.points[rows], section.rapid[rows], section.lines[rows], [], 0.0, None, section.first_line)
+
+
+def _joined(section: Section, other: Section | None) -> Section:
+    """`section` with `other`'s samples too (its lines, first line and action its own)."""
+    if other is None or not len(other.points):
+        return section
+    width = max(section.points.shape[1], other.points.shape[1])
+    points = np.vstack((_coordinates(section, width, 0.0), _coordinates(other, width, 0.0)))
+    return Section(points, np.concatenate((section.rapid, other.rapid)), np.concatenate((section.lines, other.lines)),
+                   section.feeds, section.inverse_time, section.action, section.first_line, section.cut)  # fmt: skip
 
 
 def _coordinates(section: Section, width: int, apart: float) -> np.ndarray:
@@ -370,18 +552,12 @@ def _coordinates(section: Section, width: int, apart: float) -> np.ndarray:
     return points
 
 
-def _same_feeds(original: Section, written: Section, file: str) -> None:
-    mine, theirs = [f for f, _ in original.feeds], [f for f, _ in written.feeds]
-    for k, (a, b) in enumerate(zip_longest(mine, theirs)):
-        if a is None or b is None or not math.isclose(a, b, rel_tol=1e-6, abs_tol=1e-9):
-            line = original.feeds[k][1] if k < len(original.feeds) else original.first_line
-            raise NcppError(f"verification: the written program feeds at {_rate(b)} where the original feeds at {_rate(a)}",
-                            Location(file, line, 1))
-    a, b = original.inverse_time, written.inverse_time
-    if not math.isclose(a, b, rel_tol=1e-4, abs_tol=1e-7):
-        raise NcppError(f"verification: the written program's inverse-time moves take {b:.6g} min where the original's take {a:.6g} min",
-                        Location(file, original.first_line, 1))
-
-
-def _rate(value: float | None) -> str:
-    return "nothing" if value is None else f"{value:g} mm/min"
+def _line_text(stream: BinaryIO, number: int | None) -> str:
+    """Line `number` of a program file, stripped, for a message (at most 120 characters)."""
+    if number is None:
+        return ""
+    stream.seek(0)
+    for n, raw in enumerate(stream, 1):
+        if n == number:
+            return raw.decode("latin-1").strip()[:120]
+    return ""
