@@ -157,8 +157,8 @@ def _compensate_one(job: Job, path: str | None, output: str | None) -> int:
 def compensate_files(job: Job, paths: list[str], folder: Path, jobs: int = 1) -> int:
     """Each program to `folder` under its own name, `jobs` at once; a failure is reported
     (`file:line:col: message`) and the others go on.  0 if all were written, else 2."""
-    folder.mkdir(parents=True, exist_ok=True)
     targets = _targets(paths, folder)
+    folder.mkdir(parents=True, exist_ok=True)
     failed = 0
     with _executor(job, min(jobs, len(paths))) as pool:
         futures = [pool.submit(_compensate_file, path, str(target)) for path, target in zip(paths, targets)]
