@@ -20,7 +20,7 @@ class Location:
     file: str = "<stdin>"
     line: int | None = None
     col: int | None = None
-    # A pass's fault, whose kernel knows the line but not its text: the letter of the word it
+    # A pass's fault, whose numeric work knows the line but not its text: the letter of the word it
     # is at (None: the block), until the pass finds the column (`NcppError.locate`)
     word: str | None = None
 
@@ -59,7 +59,7 @@ class NcppError(Exception):
     def __str__(self) -> str:
         return f"{self.where}: {self.message}"
 
-    def __reduce__(self):  # pickled with its location (it may come from a worker process)
+    def __reduce__(self):  # pickled with its location (it may come from another process: `compensate --jobs`)
         return (type(self), (self.message, self.where))
 
 
@@ -101,21 +101,6 @@ class Warnings:
             print(f"{where}: warning: {message} (warned {times} times: more of these are counted, not printed)", file=self.stream)
         else:
             self._hidden[message] = (self._hidden.get(message, (where,))[0], where)
-
-    def warn_repeats(self, message: str, times: int, first: Location, last: Location) -> None:
-        """`times` warnings of a text warned SHOWN_PER_TEXT times already, from `first` to
-        `last` (those between need no place: they are counted, not printed), as that many
-        `warn`s would; a second part keeps its repeats so (`parts._Kept`)."""
-        if self.strict:
-            raise NcppError(f"{message} (refused in strict mode)", first)
-        self.count += times
-        if message in self._times:
-            self._times[message] += times
-            self._hidden[message] = (self._hidden.get(message, (first,))[0], last)
-        else:  # a text over _TEXTS_COUNTED, whose every warning `say` prints: its first and last
-            print(f"{first}: warning: {message}", file=self.stream)
-            if times > 1:
-                print(f"{last}: warning: {message} ({times} times from line {first.line} to this one)", file=self.stream)
 
     def finish(self) -> None:
         """At the end of a run: how many warnings of each text were not printed, and where."""

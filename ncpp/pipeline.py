@@ -11,26 +11,20 @@ from __future__ import annotations
 
 import gc
 import hashlib
-import shutil
-import tempfile
 from contextlib import contextmanager
-from dataclasses import dataclass, field, replace
-from itertools import chain, count, islice
+from dataclasses import dataclass, field
+from itertools import chain, count, islice, tee
 from operator import itemgetter
 from pathlib import Path
 from typing import BinaryIO, Callable, Iterable, Iterator
 
 from ncpp import __version__
 from ncpp.errors import Location, NcppError, Warnings
-from ncpp.fileio import program_file
-from ncpp.motion.interpreter import Interpreter
 from ncpp.motion.offsets import AT_MACHINE_ZERO, WorkOffsets
-from ncpp.motion.skim import Skim
 from ncpp.motion.segments import COMP, CYCLE, FLOW, Arc, Event, Line, Pass
 from ncpp.passes import PASSES, PassContext, run_passes
-from ncpp.passes.context import UNDECIDED, CutLine, is_directional
+from ncpp.passes.context import is_directional
 from ncpp.passes.inverse import iterations_for
-from ncpp.passes.kernels import INLINE, Kernels, Worker
 from ncpp.program.blocks import Block, Comment, Word
 from ncpp.program.dialects import parse_program
 from ncpp.program.dialects.iso import IsoWriter
@@ -39,8 +33,7 @@ from ncpp.runtime import keep_freed_memory
 HEADER_TAG = "ncpp compensated"
 HEADER_SCAN = 30  # blocks at the top searched for an earlier header
 # Blocks the parser reads ahead of the interpreter at most (`_parsed_ahead`), and in its
-# first run: ~0.8 kB each (16k: 13 MB, whatever the program's length).  The first run is
-# short: a first part's cut waits for its first lines written (`parts.py`).
+# first run: ~0.8 kB each (16k: 13 MB, whatever the program's length).
 PARSED_AHEAD = 16384
 FIRST_RUN = 1024
 
@@ -196,47 +189,25 @@ def _passed_on(first: Event, rest: Iterator[Event], warnings: Warnings, file: st
             yield Pass(event.block)
 
 
-def _read_ahead_bounds(part: "Part | None", skim: Skim | None) -> tuple[Callable[[], bool], Callable[[], int]]:
-    """(ready, until) for `_parsed_ahead`: a second part's parser reads no line ahead while it
-    skims (`Skim` asks the interpreter, which must have read every line before); a first
-    part's reads no further past its cut than its passes do (`parts.READ_PAST`)."""
-    ready = (lambda: True) if skim is None else (lambda: skim.done)
-    if part is None or part.second:
-        return ready, lambda: UNDECIDED
-    from ncpp.parts import READ_PAST
+def _parsed_ahead(blocks: Iterable[Block], most: int = PARSED_AHEAD) -> Iterator[Block]:
+    """The blocks, parsed in runs ahead of the interpreter: the first alone, then runs of
+    FIRST_RUN blocks, each twice the last up to `most`.
 
-    # (UNDECIDED + READ_PAST: no bound yet; a part that goes on past its cut reads on)
-    return ready, lambda: UNDECIDED if part.continued else part.cut.line + READ_PAST
-
-
-def _parsed_ahead(blocks: Iterable[Block], ready: Callable[[], bool] = lambda: True, until: Callable[[], int] = lambda: UNDECIDED,
-                  most: int | None = None) -> Iterator[Block]:  # fmt: skip
-    """The blocks, parsed in runs ahead of the interpreter: first one at a time until `ready()`,
-    then runs of FIRST_RUN blocks, each twice the last up to `most` (PARSED_AHEAD), none past
-    the line `until()`.
-
-    Each stage running over many lines at once is faster than the stages taking turns a line
-    at a time (on the generated program 5-7% of compensation's CPU with runs of 16k lines;
-    benchmarks/README.md, session 31).  A run that meets a line the parser refuses is passed
-    on first: a fault in an earlier line is reported first, as without runs."""
-    blocks, most = iter(blocks), PARSED_AHEAD if most is None else most
-    last = 0  # the line of the last block handed on
-    for block in blocks:
-        last = block.line
-        yield block
-        if ready():
-            break
+    Each stage running over many lines at once is faster than the stages taking turns a
+    line at a time.  A run that meets a line the parser refuses is passed on first: a fault
+    in an earlier line is reported first, as without runs."""
+    blocks = iter(blocks)
+    yield from islice(blocks, 1)
     size = FIRST_RUN
     while True:
         run: list[Block] = []
         try:
-            run.extend(islice(blocks, max(1, min(size, until() - last))))
+            run.extend(islice(blocks, size))
         except NcppError:  # (as the passes' batches: `ncpp/passes/__init__.py`)
             yield from run
             raise
         if not run:
             return
-        last = run[-1].line
         yield from run
         size = min(2 * size, most)
 
@@ -262,10 +233,6 @@ DIALECT_TOOLS = {
     "heidenhain": ("ncpp.motion.heidenhain", "ncpp.program.dialects.heidenhain", "HeidenhainWriter"),
     "sinumerik": ("ncpp.motion.sinumerik", "ncpp.program.dialects.sinumerik", "SinumerikWriter"),
 }
-
-
-# The dialects compensated in two parts (`parts.py`)
-IN_TWO_PARTS = ("iso", "sinumerik", "heidenhain")
 
 
 def dialect_tools(name: str) -> tuple[Callable, type]:
@@ -303,10 +270,9 @@ def with_header(lines: Iterable[str], header: str, writer: IsoWriter) -> Iterato
 INVERSE_BUDGET = 0.000025
 
 
-def make_context(source: ErrorSource, tolerance: float, warnings: Warnings, file: str, kernels: Kernels = INLINE) -> PassContext:
+def make_context(source: ErrorSource, tolerance: float, warnings: Warnings, file: str) -> PassContext:
     """The pass context every front end (filter, compensate, post) compensates with."""
     return PassContext(
-        kernels=kernels,
         model=source.model,
         tolerance=tolerance,
         max_correction=source.max_correction,
@@ -330,286 +296,76 @@ def process(
     warnings: Warnings | None = None,
     progress: Callable[[int], None] | None = None,
     dialect: str | None = None,
-    jobs: int = 1,
     offsets: WorkOffsets | None = None,
-    part: "Part | None" = None,
     verify: bool = True,
 ) -> Stats:
     """Read, interpret, compensate (when `source` is given) and write one program.
 
-    A compensated program is verified before a byte of it reaches `out` (`ncpp/verify.py`):
-    it is written to a temporary file, read back and compared with the input, which is
-    read again (from its file, or from a copy of a piped stream).  `verify=False` skips it.
-
     The dialect is detected from the content (and the file name) unless given;
-    it picks the interpreter and the writer (DIALECT_TOOLS).  `jobs` 2 or more:
-    compensation's numeric kernels run in a worker process (passes/kernels.py),
-    the same output on two cores.  `offsets`: the zeros the control holds (machine
-    mm; none: the program zero is the machine zero), which place the program on
-    the machine whose errors are compensated."""
+    it picks the interpreter and the writer (DIALECT_TOOLS).  `offsets`: the zeros
+    the control holds (machine mm; none: the program zero is the machine zero),
+    which place the program on the machine whose errors are compensated.
+
+    A compensated program is verified as it is written (`ncpp/verify.py`): read back
+    and compared with the interpreter's reading of the input; where they part an
+    NcppError stops the run, and what `out` took so far must be thrown away (the
+    command line writes to a temporary file or a spool).  `verify=False` skips it."""
     warnings = warnings or Warnings(strict=strict)
-    if source is not None and verify and part is None:
-        return _verified(stream, out, file, dialect, offsets, source, tolerance,
-                         lambda given, written: process(given, written, file=file, source=source, tolerance=tolerance,
-                                                        strict=strict, force=force, warnings=warnings, progress=progress,
-                                                        dialect=dialect, jobs=jobs, offsets=offsets, verify=False))  # fmt: skip
-    # a program file long enough: two parts, one process each (parts.py)
-    split = _two_parts(stream, file, dialect) if source is not None and jobs > 1 and part is None else None
-    if split is not None:
-        from ncpp.parts import process_in_two_parts
-
-        path, lines = split
-        stats = process_in_two_parts(stream, path, out, lines, file=file, source=source, tolerance=tolerance, strict=strict, force=force,
-                                     warnings=warnings, progress=progress, dialect=dialect, offsets=offsets)  # fmt: skip
-    else:
-        kernels = _kernels(source is not None and jobs > 1)  # started first: the worker starts while we parse
-        try:
-            stats = _process(stream, out, file, source, tolerance, strict, force, warnings, progress, dialect, kernels, offsets, part)
-        finally:
-            kernels.close()
-    if part is None:  # a part's warnings are finished by the run it is part of
-        warnings.finish()
-    return stats
-
-
-def _verified(stream: BinaryIO, out: BinaryIO, file: str, dialect: str | None, offsets: WorkOffsets | None,
-              source: ErrorSource, tolerance: float, run: Callable[[BinaryIO, BinaryIO], Stats]) -> Stats:
-    """`run(stream, written)` to a temporary file, then the written program verified against
-    the input and copied to `out`: nothing is written when verification fails."""
-    from ncpp.verify import Bound, verify
-
-    with _again(stream) as (given, original), tempfile.TemporaryFile() as written:
-        stats = run(given, written)
-        written.seek(0)
-        verify(original, written, file=file, dialect=dialect, offsets=offsets,
-               bound=Bound(source.max_correction + tolerance))  # fmt: skip
-        written.seek(0)
-        shutil.copyfileobj(written, out, 1 << 20)
-    return stats
-
-
-@contextmanager
-def _again(stream: BinaryIO) -> Iterator[tuple[BinaryIO, BinaryIO]]:
-    """(the stream to compensate, the same program to read again): a program file is opened
-    a second time; anything else (a pipe) is copied to a temporary file read twice."""
-    path = program_file(stream)
-    if path is not None:
-        with open(path, "rb") as again:
-            yield stream, again
-        return
-    with tempfile.TemporaryFile() as copy:
-        shutil.copyfileobj(stream, copy, 1 << 20)
-        copy.seek(0)
-        yield copy, copy
-
-
-def _two_parts(stream: BinaryIO, file: str, dialect: str | None) -> tuple[str, int] | None:
-    """(path, lines) when the stream is an unread program file of a dialect `IN_TWO_PARTS` that
-    pays for two processes (`parts.py`); else None (a pipe, a short program)."""
-    from ncpp.parts import lines_for
-    from ncpp.program.dialects import SNIFF_BYTES, detect
-
-    path = program_file(stream)
-    if path is None:
-        return None
-    with open(path, "rb") as f:
-        if (dialect or detect(f.read(SNIFF_BYTES), file)).lower() not in IN_TWO_PARTS:
-            return None
-    lines = lines_for(path)
-    return None if lines is None else (path, lines)
-
-
-def _kernels(worker: bool) -> Kernels:
-    """A worker process when asked for and one can be started, else inline (the same output)."""
-    if worker:
-        try:
-            return Worker()
-        except OSError:  # no interpreter to start (an embedding host): one process it is
-            pass
-    return INLINE
-
-
-def _process(
-    stream: BinaryIO,
-    out: BinaryIO,
-    file: str,
-    source: ErrorSource | None,
-    tolerance: float,
-    strict: bool,
-    force: bool,
-    warnings: Warnings,
-    progress: Callable[[int], None] | None,
-    dialect: str | None,
-    kernels: Kernels,
-    offsets: WorkOffsets | None,
-    part: "Part | None" = None,
-) -> Stats:
     stats = Stats()
-    # a second part reaches its window leaving plain lines unread where it can
-    skim = Skim(part, first=HEADER_SCAN + 1) if part is not None and part.second and part.resume is None else None
-    name, parsed = parse_program(stream, file, dialect, numbered=skim)
+    name, parsed = parse_program(stream, file, dialect)
     interpret, writer_class = dialect_tools(name)
     counter = count()
-    blocks: Iterable[Block] = _counted(_parsed_ahead(parsed, *_read_ahead_bounds(part, skim)), counter, progress)
+    blocks: Iterable[Block] = _counted(_parsed_ahead(parsed), counter, progress)
     if source is not None and not force:
         blocks = refuse_compensated(blocks, file)
     if source is not None and name != "iso":  # the ISO interpreter places every work offset and tool length
         blocks = warn_unplaced(blocks, warnings, file)
     # the control's zeros place the program on the machine; passthrough places nothing
     offsets = (offsets or AT_MACHINE_ZERO) if source is not None else None
-    interpreter = None
-    if part is not None and name == "iso":  # its state at the cut is compared where a second part skims (`Skim`)
-        interpreter = Interpreter(file, offsets)
-        blocks = _state_at_cut(blocks, part, interpreter)
-        events: Iterable[Event] = interpret(blocks, file=file, warnings=warnings, strict=strict, interpreter=interpreter)
-    else:
-        events = interpret(blocks, file=file, warnings=warnings, strict=strict, offsets=offsets)
-    if source is not None:  # canned cycles, loops, subroutines (ISO), cutter compensation (every dialect)
-        events = warn_fixed(events, warnings, file)
-    writer = writer_class()
-    if skim is not None:  # (before it reads a line: parsing starts when the writer asks for events; no interpreter: no skimming)
-        skim.interpreter, skim.writer = interpreter, writer
+    events: Iterable[Event] = interpret(blocks, file=file, warnings=warnings, strict=strict, offsets=offsets)
     if source is None:
         lines: Iterable[str] = (event.block.text for event in _first_per_block(events))
     else:
+        if verify:
+            events, original = tee(events)
+        events = warn_fixed(events, warnings, file)  # cycles, loops, subroutines (ISO), cutter compensation
+        writer = writer_class()
         keep_freed_memory()  # numpy's temporaries reuse the heap, not fresh pages (runtime.py)
-        ctx = make_context(source, tolerance, warnings, file, kernels)
-        if part is None:
-            lines = with_header(writer.write(run_passes(events, ctx, PASSES)), header_text(source, tolerance), writer)
-        elif not part.second:  # the first part: up to the cut, where it records the state (and on, where it must)
-            ctx = replace(ctx, cut=part.cut)
-            done = _cut_at(run_passes(events, ctx, PASSES), part, ctx, writer, stop=True)
-            lines = with_header(_before_mark(writer.write(done), part), header_text(source, tolerance), writer)
-        elif part.resume is not None:  # the second part: from the cut on, from the state recorded there
-            pass_state, writer_state = part.resume
-            writer.restore(writer_state)
-            later = (event for event in events if event.block.line >= part.cut.line)
-            lines = writer.write(run_passes(later, replace(ctx, resume=pass_state), PASSES))
-        else:  # the second part, guessing the state at the cut: what a window of lines before it leads to
-            ctx = replace(ctx, cut=part.cut)
-            window = _learnt_before(events, part, writer)
-            lines = _after_mark(writer.write(_cut_at(run_passes(window, ctx, PASSES), part, ctx, writer, stop=False)))
+        ctx = make_context(source, tolerance, warnings, file)
+        reached = _Reached()
+        lines = with_header(writer.write(reached.follow(run_passes(events, ctx, PASSES))), header_text(source, tolerance), writer)
+        if verify:
+            from ncpp.verify import Bound, verified
+
+            lines = verified(lines, reached, original, file=file, dialect=name, offsets=offsets,
+                             bound=Bound(source.max_correction + tolerance))  # fmt: skip
     lines = iter(lines)
     with _rare_collections():
         while batch := list(islice(lines, 4096)):  # written in batches: one encode and write per 4096 lines
             out.write("".join(batch).encode("latin-1"))
             stats.lines_out += len(batch)
     stats.lines_in = next(counter)
+    warnings.finish()
     return stats
 
 
-@dataclass
-class Part:
-    """One of a program's two parts, compensated apart (one process each): the first
-    ends before the input line `cut` holds (a multiple of `geometry.LINE_CHUNK`, on a
-    long program decided while the parts run: `parts._Pacer`) and records the passes'
-    and the writer's state there in `reached`; the second starts at the cut from such
-    a state (`resume`).  Together they write what one run writes.  Where the second's
-    state at the cut is not the first's (`decide`), the first writes the rest itself."""
+class _Reached:
+    """The input line of the last event the writer took, and of the block before it: a writer
+    may take a block's first event before it writes the lines of the block before
+    (`verify.verified` tags written lines with both)."""
 
-    cut: CutLine
-    resume: tuple | None = None  # (apply_error_map.PassState, iso.WriterState)
-    reached: tuple | None = None
-    second: bool = False  # a second part (without `resume`: it guesses the state from `window`)
-    window: int = 2048  # input lines before the cut that a second part compensates to find its state
-    # A second part whose cut is undecided asks for it (`ask` returns it) on reading line `floor`
-    floor: int = 0
-    ask: Callable[[], int] | None = None
-    written: int = 0  # the input line of the last event the first part has passed to its writer
-    interpreted: tuple | None = None  # the interpreter's state as it read the cut's line (`Interpreter.state`)
-    skipped: int = 0  # lines a second part left unread (`motion/skim.py`)
-    # At the cut, with `reached` recorded: a second part tells it (`tell`); the first asks
-    # whether to stop there (`decide`: false, it writes the rest itself: `continued`)
-    tell: Callable[[], None] | None = None
-    decide: Callable[[], bool] | None = None
-    continued: bool = False
+    def __init__(self) -> None:
+        self.line = self.before = 0
 
-    def window_start(self, line: int) -> int:
-        """A second part's window's first line, as its lines are read up to `line`: while
-        the cut is undecided, the floor before it, and at the floor the cut is asked for."""
-        if self.cut.line == UNDECIDED:
-            if line < self.floor:
-                return self.floor
-            self.cut.line = self.ask()  # type: ignore[misc]
-        return self.cut.line - self.window
-
-
-_MARK = "\x00ncpp: the cut\x00"  # the text of the line that marks the cut in a part's output
-
-
-def _state_at_cut(blocks: Iterable[Block], part: Part, interpreter: Interpreter) -> Iterator[Block]:
-    """The blocks; the interpreter's state as it reads the cut's goes to `part.interpreted`."""
-    blocks = iter(blocks)
-    cut = part.cut
-    for block in blocks:
-        if block.line >= cut.line:
-            part.interpreted = interpreter.state()
-            yield block
-            break
-        yield block
-    yield from blocks
-
-
-def _learnt_before(events: Iterable[Event], part: Part, writer: IsoWriter) -> Iterator[Event]:
-    """The events from the second part's window on (`part.window` lines before its cut);
-    the writer learns from the blocks before (`IsoWriter.learn`) and from a dialect's own
-    events there (`IsoWriter.learn_event`: a Klartext pole)."""
-    last = None
-    for event in events:
-        line = event.block.line
-        if line >= part.cut.line - part.window:  # (an undecided cut was asked for as its lines were read: `window_start`)
+    def follow(self, events: Iterable[Event]) -> Iterator[Event]:
+        for event in events:
+            line = event.block.line
+            if line != self.line:
+                self.before, self.line = self.line, line
             yield event
-            break
-        kind = type(event)
-        if event.block is not last:
-            last = event.block
-            if not (kind is Pass and event.skipped):
-                writer.learn(last)
-        if kind is not Pass and kind is not Line and kind is not Arc:
-            writer.learn_event(event)
-    yield from events
 
-
-def _cut_at(events: Iterable[Event], part: Part, ctx: PassContext, writer: IsoWriter, stop: bool) -> Iterator[Event]:
-    """The events, with a marked empty line before the cut (the writer writes what came
-    before on taking it, then asks for more: the state there goes to `part.reached`,
-    and is told, `part.tell`); with `stop`, none after it unless `part.decide` says
-    the part goes on (`part.continued`)."""
-    for event in events:
-        line = event.block.line
-        if line >= part.cut.line:
-            yield Pass(Block(_MARK, "", (), part.cut.line, True), True)
-            part.reached = (ctx.at_cut[0] if ctx.at_cut else None, writer.state())  # (None: no move yet, in the window)
-            if part.tell is not None:
-                part.tell()
-            if stop:
-                if part.decide is None or part.decide():
-                    return
-                part.continued = True
-            yield event
-            break
-        part.written = line
-        yield event
-    yield from events
-
-
-def _before_mark(lines: Iterable[str], part: Part) -> Iterator[str]:
-    """The lines before the mark (and after it, but for the mark, where the part goes on)."""
-    for line in lines:
-        if line == _MARK:
-            if not part.continued:
-                return
-            continue
-        yield line
-
-
-def _after_mark(lines: Iterable[str]) -> Iterator[str]:
-    """The lines after the mark."""
-    lines = iter(lines)
-    for line in lines:
-        if line == _MARK:
-            break
-    yield from lines
+    def __call__(self) -> tuple[int, int]:
+        return self.line, self.before
 
 
 @contextmanager
@@ -618,11 +374,10 @@ def _rare_collections(threshold: int = 1_000_000) -> Iterator[None]:
 
     Every line makes a few short-lived objects (a block, its words, events, strings)
     that reference counting frees; the collector runs when allocations outnumber
-    frees by the threshold, and that count includes the objects in flight: up to
-    ~100k with a worker (three `replace_arcs` batches of 4096 events, with their
-    blocks and words).  Below that the collector would walk them again and again
-    for nothing (with 50k: 6% of the main process on stellabee1.ngc).  Memory stays
-    flat: a whole program leaves a few thousand objects in cycles at most."""
+    frees by the threshold, and that count includes the tens of thousands of objects
+    in flight (a `replace_arcs` batch with its blocks and words, the parser's run
+    ahead), which a lower threshold would have it walk again and again for nothing.
+    Memory stays flat: a whole program leaves a few thousand objects in cycles at most."""
     old = gc.get_threshold()
     gc.set_threshold(max(old[0], threshold), *old[1:])
     try:

@@ -6,19 +6,16 @@ The heap (glibc).  Compensation makes numpy arrays of 0.1-2 MB many times a
 second (a chunk's samples and rows, and their temporaries).  By default glibc
 serves arrays over its mmap threshold with fresh pages from the kernel, and hands
 memory at the top of the heap back to the kernel once more than its trim
-threshold is free; it adjusts both as it goes, but not enough for this mix of
-sizes.  Either way such an array costs page faults and the zeroing of its pages
-again and again: 2.4 faults per input line and 8% of the CPU time of compensating
-a generated program (0.5 s of system time in 6 s, 60k lines).  Higher thresholds
-keep freed memory in the heap for the next chunk: 22k faults in all instead of
-146k, the same peak size.  The setting is process-wide and stays (glibc has no
-way back to its adjusting thresholds): what it costs a host process (FreeCAD
-running the post) is freed memory kept for reuse; the peak, which is what the
-host sees, stays flat in program length.
+threshold is free; either way such an array costs page faults and the zeroing of
+its pages again and again.  Higher thresholds keep freed memory in the heap for
+the next chunk, at the same peak size.  The setting is process-wide and stays
+(glibc has no way back to its adjusting thresholds): what it costs a host process
+(FreeCAD running the post) is freed memory kept for reuse; the peak, which is what
+the host sees, stays flat in program length.
 
-BLAS.  numpy's OpenBLAS starts a thread per core that spins for 0.1 s of CPU
-after the import, taken from the other process of a run on two cores; ncpp's
-arrays are too small to share out among threads.
+BLAS.  numpy's OpenBLAS starts a thread per core that spins after the import,
+taking CPU from the other processes of `compensate --jobs`; ncpp's arrays are too
+small to share out among threads.
 """
 
 from __future__ import annotations

@@ -16,10 +16,10 @@ the passes' state) and compares it with the input program's motion:
   its time together.
 
 Paths are compared in machine coordinates (mm, tool length and work offsets
-applied), sampled every quarter of the bound: a written program passes when
+applied), sampled every half of the bound: a written program passes when
 each sample of either path lies within the bound and half a step of a sample
 of the other's (so no correction within the bound is refused, and every point
-passed is within 1.25 times the bound).  A violation is an `NcppError` at the
+passed is within 1.5 times the bound).  A violation is an `NcppError` at the
 input line where it happens.
 
 A long run of moves between two actions is compared in chunks of about
@@ -192,9 +192,11 @@ def actions_of(block: Block) -> tuple[list[str], list[str]]:
 Cut = Callable[[Block, int], int]  # (a block, the chunk's moves so far) -> the input line to cut at (0: none)
 
 
-def sections(events: Iterable[Event], step: float, cut: Cut = lambda block, moves: 0) -> Iterator[Section]:
+def sections(events: Iterable[Event], step: float, cut: Cut = lambda block, moves: 0,
+             line_of: Callable[[int], int] | None = None) -> Iterator[Section]:  # fmt: skip
     """The motion of a program's events between its actions, in the order it runs; a chunk
-    ends before a block where `cut` says."""
+    ends before a block where `cut` says.  `line_of` gives the line a block's samples are
+    told by (its own by default)."""
     moves = _Moves(step)
     extra: tuple[float, ...] = NO_EXTRA
     last: Block | None = None
@@ -222,7 +224,7 @@ def sections(events: Iterable[Event], step: float, cut: Cut = lambda block, move
                     yield moves.sample(Action(text, block.line), first_line)
                     moves, first_line = _Moves(step), block.line
         if kind is Line or kind is Arc:
-            extra = _add(moves, event, extra, inverse_time)  # type: ignore[arg-type]
+            extra = _add(moves, event, extra, inverse_time, line_of(block.line) if line_of else block.line)  # type: ignore[arg-type]
     for text in after:
         yield moves.sample(Action(text, last.line), first_line)  # type: ignore[union-attr]
         moves = _Moves(step)
@@ -235,8 +237,8 @@ def _may_act(signature: str | None) -> bool:
     return signature is None or any(c in signature for c in "MTSHDP") or "G4" in signature or "G9" in signature
 
 
-def _add(moves: _Moves, event: Line | Arc, extra: tuple[float, ...], inverse_time: bool) -> tuple[float, ...]:
-    """Add a move; return the extra axes' positions after it."""
+def _add(moves: _Moves, event: Line | Arc, extra: tuple[float, ...], inverse_time: bool, line: int) -> tuple[float, ...]:
+    """Add a move (told by `line`); return the extra axes' positions after it."""
     ctx = event.context
     (ox, oy, oz), u = ctx.offset, ctx.unit_mm
     (x0, y0, z0), (x1, y1, z1) = event.start, event.end
@@ -245,7 +247,6 @@ def _add(moves: _Moves, event: Line | Arc, extra: tuple[float, ...], inverse_tim
     moves.extra.append((extra, end_extra))
     rapid = type(event) is Line and event.rapid  # type: ignore[union-attr]
     moves.rapid.append(rapid)
-    line = event.block.line
     moves.lines.append(line)
     if type(event) is Arc:
         i, j, _ = PLANE_AXES[ctx.plane]
@@ -278,7 +279,7 @@ class Bound:
 
     @property
     def step(self) -> float:
-        return self.distance / 4
+        return self.distance / 2
 
     @property
     def within(self) -> float:
@@ -313,23 +314,24 @@ def verify(original: BinaryIO, written: BinaryIO, *, file: str, dialect: str | N
         original.seek(0)
     mine = sections(_interpreted(parse_program(original, file, dialect)[1], file, dialect, offsets), bound.step)
     theirs = sections(_interpreted(parse_program(written, file, dialect)[1], file, dialect, offsets), bound.step)
-    return _Comparison(file, bound, lambda number: _line_text(written, number)).run(mine, theirs)
+    return _Comparison(file, bound, lambda number: (_line_text(written, number), 0)).run(mine, theirs)
 
 
-def verified(lines: Iterable[str], reached: Callable[[], int], original: Iterable[Event], *, file: str, dialect: str,
+def verified(lines: Iterable[str], reached: Callable[[], tuple[int, int]], original: Iterable[Event], *, file: str, dialect: str,
              offsets: WorkOffsets | None, bound: Bound) -> Iterator[str]:  # fmt: skip
     """The written program's `lines`, handed on as they are verified against the `original`
     events (the interpreter's reading of the input): each chunk of the input's motion is
     compared with the written lines read back up to where the writer had reached the same
-    input line (`reached()` as it hands out a line).  Raises NcppError where they part."""
+    input line (`reached()` as it hands out a line: that line and the one before).  Raises NcppError where they part."""
     from ncpp.program.parser import parse_stream
 
     feed = _Feed(lines, reached)
     state = {"cut": 0}  # where the input's chunk under way ends (0: at an action)
     mine = sections(original, bound.step, lambda block, moves: block.line if moves >= CHUNK_MOVES else 0)
     theirs = sections(_interpreted(parse_stream(feed, file, dialect), file, dialect, offsets), bound.step,
-                      lambda block, moves: state["cut"] if state["cut"] and feed.tag(block.line) >= state["cut"] else 0)  # fmt: skip
-    comparison = _Comparison(file, bound, feed.text)
+                      lambda block, moves: state["cut"] if state["cut"] and feed.tag(block.line) >= state["cut"] else 0,
+                      lambda number: feed.tag(number, before=True))  # fmt: skip
+    comparison = _Comparison(file, bound, feed.text, tagged=True)
     for a in mine:
         state["cut"] = a.cut
         comparison.step(a, theirs)
@@ -347,24 +349,25 @@ class _Feed:
         self.lines = iter(lines)
         self.reached = reached
         self.pending: list[str] = []
-        self.tags: deque[tuple[int, int]] = deque()  # (last written line of a text, its tag)
+        self.tags: deque[tuple[int, int, int]] = deque()  # (last written line of a text, its tag, the line before)
         self.count = 0  # written lines read so far
         self.recent: deque[tuple[int, str]] = deque(maxlen=64)  # for messages
 
     def __iter__(self) -> Iterator[bytes]:
         for text in self.lines:
-            tag = self.reached()
+            tag, before = self.reached()
             self.pending.append(text)
             self.count += text.count("\n") or 1
-            self.tags.append((self.count, tag))
+            self.tags.append((self.count, tag, before))
             self.recent.append((self.count, text))
             yield text.encode("latin-1")
 
-    def tag(self, number: int) -> int:
-        """The tag of written line `number` (asked in increasing order)."""
+    def tag(self, number: int, before: bool = False) -> int:
+        """The tag of written line `number` (asked in increasing order): the input line the
+        writer had reached, or (`before`) the one before it, where the line most likely is from."""
         while len(self.tags) > 1 and self.tags[0][0] < number:
             self.tags.popleft()
-        return self.tags[0][1] if self.tags else 0
+        return self.tags[0][2 if before else 1] if self.tags else 0
 
     def handed(self) -> list[str]:
         done, self.pending = self.pending, []
@@ -374,15 +377,18 @@ class _Feed:
         """Lines after the parser's last (after the program's end: it reads no further)."""
         return self.lines
 
-    def text(self, number: int | None) -> str:
-        return next((t.strip()[:120] for n, t in self.recent if n == number), "")
+    def text(self, number: int | None) -> tuple[str, int]:
+        """Written line `number` (one of the last read) and its tag."""
+        return next(((t.strip()[:120], self.tag(n, before=True)) for n, t in self.recent if n == number), ("", 0))
 
 
 class _Comparison:
     """Sections of the original and the written program compared pairwise, in order."""
 
-    def __init__(self, file: str, bound: Bound, written_text: Callable[[int | None], str]):
-        self.file, self.bound, self.written_text = file, bound, written_text
+    def __init__(self, file: str, bound: Bound, written_text: Callable[[int | None], tuple[str, int]], tagged: bool = False):
+        """`written_text(n)`: the written program's line n, and the input line it was written from
+        (0: unknown); `tagged`: the written sections' samples are told by those input lines."""
+        self.file, self.bound, self.written_text, self.tagged = file, bound, written_text, tagged
         self.before: Section | None = None  # the last original chunk, when it ended at a cut
         self.owed: tuple[Section, Section] | None = None  # an original chunk not yet checked against the written
         self.feeds: tuple[deque, deque] = (deque(), deque())  # feed rates not yet matched (original, written)
@@ -428,8 +434,9 @@ class _Comparison:
             return next(theirs, None)
         except NcppError as err:
             number = err.where.line
+            text, reached = self.written_text(number)
             raise NcppError(f"verification: ncpp cannot read back the program it wrote: {err.message}, "
-                            f"at its line {number} {self.written_text(number)!r}", Location(self.file, line or 1, 1)) from None
+                            f"at its line {number} {text!r}", Location(self.file, reached or line or 1, 1)) from None
 
     def _actions(self, a: Section, b: Section) -> None:
         if (a.action is None) != (b.action is None) or (a.action is not None and a.action.text != b.action.text):  # type: ignore[union-attr]
@@ -450,14 +457,14 @@ class _Comparison:
         within = self.bound.within
         width = max(path.points.shape[1], along.points.shape[1])
         apart = 4 * within  # a rapid's samples lie this far from a feed's along an extra coordinate
-        tree = cKDTree(_coordinates(along, width, apart))
+        tree = cKDTree(_coordinates(along, width, apart), balanced_tree=False)
         distance, _ = tree.query(_coordinates(path, width, apart), distance_upper_bound=within)
         far = np.flatnonzero(np.isinf(distance))
         if not len(far):
             return
         k = int(far[0])
         gap, near = cKDTree(_coordinates(along, width, 0.0)).query(_coordinates(path, width, 0.0)[k])
-        line = int(along.lines[near]) if written else int(path.lines[k])
+        line = int(along.lines[near]) if written and not self.tagged else int(path.lines[k])
         if gap > within:
             message = f"{message} by more than {within:.4f} mm"
         elif written:

@@ -1,20 +1,26 @@
-"""`ncpp compensate --machine M.toml [--tolerance 0.001] [IN] [-o OUT]`.
+"""`ncpp compensate --machine M.toml [--tolerance 0.001] [IN] [-o OUT]`,
+`ncpp compensate --machine M.toml [--jobs N] -o FOLDER IN...`.
 
-Rewrites an NC program so that the modelled machine cuts the programmed part.
+Rewrites NC programs so that the modelled machine cuts the programmed part.
 `--from FILE` compensates straight from one measurement (ball bar,
-comparator or laser positioning file) instead of a machine file.
+comparator or laser positioning file) instead of a machine file.  Several
+programs go to a folder, each under its own name, `--jobs` of them at once
+(one process each): a program that fails is reported and the others go on.
 """
 
 from __future__ import annotations
 
 import argparse
-import io
+import multiprocessing
 import os
 import sys
-from typing import BinaryIO
+from concurrent.futures import Executor, Future, ProcessPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
+from dataclasses import dataclass
+from pathlib import Path
 
 from ncpp.cli.io import add_io_arguments, open_input, open_output
-from ncpp.cli.options import positive
+from ncpp.cli.options import at_least, positive
 from ncpp.cli.progress import progress_printer
 from ncpp.errors import NcppError, Warnings
 
@@ -22,7 +28,11 @@ from ncpp.errors import NcppError, Warnings
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("compensate", help="compensate an NC program for a machine's errors")
     add_compensation_arguments(p)
-    add_io_arguments(p)
+    add_io_arguments(p, several=True)
+    p.add_argument(
+        "--jobs", type=at_least(1), default=1, metavar="N",
+        help="programs compensated at once, one process each, when several are given (default 1)",
+    )  # fmt: skip
     p.set_defaults(func=run)
 
 
@@ -40,16 +50,6 @@ def add_compensation_arguments(p: argparse.ArgumentParser) -> None:
         "(by default a program whose actions or path differ from the input's is refused, and nothing is written)",
     )
     add_placement_arguments(p)
-    p.add_argument(
-        "--jobs",
-        type=int,
-        choices=(1, 2),
-        default=None,
-        help="processes: 2 compensates a program file of 8192 lines or more in two parts, one process each, and "
-        "other input with its numeric work in a second process (the same output either way; a piped program is "
-        "copied to a temporary file first); default 2 for a program file or piped program over 2 MB on a machine "
-        "with two or more cores, else 1 (a pipe then streams)",
-    )
 
 
 def add_placement_arguments(p: argparse.ArgumentParser) -> None:
@@ -88,35 +88,6 @@ def add_placement_arguments(p: argparse.ArgumentParser) -> None:
     )
 
 
-# A worker process pays off from about this size: it costs ~0.3 s to start (overlapped
-# with the first chunks) and takes a fifth to a third of the run off this process.
-AUTO_JOBS_BYTES = 2 << 20
-
-
-def jobs_for(requested: int | None, stream: BinaryIO) -> int:
-    """--jobs, or what suits this input on this machine."""
-    if requested is not None:
-        return requested
-    try:
-        size = os.fstat(stream.fileno()).st_size  # a pipe says 0 (`spool_from` copies a long one to a file)
-    except (OSError, ValueError, io.UnsupportedOperation):
-        return 1
-    return 2 if _cores() >= 2 and size >= AUTO_JOBS_BYTES else 1
-
-
-def spool_from(requested: int | None) -> int | None:
-    """From how many bytes a program piped to standard input is copied to a file before it
-    is compensated (`open_input`), where two processes can read it: any with --jobs 2,
-    none with --jobs 1, else from the size at which `jobs_for` gives a file two."""
-    if requested is not None:
-        return 0 if requested >= 2 else None
-    return AUTO_JOBS_BYTES if _cores() >= 2 else None
-
-
-def _cores() -> int:
-    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
-
-
 def tolerance_mm(text: str) -> float:
     """--tolerance: a positive, finite number of mm."""
     try:
@@ -152,19 +123,127 @@ def error_source(args: argparse.Namespace):
 
 
 def run(args: argparse.Namespace) -> int:
-    from ncpp.pipeline import process
-
     source = error_source(args)
     if source is None:
         raise NcppError("no error model: give --machine M.toml or --from MEASUREMENT")
-    warnings = Warnings(strict=args.strict)
+    job = Job(source, args.tolerance, args.strict, args.force, args.dialect, work_offsets(args), args.verify)
+    folder = args.output is not None and os.path.isdir(args.output)
+    if len(args.input) > 1 or folder:
+        if args.output is None:
+            raise NcppError("several programs need -o FOLDER, the folder each is written to under its own name")
+        return compensate_files(job, args.input, Path(args.output), args.jobs)
+    return _compensate_one(job, args.input[0] if args.input else None, args.output)
+
+
+@dataclass(frozen=True)
+class Job:
+    """How every program of a run is compensated (pickled once to each process of `--jobs`)."""
+
+    source: object  # pipeline.ErrorSource
+    tolerance: float
+    strict: bool
+    force: bool
+    dialect: str | None
+    offsets: object  # motion.offsets.WorkOffsets
+    verify: bool = True
+
+
+def _compensate_one(job: Job, path: str | None, output: str | None) -> int:
+    """One program (standard input for none) to `output` (standard output for none), with progress."""
+    from ncpp.pipeline import process
+
     progress = progress_printer("compensate")
-    with open_input(args.input, spool_from(args.jobs)) as (stream, name), open_output(args.output) as out:
-        stats = process(
-            stream, out, file=name, source=source, tolerance=args.tolerance, strict=args.strict, force=args.force,
-            warnings=warnings, progress=progress, dialect=args.dialect, jobs=jobs_for(args.jobs, stream), offsets=work_offsets(args), verify=args.verify,
-        )
+    with open_input(path) as (stream, name), open_output(output) as out:
+        stats = process(stream, out, file=name, source=job.source, tolerance=job.tolerance, strict=job.strict, force=job.force,  # type: ignore[arg-type]
+                        warnings=Warnings(strict=job.strict), progress=progress, dialect=job.dialect, offsets=job.offsets, verify=job.verify)  # type: ignore[arg-type]  # fmt: skip
     if progress is not None:
         progress.done()
         print(f"ncpp: {stats.lines_in} lines in, {stats.lines_out} lines out", file=sys.stderr)
     return 0
+
+
+def compensate_files(job: Job, paths: list[str], folder: Path, jobs: int = 1) -> int:
+    """Each program to `folder` under its own name, `jobs` at once; a failure is reported
+    (`file:line:col: message`) and the others go on.  0 if all were written, else 2."""
+    targets = _targets(paths, folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    failed = 0
+    with _executor(job, min(jobs, len(paths))) as pool:
+        futures = [pool.submit(_compensate_file, path, str(target)) for path, target in zip(paths, targets)]
+        for path, future in zip(paths, futures):
+            message = _failure(future, path)
+            if message is not None:
+                print(message, file=sys.stderr)
+                failed += 1
+    if failed:
+        print(f"ncpp: {failed} of {len(paths)} programs failed", file=sys.stderr)
+    return 2 if failed else 0
+
+
+def _targets(paths: list[str], folder: Path) -> list[Path]:
+    """Where each program goes: `folder`/its name, refused where two share a name or one would replace its program."""
+    targets = [folder / Path(path).name for path in paths]
+    seen: dict[Path, str] = {}
+    for path, target in zip(paths, targets):
+        if target in seen:
+            raise NcppError(f"{seen[target]} and {path} would both be written to {target}")
+        if Path(path).resolve() == target.resolve():
+            raise NcppError(f"{path}: -o {folder} would replace the program itself")
+        seen[target] = path
+    return targets
+
+
+def _failure(future: Future, path: str) -> str | None:
+    """How the program at `path` failed, as `ncpp` reports it (None: it was written)."""
+    try:
+        future.result()
+    except NcppError as err:
+        return str(err)
+    except OSError as err:
+        return f"{err.filename or path}: {err.strerror or err}"
+    except BrokenProcessPool:  # (killed, or out of memory: the programs it had are not written)
+        return f"{path}: the process compensating it stopped"
+    return None
+
+
+class _InProcess(Executor):
+    """--jobs 1: each program in this process, one after the other, as the pool would."""
+
+    def __init__(self, job: Job):
+        _start_worker(job)
+
+    def submit(self, fn, /, *args, **kwargs) -> Future:  # type: ignore[override]
+        future: Future = Future()
+        try:
+            future.set_result(fn(*args, **kwargs))
+        except (NcppError, OSError) as err:
+            future.set_exception(err)
+        return future
+
+
+def _executor(job: Job, workers: int) -> Executor:
+    """Processes started fresh ("spawn"): a fork would copy this process's threads' locks (BLAS's)."""
+    if workers <= 1:
+        return _InProcess(job)
+    context = multiprocessing.get_context("spawn")
+    return ProcessPoolExecutor(workers, mp_context=context, initializer=_start_worker, initargs=(job,))
+
+
+_job: Job | None = None  # the run's job, in each process that compensates
+
+
+def _start_worker(job: Job) -> None:
+    global _job
+    _job = job
+
+
+def _compensate_file(path: str, target: str) -> None:
+    """One program of `compensate_files`, in a process `_start_worker` was told the job."""
+    from ncpp.fileio import atomic_output
+    from ncpp.pipeline import process
+
+    job = _job
+    assert job is not None
+    with open(path, "rb") as stream, atomic_output(target) as out:
+        process(stream, out, file=path, source=job.source, tolerance=job.tolerance, strict=job.strict, force=job.force,  # type: ignore[arg-type]
+                warnings=Warnings(strict=job.strict), dialect=job.dialect, offsets=job.offsets, verify=job.verify)  # type: ignore[arg-type]  # fmt: skip

@@ -19,7 +19,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ncpp.cli.compensate import add_compensation_arguments, jobs_for, spool_from
+from ncpp.cli.compensate import add_compensation_arguments
 from ncpp.cli.io import add_io_arguments, open_input, open_output
 from ncpp.cli.progress import progress_printer
 from ncpp.errors import Location, NcppError, Warnings
@@ -38,10 +38,9 @@ def run(args: argparse.Namespace) -> int:
     warnings = Warnings(strict=args.strict)
     source, tolerance, offsets = configured_source(args)
     progress = progress_printer("filter")
-    spooled = spool_from(args.jobs) if source is not None else None  # (passthrough streams)
-    with open_input(args.input, spooled) as (stream, name), open_output(args.output) as out:
+    with open_input(args.input) as (stream, name), open_output(args.output) as out:
         process(stream, out, file=name, source=source, tolerance=tolerance, strict=args.strict, force=args.force,
-                warnings=warnings, progress=progress, dialect=args.dialect, jobs=jobs_for(args.jobs, stream), offsets=offsets, verify=args.verify)  # fmt: skip
+                warnings=warnings, progress=progress, dialect=args.dialect, offsets=offsets, verify=args.verify)  # fmt: skip
     if progress is not None:
         progress.done()
     return 1 if warnings.count and args.strict else 0

@@ -9,22 +9,27 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import io
-import os
 import shutil
 import sys
 import tempfile
 from pathlib import Path
 from typing import BinaryIO, Iterator
 
-from ncpp.fileio import atomic_output, program_file
+from ncpp.fileio import atomic_output
 
 SPOOL_BYTES = 8 << 20
 
 
-def add_io_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("input", nargs="?", help="NC program (default: standard input)")
-    p.add_argument("-o", "--output", help="output file, written atomically (default: standard output)")
+def add_io_arguments(p: argparse.ArgumentParser, several: bool = False) -> None:
+    """IN, -o OUT, --strict and --dialect; with `several`, IN is a list (`args.input`) and
+    -o may name the folder the programs are written to."""
+    if several:
+        p.add_argument("input", nargs="*", metavar="IN", help="NC programs (default: standard input)")
+        output = "output file, written atomically (default: standard output); with several programs, or a folder, the folder each goes to under its own name"
+    else:
+        p.add_argument("input", nargs="?", help="NC program (default: standard input)")
+        output = "output file, written atomically (default: standard output)"
+    p.add_argument("-o", "--output", help=output)
     p.add_argument("--strict", action="store_true", help="refuse constructs that would pass through with a warning")
     add_dialect_argument(p)
 
@@ -34,35 +39,13 @@ def add_dialect_argument(p: argparse.ArgumentParser) -> None:
 
 
 @contextlib.contextmanager
-def open_input(path: str | None, spool_from: int | None = None) -> Iterator[tuple[BinaryIO, str]]:
-    """The program to read and its name for messages.  `spool_from`: standard input that
-    is not a program file (a pipe, `fileio.program_file`) and holds at least this many
-    bytes is copied to a temporary file first, which can be compensated in two parts
-    (`ncpp/parts.py`; the output is written at the end either way); less is read from memory."""
+def open_input(path: str | None) -> Iterator[tuple[BinaryIO, str]]:
+    """The program to read and its name for messages (standard input for none or `-`)."""
     if path is None or path == "-":
-        stdin = sys.stdin.buffer
-        if spool_from is None or program_file(stdin) is not None:  # (a file the parts can read themselves)
-            yield stdin, "<stdin>"
-            return
-        with _spooled(stdin, spool_from) as stream:
-            yield stream, "<stdin>"
+        yield sys.stdin.buffer, "<stdin>"
         return
     with open(path, "rb") as stream:
         yield stream, path
-
-
-@contextlib.contextmanager
-def _spooled(stream: BinaryIO, spool_from: int) -> Iterator[BinaryIO]:
-    head = stream.read(spool_from) if spool_from else b""
-    if spool_from and len(head) < spool_from:  # the whole program, and short
-        yield io.BytesIO(head)
-        return
-    with tempfile.TemporaryDirectory(prefix="ncpp-input-") as folder:
-        with open(os.path.join(folder, "stdin.nc"), "w+b") as spool:
-            spool.write(head)
-            shutil.copyfileobj(stream, spool, 1 << 20)
-            spool.seek(0)
-            yield spool
 
 
 @contextlib.contextmanager

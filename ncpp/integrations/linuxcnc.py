@@ -27,7 +27,7 @@ from ncpp.runtime import one_blas_thread
 
 class FilterProgress:
     """`FILTER_PROGRESS=N` on stderr whenever the percentage of the program's lines done
-    changes (`pipeline.process`'s progress: in two parts, the program's lines, `parts._Pacer`)."""
+    changes (`pipeline.process`'s progress: the program's lines read)."""
 
     def __init__(self, path: str, out: TextIO):
         self.path, self.out = path, out
@@ -57,7 +57,6 @@ def already_compensated(path: str) -> bool:
 
 def run(path: str, err: TextIO, machine: str | None = None) -> None:
     """Write the compensated program to stdout (nothing on error), progress to `err`."""
-    from ncpp.cli.compensate import jobs_for
     from ncpp.cli.io import open_output
     from ncpp.integrations.config import find_settings, with_linuxcnc_ini
     from ncpp.pipeline import ErrorSource, process
@@ -73,9 +72,8 @@ def run(path: str, err: TextIO, machine: str | None = None) -> None:
                 if not os.path.isfile(settings.machine):
                     raise NcppError(f"machine file {settings.machine} (from {settings.origin}) does not exist")
                 source = ErrorSource.from_machine_file(settings.machine)
-                jobs = jobs_for(None, stream)  # LinuxCNC runs the filter as its own process: a worker is safe
                 process(stream, spool, file=path, source=source, tolerance=settings.tolerance, warnings=Warnings(stream=err),
-                        progress=progress, jobs=jobs, offsets=settings.offsets())  # fmt: skip
+                        progress=progress, offsets=settings.offsets())  # fmt: skip
         progress.report(100)
 
 

@@ -40,8 +40,7 @@ if TYPE_CHECKING:
     from ncpp.machine.trajectory import Trajectory
 
 Vec3 = tuple[float, float, float]
-# points per block: the kernels' dozens of (n,3) temporaries stay in a core's cache (0.5 MB
-# of L2 here); 2048 took 0.41-0.62 µs a point, 32768 0.80 (HR5B, 12k points)
+# points per block: small enough that the dozens of (n,3) temporaries of a block stay in a core's cache
 CHUNK = 2048
 
 

@@ -37,13 +37,10 @@ from typing import Callable, Iterable, Iterator, Sequence
 
 from ncpp.errors import Location, NcppError
 from ncpp.motion.expressions import SUBROUTINE_PARAMETERS, normalise_name, round_half_away
-from ncpp.motion.snapshot import attributes
 from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
 from ncpp.program.parser import parse_stream
 
 RUN, FIXED, SKIP, TEXT = "run", "fixed", "skip", "text"
-# Not state (`Flow.state`): the interpreter's callbacks, the stream, a cache by id, and `base`, told apart
-_NOT_FLOW_STATE = frozenset({"file", "evaluate", "parameters", "done", "stop", "path", "stream", "_controls", "base"})
 _TRIM = 4096  # blocks no loop can go back to are dropped in runs of this many
 # Blocks after an `O<n>` line kept as Fanuc subprogram `n` until its M99: a longer one is a
 # program's own number (`O1000` at its top), not a subprogram, and memory stays bounded.
@@ -172,27 +169,6 @@ class Flow:
                 continue
             yield from self._control(frame, block, control)
         yield from self._rest()
-
-    # -- lines left out (a second part's skim, `motion/skim.py`) --------------
-    def streaming(self) -> bool:
-        """Whether the next block read is the next to run, in its place in the main program,
-        with no loop to go back to and no definition or skip under way: lines left out here
-        would have run one after the other."""
-        main = self.frames[0]
-        return (len(self.frames) == 1 and main.pc == self.read == self.written and not main.labels
-                and self.skipping is None and self._defining is None and not self.done())  # fmt: skip
-
-    def skipped(self, lines: int) -> None:
-        """`lines` main-program blocks ran without being read here (`streaming` was true):
-        count them, as reading them would have."""
-        self._drop(len(self.buffer))  # none is read again (nothing to go back to)
-        self.read += lines
-        self.written = self.frames[0].pc = self.base = self.read
-
-    def state(self) -> tuple:
-        """The flow's state, comparable (`snapshot.py`): the blocks it holds by line; where
-        its buffer starts only when it holds one (it is not kept up while streaming)."""
-        return attributes(self, _NOT_FLOW_STATE) + (("base", self.base if self.buffer else None),)
 
     def _kind(self, frame: _Frame) -> tuple[str, Block | None]:
         if self._in_place(frame):

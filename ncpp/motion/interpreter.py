@@ -40,7 +40,6 @@ from ncpp.motion.expressions import ExpressionError, OutOfScope, Parameters, eva
 from ncpp.motion.offsets import SYSTEMS, WorkOffsets
 from ncpp.motion.flow import FIXED, RUN, SKIP, Flow
 from ncpp.motion.segments import COMP, CYCLE, FLOW, PLANE_AXES, Arc, Context, Event, Line, Pass, mark_off_path
-from ncpp.motion.snapshot import attributes
 from ncpp.motion.tools import UntoldLengths
 from ncpp.program.blocks import STRAY_TAPE, UNREADABLE, Block, Comment, ExprWord, Statement, Word
 
@@ -145,12 +144,8 @@ def interpret(
     warnings: Warnings | None = None,
     strict: bool = False,
     offsets: WorkOffsets | None = None,
-    interpreter: "Interpreter | None" = None,
 ) -> Iterator[Event]:
     """Motion events of a program's blocks, lazily (see the module docstring).
-
-    `interpreter`: the one to run (else one is made from `file` and `offsets`), its
-    state the caller's to look at between blocks (`ncpp/parts.py`).
 
     `offsets`: the zeros and the tool table the control holds at the start
     (none: all zero, as rs274's default parameter file).  Given, a coordinate
@@ -166,7 +161,7 @@ def interpret(
         warnings = Warnings(strict=strict)
     elif strict and not warnings.strict:
         warnings = Warnings(strict=True, stream=warnings.stream)
-    return (interpreter or Interpreter(file, offsets)).run(blocks, warnings)
+    return Interpreter(file, offsets).run(blocks, warnings)
 
 
 class Interpreter:
@@ -212,7 +207,6 @@ class Interpreter:
         self.untold: set[int] = set()  # coordinate systems whose zero nobody said (warned when selected)
         self.warnings: Warnings | None = None
         self.flow: Flow | None = None  # while `run` runs
-        self.holding: Line | None = None  # `run`'s line whose corner waits for the next move
         self.subroutine_path = offsets.subroutine_path if offsets is not None else ()
         if offsets is not None:
             self._start_from(offsets)
@@ -264,7 +258,7 @@ class Interpreter:
                 self._leave_scope(stop.reason, block, stop.col, owner)
                 if pending is not None:
                     yield from self._unrounded(pending, held)
-                    pending = self.holding = None
+                    pending = None
                 if owner is None:  # (a block that runs out of the text's order is written in its place)
                     yield Pass(block)
                 continue
@@ -281,48 +275,20 @@ class Interpreter:
                     rounded = self._round_corner(pending, corner, ev, warnings)
                     if rounded is None:  # out of scope: everything from the corner on passes
                         yield from self._unrounded(pending, held)
-                        pending = self.holding = None
+                        pending = None
                         yield Pass(ev.block)
                         break
                     yield from rounded[:-1]
                     yield from held
                     ev = rounded[-1]
                     pending, held = None, []
-                    self.holding = None
                 if new_corner is not None and type(ev) is Line and ev.block is block:
                     pending, corner = ev, new_corner
-                    self.holding = pending
                     continue
                 yield ev
         if pending is not None:
             _, _, item = corner
             raise NcppError("corner rounding/chamfer has no following move", Location(self.file, pending.block.line, item.start + 1))
-
-    # -- between blocks: the state, and plain lines not read (`motion/skim.py`) ------------
-    def state(self) -> tuple | None:
-        """What decides the events of the blocks still to read, comparable (`snapshot.py`;
-        equal states interpret the same blocks alike), taken between blocks; None while a
-        corner waits for the next move (the events held then are not state this tells)."""
-        if self.holding is not None or self.flow is None:
-            return None
-        return attributes(self, _NOT_STATE) + (("params", attributes(self.params, _NOT_STATE)), ("flow", self.flow.state()))
-
-    def skimmable(self) -> bool:
-        """Whether plain lines (`skim.PLAIN_LINE`) may be left unread from here, their effect
-        told by `skipped`: in absolute G90 without inverse time, no corner waiting, and the
-        flow reading the main program in order."""
-        return (self.absolute and not self.inverse_time and self.corner is None and self.holding is None
-                and self.cutter_comp is None and not self.off_path and not self.arc_refused and not self.done and self.flow is not None and self.flow.streaming())  # fmt: skip
-
-    def skipped(self, lines: int, ends: dict[int, float], motion: float | None, feed: float) -> None:
-        """`lines` plain lines ran unread (`skimmable` was true): they moved the axes
-        `ends` names (index: program position) in `motion`, the last feed `feed`."""
-        pos = self.pos[:]
-        for axis, value in ends.items():
-            pos[axis] = value
-        self.pos, self.motion, self.feed = pos, motion, feed
-        self._update_fast()
-        self.flow.skipped(lines)  # type: ignore[union-attr]
 
     def _leave_scope(self, reason: str, block: Block, col: int | None, owner: Block | None = None) -> None:
         """A construct outside the scope: the state is unknown from here on (an error with strict).
@@ -1401,9 +1367,6 @@ _COORD_SYSTEM_CODE = {n: code * 10 for code, n in _COORD_SYSTEM.items()}
 _PLANE_LETTERS = {17: "XY", 18: "ZX", 19: "YZ"}
 # words a plain modal move may carry without the full checks
 _AXIS_LETTERS_F = frozenset("XYZABCUVWFIJKR")
-# Not the interpreter's state (`Interpreter.state`): where it reports and what it was told,
-# a cache, its flow and parameters (told apart); callbacks compare as None (`snapshot.py`)
-_NOT_STATE = frozenset({"file", "warnings", "untold_lengths", "tools", "subroutine_path", "flow", "params", "_context", "holding"})
 _F_ONLY = frozenset("F")
 _XYZ_SLOT = {"X": (0, 1), "Y": (1, 2), "Z": (2, 4)}
 _XYZF = frozenset("XYZF")

@@ -10,12 +10,11 @@ here would hide its module, and `ncpp.passes.replace_arcs.BATCH_ARCS = ...` woul
 set an attribute of the function and change nothing.
 
 A pass that reads events in batches hands on the events it holds when an earlier
-stage refuses a line (`geometry.chunked`, `kernels.run_ahead`).  A pass that refuses a
+stage refuses a line (`geometry.chunked`, `replace_arcs._batches`).  A pass that refuses a
 line of a batch deals with the batch's lines before it first: `replace_arcs` hands them
 on compensated (a later pass may refuse one of those), `apply_error_map` solves them
 again (it checks a chunk's line ends before its reversal steps).  So the fault reported
-is the program's first, whatever the batch sizes, a worker process or the parts a
-program is compensated in; `NcppError.locate` then names its column.
+is the program's first, whatever the batch sizes; `NcppError.locate` then names its column.
 """
 
 from __future__ import annotations

@@ -25,8 +25,7 @@ from numpy.typing import NDArray
 
 from ncpp.errors import NcppError
 from ncpp.motion.segments import Arc, Event, Line
-from ncpp.passes.context import CutLine, PassContext, deviation
-from ncpp.passes.kernels import run_ahead
+from ncpp.passes.context import PassContext, deviation
 from ncpp.passes.geometry import all3, any3, compensate, frames, from_plane, in_plane, line_chunks, plane_axes, points, rows_of, tuples
 from ncpp.passes.travel import Travel, grid, hold, quantize, steps
 
@@ -47,75 +46,20 @@ def apply_error_map(events: Iterable[Event], ctx: PassContext) -> Iterator[Event
 
 def _chunks(events: Iterable[Event], ctx: PassContext) -> Iterator[list[Event]]:
     """The compensated events, a list per chunk."""
-    resume = ctx.resume
-    solver = Solve(ctx.for_kernels(), None if resume is None else resume.travel)
-    solve = ctx.kernels.bind(solver)
-    last = None if resume is None else resume.last  # the last segment written: its compensated end, in its own program frame
-    chunks = (_with_rows(chunk, ctx.directional) for chunk in line_chunks(events))
-    cut = _Cut(ctx.cut, solver) if ctx.cut is not None else None
-
-    def start(c):
-        if cut is not None:
-            cut.before_solving(c[0])
-        return None if c[2] is None else solve(c[2])
-
-    # with a worker process, the next chunks are read (parsed, interpreted, their arcs replaced) while one is solved
-    for (chunk, segs, rows), solving in run_ahead(chunks, start, ctx.kernels.ahead):
-        if cut is not None:
-            cut.before_writing(chunk, last, ctx)
-        if solving is None:  # no segments
+    solve = Solve(ctx)
+    last = None  # the last segment written: its compensated end, in its own program frame
+    for chunk, segs, rows in (_with_rows(chunk, ctx.directional) for chunk in line_chunks(events)):
+        if rows is None:  # no segments
             yield chunk
             continue
         try:
-            solved = solving.result()
+            solved = solve(rows)
         except NcppError as error:
             error.locate(e.block for e in chunk)
             raise
         out = _written(chunk, segs, rows, solved, last)
         last = _ended(segs[-1], solved.end[-1])  # (a carried row's end is not its event's: `_carry`)
         yield out
-
-
-@dataclass(eq=False)
-class PassState:
-    """Where the pass stands between two chunks: what the machine has done, and the
-    last segment written (what a run resumed there starts from)."""
-
-    travel: Travel
-    last: Line | Arc | None
-    motion: tuple | None = None  # replace_arcs.Motion's state there (None: not recorded: never equal)
-
-    def __eq__(self, other: object) -> bool:
-        """Equal states compensate the chunks after them alike: the same held directions,
-        last command and programmed motion, and a last segment ending at the same point of the same frame."""
-        if not isinstance(other, PassState):
-            return NotImplemented
-        if self.motion is None or self.motion != other.motion:
-            return False
-        a, b = self.travel, other.travel
-        if not np.array_equal(a.held, b.held) or (a.last is None) != (b.last is None):
-            return False
-        if a.last is not None and not np.array_equal(a.last, b.last):
-            return False
-        if self.last is None or other.last is None:
-            return self.last is other.last
-        return self.last.end == other.last.end and self.last.context == other.last.context
-
-
-class _Cut:
-    """Records the pass's state at the first chunk from the cut's input line on
-    (a window's first line: a chunk starts there, `line_chunks`), in one process."""
-
-    def __init__(self, cut: CutLine, solver: "Solve"):
-        self.cut, self.solver, self.travel = cut, solver, None
-
-    def before_solving(self, chunk: list[Event]) -> None:
-        if self.travel is None and chunk[0].block.line >= self.cut.line:
-            self.travel = self.solver.travel.copy()
-
-    def before_writing(self, chunk: list[Event], last, ctx: PassContext) -> None:
-        if self.travel is not None and not ctx.at_cut and chunk[0].block.line >= self.cut.line:
-            ctx.at_cut.append(PassState(self.travel, last, ctx.motion_at_cut[0] if ctx.motion_at_cut else None))
 
 
 def _with_rows(chunk: list[Event], directional: bool) -> tuple[list[Event], list, "_Rows | None"]:
@@ -126,8 +70,7 @@ def _with_rows(chunk: list[Event], directional: bool) -> tuple[list[Event], list
 
 @dataclass
 class _Rows:
-    """A chunk's segments (rows) as the solve needs them: arrays, no events
-    (the solve may run in a worker process)."""
+    """A chunk's segments (rows) as the solve needs them: arrays, no events."""
 
     start: NDArray  # (n,3) program units
     end: NDArray  # (n,3)
@@ -173,9 +116,9 @@ class Solve:
     and shifted arc pieces.  Keeps what the machine has done so far (`Travel`),
     so chunks must come in order."""
 
-    def __init__(self, ctx: PassContext, travel: Travel | None = None):
+    def __init__(self, ctx: PassContext):
         self.ctx = ctx
-        self.travel = Travel() if travel is None else travel.copy()
+        self.travel = Travel()
 
     def __call__(self, rows: _Rows) -> "_Solved":
         return self._solve(rows, self.travel)

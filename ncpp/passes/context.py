@@ -2,19 +2,13 @@
 
 from __future__ import annotations
 
-import io
-import sys
-from dataclasses import dataclass, field, replace
-from typing import TYPE_CHECKING, Protocol
+from dataclasses import dataclass, field
+from typing import Protocol
 
 import numpy as np
 from numpy.typing import NDArray
 
 from ncpp.errors import Warnings
-from ncpp.passes.kernels import INLINE, Kernels
-
-if TYPE_CHECKING:
-    from ncpp.passes.apply_error_map import PassState
 
 
 class ErrorMap(Protocol):
@@ -38,17 +32,6 @@ def deviation(model: ErrorMap, P: NDArray, direction: NDArray | None, tool_offse
     return model.deviation(P, direction, tool_offset)
 
 
-UNDECIDED = sys.maxsize  # a cut's line until it is decided: no input line reaches it
-
-
-@dataclass
-class CutLine:
-    """The input line where a run in two parts is cut (`ncpp/parts.py`): decided while
-    the parts run, before either reads that far."""
-
-    line: int = UNDECIDED
-
-
 @dataclass(frozen=True)
 class PassContext:
     model: ErrorMap
@@ -63,17 +46,6 @@ class PassContext:
     iterations: int = 2  # fixed-point steps of the inverse map (`inverse.iterations_for` picks the fewest that suffice)
     warnings: Warnings = field(default_factory=Warnings)
     file: str = "<stdin>"
-    kernels: Kernels = INLINE  # where the passes' numeric kernels run (kernels.py)
-    # A run in two parts (one process each): the input line where the second starts, where
-    # the first records the passes' state (`at_cut`), and the state the second resumes from
-    cut: CutLine | None = None
-    at_cut: list[PassState] = field(default_factory=list)
-    motion_at_cut: list[tuple] = field(default_factory=list)  # replace_arcs.Motion's state there, for `at_cut`
-    resume: PassState | None = None
-
-    def for_kernels(self) -> "PassContext":
-        """This context as a kernel holds it: picklable (no output stream, no worker)."""
-        return replace(self, warnings=Warnings(self.warnings.strict, io.StringIO()), kernels=INLINE, cut=None, at_cut=[], motion_at_cut=[], resume=None)
 
     def limit_arrays(self) -> tuple[NDArray, NDArray]:
         lo = np.array([self.limits.get(a, (-np.inf, np.inf))[0] for a in "XYZ"])

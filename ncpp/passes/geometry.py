@@ -213,7 +213,7 @@ def compensate(
 
     points (n,m,3) or (n,3): point(s) of segment k in its program frame;
     offsets (n,3), scales (n,); lines (n,): the line of segment k's block (numbers,
-    not events: this runs in a worker process too); directions: travel signs shaped
+    not events); directions: travel signs shaped
     like points, for direction-dependent (reversal) error tables; tools (n,3): the tool length
     offsets in effect, mm (`frames`; None: none).  Refuses corrections
     beyond the machine's limit and commands outside its travel, naming the line."""

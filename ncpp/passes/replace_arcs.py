@@ -24,8 +24,7 @@ from numpy.typing import NDArray
 from ncpp.errors import Location, NcppError
 from ncpp.machine.chain import norm3
 from ncpp.motion.segments import PLANE_AXES, Arc, Event, Line
-from ncpp.passes.context import CutLine, PassContext
-from ncpp.passes.kernels import run_ahead
+from ncpp.passes.context import PassContext
 from ncpp.passes.geometry import any3, before_line, compensate, frames, from_plane, in_plane, plane_axes, points, row_max, rows_of, spliced, tuples
 from ncpp.passes.travel import grid, quantize
 
@@ -44,19 +43,15 @@ REVERSAL_WINDOW = 0.002
 REVERSAL_HEIGHT = 1e-7
 # Arcs are replaced independently, a batch at a time: a batch holds up to BATCH_ARCS
 # arcs (their events and sample arrays bound the memory) and up to BATCH_EVENTS events,
-# so that programs with few arcs among their lines do not pay numpy's per-call cost per arc.
-# No more events than that: nothing is written before a batch is full, and in two parts
-# (`ncpp/parts.py`) the cut waits for the first lines written (with 16384, the first 13k
-# lines of stellabee1.ngc, 0.8 s: the second process waited half a second; 0.6% more
-# instructions with 4096)
+# so that programs with few arcs among their lines do not pay numpy's per-call cost per arc,
+# and nothing waits long to be written.
 BATCH_ARCS = 1024
 BATCH_EVENTS = 4096
 # Turns of one arc at most: an arc's pieces are made at once (~8 kB a turn: 10,000 turns take
 # 170 MB; a helix of 10⁸ turns ran out of 24 GB).
 MAX_TURNS = 10_000
 SLIVER = 0.01  # mm of arc length below which a piece becomes a line (its bulge is < 0.1 µm for radii over 0.1 mm)
-# Lines back that an arc's guess of its normal axis's direction looks (`Motion`): within a
-# two-part run's window (`parts.WINDOW`, 2048 lines)
+# Lines back that an arc's guess of its normal axis's direction looks (`Motion`)
 HELD_LINES = 1024
 
 
@@ -70,16 +65,14 @@ class _Pieces:
 
 
 def replace_arcs(events: Iterable[Event], ctx: PassContext) -> Iterator[Event]:
-    fit = ctx.kernels.bind(FitArcs(ctx.for_kernels()))
-    motion = Motion(ctx.resume.motion if ctx.resume is not None else None, ctx.cut, ctx.motion_at_cut, ctx.directional)
-    batches = (_with_arcs(batch, motion) for batch in _batches(events))
-    # with a worker process, the next batches are read while one is fitted
-    for (batch, index, arcs, normals), fitting in run_ahead(batches, lambda b: fit(_ArcRows.of(b[2], b[3])) if b[2] else None, ctx.kernels.ahead):
-        if fitting is None:
+    fit = FitArcs(ctx)
+    motion = Motion(directional=ctx.directional)
+    for batch, index, arcs, normals in (_with_arcs(batch, motion) for batch in _batches(events)):
+        if not arcs:
             yield from batch
             continue
         try:
-            fitted = fitting.result()
+            fitted = fit(_ArcRows.of(arcs, normals))
         except NcppError as error:  # the lines before the refused one go on first: a later pass may refuse one of them
             error.locate(e.block for e in batch)
             earlier = before_line(batch, error.where.line)
@@ -105,18 +98,11 @@ class Motion:
     for it (a helix's for its rise).  It is a guess, from the program's motion, of the
     direction apply_error_map finds from the compensated motion: that pass shifts a piece
     whose guess was wrong (`Arc.normal`).  A move more than HELD_LINES lines before the arc
-    is not used (the mean, 0, instead): so the second of a run's two parts (`ncpp/parts.py`),
-    which compensates a window of lines before its cut, makes the same guesses after it.  The
-    state is part of the passes' state at the cut: recorded at the first move from the cut's
-    line on (`record`; nothing where the cut was decided after the moves passed it)."""
+    is not used (the mean, 0, instead), which keeps outputs those of earlier versions."""
 
-    def __init__(self, state: tuple | None, cut: CutLine | None, record: list, directional: bool = True):
+    def __init__(self, state: tuple | None = None, directional: bool = True):
         self.state = state or (0, 0, 0, 0, 0, 0)  # x, y, z signs (0: none yet), and their lines
-        self.cut, self.record = cut, record
-        self.line = -1  # the line of the last move read
         self.directional = directional
-        if not directional and cut is not None:  # no guesses wanted (the map has no reversal errors): none made
-            record.append(self.state)
 
     def normals(self, batch: list[Event], arcs: list[Arc]) -> list[int]:
         """The direction of the normal axis of each of `arcs` (the batch's arcs to replace, in
@@ -127,15 +113,11 @@ class Motion:
         pending = iter(arcs)
         arc = next(pending, None)
         x, y, z, lx, ly, lz = self.state
-        line, cut = self.line, self.cut
         for event in batch:
             kind = type(event)
             if kind is not Line and kind is not Arc:
                 continue
             at = event.block.line
-            if cut is not None and line < cut.line <= at:
-                self.record.append(_recorded((x, y, z, lx, ly, lz), cut.line))
-            line = at
             (s0, s1, s2), (e0, e1, e2) = event.start, event.end
             if event is arc:
                 arc = next(pending, None)
@@ -152,16 +134,8 @@ class Motion:
                 y, ly = 1 if e1 > s1 else -1, at
             if e2 != s2:
                 z, lz = 1 if e2 > s2 else -1, at
-        self.state, self.line = (x, y, z, lx, ly, lz), line
+        self.state = (x, y, z, lx, ly, lz)
         return out
-
-
-def _recorded(state: tuple, cut: int) -> tuple:
-    """`Motion`'s state at the cut without what no guess from the cut on uses (moves older
-    than HELD_LINES lines), which the second part may not have seen."""
-    signs, lines = state[:3], state[3:]
-    kept = [cut - since <= HELD_LINES for since in lines]
-    return (*(s if k else 0 for s, k in zip(signs, kept)), *(n if k else 0 for n, k in zip(lines, kept)))
 
 
 def _batches(events: Iterable[Event]) -> Iterator[list[Event]]:
@@ -187,8 +161,7 @@ def _batches(events: Iterable[Event]) -> Iterator[list[Event]]:
 
 @dataclass
 class _ArcRows:
-    """A batch's arcs as the fit needs them: arrays, no events (the fit may run
-    in a worker process)."""
+    """A batch's arcs as the fit needs them: arrays, no events."""
 
     start: NDArray  # (n,3) program units
     end: NDArray  # (n,3)

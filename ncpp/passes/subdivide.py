@@ -4,8 +4,7 @@ Compensating only a line's end points corrects the path between them by the
 straight interpolation of the end-point errors.  Where the error varies more
 than that along the line (a bow, a kink in an error table), the line is split
 into pieces short enough that the remaining deviation is below the tolerance.
-The error is sampled by a kernel (`PieceCounts`), in the worker process when
-there is one; not along a line that a bound of the error's curvature already keeps
+The error is sampled a chunk at a time (`PieceCounts`); not along a line that a bound of the error's curvature already keeps
 whole (`ncpp.machine.curvature`, where the map gives one: its `bow_bound`).
 """
 
@@ -22,7 +21,6 @@ from ncpp.machine.curvature import BowBound
 from ncpp.motion.segments import Event, Line
 from ncpp.passes.context import PassContext, deviation
 from ncpp.passes.geometry import chunked, frames, points, row_max, rows_of, spliced
-from ncpp.passes.kernels import run_ahead
 
 # Interior samples where linearity is checked.
 SAMPLES = np.linspace(0.0, 1.0, 7)
@@ -36,15 +34,13 @@ SURE = 0.99
 
 
 def subdivide_lines(events: Iterable[Event], ctx: PassContext) -> Iterator[Event]:
-    count = ctx.kernels.bind(PieceCounts(ctx.for_kernels()))
+    count = PieceCounts(ctx)
     bound = getattr(ctx.model, "bow_bound", None)
-    chunks = (_with_rows(chunk, ctx, bound) for chunk in chunked(events))
-    # with a worker process, the error along the next chunks' lines is evaluated while one is split
-    for (chunk, index, lines, _), counting in run_ahead(chunks, lambda c: None if c[3] is None else count(c[3]), ctx.kernels.ahead):
-        if counting is None:
+    for chunk, index, lines, rows in (_with_rows(chunk, ctx, bound) for chunk in chunked(events)):
+        if rows is None:
             yield from chunk
             continue
-        pieces = counting.result().tolist()
+        pieces = count(rows).tolist()
         split = [i for i, n in enumerate(pieces) if n > 1]
         yield from spliced(chunk, [index[i] for i in split], [_split(lines[i], pieces[i]) for i in split])
 

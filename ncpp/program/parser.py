@@ -707,30 +707,20 @@ def continued_lines(lines: Iterable[tuple[str, str]], mark: str) -> Iterator[tup
         yield first, pending[: len(pending) - len(eol)], eol
 
 
-NumberedLines = Callable[[Iterable[bytes]], Iterable[tuple[int, tuple[str, str]]]]
-
-
 def _without_layout(scanned: tuple | None) -> tuple | None:
     """The scanner's (items, signature) with no layout (`LineParser._scan_plain`)."""
     return None if scanned is None else (*scanned, None)
 
 
-def numbered_lines(stream: Iterable[bytes]) -> Iterator[tuple[int, tuple[str, str]]]:
-    """(number, (content, eol)) of each line of a binary stream, from 1."""
-    return enumerate(iter_lines(stream), start=1)
-
-
-def parse_stream(stream: Iterable[bytes], file: str = "<stdin>", grammar: "str | Dialect" = "iso", numbered: NumberedLines = numbered_lines) -> Iterator[Block]:
+def parse_stream(stream: Iterable[bytes], file: str = "<stdin>", grammar: "str | Dialect" = "iso") -> Iterator[Block]:
     """Blocks of a program, lazily.  After the closing `%` lines are kept verbatim
-    (a control stops reading there).  `grammar` names the dialect (or is one).
-    `numbered` reads the stream's lines (another one may leave lines out: `motion/skim.py`;
-    a dialect with continued lines reads them all)."""
+    (a control stops reading there).  `grammar` names the dialect (or is one)."""
     parser = LineParser(grammar)
-    if parser.dialect.continuation:  # (`numbered` leaves no line out here: it reads them, or asks at them)
-        yield from _parse_continued(parser, (text for _, text in numbered(stream)), file)
+    if parser.dialect.continuation:
+        yield from _parse_continued(parser, iter_lines(stream), file)
         return
     tape_marks = 0
-    for number, (content, eol) in numbered(stream):
+    for number, (content, eol) in enumerate(iter_lines(stream), start=1):
         if tape_marks >= 2:
             yield Block(content, eol, (), number, verbatim=True)
             continue

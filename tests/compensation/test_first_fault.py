@@ -1,7 +1,6 @@
 """The fault reported is the program's first, whichever stage finds it: a pass that reads
 events in batches hands on the events it holds when an earlier stage refuses a later line,
-and `replace_arcs` hands on the lines before an arc it refuses (`ncpp/passes/__init__.py`);
-the same in one process, with a worker and in two parts."""
+and `replace_arcs` hands on the lines before an arc it refuses (`ncpp/passes/__init__.py`)."""
 
 import io
 
@@ -9,13 +8,13 @@ import numpy as np
 
 import pytest
 
-import ncpp.parts as parts
 import ncpp.passes.replace_arcs as replace_arcs
 from ncpp.errors import NcppError, Warnings
 from ncpp.motion.offsets import WorkOffsets
 from ncpp.pipeline import ErrorSource, process
+from tests.conftest import ROOT
 
-from .test_kernels import OFFSET, ROOT
+OFFSET = (400.0, 350.0, 300.0)
 
 # Program X runs from -400 to 400 on HR5B's X travel [0, 800] with OFFSET
 OUTSIDE = "G0 X3000\nG0 X0\n"  # the solve refuses the first line (apply_error_map, the last pass)
@@ -32,41 +31,33 @@ def _moves(n: int) -> str:
     return "".join(f"G1 X{(k % 7) * 3:.3f} Y{(k % 5) * 2:.3f}\n" for k in range(n))
 
 
-def _program(*parts_: str) -> bytes:
-    return ("G21 G90 G17\nG0 X0 Y0 Z5\nG1 Z-1 F300\n" + "".join(parts_) + "M2\n").encode()
+def _program(*pieces: str) -> bytes:
+    return ("G21 G90 G17\nG0 X0 Y0 Z5\nG1 Z-1 F300\n" + "".join(pieces) + "M2\n").encode()
 
 
 def _line_of(text: bytes, piece: str) -> int:
     return text.decode().splitlines().index(piece.splitlines()[0]) + 1
 
 
-def _refused(data: bytes, source, jobs: int = 1, path=None) -> NcppError:
-    out = io.BytesIO()
+def _refused(data: bytes, source) -> NcppError:
     with pytest.raises(NcppError) as error:
-        if path is None:  # a stream: with jobs 2 its kernels run in a worker process
-            process(io.BytesIO(data), out, file="t.ngc", source=source, jobs=jobs, warnings=Warnings(stream=io.StringIO()), offsets=WorkOffsets.at(OFFSET))
-        else:
-            path.write_bytes(data)
-            with open(path, "rb") as stream:
-                process(stream, out, file="t.ngc", source=source, jobs=jobs, warnings=Warnings(stream=io.StringIO()), offsets=WorkOffsets.at(OFFSET))
+        process(io.BytesIO(data), io.BytesIO(), file="t.ngc", source=source, warnings=Warnings(stream=io.StringIO()), offsets=WorkOffsets.at(OFFSET))
     return error.value
 
 
-@pytest.mark.parametrize("jobs", [1, 2])
-def test_a_pass_refusing_a_line_is_heard_before_the_interpreter_refusing_a_later_one(source, jobs):
+def test_a_pass_refusing_a_line_is_heard_before_the_interpreter_refusing_a_later_one(source):
     data = _program(_moves(100), OUTSIDE, _moves(500), UNREADABLE_ARC)
-    error = _refused(data, source, jobs)
+    error = _refused(data, source)
     assert (error.where.line, error.where.col) == (_line_of(data, OUTSIDE), 4)  # at its X word
     alone = _program(_moves(100), "G0 X0\n", _moves(500), UNREADABLE_ARC)
-    assert _refused(alone, source, jobs).where.line == _line_of(alone, UNREADABLE_ARC)  # the interpreter's fault is found
+    assert _refused(alone, source).where.line == _line_of(alone, UNREADABLE_ARC)  # the interpreter's fault is found
 
 
-@pytest.mark.parametrize("jobs", [1, 2])
-def test_a_line_before_an_arc_replace_arcs_refuses_is_heard_first(source, jobs):
+def test_a_line_before_an_arc_replace_arcs_refuses_is_heard_first(source):
     data = _program(_moves(50), OUTSIDE, _moves(50), BULGING_ARC, _moves(50))
-    assert _refused(data, source, jobs).where.line == _line_of(data, OUTSIDE)
+    assert _refused(data, source).where.line == _line_of(data, OUTSIDE)
     alone = _program(_moves(50), "G0 X0\n", _moves(50), BULGING_ARC, _moves(50))
-    error = _refused(alone, source, jobs)
+    error = _refused(alone, source)
     assert error.where.line == _line_of(alone, BULGING_ARC) + 1 and "outside the X travel" in error.message
     assert error.where.col == 4  # `G3 X392 ...`: at its X word
 
@@ -81,16 +72,6 @@ def test_the_first_fault_whatever_the_batches(source, monkeypatch, arcs, events)
     assert _refused(data, source).where.line == _line_of(data, OUTSIDE)
 
 
-def test_in_two_parts_the_first_fault_of_the_second_part(source, tmp_path):
-    """Both faults lie past the cut: the second process finds them, the first reports its."""
-    n = parts.MIN_LINES * 2
-    late = n * 3 // 4
-    data = _program(_moves(late), OUTSIDE, _moves(400), UNREADABLE_ARC, _moves(n - late))
-    one = _refused(data, source, 1)
-    assert one.where.line == _line_of(data, OUTSIDE)
-    assert str(_refused(data, source, 2, tmp_path / "long.ngc")) == str(one)
-
-
 class _Kinked:
     """A map with 0.5 µm of reversal error in X, and 0.6 mm more travelling -X between machine
     Y 359.5 and 360.5, program Y 9.5 and 10.5 (a correction there exceeds the 0.5 mm allowed)."""
@@ -102,18 +83,17 @@ class _Kinked:
         return error
 
 
-@pytest.mark.parametrize("jobs", [1, 2])
-def test_a_reversal_step_refused_before_a_line_end_in_the_same_chunk_is_heard_first(jobs):
+def test_a_reversal_step_refused_before_a_line_end_in_the_same_chunk_is_heard_first():
     """The solve checks a chunk's line ends before its reversal steps' starts.  Line 4 reverses X
     at Y10: it starts with a step there travelling -X (refused), and ends outside the band (too
     short, 0.6 mm, to be split); line 41 ends in the band travelling -X (refused)."""
     source = ErrorSource(model=_Kinked(), name="kinked", digest="0", max_correction=0.5)
     fillers = "".join(f"G1 Y{k % 2}\n" for k in range(35))
     data = f"G21 G90 G17\nG0 X0 Y0 Z0\nG1 X5 Y10 F100\nG1 X4.9 Y10.6\n{fillers}G1 X10\nG1 X5 Y10\nM2\n".encode()
-    error = _refused(data, source, jobs)
+    error = _refused(data, source)
     assert error.where.line == 4 and "exceeds the machine file's limit" in error.message
     outside = data.replace(b"G1 X5 Y10 F100\nG1 X4.9 Y10.6\n", b"G1 X5 Y11 F100\nG1 X4.9 Y11.6\n")  # the step at Y11
-    assert _refused(outside, source, jobs).where.line == 41
+    assert _refused(outside, source).where.line == 41
 
 
 @pytest.mark.parametrize("block, col", [("G0 X3000", 4), ("n10 g0 y0 x3000", 11)])

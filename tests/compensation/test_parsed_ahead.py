@@ -1,6 +1,5 @@
 """The parser reads ahead of the interpreter in runs (`pipeline._parsed_ahead`): the same
-output and the same first error as line by line; no line read ahead where a second part
-skims, nor past what a first part's passes read beyond its cut."""
+output and the same first error as line by line."""
 
 import io
 
@@ -12,8 +11,11 @@ from ncpp.motion.offsets import WorkOffsets
 from ncpp.pipeline import ErrorSource, process
 from ncpp.program.blocks import Block
 
+from tests.conftest import ROOT
+
 from .conftest import QUIET
-from .test_kernels import OFFSET, ROOT
+
+OFFSET = (400.0, 350.0, 300.0)
 
 
 @pytest.fixture(scope="module")
@@ -66,22 +68,3 @@ def test_runs_grow_from_the_first_to_the_most():
     assert max(taken) == 4095
     assert taken[:2] == [0, 1023]  # the first block alone, then the first run of FIRST_RUN blocks
     assert len(taken) == 20_000
-
-
-def test_no_line_is_read_ahead_until_ready():
-    log: list[int] = []
-    ready = [False]
-    ahead = []
-    for block in pipeline._parsed_ahead(_pulls(5000, log), ready=lambda: ready[0]):
-        ahead.append(len(log) - block.line)
-        if block.line == 100:
-            ready[0] = True  # a second part's window begins here
-    assert set(ahead[:100]) == {0}
-    assert max(ahead[100:]) > 0
-
-
-def test_no_line_is_read_past_the_bound():
-    log: list[int] = []
-    for block in pipeline._parsed_ahead(_pulls(10_000, log), until=lambda: 3000):
-        if block.line < 3000:
-            assert len(log) <= 3000

@@ -142,16 +142,6 @@ def test_program_end_ends_compensation():
     assert interpreter.cutter_comp is None and not interpreter.off_path
 
 
-def test_plain_lines_are_not_skimmed_under_compensation():
-    """The second part of `--jobs 2` may leave plain lines unread (`skim.py`): not while the tool is off the path."""
-    from ncpp.motion.interpreter import Interpreter
-
-    interpreter = Interpreter("t.ngc")
-    for event in interpreter.run(parse_stream(io.BytesIO((HEAD + "G41.1 D2\nG1 X10\nG40\nG1 X20\nG1 X30\n").encode()), "t.ngc"), Warnings()):
-        line = event.block.line
-        assert interpreter.skimmable() == (line not in (4, 5, 6)), line
-
-
 def test_fanuc_corners_under_compensation_are_the_controls_and_the_position_is_followed():
     """A Fanuc `,R` / `,C` corner under G41/G42: the control rounds the contour, then offsets it.
     Every piece is left as programmed; after the exit move the moves are those of the same

@@ -106,7 +106,7 @@ def test_compensation_writes_x_and_y_for_polar_words():
 
 def test_a_block_of_polar_words_is_written_in_capitals():
     """`^60` has no letter to say its case: capitals, in an upper-case program as in a lower-case
-    one (the writer keeps no case between blocks: a second part writes it as one run does)."""
+    one (the writer keeps no case between blocks)."""
     out, _ = compensate(PROGRAM, "polar.ngc")
     assert not re.search(r"\b[xy]-?\d", out)
     lower = compensate(PROGRAM.lower(), "polar.ngc")[0].splitlines()

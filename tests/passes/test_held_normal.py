@@ -10,8 +10,7 @@ import re
 import pytest
 
 from ncpp.motion.segments import Arc, Context, Line
-from ncpp.passes.context import CutLine
-from ncpp.passes.replace_arcs import HELD_LINES, Motion, _recorded
+from ncpp.passes.replace_arcs import HELD_LINES, Motion
 from ncpp.pipeline import ErrorSource, process
 from ncpp.program.blocks import Block
 from tests.conftest import ROOT
@@ -30,7 +29,7 @@ def _arcs(batch):
 
 
 def test_an_arc_takes_the_direction_its_normal_axis_last_moved_in():
-    motion = Motion(None, None, [])
+    motion = Motion()
     batch = [
         _arc((10.0, 0.0, 0.0), (0.0, 10.0, 0.0), (0.0, 0.0, 0.0), 1),  # Z never moved: the mean
         _line((0.0, 10.0, 0.0), (0.0, 10.0, -2.0), 2),  # Z down
@@ -43,19 +42,9 @@ def test_an_arc_takes_the_direction_its_normal_axis_last_moved_in():
     assert motion.normals(batch, _arcs(batch)) == [0, -1, 1, 1, -1]
     # a batch later, the state goes on; a move older than HELD_LINES lines is not used
     later = _arc((40.0, 0.0, -1.0), (50.0, 0.0, -1.0), (45.0, 0.0, -1.0), 5 + HELD_LINES)  # Z last moved in line 5
-    assert Motion(motion.state, None, []).normals([later], [later]) == [1]
+    assert Motion(motion.state).normals([later], [later]) == [1]
     stale = _arc((40.0, 0.0, -1.0), (50.0, 0.0, -1.0), (45.0, 0.0, -1.0), 6 + HELD_LINES)
     assert motion.normals([stale], [stale]) == [0]
-
-
-def test_the_state_at_a_cut_is_recorded_without_stale_moves():
-    record: list = []
-    motion = Motion(None, CutLine(2000), record)
-    motion.normals([_line((0.0, 0.0, 0.0), (1.0, 0.0, -1.0), 10), _line((1.0, 0.0, -1.0), (1.0, 2.0, -1.0), 1990)], [])
-    assert record == []
-    motion.normals([_line((1.0, 2.0, -1.0), (0.0, 2.0, -1.0), 2001)], [])
-    # X moved (line 10) too long before the cut for a guess after it: left out; Y at line 1990 kept
-    assert record == [(0, 1, 0, 0, 1990, 0)] == [_recorded((1, 1, -1, 10, 1990, 10), 2000)]
 
 
 @pytest.fixture(scope="module")

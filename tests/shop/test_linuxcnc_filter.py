@@ -10,7 +10,6 @@ import subprocess
 
 import pytest
 
-from ncpp.cli.compensate import AUTO_JOBS_BYTES
 from ncpp.errors import Warnings
 from ncpp.post import post
 from tests.conftest import CORPUS, ROOT
@@ -224,40 +223,16 @@ def test_axis_shows_the_filters_error_and_loads_nothing(tmp_path, axis):
     assert filtered.message.startswith(f"{bad}:2:4: ")  # at the X word and "outside the X travel" in filtered.message
 
 
-# Put before the filter's import path: the filter's Python then notes in NCPP_TEST_PARTS
-# whether its first part took the second process's output at the cut (`parts._Decision`).
-_PARTS_NOTED = """
-import os
-import ncpp.parts as parts
-
-_decide = parts._Decision.__call__
-
-def _noted(self):
-    taken = _decide(self)
-    with open(os.environ["NCPP_TEST_PARTS"], "a") as note:
-        note.write(f"second part taken: {taken}\\n")
-    return taken
-
-parts._Decision.__call__ = _noted
-"""
-
-
-def test_axis_filters_a_program_large_enough_for_two_parts(program, tmp_path, axis, monkeypatch):
-    """Over AUTO_JOBS_BYTES the filter compensates in two processes: AXIS reads standard
-    error to its end after the filter exits, so neither may keep it open; the bar moves
-    on past the cut."""
+def test_axis_filters_a_long_program_with_its_progress_bar(program, tmp_path, axis):
+    """AXIS reads standard error to its end after the filter exits: the bar moves on with
+    the lines compensated, and nothing else is said."""
     body = program.read_bytes().removesuffix(b"M2\n")
     large = tmp_path / "large.ngc"
-    large.write_bytes(body * (AUTO_JOBS_BYTES // len(body) + 1) + b"M2\n")
+    large.write_bytes(body * (20_000 // body.count(b"\n") + 1) + b"M2\n")
     _configure(tmp_path)
-    (tmp_path / "site").mkdir()
-    (tmp_path / "site/sitecustomize.py").write_text(_PARTS_NOTED)
-    monkeypatch.setenv("PYTHONPATH", f"{tmp_path / 'site'}{os.pathsep}{os.environ['PYTHONPATH']}")
-    monkeypatch.setenv("NCPP_TEST_PARTS", str(tmp_path / "parts.txt"))
     out = tmp_path / "loaded.ngc"
     filtered = axis(large, out)
     assert filtered.exit_code == 0 and filtered.message == "", filtered.message
-    assert (tmp_path / "parts.txt").read_text() == "second part taken: True\n"  # two parts ran, the second's output is used
     assert filtered.progress == sorted(filtered.progress) and filtered.progress[-1] == 100
     assert len({p // 10 for p in filtered.progress}) >= 8, filtered.progress  # every tenth of the way shows
     written = out.read_bytes()

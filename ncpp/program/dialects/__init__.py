@@ -14,7 +14,7 @@ from itertools import chain
 from typing import BinaryIO, Iterable, Iterator
 
 from ncpp.errors import NcppError
-from ncpp.program.parser import Dialect, LineParser, NumberedLines, _ItemBuilder
+from ncpp.program.parser import Dialect, LineParser, _ItemBuilder
 
 DIALECTS = ("iso", "heidenhain", "sinumerik")
 SNIFF_BYTES = 4096
@@ -138,10 +138,9 @@ def sniff(stream: Iterable[bytes], name: str | None = None, dialect: str | None 
     return detect(b"".join(head_lines), name), chain(head_lines, stream)  # (in C: no generator's step per line)
 
 
-def parse_program(stream: BinaryIO, file: str = "<stdin>", dialect: str | None = None, numbered: NumberedLines | None = None):
-    """(dialect, blocks) of a program stream, the dialect detected unless given;
-    `numbered` reads its lines when given (`parser.parse_stream`)."""
-    from ncpp.program.parser import numbered_lines, parse_stream
+def parse_program(stream: BinaryIO, file: str = "<stdin>", dialect: str | None = None):
+    """(dialect, blocks) of a program stream, the dialect detected unless given."""
+    from ncpp.program.parser import parse_stream
 
     name, lines = sniff(stream, file, dialect)
-    return name, parse_stream(lines, file, name, numbered or numbered_lines)
+    return name, parse_stream(lines, file, name)

@@ -216,14 +216,12 @@ HEIDENHAIN = Dialect("heidenhain", "heidenhain", HeidenhainBuilder, fast_termina
 
 # ---- writer ------------------------------------------------------------------------------
 
-import re  # noqa: E402  (the writer half of the module)
-from dataclasses import dataclass, field, replace  # noqa: E402
-from typing import BinaryIO  # noqa: E402
+from dataclasses import replace  # noqa: E402
 
 from ncpp.motion.segments import PLANE_AXES, Arc, Line  # noqa: E402
 from ncpp.program.blocks import Block  # noqa: E402
 from ncpp.program.dialects.editing import splice  # noqa: E402
-from ncpp.program.dialects.iso import IsoWriter, WriterState, written_apart  # noqa: E402
+from ncpp.program.dialects.iso import IsoWriter, written_apart  # noqa: E402
 from ncpp.program.numbers import NumberStyle, format_number, style_pattern  # noqa: E402
 
 _AXES = "XYZ"
@@ -263,32 +261,6 @@ class HeidenhainWriter(IsoWriter):
         self.restore_feed = False  # an edited corner block's F: the next move gets the program's feed back
         self.edited_last = False  # the last block was written edited (an RND/CHF after it must be too)
         self._lessons: dict[tuple[str, str], tuple] = {}  # by (letter, number pattern): see `_learn_styles`
-
-    # -- a run in two parts (`parts.py`) -------------------------------------------------
-    def state(self) -> "HeidenhainState":
-        return HeidenhainState(super().state(), self.program_pole, self.output_pole, self.changed_any,
-                               self.restore_feed, self.edited_last, self.eol, self.shift, self.last_number)  # fmt: skip
-
-    def restore(self, state: "HeidenhainState") -> None:  # type: ignore[override]
-        super().restore(state.base)
-        self.program_pole, self.output_pole, self.changed_any = state.program_pole, state.output_pole, state.changed_any
-        self.restore_feed, self.edited_last, self.eol = state.restore_feed, state.edited_last, state.eol
-        self.shift, self.last_number, self.header = state.shift, state.last_number, None
-
-    def learn(self, block: Block) -> None:
-        """What writing the block would teach, without writing it: its number styles and
-        line end (its pole: `learn_event`)."""
-        self.eol = block.eol or self.eol
-        self._learn_styles(block)
-
-    def learn_event(self, event) -> None:
-        """A `CC` block's pole, which the block written as it is sets in the output too (an
-        arc piece written since, with a `CC` of its own, would have moved the output's
-        pole: the parts' states then differ, and the first part writes the rest)."""
-        from ncpp.motion.heidenhain import Pole
-
-        if type(event) is Pole:
-            self.program_pole = self.output_pole = (event.center, event.plane)
 
     def with_header(self, lines, header: str):
         """The header goes after `BEGIN PGM` as a numbered comment block (set before writing)."""
@@ -502,39 +474,6 @@ class HeidenhainWriter(IsoWriter):
 
 
 _NO_LESSON = ()
-
-
-@dataclass(frozen=True)
-class HeidenhainState:
-    """`HeidenhainWriter.state`: the ISO writer's, the poles and what an edited corner left
-    pending.  The numbering (blocks inserted so far) is carried, not compared: a second part
-    does not know the first part's insertions, and its numbers are put right (`append`)."""
-
-    base: WriterState
-    program_pole: tuple | None
-    output_pole: tuple | None
-    changed_any: bool
-    restore_feed: bool
-    edited_last: bool
-    eol: str
-    shift: int = field(compare=False)
-    last_number: int = field(compare=False)
-
-    def append(self, second: "HeidenhainState", rest: BinaryIO, out: BinaryIO) -> None:
-        """The second part's lines with the blocks the first part inserted before the cut
-        added to their numbers (every line of a Klartext program starts with its number)."""
-        shift = self.shift - second.shift
-        if shift == 0:
-            self.base.append(second.base, rest, out)
-            return
-        continued = False  # (a block's line after a `~` has no number of its own)
-        for line in rest:
-            number = None if continued else _BLOCK_NUMBER.match(line)
-            out.write(line if number is None else b"%s%d%s" % (number[1], int(number[2]) + shift, line[number.end() :]))
-            continued = line.rstrip(b"\r\n").endswith(b"~")
-
-
-_BLOCK_NUMBER = re.compile(rb"([ \t]*)(\d+)")
 
 
 def _lesson(letter: str, number: str) -> tuple:

@@ -12,10 +12,9 @@ from __future__ import annotations
 
 import math
 import re
-import shutil
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from operator import itemgetter
-from typing import BinaryIO, Iterable, Iterator
+from typing import Iterable, Iterator
 
 from ncpp.motion.segments import Arc, Context, Event, Line, Pass
 from ncpp.program.blocks import DIGITS_AS_ONE, Block, Comment, ExprWord, Statement, Word
@@ -87,44 +86,6 @@ class IsoWriter:
 
     def comment(self, text: str) -> str:
         return f"{self.comment_open}{text}{self.comment_close}"
-
-    # -- a run in two parts ---------------------------------------------------
-    def state(self) -> "WriterState":
-        """What decides how the next block is written (the rest is caches)."""
-        return WriterState(tuple(sorted(self.styles.items())), self.program_motion, self.output_motion,
-                           frozenset(self.known_axes), self._last_end, self._last_places)  # fmt: skip
-
-    def learn(self, block: Block) -> None:
-        """What writing the block would teach about the program, without writing it: its
-        number styles and motion mode (a second part's writer reads the lines before its
-        window so, `ncpp/parts.py`)."""
-        facts = self._read_block(block)
-        if facts.flow:  # after a control line the program's mode is unknown here (`_write_control`)
-            self.program_motion = None
-        elif self._has_motion_word(block):  # (a dialect's own motion words too: Sinumerik's CIP, CT)
-            self.program_motion = self._block_motion(block)
-
-    def learn_event(self, event: Event) -> None:
-        """What a dialect's own event (neither a move nor a `Pass`) before a second part's
-        window teaches its writer: nothing here."""
-
-    def skimmed(self, motion: int | None, numbers: dict[str, str]) -> None:
-        """What learning plain lines left unread would teach (`motion/skim.py`): their last
-        motion word's code (None: none) and each letter's last number as written."""
-        for letter, number in numbers.items():
-            if letter in STYLED_LETTERS:
-                self._learn_style(letter, NumberStyle.of(number))
-        self._last_lesson = None
-        if motion is not None:
-            self.program_motion = motion
-
-    def restore(self, state: "WriterState") -> None:
-        """Continue as a writer in `state` would."""
-        for letter, style in state.styles:
-            self._learn_style(letter, style)
-        self.program_motion, self.output_motion = state.program_motion, state.output_motion
-        self.known_axes = set(state.known_axes)
-        self._last_end, self._last_places = state.last_end, state.last_places
 
     # -- the stream -----------------------------------------------------------
     def write(self, events: Iterable[Event]) -> Iterator[str]:
@@ -643,23 +604,6 @@ def written_apart(value: float, places: int, last: float, last_places: int) -> b
 _STEPS = tuple(10.0**k for k in range(10))  # grid points per unit, by decimal places
 _EXACT = 2.0**40  # scaled values this small: their product's error is < 2**-12 of a grid step
 _CLEAR = 0.5 - 2.0**-10  # how far from a grid point a scaled value may be: clear of the ties
-
-
-@dataclass(frozen=True)
-class WriterState:
-    """`IsoWriter.state`: equal states write the same blocks the same way."""
-
-    styles: tuple
-    program_motion: int | None
-    output_motion: int | None
-    known_axes: frozenset
-    last_end: tuple | None
-    last_places: tuple
-
-    def append(self, second: "WriterState", rest: BinaryIO, out: BinaryIO) -> None:
-        """Append to `out` the lines `rest` a second part wrote from `second` (a state equal
-        to this one, `parts.py`): as they are."""
-        shutil.copyfileobj(rest, out, 1 << 20)
 
 
 class _Written:

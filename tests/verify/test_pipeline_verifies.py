@@ -1,0 +1,86 @@
+"""Every rewriting command verifies its output before writing it: a pass that goes wrong is
+stopped at the input line where the written program parts from the input, and nothing is
+written; `--no-verify` writes it."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from dataclasses import replace
+from pathlib import Path
+
+import pytest
+
+import ncpp.pipeline
+from ncpp.cli import main
+from ncpp.motion.segments import Line
+
+ROOT = Path(__file__).resolve().parents[2]
+MACHINE = ROOT / "samples" / "machines" / "hr5b.toml"
+PROGRAM = "G21 G90 G17\nT1 M6\nS1000 M3\nG0 X10 Y10 Z5\nG1 Z-1 F200\nX50\nY40\nX10\nG0 Z5\nM5\nM30\n"
+
+
+def shifted_at_line(line: int, by: float):
+    """A pass that moves the end of the feed moves of one input line by `by` mm in X."""
+
+    def shift(events, ctx):
+        for event in events:
+            if type(event) is Line and event.block.line == line and not event.rapid:
+                event = replace(event, end=(event.end[0] + by, *event.end[1:]), changed=True)
+            yield event
+
+    return shift
+
+
+@pytest.fixture
+def program(tmp_path: Path) -> Path:
+    path = tmp_path / "part.ngc"
+    path.write_text(PROGRAM)
+    return path
+
+
+def compensate(program: Path, *extra: str) -> int:
+    out = program.with_suffix(".out.ngc")
+    return main(["compensate", "--machine", str(MACHINE), "--work-offset", "400,350,300", str(program), "-o", str(out), *extra])
+
+
+def test_a_pass_gone_wrong_is_stopped_and_nothing_written(program: Path, monkeypatch, capsys):
+    monkeypatch.setattr(ncpp.pipeline, "PASSES", (*ncpp.pipeline.PASSES, shifted_at_line(7, 2.0)))
+    assert compensate(program) != 0
+    err = capsys.readouterr().err
+    assert "part.ngc:7:1: verification:" in err, err
+    assert not program.with_suffix(".out.ngc").exists()
+
+
+def test_no_verify_writes_what_the_passes_make(program: Path, monkeypatch):
+    monkeypatch.setattr(ncpp.pipeline, "PASSES", (*ncpp.pipeline.PASSES, shifted_at_line(7, 2.0)))
+    assert compensate(program, "--no-verify") == 0
+    assert program.with_suffix(".out.ngc").exists()
+
+
+def test_a_correction_within_the_bound_passes(program: Path, monkeypatch):
+    monkeypatch.setattr(ncpp.pipeline, "PASSES", (*ncpp.pipeline.PASSES, shifted_at_line(7, 0.2)))
+    assert compensate(program) == 0
+
+
+def test_the_filter_verifies_too(program: Path, monkeypatch, capsys):
+    monkeypatch.setattr(ncpp.pipeline, "PASSES", (*ncpp.pipeline.PASSES, shifted_at_line(6, 2.0)))
+    monkeypatch.setenv("NCPP_MACHINE", str(MACHINE))
+    assert main([str(program), "--work-offset", "400,350,300"]) != 0
+    captured = capsys.readouterr()
+    assert "part.ngc:6:1: verification:" in captured.err and captured.out == ""
+
+
+def test_a_long_program_is_verified_in_chunks(tmp_path: Path, monkeypatch, capsys):
+    """Thousands of moves between two actions: chunks of a few hundred moves still find
+    the one line that goes wrong, and pass the program without it."""
+    import ncpp.verify
+
+    monkeypatch.setattr(ncpp.verify, "CHUNK_MOVES", 300)
+    moves = "".join(f"X{10 + (k % 40)} Y{10 + (k * 7) % 30}\n" for k in range(3000))
+    path = tmp_path / "long.ngc"
+    path.write_text(f"G21 G90 G17\nT1 M6\nS1000 M3\nG0 X10 Y10 Z5\nG1 Z-1 F200\n{moves}G0 Z5\nM5\nM30\n")
+    assert compensate(path) == 0
+    monkeypatch.setattr(ncpp.pipeline, "PASSES", (*ncpp.pipeline.PASSES, shifted_at_line(2000, 2.0)))
+    assert compensate(path) != 0
+    assert "long.ngc:2000:1: verification:" in capsys.readouterr().err
