@@ -322,23 +322,59 @@ def verified(lines: Iterable[str], reached: Callable[[], tuple[int, int]], origi
     """The written program's `lines`, handed on as they are verified against the `original`
     events (the interpreter's reading of the input): each chunk of the input's motion is
     compared with the written lines read back up to where the writer had reached the same
-    input line (`reached()` as it hands out a line: that line and the one before).  Raises NcppError where they part."""
+    input line (`reached()` as it hands out a line: that line and the one before).  Raises
+    NcppError where they part, or the program's first fault: the reading of the input runs
+    ahead of the passes, so a fault it meets waits until the passes have had the lines before."""
     from ncpp.program.parser import parse_stream
 
     feed = _Feed(lines, reached)
+    held = _Held(original)
     state = {"cut": 0}  # where the input's chunk under way ends (0: at an action)
-    mine = sections(original, bound.step, lambda block, moves: block.line if moves >= CHUNK_MOVES else 0)
+    mine = sections(held, bound.step, lambda block, moves: block.line if moves >= CHUNK_MOVES else 0)
     theirs = sections(_interpreted(parse_stream(feed, file, dialect), file, dialect, offsets), bound.step,
                       lambda block, moves: state["cut"] if state["cut"] and feed.tag(block.line) >= state["cut"] else 0,
                       lambda number: feed.tag(number, before=True))  # fmt: skip
     comparison = _Comparison(file, bound, feed.text, tagged=True)
-    for a in mine:
-        state["cut"] = a.cut
-        comparison.step(a, theirs)
-        yield from feed.handed()
-    comparison.end(theirs)
+    try:
+        for a in mine:
+            state["cut"] = a.cut
+            comparison.step(a, theirs)
+            yield from feed.handed()
+        comparison.end(theirs)
+    except NcppError as err:
+        raise held.first(err) from None
+    if held.error is not None:
+        raise held.error
     yield from feed.handed()
     yield from feed.rest()
+
+
+class _Held:
+    """The input's events up to a fault the interpreter meets, which it keeps (`error`)."""
+
+    def __init__(self, events: Iterable[Event]):
+        self.events = events
+        self.error: NcppError | None = None
+
+    def __iter__(self) -> Iterator[Event]:
+        try:
+            yield from self.events
+        except NcppError as err:
+            self.error = err
+
+    def first(self, err: NcppError) -> NcppError:
+        """`err`, or the interpreter's fault where that comes first in the program."""
+        if self.error is not None and (err.where.line is None or (self.error.where.line or 0) <= err.where.line):
+            return self.error
+        return err
+
+
+class _Upstream(Exception):
+    """A fault of the passes or the writer, passed through the reading of the written lines."""
+
+    def __init__(self, error: NcppError):
+        super().__init__(str(error))
+        self.error = error
 
 
 class _Feed:
@@ -354,7 +390,14 @@ class _Feed:
         self.recent: deque[tuple[int, str]] = deque(maxlen=64)  # for messages
 
     def __iter__(self) -> Iterator[bytes]:
-        for text in self.lines:
+        lines = iter(self.lines)
+        while True:
+            try:
+                text = next(lines)
+            except StopIteration:
+                return
+            except NcppError as err:
+                raise _Upstream(err) from None
             tag, before = self.reached()
             self.pending.append(text)
             self.count += text.count("\n") or 1
@@ -432,6 +475,8 @@ class _Comparison:
     def _next(self, theirs: Iterator[Section], line: int) -> Section | None:
         try:
             return next(theirs, None)
+        except _Upstream as up:
+            raise up.error from None
         except NcppError as err:
             number = err.where.line
             text, reached = self.written_text(number)

@@ -38,8 +38,15 @@ def tool_table(folder: Path) -> Path:
     return path
 
 
-def rs274_runs(program: Path, tools: Path) -> bool:
-    env = dict(os.environ, RS274_TOOL_TABLE=str(tools))
+def rs274_environment(home: Path) -> dict[str, str]:
+    """rs274 keeps its tool data in $HOME/.tool.mmap: a home of its own for each test, so that
+    runs side by side do not truncate each other's (a bus error)."""
+    unpacked = os.environ.get("RS274_HOME") or str(Path.home() / ".cache" / "ncpp-rs274")
+    return dict(os.environ, HOME=str(home), RS274_HOME=unpacked)
+
+
+def rs274_runs(program: Path, tools: Path, env: dict[str, str]) -> bool:
+    env = dict(env, RS274_TOOL_TABLE=str(tools))
     proc = subprocess.run([str(RS274), str(program)], capture_output=True, text=True, errors="replace", timeout=600,
                           cwd=program.parent, env=env, stdin=subprocess.DEVNULL)  # fmt: skip
     if "executing" not in proc.stderr:
@@ -61,7 +68,8 @@ def tools(tmp_path_factory) -> Path:
 def test_pathcheck_passes_on_the_compensated_program(program: Path, tools: Path, tmp_path: Path):
     if not (PATHCHECK.exists() and WIDE.exists()):
         pytest.skip(f"pathcheck or wide.toml not found under {SHARED}")
-    if not rs274_runs(program, tools):
+    env = rs274_environment(tmp_path)
+    if not rs274_runs(program, tools, env):
         pytest.skip("rs274 refuses the original: nothing to compare")
     written = tmp_path / (program.name + ".out.ngc")
     proc = subprocess.run([sys.executable, "-m", "ncpp", "compensate", "--machine", str(WIDE), "--tool-table", str(tools),
@@ -73,5 +81,5 @@ def test_pathcheck_passes_on_the_compensated_program(program: Path, tools: Path,
         assert limit is not None, f"ncpp refuses a program rs274 runs: {error}"
         return
     check = subprocess.run([sys.executable, str(PATHCHECK), str(program), str(written), "--tool-table", str(tools)],
-                           capture_output=True, text=True, timeout=1800)  # fmt: skip
+                           capture_output=True, text=True, timeout=1800, env=env)  # fmt: skip
     assert check.returncode == 0, check.stdout + check.stderr
