@@ -1,4 +1,4 @@
-"""Compensation throughput and memory (issue 4, item 7): a section of `benchmarks/run.py`.
+"""Compensation throughput and memory: a section of `benchmarks/run.py`.
 
 On the core benchmark's files (stellabee1.ngc and the generated G1/G2/G3
 program), one run times, each run in a new process (`in_fresh_process`): `ncpp` passthrough (no machine),

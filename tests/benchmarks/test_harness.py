@@ -2,7 +2,7 @@
 that a timed run in a fresh process returns what the tables are made of.
 
 The figures themselves are not tested (they are the machine's); the verdict that
-issue 4's speed floor is judged by, and the harness that feeds it, are.
+the compensation speed floor is judged by, and the harness that feeds it, are.
 """
 
 from __future__ import annotations
