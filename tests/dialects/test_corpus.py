@@ -26,7 +26,7 @@ def roundtrip(data: bytes, name: str, dialect: str) -> bytes:
     return out.getvalue()
 
 
-def test_corpus_has_both_dialects():
+def test_corpus_has_both_dialects(corpus):
     assert len(HEIDENHAIN) >= 2 and len(SINUMERIK) >= 30
 
 
@@ -51,7 +51,7 @@ def test_dialect_is_detected(path):
         assert detect(head) == want
 
 
-def test_heidenhain_continuation_lines_make_one_block():
+def test_heidenhain_continuation_lines_make_one_block(corpus):
     path = PLAN_H
     blocks = list(parse_stream(io.BytesIO(path.read_bytes()), str(path), "heidenhain"))
     physical = path.read_bytes().count(b"\n")
@@ -63,7 +63,7 @@ def test_heidenhain_continuation_lines_make_one_block():
     assert blocks[-1].items[1].kind == "program_end" and blocks[-1].items[1].node == ("Plan", "MM")
 
 
-def test_sinumerik_fast_path_agrees_with_lalr_parser_on_corpus():
+def test_sinumerik_fast_path_agrees_with_lalr_parser_on_corpus(corpus):
     parser = LineParser("sinumerik")
     checked = 0
     for path in SINUMERIK:
@@ -79,7 +79,7 @@ def test_sinumerik_fast_path_agrees_with_lalr_parser_on_corpus():
 
 
 @pytest.mark.parametrize("size", [1, 7, 4096])
-def test_sniff_rereads_the_head_and_keeps_streaming(size, monkeypatch):
+def test_sniff_rereads_the_head_and_keeps_streaming(corpus, size, monkeypatch):
     import ncpp.program.dialects as dialects
 
     monkeypatch.setattr(dialects, "SNIFF_BYTES", size)
@@ -110,7 +110,7 @@ def test_explicit_dialect_overrides_detection():
 
 
 @pytest.mark.parametrize("path", [PLAN_H, CORPUS / "sinumerik/CEAD_nc-gcode-interpreter/edge_cases.mpf"], ids=corpus_id)
-def test_cli_filter_roundtrips_from_stdin(path):
+def test_cli_filter_roundtrips_from_stdin(corpus, path):
     import subprocess
     import sys
 
