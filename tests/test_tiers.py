@@ -15,7 +15,11 @@ HERE = Path(__file__).parent
 
 def names_of_tests(module: str) -> set[str]:
     tree = ast.parse((HERE / module).read_text(encoding="utf-8"))
-    return {node.name for node in ast.walk(tree) if isinstance(node, ast.FunctionDef) and node.name.startswith("test_")}
+    return {
+        node.name
+        for node in ast.walk(tree)
+        if isinstance(node, ast.FunctionDef) and node.name.startswith("test_")
+    }
 
 
 @pytest.mark.parametrize("tier", sorted(TIERS))
