@@ -1,4 +1,4 @@
-"""Accuracy of `ncpp compensate` on the virtual machine (issue 4, item 4).
+"""Accuracy of `ncpp compensate` on the virtual machine.
 
 For each sample machine and program: place the program inside the machine's
 travel (work offset = centre of travel minus the centre of the program's

@@ -38,7 +38,7 @@ STELLABEE = SHARED / "corpus/iso_gcode/linuxcnc/large/stellabee1.ngc"
 PARAMETRIC = SHARED / "corpus/iso_gcode/linuxcnc/large/3D_Chips_abort.ngc"
 RS274 = SHARED / "tools/rs274"
 OUT = HERE / "out" / "results.json"
-PYGCODE_FLOOR = 2.0  # issue 2: ncpp parse+interpret at least twice pygcode's parse rate
+PYGCODE_FLOOR = 2.0  # the floor: ncpp parse+interpret at least twice pygcode's parse rate
 
 
 @dataclass

@@ -16,6 +16,147 @@ RS274 = SHARED / "tools" / "rs274"
 NOT_PROGRAMS = ("expected", "README", ".tbl", "__expect__stdout", "__expect__stderr", ".csv", "MANIFEST.tsv")
 
 
+# Test tiers.  `pytest` runs the fast tier: the tests below are deselected (pyproject's addopts)
+# unless asked for with `--all`, `-m ""` or `-m oracle` etc.  Keyed by the path under tests/ and
+# the test function's name; a whole module is named by its path alone (tests/test_tiers.py checks
+# that every name here is a test that exists).
+TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
+    # runs LinuxCNC's rs274 or FreeCAD, oracles ncpp did not write
+    "oracle": {
+        "compensation/test_rs274_accepts.py": None,
+        "motion/test_oracle.py": None,
+        "property/test_cutter_comp_properties.py": None,
+        "shop/test_freecad_post.py": None,
+        "compensation/test_tool_lengths.py": (
+            "test_tool_lengths_agree_with_linuxcnc_started_from_the_same_tool_table",
+        ),
+        "compensation/test_work_offsets.py": (
+            "test_placement_agrees_with_linuxcnc_started_from_the_same_parameter_file",
+        ),
+        "motion/test_corner_rounding.py": ("test_compensated_corners_are_plain_arcs_linuxcnc_accepts",),
+        "motion/test_cutter_comp.py": (
+            "test_g41_checks_against_the_radius_of_the_tool_table_ncpp_is_told",
+            "test_moves_after_compensation_agree_with_rs274",
+            "test_refused_with_compensation_as_rs274_refuses",
+            "test_rs274_runs_the_compensated_program_with_the_same_moves_under_compensation",
+        ),
+        "motion/test_cycles.py": (
+            "test_cycles_move_as_rs274_does",
+            "test_cycles_refused_where_rs274_refuses",
+            "test_random_cycle_programs_agree_with_rs274",
+            "test_rs274_accepts_the_compensated_cycles",
+        ),
+        "motion/test_flow.py": (
+            "test_flow_moves_as_rs274_does",
+            "test_flow_refused_where_rs274_refuses",
+            "test_random_flow_programs_agree_with_rs274",
+            "test_rs274_runs_the_compensated_program_with_the_same_subroutine_moves",
+            "test_subroutine_files_move_as_rs274_does",
+        ),
+        "motion/test_polar.py": (
+            "test_polar_programs_agree_with_rs274",
+            "test_rs274_runs_the_compensated_polar_program",
+        ),
+        "passes/test_compensate_cli.py": ("test_linuxcnc_accepts_every_compensated_arc",),
+        "shop/test_linuxcnc_filter.py": (
+            "test_axis_filters_a_program_large_enough_for_two_parts",
+            "test_axis_loads_the_program_the_filter_compensated",
+            "test_axis_shows_the_filters_error_and_loads_nothing",
+            "test_filter_compensates_reports_progress_and_rs274_accepts_it",
+        ),
+        "shop/test_post.py": (
+            "test_linuxcnc_runs_the_post_to_the_cl_end_points",
+            "test_posted_with_a_machine_file_is_compensated",
+        ),
+    },
+    # a second and a half or more on a 2-core machine, all parameters together
+    "slow": {
+        "cldata/test_cldata.py": ("test_corpus_file_reads_and_moves_where_the_gotos_say",),
+        "identify/test_thesis_sample.py": ("test_make_reproduces_the_committed_comparison",),
+        "diagnose/test_diagnose.py": ("test_one_hidden_effect_is_named_sized_and_closes_the_gap",),
+        "dialects/test_written_apart.py": ("test_as_round_says",),
+        "passes/test_compensate_cli.py": (
+            "test_an_arc_of_more_turns_than_compensation_holds_is_refused_with_its_line",
+            "test_simulate_refuses_motion_outside_the_travel_and_paths_past_its_sample_budget",
+        ),
+        "benchmarks/test_harness.py": ("test_a_timed_run_in_a_fresh_process",),
+        "program/test_layout_replay.py": ("test_replay_agrees_with_the_lalr_parser_on_corpus",),
+        "program/test_roundtrip.py": (
+            "test_ncpp_command_passes_corpus_program_through_unchanged",
+            "test_corpus_program_roundtrips_byte_for_byte",
+            "test_cli_error_has_location_no_traceback_and_no_output",
+            "test_cli_passthrough_is_byte_identical",
+            "test_fast_path_agrees_with_lalr_parser_on_corpus",
+        ),
+        "property/test_parser_properties.py": (
+            "test_generated_programs_parse_to_their_word_values_and_roundtrip",
+        ),
+        "shop/test_post.py": ("test_every_cl_file_posts_in_every_dialect",),
+        "shop/test_shop_pipeline.py": (
+            "test_any_error_stops_the_pipeline",
+            "test_machine_from_the_local_config_compensates",
+        ),
+        "compensation/test_non_finite.py": ("test_a_tolerance_of_1e_300_subdivides_as_finely_as_1e_30",),
+        "compensation/test_exact_model.py": (
+            "test_reversal_spots_within_tolerance",
+            "test_contour_error_within_tolerance",
+        ),
+        "program/test_writer.py": (
+            "test_a_letter_is_written_in_the_style_of_its_last_number",
+            "test_the_styles_kept_resolved_are_those_the_styles_learnt_resolve_to",
+            "test_planned_lines_are_the_general_lines",
+            "test_sinumerik_lines_by_plans_and_templates_are_the_general_ones",
+        ),
+        "interop/test_pygcode.py": ("test_word_values_agree_with_pygcode_on_corpus",),
+        "identify/test_ballbar_fit.py": (
+            "test_fit_and_predict_commands_with_ballbar_files",
+            "test_a_laser_file_of_one_axis_fixes_the_scale_and_the_comparator_follows",
+        ),
+        "compensation/test_dialect_tool_lengths.py": (
+            "test_command_line_tool_table",
+            "test_motion_and_simulate_take_the_dialect_and_its_tool_table",
+        ),
+    },
+    # runs ncpp in two processes (a test parametrized with jobs >= 2 is one too)
+    "multiprocess": {
+        "compensation/test_first_fault.py": ("test_in_two_parts_the_first_fault_of_the_second_part",),
+        "shop/test_linuxcnc_filter.py": ("test_axis_filters_a_program_large_enough_for_two_parts",),
+    },
+}
+
+
+def pytest_addoption(parser: pytest.Parser) -> None:
+    parser.addoption(
+        "--all", action="store_true", help="run every tier: slow, oracle and multi-process tests too"
+    )
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    if config.getoption("--all"):
+        config.option.markexpr = ""  # overrides the tier selection in pyproject's addopts
+
+
+def tiers_of(item: pytest.Item) -> set[str]:
+    """The tiers a collected test belongs to, by TIERS and its `jobs` parameter."""
+    module = Path(str(item.path)).relative_to(Path(__file__).parent).as_posix()
+    name = getattr(item, "originalname", item.name)
+    found = set()
+    for tier, modules in TIERS.items():
+        if module in modules and (modules[module] is None or name in modules[module]):
+            found.add(tier)
+    jobs = item.callspec.params.get("jobs") if hasattr(item, "callspec") else None
+    if isinstance(jobs, int) and jobs > 1:
+        found.add("multiprocess")
+    return found
+
+
+@pytest.hookimpl(tryfirst=True)  # before `-m` deselects by the markers
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    for item in items:
+        for tier in tiers_of(item):
+            item.add_marker(tier)
+
+
 def corpus_files(*folders: str) -> list[Path]:
     """Program files under the given corpus folders, sorted, oracles excluded."""
     found: list[Path] = []

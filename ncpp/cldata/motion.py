@@ -133,7 +133,7 @@ MAX_WORD = 99_999_999.0
 
 
 def feed_rate(rec: Record) -> float:
-    """FEDRAT/f: a feed above 0 (a negative one was written as an F word; 0 stops no move)."""
+    """FEDRAT/f: a feed above 0 (a control reads a negative F word otherwise; 0 stops no move)."""
     f = rec.numbers[0]
     if not 0 < f <= MAX_WORD:
         raise NcppError(f"{rec.major}: expected a feed rate above 0 and at most {MAX_WORD:,.0f}, got {f:g}", rec.where)
@@ -141,7 +141,7 @@ def feed_rate(rec: Record) -> float:
 
 
 def _position(rec: Record, values: list[float]) -> Point:
-    """The record's x, y, z: numbers an NC word can hold (GOTO / 1e308 was posted as 309 digits)."""
+    """The record's x, y, z: numbers an NC word can hold (GOTO / 1e308 would be 309 digits)."""
     x, y, z = values[:3]
     if not max(abs(x), abs(y), abs(z)) <= MAX_WORD:
         raise NcppError(f"{rec.major}: a coordinate beyond ±{MAX_WORD:,.0f}, what an NC word holds: {x:g}, {y:g}, {z:g}", rec.where)

@@ -7,10 +7,11 @@ From a machine file:
     ncpp predict --machine m.toml --instrument laser --axis X --quantity position \\
         --targets 0:800:50 --runs 5 --fixed "Y=350 Z=350" --offset 0,0,120 -o x.csv
 
-From measurements (thesis section 4.8.4: laser → ball bar, laser → comparator,
-comparator → ball bar): the files are first fitted into a machine (as
-`ncpp fit` does, chain and offsets from --chain / --base), then the wanted
-instrument is predicted from it:
+From measurements (M. Rahman, *Modeling and measurement of multi-axis machine tools
+to improve positioning accuracy in a software way*, University of Oulu, 2004, section
+4.8.4: laser → ball bar, laser → comparator, comparator → ball bar): the files are
+first fitted into a machine (as `ncpp fit` does, chain and offsets from --chain /
+--base), then the wanted instrument is predicted from it:
 
     ncpp predict --from laser_*.csv level_*.csv --chain XZFY --instrument ballbar ... -o bb.csv
 

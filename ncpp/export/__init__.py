@@ -1,4 +1,7 @@
-"""Controller compensation tables (thesis section 6.4.3): one module per controller.
+"""Controller compensation tables (Rahman 2004, section 6.4.3): one module per controller.
+
+Rahman 2004: M. Rahman, *Modeling and measurement of multi-axis machine tools to improve positioning
+accuracy in a software way*, University of Oulu, 2004.
 
     from ncpp.export import axis_error, export_table
     text, notes = export_table(machine, "X", "linuxcnc", comp_type=0)

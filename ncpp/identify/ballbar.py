@@ -1,6 +1,8 @@
-"""Ball bar → error components by regularised least squares (thesis 4.8.4.5).
+"""Ball bar → error components by regularised least squares (Rahman 2004, 4.8.4.5).
 
-The thesis finds error components from ball-bar traces by trial and error;
+Rahman 2004 (M. Rahman, *Modeling and measurement of multi-axis machine tools to improve positioning
+accuracy in a software way*, University of Oulu, 2004)
+finds error components from ball-bar traces by trial and error;
 here they are solved for, over all given files at once (planes, radii,
 heights, centres, both directions, feeds).
 

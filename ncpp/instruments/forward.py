@@ -1,4 +1,7 @@
-"""Forward models: what each instrument reads on a given machine (thesis 4.5–4.8, ch. 5).
+"""Forward models: what each instrument reads on a given machine (Rahman 2004, 4.5–4.8, ch. 5).
+
+Rahman 2004: M. Rahman, *Modeling and measurement of multi-axis machine tools to improve positioning
+accuracy in a software way*, University of Oulu, 2004.
 
 Every `predict_<instrument>(machine, setup...)` returns a `Measurement` in the
 contract's file form (shared/spec/measurement-files.md), so that a prediction

@@ -5,7 +5,9 @@
     m.deviation(P)            # (n,3) mm, actual minus nominal tool point vs workpiece
 
 Conventions: `ncpp.machine.chain` (frames, signs, the product of transforms);
-names and the thesis alias table: `ncpp.machine.components`; file format:
+names and the aliases of M. Rahman, *Modeling and measurement of multi-axis machine
+tools to improve positioning accuracy in a software way*, University of Oulu, 2004:
+`ncpp.machine.components`; file format:
 `ncpp.machine.io`; effects: `ncpp.machine.effects`.
 """
 

@@ -1,4 +1,7 @@
-"""The kinematic chain and the volumetric error (thesis eqs. 6–30).
+"""The kinematic chain and the volumetric error (Rahman 2004, eqs. 6–30).
+
+Rahman 2004: M. Rahman, *Modeling and measurement of multi-axis machine tools to improve positioning
+accuracy in a software way*, University of Oulu, 2004.
 
 Chain string
 ------------
@@ -46,7 +49,7 @@ Both reduce to one product in chain-string order, workpiece first:
 The deviation E(P) is that minus ``P + t``, in workpiece coordinates (the
 work point only moves the origin, so it does not enter).  Rotations are the
 exact rotation for the rotation vector ε (Rodrigues, series form: the
-errors are micro-radians); the thesis's I + [ε]× differs by terms of order
+errors are micro-radians); Rahman 2004's I + [ε]× differs by terms of order
 ε², far below a micron.  Keeping only first-order terms gives eqs. 28–30:
 
     E_lin(P) = Σ_K  δ_K + ε_K × L_K + k·(S_K × e_K),
@@ -152,7 +155,7 @@ def cyclic_cross(a: NDArray, b: NDArray, out: NDArray) -> NDArray:
 
 def norm3(vectors: NDArray) -> NDArray:
     """Lengths of (..., 3) vectors: `np.linalg.norm(vectors, axis=-1)` (bit for bit: the same
-    sum in the same order), without its reduction over a short last axis (5x slower)."""
+    sum in the same order), without its reduction over a short last axis (several times slower)."""
     squares = vectors * vectors
     return np.sqrt((squares[..., 0] + squares[..., 1]) + squares[..., 2])
 

@@ -3,7 +3,7 @@
 Naming (ISO 230-1): ``E`` + direction of the error + the axis that moves.
 
 ============  ==========================  =======================  ===========
-ISO name      meaning                     thesis names (aliases)   file unit
+ISO name      meaning                     Rahman 2004 (aliases)    file unit
 ============  ==========================  =======================  ===========
 EXX EYY EZZ   positioning of X, Y, Z      xx yy zz, Xxx Yyy Zzz    µm
 EYX EZX       straightness of X in Y, Z   yx zx, Xyx Xzx           µm
@@ -17,8 +17,10 @@ B0Z           squareness Z to X (about Y) kxz, kzx, EB0Z           µrad (= µm/
 A0Z           squareness Z to Y (about X) kyz, kzy, EA0Z           µrad (= µm/m)
 ============  ==========================  =======================  ===========
 
-The thesis (Rahman 2004) writes a linear error as <error direction><axis>
-(``yx``: Y-direction error of the X axis), optionally prefixed by the axis
+Rahman 2004 (M. Rahman, *Modeling and measurement of multi-axis machine tools
+to improve positioning accuracy in a software way*, University of Oulu, 2004)
+writes a linear error as <error direction><axis> (``yx``: Y-direction error of
+the X axis), optionally prefixed by the axis
 (``Xyx``), and an angular error as <rotation><axis> (``bx``: rotation about Y
 of the X axis); ``kij`` is the squareness of axes i and j.  The aliases map
 those spellings one to one and with the same sign; a file written by ncpp
@@ -101,7 +103,7 @@ THESIS_NAMES: dict[str, str] = _thesis_table()
 
 
 def canonical_name(name: str) -> str:
-    """The ISO name for an ISO or thesis spelling; ValueError if unknown."""
+    """The ISO name for an ISO or Rahman 2004 spelling; ValueError if unknown."""
     if name in COMPONENTS or name in SQUARENESS:
         return name
     if name.upper() in COMPONENTS or name.upper() in SQUARENESS:
@@ -319,7 +321,7 @@ class StackedTables:
         self.inner = grid[1:-1].copy()  # the interval of p in [grid[0], grid[-1]] is how many of these are <= p
         # Per power, a (curves, intervals) array: one gather along the intervals fetches every
         # curve, and each curve's values come out as a contiguous row (numpy's loops then run
-        # along the points, not along a handful of curves: 8% faster on 1400 points, 20% on 20k)
+        # along the points, not along a handful of curves)
         stacked = np.stack([_refine(x, c, grid) for x, c in pieces], axis=0)
         self.coefficients = [np.ascontiguousarray(stacked[:, :, k]) for k in range(4)]
         minus = iter(range(len(tables), len(curves)))

@@ -5,8 +5,10 @@ straight interpolation of its end errors by more than the tolerance allows.  Whe
 error is smooth, the bow of a segment of length L is at most L²/8 · max‖E''‖ along it
 (E'' the second derivative along the segment), and on a machine whose components are all
 tables with smooth interpolation, that derivative is bounded by the tables' own.  In the
-first-order model (thesis eqs. 28–30), axis K adds δ_K(P_K) + ε_K(P_K) × L_K(P) (squareness
-adds terms linear in P), so along a unit direction u
+first-order model (eqs. 28–30 of M. Rahman, *Modeling and measurement of multi-axis machine
+tools to improve positioning accuracy in a software way*, University of Oulu, 2004), axis K
+adds δ_K(P_K) + ε_K(P_K) × L_K(P) (squareness adds terms linear in P), so along a unit
+direction u
 
     d²/ds² [δ_K + ε_K × L_K] = u_K² (δ_K'' + ε_K'' × L_K) + 2 u_K ε_K' × dL_K/ds,
 

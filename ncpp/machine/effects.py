@@ -49,7 +49,7 @@ if TYPE_CHECKING:
 # The largest error a machine file may give, in its µm (a metre), µm/m or µrad/m
 LARGEST_ERROR = 1e6
 # mm: positions, offsets and travel past a kilometre are typing errors, no machine's (a reference
-# point of 1e308 mm simulated a contour error of 'inf µm'; a set-up there, inf readings)
+# point of 1e308 mm would simulate a contour error of 'inf µm'; a set-up there, inf readings)
 LARGEST_LENGTH_MM = 1e6
 PLANE_TERMS = {"XY": (0, 1), "YZ": (1, 2), "ZX": (2, 0)}  # (deviating axis, driving axis)
 LATERAL_DEFAULT = {"X": "Y", "Y": "X", "Z": "X"}
@@ -113,7 +113,7 @@ def is_finite_number(value: Any) -> bool:
 
 def _size(what: str, key: str, value: Any) -> Any:
     """An error's size (µm, µm/m, µrad/m) past LARGEST_ERROR is a typing error, not a machine's:
-    1e300 µm of backlash made simulations report 'inf µm'."""
+    1e300 µm of backlash would make simulations report 'inf µm'."""
     if key.split("_")[0] in ("um", "urad") and isinstance(value, float) and not abs(value) <= LARGEST_ERROR:
         raise ValueError(f"{what} must be within ±{LARGEST_ERROR:g} (an error of a metre is no machine's), not {value:g}")
     return value

@@ -56,9 +56,11 @@ A complete example::
     [meta]                         # free-form, kept as is
     source = "laser 2004-03-02"
 
-Component names may be ISO (EXX, EBX, C0Y) or the thesis's (xx, Xxx, bx,
-kxy); the file is written back with ISO names.  The file is UTF-8 (a byte
-order mark is skipped); every number in it must be finite (no nan or inf, [meta]
+Component names may be ISO (EXX, EBX, C0Y) or those of M. Rahman, *Modeling
+and measurement of multi-axis machine tools to improve positioning accuracy in a
+software way*, University of Oulu, 2004 (xx, Xxx, bx, kxy); the file is written
+back with ISO names.  The format, key by key: docs/machine-file.md.  The file is
+UTF-8 (a byte order mark is skipped); every number in it must be finite (no nan or inf, [meta]
 aside), and angles small (within ±10000 µrad, where the model's rotation series
 are exact).  Errors point at the file and line, and name the key.
 """
@@ -335,7 +337,7 @@ def _components(errors: dict, travel: dict[str, list[float]], loc: _Locator) -> 
             iso = canonical_name(name)
             if iso in SQUARENESS:
                 raise ValueError(f"{name} is a squareness; put it in [squareness] as {iso}_urad")
-            if iso in names:  # a thesis name and the ISO one: the second would silently win
+            if iso in names:  # a Rahman 2004 name and the ISO one: the second would silently win
                 raise ValueError(f"{iso} is given twice, as {names[iso]} and {name}")
             components[iso] = _component_from_dict(iso, spec, travel.get(COMPONENTS[iso].axis))
             names[iso] = name

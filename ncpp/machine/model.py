@@ -2,7 +2,9 @@
 
 A Machine is immutable; `with_components` and `replace` return new ones.
 Conventions (frames, signs, the chain product) are in `ncpp.machine.chain`;
-component names in `ncpp.machine.components`.
+component names in `ncpp.machine.components`.  Rahman 2004: M. Rahman, *Modeling and
+measurement of multi-axis machine tools to improve positioning accuracy in a software
+way*, University of Oulu, 2004.
 """
 
 from __future__ import annotations
@@ -40,7 +42,8 @@ if TYPE_CHECKING:
     from ncpp.machine.trajectory import Trajectory
 
 Vec3 = tuple[float, float, float]
-# points per block: small enough that the dozens of (n,3) temporaries of a block stay in a core's cache
+# points per block: the kernels' dozens of (n,3) temporaries stay in a core's second-level cache,
+# which a larger block overflows (more time a point, not less)
 CHUNK = 2048
 
 
@@ -263,7 +266,7 @@ class Machine:
         return _shaped_like(total, P)
 
     def deviation_linear(self, P: ArrayLike, direction: ArrayLike | None = None) -> NDArray:
-        """First-order deviation (thesis eqs. 28–30), mm."""
+        """First-order deviation (Rahman 2004, eqs. 28–30), mm."""
         return self._blockwise(linear_deviation, P, direction)
 
     def abbe_offset(self, axis: str, P: ArrayLike) -> NDArray:
@@ -324,7 +327,7 @@ class Machine:
 
     # ---------------------------------------------------------------- values
     def with_components(self, **updates: Component | float | None) -> "Machine":
-        """New machine with components (ISO or thesis names) replaced; None removes.
+        """New machine with components (ISO or Rahman 2004 names) replaced; None removes.
         Squareness names take an angle in rad."""
         comps = dict(self.components)
         sq = dict(self.squareness)

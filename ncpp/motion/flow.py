@@ -23,9 +23,12 @@ program `O<n>` of the file, which ends with `M99` (#1-#30 are the caller's,
 as in LinuxCNC; the other scoping is a call's).
 
 Subroutines are those of the program's own text (defined before or after the
-call, like LinuxCNC, which searches the rest of the file); subroutine files
-on the control's search path are outside the scope.  Blocks stay in memory
-only while a loop may go back to them, and subroutine bodies for the call.
+call, like LinuxCNC, which searches the rest of the file) or `name.ngc` in the
+first folder of the search path that has it (`_from_file`: LinuxCNC's
+[RS274NGC]SUBROUTINE_PATH, given as `--subroutine-path`; looked for before the
+rest of the file); a call of a subroutine found in neither is outside the scope.
+Blocks stay in memory only while a loop may go back to them, and subroutine
+bodies for the call.
 """
 
 from __future__ import annotations

@@ -68,7 +68,7 @@ class Context:
 
 
 # Events are not frozen: a pipeline makes several per output line, and a frozen
-# dataclass sets each field through object.__setattr__ (5x slower to build).
+# dataclass sets each field through object.__setattr__ (several times slower to build).
 # Treat them as values all the same: a pass that changes one makes a new one.
 @dataclass(slots=True)
 class Line:

@@ -1,4 +1,6 @@
-"""Error maps taken straight from one measurement (thesis sections 7.2–7.3).
+"""Error maps taken straight from one measurement (M. Rahman, *Modeling and measurement
+of multi-axis machine tools to improve positioning accuracy in a software way*,
+University of Oulu, 2004, sections 7.2–7.3).
 
 `ncpp compensate --from FILE` uses these instead of a full machine model:
 

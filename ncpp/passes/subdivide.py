@@ -1,4 +1,6 @@
-"""Pass: split feed lines along which the error does not vary linearly (thesis 6.2).
+"""Pass: split feed lines along which the error does not vary linearly (M. Rahman,
+*Modeling and measurement of multi-axis machine tools to improve positioning accuracy in a
+software way*, University of Oulu, 2004, section 6.2).
 
 Compensating only a line's end points corrects the path between them by the
 straight interpolation of the end-point errors.  Where the error varies more

@@ -242,7 +242,7 @@ MAX_TOOL = int(MAX_WORD)  # tool numbers a control takes
 
 
 def _tool_number(rec: Record) -> int:
-    """LOADTL/n: n a whole number a control takes (LOADTL/1.5 was tool 1, LOADTL/abc nothing)."""
+    """LOADTL/n: n a whole number a control takes (not LOADTL/1.5, not LOADTL/abc)."""
     numbers = rec.numbers
     if not numbers or numbers[0] != int(numbers[0]) or not 0 <= numbers[0] <= MAX_TOOL:
         raise NcppError(f"{rec.major}: expected a tool number from 0 to {MAX_TOOL:,}", rec.where)

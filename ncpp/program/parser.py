@@ -48,8 +48,8 @@ _LARK_OPTIONS = {"parser": "lalr", "propagate_positions": True, "maybe_placehold
 @functools.lru_cache(maxsize=None)
 def lalr_parser(name: str) -> lark.Lark:
     """The dialect's Lark parser, loaded from the user's cache when it was built before
-    (building the LALR tables takes 50-120 ms, loading them 5-20: every `ncpp` run pays it,
-    and the LinuxCNC filter runs whenever a program is opened)."""
+    (building the LALR tables takes several times as long as loading them: every `ncpp` run
+    pays it, and the LinuxCNC filter runs whenever a program is opened)."""
     text = grammar_path(name).read_text(encoding="utf-8")
     return cached_build(f"{name}-lark", f"{text}\n{_LARK_OPTIONS}\n{lark.__version__}", lambda: lark.Lark(text, **_LARK_OPTIONS), lark.Lark.load)
 

@@ -2,7 +2,9 @@
 
     python samples/machines/make_samples.py
 
-The three machine structures of the thesis with synthetic but realistic
+The three machine structures of M. Rahman, *Modeling and measurement of multi-axis
+machine tools to improve positioning accuracy in a software way*, University of Oulu,
+2004, with synthetic but realistic
 error tables of the magnitudes it reports: tens of µm positioning over ~1 m,
 a few arcsec (1" = 4.85 µrad) angular, a few µm straightness, tens of µm/m
 squareness.  Fixed seed: the output is reproducible.

@@ -1,4 +1,6 @@
-"""Reproduce the thesis's comparisons (Rahman 2004, section 4.8.4, Tables 2 and 5).
+"""Reproduce the comparisons of M. Rahman, *Modeling and measurement of multi-axis machine
+tools to improve positioning accuracy in a software way*, University of Oulu, 2004
+(section 4.8.4, Tables 2 and 5).
 
     python samples/thesis/make.py [OUTDIR]
 
@@ -147,7 +149,10 @@ def make(out: Path) -> None:
 
     dynamic = true.replace(effects=tuple(effect_from_dict(e) for e in DYNAMIC))
     lines = [
-        "# Predicted vs measured (thesis section 4.8.4, Tables 2 and 5)",
+        "# Predicted vs measured (Rahman 2004, section 4.8.4, Tables 2 and 5)",
+        "",
+        "M. Rahman, *Modeling and measurement of multi-axis machine tools to improve positioning",
+        "accuracy in a software way*, University of Oulu, 2004.",
         "",
         "Made by `python samples/thesis/make.py` (fixed seeds). The \"measured\" files are",
         "simulated from `samples/machines/hr5b.toml`: laser/level files of the cold machine",

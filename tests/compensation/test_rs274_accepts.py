@@ -1,5 +1,5 @@
 """Every emitted arc is valid: LinuxCNC's rs274 accepts each compensated corpus
-program it accepted before (issue 4, item 5).
+program it accepted before.
 
 Programs: every ISO-family corpus program under 100 kB, and a representative
 few of the large ones (3D_Chips, systems, spiral_tangent_test); the other

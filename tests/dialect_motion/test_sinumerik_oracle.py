@@ -106,7 +106,7 @@ def test_agrees_with_cead_oracle(program: Path) -> None:
             assert abs(mine["XYZ".index(axis)] - value) < TOLERANCE, (n, axis, mine, row)
 
 
-def test_every_listed_file_exists() -> None:
+def test_every_listed_file_exists(corpus) -> None:
     names = {p.name for p in _programs()}
     assert set(OUT_OF_SCOPE) <= names
     assert len(names) - len(OUT_OF_SCOPE) >= 10  # the in-scope share is real

@@ -15,6 +15,7 @@ from tests.conftest import CORPUS, corpus_files, corpus_id, expected_signature
 HEIDENHAIN = corpus_files("heidenhain")
 SINUMERIK = corpus_files("sinumerik")
 OTHERS = corpus_files("iso_gcode", "malformed", "apt_cldata", "metrology")
+PLAN_H = CORPUS / "heidenhain/jstjst_Heidenhain-Cycles/Plan.h"  # continuation lines, a cycle, a GPL header
 # Plain G code with `;` comments: nothing in it is Sinumerik-only, only its name tells.
 CONTENT_AMBIGUOUS = {"multiple_m_codes.mpf"}
 
@@ -25,7 +26,7 @@ def roundtrip(data: bytes, name: str, dialect: str) -> bytes:
     return out.getvalue()
 
 
-def test_corpus_has_both_dialects():
+def test_corpus_has_both_dialects(corpus):
     assert len(HEIDENHAIN) >= 2 and len(SINUMERIK) >= 30
 
 
@@ -50,8 +51,8 @@ def test_dialect_is_detected(path):
         assert detect(head) == want
 
 
-def test_heidenhain_continuation_lines_make_one_block():
-    path = CORPUS / "heidenhain/jstjst_Heidenhain-Cycles/Plan.h"
+def test_heidenhain_continuation_lines_make_one_block(corpus):
+    path = PLAN_H
     blocks = list(parse_stream(io.BytesIO(path.read_bytes()), str(path), "heidenhain"))
     physical = path.read_bytes().count(b"\n")
     assert len(blocks) == 216 and physical == 223  # blocks 0..215, three comments continued
@@ -62,7 +63,7 @@ def test_heidenhain_continuation_lines_make_one_block():
     assert blocks[-1].items[1].kind == "program_end" and blocks[-1].items[1].node == ("Plan", "MM")
 
 
-def test_sinumerik_fast_path_agrees_with_lalr_parser_on_corpus():
+def test_sinumerik_fast_path_agrees_with_lalr_parser_on_corpus(corpus):
     parser = LineParser("sinumerik")
     checked = 0
     for path in SINUMERIK:
@@ -78,11 +79,11 @@ def test_sinumerik_fast_path_agrees_with_lalr_parser_on_corpus():
 
 
 @pytest.mark.parametrize("size", [1, 7, 4096])
-def test_sniff_rereads_the_head_and_keeps_streaming(size, monkeypatch):
+def test_sniff_rereads_the_head_and_keeps_streaming(corpus, size, monkeypatch):
     import ncpp.program.dialects as dialects
 
     monkeypatch.setattr(dialects, "SNIFF_BYTES", size)
-    path = CORPUS / "heidenhain/jstjst_Heidenhain-Cycles/Plan.h"
+    path = PLAN_H
     data = path.read_bytes()
     dialect, lines = sniff(io.BytesIO(data), path.name)
     assert b"".join(lines) == data
@@ -108,8 +109,8 @@ def test_explicit_dialect_overrides_detection():
     assert dialect == "sinumerik"
 
 
-@pytest.mark.parametrize("path", [HEIDENHAIN[0], CORPUS / "sinumerik/CEAD_nc-gcode-interpreter/edge_cases.mpf"], ids=corpus_id)
-def test_cli_filter_roundtrips_from_stdin(path):
+@pytest.mark.parametrize("path", [PLAN_H, CORPUS / "sinumerik/CEAD_nc-gcode-interpreter/edge_cases.mpf"], ids=corpus_id)
+def test_cli_filter_roundtrips_from_stdin(corpus, path):
     import subprocess
     import sys
 

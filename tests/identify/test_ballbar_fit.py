@@ -1,4 +1,6 @@
-"""Ball bar → error components (thesis 4.8.4.5) and ball bar → comparator (5.2.3).
+"""Ball bar → error components (4.8.4.5) and ball bar → comparator (5.2.3) of M. Rahman,
+*Modeling and measurement of multi-axis machine tools to improve positioning accuracy in a
+software way*, University of Oulu, 2004.
 
 Ground truth: the HR5B sample machine (XZFY, tens of µm positioning, a few
 µrad angles, tens of µm/m squareness, reversal in its ± tables).  "Measured":

@@ -1,4 +1,6 @@
-"""Machine files: round trip, thesis aliases, errors that name file and line."""
+"""Machine files: round trip, the aliases of M. Rahman, *Modeling and measurement of multi-axis
+machine tools to improve positioning accuracy in a software way*, University of Oulu, 2004,
+errors that name file and line."""
 
 import numpy as np
 import pytest

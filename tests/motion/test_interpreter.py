@@ -275,7 +275,7 @@ def test_out_of_scope_passes_through_with_one_warning_then_stops(text, construct
 
 
 # -- the filter ------------------------------------------------------------------------------------
-def test_filter_refuses_a_bad_program_and_writes_nothing():
+def test_filter_refuses_a_bad_program_and_writes_nothing(corpus):
     bad = (CORPUS / "malformed/linuxcnc_interp_bad/bad-arc.small.metric.center-format.ngc").read_bytes()
     proc = subprocess.run([sys.executable, "-m", "ncpp"], input=bad, capture_output=True)
     assert proc.returncode != 0 and proc.stdout == b""
@@ -283,14 +283,14 @@ def test_filter_refuses_a_bad_program_and_writes_nothing():
     assert b"Traceback" not in proc.stderr
 
 
-def test_filter_passes_out_of_scope_programs_through_with_a_warning():
+def test_filter_passes_out_of_scope_programs_through_with_a_warning(corpus):
     path = CORPUS / "iso_gcode/linuxcnc/threading.ngc"
     proc = subprocess.run([sys.executable, "-m", "ncpp", str(path)], capture_output=True)
     assert proc.returncode == 0 and proc.stdout == path.read_bytes()
     assert proc.stderr.decode().count("warning") == 1
 
 
-def test_motion_command_prints_rs274_calls():
+def test_motion_command_prints_rs274_calls(corpus):
     path = CORPUS / "iso_gcode/cncjs/g2-arc.gcode"
     proc = subprocess.run([sys.executable, "-m", "ncpp", "motion", str(path)], capture_output=True, text=True, check=True)
     lines = proc.stdout.splitlines()

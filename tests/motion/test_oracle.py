@@ -242,7 +242,7 @@ def _line_text(path, line: int) -> str:
     return path.read_bytes().decode("latin-1").splitlines()[line - 1]
 
 
-def test_every_listed_file_exists():
+def test_every_listed_file_exists(corpus):
     names = {corpus_id(p) for p in PROGRAMS}
     assert set(OUT_OF_SCOPE) <= names and set(RS274_ONLY_REFUSES) <= names
 

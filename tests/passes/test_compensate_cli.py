@@ -90,8 +90,10 @@ def test_compensate_from_ballbar_file(tmp_path):
 
 
 def test_thesis_reference_case_from_a_ballbar_file(tmp_path):
-    """Section 6.5.2.1 through the command: ΔR(θ) = 9.1·sin 2θ µm from a ball-bar
-    file, a full R150 circle in G91, one arc per quadrant (blocks N201-N204)."""
+    """Section 6.5.2.1 of M. Rahman, *Modeling and measurement of multi-axis machine tools to
+    improve positioning accuracy in a software way*, University of Oulu, 2004, through the
+    command: ΔR(θ) = 9.1·sin 2θ µm from a ball-bar file, a full R150 circle in G91, one arc per
+    quadrant (blocks N201-N204)."""
     import numpy as np
 
     angles = np.arange(0.0, 360.0, 1.0)

@@ -1,4 +1,6 @@
-"""Section 6.5.2.1: a full R150 circle on a machine whose ball-bar trace is
+"""M. Rahman, *Modeling and measurement of multi-axis machine tools to improve
+positioning accuracy in a software way*, University of Oulu, 2004,
+section 6.5.2.1: a full R150 circle on a machine whose ball-bar trace is
 ΔR(θ) = 9.1·sin 2θ µm becomes four quadrant arcs, blocks N201–N204."""
 
 from __future__ import annotations
@@ -51,7 +53,7 @@ def test_written_blocks_keep_g91_and_number_style():
     lines = list(IsoWriter(mm_decimals=3).write(run_passes([arc], ctx)))
     assert len(lines) == 4
     # ncpp centres each arc for the smallest largest deviation (0.3 µm here); the
-    # thesis put it through the mid point: I-149.978 J-0.022.  Both agree to 0.001 mm.
+    # thesis (Rahman 2004) put it through the mid point: I-149.978 J-0.022.  Both agree to 0.001 mm.
     first = parse_text(lines[0])[0]
     assert first.raw.startswith("N200 G91 G02 X-150.000 Y-150.000 I-149.97")
     values = {w.letter: w.value for w in first.words()}

@@ -84,7 +84,7 @@ def test_replayed_lines_build_what_their_own_parse_builds(dialect):
 
 
 @pytest.mark.parametrize("dialect", sorted(DIALECT_FOLDERS))
-def test_replay_agrees_with_the_lalr_parser_on_corpus(dialect):
+def test_replay_agrees_with_the_lalr_parser_on_corpus(corpus, dialect):
     parser, checked, replays, cuts = LineParser(dialect), 0, 0, 0
     for path in corpus_files(*DIALECT_FOLDERS[dialect]):
         try:

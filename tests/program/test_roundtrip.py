@@ -41,7 +41,7 @@ def test_malformed_but_readable_programs_roundtrip(path):
 
 
 @pytest.mark.parametrize("name", sorted(UNREADABLE))
-def test_unreadable_programs_name_file_line_and_column(name):
+def test_unreadable_programs_name_file_line_and_column(corpus, name):
     """A line the grammar cannot read is read as it stands (byte for byte) and refused
     where it runs, as rs274ngc reads it (`Dialect.read_where_run`)."""
     path = next(p for p in MALFORMED if p.name == name)
@@ -73,7 +73,7 @@ def test_unreadable_lines_that_do_not_run_pass_through_with_a_warning(tmp_path):
     assert (err.value.where.line, err.value.where.col) == (7, 7)
 
 
-def test_fast_path_agrees_with_lalr_parser_on_corpus():
+def test_fast_path_agrees_with_lalr_parser_on_corpus(corpus):
     """The plain-line scanner must build exactly what the grammar builds."""
     parser = LineParser("iso")
     checked = 0
@@ -113,7 +113,7 @@ def test_a_stray_character_is_left_to_the_lalr_parser(raw):
         parser._parse_lalr(raw, 1, "t.ngc")
 
 
-def test_cli_passthrough_is_byte_identical(tmp_path):
+def test_cli_passthrough_is_byte_identical(corpus, tmp_path):
     path = CORPUS / "iso_gcode/cncjs_toolpath_fixtures/arc-no-plane.nc"  # CRLF
     out = subprocess.run([sys.executable, "-m", "ncpp"], input=path.read_bytes(), capture_output=True, check=True)
     assert out.stdout == path.read_bytes()

@@ -21,7 +21,7 @@ MACHINE = ROOT / "samples/machines/hr5b.toml"
 
 
 @pytest.fixture(scope="module")
-def program(tmp_path_factory):
+def program(corpus, tmp_path_factory):
     """A long LinuxCNC program: the Creo roughing CL data posted plainly (8 000+ lines)."""
     path = tmp_path_factory.mktemp("linuxcnc") / "schruppen.ngc"
     out = io.BytesIO()

@@ -51,7 +51,7 @@ def distinct(points, tol=1e-4):
     return kept
 
 
-def test_corpus_holds_cl_files():
+def test_corpus_holds_cl_files(corpus):
     assert len(CL_FILES) >= 4
 
 
@@ -79,7 +79,7 @@ def test_linuxcnc_runs_the_post_to_the_cl_end_points(path, dialect, tmp_path):
     assert np.abs(np.array(got) - np.array(want)).max() <= 1e-4
 
 
-def test_arcs_are_posted_as_arcs():
+def test_arcs_are_posted_as_arcs(corpus):
     path = CORPUS / "apt_cldata/creo_ncl/profilfraesen_2.ncl.1"
     circles = path.read_text(encoding="latin-1").count("CIRCLE")
     iso = posted(path, "linuxcnc")
@@ -111,7 +111,7 @@ def test_posted_with_a_machine_file_is_compensated(path, tmp_path):
     assert nearest.max() > 1e-3  # and really moved (HR5B errors are tens of µm)
 
 
-def test_post_command_writes_a_file(tmp_path):
+def test_post_command_writes_a_file(corpus, tmp_path):
     out = tmp_path / "part.h"
     path = CORPUS / "apt_cldata/rybakov25/test.apt"
     proc = subprocess.run(
@@ -195,7 +195,7 @@ def test_spindle_speed_is_written_as_given(dialect, rpm):
     assert re.search(rf"\bS{rpm}\b", out.getvalue().decode()), out.getvalue().decode()
 
 
-def test_the_corpus_spindle_speeds_are_posted():
+def test_the_corpus_spindle_speeds_are_posted(corpus):
     text = posted(CORPUS / "apt_cldata/creo_ncl/bohren_1.ncl.8", "iso")
     assert "S9000 M3" in text
 
