@@ -178,7 +178,7 @@ def warn_fixed(events: Iterable[Event], warnings: Warnings, file: str) -> Iterat
             if not fixed and series == CYCLE and absolute and not event.context.absolute:  # type: ignore[union-attr]
                 yield from _passed_on(event, events, warnings, file)
                 return
-            if fixed and fixed != series:
+            if fixed and fixed != series and fixed in UNCOMPENSATED:  # (a G28/G30's moves are the control's own)
                 warnings.warn(UNCOMPENSATED[fixed], Location(file, event.block.line, 1))
             series, absolute = fixed, event.context.absolute  # type: ignore[union-attr]
         yield event

@@ -39,7 +39,7 @@ from ncpp.motion.cycles import CANNED, DWELLING, PECKING, RAPID_DELTA_INCH, SPIN
 from ncpp.motion.expressions import ExpressionError, OutOfScope, Parameters, evaluate
 from ncpp.motion.offsets import SYSTEMS, WorkOffsets
 from ncpp.motion.flow import FIXED, RUN, SKIP, Flow
-from ncpp.motion.segments import COMP, CYCLE, FLOW, PLANE_AXES, Arc, Context, Event, Line, Pass, mark_off_path
+from ncpp.motion.segments import COMP, CYCLE, FLOW, HOME, PLANE_AXES, Arc, Context, Event, Line, Pass, mark_off_path
 from ncpp.motion.snapshot import attributes
 from ncpp.motion.tools import UntoldLengths
 from ncpp.program.blocks import STRAY_TAPE, UNREADABLE, Block, Comment, ExprWord, Statement, Word
@@ -1010,14 +1010,21 @@ class Interpreter:
         return None
 
     def _go_home(self, block: Block, given: list[tuple[int, float]], home: list[float]) -> tuple[Event, ...]:
-        """G28/G30: rapid to the (optional) intermediate point, then home the given axes (all if none)."""
+        """G28/G30: rapid to the (optional) intermediate point, then home the given axes (all if none).
+        Both moves are the control's (`HOME`): compensation cannot reach into them.  In G90 the
+        intermediate point puts the named axes at their words, in G91 it moves them by their words
+        from where the control stands; the home move puts the homed axes at the home position."""
+        named = tuple(any(i == axis for i, _ in given) for axis in range(3))
         middle = self._ends(given, False)
         first = self._line(block, middle, True)
+        first.fixed, first.placed = HOME, named if self.absolute else (False, False, False)
         axes = [i for i, _ in given] or range(9)
         end = middle[:]
         for i in axes:
             end[i] = home[i] - (self.g5x[self.coord_system][i] + self.g92[i] + self.tool[i])
-        return first, self._line(block, end, True)
+        second = self._line(block, end, True)
+        second.fixed, second.placed = HOME, named if given else (True, True, True)
+        return first, second
 
     # -- moves ---------------------------------------------------------------------------------
     def _note_axes(self, given) -> None:

@@ -28,6 +28,7 @@ Point = tuple[float, float, float]
 CYCLE = "canned cycle"  # a hole is drilled where the program puts it
 FLOW = "loop or subroutine"  # one text runs many times (or out of the text's order)
 COMP = "cutter compensation"  # the control offsets the path by the tool's radius: the tool is not on it
+HOME = "G28/G30 return"  # the control homes the axes it names (machine coordinates); the others stay where they stand
 # Axis letters of `Line.end` / `Arc.end` beyond XYZ, in rs274's order.
 EXTRA_AXES = ("A", "B", "C", "U", "V", "W")
 
@@ -80,7 +81,10 @@ class Line:
     context: Context = field(default_factory=Context)
     extra: tuple[float, ...] = ()  # end positions of A B C U V W, when the program uses them
     changed: bool = False  # set by a pass that moved the end point
-    fixed: str = ""  # why passes leave the move as programmed (CYCLE, FLOW, COMP), "" if they may change it
+    fixed: str = ""  # why passes leave the move as programmed (CYCLE, FLOW, COMP, HOME), "" if they may change it
+    # A fixed move's X Y Z the control puts at their programmed end; the others run their programmed
+    # increment from where the control stands (None: all of them in G90, none in G91)
+    placed: tuple[bool, bool, bool] | None = None
 
     def length(self) -> float:
         return math.dist(self.start, self.end)
@@ -156,4 +160,4 @@ def mark_off_path(moves: list, compensating: bool, off_path: bool) -> bool:
     return compensating
 
 
-__all__ = ["COMP", "CYCLE", "FLOW", "mark_off_path", "Arc", "Context", "Event", "Line", "Pass", "Point", "Segment", "PLANES", "PLANE_AXES", "EXTRA_AXES", "replace"]
+__all__ = ["COMP", "CYCLE", "FLOW", "HOME", "mark_off_path", "Arc", "Context", "Event", "Line", "Pass", "Point", "Segment", "PLANES", "PLANE_AXES", "EXTRA_AXES", "replace"]

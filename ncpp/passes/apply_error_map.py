@@ -140,7 +140,8 @@ class _Rows:
     assumed: NDArray | None  # (n,3) directions replace_arcs compensated the pieces with (reversal errors only)
     lines: NDArray  # (n,) the line of each segment's block, for messages
     rapid: NDArray  # (n,) rapid moves (G0): no reversal step before them
-    carried: NDArray  # (n,) moves left as programmed in G91: they start where the control is (`_carry`)
+    carried: NDArray  # (n,) moves left as programmed that run from where the control is (`_carry`)
+    kept: NDArray  # (n,3) their axes that do so (the others the control puts at their programmed end)
 
 
 def _rows_before(rows: _Rows, line: int | None) -> _Rows | None:
@@ -161,11 +162,24 @@ def _rows(segs: list, directional: bool) -> _Rows:
     arc, changed = (kind & 1) != 0, (kind & 4) != 0
     line = (kind & 3) == 0
     free = line & ~changed
+    kept = _kept_axes(segs, kind)
     return _Rows(
         start, end, offsets, scales, tools, free, changed, changed & line,
         _arc_assumed(segs, np.flatnonzero(changed & arc), start, end) if directional else None,
-        np.fromiter([e.block.line for e in segs], dtype=np.int64, count=len(segs)), (kind & 8) != 0, (kind & 16) != 0,
+        np.fromiter([e.block.line for e in segs], dtype=np.int64, count=len(segs)), (kind & 8) != 0, any3(kept), kept,
     )  # fmt: skip
+
+
+def _kept_axes(segs: list, kind: NDArray) -> NDArray:
+    """(n,3) the axes of moves left as programmed that run from where the control stands: every
+    axis in G91 (`kind` 16), those a move's `placed` does not put at its end (G28/G30)."""
+    kept = np.zeros((len(segs), 3), dtype=bool)
+    kept[(kind & 16) != 0] = True
+    for k in np.flatnonzero(kind & 2).tolist():  # (moves left as programmed are few)
+        placed = getattr(segs[k], "placed", None)
+        if placed is not None:
+            kept[k] = [not p for p in placed]
+    return kept
 
 
 class Solve:
@@ -376,8 +390,8 @@ def _directional(rows: _Rows, ctx: PassContext, travel: Travel) -> _Solved:
 
 def _carry(rows: _Rows, out_end: NDArray, before: NDArray | None) -> None:
     """Move the ends of the carried rows (left as programmed, in G91: the moves of loops and
-    subroutines, and under cutter compensation) by where the control stands when each run of
-    them starts: the program's increments run from the compensated end before them, which is
+    subroutines, and under cutter compensation; the axes a G28/G30 does not put at its intermediate
+    or home point) by where the control stands when each run of them starts: the program's increments run from the compensated end before them, which is
     off their programmed start by that end's correction.  `before`: the previous chunk's last
     end, in the first row's frame."""
     carried, offsets, scales = rows.carried, rows.offsets, rows.scales
@@ -395,7 +409,9 @@ def _carry(rows: _Rows, out_end: NDArray, before: NDArray | None) -> None:
         stop = starts[n + 1] if n + 1 < len(starts) else len(carried)
         rest = carried[k:stop]
         run = stop if rest.all() else k + int(np.argmin(rest))
-        out_end[k:run] = rows.end[k:run] + (previous - rows.start[k])
+        # an axis a move of the run puts at its programmed end runs from there on
+        placed = np.logical_or.accumulate(~rows.kept[k:run], axis=0)
+        out_end[k:run] = rows.end[k:run] + np.where(placed, 0.0, previous - rows.start[k])
 
 
 def _settle(free, arc, d, held, offsets, scales, limit, out_start, out_end, before) -> None:

@@ -31,6 +31,7 @@ DEFAULT_STYLE = NumberStyle(decimals=4)
 GEOMETRY_LETTERS = "XYZIJKR"  # words a pass rewrites in a changed block
 WRITTEN_LETTERS = "XYZIJK"  # the letters the writer writes numbers for
 MOVING_LETTERS = "XYZABCUVWIJKR"  # words that make a block move (with the modal motion)
+AXES_NOT_MOVED = frozenset((10.0, 28.0, 30.0, 52.0, 92.0, 43.1))  # G codes whose axis words no modal motion moves to
 # Letters whose number styles the writer uses: it writes XYZIJK (and CR, with X's style,
 # for Sinumerik); the styles of other words (F, S, R, ...) are never asked for, so not learnt.
 STYLED_LETTERS = frozenset(WRITTEN_LETTERS)
@@ -555,7 +556,7 @@ class _Facts:
     """What the writer asks about a block."""
 
     __slots__ = ("letters", "motion_word", "motion", "first_motion", "moves", "plain", "words", "styled",
-                 "word_letters", "motion_at", "bits", "axis_bits", "absent_axes", "machine", "flow")  # fmt: skip
+                 "word_letters", "motion_at", "bits", "axis_bits", "absent_axes", "machine", "flow", "settles")  # fmt: skip
 
     def __init__(self, block: Block | None = None):
         """The facts of `block`, read in one walk over its items (none: a block without words)."""
@@ -571,6 +572,7 @@ class _Facts:
         self.motion_at: tuple[int, str] | None = None  # (n, number as written) of its first G0-G3 word, the n-th word
         self.machine = False  # it moves in machine coordinates (G53)
         self.flow = False  # a control line: an o-word (not `O<name>` alone, a program's name), M98, M99
+        self.settles = False  # its axis words are a G10 / G28 / G30 / G52 / G92 / G43.1's, not a move's
         for item in block.items if block is not None else ():
             kind = type(item)
             if kind is Word:
@@ -591,6 +593,8 @@ class _Facts:
         return facts
 
     def _sum_up(self) -> None:
+        if self.settles:
+            self.moves = False
         self.bits = sum(bit for letter, bit in _BIT.items() if letter in self.letters)  # the written letters it has
         self.axis_bits = self.bits & _AXIS_BITS
         self.absent_axes = tuple((n, axis, _BIT[axis]) for n, axis in _NUMBERED_AXES if axis not in self.letters)
@@ -613,6 +617,8 @@ class _Facts:
                 self.motion_word, self.motion = True, None
             elif value == 53.0:
                 self.machine = True
+            elif value in AXES_NOT_MOVED:
+                self.moves = self.settles = True  # (`_sum_up`: its axis words do not move with the modal motion)
         elif letter in MOVING_LETTERS:
             self.moves = True
 
