@@ -23,8 +23,9 @@ from typing import Iterable, Iterator
 import numpy as np
 from numpy.typing import NDArray
 
-from ncpp.errors import NcppError
+from ncpp.errors import Location, NcppError
 from ncpp.motion.segments import Arc, Event, Line
+from ncpp.program.blocks import Word
 from ncpp.passes.context import CutLine, PassContext, deviation
 from ncpp.passes.kernels import run_ahead
 from ncpp.passes.geometry import all3, any3, compensate, frames, from_plane, in_plane, line_chunks, plane_axes, points, rows_of, tuples
@@ -71,9 +72,24 @@ def _chunks(events: Iterable[Event], ctx: PassContext) -> Iterator[list[Event]]:
         except NcppError as error:
             error.locate(e.block for e in chunk)
             raise
+        if solved.at_end.any():
+            _warn_at_travel_ends(segs, rows, solved, ctx)
         out = _written(chunk, segs, rows, solved, last)
         last = _ended(segs[-1], solved.end[-1])  # (a carried row's end is not its event's: `_carry`)
         yield out
+
+
+def _warn_at_travel_ends(segs: list, rows: "_Rows", solved: "_Solved", ctx: PassContext) -> None:
+    """One warning per line end left at a travel end (`compensate`'s `ends`), at its axis word."""
+    machine = (solved.end + rows.offsets) * rows.scales[:, None]
+    for k, axis in zip(*np.nonzero(solved.at_end)):
+        letter, block = "XYZ"[axis], segs[k].block
+        word = next((item for item in block.items if type(item) is Word and item.letter == letter), None)
+        ctx.warnings.warn(
+            f"{letter} goes to the end of its travel ({machine[k, axis]:g} mm on the machine), where the "
+            f"compensated command would be outside the travel: {letter} stops at the end, uncompensated there",
+            Location(ctx.file, block.line, 1 if word is None else word.start + 1),
+        )
 
 
 @dataclass(eq=False)
@@ -218,6 +234,7 @@ class _Solved:
     turn_start: NDArray  # (n,3) their start compensated for the new direction
     keep: NDArray  # (n,3) axes that keep their direction (they must not move in that step)
     limit: NDArray  # (n,) program units an axis may be left off its compensated position
+    at_end: NDArray  # (n,3) line ends left at a travel end their command would pass (`compensate`'s `ends`)
 
 
 # What `_written` does with a segment (bits of its row's code)
@@ -299,13 +316,16 @@ def _plain(rows: _Rows, ctx: PassContext, travel: Travel) -> _Solved:
     `travel.last` (where the carried G91 moves start from, `_carry`)."""
     start, end, free, offsets, scales = rows.start, rows.end.copy(), rows.free, rows.offsets, rows.scales
     at = np.flatnonzero(free)
+    at_end = np.zeros(end.shape, dtype=bool)
     if at.size:
-        end[at] = compensate(end[at], offsets[at], scales[at], rows.lines[at], ctx, np.sign(end[at] - start[at]), rows_of(rows.tools, at))
+        ends = np.zeros((at.size, 3), dtype=bool)
+        end[at] = compensate(end[at], offsets[at], scales[at], rows.lines[at], ctx, np.sign(end[at] - start[at]), rows_of(rows.tools, at), ends)
+        at_end[at] = ends
     if rows.carried.any():
         _carry(rows, end, None if travel.last is None else travel.last / scales[0] - offsets[0])
     travel.last = (end[-1] + offsets[-1]) * scales[-1]
     none = np.zeros(len(free), dtype=bool)
-    return _Solved(start, end, free, none, none, start, np.ones(start.shape, dtype=bool), np.zeros(len(free)))
+    return _Solved(start, end, free, none, none, start, np.ones(start.shape, dtype=bool), np.zeros(len(free)), at_end)
 
 
 class _Commands:
@@ -316,6 +336,7 @@ class _Commands:
     def __init__(self, rows: _Rows, wanted: dict[str, NDArray], step: NDArray, ctx: PassContext):
         self.rows, self.wanted, self.step, self.ctx = rows, wanted, step, ctx
         self.values = {which: np.empty_like(p) for which, p in wanted.items()}
+        self.at_end = {which: np.zeros(p.shape, dtype=bool) for which, p in wanted.items()}  # as last asked
         self.directions = {which: np.full(p.shape, np.nan) for which, p in wanted.items()}
 
     def __call__(self, which: str, rows: NDArray, d: NDArray) -> NDArray:
@@ -324,8 +345,11 @@ class _Commands:
         todo, d_todo = rows[stale], d[stale]
         if todo.size:
             segs = self.rows
-            c = compensate(self.wanted[which][todo], segs.offsets[todo], segs.scales[todo], segs.lines[todo], self.ctx, d_todo, rows_of(segs.tools, todo))
+            ends = np.zeros((todo.size, 3), dtype=bool)
+            c = compensate(self.wanted[which][todo], segs.offsets[todo], segs.scales[todo], segs.lines[todo], self.ctx, d_todo,
+                           rows_of(segs.tools, todo), ends)  # fmt: skip
             self.values[which][todo] = quantize(c, self.step[todo])
+            self.at_end[which][todo] = ends
             self.directions[which][todo] = d_todo
         return self.values[which][rows]
 
@@ -385,7 +409,7 @@ def _directional(rows: _Rows, ctx: PassContext, travel: Travel) -> _Solved:
         turn_start[rows] = commands("start", rows, d[rows])
     travel.held = d[-1].copy()
     travel.last = machine(out_end[-1:], slice(len(free) - 1, None))[0]
-    return _Solved(out_start, out_end, free, moved, turn, turn_start, ~flips, limit)
+    return _Solved(out_start, out_end, free, moved, turn, turn_start, ~flips, limit, commands.at_end["end"] & free[:, None])
 
 
 def _carry(rows: _Rows, out_end: NDArray, before: NDArray | None) -> None:

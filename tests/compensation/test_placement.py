@@ -80,3 +80,31 @@ def test_moves_after_a_return_are_corrected_from_the_home_position(tmp_path):
     for k in (0, 1, 4, 5, 6, 7, 9, 10):  # all but the G28's intermediate point and the two homes
         assert error_um(nominal, actual, k) < 0.2, (k, nominal[k], actual[k])
     pathcheck(tmp_path / "original.ngc", tmp_path / "rewritten.ngc", var, "--tol-mm", "0.05")
+
+
+TRAVEL_END = """G21 G90 G54
+G0 X10 Y10 Z20
+G1 X80 F300
+G53 G0 Y600
+G0 X20
+M2
+"""
+
+
+@pytest.mark.parametrize("jobs", [1, 2])
+def test_a_move_to_a_travel_end_stays_at_the_end(tmp_path, jobs):
+    """`G53 G0 Y600` where Y's travel ends at 600: the compensated command would pass the end
+    (the Y scale is short), so Y stops at 600 with a warning at the Y word; X and Z are
+    compensated there as elsewhere (also with the numeric work in a worker process)."""
+    var = var_file(tmp_path)
+    limits = {"X": (-5.0, 800.0), "Y": (-5.0, 600.0), "Z": (-5.0, 700.0)}
+    _, said, nominal, actual = run_both(tmp_path, TRAVEL_END, var, jobs, limits)
+    assert "t.ngc:4:8: warning: Y goes to the end of its travel (600 mm on the machine)" in said
+    assert "t.ngc:5:1: warning: Y goes to the end of its travel" in said
+    commanded = [m / np.concatenate([1 + np.array([5e-5, -4e-5, 3e-5]), np.ones(3)]) for _, m in actual]
+    assert len(actual) == len(nominal) == 4
+    assert abs(commanded[2][1] - 600.0) < 1e-7 and abs(commanded[3][1] - 600.0) < 1e-7
+    for k in range(4):
+        error = np.abs(actual[k][1][:3] - nominal[k][1][:3]) / UM
+        assert error[0] < 0.2 and error[2] < 0.2 and (k >= 2 or error[1] < 0.2), (k, error)
+    pathcheck(tmp_path / "original.ngc", tmp_path / "rewritten.ngc", var, "--tol-mm", "0.05")
