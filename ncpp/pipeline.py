@@ -155,6 +155,11 @@ INCREMENTAL_CYCLE = (
     "the program passes through uncompensated"
 )
 
+UNKNOWN_SETTING = (
+    "G92 or G10 L20 right after moves left as programmed in G90: it sets an offset from where the control "
+    "stands, which ncpp does not know exactly there; from this line on the program passes through uncompensated"
+)
+
 
 def warn_fixed(events: Iterable[Event], warnings: Warnings, file: str) -> Iterator[Event]:
     """Pass events through; warn where a series of moves the passes leave as programmed
@@ -181,12 +186,15 @@ def warn_fixed(events: Iterable[Event], warnings: Warnings, file: str) -> Iterat
             if fixed and fixed != series and fixed in UNCOMPENSATED:  # (a G28/G30's moves are the control's own)
                 warnings.warn(UNCOMPENSATED[fixed], Location(file, event.block.line, 1))
             series, absolute = fixed, event.context.absolute  # type: ignore[union-attr]
+        elif kind is Pass and event.setting is not None and series in UNCOMPENSATED and absolute:  # type: ignore[union-attr]
+            yield from _passed_on(event, events, warnings, file, UNKNOWN_SETTING)
+            return
         yield event
 
 
-def _passed_on(first: Event, rest: Iterator[Event], warnings: Warnings, file: str) -> Iterator[Pass]:
+def _passed_on(first: Event, rest: Iterator[Event], warnings: Warnings, file: str, why: str = INCREMENTAL_CYCLE) -> Iterator[Pass]:
     """`first`'s block (none of its events went by yet) and every later one, as `Pass`."""
-    warnings.warn(INCREMENTAL_CYCLE, Location(file, first.block.line, 1))
+    warnings.warn(why, Location(file, first.block.line, 1))
     last = None
     for event in chain((first,), rest):
         if event.block is not last:

@@ -39,7 +39,7 @@ from ncpp.motion.cycles import CANNED, DWELLING, PECKING, RAPID_DELTA_INCH, SPIN
 from ncpp.motion.expressions import ExpressionError, OutOfScope, Parameters, evaluate
 from ncpp.motion.offsets import SYSTEMS, WorkOffsets
 from ncpp.motion.flow import FIXED, RUN, SKIP, Flow
-from ncpp.motion.segments import COMP, CYCLE, FLOW, HOME, PLANE_AXES, Arc, Context, Event, Line, Pass, mark_off_path
+from ncpp.motion.segments import COMP, CYCLE, FLOW, HOME, PLANE_AXES, Arc, Context, Event, Line, Pass, Setting, mark_off_path
 from ncpp.motion.snapshot import attributes
 from ncpp.motion.tools import UntoldLengths
 from ncpp.program.blocks import STRAY_TAPE, UNREADABLE, Block, Comment, ExprWord, Statement, Word
@@ -345,6 +345,9 @@ class Interpreter:
         out = []
         for ev in events:
             if type(ev) is Pass:
+                if ev.setting is not None:  # set from where each run of the text stands: no one shift
+                    raise _OutOfScope("G92 or G10 L20 in a loop or subroutine (it sets an offset from where "
+                                      "the control stands, which compensation moves)", None)  # fmt: skip
                 if owner is None:
                     out.append(ev)
                 continue
@@ -969,6 +972,10 @@ class Interpreter:
     def _non_modal(self, block: Block, words: dict, code: float) -> Event | tuple[Event, ...] | None:
         given = [(AXIS_INDEX[letter], value) for letter, (value, _) in words.items() if letter in AXIS_INDEX]
         self._note_axes(given)
+        setting = None
+        if code == 92.0 or (code == 10.0 and words["L"][0] == 20.0):  # set from the current point
+            context = self.context()
+            setting = Pass(block, setting=Setting(tuple((i, v) for i, v in given if i < 3), context, (self.pos[0], self.pos[1], self.pos[2])))
         if code == 92.0:
             old = self.g92[:]
             for i, value in given:
@@ -1007,7 +1014,7 @@ class Interpreter:
             self.home[int(code)] = [self._machine(i) for i in range(9)]
         elif code in (28.0, 30.0):
             return self._go_home(block, given, self.home[int(code)])
-        return None
+        return setting
 
     def _go_home(self, block: Block, given: list[tuple[int, float]], home: list[float]) -> tuple[Event, ...]:
         """G28/G30: rapid to the (optional) intermediate point, then home the given axes (all if none).

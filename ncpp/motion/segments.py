@@ -136,13 +136,27 @@ class Arc:
         return -(d + full * (-self.turn - 1))
 
 
+@dataclass(frozen=True, slots=True)
+class Setting:
+    """What a G92 or G10 L20 block sets from where the control stands: the offset that gives the
+    current point the block's coordinates.  The control stands at the compensated point, off
+    `position` by `shift`; written with their values moved by it, the block sets the offset the
+    program means (apply_error_map fills `shift`, the writer writes it)."""
+
+    values: tuple[tuple[int, float], ...]  # (axis 0-2, the coordinate the block gives it), program units
+    context: Context  # the frame the block is read in
+    position: Point  # the programmed point the tool stands at, in that frame
+    shift: Point | None = None  # where the control stands minus `position` (None: not known, or none)
+
+
 @dataclass(slots=True)
 class Pass:
-    """A block that makes no motion; written back as it was."""
+    """A block that makes no motion; written back as it was (a `Setting`'s values moved by its shift)."""
 
     block: Block
     skipped: bool = False  # the program does not run it (an untaken branch, a subroutine's definition)
     motion: float | None = None  # an o-word control line's: the modal motion (G0-G3, a cycle) where it runs
+    setting: Setting | None = None  # a G92 or G10 L20 block's
 
 
 Segment = Union[Line, Arc]
@@ -160,4 +174,4 @@ def mark_off_path(moves: list, compensating: bool, off_path: bool) -> bool:
     return compensating
 
 
-__all__ = ["COMP", "CYCLE", "FLOW", "HOME", "mark_off_path", "Arc", "Context", "Event", "Line", "Pass", "Point", "Segment", "PLANES", "PLANE_AXES", "EXTRA_AXES", "replace"]
+__all__ = ["COMP", "CYCLE", "FLOW", "HOME", "mark_off_path", "Arc", "Context", "Event", "Line", "Pass", "Point", "Segment", "Setting", "PLANES", "PLANE_AXES", "EXTRA_AXES", "replace"]

@@ -16,7 +16,7 @@ start is compensated with its own direction and a step move is inserted.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, fields, replace
 from itertools import chain
 from typing import Iterable, Iterator
 
@@ -24,7 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ncpp.errors import Location, NcppError
-from ncpp.motion.segments import Arc, Event, Line
+from ncpp.motion.segments import Arc, Event, Line, Pass
 from ncpp.program.blocks import Word
 from ncpp.passes.context import CutLine, PassContext, deviation
 from ncpp.passes.kernels import run_ahead
@@ -65,7 +65,7 @@ def _chunks(events: Iterable[Event], ctx: PassContext) -> Iterator[list[Event]]:
         if cut is not None:
             cut.before_writing(chunk, last, ctx)
         if solving is None:  # no segments
-            yield chunk
+            yield _placed(chunk, last)
             continue
         try:
             solved = solving.result()
@@ -274,7 +274,7 @@ def _written(chunk: list[Event], segs: list, rows: _Rows, solved: _Solved, last)
     start = None  # where the output is: the previous segment's compensated end
     for i, seg, row, end in zip(range(len(segs)), segs, code, ends):
         if i in between:
-            out += between[i]
+            out += _placed(between[i], last if i == 0 else _ended(segs[i - 1], solved.end[i - 1]))
         start = starts_from.get(i, start)
         if row & _FREE:
             begin = seg.start if start is None else start
@@ -289,7 +289,25 @@ def _written(chunk: list[Event], segs: list, rows: _Rows, solved: _Solved, last)
                 out.append(Line(start, seg.start, False, seg.feed, seg.block, seg.context, seg.extra, True))
             out.append(seg)
         start = end
-    out += between.get(len(segs), ())
+    if len(segs) in between:
+        out += _placed(between[len(segs)], _ended(segs[-1], solved.end[-1]))
+    return out
+
+
+def _placed(events: list[Event], last: Line | Arc | None) -> list[Event]:
+    """The events, a G92 / G10 L20's `Setting` told where the control stands (`last`: the last
+    segment written, with its compensated end; None: nothing written yet, no shift)."""
+    if last is None:
+        return events
+    out = events
+    for k, event in enumerate(events):
+        setting = event.setting if type(event) is Pass else None
+        if setting is not None:
+            at = _end_in_frame_of(last, setting)  # type: ignore[arg-type]
+            shift = (at[0] - setting.position[0], at[1] - setting.position[1], at[2] - setting.position[2])
+            if out is events:
+                out = list(events)
+            out[k] = Pass(event.block, event.skipped, event.motion, replace(setting, shift=shift))
     return out
 
 

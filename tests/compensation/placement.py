@@ -32,11 +32,11 @@ class ScaleMap:
         return np.asarray(P, dtype=float) * SCALE
 
 
-def var_file(folder: Path, g54=(400.0, 350.0, 300.0), g28=(0.0, 0.0, 0.0), g30=(0.0, 0.0, 0.0)) -> Path:
-    """A LinuxCNC parameter file (inches: the stand-alone rs274's machine units) with G54's zero
-    and the G28 and G30 positions, in machine mm."""
+def var_file(folder: Path, g54=(400.0, 350.0, 300.0), g28=(0.0, 0.0, 0.0), g30=(0.0, 0.0, 0.0), g55=(100.0, 120.0, 140.0)) -> Path:
+    """A LinuxCNC parameter file (inches: the stand-alone rs274's machine units) with G54's and
+    G55's zeros and the G28 and G30 positions, in machine mm."""
     values = {5220: 1.0}
-    for first, vector in ((5161, g28), (5181, g30), (5221, g54)):
+    for first, vector in ((5161, g28), (5181, g30), (5221, g54), (5241, g55)):
         values.update({first + i: v / 25.4 for i, v in enumerate(vector)})
     path = folder / "placement.var"
     path.write_text("".join(f"{k} {v!r}\n" for k, v in sorted(values.items())))

@@ -108,3 +108,74 @@ def test_a_move_to_a_travel_end_stays_at_the_end(tmp_path, jobs):
         error = np.abs(actual[k][1][:3] - nominal[k][1][:3]) / UM
         assert error[0] < 0.2 and error[2] < 0.2 and (k >= 2 or error[1] < 0.2), (k, error)
     pathcheck(tmp_path / "original.ngc", tmp_path / "rewritten.ngc", var, "--tol-mm", "0.05")
+
+
+SETTINGS = """G21 G90 G54
+G0 X10 Y10 Z20
+G1 X50 Y30 F300
+G92 X0 Y0
+G1 X20 Y10
+G52 X5
+G1 X10
+G52 X0
+G92.1
+G1 X30 Y40
+G10 L20 P1 X0 Y0
+G1 X15 Y5
+G10 L20 P2 X0 Y0 Z[-2 * 3]
+G55
+G1 X3 Y4 Z-1
+G92 Z5
+G91
+G1 X5 Y2
+G92 X10 Y10
+G1 X5 Y2
+G92.2
+G1 X-4
+G92.3
+G90 G1 X1 Y1 Z2
+M2
+"""
+
+
+def offsets_set(calls) -> list[tuple[str, tuple[float, ...]]]:
+    return [(name, numbers) for name, numbers in calls if name in ("SET_G92_OFFSET", "SET_G5X_OFFSET")]
+
+
+def test_g92_and_g10_l20_set_the_offsets_the_program_means(tmp_path):
+    """G92 and G10 L20 (P1, P2, an expression, in G91) at compensated points: written with their
+    values moved by the correction where the tool stands, they set the offsets rs274 sets for
+    the original program, to 7 decimals; G52, G92.1-G92.3 follow; every move lands within 0.2 µm."""
+    from tests.compensation.placement import rs274
+
+    var = var_file(tmp_path)
+    out, said, nominal, actual = run_both(tmp_path, SETTINGS, var)
+    assert "\nG92 X0 Y0\n" not in out and "\nG10 L20 P2 X" in out and "Z[" not in out
+    original, rewritten = (offsets_set(rs274(tmp_path / name, var)) for name in ("original.ngc", "rewritten.ngc"))
+    assert [name for name, _ in original] == [name for name, _ in rewritten]
+    # exact where the tool stands at a G90 point; in G91 the control stands where the increments as
+    # written add up to, which a map without reversal errors leaves off the grid: one last digit
+    for k, ((name, want), (_, got)) in enumerate(zip(original, rewritten)):
+        assert np.abs(np.array(want) - np.array(got)).max() < (2e-7 if k < 10 else 1.01e-4), (name, want, got)
+    assert len(actual) == len(nominal)
+    for k in range(len(nominal)):
+        assert error_um(nominal, actual, k) < 0.2, (k, nominal[k], actual[k])
+    pathcheck(tmp_path / "original.ngc", tmp_path / "rewritten.ngc", var, "--tol-mm", "0.05")
+
+
+@pytest.mark.parametrize("middle, why", [
+    ("G81 X20 Y20 Z-2 R2 F100\nG80\nG92 X0 Y0\n", "G92 or G10 L20 right after moves left as programmed in G90"),
+    ("o100 repeat [2]\nG1 X[#<_x> + 1]\nG10 L20 P1 X0\no100 endrepeat\n", "G92 or G10 L20 in a loop or subroutine"),
+])  # fmt: skip
+def test_a_setting_where_ncpp_cannot_say_where_the_control_stands_passes_through(tmp_path, middle, why):
+    """After a canned cycle in G90 (its G98 retract ends at the compensated level it started from),
+    or run in a loop (each run from another point), a G92 or G10 L20 cannot be given one shift:
+    from there on the program passes through as it is, with a warning naming the line."""
+    from tests.compensation.placement import compensate
+
+    program = f"G21 G90 G54\nG0 X10 Y10 Z20\nG1 X50 F300\n{middle}G1 X20 Y10\nM2\n"
+    out, said = compensate(program.encode(), var_file(tmp_path))
+    setting = program.index("G92") if "G92" in program else program.index("G10")
+    line = program[:setting].count("\n") + 1
+    assert f"t.ngc:{line}:" in said and why in said
+    assert out.decode().endswith(program[setting if "G92" in program else program.index("o100"):])

@@ -17,7 +17,7 @@ from dataclasses import dataclass, replace
 from operator import itemgetter
 from typing import BinaryIO, Iterable, Iterator
 
-from ncpp.motion.segments import Arc, Context, Event, Line, Pass
+from ncpp.motion.segments import Arc, Context, Event, Line, Pass, Setting
 from ncpp.program.blocks import DIGITS_AS_ONE, Block, Comment, ExprWord, Statement, Word
 from ncpp.program.numbers import NumberStyle, format_number
 from ncpp.program.writer import EditPlan, _literal, _with_motion, set_words, spelling
@@ -151,6 +151,8 @@ class IsoWriter:
         facts = self._read_block(block)
         if facts.flow:
             return self._write_control(block, first)
+        if type(first) is Pass and first.setting is not None and first.setting.shift is not None:
+            return [self._setting_text(block, first.setting) + block.eol]
         motion = [e for e in group if type(e) is Line or type(e) is Arc]
         for segment in motion:
             if segment.changed:
@@ -328,6 +330,19 @@ class IsoWriter:
         self.program_motion = self.output_motion = None
         self._last_end = None
         return lines
+
+    # -- G92, G10 L20 -------------------------------------------------------------
+    def _setting_text(self, block: Block, setting: Setting) -> str:
+        """A G92 / G10 L20 block with its axis values moved by where the control stands off the
+        programmed point (`Setting.shift`): the offset the control computes from them is the
+        program's.  After it the output's position is in another frame: the next move writes
+        every axis it knows."""
+        self._last_end = None
+        moved = [(axis, value + setting.shift[axis]) for axis, value in setting.values if setting.shift[axis] != 0.0]  # type: ignore[index]
+        if not moved:
+            return block.raw
+        styles = self._units(setting.context.inch).styles
+        return set_words(_literal_geometry(block), {AXES[axis]: format_number(value, styles[AXES[axis]]) for axis, value in moved})
 
     # -- numbers as written -----------------------------------------------------
     def _moved(self, axis: str, value: float, segment: Line | Arc) -> bool:
