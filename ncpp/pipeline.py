@@ -52,6 +52,7 @@ class ErrorSource:
     digest: str
     max_correction: float = 0.5
     limits: dict = field(default_factory=dict)
+    rotary_xyz_are_axis_positions: bool = False  # the machine file's [compensation] key
 
     @classmethod
     def from_machine_file(cls, path: str) -> "ErrorSource":
@@ -59,7 +60,7 @@ class ErrorSource:
 
         machine = load_machine(path)
         limits = {a: lim for a, lim in machine.limits.items()}
-        return cls(MachineMap(machine), Path(path).name, _digest(path), machine.max_correction_mm, limits)
+        return cls(MachineMap(machine), Path(path).name, _digest(path), machine.max_correction_mm, limits, machine.rotary_xyz_are_axis_positions)
 
     @classmethod
     def from_measurement(cls, path: str) -> "ErrorSource":
@@ -316,6 +317,7 @@ def make_context(source: ErrorSource, tolerance: float, warnings: Warnings, file
         model=source.model,
         tolerance=tolerance,
         max_correction=source.max_correction,
+        rotary_xyz_are_axis_positions=source.rotary_xyz_are_axis_positions,
         limits=source.limits,
         directional=is_directional(source.model, source.limits),
         iterations=iterations_for(source.model, source.limits, INVERSE_BUDGET),

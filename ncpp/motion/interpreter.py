@@ -69,7 +69,7 @@ _GROUP_CODES = {
     5: (93, 94, 95),
     6: (20, 21),
     7: (40, 41, 42, 41.1, 42.1),
-    8: (43, 43.1, 43.2, 49),
+    8: (43, 43.1, 43.2, 43.4, 43.5, 49),
     10: (98, 99),
     12: (54, 55, 56, 57, 58, 59, 59.1, 59.2, 59.3),
     13: (61, 61.1, 64),
@@ -90,6 +90,7 @@ OUT_OF_SCOPE_G = {
     **{c: "UVW-plane arcs" for c in (17.1, 18.1, 19.1)},
     7.0: "lathe diameter mode",
     43.2: "additional tool length offset without H",
+    43.4: "tool-centre-point control", 43.5: "tool-centre-point control",
     15.0: "polar coordinates", 16.0: "polar coordinates",
     50.0: "scaling", 51.0: "scaling", 50.1: "mirroring", 51.1: "mirroring",
     54.1: "extended work offsets", 65.0: "macro call", 66.0: "modal macro call", 67.0: "modal macro call",
@@ -429,6 +430,7 @@ class Interpreter:
                 self.inch,
                 tuple(offset[i] + self.g92[i] + self.tool[i] for i in range(3)),  # type: ignore[arg-type]
                 tuple(self.tool[:3]),  # type: ignore[arg-type]
+                self.inverse_time,
             )
         return self._context
 
@@ -593,6 +595,7 @@ class Interpreter:
             block,
             self._context or self.context(),
             (end[3], end[4], end[5], end[6], end[7], end[8]) if self.uses_extra_axes else (),
+            extra_start=(pos[3], pos[4], pos[5], pos[6], pos[7], pos[8]) if self.uses_extra_axes else (),
         )
 
     def _modal_move(self, block: Block, words: dict, motion: float) -> Event:
@@ -651,7 +654,7 @@ class Interpreter:
 
         # rs274ngc's order of execution (interp_execute.cc, convert_g)
         if 5 in gcodes:
-            self.inverse_time = gcodes[5][0] == 93.0
+            self._set(inverse_time=gcodes[5][0] == 93.0)
         if "F" in words:
             self._set_feed(block, words["F"])
         if 2 in gcodes:
@@ -1061,6 +1064,7 @@ class Interpreter:
             block,
             self._context or self.context(),
             tuple(end[3:]) if self.uses_extra_axes else (),
+            extra_start=tuple(pos[3:]) if self.uses_extra_axes else (),
         )
         self.pos = end
         return line
@@ -1329,6 +1333,7 @@ class Interpreter:
             block,
             self._context or self.context(),
             (end[3], end[4], end[5], end[6], end[7], end[8]) if self.uses_extra_axes else (),
+            extra_start=(start[3], start[4], start[5], start[6], start[7], start[8]) if self.uses_extra_axes else (),
         )
 
     def _center_r(self, block, word, x0, y0, x1, y1, radius, motion) -> tuple[float, float]:

@@ -48,6 +48,7 @@ class Context:
     inch: bool = False  # G20 / G21
     offset: Point = (0.0, 0.0, 0.0)  # machine minus program position (work offset, G92, tool length), program units
     tool: Point = (0.0, 0.0, 0.0)  # the tool length offset (in `offset`): the tool tip is this far from the gauge point
+    inverse_time: bool = False  # G93: a feed move's F is 1 / its time in minutes
 
     @property
     def tool_mm(self) -> Point:
@@ -85,6 +86,7 @@ class Line:
     # A fixed move's X Y Z the control puts at their programmed end; the others run their programmed
     # increment from where the control stands (None: all of them in G90, none in G91)
     placed: tuple[bool, bool, bool] | None = None
+    extra_start: tuple[float, ...] = ()  # start positions of A B C U V W (as `extra`), when the program uses them
 
     def length(self) -> float:
         return math.dist(self.start, self.end)
@@ -112,6 +114,7 @@ class Arc:
     # a piece replace_arcs made: the direction its plane's normal axis was compensated for
     # (+1, -1: the one that axis last moved in, which the machine holds it in; 0: the mean)
     normal: int = 0
+    extra_start: tuple[float, ...] = ()  # as `Line.extra_start`
 
     @property
     def clockwise(self) -> bool:

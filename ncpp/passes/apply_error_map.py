@@ -278,10 +278,11 @@ def _written(chunk: list[Event], segs: list, rows: _Rows, solved: _Solved, last)
         start = starts_from.get(i, start)
         if row & _FREE:
             begin = seg.start if start is None else start
-            if row & _TURNS:  # the reversal step, then the line from where it ends
-                out.append(Line(begin, targets[i], seg.rapid, seg.feed, seg.block, seg.context, seg.extra, True))
+            if row & _TURNS:  # the reversal step (the axes beyond X Y Z still), then the line from where it ends
+                still = seg.extra_start or seg.extra
+                out.append(Line(begin, targets[i], seg.rapid, seg.feed, seg.block, seg.context, still, True, extra_start=still))
                 begin = targets[i]
-            out.append(Line(begin, end, seg.rapid, seg.feed, seg.block, seg.context, seg.extra, True))
+            out.append(Line(begin, end, seg.rapid, seg.feed, seg.block, seg.context, seg.extra, True, extra_start=seg.extra_start))
         else:
             if row & _MOVED:
                 seg = _moved_arc(seg, moved_starts[i], end)
