@@ -782,7 +782,7 @@ class Interpreter:
             self._fail("D word with no G41, G41.1, G42, G42.1, G71, or G96 to use it", block, words["D"][1])
         if "E" in words and motion != 76.0 and not mcodes.keys() & {66.0, 67.0, 68.0}:
             self._fail("E word with no G70, G76, M66, M67 or M68 to use it", block, words["E"][1])
-        if "H" in words and gcodes.get(8, (None,))[0] not in (43.0, 43.2) and motion != 76.0:
+        if "H" in words and gcodes.get(8, (None,))[0] not in (43.0, 43.2, 43.4, 43.5) and motion != 76.0:
             self._fail("H word with no G43 or G76 to use it", block, words["H"][1])
         for letter in "IJ":
             if letter in words and motion not in _ARC_LIKE and mode0 != 10.0:

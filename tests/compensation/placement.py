@@ -107,3 +107,36 @@ def run_both(tmp_path: Path, program: str, var: Path, jobs: int = 1, limits=LIMI
     nominal = machine_moves(rs274(original, var))
     actual = landed(machine_moves(rs274(rewritten, var)))
     return out.decode(), said, nominal, actual
+
+
+@dataclass(frozen=True)
+class BowMap:
+    """A machine whose X error bows along Y (BOW mm per mm² from Y 350): lines along Y are split."""
+
+    def deviation(self, P, direction=None, tool_offset=None):
+        P = np.asarray(P, dtype=float)
+        out = np.zeros_like(P)
+        out[:, 0] = BOW * (P[:, 1] - 350.0) ** 2
+        return out
+
+
+BOW = 1e-5
+
+
+def bowed(moves) -> list[tuple[str, np.ndarray]]:
+    """Where the tool lands on the BowMap machine for each commanded move."""
+    out = []
+    for name, m in moves:
+        landed_at = m.copy()
+        landed_at[0] += BOW * (m[1] - 350.0) ** 2
+        out.append((name, landed_at))
+    return out
+
+
+def compensate_with(data: bytes, model, var: Path, rotary: bool, file: str = "t.ngc") -> tuple[bytes, str]:
+    """`compensate` with another map, and the machine file's rotary key (`file`: its name tells the dialect)."""
+    source = ErrorSource(model, "model", "0" * 16, 0.5, dict(LIMITS), rotary)
+    said, out = io.StringIO(), io.BytesIO()
+    offsets = WorkOffsets.given({}, var_file=var, unit_mm=25.4)
+    process(io.BytesIO(data), out, file=file, source=source, warnings=Warnings(stream=said), offsets=offsets)
+    return out.getvalue(), said.getvalue()

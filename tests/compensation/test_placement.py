@@ -4,8 +4,14 @@ G92 and G10 L20 set where the tool stands, travel ends, rotary axes."""
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
+
 import numpy as np
 import pytest
+
+from ncpp.errors import NcppError
 
 from tests.compensation.placement import pathcheck, run_both, var_file
 
@@ -179,3 +185,120 @@ def test_a_setting_where_ncpp_cannot_say_where_the_control_stands_passes_through
     line = program[:setting].count("\n") + 1
     assert f"t.ngc:{line}:" in said and why in said
     assert out.decode().endswith(program[setting if "G92" in program else program.index("o100"):])
+
+
+ROTARY = """G21 G90 G54 G94
+G0 X0 Y-20 Z10 A0 C0
+G1 Z0 F500
+G93
+G1 Y20 A30 C-45 F4
+G1 X10 Y-20 A10 F2.5
+G1 X20 F10
+G94 G1 Y25 C90 F600
+G1 X0 A0
+M2
+"""
+
+
+def nominal_at(nominal, point: np.ndarray) -> tuple[float, np.ndarray]:
+    """(distance in mm from `point`'s X Y Z to the nominal path of feed moves, the A..C the
+    nominal moves have there, interpolated along the nearest one)."""
+    best = (np.inf, None)
+    for (_, a), (name, b) in zip(nominal, nominal[1:]):
+        d = b[:3] - a[:3]
+        t = 0.0 if not d.any() else float(np.clip(np.dot(point[:3] - a[:3], d) / np.dot(d, d), 0.0, 1.0))
+        distance = float(np.linalg.norm(a[:3] + t * d - point[:3]))
+        if distance < best[0] - 1e-9:
+            best = (distance, a[3:] + t * (b[3:] - a[3:]))
+    return best
+
+
+def test_moves_that_turn_rotary_axes_are_refused_unless_the_machine_file_says_xyz_are_axis_positions(tmp_path):
+    from tests.compensation.placement import BowMap, compensate_with
+
+    with pytest.raises(NcppError) as refused:
+        compensate_with(ROTARY.encode(), BowMap(), var_file(tmp_path), False)
+    assert str(refused.value).startswith("t.ngc:5:8: this move turns A and C")
+    assert "rotary_xyz_are_axis_positions = true" in str(refused.value)
+
+
+@pytest.mark.parametrize("tcp", ["G43.4 H1", "G43.5 H1"])
+def test_tool_centre_point_control_is_refused(tmp_path, tcp):
+    from tests.compensation.placement import BowMap, compensate_with
+
+    program = ROTARY.replace("G93\n", f"{tcp}\nG93\n")
+    with pytest.raises(NcppError) as refused:
+        compensate_with(program.encode(), BowMap(), var_file(tmp_path), True)
+    assert str(refused.value).startswith(f"t.ngc:4:1: {tcp.split()[0]} turns tool-centre-point control on")
+
+
+def test_split_moves_turn_their_share_and_take_their_share_of_the_time(tmp_path):
+    """With X Y Z axis positions: the lines along Y are split (the X error bows along Y); rs274
+    accepts the output (an F on every G93 piece); every piece ends on the nominal path within
+    1 µm, its A and C where the nominal move has them there (within 0.0002°); in G93 the
+    pieces' times add up to the move's; pathcheck (1° counted as 1 mm) passes."""
+    from tests.compensation.placement import BowMap, bowed, compensate_with, machine_moves, rs274
+
+    var = var_file(tmp_path)
+    out, _ = compensate_with(ROTARY.encode(), BowMap(), var, True)
+    original, rewritten = tmp_path / "original.ngc", tmp_path / "rewritten.ngc"
+    original.write_text(ROTARY)
+    rewritten.write_bytes(out)
+    nominal = machine_moves(rs274(original, var))
+    calls = rs274(rewritten, var)
+    actual = bowed(machine_moves(calls))
+    assert len(actual) > len(nominal) + 4  # split
+    for k, (_, point) in enumerate(actual[1:], 1):
+        distance, rotary = nominal_at(nominal, point)
+        assert distance < 1e-3 and np.abs(point[3:] - rotary).max() < 2e-4, (k, point, distance, rotary)
+    # the G93 feeds: each piece's time (1/F) adds up to its move's (1/4 + 1/2.5 + 1/10 min)
+    feeds, mode = [], 0
+    for name, numbers in calls:
+        if name == "SET_FEED_MODE":
+            mode = int(numbers[-1])
+        elif name == "SET_FEED_RATE" and mode == 1:
+            feeds.append(numbers[0])
+    text = out.decode()
+    g93 = text[text.index("G93"): text.index("G94 G1")]
+    times = [1 / float(f) for f in __import__("re").findall(r"F([\d.]+)", g93)]
+    assert abs(sum(times) - (1 / 4 + 1 / 2.5 + 1 / 10)) < 1e-6 and len(times) > 3
+    pathcheck(original, rewritten, var, "--tol-mm", "0.05", "--deg-per-mm", "1")
+
+
+def test_the_impeller_compensates_on_a_machine_whose_xyz_are_axis_positions(tmp_path):
+    """The corpus's 5-axis impeller (G93, A and C turning; its M428, a user M code rs274 does not
+    know, left out) on HR5B told its X Y Z are axis positions: rs274 accepts the output (an F on
+    every G93 piece) and pathcheck, 1° counted as 1 mm, finds it within 50 µm of the original."""
+    from tests.conftest import CORPUS, ROOT
+
+    source = CORPUS / "iso_gcode/linuxcnc/large/impeller-7bl-xyzac.ngc"
+    if not source.exists():
+        pytest.skip("corpus not available")
+    lines = source.read_text().splitlines(keepends=True)
+    program = tmp_path / "impeller.ngc"
+    program.write_text("".join(line for line in lines[:600] if not line.startswith("M428")) + "M2\n")
+    machine = tmp_path / "hr5b.toml"
+    machine.write_text((ROOT / "samples/machines/hr5b.toml").read_text().replace(
+        "max_correction_mm = 0.5", "max_correction_mm = 0.5\nrotary_xyz_are_axis_positions = true"))  # fmt: skip
+    out = tmp_path / "out.ngc"
+    proc = subprocess.run([sys.executable, "-m", "ncpp", "compensate", "--machine", str(machine), "--work-offset", "400,350,300",
+                           str(program), "-o", str(out)], capture_output=True, text=True, env={**os.environ, "PYTHONPATH": str(ROOT)})  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    from tests.compensation.placement import rs274
+
+    var = var_file(tmp_path, g54=(0.0, 0.0, 0.0))
+    assert len(rs274(out, var)) > len(rs274(program, var))  # reversal steps, each with its F
+    pathcheck(program, out, var, "--tol-mm", "0.05", "--deg-per-mm", "1")
+
+
+@pytest.mark.parametrize("file, program, name", [
+    ("t.h", "BEGIN PGM T MM\nL X+10 Y+10 R0 F100\nM128\nL X+20 A+5\nEND PGM T MM\n", "M128"),
+    ("t.h", "BEGIN PGM T MM\nL X+10 Y+10 R0 F100\nFUNCTION TCPM F TCP AXIS POS PATHCTRL AXIS\nL X+20\nEND PGM T MM\n", "FUNCTION TCPM"),
+    ("t.mpf", "G54\nG1 X10 Y10 F100\nTRAORI\nG1 X10 Y10 A5 F100\nM30\n", "TRAORI"),
+])  # fmt: skip
+def test_tool_centre_point_control_is_refused_in_klartext_and_sinumerik(tmp_path, file, program, name):
+    from tests.compensation.placement import ScaleMap, compensate_with
+
+    with pytest.raises(NcppError) as refused:
+        compensate_with(program.encode(), ScaleMap(), var_file(tmp_path), True, file)
+    assert str(refused.value).startswith(f"{file}:3:1: {name} turns tool-centre-point control on")
