@@ -60,7 +60,8 @@ class ErrorSource:
 
         machine = load_machine(path)
         limits = {a: lim for a, lim in machine.limits.items()}
-        return cls(MachineMap(machine), Path(path).name, _digest(path), machine.max_correction_mm, limits, machine.rotary_xyz_are_axis_positions)
+        rotary = machine.rotary_xyz_are_axis_positions
+        return cls(MachineMap(machine), Path(path).name, _digest(path), machine.max_correction_mm, limits, rotary)
 
     @classmethod
     def from_measurement(cls, path: str) -> "ErrorSource":

@@ -977,8 +977,8 @@ class Interpreter:
         self._note_axes(given)
         setting = None
         if code == 92.0 or (code == 10.0 and words["L"][0] == 20.0):  # set from the current point
-            context = self.context()
-            setting = Pass(block, setting=Setting(tuple((i, v) for i, v in given if i < 3), context, (self.pos[0], self.pos[1], self.pos[2])))
+            here = (self.pos[0], self.pos[1], self.pos[2])
+            setting = Pass(block, setting=Setting(tuple((i, v) for i, v in given if i < 3), self.context(), here))
         if code == 92.0:
             old = self.g92[:]
             for i, value in given:

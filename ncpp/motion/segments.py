@@ -177,4 +177,5 @@ def mark_off_path(moves: list, compensating: bool, off_path: bool) -> bool:
     return compensating
 
 
-__all__ = ["COMP", "CYCLE", "FLOW", "HOME", "mark_off_path", "Arc", "Context", "Event", "Line", "Pass", "Point", "Segment", "Setting", "PLANES", "PLANE_AXES", "EXTRA_AXES", "replace"]
+__all__ = ["COMP", "CYCLE", "FLOW", "HOME", "mark_off_path", "Arc", "Context", "Event", "Line", "Pass", "Point", "Segment",
+           "Setting", "PLANES", "PLANE_AXES", "EXTRA_AXES", "replace"]

@@ -433,8 +433,8 @@ def _directional(rows: _Rows, ctx: PassContext, travel: Travel) -> _Solved:
 
 def _carry(rows: _Rows, out_end: NDArray, before: NDArray | None) -> None:
     """Move the ends of the carried rows (left as programmed, in G91: the moves of loops and
-    subroutines, and under cutter compensation; the axes a G28/G30 does not put at its intermediate
-    or home point) by where the control stands when each run of them starts: the program's increments run from the compensated end before them, which is
+    subroutines, and under cutter compensation; the axes a G28/G30 does not put at its
+    intermediate or home point) by where the control stands when each run of them starts: the program's increments run from the compensated end before them, which is
     off their programmed start by that end's correction.  `before`: the previous chunk's last
     end, in the first row's frame."""
     carried, offsets, scales = rows.carried, rows.offsets, rows.scales

@@ -25,6 +25,8 @@ from ncpp.passes.geometry import chunked
 from ncpp.program.blocks import Block, Statement, Word
 
 ROTARY = "ABC"
+# Klartext's FUNCTION TCPM, Sinumerik's TRAORI (their statements' first two parts), by name
+_TCP_STATEMENTS = ((("FUNCTION", "TCPM"), "FUNCTION TCPM"), (("TRAORI", ()), "TRAORI"))
 # The least part of a G93 move's time a piece of it is given (a µm reversal step): its F stays finite
 LEAST_SHARE = 1e-4
 
@@ -83,8 +85,10 @@ def _refuse_tool_centre_point(block: Block, file: str) -> None:
             if code not in (("G", 43.4), ("G", 43.5), ("M", 128.0)):
                 continue
             name = f"{item.letter}{item.value:g}"  # type: ignore[union-attr]
-        elif kind is Statement and item.kind in ("keyword", "call") and item.node[:2] in (("FUNCTION", "TCPM"), ("TRAORI", ())):  # type: ignore[union-attr]
-            name = " ".join(item.node[:2]) if item.kind == "keyword" else "TRAORI"  # type: ignore[union-attr]
+        elif kind is Statement and item.node and item.node[0] in ("FUNCTION", "TRAORI"):  # type: ignore[union-attr]
+            name = next((name for key, name in _TCP_STATEMENTS if item.node[:2] == key), None)  # type: ignore[union-attr]
+            if name is None:
+                continue
         else:
             continue
         raise NcppError(f"{name} turns tool-centre-point control on: the programmed X Y Z are then the tool tip's, "

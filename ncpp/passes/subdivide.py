@@ -115,5 +115,9 @@ def _split(line: Line, n: int) -> list[Line]:
     a, b = np.array(line.start), np.array(line.end)
     cuts = [tuple(a + (b - a) * (i / n)) for i in range(n + 1)]
     cuts[0], cuts[-1] = line.start, line.end
-    extras = [line.extra_start] + [interpolated(line.extra_start, line.extra, i / n) for i in range(1, n + 1)] if turns(line) else [line.extra] * (n + 1)
-    return [Line(cuts[i], cuts[i + 1], line.rapid, line.feed, line.block, line.context, extras[i + 1], line.changed, extra_start=extras[i]) for i in range(n)]
+    if turns(line):
+        extras = [line.extra_start] + [interpolated(line.extra_start, line.extra, i / n) for i in range(1, n + 1)]
+    else:
+        extras = [line.extra] * (n + 1)
+    return [Line(cuts[i], cuts[i + 1], line.rapid, line.feed, line.block, line.context, extras[i + 1], line.changed,
+                 extra_start=extras[i]) for i in range(n)]  # fmt: skip
