@@ -47,6 +47,7 @@ class ErrorSource:
     digest: str
     max_correction: float = 0.5
     limits: dict = field(default_factory=dict)
+    rotary_xyz_are_axis_positions: bool = False  # the machine file's [compensation] key
 
     @classmethod
     def from_machine_file(cls, path: str) -> "ErrorSource":
@@ -54,7 +55,8 @@ class ErrorSource:
 
         machine = load_machine(path)
         limits = {a: lim for a, lim in machine.limits.items()}
-        return cls(MachineMap(machine), Path(path).name, _digest(path), machine.max_correction_mm, limits)
+        rotary = machine.rotary_xyz_are_axis_positions
+        return cls(MachineMap(machine), Path(path).name, _digest(path), machine.max_correction_mm, limits, rotary)
 
     @classmethod
     def from_measurement(cls, path: str) -> "ErrorSource":
@@ -150,6 +152,11 @@ INCREMENTAL_CYCLE = (
     "the program passes through uncompensated"
 )
 
+UNKNOWN_SETTING = (
+    "G92 or G10 L20 right after moves left as programmed in G90: it sets an offset from where the control "
+    "stands, which ncpp does not know exactly there; from this line on the program passes through uncompensated"
+)
+
 
 def warn_fixed(events: Iterable[Event], warnings: Warnings, file: str) -> Iterator[Event]:
     """Pass events through; warn where a series of moves the passes leave as programmed
@@ -173,15 +180,18 @@ def warn_fixed(events: Iterable[Event], warnings: Warnings, file: str) -> Iterat
             if not fixed and series == CYCLE and absolute and not event.context.absolute:  # type: ignore[union-attr]
                 yield from _passed_on(event, events, warnings, file)
                 return
-            if fixed and fixed != series:
+            if fixed and fixed != series and fixed in UNCOMPENSATED:  # (a G28/G30's moves are the control's own)
                 warnings.warn(UNCOMPENSATED[fixed], Location(file, event.block.line, 1))
             series, absolute = fixed, event.context.absolute  # type: ignore[union-attr]
+        elif kind is Pass and event.setting is not None and series in UNCOMPENSATED and absolute:  # type: ignore[union-attr]
+            yield from _passed_on(event, events, warnings, file, UNKNOWN_SETTING)
+            return
         yield event
 
 
-def _passed_on(first: Event, rest: Iterator[Event], warnings: Warnings, file: str) -> Iterator[Pass]:
+def _passed_on(first: Event, rest: Iterator[Event], warnings: Warnings, file: str, why: str = INCREMENTAL_CYCLE) -> Iterator[Pass]:
     """`first`'s block (none of its events went by yet) and every later one, as `Pass`."""
-    warnings.warn(INCREMENTAL_CYCLE, Location(file, first.block.line, 1))
+    warnings.warn(why, Location(file, first.block.line, 1))
     last = None
     for event in chain((first,), rest):
         if event.block is not last:
@@ -276,6 +286,7 @@ def make_context(source: ErrorSource, tolerance: float, warnings: Warnings, file
         model=source.model,
         tolerance=tolerance,
         max_correction=source.max_correction,
+        rotary_xyz_are_axis_positions=source.rotary_xyz_are_axis_positions,
         limits=source.limits,
         directional=is_directional(source.model, source.limits),
         iterations=iterations_for(source.model, source.limits, INVERSE_BUDGET),

@@ -52,6 +52,10 @@ A complete example::
 
     [compensation]
     max_correction_mm = 0.5        # refuse corrections larger than this
+    rotary_xyz_are_axis_positions = false  # true: the programmed X Y Z are the linear axes'
+                                   # positions also while A, B or C turn (the control runs no
+                                   # tool-centre-point kinematics), so such moves are compensated
+                                   # (their pieces each turn their share); false (default): refused
 
     [meta]                         # free-form, kept as is
     source = "laser 2004-03-02"
@@ -255,7 +259,11 @@ def _machine_from_dict(data: dict, loc: _Locator, default_name: str) -> Machine:
     _check_keys(limits, set(AXES), "limits", loc)
     travel = _vectors(limits, "limits", "lo, hi", loc)
     comp = _get_table(data, "compensation", loc)
-    _check_keys(comp, {"max_correction_mm"}, "compensation", loc)
+    _check_keys(comp, {"max_correction_mm", "rotary_xyz_are_axis_positions"}, "compensation", loc)
+    rotary = comp.get("rotary_xyz_are_axis_positions", False)
+    if not isinstance(rotary, bool):
+        raise _fail("compensation: rotary_xyz_are_axis_positions must be true or false",
+                    loc.where("compensation", "rotary_xyz_are_axis_positions"))  # fmt: skip
     try:
         return Machine(
             name=str(head.get("name", default_name)),
@@ -269,6 +277,7 @@ def _machine_from_dict(data: dict, loc: _Locator, default_name: str) -> Machine:
             effects=_effects(data, loc),
             max_correction_mm=_max_correction(comp, loc),
             meta=_meta(head, data, loc),
+            rotary_xyz_are_axis_positions=rotary,
         )
     except (ValueError, TypeError) as err:
         raise _fail(str(err), _where_for_machine_error(str(err), loc)) from err
@@ -572,6 +581,8 @@ def machine_to_dict(m: Machine) -> dict[str, Any]:
     if m.effects:
         doc["effects"] = [e.to_dict() for e in m.effects]
     doc["compensation"] = {"max_correction_mm": m.max_correction_mm}
+    if m.rotary_xyz_are_axis_positions:
+        doc["compensation"]["rotary_xyz_are_axis_positions"] = True
     if meta:
         doc["meta"] = meta
     return doc

@@ -103,6 +103,9 @@ class Machine:
     effects: tuple["Effect", ...] = ()
     max_correction_mm: float = 0.5
     meta: Mapping[str, Any] = field(default_factory=dict)
+    # The programmed X Y Z are the linear axes' positions also while a rotary axis turns (no
+    # tool-centre-point kinematics): moves that turn A, B or C may be compensated
+    rotary_xyz_are_axis_positions: bool = False
 
     def __post_init__(self) -> None:
         setter = lambda name, value: object.__setattr__(self, name, value)  # noqa: E731

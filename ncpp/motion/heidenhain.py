@@ -172,6 +172,8 @@ class HeidenhainInterpreter(ModalInterpreter):
                 if letter == "M":
                     if value in (89.0, 99.0):
                         raise OutOfScope(f"the cycle call M{value:g}", item.start + 1)
+                    if value == 128.0:
+                        raise OutOfScope("M128 (tool-centre-point control)", item.start + 1)
                     end = end or value in END_M
                     continue
                 words[letter] = (value, item)

@@ -39,7 +39,7 @@ from ncpp.motion.cycles import CANNED, DWELLING, PECKING, RAPID_DELTA_INCH, SPIN
 from ncpp.motion.expressions import ExpressionError, OutOfScope, Parameters, evaluate
 from ncpp.motion.offsets import SYSTEMS, WorkOffsets
 from ncpp.motion.flow import FIXED, RUN, SKIP, Flow
-from ncpp.motion.segments import COMP, CYCLE, FLOW, PLANE_AXES, Arc, Context, Event, Line, Pass, mark_off_path
+from ncpp.motion.segments import COMP, CYCLE, FLOW, HOME, PLANE_AXES, Arc, Context, Event, Line, Pass, Setting, mark_off_path
 from ncpp.motion.tools import UntoldLengths
 from ncpp.program.blocks import STRAY_TAPE, UNREADABLE, Block, Comment, ExprWord, Statement, Word
 
@@ -68,7 +68,7 @@ _GROUP_CODES = {
     5: (93, 94, 95),
     6: (20, 21),
     7: (40, 41, 42, 41.1, 42.1),
-    8: (43, 43.1, 43.2, 49),
+    8: (43, 43.1, 43.2, 43.4, 43.5, 49),
     10: (98, 99),
     12: (54, 55, 56, 57, 58, 59, 59.1, 59.2, 59.3),
     13: (61, 61.1, 64),
@@ -89,6 +89,7 @@ OUT_OF_SCOPE_G = {
     **{c: "UVW-plane arcs" for c in (17.1, 18.1, 19.1)},
     7.0: "lathe diameter mode",
     43.2: "additional tool length offset without H",
+    43.4: "tool-centre-point control", 43.5: "tool-centre-point control",
     15.0: "polar coordinates", 16.0: "polar coordinates",
     50.0: "scaling", 51.0: "scaling", 50.1: "mirroring", 51.1: "mirroring",
     54.1: "extended work offsets", 65.0: "macro call", 66.0: "modal macro call", 67.0: "modal macro call",
@@ -311,6 +312,9 @@ class Interpreter:
         out = []
         for ev in events:
             if type(ev) is Pass:
+                if ev.setting is not None:  # set from where each run of the text stands: no one shift
+                    raise _OutOfScope("G92 or G10 L20 in a loop or subroutine (it sets an offset from where "
+                                      "the control stands, which compensation moves)", None)  # fmt: skip
                 if owner is None:
                     out.append(ev)
                 continue
@@ -392,6 +396,7 @@ class Interpreter:
                 self.inch,
                 tuple(offset[i] + self.g92[i] + self.tool[i] for i in range(3)),  # type: ignore[arg-type]
                 tuple(self.tool[:3]),  # type: ignore[arg-type]
+                self.inverse_time,
             )
         return self._context
 
@@ -556,6 +561,7 @@ class Interpreter:
             block,
             self._context or self.context(),
             (end[3], end[4], end[5], end[6], end[7], end[8]) if self.uses_extra_axes else (),
+            extra_start=(pos[3], pos[4], pos[5], pos[6], pos[7], pos[8]) if self.uses_extra_axes else (),
         )
 
     def _modal_move(self, block: Block, words: dict, motion: float) -> Event:
@@ -614,7 +620,7 @@ class Interpreter:
 
         # rs274ngc's order of execution (interp_execute.cc, convert_g)
         if 5 in gcodes:
-            self.inverse_time = gcodes[5][0] == 93.0
+            self._set(inverse_time=gcodes[5][0] == 93.0)
         if "F" in words:
             self._set_feed(block, words["F"])
         if 2 in gcodes:
@@ -742,7 +748,7 @@ class Interpreter:
             self._fail("D word with no G41, G41.1, G42, G42.1, G71, or G96 to use it", block, words["D"][1])
         if "E" in words and motion != 76.0 and not mcodes.keys() & {66.0, 67.0, 68.0}:
             self._fail("E word with no G70, G76, M66, M67 or M68 to use it", block, words["E"][1])
-        if "H" in words and gcodes.get(8, (None,))[0] not in (43.0, 43.2) and motion != 76.0:
+        if "H" in words and gcodes.get(8, (None,))[0] not in (43.0, 43.2, 43.4, 43.5) and motion != 76.0:
             self._fail("H word with no G43 or G76 to use it", block, words["H"][1])
         for letter in "IJ":
             if letter in words and motion not in _ARC_LIKE and mode0 != 10.0:
@@ -935,6 +941,10 @@ class Interpreter:
     def _non_modal(self, block: Block, words: dict, code: float) -> Event | tuple[Event, ...] | None:
         given = [(AXIS_INDEX[letter], value) for letter, (value, _) in words.items() if letter in AXIS_INDEX]
         self._note_axes(given)
+        setting = None
+        if code == 92.0 or (code == 10.0 and words["L"][0] == 20.0):  # set from the current point
+            here = (self.pos[0], self.pos[1], self.pos[2])
+            setting = Pass(block, setting=Setting(tuple((i, v) for i, v in given if i < 3), self.context(), here))
         if code == 92.0:
             old = self.g92[:]
             for i, value in given:
@@ -973,17 +983,24 @@ class Interpreter:
             self.home[int(code)] = [self._machine(i) for i in range(9)]
         elif code in (28.0, 30.0):
             return self._go_home(block, given, self.home[int(code)])
-        return None
+        return setting
 
     def _go_home(self, block: Block, given: list[tuple[int, float]], home: list[float]) -> tuple[Event, ...]:
-        """G28/G30: rapid to the (optional) intermediate point, then home the given axes (all if none)."""
+        """G28/G30: rapid to the (optional) intermediate point, then home the given axes (all if none).
+        Both moves are the control's (`HOME`): compensation cannot reach into them.  In G90 the
+        intermediate point puts the named axes at their words, in G91 it moves them by their words
+        from where the control stands; the home move puts the homed axes at the home position."""
+        named = tuple(any(i == axis for i, _ in given) for axis in range(3))
         middle = self._ends(given, False)
         first = self._line(block, middle, True)
+        first.fixed, first.placed = HOME, named if self.absolute else (False, False, False)
         axes = [i for i, _ in given] or range(9)
         end = middle[:]
         for i in axes:
             end[i] = home[i] - (self.g5x[self.coord_system][i] + self.g92[i] + self.tool[i])
-        return first, self._line(block, end, True)
+        second = self._line(block, end, True)
+        second.fixed, second.placed = HOME, named if given else (True, True, True)
+        return first, second
 
     # -- moves ---------------------------------------------------------------------------------
     def _note_axes(self, given) -> None:
@@ -1013,6 +1030,7 @@ class Interpreter:
             block,
             self._context or self.context(),
             tuple(end[3:]) if self.uses_extra_axes else (),
+            extra_start=tuple(pos[3:]) if self.uses_extra_axes else (),
         )
         self.pos = end
         return line
@@ -1281,6 +1299,7 @@ class Interpreter:
             block,
             self._context or self.context(),
             (end[3], end[4], end[5], end[6], end[7], end[8]) if self.uses_extra_axes else (),
+            extra_start=(start[3], start[4], start[5], start[6], start[7], start[8]) if self.uses_extra_axes else (),
         )
 
     def _center_r(self, block, word, x0, y0, x1, y1, radius, motion) -> tuple[float, float]:

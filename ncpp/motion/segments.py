@@ -28,6 +28,7 @@ Point = tuple[float, float, float]
 CYCLE = "canned cycle"  # a hole is drilled where the program puts it
 FLOW = "loop or subroutine"  # one text runs many times (or out of the text's order)
 COMP = "cutter compensation"  # the control offsets the path by the tool's radius: the tool is not on it
+HOME = "G28/G30 return"  # the control homes the axes it names (machine coordinates); the others stay where they stand
 # Axis letters of `Line.end` / `Arc.end` beyond XYZ, in rs274's order.
 EXTRA_AXES = ("A", "B", "C", "U", "V", "W")
 
@@ -47,6 +48,7 @@ class Context:
     inch: bool = False  # G20 / G21
     offset: Point = (0.0, 0.0, 0.0)  # machine minus program position (work offset, G92, tool length), program units
     tool: Point = (0.0, 0.0, 0.0)  # the tool length offset (in `offset`): the tool tip is this far from the gauge point
+    inverse_time: bool = False  # G93: a feed move's F is 1 / its time in minutes
 
     @property
     def tool_mm(self) -> Point:
@@ -80,7 +82,11 @@ class Line:
     context: Context = field(default_factory=Context)
     extra: tuple[float, ...] = ()  # end positions of A B C U V W, when the program uses them
     changed: bool = False  # set by a pass that moved the end point
-    fixed: str = ""  # why passes leave the move as programmed (CYCLE, FLOW, COMP), "" if they may change it
+    fixed: str = ""  # why passes leave the move as programmed (CYCLE, FLOW, COMP, HOME), "" if they may change it
+    # A fixed move's X Y Z the control puts at their programmed end; the others run their programmed
+    # increment from where the control stands (None: all of them in G90, none in G91)
+    placed: tuple[bool, bool, bool] | None = None
+    extra_start: tuple[float, ...] = ()  # start positions of A B C U V W (as `extra`), when the program uses them
 
     def length(self) -> float:
         return math.dist(self.start, self.end)
@@ -108,6 +114,7 @@ class Arc:
     # a piece replace_arcs made: the direction its plane's normal axis was compensated for
     # (+1, -1: the one that axis last moved in, which the machine holds it in; 0: the mean)
     normal: int = 0
+    extra_start: tuple[float, ...] = ()  # as `Line.extra_start`
 
     @property
     def clockwise(self) -> bool:
@@ -132,13 +139,27 @@ class Arc:
         return -(d + full * (-self.turn - 1))
 
 
+@dataclass(frozen=True, slots=True)
+class Setting:
+    """What a G92 or G10 L20 block sets from where the control stands: the offset that gives the
+    current point the block's coordinates.  The control stands at the compensated point, off
+    `position` by `shift`; written with their values moved by it, the block sets the offset the
+    program means (apply_error_map fills `shift`, the writer writes it)."""
+
+    values: tuple[tuple[int, float], ...]  # (axis 0-2, the coordinate the block gives it), program units
+    context: Context  # the frame the block is read in
+    position: Point  # the programmed point the tool stands at, in that frame
+    shift: Point | None = None  # where the control stands minus `position` (None: not known, or none)
+
+
 @dataclass(slots=True)
 class Pass:
-    """A block that makes no motion; written back as it was."""
+    """A block that makes no motion; written back as it was (a `Setting`'s values moved by its shift)."""
 
     block: Block
     skipped: bool = False  # the program does not run it (an untaken branch, a subroutine's definition)
     motion: float | None = None  # an o-word control line's: the modal motion (G0-G3, a cycle) where it runs
+    setting: Setting | None = None  # a G92 or G10 L20 block's
 
 
 Segment = Union[Line, Arc]
@@ -156,4 +177,5 @@ def mark_off_path(moves: list, compensating: bool, off_path: bool) -> bool:
     return compensating
 
 
-__all__ = ["COMP", "CYCLE", "FLOW", "mark_off_path", "Arc", "Context", "Event", "Line", "Pass", "Point", "Segment", "PLANES", "PLANE_AXES", "EXTRA_AXES", "replace"]
+__all__ = ["COMP", "CYCLE", "FLOW", "HOME", "mark_off_path", "Arc", "Context", "Event", "Line", "Pass", "Point", "Segment",
+           "Setting", "PLANES", "PLANE_AXES", "EXTRA_AXES", "replace"]

@@ -16,15 +16,16 @@ start is compensated with its own direction and a step move is inserted.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, fields, replace
 from itertools import chain
 from typing import Iterable, Iterator
 
 import numpy as np
 from numpy.typing import NDArray
 
-from ncpp.errors import NcppError
-from ncpp.motion.segments import Arc, Event, Line
+from ncpp.errors import Location, NcppError
+from ncpp.motion.segments import Arc, Event, Line, Pass
+from ncpp.program.blocks import Word
 from ncpp.passes.context import PassContext, deviation
 from ncpp.passes.geometry import all3, any3, compensate, frames, from_plane, in_plane, line_chunks, plane_axes, points, rows_of, tuples
 from ncpp.passes.travel import Travel, grid, hold, quantize, steps
@@ -50,16 +51,31 @@ def _chunks(events: Iterable[Event], ctx: PassContext) -> Iterator[list[Event]]:
     last = None  # the last segment written: its compensated end, in its own program frame
     for chunk, segs, rows in (_with_rows(chunk, ctx.directional) for chunk in line_chunks(events)):
         if rows is None:  # no segments
-            yield chunk
+            yield _placed(chunk, last)
             continue
         try:
             solved = solve(rows)
         except NcppError as error:
             error.locate(e.block for e in chunk)
             raise
+        if solved.at_end.any():
+            _warn_at_travel_ends(segs, rows, solved, ctx)
         out = _written(chunk, segs, rows, solved, last)
         last = _ended(segs[-1], solved.end[-1])  # (a carried row's end is not its event's: `_carry`)
         yield out
+
+
+def _warn_at_travel_ends(segs: list, rows: "_Rows", solved: "_Solved", ctx: PassContext) -> None:
+    """One warning per line end left at a travel end (`compensate`'s `ends`), at its axis word."""
+    machine = (solved.end + rows.offsets) * rows.scales[:, None]
+    for k, axis in zip(*np.nonzero(solved.at_end)):
+        letter, block = "XYZ"[axis], segs[k].block
+        word = next((item for item in block.items if type(item) is Word and item.letter == letter), None)
+        ctx.warnings.warn(
+            f"{letter} goes to the end of its travel ({machine[k, axis]:g} mm on the machine), where the "
+            f"compensated command would be outside the travel: {letter} stops at the end, uncompensated there",
+            Location(ctx.file, block.line, 1 if word is None else word.start + 1),
+        )
 
 
 def _with_rows(chunk: list[Event], directional: bool) -> tuple[list[Event], list, "_Rows | None"]:
@@ -83,7 +99,8 @@ class _Rows:
     assumed: NDArray | None  # (n,3) directions replace_arcs compensated the pieces with (reversal errors only)
     lines: NDArray  # (n,) the line of each segment's block, for messages
     rapid: NDArray  # (n,) rapid moves (G0): no reversal step before them
-    carried: NDArray  # (n,) moves left as programmed in G91: they start where the control is (`_carry`)
+    carried: NDArray  # (n,) moves left as programmed that run from where the control is (`_carry`)
+    kept: NDArray  # (n,3) their axes that do so (the others the control puts at their programmed end)
 
 
 def _rows_before(rows: _Rows, line: int | None) -> _Rows | None:
@@ -104,11 +121,24 @@ def _rows(segs: list, directional: bool) -> _Rows:
     arc, changed = (kind & 1) != 0, (kind & 4) != 0
     line = (kind & 3) == 0
     free = line & ~changed
+    kept = _kept_axes(segs, kind)
     return _Rows(
         start, end, offsets, scales, tools, free, changed, changed & line,
         _arc_assumed(segs, np.flatnonzero(changed & arc), start, end) if directional else None,
-        np.fromiter([e.block.line for e in segs], dtype=np.int64, count=len(segs)), (kind & 8) != 0, (kind & 16) != 0,
+        np.fromiter([e.block.line for e in segs], dtype=np.int64, count=len(segs)), (kind & 8) != 0, any3(kept), kept,
     )  # fmt: skip
+
+
+def _kept_axes(segs: list, kind: NDArray) -> NDArray:
+    """(n,3) the axes of moves left as programmed that run from where the control stands: every
+    axis in G91 (`kind` 16), those a move's `placed` does not put at its end (G28/G30)."""
+    kept = np.zeros((len(segs), 3), dtype=bool)
+    kept[(kind & 16) != 0] = True
+    for k in np.flatnonzero(kind & 2).tolist():  # (moves left as programmed are few)
+        placed = getattr(segs[k], "placed", None)
+        if placed is not None:
+            kept[k] = [not p for p in placed]
+    return kept
 
 
 class Solve:
@@ -147,6 +177,7 @@ class _Solved:
     turn_start: NDArray  # (n,3) their start compensated for the new direction
     keep: NDArray  # (n,3) axes that keep their direction (they must not move in that step)
     limit: NDArray  # (n,) program units an axis may be left off its compensated position
+    at_end: NDArray  # (n,3) line ends left at a travel end their command would pass (`compensate`'s `ends`)
 
 
 # What `_written` does with a segment (bits of its row's code)
@@ -186,14 +217,15 @@ def _written(chunk: list[Event], segs: list, rows: _Rows, solved: _Solved, last)
     start = None  # where the output is: the previous segment's compensated end
     for i, seg, row, end in zip(range(len(segs)), segs, code, ends):
         if i in between:
-            out += between[i]
+            out += _placed(between[i], last if i == 0 else _ended(segs[i - 1], solved.end[i - 1]))
         start = starts_from.get(i, start)
         if row & _FREE:
             begin = seg.start if start is None else start
-            if row & _TURNS:  # the reversal step, then the line from where it ends
-                out.append(Line(begin, targets[i], seg.rapid, seg.feed, seg.block, seg.context, seg.extra, True))
+            if row & _TURNS:  # the reversal step (the axes beyond X Y Z still), then the line from where it ends
+                still = seg.extra_start or seg.extra
+                out.append(Line(begin, targets[i], seg.rapid, seg.feed, seg.block, seg.context, still, True, extra_start=still))
                 begin = targets[i]
-            out.append(Line(begin, end, seg.rapid, seg.feed, seg.block, seg.context, seg.extra, True))
+            out.append(Line(begin, end, seg.rapid, seg.feed, seg.block, seg.context, seg.extra, True, extra_start=seg.extra_start))
         else:
             if row & _MOVED:
                 seg = _moved_arc(seg, moved_starts[i], end)
@@ -201,7 +233,25 @@ def _written(chunk: list[Event], segs: list, rows: _Rows, solved: _Solved, last)
                 out.append(Line(start, seg.start, False, seg.feed, seg.block, seg.context, seg.extra, True))
             out.append(seg)
         start = end
-    out += between.get(len(segs), ())
+    if len(segs) in between:
+        out += _placed(between[len(segs)], _ended(segs[-1], solved.end[-1]))
+    return out
+
+
+def _placed(events: list[Event], last: Line | Arc | None) -> list[Event]:
+    """The events, a G92 / G10 L20's `Setting` told where the control stands (`last`: the last
+    segment written, with its compensated end; None: nothing written yet, no shift)."""
+    if last is None:
+        return events
+    out = events
+    for k, event in enumerate(events):
+        setting = event.setting if type(event) is Pass else None
+        if setting is not None:
+            at = _end_in_frame_of(last, setting)  # type: ignore[arg-type]
+            shift = (at[0] - setting.position[0], at[1] - setting.position[1], at[2] - setting.position[2])
+            if out is events:
+                out = list(events)
+            out[k] = Pass(event.block, event.skipped, event.motion, replace(setting, shift=shift))
     return out
 
 
@@ -228,13 +278,16 @@ def _plain(rows: _Rows, ctx: PassContext, travel: Travel) -> _Solved:
     `travel.last` (where the carried G91 moves start from, `_carry`)."""
     start, end, free, offsets, scales = rows.start, rows.end.copy(), rows.free, rows.offsets, rows.scales
     at = np.flatnonzero(free)
+    at_end = np.zeros(end.shape, dtype=bool)
     if at.size:
-        end[at] = compensate(end[at], offsets[at], scales[at], rows.lines[at], ctx, np.sign(end[at] - start[at]), rows_of(rows.tools, at))
+        ends = np.zeros((at.size, 3), dtype=bool)
+        end[at] = compensate(end[at], offsets[at], scales[at], rows.lines[at], ctx, np.sign(end[at] - start[at]), rows_of(rows.tools, at), ends)
+        at_end[at] = ends
     if rows.carried.any():
         _carry(rows, end, None if travel.last is None else travel.last / scales[0] - offsets[0])
     travel.last = (end[-1] + offsets[-1]) * scales[-1]
     none = np.zeros(len(free), dtype=bool)
-    return _Solved(start, end, free, none, none, start, np.ones(start.shape, dtype=bool), np.zeros(len(free)))
+    return _Solved(start, end, free, none, none, start, np.ones(start.shape, dtype=bool), np.zeros(len(free)), at_end)
 
 
 class _Commands:
@@ -245,6 +298,7 @@ class _Commands:
     def __init__(self, rows: _Rows, wanted: dict[str, NDArray], step: NDArray, ctx: PassContext):
         self.rows, self.wanted, self.step, self.ctx = rows, wanted, step, ctx
         self.values = {which: np.empty_like(p) for which, p in wanted.items()}
+        self.at_end = {which: np.zeros(p.shape, dtype=bool) for which, p in wanted.items()}  # as last asked
         self.directions = {which: np.full(p.shape, np.nan) for which, p in wanted.items()}
 
     def __call__(self, which: str, rows: NDArray, d: NDArray) -> NDArray:
@@ -253,8 +307,11 @@ class _Commands:
         todo, d_todo = rows[stale], d[stale]
         if todo.size:
             segs = self.rows
-            c = compensate(self.wanted[which][todo], segs.offsets[todo], segs.scales[todo], segs.lines[todo], self.ctx, d_todo, rows_of(segs.tools, todo))
+            ends = np.zeros((todo.size, 3), dtype=bool)
+            c = compensate(self.wanted[which][todo], segs.offsets[todo], segs.scales[todo], segs.lines[todo], self.ctx, d_todo,
+                           rows_of(segs.tools, todo), ends)  # fmt: skip
             self.values[which][todo] = quantize(c, self.step[todo])
+            self.at_end[which][todo] = ends
             self.directions[which][todo] = d_todo
         return self.values[which][rows]
 
@@ -314,13 +371,13 @@ def _directional(rows: _Rows, ctx: PassContext, travel: Travel) -> _Solved:
         turn_start[rows] = commands("start", rows, d[rows])
     travel.held = d[-1].copy()
     travel.last = machine(out_end[-1:], slice(len(free) - 1, None))[0]
-    return _Solved(out_start, out_end, free, moved, turn, turn_start, ~flips, limit)
+    return _Solved(out_start, out_end, free, moved, turn, turn_start, ~flips, limit, commands.at_end["end"] & free[:, None])
 
 
 def _carry(rows: _Rows, out_end: NDArray, before: NDArray | None) -> None:
     """Move the ends of the carried rows (left as programmed, in G91: the moves of loops and
-    subroutines, and under cutter compensation) by where the control stands when each run of
-    them starts: the program's increments run from the compensated end before them, which is
+    subroutines, and under cutter compensation; the axes a G28/G30 does not put at its
+    intermediate or home point) by where the control stands when each run of them starts: the program's increments run from the compensated end before them, which is
     off their programmed start by that end's correction.  `before`: the previous chunk's last
     end, in the first row's frame."""
     carried, offsets, scales = rows.carried, rows.offsets, rows.scales
@@ -338,7 +395,9 @@ def _carry(rows: _Rows, out_end: NDArray, before: NDArray | None) -> None:
         stop = starts[n + 1] if n + 1 < len(starts) else len(carried)
         rest = carried[k:stop]
         run = stop if rest.all() else k + int(np.argmin(rest))
-        out_end[k:run] = rows.end[k:run] + (previous - rows.start[k])
+        # an axis a move of the run puts at its programmed end runs from there on
+        placed = np.logical_or.accumulate(~rows.kept[k:run], axis=0)
+        out_end[k:run] = rows.end[k:run] + np.where(placed, 0.0, previous - rows.start[k])
 
 
 def _settle(free, arc, d, held, offsets, scales, limit, out_start, out_end, before) -> None:

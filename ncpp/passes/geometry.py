@@ -207,6 +207,7 @@ def compensate(
     ctx: PassContext,
     directions: NDArray | None = None,
     tools: NDArray | None = None,
+    ends: NDArray | None = None,
 ) -> NDArray:
     """Compensated program points for wanted program points.
 
@@ -215,15 +216,35 @@ def compensate(
     not events); directions: travel signs shaped
     like points, for direction-dependent (reversal) error tables; tools (n,3): the tool length
     offsets in effect, mm (`frames`; None: none).  Refuses corrections
-    beyond the machine's limit and commands outside its travel, naming the line."""
+    beyond the machine's limit and commands outside its travel, naming the line; with
+    `ends` ((n,3) bools, set here), a point inside the travel whose command the correction
+    puts outside it (a move to a travel end) is commanded at the travel's end instead, and
+    `ends` marks the axis."""
     shape = points.shape
     pts = points.reshape(len(lines), -1, 3)
     wanted = (pts + offsets[:, None, :]) * scales[:, None, None]
     signs = None if directions is None else np.asarray(directions, dtype=float).reshape(-1, 3)
     tool = None if tools is None else np.broadcast_to(tools[:, None, :], wanted.shape).reshape(-1, 3)
     command = command_for(ctx.model, wanted.reshape(-1, 3), signs, tool, ctx.iterations).reshape(wanted.shape)
+    if ends is not None:
+        ends |= _at_travel_ends(wanted, command, ctx).any(axis=1)
     _check(wanted, command, lines, ctx)
     return (command / scales[:, None, None] - offsets[:, None, :]).reshape(shape)
+
+
+def _at_travel_ends(wanted: NDArray, command: NDArray, ctx: PassContext) -> NDArray:
+    """(n,m,3) where a command is outside the travel at a wanted point inside it: the command is
+    set to the travel's end there (the machine can go no further; the tool stops short of the
+    point by the correction's overshoot)."""
+    lo, hi = ctx.limit_arrays()
+    inside = (wanted >= lo - _AT_END) & (wanted <= hi + _AT_END)
+    held = inside & ((command < lo) | (command > hi))
+    if held.any():
+        np.copyto(command, np.clip(command, lo, hi), where=held)
+    return held
+
+
+_AT_END = 1e-9  # mm: a wanted point this close outside a travel end is at it (its number's rounding)
 
 
 def _check(wanted: NDArray, command: NDArray, lines: NDArray, ctx: PassContext) -> None:

@@ -23,6 +23,7 @@ from ncpp.machine.curvature import BowBound
 from ncpp.motion.segments import Event, Line
 from ncpp.passes.context import PassContext, deviation
 from ncpp.passes.geometry import chunked, frames, points, row_max, rows_of, spliced
+from ncpp.passes.rotary import interpolated, turns
 
 # Interior samples where linearity is checked.
 SAMPLES = np.linspace(0.0, 1.0, 7)
@@ -108,7 +109,13 @@ def _piece_counts(rows: _LineRows, ctx: PassContext) -> NDArray:
 
 
 def _split(line: Line, n: int) -> list[Line]:
+    """The line in `n` equal pieces; each turns its share of the axes beyond X Y Z (A B C, U V W)."""
     a, b = np.array(line.start), np.array(line.end)
     cuts = [tuple(a + (b - a) * (i / n)) for i in range(n + 1)]
     cuts[0], cuts[-1] = line.start, line.end
-    return [Line(cuts[i], cuts[i + 1], line.rapid, line.feed, line.block, line.context, line.extra, line.changed) for i in range(n)]
+    if turns(line):
+        extras = [line.extra_start] + [interpolated(line.extra_start, line.extra, i / n) for i in range(1, n + 1)]
+    else:
+        extras = [line.extra] * (n + 1)
+    return [Line(cuts[i], cuts[i + 1], line.rapid, line.feed, line.block, line.context, extras[i + 1], line.changed,
+                 extra_start=extras[i]) for i in range(n)]  # fmt: skip

@@ -36,7 +36,8 @@ def placement(path: SampledPath, limits) -> np.ndarray | None:
 
 def compensate(data: bytes, model, offset, tolerance: float = 0.001, name: str = "<test>", warnings: Warnings = QUIET) -> bytes:
     """`data` compensated for `model`, the program placed by `offset`: G54's zero, or WorkOffsets."""
-    source = ErrorSource(model, "model", "0" * 16, model.max_correction_mm, dict(model.limits))
+    rotary = getattr(model, "rotary_xyz_are_axis_positions", False)
+    source = ErrorSource(model, "model", "0" * 16, model.max_correction_mm, dict(model.limits), rotary)
     offsets = offset if isinstance(offset, WorkOffsets) else WorkOffsets.at(offset)
     out = io.BytesIO()
     process(io.BytesIO(data), out, file=name, source=source, tolerance=tolerance, warnings=warnings, offsets=offsets)

@@ -103,11 +103,12 @@ def test_a_pass_names_the_column_of_the_word_it_refuses(source, block, col):
 
 
 def test_a_block_without_the_word_a_pass_refuses_is_named_by_its_first_column(source):
-    """At machine zero (no work offset) the X of the first move, G0 Z5, is commanded at
-    -0.002 mm: outside the X travel, on a line with no X word."""
+    """With G54's zero 1 mm short of the X travel, the X of the first move, G0 Z5, is outside
+    the X travel, on a line with no X word."""
     with pytest.raises(NcppError) as error:
-        process(io.BytesIO(b"G21 G90\n  G0 Z5\nM2\n"), io.BytesIO(), file="t.ngc", source=source, warnings=Warnings(stream=io.StringIO()))
-    assert str(error.value).startswith("t.ngc:2:1: command X-0.0020 mm is outside the X travel")
+        process(io.BytesIO(b"G21 G90\n  G0 Z5\nM2\n"), io.BytesIO(), file="t.ngc", source=source, warnings=Warnings(stream=io.StringIO()),
+                offsets=WorkOffsets.at((-1.0, 0.0, 0.0)))  # fmt: skip
+    assert str(error.value).startswith("t.ngc:2:1: command X-1.00") and "is outside the X travel" in str(error.value)
 
 
 def test_a_fault_named_past_its_batch_is_raised_without_solving_the_batch_again(source, monkeypatch):

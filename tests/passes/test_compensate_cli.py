@@ -50,10 +50,10 @@ def test_command_outside_travel_is_refused_with_line_and_no_output(tmp_path):
     out = tmp_path / "out.ngc"
     proc = ncpp("compensate", "--machine", str(MACHINE), str(POCKET), "-o", str(out))
     assert proc.returncode != 0
-    # at machine zero (no work offset) the first move's X (0, line 4) is commanded at -0.002 mm:
-    # the program's first fault, before the arc of line 8 that leaves the Y travel; the block
-    # (`G0 Z5.`) has no X word, so the column is the block's
-    assert proc.stderr.decode().startswith(f"{POCKET}:4:1: command X-0.0020 mm is outside the X travel")
+    # at machine zero (no work offset) the first move stands at the X travel's end (X0: stays
+    # there); the second (`X-20. Y-10.`, line 5) leaves the travel: the program's first fault,
+    # before the arc of line 8 that leaves the Y travel
+    assert proc.stderr.decode().startswith(f"{POCKET}:5:1: command X-20.0045 mm is outside the X travel")
     assert not out.exists()
 
 

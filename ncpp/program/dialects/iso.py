@@ -16,7 +16,8 @@ from dataclasses import replace
 from operator import itemgetter
 from typing import Iterable, Iterator
 
-from ncpp.motion.segments import Arc, Context, Event, Line, Pass
+from ncpp.motion.segments import EXTRA_AXES, Arc, Context, Event, Line, Pass, Setting
+from ncpp.passes.rotary import time_shares, turns
 from ncpp.program.blocks import DIGITS_AS_ONE, Block, Comment, ExprWord, Statement, Word
 from ncpp.program.numbers import NumberStyle, format_number
 from ncpp.program.writer import EditPlan, _literal, _with_motion, set_words, spelling
@@ -30,6 +31,7 @@ DEFAULT_STYLE = NumberStyle(decimals=4)
 GEOMETRY_LETTERS = "XYZIJKR"  # words a pass rewrites in a changed block
 WRITTEN_LETTERS = "XYZIJK"  # the letters the writer writes numbers for
 MOVING_LETTERS = "XYZABCUVWIJKR"  # words that make a block move (with the modal motion)
+AXES_NOT_MOVED = frozenset((10.0, 28.0, 30.0, 52.0, 92.0, 43.1))  # G codes whose axis words no modal motion moves to
 # Letters whose number styles the writer uses: it writes XYZIJK (and CR, with X's style,
 # for Sinumerik); the styles of other words (F, S, R, ...) are never asked for, so not learnt.
 STYLED_LETTERS = frozenset(WRITTEN_LETTERS)
@@ -111,6 +113,8 @@ class IsoWriter:
         facts = self._read_block(block)
         if facts.flow:
             return self._write_control(block, first)
+        if type(first) is Pass and first.setting is not None and first.setting.shift is not None:
+            return [self._setting_text(block, first.setting) + block.eol]
         motion = [e for e in group if type(e) is Line or type(e) is Arc]
         for segment in motion:
             if segment.changed:
@@ -124,10 +128,37 @@ class IsoWriter:
         if not facts.plain:
             block = _literal_geometry(block)
         eol = block.eol
+        if len(motion) > 1 and (motion[0].context.inverse_time or motion[0].extra):
+            return self._write_pieces(block, motion, eol)
         lines = [self._edit_block(block, motion[0]) + eol]
         if len(motion) > 1:
             lines += self._new_blocks(block, motion[1:], eol)
         return lines
+
+    def _write_pieces(self, block: Block, pieces: list, eol: str) -> list[str]:
+        """A move written in pieces that each need words of their own: the axes beyond X Y Z
+        (A B C, U V W) where they turn their share of the move, and in G93 the F that gives
+        each its share of the move's time (`rotary.time_shares`)."""
+        more = self._piece_words(block, pieces)
+        block = _literal_geometry(block, "".join(more[0]))
+        return [self._edit_block(block, pieces[0], more[0]) + eol] + self._new_blocks(block, pieces[1:], eol, more[1:])
+
+    def _piece_words(self, block: Block, pieces: list) -> list[dict[str, str]]:
+        """Per piece: letter -> number text of its words beyond X Y Z I J K (`_write_pieces`)."""
+        given = {item.letter: item for item in block.items if type(item) is Word or type(item) is ExprWord}
+        style = lambda letter: (NumberStyle.of(given[letter].number) if type(given.get(letter)) is Word else DEFAULT_STYLE).at_least(4)  # noqa: E731
+        feeds = [pieces[0].feed / share for share in time_shares(pieces)] if pieces[0].context.inverse_time else None
+        out = []
+        for k, piece in enumerate(pieces):
+            words = {}
+            for i, value in enumerate(piece.extra):
+                letter = EXTRA_AXES[i]
+                if (k == 0 and letter in given and value != pieces[-1].extra[i]) or (k > 0 and turns(piece) and value != piece.extra_start[i]):
+                    words[letter] = format_number(value, style(letter))
+            if feeds is not None and not (type(piece) is Line and piece.rapid):
+                words["F"] = format_number(feeds[k], style("F"))
+            out.append(words)
+        return out
 
     # -- what a block says --------------------------------------------------------
     def _facts(self, block: Block) -> "_Facts":
@@ -289,6 +320,19 @@ class IsoWriter:
         self._last_end = None
         return lines
 
+    # -- G92, G10 L20 -------------------------------------------------------------
+    def _setting_text(self, block: Block, setting: Setting) -> str:
+        """A G92 / G10 L20 block with its axis values moved by where the control stands off the
+        programmed point (`Setting.shift`): the offset the control computes from them is the
+        program's.  After it the output's position is in another frame: the next move writes
+        every axis it knows."""
+        self._last_end = None
+        moved = [(axis, value + setting.shift[axis]) for axis, value in setting.values if setting.shift[axis] != 0.0]  # type: ignore[index]
+        if not moved:
+            return block.raw
+        styles = self._units(setting.context.inch).styles
+        return set_words(_literal_geometry(block), {AXES[axis]: format_number(value, styles[AXES[axis]]) for axis, value in moved})
+
     # -- numbers as written -----------------------------------------------------
     def _moved(self, axis: str, value: float, segment: Line | Arc) -> bool:
         """Whether writing `value` for the axis changes what the output last said."""
@@ -369,7 +413,7 @@ class IsoWriter:
         machine = (end[0] + offset[0], end[1] + offset[1], end[2] + offset[2])
         return {letter: format_number(machine[n], units.styles[letter]) for letter, n in _WRITTEN[self._written_bits(facts, segment, units)]}
 
-    def _edit_block(self, block: Block, segment: Line | Arc) -> str:
+    def _edit_block(self, block: Block, segment: Line | Arc, more: dict[str, str] | None = None) -> str:
         facts = self._facts_value if block is self._facts_block else self._facts(block)  # `_facts`, inlined
         code = (3 if segment.turn > 0 else 2) if type(segment) is Arc else 0 if segment.rapid else 1  # `_motion_code`
         output_motion = self.output_motion
@@ -378,9 +422,9 @@ class IsoWriter:
         inch = segment.context.inch
         units = self._resolved.get(inch) or self._units(inch)
         # a G53 line's numbers are machine coordinates: no plan compiled for program coordinates
-        raw = None if facts.machine else self._planned_edit(block, facts, segment, motion, units)
+        raw = None if facts.machine or more else self._planned_edit(block, facts, segment, motion, units)
         if raw is None:
-            raw = self._general_edit(block, facts, segment, motion)
+            raw = self._general_edit(block, facts, segment, motion, more)
         if facts.motion_word:
             self.output_motion, self.program_motion = code, facts.motion
         elif code != output_motion:
@@ -427,8 +471,10 @@ class IsoWriter:
             )
         return plan  # type: ignore[return-value]
 
-    def _general_edit(self, block: Block, facts: "_Facts", segment: Line | Arc, motion: int | None) -> str:
+    def _general_edit(self, block: Block, facts: "_Facts", segment: Line | Arc, motion: int | None, more: dict[str, str] | None = None) -> str:
         texts = self._machine_texts(facts, segment) if facts.machine else self._texts(block, segment)
+        if more:  # (a piece's own words: `_write_pieces`)
+            texts.update(more)
         # centre words of the old arc, and Fanuc corner words: the corner is now explicit;
         # P is an arc's turn count, but a dwell time (G4) or blending tolerance (G64) elsewhere
         drop = [] if facts.letters.isdisjoint(_DROPPED) else [l for l in DROPPED if l in facts.letters and l not in texts]
@@ -438,7 +484,7 @@ class IsoWriter:
         spelled = None if facts.letters.issuperset(texts) else self._spelling(block)
         return set_words(block if motion is None else _with_motion(block, motion), texts, drop, spelled)
 
-    def _new_blocks(self, block: Block, segments: list[Event], eol: str) -> list[str]:
+    def _new_blocks(self, block: Block, segments: list[Event], eol: str, more: list[dict[str, str]] | None = None) -> list[str]:
         """The lines of the segments a block makes after its first (arc pieces, reversal
         steps, subdivisions): new blocks, spelled as the block is.  Once per line written:
         what is the same for all of them is read once, the output's state is kept in locals
@@ -461,7 +507,11 @@ class IsoWriter:
             bits = _bits_written(facts, segment, places, known, last, last_places)
             motion = code if code != output_motion else None
             values = segment.end if code < 2 and absolute else self._numbers(segment)
-            if templates is not None:
+            words = more[len(lines)] if more else None  # (a piece's own words: `_write_pieces`)
+            if words:
+                texts = {letter: format_number(values[n], units.styles[letter]) for letter, n in _WRITTEN[bits]}
+                lines.append(_new_block_text({**texts, **words}, motion, spelled) + eol)
+            elif templates is not None:
                 key = new_block_key(bits, motion)
                 template = templates.get(key)
                 if template is None:
@@ -516,7 +566,7 @@ class _Facts:
     """What the writer asks about a block."""
 
     __slots__ = ("letters", "motion_word", "motion", "first_motion", "moves", "plain", "words", "styled",
-                 "word_letters", "motion_at", "bits", "axis_bits", "absent_axes", "machine", "flow")  # fmt: skip
+                 "word_letters", "motion_at", "bits", "axis_bits", "absent_axes", "machine", "flow", "settles")  # fmt: skip
 
     def __init__(self, block: Block | None = None):
         """The facts of `block`, read in one walk over its items (none: a block without words)."""
@@ -532,6 +582,7 @@ class _Facts:
         self.motion_at: tuple[int, str] | None = None  # (n, number as written) of its first G0-G3 word, the n-th word
         self.machine = False  # it moves in machine coordinates (G53)
         self.flow = False  # a control line: an o-word (not `O<name>` alone, a program's name), M98, M99
+        self.settles = False  # its axis words are a G10 / G28 / G30 / G52 / G92 / G43.1's, not a move's
         for item in block.items if block is not None else ():
             kind = type(item)
             if kind is Word:
@@ -552,6 +603,8 @@ class _Facts:
         return facts
 
     def _sum_up(self) -> None:
+        if self.settles:
+            self.moves = False
         self.bits = sum(bit for letter, bit in _BIT.items() if letter in self.letters)  # the written letters it has
         self.axis_bits = self.bits & _AXIS_BITS
         self.absent_axes = tuple((n, axis, _BIT[axis]) for n, axis in _NUMBERED_AXES if axis not in self.letters)
@@ -574,6 +627,8 @@ class _Facts:
                 self.motion_word, self.motion = True, None
             elif value == 53.0:
                 self.machine = True
+            elif value in AXES_NOT_MOVED:
+                self.moves = self.settles = True  # (`_sum_up`: its axis words do not move with the modal motion)
         elif letter in MOVING_LETTERS:
             self.moves = True
 
@@ -639,10 +694,10 @@ class _Units:
 _MM, _INCH = _Units(False), _Units(True)
 
 
-def _literal_geometry(block: Block) -> Block:
-    """The block with expression-valued geometry words (`Z[-#<depth>]`) as plain
-    words: a pass changed what they evaluate to, so new numbers replace them."""
-    if not any(type(i) is ExprWord and i.letter in GEOMETRY_LETTERS for i in block.items):
+def _literal_geometry(block: Block, letters: str = GEOMETRY_LETTERS) -> Block:
+    """The block with expression-valued geometry words (`Z[-#<depth>]`), or those of other
+    `letters`, as plain words: a pass changed what they evaluate to, so new numbers replace them."""
+    if not any(type(i) is ExprWord and i.letter in letters for i in block.items):
         return block
-    items = [Word(i.letter, 0.0, "0", i.start, i.end) if type(i) is ExprWord and i.letter in GEOMETRY_LETTERS else i for i in block.items]
+    items = [Word(i.letter, 0.0, "0", i.start, i.end) if type(i) is ExprWord and i.letter in letters else i for i in block.items]
     return replace(block, items=items, signature=None)  # the signature is that of the old items
