@@ -184,8 +184,8 @@ def actions_of(block: Block) -> tuple[list[str], list[str]]:
                 (after if letter == "M" and value in AFTER_MOTION else before).append(text)
         elif kind is Statement and item.kind in ACTION_STATEMENTS:  # type: ignore[union-attr]
             before.append("".join(block.source(item).upper().split()))
-    if dwell:  # the dwell's time: P (ISO), F or S (Sinumerik), X (Fanuc)
-        before.extend(f"{w.letter.upper()}{w.value:g}" for w in block.words() if w.letter.upper() in "PFSX")
+    if dwell:  # the dwell's time: P (ISO), F or S (Sinumerik); X would be an axis of the block's move
+        before.extend(f"{w.letter.upper()}{w.value:g}" for w in block.words() if w.letter.upper() in "PFS")
     return before, after
 
 

@@ -171,6 +171,7 @@ class Interpreter:
     def __init__(self, file: str = "<stdin>", offsets: WorkOffsets | None = None):
         self.file = file
         self.pos = [0.0] * 9  # program position of X Y Z A B C U V W
+        self.unmoved: list[float] | None = None  # where the next move's unnamed axes go, when not `pos` (`_base`)
         self.plane = 17
         self.absolute = True
         self.arc_absolute = False
@@ -423,7 +424,7 @@ class Interpreter:
             move = _PLAIN_MOVES[block.signature]
         except KeyError:
             move = _plain_move(block.signature)
-        if move is not None and len(items) == move[0]:  # no comment among the words
+        if move is not None and len(items) == move[0] and self.unmoved is None:  # no comment among the words
             event = self._plain_move(block, move)
             if event is not None:
                 return event
@@ -519,7 +520,7 @@ class Interpreter:
     def _update_fast(self) -> None:
         """Whether a block of plain X/Y/Z words can take the fast path (nothing to check)."""
         motion = self.motion
-        self._fast = self.absolute and (motion == 0.0 or (motion == 1.0 and not self.inverse_time))
+        self._fast = self.absolute and (motion == 0.0 or (motion == 1.0 and not self.inverse_time)) and self.unmoved is None
 
     def _plain_move(self, block: Block, move: tuple) -> Event | None:
         """A block `_plain_move` read (G0-G3 or the modal motion with distinct
@@ -576,7 +577,7 @@ class Interpreter:
             self._check_feed(block, words, "Cannot do g1 with zero feed rate", "F word missing with inverse time g1 move")
         if not self.uses_extra_axes and not words.keys() <= _XYZF:
             self.uses_extra_axes = True
-        end = self.pos[:]
+        end = self._base()
         if self.absolute:
             for letter, value in words.items():
                 if letter != "F":
@@ -639,7 +640,7 @@ class Interpreter:
         if 61.0 in mcodes and "Q" in words:
             self.spindle_tool = self._tool_number(words["Q"], block)
         if 8 in gcodes:
-            self._tool_length(gcodes[8], words, block)
+            self._tool_length(gcodes[8], words, block, changed=6.0 in mcodes)
         if 12 in gcodes:
             number = _COORD_SYSTEM[gcodes[12][0]]
             if number in self.untold:
@@ -874,11 +875,26 @@ class Interpreter:
         """An offset changed from `old` to `new`: the program position moves the other way."""
         for i in range(9):
             self.pos[i] += old[i] - new[i]
+            if self.unmoved is not None:
+                self.unmoved[i] += old[i] - new[i]
         self._context = None
 
-    def _tool_length(self, code_item: tuple, words: dict, block: Block) -> None:
+    def _base(self) -> list[float]:
+        """Where a move's axes that its block does not name go: the program position, but after
+        a tool change that applied a length (`_tool_length`) the one held before it."""
+        if self.unmoved is None:
+            return self.pos[:]
+        base, self.unmoved = self.unmoved, None
+        return base
+
+    def _tool_length(self, code_item: tuple, words: dict, block: Block, changed: bool = False) -> None:
         """G43 [H]: the offsets of tool H (0 or none: the tool in the spindle); G43.2 H: those
-        added; G43.1: the axis words; G49: none.  In program units, as the control applies them."""
+        added; G43.1: the axis words; G49: none.  In program units, as the control applies them.
+
+        The machine stays where it is and the program position moves the other way, but in a
+        block that also changes the tool (`changed`, M6) rs274 keeps the program position for
+        the axes the next move does not name, which so takes the machine by the difference
+        (`T4 M6 G43` then `G0 X1` moves Z): `unmoved` holds it for that move (`_base`)."""
         code, item = code_item
         new = [0.0] * 9
         if code == 43.1:  # the axes it names; the others keep their offset (rs274ngc)
@@ -894,8 +910,12 @@ class Interpreter:
             new = [value * scale if i in LINEAR else value for i, value in enumerate(table)]
             if code == 43.2:
                 new = [old + added for old, added in zip(self.tool, new)]
+        held = self.pos[:] if changed else None
         self._shift(self.tool, new)
         self.tool = new
+        if changed:
+            self.unmoved = held
+            self._fast = False
 
     def _tool_number(self, word: tuple, block: Block) -> int:
         value, item = word
@@ -1008,7 +1028,7 @@ class Interpreter:
             self.uses_extra_axes = any(i >= 3 for i, _ in given)
 
     def _ends(self, given: list[tuple[int, float]], machine: bool) -> list[float]:
-        end = self.pos[:]
+        end = self._base()
         if machine:  # G53: machine coordinates, always absolute
             for i, value in given:
                 end[i] = value - (self.g5x[self.coord_system][i] + self.g92[i] + self.tool[i])
@@ -1037,7 +1057,7 @@ class Interpreter:
 
     def _move_end(self, block: Block, words: dict) -> list[float]:
         """`_ends` of the block's axis words in program coordinates (what G0-G3 move to)."""
-        end = self.pos[:]
+        end = self._base()
         absolute = self.absolute
         for letter, (value, _) in words.items():
             i = AXIS_INDEX.get(letter)
@@ -1188,7 +1208,7 @@ class Interpreter:
     def _fixed_line(self, block: Block, axes: tuple[int, int, int], move: tuple[float, float, float, bool]) -> Line:
         """A cycle's move (plane coordinates) as a `Line` from the current position, marked `fixed`."""
         a, b, c, rapid = move
-        end = self.pos[:]
+        end = self._base()
         end[axes[0]], end[axes[1]], end[axes[2]] = a, b, c
         line = self._line(block, end, rapid)
         line.fixed = CYCLE
