@@ -201,8 +201,9 @@ class Table:
 
     def scaled(self, factor: float) -> "Table":
         """The same table with values multiplied (unit conversion, sign flip)."""
-        minus = None if self.values_minus is None else np.multiply(self.values_minus, factor)
-        return Table(self.positions, np.multiply(self.values, factor), minus, self.interpolation)
+        values = _floats(np.multiply(self.values, factor), "values")
+        minus = None if self.values_minus is None else _floats(np.multiply(self.values_minus, factor), "minus values")
+        return Table(self.positions, values, minus, self.interpolation)
 
 
 @dataclass(frozen=True)
@@ -237,7 +238,8 @@ class Polynomial:
         return np.polyval(self.coefficients[::-1], p - self.reference)
 
     def scaled(self, factor: float) -> "Polynomial":
-        return Polynomial(np.multiply(self.coefficients, factor), self.reference, self.limits)
+        coefficients = _floats(np.multiply(self.coefficients, factor), "coefficients")
+        return Polynomial(coefficients, self.reference, self.limits)
 
 
 Component = Union[Table, Polynomial]
@@ -312,7 +314,8 @@ class StackedTables:
     def __init__(self, tables: list[Table]):
         # Curve rows: each table's + (or only) curve in table order, then the − curves, so the
         # first rows are the tables' values once the direction has chosen (no copy).
-        curves = [(t, t.values) for t in tables] + [(t, t.values_minus) for t in tables if t.directional]
+        backward = [(t, t.values_minus) for t in tables if t.values_minus is not None]  # the directional ones
+        curves = [(t, t.values) for t in tables] + backward
         pieces = [_cubic_pieces(t, v) for t, v in curves]
         grid = np.unique(np.concatenate([x for x, _ in pieces]))
         if len(grid) == 1:
