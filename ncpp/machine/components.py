@@ -54,6 +54,7 @@ from numpy.typing import ArrayLike, NDArray
 AXES = "XYZ"
 ROTATIONS = "ABC"
 SQUARENESS = ("C0Y", "B0Z", "A0Z")
+Interpolation = Literal["linear", "smooth"]  # of a `Table`: straight lines, or monotone cubic (PCHIP)
 
 
 @dataclass(frozen=True)
@@ -152,7 +153,7 @@ class Table:
     positions: tuple[float, ...]
     values: tuple[float, ...]
     values_minus: tuple[float, ...] | None = None  # travel in the − direction
-    interpolation: Literal["linear", "smooth"] = "linear"
+    interpolation: Interpolation = "linear"
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "positions", _floats(self.positions, "positions"))
