@@ -81,7 +81,7 @@ class Generator:
     decimals_mm = 4
     decimals_inch = 5
 
-    def __init__(self, warnings: Warnings | None = None, header: str | None = None, file: str = "<stdin>"):
+    def __init__(self, warnings: Warnings | None = None, header: str | None = None, file: str = "<stdin>") -> None:
         self.warnings = warnings or Warnings()
         self.file = file
         self.job = Job(header=header)
@@ -260,9 +260,9 @@ def _spindle_speed(rec: Record) -> float:
 def _named_number(rec: Record, names: tuple[str, ...]) -> float | None:
     """The number after the first of `names` among the record's arguments (`MMPM, 50`)."""
     args = rec.args
-    for k, arg in enumerate(args[:-1]):
-        if arg in names and isinstance(args[k + 1], float):
-            return args[k + 1]
+    for arg, after in zip(args, args[1:]):
+        if arg in names and isinstance(after, float):
+            return after
     return None
 
 
