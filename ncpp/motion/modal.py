@@ -10,10 +10,10 @@ expression trees both dialect builders produce (angles in degrees).
 from __future__ import annotations
 
 import math
-from typing import Callable, Iterable, Iterator
+from typing import Callable, Iterable, Iterator, Sequence
 
 from ncpp.errors import Location, NcppError, Warnings
-from ncpp.motion.segments import PLANE_AXES, Arc, Context, Event, Line, Pass, Point, mark_off_path
+from ncpp.motion.segments import PLANE_AXES, Arc, Context, Event, Line, Pass, mark_off_path
 from ncpp.program.blocks import Block
 
 MM_PER_INCH = 25.4
@@ -224,7 +224,7 @@ class ModalInterpreter:
         return self.arc(block, end, centre, 1 if s > 0 else -1, absolute=absolute)
 
 
-def plane_of(points: list[Point]) -> int | None:
+def plane_of(points: Sequence[Sequence[float]]) -> int | None:
     """The principal plane (17, 18, 19) containing all points, if any (a shared normal coordinate)."""
     for plane, (_, _, n) in PLANE_AXES.items():
         if max(p[n] for p in points) - min(p[n] for p in points) < 1e-9:
@@ -232,7 +232,9 @@ def plane_of(points: list[Point]) -> int | None:
     return None
 
 
-def circle_through(p0: Point, p1: Point, p2: Point, plane: int) -> tuple[list[float], int] | None:
+def circle_through(
+    p0: Sequence[float], p1: Sequence[float], p2: Sequence[float], plane: int
+) -> tuple[list[float], int] | None:
     """Centre and turn (+1 counter-clockwise) of the arc from p0 through p1 to p2 in `plane`."""
     a, b, _ = PLANE_AXES[plane]
     ax, ay, bx, by, cx, cy = p0[a], p0[b], p1[a], p1[b], p2[a], p2[b]
