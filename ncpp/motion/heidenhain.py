@@ -110,16 +110,18 @@ class HeidenhainInterpreter(ModalInterpreter):
                     yield event
                 continue
             if corner is not None:
-                made = self._cut(held, corner, event, warnings)  # type: ignore[arg-type]
+                made = self._cut(held, corner, event, warnings)
                 if made is None:  # out of scope: the line, the corner and this move pass through
                     yield from (e if type(e) is Pass else Pass(e.block) for e in held)
                     yield Pass(event.block)
                     held, corner = [], None
                     continue
-                held[0], event = made[0], made[-1]
+                first, last = made[0], made[-1]
+                assert not isinstance(first, Pass) and not isinstance(last, Pass)  # round_corner's lines
+                held[0], event = first, last
                 piece = made[1] if len(made) == 3 else Pass(corner.block)
-                if COMP in (made[0].fixed, made[-1].fixed) and type(piece) is not Pass:  # (the rounding is the contour's)
-                    piece.fixed = COMP  # type: ignore[attr-defined]
+                if COMP in (first.fixed, last.fixed) and not isinstance(piece, Pass):  # (the rounding is the contour's)
+                    piece.fixed = COMP
                 held = [piece if e is corner else e for e in held]
                 corner = None
             yield from held
@@ -161,12 +163,11 @@ class HeidenhainInterpreter(ModalInterpreter):
         comp: str | None = None  # RL, RR or R0
         end = False
         for item in block.items:
-            kind = type(item)
-            if kind is Comment:
+            if type(item) is Comment:
                 continue
-            if kind is Word or kind is ExprWord:
+            if type(item) is Word or type(item) is ExprWord:
                 letter = item.letter
-                value = item.value if kind is Word else self.value(item.expr, block, item)
+                value = item.value if type(item) is Word else self.value(item.expr, block, item)
                 if letter == "N":
                     continue
                 if letter == "M":
