@@ -20,7 +20,8 @@ items), so a writer can show it as a comment and errors can name its line.
 from __future__ import annotations
 
 import math
-from typing import Iterable, Iterator, Sequence
+from collections.abc import Sequence
+from typing import Iterable, Iterator
 
 from ncpp.cldata.reader import Record
 from ncpp.errors import NcppError, Warnings

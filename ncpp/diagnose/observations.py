@@ -18,8 +18,8 @@ transverse readings — offset and slope (laser alignment); angles — offset.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Callable
 
 import numpy as np
 from numpy.typing import NDArray

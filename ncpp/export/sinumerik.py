@@ -42,7 +42,7 @@ the leadscrew table to 0 at the reference point.
 
 from __future__ import annotations
 
-from typing import Sequence
+from collections.abc import Sequence
 
 import numpy as np
 

@@ -270,8 +270,8 @@ def identify(
 
 
 def _fit_tables(
-    machine: Machine, sources: Sequence[Source], interpolation: Interpolation, reversal_threshold: float, sweeps: int,
-    tolerance: float,
+    machine: Machine, sources: Sequence[Source], interpolation: Interpolation, reversal_threshold: float,
+    sweeps: int, tolerance: float,
 ) -> Machine:  # fmt: skip
     taken: dict[str, Source] = {}
     for s in sources:

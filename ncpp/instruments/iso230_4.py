@@ -131,7 +131,7 @@ def circular_test(m: Measurement) -> CircularTest:
     if not traces or not all(len(t.angle_deg) >= 3 for t in traces):
         raise NcppError("a circular test needs at least three points per direction", Location(m.source))
     radius = m.radius_mm
-    if radius is None:  # loading refuses such a ballbar or cutting file, and grid traces need it: in memory only
+    if radius is None:  # a file without it is refused on loading (ballbar, cutting) or above (grid)
         raise NcppError(f"a {m.instrument} file needs '# radius_mm: R' (R > 0)", Location(m.source))
     return CircularTest(traces, float(radius), m.plane, m.feed_mm_min, m.source)
 

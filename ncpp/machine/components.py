@@ -203,7 +203,9 @@ class Table:
     def scaled(self, factor: float) -> "Table":
         """The same table with values multiplied (unit conversion, sign flip)."""
         values = _floats(np.multiply(self.values, factor), "values")
-        minus = None if self.values_minus is None else _floats(np.multiply(self.values_minus, factor), "minus values")
+        minus = self.values_minus
+        if minus is not None:
+            minus = _floats(np.multiply(minus, factor), "minus values")
         return Table(self.positions, values, minus, self.interpolation)
 
 

@@ -55,7 +55,8 @@ def round_corner(first: Line, second: Line, kind: str, size: float, block: Block
     else:
         side = 1.0 if cross > 0 else -1.0  # the centre lies on the inside of the turn
         centre = _in_plane(start, i, j, start[i] - side * size * u[1], start[j] + side * size * u[0])
-        piece = Arc(start, end, centre, 1 if cross > 0 else -1, piece_feed, piece_block, first.context, first.extra)
+        turn = 1 if cross > 0 else -1
+        piece = Arc(start, end, centre, turn, piece_feed, piece_block, first.context, first.extra)
     return [replace(first, end=start), piece, replace(second, start=end)]
 
 

@@ -10,7 +10,8 @@ expression trees both dialect builders produce (angles in degrees).
 from __future__ import annotations
 
 import math
-from typing import Callable, Iterable, Iterator, Sequence
+from collections.abc import Sequence
+from typing import Callable, Iterable, Iterator
 
 from ncpp.errors import Location, NcppError, Warnings
 from ncpp.motion.segments import PLANE_AXES, Arc, Context, Event, Line, Pass, mark_off_path

@@ -428,7 +428,8 @@ class HeidenhainWriter(IsoWriter):
         if arc is not None and (helix or function not in ("C",)):
             # another arc form (CR, CT, CP, a helix): the block becomes C/CP, its words replaced
             texts = {n: None for n, i in enumerate(block.items)
-                     if (isinstance(i, (Word, ExprWord)) and (i.letter in _POLAR_WORDS or i.letter.lstrip("I") in _AXES))
+                     if (isinstance(i, (Word, ExprWord))
+                         and (i.letter in _POLAR_WORDS or i.letter.lstrip("I") in _AXES))
                      or (type(i) is Statement and i.kind == "rotation")}  # fmt: skip
             texts[index] = self._arc_text(arc)
             return splice(block, texts, feed)
@@ -442,7 +443,8 @@ class HeidenhainWriter(IsoWriter):
         written = set()
         anchor = block.items[index] if index is not None else None
         for n, item in enumerate(block.items):
-            if isinstance(item, (Word, ExprWord)) and item.letter.lstrip("I") in _AXES and len(item.letter) <= 2:
+            if (isinstance(item, (Word, ExprWord)) and item.letter.lstrip("I") in _AXES
+                    and len(item.letter) <= 2):
                 axis = _AXES.index(item.letter[-1])
                 incremental = item.letter.startswith("I")
                 value = segment.end[axis] - segment.start[axis] if incremental else segment.end[axis]
