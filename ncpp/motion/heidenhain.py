@@ -31,7 +31,14 @@ from typing import Iterable, Iterator
 
 from ncpp.errors import Location, NcppError, Warnings
 from ncpp.motion.corners import CornerError, round_corner
-from ncpp.motion.modal import MM_PER_INCH, PLANE_OF_TOOL_AXIS, ModalInterpreter, OutOfScope, resolve_warnings
+from ncpp.motion.modal import (
+    MM_PER_INCH,
+    PLANE_OF_TOOL_AXIS,
+    ModalInterpreter,
+    OutOfScope,
+    as_point,
+    resolve_warnings,
+)
 from ncpp.motion.offsets import WorkOffsets
 from ncpp.motion.segments import COMP, PLANE_AXES, Arc, Event, Line, Pass, Point
 from ncpp.motion.tools import ToolTable, UntoldLengths
@@ -280,7 +287,7 @@ class HeidenhainInterpreter(ModalInterpreter):
         lengths = self.tools.edges.get((number, 1))
         if lengths is None:
             self.fail(f"tool {number:g} is not defined: neither in {self.tools.source} nor by TOOL DEF", block, statement)
-        return lengths[0] / (MM_PER_INCH if self.inch else 1.0)  # type: ignore[index]
+        return lengths[0] / (MM_PER_INCH if self.inch else 1.0)
 
     def _word_value(self, item, block: Block) -> float:
         return item.value if type(item) is Word else self.value(item.expr, block, item)
@@ -343,12 +350,12 @@ class HeidenhainInterpreter(ModalInterpreter):
     def _set_pole(self, block: Block, end: list[float], written: set[int]) -> Pole:
         self.pole = end
         self.pole_plane = _plane_of_axes(written, self.plane)
-        return Pole(block, tuple(end), self.pole_plane)  # type: ignore[arg-type]
+        return Pole(block, center=as_point(end), plane=self.pole_plane)
 
     def _need_pole(self, block: Block, item) -> list[float]:
         if self.pole is None:
             self.fail("a circle or polar move with no pole: program CC first", block, item)
-        return self.pole  # type: ignore[return-value]
+        return self.pole
 
     def _circle(self, block: Block, item, end: list[float], rotation: str | None):
         centre = list(self._need_pole(block, item))

@@ -222,11 +222,11 @@ class SinumerikInterpreter(ModalInterpreter):
         number = self.loaded if type(self.loaded) is float else self.tools.names.get(self.loaded)  # type: ignore[arg-type]
         if number is None:
             self.fail(f'tool "{self.loaded}" is not in {self.tools.source}', block, item)
-        lengths = self.tools.edges.get((number, self.edge))  # type: ignore[arg-type]
+        lengths = self.tools.edges.get((number, self.edge))
         if lengths is None:
             self.fail(f"tool {self.loaded if type(self.loaded) is str else f'{number:g}'} has no cutting edge D{self.edge} in {self.tools.source}",
                       block, item)  # fmt: skip
-        return lengths  # type: ignore[return-value]
+        return lengths
 
     def _word_value(self, item: ExprWord, block: Block) -> tuple[float, str | None]:
         expr = item.expr
@@ -329,5 +329,5 @@ class SinumerikInterpreter(ModalInterpreter):
         found = circle_through(self.pos, middle, end, plane)
         if found is None or math.dist(points[0], points[2]) < 1e-9:
             self.fail("CIP points in a line (or a full circle): no arc through them", block, item)
-        centre, turn = found  # type: ignore[misc]
+        centre, turn = found
         return self.arc(block, end, centre, turn, plane, absolute)
