@@ -231,7 +231,8 @@ def motion(records: Iterable[Record], warnings: Warnings | None = None, zero: Po
         elif major == "GOHOME" and home is not None and pos is not None:
             # GOHOME/Z (and the like) sends only the named axes home.
             named = [a for a in "XYZ" if a in rec.words] or list("XYZ")
-            target: Point = tuple(home[k] if a in named else pos[k] for k, a in enumerate("XYZ"))  # type: ignore[assignment]
+            x, y, z = (home[k] if a in named else pos[k] for k, a in enumerate("XYZ"))
+            target: Point = (x, y, z)
             yield Line(pos, target, True, feed, _block(rec), context)
             pos, rapid_next = target, False
             continue

@@ -57,11 +57,11 @@ class Candidate:
         """The report's parameters and their standard uncertainties from the
         basis coefficients and their covariance."""
         effect = self.build(coef)
-        if self.kind == "cyclic":
+        if isinstance(effect, Cyclic):  # the cyclic candidates build one
             amp = float(np.hypot(*coef))
             g = coef / amp if amp > 0 else np.array([1.0, 0.0])
             return (
-                {"um": amp, "period_mm": effect.period_mm},  # type: ignore[attr-defined]
+                {"um": amp, "period_mm": effect.period_mm},
                 {"um": float(np.sqrt(max(g @ cov @ g, 0.0)))},
             )
         size = float(getattr(effect, self.unit))

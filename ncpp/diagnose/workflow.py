@@ -38,7 +38,7 @@ from ncpp.diagnose.candidates import Candidate, candidates, cyclic_variant
 from ncpp.diagnose.observations import Observation, noise_level, observe, predicted
 from ncpp.instruments.files import Measurement
 from ncpp.machine.components import AXES
-from ncpp.machine.effects import Effect
+from ncpp.machine.effects import Cyclic, Effect
 from ncpp.machine.model import Machine
 
 
@@ -303,7 +303,9 @@ def _refit(prob: _Problem, chosen: list[Candidate], cols: dict[int, NDArray], sw
 
 def _refine_period(cand: Candidate, prob: _Problem, cols, Q: NDArray, e_w: NDArray, sw: NDArray) -> Candidate:
     """Scan the screw lead around the best standard one (±8 %)."""
-    period = cand.basis[0].period_mm  # type: ignore[attr-defined]
+    basis = cand.basis[0]
+    assert isinstance(basis, Cyclic)  # called for the cyclic candidates
+    period = basis.period_mm
     axis = cand.keys["axis"]
     best, best_gain = cand, -1.0
     for p in period * np.linspace(0.92, 1.08, 33):

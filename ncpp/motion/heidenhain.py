@@ -145,13 +145,15 @@ class HeidenhainInterpreter(ModalInterpreter):
     def _cut(self, held: list[Event], corner: Corner, second: Line | Arc, warnings: Warnings) -> list[Event] | None:
         """[first line shortened, fillet or chamfer, second line] or None when out of scope."""
         where = Location(self.file, corner.block.line, corner.col)
-        if type(second) is not Line or second.rapid:
+        if not isinstance(second, Line) or second.rapid:
             self.done = True
             warnings.warn("RND/CHF next to an arc or a rapid move is outside the motion interpreter's scope; "
                           "from this line on the program passes through uninterpreted", where)  # fmt: skip
             return None
+        first = held[0]
+        assert isinstance(first, Line)  # `run` holds back a feed line and what follows it
         try:
-            return round_corner(held[0], second, corner.kind, corner.size, corner.block, corner.feed)  # type: ignore[arg-type]
+            return round_corner(first, second, corner.kind, corner.size, corner.block, corner.feed)
         except CornerError as err:
             raise NcppError(str(err), where) from None
 
@@ -227,8 +229,8 @@ class HeidenhainInterpreter(ModalInterpreter):
         if "F" in words and function is not None:
             self.feed = words["F"][0]
         events = self._path(block, function, function_item, words, rapid, rotation) if function else []
-        if events and type(events[-1]) in (Line, Arc):
-            self.last_move, self.corner_waits = events[-1], False  # type: ignore[assignment]
+        if events and isinstance(events[-1], (Line, Arc)):
+            self.last_move, self.corner_waits = events[-1], False
         if end:
             self.done = True
         return self.radius_compensation(events, None if comp is None else comp != "R0")
