@@ -177,11 +177,12 @@ def contour_error(machine, commanded: SampledPath, nominal: SampledPath, feed_ef
     error = distance_to_path(actual, nominal_path) * 1000.0
     worst = int(np.argmax(error))
     circles = _circle_traces(machine, commanded, nominal, feed_effects)
+    x, y, z = (float(v) for v in cmd[worst])
     return ContourReport(
         float(error.max()),
         float(np.sqrt(np.mean(error**2))),
         int(commanded.line[cut][worst]),
-        tuple(float(v) for v in cmd[worst]),
+        (x, y, z),
         int(len(cmd)),
         circles,
     )

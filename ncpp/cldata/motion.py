@@ -20,6 +20,7 @@ items), so a writer can show it as a comment and errors can name its line.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from typing import Iterable, Iterator
 
 from ncpp.cldata.reader import Record
@@ -47,7 +48,7 @@ def _block(record: Record) -> Block:
     return Block(raw=record.text, eol="\n", items=(), line=record.line)
 
 
-def _plane(axis: tuple[float, float, float], record: Record) -> tuple[int, int]:
+def _plane(axis: Sequence[float], record: Record) -> tuple[int, int]:
     """(G17/18/19, rotation sign) of a CIRCLE axis vector."""
     norm = math.sqrt(sum(a * a for a in axis))
     if norm == 0:
@@ -140,7 +141,7 @@ def feed_rate(rec: Record) -> float:
     return f
 
 
-def _position(rec: Record, values: list[float]) -> Point:
+def _position(rec: Record, values: Sequence[float]) -> Point:
     """The record's x, y, z: numbers an NC word can hold (GOTO / 1e308 would be 309 digits)."""
     x, y, z = values[:3]
     if not max(abs(x), abs(y), abs(z)) <= MAX_WORD:
@@ -173,7 +174,7 @@ def motion(records: Iterable[Record], warnings: Warnings | None = None, zero: Po
     feed = 0.0
     rapid_next = False
     multax = False
-    tool_vector: tuple[float, float, float] | None = None
+    tool_vector: tuple[float, ...] | None = None  # its unit vector
     vector_line = 0
     context = Context(offset=zero)
     circle: _Circle | None = None
@@ -230,7 +231,8 @@ def motion(records: Iterable[Record], warnings: Warnings | None = None, zero: Po
         elif major == "GOHOME" and home is not None and pos is not None:
             # GOHOME/Z (and the like) sends only the named axes home.
             named = [a for a in "XYZ" if a in rec.words] or list("XYZ")
-            target: Point = tuple(home[k] if a in named else pos[k] for k, a in enumerate("XYZ"))  # type: ignore[assignment]
+            x, y, z = (home[k] if a in named else pos[k] for k, a in enumerate("XYZ"))
+            target: Point = (x, y, z)
             yield Line(pos, target, True, feed, _block(rec), context)
             pos, rapid_next = target, False
             continue
@@ -240,7 +242,8 @@ def motion(records: Iterable[Record], warnings: Warnings | None = None, zero: Po
             feed = feed_rate(rec)
         elif major == "UNITS":
             inch = units_inch(rec)
-            context = replace(context, inch=inch, offset=tuple(v / 25.4 for v in zero) if inch else zero)  # program units
+            offset: Point = (zero[0] / 25.4, zero[1] / 25.4, zero[2] / 25.4) if inch else zero
+            context = replace(context, inch=inch, offset=offset)  # program units
         elif major == "MULTAX":
             multax = not (rec.words and rec.words[0] == "OFF")
         elif major == "TLAXIS" and len(rec.numbers) >= 3:

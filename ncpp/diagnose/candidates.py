@@ -12,6 +12,7 @@ the play), so its basis is re-evaluated at the current estimate (`relinearise`).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import partial
 from typing import Any, Callable, Sequence
 
 import numpy as np
@@ -56,11 +57,11 @@ class Candidate:
         """The report's parameters and their standard uncertainties from the
         basis coefficients and their covariance."""
         effect = self.build(coef)
-        if self.kind == "cyclic":
+        if isinstance(effect, Cyclic):  # the cyclic candidates build one
             amp = float(np.hypot(*coef))
             g = coef / amp if amp > 0 else np.array([1.0, 0.0])
             return (
-                {"um": amp, "period_mm": effect.period_mm},  # type: ignore[attr-defined]
+                {"um": amp, "period_mm": effect.period_mm},
                 {"um": float(np.sqrt(max(g @ cov @ g, 0.0)))},
             )
         size = float(getattr(effect, self.unit))
@@ -74,10 +75,10 @@ class Candidate:
         size = float(getattr(self.build(coef), self.unit))
         if abs(size) < 0.05:
             return self
-        cls = type(self.basis[0])
+        assert isinstance(self.basis[0], Backlash), "backlash is the only nonlinear candidate"
         axis = self.keys["axis"]
-        return Candidate(self.kind, self.keys, self.unit, (cls(axis, size),), lambda c: cls(axis, c[0] * size),
-                         self.variant, True)  # fmt: skip
+        return Candidate(self.kind, self.keys, self.unit, (Backlash(axis, size),),
+                         lambda c: Backlash(axis, c[0] * size), self.variant, True)  # fmt: skip
 
 
 def _one(kind: str, keys: dict[str, str], unit: str, make: Callable[[float], Effect], size: float,
@@ -104,40 +105,40 @@ def candidates(extent: dict[str, tuple[float, float]]) -> list[list[Candidate]]:
     (kind, keys).  `extent` is the tested range per axis (straightness over it)."""
     out: list[list[Candidate]] = []
     for a in AXES:
-        out.append([_one("scale", {"axis": a}, "um_per_m", lambda s, a=a: Scale(a, s), 10.0)])
+        out.append([_one("scale", {"axis": a}, "um_per_m", partial(Scale, a), 10.0)])
     for a in AXES:
-        out.append([_one("backlash", {"axis": a}, "um", lambda s, a=a: Backlash(a, s), 5.0, nonlinear=True)])
+        out.append([_one("backlash", {"axis": a}, "um", partial(Backlash, a), 5.0, nonlinear=True)])
     for a in AXES:
         for d in AXES:
             if d != a:
-                out.append([_one("lateral_play", {"axis": a}, "um", lambda s, a=a, d=d: LateralPlay(a, s, d), 5.0,
+                out.append([_one("lateral_play", {"axis": a}, "um", partial(LateralPlay, a, direction=d), 5.0,
                                  f"sideways along {d}")])  # fmt: skip
     for a in AXES:
         out.append([
-            _one("reversal_spike", {"axis": a}, "um", lambda s, a=a, k=k: ReversalSpike(a, s, decay_mm=k), 5.0,
+            _one("reversal_spike", {"axis": a}, "um", partial(ReversalSpike, a, decay_mm=k), 5.0,
                  f"decay {k:g} mm")
             for k in SPIKE_DECAYS_MM
         ])  # fmt: skip
     for axes in PLANES:
-        out.append([_one("servo_mismatch", {"axes": axes}, "ms", lambda s, x=axes: ServoMismatch(x, s), 1.0)])
+        out.append([_one("servo_mismatch", {"axes": axes}, "ms", partial(ServoMismatch, axes), 1.0)])
     for p in PLANES:
-        out.append([_one("squareness", {"plane": p}, "um_per_m", lambda s, p=p: Squareness(p, s), 10.0)])
+        out.append([_one("squareness", {"plane": p}, "um_per_m", partial(Squareness, p), 10.0)])
     for a in AXES:
         for d in AXES:
             if d == a:
                 continue
             variants = [_one("straightness", {"axis": a, "direction": d}, "um",
-                             lambda s, a=a, d=d: Straightness(a, d, s), 5.0, "over each test's own extent")]  # fmt: skip
+                             partial(Straightness, a, d), 5.0, "over each test's own extent")]  # fmt: skip
             if a in extent:
                 r = extent[a]
                 variants.append(_one("straightness", {"axis": a, "direction": d}, "um",
-                                     lambda s, a=a, d=d, r=r: Straightness(a, d, s, r), 5.0,
+                                     partial(Straightness, a, d, range_mm=r), 5.0,
                                      f"over {r[0]:g}..{r[1]:g} mm"))  # fmt: skip
             out.append(variants)
     for a in AXES:
         out.append([_cyclic(a, p) for p in SCREW_LEADS_MM])
     for c in ANGULAR:
-        out.append([_one("angular", {"component": c}, "urad_per_m", lambda s, c=c: Angular(c, s), 20.0)])
+        out.append([_one("angular", {"component": c}, "urad_per_m", partial(Angular, c), 20.0)])
     return out
 
 

@@ -18,6 +18,7 @@ transverse readings — offset and slope (laser alignment); angles — offset.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -26,7 +27,7 @@ from numpy.typing import NDArray
 from ncpp.errors import Location, NcppError
 from ncpp.instruments.files import PLANES, Measurement
 from ncpp.machine.components import AXES
-from ncpp.machine.effects import Effect
+from ncpp.machine.effects import Angular, Effect
 from ncpp.machine.model import Machine
 from ncpp.instruments.forward import iso230_2_cycle
 from ncpp.instruments.iso230_4 import circular_test
@@ -172,7 +173,7 @@ def _component_index(m: Measurement) -> tuple[list[int], bool, str | None]:
 
 def _positioning(machine: Machine, m: Measurement, name: str) -> Observation:
     axis = m.axis or "X"
-    components, angular, _ = _component_index(m)
+    components, angular, component = _component_index(m)
     targets = np.unique(np.asarray(m["target_mm"], dtype=float))
     runs = int(np.max(m["run"]))
     both = set(m["direction"]) == {"+", "-"}
@@ -185,18 +186,23 @@ def _positioning(machine: Machine, m: Measurement, name: str) -> Observation:
     rows_all = np.arange(n * len(components))
     k = AXES.index(axis)
 
+    read: Callable[[Effect], NDArray] | Callable[[NDArray], NDArray]
     if angular:
-        comp = _component_index(m)[2]
+        assert component is not None  # angles come with their ISO component name
 
-        def read(effect: Effect) -> NDArray:
-            if effect.kind != "angular" or effect.component[1] != comp[1]:  # type: ignore[attr-defined]
+        def read_angle(effect: Effect) -> NDArray:
+            if not isinstance(effect, Angular) or effect.component[1] != component[1]:
                 return np.zeros(n)
-            i = AXES.index(effect.component[2])  # type: ignore[attr-defined]
-            return effect.urad_per_m * 1e-3 * (traj.positions[sample, i] - effect.ref_mm)  # type: ignore[attr-defined]
+            i = AXES.index(effect.component[2])
+            return effect.urad_per_m * 1e-3 * (traj.positions[sample, i] - effect.ref_mm)
+
+        read = read_angle
     else:
 
-        def read(delta: NDArray) -> NDArray:
+        def read_deviation(delta: NDArray) -> NDArray:
             return np.concatenate([delta[sample, c] * 1e3 for c in components])
+
+        read = read_deviation
 
     run = np.asarray(m["run"], dtype=int)
     target = np.asarray(m["target_mm"], dtype=float)

@@ -38,7 +38,7 @@ from ncpp.diagnose.candidates import Candidate, candidates, cyclic_variant
 from ncpp.diagnose.observations import Observation, noise_level, observe, predicted
 from ncpp.instruments.files import Measurement
 from ncpp.machine.components import AXES
-from ncpp.machine.effects import Effect
+from ncpp.machine.effects import Cyclic, Effect
 from ncpp.machine.model import Machine
 
 
@@ -210,7 +210,7 @@ def diagnose(
             for cand in g:
                 B = cols[id(cand)] * sw[:, None]
                 Bp = B - Q @ (Q.T @ B)
-                if np.linalg.norm(Bp) <= 1e-6 * max(np.linalg.norm(B), 1e-300):
+                if np.linalg.norm(Bp) <= 1e-6 * max(float(np.linalg.norm(B)), 1e-300):
                     if np.linalg.norm(B) > 0 and not chosen:  # hidden by the set-up offsets alone
                         not_observable.add(g[0].name)
                     continue
@@ -303,7 +303,9 @@ def _refit(prob: _Problem, chosen: list[Candidate], cols: dict[int, NDArray], sw
 
 def _refine_period(cand: Candidate, prob: _Problem, cols, Q: NDArray, e_w: NDArray, sw: NDArray) -> Candidate:
     """Scan the screw lead around the best standard one (±8 %)."""
-    period = cand.basis[0].period_mm  # type: ignore[attr-defined]
+    basis = cand.basis[0]
+    assert isinstance(basis, Cyclic)  # called for the cyclic candidates
+    period = basis.period_mm
     axis = cand.keys["axis"]
     best, best_gain = cand, -1.0
     for p in period * np.linspace(0.92, 1.08, 33):
@@ -371,7 +373,7 @@ def explain(obs, slices, contribution: NDArray, stat: float, thr: float, share: 
                      "flips sign with direction (CW vs CCW)" if flip > 3 * common else "differs between CW and CCW")  # fmt: skip
     feeds = sorted({o.feed for o, v in zip(obs, rms) if v > 0 and o.measurement.instrument == "ballbar"})
     if len(feeds) > 1:
-        by_feed = {f: np.mean([v for o, v in zip(obs, rms) if o.feed == f and v > 0]) for f in feeds}
+        by_feed = {f: float(np.mean([v for o, v in zip(obs, rms) if o.feed == f and v > 0])) for f in feeds}
         ratio = by_feed[feeds[-1]] / max(by_feed[feeds[0]], 1e-12)
         if ratio > 1.3:
             parts.append(f"grows with feed (x{ratio:.1f} from F{feeds[0]:g} to F{feeds[-1]:g})")

@@ -143,7 +143,8 @@ def _fit_magnification(wanted: np.ndarray) -> tuple[int, np.ndarray]:
 
 def read_fanuc_pitch(text: str) -> tuple[dict[int, int], dict[int, int]]:
     """(parameters, pitch values by point number) from a parameter tape."""
-    params, points = {}, {}
+    params: dict[int, int] = {}
+    points: dict[int, int] = {}
     for line in text.splitlines():
         m = re.match(r"N(\d+)(?:A\d+)?P([-+]?\d+)", line)
         if m:

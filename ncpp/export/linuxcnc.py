@@ -89,7 +89,7 @@ class LinuxCncComp:
     @property
     def table(self) -> Table:
         """The error as a machine-model table (reversal in the minus values)."""
-        return Table(self.nominal, self.forward, self.reverse, "linear")
+        return Table(tuple(self.nominal), tuple(self.forward), tuple(self.reverse), "linear")
 
 
 _NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")

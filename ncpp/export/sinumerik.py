@@ -42,6 +42,8 @@ the leadscrew table to 0 at the reference point.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 
 from ncpp.export.common import AxisError, interpolation_residual, reference_on_travel, uniform_grid
@@ -54,7 +56,7 @@ DECIMALS = 4  # 0.1 um
 
 def write_sinumerik(
     error: AxisError,
-    transverse: list[AxisError] = (),
+    transverse: Sequence[AxisError] = (),
     *,
     spacing: float | None = None,
     reference: float | None = None,
@@ -63,6 +65,7 @@ def write_sinumerik(
     ax = MACHINE_AXES[error.axis]
     grid = uniform_grid(error.lo, error.hi, max_points=MAX_ENC_POINTS, spacing=spacing, what="SINUMERIK MSEC")
     x = grid.positions
+    assert grid.spacing is not None  # a uniform grid has one
     mean = error.mean(x)
     placed: list[str] = []  # the reference's note, when it is moved onto the travel
     reference = None if reference is None else reference_on_travel(error, reference, placed)
@@ -102,6 +105,7 @@ def write_sinumerik(
         g = uniform_grid(comp.lo, comp.hi, max_points=MAX_CEC_POINTS, spacing=spacing, what=f"SINUMERIK CEC {index}")
         notes += [n_ for n_ in g.notes if n_ not in notes]
         p = g.positions
+        assert g.spacing is not None  # a uniform grid has one
         cec.append(
             f"; table {index}: {kind} {comp.name}, correction -e on {out} as a function of {inp}"
             + (f", direction {direction:+d} only" if direction else "")

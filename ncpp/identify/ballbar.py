@@ -208,8 +208,8 @@ def _shifted(machine: Machine, name: str, h: float) -> Machine:
     elif isinstance(comp, Polynomial):
         new = Polynomial((comp.coefficients[0] + h, *comp.coefficients[1:]), comp.reference, comp.limits)
     else:
-        minus = None if comp.values_minus is None else np.add(comp.values_minus, h)
-        new = Table(comp.positions, np.add(comp.values, h), minus, comp.interpolation)
+        minus = None if comp.values_minus is None else tuple(v + h for v in comp.values_minus)
+        new = Table(comp.positions, tuple(v + h for v in comp.values), minus, comp.interpolation)
     return machine.with_components(**{name: new})
 
 
@@ -256,7 +256,7 @@ def penalty(blocks: Sequence[Block]) -> NDArray:
 def apply(machine: Machine, blocks: Sequence[Block], theta: NDArray) -> Machine:
     """`machine` with the fitted corrections added to its components."""
     updates: dict[str, object] = {}
-    tables: dict[str, dict[str, NDArray]] = {}
+    tables: dict[str, tuple[NDArray, dict[str, NDArray]]] = {}  # component: knots, "table" and "reversal"
     col = 0
     for b in blocks:
         values = theta[col : col + b.size] * SCALE[b.unit]
@@ -266,10 +266,10 @@ def apply(machine: Machine, blocks: Sequence[Block], theta: NDArray) -> Machine:
             continue
         full = np.zeros(len(b.knots))
         full[b.free] = values
-        entry = tables.setdefault(b.component, {"knots": b.knots, "table": np.zeros(len(b.knots)), "reversal": None})
-        entry[b.kind] = full
-    for name, entry in tables.items():
-        updates[name] = _combined(machine.component(name), entry["knots"], entry["table"], entry["reversal"])
+        _, corrections = tables.setdefault(b.component, (b.knots, {"table": np.zeros(len(b.knots))}))
+        corrections[b.kind] = full
+    for name, (knots, corrections) in tables.items():
+        updates[name] = _combined(machine.component(name), knots, corrections["table"], corrections.get("reversal"))
     return machine.with_components(**updates)  # type: ignore[arg-type]
 
 
@@ -282,7 +282,7 @@ def _combined(base, knots: NDArray, values: NDArray, reversal: NDArray | None) -
     plus = (0.0 if base is None else base(grid, 1.0)) + correction + half
     minus = (0.0 if base is None else base(grid, -1.0)) + correction - half
     directional = reversal is not None or getattr(base, "directional", False)
-    return Table(grid, plus, minus if directional else None, "linear")
+    return Table(tuple(grid), tuple(plus), tuple(minus) if directional else None, "linear")
 
 
 # -------------------------------------------------------------------- solve
@@ -389,10 +389,10 @@ def fit_ballbar(
     current, r = machine, r0
     lam = smoothing
     for _ in range(iterations):
-        b = _profiled(obs, r[:, None], sigma)[:, 0] + A @ theta
+        rhs = _profiled(obs, r[:, None], sigma)[:, 0] + A @ theta
         if lam is None:
-            lam = reg.gcv(b, n)
-        new, f = reg.solve(b, lam)
+            lam = reg.gcv(rhs, n)
+        new, f = reg.solve(rhs, lam)
         change = float(np.max(np.abs(new - theta))) if len(theta) else 0.0
         theta = new
         current = apply(machine, blocks, theta)

@@ -62,7 +62,7 @@ from ncpp.instruments import iso230_2
 from ncpp.instruments.files import ANGULAR_QUANTITIES, Measurement
 from ncpp.instruments.forward import ANGLE_COMPONENTS, level_member, predict_like, reading_component
 from ncpp.machine.chain import Chain
-from ncpp.machine.components import COMPONENTS, Table
+from ncpp.machine.components import COMPONENTS, Interpolation, Table
 from ncpp.machine.model import Machine
 
 DEFAULT_CHAIN = "XYFZ"
@@ -101,8 +101,9 @@ def sources_of(m: Measurement, chain: str) -> list[Source]:
     try:
         if m.instrument == "laser":
             name = reading_component(axis, m.quantity)
-            if m.quantity in ANGULAR_QUANTITIES and m.text("component"):
-                name = m.text("component", "").upper()
+            component = m.text("component")
+            if m.quantity in ANGULAR_QUANTITIES and component:
+                name = component.upper()
             found = [Source(m, name, m.deviation_column, 1.0)]
         elif m.instrument == "comparator":
             found = [Source(m, f"E{axis}{axis}", "linear_um", 1.0)]
@@ -166,7 +167,7 @@ class Update:
     change: float  # largest change of the component at the targets, file unit
 
 
-def _update(machine: Machine, s: Source, interpolation: str, reversal_threshold: float) -> Update:
+def _update(machine: Machine, s: Source, interpolation: Interpolation, reversal_threshold: float) -> Update:
     measured = _per_target(s, s.measurement)
     predicted = _per_target(s, predict_like(machine, s.measurement))
     t = measured.targets
@@ -182,11 +183,11 @@ def _update(machine: Machine, s: Source, interpolation: str, reversal_threshold:
     if _directional(s, measured, gap_up - gap_down + now[1.0] - now[-1.0], reversal_threshold):
         plus = now[1.0] + np.where(np.isnan(gap_up), gap_mean, gap_up)
         minus = now[-1.0] + np.where(np.isnan(gap_down), gap_mean, gap_down)
-        table = Table(t, plus / s.scale, minus / s.scale, interpolation)
+        table = Table(tuple(t), tuple(plus / s.scale), tuple(minus / s.scale), interpolation)
         change = float(np.max(np.abs(np.concatenate([plus - now[1.0], minus - now[-1.0]]))))
     else:
         values = now[None] + gap_mean
-        table = Table(t, values / s.scale, None, interpolation)
+        table = Table(tuple(t), tuple(values / s.scale), None, interpolation)
         change = float(np.max(np.abs(gap_mean)))
     return Update(table, change)
 
@@ -212,7 +213,7 @@ def fit_machine(
     chain: str | None = None,
     *,
     name: str | None = None,
-    interpolation: str = "smooth",
+    interpolation: Interpolation = "smooth",
     reversal_threshold: float = 0.5,
     sweeps: int = 6,
     tolerance: float = 1e-4,
@@ -233,7 +234,7 @@ def identify(
     chain: str | None = None,
     *,
     name: str | None = None,
-    interpolation: str = "smooth",
+    interpolation: Interpolation = "smooth",
     reversal_threshold: float = 0.5,
     sweeps: int = 6,
     tolerance: float = 1e-4,
@@ -269,8 +270,8 @@ def identify(
 
 
 def _fit_tables(
-    machine: Machine, sources: Sequence[Source], interpolation: str, reversal_threshold: float, sweeps: int,
-    tolerance: float,
+    machine: Machine, sources: Sequence[Source], interpolation: Interpolation, reversal_threshold: float,
+    sweeps: int, tolerance: float,
 ) -> Machine:  # fmt: skip
     taken: dict[str, Source] = {}
     for s in sources:

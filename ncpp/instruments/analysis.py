@@ -138,6 +138,7 @@ def _laser_profile(m: Measurement) -> Analysis:
     column = m.deviation_column
     profile = _line_fits(m, _mean_profile(m, column), m.quantity)
     result = iso230_2.evaluate_measurement(m, column)
+    figures: dict[str, float | None]
     if m.quantity in ANGULAR_QUANTITIES:
         figures = {
             "range_urad": profile.range,

@@ -424,9 +424,9 @@ def _check_meta(m: Measurement, header_line: int, meta_lines: Mapping[str, int])
             raise NcppError(err.message, at("radius_mm")) from None
         if radius is None or radius <= 0:
             raise NcppError(f"a {m.instrument} file needs '# radius_mm: R' (R > 0)", at("radius_mm"))
-    for key, view in (("center_mm", Measurement.center_mm), ("offset_mm", Measurement.offset_mm), ("fixed", Measurement.fixed), ("feed_mm_min", Measurement.feed_mm_min)):
+    for key in ("center_mm", "offset_mm", "fixed", "feed_mm_min"):  # properties that read the metadata
         try:
-            view.fget(m)
+            getattr(m, key)
         except NcppError as err:
             raise NcppError(err.message, at(key)) from None
 

@@ -58,7 +58,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ncpp.instruments.files import PLANES, Measurement, make_measurement
 from ncpp.machine.components import AXES
-from ncpp.machine.effects import LARGEST_LENGTH_MM
+from ncpp.machine.effects import LARGEST_LENGTH_MM, Angular
 from ncpp.machine.model import Machine
 from ncpp.machine.trajectory import Trajectory
 
@@ -117,7 +117,7 @@ def parse_fixed(fixed: Mapping[str, float] | str | None) -> dict[str, float]:
     return out
 
 
-def check_extent(values: ArrayLike, what: str) -> None:
+def check_extent(values: Sequence[float], what: str) -> None:
     """Refuse positions or lengths (mm) that are not finite or beyond LARGEST_LENGTH_MM."""
     if not np.all(np.abs(np.asarray(values, dtype=float)) <= LARGEST_LENGTH_MM):
         raise ValueError(f"{what} must be finite numbers within ±{LARGEST_LENGTH_MM:g} mm, got {values}")
@@ -226,7 +226,7 @@ def _angular_effects(machine: Machine, P: NDArray) -> NDArray:
     """Rotation (rad) the `angular` effects add (the others are pure translations)."""
     out = np.zeros(P.shape)
     for effect in machine.effects:
-        if effect.kind == "angular":
+        if isinstance(effect, Angular):
             info = effect.component  # e.g. ECZ
             i = AXES.index(info[2])
             out[:, "ABC".index(info[1])] += effect.urad_per_m * 1e-9 * (P[:, i] - effect.ref_mm)

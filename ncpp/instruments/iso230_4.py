@@ -130,7 +130,10 @@ def circular_test(m: Measurement) -> CircularTest:
         raise NcppError(f"{m.instrument} files hold no circular test", Location(m.source))
     if not traces or not all(len(t.angle_deg) >= 3 for t in traces):
         raise NcppError("a circular test needs at least three points per direction", Location(m.source))
-    return CircularTest(traces, float(m.radius_mm), m.plane, m.feed_mm_min, m.source)
+    radius = m.radius_mm
+    if radius is None:  # a file without it is refused on loading (ballbar, cutting) or above (grid)
+        raise NcppError(f"a {m.instrument} file needs '# radius_mm: R' (R > 0)", Location(m.source))
+    return CircularTest(traces, float(radius), m.plane, m.feed_mm_min, m.source)
 
 
 def _grid_traces(m: Measurement) -> tuple[Trace, ...]:
@@ -397,9 +400,9 @@ def diagnose_circular(test: CircularTest, spike_width_deg: float = 3.0) -> Diagn
     figures[f"centre_offset_{p}_um"] = float(np.mean(coef[1 : 3 * n_dir : 3]))
     figures[f"centre_offset_{q}_um"] = float(np.mean(coef[2 : 3 * n_dir : 3]))
     figures["radius_deviation_um"] = float(np.mean(coef[0 : 3 * n_dir : 3]))
-    figures["residual_rms_um"] = float(math.sqrt(float(residual @ residual) / len(y)))
+    figures["residual_rms_um"] = rms = float(math.sqrt(float(residual @ residual) / len(y)))
     splits = np.cumsum([len(t.theta) for t in test.traces])[:-1]
-    return Diagnosis(figures, uncertainty, figures["residual_rms_um"], tuple(np.split(fitted, splits)))
+    return Diagnosis(figures, uncertainty, rms, tuple(np.split(fitted, splits)))
 
 
 def diagnose_measurement(m: Measurement, spike_width_deg: float = 3.0) -> Diagnosis:

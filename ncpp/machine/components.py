@@ -54,6 +54,7 @@ from numpy.typing import ArrayLike, NDArray
 AXES = "XYZ"
 ROTATIONS = "ABC"
 SQUARENESS = ("C0Y", "B0Z", "A0Z")
+Interpolation = Literal["linear", "smooth"]  # of a `Table`: straight lines, or monotone cubic (PCHIP)
 
 
 @dataclass(frozen=True)
@@ -152,7 +153,7 @@ class Table:
     positions: tuple[float, ...]
     values: tuple[float, ...]
     values_minus: tuple[float, ...] | None = None  # travel in the − direction
-    interpolation: Literal["linear", "smooth"] = "linear"
+    interpolation: Interpolation = "linear"
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "positions", _floats(self.positions, "positions"))
@@ -201,8 +202,11 @@ class Table:
 
     def scaled(self, factor: float) -> "Table":
         """The same table with values multiplied (unit conversion, sign flip)."""
-        minus = None if self.values_minus is None else np.multiply(self.values_minus, factor)
-        return Table(self.positions, np.multiply(self.values, factor), minus, self.interpolation)
+        values = _floats(np.multiply(self.values, factor), "values")
+        minus = self.values_minus
+        if minus is not None:
+            minus = _floats(np.multiply(minus, factor), "minus values")
+        return Table(self.positions, values, minus, self.interpolation)
 
 
 @dataclass(frozen=True)
@@ -237,7 +241,8 @@ class Polynomial:
         return np.polyval(self.coefficients[::-1], p - self.reference)
 
     def scaled(self, factor: float) -> "Polynomial":
-        return Polynomial(np.multiply(self.coefficients, factor), self.reference, self.limits)
+        coefficients = _floats(np.multiply(self.coefficients, factor), "coefficients")
+        return Polynomial(coefficients, self.reference, self.limits)
 
 
 Component = Union[Table, Polynomial]
@@ -312,7 +317,8 @@ class StackedTables:
     def __init__(self, tables: list[Table]):
         # Curve rows: each table's + (or only) curve in table order, then the − curves, so the
         # first rows are the tables' values once the direction has chosen (no copy).
-        curves = [(t, t.values) for t in tables] + [(t, t.values_minus) for t in tables if t.directional]
+        backward = [(t, t.values_minus) for t in tables if t.values_minus is not None]  # the directional ones
+        curves = [(t, t.values) for t in tables] + backward
         pieces = [_cubic_pieces(t, v) for t, v in curves]
         grid = np.unique(np.concatenate([x for x, _ in pieces]))
         if len(grid) == 1:

@@ -51,14 +51,16 @@ class BowBound:
             return None
         if any(not isinstance(c, Table) or (c.interpolation == "linear" and len(c.positions) > 2) for c in machine.components.values()):
             return None
-        axes, angles = {}, 0.0
+        axes: dict[str, _AxisBound] = {}
+        angles = 0.0
         for axis, (stacked, rows, _) in machine._evaluators.items():
             if stacked is None:
                 continue
             mine = [c for n, c in machine.components.items() if COMPONENTS[n].axis == axis]
-            axes[axis] = bound = _AxisBound.of(stacked, rows, mine)
+            bound = _AxisBound.of(stacked, rows, mine)
             if bound is None:
                 return None
+            axes[axis] = bound
             angles += bound.angle
         return cls(machine, axes) if angles <= MAX_ANGLE else None
 

@@ -61,8 +61,10 @@ def _axis(name: str, what: str = "axis") -> int:
     return AXES.index(name)
 
 
+@dataclass(frozen=True)
 class Effect:
-    """Base: dict round trip and the shared `apply` signature."""
+    """Base: dict round trip and the shared `apply` signature.  A dataclass without
+    fields, so that every effect is one to `dataclasses` (and to the type checker)."""
 
     kind: ClassVar[str]
     # True when the effect depends on position alone (not on time, feed or the
@@ -74,7 +76,7 @@ class Effect:
 
     def to_dict(self) -> dict[str, Any]:
         out: dict[str, Any] = {"kind": self.kind}
-        for f in dataclasses.fields(self):  # type: ignore[arg-type]
+        for f in dataclasses.fields(self):
             value = getattr(self, f.name)
             if value is not None:
                 out[f.name] = list(value) if isinstance(value, tuple) else value

@@ -87,7 +87,7 @@ from ncpp.fileio import write_text_atomic
 from ncpp.machine.chain import SMALL_ANGLE
 from ncpp.machine.components import AXES, COMPONENTS, SQUARENESS, Polynomial, Table, canonical_name
 from ncpp.machine.effects import LARGEST_ERROR, LARGEST_LENGTH_MM, effect_from_dict, is_finite_number
-from ncpp.machine.model import Machine
+from ncpp.machine.model import Machine, Vec3
 
 SECTIONS = {"machine", "offsets", "limits", "errors", "squareness", "effects", "compensation", "meta"}
 SCALE = {"um": 1e-3, "urad": 1e-6}  # file unit -> model unit (mm, rad)
@@ -254,10 +254,11 @@ def _machine_from_dict(data: dict, loc: _Locator, default_name: str) -> Machine:
         raise _fail("[machine] needs chain, e.g. chain = \"XZFY\"", loc.where("machine"))
     offsets = _get_table(data, "offsets", loc)
     _check_keys(offsets, {"tool", "work", "reference"}, "offsets", loc)
-    tool_work = _vectors({k: v for k, v in offsets.items() if k != "reference"}, "offsets", "x, y, z", loc)
+    given = {k: v for k, v in offsets.items() if k != "reference"}
+    tool_work = {k: _xyz(v) for k, v in _vectors(given, "offsets", "x, y, z", loc).items()}
     limits = _get_table(data, "limits", loc)
     _check_keys(limits, set(AXES), "limits", loc)
-    travel = _vectors(limits, "limits", "lo, hi", loc)
+    travel = {k: _span(v) for k, v in _vectors(limits, "limits", "lo, hi", loc).items()}
     comp = _get_table(data, "compensation", loc)
     _check_keys(comp, {"max_correction_mm", "rotary_xyz_are_axis_positions"}, "compensation", loc)
     rotary = comp.get("rotary_xyz_are_axis_positions", False)
@@ -330,17 +331,32 @@ def _vector(value: Any, key: str, names: str) -> list[float]:
     return [float(v) for v in value]
 
 
-def _references(offsets: dict, loc: _Locator) -> dict[str, list[float]]:
+def _xyz(vector: list[float]) -> Vec3:
+    """A `_vector` of "x, y, z" as the point it is."""
+    x, y, z = vector
+    return x, y, z
+
+
+def _span(vector: list[float]) -> tuple[float, float]:
+    """A `_vector` of "lo, hi" as the interval it is."""
+    lo, hi = vector
+    return lo, hi
+
+
+def _references(offsets: dict, loc: _Locator) -> dict[str, Vec3]:
     refs = offsets.get("reference", {})
     if not isinstance(refs, dict):
         message = "offsets: reference must be a table of axis reference points, e.g. reference.X = [0.0, 350.0, 100.0]"
         raise _fail(message, loc.where("offsets", "reference"))
     _check_keys(refs, set(AXES), "offsets.reference", loc)
-    return _vectors(refs, "offsets.reference", "x, y, z", loc)
+    return {k: _xyz(v) for k, v in _vectors(refs, "offsets.reference", "x, y, z", loc).items()}
 
 
-def _components(errors: dict, travel: dict[str, list[float]], loc: _Locator) -> dict[str, Table | Polynomial]:
-    components, names = {}, {}
+def _components(
+    errors: dict, travel: dict[str, tuple[float, float]], loc: _Locator
+) -> dict[str, Table | Polynomial]:
+    components: dict[str, Table | Polynomial] = {}
+    names: dict[str, str] = {}  # ISO name: the name the file gave
     for name, spec in errors.items():
         try:
             iso = canonical_name(name)
@@ -357,7 +373,8 @@ def _components(errors: dict, travel: dict[str, list[float]], loc: _Locator) -> 
 
 
 def _squareness(table: dict, loc: _Locator) -> dict[str, float]:
-    angles, keys = {}, {}
+    angles: dict[str, float] = {}
+    keys: dict[str, str] = {}  # ISO name: the key the file gave
     for key, value in table.items():
         try:
             base, unit = _split_unit(key, ("_urad", "_um_per_m"))
@@ -462,7 +479,7 @@ def _number(value: Any, key: str) -> float:
     return float(value)
 
 
-def _component_from_dict(iso: str, spec: Any, travel: list[float] | None) -> Table | Polynomial:
+def _component_from_dict(iso: str, spec: Any, travel: tuple[float, float] | None) -> Table | Polynomial:
     if not isinstance(spec, dict):
         raise ValueError("must be a table with kind = \"table\" or \"polynomial\"")
     unit = COMPONENTS[iso].unit
@@ -483,9 +500,9 @@ def _table(spec: dict, unit: str) -> Table:
     _require(spec, allowed, {"positions", f"values_{unit}"})
     scale, minus = SCALE[unit], spec.get(f"values_{unit}_minus")
     table = Table(
-        _numbers(spec["positions"], "positions"),
-        [v * scale for v in _numbers(spec[f"values_{unit}"], f"values_{unit}")],
-        None if minus is None else [v * scale for v in _numbers(minus, f"values_{unit}_minus")],
+        tuple(_numbers(spec["positions"], "positions")),
+        tuple(v * scale for v in _numbers(spec[f"values_{unit}"], f"values_{unit}")),
+        None if minus is None else tuple(v * scale for v in _numbers(minus, f"values_{unit}_minus")),
         spec.get("interpolation", "linear"),
     )
     # both interpolations stay within the tabulated values (PCHIP keeps their shape)
@@ -496,13 +513,13 @@ def _table(spec: dict, unit: str) -> Table:
     return table
 
 
-def _polynomial(spec: dict, unit: str, travel: list[float] | None) -> Polynomial:
+def _polynomial(spec: dict, unit: str, travel: tuple[float, float] | None) -> Polynomial:
     key = f"coefficients_{unit}"
     _require(spec, {"kind", key, "reference_mm", "range_mm"}, {key})
     poly = Polynomial(
-        [c * SCALE[unit] for c in _numbers(spec[key], key)],
+        tuple(c * SCALE[unit] for c in _numbers(spec[key], key)),
         _number(spec.get("reference_mm", 0.0), "reference_mm"),
-        None if "range_mm" not in spec else _vector(spec["range_mm"], "range_mm", "lo, hi"),
+        None if "range_mm" not in spec else _span(_vector(spec["range_mm"], "range_mm", "lo, hi")),
     )
     span = poly.limits or travel  # where it is evaluated; with neither, anywhere: nothing to check
     if span is not None:

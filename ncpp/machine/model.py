@@ -171,7 +171,7 @@ class Machine:
     def _evaluators(self) -> dict[str, tuple[StackedTables | None, list[int], list[tuple[int, Component]]]]:
         """Per axis: its tables stacked for one-pass evaluation with the row of each
         in `error_motions`' (6, n) motions, and the other components with theirs."""
-        out = {}
+        out: dict[str, tuple[StackedTables | None, list[int], list[tuple[int, Component]]]] = {}
         for axis in AXES:
             mine = [(_motion_row(n), c) for n, c in self.components.items() if COMPONENTS[n].axis == axis]
             tables = [(row, c) for row, c in mine if isinstance(c, Table)]
@@ -198,7 +198,7 @@ class Machine:
             stacked, rows, others = self._evaluators[axis]
             p, d = pts[:, i], None if dirs is None else dirs[:, i]
             values = None if stacked is None else stacked(p, d)
-            if rows == MOTION_ROWS:
+            if values is not None and rows == MOTION_ROWS:
                 motions = values  # all six are tables: their values are the motions, as they are
             else:
                 motions = np.zeros((6, len(pts)))  # δx δy δz εx εy εz, each row contiguous (see chain.columns)
@@ -252,6 +252,7 @@ class Machine:
         (scale, squareness, straightness, cyclic, angular), mm: what
         compensation can cancel.  A straightness bow without `range_mm` spans
         the axis travel."""
+        from ncpp.machine.effects import Straightness
         from ncpp.machine.trajectory import Trajectory
 
         pts = as_points(P)
@@ -261,7 +262,7 @@ class Machine:
             padded = pts if len(pts) >= 2 else np.vstack([pts, pts])
             trajectory = Trajectory(padded, 1000.0)
             for effect in static:
-                if effect.kind == "straightness" and effect.range_mm is None:
+                if isinstance(effect, Straightness) and effect.range_mm is None:
                     lo, hi = self.limits.get(effect.axis, (-math.inf, math.inf))
                     if math.isfinite(lo) and math.isfinite(hi):
                         effect = dataclasses.replace(effect, range_mm=(lo, hi))

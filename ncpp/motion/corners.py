@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 from dataclasses import replace
 
-from ncpp.motion.segments import PLANE_AXES, Arc, Event, Line
+from ncpp.motion.segments import PLANE_AXES, Arc, Event, Line, Point
 from ncpp.program.blocks import Block
 
 TINY = 1e-12
@@ -46,18 +46,22 @@ def round_corner(first: Line, second: Line, kind: str, size: float, block: Block
     if distance > lu + TINY or distance > lv + TINY:
         raise CornerError(f"corner {'chamfer' if kind == 'C' else 'radius'} {size:g} does not fit between the moves")
     corner = first.end
-    t1, t2 = list(corner), list(corner)
-    t1[i], t1[j] = corner[i] - distance * u[0], corner[j] - distance * u[1]
-    t2[i], t2[j] = corner[i] + distance * v[0], corner[j] + distance * v[1]
-    start, end = tuple(t1), tuple(t2)
+    start = _in_plane(corner, i, j, corner[i] - distance * u[0], corner[j] - distance * u[1])
+    end = _in_plane(corner, i, j, corner[i] + distance * v[0], corner[j] + distance * v[1])
     piece_block = first.block if block is None else block
     piece_feed = first.feed if feed is None else feed
     if kind == "C":
         piece: Event = replace(first, start=start, end=end, block=piece_block, feed=piece_feed)
     else:
         side = 1.0 if cross > 0 else -1.0  # the centre lies on the inside of the turn
-        centre = list(t1)
-        centre[i], centre[j] = t1[i] - side * size * u[1], t1[j] + side * size * u[0]
-        piece = Arc(start, end, tuple(centre), 1 if cross > 0 else -1, piece_feed, piece_block,  # type: ignore[arg-type]
-                    first.context, first.extra)
+        centre = _in_plane(start, i, j, start[i] - side * size * u[1], start[j] + side * size * u[0])
+        turn = 1 if cross > 0 else -1
+        piece = Arc(start, end, centre, turn, piece_feed, piece_block, first.context, first.extra)
     return [replace(first, end=start), piece, replace(second, start=end)]
+
+
+def _in_plane(p: Point, i: int, j: int, a: float, b: float) -> Point:
+    """`p` with its coordinates i and j (the plane's) set to a and b."""
+    q = list(p)
+    q[i], q[j] = a, b
+    return (q[0], q[1], q[2])

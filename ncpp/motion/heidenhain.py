@@ -31,7 +31,14 @@ from typing import Iterable, Iterator
 
 from ncpp.errors import Location, NcppError, Warnings
 from ncpp.motion.corners import CornerError, round_corner
-from ncpp.motion.modal import MM_PER_INCH, PLANE_OF_TOOL_AXIS, ModalInterpreter, OutOfScope, resolve_warnings
+from ncpp.motion.modal import (
+    MM_PER_INCH,
+    PLANE_OF_TOOL_AXIS,
+    ModalInterpreter,
+    OutOfScope,
+    as_point,
+    resolve_warnings,
+)
 from ncpp.motion.offsets import WorkOffsets
 from ncpp.motion.segments import COMP, PLANE_AXES, Arc, Event, Line, Pass, Point
 from ncpp.motion.tools import ToolTable, UntoldLengths
@@ -110,16 +117,18 @@ class HeidenhainInterpreter(ModalInterpreter):
                     yield event
                 continue
             if corner is not None:
-                made = self._cut(held, corner, event, warnings)  # type: ignore[arg-type]
+                made = self._cut(held, corner, event, warnings)
                 if made is None:  # out of scope: the line, the corner and this move pass through
                     yield from (e if type(e) is Pass else Pass(e.block) for e in held)
                     yield Pass(event.block)
                     held, corner = [], None
                     continue
-                held[0], event = made[0], made[-1]
+                first, last = made[0], made[-1]
+                assert not isinstance(first, Pass) and not isinstance(last, Pass)  # round_corner's lines
+                held[0], event = first, last
                 piece = made[1] if len(made) == 3 else Pass(corner.block)
-                if COMP in (made[0].fixed, made[-1].fixed) and type(piece) is not Pass:  # (the rounding is the contour's)
-                    piece.fixed = COMP  # type: ignore[attr-defined]
+                if COMP in (first.fixed, last.fixed) and not isinstance(piece, Pass):  # (the rounding is the contour's)
+                    piece.fixed = COMP
                 held = [piece if e is corner else e for e in held]
                 corner = None
             yield from held
@@ -136,13 +145,15 @@ class HeidenhainInterpreter(ModalInterpreter):
     def _cut(self, held: list[Event], corner: Corner, second: Line | Arc, warnings: Warnings) -> list[Event] | None:
         """[first line shortened, fillet or chamfer, second line] or None when out of scope."""
         where = Location(self.file, corner.block.line, corner.col)
-        if type(second) is not Line or second.rapid:
+        if not isinstance(second, Line) or second.rapid:
             self.done = True
             warnings.warn("RND/CHF next to an arc or a rapid move is outside the motion interpreter's scope; "
                           "from this line on the program passes through uninterpreted", where)  # fmt: skip
             return None
+        first = held[0]
+        assert isinstance(first, Line)  # `run` holds back a feed line and what follows it
         try:
-            return round_corner(held[0], second, corner.kind, corner.size, corner.block, corner.feed)  # type: ignore[arg-type]
+            return round_corner(first, second, corner.kind, corner.size, corner.block, corner.feed)
         except CornerError as err:
             raise NcppError(str(err), where) from None
 
@@ -161,12 +172,11 @@ class HeidenhainInterpreter(ModalInterpreter):
         comp: str | None = None  # RL, RR or R0
         end = False
         for item in block.items:
-            kind = type(item)
-            if kind is Comment:
+            if type(item) is Comment:
                 continue
-            if kind is Word or kind is ExprWord:
+            if type(item) is Word or type(item) is ExprWord:
                 letter = item.letter
-                value = item.value if kind is Word else self.value(item.expr, block, item)
+                value = item.value if type(item) is Word else self.value(item.expr, block, item)
                 if letter == "N":
                     continue
                 if letter == "M":
@@ -221,8 +231,8 @@ class HeidenhainInterpreter(ModalInterpreter):
         if "F" in words and function is not None:
             self.feed = words["F"][0]
         events = self._path(block, function, function_item, words, rapid, rotation) if function else []
-        if events and type(events[-1]) in (Line, Arc):
-            self.last_move, self.corner_waits = events[-1], False  # type: ignore[assignment]
+        if events and isinstance(events[-1], (Line, Arc)):
+            self.last_move, self.corner_waits = events[-1], False
         if end:
             self.done = True
         return self.radius_compensation(events, None if comp is None else comp != "R0")
@@ -281,7 +291,7 @@ class HeidenhainInterpreter(ModalInterpreter):
         lengths = self.tools.edges.get((number, 1))
         if lengths is None:
             self.fail(f"tool {number:g} is not defined: neither in {self.tools.source} nor by TOOL DEF", block, statement)
-        return lengths[0] / (MM_PER_INCH if self.inch else 1.0)  # type: ignore[index]
+        return lengths[0] / (MM_PER_INCH if self.inch else 1.0)
 
     def _word_value(self, item, block: Block) -> float:
         return item.value if type(item) is Word else self.value(item.expr, block, item)
@@ -344,12 +354,12 @@ class HeidenhainInterpreter(ModalInterpreter):
     def _set_pole(self, block: Block, end: list[float], written: set[int]) -> Pole:
         self.pole = end
         self.pole_plane = _plane_of_axes(written, self.plane)
-        return Pole(block, tuple(end), self.pole_plane)  # type: ignore[arg-type]
+        return Pole(block, center=as_point(end), plane=self.pole_plane)
 
     def _need_pole(self, block: Block, item) -> list[float]:
         if self.pole is None:
             self.fail("a circle or polar move with no pole: program CC first", block, item)
-        return self.pole  # type: ignore[return-value]
+        return self.pole
 
     def _circle(self, block: Block, item, end: list[float], rotation: str | None):
         centre = list(self._need_pole(block, item))

@@ -10,7 +10,8 @@ expression trees both dialect builders produce (angles in degrees).
 from __future__ import annotations
 
 import math
-from typing import Callable, Iterable, Iterator
+from collections.abc import Sequence
+from typing import Callable, Iterable, Iterator, NoReturn
 
 from ncpp.errors import Location, NcppError, Warnings
 from ncpp.motion.segments import PLANE_AXES, Arc, Context, Event, Line, Pass, Point, mark_off_path
@@ -94,8 +95,8 @@ class ModalInterpreter:
     def context(self, plane: int | None = None, absolute: bool = True) -> Context:
         plane = plane or self.plane
         if self._context is None or self._context.plane != plane or self._context.absolute != absolute:
-            offset = tuple(z + o for z, o in zip(self.zero, self.offset))
-            self._context = Context(plane, absolute, False, self.inch, offset, tuple(self.tool))  # type: ignore[arg-type]
+            offset = as_point([z + o for z, o in zip(self.zero, self.offset)])
+            self._context = Context(plane, absolute, False, self.inch, offset, as_point(self.tool))
         return self._context
 
     def set_units(self, inch: bool) -> None:
@@ -140,28 +141,28 @@ class ModalInterpreter:
             self.fail("number out of range", block, item)
         return value
 
-    def fail(self, message: str, block: Block, item=None) -> None:
+    def fail(self, message: str, block: Block, item=None) -> NoReturn:
         raise NcppError(message, Location(self.file, block.line, item.start + 1 if item is not None else None))
 
     # -- events ---------------------------------------------------------------------------
     def line(self, block: Block, end: list[float], rapid: bool, absolute: bool = True) -> Line:
-        start = tuple(self.pos)
+        start = as_point(self.pos)
         d = [e - s for e, s in zip(end, start)]
         length = math.sqrt(sum(v * v for v in d))
         if length > 0:
             self.tangent = (d[0] / length, d[1] / length, d[2] / length)
         self.pos = list(end)
-        return Line(start, tuple(end), rapid, self.feed, block, self.context(absolute=absolute))  # type: ignore[arg-type]
+        return Line(start, as_point(end), rapid, self.feed, block, self.context(absolute=absolute))
 
     def arc(self, block: Block, end: list[float], centre: list[float], turn: int, plane: int | None = None,
             absolute: bool = True) -> Arc:
         """An arc from the position to `end` about `centre` (its plane coordinates count)."""
         plane = plane or self.plane
         a, b, n = PLANE_AXES[plane]
-        start = tuple(self.pos)
+        start = as_point(self.pos)
         c = list(centre)
         c[n] = start[n]
-        event = Arc(start, tuple(end), tuple(c), turn, self.feed, block, self.context(plane, absolute))  # type: ignore[arg-type]
+        event = Arc(start, as_point(end), as_point(c), turn, self.feed, block, self.context(plane, absolute))
         # tangent at the end: perpendicular to the radius, turning with the arc, plus the helix rise
         ra, rb = end[a] - c[a], end[b] - c[b]
         sign = 1.0 if turn > 0 else -1.0
@@ -224,7 +225,12 @@ class ModalInterpreter:
         return self.arc(block, end, centre, 1 if s > 0 else -1, absolute=absolute)
 
 
-def plane_of(points: list[Point]) -> int | None:
+def as_point(values: Sequence[float]) -> Point:
+    """An x, y, z list (the interpreter's working positions) as the point an event holds."""
+    return (values[0], values[1], values[2])
+
+
+def plane_of(points: Sequence[Sequence[float]]) -> int | None:
     """The principal plane (17, 18, 19) containing all points, if any (a shared normal coordinate)."""
     for plane, (_, _, n) in PLANE_AXES.items():
         if max(p[n] for p in points) - min(p[n] for p in points) < 1e-9:
@@ -232,7 +238,9 @@ def plane_of(points: list[Point]) -> int | None:
     return None
 
 
-def circle_through(p0: Point, p1: Point, p2: Point, plane: int) -> tuple[list[float], int] | None:
+def circle_through(
+    p0: Sequence[float], p1: Sequence[float], p2: Sequence[float], plane: int
+) -> tuple[list[float], int] | None:
     """Centre and turn (+1 counter-clockwise) of the arc from p0 through p1 to p2 in `plane`."""
     a, b, _ = PLANE_AXES[plane]
     ax, ay, bx, by, cx, cy = p0[a], p0[b], p1[a], p1[b], p2[a], p2[b]

@@ -114,21 +114,21 @@ class SinumerikInterpreter(ModalInterpreter):
     # -- one block ------------------------------------------------------------------------
     def block(self, block: Block) -> list[Event]:
         words: dict[str, tuple[float, str | None, object]] = {}  # letter -> (value, 'ac' | 'ic' | None, item)
-        gcodes: list[tuple[float, Word]] = []
+        gcodes: list[tuple[float, Word | ExprWord]] = []
         path: str | None = None
         frame: Statement | None = None
         end = False
         tool_words: list = []  # the block's T, M6 and D words, in order
-        previous = None
+        previous: Word | ExprWord | Statement | None = None
         for item in block.items:
-            kind = type(item)
-            if kind is Comment:
+            if type(item) is Comment:
                 continue
             before, previous = previous, item
-            if kind is Statement:
+            if type(item) is Statement:
                 what = item.kind
                 if what == "assignment":
-                    self.assign(*item.node, block, item)
+                    target, expr = item.node
+                    self.assign(target, expr, block, item)
                 elif what == "def":
                     self.define(item.node, block, item)
                 elif what == "path" and item.node[0] in ("CIP", "CT"):
@@ -141,10 +141,10 @@ class SinumerikInterpreter(ModalInterpreter):
                     name = item.node[0] if what in ("call", "path", "frame") else what.upper()
                     raise OutOfScope(f"{what} {name}" if what in ("call", "path", "frame") else name, item.start + 1)
                 continue
-            if item.letter == "T" and kind is ExprWord and item.expr[0] == "str":  # T="NAME"
+            if type(item) is ExprWord and item.letter == "T" and item.expr[0] == "str":  # T="NAME"
                 tool_words.append((item, item.expr[1]))
                 continue
-            if kind is Word:
+            if type(item) is Word:
                 letter, value, mode = item.letter, item.value, None
                 if letter == "E" and type(before) is not Word and before is not None and before.end == item.start:
                     self._exponent(block, before, item)
@@ -222,11 +222,11 @@ class SinumerikInterpreter(ModalInterpreter):
         number = self.loaded if type(self.loaded) is float else self.tools.names.get(self.loaded)  # type: ignore[arg-type]
         if number is None:
             self.fail(f'tool "{self.loaded}" is not in {self.tools.source}', block, item)
-        lengths = self.tools.edges.get((number, self.edge))  # type: ignore[arg-type]
+        lengths = self.tools.edges.get((number, self.edge))
         if lengths is None:
             self.fail(f"tool {self.loaded if type(self.loaded) is str else f'{number:g}'} has no cutting edge D{self.edge} in {self.tools.source}",
                       block, item)  # fmt: skip
-        return lengths  # type: ignore[return-value]
+        return lengths
 
     def _word_value(self, item: ExprWord, block: Block) -> tuple[float, str | None]:
         expr = item.expr
@@ -238,7 +238,7 @@ class SinumerikInterpreter(ModalInterpreter):
             return 0.0, None  # `T="MILL"`: a name, no motion
         return self.value(expr, block, item), None
 
-    def _modal_codes(self, gcodes: list[tuple[float, Word]], block: Block) -> bool:
+    def _modal_codes(self, gcodes: list[tuple[float, Word | ExprWord]], block: Block) -> bool:
         """Apply the block's G codes; True for a dwell block (its F is a time)."""
         dwell = False
         for code, item in gcodes:
@@ -319,15 +319,15 @@ class SinumerikInterpreter(ModalInterpreter):
             if letter in words:
                 value, mode, _ = words[letter]
                 middle[n] = value if mode == "ac" or (mode is None and self.absolute) else self.pos[n] + value
-        points = [tuple(self.pos), tuple(middle), tuple(end)]
+        points = [self.pos, middle, end]
         item = next(iter(words.values()))[2]
         plane = plane_of(points)
         if plane is None:
             raise OutOfScope("CIP in a plane other than XY, ZX, YZ", item.start + 1)
         if plane != self.plane:
             raise OutOfScope(f"CIP outside the working plane G{self.plane}", item.start + 1)
-        found = circle_through(*points, plane)
+        found = circle_through(self.pos, middle, end, plane)
         if found is None or math.dist(points[0], points[2]) < 1e-9:
             self.fail("CIP points in a line (or a full circle): no arc through them", block, item)
-        centre, turn = found  # type: ignore[misc]
+        centre, turn = found
         return self.arc(block, end, centre, turn, plane, absolute)

@@ -195,14 +195,15 @@ def read_tool_t(lines: list[str], file: str) -> tuple[dict[tuple[float, int], tu
     return tools, names
 
 
-def _columns(header: str, file: str) -> dict[str, tuple[int, int]]:
-    """Each column's (start, end) in the lines: from its name to the next column's name."""
+def _columns(header: str, file: str) -> dict[str, tuple[int, int | None]]:
+    """Each column's (start, end) in the lines: from its name to the next column's name
+    (None: the last column runs to the end of the line)."""
     found = list(_WORD.finditer(header))
     columns = {m.group().upper(): (m.start(), found[k + 1].start() if k + 1 < len(found) else None) for k, m in enumerate(found)}
     for needed in ("T", "L"):
         if needed not in columns:
             raise NcppError(f"TOOL.T header without a {needed} column", Location(file, 2, 1))
-    return columns  # type: ignore[return-value]
+    return columns
 
 
 def _decimal(text: str, col: int, line: Location) -> float:
@@ -210,7 +211,7 @@ def _decimal(text: str, col: int, line: Location) -> float:
     return _number(text.replace(",", ".") or "0", Location(line.file, line.line, col))
 
 
-def _field(line: str, columns: dict[str, tuple[int, int]], name: str) -> tuple[str, int]:
+def _field(line: str, columns: dict[str, tuple[int, int | None]], name: str) -> tuple[str, int]:
     """The stripped text of a column in a line ('' where the table has no such column), and its 1-based column."""
     if name not in columns:
         return "", 1

@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 import re
 from dataclasses import dataclass
+from itertools import pairwise
 from typing import Callable, Iterable, Iterator
 
 from ncpp.cldata.motion import MAX_WORD, units_inch
@@ -81,7 +82,9 @@ class Generator:
     decimals_mm = 4
     decimals_inch = 5
 
-    def __init__(self, warnings: Warnings | None = None, header: str | None = None, file: str = "<stdin>"):
+    def __init__(
+        self, warnings: Warnings | None = None, header: str | None = None, file: str = "<stdin>"
+    ) -> None:
         self.warnings = warnings or Warnings()
         self.file = file
         self.job = Job(header=header)
@@ -260,9 +263,9 @@ def _spindle_speed(rec: Record) -> float:
 def _named_number(rec: Record, names: tuple[str, ...]) -> float | None:
     """The number after the first of `names` among the record's arguments (`MMPM, 50`)."""
     args = rec.args
-    for k, arg in enumerate(args[:-1]):
-        if arg in names and isinstance(args[k + 1], float):
-            return args[k + 1]
+    for arg, after in pairwise(args):
+        if arg in names and isinstance(after, float):
+            return after
     return None
 
 

@@ -10,7 +10,7 @@ record or the first move.
 from __future__ import annotations
 
 import math
-from typing import Iterable, Iterator
+from typing import Any, Iterable, Iterator
 
 from ncpp.motion.segments import PLANE_AXES, Arc, Event, Line
 from ncpp.post.generator import Generator, SetupLookup, number
@@ -24,7 +24,7 @@ def signed(value: float, decimals: int) -> str:
 
 
 class HeidenhainGenerator(Generator):
-    def __init__(self, *args, **kwargs):
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
         self.pending_tool: int | None = None
 

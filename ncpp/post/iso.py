@@ -6,7 +6,7 @@ default), both plane axes always written, full turns split off.
 
 from __future__ import annotations
 
-from typing import Iterator
+from typing import Any, Iterator
 
 from ncpp.motion.segments import PLANE_AXES, Arc, Line
 from ncpp.post.generator import Generator, number
@@ -21,7 +21,7 @@ class IsoGenerator(Generator):
     program_end = 30
     keep_point = True  # "X12." — a FANUC reads "X12" as 12 µm
 
-    def __init__(self, *args, **kwargs):
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
         self.motion: int | None = None
         self.plane: int | None = None
@@ -109,7 +109,7 @@ class FanucGenerator(IsoGenerator):
     """FANUC: `%`, an O number, decimal points on every coordinate; the tool
     length offset (G43 H) goes with the first Z move after a tool change."""
 
-    def __init__(self, *args, **kwargs):
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
         self.length_offset: int | None = None
 

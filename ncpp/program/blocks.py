@@ -13,7 +13,7 @@ control bytes) survives the round trip.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Union
+from typing import Union, final
 
 # A line's layout: its Latin-1 bytes with every digit '1'.  Lines of one layout differ only in
 # their digits: the parser cuts them into words at the same places, the writer edits them alike.
@@ -39,7 +39,7 @@ class Item:
         return tuple(getattr(self, name) for cls in type(self).__mro__ for name in getattr(cls, "__slots__", ()))
 
     def __eq__(self, other: object) -> bool:
-        return type(self) is type(other) and self._fields() == other._fields()  # type: ignore[union-attr]
+        return type(self) is type(other) and self._fields() == other._fields()
 
     def __hash__(self) -> int:
         return hash((type(self), self._fields()))
@@ -49,6 +49,7 @@ class Item:
         return f"{type(self).__name__}({', '.join(f'{n}={getattr(self, n)!r}' for n in names)})"
 
 
+@final  # the readers and writers tell items apart by `type(item) is ...`
 class Word(Item):
     """A letter with a number: `G1`, `Z -110`, `F100.`; `,C1.` has letter ',C'.
 
@@ -65,6 +66,7 @@ class Word(Item):
         self.number = number
 
 
+@final  # the readers and writers tell items apart by `type(item) is ...`
 class ExprWord(Item):
     """A letter whose value is an expression: `X[#1+2]`, `X#140/2`."""
 
@@ -76,6 +78,7 @@ class ExprWord(Item):
         self.expr = expr
 
 
+@final  # the readers and writers tell items apart by `type(item) is ...`
 class Comment(Item):
     """`(text)` or `; text`; `text` excludes the delimiters."""
 
@@ -87,6 +90,7 @@ class Comment(Item):
         self.style = style
 
 
+@final  # the readers and writers tell items apart by `type(item) is ...`
 class Statement(Item):
     """A construct the motion interpreter does not execute directly.
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 import copy
 from typing import BinaryIO, Collection, Iterable, Mapping, Sequence
 
-from ncpp.program.blocks import Block, Comment, Item, Word
+from ncpp.program.blocks import AnyItem, Block, Comment, Word
 from ncpp.program.numbers import NumberStyle, format_number
 
 
@@ -92,8 +92,7 @@ def set_words(
     at = None  # where appended words go (an index into `pieces`): after the last axis word, else the last word
     seen_axis = False
     for item in block.items:
-        kind = type(item)
-        if kind is Word:
+        if type(item) is Word:
             letter = item.letter
             text = pending.pop(letter, None)
             if text is not None:  # gap, letter as written, number
@@ -118,7 +117,7 @@ def set_words(
                 continue
             cursor = item.end
             at, seen_axis = len(pieces), True
-        elif kind is not Comment:  # comments stay in the gap before the next item
+        elif type(item) is not Comment:  # comments stay in the gap before the next item
             pieces.append(raw[cursor : item.end])
             cursor = item.end
             if not seen_axis:
@@ -158,7 +157,7 @@ class EditPlan:
     def __init__(self, cuts: tuple[tuple[int, int], ...], parts: tuple[str | int, ...], count: int, keeps_numbers: bool):
         self.cuts = cuts  # (word index, how to cut): see _REPLACE ...
         self.parts = parts  # template text, and the index of each kept piece where it goes
-        self.template = "".join(part if type(part) is str else "{%d}" % (count + part) for part in parts)
+        self.template = "".join(part if isinstance(part, str) else "{%d}" % (count + part) for part in parts)
         self.keeps_numbers = keeps_numbers  # it keeps words other than G words (`F100`), whose number can be any
 
     @classmethod
@@ -243,7 +242,7 @@ class EditPlan:
         block with the same layout (other digits) and G words, when it keeps no other numbers
         (`keeps_numbers`, comments)."""
         kept = self._kept(raw, words)
-        return "".join(part if type(part) is str else _literal(kept[part]) for part in self.parts)
+        return "".join(part if isinstance(part, str) else _literal(kept[part]) for part in self.parts)
 
     def _kept(self, raw: str, words: Sequence[Word]) -> list[str]:
         """The pieces of `raw` it keeps."""
@@ -322,13 +321,13 @@ def _respan(block: Block, raw: str, after: int, shift: int) -> Block:
     return Block(raw, block.eol, tuple(_shifted(i, shift) if i.start >= after else i for i in block.items), block.line)
 
 
-def _shifted(item: Item, shift: int) -> Item:
+def _shifted(item: AnyItem, shift: int) -> AnyItem:
     """A copy of the item `shift` characters further on (constructors: far cheaper than copy.copy)."""
-    start, end, kind = item.start + shift, item.end + shift, type(item)
-    if kind is Word:
-        return Word(item.letter, item.value, item.number, start, end)  # type: ignore[attr-defined]
-    if kind is Comment:
-        return Comment(item.text, item.style, start, end)  # type: ignore[attr-defined]
+    start, end = item.start + shift, item.end + shift
+    if type(item) is Word:
+        return Word(item.letter, item.value, item.number, start, end)
+    if type(item) is Comment:
+        return Comment(item.text, item.style, start, end)
     moved = copy.copy(item)
     moved.start, moved.end = start, end
     return moved

@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from ncpp.instruments.files import read_measurement
+from ncpp.errors import NcppError
+from ncpp.instruments.files import make_measurement, read_measurement
 from ncpp.instruments.iso230_4 import (
     CircularTest,
     Trace,
@@ -162,3 +163,12 @@ def test_cyclic_error_is_found_with_its_lead(generator):
     assert f["cyclic_Y_um"] == pytest.approx(1.5, abs=0.15) and f["cyclic_Y_period_mm"] == 16.0
     assert f["cyclic_X_um"] is None  # nothing there, nothing reported
     assert f["backlash_X_um"] == pytest.approx(2.0, abs=0.2)
+
+
+def test_ballbar_built_without_a_radius_is_refused_with_its_name():
+    # loading refuses such a file; one built in memory reaches circular_test, which names
+    # the missing radius (not a TypeError from float(None))
+    columns = {"angle_deg": list(ANGLES), "deviation_um": [1.0, -1.0, 1.0, -1.0], "direction": ["CCW"] * 4}
+    m = make_measurement("ballbar", {"plane": "XY"}, columns, source="bare.csv")
+    with pytest.raises(NcppError, match="radius_mm"):
+        circular_test(m)

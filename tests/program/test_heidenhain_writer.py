@@ -82,3 +82,26 @@ def test_styles_learnt_per_number_pattern_are_each_numbers_own(pairs):
         assert writer.styles["X"] == _signed(NumberStyle.of(x)) and writer.styles["IY"] == _signed(NumberStyle.of(y))
         assert writer.styles["F"] == NumberStyle.of(y.lstrip("+-")) and "M" not in writer.styles and "N" not in writer.styles
     assert writer.known_axes == {"X", "Y"}
+
+
+def test_a_pole_event_holds_the_cc_point_and_plane():
+    """`CC X+50 Y+50` (XY plane): its Pole event says that centre, and the block runs (not skipped)."""
+    from ncpp.motion.heidenhain import Pole
+
+    interpret, _ = dialect_tools("heidenhain")
+    program = "0 BEGIN PGM T MM\n1 L X+0 Y+0 Z-2 R0 F500\n2 CC X+50 Y+50\n3 END PGM T MM\n"
+    _, blocks = parse_program(io.BytesIO(program.encode()), "t.h", "heidenhain")
+    (pole,) = [e for e in interpret(blocks, file="t.h") if type(e) is Pole]
+    assert pole.center[:2] == (50.0, 50.0) and pole.plane == 17 and pole.skipped is False
+
+
+def test_the_pole_written_back_after_an_edited_arc_is_the_programs():
+    """An edited arc writes its own `CC` first; the unchanged arc after it needs the program's
+    pole back, which here is the same point: no `CC` in the output names another point."""
+    program = ("0 BEGIN PGM T MM\n1 L X+0 Y+0 Z+0 R0 F500\n2 CC X+50 Y+50\n3 L X+60 Y+50\n"
+               "4 C X+50 Y+60 DR+\n5 C X+40 Y+50 DR+\n6 END PGM T MM\n")
+    lines = written(program, {5: (0.001, 0.0, 0.0)})  # file line 5: block 4
+    poles = [line.split()[1:] for line in lines if line.split()[1:2] == ["CC"]]
+    assert len(poles) >= 2  # the program's, and the edited arc's
+    for words in poles:
+        assert float(words[1][1:]) == 50.0 and float(words[2][1:]) == 50.0, lines

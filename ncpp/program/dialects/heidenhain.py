@@ -114,6 +114,8 @@ class HeidenhainBuilder(Transformer):
         return ExprWord(letter, expr, tok.start_pos, tok.end_pos)
 
     # -- statements --------------------------------------------------------------
+    # Helpers that build the rule methods, called in the class body: plain functions, not
+    # methods, which mypy cannot tell (hence their `type: ignore[misc]`)
     def _statement(kind: str, shape):  # type: ignore[misc]
         @v_args(meta=True)
         def build(self, meta, children):
@@ -121,17 +123,17 @@ class HeidenhainBuilder(Transformer):
 
         return build
 
-    def _text(children, skip: int = 1) -> tuple:  # type: ignore[misc]
+    def _text(children: list, skip: int = 1) -> tuple:  # type: ignore[misc]
         return tuple(str(c) for c in children[skip:])
 
-    def _pgm(children) -> tuple:  # type: ignore[misc]
+    def _pgm(children: list) -> tuple:  # type: ignore[misc]
         name = str(children[1])
         return (name, str(children[2]).upper() if len(children) > 2 else None)
 
-    def _blk(children) -> tuple:  # type: ignore[misc]
+    def _blk(children: list) -> tuple:  # type: ignore[misc]
         return (str(children[1]), str(children[2]).upper() if len(children) > 2 else None)
 
-    def _tool_call(children) -> tuple:  # type: ignore[misc]
+    def _tool_call(children: list) -> tuple:  # type: ignore[misc]
         tool, axis = None, None
         for c in children[1:]:
             if isinstance(c, Token) and c.type == "AXIS":
@@ -140,22 +142,22 @@ class HeidenhainBuilder(Transformer):
                 tool = _tool_ref(c)
         return (tool, axis)
 
-    def _call_label(children) -> tuple:  # type: ignore[misc]
+    def _call_label(children: list) -> tuple:  # type: ignore[misc]
         ints = [c for c in children[2:] if isinstance(c, Token) and c.type == "INT"]
         return (_tool_ref(children[1]), int(ints[0]) if ints else 0)
 
-    def _cycle_def(children) -> tuple:  # type: ignore[misc]
+    def _cycle_def(children: list) -> tuple:  # type: ignore[misc]
         return (str(children[1]), tuple(str(c).strip() for c in children[2:]))
 
-    def _cycle_call(children) -> tuple:  # type: ignore[misc]
+    def _cycle_call(children: list) -> tuple:  # type: ignore[misc]
         words = str(children[0]).split()
         return (words[2].upper() if len(words) > 2 else None,)
 
-    def _fn(children) -> tuple:  # type: ignore[misc]
+    def _fn(children: list) -> tuple:  # type: ignore[misc]
         number = int("".join(ch for ch in str(children[0]) if ch.isdigit()))
         return (number, str(children[1]).strip() if len(children) > 1 else "")
 
-    def _path(children) -> tuple:  # type: ignore[misc]
+    def _path(children: list) -> tuple:  # type: ignore[misc]
         return (" ".join(str(children[0]).split()).upper(),)
 
     program_begin = _statement("program_begin", _pgm)
@@ -292,7 +294,7 @@ class HeidenhainWriter(IsoWriter):
         if self.header is not None and self.last_number < 0 and not any(
             type(i) is Statement and i.kind == "program_begin" for i in block.items
         ):
-            yield self._header_first(block)
+            yield self._header_first(block, self.header)
         self._learn_styles(block)
         motion = [e for e in group if type(e) is Line or type(e) is Arc]
         pole = next((e for e in group if type(e) is Pole), None)
@@ -343,7 +345,7 @@ class HeidenhainWriter(IsoWriter):
         """` F500` for the first move after an edited `RND ... F`, unless it sets its own feed."""
         if not self.restore_feed:
             return ""
-        feeds = [i for i in block.items if (type(i) in (Word, ExprWord) and i.letter == "F") or (
+        feeds = [i for i in block.items if (isinstance(i, (Word, ExprWord)) and i.letter == "F") or (
             type(i) is Statement and i.kind == "feed")]  # fmt: skip
         if any(type(i) is Statement and i.node[0] == "FMAX" for i in feeds):
             return ""  # a rapid: the feed comes back with the move after it
@@ -352,9 +354,9 @@ class HeidenhainWriter(IsoWriter):
             return ""
         return " F" + format_number(motion[0].feed, self.styles.get("F") or NumberStyle(decimals=3))
 
-    def _header_first(self, block: Block) -> str:
+    def _header_first(self, block: Block, header: str) -> str:
         self.last_number = -1
-        line = self._inserted(self.comment(self.header))  # numbered 0; the program shifts by one
+        line = self._inserted(self.comment(header))  # numbered 0; the program shifts by one
         self.header = None
         return line
 
@@ -393,7 +395,7 @@ class HeidenhainWriter(IsoWriter):
 
     def _fresh(self, segment: Line | Arc) -> str:
         """A new block for a further piece of a changed block."""
-        if type(segment) is not Line:
+        if isinstance(segment, Arc):
             return self._arc_text(segment)
         # the axes that moved in the output (`_moved`, with the units' places read once per line)
         inch, end, last, last_places = segment.context.inch, segment.end, self._last_end, self._last_places
@@ -419,38 +421,42 @@ class HeidenhainWriter(IsoWriter):
         """The block's raw text made to say `segment` (its other words, F, M, comments kept;
         `feed` added)."""
         index, function = _function(block)
-        arc = type(segment) is Arc
-        helix = arc and self._is_helix(segment)
-        if arc and (helix or function not in ("C",)):
+        assert index is not None  # a block that moves has its path function
+        arc = segment if isinstance(segment, Arc) else None
+        helix = arc is not None and self._is_helix(arc)
+        texts: dict[int, str | None]
+        if arc is not None and (helix or function not in ("C",)):
             # another arc form (CR, CT, CP, a helix): the block becomes C/CP, its words replaced
             texts = {n: None for n, i in enumerate(block.items)
-                     if (type(i) in (Word, ExprWord) and (i.letter in _POLAR_WORDS or i.letter.lstrip("I") in _AXES))
+                     if (isinstance(i, (Word, ExprWord))
+                         and (i.letter in _POLAR_WORDS or i.letter.lstrip("I") in _AXES))
                      or (type(i) is Statement and i.kind == "rotation")}  # fmt: skip
-            texts[index] = self._arc_text(segment)
+            texts[index] = self._arc_text(arc)
             return splice(block, texts, feed)
-        texts: dict[int, str | None] = {}
-        if not arc and function != "L":  # LP, or a line where the program had an arc: the block becomes L
+        texts = {}
+        if arc is None and function != "L":  # LP, or a line where the program had an arc: the block becomes L
             texts[index] = "L"
             texts.update({n: None for n, i in enumerate(block.items)
-                          if (type(i) in (Word, ExprWord) and i.letter in _POLAR_WORDS)
+                          if (isinstance(i, (Word, ExprWord)) and i.letter in _POLAR_WORDS)
                           or (type(i) is Statement and i.kind == "rotation")})  # fmt: skip
-        plane_axes = PLANE_AXES[segment.context.plane][:2] if arc else ()
+        plane_axes = PLANE_AXES[segment.context.plane][:2] if arc is not None else ()
         written = set()
         anchor = block.items[index] if index is not None else None
         for n, item in enumerate(block.items):
-            if type(item) in (Word, ExprWord) and item.letter.lstrip("I") in _AXES and len(item.letter) <= 2:
+            if (isinstance(item, (Word, ExprWord)) and item.letter.lstrip("I") in _AXES
+                    and len(item.letter) <= 2):
                 axis = _AXES.index(item.letter[-1])
                 incremental = item.letter.startswith("I")
                 value = segment.end[axis] - segment.start[axis] if incremental else segment.end[axis]
                 texts[n] = self._word(item.letter, value, segment)
                 written.add(axis)
                 anchor = item
-            elif type(item) is Statement and item.kind == "rotation" and arc:
-                texts[n] = "DR+" if segment.turn > 0 else "DR-"
+            elif type(item) is Statement and item.kind == "rotation" and arc is not None:
+                texts[n] = "DR+" if arc.turn > 0 else "DR-"
         extra = [self._word(_AXES[k], segment.end[k], segment) for k in range(3) if k not in written and (
             k in plane_axes or (_AXES[k] in self.known_axes and self._moved(_AXES[k], segment.end[k], segment)))]  # fmt: skip
-        if arc and not any(type(i) is Statement and i.kind == "rotation" for i in block.items):
-            extra.append("DR+" if segment.turn > 0 else "DR-")
+        if arc is not None and not any(type(i) is Statement and i.kind == "rotation" for i in block.items):
+            extra.append("DR+" if arc.turn > 0 else "DR-")
         return splice(block, texts, "".join(" " + w for w in extra) + feed, after=anchor)
 
     def _learn_styles(self, block: Block) -> None:

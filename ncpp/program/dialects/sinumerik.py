@@ -86,6 +86,8 @@ class SinumerikBuilder(Transformer):
             return ExprWord(target[1].upper(), value, meta.start_pos, meta.end_pos)
         return Statement("assignment", (target, value), meta.start_pos, meta.end_pos)
 
+    # Helpers that build the rule methods, called in the class body: plain functions, not
+    # methods, which mypy cannot tell (hence their `type: ignore[misc]`)
     def _statement(kind: str, shape):  # type: ignore[misc]
         @v_args(meta=True)
         def build(self, meta, children):
@@ -93,23 +95,23 @@ class SinumerikBuilder(Transformer):
 
         return build
 
-    def _call(children) -> tuple:  # type: ignore[misc]
+    def _call(children: list) -> tuple:  # type: ignore[misc]
         return (str(children[0]).upper(), children[1] if len(children) > 1 else ())
 
-    def _define(children) -> tuple:  # type: ignore[misc]
+    def _define(children: list) -> tuple:  # type: ignore[misc]
         (type_name, length), variables = children[1], children[2:]
         return (type_name, length, tuple(variables))
 
-    def _proc(children) -> tuple:  # type: ignore[misc]
+    def _proc(children: list) -> tuple:  # type: ignore[misc]
         name = str(children[1]).upper()
         params = tuple(c for c in children[2:] if isinstance(c, tuple))
         attributes = tuple(str(c).upper() for c in children[2:] if isinstance(c, Token))
         return (name, params, attributes)
 
-    def _goto(children) -> tuple:  # type: ignore[misc]
+    def _goto(children: list) -> tuple:  # type: ignore[misc]
         return (str(children[0]).upper(), str(children[1]).upper())
 
-    def _case(children) -> tuple:  # type: ignore[misc]
+    def _case(children: list) -> tuple:  # type: ignore[misc]
         expr, rest = children[1], children[2:]
         branches = tuple(c for c in rest if isinstance(c, tuple))
         tokens = [c for c in rest if isinstance(c, Token) and c.type != "OF"]
