@@ -56,7 +56,7 @@ ACTION_LETTERS = {"M", "T", "S", "H", "D"}
 AFTER_MOTION = {0.0, 1.0, 2.0, 30.0, 60.0}
 # Statements that are actions: Klartext's TOOL CALL, CYCL CALL and END PGM
 ACTION_STATEMENTS = {"tool_call", "cycle_call", "program_end"}
-CHUNK_MOVES = 16384  # moves of the input compared at a time between two actions
+CHUNK_MOVES = 4096  # moves of the input compared at a time between two actions
 ACROSS = 0.25  # the share of a neighbouring chunk's samples each side is also compared with
 
 
@@ -73,7 +73,9 @@ class Section:
     """The motion between two actions (or a chunk of it, `cut`), sampled; `action` is the
     one that ends it (None at a cut and at the program's end)."""
 
-    points: np.ndarray  # (n, 3) machine mm, or (n, 9) with A B C U V W (each in its own unit)
+    # (n, 4) machine mm X Y Z, or (n, 10) with A B C U V W (each in its own unit) after them, and
+    # last a coordinate that is 0 for a feed's sample and `Bound.apart` for a rapid's
+    points: np.ndarray
     rapid: np.ndarray  # (n,) bool
     lines: np.ndarray  # (n,) source line of each sample
     feeds: list[tuple[float, int]]  # G94/G95 feed rates in order, each once per run, with its first line
@@ -90,7 +92,7 @@ NO_EXTRA = (0.0,) * len(EXTRA_AXES)
 class _Moves:
     """Moves collected for one section, sampled when it closes."""
 
-    step: float
+    bound: "Bound"
     ends: list = field(default_factory=list)  # per move: (x0, y0, z0, x1, y1, z1) machine mm
     extra: list = field(default_factory=list)  # per move: its extra axes' start and end (NO_EXTRA twice: none)
     rapid: list = field(default_factory=list)
@@ -102,7 +104,7 @@ class _Moves:
     def sample(self, action: Action | None, first_line: int) -> Section:
         """The moves sampled every `step` (each from its start to its end, both included)."""
         if not self.ends:
-            empty = np.zeros((0, 3))
+            empty = np.zeros((0, 4))
             return Section(empty, np.zeros(0, bool), np.zeros(0, int), self.feeds, self.inverse_time, action, first_line)
         ends = np.array(self.ends)
         starts, ends = ends[:, :3], ends[:, 3:]
@@ -114,15 +116,18 @@ class _Moves:
         arcs = _Arcs(self.arcs, starts, ends) if self.arcs else None
         if arcs is not None:
             lengths[arcs.move] += arcs.length
-        counts = np.maximum(1, np.ceil(lengths / self.step).astype(np.int64))
+        counts = np.maximum(1, np.ceil(lengths / self.bound.step).astype(np.int64))
         move = np.repeat(np.arange(len(counts)), counts + 1)
         first = np.concatenate(([0], np.cumsum(counts + 1)[:-1]))
         t = (np.arange(len(move)) - first[move]) / counts[move]
-        points = starts[move] + t[:, None] * (ends - starts)[move]
+        width = starts.shape[1]
+        points = np.empty((len(move), width + 1))
+        points[:, :width] = starts[move] + t[:, None] * (ends - starts)[move]
         if arcs is not None:
             arcs.bend(points, move, t)
-        return Section(points, np.array(self.rapid)[move], np.array(self.lines)[move], self.feeds, self.inverse_time,
-                       action, first_line)  # fmt: skip
+        rapid = np.array(self.rapid)[move]
+        points[:, width] = rapid * self.bound.apart
+        return Section(points, rapid, np.array(self.lines)[move], self.feeds, self.inverse_time, action, first_line)
 
 
 class _Arcs:
@@ -192,12 +197,12 @@ def actions_of(block: Block) -> tuple[list[str], list[str]]:
 Cut = Callable[[Block, int], int]  # (a block, the chunk's moves so far) -> the input line to cut at (0: none)
 
 
-def sections(events: Iterable[Event], step: float, cut: Cut = lambda block, moves: 0,
+def sections(events: Iterable[Event], bound: "Bound", cut: Cut = lambda block, moves: 0,
              line_of: Callable[[int], int] | None = None) -> Iterator[Section]:  # fmt: skip
     """The motion of a program's events between its actions, in the order it runs; a chunk
     ends before a block where `cut` says.  `line_of` gives the line a block's samples are
     told by (its own by default)."""
-    moves = _Moves(step)
+    moves = _Moves(bound)
     extra: tuple[float, ...] = NO_EXTRA
     last: Block | None = None
     after: list[str] = []
@@ -209,25 +214,25 @@ def sections(events: Iterable[Event], step: float, cut: Cut = lambda block, move
         if block is not last:
             for text in after:
                 yield moves.sample(Action(text, last.line), first_line)  # type: ignore[union-attr]
-                moves, first_line = _Moves(step), last.line  # type: ignore[union-attr]
+                moves, first_line = _Moves(bound), last.line  # type: ignore[union-attr]
             after = []
             last = block
             if moves.ends and (at := cut(block, len(moves.ends))):
                 chunk = moves.sample(None, first_line)
                 chunk.cut = at
                 yield chunk
-                moves, first_line = _Moves(step), block.line
+                moves, first_line = _Moves(bound), block.line
             if not (kind is Pass and event.skipped) and _may_act(block.signature):  # type: ignore[union-attr]
                 before, after = actions_of(block)
                 inverse_time = _inverse_time(block, inverse_time)
                 for text in before:
                     yield moves.sample(Action(text, block.line), first_line)
-                    moves, first_line = _Moves(step), block.line
+                    moves, first_line = _Moves(bound), block.line
         if kind is Line or kind is Arc:
             extra = _add(moves, event, extra, inverse_time, line_of(block.line) if line_of else block.line)  # type: ignore[arg-type]
     for text in after:
         yield moves.sample(Action(text, last.line), first_line)  # type: ignore[union-attr]
-        moves = _Moves(step)
+        moves = _Moves(bound)
     yield moves.sample(None, first_line)
 
 
@@ -282,6 +287,11 @@ class Bound:
         return self.distance / 2
 
     @property
+    def apart(self) -> float:
+        """How far apart rapids' and feeds' samples are kept, along a coordinate of their own."""
+        return 4 * self.within
+
+    @property
     def within(self) -> float:
         """How far a sample may lie from the other path's samples: a point of either path lies
         within half a step of a sample of its own."""
@@ -312,8 +322,8 @@ def verify(original: BinaryIO, written: BinaryIO, *, file: str, dialect: str | N
 
         dialect = detect(original.read(SNIFF_BYTES), file)
         original.seek(0)
-    mine = sections(_interpreted(parse_program(original, file, dialect)[1], file, dialect, offsets), bound.step)
-    theirs = sections(_interpreted(parse_program(written, file, dialect)[1], file, dialect, offsets), bound.step)
+    mine = sections(_interpreted(parse_program(original, file, dialect)[1], file, dialect, offsets), bound)
+    theirs = sections(_interpreted(parse_program(written, file, dialect)[1], file, dialect, offsets), bound)
     return _Comparison(file, bound, lambda number: (_line_text(written, number), 0)).run(mine, theirs)
 
 
@@ -330,8 +340,8 @@ def verified(lines: Iterable[str], reached: Callable[[], tuple[int, int]], origi
     feed = _Feed(lines, reached)
     held = _Held(original)
     state = {"cut": 0}  # where the input's chunk under way ends (0: at an action)
-    mine = sections(held, bound.step, lambda block, moves: block.line if moves >= CHUNK_MOVES else 0)
-    theirs = sections(_interpreted(parse_stream(feed, file, dialect), file, dialect, offsets), bound.step,
+    mine = sections(held, bound, lambda block, moves: block.line if moves >= CHUNK_MOVES else 0)
+    theirs = sections(_interpreted(parse_stream(feed, file, dialect), file, dialect, offsets), bound,
                       lambda block, moves: state["cut"] if state["cut"] and feed.tag(block.line) >= state["cut"] else 0,
                       lambda number: feed.tag(number, before=True))  # fmt: skip
     comparison = _Comparison(file, bound, feed.text, tagged=True)
@@ -500,15 +510,14 @@ class _Comparison:
             line = along.first_line if written else int(path.lines[0])
             raise NcppError(f"verification: {message}: it has no move here", Location(file, line, 1))
         within = self.bound.within
-        width = max(path.points.shape[1], along.points.shape[1])
-        apart = 4 * within  # a rapid's samples lie this far from a feed's along an extra coordinate
-        tree = cKDTree(_coordinates(along, width, apart), balanced_tree=False)
-        distance, _ = tree.query(_coordinates(path, width, apart), distance_upper_bound=within)
+        mine, theirs = _alike(path.points, along.points)
+        tree = cKDTree(theirs, balanced_tree=False)
+        distance, _ = tree.query(mine, distance_upper_bound=within)
         far = np.flatnonzero(np.isinf(distance))
         if not len(far):
             return
         k = int(far[0])
-        gap, near = cKDTree(_coordinates(along, width, 0.0)).query(_coordinates(path, width, 0.0)[k])
+        gap, near = cKDTree(theirs[:, :-1]).query(mine[k, :-1])  # (kinds aside)
         line = int(along.lines[near]) if written and not self.tagged else int(path.lines[k])
         if gap > within:
             message = f"{message} by more than {within:.4f} mm"
@@ -587,21 +596,27 @@ def _joined(section: Section, other: Section | None) -> Section:
     """`section` with `other`'s samples too (its lines, first line and action its own)."""
     if other is None or not len(other.points):
         return section
-    width = max(section.points.shape[1], other.points.shape[1])
-    points = np.vstack((_coordinates(section, width, 0.0), _coordinates(other, width, 0.0)))
-    return Section(points, np.concatenate((section.rapid, other.rapid)), np.concatenate((section.lines, other.lines)),
-                   section.feeds, section.inverse_time, section.action, section.first_line, section.cut)  # fmt: skip
+    mine, theirs = _alike(section.points, other.points)
+    return Section(np.vstack((mine, theirs)), np.concatenate((section.rapid, other.rapid)),
+                   np.concatenate((section.lines, other.lines)), section.feeds, section.inverse_time, section.action,
+                   section.first_line, section.cut)  # fmt: skip
 
 
-def _coordinates(section: Section, width: int, apart: float) -> np.ndarray:
-    """A section's samples as `width` coordinates (extra axes zero where it has none), and,
-    with `apart`, one more that keeps rapids' and feeds' samples that far apart."""
-    points = section.points
-    if points.shape[1] < width:
-        points = np.hstack((points, np.zeros((len(points), width - points.shape[1]))))
-    if apart:
-        points = np.hstack((points, (section.rapid * apart)[:, None]))
-    return points
+def _alike(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Two sections' samples with the same columns: the extra axes, zero where a side has none,
+    before the kind's column."""
+    if a.shape[1] == b.shape[1]:
+        return a, b
+    return _widened(a, max(a.shape[1], b.shape[1])), _widened(b, max(a.shape[1], b.shape[1]))
+
+
+def _widened(points: np.ndarray, width: int) -> np.ndarray:
+    if points.shape[1] == width:
+        return points
+    out = np.zeros((len(points), width))
+    out[:, : points.shape[1] - 1] = points[:, :-1]
+    out[:, -1] = points[:, -1]
+    return out
 
 
 def _line_text(stream: BinaryIO, number: int | None) -> str:
