@@ -16,11 +16,13 @@ the passes' state) and compares it with the input program's motion:
   its time together.
 
 Paths are compared in machine coordinates (mm, tool length and work offsets
-applied), sampled every half of the bound: a written program passes when
-each sample of either path lies within the bound and half a step of a sample
-of the other's (so no correction within the bound is refused, and every point
-passed is within 1.5 times the bound).  A violation is an `NcppError` at the
-input line where it happens.
+applied) as straight segments, arcs in chords within an eighth of the bound:
+a segment of one path whose two ends lie within the bound of one segment of
+the other (or of two that follow one another, less what their chord cuts off
+the corner) lies within it along its length; any other is looked at at points
+a quarter of the bound apart.  Every point passed lies within 1.375 times the
+bound, and no correction within the bound is refused.  A violation is an
+`NcppError` at the input line where it happens.
 
 A long run of moves between two actions is compared in chunks of about
 `CHUNK_MOVES` moves (memory stays flat in program length).  The pipeline tags
@@ -73,11 +75,13 @@ class Section:
     """The motion between two actions (or a chunk of it, `cut`), sampled; `action` is the
     one that ends it (None at a cut and at the program's end)."""
 
-    # (n, 4) machine mm X Y Z, or (n, 10) with A B C U V W (each in its own unit) after them, and
-    # last a coordinate that is 0 for a feed's sample and `Bound.apart` for a rapid's
-    points: np.ndarray
+    # Straight segments (arcs in chords within `Bound.chord`), their starts and ends: (n, 4) machine
+    # mm X Y Z, or (n, 10) with A B C U V W (each in its own unit) after them, and last a
+    # coordinate that is 0 for a feed and `Bound.apart` for a rapid
+    starts: np.ndarray
+    ends: np.ndarray
     rapid: np.ndarray  # (n,) bool
-    lines: np.ndarray  # (n,) source line of each sample
+    lines: np.ndarray  # (n,) source line of each segment
     feeds: list[tuple[float, int]]  # G94/G95 feed rates in order, each once per run, with its first line
     inverse_time: float  # minutes the G93 moves take
     action: Action | None
@@ -105,18 +109,17 @@ class _Moves:
         """The moves sampled every `step` (each from its start to its end, both included)."""
         if not self.ends:
             empty = np.zeros((0, 4))
-            return Section(empty, np.zeros(0, bool), np.zeros(0, int), self.feeds, self.inverse_time, action, first_line)
+            return Section(empty, empty, np.zeros(0, bool), np.zeros(0, int), self.feeds, self.inverse_time, action, first_line)
         ends = np.array(self.ends)
         starts, ends = ends[:, :3], ends[:, 3:]
         if any(e is not NO_EXTRA for pair in self.extra for e in pair):
             extra = np.array([s + e for s, e in self.extra])
             starts = np.hstack((starts, extra[:, : len(EXTRA_AXES)]))
             ends = np.hstack((ends, extra[:, len(EXTRA_AXES) :]))
-        lengths = np.sqrt(((ends - starts) ** 2).sum(axis=1))
+        counts = np.ones(len(starts), dtype=np.int64)
         arcs = _Arcs(self.arcs, starts, ends) if self.arcs else None
         if arcs is not None:
-            lengths[arcs.move] += arcs.length
-        counts = np.maximum(1, np.ceil(lengths / self.bound.step).astype(np.int64))
+            counts[arcs.move] = arcs.chords(self.bound.chord)
         move = np.repeat(np.arange(len(counts)), counts + 1)
         first = np.concatenate(([0], np.cumsum(counts + 1)[:-1]))
         t = (np.arange(len(move)) - first[move]) / counts[move]
@@ -125,9 +128,14 @@ class _Moves:
         points[:, :width] = starts[move] + t[:, None] * (ends - starts)[move]
         if arcs is not None:
             arcs.bend(points, move, t)
-        rapid = np.array(self.rapid)[move]
-        points[:, width] = rapid * self.bound.apart
-        return Section(points, rapid, np.array(self.lines)[move], self.feeds, self.inverse_time, action, first_line)
+        rapid = np.array(self.rapid)
+        points[:, width] = rapid[move] * self.bound.apart
+        begins = np.ones(len(move), dtype=bool)  # each point but a move's last begins a segment
+        begins[first + counts] = False
+        segment = np.flatnonzero(begins)
+        kept = move[segment]
+        return Section(points[segment], points[segment + 1], rapid[kept], np.array(self.lines)[kept], self.feeds,
+                       self.inverse_time, action, first_line)  # fmt: skip
 
 
 class _Arcs:
@@ -144,7 +152,12 @@ class _Arcs:
         self.a0 = np.arctan2(s_j, s_i)
         self.r0, self.r1 = np.hypot(s_i, s_j), np.hypot(e_i, e_j)
         self.sweep = _sweeps(self.a0, np.arctan2(e_j, e_i), table[:, 5])
-        self.length = np.abs(self.sweep) * np.maximum(self.r0, self.r1)
+
+    def chords(self, within: float) -> np.ndarray:
+        """How many chords each arc takes for none to lie further than `within` from it."""
+        radius = np.maximum(np.maximum(self.r0, self.r1), within)
+        angle = 2 * np.arccos(np.clip(1 - within / radius, -1.0, 1.0))  # what one chord may span
+        return np.maximum(1, np.ceil(np.abs(self.sweep) / np.maximum(angle, 1e-6))).astype(np.int64)
 
     def bend(self, points: np.ndarray, move: np.ndarray, t: np.ndarray) -> None:
         """Put the arcs' samples (made along their chords) on the arcs, in place; the radius
@@ -283,19 +296,24 @@ class Bound:
     distance: float
 
     @property
-    def step(self) -> float:
-        return self.distance / 2
-
-    @property
-    def apart(self) -> float:
-        """How far apart rapids' and feeds' samples are kept, along a coordinate of their own."""
-        return 4 * self.within
+    def chord(self) -> float:
+        """How far an arc's chords may lie from it."""
+        return self.distance / 8
 
     @property
     def within(self) -> float:
-        """How far a sample may lie from the other path's samples: a point of either path lies
-        within half a step of a sample of its own."""
-        return self.distance + self.step / 2
+        """How far a point of either path (made of chords) may lie from the other's chords."""
+        return self.distance + 2 * self.chord
+
+    @property
+    def apart(self) -> float:
+        """How far apart rapids and feeds are kept, along a coordinate of their own."""
+        return 4 * (self.within + self.coarse)
+
+    @property
+    def coarse(self) -> float:
+        """The spacing of the points candidate segments are looked up by (`_Nearby`)."""
+        return max(4 * self.distance, 1.0)
 
 
 def _interpreted(blocks: Iterable[Block], file: str, dialect: str, offsets: WorkOffsets | None) -> Iterator[Event]:
@@ -478,7 +496,7 @@ class _Comparison:
             pa, pb = self.owed
             self._follows(pa, pb, "the written path does not follow the original's", written=False)
         extra = self._next(theirs, 0)
-        if extra is not None and (len(extra.points) or extra.action is not None):
+        if extra is not None and (len(extra.starts) or extra.action is not None):
             raise NcppError("verification: the written program goes on after the original ends",
                             Location(self.file, extra.first_line, 1))  # fmt: skip
 
@@ -500,24 +518,22 @@ class _Comparison:
                             Location(self.file, where, 1))  # fmt: skip
 
     def _follows(self, path: Section, along: Section, message: str, written: bool) -> None:
-        """Raise where a sample of `path` lies further than the bound from every sample of
-        `along` of its kind (rapid or feed); a written path's fault is told at the original's
-        nearest line."""
-        if not len(path.points):
+        """Raise where a point of `path` lies further than the bound from `along` (from its
+        segments of the same kind, rapid or feed); a written path's fault is told at the
+        original's nearest line."""
+        if not len(path.starts):
             return
         file = self.file
-        if not len(along.points):
+        if not len(along.starts):
             line = along.first_line if written else int(path.lines[0])
             raise NcppError(f"verification: {message}: it has no move here", Location(file, line, 1))
         within = self.bound.within
-        mine, theirs = _alike(path.points, along.points)
-        tree = cKDTree(theirs, balanced_tree=False)
-        distance, _ = tree.query(mine, distance_upper_bound=within)
-        far = np.flatnonzero(np.isinf(distance))
-        if not len(far):
+        (starts, ends), (a, b) = _alike((path.starts, path.ends), (along.starts, along.ends))
+        far = _Nearby(a, b, self.bound).first_outside(starts, ends, within)
+        if far is None:
             return
-        k = int(far[0])
-        gap, near = cKDTree(theirs[:, :-1]).query(mine[k, :-1])  # (kinds aside)
+        k, point = far
+        gap, near = _Nearby(a[:, :-1], b[:, :-1], self.bound).nearest(point[:-1])  # (kinds aside)
         line = int(along.lines[near]) if written and not self.tagged else int(path.lines[k])
         if gap > within:
             message = f"{message} by more than {within:.4f} mm"
@@ -578,36 +594,39 @@ def _what(section: Section) -> str:
 
 
 def _tail(section: Section) -> Section:
-    """The last `ACROSS` of a chunk's samples."""
-    n = len(section.points)
+    """The last `ACROSS` of a chunk's segments."""
+    n = len(section.starts)
     return _part(section, slice(n - int(math.ceil(n * ACROSS)), n))
 
 
 def _head(section: Section) -> Section:
-    """The first `ACROSS` of a chunk's samples."""
-    return _part(section, slice(0, int(math.ceil(len(section.points) * ACROSS))))
+    """The first `ACROSS` of a chunk's segments."""
+    return _part(section, slice(0, int(math.ceil(len(section.starts) * ACROSS))))
 
 
 def _part(section: Section, rows: slice) -> Section:
-    return Section(section.points[rows], section.rapid[rows], section.lines[rows], [], 0.0, None, section.first_line)
+    return Section(section.starts[rows], section.ends[rows], section.rapid[rows], section.lines[rows], [], 0.0, None,
+                   section.first_line)  # fmt: skip
 
 
 def _joined(section: Section, other: Section | None) -> Section:
-    """`section` with `other`'s samples too (its lines, first line and action its own)."""
-    if other is None or not len(other.points):
+    """`section` with `other`'s segments too (its lines, first line and action its own)."""
+    if other is None or not len(other.starts):
         return section
-    mine, theirs = _alike(section.points, other.points)
-    return Section(np.vstack((mine, theirs)), np.concatenate((section.rapid, other.rapid)),
+    (a, b), (c, d) = _alike((section.starts, section.ends), (other.starts, other.ends))
+    return Section(np.vstack((a, c)), np.vstack((b, d)), np.concatenate((section.rapid, other.rapid)),
                    np.concatenate((section.lines, other.lines)), section.feeds, section.inverse_time, section.action,
                    section.first_line, section.cut)  # fmt: skip
 
 
-def _alike(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Two sections' samples with the same columns: the extra axes, zero where a side has none,
+Segments = tuple[np.ndarray, np.ndarray]
+
+
+def _alike(one: Segments, other: Segments) -> tuple[Segments, Segments]:
+    """Two sections' segments with the same columns: the extra axes, zero where a side has none,
     before the kind's column."""
-    if a.shape[1] == b.shape[1]:
-        return a, b
-    return _widened(a, max(a.shape[1], b.shape[1])), _widened(b, max(a.shape[1], b.shape[1]))
+    width = max(one[0].shape[1], other[0].shape[1])
+    return (_widened(one[0], width), _widened(one[1], width)), (_widened(other[0], width), _widened(other[1], width))
 
 
 def _widened(points: np.ndarray, width: int) -> np.ndarray:
@@ -617,6 +636,124 @@ def _widened(points: np.ndarray, width: int) -> np.ndarray:
     out[:, : points.shape[1] - 1] = points[:, :-1]
     out[:, -1] = points[:, -1]
     return out
+
+
+class _Nearby:
+    """The segments of a path, looked up by points spaced `Bound.coarse` along them: every
+    segment passing within r of a point has one of its points within r + coarse / 2."""
+
+    FEW, MANY = 6, 96  # nearest lookup points asked for, then for the points that found none near
+
+    def __init__(self, starts: np.ndarray, ends: np.ndarray, bound: Bound):
+        self.starts, self.ends, self.reach = starts, ends, bound.coarse / 2
+        lengths = np.sqrt(((ends - starts) ** 2).sum(axis=1))
+        counts = np.maximum(1, np.ceil(lengths / bound.coarse)).astype(np.int64)
+        self.segment = np.repeat(np.arange(len(counts)), counts + 1)
+        first = np.concatenate(([0], np.cumsum(counts + 1)[:-1]))
+        t = (np.arange(len(self.segment)) - first[self.segment]) / counts[self.segment]
+        points = starts[self.segment] + t[:, None] * (ends - starts)[self.segment]
+        self.tree = cKDTree(points, balanced_tree=False)
+
+    def distances(self, points: np.ndarray, within: float, k: int) -> tuple[np.ndarray, np.ndarray]:
+        """(n, k) segments near each point (-1: none) and the points' distances to them."""
+        segments, distance, _ = self.closest(points, within, k)
+        return segments, distance
+
+    def closest(self, points: np.ndarray, within: float, k: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """`distances`, and (n, k, width) the segments' points closest to each point."""
+        k = min(k, len(self.segment))
+        _, found = self.tree.query(points, k=k, distance_upper_bound=within + self.reach)
+        found = found.reshape(len(points), k)
+        missing = found >= len(self.segment)
+        segments = np.where(missing, -1, self.segment[np.minimum(found, len(self.segment) - 1)])
+        distance, closest = _to_segments(points, self.starts[segments], self.ends[segments])
+        distance[missing] = np.inf
+        return segments, distance, closest
+
+    def nearest(self, point: np.ndarray) -> tuple[float, int]:
+        segments, distance = self.distances(point[None, :], np.inf, self.MANY)
+        k = int(np.argmin(distance[0]))
+        return float(distance[0, k]), int(segments[0, k])
+
+    def _across_a_vertex(self, rest: np.ndarray, segments: np.ndarray, distance: np.ndarray, closest: np.ndarray,
+                         pair: np.ndarray, n: int, within: float) -> np.ndarray:  # fmt: skip
+        """Which of the segments `rest` lie within `within` along their length for having their
+        ends near two segments here that follow one another (q, then q + 1 from q's end: the
+        chords of an arc, the sides of a corner).  A point between the two ends lies as far from
+        the line between their closest points as the ends do at most, and that line as far from
+        the two segments as it passes from their common vertex."""
+        a_seg, b_seg = segments[rest][:, :, None], segments[n + rest][:, None, :]
+        r, i, j = np.nonzero((b_seg == a_seg + 1) & (a_seg >= 0) & pair[rest])
+        q = segments[rest[r], i]
+        vertex = self.ends[q]
+        joined = np.all(vertex == self.starts[np.minimum(q + 1, len(self.starts) - 1)], axis=1)
+        off = np.maximum(distance[rest[r], i], distance[n + rest[r], j])
+        cut = _to_lines(vertex, closest[rest[r], i], closest[n + rest[r], j])
+        ok = np.zeros(len(rest), dtype=bool)
+        ok[r[joined & (off + cut <= within)]] = True
+        return ok
+
+    def first_outside(self, starts: np.ndarray, ends: np.ndarray, within: float) -> tuple[int, np.ndarray] | None:
+        """The first segment of starts-ends with a point further than `within` from every segment
+        here, and that point; None when all lie within.  A segment both of whose ends lie within
+        `within` of one segment here lies within it along its length (the set within a distance
+        of a segment is convex); the others are looked at at points a quarter of `within` apart,
+        each allowed an eighth more (a point between two lies within an eighth of one)."""
+        n = len(starts)
+        # each segment's start, and its end where the next does not start there (most do)
+        apart = np.flatnonzero(np.any(ends[:-1] != starts[1:], axis=1))
+        ending = np.concatenate((apart, [n - 1]))
+        where_end = np.arange(1, n + 1)
+        where_end[ending] = n + np.arange(len(ending))
+        segments, distance, closest = self.closest(np.vstack((starts, ends[ending])), within, self.FEW)
+        order = np.concatenate((np.arange(n), where_end))
+        segments, distance, closest = segments[order], distance[order], closest[order]
+        near = distance <= within
+        pair = near[:n, :, None] & near[n:, None, :]
+        common = ((segments[:n, :, None] == segments[n:, None, :]) & pair).any(axis=(1, 2))
+        rest = np.flatnonzero(~common)
+        if len(rest):
+            rest = rest[~self._across_a_vertex(rest, segments, distance, closest, pair, n, within)]
+        if not len(rest):
+            return None
+        step = within / 4
+        a, b = starts[rest], ends[rest]
+        counts = np.maximum(1, np.ceil(np.sqrt(((b - a) ** 2).sum(axis=1)) / step)).astype(np.int64)
+        which = np.repeat(np.arange(len(rest)), counts + 1)
+        first = np.concatenate(([0], np.cumsum(counts + 1)[:-1]))
+        t = (np.arange(len(which)) - first[which]) / counts[which]
+        points = a[which] + t[:, None] * (b - a)[which]
+        allowed = within + step / 2
+        _, distance = self.distances(points, allowed, self.FEW)
+        low = distance.min(axis=1) > allowed
+        if low.any():
+            _, again = self.distances(points[low], allowed, self.MANY)
+            low[np.flatnonzero(low)] = again.min(axis=1) > allowed
+        if not low.any():
+            return None
+        k = int(np.argmax(low))
+        return int(rest[which[k]]), points[k]
+
+
+def _to_segments(points: np.ndarray, starts: np.ndarray, ends: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(n, k) distances of n points to their k segments (starts, ends: (n, k, width)), and
+    (n, k, width) the segments' points closest to them."""
+    d = ends - starts
+    w = points[:, None, :] - starts
+    length2 = (d * d).sum(axis=2)
+    t = np.clip((w * d).sum(axis=2) / np.where(length2 > 0, length2, 1.0), 0.0, 1.0)
+    closest = starts + t[:, :, None] * d
+    off = points[:, None, :] - closest
+    return np.sqrt((off * off).sum(axis=2)), closest
+
+
+def _to_lines(points: np.ndarray, starts: np.ndarray, ends: np.ndarray) -> np.ndarray:
+    """(n,) distances of n points to n segments."""
+    d = ends - starts
+    length2 = (d * d).sum(axis=1)
+    t = np.clip(((points - starts) * d).sum(axis=1) / np.where(length2 > 0, length2, 1.0), 0.0, 1.0)
+    off = points - starts - t[:, None] * d
+    return np.sqrt((off * off).sum(axis=1))
 
 
 def _line_text(stream: BinaryIO, number: int | None) -> str:
