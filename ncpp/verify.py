@@ -20,7 +20,7 @@ applied) as straight segments, arcs in chords within an eighth of the bound:
 a segment of one path whose two ends lie within the bound of one segment of
 the other (or of two that follow one another, less what their chord cuts off
 the corner) lies within it along its length; any other is looked at at points
-a quarter of the bound apart.  Every point passed lies within 1.375 times the
+a quarter of the bound apart.  Every point passed lies within 1.6 times the
 bound, and no correction within the bound is refused.  A violation is an
 `NcppError` at the input line where it happens.
 
