@@ -499,6 +499,8 @@ class HeidenhainWriter(IsoWriter):
                     self._learn_style(letter, style)
                     if axis:
                         self.known_axes.add(axis)
+            elif type(item) is ExprWord and item.letter[-1:] in _AXES and item.letter.lstrip("I") == item.letter[-1]:
+                self.known_axes.add(item.letter[-1])  # `X+Q1932` positions X as a number does
 
 
 _NO_LESSON = ()

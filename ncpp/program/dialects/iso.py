@@ -180,6 +180,8 @@ class IsoWriter:
         signature = block.signature
         if signature is None:
             facts = _Facts(block)
+            # an axis word written as an expression (`Y[0]`, `Y#5`) positions its axis as a number does
+            self.known_axes.update(facts.expression_axes)
         else:  # a handful of signatures make most blocks (`XZ`, `G1XY`): read each once
             facts = self._signature_facts.get(signature)
             if facts is None:
@@ -555,7 +557,8 @@ class _Facts:
     """What the writer asks about a block."""
 
     __slots__ = ("letters", "motion_word", "motion", "first_motion", "moves", "plain", "words", "styled",
-                 "word_letters", "motion_at", "bits", "axis_bits", "absent_axes", "machine", "flow")  # fmt: skip
+                 "word_letters", "motion_at", "bits", "axis_bits", "absent_axes", "machine", "flow",
+                 "expression_axes")  # fmt: skip
 
     def __init__(self, block: Block | None = None):
         """The facts of `block`, read in one walk over its items (none: a block without words)."""
@@ -571,12 +574,15 @@ class _Facts:
         self.motion_at: tuple[int, str] | None = None  # (n, number as written) of its first G0-G3 word, the n-th word
         self.machine = False  # it moves in machine coordinates (G53)
         self.flow = False  # a control line: an o-word (not `O<name>` alone, a program's name), M98, M99
+        self.expression_axes = ""  # the X Y Z words it writes as expressions (`Y[0]`, `Y#5`)
         for item in block.items if block is not None else ():
             kind = type(item)
             if kind is Word:
                 self._read_word(item.letter, item.value, item.number)
             elif kind is not Comment:
                 self.plain = False
+                if kind is ExprWord and item.letter in AXES:
+                    self.expression_axes += item.letter
                 if kind is Statement and item.kind == "oword" and len(item.node) >= 2:
                     self.flow = True
         self._sum_up()
