@@ -29,13 +29,13 @@ from ncpp.passes import PASSES, PassContext, run_passes
 from ncpp.passes.context import UNDECIDED, CutLine, is_directional
 from ncpp.passes.inverse import iterations_for
 from ncpp.passes.kernels import INLINE, Kernels, Worker
-from ncpp.program.blocks import Block, Comment, Word
+from ncpp.program.blocks import Block, Comment, Statement, Word
 from ncpp.program.dialects import parse_program
 from ncpp.program.dialects.iso import IsoWriter
 from ncpp.runtime import keep_freed_memory
 
-HEADER_TAG = "ncpp compensated"
-HEADER_SCAN = 30  # blocks at the top searched for an earlier header
+HEADER_TAG = "ncpp compensated"  # (lower case: `header_comment` finds it in any case)
+HEADER_SCAN = 30  # blocks at the top searched for an earlier header, and on while only comments follow
 # Blocks the parser reads ahead of the interpreter at most (`_parsed_ahead`), and in its
 # first run: ~0.8 kB each (16k: 13 MB, whatever the program's length).  The first run is
 # short: a first part's cut waits for its first lines written (`parts.py`).
@@ -100,17 +100,44 @@ def header_text(source: ErrorSource, tolerance: float) -> str:
 
 
 def refuse_compensated(blocks: Iterable[Block], file: str) -> Iterator[Block]:
-    """Pass blocks through; stop with an error if an ncpp header is found near the top."""
+    """Pass blocks through; stop with an error if an ncpp header is found in the program's head."""
     blocks = iter(blocks)
-    for block in islice(blocks, HEADER_SCAN):
-        for item in block.items:
-            if type(item) is Comment and HEADER_TAG in item.text:
-                raise NcppError(
-                    "program is already compensated by ncpp (use --force to compensate again)",
-                    Location(file, block.line, item.start + 1),
-                )
+    for block in program_head(blocks):
+        item = header_comment(block)
+        if item is not None:
+            raise NcppError(
+                "program is already compensated by ncpp (use --force to compensate again)",
+                Location(file, block.line, item.start + 1),
+            )
         yield block
     yield from blocks
+
+
+def program_head(blocks: Iterator[Block]) -> Iterator[Block]:
+    """The blocks an ncpp header may stand among: the first HEADER_SCAN, and on from there up
+    to the first block with more than comments (any number of comments may come before it)."""
+    for n, block in enumerate(blocks):
+        yield block
+        if n >= HEADER_SCAN - 1 and not _comments_only(block):
+            return
+
+
+_HEAD_STATEMENTS = frozenset({"tape", "program_name", "program_begin"})  # `%`, `%_N_PART_MPF`, `BEGIN PGM`
+
+
+def _comments_only(block: Block) -> bool:
+    """Nothing in the block but comments, a block number, a tape mark or the program's name."""
+    return all(type(i) is Comment or (type(i) is Word and i.letter == "N") or (type(i) is Statement and i.kind in _HEAD_STATEMENTS)
+               for i in block.items)  # fmt: skip
+
+
+def header_comment(block: Block) -> Comment | None:
+    """The block's comment that is an ncpp header, whatever its case (every dialect's comments:
+    `( )`, `;`), or None."""
+    for item in block.items:
+        if type(item) is Comment and HEADER_TAG in item.text.lower():
+            return item
+    return None
 
 
 # What the one-zero dialects' interpreters do not place (the ISO interpreter places it all):
