@@ -204,6 +204,7 @@ class _Solved:
     turn_start: NDArray  # (n,3) their start compensated for the new direction
     keep: NDArray  # (n,3) axes that keep their direction (they must not move in that step)
     limit: NDArray  # (n,) program units an axis may be left off its compensated position
+    direction: NDArray  # (n,3) the direction each axis travels in (+1, -1; 0: no reversal errors)
 
 
 # What `_written` does with a segment (bits of its row's code)
@@ -231,6 +232,10 @@ def _written(chunk: list[Event], segs: list, rows: _Rows, solved: _Solved, last)
     # are when they differ only by output rounding: a one-digit move there would reverse
     # that axis on the machine.
     target = np.where(solved.keep & (np.abs(solved.turn_start - previous) <= solved.limit[:, None]), previous, solved.turn_start)
+    # An axis that runs ahead on reversal (a reversal table below its other) would reach its
+    # start for the new direction travelling the old way, past the corner: it reverses where
+    # it is, and its jump lands the tool back along the way it came.
+    target = np.where(~solved.keep & ((target - previous) * solved.direction < 0), previous, target)
     turning &= _apart(previous, target)
     # replace_arcs' pieces start where they start: a step from the previous end first
     connect = ~solved.free & has_previous & rows.arc & _apart(previous, solved.start)
@@ -291,7 +296,7 @@ def _plain(rows: _Rows, ctx: PassContext, travel: Travel) -> _Solved:
         _carry(rows, end, None if travel.last is None else travel.last / scales[0] - offsets[0])
     travel.last = (end[-1] + offsets[-1]) * scales[-1]
     none = np.zeros(len(free), dtype=bool)
-    return _Solved(start, end, free, none, none, start, np.ones(start.shape, dtype=bool), np.zeros(len(free)))
+    return _Solved(start, end, free, none, none, start, np.ones(start.shape, dtype=bool), np.zeros(len(free)), np.zeros(start.shape))
 
 
 class _Commands:
@@ -371,7 +376,7 @@ def _directional(rows: _Rows, ctx: PassContext, travel: Travel) -> _Solved:
         turn_start[rows] = commands("start", rows, d[rows])
     travel.held = d[-1].copy()
     travel.last = machine(out_end[-1:], slice(len(free) - 1, None))[0]
-    return _Solved(out_start, out_end, free, moved, turn, turn_start, ~flips, limit)
+    return _Solved(out_start, out_end, free, moved, turn, turn_start, ~flips, limit, d)
 
 
 def _carry(rows: _Rows, out_end: NDArray, before: NDArray | None) -> None:

@@ -65,26 +65,26 @@ def moves(path: Path, scale: float = 1.0) -> list[tuple[np.ndarray, np.ndarray]]
     return out
 
 
-def actual_moves(path: Path, machine: Machine, scale: float = 1.0) -> list[tuple[np.ndarray, np.ndarray]]:
-    """Where the tool really goes for each of the program's moves: mapped through `machine`
-    with the direction each axis travels in (a still axis holds its last one, +1 before it
-    first moves)."""
+def actual_moves(path: Path, machine: Machine, scale: float = 1.0) -> list[np.ndarray]:
+    """Where the tool really goes on each of the program's moves, (k,3) points along it: the
+    commands mapped through `machine` with the direction each axis travels in (a still axis
+    holds its last one, +1 before it first moves).  An axis moving one way never goes back:
+    where it reverses with lost motion it stands until its command catches up, where it runs
+    ahead it jumps the new way at once."""
     held = np.ones(3)
+    last = None
     out = []
     for start, end in moves(path, scale):
-        held = np.where(end != start, np.sign(end - start), held)
-        a, b = machine(np.array([start, end]), held)
-        out.append((a, b))
-    return out
-
-
-def actual_path(path: Path, machine: Machine, scale: float = 1.0) -> list[tuple[np.ndarray, np.ndarray]]:
-    """`actual_moves`, with the jump between two moves where a direction changes."""
-    out: list[tuple[np.ndarray, np.ndarray]] = []
-    for a, b in actual_moves(path, machine, scale):
-        if out and np.any(np.abs(a - out[-1][1]) > 1e-12):
-            out.append((out[-1][1], a))  # a reversal's jump
-        out.append((a, b))
+        moving = end != start
+        held = np.where(moving, np.sign(end - start), held)
+        n = max(2, int(np.linalg.norm(end - start) / STEP_MM) + 2)
+        raw = machine(start + np.linspace(0.0, 1.0, n)[:, None] * (end - start), held)
+        if last is not None:
+            raw = np.vstack([last[None, :], raw])
+            d = np.where(moving, held, 0.0)
+            raw = np.where(moving, d * np.maximum.accumulate(d * raw, axis=0), raw)[1:]
+        out.append(raw)
+        last = raw[-1]
     return out
 
 
@@ -114,8 +114,7 @@ def _distance(points: np.ndarray, segments: list[tuple[np.ndarray, np.ndarray]])
 def worst_um(original: Path, output: Path, machine: Machine, skip: int = 0) -> float:
     """µm the tool gets from the original's commanded path at most, running `output` on
     `machine` (the first `skip` moves, the approach from rs274's start, left out)."""
-    wanted = moves(original)[skip:]
-    return float(_distance(_samples(actual_path(output, machine)[skip:]), wanted).max() * 1000)
+    return worst_at(original, output, machine, skip)[0]
 
 
 def holes_um(output: Path, original: Path, machine: Machine, scale: float = 1.0) -> np.ndarray:
@@ -127,7 +126,15 @@ def holes_um(output: Path, original: Path, machine: Machine, scale: float = 1.0)
         assert len(feeds) == len(segments)
         return np.array([b for (name, _), (a, b) in zip(feeds, segments) if name == "STRAIGHT_FEED" and b[2] < a[2] - 1e-9])
 
-    got = bottoms(output, actual_moves(output, machine, scale))
+    got = bottoms(output, [(m[0], m[-1]) for m in actual_moves(output, machine, scale)])
     wanted = bottoms(original, moves(original, scale))
     assert got.shape == wanted.shape
     return np.linalg.norm(got - wanted, axis=1) * 1000
+
+
+def worst_at(original: Path, output: Path, machine: Machine, skip: int = 0) -> tuple[float, np.ndarray]:
+    """`worst_um`, and the point of the mapped path where it is."""
+    points = np.vstack(actual_moves(output, machine)[skip:])
+    points = _samples(list(zip(points[:-1], points[1:])))
+    d = _distance(points, moves(original)[skip:])
+    return float(d.max() * 1000), points[int(d.argmax())]
