@@ -412,14 +412,20 @@ def _settle(free, arc, d, held, offsets, scales, limit, out_start, out_end, befo
     starts within `limit` of the previous end moves rigidly onto it (radii stay
     equal), so that no µm connecting step reverses an axis.  In order, because
     each moved end is the next row's start and a drift over many rows stays bounded.
-    `before`: the previous chunk's last end in the first row's frame (or None)."""
+    `before`: the previous chunk's last end in the first row's frame (or None).  A line
+    after a change of units or offsets settles onto its predecessor's end seen from its own
+    frame (the program's numbers there are other numbers for the same place)."""
     ends, dirs, ok = _with_previous(out_end, d, held, offsets, scales, before)
-    pred_end, pred_dir = ends[:-1], dirs[:-1]  # row k's predecessor's end and direction
+    reframed = np.flatnonzero(any3(offsets[1:] != offsets[:-1]) | (scales[1:] != scales[:-1])) + 1
+    pred_end, pred_dir = ends[:-1].copy(), dirs[:-1]  # row k's predecessor's end (in row k's frame) and direction
+    pred_end[reframed] = _reframed(pred_end[reframed], reframed - 1, reframed, offsets, scales)
+    same = ok.copy()  # the predecessor is in the row's frame
+    same[reframed] = False
     within = limit[:, None]
     line_gap = out_end - pred_end
     lines = free & ok & any3((line_gap * pred_dir < 0) & (dirs[1:] == pred_dir) & (np.abs(line_gap) <= within))
     arc_gap = pred_end - out_start
-    pieces = arc & ok & any3((np.abs(arc_gap) <= within) & (arc_gap != 0))
+    pieces = arc & same & any3((np.abs(arc_gap) <= within) & (arc_gap != 0))
     todo = np.flatnonzero(lines | pieces).tolist()
     if not todo:
         return
@@ -429,7 +435,8 @@ def _settle(free, arc, d, held, offsets, scales, limit, out_start, out_end, befo
     # A run's first row's predecessor is as it was: a row changed is followed by the next, so
     # a run ends after an unchanged row or before one that does not settle (never in `todo`).
     n = len(free)
-    is_line, limits, settles = free.tolist(), limit.tolist(), (ok & (free | arc)).tolist()
+    is_line, limits, settles = free.tolist(), limit.tolist(), ((ok & free) | (same & arc)).tolist()
+    new_frame = set(reframed.tolist())
     moved, moved_ends = [], []  # the rows changed, in order, and their new ends
     shifted, shifted_starts = [], []  # the arc pieces among them, and their new starts
     k = -1  # the last row looked at
@@ -437,7 +444,7 @@ def _settle(free, arc, d, held, offsets, scales, limit, out_start, out_end, befo
         if first <= k:
             continue
         k = first
-        pred = ends[k].tolist()
+        pred = pred_end[k].tolist()
         while k < n and settles[k]:
             limit_k, changed, end = limits[k], False, ends[k + 1].tolist()
             if is_line[k]:
@@ -465,6 +472,8 @@ def _settle(free, arc, d, held, offsets, scales, limit, out_start, out_end, befo
             moved_ends.append(end)
             pred = end
             k += 1
+            if k in new_frame and k < n:
+                pred = _reframed(np.array([pred]), np.array([k - 1]), np.array([k]), offsets, scales)[0].tolist()
     if moved:
         out_end[moved] = moved_ends
     if shifted:
@@ -473,13 +482,17 @@ def _settle(free, arc, d, held, offsets, scales, limit, out_start, out_end, befo
 
 def _with_previous(out_end, d, held, offsets, scales, before) -> tuple[NDArray, NDArray, NDArray]:
     """Ends and directions with the previous chunk's last row in front, and
-    (n,) whether each row's predecessor is in the same program frame."""
+    (n,) whether each row has a predecessor."""
     ends = np.vstack([before if before is not None else np.full(3, np.nan), out_end])
     dirs = np.vstack([held, d])
     ok = np.ones(len(out_end), dtype=bool)
-    ok[1:] = all3(offsets[1:] == offsets[:-1]) & (scales[1:] == scales[:-1])
     ok[0] = before is not None
     return ends, dirs, ok
+
+
+def _reframed(points: NDArray, rows: NDArray, to: NDArray, offsets: NDArray, scales: NDArray) -> NDArray:
+    """(r,3) points of the frames of `rows` seen from the frames of rows `to`."""
+    return (points + offsets[rows]) * (scales[rows] / scales[to])[:, None] - offsets[to]
 
 
 def _hold_pieces_still(pieces, d, held, limit, out_start, out_end) -> None:

@@ -21,14 +21,15 @@ import pytest
 
 from tests.conftest import RS274
 
-_CALL = re.compile(r"(STRAIGHT_TRAVERSE|STRAIGHT_FEED|ARC_FEED)\(([^)]*)\)")
+_CALL = re.compile(r"(STRAIGHT_TRAVERSE|STRAIGHT_FEED|ARC_FEED|USE_LENGTH_UNITS)\(([^)]*)\)")
 # (n,3) commanded points, (3,) direction each axis travels in (+1, -1) -> (n,3) actual points, mm
 Machine = Callable[[np.ndarray, np.ndarray], np.ndarray]
 STEP_MM = 0.05  # how densely paths are sampled
 
 
 def rs274_calls(path: Path) -> list[tuple[str, list[float]]]:
-    """rs274's motion calls of a program (7 decimals); fails the test if rs274 refuses it."""
+    """rs274's motion calls of a program (7 decimals), their lengths in mm (rs274 says them in
+    the units in effect); fails the test if rs274 refuses it."""
     if not RS274.exists():
         pytest.skip("rs274 oracle not available")
     env = {**os.environ, "RS274_DIGITS": "7"}
@@ -37,18 +38,26 @@ def rs274_calls(path: Path) -> list[tuple[str, list[float]]]:
         pytest.skip(f"rs274 oracle did not run: {proc.stderr.strip()[:200]}")
     messages = [line for line in proc.stderr.splitlines() if line.strip() and line.strip() != "executing"]
     assert proc.returncode == 0 and not messages, f"rs274 refused {path.name}: {messages[:3]}"
-    return [(name, [float(v) for v in args.split(",")]) for name, args in _CALL.findall(proc.stdout)]
+    calls, unit = [], 1.0
+    for name, args in _CALL.findall(proc.stdout):
+        if name == "USE_LENGTH_UNITS":
+            unit = 25.4 if "INCHES" in args else 1.0
+            continue
+        values = [float(v) for v in args.split(",")]
+        lengths = (0, 1, 2, 3, 5) if name == "ARC_FEED" else (0, 1, 2)
+        calls.append((name, [v * unit if n in lengths else v for n, v in enumerate(values)]))
+    return calls
 
 
-def moves(path: Path, scale: float = 1.0) -> list[tuple[np.ndarray, np.ndarray]]:
-    """The program's moves as (start, end) points in mm (rs274's numbers times `scale`: 25.4
-    for an inch program), arcs (G17) as short chords; the first starts at (0, 0, 0)."""
+def moves(path: Path) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The program's moves as (start, end) points in mm, arcs (G17) as short chords; the
+    first starts at (0, 0, 0)."""
     at = np.zeros(3)
     out = []
     for name, args in rs274_calls(path):
         if name == "ARC_FEED":
-            end = np.array([args[0], args[1], args[5]]) * scale
-            centre, turn = np.array(args[2:4]) * scale, int(args[4])
+            end = np.array([args[0], args[1], args[5]])
+            centre, turn = np.array(args[2:4]), int(args[4])
             a0 = np.arctan2(at[1] - centre[1], at[0] - centre[0])
             a1 = np.arctan2(end[1] - centre[1], end[0] - centre[0])
             sweep = (a1 - a0) % (2 * np.pi) if turn > 0 else -((a0 - a1) % (2 * np.pi))
@@ -59,32 +68,36 @@ def moves(path: Path, scale: float = 1.0) -> list[tuple[np.ndarray, np.ndarray]]
                                    at[2] + t * (end[2] - at[2])])  # fmt: skip
             out += list(zip(pts[:-1], pts[1:]))
         else:
-            end = np.array(args[:3]) * scale
+            end = np.array(args[:3])
             out.append((at, end))
         at = end
     return out
 
 
-def actual_moves(path: Path, machine: Machine, scale: float = 1.0) -> list[np.ndarray]:
+def actual_moves(path: Path, machine: Machine) -> list[np.ndarray]:
     """Where the tool really goes on each of the program's moves, (k,3) points along it: the
     commands mapped through `machine` with the direction each axis travels in (a still axis
-    holds its last one, +1 before it first moves).  An axis moving one way never goes back:
-    where it reverses with lost motion it stands until its command catches up, where it runs
-    ahead it jumps the new way at once."""
+    holds its last one, +1 before it first moves).  Where an axis's error travelling − is
+    above its error travelling + (lost motion) the axis is a play: it stands on reversal until
+    its command takes the play up (and stands whatever an µm command does inside it); where
+    it is below (the axis runs ahead) it jumps the new way at once."""
     held = np.ones(3)
-    last = None
+    at = None  # where the tool is
     out = []
-    for start, end in moves(path, scale):
-        moving = end != start
-        held = np.where(moving, np.sign(end - start), held)
+    for start, end in moves(path):
+        held = np.where(end != start, np.sign(end - start), held)
         n = max(2, int(np.linalg.norm(end - start) / STEP_MM) + 2)
-        raw = machine(start + np.linspace(0.0, 1.0, n)[:, None] * (end - start), held)
-        if last is not None:
-            raw = np.vstack([last[None, :], raw])
-            d = np.where(moving, held, 0.0)
-            raw = np.where(moving, d * np.maximum.accumulate(d * raw, axis=0), raw)[1:]
-        out.append(raw)
-        last = raw[-1]
+        commands = start + np.linspace(0.0, 1.0, n)[:, None] * (end - start)
+        plus, minus = machine(commands, np.ones(3)), machine(commands, -np.ones(3))
+        actual = machine(commands, held)
+        play = minus >= plus
+        if at is not None and play.any():
+            x = at.copy()
+            for k in range(n):  # the play, sample by sample
+                x = np.where(play[k], np.minimum(np.maximum(x, plus[k]), minus[k]), actual[k])
+                actual[k] = x
+        out.append(actual)
+        at = actual[-1]
     return out
 
 
@@ -117,7 +130,7 @@ def worst_um(original: Path, output: Path, machine: Machine, skip: int = 0) -> f
     return worst_at(original, output, machine, skip)[0]
 
 
-def holes_um(output: Path, original: Path, machine: Machine, scale: float = 1.0) -> np.ndarray:
+def holes_um(output: Path, original: Path, machine: Machine) -> np.ndarray:
     """µm each hole (the end of a feed move down Z) lands from the original's, running
     `output` on `machine`."""
 
@@ -126,8 +139,8 @@ def holes_um(output: Path, original: Path, machine: Machine, scale: float = 1.0)
         assert len(feeds) == len(segments)
         return np.array([b for (name, _), (a, b) in zip(feeds, segments) if name == "STRAIGHT_FEED" and b[2] < a[2] - 1e-9])
 
-    got = bottoms(output, [(m[0], m[-1]) for m in actual_moves(output, machine, scale)])
-    wanted = bottoms(original, moves(original, scale))
+    got = bottoms(output, [(m[0], m[-1]) for m in actual_moves(output, machine)])
+    wanted = bottoms(original, moves(original))
     assert got.shape == wanted.shape
     return np.linalg.norm(got - wanted, axis=1) * 1000
 

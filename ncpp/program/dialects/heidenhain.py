@@ -424,7 +424,7 @@ class HeidenhainWriter(IsoWriter):
         if type(segment) is not Line:
             return self._arc_text(segment)
         # the axes that moved in the output (`_moved`, with the units' places read once per line)
-        inch, end, last, last_places = segment.context.inch, segment.end, self._last_end, self._last_places
+        (last, last_places), inch, end = self._last_seen_from(segment.context), segment.context.inch, segment.end
         units = self._resolved.get(inch) or self._units(inch)
         places, styles = units.places, units.styles
         words = [

@@ -84,6 +84,7 @@ class IsoWriter:
         # axes a block does not write are exactly where they were.
         self._last_end: tuple[float, float, float] | None = None
         self._last_places: tuple[int, int, int] = (0, 0, 0)
+        self._last_context: Context | None = None  # the frame (units, offsets) `_last_end` is in
 
     def comment(self, text: str) -> str:
         return f"{self.comment_open}{text}{self.comment_close}"
@@ -92,7 +93,7 @@ class IsoWriter:
     def state(self) -> "WriterState":
         """What decides how the next block is written (the rest is caches)."""
         return WriterState(tuple(sorted(self.styles.items())), self.program_motion, self.output_motion,
-                           frozenset(self.known_axes), self._last_end, self._last_places)  # fmt: skip
+                           frozenset(self.known_axes), self._last_end, self._last_places, self._last_context)  # fmt: skip
 
     def learn(self, block: Block) -> None:
         """What writing the block would teach about the program, without writing it: its
@@ -124,7 +125,7 @@ class IsoWriter:
             self._learn_style(letter, style)
         self.program_motion, self.output_motion = state.program_motion, state.output_motion
         self.known_axes = set(state.known_axes)
-        self._last_end, self._last_places = state.last_end, state.last_places
+        self._last_end, self._last_places, self._last_context = state.last_end, state.last_places, state.last_context
 
     # -- the stream -----------------------------------------------------------
     def write(self, events: Iterable[Event]) -> Iterator[str]:
@@ -333,8 +334,17 @@ class IsoWriter:
     # -- numbers as written -----------------------------------------------------
     def _moved(self, axis: str, value: float, segment: Line | Arc) -> bool:
         """Whether writing `value` for the axis changes what the output last said."""
-        last, n = self._last_end, AXES.index(axis)
-        return last is None or written_apart(value, self._style(axis, segment).decimals, last[n], self._last_places[n])
+        (last, places), n = self._last_seen_from(segment.context), AXES.index(axis)
+        return last is None or written_apart(value, self._style(axis, segment).decimals, last[n], places[n])
+
+    def _last_seen_from(self, context: Context) -> tuple[tuple | None, tuple]:
+        """(where the output is, the decimal places to compare it with) in `context`'s frame:
+        after a change of units or offsets, the numbers last written, as the control holds them
+        (`seen_from`)."""
+        last, frame = self._last_end, self._last_context
+        if last is None or frame is context or frame is None or not reframed(frame, context):
+            return last, self._last_places
+        return seen_from(last, self._last_places, frame, context, self._units(context.inch).places)
 
     def _remember_end(self, segment: Line | Arc, units: "_Written | None" = None) -> None:
         """The segment's end is where the output is now, written with `units`' places
@@ -342,7 +352,7 @@ class IsoWriter:
         if units is None:
             inch = segment.context.inch  # once per line written: `_units`' cached look-up inlined
             units = self._resolved.get(inch) or self._units(inch)
-        self._last_end, self._last_places = segment.end, units.places
+        self._last_end, self._last_places, self._last_context = segment.end, units.places, segment.context
 
     def _format(self, letter: str, value: float, segment: Line | Arc) -> str:
         return format_number(value, self._style(letter, segment))
@@ -378,7 +388,11 @@ class IsoWriter:
 
     def _written_bits(self, facts: "_Facts", segment: Line | Arc, units: "_Written") -> int:
         """`_bits_written` where the output is now."""
-        return _bits_written(facts, segment, units.places, self.known_axes, self._last_end, self._last_places)
+        frame = self._last_context
+        if frame is segment.context or frame is None or self._last_end is None or not reframed(frame, segment.context):
+            return _bits_written(facts, segment, units.places, self.known_axes, self._last_end, self._last_places)
+        last, places = self._last_seen_from(segment.context)
+        return _bits_written(facts, segment, units.places, self.known_axes, last, places, named=False)
 
     @staticmethod
     def _numbers(segment: Line | Arc) -> tuple[float, ...]:
@@ -426,7 +440,7 @@ class IsoWriter:
             self.output_motion, self.program_motion = code, facts.motion
         elif code != output_motion:
             self.output_motion = code
-        self._last_end, self._last_places = segment.end, units.places  # `_remember_end`
+        self._last_end, self._last_places, self._last_context = segment.end, units.places, segment.context  # `_remember_end`
         return raw
 
     def _planned_edit(self, block: Block, facts: "_Facts", segment: Line | Arc, motion: int | None, units: "_Written") -> str | None:
@@ -462,7 +476,7 @@ class IsoWriter:
         key = (signature, bits, motion, spelled)
         plan = units.edit_plans.get(key, _UNKNOWN)
         if plan is _UNKNOWN:
-            dropped = [letter for letter in DROPPED if letter in facts.letters and not bits & _BIT.get(letter, 0)]
+            dropped = [letter for letter in DROPPED + tuple(AXES) if letter in facts.letters and not bits & _BIT.get(letter, 0)]
             plan = units.edit_plans[key] = EditPlan.compile(
                 facts.word_letters, units.fields(bits), 5 if bits & _ANY_CENTRE else 3, dropped, motion, facts.motion_at, spelled or (" ", False)
             )
@@ -472,7 +486,7 @@ class IsoWriter:
         texts = self._machine_texts(facts, segment) if facts.machine else self._texts(block, segment)
         # centre words of the old arc, and Fanuc corner words: the corner is now explicit;
         # P is an arc's turn count, but a dwell time (G4) or blending tolerance (G64) elsewhere
-        drop = [] if facts.letters.isdisjoint(_DROPPED) else [l for l in DROPPED if l in facts.letters and l not in texts]
+        drop = [l for l in DROPPED + tuple(AXES) if l in facts.letters and l not in texts]
         if "P" in drop and not self._arc_block(block):
             drop.remove("P")
         # words the block lacks are appended spelled as the block was read (before a G word is inserted)
@@ -490,10 +504,13 @@ class IsoWriter:
         known = self.known_axes
         output_motion, last, last_places = self.output_motion, self._last_end, self._last_places
         lines: list[str] = []
-        context = None
+        context, frame = None, self._last_context  # (`frame`: the one `last` is in)
         for segment in segments:
             if segment.context is not context:  # (the segments of a block share their context, mostly)
                 context = segment.context
+                if last is not None and frame is not None and frame is not context and reframed(frame, context):
+                    last, last_places = seen_from(last, last_places, frame, context, self._units(context.inch).places)
+                frame = context
                 inch, absolute = context.inch, context.absolute
                 units = self._resolved.get(inch) or self._units(inch)
                 places = units.places
@@ -515,7 +532,7 @@ class IsoWriter:
             if motion is not None:
                 output_motion = code
             last, last_places = segment.end, places
-        self.output_motion, self._last_end, self._last_places = output_motion, last, last_places
+        self.output_motion, self._last_end, self._last_places, self._last_context = output_motion, last, last_places, context
         return lines
 
 
@@ -525,11 +542,19 @@ def new_block_key(bits: int, motion: int | None) -> int:
     return bits if motion is None else bits | (motion + 1) << len(WRITTEN_LETTERS)
 
 
-def _bits_written(facts: "_Facts", segment: Line | Arc, places: tuple, known: set[str], last: tuple | None, last_places: tuple) -> int:
+def _bits_written(facts: "_Facts", segment: Line | Arc, places: tuple, known: set[str], last: tuple | None, last_places: tuple,
+                  named: bool = True) -> int:  # fmt: skip
     """The letters the segment writes (a mask of `_BIT`): the axes its block has and whatever
     moved in the output (which is at `last`, written with `last_places`; `known`: the axes it
-    has written), then an arc's centre; `places`: the decimals the segment is written with."""
+    has written), then an arc's centre; `places`: the decimals the segment is written with.
+    Not `named`: of the axes its block has, only those that move (after a change of units or
+    offsets, where the output's position is off the grid of the new numbers, a rounded number
+    for an axis that stands would move it)."""
     bits, absent, end = facts.axis_bits, facts.absent_axes, segment.end
+    if not named and last is not None and segment.context.absolute:
+        for n, axis in _NUMBERED_AXES:
+            if bits & _BIT[axis] and not written_apart(end[n], places[n], last[n], last_places[n]):
+                bits &= ~_BIT[axis]
     if absent and segment.context.absolute:
         same_places = places == last_places
         for n, axis, bit in absent:
@@ -629,6 +654,18 @@ def _words(block: Block, facts: _Facts) -> tuple[Word, ...]:
     return items if len(items) == facts.words else tuple(item for item in items if type(item) is Word)  # type: ignore[return-value]
 
 
+def reframed(before: Context, after: Context) -> bool:
+    """Whether the program's numbers mean other machine positions after than before (units, offsets)."""
+    return before.inch != after.inch or before.offset != after.offset
+
+
+def seen_from(last: tuple, places: tuple, before: Context, after: Context, after_places: tuple) -> tuple[tuple, tuple]:
+    """The point the output wrote as `last` (with `places` decimals) in the frame `before`, as
+    the control holds it in the frame `after`, with the decimal places to compare it with there."""
+    written = (round(last[0], places[0]), round(last[1], places[1]), round(last[2], places[2]))
+    return after.to_program(before.to_machine(written)), after_places
+
+
 def written_apart(value: float, places: int, last: float, last_places: int) -> bool:
     """Whether `value` written with `places` decimals says another number than `last` written
     with `last_places` (compared as numbers first: most axes a block does not write are
@@ -661,6 +698,7 @@ class WriterState:
     known_axes: frozenset
     last_end: tuple | None
     last_places: tuple
+    last_context: Context | None = None
 
     def append(self, second: "WriterState", rest: BinaryIO, out: BinaryIO) -> None:
         """Append to `out` the lines `rest` a second part wrote from `second` (a state equal
