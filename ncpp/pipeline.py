@@ -169,8 +169,8 @@ def warn_unplaced(blocks: Iterable[Block], warnings: Warnings, file: str) -> Ite
 
 # Why moves are left as programmed (`Line.fixed`), as the warning says it
 UNCOMPENSATED = {
-    CYCLE: "canned cycle: its moves pass through uncompensated (the holes are where the program puts them, "
-    "with the machine's errors); compensation resumes with the next move",
+    CYCLE: "canned cycle: its moves pass through uncompensated, from its programmed start (the holes are where the "
+    "program puts them, with the machine's errors); compensation resumes with the next move",
     FLOW: "loop or subroutine: its moves pass through uncompensated (one text runs several times, "
     "or away from where it stands, so it cannot carry one correction); compensation resumes with the next move after it",
     COMP: "cutter compensation: its moves pass through uncompensated (the control offsets them by the tool radius, "
@@ -189,9 +189,9 @@ def warn_fixed(events: Iterable[Event], warnings: Warnings, file: str) -> Iterat
     starts (refused with --strict).
 
     In G91 such a move starts from where the control is (the compensated position): the
-    moves of cycles, loops and subroutines and those under cutter compensation run their
-    increments from there, which apply_error_map follows (`_carry`; a G91 cycle's G98
-    retract, to the level it started from, is one of them).  A cycle in G90 goes to its
+    moves of loops and subroutines and those under cutter compensation run their increments
+    from there, which apply_error_map follows (`_carry`); a cycle after a compensated move
+    starts from its programmed start, stepped to (`apply_error_map._lead_in`).  A cycle in G90 goes to its
     programmed points, but its G98 retract ends at the compensated level it started from:
     from a G91 move right after one, the rest of the program passes through, as after an
     out-of-scope construct."""

@@ -24,7 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ncpp.errors import NcppError
-from ncpp.motion.segments import Arc, Event, Line
+from ncpp.motion.segments import CYCLE, Arc, Event, Line
 from ncpp.passes.context import CutLine, PassContext, deviation
 from ncpp.passes.kernels import run_ahead
 from ncpp.passes.geometry import all3, any3, compensate, frames, from_plane, in_plane, line_chunks, plane_axes, points, rows_of, tuples
@@ -51,7 +51,7 @@ def _chunks(events: Iterable[Event], ctx: PassContext) -> Iterator[list[Event]]:
     solver = Solve(ctx.for_kernels(), None if resume is None else resume.travel)
     solve = ctx.kernels.bind(solver)
     last = None if resume is None else resume.last  # the last segment written: its compensated end, in its own program frame
-    chunks = (_with_rows(chunk, ctx.directional) for chunk in line_chunks(events))
+    chunks = _rowed(line_chunks(events), ctx.directional, last)
     cut = _Cut(ctx.cut, solver) if ctx.cut is not None else None
 
     def start(c):
@@ -118,10 +118,22 @@ class _Cut:
             ctx.at_cut.append(PassState(self.travel, last, ctx.motion_at_cut[0] if ctx.motion_at_cut else None))
 
 
-def _with_rows(chunk: list[Event], directional: bool) -> tuple[list[Event], list, "_Rows | None"]:
-    """The chunk, its segments, and their rows (None without segments)."""
+def _rowed(chunks: Iterable[list[Event]], directional: bool, last: Line | Arc | None) -> Iterator[tuple]:
+    """Each chunk with its segments and their rows (`_with_rows`); `last`: the segment before
+    the first chunk (None: none)."""
+    fixed_before = last is None or bool(last.fixed)
+    for chunk in chunks:
+        rowed = _with_rows(chunk, directional, fixed_before)
+        if rowed[1]:
+            fixed_before = bool(rowed[1][-1].fixed)
+        yield rowed
+
+
+def _with_rows(chunk: list[Event], directional: bool, fixed_before: bool = True) -> tuple[list[Event], list, "_Rows | None"]:
+    """The chunk, its segments, and their rows (None without segments); `fixed_before`:
+    whether the segment before the chunk's first was left as programmed (or there is none)."""
     segs = [e for e in chunk if type(e) is Line or type(e) is Arc]
-    return chunk, segs, _rows(segs, directional) if segs else None
+    return chunk, segs, _rows(segs, directional, fixed_before) if segs else None
 
 
 @dataclass
@@ -141,6 +153,7 @@ class _Rows:
     lines: NDArray  # (n,) the line of each segment's block, for messages
     rapid: NDArray  # (n,) rapid moves (G0): no reversal step before them
     carried: NDArray  # (n,) moves left as programmed in G91: they start where the control is (`_carry`)
+    lead_in: NDArray  # (n,) a canned cycle's first move after a compensated one: a step to its programmed start first
 
 
 def _rows_before(rows: _Rows, line: int | None) -> _Rows | None:
@@ -151,20 +164,22 @@ def _rows_before(rows: _Rows, line: int | None) -> _Rows | None:
     return _Rows(**{f.name: None if (v := getattr(rows, f.name)) is None else v[:k] for f in fields(_Rows)})
 
 
-def _rows(segs: list, directional: bool) -> _Rows:
+def _rows(segs: list, directional: bool, fixed_before: bool = True) -> _Rows:
     offsets, scales, tools = frames(segs)
     start, end = points([e.start for e in segs]), points([e.end for e in segs])
-    # one walk over the events for five flags (1 arc, 2 fixed: a move left as programmed, 4 changed, 8 rapid,
-    # 16 carried: fixed in G91)
-    kind = np.fromiter([(type(e) is Arc) + (0 if not e.fixed else 2 if e.context.absolute else 18) + 4 * bool(e.changed)
-                        + 8 * (type(e) is Line and e.rapid) for e in segs], dtype=np.int8, count=len(segs))  # fmt: skip
+    # one walk over the events for six flags (1 arc, 2 fixed: a move left as programmed, 4 changed, 8 rapid,
+    # 16 carried: fixed in G91, 32 a canned cycle's)
+    kind = np.fromiter([(type(e) is Arc) + (0 if not e.fixed else (2 if e.context.absolute else 18) + 32 * (e.fixed == CYCLE))
+                        + 4 * bool(e.changed) + 8 * (type(e) is Line and e.rapid) for e in segs], dtype=np.int8, count=len(segs))  # fmt: skip
     arc, changed = (kind & 1) != 0, (kind & 4) != 0
     line = (kind & 3) == 0
     free = line & ~changed
+    fixed = (kind & 2) != 0
+    lead_in = ((kind & 32) != 0) & ~np.concatenate([[fixed_before], fixed[:-1]])
     return _Rows(
         start, end, offsets, scales, tools, free, changed, changed & line,
         _arc_assumed(segs, np.flatnonzero(changed & arc), start, end) if directional else None,
-        np.fromiter([e.block.line for e in segs], dtype=np.int64, count=len(segs)), (kind & 8) != 0, (kind & 16) != 0,
+        np.fromiter([e.block.line for e in segs], dtype=np.int64, count=len(segs)), (kind & 8) != 0, (kind & 16) != 0, lead_in,
     )  # fmt: skip
 
 
@@ -244,6 +259,7 @@ def _written(chunk: list[Event], segs: list, rows: _Rows, solved: _Solved, last)
     targets = _by_row(target, turning & solved.free)
     moved_starts = _by_row(solved.start, solved.moved & ~solved.free)
     between = _between(chunk) if len(chunk) > len(segs) else {}
+    lead_in = set(np.flatnonzero(rows.lead_in).tolist())
     out: list[Event] = []
     start = None  # where the output is: the previous segment's compensated end
     for i, seg, row, end in zip(range(len(segs)), segs, code, ends):
@@ -257,6 +273,9 @@ def _written(chunk: list[Event], segs: list, rows: _Rows, solved: _Solved, last)
                 begin = targets[i]
             out.append(Line(begin, end, seg.rapid, seg.feed, seg.block, seg.context, seg.extra, True))
         else:
+            if i in lead_in:
+                step = _lead_in(seg, last if i == 0 else _ended(segs[i - 1], solved.end[i - 1]))
+                out += () if step is None else (step,)
             if row & _MOVED:
                 seg = _moved_arc(seg, moved_starts[i], end)
             if row & _CONNECTS:
@@ -394,7 +413,7 @@ def _carry(rows: _Rows, out_end: NDArray, before: NDArray | None) -> None:
             previous = before
         else:  # the end before, seen from this row's frame
             previous = (out_end[k - 1] + offsets[k - 1]) * scales[k - 1] / scales[k] - offsets[k]
-        if previous is None:
+        if previous is None or rows.lead_in[k]:  # (a cycle starts from its programmed start: `_lead_in`)
             continue
         # the run: up to the next run's start or the first row not carried, whichever comes first
         stop = starts[n + 1] if n + 1 < len(starts) else len(carried)
@@ -596,8 +615,26 @@ def _end_in_frame_of(last: Line | Arc | None, event: Line | Arc) -> tuple | None
 
 
 def _ended(segment: Line | Arc, end: NDArray) -> Line:
-    """Stands in for a written segment where only its end and frame matter."""
-    return Line(segment.start, tuple(end.tolist()), False, 0.0, segment.block, segment.context)
+    """Stands in for a written segment where only its end, frame and `fixed` matter."""
+    return Line(segment.start, tuple(end.tolist()), False, 0.0, segment.block, segment.context, fixed=segment.fixed)
+
+
+def _lead_in(cycle: Line | Arc, before: Line | None) -> Line | None:
+    """A rapid step from where the output is (`before`'s end) to the programmed start of a
+    canned cycle, in `before`'s frame and mode (the cycle's block may set G91), written ahead
+    of the cycle's block (`fixed` and changed: `IsoWriter`).  Where a cycle puts its holes
+    depends on where it starts: in G91 its holes, R and Z levels run from there (polar words
+    turning about XY zero), in G90 a hole without X Y, a polar word without `@` or `^`, and
+    the G98 retract take the start's; from a compensated start they would carry its
+    correction, turned.  From the programmed start the holes are where the program puts
+    them, with the machine's errors.  None: no step is needed."""
+    if before is None:
+        return None
+    a, b = before.context, cycle.context
+    target = cycle.start if a.inch == b.inch and a.offset == b.offset else a.to_program(b.to_machine(cycle.start))
+    if max(abs(a - b) for a, b in zip(target, before.end)) <= 1e-9:
+        return None
+    return Line(before.end, target, True, cycle.feed, cycle.block, before.context, changed=True, fixed=CYCLE)
 
 
 def _apart(a: NDArray, b: NDArray, tolerance: float = 1e-7) -> NDArray:

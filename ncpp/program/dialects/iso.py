@@ -152,12 +152,19 @@ class IsoWriter:
         if facts.flow:
             return self._write_control(block, first)
         motion = [e for e in group if type(e) is Line or type(e) is Arc]
+        lead = 0  # steps to a canned cycle's programmed start (`apply_error_map._lead_in`): new blocks before it
+        while lead < len(motion) and motion[lead].fixed and motion[lead].changed:
+            lead += 1
+        if lead:
+            steps, motion = self._new_blocks(block, motion[:lead], block.eol), motion[lead:]
         for segment in motion:
             if segment.changed:
                 break
         else:  # nothing changed
             self._learn_program_motion(block, motion)
-            lines = [self._restore_mode_line(block)] if self._needs_mode_restore(block) else []
+            lines = steps if lead else []
+            if self._needs_mode_restore(block):
+                lines.append(self._restore_mode_line(block))
             lines.append(block.text)
             self._after_verbatim(block, motion)
             return lines
