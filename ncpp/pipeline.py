@@ -94,9 +94,15 @@ class Stats:
     lines_out: int = 0
 
 
-def header_text(source: ErrorSource, tolerance: float) -> str:
-    """The output's first comment: what compensated it, for which machine file (its hash), how closely."""
-    return f"{HEADER_TAG} for {source.name} sha256:{source.digest} tolerance {tolerance:g} mm by ncpp {__version__}"
+def header_text(source: ErrorSource, tolerance: float, offsets: WorkOffsets | None = None, dialect: str = "iso") -> str:
+    """The output's first comment: what compensated it, for which machine file (its hash), how closely;
+    with `offsets`, more lines (`header.placement_lines`): where it was placed, with which tool table."""
+    first = f"{HEADER_TAG} for {source.name} sha256:{source.digest} tolerance {tolerance:g} mm by ncpp {__version__}"
+    if offsets is None:
+        return first
+    from ncpp.header import placement_lines
+
+    return "\n".join([first, *placement_lines(offsets, dialect)])
 
 
 def refuse_compensated(blocks: Iterable[Block], file: str) -> Iterator[Block]:
@@ -302,24 +308,23 @@ def dialect_tools(name: str) -> tuple[Callable, type]:
 
 
 def with_header(lines: Iterable[str], header: str, writer: IsoWriter) -> Iterator[str]:
-    """Put the header comment first, after a leading `%` tape mark line (or where the
-    dialect's writer puts it: Heidenhain after `BEGIN PGM`)."""
+    """Put the header comment first (a comment line per line of it), after a leading `%`
+    tape mark line (or where the dialect's writer puts it: Heidenhain after `BEGIN PGM`)."""
     own = getattr(writer, "with_header", None)
     if own is not None:
         yield from own(lines, header)
         return
     it = iter(lines)
     first = next(it, None)
-    if first is None:
-        yield writer.comment(header) + "\n"
-        return
-    eol = "\r\n" if first.endswith("\r\n") else "\n"
-    if first.lstrip().startswith("%"):
+    eol = "\r\n" if first is not None and first.endswith("\r\n") else "\n"
+    comments = [writer.comment(line) + eol for line in header.split("\n")]
+    if first is not None and first.lstrip().startswith("%"):
         yield first
-        yield writer.comment(header) + eol
+        yield from comments
     else:
-        yield writer.comment(header) + eol
-        yield first
+        yield from comments
+        if first is not None:
+            yield first
     yield from it
 
 
@@ -459,11 +464,11 @@ def _process(
         keep_freed_memory()  # numpy's temporaries reuse the heap, not fresh pages (runtime.py)
         ctx = make_context(source, tolerance, warnings, file, kernels)
         if part is None:
-            lines = with_header(writer.write(run_passes(events, ctx, PASSES)), header_text(source, tolerance), writer)
+            lines = with_header(writer.write(run_passes(events, ctx, PASSES)), header_text(source, tolerance, offsets, name), writer)
         elif not part.second:  # the first part: up to the cut, where it records the state (and on, where it must)
             ctx = replace(ctx, cut=part.cut)
             done = _cut_at(run_passes(events, ctx, PASSES), part, ctx, writer, stop=True)
-            lines = with_header(_before_mark(writer.write(done), part), header_text(source, tolerance), writer)
+            lines = with_header(_before_mark(writer.write(done), part), header_text(source, tolerance, offsets, name), writer)
         elif part.resume is not None:  # the second part: from the cut on, from the state recorded there
             pass_state, writer_state = part.resume
             writer.restore(writer_state)

@@ -320,7 +320,7 @@ class HeidenhainWriter(IsoWriter):
         if self.header is not None and self.last_number < 0 and not any(
             type(i) is Statement and i.kind == "program_begin" for i in block.items
         ):
-            yield self._header_first(block)
+            yield from self._header_first(block)
         self._learn_styles(block)
         motion = [e for e in group if type(e) is Line or type(e) is Arc]
         pole = next((e for e in group if type(e) is Pole), None)
@@ -344,7 +344,8 @@ class HeidenhainWriter(IsoWriter):
                 self.output_pole = self.program_pole
             yield self._numbered(block, splice(block, {}, feed) if feed else block.raw)
             if self.header is not None and any(type(i) is Statement and i.kind == "program_begin" for i in block.items):
-                yield self._inserted(self.comment(self.header))
+                for line in self.header.split("\n"):
+                    yield self._inserted(self.comment(line))
                 self.header = None
             for segment in motion:
                 self._remember_end(segment)
@@ -380,11 +381,11 @@ class HeidenhainWriter(IsoWriter):
             return ""
         return " F" + format_number(motion[0].feed, self.styles.get("F") or NumberStyle(decimals=3))
 
-    def _header_first(self, block: Block) -> str:
+    def _header_first(self, block: Block) -> list[str]:
         self.last_number = -1
-        line = self._inserted(self.comment(self.header))  # numbered 0; the program shifts by one
+        lines = [self._inserted(self.comment(text)) for text in self.header.split("\n")]  # numbered 0..: the program shifts
         self.header = None
-        return line
+        return lines
 
     def _inserted_replacing(self, block: Block, text: str) -> str:
         number = next((i for i in block.items if type(i) is Word and i.letter == "N"), None)
