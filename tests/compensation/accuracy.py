@@ -55,6 +55,11 @@ def rs274_calls(path: Path) -> list[tuple[str, list[float]]]:
 def moves(path: Path) -> list[tuple[np.ndarray, np.ndarray]]:
     """The program's moves as (start, end) points in mm, arcs (G17) as short chords; the
     first starts at (0, 0, 0)."""
+    return [(a, b) for a, b, _ in _moves(path)]
+
+
+def _moves(path: Path) -> list[tuple[np.ndarray, np.ndarray, bool]]:
+    """`moves`, each with whether it feeds (cuts) or is a rapid."""
     at = np.zeros(3)
     out = []
     for name, args in rs274_calls(path):
@@ -69,10 +74,10 @@ def moves(path: Path) -> list[tuple[np.ndarray, np.ndarray]]:
             t = np.linspace(0.0, 1.0, n)
             pts = np.column_stack([centre[0] + radius * np.cos(a0 + t * sweep), centre[1] + radius * np.sin(a0 + t * sweep),
                                    at[2] + t * (end[2] - at[2])])  # fmt: skip
-            out += list(zip(pts[:-1], pts[1:]))
+            out += [(a, b, True) for a, b in zip(pts[:-1], pts[1:])]
         else:
             end = np.array(args[:3])
-            out.append((at, end))
+            out.append((at, end, name == "STRAIGHT_FEED"))
         at = end
     return out
 
@@ -127,10 +132,10 @@ def _distance(points: np.ndarray, segments: list[tuple[np.ndarray, np.ndarray]])
     return best
 
 
-def worst_um(original: Path, output: Path, machine: Machine, skip: int = 0) -> float:
-    """µm the tool gets from the original's commanded path at most, running `output` on
-    `machine` (the first `skip` moves, the approach from rs274's start, left out)."""
-    return worst_at(original, output, machine, skip)[0]
+def worst_um(original: Path, output: Path, machine: Machine) -> float:
+    """µm the tool gets from the original's cutting path (its feed moves) at most while it
+    cuts, running `output` on `machine`."""
+    return worst_at(original, output, machine)[0]
 
 
 def holes_um(output: Path, original: Path, machine: Machine) -> np.ndarray:
@@ -148,9 +153,16 @@ def holes_um(output: Path, original: Path, machine: Machine) -> np.ndarray:
     return np.linalg.norm(got - wanted, axis=1) * 1000
 
 
-def worst_at(original: Path, output: Path, machine: Machine, skip: int = 0) -> tuple[float, np.ndarray]:
-    """`worst_um`, and the point of the mapped path where it is."""
-    points = np.vstack(actual_moves(output, machine)[skip:])
-    points = _samples(list(zip(points[:-1], points[1:])))
-    d = _distance(points, moves(original)[skip:])
+def worst_at(original: Path, output: Path, machine: Machine) -> tuple[float, np.ndarray]:
+    """`worst_um`, and the point of the mapped path where it is.  A feed move's path starts
+    where the move before it left the tool (a reversal's jump is part of it)."""
+    segments = []
+    at = None
+    for (_, _, feed), actual in zip(_moves(output), actual_moves(output, machine)):
+        if feed:
+            points = actual if at is None else np.vstack([at[None, :], actual])
+            segments += list(zip(points[:-1], points[1:]))
+        at = actual[-1]
+    points = _samples(segments)
+    d = _distance(points, [(a, b) for a, b, feed in _moves(original) if feed])
     return float(d.max() * 1000), points[int(d.argmax())]

@@ -57,5 +57,5 @@ def test_axis_not_moved_after_a_unit_switch_is_not_reversed(tmp_path):
     depth = np.array([args[2] for name, args in rs274_calls(output) if name == "STRAIGHT_FEED"])
     # Z goes down to its depth and never back up a little (to the grid of the mm numbers)
     assert np.all(np.diff(depth) <= 1e-9), depth
-    after = worst_um(original, output, machine, skip=3)
+    after = worst_um(original, output, machine)
     assert after <= 0.3, f"{after:.2f} µm off the path"
