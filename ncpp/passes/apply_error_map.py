@@ -630,11 +630,11 @@ def _lead_in(cycle: Line | Arc, before: Line | None) -> Line | None:
     them, with the machine's errors.  None: no step is needed."""
     if before is None:
         return None
-    a, b = before.context, cycle.context
-    target = cycle.start if a.inch == b.inch and a.offset == b.offset else a.to_program(b.to_machine(cycle.start))
-    if max(abs(a - b) for a, b in zip(target, before.end)) <= 1e-9:
+    mode, frame = before.context, cycle.context
+    target = cycle.start if mode.inch == frame.inch and mode.offset == frame.offset else mode.to_program(frame.to_machine(cycle.start))
+    if max(abs(p - q) for p, q in zip(target, before.end)) <= 1e-9:
         return None
-    return Line(before.end, target, True, cycle.feed, cycle.block, before.context, changed=True, fixed=CYCLE)
+    return Line(before.end, target, True, cycle.feed, cycle.block, mode, changed=True, fixed=CYCLE)
 
 
 def _apart(a: NDArray, b: NDArray, tolerance: float = 1e-7) -> NDArray:

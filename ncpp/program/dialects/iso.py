@@ -155,14 +155,13 @@ class IsoWriter:
         lead = 0  # steps to a canned cycle's programmed start (`apply_error_map._lead_in`): new blocks before it
         while lead < len(motion) and motion[lead].fixed and motion[lead].changed:
             lead += 1
-        if lead:
-            steps, motion = self._new_blocks(block, motion[:lead], block.eol), motion[lead:]
+        lines = self._new_blocks(block, motion[:lead], block.eol) if lead else []
+        motion = motion[lead:] if lead else motion
         for segment in motion:
             if segment.changed:
                 break
         else:  # nothing changed
             self._learn_program_motion(block, motion)
-            lines = steps if lead else []
             if self._needs_mode_restore(block):
                 lines.append(self._restore_mode_line(block))
             lines.append(block.text)
@@ -171,7 +170,7 @@ class IsoWriter:
         if not facts.plain:
             block = _literal_geometry(block)
         eol = block.eol
-        lines = [self._edit_block(block, motion[0]) + eol]
+        lines.append(self._edit_block(block, motion[0]) + eol)
         if len(motion) > 1:
             lines += self._new_blocks(block, motion[1:], eol)
         return lines
