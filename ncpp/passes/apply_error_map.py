@@ -87,7 +87,8 @@ class PassState:
 
     def __eq__(self, other: object) -> bool:
         """Equal states compensate the chunks after them alike: the same held directions,
-        last command and programmed motion, and a last segment ending at the same point of the same frame."""
+        last command and programmed motion, and a last segment ending at the same point of the
+        same frame, left as programmed or not alike (a canned cycle after it starts with a step)."""
         if not isinstance(other, PassState):
             return NotImplemented
         if self.motion is None or self.motion != other.motion:
@@ -99,7 +100,7 @@ class PassState:
             return False
         if self.last is None or other.last is None:
             return self.last is other.last
-        return self.last.end == other.last.end and self.last.context == other.last.context
+        return self.last.end == other.last.end and self.last.context == other.last.context and self.last.fixed == other.last.fixed
 
 
 class _Cut:
