@@ -94,7 +94,7 @@ class Stats:
     lines_out: int = 0
 
 
-def header_text(source: ErrorSource, tolerance: float, offsets: WorkOffsets | None = None, dialect: str = "iso") -> str:
+def header_text(source: ErrorSource, tolerance: float, offsets: WorkOffsets | None = None, dialect: str = "iso") -> str:  # fmt: skip
     """The output's first comment: what compensated it, for which machine file (its hash), how closely;
     with `offsets`, more lines (`header.placement_lines`): where it was placed, with which tool table."""
     first = f"{HEADER_TAG} for {source.name} sha256:{source.digest} tolerance {tolerance:g} mm by ncpp {__version__}"

@@ -100,7 +100,8 @@ class PassState:
             return False
         if self.last is None or other.last is None:
             return self.last is other.last
-        return self.last.end == other.last.end and self.last.context == other.last.context and self.last.fixed == other.last.fixed
+        a, b = self.last, other.last
+        return a.end == b.end and a.context == b.context and a.fixed == b.fixed
 
 
 class _Cut:
@@ -130,7 +131,7 @@ def _rowed(chunks: Iterable[list[Event]], directional: bool, last: Line | Arc | 
         yield rowed
 
 
-def _with_rows(chunk: list[Event], directional: bool, fixed_before: bool = True) -> tuple[list[Event], list, "_Rows | None"]:
+def _with_rows(chunk: list[Event], directional: bool, fixed_before: bool = True) -> tuple[list[Event], list, "_Rows | None"]:  # fmt: skip
     """The chunk, its segments, and their rows (None without segments); `fixed_before`:
     whether the segment before the chunk's first was left as programmed (or there is none)."""
     segs = [e for e in chunk if type(e) is Line or type(e) is Arc]
@@ -154,7 +155,7 @@ class _Rows:
     lines: NDArray  # (n,) the line of each segment's block, for messages
     rapid: NDArray  # (n,) rapid moves (G0): no reversal step before them
     carried: NDArray  # (n,) moves left as programmed in G91: they start where the control is (`_carry`)
-    lead_in: NDArray  # (n,) a canned cycle's first move after a compensated one: a step to its programmed start first
+    lead_in: NDArray  # (n,) a canned cycle's first move after a compensated one: a step to its start first
 
 
 def _rows_before(rows: _Rows, line: int | None) -> _Rows | None:
@@ -316,7 +317,8 @@ def _plain(rows: _Rows, ctx: PassContext, travel: Travel) -> _Solved:
         _carry(rows, end, None if travel.last is None else travel.last / scales[0] - offsets[0])
     travel.last = (end[-1] + offsets[-1]) * scales[-1]
     none = np.zeros(len(free), dtype=bool)
-    return _Solved(start, end, free, none, none, start, np.ones(start.shape, dtype=bool), np.zeros(len(free)), np.zeros(start.shape))
+    keep = np.ones(start.shape, dtype=bool)
+    return _Solved(start, end, free, none, none, start, keep, np.zeros(len(free)), np.zeros(start.shape))
 
 
 class _Commands:
@@ -437,7 +439,7 @@ def _settle(free, arc, d, held, offsets, scales, limit, out_start, out_end, befo
     frame (the program's numbers there are other numbers for the same place)."""
     ends, dirs, ok = _with_previous(out_end, d, held, offsets, scales, before)
     reframed = np.flatnonzero(any3(offsets[1:] != offsets[:-1]) | (scales[1:] != scales[:-1])) + 1
-    pred_end, pred_dir = ends[:-1].copy(), dirs[:-1]  # row k's predecessor's end (in row k's frame) and direction
+    pred_end, pred_dir = ends[:-1].copy(), dirs[:-1]  # row k's predecessor's end (in k's frame), direction
     pred_end[reframed] = _reframed(pred_end[reframed], reframed - 1, reframed, offsets, scales)
     same = ok.copy()  # the predecessor is in the row's frame
     same[reframed] = False
@@ -493,7 +495,7 @@ def _settle(free, arc, d, held, offsets, scales, limit, out_start, out_end, befo
             pred = end
             k += 1
             if k in new_frame and k < n:
-                pred = _reframed(np.array([pred]), np.array([k - 1]), np.array([k]), offsets, scales)[0].tolist()
+                pred = _reframed(np.array([pred]), np.array([k - 1]), np.array([k]), offsets, scales)[0].tolist()  # fmt: skip
     if moved:
         out_end[moved] = moved_ends
     if shifted:
@@ -617,7 +619,8 @@ def _end_in_frame_of(last: Line | Arc | None, event: Line | Arc) -> tuple | None
 
 def _ended(segment: Line | Arc, end: NDArray) -> Line:
     """Stands in for a written segment where only its end, frame and `fixed` matter."""
-    return Line(segment.start, tuple(end.tolist()), False, 0.0, segment.block, segment.context, fixed=segment.fixed)
+    end_point = tuple(end.tolist())
+    return Line(segment.start, end_point, False, 0.0, segment.block, segment.context, fixed=segment.fixed)
 
 
 def _lead_in(cycle: Line | Arc, before: Line | None) -> Line | None:
@@ -632,7 +635,8 @@ def _lead_in(cycle: Line | Arc, before: Line | None) -> Line | None:
     if before is None:
         return None
     mode, frame = before.context, cycle.context
-    target = cycle.start if mode.inch == frame.inch and mode.offset == frame.offset else mode.to_program(frame.to_machine(cycle.start))
+    same = mode.inch == frame.inch and mode.offset == frame.offset
+    target = cycle.start if same else mode.to_program(frame.to_machine(cycle.start))
     if max(abs(p - q) for p, q in zip(target, before.end)) <= 1e-9:
         return None
     return Line(before.end, target, True, cycle.feed, cycle.block, mode, changed=True, fixed=CYCLE)

@@ -383,7 +383,7 @@ class HeidenhainWriter(IsoWriter):
 
     def _header_first(self, block: Block) -> list[str]:
         self.last_number = -1
-        lines = [self._inserted(self.comment(text)) for text in self.header.split("\n")]  # numbered 0..: the program shifts
+        lines = [self._inserted(self.comment(text)) for text in self.header.split("\n")]  # 0..: the program shifts
         self.header = None
         return lines
 
@@ -500,7 +500,7 @@ class HeidenhainWriter(IsoWriter):
                     self._learn_style(letter, style)
                     if axis:
                         self.known_axes.add(axis)
-            elif type(item) is ExprWord and item.letter[-1:] in _AXES and item.letter.lstrip("I") == item.letter[-1]:
+            elif type(item) is ExprWord and item.letter[-1:] in _AXES and item.letter.lstrip("I") == item.letter[-1]:  # fmt: skip
                 self.known_axes.add(item.letter[-1])  # `X+Q1932` positions X as a number does
 
 

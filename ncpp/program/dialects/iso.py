@@ -125,7 +125,7 @@ class IsoWriter:
             self._learn_style(letter, style)
         self.program_motion, self.output_motion = state.program_motion, state.output_motion
         self.known_axes = set(state.known_axes)
-        self._last_end, self._last_places, self._last_context = state.last_end, state.last_places, state.last_context
+        self._last_end, self._last_places, self._last_context = state.last_end, state.last_places, state.last_context  # fmt: skip
 
     # -- the stream -----------------------------------------------------------
     def write(self, events: Iterable[Event]) -> Iterator[str]:
@@ -152,7 +152,7 @@ class IsoWriter:
         if facts.flow:
             return self._write_control(block, first)
         motion = [e for e in group if type(e) is Line or type(e) is Arc]
-        lead = 0  # steps to a canned cycle's programmed start (`apply_error_map._lead_in`): new blocks before it
+        lead = 0  # steps to a canned cycle's start (`apply_error_map._lead_in`): new blocks before it
         while lead < len(motion) and motion[lead].fixed and motion[lead].changed:
             lead += 1
         lines = self._new_blocks(block, motion[:lead], block.eol) if lead else []
@@ -395,7 +395,8 @@ class IsoWriter:
     def _written_bits(self, facts: "_Facts", segment: Line | Arc, units: "_Written") -> int:
         """`_bits_written` where the output is now."""
         frame = self._last_context
-        if frame is segment.context or frame is None or self._last_end is None or not reframed(frame, segment.context):
+        context = segment.context
+        if frame is context or frame is None or self._last_end is None or not reframed(frame, context):
             return _bits_written(facts, segment, units.places, self.known_axes, self._last_end, self._last_places)
         last, places = self._last_seen_from(segment.context)
         return _bits_written(facts, segment, units.places, self.known_axes, last, places, named=False)
@@ -482,7 +483,7 @@ class IsoWriter:
         key = (signature, bits, motion, spelled)
         plan = units.edit_plans.get(key, _UNKNOWN)
         if plan is _UNKNOWN:
-            dropped = [letter for letter in DROPPED + tuple(AXES) if letter in facts.letters and not bits & _BIT.get(letter, 0)]
+            dropped = [l for l in DROPPED + tuple(AXES) if l in facts.letters and not bits & _BIT.get(l, 0)]
             plan = units.edit_plans[key] = EditPlan.compile(
                 facts.word_letters, units.fields(bits), 5 if bits & _ANY_CENTRE else 3, dropped, motion, facts.motion_at, spelled or (" ", False)
             )
@@ -665,7 +666,7 @@ def reframed(before: Context, after: Context) -> bool:
     return before.inch != after.inch or before.offset != after.offset
 
 
-def seen_from(last: tuple, places: tuple, before: Context, after: Context, after_places: tuple) -> tuple[tuple, tuple]:
+def seen_from(last: tuple, places: tuple, before: Context, after: Context, after_places: tuple) -> tuple[tuple, tuple]:  # fmt: skip
     """The point the output wrote as `last` (with `places` decimals) in the frame `before`, as
     the control holds it in the frame `after`, with the decimal places to compare it with there."""
     written = (round(last[0], places[0]), round(last[1], places[1]), round(last[2], places[2]))
