@@ -1,12 +1,13 @@
 """After a change of units (G20 -> G21) the output's position is off the grid of the new
-numbers: a block must not write an axis it does not move, rounded to the new unit (a
-0.016 µm move that reverses the axis).  Judged by rs274 on the output: Z stays exactly
-where the inch block left it; and mapped through a machine written here by hand whose Z
+numbers: a block must not write an axis it does not move rounded to the new unit (a 0.016 µm
+move that reverses the axis), whether it names the axis or not.  Judged by rs274 on the
+output: Z never goes back up; and mapped through a machine written here by hand whose Z
 runs ahead 5 µm on reversal, the tool stays on the programmed path."""
 
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from tests.compensation.accuracy import rs274_calls, worst_um
 from tests.writeback.conftest import compensate_file
@@ -36,7 +37,7 @@ G0 X1 Y1 Z0.2
 G1 Z-0.049737 F10
 G1 X2
 G21
-G1 X60 F100
+G1 X60{z} F100
 G1 Y40
 G1 X30
 G0 Z5
@@ -50,9 +51,10 @@ def machine(points: np.ndarray, directions: np.ndarray) -> np.ndarray:
     return points + np.column_stack([0.05 * x, 0 * x, 0 * x + z_error]) / 1000
 
 
-def test_axis_not_moved_after_a_unit_switch_is_not_reversed(tmp_path):
+@pytest.mark.parametrize("z", ["", " Z-1.2633198"], ids=["Z not in the block", "Z in the block"])
+def test_axis_not_moved_after_a_unit_switch_is_not_reversed(tmp_path, z):
     original = tmp_path / "original.ngc"
-    original.write_text(PROGRAM)
+    original.write_text(PROGRAM.format(z=z))
     output = compensate_file(original, MACHINE, tmp_path)
     depth = np.array([args[2] for name, args in rs274_calls(output) if name == "STRAIGHT_FEED"])
     # Z goes down to its depth and never back up a little (to the grid of the mm numbers)
