@@ -21,7 +21,14 @@ from ncpp.program.parser import parse_stream
 from tests.compensation.conftest import program_lines
 from tests.conftest import RS274
 from tests.motion.compensating import compensate
-from tests.motion.test_oracle import ORACLE_EXAMPLES, ours, refused_alike, rs274_error, run_rs274, same_calls
+from tests.motion.test_oracle import (
+    ORACLE_EXAMPLES,
+    ours,
+    refused_alike,
+    rs274_error,
+    run_rs274,
+    same_calls,
+)
 
 HEAD = "G21 G90 G17 G94\nG0 X0 Y0 Z5\n"
 

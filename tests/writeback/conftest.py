@@ -23,3 +23,25 @@ def compensate_file(program: Path, machine_toml: str, folder: Path, offsets: Wor
     output = program.with_name(program.stem + "-compensated" + program.suffix)
     output.write_bytes(out.getvalue())
     return output
+
+
+# A machine whose X is off by -50 µm/m · Y (a squareness), and a short program per dialect
+SQUARE = """
+[machine]
+name = "square"
+chain = "XYFZ"
+[offsets]
+tool = [0.0, 0.0, 0.0]
+work = [0.0, 0.0, 0.0]
+[limits]
+X = [-1000.0, 1000.0]
+Y = [-1000.0, 1000.0]
+Z = [-1000.0, 1000.0]
+[squareness]
+C0Y_urad = 50.0
+"""
+PROGRAMS = {
+    "iso": "%\nG21 G90\nG0 X10 Y10 Z5\nG1 Y200 F500\nM2\n%\n",
+    "heidenhain": "0 BEGIN PGM T MM\n1 L X+10 Y+10 Z+5 FMAX\n2 L Y+200 F500\n3 END PGM T MM\n",
+    "sinumerik": "%_N_T_MPF\nG90 G71\nG0 X10 Y10 Z5\nG1 Y200 F500\nM30\n",
+}

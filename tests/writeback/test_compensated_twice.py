@@ -12,26 +12,9 @@ import pytest
 from ncpp.errors import NcppError, Warnings
 from ncpp.integrations.linuxcnc import already_compensated
 from ncpp.pipeline import ErrorSource, process
+from tests.writeback.conftest import PROGRAMS
+from tests.writeback.conftest import SQUARE as MACHINE
 
-MACHINE = """
-[machine]
-name = "square"
-chain = "XYFZ"
-[offsets]
-tool = [0.0, 0.0, 0.0]
-work = [0.0, 0.0, 0.0]
-[limits]
-X = [-1000.0, 1000.0]
-Y = [-1000.0, 1000.0]
-Z = [-1000.0, 1000.0]
-[squareness]
-C0Y_urad = 50.0
-"""
-PROGRAMS = {
-    "iso": "%\nG21 G90\nG0 X10 Y10 Z5\nG1 Y200 F500\nM2\n%\n",
-    "heidenhain": "0 BEGIN PGM T MM\n1 L X+10 Y+10 Z+5 FMAX\n2 L Y+200 F500\n3 END PGM T MM\n",
-    "sinumerik": "%_N_T_MPF\nG90 G71\nG0 X10 Y10 Z5\nG1 Y200 F500\nM30\n",
-}
 QUIET = Warnings(stream=open(os.devnull, "w"))
 
 

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from tests.compensation.accuracy import worst_um
-from tests.writeback.conftest import compensate_file
+from tests.writeback.conftest import SQUARE, compensate_file
 
 MACHINE = """
 [machine]
@@ -56,27 +56,11 @@ def test_expression_axis_keeps_its_correction(tmp_path, y, set_):
     assert after <= 0.5, f"{after:.2f} µm (uncompensated {before:.2f} µm)"
 
 
-SQUARENESS = """
-[machine]
-name = "squareness"
-chain = "XYFZ"
-[offsets]
-tool = [0.0, 0.0, 0.0]
-work = [0.0, 0.0, 0.0]
-[limits]
-X = [-1000.0, 1000.0]
-Y = [-1000.0, 1000.0]
-Z = [-1000.0, 1000.0]
-[squareness]
-C0Y_urad = 50.0
-"""
-
-
 def test_sinumerik_parameter_axis_keeps_its_correction(tmp_path):
     """`X=R1`: the machine's X is off by -50 µm/m · Y (a squareness), so at Y200 the command
     is X10.0100 (worked out by hand: no rs274 for Sinumerik)."""
     original = tmp_path / "original.mpf"
     original.write_text("R1=10\nG90 G71\nG0 X=R1 Y0 Z5\nG1 Y200 F500\nY0\nM30\n")
-    output = compensate_file(original, SQUARENESS, tmp_path, dialect="sinumerik").read_text()
+    output = compensate_file(original, SQUARE, tmp_path, dialect="sinumerik").read_text()
     far = next(line for line in output.splitlines() if "Y200" in line)
     assert "X10.0100" in far, output

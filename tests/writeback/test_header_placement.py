@@ -18,7 +18,8 @@ from ncpp.pipeline import ErrorSource, process
 from ncpp.program.blocks import Comment
 from ncpp.program.dialects import parse_program
 from tests.compensation.accuracy import RS274
-from tests.writeback.test_compensated_twice import MACHINE, PROGRAMS
+from tests.writeback.conftest import PROGRAMS
+from tests.writeback.conftest import SQUARE as MACHINE
 
 VAR = "5220 2\n5221 4\n5222 3.5\n5223 3\n5241 6.0025\n5242 -3.5\n5243 0.125\n5210 1\n5211 0.06\n5212 0\n5213 0\n"
 TOOLS = "T1 P1 Z+2.0 D0.25 ;a 6 mm end mill\n"
