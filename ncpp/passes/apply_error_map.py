@@ -27,7 +27,7 @@ from ncpp.errors import NcppError
 from ncpp.motion.segments import CYCLE, Arc, Event, Line
 from ncpp.passes.context import CutLine, PassContext, deviation
 from ncpp.passes.kernels import run_ahead
-from ncpp.passes.geometry import all3, any3, compensate, frames, from_plane, in_plane, line_chunks, plane_axes, points, rows_of, tuples
+from ncpp.passes.geometry import any3, compensate, frames, from_plane, in_plane, line_chunks, plane_axes, points, rows_of, tuples
 from ncpp.passes.travel import Travel, grid, hold, quantize, steps
 
 # Compensations per line at most: each changes a direction only where a
