@@ -100,8 +100,8 @@ class PassState:
             return False
         if self.last is None or other.last is None:
             return self.last is other.last
-        a, b = self.last, other.last
-        return a.end == b.end and a.context == b.context and a.fixed == b.fixed
+        mine, theirs = self.last, other.last
+        return mine.end == theirs.end and mine.context == theirs.context and mine.fixed == theirs.fixed
 
 
 class _Cut:
