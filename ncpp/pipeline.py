@@ -25,13 +25,13 @@ from ncpp.motion.segments import COMP, CYCLE, FLOW, Arc, Event, Line, Pass
 from ncpp.passes import PASSES, PassContext, run_passes
 from ncpp.passes.context import is_directional
 from ncpp.passes.inverse import iterations_for
-from ncpp.program.blocks import Block, Comment, Word
+from ncpp.program.blocks import Block, Comment, Statement, Word
 from ncpp.program.dialects import parse_program
 from ncpp.program.dialects.iso import IsoWriter
 from ncpp.runtime import keep_freed_memory
 
-HEADER_TAG = "ncpp compensated"
-HEADER_SCAN = 30  # blocks at the top searched for an earlier header
+HEADER_TAG = "ncpp compensated"  # (lower case: `header_comment` finds it in any case)
+HEADER_SCAN = 30  # blocks at the top searched for an earlier header, and on while only comments follow
 # Blocks the parser reads ahead of the interpreter at most (`_parsed_ahead`), and in its
 # first run: ~0.8 kB each (16k: 13 MB, whatever the program's length).
 PARSED_AHEAD = 16384
@@ -91,23 +91,56 @@ class Stats:
     lines_out: int = 0
 
 
-def header_text(source: ErrorSource, tolerance: float) -> str:
-    """The output's first comment: what compensated it, for which machine file (its hash), how closely."""
-    return f"{HEADER_TAG} for {source.name} sha256:{source.digest} tolerance {tolerance:g} mm by ncpp {__version__}"
+def header_text(source: ErrorSource, tolerance: float, offsets: WorkOffsets | None = None, dialect: str = "iso") -> str:  # fmt: skip
+    """The output's first comment: what compensated it, for which machine file (its hash), how closely;
+    with `offsets`, more lines (`header.placement_lines`): where it was placed, with which tool table."""
+    first = f"{HEADER_TAG} for {source.name} sha256:{source.digest} tolerance {tolerance:g} mm by ncpp {__version__}"
+    if offsets is None:
+        return first
+    from ncpp.header import placement_lines
+
+    return "\n".join([first, *placement_lines(offsets, dialect)])
 
 
 def refuse_compensated(blocks: Iterable[Block], file: str) -> Iterator[Block]:
-    """Pass blocks through; stop with an error if an ncpp header is found near the top."""
+    """Pass blocks through; stop with an error if an ncpp header is found in the program's head."""
     blocks = iter(blocks)
-    for block in islice(blocks, HEADER_SCAN):
-        for item in block.items:
-            if type(item) is Comment and HEADER_TAG in item.text:
-                raise NcppError(
-                    "program is already compensated by ncpp (use --force to compensate again)",
-                    Location(file, block.line, item.start + 1),
-                )
+    for block in program_head(blocks):
+        item = header_comment(block)
+        if item is not None:
+            raise NcppError(
+                "program is already compensated by ncpp (use --force to compensate again)",
+                Location(file, block.line, item.start + 1),
+            )
         yield block
     yield from blocks
+
+
+def program_head(blocks: Iterator[Block]) -> Iterator[Block]:
+    """The blocks an ncpp header may stand among: the first HEADER_SCAN, and on from there up
+    to the first block with more than comments (any number of comments may come before it)."""
+    for n, block in enumerate(blocks):
+        yield block
+        if n >= HEADER_SCAN - 1 and not _comments_only(block):
+            return
+
+
+_HEAD_STATEMENTS = frozenset({"tape", "program_name", "program_begin"})  # `%`, `%_N_PART_MPF`, `BEGIN PGM`
+
+
+def _comments_only(block: Block) -> bool:
+    """Nothing in the block but comments, a block number, a tape mark or the program's name."""
+    return all(type(i) is Comment or (type(i) is Word and i.letter == "N") or (type(i) is Statement and i.kind in _HEAD_STATEMENTS)
+               for i in block.items)  # fmt: skip
+
+
+def header_comment(block: Block) -> Comment | None:
+    """The block's comment that is an ncpp header, whatever its case (every dialect's comments:
+    `( )`, `;`), or None."""
+    for item in block.items:
+        if type(item) is Comment and HEADER_TAG in item.text.lower():
+            return item
+    return None
 
 
 # What the one-zero dialects' interpreters do not place (the ISO interpreter places it all):
@@ -139,8 +172,8 @@ def warn_unplaced(blocks: Iterable[Block], warnings: Warnings, file: str) -> Ite
 
 # Why moves are left as programmed (`Line.fixed`), as the warning says it
 UNCOMPENSATED = {
-    CYCLE: "canned cycle: its moves pass through uncompensated (the holes are where the program puts them, "
-    "with the machine's errors); compensation resumes with the next move",
+    CYCLE: "canned cycle: its moves pass through uncompensated, from its programmed start (the holes are where the "
+    "program puts them, with the machine's errors); compensation resumes with the next move",
     FLOW: "loop or subroutine: its moves pass through uncompensated (one text runs several times, "
     "or away from where it stands, so it cannot carry one correction); compensation resumes with the next move after it",
     COMP: "cutter compensation: its moves pass through uncompensated (the control offsets them by the tool radius, "
@@ -164,9 +197,9 @@ def warn_fixed(events: Iterable[Event], warnings: Warnings, file: str) -> Iterat
     starts (refused with --strict).
 
     In G91 such a move starts from where the control is (the compensated position): the
-    moves of cycles, loops and subroutines and those under cutter compensation run their
-    increments from there, which apply_error_map follows (`_carry`; a G91 cycle's G98
-    retract, to the level it started from, is one of them).  A cycle in G90 goes to its
+    moves of loops and subroutines and those under cutter compensation run their increments
+    from there, which apply_error_map follows (`_carry`); a cycle after a compensated move
+    starts from its programmed start, stepped to (`apply_error_map._lead_in`).  A cycle in G90 goes to its
     programmed points, but its G98 retract ends at the compensated level it started from:
     from a G91 move right after one, the rest of the program passes through, as after an
     out-of-scope construct."""
@@ -254,24 +287,23 @@ def dialect_tools(name: str) -> tuple[Callable, type]:
 
 
 def with_header(lines: Iterable[str], header: str, writer: IsoWriter) -> Iterator[str]:
-    """Put the header comment first, after a leading `%` tape mark line (or where the
-    dialect's writer puts it: Heidenhain after `BEGIN PGM`)."""
+    """Put the header comment first (a comment line per line of it), after a leading `%`
+    tape mark line (or where the dialect's writer puts it: Heidenhain after `BEGIN PGM`)."""
     own = getattr(writer, "with_header", None)
     if own is not None:
         yield from own(lines, header)
         return
     it = iter(lines)
     first = next(it, None)
-    if first is None:
-        yield writer.comment(header) + "\n"
-        return
-    eol = "\r\n" if first.endswith("\r\n") else "\n"
-    if first.lstrip().startswith("%"):
+    eol = "\r\n" if first is not None and first.endswith("\r\n") else "\n"
+    comments = [writer.comment(line) + eol for line in header.split("\n")]
+    if first is not None and first.lstrip().startswith("%"):
         yield first
-        yield writer.comment(header) + eol
+        yield from comments
     else:
-        yield writer.comment(header) + eol
-        yield first
+        yield from comments
+        if first is not None:
+            yield first
     yield from it
 
 
@@ -344,7 +376,7 @@ def process(
         keep_freed_memory()  # numpy's temporaries reuse the heap, not fresh pages (runtime.py)
         ctx = make_context(source, tolerance, warnings, file)
         reached = _Reached()
-        lines = with_header(writer.write(reached.follow(run_passes(events, ctx, PASSES))), header_text(source, tolerance), writer)
+        lines = with_header(writer.write(reached.follow(run_passes(events, ctx, PASSES))), header_text(source, tolerance, offsets, name), writer)
         if verify:
             from ncpp.verify import Bound, verified
 

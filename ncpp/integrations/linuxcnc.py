@@ -48,11 +48,16 @@ class FilterProgress:
 
 
 def already_compensated(path: str) -> bool:
-    from ncpp.pipeline import HEADER_SCAN, HEADER_TAG
+    """Whether the program's head has an ncpp header (`pipeline.refuse_compensated`'s rule)."""
+    from ncpp.pipeline import header_comment, program_head
+    from ncpp.program.dialects import parse_program
 
     with open(path, "rb") as f:
-        head = [f.readline() for _ in range(HEADER_SCAN)]
-    return any(HEADER_TAG.encode() in line for line in head)
+        try:
+            _, blocks = parse_program(f, path, None)
+            return any(header_comment(block) is not None for block in program_head(iter(blocks)))
+        except NcppError:  # a program the parser refuses: compensating it says why
+            return False
 
 
 def run(path: str, err: TextIO, machine: str | None = None) -> None:

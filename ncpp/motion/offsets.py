@@ -58,6 +58,7 @@ class WorkOffsets:
     g30: Vector = (0.0, 0.0, 0.0)
     tools: ToolTable | None = None
     subroutine_path: tuple[Path, ...] = ()
+    unit_mm: float = 1.0  # the units the parameter file and tool table were read in (the header says them)
 
     @classmethod
     def of(cls, zeros: Mapping[str, Vector], active: str = "G54") -> "WorkOffsets":
@@ -94,7 +95,8 @@ class WorkOffsets:
         files are both in the machine's units, `unit_mm`), and subroutine folders."""
         base = cls.from_var_file(var_file, unit_mm) if var_file else AT_MACHINE_ZERO
         tools = ToolTable.from_file(tool_table, unit_mm) if tool_table else None
-        return replace(base.with_zeros(zeros), tools=tools, subroutine_path=tuple(Path(p) for p in subroutine_path))
+        folders = tuple(Path(p) for p in subroutine_path)
+        return replace(base.with_zeros(zeros), tools=tools, subroutine_path=folders, unit_mm=unit_mm)
 
     def with_zeros(self, zeros: Mapping[str, Vector]) -> "WorkOffsets":
         """These systems' zeros replaced (the command line over a parameter file)."""

@@ -24,10 +24,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ncpp.errors import Location, NcppError
-from ncpp.motion.segments import Arc, Event, Line, Pass
+from ncpp.motion.segments import CYCLE, Arc, Event, Line, Pass
 from ncpp.program.blocks import Word
 from ncpp.passes.context import PassContext, deviation
-from ncpp.passes.geometry import all3, any3, compensate, frames, from_plane, in_plane, line_chunks, plane_axes, points, rows_of, tuples
+from ncpp.passes.geometry import any3, compensate, frames, from_plane, in_plane, line_chunks, plane_axes, points, rows_of, tuples
 from ncpp.passes.travel import Travel, grid, hold, quantize, steps
 
 # Compensations per line at most: each changes a direction only where a
@@ -49,7 +49,7 @@ def _chunks(events: Iterable[Event], ctx: PassContext) -> Iterator[list[Event]]:
     """The compensated events, a list per chunk."""
     solve = Solve(ctx)
     last = None  # the last segment written: its compensated end, in its own program frame
-    for chunk, segs, rows in (_with_rows(chunk, ctx.directional) for chunk in line_chunks(events)):
+    for chunk, segs, rows in _rowed(line_chunks(events), ctx.directional, last):
         if rows is None:  # no segments
             yield _placed(chunk, last)
             continue
@@ -78,10 +78,22 @@ def _warn_at_travel_ends(segs: list, rows: "_Rows", solved: "_Solved", ctx: Pass
         )
 
 
-def _with_rows(chunk: list[Event], directional: bool) -> tuple[list[Event], list, "_Rows | None"]:
-    """The chunk, its segments, and their rows (None without segments)."""
+def _rowed(chunks: Iterable[list[Event]], directional: bool, last: Line | Arc | None) -> Iterator[tuple]:
+    """Each chunk with its segments and their rows (`_with_rows`); `last`: the segment before
+    the first chunk (None: none)."""
+    fixed_before = last is None or bool(last.fixed)
+    for chunk in chunks:
+        rowed = _with_rows(chunk, directional, fixed_before)
+        if rowed[1]:
+            fixed_before = bool(rowed[1][-1].fixed)
+        yield rowed
+
+
+def _with_rows(chunk: list[Event], directional: bool, fixed_before: bool = True) -> tuple[list[Event], list, "_Rows | None"]:  # fmt: skip
+    """The chunk, its segments, and their rows (None without segments); `fixed_before`:
+    whether the segment before the chunk's first was left as programmed (or there is none)."""
     segs = [e for e in chunk if type(e) is Line or type(e) is Arc]
-    return chunk, segs, _rows(segs, directional) if segs else None
+    return chunk, segs, _rows(segs, directional, fixed_before) if segs else None
 
 
 @dataclass
@@ -101,6 +113,7 @@ class _Rows:
     rapid: NDArray  # (n,) rapid moves (G0): no reversal step before them
     carried: NDArray  # (n,) moves left as programmed that run from where the control is (`_carry`)
     kept: NDArray  # (n,3) their axes that do so (the others the control puts at their programmed end)
+    lead_in: NDArray  # (n,) a canned cycle's first move after a compensated one: a step to its start first
 
 
 def _rows_before(rows: _Rows, line: int | None) -> _Rows | None:
@@ -111,21 +124,24 @@ def _rows_before(rows: _Rows, line: int | None) -> _Rows | None:
     return _Rows(**{f.name: None if (v := getattr(rows, f.name)) is None else v[:k] for f in fields(_Rows)})
 
 
-def _rows(segs: list, directional: bool) -> _Rows:
+def _rows(segs: list, directional: bool, fixed_before: bool = True) -> _Rows:
     offsets, scales, tools = frames(segs)
     start, end = points([e.start for e in segs]), points([e.end for e in segs])
-    # one walk over the events for five flags (1 arc, 2 fixed: a move left as programmed, 4 changed, 8 rapid,
-    # 16 carried: fixed in G91)
-    kind = np.fromiter([(type(e) is Arc) + (0 if not e.fixed else 2 if e.context.absolute else 18) + 4 * bool(e.changed)
-                        + 8 * (type(e) is Line and e.rapid) for e in segs], dtype=np.int8, count=len(segs))  # fmt: skip
+    # one walk over the events for six flags (1 arc, 2 fixed: a move left as programmed, 4 changed, 8 rapid,
+    # 16 carried: fixed in G91, 32 a canned cycle's)
+    kind = np.fromiter([(type(e) is Arc) + (0 if not e.fixed else (2 if e.context.absolute else 18) + 32 * (e.fixed == CYCLE))
+                        + 4 * bool(e.changed) + 8 * (type(e) is Line and e.rapid) for e in segs], dtype=np.int8, count=len(segs))  # fmt: skip
     arc, changed = (kind & 1) != 0, (kind & 4) != 0
     line = (kind & 3) == 0
     free = line & ~changed
     kept = _kept_axes(segs, kind)
+    fixed = (kind & 2) != 0
+    lead_in = ((kind & 32) != 0) & ~np.concatenate([[fixed_before], fixed[:-1]])
     return _Rows(
         start, end, offsets, scales, tools, free, changed, changed & line,
         _arc_assumed(segs, np.flatnonzero(changed & arc), start, end) if directional else None,
         np.fromiter([e.block.line for e in segs], dtype=np.int64, count=len(segs)), (kind & 8) != 0, any3(kept), kept,
+        lead_in,
     )  # fmt: skip
 
 
@@ -178,6 +194,7 @@ class _Solved:
     keep: NDArray  # (n,3) axes that keep their direction (they must not move in that step)
     limit: NDArray  # (n,) program units an axis may be left off its compensated position
     at_end: NDArray  # (n,3) line ends left at a travel end their command would pass (`compensate`'s `ends`)
+    direction: NDArray  # (n,3) the direction each axis travels in (+1, -1; 0: no reversal errors)
 
 
 # What `_written` does with a segment (bits of its row's code)
@@ -205,6 +222,10 @@ def _written(chunk: list[Event], segs: list, rows: _Rows, solved: _Solved, last)
     # are when they differ only by output rounding: a one-digit move there would reverse
     # that axis on the machine.
     target = np.where(solved.keep & (np.abs(solved.turn_start - previous) <= solved.limit[:, None]), previous, solved.turn_start)
+    # An axis that runs ahead on reversal (a reversal table below its other) would reach its
+    # start for the new direction travelling the old way, past the corner: it reverses where
+    # it is, and its jump lands the tool back along the way it came.
+    target = np.where(~solved.keep & ((target - previous) * solved.direction < 0), previous, target)
     turning &= _apart(previous, target)
     # replace_arcs' pieces start where they start: a step from the previous end first
     connect = ~solved.free & has_previous & rows.arc & _apart(previous, solved.start)
@@ -213,6 +234,7 @@ def _written(chunk: list[Event], segs: list, rows: _Rows, solved: _Solved, last)
     targets = _by_row(target, turning & solved.free)
     moved_starts = _by_row(solved.start, solved.moved & ~solved.free)
     between = _between(chunk) if len(chunk) > len(segs) else {}
+    lead_in = set(np.flatnonzero(rows.lead_in).tolist())
     out: list[Event] = []
     start = None  # where the output is: the previous segment's compensated end
     for i, seg, row, end in zip(range(len(segs)), segs, code, ends):
@@ -227,6 +249,9 @@ def _written(chunk: list[Event], segs: list, rows: _Rows, solved: _Solved, last)
                 begin = targets[i]
             out.append(Line(begin, end, seg.rapid, seg.feed, seg.block, seg.context, seg.extra, True, extra_start=seg.extra_start))
         else:
+            if i in lead_in:
+                step = _lead_in(seg, last if i == 0 else _ended(segs[i - 1], solved.end[i - 1]))
+                out += () if step is None else (step,)
             if row & _MOVED:
                 seg = _moved_arc(seg, moved_starts[i], end)
             if row & _CONNECTS:
@@ -287,7 +312,8 @@ def _plain(rows: _Rows, ctx: PassContext, travel: Travel) -> _Solved:
         _carry(rows, end, None if travel.last is None else travel.last / scales[0] - offsets[0])
     travel.last = (end[-1] + offsets[-1]) * scales[-1]
     none = np.zeros(len(free), dtype=bool)
-    return _Solved(start, end, free, none, none, start, np.ones(start.shape, dtype=bool), np.zeros(len(free)), at_end)
+    keep = np.ones(start.shape, dtype=bool)
+    return _Solved(start, end, free, none, none, start, keep, np.zeros(len(free)), at_end, np.zeros(start.shape))
 
 
 class _Commands:
@@ -371,7 +397,7 @@ def _directional(rows: _Rows, ctx: PassContext, travel: Travel) -> _Solved:
         turn_start[rows] = commands("start", rows, d[rows])
     travel.held = d[-1].copy()
     travel.last = machine(out_end[-1:], slice(len(free) - 1, None))[0]
-    return _Solved(out_start, out_end, free, moved, turn, turn_start, ~flips, limit, commands.at_end["end"] & free[:, None])
+    return _Solved(out_start, out_end, free, moved, turn, turn_start, ~flips, limit, commands.at_end["end"] & free[:, None], d)
 
 
 def _carry(rows: _Rows, out_end: NDArray, before: NDArray | None) -> None:
@@ -389,7 +415,7 @@ def _carry(rows: _Rows, out_end: NDArray, before: NDArray | None) -> None:
             previous = before
         else:  # the end before, seen from this row's frame
             previous = (out_end[k - 1] + offsets[k - 1]) * scales[k - 1] / scales[k] - offsets[k]
-        if previous is None:
+        if previous is None or rows.lead_in[k]:  # (a cycle starts from its programmed start: `_lead_in`)
             continue
         # the run: up to the next run's start or the first row not carried, whichever comes first
         stop = starts[n + 1] if n + 1 < len(starts) else len(carried)
@@ -409,14 +435,20 @@ def _settle(free, arc, d, held, offsets, scales, limit, out_start, out_end, befo
     starts within `limit` of the previous end moves rigidly onto it (radii stay
     equal), so that no µm connecting step reverses an axis.  In order, because
     each moved end is the next row's start and a drift over many rows stays bounded.
-    `before`: the previous chunk's last end in the first row's frame (or None)."""
+    `before`: the previous chunk's last end in the first row's frame (or None).  A line
+    after a change of units or offsets settles onto its predecessor's end seen from its own
+    frame (the program's numbers there are other numbers for the same place)."""
     ends, dirs, ok = _with_previous(out_end, d, held, offsets, scales, before)
-    pred_end, pred_dir = ends[:-1], dirs[:-1]  # row k's predecessor's end and direction
+    reframed = np.flatnonzero(any3(offsets[1:] != offsets[:-1]) | (scales[1:] != scales[:-1])) + 1
+    pred_end, pred_dir = ends[:-1].copy(), dirs[:-1]  # row k's predecessor's end (in k's frame), direction
+    pred_end[reframed] = _reframed(pred_end[reframed], reframed - 1, reframed, offsets, scales)
+    same = ok.copy()  # the predecessor is in the row's frame
+    same[reframed] = False
     within = limit[:, None]
     line_gap = out_end - pred_end
     lines = free & ok & any3((line_gap * pred_dir < 0) & (dirs[1:] == pred_dir) & (np.abs(line_gap) <= within))
     arc_gap = pred_end - out_start
-    pieces = arc & ok & any3((np.abs(arc_gap) <= within) & (arc_gap != 0))
+    pieces = arc & same & any3((np.abs(arc_gap) <= within) & (arc_gap != 0))
     todo = np.flatnonzero(lines | pieces).tolist()
     if not todo:
         return
@@ -426,7 +458,8 @@ def _settle(free, arc, d, held, offsets, scales, limit, out_start, out_end, befo
     # A run's first row's predecessor is as it was: a row changed is followed by the next, so
     # a run ends after an unchanged row or before one that does not settle (never in `todo`).
     n = len(free)
-    is_line, limits, settles = free.tolist(), limit.tolist(), (ok & (free | arc)).tolist()
+    is_line, limits, settles = free.tolist(), limit.tolist(), ((ok & free) | (same & arc)).tolist()
+    new_frame = set(reframed.tolist())
     moved, moved_ends = [], []  # the rows changed, in order, and their new ends
     shifted, shifted_starts = [], []  # the arc pieces among them, and their new starts
     k = -1  # the last row looked at
@@ -434,7 +467,7 @@ def _settle(free, arc, d, held, offsets, scales, limit, out_start, out_end, befo
         if first <= k:
             continue
         k = first
-        pred = ends[k].tolist()
+        pred = pred_end[k].tolist()
         while k < n and settles[k]:
             limit_k, changed, end = limits[k], False, ends[k + 1].tolist()
             if is_line[k]:
@@ -462,6 +495,8 @@ def _settle(free, arc, d, held, offsets, scales, limit, out_start, out_end, befo
             moved_ends.append(end)
             pred = end
             k += 1
+            if k in new_frame and k < n:
+                pred = _reframed(np.array([pred]), np.array([k - 1]), np.array([k]), offsets, scales)[0].tolist()  # fmt: skip
     if moved:
         out_end[moved] = moved_ends
     if shifted:
@@ -470,13 +505,17 @@ def _settle(free, arc, d, held, offsets, scales, limit, out_start, out_end, befo
 
 def _with_previous(out_end, d, held, offsets, scales, before) -> tuple[NDArray, NDArray, NDArray]:
     """Ends and directions with the previous chunk's last row in front, and
-    (n,) whether each row's predecessor is in the same program frame."""
+    (n,) whether each row has a predecessor."""
     ends = np.vstack([before if before is not None else np.full(3, np.nan), out_end])
     dirs = np.vstack([held, d])
     ok = np.ones(len(out_end), dtype=bool)
-    ok[1:] = all3(offsets[1:] == offsets[:-1]) & (scales[1:] == scales[:-1])
     ok[0] = before is not None
     return ends, dirs, ok
+
+
+def _reframed(points: NDArray, rows: NDArray, to: NDArray, offsets: NDArray, scales: NDArray) -> NDArray:
+    """(r,3) points of the frames of `rows` seen from the frames of rows `to`."""
+    return (points + offsets[rows]) * (scales[rows] / scales[to])[:, None] - offsets[to]
 
 
 def _hold_pieces_still(pieces, d, held, limit, out_start, out_end) -> None:
@@ -580,8 +619,28 @@ def _end_in_frame_of(last: Line | Arc | None, event: Line | Arc) -> tuple | None
 
 
 def _ended(segment: Line | Arc, end: NDArray) -> Line:
-    """Stands in for a written segment where only its end and frame matter."""
-    return Line(segment.start, tuple(end.tolist()), False, 0.0, segment.block, segment.context)
+    """Stands in for a written segment where only its end, frame and `fixed` matter."""
+    end_point = tuple(end.tolist())
+    return Line(segment.start, end_point, False, 0.0, segment.block, segment.context, fixed=segment.fixed)
+
+
+def _lead_in(cycle: Line | Arc, before: Line | None) -> Line | None:
+    """A rapid step from where the output is (`before`'s end) to the programmed start of a
+    canned cycle, in `before`'s frame and mode (the cycle's block may set G91), written ahead
+    of the cycle's block (`fixed` and changed: `IsoWriter`).  Where a cycle puts its holes
+    depends on where it starts: in G91 its holes, R and Z levels run from there (polar words
+    turning about XY zero), in G90 a hole without X Y, a polar word without `@` or `^`, and
+    the G98 retract take the start's; from a compensated start they would carry its
+    correction, turned.  From the programmed start the holes are where the program puts
+    them, with the machine's errors.  None: no step is needed."""
+    if before is None:
+        return None
+    mode, frame = before.context, cycle.context
+    same = mode.inch == frame.inch and mode.offset == frame.offset
+    target = cycle.start if same else mode.to_program(frame.to_machine(cycle.start))
+    if max(abs(p - q) for p, q in zip(target, before.end)) <= 1e-9:
+        return None
+    return Line(before.end, target, True, cycle.feed, cycle.block, mode, changed=True, fixed=CYCLE)
 
 
 def _apart(a: NDArray, b: NDArray, tolerance: float = 1e-7) -> NDArray:

@@ -57,3 +57,15 @@ def repeatable_machine(path):
             c = Table(c.positions, (np.asarray(c.values) + np.asarray(c.values_minus)) / 2, None, c.interpolation)
         comps[name] = c
     return true.replace(components=comps)
+
+
+def program_lines(text: str) -> list[str]:
+    """The output's lines but its header's placement lines (the comments after its first line,
+    `ncpp.header`): tests that count lines count the program's."""
+    from ncpp.pipeline import HEADER_TAG
+
+    def placement(line: str) -> bool:
+        said = line.lstrip("(; ").rstrip(")")
+        return said.startswith("ncpp ") and not said.startswith(HEADER_TAG)
+
+    return [line for line in text.splitlines() if not placement(line)]

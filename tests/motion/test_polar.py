@@ -18,9 +18,17 @@ from ncpp.motion import interpret
 from ncpp.motion.canon import read_canon
 from ncpp.motion.segments import Pass
 from ncpp.program.parser import parse_stream
+from tests.compensation.conftest import program_lines
 from tests.conftest import RS274
 from tests.motion.compensating import compensate
-from tests.motion.test_oracle import ORACLE_EXAMPLES, ours, refused_alike, rs274_error, run_rs274, same_calls
+from tests.motion.test_oracle import (
+    ORACLE_EXAMPLES,
+    ours,
+    refused_alike,
+    rs274_error,
+    run_rs274,
+    same_calls,
+)
 
 HEAD = "G21 G90 G17 G94\nG0 X0 Y0 Z5\n"
 
@@ -109,7 +117,7 @@ def test_a_block_of_polar_words_is_written_in_capitals():
     one (the writer keeps no case between blocks)."""
     out, _ = compensate(PROGRAM, "polar.ngc")
     assert not re.search(r"\b[xy]-?\d", out)
-    lower = compensate(PROGRAM.lower(), "polar.ngc")[0].splitlines()
+    lower = program_lines(compensate(PROGRAM.lower(), "polar.ngc")[0])
     assert lower[5].startswith("g1 x") and lower[6].startswith("x") and lower[7].startswith("X")  # `g1 @40 ^30`; `^60`
 
 

@@ -64,12 +64,13 @@ def _compensated_lines(program: bytes, name: str) -> list[str]:
 
     from ncpp.motion.offsets import WorkOffsets
     from ncpp.pipeline import ErrorSource, process
+    from tests.compensation.conftest import program_lines
 
     machine = Path(__file__).resolve().parents[2] / "samples/machines/hr5b.toml"
     source = ErrorSource.from_machine_file(str(machine))
     out = io.BytesIO()
     process(io.BytesIO(program), out, file=name, source=source, offsets=WorkOffsets.at((400.0, 350.0, 300.0)))
-    return out.getvalue().decode().splitlines()
+    return program_lines(out.getvalue().decode())
 
 
 def test_a_compensated_corner_block_starts_with_its_first_word():

@@ -294,7 +294,7 @@ class HeidenhainWriter(IsoWriter):
         if self.header is not None and self.last_number < 0 and not any(
             type(i) is Statement and i.kind == "program_begin" for i in block.items
         ):
-            yield self._header_first(block, self.header)
+            yield from self._header_first(block, self.header)
         self._learn_styles(block)
         motion = [e for e in group if type(e) is Line or type(e) is Arc]
         pole = next((e for e in group if type(e) is Pole), None)
@@ -318,7 +318,8 @@ class HeidenhainWriter(IsoWriter):
                 self.output_pole = self.program_pole
             yield self._numbered(block, splice(block, {}, feed) if feed else block.raw)
             if self.header is not None and any(type(i) is Statement and i.kind == "program_begin" for i in block.items):
-                yield self._inserted(self.comment(self.header))
+                for line in self.header.split("\n"):
+                    yield self._inserted(self.comment(line))
                 self.header = None
             for segment in motion:
                 self._remember_end(segment)
@@ -354,11 +355,11 @@ class HeidenhainWriter(IsoWriter):
             return ""
         return " F" + format_number(motion[0].feed, self.styles.get("F") or NumberStyle(decimals=3))
 
-    def _header_first(self, block: Block, header: str) -> str:
+    def _header_first(self, block: Block, header: str) -> list[str]:
         self.last_number = -1
-        line = self._inserted(self.comment(header))  # numbered 0; the program shifts by one
+        lines = [self._inserted(self.comment(text)) for text in header.split("\n")]  # 0..: the program shifts
         self.header = None
-        return line
+        return lines
 
     def _inserted_replacing(self, block: Block, text: str) -> str:
         number = next((i for i in block.items if type(i) is Word and i.letter == "N"), None)
@@ -398,7 +399,7 @@ class HeidenhainWriter(IsoWriter):
         if isinstance(segment, Arc):
             return self._arc_text(segment)
         # the axes that moved in the output (`_moved`, with the units' places read once per line)
-        inch, end, last, last_places = segment.context.inch, segment.end, self._last_end, self._last_places
+        (last, last_places), inch, end = self._last_seen_from(segment.context), segment.context.inch, segment.end
         units = self._resolved.get(inch) or self._units(inch)
         places, styles = units.places, units.styles
         words = [
@@ -477,6 +478,8 @@ class HeidenhainWriter(IsoWriter):
                     self._learn_style(letter, style)
                     if axis:
                         self.known_axes.add(axis)
+            elif type(item) is ExprWord and item.letter[-1:] in _AXES and item.letter.lstrip("I") == item.letter[-1]:  # fmt: skip
+                self.known_axes.add(item.letter[-1])  # `X+Q1932` positions X as a number does
 
 
 _NO_LESSON = ()

@@ -85,6 +85,7 @@ class IsoWriter:
         # axes a block does not write are exactly where they were.
         self._last_end: tuple[float, float, float] | None = None
         self._last_places: tuple[int, int, int] = (0, 0, 0)
+        self._last_context: Context | None = None  # the frame (units, offsets) `_last_end` is in
 
     def comment(self, text: str) -> str:
         return f"{self.comment_open}{text}{self.comment_close}"
@@ -116,12 +117,18 @@ class IsoWriter:
         if type(first) is Pass and first.setting is not None and first.setting.shift is not None:
             return [self._setting_text(block, first.setting) + block.eol]
         motion = [e for e in group if type(e) is Line or type(e) is Arc]
+        lead = 0  # steps to a canned cycle's start (`apply_error_map._lead_in`): new blocks before it
+        while lead < len(motion) and motion[lead].fixed and motion[lead].changed:
+            lead += 1
+        lines = self._new_blocks(block, motion[:lead], block.eol) if lead else []
+        motion = motion[lead:] if lead else motion
         for segment in motion:
             if segment.changed:
                 break
         else:  # nothing changed
             self._learn_program_motion(block, motion)
-            lines = [self._restore_mode_line(block)] if self._needs_mode_restore(block) else []
+            if self._needs_mode_restore(block):
+                lines.append(self._restore_mode_line(block))
             lines.append(block.text)
             self._after_verbatim(block, motion)
             return lines
@@ -129,8 +136,8 @@ class IsoWriter:
             block = _literal_geometry(block)
         eol = block.eol
         if len(motion) > 1 and (motion[0].context.inverse_time or motion[0].extra):
-            return self._write_pieces(block, motion, eol)
-        lines = [self._edit_block(block, motion[0]) + eol]
+            return lines + self._write_pieces(block, motion, eol)
+        lines.append(self._edit_block(block, motion[0]) + eol)
         if len(motion) > 1:
             lines += self._new_blocks(block, motion[1:], eol)
         return lines
@@ -172,6 +179,8 @@ class IsoWriter:
         signature = block.signature
         if signature is None:
             facts = _Facts(block)
+            # an axis word written as an expression (`Y[0]`, `Y#5`) positions its axis as a number does
+            self.known_axes.update(facts.expression_axes)
         else:  # a handful of signatures make most blocks (`XZ`, `G1XY`): read each once
             facts = self._signature_facts.get(signature)
             if facts is None:
@@ -336,8 +345,17 @@ class IsoWriter:
     # -- numbers as written -----------------------------------------------------
     def _moved(self, axis: str, value: float, segment: Line | Arc) -> bool:
         """Whether writing `value` for the axis changes what the output last said."""
-        last, n = self._last_end, AXES.index(axis)
-        return last is None or written_apart(value, self._style(axis, segment).decimals, last[n], self._last_places[n])
+        (last, places), n = self._last_seen_from(segment.context), AXES.index(axis)
+        return last is None or written_apart(value, self._style(axis, segment).decimals, last[n], places[n])
+
+    def _last_seen_from(self, context: Context) -> tuple[tuple | None, tuple]:
+        """(where the output is, the decimal places to compare it with) in `context`'s frame:
+        after a change of units or offsets, the numbers last written, as the control holds them
+        (`seen_from`)."""
+        last, frame = self._last_end, self._last_context
+        if last is None or frame is context or frame is None or not reframed(frame, context):
+            return last, self._last_places
+        return seen_from(last, self._last_places, frame, context, self._units(context.inch).places)
 
     def _remember_end(self, segment: Line | Arc, units: "_Written | None" = None) -> None:
         """The segment's end is where the output is now, written with `units`' places
@@ -345,7 +363,7 @@ class IsoWriter:
         if units is None:
             inch = segment.context.inch  # once per line written: `_units`' cached look-up inlined
             units = self._resolved.get(inch) or self._units(inch)
-        self._last_end, self._last_places = segment.end, units.places
+        self._last_end, self._last_places, self._last_context = segment.end, units.places, segment.context
 
     def _format(self, letter: str, value: float, segment: Line | Arc) -> str:
         return format_number(value, self._style(letter, segment))
@@ -381,7 +399,12 @@ class IsoWriter:
 
     def _written_bits(self, facts: "_Facts", segment: Line | Arc, units: "_Written") -> int:
         """`_bits_written` where the output is now."""
-        return _bits_written(facts, segment, units.places, self.known_axes, self._last_end, self._last_places)
+        frame = self._last_context
+        context = segment.context
+        if frame is context or frame is None or self._last_end is None or not reframed(frame, context):
+            return _bits_written(facts, segment, units.places, self.known_axes, self._last_end, self._last_places)
+        last, places = self._last_seen_from(segment.context)
+        return _bits_written(facts, segment, units.places, self.known_axes, last, places, named=False)
 
     @staticmethod
     def _numbers(segment: Line | Arc) -> tuple[float, ...]:
@@ -429,7 +452,7 @@ class IsoWriter:
             self.output_motion, self.program_motion = code, facts.motion
         elif code != output_motion:
             self.output_motion = code
-        self._last_end, self._last_places = segment.end, units.places  # `_remember_end`
+        self._last_end, self._last_places, self._last_context = segment.end, units.places, segment.context  # `_remember_end`
         return raw
 
     def _planned_edit(self, block: Block, facts: "_Facts", segment: Line | Arc, motion: int | None, units: "_Written") -> str | None:
@@ -465,7 +488,7 @@ class IsoWriter:
         key = (signature, bits, motion, spelled)
         plan = units.edit_plans.get(key, _UNKNOWN)
         if plan is _UNKNOWN:
-            dropped = [letter for letter in DROPPED if letter in facts.letters and not bits & _BIT.get(letter, 0)]
+            dropped = [l for l in DROPPED + tuple(AXES) if l in facts.letters and not bits & _BIT.get(l, 0)]
             plan = units.edit_plans[key] = EditPlan.compile(
                 facts.word_letters, units.fields(bits), 5 if bits & _ANY_CENTRE else 3, dropped, motion, facts.motion_at, spelled or (" ", False)
             )
@@ -477,7 +500,7 @@ class IsoWriter:
             texts.update(more)
         # centre words of the old arc, and Fanuc corner words: the corner is now explicit;
         # P is an arc's turn count, but a dwell time (G4) or blending tolerance (G64) elsewhere
-        drop = [] if facts.letters.isdisjoint(_DROPPED) else [l for l in DROPPED if l in facts.letters and l not in texts]
+        drop = [l for l in DROPPED + tuple(AXES) if l in facts.letters and l not in texts]
         if "P" in drop and not self._arc_block(block):
             drop.remove("P")
         # words the block lacks are appended spelled as the block was read (before a G word is inserted)
@@ -495,10 +518,13 @@ class IsoWriter:
         known = self.known_axes
         output_motion, last, last_places = self.output_motion, self._last_end, self._last_places
         lines: list[str] = []
-        context = None
+        context, frame = None, self._last_context  # (`frame`: the one `last` is in)
         for segment in segments:
             if segment.context is not context:  # (the segments of a block share their context, mostly)
                 context = segment.context
+                if last is not None and frame is not None and frame is not context and reframed(frame, context):
+                    last, last_places = seen_from(last, last_places, frame, context, self._units(context.inch).places)
+                frame = context
                 inch, absolute = context.inch, context.absolute
                 units = self._resolved.get(inch) or self._units(inch)
                 places = units.places
@@ -524,7 +550,7 @@ class IsoWriter:
             if motion is not None:
                 output_motion = code
             last, last_places = segment.end, places
-        self.output_motion, self._last_end, self._last_places = output_motion, last, last_places
+        self.output_motion, self._last_end, self._last_places, self._last_context = output_motion, last, last_places, context
         return lines
 
 
@@ -534,11 +560,19 @@ def new_block_key(bits: int, motion: int | None) -> int:
     return bits if motion is None else bits | (motion + 1) << len(WRITTEN_LETTERS)
 
 
-def _bits_written(facts: "_Facts", segment: Line | Arc, places: tuple, known: set[str], last: tuple | None, last_places: tuple) -> int:
+def _bits_written(facts: "_Facts", segment: Line | Arc, places: tuple, known: set[str], last: tuple | None, last_places: tuple,
+                  named: bool = True) -> int:  # fmt: skip
     """The letters the segment writes (a mask of `_BIT`): the axes its block has and whatever
     moved in the output (which is at `last`, written with `last_places`; `known`: the axes it
-    has written), then an arc's centre; `places`: the decimals the segment is written with."""
+    has written), then an arc's centre; `places`: the decimals the segment is written with.
+    Not `named`: of the axes its block has, only those that move (after a change of units or
+    offsets, where the output's position is off the grid of the new numbers, a rounded number
+    for an axis that stands would move it)."""
     bits, absent, end = facts.axis_bits, facts.absent_axes, segment.end
+    if not named and last is not None and segment.context.absolute:
+        for n, axis in _NUMBERED_AXES:
+            if bits & _BIT[axis] and not written_apart(end[n], places[n], last[n], last_places[n]):
+                bits &= ~_BIT[axis]
     if absent and segment.context.absolute:
         same_places = places == last_places
         for n, axis, bit in absent:
@@ -566,7 +600,8 @@ class _Facts:
     """What the writer asks about a block."""
 
     __slots__ = ("letters", "motion_word", "motion", "first_motion", "moves", "plain", "words", "styled",
-                 "word_letters", "motion_at", "bits", "axis_bits", "absent_axes", "machine", "flow", "settles")  # fmt: skip
+                 "word_letters", "motion_at", "bits", "axis_bits", "absent_axes", "machine", "flow", "settles",
+                 "expression_axes")  # fmt: skip
 
     def __init__(self, block: Block | None = None):
         """The facts of `block`, read in one walk over its items (none: a block without words)."""
@@ -583,12 +618,15 @@ class _Facts:
         self.machine = False  # it moves in machine coordinates (G53)
         self.flow = False  # a control line: an o-word (not `O<name>` alone, a program's name), M98, M99
         self.settles = False  # its axis words are a G10 / G28 / G30 / G52 / G92 / G43.1's, not a move's
+        self.expression_axes = ""  # the X Y Z words it writes as expressions (`Y[0]`, `Y#5`)
         for item in block.items if block is not None else ():
             kind = type(item)
             if kind is Word:
                 self._read_word(item.letter, item.value, item.number)
             elif kind is not Comment:
                 self.plain = False
+                if kind is ExprWord and item.letter in AXES:
+                    self.expression_axes += item.letter
                 if kind is Statement and item.kind == "oword" and len(item.node) >= 2:
                     self.flow = True
         self._sum_up()
@@ -637,6 +675,18 @@ def _words(block: Block, facts: _Facts) -> tuple[Word, ...]:
     """The plain words of the block, in order."""
     items = block.items
     return items if len(items) == facts.words else tuple(item for item in items if type(item) is Word)  # type: ignore[return-value]
+
+
+def reframed(before: Context, after: Context) -> bool:
+    """Whether the program's numbers mean other machine positions after than before (units, offsets)."""
+    return before.inch != after.inch or before.offset != after.offset
+
+
+def seen_from(last: tuple, places: tuple, before: Context, after: Context, after_places: tuple) -> tuple[tuple, tuple]:  # fmt: skip
+    """The point the output wrote as `last` (with `places` decimals) in the frame `before`, as
+    the control holds it in the frame `after`, with the decimal places to compare it with there."""
+    written = (round(last[0], places[0]), round(last[1], places[1]), round(last[2], places[2]))
+    return after.to_program(before.to_machine(written)), after_places
 
 
 def written_apart(value: float, places: int, last: float, last_places: int) -> bool:

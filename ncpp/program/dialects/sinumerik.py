@@ -213,7 +213,7 @@ SINUMERIK = Dialect("sinumerik", "sinumerik", SinumerikBuilder, fast_terminals=(
 from ncpp.motion.segments import Arc, Line  # noqa: E402  (the writer half of the module)
 from ncpp.program.blocks import Block  # noqa: E402
 from ncpp.program.dialects.editing import splice  # noqa: E402
-from ncpp.program.dialects.iso import IsoWriter, new_block_key  # noqa: E402
+from ncpp.program.dialects.iso import AXES, IsoWriter, new_block_key  # noqa: E402
 from ncpp.program.writer import edit_texts  # noqa: E402
 
 _ARC_ONLY = ("CR", "TURN", "I1", "J1", "K1")
@@ -269,8 +269,8 @@ class SinumerikWriter(IsoWriter):
         for n, item in enumerate(block.items):
             if type(item) is ExprWord and item.letter in words:
                 texts[n] = f"{item.letter}={words.pop(item.letter)}"
-            elif type(item) is ExprWord and item.letter in _ARC_ONLY + tuple("IJK"):
-                texts[n] = None
+            elif type(item) is ExprWord and item.letter in _ARC_ONLY + tuple("IJK") + tuple(AXES):
+                texts[n] = None  # (an axis the block does not move after a change of units: `_bits_written`)
             elif type(item) is Statement and item.kind == "path" and item.node[0] in _MOTION_PATHS:
                 texts[n] = None
         had_motion = self._has_motion_word(block)
@@ -278,7 +278,7 @@ class SinumerikWriter(IsoWriter):
         code = self._motion_code(segment)
         if texts:
             block = _reparse(Block(splice(block, texts), block.eol, (), block.line))
-        drop = [letter for letter in "IJK" if letter not in words]
+        drop = [letter for letter in "IJK" + AXES if letter not in words]
         raw = edit_texts(block, words, drop=drop, motion=code if code != self.output_motion or had_motion else None)
         if had_motion or code != self.output_motion:
             self.output_motion = code

@@ -1,0 +1,47 @@
+"""Helpers for the write-back tests: compensate a program file with ncpp's CLI entry point."""
+
+from __future__ import annotations
+
+import io
+import os
+from pathlib import Path
+
+from ncpp.errors import Warnings
+from ncpp.motion.offsets import WorkOffsets
+from ncpp.pipeline import ErrorSource, process
+
+
+def compensate_file(program: Path, machine_toml: str, folder: Path, offsets: WorkOffsets | None = None,
+                    warnings: Warnings | None = None, **options) -> Path:  # fmt: skip
+    """`program` compensated for the machine file `machine_toml` (its text), written beside it."""
+    machine = folder / "machine.toml"
+    machine.write_text(machine_toml)
+    out = io.BytesIO()
+    with open(program, "rb") as stream:
+        process(stream, out, file=str(program), source=ErrorSource.from_machine_file(str(machine)),
+                warnings=warnings or Warnings(stream=open(os.devnull, "w")), offsets=offsets, **options)  # fmt: skip
+    output = program.with_name(program.stem + "-compensated" + program.suffix)
+    output.write_bytes(out.getvalue())
+    return output
+
+
+# A machine whose X is off by -50 µm/m · Y (a squareness), and a short program per dialect
+SQUARE = """
+[machine]
+name = "square"
+chain = "XYFZ"
+[offsets]
+tool = [0.0, 0.0, 0.0]
+work = [0.0, 0.0, 0.0]
+[limits]
+X = [-1000.0, 1000.0]
+Y = [-1000.0, 1000.0]
+Z = [-1000.0, 1000.0]
+[squareness]
+C0Y_urad = 50.0
+"""
+PROGRAMS = {
+    "iso": "%\nG21 G90\nG0 X10 Y10 Z5\nG1 Y200 F500\nM2\n%\n",
+    "heidenhain": "0 BEGIN PGM T MM\n1 L X+10 Y+10 Z+5 FMAX\n2 L Y+200 F500\n3 END PGM T MM\n",
+    "sinumerik": "%_N_T_MPF\nG90 G71\nG0 X10 Y10 Z5\nG1 Y200 F500\nM30\n",
+}
