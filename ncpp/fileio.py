@@ -6,7 +6,9 @@ paths (`program_file`) and line counts."""
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
+import shutil
 import stat
 import tempfile
 from pathlib import Path
@@ -15,19 +17,47 @@ from typing import BinaryIO, Iterator
 
 @contextlib.contextmanager
 def atomic_output(path: str | os.PathLike[str]) -> Iterator[BinaryIO]:
-    """Yield a binary file; on clean exit it replaces `path`, on error it vanishes."""
-    target = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent or ".")
+    """Yield a binary file; on clean exit it replaces `path`, on error it vanishes.
+
+    A symbolic link is written through: its target is replaced, the link kept.  A file
+    that is not a regular one (`/dev/null`, a FIFO) is never replaced: it receives the
+    output, kept aside until complete, written into it."""
+    target = Path(os.path.realpath(path))
+    try:
+        held = os.stat(target)
+    except FileNotFoundError:
+        held = None
+    if held is not None and not stat.S_ISREG(held.st_mode):
+        with _into_special(target) as out:
+            yield out
+        return
+    with _beside(target) as (out, tmp):
+        yield out
+        out.flush()
+        os.fsync(out.fileno())
+        os.chmod(out.fileno(), held.st_mode & 0o777 if held is not None else 0o644)
+        os.replace(tmp, target)
+
+
+@contextlib.contextmanager
+def _into_special(target: Path) -> Iterator[BinaryIO]:
+    """Output for a device or a FIFO, written into it once complete."""
+    if stat.S_ISDIR(os.stat(target).st_mode):
+        raise IsADirectoryError(errno.EISDIR, os.strerror(errno.EISDIR), str(target))
+    with tempfile.TemporaryFile() as spool:
+        yield spool  # type: ignore[misc]
+        spool.seek(0)
+        with open(target, "wb") as out:  # (no truncation or replacing for such a file: it is written)
+            shutil.copyfileobj(spool, out, 1 << 20)
+
+
+@contextlib.contextmanager
+def _beside(target: Path) -> Iterator[tuple[BinaryIO, str]]:
+    """A temporary file in the target's folder, removed on error (a SIGTERM is one: `cli`)."""
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=str(target.parent))
     try:
         with os.fdopen(fd, "wb") as out:
-            yield out
-            out.flush()
-            os.fsync(out.fileno())
-        if target.exists():
-            os.chmod(tmp, target.stat().st_mode & 0o777)
-        else:
-            os.chmod(tmp, 0o644)
-        os.replace(tmp, target)
+            yield out, tmp
     except BaseException:
         with contextlib.suppress(FileNotFoundError):
             os.unlink(tmp)

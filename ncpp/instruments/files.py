@@ -260,8 +260,9 @@ def read_measurement(path: str | os.PathLike[str]) -> Measurement:
     try:
         text = raw.decode("utf-8-sig")
     except UnicodeDecodeError as err:
-        line = raw[: err.start].count(b"\n") + 1
-        raise NcppError("not UTF-8 text", Location(name, line)) from None
+        line_start = raw.rfind(b"\n", 0, err.start) + 1
+        line, col = raw[: err.start].count(b"\n") + 1, len(raw[line_start : err.start].decode("utf-8", "replace")) + 1
+        raise NcppError("not UTF-8 text", Location(name, line, col)) from None
     return parse_measurement(text, name)
 
 
@@ -285,9 +286,9 @@ def parse_measurement(text: str, source: str = "<string>") -> Measurement:
         break
     instrument = strip_remark(meta.pop("instrument", "")).lower()
     if not instrument:
-        raise NcppError("missing '# instrument: ...' metadata line", Location(source, header_at or 1))
+        raise NcppError("missing '# instrument: ...' metadata line", Location(source, header_at or 1, 1))
     if header_at is None:
-        raise NcppError("no CSV header row", Location(source, len(lines) or 1))
+        raise NcppError("no CSV header row", Location(source, len(lines) or 1, 1))
     header_line = _REMARK.sub("", lines[header_at - 1])
     names = [cell.strip() for cell in header_line.split(",")]
     schema = schema_for(instrument, meta)

@@ -109,8 +109,8 @@ class _Locator:
             if found is None and "." in section:  # dotted keys inside the parent table
                 parent, key = section.rsplit(".", 1)[0], key or section.rsplit(".", 1)[1]
                 found = self._header(parent)
-            if found is None:
-                return Location(self.file, None)
+            if found is None:  # (the file's start: the table is not written in it)
+                return Location(self.file, 1, 1)
             start = found
         if key is not None:
             key_re = re.compile(r"^\s*(?:[\w.\"]*\.)?\"?" + re.escape(key) + r"\"?\s*=")
@@ -118,8 +118,14 @@ class _Locator:
                 if section and i > start and re.match(r"^\s*\[", self.lines[i]):
                     break
                 if key_re.match(self.lines[i]):
-                    return Location(self.file, i + 1)
-        return Location(self.file, start + 1)
+                    return self._at_line(i)
+        return self._at_line(start)
+
+    def _at_line(self, index: int) -> Location:
+        """The first character written on line `index` (0-based) of the file."""
+        line = self.lines[index] if index < len(self.lines) else ""
+        return Location(self.file, index + 1, len(line) - len(line.lstrip()) + 1)
+
 
     def item(self, key: str, nth: int, inner: str | None = None) -> Location | None:
         """Where item `nth` of a top-level array ``key = [...]`` begins, or its key `inner`
@@ -176,9 +182,10 @@ def _parse_error_location(err: tomllib.TOMLDecodeError, text: str, file: str) ->
     m = re.search(r"at line (\d+), column (\d+)", str(err))
     if m:
         return Location(file, int(m.group(1)), int(m.group(2)))
-    if "at end of document" in str(err):  # a truncated file: its last line
-        return Location(file, max(1, len(text.splitlines())))
-    return Location(file)
+    lines = text.splitlines()
+    if "at end of document" in str(err):  # a truncated file: the end of its last line
+        return Location(file, max(1, len(lines)), len(lines[-1]) + 1 if lines else 1)
+    return Location(file, 1, 1)
 
 
 def load_machine(path: str | os.PathLike[str]) -> Machine:
@@ -429,7 +436,7 @@ def _where_for_machine_error(message: str, loc: _Locator) -> Location:
             return loc.where("offsets", key)
     if "max_correction_mm" in message:
         return loc.where("compensation", "max_correction_mm")
-    return Location(loc.file)
+    return Location(loc.file, 1, 1)
 
 
 def _split_unit(key: str, units: tuple[str, ...]) -> tuple[str, str]:

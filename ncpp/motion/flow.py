@@ -35,7 +35,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable, Iterable, Iterator, Sequence
 
-from ncpp.errors import Location, NcppError
+from ncpp.errors import Location, NcppError, printable
 from ncpp.motion.expressions import SUBROUTINE_PARAMETERS, normalise_name, round_half_away
 from ncpp.motion.snapshot import attributes
 from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
@@ -570,7 +570,7 @@ class Flow:
         while True:
             block = self._block(frame, frame.pc)
             if block is None:
-                raise NcppError(f"o{_shown(name)} sub has no o{_shown(name)} endsub", Location(self.file, self._opening_line(frame), None))
+                raise NcppError(f"o{_shown(name)} sub has no o{_shown(name)} endsub", self._sub_place(frame, opening))
             control = self._control_of(block)
             if control is not None and control.keyword == "sub" and frame.pc != opening:  # (rs274ngc: none in another)
                 raise NcppError("Nested subroutine definition", Location(self.file, block.line, control.item.start + 1))
@@ -580,6 +580,14 @@ class Flow:
             frame.pc += 1
             if control is not None and control.name == name and control.keyword == "endsub":
                 return
+
+    def _sub_place(self, frame: _Frame, opening: int) -> Location:
+        """Where the `sub` statement at `opening` in the frame's text stands (for messages)."""
+        block = self._block(frame, opening)
+        control = None if block is None else self._control_of(block)
+        if control is None:
+            return Location(self.file, self._opening_line(frame), 1)
+        return Location(self.file, block.line, control.item.start + 1)
 
     def _opening_line(self, frame: _Frame) -> int:
         """The line a construct left open at the end of the text started at (for messages)."""
@@ -673,4 +681,4 @@ def oword_name(text: str) -> str:
 
 
 def _shown(name: str) -> str:
-    return name if name.isdigit() else f"<{name}>"
+    return name if name.isdigit() else f"<{printable(name)}>"

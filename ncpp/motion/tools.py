@@ -138,7 +138,7 @@ def read_tool_lines(lines: list[str], file: str, unit_mm: float) -> tuple[dict[i
             elif letter in _OTHER_LETTERS:
                 _number(value, where)
             else:
-                raise NcppError(f"unknown tool table word {word.group()!r}", where)
+                raise NcppError(_unknown_word(word.group()), where)
         if number is None:
             if data.strip():
                 raise NcppError("tool table line without a T word", Location(file, n, 1))
@@ -155,7 +155,8 @@ def _number(text: str, where: Location) -> float:
     try:
         value = float(text)
     except ValueError:
-        raise NcppError(f"expected a number, got {text!r}", where) from None
+        got = repr(text) if len(text) <= _QUOTED else f"{len(text)} characters"  # (never a line of another file)
+        raise NcppError(f"expected a number, got {got}", where) from None
     if not math.isfinite(value):
         raise NcppError(f"expected a finite number, got {text!r}", where)
     return value
@@ -242,3 +243,15 @@ def read_to_ini(lines: list[str], file: str, unit_mm: float) -> tuple[dict[tuple
         if parameter in _LENGTH_PARAMETERS:
             edge_lengths[_LENGTH_PARAMETERS[parameter]] += value * unit_mm
     return {key: (a, b, c) for key, (a, b, c) in lengths.items()}, names
+
+
+_QUOTED = 16  # the longest text of a table a message quotes
+_WORD_SHAPED = re.compile(r"[A-Za-z][-+0-9.,]{0,15}")
+
+
+def _unknown_word(text: str) -> str:
+    """The message for a word a tool table does not have, quoting it only when it is shaped
+    as a tool-table word (a letter and a number): another file's text is never echoed."""
+    if _WORD_SHAPED.fullmatch(text):
+        return f"unknown tool table word {text!r}"
+    return "not a tool table word (a letter and a number, as `T1 Z+10`): is this a tool table?"
