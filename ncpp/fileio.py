@@ -14,6 +14,8 @@ import tempfile
 from pathlib import Path
 from typing import BinaryIO, Iterator
 
+from ncpp.errors import Location, NcppError
+
 
 @contextlib.contextmanager
 def atomic_output(path: str | os.PathLike[str]) -> Iterator[BinaryIO]:
@@ -72,6 +74,21 @@ def write_text_atomic(path: str | os.PathLike[str], text: str, encoding: str = "
 def write_bytes_atomic(path: str | os.PathLike[str], data: bytes) -> None:
     with atomic_output(path) as out:
         out.write(data)
+
+
+# Input files that are settings, not programs (machine files, parameter files, tool tables,
+# ncpp.toml, LinuxCNC's INI, measurement files) are read whole: past this size a path names no
+# such file (`/dev/zero` never ends) and is refused before it fills the memory.
+SMALL_FILE_BYTES = 64 << 20
+
+
+def read_small(path: str | os.PathLike[str], what: str, limit: int = SMALL_FILE_BYTES) -> bytes:
+    """The bytes of a settings file `what` (for the message); NcppError if it holds more than `limit`."""
+    with open(path, "rb") as f:
+        data = f.read(limit + 1)
+    if len(data) > limit:
+        raise NcppError(f"not {what}: it holds more than {limit >> 20} MB", Location(os.fspath(path), 1, 1))
+    return data
 
 
 def count_lines(path: str | os.PathLike[str]) -> int:

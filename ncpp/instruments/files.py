@@ -63,7 +63,7 @@ from typing import Mapping
 import numpy as np
 
 from ncpp.errors import Location, NcppError
-from ncpp.fileio import write_text_atomic
+from ncpp.fileio import read_small, write_text_atomic
 
 PLANES = {"XY": ("X", "Y"), "YZ": ("Y", "Z"), "ZX": ("Z", "X")}
 LASER_QUANTITIES = ("position", "straightness_x", "straightness_y", "straightness_z", "pitch", "yaw", "roll")
@@ -254,7 +254,7 @@ def read_measurement(path: str | os.PathLike[str]) -> Measurement:
     """Read a measurement file; a malformed file raises NcppError at its line."""
     name = os.fspath(path)
     try:
-        raw = Path(name).read_bytes()
+        raw = read_small(name, "a measurement file")
     except OSError as err:
         raise NcppError(f"cannot read: {err.strerror or err}", Location(name)) from None
     try:

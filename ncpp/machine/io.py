@@ -77,7 +77,7 @@ import numpy as np
 import tomli_w
 
 from ncpp.errors import Location, NcppError
-from ncpp.fileio import write_text_atomic
+from ncpp.fileio import read_small, write_text_atomic
 from ncpp.machine.chain import SMALL_ANGLE
 from ncpp.machine.components import AXES, COMPONENTS, SQUARENESS, Polynomial, Table, canonical_name
 from ncpp.machine.effects import LARGEST_ERROR, LARGEST_LENGTH_MM, effect_from_dict, is_finite_number
@@ -109,8 +109,8 @@ class _Locator:
             if found is None and "." in section:  # dotted keys inside the parent table
                 parent, key = section.rsplit(".", 1)[0], key or section.rsplit(".", 1)[1]
                 found = self._header(parent)
-            if found is None:  # (the file's start: the table is not written in it)
-                return Location(self.file, 1, 1)
+            if found is None:  # (no line: the table is not written in the file)
+                return Location(self.file, None)
             start = found
         if key is not None:
             key_re = re.compile(r"^\s*(?:[\w.\"]*\.)?\"?" + re.escape(key) + r"\"?\s*=")
@@ -178,7 +178,7 @@ def _array_items(lines: list[str], start: int) -> Iterator[tuple[int, int]]:
             col += 1
 
 
-def _parse_error_location(err: tomllib.TOMLDecodeError, text: str, file: str) -> Location:
+def toml_error_location(err: tomllib.TOMLDecodeError, text: str, file: str) -> Location:
     m = re.search(r"at line (\d+), column (\d+)", str(err))
     if m:
         return Location(file, int(m.group(1)), int(m.group(2)))
@@ -192,11 +192,13 @@ def load_machine(path: str | os.PathLike[str]) -> Machine:
     """Read a machine file; NcppError with file:line for anything wrong."""
     file = str(path)
     try:
-        text = Path(path).read_text(encoding="utf-8")
+        data = read_small(path, "a machine file")
     except OSError as err:
         raise NcppError(f"cannot read machine file: {err.strerror}", Location(file)) from err
+    try:
+        text = data.decode("utf-8")
     except UnicodeDecodeError as err:
-        raise _not_utf8(Path(path).read_bytes(), file) from err
+        raise _not_utf8(data, file) from err
     return loads_machine(text, file)
 
 
@@ -219,13 +221,14 @@ def loads_machine(text: str, file: str = "<string>") -> Machine:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as err:
         msg = re.sub(r"\s*\(at (?:line \d+, column \d+|end of document)\)", "", str(err))
-        raise NcppError(f"not valid TOML: {msg}", _parse_error_location(err, text, file)) from err
+        raise NcppError(f"not valid TOML: {msg}", toml_error_location(err, text, file)) from err
     loc = _Locator(text, file)
     return _machine_from_dict(data, loc, default_name=Path(file).stem)
 
 
 def _fail(message: str, where: Location) -> NcppError:
-    return NcppError(message, where)
+    """The error at `where`; at the file's start when what it is about is not written in the file."""
+    return NcppError(message, where if where.line is not None else Location(where.file, 1, 1))
 
 
 def _get_table(data: dict, name: str, loc: _Locator) -> dict:

@@ -368,8 +368,8 @@ class Flow:
     def _from_file(self, name: str) -> list[Block] | None:
         """Subroutine `name` from `name.ngc` in the first folder of the path that has it (as LinuxCNC)."""
         for folder in self.path:
-            path = folder / f"{name}.ngc"
-            if not path.is_file():
+            path = _subroutine_file(folder, name)
+            if path is None or not path.is_file():
                 continue
             lines: list[Block] = []
             with open(path, "rb") as stream:
@@ -380,7 +380,7 @@ class Flow:
                         if control is not None and control.keyword == "endsub" and control.name == name:
                             self.subroutines[name], self.files[name] = lines, str(path)
                             return lines
-            raise NcppError(f"o<{name}> sub ... o<{name}> endsub is not in the file", Location(str(path)))
+            raise NcppError(f"o<{printable(name)}> sub ... o<{printable(name)}> endsub is not in the file", Location(str(path), 1, 1))
         return None
 
     def source(self) -> str | None:
@@ -678,6 +678,15 @@ def oword_name(text: str) -> str:
     label = text[1:].strip()
     name = normalise_name(label)  # without case and blanks, a number's too (`o1 00`)
     return name if label.startswith("<") else str(int(name))
+
+
+def _subroutine_file(folder: Path, name: str) -> Path | None:
+    """The file of subroutine `name` in `folder` as rs274ngc names it: the name joined to the
+    folder as text (`find_ngc_file`: "folder/name.ngc"), so `o</etc/x>` is folder/etc/x.ngc;
+    None for a name that leads out of the folder (`..`), which ncpp does not follow."""
+    path = os.path.normpath(f"{folder}/{name}.ngc")
+    inside = os.path.normpath(folder)
+    return Path(path) if path.startswith(inside.rstrip(os.sep) + os.sep) else None
 
 
 def _shown(name: str) -> str:

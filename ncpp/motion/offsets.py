@@ -26,6 +26,7 @@ from pathlib import Path
 from typing import Mapping, Sequence
 
 from ncpp.errors import Location, NcppError
+from ncpp.fileio import read_small
 from ncpp.motion.tools import ToolTable
 
 Vector = tuple[float, float, float]
@@ -144,7 +145,7 @@ def read_var_file(path: str | Path) -> dict[int, float]:
     """`number value` lines; other lines are comments (as rs274ngc reads it)."""
     values: dict[int, float] = {}
     try:
-        text = Path(path).read_text(encoding="latin-1")
+        text = read_small(path, "a parameter file").decode("latin-1")
     except OSError as err:
         raise NcppError(f"cannot read the parameter file: {err.strerror}", Location(str(path))) from None
     for n, line in enumerate(text.splitlines(), 1):

@@ -50,6 +50,7 @@ from pathlib import Path
 from typing import Mapping
 
 from ncpp.errors import Location, NcppError, Warnings
+from ncpp.fileio import read_small
 
 OFFSET_LETTERS = "XYZABCUVW"  # a tool's offsets, in the interpreter's axis order
 _LINEAR = frozenset("XYZUVW")  # the offsets in length units (A B C are degrees)
@@ -75,7 +76,7 @@ class ToolTable:
         """LinuxCNC's tool table or Sinumerik's tool offsets, their lengths in the machine's
         units (`unit_mm` mm each), or Heidenhain's TOOL.T (its units in its first line)."""
         try:
-            text = Path(path).read_text(encoding="latin-1")
+            text = read_small(path, "a tool table").decode("latin-1")
         except OSError as err:
             raise NcppError(f"cannot read the tool table: {err.strerror}", Location(str(path))) from None
         lines = text.splitlines()
