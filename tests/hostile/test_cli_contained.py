@@ -12,9 +12,11 @@ from pathlib import Path
 
 import pytest
 
+from tests.conftest import SHARED
+
 from tests.hostile.conftest import ROOT
 
-MACHINE = ROOT.parent / "shared/machines/wide.toml"
+MACHINE = SHARED / "machines/wide.toml"
 needs_machine = pytest.mark.skipif(not MACHINE.exists(), reason="no shared machine file")
 
 
@@ -89,14 +91,18 @@ def test_output_through_a_symlink_replaces_its_target_and_keeps_the_link(ncpp, t
 
 
 def test_an_unwritable_output_names_its_file(ncpp, tmp_path):
-    """A write error has no file name of its own: the message names the output."""
+    """A write error has no file name of its own: the message names the output (a full
+    device made here: a regression must not replace the system's /dev/full)."""
     program = tmp_path / "p.ngc"
     program.write_text("G1 X1 F100\nM2\n")
-    if not Path("/dev/full").exists():
-        pytest.skip("no /dev/full")
-    done = ncpp(str(program), "-o", "/dev/full")
+    full = tmp_path / "full"
+    try:
+        os.mknod(full, 0o666 | stat.S_IFCHR, os.makedev(1, 7))
+    except PermissionError:
+        pytest.skip("making a device node takes root")
+    done = ncpp(str(program), "-o", str(full))
     assert done.returncode == 2
-    assert done.stderr.decode().strip() == "ncpp: /dev/full: No space left on device"
+    assert done.stderr.decode().strip() == f"ncpp: {full}: No space left on device"
 
 
 @pytest.mark.parametrize("text, where", [

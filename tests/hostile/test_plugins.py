@@ -10,6 +10,8 @@ from pathlib import Path
 
 import pytest
 
+from tests.conftest import SHARED
+
 ROOT = Path(__file__).resolve().parents[2]
 
 
@@ -39,7 +41,7 @@ def test_the_linuxcnc_filter_imports_nothing_from_the_working_folder(tmp_path):
     (tmp_path / "numpy.py").write_text(f"open({str(tmp_path / 'ran')!r}, 'w').close()\n")
     program = tmp_path / "p.ngc"
     program.write_text("G21 G1 X1 F100\nM2\n")
-    machine = ROOT.parent / "shared/machines/wide.toml"
+    machine = SHARED / "machines/wide.toml"
     if not machine.exists():
         pytest.skip("no shared machine file")
     env = {**os.environ, "NCPP_PYTHON": sys.executable, "NCPP_MACHINE": str(machine), "NCPP_CACHE": ""}

@@ -9,8 +9,10 @@ from pathlib import Path
 
 import pytest
 
+from tests.conftest import SHARED
+
 ROOT = Path(__file__).resolve().parents[2]
-MACHINE = ROOT.parent / "shared/machines/wide.toml"
+MACHINE = SHARED / "machines/wide.toml"
 _PEAK = """import resource, runpy, sys
 sys.argv = ["ncpp", *sys.argv[1:]]
 try:
