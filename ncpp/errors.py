@@ -24,6 +24,13 @@ def printable(text: str) -> str:
     return text.translate(_CONTROL)
 
 
+def quoted(text: str, width: int = 40) -> str:
+    """A file's text for a message: quoted, cut short, its control characters escaped (a
+    damaged or wrong file can hold a line of megabytes, or another file's secrets)."""
+    shown = repr(text if len(text) <= width else text[: width - 3] + "...")
+    return printable(shown)
+
+
 @dataclass(frozen=True, slots=True)
 class Location:
     file: str = "<stdin>"

@@ -15,7 +15,7 @@ from typing import Iterable, Iterator, TextIO
 import lark
 from lark import Transformer, v_args
 
-from ncpp.errors import Location, NcppError
+from ncpp.errors import Location, NcppError, quoted
 from ncpp.program.parser import lalr_parser
 
 # Majors that the motion module understands or that carry set-up data a
@@ -136,9 +136,9 @@ def read_cldata(stream: TextIO | Iterable[str], file: str = "<stdin>") -> Iterat
             major, args = to_record.transform(parser.parse(statement.strip()))
         except lark.exceptions.UnexpectedInput as err:
             col = getattr(err, "column", 1) or 1
-            raise NcppError(f"cannot read this CL record: {statement.strip()!r}", Location(file, line, col)) from None
+            raise NcppError(f"cannot read this CL record: {quoted(statement.strip(), 60)}", Location(file, line, col)) from None
         if any(type(a) is float and not math.isfinite(a) for a in args):  # more digits than a float holds
-            raise NcppError(f"number out of range in this CL record: {statement.strip()[:60]!r}", Location(file, line, _long_number_col(text)))
+            raise NcppError(f"number out of range in this CL record: {quoted(statement.strip(), 60)}", Location(file, line, _long_number_col(text)))
         yield Record(major, args, text, line, file)
 
 

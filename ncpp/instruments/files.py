@@ -62,7 +62,7 @@ from typing import Mapping
 
 import numpy as np
 
-from ncpp.errors import Location, NcppError
+from ncpp.errors import Location, NcppError, quoted
 from ncpp.fileio import read_small, write_text_atomic
 
 PLANES = {"XY": ("X", "Y"), "YZ": ("Y", "Z"), "ZX": ("Z", "X")}
@@ -141,6 +141,7 @@ class Measurement:
     meta: Mapping[str, str]
     columns: Mapping[str, np.ndarray]
     source: str = field(default="<memory>", compare=False)
+    meta_lines: Mapping[str, int] = field(default_factory=dict, compare=False)  # key -> its line in the file
 
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, Measurement):
@@ -176,7 +177,7 @@ class Measurement:
             return None
         parts = [p for p in re.split(r"[,\s]+", value) if p]
         if len(parts) != 3:
-            raise NcppError(f"{key} needs three numbers x,y,z, got {value!r}", Location(self.source))
+            raise NcppError(f"{key} needs three numbers x,y,z, got {quoted(value)}", _meta_where(self, key))
         return np.array([_meta_float(self, key, p) for p in parts])
 
     @property
@@ -227,7 +228,7 @@ class Measurement:
                 continue
             name, sep, number = word.partition("=")
             if not sep or not name.isalpha():
-                raise NcppError(f"fixed: expected AXIS=value words, got {word!r}", Location(self.source))
+                raise NcppError(f"fixed: expected AXIS=value words, got {quoted(word)}", _meta_where(self, "fixed"))
             out[name.upper()] = _meta_float(self, "fixed", number)
         return out
 
@@ -241,10 +242,15 @@ def _meta_float(m: Measurement, key: str, text: str) -> float:
     try:
         value = float(text)
     except ValueError:
-        raise NcppError(f"{key}: {text!r} is not a number", Location(m.source)) from None
+        raise NcppError(f"{key}: {quoted(text)} is not a number", _meta_where(m, key)) from None
     if not math.isfinite(value):
-        raise NcppError(f"{key}: {text!r} is not a finite number", Location(m.source))
+        raise NcppError(f"{key}: {quoted(text)} is not a finite number", _meta_where(m, key))
     return value
+
+
+def _meta_where(m: Measurement, key: str) -> Location:
+    """The line of metadata `key` in the measurement's file (its first line when unknown)."""
+    return Location(m.source, m.meta_lines.get(key, 1), 1)
 
 
 # -- reading -----------------------------------------------------------------
@@ -308,7 +314,7 @@ def parse_measurement(text: str, source: str = "<string>") -> Measurement:
         name: _convert_column(name, [row[i] for row in cells], [lines[n - 1] for n in where], where, i, schema, source)
         for i, name in enumerate(names)
     }
-    measurement = Measurement(instrument, meta, columns, source)
+    measurement = Measurement(instrument, meta, columns, source, meta_lines)
     _check_meta(measurement, header_at, meta_lines)
     return measurement
 
@@ -318,14 +324,14 @@ def _check_header(names: list[str], schema: Schema | None, instrument: str, sour
         if not name:
             raise NcppError("empty column name in header", Location(source, line, _cell_col(text, i)))
         if names.index(name) != i:
-            raise NcppError(f"column {name!r} appears twice", Location(source, line, _cell_col(text, i)))
+            raise NcppError(f"column {quoted(name)} appears twice", Location(source, line, _cell_col(text, i)))
     if schema is None:
         return
     allowed = set(schema.required) | set(schema.optional) | set(schema.one_of)
     for i, name in enumerate(names):
         if name not in allowed:
             raise NcppError(
-                f"unknown column {name!r} for instrument {instrument} (expected {', '.join(schema.required + schema.optional + schema.one_of)})",
+                f"unknown column {quoted(name)} for instrument {instrument} (expected {', '.join(schema.required + schema.optional + schema.one_of)})",
                 Location(source, line, _cell_col(text, i)),
             )
     missing = [n for n in schema.required if n not in names]
@@ -359,7 +365,7 @@ def _convert_column(
         for k, value in enumerate(values):
             norm = value.upper()
             if norm not in allowed:
-                raise fail(k, f"direction must be {' or '.join(allowed)}, got {value!r}")
+                raise fail(k, f"direction must be {' or '.join(allowed)}, got {quoted(value)}")
             out.append(norm)
         return np.array(out, dtype="<U3")
     if name == "run":
@@ -368,7 +374,7 @@ def _convert_column(
             try:
                 run = int(value)
             except ValueError:
-                raise fail(k, f"run must be a whole number counting from 1, got {value!r}") from None
+                raise fail(k, f"run must be a whole number counting from 1, got {quoted(value)}") from None
             if not 1 <= run <= MAX_RUNS:
                 raise fail(k, f"run counts from 1 to {MAX_RUNS} (ISO 230-2 asks for 5), got {value}")
             runs.append(run)
@@ -379,9 +385,9 @@ def _convert_column(
         try:
             numbers[k] = float(value)
         except ValueError:
-            raise fail(k, f"{name}: {value!r} is not a number") from None
+            raise fail(k, f"{name}: {quoted(value)} is not a number") from None
         if not math.isfinite(numbers[k]):
-            raise fail(k, f"{name}: {value!r} is not a finite number")
+            raise fail(k, f"{name}: {quoted(value)} is not a finite number")
         if name == "angle_deg" and not 0.0 <= numbers[k] < 360.0:
             raise fail(k, f"angle_deg must be in [0, 360), got {value}")
         if abs(numbers[k]) > limit:
@@ -405,19 +411,19 @@ def _check_meta(m: Measurement, header_line: int, meta_lines: Mapping[str, int])
     if m.instrument == "laser":
         quantity = m.quantity
         if quantity not in LASER_QUANTITIES:
-            raise NcppError(f"laser quantity must be one of {', '.join(LASER_QUANTITIES)}, got {quantity!r}", at("quantity"))
+            raise NcppError(f"laser quantity must be one of {', '.join(LASER_QUANTITIES)}, got {quoted(quantity)}", at("quantity"))
         wanted = "deviation_urad" if quantity in ANGULAR_QUANTITIES else "deviation_um"
         if wanted not in m.columns:
             raise NcppError(f"a laser {quantity} file has the column {wanted}", where)
         component, angles = m.text("component"), [f"E{r}{m.axis or 'X'}" for r in "ABC"]
         if quantity in ANGULAR_QUANTITIES and component and component.upper() not in angles:
-            raise NcppError(f"component must be an angle of the axis, {', '.join(angles)}; got {component!r}", at("component"))
+            raise NcppError(f"component must be an angle of the axis, {', '.join(angles)}; got {quoted(component)}", at("component"))
     if m.instrument == "level" and m.quantity not in LEVEL_QUANTITIES:
-        raise NcppError(f"level quantity must be roll or pitch, got {m.quantity!r}", at("quantity"))
+        raise NcppError(f"level quantity must be roll or pitch, got {quoted(m.quantity)}", at("quantity"))
     if m.instrument in ("ballbar", "grid", "cutting"):
         plane = m.text("plane")
         if plane is not None and plane.upper() not in PLANES:
-            raise NcppError(f"plane must be XY, YZ or ZX, got {plane!r}", at("plane"))
+            raise NcppError(f"plane must be XY, YZ or ZX, got {quoted(plane)}", at("plane"))
     if m.instrument in ("ballbar", "cutting"):
         try:
             radius = m.radius_mm

@@ -25,7 +25,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Mapping, Sequence
 
-from ncpp.errors import Location, NcppError
+from ncpp.errors import Location, NcppError, quoted
 from ncpp.fileio import read_small
 from ncpp.motion.tools import ToolTable
 
@@ -156,9 +156,9 @@ def read_var_file(path: str | Path) -> dict[int, float]:
         try:
             value = float(fields[1])
         except ValueError:
-            raise NcppError(f"parameter {fields[0]} has no number: {fields[1]!r}", where) from None
+            raise NcppError(f"parameter {fields[0]} has no number: {quoted(fields[1])}", where) from None
         if not math.isfinite(value):
-            raise NcppError(f"parameter {fields[0]} is not a finite number: {fields[1]!r}", where)
+            raise NcppError(f"parameter {fields[0]} is not a finite number: {quoted(fields[1])}", where)
         values[int(fields[0])] = value
     return values
 

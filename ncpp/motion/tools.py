@@ -49,7 +49,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Mapping
 
-from ncpp.errors import Location, NcppError, Warnings
+from ncpp.errors import Location, NcppError, Warnings, quoted
 from ncpp.fileio import read_small
 
 OFFSET_LETTERS = "XYZABCUVW"  # a tool's offsets, in the interpreter's axis order
@@ -156,17 +156,16 @@ def _number(text: str, where: Location) -> float:
     try:
         value = float(text)
     except ValueError:
-        got = repr(text) if len(text) <= _QUOTED else f"{len(text)} characters"  # (never a line of another file)
-        raise NcppError(f"expected a number, got {got}", where) from None
+        raise NcppError(f"expected a number, got {quoted(text, _QUOTED)}", where) from None
     if not math.isfinite(value):
-        raise NcppError(f"expected a finite number, got {text!r}", where)
+        raise NcppError(f"expected a finite number, got {quoted(text, _QUOTED)}", where)
     return value
 
 
 def _integer(text: str, where: Location) -> int:
     value = _number(text, where)
     if value != int(value) or value < 0:
-        raise NcppError(f"a tool number is a whole number, got {text!r}", where)
+        raise NcppError(f"a tool number is a whole number, got {quoted(text, _QUOTED)}", where)
     return int(value)
 
 
@@ -187,7 +186,7 @@ def read_tool_t(lines: list[str], file: str) -> tuple[dict[tuple[float, int], tu
         text, col = _field(line, columns, "T")
         number = decimal("T")
         if number < 0:
-            raise NcppError(f"a tool number is not negative, got {text!r}", Location(file, n, col))
+            raise NcppError(f"a tool number is not negative, got {quoted(text, _QUOTED)}", Location(file, n, col))
         if (number, 1) in tools:
             raise NcppError(f"tool {text} is listed twice", Location(file, n, col))
         tools[number, 1] = ((decimal("L") + decimal("DL")) * unit_mm, 0.0, 0.0)

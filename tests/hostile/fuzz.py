@@ -105,7 +105,7 @@ def run_cases(cases: list[dict], seconds: float, results: Path) -> None:
             result["exception"] = "".join(traceback.format_exception(caught))[-3000:]
         finally:
             signal.setitimer(signal.ITIMER_REAL, 0)
-        result["stderr"] = err.getvalue()[-4000:]
+        result["stderr"] = "\n".join(line[:400] for line in err.getvalue().splitlines()[-20:])
         result["peak_kb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
         with open(results, "a") as f:
             f.write(json.dumps(result) + "\n")
