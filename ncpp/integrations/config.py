@@ -73,7 +73,9 @@ def read_config(path: Path) -> dict:
     """A config file's keys, checked; `machine` made absolute."""
     try:
         text = read_small(path, "an ncpp config file").decode("utf-8")
-        data = tomllib.loads(text)
+        from ncpp.machine.io import loads_toml
+
+        data = loads_toml(text, str(path))
     except UnicodeDecodeError as err:
         raise NcppError("not UTF-8 text; save the config file as UTF-8", Location(str(path), 1, 1)) from err
     except tomllib.TOMLDecodeError as err:

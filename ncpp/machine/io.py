@@ -215,10 +215,36 @@ def _not_utf8(data: bytes, file: str) -> NcppError:
     return NcppError(f"not UTF-8 text (byte 0x{data[start]:02x}); save the machine file as UTF-8", where)
 
 
+# Arrays and inline tables nested deeper than this are refused before tomllib, which reads them
+# recursively (a machine file nests three: a table's rows of numbers)
+MAX_TOML_NESTING = 32
+
+
+def loads_toml(text: str, file: str) -> dict:
+    """`tomllib.loads`, refusing nesting past MAX_TOML_NESTING at its place."""
+    depth, line, line_start, quote = 0, 1, 0, ""
+    for at, char in enumerate(text):
+        if char == "\n":
+            line, line_start, quote = line + 1, at + 1, ""
+        elif quote:
+            quote = "" if char == quote else quote
+        elif char in "\"'":
+            quote = char
+        elif char == "#":
+            quote = "\n"  # (a comment: to the end of the line)
+        elif char in "[{":
+            depth += 1
+            if depth > MAX_TOML_NESTING:
+                raise NcppError(f"arrays or tables nested deeper than {MAX_TOML_NESTING}", Location(file, line, at - line_start + 1))
+        elif char in "]}":
+            depth = max(depth - 1, 0)
+    return tomllib.loads(text)
+
+
 def loads_machine(text: str, file: str = "<string>") -> Machine:
     text = text.removeprefix("\ufeff")  # a byte order mark, as some Windows editors write: not TOML
     try:
-        data = tomllib.loads(text)
+        data = loads_toml(text, file)
     except tomllib.TOMLDecodeError as err:
         msg = re.sub(r"\s*\(at (?:line \d+, column \d+|end of document)\)", "", str(err))
         raise NcppError(f"not valid TOML: {msg}", toml_error_location(err, text, file)) from err
