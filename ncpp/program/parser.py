@@ -288,7 +288,7 @@ class LineParser:
             _refuse_infinite(block, file)
         if "\r" in raw:  # (a CR before the LF is the line's end, not in `raw`)
             _refuse_cr_line_ends(raw, line, file)
-        if plain is None:
+        if plain is None and raw.count("[") + raw.count("(") > MAX_NESTING:  # (only such a line can nest deeper)
             _refuse_deep(block, file)
         return block
 
