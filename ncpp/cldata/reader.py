@@ -136,9 +136,12 @@ def read_cldata(stream: TextIO | Iterable[str], file: str = "<stdin>") -> Iterat
             major, args = to_record.transform(parser.parse(statement.strip()))
         except lark.exceptions.UnexpectedInput as err:
             col = getattr(err, "column", 1) or 1
-            raise NcppError(f"cannot read this CL record: {quoted(statement.strip(), 60)}", Location(file, line, col)) from None
+            record = quoted(statement.strip(), 60)
+            raise NcppError(f"cannot read this CL record: {record}", Location(file, line, col)) from None
         if any(type(a) is float and not math.isfinite(a) for a in args):  # more digits than a float holds
-            raise NcppError(f"number out of range in this CL record: {quoted(statement.strip(), 60)}", Location(file, line, _long_number_col(text)))
+            record = quoted(statement.strip(), 60)
+            where = Location(file, line, _long_number_col(text))
+            raise NcppError(f"number out of range in this CL record: {record}", where)
         yield Record(major, args, text, line, file)
 
 

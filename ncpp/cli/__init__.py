@@ -65,7 +65,8 @@ def main(argv: list[str] | None = None) -> int:
     except Terminated:
         return Terminated.EXIT_STATUS
     except OSError as err:  # (a write's has no file name: the output's)
-        print(f"ncpp: {err.filename or getattr(args, 'output', None) or '<stdout>'}: {err.strerror or err}", file=sys.stderr)
+        name = err.filename or getattr(args, "output", None) or "<stdout>"
+        print(f"ncpp: {name}: {err.strerror or err}", file=sys.stderr)
         return 2
 
 

@@ -57,7 +57,6 @@ import math
 import os
 import re
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Mapping
 
 import numpy as np
@@ -155,6 +154,11 @@ class Measurement:
 
     __hash__ = None  # type: ignore[assignment]
 
+    def at(self, key: str = "instrument") -> Location:
+        """Where metadata `key` is written in the file (its instrument line: what a whole-file
+        problem points at), else its first line."""
+        return Location(self.source, self.meta_lines.get(key, 1), 1)
+
     def __len__(self) -> int:
         return len(next(iter(self.columns.values()))) if self.columns else 0
 
@@ -177,7 +181,7 @@ class Measurement:
             return None
         parts = [p for p in re.split(r"[,\s]+", value) if p]
         if len(parts) != 3:
-            raise NcppError(f"{key} needs three numbers x,y,z, got {quoted(value)}", _meta_where(self, key))
+            raise NcppError(f"{key} needs three numbers x,y,z, got {quoted(value)}", self.at(key))
         return np.array([_meta_float(self, key, p) for p in parts])
 
     @property
@@ -228,7 +232,7 @@ class Measurement:
                 continue
             name, sep, number = word.partition("=")
             if not sep or not name.isalpha():
-                raise NcppError(f"fixed: expected AXIS=value words, got {quoted(word)}", _meta_where(self, "fixed"))
+                raise NcppError(f"fixed: expected AXIS=value words, got {quoted(word)}", self.at("fixed"))
             out[name.upper()] = _meta_float(self, "fixed", number)
         return out
 
@@ -242,15 +246,13 @@ def _meta_float(m: Measurement, key: str, text: str) -> float:
     try:
         value = float(text)
     except ValueError:
-        raise NcppError(f"{key}: {quoted(text)} is not a number", _meta_where(m, key)) from None
+        raise NcppError(f"{key}: {quoted(text)} is not a number", m.at(key)) from None
     if not math.isfinite(value):
-        raise NcppError(f"{key}: {quoted(text)} is not a finite number", _meta_where(m, key))
+        raise NcppError(f"{key}: {quoted(text)} is not a finite number", m.at(key))
     return value
 
 
-def _meta_where(m: Measurement, key: str) -> Location:
-    """The line of metadata `key` in the measurement's file (its first line when unknown)."""
-    return Location(m.source, m.meta_lines.get(key, 1), 1)
+
 
 
 # -- reading -----------------------------------------------------------------
@@ -267,8 +269,8 @@ def read_measurement(path: str | os.PathLike[str]) -> Measurement:
         text = raw.decode("utf-8-sig")
     except UnicodeDecodeError as err:
         line_start = raw.rfind(b"\n", 0, err.start) + 1
-        line, col = raw[: err.start].count(b"\n") + 1, len(raw[line_start : err.start].decode("utf-8", "replace")) + 1
-        raise NcppError("not UTF-8 text", Location(name, line, col)) from None
+        col = len(raw[line_start : err.start].decode("utf-8", "replace")) + 1
+        raise NcppError("not UTF-8 text", Location(name, raw[: err.start].count(b"\n") + 1, col)) from None
     return parse_measurement(text, name)
 
 

@@ -235,7 +235,8 @@ def loads_toml(text: str, file: str) -> dict:
         elif char in "[{":
             depth += 1
             if depth > MAX_TOML_NESTING:
-                raise NcppError(f"arrays or tables nested deeper than {MAX_TOML_NESTING}", Location(file, line, at - line_start + 1))
+                where = Location(file, line, at - line_start + 1)
+                raise NcppError(f"arrays or tables nested deeper than {MAX_TOML_NESTING}", where)
         elif char in "]}":
             depth = max(depth - 1, 0)
     return tomllib.loads(text)

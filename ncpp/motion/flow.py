@@ -380,7 +380,8 @@ class Flow:
                         if control is not None and control.keyword == "endsub" and control.name == name:
                             self.subroutines[name], self.files[name] = lines, str(path)
                             return lines
-            raise NcppError(f"o<{printable(name)}> sub ... o<{printable(name)}> endsub is not in the file", Location(str(path), 1, 1))
+            shown = printable(name)
+            raise NcppError(f"o<{shown}> sub ... o<{shown}> endsub is not in the file", Location(str(path), 1, 1))
         return None
 
     def source(self) -> str | None:
@@ -570,7 +571,8 @@ class Flow:
         while True:
             block = self._block(frame, frame.pc)
             if block is None:
-                raise NcppError(f"o{_shown(name)} sub has no o{_shown(name)} endsub", self._sub_place(frame, opening))
+                shown = _shown(name)
+                raise NcppError(f"o{shown} sub has no o{shown} endsub", self._sub_place(frame, opening))
             control = self._control_of(block)
             if control is not None and control.keyword == "sub" and frame.pc != opening:  # (rs274ngc: none in another)
                 raise NcppError("Nested subroutine definition", Location(self.file, block.line, control.item.start + 1))

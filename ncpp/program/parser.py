@@ -185,8 +185,8 @@ class Dialect:
     `continuation` is the mark that, ending a line, continues its block on
     the next line (Heidenhain `~`).  `max_line`: the longest block the dialect's
     controls read (`max_line_source` says whose rule it is); a longer one is refused
-    before it is scanned, which keeps the time and memory of a line bounded.  `read_where_run`: a line the grammar cannot
-    read is an error where it runs, not where it stands (rs274ngc reads only the
+    before it is scanned, which keeps the time and memory of a line bounded.
+    `read_where_run`: a line the grammar cannot read is an error where it runs, not where it stands (rs274ngc reads only the
     lines it runs: an uncalled subroutine, an untaken branch, the text after M2
     may hold anything): it becomes a block of one `unreadable` statement.
     """
@@ -233,8 +233,9 @@ def _refuse_cr_line_ends(raw: str, line: int, file: str) -> None:
 
 
 def _refuse_long(raw: str, dialect: Dialect, line: int, file: str) -> None:
-    raise NcppError(f"block too long: {len(raw)} characters, where a {dialect.name} block may have {dialect.max_line} "
-                    f"({dialect.max_line_source})", Location(file, line, dialect.max_line + 1))
+    limit = dialect.max_line
+    raise NcppError(f"block too long: {len(raw)} characters, where a {dialect.name} block may have {limit} "
+                    f"({dialect.max_line_source})", Location(file, line, limit + 1))
 
 
 # Brackets nested deeper than this are refused in every dialect: rs274ngc reads 120 in a line of
@@ -252,7 +253,8 @@ def _refuse_deep(block: Block, file: str) -> None:
         for offset, char in enumerate(block.raw[item.start : item.end]):
             depth += _BRACKETS.get(char, 0)
             if depth > MAX_NESTING:
-                raise NcppError(f"brackets nested deeper than {MAX_NESTING}", Location(file, block.line, item.start + offset + 1))
+                where = Location(file, block.line, item.start + offset + 1)
+                raise NcppError(f"brackets nested deeper than {MAX_NESTING}", where)
 
 
 _TEXT_AFTER_CR = re.compile(r"\r[ \t\f\v\x1a\r]*[^ \t\f\v\x1a\r\n]")
@@ -288,7 +290,7 @@ class LineParser:
             _refuse_infinite(block, file)
         if "\r" in raw:  # (a CR before the LF is the line's end, not in `raw`)
             _refuse_cr_line_ends(raw, line, file)
-        if plain is None and raw.count("[") + raw.count("(") > MAX_NESTING:  # (only such a line can nest deeper)
+        if plain is None and raw.count("[") + raw.count("(") > MAX_NESTING:  # (else it cannot nest deeper)
             _refuse_deep(block, file)
         return block
 

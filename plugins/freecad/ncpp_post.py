@@ -45,7 +45,7 @@ parser.add_argument("--work-offset", action="append", default=[], help="[G5x=]X,
 parser.add_argument("--var-file", help="LinuxCNC parameter file holding the zeros")
 parser.add_argument("--tool-table", help="LinuxCNC tool table: the lengths the program's G43 applies")
 parser.add_argument("--var-units", help="units of --var-file and --tool-table: mm or inch")
-parser.add_argument("--ncpp", help="refused: the ncpp program comes from $NCPP, the FreeCAD parameter or PATH")
+parser.add_argument("--ncpp", help="refused: ncpp is found from $NCPP, the FreeCAD parameter or PATH")
 
 TOOLTIP_ARGS = parser.format_help() + "\nOther arguments are passed to linuxcnc_post.\n"
 
@@ -82,7 +82,8 @@ def _ncpp_command(options):
                            f"program to run): set NCPP, or the parameter Program in {PARAMETERS}")
     found = os.environ.get("NCPP") or _preferred_program() or shutil.which("ncpp")
     if not found:
-        raise RuntimeError(f"ncpp_post: the ncpp program was not found; set NCPP, or Program in {PARAMETERS}, or put ncpp on PATH")
+        raise RuntimeError(f"ncpp_post: the ncpp program was not found; set NCPP, or Program in {PARAMETERS}, "
+                           "or put ncpp on PATH")
     return shlex.split(found) if " " in found and not os.path.exists(found) else [found]
 
 

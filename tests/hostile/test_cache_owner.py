@@ -7,8 +7,7 @@ import os
 import pytest
 
 from ncpp.cache import cached_build
-
-from tests.program.test_cache import Saved, build_counting, load
+from tests.program.test_cache import build_counting, load
 
 
 def _planted(folder, name="g") -> list:

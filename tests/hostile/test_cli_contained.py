@@ -13,7 +13,6 @@ from pathlib import Path
 import pytest
 
 from tests.conftest import SHARED
-
 from tests.hostile.conftest import ROOT
 
 MACHINE = SHARED / "machines/wide.toml"
