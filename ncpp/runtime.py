@@ -78,8 +78,13 @@ class Terminated(BaseException):
 
 
 def terminate_as_interrupt() -> None:
-    """Have SIGTERM raise `Terminated` (once: a second one during the clean-up is ignored)."""
+    """Have SIGTERM raise `Terminated` (once: a second one during the clean-up is ignored);
+    only a process's main thread can (`main` called from another leaves the handler as it is)."""
     import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        return
 
     def raise_terminated(signum, frame) -> None:
         signal.signal(signal.SIGTERM, signal.SIG_IGN)
