@@ -42,7 +42,7 @@ def test_fifty_megabytes_of_one_line_are_refused_in_bounded_time(ncpp, tmp_path)
     program.write_bytes(b"X1 " * (16 << 20) + b"\n")
     started = time.perf_counter()
     done = ncpp(str(program), memory_mb=1024, timeout=60)
-    assert time.perf_counter() - started < 20
+    assert time.perf_counter() - started < 10  # (the dialect's detection once read the whole line: 37 s)
     assert done.returncode == 2 and b"Traceback" not in done.stderr
     assert done.stderr.decode().startswith(f"{program}:1:257: block too long")
 
