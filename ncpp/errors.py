@@ -15,6 +15,22 @@ if TYPE_CHECKING:
     from ncpp.program.blocks import Block
 
 
+_CONTROL = {c: f"\\x{c:02x}" for c in [*range(0x20), *range(0x7F, 0xA0)]}
+
+
+def printable(text: str) -> str:
+    """`text` with its control characters escaped (`\\x1b`): a message quoting a name from a
+    file sends a terminal no escape sequence."""
+    return text.translate(_CONTROL)
+
+
+def quoted(text: str, width: int = 40) -> str:
+    """A file's text for a message: quoted, cut short, its control characters escaped (a
+    damaged or wrong file can hold a line of megabytes, or another file's secrets)."""
+    shown = repr(text if len(text) <= width else text[: width - 3] + "...")
+    return printable(shown)
+
+
 @dataclass(frozen=True, slots=True)
 class Location:
     file: str = "<stdin>"
@@ -26,11 +42,9 @@ class Location:
 
     def __str__(self) -> str:
         parts = [self.file]
-        if self.line is not None:
-            parts.append(str(self.line))
-            if self.col is not None:
-                parts.append(str(self.col))
-        return ":".join(parts)
+        if self.line is not None:  # a line's problem whose column nobody found is at its start
+            parts += [str(self.line), str(self.col or 1)]
+        return printable(":".join(parts))
 
 
 class NcppError(Exception):
@@ -57,7 +71,7 @@ class NcppError(Exception):
         self.where = replace(where, col=1 if word is None else word.start + 1, word=None)
 
     def __str__(self) -> str:
-        return f"{self.where}: {self.message}"
+        return f"{self.where}: {printable(self.message)}"
 
     def __reduce__(self):  # pickled with its location (it may come from another process: `compensate --jobs`)
         return (type(self), (self.message, self.where))
@@ -95,6 +109,7 @@ class Warnings:
         times = self._times.get(message, 0) + 1
         if times > 1 or len(self._times) < _TEXTS_COUNTED:
             self._times[message] = times
+        message = printable(message)
         if times < SHOWN_PER_TEXT:
             print(f"{where}: warning: {message}", file=self.stream)
         elif times == SHOWN_PER_TEXT:

@@ -6,28 +6,60 @@ paths (`program_file`) and line counts."""
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
+import shutil
 import stat
 import tempfile
 from pathlib import Path
 from typing import BinaryIO, Iterator
 
+from ncpp.errors import Location, NcppError
+
 
 @contextlib.contextmanager
 def atomic_output(path: str | os.PathLike[str]) -> Iterator[BinaryIO]:
-    """Yield a binary file; on clean exit it replaces `path`, on error it vanishes."""
-    target = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent or ".")
+    """Yield a binary file; on clean exit it replaces `path`, on error it vanishes.
+
+    A symbolic link is written through: its target is replaced, the link kept.  A file
+    that is not a regular one (`/dev/null`, a FIFO) is never replaced: it receives the
+    output, kept aside until complete, written into it."""
+    target = Path(os.path.realpath(path))
+    try:
+        held = os.stat(target)
+    except FileNotFoundError:
+        held = None
+    if held is not None and not stat.S_ISREG(held.st_mode):
+        with _into_special(target) as out:
+            yield out
+        return
+    with _beside(target) as (out, tmp):
+        yield out
+        out.flush()
+        os.fsync(out.fileno())
+        os.chmod(out.fileno(), held.st_mode & 0o777 if held is not None else 0o644)
+        os.replace(tmp, target)
+
+
+@contextlib.contextmanager
+def _into_special(target: Path) -> Iterator[BinaryIO]:
+    """Output for a device or a FIFO, written into it once complete."""
+    if stat.S_ISDIR(os.stat(target).st_mode):
+        raise IsADirectoryError(errno.EISDIR, os.strerror(errno.EISDIR), str(target))
+    with tempfile.TemporaryFile() as spool:
+        yield spool  # type: ignore[misc]
+        spool.seek(0)
+        with open(target, "wb") as out:  # (no truncation or replacing for such a file: it is written)
+            shutil.copyfileobj(spool, out, 1 << 20)
+
+
+@contextlib.contextmanager
+def _beside(target: Path) -> Iterator[tuple[BinaryIO, str]]:
+    """A temporary file in the target's folder, removed on error (a SIGTERM is one: `cli`)."""
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=str(target.parent))
     try:
         with os.fdopen(fd, "wb") as out:
-            yield out
-            out.flush()
-            os.fsync(out.fileno())
-        if target.exists():
-            os.chmod(tmp, target.stat().st_mode & 0o777)
-        else:
-            os.chmod(tmp, 0o644)
-        os.replace(tmp, target)
+            yield out, tmp
     except BaseException:
         with contextlib.suppress(FileNotFoundError):
             os.unlink(tmp)
@@ -42,6 +74,21 @@ def write_text_atomic(path: str | os.PathLike[str], text: str, encoding: str = "
 def write_bytes_atomic(path: str | os.PathLike[str], data: bytes) -> None:
     with atomic_output(path) as out:
         out.write(data)
+
+
+# Input files that are settings, not programs (machine files, parameter files, tool tables,
+# ncpp.toml, LinuxCNC's INI, measurement files) are read whole: past this size a path names no
+# such file (`/dev/zero` never ends) and is refused before it fills the memory.
+SMALL_FILE_BYTES = 64 << 20
+
+
+def read_small(path: str | os.PathLike[str], what: str, limit: int = SMALL_FILE_BYTES) -> bytes:
+    """The bytes of a settings file `what` (for the message); NcppError if it holds more than `limit`."""
+    with open(path, "rb") as f:
+        data = f.read(limit + 1)
+    if len(data) > limit:
+        raise NcppError(f"not {what}: it holds more than {limit >> 20} MB", Location(os.fspath(path), 1, 1))
+    return data
 
 
 def count_lines(path: str | os.PathLike[str]) -> int:

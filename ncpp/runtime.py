@@ -65,3 +65,26 @@ def one_blas_thread(environ: Environ = os.environ) -> Environ:  # type: ignore[a
     user's choice); numpy reads it when it is imported.  Returns `environ`."""
     environ.setdefault("OPENBLAS_NUM_THREADS", "1")
     return environ
+
+
+class Terminated(BaseException):
+    """A SIGTERM, raised where the process is, so that every `with` cleans up as on Ctrl-C:
+    temporary files beside the output and spooled input are removed."""
+
+    EXIT_STATUS = 128 + 15  # (a shell's status for a process SIGTERM ended)
+
+
+def terminate_as_interrupt() -> None:
+    """Have SIGTERM raise `Terminated` (once: a second one during the clean-up is ignored);
+    only a process's main thread can (`main` called from another leaves the handler as it is)."""
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        return
+
+    def raise_terminated(signum, frame) -> None:
+        signal.signal(signal.SIGTERM, signal.SIG_IGN)
+        raise Terminated()
+
+    signal.signal(signal.SIGTERM, raise_terminated)

@@ -643,6 +643,7 @@ class _Nearby:
     segment passing within r of a point has one of its points within r + coarse / 2."""
 
     FEW, MANY = 6, 96  # nearest lookup points asked for, then for the points that found none near
+    BATCH = 1 << 15  # points looked at at once
 
     def __init__(self, starts: np.ndarray, ends: np.ndarray, bound: Bound):
         self.starts, self.ends, self.reach = starts, ends, bound.coarse / 2
@@ -710,7 +711,12 @@ class _Nearby:
         segments, distance, closest = segments[order], distance[order], closest[order]
         near = distance <= within
         pair = near[:n, :, None] & near[n:, None, :]
-        common = ((segments[:n, :, None] == segments[n:, None, :]) & pair).any(axis=(1, 2))
+        # a segment near one end, near the other too (looked at from both ends: segments lying
+        # over one another, as a peck's, crowd the nearest points of either)
+        ends_to_start, _ = _to_segments(ends, self.starts[segments[:n]], self.ends[segments[:n]])
+        starts_to_end, _ = _to_segments(starts, self.starts[segments[n:]], self.ends[segments[n:]])
+        common = (near[:n] & (segments[:n] >= 0) & (ends_to_start <= within)).any(axis=1)
+        common |= (near[n:] & (segments[n:] >= 0) & (starts_to_end <= within)).any(axis=1)
         rest = np.flatnonzero(~common)
         if len(rest):
             rest = rest[~self._across_a_vertex(rest, segments, distance, closest, pair, n, within)]
@@ -724,15 +730,17 @@ class _Nearby:
         t = (np.arange(len(which)) - first[which]) / counts[which]
         points = a[which] + t[:, None] * (b - a)[which]
         allowed = within + step / 2
-        _, distance = self.distances(points, allowed, self.FEW)
-        low = distance.min(axis=1) > allowed
-        if low.any():
-            _, again = self.distances(points[low], allowed, self.MANY)
-            low[np.flatnonzero(low)] = again.min(axis=1) > allowed
-        if not low.any():
-            return None
-        k = int(np.argmax(low))
-        return int(rest[which[k]]), points[k]
+        for batch in range(0, len(points), self.BATCH):  # (memory: k segments of each point at once)
+            some = points[batch : batch + self.BATCH]
+            _, distance = self.distances(some, allowed, self.FEW)
+            low = distance.min(axis=1) > allowed
+            if low.any():
+                _, again = self.distances(some[low], allowed, self.MANY)
+                low[np.flatnonzero(low)] = again.min(axis=1) > allowed
+            if low.any():
+                k = batch + int(np.argmax(low))
+                return int(rest[which[k]]), points[k]
+        return None
 
 
 def _to_segments(points: np.ndarray, starts: np.ndarray, ends: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

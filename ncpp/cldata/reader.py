@@ -8,13 +8,14 @@ the record.  Each joined record is parsed by grammar/apt.lark.
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass
 from typing import Iterable, Iterator, TextIO
 
 import lark
 from lark import Transformer, v_args
 
-from ncpp.errors import Location, NcppError
+from ncpp.errors import Location, NcppError, quoted
 from ncpp.program.parser import lalr_parser
 
 # Majors that the motion module understands or that carry set-up data a
@@ -135,7 +136,19 @@ def read_cldata(stream: TextIO | Iterable[str], file: str = "<stdin>") -> Iterat
             major, args = to_record.transform(parser.parse(statement.strip()))
         except lark.exceptions.UnexpectedInput as err:
             col = getattr(err, "column", 1) or 1
-            raise NcppError(f"cannot read this CL record: {statement.strip()!r}", Location(file, line, col)) from None
+            record = quoted(statement.strip(), 60)
+            raise NcppError(f"cannot read this CL record: {record}", Location(file, line, col)) from None
         if any(type(a) is float and not math.isfinite(a) for a in args):  # more digits than a float holds
-            raise NcppError(f"number out of range in this CL record: {statement.strip()[:60]!r}", Location(file, line))
+            record = quoted(statement.strip(), 60)
+            where = Location(file, line, _long_number_col(text))
+            raise NcppError(f"number out of range in this CL record: {record}", where)
         yield Record(major, args, text, line, file)
+
+
+_DIGITS = re.compile(r"\d{300,}")  # (a float holds 308 digits: a number past them reads as infinity)
+
+
+def _long_number_col(text: str) -> int:
+    """The column of the record's first number too long for a float, else 1."""
+    found = _DIGITS.search(text)
+    return found.start() + 1 if found else 1

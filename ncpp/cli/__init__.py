@@ -13,7 +13,7 @@ import sys
 
 from ncpp import __version__
 from ncpp.errors import NcppError
-from ncpp.runtime import one_blas_thread
+from ncpp.runtime import Terminated, one_blas_thread, terminate_as_interrupt
 
 # Module names under ncpp.cli, in the order `ncpp --help` lists them.
 COMMANDS: tuple[str, ...] = (
@@ -47,6 +47,7 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     one_blas_thread()  # before the commands import numpy (runtime.py)
+    terminate_as_interrupt()
     parser = build_parser()
     known = set(parser._subparsers._group_actions[0].choices)  # type: ignore[union-attr]
     if not argv or (argv[0] not in known and argv[0] not in ("-h", "--help", "--version")):
@@ -61,8 +62,11 @@ def main(argv: list[str] | None = None) -> int:
         return 1
     except KeyboardInterrupt:
         return 130
-    except OSError as err:
-        print(f"ncpp: {err.filename or ''}: {err.strerror or err}", file=sys.stderr)
+    except Terminated:
+        return Terminated.EXIT_STATUS
+    except OSError as err:  # (a write's has no file name: the output's)
+        name = err.filename or getattr(args, "output", None) or "<stdout>"
+        print(f"ncpp: {name}: {err.strerror or err}", file=sys.stderr)
         return 2
 
 

@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-from ncpp.errors import Location, NcppError
+from ncpp.errors import NcppError
 from ncpp.instruments.files import PLANES, Measurement
 from ncpp.machine.components import AXES
 from ncpp.machine.effects import Angular, Effect
@@ -103,7 +103,7 @@ def observe(machine: Machine, m: Measurement, name: str = "") -> Observation:
     """The diagnosis view of one file (NcppError for files it cannot use)."""
     if m.instrument not in USED:
         raise NcppError(
-            f"diagnose uses ballbar, laser and comparator files, not {m.instrument}", Location(m.source)
+            f"diagnose uses ballbar, laser and comparator files, not {m.instrument}", m.at()
         )
     fp = machine.replace(tool=np.add(machine.tool, m.offset_mm))
     name = name or m.source
@@ -115,7 +115,7 @@ def observe(machine: Machine, m: Measurement, name: str = "") -> Observation:
 # ---------------------------------------------------------------- ball bar
 def _ballbar(machine: Machine, m: Measurement, name: str) -> Observation:
     if m.radius_mm is None:
-        raise NcppError("ballbar file without radius_mm", Location(m.source))
+        raise NcppError("ballbar file without radius_mm", m.at())
     circular_test(m)  # refuses what analyze refuses (fewer than three points a direction)
     centre = m.center_mm if m.center_mm is not None else np.zeros(3)
     radius = m.radius_mm

@@ -365,7 +365,7 @@ def fit_ballbar(
     known no better than this is reported as not separable."""
     for m in measurements:
         if m.instrument != "ballbar":
-            raise NcppError(f"fit_ballbar takes ball-bar files, not {m.instrument}", Location(m.source))
+            raise NcppError(f"fit_ballbar takes ball-bar files, not {m.instrument}", m.at())
     if knots < 2:
         raise NcppError("--knots must be at least 2", Location("ncpp fit"))
     if smoothing is not None and not 0 < smoothing < np.inf:
@@ -374,7 +374,7 @@ def fit_ballbar(
     _check_knots(measurements, knots)
     blocks = unknowns(obs, knots, fixed)
     if not blocks:
-        raise NcppError("the ball-bar files move no axis whose errors could be fitted", Location(measurements[0].source))
+        raise NcppError("the ball-bar files move no axis whose errors could be fitted", measurements[0].at())
     r0 = _residuals(machine, obs)
     before = _rms_per_file(obs, r0)
     sigma, start = [], 0

@@ -94,7 +94,7 @@ class Source:
 
 def sources_of(m: Measurement, chain: str) -> list[Source]:
     """The components file `m` gives (NcppError for files the fit cannot use)."""
-    where = Location(m.source)
+    where = m.at()
     axis = m.axis
     if axis is None:
         raise NcppError(f"a {m.instrument} file needs '# axis: X|Y|Z' to be fitted", where)
@@ -135,7 +135,7 @@ def _check_targets(m: Measurement) -> None:
     column, what = ("position_mm", "positions") if m.instrument == "level" else ("target_mm", "targets")
     count = len(np.unique(np.round(m[column] * 1e3)))
     if count < 2:
-        raise NcppError(f"a table needs readings at two or more {what}; the file has {count}", Location(m.source))
+        raise NcppError(f"a table needs readings at two or more {what}; the file has {count}", m.at())
 
 
 def _level_sign(chain: str, member: str, axis: str) -> float:
@@ -279,7 +279,7 @@ def _fit_tables(
             raise NcppError(
                 f"{s.component} is given by both {taken[s.component].measurement.source} and "
                 f"{s.measurement.source}; give one file per component",
-                Location(s.measurement.source),
+                s.measurement.at(),
             )
         taken[s.component] = s
     order = sorted(sources, key=lambda s: not s.angular)  # angles first: they set the Abbe terms

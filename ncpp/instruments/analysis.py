@@ -36,7 +36,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ncpp.errors import Location, NcppError
+from ncpp.errors import NcppError, quoted
 from ncpp.instruments import iso230_2, iso230_4
 from ncpp.instruments.files import ANGULAR_QUANTITIES, Measurement
 
@@ -91,7 +91,7 @@ def _clean(figures: dict[str, float | None]) -> dict[str, float | None]:
 def analyze(m: Measurement, spike_width_deg: float = 3.0) -> Analysis:
     """The standard evaluation of measurement `m`."""
     if len(m) == 0:
-        raise NcppError("the file holds no readings", Location(m.source))
+        raise NcppError("the file holds no readings", m.at())
     if m.instrument == "comparator" or (m.instrument == "laser" and m.quantity == "position"):
         return _positioning(m)
     if m.instrument == "laser":
@@ -102,7 +102,7 @@ def analyze(m: Measurement, spike_width_deg: float = 3.0) -> Analysis:
         return _circular(m, spike_width_deg)
     if m.instrument == "grid":
         return Analysis(m, "path", _clean(_path_figures(m)))
-    raise NcppError(f"no evaluation for instrument {m.instrument!r}", Location(m.source))
+    raise NcppError(f"no evaluation for instrument {quoted(m.instrument)}", m.at())
 
 
 def _positioning(m: Measurement) -> Analysis:
@@ -130,7 +130,7 @@ def _line_fits(m: Measurement, profile: Profile, what: str, where: str = "target
     """`profile`, to which a line is fitted: that needs two positions (NcppError if not)."""
     count = len(np.unique(profile.position_mm))
     if count < 2:
-        raise NcppError(f"a {what} profile needs at least two {where}; the file has {count}", Location(m.source))
+        raise NcppError(f"a {what} profile needs at least two {where}; the file has {count}", m.at())
     return profile
 
 

@@ -57,13 +57,12 @@ import math
 import os
 import re
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Mapping
 
 import numpy as np
 
-from ncpp.errors import Location, NcppError
-from ncpp.fileio import write_text_atomic
+from ncpp.errors import Location, NcppError, quoted
+from ncpp.fileio import read_small, write_text_atomic
 
 PLANES = {"XY": ("X", "Y"), "YZ": ("Y", "Z"), "ZX": ("Z", "X")}
 LASER_QUANTITIES = ("position", "straightness_x", "straightness_y", "straightness_z", "pitch", "yaw", "roll")
@@ -141,6 +140,7 @@ class Measurement:
     meta: Mapping[str, str]
     columns: Mapping[str, np.ndarray]
     source: str = field(default="<memory>", compare=False)
+    meta_lines: Mapping[str, int] = field(default_factory=dict, compare=False)  # key -> its line in the file
 
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, Measurement):
@@ -153,6 +153,11 @@ class Measurement:
         )
 
     __hash__ = None  # type: ignore[assignment]
+
+    def at(self, key: str = "instrument") -> Location:
+        """Where metadata `key` is written in the file (its instrument line: what a whole-file
+        problem points at), else its first line."""
+        return Location(self.source, self.meta_lines.get(key, 1), 1)
 
     def __len__(self) -> int:
         return len(next(iter(self.columns.values()))) if self.columns else 0
@@ -176,7 +181,7 @@ class Measurement:
             return None
         parts = [p for p in re.split(r"[,\s]+", value) if p]
         if len(parts) != 3:
-            raise NcppError(f"{key} needs three numbers x,y,z, got {value!r}", Location(self.source))
+            raise NcppError(f"{key} needs three numbers x,y,z, got {quoted(value)}", self.at(key))
         return np.array([_meta_float(self, key, p) for p in parts])
 
     @property
@@ -227,7 +232,7 @@ class Measurement:
                 continue
             name, sep, number = word.partition("=")
             if not sep or not name.isalpha():
-                raise NcppError(f"fixed: expected AXIS=value words, got {word!r}", Location(self.source))
+                raise NcppError(f"fixed: expected AXIS=value words, got {quoted(word)}", self.at("fixed"))
             out[name.upper()] = _meta_float(self, "fixed", number)
         return out
 
@@ -241,10 +246,13 @@ def _meta_float(m: Measurement, key: str, text: str) -> float:
     try:
         value = float(text)
     except ValueError:
-        raise NcppError(f"{key}: {text!r} is not a number", Location(m.source)) from None
+        raise NcppError(f"{key}: {quoted(text)} is not a number", m.at(key)) from None
     if not math.isfinite(value):
-        raise NcppError(f"{key}: {text!r} is not a finite number", Location(m.source))
+        raise NcppError(f"{key}: {quoted(text)} is not a finite number", m.at(key))
     return value
+
+
+
 
 
 # -- reading -----------------------------------------------------------------
@@ -254,14 +262,15 @@ def read_measurement(path: str | os.PathLike[str]) -> Measurement:
     """Read a measurement file; a malformed file raises NcppError at its line."""
     name = os.fspath(path)
     try:
-        raw = Path(name).read_bytes()
+        raw = read_small(name, "a measurement file")
     except OSError as err:
         raise NcppError(f"cannot read: {err.strerror or err}", Location(name)) from None
     try:
         text = raw.decode("utf-8-sig")
     except UnicodeDecodeError as err:
-        line = raw[: err.start].count(b"\n") + 1
-        raise NcppError("not UTF-8 text", Location(name, line)) from None
+        line_start = raw.rfind(b"\n", 0, err.start) + 1
+        col = len(raw[line_start : err.start].decode("utf-8", "replace")) + 1
+        raise NcppError("not UTF-8 text", Location(name, raw[: err.start].count(b"\n") + 1, col)) from None
     return parse_measurement(text, name)
 
 
@@ -285,9 +294,9 @@ def parse_measurement(text: str, source: str = "<string>") -> Measurement:
         break
     instrument = strip_remark(meta.pop("instrument", "")).lower()
     if not instrument:
-        raise NcppError("missing '# instrument: ...' metadata line", Location(source, header_at or 1))
+        raise NcppError("missing '# instrument: ...' metadata line", Location(source, header_at or 1, 1))
     if header_at is None:
-        raise NcppError("no CSV header row", Location(source, len(lines) or 1))
+        raise NcppError("no CSV header row", Location(source, len(lines) or 1, 1))
     header_line = _REMARK.sub("", lines[header_at - 1])
     names = [cell.strip() for cell in header_line.split(",")]
     schema = schema_for(instrument, meta)
@@ -307,7 +316,7 @@ def parse_measurement(text: str, source: str = "<string>") -> Measurement:
         name: _convert_column(name, [row[i] for row in cells], [lines[n - 1] for n in where], where, i, schema, source)
         for i, name in enumerate(names)
     }
-    measurement = Measurement(instrument, meta, columns, source)
+    measurement = Measurement(instrument, meta, columns, source, meta_lines)
     _check_meta(measurement, header_at, meta_lines)
     return measurement
 
@@ -317,14 +326,14 @@ def _check_header(names: list[str], schema: Schema | None, instrument: str, sour
         if not name:
             raise NcppError("empty column name in header", Location(source, line, _cell_col(text, i)))
         if names.index(name) != i:
-            raise NcppError(f"column {name!r} appears twice", Location(source, line, _cell_col(text, i)))
+            raise NcppError(f"column {quoted(name)} appears twice", Location(source, line, _cell_col(text, i)))
     if schema is None:
         return
     allowed = set(schema.required) | set(schema.optional) | set(schema.one_of)
     for i, name in enumerate(names):
         if name not in allowed:
             raise NcppError(
-                f"unknown column {name!r} for instrument {instrument} (expected {', '.join(schema.required + schema.optional + schema.one_of)})",
+                f"unknown column {quoted(name)} for instrument {instrument} (expected {', '.join(schema.required + schema.optional + schema.one_of)})",
                 Location(source, line, _cell_col(text, i)),
             )
     missing = [n for n in schema.required if n not in names]
@@ -358,7 +367,7 @@ def _convert_column(
         for k, value in enumerate(values):
             norm = value.upper()
             if norm not in allowed:
-                raise fail(k, f"direction must be {' or '.join(allowed)}, got {value!r}")
+                raise fail(k, f"direction must be {' or '.join(allowed)}, got {quoted(value)}")
             out.append(norm)
         return np.array(out, dtype="<U3")
     if name == "run":
@@ -367,7 +376,7 @@ def _convert_column(
             try:
                 run = int(value)
             except ValueError:
-                raise fail(k, f"run must be a whole number counting from 1, got {value!r}") from None
+                raise fail(k, f"run must be a whole number counting from 1, got {quoted(value)}") from None
             if not 1 <= run <= MAX_RUNS:
                 raise fail(k, f"run counts from 1 to {MAX_RUNS} (ISO 230-2 asks for 5), got {value}")
             runs.append(run)
@@ -378,9 +387,9 @@ def _convert_column(
         try:
             numbers[k] = float(value)
         except ValueError:
-            raise fail(k, f"{name}: {value!r} is not a number") from None
+            raise fail(k, f"{name}: {quoted(value)} is not a number") from None
         if not math.isfinite(numbers[k]):
-            raise fail(k, f"{name}: {value!r} is not a finite number")
+            raise fail(k, f"{name}: {quoted(value)} is not a finite number")
         if name == "angle_deg" and not 0.0 <= numbers[k] < 360.0:
             raise fail(k, f"angle_deg must be in [0, 360), got {value}")
         if abs(numbers[k]) > limit:
@@ -404,19 +413,19 @@ def _check_meta(m: Measurement, header_line: int, meta_lines: Mapping[str, int])
     if m.instrument == "laser":
         quantity = m.quantity
         if quantity not in LASER_QUANTITIES:
-            raise NcppError(f"laser quantity must be one of {', '.join(LASER_QUANTITIES)}, got {quantity!r}", at("quantity"))
+            raise NcppError(f"laser quantity must be one of {', '.join(LASER_QUANTITIES)}, got {quoted(quantity)}", at("quantity"))
         wanted = "deviation_urad" if quantity in ANGULAR_QUANTITIES else "deviation_um"
         if wanted not in m.columns:
             raise NcppError(f"a laser {quantity} file has the column {wanted}", where)
         component, angles = m.text("component"), [f"E{r}{m.axis or 'X'}" for r in "ABC"]
         if quantity in ANGULAR_QUANTITIES and component and component.upper() not in angles:
-            raise NcppError(f"component must be an angle of the axis, {', '.join(angles)}; got {component!r}", at("component"))
+            raise NcppError(f"component must be an angle of the axis, {', '.join(angles)}; got {quoted(component)}", at("component"))
     if m.instrument == "level" and m.quantity not in LEVEL_QUANTITIES:
-        raise NcppError(f"level quantity must be roll or pitch, got {m.quantity!r}", at("quantity"))
+        raise NcppError(f"level quantity must be roll or pitch, got {quoted(m.quantity)}", at("quantity"))
     if m.instrument in ("ballbar", "grid", "cutting"):
         plane = m.text("plane")
         if plane is not None and plane.upper() not in PLANES:
-            raise NcppError(f"plane must be XY, YZ or ZX, got {plane!r}", at("plane"))
+            raise NcppError(f"plane must be XY, YZ or ZX, got {quoted(plane)}", at("plane"))
     if m.instrument in ("ballbar", "cutting"):
         try:
             radius = m.radius_mm

@@ -36,7 +36,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ncpp.errors import Location, NcppError
+from ncpp.errors import NcppError
 from ncpp.instruments.files import MAX_LENGTH_UM, Measurement
 
 SYMBOLS = ("A", "A_up", "A_down", "E", "E_up", "E_down", "M", "B", "B_mean", "R", "R_up", "R_down")
@@ -206,7 +206,7 @@ def evaluate_measurement(m: Measurement, column: str | None = None) -> Iso230_2:
         elif m.instrument == "laser":
             column = m.deviation_column
         else:
-            raise NcppError(f"ISO 230-2 applies to laser and comparator files, not {m.instrument}", Location(m.source))
+            raise NcppError(f"ISO 230-2 applies to laser and comparator files, not {m.instrument}", m.at())
     if len(m) == 0:
-        raise NcppError("the file holds no readings", Location(m.source))
+        raise NcppError("the file holds no readings", m.at())
     return evaluate_positioning(m["target_mm"], m["direction"], m[column])

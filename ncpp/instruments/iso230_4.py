@@ -64,7 +64,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ncpp.errors import Location, NcppError
+from ncpp.errors import NcppError
 from ncpp.instruments.files import PLANES, Measurement
 
 SYMBOLS = ("G", "G_cw", "G_ccw", "H", "F_max", "F_min")
@@ -127,19 +127,19 @@ def circular_test(m: Measurement) -> CircularTest:
     elif m.instrument == "grid":
         traces = _grid_traces(m)
     else:
-        raise NcppError(f"{m.instrument} files hold no circular test", Location(m.source))
+        raise NcppError(f"{m.instrument} files hold no circular test", m.at())
     if not traces or not all(len(t.angle_deg) >= 3 for t in traces):
-        raise NcppError("a circular test needs at least three points per direction", Location(m.source))
+        raise NcppError("a circular test needs at least three points per direction", m.at())
     radius = m.radius_mm
     if radius is None:  # a file without it is refused on loading (ballbar, cutting) or above (grid)
-        raise NcppError(f"a {m.instrument} file needs '# radius_mm: R' (R > 0)", Location(m.source))
+        raise NcppError(f"a {m.instrument} file needs '# radius_mm: R' (R > 0)", m.at())
     return CircularTest(traces, float(radius), m.plane, m.feed_mm_min, m.source)
 
 
 def _grid_traces(m: Measurement) -> tuple[Trace, ...]:
     """Radial deviation of a circular grid-encoder path (needs radius_mm and center_mm)."""
     if m.radius_mm is None or m.center_mm is None:
-        raise NcppError("a grid file is a circular test only with radius_mm and center_mm", Location(m.source))
+        raise NcppError("a grid file is a circular test only with radius_mm and center_mm", m.at())
     p, q = m.plane_axes
     index = {"X": 0, "Y": 1, "Z": 2}
     centre = m.center_mm[[index[p], index[q]]]

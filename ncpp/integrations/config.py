@@ -37,6 +37,7 @@ from pathlib import Path
 from typing import Mapping
 
 from ncpp.errors import Location, NcppError
+from ncpp.fileio import read_small
 from ncpp.motion.offsets import UNIT_MM, Vector, WorkOffsets, system_number
 
 KEYS = ("machine", "tolerance", "work_offset", "var_file", "var_units", "tool_table")
@@ -71,9 +72,16 @@ def config_paths(cwd: Path | None = None, env: Mapping[str, str] | None = None) 
 def read_config(path: Path) -> dict:
     """A config file's keys, checked; `machine` made absolute."""
     try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
+        text = read_small(path, "an ncpp config file").decode("utf-8")
+        from ncpp.machine.io import loads_toml
+
+        data = loads_toml(text, str(path))
+    except UnicodeDecodeError as err:
+        raise NcppError("not UTF-8 text; save the config file as UTF-8", Location(str(path), 1, 1)) from err
     except tomllib.TOMLDecodeError as err:
-        raise NcppError(f"not a valid TOML config file: {err}", Location(str(path))) from None
+        from ncpp.machine.io import toml_error_location
+
+        raise NcppError(f"not a valid TOML config file: {err}", toml_error_location(err, text, str(path))) from None
     unknown = sorted(set(data) - set(KEYS))
     if unknown:
         raise NcppError(f"unknown key(s) {', '.join(unknown)} (known: {', '.join(KEYS)})", Location(str(path)))
@@ -164,7 +172,7 @@ def with_linuxcnc_ini(settings: Settings, ini: str | Path | None) -> Settings:
     parser = configparser.ConfigParser(strict=False, interpolation=None)  # LinuxCNC INIs repeat keys (HALFILE)
     parser.optionxform = str  # type: ignore[assignment,method-assign]
     try:
-        parser.read_string(path.read_text(encoding="latin-1"), str(path))
+        parser.read_string(read_small(path, "a LinuxCNC INI file").decode("latin-1"), str(path))
     except (OSError, configparser.Error) as err:
         raise NcppError(f"cannot read the LinuxCNC INI file: {err}", Location(str(path))) from None
 

@@ -20,9 +20,9 @@ import sys
 from functools import cached_property
 from typing import TextIO
 
-from ncpp.errors import NcppError, Warnings
+from ncpp.errors import Location, NcppError, Warnings
 from ncpp.fileio import count_lines
-from ncpp.runtime import one_blas_thread
+from ncpp.runtime import Terminated, one_blas_thread, terminate_as_interrupt
 
 
 class FilterProgress:
@@ -75,7 +75,7 @@ def run(path: str, err: TextIO, machine: str | None = None) -> None:
                 shutil.copyfileobj(stream, spool)
             else:
                 if not os.path.isfile(settings.machine):
-                    raise NcppError(f"machine file {settings.machine} (from {settings.origin}) does not exist")
+                    raise NcppError(f"machine file {settings.machine} does not exist", Location(settings.origin))
                 source = ErrorSource.from_machine_file(settings.machine)
                 process(stream, spool, file=path, source=source, tolerance=settings.tolerance, warnings=Warnings(stream=err),
                         progress=progress, offsets=settings.offsets())  # fmt: skip
@@ -88,14 +88,19 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--machine", help="machine file (default: $NCPP_MACHINE, then the ncpp config files)")
     args = parser.parse_args(argv)
     one_blas_thread()  # before `run` imports numpy (runtime.py)
+    terminate_as_interrupt()
     try:
         run(args.program, sys.stderr, args.machine)
     except NcppError as error:
         print(str(error), file=sys.stderr)
         return 2
-    except OSError as error:
-        print(f"ncpp-linuxcnc-filter: {error.filename or ''}: {error.strerror or error}", file=sys.stderr)
+    except OSError as error:  # (a write's has no file name: LinuxCNC reads the standard output)
+        print(f"ncpp-linuxcnc-filter: {error.filename or '<stdout>'}: {error.strerror or error}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:
+        return 130
+    except Terminated:
+        return Terminated.EXIT_STATUS
     return 0
 
 

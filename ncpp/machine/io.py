@@ -83,7 +83,7 @@ import numpy as np
 import tomli_w
 
 from ncpp.errors import Location, NcppError
-from ncpp.fileio import write_text_atomic
+from ncpp.fileio import read_small, write_text_atomic
 from ncpp.machine.chain import SMALL_ANGLE
 from ncpp.machine.components import AXES, COMPONENTS, SQUARENESS, Polynomial, Table, canonical_name
 from ncpp.machine.effects import LARGEST_ERROR, LARGEST_LENGTH_MM, effect_from_dict, is_finite_number
@@ -115,7 +115,7 @@ class _Locator:
             if found is None and "." in section:  # dotted keys inside the parent table
                 parent, key = section.rsplit(".", 1)[0], key or section.rsplit(".", 1)[1]
                 found = self._header(parent)
-            if found is None:
+            if found is None:  # (no line: the table is not written in the file)
                 return Location(self.file, None)
             start = found
         if key is not None:
@@ -124,8 +124,14 @@ class _Locator:
                 if section and i > start and re.match(r"^\s*\[", self.lines[i]):
                     break
                 if key_re.match(self.lines[i]):
-                    return Location(self.file, i + 1)
-        return Location(self.file, start + 1)
+                    return self._at_line(i)
+        return self._at_line(start)
+
+    def _at_line(self, index: int) -> Location:
+        """The first character written on line `index` (0-based) of the file."""
+        line = self.lines[index] if index < len(self.lines) else ""
+        return Location(self.file, index + 1, len(line) - len(line.lstrip()) + 1)
+
 
     def item(self, key: str, nth: int, inner: str | None = None) -> Location | None:
         """Where item `nth` of a top-level array ``key = [...]`` begins, or its key `inner`
@@ -178,24 +184,27 @@ def _array_items(lines: list[str], start: int) -> Iterator[tuple[int, int]]:
             col += 1
 
 
-def _parse_error_location(err: tomllib.TOMLDecodeError, text: str, file: str) -> Location:
+def toml_error_location(err: tomllib.TOMLDecodeError, text: str, file: str) -> Location:
     m = re.search(r"at line (\d+), column (\d+)", str(err))
     if m:
         return Location(file, int(m.group(1)), int(m.group(2)))
-    if "at end of document" in str(err):  # a truncated file: its last line
-        return Location(file, max(1, len(text.splitlines())))
-    return Location(file)
+    lines = text.splitlines()
+    if "at end of document" in str(err):  # a truncated file: the end of its last line
+        return Location(file, max(1, len(lines)), len(lines[-1]) + 1 if lines else 1)
+    return Location(file, 1, 1)
 
 
 def load_machine(path: str | os.PathLike[str]) -> Machine:
     """Read a machine file; NcppError with file:line for anything wrong."""
     file = str(path)
     try:
-        text = Path(path).read_text(encoding="utf-8")
+        data = read_small(path, "a machine file")
     except OSError as err:
         raise NcppError(f"cannot read machine file: {err.strerror}", Location(file)) from err
+    try:
+        text = data.decode("utf-8")
     except UnicodeDecodeError as err:
-        raise _not_utf8(Path(path).read_bytes(), file) from err
+        raise _not_utf8(data, file) from err
     return loads_machine(text, file)
 
 
@@ -212,19 +221,47 @@ def _not_utf8(data: bytes, file: str) -> NcppError:
     return NcppError(f"not UTF-8 text (byte 0x{data[start]:02x}); save the machine file as UTF-8", where)
 
 
+# Arrays and inline tables nested deeper than this are refused before tomllib, which reads them
+# recursively (a machine file nests three: a table's rows of numbers)
+MAX_TOML_NESTING = 32
+
+
+def loads_toml(text: str, file: str) -> dict:
+    """`tomllib.loads`, refusing nesting past MAX_TOML_NESTING at its place."""
+    depth, line, line_start, quote = 0, 1, 0, ""
+    for at, char in enumerate(text):
+        if char == "\n":
+            line, line_start, quote = line + 1, at + 1, ""
+        elif quote:
+            quote = "" if char == quote else quote
+        elif char in "\"'":
+            quote = char
+        elif char == "#":
+            quote = "\n"  # (a comment: to the end of the line)
+        elif char in "[{":
+            depth += 1
+            if depth > MAX_TOML_NESTING:
+                where = Location(file, line, at - line_start + 1)
+                raise NcppError(f"arrays or tables nested deeper than {MAX_TOML_NESTING}", where)
+        elif char in "]}":
+            depth = max(depth - 1, 0)
+    return tomllib.loads(text)
+
+
 def loads_machine(text: str, file: str = "<string>") -> Machine:
     text = text.removeprefix("\ufeff")  # a byte order mark, as some Windows editors write: not TOML
     try:
-        data = tomllib.loads(text)
+        data = loads_toml(text, file)
     except tomllib.TOMLDecodeError as err:
         msg = re.sub(r"\s*\(at (?:line \d+, column \d+|end of document)\)", "", str(err))
-        raise NcppError(f"not valid TOML: {msg}", _parse_error_location(err, text, file)) from err
+        raise NcppError(f"not valid TOML: {msg}", toml_error_location(err, text, file)) from err
     loc = _Locator(text, file)
     return _machine_from_dict(data, loc, default_name=Path(file).stem)
 
 
 def _fail(message: str, where: Location) -> NcppError:
-    return NcppError(message, where)
+    """The error at `where`; at the file's start when what it is about is not written in the file."""
+    return NcppError(message, where if where.line is not None else Location(where.file, 1, 1))
 
 
 def _get_table(data: dict, name: str, loc: _Locator) -> dict:
@@ -457,7 +494,7 @@ def _where_for_machine_error(message: str, loc: _Locator) -> Location:
             return loc.where("offsets", key)
     if "max_correction_mm" in message:
         return loc.where("compensation", "max_correction_mm")
-    return Location(loc.file)
+    return Location(loc.file, 1, 1)
 
 
 def _split_unit(key: str, units: tuple[str, ...]) -> tuple[str, str]:

@@ -38,7 +38,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable, Iterable, Iterator, Sequence
 
-from ncpp.errors import Location, NcppError
+from ncpp.errors import Location, NcppError, printable
 from ncpp.motion.expressions import SUBROUTINE_PARAMETERS, normalise_name, round_half_away
 from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
 from ncpp.program.parser import parse_stream
@@ -347,8 +347,8 @@ class Flow:
     def _from_file(self, name: str) -> list[Block] | None:
         """Subroutine `name` from `name.ngc` in the first folder of the path that has it (as LinuxCNC)."""
         for folder in self.path:
-            path = folder / f"{name}.ngc"
-            if not path.is_file():
+            path = _subroutine_file(folder, name)
+            if path is None or not path.is_file():
                 continue
             lines: list[Block] = []
             with open(path, "rb") as stream:
@@ -359,7 +359,8 @@ class Flow:
                         if control is not None and control.keyword == "endsub" and control.name == name:
                             self.subroutines[name], self.files[name] = lines, str(path)
                             return lines
-            raise NcppError(f"o<{name}> sub ... o<{name}> endsub is not in the file", Location(str(path)))
+            shown = printable(name)
+            raise NcppError(f"o<{shown}> sub ... o<{shown}> endsub is not in the file", Location(str(path), 1, 1))
         return None
 
     def source(self) -> str | None:
@@ -549,7 +550,8 @@ class Flow:
         while True:
             block = self._block(frame, frame.pc)
             if block is None:
-                raise NcppError(f"o{_shown(name)} sub has no o{_shown(name)} endsub", Location(self.file, self._opening_line(frame), None))
+                shown = _shown(name)
+                raise NcppError(f"o{shown} sub has no o{shown} endsub", self._sub_place(frame, opening))
             control = self._control_of(block)
             if control is not None and control.keyword == "sub" and frame.pc != opening:  # (rs274ngc: none in another)
                 raise NcppError("Nested subroutine definition", Location(self.file, block.line, control.item.start + 1))
@@ -559,6 +561,14 @@ class Flow:
             frame.pc += 1
             if control is not None and control.name == name and control.keyword == "endsub":
                 return
+
+    def _sub_place(self, frame: _Frame, opening: int) -> Location:
+        """Where the `sub` statement at `opening` in the frame's text stands (for messages)."""
+        block = self._block(frame, opening)
+        control = None if block is None else self._control_of(block)
+        if control is None:
+            return Location(self.file, self._opening_line(frame), 1)
+        return Location(self.file, block.line, control.item.start + 1)
 
     def _opening_line(self, frame: _Frame) -> int:
         """The line a construct left open at the end of the text started at (for messages)."""
@@ -651,5 +661,14 @@ def oword_name(text: str) -> str:
     return name if label.startswith("<") else str(int(name))
 
 
+def _subroutine_file(folder: Path, name: str) -> Path | None:
+    """The file of subroutine `name` in `folder` as rs274ngc names it: the name joined to the
+    folder as text (`find_ngc_file`: "folder/name.ngc"), so `o</etc/x>` is folder/etc/x.ngc;
+    None for a name that leads out of the folder (`..`), which ncpp does not follow."""
+    path = os.path.normpath(f"{folder}/{name}.ngc")
+    inside = os.path.normpath(folder)
+    return Path(path) if path.startswith(inside.rstrip(os.sep) + os.sep) else None
+
+
 def _shown(name: str) -> str:
-    return name if name.isdigit() else f"<{name}>"
+    return name if name.isdigit() else f"<{printable(name)}>"

@@ -262,9 +262,16 @@ def _div(a: float, b: float) -> float:
     return float(math.trunc(a / b))
 
 
+def _power(a: float, b: float) -> float:
+    """`a ^ b` as a real number: a negative base to a fractional power has none."""
+    if a < 0.0 and b != math.floor(b):
+        raise ValueError("negative number to a non-integer power")
+    return math.pow(a, b)
+
+
 _BINARY: dict[str, Callable[[float, float], float]] = {
     "+": lambda a, b: a + b, "-": lambda a, b: a - b, "*": lambda a, b: a * b, "/": lambda a, b: a / b,
-    "**": lambda a, b: a ** b, "DIV": _div, "MOD": math.fmod,
+    "**": _power, "DIV": _div, "MOD": math.fmod,
     "==": lambda a, b: float(a == b), "<>": lambda a, b: float(a != b), "<": lambda a, b: float(a < b),
     ">": lambda a, b: float(a > b), "<=": lambda a, b: float(a <= b), ">=": lambda a, b: float(a >= b),
     "AND": lambda a, b: float(bool(a) and bool(b)), "OR": lambda a, b: float(bool(a) or bool(b)),
@@ -282,6 +289,9 @@ _FUNCTIONS: dict[str, Callable[..., float]] = {
     "LOG": math.log10, "EXP": math.exp, "NEG": lambda x: -x, "SGN": lambda x: float((x > 0) - (x < 0)),
     "MINVAL": min, "MAXVAL": max,
 }  # fmt: skip
+# Functions of other than one argument (Siemens, Programming Manual Job Planning: ATAN2(y, x),
+# MINVAL(a, b), MAXVAL(a, b))
+_ARITY = {"ATAN2": 2, "MINVAL": 2, "MAXVAL": 2}
 
 
 def evaluate(expr: tuple, lookup: Callable[[str], float]) -> float:
@@ -312,5 +322,11 @@ def evaluate(expr: tuple, lookup: Callable[[str], float]) -> float:
         function = _FUNCTIONS.get(expr[1])
         if function is None:
             raise OutOfScope(f"the function {expr[1]}")
-        return float(function(*(evaluate(arg, lookup) for arg in expr[2:])))
+        wanted, given = _ARITY.get(expr[1], 1), len(expr) - 2
+        if given != wanted:
+            raise ValueError(f"{expr[1]} takes {wanted} argument{'s' * (wanted > 1)}, not {given}")
+        try:
+            return float(function(*(evaluate(arg, lookup) for arg in expr[2:])))
+        except ValueError:  # math's domain error
+            raise ValueError(f"{expr[1]} of a value outside its domain") from None
     raise OutOfScope(f"the expression {kind!r}")

@@ -25,7 +25,8 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Mapping, Sequence
 
-from ncpp.errors import Location, NcppError
+from ncpp.errors import Location, NcppError, quoted
+from ncpp.fileio import read_small
 from ncpp.motion.tools import ToolTable
 
 Vector = tuple[float, float, float]
@@ -146,7 +147,7 @@ def read_var_file(path: str | Path) -> dict[int, float]:
     """`number value` lines; other lines are comments (as rs274ngc reads it)."""
     values: dict[int, float] = {}
     try:
-        text = Path(path).read_text(encoding="latin-1")
+        text = read_small(path, "a parameter file").decode("latin-1")
     except OSError as err:
         raise NcppError(f"cannot read the parameter file: {err.strerror}", Location(str(path))) from None
     for n, line in enumerate(text.splitlines(), 1):
@@ -157,9 +158,9 @@ def read_var_file(path: str | Path) -> dict[int, float]:
         try:
             value = float(fields[1])
         except ValueError:
-            raise NcppError(f"parameter {fields[0]} has no number: {fields[1]!r}", where) from None
+            raise NcppError(f"parameter {fields[0]} has no number: {quoted(fields[1])}", where) from None
         if not math.isfinite(value):
-            raise NcppError(f"parameter {fields[0]} is not a finite number: {fields[1]!r}", where)
+            raise NcppError(f"parameter {fields[0]} is not a finite number: {quoted(fields[1])}", where)
         values[int(fields[0])] = value
     return values
 

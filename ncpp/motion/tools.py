@@ -49,7 +49,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Mapping
 
-from ncpp.errors import Location, NcppError, Warnings
+from ncpp.errors import Location, NcppError, Warnings, quoted
+from ncpp.fileio import read_small
 
 OFFSET_LETTERS = "XYZABCUVW"  # a tool's offsets, in the interpreter's axis order
 _LINEAR = frozenset("XYZUVW")  # the offsets in length units (A B C are degrees)
@@ -75,7 +76,7 @@ class ToolTable:
         """LinuxCNC's tool table or Sinumerik's tool offsets, their lengths in the machine's
         units (`unit_mm` mm each), or Heidenhain's TOOL.T (its units in its first line)."""
         try:
-            text = Path(path).read_text(encoding="latin-1")
+            text = read_small(path, "a tool table").decode("latin-1")
         except OSError as err:
             raise NcppError(f"cannot read the tool table: {err.strerror}", Location(str(path))) from None
         lines = text.splitlines()
@@ -138,7 +139,7 @@ def read_tool_lines(lines: list[str], file: str, unit_mm: float) -> tuple[dict[i
             elif letter in _OTHER_LETTERS:
                 _number(value, where)
             else:
-                raise NcppError(f"unknown tool table word {word.group()!r}", where)
+                raise NcppError(_unknown_word(word.group()), where)
         if number is None:
             if data.strip():
                 raise NcppError("tool table line without a T word", Location(file, n, 1))
@@ -155,16 +156,16 @@ def _number(text: str, where: Location) -> float:
     try:
         value = float(text)
     except ValueError:
-        raise NcppError(f"expected a number, got {text!r}", where) from None
+        raise NcppError(f"expected a number, got {quoted(text, _QUOTED)}", where) from None
     if not math.isfinite(value):
-        raise NcppError(f"expected a finite number, got {text!r}", where)
+        raise NcppError(f"expected a finite number, got {quoted(text, _QUOTED)}", where)
     return value
 
 
 def _integer(text: str, where: Location) -> int:
     value = _number(text, where)
     if value != int(value) or value < 0:
-        raise NcppError(f"a tool number is a whole number, got {text!r}", where)
+        raise NcppError(f"a tool number is a whole number, got {quoted(text, _QUOTED)}", where)
     return int(value)
 
 
@@ -185,7 +186,7 @@ def read_tool_t(lines: list[str], file: str) -> tuple[dict[tuple[float, int], tu
         text, col = _field(line, columns, "T")
         number = decimal("T")
         if number < 0:
-            raise NcppError(f"a tool number is not negative, got {text!r}", Location(file, n, col))
+            raise NcppError(f"a tool number is not negative, got {quoted(text, _QUOTED)}", Location(file, n, col))
         if (number, 1) in tools:
             raise NcppError(f"tool {text} is listed twice", Location(file, n, col))
         tools[number, 1] = ((decimal("L") + decimal("DL")) * unit_mm, 0.0, 0.0)
@@ -243,3 +244,15 @@ def read_to_ini(lines: list[str], file: str, unit_mm: float) -> tuple[dict[tuple
         if parameter in _LENGTH_PARAMETERS:
             edge_lengths[_LENGTH_PARAMETERS[parameter]] += value * unit_mm
     return {key: (a, b, c) for key, (a, b, c) in lengths.items()}, names
+
+
+_QUOTED = 16  # the longest text of a table a message quotes
+_WORD_SHAPED = re.compile(r"[A-Za-z][-+0-9.,]{0,15}")
+
+
+def _unknown_word(text: str) -> str:
+    """The message for a word a tool table does not have, quoting it only when it is shaped
+    as a tool-table word (a letter and a number): another file's text is never echoed."""
+    if _WORD_SHAPED.fullmatch(text):
+        return f"unknown tool table word {text!r}"
+    return "not a tool table word (a letter and a number, as `T1 Z+10`): is this a tool table?"

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from ncpp.errors import Location, NcppError
+from ncpp.errors import NcppError
 from ncpp.instruments.files import PLANES, Measurement, read_measurement
 
 AXIS_INDEX = {"X": 0, "Y": 1, "Z": 2}
@@ -73,7 +73,7 @@ def radial_map(m: Measurement) -> RadialMap:
 
     test = circular_test(m)
     if m.center_mm is None:
-        raise NcppError("a ball-bar file needs center_mm to compensate from it", Location(m.source))
+        raise NcppError("a ball-bar file needs center_mm to compensate from it", m.at())
     centre_um = lsc_centre(test.traces, test.radius_mm)
     grid = np.radians(np.arange(0.0, 360.0, 0.5))
     curves = []
@@ -109,5 +109,5 @@ def map_from_file(path: str) -> RadialMap | AxisMap:
         return axis_map(m)
     raise NcppError(
         f"cannot compensate from a {m.instrument} {m.quantity or ''} file: use a ball-bar, comparator or laser position file",
-        Location(m.source),
+        m.at(),
     )

@@ -183,8 +183,10 @@ class Dialect:
     (WORD / COMMA_WORD become words, PAREN_COMMENT a `(` comment, SEMI_COMMENT
     a `;` comment); none means every block goes through the LALR parser.
     `continuation` is the mark that, ending a line, continues its block on
-    the next line (Heidenhain `~`).  `read_where_run`: a line the grammar cannot
-    read is an error where it runs, not where it stands (rs274ngc reads only the
+    the next line (Heidenhain `~`).  `max_line`: the longest block the dialect's
+    controls read (`max_line_source` says whose rule it is); a longer one is refused
+    before it is scanned, which keeps the time and memory of a line bounded.
+    `read_where_run`: a line the grammar cannot read is an error where it runs, not where it stands (rs274ngc reads only the
     lines it runs: an uncalled subroutine, an untaken branch, the text after M2
     may hold anything): it becomes a block of one `unreadable` statement.
     """
@@ -195,6 +197,8 @@ class Dialect:
     fast_terminals: tuple[str, ...] = ()
     continuation: str | None = None
     read_where_run: bool = False
+    max_line: int = 256
+    max_line_source: str = "rs274ngc (LinuxCNC) holds a line in LINELEN, 256 characters"
 
 
 def dialect_syntax(dialect: "str | Dialect") -> Dialect:
@@ -228,6 +232,31 @@ def _refuse_cr_line_ends(raw: str, line: int, file: str) -> None:
         raise NcppError("the program's lines end in a carriage return (CR) alone: convert them to LF or CR LF", Location(file, line, bare.start() + 1))
 
 
+def _refuse_long(raw: str, dialect: Dialect, line: int, file: str) -> None:
+    limit = dialect.max_line
+    raise NcppError(f"block too long: {len(raw)} characters, where a {dialect.name} block may have {limit} "
+                    f"({dialect.max_line_source})", Location(file, line, limit + 1))
+
+
+# Brackets nested deeper than this are refused in every dialect: rs274ngc reads 120 in a line of
+# its 256 characters, and a bound keeps the parser's and the evaluator's recursion short.
+MAX_NESTING = 128
+_BRACKETS = {"[": 1, "(": 1, "]": -1, ")": -1}
+
+
+def _refuse_deep(block: Block, file: str) -> None:
+    """Refuse brackets nested deeper than MAX_NESTING in a block's expressions (not its comments)."""
+    for item in block.items:
+        if type(item) is Word or type(item) is Comment:
+            continue
+        depth = 0
+        for offset, char in enumerate(block.raw[item.start : item.end]):
+            depth += _BRACKETS.get(char, 0)
+            if depth > MAX_NESTING:
+                where = Location(file, block.line, item.start + offset + 1)
+                raise NcppError(f"brackets nested deeper than {MAX_NESTING}", where)
+
+
 _TEXT_AFTER_CR = re.compile(r"\r[ \t\f\v\x1a\r]*[^ \t\f\v\x1a\r\n]")
 
 
@@ -249,6 +278,8 @@ class LineParser:
         self._trees = _TreeLayouts.of(self._lark)
 
     def parse(self, raw: str, eol: str = "", line: int = 0, file: str = "<stdin>") -> Block:
+        if len(raw) > self.dialect.max_line:
+            _refuse_long(raw, self.dialect, line, file)
         plain = self._scan_plain(raw)
         if plain is None:
             block = Block(raw, eol, self._read_lalr(raw, line, file), line)
@@ -259,6 +290,8 @@ class LineParser:
             _refuse_infinite(block, file)
         if "\r" in raw:  # (a CR before the LF is the line's end, not in `raw`)
             _refuse_cr_line_ends(raw, line, file)
+        if plain is None and raw.count("[") + raw.count("(") > MAX_NESTING:  # (else it cannot nest deeper)
+            _refuse_deep(block, file)
         return block
 
     def _scan_plain(self, raw: str) -> tuple | None:
@@ -299,7 +332,10 @@ class LineParser:
     def _scan_items(self, raw: str) -> tuple[tuple[AnyItem, ...], str | None] | None:
         """`_scan_plain` by the scanner."""
         scanner = self._items
-        if scanner is None:
+        if scanner is None or raw.rfind("(") > raw.rfind(")"):
+            # (an unclosed comment, for the LALR parser to report: scanning would try each of its
+            # `(` to the end of the line, time quadratic in its length; each `(` the scanner tries
+            # now ends at the next `)`, which the comment takes)
             return None
         items: list[AnyItem] = []
         append = items.append
@@ -368,7 +404,7 @@ class LineParser:
                 raise NcppError(BOM_MESSAGE, Location(file, line, 1)) from None
             raise NcppError(_describe(err, raw), Location(file, line, col)) from None
         except RecursionError:  # the builder walks the tree recursively: brackets hundreds deep
-            raise NcppError("expression nested too deeply", Location(file, line)) from None
+            raise NcppError("expression nested too deeply", Location(file, line, 1)) from None
         if layout is not None:
             trees.learn(layout, _Cut.of(raw, items, trees.layout) or _Replay(tree, self._builder))
         return items

@@ -16,8 +16,12 @@
 #                         G5x=; repeat it for the Job's other fixtures G55...)
 #   --var-file FILE       LinuxCNC parameter file holding the zeros (--var-units inch)
 #   --tool-table FILE     LinuxCNC tool table: the lengths the program's G43 applies
-#   --ncpp PATH           the ncpp program (default: $NCPP, then `ncpp` on PATH)
 # Any other argument goes to linuxcnc_post (e.g. --no-comments, --precision 4).
+#
+# The ncpp program is found from the user's side only, never from the Job's arguments
+# (they are saved in the .FCStd, and a shared document must not choose a program to run):
+# $NCPP, else the FreeCAD parameter BaseApp/Preferences/Mod/ncpp "Program" (Tools >
+# Edit parameters), else `ncpp` on PATH.
 #
 # FreeCAD 0.20/0.21 call the module function export(); FreeCAD 1.x looks for
 # the class named after the file (`Ncpp`) and calls its export().
@@ -41,7 +45,7 @@ parser.add_argument("--work-offset", action="append", default=[], help="[G5x=]X,
 parser.add_argument("--var-file", help="LinuxCNC parameter file holding the zeros")
 parser.add_argument("--tool-table", help="LinuxCNC tool table: the lengths the program's G43 applies")
 parser.add_argument("--var-units", help="units of --var-file and --tool-table: mm or inch")
-parser.add_argument("--ncpp", help="the ncpp program (default: $NCPP, then ncpp on PATH)")
+parser.add_argument("--ncpp", help="refused: ncpp is found from $NCPP, the FreeCAD parameter or PATH")
 
 TOOLTIP_ARGS = parser.format_help() + "\nOther arguments are passed to linuxcnc_post.\n"
 
@@ -60,10 +64,26 @@ def _linuxcnc_post():
     return module
 
 
+PARAMETERS = "User parameter:BaseApp/Preferences/Mod/ncpp"
+
+
+def _preferred_program():
+    """The ncpp program the user set in FreeCAD's parameters ("" when none, or outside FreeCAD)."""
+    try:
+        import FreeCAD
+    except ImportError:
+        return ""
+    return FreeCAD.ParamGet(PARAMETERS).GetString("Program", "")
+
+
 def _ncpp_command(options):
-    found = options.ncpp or os.environ.get("NCPP") or shutil.which("ncpp")
+    if options.ncpp:
+        raise RuntimeError("ncpp_post: --ncpp in the Job's arguments is refused (a shared document would choose the "
+                           f"program to run): set NCPP, or the parameter Program in {PARAMETERS}")
+    found = os.environ.get("NCPP") or _preferred_program() or shutil.which("ncpp")
     if not found:
-        raise RuntimeError("ncpp_post: the ncpp program was not found; give --ncpp PATH or set NCPP")
+        raise RuntimeError(f"ncpp_post: the ncpp program was not found; set NCPP, or Program in {PARAMETERS}, "
+                           "or put ncpp on PATH")
     return shlex.split(found) if " " in found and not os.path.exists(found) else [found]
 
 

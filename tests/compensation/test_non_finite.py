@@ -33,11 +33,14 @@ def _motion(text: str, file: str) -> list:
 @pytest.mark.parametrize(
     "text, file, where, message",
     [
-        (f"G21 G90\nG1 X{TOO_LONG} F100\nM2\n", "p.ngc", "p.ngc:2:4", "number out of range"),
+        # (an ISO line cannot hold such a number: rs274 refuses it as "Command too long" too)
+        (f"G21 G90\nG1 X{TOO_LONG} F100\nM2\n", "p.ngc", "p.ngc:2:257", "block too long"),
+        (f"N1 G1 X{TOO_LONG} F100\nM30\n", "p.mpf", "p.mpf:1:7", "number out of range"),
         ("G21 G90\nG1 X[EXP[1000]] F100\nM2\n", "p.ngc", "p.ngc:2:4", "Number out of range"),
         ("G21 G90\nG1 X[10**400] F100\nM2\n", "p.ngc", "p.ngc:2:4", "Number out of range"),
-        ("G21 G90\nG1 X[1" + "0" * 300 + "*1" + "0" * 300 + "] F100\nM2\n", "p.ngc", "p.ngc:2:4", "Number out of range"),
-        ("G21 G90\nG1 X" + "[" * 800 + "1" + "]" * 800 + " F100\nM2\n", "p.ngc", "p.ngc:2", "nested too deeply"),
+        ("G21 G90\nG1 X[1" + "0" * 200 + "*1" + "0" * 200 + "] F100\nM2\n", "p.ngc", "p.ngc:2:257", "block too long"),
+        ("G21 G90\nG1 X" + "[" * 800 + "1" + "]" * 800 + " F100\nM2\n", "p.ngc", "p.ngc:2:257", "block too long"),
+        ("N1 R1=" + "(" * 200 + "1" + ")" * 200 + "\nM30\n", "p.mpf", "p.mpf:1:135", "nested deeper than 128"),
         ("BEGIN PGM X MM\nQ1 = 10 ^ 400\nL X+Q1 Y+0 R0 FMAX\nEND PGM X MM\n", "p.h", "p.h:2:1", "number out of range"),
         (f"BEGIN PGM X MM\nL X+{TOO_LONG} Y+0 R0 FMAX\nEND PGM X MM\n", "p.h", "p.h:2:3", "number out of range"),
     ],
@@ -49,14 +52,14 @@ def test_a_number_out_of_range_is_refused_where_it_stands(text, file, where, mes
 
 
 def test_a_long_line_of_ordinary_numbers_is_read():
-    line = "G1 X1.5 Y2.5 F100 " + "(" + "x" * 400 + ")"
-    assert len(_motion(f"G21 G90\n{line}\nM2\n", "p.ngc")) >= 1
+    line = "N1 G1 X1.5 Y2.5 F100 ;" + "x" * 400  # (a Sinumerik block holds 512 characters)
+    assert len(_motion(f"{line}\nM30\n", "p.mpf")) >= 1
 
 
 def test_a_point_that_is_not_a_number_is_refused_by_the_compensation_itself():
     ctx = make_context(ErrorSource.from_machine_file(str(MACHINE)), 0.001, QUIET, "p.ngc")
     points = np.array([[10.0, 20.0, 0.0], [np.nan, 20.0, 0.0]])
-    with pytest.raises(NcppError, match=r"p\.ngc:7: the program point is not a finite number"):
+    with pytest.raises(NcppError, match=r"p\.ngc:7:1: the program point is not a finite number"):
         compensate(points, np.tile([400.0, 350.0, 300.0], (2, 1)), np.ones(2), np.array([6, 7]), ctx)
 
 
@@ -99,7 +102,7 @@ def test_a_tool_length_that_is_not_a_number_is_refused(tmp_path, length):
 
 def test_a_cl_record_with_a_number_out_of_range_is_refused():
     records = read_cldata(io.StringIO(f"UNITS / MM\nFEDRAT / 100\nGOTO / {TOO_LONG}, 0, 0\nFINI\n"), "p.cl")
-    with pytest.raises(NcppError, match=r"p\.cl:3: number out of range in this CL record"):
+    with pytest.raises(NcppError, match=r"p\.cl:3:8: number out of range in this CL record"):
         list(records)
 
 

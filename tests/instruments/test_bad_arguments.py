@@ -42,7 +42,7 @@ def first_rows(tmp_path: Path, sample: str, rows: int) -> str:
 def test_analyze_profile_of_one_target(sample, tmp_path, capsys):
     path = first_rows(tmp_path, sample, 1)
     err = refused(["analyze", path], capsys)
-    assert f"{path}: " in err and "needs at least two" in err
+    assert f"{path}:1:1: " in err and "needs at least two" in err
 
 
 @pytest.mark.parametrize("width", ["0", "nan", "-3", "1e9"])
@@ -146,12 +146,12 @@ def test_fit_refuses_a_smoothing_that_diverges(tmp_path, capsys):
 def test_ballbar_of_too_few_points(rows, tmp_path, capsys):
     path = first_rows(tmp_path, "ballbar_XY_R150.csv", rows)
     for command in (["fit", path, "-o", str(tmp_path / "m.toml")], ["diagnose", "--machine", MACHINE, path]):
-        assert f"{path}: a circular test needs at least three points per direction" in refused(command, capsys)
+        assert f"{path}:1:1: a circular test needs at least three points per direction" in refused(command, capsys)
 
 
 def test_fit_table_of_one_target(tmp_path, capsys):
     path = first_rows(tmp_path, "laser_X_position.csv", 1)
-    assert f"{path}: a table needs readings at two or more targets" in refused(["fit", path, "-o", str(tmp_path / "m.toml")], capsys)
+    assert f"{path}:1:1: a table needs readings at two or more targets" in refused(["fit", path, "-o", str(tmp_path / "m.toml")], capsys)
 
 
 def test_diagnose_a_circle_of_less_than_a_micron(tmp_path, capsys):

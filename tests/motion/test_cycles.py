@@ -186,7 +186,7 @@ def test_warnings_of_other_texts_are_printed_whatever_one_text_repeats():
     warnings.finish()
     said = stream.getvalue().splitlines()
     assert warnings.count == 21 and len(said) == 7
-    assert said[5] == "t.ngc:21: warning: once" and said[6] == "t.ngc:20: warning: again (15 not printed, from line 6 to this one)"
+    assert said[5] == "t.ngc:21:1: warning: once" and said[6] == "t.ngc:20:1: warning: again (15 not printed, from line 6 to this one)"
     with pytest.raises(NcppError, match="refused in strict mode"):
         Warnings(strict=True, stream=stream).warn("again", Location("t.ngc", 1))
 

@@ -164,7 +164,7 @@ def test_a_loop_that_does_not_end_ends_interpretation(monkeypatch):
     monkeypatch.setattr(flow, "MAX_RERUN", 1000)
     warned = io.StringIO()
     events = _events(HEAD + "o1 while [1]\n G0 X1\n G0 X2\no1 endwhile\nG0 Y5\n", warnings=Warnings(stream=warned))
-    assert "t.ngc:6: warning: a loop that does not end (1,000 lines run again)" in warned.getvalue()
+    assert "t.ngc:6:1: warning: a loop that does not end (1,000 lines run again)" in warned.getvalue()
     assert events[-1].block.text == "G0 Y5\n" and type(events[-1]) is Pass
 
 

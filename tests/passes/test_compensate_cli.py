@@ -149,4 +149,4 @@ def test_simulate_refuses_motion_outside_the_travel_and_paths_past_its_sample_bu
     program.write_text("G21 G90\nG0 X10 Y10\nG0 X9999999999999 Y10\n")
     proc = ncpp("simulate", "--machine", str(MACHINE), "--work-offset", "400,350,370", str(program))
     assert proc.returncode == 2 and b"Traceback" not in proc.stderr
-    assert f"{program}:3: the path needs more than 20,000,000 samples".encode() in proc.stderr
+    assert f"{program}:3:1: the path needs more than 20,000,000 samples".encode() in proc.stderr

@@ -41,9 +41,10 @@ def posted(tmp_path_factory):
     env.update(
         HOME=str(home),
         NCPP_OUT=str(tmp / "compensated.ngc"),
-        NCPP_POST_ARGS=f"--ncpp {ncpp} --machine {MACHINE} --work-offset 400,350,300 --precision 4 --no-comments",
+        NCPP=str(ncpp),  # (the user's side: never the Job's arguments)
+        NCPP_POST_ARGS=f"--machine {MACHINE} --work-offset 400,350,300 --precision 4 --no-comments",
         NCPP_PLAIN_OUT=str(tmp / "plain.ngc"),
-        NCPP_PLAIN_ARGS=f"--ncpp {ncpp} --precision 4",
+        NCPP_PLAIN_ARGS="--precision 4",
     )
     proc = subprocess.run([FREECADCMD, str(ROOT / "tests/shop/freecad/post_job.py")], capture_output=True, text=True, errors="replace", cwd=tmp, env=env, timeout=600)
     if "NCPP_POSTED" not in proc.stdout:
@@ -86,7 +87,7 @@ def test_freecad_1_uses_the_class_and_the_legacy_script_api_agrees(posted):
     assert output.count("NCPP_LEGACY_SAME True") == 2
 
 
-def test_the_post_passes_every_fixture_zero_to_ncpp(tmp_path):
+def test_the_post_passes_every_fixture_zero_to_ncpp(tmp_path, monkeypatch):
     """A Job with two fixtures: `--work-offset` repeated (and `--var-file`, `--tool-table`)
     reach ncpp as given (the plugin needs no FreeCAD for this part)."""
     import importlib.util
@@ -105,11 +106,13 @@ def test_the_post_passes_every_fixture_zero_to_ncpp(tmp_path):
     ncpp = tmp_path / "ncpp"
     ncpp.write_text(f"#!/bin/sh\nPYTHONPATH={ROOT} exec {sys.executable} -m ncpp \"$@\"\n")
     ncpp.chmod(0o755)
+    monkeypatch.setenv("NCPP", str(ncpp))
     program = "G21 G90 G54\nG0 X10 Y10 Z5\nG1 Z-1 F100\nG55\nG1 X20 Y20\nM2\n"
-    both = f"--ncpp {ncpp} --machine {MACHINE} --work-offset 250,300,300 --work-offset G55=550,400,250"
+    both = f"--machine {MACHINE} --work-offset 250,300,300 --work-offset G55=550,400,250"
     text = plugin.compensate_text(program, both)
     assert "G55" in text and text.startswith("(ncpp compensated")
-    only_g54 = plugin.compensate_text(program, f"--ncpp {ncpp} --machine {MACHINE} --work-offset 250,300,300")
+    only_g54 = plugin.compensate_text(program, f"--machine {MACHINE} --work-offset 250,300,300")
     g55_part = lambda text: text[text.index("G55"):]  # noqa: E731
     assert g55_part(text) != g55_part(only_g54)  # compensated where G55 really is
     assert text[: text.index("G55")] == only_g54[: only_g54.index("G55")]
+

@@ -18,6 +18,9 @@ from ncpp.program.parser import Dialect, LineParser, _ItemBuilder
 
 DIALECTS = ("iso", "heidenhain", "sinumerik")
 SNIFF_BYTES = 4096
+# The most the detection reads: the sniffed bytes and the rest of their last line, cut short
+# (a line of megabytes would take the patterns minutes)
+_SNIFF_MOST = 2 * SNIFF_BYTES
 
 ISO = Dialect("iso", "iso", _ItemBuilder, fast_terminals=LineParser.FAST_TERMINALS, read_where_run=True)
 # File name endings that name a dialect when the content does not tell.
@@ -130,12 +133,13 @@ def sniff(stream: Iterable[bytes], name: str | None = None, dialect: str | None 
             if size >= SNIFF_BYTES:
                 break
         head = b"".join(head_lines)
-        return detect(head, name), chain(head_lines, lines)
+        return detect(head[:_SNIFF_MOST], name), chain(head_lines, lines)
     head = read(SNIFF_BYTES)
     head_lines = list(io.BytesIO(head))
     if head_lines and not head_lines[-1].endswith(b"\n"):
         head_lines[-1] += stream.readline()  # type: ignore[union-attr]
-    return detect(b"".join(head_lines), name), chain(head_lines, stream)  # (in C: no generator's step per line)
+    sniffed = b"".join(head_lines)[:_SNIFF_MOST]
+    return detect(sniffed, name), chain(head_lines, stream)  # (in C: no generator's step per line)
 
 
 def parse_program(stream: BinaryIO, file: str = "<stdin>", dialect: str | None = None):

@@ -213,7 +213,12 @@ class HeidenhainBuilder(Transformer):
     sum = product = power = _binary
 
 
-HEIDENHAIN = Dialect("heidenhain", "heidenhain", HeidenhainBuilder, fast_terminals=(), continuation="~")
+# The TNC manuals give no block length: ncpp's bound is a block of many `~`-continued lines
+# (a cycle definition of one Q parameter a line) with room to spare.
+HEIDENHAIN = Dialect(
+    "heidenhain", "heidenhain", HeidenhainBuilder, fast_terminals=(), continuation="~", max_line=4096,
+    max_line_source="ncpp's bound for Klartext, whose manuals state none",
+)
 
 
 # ---- writer ------------------------------------------------------------------------------

@@ -53,6 +53,9 @@ _MAX_LAYOUTS = 10000  # layouts remembered (comments can make every layout new)
 _MAX_UNITS = 64  # sets of number styles remembered with their compiled lines (a program uses a few)
 
 
+_LONG_GROUP = 1024  # events of one block past which the writer asks whether it needs them all
+
+
 class IsoWriter:
     """Stateful writer; feed it the whole event stream once, in order."""
 
@@ -95,13 +98,17 @@ class IsoWriter:
         group: list[Event] = []
         block = None
         write_group = self._write_group
+        control = False  # the group is a control line's, whose writing reads only its first event
         for event in events:
             if event.block is block:
-                group.append(event)
+                if not control:
+                    group.append(event)
+                    # (a loop's end or a call owns every move it runs, millions for a long loop: not kept)
+                    control = len(group) == _LONG_GROUP and self._facts(block).flow
                 continue
             if group:
                 yield from write_group(group)
-            block, group = event.block, [event]
+            block, group, control = event.block, [event], False
         if group:
             yield from write_group(group)
 

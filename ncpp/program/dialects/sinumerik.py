@@ -205,7 +205,10 @@ class SinumerikBuilder(Transformer):
     compare = concat = lor = lxor = land = bor = bxor = band = sum = product = _binary
 
 
-SINUMERIK = Dialect("sinumerik", "sinumerik", SinumerikBuilder, fast_terminals=("WORD", "SEMI_COMMENT"))
+SINUMERIK = Dialect(
+    "sinumerik", "sinumerik", SinumerikBuilder, fast_terminals=("WORD", "SEMI_COMMENT"), max_line=512,
+    max_line_source="SINUMERIK 840D sl Programming Manual Fundamentals, block length: 512 characters",
+)
 
 
 # ---- writer ------------------------------------------------------------------------------
