@@ -324,7 +324,8 @@ def process(
         writer = writer_class()
         keep_freed_memory()  # numpy's temporaries reuse the heap, not fresh pages (runtime.py)
         ctx = make_context(source, tolerance, warnings, file)
-        lines = with_header(writer.write(run_passes(events, ctx, PASSES)), header_text(source, tolerance), writer)
+        written = writer.write(run_passes(events, ctx, PASSES))
+        lines = with_header(written, header_text(source, tolerance), writer)
     lines = iter(lines)
     with _rare_collections():
         while batch := list(islice(lines, 4096)):  # written in batches: one encode and write per 4096 lines
