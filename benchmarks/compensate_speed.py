@@ -32,7 +32,12 @@ MACHINE = ROOT / "samples/machines/hr5b.toml"
 TOLERANCE = 0.001
 PERFORMANCE_TABLE = HERE / "out" / "performance.md"
 PROGRAMS = 4  # generated programs compensated across processes
-FLOORS = {"one process / pygcode": 0.5, "passthrough / pygcode": 2.0, "--jobs 2 / --jobs 1": 1.5, "peak RSS growth": 1.1}
+FLOORS = {
+    "one process / pygcode": 0.5,
+    "passthrough / pygcode": 2.0,
+    "--jobs 2 / --jobs 1": 1.5,
+    "peak RSS growth": 1.1,
+}
 
 
 def work_offset(path: Path) -> tuple[float, float, float]:
@@ -59,9 +64,17 @@ def ncpp_process_rate(path: Path, offset: tuple[float, float, float] | None) -> 
     offsets = None if offset is None else WorkOffsets.at(offset)
     with open(os.devnull, "wb") as sink, open(path, "rb") as stream:
         cpu, start = time.process_time(), time.perf_counter()
-        stats = process(stream, sink, file=str(path), source=source, tolerance=TOLERANCE, warnings=QUIET, offsets=offsets)
+        stats = process(
+            stream, sink, file=str(path), source=source, tolerance=TOLERANCE, warnings=QUIET, offsets=offsets
+        )
         seconds, cpu = time.perf_counter() - start, time.process_time() - cpu
-    return {"lines": stats.lines_in, "lines_out": stats.lines_out, "seconds": seconds, "lines_per_s": stats.lines_in / seconds, "cpu_s": cpu}
+    return {
+        "lines": stats.lines_in,
+        "lines_out": stats.lines_out,
+        "seconds": seconds,
+        "lines_per_s": stats.lines_in / seconds,
+        "cpu_s": cpu,
+    }
 
 
 def pygcode_rate(path: Path) -> dict[str, Any]:
@@ -91,7 +104,9 @@ def in_fresh_process(name: str, *args: Any) -> dict[str, Any]:
 
     payload = pickle.dumps(([str(HERE), str(ROOT), *sys.path], name, args))
     env = one_blas_thread(dict(os.environ))  # as the `ncpp` command starts numpy
-    done = subprocess.run([sys.executable, "-c", _FRESH], input=payload, capture_output=True, check=False, env=env)
+    done = subprocess.run(
+        [sys.executable, "-c", _FRESH], input=payload, capture_output=True, check=False, env=env
+    )
     if done.returncode != 0:
         raise RuntimeError(f"{name} failed in its process: {done.stderr.decode(errors='replace')[-2000:]}")
     return pickle.loads(done.stdout)
@@ -100,7 +115,9 @@ def in_fresh_process(name: str, *args: Any) -> dict[str, Any]:
 REPEATS = 3  # runs per tool; the fastest counts (the same for every tool: a shared machine's timing is noisy)
 
 
-def fastest(runs: dict[str, Callable[[], dict[str, Any]]], repeats: int = REPEATS) -> dict[str, dict[str, Any]]:
+def fastest(
+    runs: dict[str, Callable[[], dict[str, Any]]], repeats: int = REPEATS
+) -> dict[str, dict[str, Any]]:
     """Per tool, the run with the fewest seconds of `repeats` runs, with how many were made
     and each round's seconds.  The tools take turns (round robin): a shared machine's speed
     drifts over minutes, and a tool whose runs all fell in a slow spell would be judged by it."""
@@ -108,8 +125,14 @@ def fastest(runs: dict[str, Callable[[], dict[str, Any]]], repeats: int = REPEAT
     for _ in range(repeats):
         for name, run in runs.items():
             results[name].append(run())
-    return {name: {**min(done, key=lambda result: result["seconds"]), "runs": repeats, "all_seconds": [r["seconds"] for r in done]}
-            for name, done in results.items()}  # fmt: skip
+    return {
+        name: {
+            **min(done, key=lambda result: result["seconds"]),
+            "runs": repeats,
+            "all_seconds": [r["seconds"] for r in done],
+        }
+        for name, done in results.items()
+    }
 
 
 def paired_ratios(best: dict[str, dict[str, Any]], tool: str, baseline: str) -> list[float]:
@@ -120,10 +143,14 @@ def paired_ratios(best: dict[str, dict[str, Any]], tool: str, baseline: str) -> 
 
 def verdict(ratio: float, rounds: list[float], floor: float) -> str:
     """Met when the fastest runs' ratio and every round's reach the floor."""
-    return f"per round {', '.join(f'{r:.2f}' for r in rounds)}; floor {floor:.2f}x: " + ("met" if ratio >= floor and min(rounds) >= floor else "SHORT")
+    return f"per round {', '.join(f'{r:.2f}' for r in rounds)}; floor {floor:.2f}x: " + (
+        "met" if ratio >= floor and min(rounds) >= floor else "SHORT"
+    )
 
 
-def stage_seconds(path: Path, offset: tuple[float, float, float], lines: int = 100_000, repeats: int = 2) -> dict[str, float]:
+def stage_seconds(
+    path: Path, offset: tuple[float, float, float], lines: int = 100_000, repeats: int = 2
+) -> dict[str, float]:
     """CPU seconds of each stage of compensation alone on the program's first `lines` lines:
     where the time goes.  Each stage reads the previous stage's output from a list and runs
     `repeats` times; the fastest run counts; the collector is off while a stage runs."""
@@ -147,8 +174,17 @@ def stage_seconds(path: Path, offset: tuple[float, float, float], lines: int = 1
     interpret, writer = dialect_tools(parse_program(io.BytesIO(head[:4096]), str(path), None)[0])
     stages: list[tuple[str, Callable[[list], Iterable]]] = [
         ("parse", lambda _: parse()),
-        ("interpret", lambda blocks: interpret(iter(blocks), file=str(path), warnings=QUIET, offsets=offsets)),
-        *((step.__name__, lambda events, step=step: step(events, make_context(source, TOLERANCE, QUIET, str(path)))) for step in PASSES),
+        (
+            "interpret",
+            lambda blocks: interpret(iter(blocks), file=str(path), warnings=QUIET, offsets=offsets),
+        ),
+        *(
+            (
+                step.__name__,
+                lambda events, step=step: step(events, make_context(source, TOLERANCE, QUIET, str(path))),
+            )
+            for step in PASSES
+        ),
         ("writer", lambda events: writer().write(events)),
     ]
     seconds: dict[str, float] = {}
@@ -168,14 +204,29 @@ def stage_seconds(path: Path, offset: tuple[float, float, float], lines: int = 1
     return seconds
 
 
-def files_rate(paths: list[Path], offset: tuple[float, float, float], jobs: int, folder: Path) -> dict[str, Any]:
+def files_rate(
+    paths: list[Path], offset: tuple[float, float, float], jobs: int, folder: Path
+) -> dict[str, Any]:
     """Wall time of `ncpp compensate --jobs N -o folder PATHS...` (a fresh command: its
     processes' start and imports count, as a shop's run pays them)."""
     from ncpp.runtime import one_blas_thread
 
     shutil.rmtree(folder, ignore_errors=True)
-    command = [sys.executable, "-m", "ncpp", "compensate", "--machine", str(MACHINE), "--work-offset", ",".join(map(str, offset)),
-               "--jobs", str(jobs), "-o", str(folder), *map(str, paths)]  # fmt: skip
+    command = [
+        sys.executable,
+        "-m",
+        "ncpp",
+        "compensate",
+        "--machine",
+        str(MACHINE),
+        "--work-offset",
+        ",".join(map(str, offset)),
+        "--jobs",
+        str(jobs),
+        "-o",
+        str(folder),
+        *map(str, paths),
+    ]
     env = one_blas_thread({**os.environ, "PYTHONPATH": str(ROOT)})
     start = time.perf_counter()
     done = subprocess.run(command, capture_output=True, text=True, env=env, check=False, cwd=folder.parent)
@@ -193,7 +244,10 @@ def compensate_rss(path: Path, offset: tuple[float, float, float]) -> dict[str, 
     (a child's ru_maxrss would inherit this big benchmark process's own)."""
     import run as bench
 
-    return bench.peak_rss(path, ["compensate", "--machine", str(MACHINE), "--work-offset", ",".join(map(str, offset)), str(path)])
+    return bench.peak_rss(
+        path,
+        ["compensate", "--machine", str(MACHINE), "--work-offset", ",".join(map(str, offset)), str(path)],
+    )
 
 
 def compensate_speed(ctx):
@@ -202,76 +256,169 @@ def compensate_speed(ctx):
 
     load_before = os.getloadavg()
     lines_generated = 250_000 if ctx.quick else 1_000_000
-    programs = ctx.programs or {"stellabee1.ngc": bench.STELLABEE, f"generated {lines_generated:,} lines": ctx.generated(lines_generated)}
+    programs = ctx.programs or {
+        "stellabee1.ngc": bench.STELLABEE,
+        f"generated {lines_generated:,} lines": ctx.generated(lines_generated),
+    }
     rows, data, table = [], {}, []
     for label, path in programs.items():
         offset = work_offset(path)
         lines = bench.count_lines(path)
         # each round: pygcode between the two ncpp runs it is compared with, seconds apart
-        best = fastest({
-            "passthrough": lambda: in_fresh_process("ncpp_process_rate", path, None),
-            "pygcode": lambda: in_fresh_process("pygcode_rate", path),
-            "compensate": lambda: in_fresh_process("ncpp_process_rate", path, offset),
-        })  # fmt: skip
+        best = fastest(
+            {
+                "passthrough": lambda: in_fresh_process("ncpp_process_rate", path, None),
+                "pygcode": lambda: in_fresh_process("pygcode_rate", path),
+                "compensate": lambda: in_fresh_process("ncpp_process_rate", path, offset),
+            }
+        )
         passthrough, compensated, pyg = best["passthrough"], best["compensate"], best["pygcode"]
         rs = bench.rs274_rate(path, lines)
-        ratios = {"one process / pygcode": ("compensate", compensated), "passthrough / pygcode": ("passthrough", passthrough)}
+        ratios = {
+            "one process / pygcode": ("compensate", compensated),
+            "passthrough / pygcode": ("passthrough", passthrough),
+        }
         stages = stage_seconds(path, offset)
-        data[label] = {"work_offset_mm": offset, "passthrough": passthrough, "compensate": compensated, "pygcode": pyg, "rs274": rs,
-                       "stage_cpu_seconds": stages}  # fmt: skip
+        data[label] = {
+            "work_offset_mm": offset,
+            "passthrough": passthrough,
+            "compensate": compensated,
+            "pygcode": pyg,
+            "rs274": rs,
+            "stage_cpu_seconds": stages,
+        }
         growth = compensated["lines_out"] / max(compensated["lines"], 1)
         rows += [
             [label, "ncpp passthrough", f"{passthrough['lines_per_s']:,.0f}", ""],
-            [label, "ncpp compensate 1 µm (HR5B), one process", f"{compensated['lines_per_s']:,.0f}",
-             f"lines out/in {growth:.2f}; CPU {1e6 * compensated['cpu_s'] / max(lines, 1):.0f} µs per line in"],
+            [
+                label,
+                "ncpp compensate 1 µm (HR5B), one process",
+                f"{compensated['lines_per_s']:,.0f}",
+                f"lines out/in {growth:.2f}; "
+                f"CPU {1e6 * compensated['cpu_s'] / max(lines, 1):.0f} µs per line in",
+            ],
             [label, "pygcode Line()", f"{pyg['lines_per_s']:,.0f}", ""],
-            [label, "rs274 (process)", f"{rs['lines_per_s']:,.0f}", "completed" if rs["completed"] else "STOPPED"],
-        ]  # fmt: skip
+            [
+                label,
+                "rs274 (process)",
+                f"{rs['lines_per_s']:,.0f}",
+                "completed" if rs["completed"] else "STOPPED",
+            ],
+        ]
         for measure, (tool, result) in ratios.items():
             ratio, rounds = result["lines_per_s"] / pyg["lines_per_s"], paired_ratios(best, tool, "pygcode")
             judged = verdict(ratio, rounds, FLOORS[measure])
             data[label][measure] = {"ratio": ratio, "rounds": rounds}
             rows.append([label, f"ratio {measure}", f"{ratio:.2f}x", judged])
-            table.append([measure, label, f"{ratio:.2f}× (ncpp {result['lines_per_s']:,.0f} lines/s, pygcode {pyg['lines_per_s']:,.0f}; "
-                          f"rounds {min(rounds):.2f}-{max(rounds):.2f}×)", f"≥ {FLOORS[measure]:g}×", judged.rsplit(": ", 1)[1]])  # fmt: skip
-        rows.append([label, "compensate CPU s by stage", f"{sum(stages.values()):.2f} s",
-                     f"each alone, first {min(lines, 100_000):,} lines: " + ", ".join(f"{k} {v:.2f}" for k, v in stages.items())])  # fmt: skip
+            table.append(
+                [
+                    measure,
+                    label,
+                    f"{ratio:.2f}× (ncpp {result['lines_per_s']:,.0f} lines/s, "
+                    f"pygcode {pyg['lines_per_s']:,.0f}; "
+                    f"rounds {min(rounds):.2f}-{max(rounds):.2f}×)",
+                    f"≥ {FLOORS[measure]:g}×",
+                    judged.rsplit(": ", 1)[1],
+                ]
+            )
+        rows.append(
+            [
+                label,
+                "compensate CPU s by stage",
+                f"{sum(stages.values()):.2f} s",
+                f"each alone, first {min(lines, 100_000):,} lines: "
+                + ", ".join(f"{k} {v:.2f}" for k, v in stages.items()),
+            ]
+        )
 
     each = 50_000 if ctx.quick else 250_000
     paths = [generate(ctx.workdir / f"program-{seed}.ngc", each, seed) for seed in range(1, PROGRAMS + 1)]
     offset = work_offset(paths[0])  # (every generated program stays in one box)
-    across = fastest({f"--jobs {jobs}": lambda jobs=jobs: files_rate(paths, offset, jobs, ctx.workdir / "out") for jobs in (1, 2)}, repeats=2)
+    across = fastest(
+        {
+            f"--jobs {jobs}": lambda jobs=jobs: files_rate(paths, offset, jobs, ctx.workdir / "out")
+            for jobs in (1, 2)
+        },
+        repeats=2,
+    )
     speedup = across["--jobs 2"]["lines_per_s"] / across["--jobs 1"]["lines_per_s"]
-    rounds = [one / two for one, two in zip(across["--jobs 1"]["all_seconds"], across["--jobs 2"]["all_seconds"])]
+    rounds = [
+        one / two for one, two in zip(across["--jobs 1"]["all_seconds"], across["--jobs 2"]["all_seconds"])
+    ]
     judged = verdict(speedup, rounds, FLOORS["--jobs 2 / --jobs 1"])
     data["across programs"] = {**across, "speedup": speedup, "rounds": rounds}
     label = f"{PROGRAMS} generated programs of {each:,} lines"
     for jobs in ("--jobs 1", "--jobs 2"):
-        rows.append([label, f"ncpp compensate {jobs} -o FOLDER", f"{across[jobs]['lines_per_s']:,.0f}", f"{across[jobs]['seconds']:.1f} s, the command's start included"])
+        rows.append(
+            [
+                label,
+                f"ncpp compensate {jobs} -o FOLDER",
+                f"{across[jobs]['lines_per_s']:,.0f}",
+                f"{across[jobs]['seconds']:.1f} s, the command's start included",
+            ]
+        )
     rows.append([label, "ratio --jobs 2 / --jobs 1", f"{speedup:.2f}x", judged])
-    table.append(["--jobs 2 / --jobs 1 across programs", label, f"{speedup:.2f}× ({across['--jobs 2']['lines_per_s']:,.0f} against "
-                  f"{across['--jobs 1']['lines_per_s']:,.0f} lines/s; rounds {min(rounds):.2f}-{max(rounds):.2f}×)", f"≥ {FLOORS['--jobs 2 / --jobs 1']:g}×",
-                  judged.rsplit(": ", 1)[1]])  # fmt: skip
+    table.append(
+        [
+            "--jobs 2 / --jobs 1 across programs",
+            label,
+            f"{speedup:.2f}× ({across['--jobs 2']['lines_per_s']:,.0f} against "
+            f"{across['--jobs 1']['lines_per_s']:,.0f} lines/s; "
+            f"rounds {min(rounds):.2f}-{max(rounds):.2f}×)",
+            f"≥ {FLOORS['--jobs 2 / --jobs 1']:g}×",
+            judged.rsplit(": ", 1)[1],
+        ]
+    )
 
-    sizes = [100_000, 300_000] if ctx.quick else [1_000_000, 10_000_000]  # past the parser's read-ahead, which saturates at ~32k lines
+    sizes = (
+        [100_000, 300_000] if ctx.quick else [1_000_000, 10_000_000]
+    )  # past the parser's read-ahead, which saturates at ~32k lines
     memory = {}
     for n in sizes:
         path = ctx.generated(n)
         memory[str(n)] = result = compensate_rss(path, work_offset(path))
         if n >= 10_000_000:
             path.unlink()
-        status = "ok" if result["exit"] == 0 else f"exit {result['exit']}: {result['stderr_tail'].strip()[-100:]}"
-        rows.append([f"generated {n:,} lines", "peak RSS, ncpp compensate", f"{result['rss_mb']:.1f} MB", f"{n / result['seconds']:,.0f} lines/s; {status}"])
+        status = (
+            "ok" if result["exit"] == 0 else f"exit {result['exit']}: {result['stderr_tail'].strip()[-100:]}"
+        )
+        rows.append(
+            [
+                f"generated {n:,} lines",
+                "peak RSS, ncpp compensate",
+                f"{result['rss_mb']:.1f} MB",
+                f"{n / result['seconds']:,.0f} lines/s; {status}",
+            ]
+        )
     rss = [m["rss_mb"] for m in memory.values()]
     growth = rss[-1] / rss[0]
-    flat = "met" if growth <= FLOORS["peak RSS growth"] and all(m["exit"] == 0 for m in memory.values()) else "SHORT"
+    flat = (
+        "met"
+        if growth <= FLOORS["peak RSS growth"] and all(m["exit"] == 0 for m in memory.values())
+        else "SHORT"
+    )
     data["memory"] = memory
-    table.append(["peak RSS, one process", f"generated {sizes[0]:,} / {sizes[-1]:,} lines", f"{rss[0]:.1f} / {rss[-1]:.1f} MB ({growth:.2f}×)",
-                  f"≤ {FLOORS['peak RSS growth']:g}×", flat])  # fmt: skip
-    notes = [f"peak RSS of `ncpp compensate` grows {growth:.2f}x from {sizes[0]:,} to {sizes[-1]:,} lines: {flat}"]
+    table.append(
+        [
+            "peak RSS, one process",
+            f"generated {sizes[0]:,} / {sizes[-1]:,} lines",
+            f"{rss[0]:.1f} / {rss[-1]:.1f} MB ({growth:.2f}×)",
+            f"≤ {FLOORS['peak RSS growth']:g}×",
+            flat,
+        ]
+    )
+    notes = [
+        f"peak RSS of `ncpp compensate` grows {growth:.2f}x from {sizes[0]:,} to {sizes[-1]:,} lines: {flat}"
+    ]
     written = write_table(table, bench.cpu(), ctx.quick, load_before, os.getloadavg())
     notes.append(f"performance table written to {written}")
-    return bench.Section("Compensation throughput (lines in/s), --jobs across programs, memory", ["program", "tool", "rate", "note"], rows, data, notes)
+    return bench.Section(
+        "Compensation throughput (lines in/s), --jobs across programs, memory",
+        ["program", "tool", "rate", "note"],
+        rows,
+        data,
+        notes,
+    )
 
 
 def write_table(table: list[list[str]], cpu: str, quick: bool, load_before: tuple, load_after: tuple) -> Path:
@@ -279,10 +426,14 @@ def write_table(table: list[list[str]], cpu: str, quick: bool, load_before: tupl
     from ncpp.fileio import write_text_atomic
 
     lines = [
-        f"Measured {time.strftime('%Y-%m-%d %H:%M %Z')} by `python benchmarks/run.py{' --quick' if quick else ''} --only compensate_speed` "
-        f"on {cpu}, {os.cpu_count()} cores, Python {sys.version.split()[0]}; load average {load_before[0]:.1f} before, "
-        f"{load_after[0]:.1f} after: the machine is shared with other work, and figures move from run to run with its load.  "
-        "Each ratio is of the fastest of three runs (two across programs), each in a fresh process, the tools taking turns; "
+        f"Measured {time.strftime('%Y-%m-%d %H:%M %Z')} by "
+        f"`python benchmarks/run.py{' --quick' if quick else ''} --only compensate_speed` "
+        f"on {cpu}, {os.cpu_count()} cores, Python {sys.version.split()[0]}; "
+        f"load average {load_before[0]:.1f} before, "
+        f"{load_after[0]:.1f} after: the machine is shared with other work, "
+        "and figures move from run to run with its load.  "
+        "Each ratio is of the fastest of three runs (two across programs), each in a fresh process, "
+        "the tools taking turns; "
         "a floor is met when the fastest runs and every round reach it.",
         "",
         "| measure | program | figure | floor | |",
@@ -321,21 +472,39 @@ def dialect_speed(ctx):
     generated = ctx.generated(250_000 if ctx.quick else 1_000_000)
     offset = work_offset(generated)  # the posted programs make the same moves
     programs = {
-        f"generated, first {lines:,} lines, as Klartext": (posted(generated, lines, "heidenhain", ctx.workdir), offset),
-        f"generated, first {lines:,} lines, as Sinumerik": (posted(generated, lines, "sinumerik", ctx.workdir), offset),
+        f"generated, first {lines:,} lines, as Klartext": (
+            posted(generated, lines, "heidenhain", ctx.workdir),
+            offset,
+        ),
+        f"generated, first {lines:,} lines, as Sinumerik": (
+            posted(generated, lines, "sinumerik", ctx.workdir),
+            offset,
+        ),
         "LinuxCNC 3D_Chips_abort.ngc (expressions)": (bench.PARAMETRIC, work_offset(bench.PARAMETRIC)),
     }
     rows, data = [], {}
     for label, (path, placed) in programs.items():
-        best = fastest({
-            "passthrough": lambda: in_fresh_process("ncpp_process_rate", path, None),
-            "compensate": lambda: in_fresh_process("ncpp_process_rate", path, placed),
-        }, repeats=2)  # fmt: skip
+        best = fastest(
+            {
+                "passthrough": lambda: in_fresh_process("ncpp_process_rate", path, None),
+                "compensate": lambda: in_fresh_process("ncpp_process_rate", path, placed),
+            },
+            repeats=2,
+        )
         compensated = best["compensate"]
         data[label] = {"work_offset_mm": placed, **best}
         rows += [
             [label, "ncpp passthrough", f"{best['passthrough']['lines_per_s']:,.0f}", ""],
-            [label, "ncpp compensate 1 µm (HR5B), one process", f"{compensated['lines_per_s']:,.0f}",
-             f"lines out/in {compensated['lines_out'] / max(compensated['lines'], 1):.2f}"],
-        ]  # fmt: skip
-    return bench.Section("Compensation throughput in other dialects (lines in/s, no floor)", ["program", "tool", "rate", "note"], rows, data)
+            [
+                label,
+                "ncpp compensate 1 µm (HR5B), one process",
+                f"{compensated['lines_per_s']:,.0f}",
+                f"lines out/in {compensated['lines_out'] / max(compensated['lines'], 1):.2f}",
+            ],
+        ]
+    return bench.Section(
+        "Compensation throughput in other dialects (lines in/s, no floor)",
+        ["program", "tool", "rate", "note"],
+        rows,
+        data,
+    )

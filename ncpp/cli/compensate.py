@@ -18,6 +18,7 @@ from concurrent.futures import Executor, Future, ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass
 from pathlib import Path
+from typing import BinaryIO, Callable
 
 from ncpp.cli.io import add_io_arguments, open_input, open_output
 from ncpp.cli.options import at_least, positive
@@ -130,9 +131,12 @@ def run(args: argparse.Namespace) -> int:
     folder = args.output is not None and os.path.isdir(args.output)
     if len(args.input) > 1 or folder:
         if args.output is None:
-            raise NcppError("several programs need -o FOLDER, the folder each is written to under its own name")
+            raise NcppError("several programs need -o FOLDER, the folder each is written to under its name")
         return compensate_files(job, args.input, Path(args.output), args.jobs)
     return _compensate_one(job, args.input[0] if args.input else None, args.output)
+
+
+Progress = Callable[[int], None] | None
 
 
 @dataclass(frozen=True)
@@ -147,15 +151,23 @@ class Job:
     offsets: object  # motion.offsets.WorkOffsets
     verify: bool = True
 
+    def compensate(self, stream: BinaryIO, out: BinaryIO, name: str, progress: Progress = None):
+        """`pipeline.process` of one program, with warnings of its own."""
+        from ncpp.pipeline import process
+
+        return process(
+            stream, out, file=name, source=self.source,  # type: ignore[arg-type]
+            tolerance=self.tolerance, strict=self.strict, force=self.force,
+            warnings=Warnings(strict=self.strict), progress=progress, dialect=self.dialect,
+            offsets=self.offsets, verify=self.verify,  # type: ignore[arg-type]
+        )  # fmt: skip
+
 
 def _compensate_one(job: Job, path: str | None, output: str | None) -> int:
     """One program (standard input for none) to `output` (standard output for none), with progress."""
-    from ncpp.pipeline import process
-
     progress = progress_printer("compensate")
     with open_input(path) as (stream, name), open_output(output) as out:
-        stats = process(stream, out, file=name, source=job.source, tolerance=job.tolerance, strict=job.strict, force=job.force,  # type: ignore[arg-type]
-                        warnings=Warnings(strict=job.strict), progress=progress, dialect=job.dialect, offsets=job.offsets, verify=job.verify)  # type: ignore[arg-type]  # fmt: skip
+        stats = job.compensate(stream, out, name, progress)
     if progress is not None:
         progress.done()
         print(f"ncpp: {stats.lines_in} lines in, {stats.lines_out} lines out", file=sys.stderr)
@@ -181,7 +193,8 @@ def compensate_files(job: Job, paths: list[str], folder: Path, jobs: int = 1) ->
 
 
 def _targets(paths: list[str], folder: Path) -> list[Path]:
-    """Where each program goes: `folder`/its name, refused where two share a name or one would replace its program."""
+    """Where each program goes: `folder`/its name; refused where two share a name, or one
+    would replace its program."""
     targets = [folder / Path(path).name for path in paths]
     seen: dict[Path, str] = {}
     for path, target in zip(paths, targets):
@@ -240,10 +253,8 @@ def _start_worker(job: Job) -> None:
 def _compensate_file(path: str, target: str) -> None:
     """One program of `compensate_files`, in a process `_start_worker` was told the job."""
     from ncpp.fileio import atomic_output
-    from ncpp.pipeline import process
 
-    job = _job
-    assert job is not None
+    assert _job is not None
     with open(path, "rb") as stream, atomic_output(target) as out:
-        process(stream, out, file=path, source=job.source, tolerance=job.tolerance, strict=job.strict, force=job.force,  # type: ignore[arg-type]
-                warnings=Warnings(strict=job.strict), dialect=job.dialect, offsets=job.offsets, verify=job.verify)  # type: ignore[arg-type]  # fmt: skip
+        _job.compensate(stream, out, path)
+

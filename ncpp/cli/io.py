@@ -25,7 +25,8 @@ def add_io_arguments(p: argparse.ArgumentParser, several: bool = False) -> None:
     -o may name the folder the programs are written to."""
     if several:
         p.add_argument("input", nargs="*", metavar="IN", help="NC programs (default: standard input)")
-        output = "output file, written atomically (default: standard output); with several programs, or a folder, the folder each goes to under its own name"
+        output = ("output file, written atomically (default: standard output); with several programs, "
+                  "or a folder, the folder each goes to under its own name")
     else:
         p.add_argument("input", nargs="?", help="NC program (default: standard input)")
         output = "output file, written atomically (default: standard output)"

@@ -6,8 +6,9 @@ Compensating only a line's end points corrects the path between them by the
 straight interpolation of the end-point errors.  Where the error varies more
 than that along the line (a bow, a kink in an error table), the line is split
 into pieces short enough that the remaining deviation is below the tolerance.
-The error is sampled a chunk at a time (`PieceCounts`); not along a line that a bound of the error's curvature already keeps
-whole (`ncpp.machine.curvature`, where the map gives one: its `bow_bound`).
+The error is sampled a chunk at a time (`PieceCounts`); not along a line that a
+bound of the error's curvature already keeps whole (`ncpp.machine.curvature`,
+where the map gives one: its `bow_bound`).
 """
 
 from __future__ import annotations

@@ -748,7 +748,9 @@ def _without_layout(scanned: tuple | None) -> tuple | None:
     return None if scanned is None else (*scanned, None)
 
 
-def parse_stream(stream: Iterable[bytes], file: str = "<stdin>", grammar: "str | Dialect" = "iso") -> Iterator[Block]:
+def parse_stream(
+    stream: Iterable[bytes], file: str = "<stdin>", grammar: "str | Dialect" = "iso"
+) -> Iterator[Block]:
     """Blocks of a program, lazily.  After the closing `%` lines are kept verbatim
     (a control stops reading there).  `grammar` names the dialect (or is one)."""
     parser = LineParser(grammar)

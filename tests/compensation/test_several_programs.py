@@ -19,14 +19,22 @@ BAD = "G21 G90 G17\nG1 X10 Y10 F100\nG2 X20 Y10 R2\nM2\n"  # line 3: the radius 
 
 
 def _long(k: int) -> str:
-    lines = "".join(f"G1 X{(n * k) % 47:.3f} Y{(n * 3) % 29:.3f}\nG2 X{(n * k) % 47 + 2:.3f} Y{(n * 3) % 29:.3f} R1.5\n" for n in range(1500))
+    lines = "".join(
+        f"G1 X{(n * k) % 47:.3f} Y{(n * 3) % 29:.3f}\nG2 X{(n * k) % 47 + 2:.3f} Y{(n * 3) % 29:.3f} R1.5\n"
+        for n in range(1500)
+    )
     return f"G21 G90 G17\nG0 X0 Y0 Z5\nG1 Z-1 F300\n{lines}M2\n"
 
 
 @pytest.fixture(scope="module")
 def programs(tmp_path_factory) -> dict[str, Path]:
     folder = tmp_path_factory.mktemp("programs")
-    texts = {"pocket.ngc": (ROOT / "samples/programs/pocket.ngc").read_text(), "one.ngc": _long(5), "bad.ngc": BAD, "two.ngc": _long(7)}
+    texts = {
+        "pocket.ngc": (ROOT / "samples/programs/pocket.ngc").read_text(),
+        "one.ngc": _long(5),
+        "bad.ngc": BAD,
+        "two.ngc": _long(7),
+    }
     for name, text in texts.items():
         (folder / name).write_text(text)
     return {name: folder / name for name in texts}
@@ -43,14 +51,35 @@ def alone(programs, tmp_path_factory) -> dict[str, bytes]:
     return written
 
 
-def test_two_processes_write_each_program_as_its_own_run_does_and_report_the_one_that_fails(programs, alone, tmp_path):
+def test_two_processes_write_each_program_as_its_own_run_does_and_report_the_one_that_fails(
+    programs, alone, tmp_path
+):
     out = tmp_path / "out"
     order = [programs[name] for name in ("pocket.ngc", "one.ngc", "bad.ngc", "two.ngc")]
-    done = subprocess.run([sys.executable, "-m", "ncpp", "compensate", *PLACED, "--jobs", "2", "-o", str(out), *map(str, order)],
-                          capture_output=True, text=True, cwd=ROOT)  # fmt: skip
+    done = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "ncpp",
+            "compensate",
+            *PLACED,
+            "--jobs",
+            "2",
+            "-o",
+            str(out),
+            *map(str, order),
+        ],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+    )
     assert done.returncode != 0
     assert f"{programs['bad.ngc']}:3:1: " in done.stderr and "Traceback" not in done.stderr
-    assert sorted(p.name for p in out.iterdir()) == ["one.ngc", "pocket.ngc", "two.ngc"]  # no partial or temporary file
+    assert sorted(p.name for p in out.iterdir()) == [
+        "one.ngc",
+        "pocket.ngc",
+        "two.ngc",
+    ]  # no partial or temporary file
     assert {name: (out / name).read_bytes() for name in alone} == alone
 
 
