@@ -19,6 +19,7 @@ from ncpp.runtime import one_blas_thread
 COMMANDS: tuple[str, ...] = (
     "filter",
     "motion",
+    "extents",
     "compensate",
     "simulate",
     "analyze",

@@ -205,6 +205,7 @@ class SinumerikInterpreter(ModalInterpreter):
                 self.selected = value
             elif item.letter == "M":
                 self.loaded, self.edge, changed = self.selected, 1, True
+                self.tool_id = f'"{self.loaded}"' if type(self.loaded) is str else f"{self.loaded:g}" if self.loaded else ""
             else:
                 self.edge, changed = int(value), True
             if changed and self.tools is None and self.edge:
