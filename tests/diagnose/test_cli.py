@@ -36,7 +36,7 @@ def test_command_writes_report_model_and_plot(tmp_path, capsys):
     assert set(step) == {"effect", "axis", "parameters", "uncertainty", "gap_after", "evidence"}
     assert (step["effect"], step["axis"]) == ("backlash", "Y")
     assert step["parameters"]["um"] == pytest.approx(8.0, rel=0.1)
-    assert str(updated) in data["model"]
+    assert data["model"] == "updated machine file written to up.toml"  # named relative to the report
     model = load_machine(updated)
     assert [(e.kind, e.axis) for e in model.effects] == [("backlash", "Y")]
     assert plot.read_bytes()[:4] == b"\x89PNG"
