@@ -28,6 +28,10 @@ def account(d: Diagnosis) -> str:
         variant = f" [{s.candidate.variant}]" if s.candidate.variant else ""
         lines.append(f"step {i}: {s.candidate.kind} {keys}{variant}: {_params(s.parameters, s.uncertainty)}")
         lines.append(f"  evidence: {s.evidence}")
+        for a in s.alternatives:
+            tests = " or ".join(a.separated_by) if a.separated_by else "no variation of the given ball-bar tests"
+            lines.append(f"  or, as the data cannot tell: {a.candidate.name}: {_params(a.parameters, a.uncertainty)}")
+            lines.append(f"    to tell them apart, measure {tests}")
     if d.not_observable:
         lines += ["", "not observable with these measurements: " + ", ".join(d.not_observable)]
     lines += ["", "gap, re-simulated (set-up offsets removed):", f"  {'model':<40} {'rms µm':>8} {'max µm':>8}"]
