@@ -10,7 +10,7 @@ itself, or — for a compensated program — the original it was made from.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Iterable
 
 import numpy as np
@@ -153,6 +153,8 @@ class ContourReport:
     worst_point: tuple[float, float, float]
     samples: int
     circles: list  # per full circle: dict(centre, radius, circularity_um, trace)
+    error_um: NDArray = field(default_factory=lambda: np.zeros(0), repr=False)  # per feed sample, in path order
+    path_mm: NDArray = field(default_factory=lambda: np.zeros((0, 3)), repr=False)  # those samples' machine positions
 
     def as_dict(self) -> dict:
         return {
@@ -185,6 +187,8 @@ def contour_error(machine, commanded: SampledPath, nominal: SampledPath, feed_ef
         (x, y, z),
         int(len(cmd)),
         circles,
+        error,
+        cmd,
     )
 
 
