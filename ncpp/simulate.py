@@ -153,8 +153,9 @@ class ContourReport:
     worst_point: tuple[float, float, float]
     samples: int
     circles: list  # per full circle: dict(centre, radius, circularity_um, trace)
-    error_um: NDArray = field(default_factory=lambda: np.zeros(0), repr=False)  # per feed sample, in path order
-    path_mm: NDArray = field(default_factory=lambda: np.zeros((0, 3)), repr=False)  # those samples' machine positions
+    # per feed sample, in path order: the contour error and the machine position
+    error_um: NDArray = field(default_factory=lambda: np.zeros(0), repr=False)
+    path_mm: NDArray = field(default_factory=lambda: np.zeros((0, 3)), repr=False)
 
     def as_dict(self) -> dict:
         return {

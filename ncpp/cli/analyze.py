@@ -55,7 +55,8 @@ def run(args: argparse.Namespace) -> int:
     print("\n\n".join(format_report(a) for a in analyses))
     if args.json:
         records = [
-            {"file": portable_name(a.measurement.source, args.json), "instrument": a.measurement.instrument, "standard": a.standard, **a.figures}
+            {"file": portable_name(a.measurement.source, args.json), "instrument": a.measurement.instrument,
+             "standard": a.standard, **a.figures}  # fmt: skip
             for a in analyses
         ]
         payload = records[0] if len(records) == 1 else records

@@ -54,9 +54,11 @@ def run(args: argparse.Namespace) -> int:
     result = diagnose(machine, measurements, alpha=args.alpha)
     print(account(result))
     if args.output:
-        meta = {**result.base.meta, "diagnosed_from": ", ".join(portable_name(p, args.output) for p in args.files)}
-        if isinstance(meta.get("fitted"), dict):  # named relative to the model read, renamed for the one written
-            meta["fitted"] = {k: rebased_name(str(v), args.machine, args.output) for k, v in meta["fitted"].items()}
+        sources = ", ".join(portable_name(p, args.output) for p in args.files)
+        meta = {**result.base.meta, "diagnosed_from": sources}
+        fitted = meta.get("fitted")
+        if isinstance(fitted, dict):  # named relative to the model read, renamed for the one written
+            meta["fitted"] = {k: rebased_name(str(v), args.machine, args.output) for k, v in fitted.items()}
         save_machine(result.updated.replace(meta=meta), args.output)
     print(_model_written(args.output, None))
     if args.json:

@@ -1,4 +1,6 @@
-"""`ncpp extents FILE [--machine M.toml] [--work-offset ...] [--format text|json]`: the box a program's moves sweep.
+"""`ncpp extents FILE [--machine M.toml] [--work-offset ...] [--format text|json]`.
+
+The box a program's moves sweep.
 
 Prints the lowest and highest X, Y, Z the program's moves reach, for the whole
 program, per work coordinate system (G54-G59.3; Heidenhain and Sinumerik
@@ -38,9 +40,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument("input", nargs="?", metavar="FILE", help="NC program (default: standard input)")
-    parser.add_argument("--machine", metavar="M.toml", help="machine file whose [limits] the boxes are checked against")
+    parser.add_argument(
+        "--machine", metavar="M.toml", help="machine file whose [limits] the boxes are checked against"
+    )
     parser.add_argument("--format", choices=("text", "json"), default="text")
-    parser.add_argument("--strict", action="store_true", help="refuse constructs outside the interpreter's scope")
+    parser.add_argument(
+        "--strict", action="store_true", help="refuse constructs outside the interpreter's scope"
+    )
     add_dialect_argument(parser)
     add_placement_arguments(parser)
     parser.set_defaults(func=run)
@@ -64,12 +70,17 @@ def run(args: argparse.Namespace) -> int:
     with open_input(args.input) as (stream, name):
         dialect, blocks = parse_program(stream, name, args.dialect)
         interpret, _ = dialect_tools(dialect)
-        events = warn_off_path(interpret(blocks, file=name, warnings=warnings, offsets=offsets), warnings, name,
-                               "counted as programmed (the tool centre is off them by the radius)")  # fmt: skip
+        moves = interpret(blocks, file=name, warnings=warnings, offsets=offsets)
+        events = warn_off_path(
+            moves, warnings, name, "counted as programmed (the tool centre is off them by the radius)"
+        )
+        known = offsets if placed else None  # the zeros the control holds, where the user told them
         if dialect == "iso":
-            found = extents(events, lambda c: placed and offsets.told(c.system), iso_system_name)  # type: ignore[union-attr]
+            found = extents(events, lambda c: known is not None and known.told(c.system), iso_system_name)
         else:  # one program zero: the system in effect when the program starts
-            found = extents(events, lambda c: placed and offsets.told(offsets.active), lambda c: "program zero")  # type: ignore[union-attr]
+            found = extents(
+                events, lambda c: known is not None and known.told(known.active), lambda c: "program zero"
+            )
     warnings.finish()
     report = as_report(name, *found, limits)
     sys.stdout.write(json.dumps(report, indent=2) + "\n" if args.format == "json" else as_text(report))
@@ -112,10 +123,19 @@ def _group_text(title: str, group: dict) -> list[str]:
     lines = ["", f"{title}: {group['moves']} moves, lines {group['lines'][0]}-{group['lines'][1]}"]
     for label, key in (("program", "program_mm"), ("machine", "machine_mm")):
         if group[key] is not None:
-            lines.append(f"  {label:<8}" + "  ".join(f"{a} {lo:10.3f} .. {hi:10.3f}" for a, (lo, hi) in group[key].items()))
+            lines.append(
+                f"  {label:<8}"
+                + "  ".join(f"{a} {lo:10.3f} .. {hi:10.3f}" for a, (lo, hi) in group[key].items())
+            )
     if group["moves_zero_unknown"] and group["machine_mm"] is not None:
-        lines.append(f"  ({group['moves_zero_unknown']} moves in systems whose zero is not known are not in the machine box)")
-    fits = [f"{axis} [{f['travel'][0]:g}, {f['travel'][1]:g}]" for axis, f in group.get("travel", {}).items() if f["fits"]]
+        lines.append(
+            f"  ({group['moves_zero_unknown']} moves in systems whose zero is not known are not in the box)"
+        )
+    fits = [
+        f"{axis} [{f['travel'][0]:g}, {f['travel'][1]:g}]"
+        for axis, f in group.get("travel", {}).items()
+        if f["fits"]
+    ]
     if fits:
         lines.append("  fits the travel of " + ", ".join(fits))
     for axis, fit in group.get("travel", {}).items():
@@ -123,6 +143,7 @@ def _group_text(title: str, group: dict) -> list[str]:
                   f"{fit['above_mm']:.3f} mm above its high end" if fit["above_mm"] else ""]  # fmt: skip
         if not fit["fits"]:
             lo, hi = fit["travel"]
-            lines.append(f"  {axis} does NOT fit the travel [{lo:g}, {hi:g}]: " + " and ".join(b for b in beyond if b))
+            lines.append(
+                f"  {axis} does NOT fit the travel [{lo:g}, {hi:g}]: " + " and ".join(b for b in beyond if b)
+            )
     return lines
-

@@ -129,12 +129,14 @@ def contour_figure(report, plt):
     steps = np.linalg.norm(np.diff(report.path_mm, axis=0), axis=1)
     distance = np.concatenate([[0.0], np.cumsum(steps)])
     along.plot(distance, report.error_um, lw=0.8)
-    along.set_title(f"contour error: max {report.max_um:.2f} µm (line {report.worst_line}), rms {report.rms_um:.2f} µm")
+    worst = f"max {report.max_um:.2f} µm (line {report.worst_line})"
+    along.set_title(f"contour error: {worst}, rms {report.rms_um:.2f} µm")
     along.set_xlabel("distance along the feed moves / mm")
     along.set_ylabel("contour error / µm")
     first, second = _widest_axes(report.path_mm)
     plan = fig.add_subplot(1, panels, 2)
-    dots = plan.scatter(report.path_mm[:, first], report.path_mm[:, second], c=report.error_um, s=4, cmap="viridis")
+    x, y = report.path_mm[:, first], report.path_mm[:, second]
+    dots = plan.scatter(x, y, c=report.error_um, s=4, cmap="viridis")
     fig.colorbar(dots, ax=plan, label="contour error / µm")
     plan.set_aspect("equal", adjustable="datalim")
     plan.set_xlabel(f"{'XYZ'[first]} (machine) / mm")

@@ -29,8 +29,9 @@ def account(d: Diagnosis) -> str:
         lines.append(f"step {i}: {s.candidate.kind} {keys}{variant}: {_params(s.parameters, s.uncertainty)}")
         lines.append(f"  evidence: {s.evidence}")
         for a in s.alternatives:
-            tests = " or ".join(a.separated_by) if a.separated_by else "no variation of the given ball-bar tests"
-            lines.append(f"  or, as the data cannot tell: {a.candidate.name}: {_params(a.parameters, a.uncertainty)}")
+            tests = " or ".join(a.separated_by) or "no variation of the given ball-bar tests"
+            fitted = _params(a.parameters, a.uncertainty)
+            lines.append(f"  or, as the data cannot tell: {a.candidate.name}: {fitted}")
             lines.append(f"    to tell them apart, measure {tests}")
     if d.not_observable:
         lines += ["", "not observable with these measurements: " + ", ".join(d.not_observable)]
@@ -74,7 +75,8 @@ def gap_figure(d: Diagnosis, plt):
     ax.set_ylabel("gap rms / µm")
     ax.legend(fontsize=8)
     ax.set_title("diagnosis: the gap between measurement and model, step by step", fontsize=10)
-    models = [("model as given", d.gap_before)] + [(f"after {label[1:]}", s.gap_after) for label, s in zip(labels[1:], d.steps)]
+    models = [("model as given", d.gap_before)]
+    models += [(f"after {label[1:]}", s.gap_after) for label, s in zip(labels[1:], d.steps, strict=True)]
     for i, o in enumerate(d.observations):
         a = fig.add_subplot(rows, cols, cols + i + 1)
         for lab in dict.fromkeys(o.label):
@@ -84,7 +86,8 @@ def gap_figure(d: Diagnosis, plt):
             style = "-" if lab in ("CCW", "+") else ":"
             a.plot(x, measured, color="k", lw=1.2, ls=style, label=f"measured {lab}")
             for k, (name, gap) in enumerate(models):
-                a.plot(x, measured - gap.residuals[i][sel][order], color=f"C{k + 1}", lw=0.8, ls=style, label=f"{name} {lab}")
+                modelled = measured - gap.residuals[i][sel][order]
+                a.plot(x, modelled, color=f"C{k + 1}", lw=0.8, ls=style, label=f"{name} {lab}")
         setup = o.measurement.plane if o.measurement.instrument == "ballbar" else o.measurement.axis
         a.set_title(f"{o.measurement.instrument} {setup} F{o.feed:g}: measured and modelled", fontsize=8)
         a.set_xlabel("angle / deg" if o.measurement.instrument == "ballbar" else "target / mm", fontsize=8)

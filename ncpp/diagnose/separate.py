@@ -12,8 +12,8 @@ correlation the diagnosis calls ambiguous.
 
 from __future__ import annotations
 
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
-from typing import Iterator, Sequence
 
 import numpy as np
 from numpy.typing import NDArray
@@ -46,7 +46,7 @@ def correlation(a: NDArray, b: NDArray) -> float:
 def seen(candidate: Candidate, observations: Sequence[Observation], weights: Sequence[float]) -> NDArray:
     """The readings `candidate`'s basis adds to each file, the set-up offsets removed, each file weighted."""
     parts = []
-    for o, w in zip(observations, weights):
+    for o, w in zip(observations, weights, strict=True):
         columns = np.column_stack([o.contribution(e) for e in candidate.basis])
         fitted = o.nuisance @ np.linalg.lstsq(o.nuisance, columns, rcond=None)[0]
         parts.append((columns - fitted) * w)
@@ -67,8 +67,8 @@ def proposals(model: Machine, observations: Sequence[Observation]) -> Iterator[P
         directions = tuple(dict.fromkeys(str(d) for d in o.label))
         where = f"ball bar {plane} R{radius:g} F{feed:g}"
         for label, setup in _variants(model, plane, radius, feed, centre, directions, where):
-            key = (setup["plane"], setup["radius_mm"], setup["feed_mm_min"], tuple(np.round(setup["center_mm"], 3)),
-                   setup["directions"])  # fmt: skip
+            centre_key = tuple(np.round(setup["center_mm"], 3))
+            key = (setup["plane"], setup["radius_mm"], setup["feed_mm_min"], centre_key, setup["directions"])
             if key in done:
                 continue
             done.add(key)
@@ -79,17 +79,36 @@ def proposals(model: Machine, observations: Sequence[Observation]) -> Iterator[P
             yield Proposal(label, test)
 
 
-def _variants(model: Machine, plane: str, radius: float, feed: float, centre: NDArray, directions: tuple[str, ...],
-              where: str) -> Iterator[tuple[str, dict]]:  # fmt: skip
-    base = {"plane": plane, "radius_mm": radius, "feed_mm_min": feed, "center_mm": centre, "directions": directions}
+def _variants(
+    model: Machine,
+    plane: str,
+    radius: float,
+    feed: float,
+    centre: NDArray,
+    directions: tuple[str, ...],
+    where: str,
+) -> Iterator[tuple[str, dict]]:
+    base = {
+        "plane": plane,
+        "radius_mm": radius,
+        "feed_mm_min": feed,
+        "center_mm": centre,
+        "directions": directions,
+    }
     missing = tuple(d for d in ("CCW", "CW") if d not in directions)
     if missing:
-        yield f"the {where} run in the other direction ({', '.join(missing)}) too", {**base, "directions": ("CCW", "CW")}
+        yield (
+            f"the {where} run in the other direction ({', '.join(missing)}) too",
+            {**base, "directions": ("CCW", "CW")},
+        )
     yield f"the {where} at another radius (R{radius / 2:g})", {**base, "radius_mm": radius / 2}
     yield f"the {where} at another feed (F{2 * feed:g})", {**base, "feed_mm_min": 2 * feed}
     for other in ("XY", "YZ", "ZX"):
         if other != plane:
-            yield f"a ball bar in another plane ({other} R{radius:g} about the same centre)", {**base, "plane": other}
+            yield (
+                f"a ball bar in another plane ({other} R{radius:g} about the same centre)",
+                {**base, "plane": other},
+            )
     n = NORMAL_AXIS[plane]
     axis = "XYZ"[n]
     lo, hi = model.limits.get(axis, (-np.inf, np.inf))
@@ -102,9 +121,13 @@ def _variants(model: Machine, plane: str, radius: float, feed: float, centre: ND
 
 
 def separating(
-    model: Machine, first: Candidate, second: Candidate, observations: Sequence[Observation], weights: Sequence[float],
+    model: Machine,
+    first: Candidate,
+    second: Candidate,
+    observations: Sequence[Observation],
+    weights: Sequence[float],
     ambiguity: float,
-) -> list[str]:  # fmt: skip
+) -> list[str]:
     """The proposed tests that, added to the data, tell `first` and `second` apart (their
     correlation falls to `ambiguity` or below)."""
     a, b = seen(first, observations, weights), seen(second, observations, weights)

@@ -270,8 +270,10 @@ def diagnose(
         weights = [float(sw[s.start]) for s in slices]
         alternatives = tuple(_alternative(machine, prob, chosen, s[1], cols, sw, obs, weights, ambiguity)
                              for s in group if s[1] is not cand)  # fmt: skip
-        evidence = explain(obs, slices, contribution, stat, thr, gain / max(rss0, 1e-300), alternatives, ambiguity)
-        steps.append(Step(chosen[-1], effects[-1], params, unc, gap, evidence, stat, thr, ambiguous, alternatives))
+        share = gain / max(rss0, 1e-300)
+        evidence = explain(obs, slices, contribution, stat, thr, share, alternatives, ambiguity)
+        step = Step(chosen[-1], effects[-1], params, unc, gap, evidence, stat, thr, ambiguous, alternatives)
+        steps.append(step)
     # Final joint values for every step (later steps refine earlier estimates).
     if chosen:
         X = _design(chosen, cols, len(prob.r))
@@ -290,14 +292,22 @@ def diagnose(
 
 
 def _alternative(
-    machine: Machine, prob: _Problem, chosen: list[Candidate], twin: Candidate, cols: dict[int, NDArray], sw: NDArray,
-    obs: list[Observation], weights: list[float], ambiguity: float,
-) -> Alternative:  # fmt: skip
+    machine: Machine,
+    prob: _Problem,
+    chosen: list[Candidate],
+    twin: Candidate,
+    cols: dict[int, NDArray],
+    sw: NDArray,
+    obs: list[Observation],
+    weights: list[float],
+    ambiguity: float,
+) -> Alternative:
     """`twin` fitted in place of the last chosen effect, and the tests that would tell them apart."""
     coef, cov, _, fitted = _refit(prob, [*chosen[:-1], twin], cols, sw)
     k = _index(fitted)[-1]
     params, unc = fitted[-1].parameters(coef[k], cov[np.ix_(k, k)])
-    return Alternative(fitted[-1], params, unc, separating(machine, chosen[-1], twin, obs, weights, ambiguity))
+    tests = separating(machine, chosen[-1], twin, obs, weights, ambiguity)
+    return Alternative(fitted[-1], params, unc, tests)
 
 
 def _index(chosen: list[Candidate]) -> list[list[int]]:
@@ -418,8 +428,9 @@ def explain(obs, slices, contribution: NDArray, stat: float, thr: float, share: 
     text = "; ".join(parts)
     if alternatives:
         names = ", ".join(a.candidate.name for a in alternatives)
-        text = (f"ambiguous: cannot be told apart from {names} on this data (columns correlated > {ambiguity:g}; "
-                f"kept the first in the effect table as representative; {separation_text(alternatives)}); " + text)
+        text = (f"ambiguous: cannot be told apart from {names} on this data (columns correlated > "
+                f"{ambiguity:g}; kept the first in the effect table as representative; "
+                f"{separation_text(alternatives)}); " + text)  # fmt: skip
     return text
 
 
@@ -431,4 +442,4 @@ def separation_text(alternatives: Sequence[Alternative]) -> str:
         return "any one of these tells the representative apart from them all: " + "; ".join(common)
     if any(tests):
         return "no single further test tells them all apart: see the alternatives' separated_by"
-    return "no variation of the given ball-bar tests (direction, radius, feed, plane, height) tells them apart"
+    return "no variation of the given ball-bar tests (direction, radius, feed, plane, height) separates them"

@@ -266,7 +266,9 @@ def identify(
     direct = [m for m in measurements if m.instrument != "ballbar"]
     sources = [s for m in direct for s in sources_of(m, machine.chain)]
     if direct:
-        machine = _fit_tables(machine, sources, interpolation, reversal_threshold, sweeps, tolerance, names or {})
+        machine = _fit_tables(
+            machine, sources, interpolation, reversal_threshold, sweeps, tolerance, names or {}
+        )
     if not ballbars:
         return machine, None
     fit = fit_ballbar(machine, ballbars, knots=knots, fixed=[s.component for s in sources], smoothing=smoothing)
@@ -296,7 +298,8 @@ def _fit_tables(
         if largest < tolerance:
             break
     meta = dict(machine.meta)
-    meta["fitted"] = {s.component: f"{names.get(s.measurement.source, s.measurement.source)} [{s.column}]" for s in order}
+    named = {s.component: names.get(s.measurement.source, s.measurement.source) for s in order}
+    meta["fitted"] = {s.component: f"{named[s.component]} [{s.column}]" for s in order}
     return machine.replace(meta=meta)
 
 

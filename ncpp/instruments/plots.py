@@ -54,16 +54,20 @@ def analyses_figure(analyses: Sequence[Analysis], plt):
     for k, group in enumerate(groups, 1):
         polar = group[0].test is not None
         ax = fig.add_subplot(rows, cols, k, projection="polar" if polar else None)
-        if len(group) > 1:
-            (_polar_overlay if polar else _positioning_overlay if group[0].positioning is not None else _profile_overlay)(ax, group)
-        elif polar:
-            _polar_panel(ax, group[0])
-        elif group[0].positioning is not None:
-            _positioning_panel(ax, group[0])
-        else:
-            _profile_panel(ax, group[0])
+        _draw(ax, group)
     fig.tight_layout()
     return fig
+
+
+def _draw(ax, group: Sequence[Analysis]) -> None:
+    """One panel: a file alone in its kind in detail, several of one kind overlaid."""
+    first, alone = group[0], len(group) == 1
+    if first.test is not None:
+        _polar_panel(ax, first) if alone else _polar_overlay(ax, group)
+    elif first.positioning is not None:
+        _positioning_panel(ax, first) if alone else _positioning_overlay(ax, group)
+    else:
+        _profile_panel(ax, first) if alone else _profile_overlay(ax, group)
 
 
 def kinds(analyses: Sequence[Analysis]) -> dict[tuple[str, ...], list[Analysis]]:
@@ -73,7 +77,7 @@ def kinds(analyses: Sequence[Analysis]) -> dict[tuple[str, ...], list[Analysis]]
         m = a.measurement
         if a.test is not None:
             key: tuple[str, ...] = ("circular",)
-        elif m.instrument in ("laser", "comparator") and (m.instrument == "comparator" or m.quantity == "position"):
+        elif m.instrument == "comparator" or (m.instrument == "laser" and m.quantity == "position"):
             key = ("positioning",)
         else:
             key = (m.instrument, str(m.quantity if m.instrument != "grid" else m.plane))
@@ -82,8 +86,14 @@ def kinds(analyses: Sequence[Analysis]) -> dict[tuple[str, ...], list[Analysis]]
 
 
 # Units of the figures' keys, by suffix (longest first), and how they are written.
-UNITS = (("_um_per_m_per_m", "µm/m per m"), ("_urad_per_m", "µrad/m"), ("_um_per_m", "µm/m"), ("_urad", "µrad"),
-         ("_um", "µm"), ("_ms", "ms"))  # fmt: skip
+UNITS = (
+    ("_um_per_m_per_m", "µm/m per m"),
+    ("_urad_per_m", "µrad/m"),
+    ("_um_per_m", "µm/m"),
+    ("_urad", "µrad"),
+    ("_um", "µm"),
+    ("_ms", "ms"),
+)
 
 
 def figure_text(key: str, value: float) -> str:
@@ -122,7 +132,8 @@ def _polar_overlay(ax, group: Sequence[Analysis]) -> None:
     ax.set_rticks(np.arange(-outer, outer + step / 2, step))
     ax.set_yticklabels([f"{v:+g}" for v in np.arange(-outer, outer + step / 2, step)], fontsize=7)
     ax.set_rlabel_position(67.5)
-    ax.set_title(f"{len(group)} circular tests on one scale: radial deviation, {step:g} µm/div (LSC centred)", fontsize=9)
+    scale = f"radial deviation, {step:g} µm/div (LSC centred)"
+    ax.set_title(f"{len(group)} circular tests on one scale: {scale}", fontsize=9)
     ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.06), fontsize=6, ncol=2)
 
 
@@ -134,7 +145,8 @@ def _positioning_overlay(ax, group: Sequence[Analysis]) -> None:
         for stats, arrow, style in ((r.up, "↑", "-o"), (r.down, "↓", "--s")):
             ok = stats.measured
             if ok.any():
-                ax.plot(r.targets[ok], stats.mean[ok], style, color=f"C{k}", ms=3, lw=1, label=f"{name} x̄{arrow}")
+                label = f"{name} x̄{arrow}"
+                ax.plot(r.targets[ok], stats.mean[ok], style, color=f"C{k}", ms=3, lw=1, label=label)
     ax.axhline(0, color="grey", lw=0.6)
     ax.set_xlabel("target position (mm)")
     ax.set_ylabel("positioning deviation, actual − target (µm)")
@@ -159,7 +171,9 @@ def _profile_overlay(ax, group: Sequence[Analysis]) -> None:
 
 
 def _profile_unit(m) -> str:
-    return "µm/m" if m.instrument == "level" else ("µrad" if m.instrument == "laser" and m.deviation_column.endswith("urad") else "µm")
+    if m.instrument == "level":
+        return "µm/m"
+    return "µrad" if m.instrument == "laser" and m.deviation_column.endswith("urad") else "µm"
 
 
 def _nice_step(span: float) -> float:

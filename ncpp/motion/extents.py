@@ -12,8 +12,8 @@ and the tool length in effect, as `Context.to_machine` says.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
-from typing import Callable, Iterable, Mapping
 
 import numpy as np
 
@@ -70,7 +70,9 @@ def move_points(move: Line | Arc) -> np.ndarray:
     start = math.atan2(move.start[j] - move.center[j], move.start[i] - move.center[i])
     sweep = move.sweep()
     low, high = sorted((start, start + sweep))
-    quadrants = np.arange(math.ceil(low / (math.pi / 2)), math.floor(high / (math.pi / 2)) + 1) * (math.pi / 2)
+    quadrants = np.arange(math.ceil(low / (math.pi / 2)), math.floor(high / (math.pi / 2)) + 1) * (
+        math.pi / 2
+    )
     points = np.repeat(ends[:1], len(quadrants), axis=0)
     points[:, i] = move.center[i] + radius * np.cos(quadrants)
     points[:, j] = move.center[j] + radius * np.sin(quadrants)
@@ -91,7 +93,11 @@ def extents(
         context, line = move.context, move.block.line
         program = move_points(move)
         name = system_name(context)
-        groups = (whole, systems.setdefault(name, Extent(name)), tools.setdefault(context.tool_id, Extent(context.tool_id)))
+        groups = (
+            whole,
+            systems.setdefault(name, Extent(name)),
+            tools.setdefault(context.tool_id, Extent(context.tool_id)),
+        )
         machine = (program + np.array(context.offset)) * context.unit_mm if zero_known(context) else None
         for group in groups:
             group.program.add(program * context.unit_mm, line)
@@ -123,7 +129,9 @@ class AxisFit:
                 "above_mm": round(self.above_mm, 6)}  # fmt: skip
 
 
-def fit_in_travel(box: Box, limits: Mapping[str, tuple[float, float]], slack_mm: float = 1e-6) -> dict[str, AxisFit]:
+def fit_in_travel(
+    box: Box, limits: Mapping[str, tuple[float, float]], slack_mm: float = 1e-6
+) -> dict[str, AxisFit]:
     """Per axis the machine file gives travel for: by how much the box leaves it at each end."""
     out = {}
     for i, axis in enumerate(AXES):

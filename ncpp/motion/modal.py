@@ -97,7 +97,8 @@ class ModalInterpreter:
         plane = plane or self.plane
         if self._context is None or self._context.plane != plane or self._context.absolute != absolute:
             offset = as_point([z + o for z, o in zip(self.zero, self.offset)])
-            self._context = Context(plane, absolute, False, self.inch, offset, as_point(self.tool), tool_id=self.tool_id)
+            tool = as_point(self.tool)
+            self._context = Context(plane, absolute, False, self.inch, offset, tool, tool_id=self.tool_id)
         return self._context
 
     def set_units(self, inch: bool) -> None:

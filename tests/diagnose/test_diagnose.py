@@ -154,7 +154,7 @@ def test_alternatives_are_listed_fitted_and_told_how_to_separate():
     (step,) = d.steps
     assert (step.candidate.kind, step.candidate.keys) == ("servo_mismatch", {"axes": "XY"})
     report = step.to_dict()
-    alternatives = {(a["effect"], a.get("plane") or a.get("axes") or a.get("component")): a for a in report["alternatives"]}
+    alternatives = {(a["effect"], a.get("plane") or a.get("axes")): a for a in report["alternatives"]}
     assert {("squareness", "XY"), ("servo_mismatch", "YZ"), ("servo_mismatch", "ZX")} <= set(alternatives)
     square = alternatives[("squareness", "XY")]
     # A squareness only shapes the circle; a lag flips with the direction and grows with the feed.

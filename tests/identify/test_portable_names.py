@@ -24,7 +24,16 @@ ABSOLUTE = re.compile(r"(^|[\s\"'=(\[,])(/|[A-Za-z]:\\)[^\s\"']*")
 
 def laser_file(path: Path) -> Path:
     machine = load_machine(HR5B)
-    m = predict_laser(machine, "X", "position", np.linspace(0, 800, 9), fixed={"Y": 350, "Z": 350}, runs=2, noise_um=0.3, seed=1)
+    m = predict_laser(
+        machine,
+        "X",
+        "position",
+        np.linspace(0, 800, 9),
+        fixed={"Y": 350, "Z": 350},
+        runs=2,
+        noise_um=0.3,
+        seed=1,
+    )
     path.parent.mkdir(parents=True, exist_ok=True)
     write_measurement(m, path)
     return path
@@ -57,13 +66,20 @@ def test_diagnose_names_its_inputs_relative_to_the_model_and_report(tmp_path, ca
     truth = load_machine(HR5B).replace(effects=(Backlash("Y", 8.0),))
     ballbar = tmp_path / "shop" / "bb" / "bb_XY.csv"
     ballbar.parent.mkdir()
-    write_measurement(predict_ballbar(truth, "XY", 100, (400, 350, 300), step_deg=2.0, noise_um=0.3, seed=0), ballbar)
+    write_measurement(
+        predict_ballbar(truth, "XY", 100, (400, 350, 300), step_deg=2.0, noise_um=0.3, seed=0), ballbar
+    )
     updated, report = tmp_path / "shop" / "out" / "updated.toml", tmp_path / "shop" / "out" / "report.json"
     updated.parent.mkdir()
-    assert main(["diagnose", "--machine", str(base), str(ballbar), "-o", str(updated), "--json", str(report)]) == 0
+    assert (
+        main(["diagnose", "--machine", str(base), str(ballbar), "-o", str(updated), "--json", str(report)])
+        == 0
+    )
     meta = load_machine(updated).meta
     assert meta["diagnosed_from"] == "../bb/bb_XY.csv"
-    assert meta["fitted"]["EXX"] == "../laser/laser_X_position.csv [deviation_um]"  # renamed for where it is written
+    assert (
+        meta["fitted"]["EXX"] == "../laser/laser_X_position.csv [deviation_um]"
+    )  # renamed for where it is written
     assert json.loads(report.read_text())["model"] == "updated machine file written to updated.toml"
     for written in (updated, report):
         assert str(tmp_path) not in written.read_text()
@@ -74,5 +90,9 @@ def test_bundled_samples_carry_no_path_of_the_computer_that_made_them():
         if path.suffix not in (".toml", ".json", ".txt", ".ngc", ".csv", ".md") or not path.is_file():
             continue
         text = path.read_text(encoding="utf-8", errors="replace")
-        found = [m.group(0) for m in ABSOLUTE.finditer(text) if re.search(r"/(work|home|tmp|Users|root)/", m.group(0))]
+        found = [
+            m.group(0)
+            for m in ABSOLUTE.finditer(text)
+            if re.search(r"/(work|home|tmp|Users|root)/", m.group(0))
+        ]
         assert not found, f"{path.relative_to(ROOT)} names {found[:3]}"

@@ -49,13 +49,17 @@ def test_boxes_per_work_offset_and_tool_in_program_coordinates(tmp_path, capsys)
     report = extents(tmp_path, capsys)
     assert report["all"]["program_mm"] == box((0, 30), (0, 10), (-2, 5))
     systems = by(report["work_offsets"], "name")
-    assert systems["G54"]["program_mm"] == box((0, 20), (0, 10), (-1, 5))  # Y10: the arc's top, not an end point
+    assert systems["G54"]["program_mm"] == box(
+        (0, 20), (0, 10), (-1, 5)
+    )  # Y10: the arc's top, not an end point
     assert systems["G55"]["program_mm"] == box((10, 30), (10, 10), (-2, 5))
     assert systems["G55"]["lines"] == [10, 12]
     tools = by(report["tools"], "tool")
     assert tools["1"]["program_mm"] == systems["G54"]["program_mm"]
     assert tools["2"]["program_mm"] == systems["G55"]["program_mm"]
-    assert report["all"]["machine_mm"] is None and report["all"]["moves_zero_unknown"] == 7  # nobody said the zeros
+    assert (
+        report["all"]["machine_mm"] is None and report["all"]["moves_zero_unknown"] == 7
+    )  # nobody said the zeros
 
 
 def test_machine_boxes_and_travel(tmp_path, capsys):
@@ -109,8 +113,8 @@ def test_heidenhain_tool_calls_and_text(tmp_path, capsys):
 def test_text_says_what_counts_and_what_does_not_fit(tmp_path, capsys):
     program = tmp_path / "part.ngc"
     program.write_text(PROGRAM)
-    assert main(["extents", str(program), "--work-offset", "G54=100,200,300", "--work-offset", "G55=790,200,300",
-                 "--machine", str(HR5B)]) == 0  # fmt: skip
+    options = ["--work-offset", "G54=100,200,300", "--work-offset", "G55=790,200,300", "--machine", str(HR5B)]
+    assert main(["extents", str(program), *options]) == 0
     out = capsys.readouterr().out
     assert "feed and rapid moves, arcs by their true extent" in out
     assert "X does NOT fit the travel [0, 800]: 20.000 mm above its high end" in out

@@ -50,7 +50,9 @@ def test_simulate_plot_draws_the_contour_error_along_the_path_and_a_map_coloured
     (dots,) = plan.collections
     assert len(dots.get_offsets()) == report.samples
     np.testing.assert_allclose(dots.get_array(), report.error_um)
-    radius = np.hypot(dots.get_offsets()[:, 0] - 400.0, dots.get_offsets()[:, 1] - 350.0)  # machine XY of the circle
+    radius = np.hypot(
+        dots.get_offsets()[:, 0] - 400.0, dots.get_offsets()[:, 1] - 350.0
+    )  # machine XY of the circle
     np.testing.assert_allclose(radius, 150.0, atol=0.01)
     out = tmp_path / "sim.png"
     assert main(["simulate", "--machine", str(STORY / "warm_machine.toml"), "--work-offset", "400,350,350",
@@ -70,9 +72,15 @@ def test_analyze_overlays_files_of_one_kind_on_one_scale():
     assert any(lab.startswith("ballbar_ZX_R100.csv CW") for lab in labels)
     extreme = max(np.max(np.abs(line.get_ydata())) for line in polar.get_lines())
     assert polar.get_ylim()[1] >= extreme  # one deviation scale holds both files
-    names = {line.get_label().split()[0] for line in positioning.get_lines() if line.get_label().endswith(("↑", "↓"))}
+    names = {
+        line.get_label().split()[0]
+        for line in positioning.get_lines()
+        if line.get_label().endswith(("↑", "↓"))
+    }
     assert names == {"comparator_X.csv", "laser_X_position.csv"}
-    assert all(len(line.get_ydata()) > 3 for line in positioning.get_lines() if line.get_label().endswith("↑"))
+    assert all(
+        len(line.get_ydata()) > 3 for line in positioning.get_lines() if line.get_label().endswith("↑")
+    )
     title = straightness.get_title()
     assert "straightness 8.02 µm" in title and "slope 3.93 µm/m" in title and "_um" not in title
 
