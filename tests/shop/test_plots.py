@@ -39,7 +39,7 @@ def close_figures():
 def test_simulate_plot_draws_the_contour_error_along_the_path_and_a_map_coloured_by_it(tmp_path):
     machine = load_machine(STORY / "warm_machine.toml")
     events = program_events(str(STORY / "circle.ngc"), Warnings(), WorkOffsets.at((400.0, 350.0, 350.0)))
-    path = sample_events(events, 0.5)
+    path = sample_events(events, 2.0)
     report = contour_error(machine, path, path)
     fig = contour_figure(report, plt)
     along, plan = fig.axes[0], fig.axes[1]
@@ -56,7 +56,7 @@ def test_simulate_plot_draws_the_contour_error_along_the_path_and_a_map_coloured
     np.testing.assert_allclose(radius, 150.0, atol=0.01)
     out = tmp_path / "sim.png"
     assert main(["simulate", "--machine", str(STORY / "warm_machine.toml"), "--work-offset", "400,350,350",
-                 str(STORY / "circle.ngc"), "--plot", str(out)]) == 0  # fmt: skip
+                 str(STORY / "circle.ngc"), "--step", "5", "--plot", str(out)]) == 0  # fmt: skip
     assert out.read_bytes()[:4] == b"\x89PNG"
 
 
