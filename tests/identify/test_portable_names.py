@@ -96,3 +96,12 @@ def test_bundled_samples_carry_no_path_of_the_computer_that_made_them():
             if re.search(r"/(work|home|tmp|Users|root)/", m.group(0))
         ]
         assert not found, f"{path.relative_to(ROOT)} names {found[:3]}"
+
+
+def test_predict_saves_the_machine_it_fitted_with_portable_names(tmp_path, capsys):
+    data = laser_file(tmp_path / "data" / "laser_X_position.csv")
+    saved = tmp_path / "data" / "fitted.toml"
+    assert main(["predict", "--from", str(data), "--base", str(HR5B), "--save-machine", str(saved),
+                 "--instrument", "ballbar", "--plane", "XY", "--radius", "100", "--center", "400,350,300",
+                 "-o", str(tmp_path / "bb.csv")]) == 0  # fmt: skip
+    assert load_machine(saved).meta["fitted"]["EXX"] == "laser_X_position.csv [deviation_um]"
