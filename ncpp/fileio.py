@@ -127,3 +127,37 @@ def program_file(stream: BinaryIO) -> str | None:
         except OSError:
             pass
     return None
+
+
+# How far up from a written file's folder an input may be and still be named by its relative path
+# (`samples/story/cold/x.csv` from `samples/story/model.toml`; farther off, a relative path names
+# the build machine's folders as an absolute one would).
+PORTABLE_LEVELS_UP = 2
+
+
+def portable_name(source: str | os.PathLike[str], written: str | os.PathLike[str]) -> str:
+    """How a file that writes `written` names an input `source` so that it means the same on another
+    machine: its path relative to the written file's folder, or where that climbs more than
+    PORTABLE_LEVELS_UP folders, its name and sha256 (a path there would name this machine's folders)."""
+    path = Path(source)
+    if not path.is_file():  # standard input, a stream: nothing on disk to point at
+        return str(source)
+    try:
+        relative = Path(os.path.relpath(path.resolve(), Path(written).resolve().parent))
+    except ValueError:  # (another drive)
+        relative = Path(*[".."] * (PORTABLE_LEVELS_UP + 1))
+    if relative.parts[: PORTABLE_LEVELS_UP + 1].count("..") <= PORTABLE_LEVELS_UP:
+        return relative.as_posix()
+    import hashlib
+
+    return f"{path.name} sha256:{hashlib.sha256(path.read_bytes()).hexdigest()[:16]}"
+
+
+def rebased_name(name: str, old: str | os.PathLike[str], new: str | os.PathLike[str]) -> str:
+    """`name` (a path, maybe followed by " [what]") written in file `old`, as file `new` names it:
+    a relative path that names a file beside `old` is named afresh (`portable_name`); others stay."""
+    path, space, rest = name.partition(" ")
+    beside = Path(old).parent / path
+    if Path(path).is_absolute() or not beside.is_file():
+        return name
+    return portable_name(beside, new) + space + rest

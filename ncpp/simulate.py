@@ -10,7 +10,7 @@ itself, or — for a compensated program — the original it was made from.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Iterable
 
 import numpy as np
@@ -153,6 +153,9 @@ class ContourReport:
     worst_point: tuple[float, float, float]
     samples: int
     circles: list  # per full circle: dict(centre, radius, circularity_um, trace)
+    # per feed sample, in path order: the contour error and the machine position
+    error_um: NDArray = field(default_factory=lambda: np.zeros(0), repr=False)
+    path_mm: NDArray = field(default_factory=lambda: np.zeros((0, 3)), repr=False)
 
     def as_dict(self) -> dict:
         return {
@@ -185,6 +188,8 @@ def contour_error(machine, commanded: SampledPath, nominal: SampledPath, feed_ef
         (x, y, z),
         int(len(cmd)),
         circles,
+        error,
+        cmd,
     )
 
 

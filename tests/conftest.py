@@ -74,6 +74,9 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
         "cldata/test_cldata.py": ("test_corpus_file_reads_and_moves_where_the_gotos_say",),
         "identify/test_thesis_sample.py": ("test_make_reproduces_the_committed_comparison",),
         "diagnose/test_diagnose.py": ("test_one_hidden_effect_is_named_sized_and_closes_the_gap",),
+        "shop/test_plots.py": (
+            "test_simulate_plot_draws_the_contour_error_along_the_path_and_a_map_coloured_by_it",
+        ),
         "dialects/test_written_apart.py": ("test_as_round_says",),
         "passes/test_compensate_cli.py": (
             "test_an_arc_of_more_turns_than_compensation_holds_is_refused_with_its_line",

@@ -19,6 +19,7 @@ from ncpp.runtime import Terminated, one_blas_thread, terminate_as_interrupt
 COMMANDS: tuple[str, ...] = (
     "filter",
     "motion",
+    "extents",
     "compensate",
     "simulate",
     "analyze",

@@ -47,7 +47,7 @@ def spike_width(text: str) -> float:
 def run(args: argparse.Namespace) -> int:
     import json
 
-    from ncpp.fileio import write_text_atomic
+    from ncpp.fileio import portable_name, write_text_atomic
     from ncpp.instruments.analysis import analyze, format_report
     from ncpp.instruments.files import read_measurement
 
@@ -55,7 +55,8 @@ def run(args: argparse.Namespace) -> int:
     print("\n\n".join(format_report(a) for a in analyses))
     if args.json:
         records = [
-            {"file": a.measurement.source, "instrument": a.measurement.instrument, "standard": a.standard, **a.figures}
+            {"file": portable_name(a.measurement.source, args.json), "instrument": a.measurement.instrument,
+             "standard": a.standard, **a.figures}  # fmt: skip
             for a in analyses
         ]
         payload = records[0] if len(records) == 1 else records

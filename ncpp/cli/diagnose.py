@@ -11,7 +11,8 @@ fitted and never reported.  Candidates the data cannot tell apart are
 reported as ambiguous.
 
 --json writes the report of shared/spec/measurement-files.md; -o writes the
-model with the new effects in [[effects]]; --plot draws the gap per step and
+model with the new effects in [[effects]] (both name their input files relative
+to themselves, or by name and sha256 when far off); --plot draws the gap per step and
 the residual traces before and after.
 """
 
@@ -44,7 +45,7 @@ def run(args: argparse.Namespace) -> int:
 
     from ncpp.diagnose import diagnose
     from ncpp.diagnose.report import account, plot_gap
-    from ncpp.fileio import write_text_atomic
+    from ncpp.fileio import portable_name, rebased_name, write_text_atomic
     from ncpp.instruments.files import read_measurement
     from ncpp.machine import load_machine, save_machine
 
@@ -53,14 +54,25 @@ def run(args: argparse.Namespace) -> int:
     result = diagnose(machine, measurements, alpha=args.alpha)
     print(account(result))
     if args.output:
-        updated = result.updated.replace(meta={**result.base.meta, "diagnosed_from": ", ".join(args.files)})
-        save_machine(updated, args.output)
-        model = f"updated machine file written to {args.output}"
-    else:
-        model = "no updated machine file written (no -o)"
-    print(model)
+        sources = ", ".join(portable_name(p, args.output) for p in args.files)
+        meta = {**result.base.meta, "diagnosed_from": sources}
+        fitted = meta.get("fitted")
+        if isinstance(fitted, dict):  # named relative to the model read, renamed for the one written
+            meta["fitted"] = {k: rebased_name(str(v), args.machine, args.output) for k, v in fitted.items()}
+        save_machine(result.updated.replace(meta=meta), args.output)
+    print(_model_written(args.output, None))
     if args.json:
+        model = _model_written(args.output, args.json)
         write_text_atomic(args.json, json.dumps(result.report(model), indent=2, ensure_ascii=False) + "\n")
     if args.plot:
         plot_gap(result, args.plot)
     return 0
+
+
+def _model_written(output: str | None, report: str | None) -> str:
+    """What became of the updated model, naming it as seen from `report` (None: as given)."""
+    from ncpp.fileio import portable_name
+
+    if not output:
+        return "no updated machine file written (no -o)"
+    return f"updated machine file written to {portable_name(output, report) if report else output}"

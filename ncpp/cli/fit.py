@@ -25,6 +25,10 @@ uncertainty and the combinations the files cannot separate (left at the
 minimum-norm choice, not invented):
 
     ncpp fit bb_*.csv --base structure.toml -o fitted.toml
+
+[meta.fitted] names each file by its path relative to the machine file, or,
+where that climbs more than two folders up, by its name and sha256: the file
+means the same on another computer.
 """
 
 from __future__ import annotations
@@ -55,6 +59,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from ncpp.errors import Location, NcppError
+    from ncpp.fileio import portable_name
     from ncpp.identify import account, fit_residuals, identify
     from ncpp.instruments.files import read_measurement
     from ncpp.machine import load_machine, save_machine
@@ -65,6 +70,7 @@ def run(args: argparse.Namespace) -> int:
         machine, ballbar = identify(
             measurements, base=base, chain=args.chain, name=args.name, interpolation=args.interpolation,
             reversal_threshold=args.reversal_threshold, knots=args.knots, smoothing=args.smoothing,
+            names={p: portable_name(p, args.output) for p in args.files},
         )  # fmt: skip
     except ValueError as err:
         raise NcppError(str(err), Location("ncpp fit")) from None

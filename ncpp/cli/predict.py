@@ -216,13 +216,15 @@ def machine_from_args(args: argparse.Namespace):
     if args.machine:
         return load_machine(args.machine)
     from ncpp.errors import Location, NcppError
+    from ncpp.fileio import portable_name
     from ncpp.identify import fit_machine
     from ncpp.instruments.files import read_measurement
 
     base = load_machine(args.base) if args.base else None
     measurements = [read_measurement(p) for p in args.sources]
     try:
-        return fit_machine(measurements, base=base, chain=args.chain)
+        names = {p: portable_name(p, args.save_machine) for p in args.sources} if args.save_machine else None
+        return fit_machine(measurements, base=base, chain=args.chain, names=names)
     except ValueError as err:  # as `ncpp fit` reports it (a bad --chain)
         raise NcppError(str(err), Location("ncpp predict")) from None
 

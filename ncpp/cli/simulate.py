@@ -101,29 +101,61 @@ def check_travel(path, limits, file: str, events: list, slack_mm: float = 1e-6) 
 
 
 def plot_report(report, commanded, path: str) -> None:
+    """The contour error along the program (feed moves, by distance along them), a map of the
+    path coloured by it in the plane it spans most, and each full circle's trace."""
     import io
 
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    import numpy as np
 
     from ncpp.fileio import write_bytes_atomic
 
-    panels = 1 + len(report.circles)
+    fig = contour_figure(report, plt)
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png", dpi=100)
+    plt.close(fig)
+    write_bytes_atomic(path, buffer.getvalue())
+
+
+def contour_figure(report, plt):
+    """The figure `plot_report` draws (pyplot passed in, its backend chosen)."""
+    import numpy as np
+
+    panels = 2 + len(report.circles)
     fig = plt.figure(figsize=(6 * panels, 5))
-    ax = fig.add_subplot(1, panels, 1)
-    ax.set_title(f"contour error: max {report.max_um:.2f} µm, rms {report.rms_um:.2f} µm")
-    ax.set_xlabel("sample along the path")
-    ax.set_ylabel("µm")
-    for n, c in enumerate(report.circles, start=2):
+    along = fig.add_subplot(1, panels, 1)
+    steps = np.linalg.norm(np.diff(report.path_mm, axis=0), axis=1)
+    distance = np.concatenate([[0.0], np.cumsum(steps)])
+    along.plot(distance, report.error_um, lw=0.8)
+    worst = f"max {report.max_um:.2f} µm (line {report.worst_line})"
+    along.set_title(f"contour error: {worst}, rms {report.rms_um:.2f} µm")
+    along.set_xlabel("distance along the feed moves / mm")
+    along.set_ylabel("contour error / µm")
+    first, second = _widest_axes(report.path_mm)
+    plan = fig.add_subplot(1, panels, 2)
+    x, y = report.path_mm[:, first], report.path_mm[:, second]
+    dots = plan.scatter(x, y, c=report.error_um, s=4, cmap="viridis")
+    fig.colorbar(dots, ax=plan, label="contour error / µm")
+    plan.set_aspect("equal", adjustable="datalim")
+    plan.set_xlabel(f"{'XYZ'[first]} (machine) / mm")
+    plan.set_ylabel(f"{'XYZ'[second]} (machine) / mm")
+    plan.set_title("the path, coloured by contour error")
+    for n, c in enumerate(report.circles, start=3):
         angle, dr = c["trace"]
         order = np.argsort(angle)
         polar = fig.add_subplot(1, panels, n, projection="polar")
         polar.plot(np.radians(angle[order]), dr[order], lw=1)
         polar.set_title(f"R{c['radius_mm']:g} {c['plane']}: circularity {c['circularity_um']:.2f} µm")
-    buffer = io.BytesIO()
-    fig.savefig(buffer, format="png", dpi=100)
-    plt.close(fig)
-    write_bytes_atomic(path, buffer.getvalue())
+    fig.tight_layout()
+    return fig
+
+
+def _widest_axes(points) -> tuple[int, int]:
+    """The two axes (indices, in XYZ order) the path spans most: the plane to draw it in."""
+    import numpy as np
+
+    spans = np.ptp(points, axis=0) if len(points) else np.zeros(3)
+    first, second = sorted(np.argsort(spans)[-2:].tolist())
+    return first, second

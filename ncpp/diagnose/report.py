@@ -28,6 +28,11 @@ def account(d: Diagnosis) -> str:
         variant = f" [{s.candidate.variant}]" if s.candidate.variant else ""
         lines.append(f"step {i}: {s.candidate.kind} {keys}{variant}: {_params(s.parameters, s.uncertainty)}")
         lines.append(f"  evidence: {s.evidence}")
+        for a in s.alternatives:
+            tests = " or ".join(a.separated_by) or "no variation of the given ball-bar tests"
+            fitted = _params(a.parameters, a.uncertainty)
+            lines.append(f"  or, as the data cannot tell: {a.candidate.name}: {fitted}")
+            lines.append(f"    to tell them apart, measure {tests}")
     if d.not_observable:
         lines += ["", "not observable with these measurements: " + ", ".join(d.not_observable)]
     lines += ["", "gap, re-simulated (set-up offsets removed):", f"  {'model':<40} {'rms µm':>8} {'max µm':>8}"]
@@ -39,7 +44,7 @@ def account(d: Diagnosis) -> str:
 
 
 def plot_gap(d: Diagnosis, path: str | os.PathLike[str]) -> None:
-    """Gap rms per step (top) and each file's residual before/after (below)."""
+    """Gap rms per step (top) and, per file, measured against modelled before and after each step."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -47,10 +52,20 @@ def plot_gap(d: Diagnosis, path: str | os.PathLike[str]) -> None:
 
     from ncpp.fileio import atomic_output
 
+    fig = gap_figure(d, plt)
+    with atomic_output(path) as f:
+        fig.savefig(f, format="png", dpi=110)
+    plt.close(fig)
+
+
+def gap_figure(d: Diagnosis, plt):
+    """The figure `plot_gap` draws (pyplot passed in, its backend chosen).  The modelled
+    readings are the measured ones minus the residual the model leaves (set-up offsets
+    fitted), so measured and modelled share the set-up."""
     n = len(d.observations)
     cols = min(n, 3)
     rows = 1 + -(-n // cols)
-    fig = plt.figure(figsize=(4.2 * cols, 3.0 * rows))
+    fig = plt.figure(figsize=(4.2 * cols, 3.2 * rows))
     ax = fig.add_subplot(rows, 1, 1)
     labels = ["model"] + [f"+{s.candidate.kind} {' '.join(s.candidate.keys.values())}" for s in d.steps]
     rms = [d.gap_before.rms_um] + [s.gap_after.rms_um for s in d.steps]
@@ -60,21 +75,25 @@ def plot_gap(d: Diagnosis, path: str | os.PathLike[str]) -> None:
     ax.set_ylabel("gap rms / µm")
     ax.legend(fontsize=8)
     ax.set_title("diagnosis: the gap between measurement and model, step by step", fontsize=10)
+    models = [("model as given", d.gap_before)]
+    models += [(f"after {label[1:]}", s.gap_after) for label, s in zip(labels[1:], d.steps, strict=True)]
     for i, o in enumerate(d.observations):
         a = fig.add_subplot(rows, cols, cols + i + 1)
-        for r, colour, name in ((d.gap_before.residuals[i], "tab:red", "before"), (d.gap_after.residuals[i], "tab:blue", "after")):
-            for lab in dict.fromkeys(o.label):
-                sel = o.label == lab
-                order = np.argsort(o.position[sel])
-                a.plot(o.position[sel][order], r[sel][order], color=colour, lw=0.8,
-                       ls="-" if lab in ("CCW", "+") else ":", label=f"{name} {lab}")  # fmt: skip
-        a.set_title(f"{o.measurement.instrument} {o.measurement.plane if o.measurement.instrument == 'ballbar' else o.measurement.axis}"
-                    f" F{o.feed:g}", fontsize=8)  # fmt: skip
+        for lab in dict.fromkeys(o.label):
+            sel = o.label == lab
+            order = np.argsort(o.position[sel])
+            x, measured = o.position[sel][order], o.y[sel][order]
+            style = "-" if lab in ("CCW", "+") else ":"
+            a.plot(x, measured, color="k", lw=1.2, ls=style, label=f"measured {lab}")
+            for k, (name, gap) in enumerate(models):
+                modelled = measured - gap.residuals[i][sel][order]
+                a.plot(x, modelled, color=f"C{k + 1}", lw=0.8, ls=style, label=f"{name} {lab}")
+        setup = o.measurement.plane if o.measurement.instrument == "ballbar" else o.measurement.axis
+        a.set_title(f"{o.measurement.instrument} {setup} F{o.feed:g}: measured and modelled", fontsize=8)
         a.set_xlabel("angle / deg" if o.measurement.instrument == "ballbar" else "target / mm", fontsize=8)
+        a.set_ylabel("reading / µm", fontsize=8)
         a.tick_params(labelsize=7)
         if i == 0:
-            a.legend(fontsize=6)
+            a.legend(fontsize=5)
     fig.tight_layout()
-    with atomic_output(path) as f:
-        fig.savefig(f, format="png", dpi=110)
-    plt.close(fig)
+    return fig

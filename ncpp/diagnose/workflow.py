@@ -36,6 +36,7 @@ from scipy.special import chdtri  # χ² upper quantile; scipy.stats costs secon
 
 from ncpp.diagnose.candidates import Candidate, candidates, cyclic_variant
 from ncpp.diagnose.observations import Observation, noise_level, observe, predicted
+from ncpp.diagnose.separate import separating
 from ncpp.instruments.files import Measurement
 from ncpp.machine.components import AXES
 from ncpp.machine.effects import Cyclic, Effect
@@ -53,6 +54,23 @@ class Gap:
 
 
 @dataclass
+class Alternative:
+    """An effect the data cannot tell apart from a step's, fitted in its place, and the
+    tests (in words) that would tell them apart (`separate.py`)."""
+
+    candidate: Candidate
+    parameters: dict[str, float]
+    uncertainty: dict[str, float]
+    separated_by: list[str]
+
+    def to_dict(self) -> dict:
+        return {"effect": self.candidate.kind, **self.candidate.keys,
+                "parameters": {k: _round(v) for k, v in self.parameters.items()},
+                "uncertainty": {k: _round(v) for k, v in self.uncertainty.items()},
+                "separated_by": list(self.separated_by)}  # fmt: skip
+
+
+@dataclass
 class Step:
     candidate: Candidate
     effect: Effect
@@ -63,6 +81,7 @@ class Step:
     statistic: float
     threshold: float
     ambiguous_with: tuple[str, ...] = ()
+    alternatives: tuple[Alternative, ...] = ()  # the effects `ambiguous_with` names, fitted instead
 
     def to_dict(self) -> dict:
         out: dict = {"effect": self.candidate.kind, **self.candidate.keys}
@@ -70,6 +89,7 @@ class Step:
         out["uncertainty"] = {k: _round(v) for k, v in self.uncertainty.items()}
         out["gap_after"] = self.gap_after.to_dict()
         out["evidence"] = self.evidence
+        out["alternatives"] = [a.to_dict() for a in self.alternatives]
         return out
 
 
@@ -247,8 +267,13 @@ def diagnose(
         contribution = cols[id(chosen[-1])] @ coef[_index(chosen)[-1]]
         for o, s in zip(obs, slices):  # what the set-up offsets absorb is not evidence
             contribution[s] -= o.nuisance @ np.linalg.lstsq(o.nuisance, contribution[s], rcond=None)[0]
-        evidence = explain(obs, slices, contribution, stat, thr, gain / max(rss0, 1e-300), ambiguous)
-        steps.append(Step(chosen[-1], effects[-1], params, unc, gap, evidence, stat, thr, ambiguous))
+        weights = [float(sw[s.start]) for s in slices]
+        alternatives = tuple(_alternative(machine, prob, chosen, s[1], cols, sw, obs, weights, ambiguity)
+                             for s in group if s[1] is not cand)  # fmt: skip
+        share = gain / max(rss0, 1e-300)
+        evidence = explain(obs, slices, contribution, stat, thr, share, alternatives, ambiguity)
+        step = Step(chosen[-1], effects[-1], params, unc, gap, evidence, stat, thr, ambiguous, alternatives)
+        steps.append(step)
     # Final joint values for every step (later steps refine earlier estimates).
     if chosen:
         X = _design(chosen, cols, len(prob.r))
@@ -264,6 +289,25 @@ def diagnose(
     for c in chosen:
         not_observable.discard(c.name)
     return Diagnosis(machine, updated, obs, sig, gap_before, steps, gap_after, where, sorted(not_observable))
+
+
+def _alternative(
+    machine: Machine,
+    prob: _Problem,
+    chosen: list[Candidate],
+    twin: Candidate,
+    cols: dict[int, NDArray],
+    sw: NDArray,
+    obs: list[Observation],
+    weights: list[float],
+    ambiguity: float,
+) -> Alternative:
+    """`twin` fitted in place of the last chosen effect, and the tests that would tell them apart."""
+    coef, cov, _, fitted = _refit(prob, [*chosen[:-1], twin], cols, sw)
+    k = _index(fitted)[-1]
+    params, unc = fitted[-1].parameters(coef[k], cov[np.ix_(k, k)])
+    tests = separating(machine, chosen[-1], twin, obs, weights, ambiguity)
+    return Alternative(fitted[-1], params, unc, tests)
 
 
 def _index(chosen: list[Candidate]) -> list[list[int]]:
@@ -354,7 +398,8 @@ def describe_residual(o: Observation, r: NDArray) -> str:
     return text
 
 
-def explain(obs, slices, contribution: NDArray, stat: float, thr: float, share: float, ambiguous) -> str:
+def explain(obs, slices, contribution: NDArray, stat: float, thr: float, share: float,
+            alternatives: Sequence[Alternative] = (), ambiguity: float = 0.98) -> str:  # fmt: skip
     """The step's evidence: where its contribution shows and how sure it is."""
     parts = []
     rms = [float(np.sqrt(np.mean(contribution[s] ** 2))) for s in slices]
@@ -381,8 +426,20 @@ def explain(obs, slices, contribution: NDArray, stat: float, thr: float, share: 
             parts.append("independent of feed")
     parts.append(f"explains {100 * share:.0f} % of the remaining gap; test statistic {stat:.0f} vs threshold {thr:.1f}")
     text = "; ".join(parts)
-    if ambiguous:
-        text = (f"ambiguous: cannot be told apart from {', '.join(ambiguous)} on this data "
-                f"(columns correlated > 0.98; kept the first in the effect table as representative; a test in the other direction, "
-                f"at another feed, in another plane or at another height would separate them); " + text)  # fmt: skip
+    if alternatives:
+        names = ", ".join(a.candidate.name for a in alternatives)
+        text = (f"ambiguous: cannot be told apart from {names} on this data (columns correlated > "
+                f"{ambiguity:g}; kept the first in the effect table as representative; "
+                f"{separation_text(alternatives)}); " + text)  # fmt: skip
     return text
+
+
+def separation_text(alternatives: Sequence[Alternative]) -> str:
+    """The further tests that tell every alternative apart (each, alone), in words."""
+    tests = [set(a.separated_by) for a in alternatives]
+    common = [t for t in alternatives[0].separated_by if all(t in s for s in tests)] if alternatives else []
+    if common:
+        return "any one of these tells the representative apart from them all: " + "; ".join(common)
+    if any(tests):
+        return "no single further test tells them all apart: see the alternatives' separated_by"
+    return "no variation of the given ball-bar tests (direction, radius, feed, plane, height) separates them"

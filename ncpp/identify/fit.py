@@ -51,7 +51,7 @@ file gives keep the base's value.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Sequence
+from typing import Mapping, Sequence
 
 import numpy as np
 from numpy.typing import NDArray
@@ -219,12 +219,13 @@ def fit_machine(
     tolerance: float = 1e-4,
     knots: int = 9,
     smoothing: float | None = None,
+    names: Mapping[str, str] | None = None,
 ) -> Machine:
     """A machine whose forward predictions reproduce the files (see the module docstring
     and `identify`)."""
     return identify(
         measurements, base, chain, name=name, interpolation=interpolation, reversal_threshold=reversal_threshold,
-        sweeps=sweeps, tolerance=tolerance, knots=knots, smoothing=smoothing,
+        sweeps=sweeps, tolerance=tolerance, knots=knots, smoothing=smoothing, names=names,
     )[0]  # fmt: skip
 
 
@@ -240,6 +241,7 @@ def identify(
     tolerance: float = 1e-4,
     knots: int = 9,
     smoothing: float | None = None,
+    names: Mapping[str, str] | None = None,
 ) -> tuple[Machine, BallbarFit | None]:
     """The fitted machine and, when ball-bar files were given, the ball-bar fit's account.
 
@@ -249,7 +251,9 @@ def identify(
     tables of the other files held); base: the machine whose structure,
     squareness, effects and other components are kept; chain: overrides the
     base's chain (default ``XYFZ`` without a base).  `tolerance` (µm, µrad)
-    ends the sweeps; `knots`, `smoothing`: the ball-bar tables (λ None: GCV)."""
+    ends the sweeps; `knots`, `smoothing`: the ball-bar tables (λ None: GCV).
+    `names`: how [meta.fitted] names each file (by its source; default the source
+    itself), e.g. relative to the machine file written (`fileio.portable_name`)."""
     if not measurements:
         raise NcppError("no measurement files to fit", Location("ncpp fit"))
     if base is None:
@@ -262,7 +266,9 @@ def identify(
     direct = [m for m in measurements if m.instrument != "ballbar"]
     sources = [s for m in direct for s in sources_of(m, machine.chain)]
     if direct:
-        machine = _fit_tables(machine, sources, interpolation, reversal_threshold, sweeps, tolerance)
+        machine = _fit_tables(
+            machine, sources, interpolation, reversal_threshold, sweeps, tolerance, names or {}
+        )
     if not ballbars:
         return machine, None
     fit = fit_ballbar(machine, ballbars, knots=knots, fixed=[s.component for s in sources], smoothing=smoothing)
@@ -271,7 +277,7 @@ def identify(
 
 def _fit_tables(
     machine: Machine, sources: Sequence[Source], interpolation: Interpolation, reversal_threshold: float,
-    sweeps: int, tolerance: float,
+    sweeps: int, tolerance: float, names: Mapping[str, str],
 ) -> Machine:  # fmt: skip
     taken: dict[str, Source] = {}
     for s in sources:
@@ -292,7 +298,8 @@ def _fit_tables(
         if largest < tolerance:
             break
     meta = dict(machine.meta)
-    meta["fitted"] = {s.component: f"{s.measurement.source} [{s.column}]" for s in order}
+    named = {s.component: names.get(s.measurement.source, s.measurement.source) for s in order}
+    meta["fitted"] = {s.component: f"{named[s.component]} [{s.column}]" for s in order}
     return machine.replace(meta=meta)
 
 

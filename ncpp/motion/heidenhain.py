@@ -257,6 +257,7 @@ class HeidenhainInterpreter(ModalInterpreter):
         called = statement.node[0]
         if called is not None:
             self.tool_number = self._tool_number(called, block, statement)
+            self.tool_id = f'"{called}"' if type(called) is str else f"{self.tool_number:g}"
             self.call_dl = 0.0
         if dl is not None:
             self.call_dl = dl

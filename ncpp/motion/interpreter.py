@@ -398,6 +398,8 @@ class Interpreter:
                 tuple(offset[i] + self.g92[i] + self.tool[i] for i in range(3)),  # type: ignore[arg-type]
                 tuple(self.tool[:3]),  # type: ignore[arg-type]
                 self.inverse_time,
+                self.coord_system,
+                str(self.spindle_tool) if self.spindle_tool else "",
             )
         return self._context
 
@@ -636,9 +638,9 @@ class Interpreter:
             if code in mcodes:
                 self.spindle = turning
         if 6.0 in mcodes:
-            self.spindle_tool = self.selected_tool
+            self._set(spindle_tool=self.selected_tool)
         if 61.0 in mcodes and "Q" in words:
-            self.spindle_tool = self._tool_number(words["Q"], block)
+            self._set(spindle_tool=self._tool_number(words["Q"], block))
         if 8 in gcodes:
             self._tool_length(gcodes[8], words, block, changed=6.0 in mcodes)
         if 12 in gcodes:
@@ -946,6 +948,7 @@ class Interpreter:
     def _coordinate_system(self, number: int) -> None:
         self._shift(self.g5x[self.coord_system], self.g5x[number])
         self.coord_system = number
+        self._context = None
 
     def _program_end(self) -> None:
         """M2/M30: rs274ngc resets some modes and stops reading the program."""

@@ -56,6 +56,7 @@ class ModalInterpreter:
         self.done = False
         self.radius_comp = False  # tool radius compensation on (G41/G42, RL/RR)
         self.off_path = False  # the tool centre off the programmed path: from the first move with it on to the first after
+        self.tool_id = ""  # the tool in the spindle as the program names it (Context.tool_id)
         self._context: Context | None = None
 
     # -- the event stream -------------------------------------------------------------
@@ -96,7 +97,8 @@ class ModalInterpreter:
         plane = plane or self.plane
         if self._context is None or self._context.plane != plane or self._context.absolute != absolute:
             offset = as_point([z + o for z, o in zip(self.zero, self.offset)])
-            self._context = Context(plane, absolute, False, self.inch, offset, as_point(self.tool))
+            tool = as_point(self.tool)
+            self._context = Context(plane, absolute, False, self.inch, offset, tool, tool_id=self.tool_id)
         return self._context
 
     def set_units(self, inch: bool) -> None:

@@ -49,6 +49,8 @@ class Context:
     offset: Point = (0.0, 0.0, 0.0)  # machine minus program position (work offset, G92, tool length), program units
     tool: Point = (0.0, 0.0, 0.0)  # the tool length offset (in `offset`): the tool tip is this far from the gauge point
     inverse_time: bool = False  # G93: a feed move's F is 1 / its time in minutes
+    system: int = 1  # the work coordinate system in effect, 1..9: G54..G59.3 (one program zero: 1)
+    tool_id: str = ""  # the tool in the spindle as the program names it ("3", '"MILL"'; "": none)
 
     @property
     def tool_mm(self) -> Point:

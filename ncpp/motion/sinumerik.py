@@ -205,6 +205,7 @@ class SinumerikInterpreter(ModalInterpreter):
                 self.selected = value
             elif item.letter == "M":
                 self.loaded, self.edge, changed = self.selected, 1, True
+                self.tool_id = _tool_id(self.loaded)
             else:
                 self.edge, changed = int(value), True
             if changed and self.tools is None and self.edge:
@@ -331,3 +332,10 @@ class SinumerikInterpreter(ModalInterpreter):
             self.fail("CIP points in a line (or a full circle): no arc through them", block, item)
         centre, turn = found
         return self.arc(block, end, centre, turn, plane, absolute)
+
+
+def _tool_id(loaded: float | str) -> str:
+    """`Context.tool_id` of the tool M6 loaded: its number, or its name in quotes ("": none)."""
+    if type(loaded) is str:
+        return f'"{loaded}"' if loaded else ""
+    return f"{loaded:g}" if loaded else ""

@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from ncpp.cli import main
-from ncpp.fileio import write_text_atomic
+from ncpp.fileio import portable_name, write_text_atomic
 from ncpp.identify.fit import fit_machine
 from ncpp.instruments.files import read_measurement, write_measurement
 from ncpp.instruments.forward import predict_ballbar, predict_laser
@@ -114,8 +114,9 @@ def main_story() -> None:
     base = real.without_errors().replace(squareness=real.squareness, name="HR5B (cold laser model)")
     (HERE / "cold").mkdir(exist_ok=True)
     (HERE / "warm").mkdir(exist_ok=True)
-    model = fit_machine([read_measurement(p) for p in laser_files(cold)], base)
-    save_machine(model, HERE / "cold_model.toml")
+    measurements = [read_measurement(p) for p in laser_files(cold)]
+    names = {m.source: portable_name(m.source, HERE / "cold_model.toml") for m in measurements}
+    save_machine(fit_machine(measurements, base, names=names), HERE / "cold_model.toml")
     balls = ballbar_files(warm)
     out = io.StringIO()
     with contextlib.redirect_stdout(out):
@@ -125,9 +126,6 @@ def main_story() -> None:
     assert rc == 0
     text = out.getvalue().replace(str(HERE) + "/", "")
     write_text_atomic(HERE / "diagnosis.txt", text)
-    for name in ("diagnosis.json", "updated_model.toml"):
-        path = HERE / name
-        write_text_atomic(path, path.read_text().replace(str(HERE) + "/", "").replace(str(ROOT) + "/", ""))
     save_machine(warm.replace(name="HR5B warm (the simulated truth)"), HERE / "warm_machine.toml")
     rows = contour_errors(
         {

@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 from ncpp.diagnose import diagnose
+from ncpp.diagnose.report import account
 from ncpp.instruments.forward import predict_ballbar, predict_comparator, predict_laser
 from ncpp.machine import load_machine
 from ncpp.machine.effects import (
@@ -116,6 +117,8 @@ def test_squareness_and_servo_mismatch_from_one_direction_are_ambiguous():
     assert "ambiguous" in step["evidence"]
     other = "squareness" if step["effect"] == "servo_mismatch" else "servo_mismatch"
     assert other in step["evidence"]
+    alternatives = {(a["effect"], a.get("plane") or a.get("axes")): a for a in step["alternatives"]}
+    assert ("squareness", "XY") in alternatives or ("servo_mismatch", "XY") in alternatives
     # With both directions it is a servo mismatch, no longer confused with
     # squareness (one plane still cannot say which axis pair lags: XY, YZ, ZX
     # all put the same lag difference between X and Y).
@@ -140,3 +143,30 @@ def test_laser_and_comparator_show_thermal_growth_and_lateral_play():
     assert found[("lateral_play", ("X",))]["um"] == pytest.approx(5.0, rel=0.2)
     assert len(found) == 2
     assert d.gap_after.rms_um < 1.5 * NOISE
+
+
+def test_alternatives_are_listed_fitted_and_told_how_to_separate():
+    # One XY ball bar, one direction: a servo lag of X behind Y looks like an XY squareness
+    # (both a 2θ ovality) and, in that plane, like the same lag of the pair YZ or ZX.
+    truth = hidden(ServoMismatch("XY", 1.5))
+    data = ballbars(truth, setups=(("XY", (400.0, 350.0, 300.0)),), directions=("CCW",))
+    d = diagnose(MODEL, data)
+    (step,) = d.steps
+    assert (step.candidate.kind, step.candidate.keys) == ("servo_mismatch", {"axes": "XY"})
+    report = step.to_dict()
+    alternatives = {(a["effect"], a.get("plane") or a.get("axes")): a for a in report["alternatives"]}
+    assert {("squareness", "XY"), ("servo_mismatch", "YZ"), ("servo_mismatch", "ZX")} <= set(alternatives)
+    square = alternatives[("squareness", "XY")]
+    # A squareness only shapes the circle; a lag flips with the direction and grows with the feed.
+    assert "the ball bar XY R100 F1000 run in the other direction (CW) too" in square["separated_by"]
+    assert "the ball bar XY R100 F1000 at another feed (F2000)" in square["separated_by"]
+    # The lag of another axis pair differs only where that pair moves: another plane, not another direction.
+    lag = alternatives[("servo_mismatch", "YZ")]
+    assert any("another plane" in t for t in lag["separated_by"])
+    assert not any("other direction" in t or "another radius" in t for t in lag["separated_by"])
+    # The squareness fitted in the step's place explains the data as well: nothing is left to add.
+    again = diagnose(hidden(Squareness("XY", square["parameters"]["um_per_m"])), data)
+    assert again.steps == [] and again.gap_before.rms_um < 1.5 * NOISE
+    text = account(d)
+    assert "or, as the data cannot tell: squareness XY" in text
+    assert "to tell them apart, measure the ball bar XY R100 F1000 run in the other direction (CW) too" in text
