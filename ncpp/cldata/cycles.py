@@ -65,7 +65,9 @@ def parse_cycle(rec: Record) -> Cycle | None:
     if words[:1] == ("OFF",):
         return None
     kind = words[0] if words else ""
-    if kind == "DRILL" and len(rec.args) > 1 and rec.args[1] in ("DEEP", "BRKCHP"):  # NX: CYCLE/DRILL,DEEP,...
+    if (
+        kind == "DRILL" and len(rec.args) > 1 and rec.args[1] in ("DEEP", "BRKCHP")
+    ):  # NX: CYCLE/DRILL,DEEP,...
         kind = str(rec.args[1])
     if kind not in KINDS:
         raise NcppError(f"CYCLE/{kind or '?'}: ncpp posts the cycles {', '.join(KINDS)} and OFF", rec.where)
@@ -74,7 +76,7 @@ def parse_cycle(rec: Record) -> Cycle | None:
         kind=kind,
         bottom=_bottom(rec, values),
         r_plane=_r_plane(rec, values),
-        feed=next((values[k] for k in FEEDS if k in values), None),
+        feed=next((_number(values, k) for k in FEEDS if k in values), None),
         per_rev=any(k in values for k in FEEDS if FEEDS[k]),
         step=_step(rec, kind, values),
         dwell=_dwell(rec, kind, values),
@@ -84,24 +86,24 @@ def parse_cycle(rec: Record) -> Cycle | None:
 
 
 def _couplets(rec: Record, args: tuple) -> dict[str, float | str]:
-    """KEYWORD, value pairs (STEP may repeat with one value: a variable peck is refused)."""
+    """KEYWORD, value pairs; a keyword given twice with two values (a variable peck) is refused."""
+    name = f"CYCLE/{rec.args[0]}"
+    pairs = (*args, None) if len(args) % 2 else args
     values: dict[str, float | str] = {}
-    args = tuple(args)
-    k = 0
-    while k < len(args):
-        key = args[k]
-        value = args[k + 1] if k + 1 < len(args) else None
+    for key, value in zip(pairs[::2], pairs[1::2], strict=True):
         if not isinstance(key, str):
-            raise NcppError(f"CYCLE/{rec.args[0]}: a value {key:g} without its keyword: ncpp reads the keyword form "
-                            "(DEPTH, d, MMPM, f, CLEAR, c, ...), not positional values", rec.where)  # fmt: skip
-        if key not in NUMBERS or value is None or (not isinstance(value, float) and (key, value) != ("RTRCTO", "AUTO")):
-            raise NcppError(f"CYCLE/{rec.args[0]}: {key}{'' if value is None else f', {value}'} is not followed by ncpp "
-                            f"(it reads {', '.join(sorted(NUMBERS))} with a number, RTRCTO, AUTO)", rec.where)  # fmt: skip
-        if key in values and values[key] != value:
-            raise NcppError(f"CYCLE/{rec.args[0]}: {key} given twice ({values[key]}, {value}): "
-                            "variable pecks are not posted", rec.where)  # fmt: skip
+            raise NcppError(f"{name}: a value {key:g} without its keyword: ncpp reads the keyword form "
+                            "(DEPTH, d, MMPM, f, CLEAR, c, ...), not positional values",
+                            rec.where)  # fmt: skip
+        if key not in NUMBERS or not (isinstance(value, float) or (key, value) == ("RTRCTO", "AUTO")):
+            shown = key if value is None else f"{key}, {value}"
+            raise NcppError(f"{name}: {shown} is not followed by ncpp (it reads {', '.join(sorted(NUMBERS))} "
+                            "with a number, and RTRCTO, AUTO)", rec.where)  # fmt: skip
+        if values.get(key, value) != value:
+            raise NcppError(f"{name}: {key} given twice ({values[key]}, {value}): "
+                            "variable pecks are not posted",
+                            rec.where)  # fmt: skip
         values[key] = value
-        k += 2
     return values
 
 
@@ -117,7 +119,10 @@ def _bottom(rec: Record, values: dict[str, float | str]) -> float:
     bottom = -depth if depth is not None else fedto
     assert bottom is not None
     if not bottom < 0:
-        raise NcppError(f"CYCLE/{rec.args[0]}: the hole's bottom is {bottom:g} from the cycle point, not below it", rec.where)
+        raise NcppError(
+            f"CYCLE/{rec.args[0]}: the hole's bottom is {bottom:g} from the cycle point, not below it",
+            rec.where,
+        )
     return bottom
 
 
@@ -132,7 +137,9 @@ def _step(rec: Record, kind: str, values: dict[str, float | str]) -> float:
     step = _number(values, "STEP")
     if kind in ("DEEP", "BRKCHP"):
         if step is None or step <= 0:
-            raise NcppError(f"CYCLE/{rec.args[0]}: a {kind} cycle needs its peck depth as STEP, s (above 0)", rec.where)
+            raise NcppError(
+                f"CYCLE/{rec.args[0]}: a {kind} cycle needs its peck depth as STEP, s (above 0)", rec.where
+            )
         return step
     if step is not None:
         raise NcppError(f"CYCLE/{rec.args[0]}: STEP in a {kind} cycle, which does not peck", rec.where)
@@ -156,7 +163,8 @@ def _to_start(rec: Record, values: dict[str, float | str]) -> bool:
         level = _number(values, key)
         if level is not None and abs(level - _r_plane(rec, values)) > LEVEL_TOL:
             raise NcppError(f"CYCLE/{rec.args[0]}: {key}, {level:g} retracts elsewhere than the R plane "
-                            f"({_r_plane(rec, values):g}) or the start level (AUTO): not posted", rec.where)  # fmt: skip
+                            f"({_r_plane(rec, values):g}) or the start level (AUTO): not posted",
+                            rec.where)  # fmt: skip
     return False
 
 
@@ -171,6 +179,7 @@ class Hole:
     r: float  # the R plane's Z
     bottom: float  # the bottom's Z
     clear: float  # the Z the hole leaves the tool at (the R plane, or the start level)
+    level: float  # the Z the tool crosses over to the hole at (rs274ngc: not below R, nor G98's start level)
     feed: float  # per minute
     series: bool  # it starts a series of the cycle (the canned cycle's words are all written)
 
@@ -197,7 +206,10 @@ class Driller:
         cycle = self.cycle
         r, bottom = top[2] + cycle.r_plane, top[2] + cycle.bottom
         if not r > bottom:
-            raise NcppError(f"CYCLE/{cycle.kind}: the R plane {r:g} is not above the hole's bottom {bottom:g}", cycle.record.where)
+            raise NcppError(
+                f"CYCLE/{cycle.kind}: the R plane {r:g} is not above the hole's bottom {bottom:g}",
+                cycle.record.where,
+            )
         series = self.last_r is None or (cycle.to_start and r != self.last_r)
         if series and self.last_r is not None:  # G98 with another R: a new series from where the tool is
             self.start_z = pos[2]
@@ -214,18 +226,23 @@ class Driller:
         if level != r:
             moves.append((top[0], top[1], r, True))
         moves += hole(float(cycle.code), top[0], top[1], r, clear, bottom, cycle.step, self.rapid_delta)
-        return Hole(cycle, top[0], top[1], top[2], r, bottom, clear, self._feed(feed, rpm), series), moves
+        return Hole(
+            cycle, top[0], top[1], top[2], r, bottom, clear, level, self._feed(feed, rpm), series
+        ), moves
 
     def _feed(self, feed: float, rpm: float | None) -> float:
         cycle = self.cycle
         if cycle.feed is None:
             if feed <= 0:
-                raise NcppError(f"CYCLE/{cycle.kind}: no feed rate (none in the record, no FEDRAT before)", cycle.record.where)
+                raise NcppError(
+                    f"CYCLE/{cycle.kind}: no feed rate (none in the record, no FEDRAT before)",
+                    cycle.record.where,
+                )
             return feed
         if not cycle.per_rev:
             return cycle.feed
         if not rpm:
-            raise NcppError(f"CYCLE/{cycle.kind}: a feed per revolution without a spindle speed (SPINDL) before it",
+            raise NcppError(f"CYCLE/{cycle.kind}: a feed per revolution and no spindle speed (SPINDL) before",
                             cycle.record.where)  # fmt: skip
         return cycle.feed * rpm
 

@@ -241,7 +241,8 @@ def motion(records: Iterable[Record], warnings: Warnings | None = None, zero: Po
                 pos = end
                 continue
             yield from flush()
-            yield Line(pos if pos is not None else end, end, rapid_next, feed, _block(rec), context, fixed=fixed)
+            start = pos if pos is not None else end
+            yield Line(start, end, rapid_next, feed, _block(rec), context, fixed=fixed)
             rapid_next = False
             if leaving:
                 fixed, leaving = "", False
@@ -250,7 +251,7 @@ def motion(records: Iterable[Record], warnings: Warnings | None = None, zero: Po
         yield from flush()
         if major == "CIRCLE":
             if driller is not None:
-                raise NcppError("CIRCLE under a CYCLE: only holes (GOTO) can be posted until CYCLE/OFF", rec.where)
+                raise NcppError("CIRCLE under a CYCLE: only its holes (GOTO) until CYCLE/OFF", rec.where)
             if pos is None:
                 raise NcppError("CIRCLE before any position (FROM or GOTO)", rec.where)
             circle = _Circle(rec, pos)

@@ -200,6 +200,16 @@ class Generator:
             self.canned = True
         self.moved_axes(line.end)
 
+    def pitch(self, hole: Hole) -> float:
+        """A tapped hole's thread pitch: its feed per revolution (per minute over the spindle speed)."""
+        cycle = hole.cycle
+        if cycle.per_rev and cycle.feed is not None:
+            return cycle.feed
+        if not self.rpm:
+            raise NcppError("CYCLE/TAP: the thread pitch needs the spindle speed (SPINDL) before it",
+                            cycle.record.where)  # fmt: skip
+        return hole.feed / self.rpm
+
     def _cycle_off(self) -> Iterator[str]:
         if self.canned:
             self.canned = False

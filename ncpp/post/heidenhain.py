@@ -15,7 +15,6 @@ import math
 from typing import Any, Iterable, Iterator
 
 from ncpp.cldata.cycles import Hole
-from ncpp.errors import NcppError
 from ncpp.motion.segments import PLANE_AXES, Arc, Event, Line
 from ncpp.post.generator import Generator, SetupLookup, number
 
@@ -24,7 +23,7 @@ AXES = "XYZ"
 CYCLES = {"DRILL": (200, "DRILLING"), "FACE": (200, "DRILLING"), "DEEP": (203, "UNIVERSAL DRILLING"),
           "BRKCHP": (205, "UNIVERSAL PECKING"), "TAP": (207, "RIGID TAPPING NEW"), "BORE": (201, "REAMING"),
           "REAM": (201, "REAMING")}  # fmt: skip
-RETRACT_FOR_CHIP_BREAKING = 0.2  # Q256, mm (the controls' default)
+BREAK = 0.2  # Q256 (and the advanced stop distances of 205): the retraction to break a chip, mm
 
 
 def signed(value: float, decimals: int) -> str:
@@ -37,6 +36,7 @@ class HeidenhainGenerator(Generator):
         super().__init__(*args, **kwargs)
         self.pending_tool: int | None = None
         self.radius_comp = "R0"  # RL / RR under CUTCOM/LEFT / RIGHT
+        self.defined: str | None = None  # the CYCL DEF in force (M99 calls it at each hole)
 
     def write(self, events: Iterable[Event], setup: SetupLookup) -> Iterator[str]:
         for n, text in enumerate(super().write(events, setup)):
@@ -123,6 +123,7 @@ class HeidenhainGenerator(Generator):
         return iter(())
 
     def emit_dwell(self, seconds: float) -> Iterator[str]:
+        self.defined = None  # the next hole defines its cycle again
         yield "CYCL DEF 9.0 DWELL TIME"
         yield f"CYCL DEF 9.1 DWELL {number(seconds, 3)}"
 
@@ -135,10 +136,13 @@ class HeidenhainGenerator(Generator):
         cycle = hole.cycle
         code, name = CYCLES[cycle.kind]
         q = self._q_parameters(hole, code)
-        yield f"CYCL DEF {code} {name}" + "".join(f"\n  Q{k}={signed(v, self.decimals)} ;{label}" for k, v, label in q)
-        z = self.position[2]
-        if z is None or float(z) < hole.r:  # up to the R plane before moving over the hole
-            yield f"L Z{self.coordinate(hole.r)} R0 FMAX"
+        parameters = (f"\n  Q{k}={signed(v, self.decimals)} ;{label}" for k, v, label in q)
+        definition = f"CYCL DEF {code} {name}" + "".join(parameters)
+        if definition != self.defined:
+            self.defined = definition
+            yield definition
+        if self.position[2] != self.coordinate(hole.level):  # where an ISO canned cycle crosses over
+            yield f"L Z{self.coordinate(hole.level)} R0 FMAX"
         yield f"L X{self.coordinate(hole.x)} Y{self.coordinate(hole.y)} R0 FMAX M99"
 
     def _q_parameters(self, hole: Hole, cycle_number: int) -> list[tuple[int, float, str]]:
@@ -147,28 +151,21 @@ class HeidenhainGenerator(Generator):
         head = [(200, clearance, "SET-UP CLEARANCE"), (201, depth, "DEPTH")]
         tail = [(203, hole.top, "SURFACE COORDINATE"), (204, second, "2ND SET-UP CLEARANCE")]
         if cycle_number == 207:
-            return head + [(239, self._pitch(hole), "THREAD PITCH")] + tail
+            return head + [(239, self.pitch(hole), "THREAD PITCH")] + tail
         feed = [(206, hole.feed, "FEED RATE FOR PLNGNG")]
         if cycle_number == 201:
-            return head + feed + [(211, cycle.dwell, "DWELL TIME AT DEPTH"), (208, hole.feed, "RETRACTION FEED RATE")] + tail
+            return head + feed + [(211, cycle.dwell, "DWELL TIME AT DEPTH"),
+                                  (208, hole.feed, "RETRACTION FEED RATE"), *tail]  # fmt: skip
         if cycle_number == 200:
             return head + feed + [(202, -depth, "PLUNGING DEPTH"), (210, 0.0, "DWELL TIME AT TOP")] + tail + [
                 (211, cycle.dwell, "DWELL TIME AT DEPTH")]  # fmt: skip
         if cycle_number == 203:  # a full retraction after every peck (Q213 = 0 chip breaks before it)
-            return head + feed + [(202, cycle.step, "PLUNGING DEPTH"), (210, 0.0, "DWELL TIME AT TOP")] + tail + [
+            return head + feed + [(202, cycle.step, "PLUNGING DEPTH"), (210, 0.0, "DWELL TIME AT TOP"), *tail,
                 (212, 0.0, "DECREMENT"), (213, 0.0, "NR OF BREAKS"), (205, cycle.step, "MIN. PLUNGING DEPTH"),
                 (211, 0.0, "DWELL TIME AT DEPTH"), (208, 0.0, "RETRACTION FEED RATE"),
-                (256, RETRACT_FOR_CHIP_BREAKING, "DIST FOR CHIP BRKNG")]  # fmt: skip
+                (256, BREAK, "DIST FOR CHIP BRKNG")]  # fmt: skip
         # 205: chip breaking every STEP, no full retraction before the bottom (Q202 the whole depth)
         return head + feed + [(202, -depth, "PLUNGING DEPTH")] + tail + [
-            (212, 0.0, "DECREMENT"), (205, cycle.step, "MIN. PLUNGING DEPTH"), (258, RETRACT_FOR_CHIP_BREAKING, "UPPER ADV STOP DIST"),
-            (259, RETRACT_FOR_CHIP_BREAKING, "LOWER ADV STOP DIST"), (257, cycle.step, "DEPTH FOR CHIP BRKNG"),
-            (256, RETRACT_FOR_CHIP_BREAKING, "DIST FOR CHIP BRKNG"), (211, 0.0, "DWELL TIME AT DEPTH")]  # fmt: skip
-
-    def _pitch(self, hole: Hole) -> float:
-        """The thread pitch: the feed per revolution (Cycle 207 follows the spindle)."""
-        if hole.cycle.per_rev and hole.cycle.feed is not None:
-            return hole.cycle.feed
-        if not self.rpm:
-            raise NcppError("CYCLE/TAP: the thread pitch needs the spindle speed (SPINDL) before it", hole.cycle.record.where)
-        return hole.feed / self.rpm
+            (212, 0.0, "DECREMENT"), (205, cycle.step, "MIN. PLUNGING DEPTH"),
+            (258, BREAK, "UPPER ADV STOP DIST"), (259, BREAK, "LOWER ADV STOP DIST"),
+            (257, cycle.step, "DEPTH FOR CHIP BRKNG"), (256, BREAK, "DIST FOR CHIP BRKNG"), (211, 0.0, "DWELL TIME AT DEPTH")]  # fmt: skip

@@ -74,7 +74,8 @@ class IsoGenerator(Generator):
         if not self.canned:
             words += ["G98" if cycle.to_start else "G99", f"G{cycle.code}"]
             self.motion = cycle.code
-        words += [f"{letter}{self.coordinate(value)}" for letter, value in zip("XYZR", (hole.x, hole.y, hole.bottom, hole.r))]
+        where = (hole.x, hole.y, hole.bottom, hole.r)
+        words += [f"{axis}{self.coordinate(value)}" for axis, value in zip("XYZR", where)]
         if cycle.step:
             words.append(f"Q{self.coordinate(cycle.step)}")
         if cycle.dwell:
@@ -157,6 +158,12 @@ class FanucGenerator(IsoGenerator):
     def emit_tool(self, tool: int) -> Iterator[str]:
         yield f"T{tool} M6"
         self.length_offset = tool
+
+    def emit_hole(self, hole: Hole) -> Iterator[str]:
+        if self.length_offset is not None:  # on its own: a canned cycle's block takes no G43
+            yield f"G43 H{self.length_offset}"
+            self.length_offset = None
+        yield from super().emit_hole(hole)
 
     def emit_line(self, line: Line) -> Iterator[str]:
         for text in super().emit_line(line):

@@ -10,7 +10,6 @@ from __future__ import annotations
 from typing import Iterator
 
 from ncpp.cldata.cycles import Hole
-from ncpp.errors import NcppError
 from ncpp.post.generator import number
 from ncpp.post.iso import IsoGenerator
 
@@ -41,9 +40,8 @@ class SinumerikGenerator(IsoGenerator):
         return iter(())  # each hole calls its cycle: none stays active (no MCALL)
 
     def emit_hole(self, hole: Hole) -> Iterator[str]:
-        z = self.position[2]
-        if z is None or float(z) < hole.r:  # up to the R plane before moving over the hole
-            yield f"G0 Z{self.coordinate(hole.r)}"
+        if self.position[2] != self.coordinate(hole.level):  # where an ISO canned cycle crosses over
+            yield f"G0 Z{self.coordinate(hole.level)}"
         words = ["G0", f"X{self.coordinate(hole.x)}", f"Y{self.coordinate(hole.y)}"]
         if hole.feed != self.feed:
             self.feed = hole.feed
@@ -59,12 +57,11 @@ class SinumerikGenerator(IsoGenerator):
         dwell = number(cycle.dwell, 3) if cycle.dwell else ""
         if cycle.kind in ("DEEP", "BRKCHP"):  # FDEP FDPR DAM DTB DTS FRF VARI (1: out to clear the chips)
             first = c(hole.top - cycle.step)
-            return f"CYCLE83({', '.join(planes + [first, '', c(cycle.step), dwell, '', '1', '1' if cycle.kind == 'DEEP' else '0'])})"
+            vari = "1" if cycle.kind == "DEEP" else "0"
+            return f"CYCLE83({', '.join(planes + [first, '', c(cycle.step), dwell, '', '1', vari])})"
         if cycle.kind == "TAP":  # DTB SDAC MPIT PIT POSS SST: M3 after, the pitch, the speed
-            if not self.rpm:
-                raise NcppError("CYCLE/TAP: the thread pitch needs the spindle speed (SPINDL) before it", cycle.record.where)
-            pitch = cycle.feed if cycle.per_rev and cycle.feed is not None else hole.feed / self.rpm
-            return f"CYCLE84({', '.join(planes + [dwell, '3', '', c(pitch), '', number(self.rpm, 0)])})"
+            pitch, speed = c(self.pitch(hole)), number(self.rpm or 0, 0)
+            return f"CYCLE84({', '.join(planes + [dwell, '3', '', pitch, '', speed])})"
         if cycle.kind in ("BORE", "REAM"):  # DTB FFR RFF: feed in and out
             feed = number(hole.feed, 3)
             return f"CYCLE85({', '.join(planes + [dwell, feed, feed])})"

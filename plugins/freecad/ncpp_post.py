@@ -48,7 +48,7 @@ parser.add_argument("--var-units", help="units of --var-file and --tool-table: m
 parser.add_argument("--ncpp", help="the ncpp program (default: $NCPP, then ncpp on PATH)")
 # FreeCAD's own posts this one can wrap: all write ISO G code that the ncpp filter reads
 BASES = ("linuxcnc", "grbl", "fanuc", "mach3_mach4", "centroid")
-parser.add_argument("--base", default="linuxcnc", help=f"FreeCAD's post to wrap: {', '.join(BASES)} (default linuxcnc)")
+parser.add_argument("--base", default="linuxcnc", help=f"FreeCAD's post to wrap: {', '.join(BASES)}")
 
 TOOLTIP_ARGS = parser.format_help() + "\nOther arguments are passed to the --base post (linuxcnc_post).\n"
 
@@ -158,4 +158,5 @@ if _PostProcessor is not None:
 
         def export(self):
             argstring = self._argstring()
-            return [(name, compensate_text(base_text(objects, argstring), argstring)) for name, objects in self._buildPostList()]
+            posted = [(name, base_text(objects, argstring)) for name, objects in self._buildPostList()]
+            return [(name, compensate_text(gcode, argstring)) for name, gcode in posted]

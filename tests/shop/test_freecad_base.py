@@ -16,13 +16,14 @@ from tests.conftest import ROOT
 MACHINE = ROOT / "samples/machines/hr5b.toml"
 # A stand-in for one of FreeCAD's script posts: export(objects, filename, argstring) writes G code
 # that names the post and the arguments it was given.
-FAKE_POST = '''
+FAKE_POST = """
 def export(objectslist, filename, argstring):
-    text = "(Exported by {name})\\n(args: " + argstring + ")\\nG21 G90 G54\\nG0 X10 Y10 Z5\\nG1 Z-1 F100\\nG1 X40 Y20\\nM2\\n"
+    text = "(Exported by {name})\\n(args: " + argstring + ")\\n"
+    text += "G21 G90 G54\\nG0 X10 Y10 Z5\\nG1 Z-1 F100\\nG1 X40 Y20\\nM2\\n"
     with open(filename, "w") as f:
         f.write(text)
     return text
-'''
+"""
 LAYOUTS = {"0.20": "PathScripts/post", "1.0": "Path/Post/scripts"}
 
 
@@ -54,7 +55,9 @@ def _post(tmp_path: Path, version: str, argstring: str) -> subprocess.CompletedP
 @pytest.mark.parametrize("version", sorted(LAYOUTS))
 @pytest.mark.parametrize("base", ["grbl", "fanuc"])
 def test_base_names_the_freecad_post_that_writes_the_program(tmp_path, version, base):
-    proc = _post(tmp_path, version, f"--base {base} --machine {MACHINE} --work-offset 400,350,300 --precision 4")
+    proc = _post(
+        tmp_path, version, f"--base {base} --machine {MACHINE} --work-offset 400,350,300 --precision 4"
+    )
     assert proc.returncode == 0, proc.stderr
     lines = proc.stdout.splitlines()
     assert lines[0].startswith("(ncpp compensated for hr5b.toml")
@@ -73,4 +76,7 @@ def test_the_default_base_is_linuxcnc(tmp_path):
 def test_an_unknown_base_is_refused_by_name(tmp_path):
     proc = _post(tmp_path, "0.20", "--base heidenhain_klartext")
     assert proc.returncode != 0
-    assert "--base heidenhain_klartext: expected one of linuxcnc, grbl, fanuc, mach3_mach4, centroid" in proc.stderr
+    assert (
+        "--base heidenhain_klartext: expected one of linuxcnc, grbl, fanuc, mach3_mach4, centroid"
+        in proc.stderr
+    )

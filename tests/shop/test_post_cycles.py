@@ -62,7 +62,9 @@ NX_HOLES = {(20.0, 100.0): (0.0, 13.0), (80.0, 100.0): (0.0, 13.0), (120.0, 100.
             (140.0, 100.0): (-5.0, 6.0), (160.0, 100.0): (-6.0, 1.5)}  # fmt: skip
 
 
-def _post(text: str, dialect: str, machine: Path | None = None, tmp_path: Path | None = None) -> tuple[str, str]:
+def _post(
+    text: str, dialect: str, machine: Path | None = None, tmp_path: Path | None = None
+) -> tuple[str, str]:
     """(program, warnings) as `ncpp post` writes them."""
     source = None
     if machine is not None:
@@ -70,7 +72,14 @@ def _post(text: str, dialect: str, machine: Path | None = None, tmp_path: Path |
 
         source = ErrorSource.from_machine_file(str(machine))
     out, told = io.BytesIO(), io.StringIO()
-    post(io.StringIO(text), out, file="holes.cls", dialect=dialect, source=source, warnings=Warnings(stream=told))
+    post(
+        io.StringIO(text),
+        out,
+        file="holes.cls",
+        dialect=dialect,
+        source=source,
+        warnings=Warnings(stream=told),
+    )
     return out.getvalue().decode("latin-1"), told.getvalue()
 
 
@@ -164,11 +173,20 @@ def test_heidenhain_cycle_parameters_are_the_cl_numbers():
     program, _ = _post(BOHREN.read_text(encoding="latin-1"), "heidenhain")
     q = dict(re.findall(r"Q(\d+)=([+-][\d.]+)", program))
     assert "CYCL DEF 203 UNIVERSAL DRILLING" in program
-    assert (q["200"], q["201"], q["202"], q["203"], q["206"], q["213"]) == ("+1", "-3.5", "+1", "+0.5", "+50", "+0")
+    assert (q["200"], q["201"], q["202"], q["203"], q["206"], q["213"]) == (
+        "+1",
+        "-3.5",
+        "+1",
+        "+0.5",
+        "+50",
+        "+0",
+    )
     assert re.search(r"^\d+ L X-7.2291 Y-23 R0 FMAX M99$", program, re.M)
     program, _ = _post(NX, "heidenhain")
     assert re.search(r"^\d+ CYCL DEF 9.1 DWELL 2.5$", program, re.M)
-    assert re.search(r"^\d+ L X\+200 Y\+100 RL$", program, re.M) and re.search(r"^\d+ L X\+190 Y\+150 R0$", program, re.M)
+    assert re.search(r"^\d+ L X\+200 Y\+100 RL$", program, re.M) and re.search(
+        r"^\d+ L X\+190 Y\+150 R0$", program, re.M
+    )
 
 
 def test_sinumerik_calls_the_cycle_over_each_hole():
@@ -208,8 +226,8 @@ def test_cycles_ncpp_cannot_follow_are_refused_at_their_line(record, message):
 
 def test_the_post_command_drills_the_creo_holes(tmp_path):
     out = tmp_path / "bohren.ngc"
-    proc = subprocess.run([sys.executable, "-m", "ncpp", "post", str(BOHREN), "--dialect", "linuxcnc", "-o", str(out),
-                           "--machine", str(WIDE)], capture_output=True, text=True, cwd=ROOT)  # fmt: skip
+    command = [sys.executable, "-m", "ncpp", "post", str(BOHREN), "--dialect", "linuxcnc", "-o", str(out)]
+    proc = subprocess.run([*command, "--machine", str(WIDE)], capture_output=True, text=True, cwd=ROOT)
     assert proc.returncode == 0, proc.stderr
     assert "canned cycle: its moves pass through uncompensated" in proc.stderr
     assert "CYCLE/ is not understood" not in proc.stderr

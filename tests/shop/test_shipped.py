@@ -12,7 +12,8 @@ import pytest
 
 from tests.conftest import ROOT
 
-SHIPPED = ("plugins/freecad/ncpp_post.py", "plugins/linuxcnc/filter.ini", "plugins/linuxcnc/ncpp-linuxcnc-filter",
+SHIPPED = ("plugins/freecad/ncpp_post.py", "plugins/linuxcnc/filter.ini",
+           "plugins/linuxcnc/ncpp-linuxcnc-filter",
            "samples/programs/pocket.cls", "samples/machines/hr5b.toml")  # fmt: skip
 
 
@@ -26,8 +27,8 @@ def _ncpp(*args: str, path: Path = ROOT, **kwargs) -> subprocess.CompletedProces
 def installed(tmp_path_factory) -> Path:
     """The wheel built from this checkout, unpacked as pip installs it (its files under site-packages)."""
     tmp = tmp_path_factory.mktemp("wheel")
-    proc = subprocess.run([sys.executable, "-m", "pip", "wheel", str(ROOT), "-w", str(tmp), "--no-deps", "-q"],
-                          capture_output=True, text=True)  # fmt: skip
+    command = [sys.executable, "-m", "pip", "wheel", str(ROOT), "-w", str(tmp), "--no-deps", "-q"]
+    proc = subprocess.run(command, capture_output=True, text=True)
     if proc.returncode != 0:
         pytest.fail("pip wheel failed:\n" + proc.stderr[-2000:])
     (wheel,) = tmp.glob("ncpp-*.whl")
@@ -57,7 +58,8 @@ def test_install_freecad_post_from_the_wheel(installed, tmp_path):
 
 @pytest.mark.parametrize(
     ("existing", "expected"),
-    [((), ".local/share/FreeCAD/Macro"), ((".FreeCAD",), ".FreeCAD/Macro"), ((".FreeCAD/Macro",), ".FreeCAD/Macro"),
+    [((), ".local/share/FreeCAD/Macro"), ((".FreeCAD",), ".FreeCAD/Macro"),
+     ((".FreeCAD/Macro",), ".FreeCAD/Macro"),
      ((".FreeCAD", ".local/share/FreeCAD/Macro"), ".local/share/FreeCAD/Macro")],
 )  # fmt: skip
 def test_install_freecad_post_finds_the_macro_folder_freecad_uses(tmp_path, existing, expected):
