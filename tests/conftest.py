@@ -28,6 +28,7 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_creo_deep_holes_are_drilled_to_their_depth_in_rs274",
             "test_nx_holes_reach_their_bottoms_and_retract_as_the_records_say",
             "test_rs274_dwells_where_the_cl_data_delays",
+            "test_the_holes_moves_compensation_sees_are_the_ones_rs274_makes",
         ),
         "compensation/test_rs274_accepts.py": None,
         "motion/test_oracle.py": None,

@@ -232,3 +232,25 @@ def test_the_post_command_drills_the_creo_holes(tmp_path):
     assert "canned cycle: its moves pass through uncompensated" in proc.stderr
     assert "CYCLE/ is not understood" not in proc.stderr
     assert "X-16.7804 Y-23. Z-3. R1.5 Q1." in out.read_text().splitlines()
+
+
+def _without_repeats(points: list[tuple[float, ...]]) -> list[tuple[float, ...]]:
+    return [p for k, p in enumerate(points) if k == 0 or max(abs(a - b) for a, b in zip(p, points[k - 1])) > 1e-6]
+
+
+def test_the_holes_moves_compensation_sees_are_the_ones_rs274_makes(tmp_path):
+    """The moves `ncpp.cldata.motion` gives the passes for each hole (left as programmed, but
+    the next move starts where they end) are the canned cycles' moves in rs274, in order."""
+    from ncpp.cldata import motion, read_cldata
+    from ncpp.motion.segments import Line
+
+    cl = "".join(ln + "\n" for ln in NX.splitlines() if not ln.startswith("CUTCOM"))  # rs274 offsets those
+    ours = [(*e.end, e.rapid) for e in motion(read_cldata(io.StringIO(cl), "holes.cls")) if isinstance(e, Line)]
+    program, _ = _post(cl, "linuxcnc")
+    theirs = [(x, y, z, kind == "STRAIGHT_TRAVERSE") for kind, x, y, z in _rs274(tmp_path, program)]
+    assert len(theirs) > 40
+    drilled = _drilled([("STRAIGHT_TRAVERSE" if rapid else "STRAIGHT_FEED", x, y, z) for x, y, z, rapid in ours])
+    assert {xy: drilled.get(xy) for xy in NX_HOLES} == {xy: bottom for xy, (bottom, _) in NX_HOLES.items()}
+    ours, theirs = _without_repeats(ours), _without_repeats(theirs)
+    assert len(ours) == len(theirs)
+    assert all(a[3] == b[3] and max(abs(p - q) for p, q in zip(a[:3], b[:3])) < 1e-4 for a, b in zip(ours, theirs))
