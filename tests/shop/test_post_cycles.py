@@ -235,7 +235,11 @@ def test_the_post_command_drills_the_creo_holes(tmp_path):
 
 
 def _without_repeats(points: list[tuple[float, ...]]) -> list[tuple[float, ...]]:
-    return [p for k, p in enumerate(points) if k == 0 or max(abs(a - b) for a, b in zip(p, points[k - 1])) > 1e-6]
+    return [p for k, p in enumerate(points) if k == 0 or _apart(p[:3], points[k - 1][:3]) > 1e-6]
+
+
+def _apart(p: tuple[float, ...], q: tuple[float, ...]) -> float:
+    return max(abs(a - b) for a, b in zip(p, q, strict=True))
 
 
 def test_the_holes_moves_compensation_sees_are_the_ones_rs274_makes(tmp_path):
@@ -245,12 +249,13 @@ def test_the_holes_moves_compensation_sees_are_the_ones_rs274_makes(tmp_path):
     from ncpp.motion.segments import Line
 
     cl = "".join(ln + "\n" for ln in NX.splitlines() if not ln.startswith("CUTCOM"))  # rs274 offsets those
-    ours = [(*e.end, e.rapid) for e in motion(read_cldata(io.StringIO(cl), "holes.cls")) if isinstance(e, Line)]
+    events = motion(read_cldata(io.StringIO(cl), "holes.cls"))
+    ours = [(*e.end, e.rapid) for e in events if isinstance(e, Line)]
     program, _ = _post(cl, "linuxcnc")
     theirs = [(x, y, z, kind == "STRAIGHT_TRAVERSE") for kind, x, y, z in _rs274(tmp_path, program)]
     assert len(theirs) > 40
-    drilled = _drilled([("STRAIGHT_TRAVERSE" if rapid else "STRAIGHT_FEED", x, y, z) for x, y, z, rapid in ours])
+    drilled = _drilled([("STRAIGHT_TRAVERSE" if fast else "STRAIGHT_FEED", x, y, z) for x, y, z, fast in ours])
     assert {xy: drilled.get(xy) for xy in NX_HOLES} == {xy: bottom for xy, (bottom, _) in NX_HOLES.items()}
     ours, theirs = _without_repeats(ours), _without_repeats(theirs)
     assert len(ours) == len(theirs)
-    assert all(a[3] == b[3] and max(abs(p - q) for p, q in zip(a[:3], b[:3])) < 1e-4 for a, b in zip(ours, theirs))
+    assert all(a[3] == b[3] and _apart(a[:3], b[:3]) < 1e-4 for a, b in zip(ours, theirs, strict=True))
