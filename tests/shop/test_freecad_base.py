@@ -5,6 +5,7 @@ real FreeCAD)."""
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -45,9 +46,11 @@ def _post(tmp_path: Path, version: str, argstring: str) -> subprocess.CompletedP
     out = tmp_path / "out.nc"
     code = (
         f"import sys; sys.path[:0] = [{str(freecad)!r}, {str(ROOT / 'plugins/freecad')!r}]\n"
-        f"import ncpp_post\nncpp_post.export([], {str(out)!r}, {(argstring + f' --ncpp {ncpp}')!r})\n"
+        f"import ncpp_post\nncpp_post.export([], {str(out)!r}, {argstring!r})\n"
     )
-    proc = subprocess.run([sys.executable, "-I", "-c", code], capture_output=True, text=True, cwd=tmp_path)
+    env = {**os.environ, "NCPP": str(ncpp)}  # where the post finds the ncpp command
+    proc = subprocess.run([sys.executable, "-I", "-c", code], capture_output=True, text=True, cwd=tmp_path,
+                          env=env)  # fmt: skip
     proc.stdout = out.read_text() if out.exists() else ""
     return proc
 

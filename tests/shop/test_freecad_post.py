@@ -45,7 +45,8 @@ def posted(tmp_path_factory):
         NCPP_PLAIN_OUT=str(tmp / "plain.ngc"),
         NCPP_PLAIN_ARGS=f"--ncpp {ncpp} --precision 4",
         NCPP_BASE_OUT=str(tmp / "grbl.nc"),
-        NCPP_BASE_ARGS=f"--base grbl --ncpp {ncpp} --machine {MACHINE} --work-offset 400,350,300",
+        NCPP_BASE_ARGS=f"--base grbl --machine {MACHINE} --work-offset 400,350,300",
+        NCPP=str(ncpp),  # the ncpp command for the post that names none
     )
     proc = subprocess.run([FREECADCMD, str(ROOT / "tests/shop/freecad/post_job.py")], capture_output=True, text=True, errors="replace", cwd=tmp, env=env, timeout=600)
     if "NCPP_POSTED" not in proc.stdout:
