@@ -284,6 +284,8 @@ def motion(records: Iterable[Record], warnings: Warnings | None = None, zero: Po
             cycle = parse_cycle(rec)
             if cycle is not None and pos is None:
                 raise NcppError(f"CYCLE/{cycle.kind} before any position (FROM or GOTO)", rec.where)
+            if cycle is not None and fixed == COMP and not leaving:  # RS274/NGC and FANUC refuse it too
+                raise NcppError(f"CYCLE/{cycle.kind} under CUTCOM/LEFT or RIGHT: turn it OFF first", rec.where)
             driller = Driller(cycle, pos[2], context.inch) if cycle is not None and pos is not None else None
         elif major == "SPINDL" and rec.numbers:
             rpm = rec.numbers[0]

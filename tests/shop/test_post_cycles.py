@@ -216,12 +216,13 @@ CL_HEAD = "UNITS / MM\nSPINDL / RPM, 1000, CLW\nFEDRAT / 100\nRAPID\nGOTO / 0, 0
      ("CYCLE/DEEP, DEPTH, 9, STEP, 3, STEP, 2, MMPM, 50", "variable pecks are not posted"),
      ("CYCLE/DRILL, DEPTH, 5, MMPM, 50, CLEAR, 1, TIMES, 3", "TIMES, 3.0 is not followed"),
      ("CYCLE/DRILL, RAPTO, 2, MMPM, 50", "expected the hole's depth"),
-     ("DELAY / REV, 3", "DELAY: expected a dwell time in seconds")],
+     ("DELAY / REV, 3", "DELAY: expected a dwell time in seconds"),
+     ("CUTCOM / LEFT\nCYCLE/DRILL, DEPTH, 5, MMPM, 50, CLEAR, 1", "CYCLE/DRILL under CUTCOM/LEFT or RIGHT")],
 )  # fmt: skip
 def test_cycles_ncpp_cannot_follow_are_refused_at_their_line(record, message):
     with pytest.raises(NcppError, match=re.escape(message)) as err:
         _post(CL_HEAD + record + "\nGOTO / 5, 5, 0\nCYCLE / OFF\nFINI\n", "linuxcnc")
-    assert err.value.where.line == 6
+    assert err.value.where.line == 5 + record.count("\n") + 1
 
 
 def test_the_post_command_drills_the_creo_holes(tmp_path):
