@@ -12,6 +12,11 @@ APT semantics used here:
 * `MULTAX` + `GOTO/ x,y,z,i,j,k`: a tool vector.  A 3-axis machine can follow
   it only while it stays constant; a changing vector is refused.
 * `GOHOME` returns to the `FROM` point (rapid); `GOHOME/Z` moves Z only.
+* Under `CYCLE/DRILL` (and the other cycles of `ncpp.cldata.cycles`) a `GOTO` is a
+  hole's top: its moves are the canned cycle's, marked `fixed` (compensation leaves
+  them as programmed, as the NC interpreter's); `CYCLE/OFF` ends the cycle.
+* Between `CUTCOM/LEFT|RIGHT` and `CUTCOM/OFF` the control offsets the path by the
+  tool radius: the moves are marked `fixed` too.
 
 Each event's block is a synthetic `Block` holding the record text (no
 items), so a writer can show it as a comment and errors can name its line.
@@ -23,9 +28,10 @@ import math
 from collections.abc import Sequence
 from typing import Iterable, Iterator
 
+from ncpp.cldata.cycles import Driller, HoleBlock, parse_cycle
 from ncpp.cldata.reader import Record
 from ncpp.errors import NcppError, Warnings
-from ncpp.motion.segments import PLANE_AXES, Arc, Context, Event, Line, Pass, Point, replace
+from ncpp.motion.segments import COMP, CYCLE, PLANE_AXES, Arc, Context, Event, Line, Pass, Point, replace
 from ncpp.program.blocks import Block
 
 ON_CIRCLE_TOL = 1e-3  # mm (or inch): GOTO within this of the circle lies on it
@@ -116,7 +122,7 @@ class _Circle:
         self.sweep += step
         self.points.append(p)
 
-    def arc(self, feed: float, context: Context) -> Arc:
+    def arc(self, feed: float, context: Context, fixed: str = "") -> Arc:
         turns = 1 + int((self.sweep - 1e-9) // (2 * math.pi))
         return Arc(
             start=self.start,
@@ -126,6 +132,7 @@ class _Circle:
             feed=feed,
             block=_block(self.record),
             context=replace(context, plane=self.plane),
+            fixed=fixed,
         )
 
 
@@ -166,6 +173,14 @@ def _check_along_z(unit: tuple[float, ...], rec: Record) -> None:
         )
 
 
+def cutter_side(rec: Record) -> str:
+    """CUTCOM/LEFT or RIGHT (the side the tool runs on), "" for CUTCOM/OFF; other forms are refused."""
+    sides = [w for w in rec.words if w in ("LEFT", "RIGHT", "OFF")]
+    if len(sides) != 1:
+        raise NcppError("CUTCOM: expected LEFT, RIGHT or OFF", rec.where)
+    return "" if sides[0] == "OFF" else sides[0]
+
+
 def motion(records: Iterable[Record], warnings: Warnings | None = None, zero: Point = (0.0, 0.0, 0.0)) -> Iterator[Event]:
     """Line / Arc / Pass events of a CL record stream; `zero`: the machine position (mm)
     of the CL data's origin, the work offset the control will hold."""
@@ -178,13 +193,17 @@ def motion(records: Iterable[Record], warnings: Warnings | None = None, zero: Po
     vector_line = 0
     context = Context(offset=zero)
     circle: _Circle | None = None
+    driller: Driller | None = None
+    rpm: float | None = None
+    fixed = ""  # COMP under CUTCOM/LEFT|RIGHT and for the move leaving it (as the NC interpreter's)
+    leaving = False  # CUTCOM/OFF: the next move is the last fixed one
 
     def flush() -> Iterator[Event]:
         nonlocal circle
         if circle is not None:
             if not circle.points:
                 raise NcppError("CIRCLE without a GOTO on it", circle.record.where)
-            yield circle.arc(feed, context)
+            yield circle.arc(feed, context, fixed)
             circle = None
 
     for rec in records:
@@ -207,17 +226,32 @@ def motion(records: Iterable[Record], warnings: Warnings | None = None, zero: Po
                             rec.where,
                         )
             end: Point = _position(rec, values)
+            if driller is not None:
+                if pos is None:
+                    raise NcppError("a CYCLE hole before any position (FROM or GOTO)", rec.where)
+                hole, moves = driller.hole(end, pos, feed, rpm)
+                block = HoleBlock(raw=rec.text, eol="\n", items=(), line=rec.line, hole=hole)
+                for x, y, z, rapid in moves:
+                    yield Line(pos, (x, y, z), rapid, hole.feed, block, context, fixed=CYCLE)
+                    pos = (x, y, z)
+                rapid_next = False
+                continue
             if circle is not None and circle.takes(end):
                 circle.add(end, rec)
                 pos = end
                 continue
             yield from flush()
-            yield Line(pos if pos is not None else end, end, rapid_next, feed, _block(rec), context)
+            start = pos if pos is not None else end
+            yield Line(start, end, rapid_next, feed, _block(rec), context, fixed=fixed)
             rapid_next = False
+            if leaving:
+                fixed, leaving = "", False
             pos = end
             continue
         yield from flush()
         if major == "CIRCLE":
+            if driller is not None:
+                raise NcppError("CIRCLE under a CYCLE: only its holes (GOTO) until CYCLE/OFF", rec.where)
             if pos is None:
                 raise NcppError("CIRCLE before any position (FROM or GOTO)", rec.where)
             circle = _Circle(rec, pos)
@@ -233,8 +267,10 @@ def motion(records: Iterable[Record], warnings: Warnings | None = None, zero: Po
             named = [a for a in "XYZ" if a in rec.words] or list("XYZ")
             x, y, z = (home[k] if a in named else pos[k] for k, a in enumerate("XYZ"))
             target: Point = (x, y, z)
-            yield Line(pos, target, True, feed, _block(rec), context)
+            yield Line(pos, target, True, feed, _block(rec), context, fixed=fixed)
             pos, rapid_next = target, False
+            if driller is not None:  # the generator ends the canned cycle for the move: a new series
+                driller = Driller(driller.cycle, pos[2], context.inch)
             continue
         elif major == "RAPID":
             rapid_next = True
@@ -244,6 +280,19 @@ def motion(records: Iterable[Record], warnings: Warnings | None = None, zero: Po
             inch = units_inch(rec)
             offset: Point = (zero[0] / 25.4, zero[1] / 25.4, zero[2] / 25.4) if inch else zero
             context = replace(context, inch=inch, offset=offset)  # program units
+        elif major == "CYCLE":
+            cycle = parse_cycle(rec)
+            if cycle is not None and pos is None:
+                raise NcppError(f"CYCLE/{cycle.kind} before any position (FROM or GOTO)", rec.where)
+            if cycle is not None and fixed == COMP and not leaving:  # RS274/NGC and FANUC refuse it too
+                raise NcppError(f"CYCLE/{cycle.kind} under CUTCOM/LEFT or RIGHT: turn it OFF first", rec.where)
+            driller = Driller(cycle, pos[2], context.inch) if cycle is not None and pos is not None else None
+        elif major == "SPINDL" and rec.numbers:
+            rpm = rec.numbers[0]
+        elif major == "CUTCOM":
+            side = cutter_side(rec)
+            leaving = not side and fixed == COMP
+            fixed = COMP if side or leaving else ""
         elif major == "MULTAX":
             multax = not (rec.words and rec.words[0] == "OFF")
         elif major == "TLAXIS" and len(rec.numbers) >= 3:

@@ -22,7 +22,8 @@ from ncpp.program.parser import lalr_parser
 # postprocessor maps to NC words; anything else is a vendor word.
 KNOWN = frozenset(
     """PARTNO UNITS MULTAX FROM GOTO RAPID FEDRAT SPINDL LOADTL LOAD CUTTER COOLNT CIRCLE
-    INDIRV TLAXIS GOHOME FINI MACHIN PPRINT INSERT REMARK TITLE OPERATOR END STOP OPSTOP""".split()
+    INDIRV TLAXIS GOHOME FINI MACHIN PPRINT INSERT REMARK TITLE OPERATOR END STOP OPSTOP
+    CYCLE DELAY CUTCOM""".split()
 )
 
 Value = float | str

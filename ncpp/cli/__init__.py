@@ -28,6 +28,7 @@ COMMANDS: tuple[str, ...] = (
     "diagnose",
     "export_table",
     "post",
+    "shipped",
 )
 
 DEFAULT_COMMAND = "filter"

@@ -119,7 +119,7 @@ def _post(
     offsets: WorkOffsets | None = None,
 ) -> int:
     from ncpp.passes import PASSES, run_passes
-    from ncpp.pipeline import header_text, make_context
+    from ncpp.pipeline import header_text, make_context, warn_fixed
 
     if dialect not in GENERATORS:
         raise NcppError(f"unknown dialect {dialect!r} (known: {', '.join(GENERATORS)})")
@@ -129,6 +129,7 @@ def _post(
     events: Iterable[Event] = motion(index.watch(read_cldata(stream, file)), warnings, zero)
     header = None
     if source is not None:
+        events = warn_fixed(events, warnings, file)  # canned cycles, cutter compensation: as programmed
         events = run_passes(events, make_context(source, tolerance, warnings, file), PASSES)
         header = header_text(source, tolerance)
     generator = GENERATORS[dialect](warnings, header, file)

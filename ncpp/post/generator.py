@@ -12,13 +12,14 @@ from __future__ import annotations
 import math
 import re
 from dataclasses import dataclass
-from itertools import pairwise
 from typing import Callable, Iterable, Iterator
 
-from ncpp.cldata.motion import MAX_WORD, units_inch
+from ncpp.cldata.cycles import Hole, HoleBlock
+from ncpp.cldata.motion import MAX_WORD, cutter_side, units_inch
 from ncpp.cldata.reader import Record
 from ncpp.errors import Location, NcppError, Warnings
 from ncpp.motion.segments import PLANE_AXES, Arc, Event, Line, Pass, Point, replace
+from ncpp.program.blocks import Block
 
 SetupLookup = Callable[[Event], "Record | None"]
 # Records that only set the interpretation of later motion: nothing to write.
@@ -88,7 +89,9 @@ class Generator:
         self.warnings = warnings or Warnings()
         self.file = file
         self.job = Job(header=header)
-        self.cycle_feed: float | None = None  # the feed a vendor CYCLE/ record names
+        self.canned = False  # a canned cycle is modal (written, not ended yet)
+        self.hole_block: Block | None = None  # the block of the hole last written
+        self.rpm: float | None = None  # the spindle speed last written
         self.position: list[str | None] = [None, None, None]  # coordinate text last written per axis
         self.feed: float | None = None
         self.tool: int | None = None
@@ -125,6 +128,11 @@ class Generator:
             self.job.inch = units_inch(record)
 
     def _event(self, event: Event, record: Record | None) -> Iterator[str]:
+        if type(event) is Line and type(event.block) is HoleBlock:
+            yield from self._hole(event)
+            return
+        if self.canned and type(event) in (Line, Arc):  # a move that is no hole ends the cycle
+            yield from self._cycle_off()
         if type(event) is Line:
             yield from self.emit_line(event)
         elif type(event) is Arc:
@@ -170,11 +178,42 @@ class Generator:
             yield from self.emit_m(1)
         elif major in ("FINI", "END"):
             return  # the footer ends the program
-        elif major == "CYCLE":
-            self.cycle_feed = None if "OFF" in rec.words else _named_number(rec, ("MMPM", "IPM"))
-            yield from self.emit_comment(_one_line(rec.text))
+        elif major == "CYCLE":  # the holes write the cycle (ncpp.cldata.cycles); OFF ends it
+            if "OFF" in rec.words:
+                yield from self._cycle_off()
+        elif major == "DELAY":
+            yield from self.emit_dwell(_dwell_time(rec))
+        elif major == "CUTCOM":
+            yield from self.emit_cutcom(cutter_side(rec))
         else:  # vendor words: ncpp.cldata.motion has warned already
             yield from self.emit_comment(_one_line(rec.text))
+
+    def _hole(self, line: Line) -> Iterator[str]:
+        """A hole's moves: the first writes the hole's canned cycle, each sets where it leaves the tool."""
+        block = line.block
+        assert isinstance(block, HoleBlock) and block.hole is not None
+        if block is not self.hole_block:
+            self.hole_block = block
+            if block.hole.series and self.canned:
+                yield from self._cycle_off()
+            yield from self.emit_hole(block.hole)
+            self.canned = True
+        self.moved_axes(line.end)
+
+    def pitch(self, hole: Hole) -> float:
+        """A tapped hole's thread pitch: its feed per revolution (per minute over the spindle speed)."""
+        cycle = hole.cycle
+        if cycle.per_rev and cycle.feed is not None:
+            return cycle.feed
+        if not self.rpm:
+            raise NcppError("CYCLE/TAP: the thread pitch needs the spindle speed (SPINDL) before it",
+                            cycle.record.where)  # fmt: skip
+        return hole.feed / self.rpm
+
+    def _cycle_off(self) -> Iterator[str]:
+        if self.canned:
+            self.canned = False
+            yield from self.emit_cycle_off()
 
     def _spindle(self, rec: Record) -> Iterator[str]:
         words = rec.words
@@ -186,7 +225,8 @@ class Generator:
             if "ON" in words:
                 yield from self.emit_m(3)
             return
-        yield from self.emit_spindle(_spindle_speed(rec), "CCLW" not in words)
+        self.rpm = _spindle_speed(rec)
+        yield from self.emit_spindle(self.rpm, "CCLW" not in words)
 
     # -- helpers for dialects ----------------------------------------------------
     @property
@@ -207,12 +247,9 @@ class Generator:
         return number(value, self.decimals)
 
     def feed_of(self, segment: Line | Arc) -> float:
-        """The segment's feed; under a vendor CYCLE/ (whose GOTOs are posted as
-        feed moves to the hole tops, not as drilling) the cycle's own feed."""
+        """The segment's feed (the CL data's FEDRAT)."""
         if segment.feed > 0:
             return segment.feed
-        if self.cycle_feed:
-            return self.cycle_feed
         raise NcppError("a feed move before any FEDRAT: the CL data gives no feed rate", Location(self.file, segment.block.line, 1))
 
     # -- what dialects spell -------------------------------------------------------
@@ -240,6 +277,20 @@ class Generator:
     def emit_m(self, code: int) -> Iterator[str]:
         raise NotImplementedError
 
+    def emit_hole(self, hole: Hole) -> Iterator[str]:
+        """A hole drilled by the dialect's canned cycle, from where the tool is (above the hole's R plane)."""
+        raise NotImplementedError
+
+    def emit_cycle_off(self) -> Iterator[str]:
+        raise NotImplementedError
+
+    def emit_dwell(self, seconds: float) -> Iterator[str]:
+        raise NotImplementedError
+
+    def emit_cutcom(self, side: str) -> Iterator[str]:
+        """Cutter radius compensation to the LEFT or RIGHT of the path, or off ("")."""
+        raise NotImplementedError
+
 
 MAX_TOOL = int(MAX_WORD)  # tool numbers a control takes
 
@@ -260,13 +311,11 @@ def _spindle_speed(rec: Record) -> float:
     return n
 
 
-def _named_number(rec: Record, names: tuple[str, ...]) -> float | None:
-    """The number after the first of `names` among the record's arguments (`MMPM, 50`)."""
-    args = rec.args
-    for arg, after in pairwise(args):
-        if arg in names and isinstance(after, float):
-            return after
-    return None
+def _dwell_time(rec: Record) -> float:
+    """DELAY/t: t seconds (from 0); DELAY/REV,n (revolutions) and other forms are refused."""
+    if rec.words or len(rec.numbers) != 1 or not 0 <= rec.numbers[0] <= MAX_WORD:
+        raise NcppError("DELAY: expected a dwell time in seconds (DELAY/t)", rec.where)
+    return rec.numbers[0]
 
 
 def _one_line(text: str) -> str:

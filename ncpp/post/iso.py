@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from typing import Any, Iterator
 
+from ncpp.cldata.cycles import Hole
 from ncpp.motion.segments import PLANE_AXES, Arc, Line
 from ncpp.post.generator import Generator, number
 
@@ -20,6 +21,7 @@ class IsoGenerator(Generator):
     tape_marks = True
     program_end = 30
     keep_point = True  # "X12." — a FANUC reads "X12" as 12 µm
+    dwell_ms = False  # G4 P and a canned cycle's P in seconds (RS274/NGC); FANUC: milliseconds
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
@@ -60,6 +62,41 @@ class IsoGenerator(Generator):
 
     def emit_m(self, code: int) -> Iterator[str]:
         yield f"M{code}"
+
+    def emit_hole(self, hole: Hole) -> Iterator[str]:
+        """`G99 G81 X Y Z R F` (G98: back to the start level; Q the peck, P the dwell); the
+        cycle's words written for every hole."""
+        cycle = hole.cycle
+        words = []
+        if self.plane != 17:
+            words.append("G17")
+            self.plane = 17
+        if not self.canned:
+            words += ["G98" if cycle.to_start else "G99", f"G{cycle.code}"]
+            self.motion = cycle.code
+        where = (hole.x, hole.y, hole.bottom, hole.r)
+        words += [f"{axis}{self.coordinate(value)}" for axis, value in zip("XYZR", where)]
+        if cycle.step:
+            words.append(f"Q{self.coordinate(cycle.step)}")
+        if cycle.dwell:
+            words.append(f"P{self.dwell(cycle.dwell)}")
+        if hole.feed != self.feed:
+            self.feed = hole.feed
+            words.append(f"F{number(hole.feed, 3, self.keep_point)}")
+        yield " ".join(words)
+
+    def emit_cycle_off(self) -> Iterator[str]:
+        self.motion = None
+        yield "G80"
+
+    def dwell(self, seconds: float) -> str:
+        return str(round(seconds * 1000)) if self.dwell_ms else number(seconds, 3)
+
+    def emit_dwell(self, seconds: float) -> Iterator[str]:
+        yield f"G4 P{self.dwell(seconds)}"
+
+    def emit_cutcom(self, side: str) -> Iterator[str]:
+        yield {"LEFT": "G41", "RIGHT": "G42", "": "G40"}[side]
 
     def _motion_word(self, code: int) -> list[str]:
         if code == self.motion:
@@ -113,12 +150,20 @@ class FanucGenerator(IsoGenerator):
         super().__init__(*args, **kwargs)
         self.length_offset: int | None = None
 
+    dwell_ms = True  # G04 P1000: one second
+
     def emit_program_number(self) -> Iterator[str]:
         yield "O0001"
 
     def emit_tool(self, tool: int) -> Iterator[str]:
         yield f"T{tool} M6"
         self.length_offset = tool
+
+    def emit_hole(self, hole: Hole) -> Iterator[str]:
+        if self.length_offset is not None:  # on its own: a canned cycle's block takes no G43
+            yield f"G43 H{self.length_offset}"
+            self.length_offset = None
+        yield from super().emit_hole(hole)
 
     def emit_line(self, line: Line) -> Iterator[str]:
         for text in super().emit_line(line):

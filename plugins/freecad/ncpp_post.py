@@ -4,8 +4,8 @@
 # General > Macro > "Macro path", e.g. ~/.local/share/FreeCAD/Macro or
 # ~/.FreeCAD/Macro); choose the post processor "ncpp" in the Job.
 #
-# It posts through FreeCAD's own LinuxCNC post (linuxcnc_post) and runs the
-# result through ncpp's compensation (the `ncpp` command of your ncpp install,
+# It posts through one of FreeCAD's own posts (linuxcnc_post, or --base NAME) and
+# runs the result through ncpp's compensation (the `ncpp` command of your ncpp install,
 # run as a separate program: FreeCAD's embedded Python need not have ncpp).
 # Arguments (the Job's "Post Processor Args"):
 #   --machine M.toml      machine file (default: $NCPP_MACHINE, then the ncpp
@@ -16,7 +16,10 @@
 #                         G5x=; repeat it for the Job's other fixtures G55...)
 #   --var-file FILE       LinuxCNC parameter file holding the zeros (--var-units inch)
 #   --tool-table FILE     LinuxCNC tool table: the lengths the program's G43 applies
-# Any other argument goes to linuxcnc_post (e.g. --no-comments, --precision 4).
+#   --base NAME           FreeCAD's post to wrap: linuxcnc (default), grbl, fanuc,
+#                         mach3_mach4 or centroid
+# Any other argument goes to that post (e.g. --no-comments, --precision 4).
+# `ncpp install-freecad-post` copies this file into the macro directory.
 #
 # The ncpp program is found from the user's side only, never from the Job's arguments
 # (they are saved in the .FCStd, and a shared document must not choose a program to run):
@@ -27,6 +30,7 @@
 # the class named after the file (`Ncpp`) and calls its export().
 
 import argparse
+import importlib
 import importlib.util
 import os
 import shlex
@@ -34,7 +38,7 @@ import shutil
 import subprocess
 import tempfile
 
-TOOLTIP = """Posts through FreeCAD's LinuxCNC post, then compensates the program
+TOOLTIP = """Posts through FreeCAD's LinuxCNC post (or --base NAME), then compensates the program
 for the machine's geometric errors with ncpp (header names the machine file)."""
 
 parser = argparse.ArgumentParser(prog="ncpp", add_help=False)
@@ -46,19 +50,26 @@ parser.add_argument("--var-file", help="LinuxCNC parameter file holding the zero
 parser.add_argument("--tool-table", help="LinuxCNC tool table: the lengths the program's G43 applies")
 parser.add_argument("--var-units", help="units of --var-file and --tool-table: mm or inch")
 parser.add_argument("--ncpp", help="refused: ncpp is found from $NCPP, the FreeCAD parameter or PATH")
+# FreeCAD's own posts this one can wrap: all write ISO G code that the ncpp filter reads
+BASES = ("linuxcnc", "grbl", "fanuc", "mach3_mach4", "centroid")
+parser.add_argument("--base", default="linuxcnc", help=f"FreeCAD's post to wrap: {', '.join(BASES)}")
 
-TOOLTIP_ARGS = parser.format_help() + "\nOther arguments are passed to linuxcnc_post.\n"
+TOOLTIP_ARGS = parser.format_help() + "\nOther arguments are passed to the --base post (linuxcnc_post).\n"
 
 
-def _linuxcnc_post():
-    """A fresh copy of FreeCAD's linuxcnc_post.  It keeps its options in module
+def _base_post(name):
+    """A fresh copy of FreeCAD's `name`_post.  Such a post keeps its options in module
     globals that only its flags change (--no-comments, --inches, ... stay set
     for the rest of the session), so each post starts from a new module."""
-    try:  # FreeCAD 1.x
-        from Path.Post.scripts import linuxcnc_post
+    if name not in BASES:
+        raise RuntimeError(f"ncpp_post: --base {name}: expected one of {', '.join(BASES)}")
+    try:  # FreeCAD 1.x; after 1.0 the script post with export() is NAME_legacy_post
+        base = importlib.import_module(f"Path.Post.scripts.{name}_post")
+        if not hasattr(base, "export"):
+            base = importlib.import_module(f"Path.Post.scripts.{name}_legacy_post")
     except ImportError:  # FreeCAD 0.19-0.21 (Path is only the C++ module)
-        from PathScripts.post import linuxcnc_post
-    spec = importlib.util.spec_from_file_location(linuxcnc_post.__name__, linuxcnc_post.__file__)
+        base = importlib.import_module(f"PathScripts.post.{name}_post")
+    spec = importlib.util.spec_from_file_location(base.__name__, base.__file__)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
@@ -114,12 +125,12 @@ def compensate_text(gcode, argstring):
     return proc.stdout.decode("latin-1")
 
 
-def linuxcnc_text(objectslist, argstring):
-    """What FreeCAD's LinuxCNC post makes of the objects, with ncpp's own arguments removed."""
-    _, rest = parser.parse_known_args(shlex.split(argstring or ""))
-    post = _linuxcnc_post()
+def base_text(objectslist, argstring):
+    """What FreeCAD's --base post makes of the objects, with ncpp's own arguments removed."""
+    options, rest = parser.parse_known_args(shlex.split(argstring or ""))
+    post = _base_post(options.base)
     with tempfile.TemporaryDirectory(prefix="ncpp_post") as folder:
-        raw = os.path.join(folder, "linuxcnc.ngc")
+        raw = os.path.join(folder, f"{options.base}.ngc")
         result = post.export(objectslist, raw, " ".join(shlex.quote(a) for a in rest + ["--no-show-editor"]))
         if os.path.exists(raw):
             with open(raw, encoding="latin-1") as f:
@@ -129,7 +140,7 @@ def linuxcnc_text(objectslist, argstring):
 
 def export(objectslist, filename, argstring):
     """Legacy entry point (FreeCAD 0.19-0.21): post, compensate, write `filename`."""
-    gcode = compensate_text(linuxcnc_text(objectslist, argstring), argstring)
+    gcode = compensate_text(base_text(objectslist, argstring), argstring)
     if filename != "-":
         with open(filename, "w", encoding="latin-1", newline="") as f:
             f.write(gcode)
@@ -144,7 +155,7 @@ except ImportError:
 if _PostProcessor is not None:
 
     class Ncpp(_PostProcessor):
-        """`ncpp` for FreeCAD 1.x: each output section posted by linuxcnc_post, then compensated."""
+        """`ncpp` for FreeCAD 1.x: each output section posted by the --base post, then compensated."""
 
         def __init__(self, job):
             super().__init__(job, tooltip=TOOLTIP, tooltipargs=TOOLTIP_ARGS, units=None)  # the units property
@@ -159,7 +170,7 @@ if _PostProcessor is not None:
 
         @property
         def units(self):
-            """What linuxcnc_post writes: G20 (Inch) for --inches, else G21 (Metric)."""
+            """What the --base post writes: G20 (Inch) for --inches, else G21 (Metric)."""
             return "Inch" if "--inches" in shlex.split(self._argstring()) else "Metric"
 
         def _argstring(self):
@@ -167,4 +178,5 @@ if _PostProcessor is not None:
 
         def export(self):
             argstring = self._argstring()
-            return [(name, compensate_text(linuxcnc_text(objects, argstring), argstring)) for name, objects in self._buildPostList()]
+            posted = [(name, base_text(objects, argstring)) for name, objects in self._buildPostList()]
+            return [(name, compensate_text(gcode, argstring)) for name, gcode in posted]

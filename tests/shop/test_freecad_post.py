@@ -45,6 +45,8 @@ def posted(tmp_path_factory):
         NCPP_POST_ARGS=f"--machine {MACHINE} --work-offset 400,350,300 --precision 4 --no-comments",
         NCPP_PLAIN_OUT=str(tmp / "plain.ngc"),
         NCPP_PLAIN_ARGS="--precision 4",
+        NCPP_BASE_OUT=str(tmp / "grbl.nc"),
+        NCPP_BASE_ARGS=f"--base grbl --machine {MACHINE} --work-offset 400,350,300",
     )
     proc = subprocess.run([FREECADCMD, str(ROOT / "tests/shop/freecad/post_job.py")], capture_output=True, text=True, errors="replace", cwd=tmp, env=env, timeout=600)
     if "NCPP_POSTED" not in proc.stdout:
@@ -116,3 +118,10 @@ def test_the_post_passes_every_fixture_zero_to_ncpp(tmp_path, monkeypatch):
     assert g55_part(text) != g55_part(only_g54)  # compensated where G55 really is
     assert text[: text.index("G55")] == only_g54[: only_g54.index("G55")]
 
+
+def test_the_post_wraps_freecads_grbl_post_with_base(posted):
+    compensated, _, _ = posted
+    grbl = (compensated.parent / "grbl.nc").read_text().splitlines()
+    assert grbl[0].startswith("(ncpp compensated for hr5b.toml sha256:")
+    assert any("grbl_post" in ln for ln in grbl[:6]) and not any("linuxcnc_post" in ln for ln in grbl[:6])
+    assert any(ln.startswith(("G2", "G3")) for ln in grbl)

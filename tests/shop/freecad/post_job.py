@@ -58,6 +58,8 @@ try:
 
     post(os.environ["NCPP_OUT"], os.environ["NCPP_POST_ARGS"])
     post(os.environ["NCPP_PLAIN_OUT"], os.environ["NCPP_PLAIN_ARGS"])
+    if os.environ.get("NCPP_BASE_OUT"):  # through another of FreeCAD's posts (--base)
+        post(os.environ["NCPP_BASE_OUT"], os.environ["NCPP_BASE_ARGS"])
     print("NCPP_POSTED", FreeCAD.Version()[0] + "." + FreeCAD.Version()[1] + "." + FreeCAD.Version()[2])
 except Exception:
     traceback.print_exc()
