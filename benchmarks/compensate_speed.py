@@ -30,6 +30,7 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 MACHINE = ROOT / "samples/machines/hr5b.toml"
 TOLERANCE = 0.001
+VERIFY_TARGET = 0.30  # the verifier's CPU at most this share of compensation's without it
 PERFORMANCE_TABLE = HERE / "out" / "performance.md"
 PROGRAMS = 4  # generated programs compensated across processes
 FLOORS = {
@@ -54,8 +55,9 @@ def work_offset(path: Path) -> tuple[float, float, float]:
     return tuple(float(v) for v in np.asarray(offset))  # type: ignore[return-value]
 
 
-def ncpp_process_rate(path: Path, offset: tuple[float, float, float] | None) -> dict[str, Any]:
-    """`process` over the whole file into a null sink: passthrough (offset None) or compensation."""
+def ncpp_process_rate(path: Path, offset: tuple[float, float, float] | None, verify: bool = True) -> dict[str, Any]:
+    """`process` over the whole file into a null sink: passthrough (offset None) or compensation,
+    verified (the default, as every command runs it) or not."""
     from accuracy import QUIET
     from ncpp.motion.offsets import WorkOffsets
     from ncpp.pipeline import ErrorSource, process
@@ -65,7 +67,8 @@ def ncpp_process_rate(path: Path, offset: tuple[float, float, float] | None) -> 
     with open(os.devnull, "wb") as sink, open(path, "rb") as stream:
         cpu, start = time.process_time(), time.perf_counter()
         stats = process(
-            stream, sink, file=str(path), source=source, tolerance=TOLERANCE, warnings=QUIET, offsets=offsets
+            stream, sink, file=str(path), source=source, tolerance=TOLERANCE, warnings=QUIET, offsets=offsets,
+            verify=verify,
         )
         seconds, cpu = time.perf_counter() - start, time.process_time() - cpu
     return {
@@ -270,17 +273,24 @@ def compensate_speed(ctx):
                 "passthrough": lambda: in_fresh_process("ncpp_process_rate", path, None),
                 "pygcode": lambda: in_fresh_process("pygcode_rate", path),
                 "compensate": lambda: in_fresh_process("ncpp_process_rate", path, offset),
+                "unverified": lambda: in_fresh_process("ncpp_process_rate", path, offset, False),
             }
         )
         passthrough, compensated, pyg = best["passthrough"], best["compensate"], best["pygcode"]
+        unverified = best["unverified"]
+        verifying = compensated["cpu_s"] / max(unverified["cpu_s"], 1e-9) - 1
         rs = bench.rs274_rate(path, lines)
         ratios = {
             "one process / pygcode": ("compensate", compensated),
             "passthrough / pygcode": ("passthrough", passthrough),
         }
         stages = stage_seconds(path, offset)
+        table.append(["verifier's cost (CPU, against --no-verify)", label, f"{100 * verifying:.0f}%",
+                      f"≤ {100 * VERIFY_TARGET:.0f}%", "met" if verifying <= VERIFY_TARGET else "short"])
         data[label] = {
             "work_offset_mm": offset,
+            "unverified": unverified,
+            "verifier_cost": verifying,
             "passthrough": passthrough,
             "compensate": compensated,
             "pygcode": pyg,
@@ -296,6 +306,12 @@ def compensate_speed(ctx):
                 f"{compensated['lines_per_s']:,.0f}",
                 f"lines out/in {growth:.2f}; "
                 f"CPU {1e6 * compensated['cpu_s'] / max(lines, 1):.0f} µs per line in",
+            ],
+            [
+                label,
+                "ncpp compensate --no-verify, one process",
+                f"{unverified['lines_per_s']:,.0f}",
+                f"the verifier costs {100 * verifying:.0f}% of this CPU (target at most {100 * VERIFY_TARGET:.0f}%)",
             ],
             [label, "pygcode Line()", f"{pyg['lines_per_s']:,.0f}", ""],
             [
