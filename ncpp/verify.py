@@ -97,12 +97,17 @@ class _Moves:
     """Moves collected for one section, sampled when it closes."""
 
     bound: "Bound"
-    ends: list = field(default_factory=list)  # per move: (x0, y0, z0, x1, y1, z1) machine mm
-    extra: list = field(default_factory=list)  # per move: its extra axes' start and end (NO_EXTRA twice: none)
+    ends: list = field(default_factory=list)  # per move: (x0, y0, z0, x1, y1, z1) program coordinates
+    frames: list = field(default_factory=list)  # the contexts the moves were made in, each once in a row
+    frame_of: list = field(default_factory=list)  # per move: its context's index in `frames`
+    frame: object = None  # the last context
+    extra: dict = field(default_factory=dict)  # move -> its extra axes' start and end, where any is not 0
     rapid: list = field(default_factory=list)
     lines: list = field(default_factory=list)
-    arcs: list = field(default_factory=list)  # (move, plane, centre's first, centre's second coordinate, turn)
+    arcs: list = field(default_factory=list)  # (move, plane, centre (program coordinates), turn)
     feeds: list = field(default_factory=list)
+    feed: float = math.nan  # the last feed move's F and units (a new one is looked at)
+    feed_inch: bool = False
     inverse_time: float = 0.0
 
     def sample(self, action: Action | None, first_line: int) -> Section:
@@ -110,14 +115,19 @@ class _Moves:
         if not self.ends:
             empty = np.zeros((0, 4))
             return Section(empty, empty, np.zeros(0, bool), np.zeros(0, int), self.feeds, self.inverse_time, action, first_line)
-        ends = np.array(self.ends)
-        starts, ends = ends[:, :3], ends[:, 3:]
-        if any(e is not NO_EXTRA for pair in self.extra for e in pair):
-            extra = np.array([s + e for s, e in self.extra])
+        raw = np.array(self.ends)
+        frame = np.array(self.frame_of)
+        offsets = np.array([f.offset for f in self.frames])[frame]  # type: ignore[attr-defined]
+        units = np.array([f.unit_mm for f in self.frames])[frame][:, None]  # type: ignore[attr-defined]
+        starts, ends = (raw[:, :3] + offsets) * units, (raw[:, 3:] + offsets) * units
+        if self.extra:
+            extra = np.zeros((len(raw), 2 * len(EXTRA_AXES)))
+            for k, (s, e) in self.extra.items():
+                extra[k] = s + e
             starts = np.hstack((starts, extra[:, : len(EXTRA_AXES)]))
             ends = np.hstack((ends, extra[:, len(EXTRA_AXES) :]))
         counts = np.ones(len(starts), dtype=np.int64)
-        arcs = _Arcs(self.arcs, starts, ends) if self.arcs else None
+        arcs = _Arcs(self.arcs, starts, ends, offsets, units) if self.arcs else None
         if arcs is not None:
             counts[arcs.move] = arcs.chords(self.bound.chord)
         move = np.repeat(np.arange(len(counts)), counts + 1)
@@ -141,17 +151,20 @@ class _Moves:
 class _Arcs:
     """A section's arcs, as arrays: what their samples need to lie on them."""
 
-    def __init__(self, arcs: list, starts: np.ndarray, ends: np.ndarray):
-        table = np.array([(m, *PLANE_AXES[plane][:2], ci, cj, turn) for m, plane, ci, cj, turn in arcs])
+    def __init__(self, arcs: list, starts: np.ndarray, ends: np.ndarray, offsets: np.ndarray, units: np.ndarray):
+        table = np.array([(m, *PLANE_AXES[plane][:2], *centre, turn) for m, plane, centre, turn in arcs])
         self.move = table[:, 0].astype(np.int64)
         i, j = table[:, 1].astype(np.int64), table[:, 2].astype(np.int64)
-        self.i, self.j, self.ci, self.cj = i, j, table[:, 3], table[:, 4]
+        centre = (table[:, 3:6] + offsets[self.move]) * units[self.move]  # machine mm
+        rows = np.arange(len(table))
+        self.i, self.j, self.ci, self.cj = i, j, centre[rows, i], centre[rows, j]
+        table = np.column_stack((table[:, :3], table[:, 6]))  # (move, i, j, turn)
         rows = self.move
         s_i, s_j = starts[rows, i] - self.ci, starts[rows, j] - self.cj
         e_i, e_j = ends[rows, i] - self.ci, ends[rows, j] - self.cj
         self.a0 = np.arctan2(s_j, s_i)
         self.r0, self.r1 = np.hypot(s_i, s_j), np.hypot(e_i, e_j)
-        self.sweep = _sweeps(self.a0, np.arctan2(e_j, e_i), table[:, 5])
+        self.sweep = _sweeps(self.a0, np.arctan2(e_j, e_i), table[:, 3])
 
     def chords(self, within: float) -> np.ndarray:
         """How many chords each arc takes for none to lie further than `within` from it."""
@@ -256,26 +269,33 @@ def _may_act(signature: str | None) -> bool:
 
 
 def _add(moves: _Moves, event: Line | Arc, extra: tuple[float, ...], inverse_time: bool, line: int) -> tuple[float, ...]:
-    """Add a move (told by `line`); return the extra axes' positions after it."""
+    """Add a move (told by `line`); return the extra axes' positions after it.  (A move's own
+    work is a few appends: the numbers are turned to machine mm a section at a time.)"""
     ctx = event.context
-    (ox, oy, oz), u = ctx.offset, ctx.unit_mm
-    (x0, y0, z0), (x1, y1, z1) = event.start, event.end
-    moves.ends.append(((x0 + ox) * u, (y0 + oy) * u, (z0 + oz) * u, (x1 + ox) * u, (y1 + oy) * u, (z1 + oz) * u))
-    end_extra = (tuple(event.extra) + NO_EXTRA)[: len(EXTRA_AXES)] if event.extra else extra
-    moves.extra.append((extra, end_extra))
+    if ctx is not moves.frame:
+        moves.frame = ctx
+        moves.frames.append(ctx)
+    moves.frame_of.append(len(moves.frames) - 1)
+    moves.ends.append(event.start + event.end)
+    if event.extra:
+        end_extra = (tuple(event.extra) + NO_EXTRA)[: len(EXTRA_AXES)]
+        moves.extra[len(moves.ends) - 1] = (extra, end_extra)
+    elif extra is not NO_EXTRA:
+        moves.extra[len(moves.ends) - 1] = (extra, extra)
+        end_extra = extra
+    else:
+        end_extra = extra
     rapid = type(event) is Line and event.rapid  # type: ignore[union-attr]
     moves.rapid.append(rapid)
     moves.lines.append(line)
     if type(event) is Arc:
-        i, j, _ = PLANE_AXES[ctx.plane]
-        cx, cy, cz = event.center
-        centre = ((cx + ox) * u, (cy + oy) * u, (cz + oz) * u)
-        moves.arcs.append((len(moves.ends) - 1, ctx.plane, centre[i], centre[j], event.turn))
+        moves.arcs.append((len(moves.ends) - 1, ctx.plane, event.center, event.turn))
     if not rapid:
         if inverse_time:
             moves.inverse_time += 1.0 / event.feed if event.feed > 0 else math.inf
-        else:
-            feed = event.feed * u
+        elif event.feed != moves.feed or ctx.inch != moves.feed_inch:
+            moves.feed, moves.feed_inch = event.feed, ctx.inch
+            feed = event.feed * ctx.unit_mm
             if not moves.feeds or not math.isclose(moves.feeds[-1][0], feed, rel_tol=1e-9, abs_tol=1e-9):
                 moves.feeds.append((feed, line))
     return end_extra
