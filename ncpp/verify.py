@@ -549,7 +549,10 @@ class _Comparison:
             raise NcppError(f"verification: {message}: it has no move here", Location(file, line, 1))
         within = self.bound.within
         (starts, ends), (a, b) = _alike((path.starts, path.ends), (along.starts, along.ends))
-        far = _Nearby(a, b, self.bound).first_outside(starts, ends, within)
+        try:
+            far = _Nearby(a, b, self.bound).first_outside(starts, ends, within)
+        except NcppError as err:
+            raise NcppError(err.message, Location(file, int(path.lines[0]), 1)) from None
         if far is None:
             return
         k, point = far
@@ -674,6 +677,7 @@ class _Nearby:
         t = (np.arange(len(self.segment)) - first[self.segment]) / counts[self.segment]
         points = starts[self.segment] + t[:, None] * (ends - starts)[self.segment]
         self.tree = cKDTree(points, balanced_tree=False)
+        self.looked_at = 0
 
     def distances(self, points: np.ndarray, within: float, k: int) -> tuple[np.ndarray, np.ndarray]:
         """(n, k) segments near each point (-1: none) and the points' distances to them."""
@@ -697,22 +701,21 @@ class _Nearby:
         return float(distance[0, k]), int(segments[0, k])
 
     def _across_a_vertex(self, rest: np.ndarray, segments: np.ndarray, distance: np.ndarray, closest: np.ndarray,
-                         pair: np.ndarray, n: int, within: float) -> np.ndarray:  # fmt: skip
-        """Which of the segments `rest` lie within `within` along their length for having their
-        ends near two segments here that follow one another (q, then q + 1 from q's end: the
-        chords of an arc, the sides of a corner).  A point between the two ends lies as far from
-        the line between their closest points as the ends do at most, and that line as far from
-        the two segments as it passes from their common vertex."""
-        a_seg, b_seg = segments[rest][:, :, None], segments[n + rest][:, None, :]
-        r, i, j = np.nonzero((b_seg == a_seg + 1) & (a_seg >= 0) & pair[rest])
-        q = segments[rest[r], i]
-        vertex = self.ends[q]
-        joined = np.all(vertex == self.starts[np.minimum(q + 1, len(self.starts) - 1)], axis=1)
-        off = np.maximum(distance[rest[r], i], distance[n + rest[r], j])
-        cut = _to_lines(vertex, closest[rest[r], i], closest[n + rest[r], j])
-        ok = np.zeros(len(rest), dtype=bool)
-        ok[r[joined & (off + cut <= within)]] = True
-        return ok
+                         starts: np.ndarray, ends: np.ndarray, n: int, within: float) -> np.ndarray:  # fmt: skip
+        """Which of the segments `rest` (starts-ends) lie within `within` along their length for
+        having their start near a segment q here and their end near the one after it, q + 1 from
+        q's end (the chords of an arc, the sides of a corner).  A point between the two ends lies
+        as far from the line between their closest points as the ends do at most, and that line
+        as far from the two segments as it passes from their common vertex."""
+        q = segments[rest]  # (m, k) segments near the starts
+        after = np.minimum(q + 1, len(self.starts) - 1)
+        joined = (q >= 0) & (q + 1 < len(self.starts)) & np.all(self.ends[q] == self.starts[after], axis=2)
+        near_end, at_end = _to_segments(ends[rest], self.starts[after], self.ends[after])
+        off = np.maximum(distance[rest], near_end)
+        width = self.ends.shape[1]
+        vertex = self.ends[q].reshape(-1, width)
+        cut = _to_lines(vertex, closest[rest].reshape(-1, width), at_end.reshape(-1, width)).reshape(q.shape)
+        return (joined & (off + cut <= within)).any(axis=1)
 
     def first_outside(self, starts: np.ndarray, ends: np.ndarray, within: float) -> tuple[int, np.ndarray] | None:
         """The first segment of starts-ends with a point further than `within` from every segment
@@ -730,7 +733,6 @@ class _Nearby:
         order = np.concatenate((np.arange(n), where_end))
         segments, distance, closest = segments[order], distance[order], closest[order]
         near = distance <= within
-        pair = near[:n, :, None] & near[n:, None, :]
         # a segment near one end, near the other too (looked at from both ends: segments lying
         # over one another, as a peck's, crowd the nearest points of either)
         ends_to_start, _ = _to_segments(ends, self.starts[segments[:n]], self.ends[segments[:n]])
@@ -739,7 +741,7 @@ class _Nearby:
         common |= (near[n:] & (segments[n:] >= 0) & (starts_to_end <= within)).any(axis=1)
         rest = np.flatnonzero(~common)
         if len(rest):
-            rest = rest[~self._across_a_vertex(rest, segments, distance, closest, pair, n, within)]
+            rest = rest[~self._across_a_vertex(rest, segments, distance, closest, starts, ends, n, within)]
         if not len(rest):
             return None
         step = within / 4
@@ -757,10 +759,26 @@ class _Nearby:
             if low.any():
                 _, again = self.distances(some[low], allowed, self.MANY)
                 low[np.flatnonzero(low)] = again.min(axis=1) > allowed
-            if low.any():
-                k = batch + int(np.argmax(low))
-                return int(rest[which[k]]), points[k]
+            for k in np.flatnonzero(low).tolist():  # the nearest found were not all: every one within reach
+                if self._beyond(some[k], allowed):
+                    return int(rest[which[batch + k]]), some[k]
         return None
+
+    LOOKED_AT = 2_000_000  # segments a run may look at one by one (`_beyond`)
+
+    def _beyond(self, point: np.ndarray, allowed: float) -> bool:
+        """Whether no segment here passes within `allowed` of the point, looked at one by one
+        (where the path lies over itself more often than the nearest points show)."""
+        found = self.tree.query_ball_point(point, allowed + self.reach)
+        self.looked_at += len(found)
+        if self.looked_at > self.LOOKED_AT:
+            raise NcppError("verification: the path lies over itself too often here to be verified "
+                            "(--no-verify writes the program unverified)")
+        if not found:
+            return True
+        segments = np.unique(self.segment[found])
+        distance, _ = _to_segments(point[None, :], self.starts[segments][None], self.ends[segments][None])
+        return bool(distance.min() > allowed)
 
 
 def _to_segments(points: np.ndarray, starts: np.ndarray, ends: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

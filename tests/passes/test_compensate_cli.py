@@ -127,8 +127,9 @@ def test_thesis_reference_case_from_a_ballbar_file(tmp_path):
 def test_an_arc_of_more_turns_than_compensation_holds_is_refused_with_its_line(tmp_path, program, turns):
     path = tmp_path / "helix.ngc"
     path.write_text(f"G17 G21 G90\nG0 X0 Y0 Z0\n{program}\nM2\n")
-    proc = subprocess.run([sys.executable, "-m", "ncpp", "compensate", "--machine", str(MACHINE), "--work-offset", "400,350,300", str(path)],
-                          capture_output=True, text=True)  # fmt: skip
+    # (a path lying over itself 10,000 times is more than the verifier looks at: `verify._Nearby`)
+    proc = subprocess.run([sys.executable, "-m", "ncpp", "compensate", "--machine", str(MACHINE), "--work-offset", "400,350,300", str(path),
+                           "--no-verify"], capture_output=True, text=True)  # fmt: skip
     if turns is None:  # (10,000 turns: 80,000 lines)
         assert proc.returncode == 0 and proc.stdout.count("\n") > 80_000
     else:

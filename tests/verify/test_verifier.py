@@ -7,6 +7,7 @@ what the verifier must let through (corrections within the bound) and what it mu
 from __future__ import annotations
 
 import io
+from pathlib import Path
 
 import pytest
 
@@ -128,3 +129,17 @@ def test_heidenhain_tool_calls_are_actions():
     with pytest.raises(NcppError) as caught:
         check(original, original.replace("TOOL CALL 2 Z S3000", "TOOL CALL 3 Z S3000"), dialect="heidenhain")
     assert "TOOLCALL3" in caught.value.message
+
+
+
+def test_a_path_over_itself_too_often_is_refused_with_a_way_out(tmp_path, capsys):
+    """A helix of a thousand turns in one place: its segments lie over one another more often
+    than the verifier looks at one by one; it says so at the line, rather than pass it unseen."""
+    from ncpp.cli import main
+
+    path = tmp_path / "helix.ngc"
+    path.write_text("G17 G21 G90\nG0 X0 Y0 Z0\nG2 X0 Y0 I10 J0 Z1 P1000 F100\nM2\n")
+    machine = str(Path(__file__).resolve().parents[2] / "samples/machines/hr5b.toml")
+    assert main(["compensate", "--machine", machine, "--work-offset", "400,350,300", str(path), "-o", str(tmp_path / "out.ngc")]) != 0
+    err = capsys.readouterr().err
+    assert "helix.ngc:" in err and "verification: the path lies over itself too often" in err and "--no-verify" in err
