@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import argparse
 
-from ncpp.cli.compensate import add_compensation_arguments, error_source, work_offsets
+from ncpp.cli.compensate import add_compensation_arguments, error_source, tell, work_offsets
 from ncpp.cli.io import open_output
 from ncpp.errors import Warnings
 
@@ -32,17 +32,23 @@ def run(args: argparse.Namespace) -> int:
 
     from ncpp.cli.progress import progress_printer
     from ncpp.post import post
+    from ncpp.summary import Summary
 
     source = error_source(args)
+    summary = Summary(args.input) if source is not None else None
     offsets = work_offsets(args)
     warnings = Warnings(strict=args.strict)
     progress = progress_printer("post")
     with open_output(args.output) as out:
         if args.input == "-":
-            post(sys.stdin, out, file="<stdin>", dialect=args.dialect, source=source, tolerance=args.tolerance, warnings=warnings, progress=progress, offsets=offsets, verify=args.verify)
+            post(sys.stdin, out, file="<stdin>", dialect=args.dialect, source=source, tolerance=args.tolerance, warnings=warnings, progress=progress, offsets=offsets, verify=args.verify,
+                 summary=summary)  # fmt: skip
         else:
             with open(args.input, encoding="latin-1") as stream:
-                post(stream, out, file=args.input, dialect=args.dialect, source=source, tolerance=args.tolerance, warnings=warnings, progress=progress, offsets=offsets, verify=args.verify)
+                post(stream, out, file=args.input, dialect=args.dialect, source=source, tolerance=args.tolerance, warnings=warnings, progress=progress, offsets=offsets, verify=args.verify,
+                     summary=summary)  # fmt: skip
     if progress is not None:
         progress.done()
+    if summary is not None:
+        tell(summary, args.report)
     return 0

@@ -20,6 +20,7 @@ from ncpp.post.generator import Generator
 from ncpp.post.heidenhain import HeidenhainGenerator
 from ncpp.post.iso import FanucGenerator, IsoGenerator, LinuxCncGenerator
 from ncpp.post.sinumerik import SinumerikGenerator
+from ncpp.summary import Summary
 
 GENERATORS: dict[str, type[Generator]] = {
     "iso": IsoGenerator,
@@ -64,6 +65,7 @@ def post(
     progress: Callable[[int], None] | None = None,
     offsets: WorkOffsets | None = None,
     verify: bool = True,
+    summary: Summary | None = None,
 ) -> int:
     """Post one CL file as a `dialect` program (compensated when `source` is an
     `ncpp.pipeline.ErrorSource`, the CL origin at `offsets`' G54 zero);
@@ -71,16 +73,17 @@ def post(
 
     A compensated program is verified before it is written (`ncpp/verify.py`): the CL
     data is posted a second time without compensation, and the compensated program
-    must do what that one does (`verify=False` skips it)."""
+    must do what that one does (`verify=False` skips it).  `summary` is told what compensation did
+    (its lines in are the CL records)."""
     if source is not None and verify:
         return _verified(stream, out, file=file, dialect=dialect, source=source, tolerance=tolerance,
-                         warnings=warnings, progress=progress, offsets=offsets)  # fmt: skip
+                         warnings=warnings, progress=progress, offsets=offsets, summary=summary)  # fmt: skip
     return _post(stream, out, file=file, dialect=dialect, source=source, tolerance=tolerance,
-                 warnings=warnings, progress=progress, offsets=offsets)  # fmt: skip
+                 warnings=warnings, progress=progress, offsets=offsets, summary=summary)  # fmt: skip
 
 
 def _verified(stream: TextIO, out: BinaryIO, *, file: str, dialect: str, source, tolerance: float, warnings: Warnings | None,
-              progress: Callable[[int], None] | None, offsets: WorkOffsets | None) -> int:  # fmt: skip
+              progress: Callable[[int], None] | None, offsets: WorkOffsets | None, summary: Summary | None) -> int:  # fmt: skip
     """Post compensated and uncompensated to temporary files; verify, then copy to `out`."""
     import io
     import shutil
@@ -93,7 +96,7 @@ def _verified(stream: TextIO, out: BinaryIO, *, file: str, dialect: str, source,
         shutil.copyfileobj(stream, cl)
         cl.seek(0)
         count = _post(cl, written, file=file, dialect=dialect, source=source, tolerance=tolerance, warnings=warnings,
-                      progress=progress, offsets=offsets)  # fmt: skip
+                      progress=progress, offsets=offsets, summary=summary)  # fmt: skip
         cl.seek(0)
         _post(cl, plain, file=file, dialect=dialect, source=None, warnings=Warnings(stream=io.StringIO()), offsets=offsets)
         plain.seek(0)
@@ -117,6 +120,7 @@ def _post(
     warnings: Warnings | None = None,
     progress: Callable[[int], None] | None = None,
     offsets: WorkOffsets | None = None,
+    summary: Summary | None = None,
 ) -> int:
     from ncpp.passes import PASSES, run_passes
     from ncpp.pipeline import header_text, make_context
@@ -129,13 +133,17 @@ def _post(
     events: Iterable[Event] = motion(index.watch(read_cldata(stream, file)), warnings, zero)
     header = None
     if source is not None:
-        events = run_passes(events, make_context(source, tolerance, warnings, file), PASSES)
+        summary = summary if summary is not None else Summary(file)
+        warnings.listeners.append(summary.heard)
+        events = summary.written(run_passes(summary.programmed(events), make_context(source, tolerance, warnings, file), PASSES))
         header = header_text(source, tolerance)
     generator = GENERATORS[dialect](warnings, header, file)
     written = 0
     for line in generator.write(events, index):
         out.write((line + "\n").encode("latin-1", errors="replace"))
         written += 1
+    if summary is not None:
+        summary.lines_in, summary.lines_out = index.count, written
     warnings.finish()
     return written
 

@@ -1,0 +1,150 @@
+"""The placement guard: a compensated program stops at its start unless the control's
+work offset is the one it was compensated for.
+
+Compensation corrects the errors of the places the program's points take on the
+machine, which the work offset decides (`--work-offset`, `--var-file`).  Run under
+another offset, the program carries the corrections of other places.  The guard
+reads the control's active coordinate system and its zero (X Y Z) and stops the
+program, with a message, when the system differs or an axis's zero is more than
+`GUARD_MM` from the one told.  It is written only where ncpp was told the offset.
+
+Per control (the ISO dialect: LinuxCNC's syntax, or Fanuc's for a program that
+starts with an O number):
+
+* LinuxCNC (G-code manual, "G Code Overview": numbered parameters #5220, the active
+  system 1-9, and #5221-#5223, ..., G54's X Y Z, with 20 per system; its comments
+  section: `(abort, text)` ends the program with the text, `(MSG, text)` shows it):
+  the values stand in the machine's units (the INI's [TRAJ]LINEAR_UNITS), whatever
+  G20/G21, as rs274 reads them.
+* Fanuc and Haas (Custom Macro B: #4014 holds group 14's G code, 54-59; #5221-#5223
+  G54's X Y Z, 20 per system; `#3000=n (text)` raises macro alarm n with the text and
+  stops; `IF [cond] THEN` one assignment): G54-G59 only.
+
+Heidenhain and Sinumerik programs get no guard (yet): their presets and settable
+frames are read differently (`FN 18: SYSREAD`, `$P_UIFR`), left to a later step.
+
+Readers of a written program drop the guard (`without_guard`): ncpp's interpreter
+does not know the control's parameters, and the guard neither moves nor acts.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from itertools import chain, islice
+from typing import Iterable, Iterator
+
+from ncpp.motion.offsets import WorkOffsets
+from ncpp.program.blocks import Block, Comment
+
+GUARD_MM = 0.1  # how far an axis's zero may be from the one told: re-touching a fixture moves it microns
+BEGIN = "ncpp placement guard:"
+END = "ncpp placement guard end"
+SCAN = 60  # blocks at the top searched for a guard
+SYSTEMS = ("G54", "G55", "G56", "G57", "G58", "G59", "G59.1", "G59.2", "G59.3")
+_FANUC_PROGRAM_NUMBER = re.compile(r"\s*O\d", re.IGNORECASE)
+
+
+@dataclass(frozen=True)
+class Placement:
+    """What the guard checks: the coordinate system in effect at the start (1-9: G54-G59.3),
+    its zero (machine mm), and the mm per unit the control's parameters hold them in."""
+
+    system: int
+    zero: tuple[float, float, float]
+    unit_mm: float = 1.0
+
+    @classmethod
+    def of(cls, offsets: WorkOffsets, unit_mm: float = 1.0) -> "Placement | None":
+        """The placement `offsets` tell (None: the system in effect is not told)."""
+        if not offsets.told(offsets.active):
+            return None
+        return cls(offsets.active, offsets.zero(offsets.active), unit_mm)
+
+    @property
+    def name(self) -> str:
+        return SYSTEMS[self.system - 1]
+
+    def values(self) -> list[str]:
+        """X Y Z of the zero in the control's units, as the guard compares them."""
+        return [_number(v / self.unit_mm) for v in self.zero]
+
+    def said(self) -> str:
+        units = "mm" if self.unit_mm == 1.0 else "inch" if self.unit_mm == 25.4 else f"x{self.unit_mm:g} mm"
+        x, y, z = self.values()
+        return f"{self.name} at X{x} Y{y} Z{z} {units}"
+
+
+def _number(value: float) -> str:
+    return f"{value:.4f}".rstrip("0").rstrip(".") if value != 0 else "0"
+
+
+def guard_lines(placement: Placement, dialect: str, first_lines: Iterable[str] = ()) -> list[str]:
+    """The guard's lines (without line ends) for a program of `dialect`; `first_lines`, the
+    program's first lines, tell Fanuc's syntax from LinuxCNC's.  [] where there is none."""
+    if dialect != "iso":
+        return []
+    if any(_FANUC_PROGRAM_NUMBER.match(line) for line in first_lines):
+        return _fanuc(placement)
+    return _linuxcnc(placement)
+
+
+def _tolerance(placement: Placement) -> str:
+    return _number(GUARD_MM / placement.unit_mm)
+
+
+def _linuxcnc(placement: Placement) -> list[str]:
+    x = 5221 + 20 * (placement.system - 1)
+    tolerance = _tolerance(placement)
+    far = " OR ".join(f"[ABS[#{x + k} - {value}] GT {tolerance}]" for k, value in enumerate(placement.values()))
+    return [
+        f"({BEGIN} {placement.said()} within {_number(GUARD_MM)} mm)",
+        f"o<ncpp_guard> if [[#5220 NE {placement.system}] OR {far}]",
+        f"(abort, ncpp: compensated for {placement.said()}; the control's work offset differs: "
+        "compensate again for it, or set the offset)",
+        "o<ncpp_guard> endif",
+        f"({END})",
+    ]
+
+
+def _fanuc(placement: Placement) -> list[str]:
+    if placement.system > 6:
+        return []  # (G59.1-G59.3 are LinuxCNC's)
+    x = 5221 + 20 * (placement.system - 1)
+    tolerance = _tolerance(placement)
+    lines = [f"({BEGIN.upper()} {placement.said().upper()} WITHIN {_number(GUARD_MM)} MM)",
+             f"IF [#4014 NE {53 + placement.system}] THEN #3000=1 (NCPP {placement.name} NOT ACTIVE)"]  # fmt: skip
+    for k, (axis, value) in enumerate(zip("XYZ", placement.values())):
+        lines.append(f"IF [ABS[#{x + k}-{value}] GT {tolerance}] THEN #3000={2 + k} (NCPP {placement.name} {axis} MOVED)")
+    return lines + [f"({END.upper()})"]
+
+
+def with_guard(lines: Iterable[str], placement: Placement, dialect: str, header: str) -> Iterator[str]:
+    """The written program's lines with the guard after the header comment (a line holding `header`)."""
+    it = iter(lines)
+    head = list(islice(it, 3))
+    at = next((k + 1 for k, line in enumerate(head) if header in line), None)
+    guard = guard_lines(placement, dialect, head)
+    if at is None or not guard:
+        yield from chain(head, it)
+        return
+    eol = "\r\n" if head[at - 1].endswith("\r\n") else "\n"
+    yield from head[:at]
+    yield from (line + eol for line in guard)
+    yield from head[at:]
+    yield from it
+
+
+def without_guard(blocks: Iterable[Block]) -> Iterator[Block]:
+    """The blocks without a guard near the top: from its first comment to its last."""
+    blocks = iter(blocks)
+    inside = False
+    for block in islice(blocks, SCAN):
+        said = " ".join(item.text.lower() for item in block.items if type(item) is Comment)
+        if not inside and BEGIN in said:
+            inside = True
+        if not inside:
+            yield block
+        elif END in said:
+            inside = False
+    yield from blocks

@@ -1,0 +1,174 @@
+"""What a rewriting run did: one line for stderr, the same as JSON (`--report`).
+
+`Summary` watches the events on both sides of the passes and the run's warnings:
+the moves the passes may change (count, feed path length), those they leave as
+programmed by why (`Line.fixed`), where the program passes through from a
+construct ncpp cannot follow on, and the largest correction of a programmed
+point (a block's last compensated end against its programmed end, machine mm).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+from typing import Iterable, Iterator
+
+from ncpp.errors import Location
+from ncpp.motion.segments import COMP, CYCLE, FLOW, HOME, PLANE_AXES, Arc, Event, Line
+
+# Why moves are left as programmed, as the summary names it
+REASONS = {CYCLE: "canned cycle", FLOW: "loop or subroutine", COMP: "cutter compensation", HOME: "G28/G30 return"}
+OUT_OF_SCOPE = "out of scope"
+TRAVEL_END = "at a travel end"
+# What the warnings after which the rest of the program passes through say (the interpreters' and
+# `pipeline.warn_fixed`'s), and that of a line end left at a travel end (`apply_error_map`)
+PASSED_ON = ("the program passes through uninterpreted", "the program passes through uncompensated")
+STOPPED_AT_END = "stops at the end, uncompensated there"
+
+
+@dataclass
+class Summary:
+    file: str = "<stdin>"
+    moves: int = 0  # moves the passes compensate
+    feed_mm: float = 0.0  # their feed (not rapid) path length
+    largest_mm: float = 0.0  # the largest correction of a programmed point
+    largest_line: int | None = None
+    left: dict[str, list[int]] = field(default_factory=dict)  # reason -> input lines of its moves (each once)
+    left_moves: dict[str, int] = field(default_factory=dict)  # reason -> moves
+    passed_on_from: int | None = None  # the line from which the program passes through (out of scope)
+    warned: dict[str, tuple[Location, int]] = field(default_factory=dict)  # warning text -> (first place, times)
+    lines_in: int = 0
+    lines_out: int = 0
+
+    def __post_init__(self) -> None:
+        self._programmed: dict[int, Line | Arc] = {}  # id(block) -> its last move as programmed, until written
+
+    # -- the observers ----------------------------------------------------------------
+    def heard(self, message: str, where: Location) -> None:
+        """A warning of the run (`Warnings.listeners`)."""
+        first, times = self.warned.get(message, (where, 0))
+        self.warned[message] = (first, times + 1)
+        if self.passed_on_from is None and any(text in message for text in PASSED_ON) and where.line is not None:
+            self.passed_on_from = where.line
+        elif STOPPED_AT_END in message and where.line is not None:
+            self._leave(TRAVEL_END, where.line, count=False)
+
+    def programmed(self, events: Iterable[Event]) -> Iterator[Event]:
+        """The events as the passes take them."""
+        programmed = self._programmed
+        for event in events:
+            kind = type(event)
+            if kind is Line or kind is Arc:
+                if event.fixed:  # type: ignore[union-attr]
+                    self._leave(REASONS.get(event.fixed, event.fixed), event.block.line)  # type: ignore[union-attr]
+                else:
+                    self.moves += 1
+                    if kind is Arc or not event.rapid:  # type: ignore[union-attr]
+                        self.feed_mm += path_length(event)  # type: ignore[arg-type]
+                    programmed[id(event.block)] = event  # type: ignore[assignment]
+            yield event
+
+    def written(self, events: Iterable[Event]) -> Iterator[Event]:
+        """The events as the passes hand them on: each block's last compensated move
+        against its programmed one."""
+        block = last = None
+        for event in events:
+            kind = type(event)
+            if (kind is Line or kind is Arc) and not event.fixed:  # type: ignore[union-attr]
+                if event.block is not block:
+                    self._settle(block, last)
+                    block = event.block
+                last = event
+            yield event
+        self._settle(block, last)
+
+    def _settle(self, block, last: Line | Arc | None) -> None:
+        programmed = self._programmed.pop(id(block), None) if last is not None else None
+        if programmed is None:
+            return
+        context = last.context  # type: ignore[union-attr]
+        moved = math.dist(context.to_machine(last.end), programmed.context.to_machine(programmed.end))  # type: ignore[union-attr]
+        if moved > self.largest_mm:
+            self.largest_mm, self.largest_line = moved, block.line
+
+    def _leave(self, reason: str, line: int, count: bool = True) -> None:
+        lines = self.left.setdefault(reason, [])
+        if not lines or lines[-1] != line:
+            lines.append(line)
+        if count:
+            self.left_moves[reason] = self.left_moves.get(reason, 0) + 1
+
+    # -- what it says -------------------------------------------------------------------
+    def line(self) -> str:
+        """The summary in one line."""
+        parts = [f"compensated {self.moves} moves ({self.feed_mm:.1f} mm of feed path), "
+                 f"largest correction {1000 * self.largest_mm:.1f} µm" + (f" (line {self.largest_line})" if self.largest_line else "")]  # fmt: skip
+        left = [f"{self.left_moves.get(reason, len(lines))} {'moves' if reason in self.left_moves else 'lines'} "
+                f"{_WHY.get(reason, reason)} ({_lines_text(lines)})" for reason, lines in self.left.items()]  # fmt: skip
+        if self.passed_on_from is not None:
+            left.append(f"everything from line {self.passed_on_from} on ({self.lines_in - self.passed_on_from + 1} lines), out of scope")
+        parts.append("left as programmed: " + (", ".join(left) if left else "nothing"))
+        parts.append(f"{self.lines_in} lines in, {self.lines_out} out")
+        if self.warned:
+            parts.append(f"{sum(times for _, times in self.warned.values())} warnings")
+        return f"ncpp: {self.file}: " + "; ".join(parts)
+
+    def as_dict(self) -> dict:
+        left = {reason: {"moves": self.left_moves.get(reason), "lines": _ranges(lines)} for reason, lines in self.left.items()}
+        if self.passed_on_from is not None:
+            left[OUT_OF_SCOPE] = {"moves": None, "lines": [[self.passed_on_from, max(self.lines_in, self.passed_on_from)]]}
+        return {
+            "file": self.file,
+            "moves_compensated": self.moves,
+            "feed_path_compensated_mm": round(self.feed_mm, 4),
+            "largest_correction_um": round(1000 * self.largest_mm, 3),
+            "largest_correction_line": self.largest_line,
+            "left_as_programmed": left,
+            "lines_in": self.lines_in,
+            "lines_out": self.lines_out,
+            "warnings": [{"message": message, "first_line": where.line, "times": times} for message, (where, times) in self.warned.items()],
+        }
+
+
+_WHY = {
+    "canned cycle": "of canned cycles",
+    "loop or subroutine": "in loops or subroutines",
+    "cutter compensation": "under cutter compensation",
+    "G28/G30 return": "of G28/G30 returns",
+    TRAVEL_END: "with an axis held at a travel end",
+}
+
+
+def path_length(move: Line | Arc) -> float:
+    """mm along a move: a line's length, an arc's (with its helix)."""
+    if type(move) is Line:
+        return move.length() * move.context.unit_mm
+    arc: Arc = move  # type: ignore[assignment]
+    _, _, normal = PLANE_AXES[arc.context.plane]
+    return math.hypot(arc.radius() * arc.sweep(), arc.end[normal] - arc.start[normal]) * arc.context.unit_mm
+
+
+def _ranges(lines: list[int]) -> list[list[int]]:
+    """[[first, last], ...] of runs of consecutive line numbers (in the order they ran)."""
+    runs: list[list[int]] = []
+    for line in lines:
+        if runs and line == runs[-1][1] + 1:
+            runs[-1][1] = line
+        elif not (runs and runs[-1][0] <= line <= runs[-1][1]):
+            runs.append([line, line])
+    return runs
+
+
+def _lines_text(lines: list[int], shown: int = 4) -> str:
+    runs = [f"{a}" if a == b else f"{a}-{b}" for a, b in _ranges(lines)]
+    more = f" and {len(runs) - shown} more" if len(runs) > shown else ""
+    return ("line " if len(runs) == 1 and "-" not in runs[0] else "lines ") + ", ".join(runs[:shown]) + more
+
+
+def write_report(path: str, summaries: list[Summary]) -> None:
+    """`--report FILE.json`: one program's summary, or a list of several."""
+    from ncpp.fileio import write_text_atomic
+
+    data = summaries[0].as_dict() if len(summaries) == 1 else [s.as_dict() for s in summaries]
+    write_text_atomic(path, json.dumps(data, indent=2, ensure_ascii=False) + "\n")
