@@ -120,14 +120,17 @@ def _fanuc(placement: Placement) -> list[str]:
 
 
 def with_guard(lines: Iterable[str], placement: Placement, dialect: str, header: str) -> Iterator[str]:
-    """The written program's lines with the guard after the header comment (a line holding `header`)."""
+    """The written program's lines with the guard after the header comment (a line holding `header`)
+    and the program number that may follow it."""
     it = iter(lines)
-    head = list(islice(it, 3))
+    head = list(islice(it, 4))
     at = next((k + 1 for k, line in enumerate(head) if header in line), None)
     guard = guard_lines(placement, dialect, head)
     if at is None or not guard:
         yield from chain(head, it)
         return
+    while at < len(head) and _FANUC_PROGRAM_NUMBER.match(head[at]):  # a Fanuc program's number comes first
+        at += 1
     eol = "\r\n" if head[at - 1].endswith("\r\n") else "\n"
     yield from head[:at]
     yield from (line + eol for line in guard)
