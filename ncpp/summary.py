@@ -100,8 +100,8 @@ class Summary:
             self.left_moves[reason] = self.left_moves.get(reason, 0) + 1
 
     # -- what it says -------------------------------------------------------------------
-    def line(self) -> str:
-        """The summary in one line."""
+    def line(self, name: str | None = None) -> str:
+        """The summary in one line, naming the program `name` (default: its file)."""
         parts = [f"compensated {self.moves} moves ({self.feed_mm:.1f} mm of feed path), "
                  f"largest correction {1000 * self.largest_mm:.1f} µm" + (f" (line {self.largest_line})" if self.largest_line else "")]  # fmt: skip
         left = [f"{self.left_moves.get(reason, len(lines))} {'moves' if reason in self.left_moves else 'lines'} "
@@ -112,7 +112,7 @@ class Summary:
         parts.append(f"{self.lines_in} lines in, {self.lines_out} out")
         if self.warned:
             parts.append(f"{sum(times for _, times in self.warned.values())} warnings")
-        return f"ncpp: {self.file}: " + "; ".join(parts)
+        return f"ncpp: {name or self.file}: " + "; ".join(parts)
 
     def as_dict(self) -> dict:
         left = {reason: {"moves": self.left_moves.get(reason), "lines": _ranges(lines)} for reason, lines in self.left.items()}

@@ -98,7 +98,7 @@ def operator_messages(summary) -> list[str]:
     warning at its first line.  LinuxCNC's G-code manual ("G Code Overview", comments): the text
     after `MSG,` is shown the operator; a comment ends at the first `)`, so none may be inside."""
     texts: list[str] = []
-    for part in summary.line().split("; "):  # parts joined up to a line's length
+    for part in summary.line(os.path.basename(summary.file)).split("; "):  # parts joined up to a line's length
         if texts and len(texts[-1]) + len(part) + 2 <= MSG_TEXT:
             texts[-1] += f"; {part}"
         else:
