@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 from ncpp.cli.compensate import add_compensation_arguments, tell
@@ -64,6 +65,7 @@ def configured_source(args: argparse.Namespace):
 
     var_units = args.var_units if args.var_file or args.tool_table else None  # the config's when the files are the config's
     settings = find_settings(args.machine, args.tolerance, dict(args.work_offset), args.var_file, var_units, args.tool_table)
+    settings = replace(settings, subroutine_path=tuple(args.subroutine_path))
     if not (args.from_file or settings.machine):
         return None, settings.tolerance, None, None
     from ncpp.pipeline import ErrorSource

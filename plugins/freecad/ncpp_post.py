@@ -16,8 +16,14 @@
 #                         G5x=; repeat it for the Job's other fixtures G55...)
 #   --var-file FILE       LinuxCNC parameter file holding the zeros (--var-units inch)
 #   --tool-table FILE     LinuxCNC tool table: the lengths the program's G43 applies
+#   --no-guard            leave out the placement guard (the program's check that
+#                         the control's G54 is the one given with --work-offset)
 #   --ncpp PATH           the ncpp program (default: $NCPP, then `ncpp` on PATH)
 # Any other argument goes to linuxcnc_post (e.g. --no-comments, --precision 4).
+#
+# ncpp's summary goes to FreeCAD's Report view as a message, its warnings as
+# warnings and a failure as an error, each naming the line of the program
+# linuxcnc_post made (with its text).
 #
 # FreeCAD 0.20/0.21 call the module function export(); FreeCAD 1.x looks for
 # the class named after the file (`Ncpp`) and calls its export().
@@ -25,9 +31,11 @@
 import argparse
 import importlib.util
 import os
+import re
 import shlex
 import shutil
 import subprocess
+import sys
 import tempfile
 
 TOOLTIP = """Posts through FreeCAD's LinuxCNC post, then compensates the program
@@ -41,6 +49,7 @@ parser.add_argument("--work-offset", action="append", default=[], help="[G5x=]X,
 parser.add_argument("--var-file", help="LinuxCNC parameter file holding the zeros")
 parser.add_argument("--tool-table", help="LinuxCNC tool table: the lengths the program's G43 applies")
 parser.add_argument("--var-units", help="units of --var-file and --tool-table: mm or inch")
+parser.add_argument("--no-guard", action="store_true", help="leave out the placement guard at the program's start")
 parser.add_argument("--ncpp", help="the ncpp program (default: $NCPP, then ncpp on PATH)")
 
 TOOLTIP_ARGS = parser.format_help() + "\nOther arguments are passed to linuxcnc_post.\n"
@@ -75,6 +84,8 @@ def _ncpp_arguments(options):
             args += [flag, value]
     for zero in options.work_offset:
         args += ["--work-offset", zero]
+    if options.no_guard:
+        args.append("--no-guard")
     return args
 
 
@@ -89,9 +100,37 @@ def compensate_text(gcode, argstring):
         capture_output=True,
         env=env,
     )
+    told = [_posted_line(line, gcode) for line in proc.stderr.decode("utf-8", errors="replace").splitlines()]
     if proc.returncode != 0:
-        raise RuntimeError("ncpp_post: ncpp failed:\n" + proc.stderr.decode("utf-8", errors="replace"))
+        _report("PrintError", "ncpp_post: ncpp failed:\n" + "\n".join(told))
+        raise RuntimeError("ncpp_post: ncpp failed:\n" + "\n".join(told))
+    for line in told:
+        _report("PrintWarning" if ": warning: " in line else "PrintMessage", line)
     return proc.stdout.decode("latin-1")
+
+
+_STDIN_PLACE = re.compile(r"^<stdin>:(\d+)(?::\d+)?: ")
+
+
+def _posted_line(message, gcode):
+    """ncpp's `<stdin>:LINE:COL: ...` as the line of the posted program, with its text."""
+    found = _STDIN_PLACE.match(message)
+    if not found:
+        return message
+    number = int(found.group(1))
+    lines = gcode.splitlines()
+    text = lines[number - 1].strip() if 0 < number <= len(lines) else ""
+    return f"ncpp_post: line {number} of the posted program ({text}): " + message[found.end():]
+
+
+def _report(kind, text):
+    """A line in FreeCAD's Report view (`FreeCAD.Console.PrintWarning`, ...); stderr outside FreeCAD."""
+    try:
+        import FreeCAD
+    except ImportError:
+        print(text, file=sys.stderr)
+        return
+    getattr(FreeCAD.Console, kind)(text + "\n")
 
 
 def linuxcnc_text(objectslist, argstring):
