@@ -20,8 +20,13 @@ starts with an O number):
   G54's X Y Z, 20 per system; `#3000=n (text)` raises macro alarm n with the text and
   stops; `IF [cond] THEN` one assignment): G54-G59 only.
 
-Heidenhain and Sinumerik programs get no guard (yet): their presets and settable
-frames are read differently (`FN 18: SYSREAD`, `$P_UIFR`), left to a later step.
+* Sinumerik (840D sl System Variables parameter manual: `$P_UIFRNUM`, the number of the
+  active settable frame, 1-4 for G54-G57; `$P_UIFR[n, axis, TR]` and `[n, axis, FI]`, its
+  coarse and fine translation; Job Planning manual: `MSG("text")` shows the text, `SETAL(n)`
+  raises cycle alarm n, 65000-67999 being the user's; `M0` stops): G54-G57 only.
+
+Heidenhain programs get no guard (yet): the preset table's active row and values are read
+with `FN 18: SYSREAD` IDs that differ between TNC generations.
 
 Readers of a written program drop the guard (`without_guard`): ncpp's interpreter
 does not know the control's parameters, and the guard neither moves nor acts.
@@ -82,6 +87,8 @@ def _number(value: float) -> str:
 def guard_lines(placement: Placement, dialect: str, first_lines: Iterable[str] = ()) -> list[str]:
     """The guard's lines (without line ends) for a program of `dialect`; `first_lines`, the
     program's first lines, tell Fanuc's syntax from LinuxCNC's.  [] where there is none."""
+    if dialect == "sinumerik":
+        return _sinumerik(placement)
     if dialect != "iso":
         return []
     if any(_FANUC_PROGRAM_NUMBER.match(line) for line in first_lines):
@@ -117,6 +124,23 @@ def _fanuc(placement: Placement) -> list[str]:
     for k, (axis, value) in enumerate(zip("XYZ", placement.values())):
         lines.append(f"IF [ABS[#{x + k}-{value}] GT {tolerance}] THEN #3000={2 + k} (NCPP {placement.name} {axis} MOVED)")
     return lines + [f"({END.upper()})"]
+
+
+def _sinumerik(placement: Placement) -> list[str]:
+    if placement.system > 4:
+        return []  # (G58, G59 are Sinumerik's programmable offsets, not a settable frame)
+    n, tolerance = placement.system, _tolerance(placement)
+    far = " OR ".join(f"(ABS($P_UIFR[{n},{axis},TR]+$P_UIFR[{n},{axis},FI]-{value})>{tolerance})"
+                      for axis, value in zip("XYZ", placement.values()))  # fmt: skip
+    return [
+        f"; {BEGIN} {placement.said()} within {_number(GUARD_MM)} mm",
+        f"IF ($P_UIFRNUM<>{n}) OR {far}",
+        f'MSG("ncpp: compensated for {placement.said()}: the settable frame differs")',
+        "SETAL(65000)",
+        "M0",
+        "ENDIF",
+        f"; {END}",
+    ]
 
 
 def with_guard(lines: Iterable[str], placement: Placement, dialect: str, header: str) -> Iterator[str]:

@@ -96,3 +96,22 @@ def test_a_fanuc_program_gets_macro_b_alarms(tmp_path):
                           "IF [ABS[#5222-350] GT 0.1] THEN #3000=3 (NCPP G54 Y MOVED)",
                           "IF [ABS[#5223-300] GT 0.1] THEN #3000=4 (NCPP G54 Z MOVED)"]  # fmt: skip
     assert lines[8] == "(NCPP PLACEMENT GUARD END)" and lines[9] == "G21 G90 G54"
+
+
+def test_a_sinumerik_program_gets_its_settable_frame_checked_and_ncpp_still_reads_it(tmp_path):
+    """The guard (`$P_UIFR`, `SETAL`, `M0`) passes the verifier, and `ncpp simulate` reads the
+    compensated program past it (its contour error against the original stays at a micron)."""
+    (tmp_path / "p.mpf").write_text("G54 G17 G90\nG0 X10 Y10 Z5\nG1 Z-1 F300\nG1 X40 Y10\nG0 Z5\nM30\n")
+    env = {k: v for k, v in os.environ.items() if k not in ("NCPP_MACHINE", "XDG_CONFIG_HOME")}
+    env.update(PYTHONPATH=str(ROOT), HOME=str(tmp_path))
+    run = lambda *args: subprocess.run([sys.executable, "-m", "ncpp", *args, "--machine", str(MACHINE), "--work-offset",  # noqa: E731
+                                        "400,350,300"], capture_output=True, text=True, cwd=tmp_path, env=env, timeout=300)  # fmt: skip
+    written = run("compensate", "p.mpf", "-o", "out.mpf")
+    assert written.returncode == 0, written.stderr
+    lines = (tmp_path / "out.mpf").read_text().splitlines()
+    assert lines[2] == ("IF ($P_UIFRNUM<>1) OR (ABS($P_UIFR[1,X,TR]+$P_UIFR[1,X,FI]-400)>0.1) OR "
+                        "(ABS($P_UIFR[1,Y,TR]+$P_UIFR[1,Y,FI]-350)>0.1) OR (ABS($P_UIFR[1,Z,TR]+$P_UIFR[1,Z,FI]-300)>0.1)")
+    assert lines[4:7] == ["SETAL(65000)", "M0", "ENDIF"] and lines[8] == "G54 G17 G90"
+    simulated = run("simulate", "out.mpf", "--reference", "p.mpf")
+    assert simulated.returncode == 0 and "outside the motion interpreter" not in simulated.stderr, simulated.stderr
+    assert float(simulated.stdout.split("max ")[1].split(" ")[0]) < 1.0  # µm
