@@ -85,15 +85,13 @@ def _number(value: float) -> str:
 
 
 def guard_lines(placement: Placement, dialect: str, first_lines: Iterable[str] = ()) -> list[str]:
-    """The guard's lines (without line ends) for a program of `dialect`; `first_lines`, the
-    program's first lines, tell Fanuc's syntax from LinuxCNC's.  [] where there is none."""
-    if dialect == "sinumerik":
-        return _sinumerik(placement)
-    if dialect != "iso":
-        return []
-    if any(_FANUC_PROGRAM_NUMBER.match(line) for line in first_lines):
-        return _fanuc(placement)
-    return _linuxcnc(placement)
+    """The guard's lines (without line ends) for a program of `dialect` (a post's "linuxcnc" or
+    "fanuc" says its syntax; for "iso", `first_lines`, the program's first lines, tell Fanuc's
+    from LinuxCNC's).  [] where there is none."""
+    if dialect == "iso":
+        dialect = "fanuc" if any(_FANUC_PROGRAM_NUMBER.match(line) for line in first_lines) else "linuxcnc"
+    written = {"linuxcnc": _linuxcnc, "fanuc": _fanuc, "sinumerik": _sinumerik}.get(dialect)
+    return [] if written is None else written(placement)
 
 
 def _tolerance(placement: Placement) -> str:

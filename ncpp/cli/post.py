@@ -32,21 +32,25 @@ def run(args: argparse.Namespace) -> int:
 
     from ncpp.cli.progress import progress_printer
     from ncpp.post import post
+    from ncpp.guard import Placement
+    from ncpp.motion.offsets import UNIT_MM
     from ncpp.summary import Summary
 
     source = error_source(args)
     summary = Summary(args.input) if source is not None else None
     offsets = work_offsets(args)
+    told = args.guard and (args.work_offset or args.var_file)
+    guard = Placement.of(offsets, UNIT_MM[args.var_units]) if told else None
     warnings = Warnings(strict=args.strict)
     progress = progress_printer("post")
     with open_output(args.output) as out:
         if args.input == "-":
             post(sys.stdin, out, file="<stdin>", dialect=args.dialect, source=source, tolerance=args.tolerance, warnings=warnings, progress=progress, offsets=offsets, verify=args.verify,
-                 summary=summary)  # fmt: skip
+                 summary=summary, guard=guard)  # fmt: skip
         else:
             with open(args.input, encoding="latin-1") as stream:
                 post(stream, out, file=args.input, dialect=args.dialect, source=source, tolerance=args.tolerance, warnings=warnings, progress=progress, offsets=offsets, verify=args.verify,
-                     summary=summary)  # fmt: skip
+                     summary=summary, guard=guard)  # fmt: skip
     if progress is not None:
         progress.done()
     if summary is not None:

@@ -14,6 +14,7 @@ from typing import BinaryIO, Callable, Iterable, Iterator, TextIO
 
 from ncpp.cldata import Record, motion, read_cldata
 from ncpp.errors import NcppError, Warnings
+from ncpp.guard import Placement, with_guard
 from ncpp.motion.offsets import WorkOffsets
 from ncpp.motion.segments import Event
 from ncpp.post.generator import Generator
@@ -66,6 +67,7 @@ def post(
     offsets: WorkOffsets | None = None,
     verify: bool = True,
     summary: Summary | None = None,
+    guard: Placement | None = None,
 ) -> int:
     """Post one CL file as a `dialect` program (compensated when `source` is an
     `ncpp.pipeline.ErrorSource`, the CL origin at `offsets`' G54 zero);
@@ -74,16 +76,18 @@ def post(
     A compensated program is verified before it is written (`ncpp/verify.py`): the CL
     data is posted a second time without compensation, and the compensated program
     must do what that one does (`verify=False` skips it).  `summary` is told what compensation did
-    (its lines in are the CL records)."""
+    (its lines in are the CL records); a compensated program starts with the placement `guard`
+    (`ncpp/guard.py`) when one is given."""
     if source is not None and verify:
         return _verified(stream, out, file=file, dialect=dialect, source=source, tolerance=tolerance,
-                         warnings=warnings, progress=progress, offsets=offsets, summary=summary)  # fmt: skip
+                         warnings=warnings, progress=progress, offsets=offsets, summary=summary, guard=guard)  # fmt: skip
     return _post(stream, out, file=file, dialect=dialect, source=source, tolerance=tolerance,
-                 warnings=warnings, progress=progress, offsets=offsets, summary=summary)  # fmt: skip
+                 warnings=warnings, progress=progress, offsets=offsets, summary=summary, guard=guard)  # fmt: skip
 
 
 def _verified(stream: TextIO, out: BinaryIO, *, file: str, dialect: str, source, tolerance: float, warnings: Warnings | None,
-              progress: Callable[[int], None] | None, offsets: WorkOffsets | None, summary: Summary | None) -> int:  # fmt: skip
+              progress: Callable[[int], None] | None, offsets: WorkOffsets | None, summary: Summary | None,
+              guard: Placement | None) -> int:  # fmt: skip
     """Post compensated and uncompensated to temporary files; verify, then copy to `out`."""
     import io
     import shutil
@@ -96,7 +100,7 @@ def _verified(stream: TextIO, out: BinaryIO, *, file: str, dialect: str, source,
         shutil.copyfileobj(stream, cl)
         cl.seek(0)
         count = _post(cl, written, file=file, dialect=dialect, source=source, tolerance=tolerance, warnings=warnings,
-                      progress=progress, offsets=offsets, summary=summary)  # fmt: skip
+                      progress=progress, offsets=offsets, summary=summary, guard=guard)  # fmt: skip
         cl.seek(0)
         _post(cl, plain, file=file, dialect=dialect, source=None, warnings=Warnings(stream=io.StringIO()), offsets=offsets)
         plain.seek(0)
@@ -121,9 +125,10 @@ def _post(
     progress: Callable[[int], None] | None = None,
     offsets: WorkOffsets | None = None,
     summary: Summary | None = None,
+    guard: Placement | None = None,
 ) -> int:
     from ncpp.passes import PASSES, run_passes
-    from ncpp.pipeline import header_text, make_context
+    from ncpp.pipeline import HEADER_TAG, header_text, make_context
 
     if dialect not in GENERATORS:
         raise NcppError(f"unknown dialect {dialect!r} (known: {', '.join(GENERATORS)})")
@@ -138,9 +143,12 @@ def _post(
         events = summary.written(run_passes(summary.programmed(events), make_context(source, tolerance, warnings, file), PASSES))
         header = header_text(source, tolerance)
     generator = GENERATORS[dialect](warnings, header, file)
+    lines = (line + "\n" for line in generator.write(events, index))
+    if header is not None and guard is not None:
+        lines = with_guard(lines, guard, dialect, HEADER_TAG)
     written = 0
-    for line in generator.write(events, index):
-        out.write((line + "\n").encode("latin-1", errors="replace"))
+    for line in lines:
+        out.write(line.encode("latin-1", errors="replace"))
         written += 1
     if summary is not None:
         summary.lines_in, summary.lines_out = index.count, written

@@ -115,3 +115,20 @@ def test_a_sinumerik_program_gets_its_settable_frame_checked_and_ncpp_still_read
     simulated = run("simulate", "out.mpf", "--reference", "p.mpf")
     assert simulated.returncode == 0 and "outside the motion interpreter" not in simulated.stderr, simulated.stderr
     assert float(simulated.stdout.split("max ")[1].split(" ")[0]) < 1.0  # µm
+
+
+def test_the_post_writes_the_guard_of_its_dialect(tmp_path):
+    env = {k: v for k, v in os.environ.items() if k not in ("NCPP_MACHINE", "XDG_CONFIG_HOME")}
+    env.update(PYTHONPATH=str(ROOT), HOME=str(tmp_path))
+    for dialect in ("linuxcnc", "fanuc"):
+        proc = subprocess.run([sys.executable, "-m", "ncpp", "post", str(ROOT / "samples/programs/pocket.cls"), "--dialect", dialect,
+                               "--machine", str(MACHINE), "--work-offset", "400,350,300", "-o", f"{dialect}.nc"],
+                              capture_output=True, text=True, cwd=tmp_path, env=env, timeout=300)  # fmt: skip
+        assert proc.returncode == 0, proc.stderr  # (verified past the guard)
+    fanuc = (tmp_path / "fanuc.nc").read_text().splitlines()
+    assert fanuc[:2] == ["%", "O0001"] and fanuc[4] == "IF [#4014 NE 54] THEN #3000=1 (NCPP G54 NOT ACTIVE)"
+    told = _var_file(tmp_path / "told.var", (400 * 25.4, 350 * 25.4, 300 * 25.4))  # raw 400 350 300: the guard's mm
+    ran = _rs274(told, tmp_path / "linuxcnc.nc")
+    assert ran.returncode == 0 and "PROGRAM_END" in ran.stdout, ran.stderr
+    stopped = _rs274(_var_file(tmp_path / "moved.var", (401 * 25.4, 350 * 25.4, 300 * 25.4)), tmp_path / "linuxcnc.nc")
+    assert stopped.returncode != 0 and "PROGRAM_END" not in stopped.stdout
