@@ -83,7 +83,8 @@ class Warnings:
         self.count = 0
         self._times: dict[str, int] = {}  # how often each text was warned
         self._hidden: dict[str, tuple[Location, Location]] = {}  # where each text was first and last not printed
-        self.listeners: list[Callable[[str, Location], None]] = []  # told every warning (`summary.Summary.heard`)
+        # told every warning (`summary.Summary.heard`)
+        self.listeners: list[Callable[[str, Location], None]] = []
 
     def warn(self, message: str, where: Location) -> None:
         if self.strict:

@@ -35,9 +35,9 @@ does not know the control's parameters, and the guard neither moves nor acts.
 from __future__ import annotations
 
 import re
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from itertools import chain, islice
-from typing import Iterable, Iterator
 
 from ncpp.motion.offsets import WorkOffsets
 from ncpp.program.blocks import Block, Comment
@@ -60,7 +60,7 @@ class Placement:
     unit_mm: float = 1.0
 
     @classmethod
-    def of(cls, offsets: WorkOffsets, unit_mm: float = 1.0) -> "Placement | None":
+    def of(cls, offsets: WorkOffsets, unit_mm: float = 1.0) -> Placement | None:
         """The placement `offsets` tell (None: the system in effect is not told)."""
         if not offsets.told(offsets.active):
             return None
@@ -101,7 +101,9 @@ def _tolerance(placement: Placement) -> str:
 def _linuxcnc(placement: Placement) -> list[str]:
     x = 5221 + 20 * (placement.system - 1)
     tolerance = _tolerance(placement)
-    far = " OR ".join(f"[ABS[#{x + k} - {value}] GT {tolerance}]" for k, value in enumerate(placement.values()))
+    far = " OR ".join(
+        f"[ABS[#{x + k} - {value}] GT {tolerance}]" for k, value in enumerate(placement.values())
+    )
     return [
         f"({BEGIN} {placement.said()} within {_number(GUARD_MM)} mm)",
         f"o<ncpp_guard> if [[#5220 NE {placement.system}] OR {far}]",
@@ -117,10 +119,13 @@ def _fanuc(placement: Placement) -> list[str]:
         return []  # (G59.1-G59.3 are LinuxCNC's)
     x = 5221 + 20 * (placement.system - 1)
     tolerance = _tolerance(placement)
-    lines = [f"({BEGIN.upper()} {placement.said().upper()} WITHIN {_number(GUARD_MM)} MM)",
-             f"IF [#4014 NE {53 + placement.system}] THEN #3000=1 (NCPP {placement.name} NOT ACTIVE)"]  # fmt: skip
-    for k, (axis, value) in enumerate(zip("XYZ", placement.values())):
-        lines.append(f"IF [ABS[#{x + k}-{value}] GT {tolerance}] THEN #3000={2 + k} (NCPP {placement.name} {axis} MOVED)")
+    lines = [
+        f"({BEGIN.upper()} {placement.said().upper()} WITHIN {_number(GUARD_MM)} MM)",
+        f"IF [#4014 NE {53 + placement.system}] THEN #3000=1 (NCPP {placement.name} NOT ACTIVE)",
+    ]
+    for k, (axis, value) in enumerate(zip("XYZ", placement.values(), strict=True)):
+        alarm = f"#3000={2 + k} (NCPP {placement.name} {axis} MOVED)"
+        lines.append(f"IF [ABS[#{x + k}-{value}] GT {tolerance}] THEN {alarm}")
     return lines + [f"({END.upper()})"]
 
 
@@ -128,8 +133,10 @@ def _sinumerik(placement: Placement) -> list[str]:
     if placement.system > 4:
         return []  # (G58, G59 are Sinumerik's programmable offsets, not a settable frame)
     n, tolerance = placement.system, _tolerance(placement)
-    far = " OR ".join(f"(ABS($P_UIFR[{n},{axis},TR]+$P_UIFR[{n},{axis},FI]-{value})>{tolerance})"
-                      for axis, value in zip("XYZ", placement.values()))  # fmt: skip
+    far = " OR ".join(
+        f"(ABS($P_UIFR[{n},{axis},TR]+$P_UIFR[{n},{axis},FI]-{value})>{tolerance})"
+        for axis, value in zip("XYZ", placement.values(), strict=True)
+    )
     return [
         f"; {BEGIN} {placement.said()} within {_number(GUARD_MM)} mm",
         f"IF ($P_UIFRNUM<>{n}) OR {far}",

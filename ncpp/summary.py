@@ -11,14 +11,19 @@ from __future__ import annotations
 
 import json
 import math
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
-from typing import Iterable, Iterator
 
 from ncpp.errors import Location
 from ncpp.motion.segments import COMP, CYCLE, FLOW, HOME, PLANE_AXES, Arc, Event, Line
 
 # Why moves are left as programmed, as the summary names it
-REASONS = {CYCLE: "canned cycle", FLOW: "loop or subroutine", COMP: "cutter compensation", HOME: "G28/G30 return"}
+REASONS = {
+    CYCLE: "canned cycle",
+    FLOW: "loop or subroutine",
+    COMP: "cutter compensation",
+    HOME: "G28/G30 return",
+}
 OUT_OF_SCOPE = "out of scope"
 TRAVEL_END = "at a travel end"
 # What the warnings after which the rest of the program passes through say (the interpreters' and
@@ -37,19 +42,27 @@ class Summary:
     left: dict[str, list[int]] = field(default_factory=dict)  # reason -> input lines of its moves (each once)
     left_moves: dict[str, int] = field(default_factory=dict)  # reason -> moves
     passed_on_from: int | None = None  # the line from which the program passes through (out of scope)
-    warned: dict[str, tuple[Location, int]] = field(default_factory=dict)  # warning text -> (first place, times)
+    warned: dict[str, tuple[Location, int]] = field(
+        default_factory=dict
+    )  # warning text -> (first place, times)
     lines_in: int = 0
     lines_out: int = 0
 
     def __post_init__(self) -> None:
-        self._programmed: dict[int, Line | Arc] = {}  # id(block) -> its last move as programmed, until written
+        self._programmed: dict[
+            int, Line | Arc
+        ] = {}  # id(block) -> its last move as programmed, until written
 
     # -- the observers ----------------------------------------------------------------
     def heard(self, message: str, where: Location) -> None:
         """A warning of the run (`Warnings.listeners`)."""
         first, times = self.warned.get(message, (where, 0))
         self.warned[message] = (first, times + 1)
-        if self.passed_on_from is None and any(text in message for text in PASSED_ON) and where.line is not None:
+        if (
+            self.passed_on_from is None
+            and any(text in message for text in PASSED_ON)
+            and where.line is not None
+        ):
             self.passed_on_from = where.line
         elif STOPPED_AT_END in message and where.line is not None:
             self._leave(TRAVEL_END, where.line, count=False)
@@ -84,15 +97,16 @@ class Summary:
     def written(self, events: Iterable[Event]) -> Iterator[Event]:
         """The events as the passes hand them on: each block's last compensated move
         against its programmed one."""
-        block = last = None
+        block = None
+        last: Line | Arc | None = None
         for event in events:
             kind = type(event)
             if kind is Line or kind is Arc:
                 if event.block is block:
-                    last = event
+                    last = event  # type: ignore[assignment]
                 elif not event.fixed:  # type: ignore[union-attr]
                     self._settle(block, last)
-                    block, last = event.block, event
+                    block, last = event.block, event  # type: ignore[assignment]
             yield event
         self._settle(block, last)
 
@@ -115,12 +129,19 @@ class Summary:
     # -- what it says -------------------------------------------------------------------
     def line(self, name: str | None = None) -> str:
         """The summary in one line, naming the program `name` (default: its file)."""
-        parts = [f"compensated {self.moves} moves ({self.feed_mm:.1f} mm of feed path), "
-                 f"largest correction {1000 * self.largest_mm:.1f} µm" + (f" (line {self.largest_line})" if self.largest_line else "")]  # fmt: skip
-        left = [f"{self.left_moves.get(reason, len(lines))} {'moves' if reason in self.left_moves else 'lines'} "
-                f"{_WHY.get(reason, reason)} ({_lines_text(lines)})" for reason, lines in self.left.items()]  # fmt: skip
+        parts = [
+            f"compensated {self.moves} moves ({self.feed_mm:.1f} mm of feed path), "
+            f"largest correction {1000 * self.largest_mm:.1f} µm"
+            + (f" (line {self.largest_line})" if self.largest_line else "")
+        ]
+        left = [
+            f"{self.left_moves.get(reason, len(lines))} {'moves' if reason in self.left_moves else 'lines'} "
+            f"{_WHY.get(reason, reason)} ({_lines_text(lines)})"
+            for reason, lines in self.left.items()
+        ]
         if self.passed_on_from is not None:
-            left.append(f"everything from line {self.passed_on_from} on ({self.lines_in - self.passed_on_from + 1} lines), out of scope")
+            lines = self.lines_in - self.passed_on_from + 1
+            left.append(f"everything from line {self.passed_on_from} on ({lines} lines), out of scope")
         parts.append("left as programmed: " + (", ".join(left) if left else "nothing"))
         parts.append(f"{self.lines_in} lines in, {self.lines_out} out")
         if self.warned:
@@ -128,9 +149,15 @@ class Summary:
         return f"ncpp: {name or self.file}: " + "; ".join(parts)
 
     def as_dict(self) -> dict:
-        left = {reason: {"moves": self.left_moves.get(reason), "lines": _ranges(lines)} for reason, lines in self.left.items()}
+        left = {
+            reason: {"moves": self.left_moves.get(reason), "lines": _ranges(lines)}
+            for reason, lines in self.left.items()
+        }
         if self.passed_on_from is not None:
-            left[OUT_OF_SCOPE] = {"moves": None, "lines": [[self.passed_on_from, max(self.lines_in, self.passed_on_from)]]}
+            left[OUT_OF_SCOPE] = {
+                "moves": None,
+                "lines": [[self.passed_on_from, max(self.lines_in, self.passed_on_from)]],
+            }
         return {
             "file": self.file,
             "moves_compensated": self.moves,
@@ -140,7 +167,10 @@ class Summary:
             "left_as_programmed": left,
             "lines_in": self.lines_in,
             "lines_out": self.lines_out,
-            "warnings": [{"message": message, "first_line": where.line, "times": times} for message, (where, times) in self.warned.items()],
+            "warnings": [
+                {"message": message, "first_line": where.line, "times": times}
+                for message, (where, times) in self.warned.items()
+            ],
         }
 
 

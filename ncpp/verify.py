@@ -294,7 +294,8 @@ def _interpreted(blocks: Iterable[Block], file: str, dialect: str, offsets: Work
     from ncpp.pipeline import dialect_tools
 
     interpret, _ = dialect_tools(dialect)
-    return interpret(without_guard(blocks), file=file, warnings=Warnings(stream=_Discard()), offsets=offsets or AT_MACHINE_ZERO)
+    blocks = without_guard(blocks)  # (it neither moves nor acts, and reads the control's parameters)
+    return interpret(blocks, file=file, warnings=Warnings(stream=_Discard()), offsets=offsets or AT_MACHINE_ZERO)
 
 
 class _Discard:

@@ -51,15 +51,18 @@ def add_compensation_arguments(p: argparse.ArgumentParser) -> None:
         "(by default a program whose actions or path differ from the input's is refused, and nothing is written)",
     )
     p.add_argument(
-        "--report", metavar="FILE.json",
-        help="write what compensation did as JSON: the summary line's figures, with the input lines of each reason "
-        "moves were left as programmed (several programs: a list)",
-    )  # fmt: skip
+        "--report",
+        metavar="FILE.json",
+        help="write what compensation did as JSON: the summary line's figures, with the input lines "
+        "of each reason moves were left as programmed (several programs: a list)",
+    )
     p.add_argument(
-        "--no-guard", dest="guard", action="store_false",
-        help="leave out the placement guard: the block at the program's start that stops it when the control's "
-        "work offset (or tool length) is not the one given with --work-offset / --var-file",
-    )  # fmt: skip
+        "--no-guard",
+        dest="guard",
+        action="store_false",
+        help="leave out the placement guard: the block at the program's start that stops it when "
+        "the control's work offset is not the one given with --work-offset / --var-file",
+    )
     add_placement_arguments(p)
 
 
@@ -145,8 +148,10 @@ def run(args: argparse.Namespace) -> int:
 
     source, tolerance, offsets, guard = configured_source(args)
     if source is None:
-        raise NcppError("no error model: give --machine M.toml or --from MEASUREMENT, set $NCPP_MACHINE, "
-                        "or name a machine file in ./ncpp.toml or ~/.config/ncpp/config.toml")  # fmt: skip
+        raise NcppError(
+            "no error model: give --machine M.toml or --from MEASUREMENT, set $NCPP_MACHINE, "
+            "or name a machine file in ./ncpp.toml or ~/.config/ncpp/config.toml"
+        )
     job = Job(source, tolerance, args.strict, args.force, args.dialect, offsets, args.verify, guard)
     folder = args.output is not None and os.path.isdir(args.output)
     if len(args.input) > 1 or folder:
@@ -177,7 +182,7 @@ def _compensate_one(job: Job, path: str | None, output: str | None, report: str 
     progress = progress_printer("compensate")
     with open_input(path) as (stream, name), open_output(output) as out:
         stats = process(stream, out, file=name, source=job.source, tolerance=job.tolerance, strict=job.strict, force=job.force,  # type: ignore[arg-type]
-                        warnings=Warnings(strict=job.strict), progress=progress, dialect=job.dialect, offsets=job.offsets, verify=job.verify,
+                        warnings=Warnings(strict=job.strict), progress=progress, dialect=job.dialect, offsets=job.offsets, verify=job.verify,  # type: ignore[arg-type]
                         guard=job.guard)  # type: ignore[arg-type]  # fmt: skip
     if progress is not None:
         progress.done()
@@ -185,7 +190,9 @@ def _compensate_one(job: Job, path: str | None, output: str | None, report: str 
     return 0
 
 
-def compensate_files(job: Job, paths: list[str], folder: Path, jobs: int = 1, report: str | None = None) -> int:
+def compensate_files(
+    job: Job, paths: list[str], folder: Path, jobs: int = 1, report: str | None = None
+) -> int:
     """Each program to `folder` under its own name, `jobs` at once; a failure is reported
     (`file:line:col: message`) and the others go on, a success by its summary.  0 if all were
     written, else 2."""
@@ -276,6 +283,6 @@ def _compensate_file(path: str, target: str):
     assert job is not None
     with open(path, "rb") as stream, atomic_output(target) as out:
         stats = process(stream, out, file=path, source=job.source, tolerance=job.tolerance, strict=job.strict, force=job.force,  # type: ignore[arg-type]
-                        warnings=Warnings(strict=job.strict), dialect=job.dialect, offsets=job.offsets, verify=job.verify,
+                        warnings=Warnings(strict=job.strict), dialect=job.dialect, offsets=job.offsets, verify=job.verify,  # type: ignore[arg-type]
                         guard=job.guard)  # type: ignore[arg-type]  # fmt: skip
     return stats.summary

@@ -54,8 +54,10 @@ def run(args: argparse.Namespace) -> int:
 
 
 # What a run without a machine file says: it passes the program through as it is.
-NOT_COMPENSATED = ("no machine file, nothing was compensated: the program passes through unchanged "
-                   "(give --machine, set $NCPP_MACHINE, or name one in ./ncpp.toml or ~/.config/ncpp/config.toml)")  # fmt: skip
+NOT_COMPENSATED = (
+    "no machine file, nothing was compensated: the program passes through unchanged "
+    "(give --machine, set $NCPP_MACHINE, or name one in ./ncpp.toml or ~/.config/ncpp/config.toml)"
+)
 
 
 def configured_source(args: argparse.Namespace):

@@ -74,7 +74,8 @@ def run(args: argparse.Namespace) -> int:
     with open_input(args.input) as (stream, name):
         dialect, blocks = parse_program(stream, name, args.dialect)
         interpret, _ = dialect_tools(dialect)
-        events = interpret(without_guard(blocks), file=name, warnings=warnings, offsets=offsets)  # (a compensated program's)
+        blocks = without_guard(blocks)  # (a compensated program's)
+        events = interpret(blocks, file=name, warnings=warnings, offsets=offsets)
         for event in warn_off_path(events, warnings, name, "printed as programmed (rs274 prints the tool centre, offset by the radius)"):
             if type(event) is not Line and type(event) is not Arc:
                 continue

@@ -30,10 +30,12 @@ def register(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     import sys
 
+    from typing import Any
+
     from ncpp.cli.progress import progress_printer
-    from ncpp.post import post
     from ncpp.guard import Placement
     from ncpp.motion.offsets import UNIT_MM
+    from ncpp.post import post
     from ncpp.summary import Summary
 
     source = error_source(args)
@@ -43,14 +45,14 @@ def run(args: argparse.Namespace) -> int:
     guard = Placement.of(offsets, UNIT_MM[args.var_units]) if told else None
     warnings = Warnings(strict=args.strict)
     progress = progress_printer("post")
+    options: dict[str, Any] = dict(dialect=args.dialect, source=source, tolerance=args.tolerance, warnings=warnings, progress=progress,
+                                   offsets=offsets, verify=args.verify, summary=summary, guard=guard)  # fmt: skip
     with open_output(args.output) as out:
         if args.input == "-":
-            post(sys.stdin, out, file="<stdin>", dialect=args.dialect, source=source, tolerance=args.tolerance, warnings=warnings, progress=progress, offsets=offsets, verify=args.verify,
-                 summary=summary, guard=guard)  # fmt: skip
+            post(sys.stdin, out, file="<stdin>", **options)
         else:
             with open(args.input, encoding="latin-1") as stream:
-                post(stream, out, file=args.input, dialect=args.dialect, source=source, tolerance=args.tolerance, warnings=warnings, progress=progress, offsets=offsets, verify=args.verify,
-                     summary=summary, guard=guard)  # fmt: skip
+                post(stream, out, file=args.input, **options)
     if progress is not None:
         progress.done()
     if summary is not None:

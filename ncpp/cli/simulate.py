@@ -32,8 +32,12 @@ def step_mm(text: str) -> float:
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("simulate", help="run a program on the modelled machine: contour error, ball-bar trace")
     p.add_argument("program", help="NC program to run")
-    p.add_argument("--machine", metavar="M.toml",
-                   help="machine file (the virtual machine; default: $NCPP_MACHINE, then ./ncpp.toml or ~/.config/ncpp/config.toml)")  # fmt: skip
+    p.add_argument(
+        "--machine",
+        metavar="M.toml",
+        help="machine file (the virtual machine; default: $NCPP_MACHINE, then ./ncpp.toml "
+        "or ~/.config/ncpp/config.toml)",
+    )
     p.add_argument("--reference", metavar="ORIGINAL", help="nominal program (for a compensated PROGRAM)")
     add_placement_arguments(p)
     add_dialect_argument(p)
@@ -90,8 +94,10 @@ def machine_file(given: str | None) -> str:
 
     settings = find_settings(given)
     if settings.machine is None:
-        raise NcppError("no machine file: give --machine M.toml, set $NCPP_MACHINE, or name one in ./ncpp.toml "
-                        "or ~/.config/ncpp/config.toml")  # fmt: skip
+        raise NcppError(
+            "no machine file: give --machine M.toml, set $NCPP_MACHINE, "
+            "or name one in ./ncpp.toml or ~/.config/ncpp/config.toml"
+        )
     return settings.machine
 
 

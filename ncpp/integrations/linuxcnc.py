@@ -83,9 +83,11 @@ def run(path: str, err: TextIO, machine: str | None = None) -> None:
                     stats = process(stream, written, file=path, source=source, tolerance=settings.tolerance,
                                     warnings=Warnings(stream=err), progress=progress, offsets=offsets,
                                     guard=placement_guard(settings, offsets))  # fmt: skip
-                    print(stats.summary.line(), file=err)  # type: ignore[union-attr]
+                    summary = stats.summary
+                    assert summary is not None  # (a compensating run's)
+                    print(summary.line(), file=err)
                     written.seek(0)
-                    with_messages(written, spool, operator_messages(stats.summary))  # type: ignore[arg-type]
+                    with_messages(written, spool, operator_messages(summary))
         progress.report(100)
 
 
@@ -98,7 +100,8 @@ def operator_messages(summary) -> list[str]:
     warning at its first line.  LinuxCNC's G-code manual ("G Code Overview", comments): the text
     after `MSG,` is shown the operator; a comment ends at the first `)`, so none may be inside."""
     texts: list[str] = []
-    for part in summary.line(os.path.basename(summary.file)).split("; "):  # parts joined up to a line's length
+    said = summary.line(os.path.basename(summary.file))
+    for part in said.split("; "):  # parts joined up to a line's length
         if texts and len(texts[-1]) + len(part) + 2 <= MSG_TEXT:
             texts[-1] += f"; {part}"
         else:

@@ -140,10 +140,11 @@ def _post(
     if source is not None:
         summary = summary if summary is not None else Summary(file)
         warnings.listeners.append(summary.heard)
-        events = summary.written(run_passes(summary.programmed(events), make_context(source, tolerance, warnings, file), PASSES))
+        ctx = make_context(source, tolerance, warnings, file)
+        events = summary.written(run_passes(summary.programmed(events), ctx, PASSES))
         header = header_text(source, tolerance)
     generator = GENERATORS[dialect](warnings, header, file)
-    lines = (line + "\n" for line in generator.write(events, index))
+    lines: Iterator[str] = (line + "\n" for line in generator.write(events, index))
     if header is not None and guard is not None:
         lines = with_guard(lines, guard, dialect, HEADER_TAG)
     written = 0

@@ -49,7 +49,7 @@ parser.add_argument("--work-offset", action="append", default=[], help="[G5x=]X,
 parser.add_argument("--var-file", help="LinuxCNC parameter file holding the zeros")
 parser.add_argument("--tool-table", help="LinuxCNC tool table: the lengths the program's G43 applies")
 parser.add_argument("--var-units", help="units of --var-file and --tool-table: mm or inch")
-parser.add_argument("--no-guard", action="store_true", help="leave out the placement guard at the program's start")
+parser.add_argument("--no-guard", action="store_true", help="no placement guard at the program's start")
 parser.add_argument("--ncpp", help="the ncpp program (default: $NCPP, then ncpp on PATH)")
 
 TOOLTIP_ARGS = parser.format_help() + "\nOther arguments are passed to linuxcnc_post.\n"

@@ -19,8 +19,12 @@ PROGRAM = "G21 G90 G54\nG0 X10 Y10 Z5\nG1 X40 F300\nG98 G81 X50 Y50 Z-3 R2 F100\
 def plugin(tmp_path, monkeypatch):
     """The post module with a FreeCAD whose console records (kind, text), and an ncpp command."""
     said: list[tuple[str, str]] = []
-    console = types.SimpleNamespace(**{kind: (lambda text, kind=kind: said.append((kind, text)))
-                                       for kind in ("PrintMessage", "PrintWarning", "PrintError")})  # fmt: skip
+    console = types.SimpleNamespace(
+        **{
+            kind: (lambda text, kind=kind: said.append((kind, text)))
+            for kind in ("PrintMessage", "PrintWarning", "PrintError")
+        }
+    )
     monkeypatch.setitem(sys.modules, "FreeCAD", types.SimpleNamespace(Console=console))
     for name in ("NCPP_MACHINE", "XDG_CONFIG_HOME"):
         monkeypatch.delenv(name, raising=False)
@@ -30,7 +34,7 @@ def plugin(tmp_path, monkeypatch):
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     ncpp = tmp_path / "ncpp"
-    ncpp.write_text(f"#!/bin/sh\nPYTHONPATH={ROOT} exec {sys.executable} -m ncpp \"$@\"\n")
+    ncpp.write_text(f'#!/bin/sh\nPYTHONPATH={ROOT} exec {sys.executable} -m ncpp "$@"\n')
     ncpp.chmod(0o755)
     return module, f"--ncpp {ncpp}", said
 
@@ -40,9 +44,15 @@ def test_the_summary_and_warnings_reach_the_report_view_with_the_posted_line(plu
     text = module.compensate_text(PROGRAM, f"{ncpp} --machine {MACHINE} --work-offset 400,350,300")
     assert text.startswith("(ncpp compensated")
     warnings = [t for kind, t in said if kind == "PrintWarning"]
-    assert len(warnings) == 1 and warnings[0].startswith("ncpp_post: line 4 of the posted program (G98 G81 X50 Y50 Z-3 R2 F100): warning: canned cycle")
+    assert len(warnings) == 1 and warnings[0].startswith(
+        "ncpp_post: line 4 of the posted program (G98 G81 X50 Y50 Z-3 R2 F100): warning: canned cycle"
+    )
     messages = [t for kind, t in said if kind == "PrintMessage"]
-    assert len(messages) == 1 and "compensated 3 moves" in messages[0] and "4 moves of canned cycles (line 4)" in messages[0]
+    assert (
+        len(messages) == 1
+        and "compensated 3 moves" in messages[0]
+        and "4 moves of canned cycles (line 4)" in messages[0]
+    )
 
 
 def test_without_a_machine_file_the_report_view_warns_that_nothing_was_compensated(plugin):

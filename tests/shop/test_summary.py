@@ -11,7 +11,6 @@ import sys
 import numpy as np
 import pytest
 
-from ncpp.motion.offsets import WorkOffsets
 from ncpp.pipeline import ErrorSource, process
 from tests.conftest import ROOT
 
@@ -67,14 +66,27 @@ def test_out_of_scope_is_counted_from_its_line():
 def _ncpp(*args: str, cwd=None, env=None, stdin: bytes | None = None) -> subprocess.CompletedProcess:
     environ = {k: v for k, v in os.environ.items() if k not in ("NCPP_MACHINE", "XDG_CONFIG_HOME")}
     environ.update(PYTHONPATH=str(ROOT), HOME=str(cwd), **(env or {}))
-    return subprocess.run([sys.executable, "-m", *args], input=stdin, capture_output=True, cwd=cwd, env=environ, timeout=300)
+    return subprocess.run(
+        [sys.executable, "-m", *args], input=stdin, capture_output=True, cwd=cwd, env=environ, timeout=300
+    )
 
 
 @pytest.mark.parametrize("command", [("ncpp", "compensate"), ("ncpp",)])
 def test_the_summary_is_on_stderr_without_a_terminal_and_in_the_report(tmp_path, command):
     (tmp_path / "hand.ngc").write_bytes(PROGRAM)
-    proc = _ncpp(*command, "--machine", str(MACHINE), "--work-offset", "400,350,300", "hand.ngc", "-o", "out.ngc",
-                 "--report", "r.json", cwd=tmp_path)  # fmt: skip
+    proc = _ncpp(
+        *command,
+        "--machine",
+        str(MACHINE),
+        "--work-offset",
+        "400,350,300",
+        "hand.ngc",
+        "-o",
+        "out.ngc",
+        "--report",
+        "r.json",
+        cwd=tmp_path,
+    )
     assert proc.returncode == 0, proc.stderr
     summary = [ln for ln in proc.stderr.decode().splitlines() if ln.startswith("ncpp: hand.ngc: compensated")]
     assert len(summary) == 1 and "13 lines in" in summary[0]
@@ -86,8 +98,20 @@ def test_the_summary_is_on_stderr_without_a_terminal_and_in_the_report(tmp_path,
 
 
 def test_the_post_tells_its_summary(tmp_path):
-    proc = _ncpp("ncpp", "post", str(ROOT / "samples/programs/pocket.cls"), "--dialect", "linuxcnc", "--machine", str(MACHINE),
-                 "--work-offset", "400,350,300", "-o", "out.ngc", cwd=tmp_path)  # fmt: skip
+    proc = _ncpp(
+        "ncpp",
+        "post",
+        str(ROOT / "samples/programs/pocket.cls"),
+        "--dialect",
+        "linuxcnc",
+        "--machine",
+        str(MACHINE),
+        "--work-offset",
+        "400,350,300",
+        "-o",
+        "out.ngc",
+        cwd=tmp_path,
+    )
     assert proc.returncode == 0, proc.stderr
     assert "pocket.cls: compensated" in proc.stderr.decode()
 
@@ -105,10 +129,22 @@ def test_without_a_machine_file_the_filter_warns_and_passes_the_program_through(
 def test_compensate_and_simulate_find_the_machine_file_as_ncpp_does(tmp_path):
     (tmp_path / "hand.ngc").write_bytes(PROGRAM)
     env = {"NCPP_MACHINE": str(MACHINE)}
-    proc = _ncpp("ncpp", "compensate", "--work-offset", "400,350,300", "hand.ngc", "-o", "out.ngc", cwd=tmp_path, env=env)
+    proc = _ncpp(
+        "ncpp",
+        "compensate",
+        "--work-offset",
+        "400,350,300",
+        "hand.ngc",
+        "-o",
+        "out.ngc",
+        cwd=tmp_path,
+        env=env,
+    )
     assert proc.returncode == 0, proc.stderr
     assert (tmp_path / "out.ngc").read_text().startswith("(ncpp compensated for hr5b.toml")
     (tmp_path / "ncpp.toml").write_text(f'machine = "{MACHINE}"\n')
-    sim = _ncpp("ncpp", "simulate", "--work-offset", "400,350,300", "out.ngc", "--reference", "hand.ngc", cwd=tmp_path)
+    sim = _ncpp(
+        "ncpp", "simulate", "--work-offset", "400,350,300", "out.ngc", "--reference", "hand.ngc", cwd=tmp_path
+    )
     assert sim.returncode == 0, sim.stderr
     assert b"contour error" in sim.stdout
