@@ -148,3 +148,19 @@ def test_compensate_and_simulate_find_the_machine_file_as_ncpp_does(tmp_path):
     )
     assert sim.returncode == 0, sim.stderr
     assert b"contour error" in sim.stdout
+
+
+def test_several_programs_each_tell_their_summary_and_the_report_lists_them(tmp_path):
+    (tmp_path / "a.ngc").write_bytes(PROGRAM)
+    (tmp_path / "b.ngc").write_bytes(PROGRAM.replace(b"G41 D1 G1 X70 Y40 F200\n", b"G1 X70 Y40 F200\n"))
+    proc = _ncpp(
+        "ncpp", "compensate", "--machine", str(MACHINE), "--work-offset", "400,350,300", "-o", "out", "a.ngc", "b.ngc",
+        "--report", "r.json", cwd=tmp_path,
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    said = [ln for ln in proc.stderr.decode().splitlines() if ": compensated " in ln]
+    assert [ln.split(":")[1].strip() for ln in said] == ["a.ngc", "b.ngc"]
+    a, b = json.loads((tmp_path / "r.json").read_text())
+    assert (a["file"], b["file"]) == ("a.ngc", "b.ngc")
+    assert a["left_as_programmed"]["cutter compensation"]["moves"] == 3
+    assert "cutter compensation" not in b["left_as_programmed"] and b["moves_compensated"] == a["moves_compensated"] + 3
