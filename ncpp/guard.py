@@ -47,7 +47,8 @@ BEGIN = "ncpp placement guard:"
 END = "ncpp placement guard end"
 SCAN = 60  # blocks at the top searched for a guard
 SYSTEMS = ("G54", "G55", "G56", "G57", "G58", "G59", "G59.1", "G59.2", "G59.3")
-_FANUC_PROGRAM_NUMBER = re.compile(r"\s*O\d", re.IGNORECASE)
+# A Fanuc program number line (`O1234`, perhaps with a comment); not an o-word line (`o100 sub`)
+_FANUC_PROGRAM_NUMBER = re.compile(r"\s*O\d+\s*(\(.*\))?\s*$")
 
 
 @dataclass(frozen=True)

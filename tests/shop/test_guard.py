@@ -209,3 +209,11 @@ def test_the_post_writes_the_guard_of_its_dialect(tmp_path):
         _var_file(tmp_path / "moved.var", (401 * 25.4, 350 * 25.4, 300 * 25.4)), tmp_path / "linuxcnc.nc"
     )
     assert stopped.returncode != 0 and "PROGRAM_END" not in stopped.stdout
+
+
+def test_an_o_word_line_is_no_fanuc_program_number():
+    from ncpp.guard import Placement, guard_lines
+
+    placement = Placement(1, G54_MM)
+    assert guard_lines(placement, "iso", ["(header)\n", "o100 sub\n"])[1].startswith("o<ncpp_guard> if")
+    assert guard_lines(placement, "iso", ["%\n", "O0100 (PART)\n"])[1].startswith("IF [#4014 NE 54]")
