@@ -36,7 +36,7 @@ def _rs274(var_file: Path, program: Path) -> subprocess.CompletedProcess:
         text=True,
         env=env,
         stdin=subprocess.DEVNULL,
-        timeout=60,
+        timeout=120,
     )
 
 
