@@ -30,6 +30,7 @@ TRAVEL_END = "at a travel end"
 # `pipeline.warn_fixed`'s), and that of a line end left at a travel end (`apply_error_map`)
 PASSED_ON = ("the program passes through uninterpreted", "the program passes through uncompensated")
 STOPPED_AT_END = "stops at the end, uncompensated there"
+WARNING_TEXTS = 1000  # warning texts kept with their first place (memory stays flat in program length)
 
 
 @dataclass
@@ -39,25 +40,27 @@ class Summary:
     feed_mm: float = 0.0  # their feed (not rapid) path length
     largest_mm: float = 0.0  # the largest correction of a programmed point
     largest_line: int | None = None
-    left: dict[str, list[int]] = field(default_factory=dict)  # reason -> input lines of its moves (each once)
+    # reason -> the input lines of its moves, as runs [first, last] (memory by runs, not lines)
+    left: dict[str, list[list[int]]] = field(default_factory=dict)
     left_moves: dict[str, int] = field(default_factory=dict)  # reason -> moves
     passed_on_from: int | None = None  # the line from which the program passes through (out of scope)
-    warned: dict[str, tuple[Location, int]] = field(
-        default_factory=dict
-    )  # warning text -> (first place, times)
+    # warning text -> (first place, times), for the first WARNING_TEXTS texts
+    warned: dict[str, tuple[Location, int]] = field(default_factory=dict)
+    warnings: int = 0
     lines_in: int = 0
     lines_out: int = 0
 
     def __post_init__(self) -> None:
-        self._programmed: dict[
-            int, Line | Arc
-        ] = {}  # id(block) -> its last move as programmed, until written
+        # id(block) -> its last move as programmed, until written
+        self._programmed: dict[int, Line | Arc] = {}
 
     # -- the observers ----------------------------------------------------------------
     def heard(self, message: str, where: Location) -> None:
         """A warning of the run (`Warnings.listeners`)."""
+        self.warnings += 1
         first, times = self.warned.get(message, (where, 0))
-        self.warned[message] = (first, times + 1)
+        if times or len(self.warned) < WARNING_TEXTS:
+            self.warned[message] = (first, times + 1)
         if (
             self.passed_on_from is None
             and any(text in message for text in PASSED_ON)
@@ -120,9 +123,11 @@ class Summary:
             self.largest_mm, self.largest_line = moved, block.line
 
     def _leave(self, reason: str, line: int, count: bool = True) -> None:
-        lines = self.left.setdefault(reason, [])
-        if not lines or lines[-1] != line:
-            lines.append(line)
+        runs = self.left.setdefault(reason, [])
+        if runs and line == runs[-1][1] + 1:
+            runs[-1][1] = line
+        elif not (runs and runs[-1][0] <= line <= runs[-1][1]):
+            runs.append([line, line])
         if count:
             self.left_moves[reason] = self.left_moves.get(reason, 0) + 1
 
@@ -134,24 +139,26 @@ class Summary:
             f"largest correction {1000 * self.largest_mm:.1f} µm"
             + (f" (line {self.largest_line})" if self.largest_line else "")
         ]
-        left = [
-            f"{self.left_moves.get(reason, len(lines))} {'moves' if reason in self.left_moves else 'lines'} "
-            f"{_WHY.get(reason, reason)} ({_lines_text(lines)})"
-            for reason, lines in self.left.items()
-        ]
+        left = [f"{self._left_count(reason, runs)} {_WHY.get(reason, reason)} ({_lines_text(runs)})"
+                for reason, runs in self.left.items()]  # fmt: skip
         if self.passed_on_from is not None:
             lines = self.lines_in - self.passed_on_from + 1
             left.append(f"everything from line {self.passed_on_from} on ({lines} lines), out of scope")
         parts.append("left as programmed: " + (", ".join(left) if left else "nothing"))
         parts.append(f"{self.lines_in} lines in, {self.lines_out} out")
-        if self.warned:
-            parts.append(f"{sum(times for _, times in self.warned.values())} warnings")
+        if self.warnings:
+            parts.append(f"{self.warnings} warnings")
         return f"ncpp: {name or self.file}: " + "; ".join(parts)
+
+    def _left_count(self, reason: str, runs: list[list[int]]) -> str:
+        """How many moves left for `reason` (lines, for a reason told by warnings)."""
+        moves = self.left_moves.get(reason)
+        return f"{moves} moves" if moves is not None else f"{_count(runs)} lines"
 
     def as_dict(self) -> dict:
         left = {
-            reason: {"moves": self.left_moves.get(reason), "lines": _ranges(lines)}
-            for reason, lines in self.left.items()
+            reason: {"moves": self.left_moves.get(reason), "lines": runs}
+            for reason, runs in self.left.items()
         }
         if self.passed_on_from is not None:
             left[OUT_OF_SCOPE] = {
@@ -192,21 +199,14 @@ def path_length(move: Line | Arc) -> float:
     return math.hypot(arc.radius() * arc.sweep(), arc.end[normal] - arc.start[normal]) * arc.context.unit_mm
 
 
-def _ranges(lines: list[int]) -> list[list[int]]:
-    """[[first, last], ...] of runs of consecutive line numbers (in the order they ran)."""
-    runs: list[list[int]] = []
-    for line in lines:
-        if runs and line == runs[-1][1] + 1:
-            runs[-1][1] = line
-        elif not (runs and runs[-1][0] <= line <= runs[-1][1]):
-            runs.append([line, line])
-    return runs
+def _count(runs: list[list[int]]) -> int:
+    return sum(last - first + 1 for first, last in runs)
 
 
-def _lines_text(lines: list[int], shown: int = 4) -> str:
-    runs = [f"{a}" if a == b else f"{a}-{b}" for a, b in _ranges(lines)]
-    more = f" and {len(runs) - shown} more" if len(runs) > shown else ""
-    return ("line " if len(runs) == 1 and "-" not in runs[0] else "lines ") + ", ".join(runs[:shown]) + more
+def _lines_text(runs: list[list[int]], shown: int = 4) -> str:
+    said = [f"{a}" if a == b else f"{a}-{b}" for a, b in runs]
+    more = f" and {len(said) - shown} more" if len(said) > shown else ""
+    return ("line " if len(said) == 1 and "-" not in said[0] else "lines ") + ", ".join(said[:shown]) + more
 
 
 def write_report(path: str, summaries: list[Summary]) -> None:

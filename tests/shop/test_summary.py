@@ -47,7 +47,7 @@ def test_the_figures_of_a_hand_made_program():
     assert s.feed_mm == pytest.approx(6 + 30 + 20)  # the feed moves: Z5 to Z-1, then 30 and 20 mm
     assert s.largest_mm == pytest.approx(0.010, abs=2e-7)
     assert s.left_moves == {"canned cycle": 8, "cutter compensation": 3}  # 4 moves a hole; G41, G1, G40 moves
-    assert s.left == {"canned cycle": [6, 7], "cutter compensation": [10, 11, 12]}
+    assert s.left == {"canned cycle": [[6, 7]], "cutter compensation": [[10, 12]]}
     assert (s.lines_in, s.lines_out) == (13, stats.lines_out)
     line = s.line()
     assert "compensated 5 moves (56.0 mm of feed path), largest correction 10.0 µm" in line
@@ -154,8 +154,8 @@ def test_several_programs_each_tell_their_summary_and_the_report_lists_them(tmp_
     (tmp_path / "a.ngc").write_bytes(PROGRAM)
     (tmp_path / "b.ngc").write_bytes(PROGRAM.replace(b"G41 D1 G1 X70 Y40 F200\n", b"G1 X70 Y40 F200\n"))
     proc = _ncpp(
-        "ncpp", "compensate", "--machine", str(MACHINE), "--work-offset", "400,350,300", "-o", "out", "a.ngc", "b.ngc",
-        "--report", "r.json", cwd=tmp_path,
+        "ncpp", "compensate", "--machine", str(MACHINE), "--work-offset", "400,350,300",
+        "-o", "out", "a.ngc", "b.ngc", "--report", "r.json", cwd=tmp_path,
     )  # fmt: skip
     assert proc.returncode == 0, proc.stderr
     said = [ln for ln in proc.stderr.decode().splitlines() if ": compensated " in ln]
@@ -163,4 +163,7 @@ def test_several_programs_each_tell_their_summary_and_the_report_lists_them(tmp_
     a, b = json.loads((tmp_path / "r.json").read_text())
     assert (a["file"], b["file"]) == ("a.ngc", "b.ngc")
     assert a["left_as_programmed"]["cutter compensation"]["moves"] == 3
-    assert "cutter compensation" not in b["left_as_programmed"] and b["moves_compensated"] == a["moves_compensated"] + 3
+    assert (
+        "cutter compensation" not in b["left_as_programmed"]
+        and b["moves_compensated"] == a["moves_compensated"] + 3
+    )
