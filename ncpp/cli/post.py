@@ -29,7 +29,6 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     import sys
-
     from typing import Any
 
     from ncpp.cli.progress import progress_printer

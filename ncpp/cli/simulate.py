@@ -50,10 +50,9 @@ def register(sub: argparse._SubParsersAction) -> None:
 def program_events(path: str, warnings: Warnings, offsets=None, dialect: str | None = None) -> list:
     """The events of a program (its dialect detected unless given), placed on the machine by `offsets`."""
     from ncpp.cli.motion import warn_off_path
+    from ncpp.guard import without_guard
     from ncpp.pipeline import dialect_tools
     from ncpp.program.dialects import parse_program
-
-    from ncpp.guard import without_guard
 
     with open(path, "rb") as stream:
         name, blocks = parse_program(stream, path, dialect)

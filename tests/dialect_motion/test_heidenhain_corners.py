@@ -16,8 +16,8 @@ import numpy as np
 import pytest
 
 from ncpp.errors import NcppError, Warnings
-from ncpp.motion.segments import Arc, Line, Pass
 from ncpp.guard import without_guard
+from ncpp.motion.segments import Arc, Line, Pass
 from ncpp.pipeline import dialect_tools
 from ncpp.program.dialects import parse_program
 from ncpp.simulate import sample_events
