@@ -77,12 +77,12 @@ def test_rs274_runs_the_guarded_program_where_g54_matches_and_stops_it_where_not
     assert "PROGRAM_END" in ran.stdout and ran.stdout.count("STRAIGHT_FEED") >= 3
     for moved in ((400.5, 350.0, 300.0), (400.0, 350.0, 299.8)):
         stopped = _rs274(_var_file(tmp_path / "moved.var", moved), program)
-        assert stopped.returncode != 0 and "compensated for G54" in stopped.stderr
+        assert stopped.returncode != 0 and "compensated for G54" in stopped.stderr, stopped.stderr
         assert "STRAIGHT_FEED" not in stopped.stdout and "PROGRAM_END" not in stopped.stdout
     other_system = _rs274(_var_file(tmp_path / "g55.var", G54_MM, system=2), program)
-    assert other_system.returncode != 0 and "PROGRAM_END" not in other_system.stdout
+    assert other_system.returncode != 0 and "PROGRAM_END" not in other_system.stdout, other_system.stderr
     within = _rs274(_var_file(tmp_path / "near.var", (400.05, 349.95, 300.0)), program)
-    assert within.returncode == 0 and "PROGRAM_END" in within.stdout  # within the guard's 0.1 mm
+    assert within.returncode == 0 and "PROGRAM_END" in within.stdout, within.stderr  # within 0.1 mm
 
 
 def test_the_guard_is_written_only_where_the_offset_was_told_and_not_with_no_guard(tmp_path):
@@ -208,7 +208,7 @@ def test_the_post_writes_the_guard_of_its_dialect(tmp_path):
     stopped = _rs274(
         _var_file(tmp_path / "moved.var", (401 * 25.4, 350 * 25.4, 300 * 25.4)), tmp_path / "linuxcnc.nc"
     )
-    assert stopped.returncode != 0 and "PROGRAM_END" not in stopped.stdout
+    assert stopped.returncode != 0 and "PROGRAM_END" not in stopped.stdout, stopped.stderr
 
 
 def test_an_o_word_line_is_no_fanuc_program_number():
