@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import sys
 from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING, Iterable, TextIO
+from typing import TYPE_CHECKING, Callable, Iterable, TextIO
 
 if TYPE_CHECKING:
     from ncpp.program.blocks import Block
@@ -97,11 +97,15 @@ class Warnings:
         self.count = 0
         self._times: dict[str, int] = {}  # how often each text was warned
         self._hidden: dict[str, tuple[Location, Location]] = {}  # where each text was first and last not printed
+        # told every warning (`summary.Summary.heard`)
+        self.listeners: list[Callable[[str, Location], None]] = []
 
     def warn(self, message: str, where: Location) -> None:
         if self.strict:
             raise NcppError(f"{message} (refused in strict mode)", where)
         self.count += 1
+        for listener in self.listeners:
+            listener(message, where)
         self.say(message, where)
 
     def say(self, message: str, where: Location) -> None:

@@ -20,6 +20,7 @@ from typing import BinaryIO, Callable, Iterable, Iterator
 
 from ncpp import __version__
 from ncpp.errors import Location, NcppError, Warnings
+from ncpp.guard import Placement, with_guard, without_guard
 from ncpp.motion.offsets import AT_MACHINE_ZERO, WorkOffsets
 from ncpp.motion.segments import COMP, CYCLE, FLOW, Arc, Event, Line, Pass
 from ncpp.passes import PASSES, PassContext, run_passes
@@ -29,6 +30,7 @@ from ncpp.program.blocks import Block, Comment, Statement, Word
 from ncpp.program.dialects import parse_program
 from ncpp.program.dialects.iso import IsoWriter
 from ncpp.runtime import keep_freed_memory
+from ncpp.summary import Summary
 
 HEADER_TAG = "ncpp compensated"  # (lower case: `header_comment` finds it in any case)
 HEADER_SCAN = 30  # blocks at the top searched for an earlier header, and on while only comments follow
@@ -89,6 +91,7 @@ def _digest(path: str) -> str:
 class Stats:
     lines_in: int = 0
     lines_out: int = 0
+    summary: Summary | None = None  # what a compensating run did
 
 
 def header_text(source: ErrorSource, tolerance: float, offsets: WorkOffsets | None = None, dialect: str = "iso") -> str:  # fmt: skip
@@ -341,6 +344,7 @@ def process(
     dialect: str | None = None,
     offsets: WorkOffsets | None = None,
     verify: bool = True,
+    guard: Placement | None = None,
 ) -> Stats:
     """Read, interpret, compensate (when `source` is given) and write one program.
 
@@ -352,7 +356,8 @@ def process(
     A compensated program is verified as it is written (`ncpp/verify.py`): read back
     and compared with the interpreter's reading of the input; where they part an
     NcppError stops the run, and what `out` took so far must be thrown away (the
-    command line writes to a temporary file or a spool).  `verify=False` skips it."""
+    command line writes to a temporary file or a spool).  `verify=False` skips it.  `guard`: where
+    the program must find the control's work offset, checked at its start (`ncpp/guard.py`)."""
     warnings = warnings or Warnings(strict=strict)
     stats = Stats()
     name, parsed = parse_program(stream, file, dialect)
@@ -361,6 +366,8 @@ def process(
     blocks: Iterable[Block] = _counted(_parsed_ahead(parsed), counter, progress)
     if source is not None and not force:
         blocks = refuse_compensated(blocks, file)
+    elif source is not None:  # compensated again: the guard of the offset it was compensated for goes
+        blocks = without_guard(blocks)
     if source is not None and name != "iso":  # the ISO interpreter places every work offset and tool length
         blocks = warn_unplaced(blocks, warnings, file)
     # the control's zeros place the program on the machine; passthrough places nothing
@@ -372,11 +379,17 @@ def process(
         if verify:
             events, original = tee(events)
         events = warn_fixed(events, warnings, file)  # cycles, loops, subroutines (ISO), cutter compensation
+        stats.summary = summary = Summary(file)
+        warnings.listeners.append(summary.heard)
         writer = writer_class()
         keep_freed_memory()  # numpy's temporaries reuse the heap, not fresh pages (runtime.py)
         ctx = make_context(source, tolerance, warnings, file)
         reached = _Reached()
-        lines = with_header(writer.write(reached.follow(run_passes(events, ctx, PASSES))), header_text(source, tolerance, offsets, name), writer)
+        compensated = summary.written(run_passes(summary.programmed(events), ctx, PASSES))
+        header = header_text(source, tolerance, offsets, name)
+        lines = with_header(writer.write(reached.follow(compensated)), header, writer)
+        if guard is not None:
+            lines = with_guard(lines, guard, name, HEADER_TAG, header.count("\n") + 1)
         if verify:
             from ncpp.verify import Bound, verified
 
@@ -388,6 +401,8 @@ def process(
             out.write("".join(batch).encode("latin-1"))
             stats.lines_out += len(batch)
     stats.lines_in = next(counter)
+    if stats.summary is not None:
+        stats.summary.lines_in, stats.summary.lines_out = stats.lines_in, stats.lines_out
     warnings.finish()
     return stats
 

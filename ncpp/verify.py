@@ -338,9 +338,11 @@ class Bound:
 
 def _interpreted(blocks: Iterable[Block], file: str, dialect: str, offsets: WorkOffsets | None) -> Iterator[Event]:
     """A program's events as ncpp's interpreter reads its blocks, its warnings unsaid."""
+    from ncpp.guard import without_guard
     from ncpp.pipeline import dialect_tools
 
     interpret, _ = dialect_tools(dialect)
+    blocks = without_guard(blocks)  # (it neither moves nor acts, and reads the control's parameters)
     return interpret(blocks, file=file, warnings=Warnings(stream=_Discard()), offsets=offsets or AT_MACHINE_ZERO)
 
 

@@ -24,6 +24,7 @@ from ncpp.cli.io import add_io_arguments, open_input, open_output
 from ncpp.cli.options import at_least, positive
 from ncpp.cli.progress import progress_printer
 from ncpp.errors import NcppError, Warnings
+from ncpp.summary import write_report
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -50,7 +51,27 @@ def add_compensation_arguments(p: argparse.ArgumentParser) -> None:
         help="write the compensated program without reading it back and comparing it with the input "
         "(by default a program whose actions or path differ from the input's is refused, and nothing is written)",
     )
+    p.add_argument(
+        "--report",
+        metavar="FILE.json",
+        help="write what compensation did as JSON: the summary line's figures, with the input lines "
+        "of each reason moves were left as programmed (several programs: a list)",
+    )
+    p.add_argument(
+        "--no-guard",
+        dest="guard",
+        action="store_false",
+        help="leave out the placement guard: the block at the program's start that stops it when "
+        "the control's work offset is not the one given with --work-offset / --var-file",
+    )
     add_placement_arguments(p)
+
+
+def tell(summary, report: str | None) -> None:
+    """A run's summary (`summary.Summary`) on stderr, and in the --report file."""
+    print(summary.line(), file=sys.stderr)
+    if report:
+        write_report(report, [summary])
 
 
 def add_placement_arguments(p: argparse.ArgumentParser) -> None:
@@ -124,16 +145,21 @@ def error_source(args: argparse.Namespace):
 
 
 def run(args: argparse.Namespace) -> int:
-    source = error_source(args)
+    from ncpp.cli.filter import configured_source
+
+    source, tolerance, offsets, guard = configured_source(args)
     if source is None:
-        raise NcppError("no error model: give --machine M.toml or --from MEASUREMENT")
-    job = Job(source, args.tolerance, args.strict, args.force, args.dialect, work_offsets(args), args.verify)
+        raise NcppError(
+            "no error model: give --machine M.toml or --from MEASUREMENT, set $NCPP_MACHINE, "
+            "or name a machine file in ./ncpp.toml or ~/.config/ncpp/config.toml"
+        )
+    job = Job(source, tolerance, args.strict, args.force, args.dialect, offsets, args.verify, guard)
     folder = args.output is not None and os.path.isdir(args.output)
     if len(args.input) > 1 or folder:
         if args.output is None:
-            raise NcppError("several programs need -o FOLDER, the folder each is written to under its name")
-        return compensate_files(job, args.input, Path(args.output), args.jobs)
-    return _compensate_one(job, args.input[0] if args.input else None, args.output)
+            raise NcppError("several programs need -o FOLDER, the folder each is written to under its own name")
+        return compensate_files(job, args.input, Path(args.output), args.jobs, args.report)
+    return _compensate_one(job, args.input[0] if args.input else None, args.output, args.report)
 
 
 Progress = Callable[[int], None] | None
@@ -150,6 +176,7 @@ class Job:
     dialect: str | None
     offsets: object  # motion.offsets.WorkOffsets
     verify: bool = True
+    guard: object = None  # guard.Placement: the placement guard at the program's start (None: none)
 
     def compensate(self, stream: BinaryIO, out: BinaryIO, name: str, progress: Progress = None):
         """`pipeline.process` of one program, with warnings of its own."""
@@ -159,27 +186,31 @@ class Job:
             stream, out, file=name, source=self.source,  # type: ignore[arg-type]
             tolerance=self.tolerance, strict=self.strict, force=self.force,
             warnings=Warnings(strict=self.strict), progress=progress, dialect=self.dialect,
-            offsets=self.offsets, verify=self.verify,  # type: ignore[arg-type]
+            offsets=self.offsets, verify=self.verify, guard=self.guard,  # type: ignore[arg-type]
         )  # fmt: skip
 
 
-def _compensate_one(job: Job, path: str | None, output: str | None) -> int:
+def _compensate_one(job: Job, path: str | None, output: str | None, report: str | None = None) -> int:
     """One program (standard input for none) to `output` (standard output for none), with progress."""
     progress = progress_printer("compensate")
     with open_input(path) as (stream, name), open_output(output) as out:
         stats = job.compensate(stream, out, name, progress)
     if progress is not None:
         progress.done()
-        print(f"ncpp: {stats.lines_in} lines in, {stats.lines_out} lines out", file=sys.stderr)
+    tell(stats.summary, report)
     return 0
 
 
-def compensate_files(job: Job, paths: list[str], folder: Path, jobs: int = 1) -> int:
+def compensate_files(
+    job: Job, paths: list[str], folder: Path, jobs: int = 1, report: str | None = None
+) -> int:
     """Each program to `folder` under its own name, `jobs` at once; a failure is reported
-    (`file:line:col: message`) and the others go on.  0 if all were written, else 2."""
+    (`file:line:col: message`) and the others go on, a success by its summary.  0 if all were
+    written, else 2."""
     targets = _targets(paths, folder)
     folder.mkdir(parents=True, exist_ok=True)
     failed = 0
+    summaries = []
     with _executor(job, min(jobs, len(paths))) as pool:
         futures = [pool.submit(_compensate_file, path, str(target)) for path, target in zip(paths, targets)]
         for path, future in zip(paths, futures):
@@ -187,6 +218,11 @@ def compensate_files(job: Job, paths: list[str], folder: Path, jobs: int = 1) ->
             if message is not None:
                 print(message, file=sys.stderr)
                 failed += 1
+            else:
+                summaries.append(future.result())
+                print(summaries[-1].line(), file=sys.stderr)
+    if report and summaries:
+        write_report(report, summaries)
     if failed:
         print(f"ncpp: {failed} of {len(paths)} programs failed", file=sys.stderr)
     return 2 if failed else 0
@@ -250,11 +286,10 @@ def _start_worker(job: Job) -> None:
     _job = job
 
 
-def _compensate_file(path: str, target: str) -> None:
+def _compensate_file(path: str, target: str):
     """One program of `compensate_files`, in a process `_start_worker` was told the job."""
     from ncpp.fileio import atomic_output
 
     assert _job is not None
     with open(path, "rb") as stream, atomic_output(target) as out:
-        _job.compensate(stream, out, path)
-
+        return _job.compensate(stream, out, path).summary

@@ -17,9 +17,11 @@ when stderr is a terminal.
 from __future__ import annotations
 
 import argparse
+import sys
+from dataclasses import replace
 from pathlib import Path
 
-from ncpp.cli.compensate import add_compensation_arguments
+from ncpp.cli.compensate import add_compensation_arguments, tell
 from ncpp.cli.io import add_io_arguments, open_input, open_output
 from ncpp.cli.progress import progress_printer
 from ncpp.errors import Location, NcppError, Warnings
@@ -36,28 +38,55 @@ def run(args: argparse.Namespace) -> int:
     from ncpp.pipeline import process
 
     warnings = Warnings(strict=args.strict)
-    source, tolerance, offsets = configured_source(args)
+    source, tolerance, offsets, guard = configured_source(args)
     progress = progress_printer("filter")
     with open_input(args.input) as (stream, name), open_output(args.output) as out:
-        process(stream, out, file=name, source=source, tolerance=tolerance, strict=args.strict, force=args.force,
-                warnings=warnings, progress=progress, dialect=args.dialect, offsets=offsets, verify=args.verify)  # fmt: skip
+        stats = process(stream, out, file=name, source=source, tolerance=tolerance, strict=args.strict, force=args.force,
+                        warnings=warnings, progress=progress, dialect=args.dialect, offsets=offsets, verify=args.verify,
+                        guard=guard)  # fmt: skip
     if progress is not None:
         progress.done()
+    if stats.summary is not None:
+        tell(stats.summary, args.report)
+    else:
+        print(f"ncpp: {name}: warning: {NOT_COMPENSATED}", file=sys.stderr)
     return 1 if warnings.count and args.strict else 0
 
 
+# What a run without a machine file says: it passes the program through as it is.
+NOT_COMPENSATED = (
+    "no machine file, nothing was compensated: the program passes through unchanged "
+    "(give --machine, set $NCPP_MACHINE, or name one in ./ncpp.toml or ~/.config/ncpp/config.toml)"
+)
+
+
 def configured_source(args: argparse.Namespace):
-    """(ErrorSource or None, tolerance, WorkOffsets) from the command line, $NCPP_MACHINE and the config file."""
+    """(ErrorSource or None, tolerance, WorkOffsets, the placement guard or None) from the
+    command line, $NCPP_MACHINE and the config file."""
     from ncpp.integrations.config import find_settings
 
     var_units = args.var_units if args.var_file or args.tool_table else None  # the config's when the files are the config's
     settings = find_settings(args.machine, args.tolerance, dict(args.work_offset), args.var_file, var_units, args.tool_table)
+    settings = replace(settings, subroutine_path=tuple(args.subroutine_path))
     if not (args.from_file or settings.machine):
-        return None, settings.tolerance, None
+        return None, settings.tolerance, None, None
     from ncpp.pipeline import ErrorSource
 
+    offsets = settings.offsets()
+    guard = placement_guard(settings, offsets) if args.guard else None
     if args.from_file:
-        return ErrorSource.from_measurement(args.from_file), settings.tolerance, settings.offsets()
+        return ErrorSource.from_measurement(args.from_file), settings.tolerance, offsets, guard
     if not Path(settings.machine).is_file():
         raise NcppError(f"machine file {settings.machine} does not exist", Location(settings.origin))
-    return ErrorSource.from_machine_file(settings.machine), settings.tolerance, settings.offsets()
+    return ErrorSource.from_machine_file(settings.machine), settings.tolerance, offsets, guard
+
+
+def placement_guard(settings, offsets):
+    """The placement guard (`guard.Placement`) where the settings tell the work offset (--work-offset,
+    --var-file or the config's), else None."""
+    from ncpp.guard import Placement
+    from ncpp.motion.offsets import UNIT_MM
+
+    if not (settings.zeros or settings.var_file):
+        return None
+    return Placement.of(offsets, UNIT_MM[settings.var_units])

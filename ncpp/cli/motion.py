@@ -63,6 +63,7 @@ def run(args: argparse.Namespace) -> int:
     import sys
 
     from ncpp.cli.io import open_input
+    from ncpp.guard import without_guard
     from ncpp.motion.canon import format_event
     from ncpp.pipeline import dialect_tools
     from ncpp.program.dialects import parse_program
@@ -73,6 +74,7 @@ def run(args: argparse.Namespace) -> int:
     with open_input(args.input) as (stream, name):
         dialect, blocks = parse_program(stream, name, args.dialect)
         interpret, _ = dialect_tools(dialect)
+        blocks = without_guard(blocks)  # (a compensated program's)
         events = interpret(blocks, file=name, warnings=warnings, offsets=offsets)
         for event in warn_off_path(events, warnings, name, "printed as programmed (rs274 prints the tool centre, offset by the radius)"):
             if type(event) is not Line and type(event) is not Arc:

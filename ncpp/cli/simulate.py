@@ -32,7 +32,12 @@ def step_mm(text: str) -> float:
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("simulate", help="run a program on the modelled machine: contour error, ball-bar trace")
     p.add_argument("program", help="NC program to run")
-    p.add_argument("--machine", required=True, metavar="M.toml", help="machine file (the virtual machine)")
+    p.add_argument(
+        "--machine",
+        metavar="M.toml",
+        help="machine file (the virtual machine; default: $NCPP_MACHINE, then ./ncpp.toml "
+        "or ~/.config/ncpp/config.toml)",
+    )
     p.add_argument("--reference", metavar="ORIGINAL", help="nominal program (for a compensated PROGRAM)")
     add_placement_arguments(p)
     add_dialect_argument(p)
@@ -45,13 +50,14 @@ def register(sub: argparse._SubParsersAction) -> None:
 def program_events(path: str, warnings: Warnings, offsets=None, dialect: str | None = None) -> list:
     """The events of a program (its dialect detected unless given), placed on the machine by `offsets`."""
     from ncpp.cli.motion import warn_off_path
+    from ncpp.guard import without_guard
     from ncpp.pipeline import dialect_tools
     from ncpp.program.dialects import parse_program
 
     with open(path, "rb") as stream:
         name, blocks = parse_program(stream, path, dialect)
         interpret, _ = dialect_tools(name)
-        events = interpret(blocks, file=path, warnings=warnings, offsets=offsets)
+        events = interpret(without_guard(blocks), file=path, warnings=warnings, offsets=offsets)
         return list(warn_off_path(events, warnings, path, "simulated as programmed"))
 
 
@@ -60,7 +66,7 @@ def run(args: argparse.Namespace) -> int:
     from ncpp.machine import load_machine
     from ncpp.simulate import contour_error, sample_events
 
-    machine = load_machine(args.machine)
+    machine = load_machine(machine_file(args.machine))
     warnings = Warnings()
     offsets = work_offsets(args)
     events = program_events(args.program, warnings, offsets, args.dialect)
@@ -79,6 +85,19 @@ def run(args: argparse.Namespace) -> int:
     if args.plot:
         plot_report(report, commanded, args.plot)
     return 0
+
+
+def machine_file(given: str | None) -> str:
+    """The machine file: `given`, else the one plain `ncpp` finds (`integrations/config.py`)."""
+    from ncpp.integrations.config import find_settings
+
+    settings = find_settings(given)
+    if settings.machine is None:
+        raise NcppError(
+            "no machine file: give --machine M.toml, set $NCPP_MACHINE, "
+            "or name one in ./ncpp.toml or ~/.config/ncpp/config.toml"
+        )
+    return settings.machine
 
 
 def check_travel(path, limits, file: str, events: list, slack_mm: float = 1e-6) -> None:

@@ -17,8 +17,9 @@ import argparse
 import os
 import shutil
 import sys
+import tempfile
 from functools import cached_property
-from typing import TextIO
+from typing import BinaryIO, TextIO
 
 from ncpp.errors import Location, NcppError, Warnings
 from ncpp.fileio import count_lines
@@ -61,12 +62,17 @@ def already_compensated(path: str) -> bool:
 
 
 def run(path: str, err: TextIO, machine: str | None = None) -> None:
-    """Write the compensated program to stdout (nothing on error), progress to `err`."""
+    """Write the compensated program to stdout (nothing on error), progress, warnings and the
+    summary to `err`; the summary and each kind of warning also as `(MSG, ...)` lines at the
+    program's start, which LinuxCNC shows the operator when the program runs."""
+    from ncpp.cli.filter import NOT_COMPENSATED, placement_guard
     from ncpp.cli.io import open_output
     from ncpp.integrations.config import find_settings, with_linuxcnc_ini
     from ncpp.pipeline import ErrorSource, process
 
     settings = with_linuxcnc_ini(find_settings(machine), os.environ.get("INI_FILE_NAME"))
+    if settings.machine is None:
+        print(f"ncpp: {path}: warning: {NOT_COMPENSATED}", file=err)
     with open(path, "rb") as stream:
         progress = FilterProgress(path, err)
         progress.report(0)
@@ -77,9 +83,60 @@ def run(path: str, err: TextIO, machine: str | None = None) -> None:
                 if not os.path.isfile(settings.machine):
                     raise NcppError(f"machine file {settings.machine} does not exist", Location(settings.origin))
                 source = ErrorSource.from_machine_file(settings.machine)
-                process(stream, spool, file=path, source=source, tolerance=settings.tolerance, warnings=Warnings(stream=err),
-                        progress=progress, offsets=settings.offsets())  # fmt: skip
+                offsets = settings.offsets()
+                with tempfile.TemporaryFile() as written:
+                    stats = process(stream, written, file=path, source=source, tolerance=settings.tolerance,
+                                    warnings=Warnings(stream=err), progress=progress, offsets=offsets,
+                                    guard=placement_guard(settings, offsets))  # fmt: skip
+                    summary = stats.summary
+                    assert summary is not None  # (a compensating run's)
+                    print(summary.line(), file=err)
+                    written.seek(0)
+                    with_messages(written, spool, operator_messages(summary))
         progress.report(100)
+
+
+MSG_TEXT = 200  # characters of a message line's text at most (rs274 refuses lines of 255 and more)
+MSG_KINDS = 8  # kinds of warning shown the operator at most (the rest are counted)
+
+
+def operator_messages(summary) -> list[str]:
+    """`(MSG, ...)` lines: the summary (`summary.Summary`), a line per part, then each kind of
+    warning at its first line.  LinuxCNC's G-code manual ("G Code Overview", comments): the text
+    after `MSG,` is shown the operator; a comment ends at the first `)`, so none may be inside."""
+    texts: list[str] = []
+    said = summary.line(os.path.basename(summary.file))
+    for part in said.split("; "):  # parts joined up to a line's length
+        if texts and len(texts[-1]) + len(part) + 2 <= MSG_TEXT:
+            texts[-1] += f"; {part}"
+        else:
+            texts.append(part if not texts else f"ncpp: {part}")
+    warned = list(summary.warned.items())
+    for message, (where, times) in warned[:MSG_KINDS]:
+        again = f" [and {times - 1} more]" if times > 1 else ""
+        texts.append(f"ncpp warning line {where.line}{again}: {message}")
+    if len(warned) > MSG_KINDS:
+        texts.append(f"ncpp: {len(warned) - MSG_KINDS} more kinds of warning: see the filter's output")
+    return [f"(MSG, {_msg_text(text)})" for text in texts]
+
+
+def _msg_text(text: str) -> str:
+    text = text.replace("(", "[").replace(")", "]").replace("µm", "um")  # (ASCII: the screens' fonts)
+    return text if len(text) <= MSG_TEXT else text[: MSG_TEXT - 3] + "..."
+
+
+def with_messages(written: BinaryIO, out: BinaryIO, messages: list[str]) -> None:
+    """Copy the written program to `out` with the message lines after its header comment
+    (after a `%` line, where ncpp puts the header)."""
+    from ncpp.pipeline import HEADER_TAG
+
+    head = [written.readline() for _ in range(2)]
+    at = next((k + 1 for k, line in enumerate(head) if HEADER_TAG.encode() in line), 0)
+    eol = b"\r\n" if head[0].endswith(b"\r\n") else b"\n"
+    out.writelines(head[:at])
+    out.writelines(m.encode("latin-1", errors="replace") + eol for m in messages)
+    out.writelines(head[at:])
+    shutil.copyfileobj(written, out)
 
 
 def main(argv: list[str] | None = None) -> int:

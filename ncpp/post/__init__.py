@@ -14,12 +14,14 @@ from typing import BinaryIO, Callable, Iterable, Iterator, TextIO
 
 from ncpp.cldata import Record, motion, read_cldata
 from ncpp.errors import NcppError, Warnings
+from ncpp.guard import Placement, with_guard
 from ncpp.motion.offsets import WorkOffsets
 from ncpp.motion.segments import Event
 from ncpp.post.generator import Generator
 from ncpp.post.heidenhain import HeidenhainGenerator
 from ncpp.post.iso import FanucGenerator, IsoGenerator, LinuxCncGenerator
 from ncpp.post.sinumerik import SinumerikGenerator
+from ncpp.summary import Summary
 
 GENERATORS: dict[str, type[Generator]] = {
     "iso": IsoGenerator,
@@ -64,6 +66,8 @@ def post(
     progress: Callable[[int], None] | None = None,
     offsets: WorkOffsets | None = None,
     verify: bool = True,
+    summary: Summary | None = None,
+    guard: Placement | None = None,
 ) -> int:
     """Post one CL file as a `dialect` program (compensated when `source` is an
     `ncpp.pipeline.ErrorSource`, the CL origin at `offsets`' G54 zero);
@@ -71,16 +75,19 @@ def post(
 
     A compensated program is verified before it is written (`ncpp/verify.py`): the CL
     data is posted a second time without compensation, and the compensated program
-    must do what that one does (`verify=False` skips it)."""
+    must do what that one does (`verify=False` skips it).  `summary` is told what compensation did
+    (its lines in are the CL records); a compensated program starts with the placement `guard`
+    (`ncpp/guard.py`) when one is given."""
     if source is not None and verify:
         return _verified(stream, out, file=file, dialect=dialect, source=source, tolerance=tolerance,
-                         warnings=warnings, progress=progress, offsets=offsets)  # fmt: skip
+                         warnings=warnings, progress=progress, offsets=offsets, summary=summary, guard=guard)  # fmt: skip
     return _post(stream, out, file=file, dialect=dialect, source=source, tolerance=tolerance,
-                 warnings=warnings, progress=progress, offsets=offsets)  # fmt: skip
+                 warnings=warnings, progress=progress, offsets=offsets, summary=summary, guard=guard)  # fmt: skip
 
 
 def _verified(stream: TextIO, out: BinaryIO, *, file: str, dialect: str, source, tolerance: float, warnings: Warnings | None,
-              progress: Callable[[int], None] | None, offsets: WorkOffsets | None) -> int:  # fmt: skip
+              progress: Callable[[int], None] | None, offsets: WorkOffsets | None, summary: Summary | None,
+              guard: Placement | None) -> int:  # fmt: skip
     """Post compensated and uncompensated to temporary files; verify, then copy to `out`."""
     import io
     import shutil
@@ -93,7 +100,7 @@ def _verified(stream: TextIO, out: BinaryIO, *, file: str, dialect: str, source,
         shutil.copyfileobj(stream, cl)
         cl.seek(0)
         count = _post(cl, written, file=file, dialect=dialect, source=source, tolerance=tolerance, warnings=warnings,
-                      progress=progress, offsets=offsets)  # fmt: skip
+                      progress=progress, offsets=offsets, summary=summary, guard=guard)  # fmt: skip
         cl.seek(0)
         _post(cl, plain, file=file, dialect=dialect, source=None, warnings=Warnings(stream=io.StringIO()), offsets=offsets)
         plain.seek(0)
@@ -117,9 +124,11 @@ def _post(
     warnings: Warnings | None = None,
     progress: Callable[[int], None] | None = None,
     offsets: WorkOffsets | None = None,
+    summary: Summary | None = None,
+    guard: Placement | None = None,
 ) -> int:
     from ncpp.passes import PASSES, run_passes
-    from ncpp.pipeline import header_text, make_context, warn_fixed
+    from ncpp.pipeline import HEADER_TAG, header_text, make_context, warn_fixed
 
     if dialect not in GENERATORS:
         raise NcppError(f"unknown dialect {dialect!r} (known: {', '.join(GENERATORS)})")
@@ -130,13 +139,21 @@ def _post(
     header = None
     if source is not None:
         events = warn_fixed(events, warnings, file)  # canned cycles, cutter compensation: as programmed
-        events = run_passes(events, make_context(source, tolerance, warnings, file), PASSES)
+        summary = summary if summary is not None else Summary(file)
+        warnings.listeners.append(summary.heard)
+        ctx = make_context(source, tolerance, warnings, file)
+        events = summary.written(run_passes(summary.programmed(events), ctx, PASSES))
         header = header_text(source, tolerance)
     generator = GENERATORS[dialect](warnings, header, file)
+    lines: Iterator[str] = (line + "\n" for line in generator.write(events, index))
+    if header is not None and guard is not None:
+        lines = with_guard(lines, guard, dialect, HEADER_TAG)
     written = 0
-    for line in generator.write(events, index):
-        out.write((line + "\n").encode("latin-1", errors="replace"))
+    for line in lines:
+        out.write(line.encode("latin-1", errors="replace"))
         written += 1
+    if summary is not None:
+        summary.lines_in, summary.lines_out = index.count, written
     warnings.finish()
     return written
 

@@ -18,6 +18,8 @@
 #   --tool-table FILE     LinuxCNC tool table: the lengths the program's G43 applies
 #   --base NAME           FreeCAD's post to wrap: linuxcnc (default), grbl, fanuc,
 #                         mach3_mach4 or centroid
+#   --no-guard            leave out the placement guard (the program's check that
+#                         the control's G54 is the one given with --work-offset)
 # Any other argument goes to that post (e.g. --no-comments, --precision 4).
 # `ncpp install-freecad-post` copies this file into the macro directory.
 #
@@ -26,6 +28,10 @@
 # $NCPP, else the FreeCAD parameter BaseApp/Preferences/Mod/ncpp "Program" (Tools >
 # Edit parameters), else `ncpp` on PATH.
 #
+# ncpp's summary goes to FreeCAD's Report view as a message, its warnings as
+# warnings and a failure as an error, each naming the line of the program
+# linuxcnc_post made (with its text).
+#
 # FreeCAD 0.20/0.21 call the module function export(); FreeCAD 1.x looks for
 # the class named after the file (`Ncpp`) and calls its export().
 
@@ -33,9 +39,11 @@ import argparse
 import importlib
 import importlib.util
 import os
+import re
 import shlex
 import shutil
 import subprocess
+import sys
 import tempfile
 
 TOOLTIP = """Posts through FreeCAD's LinuxCNC post (or --base NAME), then compensates the program
@@ -53,6 +61,7 @@ parser.add_argument("--ncpp", help="refused: ncpp is found from $NCPP, the FreeC
 # FreeCAD's own posts this one can wrap: all write ISO G code that the ncpp filter reads
 BASES = ("linuxcnc", "grbl", "fanuc", "mach3_mach4", "centroid")
 parser.add_argument("--base", default="linuxcnc", help=f"FreeCAD's post to wrap: {', '.join(BASES)}")
+parser.add_argument("--no-guard", action="store_true", help="no placement guard at the program's start")
 
 TOOLTIP_ARGS = parser.format_help() + "\nOther arguments are passed to the --base post (linuxcnc_post).\n"
 
@@ -106,6 +115,8 @@ def _ncpp_arguments(options):
             args += [flag, value]
     for zero in options.work_offset:
         args += ["--work-offset", zero]
+    if options.no_guard:
+        args.append("--no-guard")
     return args
 
 
@@ -120,9 +131,37 @@ def compensate_text(gcode, argstring):
         capture_output=True,
         env=env,
     )
+    told = [_posted_line(line, gcode) for line in proc.stderr.decode("utf-8", errors="replace").splitlines()]
     if proc.returncode != 0:
-        raise RuntimeError("ncpp_post: ncpp failed:\n" + proc.stderr.decode("utf-8", errors="replace"))
+        _report("PrintError", "ncpp_post: ncpp failed:\n" + "\n".join(told))
+        raise RuntimeError("ncpp_post: ncpp failed:\n" + "\n".join(told))
+    for line in told:
+        _report("PrintWarning" if ": warning: " in line else "PrintMessage", line)
     return proc.stdout.decode("latin-1")
+
+
+_STDIN_PLACE = re.compile(r"^<stdin>:(\d+)(?::\d+)?: ")
+
+
+def _posted_line(message, gcode):
+    """ncpp's `<stdin>:LINE:COL: ...` as the line of the posted program, with its text."""
+    found = _STDIN_PLACE.match(message)
+    if not found:
+        return message
+    number = int(found.group(1))
+    lines = gcode.splitlines()
+    text = lines[number - 1].strip() if 0 < number <= len(lines) else ""
+    return f"ncpp_post: line {number} of the posted program ({text}): " + message[found.end():]
+
+
+def _report(kind, text):
+    """A line in FreeCAD's Report view (`FreeCAD.Console.PrintWarning`, ...); stderr outside FreeCAD."""
+    try:
+        import FreeCAD
+    except ImportError:
+        print(text, file=sys.stderr)
+        return
+    getattr(FreeCAD.Console, kind)(text + "\n")
 
 
 def base_text(objectslist, argstring):

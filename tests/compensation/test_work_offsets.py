@@ -151,8 +151,8 @@ def test_command_line_var_file_and_work_offsets_say_the_same(tmp_path):
 
     from_var = run("--var-file", str(var))
     given = run("--work-offset", "250,300,300", "--work-offset", "g55=550,400,250")
-    assert from_var.returncode == 0 and from_var.stderr == b"", from_var.stderr
-    assert from_var.stdout == given.stdout and given.stderr == b""
+    assert from_var.returncode == 0 and b"warning" not in from_var.stderr, from_var.stderr
+    assert from_var.stdout == given.stdout and b"warning" not in given.stderr
     overridden = run("--var-file", str(var), "--work-offset", "G55=550,400,251")
     assert overridden.stdout != from_var.stdout
     bad = run("--work-offset", "G60=1,2,3")

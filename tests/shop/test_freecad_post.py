@@ -42,7 +42,8 @@ def posted(tmp_path_factory):
         HOME=str(home),
         NCPP_OUT=str(tmp / "compensated.ngc"),
         NCPP=str(ncpp),  # (the user's side: never the Job's arguments)
-        NCPP_POST_ARGS=f"--machine {MACHINE} --work-offset 400,350,300 --precision 4 --no-comments",
+        # (no placement guard: rs274 runs the program from its own G54 below)
+        NCPP_POST_ARGS=f"--machine {MACHINE} --work-offset 400,350,300 --no-guard --precision 4 --no-comments",
         NCPP_PLAIN_OUT=str(tmp / "plain.ngc"),
         NCPP_PLAIN_ARGS="--precision 4",
         NCPP_BASE_OUT=str(tmp / "grbl.nc"),
@@ -61,6 +62,7 @@ def test_freecad_posts_a_compensated_program(posted):
     assert "(Exported by FreeCAD)" in lines[:5] and any("linuxcnc_post" in ln for ln in lines[:5])
     assert any(ln.startswith(("G2", "G3")) for ln in lines)  # the profile's corner arcs stay arcs
     assert not any(ln.startswith("(begin") for ln in lines)  # --no-comments reached linuxcnc_post
+    assert not any("placement guard" in ln for ln in lines)  # --no-guard reached ncpp
 
 
 def test_linuxcnc_accepts_it_and_the_path_is_corrected_by_microns(posted):

@@ -14,7 +14,7 @@ from ncpp.errors import Warnings
 from ncpp.post import post
 from tests.conftest import CORPUS, ROOT
 from tests.shop.axis import filter_program
-from tests.shop.rs274 import end_points, run_rs274
+from tests.shop.rs274 import end_points, run_rs274, run_rs274_from
 
 FILTER = ROOT / "plugins/linuxcnc/ncpp-linuxcnc-filter"
 MACHINE = ROOT / "samples/machines/hr5b.toml"
@@ -62,7 +62,9 @@ def test_filter_compensates_reports_progress_and_rs274_accepts_it(program, tmp_p
     out = tmp_path / "compensated.ngc"
     out.write_bytes(proc.stdout)
     assert proc.stdout.startswith(b"(ncpp compensated for hr5b.toml")
-    compensated, plain = end_points(run_rs274(out)), end_points(run_rs274(program))
+    var = tmp_path / "g54.var"  # the G54 the placement guard checks (its raw values: rs274's units are inches)
+    var.write_text("5220\t1.000000\n5221\t400.000000\n5222\t350.000000\n5223\t300.000000\n")
+    compensated, plain = end_points(run_rs274_from(var, out)), end_points(run_rs274(program))
     assert len(compensated) >= len(plain) and compensated != plain
 
 
@@ -151,7 +153,8 @@ def test_the_configuration_linuxcnc_runs_gives_its_parameter_file_and_tool_table
     from_ini = run_filter(program, tmp_path, INI_FILE_NAME=str(lcnc / "mill.ini"))
     (tmp_path / "ncpp.toml").write_text(f'machine = "{MACHINE}"\nwork_offset = [400, 350, 300]\ntool_table = "configs/mill/tool.tbl"\n')
     given = run_filter(program, tmp_path)
-    assert from_ini.returncode == 0 and from_ini.stderr.count(b"FILTER_PROGRESS") == len(from_ini.stderr.splitlines()), from_ini.stderr
+    told = [line for line in from_ini.stderr.splitlines() if not line.startswith(b"FILTER_PROGRESS")]
+    assert from_ini.returncode == 0 and len(told) == 1 and b"tool.ngc: compensated 16 moves" in told[0], from_ini.stderr  # no warning
     assert from_ini.stdout == given.stdout and from_ini.stdout.startswith(b"%\n(ncpp compensated")
     (lcnc / "sim.var").unlink()  # a fresh configuration: LinuxCNC starts with all zeros, and so does ncpp
     (tmp_path / "ncpp.toml").write_text(f'machine = "{MACHINE}"\n')
@@ -203,11 +206,17 @@ def _configure(folder):
     (folder / "ncpp.toml").write_text(f'machine = "{MACHINE}"\nwork_offset = [400, 350, 300]\ntool_table = "tool.tbl"\n')
 
 
+def _summary_only(message: str) -> bool:
+    """Standard error besides the progress: the run's summary alone (no warning)."""
+    lines = message.splitlines()
+    return len(lines) == 1 and lines[0].startswith("ncpp: ") and ": compensated " in lines[0]
+
+
 def test_axis_loads_the_program_the_filter_compensated(program, tmp_path, axis):
     _configure(tmp_path)
     out = tmp_path / "loaded.ngc"
     filtered = axis(program, out)
-    assert filtered.exit_code == 0 and filtered.message == "", filtered.message
+    assert filtered.exit_code == 0 and _summary_only(filtered.message), filtered.message
     assert filtered.progress[0] == 0 and filtered.progress[-1] == 100 and filtered.progress == sorted(filtered.progress)
     assert filtered.closed
     assert out.read_bytes() == run_filter(program, tmp_path).stdout  # AXIS's closed standard input changes nothing
@@ -225,16 +234,37 @@ def test_axis_shows_the_filters_error_and_loads_nothing(tmp_path, axis):
 
 def test_axis_filters_a_long_program_with_its_progress_bar(program, tmp_path, axis):
     """AXIS reads standard error to its end after the filter exits: the bar moves on with
-    the lines compensated, and nothing else is said."""
+    the lines compensated, and only the summary is said besides."""
     body = program.read_bytes().removesuffix(b"M2\n")
     large = tmp_path / "large.ngc"
     large.write_bytes(body * (20_000 // body.count(b"\n") + 1) + b"M2\n")
     _configure(tmp_path)
     out = tmp_path / "loaded.ngc"
     filtered = axis(large, out)
-    assert filtered.exit_code == 0 and filtered.message == "", filtered.message
+    assert filtered.exit_code == 0 and _summary_only(filtered.message), filtered.message
     assert filtered.progress == sorted(filtered.progress) and filtered.progress[-1] == 100
     assert len({p // 10 for p in filtered.progress}) >= 8, filtered.progress  # every tenth of the way shows
     written = out.read_bytes()
     assert written.startswith(b"(ncpp compensated for hr5b.toml") and written.endswith(b"M2\n")
     assert written.count(b"\n") > large.read_bytes().count(b"\n")
+
+
+def test_the_operator_sees_the_summary_and_each_kind_of_warning_when_the_program_runs(tmp_path):
+    """`(MSG, ...)` lines at the program's start: rs274 shows them as MESSAGE calls, before any motion."""
+    program = tmp_path / "drill.ngc"
+    program.write_text("G21 G90 G54\nG0 X10 Y10 Z5\nG1 X40 F300\nG98 G81 X50 Y50 Z-3 R2 F100\nX60\nX70\nG80\nG0 Z5\n"
+                       "G41 D1 G1 X80 Y40 F200\nG1 X90 Y40\nG40 G1 X100 Y40\nM2\n")  # fmt: skip
+    (tmp_path / "ncpp.toml").write_text(f'machine = "{MACHINE}"\nwork_offset = [400, 350, 300]\n')
+    proc = run_filter(program, tmp_path)
+    assert proc.returncode == 0, proc.stderr.decode()
+    out = tmp_path / "loaded.ngc"
+    out.write_bytes(proc.stdout)
+    var = tmp_path / "g54.var"
+    var.write_text("5220\t1.000000\n5221\t400.000000\n5222\t350.000000\n5223\t300.000000\n")
+    canon = run_rs274_from(var, out, "T1 P1 D0.1 Z0\n")
+    messages = re.findall(r'MESSAGE\("\s*(.*)"\)', canon)
+    assert messages[0].startswith("ncpp: drill.ngc: compensated 3 moves") and "largest correction" in messages[0]
+    said = " ".join(messages)
+    assert "12 moves of canned cycles [lines 4-6]" in said and "3 moves under cutter compensation [lines 9-11]" in said
+    assert [m.split(":")[0] for m in messages if m.startswith("ncpp warning")] == ["ncpp warning line 4", "ncpp warning line 9"]
+    assert canon.index("MESSAGE") < canon.index("STRAIGHT_")

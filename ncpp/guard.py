@@ -1,0 +1,184 @@
+"""The placement guard: a compensated program stops at its start unless the control's
+work offset is the one it was compensated for.
+
+Compensation corrects the errors of the places the program's points take on the
+machine, which the work offset decides (`--work-offset`, `--var-file`).  Run under
+another offset, the program carries the corrections of other places.  The guard
+reads the control's active coordinate system and its zero (X Y Z) and stops the
+program, with a message, when the system differs or an axis's zero is more than
+`GUARD_MM` from the one told.  It is written only where ncpp was told the offset.
+
+Per control (the ISO dialect: LinuxCNC's syntax, or Fanuc's for a program that
+starts with an O number):
+
+* LinuxCNC (G-code manual, "G Code Overview": numbered parameters #5220, the active
+  system 1-9, and #5221-#5223, ..., G54's X Y Z, with 20 per system; its comments
+  section: `(abort, text)` ends the program with the text, `(MSG, text)` shows it):
+  the values stand in the machine's units (the INI's [TRAJ]LINEAR_UNITS), whatever
+  G20/G21, as rs274 reads them.
+* Fanuc and Haas (Custom Macro B: #4014 holds group 14's G code, 54-59; #5221-#5223
+  G54's X Y Z, 20 per system; `#3000=n (text)` raises macro alarm n with the text and
+  stops; `IF [cond] THEN` one assignment): G54-G59 only.
+
+* Sinumerik (840D sl System Variables parameter manual: `$P_UIFRNUM`, the number of the
+  active settable frame, 1-4 for G54-G57; `$P_UIFR[n, axis, TR]` and `[n, axis, FI]`, its
+  coarse and fine translation; Job Planning manual: `MSG("text")` shows the text, `SETAL(n)`
+  raises cycle alarm n, 65000-67999 being the user's; `M0` stops): G54-G57 only.
+
+Heidenhain programs get no guard (yet): the preset table's active row and values are read
+with `FN 18: SYSREAD` IDs that differ between TNC generations.
+
+Readers of a written program drop the guard (`without_guard`): ncpp's interpreter
+does not know the control's parameters, and the guard neither moves nor acts.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Iterable, Iterator
+from dataclasses import dataclass
+from itertools import chain, islice
+
+from ncpp.motion.offsets import WorkOffsets
+from ncpp.program.blocks import Block, Comment
+
+GUARD_MM = 0.1  # how far an axis's zero may be from the one told: re-touching a fixture moves it microns
+BEGIN = "ncpp placement guard:"
+END = "ncpp placement guard end"
+SCAN = 60  # blocks at the top searched for a guard
+SYSTEMS = ("G54", "G55", "G56", "G57", "G58", "G59", "G59.1", "G59.2", "G59.3")
+# A Fanuc program number line (`O1234`, perhaps with a comment); not an o-word line (`o100 sub`)
+_FANUC_PROGRAM_NUMBER = re.compile(r"\s*O\d+\s*(\(.*\))?\s*$")
+
+
+@dataclass(frozen=True)
+class Placement:
+    """What the guard checks: the coordinate system in effect at the start (1-9: G54-G59.3),
+    its zero (machine mm), and the mm per unit the control's parameters hold them in."""
+
+    system: int
+    zero: tuple[float, float, float]
+    unit_mm: float = 1.0
+
+    @classmethod
+    def of(cls, offsets: WorkOffsets, unit_mm: float = 1.0) -> Placement | None:
+        """The placement `offsets` tell (None: the system in effect is not told)."""
+        if not offsets.told(offsets.active):
+            return None
+        return cls(offsets.active, offsets.zero(offsets.active), unit_mm)
+
+    @property
+    def name(self) -> str:
+        return SYSTEMS[self.system - 1]
+
+    def values(self) -> list[str]:
+        """X Y Z of the zero in the control's units, as the guard compares them."""
+        return [_number(v / self.unit_mm) for v in self.zero]
+
+    def said(self) -> str:
+        units = "mm" if self.unit_mm == 1.0 else "inch" if self.unit_mm == 25.4 else f"x{self.unit_mm:g} mm"
+        x, y, z = self.values()
+        return f"{self.name} at X{x} Y{y} Z{z} {units}"
+
+
+def _number(value: float) -> str:
+    return f"{value:.4f}".rstrip("0").rstrip(".") if value != 0 else "0"
+
+
+def guard_lines(placement: Placement, dialect: str, first_lines: Iterable[str] = ()) -> list[str]:
+    """The guard's lines (without line ends) for a program of `dialect` (a post's "linuxcnc" or
+    "fanuc" says its syntax; for "iso", `first_lines`, the program's first lines, tell Fanuc's
+    from LinuxCNC's).  [] where there is none."""
+    if dialect == "iso":
+        dialect = "fanuc" if any(_FANUC_PROGRAM_NUMBER.match(line) for line in first_lines) else "linuxcnc"
+    written = {"linuxcnc": _linuxcnc, "fanuc": _fanuc, "sinumerik": _sinumerik}.get(dialect)
+    return [] if written is None else written(placement)
+
+
+def _tolerance(placement: Placement) -> str:
+    return _number(GUARD_MM / placement.unit_mm)
+
+
+def _linuxcnc(placement: Placement) -> list[str]:
+    x = 5221 + 20 * (placement.system - 1)
+    tolerance = _tolerance(placement)
+    far = " OR ".join(
+        f"[ABS[#{x + k} - {value}] GT {tolerance}]" for k, value in enumerate(placement.values())
+    )
+    return [
+        f"({BEGIN} {placement.said()} within {_number(GUARD_MM)} mm)",
+        f"o<ncpp_guard> if [[#5220 NE {placement.system}] OR {far}]",
+        f"(abort, ncpp: compensated for {placement.said()}; the control's work offset differs: "
+        "compensate again for it, or set the offset)",
+        "o<ncpp_guard> endif",
+        f"({END})",
+    ]
+
+
+def _fanuc(placement: Placement) -> list[str]:
+    if placement.system > 6:
+        return []  # (G59.1-G59.3 are LinuxCNC's)
+    x = 5221 + 20 * (placement.system - 1)
+    tolerance = _tolerance(placement)
+    lines = [
+        f"({BEGIN.upper()} {placement.said().upper()} WITHIN {_number(GUARD_MM)} MM)",
+        f"IF [#4014 NE {53 + placement.system}] THEN #3000=1 (NCPP {placement.name} NOT ACTIVE)",
+    ]
+    for k, (axis, value) in enumerate(zip("XYZ", placement.values(), strict=True)):
+        alarm = f"#3000={2 + k} (NCPP {placement.name} {axis} MOVED)"
+        lines.append(f"IF [ABS[#{x + k}-{value}] GT {tolerance}] THEN {alarm}")
+    return lines + [f"({END.upper()})"]
+
+
+def _sinumerik(placement: Placement) -> list[str]:
+    if placement.system > 4:
+        return []  # (G58, G59 are Sinumerik's programmable offsets, not a settable frame)
+    n, tolerance = placement.system, _tolerance(placement)
+    far = " OR ".join(
+        f"(ABS($P_UIFR[{n},{axis},TR]+$P_UIFR[{n},{axis},FI]-{value})>{tolerance})"
+        for axis, value in zip("XYZ", placement.values(), strict=True)
+    )
+    return [
+        f"; {BEGIN} {placement.said()} within {_number(GUARD_MM)} mm",
+        f"IF ($P_UIFRNUM<>{n}) OR {far}",
+        f'MSG("ncpp: compensated for {placement.said()}: the settable frame differs")',
+        "SETAL(65000)",
+        "M0",
+        "ENDIF",
+        f"; {END}",
+    ]
+
+
+def with_guard(lines: Iterable[str], placement: Placement, dialect: str, header: str, header_lines: int = 1) -> Iterator[str]:
+    """The written program's lines with the guard after the header comment (`header_lines` lines,
+    the first holding `header`) and the program number that may follow it."""
+    it = iter(lines)
+    head = list(islice(it, 12))
+    at = next((k + 1 for k, line in enumerate(head) if header in line), None)
+    guard = guard_lines(placement, dialect, head)
+    if at is None or not guard:
+        yield from chain(head, it)
+        return
+    at = min(at + header_lines - 1, len(head))
+    while at < len(head) and _FANUC_PROGRAM_NUMBER.match(head[at]):  # a Fanuc program's number comes first
+        at += 1
+    eol = "\r\n" if head[at - 1].endswith("\r\n") else "\n"
+    yield from head[:at]
+    yield from (line + eol for line in guard)
+    yield from head[at:]
+    yield from it
+
+
+def without_guard(blocks: Iterable[Block]) -> Iterator[Block]:
+    """The blocks without a guard near the top: from its first comment to its last."""
+    blocks = iter(blocks)
+    inside = False
+    for block in islice(blocks, SCAN):
+        said = " ".join(item.text.lower() for item in block.items if type(item) is Comment)
+        if not inside and BEGIN in said:
+            inside = True
+        if not inside:
+            yield block
+        elif END in said:
+            inside = False
+    yield from blocks

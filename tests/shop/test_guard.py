@@ -1,0 +1,224 @@
+"""The placement guard, judged by LinuxCNC's rs274: a compensated program runs to its end
+where the control's G54 is the one it was compensated for, and stops where it is not."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from tests.conftest import ROOT
+from tests.shop.rs274 import linuxcnc_root
+
+MACHINE = ROOT / "samples/machines/hr5b.toml"
+PROGRAM = "G21 G90 G54\nG0 X10 Y10 Z5\nG1 Z-1 F300\nG1 X40 Y10\nG1 X40 Y30\nG0 Z5\nM2\n"
+G54_MM = (400.0, 350.0, 300.0)
+
+
+def _var_file(path: Path, g54_mm: tuple[float, float, float], system: int = 1) -> Path:
+    """A parameter file in inches (the stand-alone rs274's units)."""
+    x, y, z = (v / 25.4 for v in g54_mm)
+    path.write_text(f"5220\t{system}.000000\n5221\t{x:.6f}\n5222\t{y:.6f}\n5223\t{z:.6f}\n")
+    return path
+
+
+def _rs274(var_file: Path, program: Path) -> subprocess.CompletedProcess:
+    home = linuxcnc_root(var_file.parent)
+    env = {**os.environ, "LD_LIBRARY_PATH": f"{home}/usr/lib:{home}/usr/lib/x86_64-linux-gnu"}
+    table = var_file.with_suffix(".tbl")
+    table.write_text("T1 P1 D0.25 Z0\n")
+    return subprocess.run(
+        [str(home / "usr/bin/rs274"), "-t", str(table), "-v", str(var_file), "-g", str(program)],
+        capture_output=True,
+        text=True,
+        env=env,
+        stdin=subprocess.DEVNULL,
+        timeout=120,
+    )
+
+
+def _compensate(tmp_path: Path, *args: str) -> tuple[str, str]:
+    (tmp_path / "p.ngc").write_text(PROGRAM)
+    env = {k: v for k, v in os.environ.items() if k not in ("NCPP_MACHINE", "XDG_CONFIG_HOME")}
+    env.update(PYTHONPATH=str(ROOT), HOME=str(tmp_path))
+    proc = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "ncpp",
+            "compensate",
+            "--machine",
+            str(MACHINE),
+            *args,
+            "p.ngc",
+            "-o",
+            "out.ngc",
+        ],
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+        env=env,
+        timeout=300,
+    )
+    assert proc.returncode == 0, proc.stderr  # (the verifier read the guarded program back and passed it)
+    return (tmp_path / "out.ngc").read_text(), proc.stderr
+
+
+def test_rs274_runs_the_guarded_program_where_g54_matches_and_stops_it_where_not(tmp_path):
+    told = _var_file(tmp_path / "told.var", G54_MM)
+    text, _ = _compensate(tmp_path, "--var-file", str(told), "--var-units", "inch")
+    assert "o<ncpp_guard> if" in text and "(abort," in text
+    program = tmp_path / "out.ngc"
+    ran = _rs274(told, program)
+    assert ran.returncode == 0, ran.stderr
+    assert "PROGRAM_END" in ran.stdout and ran.stdout.count("STRAIGHT_FEED") >= 3
+    for moved in ((400.5, 350.0, 300.0), (400.0, 350.0, 299.8)):
+        stopped = _rs274(_var_file(tmp_path / "moved.var", moved), program)
+        assert stopped.returncode != 0 and "compensated for G54" in stopped.stderr, stopped.stderr
+        assert "STRAIGHT_FEED" not in stopped.stdout and "PROGRAM_END" not in stopped.stdout
+    other_system = _rs274(_var_file(tmp_path / "g55.var", G54_MM, system=2), program)
+    assert other_system.returncode != 0 and "PROGRAM_END" not in other_system.stdout, other_system.stderr
+    within = _rs274(_var_file(tmp_path / "near.var", (400.05, 349.95, 300.0)), program)
+    assert within.returncode == 0 and "PROGRAM_END" in within.stdout, within.stderr  # within 0.1 mm
+
+
+def test_the_guard_is_written_only_where_the_offset_was_told_and_not_with_no_guard(tmp_path):
+    told, _ = _compensate(tmp_path, "--work-offset", "400,350,300")
+    assert "#5221 - 400]" in told and "(ncpp placement guard end)" in told
+    assert (
+        "ncpp placement guard" not in _compensate(tmp_path, "--work-offset", "400,350,300", "--no-guard")[0]
+    )
+    wide = Path("/work/shared/machines/wide.toml")
+    if not wide.exists():
+        pytest.skip("no machine file whose travel holds the program at the machine zero")
+    env = {k: v for k, v in os.environ.items() if k not in ("NCPP_MACHINE", "XDG_CONFIG_HOME")}
+    proc = subprocess.run(
+        [sys.executable, "-m", "ncpp", "compensate", "--machine", str(wide), "p.ngc"],
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+        env={**env, "PYTHONPATH": str(ROOT), "HOME": str(tmp_path)},
+    )
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.startswith("(ncpp compensated") and "guard" not in proc.stdout
+
+
+def test_a_fanuc_program_gets_macro_b_alarms(tmp_path):
+    import io
+
+    from ncpp.guard import Placement
+    from ncpp.motion.offsets import WorkOffsets
+    from ncpp.pipeline import ErrorSource, process
+
+    program = b"%\nO1234\nG21 G90 G54\nG0 X10 Y10 Z5\nG1 Z-1 F300\nG1 X40 Y10\nM30\n%\n"
+    offsets = WorkOffsets.at(G54_MM)
+    out = io.BytesIO()
+    process(
+        io.BytesIO(program),
+        out,
+        file="f.nc",
+        source=ErrorSource.from_machine_file(str(MACHINE)),
+        offsets=offsets,
+        guard=Placement.of(offsets),
+    )
+    lines = out.getvalue().decode().splitlines()
+    assert lines[0] == "%" and lines[1].startswith("(ncpp compensated")
+    k = lines.index("O1234")  # after the header's lines (the placement it was made for)
+    assert all(line.startswith("(ncpp ") for line in lines[1:k])
+    lines = lines[k - 2 :]  # (as if the header were one line)
+    assert lines[2] == "O1234" and lines[3].startswith("(NCPP PLACEMENT GUARD: G54 AT X400 Y350 Z300 MM")
+    assert lines[4] == "IF [#4014 NE 54] THEN #3000=1 (NCPP G54 NOT ACTIVE)"
+    assert lines[5:8] == [
+        "IF [ABS[#5221-400] GT 0.1] THEN #3000=2 (NCPP G54 X MOVED)",
+        "IF [ABS[#5222-350] GT 0.1] THEN #3000=3 (NCPP G54 Y MOVED)",
+        "IF [ABS[#5223-300] GT 0.1] THEN #3000=4 (NCPP G54 Z MOVED)",
+    ]
+    assert lines[8] == "(NCPP PLACEMENT GUARD END)" and lines[9] == "G21 G90 G54"
+
+
+def test_a_sinumerik_program_gets_its_settable_frame_checked_and_ncpp_still_reads_it(tmp_path):
+    """The guard (`$P_UIFR`, `SETAL`, `M0`) passes the verifier, and `ncpp simulate` reads the
+    compensated program past it (its contour error against the original stays at a micron)."""
+    (tmp_path / "p.mpf").write_text("G54 G17 G90\nG0 X10 Y10 Z5\nG1 Z-1 F300\nG1 X40 Y10\nG0 Z5\nM30\n")
+    env = {k: v for k, v in os.environ.items() if k not in ("NCPP_MACHINE", "XDG_CONFIG_HOME")}
+    env.update(PYTHONPATH=str(ROOT), HOME=str(tmp_path))
+
+    def run(*args: str) -> subprocess.CompletedProcess:
+        command = [
+            sys.executable,
+            "-m",
+            "ncpp",
+            *args,
+            "--machine",
+            str(MACHINE),
+            "--work-offset",
+            "400,350,300",
+        ]
+        return subprocess.run(command, capture_output=True, text=True, cwd=tmp_path, env=env, timeout=300)
+
+    written = run("compensate", "p.mpf", "-o", "out.mpf")
+    assert written.returncode == 0, written.stderr
+    lines = (tmp_path / "out.mpf").read_text().splitlines()
+    k = next(n for n, line in enumerate(lines) if line.startswith("; ncpp placement guard:"))  # after the header's lines
+    lines = lines[k - 1 :]  # (as if the header were one line)
+    assert lines[2] == (
+        "IF ($P_UIFRNUM<>1) OR (ABS($P_UIFR[1,X,TR]+$P_UIFR[1,X,FI]-400)>0.1) OR "
+        "(ABS($P_UIFR[1,Y,TR]+$P_UIFR[1,Y,FI]-350)>0.1) OR (ABS($P_UIFR[1,Z,TR]+$P_UIFR[1,Z,FI]-300)>0.1)"
+    )
+    assert lines[4:7] == ["SETAL(65000)", "M0", "ENDIF"] and lines[8] == "G54 G17 G90"
+    simulated = run("simulate", "out.mpf", "--reference", "p.mpf")
+    assert simulated.returncode == 0 and "outside the motion interpreter" not in simulated.stderr, (
+        simulated.stderr
+    )
+    assert float(simulated.stdout.split("max ")[1].split(" ")[0]) < 1.0  # µm
+
+
+def test_the_post_writes_the_guard_of_its_dialect(tmp_path):
+    env = {k: v for k, v in os.environ.items() if k not in ("NCPP_MACHINE", "XDG_CONFIG_HOME")}
+    env.update(PYTHONPATH=str(ROOT), HOME=str(tmp_path))
+    for dialect in ("linuxcnc", "fanuc"):
+        proc = subprocess.run(
+            [
+                sys.executable,
+                "-m",
+                "ncpp",
+                "post",
+                str(ROOT / "samples/programs/pocket.cls"),
+                "--dialect",
+                dialect,
+                "--machine",
+                str(MACHINE),
+                "--work-offset",
+                "400,350,300",
+                "-o",
+                f"{dialect}.nc",
+            ],
+            capture_output=True,
+            text=True,
+            cwd=tmp_path,
+            env=env,
+            timeout=300,
+        )
+        assert proc.returncode == 0, proc.stderr  # (verified past the guard)
+    fanuc = (tmp_path / "fanuc.nc").read_text().splitlines()
+    assert fanuc[:2] == ["%", "O0001"] and fanuc[4] == "IF [#4014 NE 54] THEN #3000=1 (NCPP G54 NOT ACTIVE)"
+    told = _var_file(
+        tmp_path / "told.var", (400 * 25.4, 350 * 25.4, 300 * 25.4)
+    )  # raw 400 350 300: the guard's mm
+    ran = _rs274(told, tmp_path / "linuxcnc.nc")
+    assert ran.returncode == 0 and "PROGRAM_END" in ran.stdout, ran.stderr
+    stopped = _rs274(
+        _var_file(tmp_path / "moved.var", (401 * 25.4, 350 * 25.4, 300 * 25.4)), tmp_path / "linuxcnc.nc"
+    )
+    assert stopped.returncode != 0 and "PROGRAM_END" not in stopped.stdout, stopped.stderr
+
+
+def test_an_o_word_line_is_no_fanuc_program_number():
+    from ncpp.guard import Placement, guard_lines
+
+    placement = Placement(1, G54_MM)
+    assert guard_lines(placement, "iso", ["(header)\n", "o100 sub\n"])[1].startswith("o<ncpp_guard> if")
+    assert guard_lines(placement, "iso", ["%\n", "O0100 (PART)\n"])[1].startswith("IF [#4014 NE 54]")
