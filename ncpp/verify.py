@@ -263,7 +263,7 @@ def _add(moves: _Moves, event: Line | Arc, extra: tuple[float, ...], inverse_tim
     moves.ends.append(((x0 + ox) * u, (y0 + oy) * u, (z0 + oz) * u, (x1 + ox) * u, (y1 + oy) * u, (z1 + oz) * u))
     end_extra = (tuple(event.extra) + NO_EXTRA)[: len(EXTRA_AXES)] if event.extra else extra
     moves.extra.append((extra, end_extra))
-    rapid = type(event) is Line and event.rapid  # type: ignore[union-attr]
+    rapid = type(event) is Line and event.rapid
     moves.rapid.append(rapid)
     moves.lines.append(line)
     if type(event) is Arc:
@@ -409,7 +409,7 @@ class _Feed:
     """Written lines as the parser reads them (bytes), each remembered with the input line the
     writer had reached when it handed the line out (its tag), until the lines are handed on."""
 
-    def __init__(self, lines: Iterable[str], reached: Callable[[], int]):
+    def __init__(self, lines: Iterable[str], reached: Callable[[], tuple[int, int]]):
         self.lines = iter(lines)
         self.reached = reached
         self.pending: list[str] = []
@@ -547,6 +547,7 @@ class _Comparison:
         """Feed rates matched in order across chunks; at an action (or the end) none may be left,
         and the inverse-time moves since the last action must take the original's time."""
         mine, theirs = self.feeds
+        rate: float | None
         for queue, section in ((mine, a), (theirs, b)):
             for rate, line in section.feeds:
                 if not (queue and _same_rate(queue[-1][0], rate)):
