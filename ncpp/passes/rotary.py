@@ -127,7 +127,7 @@ def _length(piece: Line | Arc) -> float:
     if type(piece) is Line:
         return piece.length()
     a, b, n = PLANE_AXES[piece.context.plane]
-    return math.hypot(piece.radius() * piece.sweep(), piece.end[n] - piece.start[n])  # type: ignore[union-attr]
+    return math.hypot(piece.radius() * piece.sweep(), piece.end[n] - piece.start[n])
 
 
 __all__ = ["EXTRA_AXES", "interpolated", "refuse_rotary", "time_shares", "turns"]
