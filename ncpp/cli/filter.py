@@ -58,6 +58,7 @@ def configured_source(args: argparse.Namespace):
 
     if args.from_file:
         return ErrorSource.from_measurement(args.from_file), settings.tolerance, settings.offsets()
+    assert settings.machine is not None  # (a machine file or a measurement, above)
     if not Path(settings.machine).is_file():
         raise NcppError(f"machine file {settings.machine} does not exist", Location(settings.origin))
     return ErrorSource.from_machine_file(settings.machine), settings.tolerance, settings.offsets()
