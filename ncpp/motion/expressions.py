@@ -194,7 +194,8 @@ class Parameters:
         if type(key) is int:
             return True
         name: str = key  # type: ignore[assignment]  # not an int
-        return name in self.named or (name.startswith("_") and self.system is not None and self.system(name) is not None)
+        system = self.system
+        return name in self.named or (name.startswith("_") and system is not None and system(name) is not None)
 
     def write(self, key: int | str, value: float) -> None:
         if type(key) is int:

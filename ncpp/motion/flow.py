@@ -253,8 +253,8 @@ class Flow:
         starts = number is not None or (control is not None and control.keyword == "sub")
         if self._defining is not None and not (starts and self._defining[0] is self.subprograms):
             self._extend_definition(block, control)
-        elif starts:  # (a Fanuc definition under way was a program's own number)
-            self._defining = (self.subroutines, control.name, [block]) if number is None else (self.subprograms, number, [block])  # type: ignore[union-attr, assignment]  # (`starts`: a sub's control, named)
+        elif starts:  # (a Fanuc definition under way was a program's own number; else a sub's control, named)
+            self._defining = (self.subroutines, control.name, [block]) if number is None else (self.subprograms, number, [block])  # type: ignore[union-attr, assignment]
 
     def _extend_definition(self, block: Block, control: Control | None) -> None:
         found, name, lines = self._defining  # type: ignore[misc]

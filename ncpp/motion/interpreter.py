@@ -265,7 +265,8 @@ class Interpreter:
                     yield Pass(block)
                 continue
             if pending is None and self.corner is None and type(event) is not tuple:
-                yield event  # type: ignore[misc]  # (not a tuple) the common case: no corner waits, none starts
+                # the common case: no corner waits, none starts (and not a tuple)
+                yield event  # type: ignore[misc]
                 continue
             events: tuple[Event, ...] = event if type(event) is tuple else (event,)  # type: ignore[assignment]
             new_corner, self.corner = self.corner, None

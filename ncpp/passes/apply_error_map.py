@@ -121,7 +121,9 @@ def _rows_before(rows: _Rows, line: int | None) -> _Rows | None:
     k = 0 if line is None else int(np.searchsorted(rows.lines, line))
     if k == 0 or k == len(rows.lines):
         return None
-    head: dict[str, NDArray | None] = {f.name: None if (v := getattr(rows, f.name)) is None else v[:k] for f in fields(_Rows)}
+    head: dict[str, NDArray | None] = {
+        f.name: None if (v := getattr(rows, f.name)) is None else v[:k] for f in fields(_Rows)
+    }
     return _Rows(**head)  # type: ignore[arg-type]  # each field as it is in `rows`: None only where it may be
 
 

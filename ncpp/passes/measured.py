@@ -91,7 +91,8 @@ def axis_map(m: Measurement) -> AxisMap:
 
     name = m.axis
     if name not in AXIS_INDEX:
-        raise NcppError(f"a {m.instrument} file needs '# axis: X' (or Y or Z) to compensate from it", m.at("axis"))
+        what = f"a {m.instrument} file needs '# axis: X' (or Y or Z) to compensate from it"
+        raise NcppError(what, m.at("axis"))
     axis = AXIS_INDEX[name]
     linear_column = "linear_um" if m.instrument == "comparator" else None
     linear = evaluate_measurement(m, column=linear_column)
@@ -101,7 +102,8 @@ def axis_map(m: Measurement) -> AxisMap:
         transverse = evaluate_measurement(m, column="transverse_um")
         across = (m.text("transverse") or "").upper()
         if across not in AXIS_INDEX:
-            raise NcppError("a comparator file needs '# transverse: X' (or Y or Z) to compensate from it", m.at("transverse"))
+            what = "a comparator file needs '# transverse: X' (or Y or Z) to compensate from it"
+            raise NcppError(what, m.at("transverse"))
         deviation[:, AXIS_INDEX[across]] = np.nan_to_num(transverse.mean) / 1000.0
     order = np.argsort(linear.targets)
     return AxisMap(axis, np.asarray(linear.targets, dtype=float)[order], deviation[order])

@@ -372,7 +372,7 @@ class HeidenhainWriter(IsoWriter):
         return f"{self.last_number} {text}{block.eol}"
 
     # -- text -----------------------------------------------------------------------------
-    def _style(self, letter: str, segment: "Line | Arc | _Units") -> NumberStyle:
+    def _style(self, letter: str, segment: Line | Arc | _Units) -> NumberStyle:
         # resolved once per letter and units, as IsoWriter's (`_learn_style` empties `_resolved`)
         key = (letter, segment.context.inch)
         style = self._resolved.get(key)

@@ -80,7 +80,7 @@ class IsoWriter:
         self._resolved: dict = {}
         self._interned_units: dict[tuple, _Written] = {}  # styles -> their `_Written`, so its plans outlive a style change
         self._facts_block: Block | None = None  # the last block asked about, and its facts
-        self._facts_value: _Facts = None  # type: ignore[assignment]  # (read only for `_facts_block`, set with it)
+        self._facts_value: _Facts = None  # type: ignore[assignment]  # (read only with `_facts_block`)
         self._signature_facts: dict[str, _Facts] = {}  # the facts of plain blocks, by their `signature`
         self._spelled: tuple[Block | None, tuple[str, bool]] = (None, (" ", False))  # a block and its `spelling`
         # The end of the last segment written (where the output is, once rounded to the decimal
@@ -376,7 +376,7 @@ class IsoWriter:
     def _format(self, letter: str, value: float, segment: Line | Arc) -> str:
         return format_number(value, self._style(letter, segment))
 
-    def _style(self, letter: str, segment: "Line | Arc | _Units") -> NumberStyle:
+    def _style(self, letter: str, segment: Line | Arc | _Units) -> NumberStyle:
         key = (letter, segment.context.inch)
         style = self._resolved.get(key)
         if style is None:
@@ -488,7 +488,7 @@ class IsoWriter:
         numbers = segment.end if type(segment) is Line and segment.context.absolute else self._numbers(segment)
         if type(edit) is str:
             return edit.format(*numbers)
-        return edit.apply(raw, _words(block, facts), numbers)  # type: ignore[union-attr]  # (not a str: a plan)
+        return edit.apply(raw, _words(block, facts), numbers)  # type: ignore[union-attr]  # (a plan)
 
     @staticmethod
     def _edit_plan(facts: "_Facts", signature: str, bits: int, motion: int | None, spelled: tuple[str, bool] | None, units: "_Written") -> EditPlan | None:
