@@ -12,6 +12,8 @@ from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Callable, Iterable, TextIO
 
 if TYPE_CHECKING:
+    from _typeshed import SupportsWrite
+
     from ncpp.program.blocks import Block
 
 
@@ -91,7 +93,7 @@ class Warnings:
     counted; `finish` tells how many were not printed and where the last was.
     Subclasses that keep warnings instead override `say`."""
 
-    def __init__(self, strict: bool = False, stream: TextIO | None = None):
+    def __init__(self, strict: bool = False, stream: SupportsWrite[str] | None = None):
         self.strict = strict
         self.stream = stream if stream is not None else sys.stderr
         self.count = 0

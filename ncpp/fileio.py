@@ -47,7 +47,7 @@ def _into_special(target: Path) -> Iterator[BinaryIO]:
     if stat.S_ISDIR(os.stat(target).st_mode):
         raise IsADirectoryError(errno.EISDIR, os.strerror(errno.EISDIR), str(target))
     with tempfile.TemporaryFile() as spool:
-        yield spool  # type: ignore[misc]
+        yield spool
         spool.seek(0)
         with open(target, "wb") as out:  # (no truncation or replacing for such a file: it is written)
             shutil.copyfileobj(spool, out, 1 << 20)

@@ -24,7 +24,7 @@ from ncpp.guard import Placement, with_guard, without_guard
 from ncpp.motion.offsets import AT_MACHINE_ZERO, WorkOffsets
 from ncpp.motion.segments import COMP, CYCLE, FLOW, Arc, Event, Line, Pass
 from ncpp.passes import PASSES, PassContext, run_passes
-from ncpp.passes.context import is_directional
+from ncpp.passes.context import ErrorMap, is_directional
 from ncpp.passes.inverse import iterations_for
 from ncpp.program.blocks import Block, Comment, Statement, Word
 from ncpp.program.dialects import parse_program
@@ -44,7 +44,7 @@ FIRST_RUN = 1024
 class ErrorSource:
     """The error map to compensate with, and how the header names it."""
 
-    model: object  # an ErrorMap: Machine or a measured map
+    model: ErrorMap  # Machine or a measured map
     name: str
     digest: str
     max_correction: float = 0.5

@@ -194,7 +194,7 @@ def path_length(move: Line | Arc) -> float:
     """mm along a move: a line's length, an arc's (with its helix)."""
     if type(move) is Line:
         return move.length() * move.context.unit_mm
-    arc: Arc = move  # type: ignore[assignment]
+    arc: Arc = move
     _, _, normal = PLANE_AXES[arc.context.plane]
     return math.hypot(arc.radius() * arc.sweep(), arc.end[normal] - arc.start[normal]) * arc.context.unit_mm
 

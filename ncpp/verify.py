@@ -117,8 +117,8 @@ class _Moves:
             return Section(empty, empty, np.zeros(0, bool), np.zeros(0, int), self.feeds, self.inverse_time, action, first_line)
         raw = np.array(self.ends)
         frame = np.array(self.frame_of)
-        offsets = np.array([f.offset for f in self.frames])[frame]  # type: ignore[attr-defined]
-        units = np.array([f.unit_mm for f in self.frames])[frame][:, None]  # type: ignore[attr-defined]
+        offsets = np.array([f.offset for f in self.frames])[frame]
+        units = np.array([f.unit_mm for f in self.frames])[frame][:, None]
         starts, ends = (raw[:, :3] + offsets) * units, (raw[:, 3:] + offsets) * units
         if self.extra:
             extra = np.zeros((len(raw), 2 * len(EXTRA_AXES)))
@@ -285,7 +285,7 @@ def _add(moves: _Moves, event: Line | Arc, extra: tuple[float, ...], inverse_tim
         end_extra = extra
     else:
         end_extra = extra
-    rapid = type(event) is Line and event.rapid  # type: ignore[union-attr]
+    rapid = type(event) is Line and event.rapid
     moves.rapid.append(rapid)
     moves.lines.append(line)
     if type(event) is Arc:
@@ -431,7 +431,7 @@ class _Feed:
     """Written lines as the parser reads them (bytes), each remembered with the input line the
     writer had reached when it handed the line out (its tag), until the lines are handed on."""
 
-    def __init__(self, lines: Iterable[str], reached: Callable[[], int]):
+    def __init__(self, lines: Iterable[str], reached: Callable[[], tuple[int, int]]):
         self.lines = iter(lines)
         self.reached = reached
         self.pending: list[str] = []
@@ -572,6 +572,7 @@ class _Comparison:
         """Feed rates matched in order across chunks; at an action (or the end) none may be left,
         and the inverse-time moves since the last action must take the original's time."""
         mine, theirs = self.feeds
+        rate: float | None
         for queue, section in ((mine, a), (theirs, b)):
             for rate, line in section.feeds:
                 if not (queue and _same_rate(queue[-1][0], rate)):

@@ -51,7 +51,7 @@ def main(argv: list[str] | None = None) -> int:
     one_blas_thread()  # before the commands import numpy (runtime.py)
     terminate_as_interrupt()
     parser = build_parser()
-    known = set(parser._subparsers._group_actions[0].choices)  # type: ignore[union-attr]
+    known = set(parser._subparsers._group_actions[0].choices)  # type: ignore[union-attr, arg-type]
     if not argv or (argv[0] not in known and argv[0] not in ("-h", "--help", "--version")):
         argv.insert(0, DEFAULT_COMMAND)
     args = parser.parse_args(argv)

@@ -261,7 +261,7 @@ class _InProcess(Executor):
     def __init__(self, job: Job):
         _start_worker(job)
 
-    def submit(self, fn, /, *args, **kwargs) -> Future:  # type: ignore[override]
+    def submit(self, fn, /, *args, **kwargs) -> Future:
         future: Future = Future()
         try:
             future.set_result(fn(*args, **kwargs))

@@ -76,6 +76,7 @@ def configured_source(args: argparse.Namespace):
     guard = placement_guard(settings, offsets) if args.guard else None
     if args.from_file:
         return ErrorSource.from_measurement(args.from_file), settings.tolerance, offsets, guard
+    assert settings.machine is not None  # (a machine file or a measurement, above)
     if not Path(settings.machine).is_file():
         raise NcppError(f"machine file {settings.machine} does not exist", Location(settings.origin))
     return ErrorSource.from_machine_file(settings.machine), settings.tolerance, offsets, guard

@@ -80,9 +80,9 @@ def run(args: argparse.Namespace) -> int:
             if type(event) is not Line and type(event) is not Arc:
                 continue
             if args.format == "rs274":
-                out.write(format_event(event) + "\n")
+                out.write(format_event(event) + "\n")  # type: ignore[operator]  # (a move: never None)
                 continue
-            record = {
+            record: dict[str, object] = {
                 "line": event.block.line,
                 "kind": "arc" if type(event) is Arc else ("traverse" if event.rapid else "feed"),
                 "start": event.start,

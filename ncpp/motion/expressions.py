@@ -178,21 +178,24 @@ class Parameters:
             if _machine_state(key):
                 raise OutOfScope(f"machine-state parameter #{key}")
             return self.numbered.get(key, 0.0)
-        value = self.named.get(key)
+        name: str = key  # type: ignore[assignment]  # not an int (`type() is`, for speed, narrows no else)
+        value = self.named.get(name)
         if value is not None:
             return value
-        if key.startswith("_") and self.system is not None:
-            value = self.system(key)
+        if name.startswith("_") and self.system is not None:
+            value = self.system(name)
             if value is not None:
                 return value
-            if key.startswith(("_hal[", "_ini[")) or key in _MACHINE_STATE:
-                raise OutOfScope(f"machine-state parameter #<{key}>")
-        raise ExpressionError(f"Named parameter #<{key}> not defined")
+            if name.startswith(("_hal[", "_ini[")) or name in _MACHINE_STATE:
+                raise OutOfScope(f"machine-state parameter #<{name}>")
+        raise ExpressionError(f"Named parameter #<{name}> not defined")
 
     def exists(self, key: int | str) -> bool:
         if type(key) is int:
             return True
-        return key in self.named or (key.startswith("_") and self.system is not None and self.system(key) is not None)
+        name: str = key  # type: ignore[assignment]  # not an int
+        system = self.system
+        return name in self.named or (name.startswith("_") and system is not None and system(name) is not None)
 
     def write(self, key: int | str, value: float) -> None:
         if type(key) is int:
@@ -200,9 +203,10 @@ class Parameters:
                 raise OutOfScope(f"a write to the machine-state parameter #{key}")
             self.numbered[key] = value
             return
-        if key.startswith("_") and self.system is not None and self.system(key) is not None:
-            raise ExpressionError(f"Cannot assign to read-only parameter #<{key}>")
-        self.named[key] = value
+        name: str = key  # type: ignore[assignment]  # not an int
+        if name.startswith("_") and self.system is not None and self.system(name) is not None:
+            raise ExpressionError(f"Cannot assign to read-only parameter #<{name}>")
+        self.named[name] = value
 
 
 def _machine_state(key: int) -> bool:

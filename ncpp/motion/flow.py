@@ -131,6 +131,7 @@ class Flow:
         blocks that run out of the text's order."""
         self.stream = iter(blocks)
         main = self.frames[0]
+        block: Block | None
         while not self.done():
             frame = self.frames[-1]
             if frame is main and main.pc == self.read and not main.labels and self.skipping is None and self._defining is None:
@@ -252,8 +253,8 @@ class Flow:
         starts = number is not None or (control is not None and control.keyword == "sub")
         if self._defining is not None and not (starts and self._defining[0] is self.subprograms):
             self._extend_definition(block, control)
-        elif starts:  # (a Fanuc definition under way was a program's own number)
-            self._defining = (self.subroutines, control.name, [block]) if number is None else (self.subprograms, number, [block])  # type: ignore[union-attr]
+        elif starts:  # (a Fanuc definition under way was a program's own number; else a sub's control, named)
+            self._defining = (self.subroutines, control.name, [block]) if number is None else (self.subprograms, number, [block])  # type: ignore[union-attr, assignment]
 
     def _extend_definition(self, block: Block, control: Control | None) -> None:
         found, name, lines = self._defining  # type: ignore[misc]
@@ -268,6 +269,8 @@ class Flow:
             self._defining = None
 
     # -- control lines -----------------------------------------------------------
+    # _NAMED: an o-word line's handler sees its name as a str (`_control` evaluates `o[expr]`
+    # first; None is M98's and M99's, whose handlers use no label)
     def _control(self, frame: _Frame, block: Block, control: Control) -> Iterator[tuple[Block, str, Block | None]]:
         """Run one control line: decide (errors point at it), write it, then jump."""
         if control.keyword not in ("m98", "m99"):
@@ -447,7 +450,7 @@ class Flow:
 
     def _started(self, frame: _Frame, block: Block, control: Control) -> None:
         if control.name not in frame.ifs:
-            raise self._error(f"{control.keyword} without o{_shown(control.name)} if", block, control)
+            raise self._error(f"{control.keyword} without o{_shown(control.name)} if", block, control)  # type: ignore[arg-type]  # (_NAMED)
 
     def _while(self, frame, block, control, arrived):
         self._opens(frame, block, control)
@@ -522,7 +525,7 @@ class Flow:
     def _opens(self, frame: _Frame, block: Block, control: Control) -> None:
         """An if, while or repeat line opens its label: as rs274ngc, the first line of its frame to
         run one (the `while` of a do loop closes it), else a duplicate label (a reused `o1 if`)."""
-        first = frame.opened.setdefault(control.name, (frame.pc, control.keyword, block.line))
+        first = frame.opened.setdefault(control.name, (frame.pc, control.keyword, block.line))  # type: ignore[arg-type]  # (_NAMED)
         if first[0] != frame.pc and not (first[1] == "do" and control.keyword == "while"):
             raise self._error(f"is a duplicate O-word label: already defined in line {first[2]}", block, control)
 
@@ -566,7 +569,7 @@ class Flow:
         """Where the `sub` statement at `opening` in the frame's text stands (for messages)."""
         block = self._block(frame, opening)
         control = None if block is None else self._control_of(block)
-        if control is None:
+        if block is None or control is None:
             return Location(self.file, self._opening_line(frame), 1)
         return Location(self.file, block.line, control.item.start + 1)
 
@@ -578,7 +581,7 @@ class Flow:
 
     def _label(self, frame: _Frame, block: Block, control: Control, kinds: tuple[str, ...]) -> _Label:
         """The running loop the line names, of one of `kinds` (rs274ngc: no other)."""
-        label = frame.labels.get(control.name)
+        label = frame.labels.get(control.name)  # type: ignore[arg-type]  # (_NAMED)
         if label is None or label.kind not in kinds:
             found = "no loop" if label is None else f"a {label.kind} loop"
             raise self._error(f"{control.keyword} names {found}, not a {' or '.join(kinds)} loop", block, control)
@@ -603,7 +606,8 @@ class Flow:
         return item.value if type(item) is Word else self.evaluate(item.expr, block, item)
 
     def _error(self, message: str, block: Block, control: Control) -> NcppError:
-        return NcppError(f"o{_shown(control.name)} {message}", Location(self.file, block.line, control.item.start + 1))
+        name: str = control.name  # type: ignore[assignment]  # (_NAMED)
+        return NcppError(f"o{_shown(name)} {message}", Location(self.file, block.line, control.item.start + 1))
 
 
 def control_of(block: Block) -> Control | None:
@@ -613,19 +617,21 @@ def control_of(block: Block) -> Control | None:
     for item in block.items:
         kind = type(item)
         if kind is Statement:
-            if item.kind == "block_delete" and not words:  # `/o1 endsub`: with the switch off (rs274's) the line runs
+            statement: Statement = item  # type: ignore[assignment]  # (`kind` says so; one type() per item)
+            if statement.kind == "block_delete" and not words:  # `/o1 endsub`: with the switch off (rs274's) the line runs
                 continue
-            if item.kind != "oword" or len(item.node) < 2 or words:
+            if statement.kind != "oword" or len(statement.node) < 2 or words:
                 return None
-            head, rest = item.node[0], item.node[1:]
+            head, rest = statement.node[0], statement.node[1:]
             if head.endswith("["):  # o[expr] keyword ...: the name is evaluated where the line runs
                 head, rest = rest[0], rest[1:]
-                return Control(head, rest[0].lower(), tuple(rest[1:]), item) if rest else None
-            return Control(oword_name(head), rest[0].lower(), tuple(rest[1:]), item)
+                return Control(head, rest[0].lower(), tuple(rest[1:]), statement) if rest else None
+            return Control(oword_name(head), rest[0].lower(), tuple(rest[1:]), statement)
         if kind is Word or kind is ExprWord:
-            if item.letter not in "NMPL" or item.letter in words:  # (most lines end here, at their first word)
+            word: Word | ExprWord = item  # type: ignore[assignment]  # (as above)
+            if word.letter not in "NMPL" or word.letter in words:  # (most lines end here, at their first word)
                 return None
-            words[item.letter] = item
+            words[word.letter] = word
         elif kind is not Comment:
             return None
     words.pop("N", None)

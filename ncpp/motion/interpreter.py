@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import math
 import re
-from typing import Iterable, Iterator
+from typing import Iterable, Iterator, NoReturn, cast
 
 from ncpp.errors import Location, NcppError, Warnings
 from ncpp.motion.corners import CornerError, round_corner
@@ -232,18 +232,18 @@ class Interpreter:
         block_event = self.block
         self.warnings = self.untold_lengths.warnings = warnings
         pending: Line | None = None  # the line whose end corner is rounded
-        corner = None
+        corner: tuple = ()  # its corner word: (kind, size, item); read only with a pending line
         held: list[Event] = []  # non-moving events after it
         flow = self.flow = Flow(self.file, self._evaluate, self.params, lambda: self.done, self._leave_scope, self.subroutine_path)
         for block, kind, owner in flow.steps(blocks):
             if kind is not RUN and kind is not FIXED:  # text that does not run here
                 if block.signature is None:
                     _warn_unreadable(block, warnings)
-                ev = Pass(block, kind is SKIP, None if self.done else self.motion)  # (after the end: no mode the control is in)
+                text = Pass(block, kind is SKIP, None if self.done else self.motion)  # (after the end: no mode the control is in)
                 if pending is not None:
-                    held.append(ev)
+                    held.append(text)
                 else:
-                    yield ev
+                    yield text
                 continue
             try:
                 event = block_event(block)  # verbatim blocks (after the closing %) have no items
@@ -265,9 +265,10 @@ class Interpreter:
                     yield Pass(block)
                 continue
             if pending is None and self.corner is None and type(event) is not tuple:
-                yield event  # the common case: no corner waits, none starts
+                # the common case: no corner waits, none starts (and not a tuple)
+                yield event  # type: ignore[misc]
                 continue
-            events = event if type(event) is tuple else (event,)
+            events: tuple[Event, ...] = event if type(event) is tuple else (event,)  # type: ignore[assignment]
             new_corner, self.corner = self.corner, None
             for ev in events:
                 if pending is not None:
@@ -309,8 +310,8 @@ class Interpreter:
         and, where it runs out of the text's order, belong to `owner` (its text is elsewhere)."""
         if self.corner is not None:
             raise _OutOfScope("Fanuc corner rounding in a loop or subroutine", None)
-        events = event if type(event) is tuple else (event,)
-        out = []
+        events: tuple[Event, ...] = event if type(event) is tuple else (event,)  # type: ignore[assignment]
+        out: list[Event] = []
         for ev in events:
             if type(ev) is Pass:
                 if ev.setting is not None:  # set from where each run of the text stands: no one shift
@@ -319,7 +320,7 @@ class Interpreter:
                 if owner is None:
                     out.append(ev)
                 continue
-            ev.fixed = ev.fixed or FLOW
+            ev.fixed = ev.fixed or FLOW  # type: ignore[union-attr]  # (a move: `type(ev) is Pass` above)
             if owner is not None:
                 ev.block = owner
             out.append(ev)
@@ -333,8 +334,8 @@ class Interpreter:
         or a canned cycle is not one)."""
         if self.comp_radius == 0.0:  # a radius of 0: the tool stays on the programmed path (rs274ngc checks nothing either)
             return event
-        events = event if type(event) is tuple else (event,)
-        moves = [ev for ev in events if type(ev) is not Pass]
+        events: tuple[Event, ...] = event if type(event) is tuple else (event,)  # type: ignore[assignment]
+        moves: list[Line | Arc] = [ev for ev in events if type(ev) is not Pass]  # type: ignore[misc]
         if not moves:
             return event
         if self.arc_refused:
@@ -342,17 +343,17 @@ class Interpreter:
                 self._fail("The move just after exiting cutter compensation mode must be straight, not an arc", block, block.items[0])
             self.arc_refused = moves[0].fixed == CYCLE or _homes(block)
         if self.cutter_comp is not None and self.comp_radius:
-            self._check_radius(moves, block)
+            self._check_radius(moves, block, self.comp_radius)
         # (a loop's or a cycle's moves too: that the tool is off the path matters more)
         self.off_path = mark_off_path(moves, self.cutter_comp is not None, self.off_path)
         return event
 
-    def _check_radius(self, moves: list, block: Block) -> None:
+    def _check_radius(self, moves: list, block: Block, radius: float) -> None:
         """rs274ngc's checks of moves under compensation against the tool radius: the entry move
         (the first) longer than it in the plane, an entry arc's chord too, and no arc on the
         side the tool is on (G41 and G3, G42 and G2) of a radius not above it.  (The gouging
         checks of later moves need the offset path, which ncpp does not make.)"""
-        radius, item = self.comp_radius, block.items[0]
+        item = block.items[0]
         a, b, _ = PLANE_AXES[self.plane]
         first = moves[0]
         if not self.off_path and math.hypot(first.end[a] - first.start[a], first.end[b] - first.start[b]) <= radius:
@@ -361,7 +362,7 @@ class Interpreter:
         left = self.cutter_comp in (41.0, 41.1)
         for arc in moves:
             if type(arc) is Arc and (arc.turn > 0) == left:
-                if math.hypot(arc.start[a] - arc.center[a], arc.start[b] - arc.center[b]) <= radius:  # type: ignore[operator]
+                if math.hypot(arc.start[a] - arc.center[a], arc.start[b] - arc.center[b]) <= radius:
                     self._fail("Tool radius not less than arc radius with comp", block, item)
 
     def _unrounded(self, pending: Line, held: list[Event]) -> Iterator[Event]:
@@ -384,7 +385,7 @@ class Interpreter:
         except CornerError as err:
             raise NcppError(str(err), where) from None
         if first.fixed == COMP or second.fixed == COMP:  # the control rounds the contour, then offsets it
-            pieces[1].fixed = COMP  # type: ignore[union-attr]  (the lines keep their own)
+            pieces[1].fixed = COMP  # type: ignore[union-attr]  # (the lines keep their own)
         return pieces
 
     def context(self) -> Context:
@@ -437,21 +438,24 @@ class Interpreter:
         for item in items:
             kind = type(item)
             if kind is Word:
-                letter = item.letter
+                numeric: Word = item  # type: ignore[assignment]  # (`kind` is its type: one type() per item)
+                letter = numeric.letter
                 if letter in _AXIS_LETTERS_F:  # the common case first
                     if letter in words:
                         self._fail(f"Multiple {letter.lower()} words on one line", block, item)
-                    words[letter] = (item.value, item)
+                    words[letter] = (numeric.value, numeric)
                     continue
-                value = item.value
+                value = numeric.value
             elif kind is Comment:
                 continue
             elif kind is ExprWord:
-                letter, value = item.letter, self._evaluate(item.expr, block, item)
+                computed: ExprWord = item  # type: ignore[assignment]  # (as above)
+                letter, value = computed.letter, self._evaluate(computed.expr, block, computed)
             else:
-                what = item.kind
+                statement: Statement = item  # type: ignore[assignment]  # (as above)
+                what = statement.kind
                 if what == "assignment":
-                    target, expr = item.node
+                    target, expr = statement.node
                     key = self._param_key(target, block, item)
                     if type(key) is str and not self.params.exists(key):
                         # rs274ngc creates the name (at 0) as it reads it: the rest of the line,
@@ -459,10 +463,10 @@ class Interpreter:
                         self.params.write(key, 0.0)
                     assignments = assignments or []
                     assignments.append((key, self._evaluate(expr, block, item), item))
-                elif what == "oword" and len(item.node) == 1:  # `O<name>` alone: a program's name
+                elif what == "oword" and len(statement.node) == 1:  # `O<name>` alone: a program's name
                     pass
                 elif what == UNREADABLE:  # read where it runs, as rs274ngc reads it
-                    raise item.node[0]
+                    raise statement.node[0]
                 elif what == STRAY_TAPE:  # a `%` after the program's first line that was not one
                     self._fail("Bad character '%' used (a tape mark only where the program starts with one)", block, item)
                 elif what not in IGNORED_STATEMENTS:
@@ -481,17 +485,17 @@ class Interpreter:
                             continue
                     else:
                         self._fail("Two g codes used from same modal group", block, item)
-                gcodes[group] = (value, item)
+                gcodes[group] = (value, item)  # type: ignore[assignment]  # (a word: `kind`)
             elif letter == "M":
                 if mcodes is None:
                     mcodes = {}
-                mcodes[value] = item
+                mcodes[value] = item  # type: ignore[assignment]  # (a word: `kind`)
             elif letter == "N" or letter == "$":
                 continue
             else:
                 if letter in words:
                     self._fail(f"Multiple {letter.lower()} words on one line", block, item)
-                words[letter] = (value, item)
+                words[letter] = (value, item)  # type: ignore[assignment]  # (a word: `kind`)
         if assignments is not None:  # rs274ngc: after the whole line is read
             for key, value, item in assignments:
                 try:
@@ -528,7 +532,7 @@ class Interpreter:
         """A block `_plain_move` read (G0-G3 or the modal motion with distinct
         axis / F / IJKR words) without the checks; None leaves it to them."""
         _, code, letters, xyz = move
-        items = block.items
+        items: tuple[Word, ...] = block.items  # type: ignore[assignment]  # (the signature's: words only)
         words_from = len(items) - len(letters)  # after N and G
         if xyz is not None and code is not None and self._enter_straight_motion(code):
             end = self.pos[:]
@@ -803,18 +807,18 @@ class Interpreter:
             self._fail("Cannot turn cutter radius comp on when on", block, item)
         if code == 40.0 or (code is None and self.cutter_comp is None):
             return  # off from this line's G40 on
-        for group, message in _REFUSED_WITH_COMP.items():
+        for group, refusal in _REFUSED_WITH_COMP.items():
             if group in gcodes:
-                self._fail(message, block, gcodes[group][1])
+                self._fail(refusal, block, gcodes[group][1])
         mode0, mode0_item = gcodes.get(0, (None, None))
-        message = _MODE0_WITH_COMP.get(mode0)  # type: ignore[arg-type]
+        message = _MODE0_WITH_COMP.get(mode0)
         if mode0 == 53.0 and self.comp_radius == 0.0:  # (G53 only with a radius; the others with any)
             message = None
         if mode0 == 10.0 and words.get("L", (None,))[0] in (2.0, 20.0) and round(words["P"][0]) in (0, self.coord_system):
             message = "Cannot change the active coordinate system with cutter radius compensation on"
         if message is not None:
             self._fail(message, block, mode0_item)
-        message = _MOTION_WITH_COMP.get(motion)  # type: ignore[arg-type]
+        message = _MOTION_WITH_COMP.get(motion)
         if message is not None:
             self._fail(message, block, motion_item)
 
@@ -1013,7 +1017,7 @@ class Interpreter:
         Both moves are the control's (`HOME`): compensation cannot reach into them.  In G90 the
         intermediate point puts the named axes at their words, in G91 it moves them by their words
         from where the control stands; the home move puts the homed axes at the home position."""
-        named = tuple(any(i == axis for i, _ in given) for axis in range(3))
+        named = cast(tuple[bool, bool, bool], tuple(any(i == axis for i, _ in given) for axis in range(3)))
         middle = self._ends(given, False)
         first = self._line(block, middle, True)
         first.fixed, first.placed = HOME, named if self.absolute else (False, False, False)
@@ -1352,7 +1356,7 @@ class Interpreter:
         rel_err = abs_err / max(r1, r2)
         limit = CENTER_ARC_ABS[self.inch]
         if abs_err > 100 * limit or (abs_err > limit and rel_err > CENTER_ARC_REL):
-            p, q = (_PLANE_LETTERS[self.plane])
+            p, q = tuple(_PLANE_LETTERS[self.plane])  # (a message's letters)
             self._fail(
                 "Radius to end of arc differs from radius to start: "
                 f"start=({p}{x0:.4f},{q}{y0:.4f}) center=({p}{cx:.4f},{q}{cy:.4f}) end=({p}{x1:.4f},{q}{y1:.4f}) "
@@ -1399,7 +1403,7 @@ class Interpreter:
         }.get(name)
         return value
 
-    def _fail(self, message: str, block: Block, item) -> None:
+    def _fail(self, message: str, block: Block, item) -> NoReturn:
         col = item.start + 1 if item is not None else None
         raise NcppError(message, Location(self.file, block.line, col))
 

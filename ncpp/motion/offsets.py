@@ -132,7 +132,7 @@ def parse_zero(text: str) -> tuple[str, Vector]:
         values = ()
     if len(values) != 3 or not all(math.isfinite(v) for v in values):
         raise ValueError(f"expected [G5x=]X,Y,Z in mm (three finite numbers), got {text!r}")
-    return name, values  # type: ignore[return-value]
+    return name, values
 
 
 def system_number(name: str) -> int:

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
-from typing import Union
+from typing import Union, final
 
 from ncpp.program.blocks import Block
 
@@ -74,6 +74,8 @@ class Context:
 # Events are not frozen: a pipeline makes several per output line, and a frozen
 # dataclass sets each field through object.__setattr__ (several times slower to build).
 # Treat them as values all the same: a pass that changes one makes a new one.
+# Line and Arc are final: code tells them apart by `type(e) is Line` (faster than isinstance).
+@final
 @dataclass(slots=True)
 class Line:
     start: Point
@@ -94,6 +96,7 @@ class Line:
         return math.dist(self.start, self.end)
 
 
+@final
 @dataclass(slots=True)
 class Arc:
     """A circular (or helical) arc in `context.plane`.

@@ -18,13 +18,13 @@ from __future__ import annotations
 
 from dataclasses import dataclass, fields, replace
 from itertools import chain
-from typing import Iterable, Iterator
+from typing import Iterable, Iterator, overload
 
 import numpy as np
 from numpy.typing import NDArray
 
 from ncpp.errors import Location, NcppError
-from ncpp.motion.segments import CYCLE, Arc, Event, Line, Pass
+from ncpp.motion.segments import CYCLE, Arc, Event, Line, Pass, Setting
 from ncpp.program.blocks import Word
 from ncpp.passes.context import PassContext, deviation
 from ncpp.passes.geometry import any3, compensate, frames, from_plane, in_plane, line_chunks, plane_axes, points, rows_of, tuples
@@ -121,7 +121,10 @@ def _rows_before(rows: _Rows, line: int | None) -> _Rows | None:
     k = 0 if line is None else int(np.searchsorted(rows.lines, line))
     if k == 0 or k == len(rows.lines):
         return None
-    return _Rows(**{f.name: None if (v := getattr(rows, f.name)) is None else v[:k] for f in fields(_Rows)})
+    head: dict[str, NDArray | None] = {
+        f.name: None if (v := getattr(rows, f.name)) is None else v[:k] for f in fields(_Rows)
+    }
+    return _Rows(**head)  # type: ignore[arg-type]  # each field as it is in `rows`: None only where it may be
 
 
 def _rows(segs: list, directional: bool, fixed_before: bool = True) -> _Rows:
@@ -255,7 +258,8 @@ def _written(chunk: list[Event], segs: list, rows: _Rows, solved: _Solved, last)
             if row & _MOVED:
                 seg = _moved_arc(seg, moved_starts[i], end)
             if row & _CONNECTS:
-                out.append(Line(start, seg.start, False, seg.feed, seg.block, seg.context, seg.extra, True))
+                # (a step connects only after an end: `has_previous`, so `start` is one)
+                out.append(Line(start, seg.start, False, seg.feed, seg.block, seg.context, seg.extra, True))  # type: ignore[arg-type]
             out.append(seg)
         start = end
     if len(segs) in between:
@@ -270,13 +274,14 @@ def _placed(events: list[Event], last: Line | Arc | None) -> list[Event]:
         return events
     out = events
     for k, event in enumerate(events):
-        setting = event.setting if type(event) is Pass else None
-        if setting is not None:
-            at = _end_in_frame_of(last, setting)  # type: ignore[arg-type]
-            shift = (at[0] - setting.position[0], at[1] - setting.position[1], at[2] - setting.position[2])
-            if out is events:
-                out = list(events)
-            out[k] = Pass(event.block, event.skipped, event.motion, replace(setting, shift=shift))
+        if type(event) is not Pass or event.setting is None:
+            continue
+        setting = event.setting
+        at = _end_in_frame_of(last, setting)
+        shift = (at[0] - setting.position[0], at[1] - setting.position[1], at[2] - setting.position[2])
+        if out is events:
+            out = list(events)
+        out[k] = Pass(event.block, event.skipped, event.motion, replace(setting, shift=shift))
     return out
 
 
@@ -359,6 +364,7 @@ def _directional(rows: _Rows, ctx: PassContext, travel: Travel) -> _Solved:
     compensated = end_p.copy()  # line ends before _settle leaves axes standing
     commands = _Commands(rows, {"start": start_p, "end": end_p}, step, ctx)
     assumed = rows.assumed
+    assert assumed is not None  # (rows of a directional map: `_rows`)
     used = np.full(start_p.shape, np.nan)  # the directions each row is compensated with
     used[arc] = assumed[arc]
     # start from the nominal motion, standing axes holding their direction
@@ -392,9 +398,9 @@ def _directional(rows: _Rows, ctx: PassContext, travel: Travel) -> _Solved:
     flips = (d != before) & (before != 0)
     turn = free & any3(flips)
     turn_start = np.full(start_p.shape, np.nan)
-    rows = np.flatnonzero(turn)
-    if rows.size:
-        turn_start[rows] = commands("start", rows, d[rows])
+    turned = np.flatnonzero(turn)
+    if turned.size:
+        turn_start[turned] = commands("start", turned, d[turned])
     travel.held = d[-1].copy()
     travel.last = machine(out_end[-1:], slice(len(free) - 1, None))[0]
     return _Solved(out_start, out_end, free, moved, turn, turn_start, ~flips, limit, commands.at_end["end"] & free[:, None], d)
@@ -607,7 +613,11 @@ def _moved_arc(arc: Arc | Line, start: tuple, end: tuple) -> Arc | Line:
     return Arc(start, end, centre, arc.turn, arc.feed, arc.block, arc.context, arc.extra, True)
 
 
-def _end_in_frame_of(last: Line | Arc | None, event: Line | Arc) -> tuple | None:
+@overload
+def _end_in_frame_of(last: Line | Arc, event: Line | Arc | Setting) -> tuple: ...
+@overload
+def _end_in_frame_of(last: Line | Arc | None, event: Line | Arc | Setting) -> tuple | None: ...
+def _end_in_frame_of(last: Line | Arc | None, event: Line | Arc | Setting) -> tuple | None:
     """The last segment's end in `event`'s program frame: units (G20/G21) and
     offsets (G92, G54.., tool length) may have changed between them."""
     if last is None:

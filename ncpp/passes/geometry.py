@@ -12,7 +12,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ncpp.errors import Location, NcppError
-from ncpp.motion.segments import PLANE_AXES, Arc, Event, Line
+from ncpp.motion.segments import PLANE_AXES, Arc, Context, Event, Line
 from ncpp.passes.context import PassContext
 from ncpp.passes.inverse import command_for
 
@@ -113,7 +113,8 @@ def frames(segments: Sequence[Line | Arc]) -> tuple[NDArray, NDArray, NDArray | 
         return np.tile(np.asarray(c.offset, dtype=float), (n, 1)), np.full(n, scale), tools
     # a program has few contexts and consecutive segments share one: look each up once
     known: dict[int, int] = {}
-    contexts, rows = [], []
+    contexts: list[Context] = []
+    rows: list[int] = []
     for s in segments:
         c = s.context
         row = known.get(id(c))

@@ -89,14 +89,22 @@ def radial_map(m: Measurement) -> RadialMap:
 def axis_map(m: Measurement) -> AxisMap:
     from ncpp.instruments.iso230_2 import evaluate_measurement
 
-    axis = AXIS_INDEX[m.axis]
+    name = m.axis
+    if name not in AXIS_INDEX:
+        what = f"a {m.instrument} file needs '# axis: X' (or Y or Z) to compensate from it"
+        raise NcppError(what, m.at("axis"))
+    axis = AXIS_INDEX[name]
     linear_column = "linear_um" if m.instrument == "comparator" else None
     linear = evaluate_measurement(m, column=linear_column)
     deviation = np.zeros((len(linear.targets), 3))
     deviation[:, axis] = np.nan_to_num(linear.mean) / 1000.0
     if m.instrument == "comparator":
         transverse = evaluate_measurement(m, column="transverse_um")
-        deviation[:, AXIS_INDEX[m.text("transverse").upper()]] = np.nan_to_num(transverse.mean) / 1000.0
+        across = (m.text("transverse") or "").upper()
+        if across not in AXIS_INDEX:
+            what = "a comparator file needs '# transverse: X' (or Y or Z) to compensate from it"
+            raise NcppError(what, m.at("transverse"))
+        deviation[:, AXIS_INDEX[across]] = np.nan_to_num(transverse.mean) / 1000.0
     order = np.argsort(linear.targets)
     return AxisMap(axis, np.asarray(linear.targets, dtype=float)[order], deviation[order])
 

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Iterable, Iterator
+from typing import Iterable, Iterator, cast
 
 import numpy as np
 from numpy.typing import NDArray
@@ -86,7 +86,7 @@ def _with_arcs(batch: list[Event], motion: "Motion") -> tuple[list[Event], list[
     """The batch, where its arcs to replace are, those arcs, and the direction each one's
     normal axis is compensated for (`Motion`)."""
     index = [k for k, e in enumerate(batch) if type(e) is Arc and not e.changed and not e.fixed]
-    arcs = [batch[k] for k in index]
+    arcs = cast(list[Arc], [batch[k] for k in index])
     return batch, index, arcs, motion.normals(batch, arcs)
 
 
@@ -118,7 +118,7 @@ class Motion:
             if kind is not Line and kind is not Arc:
                 continue
             at = event.block.line
-            (s0, s1, s2), (e0, e1, e2) = event.start, event.end
+            (s0, s1, s2), (e0, e1, e2) = event.start, event.end  # type: ignore[union-attr]  # a Line or an Arc
             if event is arc:
                 arc = next(pending, None)
                 w = PLANE_AXES[event.context.plane][2]
@@ -455,7 +455,7 @@ def _minimax_step(uv: NDArray, q0: NDArray, c: NDArray, normal: NDArray) -> NDAr
 
 
 def _line_pieces(arc: Arc, q: list[list[float]]) -> list[Event]:
-    pts = [tuple(p) for p in q]
+    pts = cast(list[tuple[float, float, float]], [tuple(p) for p in q])  # (q's points are 3-vectors)
     return [Line(a, b, False, arc.feed, arc.block, arc.context, arc.extra, True) for a, b in zip(pts, pts[1:])]
 
 

@@ -53,7 +53,7 @@ def _checked(chunk: list[Event], ctx: PassContext) -> Iterator[list[Event]]:
                     if kind is Arc or not allowed:
                         _refuse_turn(event, kind is Arc, ctx.file)  # type: ignore[arg-type]
             elif kind is Pass:
-                _refuse_tool_centre_point(event.block, ctx.file)  # type: ignore[union-attr]
+                _refuse_tool_centre_point(event.block, ctx.file)
         except NcppError:
             yield chunk[:k]
             raise
@@ -78,6 +78,7 @@ def _refuse_turn(move: Line | Arc, arc: bool, file: str) -> None:
 
 def _refuse_tool_centre_point(block: Block, file: str) -> None:
     """G43.4 / G43.5 (LinuxCNC), M128 and FUNCTION TCPM (Heidenhain), TRAORI (Sinumerik)."""
+    name: str | None
     for item in block.items:
         kind = type(item)
         if kind is Word:
@@ -126,7 +127,7 @@ def _length(piece: Line | Arc) -> float:
     if type(piece) is Line:
         return piece.length()
     a, b, n = PLANE_AXES[piece.context.plane]
-    return math.hypot(piece.radius() * piece.sweep(), piece.end[n] - piece.start[n])  # type: ignore[union-attr]
+    return math.hypot(piece.radius() * piece.sweep(), piece.end[n] - piece.start[n])
 
 
 __all__ = ["EXTRA_AXES", "interpolated", "refuse_rotary", "time_shares", "turns"]

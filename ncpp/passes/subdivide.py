@@ -14,7 +14,7 @@ where the map gives one: its `bow_bound`).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Iterable, Iterator
+from typing import Iterable, Iterator, cast
 
 import numpy as np
 from numpy.typing import NDArray
@@ -65,7 +65,7 @@ def _with_rows(chunk: list[Event], ctx: PassContext, bound: BowBound | None = No
     index = [k for k, e in enumerate(chunk) if type(e) is Line and not e.rapid and not e.changed and not e.fixed]
     if not index:
         return chunk, [], [], None
-    lines = [chunk[k] for k in index]
+    lines = cast(list[Line], [chunk[k] for k in index])
     starts = points([ln.start for ln in lines])
     ends = points([ln.end for ln in lines])
     offsets, scales, tools = frames(lines)
@@ -109,7 +109,7 @@ def _piece_counts(rows: _LineRows, ctx: PassContext) -> NDArray:
     return np.minimum(np.ceil(np.sqrt(SAFETY * bow / ctx.tolerance)), MAX_PIECES).astype(int).clip(1, None)
 
 
-def _split(line: Line, n: int) -> list[Line]:
+def _split(line: Line, n: int) -> list[Event]:
     """The line in `n` equal pieces; each turns its share of the axes beyond X Y Z (A B C, U V W)."""
     a, b = np.array(line.start), np.array(line.end)
     cuts = [tuple(a + (b - a) * (i / n)) for i in range(n + 1)]

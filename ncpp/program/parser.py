@@ -19,7 +19,7 @@ import math
 import re
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Callable, Iterable, Iterator
+from typing import Any, Callable, Iterable, Iterator
 
 import lark
 from lark import Discard, Token, Transformer, v_args
@@ -389,10 +389,12 @@ class LineParser:
 
     def _parse_lalr(self, raw: str, line: int, file: str) -> tuple[AnyItem, ...]:
         trees = self._trees
-        layout = None if trees is None else trees.layout(raw)
-        known = None if layout is None else trees.known.get(layout)
-        if known is not None:
-            return known.items(raw)
+        layout = None
+        if trees is not None:
+            layout = trees.layout(raw)
+            known = None if layout is None else trees.known.get(layout)
+            if known is not None:
+                return known.items(raw)
         try:
             tree = self._lark.parse(raw)
             items = tuple(_flatten(self._builder.transform(tree)))
@@ -405,7 +407,7 @@ class LineParser:
             raise NcppError(_describe(err, raw), Location(file, line, col)) from None
         except RecursionError:  # the builder walks the tree recursively: brackets hundreds deep
             raise NcppError("expression nested too deeply", Location(file, line, 1)) from None
-        if layout is not None:
+        if trees is not None and layout is not None:  # (after a whole parse: the test costs nothing)
             trees.learn(layout, _Cut.of(raw, items, trees.layout) or _Replay(tree, self._builder))
         return items
 
@@ -470,7 +472,7 @@ class _Cut:
         return cls(tuple(steps))
 
     def items(self, raw: str) -> tuple[AnyItem, ...]:
-        items = []
+        items: list[AnyItem] = []
         append = items.append
         for step in self.steps:
             if type(step) is tuple:
@@ -526,8 +528,8 @@ class _Replay:
     def items(self, raw: str) -> tuple[AnyItem, ...]:
         return tuple(_flatten(self.run(raw)))
 
-    def run(self, raw: str) -> object:
-        """What `builder.transform` gives for the line `raw` of this layout."""
+    def run(self, raw: str) -> Any:
+        """What `builder.transform` gives for the line `raw` of this layout (Lark types it Any)."""
         results: list = []
         try:
             for first, call in self.steps:
@@ -651,7 +653,7 @@ class _Words(_Cut):
     """`_Cut` of a layout of plain words only (most lines): every step a word."""
 
     def items(self, raw: str) -> tuple[AnyItem, ...]:
-        items = []
+        items: list[AnyItem] = []
         append = items.append
         for letter, start, number_at, end in self.steps:
             number = raw[number_at:end]

@@ -11,7 +11,7 @@ from __future__ import annotations
 import io
 import re
 from itertools import chain
-from typing import BinaryIO, Iterable, Iterator
+from typing import BinaryIO, Iterable, Iterator, cast
 
 from ncpp.errors import NcppError
 from ncpp.program.parser import Dialect, LineParser, _ItemBuilder
@@ -137,7 +137,7 @@ def sniff(stream: Iterable[bytes], name: str | None = None, dialect: str | None 
     head = read(SNIFF_BYTES)
     head_lines = list(io.BytesIO(head))
     if head_lines and not head_lines[-1].endswith(b"\n"):
-        head_lines[-1] += stream.readline()  # type: ignore[union-attr]
+        head_lines[-1] += cast(BinaryIO, stream).readline()  # (it has `read`: a file)
     sniffed = b"".join(head_lines)[:_SNIFF_MOST]
     return detect(sniffed, name), chain(head_lines, stream)  # (in C: no generator's step per line)
 

@@ -228,7 +228,7 @@ from dataclasses import replace  # noqa: E402
 from ncpp.motion.segments import PLANE_AXES, Arc, Line  # noqa: E402
 from ncpp.program.blocks import Block  # noqa: E402
 from ncpp.program.dialects.editing import splice  # noqa: E402
-from ncpp.program.dialects.iso import IsoWriter, written_apart  # noqa: E402
+from ncpp.program.dialects.iso import IsoWriter, _Units, written_apart  # noqa: E402
 from ncpp.program.numbers import NumberStyle, format_number, style_pattern  # noqa: E402
 
 _AXES = "XYZ"
@@ -372,7 +372,7 @@ class HeidenhainWriter(IsoWriter):
         return f"{self.last_number} {text}{block.eol}"
 
     # -- text -----------------------------------------------------------------------------
-    def _style(self, letter: str, segment: Line | Arc) -> NumberStyle:
+    def _style(self, letter: str, segment: Line | Arc | _Units) -> NumberStyle:
         # resolved once per letter and units, as IsoWriter's (`_learn_style` empties `_resolved`)
         key = (letter, segment.context.inch)
         style = self._resolved.get(key)

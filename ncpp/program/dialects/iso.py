@@ -80,7 +80,7 @@ class IsoWriter:
         self._resolved: dict = {}
         self._interned_units: dict[tuple, _Written] = {}  # styles -> their `_Written`, so its plans outlive a style change
         self._facts_block: Block | None = None  # the last block asked about, and its facts
-        self._facts_value: _Facts | None = None
+        self._facts_value: _Facts = None  # type: ignore[assignment]  # (read only with `_facts_block`)
         self._signature_facts: dict[str, _Facts] = {}  # the facts of plain blocks, by their `signature`
         self._spelled: tuple[Block | None, tuple[str, bool]] = (None, (" ", False))  # a block and its `spelling`
         # The end of the last segment written (where the output is, once rounded to the decimal
@@ -160,7 +160,7 @@ class IsoWriter:
     def _piece_words(self, block: Block, pieces: list) -> list[dict[str, str]]:
         """Per piece: letter -> number text of its words beyond X Y Z I J K (`_write_pieces`)."""
         given = {item.letter: item for item in block.items if type(item) is Word or type(item) is ExprWord}
-        style = lambda letter: (NumberStyle.of(given[letter].number) if type(given.get(letter)) is Word else DEFAULT_STYLE).at_least(4)  # noqa: E731
+        style = lambda letter: (NumberStyle.of(given[letter].number) if type(given.get(letter)) is Word else DEFAULT_STYLE).at_least(4)  # type: ignore[union-attr]  # noqa: E731
         feeds = [pieces[0].feed / share for share in time_shares(pieces)] if pieces[0].context.inverse_time else None
         out = []
         for k, piece in enumerate(pieces):
@@ -179,11 +179,12 @@ class IsoWriter:
         """The facts of `block`, read once while it is being written."""
         if block is not self._facts_block:
             self._facts_block, self._facts_value = block, _Facts(block)
-        return self._facts_value  # type: ignore[return-value]
+        return self._facts_value
 
     def _read_block(self, block: Block) -> "_Facts":
         """The facts of a block about to be written; its number styles are learnt."""
         signature = block.signature
+        facts: _Facts | None
         if signature is None:
             facts = _Facts(block)
             # an axis word written as an expression (`Y[0]`, `Y#5`) positions its axis as a number does
@@ -204,7 +205,7 @@ class IsoWriter:
         """Learn the number styles of the block's styled words, reading each number."""
         words = _words(block, facts)
         for n, letter in facts.styled:
-            self._learn_style(letter, NumberStyle.of(words[n].number))  # type: ignore[union-attr]
+            self._learn_style(letter, NumberStyle.of(words[n].number))
         self._last_lesson = None
 
     def _learn_layout_styles(self, block: Block, facts: "_Facts") -> None:
@@ -248,7 +249,7 @@ class IsoWriter:
         styles, firsts = [], []
         for n, letter in facts.styled:
             word = words[n]
-            number = text[word.end - len(word.number) : word.end]  # type: ignore[union-attr]
+            number = text[word.end - len(word.number) : word.end]
             styles.append((letter, NumberStyle.of(number)))
             digits = number.lstrip("+-").lstrip(" \t")
             if len(digits.partition("," if "," in digits else ".")[0]) > 1:
@@ -291,12 +292,12 @@ class IsoWriter:
         return spelled
 
     # -- verbatim blocks ------------------------------------------------------
-    def _learn_program_motion(self, block: Block, motion: list[Event]) -> None:
+    def _learn_program_motion(self, block: Block, motion: list[Line | Arc]) -> None:
         """After a control line the program's mode is unknown here (and the output's known once
         a block was edited): a verbatim block moving without a motion word runs in it."""
         if self.program_motion is None and self.output_motion is not None and motion and not motion[0].fixed:
             if self._facts(block).moves and not self._has_motion_word(block):
-                self.program_motion = self._motion_code(motion[0])  # type: ignore[arg-type]
+                self.program_motion = self._motion_code(motion[0])
 
     def _needs_mode_restore(self, block: Block) -> bool:
         """A verbatim block relying on a modal motion the output changed (an arc written as lines)."""
@@ -311,7 +312,7 @@ class IsoWriter:
         self.output_motion = self.program_motion
         return f"G{self.program_motion}{block.eol}"
 
-    def _after_verbatim(self, block: Block, motion: list[Event]) -> None:
+    def _after_verbatim(self, block: Block, motion: list[Line | Arc]) -> None:
         if self._has_motion_word(block):
             self.program_motion = self.output_motion = self._block_motion(block)
         for segment in motion:
@@ -375,7 +376,7 @@ class IsoWriter:
     def _format(self, letter: str, value: float, segment: Line | Arc) -> str:
         return format_number(value, self._style(letter, segment))
 
-    def _style(self, letter: str, segment: Line | Arc) -> NumberStyle:
+    def _style(self, letter: str, segment: Line | Arc | _Units) -> NumberStyle:
         key = (letter, segment.context.inch)
         style = self._resolved.get(key)
         if style is None:
@@ -435,7 +436,7 @@ class IsoWriter:
         styles = units.styles
         return {letter: format_number(numbers[n], styles[letter]) for letter, n in _WRITTEN[self._written_bits(self._facts(block), segment, units)]}
 
-    def _machine_texts(self, facts: "_Facts", segment: Line) -> dict[str, str]:
+    def _machine_texts(self, facts: "_Facts", segment: Line | Arc) -> dict[str, str]:
         """`_texts` of a G53 line, whose numbers are machine coordinates (in program units):
         what it writes is decided in program coordinates, like every other block's."""
         units = self._units(segment.context.inch)
@@ -487,7 +488,7 @@ class IsoWriter:
         numbers = segment.end if type(segment) is Line and segment.context.absolute else self._numbers(segment)
         if type(edit) is str:
             return edit.format(*numbers)
-        return edit.apply(raw, _words(block, facts), numbers)
+        return edit.apply(raw, _words(block, facts), numbers)  # type: ignore[union-attr]  # (a plan)
 
     @staticmethod
     def _edit_plan(facts: "_Facts", signature: str, bits: int, motion: int | None, spelled: tuple[str, bool] | None, units: "_Written") -> EditPlan | None:
@@ -514,7 +515,7 @@ class IsoWriter:
         spelled = None if facts.letters.issuperset(texts) else self._spelling(block)
         return set_words(block if motion is None else _with_motion(block, motion), texts, drop, spelled)
 
-    def _new_blocks(self, block: Block, segments: list[Event], eol: str, more: list[dict[str, str]] | None = None) -> list[str]:
+    def _new_blocks(self, block: Block, segments: list[Line | Arc], eol: str, more: list[dict[str, str]] | None = None) -> list[str]:
         """The lines of the segments a block makes after its first (arc pieces, reversal
         steps, subdivisions): new blocks, spelled as the block is.  Once per line written:
         what is the same for all of them is read once, the output's state is kept in locals
@@ -629,12 +630,13 @@ class _Facts:
         for item in block.items if block is not None else ():
             kind = type(item)
             if kind is Word:
-                self._read_word(item.letter, item.value, item.number)
+                word: Word = item  # type: ignore[assignment]  # (`kind` is its type: one type() per item)
+                self._read_word(word.letter, word.value, word.number)
             elif kind is not Comment:
                 self.plain = False
-                if kind is ExprWord and item.letter in AXES:
-                    self.expression_axes += item.letter
-                if kind is Statement and item.kind == "oword" and len(item.node) >= 2:
+                if kind is ExprWord and item.letter in AXES:  # type: ignore[union-attr]  # (as above)
+                    self.expression_axes += item.letter  # type: ignore[union-attr]
+                if kind is Statement and item.kind == "oword" and len(item.node) >= 2:  # type: ignore[union-attr]
                     self.flow = True
         self._sum_up()
 
@@ -756,5 +758,5 @@ def _literal_geometry(block: Block, letters: str = GEOMETRY_LETTERS) -> Block:
     `letters`, as plain words: a pass changed what they evaluate to, so new numbers replace them."""
     if not any(type(i) is ExprWord and i.letter in letters for i in block.items):
         return block
-    items = [Word(i.letter, 0.0, "0", i.start, i.end) if type(i) is ExprWord and i.letter in letters else i for i in block.items]
+    items = tuple(Word(i.letter, 0.0, "0", i.start, i.end) if type(i) is ExprWord and i.letter in letters else i for i in block.items)
     return replace(block, items=items, signature=None)  # the signature is that of the old items

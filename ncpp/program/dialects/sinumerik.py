@@ -259,7 +259,9 @@ class SinumerikWriter(IsoWriter):
             texts["CR"] = self._format("CR", radius, segment)
         return texts
 
-    def _edit_block(self, block: Block, segment: Line | Arc) -> str:
+    # (no `more`: ISO's `_write_pieces` gives it for the axes beyond X Y Z and for G93, which the
+    # Sinumerik reading lacks: so as `_new_blocks`)
+    def _edit_block(self, block: Block, segment: Line | Arc) -> str:  # type: ignore[override]
         facts = self._facts(block)
         if block.signature is not None and not facts.machine and facts.letters.isdisjoint(_ISO_ONLY):
             # one-letter words and comments only (`X10.5 Y2.25`): ISO's edit, by compiled plans, says the same
@@ -290,7 +292,7 @@ class SinumerikWriter(IsoWriter):
         self._remember_end(segment)
         return raw
 
-    def _new_blocks(self, block: Block, segments: list, eol: str) -> list[str]:
+    def _new_blocks(self, block: Block, segments: list, eol: str) -> list[str]:  # type: ignore[override]
         return [self._new_block(block, segment) + eol for segment in segments]
 
     def _new_block(self, block: Block, segment: Line | Arc) -> str:
