@@ -29,7 +29,7 @@ import os
 import sys
 import time
 from dataclasses import dataclass
-from functools import lru_cache
+from functools import cache
 from pathlib import Path
 from typing import Any
 
@@ -65,7 +65,9 @@ PROGRAMS_QUICK = [
     ("freecad_grbl platteyz helix", CORPUS / "freecad_grbl/platteyz-pass-3-helix.nc"),
     ("camotics botomata_bottom", CORPUS / "camotics/botomata_bottom.nc"),
 ]
-PROGRAMS_FULL = PROGRAMS_QUICK + [("linuxcnc stellabee1 (inch, G18)", CORPUS / "linuxcnc/large/stellabee1.ngc")]
+PROGRAMS_FULL = PROGRAMS_QUICK + [
+    ("linuxcnc stellabee1 (inch, G18)", CORPUS / "linuxcnc/large/stellabee1.ngc")
+]
 
 QUIET = Warnings(stream=open(os.devnull, "w"))
 
@@ -110,13 +112,33 @@ def fitted_machine(true: Machine, noise: float = 0.3, seed: int = 7) -> Machine:
         quantities += [q for (a, q) in ANGLE_COMPONENTS if a == axis and q != "roll"]
         for q in quantities:
             files.append(
-                predict_laser(true, axis, q, targets, fixed=fixed, offset_mm=(0, 0, 120), runs=2, noise_um=noise, seed=int(rng.integers(1 << 30)))
+                predict_laser(
+                    true,
+                    axis,
+                    q,
+                    targets,
+                    fixed=fixed,
+                    offset_mm=(0, 0, 120),
+                    runs=2,
+                    noise_um=noise,
+                    seed=int(rng.integers(1 << 30)),
+                )
             )
-        files.append(predict_level(true, axis, targets, quantity="roll", fixed=fixed, noise_um=noise, seed=int(rng.integers(1 << 30))))
+        files.append(
+            predict_level(
+                true,
+                axis,
+                targets,
+                quantity="roll",
+                fixed=fixed,
+                noise_um=noise,
+                seed=int(rng.integers(1 << 30)),
+            )
+        )
     return fit_machine(files, base=true.without_errors(), name=f"{true.name} (fitted)")
 
 
-@lru_cache(maxsize=None)
+@cache
 def machine(name: str) -> Machine:
     return load_machine(MACHINES[name])
 
@@ -147,11 +169,15 @@ def placement(path: SampledPath, model: Machine) -> np.ndarray | None:
     return np.round((lo_m + hi_m) / 2 - (lo_p + hi_p) / 2, 3)
 
 
-def compensate(data: bytes, source: ErrorSource, tolerance: float, name: str, offsets: WorkOffsets) -> tuple[bytes, int, int, float]:
+def compensate(
+    data: bytes, source: ErrorSource, tolerance: float, name: str, offsets: WorkOffsets
+) -> tuple[bytes, int, int, float]:
     """Compensated program text, lines in, lines out, seconds."""
     out = io.BytesIO()
     start = time.perf_counter()
-    stats = process(io.BytesIO(data), out, file=name, source=source, tolerance=tolerance, warnings=QUIET, offsets=offsets)
+    stats = process(
+        io.BytesIO(data), out, file=name, source=source, tolerance=tolerance, warnings=QUIET, offsets=offsets
+    )
     return out.getvalue(), stats.lines_in, stats.lines_out, time.perf_counter() - start
 
 
@@ -217,17 +243,30 @@ def prepare(label: str, path: Path, model: Machine) -> Run | None:
 
 def simulate(run: Run, model: Machine, program: bytes | None = None) -> ContourReport:
     """Contour error of `program` (default: the original) against the nominal path, on `model` (geometry)."""
-    commanded = run.nominal if program is None else sample_events(answerable(events_of(program, run.label, WorkOffsets.at(run.offset))))
+    commanded = (
+        run.nominal
+        if program is None
+        else sample_events(answerable(events_of(program, run.label, WorkOffsets.at(run.offset))))
+    )
     return contour_error(model, commanded, run.nominal, feed_effects=False)
 
 
-def evaluate(run: Run, truth: Machine, compensation_model: Machine, tolerances=TOLERANCES_MM) -> dict[str, Any]:
+def evaluate(
+    run: Run, truth: Machine, compensation_model: Machine, tolerances=TOLERANCES_MM
+) -> dict[str, Any]:
     """Before/after figures of one program: compensated with one model, run on another."""
     before = simulate(run, truth)
     source = source_for(compensation_model)
-    result: dict[str, Any] = {"before_max_um": before.max_um, "before_rms_um": before.rms_um, "offset_mm": run.offset.tolist(), "after": {}}
+    result: dict[str, Any] = {
+        "before_max_um": before.max_um,
+        "before_rms_um": before.rms_um,
+        "offset_mm": run.offset.tolist(),
+        "after": {},
+    }
     for tol in tolerances:
-        text, lines_in, lines_out, seconds = compensate(run.data, source, tol, run.label, WorkOffsets.at(run.offset))
+        text, lines_in, lines_out, seconds = compensate(
+            run.data, source, tol, run.label, WorkOffsets.at(run.offset)
+        )
         after = simulate(run, truth, text)
         result["after"][f"{tol * 1000:g}"] = {
             "max_um": after.max_um,
@@ -296,12 +335,32 @@ def accuracy(ctx):
                         f"{after['1']['rms_um']:.2f}",
                         f"{after['1']['factor']:.0f}x",
                         " | ".join(f"{a['growth']:.2f}" for a in after.values()),
-                        "" if case.startswith("fitted") else ("yes" if all(a["within"] for a in after.values()) else "NO: " + ",".join(k for k, a in after.items() if not a["within"])),
+                        ""
+                        if case.startswith("fitted")
+                        else (
+                            "yes"
+                            if all(a["within"] for a in after.values())
+                            else "NO: " + ",".join(k for k, a in after.items() if not a["within"])
+                        ),
                     ]
                 )
-    columns = ["machine", "model", "program", "before max / rms µm", "after max µm @1|2|5", "after rms @1", "factor @1", "out/in @1|2|5", "≤ tol+0.5 µm"]
-    notes.append("contour error: distance of the simulated tool path (geometry, no effects) from the nominal path, feed moves")
-    return bench.Section("Accuracy: contour error before / after compensation (virtual machine)", columns, rows, data, notes)
+    columns = [
+        "machine",
+        "model",
+        "program",
+        "before max / rms µm",
+        "after max µm @1|2|5",
+        "after rms @1",
+        "factor @1",
+        "out/in @1|2|5",
+        "≤ tol+0.5 µm",
+    ]
+    notes.append(
+        "contour error: distance of the simulated tool path (geometry, no effects) from the nominal path, feed moves"
+    )
+    return bench.Section(
+        "Accuracy: contour error before / after compensation (virtual machine)", columns, rows, data, notes
+    )
 
 
 if __name__ == "__main__":

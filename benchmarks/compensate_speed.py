@@ -23,8 +23,9 @@ import shutil
 import subprocess
 import sys
 import time
+from collections.abc import Callable, Iterable
 from pathlib import Path
-from typing import Any, Callable, Iterable
+from typing import Any
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
@@ -45,8 +46,8 @@ def work_offset(path: Path) -> tuple[float, float, float]:
     """Centre of HR5B's travel minus the centre of the program's extent (first 20k lines suffice:
     the generated program stays in a fixed box; stellabee's extent is the file's)."""
     import numpy as np
-
     from accuracy import events_of, machine, placement
+
     from ncpp.simulate import sample_events
 
     with open(path, "rb") as f:
@@ -55,10 +56,13 @@ def work_offset(path: Path) -> tuple[float, float, float]:
     return tuple(float(v) for v in np.asarray(offset))  # type: ignore[return-value]
 
 
-def ncpp_process_rate(path: Path, offset: tuple[float, float, float] | None, verify: bool = True) -> dict[str, Any]:
+def ncpp_process_rate(
+    path: Path, offset: tuple[float, float, float] | None, verify: bool = True
+) -> dict[str, Any]:
     """`process` over the whole file into a null sink: passthrough (offset None) or compensation,
     verified (the default, as every command runs it) or not."""
     from accuracy import QUIET
+
     from ncpp.motion.offsets import WorkOffsets
     from ncpp.pipeline import ErrorSource, process
 
@@ -67,7 +71,13 @@ def ncpp_process_rate(path: Path, offset: tuple[float, float, float] | None, ver
     with open(os.devnull, "wb") as sink, open(path, "rb") as stream:
         cpu, start = time.process_time(), time.perf_counter()
         stats = process(
-            stream, sink, file=str(path), source=source, tolerance=TOLERANCE, warnings=QUIET, offsets=offsets,
+            stream,
+            sink,
+            file=str(path),
+            source=source,
+            tolerance=TOLERANCE,
+            warnings=QUIET,
+            offsets=offsets,
             verify=verify,
         )
         seconds, cpu = time.perf_counter() - start, time.process_time() - cpu
@@ -161,6 +171,7 @@ def stage_seconds(
     from itertools import islice
 
     from accuracy import QUIET
+
     from ncpp.motion.offsets import WorkOffsets
     from ncpp.passes import PASSES
     from ncpp.pipeline import ErrorSource, dialect_tools, make_context
@@ -285,8 +296,15 @@ def compensate_speed(ctx):
             "passthrough / pygcode": ("passthrough", passthrough),
         }
         stages = stage_seconds(path, offset)
-        table.append(["verifier's cost (CPU, against --no-verify)", label, f"{100 * verifying:.0f}%",
-                      f"≤ {100 * VERIFY_TARGET:.0f}%", "met" if verifying <= VERIFY_TARGET else "short"])
+        table.append(
+            [
+                "verifier's cost (CPU, against --no-verify)",
+                label,
+                f"{100 * verifying:.0f}%",
+                f"≤ {100 * VERIFY_TARGET:.0f}%",
+                "met" if verifying <= VERIFY_TARGET else "short",
+            ]
+        )
         data[label] = {
             "work_offset_mm": offset,
             "unverified": unverified,
@@ -467,6 +485,7 @@ def posted(source: Path, lines: int, dialect: str, workdir: Path) -> Path:
     from itertools import islice
 
     from accuracy import QUIET
+
     from ncpp.motion import interpret
     from ncpp.post import GENERATORS
     from ncpp.program.parser import parse_stream

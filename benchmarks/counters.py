@@ -19,7 +19,9 @@ _HARDWARE, _INSTRUCTIONS = 0, 1
 _INHERIT, _EXCLUDE_KERNEL, _EXCLUDE_HV = 1 << 1, 1 << 5, 1 << 6
 
 
-class _Attr(ctypes.Structure):  # struct perf_event_attr, as far as it is used (PERF_ATTR_SIZE_VER0 = 64 bytes)
+class _Attr(
+    ctypes.Structure
+):  # struct perf_event_attr, as far as it is used (PERF_ATTR_SIZE_VER0 = 64 bytes)
     _fields_ = [("type", ctypes.c_uint32), ("size", ctypes.c_uint32), ("config", ctypes.c_uint64), ("sample_period", ctypes.c_uint64),
                 ("sample_type", ctypes.c_uint64), ("read_format", ctypes.c_uint64), ("flags", ctypes.c_uint64),
                 ("wakeup_events", ctypes.c_uint32), ("bp_type", ctypes.c_uint32), ("config1", ctypes.c_uint64)]  # fmt: skip
@@ -33,7 +35,9 @@ class Instructions:
         attr = _Attr(type=_HARDWARE, size=ctypes.sizeof(_Attr), config=_INSTRUCTIONS,
                      flags=_EXCLUDE_KERNEL | _EXCLUDE_HV | (_INHERIT if children else 0))  # fmt: skip
         libc = ctypes.CDLL(None, use_errno=True)
-        fd = libc.syscall(number, ctypes.byref(attr), 0, -1, -1, 0)  # this process, any CPU, no group, no flags
+        fd = libc.syscall(
+            number, ctypes.byref(attr), 0, -1, -1, 0
+        )  # this process, any CPU, no group, no flags
         if fd < 0:
             raise OSError(ctypes.get_errno(), "perf_event_open")
         self.fd = fd

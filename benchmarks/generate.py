@@ -17,8 +17,9 @@ from __future__ import annotations
 import argparse
 import math
 import random
+from collections.abc import Iterator
 from pathlib import Path
-from typing import Iterator, TextIO
+from typing import TextIO
 
 HEADER = (
     "%",

@@ -51,8 +51,23 @@ def _run(tool: str, path: Path, offset: str, valgrind: tuple[str, ...] = ()) -> 
     from ncpp.runtime import one_blas_thread  # (imported when the section runs, as compensate_speed's)
 
     # -P: the working folder is not put first on the child's path (it may hold another ncpp)
-    command = [*valgrind, sys.executable, "-P", "-c", _CHILD.format(path=[str(HERE), str(ROOT)]), tool, str(path), offset]
-    return subprocess.run(command, capture_output=True, text=True, env=one_blas_thread({**os.environ, "PYTHONHASHSEED": "0"}), check=False)
+    command = [
+        *valgrind,
+        sys.executable,
+        "-P",
+        "-c",
+        _CHILD.format(path=[str(HERE), str(ROOT)]),
+        tool,
+        str(path),
+        offset,
+    ]
+    return subprocess.run(
+        command,
+        capture_output=True,
+        text=True,
+        env=one_blas_thread({**os.environ, "PYTHONHASHSEED": "0"}),
+        check=False,
+    )
 
 
 def counted(tool: str, path: Path, offset: str, workdir: Path) -> int:
@@ -79,7 +94,11 @@ def per_line(tool: str, path: Path, offset: str, workdir: Path, lines: int = LIN
     if warm.returncode != 0:
         raise RuntimeError(f"{tool} {path.name}: exit {warm.returncode}: {warm.stderr[-1500:]}")
     long, short = (counted(tool, heads[n], offset, workdir) for n in (len(text), SHORT))
-    return {"lines": len(text) - SHORT, "instructions": long - short, "per_line": (long - short) / (len(text) - SHORT)}
+    return {
+        "lines": len(text) - SHORT,
+        "instructions": long - short,
+        "per_line": (long - short) / (len(text) - SHORT),
+    }
 
 
 def instructions(ctx):
@@ -90,7 +109,9 @@ def instructions(ctx):
     if shutil.which("valgrind") is None:
         return Section("Instructions per input line (callgrind)", ["program", "tool", "k per line", "note"], [], {},
                        ["valgrind is not installed here: nothing counted"])  # fmt: skip
-    programs = ctx.programs or ({} if ctx.quick else {"stellabee1.ngc": bench.STELLABEE}) | {"generated": ctx.generated(LINES)}
+    programs = ctx.programs or ({} if ctx.quick else {"stellabee1.ngc": bench.STELLABEE}) | {
+        "generated": ctx.generated(LINES)
+    }
     rows, data = [], {}
     with tempfile.TemporaryDirectory(prefix="ncpp-callgrind-") as tmp:
         for label, path in programs.items():
@@ -100,9 +121,27 @@ def instructions(ctx):
             data[label] = {"ncpp_compensate_one_process": ncpp, "pygcode": pygcode}
             ratio = pygcode["per_line"] / ncpp["per_line"]
             rows += [
-                [label, "ncpp compensate 1 µm (HR5B), one process", f"{ncpp['per_line'] / 1000:.0f}", f"lines {SHORT + 1:,}-{SHORT + ncpp['lines']:,}"],
+                [
+                    label,
+                    "ncpp compensate 1 µm (HR5B), one process",
+                    f"{ncpp['per_line'] / 1000:.0f}",
+                    f"lines {SHORT + 1:,}-{SHORT + ncpp['lines']:,}",
+                ],
                 [label, "pygcode Line()", f"{pygcode['per_line'] / 1000:.0f}", ""],
-                [label, "pygcode / ncpp", f"{ratio:.2f}x", "at equal instructions per second, the ratio of the rates"],
+                [
+                    label,
+                    "pygcode / ncpp",
+                    f"{ratio:.2f}x",
+                    "at equal instructions per second, the ratio of the rates",
+                ],
             ]
-    notes = [f"the first {LINES:,} lines, less a run over the first {SHORT}; valgrind's callgrind, PYTHONHASHSEED=0"]
-    return Section("Instructions per input line (callgrind)", ["program", "tool", "k per line", "note"], rows, data, notes)
+    notes = [
+        f"the first {LINES:,} lines, less a run over the first {SHORT}; valgrind's callgrind, PYTHONHASHSEED=0"
+    ]
+    return Section(
+        "Instructions per input line (callgrind)",
+        ["program", "tool", "k per line", "note"],
+        rows,
+        data,
+        notes,
+    )

@@ -21,9 +21,10 @@ import subprocess
 import sys
 import tempfile
 import time
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable, Iterable
+from typing import Any
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
@@ -99,7 +100,9 @@ def ncpp_rate(path: Path, interpret: Callable | None) -> dict[str, Any]:
                 for _ in counted:
                     pass
             else:
-                events = sum(1 for _ in interpret(counted, file=str(path), warnings=Warnings(stream=warnings)))
+                events = sum(
+                    1 for _ in interpret(counted, file=str(path), warnings=Warnings(stream=warnings))
+                )
         except NcppError as err:
             error = str(err)
     seconds = time.perf_counter() - start
@@ -208,7 +211,10 @@ def peak_rss(path: Path, command: list[str] | None = None) -> dict[str, Any]:
 def throughput(ctx: Context) -> Section:
     """Lines/s of ncpp, pygcode and rs274 on the same files."""
     lines_generated = 250_000 if ctx.quick else 1_000_000
-    ctx.programs = {"stellabee1.ngc": STELLABEE, f"generated {lines_generated:,} lines": ctx.generated(lines_generated)}
+    ctx.programs = {
+        "stellabee1.ngc": STELLABEE,
+        f"generated {lines_generated:,} lines": ctx.generated(lines_generated),
+    }
     interpret = interpreter()
     rows, data = [], {}
     for label, path in {**ctx.programs, "3D_Chips_abort.ngc (expressions)": PARAMETRIC}.items():
@@ -230,19 +236,41 @@ def throughput(ctx: Context) -> Section:
         }
         rows.append([label, "ncpp parse", _rate(parse), _stopped(parse, lines).lstrip("; ")])
         if full:
-            rows.append([label, "ncpp parse+interpret", _rate(full), f"{full['events'] or 0:,} events" + _stopped(full, lines)])
+            rows.append(
+                [
+                    label,
+                    "ncpp parse+interpret",
+                    _rate(full),
+                    f"{full['events'] or 0:,} events" + _stopped(full, lines),
+                ]
+            )
         rows.append([label, "pygcode Line()", _rate(pyg), f"{pyg['failed_lines']:,} lines refused"])
-        rows.append([label, "rs274 (process)", _rate(rs), "completed" if rs["completed"] else f"STOPPED: {rs['error']}"])
+        rows.append(
+            [
+                label,
+                "rs274 (process)",
+                _rate(rs),
+                "completed" if rs["completed"] else f"STOPPED: {rs['error']}",
+            ]
+        )
         what = "parse+interpret" if full else "parse"
         ratio = data[label]["ratio_ncpp_pygcode"]
-        floor = f"floor {PYGCODE_FLOOR:.2f}x: " + ("ok" if ratio >= PYGCODE_FLOOR else "SHORT") if full else ""
+        floor = (
+            f"floor {PYGCODE_FLOOR:.2f}x: " + ("ok" if ratio >= PYGCODE_FLOOR else "SHORT") if full else ""
+        )
         if label not in ctx.programs:  # not a core file: pygcode refuses its expressions
             floor = "no floor (pygcode refuses the expression lines)"
         rows.append([label, f"ratio ncpp {what} / pygcode", f"{ratio:.2f}x", floor])
         rows.append([label, f"ratio ncpp {what} / rs274", f"{data[label]['ratio_ncpp_rs274']:.2f}x", ""])
     notes = [] if interpret else ["ncpp.motion.interpret is not importable yet: ncpp figures are parse only."]
     data["interpreter_available"] = interpret is not None
-    return Section("Throughput (lines/s, one pass over each file)", ["program", "tool", "lines/s", "note"], rows, data, notes)
+    return Section(
+        "Throughput (lines/s, one pass over each file)",
+        ["program", "tool", "lines/s", "note"],
+        rows,
+        data,
+        notes,
+    )
 
 
 def memory(ctx: Context) -> Section:
@@ -256,8 +284,18 @@ def memory(ctx: Context) -> Section:
         if lines >= 10_000_000:
             path.unlink()  # ~300 MB
         data[str(lines)] = {"lines": lines, "file_mb": size_mb, **result}
-        status = "ok" if result["exit"] == 0 else f"exit {result['exit']}: {result['stderr_tail'].strip()[-120:]}"
-        rows.append([f"{lines:,}", f"{size_mb:.0f}", f"{result['rss_mb']:.1f}", f"{lines / result['seconds']:,.0f}", status])
+        status = (
+            "ok" if result["exit"] == 0 else f"exit {result['exit']}: {result['stderr_tail'].strip()[-120:]}"
+        )
+        rows.append(
+            [
+                f"{lines:,}",
+                f"{size_mb:.0f}",
+                f"{result['rss_mb']:.1f}",
+                f"{lines / result['seconds']:,.0f}",
+                status,
+            ]
+        )
     rss = [v["rss_mb"] for v in data.values()]
     data["growth_mb"] = rss[-1] - rss[1]  # the smallest program does not fill the filter's 8 MB output spool
     notes = [
@@ -307,7 +345,9 @@ def render(section: Section) -> str:
     widths = [max(len(row[i]) for row in table) for i in range(len(section.columns))]
     lines = [f"\n## {section.title}", ""]
     for n, row in enumerate(table):
-        lines.append("  ".join(cell.rjust(w) if cell[:1].isdigit() else cell.ljust(w) for cell, w in zip(row, widths)))
+        lines.append(
+            "  ".join(cell.rjust(w) if cell[:1].isdigit() else cell.ljust(w) for cell, w in zip(row, widths))
+        )
         if n == 0:
             lines.append("  ".join("-" * w for w in widths))
     lines += [f"  * {note}" for note in section.notes]
@@ -318,7 +358,9 @@ def cpu() -> str:
     """The processor as Linux names it, with its family and model: a VM may name only the
     vendor, and the same code's ratio to pygcode differs from one processor to another."""
     try:
-        facts = dict(line.split(":", 1) for line in Path("/proc/cpuinfo").read_text().splitlines() if ":" in line)
+        facts = dict(
+            line.split(":", 1) for line in Path("/proc/cpuinfo").read_text().splitlines() if ":" in line
+        )
     except OSError:
         return platform.processor() or platform.machine()
     facts = {key.strip(): value.strip() for key, value in facts.items()}
@@ -327,13 +369,19 @@ def cpu() -> str:
 
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description="ncpp throughput and memory benchmarks")
-    p.add_argument("--quick", action="store_true", help="smaller programs, no 10M-line run (throughput and memory in about 2 minutes; compensate_speed about 5)")
+    p.add_argument(
+        "--quick",
+        action="store_true",
+        help="smaller programs, no 10M-line run (throughput and memory in about 2 minutes; compensate_speed about 5)",
+    )
     p.add_argument("--only", nargs="*", help="names of sections to run (default: all)")
     p.add_argument("--out", type=Path, default=OUT, help=f"JSON results (default: {OUT.relative_to(ROOT)})")
     args = p.parse_args(argv)
     unknown = sorted(set(args.only or ()) - {run.__name__ for run in SECTIONS})
     if unknown:  # a misspelt name would run nothing and say nothing
-        p.error(f"no section named {', '.join(unknown)} (sections: {', '.join(run.__name__ for run in SECTIONS)})")
+        p.error(
+            f"no section named {', '.join(unknown)} (sections: {', '.join(run.__name__ for run in SECTIONS)})"
+        )
 
     started = time.perf_counter()
     results: dict[str, Any] = {
@@ -356,7 +404,12 @@ def main(argv: list[str] | None = None) -> int:
             took = time.perf_counter() - began
             section.notes.append(f"section took {took:.0f} s")
             print(render(section), flush=True)
-            results["sections"][run.__name__] = {"title": section.title, "notes": section.notes, "seconds": took, **section.data}
+            results["sections"][run.__name__] = {
+                "title": section.title,
+                "notes": section.notes,
+                "seconds": took,
+                **section.data,
+            }
     results["seconds"] = time.perf_counter() - started
     print(f"\ntotal {results['seconds']:.0f} s; results in {args.out}")
 

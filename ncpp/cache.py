@@ -18,8 +18,9 @@ import os
 import stat
 import sys
 import tempfile
+from collections.abc import Callable
 from pathlib import Path
-from typing import BinaryIO, Callable, Protocol, TypeVar
+from typing import BinaryIO, Protocol, TypeVar
 
 
 class Savable(Protocol):

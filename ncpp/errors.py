@@ -8,8 +8,9 @@ traceback.
 from __future__ import annotations
 
 import sys
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING, Callable, Iterable, TextIO
+from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from _typeshed import SupportsWrite
@@ -57,7 +58,7 @@ class NcppError(Exception):
         self.message = message
         self.where = where or Location()
 
-    def locate(self, blocks: Iterable["Block"]) -> None:
+    def locate(self, blocks: Iterable[Block]) -> None:
         """Give an error that names its line but no column (a pass's, a path's) the column of
         its word in the block of that line among `blocks`: that of the word its location
         names, else 1 (the block)."""
@@ -98,7 +99,9 @@ class Warnings:
         self.stream = stream if stream is not None else sys.stderr
         self.count = 0
         self._times: dict[str, int] = {}  # how often each text was warned
-        self._hidden: dict[str, tuple[Location, Location]] = {}  # where each text was first and last not printed
+        self._hidden: dict[
+            str, tuple[Location, Location]
+        ] = {}  # where each text was first and last not printed
         # told every warning (`summary.Summary.heard`)
         self.listeners: list[Callable[[str, Location], None]] = []
 
@@ -119,7 +122,10 @@ class Warnings:
         if times < SHOWN_PER_TEXT:
             print(f"{where}: warning: {message}", file=self.stream)
         elif times == SHOWN_PER_TEXT:
-            print(f"{where}: warning: {message} (warned {times} times: more of these are counted, not printed)", file=self.stream)
+            print(
+                f"{where}: warning: {message} (warned {times} times: more of these are counted, not printed)",
+                file=self.stream,
+            )
         else:
             self._hidden[message] = (self._hidden.get(message, (where,))[0], where)
 
@@ -127,5 +133,8 @@ class Warnings:
         """At the end of a run: how many warnings of each text were not printed, and where."""
         for message, (first, last) in self._hidden.items():
             hidden = self._times[message] - SHOWN_PER_TEXT
-            print(f"{last}: warning: {message} ({hidden} not printed, from line {first.line} to this one)", file=self.stream)
+            print(
+                f"{last}: warning: {message} ({hidden} not printed, from line {first.line} to this one)",
+                file=self.stream,
+            )
         self._hidden.clear()

@@ -149,7 +149,9 @@ def _sinumerik(placement: Placement) -> list[str]:
     ]
 
 
-def with_guard(lines: Iterable[str], placement: Placement, dialect: str, header: str, header_lines: int = 1) -> Iterator[str]:
+def with_guard(
+    lines: Iterable[str], placement: Placement, dialect: str, header: str, header_lines: int = 1
+) -> Iterator[str]:
     """The written program's lines with the guard after the header comment (`header_lines` lines,
     the first holding `header`) and the program number that may follow it."""
     it = iter(lines)

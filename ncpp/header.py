@@ -34,7 +34,10 @@ def placement_lines(offsets: WorkOffsets, dialect: str) -> list[str]:
 def _systems(offsets: WorkOffsets) -> list[str]:
     """The work offsets the control holds (the one in effect first), a few to a line."""
     numbers = [offsets.active] + [n for n in range(1, 10) if n != offsets.active and offsets.told(n)]
-    said = [f"{SYSTEMS[n - 1]} {_point(offsets.zero(n))}{'' if offsets.told(n) else ' not given'}" for n in numbers]
+    said = [
+        f"{SYSTEMS[n - 1]} {_point(offsets.zero(n))}{'' if offsets.told(n) else ' not given'}"
+        for n in numbers
+    ]
     lines = [", ".join(said[k : k + SYSTEMS_PER_LINE]) for k in range(0, len(said), SYSTEMS_PER_LINE)]
     active = SYSTEMS[offsets.active - 1]
     lines[0] = f"ncpp work offsets in machine mm, {active} in effect at the start: {lines[0]}"

@@ -11,12 +11,13 @@ from __future__ import annotations
 
 import gc
 import hashlib
+from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from itertools import chain, count, islice, tee
 from operator import itemgetter
 from pathlib import Path
-from typing import BinaryIO, Callable, Iterable, Iterator
+from typing import BinaryIO
 
 from ncpp import __version__
 from ncpp.errors import Location, NcppError, Warnings
@@ -52,16 +53,18 @@ class ErrorSource:
     rotary_xyz_are_axis_positions: bool = False  # the machine file's [compensation] key
 
     @classmethod
-    def from_machine_file(cls, path: str) -> "ErrorSource":
+    def from_machine_file(cls, path: str) -> ErrorSource:
         from ncpp.machine import load_machine
 
         machine = load_machine(path)
         limits = {a: lim for a, lim in machine.limits.items()}
         rotary = machine.rotary_xyz_are_axis_positions
-        return cls(MachineMap(machine), Path(path).name, _digest(path), machine.max_correction_mm, limits, rotary)
+        return cls(
+            MachineMap(machine), Path(path).name, _digest(path), machine.max_correction_mm, limits, rotary
+        )
 
     @classmethod
-    def from_measurement(cls, path: str) -> "ErrorSource":
+    def from_measurement(cls, path: str) -> ErrorSource:
         from ncpp.passes.measured import map_from_file
 
         return cls(map_from_file(path), Path(path).name, _digest(path))
@@ -152,7 +155,10 @@ def header_comment(block: Block) -> Comment | None:
 # interpreter places itself, from the tool table it is told.)
 _ONE_ZERO = "ncpp compensates this dialect at one program zero, the work offset in effect when the program starts (--work-offset)"
 OTHER_ZEROS = {
-    **{value: f"{name} selects another work offset: {_ONE_ZERO}" for value, name in ((55.0, "G55"), (56.0, "G56"), (57.0, "G57"))},
+    **{
+        value: f"{name} selects another work offset: {_ONE_ZERO}"
+        for value, name in ((55.0, "G55"), (56.0, "G56"), (57.0, "G57"))
+    },
     500.0: f"G500 deselects the work offset: {_ONE_ZERO}",
 }
 
@@ -167,7 +173,12 @@ def warn_unplaced(blocks: Iterable[Block], warnings: Warnings, file: str) -> Ite
             yield block
             continue
         for item in block.items:
-            if type(item) is Word and item.letter == "G" and item.value in OTHER_ZEROS and item.value not in told:
+            if (
+                type(item) is Word
+                and item.letter == "G"
+                and item.value in OTHER_ZEROS
+                and item.value not in told
+            ):
                 told.add(item.value)
                 warnings.warn(OTHER_ZEROS[item.value], Location(file, block.line, item.start + 1))
         yield block
@@ -216,7 +227,9 @@ def warn_fixed(events: Iterable[Event], warnings: Warnings, file: str) -> Iterat
             if not fixed and series == CYCLE and absolute and not event.context.absolute:  # type: ignore[union-attr]
                 yield from _passed_on(event, events, warnings, file)
                 return
-            if fixed and fixed != series and fixed in UNCOMPENSATED:  # (a G28/G30's moves are the control's own)
+            if (
+                fixed and fixed != series and fixed in UNCOMPENSATED
+            ):  # (a G28/G30's moves are the control's own)
                 warnings.warn(UNCOMPENSATED[fixed], Location(file, event.block.line, 1))
             series, absolute = fixed, event.context.absolute  # type: ignore[union-attr]
         elif kind is Pass and event.setting is not None and series in UNCOMPENSATED and absolute:  # type: ignore[union-attr]
@@ -225,7 +238,9 @@ def warn_fixed(events: Iterable[Event], warnings: Warnings, file: str) -> Iterat
         yield event
 
 
-def _passed_on(first: Event, rest: Iterator[Event], warnings: Warnings, file: str, why: str = INCREMENTAL_CYCLE) -> Iterator[Pass]:
+def _passed_on(
+    first: Event, rest: Iterator[Event], warnings: Warnings, file: str, why: str = INCREMENTAL_CYCLE
+) -> Iterator[Pass]:
     """`first`'s block (none of its events went by yet) and every later one, as `Pass`."""
     warnings.warn(why, Location(file, first.block.line, 1))
     last = None
@@ -258,7 +273,9 @@ def _parsed_ahead(blocks: Iterable[Block], most: int = PARSED_AHEAD) -> Iterator
         size = min(2 * size, most)
 
 
-def _counted(blocks: Iterable[Block], counter: Iterator[int], progress: Callable[[int], None] | None) -> Iterator[Block]:
+def _counted(
+    blocks: Iterable[Block], counter: Iterator[int], progress: Callable[[int], None] | None
+) -> Iterator[Block]:
     """The blocks, each taking a number from `counter` (itertools.count: the next number
     it gives is how many went by); `progress` is told every 1000."""
     if progress is None:  # zip and itemgetter run in C: no Python frame per block
@@ -266,7 +283,9 @@ def _counted(blocks: Iterable[Block], counter: Iterator[int], progress: Callable
     return _reported(blocks, counter, progress)
 
 
-def _reported(blocks: Iterable[Block], counter: Iterator[int], progress: Callable[[int], None]) -> Iterator[Block]:
+def _reported(
+    blocks: Iterable[Block], counter: Iterator[int], progress: Callable[[int], None]
+) -> Iterator[Block]:
     for block, n in zip(blocks, counter):
         if (n + 1) % 1000 == 0:
             progress(n + 1)
@@ -286,7 +305,9 @@ def dialect_tools(name: str) -> tuple[Callable, type]:
     import importlib
 
     interpreter, writer_module, writer = DIALECT_TOOLS[name]
-    return importlib.import_module(interpreter).interpret, getattr(importlib.import_module(writer_module), writer)
+    return importlib.import_module(interpreter).interpret, getattr(
+        importlib.import_module(writer_module), writer
+    )
 
 
 def with_header(lines: Iterable[str], header: str, writer: IsoWriter) -> Iterator[str]:

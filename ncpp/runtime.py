@@ -23,7 +23,8 @@ from __future__ import annotations
 import ctypes
 import os
 import sys
-from typing import MutableMapping, TypeVar
+from collections.abc import MutableMapping
+from typing import TypeVar
 
 MMAP_THRESHOLD = 16 << 20  # bytes: arrays up to this size come from the heap
 TRIM_THRESHOLD = 64 << 20  # bytes: free memory at the heap's top kept for reuse
@@ -48,13 +49,17 @@ def _raise_thresholds() -> bool:
         libc = ctypes.CDLL(None)
     except OSError:
         return False
-    if not hasattr(libc, "gnu_get_libc_version") or not hasattr(libc, "mallopt"):  # not glibc (musl's mallopt does nothing)
+    if not hasattr(libc, "gnu_get_libc_version") or not hasattr(
+        libc, "mallopt"
+    ):  # not glibc (musl's mallopt does nothing)
         return False
     mallopt = libc.mallopt
     mallopt.argtypes = (ctypes.c_int, ctypes.c_int)
     # both: setting either ends glibc's adjusting of both, and one alone is worse than
     # none (the mmap threshold alone: twice the faults, trimming at 128 kB)
-    return bool(mallopt(_M_MMAP_THRESHOLD, MMAP_THRESHOLD)) and bool(mallopt(_M_TRIM_THRESHOLD, TRIM_THRESHOLD))
+    return bool(mallopt(_M_MMAP_THRESHOLD, MMAP_THRESHOLD)) and bool(
+        mallopt(_M_TRIM_THRESHOLD, TRIM_THRESHOLD)
+    )
 
 
 Environ = TypeVar("Environ", bound=MutableMapping[str, str])

@@ -10,8 +10,8 @@ itself, or — for a compensated program — the original it was made from.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass, field
-from typing import Iterable
 
 import numpy as np
 from numpy.typing import NDArray
@@ -52,7 +52,9 @@ def sample_events(events: Iterable[Event], step_mm: float = STEP_MM, file: str =
             if abs(event.sweep()) >= 2 * math.pi - 1e-9:
                 s = event.context.unit_mm
                 centre = np.array(event.context.to_machine(event.center))
-                circles.append((centre, event.radius() * s, event.context.plane, slice(count, count + len(p))))
+                circles.append(
+                    (centre, event.radius() * s, event.context.plane, slice(count, count + len(p)))
+                )
         else:
             continue
         pts.append(p)
@@ -65,7 +67,14 @@ def sample_events(events: Iterable[Event], step_mm: float = STEP_MM, file: str =
     if not pts:
         empty = np.zeros((0, 3))
         return SampledPath(empty, np.zeros(0), np.zeros(0, int), np.zeros(0, bool), [])
-    return SampledPath(np.vstack(pts), np.concatenate(feeds), np.concatenate(lines), np.concatenate(rapids), circles, _tools(tools))
+    return SampledPath(
+        np.vstack(pts),
+        np.concatenate(feeds),
+        np.concatenate(lines),
+        np.concatenate(rapids),
+        circles,
+        _tools(tools),
+    )
 
 
 def _tools(runs: list[tuple[tuple[float, float, float], int]]) -> NDArray | None:
@@ -168,7 +177,9 @@ class ContourReport:
         }
 
 
-def contour_error(machine, commanded: SampledPath, nominal: SampledPath, feed_effects: bool = True) -> ContourReport:
+def contour_error(
+    machine, commanded: SampledPath, nominal: SampledPath, feed_effects: bool = True
+) -> ContourReport:
     """Contour error of the commanded path run on `machine` against the nominal path (feed moves only)."""
     cut = ~commanded.rapid
     cmd = commanded.points[cut]

@@ -36,9 +36,9 @@ from __future__ import annotations
 
 import math
 from collections import deque
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
-from itertools import chain
-from typing import BinaryIO, Callable, Iterable, Iterator
+from typing import BinaryIO
 
 import numpy as np
 from scipy.spatial import cKDTree
@@ -96,7 +96,7 @@ NO_EXTRA = (0.0,) * len(EXTRA_AXES)
 class _Moves:
     """Moves collected for one section, sampled when it closes."""
 
-    bound: "Bound"
+    bound: Bound
     ends: list = field(default_factory=list)  # per move: (x0, y0, z0, x1, y1, z1) program coordinates
     frames: list = field(default_factory=list)  # the contexts the moves were made in, each once in a row
     frame_of: list = field(default_factory=list)  # per move: its context's index in `frames`
@@ -114,7 +114,16 @@ class _Moves:
         """The moves sampled every `step` (each from its start to its end, both included)."""
         if not self.ends:
             empty = np.zeros((0, 4))
-            return Section(empty, empty, np.zeros(0, bool), np.zeros(0, int), self.feeds, self.inverse_time, action, first_line)
+            return Section(
+                empty,
+                empty,
+                np.zeros(0, bool),
+                np.zeros(0, int),
+                self.feeds,
+                self.inverse_time,
+                action,
+                first_line,
+            )
         raw = np.array(self.ends)
         frame = np.array(self.frame_of)
         offsets = np.array([f.offset for f in self.frames])[frame]
@@ -151,7 +160,9 @@ class _Moves:
 class _Arcs:
     """A section's arcs, as arrays: what their samples need to lie on them."""
 
-    def __init__(self, arcs: list, starts: np.ndarray, ends: np.ndarray, offsets: np.ndarray, units: np.ndarray):
+    def __init__(
+        self, arcs: list, starts: np.ndarray, ends: np.ndarray, offsets: np.ndarray, units: np.ndarray
+    ):
         table = np.array([(m, *PLANE_AXES[plane][:2], *centre, turn) for m, plane, centre, turn in arcs])
         self.move = table[:, 0].astype(np.int64)
         i, j = table[:, 1].astype(np.int64), table[:, 2].astype(np.int64)
@@ -196,7 +207,6 @@ def _sweeps(a0: np.ndarray, a1: np.ndarray, turn: np.ndarray) -> np.ndarray:
     return np.where(turn > 0, ccw, cw)
 
 
-
 def actions_of(block: Block) -> tuple[list[str], list[str]]:
     """The actions of a block: (before its motion, after it), each as normalised text."""
     before: list[str] = []
@@ -223,7 +233,7 @@ def actions_of(block: Block) -> tuple[list[str], list[str]]:
 Cut = Callable[[Block, int], int]  # (a block, the chunk's moves so far) -> the input line to cut at (0: none)
 
 
-def sections(events: Iterable[Event], bound: "Bound", cut: Cut = lambda block, moves: 0,
+def sections(events: Iterable[Event], bound: Bound, cut: Cut = lambda block, moves: 0,
              line_of: Callable[[int], int] | None = None) -> Iterator[Section]:  # fmt: skip
     """The motion of a program's events between its actions, in the order it runs; a chunk
     ends before a block where `cut` says.  `line_of` gives the line a block's samples are
@@ -265,10 +275,14 @@ def sections(events: Iterable[Event], bound: "Bound", cut: Cut = lambda block, m
 def _may_act(signature: str | None) -> bool:
     """Whether a block may hold an action or a feed mode: its signature (the letters of a plain
     block's words, G words with their numbers) names one; None (not a plain block) may."""
-    return signature is None or any(c in signature for c in "MTSHDP") or "G4" in signature or "G9" in signature
+    return (
+        signature is None or any(c in signature for c in "MTSHDP") or "G4" in signature or "G9" in signature
+    )
 
 
-def _add(moves: _Moves, event: Line | Arc, extra: tuple[float, ...], inverse_time: bool, line: int) -> tuple[float, ...]:
+def _add(
+    moves: _Moves, event: Line | Arc, extra: tuple[float, ...], inverse_time: bool, line: int
+) -> tuple[float, ...]:
     """Add a move (told by `line`); return the extra axes' positions after it.  (A move's own
     work is a few appends: the numbers are turned to machine mm a section at a time.)"""
     ctx = event.context
@@ -336,14 +350,18 @@ class Bound:
         return max(4 * self.distance, 1.0)
 
 
-def _interpreted(blocks: Iterable[Block], file: str, dialect: str, offsets: WorkOffsets | None) -> Iterator[Event]:
+def _interpreted(
+    blocks: Iterable[Block], file: str, dialect: str, offsets: WorkOffsets | None
+) -> Iterator[Event]:
     """A program's events as ncpp's interpreter reads its blocks, its warnings unsaid."""
     from ncpp.guard import without_guard
     from ncpp.pipeline import dialect_tools
 
     interpret, _ = dialect_tools(dialect)
     blocks = without_guard(blocks)  # (it neither moves nor acts, and reads the control's parameters)
-    return interpret(blocks, file=file, warnings=Warnings(stream=_Discard()), offsets=offsets or AT_MACHINE_ZERO)
+    return interpret(
+        blocks, file=file, warnings=Warnings(stream=_Discard()), offsets=offsets or AT_MACHINE_ZERO
+    )
 
 
 class _Discard:
@@ -414,7 +432,9 @@ class _Held:
 
     def first(self, err: NcppError) -> NcppError:
         """`err`, or the interpreter's fault where that comes first in the program."""
-        if self.error is not None and (err.where.line is None or (self.error.where.line or 0) <= err.where.line):
+        if self.error is not None and (
+            err.where.line is None or (self.error.where.line or 0) <= err.where.line
+        ):
             return self.error
         return err
 
@@ -435,7 +455,9 @@ class _Feed:
         self.lines = iter(lines)
         self.reached = reached
         self.pending: list[str] = []
-        self.tags: deque[tuple[int, int, int]] = deque()  # (last written line of a text, its tag, the line before)
+        self.tags: deque[tuple[int, int, int]] = (
+            deque()
+        )  # (last written line of a text, its tag, the line before)
         self.count = 0  # written lines read so far
         self.recent: deque[tuple[int, str]] = deque(maxlen=64)  # for messages
 
@@ -472,18 +494,28 @@ class _Feed:
 
     def text(self, number: int | None) -> tuple[str, int]:
         """Written line `number` (one of the last read) and its tag."""
-        return next(((t.strip()[:120], self.tag(n, before=True)) for n, t in self.recent if n == number), ("", 0))
+        return next(
+            ((t.strip()[:120], self.tag(n, before=True)) for n, t in self.recent if n == number), ("", 0)
+        )
 
 
 class _Comparison:
     """Sections of the original and the written program compared pairwise, in order."""
 
-    def __init__(self, file: str, bound: Bound, written_text: Callable[[int | None], tuple[str, int]], tagged: bool = False):
+    def __init__(
+        self,
+        file: str,
+        bound: Bound,
+        written_text: Callable[[int | None], tuple[str, int]],
+        tagged: bool = False,
+    ):
         """`written_text(n)`: the written program's line n, and the input line it was written from
         (0: unknown); `tagged`: the written sections' samples are told by those input lines."""
         self.file, self.bound, self.written_text, self.tagged = file, bound, written_text, tagged
         self.before: Section | None = None  # the last original chunk, when it ended at a cut
-        self.owed: tuple[Section, Section] | None = None  # an original chunk not yet checked against the written
+        self.owed: tuple[Section, Section] | None = (
+            None  # an original chunk not yet checked against the written
+        )
         self.feeds: tuple[deque, deque] = (deque(), deque())  # feed rates not yet matched (original, written)
         self.times = [0.0, 0.0]  # inverse-time minutes since the last action (original, written)
         self.count = 0
@@ -497,14 +529,19 @@ class _Comparison:
     def step(self, a: Section, theirs: Iterator[Section]) -> None:
         b = self._next(theirs, a.first_line)
         if b is None:
-            raise NcppError("verification: the written program ends before the original", Location(self.file, a.first_line, 1))
+            raise NcppError(
+                "verification: the written program ends before the original",
+                Location(self.file, a.first_line, 1),
+            )
         self.count += 1
         self._actions(a, b)
         across = _tail(self.before) if self.before is not None else None
         self._follows(b, _joined(a, across), "the written path leaves the original's", written=True)
         if self.owed is not None:
             pa, pb = self.owed
-            self._follows(pa, _joined(pb, _head(b)), "the written path does not follow the original's", written=False)
+            self._follows(
+                pa, _joined(pb, _head(b)), "the written path does not follow the original's", written=False
+            )
             self.owed = None
         if a.cut:
             self.owed = (a, b)
@@ -530,11 +567,16 @@ class _Comparison:
         except NcppError as err:
             number = err.where.line
             text, reached = self.written_text(number)
-            raise NcppError(f"verification: ncpp cannot read back the program it wrote: {err.message}, "
-                            f"at its line {number} {text!r}", Location(self.file, reached or line or 1, 1)) from None
+            raise NcppError(
+                f"verification: ncpp cannot read back the program it wrote: {err.message}, "
+                f"at its line {number} {text!r}",
+                Location(self.file, reached or line or 1, 1),
+            ) from None
 
     def _actions(self, a: Section, b: Section) -> None:
-        if (a.action is None) != (b.action is None) or (a.action is not None and a.action.text != b.action.text):  # type: ignore[union-attr]
+        if (a.action is None) != (b.action is None) or (
+            a.action is not None and a.action.text != b.action.text  # type: ignore[union-attr]
+        ):
             where = a.action.line if a.action is not None else a.first_line
             raise NcppError(f"verification: the written program does {_what(b)} where the original does {_what(a)}",
                             Location(self.file, where, 1))  # fmt: skip
@@ -563,9 +605,15 @@ class _Comparison:
         if gap > within:
             message = f"{message} by more than {within:.4f} mm"
         elif written:
-            message = "the written program makes a " + ("rapid move where the original cuts" if path.rapid[k] else "feed move where the original rapids")
+            message = "the written program makes a " + (
+                "rapid move where the original cuts"
+                if path.rapid[k]
+                else "feed move where the original rapids"
+            )
         else:
-            message = "the written program " + ("feeds where the original rapids" if path.rapid[k] else "rapids where the original cuts")
+            message = "the written program " + (
+                "feeds where the original rapids" if path.rapid[k] else "rapids where the original cuts"
+            )
         raise NcppError(f"verification: {message}", Location(file, line, 1))
 
     def _feeds(self, a: Section, b: Section) -> None:
@@ -590,7 +638,7 @@ class _Comparison:
         if a.cut:
             return
         if len(mine) != len(theirs):
-            rate, line = (mine[-1] if len(mine) > len(theirs) else (None, a.first_line))
+            rate, line = mine[-1] if len(mine) > len(theirs) else (None, a.first_line)
             self._feed_fault(rate, theirs[-1][0] if len(theirs) > len(mine) else None, line)
         mine.clear()
         theirs.clear()
@@ -652,7 +700,10 @@ def _alike(one: Segments, other: Segments) -> tuple[Segments, Segments]:
     """Two sections' segments with the same columns: the extra axes, zero where a side has none,
     before the kind's column."""
     width = max(one[0].shape[1], other[0].shape[1])
-    return (_widened(one[0], width), _widened(one[1], width)), (_widened(other[0], width), _widened(other[1], width))
+    return (_widened(one[0], width), _widened(one[1], width)), (
+        _widened(other[0], width),
+        _widened(other[1], width),
+    )
 
 
 def _widened(points: np.ndarray, width: int) -> np.ndarray:
@@ -720,7 +771,9 @@ class _Nearby:
         cut = _to_lines(vertex, closest[rest].reshape(-1, width), at_end.reshape(-1, width)).reshape(q.shape)
         return (joined & (off + cut <= within)).any(axis=1)
 
-    def first_outside(self, starts: np.ndarray, ends: np.ndarray, within: float) -> tuple[int, np.ndarray] | None:
+    def first_outside(
+        self, starts: np.ndarray, ends: np.ndarray, within: float
+    ) -> tuple[int, np.ndarray] | None:
         """The first segment of starts-ends with a point further than `within` from every segment
         here, and that point; None when all lie within.  A segment both of whose ends lie within
         `within` of one segment here lies within it along its length (the set within a distance
@@ -775,8 +828,10 @@ class _Nearby:
         found = self.tree.query_ball_point(point, allowed + self.reach)
         self.looked_at += len(found)
         if self.looked_at > self.LOOKED_AT:
-            raise NcppError("verification: the path lies over itself too often here to be verified "
-                            "(--no-verify writes the program unverified)")
+            raise NcppError(
+                "verification: the path lies over itself too often here to be verified "
+                "(--no-verify writes the program unverified)"
+            )
         if not found:
             return True
         segments = np.unique(self.segment[found])

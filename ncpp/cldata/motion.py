@@ -25,8 +25,7 @@ items), so a writer can show it as a comment and errors can name its line.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
-from typing import Iterable, Iterator
+from collections.abc import Iterable, Iterator, Sequence
 
 from ncpp.cldata.cycles import Driller, HoleBlock, parse_cycle
 from ncpp.cldata.reader import Record
@@ -76,7 +75,9 @@ class _Circle:
     def __init__(self, record: Record, start: Point):
         values = record.numbers
         if len(values) < 7:
-            raise NcppError(f"CIRCLE needs centre, axis and radius (7 values), got {len(values)}", record.where)
+            raise NcppError(
+                f"CIRCLE needs centre, axis and radius (7 values), got {len(values)}", record.where
+            )
         self.record = record
         self.plane, self.sign = _plane(values[3:6], record)
         self.i, self.j, self.n = PLANE_AXES[self.plane]
@@ -106,7 +107,10 @@ class _Circle:
         if not self.points:
             return True
         last = self.points[-1]
-        flat = abs(p[self.n] - last[self.n]) <= ON_CIRCLE_TOL and abs(last[self.n] - self.start[self.n]) <= ON_CIRCLE_TOL
+        flat = (
+            abs(p[self.n] - last[self.n]) <= ON_CIRCLE_TOL
+            and abs(last[self.n] - self.start[self.n]) <= ON_CIRCLE_TOL
+        )
         return flat and abs(self._in_plane_radius(p) - self.radius) <= ON_CIRCLE_TOL
 
     def add(self, p: Point, record: Record) -> None:
@@ -144,7 +148,9 @@ def feed_rate(rec: Record) -> float:
     """FEDRAT/f: a feed above 0 (a control reads a negative F word otherwise; 0 stops no move)."""
     f = rec.numbers[0]
     if not 0 < f <= MAX_WORD:
-        raise NcppError(f"{rec.major}: expected a feed rate above 0 and at most {MAX_WORD:,.0f}, got {f:g}", rec.where)
+        raise NcppError(
+            f"{rec.major}: expected a feed rate above 0 and at most {MAX_WORD:,.0f}, got {f:g}", rec.where
+        )
     return f
 
 
@@ -152,7 +158,10 @@ def _position(rec: Record, values: Sequence[float]) -> Point:
     """The record's x, y, z: numbers an NC word can hold (GOTO / 1e308 would be 309 digits)."""
     x, y, z = values[:3]
     if not max(abs(x), abs(y), abs(z)) <= MAX_WORD:
-        raise NcppError(f"{rec.major}: a coordinate beyond ±{MAX_WORD:,.0f}, what an NC word holds: {x:g}, {y:g}, {z:g}", rec.where)
+        raise NcppError(
+            f"{rec.major}: a coordinate beyond ±{MAX_WORD:,.0f}, what an NC word holds: {x:g}, {y:g}, {z:g}",
+            rec.where,
+        )
     return (x, y, z)
 
 
@@ -181,7 +190,9 @@ def cutter_side(rec: Record) -> str:
     return "" if sides[0] == "OFF" else sides[0]
 
 
-def motion(records: Iterable[Record], warnings: Warnings | None = None, zero: Point = (0.0, 0.0, 0.0)) -> Iterator[Event]:
+def motion(
+    records: Iterable[Record], warnings: Warnings | None = None, zero: Point = (0.0, 0.0, 0.0)
+) -> Iterator[Event]:
     """Line / Arc / Pass events of a CL record stream; `zero`: the machine position (mm)
     of the CL data's origin, the work offset the control will hold."""
     pos: Point | None = None
@@ -211,7 +222,9 @@ def motion(records: Iterable[Record], warnings: Warnings | None = None, zero: Po
         if major == "GOTO":
             values = rec.numbers
             if len(values) not in (3, 6):
-                raise NcppError(f"GOTO needs 3 coordinates (or 6 with a tool vector), got {len(values)}", rec.where)
+                raise NcppError(
+                    f"GOTO needs 3 coordinates (or 6 with a tool vector), got {len(values)}", rec.where
+                )
             if len(values) == 6 or multax:
                 vector = _unit(values[3:6]) if len(values) == 6 else None
                 if vector is not None:
@@ -285,7 +298,9 @@ def motion(records: Iterable[Record], warnings: Warnings | None = None, zero: Po
             if cycle is not None and pos is None:
                 raise NcppError(f"CYCLE/{cycle.kind} before any position (FROM or GOTO)", rec.where)
             if cycle is not None and fixed == COMP and not leaving:  # RS274/NGC and FANUC refuse it too
-                raise NcppError(f"CYCLE/{cycle.kind} under CUTCOM/LEFT or RIGHT: turn it OFF first", rec.where)
+                raise NcppError(
+                    f"CYCLE/{cycle.kind} under CUTCOM/LEFT or RIGHT: turn it OFF first", rec.where
+                )
             driller = Driller(cycle, pos[2], context.inch) if cycle is not None and pos is not None else None
         elif major == "SPINDL" and rec.numbers:
             rpm = rec.numbers[0]
@@ -298,7 +313,10 @@ def motion(records: Iterable[Record], warnings: Warnings | None = None, zero: Po
         elif major == "TLAXIS" and len(rec.numbers) >= 3:
             vector = _unit(rec.numbers[:3])
             if tool_vector is not None and max(abs(a - b) for a, b in zip(vector, tool_vector)) > VECTOR_TOL:
-                raise NcppError("TLAXIS changes the tool vector: 5-axis motion cannot be posted for a 3-axis machine", rec.where)
+                raise NcppError(
+                    "TLAXIS changes the tool vector: 5-axis motion cannot be posted for a 3-axis machine",
+                    rec.where,
+                )
             _check_along_z(vector, rec)
             tool_vector, vector_line = vector, rec.line
         elif rec.vendor and warnings is not None:

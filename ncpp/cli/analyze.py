@@ -27,7 +27,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         description=__doc__,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    parser.add_argument("files", nargs="+", metavar="FILE", help="measurement files (laser, comparator, level, ballbar, grid, cutting)")
+    parser.add_argument(
+        "files",
+        nargs="+",
+        metavar="FILE",
+        help="measurement files (laser, comparator, level, ballbar, grid, cutting)",
+    )
     parser.add_argument("--json", metavar="OUT", help="write the figures as JSON")
     parser.add_argument("--plot", metavar="OUT.png", help="draw the standard plots into a PNG")
     parser.add_argument(
@@ -55,8 +60,12 @@ def run(args: argparse.Namespace) -> int:
     print("\n\n".join(format_report(a) for a in analyses))
     if args.json:
         records = [
-            {"file": portable_name(a.measurement.source, args.json), "instrument": a.measurement.instrument,
-             "standard": a.standard, **a.figures}  # fmt: skip
+            {
+                "file": portable_name(a.measurement.source, args.json),
+                "instrument": a.measurement.instrument,
+                "standard": a.standard,
+                **a.figures,
+            }  # fmt: skip
             for a in analyses
         ]
         payload = records[0] if len(records) == 1 else records

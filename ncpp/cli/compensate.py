@@ -14,11 +14,12 @@ import argparse
 import multiprocessing
 import os
 import sys
+from collections.abc import Callable
 from concurrent.futures import Executor, Future, ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass
 from pathlib import Path
-from typing import BinaryIO, Callable
+from typing import BinaryIO
 
 from ncpp.cli.io import add_io_arguments, open_input, open_output
 from ncpp.cli.options import at_least, positive
@@ -41,8 +42,16 @@ def register(sub: argparse._SubParsersAction) -> None:
 def add_compensation_arguments(p: argparse.ArgumentParser) -> None:
     source = p.add_mutually_exclusive_group()
     source.add_argument("--machine", metavar="M.toml", help="machine file with the error model")
-    source.add_argument("--from", dest="from_file", metavar="FILE", help="compensate from one measurement file")
-    p.add_argument("--tolerance", type=tolerance_mm, default=0.001, metavar="MM", help="allowed path deviation, mm (default 0.001)")
+    source.add_argument(
+        "--from", dest="from_file", metavar="FILE", help="compensate from one measurement file"
+    )
+    p.add_argument(
+        "--tolerance",
+        type=tolerance_mm,
+        default=0.001,
+        metavar="MM",
+        help="allowed path deviation, mm (default 0.001)",
+    )
     p.add_argument("--force", action="store_true", help="compensate a program ncpp has compensated before")
     p.add_argument(
         "--no-verify",
@@ -98,7 +107,10 @@ def add_placement_arguments(p: argparse.ArgumentParser) -> None:
         "which move the axes and lengthen the Abbe arm; without it they apply length 0, with a warning",
     )
     p.add_argument(
-        "--var-units", choices=("mm", "inch"), default="mm", help="units of --var-file and of a LinuxCNC --tool-table: the INI's [TRAJ]LINEAR_UNITS (default mm; TOOL.T says its own)"
+        "--var-units",
+        choices=("mm", "inch"),
+        default="mm",
+        help="units of --var-file and of a LinuxCNC --tool-table: the INI's [TRAJ]LINEAR_UNITS (default mm; TOOL.T says its own)",
     )
     p.add_argument(
         "--subroutine-path",
@@ -131,7 +143,9 @@ def work_offsets(args: argparse.Namespace):
     """The control's zeros and tool table from --var-file, --work-offset and --tool-table."""
     from ncpp.motion.offsets import UNIT_MM, WorkOffsets
 
-    return WorkOffsets.given(dict(args.work_offset), args.var_file, UNIT_MM[args.var_units], args.tool_table, args.subroutine_path)
+    return WorkOffsets.given(
+        dict(args.work_offset), args.var_file, UNIT_MM[args.var_units], args.tool_table, args.subroutine_path
+    )
 
 
 def error_source(args: argparse.Namespace):
@@ -157,7 +171,9 @@ def run(args: argparse.Namespace) -> int:
     folder = args.output is not None and os.path.isdir(args.output)
     if len(args.input) > 1 or folder:
         if args.output is None:
-            raise NcppError("several programs need -o FOLDER, the folder each is written to under its own name")
+            raise NcppError(
+                "several programs need -o FOLDER, the folder each is written to under its own name"
+            )
         return compensate_files(job, args.input, Path(args.output), args.jobs, args.report)
     return _compensate_one(job, args.input[0] if args.input else None, args.output, args.report)
 

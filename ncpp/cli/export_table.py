@@ -31,11 +31,15 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument("--machine", required=True, metavar="M.toml", help="machine file")
-    parser.add_argument("--axis", required=True, choices=("X", "Y", "Z", "x", "y", "z"), help="axis to tabulate")
+    parser.add_argument(
+        "--axis", required=True, choices=("X", "Y", "Z", "x", "y", "z"), help="axis to tabulate"
+    )
     parser.add_argument("--format", required=True, choices=("linuxcnc", "fanuc", "sinumerik", "heidenhain"))
     parser.add_argument("-o", "--output", metavar="FILE", help="output file (default: stdout)")
     parser.add_argument("--spacing", type=positive, metavar="MM", help="distance between table points")
-    parser.add_argument("--type", type=int, choices=(0, 1), default=0, help="LinuxCNC COMP_FILE_TYPE (default 0)")
+    parser.add_argument(
+        "--type", type=int, choices=(0, 1), default=0, help="LinuxCNC COMP_FILE_TYPE (default 0)"
+    )
     parser.add_argument(
         "--reference", type=finite, metavar="MM",
         help="reference position: FANUC's zero-correction point (default 0); SINUMERIK shifts its table to 0 there",
@@ -52,7 +56,12 @@ def run(args: argparse.Namespace) -> int:
     machine = load_machine(args.machine)
     try:
         text, notes = export_table(
-            machine, args.axis.upper(), args.format, spacing=args.spacing, comp_type=args.type, reference=args.reference
+            machine,
+            args.axis.upper(),
+            args.format,
+            spacing=args.spacing,
+            comp_type=args.type,
+            reference=args.reference,
         )
     except NcppError as err:  # what the machine file lacks or holds: name it (not <stdin>)
         if err.where != Location():

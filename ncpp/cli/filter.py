@@ -28,7 +28,10 @@ from ncpp.errors import Location, NcppError, Warnings
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("filter", help="read an NC program and write it back, compensated when a machine file is configured (the default command)")
+    p = sub.add_parser(
+        "filter",
+        help="read an NC program and write it back, compensated when a machine file is configured (the default command)",
+    )
     add_io_arguments(p)
     add_compensation_arguments(p)
     p.set_defaults(func=run, tolerance=None)  # None: the config file's, else 0.001
@@ -65,8 +68,12 @@ def configured_source(args: argparse.Namespace):
     command line, $NCPP_MACHINE and the config file."""
     from ncpp.integrations.config import find_settings
 
-    var_units = args.var_units if args.var_file or args.tool_table else None  # the config's when the files are the config's
-    settings = find_settings(args.machine, args.tolerance, dict(args.work_offset), args.var_file, var_units, args.tool_table)
+    var_units = (
+        args.var_units if args.var_file or args.tool_table else None
+    )  # the config's when the files are the config's
+    settings = find_settings(
+        args.machine, args.tolerance, dict(args.work_offset), args.var_file, var_units, args.tool_table
+    )
     settings = replace(settings, subroutine_path=tuple(args.subroutine_path))
     if not (args.from_file or settings.machine):
         return None, settings.tolerance, None, None

@@ -45,15 +45,31 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         description=__doc__,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    parser.add_argument("files", nargs="+", metavar="FILE", help="laser, comparator, level and ball-bar files")
+    parser.add_argument(
+        "files", nargs="+", metavar="FILE", help="laser, comparator, level and ball-bar files"
+    )
     parser.add_argument("-o", "--output", required=True, metavar="M.toml")
-    parser.add_argument("--chain", help="kinematic chain, workpiece to tool (e.g. XZFY; default XYFZ or the base's)")
-    parser.add_argument("--base", metavar="M0.toml", help="machine file whose structure and other errors are kept")
+    parser.add_argument(
+        "--chain", help="kinematic chain, workpiece to tool (e.g. XZFY; default XYFZ or the base's)"
+    )
+    parser.add_argument(
+        "--base", metavar="M0.toml", help="machine file whose structure and other errors are kept"
+    )
     parser.add_argument("--name", help="machine name")
     parser.add_argument("--interpolation", default="smooth", choices=("smooth", "linear"))
-    parser.add_argument("--reversal-threshold", type=non_negative, default=0.5, metavar="UM", help="per-direction tables above this reversal (default 0.5 µm)")
-    parser.add_argument("--knots", type=at_least(2), default=9, help="ball bar: values per fitted table (default 9)")
-    parser.add_argument("--smoothing", type=positive, metavar="LAMBDA", help="ball bar: penalty weight (default: by GCV)")
+    parser.add_argument(
+        "--reversal-threshold",
+        type=non_negative,
+        default=0.5,
+        metavar="UM",
+        help="per-direction tables above this reversal (default 0.5 µm)",
+    )
+    parser.add_argument(
+        "--knots", type=at_least(2), default=9, help="ball bar: values per fitted table (default 9)"
+    )
+    parser.add_argument(
+        "--smoothing", type=positive, metavar="LAMBDA", help="ball bar: penalty weight (default: by GCV)"
+    )
     parser.set_defaults(func=run)
 
 
@@ -76,7 +92,9 @@ def run(args: argparse.Namespace) -> int:
         raise NcppError(str(err), Location("ncpp fit")) from None
     save_machine(machine, args.output)
     residuals = fit_residuals(machine, measurements)
-    print(f"{args.output}: {machine.name}, chain {machine.chain}, {len(machine.meta.get('fitted', {}))} component(s) fitted")
+    print(
+        f"{args.output}: {machine.name}, chain {machine.chain}, {len(machine.meta.get('fitted', {}))} component(s) fitted"
+    )
     for name, source in machine.meta.get("fitted", {}).items():
         if name not in residuals:
             continue

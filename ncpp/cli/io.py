@@ -12,8 +12,9 @@ import contextlib
 import shutil
 import sys
 import tempfile
+from collections.abc import Iterator
 from pathlib import Path
-from typing import BinaryIO, Iterator
+from typing import BinaryIO
 
 from ncpp.fileio import atomic_output
 
@@ -25,18 +26,26 @@ def add_io_arguments(p: argparse.ArgumentParser, several: bool = False) -> None:
     -o may name the folder the programs are written to."""
     if several:
         p.add_argument("input", nargs="*", metavar="IN", help="NC programs (default: standard input)")
-        output = ("output file, written atomically (default: standard output); with several programs, "
-                  "or a folder, the folder each goes to under its own name")
+        output = (
+            "output file, written atomically (default: standard output); with several programs, "
+            "or a folder, the folder each goes to under its own name"
+        )
     else:
         p.add_argument("input", nargs="?", help="NC program (default: standard input)")
         output = "output file, written atomically (default: standard output)"
     p.add_argument("-o", "--output", help=output)
-    p.add_argument("--strict", action="store_true", help="refuse constructs that would pass through with a warning")
+    p.add_argument(
+        "--strict", action="store_true", help="refuse constructs that would pass through with a warning"
+    )
     add_dialect_argument(p)
 
 
 def add_dialect_argument(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--dialect", default=None, help="NC dialect: iso, heidenhain or sinumerik (default: detected from the content)")
+    p.add_argument(
+        "--dialect",
+        default=None,
+        help="NC dialect: iso, heidenhain or sinumerik (default: detected from the content)",
+    )
 
 
 @contextlib.contextmanager

@@ -34,13 +34,12 @@ radius from it.  A warning names the line where each such series starts
 from __future__ import annotations
 
 import argparse
-from typing import Iterable, Iterator
-
-from ncpp.errors import Location, Warnings
-from ncpp.motion.segments import COMP, Arc, Event, Line
+from collections.abc import Iterable, Iterator
 
 from ncpp.cli.compensate import add_placement_arguments, work_offsets
 from ncpp.cli.io import add_dialect_argument
+from ncpp.errors import Location, Warnings
+from ncpp.motion.segments import COMP, Arc, Event, Line
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -52,7 +51,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("input", nargs="?", metavar="FILE", help="NC program (default: standard input)")
     parser.add_argument("--format", choices=("rs274", "json"), default="rs274")
-    parser.add_argument("--strict", action="store_true", help="refuse constructs outside the interpreter's scope")
+    parser.add_argument(
+        "--strict", action="store_true", help="refuse constructs outside the interpreter's scope"
+    )
     add_dialect_argument(parser)
     add_placement_arguments(parser)
     parser.set_defaults(func=run)
@@ -69,14 +70,23 @@ def run(args: argparse.Namespace) -> int:
     from ncpp.program.dialects import parse_program
 
     warnings = Warnings(strict=args.strict)
-    offsets = work_offsets(args) if args.work_offset or args.var_file or args.tool_table or args.subroutine_path else None
+    offsets = (
+        work_offsets(args)
+        if args.work_offset or args.var_file or args.tool_table or args.subroutine_path
+        else None
+    )
     out = sys.stdout
     with open_input(args.input) as (stream, name):
         dialect, blocks = parse_program(stream, name, args.dialect)
         interpret, _ = dialect_tools(dialect)
         blocks = without_guard(blocks)  # (a compensated program's)
         events = interpret(blocks, file=name, warnings=warnings, offsets=offsets)
-        for event in warn_off_path(events, warnings, name, "printed as programmed (rs274 prints the tool centre, offset by the radius)"):
+        for event in warn_off_path(
+            events,
+            warnings,
+            name,
+            "printed as programmed (rs274 prints the tool centre, offset by the radius)",
+        ):
             if type(event) is not Line and type(event) is not Arc:
                 continue
             if args.format == "rs274":
@@ -98,14 +108,18 @@ def run(args: argparse.Namespace) -> int:
                 record["turn"] = event.turn
             if event.extra:
                 record["extra"] = event.extra
-            if event.fixed:  # why compensation leaves it as programmed (a canned cycle, cutter compensation, ...)
+            if (
+                event.fixed
+            ):  # why compensation leaves it as programmed (a canned cycle, cutter compensation, ...)
                 record["fixed"] = event.fixed
             out.write(json.dumps(record) + "\n")
     warnings.finish()
     return 0
 
 
-def warn_off_path(events: Iterable[Event], warnings: Warnings, file: str, consequence: str) -> Iterator[Event]:
+def warn_off_path(
+    events: Iterable[Event], warnings: Warnings, file: str, consequence: str
+) -> Iterator[Event]:
     """Pass events through; warn where a series of moves under cutter compensation starts
     (`COMP`: the tool centre is off the programmed contour), saying `consequence`."""
     off = False

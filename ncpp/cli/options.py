@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import argparse
 import math
-from typing import Callable
+from collections.abc import Callable
 
 
 def finite(text: str) -> float:
@@ -45,7 +45,9 @@ def between(low: float, high: float, ends: str = "[]") -> Callable[[str], float]
         above = low < value if ends[0] == "(" else low <= value
         below = value < high if ends[1] == ")" else value <= high
         if not (above and below):
-            raise argparse.ArgumentTypeError(f"expected a number in {ends[0]}{low:g}, {high:g}{ends[1]}, got {text!r}")
+            raise argparse.ArgumentTypeError(
+                f"expected a number in {ends[0]}{low:g}, {high:g}{ends[1]}, got {text!r}"
+            )
         return value
 
     return parse

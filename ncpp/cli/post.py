@@ -13,8 +13,13 @@ from ncpp.cli.compensate import add_compensation_arguments, error_source, tell, 
 from ncpp.cli.io import open_output
 from ncpp.errors import Warnings
 
-
-DIALECTS = ("iso", "linuxcnc", "fanuc", "heidenhain", "sinumerik")  # = ncpp.post.GENERATORS, without importing it
+DIALECTS = (
+    "iso",
+    "linuxcnc",
+    "fanuc",
+    "heidenhain",
+    "sinumerik",
+)  # = ncpp.post.GENERATORS, without importing it
 
 
 def register(sub: argparse._SubParsersAction) -> None:

@@ -45,7 +45,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     source = parser.add_mutually_exclusive_group(required=True)
     source.add_argument("--machine", metavar="M.toml", help="machine file")
-    source.add_argument("--from", dest="sources", nargs="+", metavar="FILE", help="laser / comparator / level / ball-bar files to fit first (ncpp fit)")
+    source.add_argument(
+        "--from",
+        dest="sources",
+        nargs="+",
+        metavar="FILE",
+        help="laser / comparator / level / ball-bar files to fit first (ncpp fit)",
+    )
     parser.add_argument("--chain", help="chain for --from when there is no --base (default XYFZ)")
     parser.add_argument("--base", metavar="M0.toml", help="machine whose structure --from keeps")
     parser.add_argument("--save-machine", metavar="M.toml", help="with --from: also write the fitted machine")
@@ -57,25 +63,62 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     g.add_argument("--radius", type=radius_mm, help="mm (default ballbar 150, grid 100, cutting 50)")
     g.add_argument("--center", metavar="X,Y,Z", help="centre, command mm (default: middle of the travel)")
     g.add_argument("--feed", type=positive, help="mm/min (default 1000; cutting 500)")
-    g.add_argument("--direction", type=str.upper, choices=("CW", "CCW", "BOTH"), help="circular tests (ballbar default BOTH)")
+    g.add_argument(
+        "--direction",
+        type=str.upper,
+        choices=("CW", "CCW", "BOTH"),
+        help="circular tests (ballbar default BOTH)",
+    )
     g.add_argument("--start", type=finite, default=0.0, metavar="DEG", help="start angle of the data arc")
-    g.add_argument("--overshoot", type=between(0.0, 360.0), default=45.0, metavar="DEG", help="feed-in/feed-out arc, 0 to 360 (default 45)")
-    g.add_argument("--step", type=positive, metavar="STEP", help="deg between circle points, at most 120 (ballbar 1, grid 2, cutting probes 2); mm for a square")
+    g.add_argument(
+        "--overshoot",
+        type=between(0.0, 360.0),
+        default=45.0,
+        metavar="DEG",
+        help="feed-in/feed-out arc, 0 to 360 (default 45)",
+    )
+    g.add_argument(
+        "--step",
+        type=positive,
+        metavar="STEP",
+        help="deg between circle points, at most 120 (ballbar 1, grid 2, cutting probes 2); mm for a square",
+    )
     g.add_argument("--path", default="circle", choices=("circle", "square"), help="grid encoder path")
     g.add_argument("--axis", type=str.upper, default="X", choices=("X", "Y", "Z"))
-    g.add_argument("--quantity", default=None, help="laser: position|straightness_x|_y|_z|pitch|yaw|roll; level: roll|pitch")
+    g.add_argument(
+        "--quantity",
+        default=None,
+        help="laser: position|straightness_x|_y|_z|pitch|yaw|roll; level: roll|pitch",
+    )
     g.add_argument("--component", help="laser angles: the ISO component the optics read (e.g. EBX)")
-    g.add_argument("--transverse", type=str.upper, choices=("X", "Y", "Z"), help="comparator transverse direction")
+    g.add_argument(
+        "--transverse", type=str.upper, choices=("X", "Y", "Z"), help="comparator transverse direction"
+    )
     g.add_argument("--member", help="level: member it sits on (axis letter, work, tool)")
-    g.add_argument("--offset", default="0,0,0", metavar="x,y,z", help="functional point from the tool point, mm")
-    g.add_argument("--fixed", default="", metavar='"Y=0 Z=0"', help="positions of the axes held still (default: middle of travel or 0)")
-    g.add_argument("--targets", metavar="A:B:STEP | a,b,c", help="laser/comparator targets, level positions (default: the travel in 20 steps)")
+    g.add_argument(
+        "--offset", default="0,0,0", metavar="x,y,z", help="functional point from the tool point, mm"
+    )
+    g.add_argument(
+        "--fixed",
+        default="",
+        metavar='"Y=0 Z=0"',
+        help="positions of the axes held still (default: middle of travel or 0)",
+    )
+    g.add_argument(
+        "--targets",
+        metavar="A:B:STEP | a,b,c",
+        help="laser/comparator targets, level positions (default: the travel in 20 steps)",
+    )
     g.add_argument("--runs", type=at_least(1), default=5, help="laser/comparator runs (default 5)")
     g.add_argument("--unidirectional", action="store_true", help="laser/comparator: + approach only")
-    g.add_argument("--noise", type=non_negative, default=0.0, help="standard deviation of added noise (file unit)")
+    g.add_argument(
+        "--noise", type=non_negative, default=0.0, help="standard deviation of added noise (file unit)"
+    )
     g.add_argument("--seed", type=int, default=None)
     g.add_argument("--no-effects", action="store_true", help="leave out the non-geometric effects")
-    g.add_argument("--no-zero", action="store_true", help="laser/comparator: absolute readings, not zeroed at the first")
+    g.add_argument(
+        "--no-zero", action="store_true", help="laser/comparator: absolute readings, not zeroed at the first"
+    )
     parser.set_defaults(func=run)
 
 
@@ -116,7 +159,9 @@ def parse_targets(text: str):
     try:
         if ":" in text:
             a, b, step = (float(v) for v in text.split(":"))
-            if not (abs(a) <= LARGEST_LENGTH_MM and abs(b) <= LARGEST_LENGTH_MM and 0 < step < math.inf and a <= b):
+            if not (
+                abs(a) <= LARGEST_LENGTH_MM and abs(b) <= LARGEST_LENGTH_MM and 0 < step < math.inf and a <= b
+            ):
                 raise ValueError
             count = math.floor((b - a) / step + 1e-9) + 1
             if count > MAX_READINGS:  # before the array is made
@@ -127,7 +172,10 @@ def parse_targets(text: str):
             if not np.all(np.abs(targets) <= LARGEST_LENGTH_MM):
                 raise ValueError
     except ValueError:
-        raise NcppError(f"--targets: expected A:B:STEP (A <= B, STEP > 0) or a,b,c, within ±{LARGEST_LENGTH_MM:g} mm, got {text!r}", where) from None
+        raise NcppError(
+            f"--targets: expected A:B:STEP (A <= B, STEP > 0) or a,b,c, within ±{LARGEST_LENGTH_MM:g} mm, got {text!r}",
+            where,
+        ) from None
     if np.any(np.diff(np.unique(targets)) < 1e-3):  # ISO 230-2 matches targets to 1 µm
         raise NcppError(f"--targets {text}: targets closer than 1 µm are one target", where)
     return targets
@@ -147,7 +195,9 @@ def setup_from_args(args: argparse.Namespace, machine) -> dict[str, object]:
 
     inst = args.instrument
     offset = _vector(args.offset, "--offset")
-    centre = _vector(args.center, "--center") if args.center else np.array([_middle(machine, a) for a in "XYZ"])
+    centre = (
+        _vector(args.center, "--center") if args.center else np.array([_middle(machine, a) for a in "XYZ"])
+    )
     try:
         fixed = parse_fixed(args.fixed)
     except ValueError as err:
@@ -161,10 +211,20 @@ def setup_from_args(args: argparse.Namespace, machine) -> dict[str, object]:
         else:
             lo, hi = machine.limits[axis]
             if not (math.isfinite(lo) and math.isfinite(hi)):
-                raise NcppError(f"--targets is needed: the machine file gives no travel for {axis}", Location("ncpp predict"))
+                raise NcppError(
+                    f"--targets is needed: the machine file gives no travel for {axis}",
+                    Location("ncpp predict"),
+                )
             targets = np.linspace(lo, hi, 21)
         if inst == "level":
-            return {"axis": axis, "positions": targets, "quantity": args.quantity or "roll", "member": args.member, "fixed": fixed, **noise}
+            return {
+                "axis": axis,
+                "positions": targets,
+                "quantity": args.quantity or "roll",
+                "member": args.member,
+                "fixed": fixed,
+                **noise,
+            }
         cycle = {
             "axis": axis, "targets": targets, "fixed": fixed, "offset_mm": offset, "runs": args.runs,
             "bidirectional": not args.unidirectional, "feed_mm_min": args.feed or 1000.0,
@@ -174,7 +234,13 @@ def setup_from_args(args: argparse.Namespace, machine) -> dict[str, object]:
             return {**cycle, "quantity": args.quantity or "position", "component": args.component}
         return {**cycle, "transverse": args.transverse}
     directions = {"BOTH": ("CCW", "CW"), "CW": ("CW",), "CCW": ("CCW",)}
-    common = {"plane": args.plane, "center_mm": centre, "offset_mm": offset, "effects": not args.no_effects, **noise}
+    common = {
+        "plane": args.plane,
+        "center_mm": centre,
+        "offset_mm": offset,
+        "effects": not args.no_effects,
+        **noise,
+    }
     if inst == "ballbar":
         return {
             **common, "radius_mm": args.radius or 150.0, "feed_mm_min": args.feed or 1000.0,
@@ -182,7 +248,9 @@ def setup_from_args(args: argparse.Namespace, machine) -> dict[str, object]:
             "overshoot_deg": args.overshoot, "step_deg": _circle_step(args, 1.0),
         }  # fmt: skip
     if inst == "grid":
-        step = {"step_mm": args.step or 5.0} if args.path == "square" else {"step_deg": _circle_step(args, 2.0)}
+        step = (
+            {"step_mm": args.step or 5.0} if args.path == "square" else {"step_deg": _circle_step(args, 2.0)}
+        )
         return {
             **common, "path": args.path, "radius_mm": args.radius or 100.0, "feed_mm_min": args.feed or 1000.0,
             "directions": directions[args.direction or "CCW"], "start_deg": args.start, "overshoot_deg": args.overshoot, **step,

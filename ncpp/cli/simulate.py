@@ -16,7 +16,6 @@ from ncpp.cli.io import add_dialect_argument
 from ncpp.cli.options import between
 from ncpp.errors import Location, NcppError, Warnings
 
-
 # Contour errors are microns: finer sampling shows nothing more, and costs memory by the path's length.
 MIN_STEP_MM = 0.001
 
@@ -26,11 +25,15 @@ def step_mm(text: str) -> float:
     try:
         return between(MIN_STEP_MM, math.inf, "[)")(text)
     except argparse.ArgumentTypeError:
-        raise argparse.ArgumentTypeError(f"expected a number of mm from {MIN_STEP_MM} on, got {text!r}") from None
+        raise argparse.ArgumentTypeError(
+            f"expected a number of mm from {MIN_STEP_MM} on, got {text!r}"
+        ) from None
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("simulate", help="run a program on the modelled machine: contour error, ball-bar trace")
+    p = sub.add_parser(
+        "simulate", help="run a program on the modelled machine: contour error, ball-bar trace"
+    )
     p.add_argument("program", help="NC program to run")
     p.add_argument(
         "--machine",
@@ -41,7 +44,13 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--reference", metavar="ORIGINAL", help="nominal program (for a compensated PROGRAM)")
     add_placement_arguments(p)
     add_dialect_argument(p)
-    p.add_argument("--step", type=step_mm, default=0.5, metavar="MM", help=f"sample spacing along the path (default 0.5, at least {MIN_STEP_MM})")
+    p.add_argument(
+        "--step",
+        type=step_mm,
+        default=0.5,
+        metavar="MM",
+        help=f"sample spacing along the path (default 0.5, at least {MIN_STEP_MM})",
+    )
     p.add_argument("--json", metavar="OUT", help="write the figures as JSON")
     p.add_argument("--plot", metavar="OUT.png", help="plot the contour error (and circle traces)")
     p.set_defaults(func=run)
@@ -71,15 +80,28 @@ def run(args: argparse.Namespace) -> int:
     offsets = work_offsets(args)
     events = program_events(args.program, warnings, offsets, args.dialect)
     commanded = sample_events(events, args.step, args.program)
-    nominal = sample_events(program_events(args.reference, warnings, offsets, args.dialect), args.step, args.reference) if args.reference else commanded
+    nominal = (
+        sample_events(
+            program_events(args.reference, warnings, offsets, args.dialect), args.step, args.reference
+        )
+        if args.reference
+        else commanded
+    )
     warnings.finish()
     if len(commanded.points) == 0:
-        raise NcppError("the program makes no motion the interpreter could follow (a file of subroutines only runs where a program calls it)", Location(args.program))
+        raise NcppError(
+            "the program makes no motion the interpreter could follow (a file of subroutines only runs where a program calls it)",
+            Location(args.program),
+        )
     check_travel(commanded, machine.limits, args.program, events)
     report = contour_error(machine, commanded, nominal)
-    print(f"contour error: max {report.max_um:.2f} µm (line {report.worst_line}), rms {report.rms_um:.2f} µm over {report.samples} samples")
+    print(
+        f"contour error: max {report.max_um:.2f} µm (line {report.worst_line}), rms {report.rms_um:.2f} µm over {report.samples} samples"
+    )
     for c in report.circles:
-        print(f"circle R{c['radius_mm']:g} in {c['plane']} at {c['centre_mm']}: circularity {c['circularity_um']:.2f} µm")
+        print(
+            f"circle R{c['radius_mm']:g} in {c['plane']} at {c['centre_mm']}: circularity {c['circularity_um']:.2f} µm"
+        )
     if args.json:
         write_text_atomic(args.json, json.dumps(report.as_dict(), indent=2) + "\n")
     if args.plot:

@@ -11,9 +11,10 @@ the play), so its basis is re-evaluated at the current estimate (`relinearise`).
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from functools import partial
-from typing import Any, Callable, Sequence
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -68,7 +69,7 @@ class Candidate:
         scale = size / coef[0] if coef[0] != 0 else 1.0
         return {self.unit: size}, {self.unit: float(abs(scale) * np.sqrt(max(cov[0, 0], 0.0)))}
 
-    def relinearise(self, coef: NDArray) -> "Candidate":
+    def relinearise(self, coef: NDArray) -> Candidate:
         """The same candidate with its basis at the current estimate (backlash)."""
         if not self.nonlinear:
             return self

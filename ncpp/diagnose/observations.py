@@ -26,11 +26,11 @@ from numpy.typing import NDArray
 
 from ncpp.errors import NcppError
 from ncpp.instruments.files import PLANES, Measurement
+from ncpp.instruments.forward import iso230_2_cycle
+from ncpp.instruments.iso230_4 import circular_test
 from ncpp.machine.components import AXES
 from ncpp.machine.effects import Angular, Effect
 from ncpp.machine.model import Machine
-from ncpp.instruments.forward import iso230_2_cycle
-from ncpp.instruments.iso230_4 import circular_test
 from ncpp.machine.trajectory import Trajectory
 
 BALLBAR_STEP_DEG = 0.25  # simulation step; the file's angles are interpolated from it
@@ -102,9 +102,7 @@ def readings_of(m: Measurement) -> NDArray:
 def observe(machine: Machine, m: Measurement, name: str = "") -> Observation:
     """The diagnosis view of one file (NcppError for files it cannot use)."""
     if m.instrument not in USED:
-        raise NcppError(
-            f"diagnose uses ballbar, laser and comparator files, not {m.instrument}", m.at()
-        )
+        raise NcppError(f"diagnose uses ballbar, laser and comparator files, not {m.instrument}", m.at())
     fp = machine.replace(tool=np.add(machine.tool, m.offset_mm))
     name = name or m.source
     if m.instrument == "ballbar":
@@ -159,7 +157,11 @@ def _component_index(m: Measurement) -> tuple[list[int], bool, str | None]:
     axis = m.axis or "X"
     if m.instrument == "comparator":
         transverse = (m.text("transverse") or {"X": "Y", "Y": "X", "Z": "X"}[axis]).upper()
-        return [AXES.index(axis), AXES.index(transverse)][: 2 if "transverse_um" in m.columns else 1], False, None
+        return (
+            [AXES.index(axis), AXES.index(transverse)][: 2 if "transverse_um" in m.columns else 1],
+            False,
+            None,
+        )
     q = m.quantity
     if q == "position":
         return [AXES.index(axis)], False, None
@@ -177,8 +179,12 @@ def _positioning(machine: Machine, m: Measurement, name: str) -> Observation:
     targets = np.unique(np.asarray(m["target_mm"], dtype=float))
     runs = int(np.max(m["run"]))
     both = set(m["direction"]) == {"+", "-"}
-    traj, at, labels = iso230_2_cycle(axis, targets, runs, both, m.fixed, m.feed_mm_min or 1000.0, OVERTRAVEL_MM)
-    key = {(round(float(t), 6), int(r), d): i for i, (t, r, d) in enumerate(labels)}  # float(t): numpy's round may differ
+    traj, at, labels = iso230_2_cycle(
+        axis, targets, runs, both, m.fixed, m.feed_mm_min or 1000.0, OVERTRAVEL_MM
+    )
+    key = {
+        (round(float(t), 6), int(r), d): i for i, (t, r, d) in enumerate(labels)
+    }  # float(t): numpy's round may differ
     sample = np.array([
         at[key[(round(float(t), 6), int(r), str(d))]] for t, r, d in zip(m["target_mm"], m["run"], m["direction"])
     ])  # fmt: skip

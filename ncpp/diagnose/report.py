@@ -10,19 +10,23 @@ from ncpp.diagnose.workflow import Diagnosis
 
 
 def _params(values: dict[str, float], unc: dict[str, float]) -> str:
-    return ", ".join(
-        f"{v:.3g} ± {unc[k]:.2g} {k}" if k in unc else f"{v:.4g} {k}" for k, v in values.items()
-    )
+    return ", ".join(f"{v:.3g} ± {unc[k]:.2g} {k}" if k in unc else f"{v:.4g} {k}" for k, v in values.items())
 
 
 def account(d: Diagnosis) -> str:
     """What was compared, where the gap sits, each step, the gap table."""
-    lines = [f"model: {d.base.name} ({len(d.base.effects)} effect(s) before diagnosis)", "", "where the gap sits (µm):"]
+    lines = [
+        f"model: {d.base.name} ({len(d.base.effects)} effect(s) before diagnosis)",
+        "",
+        "where the gap sits (µm):",
+    ]
     lines += [f"  {w}" for w in d.where]
     noise = np.sqrt(np.mean(np.square(d.noise)))
     lines += ["", f"noise (high-frequency part / repeat runs): {noise:.2f} µm rms", ""]
     if not d.steps:
-        lines.append("no candidate effect is significant: the model explains the measurements within their noise")
+        lines.append(
+            "no candidate effect is significant: the model explains the measurements within their noise"
+        )
     for i, s in enumerate(d.steps, 1):
         keys = " ".join(s.candidate.keys.values())
         variant = f" [{s.candidate.variant}]" if s.candidate.variant else ""
@@ -35,7 +39,11 @@ def account(d: Diagnosis) -> str:
             lines.append(f"    to tell them apart, measure {tests}")
     if d.not_observable:
         lines += ["", "not observable with these measurements: " + ", ".join(d.not_observable)]
-    lines += ["", "gap, re-simulated (set-up offsets removed):", f"  {'model':<40} {'rms µm':>8} {'max µm':>8}"]
+    lines += [
+        "",
+        "gap, re-simulated (set-up offsets removed):",
+        f"  {'model':<40} {'rms µm':>8} {'max µm':>8}",
+    ]
     lines.append(f"  {'as given':<40} {d.gap_before.rms_um:8.2f} {d.gap_before.max_um:8.2f}")
     for s in d.steps:
         label = "+ " + s.candidate.kind + " " + " ".join(s.candidate.keys.values())

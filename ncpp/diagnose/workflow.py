@@ -27,8 +27,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Sequence
 
 import numpy as np
 from numpy.typing import NDArray
@@ -179,7 +179,12 @@ def _gap(machine: Machine, obs: list[Observation]) -> Gap:
 def _extent(obs: list[Observation]) -> dict[str, tuple[float, float]]:
     out: dict[str, tuple[float, float]] = {}
     for i, a in enumerate(AXES):
-        vals = [p.trajectory.positions[:, i] for o in obs for p in o.parts if np.ptp(p.trajectory.positions[:, i]) > 0]
+        vals = [
+            p.trajectory.positions[:, i]
+            for o in obs
+            for p in o.parts
+            if np.ptp(p.trajectory.positions[:, i]) > 0
+        ]
         if vals:
             v = np.concatenate(vals)
             lo, hi = round(float(v.min()), 3), round(float(v.max()), 3)
@@ -202,7 +207,9 @@ def diagnose(
     base = np.concatenate([predicted(o.machine, o.measurement) for o in obs])
     sizes = np.cumsum([0] + [len(o) for o in obs])
     slices = [slice(a, b) for a, b in zip(sizes[:-1], sizes[1:])]
-    prob = _Problem(obs, np.concatenate([o.y for o in obs]) - base, _block_diag([o.nuisance for o in obs]), slices)
+    prob = _Problem(
+        obs, np.concatenate([o.y for o in obs]) - base, _block_diag([o.nuisance for o in obs]), slices
+    )
     groups = candidates(_extent(obs))
     cols = {id(c): prob.columns(c) for g in groups for c in g}
     n_tests = sum(len(g) for g in groups)
@@ -250,7 +257,11 @@ def diagnose(
         if not significant:
             break
         significant.sort(key=lambda s: -s[2])
-        twins = [s for s in significant[1:] if np.linalg.svd(significant[0][3].T @ s[3], compute_uv=False).max() > ambiguity]
+        twins = [
+            s
+            for s in significant[1:]
+            if np.linalg.svd(significant[0][3].T @ s[3], compute_uv=False).max() > ambiguity
+        ]
         # The data cannot choose among twins: the effect table's order (simpler,
         # more common effects first) picks the representative, not the noise.
         group = [significant[0], *twins]
@@ -263,7 +274,9 @@ def diagnose(
         effects = tuple(c.build(coef[k]) for c, k in zip(chosen, _index(chosen)))
         updated = machine.replace(effects=machine.effects + effects)
         gap = _gap(updated, obs)
-        params, unc = cand.parameters(coef[_index(chosen)[-1]], cov[np.ix_(_index(chosen)[-1], _index(chosen)[-1])])
+        params, unc = cand.parameters(
+            coef[_index(chosen)[-1]], cov[np.ix_(_index(chosen)[-1], _index(chosen)[-1])]
+        )
         contribution = cols[id(chosen[-1])] @ coef[_index(chosen)[-1]]
         for o, s in zip(obs, slices):  # what the set-up offsets absorb is not evidence
             contribution[s] -= o.nuisance @ np.linalg.lstsq(o.nuisance, contribution[s], rcond=None)[0]
@@ -424,7 +437,9 @@ def explain(obs, slices, contribution: NDArray, stat: float, thr: float, share: 
             parts.append(f"grows with feed (x{ratio:.1f} from F{feeds[0]:g} to F{feeds[-1]:g})")
         elif ratio > 0.77:
             parts.append("independent of feed")
-    parts.append(f"explains {100 * share:.0f} % of the remaining gap; test statistic {stat:.0f} vs threshold {thr:.1f}")
+    parts.append(
+        f"explains {100 * share:.0f} % of the remaining gap; test statistic {stat:.0f} vs threshold {thr:.1f}"
+    )
     text = "; ".join(parts)
     if alternatives:
         names = ", ".join(a.candidate.name for a in alternatives)

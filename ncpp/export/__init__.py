@@ -39,7 +39,9 @@ def export_table(
         raise NcppError(f"--reference must be a finite number of mm, not {reference!r}")
     error = axis_error(machine, axis)
     if spacing is not None and spacing > error.hi - error.lo:  # a table needs two points on the travel
-        raise NcppError(f"--spacing {spacing:g} mm is longer than the {axis} travel, {error.lo:g} to {error.hi:g} mm")
+        raise NcppError(
+            f"--spacing {spacing:g} mm is longer than the {axis} travel, {error.lo:g} to {error.hi:g} mm"
+        )
     _check_size(machine, error)
     if fmt == "linuxcnc":
         from ncpp.export.linuxcnc import write_linuxcnc_comp
@@ -53,7 +55,9 @@ def export_table(
         from ncpp.export.sinumerik import write_sinumerik
 
         a = error.axis
-        transverse = [axis_error(machine, a, f"E{j}{a}") for j in "XYZ" if j != a and f"E{j}{a}" in machine.components]
+        transverse = [
+            axis_error(machine, a, f"E{j}{a}") for j in "XYZ" if j != a and f"E{j}{a}" in machine.components
+        ]
         for t in transverse:
             _check_size(machine, t)
         return write_sinumerik(error, transverse, spacing=spacing, reference=reference)
@@ -68,7 +72,11 @@ def _check_size(machine: Machine, error: AxisError) -> None:
     """A controller applies a table's values as corrections: the machine file bounds
     those (max_correction_mm), as `ncpp compensate` does."""
     own = error.own_positions()
-    x = np.linspace(error.lo, error.hi, 2001) if own is None else np.union1d(np.linspace(error.lo, error.hi, 2001), own)
+    x = (
+        np.linspace(error.lo, error.hi, 2001)
+        if own is None
+        else np.union1d(np.linspace(error.lo, error.hi, 2001), own)
+    )
     values = np.concatenate([error.forward(x), error.reverse(x)])
     worst = int(np.argmax(np.where(np.isfinite(values), np.abs(values), np.inf)))
     if not abs(values[worst]) <= machine.max_correction_mm:

@@ -75,7 +75,9 @@ def axis_error(machine: Machine, axis: str, name: str | None = None) -> AxisErro
         lo = comp.limits[0] if not math.isfinite(lo) else lo
         hi = comp.limits[1] if not math.isfinite(hi) else hi
     if not (math.isfinite(lo) and math.isfinite(hi) and hi > lo):
-        raise NcppError(f"{name}: give [limits] {axis} in the machine file; the travel to tabulate is unknown")
+        raise NcppError(
+            f"{name}: give [limits] {axis} in the machine file; the travel to tabulate is unknown"
+        )
     return AxisError(axis, name, comp, float(lo), float(hi))
 
 

@@ -120,9 +120,7 @@ def write_fanuc_pitch(
     ]
     out = ["%"] + [f"({_safe(line)})" for line in lines]
     out += [f"N{number}A{a}P{value} ({_safe(what)})" for number, value, what in params]
-    out += [
-        f"N{10000 + first + i}P{int(v)} ({x[i]:.3f} .. {x[i + 1]:.3f} MM)" for i, v in enumerate(steps)
-    ]
+    out += [f"N{10000 + first + i}P{int(v)} ({x[i]:.3f} .. {x[i + 1]:.3f} MM)" for i, v in enumerate(steps)]
     return "\n".join(out + ["%"]) + "\n", notes
 
 

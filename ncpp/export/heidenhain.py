@@ -41,7 +41,9 @@ DECIMALS = 5  # 0.01 um
 WIDTH = 14  # every column; wide enough for -99999.99999
 
 
-def write_heidenhain_com(error: AxisError, *, spacing: float | None = None, name: str | None = None) -> tuple[str, list[str]]:
+def write_heidenhain_com(
+    error: AxisError, *, spacing: float | None = None, name: str | None = None
+) -> tuple[str, list[str]]:
     grid = uniform_grid(error.lo, error.hi, max_points=MAX_POINTS, spacing=spacing, what="HEIDENHAIN")
     x = grid.positions
     fwd, rev = error.forward(x), error.reverse(x)
@@ -50,7 +52,9 @@ def write_heidenhain_com(error: AxisError, *, spacing: float | None = None, name
     rows = [f"BEGIN {name} MM", _row(["NR", "AXISPOS", col, "BACKLASH"])]
     rows += [_row([str(i), _v(p), _v(f), _v(r)]) for i, (p, f, r) in enumerate(zip(x, fwd, rev))]
     rows.append("[END]")
-    residual = max(interpolation_residual(error, x, error.forward), interpolation_residual(error, x, error.reverse))
+    residual = max(
+        interpolation_residual(error, x, error.forward), interpolation_residual(error, x, error.reverse)
+    )
     notes = [
         f"ncpp export-table: {error.name} of axis {error.axis}, {len(x)} points every {grid.spacing:g} mm, "
         "AXISPOS from the machine datum",

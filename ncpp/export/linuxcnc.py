@@ -39,7 +39,9 @@ DECIMALS = 6  # 1 nm in mm: far below any screw error
 RESOLUTION = 10.0**-DECIMALS
 
 
-def write_linuxcnc_comp(error: AxisError, comp_type: int = 0, spacing: float | None = None) -> tuple[str, list[str]]:
+def write_linuxcnc_comp(
+    error: AxisError, comp_type: int = 0, spacing: float | None = None
+) -> tuple[str, list[str]]:
     """The comp file text for `error` and the notes on what was resampled."""
     if comp_type not in (0, 1):
         raise NcppError(f"COMP_FILE_TYPE is 0 or 1, not {comp_type}")
@@ -56,9 +58,18 @@ def write_linuxcnc_comp(error: AxisError, comp_type: int = 0, spacing: float | N
     fwd, rev = error.forward(x), error.reverse(x)
     a, b = (x + fwd, x + rev) if comp_type == 0 else (-fwd, -rev)
     width = max(len(f"{v:.{DECIMALS}f}") for v in np.concatenate([x, a, b]))
-    body = "".join(f"{n:{width}.{DECIMALS}f} {p:{width}.{DECIMALS}f} {q:{width}.{DECIMALS}f}\n" for n, p, q in zip(x, a, b))
-    residual = max(interpolation_residual(error, x, error.forward), interpolation_residual(error, x, error.reverse))
-    what = "actual positions (forward, reverse)" if comp_type == 0 else "trims added to the command (forward, reverse)"
+    body = "".join(
+        f"{n:{width}.{DECIMALS}f} {p:{width}.{DECIMALS}f} {q:{width}.{DECIMALS}f}\n"
+        for n, p, q in zip(x, a, b)
+    )
+    residual = max(
+        interpolation_residual(error, x, error.forward), interpolation_residual(error, x, error.reverse)
+    )
+    what = (
+        "actual positions (forward, reverse)"
+        if comp_type == 0
+        else "trims added to the command (forward, reverse)"
+    )
     notes = [
         f"ncpp export-table: {error.name} of axis {error.axis}, {len(x)} entries, {x[0]:g} .. {x[-1]:g} mm",
         f"COMP_FILE_TYPE = {comp_type}: columns are nominal and {what}, mm",
@@ -117,13 +128,20 @@ def read_linuxcnc_comp(path: str | Path, comp_type: int = 0) -> LinuxCncComp:
         lines.append(number)
         decimals = max(decimals, *(len(f.partition(".")[2]) for f in fields[:3]))
     if not rows:
-        raise NcppError("no `nominal forward reverse` triplets before the first other line", Location(file, 1, 1))
+        raise NcppError(
+            "no `nominal forward reverse` triplets before the first other line", Location(file, 1, 1)
+        )
     if len(rows) > MAX_ENTRIES:
-        raise NcppError(f"{len(rows)} triplets; LinuxCNC holds at most {MAX_ENTRIES}", Location(file, lines[MAX_ENTRIES], 1))
+        raise NcppError(
+            f"{len(rows)} triplets; LinuxCNC holds at most {MAX_ENTRIES}",
+            Location(file, lines[MAX_ENTRIES], 1),
+        )
     data = np.asarray(rows)
     nominal = data[:, 0]
     for i in np.flatnonzero(np.diff(nominal) <= 0):
-        raise NcppError("nominal positions must increase (LinuxCNC rejects this entry)", Location(file, lines[i + 1], 1))
+        raise NcppError(
+            "nominal positions must increase (LinuxCNC rejects this entry)", Location(file, lines[i + 1], 1)
+        )
     if comp_type == 0:
         fwd, rev = data[:, 1] - nominal, data[:, 2] - nominal
     elif comp_type == 1:
@@ -174,7 +192,15 @@ def flag_outliers(comp: LinuxCncComp, k: float = 6.0) -> list[Outlier]:
                 break
             good[worst] = False
             expected = values[worst] - residual[worst]
-            out.append(Outlier(comp.lines[worst], float(comp.nominal[worst]), column, float(values[worst]), float(expected)))
+            out.append(
+                Outlier(
+                    comp.lines[worst],
+                    float(comp.nominal[worst]),
+                    column,
+                    float(values[worst]),
+                    float(expected),
+                )
+            )
     return sorted(out, key=lambda o: (o.line, o.column))
 
 

@@ -78,7 +78,9 @@ def write_sinumerik(
         f"; largest error between points: {interpolation_residual(error, x, error.mean) * 1000:.3f} um",
     ]
     if reference is not None:
-        lines.append(f"; shifted by {shift * 1000:+.1f} um so that the value at the reference {reference:g} mm is 0")
+        lines.append(
+            f"; shifted by {shift * 1000:+.1f} um so that the value at the reference {reference:g} mm is 0"
+        )
     else:
         lines.append("; not shifted: Siemens asks for 0 at the reference point (give --reference)")
     lines += [f"; {note}" for note in placed + grid.notes]
@@ -97,12 +99,20 @@ def write_sinumerik(
         for sign, curve in ((1, error.forward), (-1, error.reverse)):
             tables.append((ax, ax, sign, error, lambda p, c=curve: -(c(p) - error.mean(p)), "reversal"))
     for t in transverse:
-        tables.append((MACHINE_AXES[t.axis], MACHINE_AXES[t.name[1]], 0, t, lambda p, t=t: -t.mean(p), "straightness"))
+        tables.append(
+            (MACHINE_AXES[t.axis], MACHINE_AXES[t.name[1]], 0, t, lambda p, t=t: -t.mean(p), "straightness")
+        )
     if not tables:
         return "\n".join(enc) + "\n", notes
-    cec = ["%_N_NC_CEC_INI", "CHANDATA(1)", "; unverified: sign of the CEC values (-e written); check one point on the machine"]
+    cec = [
+        "%_N_NC_CEC_INI",
+        "CHANDATA(1)",
+        "; unverified: sign of the CEC values (-e written); check one point on the machine",
+    ]
     for index, (inp, out, direction, comp, correction, kind) in enumerate(tables):
-        g = uniform_grid(comp.lo, comp.hi, max_points=MAX_CEC_POINTS, spacing=spacing, what=f"SINUMERIK CEC {index}")
+        g = uniform_grid(
+            comp.lo, comp.hi, max_points=MAX_CEC_POINTS, spacing=spacing, what=f"SINUMERIK CEC {index}"
+        )
         notes += [n_ for n_ in g.notes if n_ not in notes]
         p = g.positions
         assert g.spacing is not None  # a uniform grid has one
@@ -147,4 +157,3 @@ def read_sinumerik(text: str) -> dict[str, dict]:
             value = value.strip()
             out.setdefault(var, {})[key] = value.strip("()") if value.startswith("(") else float(value)
     return out
-

@@ -62,9 +62,9 @@ height, reversal from one direction only, out-of-plane straightness.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from itertools import combinations
-from typing import Sequence
 
 import numpy as np
 from numpy.typing import NDArray
@@ -161,7 +161,9 @@ class BallbarFit:
 # ----------------------------------------------------------------- unknowns
 def _knots(obs: Sequence[Observation], axis: str, count: int) -> NDArray | None:
     i = AXES.index(axis)
-    values = np.unique(np.round(np.concatenate([p.trajectory.positions[:, i] for o in obs for p in o.parts]), 6))
+    values = np.unique(
+        np.round(np.concatenate([p.trajectory.positions[:, i] for o in obs for p in o.parts]), 6)
+    )
     if len(values) < 2:
         return None
     return values if len(values) <= count else np.linspace(values[0], values[-1], count)
@@ -269,7 +271,9 @@ def apply(machine: Machine, blocks: Sequence[Block], theta: NDArray) -> Machine:
         _, corrections = tables.setdefault(b.component, (b.knots, {"table": np.zeros(len(b.knots))}))
         corrections[b.kind] = full
     for name, (knots, corrections) in tables.items():
-        updates[name] = _combined(machine.component(name), knots, corrections["table"], corrections.get("reversal"))
+        updates[name] = _combined(
+            machine.component(name), knots, corrections["table"], corrections.get("reversal")
+        )
     return machine.with_components(**updates)  # type: ignore[arg-type]
 
 
@@ -317,7 +321,12 @@ class _Regularised:
 
 def _regularised(A: NDArray, D: NDArray, blocks: Sequence[Block]) -> _Regularised:
     AtA = A.T @ A
-    weight = np.concatenate([np.full(b.size, ANGLE_PRIORITY if b.unit == "urad" and b.kind != "squareness" else 1.0) for b in blocks])
+    weight = np.concatenate(
+        [
+            np.full(b.size, ANGLE_PRIORITY if b.unit == "urad" and b.kind != "squareness" else 1.0)
+            for b in blocks
+        ]
+    )
     ridge = RIDGE * max(float(np.mean(np.diag(AtA))), 1e-300)
     mu, W = eigh(D.T @ D, AtA + ridge * np.diag(weight**2))
     return _Regularised(W, np.clip(mu, 0.0, None), A @ W)
@@ -423,7 +432,15 @@ def fit_ballbar(
     kept = [b for b, s in zip(blocks, _slices(blocks)) if written[s].all()]
     fitted = _named(apply(machine, kept, theta[written]), blocks, null)
     return BallbarFit(
-        fitted, tuple(blocks), theta, u, groups, files, float(lam), trace, float(np.sqrt(np.mean(flat**2))),
+        fitted,
+        tuple(blocks),
+        theta,
+        u,
+        groups,
+        files,
+        float(lam),
+        trace,
+        float(np.sqrt(np.mean(flat**2))),
         by_gcv=smoothing is None,
     )
 
@@ -474,7 +491,9 @@ def _named(machine: Machine, blocks: Sequence[Block], null: NDArray) -> Machine:
         determined = int(np.sum(null[col : col + b.size] <= 0.5))
         col += b.size
         if determined and b.kind != "reversal":
-            fitted[b.component] = f"ball bar, regularised least squares ({determined} of {b.size} values determined)"
+            fitted[b.component] = (
+                f"ball bar, regularised least squares ({determined} of {b.size} values determined)"
+            )
     meta["fitted"] = fitted
     return machine.replace(meta=meta)
 
@@ -486,7 +505,9 @@ def _setup(m: Measurement) -> str:
 
 
 # ---------------------------------------------------------- observability
-def _unobservable(A: NDArray, blocks: Sequence[Block], resolution: float) -> tuple[NDArray, tuple[Unobservable, ...]]:
+def _unobservable(
+    A: NDArray, blocks: Sequence[Block], resolution: float
+) -> tuple[NDArray, tuple[Unobservable, ...]]:
     """Per parameter, the share of it in directions the data cannot fix (diag
     of the projector on them), and those directions explained by the smallest
     sets of blocks: single blocks first, then pairs, then triples, each set
@@ -525,7 +546,9 @@ def _unobservable(A: NDArray, blocks: Sequence[Block], resolution: float) -> tup
     if explained.shape[1] < V0.shape[1]:
         rest = V0 - explained @ (explained.T @ V0)
         names = tuple(blocks[i].name for i in involved if np.linalg.norm(rest[slices[i]]) > 1e-3)
-        groups.append(Unobservable(names, V0.shape[1] - explained.shape[1], "combinations of four or more of these"))
+        groups.append(
+            Unobservable(names, V0.shape[1] - explained.shape[1], "combinations of four or more of these")
+        )
     return share, tuple(groups)
 
 
@@ -539,10 +562,14 @@ def _hint(blocks: Sequence[Block], null: NDArray, cols: NDArray) -> str:
             return "does not change the bar length in any tested set-up"
         v = null[cols, 0]
         if null.shape[1] == 1 and b.unit == "urad" and np.ptp(v) < 0.05 * np.max(np.abs(v)):
-            return "its mean: a constant tilt turns the whole path rigidly (values are given about their mean)"
+            return (
+                "its mean: a constant tilt turns the whole path rigidly (values are given about their mean)"
+            )
         return f"{null.shape[1]} shape(s) of it do not change the bar length"
     if kinds == {"table"} and all(b.component[1] == b.axis for b in blocks):
-        return "a common scale of these axes is the ball bar's length offset: a laser file of one axis fixes it"
+        return (
+            "a common scale of these axes is the ball bar's length offset: a laser file of one axis fixes it"
+        )
     units = {b.unit for b in blocks if b.kind == "table"}
     if units == {"um", "urad"}:
         return "an angular error seen through one lever arm looks like a translation: another height or tool offset separates them (given to the translation)"
@@ -556,9 +583,13 @@ def account(fit: BallbarFit) -> str:
              f"({fit.effective_parameters:.1f} effective), smoothing λ = {fit.smoothing:.3g} "
              f"({'GCV' if fit.by_gcv else 'given'}), "
              f"rms after {fit.rms_um:.3f} µm"]  # fmt: skip
-    lines.append("  file                                  set-up                               noise   rms before → after (µm)")
+    lines.append(
+        "  file                                  set-up                               noise   rms before → after (µm)"
+    )
     for f in fit.files:
-        lines.append(f"  {f.source[-36:]:<36}  {f.setup:<36} {f.noise_um:5.2f}   {f.rms_before_um:7.3f} → {f.rms_after_um:.3f}")
+        lines.append(
+            f"  {f.source[-36:]:<36}  {f.setup:<36} {f.noise_um:5.2f}   {f.rms_before_um:7.3f} → {f.rms_after_um:.3f}"
+        )
     lines.append("  parameters (value ± standard uncertainty; n.d. = not determined by these data;")
     lines.append("  combinations listed under 'cannot separate' are set by the minimum-norm rule):")
     for b in fit.blocks:

@@ -50,8 +50,8 @@ file gives keep the base's value.
 
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import Mapping, Sequence
 
 import numpy as np
 from numpy.typing import NDArray
@@ -109,7 +109,11 @@ def sources_of(m: Measurement, chain: str) -> list[Source]:
             found = [Source(m, f"E{axis}{axis}", "linear_um", 1.0)]
             transverse = (m.text("transverse") or "").upper()
             if "transverse_um" in m.columns and transverse:
-                found.append(Source(m, reading_component(axis, f"straightness_{transverse.lower()}"), "transverse_um", 1.0))
+                found.append(
+                    Source(
+                        m, reading_component(axis, f"straightness_{transverse.lower()}"), "transverse_um", 1.0
+                    )
+                )
         elif m.instrument == "level":
             name = ANGLE_COMPONENTS[(axis, m.quantity)]
             member = m.text("member") or level_member(axis)
@@ -143,12 +147,18 @@ def _level_sign(chain: str, member: str, axis: str) -> float:
     the tool side, −ε on the workpiece side (ε is of the tool relative to the work)."""
     c = Chain(chain)
     if member in ("work", "tool"):
-        member = (c.work_side[0] if member == "work" and c.work_side else c.tool_side[-1] if c.tool_side else "F")
+        member = (
+            c.work_side[0] if member == "work" and c.work_side else c.tool_side[-1] if c.tool_side else "F"
+        )
     if member == "F" or c.side(member) != c.side(axis):
         raise ValueError(f"a level on {member} does not see the rotation of {axis} (chain {c.text})")
     side = c.work_side if c.side(axis) == "work" else c.tool_side
     # the member must ride on the axis: outboard of it, away from the frame
-    outboard = side.index(member) <= side.index(axis) if c.side(axis) == "work" else side.index(member) >= side.index(axis)
+    outboard = (
+        side.index(member) <= side.index(axis)
+        if c.side(axis) == "work"
+        else side.index(member) >= side.index(axis)
+    )
     if not outboard:
         raise ValueError(f"a level on {member} does not ride on axis {axis} (chain {c.text})")
     return -1.0 if c.side(axis) == "work" else 1.0
@@ -178,7 +188,9 @@ def _update(machine: Machine, s: Source, interpolation: Interpolation, reversal_
     if s.relative:  # keep the component's value at the datum (first target) where it is
         datum = gap_up[0] if np.isfinite(gap_up[0]) else gap_down[0]
         gap_up, gap_down = gap_up - datum, gap_down - datum
-    gap_mean = np.where(np.isnan(gap_up), gap_down, np.where(np.isnan(gap_down), gap_up, (gap_up + gap_down) / 2))
+    gap_mean = np.where(
+        np.isnan(gap_up), gap_down, np.where(np.isnan(gap_down), gap_up, (gap_up + gap_down) / 2)
+    )
     # The reversal this component must carry: what is unexplained plus what it carries now.
     if _directional(s, measured, gap_up - gap_down + now[1.0] - now[-1.0], reversal_threshold):
         plus = now[1.0] + np.where(np.isnan(gap_up), gap_mean, gap_up)
@@ -271,7 +283,9 @@ def identify(
         )
     if not ballbars:
         return machine, None
-    fit = fit_ballbar(machine, ballbars, knots=knots, fixed=[s.component for s in sources], smoothing=smoothing)
+    fit = fit_ballbar(
+        machine, ballbars, knots=knots, fixed=[s.component for s in sources], smoothing=smoothing
+    )
     return fit.machine, fit
 
 
@@ -312,7 +326,9 @@ def fit_residuals(machine: Machine, measurements: Sequence[Measurement]) -> dict
             continue  # explained by the ball-bar fit's account
         for s in sources_of(m, machine.chain):
             measured, predicted = _per_target(s, m), _per_target(s, predict_like(machine, m))
-            gaps = np.concatenate([measured.up.mean - predicted.up.mean, measured.down.mean - predicted.down.mean])
+            gaps = np.concatenate(
+                [measured.up.mean - predicted.up.mean, measured.down.mean - predicted.down.mean]
+            )
             if s.relative:  # a zeroed reading says nothing about its level
                 gaps = gaps - np.nanmean(gaps)
             out[s.component] = float(np.nanmax(np.abs(gaps)))

@@ -98,7 +98,9 @@ def analyze(m: Measurement, spike_width_deg: float = 3.0) -> Analysis:
         return _laser_profile(m)
     if m.instrument == "level":
         return _level(m)
-    if m.instrument in ("ballbar", "cutting") or (m.instrument == "grid" and m.radius_mm and m.center_mm is not None):
+    if m.instrument in ("ballbar", "cutting") or (
+        m.instrument == "grid" and m.radius_mm and m.center_mm is not None
+    ):
         return _circular(m, spike_width_deg)
     if m.instrument == "grid":
         return Analysis(m, "path", _clean(_path_figures(m)))
@@ -113,7 +115,10 @@ def _positioning(m: Measurement) -> Analysis:
         transverse = _mean_profile(m, "transverse_um")
         profiles["transverse"] = transverse
         if len(transverse.position_mm) >= 2:  # a line needs two targets; one target: no straightness (None)
-            figures |= {"straightness_um": transverse.straightness, "slope_um_per_m": transverse.line[0] * 1000.0}
+            figures |= {
+                "straightness_um": transverse.straightness,
+                "slope_um_per_m": transverse.line[0] * 1000.0,
+            }
         else:
             figures |= {"straightness_um": None, "slope_um_per_m": None}
     return Analysis(m, "ISO 230-2", _clean(figures), positioning=result, profiles=profiles)
@@ -201,7 +206,11 @@ def describe(m: Measurement) -> str:
         runs = int(m["run"].max())
         dirs = "bidirectional" if {"+", "-"} <= set(m["direction"]) else "unidirectional"
         what = "position" if m.instrument == "comparator" else m.quantity
-        extra = f", transverse {m.text('transverse')}" if m.instrument == "comparator" and m.text("transverse") else ""
+        extra = (
+            f", transverse {m.text('transverse')}"
+            if m.instrument == "comparator" and m.text("transverse")
+            else ""
+        )
         return f"{m.instrument} {m.axis or '?'} {what}{extra}: {len(np.unique(m['target_mm']))} targets, {runs} run(s), {dirs}"
     if m.instrument == "level":
         return f"level {m.axis or '?'} {m.quantity}: {len(m)} positions"
@@ -227,6 +236,16 @@ def _target_table(r: iso230_2.Iso230_2) -> str:
     head = f"  {'target_mm':>10} {'x̄↑':>8} {'x̄↓':>8} {'x̄':>8} {'B_i':>8} {'s↑':>7} {'s↓':>7} {'R_i':>7}"
     rows = [head]
     for i, t in enumerate(r.targets):
-        cells = (r.up.mean[i], r.down.mean[i], r.mean[i], r.reversal[i], r.up.s[i], r.down.s[i], r.repeatability[i])
-        rows.append(f"  {t:10.3f} " + " ".join(f"{c:8.3f}" if not math.isnan(c) else f"{'-':>8}" for c in cells))
+        cells = (
+            r.up.mean[i],
+            r.down.mean[i],
+            r.mean[i],
+            r.reversal[i],
+            r.up.s[i],
+            r.down.s[i],
+            r.repeatability[i],
+        )
+        rows.append(
+            f"  {t:10.3f} " + " ".join(f"{c:8.3f}" if not math.isnan(c) else f"{'-':>8}" for c in cells)
+        )
     return "\n".join(rows)

@@ -56,8 +56,8 @@ from __future__ import annotations
 import math
 import os
 import re
+from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Mapping
 
 import numpy as np
 
@@ -104,9 +104,15 @@ def _grid_columns(plane: str) -> tuple[str, ...]:
 def schema_for(instrument: str, meta: Mapping[str, str]) -> Schema | None:
     """The column schema of `instrument` (None if ncpp does not know it)."""
     if instrument == "laser":
-        return Schema(("target_mm", "run", "direction"), one_of=("deviation_um", "deviation_urad"), directions=("+", "-"))
+        return Schema(
+            ("target_mm", "run", "direction"),
+            one_of=("deviation_um", "deviation_urad"),
+            directions=("+", "-"),
+        )
     if instrument == "comparator":
-        return Schema(("target_mm", "run", "direction", "linear_um"), ("transverse_um",), directions=("+", "-"))
+        return Schema(
+            ("target_mm", "run", "direction", "linear_um"), ("transverse_um",), directions=("+", "-")
+        )
     if instrument == "level":
         return Schema(("position_mm", "inclination_um_per_m"))
     if instrument == "ballbar":
@@ -252,9 +258,6 @@ def _meta_float(m: Measurement, key: str, text: str) -> float:
     return value
 
 
-
-
-
 # -- reading -----------------------------------------------------------------
 
 
@@ -309,11 +312,16 @@ def parse_measurement(text: str, source: str = "<string>") -> Measurement:
             continue
         row = line.split(",")
         if len(row) != len(names):
-            raise NcppError(f"expected {len(names)} columns ({','.join(names)}), found {len(row)}", Location(source, number, 1))
+            raise NcppError(
+                f"expected {len(names)} columns ({','.join(names)}), found {len(row)}",
+                Location(source, number, 1),
+            )
         cells.append(row)
         where.append(number)
     columns = {
-        name: _convert_column(name, [row[i] for row in cells], [lines[n - 1] for n in where], where, i, schema, source)
+        name: _convert_column(
+            name, [row[i] for row in cells], [lines[n - 1] for n in where], where, i, schema, source
+        )
         for i, name in enumerate(names)
     }
     measurement = Measurement(instrument, meta, columns, source, meta_lines)
@@ -321,12 +329,16 @@ def parse_measurement(text: str, source: str = "<string>") -> Measurement:
     return measurement
 
 
-def _check_header(names: list[str], schema: Schema | None, instrument: str, source: str, line: int, text: str) -> None:
+def _check_header(
+    names: list[str], schema: Schema | None, instrument: str, source: str, line: int, text: str
+) -> None:
     for i, name in enumerate(names):
         if not name:
             raise NcppError("empty column name in header", Location(source, line, _cell_col(text, i)))
         if names.index(name) != i:
-            raise NcppError(f"column {quoted(name)} appears twice", Location(source, line, _cell_col(text, i)))
+            raise NcppError(
+                f"column {quoted(name)} appears twice", Location(source, line, _cell_col(text, i))
+            )
     if schema is None:
         return
     allowed = set(schema.required) | set(schema.optional) | set(schema.one_of)
@@ -340,7 +352,10 @@ def _check_header(names: list[str], schema: Schema | None, instrument: str, sour
     if missing:
         raise NcppError(f"{instrument} file lacks column(s) {', '.join(missing)}", Location(source, line, 1))
     if schema.one_of and sum(n in names for n in schema.one_of) != 1:
-        raise NcppError(f"{instrument} file needs exactly one of the columns {', '.join(schema.one_of)}", Location(source, line, 1))
+        raise NcppError(
+            f"{instrument} file needs exactly one of the columns {', '.join(schema.one_of)}",
+            Location(source, line, 1),
+        )
 
 
 def _cell_col(line: str, index: int) -> int:
@@ -354,7 +369,13 @@ def _cell_col(line: str, index: int) -> int:
 
 
 def _convert_column(
-    name: str, raw: list[str], lines: list[str], where: list[int], index: int, schema: Schema | None, source: str
+    name: str,
+    raw: list[str],
+    lines: list[str],
+    where: list[int],
+    index: int,
+    schema: Schema | None,
+    source: str,
 ) -> np.ndarray:
     values = [cell.strip() for cell in raw]
 
@@ -413,13 +434,19 @@ def _check_meta(m: Measurement, header_line: int, meta_lines: Mapping[str, int])
     if m.instrument == "laser":
         quantity = m.quantity
         if quantity not in LASER_QUANTITIES:
-            raise NcppError(f"laser quantity must be one of {', '.join(LASER_QUANTITIES)}, got {quoted(quantity)}", at("quantity"))
+            raise NcppError(
+                f"laser quantity must be one of {', '.join(LASER_QUANTITIES)}, got {quoted(quantity)}",
+                at("quantity"),
+            )
         wanted = "deviation_urad" if quantity in ANGULAR_QUANTITIES else "deviation_um"
         if wanted not in m.columns:
             raise NcppError(f"a laser {quantity} file has the column {wanted}", where)
         component, angles = m.text("component"), [f"E{r}{m.axis or 'X'}" for r in "ABC"]
         if quantity in ANGULAR_QUANTITIES and component and component.upper() not in angles:
-            raise NcppError(f"component must be an angle of the axis, {', '.join(angles)}; got {quoted(component)}", at("component"))
+            raise NcppError(
+                f"component must be an angle of the axis, {', '.join(angles)}; got {quoted(component)}",
+                at("component"),
+            )
     if m.instrument == "level" and m.quantity not in LEVEL_QUANTITIES:
         raise NcppError(f"level quantity must be roll or pitch, got {quoted(m.quantity)}", at("quantity"))
     if m.instrument in ("ballbar", "grid", "cutting"):
@@ -471,7 +498,9 @@ def write_measurement(m: Measurement, path: str | os.PathLike[str]) -> None:
     write_text_atomic(path, format_measurement(m))
 
 
-def make_measurement(instrument: str, meta: Mapping[str, object], columns: Mapping[str, object], source: str = "<memory>") -> Measurement:
+def make_measurement(
+    instrument: str, meta: Mapping[str, object], columns: Mapping[str, object], source: str = "<memory>"
+) -> Measurement:
     """Build a Measurement from plain values (numbers -> str metadata, lists -> arrays)."""
     text_meta = {k: _meta_text(v) for k, v in meta.items()}
     arrays: dict[str, np.ndarray] = {}

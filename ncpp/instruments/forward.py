@@ -51,7 +51,7 @@ normal noise in the file's deviation unit (µm, µrad or µm/m) with `seed`.
 
 from __future__ import annotations
 
-from typing import Iterable, Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -85,7 +85,9 @@ def reading_component(axis: str, quantity: str) -> str:
     if quantity.startswith("straightness_"):
         direction = quantity.removeprefix("straightness_").upper()
         if direction not in AXES or direction == axis:
-            raise ValueError(f"straightness of {axis} must be across it (straightness_x|_y|_z), not {quantity!r}")
+            raise ValueError(
+                f"straightness of {axis} must be across it (straightness_x|_y|_z), not {quantity!r}"
+            )
         return f"E{direction}{axis}"
     try:
         return ANGLE_COMPONENTS[(axis, quantity)]
@@ -167,8 +169,13 @@ def _rounded(values: NDArray, digits: int = 4) -> NDArray:
 
 # ------------------------------------------------------------- positioning cycles
 def iso230_2_cycle(
-    axis: str, targets: NDArray, runs: int, bidirectional: bool, fixed: Mapping[str, float],
-    feed_mm_min: float, overtravel_mm: float,
+    axis: str,
+    targets: NDArray,
+    runs: int,
+    bidirectional: bool,
+    fixed: Mapping[str, float],
+    feed_mm_min: float,
+    overtravel_mm: float,
 ) -> tuple[Trajectory, NDArray, list[tuple[float, int, str]]]:
     """The ISO 230-2 stop-and-go cycle: + pass up the targets, overtravel, − pass
     down.  Returns the trajectory, the indices of the reading samples (standstill)
@@ -197,9 +204,17 @@ def iso230_2_cycle(
 
 
 def _positioning_readings(
-    machine: Machine, axis: str, targets: ArrayLike, runs: int, bidirectional: bool,
-    fixed: Mapping[str, float], offset_mm: ArrayLike, feed_mm_min: float, overtravel_mm: float,
-    effects: bool, angular: bool,
+    machine: Machine,
+    axis: str,
+    targets: ArrayLike,
+    runs: int,
+    bidirectional: bool,
+    fixed: Mapping[str, float],
+    offset_mm: ArrayLike,
+    feed_mm_min: float,
+    overtravel_mm: float,
+    effects: bool,
+    angular: bool,
 ) -> tuple[NDArray, list[tuple[float, int, str]]]:
     """(n,3) deviation in mm (or rotation in rad when `angular`) at each reading."""
     targets = np.unique(np.asarray(targets, dtype=float))
@@ -208,11 +223,15 @@ def _positioning_readings(
     if runs < 1:
         raise ValueError("runs must be at least 1")
     directions = 2 if bidirectional else 1
-    _check_count(targets.size * runs * directions, f"{targets.size} targets × {runs} runs × {directions} direction(s)")
+    _check_count(
+        targets.size * runs * directions, f"{targets.size} targets × {runs} runs × {directions} direction(s)"
+    )
     m = functional_point(machine, offset_mm)
     if not effects:
         m = m.replace(effects=())
-    trajectory, at, labels = iso230_2_cycle(axis, targets, runs, bidirectional, fixed, feed_mm_min, overtravel_mm)
+    trajectory, at, labels = iso230_2_cycle(
+        axis, targets, runs, bidirectional, fixed, feed_mm_min, overtravel_mm
+    )
     P = trajectory.positions[at]
     if angular:
         values = m.rotation(P, trajectory.directions()[at])
@@ -241,7 +260,9 @@ def _laser_component(axis: str, quantity: str, component: str | None) -> str:
     angles = [f"E{r}{axis}" for r in "ABC"]
     if quantity not in ("pitch", "yaw", "roll") or component.upper() not in angles:
         allowed = f"one of {', '.join(angles)}" if quantity in ("pitch", "yaw", "roll") else name
-        raise ValueError(f"component {component!r} is not what a laser reads for {quantity} of {axis}: use {allowed}")
+        raise ValueError(
+            f"component {component!r} is not what a laser reads for {quantity} of {axis}: use {allowed}"
+        )
     return component.upper()
 
 
@@ -281,7 +302,17 @@ def predict_laser(
     angular = quantity in ("pitch", "yaw", "roll")
     name = _laser_component(axis, quantity, component)
     values, labels = _positioning_readings(
-        machine, axis, targets, runs, bidirectional, fixed, offset_mm, feed_mm_min, overtravel_mm, effects, angular
+        machine,
+        axis,
+        targets,
+        runs,
+        bidirectional,
+        fixed,
+        offset_mm,
+        feed_mm_min,
+        overtravel_mm,
+        effects,
+        angular,
     )
     index = "ABC".index(name[1]) if angular else AXES.index(name[1])
     reading = values[:, index] * (1e6 if angular else 1e3)
@@ -322,7 +353,17 @@ def predict_comparator(
         raise ValueError("the transverse direction must differ from the axis")
     fixed = parse_fixed(fixed)
     values, labels = _positioning_readings(
-        machine, axis, targets, runs, bidirectional, fixed, offset_mm, feed_mm_min, overtravel_mm, effects, False
+        machine,
+        axis,
+        targets,
+        runs,
+        bidirectional,
+        fixed,
+        offset_mm,
+        feed_mm_min,
+        overtravel_mm,
+        effects,
+        False,
     )
     readings = values[:, [AXES.index(axis), AXES.index(transverse)]] * 1e3
     if zero:
@@ -332,7 +373,11 @@ def predict_comparator(
         **_base_meta(machine, "comparator"), "axis": axis, "transverse": transverse,
         "fixed": _fixed_text(fixed), "offset_mm": _vector_text(offset_mm), "feed_mm_min": feed_mm_min,
     }  # fmt: skip
-    columns = {**_layout_columns(labels), "linear_um": _rounded(readings[:, 0]), "transverse_um": _rounded(readings[:, 1])}
+    columns = {
+        **_layout_columns(labels),
+        "linear_um": _rounded(readings[:, 0]),
+        "transverse_um": _rounded(readings[:, 1]),
+    }
     return make_measurement("comparator", meta, columns)
 
 
@@ -369,12 +414,20 @@ def predict_level(
         **_base_meta(machine, "level"), "axis": axis, "quantity": quantity, "component": name,
         "member": member, "fixed": _fixed_text(fixed),
     }  # fmt: skip
-    return make_measurement("level", meta, {"position_mm": P[:, AXES.index(axis)], "inclination_um_per_m": _rounded(reading)})
+    return make_measurement(
+        "level", meta, {"position_mm": P[:, AXES.index(axis)], "inclination_um_per_m": _rounded(reading)}
+    )
 
 
 # ------------------------------------------------------------------- circular paths
 def _circle_commands(
-    plane: str, centre: NDArray, radius: float, direction: str, start_deg: float, overshoot_deg: float, step_deg: float
+    plane: str,
+    centre: NDArray,
+    radius: float,
+    direction: str,
+    start_deg: float,
+    overshoot_deg: float,
+    step_deg: float,
 ) -> tuple[NDArray, NDArray, NDArray]:
     """Command points of one direction of a circular test with lead-in and
     lead-out arcs: (positions (n,3), angle of each point in deg, mask of the data arc)."""
@@ -385,7 +438,9 @@ def _circle_commands(
         raise ValueError("the centre and the start angle must be finite numbers")
     _check_step(step_deg)
     if not 0.0 <= overshoot_deg <= 360.0:
-        raise ValueError(f"overshoot must be 0 to 360 deg (a feed-in arc of up to a turn), not {overshoot_deg:g}")
+        raise ValueError(
+            f"overshoot must be 0 to 360 deg (a feed-in arc of up to a turn), not {overshoot_deg:g}"
+        )
     n_rev = int(round(360.0 / step_deg))
     n_over = int(round(overshoot_deg / step_deg))
     _check_count(n_rev + 2 * n_over + 1, f"a step of {step_deg:g} deg and {overshoot_deg:g} deg of overshoot")
@@ -457,9 +512,13 @@ def predict_ballbar(
     rng = np.random.default_rng(seed)
     dirs, angles, values = [], [], []
     for direction in _directions(directions):
-        P, angle, data = _circle_commands(plane, centre, radius_mm, direction, start_deg, overshoot_deg, step_deg)
+        P, angle, data = _circle_commands(
+            plane, centre, radius_mm, direction, start_deg, overshoot_deg, step_deg
+        )
         d = _simulated_deviation(m, P, feed_mm_min, effects)
-        bar = (P - centre) + (d - fixed_ball)  # (P − C) is exact; microns are added, not subtracted from metres
+        bar = (P - centre) + (
+            d - fixed_ball
+        )  # (P − C) is exact; microns are added, not subtracted from metres
         dev = (np.linalg.norm(bar, axis=1) - radius_mm) * 1e3
         dirs += [direction] * int(data.sum())
         angles.append(np.round(angle[data] % 360.0, 9) % 360.0)
@@ -468,7 +527,11 @@ def predict_ballbar(
         **_base_meta(machine, "ballbar"), "plane": plane, "radius_mm": float(radius_mm),
         "center_mm": _vector_text(centre), "feed_mm_min": float(feed_mm_min), "offset_mm": _vector_text(offset_mm),
     }  # fmt: skip
-    columns = {"direction": dirs, "angle_deg": np.concatenate(angles), "deviation_um": _rounded(np.concatenate(values))}
+    columns = {
+        "direction": dirs,
+        "angle_deg": np.concatenate(angles),
+        "deviation_um": _rounded(np.concatenate(values)),
+    }
     return make_measurement("ballbar", meta, columns)
 
 
@@ -524,7 +587,9 @@ def predict_grid(
     parts: list[dict[str, object]] = []
     for direction in _directions(directions):
         if path == "circle":
-            P, _, data = _circle_commands(plane, centre, radius_mm, direction, start_deg, overshoot_deg, step_deg)
+            P, _, data = _circle_commands(
+                plane, centre, radius_mm, direction, start_deg, overshoot_deg, step_deg
+            )
         elif path == "square":
             P = _square_commands(plane, centre, radius_mm, direction, step_mm)
             data = np.ones(len(P), dtype=bool)
@@ -639,11 +704,26 @@ def setup_of(m: Measurement) -> dict[str, object]:
         return {"axis": m.axis or "X", "positions": m["position_mm"], "quantity": m.quantity,
                 "member": m.text("member"), "fixed": m.fixed}  # fmt: skip
     centre = m.center_mm if m.center_mm is not None else np.zeros(3)
-    common = {"plane": m.plane, "center_mm": centre, "offset_mm": offset, "feed_mm_min": m.feed_mm_min or 1000.0}
+    common = {
+        "plane": m.plane,
+        "center_mm": centre,
+        "offset_mm": offset,
+        "feed_mm_min": m.feed_mm_min or 1000.0,
+    }
     if inst == "ballbar":
-        return {**common, "radius_mm": m.radius_mm, "directions": tuple(dict.fromkeys(m["direction"])), "step_deg": 0.25}
+        return {
+            **common,
+            "radius_mm": m.radius_mm,
+            "directions": tuple(dict.fromkeys(m["direction"])),
+            "step_deg": 0.25,
+        }
     if inst == "cutting":
-        return {**common, "radius_mm": m.radius_mm, "direction": m.text("direction") or "CCW", "probe_step_deg": 0.25}
+        return {
+            **common,
+            "radius_mm": m.radius_mm,
+            "direction": m.text("direction") or "CCW",
+            "probe_step_deg": 0.25,
+        }
     raise ValueError(f"no forward model for {inst} files of this kind")
 
 
@@ -675,7 +755,9 @@ def predict_like(machine: Machine, m: Measurement, *, effects: bool = True, zero
         out = np.empty(len(m))
         for d in set(m["direction"]):
             mine, theirs = pred["direction"] == d, m["direction"] == d
-            out[theirs] = _periodic_interp(m["angle_deg"][theirs], pred["angle_deg"][mine], pred["deviation_um"][mine])
+            out[theirs] = _periodic_interp(
+                m["angle_deg"][theirs], pred["angle_deg"][mine], pred["deviation_um"][mine]
+            )
         columns["deviation_um"] = out
     elif inst == "cutting":
         columns["radius_dev_um"] = _periodic_interp(m["angle_deg"], pred["angle_deg"], pred["radius_dev_um"])
@@ -701,7 +783,11 @@ def _grid_like(machine: Machine, m: Measurement, effects: bool) -> Measurement:
     mm = functional_point(machine, m.offset_mm)
     centre = m.center_mm if m.center_mm is not None else np.zeros(3)
     P = _grid_line(m)
-    groups = [m["direction"] == d for d in dict.fromkeys(m["direction"])] if "direction" in m.columns else [np.ones(len(m), bool)]
+    groups = (
+        [m["direction"] == d for d in dict.fromkeys(m["direction"])]
+        if "direction" in m.columns
+        else [np.ones(len(m), bool)]
+    )
     d = np.empty(P.shape)
     for rows in groups:
         index = np.flatnonzero(rows)[np.argsort(m["s_mm"][rows], kind="stable")]

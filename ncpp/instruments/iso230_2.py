@@ -111,7 +111,9 @@ class Iso230_2:
         if not self.bidirectional:
             return self._only.repeatability
         both = 2 * self.up.s + 2 * self.down.s + np.abs(self.reversal)
-        return np.where(self.both, np.maximum(both, np.maximum(self.up.repeatability, self.down.repeatability)), np.nan)
+        return np.where(
+            self.both, np.maximum(both, np.maximum(self.up.repeatability, self.down.repeatability)), np.nan
+        )
 
     @property
     def _only(self) -> Direction:
@@ -175,7 +177,9 @@ def evaluate_positioning(target_mm: np.ndarray, direction: np.ndarray, deviation
     if target_mm.size == 0:
         raise ValueError("no readings")
     if not np.all(np.abs(target_mm) <= MAX_LENGTH_UM / 1e3):  # (read files are checked so: files.py)
-        raise ValueError(f"targets must be finite and within ±{MAX_LENGTH_UM / 1e3:.4g} mm, where 1 µm is resolved")
+        raise ValueError(
+            f"targets must be finite and within ±{MAX_LENGTH_UM / 1e3:.4g} mm, where 1 µm is resolved"
+        )
     keys = np.round(target_mm * 1e3).astype(np.int64)  # match targets to 1 µm (fits: |keys| <= 2**53)
     unique, index = np.unique(keys, return_inverse=True)
     targets = np.bincount(index, weights=target_mm) / np.bincount(index)

@@ -320,7 +320,9 @@ def _cyclic_columns(test: CircularTest, axis: int, period_mm: float) -> np.ndarr
     return np.vstack(cols)
 
 
-def _cyclic_search(test: CircularTest, design: np.ndarray, y: np.ndarray, significance: float = 6.0) -> dict[int, float]:
+def _cyclic_search(
+    test: CircularTest, design: np.ndarray, y: np.ndarray, significance: float = 6.0
+) -> dict[int, float]:
     """Greedy forward selection of periodic axis errors: each round adds the
     (axis, screw lead) that explains most of the residual, if its amplitude
     exceeds `significance` standard uncertainties.  Returns {axis index: period mm}."""
@@ -352,12 +354,16 @@ def diagnose_circular(test: CircularTest, spike_width_deg: float = 3.0) -> Diagn
         raise ValueError(f"spike width must be in (0, {MAX_SPIKE_WIDTH_DEG:g}] deg, not {spike_width_deg!r}")
     R = test.radius_mm
     bidirectional = len({t.direction for t in test.traces}) == 2
-    shared = ["cos2", "sin2", "backlash_p", "backlash_q", "spike_p", "spike_q"] + (["servo"] if bidirectional else [])
+    shared = ["cos2", "sin2", "backlash_p", "backlash_q", "spike_p", "spike_q"] + (
+        ["servo"] if bidirectional else []
+    )
     blocks, ys = [], []
     n_dir = len(test.traces)
     for k, t in enumerate(test.traces):
         nuisance = np.zeros((len(t.theta), 3 * n_dir))
-        nuisance[:, 3 * k : 3 * k + 3] = np.column_stack([np.ones_like(t.theta), np.cos(t.theta), np.sin(t.theta)])
+        nuisance[:, 3 * k : 3 * k + 3] = np.column_stack(
+            [np.ones_like(t.theta), np.cos(t.theta), np.sin(t.theta)]
+        )
         feats = _features(t, spike_width_deg)
         blocks.append(np.column_stack([nuisance] + [feats[name] for name in shared]))
         ys.append(t.deviation_um)
@@ -392,11 +398,16 @@ def diagnose_circular(test: CircularTest, spike_width_deg: float = 3.0) -> Diagn
     for axis, letter in enumerate((p, q)):
         if axis in cyclic:
             amplitude = float(np.hypot(coef[column], coef[column + 1]))
-            figures[f"cyclic_{letter}_um"], uncertainty[f"cyclic_{letter}_um"] = amplitude, float(np.mean(std[column : column + 2]))
+            figures[f"cyclic_{letter}_um"], uncertainty[f"cyclic_{letter}_um"] = (
+                amplitude,
+                float(np.mean(std[column : column + 2])),
+            )
             figures[f"cyclic_{letter}_period_mm"] = cyclic[axis]
             column += 2
         else:
-            figures[f"cyclic_{letter}_um"] = figures[f"cyclic_{letter}_period_mm"] = uncertainty[f"cyclic_{letter}_um"] = None
+            figures[f"cyclic_{letter}_um"] = figures[f"cyclic_{letter}_period_mm"] = uncertainty[
+                f"cyclic_{letter}_um"
+            ] = None
     figures[f"centre_offset_{p}_um"] = float(np.mean(coef[1 : 3 * n_dir : 3]))
     figures[f"centre_offset_{q}_um"] = float(np.mean(coef[2 : 3 * n_dir : 3]))
     figures["radius_deviation_um"] = float(np.mean(coef[0 : 3 * n_dir : 3]))

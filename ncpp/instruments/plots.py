@@ -17,7 +17,7 @@ from __future__ import annotations
 import io
 import math
 import os
-from typing import Sequence
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -186,7 +186,9 @@ def _nice_step(span: float) -> float:
 def _polar_panel(ax, a: Analysis) -> None:
     test, circle = a.test, a.circle
     assert test is not None and circle is not None
-    centred = {t.direction: (t, iso230_4.centred(t, circle.common_centre_um, test.radius_mm)) for t in test.traces}
+    centred = {
+        t.direction: (t, iso230_4.centred(t, circle.common_centre_um, test.radius_mm)) for t in test.traces
+    }
     extreme = max(float(np.max(np.abs(d))) for _, d in centred.values())
     step = _nice_step(2 * extreme)
     outer = step * math.ceil(extreme / step + 0.5)
@@ -209,8 +211,18 @@ def _polar_panel(ax, a: Analysis) -> None:
     if f.get("H") is not None:
         parts.append(f"H {f['H']:.2f} µm")
     parts.append(f"F {f['F_min']:+.2f}/{f['F_max']:+.2f} µm")
-    ax.set_title(f"{os.path.basename(a.measurement.source)}\n{describe(a.measurement)}\n" + ", ".join(parts), fontsize=9)
-    ax.text(0.0, -0.08, f"scale {step:g} µm/div (LSC centred)\n" + _diagnosis_text(a), transform=ax.transAxes, fontsize=7, va="top")
+    ax.set_title(
+        f"{os.path.basename(a.measurement.source)}\n{describe(a.measurement)}\n" + ", ".join(parts),
+        fontsize=9,
+    )
+    ax.text(
+        0.0,
+        -0.08,
+        f"scale {step:g} µm/div (LSC centred)\n" + _diagnosis_text(a),
+        transform=ax.transAxes,
+        fontsize=7,
+        va="top",
+    )
     ax.legend(loc="upper right", bbox_to_anchor=(1.18, 1.08), fontsize=7)
 
 
@@ -255,21 +267,36 @@ def _positioning_panel(ax, a: Analysis) -> None:
         ax.plot(m["target_mm"][rows], m[column][rows], ".", color=colour, alpha=0.35, ms=4)
         ax.plot(r.targets[ok], stats.mean[ok], "-o", color=colour, ms=3, label=f"x̄{name} ({sign})")
         band = np.nan_to_num(2 * stats.s[ok])
-        ax.fill_between(r.targets[ok], stats.mean[ok] - band, stats.mean[ok] + band, color=colour, alpha=0.15, label=f"x̄{name} ± 2s{name}")
+        ax.fill_between(
+            r.targets[ok],
+            stats.mean[ok] - band,
+            stats.mean[ok] + band,
+            color=colour,
+            alpha=0.15,
+            label=f"x̄{name} ± 2s{name}",
+        )
     if r.bidirectional:
         ok = ~np.isnan(r.mean)
         ax.plot(r.targets[ok], r.mean[ok], "k--", lw=1, label="x̄ bidirectional")
     for name, profile in a.profiles.items():
         if name != "transverse":  # the comparator's transverse reading has its own scale
             slope, intercept = profile.line
-            ax.plot(profile.position_mm, slope * profile.position_mm + intercept, "k:", lw=1, label="least-squares line")
+            ax.plot(
+                profile.position_mm,
+                slope * profile.position_mm + intercept,
+                "k:",
+                lw=1,
+                label="least-squares line",
+            )
     ax.axhline(0, color="grey", lw=0.6)
     ax.set_xlabel(f"target position {m.axis or ''} (mm)")
     unit = "µrad" if column.endswith("urad") else "µm"
     ax.set_ylabel(f"{column.removesuffix('_um').removesuffix('_urad')}, actual − target ({unit})")
     f = a.figures
     if a.standard == "ISO 230-2":
-        title = "ISO 230-2 (µm): " + ", ".join(f"{k} {f[k]:.2f}" for k in ("A", "E", "M", "B", "R") if f.get(k) is not None)
+        title = "ISO 230-2 (µm): " + ", ".join(
+            f"{k} {f[k]:.2f}" for k in ("A", "E", "M", "B", "R") if f.get(k) is not None
+        )
     else:
         title = _titles(a)
     ax.set_title(f"{os.path.basename(m.source)}\n{describe(m)}\n{title}", fontsize=9)
@@ -285,8 +312,17 @@ def _profile_panel(ax, a: Analysis) -> None:
         slope, intercept = profile.line
         colour = f"C{k}"
         label_unit = "µm" if name == "height" else unit
-        target.plot(profile.position_mm, profile.value, "-o", ms=3, color=colour, label=f"{name} ({label_unit})")
-        target.plot(profile.position_mm, slope * profile.position_mm + intercept, ":", color=colour, lw=1, label=f"{name}: least-squares line")
+        target.plot(
+            profile.position_mm, profile.value, "-o", ms=3, color=colour, label=f"{name} ({label_unit})"
+        )
+        target.plot(
+            profile.position_mm,
+            slope * profile.position_mm + intercept,
+            ":",
+            color=colour,
+            lw=1,
+            label=f"{name}: least-squares line",
+        )
         target.set_ylabel(f"{name} ({label_unit})")
         target.legend(fontsize=7, loc="upper left" if k == 0 else "lower right")
     if m.instrument == "grid":

@@ -32,9 +32,9 @@ import configparser
 import math
 import os
 import tomllib
+from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Mapping
 
 from ncpp.errors import Location, NcppError
 from ncpp.fileio import read_small
@@ -54,11 +54,15 @@ class Settings:
     var_units: str = "mm"
     tool_table: str | None = None
     origin: str = "defaults"  # where the machine file was named: "--machine", "NCPP_MACHINE" or a config path
-    subroutine_path: tuple[str, ...] = ()  # folders of subroutine files (LinuxCNC's [RS274NGC]SUBROUTINE_PATH)
+    subroutine_path: tuple[
+        str, ...
+    ] = ()  # folders of subroutine files (LinuxCNC's [RS274NGC]SUBROUTINE_PATH)
 
     def offsets(self) -> WorkOffsets:
         """The zeros the control holds, as these settings say them."""
-        return WorkOffsets.given(self.zeros, self.var_file, UNIT_MM[self.var_units], self.tool_table, self.subroutine_path)
+        return WorkOffsets.given(
+            self.zeros, self.var_file, UNIT_MM[self.var_units], self.tool_table, self.subroutine_path
+        )
 
 
 def config_paths(cwd: Path | None = None, env: Mapping[str, str] | None = None) -> list[Path]:
@@ -81,10 +85,14 @@ def read_config(path: Path) -> dict:
     except tomllib.TOMLDecodeError as err:
         from ncpp.machine.io import toml_error_location
 
-        raise NcppError(f"not a valid TOML config file: {err}", toml_error_location(err, text, str(path))) from None
+        raise NcppError(
+            f"not a valid TOML config file: {err}", toml_error_location(err, text, str(path))
+        ) from None
     unknown = sorted(set(data) - set(KEYS))
     if unknown:
-        raise NcppError(f"unknown key(s) {', '.join(unknown)} (known: {', '.join(KEYS)})", Location(str(path)))
+        raise NcppError(
+            f"unknown key(s) {', '.join(unknown)} (known: {', '.join(KEYS)})", Location(str(path))
+        )
     config: dict = {}
     for key in PATH_KEYS:
         if key in data:
@@ -93,7 +101,11 @@ def read_config(path: Path) -> dict:
             config[key] = str((path.parent / Path(data[key]).expanduser()).resolve())
     if "tolerance" in data:
         tolerance = data["tolerance"]
-        if isinstance(tolerance, bool) or not isinstance(tolerance, (int, float)) or not 0 < tolerance < math.inf:
+        if (
+            isinstance(tolerance, bool)
+            or not isinstance(tolerance, (int, float))
+            or not 0 < tolerance < math.inf
+        ):
             raise NcppError("`tolerance` must be a positive number of mm", Location(str(path)))
         config["tolerance"] = float(tolerance)
     if "work_offset" in data:
@@ -110,8 +122,17 @@ def _zeros(value, path: Path) -> dict[str, Vector]:
     table = value if isinstance(value, dict) else {"G54": value}
     zeros = {}
     for name, zero in table.items():
-        if not (isinstance(zero, list) and len(zero) == 3 and all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in zero)):
-            raise NcppError("`work_offset` must be [x, y, z] in mm (finite numbers), or a table of them by G word (G54 = [x, y, z])", Location(str(path)))
+        if not (
+            isinstance(zero, list)
+            and len(zero) == 3
+            and all(
+                isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in zero
+            )
+        ):
+            raise NcppError(
+                "`work_offset` must be [x, y, z] in mm (finite numbers), or a table of them by G word (G54 = [x, y, z])",
+                Location(str(path)),
+            )
         try:
             system_number(name)
         except ValueError as err:
@@ -169,7 +190,9 @@ def with_linuxcnc_ini(settings: Settings, ini: str | Path | None) -> Settings:
     if not ini:
         return settings
     path = Path(ini)
-    parser = configparser.ConfigParser(strict=False, interpolation=None)  # LinuxCNC INIs repeat keys (HALFILE)
+    parser = configparser.ConfigParser(
+        strict=False, interpolation=None
+    )  # LinuxCNC INIs repeat keys (HALFILE)
     parser.optionxform = str  # type: ignore[assignment,method-assign]
     try:
         parser.read_string(read_small(path, "a LinuxCNC INI file").decode("latin-1"), str(path))
@@ -185,7 +208,9 @@ def with_linuxcnc_ini(settings: Settings, ini: str | Path | None) -> Settings:
     var_file, tool_table = named("RS274NGC", "PARAMETER_FILE"), named("EMCIO", "TOOL_TABLE")
     folders = [parser.get("DISPLAY", "PROGRAM_PREFIX", fallback=""), *parser.get("RS274NGC", "SUBROUTINE_PATH", fallback="").split(":"),
                parser.get("WIZARD", "WIZARD_ROOT", fallback="")]  # fmt: skip
-    subroutine_path = tuple(str((path.parent / Path(f.strip()).expanduser()).resolve()) for f in folders if f.strip())
+    subroutine_path = tuple(
+        str((path.parent / Path(f.strip()).expanduser()).resolve()) for f in folders if f.strip()
+    )
     units = _INI_UNITS.get(parser.get("TRAJ", "LINEAR_UNITS", fallback="mm").strip().lower(), "mm")
     own_units = settings.var_file or settings.tool_table  # the config's files: its units
     return replace(

@@ -81,7 +81,9 @@ def run(path: str, err: TextIO, machine: str | None = None) -> None:
                 shutil.copyfileobj(stream, spool)
             else:
                 if not os.path.isfile(settings.machine):
-                    raise NcppError(f"machine file {settings.machine} does not exist", Location(settings.origin))
+                    raise NcppError(
+                        f"machine file {settings.machine} does not exist", Location(settings.origin)
+                    )
                 source = ErrorSource.from_machine_file(settings.machine)
                 offsets = settings.offsets()
                 with tempfile.TemporaryFile() as written:
@@ -140,7 +142,10 @@ def with_messages(written: BinaryIO, out: BinaryIO, messages: list[str]) -> None
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="ncpp-linuxcnc-filter", description="LinuxCNC [FILTER] program: compensate the program named on the command line")
+    parser = argparse.ArgumentParser(
+        prog="ncpp-linuxcnc-filter",
+        description="LinuxCNC [FILTER] program: compensate the program named on the command line",
+    )
     parser.add_argument("program", help="the NC program LinuxCNC opens")
     parser.add_argument("--machine", help="machine file (default: $NCPP_MACHINE, then the ncpp config files)")
     args = parser.parse_args(argv)
@@ -152,7 +157,10 @@ def main(argv: list[str] | None = None) -> int:
         print(str(error), file=sys.stderr)
         return 2
     except OSError as error:  # (a write's has no file name: LinuxCNC reads the standard output)
-        print(f"ncpp-linuxcnc-filter: {error.filename or '<stdout>'}: {error.strerror or error}", file=sys.stderr)
+        print(
+            f"ncpp-linuxcnc-filter: {error.filename or '<stdout>'}: {error.strerror or error}",
+            file=sys.stderr,
+        )
         return 2
     except KeyboardInterrupt:
         return 130

@@ -35,8 +35,8 @@ from __future__ import annotations
 
 import functools
 import math
+from collections.abc import Mapping
 from decimal import Decimal
-from typing import Mapping
 
 import pygcode
 from pygcode.comment import CommentBrackets, CommentSemicolon
@@ -92,9 +92,12 @@ def _pygcode_word(word: Word) -> pygcode.Word | None:
     return pygcode.Word(word.letter, kind(word.value))
 
 
+PLAIN = NumberStyle()  # numbers written as pygcode gives them
+
+
 def from_pygcode(
     line: pygcode.Line,
-    style: NumberStyle | Mapping[str, NumberStyle] = NumberStyle(),
+    style: NumberStyle | Mapping[str, NumberStyle] = PLAIN,
     eol: str = "\n",
 ) -> Block:
     """A Block parsed by ncpp from the line's words written in ncpp's number style."""

@@ -46,7 +46,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import cached_property
-from typing import Literal, Union
+from typing import Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -200,7 +200,7 @@ class Table:
             return curves[0](p)
         return _select(direction, curves[0](p), curves[1](p))
 
-    def scaled(self, factor: float) -> "Table":
+    def scaled(self, factor: float) -> Table:
         """The same table with values multiplied (unit conversion, sign flip)."""
         values = _floats(np.multiply(self.values, factor), "values")
         minus = self.values_minus
@@ -240,12 +240,12 @@ class Polynomial:
         # np.polyval wants the highest power first.
         return np.polyval(self.coefficients[::-1], p - self.reference)
 
-    def scaled(self, factor: float) -> "Polynomial":
+    def scaled(self, factor: float) -> Polynomial:
         coefficients = _floats(np.multiply(self.coefficients, factor), "coefficients")
         return Polynomial(coefficients, self.reference, self.limits)
 
 
-Component = Union[Table, Polynomial]
+Component = Table | Polynomial
 
 
 # ------------------------------------------------------------ fast evaluation
@@ -324,14 +324,18 @@ class StackedTables:
         if len(grid) == 1:
             grid = np.array([grid[0], grid[0] + 1.0])
         self.grid = grid
-        self.inner = grid[1:-1].copy()  # the interval of p in [grid[0], grid[-1]] is how many of these are <= p
+        self.inner = grid[
+            1:-1
+        ].copy()  # the interval of p in [grid[0], grid[-1]] is how many of these are <= p
         # Per power, a (curves, intervals) array: one gather along the intervals fetches every
         # curve, and each curve's values come out as a contiguous row (numpy's loops then run
         # along the points, not along a handful of curves)
         stacked = np.stack([_refine(x, c, grid) for x, c in pieces], axis=0)
         self.coefficients = [np.ascontiguousarray(stacked[:, :, k]) for k in range(4)]
         minus = iter(range(len(tables), len(curves)))
-        self.columns = [(k, next(minus) if t.directional else None) for k, t in enumerate(tables)]  # (+, − column)
+        self.columns = [
+            (k, next(minus) if t.directional else None) for k, t in enumerate(tables)
+        ]  # (+, − column)
 
     def __call__(self, positions: NDArray, direction: NDArray | None = None) -> NDArray:
         """(tables, n), row k table k's values: a directional table's + or − curve, or

@@ -36,20 +36,23 @@ MAX_INTERVALS = 256  # per axis: a table of the maxima over every run of interva
 class BowBound:
     """Bounds of ‖E''‖ along segments of a machine whose errors are smooth tables (`of`)."""
 
-    def __init__(self, machine, axes: dict[str, "_AxisBound"]):
+    def __init__(self, machine, axes: dict[str, _AxisBound]):
         self.chain = Chain(machine.chain)
         self.tool = np.asarray(machine.tool, dtype=float)
         self.references = {a: np.asarray(r, dtype=float) for a, r in machine.references.items()}
         self.axes = axes
 
     @classmethod
-    def of(cls, machine) -> "BowBound | None":
+    def of(cls, machine) -> BowBound | None:
         """The bound, or None where the error may not be smooth: a component other than a
         table, a table interpolated linearly (kinks), an effect that depends on position,
         or angles too large for MARGIN."""
         if any(effect.static for effect in machine.effects):
             return None
-        if any(not isinstance(c, Table) or (c.interpolation == "linear" and len(c.positions) > 2) for c in machine.components.values()):
+        if any(
+            not isinstance(c, Table) or (c.interpolation == "linear" and len(c.positions) > 2)
+            for c in machine.components.values()
+        ):
             return None
         axes: dict[str, _AxisBound] = {}
         angles = 0.0
@@ -73,7 +76,10 @@ class BowBound:
         for axis, bound in self.axes.items():
             k = AXES.index(axis)
             reference = self.references[axis]
-            lever = np.maximum(norm3(abbe_offset(self.chain, axis, start, tool, reference)), norm3(abbe_offset(self.chain, axis, end, tool, reference)))
+            lever = np.maximum(
+                norm3(abbe_offset(self.chain, axis, start, tool, reference)),
+                norm3(abbe_offset(self.chain, axis, end, tool, reference)),
+            )
             total += bound(np.minimum(start[:, k], end[:, k]), np.maximum(start[:, k], end[:, k]), lever)
         return MARGIN * total
 
@@ -81,13 +87,26 @@ class BowBound:
 class _AxisBound:
     """One axis's tables' derivatives, as maxima over every run of their intervals."""
 
-    def __init__(self, inner: NDArray, low: float, high: float, delta2: NDArray, eps2: NDArray, eps1: NDArray, angle: float):
+    def __init__(
+        self,
+        inner: NDArray,
+        low: float,
+        high: float,
+        delta2: NDArray,
+        eps2: NDArray,
+        eps1: NDArray,
+        angle: float,
+    ):
         self.inner, self.low, self.high = inner, low, high
-        self.delta2, self.eps2, self.eps1 = delta2, eps2, eps1  # (m, m): [i, j] the maximum over intervals i..j
+        self.delta2, self.eps2, self.eps1 = (
+            delta2,
+            eps2,
+            eps1,
+        )  # (m, m): [i, j] the maximum over intervals i..j
         self.angle = angle  # rad: the largest |ε| of each of its three angles, summed
 
     @classmethod
-    def of(cls, stacked: StackedTables, rows: list[int], tables: list[Table]) -> "_AxisBound | None":
+    def of(cls, stacked: StackedTables, rows: list[int], tables: list[Table]) -> _AxisBound | None:
         """From the axis's `tables` stacked (`rows`: each one's row of δx δy δz εx εy εz)."""
         grid = stacked.grid
         if len(grid) - 1 > MAX_INTERVALS:
@@ -114,9 +133,13 @@ class _AxisBound:
                 # the largest angle: at a breakpoint (smooth tables do not overshoot their values:
                 # PCHIP keeps each interval monotone), each interval's start or end
                 angle += float(max(np.abs(c3[curves]).max(), np.abs(ends[curves]).max()))
-        low = max(t.positions[0] for t in tables)  # where every table has values: outside one, it holds its end (a kink)
+        low = max(
+            t.positions[0] for t in tables
+        )  # where every table has values: outside one, it holds its end (a kink)
         high = min(t.positions[-1] for t in tables)
-        return cls(grid[1:-1].copy(), low, high, _run_maxima(delta2), _run_maxima(eps2), _run_maxima(eps1), angle)
+        return cls(
+            grid[1:-1].copy(), low, high, _run_maxima(delta2), _run_maxima(eps2), _run_maxima(eps1), angle
+        )
 
     def __call__(self, low: NDArray, high: NDArray, lever: NDArray) -> NDArray:
         """(n,) the axis's bound for segments whose positions on it span [low, high], with Abbe arms up to `lever`."""
@@ -131,4 +154,3 @@ def _run_maxima(values: NDArray) -> NDArray:
     for i in range(len(values)):
         out[i, i:] = np.maximum.accumulate(values[i:])
     return out
-

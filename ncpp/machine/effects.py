@@ -34,8 +34,9 @@ import dataclasses
 import math
 import numbers
 import typing
+from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, ClassVar, Mapping
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -71,7 +72,7 @@ class Effect:
     # direction of travel): compensation can cancel it like a geometric error.
     static: ClassVar[bool] = False
 
-    def apply(self, trajectory: Trajectory, machine: "Machine | None" = None) -> NDArray:
+    def apply(self, trajectory: Trajectory, machine: Machine | None = None) -> NDArray:
         raise NotImplementedError
 
     def to_dict(self) -> dict[str, Any]:
@@ -86,7 +87,9 @@ class Effect:
 def effect_from_dict(data: Mapping[str, Any]) -> Effect:
     """Build an effect from its dict (``kind`` plus parameters); ValueError if bad."""
     if not isinstance(data, Mapping):
-        raise ValueError(f'must be a table such as {{ kind = "backlash", axis = "X", um = 3.0 }}, not {data!r}')
+        raise ValueError(
+            f'must be a table such as {{ kind = "backlash", axis = "X", um = 3.0 }}, not {data!r}'
+        )
     kind = data.get("kind")
     cls = EFFECTS.get(kind) if isinstance(kind, str) else None
     if cls is None:
@@ -95,12 +98,19 @@ def effect_from_dict(data: Mapping[str, Any]) -> Effect:
     params = {k: v for k, v in data.items() if k != "kind"}
     unknown = sorted(set(params) - set(fields))
     if unknown:
-        raise ValueError(f"effect {kind}: unknown key(s) {', '.join(unknown)}; expected {', '.join(sorted(fields))}")
+        raise ValueError(
+            f"effect {kind}: unknown key(s) {', '.join(unknown)}; expected {', '.join(sorted(fields))}"
+        )
     missing = sorted(n for n, f in fields.items() if n not in params and f.default is dataclasses.MISSING)
     if missing:
         raise ValueError(f"effect {kind}: missing key(s) {', '.join(missing)}")
     hints = typing.get_type_hints(cls)
-    return cls(**{k: _size(f"effect {kind}: {k}", k, _param(f"effect {kind}: {k}", hints[k], v)) for k, v in params.items()})
+    return cls(
+        **{
+            k: _size(f"effect {kind}: {k}", k, _param(f"effect {kind}: {k}", hints[k], v))
+            for k, v in params.items()
+        }
+    )
 
 
 def is_finite_number(value: Any) -> bool:
@@ -117,7 +127,9 @@ def _size(what: str, key: str, value: Any) -> Any:
     """An error's size (µm, µm/m, µrad/m) past LARGEST_ERROR is a typing error, not a machine's:
     1e300 µm of backlash would make simulations report 'inf µm'."""
     if key.split("_")[0] in ("um", "urad") and isinstance(value, float) and not abs(value) <= LARGEST_ERROR:
-        raise ValueError(f"{what} must be within ±{LARGEST_ERROR:g} (an error of a metre is no machine's), not {value:g}")
+        raise ValueError(
+            f"{what} must be within ±{LARGEST_ERROR:g} (an error of a metre is no machine's), not {value:g}"
+        )
     return value
 
 
@@ -152,7 +164,7 @@ class Scale(Effect):
     def __post_init__(self) -> None:
         _axis(self.axis)
 
-    def apply(self, trajectory: Trajectory, machine: "Machine | None" = None) -> NDArray:
+    def apply(self, trajectory: Trajectory, machine: Machine | None = None) -> NDArray:
         i = _axis(self.axis)
         out = _zeros(trajectory)
         out[:, i] = self.um_per_m * 1e-6 * (trajectory.positions[:, i] - self.ref_mm)
@@ -194,7 +206,7 @@ class Backlash(Effect):
     def __post_init__(self) -> None:
         _axis(self.axis)
 
-    def apply(self, trajectory: Trajectory, machine: "Machine | None" = None) -> NDArray:
+    def apply(self, trajectory: Trajectory, machine: Machine | None = None) -> NDArray:
         i = _axis(self.axis)
         c = trajectory.positions[:, i]
         out = _zeros(trajectory)
@@ -214,7 +226,7 @@ class LateralPlay(Effect):
         if self.direction is not None and _axis(self.direction, "direction") == _axis(self.axis):
             raise ValueError("lateral_play: direction must differ from axis")
 
-    def apply(self, trajectory: Trajectory, machine: "Machine | None" = None) -> NDArray:
+    def apply(self, trajectory: Trajectory, machine: Machine | None = None) -> NDArray:
         i = _axis(self.axis)
         j = _axis(self.direction or LATERAL_DEFAULT[self.axis])
         out = _zeros(trajectory)
@@ -238,7 +250,7 @@ class ReversalSpike(Effect):
             if v is not None and not v > 0:
                 raise ValueError("reversal_spike: decay must be positive")
 
-    def apply(self, trajectory: Trajectory, machine: "Machine | None" = None) -> NDArray:
+    def apply(self, trajectory: Trajectory, machine: Machine | None = None) -> NDArray:
         i = _axis(self.axis)
         out = _zeros(trajectory)
         turns = trajectory.reversals(i)
@@ -271,7 +283,7 @@ class ServoMismatch(Effect):
             raise ValueError(f"servo_mismatch: axes must name two different axes, e.g. XY, not {self.axes!r}")
         _axis(self.axes[0], "axes"), _axis(self.axes[1], "axes")
 
-    def apply(self, trajectory: Trajectory, machine: "Machine | None" = None) -> NDArray:
+    def apply(self, trajectory: Trajectory, machine: Machine | None = None) -> NDArray:
         first, second = _axis(self.axes[0]), _axis(self.axes[1])
         half_tau = 0.5e-3 * self.ms  # s
         v = trajectory.velocity
@@ -292,7 +304,7 @@ class Squareness(Effect):
         if self.plane not in tuple(PLANE_TERMS):
             raise ValueError(f"squareness: plane must be XY, YZ or ZX, not {self.plane!r}")
 
-    def apply(self, trajectory: Trajectory, machine: "Machine | None" = None) -> NDArray:
+    def apply(self, trajectory: Trajectory, machine: Machine | None = None) -> NDArray:
         dev, drive = PLANE_TERMS[self.plane]
         out = _zeros(trajectory)
         out[:, dev] = self.um_per_m * 1e-6 * trajectory.positions[:, drive]
@@ -316,7 +328,7 @@ class Straightness(Effect):
             if not lo < hi:
                 raise ValueError("straightness: range_mm must be [lo, hi] with lo < hi")
 
-    def apply(self, trajectory: Trajectory, machine: "Machine | None" = None) -> NDArray:
+    def apply(self, trajectory: Trajectory, machine: Machine | None = None) -> NDArray:
         i, j = _axis(self.axis), _axis(self.direction)
         k = trajectory.positions[:, i]
         lo, hi = self.range_mm if self.range_mm is not None else (k.min(), k.max())
@@ -341,7 +353,7 @@ class Cyclic(Effect):
         if not self.period_mm > 0:
             raise ValueError("cyclic: period_mm must be positive")
 
-    def apply(self, trajectory: Trajectory, machine: "Machine | None" = None) -> NDArray:
+    def apply(self, trajectory: Trajectory, machine: Machine | None = None) -> NDArray:
         i = _axis(self.axis)
         out = _zeros(trajectory)
         phase = 2 * np.pi * trajectory.positions[:, i] / self.period_mm + np.deg2rad(self.phase_deg)
@@ -360,9 +372,11 @@ class Angular(Effect):
     def __post_init__(self) -> None:
         info = COMPONENTS.get(self.component) if isinstance(self.component, str) else None
         if info is None or info.kind != "rotation":
-            raise ValueError(f"angular: component must be an angular error such as ECZ, not {self.component!r}")
+            raise ValueError(
+                f"angular: component must be an angular error such as ECZ, not {self.component!r}"
+            )
 
-    def apply(self, trajectory: Trajectory, machine: "Machine | None" = None) -> NDArray:
+    def apply(self, trajectory: Trajectory, machine: Machine | None = None) -> NDArray:
         info = COMPONENTS[self.component]
         P = trajectory.positions
         i = AXES.index(info.axis)
@@ -374,5 +388,15 @@ class Angular(Effect):
 
 EFFECTS: dict[str, type[Effect]] = {
     cls.kind: cls
-    for cls in (Scale, Backlash, LateralPlay, ReversalSpike, ServoMismatch, Squareness, Straightness, Cyclic, Angular)
+    for cls in (
+        Scale,
+        Backlash,
+        LateralPlay,
+        ReversalSpike,
+        ServoMismatch,
+        Squareness,
+        Straightness,
+        Cyclic,
+        Angular,
+    )
 }

@@ -132,12 +132,13 @@ class _Locator:
         line = self.lines[index] if index < len(self.lines) else ""
         return Location(self.file, index + 1, len(line) - len(line.lstrip()) + 1)
 
-
     def item(self, key: str, nth: int, inner: str | None = None) -> Location | None:
         """Where item `nth` of a top-level array ``key = [...]`` begins, or its key `inner`
         (an inline table is on one line); None if there is no such array or item."""
         opening = re.compile(r"^\s*\"?" + re.escape(key) + r"\"?\s*=\s*\[")
-        ends = (i for i, line in enumerate(self.lines) if opening.match(line) or line.lstrip().startswith("["))
+        ends = (
+            i for i, line in enumerate(self.lines) if opening.match(line) or line.lstrip().startswith("[")
+        )
         row = next(ends, None)
         if row is None or not opening.match(self.lines[row]):  # top-level keys come before the first table
             return None
@@ -288,7 +289,7 @@ def _machine_from_dict(data: dict, loc: _Locator, default_name: str) -> Machine:
     head = _get_table(data, "machine", loc)
     _check_keys(head, {"name", "chain", "description"}, "machine", loc)
     if "chain" not in head:
-        raise _fail("[machine] needs chain, e.g. chain = \"XZFY\"", loc.where("machine"))
+        raise _fail('[machine] needs chain, e.g. chain = "XZFY"', loc.where("machine"))
     offsets = _get_table(data, "offsets", loc)
     _check_keys(offsets, {"tool", "work", "reference"}, "offsets", loc)
     given = {k: v for k, v in offsets.items() if k != "reference"}
@@ -340,7 +341,9 @@ def _refuse_non_finite(data: dict, loc: _Locator) -> None:
             continue
         table, key, items = path[:last], path[last], path[last + 1 :]
         name = "".join(f" #{p + 1}" if isinstance(p, int) else f".{p}" for p in table)[1:]
-        what = f"finite numbers, not {value} (item {items[0] + 1})" if items else f"a finite number, not {value}"
+        what = (
+            f"finite numbers, not {value} (item {items[0] + 1})" if items else f"a finite number, not {value}"
+        )
         if table[0] == "effects" and len(table) == 2:
             where = _effect_where(loc, table[1], key)
         else:
@@ -362,7 +365,9 @@ def _vectors(table: dict, section: str, names: str, loc: _Locator) -> dict[str, 
 def _vector(value: Any, key: str, names: str) -> list[float]:
     size = names.count(",") + 1
     if not (isinstance(value, list) and len(value) == size and all(map(is_finite_number, value))):
-        raise ValueError(f"{key} must be {NUMBERS.get(size, size)} numbers [{names}] in mm, not {_shown(value)}")
+        raise ValueError(
+            f"{key} must be {NUMBERS.get(size, size)} numbers [{names}] in mm, not {_shown(value)}"
+        )
     if any(abs(v) > LARGEST_LENGTH_MM for v in value):
         raise ValueError(f"{key} must be within ±{LARGEST_LENGTH_MM:g} mm (a kilometre), not {_shown(value)}")
     return [float(v) for v in value]
@@ -451,7 +456,9 @@ def _effects(data: dict, loc: _Locator) -> tuple:
         try:
             parsed.append(effect_from_dict(spec))
         except (ValueError, TypeError) as err:
-            raise _fail(f"effects #{n + 1}: {err}", _effect_where(loc, n, _key_named_in(str(err), spec))) from err
+            raise _fail(
+                f"effects #{n + 1}: {err}", _effect_where(loc, n, _key_named_in(str(err), spec))
+            ) from err
     return tuple(parsed)
 
 
@@ -518,18 +525,20 @@ def _number(value: Any, key: str) -> float:
 
 def _component_from_dict(iso: str, spec: Any, travel: tuple[float, float] | None) -> Table | Polynomial:
     if not isinstance(spec, dict):
-        raise ValueError("must be a table with kind = \"table\" or \"polynomial\"")
+        raise ValueError('must be a table with kind = "table" or "polynomial"')
     unit = COMPONENTS[iso].unit
     other = "urad" if unit == "um" else "um"
     for key in spec:
         if other in key.split("_"):
-            raise ValueError(f"{key}: {iso} is {'an angle' if unit == 'urad' else 'a length'}, give values in {unit}")
+            raise ValueError(
+                f"{key}: {iso} is {'an angle' if unit == 'urad' else 'a length'}, give values in {unit}"
+            )
     kind = spec.get("kind", "polynomial" if f"coefficients_{unit}" in spec else "table")
     if kind == "table":
         return _table(spec, unit)
     if kind == "polynomial":
         return _polynomial(spec, unit, travel)
-    raise ValueError(f"kind must be \"table\" or \"polynomial\", not {kind!r}")
+    raise ValueError(f'kind must be "table" or "polynomial", not {kind!r}')
 
 
 def _table(spec: dict, unit: str) -> Table:
@@ -564,7 +573,9 @@ def _polynomial(spec: dict, unit: str, travel: tuple[float, float] | None) -> Po
             values = poly(np.linspace(*span, 101))
         if not np.all(np.isfinite(values)):
             raise ValueError(f"{key} overflow between {span[0]:g} and {span[1]:g} mm: they are too large")
-        (_small_angles if unit == "urad" else _small_lengths)(values, f"{key} between {span[0]:g} and {span[1]:g} mm")
+        (_small_angles if unit == "urad" else _small_lengths)(
+            values, f"{key} between {span[0]:g} and {span[1]:g} mm"
+        )
     return poly
 
 

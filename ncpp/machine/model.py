@@ -11,9 +11,10 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from functools import cached_property, partial
-from typing import TYPE_CHECKING, Any, Mapping
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -37,8 +38,8 @@ from ncpp.machine.components import (
 )
 
 if TYPE_CHECKING:
-    from ncpp.machine.effects import Effect
     from ncpp.machine.curvature import BowBound
+    from ncpp.machine.effects import Effect
     from ncpp.machine.trajectory import Trajectory
 
 Vec3 = tuple[float, float, float]
@@ -100,7 +101,7 @@ class Machine:
     limits: Mapping[str, tuple[float, float]] = field(default_factory=dict)
     components: Mapping[str, Component] = field(default_factory=dict)
     squareness: Mapping[str, float] = field(default_factory=dict)
-    effects: tuple["Effect", ...] = ()
+    effects: tuple[Effect, ...] = ()
     max_correction_mm: float = 0.5
     meta: Mapping[str, Any] = field(default_factory=dict)
     # The programmed X Y Z are the linear axes' positions also while a rotary axis turns (no
@@ -176,11 +177,15 @@ class Machine:
             mine = [(_motion_row(n), c) for n, c in self.components.items() if COMPONENTS[n].axis == axis]
             tables = [(row, c) for row, c in mine if isinstance(c, Table)]
             stacked = StackedTables([c for _, c in tables]) if tables else None
-            out[axis] = (stacked, [row for row, _ in tables], [(row, c) for row, c in mine if not isinstance(c, Table)])
+            out[axis] = (
+                stacked,
+                [row for row, _ in tables],
+                [(row, c) for row, c in mine if not isinstance(c, Table)],
+            )
         return out
 
     @cached_property
-    def bow_bound(self) -> "BowBound | None":
+    def bow_bound(self) -> BowBound | None:
         """Bounds of the second derivative of `static_deviation` along segments
         (`curvature.BowBound`), or None where the errors may not be smooth."""
         from ncpp.machine.curvature import BowBound
@@ -201,7 +206,9 @@ class Machine:
             if values is not None and rows == MOTION_ROWS:
                 motions = values  # all six are tables: their values are the motions, as they are
             else:
-                motions = np.zeros((6, len(pts)))  # δx δy δz εx εy εz, each row contiguous (see chain.columns)
+                motions = np.zeros(
+                    (6, len(pts))
+                )  # δx δy δz εx εy εz, each row contiguous (see chain.columns)
                 if values is not None:
                     motions[rows] = values
                 for row, component in others:
@@ -227,17 +234,25 @@ class Machine:
         """The axes' direction errors from squareness (chain.direction_errors), once."""
         return direction_errors(self._frame[3])
 
-    def _blockwise(self, kernel, P: ArrayLike, direction: ArrayLike | None, tool_offset: ArrayLike | None = None) -> NDArray:
+    def _blockwise(
+        self, kernel, P: ArrayLike, direction: ArrayLike | None, tool_offset: ArrayLike | None = None
+    ) -> NDArray:
         pts = np.ascontiguousarray(as_points(P).T).T  # columns contiguous, like the algebra
         dirs = None if direction is None else _per_point(direction, pts.shape)
         tools = None if tool_offset is None else _per_point(tool_offset, pts.shape)
         out = np.empty(pts.shape)
         for start in range(0, len(pts), CHUNK):
             block = slice(start, start + CHUNK)
-            out[block] = kernel(*self._kinematics(pts[block], None if dirs is None else dirs[block], None if tools is None else tools[block]))
+            out[block] = kernel(
+                *self._kinematics(
+                    pts[block], None if dirs is None else dirs[block], None if tools is None else tools[block]
+                )
+            )
         return _shaped_like(out, P)
 
-    def deviation(self, P: ArrayLike, direction: ArrayLike | None = None, tool_offset: ArrayLike | None = None) -> NDArray:
+    def deviation(
+        self, P: ArrayLike, direction: ArrayLike | None = None, tool_offset: ArrayLike | None = None
+    ) -> NDArray:
         """Actual minus nominal tool point relative to the workpiece, mm.
 
         P: (n,3) axis positions X, Y, Z in mm (or one (3,) point).
@@ -245,9 +260,13 @@ class Machine:
         tables (None or 0: the mean of the + and − tables).
         tool_offset: optional (n,3) tool length offsets in effect (the control's
         G43), mm: the tool point is `tool` minus it, a longer Abbe arm for a longer tool."""
-        return self._blockwise(partial(exact_deviation, directions=self._directions), P, direction, tool_offset)
+        return self._blockwise(
+            partial(exact_deviation, directions=self._directions), P, direction, tool_offset
+        )
 
-    def static_deviation(self, P: ArrayLike, direction: ArrayLike | None = None, tool_offset: ArrayLike | None = None) -> NDArray:
+    def static_deviation(
+        self, P: ArrayLike, direction: ArrayLike | None = None, tool_offset: ArrayLike | None = None
+    ) -> NDArray:
         """Geometric deviation plus the effects that depend on position alone
         (scale, squareness, straightness, cyclic, angular), mm: what
         compensation can cancel.  A straightness bow without `range_mm` spans
@@ -277,7 +296,9 @@ class Machine:
         """Lever arm L_K (mm) through which axis K's rotation moves the tool point."""
         pts = as_points(P)
         return _shaped_like(
-            abbe_offset(Chain(self.chain), axis, pts, np.asarray(self.tool), np.asarray(self.references[axis])),
+            abbe_offset(
+                Chain(self.chain), axis, pts, np.asarray(self.tool), np.asarray(self.references[axis])
+            ),
             P,
         )
 
@@ -319,7 +340,7 @@ class Machine:
             total = total * Rotation.from_rotvec(sign * eps[axis])
         return total.as_rotvec()
 
-    def simulate(self, trajectory: "Trajectory", tool_offset: ArrayLike | None = None) -> NDArray:
+    def simulate(self, trajectory: Trajectory, tool_offset: ArrayLike | None = None) -> NDArray:
         """Actual tool positions (n,3) mm along a sampled trajectory: command +
         geometric deviation (direction of travel from the trajectory; `tool_offset`
         (n,3): the tool length offsets in effect, as in `deviation`) + effects."""
@@ -330,7 +351,7 @@ class Machine:
         return actual
 
     # ---------------------------------------------------------------- values
-    def with_components(self, **updates: Component | float | None) -> "Machine":
+    def with_components(self, **updates: Component | float | None) -> Machine:
         """New machine with components (ISO or Rahman 2004 names) replaced; None removes.
         Squareness names take an angle in rad."""
         comps = dict(self.components)
@@ -345,10 +366,10 @@ class Machine:
                 comps[iso] = value  # type: ignore[assignment]
         return dataclasses.replace(self, components=comps, squareness=sq)
 
-    def replace(self, **changes: Any) -> "Machine":
+    def replace(self, **changes: Any) -> Machine:
         """New machine with fields replaced (dataclasses.replace, validated)."""
         return dataclasses.replace(self, **changes)
 
-    def without_errors(self) -> "Machine":
+    def without_errors(self) -> Machine:
         """The same structure with no errors and no effects (the ideal machine)."""
         return dataclasses.replace(self, components={}, squareness={}, effects=())

@@ -46,7 +46,7 @@ class Trajectory:
 
     # ---------------------------------------------------------- constructors
     @classmethod
-    def line(cls, start: ArrayLike, end: ArrayLike, feed_mm_min: float, step_mm: float = 1.0) -> "Trajectory":
+    def line(cls, start: ArrayLike, end: ArrayLike, feed_mm_min: float, step_mm: float = 1.0) -> Trajectory:
         """Straight move from start to end, sampled about every step_mm."""
         a, b = np.asarray(start, dtype=float), np.asarray(end, dtype=float)
         n = max(2, int(np.ceil(np.linalg.norm(b - a) / step_mm)) + 1)
@@ -65,7 +65,7 @@ class Trajectory:
         sweep_deg: float = 360.0,
         overshoot_deg: float = 0.0,
         step_deg: float = 0.25,
-    ) -> "Trajectory":
+    ) -> Trajectory:
         """Circle in plane XY | YZ | ZX about `centre` (command coordinates).
 
         Angles follow the ball-bar file: from the plane's first axis towards
@@ -88,7 +88,7 @@ class Trajectory:
         pos[:, second] += radius * np.sin(ang)
         return cls(pos, feed_mm_min)
 
-    def then(self, other: "Trajectory") -> "Trajectory":
+    def then(self, other: Trajectory) -> Trajectory:
         """This path followed by another (time continues; the feed of the
         first is kept as the nominal feed, each part's own timing is kept)."""
         t2 = other.time - other.time[0] + self.time[-1]

@@ -63,7 +63,9 @@ def read_canon(text: str) -> list[CanonCall]:
 def canon_call(event: Event) -> CanonCall | None:
     """The rs274 canonical call of a motion event, at full precision; None for a Pass."""
     if type(event) is Line:
-        return CanonCall("STRAIGHT_TRAVERSE" if event.rapid else "STRAIGHT_FEED", (*event.end, *_rotary(event.extra)))
+        return CanonCall(
+            "STRAIGHT_TRAVERSE" if event.rapid else "STRAIGHT_FEED", (*event.end, *_rotary(event.extra))
+        )
     if type(event) is Arc:
         a, b, n = PLANE_AXES[event.context.plane]
         e, c = event.end, event.center

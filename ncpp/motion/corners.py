@@ -20,8 +20,9 @@ class CornerError(ValueError):
     """A corner that cannot be made (out of plane, zero-length move, too large)."""
 
 
-def round_corner(first: Line, second: Line, kind: str, size: float, block: Block | None = None,
-                 feed: float | None = None) -> list[Event]:
+def round_corner(
+    first: Line, second: Line, kind: str, size: float, block: Block | None = None, feed: float | None = None
+) -> list[Event]:
     """[first shortened, fillet arc (kind 'R') or chamfer line (kind 'C'), second from the tangent point].
 
     `size` is the fillet radius or the chamfer's leg along each line; the
@@ -44,7 +45,9 @@ def round_corner(first: Line, second: Line, kind: str, size: float, block: Block
     turn = math.atan2(abs(cross), dot)  # direction change, 0..pi
     distance = size if kind == "C" else size * math.tan(turn / 2)
     if distance > lu + TINY or distance > lv + TINY:
-        raise CornerError(f"corner {'chamfer' if kind == 'C' else 'radius'} {size:g} does not fit between the moves")
+        raise CornerError(
+            f"corner {'chamfer' if kind == 'C' else 'radius'} {size:g} does not fit between the moves"
+        )
     corner = first.end
     start = _in_plane(corner, i, j, corner[i] - distance * u[0], corner[j] - distance * u[1])
     end = _in_plane(corner, i, j, corner[i] + distance * v[0], corner[j] + distance * v[1])

@@ -23,7 +23,16 @@ RAPID_DELTA_INCH = 0.010
 Move = tuple[float, float, float, bool]  # (aa, bb, cc, rapid)
 
 
-def hole(motion: float, aa: float, bb: float, r: float, clear: float, bottom: float, peck: float, rapid_delta: float) -> list[Move]:
+def hole(
+    motion: float,
+    aa: float,
+    bb: float,
+    r: float,
+    clear: float,
+    bottom: float,
+    peck: float,
+    rapid_delta: float,
+) -> list[Move]:
     """The moves of one hole, from above it at the R plane (`r`) back out to `clear`."""
     moves: list[Move] = []
     if motion in PECKING:
@@ -41,7 +50,9 @@ def hole(motion: float, aa: float, bb: float, r: float, clear: float, bottom: fl
     return moves
 
 
-def back_bore(aa: float, bb: float, off_a: float, off_b: float, r: float, clear: float, middle: float, bottom: float) -> list[Move]:
+def back_bore(
+    aa: float, bb: float, off_a: float, off_b: float, r: float, clear: float, middle: float, bottom: float
+) -> list[Move]:
     """G87: in beside the hole (`off_a`, `off_b`) with the spindle oriented, feed up to
     `middle` and back from the bottom, out the same way."""
     return [

@@ -10,7 +10,7 @@ is never negative, ROUND rounds half away from zero.
 from __future__ import annotations
 
 import math
-from typing import Callable
+from collections.abc import Callable
 
 # rs274ngc: numbered parameters 1..RS274NGC_MAX_PARAMETERS-1 (#0 is Fanuc's null, read as 0)
 MAX_PARAMETER = 5601
@@ -134,15 +134,24 @@ class Parameters:
 
     def __init__(self, system: Callable[[str], float | None] | None = None):
         self.numbered: dict[int, float] = {}
-        self.named: dict[str, float] = {"_value": 0.0, "_value_returned": 0.0}  # what the last subroutine returned
+        self.named: dict[str, float] = {
+            "_value": 0.0,
+            "_value_returned": 0.0,
+        }  # what the last subroutine returned
         self.system = system
-        self._callers: list[tuple[list[float] | None, dict[str, float]]] = []  # per call level: the caller's #1..#30 and local names
+        self._callers: list[
+            tuple[list[float] | None, dict[str, float]]
+        ] = []  # per call level: the caller's #1..#30 and local names
 
     def enter(self, arguments: list[float] | None) -> None:
         """A subroutine call: #1..#30 are its arguments (0 past the last; None, a Fanuc
         M98 call: the caller's, shared), and names without a leading underscore are
         its own (the caller's come back at `leave`)."""
-        saved = None if arguments is None else [self.numbered.get(n, 0.0) for n in range(1, SUBROUTINE_PARAMETERS + 1)]
+        saved = (
+            None
+            if arguments is None
+            else [self.numbered.get(n, 0.0) for n in range(1, SUBROUTINE_PARAMETERS + 1)]
+        )
         local = {k: v for k, v in self.named.items() if not k.startswith("_")}
         for k in local:
             del self.named[k]
@@ -195,7 +204,9 @@ class Parameters:
             return True
         name: str = key  # type: ignore[assignment]  # not an int
         system = self.system
-        return name in self.named or (name.startswith("_") and system is not None and system(name) is not None)
+        return name in self.named or (
+            name.startswith("_") and system is not None and system(name) is not None
+        )
 
     def write(self, key: int | str, value: float) -> None:
         if type(key) is int:

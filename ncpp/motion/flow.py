@@ -34,9 +34,9 @@ bodies for the call.
 from __future__ import annotations
 
 import os
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable, Iterable, Iterator, Sequence
 
 from ncpp.errors import Location, NcppError, printable
 from ncpp.motion.expressions import SUBROUTINE_PARAMETERS, normalise_name, round_half_away
@@ -59,7 +59,9 @@ MAX_CALL_LEVELS = 10
 class Control:
     """The o-word of a control line: `o100 while [#1 LT 3]` is ("100", "while", (expr,))."""
 
-    name: str | tuple | None  # a tuple: `o[expr]`, an expression evaluated where the line runs; None: M98, M99
+    name: (
+        str | tuple | None
+    )  # a tuple: `o[expr]`, an expression evaluated where the line runs; None: M98, M99
     keyword: str  # sub, call, while, ...; m98, m99
     arguments: tuple  # expressions; M98's P and L words
     item: Statement | Word | ExprWord  # where messages point
@@ -81,7 +83,9 @@ class _Frame:
     space: list[Block] | None
     pc: int  # the next block to run: an index into the space (the main program: a line number from 0)
     labels: dict[str, _Label] = field(default_factory=dict)  # its loops under way
-    ifs: set[str] = field(default_factory=set)  # the if chains it has started (their elseif, else and endif may follow)
+    ifs: set[str] = field(
+        default_factory=set
+    )  # the if chains it has started (their elseif, else and endif may follow)
     # Per label, (index, keyword, line) of the first if, while, repeat or do it ran: rs274ngc
     # refuses a label that opens one of these at another line (`_opens`)
     opened: dict[str, tuple[int, str, int]] = field(default_factory=dict)
@@ -99,8 +103,23 @@ class Flow:
     `stop(reason, block, col)` ends it where the flow leaves the scope;
     `path`: the folders of subroutine files."""
 
-    def __init__(self, file: str, evaluate: Callable, parameters, done: Callable[[], bool], stop: Callable, path: Sequence[Path] = ()):
-        self.file, self.evaluate, self.parameters, self.done, self.stop, self.path = file, evaluate, parameters, done, stop, tuple(path)
+    def __init__(
+        self,
+        file: str,
+        evaluate: Callable,
+        parameters,
+        done: Callable[[], bool],
+        stop: Callable,
+        path: Sequence[Path] = (),
+    ):
+        self.file, self.evaluate, self.parameters, self.done, self.stop, self.path = (
+            file,
+            evaluate,
+            parameters,
+            done,
+            stop,
+            tuple(path),
+        )
         self.files: dict[str, str] = {}  # subroutine name -> the file it was read from
         self.buffer: list[Block] = []  # main-program blocks read and still wanted, from line `base`
         self.base = 0
@@ -109,9 +128,15 @@ class Flow:
         self.owner: Block | None = None  # the last block yielded in text order
         self.subroutines: dict[str, list[Block]] = {}  # name -> its lines, `sub` to `endsub`
         self.subprograms: dict[str, list[Block]] = {}  # Fanuc: number -> its lines, `O<n>` to `M99`
-        self.defined_at: dict[str, int] = {}  # subroutine name -> the line of the definition the program met (run or called)
-        self._definitions: dict[int, list[Block]] = {}  # every o-word definition read, by the line of its `sub`
-        self._defining: tuple[dict, str, list[Block]] | None = None  # a definition being read: where it goes, its name, lines
+        self.defined_at: dict[
+            str, int
+        ] = {}  # subroutine name -> the line of the definition the program met (run or called)
+        self._definitions: dict[
+            int, list[Block]
+        ] = {}  # every o-word definition read, by the line of its `sub`
+        self._defining: tuple[dict, str, list[Block]] | None = (
+            None  # a definition being read: where it goes, its name, lines
+        )
         self.frames = [_Frame(None, 0)]
         self.stream: Iterator[Block] = iter(())
         # rs274ngc's state, global as there (its quirks come with it: a `break` out of a while loop
@@ -134,7 +159,13 @@ class Flow:
         block: Block | None
         while not self.done():
             frame = self.frames[-1]
-            if frame is main and main.pc == self.read and not main.labels and self.skipping is None and self._defining is None:
+            if (
+                frame is main
+                and main.pc == self.read
+                and not main.labels
+                and self.skipping is None
+                and self._defining is None
+            ):
                 # the common case, nothing read ahead and no loop to go back to: straight from the stream
                 self._drop(len(self.buffer))
                 for block in self.stream:
@@ -154,7 +185,10 @@ class Flow:
             block = self._block(frame, frame.pc)
             if block is None:  # the end of the text (a subroutine's ends with its endsub)
                 if frame.space is not None:  # skipped past its endsub
-                    raise NcppError(f"o{_shown(self.skipping or '')} is not closed in its subroutine", Location(self.file, frame.space[-1].line, None))
+                    raise NcppError(
+                        f"o{_shown(self.skipping or '')} is not closed in its subroutine",
+                        Location(self.file, frame.space[-1].line, None),
+                    )
                 return  # LinuxCNC too ends a program whose file ends, in a loop or skipping
             if not self._in_place(frame):
                 self.rerun += 1
@@ -162,7 +196,9 @@ class Flow:
                     self.stop(f"a loop that does not end ({MAX_RERUN:,} lines run again)", self.owner, None)
                     break
             control = self._control_of(block)
-            if self.skipping is not None and (control is None or control.name != self.skipping):  # (M98, M99: None)
+            if self.skipping is not None and (
+                control is None or control.name != self.skipping
+            ):  # (M98, M99: None)
                 if self._in_place(frame):
                     yield block, SKIP, None
                 self._advance(frame)
@@ -216,7 +252,9 @@ class Flow:
         items = block.items
         for item in items[items.index(control.item) + 1 :]:
             if type(item) is not Comment:
-                raise NcppError("Unexpected character after O-word", Location(self.file, block.line, item.start + 1))
+                raise NcppError(
+                    "Unexpected character after O-word", Location(self.file, block.line, item.start + 1)
+                )
 
     def _rest(self) -> Iterator[tuple[Block, str, Block | None]]:
         """After the program's end: every block not yet written, as text."""
@@ -254,14 +292,19 @@ class Flow:
         if self._defining is not None and not (starts and self._defining[0] is self.subprograms):
             self._extend_definition(block, control)
         elif starts:  # (a Fanuc definition under way was a program's own number; else a sub's control, named)
-            self._defining = (self.subroutines, control.name, [block]) if number is None else (self.subprograms, number, [block])  # type: ignore[union-attr, assignment]
+            name = control.name if number is None else number  # type: ignore[union-attr]
+            self._defining = (self.subroutines if number is None else self.subprograms, name, [block])  # type: ignore[assignment]
 
     def _extend_definition(self, block: Block, control: Control | None) -> None:
         found, name, lines = self._defining  # type: ignore[misc]
         lines.append(block)
         fanuc = found is self.subprograms
-        if control is not None and (control.keyword == "m99" if fanuc else control.keyword == "endsub" and control.name == name):
-            found.setdefault(name, lines)  # the first definition counts, until the program meets another (`_sub`)
+        if control is not None and (
+            control.keyword == "m99" if fanuc else control.keyword == "endsub" and control.name == name
+        ):
+            found.setdefault(
+                name, lines
+            )  # the first definition counts, until the program meets another (`_sub`)
             if not fanuc:
                 self._definitions[lines[0].line] = lines
             self._defining = None
@@ -271,17 +314,23 @@ class Flow:
     # -- control lines -----------------------------------------------------------
     # _NAMED: an o-word line's handler sees its name as a str (`_control` evaluates `o[expr]`
     # first; None is M98's and M99's, whose handlers use no label)
-    def _control(self, frame: _Frame, block: Block, control: Control) -> Iterator[tuple[Block, str, Block | None]]:
+    def _control(
+        self, frame: _Frame, block: Block, control: Control
+    ) -> Iterator[tuple[Block, str, Block | None]]:
         """Run one control line: decide (errors point at it), write it, then jump."""
         if control.keyword not in ("m98", "m99"):
             self._nothing_after(block, control)
         if type(control.name) is tuple:
             value = self.evaluate(control.name, block, control.item)
-            control = Control(str(int(round_half_away(value))), control.keyword, control.arguments, control.item)
+            control = Control(
+                str(int(round_half_away(value))), control.keyword, control.arguments, control.item
+            )
         keyword = control.keyword
         act = getattr(self, "_" + keyword)
         arrived, self.skipping = self.skipping is not None, None  # (skipping to this line: it runs)
-        jump = act(frame, block, control, arrived)  # a function that moves the frame(s) on, or a generator doing so
+        jump = act(
+            frame, block, control, arrived
+        )  # a function that moves the frame(s) on, or a generator doing so
         if self._in_place(frame):
             yield block, (SKIP if keyword == "sub" else TEXT), None
             self._wrote(frame.pc)
@@ -297,7 +346,11 @@ class Flow:
         if frame.space is None:
             first = self.defined_at.setdefault(control.name, -1)  # (-1: none before)
             if first == block.line:  # called ahead of it, or met in a loop before
-                raise self._error("sub found in illegal location: the program met this definition before (a call ahead of it, a loop)", block, control)
+                raise self._error(
+                    "sub found in illegal location: the program met this definition before (a call ahead of it, a loop)",
+                    block,
+                    control,
+                )
             if first != -1:
                 raise self._error(f"sub redefines the subroutine defined in line {first}", block, control)
             self.defined_at[control.name] = block.line
@@ -305,7 +358,9 @@ class Flow:
         def skip():
             yield from self._skip_definition(frame, control.name)
             met = self._definitions.get(block.line) if frame.space is None else None
-            if met is not None:  # rs274ngc calls the definition the program met (one in an untaken branch it did not)
+            if (
+                met is not None
+            ):  # rs274ngc calls the definition the program met (one in an untaken branch it did not)
                 self.subroutines[control.name] = met
 
         return skip
@@ -331,7 +386,9 @@ class Flow:
         name = control.name
         body = self.subroutines.get(name) or self._from_file(name) or self._defined(self.subroutines, name)
         if body is None:
-            where = f" nor is o{_shown(name)}.ngc in {os.pathsep.join(map(str, self.path))}" if self.path else ""
+            where = (
+                f" nor is o{_shown(name)}.ngc in {os.pathsep.join(map(str, self.path))}" if self.path else ""
+            )
             self.stop(f"a call of o{_shown(name)}, which the program does not define (a subroutine file: give its folder "
                       f"with --subroutine-path; the LinuxCNC filter reads the INI's SUBROUTINE_PATH){where}", block, control.item.start + 1)  # fmt: skip
             return lambda: None
@@ -363,7 +420,9 @@ class Flow:
                             self.subroutines[name], self.files[name] = lines, str(path)
                             return lines
             shown = printable(name)
-            raise NcppError(f"o<{shown}> sub ... o<{shown}> endsub is not in the file", Location(str(path), 1, 1))
+            raise NcppError(
+                f"o<{shown}> sub ... o<{shown}> endsub is not in the file", Location(str(path), 1, 1)
+            )
         return None
 
     def source(self) -> str | None:
@@ -373,10 +432,17 @@ class Flow:
     def _m98(self, frame, block, control, arrived):
         """A Fanuc subprogram call: `M98 P<n> L<repeats>`."""
         number, repeats = (None if item is None else self._number(item, block) for item in control.arguments)
-        name, runs = str(int(round_half_away(number))), 1 if repeats is None else int(round_half_away(repeats))
+        name, runs = (
+            str(int(round_half_away(number))),
+            1 if repeats is None else int(round_half_away(repeats)),
+        )
         body = self._defined(self.subprograms, name)
         if body is None:
-            self.stop(f"M98 P{name}: a subprogram the program does not define (O{name} to M99)", block, control.item.start + 1)
+            self.stop(
+                f"M98 P{name}: a subprogram the program does not define (O{name} to M99)",
+                block,
+                control.item.start + 1,
+            )
             return lambda: None
 
         self._check_level(block, control)
@@ -403,7 +469,10 @@ class Flow:
             self.stop("M99 in the main program (an endless main program)", block, control.item.start + 1)
             return lambda: None
         if frame.repeats < 0:
-            raise NcppError("an o-word subroutine ends with o... endsub or o... return, not M99", Location(self.file, block.line, control.item.start + 1))
+            raise NcppError(
+                "an o-word subroutine ends with o... endsub or o... return, not M99",
+                Location(self.file, block.line, control.item.start + 1),
+            )
 
         def leave():
             self.parameters.leave(None)
@@ -527,7 +596,9 @@ class Flow:
         run one (the `while` of a do loop closes it), else a duplicate label (a reused `o1 if`)."""
         first = frame.opened.setdefault(control.name, (frame.pc, control.keyword, block.line))  # type: ignore[arg-type]  # (_NAMED)
         if first[0] != frame.pc and not (first[1] == "do" and control.keyword == "while"):
-            raise self._error(f"is a duplicate O-word label: already defined in line {first[2]}", block, control)
+            raise self._error(
+                f"is a duplicate O-word label: already defined in line {first[2]}", block, control
+            )
 
     def _on(self, frame: _Frame, skipping: str | None) -> Callable[[], None]:
         """On to the next line, skipping to the next line of o-word `skipping` (None: not)."""
@@ -556,8 +627,12 @@ class Flow:
                 shown = _shown(name)
                 raise NcppError(f"o{shown} sub has no o{shown} endsub", self._sub_place(frame, opening))
             control = self._control_of(block)
-            if control is not None and control.keyword == "sub" and frame.pc != opening:  # (rs274ngc: none in another)
-                raise NcppError("Nested subroutine definition", Location(self.file, block.line, control.item.start + 1))
+            if (
+                control is not None and control.keyword == "sub" and frame.pc != opening
+            ):  # (rs274ngc: none in another)
+                raise NcppError(
+                    "Nested subroutine definition", Location(self.file, block.line, control.item.start + 1)
+                )
             if self._in_place(frame):
                 yield block, SKIP, None
                 self._wrote(frame.pc)
@@ -584,7 +659,9 @@ class Flow:
         label = frame.labels.get(control.name)  # type: ignore[arg-type]  # (_NAMED)
         if label is None or label.kind not in kinds:
             found = "no loop" if label is None else f"a {label.kind} loop"
-            raise self._error(f"{control.keyword} names {found}, not a {' or '.join(kinds)} loop", block, control)
+            raise self._error(
+                f"{control.keyword} names {found}, not a {' or '.join(kinds)} loop", block, control
+            )
         return label
 
     def _condition(self, block: Block, control: Control) -> bool:
@@ -597,7 +674,11 @@ class Flow:
 
     def _arguments(self, block: Block, control: Control, wanted: int | None) -> list[float]:
         if wanted is not None and len(control.arguments) != wanted:
-            raise self._error(f"{control.keyword} wants {'an expression' if wanted == 1 else f'{wanted} expressions'} in [ ]", block, control)
+            raise self._error(
+                f"{control.keyword} wants {'an expression' if wanted == 1 else f'{wanted} expressions'} in [ ]",
+                block,
+                control,
+            )
         if wanted is None and len(control.arguments) > 1:
             raise self._error(f"{control.keyword} takes one value", block, control)
         return [self.evaluate(a, block, control.item) for a in control.arguments]
@@ -607,7 +688,9 @@ class Flow:
 
     def _error(self, message: str, block: Block, control: Control) -> NcppError:
         name: str = control.name  # type: ignore[assignment]  # (_NAMED)
-        return NcppError(f"o{_shown(name)} {message}", Location(self.file, block.line, control.item.start + 1))
+        return NcppError(
+            f"o{_shown(name)} {message}", Location(self.file, block.line, control.item.start + 1)
+        )
 
 
 def control_of(block: Block) -> Control | None:
@@ -618,7 +701,9 @@ def control_of(block: Block) -> Control | None:
         kind = type(item)
         if kind is Statement:
             statement: Statement = item  # type: ignore[assignment]  # (`kind` says so; one type() per item)
-            if statement.kind == "block_delete" and not words:  # `/o1 endsub`: with the switch off (rs274's) the line runs
+            if (
+                statement.kind == "block_delete" and not words
+            ):  # `/o1 endsub`: with the switch off (rs274's) the line runs
                 continue
             if statement.kind != "oword" or len(statement.node) < 2 or words:
                 return None
@@ -629,7 +714,9 @@ def control_of(block: Block) -> Control | None:
             return Control(oword_name(head), rest[0].lower(), tuple(rest[1:]), statement)
         if kind is Word or kind is ExprWord:
             word: Word | ExprWord = item  # type: ignore[assignment]  # (as above)
-            if word.letter not in "NMPL" or word.letter in words:  # (most lines end here, at their first word)
+            if (
+                word.letter not in "NMPL" or word.letter in words
+            ):  # (most lines end here, at their first word)
                 return None
             words[word.letter] = word
         elif kind is not Comment:

@@ -26,8 +26,8 @@ writer can keep the program's pole where compensated arcs need their own.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
-from typing import Iterable, Iterator
 
 from ncpp.errors import Location, NcppError, Warnings
 from ncpp.motion.corners import CornerError, round_corner
@@ -69,13 +69,23 @@ class Corner(Pass):
     col: int | None = None
 
 
-def interpret(blocks: Iterable[Block], *, file: str = "<stdin>", warnings: Warnings | None = None,
-              strict: bool = False, offsets: WorkOffsets | None = None) -> Iterator[Event]:
+def interpret(
+    blocks: Iterable[Block],
+    *,
+    file: str = "<stdin>",
+    warnings: Warnings | None = None,
+    strict: bool = False,
+    offsets: WorkOffsets | None = None,
+) -> Iterator[Event]:
     """Motion events of a Heidenhain program's blocks, lazily (see the module docstring)."""
-    zero = offsets.program_zero() if offsets is not None else (0.0, 0.0, 0.0)  # one program zero: the system in effect
+    zero = (
+        offsets.program_zero() if offsets is not None else (0.0, 0.0, 0.0)
+    )  # one program zero: the system in effect
     interpreter = HeidenhainInterpreter(file, zero, offsets.tools if offsets is not None else None)
     warnings = resolve_warnings(warnings, strict)
-    interpreter.untold_lengths = UntoldLengths(offsets is not None and offsets.tools is None, warnings)  # placing the program
+    interpreter.untold_lengths = UntoldLengths(
+        offsets is not None and offsets.tools is None, warnings
+    )  # placing the program
     return interpreter.run(blocks, warnings)
 
 
@@ -87,11 +97,20 @@ def _plane_of_axes(axes: set[int], default: int) -> int:
 
 
 class HeidenhainInterpreter(ModalInterpreter):
-    def __init__(self, file: str = "<stdin>", zero: tuple[float, float, float] = (0.0, 0.0, 0.0), tools: ToolTable | None = None):
+    def __init__(
+        self,
+        file: str = "<stdin>",
+        zero: tuple[float, float, float] = (0.0, 0.0, 0.0),
+        tools: ToolTable | None = None,
+    ):
         super().__init__(file, zero)
         self.tools = tools  # the control's tool table (TOOL.T), if told
-        self.defined: dict[float, float] = {}  # tool lengths the program defines (TOOL DEF n L..), program units
-        self.tool_number: float | None = 0.0  # the tool TOOL CALL put in the spindle (None: one named, no table)
+        self.defined: dict[
+            float, float
+        ] = {}  # tool lengths the program defines (TOOL DEF n L..), program units
+        self.tool_number: float | None = (
+            0.0  # the tool TOOL CALL put in the spindle (None: one named, no table)
+        )
         self.tool_axis = 2  # the axis its length is along (TOOL CALL's axis)
         self.call_dl = 0.0  # the last TOOL CALL's DL (an oversize), program units
         self.untold_lengths = UntoldLengths()  # warns at a TOOL CALL whose tool length nothing tells
@@ -127,7 +146,9 @@ class HeidenhainInterpreter(ModalInterpreter):
                 assert not isinstance(first, Pass) and not isinstance(last, Pass)  # round_corner's lines
                 held[0], event = first, last
                 piece = made[1] if len(made) == 3 else Pass(corner.block)
-                if COMP in (first.fixed, last.fixed) and not isinstance(piece, Pass):  # (the rounding is the contour's)
+                if COMP in (first.fixed, last.fixed) and not isinstance(
+                    piece, Pass
+                ):  # (the rounding is the contour's)
                     piece.fixed = COMP
                 held = [piece if e is corner else e for e in held]
                 corner = None
@@ -138,11 +159,15 @@ class HeidenhainInterpreter(ModalInterpreter):
             else:
                 yield event
         if corner is not None:
-            raise NcppError(f"{'RND' if corner.kind == 'R' else 'CHF'} has no following move",
-                            Location(self.file, corner.block.line, corner.col))
+            raise NcppError(
+                f"{'RND' if corner.kind == 'R' else 'CHF'} has no following move",
+                Location(self.file, corner.block.line, corner.col),
+            )
         yield from held
 
-    def _cut(self, held: list[Event], corner: Corner, second: Line | Arc, warnings: Warnings) -> list[Event] | None:
+    def _cut(
+        self, held: list[Event], corner: Corner, second: Line | Arc, warnings: Warnings
+    ) -> list[Event] | None:
         """[first line shortened, fillet or chamfer, second line] or None when out of scope."""
         where = Location(self.file, corner.block.line, corner.col)
         if not isinstance(second, Line) or second.rapid:
@@ -291,7 +316,11 @@ class HeidenhainInterpreter(ModalInterpreter):
             return 0.0
         lengths = self.tools.edges.get((number, 1))
         if lengths is None:
-            self.fail(f"tool {number:g} is not defined: neither in {self.tools.source} nor by TOOL DEF", block, statement)
+            self.fail(
+                f"tool {number:g} is not defined: neither in {self.tools.source} nor by TOOL DEF",
+                block,
+                statement,
+            )
         return lengths[0] / (MM_PER_INCH if self.inch else 1.0)
 
     def _word_value(self, item, block: Block) -> float:
@@ -303,8 +332,10 @@ class HeidenhainInterpreter(ModalInterpreter):
             self.fail(f"{function} right after another RND/CHF block", block, item)
         previous = self.last_move
         if type(previous) is not Line or previous.rapid:
-            raise OutOfScope(f"{function} after {'no move' if previous is None else 'an arc or a rapid move'}",
-                             item.start + 1)
+            raise OutOfScope(
+                f"{function} after {'no move' if previous is None else 'an arc or a rapid move'}",
+                item.start + 1,
+            )
         if function == "RND":
             if "R" not in words:
                 self.fail("RND without a radius R", block, item)
@@ -314,7 +345,9 @@ class HeidenhainInterpreter(ModalInterpreter):
         if size <= 0:
             self.fail(f"{function} needs a positive size", block, item)
         self.corner_waits = True
-        return Corner(block, kind=kind, size=size, feed=words["F"][0] if "F" in words else None, col=item.start + 1)
+        return Corner(
+            block, kind=kind, size=size, feed=words["F"][0] if "F" in words else None, col=item.start + 1
+        )
 
     # -- path functions ---------------------------------------------------------------------
     def _target(self, words: dict) -> tuple[list[float], set[int]]:
@@ -330,7 +363,9 @@ class HeidenhainInterpreter(ModalInterpreter):
                 written.add(n)
         return end, written
 
-    def _path(self, block: Block, function: str, item, words: dict, rapid: bool, rotation: str | None) -> list[Event]:
+    def _path(
+        self, block: Block, function: str, item, words: dict, rapid: bool, rotation: str | None
+    ) -> list[Event]:
         end, written = self._target(words)
         if function == "L":
             return [self.line(block, end, rapid)] if written else []

@@ -31,15 +31,29 @@ from __future__ import annotations
 
 import math
 import re
-from typing import Iterable, Iterator, NoReturn, cast
+from collections.abc import Iterable, Iterator
+from typing import NoReturn, cast
 
 from ncpp.errors import Location, NcppError, Warnings
 from ncpp.motion.corners import CornerError, round_corner
 from ncpp.motion.cycles import CANNED, DWELLING, PECKING, RAPID_DELTA_INCH, SPINDLE, back_bore, hole
 from ncpp.motion.expressions import ExpressionError, OutOfScope, Parameters, evaluate
-from ncpp.motion.offsets import SYSTEMS, WorkOffsets
 from ncpp.motion.flow import FIXED, RUN, SKIP, Flow
-from ncpp.motion.segments import COMP, CYCLE, FLOW, HOME, PLANE_AXES, Arc, Context, Event, Line, Pass, Setting, mark_off_path
+from ncpp.motion.offsets import SYSTEMS, WorkOffsets
+from ncpp.motion.segments import (
+    COMP,
+    CYCLE,
+    FLOW,
+    HOME,
+    PLANE_AXES,
+    Arc,
+    Context,
+    Event,
+    Line,
+    Pass,
+    Setting,
+    mark_off_path,
+)
 from ncpp.motion.tools import UntoldLengths
 from ncpp.program.blocks import STRAY_TAPE, UNREADABLE, Block, Comment, ExprWord, Statement, Word
 
@@ -125,7 +139,10 @@ _MODE0_WITH_COMP = {
     53.0: "Cannot use g53 with cutter radius comp",
 }
 _MOTION_WITH_COMP = {
-    **{c: "Cannot use canned cycles with cutter compensation on" for c in (73.0, 74.0, 76.0, 81.0, 82.0, 83.0, 84.0, 85.0, 86.0, 87.0, 88.0, 89.0)},
+    **{
+        c: "Cannot use canned cycles with cutter compensation on"
+        for c in (73.0, 74.0, 76.0, 81.0, 82.0, 83.0, 84.0, 85.0, 86.0, 87.0, 88.0, 89.0)
+    },
     **{c: "Cannot probe with cutter radius comp on" for c in (38.2, 38.3, 38.4, 38.5)},
     **{c: "Cannot convert spline with cutter radius compensation" for c in (5.0, 5.1, 5.2, 5.3)},
 }
@@ -171,7 +188,9 @@ class Interpreter:
     def __init__(self, file: str = "<stdin>", offsets: WorkOffsets | None = None):
         self.file = file
         self.pos = [0.0] * 9  # program position of X Y Z A B C U V W
-        self.unmoved: list[float] | None = None  # where the next move's unnamed axes go, when not `pos` (`_base`)
+        self.unmoved: list[float] | None = (
+            None  # where the next move's unnamed axes go, when not `pos` (`_base`)
+        )
         self.plane = 17
         self.absolute = True
         self.arc_absolute = False
@@ -194,7 +213,9 @@ class Interpreter:
         self.tools = offsets.tools if offsets is not None else None  # the control's tool table
         self.selected_tool = 0  # T
         self.spindle_tool = 0  # M6, M61 (0: none)
-        self.untold_lengths = UntoldLengths(offsets is not None and offsets.tools is None)  # warned at the first G43 that reads the table
+        self.untold_lengths = UntoldLengths(
+            offsets is not None and offsets.tools is None
+        )  # warned at the first G43 that reads the table
         self.home = {28: [0.0] * 9, 30: [0.0] * 9}  # G28/G30 positions, machine coordinates
         self.uses_extra_axes = False
         self.params = Parameters(self._system_parameter)
@@ -203,7 +224,9 @@ class Interpreter:
         self.done = False  # program end (M2/M30) reached or state unknown
         self.corner: tuple[str, float, Word | ExprWord] | None = None  # Fanuc ,R / ,C of the last block
         self.cutter_comp: float | None = None  # G41, G41.1, G42 or G42.1 in effect (None: G40)
-        self.comp_radius: float | None = None  # its tool radius, program units, where known (G41.1/G42.1's D; G41/G42: the tool table's)
+        self.comp_radius: float | None = (
+            None  # its tool radius, program units, where known (G41.1/G42.1's D; G41/G42: the tool table's)
+        )
         self.off_path = False  # the tool centre is off the programmed path: from the first move under comp to the first after G40
         self.arc_refused = False  # after G40 ended compensation that moved the tool off the path: until a G0/G1 move (rs274ngc)
         self.untold: set[int] = set()  # coordinate systems whose zero nobody said (warned when selected)
@@ -234,12 +257,16 @@ class Interpreter:
         pending: Line | None = None  # the line whose end corner is rounded
         corner: tuple = ()  # its corner word: (kind, size, item); read only with a pending line
         held: list[Event] = []  # non-moving events after it
-        flow = self.flow = Flow(self.file, self._evaluate, self.params, lambda: self.done, self._leave_scope, self.subroutine_path)
+        flow = self.flow = Flow(
+            self.file, self._evaluate, self.params, lambda: self.done, self._leave_scope, self.subroutine_path
+        )
         for block, kind, owner in flow.steps(blocks):
             if kind is not RUN and kind is not FIXED:  # text that does not run here
                 if block.signature is None:
                     _warn_unreadable(block, warnings)
-                text = Pass(block, kind is SKIP, None if self.done else self.motion)  # (after the end: no mode the control is in)
+                text = Pass(
+                    block, kind is SKIP, None if self.done else self.motion
+                )  # (after the end: no mode the control is in)
                 if pending is not None:
                     held.append(text)
                 else:
@@ -255,7 +282,10 @@ class Interpreter:
                 source = flow.source()
                 if source is None or err.where is None or err.where.file != self.file:
                     raise
-                raise NcppError(f"{err.message} (in the subroutine line {owner.line} calls)", Location(source, err.where.line, err.where.col)) from None  # type: ignore[union-attr]
+                raise NcppError(
+                    f"{err.message} (in the subroutine line {owner.line} calls)",  # type: ignore[union-attr]
+                    Location(source, err.where.line, err.where.col),
+                ) from None
             except _OutOfScope as stop:
                 self._leave_scope(stop.reason, block, stop.col, owner)
                 if pending is not None:
@@ -291,7 +321,10 @@ class Interpreter:
                 yield ev
         if pending is not None:
             _, _, item = corner
-            raise NcppError("corner rounding/chamfer has no following move", Location(self.file, pending.block.line, item.start + 1))
+            raise NcppError(
+                "corner rounding/chamfer has no following move",
+                Location(self.file, pending.block.line, item.start + 1),
+            )
 
     def _leave_scope(self, reason: str, block: Block, col: int | None, owner: Block | None = None) -> None:
         """A construct outside the scope: the state is unknown from here on (an error with strict).
@@ -332,7 +365,9 @@ class Interpreter:
         control applies).  The first move after G40 brings it back to the programmed end
         point.  As rs274ngc says, no arc may come after G40 before a G0/G1 move (a G28/G30
         or a canned cycle is not one)."""
-        if self.comp_radius == 0.0:  # a radius of 0: the tool stays on the programmed path (rs274ngc checks nothing either)
+        if (
+            self.comp_radius == 0.0
+        ):  # a radius of 0: the tool stays on the programmed path (rs274ngc checks nothing either)
             return event
         events: tuple[Event, ...] = event if type(event) is tuple else (event,)  # type: ignore[assignment]
         moves: list[Line | Arc] = [ev for ev in events if type(ev) is not Pass]  # type: ignore[misc]
@@ -340,7 +375,11 @@ class Interpreter:
             return event
         if self.arc_refused:
             if type(moves[0]) is Arc:
-                self._fail("The move just after exiting cutter compensation mode must be straight, not an arc", block, block.items[0])
+                self._fail(
+                    "The move just after exiting cutter compensation mode must be straight, not an arc",
+                    block,
+                    block.items[0],
+                )
             self.arc_refused = moves[0].fixed == CYCLE or _homes(block)
         if self.cutter_comp is not None and self.comp_radius:
             self._check_radius(moves, block, self.comp_radius)
@@ -356,8 +395,15 @@ class Interpreter:
         item = block.items[0]
         a, b, _ = PLANE_AXES[self.plane]
         first = moves[0]
-        if not self.off_path and math.hypot(first.end[a] - first.start[a], first.end[b] - first.start[b]) <= radius:
-            what = "Radius of cutter compensation entry arc" if type(first) is Arc else "Length of cutter compensation entry move"
+        if (
+            not self.off_path
+            and math.hypot(first.end[a] - first.start[a], first.end[b] - first.start[b]) <= radius
+        ):
+            what = (
+                "Radius of cutter compensation entry arc"
+                if type(first) is Arc
+                else "Length of cutter compensation entry move"
+            )
             self._fail(f"{what} is not greater than the tool radius", block, item)
         left = self.cutter_comp in (41.0, 41.1)
         for arc in moves:
@@ -371,7 +417,9 @@ class Interpreter:
         yield from held
         held.clear()
 
-    def _round_corner(self, first: Line, corner: tuple, second: Event, warnings: Warnings) -> list[Event] | None:
+    def _round_corner(
+        self, first: Line, corner: tuple, second: Event, warnings: Warnings
+    ) -> list[Event] | None:
         """[shortened first line, fillet arc or chamfer line, second line from the tangent point]."""
         kind, size, item = corner
         where = Location(self.file, first.block.line, item.start + 1)
@@ -468,7 +516,11 @@ class Interpreter:
                 elif what == UNREADABLE:  # read where it runs, as rs274ngc reads it
                     raise statement.node[0]
                 elif what == STRAY_TAPE:  # a `%` after the program's first line that was not one
-                    self._fail("Bad character '%' used (a tape mark only where the program starts with one)", block, item)
+                    self._fail(
+                        "Bad character '%' used (a tape mark only where the program starts with one)",
+                        block,
+                        item,
+                    )
                 elif what not in IGNORED_STATEMENTS:
                     raise _OutOfScope(OUT_OF_SCOPE_STATEMENT.get(what, what), item.start + 1)
                 continue
@@ -509,7 +561,11 @@ class Interpreter:
                 if not words:
                     return Pass(block)
                 motion = self.motion
-                if motion is not None and words.keys() <= _PLAIN_LETTERS[motion] and not words.keys() <= _F_ONLY:
+                if (
+                    motion is not None
+                    and words.keys() <= _PLAIN_LETTERS[motion]
+                    and not words.keys() <= _F_ONLY
+                ):
                     return self._modal_move(block, words, motion)
             elif len(gcodes) == 1 and 1 in gcodes:
                 motion, motion_item = gcodes[1]
@@ -526,7 +582,11 @@ class Interpreter:
     def _update_fast(self) -> None:
         """Whether a block of plain X/Y/Z words can take the fast path (nothing to check)."""
         motion = self.motion
-        self._fast = self.absolute and (motion == 0.0 or (motion == 1.0 and not self.inverse_time)) and self.unmoved is None
+        self._fast = (
+            self.absolute
+            and (motion == 0.0 or (motion == 1.0 and not self.inverse_time))
+            and self.unmoved is None
+        )
 
     def _plain_move(self, block: Block, move: tuple) -> Event | None:
         """A block `_plain_move` read (G0-G3 or the modal motion with distinct
@@ -580,7 +640,9 @@ class Interpreter:
         if motion > 1.0:
             return self._arc(block, words, motion, None, None)
         if motion == 1.0 and self.inverse_time:
-            self._check_feed(block, words, "Cannot do g1 with zero feed rate", "F word missing with inverse time g1 move")
+            self._check_feed(
+                block, words, "Cannot do g1 with zero feed rate", "F word missing with inverse time g1 move"
+            )
         if not self.uses_extra_axes and not words.keys() <= _XYZF:
             self.uses_extra_axes = True
         end = self._base()
@@ -619,7 +681,9 @@ class Interpreter:
             if value in OUT_OF_SCOPE_M:
                 raise _OutOfScope(OUT_OF_SCOPE_M[value], item.start + 1)
         tool_axes = gcodes.get(8, (None,))[0] == 43.1  # G43.1's axis words are offsets, not a move
-        motion = self._motion_to_be(block, 43.1 if tool_axes and mode0 is None else mode0, mode1, mode1_item, axis_item, polar_item)
+        motion = self._motion_to_be(
+            block, 43.1 if tool_axes and mode0 is None else mode0, mode1, mode1_item, axis_item, polar_item
+        )
         self._check_words(block, words, gcodes, mcodes, motion, mode0, mode0_item, mode1_item)
         if self.cutter_comp is not None or 7 in gcodes:
             self._check_with_comp(block, words, gcodes, mcodes, motion, mode1_item or axis_item)
@@ -745,13 +809,28 @@ class Interpreter:
             p = words.get("P", (0.0,))[0]
             if abs(p - round(p)) > 0.0001:
                 self._fail("P value not an integer with G10", block, words["P"][1])
-            if l_number in (2.0, 20.0) and ("P" not in words or not 0 <= round(p) <= 9):  # P0: the current system
-                self._fail(f"P value out of range (0-9) with G10 L{l_number:.0f}", block, words.get("P", (0, mode0_item))[1])
+            if l_number in (2.0, 20.0) and (
+                "P" not in words or not 0 <= round(p) <= 9
+            ):  # P0: the current system
+                self._fail(
+                    f"P value out of range (0-9) with G10 L{l_number:.0f}",
+                    block,
+                    words.get("P", (0, mode0_item))[1],
+                )
         cycle = motion in _CYCLES
         for letter in "ABC":
             if letter in words and cycle:
-                self._fail(f"Cannot put a{'n' if letter == 'A' else ''} {letter.lower()} in canned cycle", block, words[letter][1])
-        if "D" in words and g7 not in (41.0, 42.0, 41.1, 42.1) and gcodes.get(14, (None,))[0] != 96.0 and motion != 71.0:
+                self._fail(
+                    f"Cannot put a{'n' if letter == 'A' else ''} {letter.lower()} in canned cycle",
+                    block,
+                    words[letter][1],
+                )
+        if (
+            "D" in words
+            and g7 not in (41.0, 42.0, 41.1, 42.1)
+            and gcodes.get(14, (None,))[0] != 96.0
+            and motion != 71.0
+        ):
             self._fail("D word with no G41, G41.1, G42, G42.1, G71, or G96 to use it", block, words["D"][1])
         if "E" in words and motion != 76.0 and not mcodes.keys() & {66.0, 67.0, 68.0}:
             self._fail("E word with no G70, G76, M66, M67 or M68 to use it", block, words["E"][1])
@@ -759,12 +838,20 @@ class Interpreter:
             self._fail("H word with no G43 or G76 to use it", block, words["H"][1])
         for letter in "IJ":
             if letter in words and motion not in _ARC_LIKE and mode0 != 10.0:
-                self._fail(f"{letter} word with no G2, G3, G5, G5.1, G10, G71, G76, or G87 to use it", block, words[letter][1])
+                self._fail(
+                    f"{letter} word with no G2, G3, G5, G5.1, G10, G71, G76, or G87 to use it",
+                    block,
+                    words[letter][1],
+                )
         if "K" in words and motion not in _K_MOTIONS:
             self._fail("K word with no G2, G3, G33, G33.1, G71, G76, or G87 to use it", block, words["K"][1])
         if "L" in words and not (motion in _CYCLES or motion in (76.0, 5.2, 73.0, 71.0) or mode0 == 10.0
                                  or g7 is not None and g7 != 40.0 or 66.0 in mcodes):  # fmt: skip
-            self._fail("L word with no G10, cutter compensation, canned cycle, digital/analog input, or NURBS code", block, words["L"][1])
+            self._fail(
+                "L word with no G10, cutter compensation, canned cycle, digital/analog input, or NURBS code",
+                block,
+                words["L"][1],
+            )
         if "P" in words:
             p, p_item = words["P"]
             user_m = any(100.0 <= m <= 199.0 for m in mcodes)
@@ -780,10 +867,18 @@ class Interpreter:
         if "Q" in words and not (motion in _Q_MOTIONS or mode0 == 10.0 or gcodes.get(13, (None,))[0] == 64.0
                                  or mcodes.keys() & {66.0, 67.0, 68.0, 61.0, 19.0}
                                  or any(100.0 <= m <= 199.0 for m in mcodes)):  # fmt: skip
-            self._fail("Q word with no G5, G10, G64, G73, G76, G83, M19, M66, M67, M68 or user M code that uses it", block, words["Q"][1])
+            self._fail(
+                "Q word with no G5, G10, G64, G73, G76, G83, M19, M66, M67, M68 or user M code that uses it",
+                block,
+                words["Q"][1],
+            )
         if "R" in words:
             if gcodes.get(13, (None,))[0] == 64.0 and 19.0 in mcodes:
-                self._fail("R word is ambiguous on a line with both G64 and M19 - use separate lines", block, words["R"][1])
+                self._fail(
+                    "R word is ambiguous on a line with both G64 and M19 - use separate lines",
+                    block,
+                    words["R"][1],
+                )
             if motion == 0.0 and mode0 is None:
                 raise _OutOfScope("R word with G0", words["R"][1].start + 1)
             if motion == 1.0 and mode0 is None:
@@ -814,7 +909,11 @@ class Interpreter:
         message = _MODE0_WITH_COMP.get(mode0)
         if mode0 == 53.0 and self.comp_radius == 0.0:  # (G53 only with a radius; the others with any)
             message = None
-        if mode0 == 10.0 and words.get("L", (None,))[0] in (2.0, 20.0) and round(words["P"][0]) in (0, self.coord_system):
+        if (
+            mode0 == 10.0
+            and words.get("L", (None,))[0] in (2.0, 20.0)
+            and round(words["P"][0]) in (0, self.coord_system)
+        ):
             message = "Cannot change the active coordinate system with cutter radius compensation on"
         if message is not None:
             self._fail(message, block, mode0_item)
@@ -844,9 +943,16 @@ class Interpreter:
                 self._fail(f"G{code:g} requires D word to be a whole number", block, d[1])
             if self.tools is not None and round(d[0]) != 0 and self.tools.offset(round(d[0])) is None:
                 self._fail(f"Requested tool {round(d[0])} not found in the tool table", block, d[1])
-        if code in (41.0, 42.0):  # the radius of tool D, or of the tool in the spindle, from the table ncpp is told
+        if code in (
+            41.0,
+            42.0,
+        ):  # the radius of tool D, or of the tool in the spindle, from the table ncpp is told
             number = self.spindle_tool if d is None else round(d[0])
-            self.comp_radius = None if self.tools is None else self.tools.diameter(number) / 2 / (MM_PER_INCH if self.inch else 1.0)
+            self.comp_radius = (
+                None
+                if self.tools is None
+                else self.tools.diameter(number) / 2 / (MM_PER_INCH if self.inch else 1.0)
+            )
         self.cutter_comp = code
 
     def _check_scope(self, words: dict, gcodes: dict) -> None:
@@ -905,7 +1011,9 @@ class Interpreter:
         new = [0.0] * 9
         if code == 43.1:  # the axes it names; the others keep their offset (rs274ngc)
             new = self.tool[:]
-            given = [(AXIS_INDEX[letter], value) for letter, (value, _) in words.items() if letter in AXIS_INDEX]
+            given = [
+                (AXIS_INDEX[letter], value) for letter, (value, _) in words.items() if letter in AXIS_INDEX
+            ]
             for i, value in given:
                 new[i] = value
             self._note_axes(given)
@@ -971,7 +1079,9 @@ class Interpreter:
         setting = None
         if code == 92.0 or (code == 10.0 and words["L"][0] == 20.0):  # set from the current point
             here = (self.pos[0], self.pos[1], self.pos[2])
-            setting = Pass(block, setting=Setting(tuple((i, v) for i, v in given if i < 3), self.context(), here))
+            setting = Pass(
+                block, setting=Setting(tuple((i, v) for i, v in given if i < 3), self.context(), here)
+            )
         if code == 92.0:
             old = self.g92[:]
             for i, value in given:
@@ -1091,16 +1201,29 @@ class Interpreter:
                 self._fail("Must specify angle in polar coordinate if at the origin", block, radius[1])
             x, y = _about_zero(x, y, radius, theta)
         else:
-            x, y = self._polar_added(block, x, y, radius, theta, "G91 motion with polar coordinates is indeterminate when at the origin")
+            x, y = self._polar_added(
+                block,
+                x,
+                y,
+                radius,
+                theta,
+                "G91 motion with polar coordinates is indeterminate when at the origin",
+            )
         end[0], end[1] = x, y
 
-    def _polar_added(self, block: Block, x: float, y: float, radius, theta, at_origin: str) -> tuple[float, float]:
+    def _polar_added(
+        self, block: Block, x: float, y: float, radius, theta, at_origin: str
+    ) -> tuple[float, float]:
         """(x, y) with the word `radius` added to their radius about XY zero, then the word
         `theta` (degrees) to their angle (None: not added), as rs274ngc adds them; refused at
         XY zero, where the angle is not defined (`at_origin`: the angle's message)."""
         if radius is not None:
             if x == 0.0 and y == 0.0:
-                self._fail("Incremental motion with polar coordinates is indeterminate when at the origin", block, radius[1])
+                self._fail(
+                    "Incremental motion with polar coordinates is indeterminate when at the origin",
+                    block,
+                    radius[1],
+                )
             r, a = math.hypot(y, x) + radius[0], math.atan2(y, x)
             x, y = r * math.cos(a), r * math.sin(a)
         if theta is not None:
@@ -1112,14 +1235,18 @@ class Interpreter:
 
     def _straight(self, block: Block, words: dict, motion: float, machine: bool | None) -> Line:
         if motion == 1.0:
-            self._check_feed(block, words, "Cannot do g1 with zero feed rate", "F word missing with inverse time g1 move")
+            self._check_feed(
+                block, words, "Cannot do g1 with zero feed rate", "F word missing with inverse time g1 move"
+            )
         if not machine:
             return self._line(block, self._move_end(block, words), motion == 0.0)
         given = [(AXIS_INDEX[letter], value) for letter, (value, _) in words.items() if letter in AXIS_INDEX]
         self._note_axes(given)
         return self._line(block, self._ends(given, True), motion == 0.0)
 
-    def _cycle(self, block: Block, words: dict, motion: float, previous: float | None, item) -> tuple[Line, ...]:
+    def _cycle(
+        self, block: Block, words: dict, motion: float, previous: float | None, item
+    ) -> tuple[Line, ...]:
         """A canned cycle's moves (rs274ngc's convert_cycle and convert_cycle_xy, in any plane):
         `Line`s marked `fixed`, which compensation leaves as programmed."""
         first, second, normal = PLANE_AXES[self.plane]
@@ -1130,7 +1257,9 @@ class Interpreter:
         repeats = self._repeats(block, words)
         if previous in CANNED and not self.retract_to_r and r < self.cycle_last_r:
             # the levels rs274ngc then crosses and retracts at depend on more than this follows
-            raise _OutOfScope("a G98 series of canned cycles lowering its R plane", words.get("R", (0, item))[1].start + 1)
+            raise _OutOfScope(
+                "a G98 series of canned cycles lowering its R plane", words.get("R", (0, item))[1].start + 1
+            )
         self.cycle_last_r = r
         peck = self._cycle_word(block, words, motion, again, item)
         if motion in (74.0, 84.0) and self.plane != 17:  # rs274ngc's taps move other axes there
@@ -1176,7 +1305,9 @@ class Interpreter:
         reads them."""
         first, second, normal = PLANE_AXES[self.plane]
         a_letter, b_letter, c_letter = "XYZ"[first], "XYZ"[second], "XYZ"[normal]
-        plane = _PLANE_NAMES[self.plane]  # (rs274ngc's messages: `Z value unspecified in xy plane`, `R less than z`)
+        plane = _PLANE_NAMES[
+            self.plane
+        ]  # (rs274ngc's messages: `Z value unspecified in xy plane`, `R less than z`)
         if self.feed == 0.0:
             self._fail("Cannot feed with zero feed rate", block, item)
         if self.inverse_time:
@@ -1203,16 +1334,29 @@ class Interpreter:
             r = r_word + self.cycle_il
             bottom = r + c_word
         if r < bottom:
-            self._fail(f"R less than {c_letter.lower()} in cycle in {plane} plane", block, words.get("R", (0, item))[1])
+            self._fail(
+                f"R less than {c_letter.lower()} in cycle in {plane} plane",
+                block,
+                words.get("R", (0, item))[1],
+            )
         return aa, bb, step_a, step_b, r, bottom
 
     def _polar_step(self, block: Block, words: dict, x: float, y: float) -> tuple[float, float]:
         """The next hole of a G91 cycle with polar words (CYCLE_MACRO): as a G91 move's, but a
         zero word adds nothing, and one message at XY zero."""
         radius, theta = ((words[k] if words.get(k, (0.0,))[0] else None) for k in "@^")
-        return self._polar_added(block, x, y, radius, theta, "Incremental motion with polar coordinates is indeterminate when at the origin")
+        return self._polar_added(
+            block,
+            x,
+            y,
+            radius,
+            theta,
+            "Incremental motion with polar coordinates is indeterminate when at the origin",
+        )
 
-    def _fixed_line(self, block: Block, axes: tuple[int, int, int], move: tuple[float, float, float, bool]) -> Line:
+    def _fixed_line(
+        self, block: Block, axes: tuple[int, int, int], move: tuple[float, float, float, bool]
+    ) -> Line:
         """A cycle's move (plane coordinates) as a `Line` from the current position, marked `fixed`."""
         a, b, c, rapid = move
         end = self._base()
@@ -1227,7 +1371,9 @@ class Interpreter:
         if self.spindle == 0:
             self._fail(f"Spindle not turning in {name}", block, item)
         if wanted and self.spindle != wanted:
-            self._fail(f"Spindle turning {'counterclockwise' if wanted > 0 else 'clockwise'} in {name}", block, item)
+            self._fail(
+                f"Spindle turning {'counterclockwise' if wanted > 0 else 'clockwise'} in {name}", block, item
+            )
 
     def _back_bore_words(self, block: Block, words: dict, again: bool, item) -> tuple[float, float, float]:
         """G87's I J (offsets in the plane) and K (the top of the bore), sticky within the cycle."""
@@ -1245,7 +1391,9 @@ class Interpreter:
         """Refuse a cycle block of more than MAX_CYCLE_MOVES moves before making them (`G81 ... L99999999`,
         `G83 ... Q0.0000001`: rs274ngc would drill for days; the moves of one block are held at once)."""
         pecks = max(pecks, 0.0)
-        if not repeats * (3 * pecks + 10) <= MAX_CYCLE_MOVES:  # per hole: 3 moves a peck (G83), 10 more at most (G87)
+        if (
+            not repeats * (3 * pecks + 10) <= MAX_CYCLE_MOVES
+        ):  # per hole: 3 moves a peck (G83), 10 more at most (G87)
             what = f"{repeats:,} hole(s)" + (f" of {pecks:,.0f} pecks each" if pecks >= 1 else "")
             self._fail(f"a canned cycle of {what}: ncpp takes {MAX_CYCLE_MOVES:,} moves in one block at most",
                        block, words.get("L", words.get("Q", (0, item)))[1])  # fmt: skip
@@ -1294,9 +1442,15 @@ class Interpreter:
             self._fail("R i j k words all missing for arc", block, word)
         if radius is not None and has_ijk:
             self._fail("Mixed radius ijk format for arc", block, word)
-        self._check_feed(block, words, "Cannot make arc with zero feed rate", "F word missing with inverse time arc move")
+        self._check_feed(
+            block, words, "Cannot make arc with zero feed rate", "F word missing with inverse time arc move"
+        )
         if normal_letter in words:
-            self._fail(f"{normal_letter} word given for arc in {_PLANE_NAMES[plane]} plane", block, words[normal_letter][1])
+            self._fail(
+                f"{normal_letter} word given for arc in {_PLANE_NAMES[plane]} plane",
+                block,
+                words[normal_letter][1],
+            )
         end = self._move_end(block, words)
         a, b, c = PLANE_AXES[plane]
         start = self.pos
@@ -1326,7 +1480,9 @@ class Interpreter:
             block,
             self._context or self.context(),
             (end[3], end[4], end[5], end[6], end[7], end[8]) if self.uses_extra_axes else (),
-            extra_start=(start[3], start[4], start[5], start[6], start[7], start[8]) if self.uses_extra_axes else (),
+            extra_start=(start[3], start[4], start[5], start[6], start[7], start[8])
+            if self.uses_extra_axes
+            else (),
         )
 
     def _center_r(self, block, word, x0, y0, x1, y1, radius, motion) -> tuple[float, float]:
@@ -1427,7 +1583,9 @@ _PLAIN_LETTERS = {
 
 def _homes(block: Block) -> bool:
     """The block says G28 or G30 (its moves are not the straight move rs274ngc's rules ask for)."""
-    return any(type(item) is Word and item.letter == "G" and item.value in (28.0, 30.0) for item in block.items)
+    return any(
+        type(item) is Word and item.letter == "G" and item.value in (28.0, 30.0) for item in block.items
+    )
 
 
 def _warn_unreadable(block: Block, warnings: Warnings) -> None:

@@ -10,15 +10,17 @@ expression trees both dialect builders produce (angles in degrees).
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
-from typing import Callable, Iterable, Iterator, NoReturn
+from collections.abc import Callable, Iterable, Iterator, Sequence
+from typing import NoReturn
 
 from ncpp.errors import Location, NcppError, Warnings
 from ncpp.motion.segments import PLANE_AXES, Arc, Context, Event, Line, Pass, Point, mark_off_path
 from ncpp.program.blocks import Block
 
 MM_PER_INCH = 25.4
-RADIUS_TOLERANCE = 0.01  # mm: start and end radius of a centre-format arc may differ this much (controller default)
+RADIUS_TOLERANCE = (
+    0.01  # mm: start and end radius of a centre-format arc may differ this much (controller default)
+)
 PLANE_OF_TOOL_AXIS = {"Z": 17, "Y": 18, "X": 19}
 
 
@@ -49,9 +51,19 @@ class ModalInterpreter:
         self.plane = 17
         self.inch = False
         self.feed = 0.0
-        self.offset: list[float] = [0.0, 0.0, 0.0]  # machine minus program position (frames, tool length), program units
-        self.tool: list[float] = [0.0, 0.0, 0.0]  # the tool length offset in effect (in `offset`), program units
-        self.zero: list[float] = list(zero)  # the program zero the control holds (preset, settable frame), program units
+        self.offset: list[float] = [
+            0.0,
+            0.0,
+            0.0,
+        ]  # machine minus program position (frames, tool length), program units
+        self.tool: list[float] = [
+            0.0,
+            0.0,
+            0.0,
+        ]  # the tool length offset in effect (in `offset`), program units
+        self.zero: list[float] = list(
+            zero
+        )  # the program zero the control holds (preset, settable frame), program units
         self.tangent: tuple[float, float, float] | None = None  # direction at the end of the last move
         self.done = False
         self.radius_comp = False  # tool radius compensation on (G41/G42, RL/RR)
@@ -89,7 +101,9 @@ class ModalInterpreter:
         if turn is not None:
             self.radius_comp = turn
         if self.radius_comp or self.off_path:
-            self.off_path = mark_off_path([e for e in events if type(e) is Line or type(e) is Arc], self.radius_comp, self.off_path)
+            self.off_path = mark_off_path(
+                [e for e in events if type(e) is Line or type(e) is Arc], self.radius_comp, self.off_path
+            )
         return events
 
     # -- modal state --------------------------------------------------------------------
@@ -144,7 +158,9 @@ class ModalInterpreter:
         return value
 
     def fail(self, message: str, block: Block, item=None) -> NoReturn:
-        raise NcppError(message, Location(self.file, block.line, item.start + 1 if item is not None else None))
+        raise NcppError(
+            message, Location(self.file, block.line, item.start + 1 if item is not None else None)
+        )
 
     # -- events ---------------------------------------------------------------------------
     def line(self, block: Block, end: list[float], rapid: bool, absolute: bool = True) -> Line:
@@ -156,8 +172,15 @@ class ModalInterpreter:
         self.pos = list(end)
         return Line(start, as_point(end), rapid, self.feed, block, self.context(absolute=absolute))
 
-    def arc(self, block: Block, end: list[float], centre: list[float], turn: int, plane: int | None = None,
-            absolute: bool = True) -> Arc:
+    def arc(
+        self,
+        block: Block,
+        end: list[float],
+        centre: list[float],
+        turn: int,
+        plane: int | None = None,
+        absolute: bool = True,
+    ) -> Arc:
         """An arc from the position to `end` about `centre` (its plane coordinates count)."""
         plane = plane or self.plane
         a, b, n = PLANE_AXES[plane]
@@ -177,7 +200,9 @@ class ModalInterpreter:
         self.pos = list(end)
         return event
 
-    def check_radii(self, block: Block, item, end: list[float], centre: list[float], plane: int | None = None) -> None:
+    def check_radii(
+        self, block: Block, item, end: list[float], centre: list[float], plane: int | None = None
+    ) -> None:
         a, b, _ = PLANE_AXES[plane or self.plane]
         r1 = math.hypot(self.pos[a] - centre[a], self.pos[b] - centre[b])
         r2 = math.hypot(end[a] - centre[a], end[b] - centre[b])
@@ -185,9 +210,15 @@ class ModalInterpreter:
         if r1 < tolerance or r2 < tolerance:
             self.fail("zero-radius arc", block, item)
         if abs(r1 - r2) > max(tolerance, 1e-3 * max(r1, r2)):
-            self.fail(f"radius to the end of the arc ({r2:.4f}) differs from the radius to its start ({r1:.4f})", block, item)
+            self.fail(
+                f"radius to the end of the arc ({r2:.4f}) differs from the radius to its start ({r1:.4f})",
+                block,
+                item,
+            )
 
-    def centre_from_radius(self, block: Block, item, end: list[float], radius: float, clockwise: bool) -> list[float]:
+    def centre_from_radius(
+        self, block: Block, item, end: list[float], radius: float, clockwise: bool
+    ) -> list[float]:
         """The centre of an arc of signed radius (negative: more than a half circle), as G2/G3 R."""
         a, b, _ = PLANE_AXES[self.plane]
         x0, y0, x1, y1 = self.pos[a], self.pos[b], end[a], end[b]
@@ -249,8 +280,12 @@ def circle_through(
     d = 2 * (ax * (by - cy) + bx * (cy - ay) + cx * (ay - by))
     if abs(d) < 1e-12:
         return None
-    ux = ((ax * ax + ay * ay) * (by - cy) + (bx * bx + by * by) * (cy - ay) + (cx * cx + cy * cy) * (ay - by)) / d
-    uy = ((ax * ax + ay * ay) * (cx - bx) + (bx * bx + by * by) * (ax - cx) + (cx * cx + cy * cy) * (bx - ax)) / d
+    ux = (
+        (ax * ax + ay * ay) * (by - cy) + (bx * bx + by * by) * (cy - ay) + (cx * cx + cy * cy) * (ay - by)
+    ) / d
+    uy = (
+        (ax * ax + ay * ay) * (cx - bx) + (bx * bx + by * by) * (ax - cx) + (cx * cx + cy * cy) * (bx - ax)
+    ) / d
     centre = list(p0)
     centre[a], centre[b] = ux, uy
     # the turn that passes the intermediate point: the sign of the triangle's orientation
@@ -259,6 +294,7 @@ def circle_through(
 
 
 # ---- expressions --------------------------------------------------------------------------
+
 
 def _div(a: float, b: float) -> float:
     return float(math.trunc(a / b))

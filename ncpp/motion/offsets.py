@@ -21,9 +21,9 @@ Positions are machine mm (X, Y, Z).
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Mapping, Sequence
 
 from ncpp.errors import Location, NcppError, quoted
 from ncpp.fileio import read_small
@@ -62,7 +62,7 @@ class WorkOffsets:
     unit_mm: float = 1.0  # the units the parameter file and tool table were read in (the header says them)
 
     @classmethod
-    def of(cls, zeros: Mapping[str, Vector], active: str = "G54") -> "WorkOffsets":
+    def of(cls, zeros: Mapping[str, Vector], active: str = "G54") -> WorkOffsets:
         """From G word -> machine mm (`{"G54": (400, 350, 300)}`)."""
         systems: list[Vector | None] = [None] * 9
         for name, zero in zeros.items():
@@ -70,12 +70,12 @@ class WorkOffsets:
         return cls(tuple(systems), system_number(active))
 
     @classmethod
-    def at(cls, zero: Vector) -> "WorkOffsets":
+    def at(cls, zero: Vector) -> WorkOffsets:
         """G54's zero at `zero` (machine mm), the other systems not told."""
         return cls.of({"G54": zero})
 
     @classmethod
-    def from_var_file(cls, path: str | Path, unit_mm: float = 1.0) -> "WorkOffsets":
+    def from_var_file(cls, path: str | Path, unit_mm: float = 1.0) -> WorkOffsets:
         """LinuxCNC's parameter file (`linuxcnc.var`: `number value` lines), its values in
         the machine's units (`[TRAJ]LINEAR_UNITS`: 25.4 mm for inch)."""
         values = read_var_file(path)
@@ -88,9 +88,13 @@ class WorkOffsets:
 
     @classmethod
     def given(
-        cls, zeros: Mapping[str, Vector], var_file: str | Path | None = None, unit_mm: float = 1.0, tool_table: str | Path | None = None,
+        cls,
+        zeros: Mapping[str, Vector],
+        var_file: str | Path | None = None,
+        unit_mm: float = 1.0,
+        tool_table: str | Path | None = None,
         subroutine_path: Sequence[str | Path] = (),
-    ) -> "WorkOffsets":
+    ) -> WorkOffsets:
         """What a user says: a parameter file, if any (else G54 at the machine zero), with
         `zeros` (G word -> machine mm) over it, a tool table, if any (LinuxCNC's
         files are both in the machine's units, `unit_mm`), and subroutine folders."""
@@ -99,7 +103,7 @@ class WorkOffsets:
         folders = tuple(Path(p) for p in subroutine_path)
         return replace(base.with_zeros(zeros), tools=tools, subroutine_path=folders, unit_mm=unit_mm)
 
-    def with_zeros(self, zeros: Mapping[str, Vector]) -> "WorkOffsets":
+    def with_zeros(self, zeros: Mapping[str, Vector]) -> WorkOffsets:
         """These systems' zeros replaced (the command line over a parameter file)."""
         systems = list(self.systems)
         for name, zero in zeros.items():

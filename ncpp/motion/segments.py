@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
-from typing import Union, final
+from typing import final
 
 from ncpp.program.blocks import Block
 
@@ -46,8 +46,16 @@ class Context:
     absolute: bool = True  # G90 / G91
     arc_absolute: bool = False  # G90.1 / G91.1 (IJK absolute)
     inch: bool = False  # G20 / G21
-    offset: Point = (0.0, 0.0, 0.0)  # machine minus program position (work offset, G92, tool length), program units
-    tool: Point = (0.0, 0.0, 0.0)  # the tool length offset (in `offset`): the tool tip is this far from the gauge point
+    offset: Point = (
+        0.0,
+        0.0,
+        0.0,
+    )  # machine minus program position (work offset, G92, tool length), program units
+    tool: Point = (
+        0.0,
+        0.0,
+        0.0,
+    )  # the tool length offset (in `offset`): the tool tip is this far from the gauge point
     inverse_time: bool = False  # G93: a feed move's F is 1 / its time in minutes
     system: int = 1  # the work coordinate system in effect, 1..9: G54..G59.3 (one program zero: 1)
     tool_id: str = ""  # the tool in the spindle as the program names it ("3", '"MILL"'; "": none)
@@ -86,11 +94,15 @@ class Line:
     context: Context = field(default_factory=Context)
     extra: tuple[float, ...] = ()  # end positions of A B C U V W, when the program uses them
     changed: bool = False  # set by a pass that moved the end point
-    fixed: str = ""  # why passes leave the move as programmed (CYCLE, FLOW, COMP, HOME), "" if they may change it
+    fixed: str = (
+        ""  # why passes leave the move as programmed (CYCLE, FLOW, COMP, HOME), "" if they may change it
+    )
     # A fixed move's X Y Z the control puts at their programmed end; the others run their programmed
     # increment from where the control stands (None: all of them in G90, none in G91)
     placed: tuple[bool, bool, bool] | None = None
-    extra_start: tuple[float, ...] = ()  # start positions of A B C U V W (as `extra`), when the program uses them
+    extra_start: tuple[
+        float, ...
+    ] = ()  # start positions of A B C U V W (as `extra`), when the program uses them
 
     def length(self) -> float:
         return math.dist(self.start, self.end)
@@ -167,8 +179,8 @@ class Pass:
     setting: Setting | None = None  # a G92 or G10 L20 block's
 
 
-Segment = Union[Line, Arc]
-Event = Union[Line, Arc, Pass]
+Segment = Line | Arc
+Event = Line | Arc | Pass
 
 
 def mark_off_path(moves: list, compensating: bool, off_path: bool) -> bool:
@@ -182,5 +194,22 @@ def mark_off_path(moves: list, compensating: bool, off_path: bool) -> bool:
     return compensating
 
 
-__all__ = ["COMP", "CYCLE", "FLOW", "HOME", "mark_off_path", "Arc", "Context", "Event", "Line", "Pass", "Point", "Segment",
-           "Setting", "PLANES", "PLANE_AXES", "EXTRA_AXES", "replace"]
+__all__ = [
+    "COMP",
+    "CYCLE",
+    "FLOW",
+    "HOME",
+    "mark_off_path",
+    "Arc",
+    "Context",
+    "Event",
+    "Line",
+    "Pass",
+    "Point",
+    "Segment",
+    "Setting",
+    "PLANES",
+    "PLANE_AXES",
+    "EXTRA_AXES",
+    "replace",
+]

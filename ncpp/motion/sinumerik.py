@@ -20,10 +20,17 @@ they are marked `fixed` (`ModalInterpreter.radius_compensation`).
 from __future__ import annotations
 
 import math
-from typing import Iterable, Iterator
+from collections.abc import Iterable, Iterator
 
 from ncpp.errors import Location, Warnings
-from ncpp.motion.modal import MM_PER_INCH, ModalInterpreter, OutOfScope, circle_through, plane_of, resolve_warnings
+from ncpp.motion.modal import (
+    MM_PER_INCH,
+    ModalInterpreter,
+    OutOfScope,
+    circle_through,
+    plane_of,
+    resolve_warnings,
+)
 from ncpp.motion.offsets import WorkOffsets
 from ncpp.motion.segments import PLANE_AXES, Event
 from ncpp.motion.tools import ToolTable, UntoldLengths
@@ -46,13 +53,23 @@ UNREAD_GEOMETRY = {"AR": "the opening angle", "AP": "the polar angle", "RP": "th
 FRAMES = frozenset(("TRANS", "ATRANS", "ROT", "SCALE", "MIRROR"))
 
 
-def interpret(blocks: Iterable[Block], *, file: str = "<stdin>", warnings: Warnings | None = None,
-              strict: bool = False, offsets: WorkOffsets | None = None) -> Iterator[Event]:
+def interpret(
+    blocks: Iterable[Block],
+    *,
+    file: str = "<stdin>",
+    warnings: Warnings | None = None,
+    strict: bool = False,
+    offsets: WorkOffsets | None = None,
+) -> Iterator[Event]:
     """Motion events of a Sinumerik program's blocks, lazily (see the module docstring)."""
-    zero = offsets.program_zero() if offsets is not None else (0.0, 0.0, 0.0)  # one program zero: the system in effect
+    zero = (
+        offsets.program_zero() if offsets is not None else (0.0, 0.0, 0.0)
+    )  # one program zero: the system in effect
     interpreter = SinumerikInterpreter(file, zero, offsets.tools if offsets is not None else None)
     warnings = resolve_warnings(warnings, strict)
-    interpreter.untold_lengths = UntoldLengths(offsets is not None and offsets.tools is None, warnings)  # placing the program
+    interpreter.untold_lengths = UntoldLengths(
+        offsets is not None and offsets.tools is None, warnings
+    )  # placing the program
     return interpreter.run(blocks, warnings)
 
 
@@ -62,7 +79,12 @@ TOOL_CHANGE = 6.0  # M6 loads the tool T selected, with its cutting edge D1 unle
 
 
 class SinumerikInterpreter(ModalInterpreter):
-    def __init__(self, file: str = "<stdin>", zero: tuple[float, float, float] = (0.0, 0.0, 0.0), tools: ToolTable | None = None):
+    def __init__(
+        self,
+        file: str = "<stdin>",
+        zero: tuple[float, float, float] = (0.0, 0.0, 0.0),
+        tools: ToolTable | None = None,
+    ):
         super().__init__(file, zero)
         self.tools = tools  # the control's tool offsets (_N_TO_INI), if told
         self.selected: float | str = 0.0  # the tool T selected: a number, or a name
@@ -139,14 +161,21 @@ class SinumerikInterpreter(ModalInterpreter):
                     pass
                 elif what not in ("label", "program_name", "block_delete"):
                     name = item.node[0] if what in ("call", "path", "frame") else what.upper()
-                    raise OutOfScope(f"{what} {name}" if what in ("call", "path", "frame") else name, item.start + 1)
+                    raise OutOfScope(
+                        f"{what} {name}" if what in ("call", "path", "frame") else name, item.start + 1
+                    )
                 continue
             if type(item) is ExprWord and item.letter == "T" and item.expr[0] == "str":  # T="NAME"
                 tool_words.append((item, item.expr[1]))
                 continue
             if type(item) is Word:
                 letter, value, mode = item.letter, item.value, None
-                if letter == "E" and type(before) is not Word and before is not None and before.end == item.start:
+                if (
+                    letter == "E"
+                    and type(before) is not Word
+                    and before is not None
+                    and before.end == item.start
+                ):
                     self._exponent(block, before, item)
             else:
                 letter, (value, mode) = item.letter, self._word_value(item, block)
@@ -209,7 +238,9 @@ class SinumerikInterpreter(ModalInterpreter):
             else:
                 self.edge, changed = int(value), True
             if changed and self.tools is None and self.edge:
-                self.untold_lengths(f"{item.letter}{value:g}", "_N_TO_INI", Location(self.file, block.line, item.start + 1))
+                self.untold_lengths(
+                    f"{item.letter}{value:g}", "_N_TO_INI", Location(self.file, block.line, item.start + 1)
+                )
         lengths = self._edge_lengths(block, tool_words[-1][0] if tool_words else None)
         tool = [0.0, 0.0, 0.0]
         for length, axis in zip(lengths, LENGTH_AXES[self.plane]):
@@ -254,7 +285,9 @@ class SinumerikInterpreter(ModalInterpreter):
             elif code == 4.0:
                 dwell = True
             elif code not in NEUTRAL_G:
-                reason = {53.0: "machine coordinates", 33.0: "thread cutting", 93.0: "inverse time feed"}.get(code, "the G code")
+                reason = {53.0: "machine coordinates", 33.0: "thread cutting", 93.0: "inverse time feed"}.get(
+                    code, "the G code"
+                )
                 raise OutOfScope(f"{reason} G{code:g}", item.start + 1)
         return dwell
 
@@ -262,7 +295,9 @@ class SinumerikInterpreter(ModalInterpreter):
         name = frame.node[0]
         if name not in ("TRANS", "ATRANS") and words:
             raise OutOfScope(f"frame {name}", frame.start + 1)
-        offset = list(self.offset) if name == "ATRANS" else list(self.tool)  # TRANS replaces the frame, not the tool length
+        offset = (
+            list(self.offset) if name == "ATRANS" else list(self.tool)
+        )  # TRANS replaces the frame, not the tool length
         for letter, (value, _, item) in words.items():
             if letter not in AXES:
                 raise OutOfScope(f"{frame.node[0]} of the {letter} axis", item.start + 1)

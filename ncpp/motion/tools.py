@@ -45,9 +45,9 @@ from __future__ import annotations
 
 import math
 import re
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Mapping
 
 from ncpp.errors import Location, NcppError, Warnings, quoted
 from ncpp.fileio import read_small
@@ -67,12 +67,18 @@ class ToolTable:
 
     offsets: Mapping[int, tuple[float, ...]] = field(default_factory=dict, hash=False)
     source: str = "<tool table>"
-    names: Mapping[str, float] = field(default_factory=dict, hash=False)  # name -> tool number (the first listed)
-    edges: Mapping[tuple[float, int], tuple[float, float, float]] = field(default_factory=dict, hash=False)  # (T, D) -> lengths 1-3
-    diameters: Mapping[int, float] = field(default_factory=dict, hash=False)  # LinuxCNC's D per tool number, mm
+    names: Mapping[str, float] = field(
+        default_factory=dict, hash=False
+    )  # name -> tool number (the first listed)
+    edges: Mapping[tuple[float, int], tuple[float, float, float]] = field(
+        default_factory=dict, hash=False
+    )  # (T, D) -> lengths 1-3
+    diameters: Mapping[int, float] = field(
+        default_factory=dict, hash=False
+    )  # LinuxCNC's D per tool number, mm
 
     @classmethod
-    def from_file(cls, path: str | Path, unit_mm: float = 1.0) -> "ToolTable":
+    def from_file(cls, path: str | Path, unit_mm: float = 1.0) -> ToolTable:
         """LinuxCNC's tool table or Sinumerik's tool offsets, their lengths in the machine's
         units (`unit_mm` mm each), or Heidenhain's TOOL.T (its units in its first line)."""
         try:
@@ -118,7 +124,9 @@ class UntoldLengths:
             )
 
 
-def read_tool_lines(lines: list[str], file: str, unit_mm: float) -> tuple[dict[int, tuple[float, ...]], dict[int, float]]:
+def read_tool_lines(
+    lines: list[str], file: str, unit_mm: float
+) -> tuple[dict[int, tuple[float, ...]], dict[int, float]]:
     """Per tool number its offsets (mm and degrees), and the diameters the table gives (mm)."""
     tools: dict[int, tuple[float, ...]] = {}
     diameters: dict[int, float] = {}
@@ -169,7 +177,9 @@ def _integer(text: str, where: Location) -> int:
     return int(value)
 
 
-def read_tool_t(lines: list[str], file: str) -> tuple[dict[tuple[float, int], tuple[float, float, float]], dict[str, float]]:
+def read_tool_t(
+    lines: list[str], file: str
+) -> tuple[dict[tuple[float, int], tuple[float, float, float]], dict[str, float]]:
     """Heidenhain's TOOL.T: per (tool, its one edge) its lengths (L + DL, 0, 0) in mm, and the names."""
     unit_mm = 25.4 if "INCH" in lines[0].upper().split() else 1.0
     if len(lines) < 2:
@@ -182,11 +192,13 @@ def read_tool_t(lines: list[str], file: str) -> tuple[dict[tuple[float, int], tu
             break
         if not line.strip():
             continue
-        decimal = lambda name: _decimal(*_field(line, columns, name), Location(file, n))  # noqa: E731  a column's number
+        decimal = lambda name: _decimal(*_field(line, columns, name), Location(file, n))  # noqa: E731, B023  a column's number, read in this iteration
         text, col = _field(line, columns, "T")
         number = decimal("T")
         if number < 0:
-            raise NcppError(f"a tool number is not negative, got {quoted(text, _QUOTED)}", Location(file, n, col))
+            raise NcppError(
+                f"a tool number is not negative, got {quoted(text, _QUOTED)}", Location(file, n, col)
+            )
         if (number, 1) in tools:
             raise NcppError(f"tool {text} is listed twice", Location(file, n, col))
         tools[number, 1] = ((decimal("L") + decimal("DL")) * unit_mm, 0.0, 0.0)
@@ -200,7 +212,10 @@ def _columns(header: str, file: str) -> dict[str, tuple[int, int | None]]:
     """Each column's (start, end) in the lines: from its name to the next column's name
     (None: the last column runs to the end of the line)."""
     found = list(_WORD.finditer(header))
-    columns = {m.group().upper(): (m.start(), found[k + 1].start() if k + 1 < len(found) else None) for k, m in enumerate(found)}
+    columns = {
+        m.group().upper(): (m.start(), found[k + 1].start() if k + 1 < len(found) else None)
+        for k, m in enumerate(found)
+    }
     for needed in ("T", "L"):
         if needed not in columns:
             raise NcppError(f"TOOL.T header without a {needed} column", Location(file, 2, 1))
@@ -226,7 +241,9 @@ _TC_TP2 = re.compile(r"\$TC_TP2\[\s*(\d+)\s*\]\s*=\s*\"([^\"]*)\"", re.IGNORECAS
 _LENGTH_PARAMETERS = {3: 0, 12: 0, 21: 0, 4: 1, 13: 1, 22: 1, 5: 2, 14: 2, 23: 2}
 
 
-def read_to_ini(lines: list[str], file: str, unit_mm: float) -> tuple[dict[tuple[float, int], tuple[float, float, float]], dict[str, float]]:
+def read_to_ini(
+    lines: list[str], file: str, unit_mm: float
+) -> tuple[dict[tuple[float, int], tuple[float, float, float]], dict[str, float]]:
     """Sinumerik's tool offsets: per (T, D) its lengths 1-3 in mm, and the tools' names."""
     lengths: dict[tuple[float, int], list[float]] = {}
     names: dict[str, float] = {}

@@ -19,7 +19,7 @@ is the program's first, whatever the batch sizes; `NcppError.locate` then names 
 
 from __future__ import annotations
 
-from typing import Callable, Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 
 from ncpp.motion.segments import Event
 from ncpp.passes import apply_error_map, replace_arcs, rotary, subdivide
@@ -29,10 +29,17 @@ Pass = Callable[[Iterable[Event], PassContext], Iterator[Event]]
 
 # Order matters: refuse what turns rotary axes where it cannot be compensated, split lines
 # on the nominal path, replace arcs by compensated arcs, then move every remaining line end point.
-PASSES: tuple[Pass, ...] = (rotary.refuse_rotary, subdivide.subdivide_lines, replace_arcs.replace_arcs, apply_error_map.apply_error_map)
+PASSES: tuple[Pass, ...] = (
+    rotary.refuse_rotary,
+    subdivide.subdivide_lines,
+    replace_arcs.replace_arcs,
+    apply_error_map.apply_error_map,
+)
 
 
-def run_passes(events: Iterable[Event], ctx: PassContext, passes: tuple[Pass, ...] = PASSES) -> Iterator[Event]:
+def run_passes(
+    events: Iterable[Event], ctx: PassContext, passes: tuple[Pass, ...] = PASSES
+) -> Iterator[Event]:
     for step in passes:
         events = step(events, ctx)
     return iter(events)

@@ -16,19 +16,31 @@ start is compensated with its own direction and a step move is inserted.
 
 from __future__ import annotations
 
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, fields, replace
 from itertools import chain
-from typing import Iterable, Iterator, overload
+from typing import overload
 
 import numpy as np
 from numpy.typing import NDArray
 
 from ncpp.errors import Location, NcppError
 from ncpp.motion.segments import CYCLE, Arc, Event, Line, Pass, Setting
-from ncpp.program.blocks import Word
 from ncpp.passes.context import PassContext, deviation
-from ncpp.passes.geometry import any3, compensate, frames, from_plane, in_plane, line_chunks, plane_axes, points, rows_of, tuples
+from ncpp.passes.geometry import (
+    any3,
+    compensate,
+    frames,
+    from_plane,
+    in_plane,
+    line_chunks,
+    plane_axes,
+    points,
+    rows_of,
+    tuples,
+)
 from ncpp.passes.travel import Travel, grid, hold, quantize, steps
+from ncpp.program.blocks import Word
 
 # Compensations per line at most: each changes a direction only where a
 # correction of the previous round flipped a µm motion; two rounds settle almost all.
@@ -65,7 +77,7 @@ def _chunks(events: Iterable[Event], ctx: PassContext) -> Iterator[list[Event]]:
         yield out
 
 
-def _warn_at_travel_ends(segs: list, rows: "_Rows", solved: "_Solved", ctx: PassContext) -> None:
+def _warn_at_travel_ends(segs: list, rows: _Rows, solved: _Solved, ctx: PassContext) -> None:
     """One warning per line end left at a travel end (`compensate`'s `ends`), at its axis word."""
     machine = (solved.end + rows.offsets) * rows.scales[:, None]
     for k, axis in zip(*np.nonzero(solved.at_end)):
@@ -89,7 +101,7 @@ def _rowed(chunks: Iterable[list[Event]], directional: bool, last: Line | Arc | 
         yield rowed
 
 
-def _with_rows(chunk: list[Event], directional: bool, fixed_before: bool = True) -> tuple[list[Event], list, "_Rows | None"]:  # fmt: skip
+def _with_rows(chunk: list[Event], directional: bool, fixed_before: bool = True) -> tuple[list[Event], list, _Rows | None]:  # fmt: skip
     """The chunk, its segments, and their rows (None without segments); `fixed_before`:
     whether the segment before the chunk's first was left as programmed (or there is none)."""
     segs = [e for e in chunk if type(e) is Line or type(e) is Arc]
@@ -108,7 +120,9 @@ class _Rows:
     free: NDArray  # (n,) lines no pass has changed: their ends are compensated here
     arc: NDArray  # (n,) pieces replace_arcs made (arcs, and lines for slivers)
     pieces: NDArray  # (n,) the lines among them
-    assumed: NDArray | None  # (n,3) directions replace_arcs compensated the pieces with (reversal errors only)
+    assumed: (
+        NDArray | None
+    )  # (n,3) directions replace_arcs compensated the pieces with (reversal errors only)
     lines: NDArray  # (n,) the line of each segment's block, for messages
     rapid: NDArray  # (n,) rapid moves (G0): no reversal step before them
     carried: NDArray  # (n,) moves left as programmed that run from where the control is (`_carry`)
@@ -169,12 +183,16 @@ class Solve:
         self.ctx = ctx
         self.travel = Travel()
 
-    def __call__(self, rows: _Rows) -> "_Solved":
+    def __call__(self, rows: _Rows) -> _Solved:
         return self._solve(rows, self.travel)
 
-    def _solve(self, rows: _Rows, travel: Travel) -> "_Solved":
+    def _solve(self, rows: _Rows, travel: Travel) -> _Solved:
         try:
-            return _directional(rows, self.ctx, travel) if self.ctx.directional else _plain(rows, self.ctx, travel)
+            return (
+                _directional(rows, self.ctx, travel)
+                if self.ctx.directional
+                else _plain(rows, self.ctx, travel)
+            )
         except NcppError as error:  # (`travel` is advanced only once a chunk is solved)
             # the chunk's line ends are checked before its reversal steps: an earlier line's fault
             # among these is found solving the rows before the refused line alone, and raised instead
@@ -224,7 +242,11 @@ def _written(chunk: list[Event], segs: list, rows: _Rows, solved: _Solved, last)
     # A reversal step's target, with the axes that keep their direction left where they
     # are when they differ only by output rounding: a one-digit move there would reverse
     # that axis on the machine.
-    target = np.where(solved.keep & (np.abs(solved.turn_start - previous) <= solved.limit[:, None]), previous, solved.turn_start)
+    target = np.where(
+        solved.keep & (np.abs(solved.turn_start - previous) <= solved.limit[:, None]),
+        previous,
+        solved.turn_start,
+    )
     # An axis that runs ahead on reversal (a reversal table below its other) would reach its
     # start for the new direction travelling the old way, past the corner: it reverses where
     # it is, and its jump lands the tool back along the way it came.
@@ -232,7 +254,9 @@ def _written(chunk: list[Event], segs: list, rows: _Rows, solved: _Solved, last)
     turning &= _apart(previous, target)
     # replace_arcs' pieces start where they start: a step from the previous end first
     connect = ~solved.free & has_previous & rows.arc & _apart(previous, solved.start)
-    code = (solved.free * _FREE + (solved.moved & ~solved.free) * _MOVED + turning * _TURNS + connect * _CONNECTS).tolist()
+    code = (
+        solved.free * _FREE + (solved.moved & ~solved.free) * _MOVED + turning * _TURNS + connect * _CONNECTS
+    ).tolist()
     ends = tuples(solved.end)
     targets = _by_row(target, turning & solved.free)
     moved_starts = _by_row(solved.start, solved.moved & ~solved.free)
@@ -246,11 +270,37 @@ def _written(chunk: list[Event], segs: list, rows: _Rows, solved: _Solved, last)
         start = starts_from.get(i, start)
         if row & _FREE:
             begin = seg.start if start is None else start
-            if row & _TURNS:  # the reversal step (the axes beyond X Y Z still), then the line from where it ends
+            if (
+                row & _TURNS
+            ):  # the reversal step (the axes beyond X Y Z still), then the line from where it ends
                 still = seg.extra_start or seg.extra
-                out.append(Line(begin, targets[i], seg.rapid, seg.feed, seg.block, seg.context, still, True, extra_start=still))
+                out.append(
+                    Line(
+                        begin,
+                        targets[i],
+                        seg.rapid,
+                        seg.feed,
+                        seg.block,
+                        seg.context,
+                        still,
+                        True,
+                        extra_start=still,
+                    )
+                )
                 begin = targets[i]
-            out.append(Line(begin, end, seg.rapid, seg.feed, seg.block, seg.context, seg.extra, True, extra_start=seg.extra_start))
+            out.append(
+                Line(
+                    begin,
+                    end,
+                    seg.rapid,
+                    seg.feed,
+                    seg.block,
+                    seg.context,
+                    seg.extra,
+                    True,
+                    extra_start=seg.extra_start,
+                )
+            )
         else:
             if i in lead_in:
                 step = _lead_in(seg, last if i == 0 else _ended(segs[i - 1], solved.end[i - 1]))
@@ -311,14 +361,25 @@ def _plain(rows: _Rows, ctx: PassContext, travel: Travel) -> _Solved:
     at_end = np.zeros(end.shape, dtype=bool)
     if at.size:
         ends = np.zeros((at.size, 3), dtype=bool)
-        end[at] = compensate(end[at], offsets[at], scales[at], rows.lines[at], ctx, np.sign(end[at] - start[at]), rows_of(rows.tools, at), ends)
+        end[at] = compensate(
+            end[at],
+            offsets[at],
+            scales[at],
+            rows.lines[at],
+            ctx,
+            np.sign(end[at] - start[at]),
+            rows_of(rows.tools, at),
+            ends,
+        )
         at_end[at] = ends
     if rows.carried.any():
         _carry(rows, end, None if travel.last is None else travel.last / scales[0] - offsets[0])
     travel.last = (end[-1] + offsets[-1]) * scales[-1]
     none = np.zeros(len(free), dtype=bool)
     keep = np.ones(start.shape, dtype=bool)
-    return _Solved(start, end, free, none, none, start, keep, np.zeros(len(free)), at_end, np.zeros(start.shape))
+    return _Solved(
+        start, end, free, none, none, start, keep, np.zeros(len(free)), at_end, np.zeros(start.shape)
+    )
 
 
 class _Commands:
@@ -387,7 +448,9 @@ def _directional(rows: _Rows, ctx: PassContext, travel: Travel) -> _Solved:
         # a piece moves from the previous end to its start first (a connecting step), then along itself
         own = steps(np.where(free[:, None], cur_end - previous, cur_end - cur_start), threshold)
         moved = np.where(arc[:, None] & (own == 0), steps(cur_start - previous, threshold), own)
-        d_new = _own_motion(moved, hold(moved, travel.held), free, start_p, end_p, scales, threshold, commands, travel)
+        d_new = _own_motion(
+            moved, hold(moved, travel.held), free, start_p, end_p, scales, threshold, commands, travel
+        )
         if np.array_equal(d_new, d) or round_ == ROUNDS - 1:
             break  # unsettled: keep the directions the ends were computed for
         d = d_new
@@ -403,7 +466,18 @@ def _directional(rows: _Rows, ctx: PassContext, travel: Travel) -> _Solved:
         turn_start[turned] = commands("start", turned, d[turned])
     travel.held = d[-1].copy()
     travel.last = machine(out_end[-1:], slice(len(free) - 1, None))[0]
-    return _Solved(out_start, out_end, free, moved, turn, turn_start, ~flips, limit, commands.at_end["end"] & free[:, None], d)
+    return _Solved(
+        out_start,
+        out_end,
+        free,
+        moved,
+        turn,
+        turn_start,
+        ~flips,
+        limit,
+        commands.at_end["end"] & free[:, None],
+        d,
+    )
 
 
 def _carry(rows: _Rows, out_end: NDArray, before: NDArray | None) -> None:
@@ -452,7 +526,9 @@ def _settle(free, arc, d, held, offsets, scales, limit, out_start, out_end, befo
     same[reframed] = False
     within = limit[:, None]
     line_gap = out_end - pred_end
-    lines = free & ok & any3((line_gap * pred_dir < 0) & (dirs[1:] == pred_dir) & (np.abs(line_gap) <= within))
+    lines = (
+        free & ok & any3((line_gap * pred_dir < 0) & (dirs[1:] == pred_dir) & (np.abs(line_gap) <= within))
+    )
     arc_gap = pred_end - out_start
     pieces = arc & same & any3((np.abs(arc_gap) <= within) & (arc_gap != 0))
     todo = np.flatnonzero(lines | pieces).tolist()
@@ -550,7 +626,10 @@ def _own_motion(moved, d, free, start_p, end_p, scales, threshold, commands: _Co
     rows = np.flatnonzero(any3(flips))
     if rows.size == 0:
         return d
-    own = steps((commands("end", rows, d[rows]) - commands("start", rows, d[rows])) * scales[rows, None], threshold[rows])
+    own = steps(
+        (commands("end", rows, d[rows]) - commands("start", rows, d[rows])) * scales[rows, None],
+        threshold[rows],
+    )
     contrary = flips[rows] & (own != 0) & (own != d[rows])
     if not contrary.any():
         return d
@@ -568,7 +647,9 @@ def _arc_assumed(segs: list, rows: NDArray, start: NDArray, end: NDArray) -> NDA
         return out
     arcs = [segs[i] for i in rows.tolist()]
     axes = plane_axes(arcs)
-    (su, sv, _), (eu, ev, _), (cu, cv, _) = (in_plane(p, axes) for p in (start[rows], end[rows], points([a.center for a in arcs])))
+    (su, sv, _), (eu, ev, _), (cu, cv, _) = (
+        in_plane(p, axes) for p in (start[rows], end[rows], points([a.center for a in arcs]))
+    )
     u0, v0, u1, v1 = su - cu, sv - cv, eu - cu, ev - cv
     with np.errstate(invalid="ignore", divide="ignore"):
         r0, r1 = np.sqrt(u0 * u0 + v0 * v0), np.sqrt(u1 * u1 + v1 * v1)
@@ -609,7 +690,11 @@ def _moved_arc(arc: Arc | Line, start: tuple, end: tuple) -> Arc | Line:
     if type(arc) is Line:
         return Line(start, end, arc.rapid, arc.feed, arc.block, arc.context, arc.extra, True)
     (s0, s1, s2), (e0, e1, e2), (c0, c1, c2) = arc.start, arc.end, arc.center
-    centre = (c0 + (start[0] - s0 + end[0] - e0) / 2, c1 + (start[1] - s1 + end[1] - e1) / 2, c2 + (start[2] - s2 + end[2] - e2) / 2)
+    centre = (
+        c0 + (start[0] - s0 + end[0] - e0) / 2,
+        c1 + (start[1] - s1 + end[1] - e1) / 2,
+        c2 + (start[2] - s2 + end[2] - e2) / 2,
+    )
     return Arc(start, end, centre, arc.turn, arc.feed, arc.block, arc.context, arc.extra, True)
 
 

@@ -17,7 +17,9 @@ class ErrorMap(Protocol):
     have a `bow_bound` (`ncpp.machine.curvature.BowBound`, or None): with one,
     subdivide_lines leaves unsampled the lines it keeps whole."""
 
-    def deviation(self, P: NDArray, direction: NDArray | None = None, tool_offset: NDArray | None = None) -> NDArray:
+    def deviation(
+        self, P: NDArray, direction: NDArray | None = None, tool_offset: NDArray | None = None
+    ) -> NDArray:
         """(n,3) actual minus nominal tool point, mm, for (n,3) axis positions in mm
         reached with travel signs `direction` (n,3) (None: unknown, mean of both),
         with the (n,3) tool length offsets `tool_offset` in effect, mm (None: none)."""
@@ -44,7 +46,9 @@ class PassContext:
     resolution: float = 1e-4  # mm: the output grid of mm programs (every writer writes at least 4 decimals)
     resolution_inch: float = 1e-5  # inch: the same for inch programs (5 decimals)
     min_line_check: float = 1.0  # mm: shorter lines are never subdivided (their error is linear to < 0.01 µm)
-    iterations: int = 2  # fixed-point steps of the inverse map (`inverse.iterations_for` picks the fewest that suffice)
+    iterations: int = (
+        2  # fixed-point steps of the inverse map (`inverse.iterations_for` picks the fewest that suffice)
+    )
     warnings: Warnings = field(default_factory=Warnings)
     file: str = "<stdin>"
 

@@ -4,9 +4,10 @@ program points to machine positions and back, compensating many at once."""
 from __future__ import annotations
 
 from bisect import bisect_left
+from collections.abc import Iterable, Iterator, Sequence
 from itertools import chain, islice
 from operator import attrgetter
-from typing import Iterable, Iterator, Sequence, TypeVar
+from typing import TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -48,7 +49,9 @@ def chunked(items: Iterable[T], size: int = CHUNK) -> Iterator[list[T]]:
         yield chunk
 
 
-def line_chunks(events: Iterable[Event], lines: int = LINE_CHUNK, size: int = LINE_CHUNK_CAP) -> Iterator[list[Event]]:
+def line_chunks(
+    events: Iterable[Event], lines: int = LINE_CHUNK, size: int = LINE_CHUNK_CAP
+) -> Iterator[list[Event]]:
     """Lists of the events of one window of `lines` input lines each (windows start at
     multiples of `lines`), cut short at `size` events.  Where a chunk ends depends on
     the program, not on where the stream started: compensating a program from a later
@@ -106,7 +109,9 @@ def frames(segments: Sequence[Line | Arc]) -> tuple[NDArray, NDArray, NDArray | 
     """(n,3) offsets (machine minus program, program units), (n,) mm per unit, and
     (n,3) tool length offsets in mm (None when no segment has one)."""
     every = [s.context for s in segments]
-    if every and every.count(every[0]) == len(every):  # one context (mostly one object: `count` tries `is` first)
+    if every and every.count(every[0]) == len(
+        every
+    ):  # one context (mostly one object: `count` tries `is` first)
         c = every[0]
         n, scale = len(every), 25.4 if c.inch else 1.0
         tools = None if c.tool == _NO_TOOL else np.tile(np.asarray(c.tool, dtype=float) * scale, (n, 1))
@@ -127,7 +132,11 @@ def frames(segments: Sequence[Line | Arc]) -> tuple[NDArray, NDArray, NDArray | 
     scales = np.array([25.4 if c.inch else 1.0 for c in contexts])[index]
     if all(c.tool == _NO_TOOL for c in contexts):
         return offsets, scales, None
-    return offsets, scales, np.array([c.tool for c in contexts], dtype=float).reshape(-1, 3)[index] * scales[:, None]
+    return (
+        offsets,
+        scales,
+        np.array([c.tool for c in contexts], dtype=float).reshape(-1, 3)[index] * scales[:, None],
+    )
 
 
 def rows_of(tools: NDArray | None, rows) -> NDArray | None:
@@ -162,7 +171,9 @@ def all3(flags: NDArray) -> NDArray:
 
 def points(coordinates: Sequence[tuple[float, float, float]]) -> NDArray:
     """(n,3) array of n (x, y, z) tuples (twice as fast as np.array on the list)."""
-    return np.fromiter(chain.from_iterable(coordinates), dtype=float, count=3 * len(coordinates)).reshape(-1, 3)
+    return np.fromiter(chain.from_iterable(coordinates), dtype=float, count=3 * len(coordinates)).reshape(
+        -1, 3
+    )
 
 
 # PLANE_AXES as an array indexed by the plane's G code
@@ -264,7 +275,9 @@ def _check(wanted: NDArray, command: NDArray, lines: NDArray, ctx: PassContext) 
     if broken.size:
         k = int(broken[0])
         what = "the program point" if not np.isfinite(wanted[k]).all() else "the machine model's correction"
-        raise NcppError(f"{what} is not a finite number: nothing to command", Location(ctx.file, int(lines[k])))
+        raise NcppError(
+            f"{what} is not a finite number: nothing to command", Location(ctx.file, int(lines[k]))
+        )
     correction = np.linalg.norm(command - wanted, axis=-1).max(axis=-1)
     bad = np.flatnonzero(correction > ctx.max_correction)
     if bad.size:
@@ -280,7 +293,9 @@ def _check(wanted: NDArray, command: NDArray, lines: NDArray, ctx: PassContext) 
         pts = command[k].reshape(-1, 3)
         axis_index = int(np.flatnonzero(((pts < lo) | (pts > hi)).any(axis=0))[0])
         axis = "XYZ"[axis_index]
-        value = pts[:, axis_index][(pts[:, axis_index] < lo[axis_index]) | (pts[:, axis_index] > hi[axis_index])][0]
+        value = pts[:, axis_index][
+            (pts[:, axis_index] < lo[axis_index]) | (pts[:, axis_index] > hi[axis_index])
+        ][0]
         raise NcppError(
             f"command {axis}{value:.4f} mm is outside the {axis} travel [{lo[axis_index]:g}, {hi[axis_index]:g}] mm",
             Location(ctx.file, int(lines[k]), word=axis),

@@ -40,7 +40,9 @@ class RadialMap:
     angle: NDArray  # (n,) rad, sorted, in [0, 2π)
     delta_r: NDArray  # (n,) mm
 
-    def deviation(self, P: NDArray, direction: NDArray | None = None, tool_offset: NDArray | None = None) -> NDArray:
+    def deviation(
+        self, P: NDArray, direction: NDArray | None = None, tool_offset: NDArray | None = None
+    ) -> NDArray:
         P = np.atleast_2d(np.asarray(P, dtype=float))
         i, j = self.axes
         u, v = P[:, i] - self.centre[i], P[:, j] - self.centre[j]
@@ -62,14 +64,16 @@ class AxisMap:
     position: NDArray  # (n,) mm, ascending
     deviation_mm: NDArray  # (n,3) mm
 
-    def deviation(self, P: NDArray, direction: NDArray | None = None, tool_offset: NDArray | None = None) -> NDArray:
+    def deviation(
+        self, P: NDArray, direction: NDArray | None = None, tool_offset: NDArray | None = None
+    ) -> NDArray:
         P = np.atleast_2d(np.asarray(P, dtype=float))
         x = P[:, self.axis]
         return np.column_stack([np.interp(x, self.position, self.deviation_mm[:, k]) for k in range(3)])
 
 
 def radial_map(m: Measurement) -> RadialMap:
-    from ncpp.instruments.iso230_4 import circular_test, lsc_centre, _angles_about, centred
+    from ncpp.instruments.iso230_4 import _angles_about, centred, circular_test, lsc_centre
 
     test = circular_test(m)
     if m.center_mm is None:
@@ -83,7 +87,9 @@ def radial_map(m: Measurement) -> RadialMap:
         dr = centred(trace, centre_um, test.radius_mm)[order]
         curves.append(np.interp(grid, theta[order], dr, period=2 * np.pi))
     first, second = (AXIS_INDEX[a] for a in PLANES[m.plane])
-    return RadialMap(np.asarray(m.center_mm, dtype=float), (first, second), grid, np.mean(curves, axis=0) / 1000.0)
+    return RadialMap(
+        np.asarray(m.center_mm, dtype=float), (first, second), grid, np.mean(curves, axis=0) / 1000.0
+    )
 
 
 def axis_map(m: Measurement) -> AxisMap:

@@ -15,8 +15,9 @@ All arcs of a chunk are processed together, piece arrays in, piece arrays out.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
-from typing import Iterable, Iterator, cast
+from typing import cast
 
 import numpy as np
 from numpy.typing import NDArray
@@ -25,7 +26,20 @@ from ncpp.errors import Location, NcppError
 from ncpp.machine.chain import norm3
 from ncpp.motion.segments import PLANE_AXES, Arc, Event, Line
 from ncpp.passes.context import PassContext
-from ncpp.passes.geometry import any3, before_line, compensate, frames, from_plane, in_plane, plane_axes, points, row_max, rows_of, spliced, tuples
+from ncpp.passes.geometry import (
+    any3,
+    before_line,
+    compensate,
+    frames,
+    from_plane,
+    in_plane,
+    plane_axes,
+    points,
+    row_max,
+    rows_of,
+    spliced,
+    tuples,
+)
 from ncpp.passes.travel import grid, quantize
 
 # Points per piece where the fit is checked (ends included).  Fewer on short
@@ -50,7 +64,9 @@ BATCH_EVENTS = 4096
 # Turns of one arc at most: an arc's pieces are made at once (~8 kB a turn: 10,000 turns take
 # 170 MB; a helix of 10⁸ turns ran out of 24 GB).
 MAX_TURNS = 10_000
-SLIVER = 0.01  # mm of arc length below which a piece becomes a line (its bulge is < 0.1 µm for radii over 0.1 mm)
+SLIVER = (
+    0.01  # mm of arc length below which a piece becomes a line (its bulge is < 0.1 µm for radii over 0.1 mm)
+)
 # Lines back that an arc's guess of its normal axis's direction looks (`Motion`)
 HELD_LINES = 1024
 
@@ -73,7 +89,9 @@ def replace_arcs(events: Iterable[Event], ctx: PassContext) -> Iterator[Event]:
             continue
         try:
             fitted = fit(_ArcRows.of(arcs, normals))
-        except NcppError as error:  # the lines before the refused one go on first: a later pass may refuse one of them
+        except (
+            NcppError
+        ) as error:  # the lines before the refused one go on first: a later pass may refuse one of them
             error.locate(e.block for e in batch)
             earlier = before_line(batch, error.where.line)
             if len(earlier) < len(batch):
@@ -82,7 +100,7 @@ def replace_arcs(events: Iterable[Event], ctx: PassContext) -> Iterator[Event]:
         yield from spliced(batch, index, _assemble(arcs, fitted, normals))
 
 
-def _with_arcs(batch: list[Event], motion: "Motion") -> tuple[list[Event], list[int], list[Arc], list[int]]:
+def _with_arcs(batch: list[Event], motion: Motion) -> tuple[list[Event], list[int], list[Arc], list[int]]:
     """The batch, where its arcs to replace are, those arcs, and the direction each one's
     normal axis is compensated for (`Motion`)."""
     index = [k for k, e in enumerate(batch) if type(e) is Arc and not e.changed and not e.fixed]
@@ -175,7 +193,7 @@ class _ArcRows:
     normal: NDArray  # (n,) the direction each arc's normal axis is compensated for (`Motion`)
 
     @classmethod
-    def of(cls, arcs: list[Arc], normals: list[int]) -> "_ArcRows":
+    def of(cls, arcs: list[Arc], normals: list[int]) -> _ArcRows:
         offsets, scales, tools = frames(arcs)
         return cls(
             points([a.start for a in arcs]), points([a.end for a in arcs]), points([a.center for a in arcs]),
@@ -193,7 +211,9 @@ class _Fitted:
     a0: NDArray  # (n,) each arc's start angle
     sign: NDArray  # (n,) +1 counter-clockwise, -1 clockwise
     arcs: list[tuple[NDArray, ...]] = field(default_factory=list)  # (arc, a0, start, end, centre) per round
-    lines: list[tuple[NDArray, ...]] = field(default_factory=list)  # (arc, a0, points (p,m,3)): lines through the points
+    lines: list[tuple[NDArray, ...]] = field(
+        default_factory=list
+    )  # (arc, a0, points (p,m,3)): lines through the points
 
 
 class FitArcs:
@@ -212,7 +232,9 @@ class _ArcGeometry:
 
     def __init__(self, rows: _ArcRows):
         self.axes = rows.axes
-        (su, sv, sw), (eu, ev, ew), (cu, cv, _) = (in_plane(p, self.axes) for p in (rows.start, rows.end, rows.centre))
+        (su, sv, sw), (eu, ev, ew), (cu, cv, _) = (
+            in_plane(p, self.axes) for p in (rows.start, rows.end, rows.centre)
+        )
         self.centre_u, self.centre_v = cu, cv
         self.radius = np.hypot(su - cu, sv - cv)
         self.a0 = np.arctan2(sv - cv, su - cu)
@@ -283,7 +305,10 @@ def _replace(arcs: _ArcRows, ctx: PassContext) -> _Fitted:
     many = np.flatnonzero(np.abs(arcs.turn) > MAX_TURNS)
     if many.size:
         turns, line = int(abs(arcs.turn[many[0]])), int(arcs.lines[many[0]])
-        raise NcppError(f"an arc of {turns:,} turns: ncpp compensates {MAX_TURNS:,} at most (its pieces, 8 a turn, are held at once)", Location(ctx.file, line, word="P"))
+        raise NcppError(
+            f"an arc of {turns:,} turns: ncpp compensates {MAX_TURNS:,} at most (its pieces, 8 a turn, are held at once)",
+            Location(ctx.file, line, word="P"),
+        )
     geometry = _ArcGeometry(arcs)
     offsets, scales, tools, line_of = arcs.offsets, arcs.scales, arcs.tools, arcs.lines
     pending = _initial_pieces(geometry, ctx.directional)
@@ -297,7 +322,18 @@ def _replace(arcs: _ArcRows, ctx: PassContext) -> _Fitted:
         for m in np.unique(counts).tolist():
             rows = np.flatnonzero(counts == m)
             some = _Pieces(pending.arc[rows], pending.a0[rows], pending.sweep[rows])
-            split[rows] = _round(some, length[rows], np.linspace(0.0, 1.0, m), geometry, offsets, scales, tools, line_of, ctx, done)
+            split[rows] = _round(
+                some,
+                length[rows],
+                np.linspace(0.0, 1.0, m),
+                geometry,
+                offsets,
+                scales,
+                tools,
+                line_of,
+                ctx,
+                done,
+            )
         half = pending.sweep[split] / 2
         pending = _Pieces(
             np.repeat(pending.arc[split], 2),
@@ -307,7 +343,18 @@ def _replace(arcs: _ArcRows, ctx: PassContext) -> _Fitted:
     return done
 
 
-def _round(pending: _Pieces, length: NDArray, t: NDArray, geometry, offsets, scales, tools, line_of, ctx, done: _Fitted) -> NDArray:
+def _round(
+    pending: _Pieces,
+    length: NDArray,
+    t: NDArray,
+    geometry,
+    offsets,
+    scales,
+    tools,
+    line_of,
+    ctx,
+    done: _Fitted,
+) -> NDArray:
     """Compensate and fit pieces sampled at `t`; append the finished ones to
     `done` and return (p,) which to halve."""
     angles = pending.a0[:, None] + t[None, :] * pending.sweep[:, None]
@@ -317,17 +364,35 @@ def _round(pending: _Pieces, length: NDArray, t: NDArray, geometry, offsets, sca
     direction = np.sign(ahead[:, :1] - ahead[:, 1:])  # of the tangent in the middle
     # the normal axis's direction is the one the machine holds when it gets here, as
     # `Motion` guesses it: apply_error_map knows it and shifts the piece where it differs
-    np.put_along_axis(direction, geometry.axes[pending.arc, None, 2:], geometry.normal[pending.arc, None, None], axis=2)
+    np.put_along_axis(
+        direction, geometry.axes[pending.arc, None, 2:], geometry.normal[pending.arc, None, None], axis=2
+    )
     direction = np.broadcast_to(direction, nominal.shape)
     scale = scales[pending.arc]
-    q = compensate(nominal, offsets[pending.arc], scale, line_of[pending.arc], ctx, direction, rows_of(tools, pending.arc))
+    q = compensate(
+        nominal,
+        offsets[pending.arc],
+        scale,
+        line_of[pending.arc],
+        ctx,
+        direction,
+        rows_of(tools, pending.arc),
+    )
     centre, deviation = _fit(q, geometry.axes[pending.arc], t, ctx.tolerance / scale)
     ok = deviation <= ctx.tolerance / scale
     if ctx.directional:  # ends on the output grid (after the fit: a short piece's chord fixes the bisector)
         step = grid(ctx, scale)
         q[:, 0], q[:, -1] = quantize(q[:, 0], step), quantize(q[:, -1], step)
         window = np.maximum(step, REVERSAL_WINDOW / scale)
-        one_way = _one_way(q, centre, geometry.axes[pending.arc], direction[:, 0], np.sign(pending.sweep), window, REVERSAL_HEIGHT / scale)
+        one_way = _one_way(
+            q,
+            centre,
+            geometry.axes[pending.arc],
+            direction[:, 0],
+            np.sign(pending.sweep),
+            window,
+            REVERSAL_HEIGHT / scale,
+        )
     else:
         one_way = np.ones(len(ok), dtype=bool)
     # a sliver (a quadrant cut next to an arc's end) is a line: on the output grid its
@@ -342,17 +407,32 @@ def _round(pending: _Pieces, length: NDArray, t: NDArray, geometry, offsets, sca
     if lines.size and ctx.directional:
         # lines are compensated for the mean direction: apply_error_map moves them to the real one
         arc = pending.arc[lines]
-        q[lines] = _mean_compensated(nominal[lines], offsets[arc], scale[lines], line_of[arc], ctx, rows_of(tools, arc))
-    for rows, pts in ((np.flatnonzero(straight), lambda r: q[r][:, [0, -1]]), (np.flatnonzero(give_up), lambda r: q[r])):
+        q[lines] = _mean_compensated(
+            nominal[lines], offsets[arc], scale[lines], line_of[arc], ctx, rows_of(tools, arc)
+        )
+    for rows, pts in (
+        (np.flatnonzero(straight), lambda r: q[r][:, [0, -1]]),
+        (np.flatnonzero(give_up), lambda r: q[r]),
+    ):
         if rows.size:
             done.lines.append((pending.arc[rows], pending.a0[rows], pts(rows)))
     fitted = np.flatnonzero(ok)
     if fitted.size:
-        done.arcs.append((pending.arc[fitted], pending.a0[fitted], q[fitted, 0], q[fitted, -1], centre[fitted]))
+        done.arcs.append(
+            (pending.arc[fitted], pending.a0[fitted], q[fitted, 0], q[fitted, -1], centre[fitted])
+        )
     return ~ok & ~give_up & ~straight
 
 
-def _one_way(q: NDArray, centre: NDArray, axes: NDArray, direction: NDArray, sign: NDArray, window: NDArray, height: NDArray) -> NDArray:
+def _one_way(
+    q: NDArray,
+    centre: NDArray,
+    axes: NDArray,
+    direction: NDArray,
+    sign: NDArray,
+    window: NDArray,
+    height: NDArray,
+) -> NDArray:
     """(p,) whether each compensated piece (ends `q` on the output grid, `centre`) moves
     every plane axis one way only, in the `direction` (p,3) it was compensated for
     (`sign` (p,): +1 counter-clockwise).
@@ -362,7 +442,11 @@ def _one_way(q: NDArray, centre: NDArray, axes: NDArray, direction: NDArray, sig
     the axis there, where no step can follow.  An extreme within `window` (p,)
     (program units of path) of an end, or from which the axis goes back by less
     than `height` (p,), is rounding or a rotation of the compensated frame, not a reversal."""
-    (cu, cv, _), (u0, v0, _), (u1, v1, _) = in_plane(centre, axes), in_plane(q[:, 0], axes), in_plane(q[:, -1], axes)
+    (cu, cv, _), (u0, v0, _), (u1, v1, _) = (
+        in_plane(centre, axes),
+        in_plane(q[:, 0], axes),
+        in_plane(q[:, -1], axes),
+    )
     want_u, want_v, _ = in_plane(direction, axes)
     a0 = np.arctan2(v0 - cv, u0 - cu)
     a1 = np.arctan2(v1 - cv, u1 - cu)
@@ -382,7 +466,9 @@ def _one_way(q: NDArray, centre: NDArray, axes: NDArray, direction: NDArray, sig
     back = radius[:, None] * from_end**2 / 2 > height[:, None]
     inside = any3((at > margin[:, None]) & (at < (span - margin)[:, None]) & back)
     mid = a0 + sign * span / 2
-    agrees = (np.sign(sign * -np.sin(mid)) == want_u) & (np.sign(sign * np.cos(mid)) == want_v)  # the tangent's signs
+    agrees = (np.sign(sign * -np.sin(mid)) == want_u) & (
+        np.sign(sign * np.cos(mid)) == want_v
+    )  # the tangent's signs
     return ~inside & agrees & (span < np.pi) & (np.abs(blend) < quarter / 2)
 
 
@@ -446,7 +532,11 @@ def _minimax_step(uv: NDArray, q0: NDArray, c: NDArray, normal: NDArray) -> NDAr
     ri, rj, gi, gj = r[:, :, None], r[:, None, :], g[:, :, None], g[:, None, :]
     with np.errstate(divide="ignore", invalid="ignore"):
         candidates = np.concatenate(
-            [(-(ri + rj) / (gi + gj)).reshape(len(r), -1), (-(ri - rj) / (gi - gj)).reshape(len(r), -1), np.zeros((len(r), 1))],
+            [
+                (-(ri + rj) / (gi + gj)).reshape(len(r), -1),
+                (-(ri - rj) / (gi - gj)).reshape(len(r), -1),
+                np.zeros((len(r), 1)),
+            ],
             axis=1,
         )
     candidates = np.where(np.isfinite(candidates), candidates, 0.0)
@@ -456,7 +546,9 @@ def _minimax_step(uv: NDArray, q0: NDArray, c: NDArray, normal: NDArray) -> NDAr
 
 def _line_pieces(arc: Arc, q: list[list[float]]) -> list[Event]:
     pts = cast(list[tuple[float, float, float]], [tuple(p) for p in q])  # (q's points are 3-vectors)
-    return [Line(a, b, False, arc.feed, arc.block, arc.context, arc.extra, True) for a, b in zip(pts, pts[1:])]
+    return [
+        Line(a, b, False, arc.feed, arc.block, arc.context, arc.extra, True) for a, b in zip(pts, pts[1:])
+    ]
 
 
 def _assemble(arcs: list[Arc], fitted: _Fitted, normals: list[int]) -> list[list[Event]]:
@@ -477,7 +569,21 @@ def _assemble(arcs: list[Arc], fitted: _Fitted, normals: list[int]) -> list[list
         k = of_list[j]
         arc = arcs[k]
         if j < fitted_count:
-            out[k].append(Arc(ends[0][j], ends[1][j], ends[2][j], 1 if arc.turn > 0 else -1, arc.feed, arc.block, arc.context, arc.extra, True, "", normals[k]))
+            out[k].append(
+                Arc(
+                    ends[0][j],
+                    ends[1][j],
+                    ends[2][j],
+                    1 if arc.turn > 0 else -1,
+                    arc.feed,
+                    arc.block,
+                    arc.context,
+                    arc.extra,
+                    True,
+                    "",
+                    normals[k],
+                )
+            )
         else:
             out[k] += _line_pieces(arc, runs[j - fitted_count])
     return out

@@ -15,8 +15,8 @@ a rotary axis (its pieces would not be given their share).
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable, Iterator
 from itertools import chain
-from typing import Iterable, Iterator
 
 from ncpp.errors import Location, NcppError
 from ncpp.motion.segments import EXTRA_AXES, PLANE_AXES, Arc, Event, Line, Pass
@@ -62,7 +62,10 @@ def _checked(chunk: list[Event], ctx: PassContext) -> Iterator[list[Event]]:
 
 def _refuse_turn(move: Line | Arc, arc: bool, file: str) -> None:
     turned = [letter for letter, a, b in zip(ROTARY, move.extra_start, move.extra) if a != b]
-    word = next((i for i in move.block.items if type(i) is not Statement and getattr(i, "letter", None) in turned), None)
+    word = next(
+        (i for i in move.block.items if type(i) is not Statement and getattr(i, "letter", None) in turned),
+        None,
+    )
     where = Location(file, move.block.line, 1 if word is None else word.start + 1)
     what = " and ".join(turned)
     if arc:
@@ -116,7 +119,9 @@ def time_shares(pieces: list[Line | Arc]) -> list[float]:
     the other axes turn; each at least LEAST_SHARE."""
     lengths = [_length(p) for p in pieces]
     if sum(lengths) < 1e-6:
-        lengths = [sum(abs(b - a) for a, b in zip(p.extra_start, p.extra)) if turns(p) else 0.0 for p in pieces]
+        lengths = [
+            sum(abs(b - a) for a, b in zip(p.extra_start, p.extra)) if turns(p) else 0.0 for p in pieces
+        ]
     total = sum(lengths)
     shares = [max(length / total, LEAST_SHARE) if total > 0 else 1.0 for length in lengths]
     scale = sum(shares)

@@ -13,8 +13,9 @@ where the map gives one: its `bow_bound`).
 
 from __future__ import annotations
 
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
-from typing import Iterable, Iterator, cast
+from typing import cast
 
 import numpy as np
 from numpy.typing import NDArray
@@ -60,9 +61,13 @@ class _LineRows:
     tools: NDArray | None  # (n,3) tool length offsets, mm (None: none)
 
 
-def _with_rows(chunk: list[Event], ctx: PassContext, bound: BowBound | None = None) -> tuple[list[Event], list[int], list[Line], _LineRows | None]:
+def _with_rows(
+    chunk: list[Event], ctx: PassContext, bound: BowBound | None = None
+) -> tuple[list[Event], list[int], list[Line], _LineRows | None]:
     """The chunk, where its lines to check are, those lines, and their rows (None: none)."""
-    index = [k for k, e in enumerate(chunk) if type(e) is Line and not e.rapid and not e.changed and not e.fixed]
+    index = [
+        k for k, e in enumerate(chunk) if type(e) is Line and not e.rapid and not e.changed and not e.fixed
+    ]
     if not index:
         return chunk, [], [], None
     lines = cast(list[Line], [chunk[k] for k in index])
@@ -71,7 +76,9 @@ def _with_rows(chunk: list[Event], ctx: PassContext, bound: BowBound | None = No
     offsets, scales, tools = frames(lines)
     length = norm3(ends - starts) * scales
     long = np.flatnonzero(length >= ctx.min_line_check)
-    if long.size and bound is not None:  # and not kept whole by the bound (the samples would find less bow than it)
+    if (
+        long.size and bound is not None
+    ):  # and not kept whole by the bound (the samples would find less bow than it)
         machine = lambda p: (p[long] + offsets[long]) * scales[long, None]  # noqa: E731
         bow = length[long] ** 2 / 8 * bound(machine(starts), machine(ends), rows_of(tools, long))
         long = long[SAFETY * bow > SURE * ctx.tolerance]
@@ -115,7 +122,9 @@ def _split(line: Line, n: int) -> list[Event]:
     cuts = [tuple(a + (b - a) * (i / n)) for i in range(n + 1)]
     cuts[0], cuts[-1] = line.start, line.end
     if turns(line):
-        extras = [line.extra_start] + [interpolated(line.extra_start, line.extra, i / n) for i in range(1, n + 1)]
+        extras = [line.extra_start] + [
+            interpolated(line.extra_start, line.extra, i / n) for i in range(1, n + 1)
+        ]
     else:
         extras = [line.extra] * (n + 1)
     return [Line(cuts[i], cuts[i + 1], line.rapid, line.feed, line.block, line.context, extras[i + 1], line.changed,

@@ -27,7 +27,7 @@ class Travel:
     held: NDArray = field(default_factory=lambda: np.zeros(3))
     last: NDArray | None = None
 
-    def copy(self) -> "Travel":
+    def copy(self) -> Travel:
         return Travel(self.held.copy(), None if self.last is None else self.last.copy())
 
 

@@ -10,7 +10,8 @@ written by a generator per dialect that writes whole programs from scratch
 
 from __future__ import annotations
 
-from typing import BinaryIO, Callable, Iterable, Iterator, TextIO
+from collections.abc import Callable, Iterable, Iterator
+from typing import BinaryIO, TextIO
 
 from ncpp.cldata import Record, motion, read_cldata
 from ncpp.errors import NcppError, Warnings
@@ -102,7 +103,15 @@ def _verified(stream: TextIO, out: BinaryIO, *, file: str, dialect: str, source,
         count = _post(cl, written, file=file, dialect=dialect, source=source, tolerance=tolerance, warnings=warnings,
                       progress=progress, offsets=offsets, summary=summary, guard=guard)  # fmt: skip
         cl.seek(0)
-        _post(cl, plain, file=file, dialect=dialect, source=None, warnings=Warnings(stream=io.StringIO()), offsets=offsets)
+        _post(
+            cl,
+            plain,
+            file=file,
+            dialect=dialect,
+            source=None,
+            warnings=Warnings(stream=io.StringIO()),
+            offsets=offsets,
+        )
         plain.seek(0)
         written.seek(0)
         nc = "iso" if dialect in ("linuxcnc", "fanuc") else dialect

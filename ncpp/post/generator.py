@@ -11,8 +11,8 @@ from __future__ import annotations
 
 import math
 import re
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
-from typing import Callable, Iterable, Iterator
 
 from ncpp.cldata.cycles import Hole, HoleBlock
 from ncpp.cldata.motion import MAX_WORD, cutter_side, units_inch
@@ -64,7 +64,13 @@ def single_turns(arc: Arc) -> Iterator[Arc]:
         piece_end: Point = (end[0], end[1], end[2])
         centre = list(arc.center)
         centre[n] = start[n]
-        yield replace(arc, start=start, end=piece_end, center=(centre[0], centre[1], centre[2]), turn=1 if arc.turn > 0 else -1)
+        yield replace(
+            arc,
+            start=start,
+            end=piece_end,
+            center=(centre[0], centre[1], centre[2]),
+            turn=1 if arc.turn > 0 else -1,
+        )
         start = piece_end
     centre = list(arc.center)
     centre[n] = start[n]
@@ -103,7 +109,9 @@ class Generator:
         first_motion: Event | None = None
         for event in it:
             record = setup(event)
-            if type(event) is Pass and (record is None or record.major in ("PARTNO", "UNITS", "MACHIN", "$$")):
+            if type(event) is Pass and (
+                record is None or record.major in ("PARTNO", "UNITS", "MACHIN", "$$")
+            ):
                 self._absorb(record)
                 prelude.append((event, record))
                 continue
@@ -164,7 +172,9 @@ class Generator:
             if mode in COOLANT:
                 yield from self.emit_m(COOLANT[mode])
             else:
-                self.warnings.warn(f"COOLNT/{mode} has no machine function; passed through as a comment", rec.where)
+                self.warnings.warn(
+                    f"COOLNT/{mode} has no machine function; passed through as a comment", rec.where
+                )
                 yield from self.emit_comment(_one_line(rec.text))
         elif major == "CUTTER":
             yield from self.emit_comment("CUTTER " + ", ".join(f"{v:g}" for v in rec.numbers))
@@ -250,7 +260,10 @@ class Generator:
         """The segment's feed (the CL data's FEDRAT)."""
         if segment.feed > 0:
             return segment.feed
-        raise NcppError("a feed move before any FEDRAT: the CL data gives no feed rate", Location(self.file, segment.block.line, 1))
+        raise NcppError(
+            "a feed move before any FEDRAT: the CL data gives no feed rate",
+            Location(self.file, segment.block.line, 1),
+        )
 
     # -- what dialects spell -------------------------------------------------------
     def emit_header(self) -> Iterator[str]:
@@ -307,7 +320,10 @@ def _spindle_speed(rec: Record) -> float:
     """SPINDL/n: a speed from 0 on (the direction is CLW or CCLW, not a sign)."""
     n = rec.numbers[0]
     if not 0 <= n <= MAX_WORD:
-        raise NcppError(f"{rec.major}: expected a spindle speed from 0 to {MAX_WORD:,.0f} (turning CLW or CCLW), got {n:g}", rec.where)
+        raise NcppError(
+            f"{rec.major}: expected a spindle speed from 0 to {MAX_WORD:,.0f} (turning CLW or CCLW), got {n:g}",
+            rec.where,
+        )
     return n
 
 

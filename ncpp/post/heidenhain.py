@@ -12,7 +12,8 @@ parameters, then `L X.. Y.. R0 FMAX M99` over the hole, which calls it there.
 from __future__ import annotations
 
 import math
-from typing import Any, Iterable, Iterator
+from collections.abc import Iterable, Iterator
+from typing import Any
 
 from ncpp.cldata.cycles import Hole
 from ncpp.motion.segments import PLANE_AXES, Arc, Event, Line

@@ -6,7 +6,8 @@ default), both plane axes always written, full turns split off.
 
 from __future__ import annotations
 
-from typing import Any, Iterator
+from collections.abc import Iterator
+from typing import Any
 
 from ncpp.cldata.cycles import Hole
 from ncpp.motion.segments import PLANE_AXES, Arc, Line

@@ -7,7 +7,7 @@ the final depth DP, absolute; a dwell is `G4 F` seconds."""
 
 from __future__ import annotations
 
-from typing import Iterator
+from collections.abc import Iterator
 
 from ncpp.cldata.cycles import Hole
 from ncpp.post.generator import number

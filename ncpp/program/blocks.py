@@ -13,7 +13,7 @@ control bytes) survives the round trip.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Union, final
+from typing import final
 
 # A line's layout: its Latin-1 bytes with every digit '1'.  Lines of one layout differ only in
 # their digits: the parser cuts them into words at the same places, the writer edits them alike.
@@ -36,7 +36,9 @@ class Item:
         self.end = end
 
     def _fields(self) -> tuple:
-        return tuple(getattr(self, name) for cls in type(self).__mro__ for name in getattr(cls, "__slots__", ()))
+        return tuple(
+            getattr(self, name) for cls in type(self).__mro__ for name in getattr(cls, "__slots__", ())
+        )
 
     def __eq__(self, other: object) -> bool:
         return type(self) is type(other) and self._fields() == other._fields()
@@ -112,7 +114,7 @@ class Statement(Item):
 UNREADABLE = "unreadable"  # the kind of a `Statement` standing for a line the grammar cannot read
 STRAY_TAPE = "stray_tape"  # the kind of a `%` line in a program that did not start with one
 
-AnyItem = Union[Word, ExprWord, Comment, Statement]
+AnyItem = Word | ExprWord | Comment | Statement
 
 
 @dataclass(slots=True, eq=True)

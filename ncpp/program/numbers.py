@@ -26,15 +26,17 @@ class NumberStyle:
 
     def __post_init__(self) -> None:
         plain = self.decimals > 0 and self.leading_zero and not (self.int_width or self.comma)
-        object.__setattr__(self, "spec", f"{'+' if self.plus_sign else ''}z.{self.decimals}f" if plain else "")
+        object.__setattr__(
+            self, "spec", f"{'+' if self.plus_sign else ''}z.{self.decimals}f" if plain else ""
+        )
 
     @classmethod
-    def of(cls, number: str) -> "NumberStyle":
+    def of(cls, number: str) -> NumberStyle:
         """The style of a number as written (sign included, letter excluded)."""
         return _style_of(style_pattern(number))  # read once per pattern
 
     @classmethod
-    def _read(cls, number: str) -> "NumberStyle":
+    def _read(cls, number: str) -> NumberStyle:
         plus = number.startswith("+")
         digits = number.lstrip("+-").lstrip(" \t")
         comma = "," in digits
@@ -54,18 +56,20 @@ class NumberStyle:
         """`-12.345`, `+12.345`: what one `format` spec writes (the writer's fast path)."""
         return bool(self.spec)
 
-    def at_least(self, decimals: int) -> "NumberStyle":
+    def at_least(self, decimals: int) -> NumberStyle:
         """The same style with at least `decimals` places (never lose resolution)."""
         if decimals <= self.decimals:
             return self
         return NumberStyle(decimals, False, self.leading_zero, self.int_width, self.plus_sign, self.comma)
 
-    def resolves_like(self, other: "NumberStyle", decimals: int) -> bool:
+    def resolves_like(self, other: NumberStyle, decimals: int) -> bool:
         """`self.at_least(decimals) == other.at_least(decimals)`, without making either."""
         return (
             max(self.decimals, decimals) == max(other.decimals, decimals)
-            and (self.trailing_dot and self.decimals >= decimals) == (other.trailing_dot and other.decimals >= decimals)
-            and (self.leading_zero, self.int_width, self.plus_sign, self.comma) == (other.leading_zero, other.int_width, other.plus_sign, other.comma)
+            and (self.trailing_dot and self.decimals >= decimals)
+            == (other.trailing_dot and other.decimals >= decimals)
+            and (self.leading_zero, self.int_width, self.plus_sign, self.comma)
+            == (other.leading_zero, other.int_width, other.plus_sign, other.comma)
         )
 
 

@@ -17,18 +17,31 @@ from __future__ import annotations
 import functools
 import math
 import re
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any, Callable, Iterable, Iterator
+from typing import Any
 
 import lark
 from lark import Discard, Token, Transformer, v_args
 
 from ncpp.cache import cached_build
 from ncpp.errors import Location, NcppError
-from ncpp.program.blocks import DIGITS_AS_ONE, STRAY_TAPE, UNREADABLE, AnyItem, Block, Comment, ExprWord, Statement, Word
+from ncpp.program.blocks import (
+    DIGITS_AS_ONE,
+    STRAY_TAPE,
+    UNREADABLE,
+    AnyItem,
+    Block,
+    Comment,
+    ExprWord,
+    Statement,
+    Word,
+)
 
-_GAP_CHARS = " \t\r\f\v\x1a"  # blanks between items (a regex class body: SUB as itself, no digit in the pattern)
+_GAP_CHARS = (
+    " \t\r\f\v\x1a"  # blanks between items (a regex class body: SUB as itself, no digit in the pattern)
+)
 _GAP = f"[{_GAP_CHARS}]*"
 
 
@@ -45,13 +58,18 @@ def grammar_path(name: str) -> Path:
 _LARK_OPTIONS = {"parser": "lalr", "propagate_positions": True, "maybe_placeholders": False}
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def lalr_parser(name: str) -> lark.Lark:
     """The dialect's Lark parser, loaded from the user's cache when it was built before
     (building the LALR tables takes several times as long as loading them: every `ncpp` run
     pays it, and the LinuxCNC filter runs whenever a program is opened)."""
     text = grammar_path(name).read_text(encoding="utf-8")
-    return cached_build(f"{name}-lark", f"{text}\n{_LARK_OPTIONS}\n{lark.__version__}", lambda: lark.Lark(text, **_LARK_OPTIONS), lark.Lark.load)
+    return cached_build(
+        f"{name}-lark",
+        f"{text}\n{_LARK_OPTIONS}\n{lark.__version__}",
+        lambda: lark.Lark(text, **_LARK_OPTIONS),
+        lark.Lark.load,
+    )
 
 
 def _word(text: str, start: int, end: int) -> Word:
@@ -201,7 +219,7 @@ class Dialect:
     max_line_source: str = "rs274ngc (LinuxCNC) holds a line in LINELEN, 256 characters"
 
 
-def dialect_syntax(dialect: "str | Dialect") -> Dialect:
+def dialect_syntax(dialect: str | Dialect) -> Dialect:
     if isinstance(dialect, Dialect):
         return dialect
     from ncpp.program.dialects import get_dialect  # the registry imports this module
@@ -221,7 +239,10 @@ _FINITE_LINE = 300
 def _refuse_infinite(block: Block, file: str) -> None:
     for item in block.items:
         if type(item) is Word and not math.isfinite(item.value):
-            raise NcppError(f"number out of range: {item.letter}{item.number[:20]}... ({len(item.number)} characters)", Location(file, block.line, item.start + 1))
+            raise NcppError(
+                f"number out of range: {item.letter}{item.number[:20]}... ({len(item.number)} characters)",
+                Location(file, block.line, item.start + 1),
+            )
 
 
 def _refuse_cr_line_ends(raw: str, line: int, file: str) -> None:
@@ -229,13 +250,19 @@ def _refuse_cr_line_ends(raw: str, line: int, file: str) -> None:
     read as blanks, running every line of the program into one."""
     bare = _TEXT_AFTER_CR.search(raw)  # (a continued block holds the CR LF of its lines)
     if bare is not None:
-        raise NcppError("the program's lines end in a carriage return (CR) alone: convert them to LF or CR LF", Location(file, line, bare.start() + 1))
+        raise NcppError(
+            "the program's lines end in a carriage return (CR) alone: convert them to LF or CR LF",
+            Location(file, line, bare.start() + 1),
+        )
 
 
 def _refuse_long(raw: str, dialect: Dialect, line: int, file: str) -> None:
     limit = dialect.max_line
-    raise NcppError(f"block too long: {len(raw)} characters, where a {dialect.name} block may have {limit} "
-                    f"({dialect.max_line_source})", Location(file, line, limit + 1))
+    raise NcppError(
+        f"block too long: {len(raw)} characters, where a {dialect.name} block may have {limit} "
+        f"({dialect.max_line_source})",
+        Location(file, line, limit + 1),
+    )
 
 
 # Brackets nested deeper than this are refused in every dialect: rs274ngc reads 120 in a line of
@@ -265,12 +292,14 @@ class LineParser:
 
     FAST_TERMINALS = ("WORD", "COMMA_WORD", "PAREN_COMMENT", "SEMI_COMMENT")
 
-    def __init__(self, grammar: "str | Dialect" = "iso"):
+    def __init__(self, grammar: str | Dialect = "iso"):
         self.dialect = dialect_syntax(grammar)
         self.grammar = self.dialect.grammar
         self._lark = lalr_parser(self.grammar)
         self._builder = self.dialect.builder()
-        self._items = _PlainItems(self._lark, self.dialect.fast_terminals) if self.dialect.fast_terminals else None
+        self._items = (
+            _PlainItems(self._lark, self.dialect.fast_terminals) if self.dialect.fast_terminals else None
+        )
         self._blank = re.compile(f"{_GAP}$")
         # plain lines by their layout (`DIGITS_AS_ONE`): what `_scan_plain` reads of them, see `_shape`
         self._shapes: dict[bytes, object] = {}
@@ -353,7 +382,13 @@ class LineParser:
                 if " " in number or "\t" in number:  # `X - 5`, `X1 5`
                     number = _digits(number)
                 word = _new_word(Word)
-                word.letter, word.value, word.number, word.start, word.end = letter, float(number), number, start, pos
+                word.letter, word.value, word.number, word.start, word.end = (
+                    letter,
+                    float(number),
+                    number,
+                    start,
+                    pos,
+                )
                 append(word)
                 signature += letter if letter != "G" else "G" + number
                 continue
@@ -383,7 +418,9 @@ class LineParser:
         try:
             return self._parse_lalr(raw, line, file)
         except NcppError as err:
-            if not self.dialect.read_where_run or err.message == BOM_MESSAGE:  # (a byte order mark: the file's, not a line's)
+            if (
+                not self.dialect.read_where_run or err.message == BOM_MESSAGE
+            ):  # (a byte order mark: the file's, not a line's)
                 raise
             return (Statement(UNREADABLE, (err,), 0, len(raw)),)
 
@@ -431,7 +468,7 @@ class _TreeLayouts:
         self.known: dict[str, _Cut | _Replay] = {}
 
     @classmethod
-    def of(cls, parser: lark.Lark) -> "_TreeLayouts | None":
+    def of(cls, parser: lark.Lark) -> _TreeLayouts | None:
         """The layouts of the grammar's lines (None: its terminals name digits elsewhere)."""
         named = [_digits_named(t.pattern.to_regexp()) for t in parser.terminals]
         if any(found is None for found in named):
@@ -440,7 +477,7 @@ class _TreeLayouts:
             return cls(lambda raw: raw.translate(_ALL_DIGITS_AS_ONE))
         return cls(functools.partial(_DIGITS_NOT_AFTER_A_LETTER.sub, "1"))
 
-    def learn(self, layout: str, known: "_Cut | _Replay") -> None:
+    def learn(self, layout: str, known: _Cut | _Replay) -> None:
         if len(self.known) >= self.MAX:
             self.known.clear()
         self.known[layout] = known
@@ -456,7 +493,7 @@ class _Cut:
         self.steps = steps  # per item: the item itself, or (letter, start, start of the number, end)
 
     @classmethod
-    def of(cls, raw: str, items: tuple[AnyItem, ...], layout: Callable[[str], str]) -> "_Cut | None":
+    def of(cls, raw: str, items: tuple[AnyItem, ...], layout: Callable[[str], str]) -> _Cut | None:
         varying = _varying(raw, layout)
         steps: list = []
         for item in items:
@@ -466,7 +503,11 @@ class _Cut:
             if type(item) is not Word:
                 return None
             number_at = item.end - len(item.number)
-            if any(varying[item.start : number_at]) or raw[number_at : item.end] != item.number or not _reads_as(item.number, item.value):
+            if (
+                any(varying[item.start : number_at])
+                or raw[number_at : item.end] != item.number
+                or not _reads_as(item.number, item.value)
+            ):
                 return None  # `X+10,5`, `X - 5`: the builder reads such numbers its own way
             steps.append((item.letter, item.start, number_at, item.end))
         return cls(tuple(steps))
@@ -479,7 +520,13 @@ class _Cut:
                 letter, start, number_at, end = step
                 number = raw[number_at:end]
                 word = _new_word(Word)  # built inline: one per word of the program
-                word.letter, word.value, word.number, word.start, word.end = letter, float(number), number, start, end
+                word.letter, word.value, word.number, word.start, word.end = (
+                    letter,
+                    float(number),
+                    number,
+                    start,
+                    end,
+                )
                 append(word)
             else:
                 append(step)
@@ -494,7 +541,7 @@ def _varying(raw: str, layout: Callable[[str], str]) -> list[bool]:
     the layout turns to `1` (it is `1` in the layout of the line with every digit changed
     too; a digit the layout keeps changes there)."""
     kept = layout(raw.translate(_NEXT_DIGIT))
-    return [c.isdigit() and k == "1" == l for c, k, l in zip(raw, kept, layout(raw))]
+    return [c.isdigit() and k == "1" == one for c, k, one in zip(raw, kept, layout(raw))]
 
 
 def _reads_as(number: str, value: float) -> bool:
@@ -555,7 +602,12 @@ def _borrowed(template: Token, text: str) -> Token:
     token = _new_str(Token, text)
     token.type, token.value = template.type, text
     token.start_pos, token.end_pos = template.start_pos, template.end_pos
-    token.line, token.column, token.end_line, token.end_column = template.line, template.column, template.end_line, template.end_column
+    token.line, token.column, token.end_line, token.end_column = (
+        template.line,
+        template.column,
+        template.end_line,
+        template.end_column,
+    )
     return token
 
 
@@ -592,7 +644,9 @@ def _digits_named(pattern: str) -> bool | None:
             atom, i = repeat.group(), repeat.end()
         else:
             atom, i = c, i + 1
-        if atom.isdigit() or (atom[0] == "[" and re.search(r"[0-9]", atom.replace("\\d", "").replace("0-9", ""))):
+        if atom.isdigit() or (
+            atom[0] == "[" and re.search(r"[0-9]", atom.replace("\\d", "").replace("0-9", ""))
+        ):
             if not (len(previous) == 1 and previous.isascii() and previous.isalpha()):
                 return None
             named = True
@@ -612,7 +666,9 @@ def _class_end(pattern: str, start: int) -> int:
 def _retokened(tree: lark.Tree, raw: str) -> lark.Tree:
     """`tree` (of a line of raw's layout) with every token's text read from `raw`."""
     children = [
-        _borrowed(child, raw[child.start_pos : child.end_pos]) if type(child) is Token else _retokened(child, raw)
+        _borrowed(child, raw[child.start_pos : child.end_pos])
+        if type(child) is Token
+        else _retokened(child, raw)
         for child in tree.children
     ]
     return lark.Tree(tree.data, children, tree.meta)
@@ -751,7 +807,7 @@ def _without_layout(scanned: tuple | None) -> tuple | None:
 
 
 def parse_stream(
-    stream: Iterable[bytes], file: str = "<stdin>", grammar: "str | Dialect" = "iso"
+    stream: Iterable[bytes], file: str = "<stdin>", grammar: str | Dialect = "iso"
 ) -> Iterator[Block]:
     """Blocks of a program, lazily.  After the closing `%` lines are kept verbatim
     (a control stops reading there).  `grammar` names the dialect (or is one)."""
@@ -770,7 +826,7 @@ def parse_stream(
             if tape_marks < 0 and parser.dialect.read_where_run:  # rs274ngc: a bad character where it runs
                 block = _stray_tape_mark(block)
         elif tape_marks == 0 and block.items:
-            tape_marks = -10**9  # material before any `%`: the program has no tape marks
+            tape_marks = -(10**9)  # material before any `%`: the program has no tape marks
         yield block
 
 
@@ -785,7 +841,7 @@ def _parse_continued(parser: LineParser, lines: Iterable[tuple[str, str]], file:
         yield parser.parse(content, eol, number, file)
 
 
-def parse_text(text: str, file: str = "<string>", grammar: "str | Dialect" = "iso") -> list[Block]:
+def parse_text(text: str, file: str = "<string>", grammar: str | Dialect = "iso") -> list[Block]:
     import io
 
     return list(parse_stream(io.BytesIO(text.encode("latin-1")), file, grammar))

@@ -9,11 +9,11 @@ separates its words.
 from __future__ import annotations
 
 import copy
-from typing import BinaryIO, Collection, Iterable, Mapping, Sequence
+from collections.abc import Collection, Iterable, Mapping, Sequence
+from typing import BinaryIO
 
 from ncpp.program.blocks import AnyItem, Block, Comment, Word
 from ncpp.program.numbers import NumberStyle, format_number
-
 
 AXIS_LETTERS = frozenset("XYZABCUVWIJKR")
 
@@ -68,7 +68,9 @@ def edit_words(
     return edit_texts(block, texts, drop, motion)
 
 
-def edit_texts(block: Block, texts: Mapping[str, str], drop: Iterable[str] = (), motion: int | None = None) -> str:
+def edit_texts(
+    block: Block, texts: Mapping[str, str], drop: Iterable[str] = (), motion: int | None = None
+) -> str:
     """`edit_words` with the numbers already written (`texts`: letter -> number text)."""
     spelled = spelling(block)  # before a G word is inserted between the words
     if motion is not None:
@@ -89,7 +91,9 @@ def set_words(
     pieces: list[str] = []
     cursor = 0
     pending = dict(texts)
-    at = None  # where appended words go (an index into `pieces`): after the last axis word, else the last word
+    at = (
+        None  # where appended words go (an index into `pieces`): after the last axis word, else the last word
+    )
     seen_axis = False
     for item in block.items:
         if type(item) is Word:
@@ -124,7 +128,9 @@ def set_words(
                 at = len(pieces)
     if pending:
         sep, lower = spelled or spelling(block)
-        extra = "".join(sep + (letter.lower() if lower else letter) + text for letter, text in pending.items())
+        extra = "".join(
+            sep + (letter.lower() if lower else letter) + text for letter, text in pending.items()
+        )
         if at is None:
             if not "".join(pieces).strip():
                 extra = extra.lstrip()
@@ -154,11 +160,15 @@ class EditPlan:
 
     __slots__ = ("cuts", "parts", "template", "keeps_numbers")
 
-    def __init__(self, cuts: tuple[tuple[int, int], ...], parts: tuple[str | int, ...], count: int, keeps_numbers: bool):
+    def __init__(
+        self, cuts: tuple[tuple[int, int], ...], parts: tuple[str | int, ...], count: int, keeps_numbers: bool
+    ):
         self.cuts = cuts  # (word index, how to cut): see _REPLACE ...
         self.parts = parts  # template text, and the index of each kept piece where it goes
-        self.template = "".join(part if isinstance(part, str) else "{%d}" % (count + part) for part in parts)
-        self.keeps_numbers = keeps_numbers  # it keeps words other than G words (`F100`), whose number can be any
+        self.template = "".join(part if isinstance(part, str) else f"{{{count + part}}}" for part in parts)
+        self.keeps_numbers = (
+            keeps_numbers  # it keeps words other than G words (`F100`), whose number can be any
+        )
 
     @classmethod
     def compile(
@@ -170,7 +180,7 @@ class EditPlan:
         motion: int | None = None,
         motion_word: tuple[int, str] | None = None,
         spelled: tuple[str, bool] = (" ", False),
-    ) -> "EditPlan | None":
+    ) -> EditPlan | None:
         """The plan of `edit_texts(block, texts, drop, motion)` for blocks whose words have
         these `letters`, `motion_word` (its index and number as written) being the first
         G0-G3 word; `count` numbers fill `fields`.  None for the shapes it does not cover
@@ -206,9 +216,13 @@ class EditPlan:
         leading = 0  # the words before the first one kept or replaced: dropped, they may lead the block
         while leading < len(letters) and leading in dropped:
             leading += 1
-        if at is None or (pending and at < leading):  # words appended where the dropped words led: `set_words`
+        if at is None or (
+            pending and at < leading
+        ):  # words appended where the dropped words led: `set_words`
             return None
-        appended = "".join(_literal(sep) + (letter.lower() if lower else letter) + field for letter, field in pending.items())
+        appended = "".join(
+            _literal(sep) + (letter.lower() if lower else letter) + field for letter, field in pending.items()
+        )
         cuts: list[tuple[int, int]] = []
         parts: list[str | int] = []
 
@@ -318,7 +332,9 @@ def _respan(block: Block, raw: str, after: int, shift: int) -> Block:
     """Shift the spans of items that start at or after `after` by `shift`."""
     if shift == 0:  # `G2` -> `G1`: the same spans
         return Block(raw, block.eol, block.items, block.line)
-    return Block(raw, block.eol, tuple(_shifted(i, shift) if i.start >= after else i for i in block.items), block.line)
+    return Block(
+        raw, block.eol, tuple(_shifted(i, shift) if i.start >= after else i for i in block.items), block.line
+    )
 
 
 def _shifted(item: AnyItem, shift: int) -> AnyItem:

@@ -53,7 +53,12 @@ parser = argparse.ArgumentParser(prog="ncpp", add_help=False)
 parser.add_argument("--machine", help="machine file (default: $NCPP_MACHINE or the ncpp config)")
 parser.add_argument("--from", dest="from_file", help="compensate from one measurement file")
 parser.add_argument("--tolerance", help="allowed path deviation in mm")
-parser.add_argument("--work-offset", action="append", default=[], help="[G5x=]X,Y,Z machine position of a fixture's zero, mm (repeat)")
+parser.add_argument(
+    "--work-offset",
+    action="append",
+    default=[],
+    help="[G5x=]X,Y,Z machine position of a fixture's zero, mm (repeat)",
+)
 parser.add_argument("--var-file", help="LinuxCNC parameter file holding the zeros")
 parser.add_argument("--tool-table", help="LinuxCNC tool table: the lengths the program's G43 applies")
 parser.add_argument("--var-units", help="units of --var-file and --tool-table: mm or inch")
@@ -98,12 +103,16 @@ def _preferred_program():
 
 def _ncpp_command(options):
     if options.ncpp:
-        raise RuntimeError("ncpp_post: --ncpp in the Job's arguments is refused (a shared document would choose the "
-                           f"program to run): set NCPP, or the parameter Program in {PARAMETERS}")
+        raise RuntimeError(
+            "ncpp_post: --ncpp in the Job's arguments is refused (a shared document would choose the "
+            f"program to run): set NCPP, or the parameter Program in {PARAMETERS}"
+        )
     found = os.environ.get("NCPP") or _preferred_program() or shutil.which("ncpp")
     if not found:
-        raise RuntimeError(f"ncpp_post: the ncpp program was not found; set NCPP, or Program in {PARAMETERS}, "
-                           "or put ncpp on PATH")
+        raise RuntimeError(
+            f"ncpp_post: the ncpp program was not found; set NCPP, or Program in {PARAMETERS}, "
+            "or put ncpp on PATH"
+        )
     return shlex.split(found) if " " in found and not os.path.exists(found) else [found]
 
 
@@ -151,7 +160,7 @@ def _posted_line(message, gcode):
     number = int(found.group(1))
     lines = gcode.splitlines()
     text = lines[number - 1].strip() if 0 < number <= len(lines) else ""
-    return f"ncpp_post: line {number} of the posted program ({text}): " + message[found.end():]
+    return f"ncpp_post: line {number} of the posted program ({text}): " + message[found.end() :]
 
 
 def _report(kind, text):

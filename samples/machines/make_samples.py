@@ -15,10 +15,11 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+
 from ncpp.fileio import write_text_atomic
 from ncpp.machine import Machine, Table
-from ncpp.machine.io import dumps_machine
 from ncpp.machine.effects import Backlash, Cyclic, ReversalSpike, ServoMismatch
+from ncpp.machine.io import dumps_machine
 
 HERE = Path(__file__).parent
 ARCSEC_URAD = 4.8481
@@ -58,8 +59,14 @@ def build(name, chain, tool, limits, references, squareness_urad, rng, reversal=
         lo, hi = limits[axis]
         tabs = axis_tables(rng, lo, hi, step, (reversal or {}).get(axis))
         others = [d for d in "XYZ" if d != axis]
-        iso = {"position": f"E{axis}{axis}", "straight1": f"E{others[0]}{axis}", "straight2": f"E{others[1]}{axis}",
-               "a": f"EA{axis}", "b": f"EB{axis}", "c": f"EC{axis}"}
+        iso = {
+            "position": f"E{axis}{axis}",
+            "straight1": f"E{others[0]}{axis}",
+            "straight2": f"E{others[1]}{axis}",
+            "a": f"EA{axis}",
+            "b": f"EB{axis}",
+            "c": f"EC{axis}",
+        }
         for key, (x, v, vm) in tabs.items():
             scale = 1e-3 if key in ("position", "straight1", "straight2") else 1e-6
             vals = np.round(v, 1) * scale
@@ -93,11 +100,14 @@ def main() -> None:
     machines = {
         "hr5b.toml": (
             build(
-                "Mitsui Seiki HR5B", "XZFY", (0.0, 0.0, -250.0),
+                "Mitsui Seiki HR5B",
+                "XZFY",
+                (0.0, 0.0, -250.0),
                 {"X": (0.0, 800.0), "Y": (0.0, 700.0), "Z": (0.0, 700.0)},
                 # Tool point (optic) at the position each axis was measured.
                 {"X": (0.0, 350.0, 100.0), "Y": (0.0, 0.0, -250.0), "Z": (0.0, 350.0, -250.0)},
-                {"C0Y": 22.0, "B0Z": -15.0, "A0Z": 31.0}, rng,
+                {"C0Y": 22.0, "B0Z": -15.0, "A0Z": 31.0},
+                rng,
                 reversal={"X": 4.5, "Y": 6.0, "Z": 3.5},
             ),
             "Horizontal machining centre: work on X, X on Z, Z on frame; tool on Y. "
@@ -105,24 +115,35 @@ def main() -> None:
         ),
         "tl_tuotanto.toml": (
             build(
-                "TL-Tuotanto", "XYFZ", (0.0, 0.0, -200.0),
+                "TL-Tuotanto",
+                "XYFZ",
+                (0.0, 0.0, -200.0),
                 {"X": (0.0, 1000.0), "Y": (0.0, 500.0), "Z": (0.0, 500.0)},
                 {"X": (0.0, 250.0, 50.0), "Y": (0.0, 0.0, 50.0), "Z": (0.0, 0.0, -200.0)},
-                {"C0Y": -35.0, "B0Z": 18.0, "A0Z": -12.0}, rng,
-                effects=(Backlash("X", 3.0), Backlash("Y", 4.0), ServoMismatch("XY", 0.4),
-                         ReversalSpike("Y", 2.5, decay_mm=3.0)),
+                {"C0Y": -35.0, "B0Z": 18.0, "A0Z": -12.0},
+                rng,
+                effects=(
+                    Backlash("X", 3.0),
+                    Backlash("Y", 4.0),
+                    ServoMismatch("XY", 0.4),
+                    ReversalSpike("Y", 2.5, decay_mm=3.0),
+                ),
             ),
             "Vertical machine: work on X, X on Y, Y on frame; tool on Z. "
             "Reversal behaviour as [[effects]] (backlash, spikes, servo mismatch).",
         ),
         "valmet.toml": (
             build(
-                "Valmet", "XFYZ", (0.0, 0.0, -180.0),
+                "Valmet",
+                "XFYZ",
+                (0.0, 0.0, -180.0),
                 {"X": (0.0, 1500.0), "Y": (0.0, 700.0), "Z": (0.0, 600.0)},
                 {"X": (0.0, 350.0, 120.0), "Y": (0.0, 0.0, 120.0), "Z": (0.0, 0.0, -180.0)},
-                {"C0Y": 28.0, "B0Z": -40.0, "A0Z": 16.0}, rng,
+                {"C0Y": 28.0, "B0Z": -40.0, "A0Z": 16.0},
+                rng,
                 reversal={"X": 7.0, "Y": 5.0, "Z": 4.0},
-                effects=(Cyclic("X", 1.2, 10.0),), step=100.0,
+                effects=(Cyclic("X", 1.2, 10.0),),
+                step=100.0,
             ),
             "Work on X, X on frame; Y on frame, Z on Y, tool on Z. "
             "Reversal error in the minus tables; ball-screw cyclic error as an effect.",

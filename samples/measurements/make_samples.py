@@ -83,10 +83,18 @@ def simulate_circle(
     p_cmd, q_cmd = radius_mm * np.cos(theta), radius_mm * np.sin(theta)
     p = radius_mm * np.cos(theta - lag[0])
     q = radius_mm * np.sin(theta - lag[1])
-    p = play(p, backlash_um[0] / 1000.0) + reversal_spike(p_cmd, travel, spike_um[0] / 1000.0, spike_width_deg)
-    q = play(q, backlash_um[1] / 1000.0) + reversal_spike(q_cmd, travel, spike_um[1] / 1000.0, spike_width_deg)
+    p = play(p, backlash_um[0] / 1000.0) + reversal_spike(
+        p_cmd, travel, spike_um[0] / 1000.0, spike_width_deg
+    )
+    q = play(q, backlash_um[1] / 1000.0) + reversal_spike(
+        q_cmd, travel, spike_um[1] / 1000.0, spike_width_deg
+    )
     wave = 2 * np.pi / cyclic_period_mm
-    p_act = p * (1 + scale_um_per_m[0] * 1e-6) + squareness_um_per_m * 1e-6 * q + cyclic_um[0] / 1000.0 * np.sin(wave * p)
+    p_act = (
+        p * (1 + scale_um_per_m[0] * 1e-6)
+        + squareness_um_per_m * 1e-6 * q
+        + cyclic_um[0] / 1000.0 * np.sin(wave * p)
+    )
     q_act = q * (1 + scale_um_per_m[1] * 1e-6) + cyclic_um[1] / 1000.0 * np.sin(wave * q)
     ball = np.array(setup_offset_um) / 1000.0
     length = np.hypot(p_act - ball[0], q_act - ball[1])
@@ -162,8 +170,15 @@ def ballbar(rng: np.random.Generator, radius: float, feed: float, **effects) -> 
 
 def grid_circle(rng: np.random.Generator, radius: float, centre: tuple[float, float]) -> dict:
     angle, _, actual = simulate_circle(
-        radius, "CCW", points=180, squareness_um_per_m=-15.0, backlash_um=(3.0, 2.0), lag_ms=(0.4, 0.0),
-        feed_mm_min=2000.0, noise_um=0.0, rng=rng,
+        radius,
+        "CCW",
+        points=180,
+        squareness_um_per_m=-15.0,
+        backlash_um=(3.0, 2.0),
+        lag_ms=(0.4, 0.0),
+        feed_mm_min=2000.0,
+        noise_um=0.0,
+        rng=rng,
     )
     th = np.radians(angle)
     nominal = np.column_stack([radius * np.cos(th), radius * np.sin(th)])
@@ -181,7 +196,12 @@ def cutting(rng: np.random.Generator, radius: float) -> dict:
     angle = np.arange(0.0, 360.0, 5.0)
     th = np.radians(angle)
     # Squareness and X/Y scale mismatch make an ellipse; the cutter adds a small lobing.
-    dev = 20e-6 * radius * 1000 / 2 * np.sin(2 * th) + 8e-6 * radius * 1000 / 2 * np.cos(2 * th) + 0.8 * np.cos(3 * th + 0.4) - 2.0
+    dev = (
+        20e-6 * radius * 1000 / 2 * np.sin(2 * th)
+        + 8e-6 * radius * 1000 / 2 * np.cos(2 * th)
+        + 0.8 * np.cos(3 * th + 0.4)
+        - 2.0
+    )
     return {"angle_deg": angle, "radius_dev_um": np.round(dev + rng.normal(0, 0.25, angle.size), 2)}
 
 
@@ -194,19 +214,99 @@ def samples() -> dict[str, tuple[str, dict, dict]]:
     rng = np.random.default_rng(20040101)
     common = {"machine": "Mitsui Seiki HR5B (simulated)", "date": "2026-11-21", "temperature_c": 20.3}
     return {
-        "laser_X_position.csv": ("laser", {**common, "axis": "X", "quantity": "position", "fixed": "Y=-250 Z=300", "offset_mm": "0,0,120", "feed_mm_min": 1000}, laser_position(rng)),
-        "laser_X_pitch.csv": ("laser", {**common, "axis": "X", "quantity": "pitch", "component": "EBX", "fixed": "Y=-250 Z=300", "offset_mm": "0,0,120"}, laser_angular(rng, 12.0)),
-        "laser_X_straightness_y.csv": ("laser", {**common, "axis": "X", "quantity": "straightness_y", "component": "EYX", "fixed": "Y=-250 Z=300", "offset_mm": "0,0,120"}, laser_straightness(rng)),
-        "comparator_X.csv": ("comparator", {**common, "axis": "X", "transverse": "Y", "fixed": "Y=0 Z=350", "offset_mm": "0,0,100"}, comparator(rng)),
-        "level_X_roll.csv": ("level", {**common, "axis": "X", "quantity": "roll", "fixed": "Y=0 Z=350"}, level(rng)),
-        "ballbar_XY_R150.csv": ("ballbar", {**common, "plane": "XY", "radius_mm": 150, "center_mm": "400,-200,350", "feed_mm_min": 1000}, ballbar(
-            rng, 150.0, 1000.0, squareness_um_per_m=40.0, backlash_um=(4.0, 2.5), lag_ms=(0.5, 0.0),
-            scale_um_per_m=(15.0, 5.0), setup_offset_um=(6.0, -3.0), noise_um=0.2)),
-        "ballbar_ZX_R100.csv": ("ballbar", {**common, "plane": "ZX", "radius_mm": 100, "center_mm": "400,-200,300", "feed_mm_min": 2000}, ballbar(
-            rng, 100.0, 2000.0, squareness_um_per_m=-25.0, backlash_um=(1.5, 5.0), spike_um=(0.0, 3.0),
-            setup_offset_um=(-4.0, 2.0), noise_um=0.2)),
-        "grid_XY_circle.csv": ("grid", {**common, "plane": "XY", "radius_mm": 115, "center_mm": "0,0,0", "feed_mm_min": 2000}, grid_circle(rng, 115.0, (0.0, 0.0))),
-        "cutting_XY_R50.csv": ("cutting", {**common, "plane": "XY", "radius_mm": 50, "center_mm": "300,-150,0", "feed_mm_min": 600, "direction": "CCW", "tool_diameter_mm": 10}, cutting(rng, 50.0)),
+        "laser_X_position.csv": (
+            "laser",
+            {
+                **common,
+                "axis": "X",
+                "quantity": "position",
+                "fixed": "Y=-250 Z=300",
+                "offset_mm": "0,0,120",
+                "feed_mm_min": 1000,
+            },
+            laser_position(rng),
+        ),
+        "laser_X_pitch.csv": (
+            "laser",
+            {
+                **common,
+                "axis": "X",
+                "quantity": "pitch",
+                "component": "EBX",
+                "fixed": "Y=-250 Z=300",
+                "offset_mm": "0,0,120",
+            },
+            laser_angular(rng, 12.0),
+        ),
+        "laser_X_straightness_y.csv": (
+            "laser",
+            {
+                **common,
+                "axis": "X",
+                "quantity": "straightness_y",
+                "component": "EYX",
+                "fixed": "Y=-250 Z=300",
+                "offset_mm": "0,0,120",
+            },
+            laser_straightness(rng),
+        ),
+        "comparator_X.csv": (
+            "comparator",
+            {**common, "axis": "X", "transverse": "Y", "fixed": "Y=0 Z=350", "offset_mm": "0,0,100"},
+            comparator(rng),
+        ),
+        "level_X_roll.csv": (
+            "level",
+            {**common, "axis": "X", "quantity": "roll", "fixed": "Y=0 Z=350"},
+            level(rng),
+        ),
+        "ballbar_XY_R150.csv": (
+            "ballbar",
+            {**common, "plane": "XY", "radius_mm": 150, "center_mm": "400,-200,350", "feed_mm_min": 1000},
+            ballbar(
+                rng,
+                150.0,
+                1000.0,
+                squareness_um_per_m=40.0,
+                backlash_um=(4.0, 2.5),
+                lag_ms=(0.5, 0.0),
+                scale_um_per_m=(15.0, 5.0),
+                setup_offset_um=(6.0, -3.0),
+                noise_um=0.2,
+            ),
+        ),
+        "ballbar_ZX_R100.csv": (
+            "ballbar",
+            {**common, "plane": "ZX", "radius_mm": 100, "center_mm": "400,-200,300", "feed_mm_min": 2000},
+            ballbar(
+                rng,
+                100.0,
+                2000.0,
+                squareness_um_per_m=-25.0,
+                backlash_um=(1.5, 5.0),
+                spike_um=(0.0, 3.0),
+                setup_offset_um=(-4.0, 2.0),
+                noise_um=0.2,
+            ),
+        ),
+        "grid_XY_circle.csv": (
+            "grid",
+            {**common, "plane": "XY", "radius_mm": 115, "center_mm": "0,0,0", "feed_mm_min": 2000},
+            grid_circle(rng, 115.0, (0.0, 0.0)),
+        ),
+        "cutting_XY_R50.csv": (
+            "cutting",
+            {
+                **common,
+                "plane": "XY",
+                "radius_mm": 50,
+                "center_mm": "300,-150,0",
+                "feed_mm_min": 600,
+                "direction": "CCW",
+                "tool_diameter_mm": 10,
+            },
+            cutting(rng, 50.0),
+        ),
     }
 
 

@@ -62,7 +62,9 @@ def laser_files(cold: Machine) -> list[Path]:
 def ballbar_files(warm: Machine) -> list[Path]:
     paths = []
     for seed, plane in enumerate(("XY", "YZ", "ZX")):
-        m = predict_ballbar(warm, plane, 150.0, CENTRE, feed_mm_min=1000.0, step_deg=1.0, noise_um=NOISE, seed=seed)
+        m = predict_ballbar(
+            warm, plane, 150.0, CENTRE, feed_mm_min=1000.0, step_deg=1.0, noise_um=NOISE, seed=seed
+        )
         path = HERE / "warm" / f"ballbar_{plane}_R150.csv"
         write_measurement(m, path)
         paths.append(path)
@@ -99,7 +101,16 @@ def contour_errors(models: dict[str, Path]) -> list[tuple[str, dict]]:
         target = program
         if model is not None:
             target = HERE / f"circle_{model.stem}.ngc"
-            run_quietly("compensate", "--machine", str(model), "--work-offset", offset, str(program), "-o", str(target))
+            run_quietly(
+                "compensate",
+                "--machine",
+                str(model),
+                "--work-offset",
+                offset,
+                str(program),
+                "-o",
+                str(target),
+            )
         report = HERE / "simulate.json"
         run_quietly("simulate", "--machine", str(HERE / "warm_machine.toml"), "--work-offset", offset,
                     "--reference", str(program), str(target), "--json", str(report))  # fmt: skip

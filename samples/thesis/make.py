@@ -34,12 +34,18 @@ ROOT = HERE.parents[1]
 sys.path.insert(0, str(ROOT))  # run from a source checkout without installing
 
 from ncpp.cli import main as ncpp  # noqa: E402
+from ncpp.fileio import write_text_atomic  # noqa: E402
 from ncpp.instruments.analysis import analyze  # noqa: E402
 from ncpp.instruments.files import read_measurement, write_measurement  # noqa: E402
-from ncpp.instruments.forward import ANGLE_COMPONENTS, predict_ballbar, predict_comparator, predict_laser, predict_level  # noqa: E402
+from ncpp.instruments.forward import (  # noqa: E402
+    ANGLE_COMPONENTS,
+    predict_ballbar,
+    predict_comparator,
+    predict_laser,
+    predict_level,
+)  # noqa: E402
 from ncpp.instruments.plots import plot_analyses  # noqa: E402
 from ncpp.machine import effect_from_dict, load_machine, save_machine  # noqa: E402
-from ncpp.fileio import write_text_atomic  # noqa: E402
 
 MIDDLE = {"X": 400.0, "Y": 350.0, "Z": 350.0}
 OPTIC = (0.0, 0.0, 120.0)
@@ -80,7 +86,17 @@ def measure_laser(machine, out: Path) -> list[Path]:
         quantities += [q for (a, q) in ANGLE_COMPONENTS if a == axis and q != "roll"]
         for quantity in quantities:
             seed += 1
-            m = predict_laser(machine, axis, quantity, targets, fixed=fixed, offset_mm=OPTIC, runs=3, noise_um=0.3, seed=seed)
+            m = predict_laser(
+                machine,
+                axis,
+                quantity,
+                targets,
+                fixed=fixed,
+                offset_mm=OPTIC,
+                runs=3,
+                noise_um=0.3,
+                seed=seed,
+            )
             paths.append(_write(m, out / f"laser_{axis}_{quantity}.csv"))
         seed += 1
         m = predict_level(machine, axis, targets, quantity="roll", fixed=fixed, noise_um=0.3, seed=seed)
@@ -94,7 +110,9 @@ def measure_comparator(machine, out: Path) -> list[Path]:
     for seed, (axis, transverse) in enumerate((("X", "Y"), ("Y", "X")), 200):
         lo, hi = machine.limits[axis]
         fixed = {a: v for a, v in MIDDLE.items() if a != axis}
-        m = predict_comparator(machine, axis, transverse, np.linspace(lo, hi, 15), fixed=fixed, runs=3, noise_um=0.3, seed=seed)
+        m = predict_comparator(
+            machine, axis, transverse, np.linspace(lo, hi, 15), fixed=fixed, runs=3, noise_um=0.3, seed=seed
+        )
         paths.append(_write(m, out / f"comparator_{axis}.csv"))
     return paths
 
@@ -117,7 +135,12 @@ def _figure(figures: dict, key: str) -> str:
 
 def circle_table(title: str, predicted: dict, measured: dict, plane: str) -> list[str]:
     p, q = plane
-    rows = [f"### {title}", "", "| figure | predicted | measured | measured − predicted |", "|---|---:|---:|---:|"]
+    rows = [
+        f"### {title}",
+        "",
+        "| figure | predicted | measured | measured − predicted |",
+        "|---|---:|---:|---:|",
+    ]
     for key, label in FIGURES:
         key, label = key.format(p=p, q=q), label.format(p=p, q=q)
         a, b = predicted.get(key), measured.get(key)
@@ -144,8 +167,26 @@ def make(out: Path) -> None:
     laser = measure_laser(true, out / "laser")
     comparator = measure_comparator(true, out / "comparator")
     from_laser, from_comparator = out / "fitted_from_laser.toml", out / "fitted_from_comparator.toml"
-    _run("fit", *map(str, laser), "--base", str(structure), "--name", "HR5B fitted from laser", "-o", str(from_laser))
-    _run("fit", *map(str, comparator), "--base", str(structure), "--name", "HR5B fitted from VM182", "-o", str(from_comparator))
+    _run(
+        "fit",
+        *map(str, laser),
+        "--base",
+        str(structure),
+        "--name",
+        "HR5B fitted from laser",
+        "-o",
+        str(from_laser),
+    )
+    _run(
+        "fit",
+        *map(str, comparator),
+        "--base",
+        str(structure),
+        "--name",
+        "HR5B fitted from VM182",
+        "-o",
+        str(from_comparator),
+    )
 
     dynamic = true.replace(effects=tuple(effect_from_dict(e) for e in DYNAMIC))
     lines = [
@@ -154,16 +195,29 @@ def make(out: Path) -> None:
         "M. Rahman, *Modeling and measurement of multi-axis machine tools to improve positioning",
         "accuracy in a software way*, University of Oulu, 2004.",
         "",
-        "Made by `python samples/thesis/make.py` (fixed seeds). The \"measured\" files are",
+        'Made by `python samples/thesis/make.py` (fixed seeds). The "measured" files are',
         "simulated from `samples/machines/hr5b.toml`: laser/level files of the cold machine",
         "(optic 120 mm off the tool point, 3 runs, noise 0.3), and ball-bar traces of the same",
-        "machine with what a static map lacks: " + ", ".join(_effect_text(e) for e in DYNAMIC) + ", noise 0.3 µm.",
+        "machine with what a static map lacks: "
+        + ", ".join(_effect_text(e) for e in DYNAMIC)
+        + ", noise 0.3 µm.",
         "The predictions come from `ncpp fit` + `ncpp predict`: laser → ball bar, comparator",
         "→ ball bar, laser → comparator. The differences are the non-geometric effects.",
         "",
     ]
     for plane, radius, centre, feed in CIRCLES:
-        setup = ["--instrument", "ballbar", "--plane", plane, "--radius", f"{radius:g}", "--center", centre, "--feed", f"{feed:g}"]
+        setup = [
+            "--instrument",
+            "ballbar",
+            "--plane",
+            plane,
+            "--radius",
+            f"{radius:g}",
+            "--center",
+            centre,
+            "--feed",
+            f"{feed:g}",
+        ]
         predicted = out / f"ballbar_{plane}_predicted_from_laser.csv"
         _run("predict", "--machine", str(from_laser), *setup, "-o", str(predicted))
         centre_mm = np.array([float(v) for v in centre.split(",")])
@@ -172,11 +226,18 @@ def make(out: Path) -> None:
             out / f"ballbar_{plane}_measured.csv",
         )
         a, b = analyze(read_measurement(predicted)), analyze(read_measurement(measured))
-        lines += circle_table(f"Ball bar {plane} R{radius:g} F{feed:g}: laser → ball bar", a.figures, b.figures, plane)
+        lines += circle_table(
+            f"Ball bar {plane} R{radius:g} F{feed:g}: laser → ball bar", a.figures, b.figures, plane
+        )
         if plane == "XY":
             via = out / "ballbar_XY_predicted_from_comparator.csv"
             _run("predict", "--machine", str(from_comparator), *setup, "-o", str(via))
-            lines += circle_table("Ball bar XY R150: comparator → ball bar", analyze(read_measurement(via)).figures, b.figures, plane)
+            lines += circle_table(
+                "Ball bar XY R150: comparator → ball bar",
+                analyze(read_measurement(via)).figures,
+                b.figures,
+                plane,
+            )
         plot_analyses([a, b], out / f"ballbar_{plane}.png", dpi=75)
 
     predicted = out / "comparator_X_predicted_from_laser.csv"

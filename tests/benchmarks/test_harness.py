@@ -95,7 +95,15 @@ def test_programs_compensated_across_processes_are_timed_and_counted(tmp_path):
 
 def test_the_table_names_its_machine_and_its_floors(monkeypatch, tmp_path):
     monkeypatch.setattr(speed, "PERFORMANCE_TABLE", tmp_path / "performance.md")
-    written = speed.write_table([["one process / pygcode", "p.ngc", "0.61×", "≥ 0.5×", "met"]], "a CPU", True, (1.0, 0, 0), (2.0, 0, 0))
+    written = speed.write_table(
+        [["one process / pygcode", "p.ngc", "0.61×", "≥ 0.5×", "met"]],
+        "a CPU",
+        True,
+        (1.0, 0, 0),
+        (2.0, 0, 0),
+    )
     text = written.read_text()
-    assert "a CPU" in text and "shared with other work" in text and "load average 1.0 before, 2.0 after" in text
+    assert (
+        "a CPU" in text and "shared with other work" in text and "load average 1.0 before, 2.0 after" in text
+    )
     assert "| one process / pygcode | p.ngc | 0.61× | ≥ 0.5× | met |" in text

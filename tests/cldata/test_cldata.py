@@ -62,7 +62,9 @@ def test_creo_profile_arcs_turn_clockwise_about_minus_z():
 
 
 def test_continuation_and_comments():
-    records = list(read_cldata(io.StringIO("$$ a comment $\n  still the comment\nGOTO / 1, $\n 2, 3 $$ tail\nFINI\n")))
+    records = list(
+        read_cldata(io.StringIO("$$ a comment $\n  still the comment\nGOTO / 1, $\n 2, 3 $$ tail\nFINI\n"))
+    )
     assert [r.major for r in records] == ["$$", "GOTO", "FINI"]
     assert records[1].numbers == (1.0, 2.0, 3.0) and records[1].line == 3
 
@@ -135,12 +137,19 @@ def test_a_tool_vector_not_along_z_is_refused(cl, line):
 
 
 def test_a_tool_vector_along_z_of_any_length_posts():
-    assert sum(isinstance(e, Line) for e in events_of("MULTAX\nGOTO/0,0,5,0,0,2\nTLAXIS/0,0,1\nGOTO/1,0,5\n")) == 2
+    assert (
+        sum(isinstance(e, Line) for e in events_of("MULTAX\nGOTO/0,0,5,0,0,2\nTLAXIS/0,0,1\nGOTO/1,0,5\n"))
+        == 2
+    )
 
 
 @pytest.mark.parametrize(
     "cl, line",
-    [("GOTO/0,0,0\nGOTO/1e308,0,0\n", 2), ("FROM/0,0,-1e9\n", 1), ("GOTO/0,0,0\nCIRCLE/1e200,0,0,0,0,1,5\nGOTO/5,0,0\n", 2)],
+    [
+        ("GOTO/0,0,0\nGOTO/1e308,0,0\n", 2),
+        ("FROM/0,0,-1e9\n", 1),
+        ("GOTO/0,0,0\nCIRCLE/1e200,0,0,0,0,1,5\nGOTO/5,0,0\n", 2),
+    ],
 )
 def test_a_coordinate_no_nc_word_holds_is_refused(cl, line):
     """GOTO / 1e308 was posted as an X word of 309 digits."""

@@ -13,8 +13,8 @@ from __future__ import annotations
 import os
 import re
 import subprocess
+from collections.abc import Callable
 from pathlib import Path
-from typing import Callable
 
 import numpy as np
 import pytest
@@ -33,8 +33,17 @@ def rs274_calls(path: Path) -> list[tuple[str, list[float]]]:
     if not RS274.exists():
         pytest.skip("rs274 oracle not available")
     env = {**os.environ, "RS274_DIGITS": "7"}
-    for _ in range(5):  # (the stand-alone rs274 now and then dies of a bus error, whatever the program: run it again)
-        proc = subprocess.run([str(RS274), str(path)], capture_output=True, text=True, env=env, timeout=120, stdin=subprocess.DEVNULL)
+    for _ in range(
+        5
+    ):  # (the stand-alone rs274 now and then dies of a bus error, whatever the program: run it again)
+        proc = subprocess.run(
+            [str(RS274), str(path)],
+            capture_output=True,
+            text=True,
+            env=env,
+            timeout=120,
+            stdin=subprocess.DEVNULL,
+        )
         if "Bus error" not in proc.stderr:
             break
     if "executing" not in proc.stderr:
@@ -145,7 +154,13 @@ def holes_um(output: Path, original: Path, machine: Machine) -> np.ndarray:
     def bottoms(path: Path, segments) -> np.ndarray:
         feeds = [(name, args) for name, args in rs274_calls(path) if name != "ARC_FEED"]
         assert len(feeds) == len(segments)
-        return np.array([b for (name, _), (a, b) in zip(feeds, segments) if name == "STRAIGHT_FEED" and b[2] < a[2] - 1e-9])
+        return np.array(
+            [
+                b
+                for (name, _), (a, b) in zip(feeds, segments)
+                if name == "STRAIGHT_FEED" and b[2] < a[2] - 1e-9
+            ]
+        )
 
     got = bottoms(output, [(m[0], m[-1]) for m in actual_moves(output, machine)])
     wanted = bottoms(original, moves(original))

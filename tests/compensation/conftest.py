@@ -34,13 +34,23 @@ def placement(path: SampledPath, limits) -> np.ndarray | None:
     return np.round((lo_m + hi_m) / 2 - (lo_p + hi_p) / 2, 3)
 
 
-def compensate(data: bytes, model, offset, tolerance: float = 0.001, name: str = "<test>", warnings: Warnings = QUIET) -> bytes:
+def compensate(
+    data: bytes, model, offset, tolerance: float = 0.001, name: str = "<test>", warnings: Warnings = QUIET
+) -> bytes:
     """`data` compensated for `model`, the program placed by `offset`: G54's zero, or WorkOffsets."""
     rotary = getattr(model, "rotary_xyz_are_axis_positions", False)
     source = ErrorSource(model, "model", "0" * 16, model.max_correction_mm, dict(model.limits), rotary)
     offsets = offset if isinstance(offset, WorkOffsets) else WorkOffsets.at(offset)
     out = io.BytesIO()
-    process(io.BytesIO(data), out, file=name, source=source, tolerance=tolerance, warnings=warnings, offsets=offsets)
+    process(
+        io.BytesIO(data),
+        out,
+        file=name,
+        source=source,
+        tolerance=tolerance,
+        warnings=warnings,
+        offsets=offsets,
+    )
     return out.getvalue()
 
 
@@ -54,7 +64,9 @@ def repeatable_machine(path):
     comps = {}
     for name, c in true.components.items():
         if isinstance(c, Table) and c.values_minus is not None:
-            c = Table(c.positions, (np.asarray(c.values) + np.asarray(c.values_minus)) / 2, None, c.interpolation)
+            c = Table(
+                c.positions, (np.asarray(c.values) + np.asarray(c.values_minus)) / 2, None, c.interpolation
+            )
         comps[name] = c
     return true.replace(components=comps)
 

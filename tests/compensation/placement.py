@@ -32,7 +32,13 @@ class ScaleMap:
         return np.asarray(P, dtype=float) * SCALE
 
 
-def var_file(folder: Path, g54=(400.0, 350.0, 300.0), g28=(0.0, 0.0, 0.0), g30=(0.0, 0.0, 0.0), g55=(100.0, 120.0, 140.0)) -> Path:
+def var_file(
+    folder: Path,
+    g54=(400.0, 350.0, 300.0),
+    g28=(0.0, 0.0, 0.0),
+    g30=(0.0, 0.0, 0.0),
+    g55=(100.0, 120.0, 140.0),
+) -> Path:
     """A LinuxCNC parameter file (inches: the stand-alone rs274's machine units) with G54's and
     G55's zeros and the G28 and G30 positions, in machine mm."""
     values = {5220: 1.0}
@@ -49,7 +55,9 @@ def compensate(data: bytes, var: Path, limits=LIMITS) -> tuple[bytes, str]:
     said = io.StringIO()
     out = io.BytesIO()
     offsets = WorkOffsets.given({}, var_file=var, unit_mm=25.4)
-    process(io.BytesIO(data), out, file="t.ngc", source=source, warnings=Warnings(stream=said), offsets=offsets)
+    process(
+        io.BytesIO(data), out, file="t.ngc", source=source, warnings=Warnings(stream=said), offsets=offsets
+    )
     return out.getvalue(), said.getvalue()
 
 
@@ -58,7 +66,14 @@ def rs274(program: Path, var: Path) -> list[tuple[str, tuple[float, ...]]]:
     if not RS274.exists():
         pytest.skip("rs274 oracle not available")
     env = {**os.environ, "RS274_DIGITS": "7", "RS274_VAR_FILE": str(var)}
-    proc = subprocess.run([str(RS274), str(program)], capture_output=True, text=True, env=env, timeout=120, stdin=subprocess.DEVNULL)
+    proc = subprocess.run(
+        [str(RS274), str(program)],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=120,
+        stdin=subprocess.DEVNULL,
+    )
     messages = [line for line in proc.stderr.splitlines() if line.strip() and line.strip() != "executing"]
     assert proc.returncode == 0 and not messages, f"rs274 refused {program.name}: {messages[:3]}"
     calls = []

@@ -44,13 +44,21 @@ def _table(tmp_path: Path, text: str = TOOL_T) -> ToolTable:
 
 def test_tool_t_lengths_are_l_plus_dl_in_its_units(tmp_path):
     tools = _table(tmp_path)  # each tool one edge, its length 1 along the tool axis
-    assert tools.edges == {(0, 1): (0, 0, 0), (1, 1): (pytest.approx(150.0), 0, 0), (2, 1): (40.5, 0, 0), (3, 1): (90.0, 0, 0)}
+    assert tools.edges == {
+        (0, 1): (0, 0, 0),
+        (1, 1): (pytest.approx(150.0), 0, 0),
+        (2, 1): (40.5, 0, 0),
+        (3, 1): (90.0, 0, 0),
+    }
     assert tools.names == {"D10_ENDMILL": 1.0, "DRILL_6": 2.0}  # a name listed twice: its first tool
     inch = _table(tmp_path, TOOL_T.replace("MM\n", "INCH\n", 1).replace("+40,5 ", "+2,0  "))
     assert inch.edges[2, 1][0] == pytest.approx(50.8)
     header = TOOL_T.splitlines()[:2]
     for lines, message in (
-        ([*header, "1                     +1,0", "1                     +2,0"], r"TOOL.T:4:1: tool 1 is listed twice"),
+        (
+            [*header, "1                     +1,0", "1                     +2,0"],
+            r"TOOL.T:4:1: tool 1 is listed twice",
+        ),
         ([*header, "5                     +1,x"], r"TOOL.T:3:23: expected a number, got '\+1.x'"),
         ([header[0], "T    NAME             R"], r"TOOL.T:2:1: TOOL.T header without a L column"),
     ):
@@ -79,7 +87,11 @@ PROGRAM = b"""0 BEGIN PGM P MM
 def _events(program: bytes, offsets: WorkOffsets, dialect: str = "heidenhain") -> list:
     interpret, _ = dialect_tools(dialect)
     _, blocks = parse_program(io.BytesIO(program), "p.h", dialect)
-    return [e for e in interpret(blocks, file="p.h", warnings=QUIET, offsets=offsets) if type(e).__name__ in ("Line", "Arc")]
+    return [
+        e
+        for e in interpret(blocks, file="p.h", warnings=QUIET, offsets=offsets)
+        if type(e).__name__ in ("Line", "Arc")
+    ]
 
 
 def test_tool_call_applies_the_tools_length_along_the_tool_axis(tmp_path):
@@ -87,15 +99,20 @@ def test_tool_call_applies_the_tools_length_along_the_tool_axis(tmp_path):
     tool, along X for a TOOL CALL .. X, none for tool 0."""
     events = _events(PROGRAM, replace(WorkOffsets.at(ZERO), tools=_table(tmp_path)))
     assert [e.context.tool for e in events] == [
-        pytest.approx(t) for t in ((0, 0, 150.0), (0, 0, 41.0), (0, 0, 55.0), (0, 0, 55.0), (40.5, 0, 0), (0, 0, 0))
+        pytest.approx(t)
+        for t in ((0, 0, 150.0), (0, 0, 41.0), (0, 0, 55.0), (0, 0, 55.0), (40.5, 0, 0), (0, 0, 0))
     ]
     first = events[0]
-    assert first.context.to_machine(first.end) == pytest.approx((410.0, 360.0, 300.0 + 5.0 + 150.0))  # the gauge line above the tip
+    assert first.context.to_machine(first.end) == pytest.approx(
+        (410.0, 360.0, 300.0 + 5.0 + 150.0)
+    )  # the gauge line above the tip
 
 
 def test_a_tool_the_table_lacks_is_a_located_error(tmp_path):
     told = replace(WorkOffsets.at(ZERO), tools=_table(tmp_path))
-    with pytest.raises(NcppError, match=r"p.h:2:3: tool 9 is not defined: neither in .*TOOL.T nor by TOOL DEF"):
+    with pytest.raises(
+        NcppError, match=r"p.h:2:3: tool 9 is not defined: neither in .*TOOL.T nor by TOOL DEF"
+    ):
         _events(b"0 BEGIN PGM P MM\n1 TOOL CALL 9 Z\n2 END PGM P MM\n", told)
     with pytest.raises(NcppError, match=r'p.h:2:3: tool "FLY" is not in .*TOOL.T'):
         _events(b'0 BEGIN PGM P MM\n1 TOOL CALL "FLY" Z\n2 END PGM P MM\n', told)
@@ -113,7 +130,11 @@ UNTOLD = b"0 BEGIN PGM P MM\n1 TOOL CALL 1 Z S800\n2 L X+10 Y+10 FMAX\n3 TOOL CA
 
 def test_without_a_tool_table_tool_call_is_warned_once(tmp_path):
     lines = _warnings(UNTOLD, WorkOffsets.at(ZERO)).splitlines()
-    assert len(lines) == 1 and lines[0].startswith("t:2:3: warning: TOOL CALL applies a tool length") and "tool length 0" in lines[0]
+    assert (
+        len(lines) == 1
+        and lines[0].startswith("t:2:3: warning: TOOL CALL applies a tool length")
+        and "tool length 0" in lines[0]
+    )
     assert _warnings(UNTOLD, replace(WorkOffsets.at(ZERO), tools=_table(tmp_path))) == ""
     defined = UNTOLD.replace(b"1 TOOL CALL", b"1 TOOL DEF 1 L+100 R+5\n1 TOOL DEF 2 L+50 R+3\n1 TOOL CALL")
     assert _warnings(defined, WorkOffsets.at(ZERO)) == ""  # the program says its tools' lengths
@@ -147,7 +168,11 @@ def _offsets(tmp_path: Path, text: str = TO_INI) -> ToolTable:
 
 def test_sinumerik_tool_offsets_are_per_edge_geometry_plus_wear_plus_adapter(tmp_path):
     tools = _offsets(tmp_path)
-    assert tools.edges == {(1, 1): pytest.approx((150.0, 0, 0)), (1, 2): (100.0, 0, 0), (2, 1): pytest.approx((40.5, 1.5, 0))}
+    assert tools.edges == {
+        (1, 1): pytest.approx((150.0, 0, 0)),
+        (1, 2): (100.0, 0, 0),
+        (2, 1): pytest.approx((40.5, 1.5, 0)),
+    }
     assert tools.names == {"D10_ENDMILL": 1, "DRILL_6": 2}
     with pytest.raises(NcppError, match=r"_N_TO_INI:2:14: expected a number, got 'x'"):
         _offsets(tmp_path, "CHANDATA(1)\n$TC_DP3[1,1]=x\n")
@@ -189,26 +214,65 @@ def test_sinumerik_a_tool_or_edge_the_offsets_lack_is_a_located_error(tmp_path):
 
 @pytest.mark.parametrize(
     "program, where",
-    [(b"G0 X10 Y10\nT=\"MILL\" M6\nD1\nG1 X20 F100\nM30\n", "t:2:10"), (b"G0 X10 Y10\nD0\nG1 X20 D2 F100\nM30\n", "t:3:8")],
+    [
+        (b'G0 X10 Y10\nT="MILL" M6\nD1\nG1 X20 F100\nM30\n', "t:2:10"),
+        (b"G0 X10 Y10\nD0\nG1 X20 D2 F100\nM30\n", "t:3:8"),
+    ],
 )
 def test_sinumerik_without_tool_offsets_the_first_length_applied_is_warned(tmp_path, program, where):
     lines = _warnings(program, WorkOffsets.at(ZERO), dialect="sinumerik").splitlines()
-    assert len(lines) == 1 and lines[0].startswith(f"{where}: warning: ") and "tool length 0" in lines[0], lines
-    told = replace(WorkOffsets.at(ZERO), tools=_offsets(tmp_path, '$TC_TP2[1]="MILL"\n$TC_DP3[1,1]=50\n$TC_DP3[1,2]=60\n'))
+    assert len(lines) == 1 and lines[0].startswith(f"{where}: warning: ") and "tool length 0" in lines[0], (
+        lines
+    )
+    told = replace(
+        WorkOffsets.at(ZERO),
+        tools=_offsets(tmp_path, '$TC_TP2[1]="MILL"\n$TC_DP3[1,1]=50\n$TC_DP3[1,2]=60\n'),
+    )
     assert _warnings(program.replace(b"D2", b"D1"), told, dialect="sinumerik") == ""
 
 
 # The sample pocket, cut with a 150 mm and a 40.5 mm tool, in Klartext and in Sinumerik's G code
 KLARTEXT_POCKET = [
-    "L Z+5 R0 FMAX", "L X-20 Y-10 FMAX", "L Z-2 F200", "L X+20 F600", "CC X+20 Y+0", "C X+30 Y+0 DR+", "L Y+10",
-    "CC X+20 Y+10", "C X+20 Y+20 DR+", "L X-20", "CC X-20 Y+10", "C X-30 Y+10 DR+", "L Y+0", "CC X-20 Y+0",
-    "C X-20 Y-10 DR+", "L Z+5 FMAX", "L X+75 Y+0 FMAX", "L Z-2 F200", "CC X+0 Y+0", "C X+75 Y+0 DR- F600", "L Z+5 FMAX",
+    "L Z+5 R0 FMAX",
+    "L X-20 Y-10 FMAX",
+    "L Z-2 F200",
+    "L X+20 F600",
+    "CC X+20 Y+0",
+    "C X+30 Y+0 DR+",
+    "L Y+10",
+    "CC X+20 Y+10",
+    "C X+20 Y+20 DR+",
+    "L X-20",
+    "CC X-20 Y+10",
+    "C X-30 Y+10 DR+",
+    "L Y+0",
+    "CC X-20 Y+0",
+    "C X-20 Y-10 DR+",
+    "L Z+5 FMAX",
+    "L X+75 Y+0 FMAX",
+    "L Z-2 F200",
+    "CC X+0 Y+0",
+    "C X+75 Y+0 DR- F600",
+    "L Z+5 FMAX",
 ]
-KLARTEXT = ["BEGIN PGM POCKET MM", "TOOL CALL 1 Z S3000", *KLARTEXT_POCKET, "TOOL CALL 2 Z S3000", *KLARTEXT_POCKET, "END PGM POCKET MM"]
-G_POCKET = [line.decode() for line in (ROOT / "samples/programs/pocket.ngc").read_bytes().splitlines()[3:-2]]  # its moves
+KLARTEXT = [
+    "BEGIN PGM POCKET MM",
+    "TOOL CALL 1 Z S3000",
+    *KLARTEXT_POCKET,
+    "TOOL CALL 2 Z S3000",
+    *KLARTEXT_POCKET,
+    "END PGM POCKET MM",
+]
+G_POCKET = [
+    line.decode() for line in (ROOT / "samples/programs/pocket.ngc").read_bytes().splitlines()[3:-2]
+]  # its moves
 TWO_TOOLS = {
     "heidenhain": ("".join(f"{n} {line}\n" for n, line in enumerate(KLARTEXT)).encode(), "TOOL.T", TOOL_T),
-    "sinumerik": ("\n".join(["G90 G17 G71", "T1 M6", *G_POCKET, "T2 M6", *G_POCKET, "M30", ""]).encode(), "_N_TO_INI", TO_INI),
+    "sinumerik": (
+        "\n".join(["G90 G17 G71", "T1 M6", *G_POCKET, "T2 M6", *G_POCKET, "M30", ""]).encode(),
+        "_N_TO_INI",
+        TO_INI,
+    ),
 }
 
 
@@ -224,12 +288,23 @@ def _placed(dialect: str, tmp_path: Path | None) -> WorkOffsets:
 def _compensated(dialect: str, offsets: WorkOffsets, machine) -> bytes:
     source = ErrorSource(machine, "model", "0" * 16, machine.max_correction_mm, dict(machine.limits))
     out = io.BytesIO()
-    process(io.BytesIO(TWO_TOOLS[dialect][0]), out, file="p", source=source, warnings=QUIET, dialect=dialect, offsets=offsets)
+    process(
+        io.BytesIO(TWO_TOOLS[dialect][0]),
+        out,
+        file="p",
+        source=source,
+        warnings=QUIET,
+        dialect=dialect,
+        offsets=offsets,
+    )
     return out.getvalue()
 
 
 def _contour_um(machine, dialect: str, program: bytes, offsets: WorkOffsets) -> float:
-    run, nominal = sample_events(_events(program, offsets, dialect)), sample_events(_events(TWO_TOOLS[dialect][0], offsets, dialect))
+    run, nominal = (
+        sample_events(_events(program, offsets, dialect)),
+        sample_events(_events(TWO_TOOLS[dialect][0], offsets, dialect)),
+    )
     return contour_error(machine, run, nominal, feed_effects=False).max_um
 
 
@@ -269,11 +344,27 @@ def test_motion_and_simulate_take_the_dialect_and_its_tool_table(tmp_path):
     program, name, text = TWO_TOOLS["sinumerik"]
     (tmp_path / name).write_text(text)
     (tmp_path / "pocket.mpf").write_bytes(program)
-    placed = ["--work-offset", "400,350,300", "--tool-table", str(tmp_path / name), "--dialect", "sinumerik", str(tmp_path / "pocket.mpf")]
-    motion = subprocess.run([sys.executable, "-m", "ncpp", "motion", "--format", "json", *placed], capture_output=True, cwd=ROOT)
+    placed = [
+        "--work-offset",
+        "400,350,300",
+        "--tool-table",
+        str(tmp_path / name),
+        "--dialect",
+        "sinumerik",
+        str(tmp_path / "pocket.mpf"),
+    ]
+    motion = subprocess.run(
+        [sys.executable, "-m", "ncpp", "motion", "--format", "json", *placed], capture_output=True, cwd=ROOT
+    )
     assert motion.returncode == 0, motion.stderr
     tools = {tuple(json.loads(line)["tool"]) for line in motion.stdout.splitlines()}
     assert tools == {(0.0, 0.0, 150.0), (0.0, 1.5, 40.5)}
-    simulated = subprocess.run([sys.executable, "-m", "ncpp", "simulate", "--machine", str(MACHINE), *placed], capture_output=True, cwd=ROOT)
+    simulated = subprocess.run(
+        [sys.executable, "-m", "ncpp", "simulate", "--machine", str(MACHINE), *placed],
+        capture_output=True,
+        cwd=ROOT,
+    )
     assert simulated.returncode == 0, simulated.stderr
-    assert b"at [400.0, 350.0, 448.0]" in simulated.stdout and b"at [400.0, 351.5, 338.5]" in simulated.stdout  # each tool's circle
+    assert (
+        b"at [400.0, 350.0, 448.0]" in simulated.stdout and b"at [400.0, 351.5, 338.5]" in simulated.stdout
+    )  # each tool's circle

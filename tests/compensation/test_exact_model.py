@@ -8,8 +8,8 @@ from __future__ import annotations
 import pytest
 
 from ncpp.machine import load_machine
-from ncpp.simulate import contour_error, sample_events
 from ncpp.motion.offsets import WorkOffsets
+from ncpp.simulate import contour_error, sample_events
 from tests.compensation.conftest import compensate, events_of, placement, repeatable_machine
 from tests.conftest import CORPUS, ROOT
 
@@ -29,7 +29,9 @@ def before_after(machine, data: bytes, tolerance: float):
     offset = placement(sample_events(events_of(data)), machine.limits)
     nominal = sample_events(events_of(data, offsets=WorkOffsets.at(offset)))
     before = contour_error(machine, nominal, nominal, feed_effects=False)
-    commanded = sample_events(events_of(compensate(data, machine, offset, tolerance), offsets=WorkOffsets.at(offset)))
+    commanded = sample_events(
+        events_of(compensate(data, machine, offset, tolerance), offsets=WorkOffsets.at(offset))
+    )
     return before, contour_error(machine, commanded, nominal, feed_effects=False)
 
 
@@ -85,7 +87,9 @@ def test_reversal_spots_within_tolerance(name):
         data = b"\n".join(data.split(b"\n")[:lines]) + b"\nM2\n"
     # botomata sets G54 and G55 to the machine zero (G10 L2), outside HR5B's travel: in G54
     # without them, the placement puts it in the middle of the travel
-    data = b"\n".join(line for line in data.split(b"\n") if not line.startswith(b"G10 L2")).replace(b"G55", b"G54")
+    data = b"\n".join(line for line in data.split(b"\n") if not line.startswith(b"G10 L2")).replace(
+        b"G55", b"G54"
+    )
     inch = data.startswith(b"G20\n")
     data = data.replace(b"G20\n", b"G20\n" + START, 1) if inch else START + data
     machine = load_machine(ROOT / "samples/machines/hr5b.toml").replace(effects=())
@@ -128,8 +132,12 @@ def residual_after(machine, program: bytes, reason: str):
 
     offset = placement(sample_events(events_of(program)), machine.limits)
     nominal = sample_events(after(events_of(program, offsets=WorkOffsets.at(offset))))
-    commanded = sample_events(after(events_of(compensate(program, machine, offset, 0.001), offsets=WorkOffsets.at(offset))))
-    return contour_error(machine, nominal, nominal, feed_effects=False), contour_error(machine, commanded, nominal, feed_effects=False)
+    commanded = sample_events(
+        after(events_of(compensate(program, machine, offset, 0.001), offsets=WorkOffsets.at(offset)))
+    )
+    return contour_error(machine, nominal, nominal, feed_effects=False), contour_error(
+        machine, commanded, nominal, feed_effects=False
+    )
 
 
 def test_in_g91_the_moves_after_cutter_compensation_are_compensated(machine):
@@ -155,11 +163,23 @@ def test_in_g91_the_carry_crosses_the_passes_windows():
     hands on where the control stands, not its programmed end (which would lose a correction)."""
     from ncpp.motion.segments import Arc, Line
 
-    series = ["G1 X3 Y1", "G1 X1 Y2", "G41.1 D4", "G1 X2 Y2", "G1 X3", "G40", "G1 X-2 Y1", "G1 X-4 Y-3", "G1 X-3 Y-3"]  # nets 0
+    series = [
+        "G1 X3 Y1",
+        "G1 X1 Y2",
+        "G41.1 D4",
+        "G1 X2 Y2",
+        "G1 X3",
+        "G40",
+        "G1 X-2 Y1",
+        "G1 X-4 Y-3",
+        "G1 X-3 Y-3",
+    ]  # nets 0
     head = ["G21 G17 G90 G94 F500", "G0 X0 Y0 Z0", "G91"]
     filler = ["G1 X1", "G1 X-1"] * ((1016 - len(head) - len(series)) // 2)
     lines = head + series + filler + series + series + ["G90", "M2"]
-    assert lines.index("G1 X-2 Y1", len(head) + len(series) + len(filler)) + 1 == 1023  # the exit move ends the first window
+    assert (
+        lines.index("G1 X-2 Y1", len(head) + len(series) + len(filler)) + 1 == 1023
+    )  # the exit move ends the first window
     data = ("\n".join(lines) + "\n").encode()
     model = load_machine(ROOT / "samples/machines/hr5b.toml")
     offset = (400.0, 350.0, 400.0)
@@ -174,8 +194,14 @@ def test_in_g91_the_carry_crosses_the_passes_windows():
                 found.append(last)
         return found
 
-    corrections = [tuple(round(b - a, 7) for a, b in zip(p, q)) for p, q in zip(before_comp(data), before_comp(out))]
-    assert len(corrections) == 3 and corrections[0] == corrections[1] == corrections[2] and max(map(abs, corrections[0])) > 0.01
+    corrections = [
+        tuple(round(b - a, 7) for a, b in zip(p, q)) for p, q in zip(before_comp(data), before_comp(out))
+    ]
+    assert (
+        len(corrections) == 3
+        and corrections[0] == corrections[1] == corrections[2]
+        and max(map(abs, corrections[0])) > 0.01
+    )
 
 
 G91_FLOW = b"""G21 G17 G90 G94 F500

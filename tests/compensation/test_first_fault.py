@@ -5,7 +5,6 @@ and `replace_arcs` hands on the lines before an arc it refuses (`ncpp/passes/__i
 import io
 
 import numpy as np
-
 import pytest
 
 import ncpp.passes.replace_arcs as replace_arcs
@@ -41,7 +40,14 @@ def _line_of(text: bytes, piece: str) -> int:
 
 def _refused(data: bytes, source) -> NcppError:
     with pytest.raises(NcppError) as error:
-        process(io.BytesIO(data), io.BytesIO(), file="t.ngc", source=source, warnings=Warnings(stream=io.StringIO()), offsets=WorkOffsets.at(OFFSET))
+        process(
+            io.BytesIO(data),
+            io.BytesIO(),
+            file="t.ngc",
+            source=source,
+            warnings=Warnings(stream=io.StringIO()),
+            offsets=WorkOffsets.at(OFFSET),
+        )
     return error.value
 
 
@@ -50,7 +56,9 @@ def test_a_pass_refusing_a_line_is_heard_before_the_interpreter_refusing_a_later
     error = _refused(data, source)
     assert (error.where.line, error.where.col) == (_line_of(data, OUTSIDE), 4)  # at its X word
     alone = _program(_moves(100), "G0 X0\n", _moves(500), UNREADABLE_ARC)
-    assert _refused(alone, source).where.line == _line_of(alone, UNREADABLE_ARC)  # the interpreter's fault is found
+    assert _refused(alone, source).where.line == _line_of(
+        alone, UNREADABLE_ARC
+    )  # the interpreter's fault is found
 
 
 def test_a_line_before_an_arc_replace_arcs_refuses_is_heard_first(source):
@@ -89,10 +97,14 @@ def test_a_reversal_step_refused_before_a_line_end_in_the_same_chunk_is_heard_fi
     short, 0.6 mm, to be split); line 41 ends in the band travelling -X (refused)."""
     source = ErrorSource(model=_Kinked(), name="kinked", digest="0", max_correction=0.5)
     fillers = "".join(f"G1 Y{k % 2}\n" for k in range(35))
-    data = f"G21 G90 G17\nG0 X0 Y0 Z0\nG1 X5 Y10 F100\nG1 X4.9 Y10.6\n{fillers}G1 X10\nG1 X5 Y10\nM2\n".encode()
+    data = (
+        f"G21 G90 G17\nG0 X0 Y0 Z0\nG1 X5 Y10 F100\nG1 X4.9 Y10.6\n{fillers}G1 X10\nG1 X5 Y10\nM2\n".encode()
+    )
     error = _refused(data, source)
     assert error.where.line == 4 and "exceeds the machine file's limit" in error.message
-    outside = data.replace(b"G1 X5 Y10 F100\nG1 X4.9 Y10.6\n", b"G1 X5 Y11 F100\nG1 X4.9 Y11.6\n")  # the step at Y11
+    outside = data.replace(
+        b"G1 X5 Y10 F100\nG1 X4.9 Y10.6\n", b"G1 X5 Y11 F100\nG1 X4.9 Y11.6\n"
+    )  # the step at Y11
     assert _refused(outside, source).where.line == 41
 
 
@@ -108,7 +120,9 @@ def test_a_block_without_the_word_a_pass_refuses_is_named_by_its_first_column(so
     with pytest.raises(NcppError) as error:
         process(io.BytesIO(b"G21 G90\n  G0 Z5\nM2\n"), io.BytesIO(), file="t.ngc", source=source, warnings=Warnings(stream=io.StringIO()),
                 offsets=WorkOffsets.at((-1.0, 0.0, 0.0)))  # fmt: skip
-    assert str(error.value).startswith("t.ngc:2:1: command X-1.00") and "is outside the X travel" in str(error.value)
+    assert str(error.value).startswith("t.ngc:2:1: command X-1.00") and "is outside the X travel" in str(
+        error.value
+    )
 
 
 def test_a_fault_named_past_its_batch_is_raised_without_solving_the_batch_again(source, monkeypatch):

@@ -14,8 +14,8 @@ from ncpp.errors import NcppError
 from ncpp.motion.offsets import parse_zero, read_var_file
 from ncpp.motion.tools import read_tool_lines
 from ncpp.passes.geometry import compensate
-from ncpp.program.dialects import parse_program
 from ncpp.pipeline import ErrorSource, dialect_tools, make_context
+from ncpp.program.dialects import parse_program
 from tests.compensation.conftest import QUIET
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -38,11 +38,36 @@ def _motion(text: str, file: str) -> list:
         (f"N1 G1 X{TOO_LONG} F100\nM30\n", "p.mpf", "p.mpf:1:7", "number out of range"),
         ("G21 G90\nG1 X[EXP[1000]] F100\nM2\n", "p.ngc", "p.ngc:2:4", "Number out of range"),
         ("G21 G90\nG1 X[10**400] F100\nM2\n", "p.ngc", "p.ngc:2:4", "Number out of range"),
-        ("G21 G90\nG1 X[1" + "0" * 200 + "*1" + "0" * 200 + "] F100\nM2\n", "p.ngc", "p.ngc:2:257", "block too long"),
-        ("G21 G90\nG1 X" + "[" * 800 + "1" + "]" * 800 + " F100\nM2\n", "p.ngc", "p.ngc:2:257", "block too long"),
-        ("N1 R1=" + "(" * 200 + "1" + ")" * 200 + "\nM30\n", "p.mpf", "p.mpf:1:135", "nested deeper than 128"),
-        ("BEGIN PGM X MM\nQ1 = 10 ^ 400\nL X+Q1 Y+0 R0 FMAX\nEND PGM X MM\n", "p.h", "p.h:2:1", "number out of range"),
-        (f"BEGIN PGM X MM\nL X+{TOO_LONG} Y+0 R0 FMAX\nEND PGM X MM\n", "p.h", "p.h:2:3", "number out of range"),
+        (
+            "G21 G90\nG1 X[1" + "0" * 200 + "*1" + "0" * 200 + "] F100\nM2\n",
+            "p.ngc",
+            "p.ngc:2:257",
+            "block too long",
+        ),
+        (
+            "G21 G90\nG1 X" + "[" * 800 + "1" + "]" * 800 + " F100\nM2\n",
+            "p.ngc",
+            "p.ngc:2:257",
+            "block too long",
+        ),
+        (
+            "N1 R1=" + "(" * 200 + "1" + ")" * 200 + "\nM30\n",
+            "p.mpf",
+            "p.mpf:1:135",
+            "nested deeper than 128",
+        ),
+        (
+            "BEGIN PGM X MM\nQ1 = 10 ^ 400\nL X+Q1 Y+0 R0 FMAX\nEND PGM X MM\n",
+            "p.h",
+            "p.h:2:1",
+            "number out of range",
+        ),
+        (
+            f"BEGIN PGM X MM\nL X+{TOO_LONG} Y+0 R0 FMAX\nEND PGM X MM\n",
+            "p.h",
+            "p.h:2:3",
+            "number out of range",
+        ),
     ],
 )
 def test_a_number_out_of_range_is_refused_where_it_stands(text, file, where, message):
@@ -77,7 +102,11 @@ def test_a_work_offset_that_is_not_a_number_is_a_bad_option(zero, capsys):
 def test_a_tolerance_that_is_not_a_positive_number_is_a_bad_option(command, tolerance, capsys):
     with pytest.raises(SystemExit) as done:
         main([command, "--machine", str(MACHINE), "--tolerance", tolerance, str(POCKET)])
-    assert done.value.code == 2 and f"argument --tolerance: expected a positive number of mm, got '{tolerance}'" in capsys.readouterr().err
+    assert (
+        done.value.code == 2
+        and f"argument --tolerance: expected a positive number of mm, got '{tolerance}'"
+        in capsys.readouterr().err
+    )
 
 
 @pytest.mark.parametrize("step", ["0", "-1", "nan", "inf", "1e-9"])
@@ -111,7 +140,15 @@ def test_a_tolerance_of_1e_300_subdivides_as_finely_as_1e_30(tmp_path, capsys, r
     outputs = []
     for tolerance in ("1e-30", "1e-300"):
         out = tmp_path / f"{tolerance}.ngc"
-        argv = ["compensate", "--machine", str(MACHINE), "--work-offset", "400,350,300", "--tolerance", tolerance]
+        argv = [
+            "compensate",
+            "--machine",
+            str(MACHINE),
+            "--work-offset",
+            "400,350,300",
+            "--tolerance",
+            tolerance,
+        ]
         assert main([*argv, str(POCKET), "-o", str(out)]) == 0
         outputs.append(out.read_bytes().splitlines()[2:])  # after the header, which names the tolerance
     assert outputs[0] == outputs[1] and len(outputs[0]) > 90_000

@@ -10,7 +10,6 @@ from ncpp.errors import NcppError
 from ncpp.motion.offsets import WorkOffsets
 from ncpp.pipeline import ErrorSource, process
 from ncpp.program.blocks import Block
-
 from tests.conftest import ROOT
 
 from .conftest import QUIET
@@ -25,12 +24,17 @@ def source():
 
 def _run(data: bytes, source) -> bytes:
     out = io.BytesIO()
-    process(io.BytesIO(data), out, file="t.ngc", source=source, warnings=QUIET, offsets=WorkOffsets.at(OFFSET))
+    process(
+        io.BytesIO(data), out, file="t.ngc", source=source, warnings=QUIET, offsets=WorkOffsets.at(OFFSET)
+    )
     return out.getvalue()
 
 
 def _program(lines: int) -> bytes:
-    body = "".join(f"G1 X{(k % 37) * 0.5:.3f} Y{(k % 23) * 0.7:.3f}\nG2 X{(k % 37) * 0.5 + 1:.3f} Y{(k % 23) * 0.7:.3f} R0.6\n" for k in range(lines // 2))
+    body = "".join(
+        f"G1 X{(k % 37) * 0.5:.3f} Y{(k % 23) * 0.7:.3f}\nG2 X{(k % 37) * 0.5 + 1:.3f} Y{(k % 23) * 0.7:.3f} R0.6\n"
+        for k in range(lines // 2)
+    )
     return f"G21 G90 G17\nF600\n{body}M2\n".encode()
 
 

@@ -16,13 +16,17 @@ def test_the_garbage_collector_threshold_is_restored():
     before = gc.get_threshold()
     source = ErrorSource.from_machine_file(str(MACHINE))
     out = io.BytesIO()
-    process(io.BytesIO(PROGRAM), out, file="t.ngc", source=source, offsets=WorkOffsets.at((400.0, 350.0, 300.0)))
+    process(
+        io.BytesIO(PROGRAM), out, file="t.ngc", source=source, offsets=WorkOffsets.at((400.0, 350.0, 300.0))
+    )
     assert gc.get_threshold() == before
     assert out.getvalue().count(b"\n") >= PROGRAM.count(b"\n")
 
 
 def test_lines_in_are_counted_with_and_without_progress():
-    program = b"G21 G90\n" + b"G1 X1 Y2 F100\nX2 Y3\n" * 1500 + b"M2"  # 3002 lines, the last without a newline
+    program = (
+        b"G21 G90\n" + b"G1 X1 Y2 F100\nX2 Y3\n" * 1500 + b"M2"
+    )  # 3002 lines, the last without a newline
     reported: list[int] = []
     quiet = process(io.BytesIO(program), io.BytesIO(), file="t.ngc")
     told = process(io.BytesIO(program), io.BytesIO(), file="t.ngc", progress=reported.append)

@@ -12,7 +12,6 @@ import numpy as np
 import pytest
 
 from ncpp.errors import NcppError
-
 from tests.compensation.placement import pathcheck, run_both, var_file
 
 UM = 1e-3
@@ -156,7 +155,9 @@ def test_g92_and_g10_l20_set_the_offsets_the_program_means(tmp_path):
     var = var_file(tmp_path)
     out, said, nominal, actual = run_both(tmp_path, SETTINGS, var)
     assert "\nG92 X0 Y0\n" not in out and "\nG10 L20 P2 X" in out and "Z[" not in out
-    original, rewritten = (offsets_set(rs274(tmp_path / name, var)) for name in ("original.ngc", "rewritten.ngc"))
+    original, rewritten = (
+        offsets_set(rs274(tmp_path / name, var)) for name in ("original.ngc", "rewritten.ngc")
+    )
     assert [name for name, _ in original] == [name for name, _ in rewritten]
     # exact where the tool stands at a G90 point; in G91 the control stands where the increments as
     # written add up to, which a map without reversal errors leaves off the grid: one last digit
@@ -183,7 +184,7 @@ def test_a_setting_where_ncpp_cannot_say_where_the_control_stands_passes_through
     setting = program.index("G92") if "G92" in program else program.index("G10")
     line = program[:setting].count("\n") + 1
     assert f"t.ngc:{line}:" in said and why in said
-    assert out.decode().endswith(program[setting if "G92" in program else program.index("o100"):])
+    assert out.decode().endswith(program[setting if "G92" in program else program.index("o100") :])
 
 
 ROTARY = """G21 G90 G54 G94
@@ -203,7 +204,7 @@ def nominal_at(nominal, point: np.ndarray) -> tuple[float, np.ndarray]:
     """(distance in mm from `point`'s X Y Z to the nominal path of feed moves, the A..C the
     nominal moves have there, interpolated along the nearest one)."""
     best = (np.inf, None)
-    for (_, a), (name, b) in zip(nominal, nominal[1:]):
+    for (_, a), (_name, b) in zip(nominal, nominal[1:]):
         d = b[:3] - a[:3]
         t = 0.0 if not d.any() else float(np.clip(np.dot(point[:3] - a[:3], d) / np.dot(d, d), 0.0, 1.0))
         distance = float(np.linalg.norm(a[:3] + t * d - point[:3]))
@@ -212,7 +213,9 @@ def nominal_at(nominal, point: np.ndarray) -> tuple[float, np.ndarray]:
     return best
 
 
-def test_moves_that_turn_rotary_axes_are_refused_unless_the_machine_file_says_xyz_are_axis_positions(tmp_path):
+def test_moves_that_turn_rotary_axes_are_refused_unless_the_machine_file_says_xyz_are_axis_positions(
+    tmp_path,
+):
     from tests.compensation.placement import BowMap, compensate_with
 
     with pytest.raises(NcppError) as refused:
@@ -258,7 +261,7 @@ def test_split_moves_turn_their_share_and_take_their_share_of_the_time(tmp_path)
         elif name == "SET_FEED_RATE" and mode == 1:
             feeds.append(numbers[0])
     text = out.decode()
-    g93 = text[text.index("G93"): text.index("G94 G1")]
+    g93 = text[text.index("G93") : text.index("G94 G1")]
     times = [1 / float(f) for f in __import__("re").findall(r"F([\d.]+)", g93)]
     assert abs(sum(times) - (1 / 4 + 1 / 2.5 + 1 / 10)) < 1e-6 and len(times) > 3
     pathcheck(original, rewritten, var, "--tol-mm", "0.05", "--deg-per-mm", "1")

@@ -38,7 +38,9 @@ def programs() -> list:
 
 
 def rs274(path, tools) -> subprocess.CompletedProcess:
-    return subprocess.run([str(RS274), "-t", str(tools), str(path)], capture_output=True, text=True, timeout=120)
+    return subprocess.run(
+        [str(RS274), "-t", str(tools), str(path)], capture_output=True, text=True, timeout=120
+    )
 
 
 @pytest.fixture(scope="module")
@@ -73,8 +75,12 @@ def test_rs274_accepts_compensated_program(path, machines, tools, tmp_path):
     else:
         pytest.skip("no motion, or too large for the sample machines' travel")
     out = tmp_path / "compensated.ngc"
-    machine = machine.replace(rotary_xyz_are_axis_positions=True)  # (b-index.ngc turns B: compensated with its pieces' shares)
-    out.write_bytes(compensate(data, machine, WorkOffsets.of(dict.fromkeys(SYSTEMS, offset)), name=str(path)))  # (G55.. at G54's zero)
+    machine = machine.replace(
+        rotary_xyz_are_axis_positions=True
+    )  # (b-index.ngc turns B: compensated with its pieces' shares)
+    out.write_bytes(
+        compensate(data, machine, WorkOffsets.of(dict.fromkeys(SYSTEMS, offset)), name=str(path))
+    )  # (G55.. at G54's zero)
     after = rs274(out, tools)
     assert after.returncode == 0, after.stderr[-500:]
     assert "error" not in (after.stdout + after.stderr).lower()

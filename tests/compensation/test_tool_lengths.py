@@ -51,17 +51,29 @@ def test_linuxcnc_tool_table(tmp_path):
 
 
 def _lengths(program: bytes, offsets: WorkOffsets) -> list[tuple[float, float, float]]:
-    return [e.context.tool for e in events_of(program, offsets=offsets) if type(e).__name__ in ("Line", "Arc")]
+    return [
+        e.context.tool for e in events_of(program, offsets=offsets) if type(e).__name__ in ("Line", "Arc")
+    ]
 
 
 def test_g43_applies_the_tool_in_the_spindle_or_h_and_g49_none(tmp_path):
     told = replace(WorkOffsets.at(G54), tools=_tools(tmp_path))
     program = b"G21 G90\nT1 M6\nG43\nG0 Z10\nG43 H2\nG0 Z10\nT7\nG43\nG0 Z10\nM6 G43\nG0 Z10\nG43.2 H2\nG0 Z10\nG49\nG0 Z10\nM61 Q2\nG43 H0\nG0 Z10\nM2\n"
     # T selects, M6 loads, G43 (H0 too) applies the loaded tool, G43.2 adds one, G49 cancels; M61 sets the loaded tool
-    want = [(0, 0, 150.0), (0, 0, 40.0), (0, 0, 150.0), (0.5, 0, 4.25), (0.5, 0, 44.25), (0, 0, 0), (0, 0, 40.0)]
+    want = [
+        (0, 0, 150.0),
+        (0, 0, 40.0),
+        (0, 0, 150.0),
+        (0.5, 0, 4.25),
+        (0.5, 0, 44.25),
+        (0, 0, 0),
+        (0, 0, 40.0),
+    ]
     assert _lengths(program, told) == want
     z10 = [e for e in events_of(program, offsets=told) if type(e).__name__ == "Line"][0]
-    assert z10.context.to_machine(z10.end)[2] == pytest.approx(300.0 + 150.0 + 10.0)  # the gauge line is 150 mm above the tip
+    assert z10.context.to_machine(z10.end)[2] == pytest.approx(
+        300.0 + 150.0 + 10.0
+    )  # the gauge line is 150 mm above the tip
     inch = b"G20 G90\nT1 M6 G43\nG0 Z1\nM2\n"  # the table's mm lengths in program inches, as the control applies them
     assert _lengths(inch, told) == [pytest.approx((0, 0, 150.0 / 25.4))]
 
@@ -77,7 +89,14 @@ def test_a_tool_the_table_lacks_is_a_located_error(tmp_path):
 def _warnings(program: bytes, offsets: WorkOffsets, strict: bool = False, source: bool = True) -> str:
     said = io.StringIO()
     src = ErrorSource.from_machine_file(str(MACHINE)) if source else None
-    process(io.BytesIO(program), io.BytesIO(), file="t.ngc", source=src, warnings=Warnings(strict, said), offsets=offsets)
+    process(
+        io.BytesIO(program),
+        io.BytesIO(),
+        file="t.ngc",
+        source=src,
+        warnings=Warnings(strict, said),
+        offsets=offsets,
+    )
     return said.getvalue()
 
 
@@ -86,7 +105,9 @@ G43_PROGRAM = b"G21 G90\nT1 M6\nG43 H1\nG0 X10 Y10 Z5\nG43 H2\nG1 X20 F100\nM2\n
 
 def test_g43_without_a_tool_table_is_warned_once_where_it_applies_one(tmp_path):
     lines = _warnings(G43_PROGRAM, WorkOffsets.at(G54)).splitlines()
-    assert len(lines) == 1 and lines[0].startswith("t.ngc:3:5: warning: G43 applies a tool length from the control's tool table")
+    assert len(lines) == 1 and lines[0].startswith(
+        "t.ngc:3:5: warning: G43 applies a tool length from the control's tool table"
+    )
     assert "--tool-table" in lines[0]
     assert _warnings(G43_PROGRAM, replace(WorkOffsets.at(G54), tools=_tools(tmp_path))) == ""
     assert _warnings(G43_PROGRAM, WorkOffsets.at(G54), source=False) == ""  # passthrough places nothing
@@ -105,12 +126,21 @@ def test_a_longer_tool_is_a_longer_abbe_arm():
     assert np.abs(arm).max() > 0.001  # µm-size: the pitch and yaw of the axes times 150 mm
 
 
-POCKET = [line for line in (ROOT / "samples/programs/pocket.ngc").read_bytes().splitlines() if line.strip() not in (b"%", b"M2")]
-TWO_TOOLS = b"\n".join([b"T1 M6", b"G43 H1", *POCKET, b"T2 M6", b"G43 H2", *POCKET[2:], b"M2", b""])  # the pocket with each tool
+POCKET = [
+    line
+    for line in (ROOT / "samples/programs/pocket.ngc").read_bytes().splitlines()
+    if line.strip() not in (b"%", b"M2")
+]
+TWO_TOOLS = b"\n".join(
+    [b"T1 M6", b"G43 H1", *POCKET, b"T2 M6", b"G43 H2", *POCKET[2:], b"M2", b""]
+)  # the pocket with each tool
 
 
 def _contour_um(machine, program: bytes, offsets: WorkOffsets) -> float:
-    run, nominal = sample_events(events_of(program, offsets=offsets)), sample_events(events_of(TWO_TOOLS, offsets=offsets))
+    run, nominal = (
+        sample_events(events_of(program, offsets=offsets)),
+        sample_events(events_of(TWO_TOOLS, offsets=offsets)),
+    )
     return contour_error(machine, run, nominal, feed_effects=False).max_um
 
 
@@ -149,7 +179,9 @@ G43 H1
 G1 Z1
 M2
 """
-ORACLE_TABLE = "T1 P1 D6.0 Z2.0 ;a\nT2 P2 D3 Z-1.5 X0.1\nT7 P3 Z4\n"  # inches: the stand-alone rs274 reads them so
+ORACLE_TABLE = (
+    "T1 P1 D6.0 Z2.0 ;a\nT2 P2 D3 Z-1.5 X0.1\nT7 P3 Z4\n"  # inches: the stand-alone rs274 reads them so
+)
 
 
 def test_tool_lengths_agree_with_linuxcnc_started_from_the_same_tool_table(tmp_path):
@@ -166,7 +198,10 @@ def test_tool_lengths_agree_with_linuxcnc_started_from_the_same_tool_table(tmp_p
     for event, point in zip(events, want):
         assert event.end == pytest.approx(point, abs=1e-4)
     # the offset rs274 applies before each move is the one the move is placed with
-    applied = [[float(v) for v in call.replace(",", " ").split()[:3]] for call in re.findall(r"USE_TOOL_LENGTH_OFFSET\((.*)\)", canon)]
+    applied = [
+        [float(v) for v in call.replace(",", " ").split()[:3]]
+        for call in re.findall(r"USE_TOOL_LENGTH_OFFSET\((.*)\)", canon)
+    ]
     assert len(applied) == 8
     np.testing.assert_allclose([e.context.tool for e in events], [[0.0, 0.0, 0.0], *applied], atol=1e-4)
 
@@ -177,7 +212,18 @@ def test_command_line_tool_table(tmp_path):
     program.write_bytes(TWO_TOOLS)
 
     def run(*placement: str) -> subprocess.CompletedProcess:
-        command = [sys.executable, "-m", "ncpp", "compensate", "--machine", str(MACHINE), "--work-offset", "400,350,300", str(program), *placement]
+        command = [
+            sys.executable,
+            "-m",
+            "ncpp",
+            "compensate",
+            "--machine",
+            str(MACHINE),
+            "--work-offset",
+            "400,350,300",
+            str(program),
+            *placement,
+        ]
         return subprocess.run(command, capture_output=True, cwd=ROOT)
 
     told, untold = run("--tool-table", str(table)), run()

@@ -22,10 +22,19 @@ PROGRAM = b"G21 G90 G54\nG0 X10 Y10\nG55\nG1 X20 F100\nG56 G1 X5\nG55 X1\nG59.1 
 G54 = (400.0, 350.0, 300.0)
 
 
-def _warnings(program: bytes, offsets: WorkOffsets | None = None, strict: bool = False, source: bool = True) -> str:
+def _warnings(
+    program: bytes, offsets: WorkOffsets | None = None, strict: bool = False, source: bool = True
+) -> str:
     said = io.StringIO()
     src = ErrorSource.from_machine_file(str(MACHINE)) if source else None
-    process(io.BytesIO(program), io.BytesIO(), file="t.ngc", source=src, warnings=Warnings(strict, said), offsets=offsets or WorkOffsets.at(G54))
+    process(
+        io.BytesIO(program),
+        io.BytesIO(),
+        file="t.ngc",
+        source=src,
+        warnings=Warnings(strict, said),
+        offsets=offsets or WorkOffsets.at(G54),
+    )
     return said.getvalue()
 
 
@@ -37,7 +46,9 @@ def test_each_system_nobody_gave_is_named_once_where_it_is_first_selected():
 
 
 def test_systems_given_or_set_by_the_program_say_nothing():
-    told = WorkOffsets.of({"G54": G54, "G55": (500, 350, 300), "G56": (300, 350, 300), "G59.1": (100, 100, 300)})
+    told = WorkOffsets.of(
+        {"G54": G54, "G55": (500, 350, 300), "G56": (300, 350, 300), "G59.1": (100, 100, 300)}
+    )
     assert _warnings(PROGRAM, told) == ""
     set_here = b"G10 L2 P2 X500 Y350 Z300\nG10 L2 P3 X300 Y350 Z300\nG10 L2 P7 X100 Y100 Z300\n"
     assert _warnings(set_here + PROGRAM) == ""
@@ -55,7 +66,13 @@ def test_passthrough_says_nothing():
 
 def _compensated_lines(program: bytes, offsets: WorkOffsets) -> list[str]:
     out = io.BytesIO()
-    process(io.BytesIO(program), out, file="t.ngc", source=ErrorSource.from_machine_file(str(MACHINE)), offsets=offsets)
+    process(
+        io.BytesIO(program),
+        out,
+        file="t.ngc",
+        source=ErrorSource.from_machine_file(str(MACHINE)),
+        offsets=offsets,
+    )
     return out.getvalue().decode().splitlines()
 
 
@@ -69,18 +86,29 @@ def test_a_g53_move_is_written_in_machine_coordinates():
 
 
 def test_the_error_message_names_machine_coordinates_and_the_real_travel():
-    with pytest.raises(NcppError, match=r"t.ngc:2:4: command X\d+\.\d+ mm is outside the X travel \[0, 800\] mm") as err:
+    with pytest.raises(
+        NcppError, match=r"t.ngc:2:4: command X\d+\.\d+ mm is outside the X travel \[0, 800\] mm"
+    ) as err:
         _compensated_lines(b"G21 G90\nG1 X900 F100\nM2\n", WorkOffsets.at(G54))  # to machine X1300
     assert 800 < float(str(err.value).split("command X")[1].split()[0]) <= 1300.1
 
 
-POCKET = [line for line in (ROOT / "samples/programs/pocket.ngc").read_bytes().splitlines() if line.strip() not in (b"%", b"M2")]
+POCKET = [
+    line
+    for line in (ROOT / "samples/programs/pocket.ngc").read_bytes().splitlines()
+    if line.strip() not in (b"%", b"M2")
+]
 TWO_FIXTURES = b"\n".join(POCKET + [b"G55"] + POCKET[2:] + [b"M2", b""])  # the pocket at G54, then at G55
 FIXTURES = WorkOffsets.of({"G54": (250.0, 300.0, 300.0), "G55": (550.0, 400.0, 250.0)})
 
 
 def _contour_um(machine, program: bytes, nominal: bytes, offsets: WorkOffsets) -> float:
-    return contour_error(machine, sample_events(events_of(program, offsets=offsets)), sample_events(events_of(nominal, offsets=offsets)), feed_effects=False).max_um
+    return contour_error(
+        machine,
+        sample_events(events_of(program, offsets=offsets)),
+        sample_events(events_of(nominal, offsets=offsets)),
+        feed_effects=False,
+    ).max_um
 
 
 def test_two_fixtures_are_each_compensated_at_their_own_place():
@@ -88,7 +116,9 @@ def test_two_fixtures_are_each_compensated_at_their_own_place():
     simulated contour error is within the tolerance + 0.5 µm on both."""
     machine = repeatable_machine(MACHINE)
     moves = [e for e in events_of(TWO_FIXTURES) if type(e).__name__ in ("Line", "Arc")]
-    assert len(moves) == 2 * len([e for e in events_of(b"\n".join(POCKET)) if type(e).__name__ in ("Line", "Arc")])
+    assert len(moves) == 2 * len(
+        [e for e in events_of(b"\n".join(POCKET)) if type(e).__name__ in ("Line", "Arc")]
+    )
     before = _contour_um(machine, TWO_FIXTURES, TWO_FIXTURES, FIXTURES)
     after = _contour_um(machine, compensate(TWO_FIXTURES, machine, FIXTURES), TWO_FIXTURES, FIXTURES)
     assert before > 20.0 and after <= 1.5, (before, after)
@@ -98,7 +128,9 @@ def test_two_fixtures_are_each_compensated_at_their_own_place():
     with pytest.raises(NcppError, match="outside the . travel") as err:
         compensate(TWO_FIXTURES, machine, only_g54, warnings=Warnings(stream=said))
     g55_line = TWO_FIXTURES.splitlines().index(b"G55") + 1
-    assert said.getvalue().startswith(f"<test>:{g55_line}:1: warning: G55 selects a work offset ncpp is not told")
+    assert said.getvalue().startswith(
+        f"<test>:{g55_line}:1: warning: G55 selects a work offset ncpp is not told"
+    )
     assert err.value.where.line > g55_line
 
 
@@ -146,8 +178,19 @@ def test_command_line_var_file_and_work_offsets_say_the_same(tmp_path):
     program.write_bytes(TWO_FIXTURES)
 
     def run(*placement: str) -> subprocess.CompletedProcess:
-        command = [sys.executable, "-m", "ncpp", "compensate", "--machine", str(MACHINE), str(program), *placement]
-        return subprocess.run(command, capture_output=True, cwd=ROOT)  # ncpp is importable there from the tree too
+        command = [
+            sys.executable,
+            "-m",
+            "ncpp",
+            "compensate",
+            "--machine",
+            str(MACHINE),
+            str(program),
+            *placement,
+        ]
+        return subprocess.run(
+            command, capture_output=True, cwd=ROOT
+        )  # ncpp is importable there from the tree too
 
     from_var = run("--var-file", str(var))
     given = run("--work-offset", "250,300,300", "--work-offset", "g55=550,400,250")
@@ -215,7 +258,9 @@ def test_placement_agrees_with_linuxcnc_started_from_the_same_parameter_file(tmp
     assert main(["motion", str(program), "--var-file", str(var), "--var-units", "inch"]) == 0
     listed = capsys.readouterr().out.splitlines()
     canon = run_rs274_from(var, program)
-    assert listed == re.findall(r"(?:STRAIGHT_TRAVERSE|STRAIGHT_FEED|ARC_FEED)\(.*\)", canon)  # `ncpp motion` says the same
+    assert listed == re.findall(
+        r"(?:STRAIGHT_TRAVERSE|STRAIGHT_FEED|ARC_FEED)\(.*\)", canon
+    )  # `ncpp motion` says the same
     want = end_points(canon)
     events = [e for e in events_of(ORACLE_PROGRAM, offsets=offsets) if type(e).__name__ in ("Line", "Arc")]
     assert len(events) == len(want) == 9

@@ -22,10 +22,25 @@ def test_command_writes_report_model_and_plot(tmp_path, capsys):
     files = []
     for i, (plane, centre) in enumerate((("XY", (400, 350, 300)), ("YZ", (400, 350, 350)))):
         path = tmp_path / f"bb_{plane}.csv"
-        write_measurement(predict_ballbar(truth, plane, 100, centre, step_deg=2.0, noise_um=0.3, seed=i), path)
+        write_measurement(
+            predict_ballbar(truth, plane, 100, centre, step_deg=2.0, noise_um=0.3, seed=i), path
+        )
         files.append(str(path))
     report, updated, plot = tmp_path / "r.json", tmp_path / "up.toml", tmp_path / "gap.png"
-    rc = main(["diagnose", "--machine", str(MODEL), *files, "--json", str(report), "-o", str(updated), "--plot", str(plot)])
+    rc = main(
+        [
+            "diagnose",
+            "--machine",
+            str(MODEL),
+            *files,
+            "--json",
+            str(report),
+            "-o",
+            str(updated),
+            "--plot",
+            str(plot),
+        ]
+    )
     assert rc == 0
     out = capsys.readouterr().out
     assert "backlash Y" in out and "where the gap sits" in out

@@ -77,7 +77,9 @@ CASES = [
 ]  # fmt: skip
 
 
-@pytest.mark.parametrize("effect, keys, size_key, size, options", [c[1:] for c in CASES], ids=[c[0] for c in CASES])
+@pytest.mark.parametrize(
+    "effect, keys, size_key, size, options", [c[1:] for c in CASES], ids=[c[0] for c in CASES]
+)
 def test_one_hidden_effect_is_named_sized_and_closes_the_gap(effect, keys, size_key, size, options):
     d = diagnose(MODEL, ballbars(hidden(effect), **options))
     step = check_found(d, effect, size_key, size, keys)
@@ -169,4 +171,6 @@ def test_alternatives_are_listed_fitted_and_told_how_to_separate():
     assert again.steps == [] and again.gap_before.rms_um < 1.5 * NOISE
     text = account(d)
     assert "or, as the data cannot tell: squareness XY" in text
-    assert "to tell them apart, measure the ball bar XY R100 F1000 run in the other direction (CW) too" in text
+    assert (
+        "to tell them apart, measure the ball bar XY R100 F1000 run in the other direction (CW) too" in text
+    )

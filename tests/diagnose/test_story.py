@@ -16,8 +16,19 @@ def test_diagnose_names_the_thermal_growth_of_x(tmp_path):
     updated = tmp_path / "updated.toml"
     balls = sorted(str(p) for p in (STORY / "warm").glob("ballbar_*.csv"))
     proc = subprocess.run(
-        [sys.executable, "-m", "ncpp", "diagnose", "--machine", str(STORY / "cold_model.toml"), *balls,
-         "--json", str(report), "-o", str(updated)],  # fmt: skip
+        [
+            sys.executable,
+            "-m",
+            "ncpp",
+            "diagnose",
+            "--machine",
+            str(STORY / "cold_model.toml"),
+            *balls,
+            "--json",
+            str(report),
+            "-o",
+            str(updated),
+        ],  # fmt: skip
         capture_output=True,
         text=True,
     )

@@ -94,7 +94,9 @@ def _compensated(text: str, dialect: str, source: ErrorSource) -> str:
             warnings=Warnings(stream=said), dialect=dialect, offsets=WorkOffsets.at(WORK_OFFSET))  # fmt: skip
     lines = said.getvalue().splitlines()
     if dialect == "heidenhain":
-        assert len(lines) == 1 and lines[0].startswith("part:2:4: warning: TOOL CALL applies a tool length"), lines
+        assert len(lines) == 1 and lines[0].startswith(
+            "part:2:4: warning: TOOL CALL applies a tool length"
+        ), lines
     else:
         assert lines == []
     return out.getvalue().decode("latin-1")

@@ -24,7 +24,9 @@ from ncpp.simulate import sample_events
 from tests.conftest import ROOT
 
 HEAD = "0 BEGIN PGM T MM\n1 TOOL CALL 1 Z S3000\n2 L X+0 Y+0 Z-2 R0 F500\n"
-PART = HEAD + """3 L X+40 Y+0
+PART = (
+    HEAD
+    + """3 L X+40 Y+0
 4 RND R5 F200
 5 L X+40 Y+30
 6 CHF 3
@@ -37,6 +39,7 @@ PART = HEAD + """3 L X+40 Y+0
 12 L Z+5 FMAX
 13 END PGM T MM
 """
+)
 ISO = """G21 G90 G17
 G1 X0 Y0 Z-2 F500
 G1 X40 Y0 ,R5
@@ -52,7 +55,9 @@ M30
 def events(text: str, dialect: str = "heidenhain", **kw) -> list:
     interpreter, _ = dialect_tools(dialect)
     _, blocks = parse_program(io.BytesIO(text.encode()), "t", dialect)
-    return list(interpreter(without_guard(blocks), file="t", **kw))  # (a compensated program's placement guard)
+    return list(
+        interpreter(without_guard(blocks), file="t", **kw)
+    )  # (a compensated program's placement guard)
 
 
 def moves(evs: list) -> list:
@@ -83,7 +88,9 @@ def test_rnd_at_an_oblique_corner_touches_both_lines() -> None:
     v = np.array([-10.0, -20.0]) / math.hypot(10, 20)
     c = np.array(fillet.center[:2])
     for p, d in ((np.array(fillet.start[:2]), u), (np.array(fillet.end[:2]), v)):
-        assert abs(d[0] * (p - corner)[1] - d[1] * (p - corner)[0]) < 1e-12  # the tangent point lies on its line
+        assert (
+            abs(d[0] * (p - corner)[1] - d[1] * (p - corner)[0]) < 1e-12
+        )  # the tangent point lies on its line
         assert np.linalg.norm(c - p) == pytest.approx(r)
         assert abs(np.dot(c - p, d)) < 1e-12  # the radius meets the line at a right angle
     assert before.end == fillet.start and after.start == fillet.end
@@ -101,7 +108,7 @@ def test_chf_cuts_legs_of_its_length_along_each_line() -> None:
     assert chamfer.start == pytest.approx((40, 27, -2)) and chamfer.end == pytest.approx((37, 30, -2))
     assert m[3].end == chamfer.start and m[5].start == chamfer.end
     # the comment between the chamfer and the next line keeps its place
-    order = [block_text(e) for e in evs[evs.index(chamfer):][:3]]
+    order = [block_text(e) for e in evs[evs.index(chamfer) :][:3]]
     assert order == ["CHF 3", "the chamfer's comment", "L X+10 Y+30"]
 
 
@@ -118,7 +125,10 @@ def test_corners_next_to_an_arc_stay_out_of_scope() -> None:
     for text, line, first_pass in ((after_arc, 6, 5), (before_arc, 5, 3)):
         stream = io.StringIO()
         evs = events(text, warnings=Warnings(stream=stream))
-        assert f"t:{line}:" in stream.getvalue() and "outside the motion interpreter's scope" in stream.getvalue()
+        assert (
+            f"t:{line}:" in stream.getvalue()
+            and "outside the motion interpreter's scope" in stream.getvalue()
+        )
         assert all(type(e) is Pass for e in evs[first_pass:]) and type(evs[first_pass - 1]) is not Pass
         with pytest.raises(NcppError):
             events(text, strict=True)
@@ -160,12 +170,14 @@ def test_compensated_klartext_has_explicit_arcs_and_consistent_numbers(compensat
     assert numbered[-1].split(None, 1)[1] == "END PGM T MM"
     assert "; the chamfer's comment" in lines
     fillet = next(line for line in lines if " C " in line and "F200" in line)  # the RND R5 F200 block
-    after = lines[lines.index(fillet) + 1:]
+    after = lines[lines.index(fillet) + 1 :]
     assert "F500" in next(line for line in after if " L " in line)  # the program's feed comes back
     arcs = [e for e in events(compensated["part.h"], strict=True) if type(e) is Arc]
     radii = sorted(math.dist(a.start[:2], a.center[:2]) for a in arcs)
     assert radii == pytest.approx([2, 4, 5], abs=0.01)  # compensation moves points by micrometres
-    assert all(abs(math.dist(a.start[:2], a.center[:2]) - math.dist(a.end[:2], a.center[:2])) < 1e-3 for a in arcs)
+    assert all(
+        abs(math.dist(a.start[:2], a.center[:2]) - math.dist(a.end[:2], a.center[:2])) < 1e-3 for a in arcs
+    )
 
 
 def test_compensated_klartext_traces_the_compensated_iso_path(compensated) -> None:

@@ -44,13 +44,21 @@ HEIDENHAIN = """0 BEGIN PGM COMP MM
 """
 SINUMERIK = ISO.replace("G21 G90 G17", "G90 G17 G71").replace("G41 D1", "G41")  # (D is a tool edge there)
 # dialect: (program, file name, the line compensation starts on, the lines to the exit move's)
-PROGRAMS = {"iso": (ISO, "part.ngc", 4, 5), "heidenhain": (HEIDENHAIN, "part.h", 4, 6), "sinumerik": (SINUMERIK, "part.mpf", 4, 5)}
+PROGRAMS = {
+    "iso": (ISO, "part.ngc", 4, 5),
+    "heidenhain": (HEIDENHAIN, "part.h", 4, 6),
+    "sinumerik": (SINUMERIK, "part.mpf", 4, 5),
+}
 
 
 def moves(text: str, name: str) -> list:
     dialect, blocks = parse_program(io.BytesIO(text.encode()), name, None)
     interpret, _ = dialect_tools(dialect)
-    return [e for e in interpret(blocks, file=name, warnings=Warnings(stream=io.StringIO())) if type(e) is Line or type(e) is Arc]
+    return [
+        e
+        for e in interpret(blocks, file=name, warnings=Warnings(stream=io.StringIO()))
+        if type(e) is Line or type(e) is Arc
+    ]
 
 
 @pytest.mark.parametrize("dialect", PROGRAMS)
@@ -64,12 +72,22 @@ def test_the_moves_from_the_first_with_compensation_to_the_first_after_it_are_ma
 def test_they_pass_through_and_compensation_resumes_after_them(dialect):
     text, name, first, count = PROGRAMS[dialect]
     out, warned = compensate(text, name)
-    unnumbered = (lambda line: line.split(" ", 1)[1]) if dialect == "heidenhain" else (lambda line: line)  # (Klartext renumbers)
-    source, lines = [unnumbered(line) for line in text.splitlines()], [unnumbered(line) for line in out.splitlines()[1:]]
+    unnumbered = (
+        (lambda line: line.split(" ", 1)[1]) if dialect == "heidenhain" else (lambda line: line)
+    )  # (Klartext renumbers)
+    source, lines = (
+        [unnumbered(line) for line in text.splitlines()],
+        [unnumbered(line) for line in out.splitlines()[1:]],
+    )
     start = lines.index(source[first - 1])
-    assert lines[start : start + count] == source[first - 1 : first - 1 + count]  # the contour under compensation, to the exit move
+    assert (
+        lines[start : start + count] == source[first - 1 : first - 1 + count]
+    )  # the contour under compensation, to the exit move
     assert lines[start + count] != source[first - 1 + count]  # the move after it compensated
-    assert warned.count("cutter compensation") == 1 and f"{name}:{first}:1: warning: cutter compensation" in warned
+    assert (
+        warned.count("cutter compensation") == 1
+        and f"{name}:{first}:1: warning: cutter compensation" in warned
+    )
     with pytest.raises(NcppError, match=f"{name}:{first}:1: cutter compensation"):
         compensate(text, name, strict=True)
 
@@ -79,8 +97,14 @@ def test_the_same_part_compensates_alike_after_compensation_in_every_dialect():
     for dialect, (text, name, _, _) in PROGRAMS.items():
         out, _ = compensate(text, name)
         compensated = [e for e in moves(out, name) if e.fixed != COMP]
-        after[dialect] = [e.end for e in compensated[-4:]]  # from the exit move's end: connecting step, line, arc, rapid
+        after[dialect] = [
+            e.end for e in compensated[-4:]
+        ]  # from the exit move's end: connecting step, line, arc, rapid
         programmed = [e.end for e in moves(text, name)[-3:]]
-        assert len(after[dialect]) == 4 and all(max(abs(a - b) for a, b in zip(p, q)) > 0.001 for p, q in zip(after[dialect][1:], programmed))
+        assert len(after[dialect]) == 4 and all(
+            max(abs(a - b) for a, b in zip(p, q)) > 0.001 for p, q in zip(after[dialect][1:], programmed)
+        )
     for dialect in ("heidenhain", "sinumerik"):
-        assert all(max(abs(a - b) for a, b in zip(p, q)) < 2e-4 for p, q in zip(after["iso"], after[dialect])), (dialect, after)
+        assert all(
+            max(abs(a - b) for a, b in zip(p, q)) < 2e-4 for p, q in zip(after["iso"], after[dialect])
+        ), (dialect, after)

@@ -96,7 +96,9 @@ def test_agrees_with_cead_oracle(program: Path) -> None:
     expected = _oracle(program)
     positions, stopped = _ncpp(program)
     if program.name in OUT_OF_SCOPE:
-        assert stopped, f"{program.name} is listed out of scope but ncpp interpreted all of it: remove it from the list"
+        assert stopped, (
+            f"{program.name} is listed out of scope but ncpp interpreted all of it: remove it from the list"
+        )
         expected = expected[: len(positions)]
     else:
         assert stopped is None, stopped

@@ -73,7 +73,10 @@ def test_sinumerik_fast_path_agrees_with_lalr_parser_on_corpus(corpus):
                 items, signature, layout = fast
                 assert items == parser._parse_lalr(block.raw, block.line, str(path)), (path, block.line)
                 assert signature == expected_signature(items), (path, block.line)
-                assert layout in (None, block.raw.encode("latin-1").translate(DIGITS_AS_ONE)), (path, block.line)
+                assert layout in (None, block.raw.encode("latin-1").translate(DIGITS_AS_ONE)), (
+                    path,
+                    block.line,
+                )
                 checked += 1
     assert checked > 100
 
@@ -101,7 +104,9 @@ def test_linuxcnc_constructs_outweigh_a_line_that_reads_like_a_label():
     program = b"G21\no100 sub\nG1 X#1 F100\no100 endsub\no100 call [2]\nM2\nTools: T1 6mm\n"
     assert detect(program) == "iso"
     assert detect(b"#<depth> = 2\nG1 Z-#<depth>\nM2\nnote: deburr\n") == "iso"
-    assert detect(b"G21\nG1 X1 F100\nM2\nTools: T1 6mm\n") == "sinumerik"  # (no LinuxCNC construct: a label it is)
+    assert (
+        detect(b"G21\nG1 X1 F100\nM2\nTools: T1 6mm\n") == "sinumerik"
+    )  # (no LinuxCNC construct: a label it is)
 
 
 def test_explicit_dialect_overrides_detection():
@@ -109,7 +114,9 @@ def test_explicit_dialect_overrides_detection():
     assert dialect == "sinumerik"
 
 
-@pytest.mark.parametrize("path", [PLAN_H, CORPUS / "sinumerik/CEAD_nc-gcode-interpreter/edge_cases.mpf"], ids=corpus_id)
+@pytest.mark.parametrize(
+    "path", [PLAN_H, CORPUS / "sinumerik/CEAD_nc-gcode-interpreter/edge_cases.mpf"], ids=corpus_id
+)
 def test_cli_filter_roundtrips_from_stdin(corpus, path):
     import subprocess
     import sys
@@ -125,9 +132,13 @@ def test_cli_dialect_option_overrides_and_errors_name_the_line(tmp_path):
 
     bad = tmp_path / "bad.mpf"
     bad.write_bytes(b"G1 X1\nX=(1+\n")
-    proc = subprocess.run([sys.executable, "-m", "ncpp", "--dialect", "sinumerik", str(bad)], capture_output=True, text=True)
+    proc = subprocess.run(
+        [sys.executable, "-m", "ncpp", "--dialect", "sinumerik", str(bad)], capture_output=True, text=True
+    )
     assert proc.returncode != 0 and proc.stdout == "" and proc.stderr.startswith(f"{bad}:2:")
-    proc = subprocess.run([sys.executable, "-m", "ncpp", "--dialect", "klingon", str(bad)], capture_output=True, text=True)
+    proc = subprocess.run(
+        [sys.executable, "-m", "ncpp", "--dialect", "klingon", str(bad)], capture_output=True, text=True
+    )
     assert proc.returncode != 0 and "unknown dialect" in proc.stderr
 
 

@@ -37,7 +37,13 @@ def test_line_with_decimal_comma_and_fmax():
 
 
 def test_incremental_words_feed_and_m():
-    assert words("L IX+5 IY-2,25 IZ+0 RL F250 M3") == {"IX": 5.0, "IY": -2.25, "IZ": 0.0, "F": 250.0, "M": 3.0}
+    assert words("L IX+5 IY-2,25 IZ+0 RL F250 M3") == {
+        "IX": 5.0,
+        "IY": -2.25,
+        "IZ": 0.0,
+        "F": 250.0,
+        "M": 3.0,
+    }
     assert ("radius_comp", ("RR",)) in statements("L IX+5 RR FAUTO")
     assert ("feed", ("FAUTO",)) in statements("L IX+5 RR FAUTO")
 
@@ -73,9 +79,15 @@ def test_program_frame_tool_and_blank_form():
     assert statements("25 END PGM Plan-Beispiel INCH") == [("program_end", ("Plan-Beispiel", "INCH"))]
     assert statements("1  BLK FORM 0.1 Z  X-200  Y-100  Z-30") == [("blk_form", ("0.1", "Z"))]
     assert words("2  BLK FORM 0.2  X+200  Y+100  Z+0") == {"N": 2.0, "X": 200.0, "Y": 100.0, "Z": 0.0}
-    assert statements("3  TOOL CALL 1 Z S800") == [("tool_call", (1, "Z"))] and words("TOOL CALL 1 Z S800 F100")["S"] == 800
+    assert (
+        statements("3  TOOL CALL 1 Z S800") == [("tool_call", (1, "Z"))]
+        and words("TOOL CALL 1 Z S800 F100")["S"] == 800
+    )
     assert statements('TOOL CALL "MILL_D10" Z') == [("tool_call", ("MILL_D10", "Z"))]
-    assert statements("TOOL DEF 5 L+0 R+5") == [("tool_def", (5,))] and words("TOOL DEF 5 L+0 R+5") == {"L": 0.0, "R": 5.0}
+    assert statements("TOOL DEF 5 L+0 R+5") == [("tool_def", (5,))] and words("TOOL DEF 5 L+0 R+5") == {
+        "L": 0.0,
+        "R": 5.0,
+    }
 
 
 def test_labels_calls_and_cycles():
@@ -85,7 +97,9 @@ def test_labels_calls_and_cycles():
     assert statements('CALL LBL "x"') == [("call_label", ("x", 0))]
     assert statements("22 CALL PGM TNC:\\Plan.h") == [("call_program", ("TNC:\\Plan.h",))]
     assert statements("CYCL DEF 1.1 ABST 2") == [("cycle_def", ("1.1", ("ABST", "2")))]
-    assert statements("CYCL DEF 7.1 IX+10") == [("cycle_def", ("7.1", ()))] and words("CYCL DEF 7.1 IX+10") == {"IX": 10.0}
+    assert statements("CYCL DEF 7.1 IX+10") == [("cycle_def", ("7.1", ()))] and words(
+        "CYCL DEF 7.1 IX+10"
+    ) == {"IX": 10.0}
     assert statements("CYCL CALL M3") == [("cycle_call", (None,))]
 
 
@@ -94,8 +108,14 @@ def test_multi_line_cycle_definition_is_one_block_and_roundtrips():
     blocks = list(parse_stream(io.BytesIO(text), "c.h", "heidenhain"))
     assert len(blocks) == 2 and blocks[0].eol == "\r\n" and blocks[1].line == 4
     kinds = [(type(i).__name__, getattr(i, "kind", None)) for i in blocks[0].items]
-    assert kinds == [("Word", None), ("Statement", "cycle_def"), ("Statement", "assignment"), ("Comment", None),
-                     ("Statement", "assignment"), ("Comment", None)]
+    assert kinds == [
+        ("Word", None),
+        ("Statement", "cycle_def"),
+        ("Statement", "assignment"),
+        ("Comment", None),
+        ("Statement", "assignment"),
+        ("Comment", None),
+    ]
     assert blocks[0].items[1].node == ("200", ("BOHREN",))
     assert blocks[0].items[4].node == (("param", "q201"), ("num", -20.5))
     assert blocks[0].items[3].text == "SICHERHEITS-ABST. "
@@ -106,11 +126,25 @@ def test_multi_line_cycle_definition_is_one_block_and_roundtrips():
 
 def test_q_formulas_and_fn_pass_through():
     (_, assign, comment) = items("30 Q1951 = INT ( ( Q1950 / Q1810 ) + 0.99999999 ) ;Anzahl")
-    assert assign.node == (("param", "q1951"), ("call", "INT", ("bin", "+", ("bin", "/", ("param", "q1950"), ("param", "q1810")), ("num", 0.99999999))))
+    assert assign.node == (
+        ("param", "q1951"),
+        (
+            "call",
+            "INT",
+            ("bin", "+", ("bin", "/", ("param", "q1950"), ("param", "q1810")), ("num", 0.99999999)),
+        ),
+    )
     assert comment.text == "Anzahl"
     assert items("Q1800 = - 200")[0].node == (("param", "q1800"), ("num", -200.0))
-    assert items("Q1 = PI * Q2 ^ 2")[0].node[1] == ("bin", "*", ("num", math.pi), ("bin", "**", ("param", "q2"), ("num", 2.0)))
-    assert statements('8  FN 12: IF +Q1840 LT +1 GOTO LBL "1042"') == [("fn", (12, 'IF +Q1840 LT +1 GOTO LBL "1042"'))]
+    assert items("Q1 = PI * Q2 ^ 2")[0].node[1] == (
+        "bin",
+        "*",
+        ("num", math.pi),
+        ("bin", "**", ("param", "q2"), ("num", 2.0)),
+    )
+    assert statements('8  FN 12: IF +Q1840 LT +1 GOTO LBL "1042"') == [
+        ("fn", (12, 'IF +Q1840 LT +1 GOTO LBL "1042"'))
+    ]
     assert statements("FN 14: ERROR= 1005") == [("fn", (14, "ERROR= 1005"))]
 
 
@@ -133,7 +167,10 @@ def test_crlf_leading_blanks_and_continued_comment_roundtrip():
 
 @pytest.mark.parametrize(
     "text, line, col",
-    [(b"0 BEGIN PGM T MM\n1 L X+1 Y@2\n", 2, 9), (b"0 BEGIN PGM T MM\n1 CYCL DEF 1.0 ~\n  Q1=+1 ;x ~\n  X+1 Y=\n", 4, 7)],
+    [
+        (b"0 BEGIN PGM T MM\n1 L X+1 Y@2\n", 2, 9),
+        (b"0 BEGIN PGM T MM\n1 CYCL DEF 1.0 ~\n  Q1=+1 ;x ~\n  X+1 Y=\n", 4, 7),
+    ],
 )
 def test_bad_input_names_file_line_and_column(text, line, col):
     with pytest.raises(NcppError) as err:

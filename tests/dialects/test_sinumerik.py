@@ -33,7 +33,14 @@ def statements(text: str) -> list[tuple[str, tuple]]:
 
 def test_plain_words_take_the_fast_path():
     assert PARSER._scan_plain("N10 G1 X1.5 Y-2. Z0.001 F2400 ; c") is not None
-    assert words("N10 G1 X1.5 Y-2. Z0.001 F2400") == {"N": 10.0, "G": 1.0, "X": 1.5, "Y": -2.0, "Z": 0.001, "F": 2400.0}
+    assert words("N10 G1 X1.5 Y-2. Z0.001 F2400") == {
+        "N": 10.0,
+        "G": 1.0,
+        "X": 1.5,
+        "Y": -2.0,
+        "Z": 0.001,
+        "F": 2400.0,
+    }
     assert PARSER._scan_plain("X(1)") is None  # parentheses are arithmetic, not comments
 
 
@@ -42,7 +49,11 @@ def test_arcs_with_centre_and_radius():
     assert words("G2 X10 Y0 CR=5") == {"G": 2.0, "X": 10.0, "Y": 0.0}
     assert exprs("G2 X10 Y0 CR=5") == {"CR": ("num", 5.0)}
     assert exprs("G3 X0 Y50 CR=-60") == {"CR": ("neg", ("num", 60.0))}
-    assert exprs("G2 X10 Y10 I=AC(5) J=AC(0) TURN=2") == {"I": ("ac", ("num", 5.0)), "J": ("ac", ("num", 0.0)), "TURN": ("num", 2.0)}
+    assert exprs("G2 X10 Y10 I=AC(5) J=AC(0) TURN=2") == {
+        "I": ("ac", ("num", 5.0)),
+        "J": ("ac", ("num", 0.0)),
+        "TURN": ("num", 2.0),
+    }
 
 
 def test_absolute_and_incremental_coordinates():
@@ -65,28 +76,38 @@ def test_expressions_in_addresses():
     assert exprs("X=R1+2") == {"X": ("bin", "+", ("param", "r1"), ("num", 2.0))}
     assert exprs("X=SIN(30)") == {"X": ("call", "SIN", ("num", 30.0))}
     assert exprs("X=ATAN2(30.5, 80.1)") == {"X": ("call", "ATAN2", ("num", 30.5), ("num", 80.1))}
-    assert exprs("X=2+6 DIV 4") == {"X": ("bin", "+", ("num", 2.0), ("bin", "DIV", ("num", 6.0), ("num", 4.0)))}
+    assert exprs("X=2+6 DIV 4") == {
+        "X": ("bin", "+", ("num", 2.0), ("bin", "DIV", ("num", 6.0), ("num", 4.0)))
+    }
     assert exprs("X=2*-3") == {"X": ("bin", "*", ("num", 2.0), ("neg", ("num", 3.0)))}
     assert exprs("G1 X=ACC[E]") == {"X": ("index", "acc", (("param", "e"),))}
     assert exprs('T="BALL_MILL" M6') == {"T": ("str", "BALL_MILL")}
-    assert exprs("X1 Y=-2/3") == {"Y": ("bin", "/", ("neg", ("num", 2.0)), ("num", 3.0))} and words("X1 Y=-2/3") == {"X": 1.0}
+    assert exprs("X1 Y=-2/3") == {"Y": ("bin", "/", ("neg", ("num", 2.0)), ("num", 3.0))} and words(
+        "X1 Y=-2/3"
+    ) == {"X": 1.0}
 
 
 def test_parameters_variables_and_system_variables():
     assert statements("R1=10") == [("assignment", (("param", "r1"), ("num", 10.0)))]
-    assert statements("R1 = $AA_IW[Z] ; 10") == [("assignment", (("param", "r1"), ("index", "$aa_iw", (("param", "z"),))))]
+    assert statements("R1 = $AA_IW[Z] ; 10") == [
+        ("assignment", (("param", "r1"), ("index", "$aa_iw", (("param", "z"),))))
+    ]
     assert statements("LAYER_HEIGHT = 2.5") == [("assignment", (("param", "layer_height"), ("num", 2.5)))]
-    assert statements("FELD[nn,m]=1") == [("assignment", (("index", "feld", (("param", "nn"), ("param", "m"))), ("num", 1.0)))]
-    assert statements("R11 = R_SPEED >= 100") == [("assignment", (("param", "r11"), ("bin", ">=", ("param", "r_speed"), ("num", 100.0))))]
+    assert statements("FELD[nn,m]=1") == [
+        ("assignment", (("index", "feld", (("param", "nn"), ("param", "m"))), ("num", 1.0)))
+    ]
+    assert statements("R11 = R_SPEED >= 100") == [
+        ("assignment", (("param", "r11"), ("bin", ">=", ("param", "r_speed"), ("num", 100.0))))
+    ]
 
 
 def test_definitions_and_procedures():
-    (kind, (type_, length, variables)), = statements("DEF REAL LAYER_HEIGHT = 2, PART_HEIGHT")
+    ((kind, (type_, length, variables)),) = statements("DEF REAL LAYER_HEIGHT = 2, PART_HEIGHT")
     assert (kind, type_, length) == ("def", "REAL", None)
     assert variables == ((("param", "layer_height"), ("num", 2.0)), (("param", "part_height"), None))
-    (_, (type_, length, variables)), = statements('DEF STRING[28] NAME = "x"')
+    ((_, (type_, length, variables)),) = statements('DEF STRING[28] NAME = "x"')
     assert (type_, length, variables) == ("STRING", ("num", 28.0), ((("param", "name"), ("str", "x")),))
-    (_, (_, _, variables)), = statements("DEF REAL FELD1[10,3]=SET(0,,9)")
+    ((_, (_, _, variables)),) = statements("DEF REAL FELD1[10,3]=SET(0,,9)")
     assert variables[0][1] == ("call", "SET", ("num", 0.0), None, ("num", 9.0))
     assert statements("PROC CONTOUR(REAL DEPTH, VAR INT N) SAVE") == [
         ("proc", ("CONTOUR", (("REAL", "depth", False, None), ("INT", "n", True, None)), ("SAVE",)))
@@ -96,26 +117,38 @@ def test_definitions_and_procedures():
 def test_labels_jumps_and_control():
     assert statements("N40 REPEAT_HERE: X=R1 ; jump label")[0] == ("label", ("REPEAT_HERE",))
     assert words("N40 LABEL_1: X1") == {"N": 40.0, "X": 1.0}
-    assert statements("IF R4>0 GOTOB LA1") == [("if", (("bin", ">", ("param", "r4"), ("num", 0.0)),)), ("goto", ("GOTOB", "LA1"))]
+    assert statements("IF R4>0 GOTOB LA1") == [
+        ("if", (("bin", ">", ("param", "r4"), ("num", 0.0)),)),
+        ("goto", ("GOTOB", "LA1")),
+    ]
     assert statements("GOTOF 90") == [("goto", ("GOTOF", "90"))]
     assert statements("N100 GOTO FINISH") == [("goto", ("GOTO", "FINISH"))]
     assert statements("WHILE (y_current <= y_end)")[0][0] == "while"
-    assert statements("FOR COUNTER=0 TO NUMBER") == [("for", (("param", "counter"), ("num", 0.0), ("param", "number")))]
+    assert statements("FOR COUNTER=0 TO NUMBER") == [
+        ("for", (("param", "counter"), ("num", 0.0), ("param", "number")))
+    ]
     assert [k for k, _ in statements("ELSE")] == ["else"]
     for word in ("ENDIF", "ENDWHILE", "ENDFOR", "REPEAT", "LOOP", "ENDLOOP"):
         assert statements(word) == [(word.lower(), ())]
     assert statements("UNTIL COUNTER>NUMBER")[0][0] == "until"
     assert statements("IF NOT TRACK_Y") == [("if", (("not", ("param", "track_y")),))]
-    (kind, (expr, branches, default)), = statements("CASE(4+3) OF 7 GOTOF SEVEN 9 GOTOF NINE DEFAULT GOTOF OTHER")
+    ((kind, (expr, branches, default)),) = statements(
+        "CASE(4+3) OF 7 GOTOF SEVEN 9 GOTOF NINE DEFAULT GOTOF OTHER"
+    )
     assert kind == "case" and branches == ((("num", 7.0), "GOTOF", "SEVEN"), (("num", 9.0), "GOTOF", "NINE"))
     assert default == ("GOTOF", "OTHER")
 
 
 def test_calls_frames_messages_and_headers():
-    assert statements("CYCLE81(10, 0, 2, -5)") == [("call", ("CYCLE81", (("num", 10.0), ("num", 0.0), ("num", 2.0), ("neg", ("num", 5.0)))))]
+    assert statements("CYCLE81(10, 0, 2, -5)") == [
+        ("call", ("CYCLE81", (("num", 10.0), ("num", 0.0), ("num", 2.0), ("neg", ("num", 5.0)))))
+    ]
     assert statements('MSG("Roughing")') == [("call", ("MSG", (("str", "Roughing"),)))]
     assert statements("N53 MATERIAL_UPDATE") == [("call", ("MATERIAL_UPDATE", ()))]
-    assert statements("TRANS X10 Y20") == [("frame", ("TRANS",))] and words("TRANS X10 Y20") == {"X": 10.0, "Y": 20.0}
+    assert statements("TRANS X10 Y20") == [("frame", ("TRANS",))] and words("TRANS X10 Y20") == {
+        "X": 10.0,
+        "Y": 20.0,
+    }
     assert statements("%_N_PART1_MPF") == [("program_name", ("%_N_PART1_MPF",))]
     (main,) = items(":10")
     assert (main.letter, main.value) == (":", 10.0)
@@ -135,7 +168,11 @@ def test_bad_input_names_file_line_and_column():
 @pytest.mark.parametrize(
     "block, column, message",
     [
-        ("G1 X=1e3 Y10", 7, "X=1e3: a Sinumerik writes an exponent as EX (X=1EX3); as written this is X=1 and an address E"),
+        (
+            "G1 X=1e3 Y10",
+            7,
+            "X=1e3: a Sinumerik writes an exponent as EX (X=1EX3); as written this is X=1 and an address E",
+        ),
         ("G1 X=2*1E-3", 9, "X=2*1E-3: a Sinumerik writes an exponent as EX (X=2*1EX-3)"),
         ("R1=5e2", 5, "R1=5e2: a Sinumerik writes an exponent as EX (R1=5EX2)"),
     ],
@@ -160,7 +197,10 @@ def test_an_exponent_written_with_ex_is_a_number():
     [
         ("G2 AR=90 I5 J0 F100", "the opening angle AR="),
         ("G1 AP=45 RP=10 F100", "the polar angle AP="),
-        ("L100 P2", "the subprogram call L100"),  # was ignored: the next block's Y and Z were written as before the call
+        (
+            "L100 P2",
+            "the subprogram call L100",
+        ),  # was ignored: the next block's Y and Z were written as before the call
     ],
 )
 def test_geometry_the_interpreter_does_not_follow_ends_interpretation(block, what):

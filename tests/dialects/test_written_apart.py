@@ -14,14 +14,26 @@ def by_round(value: float, places: int, last: float, last_places: int) -> bool:
 
 
 near_ties = st.builds(
-    lambda k, places, ulps: math.nextafter((k + 0.5) / 10**places, math.inf if ulps > 0 else -math.inf) if ulps else (k + 0.5) / 10**places,
-    st.integers(-10**9, 10**9), st.integers(0, 6), st.integers(-2, 2),
+    lambda k, places, ulps: (
+        math.nextafter((k + 0.5) / 10**places, math.inf if ulps > 0 else -math.inf)
+        if ulps
+        else (k + 0.5) / 10**places
+    ),
+    st.integers(-(10**9), 10**9),
+    st.integers(0, 6),
+    st.integers(-2, 2),
 )
 values = st.one_of(st.floats(-1e5, 1e5, allow_nan=False), near_ties)
 
 
 @settings(max_examples=1000, deadline=None)
-@given(value=values, last=values, places=st.integers(0, 9), other_places=st.integers(0, 9), same_places=st.booleans())
+@given(
+    value=values,
+    last=values,
+    places=st.integers(0, 9),
+    other_places=st.integers(0, 9),
+    same_places=st.booleans(),
+)
 @example(value=0.00005, last=0.00015, places=4, other_places=4, same_places=True)
 @example(value=2.675, last=2.665, places=2, other_places=2, same_places=True)
 @example(value=-0.5, last=0.5, places=0, other_places=0, same_places=True)

@@ -33,7 +33,9 @@ def long_axis_machine(n: int = 600) -> Machine:
     """A 1200 mm axis measured every 2 mm with reversal: more points than LinuxCNC holds."""
     x = np.linspace(0.0, 1200.0, n)
     plus = 0.02 * np.sin(x / 90.0) + 1e-5 * x
-    return Machine("long", "XYFZ", limits={"X": (0, 1200)}, components={"EXX": Table(x, plus, plus + 0.004, "linear")})
+    return Machine(
+        "long", "XYFZ", limits={"X": (0, 1200)}, components={"EXX": Table(x, plus, plus + 0.004, "linear")}
+    )
 
 
 @pytest.mark.parametrize("comp_type", [0, 1])
@@ -58,7 +60,9 @@ def test_linuxcnc_round_trip_cancels_the_error(tmp_path, machine, comp_type):
 def test_linuxcnc_type0_sign_is_where_the_axis_is(machine):
     text, _ = export_table(machine, "X", "linuxcnc", comp_type=0)
     nominal, forward, _ = (float(v) for v in text.splitlines()[2].split())
-    assert forward == pytest.approx(nominal + axis_error(machine, "X").forward(np.array([nominal]))[0], abs=1e-6)
+    assert forward == pytest.approx(
+        nominal + axis_error(machine, "X").forward(np.array([nominal]))[0], abs=1e-6
+    )
 
 
 def test_linuxcnc_resamples_to_256_and_says_so(tmp_path):
@@ -78,9 +82,9 @@ def test_linuxcnc_resamples_to_256_and_says_so(tmp_path):
 def test_linuxcnc_notes_come_after_the_data(machine):
     text, _ = export_table(machine, "X", "linuxcnc")
     lines = text.splitlines()
-    first_comment = next(i for i, l in enumerate(lines) if l.startswith("#"))
-    assert all(len(l.split()) == 3 for l in lines[:first_comment])
-    assert all(l.startswith("#") for l in lines[first_comment:])
+    first_comment = next(i for i, line in enumerate(lines) if line.startswith("#"))
+    assert all(len(line.split()) == 3 for line in lines[:first_comment])
+    assert all(line.startswith("#") for line in lines[first_comment:])
 
 
 def test_reader_refuses_what_linuxcnc_would_misread(tmp_path):
@@ -115,7 +119,9 @@ FANUC_0I_PB = "FANUC 0i-PB parameter manual B-63980EN/01 p.100, http://cncmanual
 FANUC_A77810E = "FANUC technical report A-77810E, 16i/18i bidirectional pitch error compensation (parameter list 3620-3627)"
 K3_EXAMPLE = "SINUMERIK K3 6FC5397-1BP40-3BA1 p.242, https://manual.onestart.ai/manuals/Siemens-SINUMERIK-Series-Function-Manual-5628364?page=242"
 K3_CEC = "SINUMERIK K3 6FC5397-1BP40-3BA1 p.248-249, https://www.easymanua.ls/siemens/sinumerik-series/manual/275710?p=248"
-K3_802D_CEC = "SINUMERIK 802D sl K3 example, https://www.easymanua.ls/siemens/sinumerik-802d-sl/manual/592298?p=222"
+K3_802D_CEC = (
+    "SINUMERIK 802D sl K3 example, https://www.easymanua.ls/siemens/sinumerik-802d-sl/manual/592298?p=222"
+)
 S808D_SIGN = "SINUMERIK 808D Function Manual 01/2017 p.106, https://www.easymanua.ls/siemens/sinumerik-808d/manual/217421?p=106"
 HH_COM = "HEIDENHAIN MANUALplus 620 Technical Manual p.716, https://www.easymanua.ls/heidenhain/manualplus-620/manual/506189?p=716"
 HH_TNC407 = "HEIDENHAIN TNC 407 Technical Manual, module 9095, https://azmanual.top/manuals/797826/heidenhain-tnc-407-243-020-technical-manual.html?page=622"
@@ -211,7 +217,9 @@ def test_sinumerik_tables(machine):
     # Axes given as (AXn). Source: K3_802D_CEC ($AN_CEC_INPUT_AXIS[0]=(AX2)).
     outputs = {var["$AN_CEC_OUTPUT_AXIS"][(str(t),)] for t in range(4)}
     assert outputs == {"AX1", "AX2", "AX3"}  # reversal on X, straightness EYX on Y, EZX on Z
-    assert var["$AN_CEC_MULT_BY_TABLE"][("2",)] == 0 and var["$AN_CEC_IS_MODULO"][("2",)] == 0  # Source: K3_CEC
+    assert (
+        var["$AN_CEC_MULT_BY_TABLE"][("2",)] == 0 and var["$AN_CEC_IS_MODULO"][("2",)] == 0
+    )  # Source: K3_CEC
     eyx = axis_error(machine, "X", "EYX")
     cec2 = np.array([var["$AN_CEC"][("2", str(i))] for i in range(n)])
     # CEC adds -e to the output axis: NOT verified (no source states the CEC sign).
@@ -251,7 +259,24 @@ def test_heidenhain_com(machine):
 
 def test_cli_writes_file_and_reports_resampling(tmp_path, capsys):
     out = tmp_path / "x.comp"
-    assert main(["export-table", "--machine", str(HR5B), "--axis", "X", "--format", "linuxcnc", "--spacing", "1", "-o", str(out)]) == 0
+    assert (
+        main(
+            [
+                "export-table",
+                "--machine",
+                str(HR5B),
+                "--axis",
+                "X",
+                "--format",
+                "linuxcnc",
+                "--spacing",
+                "1",
+                "-o",
+                str(out),
+            ]
+        )
+        == 0
+    )
     assert "256" in capsys.readouterr().err
     assert len(read_linuxcnc_comp(out).nominal) <= 256
 

@@ -88,7 +88,11 @@ def test_level_reads_the_member_rotation():
     # Z carries the tool: its carriage turns by +EAZ (pitch of Z).
     pitch = predict_level(m, "Z", TARGETS, quantity="pitch")
     assert np.allclose(pitch["inclination_um_per_m"], EAZ(TARGETS) * 1e6, atol=1e-4)
-    assert np.allclose(pitch["inclination_um_per_m"], m.member_rotation("Z", np.c_[0 * TARGETS, 0 * TARGETS, TARGETS])[:, 0] * 1e6, atol=1e-4)
+    assert np.allclose(
+        pitch["inclination_um_per_m"],
+        m.member_rotation("Z", np.c_[0 * TARGETS, 0 * TARGETS, TARGETS])[:, 0] * 1e6,
+        atol=1e-4,
+    )
 
 
 def test_ballbar_of_a_pure_squareness_machine():
@@ -137,7 +141,9 @@ def test_cutting_circularity_matches_ballbar_g():
     m = plain(EXX=EXX, EYX=EYX).with_components(C0Y=30e-6).replace(effects=(Backlash("X", 3.0),))
     centre = (400, 0, 0)
     cut = analyze(predict_cutting(m, "XY", 50, centre, feed_mm_min=1000, direction="CCW")).figures
-    bar = analyze(predict_ballbar(m, "XY", 50, centre, feed_mm_min=1000, directions="CCW", step_deg=0.5)).figures
+    bar = analyze(
+        predict_ballbar(m, "XY", 50, centre, feed_mm_min=1000, directions="CCW", step_deg=0.5)
+    ).figures
     assert cut["G"] == pytest.approx(bar["G"], rel=0.1)
 
 

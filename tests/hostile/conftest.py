@@ -13,8 +13,14 @@ ROOT = Path(__file__).resolve().parents[2]
 PYTHON = sys.executable
 
 
-def run_ncpp(*args: str, timeout: float = 60, stdin: bytes | None = None, env: dict | None = None,
-             memory_mb: int | None = None, cwd: str | None = None) -> subprocess.CompletedProcess:
+def run_ncpp(
+    *args: str,
+    timeout: float = 60,
+    stdin: bytes | None = None,
+    env: dict | None = None,
+    memory_mb: int | None = None,
+    cwd: str | None = None,
+) -> subprocess.CompletedProcess:
     """`python -m ncpp ARGS` with this checkout first on the path; `memory_mb` caps the
     address space (RLIMIT_AS), so a run past it fails instead of swapping."""
     environment = {**os.environ, "PYTHONPATH": str(ROOT), **(env or {})}
@@ -25,8 +31,15 @@ def run_ncpp(*args: str, timeout: float = 60, stdin: bytes | None = None, env: d
 
             resource.setrlimit(resource.RLIMIT_AS, (memory_mb << 20, memory_mb << 20))
 
-    return subprocess.run([PYTHON, "-m", "ncpp", *args], input=stdin, capture_output=True, timeout=timeout,
-                          env=environment, preexec_fn=limit, cwd=cwd)
+    return subprocess.run(
+        [PYTHON, "-m", "ncpp", *args],
+        input=stdin,
+        capture_output=True,
+        timeout=timeout,
+        env=environment,
+        preexec_fn=limit,
+        cwd=cwd,
+    )
 
 
 @pytest.fixture

@@ -19,11 +19,53 @@ from contextlib import redirect_stderr
 from pathlib import Path
 
 TOKENS = [
-    b"[", b"]", b"(", b")", b"#<a>", b"#1=", b"o100 while [1]\n", b"o100 endwhile\n", b"o100 repeat [1e6]\n",
-    b"o100 endrepeat\n", b"o<x> call\n", b"o<x> sub\n", b"G83 X1 Y1 Z-5 R1 Q0.001\n", b"G2 X1 Y1 R0.0001 ",
-    b"9" * 400, b"1e308", b"-0", b"\x00", b"\x1b[2J", b"\xff\xfe", b"\r", b"~\n", b";", b"%\n", b"N", b"=",
-    b"SIN(", b"ATAN2(1)", b"MAXVAL(1,2,3)", b"Q1 = -8 ^ 0,5\n", b"FN 4: Q1 = +6 DIV +2\n", b"REPEAT", b"GOTOB",
-    b"GOTO/", b"CIRCLE/", b"$$", b"= [", b"{", b"}", b'"', b"\n\n", b",", b"nan", b"inf", b"X", b"G", b"M98 P1 L9999\n",
+    b"[",
+    b"]",
+    b"(",
+    b")",
+    b"#<a>",
+    b"#1=",
+    b"o100 while [1]\n",
+    b"o100 endwhile\n",
+    b"o100 repeat [1e6]\n",
+    b"o100 endrepeat\n",
+    b"o<x> call\n",
+    b"o<x> sub\n",
+    b"G83 X1 Y1 Z-5 R1 Q0.001\n",
+    b"G2 X1 Y1 R0.0001 ",
+    b"9" * 400,
+    b"1e308",
+    b"-0",
+    b"\x00",
+    b"\x1b[2J",
+    b"\xff\xfe",
+    b"\r",
+    b"~\n",
+    b";",
+    b"%\n",
+    b"N",
+    b"=",
+    b"SIN(",
+    b"ATAN2(1)",
+    b"MAXVAL(1,2,3)",
+    b"Q1 = -8 ^ 0,5\n",
+    b"FN 4: Q1 = +6 DIV +2\n",
+    b"REPEAT",
+    b"GOTOB",
+    b"GOTO/",
+    b"CIRCLE/",
+    b"$$",
+    b"= [",
+    b"{",
+    b"}",
+    b'"',
+    b"\n\n",
+    b",",
+    b"nan",
+    b"inf",
+    b"X",
+    b"G",
+    b"M98 P1 L9999\n",
 ]
 
 
@@ -31,7 +73,7 @@ def mutate(data: bytes, rng: random.Random, others: list[bytes]) -> bytes:
     """`data` with one to four random mutations (bounded: at most 300 kB)."""
     for _ in range(rng.randint(1, 4)):
         data = rng.choice(_MUTATIONS)(data, rng, others)
-    return data[: 300_000]
+    return data[:300_000]
 
 
 def _flip(data: bytes, rng: random.Random, others: list[bytes]) -> bytes:

@@ -36,8 +36,23 @@ def test_a_terminated_run_removes_its_temporaries(tmp_path, sig, status):
     tmp = tmp_path / "tmp"
     tmp.mkdir()
     env = {**os.environ, "PYTHONPATH": str(ROOT), "TMPDIR": str(tmp)}
-    run = subprocess.Popen([sys.executable, "-m", "ncpp", "compensate", "--machine", str(MACHINE), "--jobs", "1",
-                            str(program), "-o", str(out)], env=env, stderr=subprocess.PIPE)
+    run = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "ncpp",
+            "compensate",
+            "--machine",
+            str(MACHINE),
+            "--jobs",
+            "1",
+            str(program),
+            "-o",
+            str(out),
+        ],
+        env=env,
+        stderr=subprocess.PIPE,
+    )
     deadline = time.monotonic() + 60
     while not list(tmp_path.glob(".out.nc.*.tmp")) and time.monotonic() < deadline:
         time.sleep(0.05)
@@ -104,10 +119,13 @@ def test_an_unwritable_output_names_its_file(ncpp, tmp_path):
     assert done.stderr.decode().strip() == f"ncpp: {full}: No space left on device"
 
 
-@pytest.mark.parametrize("text, where", [
-    ("o<s> sub\nG1 X1\n", "1:1: o<s> sub has no o<s> endsub"),
-    ("G1 X1 F100\n  o100 sub\nG1 X1\nM2\n", "2:3: o100 sub has no o100 endsub"),
-])
+@pytest.mark.parametrize(
+    "text, where",
+    [
+        ("o<s> sub\nG1 X1\n", "1:1: o<s> sub has no o<s> endsub"),
+        ("G1 X1 F100\n  o100 sub\nG1 X1\nM2\n", "2:3: o100 sub has no o100 endsub"),
+    ],
+)
 def test_an_open_subroutine_is_located(ncpp, tmp_path, text, where):
     program = tmp_path / "p.ngc"
     program.write_text(text)
@@ -142,9 +160,13 @@ def test_a_settings_file_that_never_ends_is_refused(ncpp, tmp_path, key):
         done = ncpp("compensate", "--machine", "/dev/zero", str(program), memory_mb=2048)
     else:
         (tmp_path / "ncpp.toml").write_text(f'machine = "{MACHINE}"\n{key} = "/dev/zero"\n')
-        done = ncpp(str(program), cwd=str(tmp_path), memory_mb=2048, env={"XDG_CONFIG_HOME": str(tmp_path / "none")})
+        done = ncpp(
+            str(program), cwd=str(tmp_path), memory_mb=2048, env={"XDG_CONFIG_HOME": str(tmp_path / "none")}
+        )
     assert done.returncode == 2 and b"Traceback" not in done.stderr
-    assert done.stderr.decode().startswith("/dev/zero:1:1: not a ") and "more than 64 MB" in done.stderr.decode()
+    assert (
+        done.stderr.decode().startswith("/dev/zero:1:1: not a ") and "more than 64 MB" in done.stderr.decode()
+    )
 
 
 @needs_machine
@@ -172,7 +194,9 @@ def test_a_subroutine_name_stays_inside_the_subroutine_path(ncpp, tmp_path):
         assert "77" not in done.stdout.decode() and "does not define" in done.stderr.decode()
     inner = subs / outside.relative_to("/")
     inner.mkdir(parents=True)
-    (inner / "evil.ngc").write_text(f"o<{outside / 'evil'}> sub\nG1 X33 F100\no<{outside / 'evil'}> endsub\nM2\n")
+    (inner / "evil.ngc").write_text(
+        f"o<{outside / 'evil'}> sub\nG1 X33 F100\no<{outside / 'evil'}> endsub\nM2\n"
+    )
     program.write_text(f"G21 F100\no<{outside / 'evil'}> call\nM2\n")
     done = ncpp("motion", "--subroutine-path", str(subs), str(program))
     assert "33" in done.stdout.decode(), done.stderr

@@ -37,8 +37,17 @@ def _files(folder: Path, *suffixes: str) -> list[Path]:
 
 
 def _seeds() -> dict[str, list[Path]]:
-    programs = [p for p in (*_files(CORPUS / "iso_gcode"), *_files(CORPUS / "heidenhain"), *_files(CORPUS / "sinumerik"),
-                            *_files(CORPUS / "malformed"), ROOT / "samples/programs/pocket.ngc") if p.stat().st_size < 400_000]
+    programs = [
+        p
+        for p in (
+            *_files(CORPUS / "iso_gcode"),
+            *_files(CORPUS / "heidenhain"),
+            *_files(CORPUS / "sinumerik"),
+            *_files(CORPUS / "malformed"),
+            ROOT / "samples/programs/pocket.ngc",
+        )
+        if p.stat().st_size < 400_000
+    ]
     return {
         "program": programs,
         "cl": _files(CORPUS / "apt_cldata"),
@@ -50,9 +59,18 @@ def _seeds() -> dict[str, list[Path]]:
 def _argv(kind: str, path: Path, out: Path, rng: random.Random) -> list[str]:
     machine, output = ["--machine", str(MACHINE)], ["-o", str(out)]
     if kind == "program":
-        return rng.choice([[str(path), *output], ["compensate", *machine, str(path), *output], ["motion", str(path)]])
+        return rng.choice(
+            [[str(path), *output], ["compensate", *machine, str(path), *output], ["motion", str(path)]]
+        )
     if kind == "cl":
-        return ["post", "--dialect", rng.choice(["linuxcnc", "heidenhain", "sinumerik"]), *machine, str(path), *output]
+        return [
+            "post",
+            "--dialect",
+            rng.choice(["linuxcnc", "heidenhain", "sinumerik"]),
+            *machine,
+            str(path),
+            *output,
+        ]
     if kind == "measurement":
         return ["analyze", str(path)]
     return ["compensate", "--machine", str(path), str(ROOT / "samples/programs/pocket.ngc"), *output]
@@ -69,7 +87,14 @@ def _cases(folder: Path, count: int, seed: int) -> list[dict]:
         source = seeds[kind][k]
         mutated = folder / f"case{n}{''.join(source.suffixes[-1:])}"
         mutated.write_bytes(mutate(texts[kind][k], rng, texts[kind]))
-        cases.append({"id": n, "kind": kind, "source": str(source), "argv": _argv(kind, mutated, folder / f"out{n}.nc", rng)})
+        cases.append(
+            {
+                "id": n,
+                "kind": kind,
+                "source": str(source),
+                "argv": _argv(kind, mutated, folder / f"out{n}.nc", rng),
+            }
+        )
     return cases
 
 
@@ -90,7 +115,9 @@ def _problems(case: dict, result: dict | None) -> list[str]:
     return found
 
 
-@pytest.mark.skipif(not CORPUS.is_dir() or not MACHINE.exists(), reason="corpus or shared machine file not found")
+@pytest.mark.skipif(
+    not CORPUS.is_dir() or not MACHINE.exists(), reason="corpus or shared machine file not found"
+)
 def test_fuzzed_inputs_are_refused_located_in_bounded_time_and_memory(tmp_path):
     cases = _cases(tmp_path, CASES, SEED)
     (tmp_path / "cases.json").write_text(json.dumps(cases))
@@ -100,17 +127,37 @@ def test_fuzzed_inputs_are_refused_located_in_bounded_time_and_memory(tmp_path):
     while len(results) < len(cases):  # (a worker that dies is restarted after the case it died on)
         todo = [c for c in cases if c["id"] not in results]
         (tmp_path / "todo.json").write_text(json.dumps(todo))
-        subprocess.run([sys.executable, "-m", "tests.hostile.fuzz", str(tmp_path / "todo.json"), str(MEMORY_MB),
-                        str(SECONDS_PER_CASE), str(results_file)], env=env, cwd=ROOT, timeout=60 + SECONDS_PER_CASE * len(todo),
-                       capture_output=True)
-        done = [json.loads(line) for line in results_file.read_text().splitlines()] if results_file.exists() else []
+        subprocess.run(
+            [
+                sys.executable,
+                "-m",
+                "tests.hostile.fuzz",
+                str(tmp_path / "todo.json"),
+                str(MEMORY_MB),
+                str(SECONDS_PER_CASE),
+                str(results_file),
+            ],
+            env=env,
+            cwd=ROOT,
+            timeout=60 + SECONDS_PER_CASE * len(todo),
+            capture_output=True,
+        )
+        done = (
+            [json.loads(line) for line in results_file.read_text().splitlines()]
+            if results_file.exists()
+            else []
+        )
         results.update((r["id"], r) for r in done)
         if len(results) < len(cases):
             died = next(c for c in cases if c["id"] not in results)
             results[died["id"]] = None  # type: ignore[assignment]
     failures = [(case, problem) for case in cases for problem in _problems(case, results[case["id"]])]
     peak = max((r["peak_kb"] for r in results.values() if r), default=0)
-    print(f"fuzz: {len(cases)} cases from seed {SEED}, {len(failures)} problems, worker peak {peak // 1024} MB")
-    report = "\n\n".join(f"case {c['id']} ({c['kind']}, from {c['source']}): ncpp {' '.join(c['argv'])}\n{p}"
-                         for c, p in failures[:12])
+    print(
+        f"fuzz: {len(cases)} cases from seed {SEED}, {len(failures)} problems, worker peak {peak // 1024} MB"
+    )
+    report = "\n\n".join(
+        f"case {c['id']} ({c['kind']}, from {c['source']}): ncpp {' '.join(c['argv'])}\n{p}"
+        for c, p in failures[:12]
+    )
     assert not failures, f"{len(failures)} of {len(cases)} cases:\n{report}"

@@ -47,11 +47,14 @@ def test_fifty_megabytes_of_one_line_are_refused_in_bounded_time(ncpp, tmp_path)
     assert done.stderr.decode().startswith(f"{program}:1:257: block too long")
 
 
-@pytest.mark.parametrize("dialect, text", [
-    ("iso", "G1 X{open}1{close}"),
-    ("sinumerik", "R1={open}1{close}"),
-    ("heidenhain", "1 Q1 = {open}1{close}"),
-])
+@pytest.mark.parametrize(
+    "dialect, text",
+    [
+        ("iso", "G1 X{open}1{close}"),
+        ("sinumerik", "R1={open}1{close}"),
+        ("heidenhain", "1 Q1 = {open}1{close}"),
+    ],
+)
 def test_brackets_nest_to_one_bound_in_every_dialect(dialect, text):
     opening, closing = ("[", "]") if dialect == "iso" else ("(", ")")
     deep = MAX_NESTING + 1

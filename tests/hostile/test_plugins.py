@@ -46,7 +46,12 @@ def test_the_linuxcnc_filter_imports_nothing_from_the_working_folder(tmp_path):
         pytest.skip("no shared machine file")
     env = {**os.environ, "NCPP_PYTHON": sys.executable, "NCPP_MACHINE": str(machine), "NCPP_CACHE": ""}
     env.pop("PYTHONPATH", None)
-    done = subprocess.run([str(ROOT / "plugins/linuxcnc/ncpp-linuxcnc-filter"), str(program)], cwd=tmp_path,
-                          capture_output=True, env=env, timeout=120)
+    done = subprocess.run(
+        [str(ROOT / "plugins/linuxcnc/ncpp-linuxcnc-filter"), str(program)],
+        cwd=tmp_path,
+        capture_output=True,
+        env=env,
+        timeout=120,
+    )
     assert done.returncode == 0, done.stderr
     assert not (tmp_path / "ran").exists()

@@ -25,22 +25,33 @@ print("PEAK_KB", resource.getrusage(resource.RUSAGE_SELF).ru_maxrss, file=sys.st
 
 def peak_kb(*args: str) -> int:
     """The peak resident memory of `ncpp ARGS` (its own process)."""
-    done = subprocess.run([sys.executable, "-c", _PEAK, *args], capture_output=True, text=True, timeout=300,
-                          env={**os.environ, "PYTHONPATH": str(ROOT)})
+    done = subprocess.run(
+        [sys.executable, "-c", _PEAK, *args],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env={**os.environ, "PYTHONPATH": str(ROOT)},
+    )
     assert "Traceback" not in done.stderr, done.stderr
     return int(done.stderr.rsplit("PEAK_KB", 1)[1])
 
 
 @pytest.mark.skipif(not MACHINE.exists(), reason="no shared machine file")
-@pytest.mark.parametrize("body, times", [
-    ("G83 X10 Y10 Z-20 R2 Q0.01\nG80\n", 40),  # a canned cycle of 2000 pecks a pass
-    ("G1 X1 Y1\nG1 X0 Y0\n", 40_000),
-])
+@pytest.mark.parametrize(
+    "body, times",
+    [
+        ("G83 X10 Y10 Z-20 R2 Q0.01\nG80\n", 40),  # a canned cycle of 2000 pecks a pass
+        ("G1 X1 Y1\nG1 X0 Y0\n", 40_000),
+    ],
+)
 def test_compensating_a_loop_takes_the_same_memory_however_often_it_runs(tmp_path, body, times):
     def program(times: int) -> str:
         path = tmp_path / f"loop{times}.ngc"
         path.write_text(f"G21 G17 G90 F200\nG0 X0 Y0 Z5\no100 repeat [{times}]\n{body}o100 endrepeat\nM2\n")
         return str(path)
 
-    few, many = (peak_kb("compensate", "--machine", str(MACHINE), program(n), "-o", str(tmp_path / "out.nc")) for n in (2, times))
+    few, many = (
+        peak_kb("compensate", "--machine", str(MACHINE), program(n), "-o", str(tmp_path / "out.nc"))
+        for n in (2, times)
+    )
     assert many - few < 12_000, (few, many)  # (each pass kept: 1.7 MB more a pass of the cycle)

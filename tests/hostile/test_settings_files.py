@@ -23,17 +23,21 @@ def test_brackets_in_strings_and_comments_are_not_nesting():
 
 def test_a_metadata_number_is_refused_at_its_line_and_cut_short(tmp_path):
     path = tmp_path / "laser.csv"
-    path.write_text("# instrument: laser\n# axis: X\n# quantity: position\n# feed_mm_min: 1" + "#1=" * 5000 + "\n"
-                    "target_mm,run,direction,deviation_um\n0,1,+,0\n10,1,+,1\n")
+    path.write_text(
+        "# instrument: laser\n# axis: X\n# quantity: position\n# feed_mm_min: 1" + "#1=" * 5000 + "\n"
+        "target_mm,run,direction,deviation_um\n0,1,+,0\n10,1,+,1\n"
+    )
     with pytest.raises(NcppError) as caught:
-        read_measurement(path).feed_mm_min
+        _ = read_measurement(path).feed_mm_min
     message = str(caught.value)
     assert message.startswith(f"{path}:4:1: feed_mm_min: '1#1=#1=") and len(message) < len(str(path)) + 100
 
 
 def test_a_measurement_problem_of_the_whole_file_points_at_its_instrument_line(ncpp, tmp_path):
     path = tmp_path / "m.csv"
-    path.write_text("# a comment\n# instrument: level\x1b[2J\n# axis: X\ntarget_mm,run,direction,deviation_um\n0,1,+,0\n")
+    path.write_text(
+        "# a comment\n# instrument: level\x1b[2J\n# axis: X\ntarget_mm,run,direction,deviation_um\n0,1,+,0\n"
+    )
     done = ncpp("analyze", str(path))
     assert done.returncode == 2 and b"\x1b" not in done.stderr
     assert done.stderr.decode().startswith(f"{path}:2:1: ")

@@ -32,7 +32,10 @@ X_TARGETS = np.arange(250.0, 551.0, 25.0)  # inside the tested X range
 
 
 def measured() -> list:
-    return [predict_ballbar(TRUE, p, r, c, step_deg=1.0, noise_um=NOISE, seed=i) for i, (p, r, c) in enumerate(SETUPS)]
+    return [
+        predict_ballbar(TRUE, p, r, c, step_deg=1.0, noise_um=NOISE, seed=i)
+        for i, (p, r, c) in enumerate(SETUPS)
+    ]
 
 
 @pytest.fixture(scope="module")
@@ -136,7 +139,9 @@ def test_one_xy_plane_lists_what_it_cannot_separate_instead_of_inventing():
 
 
 def test_reversal_from_one_direction_is_not_separable():
-    ccw = predict_ballbar(TRUE, "XY", 150.0, (400, 350, 350), step_deg=1.0, noise_um=NOISE, seed=3, directions="CCW")
+    ccw = predict_ballbar(
+        TRUE, "XY", 150.0, (400, 350, 350), step_deg=1.0, noise_um=NOISE, seed=3, directions="CCW"
+    )
     _, fit = identify([ccw], BASE)
     reversal = [g for g in fit.unobservable if any("reversal" in n for n in g.components)]
     assert reversal and all("both directions" in g.hint or len(g.components) > 1 for g in reversal)

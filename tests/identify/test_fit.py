@@ -12,7 +12,14 @@ from ncpp.errors import NcppError
 from ncpp.identify import fit_machine, fit_residuals
 from ncpp.instruments.analysis import analyze
 from ncpp.instruments.files import read_measurement, write_measurement
-from ncpp.instruments.forward import ANGLE_COMPONENTS, predict_ballbar, predict_comparator, predict_grid, predict_laser, predict_level
+from ncpp.instruments.forward import (
+    ANGLE_COMPONENTS,
+    predict_ballbar,
+    predict_comparator,
+    predict_grid,
+    predict_laser,
+    predict_level,
+)
 from ncpp.machine import Machine, Polynomial, Table, load_machine
 from ncpp.machine.effects import Backlash
 
@@ -24,7 +31,9 @@ EAX = Polynomial((0.0, -1.5e-8))
 
 
 def true_machine() -> Machine:
-    return Machine(name="true", chain="XYFZ", tool=(0, 0, -100), components={"EXX": EXX, "EBX": EBX, "EAX": EAX})
+    return Machine(
+        name="true", chain="XYFZ", tool=(0, 0, -100), components={"EXX": EXX, "EBX": EBX, "EAX": EAX}
+    )
 
 
 def test_abbe_offset_of_the_optic_is_removed_with_the_pitch_file():
@@ -78,7 +87,10 @@ def test_fitted_sample_machine_predicts_the_same_ballbar():
         fixed = {a: v for a, v in middle.items() if a != axis}
         quantities = ["position"] + [f"straightness_{d.lower()}" for d in "XYZ" if d != axis]
         quantities += [q for (a, q) in ANGLE_COMPONENTS if a == axis and q != "roll"]
-        files += [predict_laser(true, axis, q, targets, fixed=fixed, offset_mm=(0, 0, 120), runs=2) for q in quantities]
+        files += [
+            predict_laser(true, axis, q, targets, fixed=fixed, offset_mm=(0, 0, 120), runs=2)
+            for q in quantities
+        ]
         files.append(predict_level(true, axis, targets, quantity="roll", fixed=fixed))
     fitted = fit_machine(files, base=true.without_errors())
     assert max(fit_residuals(fitted, files).values()) < 1e-3
@@ -103,7 +115,15 @@ def test_files_the_fit_cannot_use():
 
 def test_fit_and_predict_commands(tmp_path):
     samples = ROOT / "samples/measurements"
-    files = [str(samples / n) for n in ("laser_X_position.csv", "laser_X_pitch.csv", "laser_X_straightness_y.csv", "level_X_roll.csv")]
+    files = [
+        str(samples / n)
+        for n in (
+            "laser_X_position.csv",
+            "laser_X_pitch.csv",
+            "laser_X_straightness_y.csv",
+            "level_X_roll.csv",
+        )
+    ]
     out = tmp_path / "fitted.toml"
     assert main(["fit", *files, "--chain", "XZFY", "-o", str(out)]) == 0
     machine = load_machine(out)
@@ -127,6 +147,16 @@ def test_command_errors_are_messages(tmp_path, capsys):
     write_measurement(predict_grid(true_machine(), "XY", "circle", (400, 0, 0), 100, step_deg=30.0), bad)
     assert main(["fit", str(bad), "-o", str(tmp_path / "m.toml")]) == 2
     assert "grid" in capsys.readouterr().err
-    args = ["predict", "--machine", str(ROOT / "samples/machines/hr5b.toml"), "--instrument", "laser", "--targets", "5:1", "-o", str(tmp_path / "o.csv")]
+    args = [
+        "predict",
+        "--machine",
+        str(ROOT / "samples/machines/hr5b.toml"),
+        "--instrument",
+        "laser",
+        "--targets",
+        "5:1",
+        "-o",
+        str(tmp_path / "o.csv"),
+    ]
     assert main(args) == 2
     assert "--targets" in capsys.readouterr().err

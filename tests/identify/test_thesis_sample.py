@@ -19,7 +19,12 @@ def test_make_reproduces_the_committed_comparison(tmp_path):
         module.make(tmp_path)
     finally:
         os.chdir(here)
-    for name in ("comparison.md", "fitted_from_laser.toml", "ballbar_XY_measured.csv", "ballbar_XY_predicted_from_laser.csv"):
+    for name in (
+        "comparison.md",
+        "fitted_from_laser.toml",
+        "ballbar_XY_measured.csv",
+        "ballbar_XY_predicted_from_laser.csv",
+    ):
         assert (tmp_path / name).read_text() == (THESIS / name).read_text(), name
     table = (tmp_path / "comparison.md").read_text()
     # The laser model lacks the servo mismatch the measured trace has: the gap shows it.

@@ -27,21 +27,38 @@ def test_json_for_one_laser_file(samples_dir, tmp_path, capsys):
 
 def test_json_for_several_files_is_a_list(samples_dir, tmp_path):
     out = tmp_path / "all.json"
-    files = [samples_dir / "ballbar_XY_R150.csv", samples_dir / "comparator_X.csv", samples_dir / "level_X_roll.csv"]
+    files = [
+        samples_dir / "ballbar_XY_R150.csv",
+        samples_dir / "comparator_X.csv",
+        samples_dir / "level_X_roll.csv",
+    ]
     assert main(["analyze", *map(str, files), "--json", str(out)]) == 0
     ballbar, comparator, level = json.loads(out.read_text())
     assert ISO230_4 <= set(ballbar)
-    for key in ("squareness_um_per_m", "scale_mismatch_um_per_m", "servo_mismatch_ms", "backlash_X_um", "backlash_Y_um", "reversal_spike_X_um"):
+    for key in (
+        "squareness_um_per_m",
+        "scale_mismatch_um_per_m",
+        "servo_mismatch_ms",
+        "backlash_X_um",
+        "backlash_Y_um",
+        "reversal_spike_X_um",
+    ):
         assert key in ballbar
     assert ballbar["squareness_um_per_m"] == pytest.approx(40.0, abs=1.0)  # the sample was made with 40
-    assert ballbar["backlash_X_um"] == pytest.approx(4.0, abs=0.3) and ballbar["servo_mismatch_ms"] == pytest.approx(0.5, abs=0.05)
+    assert ballbar["backlash_X_um"] == pytest.approx(4.0, abs=0.3) and ballbar[
+        "servo_mismatch_ms"
+    ] == pytest.approx(0.5, abs=0.05)
     assert ISO230_2 <= set(comparator) and "straightness_um" in comparator
     assert level["range_um_per_m"] > 0
 
 
 def test_unidirectional_ballbar_json_has_nulls(tmp_path):
     a = np.arange(0.0, 360.0, 5.0)
-    m = make_measurement("ballbar", {"radius_mm": 100}, {"direction": ["CW"] * a.size, "angle_deg": a, "deviation_um": np.sin(np.radians(2 * a))})
+    m = make_measurement(
+        "ballbar",
+        {"radius_mm": 100},
+        {"direction": ["CW"] * a.size, "angle_deg": a, "deviation_um": np.sin(np.radians(2 * a))},
+    )
     path = tmp_path / "cw.csv"
     from ncpp.instruments.files import write_measurement
 
@@ -60,7 +77,9 @@ def test_plot_writes_a_png_for_every_kind(samples_dir, tmp_path):
 
 def test_bad_file_prints_location_not_traceback(tmp_path, capsys):
     bad = tmp_path / "bad.csv"
-    bad.write_text("# instrument: ballbar\n# radius_mm: 150\ndirection,angle_deg,deviation_um\nCCW,0,0\nCCW,12,oops\n")
+    bad.write_text(
+        "# instrument: ballbar\n# radius_mm: 150\ndirection,angle_deg,deviation_um\nCCW,0,0\nCCW,12,oops\n"
+    )
     assert main(["analyze", str(bad)]) == 2
     assert f"{bad}:5:8:" in capsys.readouterr().err
 
@@ -73,7 +92,11 @@ def test_profiles_of_straightness_angle_and_level(samples_dir):
     assert pitch["range_urad"] == pytest.approx(12.0, abs=1.5)
     # Level pitch: a constant 10 µm/m slope over 500 mm is a straight tilted line, no straightness.
     x = np.linspace(0, 500, 11)
-    level = analyze(make_measurement("level", {"quantity": "pitch"}, {"position_mm": x, "inclination_um_per_m": np.full(11, 10.0)}))
+    level = analyze(
+        make_measurement(
+            "level", {"quantity": "pitch"}, {"position_mm": x, "inclination_um_per_m": np.full(11, 10.0)}
+        )
+    )
     assert level.figures["integrated_straightness_um"] == pytest.approx(0.0, abs=1e-9)
     assert level.profiles["height"].value[-1] == pytest.approx(5.0)  # 10 µm/m × 0.5 m
 

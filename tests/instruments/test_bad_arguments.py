@@ -120,12 +120,24 @@ def test_predict_laser_options(args, expected, tmp_path, capsys):
 
 
 def test_predict_from_files_with_a_bad_chain(tmp_path, capsys):
-    argv = ["predict", "--from", LASER, "--chain", "QQQ", "--instrument", "ballbar", "-o", str(tmp_path / "bb.csv")]
+    argv = [
+        "predict",
+        "--from",
+        LASER,
+        "--chain",
+        "QQQ",
+        "--instrument",
+        "ballbar",
+        "-o",
+        str(tmp_path / "bb.csv"),
+    ]
     assert "ncpp predict: chain 'QQQ'" in refused(argv, capsys)
 
 
 # -- fit and diagnose ------------------------------------------------------------------------
-@pytest.mark.parametrize("args, option", [(["--knots", "5000"], "--knots 5000"), (["--smoothing", "-1"], "--smoothing")])
+@pytest.mark.parametrize(
+    "args, option", [(["--knots", "5000"], "--knots 5000"), (["--smoothing", "-1"], "--smoothing")]
+)
 def test_fit_ballbar_options(args, option, tmp_path, capsys):
     out = tmp_path / "m.toml"
     assert option in refused(["fit", BALLBAR, "--base", MACHINE, *args, "-o", str(out)], capsys)
@@ -138,7 +150,9 @@ def test_fit_says_a_given_smoothing_is_given(tmp_path, capsys):
 
 
 def test_fit_refuses_a_smoothing_that_diverges(tmp_path, capsys):
-    err = refused(["fit", BALLBAR, "--base", MACHINE, "--smoothing", "1e-12", "-o", str(tmp_path / "m.toml")], capsys)
+    err = refused(
+        ["fit", BALLBAR, "--base", MACHINE, "--smoothing", "1e-12", "-o", str(tmp_path / "m.toml")], capsys
+    )
     assert "diverged" in err and "--smoothing" in err
 
 
@@ -146,12 +160,16 @@ def test_fit_refuses_a_smoothing_that_diverges(tmp_path, capsys):
 def test_ballbar_of_too_few_points(rows, tmp_path, capsys):
     path = first_rows(tmp_path, "ballbar_XY_R150.csv", rows)
     for command in (["fit", path, "-o", str(tmp_path / "m.toml")], ["diagnose", "--machine", MACHINE, path]):
-        assert f"{path}:1:1: a circular test needs at least three points per direction" in refused(command, capsys)
+        assert f"{path}:1:1: a circular test needs at least three points per direction" in refused(
+            command, capsys
+        )
 
 
 def test_fit_table_of_one_target(tmp_path, capsys):
     path = first_rows(tmp_path, "laser_X_position.csv", 1)
-    assert f"{path}:1:1: a table needs readings at two or more targets" in refused(["fit", path, "-o", str(tmp_path / "m.toml")], capsys)
+    assert f"{path}:1:1: a table needs readings at two or more targets" in refused(
+        ["fit", path, "-o", str(tmp_path / "m.toml")], capsys
+    )
 
 
 def test_diagnose_a_circle_of_less_than_a_micron(tmp_path, capsys):
@@ -169,7 +187,14 @@ def test_diagnose_alpha(capsys):
 
 # -- export-table ----------------------------------------------------------------------------
 @pytest.mark.parametrize("fmt", ["linuxcnc", "fanuc", "sinumerik", "heidenhain"])
-@pytest.mark.parametrize("args, option", [(["--spacing", "nan"], "--spacing"), (["--spacing", "0"], "--spacing"), (["--reference", "nan"], "--reference")])
+@pytest.mark.parametrize(
+    "args, option",
+    [
+        (["--spacing", "nan"], "--spacing"),
+        (["--spacing", "0"], "--spacing"),
+        (["--reference", "nan"], "--reference"),
+    ],
+)
 def test_export_options(fmt, args, option, tmp_path, capsys):
     out = tmp_path / "table"
     argv = ["export-table", "--machine", MACHINE, "--axis", "X", "--format", fmt, *args, "-o", str(out)]
@@ -194,12 +219,31 @@ def test_export_error_beyond_the_machines_correction_limit(tmp_path, capsys):
 @pytest.mark.parametrize("fmt", ["linuxcnc", "fanuc", "sinumerik", "heidenhain"])
 def test_export_spacing_longer_than_the_travel(fmt, capsys):
     """--spacing 1e308 was an OverflowError in the FANUC writer."""
-    err = refused(["export-table", "--machine", MACHINE, "--axis", "X", "--format", fmt, "--spacing", "1e308"], capsys)
+    err = refused(
+        ["export-table", "--machine", MACHINE, "--axis", "X", "--format", fmt, "--spacing", "1e308"], capsys
+    )
     assert "--spacing 1e+308 mm is longer than the X travel, 0 to 800 mm" in err
 
 
 @pytest.mark.parametrize("fmt", ["fanuc", "sinumerik"])
 def test_export_reference_outside_the_travel_is_moved_onto_it_with_a_note(fmt, tmp_path, capsys):
     out = tmp_path / "table"
-    assert main(["export-table", "--machine", MACHINE, "--axis", "X", "--format", fmt, "--reference", "1e308", "-o", str(out)]) == 0
+    assert (
+        main(
+            [
+                "export-table",
+                "--machine",
+                MACHINE,
+                "--axis",
+                "X",
+                "--format",
+                fmt,
+                "--reference",
+                "1e308",
+                "-o",
+                str(out),
+            ]
+        )
+        == 0
+    )
     assert "reference position 1e+308 mm lies outside the table range; 800 mm used" in capsys.readouterr().err

@@ -47,7 +47,12 @@ def test_laser_file_columns_and_metadata():
 
 def test_crlf_blank_lines_and_no_trailing_newline_read_the_same():
     plain = parse_measurement(LASER)
-    messy = LASER.replace("\n", "\r\n").replace("# axis", "\r\n# axis").replace("50,1,-", "\r\n\r\n50,1,-").rstrip("\r\n")
+    messy = (
+        LASER.replace("\n", "\r\n")
+        .replace("# axis", "\r\n# axis")
+        .replace("50,1,-", "\r\n\r\n50,1,-")
+        .rstrip("\r\n")
+    )
     assert parse_measurement(messy) == plain
 
 
@@ -66,7 +71,14 @@ def test_contract_example_with_remarks_is_understood():
 
 def test_round_trip_of_every_sample(samples_dir, tmp_path):
     files = sorted(samples_dir.glob("*.csv"))
-    assert {read_measurement(f).instrument for f in files} == {"laser", "comparator", "level", "ballbar", "grid", "cutting"}
+    assert {read_measurement(f).instrument for f in files} == {
+        "laser",
+        "comparator",
+        "level",
+        "ballbar",
+        "grid",
+        "cutting",
+    }
     for f in files:
         m = read_measurement(f)
         write_measurement(m, tmp_path / f.name)
@@ -82,12 +94,20 @@ def test_samples_are_reproducible(generator, samples_dir, tmp_path):
 
 def test_round_trip_keeps_exact_floats(tmp_path):
     values = np.array([0.1, 1 / 3, -2.5e-7, 12345.678901234567, 0.0])
-    m = make_measurement("level", {"axis": "Y", "quantity": "pitch", "note": "x: y"}, {"position_mm": np.arange(5.0), "inclination_um_per_m": values})
+    m = make_measurement(
+        "level",
+        {"axis": "Y", "quantity": "pitch", "note": "x: y"},
+        {"position_mm": np.arange(5.0), "inclination_um_per_m": values},
+    )
     write_measurement(m, tmp_path / "l.csv")
     back = read_measurement(tmp_path / "l.csv")
     assert back == m and back.meta["note"] == "x: y"
     np.testing.assert_array_equal(back["inclination_um_per_m"], values)
-    assert m != make_measurement("level", {"axis": "Y", "quantity": "pitch"}, {"position_mm": np.arange(5.0), "inclination_um_per_m": values})
+    assert m != make_measurement(
+        "level",
+        {"axis": "Y", "quantity": "pitch"},
+        {"position_mm": np.arange(5.0), "inclination_um_per_m": values},
+    )
 
 
 def test_write_is_atomic_and_leaves_no_temporary(tmp_path):
@@ -99,7 +119,9 @@ def test_write_is_atomic_and_leaves_no_temporary(tmp_path):
 
 
 def test_own_instruments_grid_and_cutting():
-    grid = parse_measurement("# instrument: grid\n# plane: YZ\ns_mm,y_mm,z_mm,dev_y_um,dev_z_um\n0,10,0,0.5,-0.2\n")
+    grid = parse_measurement(
+        "# instrument: grid\n# plane: YZ\ns_mm,y_mm,z_mm,dev_y_um,dev_z_um\n0,10,0,0.5,-0.2\n"
+    )
     assert grid.plane_axes == ("Y", "Z") and grid["dev_z_um"][0] == -0.2
     cut = parse_measurement("# instrument: cutting\n# radius_mm: 50\nangle_deg,radius_dev_um\n0,1.5\n90,-1\n")
     assert cut.radius_mm == 50 and list(cut["radius_dev_um"]) == [1.5, -1.0]
@@ -118,10 +140,25 @@ def test_own_instruments_grid_and_cutting():
         (LASER.replace("position", "speed"), 3, 1, "quantity"),
         (LASER.replace("0,0,120", "0,120"), 5, 1, "three numbers"),
         (LASER.replace("Y=-250", "Y-250"), 4, 1, "AXIS=value"),
-        ("# instrument: ballbar\n# radius_mm: 150\ndirection,angle_deg,deviation_um\nCCW,0,0\nCW,360,0.1\n", 5, 4, "[0, 360)"),
-        ("# instrument: ballbar\n# radius_mm: 150\ndirection,angle_deg,deviation_um\nCCW,0,0\n+,10,0.1\n", 5, 1, "CW or CCW"),
+        (
+            "# instrument: ballbar\n# radius_mm: 150\ndirection,angle_deg,deviation_um\nCCW,0,0\nCW,360,0.1\n",
+            5,
+            4,
+            "[0, 360)",
+        ),
+        (
+            "# instrument: ballbar\n# radius_mm: 150\ndirection,angle_deg,deviation_um\nCCW,0,0\n+,10,0.1\n",
+            5,
+            1,
+            "CW or CCW",
+        ),
         ("# instrument: ballbar\ndirection,angle_deg,deviation_um\nCCW,0,0\n", 2, 1, "radius_mm"),
-        ("# instrument: laser\n# quantity: pitch\ntarget_mm,run,direction,deviation_um\n0,1,+,0\n", 3, 1, "deviation_urad"),
+        (
+            "# instrument: laser\n# quantity: pitch\ntarget_mm,run,direction,deviation_um\n0,1,+,0\n",
+            3,
+            1,
+            "deviation_urad",
+        ),
         ("# instrument: comparator\ntarget_mm,run,direction\n0,1,+\n", 2, 1, "lacks column(s) linear_um"),
         ("# instrument: laser\n", 1, None, "no CSV header"),
     ],

@@ -73,7 +73,11 @@ def test_single_run_leaves_statistical_figures_undefined():
 
 def test_comparator_uses_the_linear_column():
     t, d, x = rows(UP, DOWN)
-    m = make_measurement("comparator", {"axis": "X"}, {"target_mm": t, "run": [1] * len(t), "direction": d, "linear_um": x, "transverse_um": x * 100})
+    m = make_measurement(
+        "comparator",
+        {"axis": "X"},
+        {"target_mm": t, "run": [1] * len(t), "direction": d, "linear_um": x, "transverse_um": x * 100},
+    )
     assert evaluate_measurement(m).figures()["A"] == pytest.approx(11.0)
 
 

@@ -76,7 +76,9 @@ def test_pure_squareness_gives_half_sR_sin2theta(generator):
     # First principles: δx = s·y on a circle of radius R reads ΔR = (sR/2)·sin 2θ.
     s = 50e-6
     angle, dev, _ = generator.simulate_circle(150.0, "CCW", squareness_um_per_m=50.0)
-    np.testing.assert_allclose(dev, s * 150.0 * 1000 / 2 * np.sin(np.radians(2 * angle)), atol=1e-3)  # + (sy)²/2R
+    np.testing.assert_allclose(
+        dev, s * 150.0 * 1000 / 2 * np.sin(np.radians(2 * angle)), atol=1e-3
+    )  # + (sy)²/2R
 
 
 @pytest.mark.parametrize("value", [40.0, -25.0])
@@ -159,7 +161,9 @@ def test_partial_arcs_compare_only_where_both_were_measured(generator):
 
 def test_cyclic_error_is_found_with_its_lead(generator):
     rng = np.random.default_rng(3)
-    f = diagnose(generator, cyclic_um=(0.0, 1.5), cyclic_period_mm=16.0, backlash_um=(2.0, 2.0), noise_um=0.2, rng=rng)
+    f = diagnose(
+        generator, cyclic_um=(0.0, 1.5), cyclic_period_mm=16.0, backlash_um=(2.0, 2.0), noise_um=0.2, rng=rng
+    )
     assert f["cyclic_Y_um"] == pytest.approx(1.5, abs=0.15) and f["cyclic_Y_period_mm"] == 16.0
     assert f["cyclic_X_um"] is None  # nothing there, nothing reported
     assert f["backlash_X_um"] == pytest.approx(2.0, abs=0.2)

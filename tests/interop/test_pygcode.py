@@ -86,7 +86,17 @@ def test_block_to_pygcode_and_back_keeps_every_word_value(blocks):
 
 @pytest.mark.parametrize(
     "text",
-    ["X[#1+2]", "#1=5", "G1 X1 ,C2.", "N10.5 G1 X1", "M3 $1 S100", "G1 @1 ^90", "/G1 X1", "o100 sub", "OCIRCLE"],
+    [
+        "X[#1+2]",
+        "#1=5",
+        "G1 X1 ,C2.",
+        "N10.5 G1 X1",
+        "M3 $1 S100",
+        "G1 @1 ^90",
+        "/G1 X1",
+        "o100 sub",
+        "OCIRCLE",
+    ],
 )
 def test_blocks_pygcode_cannot_represent_give_none(text):
     assert to_pygcode(LineParser().parse(text)) is None

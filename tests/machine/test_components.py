@@ -11,7 +11,9 @@ def test_there_are_21_components_plus_3_squarenesses():
     assert len(COMPONENTS) == 18  # 6 per axis; the 3 squarenesses are constants
     assert canonical_name("Yxy") == "EXY" and canonical_name("xy") == "EXY"
     assert canonical_name("cx") == "ECX" and canonical_name("Zbz") == "EBZ"
-    assert canonical_name("kxy") == "C0Y" and canonical_name("kzx") == "B0Z" and canonical_name("kyz") == "A0Z"
+    assert (
+        canonical_name("kxy") == "C0Y" and canonical_name("kzx") == "B0Z" and canonical_name("kyz") == "A0Z"
+    )
     assert canonical_name("exx") == "EXX"
     assert all(canonical_name(t) == iso for t, iso in THESIS_NAMES.items())
     with pytest.raises(ValueError):

@@ -31,7 +31,12 @@ def bumpy(hr5b):
     x, z = np.arange(0.0, 801.0, 50.0), np.arange(0.0, 701.0, 50.0)
     components = dict(hr5b.components)
     components["EYX"] = Table(tuple(x), tuple(rng.normal(0.0, 0.02, len(x))), interpolation="smooth")
-    components["EBZ"] = Table(tuple(z), tuple(rng.normal(0.0, 4e-5, len(z))), tuple(rng.normal(0.0, 4e-5, len(z))), interpolation="smooth")
+    components["EBZ"] = Table(
+        tuple(z),
+        tuple(rng.normal(0.0, 4e-5, len(z))),
+        tuple(rng.normal(0.0, 4e-5, len(z))),
+        interpolation="smooth",
+    )
     return hr5b.replace(components=components)
 
 
@@ -59,7 +64,11 @@ def test_the_bound_holds_along_random_segments(which, request):
     tools[::3, 2] = rng.uniform(-150.0, 150.0, len(tools[::3]))  # some with a tool length offset
     kappa = bound(start, end, tools)
     assert np.isfinite(kappa).all()
-    ratios = [_bow(machine, start[i], end[i], np.sign(end[i] - start[i]), tools[i]) / (length[i] ** 2 / 8 * kappa[i]) for i in range(n)]
+    ratios = [
+        _bow(machine, start[i], end[i], np.sign(end[i] - start[i]), tools[i])
+        / (length[i] ** 2 / 8 * kappa[i])
+        for i in range(n)
+    ]
     assert max(ratios) <= 1.0
     assert max(ratios) > 0.02  # (a bound that says something)
 
@@ -68,13 +77,18 @@ def test_no_bound_where_the_error_may_not_be_smooth(hr5b):
     x = (0.0, 400.0, 800.0)
     linear = dict(hr5b.components, EYX=Table(x, (0.0, 0.005, 0.0), interpolation="linear"))
     assert hr5b.replace(components=linear).bow_bound is None  # a kink at 400
-    assert hr5b.replace(effects=(Scale(axis="X", um_per_m=10.0),)).bow_bound is None  # a static effect the bound does not know
+    assert (
+        hr5b.replace(effects=(Scale(axis="X", um_per_m=10.0),)).bow_bound is None
+    )  # a static effect the bound does not know
     assert load_machine(ROOT / "samples/machines/valmet.toml").bow_bound is None
 
 
 def test_outside_a_table_there_is_no_bound(hr5b):
     bound = hr5b.bow_bound
-    inside, outside = np.array([[100.0, 100.0, 100.0]]), np.array([[900.0, 100.0, 100.0]])  # X's tables end at 800
+    inside, outside = (
+        np.array([[100.0, 100.0, 100.0]]),
+        np.array([[900.0, 100.0, 100.0]]),
+    )  # X's tables end at 800
     assert np.isfinite(bound(inside, inside + 10.0))
     assert bound(inside, outside) == np.inf
 
@@ -86,7 +100,9 @@ def test_lines_the_bound_keeps_whole_are_those_the_samples_keep_whole(bumpy):
     u = rng.normal(size=(400, 3))
     u /= np.linalg.norm(u, axis=1)[:, None]
     end = np.clip(start + u * rng.uniform(1.0, 80.0, (400, 1)), 0.0, [800.0, 700.0, 700.0])
-    lines = [Line(tuple(a), tuple(b), False, 500.0, block, context) for a, b in zip(start.tolist(), end.tolist())]
+    lines = [
+        Line(tuple(a), tuple(b), False, 500.0, block, context) for a, b in zip(start.tolist(), end.tolist())
+    ]
     ctx = PassContext(model=MachineMap(bumpy), tolerance=0.001, directional=True)
     sampled = _with_rows(lines, ctx)
     bounded = _with_rows(lines, ctx, bumpy.bow_bound)

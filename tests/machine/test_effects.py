@@ -21,7 +21,9 @@ from ncpp.machine.effects import (
 def there_and_back(axis=0, length=100.0, step=0.5) -> Trajectory:
     end = np.zeros(3)
     end[axis] = length
-    return Trajectory.line(np.zeros(3), end, 1000.0, step).then(Trajectory.line(end, np.zeros(3), 1000.0, step))
+    return Trajectory.line(np.zeros(3), end, 1000.0, step).then(
+        Trajectory.line(end, np.zeros(3), 1000.0, step)
+    )
 
 
 def radial(traj: Trajectory, dev: np.ndarray, centre) -> np.ndarray:
@@ -34,13 +36,13 @@ def test_backlash_is_a_play_operator():
     traj = there_and_back()
     d = Backlash("X", 6.0).apply(traj)[:, 0] * 1e3
     n = len(traj) // 2
-    assert np.allclose(d[5:n - 1], -3.0)  # lags half the play behind going +
+    assert np.allclose(d[5 : n - 1], -3.0)  # lags half the play behind going +
     assert np.allclose(d[n + 20 :], 3.0)  # and the other half going −
     # after the reversal it stands still: lost motion of exactly b
     x = traj.positions[:, 0]
     actual = x + d * 1e-3
     turn = np.argmax(x)
-    still = np.flatnonzero(np.isclose(actual[turn:turn + 30], actual[turn]))
+    still = np.flatnonzero(np.isclose(actual[turn : turn + 30], actual[turn]))
     assert (x[turn] - x[turn + still[-1]]) == pytest.approx(6e-3, abs=0.5)  # within one sample
     assert np.ptp(d) == pytest.approx(6.0)
 
@@ -122,9 +124,15 @@ def test_angular_uses_the_machine_abbe_offset():
 
 def test_dict_round_trip_for_every_kind():
     samples = [
-        Scale("X", 5.0), Backlash("Y", 3.0), LateralPlay("Z", 2.0, "Y"), ReversalSpike("X", 1.0, decay_ms=20.0),
-        ServoMismatch("YZ", 0.5), Squareness("ZX", 12.0), Straightness("Y", "X", 3.0, (0.0, 500.0)),
-        Cyclic("Z", 1.0, 5.0, 30.0), Angular("EAY", 10.0),
+        Scale("X", 5.0),
+        Backlash("Y", 3.0),
+        LateralPlay("Z", 2.0, "Y"),
+        ReversalSpike("X", 1.0, decay_ms=20.0),
+        ServoMismatch("YZ", 0.5),
+        Squareness("ZX", 12.0),
+        Straightness("Y", "X", 3.0, (0.0, 500.0)),
+        Cyclic("Z", 1.0, 5.0, 30.0),
+        Angular("EAY", 10.0),
     ]
     assert {e.kind for e in samples} == set(EFFECTS)
     for e in samples:

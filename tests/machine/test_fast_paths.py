@@ -22,7 +22,9 @@ def _directions(rng: np.random.Generator, shape: tuple[int, ...]) -> NDArray | N
     """None, or travel signs with standing axes, odd magnitudes and NaN mixed in."""
     if rng.random() < 0.2:
         return None
-    return rng.choice([-1.0, 1.0, 0.0, -0.0, 2.5, -0.5, np.nan], size=shape, p=[0.35, 0.35, 0.1, 0.05, 0.05, 0.05, 0.05])
+    return rng.choice(
+        [-1.0, 1.0, 0.0, -0.0, 2.5, -0.5, np.nan], size=shape, p=[0.35, 0.35, 0.1, 0.05, 0.05, 0.05, 0.05]
+    )
 
 
 def _curve(stacked: StackedTables, column: int, p: NDArray) -> NDArray:
@@ -59,7 +61,11 @@ def test_stacked_tables_equal_each_curve_chosen_by_direction(seed, n):
     got = stacked(p, d)
     assert len(got) == len(tables)
     for values, (plus, minus) in zip(got, stacked.columns):
-        want = _curve(stacked, plus, p) if minus is None else _chosen(_signs(d), _curve(stacked, plus, p), _curve(stacked, minus, p))
+        want = (
+            _curve(stacked, plus, p)
+            if minus is None
+            else _chosen(_signs(d), _curve(stacked, plus, p), _curve(stacked, minus, p))
+        )
         assert np.array_equal(values, want, equal_nan=True)
 
 
@@ -114,12 +120,18 @@ def test_machine_deviation_equals_the_plain_evaluation(seed, n):
     tools = rng.uniform(0.0, 150.0, (n, 3)) if rng.random() < 0.5 else None
     delta, eps = {}, {}
     for i, axis in enumerate(AXES):
-        values = {name: c(P[:, i], None if d is None else d[:, i]) for name, c in MACHINE.components.items() if name.endswith(axis)}
+        values = {
+            name: c(P[:, i], None if d is None else d[:, i])
+            for name, c in MACHINE.components.items()
+            if name.endswith(axis)
+        }
         zero = np.zeros(n)
         delta[axis] = np.column_stack([values.get(f"E{e}{axis}", zero) for e in "XYZ"])
         eps[axis] = np.column_stack([values.get(f"E{r}{axis}", zero) for r in "ABC"])
     chain, tool, refs, squareness = MACHINE._frame
-    want = _plain_exact_deviation(chain, P, tool if tools is None else tool - tools, refs, delta, eps, squareness)
+    want = _plain_exact_deviation(
+        chain, P, tool if tools is None else tool - tools, refs, delta, eps, squareness
+    )
     assert np.allclose(MACHINE.deviation(P, d, tools), want, rtol=0, atol=1e-12)
 
 
@@ -131,8 +143,12 @@ def test_error_motions_of_an_axis_with_missing_and_polynomial_components():
     P, d = rng.uniform(0.0, 700.0, (500, 3)), rng.choice([-1.0, 0.0, 1.0], (500, 3))
     full_delta, full_eps = MACHINE.error_motions(P, d)
     delta, eps = partial.error_motions(P, d)
-    assert np.array_equal(delta["X"][:, 1], np.zeros(500)) and np.array_equal(delta["X"][:, [0, 2]], full_delta["X"][:, [0, 2]])
-    assert np.array_equal(delta["Y"][:, 2], poly(P[:, 1])) and np.array_equal(delta["Y"][:, :2], full_delta["Y"][:, :2])
+    assert np.array_equal(delta["X"][:, 1], np.zeros(500)) and np.array_equal(
+        delta["X"][:, [0, 2]], full_delta["X"][:, [0, 2]]
+    )
+    assert np.array_equal(delta["Y"][:, 2], poly(P[:, 1])) and np.array_equal(
+        delta["Y"][:, :2], full_delta["Y"][:, :2]
+    )
     for axis in AXES:
         assert np.array_equal(eps[axis], full_eps[axis])
     assert np.array_equal(delta["Z"], full_delta["Z"])

@@ -103,7 +103,12 @@ def test_thesis_names_and_units():
         ("values_um = [0.0, 10.0]", "values_um = [0.0, 10.0, 3.0]", 14, "3 values"),
         ("[compensation]", "[compensate]", 37, "unknown section"),
         ('name = "demo"', 'name = "demo', 3, "TOML"),
-        ("max_correction_mm = 0.2", "max_correction_mm = 0.2\nrotary_xyz_are_axis_positions = 1", 39, "true or false"),
+        (
+            "max_correction_mm = 0.2",
+            "max_correction_mm = 0.2\nrotary_xyz_are_axis_positions = 1",
+            39,
+            "true or false",
+        ),
     ],
 )
 def test_errors_name_file_and_line(tmp_path, old, new, line, message):
@@ -127,8 +132,15 @@ def test_missing_file():
 
 def test_rotary_xyz_are_axis_positions_is_read_and_written(tmp_path):
     path = tmp_path / "rotary.toml"
-    path.write_text(FULL.replace("max_correction_mm = 0.2", "max_correction_mm = 0.2\nrotary_xyz_are_axis_positions = true"))
+    path.write_text(
+        FULL.replace(
+            "max_correction_mm = 0.2", "max_correction_mm = 0.2\nrotary_xyz_are_axis_positions = true"
+        )
+    )
     machine = load_machine(path)
-    assert machine.rotary_xyz_are_axis_positions and not load_machine(f"{SAMPLES}/hr5b.toml").rotary_xyz_are_axis_positions
+    assert (
+        machine.rotary_xyz_are_axis_positions
+        and not load_machine(f"{SAMPLES}/hr5b.toml").rotary_xyz_are_axis_positions
+    )
     save_machine(machine, tmp_path / "again.toml")
     assert load_machine(tmp_path / "again.toml").rotary_xyz_are_axis_positions

@@ -13,7 +13,7 @@ from tests.conftest import ROOT
 PLACED = WorkOffsets.at((400.0, 350.0, 350.0))  # G54 in the middle of HR5B's travel
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def hr5b() -> ErrorSource:
     return ErrorSource.from_machine_file(str(ROOT / "samples/machines/hr5b.toml"))
 
@@ -21,5 +21,12 @@ def hr5b() -> ErrorSource:
 def compensate(text: str, file: str, strict: bool = False) -> tuple[str, str]:
     """(the compensated program, the warnings) of `text`, read as `file`."""
     warned, out = io.StringIO(), io.BytesIO()
-    process(io.BytesIO(text.encode()), out, file=file, source=hr5b(), warnings=Warnings(stream=warned, strict=strict), offsets=PLACED)
+    process(
+        io.BytesIO(text.encode()),
+        out,
+        file=file,
+        source=hr5b(),
+        warnings=Warnings(stream=warned, strict=strict),
+        offsets=PLACED,
+    )
     return out.getvalue().decode(), warned.getvalue()

@@ -12,7 +12,7 @@ from ncpp.errors import NcppError
 from ncpp.motion import interpret
 from ncpp.motion.segments import Arc, Line
 from ncpp.program.parser import parse_text
-from tests.conftest import RS274, ROOT
+from tests.conftest import ROOT, RS274
 
 SQUARE = "G21 G17 G90 F100\nG1 X0 Y0\nG1 X10 ,R2\n(held comment)\nY10 ,C1\nX0\nG1 X-10 R1\nY0\nM2\n"
 
@@ -30,7 +30,11 @@ def test_fillet_is_tangent_to_both_lines_and_chamfer_cuts_equal_legs():
     assert second.start == pytest.approx((10.0, 2.0, 0.0)) and second.end == pytest.approx((10.0, 9.0, 0.0))
     chamfer = m[4]
     assert (chamfer.start, chamfer.end) == (pytest.approx((10.0, 9.0, 0.0)), pytest.approx((9.0, 10.0, 0.0)))
-    assert m[-3].end == pytest.approx((-9.0, 10.0, 0.0)) and type(m[-2]) is Arc and m[-1].start == pytest.approx((-10.0, 9.0, 0.0))
+    assert (
+        m[-3].end == pytest.approx((-9.0, 10.0, 0.0))
+        and type(m[-2]) is Arc
+        and m[-1].start == pytest.approx((-10.0, 9.0, 0.0))
+    )
 
 
 def test_clockwise_corner_gets_a_clockwise_fillet():
@@ -55,8 +59,19 @@ def test_compensated_corners_are_plain_arcs_linuxcnc_accepts(tmp_path):
     program.write_text(SQUARE.replace("G21 G17 G90 F100", "G21 G17 G90 G0 X0 Y0 Z0\nF100"))
     out = tmp_path / "out.ngc"
     proc = subprocess.run(
-        [sys.executable, "-m", "ncpp", "compensate", "--machine", str(ROOT / "samples/machines/hr5b.toml"),
-         "--work-offset", "400,350,300", str(program), "-o", str(out)],  # fmt: skip
+        [
+            sys.executable,
+            "-m",
+            "ncpp",
+            "compensate",
+            "--machine",
+            str(ROOT / "samples/machines/hr5b.toml"),
+            "--work-offset",
+            "400,350,300",
+            str(program),
+            "-o",
+            str(out),
+        ],  # fmt: skip
         capture_output=True,
         text=True,
     )

@@ -16,12 +16,24 @@ from ncpp.motion.segments import COMP, Arc, Line
 from ncpp.program.parser import parse_stream
 from tests.conftest import RS274
 from tests.motion.compensating import compensate
-from tests.motion.test_oracle import assert_refused_like_rs274, ours, read_canon, rs274, rs274_error, same_calls, without_comp, write_program
+from tests.motion.test_oracle import (
+    assert_refused_like_rs274,
+    ours,
+    read_canon,
+    rs274,
+    rs274_error,
+    same_calls,
+    without_comp,
+    write_program,
+)
 
 needs_rs274 = pytest.mark.skipif(not RS274.exists(), reason="rs274 oracle not available")
 
 HEAD = "G21 G90 G17 G94 G64\nG0 X0 Y0 Z5\nG1 Z-1 F100\n"
-CONTOUR = HEAD + "G41.1 D10\nG1 X10 Y0\nG1 X10 Y10\nG2 X20 Y20 R10\nG1 Y30\nG40\nG1 X30\nG1 Y40 Z2\nG2 X40 Y50 I10\nM2\n"
+CONTOUR = (
+    HEAD
+    + "G41.1 D10\nG1 X10 Y0\nG1 X10 Y10\nG2 X20 Y20 R10\nG1 Y30\nG40\nG1 X30\nG1 Y40 Z2\nG2 X40 Y50 I10\nM2\n"
+)
 
 
 def events_of(text: str, **kwargs) -> list:
@@ -34,7 +46,17 @@ def moves(events) -> list:
 
 def test_moves_off_the_path_are_marked_from_the_first_under_comp_to_the_first_after_g40():
     lines = [(e.block.line, e.fixed) for e in moves(events_of(CONTOUR))]
-    assert lines == [(2, ""), (3, ""), (5, COMP), (6, COMP), (7, COMP), (8, COMP), (10, COMP), (11, ""), (12, "")]
+    assert lines == [
+        (2, ""),
+        (3, ""),
+        (5, COMP),
+        (6, COMP),
+        (7, COMP),
+        (8, COMP),
+        (10, COMP),
+        (11, ""),
+        (12, ""),
+    ]
 
 
 def test_after_g40_the_position_is_the_programs():
@@ -61,7 +83,20 @@ def test_after_g40_the_position_is_the_programs():
         "G41.1 D0\nG1 Z-2\nG1 X10\nG53 G0 X0\nG40\nG1 X0\nG1 Y5\n",  # radius 0: no check, and G53 allowed
         "G41.1 D10\nG1 X20\nG20\nG1 X1\nG3 X1.6 R0.3\nG40\nG1 X0\nG1 Y5\n",  # the radius follows G20 (0.197 in)  # radius 0: rs274's moves are the programmed ones
     ],
-    ids=["contour", "rapids", "xz", "g91", "g40-g55", "allowed", "no-move", "d0-arc", "d0", "radius", "d0-z", "units"],
+    ids=[
+        "contour",
+        "rapids",
+        "xz",
+        "g91",
+        "g40-g55",
+        "allowed",
+        "no-move",
+        "d0-arc",
+        "d0",
+        "radius",
+        "d0-z",
+        "units",
+    ],
 )
 def test_moves_after_compensation_agree_with_rs274(tmp_path, body):
     path = write_program(tmp_path, HEAD + body)
@@ -138,7 +173,11 @@ def test_program_end_ends_compensation():
     from ncpp.motion.interpreter import Interpreter
 
     interpreter = Interpreter("t.ngc")
-    list(interpreter.run(parse_stream(io.BytesIO((HEAD + "G41.1 D2\nG1 X10\nM2\n").encode()), "t.ngc"), Warnings()))
+    list(
+        interpreter.run(
+            parse_stream(io.BytesIO((HEAD + "G41.1 D2\nG1 X10\nM2\n").encode()), "t.ngc"), Warnings()
+        )
+    )
     assert interpreter.cutter_comp is None and not interpreter.off_path
 
 
@@ -153,11 +192,16 @@ def test_fanuc_corners_under_compensation_are_the_controls_and_the_position_is_f
     assert [e.end for e in rounded[-2:]] == [e.end for e in plain[-2:]]
     out, warned = compensate(HEAD + body, "corner.ngc")
     lines, start = out.splitlines(), out.splitlines().index("G41.1 D2")
-    assert lines[start : start + 6] == body.splitlines()[:6] and warned.count("cutter compensation") == 1  # to the exit move
+    assert (
+        lines[start : start + 6] == body.splitlines()[:6] and warned.count("cutter compensation") == 1
+    )  # to the exit move
 
 
 # -- compensation ---------------------------------------------------------------------------------
-POCKET = HEAD + "G1 X-20 Y-20\nG1 X-5\nG41.1 D6\nG1 X0 Y0\nG1 X40\nG3 X50 Y10 R10\nG1 Y40\nG40\nG1 X55 Y45\nG1 X70\nG2 X80 Y55 R10\nG0 Z10\nM2\n"
+POCKET = (
+    HEAD
+    + "G1 X-20 Y-20\nG1 X-5\nG41.1 D6\nG1 X0 Y0\nG1 X40\nG3 X50 Y10 R10\nG1 Y40\nG40\nG1 X55 Y45\nG1 X70\nG2 X80 Y55 R10\nG0 Z10\nM2\n"
+)
 
 
 def test_moves_off_the_path_pass_through_and_compensation_resumes_after_the_exit_move():
@@ -168,9 +212,17 @@ def test_moves_off_the_path_pass_through_and_compensation_resumes_after_the_exit
     assert lines[start : start + 7] == original[5:12]  # from G41.1 to the exit move: verbatim
     after = lines[start + 7 :]
     # from the exit move's end (as programmed) to the compensated start of the next line, every axis said; then that line
-    assert after[0].startswith("G1 X55.0") and "Y45.0" in after[0] and "Z-0.9" in after[0] and after[1].startswith("X70.0")
+    assert (
+        after[0].startswith("G1 X55.0")
+        and "Y45.0" in after[0]
+        and "Z-0.9" in after[0]
+        and after[1].startswith("X70.0")
+    )
     assert any(line.startswith("G2 ") and "I" in line for line in after)  # the arc after it replaced
-    assert warned.count("warning") == 1 and "comp.ngc:7:1: warning: cutter compensation: its moves pass through uncompensated" in warned
+    assert (
+        warned.count("warning") == 1
+        and "comp.ngc:7:1: warning: cutter compensation: its moves pass through uncompensated" in warned
+    )
 
 
 def test_strict_refuses_moves_under_compensation():
@@ -187,7 +239,9 @@ def test_in_g91_compensation_resumes_from_where_the_moves_left_as_programmed_lea
     lines = out.splitlines()
     start = lines.index("G41.1 D6")
     assert lines[start : start + 5] == text.splitlines()[4:9]  # to the exit move: as written
-    assert lines[start + 5] != "G1 X30" and lines[start + 5].startswith("G1 X30.0")  # compensated, an increment
+    assert lines[start + 5] != "G1 X30" and lines[start + 5].startswith(
+        "G1 X30.0"
+    )  # compensated, an increment
     assert "in G91" not in warned and warned.count("cutter compensation") == 1
 
 
@@ -203,7 +257,9 @@ def test_rs274_runs_the_compensated_program_with_the_same_moves_under_compensati
     # little with its start (rs274 offsets it square to the move), which compensation moved
     k, n = (next(i for i, c in enumerate(calls) if c.name == "ARC_FEED") for calls in (original, compensated))
     plane = [(a.name, a.args[:4] if a.name == "ARC_FEED" else a.args[:2]) for a in original[k : k + 5]]
-    assert plane == [(a.name, a.args[:4] if a.name == "ARC_FEED" else a.args[:2]) for a in compensated[n : n + 5]]
+    assert plane == [
+        (a.name, a.args[:4] if a.name == "ARC_FEED" else a.args[:2]) for a in compensated[n : n + 5]
+    ]
     assert math.dist(original[k - 1].args[:2], compensated[n - 1].args[:2]) < 0.005
     assert compensated[n + 5].args[:2] != original[k + 5].args[:2]  # compensated again after the exit move
 
@@ -217,11 +273,29 @@ def test_motion_and_simulate_say_where_the_tool_leaves_the_programmed_contour(tm
     path = write_program(tmp_path, CONTOUR.replace("G0 X0 Y0 Z5", "G0 X0 Y0 Z5\nG10 L2 P1 X400 Y350 Z400"))
     run = [sys.executable, "-m", "ncpp"]
     motion = subprocess.run([*run, "motion", str(path)], capture_output=True, text=True)
-    assert motion.returncode == 0 and motion.stderr.count("warning") == 1 and "program.ngc:6:1: warning: cutter compensation" in motion.stderr
-    assert "printed as programmed" in motion.stderr and "STRAIGHT_FEED(30.0000, 30.0000, -1.0000" in motion.stdout
-    assert subprocess.run([*run, "motion", "--strict", str(path)], capture_output=True, text=True).returncode != 0
-    simulate = subprocess.run([*run, "simulate", "--machine", str(ROOT / "samples/machines/hr5b.toml"), str(path)], capture_output=True, text=True)
-    assert simulate.returncode == 0 and "program.ngc:6:1: warning: cutter compensation" in simulate.stderr and "simulated as programmed" in simulate.stderr
+    assert (
+        motion.returncode == 0
+        and motion.stderr.count("warning") == 1
+        and "program.ngc:6:1: warning: cutter compensation" in motion.stderr
+    )
+    assert (
+        "printed as programmed" in motion.stderr
+        and "STRAIGHT_FEED(30.0000, 30.0000, -1.0000" in motion.stdout
+    )
+    assert (
+        subprocess.run([*run, "motion", "--strict", str(path)], capture_output=True, text=True).returncode
+        != 0
+    )
+    simulate = subprocess.run(
+        [*run, "simulate", "--machine", str(ROOT / "samples/machines/hr5b.toml"), str(path)],
+        capture_output=True,
+        text=True,
+    )
+    assert (
+        simulate.returncode == 0
+        and "program.ngc:6:1: warning: cutter compensation" in simulate.stderr
+        and "simulated as programmed" in simulate.stderr
+    )
 
 
 @needs_rs274
@@ -248,7 +322,9 @@ def test_g41_checks_against_the_radius_of_the_tool_table_ncpp_is_told(tmp_path, 
     table = tmp_path / "tool.tbl"
     table.write_text("T1 P1 D10 Z0\nT2 P2 D3 Z0\n")
     path = write_program(tmp_path, HEAD + body)
-    proc = subprocess.run([str(RS274), "-t", str(table), str(path)], capture_output=True, text=True, timeout=60)
+    proc = subprocess.run(
+        [str(RS274), "-t", str(table), str(path)], capture_output=True, text=True, timeout=60
+    )
     theirs = rs274_error(proc.stderr)
     offsets = replace(WorkOffsets.at((0.0, 0.0, 0.0)), tools=ToolTable.from_file(table, unit_mm=25.4))
     try:
@@ -259,4 +335,9 @@ def test_g41_checks_against_the_radius_of_the_tool_table_ncpp_is_told(tmp_path, 
     if refused is None:
         assert theirs is None and error is None, (theirs, error)
     else:
-        assert theirs is not None and error is not None and theirs[0] == error.message and error.where.line == refused, (theirs, error)
+        assert (
+            theirs is not None
+            and error is not None
+            and theirs[0] == error.message
+            and error.where.line == refused
+        ), (theirs, error)

@@ -20,24 +20,39 @@ from ncpp.motion.segments import CYCLE, Line
 from ncpp.program.parser import parse_stream
 from tests.conftest import RS274
 from tests.motion.compensating import compensate
-from tests.motion.test_oracle import assert_agrees_with_rs274, assert_refused_like_rs274, ours, read_canon, rs274, rs274_error, same_calls, write_program
+from tests.motion.test_oracle import (
+    assert_agrees_with_rs274,
+    assert_refused_like_rs274,
+    ours,
+    read_canon,
+    rs274,
+    rs274_error,
+    same_calls,
+    write_program,
+)
 
 HEAD = "G21 G90 G17 G54\nG0 X0 Y0 Z10 F200\n"
 
 AGREE = {
     "g81 g98 series": HEAD + "G98 G81 X10 Y5 Z-3 R2\nX20\nY15\nG80\nG0 X0\n",
     "g99 from below r": "G21 G90\nG0 X1 Y1 Z1 F100\nG99 G81 X5 Y5 Z-3 R2\nX6\nM2\n",
-    "g82 dwell, g85, g89": HEAD + "G99 G82 X1 Y1 Z-3 R2 P0.5\nX2\nG98 G85 X3 Z-4 R2\nG89 X4 Z-3 R2 P1\nX5\nG80\n",
+    "g82 dwell, g85, g89": HEAD
+    + "G99 G82 X1 Y1 Z-3 R2 P0.5\nX2\nG98 G85 X3 Z-4 R2\nG89 X4 Z-3 R2 P1\nX5\nG80\n",
     "g83 peck, sticky q": HEAD + "G83 X1 Y1 Z-7 R1 Q2.5\nX2 Q1.5\nX3 Z-2\nG80\n",
     "g73 chip break": HEAD + "G98 G73 X5 Y1 Z-3 R2 Q1\nX6\nG80\n",
     "inch peck": "G20 G90\nG0 X0 Y0 Z1 F10\nG83 X1 Y1 Z-0.3 R0.1 Q0.1\nG80\n",
-    "incremental repeats": HEAD + "G0 Z1\nG91 G81 X5 Y5 Z-3 R2 L3\nG90 G80\nG0 X0 Y0\nG91 G98 G83 X-2 Z-4 R3 Q1.5 L2\nG90 G80\n",
+    "incremental repeats": HEAD
+    + "G0 Z1\nG91 G81 X5 Y5 Z-3 R2 L3\nG90 G80\nG0 X0 Y0\nG91 G98 G83 X-2 Z-4 R3 Q1.5 L2\nG90 G80\n",
     "absolute repeats": HEAD + "G81 X3 Y3 Z-1 R0.5 L2\nG80\n",
     "g18 and g19": HEAD + "G18 G98 G81 X1 Z1 Y-3 R2\nG19 G83 Y1 Z1 X-3 R2 Q1\nG17 G80\n",
-    "a series across cycles": HEAD + "G98 G81 X1 Y1 Z-3 R2\nG99 G83 X2 Z-3 R1 Q1\nG98 G82 X3 Z-3 R2 P1\nG80\n",
-    "arcs after a cycle": HEAD + "G81 X10 Y10 Z-2 R1\nG0 X20\nG1 Z-1\nG2 X30 Y20 I10 J0\nG3 X20 Y10 R10\nM2\n",
-    "tapping and boring": HEAD + "S500 M3\nG99 G84 X1 Y1 Z-3 R2\nX2\nG98 G86 X3 Z-3 R2 P1\nG87 X4 Y4 Z-5 R2 I1 J0 K-3\nX6\nG80\nM4\nG74 X5 Y5 Z-2 R1\nG80\nM5\n",
-    "incremental back bore, g18 boring": HEAD + "M3\nG91 G87 X1 Y1 Z-3 R2 I1 J1 K1 L2\nG90 G80\nG18 G86 X1 Z1 Y-3 R2 P1\nG17 G80\n",
+    "a series across cycles": HEAD
+    + "G98 G81 X1 Y1 Z-3 R2\nG99 G83 X2 Z-3 R1 Q1\nG98 G82 X3 Z-3 R2 P1\nG80\n",
+    "arcs after a cycle": HEAD
+    + "G81 X10 Y10 Z-2 R1\nG0 X20\nG1 Z-1\nG2 X30 Y20 I10 J0\nG3 X20 Y10 R10\nM2\n",
+    "tapping and boring": HEAD
+    + "S500 M3\nG99 G84 X1 Y1 Z-3 R2\nX2\nG98 G86 X3 Z-3 R2 P1\nG87 X4 Y4 Z-5 R2 I1 J0 K-3\nX6\nG80\nM4\nG74 X5 Y5 Z-2 R1\nG80\nM5\n",
+    "incremental back bore, g18 boring": HEAD
+    + "M3\nG91 G87 X1 Y1 Z-3 R2 I1 J1 K1 L2\nG90 G80\nG18 G86 X1 Z1 Y-3 R2 P1\nG17 G80\n",
     # the levels a series crosses at and retracts to (found by probing rs274)
     "g99 series changing r": "G21 G90\nG0 X0 Y0 Z7.077 F100\nG89 G99 X1 Y-1 R1.541 Z-2.5 P0.3\nG83 X-3 Y-1 R2.271 Z-1.2 Q1.2\nX-2 R1\nM2\n",
     "g98 after g99, higher r": "G21 G90\nG0 X0 Y0 Z10 F100\nG99 G81 X1 Z-3 R2\nG98 G82 X3 Z-3 R5 P1\nX4\nM2\n",
@@ -89,31 +104,52 @@ def test_cycles_refused_where_rs274_refuses(tmp_path, name):
 def test_cycles_out_of_scope(name):
     text, line, reason = OUT_OF_SCOPE[name]
     warned = io.StringIO()
-    list(interpret(parse_stream(io.BytesIO(text.encode()), "t.ngc"), file="t.ngc", warnings=Warnings(stream=warned)))
+    list(
+        interpret(
+            parse_stream(io.BytesIO(text.encode()), "t.ngc"), file="t.ngc", warnings=Warnings(stream=warned)
+        )
+    )
     assert f"t.ngc:{line}:" in warned.getvalue() and reason in warned.getvalue(), warned.getvalue()
 
 
 def _random_program(rng: random.Random) -> str:
     """Cycles of every kind with random words, repeats, G91, G98/G99 and plane changes."""
-    lines, plane = [rng.choice(["G21", "G20"]) + " G90 G17", f"G0 X0 Y0 Z{rng.uniform(-2, 12):.3f} F100", "M3"], 17
+    lines, plane = (
+        [rng.choice(["G21", "G20"]) + " G90 G17", f"G0 X0 Y0 Z{rng.uniform(-2, 12):.3f} F100", "M3"],
+        17,
+    )
     for _ in range(rng.randint(2, 7)):
         if rng.random() < 0.2:
-            extra = rng.choice(["G80", "G0 X1 Y-2", "G80 G0 Z4", "G90", "G91", "G98", "G99", "G80 G18", "G80 G19", "G80 G17"])
+            extra = rng.choice(
+                ["G80", "G0 X1 Y-2", "G80 G0 Z4", "G90", "G91", "G98", "G99", "G80 G18", "G80 G19", "G80 G17"]
+            )
             plane = {"G80 G18": 18, "G80 G19": 19, "G80 G17": 17}.get(extra, plane)
             lines.append(extra)
             continue
-        code = rng.choice(["G73", "G81", "G82", "G83", "G85", "G86", "G89"] + (["G84", "G87"] if plane == 17 else []))
+        code = rng.choice(
+            ["G73", "G81", "G82", "G83", "G85", "G86", "G89"] + (["G84", "G87"] if plane == 17 else [])
+        )
         normal = {17: "Z", 18: "Y", 19: "X"}[plane]
         incremental, r = rng.random() < 0.3, rng.uniform(0, 4)
         words = [code, rng.choice(["", "G98", "G99"]), "G91" if incremental else "G90"]
         words += [a + f"{rng.uniform(-5, 5):.3f}" for a in "XYZ" if a != normal and rng.random() < 0.8]
         words.append(f"R{rng.uniform(-1, 3) if incremental else r:.3f}")
         words.append(normal + f"{-rng.uniform(0.5, 5) if incremental else r - rng.uniform(0.5, 6):.3f}")
-        words += {"G73": ["Q0.9"], "G83": ["Q1.3"], "G82": ["P0.2"], "G86": ["P0.2"], "G89": ["P0.2"], "G87": ["I0.6", "J-0.4", "K" + ("0.5" if incremental else "-1")]}.get(code, [])
+        words += {
+            "G73": ["Q0.9"],
+            "G83": ["Q1.3"],
+            "G82": ["P0.2"],
+            "G86": ["P0.2"],
+            "G89": ["P0.2"],
+            "G87": ["I0.6", "J-0.4", "K" + ("0.5" if incremental else "-1")],
+        }.get(code, [])
         if rng.random() < 0.25:
             words.append(f"L{rng.randint(1, 3)}")
         lines.append(" ".join(w for w in words if w))
-        lines += [" ".join(a + f"{rng.uniform(-5, 5):.3f}" for a in "XYZ" if a != normal) for _ in range(rng.randint(0, 2))]
+        lines += [
+            " ".join(a + f"{rng.uniform(-5, 5):.3f}" for a in "XYZ" if a != normal)
+            for _ in range(rng.randint(0, 2))
+        ]
     return "\n".join(lines + ["M2"]) + "\n"
 
 
@@ -134,12 +170,16 @@ def test_random_cycle_programs_agree_with_rs274(tmp_path):
             assert error is None and len(mine) == len(reference), (text, error)
             compared += 1
         else:
-            assert error is not None and text.splitlines()[error.where.line - 1].strip() == refused[1].strip(), (text, refused, error)
+            assert (
+                error is not None and text.splitlines()[error.where.line - 1].strip() == refused[1].strip()
+            ), (text, refused, error)
     assert compared >= 10  # enough programs stay in scope to mean something
 
 
 def test_cycle_moves_are_fixed():
-    events = list(interpret(parse_stream(io.BytesIO((HEAD + "G81 X1 Y1 Z-3 R2\nG80\nG1 X5\n").encode()), "t.ngc")))
+    events = list(
+        interpret(parse_stream(io.BytesIO((HEAD + "G81 X1 Y1 Z-3 R2\nG80\nG1 X5\n").encode()), "t.ngc"))
+    )
     lines = [e for e in events if type(e) is Line]
     assert [e.fixed for e in lines] == ["", CYCLE, CYCLE, CYCLE, CYCLE, ""]
 
@@ -148,7 +188,10 @@ def _compensate(text: str, strict: bool = False) -> tuple[str, str]:
     return compensate(text, "drill.ngc", strict)
 
 
-DRILL = HEAD + "G1 Z-1\nX40 Y12\nG0 Z5\nG98 G81 X20 Y20 Z-3 R2\nX30\n(between)\nX40 Y25\nG80\nG0 X50 Y50\nG1 Z-1\nX70 Y40\nG3 X80 Y60 R15\nG0 Z10\nM2\n"
+DRILL = (
+    HEAD
+    + "G1 Z-1\nX40 Y12\nG0 Z5\nG98 G81 X20 Y20 Z-3 R2\nX30\n(between)\nX40 Y25\nG80\nG0 X50 Y50\nG1 Z-1\nX70 Y40\nG3 X80 Y60 R15\nG0 Z10\nM2\n"
+)
 
 
 def test_cycles_pass_through_and_compensation_resumes():
@@ -167,11 +210,16 @@ def test_cycles_pass_through_and_compensation_resumes():
 def test_a_warning_repeated_hundreds_of_times_is_printed_five_times_then_counted():
     """A drilling program warns at each of its 300 cycle series: five are printed (the fifth
     says the rest are counted), then one line at the end tells how many and where."""
-    holes = "".join(f"G0 X{k % 20 * 5} Y{k // 20 * 5}\nG81 X{k % 20 * 5 + 1} Y{k // 20 * 5} Z-3 R2 F100\nG80\nG1 X{k % 20 * 5 + 2}\n" for k in range(300))
+    holes = "".join(
+        f"G0 X{k % 20 * 5} Y{k // 20 * 5}\nG81 X{k % 20 * 5 + 1} Y{k // 20 * 5} Z-3 R2 F100\nG80\nG1 X{k % 20 * 5 + 2}\n"
+        for k in range(300)
+    )
     out, warned = _compensate(HEAD + holes + "M2\n")
     said = warned.splitlines()
     series = [n + 1 for n, line in enumerate((HEAD + holes).splitlines()) if line.startswith("G81")]
-    assert [line.split(": warning: ")[0] for line in said] == [f"drill.ngc:{n}:1" for n in (*series[:5], series[-1])]
+    assert [line.split(": warning: ")[0] for line in said] == [
+        f"drill.ngc:{n}:1" for n in (*series[:5], series[-1])
+    ]
     assert said[4].endswith("(warned 5 times: more of these are counted, not printed)")
     assert said[5].endswith(f"(295 not printed, from line {series[5]} to this one)")
     assert out.count("G81") == 300
@@ -186,7 +234,10 @@ def test_warnings_of_other_texts_are_printed_whatever_one_text_repeats():
     warnings.finish()
     said = stream.getvalue().splitlines()
     assert warnings.count == 21 and len(said) == 7
-    assert said[5] == "t.ngc:21:1: warning: once" and said[6] == "t.ngc:20:1: warning: again (15 not printed, from line 6 to this one)"
+    assert (
+        said[5] == "t.ngc:21:1: warning: once"
+        and said[6] == "t.ngc:20:1: warning: again (15 not printed, from line 6 to this one)"
+    )
     with pytest.raises(NcppError, match="refused in strict mode"):
         Warnings(strict=True, stream=stream).warn("again", Location("t.ngc", 1))
 
@@ -196,9 +247,13 @@ def test_the_block_after_a_cycle_says_every_axis():
     be elsewhere (G98 retracts to the compensated level the series started at)."""
     from ncpp.program.dialects.iso import IsoWriter
 
-    events = list(interpret(parse_stream(io.BytesIO((HEAD + "G81 X1 Y1 Z-3 R2\nG80\nG1 X5\n").encode()), "t.ngc")))
+    events = list(
+        interpret(parse_stream(io.BytesIO((HEAD + "G81 X1 Y1 Z-3 R2\nG80\nG1 X5\n").encode()), "t.ngc"))
+    )
     move = events[-1]
-    events[-1] = Line(move.start, (5.00001, 1.0, 2.0), False, move.feed, move.block, move.context, changed=True)
+    events[-1] = Line(
+        move.start, (5.00001, 1.0, 2.0), False, move.feed, move.block, move.context, changed=True
+    )
     assert list(IsoWriter().write(events))[-1] == "G1 X5.0000 Y1.0000 Z2.0000\n"
 
 
@@ -227,10 +282,17 @@ def test_compensation_goes_on_after_a_g91_cycle(after):
     after it on the machine), and compensates the moves after it, in G90 or G91."""
     text = HEAD + "G1 Z-1\nX40 Y12\nG0 Z5\nG91 G98 G81 X10 Y10 Z-3 R-3 L2\n" + after
     out, warned = _compensate(text)
-    assert "in G91" not in warned and "G91 move" not in warned and "drill.ngc:6:1: warning: canned cycle" in warned
+    assert (
+        "in G91" not in warned
+        and "G91 move" not in warned
+        and "drill.ngc:6:1: warning: canned cycle" in warned
+    )
     original, written = text.splitlines(), out.splitlines()
     last = re.search(r"X(-?[\d.]+)", written[-1])  # compensated: the X the block says, moved by microns
-    assert written[-1] != original[-1] and 0 < abs(float(last[1]) - float(original[-1].split("X")[1].split()[0])) < 0.1
+    assert (
+        written[-1] != original[-1]
+        and 0 < abs(float(last[1]) - float(original[-1].split("X")[1].split()[0])) < 0.1
+    )
     assert "G91 G98 G81 X10 Y10 Z-3 R-3 L2" in written
 
 
@@ -255,6 +317,11 @@ def test_a_cycle_of_millions_of_moves_is_refused_before_they_are_made(cycle, col
     """rs274ngc would drill for days; these took 3 GB and a MemoryError (or, with a peck below
     the float resolution, looped for ever)."""
     with pytest.raises(NcppError) as err:
-        list(interpret(parse_stream(io.BytesIO(f"G21 G90 G17 F100\nG0 X0 Y0 Z10\n{cycle}\n".encode()), "c.ngc"), file="c.ngc"))
+        list(
+            interpret(
+                parse_stream(io.BytesIO(f"G21 G90 G17 F100\nG0 X0 Y0 Z10\n{cycle}\n".encode()), "c.ngc"),
+                file="c.ngc",
+            )
+        )
     assert (err.value.where.line, err.value.where.col) == (3, col)
     assert err.value.message == f"a canned cycle of {what}: ncpp takes 1,000,000 moves in one block at most"

@@ -66,8 +66,15 @@ def test_direct_motion_path_agrees_with_execute(monkeypatch):
 
 @pytest.mark.parametrize(
     "bad",
-    ["G2 X1 Y1", "G2 X1 Y1 R1 I1", "G18 G2 X1 Z1 J1 I1", "G93 G1 X1", "G3 X5 Y0 I1 J0", "G2 X0 Y0 R1",
-     "G2 X9 Y0 R1"],  # fmt: skip
+    [
+        "G2 X1 Y1",
+        "G2 X1 Y1 R1 I1",
+        "G18 G2 X1 Z1 J1 I1",
+        "G93 G1 X1",
+        "G3 X5 Y0 I1 J0",
+        "G2 X0 Y0 R1",
+        "G2 X9 Y0 R1",
+    ],  # fmt: skip
 )
 def test_direct_motion_path_fails_like_execute(monkeypatch, bad):
     text = "G21 G90 F100\nG0 X0 Y0\n" + bad + "\n"
@@ -77,7 +84,9 @@ def test_direct_motion_path_fails_like_execute(monkeypatch, bad):
     assert _outcome(text) == direct
 
 
-SIGNED = PROGRAM + """G90 G17 G0 X0 Y0
+SIGNED = (
+    PROGRAM
+    + """G90 G17 G0 X0 Y0
 N10 G01 X1 Y2 F300
 N11 X2 Y3
 G2 X3 Y4 I1 J0
@@ -88,10 +97,13 @@ G0 Z2
 F200
 G3 X5 Y4 I1 J0 P2 F100
 """
+)
 FAILING = ["G0 Z1 Z2", "G1 X1 Y1 K1", "G3 X5 Y0 I1 J0", "G2 X1 Y1", "G0 X1 R2"]
 
 
-@pytest.mark.parametrize("program", [PROGRAM, SIGNED] + [f"G21 G90 F100\nG0 X0 Y0\n{bad}\n" for bad in FAILING])
+@pytest.mark.parametrize(
+    "program", [PROGRAM, SIGNED] + [f"G21 G90 F100\nG0 X0 Y0\n{bad}\n" for bad in FAILING]
+)
 def test_signature_path_agrees_with_the_checks(monkeypatch, program):
     """Blocks the interpreter reads from their signature give what the full checks give."""
     import ncpp.motion.interpreter as interpreter

@@ -17,7 +17,14 @@ from tests.conftest import CORPUS
 
 
 def run(text: str, **kwargs) -> list:
-    return list(interpret(parse_text(text), file="t.nc", warnings=kwargs.pop("warnings", Warnings(stream=io.StringIO())), **kwargs))
+    return list(
+        interpret(
+            parse_text(text),
+            file="t.nc",
+            warnings=kwargs.pop("warnings", Warnings(stream=io.StringIO())),
+            **kwargs,
+        )
+    )
 
 
 def moves(text: str) -> list:
@@ -68,14 +75,20 @@ def test_g80_may_share_a_line_with_a_motion_code():
 
 def test_units_switch_converts_the_position_and_sets_context():
     events = moves("G20 G0 X1\nG21\nG0 Y1\n")
-    assert events[1].start == pytest.approx((25.4, 0.0, 0.0)) and events[1].end == pytest.approx((25.4, 1.0, 0.0))
+    assert events[1].start == pytest.approx((25.4, 0.0, 0.0)) and events[1].end == pytest.approx(
+        (25.4, 1.0, 0.0)
+    )
     assert events[0].context.inch and not events[1].context.inch
 
 
 def test_planes_order_arc_feed_like_rs274():
     # G18: first axis Z, second X; G19: first Y, second Z
-    assert calls("G18 G2 X10 Z0 I5 K0 F1\n") == ["ARC_FEED(0.0000, 10.0000, 0.0000, 5.0000, -1, 0.0000, 0.0000, 0.0000, 0.0000)"]
-    assert calls("G19 G3 Y10 Z0 J5 K0 F1\n") == ["ARC_FEED(10.0000, 0.0000, 5.0000, 0.0000, 1, 0.0000, 0.0000, 0.0000, 0.0000)"]
+    assert calls("G18 G2 X10 Z0 I5 K0 F1\n") == [
+        "ARC_FEED(0.0000, 10.0000, 0.0000, 5.0000, -1, 0.0000, 0.0000, 0.0000, 0.0000)"
+    ]
+    assert calls("G19 G3 Y10 Z0 J5 K0 F1\n") == [
+        "ARC_FEED(10.0000, 0.0000, 5.0000, 0.0000, 1, 0.0000, 0.0000, 0.0000, 0.0000)"
+    ]
 
 
 def test_helix_full_circle_and_extra_turns():
@@ -86,7 +99,7 @@ def test_helix_full_circle_and_extra_turns():
 
 
 def test_r_arcs_short_and_long_way():
-    short, = moves("G2 X10 R5 F1\n")
+    (short,) = moves("G2 X10 R5 F1\n")
     assert short.center == pytest.approx((5.0, 0.0, 0.0))
     (arc,) = moves("G2 X10 R10 F1\n")
     assert arc.center == pytest.approx((5.0, -math.sqrt(75), 0.0))
@@ -256,7 +269,10 @@ def test_arc_radius_tolerance_matches_linuxcnc_files():
         ("o<probe> call\n", "o<probe>, which the program does not define (a subroutine file"),
         ("IF [#1 EQ 1] GOTO 10\n", "Fanuc macro IF"),
         ("M98 P100\n", "M98 P100: a subprogram the program does not define"),
-        ("G88 X0 Y0 Z-1 R1 P1 F10\n", "canned cycle G88"),  # a manual retract: the other cycles are interpreted
+        (
+            "G88 X0 Y0 Z-1 R1 P1 F10\n",
+            "canned cycle G88",
+        ),  # a manual retract: the other cycles are interpreted
         ("G38.2 X1 F1\n", "probing G38.2"),
         ("G0 X#<_hal[x.y]>\n", "machine-state parameter"),
         ("G0 X#5221\n", "machine-state parameter #5221"),
@@ -268,7 +284,11 @@ def test_out_of_scope_passes_through_with_one_warning_then_stops(text, construct
     stream = io.StringIO()
     events = run("G0 X1\n" + text + "G0 X2\nG0 X3\n", warnings=Warnings(stream=stream))
     assert [type(e) for e in events] == [Line, Pass, Pass, Pass]
-    assert stream.getvalue().count("warning") == 1 and "t.nc:2:" in stream.getvalue() and construct in stream.getvalue()
+    assert (
+        stream.getvalue().count("warning") == 1
+        and "t.nc:2:" in stream.getvalue()
+        and construct in stream.getvalue()
+    )
     with pytest.raises(NcppError) as err:
         run("G0 X1\n" + text, strict=True)
     assert err.value.where.line == 2 and "strict" in err.value.message
@@ -292,7 +312,9 @@ def test_filter_passes_out_of_scope_programs_through_with_a_warning(corpus):
 
 def test_motion_command_prints_rs274_calls(corpus):
     path = CORPUS / "iso_gcode/cncjs/g2-arc.gcode"
-    proc = subprocess.run([sys.executable, "-m", "ncpp", "motion", str(path)], capture_output=True, text=True, check=True)
+    proc = subprocess.run(
+        [sys.executable, "-m", "ncpp", "motion", str(path)], capture_output=True, text=True, check=True
+    )
     lines = proc.stdout.splitlines()
     assert lines[0] == "STRAIGHT_TRAVERSE(0.0000, 0.0000, 50.0000, 0.0000, 0.0000, 0.0000)"
     assert lines[5] == "ARC_FEED(50.0000, 40.0000, 40.0000, 40.0000, -1, 0.0000, 0.0000, 0.0000, 0.0000)"

@@ -74,8 +74,8 @@ RS274_ONLY_REFUSES = {
 }
 
 
-@functools.lru_cache(maxsize=None)
-@functools.lru_cache(maxsize=None)
+@functools.cache
+@functools.cache
 def tool_table() -> Path:
     """A tool table of tools 1-99 (0.01 across, in the stand-alone rs274's inches; length 0) for
     rs274 (its last -t is the one it reads; the wrapper's holds T1 alone, 6 across): programs
@@ -94,7 +94,14 @@ ORACLE_EXAMPLES = max(int(os.environ.get("NCPP_HYPOTHESIS_EXAMPLES", "300")) // 
 def run_rs274(path) -> tuple[str, str]:
     """rs274's (canonical calls, messages) for the program at `path`, with `tool_table`."""
     try:
-        proc = subprocess.run([str(RS274), "-t", str(tool_table()), str(path)], capture_output=True, text=True, errors="replace", timeout=300, stdin=subprocess.DEVNULL)
+        proc = subprocess.run(
+            [str(RS274), "-t", str(tool_table()), str(path)],
+            capture_output=True,
+            text=True,
+            errors="replace",
+            timeout=300,
+            stdin=subprocess.DEVNULL,
+        )
     except (OSError, subprocess.TimeoutExpired) as err:
         pytest.skip(f"rs274 oracle unavailable: {err}")
     if "executing" not in proc.stderr:
@@ -102,7 +109,7 @@ def run_rs274(path) -> tuple[str, str]:
     return proc.stdout, proc.stderr
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def rs274(path: str) -> tuple[str, str]:
     """`run_rs274`, cached for this test session (the corpus's programs do not change; a
     property test rewrites one file, and runs `run_rs274` itself)."""
@@ -117,7 +124,9 @@ def rs274_error(messages: str) -> tuple[str, str] | None:
     return lines[0], lines[1]
 
 
-def ours(path, off_path: list[bool] | None = None, offsets=None) -> tuple[list[CanonCall], NcppError | None, str]:
+def ours(
+    path, off_path: list[bool] | None = None, offsets=None
+) -> tuple[list[CanonCall], NcppError | None, str]:
     """ncpp's calls, error and warnings (from `offsets`, a `WorkOffsets`, if given); `off_path`
     gets, call by call, whether it is a move under cutter compensation."""
     stream = io.StringIO()
@@ -125,7 +134,9 @@ def ours(path, off_path: list[bool] | None = None, offsets=None) -> tuple[list[C
     error = None
     with open(path, "rb") as f:
         try:
-            for event in interpret(parse_stream(f, str(path)), file=str(path), warnings=Warnings(stream=stream), offsets=offsets):
+            for event in interpret(
+                parse_stream(f, str(path)), file=str(path), warnings=Warnings(stream=stream), offsets=offsets
+            ):
                 call = canon_call(event)
                 if call is not None:
                     calls.append(call)
@@ -145,7 +156,9 @@ def refused_alike(refused: tuple[str, str] | None, error: NcppError | None) -> b
     return refused is not None
 
 
-def without_comp(reference: list[CanonCall], mine: list[CanonCall], off_path: list[bool]) -> tuple[list[CanonCall], list[CanonCall]]:
+def without_comp(
+    reference: list[CanonCall], mine: list[CanonCall], off_path: list[bool]
+) -> tuple[list[CanonCall], list[CanonCall]]:
     """rs274's calls and ncpp's with the runs of moves under cutter compensation left out: each
     run of ncpp's is matched to the calls of rs274's before the first place where the run of
     ncpp's calls after it agrees (all of rs274's rest when none follows, or none agrees)."""
@@ -165,7 +178,11 @@ def without_comp(reference: list[CanonCall], mine: list[CanonCall], off_path: li
             j += len(calls)
             continue
         after = runs[n + 1][1] if n + 1 < len(runs) else []
-        shifts = (s for s in range(len(reference) - j) if after and same_calls(reference[j + s : j + s + len(after)], after))
+        shifts = (
+            s
+            for s in range(len(reference) - j)
+            if after and same_calls(reference[j + s : j + s + len(after)], after)
+        )
         j += next(shifts, len(reference) - j)
     return theirs, kept
 
@@ -179,7 +196,10 @@ def write_program(folder, text: str, name: str = "program.ngc"):
 
 def same_calls(reference: list[CanonCall], mine: list[CanonCall]) -> bool:
     """The calls they have in common agree (names, and arguments within TOLERANCE)."""
-    return all(want.name == got.name and all(abs(a - b) <= TOLERANCE for a, b in zip(want.args, got.args)) for want, got in zip(reference, mine))
+    return all(
+        want.name == got.name and all(abs(a - b) <= TOLERANCE for a, b in zip(want.args, got.args))
+        for want, got in zip(reference, mine)
+    )
 
 
 def assert_agrees_with_rs274(path) -> list[CanonCall]:
@@ -219,14 +239,18 @@ def test_motion_agrees_with_linuxcnc(path):
     name = corpus_id(path)
     assert_same_moves(path, reference, mine)
     if warning:
-        assert name in OUT_OF_SCOPE, f"{corpus_id(path)} left the interpreter's scope but is not listed: {warning}"
+        assert name in OUT_OF_SCOPE, (
+            f"{corpus_id(path)} left the interpreter's scope but is not listed: {warning}"
+        )
         assert OUT_OF_SCOPE[name] in warning, warning
         return
     assert name not in OUT_OF_SCOPE, f"{corpus_id(path)} is listed as out of scope but is interpreted"
     if refused is None:
         assert error is None, f"rs274 accepts {corpus_id(path)} but ncpp refuses it: {error}"
         assert name not in RS274_ONLY_REFUSES
-        assert len(mine) == len(reference), f"{corpus_id(path)}: rs274 made {len(reference)} moves, ncpp {len(mine)}"
+        assert len(mine) == len(reference), (
+            f"{corpus_id(path)}: rs274 made {len(reference)} moves, ncpp {len(mine)}"
+        )
         return
     message, source = refused
     if error is not None:
@@ -234,7 +258,9 @@ def test_motion_agrees_with_linuxcnc(path):
         assert block_text.strip() == source.strip(), f"rs274 refused {source!r} ({message}), ncpp {error}"
         assert len(mine) == len(reference)
         return
-    assert name in RS274_ONLY_REFUSES, f"rs274 refuses {corpus_id(path)} ({message} at {source!r}), ncpp does not"
+    assert name in RS274_ONLY_REFUSES, (
+        f"rs274 refuses {corpus_id(path)} ({message} at {source!r}), ncpp does not"
+    )
     assert len(mine) >= len(reference)
 
 

@@ -34,7 +34,11 @@ HEAD = "G21 G90 G17 G94\nG0 X0 Y0 Z5\n"
 
 
 def ends(text: str) -> list[tuple[float, float]]:
-    events = interpret(parse_stream(io.BytesIO((HEAD + text).encode()), "p.ngc"), file="p.ngc", warnings=Warnings(stream=io.StringIO()))
+    events = interpret(
+        parse_stream(io.BytesIO((HEAD + text).encode()), "p.ngc"),
+        file="p.ngc",
+        warnings=Warnings(stream=io.StringIO()),
+    )
     return [(round(e.end[0], 6), round(e.end[1], 6)) for e in events if type(e) is not Pass][1:]
 
 
@@ -69,14 +73,20 @@ def test_a_g91_cycle_walks_its_holes_round_xy_zero():
     """polar.ngc's bolt circle: each repeat turns the hole by `^` about XY zero."""
     holes = {xy for xy in ends("G0 X2\nG91 G81 ^90 R1 Z-2 L4 F100\n")}
     for angle in (90, 180, 270, 0):
-        assert (round(2 * math.cos(math.radians(angle)), 6), round(2 * math.sin(math.radians(angle)), 6)) in holes
+        assert (
+            round(2 * math.cos(math.radians(angle)), 6),
+            round(2 * math.sin(math.radians(angle)), 6),
+        ) in holes
 
 
 @pytest.mark.parametrize(
     "text, message",
     [
         ("G1 @10 F100\n", "Must specify angle in polar coordinate if at the origin"),
-        ("G91 G1 @10 F100\n", "Incremental motion with polar coordinates is indeterminate when at the origin"),
+        (
+            "G91 G1 @10 F100\n",
+            "Incremental motion with polar coordinates is indeterminate when at the origin",
+        ),
         ("G91 G1 ^10 F100\n", "G91 motion with polar coordinates is indeterminate when at the origin"),
         ("G18\nG1 @10 ^10 F100\n", "Cannot use polar coordinate except in G17 plane"),
         ("G1 X1 @10 ^10 F100\n", "Cannot specify both polar coordinate and X word"),
@@ -93,8 +103,14 @@ def test_polar_words_under_cutter_compensation_are_out_of_scope():
     """rs274ngc starts them from the programmed point, not the tool's: not followed here."""
     stream = io.StringIO()
     text = HEAD + "G1 X10 F100\nG41.1 D2\nG1 X20\nG1 @20 ^45\nG40\nG1 X0\n"
-    events = list(interpret(parse_stream(io.BytesIO(text.encode()), "p.ngc"), file="p.ngc", warnings=Warnings(stream=stream)))
-    assert "p.ngc:6:" in stream.getvalue() and "polar coordinates under cutter compensation" in stream.getvalue()
+    events = list(
+        interpret(
+            parse_stream(io.BytesIO(text.encode()), "p.ngc"), file="p.ngc", warnings=Warnings(stream=stream)
+        )
+    )
+    assert (
+        "p.ngc:6:" in stream.getvalue() and "polar coordinates under cutter compensation" in stream.getvalue()
+    )
     assert type(events[-1]) is Pass
 
 
@@ -118,7 +134,9 @@ def test_a_block_of_polar_words_is_written_in_capitals():
     out, _ = compensate(PROGRAM, "polar.ngc")
     assert not re.search(r"\b[xy]-?\d", out)
     lower = program_lines(compensate(PROGRAM.lower(), "polar.ngc")[0])
-    assert lower[5].startswith("g1 x") and lower[6].startswith("x") and lower[7].startswith("X")  # `g1 @40 ^30`; `^60`
+    assert (
+        lower[5].startswith("g1 x") and lower[6].startswith("x") and lower[7].startswith("X")
+    )  # `g1 @40 ^30`; `^60`
 
 
 @pytest.mark.skipif(not RS274.exists(), reason="rs274 oracle not available")
@@ -138,21 +156,38 @@ number = st.integers(-40_000, 40_000).map(lambda n: f"{n / 1000:g}")
 angle = st.integers(-720_000, 720_000).map(lambda n: f"{n / 1000:g}")
 polar = st.builds(
     lambda g, r, a, which: f"G{g} " + {"both": f"@{r} ^{a}", "r": f"@{r}", "a": f"^{a}"}[which],
-    st.sampled_from([0, 1, 1]), number, angle, st.sampled_from(["both", "both", "r", "a"]),
+    st.sampled_from([0, 1, 1]),
+    number,
+    angle,
+    st.sampled_from(["both", "both", "r", "a"]),
 )
 plain = st.builds(lambda g, x, y: f"G{g} X{x} Y{y}", st.sampled_from([0, 1]), number, number)
-arc = st.builds(lambda g, r, a, radius: f"G{g} @{r} ^{a} R{radius / 1000:g}", st.sampled_from([2, 3]), number, angle, st.integers(30_000, 90_000))
-cycle = st.builds(
-    lambda words, repeats: f"G81 {words} R2 Z-1 L{repeats}", st.sampled_from(["@5", "^30", "@2 ^45", "^-20", "X1 Y1"]), st.integers(1, 4)
+arc = st.builds(
+    lambda g, r, a, radius: f"G{g} @{r} ^{a} R{radius / 1000:g}",
+    st.sampled_from([2, 3]),
+    number,
+    angle,
+    st.integers(30_000, 90_000),
 )
-codes = st.sampled_from(["G90", "G91", "G91", "G80", "G20", "G21", "G55", "G54", "G92 X1 Y1", "G92.1", "G18", "G17", "G98", "G99"])
+cycle = st.builds(
+    lambda words, repeats: f"G81 {words} R2 Z-1 L{repeats}",
+    st.sampled_from(["@5", "^30", "@2 ^45", "^-20", "X1 Y1"]),
+    st.integers(1, 4),
+)
+codes = st.sampled_from(
+    ["G90", "G91", "G91", "G80", "G20", "G21", "G55", "G54", "G92 X1 Y1", "G92.1", "G18", "G17", "G98", "G99"]
+)
 programs = st.lists(st.one_of(polar, polar, plain, arc, cycle, codes), min_size=2, max_size=20).map(
     lambda body: "G21 G90 G17 G94\nG0 X5 Y5 Z5\nG1 Z0 F100\n" + "\n".join(body) + "\nG80\nM2\n"
 )
 
 
 @pytest.mark.skipif(not RS274.exists(), reason="rs274 oracle not available")
-@settings(max_examples=ORACLE_EXAMPLES, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
+@settings(
+    max_examples=ORACLE_EXAMPLES,
+    deadline=None,
+    suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture],
+)
 @given(programs)
 def test_polar_programs_agree_with_rs274(tmp_path, text):
     path = tmp_path / "polar.ngc"

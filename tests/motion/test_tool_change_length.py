@@ -52,11 +52,20 @@ def test_tool_lengths_applied_with_a_tool_change_follow_rs274(tmp_path: Path):
     table.write_text(TOOLS)
     unpacked = os.environ.get("RS274_HOME") or str(Path.home() / ".cache" / "ncpp-rs274")
     env = dict(os.environ, RS274_TOOL_TABLE=str(table), HOME=str(tmp_path), RS274_HOME=unpacked)
-    proc = subprocess.run([str(RS274), str(program)], capture_output=True, text=True, env=env, timeout=60, stdin=subprocess.DEVNULL)
+    proc = subprocess.run(
+        [str(RS274), str(program)],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=60,
+        stdin=subprocess.DEVNULL,
+    )
     if "executing" not in proc.stderr:
         pytest.skip(f"rs274 oracle did not run: {proc.stderr.strip()[:200]}")
     theirs = read_canon(proc.stdout)
-    offsets = WorkOffsets.given({}, None, UNIT_MM["inch"], str(table))  # the stand-alone rs274 reads its table in inches
+    offsets = WorkOffsets.given(
+        {}, None, UNIT_MM["inch"], str(table)
+    )  # the stand-alone rs274 reads its table in inches
     events = interpret(parse_stream(io.BytesIO(PROGRAM.encode()), "lengths.ngc"), file="lengths.ngc",
                        warnings=Warnings(stream=io.StringIO()), offsets=offsets)  # fmt: skip
     mine = [call for call in map(canon_call, events) if call is not None]

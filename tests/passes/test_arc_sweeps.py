@@ -37,13 +37,25 @@ def _geometry(arcs: list[Arc]) -> _ArcGeometry:
 @settings(max_examples=60, deadline=None)
 @given(
     arcs=st.lists(
-        st.tuples(st.sampled_from(sorted(PLANE_AXES)), st.floats(-500, 500), st.floats(-500, 500), st.floats(0.01, 300),
-                  _angle, _angle, st.sampled_from([-3, -2, -1, 1, 2, 3]), st.booleans()),  # fmt: skip
-        min_size=1, max_size=20,
+        st.tuples(
+            st.sampled_from(sorted(PLANE_AXES)),
+            st.floats(-500, 500),
+            st.floats(-500, 500),
+            st.floats(0.01, 300),
+            _angle,
+            _angle,
+            st.sampled_from([-3, -2, -1, 1, 2, 3]),
+            st.booleans(),
+        ),  # fmt: skip
+        min_size=1,
+        max_size=20,
     )
 )
 def test_batch_sweeps_are_arc_sweeps(arcs):
-    made = [_arc(plane, (cu, cv), r, a0, a0 if closed else a1, turn) for plane, cu, cv, r, a0, a1, turn, closed in arcs]
+    made = [
+        _arc(plane, (cu, cv), r, a0, a0 if closed else a1, turn)
+        for plane, cu, cv, r, a0, a1, turn, closed in arcs
+    ]
     np.testing.assert_allclose(_geometry(made).sweep, [a.sweep() for a in made], rtol=0, atol=1e-12)
 
 

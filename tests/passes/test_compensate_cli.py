@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from tests.conftest import RS274, ROOT
+from tests.conftest import ROOT, RS274
 
 MACHINE = ROOT / "samples/machines/hr5b.toml"
 POCKET = ROOT / "samples/programs/pocket.ngc"
@@ -35,14 +35,20 @@ def test_header_names_machine_and_hash_after_tape_mark(compensated):
 
 def test_untouched_blocks_are_byte_identical(compensated):
     out = compensated.read_text().splitlines()
-    for line in ("(ncpp sample: a 60 x 40 mm pocket with R10 corners and a finishing circle)", "G21 G17 G90 G54", "M2"):
+    for line in (
+        "(ncpp sample: a 60 x 40 mm pocket with R10 corners and a finishing circle)",
+        "G21 G17 G90 G54",
+        "M2",
+    ):
         assert line in out
 
 
 def test_second_compensation_is_refused_unless_forced(compensated, tmp_path):
     proc = ncpp("compensate", "--machine", str(MACHINE), "--work-offset", OFFSET, str(compensated))
     assert proc.returncode != 0 and b"already compensated" in proc.stderr and proc.stdout == b""
-    forced = ncpp("compensate", "--force", "--machine", str(MACHINE), "--work-offset", OFFSET, str(compensated))
+    forced = ncpp(
+        "compensate", "--force", "--machine", str(MACHINE), "--work-offset", OFFSET, str(compensated)
+    )
     assert forced.returncode == 0
 
 
@@ -60,7 +66,18 @@ def test_command_outside_travel_is_refused_with_line_and_no_output(tmp_path):
 def test_contour_error_shrinks_on_the_virtual_machine(compensated, tmp_path):
     def simulate(program: Path) -> float:
         report = tmp_path / f"{program.stem}-{len(list(tmp_path.iterdir()))}.json"
-        proc = ncpp("simulate", "--machine", str(MACHINE), "--work-offset", OFFSET, "--reference", str(POCKET), str(program), "--json", str(report))
+        proc = ncpp(
+            "simulate",
+            "--machine",
+            str(MACHINE),
+            "--work-offset",
+            OFFSET,
+            "--reference",
+            str(POCKET),
+            str(program),
+            "--json",
+            str(report),
+        )
         assert proc.returncode == 0, proc.stderr.decode()
         import json
 
@@ -104,7 +121,9 @@ def test_thesis_reference_case_from_a_ballbar_file(tmp_path):
         "direction,angle_deg,deviation_um\n" + "\n".join(rows) + "\n"
     )
     program = tmp_path / "circle.ngc"
-    program.write_text("G21 G17 G90\nG0 X550.000 Y-200.000 Z350.000\nG91\nN200 G02 X0 Y0 I-150.000 J0 F500\nG90\nM2\n")
+    program.write_text(
+        "G21 G17 G90\nG0 X550.000 Y-200.000 Z350.000\nG91\nN200 G02 X0 Y0 I-150.000 J0 F500\nG90\nM2\n"
+    )
     proc = ncpp("compensate", "--from", str(ballbar), "--tolerance", "0.004", str(program))
     assert proc.returncode == 0, proc.stderr.decode()
     lines = proc.stdout.decode().splitlines()
@@ -114,7 +133,12 @@ def test_thesis_reference_case_from_a_ballbar_file(tmp_path):
 
     # N201 is the thesis's block; N202-N204 follow from the symmetry of sin 2θ
     # (quadrants where ΔR > 0 get centres moved outward, radius 150.022).
-    thesis = [(-150, -150, -149.978, -0.022), (-150, 150, 0.022, 150.022), (150, 150, 149.978, 0.022), (150, -150, -0.022, -150.022)]
+    thesis = [
+        (-150, -150, -149.978, -0.022),
+        (-150, 150, 0.022, 150.022),
+        (150, 150, 149.978, 0.022),
+        (150, -150, -0.022, -150.022),
+    ]
     for text, (x, y, i, j) in zip(arcs, thesis):
         words = {w.letter: w.value for w in parse_text(text + "\n")[0].words()}
         assert (words["X"], words["Y"]) == pytest.approx((x, y), abs=0.001)
@@ -123,7 +147,9 @@ def test_thesis_reference_case_from_a_ballbar_file(tmp_path):
     assert arcs[0].startswith("N200 G02 X-150.0000 Y-150.0000 I-149.97")
 
 
-@pytest.mark.parametrize("program, turns", [("G2 X0 Y0 I10 J0 Z1 P10001 F100", "10,001"), ("G2 X0 Y0 I10 J0 Z1 P10000 F100", None)])
+@pytest.mark.parametrize(
+    "program, turns", [("G2 X0 Y0 I10 J0 Z1 P10001 F100", "10,001"), ("G2 X0 Y0 I10 J0 Z1 P10000 F100", None)]
+)
 def test_an_arc_of_more_turns_than_compensation_holds_is_refused_with_its_line(tmp_path, program, turns):
     path = tmp_path / "helix.ngc"
     path.write_text(f"G17 G21 G90\nG0 X0 Y0 Z0\n{program}\nM2\n")
@@ -133,7 +159,11 @@ def test_an_arc_of_more_turns_than_compensation_holds_is_refused_with_its_line(t
     if turns is None:  # (10,000 turns: 80,000 lines)
         assert proc.returncode == 0 and proc.stdout.count("\n") > 80_000
     else:
-        assert proc.returncode == 2 and proc.stdout == "" and proc.stderr.startswith(f"{path}:3:20: an arc of {turns} turns")  # at its P word
+        assert (
+            proc.returncode == 2
+            and proc.stdout == ""
+            and proc.stderr.startswith(f"{path}:3:20: an arc of {turns} turns")
+        )  # at its P word
 
 
 def test_simulate_refuses_motion_outside_the_travel_and_paths_past_its_sample_budget(tmp_path):
@@ -143,10 +173,18 @@ def test_simulate_refuses_motion_outside_the_travel_and_paths_past_its_sample_bu
     program.write_text("G21 G90\nG0 X0 Y0 Z0\nG1 X5000 F100\nM2\n")
     proc = ncpp("simulate", "--machine", str(MACHINE), "--work-offset", "400,350,370", str(program))
     assert proc.returncode == 2 and b"Traceback" not in proc.stderr
-    assert f"{program}:3:4: the motion reaches X800.5000 mm, outside the X travel [0, 800] mm".encode() in proc.stderr
-    program.write_text("G21 G90\nG0 X0 Y0 Z0\nG1 Z-50 Y5000 F100\nG1 X5000\nM2\n")  # the first line out, whichever axis
+    assert (
+        f"{program}:3:4: the motion reaches X800.5000 mm, outside the X travel [0, 800] mm".encode()
+        in proc.stderr
+    )
+    program.write_text(
+        "G21 G90\nG0 X0 Y0 Z0\nG1 Z-50 Y5000 F100\nG1 X5000\nM2\n"
+    )  # the first line out, whichever axis
     proc = ncpp("simulate", "--machine", str(MACHINE), "--work-offset", "400,350,370", str(program))
-    assert f"{program}:3:9: the motion reaches Y700.".encode() in proc.stderr and b"outside the Y travel" in proc.stderr
+    assert (
+        f"{program}:3:9: the motion reaches Y700.".encode() in proc.stderr
+        and b"outside the Y travel" in proc.stderr
+    )
     program.write_text("G21 G90\nG0 X10 Y10\nG0 X9999999999999 Y10\n")
     proc = ncpp("simulate", "--machine", str(MACHINE), "--work-offset", "400,350,370", str(program))
     assert proc.returncode == 2 and b"Traceback" not in proc.stderr

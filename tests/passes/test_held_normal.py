@@ -37,11 +37,15 @@ def test_an_arc_takes_the_direction_its_normal_axis_last_moved_in():
         _line((10.0, 0.0, -2.0), (20.0, 0.0, -2.0), 4),  # X only: Z still held down
         _arc((20.0, 0.0, -2.0), (30.0, 0.0, -1.0), (25.0, 0.0, -2.0), 5),  # a helix rising: up
         _arc((30.0, 0.0, -1.0), (40.0, 0.0, -1.0), (35.0, 0.0, -1.0), 6),  # after it Z is held up
-        _arc((40.0, 0.0, -1.0), (40.0, 0.0, -1.0), (40.0, 5.0, -1.0), 7, plane=18),  # XZ: Y's, down in line 3's arc
+        _arc(
+            (40.0, 0.0, -1.0), (40.0, 0.0, -1.0), (40.0, 5.0, -1.0), 7, plane=18
+        ),  # XZ: Y's, down in line 3's arc
     ]
     assert motion.normals(batch, _arcs(batch)) == [0, -1, 1, 1, -1]
     # a batch later, the state goes on; a move older than HELD_LINES lines is not used
-    later = _arc((40.0, 0.0, -1.0), (50.0, 0.0, -1.0), (45.0, 0.0, -1.0), 5 + HELD_LINES)  # Z last moved in line 5
+    later = _arc(
+        (40.0, 0.0, -1.0), (50.0, 0.0, -1.0), (45.0, 0.0, -1.0), 5 + HELD_LINES
+    )  # Z last moved in line 5
     assert Motion(motion.state).normals([later], [later]) == [1]
     stale = _arc((40.0, 0.0, -1.0), (50.0, 0.0, -1.0), (45.0, 0.0, -1.0), 6 + HELD_LINES)
     assert motion.normals([stale], [stale]) == [0]
@@ -65,7 +69,9 @@ def test_pieces_of_arcs_after_a_plunge_are_shifted_less_often(source, monkeypatc
 
     def shifted_pieces() -> tuple[int, int]:
         shifted: list[int] = []
-        monkeypatch.setattr(apply_error_map, "_shift_arcs", lambda at, *rest: shifted.append(len(at)) or shift(at, *rest))
+        monkeypatch.setattr(
+            apply_error_map, "_shift_arcs", lambda at, *rest: shifted.append(len(at)) or shift(at, *rest)
+        )
         out = io.BytesIO()
         process(io.BytesIO(program.encode()), out, file="p.ngc", source=source, tolerance=0.001)
         return sum(shifted), len(re.findall(r"\bG2(?![\d.])", out.getvalue().decode()))

@@ -25,7 +25,11 @@ def test_the_chosen_steps_leave_the_command_within_the_budget(path):
     wanted = lo + (hi - lo) * rng.random((20_000, 3))
     direction = rng.choice([-1.0, 0.0, 1.0], size=wanted.shape)
     tool = np.tile([0.0, 0.0, 150.0], (len(wanted), 1))  # a long tool: a longer Abbe arm than the estimate's
-    residual = lambda k: np.abs((c := command_for(model, wanted, direction, tool, k)) + model.deviation(c, direction, tool) - wanted).max()  # noqa: E731
+
+    def residual(k: int) -> float:
+        c = command_for(model, wanted, direction, tool, k)
+        return float(np.abs(c + model.deviation(c, direction, tool) - wanted).max())
+
     assert residual(steps) <= INVERSE_BUDGET
     assert steps == 1 or residual(steps - 1) > INVERSE_BUDGET / 2  # one step fewer would not do
 

@@ -17,7 +17,9 @@ def _events(lines: list[int]) -> list[SimpleNamespace]:
 
 
 # events in line order, several to a line (a block's pieces) and lines without any
-_LINES = st.lists(st.integers(0, 6), max_size=300).map(lambda steps: [sum(steps[: i + 1]) for i in range(len(steps))])
+_LINES = st.lists(st.integers(0, 6), max_size=300).map(
+    lambda steps: [sum(steps[: i + 1]) for i in range(len(steps))]
+)
 
 
 @given(_LINES, st.integers(1, 40), st.integers(1, 50))
@@ -35,5 +37,8 @@ def test_a_stream_started_at_a_window_chunks_the_rest_alike(lines, window, data)
     events = _events(lines)
     start = data.draw(st.integers(0, max(lines, default=0) // window + 1)) * window
     whole = [[e.k for e in chunk] for chunk in line_chunks(events, window, 10_000)]
-    later = [[e.k for e in chunk] for chunk in line_chunks([e for e in events if e.block.line >= start], window, 10_000)]
+    later = [
+        [e.k for e in chunk]
+        for chunk in line_chunks([e for e in events if e.block.line >= start], window, 10_000)
+    ]
     assert later == [chunk for chunk in whole if events[chunk[0]].block.line >= start]

@@ -24,7 +24,9 @@ def sin2theta_map(amplitude_um: float = 9.1) -> RadialMap:
 
 def full_circle(text: str = "N200 G91 G02 X0 Y0 I-150. J0 F500\n") -> tuple[Arc, object]:
     block = parse_text(text)[0]
-    arc = Arc((150.0, 0.0, 0.0), (150.0, 0.0, 0.0), (0.0, 0.0, 0.0), -1, 500.0, block, Context(absolute=False))
+    arc = Arc(
+        (150.0, 0.0, 0.0), (150.0, 0.0, 0.0), (0.0, 0.0, 0.0), -1, 500.0, block, Context(absolute=False)
+    )
     return arc, block
 
 
@@ -41,7 +43,9 @@ def test_four_quadrant_arcs_match_blocks_n201_to_n204():
     assert first.center[1] - first.start[1] == pytest.approx(-0.022, abs=1e-3)
     expected_ends = [(-150, -150), (-150, 150), (150, 150), (150, -150)]
     for event, (dx, dy) in zip(events, expected_ends):
-        assert (event.end[0] - event.start[0], event.end[1] - event.start[1]) == pytest.approx((dx, dy), abs=1e-3)
+        assert (event.end[0] - event.start[0], event.end[1] - event.start[1]) == pytest.approx(
+            (dx, dy), abs=1e-3
+        )
         radius_start = math.dist(event.start[:2], event.center[:2])
         radius_end = math.dist(event.end[:2], event.center[:2])
         assert abs(radius_start - radius_end) < 0.0005e-3
@@ -57,7 +61,9 @@ def test_written_blocks_keep_g91_and_number_style():
     first = parse_text(lines[0])[0]
     assert first.raw.startswith("N200 G91 G02 X-150.000 Y-150.000 I-149.97")
     values = {w.letter: w.value for w in first.words()}
-    assert values["I"] == pytest.approx(-149.978, abs=0.0015) and values["J"] == pytest.approx(-0.022, abs=0.0015)
+    assert values["I"] == pytest.approx(-149.978, abs=0.0015) and values["J"] == pytest.approx(
+        -0.022, abs=0.0015
+    )
     assert values["F"] == 500 and lines[0].endswith("F500\n")
     assert lines[1].startswith("X-150.000 Y150.000 I")
 
@@ -75,7 +81,9 @@ def test_tight_tolerance_splits_further_and_stays_within_it():
         a0 = math.atan2(event.start[1] - event.center[1], event.start[0] - event.center[0])
         r = math.dist(event.start[:2], event.center[:2])
         angles = a0 + np.linspace(0, sweep, 50)
-        cmd = np.column_stack([event.center[0] + r * np.cos(angles), event.center[1] + r * np.sin(angles), np.zeros(50)])
+        cmd = np.column_stack(
+            [event.center[0] + r * np.cos(angles), event.center[1] + r * np.sin(angles), np.zeros(50)]
+        )
         actual = cmd + model.deviation(cmd)
         worst = max(worst, np.abs(np.hypot(actual[:, 0], actual[:, 1]) - 150.0).max())
     assert worst < 0.0002 + 0.0001

@@ -101,7 +101,12 @@ def test_a_folder_that_cannot_be_made_still_builds(tmp_path, monkeypatch):
 
 @pytest.mark.parametrize(
     "name, line",
-    [("iso", "G1 X#<a>*2 Y[1+2] (c)"), ("heidenhain", "L X+1.5 R0 FMAX"), ("sinumerik", "N10 G1 X=R1+2 Y20"), ("apt", "GOTO/1,2,3")],
+    [
+        ("iso", "G1 X#<a>*2 Y[1+2] (c)"),
+        ("heidenhain", "L X+1.5 R0 FMAX"),
+        ("sinumerik", "N10 G1 X=R1+2 Y20"),
+        ("apt", "GOTO/1,2,3"),
+    ],
 )
 def test_a_grammar_loaded_from_the_cache_parses_as_the_built_one(name, line, tmp_path, monkeypatch):
     monkeypatch.setenv("NCPP_CACHE", str(tmp_path))

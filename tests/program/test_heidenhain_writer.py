@@ -48,13 +48,17 @@ def test_signs_teach_no_new_style_and_the_feed_keeps_its_own():
     from ncpp.program.dialects.heidenhain import HeidenhainWriter
     from ncpp.program.dialects.iso import _MM
 
-    _, blocks = parse_program(io.BytesIO(b"1 L X+1.500 Y-2.500 F500\n2 L X-1.500 Y+2.500\n"), "t.h", "heidenhain")
+    _, blocks = parse_program(
+        io.BytesIO(b"1 L X+1.500 Y-2.500 F500\n2 L X-1.500 Y+2.500\n"), "t.h", "heidenhain"
+    )
     writer = HeidenhainWriter()
     first, second = blocks
     writer._learn_styles(first)
     x = writer._style("X", _MM)
     writer._learn_styles(second)
-    assert writer._resolved.get(("X", False)) is x and x.plus_sign and x.decimals == 4  # at least the writer's 4
+    assert (
+        writer._resolved.get(("X", False)) is x and x.plus_sign and x.decimals == 4
+    )  # at least the writer's 4
     assert writer.styles["X"] == writer.styles["Y"] and not writer.styles["F"].plus_sign
 
 
@@ -62,8 +66,12 @@ from hypothesis import given  # noqa: E402
 from hypothesis import strategies as st  # noqa: E402
 
 _klartext_numbers = st.builds(
-    lambda sign, whole, frac: sign + whole + frac, st.sampled_from(["", "+", "-"]), st.text("0123456789", min_size=1, max_size=3),
-    st.sampled_from(["", "."]).flatmap(lambda dot: st.text("0123456789", max_size=4).map(lambda d: dot + d if dot else "")),
+    lambda sign, whole, frac: sign + whole + frac,
+    st.sampled_from(["", "+", "-"]),
+    st.text("0123456789", min_size=1, max_size=3),
+    st.sampled_from(["", "."]).flatmap(
+        lambda dot: st.text("0123456789", max_size=4).map(lambda d: dot + d if dot else "")
+    ),
 )
 
 
@@ -79,8 +87,14 @@ def test_styles_learnt_per_number_pattern_are_each_numbers_own(pairs):
     _, blocks = parse_program(io.BytesIO(text.encode()), "t.h", "heidenhain")
     for block, (x, y) in zip(blocks, pairs):
         writer._learn_styles(block)
-        assert writer.styles["X"] == _signed(NumberStyle.of(x)) and writer.styles["IY"] == _signed(NumberStyle.of(y))
-        assert writer.styles["F"] == NumberStyle.of(y.lstrip("+-")) and "M" not in writer.styles and "N" not in writer.styles
+        assert writer.styles["X"] == _signed(NumberStyle.of(x)) and writer.styles["IY"] == _signed(
+            NumberStyle.of(y)
+        )
+        assert (
+            writer.styles["F"] == NumberStyle.of(y.lstrip("+-"))
+            and "M" not in writer.styles
+            and "N" not in writer.styles
+        )
     assert writer.known_axes == {"X", "Y"}
 
 
@@ -98,8 +112,10 @@ def test_a_pole_event_holds_the_cc_point_and_plane():
 def test_the_pole_written_back_after_an_edited_arc_is_the_programs():
     """An edited arc writes its own `CC` first; the unchanged arc after it needs the program's
     pole back, which here is the same point: no `CC` in the output names another point."""
-    program = ("0 BEGIN PGM T MM\n1 L X+0 Y+0 Z+0 R0 F500\n2 CC X+50 Y+50\n3 L X+60 Y+50\n"
-               "4 C X+50 Y+60 DR+\n5 C X+40 Y+50 DR+\n6 END PGM T MM\n")
+    program = (
+        "0 BEGIN PGM T MM\n1 L X+0 Y+0 Z+0 R0 F500\n2 CC X+50 Y+50\n3 L X+60 Y+50\n"
+        "4 C X+50 Y+60 DR+\n5 C X+40 Y+50 DR+\n6 END PGM T MM\n"
+    )
     lines = written(program, {5: (0.001, 0.0, 0.0)})  # file line 5: block 4
     poles = [line.split()[1:] for line in lines if line.split()[1:2] == ["CC"]]
     assert len(poles) >= 2  # the program's, and the edited arc's

@@ -11,10 +11,22 @@ import pytest
 
 from ncpp.errors import NcppError
 from ncpp.program.blocks import UNREADABLE
-from ncpp.program.parser import LineParser, _Cut, _digits_named, _flatten, _TreeLayouts, lalr_parser, parse_stream
+from ncpp.program.parser import (
+    LineParser,
+    _Cut,
+    _digits_named,
+    _flatten,
+    _TreeLayouts,
+    lalr_parser,
+    parse_stream,
+)
 from tests.conftest import corpus_files
 
-DIALECT_FOLDERS = {"iso": ("iso_gcode", "malformed"), "heidenhain": ("heidenhain",), "sinumerik": ("sinumerik",)}
+DIALECT_FOLDERS = {
+    "iso": ("iso_gcode", "malformed"),
+    "heidenhain": ("heidenhain",),
+    "sinumerik": ("sinumerik",),
+}
 
 # Lines whose layouts differ only where a grammar tells digits apart, and expression lines.
 LINES = {
@@ -101,20 +113,32 @@ def test_replay_agrees_with_the_lalr_parser_on_corpus(corpus, dialect):
             assert got == want if isinstance(want, tuple) else not isinstance(got, tuple), (path, block.line)
             checked += 1
     assert checked > {"iso": 5000, "heidenhain": 200, "sinumerik": 100}[dialect]
-    assert replays > {"iso": 10000, "heidenhain": 50, "sinumerik": 15}[dialect]  # lines built by the replay itself
-    assert cuts >= {"iso": 60, "heidenhain": 4, "sinumerik": 10}[dialect]  # and of those, cut from the line (82, 4, 12)
+    assert (
+        replays > {"iso": 10000, "heidenhain": 50, "sinumerik": 15}[dialect]
+    )  # lines built by the replay itself
+    assert (
+        cuts >= {"iso": 60, "heidenhain": 4, "sinumerik": 10}[dialect]
+    )  # and of those, cut from the line (82, 4, 12)
 
 
 def test_plain_klartext_blocks_are_cut_from_the_line():
     """`L X+1.5 Y+2 R0 F800`: the items are the constant ones (`L`, `R0`) and plain words;
     numbers with a decimal comma are left to the builder's own reading (the replay)."""
     parser = LineParser("heidenhain")
-    lines = ["4 L X+1.5 Y+2 R0 F800", "5 L X-2.5 Y+7 R0 F900", "6 L X+10,5 Y+2 R0 F800", "7 L X+11,5 Y+3 R0 F800", "8 L X+1.5 Y+2 R1 F800"]
+    lines = [
+        "4 L X+1.5 Y+2 R0 F800",
+        "5 L X-2.5 Y+7 R0 F900",
+        "6 L X+10,5 Y+2 R0 F800",
+        "7 L X+11,5 Y+3 R0 F800",
+        "8 L X+1.5 Y+2 R1 F800",
+    ]
     for line in lines:
         assert replayed(parser, line) == fresh(parser, line), line
     kinds = [type(parser._trees.known[parser._trees.layout(line)]).__name__ for line in lines]
     assert kinds == ["_Cut", "_Cut", "_Replay", "_Replay", "_Cut"]
-    assert replayed(parser, "9 L X+1.5 Y+2 R1 F800")[4] == fresh(parser, "9 L X+1.5 Y+2 R1 F800")[4]  # R1 kept: not R0's items
+    assert (
+        replayed(parser, "9 L X+1.5 Y+2 R1 F800")[4] == fresh(parser, "9 L X+1.5 Y+2 R1 F800")[4]
+    )  # R1 kept: not R0's items
 
 
 def test_grammars_name_digits_only_right_after_a_letter():

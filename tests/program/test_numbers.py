@@ -12,11 +12,16 @@ from ncpp.program.numbers import NumberStyle, _format_any, format_number
 values = st.one_of(
     st.floats(allow_nan=True, allow_infinity=True),
     st.floats(min_value=-1e-3, max_value=1e-3),
-    st.integers(-10**6, 10**6).map(lambda n: n / 2000),
+    st.integers(-(10**6), 10**6).map(lambda n: n / 2000),
 )
 
 
-@given(values, st.sampled_from(["1.5", "-1.5", "10.000", "0.0001", "-0.25000000", "123.45678", "+1.5", "+10.000", "+0.0001"]))
+@given(
+    values,
+    st.sampled_from(
+        ["1.5", "-1.5", "10.000", "0.0001", "-0.25000000", "123.45678", "+1.5", "+10.000", "+0.0001"]
+    ),
+)
 def test_fast_format_is_the_general_one(value, written):
     style = NumberStyle.of(written)
     assert style.plain

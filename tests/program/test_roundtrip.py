@@ -64,7 +64,11 @@ def test_unreadable_lines_that_do_not_run_pass_through_with_a_warning(tmp_path):
     with open(path, "rb") as stream:
         process(stream, out, file=str(path), warnings=Warnings(stream=said))
     assert out.getvalue() == text.encode()
-    assert [line.split(": warning")[0] for line in said.getvalue().splitlines()] == [f"{path}:3:12", f"{path}:7:7", f"{path}:10:2"]
+    assert [line.split(": warning")[0] for line in said.getvalue().splitlines()] == [
+        f"{path}:3:12",
+        f"{path}:7:7",
+        f"{path}:10:2",
+    ]
     with pytest.raises(NcppError, match="the line does not run here"), open(path, "rb") as stream:
         process(stream, io.BytesIO(), file=str(path), strict=True)
     path.write_text(text.replace("o2 if [0]", "o2 if [1]"))
@@ -97,7 +101,17 @@ def test_lines_of_one_layout_are_read_as_the_scanner_reads_each():
     """Lines differing only in their digits are cut where the first one had its words:
     numbers, G numbers in the signature, blanks inside a number, text not from bytes."""
     parser, scanner = LineParser("iso"), LineParser("iso")
-    for raw in ["G1 X1.5 Y-2", "G0 X7.0 Y-9", "G90G1X1", "G91G0X2", " X - 5", " X - 6", "X1 (a)", "X2 (b)", "X1 (\u20ac)"]:
+    for raw in [
+        "G1 X1.5 Y-2",
+        "G0 X7.0 Y-9",
+        "G90G1X1",
+        "G91G0X2",
+        " X - 5",
+        " X - 6",
+        "X1 (a)",
+        "X2 (b)",
+        "X1 (\u20ac)",
+    ]:
         assert parser._scan_plain(raw)[:2] == scanner._scan_items(raw), raw
     assert parser._scan_plain("G0 X7.0 Y-9")[1:] == ("G0XY", b"G1 X1.1 Y-1")
     assert parser._scan_plain("X1 (\u20ac)")[2] is None  # (text not from bytes: no layout)
@@ -115,7 +129,9 @@ def test_a_stray_character_is_left_to_the_lalr_parser(raw):
 
 def test_cli_passthrough_is_byte_identical(corpus, tmp_path):
     path = CORPUS / "iso_gcode/cncjs_toolpath_fixtures/arc-no-plane.nc"  # CRLF
-    out = subprocess.run([sys.executable, "-m", "ncpp"], input=path.read_bytes(), capture_output=True, check=True)
+    out = subprocess.run(
+        [sys.executable, "-m", "ncpp"], input=path.read_bytes(), capture_output=True, check=True
+    )
     assert out.stdout == path.read_bytes()
     target = tmp_path / "out.nc"
     subprocess.run([sys.executable, "-m", "ncpp", str(path), "-o", str(target)], check=True)
@@ -126,7 +142,9 @@ def test_cli_error_has_location_no_traceback_and_no_output(tmp_path):
     bad = tmp_path / "bad.nc"
     bad.write_bytes(b"G1 X1\nG1 X2 Y(unclosed\nG1 X3\n")
     target = tmp_path / "out.nc"
-    proc = subprocess.run([sys.executable, "-m", "ncpp", str(bad), "-o", str(target)], capture_output=True, text=True)
+    proc = subprocess.run(
+        [sys.executable, "-m", "ncpp", str(bad), "-o", str(target)], capture_output=True, text=True
+    )
     assert proc.returncode != 0
     assert proc.stderr.startswith(f"{bad}:2:")
     assert "Traceback" not in proc.stderr
@@ -135,7 +153,10 @@ def test_cli_error_has_location_no_traceback_and_no_output(tmp_path):
     assert proc.returncode != 0 and proc.stdout == b""
 
 
-@pytest.mark.parametrize("program, name", [(b"%\nG1 X1 F100\n%\n", "p.ngc"), (b"BEGIN PGM X MM\nL X+1 R0 FMAX\nEND PGM X MM\n", "p.h")])
+@pytest.mark.parametrize(
+    "program, name",
+    [(b"%\nG1 X1 F100\n%\n", "p.ngc"), (b"BEGIN PGM X MM\nL X+1 R0 FMAX\nEND PGM X MM\n", "p.h")],
+)
 def test_a_byte_order_mark_is_named_not_shown_as_latin_1(program, name):
     with pytest.raises(NcppError) as err:
         list(parse_program(io.BytesIO(b"\xef\xbb\xbf" + program), name, None)[1])
@@ -143,10 +164,17 @@ def test_a_byte_order_mark_is_named_not_shown_as_latin_1(program, name):
 
 
 def test_lines_ended_by_cr_alone_are_refused_not_read_as_one_line():
-    with pytest.raises(NcppError, match=r"^p\.ngc:1:2: the program's lines end in a carriage return \(CR\) alone"):
+    with pytest.raises(
+        NcppError, match=r"^p\.ngc:1:2: the program's lines end in a carriage return \(CR\) alone"
+    ):
         list(parse_program(io.BytesIO(b"%\rG21 G90\rG1 X10 F100\r%\r"), "p.ngc", None)[1])
     blank_crs = b"G21\r\r\nG1 X1 F100 \r\r\n"  # a CR doubled before the LF ends the line still
-    assert b"".join(b.raw.encode() + b.eol.encode() for b in parse_program(io.BytesIO(blank_crs), "p.ngc", None)[1]) == blank_crs
+    assert (
+        b"".join(
+            b.raw.encode() + b.eol.encode() for b in parse_program(io.BytesIO(blank_crs), "p.ngc", None)[1]
+        )
+        == blank_crs
+    )
 
 
 # Programs LinuxCNC's interpreter refuses too (rs274 prints the same error):
@@ -194,7 +222,9 @@ def test_blanks_between_a_numbers_digits_are_read_as_rs274_reads_them(raw, words
     """rs274ngc reads a line with its blanks removed: `X1 5` is X15.  The word's span
     covers its digits and the blanks between them, not a blank after the last one."""
     parser = LineParser("iso")
-    for _ in range(2):  # the first read learns the line's layout; the second goes as it says (to the scanner again: blanks in a number)
+    for _ in range(
+        2
+    ):  # the first read learns the line's layout; the second goes as it says (to the scanner again: blanks in a number)
         found = parser.parse(raw).words()
         assert [(w.letter, w.value, w.number) for w in found] == words
         assert all(not raw[w.start : w.end].endswith(" ") for w in found)

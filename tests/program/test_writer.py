@@ -19,7 +19,13 @@ def edit(text: str, values: dict, drop=(), motion=None, style: str = "1.000") ->
 @pytest.mark.parametrize(
     "text, values, drop, motion, expected",
     [
-        ("N10 G02 X10. Y-2.500 I5 J0 (cut) F100", {"X": 10.0012, "Y": -2.4}, "IJ", 3, "N10 G03 X10.001 Y-2.400 (cut) F100"),
+        (
+            "N10 G02 X10. Y-2.500 I5 J0 (cut) F100",
+            {"X": 10.0012, "Y": -2.4},
+            "IJ",
+            3,
+            "N10 G03 X10.001 Y-2.400 (cut) F100",
+        ),
         ("g1x.5y2i3", {"X": 0.25, "Z": 3.0}, ("Y", "I"), None, "g1x0.250z3.000"),
         ("N10 X1", {"X": 1.0, "Y": 2.0}, (), 1, "N10 G1 X1.000 Y2.000"),  # the inserted G is not a separator
         ("M3 S100 ; spindle", {"X": 1.0}, (), None, "M3 S100 X1.000 ; spindle"),
@@ -53,7 +59,7 @@ def test_a_dropped_leading_word_takes_the_separator_after_it(text, values, drop,
     block = parse_text(text + "\n")[0]
     if block.signature is not None:
         words = block.words()
-        fields = {letter: "{%d:.3f}" % n for n, letter in enumerate(values)}
+        fields = {letter: f"{{{n}:.3f}}" for n, letter in enumerate(values)}
         plan = EditPlan.compile([w.letter for w in words], fields, len(values), drop, spelled=spelling(block))
         assert plan is None or plan.apply(block.raw, words, list(values.values())) == expected
 
@@ -77,8 +83,9 @@ def test_a_compensated_corner_block_starts_with_its_first_word():
     """`,R1 X10`: compensation writes the corner out and drops `,R`; the line keeps no blank for it."""
     lines = _compensated_lines(b"G21 G90\nG1 X0 Y0 F100\n,R1 X10\nN20 ,R1 X4 Y5\nX0\nM2\n", "t.ngc")
     assert not [line for line in lines if line[:1].isspace() or "  " in line or ",R" in line]
-    assert lines[3].startswith("X") and any(line.startswith("N20 G1 X") for line in lines)  # G1: after the corner arc
-
+    assert lines[3].startswith("X") and any(
+        line.startswith("N20 G1 X") for line in lines
+    )  # G1: after the corner arc
 
 
 def test_sinumerik_blocks_losing_their_leading_word_start_with_the_next():
@@ -175,17 +182,23 @@ def test_edit_plan_writes_what_edit_texts_writes(text, seed, letters, drop, moti
     for every block of that layout and G words, when it keeps no other numbers and comments."""
     block = parse_text(text + "\n")[0]
     words = block.words()
-    first_g = next(((n, w.number) for n, w in enumerate(words) if w.letter == "G" and w.value in (0, 1, 2, 3)), None)
+    first_g = next(
+        ((n, w.number) for n, w in enumerate(words) if w.letter == "G" and w.value in (0, 1, 2, 3)), None
+    )
     if motion is not None and first_g is not None and motion == int(words[first_g[0]].value):
         motion = None  # `_with_motion` leaves the word: the plan is compiled without it
-    fields = {letter: "{%d}" % n for n, letter in enumerate(letters)}
-    plan = EditPlan.compile([w.letter for w in words], fields, len(letters), drop, motion, first_g, spelling(block))
+    fields = {letter: f"{{{n}}}" for n, letter in enumerate(letters)}
+    plan = EditPlan.compile(
+        [w.letter for w in words], fields, len(letters), drop, motion, first_g, spelling(block)
+    )
     if plan is None:
         return
     texts = {letter: f"{n}.5" for n, letter in enumerate(letters)}
     assert plan.apply(block.raw, words, list(texts.values())) == edit_texts(block, texts, drop, motion)
     sibling = parse_text(_other_digits(text, seed) + "\n")[0]
-    same_g = [w.number for w in sibling.words() if w.letter == "G"] == [w.number for w in words if w.letter == "G"]
+    same_g = [w.number for w in sibling.words() if w.letter == "G"] == [
+        w.number for w in words if w.letter == "G"
+    ]
     if same_g and not plan.keeps_numbers and len(words) == len(block.items):
         template = plan.template_for(block.raw, words)
         assert template.format(*texts.values()) == edit_texts(sibling, texts, drop, motion)
@@ -241,15 +254,35 @@ def test_planned_lines_are_the_general_lines(moves):
         pieces, shift = moves[n % len(moves)]
         if type(event) is Line or type(event) is Arc:
             end = tuple(v + shift for v in event.end)
-            steps = [Line(event.start, tuple(v - shift for v in end), False, 1.0, event.block, event.context, changed=True)]
-            moved += steps[:pieces] + [replace(event, end=end, changed=bool(shift) or pieces > 0)] + steps[:pieces // 2]
+            steps = [
+                Line(
+                    event.start,
+                    tuple(v - shift for v in end),
+                    False,
+                    1.0,
+                    event.block,
+                    event.context,
+                    changed=True,
+                )
+            ]
+            moved += (
+                steps[:pieces]
+                + [replace(event, end=end, changed=bool(shift) or pieces > 0)]
+                + steps[: pieces // 2]
+            )
         else:
             moved.append(event)
     assert list(IsoWriter().write(moved)) == list(_unplanned_writer().write(moved))
 
 
 _digits = st.text("0123456789", max_size=3)
-_number = st.builds(lambda sign, whole, dot, frac: sign + whole + dot + frac, st.sampled_from(["", "-", "+"]), _digits, st.sampled_from(["", "."]), _digits)
+_number = st.builds(
+    lambda sign, whole, dot, frac: sign + whole + dot + frac,
+    st.sampled_from(["", "-", "+"]),
+    _digits,
+    st.sampled_from(["", "."]),
+    _digits,
+)
 
 
 @PLAN_EXAMPLES
@@ -266,7 +299,12 @@ def test_a_letter_is_written_in_the_style_of_its_last_number(numbers):
 
 
 @PLAN_EXAMPLES
-@given(st.lists(_number.filter(lambda n: any(c.isdigit() for c in n) and ("." in n or not n.endswith("."))), min_size=1))
+@given(
+    st.lists(
+        _number.filter(lambda n: any(c.isdigit() for c in n) and ("." in n or not n.endswith("."))),
+        min_size=1,
+    )
+)
 def test_the_styles_kept_resolved_are_those_the_styles_learnt_resolve_to(numbers):
     """A new style that writes alike (`X1.125` then `X0.`) keeps what was resolved:
     it is what the styles learnt so far resolve to, in mm and in inch."""
@@ -343,8 +381,22 @@ def _sinumerik_moved(moves) -> list:
         pieces, shift = moves[n % len(moves)]
         if type(event) is Line or type(event) is Arc:
             end = tuple(v + shift for v in event.end)
-            steps = [Line(event.start, tuple(v - shift for v in end), n % 3 == 0, 1.0, event.block, event.context, changed=True)]
-            moved += steps[:pieces] + [replace(event, end=end, changed=bool(shift) or pieces > 0)] + steps[:pieces // 2]
+            steps = [
+                Line(
+                    event.start,
+                    tuple(v - shift for v in end),
+                    n % 3 == 0,
+                    1.0,
+                    event.block,
+                    event.context,
+                    changed=True,
+                )
+            ]
+            moved += (
+                steps[:pieces]
+                + [replace(event, end=end, changed=bool(shift) or pieces > 0)]
+                + steps[: pieces // 2]
+            )
         else:
             moved.append(event)
     return moved

@@ -19,11 +19,26 @@ from ncpp.motion.canon import read_canon
 from ncpp.motion.offsets import WorkOffsets
 from ncpp.motion.tools import ToolTable
 from tests.conftest import RS274
-from tests.motion.test_oracle import ORACLE_EXAMPLES, ours, refused_alike, rs274_error, run_rs274, same_calls, tool_table, without_comp
+from tests.motion.test_oracle import (
+    ORACLE_EXAMPLES,
+    ours,
+    refused_alike,
+    rs274_error,
+    run_rs274,
+    same_calls,
+    tool_table,
+    without_comp,
+)
 
 coordinate = st.integers(-40_000, 40_000).map(lambda n: f"{n / 1000:g}")
 line = st.builds(lambda g, x, y: f"G{g} X{x} Y{y}", st.sampled_from([0, 1, 1]), coordinate, coordinate)
-arc = st.builds(lambda g, x, y, r: f"G{g} X{x} Y{y} R{r / 1000:g}", st.sampled_from([2, 3]), coordinate, coordinate, st.integers(30_000, 60_000))
+arc = st.builds(
+    lambda g, x, y, r: f"G{g} X{x} Y{y} R{r / 1000:g}",
+    st.sampled_from([2, 3]),
+    coordinate,
+    coordinate,
+    st.integers(30_000, 60_000),
+)
 plunge = st.integers(-3_000, 3_000).map(lambda n: f"G1 Z{n / 1000:g}")
 codes = st.sampled_from([
     "G41.1 D0", "G41.1 D2", "G41.1 D10", "G42.1 D2", "G42.1 D6", "G41 D1", "G42", "G40", "G40",
@@ -36,7 +51,11 @@ programs = st.lists(st.one_of(line, line, arc, plunge, codes), min_size=3, max_s
 
 
 @pytest.mark.skipif(not RS274.exists(), reason="rs274 oracle not available")
-@settings(max_examples=ORACLE_EXAMPLES, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
+@settings(
+    max_examples=ORACLE_EXAMPLES,
+    deadline=None,
+    suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture],
+)
 @given(programs)
 def test_cutter_compensation_agrees_with_rs274(tmp_path, text):
     path = tmp_path / "comp.ngc"

@@ -12,9 +12,9 @@ import os
 import re
 import select
 import sys
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable
 
 import pytest
 
@@ -49,7 +49,15 @@ def filter_program(scratch: Path) -> Callable[[str, Path, Path], Filtered]:
             bars.append(_Progress())
             return bars[-1]
 
-        namespace = {"os": os, "re": re, "select": select, "sys": sys, "_": str, "t": _Screen(), "Progress": progress}
+        namespace = {
+            "os": os,
+            "re": re,
+            "select": select,
+            "sys": sys,
+            "_": str,
+            "t": _Screen(),
+            "Progress": progress,
+        }
         exec(code, namespace)
         exit_code, message = namespace["filter_program"](program_filter, str(infile), str(outfile))
         (bar,) = bars
@@ -61,7 +69,9 @@ def filter_program(scratch: Path) -> Callable[[str, Path, Path], Filtered]:
 def _defines(node: ast.stmt, function: str, name: str) -> bool:
     if isinstance(node, ast.FunctionDef):
         return node.name == function
-    return isinstance(node, ast.Assign) and any(isinstance(t, ast.Name) and t.id == name for t in node.targets)
+    return isinstance(node, ast.Assign) and any(
+        isinstance(t, ast.Name) and t.id == name for t in node.targets
+    )
 
 
 class _Screen:

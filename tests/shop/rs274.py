@@ -20,7 +20,14 @@ def run_rs274(path: Path) -> str:
     """rs274's canonical calls for a program; fails the test on any rs274 error."""
     if not RS274.exists():
         pytest.skip("rs274 oracle not available")
-    proc = subprocess.run([str(RS274), str(path)], capture_output=True, text=True, errors="replace", timeout=300, stdin=subprocess.DEVNULL)
+    proc = subprocess.run(
+        [str(RS274), str(path)],
+        capture_output=True,
+        text=True,
+        errors="replace",
+        timeout=300,
+        stdin=subprocess.DEVNULL,
+    )
     if "executing" not in proc.stderr:
         pytest.skip(f"rs274 oracle did not run: {proc.stderr.strip()[:200]}")
     messages = [line for line in proc.stderr.splitlines() if line.strip() and line.strip() != "executing"]

@@ -23,7 +23,10 @@ def _freecadcmd() -> str | None:
 
 FREECADCMD = _freecadcmd()
 MACHINE = ROOT / "samples/machines/hr5b.toml"
-pytestmark = pytest.mark.skipif(FREECADCMD is None, reason=f"{os.environ.get('NCPP_FREECADCMD') or 'freecadcmd (Debian package freecad)'} is not installed")
+pytestmark = pytest.mark.skipif(
+    FREECADCMD is None,
+    reason=f"{os.environ.get('NCPP_FREECADCMD') or 'freecadcmd (Debian package freecad)'} is not installed",
+)
 
 
 @pytest.fixture(scope="module")
@@ -35,7 +38,7 @@ def posted(tmp_path_factory):
     macros.mkdir(parents=True)
     shutil.copy(ROOT / "plugins/freecad/ncpp_post.py", macros)
     ncpp = tmp / "ncpp"  # the ncpp command of this checkout (an installed one is on PATH as `ncpp`)
-    ncpp.write_text(f"#!/bin/sh\nPYTHONPATH={ROOT} exec {sys.executable} -m ncpp \"$@\"\n")
+    ncpp.write_text(f'#!/bin/sh\nPYTHONPATH={ROOT} exec {sys.executable} -m ncpp "$@"\n')
     ncpp.chmod(0o755)
     env = {k: v for k, v in os.environ.items() if k not in ("NCPP_MACHINE", "XDG_CONFIG_HOME", "PYTHONPATH")}
     env.update(
@@ -49,7 +52,15 @@ def posted(tmp_path_factory):
         NCPP_BASE_OUT=str(tmp / "grbl.nc"),
         NCPP_BASE_ARGS=f"--base grbl --machine {MACHINE} --work-offset 400,350,300",
     )
-    proc = subprocess.run([FREECADCMD, str(ROOT / "tests/shop/freecad/post_job.py")], capture_output=True, text=True, errors="replace", cwd=tmp, env=env, timeout=600)
+    proc = subprocess.run(
+        [FREECADCMD, str(ROOT / "tests/shop/freecad/post_job.py")],
+        capture_output=True,
+        text=True,
+        errors="replace",
+        cwd=tmp,
+        env=env,
+        timeout=600,
+    )
     if "NCPP_POSTED" not in proc.stdout:
         pytest.fail("FreeCAD did not post:\n" + proc.stdout[-3000:] + proc.stderr[-2000:])
     return tmp / "compensated.ngc", tmp / "plain.ngc", proc.stdout
@@ -100,15 +111,26 @@ def test_the_post_passes_every_fixture_zero_to_ncpp(tmp_path, monkeypatch):
     plugin = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(plugin)
     options, rest = plugin.parser.parse_known_args(
-        ["--machine", "m.toml", "--work-offset", "250,300,300", "--work-offset", "G55=550,400,250", "--var-file", "l.var",
-         "--tool-table", "t.tbl", "--no-comments"]  # fmt: skip
+        [
+            "--machine",
+            "m.toml",
+            "--work-offset",
+            "250,300,300",
+            "--work-offset",
+            "G55=550,400,250",
+            "--var-file",
+            "l.var",
+            "--tool-table",
+            "t.tbl",
+            "--no-comments",
+        ]  # fmt: skip
     )
     assert plugin._ncpp_arguments(options) == [
         "--machine", "m.toml", "--var-file", "l.var", "--tool-table", "t.tbl", "--work-offset", "250,300,300", "--work-offset", "G55=550,400,250",
     ]  # fmt: skip
     assert rest == ["--no-comments"]  # for FreeCAD's linuxcnc_post
     ncpp = tmp_path / "ncpp"
-    ncpp.write_text(f"#!/bin/sh\nPYTHONPATH={ROOT} exec {sys.executable} -m ncpp \"$@\"\n")
+    ncpp.write_text(f'#!/bin/sh\nPYTHONPATH={ROOT} exec {sys.executable} -m ncpp "$@"\n')
     ncpp.chmod(0o755)
     monkeypatch.setenv("NCPP", str(ncpp))
     program = "G21 G90 G54\nG0 X10 Y10 Z5\nG1 Z-1 F100\nG55\nG1 X20 Y20\nM2\n"
@@ -116,7 +138,7 @@ def test_the_post_passes_every_fixture_zero_to_ncpp(tmp_path, monkeypatch):
     text = plugin.compensate_text(program, both)
     assert "G55" in text and text.startswith("(ncpp compensated")
     only_g54 = plugin.compensate_text(program, f"--machine {MACHINE} --work-offset 250,300,300")
-    g55_part = lambda text: text[text.index("G55"):]  # noqa: E731
+    g55_part = lambda text: text[text.index("G55") :]  # noqa: E731
     assert g55_part(text) != g55_part(only_g54)  # compensated where G55 really is
     assert text[: text.index("G55")] == only_g54[: only_g54.index("G55")]
 

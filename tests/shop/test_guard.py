@@ -162,7 +162,9 @@ def test_a_sinumerik_program_gets_its_settable_frame_checked_and_ncpp_still_read
     written = run("compensate", "p.mpf", "-o", "out.mpf")
     assert written.returncode == 0, written.stderr
     lines = (tmp_path / "out.mpf").read_text().splitlines()
-    k = next(n for n, line in enumerate(lines) if line.startswith("; ncpp placement guard:"))  # after the header's lines
+    k = next(
+        n for n, line in enumerate(lines) if line.startswith("; ncpp placement guard:")
+    )  # after the header's lines
     lines = lines[k - 1 :]  # (as if the header were one line)
     assert lines[2] == (
         "IF ($P_UIFRNUM<>1) OR (ABS($P_UIFR[1,X,TR]+$P_UIFR[1,X,FI]-400)>0.1) OR "

@@ -41,7 +41,13 @@ def filter_environment(tmp_path) -> dict[str, str]:
 
 
 def run_filter(path, tmp_path, **env):
-    return subprocess.run([str(FILTER), str(path)], capture_output=True, cwd=tmp_path, env={**filter_environment(tmp_path), **env}, timeout=300)
+    return subprocess.run(
+        [str(FILTER), str(path)],
+        capture_output=True,
+        cwd=tmp_path,
+        env={**filter_environment(tmp_path), **env},
+        timeout=300,
+    )
 
 
 def test_ini_lines_name_the_filter_for_ngc_and_nc():
@@ -62,7 +68,9 @@ def test_filter_compensates_reports_progress_and_rs274_accepts_it(program, tmp_p
     out = tmp_path / "compensated.ngc"
     out.write_bytes(proc.stdout)
     assert proc.stdout.startswith(b"(ncpp compensated for hr5b.toml")
-    var = tmp_path / "g54.var"  # the G54 the placement guard checks (its raw values: rs274's units are inches)
+    var = (
+        tmp_path / "g54.var"
+    )  # the G54 the placement guard checks (its raw values: rs274's units are inches)
     var.write_text("5220\t1.000000\n5221\t400.000000\n5222\t350.000000\n5223\t300.000000\n")
     compensated, plain = end_points(run_rs274_from(var, out)), end_points(run_rs274(program))
     assert len(compensated) >= len(plain) and compensated != plain
@@ -95,14 +103,18 @@ def test_the_parameter_file_places_the_program_as_linuxcnc_does(tmp_path):
     """`var_file` in the config: G54 from LinuxCNC's parameter file, the same output as
     `work_offset` saying the same zero."""
     pocket = ROOT / "samples/programs/pocket.ngc"
-    (tmp_path / "linuxcnc.var").write_text("5220\t1.000000\n5221\t400.000000\n5222\t350.000000\n5223\t300.000000\n")
+    (tmp_path / "linuxcnc.var").write_text(
+        "5220\t1.000000\n5221\t400.000000\n5222\t350.000000\n5223\t300.000000\n"
+    )
     (tmp_path / "ncpp.toml").write_text(f'machine = "{MACHINE}"\nvar_file = "linuxcnc.var"\n')
     from_var = run_filter(pocket, tmp_path)
     (tmp_path / "ncpp.toml").write_text(f'machine = "{MACHINE}"\nwork_offset = [400, 350, 300]\n')
     given = run_filter(pocket, tmp_path)
     assert from_var.returncode == 0 and given.returncode == 0, from_var.stderr.decode()
     assert from_var.stdout == given.stdout and from_var.stdout.startswith(b"%\n(ncpp compensated")
-    (tmp_path / "ncpp.toml").write_text(f'machine = "{MACHINE}"\n')  # G54 at the machine zero: outside the travel
+    (tmp_path / "ncpp.toml").write_text(
+        f'machine = "{MACHINE}"\n'
+    )  # G54 at the machine zero: outside the travel
     assert run_filter(pocket, tmp_path).returncode == 2
 
 
@@ -151,15 +163,21 @@ def test_the_configuration_linuxcnc_runs_gives_its_parameter_file_and_tool_table
     (lcnc / "tool.tbl").write_text("T1 P1 Z+120.0 D6.0\n")
     (tmp_path / "ncpp.toml").write_text(f'machine = "{MACHINE}"\n')
     from_ini = run_filter(program, tmp_path, INI_FILE_NAME=str(lcnc / "mill.ini"))
-    (tmp_path / "ncpp.toml").write_text(f'machine = "{MACHINE}"\nwork_offset = [400, 350, 300]\ntool_table = "configs/mill/tool.tbl"\n')
+    (tmp_path / "ncpp.toml").write_text(
+        f'machine = "{MACHINE}"\nwork_offset = [400, 350, 300]\ntool_table = "configs/mill/tool.tbl"\n'
+    )
     given = run_filter(program, tmp_path)
     told = [line for line in from_ini.stderr.splitlines() if not line.startswith(b"FILTER_PROGRESS")]
-    assert from_ini.returncode == 0 and len(told) == 1 and b"tool.ngc: compensated 16 moves" in told[0], from_ini.stderr  # no warning
+    assert from_ini.returncode == 0 and len(told) == 1 and b"tool.ngc: compensated 16 moves" in told[0], (
+        from_ini.stderr
+    )  # no warning
     assert from_ini.stdout == given.stdout and from_ini.stdout.startswith(b"%\n(ncpp compensated")
     (lcnc / "sim.var").unlink()  # a fresh configuration: LinuxCNC starts with all zeros, and so does ncpp
     (tmp_path / "ncpp.toml").write_text(f'machine = "{MACHINE}"\n')
     fresh = run_filter(program, tmp_path, INI_FILE_NAME=str(lcnc / "mill.ini"))
-    assert fresh.returncode == 2 and b"outside the" in fresh.stderr  # G54 at the machine zero: the pocket leaves the travel
+    assert (
+        fresh.returncode == 2 and b"outside the" in fresh.stderr
+    )  # G54 at the machine zero: the pocket leaves the travel
 
 
 def test_the_filter_runs_subroutine_files_from_the_ini_subroutine_path(tmp_path):
@@ -168,17 +186,23 @@ def test_the_filter_runs_subroutine_files_from_the_ini_subroutine_path(tmp_path)
     program's own moves after the call; without the path the rest would pass uncompensated."""
     lcnc = tmp_path / "configs" / "mill"
     (lcnc / "subs").mkdir(parents=True)
-    (lcnc / "mill.ini").write_text(INI.replace("PARAMETER_FILE = sim.var", "PARAMETER_FILE = sim.var\nSUBROUTINE_PATH = subs"))
+    (lcnc / "mill.ini").write_text(
+        INI.replace("PARAMETER_FILE = sim.var", "PARAMETER_FILE = sim.var\nSUBROUTINE_PATH = subs")
+    )
     (lcnc / "sim.var").write_text("5220\t1.000000\n5221\t400.000000\n5222\t350.000000\n5223\t300.000000\n")
     (lcnc / "subs" / "slot.ngc").write_text("o<slot> sub\nG1 X[#1 + #3] F200\nG1 X#1\no<slot> endsub\n")
     program = tmp_path / "part.ngc"
-    program.write_text("G21 G90 G17\nG0 X0 Y0 Z5\nG1 Z-1 F200\nG1 X20 Y10\no<slot> call [20] [10] [15]\nG1 X40 Y30\nG0 Z5\nM2\n")
+    program.write_text(
+        "G21 G90 G17\nG0 X0 Y0 Z5\nG1 Z-1 F200\nG1 X20 Y10\no<slot> call [20] [10] [15]\nG1 X40 Y30\nG0 Z5\nM2\n"
+    )
     (tmp_path / "ncpp.toml").write_text(f'machine = "{MACHINE}"\n')
     proc = run_filter(program, tmp_path, INI_FILE_NAME=str(lcnc / "mill.ini"))
     assert proc.returncode == 0, proc.stderr
     lines = proc.stdout.decode().splitlines()
     call = lines.index("o<slot> call [20] [10] [15]")
-    assert lines[call - 1].startswith("X20.0") and lines[call + 1].startswith("G1 X")  # compensated on both sides
+    assert lines[call - 1].startswith("X20.0") and lines[call + 1].startswith(
+        "G1 X"
+    )  # compensated on both sides
     assert b"loop or subroutine" in proc.stderr and b"outside the motion interpreter" not in proc.stderr
 
 
@@ -203,7 +227,9 @@ def axis(tmp_path, monkeypatch):
 def _configure(folder):
     """An ncpp config placing the program, with the tool its G43 H1 applies (no warning)."""
     (folder / "tool.tbl").write_text("T1 P1 Z+50.0 D3.0\n")
-    (folder / "ncpp.toml").write_text(f'machine = "{MACHINE}"\nwork_offset = [400, 350, 300]\ntool_table = "tool.tbl"\n')
+    (folder / "ncpp.toml").write_text(
+        f'machine = "{MACHINE}"\nwork_offset = [400, 350, 300]\ntool_table = "tool.tbl"\n'
+    )
 
 
 def _summary_only(message: str) -> bool:
@@ -217,9 +243,15 @@ def test_axis_loads_the_program_the_filter_compensated(program, tmp_path, axis):
     out = tmp_path / "loaded.ngc"
     filtered = axis(program, out)
     assert filtered.exit_code == 0 and _summary_only(filtered.message), filtered.message
-    assert filtered.progress[0] == 0 and filtered.progress[-1] == 100 and filtered.progress == sorted(filtered.progress)
+    assert (
+        filtered.progress[0] == 0
+        and filtered.progress[-1] == 100
+        and filtered.progress == sorted(filtered.progress)
+    )
     assert filtered.closed
-    assert out.read_bytes() == run_filter(program, tmp_path).stdout  # AXIS's closed standard input changes nothing
+    assert (
+        out.read_bytes() == run_filter(program, tmp_path).stdout
+    )  # AXIS's closed standard input changes nothing
 
 
 def test_axis_shows_the_filters_error_and_loads_nothing(tmp_path, axis):
@@ -229,7 +261,9 @@ def test_axis_shows_the_filters_error_and_loads_nothing(tmp_path, axis):
     out = tmp_path / "loaded.ngc"
     filtered = axis(bad, out)
     assert filtered.exit_code == 2 and out.read_bytes() == b""
-    assert filtered.message.startswith(f"{bad}:2:4: ")  # at the X word and "outside the X travel" in filtered.message
+    assert filtered.message.startswith(
+        f"{bad}:2:4: "
+    )  # at the X word and "outside the X travel" in filtered.message
 
 
 def test_axis_filters_a_long_program_with_its_progress_bar(program, tmp_path, axis):
@@ -263,8 +297,16 @@ def test_the_operator_sees_the_summary_and_each_kind_of_warning_when_the_program
     var.write_text("5220\t1.000000\n5221\t400.000000\n5222\t350.000000\n5223\t300.000000\n")
     canon = run_rs274_from(var, out, "T1 P1 D0.1 Z0\n")
     messages = re.findall(r'MESSAGE\("\s*(.*)"\)', canon)
-    assert messages[0].startswith("ncpp: drill.ngc: compensated 3 moves") and "largest correction" in messages[0]
+    assert (
+        messages[0].startswith("ncpp: drill.ngc: compensated 3 moves") and "largest correction" in messages[0]
+    )
     said = " ".join(messages)
-    assert "12 moves of canned cycles [lines 4-6]" in said and "3 moves under cutter compensation [lines 9-11]" in said
-    assert [m.split(":")[0] for m in messages if m.startswith("ncpp warning")] == ["ncpp warning line 4", "ncpp warning line 9"]
+    assert (
+        "12 moves of canned cycles [lines 4-6]" in said
+        and "3 moves under cutter compensation [lines 9-11]" in said
+    )
+    assert [m.split(":")[0] for m in messages if m.startswith("ncpp warning")] == [
+        "ncpp warning line 4",
+        "ncpp warning line 9",
+    ]
     assert canon.index("MESSAGE") < canon.index("STRAIGHT_")

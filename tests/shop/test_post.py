@@ -30,8 +30,15 @@ OFFSET = (400.0, 350.0, 300.0)
 def posted(path, dialect: str, source=None) -> str:
     out = io.BytesIO()
     with open(path, encoding="latin-1") as stream:
-        post(stream, out, file=str(path), dialect=dialect, source=source, warnings=Warnings(stream=io.StringIO()),
-             offsets=WorkOffsets.at(OFFSET))
+        post(
+            stream,
+            out,
+            file=str(path),
+            dialect=dialect,
+            source=source,
+            warnings=Warnings(stream=io.StringIO()),
+            offsets=WorkOffsets.at(OFFSET),
+        )
     return out.getvalue().decode("latin-1")
 
 
@@ -87,11 +94,16 @@ def test_arcs_are_posted_as_arcs(corpus):
     klartext = posted(path, "heidenhain").splitlines()
     cc = [n for n, ln in enumerate(klartext) if ln.split()[1] == "CC"]
     assert len(cc) == circles
-    assert all(klartext[n + 1].split()[1] == "C" and klartext[n + 1].split()[-1] in ("DR-", "DR+") for n in cc)
+    assert all(
+        klartext[n + 1].split()[1] == "C" and klartext[n + 1].split()[-1] in ("DR-", "DR+") for n in cc
+    )
     assert klartext[0] == "0 BEGIN PGM MFG0004 MM" and klartext[-1].endswith("END PGM MFG0004 MM")
     assert [int(ln.split()[0]) for ln in klartext] == list(range(len(klartext)))
     sinumerik = posted(path, "sinumerik")
-    assert sum(" I" in ln and " J" in ln for ln in sinumerik.splitlines()) == circles and "\n; PARTNO MFG0004" in sinumerik
+    assert (
+        sum(" I" in ln and " J" in ln for ln in sinumerik.splitlines()) == circles
+        and "\n; PARTNO MFG0004" in sinumerik
+    )
 
 
 @pytest.mark.parametrize("path", CL_FILES[:2] + CL_FILES[-1:], ids=corpus_id)
@@ -116,13 +128,18 @@ def test_post_command_writes_a_file(corpus, tmp_path):
     path = CORPUS / "apt_cldata/rybakov25/test.apt"
     proc = subprocess.run(
         [sys.executable, "-m", "ncpp", "post", str(path), "--dialect", "heidenhain", "-o", str(out)],
-        capture_output=True, text=True, cwd=ROOT,
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
     )
     assert proc.returncode == 0, proc.stderr
     assert "DELAY" not in proc.stderr
     lines = out.read_text().splitlines()
     assert lines[0] == "0 BEGIN PGM TEST_MACRO_LOAD MM"
-    assert [ln.split(" ", 1)[1] for ln in lines if "CYCL DEF 9" in ln] == ["CYCL DEF 9.0 DWELL TIME", "CYCL DEF 9.1 DWELL 2.5"]
+    assert [ln.split(" ", 1)[1] for ln in lines if "CYCL DEF 9" in ln] == [
+        "CYCL DEF 9.0 DWELL TIME",
+        "CYCL DEF 9.1 DWELL 2.5",
+    ]
 
 
 def test_changing_tool_vector_is_refused():
@@ -137,21 +154,33 @@ def test_changing_tool_vector_is_refused():
 
 def test_feed_move_without_feed_rate_is_refused():
     with pytest.raises(NcppError, match="no feed rate"):
-        post(io.StringIO("GOTO / 0, 0, 10\nGOTO / 5, 0, 10\n"), io.BytesIO(), file="nofeed.cls", dialect="sinumerik")
+        post(
+            io.StringIO("GOTO / 0, 0, 10\nGOTO / 5, 0, 10\n"),
+            io.BytesIO(),
+            file="nofeed.cls",
+            dialect="sinumerik",
+        )
 
 
 def test_error_stops_the_command_with_no_output(tmp_path):
     bad = tmp_path / "bad.cls"
     bad.write_text("FROM / 0, 0, 0\nCIRCLE / 0, 0, 0, 0, 0, 1, 5\nGOTO / 5, 0, 0\n")
     out = tmp_path / "out.ngc"
-    proc = subprocess.run([sys.executable, "-m", "ncpp", "post", str(bad), "--dialect", "iso", "-o", str(out)], capture_output=True, text=True, cwd=ROOT)
+    proc = subprocess.run(
+        [sys.executable, "-m", "ncpp", "post", str(bad), "--dialect", "iso", "-o", str(out)],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+    )
     assert proc.returncode == 2 and f"{bad}:2:1:" in proc.stderr
     assert not out.exists()
 
 
 def test_multi_turn_helix_splits_into_single_turns_keeping_the_pitch():
     block = Block(raw="", eol="\n", items=(), line=1)
-    helix = Arc(start=(5, 0, 0), end=(0, 5, -9), center=(0, 0, 0), turn=3, feed=100, block=block, context=Context())
+    helix = Arc(
+        start=(5, 0, 0), end=(0, 5, -9), center=(0, 0, 0), turn=3, feed=100, block=block, context=Context()
+    )
     pieces = list(single_turns(helix))
     assert len(pieces) == 3 and all(p.turn == 1 for p in pieces)
     assert pieces[-1].end == helix.end
@@ -176,13 +205,23 @@ def test_multi_turn_helix_splits_into_single_turns_keeping_the_pitch():
 )
 def test_a_unit_or_tool_the_post_cannot_write_is_refused(record, message):
     with pytest.raises(NcppError, match=message):
-        post(io.StringIO(f"{record}\nFEDRAT / 100\nGOTO / 1, 2, 3\nFINI\n"), io.BytesIO(), file="p.cls", dialect="iso")
+        post(
+            io.StringIO(f"{record}\nFEDRAT / 100\nGOTO / 1, 2, 3\nFINI\n"),
+            io.BytesIO(),
+            file="p.cls",
+            dialect="iso",
+        )
 
 
 def test_units_inches_and_mm_are_read():
     for unit in ("MM", "INCHES"):
         out = io.BytesIO()
-        post(io.StringIO(f"UNITS / {unit}\nLOADTL / 3\nFEDRAT / 100\nGOTO / 1, 2, 3\nFINI\n"), out, file="p.cls", dialect="iso")
+        post(
+            io.StringIO(f"UNITS / {unit}\nLOADTL / 3\nFEDRAT / 100\nGOTO / 1, 2, 3\nFINI\n"),
+            out,
+            file="p.cls",
+            dialect="iso",
+        )
         assert b"G20" in out.getvalue() if unit == "INCHES" else b"G21" in out.getvalue()
 
 
@@ -191,7 +230,12 @@ def test_units_inches_and_mm_are_read():
 def test_spindle_speed_is_written_as_given(dialect, rpm):
     """`SPINDL / 1000` was posted as S1 (trailing zeros dropped from a whole number)."""
     out = io.BytesIO()
-    post(io.StringIO(f"UNITS / MM\nSPINDL / RPM, {rpm}, CLW\nFEDRAT / 100\nGOTO / 0, 0, 0\nFINI\n"), out, file="s.cls", dialect=dialect)
+    post(
+        io.StringIO(f"UNITS / MM\nSPINDL / RPM, {rpm}, CLW\nFEDRAT / 100\nGOTO / 0, 0, 0\nFINI\n"),
+        out,
+        file="s.cls",
+        dialect=dialect,
+    )
     assert re.search(rf"\bS{rpm}\b", out.getvalue().decode()), out.getvalue().decode()
 
 

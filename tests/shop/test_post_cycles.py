@@ -255,9 +255,9 @@ def test_the_holes_moves_compensation_sees_are_the_ones_rs274_makes(tmp_path):
     program, _ = _post(cl, "linuxcnc")
     theirs = [(x, y, z, kind == "STRAIGHT_TRAVERSE") for kind, x, y, z in _rs274(tmp_path, program)]
     assert len(theirs) > 40
-    drilled = _drilled([
-        ("STRAIGHT_TRAVERSE" if fast else "STRAIGHT_FEED", x, y, z) for x, y, z, fast in ours
-    ])
+    drilled = _drilled(
+        [("STRAIGHT_TRAVERSE" if fast else "STRAIGHT_FEED", x, y, z) for x, y, z, fast in ours]
+    )
     assert {xy: drilled.get(xy) for xy in NX_HOLES} == {xy: bottom for xy, (bottom, _) in NX_HOLES.items()}
     ours, theirs = _without_repeats(ours), _without_repeats(theirs)
     assert len(ours) == len(theirs)

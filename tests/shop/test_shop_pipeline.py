@@ -33,7 +33,10 @@ def env_of(shop: Path, **extra: str) -> dict[str, str]:
 
 def test_config_files_are_searched_in_the_documented_order(shop):
     env = env_of(shop)
-    assert config_paths(shop / "work", env) == [shop / "work/ncpp.toml", shop / "home/.config/ncpp/config.toml"]
+    assert config_paths(shop / "work", env) == [
+        shop / "work/ncpp.toml",
+        shop / "home/.config/ncpp/config.toml",
+    ]
     env["XDG_CONFIG_HOME"] = str(shop / "xdg")
     assert config_paths(shop / "work", env)[1] == shop / "xdg/ncpp/config.toml"
 
@@ -48,7 +51,9 @@ def test_lookup_order_option_then_environment_then_local_then_user_config(shop):
     (work / "ncpp.toml").write_text('machine = "m/hr5b.toml"\nwork_offset = [400, 350, 300]\n')
     local = find_settings(cwd=work, env=env)
     assert local.machine == str(work / "m/hr5b.toml")  # relative to the config file
-    assert local.zeros == {"G54": (400.0, 350.0, 300.0)} and local.tolerance == 0.001  # only the first file is read
+    assert (
+        local.zeros == {"G54": (400.0, 350.0, 300.0)} and local.tolerance == 0.001
+    )  # only the first file is read
     assert local.origin == str(work / "ncpp.toml")
     env["NCPP_MACHINE"] = "/env/m.toml"
     assert find_settings(cwd=work, env=env).machine == "/env/m.toml"
@@ -64,8 +69,13 @@ def test_no_machine_anywhere(shop):
 
 @pytest.mark.parametrize(
     "text, message",
-    [("machine = 3\n", "path string"), ("tolerance = -1\n", "positive"), ("work_offset = [1, 2]\n", r"\[x, y, z\]"),
-     ("mashine = 'a'\n", "unknown key"), ("machine = \n", "not a valid TOML")],
+    [
+        ("machine = 3\n", "path string"),
+        ("tolerance = -1\n", "positive"),
+        ("work_offset = [1, 2]\n", r"\[x, y, z\]"),
+        ("mashine = 'a'\n", "unknown key"),
+        ("machine = \n", "not a valid TOML"),
+    ],
 )
 def test_bad_config_is_an_error_naming_the_file(shop, text, message):
     (shop / "work/ncpp.toml").write_text(text)
@@ -83,11 +93,17 @@ def test_config_paths_and_the_linuxcnc_ini_files(shop):
     assert settings.tool_table == str(work / "lcnc/tool.tbl") and settings.var_file is None
     ini = work / "lcnc/mill.ini"
     ini.parent.mkdir()
-    ini.write_text("[TRAJ]\nLINEAR_UNITS = imperial\n[RS274NGC]\nPARAMETER_FILE = sim.var\n[EMCIO]\nTOOL_TABLE = other.tbl\n")
+    ini.write_text(
+        "[TRAJ]\nLINEAR_UNITS = imperial\n[RS274NGC]\nPARAMETER_FILE = sim.var\n[EMCIO]\nTOOL_TABLE = other.tbl\n"
+    )
     assert with_linuxcnc_ini(settings, ini).var_file is None  # no sim.var yet: LinuxCNC starts from zeros
     (ini.parent / "sim.var").write_text("5220 1\n")
     merged = with_linuxcnc_ini(settings, ini)
-    assert merged.var_file == str(ini.parent / "sim.var") and merged.tool_table == settings.tool_table and merged.var_units == "inch"
+    assert (
+        merged.var_file == str(ini.parent / "sim.var")
+        and merged.tool_table == settings.tool_table
+        and merged.var_units == "inch"
+    )
     plain = with_linuxcnc_ini(find_settings(cwd=shop, env=env_of(shop)), ini)
     assert plain.var_units == "inch" and plain.tool_table is None  # other.tbl does not exist
     assert with_linuxcnc_ini(settings, None) is settings
@@ -96,7 +112,13 @@ def test_config_paths_and_the_linuxcnc_ini_files(shop):
 def ncpp(shop: Path, *args: str, stdin: str = PROGRAM, **env: str) -> subprocess.CompletedProcess:
     full_env = {k: v for k, v in os.environ.items() if k not in ("NCPP_MACHINE", "XDG_CONFIG_HOME")}
     full_env.update(env_of(shop, **env), PYTHONPATH=str(ROOT))
-    return subprocess.run([sys.executable, "-m", "ncpp", *args], input=stdin.encode(), capture_output=True, cwd=shop / "work", env=full_env)
+    return subprocess.run(
+        [sys.executable, "-m", "ncpp", *args],
+        input=stdin.encode(),
+        capture_output=True,
+        cwd=shop / "work",
+        env=full_env,
+    )
 
 
 def test_without_a_machine_file_the_filter_passes_through(shop):
@@ -118,20 +140,40 @@ def test_machine_from_the_environment_compensates(shop):
 
 
 def test_machine_from_the_local_config_compensates(shop):
-    (shop / "work/ncpp.toml").write_text(f'machine = "{MACHINE}"\nwork_offset = [400, 350, 300]\ntolerance = 0.002\n')
+    (shop / "work/ncpp.toml").write_text(
+        f'machine = "{MACHINE}"\nwork_offset = [400, 350, 300]\ntolerance = 0.002\n'
+    )
     proc = ncpp(shop)
     assert proc.returncode == 0, proc.stderr.decode()
     digest = proc.stdout.decode().split("sha256:")[1].split()[0]
-    assert proc.stdout.decode().splitlines()[0] == f"(ncpp compensated for hr5b.toml sha256:{digest} tolerance 0.002 mm by ncpp {package_version})"
+    assert (
+        proc.stdout.decode().splitlines()[0]
+        == f"(ncpp compensated for hr5b.toml sha256:{digest} tolerance 0.002 mm by ncpp {package_version})"
+    )
 
 
 @pytest.mark.parametrize(
     "case, stdin, env, message",
     [
-        ("missing machine file", PROGRAM, {"NCPP_MACHINE": "/no/such.toml"}, "NCPP_MACHINE: machine file /no/such.toml does not exist"),
+        (
+            "missing machine file",
+            PROGRAM,
+            {"NCPP_MACHINE": "/no/such.toml"},
+            "NCPP_MACHINE: machine file /no/such.toml does not exist",
+        ),
         ("unreadable program", "G1 X1 F100\nG2 X3 Y0 R0.1\nM2\n", {}, "<stdin>:2:"),
-        ("compensated twice", "(ncpp compensated for hr5b.toml sha256:0 tolerance 0.001 mm)\n" + PROGRAM, {"NCPP_MACHINE": str(MACHINE)}, "already compensated"),
-        ("outside the travel", "G21 G90\nG0 X5000 Y10 Z10\nM2\n", {"NCPP_MACHINE": str(MACHINE)}, "<stdin>:2:"),
+        (
+            "compensated twice",
+            "(ncpp compensated for hr5b.toml sha256:0 tolerance 0.001 mm)\n" + PROGRAM,
+            {"NCPP_MACHINE": str(MACHINE)},
+            "already compensated",
+        ),
+        (
+            "outside the travel",
+            "G21 G90\nG0 X5000 Y10 Z10\nM2\n",
+            {"NCPP_MACHINE": str(MACHINE)},
+            "<stdin>:2:",
+        ),
     ],
 )
 def test_any_error_stops_the_pipeline(shop, case, stdin, env, message):
@@ -145,7 +187,12 @@ def test_shell_pipeline_stops_on_error(shop):
     """With `set -o pipefail` a shell pipeline fails when ncpp fails."""
     script = "set -o pipefail; printf 'G2 X3 Y0 R0.1\\n' | python3 -m ncpp | cat > out.nc"
     env = {k: v for k, v in os.environ.items() if k != "NCPP_MACHINE"}
-    proc = subprocess.run(["bash", "-c", script], cwd=shop / "work", env={**env, "PYTHONPATH": str(ROOT), "HOME": str(shop / "home")}, capture_output=True)
+    proc = subprocess.run(
+        ["bash", "-c", script],
+        cwd=shop / "work",
+        env={**env, "PYTHONPATH": str(ROOT), "HOME": str(shop / "home")},
+        capture_output=True,
+    )
     assert proc.returncode != 0
     assert (shop / "work/out.nc").read_text() == ""
 

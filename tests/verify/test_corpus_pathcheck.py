@@ -39,7 +39,12 @@ def tool_table(folder: Path) -> Path:
     alike (in inches: the stand-alone rs274 reads its tool table so, ncpp is told --var-units inch)."""
     path = folder / "tools.tbl"
     if not path.exists():
-        path.write_text("".join(f"T{n} P{n} Z{0.4 + 0.02 * n:.2f} D{0.02 + 0.005 * (n % 5):.3f} ;tool {n}\n" for n in range(1, 100)))
+        path.write_text(
+            "".join(
+                f"T{n} P{n} Z{0.4 + 0.02 * n:.2f} D{0.02 + 0.005 * (n % 5):.3f} ;tool {n}\n"
+                for n in range(1, 100)
+            )
+        )
     return path
 
 

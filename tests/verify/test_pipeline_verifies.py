@@ -4,8 +4,6 @@ written; `--no-verify` writes it."""
 
 from __future__ import annotations
 
-import subprocess
-import sys
 from dataclasses import replace
 from pathlib import Path
 
@@ -41,7 +39,19 @@ def program(tmp_path: Path) -> Path:
 
 def compensate(program: Path, *extra: str) -> int:
     out = program.with_suffix(".out.ngc")
-    return main(["compensate", "--machine", str(MACHINE), "--work-offset", "400,350,300", str(program), "-o", str(out), *extra])
+    return main(
+        [
+            "compensate",
+            "--machine",
+            str(MACHINE),
+            "--work-offset",
+            "400,350,300",
+            str(program),
+            "-o",
+            str(out),
+            *extra,
+        ]
+    )
 
 
 def test_a_pass_gone_wrong_is_stopped_and_nothing_written(program: Path, monkeypatch, capsys):

@@ -45,7 +45,9 @@ def test_the_same_program_passes():
 
 
 def test_corrections_within_the_bound_and_pieces_pass():
-    written = ORIGINAL.replace("X50 Y0", "X25.01 Y0.01\nX50.02 Y0.01").replace("G1 Y40 F400", "G1 Y40.02 F400")
+    written = ORIGINAL.replace("X50 Y0", "X25.01 Y0.01\nX50.02 Y0.01").replace(
+        "G1 Y40 F400", "G1 Y40.02 F400"
+    )
     check(ORIGINAL, written)
 
 
@@ -60,7 +62,11 @@ def test_a_missing_move_is_refused():
 
 
 def test_an_action_moved_along_the_path_is_refused():
-    written = ORIGINAL.replace("M5\n", "").replace("G0 Z5\nM30", "G0 Z5\nM5\nM30").replace("G1 Y40 F400", "G1 Y40 F400 M5")
+    written = (
+        ORIGINAL.replace("M5\n", "")
+        .replace("G0 Z5\nM30", "G0 Z5\nM5\nM30")
+        .replace("G1 Y40 F400", "G1 Y40 F400 M5")
+    )
     err = refused(ORIGINAL, written)  # the path before M5 is not the original's
     assert err.where.line in (8, 9, 10)
 
@@ -123,13 +129,14 @@ def test_units_are_compared_in_mm():
 
 
 def test_heidenhain_tool_calls_are_actions():
-    original = ("0 BEGIN PGM P MM\n1 TOOL CALL 1 Z S2000\n2 L X+0 Y+0 Z+5 R0 FMAX M3\n3 L Z-1 F200\n"
-                "4 L X+50\n5 TOOL CALL 2 Z S3000\n6 L X+0\n7 END PGM P MM\n")
+    original = (
+        "0 BEGIN PGM P MM\n1 TOOL CALL 1 Z S2000\n2 L X+0 Y+0 Z+5 R0 FMAX M3\n3 L Z-1 F200\n"
+        "4 L X+50\n5 TOOL CALL 2 Z S3000\n6 L X+0\n7 END PGM P MM\n"
+    )
     check(original, original, dialect="heidenhain")
     with pytest.raises(NcppError) as caught:
         check(original, original.replace("TOOL CALL 2 Z S3000", "TOOL CALL 3 Z S3000"), dialect="heidenhain")
     assert "TOOLCALL3" in caught.value.message
-
 
 
 def test_a_path_over_itself_too_often_is_refused_with_a_way_out(tmp_path, capsys):
@@ -140,6 +147,24 @@ def test_a_path_over_itself_too_often_is_refused_with_a_way_out(tmp_path, capsys
     path = tmp_path / "helix.ngc"
     path.write_text("G17 G21 G90\nG0 X0 Y0 Z0\nG2 X0 Y0 I10 J0 Z1 P1000 F100\nM2\n")
     machine = str(Path(__file__).resolve().parents[2] / "samples/machines/hr5b.toml")
-    assert main(["compensate", "--machine", machine, "--work-offset", "400,350,300", str(path), "-o", str(tmp_path / "out.ngc")]) != 0
+    assert (
+        main(
+            [
+                "compensate",
+                "--machine",
+                machine,
+                "--work-offset",
+                "400,350,300",
+                str(path),
+                "-o",
+                str(tmp_path / "out.ngc"),
+            ]
+        )
+        != 0
+    )
     err = capsys.readouterr().err
-    assert "helix.ngc:" in err and "verification: the path lies over itself too often" in err and "--no-verify" in err
+    assert (
+        "helix.ngc:" in err
+        and "verification: the path lies over itself too often" in err
+        and "--no-verify" in err
+    )

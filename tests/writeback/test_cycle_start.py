@@ -68,7 +68,9 @@ def polar():
 @pytest.mark.parametrize("name", ["polar.ngc", "G91 cycle", "all in G91"])
 def test_cycle_holes_where_the_program_puts_them(tmp_path, name):
     original = tmp_path / "original.ngc"
-    original.write_text(polar() if name == "polar.ngc" else {"G91 cycle": CARTESIAN, "all in G91": ALL_G91}[name])
+    original.write_text(
+        polar() if name == "polar.ngc" else {"G91 cycle": CARTESIAN, "all in G91": ALL_G91}[name]
+    )
     output = compensate_file(original, MACHINE, tmp_path)
     before = holes_um(original, original, machine)
     after = holes_um(output, original, machine)

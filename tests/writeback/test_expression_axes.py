@@ -45,7 +45,9 @@ M2
 """
 
 
-@pytest.mark.parametrize("y, set_", [("0", ""), ("[0]", ""), ("#5", "#5=0\n"), ("[#<_zero> * 2]", "#<_zero>=0\n")])
+@pytest.mark.parametrize(
+    "y, set_", [("0", ""), ("[0]", ""), ("#5", "#5=0\n"), ("[#<_zero> * 2]", "#<_zero>=0\n")]
+)
 def test_expression_axis_keeps_its_correction(tmp_path, y, set_):
     original = tmp_path / "original.ngc"
     original.write_text(PROGRAM.format(y=y, set=set_))

@@ -36,7 +36,14 @@ def placed(tmp_path):
 
 def compensated(text: str, source, offsets, dialect: str) -> str:
     out = io.BytesIO()
-    process(io.BytesIO(text.encode()), out, source=source, dialect=dialect, offsets=offsets, warnings=Warnings(stream=open(os.devnull, "w")))
+    process(
+        io.BytesIO(text.encode()),
+        out,
+        source=source,
+        dialect=dialect,
+        offsets=offsets,
+        warnings=Warnings(stream=open(os.devnull, "w")),
+    )
     return out.getvalue().decode()
 
 
@@ -50,7 +57,9 @@ def test_iso_header_says_the_placement_and_rs274_reads_it(placed, tmp_path):
         pytest.skip("rs274 oracle not available")
     assert proc.returncode == 0 and "error" not in proc.stderr.lower(), proc.stderr
     said = " ".join(re.findall(r'COMMENT\("(.*)"\)', proc.stdout))
-    assert "G55 in effect at the start: G55 X152.4635 Y-88.9 Z3.175" in said  # the parameter file's inches in mm
+    assert (
+        "G55 in effect at the start: G55 X152.4635 Y-88.9 Z3.175" in said
+    )  # the parameter file's inches in mm
     assert "G54 X101.6 Y88.9 Z76.2" in said
     assert "G92/G52 offset X1.524 Y0 Z0 mm" in said
     assert f"sha256:{hashlib.sha256(tools.read_bytes()).hexdigest()[:16]}" in said

@@ -10,8 +10,9 @@ from __future__ import annotations
 
 import io
 import re
+from collections.abc import Iterable, Iterator
 from itertools import chain
-from typing import BinaryIO, Iterable, Iterator, cast
+from typing import BinaryIO, cast
 
 from ncpp.errors import NcppError
 from ncpp.program.parser import Dialect, LineParser, _ItemBuilder
@@ -89,7 +90,9 @@ def _code_only(text: str) -> str:
 
 def _call_like(line: str) -> bool:
     """Parentheses that call (`AC(`, `CYCLE81(`), not an ISO comment."""
-    return bool(re.search(r"\b(AC|IC|DC)[ \t]*\(|\b(?!GOTO)[A-NP-Za-np-z_][A-Za-z_]{2}[A-Za-z0-9_]*[ \t]*\(", line))
+    return bool(
+        re.search(r"\b(AC|IC|DC)[ \t]*\(|\b(?!GOTO)[A-NP-Za-np-z_][A-Za-z_]{2}[A-Za-z0-9_]*[ \t]*\(", line)
+    )
 
 
 def detect(first_bytes: bytes, name: str | None = None) -> str:
@@ -115,7 +118,9 @@ def detect(first_bytes: bytes, name: str | None = None) -> str:
     return "iso"
 
 
-def sniff(stream: Iterable[bytes], name: str | None = None, dialect: str | None = None) -> tuple[str, Iterator[bytes]]:
+def sniff(
+    stream: Iterable[bytes], name: str | None = None, dialect: str | None = None
+) -> tuple[str, Iterator[bytes]]:
     """(dialect, lines) for a binary stream: the dialect is `dialect` when given,
     else detected from the first SNIFF_BYTES; lines are the stream's lines from
     the beginning, the sniffed head re-read from a buffer (stdin keeps streaming)."""

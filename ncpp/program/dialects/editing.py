@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Mapping
+from collections.abc import Mapping
 
 from ncpp.program.blocks import Block, Item
 from ncpp.program.writer import _leads, _past_blanks

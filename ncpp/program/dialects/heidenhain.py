@@ -216,7 +216,12 @@ class HeidenhainBuilder(Transformer):
 # The TNC manuals give no block length: ncpp's bound is a block of many `~`-continued lines
 # (a cycle definition of one Q parameter a line) with room to spare.
 HEIDENHAIN = Dialect(
-    "heidenhain", "heidenhain", HeidenhainBuilder, fast_terminals=(), continuation="~", max_line=4096,
+    "heidenhain",
+    "heidenhain",
+    HeidenhainBuilder,
+    fast_terminals=(),
+    continuation="~",
+    max_line=4096,
     max_line_source="ncpp's bound for Klartext, whose manuals state none",
 )
 
@@ -296,8 +301,10 @@ class HeidenhainWriter(IsoWriter):
 
         block = group[0].block
         self.eol = block.eol or self.eol
-        if self.header is not None and self.last_number < 0 and not any(
-            type(i) is Statement and i.kind == "program_begin" for i in block.items
+        if (
+            self.header is not None
+            and self.last_number < 0
+            and not any(type(i) is Statement and i.kind == "program_begin" for i in block.items)
         ):
             yield from self._header_first(block, self.header)
         self._learn_styles(block)
@@ -322,7 +329,9 @@ class HeidenhainWriter(IsoWriter):
                 yield self._inserted(self._cc_text(*self.program_pole))
                 self.output_pole = self.program_pole
             yield self._numbered(block, splice(block, {}, feed) if feed else block.raw)
-            if self.header is not None and any(type(i) is Statement and i.kind == "program_begin" for i in block.items):
+            if self.header is not None and any(
+                type(i) is Statement and i.kind == "program_begin" for i in block.items
+            ):
                 for line in self.header.split("\n"):
                     yield self._inserted(self.comment(line))
                 self.header = None
@@ -378,8 +387,15 @@ class HeidenhainWriter(IsoWriter):
         style = self._resolved.get(key)
         if style is None:
             base = letter[-1] if letter.startswith("I") and len(letter) == 2 else letter
-            style = self.styles.get(letter) or self.styles.get(base) or self.styles.get("X") or NumberStyle(decimals=3)
-            style = self._resolved[key] = _signed(style.at_least(self.inch_decimals if key[1] else self.mm_decimals))
+            style = (
+                self.styles.get(letter)
+                or self.styles.get(base)
+                or self.styles.get("X")
+                or NumberStyle(decimals=3)
+            )
+            style = self._resolved[key] = _signed(
+                style.at_least(self.inch_decimals if key[1] else self.mm_decimals)
+            )
         return style
 
     def _word(self, letter: str, value: float, segment: Line | Arc) -> str:
@@ -392,7 +408,9 @@ class HeidenhainWriter(IsoWriter):
         # (kept with the resolved styles: X's styles that resolve alike at mm and inch places do so here too)
         style = self._resolved.get("CC")
         if style is None:
-            style = self._resolved["CC"] = _signed((self.styles.get("X") or NumberStyle(decimals=3)).at_least(self.mm_decimals + 2))
+            style = self._resolved["CC"] = _signed(
+                (self.styles.get("X") or NumberStyle(decimals=3)).at_least(self.mm_decimals + 2)
+            )
         return f"CC {_AXES[first]}{format_number(centre[first], style)} {_AXES[second]}{format_number(centre[second], style)}"
 
     def _is_helix(self, segment: Arc) -> bool:
@@ -404,7 +422,11 @@ class HeidenhainWriter(IsoWriter):
         if isinstance(segment, Arc):
             return self._arc_text(segment)
         # the axes that moved in the output (`_moved`, with the units' places read once per line)
-        (last, last_places), inch, end = self._last_seen_from(segment.context), segment.context.inch, segment.end
+        (last, last_places), inch, end = (
+            self._last_seen_from(segment.context),
+            segment.context.inch,
+            segment.end,
+        )
         units = self._resolved.get(inch) or self._units(inch)
         places, styles = units.places, units.styles
         words = [
@@ -449,8 +471,11 @@ class HeidenhainWriter(IsoWriter):
         written = set()
         anchor = block.items[index] if index is not None else None
         for n, item in enumerate(block.items):
-            if (isinstance(item, (Word, ExprWord)) and item.letter.lstrip("I") in _AXES
-                    and len(item.letter) <= 2):
+            if (
+                isinstance(item, (Word, ExprWord))
+                and item.letter.lstrip("I") in _AXES
+                and len(item.letter) <= 2
+            ):
                 axis = _AXES.index(item.letter[-1])
                 incremental = item.letter.startswith("I")
                 value = segment.end[axis] - segment.start[axis] if incremental else segment.end[axis]

@@ -12,9 +12,9 @@ from __future__ import annotations
 
 import math
 import re
+from collections.abc import Iterable, Iterator
 from dataclasses import replace
 from operator import itemgetter
-from typing import Iterable, Iterator
 
 from ncpp.motion.segments import EXTRA_AXES, Arc, Context, Event, Line, Pass, Setting
 from ncpp.passes.rotary import time_shares, turns
@@ -24,25 +24,45 @@ from ncpp.program.writer import EditPlan, _literal, _with_motion, set_words, spe
 
 AXES = "XYZ"
 _NUMBERED_AXES = tuple(enumerate(AXES))  # ((0, "X"), ...): no enumerate object per line written
-CENTRE_WORDS = {17: (("I", 0), ("J", 1)), 18: (("I", 0), ("K", 2)), 19: (("J", 1), ("K", 2))}  # (letter, axis), as written
+CENTRE_WORDS = {
+    17: (("I", 0), ("J", 1)),
+    18: (("I", 0), ("K", 2)),
+    19: (("J", 1), ("K", 2)),
+}  # (letter, axis), as written
 _CENTRE_AXES = {plane: (a, b) for plane, ((_, a), (_, b)) in CENTRE_WORDS.items()}
 MOTION_CODES = {0.0: 0, 1.0: 1, 2.0: 2, 3.0: 3}
 DEFAULT_STYLE = NumberStyle(decimals=4)
 GEOMETRY_LETTERS = "XYZIJKR"  # words a pass rewrites in a changed block
 WRITTEN_LETTERS = "XYZIJK"  # the letters the writer writes numbers for
 MOVING_LETTERS = "XYZABCUVWIJKR"  # words that make a block move (with the modal motion)
-AXES_NOT_MOVED = frozenset((10.0, 28.0, 30.0, 52.0, 92.0, 43.1))  # G codes whose axis words no modal motion moves to
+AXES_NOT_MOVED = frozenset(
+    (10.0, 28.0, 30.0, 52.0, 92.0, 43.1)
+)  # G codes whose axis words no modal motion moves to
 # Letters whose number styles the writer uses: it writes XYZIJK (and CR, with X's style,
 # for Sinumerik); the styles of other words (F, S, R, ...) are never asked for, so not learnt.
 STYLED_LETTERS = frozenset(WRITTEN_LETTERS)
-DROPPED = ("I", "J", "K", "R", "P", ",R", ",C", "@", "^")  # words of the old geometry a changed block loses (`@` `^`: polar)
+DROPPED = (
+    "I",
+    "J",
+    "K",
+    "R",
+    "P",
+    ",R",
+    ",C",
+    "@",
+    "^",
+)  # words of the old geometry a changed block loses (`@` `^`: polar)
 _DROPPED = frozenset(DROPPED)
 _BIT = {letter: 1 << n for n, letter in enumerate(WRITTEN_LETTERS)}  # a set of written letters is a bit mask
 _CENTRE_BITS = {plane: _BIT[a] | _BIT[b] for plane, ((a, _), (b, _)) in CENTRE_WORDS.items()}
 # Per bit mask: the letters written, in order, each with the index of its number in `_numbers`
 # (X Y Z: 0 1 2; an arc's two centre words: 3 4).
 _WRITTEN = tuple(
-    tuple((letter, n if n < 3 else 3 + sum(bool(bits & _BIT[c]) for c in WRITTEN_LETTERS[3:n])) for n, letter in enumerate(WRITTEN_LETTERS) if bits & _BIT[letter])
+    tuple(
+        (letter, n if n < 3 else 3 + sum(bool(bits & _BIT[c]) for c in WRITTEN_LETTERS[3:n]))
+        for n, letter in enumerate(WRITTEN_LETTERS)
+        if bits & _BIT[letter]
+    )
     for bits in range(1 << len(WRITTEN_LETTERS))
 )
 _AXIS_BITS = _BIT["X"] | _BIT["Y"] | _BIT["Z"]
@@ -74,15 +94,22 @@ class IsoWriter:
         self._layouts: dict[bytes, tuple] = {}
         self._layout: tuple[Block | None, bytes] = (None, b"")  # the last block whose layout was read, and it
         self._interned_lessons: dict[tuple, tuple] = {}  # equal (letter, style) tuples are one
-        self._last_lesson: tuple | None = None  # the (letter, style) learnt last (learning them again changes nothing)
+        self._last_lesson: tuple | None = (
+            None  # the (letter, style) learnt last (learning them again changes nothing)
+        )
         # Derived from `styles`, emptied when a style changes: (letter, inch) -> style to write,
         # inch -> `_Written` (the styles of WRITTEN_LETTERS and the decimal places of X, Y, Z).
         self._resolved: dict = {}
-        self._interned_units: dict[tuple, _Written] = {}  # styles -> their `_Written`, so its plans outlive a style change
+        self._interned_units: dict[
+            tuple, _Written
+        ] = {}  # styles -> their `_Written`, so its plans outlive a style change
         self._facts_block: Block | None = None  # the last block asked about, and its facts
         self._facts_value: _Facts = None  # type: ignore[assignment]  # (read only with `_facts_block`)
         self._signature_facts: dict[str, _Facts] = {}  # the facts of plain blocks, by their `signature`
-        self._spelled: tuple[Block | None, tuple[str, bool]] = (None, (" ", False))  # a block and its `spelling`
+        self._spelled: tuple[Block | None, tuple[str, bool]] = (
+            None,
+            (" ", False),
+        )  # a block and its `spelling`
         # The end of the last segment written (where the output is, once rounded to the decimal
         # places of X, Y and Z it was written with): rounded only when compared, and most
         # axes a block does not write are exactly where they were.
@@ -155,19 +182,31 @@ class IsoWriter:
         each its share of the move's time (`rotary.time_shares`)."""
         more = self._piece_words(block, pieces)
         block = _literal_geometry(block, "".join(more[0]))
-        return [self._edit_block(block, pieces[0], more[0]) + eol] + self._new_blocks(block, pieces[1:], eol, more[1:])
+        return [self._edit_block(block, pieces[0], more[0]) + eol] + self._new_blocks(
+            block, pieces[1:], eol, more[1:]
+        )
 
     def _piece_words(self, block: Block, pieces: list) -> list[dict[str, str]]:
         """Per piece: letter -> number text of its words beyond X Y Z I J K (`_write_pieces`)."""
         given = {item.letter: item for item in block.items if type(item) is Word or type(item) is ExprWord}
-        style = lambda letter: (NumberStyle.of(given[letter].number) if type(given.get(letter)) is Word else DEFAULT_STYLE).at_least(4)  # type: ignore[union-attr]  # noqa: E731
-        feeds = [pieces[0].feed / share for share in time_shares(pieces)] if pieces[0].context.inverse_time else None
+
+        def style(letter: str) -> NumberStyle:
+            word = given.get(letter)
+            return (NumberStyle.of(word.number) if type(word) is Word else DEFAULT_STYLE).at_least(4)
+
+        feeds = (
+            [pieces[0].feed / share for share in time_shares(pieces)]
+            if pieces[0].context.inverse_time
+            else None
+        )
         out = []
         for k, piece in enumerate(pieces):
             words = {}
             for i, value in enumerate(piece.extra):
                 letter = EXTRA_AXES[i]
-                if (k == 0 and letter in given and value != pieces[-1].extra[i]) or (k > 0 and turns(piece) and value != piece.extra_start[i]):
+                if (k == 0 and letter in given and value != pieces[-1].extra[i]) or (
+                    k > 0 and turns(piece) and value != piece.extra_start[i]
+                ):
                     words[letter] = format_number(value, style(letter))
             if feeds is not None and not (type(piece) is Line and piece.rapid):
                 words["F"] = format_number(feeds[k], style("F"))
@@ -175,13 +214,13 @@ class IsoWriter:
         return out
 
     # -- what a block says --------------------------------------------------------
-    def _facts(self, block: Block) -> "_Facts":
+    def _facts(self, block: Block) -> _Facts:
         """The facts of `block`, read once while it is being written."""
         if block is not self._facts_block:
             self._facts_block, self._facts_value = block, _Facts(block)
         return self._facts_value
 
-    def _read_block(self, block: Block) -> "_Facts":
+    def _read_block(self, block: Block) -> _Facts:
         """The facts of a block about to be written; its number styles are learnt."""
         signature = block.signature
         facts: _Facts | None
@@ -201,14 +240,14 @@ class IsoWriter:
                 self._learn_layout_styles(block, facts)
         return facts
 
-    def _learn_word_styles(self, block: Block, facts: "_Facts") -> None:
+    def _learn_word_styles(self, block: Block, facts: _Facts) -> None:
         """Learn the number styles of the block's styled words, reading each number."""
         words = _words(block, facts)
         for n, letter in facts.styled:
             self._learn_style(letter, NumberStyle.of(words[n].number))
         self._last_lesson = None
 
-    def _learn_layout_styles(self, block: Block, facts: "_Facts") -> None:
+    def _learn_layout_styles(self, block: Block, facts: _Facts) -> None:
         """Learn the number styles of a plain block's styled words: the styles are those of
         its layout's numbers, read once per layout, unless a number is zero-padded."""
         raw = block.raw
@@ -239,7 +278,7 @@ class IsoWriter:
                 self._layout = (block, layout)
         return layout
 
-    def _read_layout(self, block: Block, facts: "_Facts", layout: bytes) -> tuple:
+    def _read_layout(self, block: Block, facts: _Facts, layout: bytes) -> tuple:
         """(the (letter, style) of each styled word of the layout, a getter of the first digits of
         its numbers with more than one digit before the point or None if there are none, its
         `spelling` or None if its separator has digits, in a comment)."""
@@ -268,7 +307,10 @@ class IsoWriter:
             self.styles[letter] = style
             # what is resolved from styles is written with at least mm_decimals / inch_decimals places:
             # `X1.125` then `X0.` (trailing zeros dropped, cameo.nc: 29k changes in 35k lines) write alike
-            if known is None or not (known.resolves_like(style, self.mm_decimals) and known.resolves_like(style, self.inch_decimals)):
+            if known is None or not (
+                known.resolves_like(style, self.mm_decimals)
+                and known.resolves_like(style, self.inch_decimals)
+            ):
                 self._resolved.clear()
         if letter in AXES:
             self.known_axes.add(letter)
@@ -344,11 +386,16 @@ class IsoWriter:
         program's.  After it the output's position is in another frame: the next move writes
         every axis it knows."""
         self._last_end = None
-        moved = [(axis, value + setting.shift[axis]) for axis, value in setting.values if setting.shift[axis] != 0.0]  # type: ignore[index]
+        shift = setting.shift
+        assert shift is not None  # (the pass told it, or the block was not handed here)
+        moved = [(axis, value + shift[axis]) for axis, value in setting.values if shift[axis] != 0.0]
         if not moved:
             return block.raw
         styles = self._units(setting.context.inch).styles
-        return set_words(_literal_geometry(block), {AXES[axis]: format_number(value, styles[AXES[axis]]) for axis, value in moved})
+        return set_words(
+            _literal_geometry(block),
+            {AXES[axis]: format_number(value, styles[AXES[axis]]) for axis, value in moved},
+        )
 
     # -- numbers as written -----------------------------------------------------
     def _moved(self, axis: str, value: float, segment: Line | Arc) -> bool:
@@ -365,7 +412,7 @@ class IsoWriter:
             return last, self._last_places
         return seen_from(last, self._last_places, frame, context, self._units(context.inch).places)
 
-    def _remember_end(self, segment: Line | Arc, units: "_Written | None" = None) -> None:
+    def _remember_end(self, segment: Line | Arc, units: _Written | None = None) -> None:
         """The segment's end is where the output is now, written with `units`' places
         (the segment's units, looked up unless the caller has them)."""
         if units is None:
@@ -384,7 +431,7 @@ class IsoWriter:
             style = self._resolved[key] = style.at_least(self.inch_decimals if key[1] else self.mm_decimals)
         return style
 
-    def _units(self, inch: bool) -> "_Written":
+    def _units(self, inch: bool) -> _Written:
         """How the output writes numbers in these units, resolved once per change of styles."""
         found = self._resolved.get(inch)
         if found is None:
@@ -405,12 +452,14 @@ class IsoWriter:
             return 3 if segment.turn > 0 else 2
         return 0 if segment.rapid else 1
 
-    def _written_bits(self, facts: "_Facts", segment: Line | Arc, units: "_Written") -> int:
+    def _written_bits(self, facts: _Facts, segment: Line | Arc, units: _Written) -> int:
         """`_bits_written` where the output is now."""
         frame = self._last_context
         context = segment.context
         if frame is context or frame is None or self._last_end is None or not reframed(frame, context):
-            return _bits_written(facts, segment, units.places, self.known_axes, self._last_end, self._last_places)
+            return _bits_written(
+                facts, segment, units.places, self.known_axes, self._last_end, self._last_places
+            )
         last, places = self._last_seen_from(segment.context)
         return _bits_written(facts, segment, units.places, self.known_axes, last, places, named=False)
 
@@ -434,19 +483,27 @@ class IsoWriter:
         units = self._units(segment.context.inch)
         numbers = self._numbers(segment)
         styles = units.styles
-        return {letter: format_number(numbers[n], styles[letter]) for letter, n in _WRITTEN[self._written_bits(self._facts(block), segment, units)]}
+        return {
+            letter: format_number(numbers[n], styles[letter])
+            for letter, n in _WRITTEN[self._written_bits(self._facts(block), segment, units)]
+        }
 
-    def _machine_texts(self, facts: "_Facts", segment: Line | Arc) -> dict[str, str]:
+    def _machine_texts(self, facts: _Facts, segment: Line | Arc) -> dict[str, str]:
         """`_texts` of a G53 line, whose numbers are machine coordinates (in program units):
         what it writes is decided in program coordinates, like every other block's."""
         units = self._units(segment.context.inch)
         end, offset = segment.end, segment.context.offset
         machine = (end[0] + offset[0], end[1] + offset[1], end[2] + offset[2])
-        return {letter: format_number(machine[n], units.styles[letter]) for letter, n in _WRITTEN[self._written_bits(facts, segment, units)]}
+        return {
+            letter: format_number(machine[n], units.styles[letter])
+            for letter, n in _WRITTEN[self._written_bits(facts, segment, units)]
+        }
 
     def _edit_block(self, block: Block, segment: Line | Arc, more: dict[str, str] | None = None) -> str:
         facts = self._facts_value if block is self._facts_block else self._facts(block)  # `_facts`, inlined
-        code = (3 if segment.turn > 0 else 2) if type(segment) is Arc else 0 if segment.rapid else 1  # `_motion_code`
+        code = (
+            (3 if segment.turn > 0 else 2) if type(segment) is Arc else 0 if segment.rapid else 1
+        )  # `_motion_code`
         output_motion = self.output_motion
         # the block's motion word is set when it says another motion, or when the output's mode is another
         motion = code if facts.first_motion != code and (code != output_motion or facts.motion_word) else None
@@ -460,17 +517,29 @@ class IsoWriter:
             self.output_motion, self.program_motion = code, facts.motion
         elif code != output_motion:
             self.output_motion = code
-        self._last_end, self._last_places, self._last_context = segment.end, units.places, segment.context  # `_remember_end`
+        self._last_end, self._last_places, self._last_context = (
+            segment.end,
+            units.places,
+            segment.context,
+        )  # `_remember_end`
         return raw
 
-    def _planned_edit(self, block: Block, facts: "_Facts", segment: Line | Arc, motion: int | None, units: "_Written") -> str | None:
+    def _planned_edit(
+        self, block: Block, facts: _Facts, segment: Line | Arc, motion: int | None, units: _Written
+    ) -> str | None:
         """The edit by a plan compiled for the block's signature (None: a block no plan covers)."""
         signature = block.signature
-        if signature is None or not units.plain or "P" in facts.letters:  # P: a turn count or not, see `_general_edit`
+        if (
+            signature is None or not units.plain or "P" in facts.letters
+        ):  # P: a turn count or not, see `_general_edit`
             return None
         bits = self._written_bits(facts, segment, units)
         # words the block lacks are appended spelled as the block was read
-        spelled = self._spelling(block) if bits & ~facts.bits or (motion is not None and facts.motion_at is None) else None
+        spelled = (
+            self._spelling(block)
+            if bits & ~facts.bits or (motion is not None and facts.motion_at is None)
+            else None
+        )
         raw = block.raw
         # the block's layout, and a plan: blocks of one layout without comments whose numbers the
         # plan writes or drops all (but G words', in the signature) are its template with their numbers
@@ -483,39 +552,69 @@ class IsoWriter:
             if len(units.edits) >= _MAX_LAYOUTS:
                 units.edits.clear()
             comments = len(block.items) != facts.words
-            edit = units.edits[key] = plan if plan.keeps_numbers or comments else plan.template_for(raw, block.items)  # type: ignore[arg-type]
+            edit = units.edits[key] = (
+                plan if plan.keeps_numbers or comments else plan.template_for(raw, block.items)  # type: ignore[arg-type]
+            )
         # (`_numbers`, inlined for an absolute line)
-        numbers = segment.end if type(segment) is Line and segment.context.absolute else self._numbers(segment)
+        numbers = (
+            segment.end if type(segment) is Line and segment.context.absolute else self._numbers(segment)
+        )
         if type(edit) is str:
             return edit.format(*numbers)
         return edit.apply(raw, _words(block, facts), numbers)  # type: ignore[union-attr]  # (a plan)
 
     @staticmethod
-    def _edit_plan(facts: "_Facts", signature: str, bits: int, motion: int | None, spelled: tuple[str, bool] | None, units: "_Written") -> EditPlan | None:
+    def _edit_plan(
+        facts: _Facts,
+        signature: str,
+        bits: int,
+        motion: int | None,
+        spelled: tuple[str, bool] | None,
+        units: _Written,
+    ) -> EditPlan | None:
         """The plan of an edit of a block with this signature, compiled once."""
         key = (signature, bits, motion, spelled)
         plan = units.edit_plans.get(key, _UNKNOWN)
         if plan is _UNKNOWN:
-            dropped = [l for l in DROPPED + tuple(AXES) if l in facts.letters and not bits & _BIT.get(l, 0)]
+            dropped = [
+                letter
+                for letter in DROPPED + tuple(AXES)
+                if letter in facts.letters and not bits & _BIT.get(letter, 0)
+            ]
             plan = units.edit_plans[key] = EditPlan.compile(
-                facts.word_letters, units.fields(bits), 5 if bits & _ANY_CENTRE else 3, dropped, motion, facts.motion_at, spelled or (" ", False)
+                facts.word_letters,
+                units.fields(bits),
+                5 if bits & _ANY_CENTRE else 3,
+                dropped,
+                motion,
+                facts.motion_at,
+                spelled or (" ", False),
             )
         return plan  # type: ignore[return-value]
 
-    def _general_edit(self, block: Block, facts: "_Facts", segment: Line | Arc, motion: int | None, more: dict[str, str] | None = None) -> str:
+    def _general_edit(
+        self,
+        block: Block,
+        facts: _Facts,
+        segment: Line | Arc,
+        motion: int | None,
+        more: dict[str, str] | None = None,
+    ) -> str:
         texts = self._machine_texts(facts, segment) if facts.machine else self._texts(block, segment)
         if more:  # (a piece's own words: `_write_pieces`)
             texts.update(more)
         # centre words of the old arc, and Fanuc corner words: the corner is now explicit;
         # P is an arc's turn count, but a dwell time (G4) or blending tolerance (G64) elsewhere
-        drop = [l for l in DROPPED + tuple(AXES) if l in facts.letters and l not in texts]
+        drop = [letter for letter in DROPPED + tuple(AXES) if letter in facts.letters and letter not in texts]
         if "P" in drop and not self._arc_block(block):
             drop.remove("P")
         # words the block lacks are appended spelled as the block was read (before a G word is inserted)
         spelled = None if facts.letters.issuperset(texts) else self._spelling(block)
         return set_words(block if motion is None else _with_motion(block, motion), texts, drop, spelled)
 
-    def _new_blocks(self, block: Block, segments: list[Line | Arc], eol: str, more: list[dict[str, str]] | None = None) -> list[str]:
+    def _new_blocks(
+        self, block: Block, segments: list[Line | Arc], eol: str, more: list[dict[str, str]] | None = None
+    ) -> list[str]:
         """The lines of the segments a block makes after its first (arc pieces, reversal
         steps, subdivisions): new blocks, spelled as the block is.  Once per line written:
         what is the same for all of them is read once, the output's state is kept in locals
@@ -530,8 +629,15 @@ class IsoWriter:
         for segment in segments:
             if segment.context is not context:  # (the segments of a block share their context, mostly)
                 context = segment.context
-                if last is not None and frame is not None and frame is not context and reframed(frame, context):
-                    last, last_places = seen_from(last, last_places, frame, context, self._units(context.inch).places)
+                if (
+                    last is not None
+                    and frame is not None
+                    and frame is not context
+                    and reframed(frame, context)
+                ):
+                    last, last_places = seen_from(
+                        last, last_places, frame, context, self._units(context.inch).places
+                    )
                 frame = context
                 inch, absolute = context.inch, context.absolute
                 units = self._resolved.get(inch) or self._units(inch)
@@ -543,13 +649,17 @@ class IsoWriter:
             values = segment.end if code < 2 and absolute else self._numbers(segment)
             words = more[len(lines)] if more else None  # (a piece's own words: `_write_pieces`)
             if words:
-                texts = {letter: format_number(values[n], units.styles[letter]) for letter, n in _WRITTEN[bits]}
+                texts = {
+                    letter: format_number(values[n], units.styles[letter]) for letter, n in _WRITTEN[bits]
+                }
                 lines.append(_new_block_text({**texts, **words}, motion, spelled) + eol)
             elif templates is not None:
                 key = new_block_key(bits, motion)
                 template = templates.get(key)
                 if template is None:
-                    template = templates[key] = _new_block_text(units.fields(bits), motion, (_literal(spelled[0]), spelled[1])) + eol
+                    template = templates[key] = (
+                        _new_block_text(units.fields(bits), motion, (_literal(spelled[0]), spelled[1])) + eol
+                    )
                 lines.append(template.format(*values))
             else:
                 styles = units.styles
@@ -558,7 +668,12 @@ class IsoWriter:
             if motion is not None:
                 output_motion = code
             last, last_places = segment.end, places
-        self.output_motion, self._last_end, self._last_places, self._last_context = output_motion, last, last_places, context
+        self.output_motion, self._last_end, self._last_places, self._last_context = (
+            output_motion,
+            last,
+            last_places,
+            context,
+        )
         return lines
 
 
@@ -568,7 +683,7 @@ def new_block_key(bits: int, motion: int | None) -> int:
     return bits if motion is None else bits | (motion + 1) << len(WRITTEN_LETTERS)
 
 
-def _bits_written(facts: "_Facts", segment: Line | Arc, places: tuple, known: set[str], last: tuple | None, last_places: tuple,
+def _bits_written(facts: _Facts, segment: Line | Arc, places: tuple, known: set[str], last: tuple | None, last_places: tuple,
                   named: bool = True) -> int:  # fmt: skip
     """The letters the segment writes (a mask of `_BIT`): the axes its block has and whatever
     moved in the output (which is at `last`, written with `last_places`; `known`: the axes it
@@ -585,11 +700,15 @@ def _bits_written(facts: "_Facts", segment: Line | Arc, places: tuple, known: se
         same_places = places == last_places
         for n, axis, bit in absent:
             # (`written_apart`'s first test first: most such axes are where the output left them)
-            if axis in known and (last is None or not (same_places and end[n] == last[n]) and written_apart(end[n], places[n], last[n], last_places[n])):
+            if axis in known and (
+                last is None
+                or not (same_places and end[n] == last[n])
+                and written_apart(end[n], places[n], last[n], last_places[n])
+            ):
                 bits |= bit
     elif absent:
         start = segment.start
-        for n, axis, bit in absent:
+        for n, _axis, bit in absent:
             if round(end[n] - start[n], places[n]) != 0.0:
                 bits |= bit
     if type(segment) is Arc:
@@ -600,7 +719,11 @@ def _bits_written(facts: "_Facts", segment: Line | Arc, places: tuple, known: se
 def _new_block_text(words: dict[str, str], motion: int | None, spelled: tuple[str, bool]) -> str:
     """A new block of `words` (letter -> number text, or a format field), after `G<motion>` when it is set."""
     sep, lower = spelled
-    text = sep.join([letter + number for letter, number in words.items()] if motion is None else [f"G{motion}", *(letter + number for letter, number in words.items())])
+    text = sep.join(
+        [letter + number for letter, number in words.items()]
+        if motion is None
+        else [f"G{motion}", *(letter + number for letter, number in words.items())]
+    )
     return text.lower() if lower else text
 
 
@@ -620,9 +743,13 @@ class _Facts:
         self.moves = False  # it has words that move with the modal motion
         self.plain = True  # only words and comments
         self.words = 0  # how many plain words it has
-        self.styled: tuple[tuple[int, str], ...] = ()  # (n, letter) of its n-th word when the writer learns its style
+        self.styled: tuple[
+            tuple[int, str], ...
+        ] = ()  # (n, letter) of its n-th word when the writer learns its style
         self.word_letters: list[str] = []  # the letters of its plain words, in order
-        self.motion_at: tuple[int, str] | None = None  # (n, number as written) of its first G0-G3 word, the n-th word
+        self.motion_at: tuple[int, str] | None = (
+            None  # (n, number as written) of its first G0-G3 word, the n-th word
+        )
         self.machine = False  # it moves in machine coordinates (G53)
         self.flow = False  # a control line: an o-word (not `O<name>` alone, a program's name), M98, M99
         self.settles = False  # its axis words are a G10 / G28 / G30 / G52 / G92 / G43.1's, not a move's
@@ -641,7 +768,7 @@ class _Facts:
         self._sum_up()
 
     @classmethod
-    def of_signature(cls, signature: str) -> "_Facts":
+    def of_signature(cls, signature: str) -> _Facts:
         """The facts of a plain block with this `Block.signature`."""
         facts = cls()
         for letter, number in _SIGNATURE_WORD.findall(signature):
@@ -652,9 +779,13 @@ class _Facts:
     def _sum_up(self) -> None:
         if self.settles:
             self.moves = False
-        self.bits = sum(bit for letter, bit in _BIT.items() if letter in self.letters)  # the written letters it has
+        self.bits = sum(
+            bit for letter, bit in _BIT.items() if letter in self.letters
+        )  # the written letters it has
         self.axis_bits = self.bits & _AXIS_BITS
-        self.absent_axes = tuple((n, axis, _BIT[axis]) for n, axis in _NUMBERED_AXES if axis not in self.letters)
+        self.absent_axes = tuple(
+            (n, axis, _BIT[axis]) for n, axis in _NUMBERED_AXES if axis not in self.letters
+        )
 
     def _read_word(self, letter: str, value: float, number: str) -> None:
         if letter == "M" and (value == 98.0 or value == 99.0):
@@ -675,7 +806,9 @@ class _Facts:
             elif value == 53.0:
                 self.machine = True
             elif value in AXES_NOT_MOVED:
-                self.moves = self.settles = True  # (`_sum_up`: its axis words do not move with the modal motion)
+                self.moves = self.settles = (
+                    True  # (`_sum_up`: its axis words do not move with the modal motion)
+                )
         elif letter in MOVING_LETTERS:
             self.moves = True
 
@@ -729,7 +862,9 @@ class _Written:
     def __init__(self, styles: dict[str, NumberStyle]):
         self.styles = styles
         self.places: tuple[int, int, int] = tuple(styles[axis].decimals for axis in AXES)  # type: ignore[assignment]
-        self.plain = all(style.plain for style in styles.values())  # every number one `format` spec: plans apply
+        self.plain = all(
+            style.plain for style in styles.values()
+        )  # every number one `format` spec: plans apply
         # Compiled lines: (signature, written bits, motion, spelling) -> `EditPlan` (None: none applies),
         # (layout, signature, ...) -> that plan, or the format template it makes of such blocks,
         # and per spelling (a dialect's: (spelling, line end) here) {`new_block_key`: the format
@@ -740,7 +875,7 @@ class _Written:
 
     def fields(self, bits: int) -> dict[str, str]:
         """The written letters of the mask, each with its number as a field of `IsoWriter._numbers`."""
-        return {letter: "{%d:%s}" % (n, self.styles[letter].spec) for letter, n in _WRITTEN[bits]}
+        return {letter: f"{{{n}:{self.styles[letter].spec}}}" for letter, n in _WRITTEN[bits]}
 
 
 class _Units:
@@ -758,5 +893,8 @@ def _literal_geometry(block: Block, letters: str = GEOMETRY_LETTERS) -> Block:
     `letters`, as plain words: a pass changed what they evaluate to, so new numbers replace them."""
     if not any(type(i) is ExprWord and i.letter in letters for i in block.items):
         return block
-    items = tuple(Word(i.letter, 0.0, "0", i.start, i.end) if type(i) is ExprWord and i.letter in letters else i for i in block.items)
+    items = tuple(
+        Word(i.letter, 0.0, "0", i.start, i.end) if type(i) is ExprWord and i.letter in letters else i
+        for i in block.items
+    )
     return replace(block, items=items, signature=None)  # the signature is that of the old items

@@ -44,7 +44,9 @@ from ncpp.program.blocks import Comment, ExprWord, Statement, Word
 from ncpp.program.parser import Dialect, _word
 
 # Multi-letter addresses that take `=`: interpolation and spline parameters, polar words.
-ADDRESSES = frozenset({"CR", "TURN", "AR", "AP", "RP", "PW", "SD", "PL", "SF", "SPOS", "OFFN", "ACC", "SR", "SRA"})
+ADDRESSES = frozenset(
+    {"CR", "TURN", "AR", "AP", "RP", "PW", "SD", "PL", "SF", "SPOS", "OFFN", "ACC", "SR", "SRA"}
+)
 COORDINATE_MODES = frozenset({"AC", "IC", "DC", "ACP", "ACN", "CAC", "CIC"})
 _ADDRESS = re.compile(r"[A-QS-Za-qs-z]\d*|[Rr]")
 _R_PARAMETER = re.compile(r"[Rr]\d+")
@@ -206,7 +208,11 @@ class SinumerikBuilder(Transformer):
 
 
 SINUMERIK = Dialect(
-    "sinumerik", "sinumerik", SinumerikBuilder, fast_terminals=("WORD", "SEMI_COMMENT"), max_line=512,
+    "sinumerik",
+    "sinumerik",
+    SinumerikBuilder,
+    fast_terminals=("WORD", "SEMI_COMMENT"),
+    max_line=512,
     max_line_source="SINUMERIK 840D sl Programming Manual Fundamentals, block length: 512 characters",
 )
 
@@ -233,7 +239,14 @@ class SinumerikWriter(IsoWriter):
 
     @staticmethod
     def _path(block: Block) -> str | None:
-        return next((i.node[0] for i in block.items if type(i) is Statement and i.kind == "path" and i.node[0] in _MOTION_PATHS), None)
+        return next(
+            (
+                i.node[0]
+                for i in block.items
+                if type(i) is Statement and i.kind == "path" and i.node[0] in _MOTION_PATHS
+            ),
+            None,
+        )
 
     def _has_motion_word(self, block: Block) -> bool:
         return super()._has_motion_word(block) or self._path(block) is not None
@@ -252,7 +265,11 @@ class SinumerikWriter(IsoWriter):
 
     def _texts(self, block: Block, segment: Line | Arc) -> dict[str, str]:
         texts = super()._texts(block, segment)
-        if type(segment) is Arc and self._uses_cr(block) and abs(segment.sweep()) < 2 * 3.141592653589793 - 1e-9:
+        if (
+            type(segment) is Arc
+            and self._uses_cr(block)
+            and abs(segment.sweep()) < 2 * 3.141592653589793 - 1e-9
+        ):
             for letter in "IJK":
                 texts.pop(letter, None)
             radius = segment.radius() if abs(segment.sweep()) <= 3.141592653589793 else -segment.radius()
@@ -284,7 +301,9 @@ class SinumerikWriter(IsoWriter):
         if texts:
             block = _reparse(Block(splice(block, texts), block.eol, (), block.line))
         drop = [letter for letter in "IJK" + AXES if letter not in words]
-        raw = edit_texts(block, words, drop=drop, motion=code if code != self.output_motion or had_motion else None)
+        raw = edit_texts(
+            block, words, drop=drop, motion=code if code != self.output_motion or had_motion else None
+        )
         if had_motion or code != self.output_motion:
             self.output_motion = code
         if had_motion:
@@ -310,12 +329,16 @@ class SinumerikWriter(IsoWriter):
             template = templates.get(key)
             if template is None:
                 fields = [f"G{motion}"] if motion is not None else []
-                template = templates[key] = sep.join(fields + [letter + field for letter, field in units.fields(bits).items()])
+                template = templates[key] = sep.join(
+                    fields + [letter + field for letter, field in units.fields(bits).items()]
+                )
             text = template.format(*self._numbers(segment))
         else:
             words = self._texts(block, segment)
             parts = [f"G{motion}"] if motion is not None else []
-            parts += [f"{letter}={text}" if len(letter) > 1 else letter + text for letter, text in words.items()]
+            parts += [
+                f"{letter}={text}" if len(letter) > 1 else letter + text for letter, text in words.items()
+            ]
             text = sep.join(parts)
         if motion is not None:
             self.output_motion = code
