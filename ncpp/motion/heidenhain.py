@@ -45,6 +45,7 @@ from ncpp.motion.tools import ToolTable, UntoldLengths
 from ncpp.program.blocks import Block, Comment, ExprWord, Word
 
 AXES = "XYZ"
+ROTARY = ("A", "B", "C")
 # Cycles that move or turn the datum (datum shift, mirror, rotation, scaling, working plane, presets)
 DATUM_CYCLES = frozenset(("7", "8", "10", "11", "19", "26", "247"))
 END_M = frozenset((2.0, 30.0))
@@ -211,6 +212,8 @@ class HeidenhainInterpreter(ModalInterpreter):
                         raise OutOfScope("M128 (tool-centre-point control)", item.start + 1)
                     end = end or value in END_M
                     continue
+                if letter in ROTARY:  # (its moves would be compensated as if the axis stood)
+                    raise OutOfScope(f"the rotary axis {letter} (this interpreter follows X Y Z)", item.start + 1)
                 words[letter] = (value, item)
                 continue
             what, node = item.kind, item.node

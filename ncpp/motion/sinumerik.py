@@ -37,6 +37,7 @@ from ncpp.motion.tools import ToolTable, UntoldLengths
 from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
 
 AXES = "XYZ"
+ROTARY = ("A", "B", "C")
 CENTRE_LETTERS = "IJK"
 INTERMEDIATE = ("I1", "J1", "K1")
 # G codes that change nothing the motion depends on (exact stop, continuous path, feed types, work offsets
@@ -192,6 +193,8 @@ class SinumerikInterpreter(ModalInterpreter):
             else:
                 if letter in UNREAD_GEOMETRY:
                     raise OutOfScope(f"{UNREAD_GEOMETRY[letter]} {letter}=", item.start + 1)
+                if letter in ROTARY:  # (its moves would be compensated as if the axis stood)
+                    raise OutOfScope(f"the rotary axis {letter} (this interpreter follows X Y Z)", item.start + 1)
                 if letter == "L":  # `L100`: runs subprogram L100.SPF, which may move the tool anywhere
                     raise OutOfScope(f"the subprogram call L{value:g}", item.start + 1)
                 if letter in words:
