@@ -213,7 +213,9 @@ class HeidenhainInterpreter(ModalInterpreter):
                     end = end or value in END_M
                     continue
                 if letter in ROTARY:  # (its moves would be compensated as if the axis stood)
-                    raise OutOfScope(f"the rotary axis {letter} (this interpreter follows X Y Z)", item.start + 1)
+                    raise OutOfScope(
+                        f"the rotary axis {letter} (this interpreter follows X Y Z)", item.start + 1
+                    )
                 words[letter] = (value, item)
                 continue
             what, node = item.kind, item.node

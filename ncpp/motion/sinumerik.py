@@ -194,7 +194,9 @@ class SinumerikInterpreter(ModalInterpreter):
                 if letter in UNREAD_GEOMETRY:
                     raise OutOfScope(f"{UNREAD_GEOMETRY[letter]} {letter}=", item.start + 1)
                 if letter in ROTARY:  # (its moves would be compensated as if the axis stood)
-                    raise OutOfScope(f"the rotary axis {letter} (this interpreter follows X Y Z)", item.start + 1)
+                    raise OutOfScope(
+                        f"the rotary axis {letter} (this interpreter follows X Y Z)", item.start + 1
+                    )
                 if letter == "L":  # `L100`: runs subprogram L100.SPF, which may move the tool anywhere
                     raise OutOfScope(f"the subprogram call L{value:g}", item.start + 1)
                 if letter in words:
