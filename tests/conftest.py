@@ -66,7 +66,7 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
         ),
         "passes/test_compensate_cli.py": ("test_linuxcnc_accepts_every_compensated_arc",),
         "shop/test_linuxcnc_filter.py": (
-            "test_axis_filters_a_program_large_enough_for_two_parts",
+            "test_axis_filters_a_long_program_with_its_progress_bar",
             "test_axis_loads_the_program_the_filter_compensated",
             "test_axis_shows_the_filters_error_and_loads_nothing",
             "test_filter_compensates_reports_progress_and_rs274_accepts_it",
@@ -135,8 +135,9 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
     },
     # runs ncpp in two processes (a test parametrized with jobs >= 2 is one too)
     "multiprocess": {
-        "compensation/test_first_fault.py": ("test_in_two_parts_the_first_fault_of_the_second_part",),
-        "shop/test_linuxcnc_filter.py": ("test_axis_filters_a_program_large_enough_for_two_parts",),
+        "compensation/test_several_programs.py": (
+            "test_two_processes_write_each_program_as_its_own_run_does_and_report_the_one_that_fails",
+        ),
     },
 }
 

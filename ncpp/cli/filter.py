@@ -84,7 +84,7 @@ def configured_source(args: argparse.Namespace):
     if args.from_file:
         return ErrorSource.from_measurement(args.from_file), settings.tolerance, offsets, guard
     assert settings.machine is not None  # (a machine file or a measurement, above)
-    if not Path(settings.machine).is_file():
+    if not Path(settings.machine).exists():  # (a device is read, to its size limit)
         raise NcppError(f"machine file {settings.machine} does not exist", Location(settings.origin))
     return ErrorSource.from_machine_file(settings.machine), settings.tolerance, offsets, guard
 

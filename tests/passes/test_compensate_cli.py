@@ -22,7 +22,18 @@ def ncpp(*args: str, input: bytes | None = None) -> subprocess.CompletedProcess:
 @pytest.fixture(scope="module")
 def compensated(tmp_path_factory) -> Path:
     out = tmp_path_factory.mktemp("comp") / "pocket.ngc"
-    proc = ncpp("compensate", "--machine", str(MACHINE), "--work-offset", OFFSET, str(POCKET), "-o", str(out))
+    # (no placement guard: rs274 runs it from G54 at 0)
+    proc = ncpp(
+        "compensate",
+        "--machine",
+        str(MACHINE),
+        "--work-offset",
+        OFFSET,
+        "--no-guard",
+        str(POCKET),
+        "-o",
+        str(out),
+    )
     assert proc.returncode == 0, proc.stderr.decode()
     return out
 

@@ -90,6 +90,9 @@ def test_pathcheck_passes_on_the_compensated_program(program: Path, tools: Path,
         limit = next((name for name, pattern in SCOPE_LIMITS.items() if re.search(pattern, error)), None)
         assert limit is not None, f"ncpp refuses a program rs274 runs: {error}"
         return
-    check = subprocess.run([sys.executable, str(PATHCHECK), str(program), str(written), "--tool-table", str(tools)],
+    # within the largest correction the machine file allows (wide.toml: max_correction_mm = 0.5; far out
+    # in its travel, as fusion-output.nc goes, the corrections pass 0.1 mm, pathcheck's default)
+    check = subprocess.run([sys.executable, str(PATHCHECK), str(program), str(written), "--tool-table", str(tools),
+                            "--tol-mm", "0.5"],
                            capture_output=True, text=True, timeout=1800, env=env)  # fmt: skip
     assert check.returncode == 0, check.stdout + check.stderr

@@ -78,7 +78,10 @@ def test_the_filter_verifies_too(program: Path, monkeypatch, capsys):
     monkeypatch.setenv("NCPP_MACHINE", str(MACHINE))
     assert main([str(program), "--work-offset", "400,350,300"]) != 0
     captured = capsys.readouterr()
-    assert "part.ngc:6:1: verification:" in captured.err and captured.out == ""
+    # (line 7's move starts where line 6's ends: the first point found off may be either's)
+    assert (
+        "part.ngc:6:1: verification:" in captured.err or "part.ngc:7:1: verification:" in captured.err
+    ) and captured.out == ""
 
 
 def test_a_long_program_is_verified_in_chunks(tmp_path: Path, monkeypatch, capsys):

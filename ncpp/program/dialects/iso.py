@@ -54,6 +54,7 @@ DROPPED = (
 )  # words of the old geometry a changed block loses (`@` `^`: polar)
 _DROPPED = frozenset(DROPPED)
 _BIT = {letter: 1 << n for n, letter in enumerate(WRITTEN_LETTERS)}  # a set of written letters is a bit mask
+_ALL_AXES = _BIT["X"] | _BIT["Y"] | _BIT["Z"]
 _CENTRE_BITS = {plane: _BIT[a] | _BIT[b] for plane, ((a, _), (b, _)) in CENTRE_WORDS.items()}
 # Per bit mask: the letters written, in order, each with the index of its number in `_numbers`
 # (X Y Z: 0 1 2; an arc's two centre words: 3 4).
@@ -690,12 +691,16 @@ def _bits_written(facts: _Facts, segment: Line | Arc, places: tuple, known: set[
     has written), then an arc's centre; `places`: the decimals the segment is written with.
     Not `named`: of the axes its block has, only those that move (after a change of units or
     offsets, where the output's position is off the grid of the new numbers, a rounded number
-    for an axis that stands would move it)."""
+    for an axis that stands would move it), unless none would be left: the block is a move the
+    control makes (of no length), as the program's was."""
     bits, absent, end = facts.axis_bits, facts.absent_axes, segment.end
     if not named and last is not None and segment.context.absolute:
+        named_bits = bits
         for n, axis in _NUMBERED_AXES:
             if bits & _BIT[axis] and not written_apart(end[n], places[n], last[n], last_places[n]):
                 bits &= ~_BIT[axis]
+        if named_bits & _ALL_AXES and not bits & _ALL_AXES:
+            bits = named_bits
     if absent and segment.context.absolute:
         same_places = places == last_places
         for n, axis, bit in absent:
