@@ -54,7 +54,8 @@ def test_a_terminated_run_removes_its_temporaries(tmp_path, sig, status):
         stderr=subprocess.PIPE,
     )
     deadline = time.monotonic() + 60
-    while not list(tmp_path.glob(".out.nc.*.tmp")) and time.monotonic() < deadline:
+    # (a temporary holding lines: the run is past its start, imports and all)
+    while not any(p.stat().st_size for p in tmp_path.glob(".out.nc.*.tmp")) and time.monotonic() < deadline:
         time.sleep(0.05)
     assert list(tmp_path.glob(".out.nc.*.tmp")), "the run never started writing"
     run.send_signal(sig)
