@@ -51,6 +51,7 @@ class ErrorSource:
     max_correction: float = 0.5
     limits: dict = field(default_factory=dict)
     rotary_xyz_are_axis_positions: bool = False  # the machine file's [compensation] key
+    kinematics_m_codes: tuple[int, ...] = ()  # and the M codes it says switch the kinematics
 
     @classmethod
     def from_machine_file(cls, path: str) -> ErrorSource:
@@ -60,7 +61,13 @@ class ErrorSource:
         limits = {a: lim for a, lim in machine.limits.items()}
         rotary = machine.rotary_xyz_are_axis_positions
         return cls(
-            MachineMap(machine), Path(path).name, _digest(path), machine.max_correction_mm, limits, rotary
+            MachineMap(machine),
+            Path(path).name,
+            _digest(path),
+            machine.max_correction_mm,
+            limits,
+            rotary,
+            machine.kinematics_m_codes,
         )
 
     @classmethod
@@ -343,6 +350,7 @@ def make_context(source: ErrorSource, tolerance: float, warnings: Warnings, file
         tolerance=tolerance,
         max_correction=source.max_correction,
         rotary_xyz_are_axis_positions=source.rotary_xyz_are_axis_positions,
+        kinematics_m_codes=source.kinematics_m_codes,
         limits=source.limits,
         directional=is_directional(source.model, source.limits),
         iterations=iterations_for(source.model, source.limits, INVERSE_BUDGET),

@@ -56,6 +56,8 @@ A complete example::
                                    # positions also while A, B or C turn (the control runs no
                                    # tool-centre-point kinematics), so such moves are compensated
                                    # (their pieces each turn their share); false (default): refused
+    kinematics_m_codes = [428, 429]  # M codes the control is set up to switch its kinematics with
+                                   # (a LinuxCNC remap to tool-centre-point control): refused
 
     [meta]                         # free-form, kept as is
     source = "laser 2004-03-02"
@@ -298,7 +300,16 @@ def _machine_from_dict(data: dict, loc: _Locator, default_name: str) -> Machine:
     _check_keys(limits, set(AXES), "limits", loc)
     travel = {k: _span(v) for k, v in _vectors(limits, "limits", "lo, hi", loc).items()}
     comp = _get_table(data, "compensation", loc)
-    _check_keys(comp, {"max_correction_mm", "rotary_xyz_are_axis_positions"}, "compensation", loc)
+    _check_keys(
+        comp,
+        {"max_correction_mm", "rotary_xyz_are_axis_positions", "kinematics_m_codes"},
+        "compensation",
+        loc,
+    )
+    kinematics = comp.get("kinematics_m_codes", [])
+    if not isinstance(kinematics, list) or not all(type(m) is int and m >= 0 for m in kinematics):
+        raise _fail("compensation: kinematics_m_codes must be a list of M numbers, as [428, 429]",
+                    loc.where("compensation", "kinematics_m_codes"))  # fmt: skip
     rotary = comp.get("rotary_xyz_are_axis_positions", False)
     if not isinstance(rotary, bool):
         raise _fail("compensation: rotary_xyz_are_axis_positions must be true or false",
@@ -317,6 +328,7 @@ def _machine_from_dict(data: dict, loc: _Locator, default_name: str) -> Machine:
             max_correction_mm=_max_correction(comp, loc),
             meta=_meta(head, data, loc),
             rotary_xyz_are_axis_positions=rotary,
+            kinematics_m_codes=tuple(kinematics),
         )
     except (ValueError, TypeError) as err:
         raise _fail(str(err), _where_for_machine_error(str(err), loc)) from err
@@ -648,6 +660,8 @@ def machine_to_dict(m: Machine) -> dict[str, Any]:
     doc["compensation"] = {"max_correction_mm": m.max_correction_mm}
     if m.rotary_xyz_are_axis_positions:
         doc["compensation"]["rotary_xyz_are_axis_positions"] = True
+    if m.kinematics_m_codes:
+        doc["compensation"]["kinematics_m_codes"] = list(m.kinematics_m_codes)
     if meta:
         doc["meta"] = meta
     return doc

@@ -107,6 +107,7 @@ class Machine:
     # The programmed X Y Z are the linear axes' positions also while a rotary axis turns (no
     # tool-centre-point kinematics): moves that turn A, B or C may be compensated
     rotary_xyz_are_axis_positions: bool = False
+    kinematics_m_codes: tuple[int, ...] = ()  # M codes that switch the control's kinematics (refused)
 
     def __post_init__(self) -> None:
         setter = lambda name, value: object.__setattr__(self, name, value)  # noqa: E731

@@ -41,6 +41,9 @@ class PassContext:
     arc_radius_tolerance: float = 0.0005  # mm: start/end radius agreement of emitted arcs
     max_correction: float = 0.5  # mm: larger corrections are refused
     rotary_xyz_are_axis_positions: bool = False  # moves that turn A, B or C may be compensated (`rotary.py`)
+    kinematics_m_codes: tuple[
+        int, ...
+    ] = ()  # M codes that switch the control's kinematics: refused (`rotary.py`)
     limits: dict[str, tuple[float, float]] = field(default_factory=dict)  # machine axis travel, mm
     directional: bool = False  # the model has reversal (direction-dependent) errors
     resolution: float = 1e-4  # mm: the output grid of mm programs (every writer writes at least 4 decimals)

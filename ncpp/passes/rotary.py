@@ -49,11 +49,13 @@ def _checked(chunk: list[Event], ctx: PassContext) -> Iterator[list[Event]]:
         kind = type(event)
         try:
             if kind is Line or kind is Arc:
+                if ctx.kinematics_m_codes:  # (a move's block may switch them too: only looked at where told)
+                    _refuse_tool_centre_point(event.block, ctx.file, ctx.kinematics_m_codes)
                 if event.extra_start and not event.fixed and event.extra[:3] != event.extra_start[:3]:  # type: ignore[union-attr]
                     if kind is Arc or not allowed:
                         _refuse_turn(event, kind is Arc, ctx.file)  # type: ignore[arg-type]
             elif kind is Pass:
-                _refuse_tool_centre_point(event.block, ctx.file)
+                _refuse_tool_centre_point(event.block, ctx.file, ctx.kinematics_m_codes)
         except NcppError:
             yield chunk[:k]
             raise
@@ -79,14 +81,17 @@ def _refuse_turn(move: Line | Arc, arc: bool, file: str) -> None:
     )
 
 
-def _refuse_tool_centre_point(block: Block, file: str) -> None:
-    """G43.4 / G43.5 (LinuxCNC), M128 and FUNCTION TCPM (Heidenhain), TRAORI (Sinumerik)."""
+def _refuse_tool_centre_point(block: Block, file: str, kinematics: tuple[int, ...] = ()) -> None:
+    """G43.4 / G43.5 (LinuxCNC), M128 and FUNCTION TCPM (Heidenhain), TRAORI (Sinumerik), and the
+    M codes the machine file says switch the control's kinematics (a LinuxCNC remap, as M428)."""
     name: str | None
     for item in block.items:
         kind = type(item)
         if kind is Word:
             code = (item.letter, item.value)  # type: ignore[union-attr]
-            if code not in (("G", 43.4), ("G", 43.5), ("M", 128.0)):
+            if code not in (("G", 43.4), ("G", 43.5), ("M", 128.0)) and not (
+                code[0] == "M" and code[1] in kinematics
+            ):
                 continue
             name = f"{item.letter}{item.value:g}"  # type: ignore[union-attr]
         elif kind is Statement and item.node and item.node[0] in ("FUNCTION", "TRAORI"):  # type: ignore[union-attr]
