@@ -437,22 +437,27 @@ def process(
 
 
 class _Reached:
-    """The input line of the last event the writer took, and of the block before it: a writer
-    may take a block's first event before it writes the lines of the block before
-    (`verify.verified` tags written lines with both)."""
+    """How far the writer has read: the input line of the last event it took and of the block
+    before it (a writer may take a block's first event before it writes the lines of the block
+    before), and how many blocks it has taken, in the order they run (loops run lines again).
+    `verify.verified` tags written lines with these."""
 
     def __init__(self) -> None:
-        self.line = self.before = 0
+        self.line = self.before = self.blocks = 0
+        self.block: Block | None = None
 
     def follow(self, events: Iterable[Event]) -> Iterator[Event]:
         for event in events:
-            line = event.block.line
-            if line != self.line:
-                self.before, self.line = self.line, line
+            block = event.block
+            if block is not self.block:
+                self.block = block
+                self.blocks += 1
+                if block.line != self.line:
+                    self.before, self.line = self.line, block.line
             yield event
 
-    def __call__(self) -> tuple[int, int]:
-        return self.line, self.before
+    def __call__(self) -> tuple[int, int, int]:
+        return self.line, self.before, self.blocks
 
 
 @contextmanager

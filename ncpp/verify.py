@@ -86,7 +86,7 @@ class Section:
     inverse_time: float  # minutes the G93 moves take
     action: Action | None
     first_line: int
-    cut: int = 0  # a chunk's end: the input line the next chunk starts at (0: not a chunk)
+    cut: int = 0  # a chunk's end: how many input blocks have run where the next chunk starts (0: not a chunk)
 
 
 NO_EXTRA = (0.0,) * len(EXTRA_AXES)
@@ -230,10 +230,11 @@ def actions_of(block: Block) -> tuple[list[str], list[str]]:
     return before, after
 
 
-Cut = Callable[[Block, int], int]  # (a block, the chunk's moves so far) -> the input line to cut at (0: none)
+# (a block, the chunk's moves so far, the blocks run so far with it) -> where the next chunk starts (0: no cut)
+Cut = Callable[[Block, int, int], int]
 
 
-def sections(events: Iterable[Event], bound: Bound, cut: Cut = lambda block, moves: 0,
+def sections(events: Iterable[Event], bound: Bound, cut: Cut = lambda block, moves, run: 0,
              line_of: Callable[[int], int] | None = None) -> Iterator[Section]:  # fmt: skip
     """The motion of a program's events between its actions, in the order it runs; a chunk
     ends before a block where `cut` says.  `line_of` gives the line a block's samples are
@@ -244,6 +245,7 @@ def sections(events: Iterable[Event], bound: Bound, cut: Cut = lambda block, mov
     after: list[str] = []
     first_line = 1
     inverse_time = False
+    run = 0  # blocks run so far
     for event in events:
         kind = type(event)
         block = event.block
@@ -253,7 +255,8 @@ def sections(events: Iterable[Event], bound: Bound, cut: Cut = lambda block, mov
                 moves, first_line = _Moves(bound), last.line  # type: ignore[union-attr]
             after = []
             last = block
-            if moves.ends and (at := cut(block, len(moves.ends))):
+            run += 1
+            if moves.ends and (at := cut(block, len(moves.ends), run)):
                 chunk = moves.sample(None, first_line)
                 chunk.cut = at
                 yield chunk
@@ -385,12 +388,13 @@ def verify(original: BinaryIO, written: BinaryIO, *, file: str, dialect: str | N
     return _Comparison(file, bound, lambda number: (_line_text(written, number), 0)).run(mine, theirs)
 
 
-def verified(lines: Iterable[str], reached: Callable[[], tuple[int, int]], original: Iterable[Event], *, file: str, dialect: str,
+def verified(lines: Iterable[str], reached: Callable[[], tuple[int, int, int]], original: Iterable[Event], *, file: str, dialect: str,
              offsets: WorkOffsets | None, bound: Bound) -> Iterator[str]:  # fmt: skip
     """The written program's `lines`, handed on as they are verified against the `original`
     events (the interpreter's reading of the input): each chunk of the input's motion is
     compared with the written lines read back up to where the writer had reached the same
-    input line (`reached()` as it hands out a line: that line and the one before).  Raises
+    input blocks (`reached()` as it hands out a line: its input line, the one before, and how
+    many input blocks have run, which loops make other than the lines).  Raises
     NcppError where they part, or the program's first fault: the reading of the input runs
     ahead of the passes, so a fault it meets waits until the passes have had the lines before."""
     from ncpp.program.parser import parse_stream
@@ -398,9 +402,9 @@ def verified(lines: Iterable[str], reached: Callable[[], tuple[int, int]], origi
     feed = _Feed(lines, reached)
     held = _Held(original)
     state = {"cut": 0}  # where the input's chunk under way ends (0: at an action)
-    mine = sections(held, bound, lambda block, moves: block.line if moves >= CHUNK_MOVES else 0)
+    mine = sections(held, bound, lambda block, moves, run: run if moves >= CHUNK_MOVES else 0)
     theirs = sections(_interpreted(parse_stream(feed, file, dialect), file, dialect, offsets), bound,
-                      lambda block, moves: state["cut"] if state["cut"] and feed.tag(block.line) >= state["cut"] else 0,
+                      lambda block, moves, run: state["cut"] if state["cut"] and feed.run(block.line) >= state["cut"] else 0,
                       lambda number: feed.tag(number, before=True))  # fmt: skip
     comparison = _Comparison(file, bound, feed.text, tagged=True)
     try:
@@ -451,13 +455,12 @@ class _Feed:
     """Written lines as the parser reads them (bytes), each remembered with the input line the
     writer had reached when it handed the line out (its tag), until the lines are handed on."""
 
-    def __init__(self, lines: Iterable[str], reached: Callable[[], tuple[int, int]]):
+    def __init__(self, lines: Iterable[str], reached: Callable[[], tuple[int, int, int]]):
         self.lines = iter(lines)
         self.reached = reached
         self.pending: list[str] = []
-        self.tags: deque[tuple[int, int, int]] = (
-            deque()
-        )  # (last written line of a text, its tag, the line before)
+        # (last written line of a text, its tag, the line before, the input blocks run so far)
+        self.tags: deque[tuple[int, int, int, int]] = deque()
         self.count = 0  # written lines read so far
         self.recent: deque[tuple[int, str]] = deque(maxlen=64)  # for messages
 
@@ -470,10 +473,10 @@ class _Feed:
                 return
             except NcppError as err:
                 raise _Upstream(err) from None
-            tag, before = self.reached()
+            tag, before, run = self.reached()
             self.pending.append(text)
             self.count += text.count("\n") or 1
-            self.tags.append((self.count, tag, before))
+            self.tags.append((self.count, tag, before, run))
             self.recent.append((self.count, text))
             yield text.encode("latin-1")
 
@@ -483,6 +486,12 @@ class _Feed:
         while len(self.tags) > 1 and self.tags[0][0] < number:
             self.tags.popleft()
         return self.tags[0][2 if before else 1] if self.tags else 0
+
+    def run(self, number: int) -> int:
+        """How many input blocks the writer had taken when it handed out written line `number`
+        (asked in increasing order)."""
+        self.tag(number)
+        return self.tags[0][3] if self.tags else 0
 
     def handed(self) -> list[str]:
         done, self.pending = self.pending, []
