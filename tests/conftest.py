@@ -78,6 +78,9 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
     },
     # a second and a half or more on a 2-core machine, all parameters together
     "slow": {
+        "hostile/test_resources.py": (
+            "test_compensating_a_loop_takes_the_same_memory_however_often_it_runs",
+        ),
         "cldata/test_cldata.py": ("test_corpus_file_reads_and_moves_where_the_gotos_say",),
         "identify/test_thesis_sample.py": ("test_make_reproduces_the_committed_comparison",),
         "diagnose/test_diagnose.py": ("test_one_hidden_effect_is_named_sized_and_closes_the_gap",),
