@@ -25,21 +25,24 @@ def compensate_file(program: Path, machine_toml: str, folder: Path, offsets: Wor
     return output
 
 
+def machine_file(name: str, errors: str) -> str:
+    """A machine file of X Y Z with 2 m travels at zero offsets, named `name`, with `errors`
+    (its [errors...] and [squareness] tables): the closed-form machines these tests judge by."""
+    head = (
+        f'[machine]\nname = "{name}"\nchain = "XYFZ"\n[offsets]\ntool = [0.0, 0.0, 0.0]\nwork = [0.0, 0.0, 0.0]\n'
+        "[limits]\nX = [-1000.0, 1000.0]\nY = [-1000.0, 1000.0]\nZ = [-1000.0, 1000.0]\n"
+    )
+    return head + errors
+
+
 # A machine whose X is off by -50 µm/m · Y (a squareness), and a short program per dialect
-SQUARE = """
-[machine]
-name = "square"
-chain = "XYFZ"
-[offsets]
-tool = [0.0, 0.0, 0.0]
-work = [0.0, 0.0, 0.0]
-[limits]
-X = [-1000.0, 1000.0]
-Y = [-1000.0, 1000.0]
-Z = [-1000.0, 1000.0]
+SQUARE = machine_file(
+    "square",
+    """
 [squareness]
 C0Y_urad = 50.0
-"""
+""",
+)
 PROGRAMS = {
     "iso": "%\nG21 G90\nG0 X10 Y10 Z5\nG1 Y200 F500\nM2\n%\n",
     "heidenhain": "0 BEGIN PGM T MM\n1 L X+10 Y+10 Z+5 FMAX\n2 L Y+200 F500\n3 END PGM T MM\n",

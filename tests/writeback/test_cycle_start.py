@@ -11,19 +11,11 @@ import pytest
 
 from tests.compensation.accuracy import holes_um
 from tests.conftest import CORPUS
-from tests.writeback.conftest import compensate_file
+from tests.writeback.conftest import compensate_file, machine_file
 
-MACHINE = """
-[machine]
-name = "scales and squareness"
-chain = "XYFZ"
-[offsets]
-tool = [0.0, 0.0, 0.0]
-work = [0.0, 0.0, 0.0]
-[limits]
-X = [-1000.0, 1000.0]
-Y = [-1000.0, 1000.0]
-Z = [-1000.0, 1000.0]
+MACHINE = machine_file(
+    "scales and squareness",
+    """
 [errors.EXX]
 kind = "polynomial"
 coefficients_um = [0.0, 0.05]
@@ -32,7 +24,8 @@ kind = "polynomial"
 coefficients_um = [0.0, -0.04]
 [squareness]
 C0Y_urad = 30.0
-"""
+""",
+)
 
 
 def machine(points: np.ndarray, _directions: np.ndarray) -> np.ndarray:

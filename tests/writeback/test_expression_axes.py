@@ -9,25 +9,18 @@ import numpy as np
 import pytest
 
 from tests.compensation.accuracy import worst_um
-from tests.writeback.conftest import SQUARE, compensate_file
+from tests.writeback.conftest import SQUARE, compensate_file, machine_file
 
-MACHINE = """
-[machine]
-name = "straightness of X in Y"
-chain = "XYFZ"
-[offsets]
-tool = [0.0, 0.0, 0.0]
-work = [0.0, 0.0, 0.0]
-[limits]
-X = [-1000.0, 1000.0]
-Y = [-1000.0, 1000.0]
-Z = [-1000.0, 1000.0]
+MACHINE = machine_file(
+    "straightness of X in Y",
+    """
 [errors.EYX]
 kind = "polynomial"
 coefficients_um = [0.0, 0.02, 2e-4]
 [compensation]
 max_correction_mm = 0.5
-"""
+""",
+)
 
 
 def straightness(points: np.ndarray, _directions: np.ndarray) -> np.ndarray:

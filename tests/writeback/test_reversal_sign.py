@@ -10,25 +10,18 @@ import numpy as np
 import pytest
 
 from tests.compensation.accuracy import worst_um
-from tests.writeback.conftest import compensate_file
+from tests.writeback.conftest import compensate_file, machine_file
 
-MACHINE = """
-[machine]
-name = "reversal of X"
-chain = "XYFZ"
-[offsets]
-tool = [0.0, 0.0, 0.0]
-work = [0.0, 0.0, 0.0]
-[limits]
-X = [-1000.0, 1000.0]
-Y = [-1000.0, 1000.0]
-Z = [-1000.0, 1000.0]
+MACHINE = machine_file(
+    "reversal of X",
+    """
 [errors.EXX]
 kind = "table"
 positions = [-1000.0, 1000.0]
 values_um = [-10.0, 10.0]
 values_um_minus = [{low}, {high}]
-"""
+""",
+)
 # X reverses after lines along X (the corner is on the path either way) and after a line
 # along Y into a slanted line (a jump there leaves the slanted line by its sine)
 PROGRAM = """G21 G90 G17

@@ -10,19 +10,11 @@ import numpy as np
 import pytest
 
 from tests.compensation.accuracy import rs274_calls, worst_um
-from tests.writeback.conftest import compensate_file
+from tests.writeback.conftest import compensate_file, machine_file
 
-MACHINE = """
-[machine]
-name = "positioning of X, reversal of Z"
-chain = "XYFZ"
-[offsets]
-tool = [0.0, 0.0, 0.0]
-work = [0.0, 0.0, 0.0]
-[limits]
-X = [-1000.0, 1000.0]
-Y = [-1000.0, 1000.0]
-Z = [-1000.0, 1000.0]
+MACHINE = machine_file(
+    "positioning of X, reversal of Z",
+    """
 [errors.EXX]
 kind = "polynomial"
 coefficients_um = [0.0, 0.05]
@@ -31,7 +23,8 @@ kind = "table"
 positions = [-1000.0, 1000.0]
 values_um = [0.0, 0.0]
 values_um_minus = [-5.0, -5.0]
-"""
+""",
+)
 PROGRAM = """G20 G90 G17
 G0 X1 Y1 Z0.2
 G1 Z-0.049737 F10
