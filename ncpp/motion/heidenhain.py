@@ -37,7 +37,7 @@ from ncpp.motion.modal import (
     ModalInterpreter,
     OutOfScope,
     as_point,
-    resolve_warnings,
+    run_placed,
 )
 from ncpp.motion.offsets import WorkOffsets
 from ncpp.motion.segments import COMP, PLANE_AXES, Arc, Event, Line, Pass, Point
@@ -83,11 +83,7 @@ def interpret(
         offsets.program_zero() if offsets is not None else (0.0, 0.0, 0.0)
     )  # one program zero: the system in effect
     interpreter = HeidenhainInterpreter(file, zero, offsets.tools if offsets is not None else None)
-    warnings = resolve_warnings(warnings, strict)
-    interpreter.untold_lengths = UntoldLengths(
-        offsets is not None and offsets.tools is None, warnings
-    )  # placing the program
-    return interpreter.run(blocks, warnings)
+    return run_placed(interpreter, blocks, warnings, strict, offsets is None or offsets.tools is not None)
 
 
 def _plane_of_axes(axes: set[int], default: int) -> int:

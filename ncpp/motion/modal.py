@@ -42,6 +42,22 @@ def resolve_warnings(warnings: Warnings | None, strict: bool) -> Warnings:
     return warnings
 
 
+def run_placed(
+    interpreter: ModalInterpreter,
+    blocks: Iterable[Block],
+    warnings: Warnings | None,
+    strict: bool,
+    tools_told: bool,
+) -> Iterator[Event]:
+    """Run a one-zero dialect's interpreter (Klartext, Sinumerik) over the blocks: it warns where a
+    tool length applies that nothing tells, when the program is placed (`tools_told` False)."""
+    from ncpp.motion.tools import UntoldLengths
+
+    warnings = resolve_warnings(warnings, strict)
+    interpreter.untold_lengths = UntoldLengths(not tools_told, warnings)  # type: ignore[attr-defined]
+    return interpreter.run(blocks, warnings)
+
+
 class ModalInterpreter:
     """Position and modal state of one program run (program units throughout)."""
 

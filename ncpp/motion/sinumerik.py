@@ -29,7 +29,7 @@ from ncpp.motion.modal import (
     OutOfScope,
     circle_through,
     plane_of,
-    resolve_warnings,
+    run_placed,
 )
 from ncpp.motion.offsets import WorkOffsets
 from ncpp.motion.segments import PLANE_AXES, Event
@@ -67,11 +67,7 @@ def interpret(
         offsets.program_zero() if offsets is not None else (0.0, 0.0, 0.0)
     )  # one program zero: the system in effect
     interpreter = SinumerikInterpreter(file, zero, offsets.tools if offsets is not None else None)
-    warnings = resolve_warnings(warnings, strict)
-    interpreter.untold_lengths = UntoldLengths(
-        offsets is not None and offsets.tools is None, warnings
-    )  # placing the program
-    return interpreter.run(blocks, warnings)
+    return run_placed(interpreter, blocks, warnings, strict, offsets is None or offsets.tools is not None)
 
 
 # The axis (X, Y, Z index) that lengths 1, 2 and 3 of a milling tool act along, per plane
