@@ -54,10 +54,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from ncpp.cli.io import open_input
-    from ncpp.cli.motion import warn_off_path
+    from ncpp.cli.motion import interpreted, warn_off_path
     from ncpp.motion.extents import iso_system_name
-    from ncpp.pipeline import dialect_tools
-    from ncpp.program.dialects import parse_program
 
     limits = None
     if args.machine:
@@ -68,9 +66,7 @@ def run(args: argparse.Namespace) -> int:
     offsets = work_offsets(args) if placed or args.tool_table or args.subroutine_path else None
     warnings = Warnings(strict=args.strict)
     with open_input(args.input) as (stream, name):
-        dialect, blocks = parse_program(stream, name, args.dialect)
-        interpret, _ = dialect_tools(dialect)
-        moves = interpret(blocks, file=name, warnings=warnings, offsets=offsets)
+        dialect, moves = interpreted(stream, name, args.dialect, warnings, offsets)
         events = warn_off_path(
             moves, warnings, name, "counted as programmed (the tool centre is off them by the radius)"
         )

@@ -59,15 +59,26 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.set_defaults(func=run)
 
 
+def interpreted(
+    stream, name: str, dialect: str | None, warnings: Warnings, offsets
+) -> tuple[str, Iterable[Event]]:
+    """A program's dialect and its motion events as the interpreter reads it (the placement
+    guard of a compensated program left out: it moves nothing)."""
+    from ncpp.guard import without_guard
+    from ncpp.pipeline import dialect_tools
+    from ncpp.program.dialects import parse_program
+
+    found, blocks = parse_program(stream, name, dialect)
+    interpret, _ = dialect_tools(found)
+    return found, interpret(without_guard(blocks), file=name, warnings=warnings, offsets=offsets)
+
+
 def run(args: argparse.Namespace) -> int:
     import json
     import sys
 
     from ncpp.cli.io import open_input
-    from ncpp.guard import without_guard
     from ncpp.motion.canon import format_event
-    from ncpp.pipeline import dialect_tools
-    from ncpp.program.dialects import parse_program
 
     warnings = Warnings(strict=args.strict)
     offsets = (
@@ -77,10 +88,7 @@ def run(args: argparse.Namespace) -> int:
     )
     out = sys.stdout
     with open_input(args.input) as (stream, name):
-        dialect, blocks = parse_program(stream, name, args.dialect)
-        interpret, _ = dialect_tools(dialect)
-        blocks = without_guard(blocks)  # (a compensated program's)
-        events = interpret(blocks, file=name, warnings=warnings, offsets=offsets)
+        _, events = interpreted(stream, name, args.dialect, warnings, offsets)
         for event in warn_off_path(
             events,
             warnings,
