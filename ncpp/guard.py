@@ -91,6 +91,7 @@ def guard_lines(placement: Placement, dialect: str, first_lines: Iterable[str] =
     from LinuxCNC's).  [] where there is none."""
     if dialect == "iso":
         dialect = "fanuc" if any(_FANUC_PROGRAM_NUMBER.match(line) for line in first_lines) else "linuxcnc"
+    # (grbl reads no parameters and has no conditionals: it cannot test its work offset)
     written = {"linuxcnc": _linuxcnc, "fanuc": _fanuc, "sinumerik": _sinumerik}.get(dialect)
     return [] if written is None else written(placement)
 

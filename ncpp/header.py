@@ -15,13 +15,14 @@ import hashlib
 from pathlib import Path
 
 from ncpp.motion.offsets import SYSTEMS, WorkOffsets
+from ncpp.program.dialects import FAMILY
 
 SYSTEMS_PER_LINE = 3  # work offsets said on one header line
 
 
 def placement_lines(offsets: WorkOffsets, dialect: str) -> list[str]:
     """The header's lines after its first: zeros (machine mm), G92, tool table, units."""
-    if dialect == "iso":
+    if FAMILY.get(dialect, dialect) == "iso":
         lines = _systems(offsets)
     else:  # one program zero: the system in effect with G92 (`WorkOffsets.program_zero`)
         lines = [f"ncpp program zero at {_point(offsets.program_zero())} machine mm"]

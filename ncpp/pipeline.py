@@ -28,7 +28,7 @@ from ncpp.passes import PASSES, PassContext, run_passes
 from ncpp.passes.context import ErrorMap, is_directional
 from ncpp.passes.inverse import iterations_for
 from ncpp.program.blocks import Block, Comment, Statement, Word
-from ncpp.program.dialects import parse_program
+from ncpp.program.dialects import FAMILY, get_dialect, parse_program
 from ncpp.program.dialects.iso import IsoWriter
 from ncpp.runtime import keep_freed_memory
 from ncpp.summary import Summary
@@ -302,6 +302,7 @@ def _reported(
 # Per dialect: the module of its interpreter (an `interpret` function) and its writer class.
 DIALECT_TOOLS = {
     "iso": ("ncpp.motion.interpreter", "ncpp.program.dialects.iso", "IsoWriter"),
+    "grbl": ("ncpp.motion.grbl", "ncpp.program.dialects.iso", "IsoWriter"),
     "heidenhain": ("ncpp.motion.heidenhain", "ncpp.program.dialects.heidenhain", "HeidenhainWriter"),
     "sinumerik": ("ncpp.motion.sinumerik", "ncpp.program.dialects.sinumerik", "SinumerikWriter"),
 }
@@ -388,42 +389,48 @@ def process(
     command line writes to a temporary file or a spool).  `verify=False` skips it.  `guard`: where
     the program must find the control's work offset, checked at its start (`ncpp/guard.py`)."""
     warnings = warnings or Warnings(strict=strict)
+    if source is None:
+        stats = _copied(stream, out, dialect, progress)
+        warnings.finish()
+        return stats
     stats = Stats()
     name, parsed = parse_program(stream, file, dialect)
     interpret, writer_class = dialect_tools(name)
     counter = count()
     blocks: Iterable[Block] = _counted(_parsed_ahead(parsed), counter, progress)
-    if source is not None and not force:
+    if not force:
         blocks = refuse_compensated(blocks, file)
-    elif source is not None:  # compensated again: the guard of the offset it was compensated for goes
+    else:  # compensated again: the guard of the offset it was compensated for goes
         blocks = without_guard(blocks)
-    if source is not None and name != "iso":  # the ISO interpreter places every work offset and tool length
+    if FAMILY[name] != "iso":  # the ISO interpreter places every work offset and tool length
         blocks = warn_unplaced(blocks, warnings, file)
-    # the control's zeros place the program on the machine; passthrough places nothing
-    offsets = (offsets or AT_MACHINE_ZERO) if source is not None else None
+    offsets = offsets or AT_MACHINE_ZERO  # the control's zeros place the program on the machine
     events: Iterable[Event] = interpret(blocks, file=file, warnings=warnings, strict=strict, offsets=offsets)
-    if source is None:
-        lines: Iterable[str] = (event.block.text for event in _first_per_block(events))
-    else:
-        if verify:
-            events, original = tee(events)
-        events = warn_fixed(events, warnings, file)  # cycles, loops, subroutines (ISO), cutter compensation
-        stats.summary = summary = Summary(file)
-        warnings.listeners.append(summary.heard)
-        writer = writer_class()
-        keep_freed_memory()  # numpy's temporaries reuse the heap, not fresh pages (runtime.py)
-        ctx = make_context(source, tolerance, warnings, file)
-        reached = _Reached()
-        compensated = summary.written(run_passes(summary.programmed(events), ctx, PASSES))
-        header = header_text(source, tolerance, offsets, name)
-        lines = with_header(writer.write(reached.follow(compensated)), header, writer)
-        if guard is not None:
-            lines = with_guard(lines, guard, name, HEADER_TAG, header.count("\n") + 1)
-        if verify:
-            from ncpp.verify import Bound, verified
+    if verify:
+        events, original = tee(events)
+    events = warn_fixed(events, warnings, file)  # cycles, loops, subroutines (ISO), cutter compensation
+    stats.summary = summary = Summary(file)
+    warnings.listeners.append(summary.heard)
+    writer = writer_class()
+    keep_freed_memory()  # numpy's temporaries reuse the heap, not fresh pages (runtime.py)
+    ctx = make_context(source, tolerance, warnings, file)
+    reached = _Reached()
+    compensated = summary.written(run_passes(summary.programmed(events), ctx, PASSES))
+    header = header_text(source, tolerance, offsets, name)
+    lines = with_header(writer.write(reached.follow(compensated)), header, writer)
+    if guard is not None and name == "grbl":
+        warnings.warn(
+            f"grbl cannot test its work offset (it reads no parameters): the program carries no "
+            f"placement guard; make sure the control has {guard.said()} before it runs",
+            Location(file, 1, None),
+        )
+    elif guard is not None:
+        lines = with_guard(lines, guard, name, HEADER_TAG, header.count("\n") + 1)
+    if verify:
+        from ncpp.verify import Bound, verified
 
-            lines = verified(lines, reached, original, file=file, dialect=name, offsets=offsets,
-                             bound=Bound(source.max_correction + tolerance))  # fmt: skip
+        lines = verified(lines, reached, original, file=file, dialect=name, offsets=offsets,
+                         bound=Bound(source.max_correction + tolerance))  # fmt: skip
     lines = iter(lines)
     with _rare_collections():
         while batch := list(islice(lines, 4096)):  # written in batches: one encode and write per 4096 lines
@@ -433,6 +440,23 @@ def process(
     if stats.summary is not None:
         stats.summary.lines_in, stats.summary.lines_out = stats.lines_in, stats.lines_out
     warnings.finish()
+    return stats
+
+
+def _copied(
+    stream: BinaryIO, out: BinaryIO, dialect: str | None, progress: Callable[[int], None] | None
+) -> Stats:
+    """With nothing to compensate, the program as it is, byte for byte: not read as a program
+    at all, so nothing a control would run is refused or changed on the way."""
+    if dialect is not None:
+        get_dialect(dialect)  # an unknown name is an error still
+    stats = Stats()
+    for line in stream:
+        out.write(line)
+        stats.lines_in += 1
+        if progress is not None and stats.lines_in % 1000 == 0:
+            progress(stats.lines_in)
+    stats.lines_out = stats.lines_in
     return stats
 
 
@@ -476,11 +500,3 @@ def _rare_collections(threshold: int = 1_000_000) -> Iterator[None]:
         yield
     finally:
         gc.set_threshold(*old)
-
-
-def _first_per_block(events: Iterable[Event]) -> Iterator[Event]:
-    last = None
-    for event in events:
-        if event.block is not last:
-            last = event.block
-            yield event

@@ -413,6 +413,8 @@ def verified(lines: Iterable[str], reached: Callable[[], tuple[int, int, int]], 
             comparison.step(a, theirs)
             yield from feed.handed()
         comparison.end(theirs)
+    except _Unread as err:  # the written program cut short where a fault of the input stopped it
+        raise held.error or err from None
     except NcppError as err:
         raise held.first(err) from None
     if held.error is not None:
@@ -441,6 +443,10 @@ class _Held:
         ):
             return self.error
         return err
+
+
+class _Unread(NcppError):
+    """The written program cannot be read back."""
 
 
 class _Upstream(Exception):
@@ -576,7 +582,7 @@ class _Comparison:
         except NcppError as err:
             number = err.where.line
             text, reached = self.written_text(number)
-            raise NcppError(
+            raise _Unread(
                 f"verification: ncpp cannot read back the program it wrote: {err.message}, "
                 f"at its line {number} {text!r}",
                 Location(self.file, reached or line or 1, 1),

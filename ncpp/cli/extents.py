@@ -28,6 +28,7 @@ from ncpp.cli.compensate import add_placement_arguments, work_offsets
 from ncpp.cli.io import add_dialect_argument
 from ncpp.errors import Warnings
 from ncpp.motion.extents import Extent, extents, fit_in_travel
+from ncpp.program.dialects import FAMILY
 
 MOVES = "feed and rapid moves, arcs by their true extent"
 
@@ -71,7 +72,7 @@ def run(args: argparse.Namespace) -> int:
             moves, warnings, name, "counted as programmed (the tool centre is off them by the radius)"
         )
         known = offsets if placed else None  # the zeros the control holds, where the user told them
-        if dialect == "iso":
+        if FAMILY[dialect] == "iso":
             found = extents(events, lambda c: known is not None and known.told(c.system), iso_system_name)
         else:  # one program zero: the system in effect when the program starts
             found = extents(

@@ -44,7 +44,7 @@ def add_dialect_argument(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--dialect",
         default=None,
-        help="NC dialect: iso, heidenhain or sinumerik (default: detected from the content)",
+        help="NC dialect: iso (LinuxCNC), grbl, heidenhain or sinumerik (default: detected from the content)",
     )
 
 

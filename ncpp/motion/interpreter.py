@@ -175,15 +175,28 @@ def interpret(
     `warnings` (stderr by default) and end interpretation; with `strict`
     (or a strict `warnings`) they raise NcppError instead.
     """
+    return run(Interpreter(file, offsets), blocks, warnings, strict)
+
+
+def run(
+    interpreter: Interpreter, blocks: Iterable[Block], warnings: Warnings | None, strict: bool
+) -> Iterator[Event]:
+    """The events of `interpreter` (LinuxCNC's, or a flavour's subclass) running `blocks`."""
     if warnings is None:
         warnings = Warnings(strict=strict)
     elif strict and not warnings.strict:
         warnings = Warnings(strict=True, stream=warnings.stream)
-    return Interpreter(file, offsets).run(blocks, warnings)
+    return interpreter.run(blocks, warnings)
 
 
 class Interpreter:
-    """Modal state of one program run (program units throughout)."""
+    """Modal state of one program run (program units throughout).
+
+    A flavour of the ISO family subclasses it where its control reads a construct
+    otherwise (`grbl.py`); the class attributes below are the rules it may change."""
+
+    # An arc's offset word along the plane's normal (K in G17): rs274ngc refuses it
+    arc_normal_offset_ignored = False
 
     def __init__(self, file: str = "<stdin>", offsets: WorkOffsets | None = None):
         self.file = file
@@ -1445,7 +1458,7 @@ class Interpreter:
         self._check_feed(
             block, words, "Cannot make arc with zero feed rate", "F word missing with inverse time arc move"
         )
-        if normal_letter in words:
+        if normal_letter in words and not (self.arc_normal_offset_ignored and radius is None):
             self._fail(
                 f"{normal_letter} word given for arc in {_PLANE_NAMES[plane]} plane",
                 block,

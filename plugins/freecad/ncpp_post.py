@@ -65,6 +65,9 @@ parser.add_argument("--var-units", help="units of --var-file and --tool-table: m
 parser.add_argument("--ncpp", help="refused: ncpp is found from $NCPP, the FreeCAD parameter or PATH")
 # FreeCAD's own posts this one can wrap: all write ISO G code that the ncpp filter reads
 BASES = ("linuxcnc", "grbl", "fanuc", "mach3_mach4", "centroid")
+# The ncpp dialect a base post's program is read in, where it is not LinuxCNC's (grbl takes
+# K in a G17 arc, which FreeCAD's grbl post writes)
+BASE_DIALECTS = {"grbl": "grbl"}
 parser.add_argument("--base", default="linuxcnc", help=f"FreeCAD's post to wrap: {', '.join(BASES)}")
 parser.add_argument("--no-guard", action="store_true", help="no placement guard at the program's start")
 
@@ -126,6 +129,8 @@ def _ncpp_arguments(options):
         args += ["--work-offset", zero]
     if options.no_guard:
         args.append("--no-guard")
+    if options.base in BASE_DIALECTS:
+        args += ["--dialect", BASE_DIALECTS[options.base]]
     return args
 
 

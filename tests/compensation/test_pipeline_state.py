@@ -6,6 +6,7 @@ from pathlib import Path
 
 from ncpp.motion.offsets import WorkOffsets
 from ncpp.pipeline import ErrorSource, process
+from tests.conftest import READING
 
 MACHINE = Path(__file__).resolve().parents[2] / "samples/machines/hr5b.toml"
 
@@ -43,7 +44,12 @@ def test_an_earlier_lines_error_is_told_before_a_later_parse_error():
     for program, line in ((b"G21 G90\n" + good + b"G1 X1 X2\n" + good + b"G1 X(unclosed\n" + good, 202),
                           (b"G21 G90\n" + good * 30 + b"G1 X(unclosed\n" + good, 6002)):  # fmt: skip
         try:
-            process(io.BytesIO(program), io.BytesIO(), file="t.ngc")
+            process(
+                io.BytesIO(program),
+                io.BytesIO(),
+                file="t.ngc",
+                source=ErrorSource.from_machine_file(str(READING)),
+            )
         except NcppError as err:
             assert err.where.line == line
         else:

@@ -10,11 +10,12 @@ from ncpp.program.blocks import DIGITS_AS_ONE
 from ncpp.program.dialects import detect, parse_program, sniff
 from ncpp.program.parser import LineParser, parse_stream
 from ncpp.program.writer import write_blocks
-from tests.conftest import CORPUS, corpus_files, corpus_id, expected_signature
+from tests.conftest import CORPUS, READING, corpus_files, corpus_id, expected_signature
 
 HEIDENHAIN = corpus_files("heidenhain")
 SINUMERIK = corpus_files("sinumerik")
 OTHERS = corpus_files("iso_gcode", "malformed", "apt_cldata", "metrology")
+GRBL = corpus_files("iso_gcode/freecad_grbl")  # FreeCAD's grbl posts say so in their first comment
 PLAN_H = CORPUS / "heidenhain/jstjst_Heidenhain-Cycles/Plan.h"  # continuation lines, a cycle, a GPL header
 # Plain G code with `;` comments: nothing in it is Sinumerik-only, only its name tells.
 CONTENT_AMBIGUOUS = {"multiple_m_codes.mpf"}
@@ -44,7 +45,15 @@ def test_sinumerik_program_roundtrips(path):
 
 @pytest.mark.parametrize("path", HEIDENHAIN + SINUMERIK + OTHERS, ids=corpus_id)
 def test_dialect_is_detected(path):
-    want = "heidenhain" if path in HEIDENHAIN else "sinumerik" if path in SINUMERIK else "iso"
+    want = (
+        "heidenhain"
+        if path in HEIDENHAIN
+        else "sinumerik"
+        if path in SINUMERIK
+        else "grbl"
+        if path in GRBL
+        else "iso"
+    )
     head = path.read_bytes()[:4096]
     assert detect(head, path.name) == want
     if path.name not in CONTENT_AMBIGUOUS:
@@ -133,7 +142,9 @@ def test_cli_dialect_option_overrides_and_errors_name_the_line(tmp_path):
     bad = tmp_path / "bad.mpf"
     bad.write_bytes(b"G1 X1\nX=(1+\n")
     proc = subprocess.run(
-        [sys.executable, "-m", "ncpp", "--dialect", "sinumerik", str(bad)], capture_output=True, text=True
+        [sys.executable, "-m", "ncpp", "--dialect", "sinumerik", "--machine", str(READING), str(bad)],
+        capture_output=True,
+        text=True,
     )
     assert proc.returncode != 0 and proc.stdout == "" and proc.stderr.startswith(f"{bad}:2:")
     proc = subprocess.run(
@@ -142,24 +153,29 @@ def test_cli_dialect_option_overrides_and_errors_name_the_line(tmp_path):
     assert proc.returncode != 0 and "unknown dialect" in proc.stderr
 
 
+@pytest.mark.parametrize("path", corpus_files("."), ids=corpus_id)
+def test_without_a_machine_file_every_corpus_file_passes_through_byte_for_byte(path, tmp_path, capsys):
+    """Nothing to compensate: the file is not read as a program, whatever it holds."""
+    from ncpp.cli import main
+
+    out = tmp_path / "out"
+    assert main([str(path), "-o", str(out)]) == 0
+    assert out.read_bytes() == path.read_bytes()
+    assert "no machine file, nothing was compensated" in capsys.readouterr().err
+
+
 # Programs a control would refuse: `ncpp` refuses them too, with a location.
 REFUSED = {
     "sinumerik/CEAD_nc-gcode-interpreter/simple.mpf": "circular interpolation without I/J/K",
 }
 
 
-@pytest.mark.parametrize("path", corpus_files("heidenhain", "sinumerik"), ids=corpus_id)
-def test_ncpp_command_passes_dialect_program_through_unchanged(path, tmp_path, capsys):
-    """Parse, interpret (each dialect's interpreter) and write: byte for byte, or a located refusal."""
+@pytest.mark.parametrize("path", [CORPUS / name for name in REFUSED], ids=corpus_id)
+def test_a_program_its_control_refuses_is_refused_with_its_place(path, tmp_path, capsys):
     from ncpp.cli import main
 
     out = tmp_path / "out"
-    status = main([str(path), "-o", str(out)])
-    expected = REFUSED.get(corpus_id(path))
+    status = main(["--machine", str(READING), str(path), "-o", str(out)])
     err = capsys.readouterr().err
-    if expected is None:
-        assert status == 0, err
-        assert out.read_bytes() == path.read_bytes()
-    else:
-        assert status != 0 and expected in err and err.startswith(f"{path}:")
-        assert not out.exists()
+    assert status != 0 and REFUSED[corpus_id(path)] in err and err.startswith(f"{path}:")
+    assert not out.exists()

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from tests.conftest import SHARED
+from tests.conftest import READING, SHARED
 from tests.hostile.conftest import ROOT
 
 MACHINE = SHARED / "machines/wide.toml"
@@ -52,6 +52,8 @@ def test_a_terminated_run_removes_its_temporaries(tmp_path, sig, status):
         ],
         env=env,
         stderr=subprocess.PIPE,
+        # (a shell's background job ignores SIGINT, and so would ncpp started from it: as at a terminal)
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
     )
     deadline = time.monotonic() + 60
     # (a temporary holding lines: the run is past its start, imports and all)
@@ -130,14 +132,14 @@ def test_an_unwritable_output_names_its_file(ncpp, tmp_path):
 def test_an_open_subroutine_is_located(ncpp, tmp_path, text, where):
     program = tmp_path / "p.ngc"
     program.write_text(text)
-    done = ncpp(str(program))
+    done = ncpp("--machine", str(READING), str(program))
     assert done.stderr.decode().strip() == f"{program}:{where}"
 
 
 def test_a_name_with_control_characters_is_escaped(ncpp, tmp_path):
     program = tmp_path / "p.ngc"
     program.write_bytes(b"o<a\x1b[31mb> call\nM2\n")
-    done = ncpp(str(program))
+    done = ncpp("--machine", str(READING), str(program))
     assert b"\x1b" not in done.stderr and b"o<a\\x1b[31mb>" in done.stderr
 
 

@@ -9,6 +9,7 @@ import pytest
 from ncpp.errors import NcppError
 from ncpp.program.dialects import get_dialect
 from ncpp.program.parser import LineParser, parse_text
+from tests.conftest import READING
 
 MAX_NESTING = 128  # the bound README states
 
@@ -41,7 +42,7 @@ def test_fifty_megabytes_of_one_line_are_refused_in_bounded_time(ncpp, tmp_path)
     program = tmp_path / "wide.ngc"
     program.write_bytes(b"X1 " * (16 << 20) + b"\n")
     started = time.perf_counter()
-    done = ncpp(str(program), memory_mb=1024, timeout=60)
+    done = ncpp("--machine", str(READING), str(program), memory_mb=1024, timeout=60)
     assert time.perf_counter() - started < 10  # (the dialect's detection once read the whole line: 37 s)
     assert done.returncode == 2 and b"Traceback" not in done.stderr
     assert done.stderr.decode().startswith(f"{program}:1:257: block too long")
@@ -77,6 +78,6 @@ def test_a_million_brackets_are_refused_in_a_second(ncpp, tmp_path, dialect, suf
     start = "1 Q1 = " if dialect == "heidenhain" else "R1="
     program.write_text(start + "(" * 10**6 + "1" + ")" * 10**6 + "\n")
     started = time.perf_counter()
-    done = ncpp("--dialect", dialect, str(program), timeout=60)
+    done = ncpp("--machine", str(READING), "--dialect", dialect, str(program), timeout=60)
     assert time.perf_counter() - started < 5
     assert done.returncode == 2 and b"block too long" in done.stderr

@@ -138,9 +138,12 @@ def test_the_post_passes_every_fixture_zero_to_ncpp(tmp_path, monkeypatch):
     text = plugin.compensate_text(program, both)
     assert "G55" in text and text.startswith("(ncpp compensated")
     only_g54 = plugin.compensate_text(program, f"--machine {MACHINE} --work-offset 250,300,300")
-    g55_part = lambda text: text[text.index("G55") :]  # noqa: E731
-    assert g55_part(text) != g55_part(only_g54)  # compensated where G55 really is
-    assert text[: text.index("G55")] == only_g54[: only_g54.index("G55")]
+    body = lambda text: text[text.index("G21 G90 G54\n") :]  # noqa: E731 (after ncpp's header)
+    before_g55 = lambda text: body(text)[: body(text).index("\nG55\n")]  # noqa: E731
+    after_g55 = lambda text: body(text)[body(text).index("\nG55\n") :]  # noqa: E731
+    assert after_g55(text) != after_g55(only_g54)  # compensated where G55 really is
+    assert before_g55(text) == before_g55(only_g54)
+    assert "G55 X550 Y400 Z250" in text and "G55 X550" not in only_g54  # the header tells both
 
 
 def test_the_post_wraps_freecads_grbl_post_with_base(posted):

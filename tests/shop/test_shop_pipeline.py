@@ -12,7 +12,7 @@ import pytest
 from ncpp import __version__ as package_version
 from ncpp.errors import NcppError
 from ncpp.integrations.config import config_paths, find_settings, with_linuxcnc_ini
-from tests.conftest import ROOT
+from tests.conftest import READING, ROOT
 
 MACHINE = ROOT / "samples/machines/hr5b.toml"
 OTHER = ROOT / "samples/machines/valmet.toml"
@@ -161,7 +161,12 @@ def test_machine_from_the_local_config_compensates(shop):
             {"NCPP_MACHINE": "/no/such.toml"},
             "NCPP_MACHINE: machine file /no/such.toml does not exist",
         ),
-        ("unreadable program", "G1 X1 F100\nG2 X3 Y0 R0.1\nM2\n", {}, "<stdin>:2:"),
+        (
+            "unreadable program",
+            "G1 X1 F100\nG2 X3 Y0 R0.1\nM2\n",
+            {"NCPP_MACHINE": str(READING)},
+            "<stdin>:2:",
+        ),
         (
             "compensated twice",
             "(ncpp compensated for hr5b.toml sha256:0 tolerance 0.001 mm)\n" + PROGRAM,
@@ -185,7 +190,9 @@ def test_any_error_stops_the_pipeline(shop, case, stdin, env, message):
 
 def test_shell_pipeline_stops_on_error(shop):
     """With `set -o pipefail` a shell pipeline fails when ncpp fails."""
-    script = "set -o pipefail; printf 'G2 X3 Y0 R0.1\\n' | python3 -m ncpp | cat > out.nc"
+    script = (
+        f"set -o pipefail; printf 'G2 X3 Y0 R0.1\\n' | python3 -m ncpp --machine {READING} | cat > out.nc"
+    )
     env = {k: v for k, v in os.environ.items() if k != "NCPP_MACHINE"}
     proc = subprocess.run(
         ["bash", "-c", script],

@@ -17,13 +17,19 @@ from typing import BinaryIO, cast
 from ncpp.errors import NcppError
 from ncpp.program.parser import Dialect, LineParser, _ItemBuilder
 
-DIALECTS = ("iso", "heidenhain", "sinumerik")
+DIALECTS = ("iso", "grbl", "heidenhain", "sinumerik")
+# The family a dialect's syntax belongs to: a flavour of ISO G code reads with ISO's grammar
+# and writer, and its interpreter is a subclass of LinuxCNC's (`ncpp/motion/grbl.py`)
+FAMILY = {"iso": "iso", "grbl": "iso", "heidenhain": "heidenhain", "sinumerik": "sinumerik"}
 SNIFF_BYTES = 4096
 # The most the detection reads: the sniffed bytes and the rest of their last line, cut short
 # (a line of megabytes would take the patterns minutes)
 _SNIFF_MOST = 2 * SNIFF_BYTES
 
 ISO = Dialect("iso", "iso", _ItemBuilder, fast_terminals=LineParser.FAST_TERMINALS, read_where_run=True)
+# grbl: a line it reads as a system command (`$H`, `$100=250`) is no G code: read where it
+# runs, it reaches the interpreter as a line the grammar cannot read
+GRBL = Dialect("grbl", "iso", _ItemBuilder, fast_terminals=LineParser.FAST_TERMINALS, read_where_run=True)
 # File name endings that name a dialect when the content does not tell.
 SUFFIXES = {".h": "heidenhain", ".mpf": "sinumerik", ".spf": "sinumerik"}
 
@@ -33,6 +39,8 @@ def get_dialect(name: str) -> Dialect:
     key = name.lower()
     if key == "iso":
         return ISO
+    if key == "grbl":
+        return GRBL
     if key == "heidenhain":
         from ncpp.program.dialects.heidenhain import HEIDENHAIN
 
@@ -95,10 +103,20 @@ def _call_like(line: str) -> bool:
     )
 
 
-def detect(first_bytes: bytes, name: str | None = None) -> str:
-    """'iso', 'heidenhain' or 'sinumerik' from the start of a program.
+# grbl's system commands (grbl 1.1, "Grbl v1.1 Commands"): homing, jogging, unlock, settings
+# `$100=250`, startup blocks `$N0=`, `$$ $# $G $I $C`; and the comment FreeCAD's grbl posts write
+_GRBL = re.compile(
+    r"^[ \t]*\$(H|X|\$|#|G|I|C|SLP)[ \t]*\r?$|^[ \t]*\$(J|RST|N\d?|\d+)[ \t]*="
+    r"|^\(Post Processor: grbl",
+    re.M | re.I,
+)
 
-    `BEGIN PGM` or numbered conversational blocks mean Heidenhain; a
+
+def detect(first_bytes: bytes, name: str | None = None) -> str:
+    """'iso', 'grbl', 'heidenhain' or 'sinumerik' from the start of a program.
+
+    grbl's system commands (`$H`, `$J=`, `$100=250`) or the comment FreeCAD's grbl
+    posts write first mean grbl; `BEGIN PGM` or numbered conversational blocks mean Heidenhain; a
     `%_N_` header or a construct only Sinumerik has (`DEF`, `PROC`, `X=...`,
     `CR=`, `AC(`, `MSG(`, `GOTOF`, labels, `IF` without brackets, `$AA_...`)
     means Sinumerik, unless LinuxCNC's o-word lines or `#<name>` parameters
@@ -108,6 +126,8 @@ def detect(first_bytes: bytes, name: str | None = None) -> str:
     text = first_bytes.decode("latin-1")
     if _HEIDENHAIN.search(text) or len(_HEIDENHAIN_BLOCK.findall(text)) >= 2:
         return "heidenhain"
+    if _GRBL.search(text):
+        return "grbl"
     code = _code_only(text)
     if text.startswith("%_N_") or (_SINUMERIK.search(code) and not _LINUXCNC.search(code)):
         return "sinumerik"

@@ -1,0 +1,51 @@
+"""grbl 1.1: where its reading of G code differs from LinuxCNC's.
+
+grbl reads a subset of rs274ngc (its wiki page "G-code commands" and `grbl/gcode.c`,
+`gc_execute_line`); the differences a program meets are rules of `GrblInterpreter`:
+
+* an arc in offset mode takes I, J and K whatever the plane, and uses the plane's two
+  (`gc_execute_line`, "Arc Center Format Offset Mode": all of I J K are cleared as used),
+  so FreeCAD's grbl post writes `G2 X.. Y.. I.. J.. K0.000` in G17;
+* a line that starts with `$` is a system command for grbl's own settings and states
+  (`protocol.c` hands it to `system_execute_line`, never to the G-code parser): it passes
+  through untouched; `$H` (homing) and `$J=` (jogging) move the machine where ncpp does not
+  follow, so the state is unknown from there, as with any construct out of scope.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Iterator
+
+from ncpp.errors import Warnings
+from ncpp.motion.interpreter import Interpreter, _OutOfScope, run
+from ncpp.motion.offsets import WorkOffsets
+from ncpp.motion.segments import Event, Pass
+from ncpp.program.blocks import Block
+
+# grbl's system commands that move the machine
+_MOVING = {"$H": "grbl homing ($H)", "$J=": "a grbl jog ($J=)"}
+
+
+def interpret(
+    blocks: Iterable[Block],
+    *,
+    file: str = "<stdin>",
+    warnings: Warnings | None = None,
+    strict: bool = False,
+    offsets: WorkOffsets | None = None,
+) -> Iterator[Event]:
+    """Motion events of a grbl program's blocks, lazily (as `ncpp.motion.interpreter.interpret`)."""
+    return run(GrblInterpreter(file, offsets), blocks, warnings, strict)
+
+
+class GrblInterpreter(Interpreter):
+    arc_normal_offset_ignored = True
+
+    def block(self, block: Block) -> Event | tuple[Event, ...]:
+        text = block.text.lstrip()
+        if text.startswith("$"):
+            for start, what in _MOVING.items():
+                if text[: len(start)].upper() == start:
+                    raise _OutOfScope(f"{what}, a move ncpp cannot follow", 1)
+            return Pass(block)
+        return super().block(block)

@@ -1,0 +1,100 @@
+"""grbl 1.1's reading of G code where it differs from LinuxCNC's (`ncpp/motion/grbl.py`).
+
+The rules are grbl's own source, `grbl/gcode.c` (`gc_execute_line`) and `protocol.c`."""
+
+from __future__ import annotations
+
+import io
+import subprocess
+import sys
+
+import pytest
+
+from ncpp.errors import NcppError, Warnings
+from ncpp.motion.segments import Arc, Line, Pass
+from ncpp.pipeline import dialect_tools
+from ncpp.program.dialects import detect, parse_program
+from tests.conftest import READING, ROOT
+
+ARC_WITH_K = b"G21 G90 G17\nG0 X0 Y0 Z1\nG2 X10 Y0 Z1 I5 J0 K0.000 F300\nM2\n"
+
+
+def events(program: bytes, dialect: str, warnings: Warnings | None = None) -> list:
+    interpret, _ = dialect_tools(dialect)
+    _, blocks = parse_program(io.BytesIO(program), "p.nc", dialect)
+    return list(interpret(blocks, file="p.nc", warnings=warnings or Warnings(stream=io.StringIO())))
+
+
+def test_an_arc_in_offset_mode_takes_k_in_g17_as_grbl_does():
+    """gcode.c, "Arc Center Format Offset Mode": `bit_false(value_words, I|J|K)`, all three used;
+    LinuxCNC refuses the K (rs274ngc: "K word given for arc in xy plane")."""
+    arc = events(ARC_WITH_K, "grbl")[2]
+    assert type(arc) is Arc and arc.end == (10.0, 0.0, 1.0) and arc.center[:2] == (5.0, 0.0)
+    with pytest.raises(NcppError, match="K word given for arc in xy plane"):
+        events(ARC_WITH_K, "iso")
+
+
+def test_an_arc_in_radius_mode_with_k_is_refused():
+    """In radius mode the I J K words are not used: grbl's "unused words" error (20)."""
+    with pytest.raises(NcppError, match="Mixed radius ijk format"):
+        events(b"G0 X0 Y0\nG2 X10 Y0 R5 K0 F300\n", "grbl")
+
+
+def test_system_commands_pass_through_and_homing_ends_what_ncpp_follows():
+    """protocol.c hands a line that starts with `$` to `system_execute_line`, never to the
+    G-code parser; `$H` and `$J=` move the machine, so the state after them is unknown."""
+    said = io.StringIO()
+    program = b"$100=250.000\n$X\nG0 X1 Y1\n$H\nG0 X5\nM2\n"
+    found = events(program, "grbl", Warnings(stream=said))
+    kinds = [type(event) for event in found]
+    assert kinds == [Pass, Pass, Line, Pass, Pass, Pass]
+    assert "p.nc:4:1: warning: grbl homing ($H), a move ncpp cannot follow" in said.getvalue()
+    jog = events(b"G0 X1\n$J=G91 X10 F500\nG1 X2 F100\n", "grbl", Warnings(stream=said))
+    assert [type(event) for event in jog] == [Line, Pass, Pass]
+
+
+@pytest.mark.parametrize(
+    "head, dialect",
+    [
+        (b"$H\nG21 G90\nG0 X1\n", "grbl"),
+        (b"G21\n$J=G91 X10 F500\n", "grbl"),  # (not Sinumerik's `J=` assignment)
+        (b"$110=500\nG0 X1\n", "grbl"),
+        (b"(Exported by FreeCAD)\n(Post Processor: grbl_post)\nG17 G90\n", "grbl"),
+        (b"G21 G90\nG0 X1 Y2\n", "iso"),
+        (b"$P_UIFR[1]=CTRANS(X,10)\nG0 X1\n", "sinumerik"),
+        (b"G0 X1\nG1 X2 $1 F100\n", "iso"),  # LinuxCNC's spindle word
+    ],
+)
+def test_grbl_is_told_by_its_system_commands_and_freecads_comment(head, dialect):
+    assert detect(head) == dialect
+
+
+def test_a_grbl_program_is_compensated_without_a_guard_and_the_user_is_told(tmp_path):
+    """grbl has no parameters and no conditionals: no placement guard can be written."""
+    program = tmp_path / "p.nc"
+    program.write_bytes(b"$H\n" + ARC_WITH_K.replace(b"M2\n", b"") + b"G0 X0\nM2\n")
+    proc = subprocess.run(
+        [sys.executable, "-m", "ncpp", "--machine", str(READING), "--work-offset", "10,20,30", str(program)],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+    )
+    assert proc.returncode == 0, proc.stderr
+    assert "o<ncpp_guard>" not in proc.stdout and "#5220" not in proc.stdout
+    assert "grbl cannot test its work offset" in proc.stderr
+    assert "make sure the control has G54 at X10 Y20 Z30 mm" in proc.stderr
+
+
+def test_grbl_programs_are_compensated_and_read_back_as_grbl(tmp_path):
+    """The verifier reads the written program as grbl too: the K words of the arcs are no fault."""
+    program = tmp_path / "p.nc"
+    program.write_bytes(ARC_WITH_K)
+    proc = subprocess.run(
+        [sys.executable, "-m", "ncpp", "--dialect", "grbl", "--machine", str(READING), str(program)],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+    )
+    assert proc.returncode == 0, proc.stderr
+    assert "compensated 2 moves" in proc.stderr and "left as programmed: nothing" in proc.stderr
+    assert "\nG2 X9.9999 Y0.0000 Z1.0000 I5.0000 J0.0001 F300\n" in proc.stdout
