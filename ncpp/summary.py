@@ -15,7 +15,7 @@ from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
 
 from ncpp.errors import Location
-from ncpp.motion.segments import COMP, CYCLE, FLOW, HOME, PLANE_AXES, Arc, Event, Line
+from ncpp.motion.segments import COMP, CYCLE, FLOW, HOME, MACHINE, PLANE_AXES, Arc, Event, Line
 
 # Why moves are left as programmed, as the summary names it
 REASONS = {
@@ -23,6 +23,7 @@ REASONS = {
     FLOW: "loop or subroutine",
     COMP: "cutter compensation",
     HOME: "G28/G30 return",
+    MACHINE: "M91 or M140 move",
 }
 OUT_OF_SCOPE = "out of scope"
 TRAVEL_END = "at a travel end"
@@ -106,7 +107,8 @@ class Summary:
             kind = type(event)
             if kind is Line or kind is Arc:
                 if event.block is block:
-                    last = event  # type: ignore[assignment]
+                    if not event.fixed:  # type: ignore[union-attr]  # (not the control's own after it: M140)
+                        last = event  # type: ignore[assignment]
                 elif not event.fixed:  # type: ignore[union-attr]
                     self._settle(block, last)
                     block, last = event.block, event  # type: ignore[assignment]
@@ -186,6 +188,7 @@ _WHY = {
     "loop or subroutine": "in loops or subroutines",
     "cutter compensation": "under cutter compensation",
     "G28/G30 return": "of G28/G30 returns",
+    "M91 or M140 move": "in machine coordinates (M91, M140)",
     TRAVEL_END: "with an axis held at a travel end",
 }
 

@@ -40,7 +40,7 @@ from ncpp.motion.modal import (
     run_placed,
 )
 from ncpp.motion.offsets import WorkOffsets
-from ncpp.motion.segments import COMP, PLANE_AXES, Arc, Event, Line, Pass, Point
+from ncpp.motion.segments import COMP, MACHINE, PLANE_AXES, Arc, Event, Line, Pass, Point
 from ncpp.motion.tools import ToolTable, UntoldLengths
 from ncpp.program.blocks import Block, Comment, ExprWord, Word
 
@@ -193,6 +193,8 @@ class HeidenhainInterpreter(ModalInterpreter):
         rotation: str | None = None
         comp: str | None = None  # RL, RR or R0
         end = False
+        machine_datum = False  # M91: the block's coordinates are the machine datum's
+        retract: float | None = None  # M140 MB: a retract along the tool axis after the move
         for item in block.items:
             if type(item) is Comment:
                 continue
@@ -206,6 +208,9 @@ class HeidenhainInterpreter(ModalInterpreter):
                         raise OutOfScope(f"the cycle call M{value:g}", item.start + 1)
                     if value == 128.0:
                         raise OutOfScope("M128 (tool-centre-point control)", item.start + 1)
+                    if value == 92.0:  # (its datum is a machine parameter ncpp is not told)
+                        raise OutOfScope("M92 (a position the machine tool builder sets)", item.start + 1)
+                    machine_datum = machine_datum or value == 91.0
                     end = end or value in END_M
                     continue
                 if letter in ROTARY:  # (its moves would be compensated as if the axis stood)
@@ -235,6 +240,13 @@ class HeidenhainInterpreter(ModalInterpreter):
                     self.feed = self.auto_feed
             elif what == "rotation":
                 rotation = node[0]
+            elif what == "retract":
+                if node[0] == "MAX":
+                    raise OutOfScope(
+                        "M140 MB MAX (a retract to the end of the traverse range, which ncpp is not told)",
+                        item.start + 1,
+                    )
+                retract = node[0]
             elif what == "assignment":
                 if node[1][0] != "str":
                     self.q[node[0][1]] = self.value(node[1], block, item)
@@ -256,7 +268,12 @@ class HeidenhainInterpreter(ModalInterpreter):
             return [self._corner(block, function_item, words)]
         if "F" in words and function is not None:
             self.feed = words["F"][0]
-        events = self._path(block, function, function_item, words, rapid, rotation) if function else []
+        if machine_datum and function is not None:
+            events: list[Event] = [self._machine_move(block, function, function_item, words, rapid)]
+        else:
+            events = self._path(block, function, function_item, words, rapid, rotation) if function else []
+        if retract is not None:
+            events.append(self._retract(block, retract))
         if events and isinstance(events[-1], (Line, Arc)):
             self.last_move, self.corner_waits = events[-1], False
         if end:
@@ -387,6 +404,35 @@ class HeidenhainInterpreter(ModalInterpreter):
         if function == "CP":
             return [self._polar_arc(block, item, words, end, rotation)]
         raise OutOfScope(f"the path function {function}", item.start + 1)
+
+    def _machine_move(self, block: Block, function: str, item, words: dict, rapid: bool) -> Line:
+        """`L ... M91`: the coordinates are the machine datum's, and the tool length is not
+        applied (TNC 640 Klartext manual, "Miscellaneous functions for coordinate data": "M91 and
+        M92 are effective only in the blocks in which they are programmed ... the tool length,
+        however, is not compensated").  The control's own position, left as programmed (MACHINE);
+        the axes it names end there, the others stay where they stand."""
+        if function != "L":
+            raise OutOfScope(f"M91 with the path function {function}", item.start + 1)
+        end, written = self._target(words)
+        context = self.context()
+        for n, axis in enumerate(AXES):
+            if axis in words:  # machine position = program position + the context's offset (its tool too)
+                end[n] = words[axis][0] - context.offset[n]
+        move = self.line(block, end, rapid)
+        move.fixed = MACHINE
+        move.placed = (0 in written and AXES[0] in words, 1 in written and AXES[1] in words,
+                       2 in written and AXES[2] in words)  # fmt: skip
+        return move
+
+    def _retract(self, block: Block, distance: float) -> Line:
+        """M140 MB: after the block's move, the control retracts along the tool axis (away from the
+        workpiece) by `distance` from where it stands (TNC 640 Klartext manual, "Retraction in the
+        tool-axis direction: M140"); left as programmed (MACHINE), in increments."""
+        end = list(self.pos)
+        end[self.tool_axis] += distance
+        move = self.line(block, end, True, absolute=False)
+        move.fixed = MACHINE
+        return move
 
     def _set_pole(self, block: Block, end: list[float], written: set[int]) -> Pole:
         self.pole = end

@@ -29,6 +29,9 @@ CYCLE = "canned cycle"  # a hole is drilled where the program puts it
 FLOW = "loop or subroutine"  # one text runs many times (or out of the text's order)
 COMP = "cutter compensation"  # the control offsets the path by the tool's radius: the tool is not on it
 HOME = "G28/G30 return"  # the control homes the axes it names (machine coordinates); the others stay where they stand
+MACHINE = (
+    "machine-referenced move"  # Klartext M91, M140 MB: positions of the control's own, not the program's
+)
 # Axis letters of `Line.end` / `Arc.end` beyond XYZ, in rs274's order.
 EXTRA_AXES = ("A", "B", "C", "U", "V", "W")
 
@@ -199,6 +202,7 @@ __all__ = [
     "CYCLE",
     "FLOW",
     "HOME",
+    "MACHINE",
     "mark_off_path",
     "Arc",
     "Context",

@@ -44,6 +44,28 @@ def test_plain_words_take_the_fast_path():
     assert PARSER._scan_plain("X(1)") is None  # parentheses are arithmetic, not comments
 
 
+@pytest.mark.parametrize(
+    "block, found",
+    [
+        ("g0X-170 Y20", {"G": 0.0, "X": -170.0, "Y": 20.0}),
+        ("N20G1X10Y5F100", {"N": 20.0, "G": 1.0, "X": 10.0, "Y": 5.0, "F": 100.0}),
+        ("g1x10 y5 f100", {"G": 1.0, "X": 10.0, "Y": 5.0, "F": 100.0}),
+    ],
+)
+def test_words_without_blanks_and_in_lower_case_are_read(block, found):
+    """An address is one letter and its number; a name starts with two letters or an underscore
+    (SINUMERIK 840D sl Programming Manual, Fundamentals, "Block format" and "Definition of
+    user-defined variables"), so `G0X` is two words, not a name."""
+    assert {letter.upper(): value for letter, value in words(block).items()} == found
+    assert PARSER._scan_plain(block) is None or PARSER._scan_plain(block)[0] == PARSER._parse_lalr(
+        block, 1, "t"
+    )
+
+
+def test_a_name_after_a_number_is_still_no_word():
+    assert [kind for kind, _ in statements("R1=5 X10 AB_C")] and "A" not in words("X10 AB_C")
+
+
 def test_arcs_with_centre_and_radius():
     assert words("G2 X100 Y0 I50 J0") == {"G": 2.0, "X": 100.0, "Y": 0.0, "I": 50.0, "J": 0.0}
     assert words("G2 X10 Y0 CR=5") == {"G": 2.0, "X": 10.0, "Y": 0.0}

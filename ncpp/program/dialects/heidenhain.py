@@ -23,6 +23,7 @@ Statement kinds and nodes (Heidenhain):
   radius_comp    ('R0' | 'RL' | 'RR',)
   feed           ('FMAX' | 'FAUTO',)     `F200` is a Word
   rotation       ('+' | '-',)            `DR+` counter-clockwise, `DR-` clockwise
+  retract        (distance | 'MAX',)     M140's `MB 50` -> (50.0,), `MB MAX` -> ('MAX',)
   tool_call      (tool, axis)            `TOOL CALL 1 Z S800`: tool int | float | "name" | ("param", q)
                                          | None, axis 'X' | 'Y' | 'Z' | None; S F DL DR words follow
   tool_def       (tool,)                 `TOOL DEF 5 L+0 R+5`
@@ -55,6 +56,12 @@ _ADDRESS_END = "+-0123456789.,Q"
 def number_value(text: str) -> float:
     """`+10,5` -> 10.5; `- 200` -> -200.0 (sign, blanks and decimal comma as written)."""
     return float(text.replace(" ", "").replace("\t", "").replace(",", "."))
+
+
+def _retract_distance(text: str) -> float | str:
+    """`MB 50` -> 50.0, `MB MAX` -> 'MAX'."""
+    value = text[2:].strip()
+    return "MAX" if value.upper() == "MAX" else number_value(value.replace(" ", "").replace("\t", ""))
 
 
 def _split_address(text: str) -> tuple[str, str]:
@@ -177,6 +184,7 @@ class HeidenhainBuilder(Transformer):
     radius_comp = _statement("radius_comp", lambda c: (str(c[0]).upper(),))
     feed = _statement("feed", lambda c: (str(c[0]).upper(),))
     rotation = _statement("rotation", lambda c: (str(c[0])[-1],))
+    retract = _statement("retract", lambda c: (_retract_distance(str(c[0])),))
     del _statement, _text, _pgm, _blk, _tool_call, _call_label, _cycle_def, _cycle_call, _fn, _path
 
     @v_args(meta=True)
@@ -345,6 +353,11 @@ class HeidenhainWriter(IsoWriter):
         own_kind = Line if function in ("L", "LP", "CHF") else Arc
         own = next((n for n, e in enumerate(motion) if type(e) is own_kind), 0)
         for n, segment in enumerate(motion):
+            if (
+                n > own and segment.fixed
+            ):  # the control's own move after the block's (M140 MB): the text says it
+                self._remember_end(segment)
+                continue
             if type(segment) is Arc:
                 centre_plane = (segment.center, segment.context.plane)
                 yield self._inserted(self._cc_text(*centre_plane))

@@ -1,0 +1,89 @@
+"""Klartext blocks in the control's own coordinates: M91 (machine datum), M140 MB (retract along
+the tool axis), M92 and M140 MB MAX (positions ncpp is not told).
+
+TNC 640 Klartext manual, "Miscellaneous functions for coordinate data": M91 references the
+block's coordinates to the machine datum, in that block only, and the tool length is not
+compensated; "Retraction in the tool-axis direction: M140": MB retracts by a distance from
+where the tool stands (MB MAX to the end of the traverse range)."""
+
+from __future__ import annotations
+
+import io
+import subprocess
+import sys
+
+from ncpp.errors import Warnings
+from ncpp.motion.offsets import WorkOffsets
+from ncpp.motion.segments import MACHINE, Line
+from ncpp.pipeline import dialect_tools
+from ncpp.program.dialects import parse_program
+from tests.conftest import READING, ROOT
+
+PROGRAM = """0 BEGIN PGM P MM
+1 TOOL DEF 1 L+30 R+3
+2 TOOL CALL 1 Z S1000
+3 L Z-20 R0 FMAX M91
+4 L X+10 Y+10 R0 FMAX
+5 L Z-1 F100
+6 L X+30 F200 M140 MB 50
+7 L X+0 Y+0 FMAX
+8 L Z-2 F100
+9 END PGM P MM
+"""
+ZERO = (100.0, 200.0, 300.0)
+
+
+def lines(text: str, warnings: Warnings | None = None) -> list[Line]:
+    interpret, _ = dialect_tools("heidenhain")
+    _, blocks = parse_program(io.BytesIO(text.encode()), "p.h", "heidenhain")
+    found = interpret(blocks, file="p.h", warnings=warnings or Warnings(stream=io.StringIO()),
+                      offsets=WorkOffsets.at(ZERO))  # fmt: skip
+    return [event for event in found if type(event) is Line]
+
+
+def test_m91_puts_the_spindle_at_machine_coordinates_and_is_left_as_programmed():
+    """Z-20 at the machine datum is program Z -20 - 300 (the zero) - 30 (the tool length it leaves out)."""
+    m91 = lines(PROGRAM)[0]
+    assert m91.fixed == MACHINE and m91.placed == (False, False, True)
+    assert m91.end[2] == -20.0 - ZERO[2] - 30.0
+    assert m91.context.to_machine(m91.end)[2] == -20.0  # the machine position the block names
+    after = lines(PROGRAM)[1]
+    assert after.start == m91.end and after.end[:2] == (10.0, 10.0)
+
+
+def test_m140_retracts_from_where_the_block_ends_along_the_tool_axis():
+    moves = lines(PROGRAM)
+    cut, retract, away = moves[3], moves[4], moves[5]
+    assert cut.block is retract.block and retract.fixed == MACHINE and retract.rapid
+    assert retract.start == cut.end == (30.0, 10.0, -1.0) and retract.end == (30.0, 10.0, 49.0)
+    assert away.start == (30.0, 10.0, 49.0)
+
+
+def test_m92_and_mb_max_end_what_ncpp_follows_with_a_warning():
+    for block, said in (("L Z+0 R0 FMAX M92", "M92 (a position the machine tool builder sets)"),
+                        ("L M140 MB MAX", "M140 MB MAX (a retract to the end of the traverse range")):  # fmt: skip
+        stream = io.StringIO()
+        text = PROGRAM.replace("L X+0 Y+0 FMAX", block)
+        found = lines(text, Warnings(stream=stream))
+        assert len(found) == 5 and said in stream.getvalue()
+
+
+def test_compensated_m91_and_m140_blocks_keep_their_text_and_write_no_extra_block(tmp_path):
+    program = tmp_path / "p.h"
+    program.write_text(PROGRAM)
+    proc = subprocess.run(
+        [sys.executable, "-m", "ncpp", "--machine", str(READING), "--work-offset", ",".join(map(str, ZERO)),
+         "--no-guard", str(program)],
+        capture_output=True, text=True, cwd=ROOT,
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    written = proc.stdout.splitlines()
+    assert "L Z-20 R0 FMAX M91" in " ".join(written)  # (renumbered after the header, text as it was)
+    retract = next(line for line in written if "M140 MB 50" in line)
+    after = written[written.index(retract) + 1].split(" ")  # the program's `L X+0 Y+0 FMAX`, compensated
+    assert after[1] == "L" and after[2].startswith("X") and after[3].startswith("Y") and after[-1] == "FMAX"
+    assert (
+        abs(float(after[2][1:])) < 0.01 and abs(float(after[3][1:])) < 0.01
+    )  # no block to the retract's end
+    assert "left as programmed: 2 moves in machine coordinates (M91, M140)" in proc.stderr
+    assert "largest correction" in proc.stderr and "50000" not in proc.stderr
