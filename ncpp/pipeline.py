@@ -28,7 +28,7 @@ from ncpp.passes import PASSES, PassContext, run_passes
 from ncpp.passes.context import ErrorMap, is_directional
 from ncpp.passes.inverse import iterations_for
 from ncpp.program.blocks import Block, Comment, Statement, Word
-from ncpp.program.dialects import FAMILY, get_dialect, parse_program
+from ncpp.program.dialects import FAMILY, dialect_tools, get_dialect, parse_program
 from ncpp.program.dialects.iso import IsoWriter
 from ncpp.runtime import keep_freed_memory
 from ncpp.summary import Summary
@@ -299,25 +299,6 @@ def _reported(
         yield block
 
 
-# Per dialect: the module of its interpreter (an `interpret` function) and its writer class.
-DIALECT_TOOLS = {
-    "iso": ("ncpp.motion.interpreter", "ncpp.program.dialects.iso", "IsoWriter"),
-    "grbl": ("ncpp.motion.grbl", "ncpp.program.dialects.iso", "IsoWriter"),
-    "heidenhain": ("ncpp.motion.heidenhain", "ncpp.program.dialects.heidenhain", "HeidenhainWriter"),
-    "sinumerik": ("ncpp.motion.sinumerik", "ncpp.program.dialects.sinumerik", "SinumerikWriter"),
-}
-
-
-def dialect_tools(name: str) -> tuple[Callable, type]:
-    """(interpret, Writer) of a dialect."""
-    import importlib
-
-    interpreter, writer_module, writer = DIALECT_TOOLS[name]
-    return importlib.import_module(interpreter).interpret, getattr(
-        importlib.import_module(writer_module), writer
-    )
-
-
 def with_header(lines: Iterable[str], header: str, writer: IsoWriter) -> Iterator[str]:
     """Put the header comment first (a comment line per line of it), after a leading `%`
     tape mark line (or where the dialect's writer puts it: Heidenhain after `BEGIN PGM`)."""
@@ -379,7 +360,7 @@ def process(
     """Read, interpret, compensate (when `source` is given) and write one program.
 
     The dialect is detected from the content (and the file name) unless given;
-    it picks the interpreter and the writer (DIALECT_TOOLS).  `offsets`: the zeros
+    it picks the interpreter and the writer (`ncpp.program.dialects.UNITS`).  `offsets`: the zeros
     the control holds (machine mm; none: the program zero is the machine zero),
     which place the program on the machine whose errors are compensated.
 

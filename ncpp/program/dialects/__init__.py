@@ -3,24 +3,73 @@
 Each dialect brings a grammar (`grammar/<name>.lark`) and a builder that maps
 its syntax onto the common items (see `heidenhain` and `sinumerik` for their
 Statement kinds and node shapes); `parser_for(name)` gives its line parser.
-Writers live beside them (`iso.IsoWriter`).
+Writers live beside them (`iso.IsoWriter`), interpreters in `ncpp/motion/`;
+`UNITS` names each dialect's parts, the one place a dialect is registered.
 """
 
 from __future__ import annotations
 
+import importlib
 import io
 import re
-from collections.abc import Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator
+from dataclasses import dataclass
 from itertools import chain
 from typing import BinaryIO, cast
 
 from ncpp.errors import NcppError
 from ncpp.program.parser import Dialect, LineParser, _ItemBuilder
 
-DIALECTS = ("iso", "grbl", "heidenhain", "sinumerik")
-# The family a dialect's syntax belongs to: a flavour of ISO G code reads with ISO's grammar
-# and writer, and its interpreter is a subclass of LinuxCNC's (`ncpp/motion/grbl.py`)
-FAMILY = {"iso": "iso", "grbl": "iso", "heidenhain": "heidenhain", "sinumerik": "sinumerik"}
+
+@dataclass(frozen=True)
+class DialectUnit:
+    """Where one dialect's parts live, each named here once: its syntax (the parser's
+    `Dialect`, "module:attribute"), its interpreter (a module with an `interpret` function)
+    and its writer ("module:Class").  `family`: the dialect whose grammar and writer a
+    flavour shares (grbl is ISO's, its interpreter a subclass of LinuxCNC's)."""
+
+    name: str
+    family: str
+    syntax: str
+    interpreter: str
+    writer: str
+
+
+UNITS = {
+    unit.name: unit
+    for unit in (
+        DialectUnit(
+            "iso",
+            "iso",
+            "ncpp.program.dialects:ISO",
+            "ncpp.motion.interpreter",
+            "ncpp.program.dialects.iso:IsoWriter",
+        ),
+        DialectUnit(
+            "grbl",
+            "iso",
+            "ncpp.program.dialects:GRBL",
+            "ncpp.motion.grbl",
+            "ncpp.program.dialects.iso:IsoWriter",
+        ),
+        DialectUnit(
+            "heidenhain",
+            "heidenhain",
+            "ncpp.program.dialects.heidenhain:HEIDENHAIN",
+            "ncpp.motion.heidenhain",
+            "ncpp.program.dialects.heidenhain:HeidenhainWriter",
+        ),
+        DialectUnit(
+            "sinumerik",
+            "sinumerik",
+            "ncpp.program.dialects.sinumerik:SINUMERIK",
+            "ncpp.motion.sinumerik",
+            "ncpp.program.dialects.sinumerik:SinumerikWriter",
+        ),
+    )  # fmt: skip
+}
+DIALECTS = tuple(UNITS)
+FAMILY = {name: unit.family for name, unit in UNITS.items()}
 SNIFF_BYTES = 4096
 # The most the detection reads: the sniffed bytes and the rest of their last line, cut short
 # (a line of megabytes would take the patterns minutes)
@@ -34,22 +83,27 @@ GRBL = Dialect("grbl", "iso", _ItemBuilder, fast_terminals=LineParser.FAST_TERMI
 SUFFIXES = {".h": "heidenhain", ".mpf": "sinumerik", ".spf": "sinumerik"}
 
 
+def _unit(name: str) -> DialectUnit:
+    unit = UNITS.get(name.lower())
+    if unit is None:
+        raise NcppError(f"unknown dialect {name!r} (known: {', '.join(DIALECTS)})")
+    return unit
+
+
+def _load(where: str):
+    module, attribute = where.split(":")
+    return getattr(importlib.import_module(module), attribute)
+
+
 def get_dialect(name: str) -> Dialect:
-    """The dialect called `name` (case-insensitive)."""
-    key = name.lower()
-    if key == "iso":
-        return ISO
-    if key == "grbl":
-        return GRBL
-    if key == "heidenhain":
-        from ncpp.program.dialects.heidenhain import HEIDENHAIN
+    """The syntax of the dialect called `name` (case-insensitive)."""
+    return cast(Dialect, _load(_unit(name).syntax))
 
-        return HEIDENHAIN
-    if key == "sinumerik":
-        from ncpp.program.dialects.sinumerik import SINUMERIK
 
-        return SINUMERIK
-    raise NcppError(f"unknown dialect {name!r} (known: {', '.join(DIALECTS)})")
+def dialect_tools(name: str) -> tuple[Callable, type]:
+    """(interpret, Writer) of the dialect called `name`."""
+    unit = _unit(name)
+    return importlib.import_module(unit.interpreter).interpret, _load(unit.writer)
 
 
 def parser_for(dialect: str | Dialect) -> LineParser:
