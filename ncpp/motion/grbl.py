@@ -9,11 +9,15 @@ grbl reads a subset of rs274ngc (its wiki page "G-code commands" and `grbl/gcode
 * a line that starts with `$` is a system command for grbl's own settings and states
   (`protocol.c` hands it to `system_execute_line`, never to the G-code parser): it passes
   through untouched; `$H` (homing) and `$J=` (jogging) move the machine where ncpp does not
-  follow, so the state is unknown from there, as with any construct out of scope.
+  follow, so the state is unknown from there, as with any construct out of scope;
+* `?`, `~` and `!` are realtime commands (status report, cycle start, feed hold) that grbl
+  picks out of the stream as they arrive (`serial.c`), never G code: a line of them
+  passes through untouched.
 """
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterable, Iterator
 
 from ncpp.errors import Warnings
@@ -22,6 +26,8 @@ from ncpp.motion.offsets import WorkOffsets
 from ncpp.motion.segments import Event, Pass
 from ncpp.program.blocks import Block
 
+# A line of realtime commands, perhaps with a comment
+_REALTIME = re.compile(r"[?~!]+[ \t]*(;.*|\(.*)?\r?\n?$")
 # grbl's system commands that move the machine
 _MOVING = {"$H": "grbl homing ($H)", "$J=": "a grbl jog ($J=)"}
 
@@ -43,6 +49,8 @@ class GrblInterpreter(Interpreter):
 
     def block(self, block: Block) -> Event | tuple[Event, ...]:
         text = block.text.lstrip()
+        if _REALTIME.match(text):
+            return Pass(block)
         if text.startswith("$"):
             for start, what in _MOVING.items():
                 if text[: len(start)].upper() == start:

@@ -40,6 +40,12 @@ def test_an_arc_in_radius_mode_with_k_is_refused():
         events(b"G0 X0 Y0\nG2 X10 Y0 R5 K0 F300\n", "grbl")
 
 
+def test_realtime_commands_pass_through():
+    """serial.c picks `?` `~` `!` out of the stream as they arrive: the parser never sees them."""
+    found = events(b"?  ; status\nG0 X1\n~\nG1 X2 F100\n", "grbl")
+    assert [type(event) for event in found] == [Pass, Line, Pass, Line]
+
+
 def test_system_commands_pass_through_and_homing_ends_what_ncpp_follows():
     """protocol.c hands a line that starts with `$` to `system_execute_line`, never to the
     G-code parser; `$H` and `$J=` move the machine, so the state after them is unknown."""
@@ -59,6 +65,7 @@ def test_system_commands_pass_through_and_homing_ends_what_ncpp_follows():
         (b"$H\nG21 G90\nG0 X1\n", "grbl"),
         (b"G21\n$J=G91 X10 F500\n", "grbl"),  # (not Sinumerik's `J=` assignment)
         (b"$110=500\nG0 X1\n", "grbl"),
+        (b"$I  ; View build info\n$$\nG90\n", "grbl"),
         (b"(Exported by FreeCAD)\n(Post Processor: grbl_post)\nG17 G90\n", "grbl"),
         (b"G21 G90\nG0 X1 Y2\n", "iso"),
         (b"$P_UIFR[1]=CTRANS(X,10)\nG0 X1\n", "sinumerik"),

@@ -160,7 +160,7 @@ def _call_like(line: str) -> bool:
 # grbl's system commands (grbl 1.1, "Grbl v1.1 Commands"): homing, jogging, unlock, settings
 # `$100=250`, startup blocks `$N0=`, `$$ $# $G $I $C`; and the comment FreeCAD's grbl posts write
 _GRBL = re.compile(
-    r"^[ \t]*\$(H|X|\$|#|G|I|C|SLP)[ \t]*\r?$|^[ \t]*\$(J|RST|N\d?|\d+)[ \t]*="
+    r"^[ \t]*\$(H|X|\$|#|G|I|C|SLP)[ \t]*(;.*|\(.*)?\r?$|^[ \t]*\$(J|RST|N\d?|\d+)[ \t]*="
     r"|^\(Post Processor: grbl",
     re.M | re.I,
 )
