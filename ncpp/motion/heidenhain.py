@@ -117,6 +117,7 @@ class HeidenhainInterpreter(ModalInterpreter):
         self.auto_feed = 0.0
         self.last_move: Line | Arc | None = None
         self.corner_waits = False  # an RND/CHF block came after the last move
+        self.unknown_axes: set[int] = set()  # axes whose position ncpp is not told (after M140 MB MAX)
 
     def run(self, blocks: Iterable[Block], warnings: Warnings) -> Iterator[Event]:
         """Events as `ModalInterpreter.run`; a feed line waits (with the events after it)
@@ -194,7 +195,7 @@ class HeidenhainInterpreter(ModalInterpreter):
         comp: str | None = None  # RL, RR or R0
         end = False
         machine_datum = False  # M91: the block's coordinates are the machine datum's
-        retract: float | None = None  # M140 MB: a retract along the tool axis after the move
+        retract: float | str | None = None  # M140 MB: a retract along the tool axis after the move
         for item in block.items:
             if type(item) is Comment:
                 continue
@@ -241,11 +242,6 @@ class HeidenhainInterpreter(ModalInterpreter):
             elif what == "rotation":
                 rotation = node[0]
             elif what == "retract":
-                if node[0] == "MAX":
-                    raise OutOfScope(
-                        "M140 MB MAX (a retract to the end of the traverse range, which ncpp is not told)",
-                        item.start + 1,
-                    )
                 retract = node[0]
             elif what == "assignment":
                 if node[1][0] != "str":
@@ -272,6 +268,8 @@ class HeidenhainInterpreter(ModalInterpreter):
             events: list[Event] = [self._machine_move(block, function, function_item, words, rapid)]
         else:
             events = self._path(block, function, function_item, words, rapid, rotation) if function else []
+        if self.unknown_axes:
+            self._from_unknown(events, words)
         if retract is not None:
             events.append(self._retract(block, retract))
         if events and isinstance(events[-1], (Line, Arc)):
@@ -424,15 +422,29 @@ class HeidenhainInterpreter(ModalInterpreter):
                        2 in written and AXES[2] in words)  # fmt: skip
         return move
 
-    def _retract(self, block: Block, distance: float) -> Line:
+    def _retract(self, block: Block, distance: float | str) -> Line:
         """M140 MB: after the block's move, the control retracts along the tool axis (away from the
-        workpiece) by `distance` from where it stands (TNC 640 Klartext manual, "Retraction in the
-        tool-axis direction: M140"); left as programmed (MACHINE), in increments."""
+        workpiece) by `distance` from where it stands, or with MB MAX to the end of the traverse
+        range (TNC 640 Klartext manual, "Retraction in the tool-axis direction: M140"); left as
+        programmed (MACHINE).  Where MB MAX ends ncpp is not told: the tool axis is unknown until
+        a block names it (`_from_unknown`), and the event stands where the retract starts."""
         end = list(self.pos)
-        end[self.tool_axis] += distance
+        if distance == "MAX":
+            self.unknown_axes.add(self.tool_axis)
+        else:
+            end[self.tool_axis] += float(distance)
         move = self.line(block, end, True, absolute=False)
         move.fixed = MACHINE
         return move
+
+    def _from_unknown(self, events: list[Event], words: dict) -> None:
+        """Moves while an axis's position is unknown (after `M140 MB MAX`) run from where the
+        control stands, which ncpp does not know: left as programmed, up to and with the first
+        block that names the axis absolutely, which puts it where the program says."""
+        for event in events:
+            if type(event) is Line or type(event) is Arc:
+                event.fixed = MACHINE
+        self.unknown_axes -= {n for n, axis in enumerate(AXES) if axis in words}
 
     def _set_pole(self, block: Block, end: list[float], written: set[int]) -> Pole:
         self.pole = end

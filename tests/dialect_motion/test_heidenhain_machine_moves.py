@@ -59,13 +59,22 @@ def test_m140_retracts_from_where_the_block_ends_along_the_tool_axis():
     assert away.start == (30.0, 10.0, 49.0)
 
 
-def test_m92_and_mb_max_end_what_ncpp_follows_with_a_warning():
-    for block, said in (("L Z+0 R0 FMAX M92", "M92 (a position the machine tool builder sets)"),
-                        ("L M140 MB MAX", "M140 MB MAX (a retract to the end of the traverse range")):  # fmt: skip
-        stream = io.StringIO()
-        text = PROGRAM.replace("L X+0 Y+0 FMAX", block)
-        found = lines(text, Warnings(stream=stream))
-        assert len(found) == 5 and said in stream.getvalue()
+def test_m92_ends_what_ncpp_follows_with_a_warning():
+    stream = io.StringIO()
+    found = lines(PROGRAM.replace("L X+0 Y+0 FMAX", "L Z+0 R0 FMAX M92"), Warnings(stream=stream))
+    assert len(found) == 5 and "M92 (a position the machine tool builder sets)" in stream.getvalue()
+
+
+def test_after_mb_max_moves_are_left_as_programmed_until_a_block_names_the_tool_axis():
+    """Where the end of the traverse range is ncpp is not told: from there the control runs from a
+    position ncpp does not know, so those moves are the control's, up to the block that names Z."""
+    text = PROGRAM.replace("6 L X+30 F200 M140 MB 50", "6 L X+30 F200\n6 L M140 MB MAX").replace(
+        "8 L Z-2 F100", "8 L Z+5 FMAX\n8 L Z-2 F100"
+    )
+    moves = lines(text)
+    retract, across, down, cut = moves[4:8]
+    assert [m.fixed for m in (retract, across, down)] == [MACHINE] * 3 and not cut.fixed
+    assert down.end[2] == 5.0 and cut.start == down.end
 
 
 def test_compensated_m91_and_m140_blocks_keep_their_text_and_write_no_extra_block(tmp_path):
