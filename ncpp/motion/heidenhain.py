@@ -42,14 +42,22 @@ from ncpp.motion.modal import (
 from ncpp.motion.offsets import WorkOffsets
 from ncpp.motion.segments import COMP, MACHINE, PLANE_AXES, Arc, Event, Line, Pass, Point
 from ncpp.motion.tools import ToolTable, UntoldLengths
-from ncpp.program.blocks import Block, Comment, ExprWord, Word
+from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
 
 AXES = "XYZ"
 ROTARY = ("A", "B", "C")
 # Cycles that move or turn the datum (datum shift, mirror, rotation, scaling, working plane, presets)
-DATUM_CYCLES = frozenset(("7", "8", "10", "11", "19", "26", "247"))
+DATUM_CYCLES = frozenset(("7", "8", "10", "11", "19", "26"))
+# CYCL DEF 247 DATUM SETTING activates the preset Q339 of the preset table (TNC 640 Klartext manual,
+# "Cycle 247 DATUM SETTING"): the program zero ncpp is told is that preset's; another preset later
+# is a zero ncpp is not told
+PRESET_CYCLE = "247"
 END_M = frozenset((2.0, 30.0))
 HARMLESS_KEYWORDS = frozenset(("STOP",))
+# Resets of what this interpreter never follows (a tilted plane, TCPM: it stops at any that sets
+# one), which move no axis: `PLANE RESET STAY` keeps the rotary axes where they are (TNC 640
+# Klartext manual, "PLANE RESET"), `FUNCTION RESET TCPM` ends tool-centre-point control
+HARMLESS_RESETS = frozenset((("PLANE", "RESET", "STAY"), ("FUNCTION", "RESET", "TCPM")))
 
 
 @dataclass(slots=True)
@@ -118,6 +126,7 @@ class HeidenhainInterpreter(ModalInterpreter):
         self.last_move: Line | Arc | None = None
         self.corner_waits = False  # an RND/CHF block came after the last move
         self.unknown_axes: set[int] = set()  # axes whose position ncpp is not told (after M140 MB MAX)
+        self.preset: float | None = None  # the preset CYCL DEF 247 activated (the program zero told)
 
     def run(self, blocks: Iterable[Block], warnings: Warnings) -> Iterator[Event]:
         """Events as `ModalInterpreter.run`; a feed line waits (with the events after it)
@@ -247,10 +256,13 @@ class HeidenhainInterpreter(ModalInterpreter):
                 if node[1][0] != "str":
                     self.q[node[0][1]] = self.value(node[1], block, item)
             elif what == "cycle_def":
+                if node[0] == PRESET_CYCLE:
+                    self._preset(block, item)
+                    return []
                 if node[0] in DATUM_CYCLES:
                     raise OutOfScope(f"CYCL DEF {node[0]} (it moves the datum)", item.start + 1)
                 return []
-            elif what == "keyword" and node and node[0] in HARMLESS_KEYWORDS:
+            elif what == "keyword" and node and (node[0] in HARMLESS_KEYWORDS or tuple(node) in HARMLESS_RESETS):
                 continue
             elif what == "tool_def":
                 return self._tool_def(block, item)
@@ -421,6 +433,25 @@ class HeidenhainInterpreter(ModalInterpreter):
         move.placed = (0 in written and AXES[0] in words, 1 in written and AXES[1] in words,
                        2 in written and AXES[2] in words)  # fmt: skip
         return move
+
+    def _preset(self, block: Block, item) -> None:
+        """CYCL DEF 247: the first preset the program activates is the program zero ncpp was
+        told; activating another one is out of scope."""
+        number = next(
+            (self.value(i.node[1], block, i) for i in block.items
+             if type(i) is Statement and i.kind == "assignment" and i.node[0][1] == "q339"),
+            None,
+        )  # fmt: skip
+        if number is None:
+            self.fail("CYCL DEF 247 without Q339 (the preset number)", block, item)
+        if self.preset is None:
+            self.preset = number
+        elif number != self.preset:
+            raise OutOfScope(
+                f"CYCL DEF 247 activating preset {number:g} after preset {self.preset:g} (ncpp is told one "
+                "program zero)",
+                item.start + 1,
+            )
 
     def _retract(self, block: Block, distance: float | str) -> Line:
         """M140 MB: after the block's move, the control retracts along the tool axis (away from the

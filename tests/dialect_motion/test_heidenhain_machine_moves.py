@@ -96,3 +96,29 @@ def test_compensated_m91_and_m140_blocks_keep_their_text_and_write_no_extra_bloc
     )  # no block to the retract's end
     assert "left as programmed: 2 moves in machine coordinates (M91, M140)" in proc.stderr
     assert "largest correction" in proc.stderr and "50000" not in proc.stderr
+
+
+def test_the_first_preset_cycle_247_activates_is_the_program_zero_and_another_ends_interpretation():
+    """TNC 640 Klartext manual, "Cycle 247 DATUM SETTING": Q339 is the preset activated."""
+    text = PROGRAM.replace(
+        "2 TOOL CALL 1 Z S1000", "2 CYCL DEF 247 DATUM SETTING ~\n  Q339=+1 ;DATUM\n2 TOOL CALL 1 Z S1000"
+    )
+    assert len(lines(text)) == len(lines(PROGRAM))
+    stream = io.StringIO()
+    again = text.replace(
+        "7 L X+0 Y+0 FMAX", "7 CYCL DEF 247 DATUM SETTING ~\n  Q339=+2 ;DATUM\n7 L X+0 Y+0 FMAX"
+    )
+    assert len(lines(again, Warnings(stream=stream))) == 5
+    assert "CYCL DEF 247 activating preset 2 after preset 1" in stream.getvalue()
+
+
+def test_resets_of_a_plane_or_tcpm_that_move_nothing_are_read_past():
+    text = PROGRAM.replace(
+        "2 TOOL CALL 1 Z S1000", "2 PLANE RESET STAY\n2 FUNCTION RESET TCPM\n2 TOOL CALL 1 Z S1000"
+    )
+    stream = io.StringIO()
+    assert (
+        len(lines(text, Warnings(stream=stream))) == len(lines(PROGRAM)) and "scope" not in stream.getvalue()
+    )
+    turning = PROGRAM.replace("2 TOOL CALL 1 Z S1000", "2 PLANE RESET TURN FMAX\n2 TOOL CALL 1 Z S1000")
+    assert lines(turning, Warnings(stream=stream)) == [] and "PLANE RESET TURN" in stream.getvalue()
