@@ -23,7 +23,7 @@ REASONS = {
     FLOW: "loop or subroutine",
     COMP: "cutter compensation",
     HOME: "G28/G30 return",
-    MACHINE: "M91 or M140 move",
+    MACHINE: "machine-coordinate move",
 }
 OUT_OF_SCOPE = "out of scope"
 TRAVEL_END = "at a travel end"
@@ -188,7 +188,7 @@ _WHY = {
     "loop or subroutine": "in loops or subroutines",
     "cutter compensation": "under cutter compensation",
     "G28/G30 return": "of G28/G30 returns",
-    "M91 or M140 move": "in machine coordinates (M91, M140)",
+    "machine-coordinate move": "in machine coordinates",
     TRAVEL_END: "with an axis held at a travel end",
 }
 

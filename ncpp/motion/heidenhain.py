@@ -262,7 +262,11 @@ class HeidenhainInterpreter(ModalInterpreter):
                 if node[0] in DATUM_CYCLES:
                     raise OutOfScope(f"CYCL DEF {node[0]} (it moves the datum)", item.start + 1)
                 return []
-            elif what == "keyword" and node and (node[0] in HARMLESS_KEYWORDS or tuple(node) in HARMLESS_RESETS):
+            elif (
+                what == "keyword"
+                and node
+                and (node[0] in HARMLESS_KEYWORDS or tuple(node) in HARMLESS_RESETS)
+            ):
                 continue
             elif what == "tool_def":
                 return self._tool_def(block, item)

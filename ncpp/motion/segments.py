@@ -29,9 +29,8 @@ CYCLE = "canned cycle"  # a hole is drilled where the program puts it
 FLOW = "loop or subroutine"  # one text runs many times (or out of the text's order)
 COMP = "cutter compensation"  # the control offsets the path by the tool's radius: the tool is not on it
 HOME = "G28/G30 return"  # the control homes the axes it names (machine coordinates); the others stay where they stand
-MACHINE = (
-    "machine-referenced move"  # Klartext M91, M140 MB: positions of the control's own, not the program's
-)
+# Klartext M91 and M140 MB, Sinumerik SUPA, G53 and G153: positions of the control's own
+MACHINE = "machine-coordinate move"
 # Axis letters of `Line.end` / `Arc.end` beyond XYZ, in rs274's order.
 EXTRA_AXES = ("A", "B", "C", "U", "V", "W")
 

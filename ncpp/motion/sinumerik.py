@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable, Iterator
+from typing import cast
 
 from ncpp.errors import Location, Warnings
 from ncpp.motion.modal import (
@@ -32,7 +33,7 @@ from ncpp.motion.modal import (
     run_placed,
 )
 from ncpp.motion.offsets import WorkOffsets
-from ncpp.motion.segments import PLANE_AXES, Event
+from ncpp.motion.segments import MACHINE, PLANE_AXES, Event
 from ncpp.motion.tools import ToolTable, UntoldLengths
 from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
 
@@ -42,11 +43,27 @@ CENTRE_LETTERS = "IJK"
 INTERMEDIATE = ("I1", "J1", "K1")
 # G codes that change nothing the motion depends on (exact stop, continuous path, feed types, work offsets
 # the control holds, spindle modes, acceleration; G40-G42 are read apart: `block`)
-NEUTRAL_G = frozenset((9.0, 40.0, 41.0, 42.0, 54.0, 55.0, 56.0, 57.0, 500.0, 60.0, 64.0, 601.0, 602.0, 603.0, 641.0, 642.0,
-                       643.0, 644.0, 645.0, 94.0, 95.0, 96.0, 97.0, 153.0, 450.0, 451.0, 961.0, 971.0))  # fmt: skip
+NEUTRAL_G = frozenset((9.0, 40.0, 41.0, 42.0, 60.0, 64.0, 601.0, 602.0, 603.0, 641.0, 642.0,
+                       643.0, 644.0, 645.0, 94.0, 95.0, 96.0, 97.0, 450.0, 451.0, 961.0, 971.0))  # fmt: skip
+# Settable frames (G54-G57, G505-G599) and G500, which turns them off: the program zero ncpp is
+# told is the frame the program selects first (or the one in effect, if it selects none); a move
+# under another is out of scope
+SETTABLE_FRAMES = frozenset((54.0, 55.0, 56.0, 57.0, *(float(n) for n in range(505, 600))))
+NO_SETTABLE_FRAME = 500.0
+# Non-modal machine coordinates: G53 suppresses the settable and programmable frames, G153 the
+# basic frame too, SUPA every offset (840D sl Programming Manual, Fundamentals, "Frame
+# suppression"); with no basic frame or external offsets, as ncpp assumes, all three are the
+# machine's coordinates (the tool offset still applies)
+MACHINE_G = frozenset((53.0, 153.0))
 UNITS_G = {70.0: True, 700.0: True, 71.0: False, 710.0: False}
 HARMLESS_CALLS = frozenset(("MSG", "BNAT", "ENAT", "BTAN", "ETAN", "BAUTO", "EAUTO", "FFWON", "FFWOF", "SOFT",
                             "BRISK", "CFC", "CFTCP", "CFIN", "M"))  # fmt: skip
+# Calls that move nothing when given no arguments: CYCLE800() deselects the swivelled plane without
+# turning an axis (SINUMERIK 840D sl Milling manual, "Swiveling plane - CYCLE800": "CYCLE800()"
+# resets the swivel frames); CYCLE832() deselects the high-speed settings.  CYCLE832 with its
+# arguments sets the contour tolerance and smoothing only ("High-speed settings - CYCLE832").
+RESETTING_CALLS = frozenset(("CYCLE800", "CYCLE832"))
+SETTING_CALLS = frozenset(("CYCLE832",))
 END_M = frozenset((2.0, 17.0, 30.0))
 # Addresses that say where the tool goes in a way this interpreter does not follow
 UNREAD_GEOMETRY = {"AR": "the opening angle", "AP": "the polar angle", "RP": "the polar radius"}
@@ -95,6 +112,8 @@ class SinumerikInterpreter(ModalInterpreter):
         # A frame's offset is traversed with the axis's next incremental move (MD 42440
         # FRAME_OFFSET_INCR_PROG = 1): IC(d) after TRANS goes d from the old program position.
         self.frame_shift = [0.0, 0.0, 0.0]
+        self.told_frame: float | None = None  # the settable frame the program selected first
+        self.zero_frame: float | None = None  # the one in effect (None: as when the program started)
 
     # -- variables --------------------------------------------------------------------
     def lookup(self, name: str) -> float:
@@ -136,6 +155,7 @@ class SinumerikInterpreter(ModalInterpreter):
         gcodes: list[tuple[float, Word | ExprWord]] = []
         path: str | None = None
         frame: Statement | None = None
+        machine = False  # SUPA: the block's coordinates are the machine's
         end = False
         tool_words: list = []  # the block's T, M6 and D words, in order
         previous: Word | ExprWord | Statement | None = None
@@ -154,7 +174,13 @@ class SinumerikInterpreter(ModalInterpreter):
                     path = item.node[0]
                 elif what == "frame" and item.node[0] in FRAMES:
                     frame = item
-                elif what == "call" and item.node[0] in HARMLESS_CALLS:
+                elif what == "call" and item.node[0] == "SUPA" and not item.node[1]:
+                    machine = True
+                elif what == "call" and (
+                    item.node[0] in HARMLESS_CALLS
+                    or item.node[0] in SETTING_CALLS
+                    or (item.node[0] in RESETTING_CALLS and not item.node[1])
+                ):
                     pass
                 elif what not in ("label", "program_name", "block_delete"):
                     name = item.node[0] if what in ("call", "path", "frame") else what.upper()
@@ -213,7 +239,15 @@ class SinumerikInterpreter(ModalInterpreter):
         if not dwell:
             if "F" in words:
                 self.feed = words["F"][0]
-            events = self._move(block, words)
+            if machine or codes & MACHINE_G:
+                events = self._machine_move(block, words)
+            else:
+                events = self._move(block, words)
+            if events and self.zero_frame != self.told_frame:
+                raise OutOfScope(
+                    f"a move under {_frame_name(self.zero_frame)} (ncpp is told the zero of {_frame_name(self.told_frame)})",
+                    block.items[0].start + 1,
+                )
         if end:
             self.done = True
         return self.radius_compensation(events, turn)
@@ -285,10 +319,10 @@ class SinumerikInterpreter(ModalInterpreter):
                 self.set_units(UNITS_G[code])
             elif code == 4.0:
                 dwell = True
-            elif code not in NEUTRAL_G:
-                reason = {53.0: "machine coordinates", 33.0: "thread cutting", 93.0: "inverse time feed"}.get(
-                    code, "the G code"
-                )
+            elif code in SETTABLE_FRAMES or code == NO_SETTABLE_FRAME:
+                self._select_frame(code)
+            elif code not in NEUTRAL_G and code not in MACHINE_G:
+                reason = {33.0: "thread cutting", 93.0: "inverse time feed"}.get(code, "the G code")
                 raise OutOfScope(f"{reason} G{code:g}", item.start + 1)
         return dwell
 
@@ -331,6 +365,31 @@ class SinumerikInterpreter(ModalInterpreter):
         if motion == "CIP":
             return [self._cip(block, words, end, absolute)]
         return [self._arc(block, words, end, motion == 2.0, absolute)]
+
+    def _select_frame(self, code: float) -> None:
+        if self.told_frame is None and code != NO_SETTABLE_FRAME:
+            self.told_frame = code
+        self.zero_frame = code
+
+    def _machine_move(self, block: Block, words: dict) -> list[Event]:
+        """A G0/G1 block in machine coordinates (G53, G153, SUPA): left as programmed (MACHINE);
+        the axes it names end at the machine positions it says."""
+        if not any(a in words for a in AXES):
+            return []
+        item = next(iter(words.values()))[2]
+        if self.motion not in (0.0, 1.0) or any(words[a][1] is not None for a in AXES if a in words):
+            raise OutOfScope(
+                "a move in machine coordinates other than G0/G1 to absolute positions", item.start + 1
+            )
+        end = list(self.pos)
+        offset = self.context().offset
+        for n, axis in enumerate(AXES):
+            if axis in words:  # machine position = program position + the context's offset (tool, frames)
+                end[n] = words[axis][0] - offset[n]
+        move = self.line(block, end, self.motion == 0.0)
+        move.fixed = MACHINE
+        move.placed = cast(tuple[bool, bool, bool], tuple(axis in words for axis in AXES))
+        return [move]
 
     def _arc(self, block: Block, words: dict, end: list[float], clockwise: bool, absolute: bool):
         a, b, _ = PLANE_AXES[self.plane]
@@ -375,3 +434,7 @@ def _tool_id(loaded: float | str) -> str:
     if type(loaded) is str:
         return f'"{loaded}"' if loaded else ""
     return f"{loaded:g}" if loaded else ""
+
+
+def _frame_name(code: float | None) -> str:
+    return "the frame in effect at the start" if code is None else f"G{code:g}"

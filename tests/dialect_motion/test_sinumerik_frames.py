@@ -1,0 +1,55 @@
+"""Sinumerik blocks in machine coordinates (G53, G153, SUPA) and the settable frame in effect.
+
+840D sl Programming Manual, Fundamentals, "Frame suppression (G53, G153, SUPA)": the block's
+coordinates are the machine's (ncpp assumes no basic frame and no external offsets), the tool
+offset still applies unless the block says D0; "Settable zero offset (G54 to G57, G505 to G599,
+G500)": G500 turns the settable frame off."""
+
+from __future__ import annotations
+
+import io
+
+import pytest
+
+from ncpp.errors import Warnings
+from ncpp.motion.offsets import WorkOffsets
+from ncpp.motion.segments import MACHINE, Line
+from ncpp.pipeline import dialect_tools
+from ncpp.program.dialects import parse_program
+
+ZERO = (100.0, 200.0, 300.0)
+
+
+def lines(text: str, warnings: Warnings | None = None) -> list[Line]:
+    interpret, _ = dialect_tools("sinumerik")
+    _, blocks = parse_program(io.BytesIO(text.encode()), "p.mpf", "sinumerik")
+    found = interpret(blocks, file="p.mpf", warnings=warnings or Warnings(stream=io.StringIO()),
+                      offsets=WorkOffsets.at(ZERO))  # fmt: skip
+    return [event for event in found if type(event) is Line]
+
+
+@pytest.mark.parametrize("block", ["G0 SUPA Z0 D0", "G0 G53 Z0 D0", "G0 G153 Z0 D0"])
+def test_a_move_in_machine_coordinates_is_left_as_programmed_and_followed(block):
+    moves = lines(f"G54 G90\nG0 X10 Y20 Z5\n{block}\nG0 X30\nM30\n")
+    retract = moves[1]
+    assert retract.fixed == MACHINE and retract.placed == (False, False, True)
+    assert retract.end == (10.0, 20.0, -ZERO[2]) and retract.context.to_machine(retract.end)[2] == 0.0
+    assert not moves[2].fixed and moves[2].start == retract.end
+
+
+def test_a_move_under_another_settable_frame_than_the_first_ends_interpretation():
+    said = io.StringIO()
+    moves = lines("G500 G90\nG54\nG0 X10 Y20 Z5\nG55\nG0 X30\nM30\n", Warnings(stream=said))
+    assert len(moves) == 1 and "a move under G55 (ncpp is told the zero of G54)" in said.getvalue()
+    said = io.StringIO()
+    assert lines("G500\nG0 X1\nG54\nG0 X2\n", Warnings(stream=said)) == []
+    assert "a move under G500" in said.getvalue()
+    assert len(lines("G54\nG0 X1\nG500\nG54\nG0 X2\n")) == 2  # (G500 with no move under it)
+
+
+def test_cycle800_and_cycle832_that_move_nothing_are_read_past():
+    text = "CYCLE800()\nCYCLE832(0.01,_ROUGH,1)\nG54\nG0 X1 Y2 Z3\nCYCLE832()\nG1 X4 F100\nM30\n"
+    said = io.StringIO()
+    assert len(lines(text, Warnings(stream=said))) == 2 and "scope" not in said.getvalue()
+    lines('CYCLE800(1,"TABLE",200000,57,0,0,0,0,0,0,0,0,0,-1,100,1)\nG0 X1\n', Warnings(stream=said))
+    assert "call CYCLE800" in said.getvalue()
