@@ -57,7 +57,13 @@ NO_SETTABLE_FRAME = 500.0
 MACHINE_G = frozenset((53.0, 153.0))
 UNITS_G = {70.0: True, 700.0: True, 71.0: False, 710.0: False}
 HARMLESS_CALLS = frozenset(("MSG", "BNAT", "ENAT", "BTAN", "ETAN", "BAUTO", "EAUTO", "FFWON", "FFWOF", "SOFT",
-                            "BRISK", "CFC", "CFTCP", "CFIN", "M"))  # fmt: skip
+                            "BRISK", "CFC", "CFTCP", "CFIN", "M",
+                            # what CAM posts write that moves no axis (840D sl Job Planning manual):
+                            # the compressor, a preprocessing stop, the blank for simulation, feed
+                            # groups, radius programming, and a transformation off or its
+                            # orientation modes (this interpreter stops at any that turns one on)
+                            "COMPOF", "COMPCAD", "COMPCURV", "COMPSURF", "STOPRE", "WORKPIECE", "FGROUP",
+                            "UPATH", "SPATH", "DIAMOF", "TRAFOOF", "ORIWKS", "ORIMKS", "ORIAXES", "ORIVECT"))  # fmt: skip
 # Calls that move nothing when given no arguments: CYCLE800() deselects the swivelled plane without
 # turning an axis (SINUMERIK 840D sl Milling manual, "Swiveling plane - CYCLE800": "CYCLE800()"
 # resets the swivel frames); CYCLE832() deselects the high-speed settings.  CYCLE832 with its

@@ -53,3 +53,11 @@ def test_cycle800_and_cycle832_that_move_nothing_are_read_past():
     assert len(lines(text, Warnings(stream=said))) == 2 and "scope" not in said.getvalue()
     lines('CYCLE800(1,"TABLE",200000,57,0,0,0,0,0,0,0,0,0,-1,100,1)\nG0 X1\n', Warnings(stream=said))
     assert "call CYCLE800" in said.getvalue()
+
+
+@pytest.mark.parametrize("block", ["COMPCAD", "STOPRE", "TRAFOOF", "ORIWKS", "FGROUP()", "DIAMOF",
+                                   'WORKPIECE(,"",,"BOX",0,0,-50,-80,0,0,100,100)'])  # fmt: skip
+def test_what_cam_posts_write_that_moves_no_axis_is_read_past(block):
+    said = io.StringIO()
+    assert len(lines(f"G54\n{block}\nG0 X1 Y2 Z3\nM30\n", Warnings(stream=said))) == 1
+    assert "scope" not in said.getvalue()
