@@ -87,12 +87,12 @@ def _number(value: float) -> str:
 
 def guard_lines(placement: Placement, dialect: str, first_lines: Iterable[str] = ()) -> list[str]:
     """The guard's lines (without line ends) for a program of `dialect` (a post's "linuxcnc" or
-    "fanuc" says its syntax; for "iso", `first_lines`, the program's first lines, tell Fanuc's
-    from LinuxCNC's).  [] where there is none."""
+    "fanuc" says its syntax, and a Haas program's is Fanuc's; for "iso", `first_lines`, the
+    program's first lines, tell Fanuc's from LinuxCNC's).  [] where there is none."""
     if dialect == "iso":
         dialect = "fanuc" if any(_FANUC_PROGRAM_NUMBER.match(line) for line in first_lines) else "linuxcnc"
     # (grbl reads no parameters and has no conditionals: it cannot test its work offset)
-    written = {"linuxcnc": _linuxcnc, "fanuc": _fanuc, "sinumerik": _sinumerik}.get(dialect)
+    written = {"linuxcnc": _linuxcnc, "fanuc": _fanuc, "haas": _fanuc, "sinumerik": _sinumerik}.get(dialect)
     return [] if written is None else written(placement)
 
 

@@ -28,7 +28,7 @@ from ncpp.passes import PASSES, PassContext, run_passes
 from ncpp.passes.context import ErrorMap, is_directional
 from ncpp.passes.inverse import iterations_for
 from ncpp.program.blocks import Block, Comment, Statement, Word
-from ncpp.program.dialects import FAMILY, dialect_tools, get_dialect, parse_program
+from ncpp.program.dialects import dialect_tools, get_dialect, parse_program
 from ncpp.program.dialects.iso import IsoWriter
 from ncpp.runtime import keep_freed_memory
 from ncpp.summary import Summary
@@ -154,41 +154,6 @@ def header_comment(block: Block) -> Comment | None:
         if type(item) is Comment and HEADER_TAG in item.text.lower():
             return item
     return None
-
-
-# What the one-zero dialects' interpreters do not place (the ISO interpreter places it all):
-# Sinumerik's settable frames G54-G57 (G58/G59 are its programmable offsets: out of the
-# interpreter's scope, warned there) and G500, which deselects them.  (Tool lengths each
-# interpreter places itself, from the tool table it is told.)
-_ONE_ZERO = "ncpp compensates this dialect at one program zero, the work offset in effect when the program starts (--work-offset)"
-OTHER_ZEROS = {
-    **{
-        value: f"{name} selects another work offset: {_ONE_ZERO}"
-        for value, name in ((55.0, "G55"), (56.0, "G56"), (57.0, "G57"))
-    },
-    500.0: f"G500 deselects the work offset: {_ONE_ZERO}",
-}
-
-
-def warn_unplaced(blocks: Iterable[Block], warnings: Warnings, file: str) -> Iterator[Block]:
-    """Pass blocks through; warn once per `OTHER_ZEROS` G word where the program first uses
-    it (refused with --strict): the errors compensated there are those of another place."""
-    told: set[float] = set()
-    for block in blocks:
-        signature = block.signature  # the words' letters and G numbers: most blocks are passed on here
-        if signature is not None and "G5" not in signature:
-            yield block
-            continue
-        for item in block.items:
-            if (
-                type(item) is Word
-                and item.letter == "G"
-                and item.value in OTHER_ZEROS
-                and item.value not in told
-            ):
-                told.add(item.value)
-                warnings.warn(OTHER_ZEROS[item.value], Location(file, block.line, item.start + 1))
-        yield block
 
 
 # Why moves are left as programmed (`Line.fixed`), as the warning says it
@@ -383,8 +348,6 @@ def process(
         blocks = refuse_compensated(blocks, file)
     else:  # compensated again: the guard of the offset it was compensated for goes
         blocks = without_guard(blocks)
-    if FAMILY[name] != "iso":  # the ISO interpreter places every work offset and tool length
-        blocks = warn_unplaced(blocks, warnings, file)
     offsets = offsets or AT_MACHINE_ZERO  # the control's zeros place the program on the machine
     events: Iterable[Event] = interpret(blocks, file=file, warnings=warnings, strict=strict, offsets=offsets)
     if verify:

@@ -16,6 +16,13 @@ HEIDENHAIN = corpus_files("heidenhain")
 SINUMERIK = corpus_files("sinumerik")
 OTHERS = corpus_files("iso_gcode", "malformed", "apt_cldata", "metrology")
 GRBL = corpus_files("iso_gcode/freecad_grbl")  # FreeCAD's grbl posts say so in their first comment
+# Fanuc programs: a program number line (`O9250`, `O0001`), as LinuxCNC's tests of Fanuc subprograms have
+FANUC = [CORPUS / "iso_gcode/haas_fanuc_macroB/O9250-DynamicOffsetRotation.nc"] + [
+    CORPUS / f"iso_gcode/linuxcnc_fanuc_subs/{name}"
+    for name in ("01-basics__test.ngc", "05-M98-loops__test.ngc", "07-nested-subs__test.ngc",
+                 "08-sub-follows-main__test.ngc", "09-disable-fanuc-subs__test-fanuc.ngc", "10-M98-P001__test.ngc",
+                 "13-named-program__test-numbered.ngc")
+] + [CORPUS / "malformed/linuxcnc_m98m99/03-error-M98-no-P-word__test.ngc"]  # fmt: skip
 PLAN_H = CORPUS / "heidenhain/jstjst_Heidenhain-Cycles/Plan.h"  # continuation lines, a cycle, a GPL header
 # Plain G code with `;` comments: nothing in it is Sinumerik-only, only its name tells.
 CONTENT_AMBIGUOUS = {"multiple_m_codes.mpf"}
@@ -45,15 +52,9 @@ def test_sinumerik_program_roundtrips(path):
 
 @pytest.mark.parametrize("path", HEIDENHAIN + SINUMERIK + OTHERS, ids=corpus_id)
 def test_dialect_is_detected(path):
-    want = (
-        "heidenhain"
-        if path in HEIDENHAIN
-        else "sinumerik"
-        if path in SINUMERIK
-        else "grbl"
-        if path in GRBL
-        else "iso"
-    )
+    known = {**dict.fromkeys(HEIDENHAIN, "heidenhain"), **dict.fromkeys(SINUMERIK, "sinumerik"),
+             **dict.fromkeys(GRBL, "grbl"), **dict.fromkeys(FANUC, "fanuc")}  # fmt: skip
+    want = known.get(path, "iso")
     head = path.read_bytes()[:4096]
     assert detect(head, path.name) == want
     if path.name not in CONTENT_AMBIGUOUS:

@@ -24,8 +24,8 @@ from ncpp.program.parser import Dialect, LineParser, _ItemBuilder
 @dataclass(frozen=True)
 class DialectUnit:
     """Where one dialect's parts live, each named here once: its syntax (the parser's
-    `Dialect`, "module:attribute"), its interpreter (a module with an `interpret` function)
-    and its writer ("module:Class").  `family`: the dialect whose grammar and writer a
+    `Dialect`, "module:attribute"), its interpreter ("module:function", as `interpret` of
+    `ncpp.motion.interpreter`) and its writer ("module:Class").  `family`: the dialect whose grammar and writer a
     flavour shares (grbl is ISO's, its interpreter a subclass of LinuxCNC's)."""
 
     name: str
@@ -42,28 +42,42 @@ UNITS = {
             "iso",
             "iso",
             "ncpp.program.dialects:ISO",
-            "ncpp.motion.interpreter",
+            "ncpp.motion.interpreter:interpret",
+            "ncpp.program.dialects.iso:IsoWriter",
+        ),
+        DialectUnit(
+            "fanuc",
+            "iso",
+            "ncpp.program.dialects:FANUC",
+            "ncpp.motion.fanuc:interpret",
+            "ncpp.program.dialects.iso:IsoWriter",
+        ),
+        DialectUnit(
+            "haas",
+            "iso",
+            "ncpp.program.dialects:HAAS",
+            "ncpp.motion.fanuc:interpret_haas",
             "ncpp.program.dialects.iso:IsoWriter",
         ),
         DialectUnit(
             "grbl",
             "iso",
             "ncpp.program.dialects:GRBL",
-            "ncpp.motion.grbl",
+            "ncpp.motion.grbl:interpret",
             "ncpp.program.dialects.iso:IsoWriter",
         ),
         DialectUnit(
             "heidenhain",
             "heidenhain",
             "ncpp.program.dialects.heidenhain:HEIDENHAIN",
-            "ncpp.motion.heidenhain",
+            "ncpp.motion.heidenhain:interpret",
             "ncpp.program.dialects.heidenhain:HeidenhainWriter",
         ),
         DialectUnit(
             "sinumerik",
             "sinumerik",
             "ncpp.program.dialects.sinumerik:SINUMERIK",
-            "ncpp.motion.sinumerik",
+            "ncpp.motion.sinumerik:interpret",
             "ncpp.program.dialects.sinumerik:SinumerikWriter",
         ),
     )  # fmt: skip
@@ -79,6 +93,8 @@ ISO = Dialect("iso", "iso", _ItemBuilder, fast_terminals=LineParser.FAST_TERMINA
 # grbl: a line it reads as a system command (`$H`, `$100=250`) is no G code: read where it
 # runs, it reaches the interpreter as a line the grammar cannot read
 GRBL = Dialect("grbl", "iso", _ItemBuilder, fast_terminals=LineParser.FAST_TERMINALS, read_where_run=True)
+FANUC = Dialect("fanuc", "iso", _ItemBuilder, fast_terminals=LineParser.FAST_TERMINALS, read_where_run=True)
+HAAS = Dialect("haas", "iso", _ItemBuilder, fast_terminals=LineParser.FAST_TERMINALS, read_where_run=True)
 # File name endings that name a dialect when the content does not tell.
 SUFFIXES = {".h": "heidenhain", ".mpf": "sinumerik", ".spf": "sinumerik"}
 
@@ -103,7 +119,7 @@ def get_dialect(name: str) -> Dialect:
 def dialect_tools(name: str) -> tuple[Callable, type]:
     """(interpret, Writer) of the dialect called `name`."""
     unit = _unit(name)
-    return importlib.import_module(unit.interpreter).interpret, _load(unit.writer)
+    return _load(unit.interpreter), _load(unit.writer)
 
 
 def parser_for(dialect: str | Dialect) -> LineParser:
@@ -166,8 +182,18 @@ _GRBL = re.compile(
 )
 
 
+# Haas's own settings (G187 smoothness, G103 look-ahead, G154 work offsets); Fanuc's program
+# number line (`O1000`, `O1000 (NAME)`, `:1000`), macro call, alarm, AI contour and preview control
+_HAAS = re.compile(r"(?<![\w#.])G0*(187|103|154)(?![\d.])", re.I)
+_FANUC = re.compile(
+    r"^[ \t]*[O:]\d+[ \t]*(\(.*\))?[ \t]*\r?$|(?<![\w#.])G0*65[ \t]*P|#3000[ \t]*=|(?<![\w#.])G0*5\.1[ \t]*Q"
+    r"|(?<![\w#.])G0*8[ \t]*P",
+    re.M | re.I,
+)
+
+
 def detect(first_bytes: bytes, name: str | None = None) -> str:
-    """'iso', 'grbl', 'heidenhain' or 'sinumerik' from the start of a program.
+    """'iso', 'fanuc', 'haas', 'grbl', 'heidenhain' or 'sinumerik' from the start of a program.
 
     grbl's system commands (`$H`, `$J=`, `$100=250`) or the comment FreeCAD's grbl
     posts write first mean grbl; `BEGIN PGM` or numbered conversational blocks mean Heidenhain; a
@@ -175,7 +201,9 @@ def detect(first_bytes: bytes, name: str | None = None) -> str:
     `CR=`, `AC(`, `MSG(`, `GOTOF`, labels, `IF` without brackets, `$AA_...`)
     means Sinumerik, unless LinuxCNC's o-word lines or `#<name>` parameters
     are there too.  When the content is plain ISO-looking G code, a file name
-    ending in .h / .mpf / .spf decides.
+    ending in .h / .mpf / .spf decides; then Haas's settings (G187, G103, G154) mean Haas,
+    and a Fanuc program number line, G65, #3000, G05.1 Q or G08 P mean Fanuc (unless
+    LinuxCNC's o-word lines are there); any other is LinuxCNC's ISO.
     """
     text = first_bytes.decode("latin-1")
     if _HEIDENHAIN.search(text) or len(_HEIDENHAIN_BLOCK.findall(text)) >= 2:
@@ -189,6 +217,10 @@ def detect(first_bytes: bytes, name: str | None = None) -> str:
         for suffix, dialect in SUFFIXES.items():
             if name.lower().endswith(suffix):
                 return dialect
+    if _HAAS.search(code):
+        return "haas"
+    if _FANUC.search(code) and not _LINUXCNC.search(code):
+        return "fanuc"
     return "iso"
 
 

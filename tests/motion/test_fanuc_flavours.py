@@ -1,0 +1,80 @@
+"""Fanuc and Haas settings that move no axis (`ncpp/motion/fanuc.py`), where LinuxCNC reads
+the same codes otherwise (G5.1 a spline, G8 lathe radius mode) or not at all.
+
+Fanuc 0i-MF operator's manual: "AI contour control (G05.1 Q1)", "Advanced preview control (G08
+P1)"; Haas Mill Operator's Manual: "G187 Accuracy Control", "G103 Limit Block Buffering",
+"G154 Select Work Coordinates P1-P99", "M97 Local Sub-Program Call"."""
+
+from __future__ import annotations
+
+import io
+import subprocess
+import sys
+
+import pytest
+
+from ncpp.errors import NcppError, Warnings
+from ncpp.motion.segments import Line, Pass
+from ncpp.pipeline import dialect_tools
+from ncpp.program.dialects import detect, parse_program
+from tests.conftest import READING, ROOT
+
+
+def events(program: str, dialect: str, warnings: Warnings | None = None) -> list:
+    interpret, _ = dialect_tools(dialect)
+    _, blocks = parse_program(io.BytesIO(program.encode()), "p.nc", dialect)
+    return list(interpret(blocks, file="p.nc", warnings=warnings or Warnings(stream=io.StringIO())))
+
+
+@pytest.mark.parametrize(
+    "setting, dialects",
+    [("G05.1 Q1", ("fanuc", "haas")), ("G08 P1", ("fanuc", "haas")), ("G187 P1 E0.01", ("haas",)),
+     ("G103 P1", ("haas",))],
+)  # fmt: skip
+def test_a_setting_on_its_own_line_is_read_past(setting, dialects):
+    program = f"G21 G90 G54\n{setting}\nG0 X10 Y10\nG1 X20 F100\n{setting.split()[0]} {setting.split()[1][0]}0\nM30\n"
+    for dialect in dialects:
+        found = events(program, dialect)
+        assert [type(e) for e in found] == [Pass, Pass, Line, Line, Pass, Pass]
+    with pytest.raises(NcppError):  # LinuxCNC's reading: an unknown code, a spline, or a P word for nothing
+        events(program, "iso")
+
+
+def test_a_setting_with_motion_in_its_block_ends_interpretation():
+    said = io.StringIO()
+    found = events("G0 X1\nG05.1 Q1 X10\nG0 X2\n", "fanuc", Warnings(stream=said))
+    assert [type(e) for e in found] == [Line, Pass, Pass] and "G05.1 with other words" in said.getvalue()
+
+
+@pytest.mark.parametrize(
+    "block, reason", [("G154 P1", "G154 (an additional work offset"), ("M97 P1000", "M97 (a local")]
+)
+def test_what_haas_programs_need_ncpp_is_not_told_ends_interpretation(block, reason):
+    said = io.StringIO()
+    found = events(f"G0 X1\n{block}\nG0 X2\nM30\n", "haas", Warnings(stream=said))
+    assert [type(e) for e in found] == [Line, Pass, Pass, Pass] and reason in said.getvalue()
+
+
+@pytest.mark.parametrize(
+    "head, dialect",
+    [
+        (b"%\nO1000 (PART)\nG21 G90\n", "fanuc"),
+        (b"%\nO1000\nG187 P1 E0.01\n", "haas"),
+        (b"G21\nG154 P3\nG0 X1\n", "haas"),
+        (b"G21\nG05.1 Q1\n", "fanuc"),
+        (b"G65 P9810 X1. Y2.\n", "fanuc"),
+        (b"o100 sub\nG0 X1\no100 endsub\nO1000\n", "iso"),  # LinuxCNC's o-words win
+        (b"G21 G90\nG0 X1 Y2 (G187 in a comment)\n", "iso"),
+    ],
+)
+def test_fanuc_and_haas_are_told_by_what_only_they_write(head, dialect):
+    assert detect(head) == dialect
+
+
+def test_a_haas_program_gets_the_fanuc_guard(tmp_path):
+    program = tmp_path / "p.nc"
+    program.write_text("%\nO1000\nG187 P1 E0.01\nG21 G90 G54\nG0 X10 Y10 Z5\nG1 Z-1 F100\nM30\n%\n")
+    proc = subprocess.run([sys.executable, "-m", "ncpp", "--machine", str(READING), "--work-offset", "10,20,30",
+                           str(program)], capture_output=True, text=True, cwd=ROOT)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    assert "IF [#4014 NE 54] THEN #3000=1" in proc.stdout and "\nG187 P1 E0.01\n" in proc.stdout
