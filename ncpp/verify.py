@@ -857,22 +857,23 @@ class _Nearby:
 def _to_segments(points: np.ndarray, starts: np.ndarray, ends: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(n, k) distances of n points to their k segments (starts, ends: (n, k, width)), and
     (n, k, width) the segments' points closest to them."""
+    # (einsum: numpy's sum over an axis of a few coordinates costs many times the arithmetic)
     d = ends - starts
     w = points[:, None, :] - starts
-    length2 = (d * d).sum(axis=2)
-    t = np.clip((w * d).sum(axis=2) / np.where(length2 > 0, length2, 1.0), 0.0, 1.0)
+    length2 = np.einsum("nkw,nkw->nk", d, d)
+    t = np.clip(np.einsum("nkw,nkw->nk", w, d) / np.where(length2 > 0, length2, 1.0), 0.0, 1.0)
     closest = starts + t[:, :, None] * d
     off = points[:, None, :] - closest
-    return np.sqrt((off * off).sum(axis=2)), closest
+    return np.sqrt(np.einsum("nkw,nkw->nk", off, off)), closest
 
 
 def _to_lines(points: np.ndarray, starts: np.ndarray, ends: np.ndarray) -> np.ndarray:
     """(n,) distances of n points to n segments."""
     d = ends - starts
-    length2 = (d * d).sum(axis=1)
-    t = np.clip(((points - starts) * d).sum(axis=1) / np.where(length2 > 0, length2, 1.0), 0.0, 1.0)
+    length2 = np.einsum("nw,nw->n", d, d)
+    t = np.clip(np.einsum("nw,nw->n", points - starts, d) / np.where(length2 > 0, length2, 1.0), 0.0, 1.0)
     off = points - starts - t[:, None] * d
-    return np.sqrt((off * off).sum(axis=1))
+    return np.sqrt(np.einsum("nw,nw->n", off, off))
 
 
 def _line_text(stream: BinaryIO, number: int | None) -> str:
