@@ -26,6 +26,7 @@ writer can keep the program's pole where compensated arcs need their own.
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 
@@ -58,6 +59,21 @@ HARMLESS_KEYWORDS = frozenset(("STOP",))
 # one), which move no axis: `PLANE RESET STAY` keeps the rotary axes where they are (TNC 640
 # Klartext manual, "PLANE RESET"), `FUNCTION RESET TCPM` ends tool-centre-point control
 HARMLESS_RESETS = frozenset((("PLANE", "RESET", "STAY"), ("FUNCTION", "RESET", "TCPM")))
+
+
+# FN 0-8: Q parameter arithmetic (TNC 640 Klartext manual, "Basic arithmetic" and "Angle
+# functions": `FN 0: Q5 = +10`, `FN 1: Q1 = -Q2 + -5`, `FN 4: Q25 = +Q1 DIV +Q7`, `FN 5:
+# Q20 = SQRT Q4`, `FN 6: Q20 = SIN-Q5` in degrees, `FN 8: Q10 = +5 LEN +4`).  FN 13 (ANG)
+# and the jumps FN 9-12 stay out of scope.
+FN_ARITHMETIC = {0: "", 1: "+", 2: "-", 3: "*", 4: "DIV", 5: "SQRT", 6: "SIN", 7: "COS", 8: "LEN"}
+_FN_OPERAND = r"([+-]?)[ \t]*(Q[LR]?\d+|\d+(?:[.,]\d*)?|[.,]\d+)"
+_FN_TARGET = re.compile(r"[ \t]*(Q[LR]?\d+)[ \t]*=[ \t]*(.*?)[ \t]*$", re.I)
+
+
+def _fn_operand(text: str) -> tuple:
+    sign, value = re.fullmatch(_FN_OPERAND, text.strip(), re.I).groups()  # type: ignore[union-attr]
+    expr = ("param", value.lower()) if value[0] in "Qq" else ("num", float(value.replace(",", ".")))
+    return ("neg", expr) if sign == "-" else expr
 
 
 @dataclass(slots=True)
@@ -268,6 +284,8 @@ class HeidenhainInterpreter(ModalInterpreter):
                 and (node[0] in HARMLESS_KEYWORDS or tuple(node) in HARMLESS_RESETS)
             ):
                 continue
+            elif what == "fn" and node[0] in FN_ARITHMETIC:
+                self._fn(block, item)
             elif what == "tool_def":
                 return self._tool_def(block, item)
             elif what == "blk_form":
@@ -437,6 +455,51 @@ class HeidenhainInterpreter(ModalInterpreter):
         move.placed = (0 in written and AXES[0] in words, 1 in written and AXES[1] in words,
                        2 in written and AXES[2] in words)  # fmt: skip
         return move
+
+    def _fn(self, block: Block, item) -> None:
+        """FN 0-8: a Q parameter set to one operand, an operation of two, or a function of one."""
+        number, text = item.node
+        operation = FN_ARITHMETIC[number]
+        found = _FN_TARGET.fullmatch(text)
+        operands: tuple[str, ...] | None = None
+        if found is not None:
+            body = found.group(2)
+            if number == 0:
+                operands = (body,)
+            elif number in (5, 6, 7):
+                unary = re.fullmatch(rf"{operation}[ \t]*(.+)", body, re.I)
+                operands = None if unary is None else (unary.group(1),)
+            else:
+                binary = re.fullmatch(rf"(.+?)[ \t]*{re.escape(operation)}[ \t]*(.+)", body, re.I)
+                operands = None if binary is None else (binary.group(1), binary.group(2))
+        if (
+            found is None
+            or operands is None
+            or not all(re.fullmatch(_FN_OPERAND, o.strip(), re.I) for o in operands)
+        ):
+            shape = "a" if number == 0 else f"{operation} a" if number in (5, 6, 7) else f"a {operation} b"
+            self.fail(f"FN {number}: expected Q.. = {shape}", block, item)
+        values = [self.value(_fn_operand(o), block, item) for o in operands]
+        self.q[found.group(1).lower()] = self._fn_value(number, values, block, item)
+
+    def _fn_value(self, number: int, values: list[float], block: Block, item) -> float:
+        if number == 0:
+            return values[0]
+        if number in (5, 6, 7):
+            (a,) = values
+            if number == 5 and a < 0:
+                self.fail("FN 5: the square root of a negative number", block, item)
+            return (
+                math.sqrt(a)
+                if number == 5
+                else math.sin(math.radians(a))
+                if number == 6
+                else math.cos(math.radians(a))
+            )
+        a, b = values
+        if number == 4 and b == 0:
+            self.fail("FN 4: division by zero", block, item)
+        return {1: a + b, 2: a - b, 3: a * b, 8: math.hypot(a, b)}[number] if number != 4 else a / b
 
     def _preset(self, block: Block, item) -> None:
         """CYCL DEF 247: the first preset the program activates is the program zero ncpp was

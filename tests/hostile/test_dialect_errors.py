@@ -44,14 +44,15 @@ def test_a_negative_base_to_a_fractional_power_is_a_located_error(ncpp, tmp_path
     "body",
     [
         "FN 4: Q1 = +6 DIV +2",
-        "FN 6: Q1 = SQRT +4",
+        "FN 5: Q1 = SQRT +4",
+        "FN 6: Q1 = SIN +30",
         "FN 8: Q1 = +3 LEN +4",
         "FN 13: Q1 = +1 ANG +1",
         "FN 0: Q1 = +5",
     ],
 )
 def test_fn_functions_of_a_valid_tnc_program_are_read(ncpp, tmp_path, body):
-    """(TNC 640 Klartext manual, Q parameter programming: FN 4 DIV, FN 6 SQRT, FN 8 LEN, FN 13 ANG)"""
+    """(TNC 640 Klartext manual, Q parameter programming: FN 4 DIV, FN 5 SQRT, FN 6 SIN, FN 8 LEN, FN 13 ANG)"""
     text = f"0 BEGIN PGM P MM\n1 {body}\n2 L X+1 F100\n3 END PGM P MM\n"
     program = tmp_path / "p.h"
     program.write_text(text)
