@@ -18,11 +18,7 @@ both sets and moves is not one these controls' posts write.
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Iterator
-
-from ncpp.errors import Warnings
-from ncpp.motion.interpreter import Interpreter, _OutOfScope, run
-from ncpp.motion.offsets import WorkOffsets
+from ncpp.motion.interpreter import Interpreter, _OutOfScope, interpreting
 from ncpp.motion.segments import Event, Pass
 from ncpp.program.blocks import Block, Comment, Word
 
@@ -32,30 +28,6 @@ HAAS_SETTINGS = {**FANUC_SETTINGS, 187.0: frozenset("PE"), 103.0: frozenset("P")
 # Codes of the flavour that need what ncpp is not told (a zero, a sequence number's block)
 HAAS_UNFOLLOWED = {("G", 154.0): "G154 (an additional work offset ncpp is not told)",
                    ("M", 97.0): "M97 (a local subprogram at a sequence number)"}  # fmt: skip
-
-
-def interpret(
-    blocks: Iterable[Block],
-    *,
-    file: str = "<stdin>",
-    warnings: Warnings | None = None,
-    strict: bool = False,
-    offsets: WorkOffsets | None = None,
-) -> Iterator[Event]:
-    """Motion events of a Fanuc program's blocks, lazily (as `ncpp.motion.interpreter.interpret`)."""
-    return run(FanucInterpreter(file, offsets), blocks, warnings, strict)
-
-
-def interpret_haas(
-    blocks: Iterable[Block],
-    *,
-    file: str = "<stdin>",
-    warnings: Warnings | None = None,
-    strict: bool = False,
-    offsets: WorkOffsets | None = None,
-) -> Iterator[Event]:
-    """Motion events of a Haas program's blocks, lazily."""
-    return run(HaasInterpreter(file, offsets), blocks, warnings, strict)
 
 
 class FanucInterpreter(Interpreter):
@@ -81,3 +53,7 @@ class FanucInterpreter(Interpreter):
 class HaasInterpreter(FanucInterpreter):
     settings = HAAS_SETTINGS
     unfollowed = HAAS_UNFOLLOWED
+
+
+interpret = interpreting(FanucInterpreter)
+interpret_haas = interpreting(HaasInterpreter)

@@ -18,11 +18,8 @@ grbl reads a subset of rs274ngc (its wiki page "G-code commands" and `grbl/gcode
 from __future__ import annotations
 
 import re
-from collections.abc import Iterable, Iterator
 
-from ncpp.errors import Warnings
-from ncpp.motion.interpreter import Interpreter, _OutOfScope, run
-from ncpp.motion.offsets import WorkOffsets
+from ncpp.motion.interpreter import Interpreter, _OutOfScope, interpreting
 from ncpp.motion.segments import Event, Pass
 from ncpp.program.blocks import Block
 
@@ -30,18 +27,6 @@ from ncpp.program.blocks import Block
 _REALTIME = re.compile(r"[?~!]+[ \t]*(;.*|\(.*)?\r?\n?$")
 # grbl's system commands that move the machine
 _MOVING = {"$H": "grbl homing ($H)", "$J=": "a grbl jog ($J=)"}
-
-
-def interpret(
-    blocks: Iterable[Block],
-    *,
-    file: str = "<stdin>",
-    warnings: Warnings | None = None,
-    strict: bool = False,
-    offsets: WorkOffsets | None = None,
-) -> Iterator[Event]:
-    """Motion events of a grbl program's blocks, lazily (as `ncpp.motion.interpreter.interpret`)."""
-    return run(GrblInterpreter(file, offsets), blocks, warnings, strict)
 
 
 class GrblInterpreter(Interpreter):
@@ -57,3 +42,6 @@ class GrblInterpreter(Interpreter):
                     raise _OutOfScope(f"{what}, a move ncpp cannot follow", 1)
             return Pass(block)
         return super().block(block)
+
+
+interpret = interpreting(GrblInterpreter)

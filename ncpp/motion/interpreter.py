@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from typing import NoReturn, cast
 
 from ncpp.errors import Location, NcppError, Warnings
@@ -155,27 +155,33 @@ class _OutOfScope(Exception):
         self.col = col
 
 
-def interpret(
-    blocks: Iterable[Block],
-    *,
-    file: str = "<stdin>",
-    warnings: Warnings | None = None,
-    strict: bool = False,
-    offsets: WorkOffsets | None = None,
-) -> Iterator[Event]:
-    """Motion events of a program's blocks, lazily (see the module docstring).
+def interpreting(flavour: type[Interpreter]) -> Callable[..., Iterator[Event]]:
+    """The `interpret` function of a flavour of the ISO family, whose interpreter is `flavour`."""
 
-    `offsets`: the zeros and the tool table the control holds at the start
-    (none: all zero, as rs274's default parameter file).  Given, a coordinate
-    system selected whose zero they do not tell gets a warning where it is
-    first selected, and so does the first G43 when they hold no tool table.
+    def interpret(
+        blocks: Iterable[Block],
+        *,
+        file: str = "<stdin>",
+        warnings: Warnings | None = None,
+        strict: bool = False,
+        offsets: WorkOffsets | None = None,
+    ) -> Iterator[Event]:
+        """Motion events of a program's blocks, lazily, as the flavour reads them (see the
+        module docstring).
 
-    Raises NcppError (file, line, column of the offending word) on a program
-    LinuxCNC would refuse.  Out-of-scope constructs warn once through
-    `warnings` (stderr by default) and end interpretation; with `strict`
-    (or a strict `warnings`) they raise NcppError instead.
-    """
-    return run(Interpreter(file, offsets), blocks, warnings, strict)
+        `offsets`: the zeros and the tool table the control holds at the start
+        (none: all zero, as rs274's default parameter file).  Given, a coordinate
+        system selected whose zero they do not tell gets a warning where it is
+        first selected, and so does the first G43 when they hold no tool table.
+
+        Raises NcppError (file, line, column of the offending word) on a program
+        the control would refuse.  Out-of-scope constructs warn once through
+        `warnings` (stderr by default) and end interpretation; with `strict`
+        (or a strict `warnings`) they raise NcppError instead.
+        """
+        return run(flavour(file, offsets), blocks, warnings, strict)
+
+    return interpret
 
 
 def run(
@@ -1656,3 +1662,6 @@ def _about_zero(x: float, y: float, radius: tuple | None, theta: tuple | None) -
     r = radius[0] if radius is not None else math.hypot(y, x)
     a = math.radians(theta[0]) if theta is not None else math.atan2(y, x)
     return r * math.cos(a), r * math.sin(a)
+
+
+interpret = interpreting(Interpreter)  # LinuxCNC's rs274ngc reading
