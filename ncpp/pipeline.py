@@ -23,7 +23,7 @@ from ncpp import __version__
 from ncpp.errors import Location, NcppError, Warnings
 from ncpp.guard import Placement, with_guard, without_guard
 from ncpp.motion.offsets import AT_MACHINE_ZERO, WorkOffsets
-from ncpp.motion.segments import COMP, CYCLE, FLOW, Arc, Event, Line, Pass
+from ncpp.motion.segments import COMP, CYCLE, FLOW, HOLE, Arc, Event, Line, Pass
 from ncpp.passes import PASSES, PassContext, run_passes
 from ncpp.passes.context import ErrorMap, is_directional
 from ncpp.passes.inverse import iterations_for
@@ -231,7 +231,7 @@ def warn_fixed(events: Iterable[Event], warnings: Warnings, file: str) -> Iterat
         kind = type(event)
         if kind is Line or kind is Arc:  # (not a Pass, nor a dialect's own: Klartext's pole)
             fixed = event.fixed  # type: ignore[union-attr]
-            if not fixed and series == CYCLE and absolute and not event.context.absolute:  # type: ignore[union-attr]
+            if not fixed and series in (CYCLE, HOLE) and absolute and not event.context.absolute:  # type: ignore[union-attr]
                 yield from _passed_on(event, events, warnings, file)
                 return
             if (

@@ -15,7 +15,7 @@ from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
 
 from ncpp.errors import Location
-from ncpp.motion.segments import COMP, CYCLE, FLOW, HOME, PLANE_AXES, Arc, Event, Line
+from ncpp.motion.segments import COMP, CYCLE, FLOW, HOLE, HOME, PLANE_AXES, Arc, Event, Line
 
 # Why moves are left as programmed, as the summary names it
 REASONS = {
@@ -78,7 +78,7 @@ class Summary:
             for event in events:
                 kind = type(event)
                 if kind is Line:
-                    if event.fixed:  # type: ignore[union-attr]
+                    if event.fixed and event.fixed != HOLE:  # type: ignore[union-attr]  # (a hole is compensated)
                         self._leave(REASONS.get(event.fixed, event.fixed), event.block.line)  # type: ignore[union-attr]
                     else:
                         moves += 1
@@ -107,7 +107,7 @@ class Summary:
             if kind is Line or kind is Arc:
                 if event.block is block:
                     last = event  # type: ignore[assignment]
-                elif not event.fixed:  # type: ignore[union-attr]
+                elif not event.fixed or event.fixed == HOLE:  # type: ignore[union-attr]
                     self._settle(block, last)
                     block, last = event.block, event  # type: ignore[assignment]
             yield event

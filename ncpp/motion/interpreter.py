@@ -36,7 +36,16 @@ from typing import NoReturn, cast
 
 from ncpp.errors import Location, NcppError, Warnings
 from ncpp.motion.corners import CornerError, round_corner
-from ncpp.motion.cycles import CANNED, DWELLING, PECKING, RAPID_DELTA_INCH, SPINDLE, back_bore, hole
+from ncpp.motion.cycles import (
+    CANNED,
+    DWELLING,
+    PECKING,
+    RAPID_DELTA_INCH,
+    SPINDLE,
+    approach,
+    back_bore,
+    hole,
+)
 from ncpp.motion.expressions import ExpressionError, OutOfScope, Parameters, evaluate
 from ncpp.motion.flow import FIXED, RUN, SKIP, Flow
 from ncpp.motion.offsets import SYSTEMS, WorkOffsets
@@ -44,11 +53,13 @@ from ncpp.motion.segments import (
     COMP,
     CYCLE,
     FLOW,
+    HOLE,
     HOME,
     PLANE_AXES,
     Arc,
     Context,
     Event,
+    Hole,
     Line,
     Pass,
     Setting,
@@ -217,6 +228,7 @@ class Interpreter:
         self.cycle_r = self.cycle_cc = self.cycle_q = self.cycle_il = 0.0
         self.cycle_ijk = (0.0, 0.0, 0.0)  # G87's sticky I J K
         self.cycle_last_r = 0.0  # the R plane of the series' last cycle
+        self.cycle_holes = False  # the series' cycles are compensated hole by hole (`Hole`)
         self.spindle = 0  # M3 1, M4 -1, stopped 0 (tapping and boring cycles check it)
         self.coord_system = 1
         self.g5x = [[0.0] * 9 for _ in range(10)]  # index 1..9: G54..G59.3
@@ -366,7 +378,9 @@ class Interpreter:
                 if owner is None:
                     out.append(ev)
                 continue
-            ev.fixed = ev.fixed or FLOW  # type: ignore[union-attr]  # (a move: `type(ev) is Pass` above)
+            if ev.fixed == HOLE:  # type: ignore[union-attr]  # (a move: `type(ev) is Pass` above)
+                ev.fixed, ev.hole = CYCLE, None  # type: ignore[union-attr]  # each run may need its own correction
+            ev.fixed = ev.fixed or FLOW  # type: ignore[union-attr]
             if owner is not None:
                 ev.block = owner
             out.append(ev)
@@ -393,7 +407,7 @@ class Interpreter:
                     block,
                     block.items[0],
                 )
-            self.arc_refused = moves[0].fixed == CYCLE or _homes(block)
+            self.arc_refused = moves[0].fixed in (CYCLE, HOLE) or _homes(block)
         if self.cutter_comp is not None and self.comp_radius:
             self._check_radius(moves, block, self.comp_radius)
         # (a loop's or a cycle's moves too: that the tool is off the path matters more)
@@ -1284,17 +1298,7 @@ class Interpreter:
             i, j, k = self._back_bore_words(block, words, again, item)
             middle = k if self.absolute else bottom + k
         pos = self.pos
-        moves: list[tuple[float, float, float, bool]] = []
-        # The level the tool crosses to the hole at (and G98 retracts to): where the tool is, but
-        # not below R (G99) or the series' start level (G98); a series that started below R goes
-        # up to R first.  rs274ngc as LinuxCNC 2.9 runs it, found by probing it (test_cycles.py).
-        level = self.cycle_il
-        if level < r:
-            moves.append((pos[first], pos[second], r, True))
-            level = r
-        else:
-            level = max(pos[normal], r if self.retract_to_r else level)
-        clear = r if self.retract_to_r else level
+        moves, level, clear = approach((pos[first], pos[second], pos[normal]), self.cycle_il, r, self.retract_to_r)
         rapid_delta = RAPID_DELTA_INCH if self.inch else RAPID_DELTA_INCH * MM_PER_INCH
         polar = not self.absolute and ("@" in words or "^" in words)
         for _ in range(repeats):
@@ -1309,7 +1313,17 @@ class Interpreter:
             else:
                 moves += hole(motion, aa, bb, r, clear, bottom, peck, rapid_delta)
             level = clear
-        return tuple(self._fixed_line(block, (first, second, normal), move) for move in moves)
+        lines = tuple(self._fixed_line(block, (first, second, normal), move) for move in moves)
+        # a hole apply_error_map compensates: one hole in G17 and G90 (polar words written as X Y), the
+        # series' holes all such
+        self.cycle_holes = (previous not in CANNED or self.cycle_holes) and (
+            self.plane == 17 and self.absolute and repeats == 1 and motion != 87.0
+        )
+        if self.cycle_holes:
+            drilled = Hole(motion, aa, bb, bottom, r, peck, rapid_delta, self.retract_to_r, previous not in CANNED)
+            for line in lines:
+                line.fixed, line.hole = HOLE, drilled
+        return lines
 
     def _cycle_geometry(self, block: Block, words: dict, again: bool, item) -> tuple[float, ...]:
         """(aa, bb, their step per repeat, R, bottom) of a cycle in plane coordinates; keeps the

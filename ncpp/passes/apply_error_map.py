@@ -16,7 +16,7 @@ start is compensated with its own direction and a step move is inserted.
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, fields, replace
 from itertools import chain
 from typing import overload
@@ -25,7 +25,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ncpp.errors import Location, NcppError
-from ncpp.motion.segments import CYCLE, Arc, Event, Line, Pass, Setting
+from ncpp.motion import cycles
+from ncpp.motion.segments import CYCLE, HOLE, Arc, Event, Hole, Line, Pass, Setting
 from ncpp.passes.context import PassContext, deviation
 from ncpp.passes.geometry import (
     any3,
@@ -40,7 +41,7 @@ from ncpp.passes.geometry import (
     tuples,
 )
 from ncpp.passes.travel import Travel, grid, hold, quantize, steps
-from ncpp.program.blocks import Word
+from ncpp.program.blocks import Block, Word
 
 # Compensations per line at most: each changes a direction only where a
 # correction of the previous round flipped a µm motion; two rounds settle almost all.
@@ -60,8 +61,9 @@ def apply_error_map(events: Iterable[Event], ctx: PassContext) -> Iterator[Event
 def _chunks(events: Iterable[Event], ctx: PassContext) -> Iterator[list[Event]]:
     """The compensated events, a list per chunk."""
     solve = Solve(ctx)
+    holes = _Holes(ctx)
     last = None  # the last segment written: its compensated end, in its own program frame
-    for chunk, segs, rows in _rowed(line_chunks(events), ctx.directional, last):
+    for chunk, segs, rows in _rowed(_drilled(line_chunks(events), holes, solve, lambda: last), ctx.directional, last):
         if rows is None:  # no segments
             yield _placed(chunk, last)
             continue
@@ -75,6 +77,82 @@ def _chunks(events: Iterable[Event], ctx: PassContext) -> Iterator[list[Event]]:
         out = _written(chunk, segs, rows, solved, last)
         last = _ended(segs[-1], solved.end[-1])  # (a carried row's end is not its event's: `_carry`)
         yield out
+
+
+def _drilled(chunks: Iterable[list[Event]], holes: _Holes, solve: Solve, last: Callable[[], Line | Arc | None]) -> Iterator[list[Event]]:  # fmt: skip
+    """The chunks, each compensated cycle block's moves cut out as a chunk of their own and
+    written again from the corrected hole (`_Holes`): from where the output stands then (`last`,
+    asked when the chunk is taken, after the chunks before it are solved), holding `solve`'s directions."""
+    for chunk in chunks:
+        if not any(type(e) is Line and e.fixed == HOLE for e in chunk):
+            yield chunk
+            continue
+        for piece, block in _at_holes(chunk):
+            yield piece if block is None else holes.drilled(piece, last(), solve.travel.held)
+
+
+def _at_holes(chunk: list[Event]) -> Iterator[tuple[list[Event], Block | None]]:
+    """The chunk cut before and after the moves of each compensated cycle block, with that
+    block (None: a piece of other events)."""
+    piece: list[Event] = []
+    block = None
+    for event in chunk:
+        here = event.block if type(event) is Line and event.fixed == HOLE else None
+        if here is not block and piece:
+            yield piece, block
+            piece = []
+        block = here
+        piece.append(event)
+    if piece:
+        yield piece, block
+
+
+class _Holes:
+    """Compensated canned cycles (`Line.hole`): each block's X Y and Z corrected at the hole's bottom, its R at
+    the R point above the hole, its moves as the control runs them from those words (`cycles.drilled`)."""
+
+    def __init__(self, ctx: PassContext):
+        self.ctx = ctx
+        self.block: Block | None = None  # the last block written again (its moves may span two chunks)
+        self.start_level = 0.0  # Z where the G98 series under way started, as the control stands there
+
+    def drilled(self, moves: list[Event], last: Line | Arc | None, held: NDArray) -> list[Event]:
+        """The block's moves (`moves`, Lines of one block) from the corrected words, starting
+        where the output stands (`last`'s end; None: nothing was compensated, the programmed start)."""
+        first = moves[0]
+        assert type(first) is Line and first.hole is not None  # (`_at_holes`)
+        if first.block is self.block:  # the rest of a block cut by a chunk's end: written already
+            return []
+        self.block, hole = first.block, first.hole
+        at = first.start if last is None else _end_in_frame_of(last, first)
+        if hole.series_start:
+            self.start_level = at[2]
+        offsets, scales, tools = frames([first, first])
+        wanted = np.array([[hole.x, hole.y, hole.bottom], [hole.x, hole.y, hole.r]])
+        direction = _hole_directions(moves, hole, held) if self.ctx.directional else None
+        lines = np.full(2, first.block.line)
+        (x, y, z), (_, _, r) = compensate(wanted, offsets, scales, lines, self.ctx, direction, tools).tolist()
+        corrected = replace(hole, command=(x, y, z, r))
+        out: list[Event] = []
+        start = tuple(at)
+        # (not `changed`: that marks the pieces replace_arcs made, which the solve moves; the writer
+        # tells a written hole by its `command`)
+        for end in cycles.drilled(hole.motion, start, self.start_level, x, y, r, z, hole.peck, hole.rapid_delta,
+                                  hole.retract_to_r):  # fmt: skip
+            out.append(replace(first, start=start, end=end[:3], rapid=end[3], hole=corrected))
+            start = end[:3]
+        return out
+
+
+def _hole_directions(moves: list[Event], hole: Hole, held: NDArray) -> NDArray:
+    """(2,3) the directions the hole's bottom and its R point are reached in: X and Y as the
+    rapid to the hole moves them, Z down to the bottom, and to R as the move that reaches it
+    (an axis that stands holds the direction it had)."""
+    start = moves[0].start  # type: ignore[union-attr]
+    reach_r = next(m for m in moves if m.end == (hole.x, hole.y, hole.r))  # type: ignore[union-attr]
+    toward = np.sign([hole.x - start[0], hole.y - start[1], hole.r - reach_r.start[2]])  # type: ignore[union-attr]
+    toward = np.where(toward != 0, toward, held)
+    return np.array([[toward[0], toward[1], -1.0], toward])
 
 
 def _warn_at_travel_ends(segs: list, rows: _Rows, solved: _Solved, ctx: PassContext) -> None:
@@ -152,6 +230,8 @@ def _rows(segs: list, directional: bool, fixed_before: bool = True) -> _Rows:
     line = (kind & 3) == 0
     free = line & ~changed
     kept = _kept_axes(segs, kind)
+    # (not after a compensated hole: that is in the cycle's series, whose modal cycle and start level
+    # a step there would end)
     fixed = (kind & 2) != 0
     lead_in = ((kind & 32) != 0) & ~np.concatenate([[fixed_before], fixed[:-1]])
     return _Rows(

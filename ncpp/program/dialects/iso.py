@@ -16,7 +16,7 @@ from collections.abc import Iterable, Iterator
 from dataclasses import replace
 from operator import itemgetter
 
-from ncpp.motion.segments import EXTRA_AXES, Arc, Context, Event, Line, Pass, Setting
+from ncpp.motion.segments import CYCLE, EXTRA_AXES, Arc, Context, Event, Line, Pass, Setting
 from ncpp.passes.rotary import time_shares, turns
 from ncpp.program.blocks import DIGITS_AS_ONE, Block, Comment, ExprWord, Statement, Word
 from ncpp.program.numbers import NumberStyle, format_number
@@ -153,18 +153,19 @@ class IsoWriter:
             return [self._setting_text(block, first.setting) + block.eol]
         motion = [e for e in group if type(e) is Line or type(e) is Arc]
         lead = 0  # steps to a canned cycle's start (`apply_error_map._lead_in`): new blocks before it
-        while lead < len(motion) and motion[lead].fixed and motion[lead].changed:
+        while lead < len(motion) and motion[lead].fixed == CYCLE and motion[lead].changed:
             lead += 1
         lines = self._new_blocks(block, motion[:lead], block.eol) if lead else []
         motion = motion[lead:] if lead else motion
+        drilled = motion and type(motion[0]) is Line and motion[0].hole is not None and motion[0].hole.command is not None
         for segment in motion:
             if segment.changed:
                 break
-        else:  # nothing changed
+        else:  # nothing changed, or a compensated cycle's words only
             self._learn_program_motion(block, motion)
             if self._needs_mode_restore(block):
                 lines.append(self._restore_mode_line(block))
-            lines.append(block.text)
+            lines.append(self._hole_text(block, motion[0]) if drilled else block.text)  # type: ignore[arg-type]
             self._after_verbatim(block, motion)
             return lines
         if not facts.plain:
@@ -364,6 +365,15 @@ class IsoWriter:
             # a canned cycle, a loop or a subroutine: where it leaves the tool is the control's (G98
             # retracts to the compensated level it started from), so the next block writes every axis it knows
             self._last_end = None
+
+    def _hole_text(self, block: Block, move: Line) -> str:
+        """A compensated canned cycle's block with its corrected X Y Z R, each written: every hole
+        has a correction of its own, so none may be left to the previous block's sticky value.  Polar
+        words (`@` `^`) give way to the X Y they put the hole at."""
+        assert move.hole is not None and move.hole.command is not None  # (apply_error_map's)
+        texts = {letter: format_number(value, self._style(letter, move)) for letter, value in zip("XYZR", move.hole.command)}  # fmt: skip
+        return set_words(_literal_geometry(block, GEOMETRY_LETTERS + "@^"), texts, drop="@^",
+                         spelled=self._spelling(block)) + block.eol  # fmt: skip
 
     # -- o-word control lines ---------------------------------------------------
     def _write_control(self, block: Block, first: Event) -> list[str]:

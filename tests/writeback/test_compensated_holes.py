@@ -1,0 +1,119 @@
+"""Canned cycles in G90 and G17 are compensated hole by hole: the control's tool lands on each
+hole's programmed bottom (X Y Z) and R plane.  Judged by LinuxCNC's rs274 running ncpp's output,
+its moves mapped through a machine written here by hand (scale errors on X Y Z, squareness of
+X-Y and X-Z), not by ncpp's interpreter or model."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from tests.compensation.accuracy import _moves, actual_moves
+from tests.writeback.conftest import compensate_file, machine_file
+
+MACHINE = machine_file(
+    "scales and squareness",
+    """
+[errors.EXX]
+kind = "polynomial"
+coefficients_um = [0.0, 0.05]
+[errors.EYY]
+kind = "polynomial"
+coefficients_um = [0.0, -0.04]
+[errors.EZZ]
+kind = "polynomial"
+coefficients_um = [0.0, 0.03]
+[squareness]
+C0Y_urad = 30.0
+B0Z_urad = 40.0
+""",
+)
+
+
+def machine(points: np.ndarray, _directions: np.ndarray) -> np.ndarray:
+    """Where the tool is for commanded points, mm: X scale 50 µm/m, Y scale -40 µm/m, Z scale
+    30 µm/m; Y motion carries X by -30 µm/m (C0Y), Z motion carries X by +40 µm/m (B0Z)."""
+    x, y, z = points[:, 0], points[:, 1], points[:, 2]
+    return points + np.column_stack([0.05 * x - 0.03 * y + 0.04 * z, -0.04 * y, 0.03 * z]) / 1000
+
+
+# (X, Y, Z bottom, R) of each hole, in the order the program drills them
+HOLES = [
+    (100, 120, -16, 3), (30, 40, -16, 3), (150, -50, -20, 5), (-80, 60, -20, 5),
+    (200, 10, -5, 2), (210, 10, -7.5, 2.5), (220, 100, -9, 1), (230, 110, -3, 1), (240, 120, -3, 1),
+    (250, 130, -4, 1.5), (-250, -130, -4, 1.5), (-200, 300, -6, 2), (-190, 300, -3, 1),
+    (300 * 0.5**0.5, 300 * 0.5**0.5, -3, 1),
+]  # fmt: skip
+PROGRAM = """G21 G90 G17
+G0 X40 Y30 Z25
+G1 X45 Y35 F300
+G0 Z25
+G99 G81 X100 Y120 R3 Z-16 F100
+X30 Y40
+G98 G83 X150 Y-50 R5 Z-20 Q4
+X-80 Y60
+G80
+G0 X0 Y0
+G99 G82 X200 Y10 R2 Z-5 P0.5
+G85 X210 R2.5 Z-7.5
+G73 X220 Y100 Z-9 R1 Q2.5
+M3 S500
+G86 X230 Y110 Z-3 R1 P1
+G89 X240 Y120 Z-3 R1 P1
+G84 X250 Y130 Z-4 R1.5
+M4
+G74 X-250 Y-130 R1.5 Z-4
+G80
+G1 X-190 Y290 Z4 F400
+G98 G81 X-200 Y300 R2 Z-6
+G99 X-190 Z-3 R1
+@300 ^45
+G80
+M5
+M2
+"""
+
+
+def drilled(path: Path, mapped: bool) -> list[tuple[np.ndarray, float]]:
+    """Per hole of `path` as rs274 runs it (mapped through `machine`, or as commanded): where
+    the tool is at its bottom, and its Z where it arrives above the hole at R.  A hole: a run
+    of moves ending at one commanded X Y with a feed down Z; its R point the end of the move
+    before its first feed, its bottom the lowest feed end."""
+    commanded = _moves(path)
+    actual = [m[-1] for m in actual_moves(path, machine)] if mapped else [b for _, b, _ in commanded]
+    runs: list[list[int]] = []
+    for k, (_, end, _) in enumerate(commanded):
+        if runs and np.allclose(commanded[runs[-1][0]][1][:2], end[:2], atol=1e-9):
+            runs[-1].append(k)
+        else:
+            runs.append([k])
+    out = []
+    for run in runs:
+        plunges = [k for k in run if commanded[k][2] and _plunges(*commanded[k][:2])]
+        if plunges:
+            lowest = min(plunges, key=lambda k: commanded[k][1][2])
+            out.append((actual[lowest], float(actual[plunges[0] - 1][2])))
+    return out
+
+
+def _plunges(start: np.ndarray, end: np.ndarray) -> bool:
+    return bool(np.allclose(start[:2], end[:2], atol=1e-9) and end[2] < start[2])
+
+
+def test_each_hole_bottom_and_r_plane_land_where_programmed(tmp_path):
+    original = tmp_path / "holes.ngc"
+    original.write_text(PROGRAM)
+    output = compensate_file(original, MACHINE, tmp_path)
+    wanted = np.array(HOLES, dtype=float)
+    assert np.allclose([tuple(b) + (r,) for b, r in drilled(original, mapped=False)], wanted, atol=1e-6)
+    before = drilled(original, mapped=True)
+    after = drilled(output, mapped=True)
+    assert len(after) == len(HOLES)
+    off_before = np.array([np.linalg.norm(b - h[:3]) for (b, _), h in zip(before, wanted)]) * 1000
+    off_after = np.array([np.linalg.norm(b - h[:3]) for (b, _), h in zip(after, wanted)]) * 1000
+    r_after = np.array([abs(r - h[3]) for (_, r), h in zip(after, wanted)]) * 1000
+    assert off_before.min() > 1.5  # the machine is wrong enough to tell, at every hole
+    assert off_after.max() <= 0.5, off_after
+    assert r_after.max() <= 0.5, r_after
