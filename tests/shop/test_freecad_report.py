@@ -52,7 +52,7 @@ def test_the_summary_and_warnings_reach_the_report_view_with_the_posted_line(plu
     assert (
         len(messages) == 1
         and "compensated 3 moves" in messages[0]
-        and "4 moves of canned cycles (line 4)" in messages[0]
+        and "8 moves of canned cycles (line 4)" in messages[0]
     )
 
 
