@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tests.compensation.accuracy import _moves, actual_moves
+from tests.compensation.accuracy import Machine, _moves, actual_moves
 from tests.writeback.conftest import compensate_file, machine_file
 
 MACHINE = machine_file(
@@ -32,11 +32,36 @@ B0Z_urad = 40.0
 )
 
 
-def machine(points: np.ndarray, _directions: np.ndarray) -> np.ndarray:
+def square(points: np.ndarray, _directions: np.ndarray) -> np.ndarray:
     """Where the tool is for commanded points, mm: X scale 50 µm/m, Y scale -40 µm/m, Z scale
     30 µm/m; Y motion carries X by -30 µm/m (C0Y), Z motion carries X by +40 µm/m (B0Z)."""
     x, y, z = points[:, 0], points[:, 1], points[:, 2]
     return points + np.column_stack([0.05 * x - 0.03 * y + 0.04 * z, -0.04 * y, 0.03 * z]) / 1000
+
+
+REVERSAL = machine_file(
+    "reversals of X and Z",
+    """
+[errors.EXX]
+kind = "table"
+positions = [-1000.0, 1000.0]
+values_um = [-10.0, 10.0]
+values_um_minus = [-7.0, 13.0]
+[errors.EZZ]
+kind = "table"
+positions = [-1000.0, 1000.0]
+values_um = [-20.0, 20.0]
+values_um_minus = [-18.0, 22.0]
+""",
+)
+
+
+def reversing(points: np.ndarray, directions: np.ndarray) -> np.ndarray:
+    """X off by 0.01 µm/mm · x, 3 µm more travelling −; Z by 0.02 µm/mm · z, 2 µm more travelling −."""
+    x, z = points[:, 0], points[:, 2]
+    dx = 0.01 * x + (3.0 if directions[0] < 0 else 0.0)
+    dz = 0.02 * z + (2.0 if directions[2] < 0 else 0.0)
+    return points + np.column_stack([dx, 0 * x, dz]) / 1000
 
 
 # (X, Y, Z bottom, R) of each hole, in the order the program drills them
@@ -76,13 +101,13 @@ M2
 """
 
 
-def drilled(path: Path, mapped: bool) -> list[tuple[np.ndarray, float]]:
-    """Per hole of `path` as rs274 runs it (mapped through `machine`, or as commanded): where
+def drilled(path: Path, machine: Machine | None) -> list[tuple[np.ndarray, float]]:
+    """Per hole of `path` as rs274 runs it (mapped through `machine`, or as commanded: None): where
     the tool is at its bottom, and its Z where it arrives above the hole at R.  A hole: a run
     of moves ending at one commanded X Y with a feed down Z; its R point the end of the move
     before its first feed, its bottom the lowest feed end."""
     commanded = _moves(path)
-    actual = [m[-1] for m in actual_moves(path, machine)] if mapped else [b for _, b, _ in commanded]
+    actual = [b for _, b, _ in commanded] if machine is None else [m[-1] for m in actual_moves(path, machine)]
     runs: list[list[int]] = []
     for k, (_, end, _) in enumerate(commanded):
         if runs and np.allclose(commanded[runs[-1][0]][1][:2], end[:2], atol=1e-9):
@@ -102,14 +127,16 @@ def _plunges(start: np.ndarray, end: np.ndarray) -> bool:
     return bool(np.allclose(start[:2], end[:2], atol=1e-9) and end[2] < start[2])
 
 
-def test_each_hole_bottom_and_r_plane_land_where_programmed(tmp_path):
+@pytest.mark.parametrize("machine_toml, machine", [(MACHINE, square), (REVERSAL, reversing)],
+                         ids=["scales and squareness", "reversals"])  # fmt: skip
+def test_each_hole_bottom_and_r_plane_land_where_programmed(tmp_path, machine_toml, machine):
     original = tmp_path / "holes.ngc"
     original.write_text(PROGRAM)
-    output = compensate_file(original, MACHINE, tmp_path)
+    output = compensate_file(original, machine_toml, tmp_path)
     wanted = np.array(HOLES, dtype=float)
-    assert np.allclose([tuple(b) + (r,) for b, r in drilled(original, mapped=False)], wanted, atol=1e-6)
-    before = drilled(original, mapped=True)
-    after = drilled(output, mapped=True)
+    assert np.allclose([tuple(b) + (r,) for b, r in drilled(original, None)], wanted, atol=1e-6)
+    before = drilled(original, machine)
+    after = drilled(output, machine)
     assert len(after) == len(HOLES)
     off_before = np.array([np.linalg.norm(b - h[:3]) for (b, _), h in zip(before, wanted)]) * 1000
     off_after = np.array([np.linalg.norm(b - h[:3]) for (b, _), h in zip(after, wanted)]) * 1000
