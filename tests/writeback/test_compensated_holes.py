@@ -5,12 +5,16 @@ X-Y and X-Z), not by ncpp's interpreter or model."""
 
 from __future__ import annotations
 
+import os
+import re
+import subprocess
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from tests.compensation.accuracy import Machine, _moves, actual_moves
+from tests.compensation.accuracy import Machine, _moves, actual_moves, rs274_calls
+from tests.conftest import RS274
 from tests.writeback.conftest import compensate_file, machine_file
 
 MACHINE = machine_file(
@@ -144,3 +148,28 @@ def test_each_hole_bottom_and_r_plane_land_where_programmed(tmp_path, machine_to
     assert off_before.min() > 1.5  # the machine is wrong enough to tell, at every hole
     assert off_after.max() <= 0.5, off_after
     assert r_after.max() <= 0.5, r_after
+
+
+def _rs274_text(path: Path) -> str:
+    if not RS274.exists():
+        pytest.skip("rs274 oracle not available")
+    proc = subprocess.run([str(RS274), str(path)], capture_output=True, text=True, timeout=120,
+                          env={**os.environ, "RS274_DIGITS": "7"}, stdin=subprocess.DEVNULL)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    return proc.stdout
+
+
+def test_a_g92_after_a_compensated_hole_sets_the_programs_offset(tmp_path):
+    """After a compensated hole the control stands at the corrected point, which ncpp knows: a G92
+    there is written moved by it, so the control sets the offset the program means, and the moves
+    after it land where the program puts them."""
+    original = tmp_path / "g92.ngc"
+    original.write_text("G21 G90 G54\nG0 X10 Y10 Z20\nG1 X50 F300\nG98 G81 X20 Y30 Z-2 R2 F100\nG80\n"
+                        "G92 X0 Y0\nG1 X20 Y10\nX-5 Y40 Z3\nG92.1\nM2\n")  # fmt: skip
+    output = compensate_file(original, MACHINE, tmp_path)
+    offsets = [re.findall(r"SET_G92_OFFSET\(([^)]*)\)", _rs274_text(p)) for p in (original, output)]
+    assert offsets[0] == offsets[1] and "20.0000000, 30.0000000" in offsets[0][1]
+    shift = np.array([20.0, 30.0, 0.0])
+    wanted = np.array([[20, 10, 20], [-5, 40, 3]], dtype=float) + shift
+    got = np.array([args[:3] for name, args in rs274_calls(output) if name == "STRAIGHT_FEED"][-2:]) + shift
+    assert np.abs(square(got, np.ones(3)) - wanted).max() * 1000 <= 0.5
