@@ -1298,7 +1298,9 @@ class Interpreter:
             i, j, k = self._back_bore_words(block, words, again, item)
             middle = k if self.absolute else bottom + k
         pos = self.pos
-        moves, level, clear = approach((pos[first], pos[second], pos[normal]), self.cycle_il, r, self.retract_to_r)
+        moves, level, clear = approach(
+            (pos[first], pos[second], pos[normal]), self.cycle_il, r, self.retract_to_r
+        )
         rapid_delta = RAPID_DELTA_INCH if self.inch else RAPID_DELTA_INCH * MM_PER_INCH
         polar = not self.absolute and ("@" in words or "^" in words)
         for _ in range(repeats):
@@ -1320,7 +1322,9 @@ class Interpreter:
             self.plane == 17 and self.absolute and repeats == 1 and motion != 87.0
         )
         if self.cycle_holes:
-            drilled = Hole(motion, aa, bb, bottom, r, peck, rapid_delta, self.retract_to_r, previous not in CANNED)
+            drilled = Hole(
+                motion, aa, bb, bottom, r, peck, rapid_delta, self.retract_to_r, previous not in CANNED
+            )
             for line in lines:
                 line.fixed, line.hole = HOLE, drilled
         return lines

@@ -124,7 +124,8 @@ class Line:
     extra_start: tuple[
         float, ...
     ] = ()  # start positions of A B C U V W (as `extra`), when the program uses them
-    hole: Hole | None = None  # a compensated canned cycle's hole (`fixed` HOLE), the same for its block's moves
+    # a compensated canned cycle's hole (`fixed` HOLE), the same for its block's moves
+    hole: Hole | None = None
 
     def length(self) -> float:
         return math.dist(self.start, self.end)

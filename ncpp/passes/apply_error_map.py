@@ -16,7 +16,7 @@ start is compensated with its own direction and a step move is inserted.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, fields, replace
 from itertools import chain
 from typing import overload
@@ -63,7 +63,7 @@ def _chunks(events: Iterable[Event], ctx: PassContext) -> Iterator[list[Event]]:
     solve = Solve(ctx)
     holes = _Holes(ctx)
     last = None  # the last segment written: its compensated end, in its own program frame
-    for chunk, segs, rows in _rowed(_drilled(line_chunks(events), holes, solve, lambda: last), ctx.directional, last):
+    for chunk, segs, rows in _rowed(_drilled(line_chunks(events), holes, solve), ctx.directional, last):
         if rows is None:  # no segments
             yield _placed(chunk, last)
             continue
@@ -75,20 +75,22 @@ def _chunks(events: Iterable[Event], ctx: PassContext) -> Iterator[list[Event]]:
         if solved.at_end.any():
             _warn_at_travel_ends(segs, rows, solved, ctx)
         out = _written(chunk, segs, rows, solved, last)
-        last = _ended(segs[-1], solved.end[-1])  # (a carried row's end is not its event's: `_carry`)
+        # (a carried row's end is not its event's: `_carry`)
+        last = holes.last = _ended(segs[-1], solved.end[-1])
         yield out
 
 
-def _drilled(chunks: Iterable[list[Event]], holes: _Holes, solve: Solve, last: Callable[[], Line | Arc | None]) -> Iterator[list[Event]]:  # fmt: skip
+def _drilled(chunks: Iterable[list[Event]], holes: _Holes, solve: Solve) -> Iterator[list[Event]]:
     """The chunks, each compensated cycle block's moves cut out as a chunk of their own and
-    written again from the corrected hole (`_Holes`): from where the output stands then (`last`,
-    asked when the chunk is taken, after the chunks before it are solved), holding `solve`'s directions."""
+    written again from the corrected hole (`_Holes`): from where the output stands then
+    (`holes.last`, read when the chunk is taken, after the chunks before it are solved), holding
+    `solve`'s directions."""
     for chunk in chunks:
         if not any(type(e) is Line and e.fixed == HOLE for e in chunk):
             yield chunk
             continue
         for piece, block in _at_holes(chunk):
-            yield piece if block is None else holes.drilled(piece, last(), solve.travel.held)
+            yield piece if block is None else holes.drilled(piece, solve.travel.held)
 
 
 def _at_holes(chunk: list[Event]) -> Iterator[tuple[list[Event], Block | None]]:
@@ -115,10 +117,12 @@ class _Holes:
         self.ctx = ctx
         self.block: Block | None = None  # the last block written again (its moves may span two chunks)
         self.start_level = 0.0  # Z where the G98 series under way started, as the control stands there
+        self.last: Line | None = None  # the last segment written, with its compensated end (`_chunks` tells)
 
-    def drilled(self, moves: list[Event], last: Line | Arc | None, held: NDArray) -> list[Event]:
+    def drilled(self, moves: list[Event], held: NDArray) -> list[Event]:
         """The block's moves (`moves`, Lines of one block) from the corrected words, starting
         where the output stands (`last`'s end; None: nothing was compensated, the programmed start)."""
+        last = self.last
         first = moves[0]
         assert type(first) is Line and first.hole is not None  # (`_at_holes`)
         if first.block is self.block:  # the rest of a block cut by a chunk's end: written already

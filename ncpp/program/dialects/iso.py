@@ -157,7 +157,8 @@ class IsoWriter:
             lead += 1
         lines = self._new_blocks(block, motion[:lead], block.eol) if lead else []
         motion = motion[lead:] if lead else motion
-        drilled = motion and type(motion[0]) is Line and motion[0].hole is not None and motion[0].hole.command is not None
+        hole = motion[0].hole if motion and type(motion[0]) is Line else None
+        drilled = hole is not None and hole.command is not None  # a compensated cycle: its words change
         for segment in motion:
             if segment.changed:
                 break
