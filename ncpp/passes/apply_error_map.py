@@ -131,11 +131,7 @@ class _Holes:
         at = first.start if last is None else _end_in_frame_of(last, first)
         if hole.series_start:
             self.start_level = at[2]
-        offsets, scales, tools = frames([first, first])
-        wanted = np.array([[hole.x, hole.y, hole.bottom], [hole.x, hole.y, hole.r]])
-        direction = _hole_directions(moves, hole, held) if self.ctx.directional else None
-        lines = np.full(2, first.block.line)
-        (x, y, z), (_, _, r) = compensate(wanted, offsets, scales, lines, self.ctx, direction, tools).tolist()
+        (x, y, z), (_, _, r) = self._commands(moves, hole, at, held).tolist()
         corrected = replace(hole, command=(x, y, z, r))
         out: list[Event] = []
         start = tuple(at)
@@ -146,6 +142,32 @@ class _Holes:
             out.append(replace(first, start=start, end=end[:3], rapid=end[3], hole=corrected))
             start = end[:3]
         return out
+
+
+    def _commands(self, moves: list[Event], hole: Hole, at: tuple, held: NDArray) -> NDArray:
+        """(2,3) the commands for the hole's bottom and its R point (one X Y for both: the bottom's),
+        the control standing at `at`.  With reversal errors, X or Y that the corrections alone move
+        (the program keeps it) may go against the direction it holds: by a rounding step or so it
+        stays where it is rather than reverse, by more it reverses and is compensated so."""
+        first = moves[0]
+        offsets, scales, tools = frames([first, first])  # type: ignore[list-item]
+        wanted = np.array([[hole.x, hole.y, hole.bottom], [hole.x, hole.y, hole.r]])
+        lines = np.full(2, first.block.line)
+        if not self.ctx.directional:
+            return compensate(wanted, offsets, scales, lines, self.ctx, None, tools)
+        direction = _hole_directions(moves, hole, held)
+        command = compensate(wanted, offsets, scales, lines, self.ctx, direction, tools)
+        gap = command[0, :2] - np.array(at[:2])
+        against = gap * direction[0, :2] < 0
+        if not against.any():
+            return command
+        stay = against & (np.abs(gap) <= _snap_limit(grid(self.ctx, scales[:1]), scales[:1]))
+        turn = against & ~stay
+        if turn.any():
+            direction[:, :2] = np.where(turn, -direction[:, :2], direction[:, :2])
+            command = compensate(wanted, offsets, scales, lines, self.ctx, direction, tools)
+        command[:, :2] = np.where(stay, np.array(at[:2]), command[0, :2])
+        return command
 
 
 def _hole_directions(moves: list[Event], hole: Hole, held: NDArray) -> NDArray:

@@ -50,20 +50,23 @@ REVERSAL = machine_file(
 kind = "table"
 positions = [-1000.0, 1000.0]
 values_um = [-10.0, 10.0]
-values_um_minus = [-7.0, 13.0]
+values_um_minus = [-13.0, 7.0]
 [errors.EZZ]
 kind = "table"
 positions = [-1000.0, 1000.0]
 values_um = [-20.0, 20.0]
 values_um_minus = [-18.0, 22.0]
+[squareness]
+C0Y_urad = 30.0
 """,
 )
 
 
 def reversing(points: np.ndarray, directions: np.ndarray) -> np.ndarray:
-    """X off by 0.01 µm/mm · x, 3 µm more travelling −; Z by 0.02 µm/mm · z, 2 µm more travelling −."""
-    x, z = points[:, 0], points[:, 2]
-    dx = 0.01 * x + (3.0 if directions[0] < 0 else 0.0)
+    """X off by 0.01 µm/mm · x, 3 µm less travelling − (it runs ahead on reversal), and -30 µm/m · y
+    (C0Y); Z by 0.02 µm/mm · z, 2 µm more travelling − (lost motion)."""
+    x, y, z = points[:, 0], points[:, 1], points[:, 2]
+    dx = 0.01 * x - 0.03 * y - (3.0 if directions[0] < 0 else 0.0)
     dz = 0.02 * z + (2.0 if directions[2] < 0 else 0.0)
     return points + np.column_stack([dx, 0 * x, dz]) / 1000
 
@@ -72,7 +75,7 @@ def reversing(points: np.ndarray, directions: np.ndarray) -> np.ndarray:
 HOLES = [
     (100, 120, -16, 3), (30, 40, -16, 3), (150, -50, -20, 5), (-80, 60, -20, 5),
     (200, 10, -5, 2), (210, 10, -7.5, 2.5), (220, 100, -9, 1), (230, 110, -3, 1), (240, 120, -3, 1),
-    (250, 130, -4, 1.5), (-250, -130, -4, 1.5), (-200, 300, -6, 2), (-190, 300, -3, 1),
+    (250, 130, -4, 1.5), (-250, -130, -4, 1.5), (-200, 300, -6, 2), (-190, 300, -3, 1), (-190, -250, -3, 1),
     (300 * 0.5**0.5, 300 * 0.5**0.5, -3, 1),
 ]  # fmt: skip
 PROGRAM = """G21 G90 G17
@@ -98,6 +101,7 @@ G80
 G1 X-190 Y290 Z4 F400
 G98 G81 X-200 Y300 R2 Z-6
 G99 X-190 Z-3 R1
+Y-250
 @300 ^45
 G80
 M5
