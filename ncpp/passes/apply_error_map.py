@@ -143,7 +143,6 @@ class _Holes:
             start = end[:3]
         return out
 
-
     def _commands(self, moves: list[Event], hole: Hole, at: tuple, held: NDArray) -> NDArray:
         """(2,3) the commands for the hole's bottom and its R point (one X Y for both: the bottom's),
         the control standing at `at`.  With reversal errors, X or Y that the corrections alone move
