@@ -375,6 +375,7 @@ def process(
     offsets: WorkOffsets | None = None,
     verify: bool = True,
     guard: Placement | None = None,
+    expand_cycles: bool = False,
 ) -> Stats:
     """Read, interpret, compensate (when `source` is given) and write one program.
 
@@ -382,6 +383,7 @@ def process(
     it picks the interpreter and the writer (DIALECT_TOOLS).  `offsets`: the zeros
     the control holds (machine mm; none: the program zero is the machine zero),
     which place the program on the machine whose errors are compensated.
+    `expand_cycles`: an ISO program's canned cycles are written as G0/G1 blocks (and G4 dwells).
 
     A compensated program is verified as it is written (`ncpp/verify.py`): read back
     and compared with the interpreter's reading of the input; where they part an
@@ -405,7 +407,10 @@ def process(
     if FAMILY[name] != "iso":  # the ISO interpreter places every work offset and tool length
         blocks = warn_unplaced(blocks, warnings, file)
     offsets = offsets or AT_MACHINE_ZERO  # the control's zeros place the program on the machine
-    events: Iterable[Event] = interpret(blocks, file=file, warnings=warnings, strict=strict, offsets=offsets)
+    expanding = {"expand_cycles": True} if expand_cycles and name == "iso" else {}  # (the others have none)
+    events: Iterable[Event] = interpret(
+        blocks, file=file, warnings=warnings, strict=strict, offsets=offsets, **expanding
+    )
     if verify:
         events, original = tee(events)
     events = warn_fixed(events, warnings, file)  # cycles, loops, subroutines (ISO), cutter compensation

@@ -69,6 +69,13 @@ from ncpp.motion.tools import UntoldLengths
 from ncpp.program.blocks import STRAY_TAPE, UNREADABLE, Block, Comment, ExprWord, Statement, Word
 
 MM_PER_INCH = 25.4
+# Cycles --expand-cycles refuses: what G0/G1 blocks cannot do
+UNEXPANDED = {
+    74.0: "tapping: the spindle reverses at the bottom, in step with the feed",
+    84.0: "tapping: the spindle reverses at the bottom, in step with the feed",
+    86.0: "the spindle stops at the bottom",
+    87.0: "back boring: the spindle stops and orients",
+}
 AXES = "XYZABCUVW"
 AXIS_INDEX = {letter: i for i, letter in enumerate(AXES)}
 LINEAR = (0, 1, 2, 6, 7, 8)  # axes that change with G20/G21 (not the rotary A B C)
@@ -173,6 +180,7 @@ def interpret(
     warnings: Warnings | None = None,
     strict: bool = False,
     offsets: WorkOffsets | None = None,
+    expand_cycles: bool = False,
 ) -> Iterator[Event]:
     """Motion events of a program's blocks, lazily (see the module docstring).
 
@@ -185,8 +193,12 @@ def interpret(
     LinuxCNC would refuse.  Out-of-scope constructs warn once through
     `warnings` (stderr by default) and end interpretation; with `strict`
     (or a strict `warnings`) they raise NcppError instead.
+
+    `expand_cycles`: a canned cycle's block is to be written as its moves (`expanded`).
     """
-    return run(Interpreter(file, offsets), blocks, warnings, strict)
+    interpreter = Interpreter(file, offsets)
+    interpreter.expand_cycles = expand_cycles
+    return run(interpreter, blocks, warnings, strict)
 
 
 def run(
@@ -229,6 +241,8 @@ class Interpreter:
         self.cycle_ijk = (0.0, 0.0, 0.0)  # G87's sticky I J K
         self.cycle_last_r = 0.0  # the R plane of the series' last cycle
         self.cycle_holes = False  # the series' cycles are compensated hole by hole (`Hole`)
+        self.cycle_p = 0.0  # G82 G89's dwell, seconds (sticky within the cycle)
+        self.expand_cycles = False  # cycles are written as their moves (`expanded`)
         self.spindle = 0  # M3 1, M4 -1, stopped 0 (tapping and boring cycles check it)
         self.coord_system = 1
         self.g5x = [[0.0] * 9 for _ in range(10)]  # index 1..9: G54..G59.3
@@ -375,7 +389,7 @@ class Interpreter:
                 if ev.setting is not None:  # set from where each run of the text stands: no one shift
                     raise _OutOfScope("G92 or G10 L20 in a loop or subroutine (it sets an offset from where "
                                       "the control stands, which compensation moves)", None)  # fmt: skip
-                if owner is None:
+                if owner is None and not _expanding(ev):  # (a cycle there stays one: as programmed)
                     out.append(ev)
                 continue
             if ev.fixed == HOLE:  # type: ignore[union-attr]  # (a move: `type(ev) is Pass` above)
@@ -407,11 +421,14 @@ class Interpreter:
                     block,
                     block.items[0],
                 )
-            self.arc_refused = moves[0].fixed in (CYCLE, HOLE) or _homes(block)
+            self.arc_refused = moves[0].fixed in (CYCLE, HOLE) or _expanding(events[0]) or _homes(block)
         if self.cutter_comp is not None and self.comp_radius:
             self._check_radius(moves, block, self.comp_radius)
         # (a loop's or a cycle's moves too: that the tool is off the path matters more)
         self.off_path = mark_off_path(moves, self.cutter_comp is not None, self.off_path)
+        if moves[0].fixed and any(_expanding(ev) for ev in events):  # a cycle left as programmed stays one
+            kept = tuple(ev for ev in events if not _expanding(ev))
+            return kept if len(kept) != 1 else kept[0]
         return event
 
     def _check_radius(self, moves: list, block: Block, radius: float) -> None:
@@ -1273,7 +1290,7 @@ class Interpreter:
 
     def _cycle(
         self, block: Block, words: dict, motion: float, previous: float | None, item
-    ) -> tuple[Line, ...]:
+    ) -> tuple[Event, ...]:
         """A canned cycle's moves (rs274ngc's convert_cycle and convert_cycle_xy, in any plane):
         `Line`s marked `fixed`, which compensation leaves as programmed."""
         first, second, normal = PLANE_AXES[self.plane]
@@ -1293,6 +1310,9 @@ class Interpreter:
             raise _OutOfScope(f"canned cycle G{motion:g} outside the XY plane", item.start + 1)
         if motion in SPINDLE:
             self._check_spindle(block, motion, item)
+        if self.expand_cycles and motion in UNEXPANDED:
+            self._fail(f"--expand-cycles: G{motion:g} cannot be written as G0/G1 moves ({UNEXPANDED[motion]}); "
+                       "leave the option out, the cycle is then compensated or left as programmed", block, item)  # fmt: skip
         self._check_cycle_size(block, words, repeats, (r - bottom) / peck if motion in PECKING else 0.0, item)
         if motion == 87.0:
             i, j, k = self._back_bore_words(block, words, again, item)
@@ -1303,6 +1323,7 @@ class Interpreter:
         )
         rapid_delta = RAPID_DELTA_INCH if self.inch else RAPID_DELTA_INCH * MM_PER_INCH
         polar = not self.absolute and ("@" in words or "^" in words)
+        bottoms = []  # the moves at a hole's bottom (a dwell follows them: `expanded`)
         for _ in range(repeats):
             aa, bb = aa + step_a, bb + step_b
             if polar:
@@ -1314,8 +1335,12 @@ class Interpreter:
                 moves += back_bore(aa, bb, aa + i, bb + j, r, clear, middle, bottom)
             else:
                 moves += hole(motion, aa, bb, r, clear, bottom, peck, rapid_delta)
+                bottoms.append(len(moves) - 2)  # (the bottom, then out of the hole: `hole`)
             level = clear
         lines = tuple(self._fixed_line(block, (first, second, normal), move) for move in moves)
+        if self.expand_cycles:
+            self.cycle_holes = False
+            return self._expanded(block, motion, lines, bottoms)
         # a hole apply_error_map compensates: one hole in G17 and G90 (polar words written as X Y), the
         # series' holes all such
         self.cycle_holes = (previous not in CANNED or self.cycle_holes) and (
@@ -1385,6 +1410,18 @@ class Interpreter:
             "Incremental motion with polar coordinates is indeterminate when at the origin",
         )
 
+    def _expanded(self, block: Block, motion: float, lines: tuple[Line, ...], bottoms: list[int]) -> tuple[Event, ...]:  # fmt: skip
+        """A cycle's moves to be written as G0/G1 blocks (--expand-cycles): moves like any other,
+        after a `Pass` that tells the writer, with a dwell after each bottom of G82 G89."""
+        events: list[Event] = [Pass(block, cycle=motion)]
+        dwells = set(bottoms) if motion in DWELLING else set()  # (P0 too: rs274 dwells 0 s)
+        for k, line in enumerate(lines):
+            line.fixed = ""
+            events.append(line)
+            if k in dwells:
+                events.append(Pass(block, dwell=self.cycle_p))
+        return tuple(events)
+
     def _fixed_line(
         self, block: Block, axes: tuple[int, int, int], move: tuple[float, float, float, bool]
     ) -> Line:
@@ -1447,6 +1484,8 @@ class Interpreter:
         code = f"G{motion:g}"
         if motion in DWELLING and "P" not in words and not again:
             self._fail(f"Dwell time P word missing with {code}", block, item)
+        if "P" in words:
+            self.cycle_p = words["P"][0]
         if motion not in PECKING:
             return 0.0
         if "Q" not in words and not again:
@@ -1610,6 +1649,11 @@ _PLAIN_LETTERS = {
     3.0: frozenset("XYZABCUVWFIJKR"),
     **{code: frozenset() for code in CANNED},  # a cycle's words are checked in full
 }
+
+
+def _expanding(event: Event) -> bool:
+    """Whether the event is one of those that write a canned cycle's block as its moves."""
+    return type(event) is Pass and (event.cycle is not None or event.dwell is not None)
 
 
 def _homes(block: Block) -> bool:

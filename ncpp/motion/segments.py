@@ -200,6 +200,10 @@ class Pass:
     skipped: bool = False  # the program does not run it (an untaken branch, a subroutine's definition)
     motion: float | None = None  # an o-word control line's: the modal motion (G0-G3, a cycle) where it runs
     setting: Setting | None = None  # a G92 or G10 L20 block's
+    # --expand-cycles: `cycle` the G code of a canned cycle's block whose moves are written as G0/G1 blocks
+    # (the first of its events), `dwell` the seconds it dwells between two of them (G82 G89's P)
+    cycle: float | None = None
+    dwell: float | None = None
 
 
 Segment = Line | Arc

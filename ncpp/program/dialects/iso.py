@@ -16,6 +16,7 @@ from collections.abc import Iterable, Iterator
 from dataclasses import replace
 from operator import itemgetter
 
+from ncpp.motion.cycles import CANNED
 from ncpp.motion.segments import CYCLE, EXTRA_AXES, Arc, Context, Event, Line, Pass, Setting
 from ncpp.passes.rotary import time_shares, turns
 from ncpp.program.blocks import DIGITS_AS_ONE, Block, Comment, ExprWord, Statement, Word
@@ -146,6 +147,8 @@ class IsoWriter:
         block = first.block
         if type(first) is Pass and first.skipped:  # text the program does not run: it teaches nothing
             return [block.text]
+        if type(first) is Pass and first.cycle is not None:
+            return self._expanded(block, group)
         facts = self._read_block(block)
         if facts.flow:
             return self._write_control(block, first)
@@ -366,6 +369,28 @@ class IsoWriter:
             # a canned cycle, a loop or a subroutine: where it leaves the tool is the control's (G98
             # retracts to the compensated level it started from), so the next block writes every axis it knows
             self._last_end = None
+
+    def _expanded(self, block: Block, group: list[Event]) -> list[str]:
+        """A canned cycle's block written as its moves (--expand-cycles): its other words first
+        (`_cycle_rest`), then a G0/G1 block per move, a G4 where it dwells.  The program's motion
+        mode after it is the cycle's, which no block written after relies on (a block moving in it
+        is one of these too)."""
+        self._read_block(block)
+        eol, (separator, lower) = block.eol, self._spelling(block)
+        rest = _cycle_rest(block, separator)
+        lines = [rest + eol] if rest else []
+        run: list[Line | Arc] = []
+        for event in group[1:]:
+            if type(event) is Pass and event.dwell is not None:
+                lines += self._new_blocks(block, run, eol)
+                dwell = f"G4{separator}P{event.dwell:g}"
+                lines.append((dwell.lower() if lower else dwell) + eol)
+                run = []
+            elif type(event) is Line or type(event) is Arc:
+                run.append(event)
+        lines += self._new_blocks(block, run, eol)
+        self.program_motion = None
+        return lines
 
     def _hole_text(self, block: Block, move: Line) -> str:
         """A compensated canned cycle's block with its corrected X Y Z R, each written: every hole
@@ -902,6 +927,25 @@ class _Units:
 
 
 _MM, _INCH = _Units(False), _Units(True)
+
+
+# A canned cycle's own words, which its moves written as G0/G1 blocks replace (`IsoWriter._expanded`)
+_CYCLE_LETTERS = frozenset("XYZABCUVWRQLPIJK@^")
+
+
+def _cycle_rest(block: Block, separator: str) -> str:
+    """The block's text without its canned-cycle words (the cycle's G code, the hole's words):
+    its other words and comments, as written ("" when none is left but a block number)."""
+    raw, kept = block.raw, []
+    for item in block.items:
+        if type(item) is Word and item.letter.upper() == "G" and item.value in CANNED:
+            continue
+        if (type(item) is Word or type(item) is ExprWord) and item.letter.upper() in _CYCLE_LETTERS:
+            continue
+        kept.append(raw[item.start : item.end])
+    if all(text[:1] in "Nn" for text in kept):
+        return ""
+    return separator.join(kept)
 
 
 def _literal_geometry(block: Block, letters: str = GEOMETRY_LETTERS) -> Block:
