@@ -145,39 +145,51 @@ class _Holes:
 
     def _commands(self, moves: list[Event], hole: Hole, at: tuple, held: NDArray) -> NDArray:
         """(2,3) the commands for the hole's bottom and its R point (one X Y for both: the bottom's),
-        the control standing at `at`.  With reversal errors, X or Y that the corrections alone move
-        (the program keeps it) may go against the direction it holds: by a rounding step or so it
-        stays where it is rather than reverse, by more it reverses and is compensated so."""
+        the control standing at `at`.  With reversal errors, an axis that the corrections alone move
+        on the way to the hole (X or Y the program keeps, Z to an R plane it stands at) may go against
+        the direction it holds: by a rounding step or so it stays where it is rather than reverse, by
+        more it reverses and is compensated so."""
         first = moves[0]
         offsets, scales, tools = frames([first, first])  # type: ignore[list-item]
         wanted = np.array([[hole.x, hole.y, hole.bottom], [hole.x, hole.y, hole.r]])
         lines = np.full(2, first.block.line)
         if not self.ctx.directional:
             return compensate(wanted, offsets, scales, lines, self.ctx, None, tools)
-        direction = _hole_directions(moves, hole, held)
+        direction, still = _hole_directions(moves, hole, held)
         command = compensate(wanted, offsets, scales, lines, self.ctx, direction, tools)
-        gap = command[0, :2] - np.array(at[:2])
-        against = gap * direction[0, :2] < 0
+        gap = command[_REACHED] - np.array(at)  # X Y over the hole, Z at R
+        against = still & (gap * direction[_REACHED] < 0)
         if not against.any():
             return command
         stay = against & (np.abs(gap) <= _snap_limit(grid(self.ctx, scales[:1]), scales[:1]))
         turn = against & ~stay
-        if turn.any():
-            direction[:, :2] = np.where(turn, -direction[:, :2], direction[:, :2])
+        if turn.any():  # (X and Y are reached once for both points)
+            direction[:, :2] = np.where(turn[:2], -direction[:, :2], direction[:, :2])
+            direction[1, 2] = -direction[1, 2] if turn[2] else direction[1, 2]
             command = compensate(wanted, offsets, scales, lines, self.ctx, direction, tools)
-        command[:, :2] = np.where(stay, np.array(at[:2]), command[0, :2])
+            # reversed, the command may move the axis the way it held after all (an axis that runs
+            # ahead on reversal cannot reach the points between): it stays, the nearest it gets
+            stay |= turn & ((command[_REACHED] - np.array(at)) * direction[_REACHED] < 0)
+        command[:, :2] = np.where(stay[:2], np.array(at[:2]), command[0, :2])
+        command[1, 2] = at[2] if stay[2] else command[1, 2]
         return command
 
 
-def _hole_directions(moves: list[Event], hole: Hole, held: NDArray) -> NDArray:
+# Where `_Holes._commands`' rows reach the hole first: X and Y of the bottom's, Z of the R point's
+_REACHED = (np.array([0, 0, 1]), np.array([0, 1, 2]))
+
+
+def _hole_directions(moves: list[Event], hole: Hole, held: NDArray) -> tuple[NDArray, NDArray]:
     """(2,3) the directions the hole's bottom and its R point are reached in: X and Y as the
     rapid to the hole moves them, Z down to the bottom, and to R as the move that reaches it
-    (an axis that stands holds the direction it had)."""
+    (an axis that stands holds the direction it had); (3,) the axes the program keeps still
+    there (X Y over the hole, Z at R: `_REACHED`)."""
     start = moves[0].start  # type: ignore[union-attr]
     reach_r = next(m for m in moves if m.end == (hole.x, hole.y, hole.r))  # type: ignore[union-attr]
     toward = np.sign([hole.x - start[0], hole.y - start[1], hole.r - reach_r.start[2]])  # type: ignore[union-attr]
-    toward = np.where(toward != 0, toward, held)
-    return np.array([[toward[0], toward[1], -1.0], toward])
+    still = toward == 0
+    toward = np.where(still, held, toward)
+    return np.array([[toward[0], toward[1], -1.0], toward]), still
 
 
 def _warn_at_travel_ends(segs: list, rows: _Rows, solved: _Solved, ctx: PassContext) -> None:

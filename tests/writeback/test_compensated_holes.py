@@ -56,6 +56,9 @@ kind = "table"
 positions = [-1000.0, 1000.0]
 values_um = [-20.0, 20.0]
 values_um_minus = [-18.0, 22.0]
+[errors.EZX]
+kind = "polynomial"
+coefficients_um = [0.0, 0.02]
 [squareness]
 C0Y_urad = 30.0
 """,
@@ -64,10 +67,11 @@ C0Y_urad = 30.0
 
 def reversing(points: np.ndarray, directions: np.ndarray) -> np.ndarray:
     """X off by 0.01 µm/mm · x, 3 µm less travelling − (it runs ahead on reversal), and -30 µm/m · y
-    (C0Y); Z by 0.02 µm/mm · z, 2 µm more travelling − (lost motion)."""
+    (C0Y); Z by 0.02 µm/mm · z and 0.02 µm/mm · x (X's straightness), 2 µm more travelling − (lost
+    motion)."""
     x, y, z = points[:, 0], points[:, 1], points[:, 2]
     dx = 0.01 * x - 0.03 * y - (3.0 if directions[0] < 0 else 0.0)
-    dz = 0.02 * z + (2.0 if directions[2] < 0 else 0.0)
+    dz = 0.02 * z + 0.02 * x + (2.0 if directions[2] < 0 else 0.0)
     return points + np.column_stack([dx, 0 * x, dz]) / 1000
 
 
