@@ -231,7 +231,8 @@ def warn_fixed(events: Iterable[Event], warnings: Warnings, file: str) -> Iterat
         kind = type(event)
         if kind is Line or kind is Arc:  # (not a Pass, nor a dialect's own: Klartext's pole)
             fixed = event.fixed  # type: ignore[union-attr]
-            if not fixed and series in (CYCLE, HOLE) and absolute and not event.context.absolute:  # type: ignore[union-attr]
+            cycle = series == CYCLE or series == HOLE
+            if not fixed and cycle and absolute and not event.context.absolute:  # type: ignore[union-attr]
                 yield from _passed_on(event, events, warnings, file)
                 return
             if (

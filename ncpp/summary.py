@@ -78,7 +78,7 @@ class Summary:
             for event in events:
                 kind = type(event)
                 if kind is Line:
-                    if event.fixed and event.fixed != HOLE:  # type: ignore[union-attr]  # (a hole is compensated)
+                    if event.fixed and event.fixed != HOLE:  # type: ignore[union-attr]  # (HOLE: compensated)
                         self._leave(REASONS.get(event.fixed, event.fixed), event.block.line)  # type: ignore[union-attr]
                     else:
                         moves += 1

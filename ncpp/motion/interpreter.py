@@ -393,7 +393,8 @@ class Interpreter:
                     out.append(ev)
                 continue
             if ev.fixed == HOLE:  # type: ignore[union-attr]  # (a move: `type(ev) is Pass` above)
-                ev.fixed, ev.hole = CYCLE, None  # type: ignore[union-attr]  # each run may need its own correction
+                # each run may need a correction of its own: the cycle is left as programmed
+                ev.fixed, ev.hole = CYCLE, None  # type: ignore[union-attr]
             ev.fixed = ev.fixed or FLOW  # type: ignore[union-attr]
             if owner is not None:
                 ev.block = owner
@@ -1292,7 +1293,8 @@ class Interpreter:
         self, block: Block, words: dict, motion: float, previous: float | None, item
     ) -> tuple[Event, ...]:
         """A canned cycle's moves (rs274ngc's convert_cycle and convert_cycle_xy, in any plane):
-        `Line`s marked `fixed`, which compensation leaves as programmed."""
+        `Line`s marked `fixed`: HOLE, one hole in G17 and G90 that apply_error_map compensates as a
+        whole, or CYCLE, left as programmed; with --expand-cycles moves like any other (`_expanded`)."""
         first, second, normal = PLANE_AXES[self.plane]
         again = previous == motion  # the same cycle again: R, the normal-axis word, P and Q are sticky
         if previous not in CANNED:  # a new series: G98 retracts to where it started
@@ -1311,8 +1313,10 @@ class Interpreter:
         if motion in SPINDLE:
             self._check_spindle(block, motion, item)
         if self.expand_cycles and motion in UNEXPANDED:
-            self._fail(f"--expand-cycles: G{motion:g} cannot be written as G0/G1 moves ({UNEXPANDED[motion]}); "
-                       "leave the option out, the cycle is then compensated or left as programmed", block, item)  # fmt: skip
+            self._fail(
+                f"--expand-cycles: G{motion:g} cannot be written as G0/G1 moves ({UNEXPANDED[motion]}); "
+                "leave the option out, the cycle is then compensated or left as programmed", block, item,
+            )  # fmt: skip
         self._check_cycle_size(block, words, repeats, (r - bottom) / peck if motion in PECKING else 0.0, item)
         if motion == 87.0:
             i, j, k = self._back_bore_words(block, words, again, item)
@@ -1410,7 +1414,9 @@ class Interpreter:
             "Incremental motion with polar coordinates is indeterminate when at the origin",
         )
 
-    def _expanded(self, block: Block, motion: float, lines: tuple[Line, ...], bottoms: list[int]) -> tuple[Event, ...]:  # fmt: skip
+    def _expanded(
+        self, block: Block, motion: float, lines: tuple[Line, ...], bottoms: list[int]
+    ) -> tuple[Event, ...]:
         """A cycle's moves to be written as G0/G1 blocks (--expand-cycles): moves like any other,
         after a `Pass` that tells the writer, with a dwell after each bottom of G82 G89."""
         events: list[Event] = [Pass(block, cycle=motion)]

@@ -110,8 +110,9 @@ def _at_holes(chunk: list[Event]) -> Iterator[tuple[list[Event], Block | None]]:
 
 
 class _Holes:
-    """Compensated canned cycles (`Line.hole`): each block's X Y and Z corrected at the hole's bottom, its R at
-    the R point above the hole, its moves as the control runs them from those words (`cycles.drilled`)."""
+    """Compensated canned cycles (`Line.hole`): each block's X Y and Z corrected at the hole's bottom,
+    its R at the R point above the hole, its moves as the control runs them from those words
+    (`cycles.drilled`)."""
 
     def __init__(self, ctx: PassContext):
         self.ctx = ctx
@@ -137,8 +138,10 @@ class _Holes:
         start = tuple(at)
         # (not `changed`: that marks the pieces replace_arcs made, which the solve moves; the writer
         # tells a written hole by its `command`)
-        for end in cycles.drilled(hole.motion, start, self.start_level, x, y, r, z, hole.peck, hole.rapid_delta,
-                                  hole.retract_to_r):  # fmt: skip
+        moves_run = cycles.drilled(
+            hole.motion, start, self.start_level, x, y, r, z, hole.peck, hole.rapid_delta, hole.retract_to_r
+        )
+        for end in moves_run:
             out.append(replace(first, start=start, end=end[:3], rapid=end[3], hole=corrected))
             start = end[:3]
         return out
@@ -186,7 +189,8 @@ def _hole_directions(moves: list[Event], hole: Hole, held: NDArray) -> tuple[NDA
     there (X Y over the hole, Z at R: `_REACHED`)."""
     start = moves[0].start  # type: ignore[union-attr]
     reach_r = next(m for m in moves if m.end == (hole.x, hole.y, hole.r))  # type: ignore[union-attr]
-    toward = np.sign([hole.x - start[0], hole.y - start[1], hole.r - reach_r.start[2]])  # type: ignore[union-attr]
+    reach_z = reach_r.start[2]  # type: ignore[union-attr]
+    toward = np.sign([hole.x - start[0], hole.y - start[1], hole.r - reach_z])
     still = toward == 0
     toward = np.where(still, held, toward)
     return np.array([[toward[0], toward[1], -1.0], toward]), still

@@ -169,7 +169,8 @@ class IsoWriter:
             self._learn_program_motion(block, motion)
             if self._needs_mode_restore(block):
                 lines.append(self._restore_mode_line(block))
-            lines.append(self._hole_text(block, motion[0]) if drilled else block.text)  # type: ignore[arg-type]
+            text = self._hole_text(block, motion[0]) if drilled else block.text  # type: ignore[arg-type]
+            lines.append(text)
             self._after_verbatim(block, motion)
             return lines
         if not facts.plain:
@@ -397,7 +398,10 @@ class IsoWriter:
         has a correction of its own, so none may be left to the previous block's sticky value.  Polar
         words (`@` `^`) give way to the X Y they put the hole at."""
         assert move.hole is not None and move.hole.command is not None  # (apply_error_map's)
-        texts = {letter: format_number(value, self._style(letter, move)) for letter, value in zip("XYZR", move.hole.command)}  # fmt: skip
+        texts = {
+            letter: format_number(value, self._style(letter, move))
+            for letter, value in zip("XYZR", move.hole.command)
+        }
         return set_words(_literal_geometry(block, GEOMETRY_LETTERS + "@^"), texts, drop="@^",
                          spelled=self._spelling(block)) + block.eol  # fmt: skip
 
