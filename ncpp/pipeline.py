@@ -23,12 +23,12 @@ from ncpp import __version__
 from ncpp.errors import Location, NcppError, Warnings
 from ncpp.guard import Placement, with_guard, without_guard
 from ncpp.motion.offsets import AT_MACHINE_ZERO, WorkOffsets
-from ncpp.motion.segments import COMP, CYCLE, FLOW, Arc, Event, Line, Pass
+from ncpp.motion.segments import COMP, CYCLE, FLOW, HOLE, Arc, Event, Line, Pass
 from ncpp.passes import PASSES, PassContext, run_passes
 from ncpp.passes.context import ErrorMap, is_directional
 from ncpp.passes.inverse import iterations_for
 from ncpp.program.blocks import Block, Comment, Statement, Word
-from ncpp.program.dialects import dialect_tools, get_dialect, parse_program
+from ncpp.program.dialects import FAMILY, dialect_tools, get_dialect, parse_program
 from ncpp.program.dialects.iso import IsoWriter
 from ncpp.runtime import keep_freed_memory
 from ncpp.summary import Summary
@@ -196,7 +196,8 @@ def warn_fixed(events: Iterable[Event], warnings: Warnings, file: str) -> Iterat
         kind = type(event)
         if kind is Line or kind is Arc:  # (not a Pass, nor a dialect's own: Klartext's pole)
             fixed = event.fixed  # type: ignore[union-attr]
-            if not fixed and series == CYCLE and absolute and not event.context.absolute:  # type: ignore[union-attr]
+            cycle = series == CYCLE or series == HOLE
+            if not fixed and cycle and absolute and not event.context.absolute:  # type: ignore[union-attr]
                 yield from _passed_on(event, events, warnings, file)
                 return
             if (
@@ -321,6 +322,7 @@ def process(
     offsets: WorkOffsets | None = None,
     verify: bool = True,
     guard: Placement | None = None,
+    expand_cycles: bool = False,
 ) -> Stats:
     """Read, interpret, compensate (when `source` is given) and write one program.
 
@@ -328,6 +330,7 @@ def process(
     it picks the interpreter and the writer (`ncpp.program.dialects.UNITS`).  `offsets`: the zeros
     the control holds (machine mm; none: the program zero is the machine zero),
     which place the program on the machine whose errors are compensated.
+    `expand_cycles`: an ISO program's canned cycles are written as G0/G1 blocks (and G4 dwells).
 
     A compensated program is verified as it is written (`ncpp/verify.py`): read back
     and compared with the interpreter's reading of the input; where they part an
@@ -349,7 +352,12 @@ def process(
     else:  # compensated again: the guard of the offset it was compensated for goes
         blocks = without_guard(blocks)
     offsets = offsets or AT_MACHINE_ZERO  # the control's zeros place the program on the machine
-    events: Iterable[Event] = interpret(blocks, file=file, warnings=warnings, strict=strict, offsets=offsets)
+    expanding = (
+        {"expand_cycles": True} if expand_cycles and FAMILY[name] == "iso" else {}
+    )  # (the others have none)
+    events: Iterable[Event] = interpret(
+        blocks, file=file, warnings=warnings, strict=strict, offsets=offsets, **expanding
+    )
     if verify:
         events, original = tee(events)
     events = warn_fixed(events, warnings, file)  # cycles, loops, subroutines (ISO), cutter compensation

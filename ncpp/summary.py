@@ -15,7 +15,7 @@ from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
 
 from ncpp.errors import Location
-from ncpp.motion.segments import COMP, CYCLE, FLOW, HOME, MACHINE, PLANE_AXES, Arc, Event, Line
+from ncpp.motion.segments import COMP, CYCLE, FLOW, HOLE, HOME, MACHINE, PLANE_AXES, Arc, Event, Line
 
 # Why moves are left as programmed, as the summary names it
 REASONS = {
@@ -79,7 +79,7 @@ class Summary:
             for event in events:
                 kind = type(event)
                 if kind is Line:
-                    if event.fixed:  # type: ignore[union-attr]
+                    if event.fixed and event.fixed != HOLE:  # type: ignore[union-attr]  # (HOLE: compensated)
                         self._leave(REASONS.get(event.fixed, event.fixed), event.block.line)  # type: ignore[union-attr]
                     else:
                         moves += 1
@@ -107,9 +107,9 @@ class Summary:
             kind = type(event)
             if kind is Line or kind is Arc:
                 if event.block is block:
-                    if not event.fixed:  # type: ignore[union-attr]  # (not the control's own after it: M140)
+                    if not event.fixed or event.fixed == HOLE:  # type: ignore[union-attr]  # (not M140's retract)
                         last = event  # type: ignore[assignment]
-                elif not event.fixed:  # type: ignore[union-attr]
+                elif not event.fixed or event.fixed == HOLE:  # type: ignore[union-attr]
                     self._settle(block, last)
                     block, last = event.block, event  # type: ignore[assignment]
             yield event

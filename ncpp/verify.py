@@ -269,6 +269,10 @@ def sections(events: Iterable[Event], bound: Bound, cut: Cut = lambda block, mov
                     moves, first_line = _Moves(bound), block.line
         if kind is Line or kind is Arc:
             extra = _add(moves, event, extra, inverse_time, line_of(block.line) if line_of else block.line)  # type: ignore[arg-type]
+        elif kind is Pass and event.dwell is not None:  # type: ignore[union-attr]  # a cycle's, written G4 P
+            for text in ("G4", f"P{event.dwell:g}"):  # type: ignore[union-attr]
+                yield moves.sample(Action(text, block.line), first_line)
+                moves, first_line = _Moves(bound), block.line
     for text in after:
         yield moves.sample(Action(text, last.line), first_line)  # type: ignore[union-attr]
         moves = _Moves(bound)

@@ -31,12 +31,23 @@ from ncpp.summary import write_report
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("compensate", help="compensate an NC program for a machine's errors")
     add_compensation_arguments(p)
+    add_expand_argument(p)
     add_io_arguments(p, several=True)
     p.add_argument(
         "--jobs", type=at_least(1), default=1, metavar="N",
         help="programs compensated at once, one process each, when several are given (default 1)",
     )  # fmt: skip
     p.set_defaults(func=run)
+
+
+def add_expand_argument(p: argparse.ArgumentParser) -> None:
+    """`--expand-cycles`, of the commands that compensate a program (not the CL-data post)."""
+    p.add_argument(
+        "--expand-cycles",
+        action="store_true",
+        help="write each canned cycle of an ISO program as G0/G1 blocks (G4 where it dwells), each move "
+        "compensated, for controls without canned cycles (tapping, G86 and G87 are refused)",
+    )
 
 
 def add_compensation_arguments(p: argparse.ArgumentParser) -> None:
@@ -167,7 +178,8 @@ def run(args: argparse.Namespace) -> int:
             "no error model: give --machine M.toml or --from MEASUREMENT, set $NCPP_MACHINE, "
             "or name a machine file in ./ncpp.toml or ~/.config/ncpp/config.toml"
         )
-    job = Job(source, tolerance, args.strict, args.force, args.dialect, offsets, args.verify, guard)
+    job = Job(source, tolerance, args.strict, args.force, args.dialect, offsets, args.verify, guard,
+              args.expand_cycles)  # fmt: skip
     folder = args.output is not None and os.path.isdir(args.output)
     if len(args.input) > 1 or folder:
         if args.output is None:
@@ -193,6 +205,7 @@ class Job:
     offsets: object  # motion.offsets.WorkOffsets
     verify: bool = True
     guard: object = None  # guard.Placement: the placement guard at the program's start (None: none)
+    expand_cycles: bool = False  # canned cycles written as G0/G1 blocks
 
     def compensate(self, stream: BinaryIO, out: BinaryIO, name: str, progress: Progress = None):
         """`pipeline.process` of one program, with warnings of its own."""
@@ -203,6 +216,7 @@ class Job:
             tolerance=self.tolerance, strict=self.strict, force=self.force,
             warnings=Warnings(strict=self.strict), progress=progress, dialect=self.dialect,
             offsets=self.offsets, verify=self.verify, guard=self.guard,  # type: ignore[arg-type]
+            expand_cycles=self.expand_cycles,
         )  # fmt: skip
 
 

@@ -21,7 +21,7 @@ import sys
 from dataclasses import replace
 from pathlib import Path
 
-from ncpp.cli.compensate import add_compensation_arguments, tell
+from ncpp.cli.compensate import add_compensation_arguments, add_expand_argument, tell
 from ncpp.cli.io import add_io_arguments, open_input, open_output
 from ncpp.cli.progress import progress_printer
 from ncpp.errors import Location, NcppError, Warnings
@@ -34,6 +34,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     add_io_arguments(p)
     add_compensation_arguments(p)
+    add_expand_argument(p)
     p.set_defaults(func=run, tolerance=None)  # None: the config file's, else 0.001
 
 
@@ -46,7 +47,7 @@ def run(args: argparse.Namespace) -> int:
     with open_input(args.input) as (stream, name), open_output(args.output) as out:
         stats = process(stream, out, file=name, source=source, tolerance=tolerance, strict=args.strict, force=args.force,
                         warnings=warnings, progress=progress, dialect=args.dialect, offsets=offsets, verify=args.verify,
-                        guard=guard)  # fmt: skip
+                        guard=guard, expand_cycles=args.expand_cycles)  # fmt: skip
     if progress is not None:
         progress.done()
     if stats.summary is not None:

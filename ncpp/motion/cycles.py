@@ -23,6 +23,20 @@ RAPID_DELTA_INCH = 0.010
 Move = tuple[float, float, float, bool]  # (aa, bb, cc, rapid)
 
 
+def approach(
+    at: tuple[float, float, float], start_level: float, r: float, retract_to_r: bool
+) -> tuple[list[Move], float, float]:
+    """How a cycle reaches its holes from where the tool is (`at`, plane coordinates) when its
+    series started at the normal-axis level `start_level`: (the move up to R first, if any,
+    the level the tool crosses to the hole at, the level it retracts to).  Not below R
+    (G99) or the series' start level (G98); a series that started below R goes up to R
+    first.  rs274ngc as LinuxCNC 2.9 runs it, found by probing it (test_cycles.py)."""
+    if start_level < r:
+        return [(at[0], at[1], r, True)], r, r
+    level = max(at[2], r if retract_to_r else start_level)
+    return [], level, r if retract_to_r else level
+
+
 def hole(
     motion: float,
     aa: float,
@@ -60,3 +74,23 @@ def back_bore(
         (aa, bb, middle, False), (aa, bb, bottom, False),
         (off_a, off_b, bottom, True), (off_a, off_b, clear, True), (aa, bb, clear, True),
     ]  # fmt: skip
+
+
+def drilled(
+    motion: float,
+    at: tuple[float, float, float],
+    start_level: float,
+    aa: float,
+    bb: float,
+    r: float,
+    bottom: float,
+    peck: float,
+    rapid_delta: float,
+    retract_to_r: bool,
+) -> list[Move]:
+    """The moves of a cycle block drilling one hole (no L repeats, not G87) from `at`."""
+    moves, level, clear = approach(at, start_level, r, retract_to_r)
+    moves.append((aa, bb, level, True))
+    if level != r:
+        moves.append((aa, bb, r, True))
+    return moves + hole(motion, aa, bb, r, clear, bottom, peck, rapid_delta)

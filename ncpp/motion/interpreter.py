@@ -36,7 +36,16 @@ from typing import NoReturn, cast
 
 from ncpp.errors import Location, NcppError, Warnings
 from ncpp.motion.corners import CornerError, round_corner
-from ncpp.motion.cycles import CANNED, DWELLING, PECKING, RAPID_DELTA_INCH, SPINDLE, back_bore, hole
+from ncpp.motion.cycles import (
+    CANNED,
+    DWELLING,
+    PECKING,
+    RAPID_DELTA_INCH,
+    SPINDLE,
+    approach,
+    back_bore,
+    hole,
+)
 from ncpp.motion.expressions import ExpressionError, OutOfScope, Parameters, evaluate
 from ncpp.motion.flow import FIXED, RUN, SKIP, Flow
 from ncpp.motion.offsets import SYSTEMS, WorkOffsets
@@ -44,11 +53,13 @@ from ncpp.motion.segments import (
     COMP,
     CYCLE,
     FLOW,
+    HOLE,
     HOME,
     PLANE_AXES,
     Arc,
     Context,
     Event,
+    Hole,
     Line,
     Pass,
     Setting,
@@ -58,6 +69,13 @@ from ncpp.motion.tools import UntoldLengths
 from ncpp.program.blocks import STRAY_TAPE, UNREADABLE, Block, Comment, ExprWord, Statement, Word
 
 MM_PER_INCH = 25.4
+# Cycles --expand-cycles refuses: what G0/G1 blocks cannot do
+UNEXPANDED = {
+    74.0: "tapping: the spindle reverses at the bottom, in step with the feed",
+    84.0: "tapping: the spindle reverses at the bottom, in step with the feed",
+    86.0: "the spindle stops at the bottom",
+    87.0: "back boring: the spindle stops and orients",
+}
 AXES = "XYZABCUVW"
 AXIS_INDEX = {letter: i for i, letter in enumerate(AXES)}
 LINEAR = (0, 1, 2, 6, 7, 8)  # axes that change with G20/G21 (not the rotary A B C)
@@ -165,6 +183,7 @@ def interpreting(flavour: type[Interpreter]) -> Callable[..., Iterator[Event]]:
         warnings: Warnings | None = None,
         strict: bool = False,
         offsets: WorkOffsets | None = None,
+        expand_cycles: bool = False,
     ) -> Iterator[Event]:
         """Motion events of a program's blocks, lazily, as the flavour reads them (see the
         module docstring).
@@ -178,8 +197,12 @@ def interpreting(flavour: type[Interpreter]) -> Callable[..., Iterator[Event]]:
         the control would refuse.  Out-of-scope constructs warn once through
         `warnings` (stderr by default) and end interpretation; with `strict`
         (or a strict `warnings`) they raise NcppError instead.
+
+        `expand_cycles`: a canned cycle's block is to be written as its moves (`expanded`).
         """
-        return run(flavour(file, offsets), blocks, warnings, strict)
+        interpreter = flavour(file, offsets)
+        interpreter.expand_cycles = expand_cycles
+        return run(interpreter, blocks, warnings, strict)
 
     return interpret
 
@@ -223,6 +246,9 @@ class Interpreter:
         self.cycle_r = self.cycle_cc = self.cycle_q = self.cycle_il = 0.0
         self.cycle_ijk = (0.0, 0.0, 0.0)  # G87's sticky I J K
         self.cycle_last_r = 0.0  # the R plane of the series' last cycle
+        self.cycle_holes = False  # the series' cycles are compensated hole by hole (`Hole`)
+        self.cycle_p = 0.0  # G82 G89's dwell, seconds (sticky within the cycle)
+        self.expand_cycles = False  # cycles are written as their moves (`expanded`)
         self.spindle = 0  # M3 1, M4 -1, stopped 0 (tapping and boring cycles check it)
         self.coord_system = 1
         self.g5x = [[0.0] * 9 for _ in range(10)]  # index 1..9: G54..G59.3
@@ -369,10 +395,13 @@ class Interpreter:
                 if ev.setting is not None:  # set from where each run of the text stands: no one shift
                     raise _OutOfScope("G92 or G10 L20 in a loop or subroutine (it sets an offset from where "
                                       "the control stands, which compensation moves)", None)  # fmt: skip
-                if owner is None:
+                if owner is None and not _expanding(ev):  # (a cycle there stays one: as programmed)
                     out.append(ev)
                 continue
-            ev.fixed = ev.fixed or FLOW  # type: ignore[union-attr]  # (a move: `type(ev) is Pass` above)
+            if ev.fixed == HOLE:  # type: ignore[union-attr]  # (a move: `type(ev) is Pass` above)
+                # each run may need a correction of its own: the cycle is left as programmed
+                ev.fixed, ev.hole = CYCLE, None  # type: ignore[union-attr]
+            ev.fixed = ev.fixed or FLOW  # type: ignore[union-attr]
             if owner is not None:
                 ev.block = owner
             out.append(ev)
@@ -399,11 +428,14 @@ class Interpreter:
                     block,
                     block.items[0],
                 )
-            self.arc_refused = moves[0].fixed == CYCLE or _homes(block)
+            self.arc_refused = moves[0].fixed in (CYCLE, HOLE) or _expanding(events[0]) or _homes(block)
         if self.cutter_comp is not None and self.comp_radius:
             self._check_radius(moves, block, self.comp_radius)
         # (a loop's or a cycle's moves too: that the tool is off the path matters more)
         self.off_path = mark_off_path(moves, self.cutter_comp is not None, self.off_path)
+        if moves[0].fixed and any(_expanding(ev) for ev in events):  # a cycle left as programmed stays one
+            kept = tuple(ev for ev in events if not _expanding(ev))
+            return kept if len(kept) != 1 else kept[0]
         return event
 
     def _check_radius(self, moves: list, block: Block, radius: float) -> None:
@@ -1265,9 +1297,10 @@ class Interpreter:
 
     def _cycle(
         self, block: Block, words: dict, motion: float, previous: float | None, item
-    ) -> tuple[Line, ...]:
+    ) -> tuple[Event, ...]:
         """A canned cycle's moves (rs274ngc's convert_cycle and convert_cycle_xy, in any plane):
-        `Line`s marked `fixed`, which compensation leaves as programmed."""
+        `Line`s marked `fixed`: HOLE, one hole in G17 and G90 that apply_error_map compensates as a
+        whole, or CYCLE, left as programmed; with --expand-cycles moves like any other (`_expanded`)."""
         first, second, normal = PLANE_AXES[self.plane]
         again = previous == motion  # the same cycle again: R, the normal-axis word, P and Q are sticky
         if previous not in CANNED:  # a new series: G98 retracts to where it started
@@ -1285,24 +1318,22 @@ class Interpreter:
             raise _OutOfScope(f"canned cycle G{motion:g} outside the XY plane", item.start + 1)
         if motion in SPINDLE:
             self._check_spindle(block, motion, item)
+        if self.expand_cycles and motion in UNEXPANDED:
+            self._fail(
+                f"--expand-cycles: G{motion:g} cannot be written as G0/G1 moves ({UNEXPANDED[motion]}); "
+                "leave the option out, the cycle is then compensated or left as programmed", block, item,
+            )  # fmt: skip
         self._check_cycle_size(block, words, repeats, (r - bottom) / peck if motion in PECKING else 0.0, item)
         if motion == 87.0:
             i, j, k = self._back_bore_words(block, words, again, item)
             middle = k if self.absolute else bottom + k
         pos = self.pos
-        moves: list[tuple[float, float, float, bool]] = []
-        # The level the tool crosses to the hole at (and G98 retracts to): where the tool is, but
-        # not below R (G99) or the series' start level (G98); a series that started below R goes
-        # up to R first.  rs274ngc as LinuxCNC 2.9 runs it, found by probing it (test_cycles.py).
-        level = self.cycle_il
-        if level < r:
-            moves.append((pos[first], pos[second], r, True))
-            level = r
-        else:
-            level = max(pos[normal], r if self.retract_to_r else level)
-        clear = r if self.retract_to_r else level
+        moves, level, clear = approach(
+            (pos[first], pos[second], pos[normal]), self.cycle_il, r, self.retract_to_r
+        )
         rapid_delta = RAPID_DELTA_INCH if self.inch else RAPID_DELTA_INCH * MM_PER_INCH
         polar = not self.absolute and ("@" in words or "^" in words)
+        bottoms = []  # the moves at a hole's bottom (a dwell follows them: `expanded`)
         for _ in range(repeats):
             aa, bb = aa + step_a, bb + step_b
             if polar:
@@ -1314,8 +1345,24 @@ class Interpreter:
                 moves += back_bore(aa, bb, aa + i, bb + j, r, clear, middle, bottom)
             else:
                 moves += hole(motion, aa, bb, r, clear, bottom, peck, rapid_delta)
+                bottoms.append(len(moves) - 2)  # (the bottom, then out of the hole: `hole`)
             level = clear
-        return tuple(self._fixed_line(block, (first, second, normal), move) for move in moves)
+        lines = tuple(self._fixed_line(block, (first, second, normal), move) for move in moves)
+        if self.expand_cycles:
+            self.cycle_holes = False
+            return self._expanded(block, motion, lines, bottoms)
+        # a hole apply_error_map compensates: one hole in G17 and G90 (polar words written as X Y), the
+        # series' holes all such
+        self.cycle_holes = (previous not in CANNED or self.cycle_holes) and (
+            self.plane == 17 and self.absolute and repeats == 1 and motion != 87.0
+        )
+        if self.cycle_holes:
+            drilled = Hole(
+                motion, aa, bb, bottom, r, peck, rapid_delta, self.retract_to_r, previous not in CANNED
+            )
+            for line in lines:
+                line.fixed, line.hole = HOLE, drilled
+        return lines
 
     def _cycle_geometry(self, block: Block, words: dict, again: bool, item) -> tuple[float, ...]:
         """(aa, bb, their step per repeat, R, bottom) of a cycle in plane coordinates; keeps the
@@ -1372,6 +1419,20 @@ class Interpreter:
             theta,
             "Incremental motion with polar coordinates is indeterminate when at the origin",
         )
+
+    def _expanded(
+        self, block: Block, motion: float, lines: tuple[Line, ...], bottoms: list[int]
+    ) -> tuple[Event, ...]:
+        """A cycle's moves to be written as G0/G1 blocks (--expand-cycles): moves like any other,
+        after a `Pass` that tells the writer, with a dwell after each bottom of G82 G89."""
+        events: list[Event] = [Pass(block, cycle=motion)]
+        dwells = set(bottoms) if motion in DWELLING else set()  # (P0 too: rs274 dwells 0 s)
+        for k, line in enumerate(lines):
+            line.fixed = ""
+            events.append(line)
+            if k in dwells:
+                events.append(Pass(block, dwell=self.cycle_p))
+        return tuple(events)
 
     def _fixed_line(
         self, block: Block, axes: tuple[int, int, int], move: tuple[float, float, float, bool]
@@ -1435,6 +1496,8 @@ class Interpreter:
         code = f"G{motion:g}"
         if motion in DWELLING and "P" not in words and not again:
             self._fail(f"Dwell time P word missing with {code}", block, item)
+        if "P" in words:
+            self.cycle_p = words["P"][0]
         if motion not in PECKING:
             return 0.0
         if "Q" not in words and not again:
@@ -1598,6 +1661,11 @@ _PLAIN_LETTERS = {
     3.0: frozenset("XYZABCUVWFIJKR"),
     **{code: frozenset() for code in CANNED},  # a cycle's words are checked in full
 }
+
+
+def _expanding(event: Event) -> bool:
+    """Whether the event is one of those that write a canned cycle's block as its moves."""
+    return type(event) is Pass and (event.cycle is not None or event.dwell is not None)
 
 
 def _homes(block: Block) -> bool:

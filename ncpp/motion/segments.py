@@ -26,6 +26,9 @@ from ncpp.program.blocks import Block
 Point = tuple[float, float, float]
 # Why a segment is `fixed`: passes leave it as programmed
 CYCLE = "canned cycle"  # a hole is drilled where the program puts it
+# a canned cycle compensated hole by hole: apply_error_map corrects its X Y Z R words (`Hole`), and no
+# other pass splits or moves its moves
+HOLE = "compensated canned cycle"
 FLOW = "loop or subroutine"  # one text runs many times (or out of the text's order)
 COMP = "cutter compensation"  # the control offsets the path by the tool's radius: the tool is not on it
 HOME = "G28/G30 return"  # the control homes the axes it names (machine coordinates); the others stay where they stand
@@ -81,6 +84,24 @@ class Context:
         return (m[0] / s - self.offset[0], m[1] / s - self.offset[1], m[2] / s - self.offset[2])
 
 
+@dataclass(frozen=True, slots=True)
+class Hole:
+    """One hole of a G17 canned cycle in G90 (`fixed` HOLE): what the control drills it from,
+    program units.  apply_error_map writes its moves again from the corrected words
+    (`command`), as the control will run them (`cycles.drilled`)."""
+
+    motion: float  # the cycle's G code (81.0, 83.0, ...)
+    x: float
+    y: float
+    bottom: float  # Z
+    r: float  # the R plane
+    peck: float  # G73 G83's Q (0: none)
+    rapid_delta: float  # how far above the last peck G73 G83 rapid back in
+    retract_to_r: bool  # G99 (True) or G98
+    series_start: bool  # the first cycle of a series: G98 retracts to the Z it starts from
+    command: tuple[float, float, float, float] | None = None  # the X Y Z R written (None: as programmed)
+
+
 # Events are not frozen: a pipeline makes several per output line, and a frozen
 # dataclass sets each field through object.__setattr__ (several times slower to build).
 # Treat them as values all the same: a pass that changes one makes a new one.
@@ -105,6 +126,8 @@ class Line:
     extra_start: tuple[
         float, ...
     ] = ()  # start positions of A B C U V W (as `extra`), when the program uses them
+    # a compensated canned cycle's hole (`fixed` HOLE), the same for its block's moves
+    hole: Hole | None = None
 
     def length(self) -> float:
         return math.dist(self.start, self.end)
@@ -179,6 +202,10 @@ class Pass:
     skipped: bool = False  # the program does not run it (an untaken branch, a subroutine's definition)
     motion: float | None = None  # an o-word control line's: the modal motion (G0-G3, a cycle) where it runs
     setting: Setting | None = None  # a G92 or G10 L20 block's
+    # --expand-cycles: `cycle` the G code of a canned cycle's block whose moves are written as G0/G1 blocks
+    # (the first of its events), `dwell` the seconds it dwells between two of them (G82 G89's P)
+    cycle: float | None = None
+    dwell: float | None = None
 
 
 Segment = Line | Arc
@@ -199,6 +226,8 @@ def mark_off_path(moves: list, compensating: bool, off_path: bool) -> bool:
 __all__ = [
     "COMP",
     "CYCLE",
+    "HOLE",
+    "Hole",
     "FLOW",
     "HOME",
     "MACHINE",

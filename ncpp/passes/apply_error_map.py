@@ -25,7 +25,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ncpp.errors import Location, NcppError
-from ncpp.motion.segments import CYCLE, Arc, Event, Line, Pass, Setting
+from ncpp.motion import cycles
+from ncpp.motion.segments import CYCLE, HOLE, Arc, Event, Hole, Line, Pass, Setting
 from ncpp.passes.context import PassContext, deviation
 from ncpp.passes.geometry import (
     any3,
@@ -40,7 +41,7 @@ from ncpp.passes.geometry import (
     tuples,
 )
 from ncpp.passes.travel import Travel, grid, hold, quantize, steps
-from ncpp.program.blocks import Word
+from ncpp.program.blocks import Block, Word
 
 # Compensations per line at most: each changes a direction only where a
 # correction of the previous round flipped a µm motion; two rounds settle almost all.
@@ -60,8 +61,9 @@ def apply_error_map(events: Iterable[Event], ctx: PassContext) -> Iterator[Event
 def _chunks(events: Iterable[Event], ctx: PassContext) -> Iterator[list[Event]]:
     """The compensated events, a list per chunk."""
     solve = Solve(ctx)
+    holes = _Holes(ctx)
     last = None  # the last segment written: its compensated end, in its own program frame
-    for chunk, segs, rows in _rowed(line_chunks(events), ctx.directional, last):
+    for chunk, segs, rows in _rowed(_drilled(line_chunks(events), holes, solve), ctx.directional, last):
         if rows is None:  # no segments
             yield _placed(chunk, last)
             continue
@@ -73,8 +75,125 @@ def _chunks(events: Iterable[Event], ctx: PassContext) -> Iterator[list[Event]]:
         if solved.at_end.any():
             _warn_at_travel_ends(segs, rows, solved, ctx)
         out = _written(chunk, segs, rows, solved, last)
-        last = _ended(segs[-1], solved.end[-1])  # (a carried row's end is not its event's: `_carry`)
+        # (a carried row's end is not its event's: `_carry`)
+        last = holes.last = _ended(segs[-1], solved.end[-1])
         yield out
+
+
+def _drilled(chunks: Iterable[list[Event]], holes: _Holes, solve: Solve) -> Iterator[list[Event]]:
+    """The chunks, each compensated cycle block's moves cut out as a chunk of their own and
+    written again from the corrected hole (`_Holes`): from where the output stands then
+    (`holes.last`, read when the chunk is taken, after the chunks before it are solved), holding
+    `solve`'s directions."""
+    for chunk in chunks:
+        if not any(type(e) is Line and e.fixed == HOLE for e in chunk):
+            yield chunk
+            continue
+        for piece, block in _at_holes(chunk):
+            yield piece if block is None else holes.drilled(piece, solve.travel.held)
+
+
+def _at_holes(chunk: list[Event]) -> Iterator[tuple[list[Event], Block | None]]:
+    """The chunk cut before and after the moves of each compensated cycle block, with that
+    block (None: a piece of other events)."""
+    piece: list[Event] = []
+    block = None
+    for event in chunk:
+        here = event.block if type(event) is Line and event.fixed == HOLE else None
+        if here is not block and piece:
+            yield piece, block
+            piece = []
+        block = here
+        piece.append(event)
+    if piece:
+        yield piece, block
+
+
+class _Holes:
+    """Compensated canned cycles (`Line.hole`): each block's X Y and Z corrected at the hole's bottom,
+    its R at the R point above the hole, its moves as the control runs them from those words
+    (`cycles.drilled`)."""
+
+    def __init__(self, ctx: PassContext):
+        self.ctx = ctx
+        self.block: Block | None = None  # the last block written again (its moves may span two chunks)
+        self.start_level = 0.0  # Z where the G98 series under way started, as the control stands there
+        self.last: Line | None = None  # the last segment written, with its compensated end (`_chunks` tells)
+
+    def drilled(self, moves: list[Event], held: NDArray) -> list[Event]:
+        """The block's moves (`moves`, Lines of one block) from the corrected words, starting
+        where the output stands (`last`'s end; None: nothing was compensated, the programmed start)."""
+        last = self.last
+        first = moves[0]
+        assert type(first) is Line and first.hole is not None  # (`_at_holes`)
+        if first.block is self.block:  # the rest of a block cut by a chunk's end: written already
+            return []
+        self.block, hole = first.block, first.hole
+        at = first.start if last is None else _end_in_frame_of(last, first)
+        if hole.series_start:
+            self.start_level = at[2]
+        (x, y, z), (_, _, r) = self._commands(moves, hole, at, held).tolist()
+        corrected = replace(hole, command=(x, y, z, r))
+        out: list[Event] = []
+        start = tuple(at)
+        # (not `changed`: that marks the pieces replace_arcs made, which the solve moves; the writer
+        # tells a written hole by its `command`)
+        moves_run = cycles.drilled(
+            hole.motion, start, self.start_level, x, y, r, z, hole.peck, hole.rapid_delta, hole.retract_to_r
+        )
+        for end in moves_run:
+            out.append(replace(first, start=start, end=end[:3], rapid=end[3], hole=corrected))
+            start = end[:3]
+        return out
+
+    def _commands(self, moves: list[Event], hole: Hole, at: tuple, held: NDArray) -> NDArray:
+        """(2,3) the commands for the hole's bottom and its R point (one X Y for both: the bottom's),
+        the control standing at `at`.  With reversal errors, an axis that the corrections alone move
+        on the way to the hole (X or Y the program keeps, Z to an R plane it stands at) may go against
+        the direction it holds: by a rounding step or so it stays where it is rather than reverse, by
+        more it reverses and is compensated so."""
+        first = moves[0]
+        offsets, scales, tools = frames([first, first])  # type: ignore[list-item]
+        wanted = np.array([[hole.x, hole.y, hole.bottom], [hole.x, hole.y, hole.r]])
+        lines = np.full(2, first.block.line)
+        if not self.ctx.directional:
+            return compensate(wanted, offsets, scales, lines, self.ctx, None, tools)
+        direction, still = _hole_directions(moves, hole, held)
+        command = compensate(wanted, offsets, scales, lines, self.ctx, direction, tools)
+        gap = command[_REACHED] - np.array(at)  # X Y over the hole, Z at R
+        against = still & (gap * direction[_REACHED] < 0)
+        if not against.any():
+            return command
+        stay = against & (np.abs(gap) <= _snap_limit(grid(self.ctx, scales[:1]), scales[:1]))
+        turn = against & ~stay
+        if turn.any():  # (X and Y are reached once for both points)
+            direction[:, :2] = np.where(turn[:2], -direction[:, :2], direction[:, :2])
+            direction[1, 2] = -direction[1, 2] if turn[2] else direction[1, 2]
+            command = compensate(wanted, offsets, scales, lines, self.ctx, direction, tools)
+            # reversed, the command may move the axis the way it held after all (an axis that runs
+            # ahead on reversal cannot reach the points between): it stays, the nearest it gets
+            stay |= turn & ((command[_REACHED] - np.array(at)) * direction[_REACHED] < 0)
+        command[:, :2] = np.where(stay[:2], np.array(at[:2]), command[0, :2])
+        command[1, 2] = at[2] if stay[2] else command[1, 2]
+        return command
+
+
+# Where `_Holes._commands`' rows reach the hole first: X and Y of the bottom's, Z of the R point's
+_REACHED = (np.array([0, 0, 1]), np.array([0, 1, 2]))
+
+
+def _hole_directions(moves: list[Event], hole: Hole, held: NDArray) -> tuple[NDArray, NDArray]:
+    """(2,3) the directions the hole's bottom and its R point are reached in: X and Y as the
+    rapid to the hole moves them, Z down to the bottom, and to R as the move that reaches it
+    (an axis that stands holds the direction it had); (3,) the axes the program keeps still
+    there (X Y over the hole, Z at R: `_REACHED`)."""
+    start = moves[0].start  # type: ignore[union-attr]
+    reach_r = next(m for m in moves if m.end == (hole.x, hole.y, hole.r))  # type: ignore[union-attr]
+    reach_z = reach_r.start[2]  # type: ignore[union-attr]
+    toward = np.sign([hole.x - start[0], hole.y - start[1], hole.r - reach_z])
+    still = toward == 0
+    toward = np.where(still, held, toward)
+    return np.array([[toward[0], toward[1], -1.0], toward]), still
 
 
 def _warn_at_travel_ends(segs: list, rows: _Rows, solved: _Solved, ctx: PassContext) -> None:
@@ -152,6 +271,8 @@ def _rows(segs: list, directional: bool, fixed_before: bool = True) -> _Rows:
     line = (kind & 3) == 0
     free = line & ~changed
     kept = _kept_axes(segs, kind)
+    # (not after a compensated hole: that is in the cycle's series, whose modal cycle and start level
+    # a step there would end)
     fixed = (kind & 2) != 0
     lead_in = ((kind & 32) != 0) & ~np.concatenate([[fixed_before], fixed[:-1]])
     return _Rows(

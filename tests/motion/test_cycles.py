@@ -16,7 +16,7 @@ import pytest
 
 from ncpp.errors import Location, NcppError, Warnings
 from ncpp.motion import interpret
-from ncpp.motion.segments import CYCLE, Line
+from ncpp.motion.segments import CYCLE, HOLE, Line
 from ncpp.program.parser import parse_stream
 from tests.conftest import RS274
 from tests.motion.compensating import compensate
@@ -176,12 +176,16 @@ def test_random_cycle_programs_agree_with_rs274(tmp_path):
     assert compared >= 10  # enough programs stay in scope to mean something
 
 
-def test_cycle_moves_are_fixed():
-    events = list(
-        interpret(parse_stream(io.BytesIO((HEAD + "G81 X1 Y1 Z-3 R2\nG80\nG1 X5\n").encode()), "t.ngc"))
-    )
+@pytest.mark.parametrize("cycle, why", [("G81 X1 Y1 Z-3 R2", HOLE), ("G81 X1 Y1 Z-3 R2 L1", HOLE),
+                                        ("G81 X1 Y1 Z-3 R2 L2", CYCLE), ("G91 G81 X1 Y1 Z-3 R-2", CYCLE),
+                                        ("G81 @1 ^45 Z-3 R2", HOLE), ("G18 G81 X1 Z1 Y-3 R2", CYCLE)])  # fmt: skip
+def test_cycle_moves_are_fixed(cycle, why):
+    """A hole in G17 and G90 is compensated as a whole (HOLE); repeats, G91 and the other planes
+    leave the cycle as programmed (CYCLE)."""
+    events = list(interpret(parse_stream(io.BytesIO((HEAD + cycle + "\nG80\nG1 X5\n").encode()), "t.ngc")))
     lines = [e for e in events if type(e) is Line]
-    assert [e.fixed for e in lines] == ["", CYCLE, CYCLE, CYCLE, CYCLE, ""]
+    assert lines[0].fixed == lines[-1].fixed == "" and {e.fixed for e in lines[1:-1]} == {why}
+    assert all((e.hole is not None) == (why == HOLE) for e in lines[1:-1])
 
 
 def _compensate(text: str, strict: bool = False) -> tuple[str, str]:
@@ -190,14 +194,14 @@ def _compensate(text: str, strict: bool = False) -> tuple[str, str]:
 
 DRILL = (
     HEAD
-    + "G1 Z-1\nX40 Y12\nG0 Z5\nG98 G81 X20 Y20 Z-3 R2\nX30\n(between)\nX40 Y25\nG80\nG0 X50 Y50\nG1 Z-1\nX70 Y40\nG3 X80 Y60 R15\nG0 Z10\nM2\n"
+    + "G1 Z-1\nX40 Y12\nG0 Z5\nG98 G81 X20 Y20 Z-3 R2 L2\nX30\n(between)\nX40 Y25\nG80\nG0 X50 Y50\nG1 Z-1\nX70 Y40\nG3 X80 Y60 R15\nG0 Z10\nM2\n"
 )
 
 
 def test_cycles_pass_through_and_compensation_resumes():
     out, warned = _compensate(DRILL)
     lines = out.splitlines()
-    cycle = ["G98 G81 X20 Y20 Z-3 R2", "X30", "(between)", "X40 Y25", "G80"]
+    cycle = ["G98 G81 X20 Y20 Z-3 R2 L2", "X30", "(between)", "X40 Y25", "G80"]
     start = lines.index(cycle[0])
     assert lines[start : start + len(cycle)] == cycle  # verbatim
     # one warning, naming the line where the series starts
@@ -211,7 +215,7 @@ def test_a_warning_repeated_hundreds_of_times_is_printed_five_times_then_counted
     """A drilling program warns at each of its 300 cycle series: five are printed (the fifth
     says the rest are counted), then one line at the end tells how many and where."""
     holes = "".join(
-        f"G0 X{k % 20 * 5} Y{k // 20 * 5}\nG81 X{k % 20 * 5 + 1} Y{k // 20 * 5} Z-3 R2 F100\nG80\nG1 X{k % 20 * 5 + 2}\n"
+        f"G0 X{k % 20 * 5} Y{k // 20 * 5}\nG81 X{k % 20 * 5 + 1} Y{k // 20 * 5} Z-3 R2 F100 L2\nG80\nG1 X{k % 20 * 5 + 2}\n"
         for k in range(300)
     )
     out, warned = _compensate(HEAD + holes + "M2\n")
@@ -271,7 +275,7 @@ def test_a_g91_move_right_after_a_g90_cycle_ends_compensation():
     original, written = text.splitlines(), out.splitlines()
     assert written[-(len(original) - line + 1) :] == original[line - 1 :]  # the rest verbatim
     assert written[3] != original[2]  # compensated before it
-    with pytest.raises(NcppError, match="drill.ngc:6:1: .*canned cycle"):
+    with pytest.raises(NcppError, match=f"drill.ngc:{line}:1: .*canned cycle"):
         _compensate(text, strict=True)
 
 

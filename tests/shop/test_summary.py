@@ -15,7 +15,8 @@ from ncpp.pipeline import ErrorSource, process
 from tests.conftest import ROOT
 
 MACHINE = ROOT / "samples/machines/hr5b.toml"
-# 3 plain moves after a rapid, a G81 cycle of two holes, a G41 section (and the rapid after the cycle)
+# 3 plain moves after a rapid, a G81 cycle of two holes (compensated hole by hole), a G41 section (and the
+# rapid after the cycle)
 PROGRAM = b"""G21 G90 G17 G54
 G0 X10 Y10 Z5
 G1 Z-1 F300
@@ -43,15 +44,17 @@ def test_the_figures_of_a_hand_made_program():
     source = ErrorSource(Shift(), "shift", "0" * 16, 0.5)
     stats = process(io.BytesIO(PROGRAM), io.BytesIO(), file="hand.ngc", source=source, warnings=None)
     s = stats.summary
-    assert s.moves == 5  # G0 X10 Y10 Z5, G1 Z-1, X40 Y10, X40 Y30, G0 Z5
-    assert s.feed_mm == pytest.approx(6 + 30 + 20)  # the feed moves: Z5 to Z-1, then 30 and 20 mm
+    # G0 X10 Y10 Z5, G1 Z-1, X40 Y10, X40 Y30, G0 Z5; 4 a hole (up to R: the series started below it, over, down, up)
+    assert s.moves == 5 + 8
+    # the feed moves: Z5 to Z-1, then 30 and 20 mm; each hole 5 mm down from R
+    assert s.feed_mm == pytest.approx(6 + 30 + 20 + 2 * 5)
     assert s.largest_mm == pytest.approx(0.010, abs=2e-7)
-    assert s.left_moves == {"canned cycle": 8, "cutter compensation": 3}  # 4 moves a hole; G41, G1, G40 moves
-    assert s.left == {"canned cycle": [[6, 7]], "cutter compensation": [[10, 12]]}
+    assert s.left_moves == {"cutter compensation": 3}  # G41, G1, G40 moves
+    assert s.left == {"cutter compensation": [[10, 12]]}
     assert (s.lines_in, s.lines_out) == (13, stats.lines_out)
     line = s.line()
-    assert "compensated 5 moves (56.0 mm of feed path), largest correction 10.0 µm" in line
-    assert "8 moves of canned cycles (lines 6-7), 3 moves under cutter compensation (lines 10-12)" in line
+    assert "compensated 13 moves (66.0 mm of feed path), largest correction 10.0 µm" in line
+    assert "left as programmed: 3 moves under cutter compensation (lines 10-12);" in line
 
 
 def test_out_of_scope_is_counted_from_its_line():
@@ -91,8 +94,8 @@ def test_the_summary_is_on_stderr_without_a_terminal_and_in_the_report(tmp_path,
     summary = [ln for ln in proc.stderr.decode().splitlines() if ln.startswith("ncpp: hand.ngc: compensated")]
     assert len(summary) == 1 and "13 lines in" in summary[0]
     report = json.loads((tmp_path / "r.json").read_text())
-    assert report["moves_compensated"] == 5 and report["feed_path_compensated_mm"] == 56.0
-    assert report["left_as_programmed"]["canned cycle"] == {"moves": 8, "lines": [[6, 7]]}
+    assert report["moves_compensated"] == 13 and report["feed_path_compensated_mm"] == 66.0
+    assert "canned cycle" not in report["left_as_programmed"]
     assert report["left_as_programmed"]["cutter compensation"] == {"moves": 3, "lines": [[10, 12]]}
     assert 1.0 < report["largest_correction_um"] < 100.0 and report["lines_in"] == 13
 

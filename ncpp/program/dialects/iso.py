@@ -16,7 +16,8 @@ from collections.abc import Iterable, Iterator
 from dataclasses import replace
 from operator import itemgetter
 
-from ncpp.motion.segments import EXTRA_AXES, Arc, Context, Event, Line, Pass, Setting
+from ncpp.motion.cycles import CANNED
+from ncpp.motion.segments import CYCLE, EXTRA_AXES, Arc, Context, Event, Line, Pass, Setting
 from ncpp.passes.rotary import time_shares, turns
 from ncpp.program.blocks import DIGITS_AS_ONE, Block, Comment, ExprWord, Statement, Word
 from ncpp.program.numbers import NumberStyle, format_number
@@ -146,6 +147,8 @@ class IsoWriter:
         block = first.block
         if type(first) is Pass and first.skipped:  # text the program does not run: it teaches nothing
             return [block.text]
+        if type(first) is Pass and first.cycle is not None:
+            return self._expanded(block, group)
         facts = self._read_block(block)
         if facts.flow:
             return self._write_control(block, first)
@@ -153,18 +156,21 @@ class IsoWriter:
             return [self._setting_text(block, first.setting) + block.eol]
         motion = [e for e in group if type(e) is Line or type(e) is Arc]
         lead = 0  # steps to a canned cycle's start (`apply_error_map._lead_in`): new blocks before it
-        while lead < len(motion) and motion[lead].fixed and motion[lead].changed:
+        while lead < len(motion) and motion[lead].fixed == CYCLE and motion[lead].changed:
             lead += 1
         lines = self._new_blocks(block, motion[:lead], block.eol) if lead else []
         motion = motion[lead:] if lead else motion
+        hole = motion[0].hole if motion and type(motion[0]) is Line else None
+        drilled = hole is not None and hole.command is not None  # a compensated cycle: its words change
         for segment in motion:
             if segment.changed:
                 break
-        else:  # nothing changed
+        else:  # nothing changed, or a compensated cycle's words only
             self._learn_program_motion(block, motion)
             if self._needs_mode_restore(block):
                 lines.append(self._restore_mode_line(block))
-            lines.append(block.text)
+            text = self._hole_text(block, motion[0]) if drilled else block.text  # type: ignore[arg-type]
+            lines.append(text)
             self._after_verbatim(block, motion)
             return lines
         if not facts.plain:
@@ -364,6 +370,40 @@ class IsoWriter:
             # a canned cycle, a loop or a subroutine: where it leaves the tool is the control's (G98
             # retracts to the compensated level it started from), so the next block writes every axis it knows
             self._last_end = None
+
+    def _expanded(self, block: Block, group: list[Event]) -> list[str]:
+        """A canned cycle's block written as its moves (--expand-cycles): its other words first
+        (`_cycle_rest`), then a G0/G1 block per move, a G4 where it dwells.  The program's motion
+        mode after it is the cycle's, which no block written after relies on (a block moving in it
+        is one of these too)."""
+        self._read_block(block)
+        eol, (separator, lower) = block.eol, self._spelling(block)
+        rest = _cycle_rest(block, separator)
+        lines = [rest + eol] if rest else []
+        run: list[Line | Arc] = []
+        for event in group[1:]:
+            if type(event) is Pass and event.dwell is not None:
+                lines += self._new_blocks(block, run, eol)
+                dwell = f"G4{separator}P{event.dwell:g}"
+                lines.append((dwell.lower() if lower else dwell) + eol)
+                run = []
+            elif type(event) is Line or type(event) is Arc:
+                run.append(event)
+        lines += self._new_blocks(block, run, eol)
+        self.program_motion = None
+        return lines
+
+    def _hole_text(self, block: Block, move: Line) -> str:
+        """A compensated canned cycle's block with its corrected X Y Z R, each written: every hole
+        has a correction of its own, so none may be left to the previous block's sticky value.  Polar
+        words (`@` `^`) give way to the X Y they put the hole at."""
+        assert move.hole is not None and move.hole.command is not None  # (apply_error_map's)
+        texts = {
+            letter: format_number(value, self._style(letter, move))
+            for letter, value in zip("XYZR", move.hole.command)
+        }
+        return set_words(_literal_geometry(block, GEOMETRY_LETTERS + "@^"), texts, drop="@^",
+                         spelled=self._spelling(block)) + block.eol  # fmt: skip
 
     # -- o-word control lines ---------------------------------------------------
     def _write_control(self, block: Block, first: Event) -> list[str]:
@@ -891,6 +931,25 @@ class _Units:
 
 
 _MM, _INCH = _Units(False), _Units(True)
+
+
+# A canned cycle's own words, which its moves written as G0/G1 blocks replace (`IsoWriter._expanded`)
+_CYCLE_LETTERS = frozenset("XYZABCUVWRQLPIJK@^")
+
+
+def _cycle_rest(block: Block, separator: str) -> str:
+    """The block's text without its canned-cycle words (the cycle's G code, the hole's words):
+    its other words and comments, as written ("" when none is left but a block number)."""
+    raw, kept = block.raw, []
+    for item in block.items:
+        if type(item) is Word and item.letter.upper() == "G" and item.value in CANNED:
+            continue
+        if (type(item) is Word or type(item) is ExprWord) and item.letter.upper() in _CYCLE_LETTERS:
+            continue
+        kept.append(raw[item.start : item.end])
+    if all(text[:1] in "Nn" for text in kept):
+        return ""
+    return separator.join(kept)
 
 
 def _literal_geometry(block: Block, letters: str = GEOMETRY_LETTERS) -> Block:

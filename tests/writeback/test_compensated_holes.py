@@ -1,0 +1,183 @@
+"""Canned cycles in G90 and G17 are compensated hole by hole: the control's tool lands on each
+hole's programmed bottom (X Y Z) and R plane.  Judged by LinuxCNC's rs274 running ncpp's output,
+its moves mapped through a machine written here by hand (scale errors on X Y Z, squareness of
+X-Y and X-Z), not by ncpp's interpreter or model."""
+
+from __future__ import annotations
+
+import os
+import re
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from tests.compensation.accuracy import Machine, _moves, actual_moves, rs274_calls
+from tests.conftest import RS274
+from tests.writeback.conftest import compensate_file, machine_file
+
+MACHINE = machine_file(
+    "scales and squareness",
+    """
+[errors.EXX]
+kind = "polynomial"
+coefficients_um = [0.0, 0.05]
+[errors.EYY]
+kind = "polynomial"
+coefficients_um = [0.0, -0.04]
+[errors.EZZ]
+kind = "polynomial"
+coefficients_um = [0.0, 0.03]
+[squareness]
+C0Y_urad = 30.0
+B0Z_urad = 40.0
+""",
+)
+
+
+def square(points: np.ndarray, _directions: np.ndarray) -> np.ndarray:
+    """Where the tool is for commanded points, mm: X scale 50 µm/m, Y scale -40 µm/m, Z scale
+    30 µm/m; Y motion carries X by -30 µm/m (C0Y), Z motion carries X by +40 µm/m (B0Z)."""
+    x, y, z = points[:, 0], points[:, 1], points[:, 2]
+    return points + np.column_stack([0.05 * x - 0.03 * y + 0.04 * z, -0.04 * y, 0.03 * z]) / 1000
+
+
+REVERSAL = machine_file(
+    "reversals of X and Z",
+    """
+[errors.EXX]
+kind = "table"
+positions = [-1000.0, 1000.0]
+values_um = [-10.0, 10.0]
+values_um_minus = [-13.0, 7.0]
+[errors.EZZ]
+kind = "table"
+positions = [-1000.0, 1000.0]
+values_um = [-20.0, 20.0]
+values_um_minus = [-18.0, 22.0]
+[errors.EZX]
+kind = "polynomial"
+coefficients_um = [0.0, 0.02]
+[squareness]
+C0Y_urad = 30.0
+""",
+)
+
+
+def reversing(points: np.ndarray, directions: np.ndarray) -> np.ndarray:
+    """X off by 0.01 µm/mm · x, 3 µm less travelling − (it runs ahead on reversal), and -30 µm/m · y
+    (C0Y); Z by 0.02 µm/mm · z and 0.02 µm/mm · x (X's straightness), 2 µm more travelling − (lost
+    motion)."""
+    x, y, z = points[:, 0], points[:, 1], points[:, 2]
+    dx = 0.01 * x - 0.03 * y - (3.0 if directions[0] < 0 else 0.0)
+    dz = 0.02 * z + 0.02 * x + (2.0 if directions[2] < 0 else 0.0)
+    return points + np.column_stack([dx, 0 * x, dz]) / 1000
+
+
+# (X, Y, Z bottom, R) of each hole, in the order the program drills them
+HOLES = [
+    (100, 120, -16, 3), (30, 40, -16, 3), (150, -50, -20, 5), (-80, 60, -20, 5),
+    (200, 10, -5, 2), (210, 10, -7.5, 2.5), (220, 100, -9, 1), (230, 110, -3, 1), (240, 120, -3, 1),
+    (250, 130, -4, 1.5), (-250, -130, -4, 1.5), (-200, 300, -6, 2), (-190, 300, -3, 1), (-190, -250, -3, 1),
+    (300 * 0.5**0.5, 300 * 0.5**0.5, -3, 1),
+]  # fmt: skip
+PROGRAM = """G21 G90 G17
+G0 X40 Y30 Z25
+G1 X45 Y35 F300
+G0 Z25
+G99 G81 X100 Y120 R3 Z-16 F100
+X30 Y40
+G98 G83 X150 Y-50 R5 Z-20 Q4
+X-80 Y60
+G80
+G0 X0 Y0
+G99 G82 X200 Y10 R2 Z-5 P0.5
+G85 X210 R2.5 Z-7.5
+G73 X220 Y100 Z-9 R1 Q2.5
+M3 S500
+G86 X230 Y110 Z-3 R1 P1
+G89 X240 Y120 Z-3 R1 P1
+G84 X250 Y130 Z-4 R1.5
+M4
+G74 X-250 Y-130 R1.5 Z-4
+G80
+G1 X-190 Y290 Z4 F400
+G98 G81 X-200 Y300 R2 Z-6
+G99 X-190 Z-3 R1
+Y-250
+@300 ^45
+G80
+M5
+M2
+"""
+
+
+def drilled(path: Path, machine: Machine | None) -> list[tuple[np.ndarray, float]]:
+    """Per hole of `path` as rs274 runs it (mapped through `machine`, or as commanded: None): where
+    the tool is at its bottom, and its Z where it arrives above the hole at R.  A hole: a run
+    of moves ending at one commanded X Y with a feed down Z; its R point the end of the move
+    before its first feed, its bottom the lowest feed end."""
+    commanded = _moves(path)
+    actual = [b for _, b, _ in commanded] if machine is None else [m[-1] for m in actual_moves(path, machine)]
+    runs: list[list[int]] = []
+    for k, (_, end, _) in enumerate(commanded):  # (moves written one by one: µm apart in X Y)
+        if runs and np.allclose(commanded[runs[-1][0]][1][:2], end[:2], atol=0.01):
+            runs[-1].append(k)
+        else:
+            runs.append([k])
+    out = []
+    for run in runs:
+        plunges = [k for k in run if commanded[k][2] and _plunges(*commanded[k][:2])]
+        if plunges:
+            lowest = min(plunges, key=lambda k: commanded[k][1][2])
+            out.append((actual[lowest], float(actual[plunges[0] - 1][2])))
+    return out
+
+
+def _plunges(start: np.ndarray, end: np.ndarray) -> bool:
+    return bool(np.allclose(start[:2], end[:2], atol=0.01) and end[2] < start[2] - 0.01)
+
+
+@pytest.mark.parametrize("machine_toml, machine", [(MACHINE, square), (REVERSAL, reversing)],
+                         ids=["scales and squareness", "reversals"])  # fmt: skip
+def test_each_hole_bottom_and_r_plane_land_where_programmed(tmp_path, machine_toml, machine):
+    original = tmp_path / "holes.ngc"
+    original.write_text(PROGRAM)
+    output = compensate_file(original, machine_toml, tmp_path)
+    wanted = np.array(HOLES, dtype=float)
+    assert np.allclose([tuple(b) + (r,) for b, r in drilled(original, None)], wanted, atol=1e-6)
+    before = drilled(original, machine)
+    after = drilled(output, machine)
+    assert len(after) == len(HOLES)
+    off_before = np.array([np.linalg.norm(b - h[:3]) for (b, _), h in zip(before, wanted)]) * 1000
+    off_after = np.array([np.linalg.norm(b - h[:3]) for (b, _), h in zip(after, wanted)]) * 1000
+    r_after = np.array([abs(r - h[3]) for (_, r), h in zip(after, wanted)]) * 1000
+    assert off_before.min() > 1.5  # the machine is wrong enough to tell, at every hole
+    assert off_after.max() <= 0.5, off_after
+    assert r_after.max() <= 0.5, r_after
+
+
+def _rs274_text(path: Path) -> str:
+    if not RS274.exists():
+        pytest.skip("rs274 oracle not available")
+    proc = subprocess.run([str(RS274), str(path)], capture_output=True, text=True, timeout=120,
+                          env={**os.environ, "RS274_DIGITS": "7"}, stdin=subprocess.DEVNULL)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    return proc.stdout
+
+
+def test_a_g92_after_a_compensated_hole_sets_the_programs_offset(tmp_path):
+    """After a compensated hole the control stands at the corrected point, which ncpp knows: a G92
+    there is written moved by it, so the control sets the offset the program means, and the moves
+    after it land where the program puts them."""
+    original = tmp_path / "g92.ngc"
+    original.write_text("G21 G90 G54\nG0 X10 Y10 Z20\nG1 X50 F300\nG98 G81 X20 Y30 Z-2 R2 F100\nG80\n"
+                        "G92 X0 Y0\nG1 X20 Y10\nX-5 Y40 Z3\nG92.1\nM2\n")  # fmt: skip
+    output = compensate_file(original, MACHINE, tmp_path)
+    offsets = [re.findall(r"SET_G92_OFFSET\(([^)]*)\)", _rs274_text(p)) for p in (original, output)]
+    assert offsets[0] == offsets[1] and "20.0000000, 30.0000000" in offsets[0][1]
+    shift = np.array([20.0, 30.0, 0.0])
+    wanted = np.array([[20, 10, 20], [-5, 40, 3]], dtype=float) + shift
+    got = np.array([args[:3] for name, args in rs274_calls(output) if name == "STRAIGHT_FEED"][-2:]) + shift
+    assert np.abs(square(got, np.ones(3)) - wanted).max() * 1000 <= 0.5

@@ -1,0 +1,95 @@
+"""`--expand-cycles`: a canned cycle's block is written as G0/G1 blocks, each move compensated,
+and G4 where G82 and G89 dwell, for controls without canned cycles.  Judged by LinuxCNC's rs274
+on the output (the same dwells; no cycle left; every hole's bottom and R point where the
+program puts them on a machine written here by hand), and the cycles that cannot be written so
+are refused."""
+
+from __future__ import annotations
+
+import io
+import os
+import re
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from ncpp.errors import NcppError, Warnings
+from ncpp.pipeline import ErrorSource, process
+from tests.conftest import ROOT
+from tests.writeback.conftest import compensate_file
+from tests.writeback.test_compensated_holes import MACHINE, _rs274_text, drilled, square
+
+PROGRAM = """G21 G90 G17
+G0 X40 Y30 Z25
+G1 X45 Y35 F300
+G0 Z25
+G99 G81 X100 Y120 R3 Z-16 F100
+X30 Y40
+G98 G83 X150 Y-50 R5 Z-20 Q4
+X-80 Y60
+G80
+G0 X0 Y0
+G99 G82 X200 Y10 R2 Z-5 P0.5 M8
+G85 X210 R2.5 Z-7.5
+G73 X220 Y100 Z-9 R1 Q2.5
+G89 X240 Y120 Z-3 R1 P1
+G91 G81 X10 Y-10 R-24 Z-5 L2
+G90 G80
+M9
+M2
+"""
+HOLES = [
+    (100, 120, -16, 3), (30, 40, -16, 3), (150, -50, -20, 5), (-80, 60, -20, 5), (200, 10, -5, 2),
+    (210, 10, -7.5, 2.5), (220, 100, -9, 1), (240, 120, -3, 1), (250, 110, -4, 1), (260, 100, -4, 1),
+]  # fmt: skip
+
+
+def test_expanded_cycles_dwell_as_programmed_and_hit_every_hole(tmp_path):
+    original = tmp_path / "holes.ngc"
+    original.write_text(PROGRAM)
+    output = compensate_file(original, MACHINE, tmp_path, expand_cycles=True)
+    text = output.read_text()
+    assert not re.search(r"G(7[34]|8[1-9])\b", text)  # no cycle left
+    dwells = [re.findall(r"DWELL\(([^)]*)\)", _rs274_text(p)) for p in (original, output)]
+    assert dwells[0] == dwells[1] == ["0.5000000", "1.0000000"]
+    wanted = np.array(HOLES, dtype=float)
+    assert np.allclose([tuple(b) + (r,) for b, r in drilled(original, None)], wanted, atol=1e-6)
+    after = drilled(output, square)
+    assert len(after) == len(HOLES)
+    assert max(np.linalg.norm(b - h[:3]) for (b, _), h in zip(after, wanted)) * 1000 <= 0.5
+    assert max(abs(r - h[3]) for (_, r), h in zip(after, wanted)) * 1000 <= 0.5
+
+
+class Shift:
+    """Every point lands 6 µm off in X."""
+
+    def deviation(self, P, direction=None):
+        return np.broadcast_to(np.array([0.006, 0.0, 0.0]), np.shape(P)).copy()
+
+
+@pytest.mark.parametrize("cycle", ["G84 X2 Y2 Z-1 R1", "G74 X2 Y2 Z-1 R1", "G86 X2 Y2 Z-1 R1 P1",
+                                   "G87 X2 Y2 Z-1 R1 I1 J0 K0"])  # fmt: skip
+def test_the_cycles_g0_g1_cannot_do_are_refused(cycle):
+    spindle = "M4" if cycle.startswith("G74") else "M3"
+    program = f"G21 G90\nG0 X0 Y0 Z5\n{spindle} S100\nG1 X1 F100\n{cycle} F100\nG80\nM2\n"
+    source = ErrorSource(Shift(), "shift", "0" * 16, 0.5)
+    with pytest.raises(
+        NcppError, match=rf"t\.ngc:5:1: --expand-cycles: {cycle[:3]} cannot be written as G0/G1"
+    ):
+        process(io.BytesIO(program.encode()), io.BytesIO(), file="t.ngc", source=source,
+                warnings=Warnings(stream=open(os.devnull, "w")), expand_cycles=True)  # fmt: skip
+
+
+@pytest.mark.parametrize("command", [("ncpp", "compensate"), ("ncpp",)])
+def test_both_commands_take_the_option(tmp_path, command):
+    (tmp_path / "machine.toml").write_text(MACHINE)
+    (tmp_path / "p.ngc").write_text("G21 G90\nG0 X0 Y0 Z5\nG82 X10 Y10 Z-1 R1 P0.2 F100\nG80\nM2\n")
+    environ = {k: v for k, v in os.environ.items() if k not in ("NCPP_MACHINE", "XDG_CONFIG_HOME")}
+    environ.update(PYTHONPATH=str(ROOT), HOME=str(tmp_path))
+    proc = subprocess.run([sys.executable, "-m", *command, "--machine", "machine.toml", "--expand-cycles", "p.ngc",
+                           "-o", "out.ngc"], capture_output=True, cwd=tmp_path, env=environ, timeout=300)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    written = (tmp_path / "out.ngc").read_text()
+    assert "G82" not in written and "G4 P0.2" in written and "canned cycle" not in proc.stderr.decode()
