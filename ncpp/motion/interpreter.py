@@ -138,6 +138,7 @@ _MODE0_WITH_COMP = {
     **{c: "Cannot set reference point with cutter compensation in effect" for c in (28.1, 30.1)},
     53.0: "Cannot use g53 with cutter radius comp",
 }
+_FANUC_MESSAGES = (3000, 3006)  # Fanuc's alarm and stop-with-message system variables
 _MOTION_WITH_COMP = {
     **{
         c: "Cannot use canned cycles with cutter compensation on"
@@ -245,6 +246,7 @@ class Interpreter:
         self.untold: set[int] = set()  # coordinate systems whose zero nobody said (warned when selected)
         self.warnings: Warnings | None = None
         self.flow: Flow | None = None  # while `run` runs
+        self.stopped = False  # a program stop (M0, M1, #3006) the operator may have jogged the machine at
         self.subroutine_path = offsets.subroutine_path if offsets is not None else ()
         if offsets is not None:
             self._start_from(offsets)
@@ -289,6 +291,8 @@ class Interpreter:
                 event = block_event(block)  # verbatim blocks (after the closing %) have no items
                 if kind is FIXED:
                     event = self._in_flow(event, owner)
+                elif type(event) is not Pass:  # a move in its place: a backward GOTO may not run it again
+                    flow.last_run_move = block.line
                 if self.off_path or self.cutter_comp is not None or self.arc_refused:
                     event = self._in_comp(event, block)
             except NcppError as err:
@@ -511,10 +515,16 @@ class Interpreter:
                 continue
             elif kind is ExprWord:
                 computed: ExprWord = item  # type: ignore[assignment]  # (as above)
+                if _vacant(computed.expr, self.params):  # Fanuc: `X#1`, #1 vacant, is no X word
+                    continue
                 letter, value = computed.letter, self._evaluate(computed.expr, block, computed)
             else:
                 statement: Statement = item  # type: ignore[assignment]  # (as above)
                 what = statement.kind
+                if what == "if" and statement.node[2].upper() == "THEN":  # Fanuc `IF [..] THEN #i = ..`
+                    if self._evaluate(statement.node[1], block, item) == 0.0:
+                        continue
+                    statement, what = statement.node[3], "assignment"
                 if what == "assignment":
                     target, expr = statement.node
                     key = self._param_key(target, block, item)
@@ -523,7 +533,8 @@ class Interpreter:
                         # the value's expression too, reads 0; the value is set after the line
                         self.params.write(key, 0.0)
                     assignments = assignments or []
-                    assignments.append((key, self._evaluate(expr, block, item), item))
+                    value = None if _vacant(expr, self.params) else self._evaluate(expr, block, item)
+                    assignments.append((key, value, item))
                 elif what == "oword" and len(statement.node) == 1:  # `O<name>` alone: a program's name
                     pass
                 elif what == UNREADABLE:  # read where it runs, as rs274ngc reads it
@@ -563,7 +574,13 @@ class Interpreter:
                 words[letter] = (value, item)  # type: ignore[assignment]  # (a word: `kind`)
         if assignments is not None:  # rs274ngc: after the whole line is read
             for key, value, item in assignments:
+                if key in _FANUC_MESSAGES and self.flow is not None and self.flow.fanuc:
+                    self._fanuc_message(key, value, block, item)
+                    continue
                 try:
+                    if value is None:  # `#i = #0`: vacant, as Fanuc assigns it
+                        self.params.vacate(key) if type(key) is int else self.params.write(key, 0.0)
+                        continue
                     self.params.write(key, value)
                 except ExpressionError as err:
                     self._fail(str(err), block, item)
@@ -586,6 +603,17 @@ class Interpreter:
                 if plain is not None and words.keys() <= plain:
                     return self._motion_move(block, words, motion, motion_item)
         return self._execute(block, words, gcodes or {}, mcodes or {})
+
+    def _fanuc_message(self, key: int | str, value: float | None, block: Block, item) -> None:
+        """Fanuc's `#3000 = n (MESSAGE)`: the control stops with alarm 3000 + n and the message,
+        so ncpp refuses the program there; `#3006 = n (MESSAGE)`: it stops and shows the message
+        until the operator starts it again, as M0 (Fanuc 0i-MF operator's manual, "Custom macro",
+        System variables: alarm #3000, stop with message #3006)."""
+        comments = [i for i in block.items[block.items.index(item) + 1 :] if type(i) is Comment]
+        message = comments[0].text if comments else ""  # type: ignore[attr-defined]
+        if key == 3000:
+            self._fail(f"macro alarm {3000 + int(value or 0)}: {message}".rstrip(": "), block, item)
+        self.stopped = True
 
     def _set_feed(self, block: Block, word: tuple) -> None:
         if word[0] < 0.0:
@@ -1592,6 +1620,11 @@ _PLAIN_LETTERS = {
     3.0: frozenset("XYZABCUVWFIJKR"),
     **{code: frozenset() for code in CANNED},  # a cycle's words are checked in full
 }
+
+
+def _vacant(expr: tuple, params: Parameters) -> bool:
+    """An expression that is a vacant Fanuc variable itself (`#0`, an argument a G65 call left out)."""
+    return expr[0] == "param" and type(expr[1]) is int and params.is_vacant(expr[1])
 
 
 def _homes(block: Block) -> bool:

@@ -1,0 +1,230 @@
+"""Fanuc macro B control flow: GOTO, IF ... GOTO, IF ... THEN, WHILE ... DO ... END, G65 macro
+calls, vacant variables, #3000 / #3006.
+
+The rules are Fanuc's (Fanuc 0i-MF / 30i operator's manual, "Custom macro": "Branch and
+repetition", "Macro call", "Variables"); the oracle for the motion is LinuxCNC's rs274 running
+the same program written with o-words (`o100 while`, `o100 if`, `o100 sub` with #1..): each
+Fanuc program here has its LinuxCNC twin, and ncpp's moves of the one are rs274's of the other.
+"""
+
+from __future__ import annotations
+
+import io
+
+import pytest
+
+from ncpp.errors import NcppError, Warnings
+from ncpp.motion import interpret
+from ncpp.motion.segments import FLOW, Line, Pass
+from ncpp.program.parser import parse_stream
+from tests.motion.test_oracle import ours, read_canon, rs274, rs274_error, same_calls, write_program
+
+HEAD = "G21 G90 G17\nG0 X0 Y0 Z5 F300\n"
+
+# name: (Fanuc program, the same program for LinuxCNC)
+TWINS = {
+    # the manual's example: the sum of 1 to 10 with IF ... GOTO, each partial sum a move
+    "sum with IF GOTO back": (
+        "O0001\n" + HEAD + "#1=0\n#2=1\nN1 IF [#2 GT 10] GOTO 2\n#1=#1+#2\nG1 X#1\n#2=#2+1\nGOTO 1\n"
+        "N2 G0 Y#1\nM30\n",
+        HEAD + "#1=0\n#2=1\no1 while [#2 LE 10]\n#1=[#1+#2]\nG1 X#1\n#2=[#2+1]\no1 endwhile\nG0 Y#1\nM2\n",
+    ),
+    # the manual's example again, with WHILE
+    "sum with WHILE": (
+        "O0002\n" + HEAD + "#1=0\n#2=1\nWHILE [#2 LE 10] DO1\n#1=#1+#2\nG1 X#1 Y#2\n#2=#2+1\nEND1\nM30\n",
+        HEAD + "#1=0\n#2=1\no1 while [#2 LE 10]\n#1=[#1+#2]\nG1 X#1 Y#2\n#2=[#2+1]\no1 endwhile\nM2\n",
+    ),
+    # nested loops (DO1 around DO2), a grid of plunges
+    "nested WHILE": (
+        HEAD + "#10=0\nWHILE [#10 LT 3] DO1\n#11=0\nWHILE [#11 LT 2] DO2\nG0 X[#10*10] Y[#11*5]\n"
+        "G1 Z-1\nG0 Z5\n#11=#11+1\nEND2\n#10=#10+1\nEND1\nM30\n",
+        HEAD + "#10=0\no1 while [#10 LT 3]\n#11=0\no2 while [#11 LT 2]\nG0 X[#10*10] Y[#11*5]\n"
+        "G1 Z-1\nG0 Z5\n#11=[#11+1]\no2 endwhile\n#10=[#10+1]\no1 endwhile\nM2\n",
+    ),
+    # a loop that runs no time, then a loop of the same number again (ids may be reused)
+    "WHILE false, DO1 reused": (
+        HEAD + "#1=5\nWHILE [#1 LT 3] DO1\nG1 X99\nEND1\nWHILE [#1 GT 3] DO1\nG1 X#1\n#1=#1-1\nEND1\nM30\n",
+        HEAD + "#1=5\no1 while [#1 LT 3]\nG1 X99\no1 endwhile\no2 while [#1 GT 3]\nG1 X#1\n#1=[#1-1]\n"
+        "o2 endwhile\nM2\n",
+    ),
+    # forward jumps: IF ... GOTO over moves, a computed GOTO#10, GOTO out of a loop
+    "forward and computed GOTO": (
+        HEAD + "#10=30\nIF [#10 EQ 30] GOTO 20\nG1 X99\nN20 G1 X1\nGOTO#10\nN25 G1 X98\nN30 G1 Y2\n"
+        "#1=0\nWHILE [1 EQ 1] DO1\n#1=#1+1\nG1 Z-#1\nIF [#1 GE 3] GOTO 40\nEND1\nN40 G0 Z5\nM30\n",
+        HEAD + "#10=30\nG1 X1\nG1 Y2\n#1=0\no1 while [1 EQ 1]\n#1=[#1+1]\nG1 Z-#1\no2 if [#1 GE 3]\n"
+        "o1 break\no2 endif\no1 endwhile\nG0 Z5\nM2\n",
+    ),
+    # IF ... THEN: one assignment, when the condition holds
+    "IF THEN": (
+        HEAD + "#1=2\n#2=0\nIF [#1 EQ 2] THEN #2=7\nIF [#1 NE 2] THEN #2=9\nG1 X#2\n"
+        "IF [[#1 GT 1] AND [#2 LT 8]] THEN #3=#1+#2\nG1 Y#3\nM30\n",
+        HEAD + "#1=2\n#2=7\nG1 X#2\n#3=[#1+#2]\nG1 Y#3\nM2\n",
+    ),
+    # a bolt-hole circle macro called with G65 and arguments (X Y: centre, R: radius,
+    # A: first angle, B: angle step, H: holes, Z: depth), its locals its own (#1 of the
+    # caller comes back); the LinuxCNC twin passes them in the order #1.. of its sub
+    "G65 bolt-hole circle": (
+        HEAD + "#1=77\nG65 P9100 X50 Y20 R15 A0 B60 H6 Z-3\nG65 P9100 X-10 Y0 R5 A45 B90 H4 Z-1\n"
+        "G0 X#1\nM30\n"
+        "O9100 (BOLT HOLE CIRCLE)\n#30=0\nWHILE [#30 LT #11] DO1\n#31=#1+#30*#2\n"
+        "G0 X[#24+#18*COS[#31]] Y[#25+#18*SIN[#31]]\nG1 Z#26\nG0 Z5\n#30=#30+1\nEND1\nM99\n",
+        HEAD + "#1=77\no100 sub\n#30=0\no101 while [#30 LT #6]\n#31=[#4+#30*#5]\n"
+        "G0 X[#1+#3*COS[#31]] Y[#2+#3*SIN[#31]]\nG1 Z#7\nG0 Z5\n#30=[#30+1]\no101 endwhile\no100 endsub\n"
+        "o100 call [50] [20] [15] [0] [60] [6] [-3]\no100 call [-10] [0] [5] [45] [90] [4] [-1]\nG0 X#1\nM2\n",
+    ),
+    # G65 ... L3: the macro runs three times, with the locals it left (the arguments set once)
+    "G65 L repeats": (
+        HEAD + "G65 P200 L3 X1 Z-2\nM30\nO200\nG1 X#24 Z#26\n#24=#24+1\nM99\n",
+        HEAD + "G1 X1 Z-2\nG1 X2 Z-2\nG1 X3 Z-2\nM2\n",
+    ),
+    # vacant arguments: IF [#i EQ #0] tells a left-out argument from one given as 0, and an
+    # address whose value is vacant is no address (`X#24` with no X moves no X)
+    "vacant arguments": (
+        HEAD + "G65 P300 X0 Y4\nG65 P300 Y6\nM30\n"
+        "O300\nIF [#24 EQ #0] GOTO 1\nG1 X#24\nGOTO 2\nN1 G1 X9\nN2 G1 X#24 Y#25\nM99\n",
+        HEAD + "G1 X0\nG1 X0 Y4\nG1 X9\nG1 Y6\nM2\n",
+    ),
+    # M98 inside a G65 macro shares the macro's locals
+    "M98 in a G65 macro": (
+        HEAD + "G65 P400 A3\nM30\nO400\nM98 P401\nG1 X#1\nM99\nO401\n#1=#1*2\nG1 Y#1\nM99\n",
+        HEAD + "G1 Y6\nG1 X6\nM2\n",
+    ),
+}
+
+
+def _pair(tmp_path, name: str):
+    fanuc, linuxcnc = TWINS[name]
+    program = tmp_path / "fanuc.nc"
+    program.write_text(fanuc)
+    return program, write_program(tmp_path, linuxcnc, "twin.ngc")
+
+
+def _events(text: str, **kwargs) -> list:
+    return list(interpret(parse_stream(io.BytesIO(text.encode()), "t.nc"), file="t.nc", **kwargs))
+
+
+def _warned(text: str) -> tuple[list, str]:
+    stream = io.StringIO()
+    events = _events(text, warnings=Warnings(stream=stream))
+    return events, stream.getvalue()
+
+
+@pytest.mark.parametrize("name", TWINS)
+def test_fanuc_macros_move_as_rs274_runs_their_o_word_twins(tmp_path, name):
+    program, twin = _pair(tmp_path, name)
+    calls, messages = rs274(str(twin))
+    assert rs274_error(messages) is None, messages
+    reference = read_canon(calls)
+    mine, error, warning = ours(program)
+    assert error is None and not warning, (error, warning)
+    assert len(mine) == len(reference) and same_calls(reference, mine), (reference, mine)
+
+
+@pytest.mark.parametrize("name", TWINS)
+def test_every_fanuc_block_is_written_once_where_it_stands(name):
+    text = TWINS[name][0]
+    groups, last = [], None
+    events, warned = _warned(text)
+    assert not warned  # (read, not passed through unread)
+    for event in events:
+        if event.block is not last:
+            groups.append(event.block.text)
+            last = event.block
+    assert "".join(groups) == text
+
+
+def test_moves_that_run_again_are_left_as_programmed():
+    """A loop's moves, a backward GOTO's from their first pass, a macro's: FIXED; the rest not."""
+    for name in ("sum with IF GOTO back", "sum with WHILE", "G65 bolt-hole circle"):
+        moves = [e for e in _events(TWINS[name][0]) if type(e) is not Pass]
+        looped = [m for m in moves if m.fixed == FLOW]
+        assert looped and all(not m.fixed for m in moves if m not in looped)
+    moves = [e for e in _events(TWINS["sum with IF GOTO back"][0]) if type(e) is Line]
+    assert [m.fixed == FLOW for m in moves] == [False] + [True] * 10 + [False]  # (G0 at the top, G0 Y after)
+
+
+def test_the_manual_sum_ends_with_55():
+    events = _events("O0001\n#1=0\n#2=1\nN1 IF [#2 GT 10] GOTO 2\n#1=#1+#2\n#2=#2+1\nGOTO 1\nN2 G0 X#1\nM30\n")
+    (move,) = [e for e in events if type(e) is Line]
+    assert move.end[0] == 55.0
+
+
+@pytest.mark.parametrize(
+    "text, line, message",
+    [
+        (HEAD + "END1\n", 3, "END1 without WHILE ... DO1"),
+        (HEAD + "WHILE [1 EQ 1] DO4\nEND4\n", 3, "a loop's number is 1, 2 or 3"),
+        (HEAD + "GOTO 0\n", 3, "a sequence number is 1 to 99999"),
+        (HEAD + "GOTO 7\nN8 G0 X1\n", 3, "the program has no block N7"),
+        (HEAD + "GOTO 5\nWHILE [1 EQ 1] DO1\nN5 G0 X1\nEND1\n", 3, "jumps into the loop WHILE ... DO1"),
+        (HEAD + "WHILE [1 EQ 1] DO1\nWHILE [1 EQ 1] DO2\nEND1\nEND2\n", 5, "END1 closes DO1 across the loop DO2"),
+        (HEAD + "WHILE [1 EQ 1] DO1\nWHILE [1 EQ 1] DO1\nEND1\nEND1\n", 4, "nested loops take different numbers"),
+        (HEAD + "G65 P9 L0\nM30\nO9\nM99\n", 3, "G65 L0: a macro runs 1 to 9999 times"),
+        (HEAD + "G65 P9\nM30\nO9\nIF [#24 EQ #0] THEN #3000=1 (X MISSING)\nM99\n", 6, "macro alarm 3001: X MISSING"),
+    ],
+)
+def test_refused_as_the_control_alarms(text, line, message):
+    with pytest.raises(NcppError) as err:
+        _events(text)
+    assert err.value.where.line == line and message in err.value.message, err.value
+
+
+def test_a_stop_with_a_message_is_no_error():
+    """#3006 = 1 (MESSAGE) stops the control as M0 does; the program goes on."""
+    events, warned = _warned("O1\n" + HEAD + "IF [1 EQ 1] GOTO 5\nN5 #3006=1 (TURN THE PART)\nG1 X4\nM30\n")
+    assert not warned and [e.end[0] for e in events if type(e) is Line][-1] == 4.0
+
+
+def test_3000_is_an_alarm_in_a_fanuc_program_a_parameter_in_a_linuxcnc_one():
+    with pytest.raises(NcppError) as err:
+        _events("O1\n" + HEAD + "GOTO 2\nN2 #3000=4 (NO TOOL)\nG1 X#3000\nM30\n")
+    assert err.value.where.line == 5 and err.value.message == "macro alarm 3004: NO TOOL"
+    events = _events(HEAD + "#3000=4 (NO TOOL)\nG1 X#3000\nM2\n")
+    assert [e.end[0] for e in events if type(e) is Line][-1] == 4.0
+
+
+def test_a_fanuc_programs_system_variables_are_out_of_scope():
+    """#5021 is where the machine stands, which the operator may have jogged it to; #2001 a tool
+    offset: read as a plain parameter (0) they would be a guess."""
+    _, warned = _warned("O1\n" + HEAD + "#1=#5021\nIF [#1 GT 0] GOTO 3\nN3 G1 X#1\nM30\n")
+    assert "t.nc:4:1: warning: the Fanuc system variable #5021 is outside" in warned
+    _, warned = _warned("O1\n" + HEAD + "#2001=0.1\nWHILE [0 EQ 1] DO1\nEND1\nM30\n")
+    assert "t.nc:4:1: warning: a write to the Fanuc system variable #2001" in warned
+
+
+def test_a_backward_goto_past_the_read_ahead_over_moves_run_once_is_out_of_scope(monkeypatch):
+    """Beyond the blocks read ahead at the start, a backward GOTO would run again a move passed
+    on as run once (its text may be rewritten for that one run): ncpp stops following."""
+    import ncpp.motion.flow as flow
+
+    monkeypatch.setattr(flow, "_TRIM", 4)
+    text = "O1\n" + HEAD + "#1=0\nG0 X1\nG0 X2\nN10 G1 X#1\n#1=#1+1\nIF [#1 LT 3] GOTO 10\nG0 Y5\nM30\n"
+    events, warned = _warned(text)
+    assert "t.nc:9:1: warning: GOTO 10 back over moves that ran once in their place" in warned
+    assert type(events[-2]) is Pass and events[-2].block.text == "G0 Y5\n"
+    monkeypatch.setattr(flow, "_TRIM", 4096)  # read ahead: the loop is seen, its moves FIXED
+    events, warned = _warned(text)
+    assert not warned and [e.end[0] for e in events if type(e) is Line and e.fixed == FLOW] == [0, 1, 2]
+
+
+def test_a_goto_whose_target_is_no_longer_held_is_out_of_scope():
+    body = "".join(f"G1 X{i % 50} Y{i % 7}\n" for i in range(3 * 4096))
+    _, warned = _warned("O1\n" + HEAD + "N5 G0 Z5\n" + body + "#1=1\nIF [#1 EQ 1] GOTO 5\nM30\n")
+    assert "GOTO 5: N5 is further back than the blocks ncpp holds" in warned
+
+
+def test_memory_stays_flat_with_fanuc_loops():
+    """A long program of WHILE loops and forward GOTOs: blocks are held only for a loop, and a
+    window back for a GOTO."""
+    from ncpp.motion.flow import _TRIM
+    from ncpp.motion.interpreter import Interpreter, run
+
+    piece = "#1=0\nWHILE [#1 LT 2] DO1\nG1 X#1\n#1=#1+1\nEND1\nIF [#1 EQ 2] GOTO {n}\nG1 X99\nN{n} G0 Z1\n"
+    body = "".join(piece.format(n=n + 1) for n in range(6000))
+    interpreter = Interpreter("t.nc")
+    seen = []
+    events = run(interpreter, parse_stream(io.BytesIO(("O1\n" + body).encode()), "t.nc"), None, True)
+    for n, _ in enumerate(events):
+        if n % 1000 == 0:
+            seen.append(len(interpreter.flow.buffer))  # type: ignore[union-attr]
+    assert n > 6000 * 5 and max(seen) <= 3 * _TRIM
