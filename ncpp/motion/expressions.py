@@ -133,7 +133,11 @@ class Parameters:
     and units.
     """
 
-    def __init__(self, system: Callable[[str], float | None] | None = None):
+    def __init__(
+        self,
+        system: Callable[[str], float | None] | None = None,
+        fanuc_system: Callable[[int], float | None] | None = None,
+    ):
         self.numbered: dict[int, float] = {}
         self.named: dict[str, float] = {
             "_value": 0.0,
@@ -148,6 +152,7 @@ class Parameters:
         # differs from 0 in EQ and NE, and leaves out the address it is the value of)
         self.vacant: set[int] = set()
         self.fanuc = False  # a Fanuc program: #1000 and up are the control's system variables
+        self.fanuc_system = fanuc_system  # those the interpreter knows (None: not known)
 
     def start_fanuc(self) -> None:
         """A Fanuc macro program starts: its local variables #1-#33 vacant, and #1000 and up the
@@ -195,7 +200,9 @@ class Parameters:
         if saved is not None:
             self.numbered.update(zip(range(1, len(saved) + 1), saved))
             if self.vacant or vacant:  # the caller's locals as they were; what the call did to the others
-                self.vacant = {k for k in self.vacant if k > len(saved)} | {k for k in vacant if k <= len(saved)}
+                self.vacant = {k for k in self.vacant if k > len(saved)} | {
+                    k for k in vacant if k <= len(saved)
+                }
         self.named["_value"], self.named["_value_returned"] = (0.0, 0.0) if value is None else (value, 1.0)
 
     def key(self, key, evaluate: Callable[[tuple], float]) -> int | str:
@@ -222,6 +229,9 @@ class Parameters:
     def read(self, key: int | str) -> float:
         if type(key) is int:
             if _machine_state(key) or key >= 1000 and self.fanuc:
+                known = self.fanuc_system(key) if self.fanuc and self.fanuc_system is not None else None
+                if known is not None:
+                    return known
                 raise OutOfScope(f"machine-state parameter #{key}" if not self.fanuc else
                                  f"the Fanuc system variable #{key}")  # fmt: skip
             return self.numbered.get(key, 0.0)  # (a vacant one: 0 in arithmetic, as Fanuc reads it)
@@ -248,7 +258,9 @@ class Parameters:
 
     def write(self, key: int | str, value: float) -> None:
         if type(key) is int:
-            if _machine_state(key) or key >= 1000 and self.fanuc:  # the control's zeros follow it, in its own units
+            if (
+                _machine_state(key) or key >= 1000 and self.fanuc
+            ):  # the control's zeros follow it, in its own units
                 raise OutOfScope(f"a write to the machine-state parameter #{key}" if not self.fanuc else
                                  f"a write to the Fanuc system variable #{key}")  # fmt: skip
             self.numbered[key] = value
@@ -304,8 +316,8 @@ def _value(expr: tuple, params: Parameters) -> float:
         return params.read(params.key(expr[1], lambda e: evaluate(e, params)))
     if kind == "bin":
         op = expr[1]
-        if (op == "EQ" or op == "NE") and (_vacant(expr[2], params) or _vacant(expr[3], params)):
-            same = _vacant(expr[2], params) and _vacant(expr[3], params)  # vacant EQ 0 is false
+        if (op == "EQ" or op == "NE") and (vacant(expr[2], params) or vacant(expr[3], params)):
+            same = vacant(expr[2], params) and vacant(expr[3], params)  # vacant EQ 0 is false
             return float(same == (op == "EQ"))
         return OPERATORS[op](evaluate(expr[2], params), evaluate(expr[3], params))
     if kind == "neg":
@@ -322,6 +334,7 @@ def _value(expr: tuple, params: Parameters) -> float:
     raise ExpressionError(f"cannot evaluate {kind!r}")
 
 
-def _vacant(expr: tuple, params: Parameters) -> bool:
-    """An operand that is a vacant Fanuc variable itself (`#0`, `#1` left vacant; `[#1+0]` is 0)."""
+def vacant(expr: tuple, params: Parameters) -> bool:
+    """An expression that is a vacant Fanuc variable itself (`#0`, an argument a G65 call left
+    out; `[#1+0]` is 0): EQ and NE tell it from 0, an address it is the value of is left out."""
     return expr[0] == "param" and type(expr[1]) is int and params.is_vacant(expr[1])

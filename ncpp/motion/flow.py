@@ -61,7 +61,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ncpp.errors import Location, NcppError, printable
-from ncpp.motion.expressions import SUBROUTINE_PARAMETERS, normalise_name, round_half_away
+from ncpp.motion.expressions import SUBROUTINE_PARAMETERS, normalise_name, round_half_away, vacant
 from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
 from ncpp.program.parser import parse_stream
 
@@ -180,7 +180,7 @@ class Flow:
         self.dropped: set[int] = set()  # sequence numbers of main-program blocks no longer held
         self.looped: set[int] = set()  # main-program lines a backward GOTO read ahead runs again
         self.last_run_move = -1  # the text line of the last move run in place (RUN): the interpreter's
-        self.fanuc = False  # the program has shown Fanuc macro control (its #3000 is an alarm)
+        self.fanuc = False  # the program has shown itself a Fanuc one (its #3000 is an alarm)
 
     # -- the stream ------------------------------------------------------------
     def steps(self, blocks: Iterable[Block]) -> Iterator[tuple[Block, str, Block | None]]:
@@ -352,9 +352,13 @@ class Flow:
         self.buffer.append(block)
         self.read += 1
         control = self._control_of(block)
-        if control is not None and control.name is None or control is not None and control.keyword == "fanuc_end":
-            self.fanuc = True
         number = program_number(block) if control is None else None
+        if (
+            number is not None
+            or control is not None
+            and (control.name is None or control.keyword == "fanuc_end")
+        ):
+            self.fanuc = True  # (a program number, M98, M99, G65, a macro statement)
         starts = number is not None or (control is not None and control.keyword == "sub")
         if self._defining is not None and not (starts and self._defining[0] is self.subprograms):
             self._extend_definition(block, control)
@@ -565,7 +569,7 @@ class Flow:
         values = {
             MACRO_ARGUMENTS[item.letter]: self._number(item, block)
             for item in arguments
-            if not _vacant_word(item, self.parameters)  # (an argument whose value is vacant is not given)
+            if type(item) is Word or not vacant(item.expr, self.parameters)  # (a vacant one: not given)
         }
         body = self._defined(self.subprograms, name)
         if body is None:
@@ -619,7 +623,11 @@ class Flow:
         where = Location(self.file, block.line, control.item.start + 1)
         if label is None or label.kind != "fanuc":
             raise NcppError(f"END{m} without WHILE ... DO{m} (Fanuc alarm 124)", where)
-        inner = [other for other, open_ in frame.labels.items() if open_.kind == "fanuc" and open_.start > label.start]
+        inner = [
+            other
+            for other, open_ in frame.labels.items()
+            if open_.kind == "fanuc" and open_.start > label.start
+        ]
         if inner:
             raise NcppError(f"END{m} closes DO{m} across the loop {inner[0]}: loops nest, they do not cross "
                             "(Fanuc alarm 124)", where)  # fmt: skip
@@ -652,7 +660,9 @@ class Flow:
             return lambda: None
 
         def back():
-            for name in [n for n, label in frame.labels.items() if label.kind == "fanuc" and label.start >= index]:
+            for name in [
+                n for n, label in frame.labels.items() if label.kind == "fanuc" and label.start >= index
+            ]:
                 del frame.labels[name]  # left: the jump goes back before its WHILE
             frame.pc = index
 
@@ -1005,14 +1015,6 @@ def _macro_call(block: Block, g65: Word) -> Control | None:
 
 def _integer(digits: str) -> int:
     return int("".join(digits.split()))
-
-
-def _vacant_word(word: Word | ExprWord, parameters) -> bool:
-    """A word whose value is a vacant variable itself (`X#24`, #24 vacant): Fanuc leaves it out."""
-    if type(word) is Word:
-        return False
-    expr = word.expr  # type: ignore[union-attr]
-    return expr[0] == "param" and type(expr[1]) is int and parameters.is_vacant(expr[1])
 
 
 def sequence_number(block: Block) -> int | None:

@@ -37,7 +37,7 @@ from typing import NoReturn, cast
 from ncpp.errors import Location, NcppError, Warnings
 from ncpp.motion.corners import CornerError, round_corner
 from ncpp.motion.cycles import CANNED, DWELLING, PECKING, RAPID_DELTA_INCH, SPINDLE, back_bore, hole
-from ncpp.motion.expressions import ExpressionError, OutOfScope, Parameters, evaluate
+from ncpp.motion.expressions import ExpressionError, OutOfScope, Parameters, evaluate, vacant
 from ncpp.motion.flow import FIXED, RUN, SKIP, Flow
 from ncpp.motion.offsets import SYSTEMS, WorkOffsets
 from ncpp.motion.segments import (
@@ -232,7 +232,7 @@ class Interpreter:
         )  # warned at the first G43 that reads the table
         self.home = {28: [0.0] * 9, 30: [0.0] * 9}  # G28/G30 positions, machine coordinates
         self.uses_extra_axes = False
-        self.params = Parameters(self._system_parameter)
+        self.params = Parameters(self._system_parameter, self._fanuc_system_variable)
         self._context: Context | None = None
         self._fast = False
         self.done = False  # program end (M2/M30) reached or state unknown
@@ -246,7 +246,9 @@ class Interpreter:
         self.untold: set[int] = set()  # coordinate systems whose zero nobody said (warned when selected)
         self.warnings: Warnings | None = None
         self.flow: Flow | None = None  # while `run` runs
-        self.stopped = False  # a program stop (M0, M1, #3006) the operator may have jogged the machine at
+        # Fanuc: the axes (0 X, 1 Y, 2 Z) a move has put at a programmed position since the start or
+        # the last program stop (where the operator may jog the machine): #5001-#5003 read them
+        self.placed: set[int] = set()
         self.subroutine_path = offsets.subroutine_path if offsets is not None else ()
         if offsets is not None:
             self._start_from(offsets)
@@ -293,6 +295,8 @@ class Interpreter:
                     event = self._in_flow(event, owner)
                 elif type(event) is not Pass:  # a move in its place: a backward GOTO may not run it again
                     flow.last_run_move = block.line
+                if self.params.fanuc:
+                    self._note_placed(block)
                 if self.off_path or self.cutter_comp is not None or self.arc_refused:
                     event = self._in_comp(event, block)
             except NcppError as err:
@@ -515,7 +519,7 @@ class Interpreter:
                 continue
             elif kind is ExprWord:
                 computed: ExprWord = item  # type: ignore[assignment]  # (as above)
-                if _vacant(computed.expr, self.params):  # Fanuc: `X#1`, #1 vacant, is no X word
+                if vacant(computed.expr, self.params):  # Fanuc: `X#1`, #1 vacant, is no X word
                     continue
                 letter, value = computed.letter, self._evaluate(computed.expr, block, computed)
             else:
@@ -533,8 +537,8 @@ class Interpreter:
                         # the value's expression too, reads 0; the value is set after the line
                         self.params.write(key, 0.0)
                     assignments = assignments or []
-                    value = None if _vacant(expr, self.params) else self._evaluate(expr, block, item)
-                    assignments.append((key, value, item))
+                    assigned = None if vacant(expr, self.params) else self._evaluate(expr, block, item)
+                    assignments.append((key, assigned, item))
                 elif what == "oword" and len(statement.node) == 1:  # `O<name>` alone: a program's name
                     pass
                 elif what == UNREADABLE:  # read where it runs, as rs274ngc reads it
@@ -573,15 +577,15 @@ class Interpreter:
                     self._fail(f"Multiple {letter.lower()} words on one line", block, item)
                 words[letter] = (value, item)  # type: ignore[assignment]  # (a word: `kind`)
         if assignments is not None:  # rs274ngc: after the whole line is read
-            for key, value, item in assignments:
+            for key, assigned, item in assignments:
                 if key in _FANUC_MESSAGES and self.flow is not None and self.flow.fanuc:
-                    self._fanuc_message(key, value, block, item)
+                    self._fanuc_message(key, assigned, block, item)
                     continue
                 try:
-                    if value is None:  # `#i = #0`: vacant, as Fanuc assigns it
-                        self.params.vacate(key) if type(key) is int else self.params.write(key, 0.0)
-                        continue
-                    self.params.write(key, value)
+                    if assigned is None and type(key) is int:  # `#i = #0`: vacant, as Fanuc assigns it
+                        self.params.vacate(key)
+                    else:
+                        self.params.write(key, 0.0 if assigned is None else assigned)
                 except ExpressionError as err:
                     self._fail(str(err), block, item)
                 except OutOfScope as err:
@@ -610,10 +614,38 @@ class Interpreter:
         until the operator starts it again, as M0 (Fanuc 0i-MF operator's manual, "Custom macro",
         System variables: alarm #3000, stop with message #3006)."""
         comments = [i for i in block.items[block.items.index(item) + 1 :] if type(i) is Comment]
-        message = comments[0].text if comments else ""  # type: ignore[attr-defined]
+        message = comments[0].text if comments else ""
         if key == 3000:
             self._fail(f"macro alarm {3000 + int(value or 0)}: {message}".rstrip(": "), block, item)
-        self.stopped = True
+        self.placed.clear()
+
+    def _fanuc_system_variable(self, key: int) -> float | None:
+        """The Fanuc system variables ncpp knows: #5001-#5003, the end point of the last block
+        in the workpiece coordinate system, of an axis a move has placed since the start or the
+        last stop, with no G92/G52 shift (Fanuc 0i-MF operator's manual, "Custom macro", System
+        variables: position information).  Not #5021-#5023, the machine position: the control
+        reads it ahead, while the block before moves ("reading during movement: not possible")."""
+        axis = key - 5001
+        if 0 <= axis <= 2 and axis in self.placed and not any(self.g92[:3]):
+            return self.pos[axis]
+        return None
+
+    def _note_placed(self, block: Block) -> None:
+        """Which axes a Fanuc program's block puts at a programmed position (`placed`): the X Y Z
+        words of a G0-G3 move in G90; a program stop (M0, M1, M60) lets the operator move them."""
+        letters = set()
+        for item in block.items:
+            kind = type(item)
+            if kind is Word or kind is ExprWord:
+                letter = item.letter  # type: ignore[union-attr]
+                if letter == "M" and kind is Word and item.value in (0.0, 1.0, 60.0):  # type: ignore[union-attr]
+                    self.placed.clear()
+                    return
+                if letter == "G" and G_GROUP.get(item.value if kind is Word else -1.0) == 0:  # type: ignore[union-attr]
+                    return  # (G28, G53, G92 ...: not a plain move)
+                letters.add(letter)
+        if self.absolute and self.motion in (0.0, 1.0, 2.0, 3.0):
+            self.placed.update(i for i, letter in enumerate("XYZ") if letter in letters)
 
     def _set_feed(self, block: Block, word: tuple) -> None:
         if word[0] < 0.0:
@@ -1620,11 +1652,6 @@ _PLAIN_LETTERS = {
     3.0: frozenset("XYZABCUVWFIJKR"),
     **{code: frozenset() for code in CANNED},  # a cycle's words are checked in full
 }
-
-
-def _vacant(expr: tuple, params: Parameters) -> bool:
-    """An expression that is a vacant Fanuc variable itself (`#0`, an argument a G65 call left out)."""
-    return expr[0] == "param" and type(expr[1]) is int and params.is_vacant(expr[1])
 
 
 def _homes(block: Block) -> bool:

@@ -144,7 +144,9 @@ def test_moves_that_run_again_are_left_as_programmed():
 
 
 def test_the_manual_sum_ends_with_55():
-    events = _events("O0001\n#1=0\n#2=1\nN1 IF [#2 GT 10] GOTO 2\n#1=#1+#2\n#2=#2+1\nGOTO 1\nN2 G0 X#1\nM30\n")
+    events = _events(
+        "O0001\n#1=0\n#2=1\nN1 IF [#2 GT 10] GOTO 2\n#1=#1+#2\n#2=#2+1\nGOTO 1\nN2 G0 X#1\nM30\n"
+    )
     (move,) = [e for e in events if type(e) is Line]
     assert move.end[0] == 55.0
 
@@ -157,10 +159,22 @@ def test_the_manual_sum_ends_with_55():
         (HEAD + "GOTO 0\n", 3, "a sequence number is 1 to 99999"),
         (HEAD + "GOTO 7\nN8 G0 X1\n", 3, "the program has no block N7"),
         (HEAD + "GOTO 5\nWHILE [1 EQ 1] DO1\nN5 G0 X1\nEND1\n", 3, "jumps into the loop WHILE ... DO1"),
-        (HEAD + "WHILE [1 EQ 1] DO1\nWHILE [1 EQ 1] DO2\nEND1\nEND2\n", 5, "END1 closes DO1 across the loop DO2"),
-        (HEAD + "WHILE [1 EQ 1] DO1\nWHILE [1 EQ 1] DO1\nEND1\nEND1\n", 4, "nested loops take different numbers"),
+        (
+            HEAD + "WHILE [1 EQ 1] DO1\nWHILE [1 EQ 1] DO2\nEND1\nEND2\n",
+            5,
+            "END1 closes DO1 across the loop DO2",
+        ),
+        (
+            HEAD + "WHILE [1 EQ 1] DO1\nWHILE [1 EQ 1] DO1\nEND1\nEND1\n",
+            4,
+            "nested loops take different numbers",
+        ),
         (HEAD + "G65 P9 L0\nM30\nO9\nM99\n", 3, "G65 L0: a macro runs 1 to 9999 times"),
-        (HEAD + "G65 P9\nM30\nO9\nIF [#24 EQ #0] THEN #3000=1 (X MISSING)\nM99\n", 6, "macro alarm 3001: X MISSING"),
+        (
+            HEAD + "G65 P9\nM30\nO9\nIF [#24 EQ #0] THEN #3000=1 (X MISSING)\nM99\n",
+            6,
+            "macro alarm 3001: X MISSING",
+        ),
     ],
 )
 def test_refused_as_the_control_alarms(text, line, message):
@@ -228,3 +242,27 @@ def test_memory_stays_flat_with_fanuc_loops():
         if n % 1000 == 0:
             seen.append(len(interpreter.flow.buffer))  # type: ignore[union-attr]
     assert n > 6000 * 5 and max(seen) <= 3 * _TRIM
+
+
+def test_the_block_end_position_is_read_where_a_move_placed_the_axis():
+    """#5001-#5003: the end point of the last block, work coordinates (Fanuc's position
+    information); known once a move has put the axis at a programmed position, and not at the
+    start or after a program stop, where the operator may move the machine."""
+    events, warned = _warned(
+        "O1\nG21 G90 G0 X10 Y20\nG1 X12 F100\n#1=#5001\n#2=#5002\nG1 X[#1+1] Y[#2+1]\nM30\n"
+    )
+    assert not warned and [e.end[:2] for e in events if type(e) is Line][-1] == (13.0, 21.0)
+    for text, line in (("O1\nG0 X1\n#1=#5003\nM30\n", 3), ("O1\nG0 X1 Z2\nM0\n#1=#5001\nM30\n", 4)):
+        _, warned = _warned(text)
+        assert f"t.nc:{line}:1: warning: the Fanuc system variable #500" in warned
+
+
+def test_a_vacant_variable_copies_as_vacant():
+    """`#2 = #1` with #1 vacant leaves #2 vacant; `#2 = #1 + 0` makes it 0 (Fanuc's table)."""
+    text = (
+        "O1\n"
+        + HEAD
+        + "#2=#1\n#3=#1+0\nIF [#2 EQ #0] GOTO 8\nG1 X99\nN8 IF [#3 EQ #0] GOTO 9\nG1 Y7\nN9 M30\n"
+    )
+    events = _events(text)
+    assert [(e.end[0], e.end[1]) for e in events if type(e) is Line][-1] == (0.0, 7.0)
