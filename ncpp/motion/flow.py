@@ -180,7 +180,10 @@ class Flow:
         self.dropped: set[int] = set()  # sequence numbers of main-program blocks no longer held
         self.looped: set[int] = set()  # main-program lines a backward GOTO read ahead runs again
         self.last_run_move = -1  # the text line of the last move run in place (RUN): the interpreter's
-        self.fanuc = False  # the program has shown itself a Fanuc one (its #3000 is an alarm)
+        # A Fanuc macro program: a macro statement or G65 among the blocks read ahead (which
+        # LinuxCNC refuses; its M98, M99 and O numbers may be LinuxCNC's): its locals start
+        # vacant, #1000 and up are the control's system variables, #3000 an alarm
+        self.fanuc = False
 
     # -- the stream ------------------------------------------------------------
     def steps(self, blocks: Iterable[Block]) -> Iterator[tuple[Block, str, Block | None]]:
@@ -294,7 +297,14 @@ class Flow:
             number = sequence_number(block)
             if number is not None:
                 first.setdefault(number, index)
-            control = self._control_of(block) if block.signature is None else None
+            control = self._control_of(block)
+            if (
+                control is not None
+                and control.keyword == "g65"
+                or block.signature is None
+                and _macro_b(block)
+            ):
+                self.fanuc = True
             if control is None or control.keyword not in ("goto", "fanuc_if"):
                 continue
             target = control.arguments[-1]
@@ -353,12 +363,6 @@ class Flow:
         self.read += 1
         control = self._control_of(block)
         number = program_number(block) if control is None else None
-        if (
-            number is not None
-            or control is not None
-            and (control.name is None or control.keyword == "fanuc_end")
-        ):
-            self.fanuc = True  # (a program number, M98, M99, G65, a macro statement)
         starts = number is not None or (control is not None and control.keyword == "sub")
         if self._defining is not None and not (starts and self._defining[0] is self.subprograms):
             self._extend_definition(block, control)
@@ -1011,6 +1015,11 @@ def _macro_call(block: Block, g65: Word) -> Control | None:
         else:
             arguments.append(word)
     return None if program is None else Control(None, "g65", (program, repeats, tuple(arguments)), g65)
+
+
+def _macro_b(block: Block) -> bool:
+    """A line with a Fanuc macro statement (IF, WHILE, END, GOTO)."""
+    return any(type(item) is Statement and item.kind in _FANUC_FLOW for item in block.items)  # type: ignore[union-attr]
 
 
 def _integer(digits: str) -> int:

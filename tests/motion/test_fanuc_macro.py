@@ -248,13 +248,16 @@ def test_the_block_end_position_is_read_where_a_move_placed_the_axis():
     """#5001-#5003: the end point of the last block, work coordinates (Fanuc's position
     information); known once a move has put the axis at a programmed position, and not at the
     start or after a program stop, where the operator may move the machine."""
-    events, warned = _warned(
-        "O1\nG21 G90 G0 X10 Y20\nG1 X12 F100\n#1=#5001\n#2=#5002\nG1 X[#1+1] Y[#2+1]\nM30\n"
-    )
+    top = "O1\nIF [#1 NE #0] GOTO 9\n"  # (a macro statement: a Fanuc program)
+    body = "G21 G90 G0 X10 Y20\nG1 X12 F100\n#1=#5001\n#2=#5002\nG1 X[#1+1] Y[#2+1]\nN9 M30\n"
+    events, warned = _warned(top + body)
     assert not warned and [e.end[:2] for e in events if type(e) is Line][-1] == (13.0, 21.0)
-    for text, line in (("O1\nG0 X1\n#1=#5003\nM30\n", 3), ("O1\nG0 X1 Z2\nM0\n#1=#5001\nM30\n", 4)):
+    for text, line in ((top + "G0 X1\n#1=#5003\nN9 M30\n", 4), (top + "G0 X1 Z2\nM0\n#1=#5001\nN9 M30\n", 5)):
         _, warned = _warned(text)
         assert f"t.nc:{line}:1: warning: the Fanuc system variable #500" in warned
+    # a program that may be LinuxCNC's (no macro statement): #5001 is a parameter as rs274 reads it
+    events = _events("O1\nG0 X1\n#5001=3\nG0 Y#5001\nM30\n")
+    assert [e.end[1] for e in events if type(e) is Line] == [0.0, 3.0]
 
 
 def test_a_vacant_variable_copies_as_vacant():
