@@ -1019,7 +1019,7 @@ def _macro_call(block: Block, g65: Word) -> Control | None:
 
 def _macro_b(block: Block) -> bool:
     """A line with a Fanuc macro statement (IF, WHILE, END, GOTO)."""
-    return any(type(item) is Statement and item.kind in _FANUC_FLOW for item in block.items)  # type: ignore[union-attr]
+    return any(type(item) is Statement and item.kind in _FANUC_FLOW for item in block.items)
 
 
 def _integer(digits: str) -> int:
