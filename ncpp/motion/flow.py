@@ -205,18 +205,23 @@ class Flow:
                 and self._defining is None
             ):
                 # the common case, nothing read ahead and no loop to go back to: straight from the
-                # stream (the last blocks held for a backward GOTO)
-                buffer = self.buffer
+                # stream (a Fanuc program's last blocks held for a backward GOTO)
+                buffer, hold = self.buffer, self.fanuc
+                if not hold:
+                    self._drop(len(buffer))
                 for block in self.stream:
                     signature = block.signature
                     if (
                         signature is None or "M" in signature or "O" in signature or "P" in signature
                     ) and _notable(block):
+                        if not hold:
+                            self.base = self.read
                         self._keep(block)
                         break
-                    buffer.append(block)
-                    if len(buffer) > 2 * _TRIM:
-                        self._drop(_TRIM)
+                    if hold:
+                        buffer.append(block)
+                        if len(buffer) > 2 * _TRIM:
+                            self._drop(_TRIM)
                     self.owner, self.read = block, self.read + 1
                     self.written = main.pc = self.read
                     yield block, RUN, None
@@ -273,15 +278,17 @@ class Flow:
         self.owner = self.buffer[line - self.base]
         self.written = line + 1
         if len(self.buffer) > 2 * _TRIM and not self.frames[0].labels:
-            keep = self.written - self.base  # the last _TRIM written held for a backward GOTO
-            if keep > 2 * _TRIM:
+            keep = self.written - self.base  # nothing before the next block is read again
+            if not self.fanuc and keep > _TRIM:
+                self._drop(keep)
+            elif keep > 2 * _TRIM:  # but by a Fanuc backward GOTO: the last _TRIM held
                 self._drop(keep - _TRIM)
 
     def _drop(self, n: int) -> None:
         """The first `n` blocks of the buffer, no longer wanted."""
         for block in self.buffer[:n]:
             self._controls.pop(id(block), None)
-            number = sequence_number(block)
+            number = sequence_number(block) if self.fanuc else None
             if number is not None:
                 self.dropped.add(number)
         del self.buffer[:n]
@@ -657,6 +664,10 @@ class Flow:
         if index > frame.pc:
             return lambda: self._forward(frame, index, number, block, col)
         target_line = self._block(frame, index).line  # type: ignore[union-attr]  # (found: held)
+        if frame.space is None and not self.fanuc:  # (its moves run in place were not noted)
+            self.stop(f"GOTO {number} back, the program's first macro statement past the {_TRIM:,} blocks "
+                      "read ahead", block, col)  # fmt: skip
+            return lambda: None
         if frame.space is None and self.last_run_move >= target_line:
             self.stop(f"GOTO {number} back over moves that ran once in their place (their text may be "
                       "rewritten for that run; a WHILE ... DO loop or a loop near the top of the program is "
@@ -714,7 +725,7 @@ class Flow:
                 self.stop(f"GOTO {number}: N{number} is not within {MAX_SUBPROGRAM:,} blocks ahead and "
                           "the blocks before are not all held", block, col)  # fmt: skip
                 return None
-        if number in self.dropped:
+        if number in self.dropped or not self.fanuc and self.base > 0:  # (not a Fanuc one: none noted)
             self.stop(f"GOTO {number}: N{number} is further back than the blocks ncpp holds", block, col)
             return None
         for index in range(self.base, frame.pc + 1):

@@ -293,9 +293,11 @@ class Interpreter:
                 event = block_event(block)  # verbatim blocks (after the closing %) have no items
                 if kind is FIXED:
                     event = self._in_flow(event, owner)
-                elif type(event) is not Pass:  # a move in its place: a backward GOTO may not run it again
-                    flow.last_run_move = block.line
                 if self.params.fanuc:
+                    if (
+                        kind is RUN and type(event) is not Pass
+                    ):  # in its place: no backward GOTO runs it again
+                        flow.last_run_move = block.line
                     self._note_placed(block)
                 if self.off_path or self.cutter_comp is not None or self.arc_refused:
                     event = self._in_comp(event, block)

@@ -212,10 +212,14 @@ def test_a_backward_goto_past_the_read_ahead_over_moves_run_once_is_out_of_scope
     import ncpp.motion.flow as flow
 
     monkeypatch.setattr(flow, "_TRIM", 4)
-    text = "O1\n" + HEAD + "#1=0\nG0 X1\nG0 X2\nN10 G1 X#1\n#1=#1+1\nIF [#1 LT 3] GOTO 10\nG0 Y5\nM30\n"
+    body = "#1=0\nG0 X1\nG0 X2\nN10 G1 X#1\n#1=#1+1\nIF [#1 LT 3] GOTO 10\nG0 Y5\nM30\n"
+    text = "O1\nIF [#1 EQ 1] GOTO 99\n" + HEAD + body  # (a macro statement read ahead: a Fanuc program)
     events, warned = _warned(text)
-    assert "t.nc:9:1: warning: GOTO 10 back over moves that ran once in their place" in warned
+    assert "t.nc:10:1: warning: GOTO 10 back over moves that ran once in their place" in warned
     assert type(events[-2]) is Pass and events[-2].block.text == "G0 Y5\n"
+    # a program whose first macro statement comes past the blocks read ahead: no moves were noted
+    _, warned = _warned("O1\n" + HEAD + body)
+    assert "t.nc:9:1: warning: GOTO 10 back, the program's first macro statement past the 4 blocks" in warned
     monkeypatch.setattr(flow, "_TRIM", 4096)  # read ahead: the loop is seen, its moves FIXED
     events, warned = _warned(text)
     assert not warned and [e.end[0] for e in events if type(e) is Line and e.fixed == FLOW] == [0, 1, 2]
