@@ -634,17 +634,24 @@ class Interpreter:
 
     def _note_placed(self, block: Block) -> None:
         """Which axes a Fanuc program's block puts at a programmed position (`placed`): the X Y Z
-        words of a G0-G3 move in G90; a program stop (M0, M1, M60) lets the operator move them."""
+        words of a G0-G3 move in G90.  A program stop (M0, M1, M60) lets the operator move the
+        machine, and a G10, G28, G92 ... (or a G or M code from a variable) may shift or move it
+        elsewhere: no axis is placed after them."""
         letters = set()
         for item in block.items:
             kind = type(item)
-            if kind is Word or kind is ExprWord:
-                letter = item.letter  # type: ignore[union-attr]
-                if letter == "M" and kind is Word and item.value in (0.0, 1.0, 60.0):  # type: ignore[union-attr]
+            if kind is not Word and kind is not ExprWord:
+                continue
+            word: Word | ExprWord = item  # type: ignore[assignment]  # (`kind` says so)
+            letter = word.letter
+            if letter == "G" or letter == "M":
+                value = word.value if type(word) is Word else None
+                if value is None or (
+                    value in (0.0, 1.0, 60.0) if letter == "M" else G_GROUP.get(value) == 0 and value != 4.0
+                ):
                     self.placed.clear()
                     return
-                if letter == "G" and G_GROUP.get(item.value if kind is Word else -1.0) == 0:  # type: ignore[union-attr]
-                    return  # (G28, G53, G92 ...: not a plain move)
+            elif type(word) is Word or not vacant(word.expr, self.params):  # (a vacant one is no word)
                 letters.add(letter)
         if self.absolute and self.motion in (0.0, 1.0, 2.0, 3.0):
             self.placed.update(i for i, letter in enumerate("XYZ") if letter in letters)

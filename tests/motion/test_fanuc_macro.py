@@ -256,7 +256,12 @@ def test_the_block_end_position_is_read_where_a_move_placed_the_axis():
     body = "G21 G90 G0 X10 Y20\nG1 X12 F100\n#1=#5001\n#2=#5002\nG1 X[#1+1] Y[#2+1]\nN9 M30\n"
     events, warned = _warned(top + body)
     assert not warned and [e.end[:2] for e in events if type(e) is Line][-1] == (13.0, 21.0)
-    for text, line in ((top + "G0 X1\n#1=#5003\nN9 M30\n", 4), (top + "G0 X1 Z2\nM0\n#1=#5001\nN9 M30\n", 5)):
+    for text, line in (
+        (top + "G0 X1\n#1=#5003\nN9 M30\n", 4),
+        (top + "G0 X1 Z2\nM0\n#1=#5001\nN9 M30\n", 5),
+        (top + "G0 X1\nG92 X0\n#1=#5001\nN9 M30\n", 5),
+        (top + "#2=#0\nG0 X1 Y#2\n#1=#5002\nN9 M30\n", 5),
+    ):
         _, warned = _warned(text)
         assert f"t.nc:{line}:1: warning: the Fanuc system variable #500" in warned
     # a program that may be LinuxCNC's (no macro statement): #5001 is a parameter as rs274 reads it
