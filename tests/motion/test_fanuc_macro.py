@@ -278,3 +278,17 @@ def test_a_vacant_variable_copies_as_vacant():
     )
     events = _events(text)
     assert [(e.end[0], e.end[1]) for e in events if type(e) is Line][-1] == (0.0, 7.0)
+
+
+def test_compensation_leaves_the_loops_and_the_macro_and_corrects_the_moves_that_run_once():
+    from tests.motion.compensating import compensate
+
+    text = TWINS["sum with IF GOTO back"][0]
+    out, warned = compensate(text, "t.nc")
+    body = text.splitlines()[3:10]  # #1=0 ... GOTO 1: the loop and its set-up, as programmed
+    assert "\n".join(body) in out and "t.nc:8:1: warning: loop or subroutine" in warned
+    last = out.splitlines()[-2]
+    assert last.startswith("N2 G0 Y55.0") and "#" not in last  # the move after the loop: corrected
+    out, _ = compensate(TWINS["G65 bolt-hole circle"][0], "t.nc")
+    assert TWINS["G65 bolt-hole circle"][0].split("M30\n")[1] in out  # the macro's text as it was
+    assert "G0 X77.0" in out  # `G0 X#1` after the calls: the caller's #1 again, corrected
