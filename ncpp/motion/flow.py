@@ -76,8 +76,9 @@ MAX_RERUN = 5_000_000
 # Subroutine levels (o-word calls and M98 together) as rs274ngc counts them: the tenth call is refused
 MAX_CALL_LEVELS = 10
 # Fanuc argument specification I: the local variable each letter of a G65 block sets
-MACRO_ARGUMENTS = {"A": 1, "B": 2, "C": 3, "I": 4, "J": 5, "K": 6, "D": 7, "E": 8, "F": 9, "H": 11, "M": 13,
-                   "Q": 17, "R": 18, "S": 19, "T": 20, "U": 21, "V": 22, "W": 23, "X": 24, "Y": 25, "Z": 26}  # fmt: skip
+MACRO_ARGUMENTS = {"A": 1, "B": 2, "C": 3, "I": 4, "J": 5, "K": 6, "D": 7, "E": 8, "F": 9, "H": 11,
+                   "M": 13, "Q": 17, "R": 18, "S": 19, "T": 20, "U": 21, "V": 22, "W": 23, "X": 24,
+                   "Y": 25, "Z": 26}  # fmt: skip
 _FANUC_FLOW = {"goto": "goto", "if": "fanuc_if", "while": "fanuc_while", "end": "fanuc_end"}
 MAX_SEQUENCE_NUMBER = 99_999
 
@@ -612,8 +613,9 @@ class Flow:
         name = self._loop_name(m, block, control)
         label = frame.labels.get(name)
         if label is not None and label.start != frame.pc:
+            where = Location(self.file, block.line, control.item.start + 1)
             raise NcppError(f"WHILE ... DO{m} inside the loop DO{m} under way: nested loops take different "
-                            "numbers (Fanuc alarm 124)", Location(self.file, block.line, control.item.start + 1))  # fmt: skip
+                            "numbers (Fanuc alarm 124)", where)  # fmt: skip
         again = self.evaluate(condition, block, control.item) != 0.0
 
         def test():
@@ -656,7 +658,8 @@ class Flow:
         value = self.evaluate(target, block, control.item)
         number = int(round_half_away(value))
         if not 1 <= number <= MAX_SEQUENCE_NUMBER:
-            raise NcppError(f"GOTO {printable(f'{value:g}')}: a sequence number is 1 to {MAX_SEQUENCE_NUMBER} "
+            shown = printable(f"{value:g}")
+            raise NcppError(f"GOTO {shown}: a sequence number is 1 to {MAX_SEQUENCE_NUMBER} "
                             "(Fanuc alarm 128)", Location(self.file, block.line, col))  # fmt: skip
         index = self._sequence_index(frame, number, block, col)
         if index is None:
@@ -702,8 +705,9 @@ class Flow:
             frame.pc += 1
         if entered:
             name, line = next(iter(entered.items()))
-            raise NcppError(f"GOTO {number} jumps into the loop WHILE ... {name} of line {line}: a branch may "
-                            "leave a loop, not enter one", Location(self.file, block.line, col))  # fmt: skip
+            raise NcppError(f"GOTO {number} jumps into the loop WHILE ... {name} of line {line}: a branch "
+                            "may leave a loop, not enter one",
+                            Location(self.file, block.line, col))  # fmt: skip
 
     def _sequence_index(self, frame: _Frame, number: int, block: Block, col: int) -> int | None:
         """Where block Nn stands in the frame: searched forward from the jump, then from the top

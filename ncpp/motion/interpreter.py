@@ -13,18 +13,21 @@ control's tool table, `tools.py`; zero when it is not told), F and inverse time,
 P turns, parameters and expressions, Fanuc corner rounding and
 chamfering between two lines (`,R` `,C`, `G1 ... R`: a one-move look-ahead),
 the canned cycles G73 G74 G81-G87 G89 with G98/G99 (`cycles.py`), and
-o-word subroutines, branches and loops and Fanuc M98/M99 subprograms
-(`flow.py`), and cutter compensation G40-G42.1 (`_in_comp`): where the control
-offsets the path by the tool radius the moves are the programmed contour, not
-the tool centre, and after G40 the position is the program's again, as in
-rs274ngc.  The moves of cycles, loops and subroutines, and those the tool
-makes off the programmed path (from the first move under G41/G42 to the first
-after G40), are marked `fixed`: compensation leaves them as programmed.
-Anything else (subroutine files, Fanuc macro
-control flow, M99 in the main program, G88 (a manual retract) and the lathe cycles, splines,
-threading, probing) makes the
-interpreter's state unknown: that block and every later block pass through
-as `Pass` after ONE warning (an error with `strict`).
+o-word subroutines, branches and loops, Fanuc M98/M99 subprograms and Fanuc
+macro B (GOTO, IF ... GOTO, WHILE ... DO ... END, G65 macro calls: `flow.py`;
+`IF [..] THEN #i = ..`, vacant variables, #3000 alarms and #3006 stops,
+#5001-#5003 where known: here), and cutter compensation G40-G42.1
+(`_in_comp`): where the control offsets the path by the tool radius the moves
+are the programmed contour, not the tool centre, and after G40 the position is
+the program's again, as in rs274ngc.  The moves of cycles, loops, subroutines
+and macros, and those the tool makes off the programmed path (from the first
+move under G41/G42 to the first after G40), are marked `fixed`: compensation
+leaves them as programmed.  Anything else (subroutine files ncpp is not told
+of, G66/G67 modal macro calls, a Fanuc system variable it does not know, M99
+in the main program, G88 (a manual retract) and the lathe cycles, splines,
+threading, probing) makes the interpreter's state unknown: that block and
+every later block pass through as `Pass` after ONE warning (an error with
+`strict`).
 """
 
 from __future__ import annotations

@@ -70,7 +70,8 @@ TWINS = {
         "G0 X[#24+#18*COS[#31]] Y[#25+#18*SIN[#31]]\nG1 Z#26\nG0 Z5\n#30=#30+1\nEND1\nM99\n",
         HEAD + "#1=77\no100 sub\n#30=0\no101 while [#30 LT #6]\n#31=[#4+#30*#5]\n"
         "G0 X[#1+#3*COS[#31]] Y[#2+#3*SIN[#31]]\nG1 Z#7\nG0 Z5\n#30=[#30+1]\no101 endwhile\no100 endsub\n"
-        "o100 call [50] [20] [15] [0] [60] [6] [-3]\no100 call [-10] [0] [5] [45] [90] [4] [-1]\nG0 X#1\nM2\n",
+        "o100 call [50] [20] [15] [0] [60] [6] [-3]\no100 call [-10] [0] [5] [45] [90] [4] [-1]\n"
+        "G0 X#1\nM2\n",
     ),
     # G65 ... L3: the macro runs three times, with the locals it left (the arguments set once)
     "G65 L repeats": (
