@@ -305,6 +305,8 @@ class Flow:
             number = sequence_number(block)
             if number is not None:
                 first.setdefault(number, index)
+            elif program_number(block) is not None:  # another program (a macro after M30): its own numbers
+                first.clear()
             control = self._control_of(block)
             if (
                 control is not None

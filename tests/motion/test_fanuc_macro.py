@@ -293,3 +293,17 @@ def test_compensation_leaves_the_loops_and_the_macro_and_corrects_the_moves_that
     out, _ = compensate(TWINS["G65 bolt-hole circle"][0], "t.nc")
     assert TWINS["G65 bolt-hole circle"][0].split("M30\n")[1] in out  # the macro's text as it was
     assert "G0 X77.0" in out  # `G0 X#1` after the calls: the caller's #1 again, corrected
+
+
+def test_a_macros_backward_goto_leaves_the_main_programs_moves_to_compensation():
+    """A macro after M30 numbers its blocks as it likes: its backward GOTO to N1 is its own N1,
+    not the main program's, whose moves run once and are corrected."""
+    text = HEAD + "N1 G1 X1\nG65 P500 A2\nG1 X3\nM30\nO500\nN1 G1 Y#1\n#1=#1-1\nIF [#1 GT 0] GOTO 1\nM99\n"
+    moves = [e for e in _events(text) if type(e) is Line]
+    assert [(m.end[0], m.end[1], m.fixed == FLOW) for m in moves] == [
+        (0.0, 0.0, False),
+        (1.0, 0.0, False),
+        (1.0, 2.0, True),
+        (1.0, 1.0, True),
+        (3.0, 1.0, False),
+    ]
