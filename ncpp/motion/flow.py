@@ -35,7 +35,9 @@ Fanuc macro B runs here too (Fanuc 0i-MF / 30i operator's manual, "Custom macro"
   variables #1-#33, argument specification I (A #1, B #2, C #3, I #4, J #5, K #6, D #7,
   E #8, F #9, H #11, M #13, Q #17, R #18, S #19, T #20, U #21, V #22, W #23, X #24,
   Y #25, Z #26), the others vacant; M99 returns.  With L the macro runs again with the
-  locals it left (as Haas, a Fanuc-compatible control, documents).
+  locals it left (as Haas, a Fanuc-compatible control, documents);
+* `G66 P<n> <arguments>` ... `G67`: the macro is called so after each block that moves
+  (the interpreter says which: `moved`), not after its own moves (`_g66`).
 
 A backward jump runs the blocks from its target again, out of the text's order.  The
 first `_TRIM` blocks are read ahead at the start to find the literal backward jumps
@@ -80,6 +82,7 @@ MACRO_ARGUMENTS = {"A": 1, "B": 2, "C": 3, "I": 4, "J": 5, "K": 6, "D": 7, "E": 
                    "M": 13, "Q": 17, "R": 18, "S": 19, "T": 20, "U": 21, "V": 22, "W": 23, "X": 24,
                    "Y": 25, "Z": 26}  # fmt: skip
 _FANUC_FLOW = {"goto": "goto", "if": "fanuc_if", "while": "fanuc_while", "end": "fanuc_end"}
+_MACRO_CALLS = {65.0: "g65", 66.0: "g66", 67.0: "g67"}
 MAX_SEQUENCE_NUMBER = 99_999
 
 
@@ -120,6 +123,17 @@ class _Frame:
     repeats: int = 0  # a Fanuc subprogram (M98): the runs still to make after this one; -1: an o-word call
     source: str | None = None  # the subroutine file its lines are from (None: the program's)
     macro: bool = False  # a Fanuc G65 macro call (its own level of local variables)
+    modal: bool = False  # a macro G66 calls after a move
+
+
+@dataclass(frozen=True)
+class _ModalCall:
+    """G66 in effect: the macro it calls after each move of the frame at `depth`."""
+
+    body: list[Block]
+    runs: int
+    values: dict[int, float]
+    depth: int  # the index in `Flow.frames` of the frame that gave G66
 
 
 class Flow:
@@ -185,6 +199,8 @@ class Flow:
         # LinuxCNC refuses; its M98, M99 and O numbers may be LinuxCNC's): its locals start
         # vacant, #1000 and up are the control's system variables, #3000 an alarm
         self.fanuc = False
+        self.modal: _ModalCall | None = None  # G66 in effect
+        self.moved = False  # the interpreter's: the block just run moved (under G66)
 
     # -- the stream ------------------------------------------------------------
     def steps(self, blocks: Iterable[Block]) -> Iterator[tuple[Block, str, Block | None]]:
@@ -204,6 +220,7 @@ class Flow:
                 and not main.labels
                 and self.skipping is None
                 and self._defining is None
+                and self.modal is None
             ):
                 # the common case, nothing read ahead and no loop to go back to: straight from the
                 # stream (a Fanuc program's last blocks held for a backward GOTO)
@@ -213,7 +230,11 @@ class Flow:
                 for block in self.stream:
                     signature = block.signature
                     if (
-                        signature is None or "M" in signature or "O" in signature or "P" in signature
+                        signature is None
+                        or "M" in signature
+                        or "O" in signature
+                        or "P" in signature
+                        or "G6" in signature
                     ) and _notable(block):
                         if not hold:
                             self.base = self.read
@@ -258,6 +279,9 @@ class Flow:
             if control is None:
                 yield block, *self._kind(frame)
                 self._advance(frame)
+                if self.moved:
+                    self.moved = False
+                    self._modal_call(block)
                 continue
             yield from self._control(frame, block, control)
         yield from self._rest()
@@ -310,7 +334,7 @@ class Flow:
             control = self._control_of(block)
             if (
                 control is not None
-                and control.keyword == "g65"
+                and control.keyword in ("g65", "g66")
                 or block.signature is None
                 and _macro_b(block)
             ):
@@ -403,7 +427,7 @@ class Flow:
         self, frame: _Frame, block: Block, control: Control
     ) -> Iterator[tuple[Block, str, Block | None]]:
         """Run one control line: decide (errors point at it), write it, then jump."""
-        if control.keyword not in ("m98", "m99", "g65"):
+        if control.keyword not in ("m98", "m99", "g65", "g66", "g67"):
             self._nothing_after(block, control)
         if type(control.name) is tuple:
             value = self.evaluate(control.name, block, control.item)
@@ -574,22 +598,10 @@ class Flow:
 
     def _g65(self, frame, block, control, arrived):
         """A Fanuc macro call: `G65 P<n> L<repeats> <arguments>` (the module docstring)."""
-        program, repeats, arguments = control.arguments
-        name = str(int(round_half_away(self._number(program, block))))
-        runs = 1 if repeats is None else int(round_half_away(self._number(repeats, block)))
-        if runs < 1:
-            raise NcppError(f"G65 L{runs}: a macro runs 1 to 9999 times",
-                            Location(self.file, block.line, repeats.start + 1))  # fmt: skip
-        values = {
-            MACRO_ARGUMENTS[item.letter]: self._number(item, block)
-            for item in arguments
-            if type(item) is Word or not vacant(item.expr, self.parameters)  # (a vacant one: not given)
-        }
-        body = self._defined(self.subprograms, name)
-        if body is None:
-            self.stop(f"G65 P{name}: a macro the program does not define (O{name} to M99)", block,
-                      control.item.start + 1)  # fmt: skip
+        found = self._macro(block, control)
+        if found is None:
             return lambda: None
+        body, runs, values = found
         self._check_level(block, control)
 
         def call():
@@ -598,6 +610,69 @@ class Flow:
             self.frames.append(_Frame(body, 1, repeats=runs - 1, macro=True))
 
         return call
+
+    def _g66(self, frame, block, control, arrived):
+        """`G66 P<n> L<repeats> <arguments>`: from the next block on, O<n> is called with the
+        arguments after each block of this frame that moves, until G67; the moves of the macro
+        call it no more (Fanuc 0i-MF operator's manual, "Custom macro", Modal call: G66)."""
+        if self.modal is not None:
+            self.stop(
+                "G66 while a G66 modal call is in effect (nested modal calls)", block, control.item.start + 1
+            )
+            return lambda: None
+        found = self._macro(block, control)
+        if found is None:
+            return lambda: None
+        depth = len(self.frames) - 1
+
+        def start():
+            frame.pc += 1
+            self.modal = _ModalCall(*found, depth)
+
+        return start
+
+    def _g67(self, frame, block, control, arrived):
+        def cancel():
+            frame.pc += 1
+            self.modal = None
+
+        return cancel
+
+    def _modal_call(self, block: Block) -> None:
+        """After a block that moved under G66: the macro, called (its own moves call nothing)."""
+        modal = self.modal
+        if modal is None:
+            return
+        if len(self.frames) - 1 != modal.depth:
+            if not any(f.modal for f in self.frames[modal.depth + 1 :]):
+                self.stop("a move in a subprogram or macro called while G66 is in effect", block, None)
+            return
+        if len(self.frames) >= MAX_CALL_LEVELS:
+            raise NcppError(f"Too many subroutine levels: calls nest at most {MAX_CALL_LEVELS - 1} deep",
+                            Location(self.file, block.line, None))  # fmt: skip
+        self.parameters.enter_macro(modal.values)
+        self.frames.append(_Frame(modal.body, 1, repeats=modal.runs - 1, macro=True, modal=True))
+
+    def _macro(self, block: Block, control: Control) -> tuple[list[Block], int, dict[int, float]] | None:
+        """The body, runs and arguments of a G65 or G66 line (None: the program lacks the macro)."""
+        program, repeats, arguments = control.arguments
+        name = str(int(round_half_away(self._number(program, block))))
+        runs = 1 if repeats is None else int(round_half_away(self._number(repeats, block)))
+        if runs < 1:
+            raise NcppError(f"{control.keyword.upper()} L{runs}: a macro runs 1 to 9999 times",
+                            Location(self.file, block.line, repeats.start + 1))  # fmt: skip
+        values = {
+            MACRO_ARGUMENTS[item.letter]: self._number(item, block)
+            for item in arguments
+            if type(item) is Word or not vacant(item.expr, self.parameters)  # (a vacant one: not given)
+        }
+        body = self._defined(self.subprograms, name)
+        if body is None:
+            what = control.keyword.upper()
+            self.stop(f"{what} P{name}: a macro the program does not define (O{name} to M99)", block,
+                      control.item.start + 1)  # fmt: skip
+            return None
+        return body, runs, values
 
     # -- Fanuc branches and loops ------------------------------------------------
     def _goto(self, frame, block, control, arrived):
@@ -974,7 +1049,12 @@ def control_of(block: Block) -> Control | None:
             if (
                 word.letter not in "NMPL" or word.letter in words
             ):  # (most lines end here, at their first word)
-                if word.letter == "G" and type(word) is Word and word.value == 65.0 and words.keys() <= {"N"}:
+                if (
+                    word.letter == "G"
+                    and type(word) is Word
+                    and word.value in _MACRO_CALLS
+                    and words.keys() <= {"N"}
+                ):
                     return _macro_call(block, word)
                 return None
             words[word.letter] = word
@@ -1010,7 +1090,12 @@ def _fanuc_control(block: Block, statement: Statement, words: dict) -> Control |
 
 
 def _macro_call(block: Block, g65: Word) -> Control | None:
-    """`G65 P.. L.. <arguments>` (argument specification I, each letter once), else None."""
+    """`G65 P.. L.. <arguments>` (argument specification I, each letter once), `G66` alike,
+    `G67` alone; else None."""
+    keyword = _MACRO_CALLS[g65.value]
+    if keyword == "g67":
+        rest = block.items[block.items.index(g65) + 1 :]
+        return Control(None, keyword, (), g65) if all(type(i) is Comment for i in rest) else None
     program = repeats = None
     arguments: list[Word | ExprWord] = []
     seen: set[str] = set()
@@ -1031,7 +1116,7 @@ def _macro_call(block: Block, g65: Word) -> Control | None:
             repeats = word
         else:
             arguments.append(word)
-    return None if program is None else Control(None, "g65", (program, repeats, tuple(arguments)), g65)
+    return None if program is None else Control(None, keyword, (program, repeats, tuple(arguments)), g65)
 
 
 def _macro_b(block: Block) -> bool:

@@ -14,7 +14,7 @@ P turns, parameters and expressions, Fanuc corner rounding and
 chamfering between two lines (`,R` `,C`, `G1 ... R`: a one-move look-ahead),
 the canned cycles G73 G74 G81-G87 G89 with G98/G99 (`cycles.py`), and
 o-word subroutines, branches and loops, Fanuc M98/M99 subprograms and Fanuc
-macro B (GOTO, IF ... GOTO, WHILE ... DO ... END, G65 macro calls: `flow.py`;
+macro B (GOTO, IF ... GOTO, WHILE ... DO ... END, G65 and G66/G67 macro calls: `flow.py`;
 `IF [..] THEN #i = ..`, vacant variables, #3000 alarms and #3006 stops,
 #5001-#5003 where known: here), and cutter compensation G40-G42.1
 (`_in_comp`): where the control offsets the path by the tool radius the moves
@@ -23,7 +23,7 @@ the program's again, as in rs274ngc.  The moves of cycles, loops, subroutines
 and macros, and those the tool makes off the programmed path (from the first
 move under G41/G42 to the first after G40), are marked `fixed`: compensation
 leaves them as programmed.  Anything else (subroutine files ncpp is not told
-of, G66/G67 modal macro calls, a Fanuc system variable it does not know, M99
+of, a move of a subprogram under G66, a Fanuc system variable it does not know, M99
 in the main program, G88 (a manual retract) and the lathe cycles, splines,
 threading, probing) makes the interpreter's state unknown: that block and
 every later block pass through as `Pass` after ONE warning (an error with
@@ -296,6 +296,8 @@ class Interpreter:
                 event = block_event(block)  # verbatim blocks (after the closing %) have no items
                 if kind is FIXED:
                     event = self._in_flow(event, owner)
+                if flow.modal is not None and type(event) is not Pass:  # a move under G66: the macro next
+                    flow.moved = True
                 if self.params.fanuc:
                     if (
                         kind is RUN and type(event) is not Pass

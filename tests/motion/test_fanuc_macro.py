@@ -85,6 +85,13 @@ TWINS = {
         "O300\nIF [#24 EQ #0] GOTO 1\nG1 X#24\nGOTO 2\nN1 G1 X9\nN2 G1 X#24 Y#25\nM99\n",
         HEAD + "G1 X0\nG1 X0 Y4\nG1 X9\nG1 Y6\nM2\n",
     ),
+    # G66: the macro is called after each block that moves, with the G66 block's arguments,
+    # until G67; the G66 block, a block that does not move and the macro's own moves call nothing
+    "G66 modal call": (
+        HEAD + "G67\nG66 P9200 Z-2 R1 F50\nG0 X10 Y10\nM8\nX20\nG67\nG0 X30\nM30\n"
+        "O9200\nG0 Z#18\nG1 Z#26 F#9\nG0 Z5\nM99\n",
+        HEAD + "G0 X10 Y10\nG0 Z1\nG1 Z-2 F50\nG0 Z5\nM8\nG0 X20\nG0 Z1\nG1 Z-2\nG0 Z5\nG0 X30\nM2\n",
+    ),
     # M98 inside a G65 macro shares the macro's locals
     "M98 in a G65 macro": (
         HEAD + "G65 P400 A3\nM30\nO400\nM98 P401\nG1 X#1\nM99\nO401\n#1=#1*2\nG1 Y#1\nM99\n",
@@ -136,7 +143,7 @@ def test_every_fanuc_block_is_written_once_where_it_stands(name):
 
 def test_moves_that_run_again_are_left_as_programmed():
     """A loop's moves, a backward GOTO's from their first pass, a macro's: FIXED; the rest not."""
-    for name in ("sum with IF GOTO back", "sum with WHILE", "G65 bolt-hole circle"):
+    for name in ("sum with IF GOTO back", "sum with WHILE", "G65 bolt-hole circle", "G66 modal call"):
         moves = [e for e in _events(TWINS[name][0]) if type(e) is not Pass]
         looped = [m for m in moves if m.fixed == FLOW]
         assert looped and all(not m.fixed for m in moves if m not in looped)
@@ -307,3 +314,13 @@ def test_a_macros_backward_goto_leaves_the_main_programs_moves_to_compensation()
         (1.0, 1.0, True),
         (3.0, 1.0, False),
     ]
+
+
+def test_a_move_in_a_subprogram_under_g66_is_out_of_scope():
+    """Whether the control calls the modal macro after a move of a subprogram the G66 frame
+    calls is not ncpp's to guess."""
+    text = HEAD + "G66 P9 Z-1\nM98 P8\nM30\nO8\nG0 X1\nM99\nO9\nG1 Z#26\nM99\n"
+    events, warned = _warned(text)
+    assert "t.nc:7:1: warning: a move in a subprogram or macro called while G66 is in effect" in warned
+    _, warned = _warned(HEAD + "G66 P9 Z-1\nG66 P9 Z-2\nM30\nO9\nM99\n")
+    assert "t.nc:4:1: warning: G66 while a G66 modal call is in effect" in warned
