@@ -201,6 +201,7 @@ class Flow:
         self.fanuc = False
         self.modal: _ModalCall | None = None  # G66 in effect
         self.moved = False  # the interpreter's: the block just run moved (under G66)
+        self._fault: NcppError | None = None  # the parser's, met reading ahead (`_raise_fault`)
 
     # -- the stream ------------------------------------------------------------
     def steps(self, blocks: Iterable[Block]) -> Iterator[tuple[Block, str, Block | None]]:
@@ -225,6 +226,7 @@ class Flow:
                 # the common case, nothing read ahead and no loop to go back to: straight from the
                 # stream (a Fanuc program's last blocks held for a backward GOTO)
                 buffer, hold = self.buffer, self.fanuc
+                self._raise_fault()
                 if not hold:
                     self._drop(len(buffer))
                 for block in self.stream:
@@ -323,7 +325,13 @@ class Flow:
         """The first `_TRIM` blocks, read ahead: the lines a literal backward GOTO among them
         goes back over are `looped` (they run again; their first pass is FIXED too)."""
         first: dict[int, int] = {}  # sequence number -> its first line (index)
-        while self.read < _TRIM and self._read():
+        while self.read < _TRIM:
+            try:
+                if not self._read():
+                    break
+            except NcppError as fault:  # (raised where the flow reaches its line)
+                self._fault = fault
+                break
             index = self.read - 1
             block = self.buffer[index]
             number = sequence_number(block)
@@ -370,6 +378,7 @@ class Flow:
         for line in range(self.written, self.read):
             yield self.buffer[line - self.base], TEXT, None
         self.buffer.clear()
+        self._raise_fault()
         for block in self.stream:
             yield block, TEXT, None
 
@@ -385,11 +394,19 @@ class Flow:
     def _read(self) -> bool:
         """Read the next main-program block (False: the stream has ended); subroutine
         definitions are kept as they go by, for calls before and after them."""
+        self._raise_fault()
         block = next(self.stream, None)
         if block is None:
             return False
         self._keep(block)
         return True
+
+    def _raise_fault(self) -> None:
+        """The parser's error the read-ahead met, where the flow reaches its line: an error of
+        an earlier line is reported first, as without reading ahead."""
+        fault, self._fault = self._fault, None
+        if fault is not None:
+            raise fault
 
     def _keep(self, block: Block) -> None:
         """A main-program block read: in the buffer, and in the definition being read."""
