@@ -64,7 +64,7 @@ TWINS = {
     # A: first angle, B: angle step, H: holes, Z: depth), its locals its own (#1 of the
     # caller comes back); the LinuxCNC twin passes them in the order #1.. of its sub
     "G65 bolt-hole circle": (
-        HEAD + "#1=77\nG65 P9100 X50 Y20 R15 A0 B60 H6 Z-3\nG65 P9100 X-10 Y0 R5 A45 B90 H4 Z-1\n"
+        HEAD + "#1=77\nG65 P9100 X50. Y20. R15. A0 B60. H6 Z-3.\nG65 P9100 X-10. Y0 R5. A45. B90. H4 Z-1.\n"
         "G0 X#1\nM30\n"
         "O9100 (BOLT HOLE CIRCLE)\n#30=0\nWHILE [#30 LT #11] DO1\n#31=#1+#30*#2\n"
         "G0 X[#24+#18*COS[#31]] Y[#25+#18*SIN[#31]]\nG1 Z#26\nG0 Z5\n#30=#30+1\nEND1\nM99\n",
