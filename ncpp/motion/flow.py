@@ -807,13 +807,16 @@ class Flow:
         """Where block Nn stands in the frame: searched forward from the jump, then from the top
         (None: ncpp cannot tell, the flow has stopped)."""
         if frame.space is not None:
-            space = frame.space
-            for index in (*range(frame.pc + 1, len(space)), *range(1, frame.pc + 1)):
-                if sequence_number(space[index]) == number:
-                    return index
-            self.stop(f"GOTO {number}: no N{number} in the subprogram up to its first M99 (ncpp holds a "
-                      "subprogram to its first M99)", block, col)  # fmt: skip
-            return None
+            found = _numbered(frame.space, frame.pc, number)
+            if found is None and frame.repeats >= 0:  # (a Fanuc subprogram, past its first M99)
+                rest = self._rest_of_program(frame.space)
+                if rest:
+                    frame.space = frame.space + rest
+                    found = _numbered(frame.space, frame.pc, number)
+            if found is None:
+                self.stop(f"GOTO {number}: no N{number} in the subprogram (to the next program number or "
+                          "%, with no M2 or M30)", block, col)  # fmt: skip
+            return found
         index = frame.pc + 1
         while (ahead := self._block(frame, index)) is not None:
             if sequence_number(ahead) == number:
@@ -831,6 +834,27 @@ class Flow:
                 return index
         raise NcppError(f"GOTO {number}: the program has no block N{number} (Fanuc alarm 078)",
                         Location(self.file, block.line, col))  # fmt: skip
+
+    def _rest_of_program(self, space: list[Block]) -> list[Block] | None:
+        """A Fanuc subprogram's blocks after its first M99 (where `space` ends), to the next
+        program number, `%` or the end of the file: a program is all of them on a Fanuc.  None
+        where they are not all held, or one ends a program (M2, M30: the main program's text)."""
+        last = space[-1]
+        start = next((i for i, held in enumerate(self.buffer) if held is last), None)
+        if start is None:
+            return None
+        rest: list[Block] = []
+        main = self.frames[0]
+        index = self.base + start + 1
+        while len(rest) < MAX_SUBPROGRAM:
+            block = self._block(main, index)
+            if block is None or program_number(block) is not None or _starts_program(block):
+                return rest
+            if _ends_program(block):
+                return None
+            rest.append(block)
+            index += 1
+        return None
 
     def _defined(self, found: dict[str, list[Block]], name: str) -> list[Block] | None:
         """The lines of subroutine (or subprogram) `name`, read on for if it comes later in the text (None: nowhere)."""
@@ -1134,6 +1158,25 @@ def _macro_call(block: Block, g65: Word) -> Control | None:
         else:
             arguments.append(word)
     return None if program is None else Control(None, keyword, (program, repeats, tuple(arguments)), g65)
+
+
+def _numbered(space: list[Block], pc: int, number: int) -> int | None:
+    """Where Nn stands in a subprogram's lines: forward from `pc`, then from its top."""
+    for index in (*range(pc + 1, len(space)), *range(1, pc + 1)):
+        if sequence_number(space[index]) == number:
+            return index
+    return None
+
+
+def _starts_program(block: Block) -> bool:
+    """A `%` line or a program's name (`OCIRCLE`): where a Fanuc program ends."""
+    return any(type(item) is Statement and item.kind in ("tape", "program_name") for item in block.items)
+
+
+def _ends_program(block: Block) -> bool:
+    return any(
+        type(item) is Word and item.letter == "M" and item.value in (2.0, 30.0) for item in block.items
+    )
 
 
 def _macro_b(block: Block) -> bool:

@@ -324,3 +324,17 @@ def test_a_move_in_a_subprogram_under_g66_is_out_of_scope():
     assert "t.nc:7:1: warning: a move in a subprogram or macro called while G66 is in effect" in warned
     _, warned = _warned(HEAD + "G66 P9 Z-1\nG66 P9 Z-2\nM30\nO9\nM99\n")
     assert "t.nc:4:1: warning: G66 while a G66 modal call is in effect" in warned
+
+
+def test_a_macro_goes_on_past_its_first_m99_to_the_next_program():
+    """A Fanuc program is all its blocks to the next program number or %: a GOTO finds the
+    alarm after the macro's first M99 (as Haas's O0300 example does)."""
+    macro = "O9300\nIF [#1 EQ #0] GOTO 10\nG1 X#1\nM99\nN10 #3000=1 (A MISSING)\nM99\n"
+    events = _events(HEAD + "G65 P9300 A1.\nM30\n" + macro + "%\n")
+    assert [e.end[0] for e in events if type(e) is Line][-1] == 1.0
+    with pytest.raises(NcppError) as err:
+        _events(HEAD + "G65 P9300 A1.\nG65 P9300\nM30\n" + macro + "O9301\nM99\n")
+    assert err.value.where.line == 10 and err.value.message == "macro alarm 3001: A MISSING"
+    # what follows may be the main program's (it ends with M30): not the macro's
+    _, warned = _warned(HEAD + "G65 P9300\n" + macro + "G0 X5\nM30\n")
+    assert "t.nc:5:1: warning: GOTO 10: no N10 in the subprogram" in warned
