@@ -27,7 +27,8 @@ Fanuc macro B runs here too (Fanuc 0i-MF / 30i operator's manual, "Custom macro"
 
 * `GOTO n`, `IF [cond] GOTO n` (n an expression: `GOTO#10`) jump to the block with
   sequence number Nn, searched forward from the jump, then from the program's (or the
-  subprogram's) top; a number 1-99999 (alarm 128), found (alarm 078);
+  subprogram's) top; a number 1-99999 (alarm 128), found (alarm 078); a subprogram's
+  search goes on past its first M99 to the next program number or `%` (`_rest_of_program`);
 * `WHILE [cond] DOm` ... `ENDm`, m = 1, 2 or 3 (alarm 126): the body runs while the
   condition holds, loops nest (each its own m) and do not cross (alarm 124); a GOTO may
   leave a loop, not enter one;
