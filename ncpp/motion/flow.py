@@ -94,8 +94,8 @@ class Control:
     name: (
         str | tuple | None
     )  # a tuple: `o[expr]`, an expression evaluated where the line runs; None: M98, M99
-    keyword: str  # sub, call, while, ...; m98, m99
-    arguments: tuple  # expressions; M98's P and L words
+    keyword: str  # sub, call, while, ...; m98, m99; goto, fanuc_if, fanuc_while, fanuc_end; g65, g66, g67
+    arguments: tuple  # expressions; M98's P and L words; G65's and G66's P, L and argument words
     item: Statement | Word | ExprWord  # where messages point
 
 
@@ -121,7 +121,7 @@ class _Frame:
     # Per label, (index, keyword, line) of the first if, while, repeat or do it ran: rs274ngc
     # refuses a label that opens one of these at another line (`_opens`)
     opened: dict[str, tuple[int, str, int]] = field(default_factory=dict)
-    repeats: int = 0  # a Fanuc subprogram (M98): the runs still to make after this one; -1: an o-word call
+    repeats: int = 0  # a Fanuc subprogram (M98, G65): the runs still to make after this one; -1: an o-word call
     source: str | None = None  # the subroutine file its lines are from (None: the program's)
     macro: bool = False  # a Fanuc G65 macro call (its own level of local variables)
     modal: bool = False  # a macro G66 calls after a move
@@ -1067,7 +1067,8 @@ class Flow:
 
 def control_of(block: Block) -> Control | None:
     """The block's control line, if it is one: an o-word (`O<name>` alone, a program
-    name, is not), or a line of only M98 P.. L.. or M99 (N, comments and a leading `/` aside)."""
+    name, is not), a line of only M98 P.. L.. or M99, a Fanuc GOTO, IF ... GOTO, WHILE or
+    END, or a G65, G66 or G67 line (N, comments and a leading `/` aside)."""
     words: dict[str, Word | ExprWord] = {}
     for item in block.items:
         kind = type(item)
