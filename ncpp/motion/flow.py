@@ -121,7 +121,8 @@ class _Frame:
     # Per label, (index, keyword, line) of the first if, while, repeat or do it ran: rs274ngc
     # refuses a label that opens one of these at another line (`_opens`)
     opened: dict[str, tuple[int, str, int]] = field(default_factory=dict)
-    repeats: int = 0  # a Fanuc subprogram (M98, G65): the runs still to make after this one; -1: an o-word call
+    # a Fanuc subprogram (M98, G65): the runs still to make after this one; -1: an o-word call
+    repeats: int = 0
     source: str | None = None  # the subroutine file its lines are from (None: the program's)
     macro: bool = False  # a Fanuc G65 macro call (its own level of local variables)
     modal: bool = False  # a macro G66 calls after a move
