@@ -34,7 +34,10 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
         ),
         "compensation/test_rs274_accepts.py": None,
         "motion/test_oracle.py": None,
-        "motion/test_fanuc_macro.py": ("test_fanuc_macros_move_as_rs274_runs_their_o_word_twins",),
+        "motion/test_fanuc_macro.py": (
+            "test_fanuc_macros_move_as_rs274_runs_their_o_word_twins",
+            "test_random_fanuc_macros_move_as_rs274_runs_their_o_word_twins",
+        ),
         "property/test_cutter_comp_properties.py": None,
         "shop/test_freecad_post.py": None,
         "compensation/test_tool_lengths.py": (

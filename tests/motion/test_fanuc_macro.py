@@ -10,6 +10,7 @@ Fanuc program here has its LinuxCNC twin, and ncpp's moves of the one are rs274'
 from __future__ import annotations
 
 import io
+import random
 
 import pytest
 
@@ -338,3 +339,99 @@ def test_a_macro_goes_on_past_its_first_m99_to_the_next_program():
     # what follows may be the main program's (it ends with M30): not the macro's
     _, warned = _warned(HEAD + "G65 P9300\n" + macro + "G0 X5\nM30\n")
     assert "t.nc:5:1: warning: GOTO 10: no N10 in the subprogram" in warned
+
+
+def _random_twins(rng: random.Random) -> tuple[str, str]:
+    """A random Fanuc macro program of nested WHILE loops, IF ... THEN, IF ... GOTO over blocks
+    and IF ... GOTO back loops, with moves, and the same program in o-words for rs274."""
+    numbers, labels, counters = iter(range(10, 9000, 10)), iter(range(100, 900)), iter(range(110, 199))
+    fanuc, twin = (
+        ["O0100", "G21 G90 G17", "G0 X0 Y0 Z5 F100", "#101=0"],
+        ["G21 G90 G17", "G0 X0 Y0 Z5 F100", "#101=0"],
+    )
+
+    def both(*lines: str) -> None:
+        fanuc.extend(lines)
+        twin.extend(lines)
+
+    def statements(depth: int) -> None:
+        for _ in range(rng.randint(1, 3)):
+            kind = rng.choice(
+                ["move", "move", "assign", "then", "while", "skip", "back"]
+                if depth < 3
+                else ["move", "assign", "then"]
+            )
+            if kind == "move":
+                both(
+                    f"{rng.choice(['G1', 'G0', ''])} X[#101*2+{rng.randint(-3, 3)}] Y{rng.uniform(-3, 3):.3f}"
+                )
+            elif kind == "assign":
+                k = rng.randint(1, 3)
+                fanuc.append(f"#101=#101+{k}")
+                twin.append(f"#101=[#101+{k}]")
+            elif kind == "then":
+                k, j, label = rng.randint(0, 6), rng.randint(1, 3), next(labels)
+                fanuc.append(f"IF [#101 GT {k}] THEN #101=#101-{j}")
+                twin.extend([f"o{label} if [#101 GT {k}]", f"#101=[#101-{j}]", f"o{label} endif"])
+            elif kind == "while":
+                c, k, label, m = next(counters), rng.randint(0, 3), next(labels), depth + 1
+                both(f"#{c}=0")
+                fanuc.append(f"WHILE [#{c} LT {k}] DO{m}")
+                twin.append(f"o{label} while [#{c} LT {k}]")
+                statements(depth + 1)
+                fanuc.extend([f"#{c}=#{c}+1", f"END{m}"])
+                twin.extend([f"#{c}=[#{c}+1]", f"o{label} endwhile"])
+            elif kind == "skip":
+                k, n, label, z = rng.randint(0, 6), next(numbers), next(labels), rng.randint(1, 9)
+                fanuc.append(f"IF [#101 LT {k}] GOTO {n}")
+                twin.extend([f"o{label} if [#101 LT {k}]", f"o{label} else"])
+                statements(depth + 1)
+                fanuc.append(f"N{n} G0 Z{z}")
+                twin.extend([f"o{label} endif", f"G0 Z{z}"])
+            else:  # a loop back with IF ... GOTO: a do-while in o-words
+                c, k, n, label, z = (
+                    next(counters),
+                    rng.randint(1, 3),
+                    next(numbers),
+                    next(labels),
+                    rng.randint(1, 9),
+                )
+                both(f"#{c}=0")
+                fanuc.append(f"N{n} G1 Z{z}")
+                twin.extend([f"o{label} do", f"G1 Z{z}"])
+                statements(depth + 1)
+                fanuc.extend([f"#{c}=#{c}+1", f"IF [#{c} LT {k}] GOTO {n}"])
+                twin.extend([f"#{c}=[#{c}+1]", f"o{label} while [#{c} LT {k}]"])
+
+    statements(0)
+    return "\n".join(fanuc + ["M30"]) + "\n", "\n".join(twin + ["M2"]) + "\n"
+
+
+def test_random_fanuc_macros_move_as_rs274_runs_their_o_word_twins(tmp_path):
+    """40 random programs: ncpp's moves of the Fanuc one are rs274's of the o-word one, call by
+    call, and every block is written once where it stands."""
+    rng, moves = random.Random(20261127), 0
+    for n in range(40):
+        fanuc, twin = _random_twins(rng)
+        program, reference_program = tmp_path / f"random{n}.nc", tmp_path / f"random{n}.ngc"
+        program.write_text(fanuc)
+        reference_program.write_text(twin)
+        calls, messages = rs274(str(reference_program))
+        assert rs274_error(messages) is None, (twin, messages)
+        reference = read_canon(calls)
+        mine, error, warning = ours(program)
+        assert error is None and not warning, (fanuc, error, warning)
+        assert len(mine) == len(reference) and same_calls(reference, mine), (fanuc, twin)
+        assert "".join(block.text for block in _written(fanuc)) == fanuc
+        moves += len(mine)
+    assert moves > 200
+
+
+def _written(text: str) -> list:
+    """The blocks of the events, each run of one block's events once: what passthrough writes."""
+    blocks, last = [], None
+    for event in _events(text):
+        if event.block is not last:
+            blocks.append(event.block)
+            last = event.block
+    return blocks
