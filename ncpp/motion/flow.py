@@ -204,6 +204,9 @@ class Flow:
         self.modal: _ModalCall | None = None  # G66 in effect
         self.moved = False  # the interpreter's: the block just run moved (under G66)
         self._fault: NcppError | None = None  # the parser's, met reading ahead (`_raise_fault`)
+        # A Fanuc subprogram's lines to the next program number (`_rest_of_program`), by the id of
+        # its lines to its first M99 (kept in `subprograms`, so an id is never another's)
+        self._whole_programs: dict[int, list[Block]] = {}
 
     # -- the stream ------------------------------------------------------------
     def steps(self, blocks: Iterable[Block]) -> Iterator[tuple[Block, str, Block | None]]:
@@ -811,10 +814,12 @@ class Flow:
         if frame.space is not None:
             found = _numbered(frame.space, frame.pc, number)
             if found is None and frame.repeats >= 0:  # (a Fanuc subprogram, past its first M99)
-                rest = self._rest_of_program(frame.space)
-                if rest:
-                    frame.space = frame.space + rest
-                    found = _numbered(frame.space, frame.pc, number)
+                whole = self._whole_programs.get(id(frame.space))
+                if whole is None:
+                    rest = self._rest_of_program(frame.space)
+                    whole = self._whole_programs[id(frame.space)] = frame.space + (rest or [])
+                frame.space = whole
+                found = _numbered(frame.space, frame.pc, number)
             if found is None:
                 self.stop(f"GOTO {number}: no N{number} in the subprogram (to the next program number or "
                           "%, with no M2 or M30)", block, col)  # fmt: skip
