@@ -296,12 +296,10 @@ class Interpreter:
                 event = block_event(block)  # verbatim blocks (after the closing %) have no items
                 if kind is FIXED:
                     event = self._in_flow(event, owner)
-                if flow.modal is not None and type(event) is not Pass:  # a move under G66: the macro next
+                if flow.modal is not None and _moves(event):  # a move under G66: the macro next
                     flow.moved = True
                 if self.params.fanuc:
-                    if (
-                        kind is RUN and type(event) is not Pass
-                    ):  # in its place: no backward GOTO runs it again
+                    if kind is RUN and _moves(event):  # in its place: no backward GOTO may run it again
                         flow.last_run_move = block.line
                     self._note_placed(block)
                 if self.off_path or self.cutter_comp is not None or self.arc_refused:
@@ -1666,6 +1664,13 @@ _PLAIN_LETTERS = {
     3.0: frozenset("XYZABCUVWFIJKR"),
     **{code: frozenset() for code in CANNED},  # a cycle's words are checked in full
 }
+
+
+def _moves(event: Event | tuple[Event, ...]) -> bool:
+    """Whether a block's events hold a move (a loop's block run out of order may have none)."""
+    if type(event) is tuple:
+        return any(type(e) is not Pass for e in event)
+    return type(event) is not Pass
 
 
 def _homes(block: Block) -> bool:

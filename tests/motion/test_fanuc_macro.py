@@ -93,6 +93,12 @@ TWINS = {
         "O9200\nG0 Z#18\nG1 Z#26 F#9\nG0 Z5\nM99\n",
         HEAD + "G0 X10 Y10\nG0 Z1\nG1 Z-2 F50\nG0 Z5\nM8\nG0 X20\nG0 Z1\nG1 Z-2\nG0 Z5\nG0 X30\nM2\n",
     ),
+    # G66 in a loop: the blocks of its second pass that do not move call nothing
+    "G66 in a loop": (
+        HEAD + "G66 P9 Z-1.\n#1=0\nWHILE [#1 LT 2] DO1\nG0 X#1\n#1=#1+1\nEND1\nG67\nM30\n"
+        "O9\nG1 Z#26\nG0 Z5\nM99\n",
+        HEAD + "G0 X0\nG1 Z-1\nG0 Z5\nG0 X1\nG1 Z-1\nG0 Z5\nM2\n",
+    ),
     # M98 inside a G65 macro shares the macro's locals
     "M98 in a G65 macro": (
         HEAD + "G65 P400 A3\nM30\nO400\nM98 P401\nG1 X#1\nM99\nO401\n#1=#1*2\nG1 Y#1\nM99\n",
