@@ -640,24 +640,19 @@ class Interpreter:
         words of a G0-G3 move in G90.  A program stop (M0, M1, M60) lets the operator move the
         machine, and a G10, G28, G92 ... (or a G or M code from a variable) may shift or move it
         elsewhere: no axis is placed after them."""
-        letters = set()
-        for item in block.items:
-            kind = type(item)
-            if kind is not Word and kind is not ExprWord:
-                continue
-            word: Word | ExprWord = item  # type: ignore[assignment]  # (`kind` says so)
-            letter = word.letter
-            if letter == "G" or letter == "M":
-                value = word.value if type(word) is Word else None
-                if value is None or (
-                    value in (0.0, 1.0, 60.0) if letter == "M" else G_GROUP.get(value) == 0 and value != 4.0
-                ):
-                    self.placed.clear()
-                    return
-            elif type(word) is Word or not vacant(word.expr, self.params):  # (a vacant one is no word)
-                letters.add(letter)
-        if self.absolute and self.motion in (0.0, 1.0, 2.0, 3.0):
-            self.placed.update(i for i, letter in enumerate("XYZ") if letter in letters)
+        signature = block.signature
+        if signature is not None and "M" not in signature:  # (plain words: the signature tells)
+            effect = _PLACING.get(signature)
+            if effect is None:
+                effect = _placing(block, self.params)
+                if len(_PLACING) < 4096:  # a program has few distinct signatures
+                    _PLACING[signature] = effect
+        else:
+            effect = _placing(block, self.params)
+        if effect is None:
+            self.placed.clear()
+        elif effect and self.absolute and self.motion in (0.0, 1.0, 2.0, 3.0):
+            self.placed.update(effect)
 
     def _set_feed(self, block: Block, word: tuple) -> None:
         if word[0] < 0.0:
@@ -1664,6 +1659,30 @@ _PLAIN_LETTERS = {
     3.0: frozenset("XYZABCUVWFIJKR"),
     **{code: frozenset() for code in CANNED},  # a cycle's words are checked in full
 }
+
+
+_PLACING: dict[str, tuple[int, ...] | None] = {}  # a plain block's signature -> its `_placing`
+
+
+def _placing(block: Block, params: Parameters) -> tuple[int, ...] | None:
+    """The X Y Z axes (0 1 2) a block's words name, or None where it stops the program (M0, M1,
+    M60) or has a G code of group 0 other than G4 (or a G or M code from a variable)."""
+    letters = set()
+    for item in block.items:
+        kind = type(item)
+        if kind is not Word and kind is not ExprWord:
+            continue
+        word: Word | ExprWord = item  # type: ignore[assignment]  # (`kind` says so)
+        letter = word.letter
+        if letter == "G" or letter == "M":
+            value = word.value if type(word) is Word else None
+            if value is None or (
+                value in (0.0, 1.0, 60.0) if letter == "M" else G_GROUP.get(value) == 0 and value != 4.0
+            ):
+                return None
+        elif type(word) is Word or not vacant(word.expr, params):  # (a vacant one is no word)
+            letters.add(letter)
+    return tuple(i for i, letter in enumerate("XYZ") if letter in letters)
 
 
 def _moves(event: Event | tuple[Event, ...]) -> bool:
