@@ -147,9 +147,9 @@ class Parameters:
         self._callers: list[
             tuple[list[float] | None, dict[str, float], set[int]]
         ] = []  # per call level: the caller's #1..#30 (#1..#33), local names and vacant numbers
-        # Fanuc's vacant (<null>) variables: #0, a G65 argument not given, `#i = #0` (Fanuc 0i-MF
-        # operator's manual, "Custom macro", Variables: a vacant variable reads as 0 in arithmetic,
-        # differs from 0 in EQ and NE, and leaves out the address it is the value of)
+        # Fanuc's vacant (<null>) variables: #0, a G65 argument not given, `#i = #0` (Fanuc 16i/18i
+        # operator's manual B-63684EN, "Custom macro", Variables: a vacant variable reads as 0 in
+        # arithmetic, differs from 0 in EQ and NE, and leaves out the address it is the value of)
         self.vacant: set[int] = set()
         self.fanuc = False  # a Fanuc program: #1000 and up are the control's system variables
         self.fanuc_system = fanuc_system  # those the interpreter knows (None: not known)
@@ -157,7 +157,7 @@ class Parameters:
     def start_fanuc(self) -> None:
         """A Fanuc macro program starts: its local variables #1-#33 vacant, and #1000 and up the
         control's system variables (the machine's position, offsets, alarms), which ncpp does not
-        know but for the messages (#3000, #3006, the interpreter's) (Fanuc 0i-MF operator's
+        know but for the messages (#3000, #3006, the interpreter's) (Fanuc 16i/18i operator's
         manual, "Custom macro", Variables: local variables are vacant at the start)."""
         self.fanuc = True
         self.vacant.update(range(1, MACRO_LOCALS + 1))

@@ -22,15 +22,15 @@ Fanuc subprograms run the same way: `M98 P<n> [L<repeats>]` calls the
 program `O<n>` of the file, which ends with `M99` (#1-#30 are the caller's,
 as in LinuxCNC; the other scoping is a call's).
 
-Fanuc macro B runs here too (Fanuc 0i-MF / 30i operator's manual, "Custom macro",
-"Branch and repetition" and "Macro call"):
+Fanuc macro B runs here too (the Fanuc operator's manuals, Series 16i/18i B-63684EN and 0i,
+"Custom macro": "Branch and repetition", "Macro call"):
 
 * `GOTO n`, `IF [cond] GOTO n` (n an expression: `GOTO#10`) jump to the block with
   sequence number Nn, searched forward from the jump, then from the program's (or the
-  subprogram's) top; a number 1-99999 (alarm 128), found (alarm 078); a subprogram's
+  subprogram's) top; a number 1-99999 that is there, else the control alarms; a subprogram's
   search goes on past its first M99 to the next program number or `%` (`_rest_of_program`);
-* `WHILE [cond] DOm` ... `ENDm`, m = 1, 2 or 3 (alarm 126): the body runs while the
-  condition holds, loops nest (each its own m) and do not cross (alarm 124); a GOTO may
+* `WHILE [cond] DOm` ... `ENDm`, m = 1, 2 or 3: the body runs while the condition
+  holds, loops nest (each its own m) and do not cross (else alarms); a GOTO may
   leave a loop, not enter one;
 * `G65 P<n> L<count> <arguments>` calls `O<n>` as a macro (`_g65`): a new level of local
   variables #1-#33, argument specification I (A #1, B #2, C #3, I #4, J #5, K #6, D #7,
@@ -636,7 +636,7 @@ class Flow:
     def _g66(self, frame, block, control, arrived):
         """`G66 P<n> L<repeats> <arguments>`: from the next block on, O<n> is called with the
         arguments after each block of this frame that moves, until G67; the moves of the macro
-        call it no more (Fanuc 0i-MF operator's manual, "Custom macro", Modal call: G66)."""
+        call it no more (Fanuc 16i/18i operator's manual, "Custom macro", Modal call: G66)."""
         if self.modal is not None:
             self.stop(
                 "G66 while a G66 modal call is in effect (nested modal calls)", block, control.item.start + 1
@@ -714,7 +714,7 @@ class Flow:
         if label is not None and label.start != frame.pc:
             where = Location(self.file, block.line, control.item.start + 1)
             raise NcppError(f"WHILE ... DO{m} inside the loop DO{m} under way: nested loops take different "
-                            "numbers (Fanuc alarm 124)", where)  # fmt: skip
+                            "numbers (a Fanuc alarm)", where)  # fmt: skip
         again = self.evaluate(condition, block, control.item) != 0.0
 
         def test():
@@ -734,7 +734,7 @@ class Flow:
         label = frame.labels.get(name)
         where = Location(self.file, block.line, control.item.start + 1)
         if label is None or label.kind != "fanuc":
-            raise NcppError(f"END{m} without WHILE ... DO{m} (Fanuc alarm 124)", where)
+            raise NcppError(f"END{m} without WHILE ... DO{m} (a Fanuc alarm)", where)
         inner = [
             other
             for other, open_ in frame.labels.items()
@@ -742,12 +742,12 @@ class Flow:
         ]
         if inner:
             raise NcppError(f"END{m} closes DO{m} across the loop {inner[0]}: loops nest, they do not cross "
-                            "(Fanuc alarm 124)", where)  # fmt: skip
+                            "(a Fanuc alarm)", where)  # fmt: skip
         return lambda: setattr(frame, "pc", label.start)
 
     def _loop_name(self, m: int, block: Block, control: Control) -> str:
         if m not in (1, 2, 3):
-            raise NcppError(f"DO{m} / END{m}: a loop's number is 1, 2 or 3 (Fanuc alarm 126)",
+            raise NcppError(f"DO{m} / END{m}: a loop's number is 1, 2 or 3 (a Fanuc alarm)",
                             Location(self.file, block.line, control.item.start + 1))  # fmt: skip
         return f"DO{m}"
 
@@ -759,7 +759,7 @@ class Flow:
         if not 1 <= number <= MAX_SEQUENCE_NUMBER:
             shown = printable(f"{value:g}")
             raise NcppError(f"GOTO {shown}: a sequence number is 1 to {MAX_SEQUENCE_NUMBER} "
-                            "(Fanuc alarm 128)", Location(self.file, block.line, col))  # fmt: skip
+                            "(a Fanuc alarm)", Location(self.file, block.line, col))  # fmt: skip
         index = self._sequence_index(frame, number, block, col)
         if index is None:
             return lambda: None
@@ -839,7 +839,7 @@ class Flow:
         for index in range(self.base, frame.pc + 1):
             if sequence_number(self.buffer[index - self.base]) == number:
                 return index
-        raise NcppError(f"GOTO {number}: the program has no block N{number} (Fanuc alarm 078)",
+        raise NcppError(f"GOTO {number}: the program has no block N{number} (a Fanuc alarm)",
                         Location(self.file, block.line, col))  # fmt: skip
 
     def _rest_of_program(self, space: list[Block]) -> list[Block] | None:

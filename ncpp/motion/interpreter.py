@@ -616,7 +616,7 @@ class Interpreter:
     def _fanuc_message(self, key: int | str, value: float | None, block: Block, item) -> None:
         """Fanuc's `#3000 = n (MESSAGE)`: the control stops with alarm 3000 + n and the message,
         so ncpp refuses the program there; `#3006 = n (MESSAGE)`: it stops and shows the message
-        until the operator starts it again, as M0 (Fanuc 0i-MF operator's manual, "Custom macro",
+        until the operator starts it again, as M0 (Fanuc 16i/18i operator's manual, "Custom macro",
         System variables: alarm #3000, stop with message #3006)."""
         comments = [i for i in block.items[block.items.index(item) + 1 :] if type(i) is Comment]
         message = comments[0].text if comments else ""
@@ -627,7 +627,7 @@ class Interpreter:
     def _fanuc_system_variable(self, key: int) -> float | None:
         """The Fanuc system variables ncpp knows: #5001-#5003, the end point of the last block
         in the workpiece coordinate system, of an axis a move has placed since the start or the
-        last stop, with no G92/G52 shift (Fanuc 0i-MF operator's manual, "Custom macro", System
+        last stop, with no G92/G52 shift (Fanuc 16i/18i operator's manual, "Custom macro", System
         variables: position information).  Not #5021-#5023, the machine position: the control
         reads it ahead, while the block before moves ("reading during movement: not possible")."""
         axis = key - 5001

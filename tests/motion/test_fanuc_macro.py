@@ -1,9 +1,9 @@
 """Fanuc macro B control flow: GOTO, IF ... GOTO, IF ... THEN, WHILE ... DO ... END, G65 macro
 calls, vacant variables, #3000 / #3006.
 
-The rules are Fanuc's (Fanuc 0i-MF / 30i operator's manual, "Custom macro": "Branch and
-repetition", "Macro call", "Variables"); the oracle for the motion is LinuxCNC's rs274 running
-the same program written with o-words (`o100 while`, `o100 if`, `o100 sub` with #1..): each
+The rules are Fanuc's (the Fanuc operator's manuals, Series 16i/18i B-63684EN and 0i, "Custom
+macro": "Branch and repetition", "Macro call", "Variables"); the oracle for the motion is
+LinuxCNC's rs274 running the same program written with o-words (`o100 while`, `o100 if`, `o100 sub` with #1..): each
 Fanuc program here has its LinuxCNC twin, and ncpp's moves of the one are rs274's of the other.
 """
 
