@@ -36,6 +36,10 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
         "motion/test_oracle.py": None,
         "writeback/test_compensated_holes.py": None,
         "writeback/test_expand_cycles.py": ("test_expanded_cycles_dwell_as_programmed_and_hit_every_hole",),
+        "motion/test_fanuc_macro.py": (
+            "test_fanuc_macros_move_as_rs274_runs_their_o_word_twins",
+            "test_random_fanuc_macros_move_as_rs274_runs_their_o_word_twins",
+        ),
         "property/test_cutter_comp_properties.py": None,
         "shop/test_freecad_post.py": None,
         "compensation/test_tool_lengths.py": (

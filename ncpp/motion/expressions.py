@@ -15,6 +15,7 @@ from collections.abc import Callable
 # rs274ngc: numbered parameters 1..RS274NGC_MAX_PARAMETERS-1 (#0 is Fanuc's null, read as 0)
 MAX_PARAMETER = 5601
 SUBROUTINE_PARAMETERS = 30  # #1..#30: a subroutine's arguments, local to each call
+MACRO_LOCALS = 33  # Fanuc: #1..#33, a new level of them for each G65 macro call
 EQUAL_TOLERANCE = 0.0001
 
 
@@ -132,7 +133,11 @@ class Parameters:
     and units.
     """
 
-    def __init__(self, system: Callable[[str], float | None] | None = None):
+    def __init__(
+        self,
+        system: Callable[[str], float | None] | None = None,
+        fanuc_system: Callable[[int], float | None] | None = None,
+    ):
         self.numbered: dict[int, float] = {}
         self.named: dict[str, float] = {
             "_value": 0.0,
@@ -140,8 +145,22 @@ class Parameters:
         }  # what the last subroutine returned
         self.system = system
         self._callers: list[
-            tuple[list[float] | None, dict[str, float]]
-        ] = []  # per call level: the caller's #1..#30 and local names
+            tuple[list[float] | None, dict[str, float], set[int]]
+        ] = []  # per call level: the caller's #1..#30 (#1..#33), local names and vacant numbers
+        # Fanuc's vacant (<null>) variables: #0, a G65 argument not given, `#i = #0` (Fanuc 16i/18i
+        # operator's manual B-63684EN, "Custom macro", Variables: a vacant variable reads as 0 in
+        # arithmetic, differs from 0 in EQ and NE, and leaves out the address it is the value of)
+        self.vacant: set[int] = set()
+        self.fanuc = False  # a Fanuc program: #1000 and up are the control's system variables
+        self.fanuc_system = fanuc_system  # those the interpreter knows (None: not known)
+
+    def start_fanuc(self) -> None:
+        """A Fanuc macro program starts: its local variables #1-#33 vacant, and #1000 and up the
+        control's system variables (the machine's position, offsets, alarms), which ncpp does not
+        know but for the messages (#3000, #3006, the interpreter's) (Fanuc 16i/18i operator's
+        manual, "Custom macro", Variables: local variables are vacant at the start)."""
+        self.fanuc = True
+        self.vacant.update(range(1, MACRO_LOCALS + 1))
 
     def enter(self, arguments: list[float] | None) -> None:
         """A subroutine call: #1..#30 are its arguments (0 past the last; None, a Fanuc
@@ -155,19 +174,35 @@ class Parameters:
         local = {k: v for k, v in self.named.items() if not k.startswith("_")}
         for k in local:
             del self.named[k]
-        self._callers.append((saved, local))
+        self._callers.append((saved, local, set(self.vacant)))
         if arguments is not None:
             for n in range(1, SUBROUTINE_PARAMETERS + 1):
                 self.numbered[n] = arguments[n - 1] if n <= len(arguments) else 0.0
+                self.vacant.discard(n)
+
+    def enter_macro(self, arguments: dict[int, float]) -> None:
+        """A Fanuc G65 macro call: a new level of #1..#33, those `arguments` names set, the rest
+        vacant (the caller's come back at `leave`)."""
+        self._callers.append(
+            ([self.numbered.get(n, 0.0) for n in range(1, MACRO_LOCALS + 1)], {}, set(self.vacant))
+        )
+        for n in range(1, MACRO_LOCALS + 1):
+            self.numbered[n] = arguments.get(n, 0.0)
+        self.vacant.difference_update(arguments)
+        self.vacant.update(n for n in range(1, MACRO_LOCALS + 1) if n not in arguments)
 
     def leave(self, value: float | None) -> None:
         """The subroutine returns (`value`: what its return or endsub gave, if anything)."""
-        saved, local = self._callers.pop()
+        saved, local, vacant = self._callers.pop()
         for k in [k for k in self.named if not k.startswith("_")]:
             del self.named[k]
         self.named.update(local)
         if saved is not None:
-            self.numbered.update(zip(range(1, SUBROUTINE_PARAMETERS + 1), saved))
+            self.numbered.update(zip(range(1, len(saved) + 1), saved))
+            if self.vacant or vacant:  # the caller's locals as they were; what the call did to the others
+                self.vacant = {k for k in self.vacant if k > len(saved)} | {
+                    k for k in vacant if k <= len(saved)
+                }
         self.named["_value"], self.named["_value_returned"] = (0.0, 0.0) if value is None else (value, 1.0)
 
     def key(self, key, evaluate: Callable[[tuple], float]) -> int | str:
@@ -182,11 +217,24 @@ class Parameters:
             return key
         return normalise_name(key)
 
+    def is_vacant(self, key: int | str) -> bool:
+        """Fanuc's vacant variable: #0, or one the program left vacant (`vacant`)."""
+        return key == 0 or key in self.vacant
+
+    def vacate(self, key: int) -> None:
+        """`#i = #0` (or another vacant variable): #i is vacant, as Fanuc assigns it."""
+        self.write(key, 0.0)
+        self.vacant.add(key)
+
     def read(self, key: int | str) -> float:
         if type(key) is int:
-            if _machine_state(key):
-                raise OutOfScope(f"machine-state parameter #{key}")
-            return self.numbered.get(key, 0.0)
+            if _machine_state(key) or key >= 1000 and self.fanuc:
+                known = self.fanuc_system(key) if self.fanuc and self.fanuc_system is not None else None
+                if known is not None:
+                    return known
+                raise OutOfScope(f"machine-state parameter #{key}" if not self.fanuc else
+                                 f"the Fanuc system variable #{key}")  # fmt: skip
+            return self.numbered.get(key, 0.0)  # (a vacant one: 0 in arithmetic, as Fanuc reads it)
         name: str = key  # type: ignore[assignment]  # not an int (`type() is`, for speed, narrows no else)
         value = self.named.get(name)
         if value is not None:
@@ -210,9 +258,14 @@ class Parameters:
 
     def write(self, key: int | str, value: float) -> None:
         if type(key) is int:
-            if _machine_state(key):  # the control's zeros follow it, in its own units: not the interpreter's
-                raise OutOfScope(f"a write to the machine-state parameter #{key}")
+            if (
+                _machine_state(key) or key >= 1000 and self.fanuc
+            ):  # the control's zeros follow it, in its own units
+                raise OutOfScope(f"a write to the machine-state parameter #{key}" if not self.fanuc else
+                                 f"a write to the Fanuc system variable #{key}")  # fmt: skip
             self.numbered[key] = value
+            if self.vacant:
+                self.vacant.discard(key)
             return
         name: str = key  # type: ignore[assignment]  # not an int
         if name.startswith("_") and self.system is not None and self.system(name) is not None:
@@ -262,7 +315,11 @@ def _value(expr: tuple, params: Parameters) -> float:
     if kind == "param":
         return params.read(params.key(expr[1], lambda e: evaluate(e, params)))
     if kind == "bin":
-        return OPERATORS[expr[1]](evaluate(expr[2], params), evaluate(expr[3], params))
+        op = expr[1]
+        if (op == "EQ" or op == "NE") and (vacant(expr[2], params) or vacant(expr[3], params)):
+            same = vacant(expr[2], params) and vacant(expr[3], params)  # vacant EQ 0 is false
+            return float(same == (op == "EQ"))
+        return OPERATORS[op](evaluate(expr[2], params), evaluate(expr[3], params))
     if kind == "neg":
         return -evaluate(expr[1], params)
     if kind == "pos":
@@ -275,3 +332,9 @@ def _value(expr: tuple, params: Parameters) -> float:
         target = expr[1]
         return float(params.exists(params.key(target[1], lambda e: evaluate(e, params))))
     raise ExpressionError(f"cannot evaluate {kind!r}")
+
+
+def vacant(expr: tuple, params: Parameters) -> bool:
+    """An expression that is a vacant Fanuc variable itself (`#0`, an argument a G65 call left
+    out; `[#1+0]` is 0): EQ and NE tell it from 0, an address it is the value of is left out."""
+    return expr[0] == "param" and type(expr[1]) is int and params.is_vacant(expr[1])

@@ -22,6 +22,31 @@ Fanuc subprograms run the same way: `M98 P<n> [L<repeats>]` calls the
 program `O<n>` of the file, which ends with `M99` (#1-#30 are the caller's,
 as in LinuxCNC; the other scoping is a call's).
 
+Fanuc macro B runs here too (the Fanuc operator's manuals, Series 16i/18i B-63684EN and 0i,
+"Custom macro": "Branch and repetition", "Macro call"):
+
+* `GOTO n`, `IF [cond] GOTO n` (n an expression: `GOTO#10`) jump to the block with
+  sequence number Nn, searched forward from the jump, then from the program's (or the
+  subprogram's) top; a number 1-99999 that is there, else the control alarms; a subprogram's
+  search goes on past its first M99 to the next program number or `%` (`_rest_of_program`);
+* `WHILE [cond] DOm` ... `ENDm`, m = 1, 2 or 3: the body runs while the condition
+  holds, loops nest (each its own m) and do not cross (else alarms); a GOTO may
+  leave a loop, not enter one;
+* `G65 P<n> L<count> <arguments>` calls `O<n>` as a macro (`_g65`): a new level of local
+  variables #1-#33, argument specification I (A #1, B #2, C #3, I #4, J #5, K #6, D #7,
+  E #8, F #9, H #11, M #13, Q #17, R #18, S #19, T #20, U #21, V #22, W #23, X #24,
+  Y #25, Z #26), the others vacant; M99 returns.  With L the macro runs again with the
+  locals it left (as Haas, a Fanuc-compatible control, documents);
+* `G66 P<n> <arguments>` ... `G67`: the macro is called so after each block that moves
+  (the interpreter says which: `moved`), not after its own moves (`_g66`).
+
+A backward jump runs the blocks from its target again, out of the text's order.  The
+first `_TRIM` blocks are read ahead at the start to find the literal backward jumps
+among them: their bodies run FIXED from their first pass, as loops.  Past them, a
+backward jump over a move that ran in place (RUN: its text may be rewritten for that one
+run) leaves the scope, and so does one whose target is no longer held (blocks are held
+to `_TRIM` back, and while a loop runs).
+
 Subroutines are those of the program's own text (defined before or after the
 call, like LinuxCNC, which searches the rest of the file) or `name.ngc` in the
 first folder of the search path that has it (`_from_file`: LinuxCNC's
@@ -39,7 +64,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ncpp.errors import Location, NcppError, printable
-from ncpp.motion.expressions import SUBROUTINE_PARAMETERS, normalise_name, round_half_away
+from ncpp.motion.expressions import SUBROUTINE_PARAMETERS, normalise_name, round_half_away, vacant
 from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
 from ncpp.program.parser import parse_stream
 
@@ -53,6 +78,13 @@ MAX_SUBPROGRAM = 20_000
 MAX_RERUN = 5_000_000
 # Subroutine levels (o-word calls and M98 together) as rs274ngc counts them: the tenth call is refused
 MAX_CALL_LEVELS = 10
+# Fanuc argument specification I: the local variable each letter of a G65 block sets
+MACRO_ARGUMENTS = {"A": 1, "B": 2, "C": 3, "I": 4, "J": 5, "K": 6, "D": 7, "E": 8, "F": 9, "H": 11,
+                   "M": 13, "Q": 17, "R": 18, "S": 19, "T": 20, "U": 21, "V": 22, "W": 23, "X": 24,
+                   "Y": 25, "Z": 26}  # fmt: skip
+_FANUC_FLOW = {"goto": "goto", "if": "fanuc_if", "while": "fanuc_while", "end": "fanuc_end"}
+_MACRO_CALLS = {65.0: "g65", 66.0: "g66", 67.0: "g67"}
+MAX_SEQUENCE_NUMBER = 99_999
 
 
 @dataclass(frozen=True, slots=True)
@@ -62,8 +94,8 @@ class Control:
     name: (
         str | tuple | None
     )  # a tuple: `o[expr]`, an expression evaluated where the line runs; None: M98, M99
-    keyword: str  # sub, call, while, ...; m98, m99
-    arguments: tuple  # expressions; M98's P and L words
+    keyword: str  # sub, call, while, ...; m98, m99; goto, fanuc_if, fanuc_while, fanuc_end; g65, g66, g67
+    arguments: tuple  # expressions; M98's P and L words; G65's and G66's P, L and argument words
     item: Statement | Word | ExprWord  # where messages point
 
 
@@ -71,7 +103,7 @@ class Control:
 class _Label:
     """A loop's opening line, where its end (and `continue`) send the program back."""
 
-    kind: str  # while, do, repeat
+    kind: str  # while, do, repeat; fanuc (WHILE ... DOm)
     start: int  # the line's index in its frame's space
     count: int = -1  # repeat: iterations still to run (-1: not counted yet)
 
@@ -89,8 +121,21 @@ class _Frame:
     # Per label, (index, keyword, line) of the first if, while, repeat or do it ran: rs274ngc
     # refuses a label that opens one of these at another line (`_opens`)
     opened: dict[str, tuple[int, str, int]] = field(default_factory=dict)
-    repeats: int = 0  # a Fanuc subprogram (M98): the runs still to make after this one; -1: an o-word call
+    # a Fanuc subprogram (M98, G65): the runs still to make after this one; -1: an o-word call
+    repeats: int = 0
     source: str | None = None  # the subroutine file its lines are from (None: the program's)
+    macro: bool = False  # a Fanuc G65 macro call (its own level of local variables)
+    modal: bool = False  # a macro G66 calls after a move
+
+
+@dataclass(frozen=True)
+class _ModalCall:
+    """G66 in effect: the macro it calls after each move of the frame at `depth`."""
+
+    body: list[Block]
+    runs: int
+    values: dict[int, float]
+    depth: int  # the index in `Flow.frames` of the frame that gave G66
 
 
 class Flow:
@@ -149,6 +194,19 @@ class Flow:
         # Control lines of the blocks held (a loop goes over them again and again), by id: an
         # entry leaves with its block (`_drop`), so an id is never that of another block
         self._controls: dict[int, Control | None] = {}
+        self.dropped: set[int] = set()  # sequence numbers of main-program blocks no longer held
+        self.looped: set[int] = set()  # main-program lines a backward GOTO read ahead runs again
+        self.last_run_move = -1  # the text line of the last move run in place (RUN): the interpreter's
+        # A Fanuc macro program: a macro statement or G65 among the blocks read ahead (which
+        # LinuxCNC refuses; its M98, M99 and O numbers may be LinuxCNC's): its locals start
+        # vacant, #1000 and up are the control's system variables, #3000 an alarm
+        self.fanuc = False
+        self.modal: _ModalCall | None = None  # G66 in effect
+        self.moved = False  # the interpreter's: the block just run moved (under G66)
+        self._fault: NcppError | None = None  # the parser's, met reading ahead (`_raise_fault`)
+        # A Fanuc subprogram's lines to the next program number (`_rest_of_program`), by the id of
+        # its lines to its first M99 (kept in `subprograms`, so an id is never another's)
+        self._whole_programs: dict[int, list[Block]] = {}
 
     # -- the stream ------------------------------------------------------------
     def steps(self, blocks: Iterable[Block]) -> Iterator[tuple[Block, str, Block | None]]:
@@ -157,6 +215,9 @@ class Flow:
         self.stream = iter(blocks)
         main = self.frames[0]
         block: Block | None
+        self._read_ahead()
+        if self.fanuc:
+            self.parameters.start_fanuc()
         while not self.done():
             frame = self.frames[-1]
             if (
@@ -165,15 +226,31 @@ class Flow:
                 and not main.labels
                 and self.skipping is None
                 and self._defining is None
+                and self.modal is None
             ):
-                # the common case, nothing read ahead and no loop to go back to: straight from the stream
-                self._drop(len(self.buffer))
+                # the common case, nothing read ahead and no loop to go back to: straight from the
+                # stream (a Fanuc program's last blocks held for a backward GOTO)
+                buffer, hold = self.buffer, self.fanuc
+                self._raise_fault()
+                if not hold:
+                    self._drop(len(buffer))
                 for block in self.stream:
                     signature = block.signature
-                    if (signature is None or "M" in signature or "O" in signature) and _notable(block):
-                        self.base = self.read
+                    if (
+                        signature is None
+                        or "M" in signature
+                        or "O" in signature
+                        or "P" in signature
+                        or "G6" in signature
+                    ) and _notable(block):
+                        if not hold:
+                            self.base = self.read
                         self._keep(block)
                         break
+                    if hold:
+                        buffer.append(block)
+                        if len(buffer) > 2 * _TRIM:
+                            self._drop(_TRIM)
                     self.owner, self.read = block, self.read + 1
                     self.written = main.pc = self.read
                     yield block, RUN, None
@@ -185,8 +262,11 @@ class Flow:
             block = self._block(frame, frame.pc)
             if block is None:  # the end of the text (a subroutine's ends with its endsub)
                 if frame.space is not None:  # skipped past its endsub
+                    skipped = self.skipping or ""
                     raise NcppError(
-                        f"o{_shown(self.skipping or '')} is not closed in its subroutine",
+                        f"WHILE ... {skipped} has no END{skipped[2:]} in its subprogram"
+                        if skipped.startswith("DO")
+                        else f"o{_shown(skipped)} is not closed in its subroutine",
                         Location(self.file, frame.space[-1].line, None),
                     )
                 return  # LinuxCNC too ends a program whose file ends, in a loop or skipping
@@ -206,13 +286,16 @@ class Flow:
             if control is None:
                 yield block, *self._kind(frame)
                 self._advance(frame)
+                if self.moved:
+                    self.moved = False
+                    self._modal_call(block)
                 continue
             yield from self._control(frame, block, control)
         yield from self._rest()
 
     def _kind(self, frame: _Frame) -> tuple[str, Block | None]:
         if self._in_place(frame):
-            return (FIXED if frame.labels else RUN), None
+            return (FIXED if frame.labels or frame.pc in self.looped else RUN), None
         return FIXED, self.owner
 
     def _in_place(self, frame: _Frame) -> bool:
@@ -228,15 +311,54 @@ class Flow:
         self.written = line + 1
         if len(self.buffer) > 2 * _TRIM and not self.frames[0].labels:
             keep = self.written - self.base  # nothing before the next block is read again
-            if keep > _TRIM:
+            if not self.fanuc and keep > _TRIM:
                 self._drop(keep)
+            elif keep > 2 * _TRIM:  # but by a Fanuc backward GOTO: the last _TRIM held
+                self._drop(keep - _TRIM)
 
     def _drop(self, n: int) -> None:
         """The first `n` blocks of the buffer, no longer wanted."""
         for block in self.buffer[:n]:
             self._controls.pop(id(block), None)
+            number = sequence_number(block) if self.fanuc else None
+            if number is not None:
+                self.dropped.add(number)
         del self.buffer[:n]
         self.base += n
+
+    def _read_ahead(self) -> None:
+        """The first `_TRIM` blocks, read ahead: the lines a literal backward GOTO among them
+        goes back over are `looped` (they run again; their first pass is FIXED too)."""
+        first: dict[int, int] = {}  # sequence number -> its first line (index)
+        while self.read < _TRIM:
+            try:
+                if not self._read():
+                    break
+            except NcppError as fault:  # (raised where the flow reaches its line)
+                self._fault = fault
+                break
+            index = self.read - 1
+            block = self.buffer[index]
+            number = sequence_number(block)
+            if number is not None:
+                first.setdefault(number, index)
+            elif program_number(block) is not None:  # another program (a macro after M30): its own numbers
+                first.clear()
+            control = self._control_of(block)
+            if (
+                control is not None
+                and control.keyword in ("g65", "g66")
+                or block.signature is None
+                and _macro_b(block)
+            ):
+                self.fanuc = True
+            if control is None or control.keyword not in ("goto", "fanuc_if"):
+                continue
+            target = control.arguments[-1]
+            if target[0] == "num":
+                start = first.get(int(round_half_away(target[1])))
+                if start is not None:  # (a forward one the search finds first: FIXED too, which is safe)
+                    self.looped.update(range(start, index + 1))
 
     def _control_of(self, block: Block) -> Control | None:
         key = id(block)
@@ -261,6 +383,7 @@ class Flow:
         for line in range(self.written, self.read):
             yield self.buffer[line - self.base], TEXT, None
         self.buffer.clear()
+        self._raise_fault()
         for block in self.stream:
             yield block, TEXT, None
 
@@ -276,11 +399,19 @@ class Flow:
     def _read(self) -> bool:
         """Read the next main-program block (False: the stream has ended); subroutine
         definitions are kept as they go by, for calls before and after them."""
+        self._raise_fault()
         block = next(self.stream, None)
         if block is None:
             return False
         self._keep(block)
         return True
+
+    def _raise_fault(self) -> None:
+        """The parser's error the read-ahead met, where the flow reaches its line: an error of
+        an earlier line is reported first, as without reading ahead."""
+        fault, self._fault = self._fault, None
+        if fault is not None:
+            raise fault
 
     def _keep(self, block: Block) -> None:
         """A main-program block read: in the buffer, and in the definition being read."""
@@ -318,7 +449,7 @@ class Flow:
         self, frame: _Frame, block: Block, control: Control
     ) -> Iterator[tuple[Block, str, Block | None]]:
         """Run one control line: decide (errors point at it), write it, then jump."""
-        if control.keyword not in ("m98", "m99"):
+        if control.keyword not in ("m98", "m99", "g65", "g66", "g67"):
             self._nothing_after(block, control)
         if type(control.name) is tuple:
             value = self.evaluate(control.name, block, control.item)
@@ -475,15 +606,262 @@ class Flow:
             )
 
         def leave():
-            self.parameters.leave(None)
-            if frame.repeats > 0:  # L: once more
+            if frame.repeats > 0:  # L: once more (a G65 macro with the locals it left)
                 frame.repeats -= 1
                 frame.pc, frame.labels = 1, {}
-                self.parameters.enter(None)
+                if not frame.macro:
+                    self.parameters.leave(None)
+                    self.parameters.enter(None)
             else:
+                self.parameters.leave(None)
                 self.frames.pop()
 
         return leave
+
+    def _g65(self, frame, block, control, arrived):
+        """A Fanuc macro call: `G65 P<n> L<repeats> <arguments>` (the module docstring)."""
+        found = self._macro(block, control)
+        if found is None:
+            return lambda: None
+        body, runs, values = found
+        self._check_level(block, control)
+
+        def call():
+            frame.pc += 1
+            self.parameters.enter_macro(values)
+            self.frames.append(_Frame(body, 1, repeats=runs - 1, macro=True))
+
+        return call
+
+    def _g66(self, frame, block, control, arrived):
+        """`G66 P<n> L<repeats> <arguments>`: from the next block on, O<n> is called with the
+        arguments after each block of this frame that moves, until G67; the moves of the macro
+        call it no more (Fanuc 16i/18i operator's manual, "Custom macro", Modal call: G66)."""
+        if self.modal is not None:
+            self.stop(
+                "G66 while a G66 modal call is in effect (nested modal calls)", block, control.item.start + 1
+            )
+            return lambda: None
+        found = self._macro(block, control)
+        if found is None:
+            return lambda: None
+        depth = len(self.frames) - 1
+
+        def start():
+            frame.pc += 1
+            self.modal = _ModalCall(*found, depth)
+
+        return start
+
+    def _g67(self, frame, block, control, arrived):
+        def cancel():
+            frame.pc += 1
+            self.modal = None
+
+        return cancel
+
+    def _modal_call(self, block: Block) -> None:
+        """After a block that moved under G66: the macro, called (its own moves call nothing)."""
+        modal = self.modal
+        if modal is None:
+            return
+        if len(self.frames) - 1 != modal.depth:
+            if not any(f.modal for f in self.frames[modal.depth + 1 :]):
+                self.stop("a move in a subprogram or macro called while G66 is in effect", block, None)
+            return
+        if len(self.frames) >= MAX_CALL_LEVELS:
+            raise NcppError(f"Too many subroutine levels: calls nest at most {MAX_CALL_LEVELS - 1} deep",
+                            Location(self.file, block.line, None))  # fmt: skip
+        self.parameters.enter_macro(modal.values)
+        self.frames.append(_Frame(modal.body, 1, repeats=modal.runs - 1, macro=True, modal=True))
+
+    def _macro(self, block: Block, control: Control) -> tuple[list[Block], int, dict[int, float]] | None:
+        """The body, runs and arguments of a G65 or G66 line (None: the program lacks the macro)."""
+        program, repeats, arguments = control.arguments
+        name = str(int(round_half_away(self._number(program, block))))
+        runs = 1 if repeats is None else int(round_half_away(self._number(repeats, block)))
+        if runs < 1:
+            raise NcppError(f"{control.keyword.upper()} L{runs}: a macro runs 1 to 9999 times",
+                            Location(self.file, block.line, repeats.start + 1))  # fmt: skip
+        values = {
+            MACRO_ARGUMENTS[item.letter]: self._number(item, block)
+            for item in arguments
+            if type(item) is Word or not vacant(item.expr, self.parameters)  # (a vacant one: not given)
+        }
+        body = self._defined(self.subprograms, name)
+        if body is None:
+            what = control.keyword.upper()
+            self.stop(f"{what} P{name}: a macro the program does not define (O{name} to M99)", block,
+                      control.item.start + 1)  # fmt: skip
+            return None
+        return body, runs, values
+
+    # -- Fanuc branches and loops ------------------------------------------------
+    def _goto(self, frame, block, control, arrived):
+        (target,) = control.arguments
+        return self._jump(frame, block, control, target)
+
+    def _fanuc_if(self, frame, block, control, arrived):
+        condition, target = control.arguments
+        if self.evaluate(condition, block, control.item) == 0.0:
+            return self._on(frame, None)
+        return self._jump(frame, block, control, target)
+
+    def _fanuc_while(self, frame, block, control, arrived):
+        condition, m = control.arguments
+        name = self._loop_name(m, block, control)
+        label = frame.labels.get(name)
+        if label is not None and label.start != frame.pc:
+            where = Location(self.file, block.line, control.item.start + 1)
+            raise NcppError(f"WHILE ... DO{m} inside the loop DO{m} under way: nested loops take different "
+                            "numbers (a Fanuc alarm)", where)  # fmt: skip
+        again = self.evaluate(condition, block, control.item) != 0.0
+
+        def test():
+            if again:
+                frame.labels.setdefault(name, _Label("fanuc", frame.pc))
+            else:  # on past its END
+                self.skipping = name
+            frame.pc += 1
+
+        return test
+
+    def _fanuc_end(self, frame, block, control, arrived):
+        (m,) = control.arguments
+        name = self._loop_name(m, block, control)
+        if arrived:  # the WHILE's condition failed
+            return self._ended(frame, name)
+        label = frame.labels.get(name)
+        where = Location(self.file, block.line, control.item.start + 1)
+        if label is None or label.kind != "fanuc":
+            raise NcppError(f"END{m} without WHILE ... DO{m} (a Fanuc alarm)", where)
+        inner = [
+            other
+            for other, open_ in frame.labels.items()
+            if open_.kind == "fanuc" and open_.start > label.start
+        ]
+        if inner:
+            raise NcppError(f"END{m} closes DO{m} across the loop {inner[0]}: loops nest, they do not cross "
+                            "(a Fanuc alarm)", where)  # fmt: skip
+        return lambda: setattr(frame, "pc", label.start)
+
+    def _loop_name(self, m: int, block: Block, control: Control) -> str:
+        if m not in (1, 2, 3):
+            raise NcppError(f"DO{m} / END{m}: a loop's number is 1, 2 or 3 (a Fanuc alarm)",
+                            Location(self.file, block.line, control.item.start + 1))  # fmt: skip
+        return f"DO{m}"
+
+    def _jump(self, frame: _Frame, block: Block, control: Control, target: tuple) -> Callable:
+        """GOTO: on at the block numbered `target`, forward (the blocks between are skipped) or back."""
+        col = control.item.start + 1
+        value = self.evaluate(target, block, control.item)
+        number = int(round_half_away(value))
+        if not 1 <= number <= MAX_SEQUENCE_NUMBER:
+            shown = printable(f"{value:g}")
+            raise NcppError(f"GOTO {shown}: a sequence number is 1 to {MAX_SEQUENCE_NUMBER} "
+                            "(a Fanuc alarm)", Location(self.file, block.line, col))  # fmt: skip
+        index = self._sequence_index(frame, number, block, col)
+        if index is None:
+            return lambda: None
+        if index > frame.pc:
+            return lambda: self._forward(frame, index, number, block, col)
+        target_line = self._block(frame, index).line  # type: ignore[union-attr]  # (found: held)
+        if frame.space is None and not self.fanuc:  # (its moves run in place were not noted)
+            self.stop(f"GOTO {number} back, the program's first macro statement past the {_TRIM:,} blocks "
+                      "read ahead", block, col)  # fmt: skip
+            return lambda: None
+        if frame.space is None and self.last_run_move >= target_line:
+            self.stop(f"GOTO {number} back over moves that ran once in their place (their text may be "
+                      "rewritten for that run; a WHILE ... DO loop or a loop near the top of the program is "
+                      "followed)", block, col)  # fmt: skip
+            return lambda: None
+
+        def back():
+            for name in [
+                n for n, label in frame.labels.items() if label.kind == "fanuc" and label.start >= index
+            ]:
+                del frame.labels[name]  # left: the jump goes back before its WHILE
+            frame.pc = index
+
+        return back
+
+    def _forward(self, frame: _Frame, index: int, number: int, block: Block, col: int) -> Iterator:
+        """Past the blocks up to `index`: text that does not run; a loop whose END it passes is
+        left, one whose WHILE it passes is entered, which Fanuc refuses."""
+        entered: dict[str, int] = {}
+        frame.pc += 1
+        while frame.pc < index:
+            passed = self._block(frame, frame.pc)
+            control = self._control_of(passed)  # type: ignore[arg-type]  # (held: read by the search)
+            if control is not None and control.keyword == "fanuc_end":
+                frame.labels.pop(control.name, None)  # type: ignore[arg-type]  # (a str: DOm)
+                entered.pop(control.name, None)  # type: ignore[arg-type]
+            elif control is not None and control.keyword == "fanuc_while":
+                entered[f"DO{control.arguments[1]}"] = passed.line  # type: ignore[union-attr]
+            if self._in_place(frame):
+                yield passed, SKIP, None
+                self._wrote(frame.pc)
+            frame.pc += 1
+        if entered:
+            name, line = next(iter(entered.items()))
+            raise NcppError(f"GOTO {number} jumps into the loop WHILE ... {name} of line {line}: a branch "
+                            "may leave a loop, not enter one",
+                            Location(self.file, block.line, col))  # fmt: skip
+
+    def _sequence_index(self, frame: _Frame, number: int, block: Block, col: int) -> int | None:
+        """Where block Nn stands in the frame: searched forward from the jump, then from the top
+        (None: ncpp cannot tell, the flow has stopped)."""
+        if frame.space is not None:
+            found = _numbered(frame.space, frame.pc, number)
+            if found is None and frame.repeats >= 0:  # (a Fanuc subprogram, past its first M99)
+                whole = self._whole_programs.get(id(frame.space))
+                if whole is None:
+                    rest = self._rest_of_program(frame.space)
+                    whole = self._whole_programs[id(frame.space)] = frame.space + (rest or [])
+                frame.space = whole
+                found = _numbered(frame.space, frame.pc, number)
+            if found is None:
+                self.stop(f"GOTO {number}: no N{number} in the subprogram (to the next program number or "
+                          "%, with no M2 or M30)", block, col)  # fmt: skip
+            return found
+        index = frame.pc + 1
+        while (ahead := self._block(frame, index)) is not None:
+            if sequence_number(ahead) == number:
+                return index
+            index += 1
+            if index > frame.pc + MAX_SUBPROGRAM:
+                self.stop(f"GOTO {number}: N{number} is not within {MAX_SUBPROGRAM:,} blocks ahead and "
+                          "the blocks before are not all held", block, col)  # fmt: skip
+                return None
+        if number in self.dropped or not self.fanuc and self.base > 0:  # (not a Fanuc one: none noted)
+            self.stop(f"GOTO {number}: N{number} is further back than the blocks ncpp holds", block, col)
+            return None
+        for index in range(self.base, frame.pc + 1):
+            if sequence_number(self.buffer[index - self.base]) == number:
+                return index
+        raise NcppError(f"GOTO {number}: the program has no block N{number} (a Fanuc alarm)",
+                        Location(self.file, block.line, col))  # fmt: skip
+
+    def _rest_of_program(self, space: list[Block]) -> list[Block] | None:
+        """A Fanuc subprogram's blocks after its first M99 (where `space` ends), to the next
+        program number, `%` or the end of the file: a program is all of them on a Fanuc.  None
+        where they are not all held, or one ends a program (M2, M30: the main program's text)."""
+        last = space[-1]
+        start = next((i for i, held in enumerate(self.buffer) if held is last), None)
+        if start is None:
+            return None
+        rest: list[Block] = []
+        main = self.frames[0]
+        index = self.base + start + 1
+        while len(rest) < MAX_SUBPROGRAM:
+            block = self._block(main, index)
+            if block is None or program_number(block) is not None or _starts_program(block):
+                return rest
+            if _ends_program(block):
+                return None
+            rest.append(block)
+            index += 1
+        return None
 
     def _defined(self, found: dict[str, list[Block]], name: str) -> list[Block] | None:
         """The lines of subroutine (or subprogram) `name`, read on for if it comes later in the text (None: nowhere)."""
@@ -695,7 +1073,8 @@ class Flow:
 
 def control_of(block: Block) -> Control | None:
     """The block's control line, if it is one: an o-word (`O<name>` alone, a program
-    name, is not), or a line of only M98 P.. L.. or M99 (N, comments and a leading `/` aside)."""
+    name, is not), a line of only M98 P.. L.. or M99, a Fanuc GOTO, IF ... GOTO, WHILE or
+    END, or a G65, G66 or G67 line (N, comments and a leading `/` aside)."""
     words: dict[str, Word | ExprWord] = {}
     for item in block.items:
         kind = type(item)
@@ -705,6 +1084,8 @@ def control_of(block: Block) -> Control | None:
                 statement.kind == "block_delete" and not words
             ):  # `/o1 endsub`: with the switch off (rs274's) the line runs
                 continue
+            if statement.kind in _FANUC_FLOW:
+                return _fanuc_control(block, statement, words)
             if statement.kind != "oword" or len(statement.node) < 2 or words:
                 return None
             head, rest = statement.node[0], statement.node[1:]
@@ -717,6 +1098,13 @@ def control_of(block: Block) -> Control | None:
             if (
                 word.letter not in "NMPL" or word.letter in words
             ):  # (most lines end here, at their first word)
+                if (
+                    word.letter == "G"
+                    and type(word) is Word
+                    and word.value in _MACRO_CALLS
+                    and words.keys() <= {"N"}
+                ):
+                    return _macro_call(block, word)
                 return None
             words[word.letter] = word
         elif kind is not Comment:
@@ -729,6 +1117,93 @@ def control_of(block: Block) -> Control | None:
         return Control(None, "m98", (words["P"], words.get("L")), m)
     if m.value == 99.0 and len(words) == 1:
         return Control(None, "m99", (), m)
+    return None
+
+
+def _fanuc_control(block: Block, statement: Statement, words: dict) -> Control | None:
+    """A Fanuc GOTO, IF ... GOTO, WHILE ... DO or END line (an N and comments aside); None for
+    IF ... THEN, which the interpreter runs, and for a line with more on it."""
+    items = block.items
+    if words.keys() - {"N"} or any(type(i) is not Comment for i in items[items.index(statement) + 1 :]):
+        return None
+    node = statement.node
+    keyword = _FANUC_FLOW[statement.kind]
+    if keyword == "goto":
+        return Control(None, keyword, (node[1],), statement)
+    if keyword == "fanuc_if":
+        return Control(None, keyword, (node[1], node[3]), statement) if node[2].upper() == "GOTO" else None
+    if keyword == "fanuc_while":
+        return Control(None, keyword, (node[1], _integer(node[3])), statement)
+    m = _integer(node[1])
+    return Control(f"DO{m}", keyword, (m,), statement)
+
+
+def _macro_call(block: Block, g65: Word) -> Control | None:
+    """`G65 P.. L.. <arguments>` (argument specification I, each letter once), `G66` alike,
+    `G67` alone; else None."""
+    keyword = _MACRO_CALLS[g65.value]
+    if keyword == "g67":
+        rest = block.items[block.items.index(g65) + 1 :]
+        return Control(None, keyword, (), g65) if all(type(i) is Comment for i in rest) else None
+    program = repeats = None
+    arguments: list[Word | ExprWord] = []
+    seen: set[str] = set()
+    for item in block.items[block.items.index(g65) + 1 :]:
+        kind = type(item)
+        if kind is Comment:
+            continue
+        if kind is not Word and kind is not ExprWord:
+            return None
+        word: Word | ExprWord = item  # type: ignore[assignment]  # (`kind` says so)
+        letter = word.letter
+        if letter in seen or (letter not in MACRO_ARGUMENTS and letter not in "PL"):
+            return None  # (specification II repeats I J K: not read)
+        seen.add(letter)
+        if letter == "P":
+            program = word
+        elif letter == "L":
+            repeats = word
+        else:
+            arguments.append(word)
+    return None if program is None else Control(None, keyword, (program, repeats, tuple(arguments)), g65)
+
+
+def _numbered(space: list[Block], pc: int, number: int) -> int | None:
+    """Where Nn stands in a subprogram's lines: forward from `pc`, then from its top."""
+    for index in (*range(pc + 1, len(space)), *range(1, pc + 1)):
+        if sequence_number(space[index]) == number:
+            return index
+    return None
+
+
+def _starts_program(block: Block) -> bool:
+    """A `%` line or a program's name (`OCIRCLE`): where a Fanuc program ends."""
+    return any(type(item) is Statement and item.kind in ("tape", "program_name") for item in block.items)
+
+
+def _ends_program(block: Block) -> bool:
+    return any(
+        type(item) is Word and item.letter == "M" and item.value in (2.0, 30.0) for item in block.items
+    )
+
+
+def _macro_b(block: Block) -> bool:
+    """A line with a Fanuc macro statement (IF, WHILE, END, GOTO)."""
+    return any(type(item) is Statement and item.kind in _FANUC_FLOW for item in block.items)
+
+
+def _integer(digits: str) -> int:
+    return int("".join(digits.split()))
+
+
+def sequence_number(block: Block) -> int | None:
+    """The block's sequence number (its N word, first but for a block delete), else None."""
+    for item in block.items:
+        kind = type(item)
+        if kind is Word:
+            return int(item.value) if item.letter == "N" else None  # type: ignore[union-attr]
+        if kind is not Statement or item.kind != "block_delete":  # type: ignore[union-attr]
+            return None
     return None
 
 

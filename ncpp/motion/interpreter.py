@@ -13,18 +13,21 @@ control's tool table, `tools.py`; zero when it is not told), F and inverse time,
 P turns, parameters and expressions, Fanuc corner rounding and
 chamfering between two lines (`,R` `,C`, `G1 ... R`: a one-move look-ahead),
 the canned cycles G73 G74 G81-G87 G89 with G98/G99 (`cycles.py`), and
-o-word subroutines, branches and loops and Fanuc M98/M99 subprograms
-(`flow.py`), and cutter compensation G40-G42.1 (`_in_comp`): where the control
-offsets the path by the tool radius the moves are the programmed contour, not
-the tool centre, and after G40 the position is the program's again, as in
-rs274ngc.  The moves of cycles, loops and subroutines, and those the tool
-makes off the programmed path (from the first move under G41/G42 to the first
-after G40), are marked `fixed`: compensation leaves them as programmed.
-Anything else (subroutine files, Fanuc macro
-control flow, M99 in the main program, G88 (a manual retract) and the lathe cycles, splines,
-threading, probing) makes the
-interpreter's state unknown: that block and every later block pass through
-as `Pass` after ONE warning (an error with `strict`).
+o-word subroutines, branches and loops, Fanuc M98/M99 subprograms and Fanuc
+macro B (GOTO, IF ... GOTO, WHILE ... DO ... END, G65 and G66/G67 macro calls: `flow.py`;
+`IF [..] THEN #i = ..`, vacant variables, #3000 alarms and #3006 stops,
+#5001-#5003 where known: here), and cutter compensation G40-G42.1
+(`_in_comp`): where the control offsets the path by the tool radius the moves
+are the programmed contour, not the tool centre, and after G40 the position is
+the program's again, as in rs274ngc.  The moves of cycles, loops, subroutines
+and macros, and those the tool makes off the programmed path (from the first
+move under G41/G42 to the first after G40), are marked `fixed`: compensation
+leaves them as programmed.  Anything else (subroutine files ncpp is not told
+of, a move of a subprogram under G66, a Fanuc system variable it does not know, M99
+in the main program, G88 (a manual retract) and the lathe cycles, splines,
+threading, probing) makes the interpreter's state unknown: that block and
+every later block pass through as `Pass` after ONE warning (an error with
+`strict`).
 """
 
 from __future__ import annotations
@@ -46,7 +49,7 @@ from ncpp.motion.cycles import (
     back_bore,
     hole,
 )
-from ncpp.motion.expressions import ExpressionError, OutOfScope, Parameters, evaluate
+from ncpp.motion.expressions import ExpressionError, OutOfScope, Parameters, evaluate, vacant
 from ncpp.motion.flow import FIXED, RUN, SKIP, Flow
 from ncpp.motion.offsets import SYSTEMS, WorkOffsets
 from ncpp.motion.segments import (
@@ -156,6 +159,7 @@ _MODE0_WITH_COMP = {
     **{c: "Cannot set reference point with cutter compensation in effect" for c in (28.1, 30.1)},
     53.0: "Cannot use g53 with cutter radius comp",
 }
+_FANUC_MESSAGES = (3000, 3006)  # Fanuc's alarm and stop-with-message system variables
 _MOTION_WITH_COMP = {
     **{
         c: "Cannot use canned cycles with cutter compensation on"
@@ -263,7 +267,7 @@ class Interpreter:
         )  # warned at the first G43 that reads the table
         self.home = {28: [0.0] * 9, 30: [0.0] * 9}  # G28/G30 positions, machine coordinates
         self.uses_extra_axes = False
-        self.params = Parameters(self._system_parameter)
+        self.params = Parameters(self._system_parameter, self._fanuc_system_variable)
         self._context: Context | None = None
         self._fast = False
         self.done = False  # program end (M2/M30) reached or state unknown
@@ -277,6 +281,9 @@ class Interpreter:
         self.untold: set[int] = set()  # coordinate systems whose zero nobody said (warned when selected)
         self.warnings: Warnings | None = None
         self.flow: Flow | None = None  # while `run` runs
+        # Fanuc: the axes (0 X, 1 Y, 2 Z) a move has put at a programmed position since the start or
+        # the last program stop (where the operator may jog the machine): #5001-#5003 read them
+        self.placed: set[int] = set()
         self.subroutine_path = offsets.subroutine_path if offsets is not None else ()
         if offsets is not None:
             self._start_from(offsets)
@@ -321,6 +328,12 @@ class Interpreter:
                 event = block_event(block)  # verbatim blocks (after the closing %) have no items
                 if kind is FIXED:
                     event = self._in_flow(event, owner)
+                if flow.modal is not None and _moves(event):  # a move under G66: the macro next
+                    flow.moved = True
+                if self.params.fanuc:
+                    if kind is RUN and _moves(event):  # in its place: no backward GOTO may run it again
+                        flow.last_run_move = block.line
+                    self._note_placed(block)
                 if self.off_path or self.cutter_comp is not None or self.arc_refused:
                     event = self._in_comp(event, block)
             except NcppError as err:
@@ -549,10 +562,16 @@ class Interpreter:
                 continue
             elif kind is ExprWord:
                 computed: ExprWord = item  # type: ignore[assignment]  # (as above)
+                if vacant(computed.expr, self.params):  # Fanuc: `X#1`, #1 vacant, is no X word
+                    continue
                 letter, value = computed.letter, self._evaluate(computed.expr, block, computed)
             else:
                 statement: Statement = item  # type: ignore[assignment]  # (as above)
                 what = statement.kind
+                if what == "if" and statement.node[2].upper() == "THEN":  # Fanuc `IF [..] THEN #i = ..`
+                    if self._evaluate(statement.node[1], block, item) == 0.0:
+                        continue
+                    statement, what = statement.node[3], "assignment"
                 if what == "assignment":
                     target, expr = statement.node
                     key = self._param_key(target, block, item)
@@ -561,7 +580,8 @@ class Interpreter:
                         # the value's expression too, reads 0; the value is set after the line
                         self.params.write(key, 0.0)
                     assignments = assignments or []
-                    assignments.append((key, self._evaluate(expr, block, item), item))
+                    assigned = None if vacant(expr, self.params) else self._evaluate(expr, block, item)
+                    assignments.append((key, assigned, item))
                 elif what == "oword" and len(statement.node) == 1:  # `O<name>` alone: a program's name
                     pass
                 elif what == UNREADABLE:  # read where it runs, as rs274ngc reads it
@@ -600,9 +620,15 @@ class Interpreter:
                     self._fail(f"Multiple {letter.lower()} words on one line", block, item)
                 words[letter] = (value, item)  # type: ignore[assignment]  # (a word: `kind`)
         if assignments is not None:  # rs274ngc: after the whole line is read
-            for key, value, item in assignments:
+            for key, assigned, item in assignments:
+                if key in _FANUC_MESSAGES and self.flow is not None and self.flow.fanuc:
+                    self._fanuc_message(key, assigned, block, item)
+                    continue
                 try:
-                    self.params.write(key, value)
+                    if assigned is None and type(key) is int:  # `#i = #0`: vacant, as Fanuc assigns it
+                        self.params.vacate(key)
+                    else:
+                        self.params.write(key, 0.0 if assigned is None else assigned)
                 except ExpressionError as err:
                     self._fail(str(err), block, item)
                 except OutOfScope as err:
@@ -624,6 +650,47 @@ class Interpreter:
                 if plain is not None and words.keys() <= plain:
                     return self._motion_move(block, words, motion, motion_item)
         return self._execute(block, words, gcodes or {}, mcodes or {})
+
+    def _fanuc_message(self, key: int | str, value: float | None, block: Block, item) -> None:
+        """Fanuc's `#3000 = n (MESSAGE)`: the control stops with alarm 3000 + n and the message,
+        so ncpp refuses the program there; `#3006 = n (MESSAGE)`: it stops and shows the message
+        until the operator starts it again, as M0 (Fanuc 16i/18i operator's manual, "Custom macro",
+        System variables: alarm #3000, stop with message #3006)."""
+        comments = [i for i in block.items[block.items.index(item) + 1 :] if type(i) is Comment]
+        message = comments[0].text if comments else ""
+        if key == 3000:
+            self._fail(f"macro alarm {3000 + int(value or 0)}: {message}".rstrip(": "), block, item)
+        self.placed.clear()
+
+    def _fanuc_system_variable(self, key: int) -> float | None:
+        """The Fanuc system variables ncpp knows: #5001-#5003, the end point of the last block
+        in the workpiece coordinate system, of an axis a move has placed since the start or the
+        last stop, with no G92/G52 shift (Fanuc 16i/18i operator's manual, "Custom macro", System
+        variables: position information).  Not #5021-#5023, the machine position: the control
+        reads it ahead, while the block before moves ("reading during movement: not possible")."""
+        axis = key - 5001
+        if 0 <= axis <= 2 and axis in self.placed and not any(self.g92[:3]):
+            return self.pos[axis]
+        return None
+
+    def _note_placed(self, block: Block) -> None:
+        """Which axes a Fanuc program's block puts at a programmed position (`placed`): the X Y Z
+        words of a G0-G3 move in G90.  A program stop (M0, M1, M60) lets the operator move the
+        machine, and a G10, G28, G92 ... (or a G or M code from a variable) may shift or move it
+        elsewhere: no axis is placed after them."""
+        signature = block.signature
+        if signature is not None and "M" not in signature:  # (plain words: the signature tells)
+            effect = _PLACING.get(signature)
+            if effect is None:
+                effect = _placing(block, self.params)
+                if len(_PLACING) < 4096:  # a program has few distinct signatures
+                    _PLACING[signature] = effect
+        else:
+            effect = _placing(block, self.params)
+        if effect is None:
+            self.placed.clear()
+        elif effect and self.absolute and self.motion in (0.0, 1.0, 2.0, 3.0):
+            self.placed.update(effect)
 
     def _set_feed(self, block: Block, word: tuple) -> None:
         if word[0] < 0.0:
@@ -1666,6 +1733,37 @@ _PLAIN_LETTERS = {
 def _expanding(event: Event) -> bool:
     """Whether the event is one of those that write a canned cycle's block as its moves."""
     return type(event) is Pass and (event.cycle is not None or event.dwell is not None)
+
+
+_PLACING: dict[str, tuple[int, ...] | None] = {}  # a plain block's signature -> its `_placing`
+
+
+def _placing(block: Block, params: Parameters) -> tuple[int, ...] | None:
+    """The X Y Z axes (0 1 2) a block's words name, or None where it stops the program (M0, M1,
+    M60) or has a G code of group 0 other than G4 (or a G or M code from a variable)."""
+    letters = set()
+    for item in block.items:
+        kind = type(item)
+        if kind is not Word and kind is not ExprWord:
+            continue
+        word: Word | ExprWord = item  # type: ignore[assignment]  # (`kind` says so)
+        letter = word.letter
+        if letter == "G" or letter == "M":
+            value = word.value if type(word) is Word else None
+            if value is None or (
+                value in (0.0, 1.0, 60.0) if letter == "M" else G_GROUP.get(value) == 0 and value != 4.0
+            ):
+                return None
+        elif type(word) is Word or not vacant(word.expr, params):  # (a vacant one is no word)
+            letters.add(letter)
+    return tuple(i for i, letter in enumerate("XYZ") if letter in letters)
+
+
+def _moves(event: Event | tuple[Event, ...]) -> bool:
+    """Whether a block's events hold a move (a loop's block run out of order may have none)."""
+    if type(event) is tuple:
+        return any(type(e) is not Pass for e in event)
+    return type(event) is not Pass
 
 
 def _homes(block: Block) -> bool:

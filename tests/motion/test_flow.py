@@ -271,6 +271,9 @@ class _Params:
     def leave(self, value):
         pass
 
+    def start_fanuc(self):
+        pass
+
 
 def _random_program(rng: random.Random) -> str:
     """Nested branches, loops and calls with random conditions, numbered and named parameters."""

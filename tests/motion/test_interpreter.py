@@ -267,7 +267,8 @@ def test_arc_radius_tolerance_matches_linuxcnc_files():
     "text, construct",
     [
         ("o<probe> call\n", "o<probe>, which the program does not define (a subroutine file"),
-        ("IF [#1 EQ 1] GOTO 10\n", "Fanuc macro IF"),
+        ("G65 P100 X1\n", "G65 P100: a macro the program does not define"),
+        ("G1 X1 IF [#1 EQ 1] GOTO 10\n", "Fanuc macro IF"),  # (Fanuc: a macro statement alone on its line)
         ("M98 P100\n", "M98 P100: a subprogram the program does not define"),
         (
             "G88 X0 Y0 Z-1 R1 P1 F10\n",
