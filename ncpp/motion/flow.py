@@ -74,7 +74,8 @@ _TRIM = 4096  # blocks no loop can go back to are dropped in runs of this many
 # program's own number (`O1000` at its top), not a subprogram, and memory stays bounded.
 MAX_SUBPROGRAM = 20_000
 # Lines run (or skipped) out of the text's order, loop iterations and calls, before a program
-# counts as one that never ends (LinuxCNC would run it for ever; a pass over it must end): ~1 minute
+# counts as one that never ends and is refused (LinuxCNC would run it for ever; a pass over it
+# must end): about a minute
 MAX_RERUN = 5_000_000
 # Subroutine levels (o-word calls and M98 together) as rs274ngc counts them: the tenth call is refused
 MAX_CALL_LEVELS = 10
@@ -273,8 +274,9 @@ class Flow:
             if not self._in_place(frame):
                 self.rerun += 1
                 if self.rerun > MAX_RERUN:
-                    self.stop(f"a loop that does not end ({MAX_RERUN:,} lines run again)", self.owner, None)
-                    break
+                    line = self.owner.line if self.owner is not None else block.line
+                    raise NcppError(f"a loop that does not end: {MAX_RERUN:,} lines run again (the control would run "
+                                    "it for ever; ncpp follows a program to its end)", Location(self.file, line, 1))  # fmt: skip
             control = self._control_of(block)
             if self.skipping is not None and (
                 control is None or control.name != self.skipping

@@ -23,7 +23,7 @@ from tests.hostile.fuzz import mutate
 MACHINE = SHARED / "machines/wide.toml"
 CASES = int(os.environ.get("NCPP_FUZZ_CASES", "12"))
 SEED = int(os.environ.get("NCPP_FUZZ_SEED", "0"))
-SECONDS_PER_CASE = 30.0  # (a loop that never ends is given up after MAX_RERUN lines: under a minute)
+SECONDS_PER_CASE = 30.0  # (a loop that never ends is refused after MAX_RERUN lines: under a minute)
 MEMORY_MB = 1536  # the worker's address space (a compensation run maps under 200 MB)
 LOCATED = re.compile(r"^(?!ncpp: )(?P<file>[^:\n]+):\d+:\d+: ")
 

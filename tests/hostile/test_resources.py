@@ -1,4 +1,4 @@
-"""Memory stays flat in the length of a loop, and a loop that never ends is given up at a bound."""
+"""Memory stays flat in the length of a loop, and a loop that never ends is refused at a bound."""
 
 from __future__ import annotations
 

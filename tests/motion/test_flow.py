@@ -226,17 +226,14 @@ def test_out_of_scope_inside_a_subroutine_names_the_call():
     assert "".join(e.block.text for e in events if type(e) is not Line).count("o1 call") == 1
 
 
-def test_a_loop_that_does_not_end_ends_interpretation(monkeypatch):
-    """LinuxCNC would run it for ever; a pass over the program must end."""
+def test_a_loop_that_does_not_end_is_refused_at_its_line(monkeypatch):
+    """LinuxCNC would run it for ever; a pass over the program must end, at a stated bound."""
     import ncpp.motion.flow as flow
 
     monkeypatch.setattr(flow, "MAX_RERUN", 1000)
-    warned = io.StringIO()
-    events = _events(
-        HEAD + "o1 while [1]\n G0 X1\n G0 X2\no1 endwhile\nG0 Y5\n", warnings=Warnings(stream=warned)
-    )
-    assert "t.ngc:6:1: warning: a loop that does not end (1,000 lines run again)" in warned.getvalue()
-    assert events[-1].block.text == "G0 Y5\n" and type(events[-1]) is Pass
+    with pytest.raises(NcppError, match=r"a loop that does not end: 1,000 lines run again") as err:
+        _events(HEAD + "o1 while [1]\n G0 X1\n G0 X2\no1 endwhile\nG0 Y5\n")
+    assert (err.value.where.file, err.value.where.line) == ("t.ngc", 6)
 
 
 def test_memory_stays_flat_around_loops_and_calls():
