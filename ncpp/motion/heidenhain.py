@@ -40,8 +40,9 @@ from ncpp.motion.modal import (
     as_point,
     run_placed,
 )
+from ncpp.motion.heidenhain_flow import FIXED, JUMPS, SKIP, TEXT, KlartextFlow, jump_parts, label_key
 from ncpp.motion.offsets import WorkOffsets
-from ncpp.motion.segments import COMP, MACHINE, PLANE_AXES, Arc, Event, Line, Pass, Point
+from ncpp.motion.segments import COMP, FLOW, MACHINE, PLANE_AXES, Arc, Event, Line, Pass, Point
 from ncpp.motion.tools import ToolTable, UntoldLengths
 from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
 
@@ -110,6 +111,22 @@ def interpret(
     return run_placed(interpreter, blocks, warnings, strict, offsets is None or offsets.tools is not None)
 
 
+def _in_flow(events: list[Event], owner: Block | None) -> list[Event]:
+    """A block's events where it runs again: its moves are left as programmed (FLOW) and, run
+    out of the text's order, belong to `owner`, as do its pole and corner (the writer's state);
+    its other events are the text, written where it stands."""
+    out: list[Event] = []
+    for event in events:
+        if type(event) is Line or type(event) is Arc:
+            event.fixed = event.fixed or FLOW
+        elif owner is not None and type(event) is not Pole and type(event) is not Corner:
+            continue
+        if owner is not None:
+            event.block = owner
+        out.append(event)
+    return out
+
+
 def _plane_of_axes(axes: set[int], default: int) -> int:
     for plane, (a, b, _) in PLANE_AXES.items():
         if axes == {a, b}:
@@ -143,13 +160,14 @@ class HeidenhainInterpreter(ModalInterpreter):
         self.corner_waits = False  # an RND/CHF block came after the last move
         self.unknown_axes: set[int] = set()  # axes whose position ncpp is not told (after M140 MB MAX)
         self.preset: float | None = None  # the preset CYCL DEF 247 activated (the program zero told)
+        self.flow: KlartextFlow | None = None  # the order the blocks run in (labels, calls, jumps)
 
     def run(self, blocks: Iterable[Block], warnings: Warnings) -> Iterator[Event]:
         """Events as `ModalInterpreter.run`; a feed line waits (with the events after it)
         for the next move, which an RND/CHF block in between makes round or cut."""
         held: list[Event] = []  # the last feed line and the events after it
         corner: Corner | None = None
-        for event in super().run(blocks, warnings):
+        for event in self._flowing(blocks, warnings):
             if isinstance(event, Pass):
                 if type(event) is Corner:
                     corner = event
@@ -169,10 +187,9 @@ class HeidenhainInterpreter(ModalInterpreter):
                 assert not isinstance(first, Pass) and not isinstance(last, Pass)  # round_corner's lines
                 held[0], event = first, last
                 piece = made[1] if len(made) == 3 else Pass(corner.block)
-                if COMP in (first.fixed, last.fixed) and not isinstance(
-                    piece, Pass
-                ):  # (the rounding is the contour's)
-                    piece.fixed = COMP
+                kept = next((f for f in (first.fixed, last.fixed) if f in (COMP, FLOW)), None)
+                if kept is not None and not isinstance(piece, Pass):  # (the contour's, or runs again)
+                    piece.fixed = kept
                 held = [piece if e is corner else e for e in held]
                 corner = None
             yield from held
@@ -290,7 +307,14 @@ class HeidenhainInterpreter(ModalInterpreter):
                 return self._tool_def(block, item)
             elif what == "blk_form":
                 return []  # its words describe the blank, not a move
-            elif what != "label":
+            elif what == "label":
+                if node[0] == 0 and self.flow is not None:
+                    self.flow.end_subprogram()
+            elif what == "call_label" and self.flow is not None:
+                self._call_label(block, item)
+            elif what == "fn" and node[0] in JUMPS and self.flow is not None:
+                self._jump(block, item)
+            else:
                 reason = {"call_label": "CALL LBL", "call_program": "CALL PGM", "cycle_call": "CYCL CALL",
                           "fn": f"FN {node[0]}", "keyword": " ".join(map(str, node))}.get(what, what)  # fmt: skip
                 raise OutOfScope(reason, item.start + 1)
@@ -375,6 +399,63 @@ class HeidenhainInterpreter(ModalInterpreter):
 
     def _word_value(self, item, block: Block) -> float:
         return item.value if type(item) is Word else self.value(item.expr, block, item)
+
+    # -- control flow (`heidenhain_flow`) ------------------------------------------------------
+    def _flowing(self, blocks: Iterable[Block], warnings: Warnings) -> Iterator[Event]:
+        """Events as `ModalInterpreter.run`, block by block in the order they run: the moves of
+        a block that runs again are left as programmed (FLOW) and, where it runs out of the
+        text's order, belong to the line that runs it (a call, a jump back), written once."""
+        flow = self.flow = KlartextFlow(self.file, blocks)
+
+        def stop(reason: str, block: Block | None) -> None:
+            self.done = True
+            if block is not None:
+                warnings.warn(f"{reason} is outside the motion interpreter's scope; from this line on the "
+                              "program passes through uninterpreted", Location(self.file, block.line))  # fmt: skip
+
+        for block, kind, owner in flow.steps(lambda: self.done, stop):
+            if kind is SKIP or kind is TEXT or self.done or not block.items:
+                if owner is None:
+                    yield Pass(block, kind is SKIP)
+                continue
+            try:
+                events = self.block(block)
+            except OutOfScope as out:
+                self.done = True
+                where = "this line" if owner is None else f"line {owner.line}, which runs it,"
+                warnings.warn(f"{out.reason} is outside the motion interpreter's scope; from {where} on the "
+                              "program passes through uninterpreted (its modal state is unknown)",
+                              Location(self.file, block.line, out.col))  # fmt: skip
+                if owner is None:
+                    yield Pass(block)
+                continue
+            if kind is FIXED:
+                events = _in_flow(events, owner)
+            elif any(type(e) is Line or type(e) is Arc for e in events):
+                flow.moved()
+            yield from events or ((Pass(block),) if owner is None else ())
+
+    def _call_label(self, block: Block, item) -> None:
+        """`CALL LBL n [REP k]`: a subprogram call or a program-section repeat."""
+        assert self.flow is not None
+        name, repeat = item.node
+        index = self.flow.target(name, lambda q: self.value(q, block, item), item.start + 1)
+        key = label_key(self.value(name, block, item) if type(name) is tuple else name)
+        self.flow.call(index, repeat, key, item.start + 1)
+
+    def _jump(self, block: Block, item) -> None:
+        """FN 9-12: `IF a EQU|NE|GT|LT b GOTO LBL n` jumps to the label when the comparison holds."""
+        assert self.flow is not None
+        number, text = item.node
+        parts = jump_parts(text or "")
+        if parts is None or parts[1] != JUMPS[number] or not all(
+            re.fullmatch(_FN_OPERAND, o.strip(), re.I) for o in parts[:3:2]
+        ):
+            self.fail(f"FN {number}: expected IF a {JUMPS[number]} b GOTO LBL n", block, item)
+        left, test, right, name = parts
+        a, b = (self.value(_fn_operand(o), block, item) for o in (left, right))
+        if {"EQU": a == b, "NE": a != b, "GT": a > b, "LT": a < b}[test]:
+            self.flow.goto(self.flow.target(name, lambda q: self.value(q, block, item), item.start + 1))
 
     def _corner(self, block: Block, item, words: dict) -> Corner:
         function = item.node[0]

@@ -1,0 +1,234 @@
+"""Klartext labels, subprograms, program-section repeats and jumps: the order a program's blocks run in.
+
+TNC 640 Klartext manual, "Subprograms and program section repeats": `LBL n` (1-65535 or a
+name in quotes) marks a place, `LBL 0` ends a subprogram.  `CALL LBL n` runs the blocks after
+`LBL n` up to `LBL 0` and goes on after the call (subprograms stand after M2/M30, since the
+program runs through them otherwise; they nest up to 19 deep and do not call themselves);
+`CALL LBL n REP k` runs the section from `LBL n` to the call k more times.  "If-then
+decisions with Q parameters": `FN 9: IF +Q1 EQU +Q2 GOTO LBL n` (FN 10 NE, FN 11 GT,
+FN 12 LT) jumps to `LBL n` when the condition holds.
+
+`KlartextFlow.steps` yields each block with what the interpreter is to do with it, as
+`ncpp.motion.flow` does for o-words (RUN, FIXED, SKIP, TEXT) and its `owner`: a block that
+runs out of the text's order (a subprogram's, a repeat's, a loop's second pass) belongs to
+the line that runs it, whose text the output is at, so that every text is written once where
+it stands.  A block that will run again (it lies between a label and a later call of or jump
+back to it, read ahead up to `LOOKAHEAD` blocks) is FIXED from its first pass: its one text
+cannot be rewritten for each run.  A call or jump back over a move that ran in place (RUN)
+leaves the scope, and so does a label more than `MAX_AHEAD` blocks ahead or no longer held
+(blocks are held from the first label before the position, up to `MAX_BEHIND` back).
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Callable, Iterable, Iterator
+
+from ncpp.errors import Location, NcppError
+from ncpp.motion.flow import FIXED, MAX_RERUN, RUN, SKIP, TEXT
+from ncpp.motion.modal import OutOfScope
+from ncpp.program.blocks import Block, Statement
+
+LOOKAHEAD = 20_000  # blocks read ahead of the one that runs, to find the calls and jumps back
+MAX_AHEAD = 200_000  # blocks read ahead to find a label a call or jump names
+MAX_BEHIND = 200_000  # blocks held behind the one that runs, for calls and jumps back
+MAX_NESTING = 19  # subprogram levels (TNC 640 Klartext manual, "Nesting")
+JUMPS = {9: "EQU", 10: "NE", 11: "GT", 12: "LT"}  # FN 9-12 and the comparison each makes
+_JUMP = re.compile(
+    r"[ \t]*IF[ \t]*(.+?)[ \t]*(EQU|NE|GT|LT)[ \t]*(.+?)[ \t]*GOTO[ \t]*LBL[ \t]*"
+    r"(\d+|\"[^\"]*\"|Q\d+)[ \t]*$",
+    re.I,
+)
+_DROP = 4096  # blocks dropped at a time
+
+
+def label_key(name: object) -> float | str:
+    """A label as its definitions and calls name it: a number or a name."""
+    return name if type(name) is str else float(name)  # type: ignore[arg-type]
+
+
+def jump_parts(text: str) -> tuple[str, str, str, object] | None:
+    """An FN 9-12 body's (left operand, comparison, right operand, label), None if not one."""
+    found = _JUMP.fullmatch(text)
+    if found is None:
+        return None
+    left, test, right, label = found.groups()
+    target: object = (
+        label[1:-1] if label[0] == '"' else ("param", label.lower()) if label[0] in "Qq" else int(label)
+    )
+    return left, test.upper(), right, target
+
+
+def _references(block: Block) -> Iterator[object]:
+    """The labels a block's call or jump names (a literal, else a Q parameter tuple)."""
+    for item in block.items:
+        if type(item) is Statement and item.kind == "call_label":
+            yield item.node[0]
+        elif type(item) is Statement and item.kind == "fn" and item.node[0] in JUMPS:
+            parts = jump_parts(item.node[1] or "")
+            if parts is not None:
+                yield parts[3]
+
+
+class KlartextFlow:
+    """The blocks of a Klartext program in the order they run (see the module docstring).
+
+    The interpreter tells it, while it runs a block, where the program goes next
+    (`goto`, `call`, `end_subprogram`) and which in-place blocks moved (`moved`);
+    `done()` says the program has ended; `stop(reason, block)` ends it where the
+    flow itself cannot go on."""
+
+    def __init__(self, file: str, blocks: Iterable[Block]):
+        self.file = file
+        self.stream = iter(blocks)
+        self.held: list[Block] = []  # blocks read and still wanted, from index `base`
+        self.base = 0
+        self.exhausted = False
+        self.labels: dict[float | str, int] = {}  # label -> the index of its LBL block
+        self.again: list[tuple[int, int]] = []  # [label, call or jump back]: blocks that run again
+        self.named_by_q = False  # a label defined by a Q parameter: no call or jump can be followed
+        self.frames: list[tuple[int, float | str]] = []  # subprogram calls: (index to return to, label)
+        self.counters: dict[int, int] = {}  # a REP call's index -> the repeats still to run
+        self.current = -1  # the index of the block the interpreter runs
+        self.next: int | None = None  # where the block running sends the program (None: the next)
+        self.last_run_move = -1  # the index of the last block whose moves ran in place (RUN)
+        self.rerun = 0  # blocks run out of the text's order
+
+    # -- reading ------------------------------------------------------------------------
+    def _read(self) -> bool:
+        block = next(self.stream, None)
+        if block is None:
+            self.exhausted = True
+            return False
+        index = self.base + len(self.held)
+        self.held.append(block)
+        for item in block.items:
+            if type(item) is Statement and item.kind == "label":
+                if type(item.node[0]) is tuple:
+                    self.named_by_q = True
+                else:
+                    self.labels.setdefault(label_key(item.node[0]), index)
+        for name in _references(block):
+            if type(name) is not tuple and self.labels.get(label_key(name), index) < index:
+                self.again.append((self.labels[label_key(name)], index))
+        return True
+
+    def block(self, index: int) -> Block | None:
+        """The block at `index`, read ahead to it (None past the end)."""
+        while self.base + len(self.held) <= index and not self.exhausted:
+            self._read()
+        if index < self.base or index >= self.base + len(self.held):
+            return None
+        return self.held[index - self.base]
+
+    def _look_ahead(self, index: int) -> None:
+        while not self.exhausted and self.base + len(self.held) < index + LOOKAHEAD:
+            self._read()
+
+    def _trim(self, low: int) -> None:
+        """Drop the blocks no call or jump can go back to: those before `low` and before
+        the first label at or after `base` (and all more than MAX_BEHIND back)."""
+        if low - self.base < _DROP:
+            return
+        first_label = min((i for i in self.labels.values() if i >= self.base), default=low)
+        keep = max(min(low, first_label), low - MAX_BEHIND)
+        if keep - self.base >= _DROP:
+            del self.held[: keep - self.base]
+            self.base = keep
+            self.again = [(a, b) for a, b in self.again if b >= keep]
+
+    # -- what the interpreter tells ---------------------------------------------------
+    def target(self, name: object, value: Callable[[tuple], float], col: int) -> int:
+        """The index of the label a call or jump names (OutOfScope where ncpp cannot follow)."""
+        if self.named_by_q:
+            raise OutOfScope("a jump in a program with a label named by a Q parameter", col)
+        key = label_key(value(name) if type(name) is tuple else name)  # type: ignore[arg-type]
+        if key == 0.0:
+            raise OutOfScope("a call of LBL 0 (it only ends a subprogram)", col)
+        while key not in self.labels and not self.exhausted:
+            if self.base + len(self.held) > self.current + MAX_AHEAD:
+                break
+            self._read()
+        index = self.labels.get(key)
+        shown = f'"{key}"' if type(key) is str else f"{key:g}"
+        if index is None:
+            raise OutOfScope(f"LBL {shown} (not found within {MAX_AHEAD} blocks)", col)
+        if index < self.base:
+            raise OutOfScope(f"LBL {shown} (more than {MAX_BEHIND} blocks back)", col)
+        if index <= self.current and self.last_run_move >= index:
+            raise OutOfScope(f"a jump back to LBL {shown} over moves that ran in their place", col)
+        return index
+
+    def goto(self, index: int) -> None:
+        """FN 9-12 whose condition holds: on at the label."""
+        self.next = index
+
+    def call(self, index: int, repeat: int, key: float | str, col: int) -> None:
+        """`CALL LBL n [REP k]`: the subprogram at `index`, or the section from it once more."""
+        if repeat:
+            if index >= self.current:
+                raise OutOfScope("CALL LBL ... REP with the label after the call", col)
+            left = self.counters.get(self.current, repeat)
+            if left:
+                self.counters[self.current] = left - 1
+                self.next = index + 1
+            else:
+                del self.counters[self.current]
+            return
+        if any(label == key for _, label in self.frames):
+            raise OutOfScope("a subprogram that calls itself", col)
+        if len(self.frames) >= MAX_NESTING:
+            raise OutOfScope(f"subprograms nested more than {MAX_NESTING} deep", col)
+        self.frames.append((self.current + 1, key))
+        self.next = index + 1
+
+    def end_subprogram(self) -> None:
+        """`LBL 0`: back after the call (in the main program it only marks a place)."""
+        if self.frames:
+            self.next = self.frames.pop()[0]
+
+    def moved(self) -> None:
+        """The block running in its place moved (its text may be rewritten for that run)."""
+        self.last_run_move = self.current
+
+    # -- the order ----------------------------------------------------------------------
+    def steps(self, done: Callable[[], bool], stop: Callable[[str, Block], None]) -> Iterator[tuple]:
+        """(block, kind, owner) in the order the blocks run; the rest as TEXT once `done()`."""
+        pc = written = 0
+        while True:
+            if done():
+                break
+            in_place = not self.frames and pc >= written
+            if in_place:
+                while written < pc:  # jumped over: written, not run
+                    yield self.block(written), SKIP, None
+                    written += 1
+                self._look_ahead(pc)
+            block = self.block(pc)
+            if block is None:
+                if self.frames:
+                    stop("a subprogram without LBL 0 before the end of the program", self.block(written - 1))
+                break
+            self.current, self.next = pc, None
+            if in_place:
+                yield block, FIXED if any(a <= pc <= b for a, b in self.again) else RUN, None
+                written = pc + 1
+            else:
+                owner = self.block(written - 1)
+                self.rerun += 1
+                if self.rerun > MAX_RERUN:
+                    raise NcppError(
+                        f"the program runs more than {MAX_RERUN} blocks in loops and subprograms: "
+                        "a loop that never ends?",
+                        Location(self.file, owner.line if owner is not None else None),
+                    )
+                yield block, FIXED, owner
+            pc = self.next if self.next is not None else pc + 1
+            self._trim(min([pc, written - 1] + [i for i, _ in self.frames]))
+        while (rest := self.block(written)) is not None:
+            yield rest, TEXT, None
+            written += 1
+            self._trim(written)
+
+
+__all__ = ["FIXED", "RUN", "SKIP", "TEXT", "KlartextFlow", "JUMPS", "jump_parts", "label_key"]
