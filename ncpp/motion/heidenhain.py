@@ -268,6 +268,8 @@ class HeidenhainInterpreter(ModalInterpreter):
             elif what == "program_begin":
                 self.set_units(node[1] == "INCH")
             elif what == "program_end":
+                if self.flow is not None and self.flow.frames:  # (where the control goes is not told)
+                    raise OutOfScope("END PGM in a subprogram (no LBL 0 before it)", item.start + 1)
                 end = True
             elif what == "tool_call":
                 if node[1] is not None:
