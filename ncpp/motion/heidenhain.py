@@ -83,6 +83,7 @@ class Pole(Pass):
 
     center: Point = (0.0, 0.0, 0.0)
     plane: int = 17
+    again: bool = False  # the block runs again or away from its text: its text stays as it is
 
 
 @dataclass(slots=True)
@@ -119,6 +120,8 @@ def _in_flow(events: list[Event], owner: Block | None) -> list[Event]:
     for event in events:
         if type(event) is Line or type(event) is Arc:
             event.fixed = event.fixed or FLOW
+        elif type(event) is Pole:
+            event.again = True
         elif owner is not None and type(event) is not Pole and type(event) is not Corner:
             continue
         if owner is not None:
@@ -160,6 +163,7 @@ class HeidenhainInterpreter(ModalInterpreter):
         self.corner_waits = False  # an RND/CHF block came after the last move
         self.unknown_axes: set[int] = set()  # axes whose position ncpp is not told (after M140 MB MAX)
         self.preset: float | None = None  # the preset CYCL DEF 247 activated (the program zero told)
+        self.ended = False  # the program ended (M2, M30, END PGM), not left the scope
         self.flow: KlartextFlow | None = None  # the order the blocks run in (labels, calls, jumps)
 
     def run(self, blocks: Iterable[Block], warnings: Warnings) -> Iterator[Event]:
@@ -335,7 +339,7 @@ class HeidenhainInterpreter(ModalInterpreter):
         if events and isinstance(events[-1], (Line, Arc)):
             self.last_move, self.corner_waits = events[-1], False
         if end:
-            self.done = True
+            self.done = self.ended = True
         return self.radius_compensation(events, None if comp is None else comp != "R0")
 
     def _tool_def(self, block: Block, statement) -> list[Event]:
@@ -417,8 +421,8 @@ class HeidenhainInterpreter(ModalInterpreter):
 
         for block, kind, owner in flow.steps(lambda: self.done, stop):
             if kind is SKIP or kind is TEXT or self.done or not block.items:
-                if owner is None:
-                    yield Pass(block, kind is SKIP)
+                if owner is None:  # (after M2/M30/END PGM: a subprogram's text, run where it is called)
+                    yield Pass(block, kind is SKIP or (kind is TEXT and self.ended))
                 continue
             try:
                 events = self.block(block)

@@ -179,3 +179,50 @@ def test_a_compensated_program_writes_each_text_once_and_leaves_the_called_moves
     assert "compensated 3 moves" in proc.stderr
     across = next(line for line in written if line.startswith("L X+49"))  # `L X+50 Y+0`, compensated
     assert across != "L X+50 Y+0 R0 FMAX"
+
+
+# A contour subprogram with a fillet and its own incremental pole, called after compensated arcs
+CONTOUR = """0 BEGIN PGM C MM
+1 TOOL CALL 1 Z S1000
+2 L X+0 Y+0 Z+2 R0 FMAX
+3 CALL LBL 5
+4 L X+100 Y+0 R0 FMAX
+5 CC X+110 Y+0
+6 C X+120 Y+0 DR- F200
+7 CALL LBL 5
+8 L X+135 Y+20 R0 FMAX
+9 C X+135 Y+0 DR-
+10 L Z+50 R0 FMAX M30
+11 LBL 5
+12 L IX+10 F100
+13 RND R2
+14 L IY+10
+15 CC IX+5 IY+0
+16 C IX+10 IY+0 DR+
+17 LBL 0
+18 END PGM C MM
+"""
+
+
+def test_a_subprogram_with_a_fillet_and_its_own_pole_runs_about_it_at_each_call():
+    arcs = [e for e in events(CONTOUR) if type(e).__name__ == "Arc"]
+    fillet, half, _, second_fillet, second_half, after = arcs
+    assert fillet.center[:2] == pytest.approx((8.0, 2.0)) and second_fillet.center[:2] == pytest.approx((128.0, 2.0))
+    assert half.center[:2] == (15.0, 10.0) and second_half.center[:2] == (135.0, 10.0)
+    assert after.center[:2] == (135.0, 10.0)  # (the pole the subprogram left, as the control keeps it)
+    assert {fillet.fixed, half.fixed, second_fillet.fixed, second_half.fixed} == {FLOW}
+    assert second_half.block.line == 8 and not after.fixed
+
+
+def test_a_compensated_contour_subprogram_keeps_its_text_and_gets_the_program_pole_at_the_call(tmp_path):
+    program = tmp_path / "p.h"
+    program.write_text(CONTOUR)
+    proc = subprocess.run(
+        [sys.executable, "-m", "ncpp", "--machine", str(READING), "--no-guard", str(program)],
+        capture_output=True, text=True, cwd=ROOT,
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr  # (and the written program reads back the same)
+    written = [line.split(" ", 1)[1] for line in proc.stdout.splitlines()]
+    assert written[written.index("LBL 5"):] == [line.split(" ", 1)[1] for line in CONTOUR.splitlines()[11:]]
+    before_call = written[written.index("CALL LBL 5", written.index("CALL LBL 5") + 1) - 1]
+    assert before_call == "CC X+110.000000 Y+0.000000"  # the arc before moved the output's pole

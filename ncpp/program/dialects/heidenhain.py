@@ -238,7 +238,7 @@ HEIDENHAIN = Dialect(
 
 from dataclasses import replace  # noqa: E402
 
-from ncpp.motion.segments import PLANE_AXES, Arc, Line  # noqa: E402
+from ncpp.motion.segments import FLOW, PLANE_AXES, Arc, Line, Pass  # noqa: E402
 from ncpp.program.blocks import Block  # noqa: E402
 from ncpp.program.dialects.editing import splice  # noqa: E402
 from ncpp.program.dialects.iso import IsoWriter, _Units, written_apart  # noqa: E402
@@ -317,7 +317,7 @@ class HeidenhainWriter(IsoWriter):
             yield from self._header_first(block, self.header)
         self._learn_styles(block)
         motion = [e for e in group if type(e) is Line or type(e) is Arc]
-        pole = next((e for e in group if type(e) is Pole), None)
+        pole = next((e for e in reversed(group) if type(e) is Pole), None)  # (a call's: its last)
         _, function = _function(block)
         edited_before = self.edited_last
         if motion:
@@ -327,15 +327,22 @@ class HeidenhainWriter(IsoWriter):
         corner = function in ("RND", "CHF")
         feed = self._restored_feed(block, motion) if motion and not corner else ""
         if (not corner and not any(e.changed for e in motion)) or (corner and not (motion and edited_before)):
+            # a subprogram or loop a call or jump line runs uses the pole as the program has it there
+            calls = function is None and any(m.fixed == FLOW for m in motion)
+            if (
+                (function in _POLE_FUNCTIONS or calls)
+                and self.program_pole
+                and self.output_pole != self.program_pole
+                and not all(isinstance(e, Pass) and e.skipped for e in group)  # (text not run here)
+            ):
+                yield self._inserted(self._cc_text(*self.program_pole))
+                self.output_pole = self.program_pole
             if pole is not None:
                 self.program_pole = self.output_pole = (pole.center, pole.plane)
                 incremental = any(type(i) is Word and i.letter in ("IX", "IY", "IZ") for i in block.items)
-                if incremental and self.changed_any:  # relative to a position the output moved
+                if incremental and self.changed_any and not pole.again:  # relative to a position moved
                     yield self._inserted_replacing(block, self._cc_text(pole.center, pole.plane))
                     return
-            elif function in _POLE_FUNCTIONS and self.program_pole and self.output_pole != self.program_pole:
-                yield self._inserted(self._cc_text(*self.program_pole))
-                self.output_pole = self.program_pole
             yield self._numbered(block, splice(block, {}, feed) if feed else block.raw)
             if self.header is not None and any(
                 type(i) is Statement and i.kind == "program_begin" for i in block.items
