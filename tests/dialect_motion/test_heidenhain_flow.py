@@ -226,3 +226,25 @@ def test_a_compensated_contour_subprogram_keeps_its_text_and_gets_the_program_po
     assert written[written.index("LBL 5"):] == [line.split(" ", 1)[1] for line in CONTOUR.splitlines()[11:]]
     before_call = written[written.index("CALL LBL 5", written.index("CALL LBL 5") + 1) - 1]
     assert before_call == "CC X+110.000000 Y+0.000000"  # the arc before moved the output's pole
+
+
+# Plan.h's inputs (a face 100 x 60 from Z0 to Z-2, 1 mm infeeds, tool radius Q108 = 10): it
+# is a cycle a calling program gives them to
+PLAN_INPUTS = {"Q1800": 0, "Q1801": 100, "Q1802": 0, "Q1803": 60, "Q1804": 0, "Q1805": -2, "Q1810": 1,
+               "Q1812": 0.7, "Q1813": 0.1, "Q1820": 1000, "Q1822": 500, "Q1830": 2, "Q1831": 5,
+               "Q1832": 2, "Q1840": 1, "Q108": 10}  # fmt: skip
+
+
+def test_the_corpus_face_milling_cycle_is_followed_through_its_fn_jumps_to_its_end(corpus):
+    """Plan.h (jstjst/Heidenhain-Cycles) checks its inputs with FN 9-12, then mills a spiral per
+    infeed, jumping back to its infeed label: (-2 - 0) / 1 gives two infeeds, at Z-1 and Z-2."""
+    path = corpus / "heidenhain" / "jstjst_Heidenhain-Cycles" / "Plan.h"
+    lines = path.read_text(encoding="latin-1").split("\n")
+    text = "\n".join([lines[0], *(f"0 {q} = {value:+g}" for q, value in PLAN_INPUTS.items()), *lines[1:]])
+    stream = io.StringIO()
+    found = [e for e in events(text, Warnings(stream=stream)) if type(e) is Line and not e.rapid]
+    assert "scope" not in stream.getvalue()
+    depths = sorted({round(move.end[2], 9) for move in found})
+    assert depths == [-2.0, -1.0] and all(move.fixed == FLOW for move in found)
+    second = [move for move in found if move.end[2] == -2.0]
+    assert len({move.block.line for move in second}) == 1  # the jump back runs the second infeed
