@@ -7,7 +7,9 @@ program's `TOOL DEF n L..`, plus the call's DL, along that axis), `L` with X/Y/Z
 the axes written), `C ... DR±` about the pole, `CR ... R± DR±` (R+: less than a
 half circle), `CT` (tangential arc), `LP`/`CP` polar with PR/IPR/PA/IPA (a
 helix with IZ, several turns with |IPA| > 360), Q parameters with arithmetic,
-labels, `CYCL DEF` of machining cycles (they only define), M2/M30
+labels, subprograms (`CALL LBL n` ... `LBL 0`), program-section repeats (`CALL LBL n REP k`)
+and the jumps FN 9-12 (`heidenhain_flow`: a block that runs again is left as programmed,
+FLOW), `CYCL DEF` of machining cycles (they only define), M2/M30
 and `END PGM` (end), and `RND R..` / `CHF ..` between two feed lines in the
 working plane (the fillet arc or chamfer line is the RND/CHF block's event; a
 feed line waits for the next move to know whether its corner is cut).
@@ -15,7 +17,7 @@ Radius compensation RL/RR is followed to R0: the moves from the first with RL/RR
 to the R0 block's are the programmed contour, the tool centre off it by the radius,
 and are marked `fixed` (`ModalInterpreter.radius_compensation`).  Paraxial R+/R-,
 RND/CHF next to an arc or a rapid, FK free contours,
-APPR/DEP, `CALL LBL`, `CALL PGM`, `CYCL CALL`, M99, FN functions and cycles
+APPR/DEP, `CALL PGM`, `CYCL CALL`, M99, FN 13 and later FN functions and cycles
 that move the datum make the position unknown: one warning (an error with
 `strict`) and the rest passes through.
 
@@ -32,6 +34,7 @@ from dataclasses import dataclass
 
 from ncpp.errors import Location, NcppError, Warnings
 from ncpp.motion.corners import CornerError, round_corner
+from ncpp.motion.heidenhain_flow import FIXED, JUMPS, SKIP, TEXT, KlartextFlow, jump_parts, label_key
 from ncpp.motion.modal import (
     MM_PER_INCH,
     PLANE_OF_TOOL_AXIS,
@@ -40,7 +43,6 @@ from ncpp.motion.modal import (
     as_point,
     run_placed,
 )
-from ncpp.motion.heidenhain_flow import FIXED, JUMPS, SKIP, TEXT, KlartextFlow, jump_parts, label_key
 from ncpp.motion.offsets import WorkOffsets
 from ncpp.motion.segments import COMP, FLOW, MACHINE, PLANE_AXES, Arc, Event, Line, Pass, Point
 from ncpp.motion.tools import ToolTable, UntoldLengths
@@ -64,8 +66,8 @@ HARMLESS_RESETS = frozenset((("PLANE", "RESET", "STAY"), ("FUNCTION", "RESET", "
 
 # FN 0-8: Q parameter arithmetic (TNC 640 Klartext manual, "Basic arithmetic" and "Angle
 # functions": `FN 0: Q5 = +10`, `FN 1: Q1 = -Q2 + -5`, `FN 4: Q25 = +Q1 DIV +Q7`, `FN 5:
-# Q20 = SQRT Q4`, `FN 6: Q20 = SIN-Q5` in degrees, `FN 8: Q10 = +5 LEN +4`).  FN 13 (ANG)
-# and the jumps FN 9-12 stay out of scope.
+# Q20 = SQRT Q4`, `FN 6: Q20 = SIN-Q5` in degrees, `FN 8: Q10 = +5 LEN +4`).  The jumps
+# FN 9-12 are `heidenhain_flow`'s; FN 13 (ANG) stays out of scope.
 FN_ARITHMETIC = {0: "", 1: "+", 2: "-", 3: "*", 4: "DIV", 5: "SQRT", 6: "SIN", 7: "COS", 8: "LEN"}
 _FN_OPERAND = r"([+-]?)[ \t]*(Q[LR]?\d+|\d+(?:[.,]\d*)?|[.,]\d+)"
 _FN_TARGET = re.compile(r"[ \t]*(Q[LR]?\d+)[ \t]*=[ \t]*(.*?)[ \t]*$", re.I)
@@ -454,8 +456,10 @@ class HeidenhainInterpreter(ModalInterpreter):
         assert self.flow is not None
         number, text = item.node
         parts = jump_parts(text or "")
-        if parts is None or parts[1] != JUMPS[number] or not all(
-            re.fullmatch(_FN_OPERAND, o.strip(), re.I) for o in parts[:3:2]
+        if (
+            parts is None
+            or parts[1] != JUMPS[number]
+            or not all(re.fullmatch(_FN_OPERAND, o.strip(), re.I) for o in parts[:3:2])
         ):
             self.fail(f"FN {number}: expected IF a {JUMPS[number]} b GOTO LBL n", block, item)
         left, test, right, name = parts

@@ -142,7 +142,7 @@ class KlartextFlow:
         """The index of the label a call or jump names (OutOfScope where ncpp cannot follow)."""
         if self.named_by_q:
             raise OutOfScope("a jump in a program with a label named by a Q parameter", col)
-        key = label_key(value(name) if type(name) is tuple else name)  # type: ignore[arg-type]
+        key = label_key(value(name) if type(name) is tuple else name)
         if key == 0.0:
             raise OutOfScope("a call of LBL 0 (it only ends a subprogram)", col)
         while key not in self.labels and not self.exhausted:
@@ -192,7 +192,7 @@ class KlartextFlow:
         self.last_run_move = self.current
 
     # -- the order ----------------------------------------------------------------------
-    def steps(self, done: Callable[[], bool], stop: Callable[[str, Block], None]) -> Iterator[tuple]:
+    def steps(self, done: Callable[[], bool], stop: Callable[[str, Block | None], None]) -> Iterator[tuple]:
         """(block, kind, owner) in the order the blocks run; the rest as TEXT once `done()`."""
         pc = written = 0
         while True:

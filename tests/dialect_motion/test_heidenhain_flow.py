@@ -207,7 +207,9 @@ CONTOUR = """0 BEGIN PGM C MM
 def test_a_subprogram_with_a_fillet_and_its_own_pole_runs_about_it_at_each_call():
     arcs = [e for e in events(CONTOUR) if type(e).__name__ == "Arc"]
     fillet, half, _, second_fillet, second_half, after = arcs
-    assert fillet.center[:2] == pytest.approx((8.0, 2.0)) and second_fillet.center[:2] == pytest.approx((128.0, 2.0))
+    assert fillet.center[:2] == pytest.approx((8.0, 2.0)) and second_fillet.center[:2] == pytest.approx(
+        (128.0, 2.0)
+    )
     assert half.center[:2] == (15.0, 10.0) and second_half.center[:2] == (135.0, 10.0)
     assert after.center[:2] == (135.0, 10.0)  # (the pole the subprogram left, as the control keeps it)
     assert {fillet.fixed, half.fixed, second_fillet.fixed, second_half.fixed} == {FLOW}
@@ -223,7 +225,7 @@ def test_a_compensated_contour_subprogram_keeps_its_text_and_gets_the_program_po
     )  # fmt: skip
     assert proc.returncode == 0, proc.stderr  # (and the written program reads back the same)
     written = [line.split(" ", 1)[1] for line in proc.stdout.splitlines()]
-    assert written[written.index("LBL 5"):] == [line.split(" ", 1)[1] for line in CONTOUR.splitlines()[11:]]
+    assert written[written.index("LBL 5") :] == [line.split(" ", 1)[1] for line in CONTOUR.splitlines()[11:]]
     before_call = written[written.index("CALL LBL 5", written.index("CALL LBL 5") + 1) - 1]
     assert before_call == "CC X+110.000000 Y+0.000000"  # the arc before moved the output's pole
 
