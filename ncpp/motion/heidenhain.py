@@ -418,8 +418,8 @@ class HeidenhainInterpreter(ModalInterpreter):
         def stop(reason: str, block: Block | None) -> None:
             self.done = True
             if block is not None:
-                warnings.warn(f"{reason} is outside the motion interpreter's scope; from this line on the "
-                              "program passes through uninterpreted", Location(self.file, block.line))  # fmt: skip
+                message = f"{reason} is outside the motion interpreter's scope; from this line on the program"
+                warnings.warn(f"{message} passes through uninterpreted", Location(self.file, block.line))
 
         for block, kind, owner in flow.steps(lambda: self.done, stop):
             if kind is SKIP or kind is TEXT or self.done or not block.items:

@@ -152,7 +152,8 @@ class KlartextFlow:
         index = self.labels.get(key)
         shown = f'"{key}"' if type(key) is str else f"{key:g}"
         if index is None:
-            raise OutOfScope(f"LBL {shown} (not found within {MAX_AHEAD} blocks)", col)
+            where = "not in the program" if self.exhausted else f"not within {MAX_AHEAD} blocks ahead"
+            raise OutOfScope(f"LBL {shown} ({where})", col)
         if index < self.base:
             raise OutOfScope(f"LBL {shown} (more than {MAX_BEHIND} blocks back)", col)
         if index <= self.current and self.last_run_move >= index:

@@ -144,7 +144,7 @@ def test_a_loop_that_never_ends_is_refused(monkeypatch):
     ("change", "reason"),
     [
         (("9 L IX+10", "9 CALL LBL 1"), "a subprogram that calls itself"),
-        (("3 CALL LBL 1", "3 CALL LBL 7"), "LBL 7 (not found"),
+        (("3 CALL LBL 1", "3 CALL LBL 7"), "LBL 7 (not in the program)"),
         (("11 LBL 0\n", ""), "END PGM in a subprogram (no LBL 0 before it)"),
         (("5 CALL LBL 1", "5 CALL LBL 1 REP 2"), "CALL LBL ... REP with the label after the call"),
     ],
@@ -153,6 +153,13 @@ def test_what_cannot_be_followed_ends_interpretation_with_a_warning(change, reas
     stream = io.StringIO()
     moves(SUBPROGRAM.replace(*change), Warnings(stream=stream))
     assert reason in stream.getvalue() and "scope" in stream.getvalue()
+
+
+def test_a_label_further_ahead_than_ncpp_reads_ends_interpretation(monkeypatch):
+    monkeypatch.setattr(heidenhain_flow, "MAX_AHEAD", 3)
+    stream = io.StringIO()
+    assert len(moves(SUBPROGRAM, Warnings(stream=stream))) == 1
+    assert "LBL 1 (not within 3 blocks ahead)" in stream.getvalue()
 
 
 def test_a_jump_back_over_moves_run_in_their_place_ends_interpretation(monkeypatch):
