@@ -157,6 +157,7 @@ def test_what_cannot_be_followed_ends_interpretation_with_a_warning(change, reas
 
 def test_a_label_further_ahead_than_ncpp_reads_ends_interpretation(monkeypatch):
     monkeypatch.setattr(heidenhain_flow, "MAX_AHEAD", 3)
+    monkeypatch.setattr(heidenhain_flow, "LOOKAHEAD", 1)
     stream = io.StringIO()
     assert len(moves(SUBPROGRAM, Warnings(stream=stream))) == 1
     assert "LBL 1 (not within 3 blocks ahead)" in stream.getvalue()
