@@ -439,8 +439,8 @@ class HeidenhainInterpreter(ModalInterpreter):
                 continue
             if kind is FIXED:
                 events = _in_flow(events, owner)
-            elif any(type(e) is Line or type(e) is Arc for e in events):
-                flow.moved()
+            elif flow.labels and any(type(e) is Line or type(e) is Arc for e in events):
+                flow.moved()  # (before the first label nothing can jump back over it)
             yield from events or ((Pass(block),) if owner is None else ())
 
     def _call_label(self, block: Block, item) -> None:

@@ -13,7 +13,7 @@ FN 12 LT) jumps to `LBL n` when the condition holds.
 runs out of the text's order (a subprogram's, a repeat's, a loop's second pass) belongs to
 the line that runs it, whose text the output is at, so that every text is written once where
 it stands.  A block that will run again (it lies between a label and a later call of or jump
-back to it, read ahead up to `LOOKAHEAD` blocks) is FIXED from its first pass: its one text
+back to it, read ahead up to `LOOKAHEAD` blocks once a label is read) is FIXED from its first pass: its one text
 cannot be rewritten for each run.  A call or jump back over a move that ran in place (RUN)
 leaves the scope, and so does a label more than `MAX_AHEAD` blocks ahead or no longer held
 (blocks are held from the first label before the position, up to `MAX_BEHIND` back).
@@ -59,15 +59,14 @@ def jump_parts(text: str) -> tuple[str, str, str, object] | None:
     return left, test.upper(), right, target
 
 
-def _references(block: Block) -> Iterator[object]:
-    """The labels a block's call or jump names (a literal, else a Q parameter tuple)."""
-    for item in block.items:
-        if type(item) is Statement and item.kind == "call_label":
-            yield item.node[0]
-        elif type(item) is Statement and item.kind == "fn" and item.node[0] in JUMPS:
-            parts = jump_parts(item.node[1] or "")
-            if parts is not None:
-                yield parts[3]
+def _reference(item: Statement) -> object:
+    """The label a call or jump statement names (a literal, else a Q parameter tuple), or None."""
+    if item.kind == "call_label":
+        return item.node[0]
+    if item.kind == "fn" and item.node[0] in JUMPS:
+        parts = jump_parts(item.node[1] or "")
+        return None if parts is None else parts[3]
+    return None
 
 
 class KlartextFlow:
@@ -102,15 +101,18 @@ class KlartextFlow:
             return False
         index = self.base + len(self.held)
         self.held.append(block)
-        for item in block.items:
-            if type(item) is Statement and item.kind == "label":
-                if type(item.node[0]) is tuple:
-                    self.named_by_q = True
-                else:
-                    self.labels.setdefault(label_key(item.node[0]), index)
-        for name in _references(block):
-            if type(name) is not tuple and self.labels.get(label_key(name), index) < index:
-                self.again.append((self.labels[label_key(name)], index))
+        item = next((i for i in block.items if type(i) is Statement), None)  # (a block has one head)
+        if item is None:
+            return True
+        if item.kind == "label":
+            if type(item.node[0]) is tuple:
+                self.named_by_q = True
+            else:
+                self.labels.setdefault(label_key(item.node[0]), index)
+            return True
+        name = _reference(item)
+        if name is not None and type(name) is not tuple and self.labels.get(label_key(name), index) < index:
+            self.again.append((self.labels[label_key(name)], index))
         return True
 
     def block(self, index: int) -> Block | None:
@@ -204,7 +206,8 @@ class KlartextFlow:
                 while written < pc:  # jumped over: written, not run
                     yield self.block(written), SKIP, None
                     written += 1
-                self._look_ahead(pc)
+                if self.labels:  # (before the first label no block can run again: the text streams)
+                    self._look_ahead(pc)
             block = self.block(pc)
             if block is None:
                 if self.frames:
@@ -212,7 +215,8 @@ class KlartextFlow:
                 break
             self.current, self.next = pc, None
             if in_place:
-                yield block, FIXED if any(a <= pc <= b for a, b in self.again) else RUN, None
+                again = self.again and any(a <= pc <= b for a, b in self.again)
+                yield block, FIXED if again else RUN, None
                 written = pc + 1
             else:
                 owner = self.block(written - 1)
@@ -225,7 +229,8 @@ class KlartextFlow:
                     )
                 yield block, FIXED, owner
             pc = self.next if self.next is not None else pc + 1
-            self._trim(min([pc, written - 1] + [i for i, _ in self.frames]))
+            if min(pc, written - 1) - self.base >= _DROP:
+                self._trim(min([pc, written - 1] + [i for i, _ in self.frames]))
         while (rest := self.block(written)) is not None:
             yield rest, TEXT, None
             written += 1
