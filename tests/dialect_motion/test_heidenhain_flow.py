@@ -258,3 +258,21 @@ def test_the_corpus_face_milling_cycle_is_followed_through_its_fn_jumps_to_its_e
     assert depths == [-2.0, -1.0] and all(move.fixed == FLOW for move in found)
     second = [move for move in found if move.end[2] == -2.0]
     assert len({move.block.line for move in second}) == 1  # the jump back runs the second infeed
+
+
+def test_blocks_are_held_only_so_far_back_and_a_call_past_them_ends_interpretation(monkeypatch):
+    """A label at the top and a call 20 000 blocks on: memory stays bounded, the call is refused."""
+    from ncpp.motion.heidenhain import HeidenhainInterpreter
+
+    monkeypatch.setattr(heidenhain_flow, "LOOKAHEAD", 100)
+    monkeypatch.setattr(heidenhain_flow, "MAX_BEHIND", 1000)
+    body = "".join(f"{n} L X+{n % 7} F100\n" for n in range(2, 20_002))
+    text = f"0 BEGIN PGM B MM\n1 LBL 1\n{body}20002 CALL LBL 1 REP 1\n20003 END PGM B MM\n"
+    _, blocks = parse_program(io.BytesIO(text.encode()), "p.h", "heidenhain")
+    interpreter, stream = HeidenhainInterpreter("p.h"), io.StringIO()
+    held = 0
+    for _ in interpreter.run(blocks, Warnings(stream=stream)):
+        assert interpreter.flow is not None
+        held = max(held, len(interpreter.flow.held))
+    assert held <= 1000 + 100 + 4096 + 1
+    assert "LBL 1 (more than 1000 blocks back)" in stream.getvalue()
