@@ -85,6 +85,7 @@ class KlartextFlow:
         self.exhausted = False
         self.labels: dict[float | str, int] = {}  # label -> the index of its LBL block
         self.again: list[tuple[int, int]] = []  # [label, call or jump back]: blocks that run again
+        self.twice: set[float | str] = set()  # labels defined more than once (the control refuses them)
         self.named_by_q = False  # a label defined by a Q parameter: no call or jump can be followed
         self.frames: list[tuple[int, float | str]] = []  # subprogram calls: (index to return to, label)
         self.counters: dict[int, int] = {}  # a REP call's index -> the repeats still to run
@@ -107,8 +108,10 @@ class KlartextFlow:
         if item.kind == "label":
             if type(item.node[0]) is tuple:
                 self.named_by_q = True
+            elif label_key(item.node[0]) in self.labels:
+                self.twice.add(label_key(item.node[0]))
             else:
-                self.labels.setdefault(label_key(item.node[0]), index)
+                self.labels[label_key(item.node[0])] = index
             return True
         name = _reference(item)
         if name is not None and type(name) is not tuple and self.labels.get(label_key(name), index) < index:
@@ -153,6 +156,8 @@ class KlartextFlow:
             self._read()
         index = self.labels.get(key)
         shown = f'"{key}"' if type(key) is str else f"{key:g}"
+        if key in self.twice:
+            raise OutOfScope(f"LBL {shown} (defined more than once)", col)
         if index is None:
             where = "not in the program" if self.exhausted else f"not within {MAX_AHEAD} blocks ahead"
             raise OutOfScope(f"LBL {shown} ({where})", col)
