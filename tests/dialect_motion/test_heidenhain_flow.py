@@ -148,6 +148,7 @@ def test_a_loop_that_never_ends_is_refused(monkeypatch):
         (("11 LBL 0\n", ""), "END PGM in a subprogram (no LBL 0 before it)"),
         (("5 CALL LBL 1", "5 CALL LBL 1 REP 2"), "CALL LBL ... REP with the label after the call"),
         (("12 END PGM", "12 LBL 1\n12 END PGM"), "LBL 1 (defined more than once)"),
+        (("11 LBL 0\n12 END PGM SUB MM\n", ""), "a subprogram without LBL 0 before the end of the program"),
     ],
 )
 def test_what_cannot_be_followed_ends_interpretation_with_a_warning(change, reason):
