@@ -95,16 +95,17 @@ class KlartextFlow:
         self.rerun = 0  # blocks run out of the text's order
 
     # -- reading ------------------------------------------------------------------------
-    def _read(self) -> bool:
+    def _read(self) -> None:
+        """One more block of the stream: its label, or the label its call or jump names."""
         block = next(self.stream, None)
         if block is None:
             self.exhausted = True
-            return False
+            return
         index = self.base + len(self.held)
         self.held.append(block)
         item = next((i for i in block.items if type(i) is Statement), None)  # (a block has one head)
         if item is None:
-            return True
+            return
         if item.kind == "label":
             if type(item.node[0]) is tuple:
                 self.named_by_q = True
@@ -112,11 +113,10 @@ class KlartextFlow:
                 self.twice.add(label_key(item.node[0]))
             else:
                 self.labels[label_key(item.node[0])] = index
-            return True
+            return
         name = _reference(item)
         if name is not None and type(name) is not tuple and self.labels.get(label_key(name), index) < index:
             self.again.append((self.labels[label_key(name)], index))
-        return True
 
     def block(self, index: int) -> Block | None:
         """The block at `index`, read ahead to it (None past the end)."""
