@@ -24,6 +24,7 @@ from collections.abc import Iterable, Iterator
 from typing import cast
 
 from ncpp.errors import Location, Warnings
+from ncpp.motion.flow import FIXED, RUN, SKIP
 from ncpp.motion.modal import (
     MM_PER_INCH,
     ModalInterpreter,
@@ -33,7 +34,8 @@ from ncpp.motion.modal import (
     run_placed,
 )
 from ncpp.motion.offsets import WorkOffsets
-from ncpp.motion.segments import MACHINE, PLANE_AXES, Event
+from ncpp.motion.segments import FLOW, MACHINE, PLANE_AXES, Event, Pass
+from ncpp.motion.sinumerik_flow import SinumerikFlow
 from ncpp.motion.tools import ToolTable, UntoldLengths
 from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
 
@@ -120,6 +122,37 @@ class SinumerikInterpreter(ModalInterpreter):
         self.frame_shift = [0.0, 0.0, 0.0]
         self.told_frame: float | None = None  # the settable frame the program selected first
         self.zero_frame: float | None = None  # the one in effect (None: as when the program started)
+
+    # -- the event stream ---------------------------------------------------------------
+    def run(self, blocks: Iterable[Block], warnings: Warnings) -> Iterator[Event]:
+        """Events block by block, in the order the blocks run (`sinumerik_flow.py`): a block
+        run out of the text's order gives its moves, left as programmed, to the line that
+        runs it (its `owner`), so that every block's text is written once, where it stands."""
+        flow = SinumerikFlow(self.file, self.value, self.assign, lambda: self.done,
+                             lambda reason, block, col, owner: self.leave_scope(warnings, reason, block, col, owner))  # fmt: skip
+        for block, kind, owner in flow.steps(blocks):
+            if (kind is not RUN and kind is not FIXED) or not block.items:
+                yield Pass(block, kind is SKIP)
+                continue
+            try:
+                events = self.block(block)
+            except OutOfScope as stop:
+                self.leave_scope(warnings, stop.reason, block, stop.col, owner)
+                if owner is None:  # (a block run out of the text's order is written in its place)
+                    yield Pass(block)
+                continue
+            moves = [event for event in events if type(event) is not Pass]
+            if kind is FIXED:
+                for move in moves:
+                    move.fixed = move.fixed or FLOW  # type: ignore[union-attr]
+                    if owner is not None:
+                        move.block = owner
+                if owner is not None:
+                    yield from moves
+                    continue
+            elif moves:
+                flow.last_run_move = flow.pc
+            yield from events or (Pass(block),)
 
     # -- variables --------------------------------------------------------------------
     def lookup(self, name: str) -> float:
