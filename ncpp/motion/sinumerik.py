@@ -8,10 +8,11 @@ arc), G90/G91 and `AC()`/`IC()` per word, G17/G18/G19, G70/G71/G700/G710,
 arithmetic, labels, `MSG`, G4 dwell, M2/M17/M30 (end), and tool lengths: `T n`
 or `T="NAME"` selects, M6 loads it with cutting edge D1, `D n` picks an edge
 (D0 none); the edge's lengths 1-3 from the control's tool offsets (`_N_TO_INI`,
-`tools.py`) act along the plane's axes (G17: length 1 along Z).  Control flow (GOTO*,
-IF, WHILE, FOR, REPEAT, CASE), calls of cycles and subprograms (by name or `L<n>`), splines, other
-frames, polar coordinates (AP=, RP=), arcs by opening angle (AR=) and unknown G
-codes make the position unknown: one warning (an error with `strict`) and the
+`tools.py`) act along the plane's axes (G17: length 1 along Z).  Control flow (GOTOF,
+GOTOB, GOTO, GOTOC, CASE, IF, WHILE, FOR, REPEAT, LOOP) runs as `sinumerik_flow.py` says: a
+loop's moves are left as programmed (FLOW).  Calls of cycles and subprograms (by name or
+`L<n>`), splines, other frames, polar coordinates (AP=, RP=), arcs by opening angle (AR=)
+and unknown G codes make the position unknown: one warning (an error with `strict`) and the
 rest passes through.  Under cutter compensation (G41/G42 to the first move after
 G40) the moves are the programmed contour, the tool centre off it by the radius:
 they are marked `fixed` (`ModalInterpreter.radius_compensation`).
@@ -128,8 +129,11 @@ class SinumerikInterpreter(ModalInterpreter):
         """Events block by block, in the order the blocks run (`sinumerik_flow.py`): a block
         run out of the text's order gives its moves, left as programmed, to the line that
         runs it (its `owner`), so that every block's text is written once, where it stands."""
-        flow = SinumerikFlow(self.file, self.value, self.assign, lambda: self.done,
-                             lambda reason, block, col, owner: self.leave_scope(warnings, reason, block, col, owner))  # fmt: skip
+
+        def stop(reason: str, block: Block, col: int | None, owner: Block | None) -> None:
+            self.leave_scope(warnings, reason, block, col, owner)
+
+        flow = SinumerikFlow(self.file, self.value, self.assign, lambda: self.done, stop)
         for block, kind, owner in flow.steps(blocks):
             if (kind is not RUN and kind is not FIXED) or not block.items:
                 yield Pass(block, kind is SKIP)

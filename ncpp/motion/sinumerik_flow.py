@@ -1,7 +1,8 @@
 """Sinumerik control flow: the order a program's blocks run in.
 
-The rules are those of the SINUMERIK 840D sl Programming Manual, Job Planning (and
-Fundamentals), "Program jumps and branches" and "Control structures":
+The rules are those of the SINUMERIK 840D sl Programming Manual, Job Planning
+(6FC5398-2BP40-1AA0), "Flexible NC programming": "Program jumps and branches" and
+"Control structures":
 
 * `GOTOF label` searches forward for the jump destination, `GOTOB` backward, `GOTO`
   forward then backward, `GOTOC` as GOTO but a destination not found raises no alarm:
@@ -13,7 +14,8 @@ Fundamentals), "Program jumps and branches" and "Control structures":
 * `IF ... ELSE ... ENDIF`, `WHILE ... ENDWHILE`, `FOR variable = start TO end ...
   ENDFOR` (the variable counts up by 1 while it is not above the end), `REPEAT ...
   UNTIL condition`, `LOOP ... ENDLOOP` (endless, left by a jump) are the control
-  structures; they nest.
+  structures; they nest.  The manual advises against mixing control structures and
+  program jumps: ncpp does not follow a jump while a structure is open.
 
 `SinumerikFlow.steps(blocks)` yields each block with what the interpreter is to do
 with it, as `ncpp.motion.flow` does for o-words (its RUN, FIXED, SKIP, TEXT): a block
@@ -63,7 +65,9 @@ class SinumerikFlow:
     interpreter's; `done()` says the program has ended; `stop(reason, block, col, owner)`
     ends interpretation where the flow leaves the scope."""
 
-    def __init__(self, file: str, value: Callable, assign: Callable, done: Callable[[], bool], stop: Callable):
+    def __init__(
+        self, file: str, value: Callable, assign: Callable, done: Callable[[], bool], stop: Callable
+    ):
         self.file, self.value, self.assign, self.done, self.stop = file, value, assign, done, stop
         self.stream: Iterator[Block] = iter(())
         self.buffer: list[Block] = []  # blocks read and still held, from index `base`
@@ -90,9 +94,11 @@ class SinumerikFlow:
             if not in_place:
                 self.rerun += 1
                 if self.rerun > MAX_RERUN:
-                    raise NcppError(f"a loop that does not end: {MAX_RERUN:,} blocks run again (the control would "
-                                    "run it for ever; ncpp follows a program to its end)",
-                                    Location(self.file, owner.line, 1))  # type: ignore[union-attr]  # fmt: skip
+                    raise NcppError(
+                        f"a loop that does not end: {MAX_RERUN:,} blocks run again (the control would "
+                        "run it for ever; ncpp follows a program to its end)",
+                        Location(self.file, owner.line, 1),  # type: ignore[union-attr]
+                    )
             control = _controls(block)
             if not control:
                 looping = self.pc in self.looped or any(o.kind != "if" for o in self.open)
@@ -173,9 +179,13 @@ class SinumerikFlow:
         """Run a control block: the index of the block that runs next."""
         first = control[0]
         if first.kind == "if" and len(control) == 2 and control[1].kind == "goto":  # a conditional jump
-            return self._jump(block, control[1], *control[1].node) if self._holds(block, first) else self.pc + 1
+            return (
+                self._jump(block, control[1], *control[1].node) if self._holds(block, first) else self.pc + 1
+            )
         if len(control) > 1:
-            raise OutOfScope(f"{control[1].kind.upper()} after {first.kind.upper()} in one block", control[1].start + 1)
+            raise OutOfScope(
+                f"{control[1].kind.upper()} after {first.kind.upper()} in one block", control[1].start + 1
+            )
         return getattr(self, "_" + first.kind)(block, first)
 
     def _holds(self, block: Block, statement: Statement) -> bool:
@@ -265,7 +275,9 @@ class SinumerikFlow:
         """The structure a closing statement closes: the innermost open one, of its kind."""
         if not self.open or self.open[-1].kind != kind:
             found = f"the {self.open[-1].kind.upper()} open" if self.open else "no open structure"
-            raise OutOfScope(f"{statement.kind.upper()} with {found} (not {kind.upper()})", statement.start + 1)
+            raise OutOfScope(
+                f"{statement.kind.upper()} with {found} (not {kind.upper()})", statement.start + 1
+            )
         return self.open[-1]
 
     def _match(self, start: int, kind: str, statement: Statement, past_else: bool = False) -> int:
@@ -286,7 +298,9 @@ class SinumerikFlow:
                 elif found.kind in CLOSERS:
                     if depth == 0:
                         if found.kind != OPENERS[kind]:
-                            raise OutOfScope(f"{kind.upper()} closed by {found.kind.upper()}", statement.start + 1)
+                            raise OutOfScope(
+                                f"{kind.upper()} closed by {found.kind.upper()}", statement.start + 1
+                            )
                         return index
                     depth -= 1
                 elif found.kind == "else" and depth == 0 and kind == "if" and not past_else:
@@ -306,11 +320,17 @@ class SinumerikFlow:
         if found is None:
             if keyword == "GOTOC":
                 return self.pc + 1
-            held = "no longer held (ncpp holds the last blocks only)" if self.base > 0 and keyword != "GOTOF" else "not found"
+            held = (
+                "no longer held (ncpp holds the last blocks only)"
+                if self.base > 0 and keyword != "GOTOF"
+                else "not found"
+            )
             raise OutOfScope(f"{keyword} {destination}, a jump destination {held}", statement.start + 1)
         if found <= self.pc and self.last_run_move >= found:  # (a looped block runs FIXED)
-            raise OutOfScope(f"{keyword} {destination}, a backward jump over moves compensated where they stand",
-                             statement.start + 1)  # fmt: skip
+            raise OutOfScope(
+                f"{keyword} {destination}, a backward jump over moves compensated where they stand",
+                statement.start + 1,
+            )
         return found
 
     def _forward(self, name: str) -> int | None:
@@ -364,5 +384,7 @@ def _jumps(statement: Statement) -> list[tuple[str, str]]:
         return [statement.node]
     if statement.kind == "case":
         _, branches, default = statement.node
-        return [(keyword, destination) for _, keyword, destination in branches] + ([default] if default else [])
+        return [(keyword, destination) for _, keyword, destination in branches] + (
+            [default] if default else []
+        )
     return []

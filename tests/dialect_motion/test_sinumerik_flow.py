@@ -39,7 +39,10 @@ def test_repeat_runs_once_before_its_test_while_may_run_no_time():
     text = "R1=5\nG1 F100\nREPEAT\nX=R1\nR1=R1+1\nUNTIL R1>2\nWHILE R1<0\nX99\nENDWHILE\nY1\nM30\n"
     events, warned = _run(text)
     assert warned == "" and _xs(events) == [5.0, 5.0]
-    assert [e.block.line for e in events if type(e) is Pass and e.skipped] == [8, 9]  # the body that did not run, its end
+    assert [e.block.line for e in events if type(e) is Pass and e.skipped] == [
+        8,
+        9,
+    ]  # the body that did not run, its end
 
 
 def test_loop_left_by_a_forward_jump_is_refused_not_guessed():
@@ -55,8 +58,10 @@ def test_nested_if_else_takes_one_branch():
 
 
 def test_jumps_to_labels_and_block_numbers():
-    text = ("R1=0\nG1 F100\nGOTOF N40\nX99\nN40 BACK: X=R1\nR1=R1+1\nIF R1<3 GOTOB BACK\n"
-            "GOTOC NOWHERE\nCASE(R1) OF 2 GOTOF TWO 3 GOTOF THREE DEFAULT GOTOF TWO\nTWO: X77\nTHREE: Y5\nM30\n")  # fmt: skip
+    text = (
+        "R1=0\nG1 F100\nGOTOF N40\nX99\nN40 BACK: X=R1\nR1=R1+1\nIF R1<3 GOTOB BACK\nGOTOC NOWHERE\n"
+        "CASE(R1) OF 2 GOTOF TWO 3 GOTOF THREE DEFAULT GOTOF TWO\nTWO: X77\nTHREE: Y5\nM30\n"
+    )
     events, warned = _run(text)
     assert warned == "" and _xs(events) == [0.0, 1.0, 2.0, 2.0]
     # a backward jump among the first blocks: the blocks it runs again are left as programmed
@@ -92,7 +97,7 @@ def test_memory_stays_bounded_on_a_long_program_with_a_loop(monkeypatch):
                                         lambda: interpreter.done, None)  # fmt: skip
     held = 0
     kinds = []
-    for block, kind, owner in flow.steps(blocks):
+    for block, kind, _owner in flow.steps(blocks):
         held = max(held, len(flow.buffer))
         kinds.append(kind)
         if kind in (RUN, sinumerik_flow.FIXED):
@@ -105,7 +110,9 @@ def test_a_compensated_loop_is_written_once_as_programmed_and_the_moves_around_i
     """The machine's X is off by -50 µm/m · Y: at Y200 a compensated X gains 0.0100."""
     loop = ["WHILE R1<2", "G1 X=20+R1 Y200", "R1=R1+1", "ENDWHILE"]
     program = tmp_path / "loop.mpf"
-    program.write_text("\n".join(["R1=0", "G90 G71", "G0 X10 Y200 Z5", *loop, "G1 X30 Y200 F500", "M30"]) + "\n")
+    program.write_text(
+        "\n".join(["R1=0", "G90 G71", "G0 X10 Y200 Z5", *loop, "G1 X30 Y200 F500", "M30"]) + "\n"
+    )
     lines = compensate_file(program, SQUARE, tmp_path, dialect="sinumerik").read_text().splitlines()
     start = lines.index("WHILE R1<2")
     assert lines[start : start + 4] == loop and lines.count("WHILE R1<2") == 1  # its text once, as programmed
