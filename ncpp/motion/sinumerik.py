@@ -130,13 +130,14 @@ class SinumerikInterpreter(ModalInterpreter):
         run out of the text's order gives its moves, left as programmed, to the line that
         runs it (its `owner`), so that every block's text is written once, where it stands."""
 
-        def stop(reason: str, block: Block, col: int | None, owner: Block | None) -> None:
+        def leave(reason: str, block: Block, col: int | None, owner: Block | None) -> None:
             self.leave_scope(warnings, reason, block, col, owner)
 
-        flow = SinumerikFlow(self.file, self.value, self.assign, lambda: self.done, stop)
+        flow = SinumerikFlow(self.file, self.value, self.assign, lambda: self.done, leave)
         for block, kind, owner in flow.steps(blocks):
             if (kind is not RUN and kind is not FIXED) or not block.items:
-                yield Pass(block, kind is SKIP)
+                if owner is None:  # (a block run out of the text's order is written in its place)
+                    yield Pass(block, kind is SKIP)
                 continue
             try:
                 events = self.block(block)

@@ -99,17 +99,17 @@ class SinumerikFlow:
                         "run it for ever; ncpp follows a program to its end)",
                         Location(self.file, owner.line, 1),  # type: ignore[union-attr]
                     )
-            control = _controls(block)
-            if not control:
+            try:
+                control = _controls(block)
+                target = self._decide(block, control) if control else None
+            except OutOfScope as leave:
+                self.stop(leave.reason, block, leave.col, owner)
+                break
+            if target is None:
                 looping = self.pc in self.looped or any(o.kind != "if" for o in self.open)
                 yield block, (FIXED if looping or not in_place else RUN), owner
                 self._advance()
                 continue
-            try:
-                target = self._decide(block, control)
-            except OutOfScope as leave:
-                self.stop(leave.reason, block, leave.col, owner)
-                break
             if in_place:
                 yield block, TEXT, None
                 self._wrote()

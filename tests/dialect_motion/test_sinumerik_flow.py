@@ -108,13 +108,19 @@ def test_memory_stays_bounded_on_a_long_program_with_a_loop(monkeypatch):
 
 def test_a_compensated_loop_is_written_once_as_programmed_and_the_moves_around_it_compensated(tmp_path):
     """The machine's X is off by -50 µm/m · Y: at Y200 a compensated X gains 0.0100."""
-    loop = ["WHILE R1<2", "G1 X=20+R1 Y200", "R1=R1+1", "ENDWHILE"]
+    loop = ["WHILE R1<2", "G1 X=20+R1 Y200", "", "; the next row", "R1=R1+1", "ENDWHILE"]
     program = tmp_path / "loop.mpf"
     program.write_text(
         "\n".join(["R1=0", "G90 G71", "G0 X10 Y200 Z5", *loop, "G1 X30 Y200 F500", "M30"]) + "\n"
     )
     lines = compensate_file(program, SQUARE, tmp_path, dialect="sinumerik").read_text().splitlines()
     start = lines.index("WHILE R1<2")
-    assert lines[start : start + 4] == loop and lines.count("WHILE R1<2") == 1  # its text once, as programmed
+    assert lines[start : start + 6] == loop and lines.count("WHILE R1<2") == 1  # its text once, as programmed
     assert "X10.0100" in " ".join(lines[:start])  # compensated before the loop
-    assert "X30.0100" in " ".join(lines[start + 4 :])  # and after it
+    assert lines[start + 6].startswith("G1 X30.0100")  # and after it (the blank line not written again)
+
+
+def test_a_control_statement_with_more_in_its_block_ends_interpretation():
+    events, warned = _run("G1 X1 F100\nR1=0\nWHILE R1<2\nR1=R1+1\nENDWHILE G1 X5\nX7\nM30\n")
+    assert "flow.mpf:5:10: warning: ENDWHILE with more in its block" in warned
+    assert _xs(events) == [1.0] and len(events) == 7  # every block written once
