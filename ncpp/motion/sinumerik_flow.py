@@ -106,7 +106,7 @@ class SinumerikFlow:
                 self.stop(leave.reason, block, leave.col, owner)
                 break
             if target is None:
-                looping = self.pc in self.looped or any(o.kind != "if" for o in self.open)
+                looping = self.pc in self.looped or self._looping()
                 yield block, (FIXED if looping or not in_place else RUN), owner
                 self._advance()
                 continue
@@ -123,11 +123,15 @@ class SinumerikFlow:
 
     def _wrote(self) -> None:
         self.written = self.pc + 1
-        if len(self.buffer) > 2 * _TRIM and not self.open:
+        if len(self.buffer) > 2 * _TRIM and not self._looping():
             keep = self.written - self.base - _TRIM  # a backward jump may go back _TRIM blocks
             if keep > 0:
                 del self.buffer[:keep]
                 self.base += keep
+
+    def _looping(self) -> bool:
+        """A loop is under way: its blocks run again (an IF's do not: they are not held for it)."""
+        return any(o.kind != "if" for o in self.open)
 
     def _go(self, target: int) -> Iterator[tuple[Block, str, Block | None]]:
         """On to block `target`: the blocks a forward jump passes that stand where the text
@@ -169,8 +173,8 @@ class SinumerikFlow:
             except OutOfScope:  # (met where the flow reaches it)
                 continue
             for statement in controls:
-                for _, destination in _jumps(statement):
-                    start = seen.get(destination.upper())
+                for keyword, destination in _jumps(statement):
+                    start = None if keyword == "GOTOF" else seen.get(destination.upper())
                     if start is not None:  # (GOTO may find one ahead first: FIXED too, which is safe)
                         self.looped.update(range(start, index + 1))
 
@@ -201,9 +205,9 @@ class SinumerikFlow:
         return match + 1
 
     def _else(self, block: Block, statement: Statement) -> int:
-        opened = self._top("if", statement)
+        self._top("if", statement)
         self.open.pop()
-        return self._match(opened.start, "if", statement, past_else=True) + 1
+        return self._match(self.pc, "if", statement, past_else=True) + 1
 
     def _endif(self, block: Block, statement: Statement) -> int:
         self._top("if", statement)
@@ -282,7 +286,7 @@ class SinumerikFlow:
 
     def _match(self, start: int, kind: str, statement: Statement, past_else: bool = False) -> int:
         """The index of the block closing the structure opened at `start` (an IF's ELSE, unless
-        `past_else`, or its ENDIF), reading ahead as far as it takes."""
+        `past_else`, or its ENDIF; `start` may be the ELSE), reading ahead as far as it takes."""
         depth = 0
         index = start
         while True:

@@ -90,7 +90,8 @@ def test_a_loop_that_does_not_end_is_refused(monkeypatch):
 
 def test_memory_stays_bounded_on_a_long_program_with_a_loop(monkeypatch):
     monkeypatch.setattr(sinumerik_flow, "_TRIM", 10)
-    text = "G1 F100\n" + "X1\nX2\n" * 200 + "R1=0\nWHILE R1<3\nX=R1\nR1=R1+1\nENDWHILE\n" + "Y1\nY2\n" * 200
+    loop = "R1=0\nWHILE R1<3\nX=R1\nR1=R1+1\nENDWHILE\n"
+    text = "G1 F100\n" + "X1\nX2\n" * 200 + loop + "IF R1==3\n" + "Y1\nY2\n" * 200 + "ELSE\nX9\nENDIF\n"
     _, blocks = parse_program(io.BytesIO(text.encode()), "flow.mpf", "sinumerik")
     interpreter = SinumerikInterpreter("flow.mpf")
     flow = sinumerik_flow.SinumerikFlow("flow.mpf", interpreter.value, interpreter.assign,
@@ -103,7 +104,8 @@ def test_memory_stays_bounded_on_a_long_program_with_a_loop(monkeypatch):
         if kind in (RUN, sinumerik_flow.FIXED):
             interpreter.block(block)
     assert held <= 2 * 10 + 2  # (not the 800 blocks of the program)
-    assert kinds.count(TEXT) == 2 and SKIP not in kinds  # WHILE and ENDWHILE, once each
+    assert kinds.count(TEXT) == 4 and kinds.count(SKIP) == 2  # WHILE, ENDWHILE, IF, ELSE; X9, ENDIF
+    assert interpreter.pos == [2.0, 2.0, 0.0]
 
 
 def test_a_compensated_loop_is_written_once_as_programmed_and_the_moves_around_it_compensated(tmp_path):
