@@ -115,7 +115,10 @@ def test_a_compensated_loop_is_written_once_as_programmed_and_the_moves_around_i
     program.write_text(
         "\n".join(["R1=0", "G90 G71", "G0 X10 Y200 Z5", *loop, "G1 X30 Y200 F500", "M30"]) + "\n"
     )
-    lines = compensate_file(program, SQUARE, tmp_path, dialect="sinumerik").read_text().splitlines()
+    warned = io.StringIO()
+    output = compensate_file(program, SQUARE, tmp_path, dialect="sinumerik", warnings=Warnings(stream=warned))
+    lines = output.read_text().splitlines()
+    assert "loop.mpf:5:1: warning: loop or subroutine" in warned.getvalue()  # the user is told
     start = lines.index("WHILE R1<2")
     assert lines[start : start + 6] == loop and lines.count("WHILE R1<2") == 1  # its text once, as programmed
     assert "X10.0100" in " ".join(lines[:start])  # compensated before the loop
