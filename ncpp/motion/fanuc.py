@@ -6,7 +6,8 @@ Fanuc and Haas posts write on lines of their own and that move no axis, where Li
 reads the same codes otherwise (G5.1 is a spline there, G8 lathe radius mode):
 
 * Fanuc (0i-MF / 30i operator's manuals): `G05.1 Q1` / `Q0`, AI contour control on and off;
-  `G08 P1` / `P0`, advanced preview control on and off.
+  `G08 P1` / `P0`, advanced preview control on and off.  `G54.1 P1`-`P48` selects an
+  additional work offset, whose zero ncpp is not told: it ends interpretation with a warning.
 * Haas (Mill Operator's Manual, "G-codes"): also `G187 P1-P3 [E..]`, the smoothness level and
   corner tolerance; `G103 P..`, the limit of blocks looked ahead.  `G154 P1-P99` selects one
   of Haas's additional work offsets, whose zero ncpp is not told, and `M97 P..` runs a local
@@ -25,14 +26,16 @@ from ncpp.program.blocks import Block, Comment, Word
 # G code -> the words it takes, for the settings each flavour reads past
 FANUC_SETTINGS: dict[float, frozenset[str]] = {5.1: frozenset("Q"), 8.0: frozenset("P")}
 HAAS_SETTINGS = {**FANUC_SETTINGS, 187.0: frozenset("PE"), 103.0: frozenset("P")}
-# Codes of the flavour that need what ncpp is not told (a zero, a sequence number's block)
-HAAS_UNFOLLOWED = {("G", 154.0): "G154 (an additional work offset ncpp is not told)",
+# Codes of the flavour that need what ncpp is not told (a zero, a sequence number's block):
+# Fanuc's additional work offsets `G54.1 P1`-`P48`, Haas's `G154 P1`-`P99`
+FANUC_UNFOLLOWED = {("G", 54.1): "G54.1 (an additional work offset ncpp is not told)"}
+HAAS_UNFOLLOWED = {**FANUC_UNFOLLOWED, ("G", 154.0): "G154 (an additional work offset ncpp is not told)",
                    ("M", 97.0): "M97 (a local subprogram at a sequence number)"}  # fmt: skip
 
 
 class FanucInterpreter(Interpreter):
     settings: dict[float, frozenset[str]] = FANUC_SETTINGS
-    unfollowed: dict[tuple[str, float], str] = {}
+    unfollowed: dict[tuple[str, float], str] = FANUC_UNFOLLOWED
 
     def block(self, block: Block) -> Event | tuple[Event, ...]:
         words = [item for item in block.items if type(item) is Word]

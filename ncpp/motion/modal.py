@@ -96,15 +96,23 @@ class ModalInterpreter:
             try:
                 events = self.block(block)
             except OutOfScope as stop:
-                self.done = True
-                warnings.warn(
-                    f"{stop.reason} is outside the motion interpreter's scope; from this line on the "
-                    "program passes through uninterpreted (its modal state is unknown)",
-                    Location(self.file, block.line, stop.col),
-                )
+                self.leave_scope(warnings, stop.reason, block, stop.col)
                 yield Pass(block)
                 continue
             yield from events or (Pass(block),)
+
+    def leave_scope(
+        self, warnings: Warnings, reason: str, block: Block, col: int | None, owner: Block | None = None
+    ) -> None:
+        """A construct outside the scope: the state is unknown from here on (an error with strict).
+        `owner`: the line that ran the block (a loop's end, a backward jump), from which the rest passes."""
+        self.done = True
+        where = "this line" if owner is None else f"line {owner.line}, which runs it,"
+        warnings.warn(
+            f"{reason} is outside the motion interpreter's scope; from {where} on the "
+            "program passes through uninterpreted (its modal state is unknown)",
+            Location(self.file, block.line, col),
+        )
 
     def block(self, block: Block) -> list[Event]:
         raise NotImplementedError

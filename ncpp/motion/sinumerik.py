@@ -8,10 +8,11 @@ arc), G90/G91 and `AC()`/`IC()` per word, G17/G18/G19, G70/G71/G700/G710,
 arithmetic, labels, `MSG`, G4 dwell, M2/M17/M30 (end), and tool lengths: `T n`
 or `T="NAME"` selects, M6 loads it with cutting edge D1, `D n` picks an edge
 (D0 none); the edge's lengths 1-3 from the control's tool offsets (`_N_TO_INI`,
-`tools.py`) act along the plane's axes (G17: length 1 along Z).  Control flow (GOTO*,
-IF, WHILE, FOR, REPEAT, CASE), calls of cycles and subprograms (by name or `L<n>`), splines, other
-frames, polar coordinates (AP=, RP=), arcs by opening angle (AR=) and unknown G
-codes make the position unknown: one warning (an error with `strict`) and the
+`tools.py`) act along the plane's axes (G17: length 1 along Z).  Control flow (GOTOF,
+GOTOB, GOTO, GOTOC, CASE, IF, WHILE, FOR, REPEAT, LOOP) runs as `sinumerik_flow.py` says: a
+loop's moves are left as programmed (FLOW).  Calls of cycles and subprograms (by name or
+`L<n>`), splines, other frames, polar coordinates (AP=, RP=), arcs by opening angle (AR=)
+and unknown G codes make the position unknown: one warning (an error with `strict`) and the
 rest passes through.  Under cutter compensation (G41/G42 to the first move after
 G40) the moves are the programmed contour, the tool centre off it by the radius:
 they are marked `fixed` (`ModalInterpreter.radius_compensation`).
@@ -24,6 +25,7 @@ from collections.abc import Iterable, Iterator
 from typing import cast
 
 from ncpp.errors import Location, Warnings
+from ncpp.motion.flow import FIXED, RUN, SKIP
 from ncpp.motion.modal import (
     MM_PER_INCH,
     ModalInterpreter,
@@ -33,7 +35,8 @@ from ncpp.motion.modal import (
     run_placed,
 )
 from ncpp.motion.offsets import WorkOffsets
-from ncpp.motion.segments import MACHINE, PLANE_AXES, Event
+from ncpp.motion.segments import FLOW, MACHINE, PLANE_AXES, Event, Pass
+from ncpp.motion.sinumerik_flow import SinumerikFlow
 from ncpp.motion.tools import ToolTable, UntoldLengths
 from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
 
@@ -120,6 +123,41 @@ class SinumerikInterpreter(ModalInterpreter):
         self.frame_shift = [0.0, 0.0, 0.0]
         self.told_frame: float | None = None  # the settable frame the program selected first
         self.zero_frame: float | None = None  # the one in effect (None: as when the program started)
+
+    # -- the event stream ---------------------------------------------------------------
+    def run(self, blocks: Iterable[Block], warnings: Warnings) -> Iterator[Event]:
+        """Events block by block, in the order the blocks run (`sinumerik_flow.py`): a block
+        run out of the text's order gives its moves, left as programmed, to the line that
+        runs it (its `owner`), so that every block's text is written once, where it stands."""
+
+        def leave(reason: str, block: Block, col: int | None, owner: Block | None) -> None:
+            self.leave_scope(warnings, reason, block, col, owner)
+
+        flow = SinumerikFlow(self.file, self.value, self.assign, lambda: self.done, leave)
+        for block, kind, owner in flow.steps(blocks):
+            if (kind is not RUN and kind is not FIXED) or not block.items:
+                if owner is None:  # (a block run out of the text's order is written in its place)
+                    yield Pass(block, kind is SKIP)
+                continue
+            try:
+                events = self.block(block)
+            except OutOfScope as stop:
+                self.leave_scope(warnings, stop.reason, block, stop.col, owner)
+                if owner is None:  # (a block run out of the text's order is written in its place)
+                    yield Pass(block)
+                continue
+            moves = [event for event in events if type(event) is not Pass]
+            if kind is FIXED:
+                for move in moves:
+                    move.fixed = move.fixed or FLOW  # type: ignore[union-attr]
+                    if owner is not None:
+                        move.block = owner
+                if owner is not None:
+                    yield from moves
+                    continue
+            elif moves:
+                flow.last_run_move = flow.pc
+            yield from events or (Pass(block),)
 
     # -- variables --------------------------------------------------------------------
     def lookup(self, name: str) -> float:

@@ -28,19 +28,14 @@ FOLDER = CORPUS / "sinumerik" / "CEAD_nc-gcode-interpreter"
 PRELUDE = "defaults.mpf"
 
 OUT_OF_SCOPE = {
-    "actual_position.mpf": "REPEAT/UNTIL loop on $AA_IW (control flow)",
-    "arrays.mpf": "DEF of arrays and FOR loops",
+    "actual_position.mpf": "UNTIL on $AA_IW[Z] (the system variable of an axis position)",
+    "arrays.mpf": "DEF of arrays",
     "axis_index_assignment.mpf": "ACC[E] array-style machine data",
-    "case.mpf": "CASE ... GOTOF branches",
-    "edge_cases.mpf": "MATERIAL_UPDATE subprogram call, labels with GOTOB/GOTOF/CASE",
+    "edge_cases.mpf": "the rotary axes A B C",
     "flattening__flatten_demo.mpf": "BSPLINE spline interpolation",
-    "for_loop.mpf": "FOR loop",
+    "for_loop.mpf": "the rotary axis A the FOR loop moves (ncpp follows X Y Z)",
     "function_calls.mpf": "SETAL alarm call",
-    "goto.mpf": "GOTOF/GOTOB jumps",
-    "if_statement.mpf": "IF/ELSE blocks",
-    "logic_operators.mpf": "IF blocks",
-    "loop.mpf": "IF/WHILE blocks",
-    "repeat.mpf": "REPEAT/UNTIL loop",
+    "repeat.mpf": "the rotary axis A the REPEAT loop moves (ncpp follows X Y Z)",
     "simple.mpf": "G2/G3 with neither I/J/K nor CR= (the oracle records modes; ncpp refuses a centreless arc) and G341",
     "spline.mpf": "BSPLINE/ASPLINE spline interpolation",
 }

@@ -47,11 +47,13 @@ def test_a_setting_with_motion_in_its_block_ends_interpretation():
 
 
 @pytest.mark.parametrize(
-    "block, reason", [("G154 P1", "G154 (an additional work offset"), ("M97 P1000", "M97 (a local")]
-)
-def test_what_haas_programs_need_ncpp_is_not_told_ends_interpretation(block, reason):
+    "block, reason, dialect",
+    [("G154 P1", "G154 (an additional work offset", "haas"), ("M97 P1000", "M97 (a local", "haas"),
+     ("G54.1 P1", "G54.1 (an additional work offset", "haas"), ("G54.1 P1", "G54.1 (an additional work", "fanuc")],
+)  # fmt: skip
+def test_what_fanuc_and_haas_programs_need_ncpp_is_not_told_ends_interpretation(block, reason, dialect):
     said = io.StringIO()
-    found = events(f"G0 X1\n{block}\nG0 X2\nM30\n", "haas", Warnings(stream=said))
+    found = events(f"G0 X1\n{block}\nG0 X2\nM30\n", dialect, Warnings(stream=said))
     assert [type(e) for e in found] == [Line, Pass, Pass, Pass] and reason in said.getvalue()
 
 

@@ -1,0 +1,394 @@
+"""Sinumerik control flow: the order a program's blocks run in.
+
+The rules are those of the SINUMERIK 840D sl Programming Manual, Job Planning
+(6FC5398-2BP40-1AA0), "Flexible NC programming": "Program jumps and branches" and
+"Control structures":
+
+* `GOTOF label` searches forward for the jump destination, `GOTOB` backward, `GOTO`
+  forward then backward, `GOTOC` as GOTO but a destination not found raises no alarm:
+  the program goes on with the next block; a destination is a label (`NAME:`) or a
+  block number (`N100`, `GOTOF 100`);
+* `IF condition GOTOx destination` jumps when the condition holds (a conditional jump);
+* `CASE (expression) OF constant GOTOx destination ... DEFAULT GOTOx destination`
+  jumps at the first constant equal to the expression, else at DEFAULT, else goes on;
+* `IF ... ELSE ... ENDIF`, `WHILE ... ENDWHILE`, `FOR variable = start TO end ...
+  ENDFOR` (the variable counts up by 1 while it is not above the end), `REPEAT ...
+  UNTIL condition`, `LOOP ... ENDLOOP` (endless, left by a jump) are the control
+  structures; they nest.  The manual advises against mixing control structures and
+  program jumps: ncpp does not follow a jump while a structure is open.
+
+`SinumerikFlow.steps(blocks)` yields each block with what the interpreter is to do
+with it, as `ncpp.motion.flow` does for o-words (its RUN, FIXED, SKIP, TEXT): a block
+that runs once where it stands is RUN; the body of a loop (WHILE, FOR, REPEAT, LOOP)
+and the blocks a backward jump among the first `_TRIM` blocks goes back over are FIXED
+from their first pass (one text runs many times: its moves are left as programmed);
+their second and later passes come again, FIXED, with an `owner`, the line that sent
+the program back (ENDWHILE, UNTIL, a GOTOB), whose text holds them.  Past the first
+`_TRIM` blocks, a backward jump over a move that ran in place (its text may be
+rewritten for that one run) leaves the scope.  A jump into or out of an open
+structure, a destination not found (but GOTOC's) or no longer held (blocks are held
+`_TRIM` back, and while a loop runs) leave the scope too: the rest passes through.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable, Iterator
+from dataclasses import dataclass
+
+from ncpp.errors import Location, NcppError
+from ncpp.motion.flow import _TRIM, FIXED, MAX_RERUN, RUN, SKIP, TEXT
+from ncpp.motion.modal import OutOfScope
+from ncpp.program.blocks import Block, Comment, Statement, Word
+
+# Statements that steer the flow (the builder's kinds: ncpp/program/dialects/sinumerik.py)
+CONTROLS = frozenset(("if", "else", "endif", "while", "endwhile", "for", "endfor", "repeat", "until",
+                      "loop", "endloop", "goto", "case"))  # fmt: skip
+OPENERS = {"if": "endif", "while": "endwhile", "for": "endfor", "repeat": "until", "loop": "endloop"}
+CLOSERS = frozenset(OPENERS.values())
+# Blocks a forward search for a jump destination reads ahead before it gives up (memory stays bounded)
+MAX_AHEAD = 100_000
+
+
+@dataclass
+class _Open:
+    """A control structure under way."""
+
+    kind: str  # if, while, for, repeat, loop
+    start: int  # the index of its opening block
+    end: float = 0.0  # FOR: the end value
+
+
+class SinumerikFlow:
+    """The blocks of a Sinumerik program in the order they run (see the module docstring).
+
+    `value(expr, block, item)` and `assign(target, expr, block, item)` are the
+    interpreter's; `done()` says the program has ended; `stop(reason, block, col, owner)`
+    ends interpretation where the flow leaves the scope."""
+
+    def __init__(
+        self, file: str, value: Callable, assign: Callable, done: Callable[[], bool], stop: Callable
+    ):
+        self.file, self.value, self.assign, self.done, self.stop = file, value, assign, done, stop
+        self.stream: Iterator[Block] = iter(())
+        self.buffer: list[Block] = []  # blocks read and still held, from index `base`
+        self.base = 0
+        self.read = 0  # blocks read from the stream
+        self.written = 0  # the next block to write in the text's order
+        self.pc = 0  # the next block to run
+        self.open: list[_Open] = []
+        self.looped: set[int] = set()  # blocks a backward jump read ahead runs again
+        self.last_run_move = -1  # the index of the last block that moved in place (RUN): the interpreter's
+        self.rerun = 0  # blocks run out of the text's order so far
+
+    # -- the stream ------------------------------------------------------------------
+    def steps(self, blocks: Iterable[Block]) -> Iterator[tuple[Block, str, Block | None]]:
+        """(block, kind, owner): owner is None but for blocks that run out of the text's order."""
+        self.stream = iter(blocks)
+        self._read_ahead()
+        while not self.done():
+            block = self._block(self.pc)
+            if block is None:
+                break
+            in_place = self.pc == self.written
+            owner = None if in_place else self.buffer[self.written - 1 - self.base]
+            if not in_place:
+                self.rerun += 1
+                if self.rerun > MAX_RERUN:
+                    raise NcppError(
+                        f"a loop that does not end: {MAX_RERUN:,} blocks run again (the control would "
+                        "run it for ever; ncpp follows a program to its end)",
+                        Location(self.file, owner.line, 1),  # type: ignore[union-attr]
+                    )
+            try:
+                control = _controls(block)
+                target = self._decide(block, control) if control else None
+            except OutOfScope as leave:
+                self.stop(leave.reason, block, leave.col, owner)
+                break
+            if target is None:
+                looping = self.pc in self.looped or self._looping()
+                yield block, (FIXED if looping or not in_place else RUN), owner
+                self._advance()
+                continue
+            if in_place:
+                yield block, TEXT, None
+                self._wrote()
+            yield from self._go(target)
+        yield from self._rest()
+
+    def _advance(self) -> None:
+        if self.pc == self.written:
+            self._wrote()
+        self.pc += 1
+
+    def _wrote(self) -> None:
+        self.written = self.pc + 1
+        if len(self.buffer) > 2 * _TRIM and not self._looping():
+            keep = self.written - self.base - _TRIM  # a backward jump may go back _TRIM blocks
+            if keep > 0:
+                del self.buffer[:keep]
+                self.base += keep
+
+    def _looping(self) -> bool:
+        """A loop is under way: its blocks run again (an IF's do not: they are not held for it)."""
+        return any(o.kind != "if" for o in self.open)
+
+    def _go(self, target: int) -> Iterator[tuple[Block, str, Block | None]]:
+        """On to block `target`: the blocks a forward jump passes that stand where the text
+        is written are written, and do not run."""
+        for index in range(max(self.written, self.pc + 1), target):
+            yield self.buffer[index - self.base], SKIP, None
+            self.written = index + 1
+        self.pc = target
+
+    def _rest(self) -> Iterator[tuple[Block, str, Block | None]]:
+        """After the program's end: every block not yet written, as text."""
+        for index in range(self.written, self.read):
+            yield self.buffer[index - self.base], TEXT, None
+        self.buffer.clear()
+        for block in self.stream:
+            yield block, TEXT, None
+
+    def _block(self, index: int) -> Block | None:
+        while index >= self.read:
+            block = next(self.stream, None)
+            if block is None:
+                return None
+            self.buffer.append(block)
+            self.read += 1
+        return self.buffer[index - self.base]
+
+    def _read_ahead(self) -> None:
+        """The first `_TRIM` blocks, read ahead: the blocks a literal backward jump among them
+        goes back over are `looped` (they run again; their first pass is FIXED too)."""
+        seen: dict[str, int] = {}  # a destination -> the first block it names
+        for index in range(_TRIM):
+            block = self._block(index)
+            if block is None:
+                return
+            for name in _destinations(block):
+                seen.setdefault(name, index)
+            try:
+                controls = _controls(block)
+            except OutOfScope:  # (met where the flow reaches it)
+                continue
+            for statement in controls:
+                for keyword, destination in _jumps(statement):
+                    start = None if keyword == "GOTOF" else seen.get(destination.upper())
+                    if start is not None:  # (GOTO may find one ahead first: FIXED too, which is safe)
+                        self.looped.update(range(start, index + 1))
+
+    # -- control blocks ---------------------------------------------------------------
+    def _decide(self, block: Block, control: list[Statement]) -> int:
+        """Run a control block: the index of the block that runs next."""
+        first = control[0]
+        if first.kind == "if" and len(control) == 2 and control[1].kind == "goto":  # a conditional jump
+            return (
+                self._jump(block, control[1], *control[1].node) if self._holds(block, first) else self.pc + 1
+            )
+        if len(control) > 1:
+            raise OutOfScope(
+                f"{control[1].kind.upper()} after {first.kind.upper()} in one block", control[1].start + 1
+            )
+        return getattr(self, "_" + first.kind)(block, first)
+
+    def _holds(self, block: Block, statement: Statement) -> bool:
+        return self.value(statement.node[0], block, statement) != 0.0
+
+    def _if(self, block: Block, statement: Statement) -> int:
+        if self._holds(block, statement):
+            self.open.append(_Open("if", self.pc))
+            return self.pc + 1
+        match = self._match(self.pc, "if", statement)
+        if _controls(self.buffer[match - self.base])[0].kind == "else":  # the ELSE branch runs
+            self.open.append(_Open("if", self.pc))
+        return match + 1
+
+    def _else(self, block: Block, statement: Statement) -> int:
+        self._top("if", statement)
+        self.open.pop()
+        return self._match(self.pc, "if", statement, past_else=True) + 1
+
+    def _endif(self, block: Block, statement: Statement) -> int:
+        self._top("if", statement)
+        self.open.pop()
+        return self.pc + 1
+
+    def _while(self, block: Block, statement: Statement) -> int:
+        again = bool(self.open) and self.open[-1].kind == "while" and self.open[-1].start == self.pc
+        if self._holds(block, statement):
+            if not again:
+                self.open.append(_Open("while", self.pc))
+            return self.pc + 1
+        if again:
+            self.open.pop()
+        return self._match(self.pc, "while", statement) + 1
+
+    def _endwhile(self, block: Block, statement: Statement) -> int:
+        return self._top("while", statement).start
+
+    def _for(self, block: Block, statement: Statement) -> int:
+        target, start, end = statement.node
+        self.assign(target, ("num", self.value(start, block, statement)), block, statement)
+        last = self.value(end, block, statement)
+        if self.value(target, block, statement) <= last:
+            self.open.append(_Open("for", self.pc, last))
+            return self.pc + 1
+        return self._match(self.pc, "for", statement) + 1
+
+    def _endfor(self, block: Block, statement: Statement) -> int:
+        opened = self._top("for", statement)
+        counter = _controls(self.buffer[opened.start - self.base])[0].node[0]  # (held while the loop runs)
+        self.assign(counter, ("bin", "+", counter, ("num", 1.0)), block, statement)
+        if self.value(counter, block, statement) <= opened.end:
+            return opened.start + 1
+        self.open.pop()
+        return self.pc + 1
+
+    def _repeat(self, block: Block, statement: Statement) -> int:
+        self.open.append(_Open("repeat", self.pc))
+        return self.pc + 1
+
+    def _until(self, block: Block, statement: Statement) -> int:
+        opened = self._top("repeat", statement)
+        if self._holds(block, statement):
+            self.open.pop()
+            return self.pc + 1
+        return opened.start + 1
+
+    def _loop(self, block: Block, statement: Statement) -> int:
+        self.open.append(_Open("loop", self.pc))
+        return self.pc + 1
+
+    def _endloop(self, block: Block, statement: Statement) -> int:
+        return self._top("loop", statement).start + 1
+
+    def _goto(self, block: Block, statement: Statement) -> int:
+        return self._jump(block, statement, *statement.node)
+
+    def _case(self, block: Block, statement: Statement) -> int:
+        expr, branches, default = statement.node
+        value = self.value(expr, block, statement)
+        for constant, keyword, destination in branches:
+            if self.value(constant, block, statement) == value:
+                return self._jump(block, statement, keyword, destination)
+        return self.pc + 1 if default is None else self._jump(block, statement, *default)
+
+    # -- helpers ---------------------------------------------------------------------
+    def _top(self, kind: str, statement: Statement) -> _Open:
+        """The structure a closing statement closes: the innermost open one, of its kind."""
+        if not self.open or self.open[-1].kind != kind:
+            found = f"the {self.open[-1].kind.upper()} open" if self.open else "no open structure"
+            raise OutOfScope(
+                f"{statement.kind.upper()} with {found} (not {kind.upper()})", statement.start + 1
+            )
+        return self.open[-1]
+
+    def _match(self, start: int, kind: str, statement: Statement, past_else: bool = False) -> int:
+        """The index of the block closing the structure opened at `start` (an IF's ELSE, unless
+        `past_else`, or its ENDIF; `start` may be the ELSE), reading ahead as far as it takes."""
+        depth = 0
+        index = start
+        while True:
+            index += 1
+            if index - start > MAX_AHEAD:
+                raise OutOfScope(f"{kind.upper()} with no end in {MAX_AHEAD:,} blocks", statement.start + 1)
+            block = self._block(index)
+            if block is None:
+                raise OutOfScope(f"{kind.upper()} with no {OPENERS[kind].upper()}", statement.start + 1)
+            for found in _controls(block):
+                if found.kind in OPENERS and not _conditional_jump(block, found):
+                    depth += 1
+                elif found.kind in CLOSERS:
+                    if depth == 0:
+                        if found.kind != OPENERS[kind]:
+                            raise OutOfScope(
+                                f"{kind.upper()} closed by {found.kind.upper()}", statement.start + 1
+                            )
+                        return index
+                    depth -= 1
+                elif found.kind == "else" and depth == 0 and kind == "if" and not past_else:
+                    return index
+
+    def _jump(self, block: Block, statement: Statement, keyword: str, destination: str) -> int:
+        """Where GOTOF, GOTOB, GOTO or GOTOC goes (a destination GOTOC does not find: on)."""
+        if self.open:
+            raise OutOfScope(f"{keyword} inside {self.open[-1].kind.upper()} (a jump in or out of a control "
+                             "structure)", statement.start + 1)  # fmt: skip
+        name = destination.upper()
+        found = None
+        if keyword != "GOTOB":
+            found = self._forward(name)
+        if found is None and keyword != "GOTOF":
+            found = self._backward(name)
+        if found is None:
+            if keyword == "GOTOC":
+                return self.pc + 1
+            held = (
+                "no longer held (ncpp holds the last blocks only)"
+                if self.base > 0 and keyword != "GOTOF"
+                else "not found"
+            )
+            raise OutOfScope(f"{keyword} {destination}, a jump destination {held}", statement.start + 1)
+        if found <= self.pc and self.last_run_move >= found:  # (a looped block runs FIXED)
+            raise OutOfScope(
+                f"{keyword} {destination}, a backward jump over moves compensated where they stand",
+                statement.start + 1,
+            )
+        return found
+
+    def _forward(self, name: str) -> int | None:
+        for index in range(self.pc + 1, self.pc + 1 + MAX_AHEAD):
+            block = self._block(index)
+            if block is None:
+                return None
+            if name in _destinations(block):
+                return index
+        return None
+
+    def _backward(self, name: str) -> int | None:
+        for index in range(self.pc, self.base - 1, -1):
+            if name in _destinations(self.buffer[index - self.base]):
+                return index
+        return None
+
+
+def _controls(block: Block) -> list[Statement]:
+    """The block's control statements; OutOfScope when more than its block number, labels
+    and comments stand beside them."""
+    found = [i for i in block.items if type(i) is Statement and i.kind in CONTROLS]
+    if found:
+        for item in block.items:
+            if not (item in found or type(item) is Comment or (type(item) is Word and item.letter in "N:")
+                    or (type(item) is Statement and item.kind == "label")):  # fmt: skip
+                raise OutOfScope(f"{found[0].kind.upper()} with more in its block", item.start + 1)
+    return found
+
+
+def _conditional_jump(block: Block, statement: Statement) -> bool:
+    """`IF condition GOTOx destination`: an IF that opens no structure."""
+    controls = _controls(block)
+    return statement.kind == "if" and len(controls) == 2 and controls[1].kind == "goto"
+
+
+def _destinations(block: Block) -> list[str]:
+    """The names a jump may reach the block by: its labels and its block number (`N100`, `100`)."""
+    names = []
+    for item in block.items:
+        if type(item) is Statement and item.kind == "label":
+            names.append(item.node[0].upper())
+        elif type(item) is Word and item.letter == "N":
+            names += [f"N{item.number}", item.number]
+    return names
+
+
+def _jumps(statement: Statement) -> list[tuple[str, str]]:
+    """The (keyword, destination) pairs of a GOTO or CASE statement."""
+    if statement.kind == "goto":
+        return [statement.node]
+    if statement.kind == "case":
+        _, branches, default = statement.node
+        return [(keyword, destination) for _, keyword, destination in branches] + (
+            [default] if default else []
+        )
+    return []
