@@ -415,11 +415,8 @@ class HeidenhainInterpreter(ModalInterpreter):
         text's order, belong to the line that runs it (a call, a jump back), written once."""
         flow = self.flow = KlartextFlow(self.file, blocks)
 
-        def stop(reason: str, block: Block | None) -> None:
-            self.done = True
-            if block is not None:
-                message = f"{reason} is outside the motion interpreter's scope; from this line on the program"
-                warnings.warn(f"{message} passes through uninterpreted", Location(self.file, block.line))
+        def stop(reason: str, owner: Block) -> None:  # (where the flow itself cannot go on)
+            self.leave_scope(warnings, reason, owner, None)
 
         for block, kind, owner in flow.steps(lambda: self.done, stop):
             if kind is SKIP or kind is TEXT or self.done or not block.items:
@@ -429,11 +426,7 @@ class HeidenhainInterpreter(ModalInterpreter):
             try:
                 events = self.block(block)
             except OutOfScope as out:
-                self.done = True
-                where = "this line" if owner is None else f"line {owner.line}, which runs it,"
-                warnings.warn(f"{out.reason} is outside the motion interpreter's scope; from {where} on the "
-                              "program passes through uninterpreted (its modal state is unknown)",
-                              Location(self.file, block.line, out.col))  # fmt: skip
+                self.leave_scope(warnings, out.reason, block, out.col, owner)
                 if owner is None:
                     yield Pass(block)
                 continue

@@ -200,7 +200,7 @@ class KlartextFlow:
         self.last_run_move = self.current
 
     # -- the order ----------------------------------------------------------------------
-    def steps(self, done: Callable[[], bool], stop: Callable[[str, Block | None], None]) -> Iterator[tuple]:
+    def steps(self, done: Callable[[], bool], stop: Callable[[str, Block], None]) -> Iterator[tuple]:
         """(block, kind, owner) in the order the blocks run; the rest as TEXT once `done()`."""
         pc = written = 0
         while True:
@@ -215,8 +215,9 @@ class KlartextFlow:
                     self._look_ahead(pc)
             block = self.block(pc)
             if block is None:
-                if self.frames:
-                    stop("a subprogram without LBL 0 before the end of the program", self.block(written - 1))
+                owner = self.block(written - 1)
+                if self.frames and owner is not None:
+                    stop("a subprogram without LBL 0 before the end of the program", owner)
                 break
             self.current, self.next = pc, None
             if in_place:
