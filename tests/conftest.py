@@ -100,7 +100,32 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_an_arc_of_more_turns_than_compensation_holds_is_refused_with_its_line",
             "test_simulate_refuses_motion_outside_the_travel_and_paths_past_its_sample_budget",
         ),
-        "benchmarks/test_harness.py": ("test_a_timed_run_in_a_fresh_process",),
+        "benchmarks/test_harness.py": (
+            "test_a_timed_run_in_a_fresh_process",
+            "test_programs_compensated_across_processes_are_timed_and_counted",
+        ),
+        # the fast tier's slowest (command-line runs of a second or more each)
+        "motion/test_fanuc_macro.py": ("test_memory_stays_flat_with_fanuc_loops",),
+        "compensation/test_work_offsets.py": ("test_command_line_var_file_and_work_offsets_say_the_same",),
+        "compensation/test_tool_lengths.py": ("test_command_line_tool_table",),
+        "compensation/test_placement.py": (
+            "test_fusion_g28_retract_is_left_to_the_control",
+            "test_the_impeller_compensates_on_a_machine_whose_xyz_are_axis_positions",
+            "test_moves_after_a_return_are_corrected_from_the_home_position",
+        ),
+        "verify/test_verifier.py": ("test_a_path_over_itself_too_often_is_refused_with_a_way_out",),
+        "shop/test_linuxcnc_filter.py": (
+            "test_the_parameter_file_places_the_program_as_linuxcnc_does",
+            "test_the_configuration_linuxcnc_runs_gives_its_parameter_file_and_tool_table",
+            "test_a_compensated_program_is_not_compensated_again",
+            "test_the_tool_table_gives_the_lengths_g43_applies",
+        ),
+        "shop/test_guard.py": (
+            "test_the_guard_is_written_only_where_the_offset_was_told_and_not_with_no_guard",
+        ),
+        "compensation/test_parsed_ahead.py": (
+            "test_runs_of_any_length_write_what_one_line_at_a_time_writes",
+        ),
         "program/test_layout_replay.py": ("test_replay_agrees_with_the_lalr_parser_on_corpus",),
         "program/test_roundtrip.py": (
             "test_corpus_program_roundtrips_byte_for_byte",
