@@ -9,7 +9,7 @@ missing program end (the short cncjs arc samples, G18/G19 among them) gets
 `M2` appended.  rs274 reads a tool table of tools 1-99 (0.01 across, in the
 stand-alone rs274's inches; length 0), so that programs changing tools or compensating the cutter radius
 are checked too (the wrapper's table has T1 alone: 8 programs more).  Each is
-placed in the HR5B's travel (the Valmet's when it is too large), every work
+placed in the HR5B's travel (the Valmet's when it is too large, wide.toml's beyond), every work
 system at one zero (mmount.ngc cuts in G55), and compensated at 1 µm with the
 HR5B's model, reversal included.
 """
@@ -24,10 +24,11 @@ from ncpp.machine import load_machine
 from ncpp.motion.offsets import SYSTEMS, WorkOffsets
 from ncpp.simulate import sample_events
 from tests.compensation.conftest import compensate, events_of, placement
-from tests.conftest import CORPUS, ROOT, RS274, corpus_files, corpus_id
+from tests.conftest import CORPUS, ROOT, RS274, SHARED, corpus_files, corpus_id
 
 LARGE = ("linuxcnc/3D_Chips.ngc", "linuxcnc/systems.ngc", "linuxcnc/spiral_tangent_test.ngc")
 MISSING_END = "File ended with no percent sign or program end"
+WIDE = SHARED / "machines" / "wide.toml"
 
 
 def programs() -> list:
@@ -53,7 +54,10 @@ def tools(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def machines():
-    return [load_machine(ROOT / f"samples/machines/{name}.toml") for name in ("hr5b", "valmet")]
+    """The HR5B, the Valmet when a program is too large for it, and the wide test machine
+    (`shared/machines/wide.toml`) for any larger still: no program is skipped for its size."""
+    found = [load_machine(ROOT / f"samples/machines/{name}.toml") for name in ("hr5b", "valmet")]
+    return found + ([load_machine(WIDE)] if WIDE.exists() else [])
 
 
 @pytest.mark.skipif(not RS274.exists(), reason="rs274 oracle not available")
@@ -73,7 +77,7 @@ def test_rs274_accepts_compensated_program(path, machines, tools, tmp_path):
         if offset is not None:
             break
     else:
-        pytest.skip("no motion, or too large for the sample machines' travel")
+        pytest.skip("no motion, or too large for every machine's travel")
     out = tmp_path / "compensated.ngc"
     machine = machine.replace(
         rotary_xyz_are_axis_positions=True
