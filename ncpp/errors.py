@@ -138,3 +138,12 @@ class Warnings:
                 file=self.stream,
             )
         self._hidden.clear()
+
+
+def resolve_warnings(warnings: Warnings | None, strict: bool) -> Warnings:
+    """The warnings to report through: strict when asked, whatever was passed."""
+    if warnings is None:
+        return Warnings(strict=strict)
+    if strict and not warnings.strict:
+        return Warnings(strict=True, stream=warnings.stream)
+    return warnings

@@ -41,9 +41,8 @@ from ncpp.motion.modal import (
     ModalInterpreter,
     OutOfScope,
     as_point,
-    run_placed,
+    placed_interpreting,
 )
-from ncpp.motion.offsets import WorkOffsets
 from ncpp.motion.segments import COMP, FLOW, MACHINE, PLANE_AXES, Arc, Event, Line, Pass, Point
 from ncpp.motion.tools import ToolTable, UntoldLengths
 from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
@@ -96,22 +95,6 @@ class Corner(Pass):
     size: float = 0.0
     feed: float | None = None  # `RND R5 F200`: the feed of the fillet only
     col: int | None = None
-
-
-def interpret(
-    blocks: Iterable[Block],
-    *,
-    file: str = "<stdin>",
-    warnings: Warnings | None = None,
-    strict: bool = False,
-    offsets: WorkOffsets | None = None,
-) -> Iterator[Event]:
-    """Motion events of a Heidenhain program's blocks, lazily (see the module docstring)."""
-    zero = (
-        offsets.program_zero() if offsets is not None else (0.0, 0.0, 0.0)
-    )  # one program zero: the system in effect
-    interpreter = HeidenhainInterpreter(file, zero, offsets.tools if offsets is not None else None)
-    return run_placed(interpreter, blocks, warnings, strict, offsets is None or offsets.tools is not None)
 
 
 def _in_flow(events: list[Event], owner: Block | None) -> list[Event]:
@@ -677,3 +660,6 @@ class HeidenhainInterpreter(ModalInterpreter):
             turns = int(full) + (1 if rest > 1e-9 or full == 0 else 0)
             turn *= turns
         return self.arc(block, end, centre, turn, self.pole_plane)
+
+
+interpret = placed_interpreting(HeidenhainInterpreter)

@@ -37,7 +37,7 @@ import re
 from collections.abc import Callable, Iterable, Iterator
 from typing import NoReturn, cast
 
-from ncpp.errors import Location, NcppError, Warnings
+from ncpp.errors import Location, NcppError, Warnings, resolve_warnings
 from ncpp.motion.corners import CornerError, round_corner
 from ncpp.motion.cycles import (
     CANNED,
@@ -215,11 +215,7 @@ def run(
     interpreter: Interpreter, blocks: Iterable[Block], warnings: Warnings | None, strict: bool
 ) -> Iterator[Event]:
     """The events of `interpreter` (LinuxCNC's, or a flavour's subclass) running `blocks`."""
-    if warnings is None:
-        warnings = Warnings(strict=strict)
-    elif strict and not warnings.strict:
-        warnings = Warnings(strict=True, stream=warnings.stream)
-    return interpreter.run(blocks, warnings)
+    return interpreter.run(blocks, resolve_warnings(warnings, strict))
 
 
 class Interpreter:

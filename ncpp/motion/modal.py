@@ -13,7 +13,8 @@ import math
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from typing import NoReturn
 
-from ncpp.errors import Location, NcppError, Warnings
+from ncpp.errors import Location, NcppError, Warnings, resolve_warnings
+from ncpp.motion.offsets import WorkOffsets
 from ncpp.motion.segments import PLANE_AXES, Arc, Context, Event, Line, Pass, Point, mark_off_path
 from ncpp.program.blocks import Block
 
@@ -33,29 +34,30 @@ class OutOfScope(Exception):
         self.col = col
 
 
-def resolve_warnings(warnings: Warnings | None, strict: bool) -> Warnings:
-    """The warnings to report through: strict when asked, whatever was passed."""
-    if warnings is None:
-        return Warnings(strict=strict)
-    if strict and not warnings.strict:
-        return Warnings(strict=True, stream=warnings.stream)
-    return warnings
+def placed_interpreting(dialect: type[ModalInterpreter]) -> Callable[..., Iterator[Event]]:
+    """The `interpret` function of a one-zero dialect (Klartext, Sinumerik): its interpreter
+    starts at the program zero in effect and warns where a tool length applies that nothing
+    tells, when the program is placed."""
 
+    def interpret(
+        blocks: Iterable[Block],
+        *,
+        file: str = "<stdin>",
+        warnings: Warnings | None = None,
+        strict: bool = False,
+        offsets: WorkOffsets | None = None,
+    ) -> Iterator[Event]:
+        """Motion events of a program's blocks, lazily (see the dialect module's docstring)."""
+        from ncpp.motion.tools import UntoldLengths
 
-def run_placed(
-    interpreter: ModalInterpreter,
-    blocks: Iterable[Block],
-    warnings: Warnings | None,
-    strict: bool,
-    tools_told: bool,
-) -> Iterator[Event]:
-    """Run a one-zero dialect's interpreter (Klartext, Sinumerik) over the blocks: it warns where a
-    tool length applies that nothing tells, when the program is placed (`tools_told` False)."""
-    from ncpp.motion.tools import UntoldLengths
+        zero = offsets.program_zero() if offsets is not None else (0.0, 0.0, 0.0)
+        interpreter = dialect(file, zero, offsets.tools if offsets is not None else None)  # type: ignore[call-arg]
+        warnings = resolve_warnings(warnings, strict)
+        told = offsets is None or offsets.tools is not None
+        interpreter.untold_lengths = UntoldLengths(not told, warnings)  # type: ignore[attr-defined]
+        return interpreter.run(blocks, warnings)
 
-    warnings = resolve_warnings(warnings, strict)
-    interpreter.untold_lengths = UntoldLengths(not tools_told, warnings)  # type: ignore[attr-defined]
-    return interpreter.run(blocks, warnings)
+    return interpret
 
 
 class ModalInterpreter:

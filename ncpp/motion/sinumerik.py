@@ -31,10 +31,9 @@ from ncpp.motion.modal import (
     ModalInterpreter,
     OutOfScope,
     circle_through,
+    placed_interpreting,
     plane_of,
-    run_placed,
 )
-from ncpp.motion.offsets import WorkOffsets
 from ncpp.motion.segments import FLOW, MACHINE, PLANE_AXES, Event, Pass
 from ncpp.motion.sinumerik_flow import SinumerikFlow
 from ncpp.motion.tools import ToolTable, UntoldLengths
@@ -78,22 +77,6 @@ END_M = frozenset((2.0, 17.0, 30.0))
 UNREAD_GEOMETRY = {"AR": "the opening angle", "AP": "the polar angle", "RP": "the polar radius"}
 # Frame instructions followed: translations; a bare substituting ROT / SCALE / MIRROR resets the frame.
 FRAMES = frozenset(("TRANS", "ATRANS", "ROT", "SCALE", "MIRROR"))
-
-
-def interpret(
-    blocks: Iterable[Block],
-    *,
-    file: str = "<stdin>",
-    warnings: Warnings | None = None,
-    strict: bool = False,
-    offsets: WorkOffsets | None = None,
-) -> Iterator[Event]:
-    """Motion events of a Sinumerik program's blocks, lazily (see the module docstring)."""
-    zero = (
-        offsets.program_zero() if offsets is not None else (0.0, 0.0, 0.0)
-    )  # one program zero: the system in effect
-    interpreter = SinumerikInterpreter(file, zero, offsets.tools if offsets is not None else None)
-    return run_placed(interpreter, blocks, warnings, strict, offsets is None or offsets.tools is not None)
 
 
 # The axis (X, Y, Z index) that lengths 1, 2 and 3 of a milling tool act along, per plane
@@ -482,3 +465,6 @@ def _tool_id(loaded: float | str) -> str:
 
 def _frame_name(code: float | None) -> str:
     return "the frame in effect at the start" if code is None else f"G{code:g}"
+
+
+interpret = placed_interpreting(SinumerikInterpreter)
