@@ -38,6 +38,9 @@ class FanucInterpreter(Interpreter):
     unfollowed: dict[tuple[str, float], str] = FANUC_UNFOLLOWED
 
     def block(self, block: Block) -> Event | tuple[Event, ...]:
+        signature = block.signature
+        if signature is not None and "G" not in signature and "M" not in signature:
+            return super().block(block)  # axis words only (the most): no setting, nothing unfollowed
         words = [item for item in block.items if type(item) is Word]
         for word in words:
             reason = self.unfollowed.get((word.letter, word.value))

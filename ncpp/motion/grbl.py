@@ -33,6 +33,9 @@ class GrblInterpreter(Interpreter):
     arc_normal_offset_ignored = True
 
     def block(self, block: Block) -> Event | tuple[Event, ...]:
+        signature = block.signature
+        if signature is not None and signature[:1] != "$":  # a plain block (the most): G code
+            return super().block(block)
         text = block.text.lstrip()
         if _REALTIME.match(text):
             return Pass(block)

@@ -28,6 +28,7 @@ writer can keep the program's pole where compensated arcs need their own.
 from __future__ import annotations
 
 import math
+import operator
 import re
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
@@ -68,6 +69,7 @@ HARMLESS_RESETS = frozenset((("PLANE", "RESET", "STAY"), ("FUNCTION", "RESET", "
 # Q20 = SQRT Q4`, `FN 6: Q20 = SIN-Q5` in degrees, `FN 8: Q10 = +5 LEN +4`).  The jumps
 # FN 9-12 are `heidenhain_flow`'s; FN 13 (ANG) stays out of scope.
 FN_ARITHMETIC = {0: "", 1: "+", 2: "-", 3: "*", 4: "DIV", 5: "SQRT", 6: "SIN", 7: "COS", 8: "LEN"}
+FN_BINARY = {1: operator.add, 2: operator.sub, 3: operator.mul, 4: operator.truediv, 8: math.hypot}
 _FN_OPERAND = r"([+-]?)[ \t]*(Q[LR]?\d+|\d+(?:[.,]\d*)?|[.,]\d+)"
 _FN_TARGET = re.compile(r"[ \t]*(Q[LR]?\d+)[ \t]*=[ \t]*(.*?)[ \t]*$", re.I)
 
@@ -566,7 +568,7 @@ class HeidenhainInterpreter(ModalInterpreter):
         a, b = values
         if number == 4 and b == 0:
             self.fail("FN 4: division by zero", block, item)
-        return {1: a + b, 2: a - b, 3: a * b, 8: math.hypot(a, b)}[number] if number != 4 else a / b
+        return FN_BINARY[number](a, b)
 
     def _preset(self, block: Block, item) -> None:
         """CYCL DEF 247: the first preset the program activates is the program zero ncpp was
