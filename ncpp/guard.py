@@ -35,7 +35,7 @@ does not know the control's parameters, and the guard neither moves nor acts.
 from __future__ import annotations
 
 import re
-from collections.abc import Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 from itertools import chain, islice
 
@@ -150,15 +150,30 @@ def _sinumerik(placement: Placement) -> list[str]:
     ]
 
 
+# Why a dialect's program gets no guard, as the warning says it
+UNGUARDED = {
+    "grbl": "grbl cannot test its work offset (it reads no parameters)",
+    "heidenhain": "Klartext reads the preset with FN 18 IDs that differ between TNC generations",
+}
+
+
 def with_guard(
-    lines: Iterable[str], placement: Placement, dialect: str, header: str, header_lines: int = 1
+    lines: Iterable[str],
+    placement: Placement,
+    dialect: str,
+    header: str,
+    header_lines: int = 1,
+    unguarded: Callable[[str], None] = lambda why: None,
 ) -> Iterator[str]:
     """The written program's lines with the guard after the header comment (`header_lines` lines,
-    the first holding `header`) and the program number that may follow it."""
+    the first holding `header`) and the program number that may follow it.  Where the dialect
+    (or the control's system) has no guard, `unguarded` is told why."""
     it = iter(lines)
     head = list(islice(it, 12))
     at = next((k + 1 for k, line in enumerate(head) if header in line), None)
     guard = guard_lines(placement, dialect, head)
+    if not guard:
+        unguarded(UNGUARDED.get(dialect, f"{dialect} has no settable frame for {placement.name}"))
     if at is None or not guard:
         yield from chain(head, it)
         return

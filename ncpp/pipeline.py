@@ -370,14 +370,11 @@ def process(
     compensated = summary.written(run_passes(summary.programmed(events), ctx, PASSES))
     header = header_text(source, tolerance, offsets, name)
     lines = with_header(writer.write(reached.follow(compensated)), header, writer)
-    if guard is not None and name == "grbl":
-        warnings.warn(
-            f"grbl cannot test its work offset (it reads no parameters): the program carries no "
-            f"placement guard; make sure the control has {guard.said()} before it runs",
-            Location(file, 1, None),
-        )
-    elif guard is not None:
-        lines = with_guard(lines, guard, name, HEADER_TAG, header.count("\n") + 1)
+    if guard is not None:
+        said = guard.said()
+        lines = with_guard(lines, guard, name, HEADER_TAG, header.count("\n") + 1,
+                           lambda why: warnings.warn(f"no placement guard: {why}; make sure the control has {said} "
+                                                     "before the program runs", Location(file, 1, None)))  # fmt: skip
     if verify:
         from ncpp.verify import Bound, verified
 
