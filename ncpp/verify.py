@@ -614,14 +614,19 @@ class _Comparison:
             raise NcppError(f"verification: {message}: it has no move here", Location(file, line, 1))
         within = self.bound.within
         (starts, ends), (a, b) = _alike((path.starts, path.ends), (along.starts, along.ends))
+        # (a path that runs again, a loop's, looks each segment up once: a lookup tree of many
+        # equal points looks at all of them)
+        mine, theirs = _first_of_each(starts, ends), _first_of_each(a, b)
+        a, b = a[theirs], b[theirs]
         try:
-            far = _Nearby(a, b, self.bound).first_outside(starts, ends, within)
+            far = _Nearby(a, b, self.bound).first_outside(starts[mine], ends[mine], within)
         except NcppError as err:
             raise NcppError(err.message, Location(file, int(path.lines[0]), 1)) from None
         if far is None:
             return
-        k, point = far
+        k, point = int(mine[far[0]]), far[1]
         gap, near = _Nearby(a[:, :-1], b[:, :-1], self.bound).nearest(point[:-1])  # (kinds aside)
+        near = int(theirs[near])
         line = int(along.lines[near]) if written and not self.tagged else int(path.lines[k])
         if gap > within:
             message = f"{message} by more than {within:.4f} mm"
@@ -715,6 +720,18 @@ def _joined(section: Section, other: Section | None) -> Section:
 
 
 Segments = tuple[np.ndarray, np.ndarray]
+
+
+def _first_of_each(starts: np.ndarray, ends: np.ndarray) -> np.ndarray:
+    """The indices of the segments not equal to one before them, in order.  (Equal segments are
+    found next to one another when sorted by a mix of their coordinates, which equal ones share.)"""
+    rows = np.hstack((starts, ends))
+    key = rows @ np.linspace(1.0, 1.0 + 1 / np.e, rows.shape[1])
+    order = np.argsort(key, kind="stable")
+    ordered = rows[order]
+    new = np.ones(len(rows), dtype=bool)
+    new[1:] = np.any(ordered[1:] != ordered[:-1], axis=1)
+    return np.sort(order[new])
 
 
 def _alike(one: Segments, other: Segments) -> tuple[Segments, Segments]:

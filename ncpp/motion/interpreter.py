@@ -407,9 +407,11 @@ class Interpreter:
                 if owner is None and not _expanding(ev):  # (a cycle there stays one: as programmed)
                     out.append(ev)
                 continue
-            if ev.fixed == HOLE:  # type: ignore[union-attr]  # (a move: `type(ev) is Pass` above)
-                # each run may need a correction of its own: the cycle is left as programmed
-                ev.fixed, ev.hole = CYCLE, None  # type: ignore[union-attr]
+            if ev.fixed in (HOLE, CYCLE):  # type: ignore[union-attr]  # (a move: `type(ev) is Pass` above)
+                # each run may need a correction of its own: the cycle is left as programmed; in a
+                # body written in place it starts from where each run stands (a step to its
+                # programmed start written there would run every time): a loop's move
+                ev.fixed, ev.hole = (CYCLE if owner is not None else FLOW), None  # type: ignore[union-attr]
             ev.fixed = ev.fixed or FLOW  # type: ignore[union-attr]
             if owner is not None:
                 ev.block = owner

@@ -168,3 +168,32 @@ def test_a_path_over_itself_too_often_is_refused_with_a_way_out(tmp_path, capsys
         and "verification: the path lies over itself too often" in err
         and "--no-verify" in err
     )
+
+
+LOOP = """G21 G90 G17
+G0 X0 Y0 Z5
+G1 Z-1 F200
+o100 repeat [5000]
+G1 X50 Y0
+G1 X50 Y{y}
+G1 X0 Y0
+o100 endrepeat
+M2
+"""
+
+
+def test_a_loop_is_verified_run_by_run():
+    """Five thousand runs of one body: each distinct segment is looked up once, and a body
+    that leaves the path is refused all the same."""
+    assert check(LOOP.format(y=20), LOOP.format(y=20.04)) >= 1
+    assert "verification" in str(refused(LOOP.format(y=20), LOOP.format(y=20.2)))
+
+
+def test_equal_segments_are_looked_up_once():
+    import numpy as np
+
+    from ncpp.verify import _first_of_each
+
+    starts = np.array([[0.0, 0, 0], [1, 0, 0], [0, 0, 0], [2, 0, 0], [1, 0, 0]])
+    ends = np.array([[1.0, 0, 0], [2, 0, 0], [1, 0, 0], [3, 0, 0], [2, 0, 0]])
+    assert _first_of_each(starts, ends).tolist() == [0, 1, 3]

@@ -49,6 +49,17 @@ G81 X-25 Y10 R-2 Z-6 F100 L4
 G80
 M2
 """
+# a cycle in a loop body after a compensated move: each run starts where the last left the
+# tool (a step to the programmed start written in the body would run every time)
+IN_A_LOOP = """G21 G90 G17
+G0 X40 Y30 Z5
+o100 repeat [3]
+G83 X120 Y90 Z-6 R2 Q2 F100
+G80
+G0 X140
+o100 endrepeat
+M2
+"""
 
 
 def polar():
@@ -58,12 +69,13 @@ def polar():
     return path.read_text()
 
 
-@pytest.mark.parametrize("name", ["polar.ngc", "G91 cycle", "all in G91"])
+PROGRAMS = {"G91 cycle": CARTESIAN, "all in G91": ALL_G91, "in a loop": IN_A_LOOP}
+
+
+@pytest.mark.parametrize("name", ["polar.ngc", *PROGRAMS])
 def test_cycle_holes_where_the_program_puts_them(tmp_path, name):
     original = tmp_path / "original.ngc"
-    original.write_text(
-        polar() if name == "polar.ngc" else {"G91 cycle": CARTESIAN, "all in G91": ALL_G91}[name]
-    )
+    original.write_text(polar() if name == "polar.ngc" else PROGRAMS[name])
     output = compensate_file(original, MACHINE, tmp_path)
     before = holes_um(original, original, machine)
     after = holes_um(output, original, machine)
