@@ -614,17 +614,17 @@ class _Comparison:
             raise NcppError(f"verification: {message}: it has no move here", Location(file, line, 1))
         within = self.bound.within
         (starts, ends), (a, b) = _alike((path.starts, path.ends), (along.starts, along.ends))
-        # (a path that runs again, a loop's, looks each segment up once: a lookup tree of many
-        # equal points looks at all of them)
-        mine, theirs = _first_of_each(starts, ends), _first_of_each(a, b)
+        # (a path that runs again, a loop's, is looked up by each segment once: a lookup tree of
+        # many equal points looks at all of them)
+        theirs = _first_of_each(a, b)
         a, b = a[theirs], b[theirs]
         try:
-            far = _Nearby(a, b, self.bound).first_outside(starts[mine], ends[mine], within)
+            far = _Nearby(a, b, self.bound).first_outside(starts, ends, within)
         except NcppError as err:
             raise NcppError(err.message, Location(file, int(path.lines[0]), 1)) from None
         if far is None:
             return
-        k, point = int(mine[far[0]]), far[1]
+        k, point = far
         gap, near = _Nearby(a[:, :-1], b[:, :-1], self.bound).nearest(point[:-1])  # (kinds aside)
         near = int(theirs[near])
         line = int(along.lines[near]) if written and not self.tagged else int(path.lines[k])
