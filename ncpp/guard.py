@@ -41,6 +41,7 @@ from itertools import chain, islice
 
 from ncpp.motion.offsets import WorkOffsets
 from ncpp.program.blocks import Block, Comment
+from ncpp.program.parser import LEADER_LINES
 
 GUARD_MM = 0.1  # how far an axis's zero may be from the one told: re-touching a fixture moves it microns
 BEGIN = "ncpp placement guard:"
@@ -168,17 +169,29 @@ def with_guard(
     """The written program's lines with the guard after the header comment (`header_lines` lines,
     the first holding `header`) and the program number that may follow it.  Where the dialect
     (or the control's system) has no guard, `unguarded` is told why."""
+    # (lines are taken from `lines` no further than the guard's place: the verifier tags each
+    # line with how far the writer had read when it was taken)
     it = iter(lines)
-    head = list(islice(it, 12))
-    at = next((k + 1 for k, line in enumerate(head) if header in line), None)
+    head: list[str] = []
+    for line in it:  # (a Fanuc tape leader may stand above the header)
+        head.append(line)
+        if header in line or len(head) >= LEADER_LINES + 12:
+            break
+    at = None
+    if head and header in head[-1]:
+        head.extend(islice(it, header_lines - 1))
+        at = len(head)
+        for line in it:  # a Fanuc program's number comes first
+            head.append(line)
+            if not _FANUC_PROGRAM_NUMBER.match(line):
+                break
     guard = guard_lines(placement, dialect, head)
     if not guard:
         unguarded(UNGUARDED.get(dialect, f"{dialect} has no settable frame for {placement.name}"))
     if at is None or not guard:
         yield from chain(head, it)
         return
-    at = min(at + header_lines - 1, len(head))
-    while at < len(head) and _FANUC_PROGRAM_NUMBER.match(head[at]):  # a Fanuc program's number comes first
+    while at < len(head) and _FANUC_PROGRAM_NUMBER.match(head[at]):
         at += 1
     eol = "\r\n" if head[at - 1].endswith("\r\n") else "\n"
     yield from head[:at]

@@ -30,6 +30,7 @@ from ncpp.passes.inverse import iterations_for
 from ncpp.program.blocks import Block, Comment, Statement, Word
 from ncpp.program.dialects import FAMILY, dialect_tools, get_dialect, parse_program
 from ncpp.program.dialects.iso import IsoWriter
+from ncpp.program.parser import LEADER_LINES
 from ncpp.runtime import keep_freed_memory
 from ncpp.summary import Summary
 
@@ -265,24 +266,26 @@ def _reported(
         yield block
 
 
-def with_header(lines: Iterable[str], header: str, writer: IsoWriter) -> Iterator[str]:
+def with_header(lines: Iterable[str], header: str, writer: IsoWriter, leader: bool = False) -> Iterator[str]:
     """Put the header comment first (a comment line per line of it), after a leading `%`
-    tape mark line (or where the dialect's writer puts it: Heidenhain after `BEGIN PGM`)."""
+    tape mark line, or the first `%` below a tape leader the dialect's controls skip
+    (`leader`), or where the dialect's writer puts it (Heidenhain after `BEGIN PGM`)."""
     own = getattr(writer, "with_header", None)
     if own is not None:
         yield from own(lines, header)
         return
     it = iter(lines)
-    first = next(it, None)
-    eol = "\r\n" if first is not None and first.endswith("\r\n") else "\n"
+    head: list[str] = []
+    for line in it:  # (no further than the `%`: the verifier tags lines by how far the writer had read)
+        head.append(line)
+        if line.lstrip(" \t").startswith("%") or len(head) >= (LEADER_LINES if leader else 1):
+            break
+    eol = "\r\n" if head and head[0].endswith("\r\n") else "\n"
     comments = [writer.comment(line) + eol for line in header.split("\n")]
-    if first is not None and first.lstrip().startswith("%"):
-        yield first
-        yield from comments
-    else:
-        yield from comments
-        if first is not None:
-            yield first
+    at = len(head) if head and head[-1].lstrip(" \t").startswith("%") else 0
+    yield from head[:at]
+    yield from comments
+    yield from head[at:]
     yield from it
 
 
@@ -369,7 +372,7 @@ def process(
     reached = _Reached()
     compensated = summary.written(run_passes(summary.programmed(events), ctx, PASSES))
     header = header_text(source, tolerance, offsets, name)
-    lines = with_header(writer.write(reached.follow(compensated)), header, writer)
+    lines = with_header(writer.write(reached.follow(compensated)), header, writer, get_dialect(name).leader)
     if guard is not None:
         said = guard.said()
         lines = with_guard(lines, guard, name, HEADER_TAG, header.count("\n") + 1,

@@ -19,6 +19,7 @@ import math
 import re
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, replace
+from itertools import chain, islice
 from pathlib import Path
 from typing import Any
 
@@ -204,6 +205,8 @@ class Dialect:
     the next line (Heidenhain `~`).  `max_line`: the longest block the dialect's
     controls read (`max_line_source` says whose rule it is); a longer one is refused
     before it is scanned, which keeps the time and memory of a line bounded.
+    `leader`: text before the program start `%` (within the first `LEADER_LINES` lines) is a
+    tape leader the control skips, as Fanuc's do.
     `read_where_run`: a line the grammar cannot read is an error where it runs, not where it stands (rs274ngc reads only the
     lines it runs: an uncalled subroutine, an untaken branch, the text after M2
     may hold anything): it becomes a block of one `unreadable` statement.
@@ -217,6 +220,7 @@ class Dialect:
     read_where_run: bool = False
     max_line: int = 256
     max_line_source: str = "rs274ngc (LinuxCNC) holds a line in LINELEN, 256 characters"
+    leader: bool = False  # lines before a first `%` line are a tape leader, not read (`_leader`)
 
 
 def dialect_syntax(dialect: str | Dialect) -> Dialect:
@@ -816,7 +820,13 @@ def parse_stream(
         yield from _parse_continued(parser, iter_lines(stream), file)
         return
     tape_marks = 0
-    for number, (content, eol) in enumerate(iter_lines(stream), start=1):
+    lines: Iterable[tuple[str, str]] = iter_lines(stream)
+    skipped: list[tuple[str, str]] = []
+    if parser.dialect.leader:
+        skipped, lines = _leader(lines)
+        for number, (content, eol) in enumerate(skipped, start=1):
+            yield Block(content, eol, (), number, verbatim=True)
+    for number, (content, eol) in enumerate(lines, start=len(skipped) + 1):
         if tape_marks >= 2:
             yield Block(content, eol, (), number, verbatim=True)
             continue
@@ -828,6 +838,22 @@ def parse_stream(
         elif tape_marks == 0 and block.items:
             tape_marks = -(10**9)  # material before any `%`: the program has no tape marks
         yield block
+
+
+LEADER_LINES = 64  # how far down a program's start `%` is looked for, below a tape leader
+_TAPE_MARK = re.compile(r"[ \t]*%")
+
+
+def _leader(lines: Iterable[tuple[str, str]]) -> tuple[list[tuple[str, str]], Iterator[tuple[str, str]]]:
+    """(the tape leader, the lines from the program start on).  A Fanuc control reads a file
+    from its first `%`: "data between the first % and the next LF is skipped" (Series 16i/18i
+    operator's manual B-63524EN, memory card file format), and the leader before the program
+    start is not read (the Data Server manual B-64014EN, NC program format).  Simulators'
+    example files put their own directives there (`($Message("...") )`)."""
+    lines = iter(lines)
+    head = list(islice(lines, LEADER_LINES))
+    start = next((k for k, (content, _) in enumerate(head) if _TAPE_MARK.match(content)), 0)
+    return head[:start], chain(head[start:], lines)
 
 
 def _stray_tape_mark(block: Block) -> Block:

@@ -80,3 +80,37 @@ def test_a_haas_program_gets_the_fanuc_guard(tmp_path):
                            str(program)], capture_output=True, text=True, cwd=ROOT)  # fmt: skip
     assert proc.returncode == 0, proc.stderr
     assert "IF [#4014 NE 54] THEN #3000=1" in proc.stdout and "\nG187 P1 E0.01\n" in proc.stdout
+
+
+# A simulator's example file: its own directives stand above the program's start `%`
+LEADER = """($Message("Load the machine settings file first.") )
+($SetPartSize(4, 4, 1, 1) )
+
+ %
+ O123 ( SAMPLE )
+ G21 G40 G54 G80 G90
+ G0 X10 Y10 Z5
+ G1 Z-1 F100
+ X50
+ M30
+%
+"""
+
+
+def test_a_tape_leader_above_the_start_is_not_read():
+    """Fanuc 16i/18i operator's manual (B-63524EN), memory card file format: a file is read from
+    its first `%`; text above it is a leader the control skips."""
+    found = events(LEADER, "fanuc")
+    assert [type(e) for e in found if type(e) is Line] == [Line] * 3
+    assert detect(LEADER.encode()) == "fanuc"
+
+
+def test_the_header_and_guard_go_below_the_start_not_into_the_leader(tmp_path):
+    program = tmp_path / "p.nc"
+    program.write_text(LEADER)
+    proc = subprocess.run([sys.executable, "-m", "ncpp", "--machine", str(READING), "--work-offset", "10,20,30",
+                           str(program)], capture_output=True, text=True, cwd=ROOT)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    leader, program_part = proc.stdout.split(" %\n", 1)
+    assert leader == LEADER.split(" %\n")[0]  # the leader as it was
+    assert program_part.startswith("(ncpp compensated for") and "IF [#4014 NE 54] THEN #3000=1" in program_part
