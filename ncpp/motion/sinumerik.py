@@ -20,6 +20,7 @@ they are marked `fixed` (`ModalInterpreter.radius_compensation`).
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Iterable, Iterator
 from typing import cast
@@ -84,6 +85,10 @@ LENGTH_AXES = {17: (2, 1, 0), 18: (1, 0, 2), 19: (0, 2, 1)}
 TOOL_CHANGE = 6.0  # M6 loads the tool T selected, with its cutting edge D1 unless the block says another
 
 
+_FROM_THE_CALLER = "(the caller's value)"  # a PROC parameter's value: not told
+MAX_ELEMENTS = 65_536  # the elements of an array this interpreter holds (each is a variable)
+
+
 class SinumerikInterpreter(ModalInterpreter):
     def __init__(
         self,
@@ -101,6 +106,8 @@ class SinumerikInterpreter(ModalInterpreter):
         self.absolute = True
         self.variables: dict[str, float | str] = {}
         self.integers: set[str] = set()  # DEF INT variables round on assignment
+        self.arrays: dict[str, tuple[int, ...]] = {}  # DEF arrays' sizes (their elements are variables)
+        self.started = False  # a block has run (a PROC opens the program or is out of scope)
         # A frame's offset is traversed with the axis's next incremental move (MD 42440
         # FRAME_OFFSET_INCR_PROG = 1): IC(d) after TRANS goes d from the old program position.
         self.frame_shift = [0.0, 0.0, 0.0]
@@ -143,8 +150,19 @@ class SinumerikInterpreter(ModalInterpreter):
             yield from events or (Pass(block),)
 
     # -- variables --------------------------------------------------------------------
+    def _procedure(self, node: tuple, block: Block, item) -> None:
+        """`PROC NAME(params)` opening the program: the program runs as the procedure, whose
+        parameters take the caller's values, which ncpp is not told: reading one ends
+        interpretation; its other blocks are followed.  A PROC anywhere else is out of scope."""
+        if self.started:
+            raise OutOfScope("PROC below the program's first block", item.start + 1)
+        for _type, name, _by_reference, _dims in node[1]:
+            self.variables[name] = _FROM_THE_CALLER
+
     def lookup(self, name: str) -> float:
         value = self.variables.get(name)
+        if value is _FROM_THE_CALLER:
+            raise OutOfScope(f"the parameter {name.upper()} (its value comes from the caller)")
         if value is None:
             if name[0] == "r" and name[1:].isdigit():
                 return 0.0  # R parameters exist on every control, zero until set
@@ -154,6 +172,9 @@ class SinumerikInterpreter(ModalInterpreter):
         return value
 
     def assign(self, target: tuple, expr: tuple, block: Block, item) -> None:
+        if target[0] == "index":
+            self._assign_elements(target, expr, block, item)
+            return
         if target[0] != "param" or target[1].startswith("$"):
             raise OutOfScope(f"the assignment to {target[1].upper()}", item.start + 1)
         name = target[1]
@@ -167,14 +188,89 @@ class SinumerikInterpreter(ModalInterpreter):
         type_name, _, variables = node
         for target, init in variables:
             name = target[1]
-            if target[0] != "param":
-                raise OutOfScope(f"the array {name.upper()}", item.start + 1)
             if type_name == "INT":
                 self.integers.add(name)
-            if init is None:
+            if target[0] == "index":
+                self._define_array(type_name, target, init, block, item)
+            elif init is None:
                 self.variables[name] = "" if type_name == "STRING" else 0.0
             else:
                 self.assign(target, init, block, item)
+
+    # -- arrays (Job Planning manual, "Definition and initialization of array variables (DEF,
+    # SET, REP)": indices from 0, up to three dimensions, the elements in row order, SET(a, b, ...)
+    # assigning from the element named on, REP(v) every element from it to the end, REP(v, n) n) --
+    def _define_array(self, type_name: str, target: tuple, init: tuple | None, block: Block, item) -> None:
+        if type_name not in ("REAL", "INT", "BOOL"):
+            raise OutOfScope(f"the {type_name} array {target[1].upper()}", item.start + 1)
+        sizes = tuple(int(self.value(size, block, item)) for size in target[2])
+        if len(sizes) > 3 or min(sizes) < 1:
+            self.fail(f"the array {target[1].upper()} cannot have the sizes {list(sizes)}", block, item)
+        if math.prod(sizes) > MAX_ELEMENTS:
+            raise OutOfScope(
+                f"the array {target[1].upper()} of over {MAX_ELEMENTS:,} elements", item.start + 1
+            )
+        name = target[1]
+        self.arrays[name] = sizes
+        self.variables.update((key, 0.0) for key in _element_keys(name, sizes))
+        if init is not None:
+            self._assign_elements(("index", name, (("num", 0.0),) * len(sizes)), init, block, item)
+
+    def _assign_elements(self, target: tuple, expr: tuple, block: Block, item) -> None:
+        name = target[1]
+        keys = _element_keys(name, self.arrays.get(name, ()))
+        if not keys:
+            raise OutOfScope(f"the array {name.upper()} (not defined in the program)", item.start + 1)
+        first = keys.index(self._element(target, block, item))
+        values: list[float | None]
+        if expr[0] == "call" and expr[1] in ("SET", "REP"):
+            # (an empty place in SET leaves its element as it is; REP(v, n) fills n elements)
+            args = [None if arg is None else self.value(arg, block, item) for arg in expr[2:]]
+            if expr[1] == "SET":
+                values = args
+            elif len(args) in (1, 2) and args[0] is not None:
+                count = len(keys) - first if len(args) == 1 or args[1] is None else int(args[1])
+                values = [args[0]] * count
+            else:
+                self.fail("REP takes a value and, perhaps, how many elements it fills", block, item)
+            if first + len(values) > len(keys):
+                self.fail(f"{expr[1]} gives {name.upper()} more values than it holds from here", block, item)
+        else:
+            values = [self.value(expr, block, item)]
+        integer = name in self.integers
+        for key, value in zip(keys[first:], values):
+            if value is not None:
+                self.variables[key] = float(round(value)) if integer else value
+
+    def _element(self, target: tuple, block: Block, item) -> str:
+        """The variable key of an array element `("index", name, (exprs))`, its indices checked."""
+        name = target[1]
+        sizes = self.arrays.get(name)
+        if self.variables.get(name) is _FROM_THE_CALLER:
+            raise OutOfScope(
+                f"the parameter {name.upper()} (its value comes from the caller)", item.start + 1
+            )
+        if sizes is None:
+            raise OutOfScope(f"the array {name.upper()} (not defined in the program)", item.start + 1)
+        index = tuple(int(round(self.value(i, block, item))) for i in target[2])
+        if len(index) != len(sizes) or any(not 0 <= i < n for i, n in zip(index, sizes)):
+            self.fail(
+                f"the index {list(index)} is outside the array {name.upper()}{list(sizes)}", block, item
+            )
+        return _element_key(name, index)
+
+    def value(self, expr: tuple, block: Block, item) -> float:
+        return super().value(self._elements_named(expr, block, item), block, item)
+
+    def _elements_named(self, expr: tuple, block: Block, item) -> tuple:
+        """`expr` with each array element read as the variable that holds it."""
+        if expr[0] == "index":
+            return ("param", self._element(expr, block, item))
+        if expr[0] in ("num", "str", "param"):
+            return expr
+        return tuple(
+            self._elements_named(part, block, item) if type(part) is tuple else part for part in expr
+        )
 
     # -- one block ------------------------------------------------------------------------
     def block(self, block: Block) -> list[Event]:
@@ -197,6 +293,8 @@ class SinumerikInterpreter(ModalInterpreter):
                     self.assign(target, expr, block, item)
                 elif what == "def":
                     self.define(item.node, block, item)
+                elif what == "proc":
+                    self._procedure(item.node, block, item)
                 elif what == "path" and item.node[0] in ("CIP", "CT"):
                     path = item.node[0]
                 elif what == "frame" and item.node[0] in FRAMES:
@@ -251,6 +349,7 @@ class SinumerikInterpreter(ModalInterpreter):
                 if letter in words:
                     self.fail(f"the address {letter} twice in one block", block, item)
                 words[letter] = (value, mode, item)
+        self.started = self.started or previous is not None  # (comments do not start the program)
         plane = self.plane
         codes = {code for code, _ in gcodes}
         turn = True if codes & {41.0, 42.0} else False if 40.0 in codes else None  # cutter compensation
@@ -468,3 +567,14 @@ def _frame_name(code: float | None) -> str:
 
 
 interpret = placed_interpreting(SinumerikInterpreter)
+
+
+def _element_key(name: str, index: tuple[int, ...]) -> str:
+    return f"{name}[{','.join(map(str, index))}]"
+
+
+def _element_keys(name: str, sizes: tuple[int, ...]) -> list[str]:
+    """An array's element keys in row order (the order SET and REP fill them)."""
+    if not sizes:
+        return []
+    return [_element_key(name, index) for index in itertools.product(*(range(n) for n in sizes))]

@@ -29,7 +29,6 @@ PRELUDE = "defaults.mpf"
 
 OUT_OF_SCOPE = {
     "actual_position.mpf": "UNTIL on $AA_IW[Z] (the system variable of an axis position)",
-    "arrays.mpf": "DEF of arrays",
     "axis_index_assignment.mpf": "ACC[E] array-style machine data",
     "edge_cases.mpf": "the rotary axes A B C",
     "flattening__flatten_demo.mpf": "BSPLINE spline interpolation",

@@ -37,6 +37,8 @@ case-insensitive and kept lower case.
 from __future__ import annotations
 
 import re
+from collections.abc import Iterable, Iterator
+from itertools import islice
 
 from lark import Token, Transformer, v_args
 
@@ -229,6 +231,11 @@ _ARC_ONLY = ("CR", "TURN", "I1", "J1", "K1")
 _MOTION_PATHS = ("CIP", "CT")
 
 
+# A program's opening lines the header goes below: its name `%_N_PART_MPF`, a PROC definition
+_NAME_LINE = re.compile(r"[ \t]*%")
+_PROC = re.compile(r"[ \t]*(N\d+[ \t]*)?PROC\b", re.IGNORECASE)
+
+
 class SinumerikWriter(IsoWriter):
     """ISO writer with Sinumerik spelling: `;` comments, `X=..` for words written as
     expressions, `CR=` arcs when the program wrote `CR=`, and `CIP` / `CT` blocks
@@ -236,6 +243,21 @@ class SinumerikWriter(IsoWriter):
     blocks that rely on it)."""
 
     comment_open, comment_close = "; ", ""
+
+    def with_header(self, lines: Iterable[str], header: str) -> Iterator[str]:
+        """The header's comment lines first, after a `%_N_..` name line and after a `PROC`
+        definition that opens the program: the Job Planning manual has the PROC statement
+        as the subprogram's first block."""
+        it = iter(lines)
+        head = list(islice(it, 2))
+        at = 1 if head and _NAME_LINE.match(head[0]) else 0
+        if at < len(head) and _PROC.match(head[at]):
+            at += 1
+        eol = "\r\n" if head and head[0].endswith("\r\n") else "\n"
+        yield from head[:at]
+        yield from (self.comment(line) + eol for line in header.split("\n"))
+        yield from head[at:]
+        yield from it
 
     @staticmethod
     def _path(block: Block) -> str | None:
