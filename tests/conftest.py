@@ -210,11 +210,12 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
 
 
 def corpus_files(*folders: str) -> list[Path]:
-    """Program files under the given corpus folders, sorted, oracles excluded."""
+    """Program files under the given corpus folders, sorted, oracles and hidden files (a tool's
+    `.tool.mmap` left by an rs274 run there) excluded."""
     found: list[Path] = []
     for folder in folders:
         for path in sorted((CORPUS / folder).rglob("*")):
-            if path.is_file() and not any(path.name.endswith(s) or s in path.name for s in NOT_PROGRAMS):
+            if path.is_file() and not path.name.startswith(".") and not any(path.name.endswith(s) or s in path.name for s in NOT_PROGRAMS):
                 found.append(path)
     return found
 
