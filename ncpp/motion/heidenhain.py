@@ -17,7 +17,7 @@ Radius compensation RL/RR is followed to R0: the moves from the first with RL/RR
 to the R0 block's are the programmed contour, the tool centre off it by the radius,
 and are marked `fixed` (`ModalInterpreter.radius_compensation`).  Paraxial R+/R-,
 RND/CHF next to an arc or a rapid, FK free contours,
-APPR/DEP, `CALL PGM`, `CYCL CALL`, M99, FN 13 and later FN functions and cycles
+APPR/DEP, `CALL PGM`, `CYCL CALL`, M99, FN 14 and later FN functions and cycles
 that move the datum make the position unknown: one warning (an error with
 `strict`) and the rest passes through.
 
@@ -64,12 +64,14 @@ HARMLESS_KEYWORDS = frozenset(("STOP",))
 HARMLESS_RESETS = frozenset((("PLANE", "RESET", "STAY"), ("FUNCTION", "RESET", "TCPM")))
 
 
-# FN 0-8: Q parameter arithmetic (TNC 640 Klartext manual, "Basic arithmetic" and "Angle
+# FN 0-8 and 13: Q parameter arithmetic (TNC 640 Klartext manual, "Basic arithmetic" and "Angle
 # functions": `FN 0: Q5 = +10`, `FN 1: Q1 = -Q2 + -5`, `FN 4: Q25 = +Q1 DIV +Q7`, `FN 5:
-# Q20 = SQRT Q4`, `FN 6: Q20 = SIN-Q5` in degrees, `FN 8: Q10 = +5 LEN +4`).  The jumps
-# FN 9-12 are `heidenhain_flow`'s; FN 13 (ANG) stays out of scope.
-FN_ARITHMETIC = {0: "", 1: "+", 2: "-", 3: "*", 4: "DIV", 5: "SQRT", 6: "SIN", 7: "COS", 8: "LEN"}
-FN_BINARY = {1: operator.add, 2: operator.sub, 3: operator.mul, 4: operator.truediv, 8: math.hypot}
+# Q20 = SQRT Q4`, `FN 6: Q20 = SIN-Q5` in degrees, `FN 8: Q10 = +5 LEN +4`, `FN 13: Q20 =
+# +25 ANG-Q1`, the angle whose opposite and adjacent sides (or sine and cosine) the two are,
+# 0 to 360 degrees).  The jumps FN 9-12 are `heidenhain_flow`'s.
+FN_ARITHMETIC = {0: "", 1: "+", 2: "-", 3: "*", 4: "DIV", 5: "SQRT", 6: "SIN", 7: "COS", 8: "LEN", 13: "ANG"}
+FN_BINARY = {1: operator.add, 2: operator.sub, 3: operator.mul, 4: operator.truediv, 8: math.hypot,
+             13: lambda a, b: math.degrees(math.atan2(a, b)) % 360.0}  # fmt: skip
 _FN_OPERAND = r"([+-]?)[ \t]*(Q[LR]?\d+|\d+(?:[.,]\d*)?|[.,]\d+)"
 _FN_TARGET = re.compile(r"[ \t]*(Q[LR]?\d+)[ \t]*=[ \t]*(.*?)[ \t]*$", re.I)
 
@@ -526,7 +528,7 @@ class HeidenhainInterpreter(ModalInterpreter):
         return move
 
     def _fn(self, block: Block, item) -> None:
-        """FN 0-8: a Q parameter set to one operand, an operation of two, or a function of one."""
+        """FN 0-8, 13: a Q parameter set to one operand, an operation of two, or a function of one."""
         number, text = item.node
         operation = FN_ARITHMETIC[number]
         found = _FN_TARGET.fullmatch(text)

@@ -36,6 +36,9 @@ def end_of(assignments: str, axis: str = "X") -> float:
         ("1 FN 0: Q5 = +30\n2 FN 6: Q9 = SIN+Q5", 0.5),
         ("1 FN 7: Q9 = COS-60", 0.5),
         ("1 FN 8: Q9 = +5 LEN +4", 41**0.5),
+        ("1 FN 13: Q9 = +25 ANG +50", 26.565051177),  # the manual's example: arctan 0.5
+        ("1 FN 0: Q1 = -1\n2 FN 13: Q9 = +0 ANG +Q1", 180.0),
+        ("1 FN 13: Q9 = -1 ANG +0", 270.0),  # (0 to 360 degrees)
     ],
 )
 def test_fn_arithmetic_as_the_manual_gives_it(blocks, value):
