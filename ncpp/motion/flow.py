@@ -19,8 +19,8 @@ so that every block's text is written once, where it stands.  Control lines
 that run out of the text's order yield nothing.
 
 Fanuc subprograms run the same way: `M98 P<n> [L<repeats>]` calls the
-program `O<n>` of the file, which ends with `M99` (#1-#30 are the caller's,
-as in LinuxCNC; the other scoping is a call's).
+program `O<n>` of the file, or of a file `O<n>` (`O<n>.nc`) on the subroutine path, which
+ends with `M99` (#1-#30 are the caller's, as in LinuxCNC; the other scoping is a call's).
 
 Fanuc macro B runs here too (the Fanuc operator's manuals, Series 16i/18i B-63684EN and 0i,
 "Custom macro": "Branch and repetition", "Macro call"):
@@ -167,6 +167,7 @@ class Flow:
             tuple(path),
         )
         self.files: dict[str, str] = {}  # subroutine name -> the file it was read from
+        self.program_files: dict[str, str] = {}  # Fanuc program number -> the file it was read from
         self.buffer: list[Block] = []  # main-program blocks read and still wanted, from line `base`
         self.base = 0
         self.read = 0  # main-program blocks read from the stream
@@ -537,6 +538,33 @@ class Flow:
 
         return call
 
+    def _source_of(self, body: list[Block]) -> str | None:
+        """The file a Fanuc program's lines were read from (None: the program's own)."""
+        return next((self.program_files[n] for n, lines in self.subprograms.items()
+                     if lines is body and n in self.program_files), None)  # fmt: skip
+
+    def _program_from_file(self, name: str) -> list[Block] | None:
+        """Fanuc program `O<name>`, `O<name>` to its first M99, from the first folder of the path
+        with a file named for it (`_program_files`): a Fanuc control keeps each program under
+        its number, and a file on a PC holds one so (the file must say `O<name>` itself)."""
+        for folder in self.path:
+            path = next((p for p in _program_files(folder, name) if p.is_file()), None)
+            if path is None:
+                continue
+            lines: list[Block] = []
+            with open(path, "rb") as stream:
+                for block in parse_stream(stream, str(path), "fanuc"):
+                    if lines or program_number(block) == name:
+                        lines.append(block)
+                        control = control_of(block)
+                        if control is not None and control.keyword == "m99":
+                            self.subprograms[name], self.program_files[name] = lines, str(path)
+                            return lines
+                    if len(lines) > MAX_SUBPROGRAM:
+                        break
+            raise NcppError(f"O{name} ... M99 is not in the file", Location(str(path), 1, 1))
+        return None
+
     def _from_file(self, name: str) -> list[Block] | None:
         """Subroutine `name` from `name.ngc` in the first folder of the path that has it (as LinuxCNC)."""
         for folder in self.path:
@@ -569,13 +597,11 @@ class Flow:
             str(int(round_half_away(number))),
             1 if repeats is None else int(round_half_away(repeats)),
         )
-        body = self._defined(self.subprograms, name)
+        body = self._defined(self.subprograms, name) or self._program_from_file(name)
         if body is None:
-            self.stop(
-                f"M98 P{name}: a subprogram the program does not define (O{name} to M99)",
-                block,
-                control.item.start + 1,
-            )
+            where = f", nor is it in {os.pathsep.join(map(str, self.path))}" if self.path else ""
+            self.stop(f"M98 P{name}: a subprogram the program does not define (O{name} to M99){where}",
+                      block, control.item.start + 1)  # fmt: skip
             return lambda: None
 
         self._check_level(block, control)
@@ -584,7 +610,7 @@ class Flow:
             frame.pc += 1
             self.parameters.enter(None)
             if runs > 0:
-                self.frames.append(_Frame(body, 1, repeats=runs - 1))
+                self.frames.append(_Frame(body, 1, repeats=runs - 1, source=self._source_of(body)))
             else:  # L0: rs274ngc runs nothing but stays a call level deeper: the caller's names, loops and ifs are gone
                 frame.labels.clear()
                 frame.ifs.clear()
@@ -631,7 +657,7 @@ class Flow:
         def call():
             frame.pc += 1
             self.parameters.enter_macro(values)
-            self.frames.append(_Frame(body, 1, repeats=runs - 1, macro=True))
+            self.frames.append(_Frame(body, 1, repeats=runs - 1, macro=True, source=self._source_of(body)))
 
         return call
 
@@ -675,7 +701,8 @@ class Flow:
             raise NcppError(f"Too many subroutine levels: calls nest at most {MAX_CALL_LEVELS - 1} deep",
                             Location(self.file, block.line, None))  # fmt: skip
         self.parameters.enter_macro(modal.values)
-        self.frames.append(_Frame(modal.body, 1, repeats=modal.runs - 1, macro=True, modal=True))
+        self.frames.append(_Frame(modal.body, 1, repeats=modal.runs - 1, macro=True, modal=True,
+                                  source=self._source_of(modal.body)))  # fmt: skip
 
     def _macro(self, block: Block, control: Control) -> tuple[list[Block], int, dict[int, float]] | None:
         """The body, runs and arguments of a G65 or G66 line (None: the program lacks the macro)."""
@@ -690,7 +717,7 @@ class Flow:
             for item in arguments
             if type(item) is Word or not vacant(item.expr, self.parameters)  # (a vacant one: not given)
         }
-        body = self._defined(self.subprograms, name)
+        body = self._defined(self.subprograms, name) or self._program_from_file(name)
         if body is None:
             what = control.keyword.upper()
             self.stop(f"{what} P{name}: a macro the program does not define (O{name} to M99)", block,
@@ -1238,6 +1265,13 @@ def _subroutine_file(folder: Path, name: str) -> Path | None:
     path = os.path.normpath(f"{folder}/{name}.ngc")
     inside = os.path.normpath(folder)
     return Path(path) if path.startswith(inside.rstrip(os.sep) + os.sep) else None
+
+
+def _program_files(folder: Path, name: str) -> list[Path]:
+    """The files Fanuc program `name` may be kept in: `O1234`, `O1234.nc` (and `.NC`, `.txt`),
+    the number also as written (`O12` besides `O0012`)."""
+    stems = dict.fromkeys((f"O{int(name):04d}", f"O{name}"))
+    return [Path(folder) / f"{stem}{suffix}" for stem in stems for suffix in ("", ".nc", ".NC", ".txt")]
 
 
 def _shown(name: str) -> str:

@@ -113,4 +113,6 @@ def test_the_header_and_guard_go_below_the_start_not_into_the_leader(tmp_path):
     assert proc.returncode == 0, proc.stderr
     leader, program_part = proc.stdout.split(" %\n", 1)
     assert leader == LEADER.split(" %\n")[0]  # the leader as it was
-    assert program_part.startswith("(ncpp compensated for") and "IF [#4014 NE 54] THEN #3000=1" in program_part
+    assert (
+        program_part.startswith("(ncpp compensated for") and "IF [#4014 NE 54] THEN #3000=1" in program_part
+    )

@@ -441,3 +441,38 @@ def _written(text: str) -> list:
             blocks.append(event.block)
             last = event.block
     return blocks
+
+
+def test_m98_runs_a_program_kept_in_a_file_of_the_subroutine_path(tmp_path):
+    """A Fanuc control keeps each program under its number; on a PC a file `O9010.nc` holds
+    it.  The twin defines the same lines as an o-word subroutine in its own file."""
+    from ncpp.motion.offsets import WorkOffsets
+
+    folder = tmp_path / "programs"
+    folder.mkdir()
+    (folder / "O9010.nc").write_text("%\nO9010 (PIERCE)\nG0 Z1\nG1 Z-0.5 F50\nG0 Z1\nM99\n%\n")
+    program = write_program(tmp_path, "O1000\n" + HEAD + "G0 X10 Y10\nM98 P9010\nG1 X50\nM98 P9010 L2\nG0 X0\nM30\n",
+                            "main.nc")  # fmt: skip
+    twin = write_program(tmp_path, "o9010 sub\nG0 Z1\nG1 Z-0.5 F50\nG0 Z1\no9010 endsub\n" + HEAD
+                         + "G0 X10 Y10\no9010 call\nG1 X50\no9010 call\no9010 call\nG0 X0\nM2\n", "twin.ngc")  # fmt: skip
+    reference = read_canon(rs274(str(twin))[0])
+    mine, error, warning = ours(program, offsets=WorkOffsets.given({}, subroutine_path=[folder]))
+    assert error is None and not warning, (error, warning)
+    assert len(mine) == len(reference) and same_calls(reference, mine), (reference, mine)
+    # without the path, or without the file there, the call is out of scope and said so
+    _, error, warning = ours(program, offsets=WorkOffsets.given({}, subroutine_path=[tmp_path]))
+    assert (
+        f"M98 P9010: a subprogram the program does not define (O9010 to M99), nor is it in {tmp_path}"
+        in warning
+    )
+
+
+def test_a_program_file_without_its_number_is_an_error_at_the_file(tmp_path):
+    from ncpp.motion.offsets import WorkOffsets
+
+    (tmp_path / "O0012.nc").write_text("%\nO0013\nG0 Z1\nM99\n%\n")
+    program = write_program(tmp_path, "O1000\n" + HEAD + "M98 P12\nM30\n", "main.nc")
+    _, error, _ = ours(program, offsets=WorkOffsets.given({}, subroutine_path=[tmp_path]))
+    assert (
+        error is not None and "O12 ... M99 is not in the file" in str(error) and "O0012.nc:1:1" in str(error)
+    )
