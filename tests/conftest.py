@@ -215,7 +215,11 @@ def corpus_files(*folders: str) -> list[Path]:
     found: list[Path] = []
     for folder in folders:
         for path in sorted((CORPUS / folder).rglob("*")):
-            if path.is_file() and not path.name.startswith(".") and not any(path.name.endswith(s) or s in path.name for s in NOT_PROGRAMS):
+            if (
+                path.is_file()
+                and not path.name.startswith(".")
+                and not any(path.name.endswith(s) or s in path.name for s in NOT_PROGRAMS)
+            ):
                 found.append(path)
     return found
 

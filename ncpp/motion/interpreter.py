@@ -1399,10 +1399,12 @@ class Interpreter:
         rapid_delta = RAPID_DELTA_INCH if self.inch else RAPID_DELTA_INCH * MM_PER_INCH
         polar = not self.absolute and ("@" in words or "^" in words)
         bottoms = []  # the moves at a hole's bottom (a dwell follows them: `expanded`)
+        holes: list[tuple[int, float, float]] = []  # (its first move, X, Y) of each repeat's hole
         for _ in range(repeats):
             aa, bb = aa + step_a, bb + step_b
             if polar:
                 aa, bb = self._polar_step(block, words, aa, bb)
+            holes.append((len(moves) if holes else 0, aa, bb))
             moves.append((aa, bb, level, True))
             if level != r:
                 moves.append((aa, bb, r, True))
@@ -1416,17 +1418,18 @@ class Interpreter:
         if self.expand_cycles:
             self.cycle_holes = False
             return self._expanded(block, motion, lines, bottoms)
-        # a hole apply_error_map compensates: one hole in G17 and G90 (polar words written as X Y), the
-        # series' holes all such
+        # holes apply_error_map compensates: in G17 (polar words written as X Y, repeats as a block
+        # each), the series' holes all such
         self.cycle_holes = (previous not in CANNED or self.cycle_holes) and (
-            self.plane == 17 and self.absolute and repeats == 1 and motion != 87.0
+            self.plane == 17 and motion != 87.0
         )
         if self.cycle_holes:
-            drilled = Hole(
-                motion, aa, bb, bottom, r, peck, rapid_delta, self.retract_to_r, previous not in CANNED
-            )
-            for line in lines:
-                line.fixed, line.hole = HOLE, drilled
+            ends = [k for k, _, _ in holes[1:]] + [len(lines)]
+            for n, ((k, x, y), end) in enumerate(zip(holes, ends)):
+                drilled = Hole(motion, x, y, bottom, r, peck, rapid_delta, self.retract_to_r,
+                               previous not in CANNED and n == 0, n, len(holes))  # fmt: skip
+                for line in lines[k:end]:
+                    line.fixed, line.hole = HOLE, drilled
         return lines
 
     def _cycle_geometry(self, block: Block, words: dict, again: bool, item) -> tuple[float, ...]:

@@ -86,9 +86,10 @@ class Context:
 
 @dataclass(frozen=True, slots=True)
 class Hole:
-    """One hole of a G17 canned cycle in G90 (`fixed` HOLE): what the control drills it from,
-    program units.  apply_error_map writes its moves again from the corrected words
-    (`command`), as the control will run them (`cycles.drilled`)."""
+    """One hole of a G17 canned cycle (`fixed` HOLE): what the control drills it from, program
+    units, absolute.  apply_error_map writes its moves again from the corrected words
+    (`command`), as the control will run them (`cycles.drilled`); the writer writes each hole
+    of a block's repeats (L) as a block of its own."""
 
     motion: float  # the cycle's G code (81.0, 83.0, ...)
     x: float
@@ -99,7 +100,12 @@ class Hole:
     rapid_delta: float  # how far above the last peck G73 G83 rapid back in
     retract_to_r: bool  # G99 (True) or G98
     series_start: bool  # the first cycle of a series: G98 retracts to the Z it starts from
-    command: tuple[float, float, float, float] | None = None  # the X Y Z R written (None: as programmed)
+    repeat: int = 0  # which of its block's repeats (L) it is, from 0
+    repeats: int = 1  # how many the block has
+    # with its correction: the X Y Z R written, absolute (None: as programmed), and the Z its
+    # series starts from as written (in G91 R counts from there)
+    command: tuple[float, float, float, float] | None = None
+    series_level: float = 0.0
 
 
 # Events are not frozen: a pipeline makes several per output line, and a frozen

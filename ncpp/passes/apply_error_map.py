@@ -41,7 +41,7 @@ from ncpp.passes.geometry import (
     tuples,
 )
 from ncpp.passes.travel import Travel, grid, hold, quantize, steps
-from ncpp.program.blocks import Block, Word
+from ncpp.program.blocks import Word
 
 # Compensations per line at most: each changes a direction only where a
 # correction of the previous round flipped a µm motion; two rounds settle almost all.
@@ -89,24 +89,24 @@ def _drilled(chunks: Iterable[list[Event]], holes: _Holes, solve: Solve) -> Iter
         if not any(type(e) is Line and e.fixed == HOLE for e in chunk):
             yield chunk
             continue
-        for piece, block in _at_holes(chunk):
-            yield piece if block is None else holes.drilled(piece, solve.travel.held)
+        for piece, drilled in _at_holes(chunk):
+            yield piece if drilled is None else holes.drilled(piece, solve.travel.held)
 
 
-def _at_holes(chunk: list[Event]) -> Iterator[tuple[list[Event], Block | None]]:
-    """The chunk cut before and after the moves of each compensated cycle block, with that
-    block (None: a piece of other events)."""
+def _at_holes(chunk: list[Event]) -> Iterator[tuple[list[Event], Hole | None]]:
+    """The chunk cut before and after the moves of each compensated hole, with that hole
+    (None: a piece of other events)."""
     piece: list[Event] = []
-    block = None
+    drilled = None
     for event in chunk:
-        here = event.block if type(event) is Line and event.fixed == HOLE else None
-        if here is not block and piece:
-            yield piece, block
+        here = event.hole if type(event) is Line and event.fixed == HOLE else None
+        if here is not drilled and piece:
+            yield piece, drilled
             piece = []
-        block = here
+        drilled = here
         piece.append(event)
     if piece:
-        yield piece, block
+        yield piece, drilled
 
 
 class _Holes:
@@ -116,7 +116,7 @@ class _Holes:
 
     def __init__(self, ctx: PassContext):
         self.ctx = ctx
-        self.block: Block | None = None  # the last block written again (its moves may span two chunks)
+        self.hole: Hole | None = None  # the last hole written again (its moves may span two chunks)
         self.start_level = 0.0  # Z where the G98 series under way started, as the control stands there
         self.last: Line | None = None  # the last segment written, with its compensated end (`_chunks` tells)
 
@@ -126,14 +126,16 @@ class _Holes:
         last = self.last
         first = moves[0]
         assert type(first) is Line and first.hole is not None  # (`_at_holes`)
-        if first.block is self.block:  # the rest of a block cut by a chunk's end: written already
+        if first.hole is self.hole:  # the rest of a hole cut by a chunk's end: written already
             return []
-        self.block, hole = first.block, first.hole
+        self.hole = hole = first.hole
         at = first.start if last is None else _end_in_frame_of(last, first)
         if hole.series_start:
             self.start_level = at[2]
         (x, y, z), (_, _, r) = self._commands(moves, hole, at, held).tolist()
-        corrected = replace(hole, command=(x, y, z, r))
+        if not first.context.absolute:
+            x, y, z, r = self._incremental(first, at, (x, y, z, r))
+        corrected = replace(hole, command=(x, y, z, r), series_level=self.start_level)
         out: list[Event] = []
         start = tuple(at)
         # (not `changed`: that marks the pieces replace_arcs made, which the solve moves; the writer
@@ -145,6 +147,20 @@ class _Holes:
             out.append(replace(first, start=start, end=end[:3], rapid=end[3], hole=corrected))
             start = end[:3]
         return out
+
+    def _incremental(self, first: Line, at: tuple, command: tuple) -> tuple[float, float, float, float]:
+        """The command of a hole in G91 on the output's grid as the control adds it up: X Y from
+        where it stands, R from the series' start level, the bottom from R (rs274ngc's G91 cycle),
+        each a whole number of the last digit written, so that the roundings do not add up
+        along a row of holes."""
+        step = float(grid(self.ctx, frames([first, first])[1][:1])[0])
+
+        def on_grid(value: float, base: float) -> float:
+            return base + round((value - base) / step) * step
+
+        x, y, z, r = command
+        r = on_grid(r, self.start_level)
+        return on_grid(x, at[0]), on_grid(y, at[1]), on_grid(z, r), r
 
     def _commands(self, moves: list[Event], hole: Hole, at: tuple, held: NDArray) -> NDArray:
         """(2,3) the commands for the hole's bottom and its R point (one X Y for both: the bottom's),

@@ -253,13 +253,10 @@ M2
 """
 
 
-def test_in_g91_the_moves_after_a_canned_cycle_are_compensated(machine):
-    """As after a subroutine: the cycles run from the compensated point before them (in G91
-    all their levels are relative to it), and the moves after them, in G91 and then in G90,
-    are compensated."""
-    from ncpp.motion.segments import CYCLE
-
-    before, after = residual_after(machine, G91_CYCLE, CYCLE)
+def test_in_g91_canned_cycles_and_the_moves_after_them_are_compensated(machine):
+    """G91 cycles with repeats are compensated hole by hole (a block per repeat, its words
+    from where the control stands), and the moves after them, in G91 and then in G90, too."""
+    before, after = before_after(machine, G91_CYCLE, 0.001)
     assert before.max_um > 20.0 and after.max_um <= 1.5, f"{after.max_um:.2f} µm at line {after.worst_line}"
 
 

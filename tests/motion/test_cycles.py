@@ -176,16 +176,20 @@ def test_random_cycle_programs_agree_with_rs274(tmp_path):
     assert compared >= 10  # enough programs stay in scope to mean something
 
 
-@pytest.mark.parametrize("cycle, why", [("G81 X1 Y1 Z-3 R2", HOLE), ("G81 X1 Y1 Z-3 R2 L1", HOLE),
-                                        ("G81 X1 Y1 Z-3 R2 L2", CYCLE), ("G91 G81 X1 Y1 Z-3 R-2", CYCLE),
-                                        ("G81 @1 ^45 Z-3 R2", HOLE), ("G18 G81 X1 Z1 Y-3 R2", CYCLE)])  # fmt: skip
-def test_cycle_moves_are_fixed(cycle, why):
-    """A hole in G17 and G90 is compensated as a whole (HOLE); repeats, G91 and the other planes
-    leave the cycle as programmed (CYCLE)."""
-    events = list(interpret(parse_stream(io.BytesIO((HEAD + cycle + "\nG80\nG1 X5\n").encode()), "t.ngc")))
+@pytest.mark.parametrize("cycle, why, holes", [("G81 X1 Y1 Z-3 R2", HOLE, 1), ("G81 X1 Y1 Z-3 R2 L1", HOLE, 1),
+                                               ("G81 X1 Y1 Z-3 R2 L2", HOLE, 2), ("G91 G81 X1 Y1 Z-3 R-2 L3", HOLE, 3),
+                                               ("G81 @1 ^45 Z-3 R2", HOLE, 1), ("G18 G81 X1 Z1 Y-3 R2", CYCLE, 0),
+                                               ("G87 X1 Y1 Z-3 R2 I1 J0 K-1", CYCLE, 0)])  # fmt: skip
+def test_cycle_moves_are_fixed(cycle, why, holes):
+    """A hole in G17 is compensated as a whole (HOLE), each of a block's repeats its own; the
+    other planes and G87 leave the cycle as programmed (CYCLE)."""
+    text = HEAD + "M3 S1000\n" + cycle + "\nG80\nG1 X5\n"
+    events = list(interpret(parse_stream(io.BytesIO(text.encode()), "t.ngc")))
     lines = [e for e in events if type(e) is Line]
     assert lines[0].fixed == lines[-1].fixed == "" and {e.fixed for e in lines[1:-1]} == {why}
     assert all((e.hole is not None) == (why == HOLE) for e in lines[1:-1])
+    assert len({id(e.hole) for e in lines[1:-1] if e.hole is not None}) == holes
+    assert [e.hole.repeat for e in lines[1:-1] if e.hole is not None][-1:] == ([holes - 1] if holes else [])
 
 
 def _compensate(text: str, strict: bool = False) -> tuple[str, str]:
@@ -194,14 +198,14 @@ def _compensate(text: str, strict: bool = False) -> tuple[str, str]:
 
 DRILL = (
     HEAD
-    + "G1 Z-1\nX40 Y12\nG0 Z5\nG98 G81 X20 Y20 Z-3 R2 L2\nX30\n(between)\nX40 Y25\nG80\nG0 X50 Y50\nG1 Z-1\nX70 Y40\nG3 X80 Y60 R15\nG0 Z10\nM2\n"
+    + "G1 Z-1\nX40 Y12\nG0 Z5\nG18 G98 G81 X20 Z20 Y-3 R2 L2\nX30\n(between)\nX40 Z25\nG80 G17\nG0 X50 Y50\nG1 Z-1\nX70 Y40\nG3 X80 Y60 R15\nG0 Z10\nM2\n"
 )
 
 
 def test_cycles_pass_through_and_compensation_resumes():
     out, warned = _compensate(DRILL)
     lines = out.splitlines()
-    cycle = ["G98 G81 X20 Y20 Z-3 R2 L2", "X30", "(between)", "X40 Y25", "G80"]
+    cycle = ["G18 G98 G81 X20 Z20 Y-3 R2 L2", "X30", "(between)", "X40 Z25", "G80 G17"]
     start = lines.index(cycle[0])
     assert lines[start : start + len(cycle)] == cycle  # verbatim
     # one warning, naming the line where the series starts
@@ -215,12 +219,12 @@ def test_a_warning_repeated_hundreds_of_times_is_printed_five_times_then_counted
     """A drilling program warns at each of its 300 cycle series: five are printed (the fifth
     says the rest are counted), then one line at the end tells how many and where."""
     holes = "".join(
-        f"G0 X{k % 20 * 5} Y{k // 20 * 5}\nG81 X{k % 20 * 5 + 1} Y{k // 20 * 5} Z-3 R2 F100 L2\nG80\nG1 X{k % 20 * 5 + 2}\n"
+        f"G0 X{k % 20 * 5} Y{k // 20 * 5}\nG19 G81 Y{k // 20 * 5} Z-3 X-3 R2 F100 L2\nG80 G17\nG1 X{k % 20 * 5 + 2}\n"
         for k in range(300)
     )
     out, warned = _compensate(HEAD + holes + "M2\n")
     said = warned.splitlines()
-    series = [n + 1 for n, line in enumerate((HEAD + holes).splitlines()) if line.startswith("G81")]
+    series = [n + 1 for n, line in enumerate((HEAD + holes).splitlines()) if line.startswith("G19 G81")]
     assert [line.split(": warning: ")[0] for line in said] == [
         f"drill.ngc:{n}:1" for n in (*series[:5], series[-1])
     ]
@@ -284,7 +288,7 @@ def test_compensation_goes_on_after_a_g91_cycle(after):
     """A G91 cycle runs its increments from where the control stands, its G98 retract to the
     level it started from: apply_error_map carries it (test_exact_model measures the moves
     after it on the machine), and compensates the moves after it, in G90 or G91."""
-    text = HEAD + "G1 Z-1\nX40 Y12\nG0 Z5\nG91 G98 G81 X10 Y10 Z-3 R-3 L2\n" + after
+    text = HEAD + "G1 Z-1\nX40 Y12\nG0 Z5\nG18 G91 G98 G81 X10 Z10 Y-3 R-3 L2\nG17\n" + after
     out, warned = _compensate(text)
     assert (
         "in G91" not in warned
@@ -297,7 +301,7 @@ def test_compensation_goes_on_after_a_g91_cycle(after):
         written[-1] != original[-1]
         and 0 < abs(float(last[1]) - float(original[-1].split("X")[1].split()[0])) < 0.1
     )
-    assert "G91 G98 G81 X10 Y10 Z-3 R-3 L2" in written
+    assert "G18 G91 G98 G81 X10 Z10 Y-3 R-3 L2" in written
 
 
 @pytest.mark.skipif(not RS274.exists(), reason="no rs274")

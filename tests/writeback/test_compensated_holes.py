@@ -113,6 +113,25 @@ M2
 """
 
 
+# Cycles in G91 with repeats (L): a block per hole is written, X Y from where the control
+# stands, R from the series' start level (Z25 for the G83 too: no G80 between), Z from R
+# (rs274ngc's convert_cycle in G91)
+HOLES_G91 = [(132, 117, -7, 3), (152, 122, -7, 3), (172, 127, -7, 3), (162, 157, 18, 24), (152, 187, 18, 24),
+             (-128, -107, -1, 2.5), (-108, -107, -1, 2.5)]  # fmt: skip
+PROGRAM_G91 = """G21 G90 G17
+G0 X110 Y110 Z25
+G1 X112 Y112 F300
+G0 Z25
+G91 G99 G81 X20 Y5 R-22 Z-10 L3 F100
+G98 G83 X-10 Y30 R-1 Z-6 Q2 L2
+G90 G80
+G0 X-148 Y-107 Z4
+G91 G99 G82 X20 R-1.5 Z-3.5 P0.2 L2
+G90 G80
+M2
+"""
+
+
 def drilled(path: Path, machine: Machine | None) -> list[tuple[np.ndarray, float]]:
     """Per hole of `path` as rs274 runs it (mapped through `machine`, or as commanded: None): where
     the tool is at its bottom, and its Z where it arrives above the hole at R.  A hole: a run
@@ -141,15 +160,18 @@ def _plunges(start: np.ndarray, end: np.ndarray) -> bool:
 
 @pytest.mark.parametrize("machine_toml, machine", [(MACHINE, square), (REVERSAL, reversing)],
                          ids=["scales and squareness", "reversals"])  # fmt: skip
-def test_each_hole_bottom_and_r_plane_land_where_programmed(tmp_path, machine_toml, machine):
+@pytest.mark.parametrize(
+    "program, holes", [(PROGRAM, HOLES), (PROGRAM_G91, HOLES_G91)], ids=["G90", "G91 repeats"]
+)
+def test_each_hole_bottom_and_r_plane_land_where_programmed(tmp_path, machine_toml, machine, program, holes):
     original = tmp_path / "holes.ngc"
-    original.write_text(PROGRAM)
+    original.write_text(program)
     output = compensate_file(original, machine_toml, tmp_path)
-    wanted = np.array(HOLES, dtype=float)
+    wanted = np.array(holes, dtype=float)
     assert np.allclose([tuple(b) + (r,) for b, r in drilled(original, None)], wanted, atol=1e-6)
     before = drilled(original, machine)
     after = drilled(output, machine)
-    assert len(after) == len(HOLES)
+    assert len(after) == len(holes)
     off_before = np.array([np.linalg.norm(b - h[:3]) for (b, _), h in zip(before, wanted)]) * 1000
     off_after = np.array([np.linalg.norm(b - h[:3]) for (b, _), h in zip(after, wanted)]) * 1000
     r_after = np.array([abs(r - h[3]) for (_, r), h in zip(after, wanted)]) * 1000

@@ -169,8 +169,10 @@ class IsoWriter:
             self._learn_program_motion(block, motion)
             if self._needs_mode_restore(block):
                 lines.append(self._restore_mode_line(block))
-            text = self._hole_text(block, motion[0]) if drilled else block.text  # type: ignore[arg-type]
-            lines.append(text)
+            if drilled:
+                lines += self._hole_texts(block, motion)  # type: ignore[arg-type]
+            else:
+                lines.append(block.text)
             self._after_verbatim(block, motion)
             return lines
         if not facts.plain:
@@ -393,17 +395,37 @@ class IsoWriter:
         self.program_motion = None
         return lines
 
-    def _hole_text(self, block: Block, move: Line) -> str:
+    def _hole_texts(self, block: Block, moves: list[Line]) -> list[str]:
         """A compensated canned cycle's block with its corrected X Y Z R, each written: every hole
         has a correction of its own, so none may be left to the previous block's sticky value.  Polar
-        words (`@` `^`) give way to the X Y they put the hole at."""
+        words (`@` `^`) give way to the X Y they put the hole at.  A block of repeats (L) is written
+        a block per hole: the first without its L, the others X Y Z R alone, which continue the
+        cycle (rs274ngc's convert_cycle: the same motion again keeps the series)."""
+        firsts = [m for k, m in enumerate(moves) if k == 0 or m.hole is not moves[k - 1].hole]
+        spelled = self._spelling(block)
+        words = [self._hole_words(move) for move in firsts]
+        drop = "@^L" if firsts[0].hole.repeats > 1 else "@^"  # type: ignore[union-attr]
+        lines = [set_words(_literal_geometry(block, GEOMETRY_LETTERS + drop), words[0], drop=drop,
+                           spelled=spelled) + block.eol]  # fmt: skip
+        separator, lower = spelled
+        for texts in words[1:]:
+            text = separator.join(f"{letter}{number}" for letter, number in texts.items())
+            lines.append((text.lower() if lower else text) + block.eol)
+        return lines
+
+    def _hole_words(self, move: Line) -> dict[str, str]:
+        """The X Y Z R a hole is written with (letter -> number text): its corrected command, in
+        G91 as rs274ngc reads a cycle there: X Y from where the control stands, R from the Z the
+        series started at, the bottom from R."""
         assert move.hole is not None and move.hole.command is not None  # (apply_error_map's)
-        texts = {
+        x, y, z, r = move.hole.command
+        if not move.context.absolute:
+            sx, sy, _ = move.start
+            x, y, z, r = x - sx, y - sy, z - r, r - move.hole.series_level
+        return {
             letter: format_number(value, self._style(letter, move))
-            for letter, value in zip("XYZR", move.hole.command)
+            for letter, value in zip("XYZR", (x, y, z, r))
         }
-        return set_words(_literal_geometry(block, GEOMETRY_LETTERS + "@^"), texts, drop="@^",
-                         spelled=self._spelling(block)) + block.eol  # fmt: skip
 
     # -- o-word control lines ---------------------------------------------------
     def _write_control(self, block: Block, first: Event) -> list[str]:
