@@ -1,0 +1,217 @@
+"""`--expand`: an ISO program's loops and subroutines written out as straight code.
+
+The flow (`flow.py`) runs the bodies of loops and subroutines block by block, out of the text's
+order; without --expand their moves are left as programmed (FLOW).  With it every block a body
+runs is written where it runs, as a block of its own for that run: its expressions written as
+the numbers they have there (`literal`), so the moves are plain moves that compensation
+corrects like any other, and its other words (M codes, tools, dwells, spindle) act once per run,
+in the order they run.  The control lines (`o100 call`, `while`, `endwhile`, `if`, `M98`, `M99`,
+`WHILE`, `END`, `GOTO` ...) and the text that does not run (subroutine definitions, untaken
+branches) are left out; the text after the program's end stays as it is.
+
+A body's parameter assignments are not written: its blocks read no parameter once written as
+numbers.  The lines of the main program that are written as they are may read them, so before
+the first of those after an expanded stretch the parameters whose values the stretch changed
+are set to the values they have there (`settled`): the program's own parameters, as its main
+level sees them.  LinuxCNC's `#<_value>` and `#<_value_returned>` are read-only: a main-program
+line that reads one is written with numbers too.
+
+A construct outside the interpreter's scope after something was expanded is refused (the rest
+could not pass through as it is: its loops and calls have lost their lines), and so is a
+program whose loops and subroutines make more than MAX_EXPANDED blocks.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from ncpp.errors import Location, NcppError
+from ncpp.motion.expressions import Parameters, evaluate, normalise_name, vacant
+from ncpp.motion.flow import RUN, SKIP, TEXT
+from ncpp.motion.segments import Event, Pass
+from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
+
+# Blocks that loops and subroutines may be written out in at most: each is a line of the output
+# (or a few, for an arc written in pieces); past it the program is refused, not written for hours
+MAX_EXPANDED = 1_000_000
+# Letters whose values are whole numbers where they are (codes, tools, numbers, counts): written
+# without a decimal point; every other letter's number has one (a Fanuc `X10` is 10 µm, not mm)
+WHOLE_LETTERS = frozenset("GMTNOHDLPS")
+# Parameters a program may not set (LinuxCNC: read-only), what the last subroutine returned
+RETURNED = frozenset(("_value", "_value_returned"))
+FANUC_STOP = 3006  # Fanuc's stop-with-message variable: its assignment is an action, kept
+
+
+class Expansion:
+    """What --expand does to one run of a program (the interpreter asks it at each block)."""
+
+    def __init__(self, params: Parameters, file: str):
+        self.params = params
+        self.file = file
+        self.started = False  # something was expanded or left out: the rest cannot pass through as text
+        self.expanded = 0  # blocks written out of loops and subroutines
+        self.settled = True  # the written program's parameters are the program's (at the main level)
+        # The written program's parameters where they were last the same: numbered, named, vacant
+        self.written: tuple[dict, dict, frozenset] | None = None
+
+    def leaves_out(self, kind: str, done: bool) -> bool:
+        """Whether a line the flow does not run here is left out: text that does not run (SKIP) and
+        a control line (TEXT before the program's end); the text after the end is kept."""
+        if kind is SKIP or (kind is TEXT and not done):
+            self._begin()
+            self.started, self.settled = True, False
+            return True
+        return False
+
+    def event(self, run: Callable[[Block], Event | tuple[Event, ...]], block: Block, kind: str
+              ) -> tuple[Event | tuple[Event, ...], Block]:  # fmt: skip
+        """The events of a block the flow runs, run by `run` (the interpreter's), and the block they
+        are written as: a main-program line as it is (after the assignments that settle the
+        parameters it may read), a body's line as the numbers of this run (`literal`)."""
+        self._begin()
+        if kind is RUN and not _reads_returned(block):
+            settling = self._settle(block)
+            events = run(block)
+            if block.signature is None and _assigns(block):
+                self.written = self._snapshot()
+            if not settling:
+                return events, block
+            return (*settling, *(events if type(events) is tuple else (events,))), block  # type: ignore[misc]
+        self.started, self.settled = True, False
+        if kind is not RUN:
+            self.expanded += 1
+            if self.expanded > MAX_EXPANDED:
+                raise NcppError(f"--expand: the loops and subroutines make more than {MAX_EXPANDED:,} blocks "
+                                "written out; leave --expand out (their moves then pass through uncompensated)",
+                                Location(self.file, block.line, 1))  # fmt: skip
+        written = literal(block, self.params)
+        events = run(block)  # (an expression `literal` cannot evaluate fails here, as without --expand)
+        if written is None:
+            raise NcppError("--expand: the line cannot be written with numbers", Location(self.file, block.line, 1))
+        each = events if type(events) is tuple else (events,)
+        if not written.items and all(type(ev) is Pass for ev in each):  # (assignments only: nothing to write)
+            return (), written
+        for ev in each:  # type: ignore[union-attr]
+            ev.block = written
+        return events, written
+
+    def _begin(self) -> None:
+        if self.written is None:
+            self.written = self._snapshot()
+
+    def _snapshot(self) -> tuple[dict, dict, frozenset]:
+        params = self.params
+        named = {k: v for k, v in params.named.items() if k not in RETURNED}
+        return dict(params.numbered), named, frozenset(params.vacant)
+
+    def _settle(self, block: Block) -> tuple[Pass, ...]:
+        """Assignments that give the written program the parameters the program has before `block`
+        (none when nothing was expanded since they were the same)."""
+        if self.settled:
+            return ()
+        self.settled = True
+        numbered, named, vacant_now = self._snapshot()
+        before = self.written
+        self.written = (numbered, named, vacant_now)
+        if before is None:
+            return ()
+        was, was_named, was_vacant = before
+        lines = []
+        for key in sorted(numbered.keys() | was.keys()):
+            if key in vacant_now:
+                if key not in was_vacant:
+                    lines.append(f"#{key}=#0")
+            elif key in was_vacant or was.get(key, 0.0) != numbered.get(key, 0.0):
+                lines.append(f"#{key}={number('#', numbered.get(key, 0.0))}")
+        for name, value in named.items():
+            if was_named.get(name) != value:
+                lines.append(f"#<{name}>={number('#', value)}")
+        return tuple(Pass(_assignment(text, block)) for text in lines)
+
+
+def literal(block: Block, params: Parameters) -> Block | None:
+    """The block as it runs now: each expression word as its value's number (a vacant one left
+    out), its parameter assignments left out (but Fanuc's stop with a message), the rest as
+    written.  None where an expression cannot be evaluated (the interpreter then says why)."""
+    raw, pieces, items = block.raw, [], []
+    at = last = 0  # where the new text and the old one are
+    for item in block.items:
+        kind = type(item)
+        text: str | None = raw[item.start : item.end]
+        if kind is ExprWord:
+            try:
+                value = None if vacant(item.expr, params) else evaluate(item.expr, params)  # type: ignore[union-attr]
+            except Exception:  # (ExpressionError, OutOfScope: the interpreter reports them)
+                return None
+            text = None if value is None else item.letter + number(item.letter, value)  # type: ignore[union-attr]
+        elif kind is Statement and item.kind in ("assignment", "if") and not _stops(item):  # type: ignore[union-attr]
+            text = None
+        gap = raw[last : item.start]
+        last = item.end
+        if text is None:
+            continue
+        pieces.append(gap)
+        at += len(gap)
+        items.append(_moved(item, text, at) if kind is not ExprWord else _word(item.letter, text, at))  # type: ignore[union-attr]
+        pieces.append(text)
+        at += len(text)
+    pieces.append(raw[last:])
+    written = "".join(pieces)
+    return Block(written.rstrip() if not items else written, block.eol, tuple(items), block.line)
+
+
+def number(letter: str, value: float) -> str:
+    """`value` as the program is to read it exactly: the shortest digits that read back as it, a
+    decimal point on every letter's but whole codes' (`WHOLE_LETTERS`), no exponent."""
+    if letter.upper() in WHOLE_LETTERS and value == int(value):
+        return str(int(value))
+    return np.format_float_positional(value, unique=True, trim="." if letter != "#" else "-")
+
+
+def _word(letter: str, text: str, at: int) -> Word:
+    digits = text[len(letter) :]
+    return Word(letter, float(digits), digits, at, at + len(text))
+
+
+def _moved(item, text: str, at: int):
+    """A copy of `item` at `at` in the new text."""
+    end = at + len(text)
+    kind = type(item)
+    if kind is Word:
+        return Word(item.letter, item.value, item.number, at, end)
+    if kind is Comment:
+        return Comment(item.text, item.style, at, end)
+    return Statement(item.kind, item.node, at, end)
+
+
+def _stops(statement: Statement) -> bool:
+    """Fanuc's `#3006 = n (MESSAGE)`: the control stops there (an action of each run)."""
+    return statement.kind == "assignment" and statement.node[0][1] == FANUC_STOP
+
+
+def _assigns(block: Block) -> bool:
+    return any(type(i) is Statement and i.kind in ("assignment", "if") for i in block.items)
+
+
+def _reads_returned(block: Block) -> bool:
+    """Whether the block reads what a subroutine returned (`#<_value>`), which the written program
+    cannot set: the block is written with numbers."""
+    if block.signature is not None:  # (plain words: no parameter)
+        return False
+    return any(_names_returned(i.expr if type(i) is ExprWord else i.node) for i in block.items  # type: ignore[union-attr]
+               if type(i) is ExprWord or type(i) is Statement)  # fmt: skip
+
+
+def _names_returned(node: object) -> bool:
+    if type(node) is tuple:
+        if len(node) == 2 and node[0] == "param" and type(node[1]) is str:
+            return normalise_name(node[1]) in RETURNED
+        return any(_names_returned(part) for part in node)
+    return False
+
+
+def _assignment(text: str, block: Block) -> Block:
+    """A line `#k=v` that sets a parameter, written before `block` (its line's number and end)."""
+    return Block(text, block.eol, (Statement("assignment", (), 0, len(text)),), block.line)
