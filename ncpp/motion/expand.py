@@ -6,8 +6,11 @@ runs is written where it runs, as a block of its own for that run: its expressio
 the numbers they have there (`literal`), so the moves are plain moves that compensation
 corrects like any other, and its other words (M codes, tools, dwells, spindle) act once per run,
 in the order they run.  The control lines (`o100 call`, `while`, `endwhile`, `if`, `M98`, `M99`,
-`WHILE`, `END`, `GOTO` ...) and the text that does not run (subroutine definitions, untaken
-branches) are left out; the text after the program's end stays as it is.
+`WHILE`, `END`, `GOTO` ...) and the text that does not run (untaken branches, loops that run no
+time) are left out.  Subroutine definitions stay, as the control skips them: a line out of the
+interpreter's scope in the main program, outside any loop or branch, passes the rest of the
+program through as it is, as without --expand, and the calls there find their subroutines.  The
+text after the program's end stays as it is too.
 
 A body's parameter assignments are not written: its blocks read no parameter once written as
 numbers.  The lines of the main program that are written as they are may read them, so before
@@ -16,9 +19,10 @@ are set to the values they have there (`settled`): the program's own parameters,
 level sees them.  LinuxCNC's `#<_value>` and `#<_value_returned>` are read-only: a main-program
 line that reads one is written with numbers too.
 
-A construct outside the interpreter's scope after something was expanded is refused (the rest
-could not pass through as it is: its loops and calls have lost their lines), and so is a
-program whose loops and subroutines make more than MAX_EXPANDED blocks.
+A construct outside the interpreter's scope inside a loop, a branch or a subroutine (once
+something was expanded) is refused: the rest could not pass through as it is, its loop or
+branch has lost its opening line.  So is a program whose loops and subroutines make more than
+MAX_EXPANDED blocks.
 """
 
 from __future__ import annotations
@@ -29,7 +33,7 @@ import numpy as np
 
 from ncpp.errors import Location, NcppError
 from ncpp.motion.expressions import Parameters, evaluate, normalise_name, vacant
-from ncpp.motion.flow import RUN, SKIP, TEXT
+from ncpp.motion.flow import RUN, SKIP, TEXT, Flow, control_of
 from ncpp.motion.segments import Event, Pass
 from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
 
@@ -55,15 +59,40 @@ class Expansion:
         self.settled = True  # the written program's parameters are the program's (at the main level)
         # The written program's parameters where they were last the same: numbered, named, vacant
         self.written: tuple[dict, dict, frozenset] | None = None
+        self.defining: str | None = None  # the subroutine whose definition's lines go by (kept)
+        self.branches = 0  # if chains of the main program whose `if` was left out and `endif` not yet
 
-    def leaves_out(self, kind: str, done: bool) -> bool:
-        """Whether a line the flow does not run here is left out: text that does not run (SKIP) and
-        a control line (TEXT before the program's end); the text after the end is kept."""
-        if kind is SKIP or (kind is TEXT and not done):
-            self._begin()
-            self.started, self.settled = True, False
+    def leaves_out(self, kind: str, done: bool, block: Block) -> bool:
+        """Whether a line the flow does not run here is left out: text that does not run (SKIP) but
+        a subroutine's definition, and a control line (TEXT before the program's end); the text
+        after the end is kept."""
+        if done or (kind is not SKIP and kind is not TEXT):
+            return False
+        control = control_of(block) if block.signature is None else None  # (a control line is no plain block)
+        if kind is SKIP and self._defines(control):
+            return False
+        if kind is TEXT and control is not None:
+            self.branches += (control.keyword == "if") - (control.keyword == "endif")
+        self._begin()
+        self.started, self.settled = True, False
+        return True
+
+    def _defines(self, control) -> bool:
+        """Whether a line that does not run is one of a subroutine's definition (`sub` to `endsub`)."""
+        if self.defining is None and control is not None and control.keyword == "sub":
+            self.defining = control.name
+        elif self.defining is not None and control is not None and control.keyword == "endsub" \
+                and control.name == self.defining:
+            self.defining = None
             return True
-        return False
+        return self.defining is not None
+
+    def refuses_leaving(self, flow: Flow) -> bool:
+        """Whether the rest of the program cannot pass through as it is from here: a loop, a branch
+        or a call is under way whose opening line was left out."""
+        main = flow.frames[0]
+        return self.started and (len(flow.frames) > 1 or bool(main.labels) or self.branches > 0
+                                 or flow.skipping is not None or main.pc in flow.looped)  # fmt: skip
 
     def event(self, run: Callable[[Block], Event | tuple[Event, ...]], block: Block, kind: str
               ) -> tuple[Event | tuple[Event, ...], Block]:  # fmt: skip

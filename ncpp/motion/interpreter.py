@@ -316,7 +316,7 @@ class Interpreter:
         expansion = self.expansion
         for block, kind, owner in flow.steps(blocks):
             if kind is not RUN and kind is not FIXED:  # text that does not run here
-                if expansion is not None and expansion.leaves_out(kind, self.done):
+                if expansion is not None and expansion.leaves_out(kind, self.done, block):
                     continue
                 if block.signature is None:
                     _warn_unreadable(block, warnings)
@@ -397,9 +397,10 @@ class Interpreter:
         self.done = True
         where = "this line" if owner is None else f"line {owner.line}, which runs it,"
         source = self.flow.source() if self.flow is not None else None
-        if self.expansion is not None and self.expansion.started:  # its loops' lines are gone: no text passes
-            raise NcppError(f"--expand: {reason} is outside the motion interpreter's scope, so the program "
-                            "cannot be written out from here", Location(source or self.file, block.line, col))  # fmt: skip
+        if self.expansion is not None and self.flow is not None and self.expansion.refuses_leaving(self.flow):
+            raise NcppError(f"--expand: {reason} is outside the motion interpreter's scope, inside a loop, a branch "
+                            "or a subroutine written out: the rest cannot pass through as it is",
+                            Location(source or self.file, block.line, col))  # fmt: skip
         self.warnings.warn(  # type: ignore[union-attr]
             f"{reason} is outside the motion interpreter's scope; from {where} on the "
             "program passes through uninterpreted (its modal state is unknown)",
