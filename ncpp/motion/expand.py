@@ -43,6 +43,11 @@ MAX_EXPANDED = 1_000_000
 # Letters whose values are whole numbers where they are (codes, tools, numbers, counts): written
 # without a decimal point; every other letter's number has one (a Fanuc `X10` is 10 µm, not mm)
 WHOLE_LETTERS = frozenset("GMTNOHDLPS")
+# Positions (axes, arc centres and radii): written to PLACES decimals, far finer than any control
+# moves (1e-6 mm, or inch), not the 17 digits of a double that a control may refuse; the moves
+# compensation changes are written in the program's own style (the writer's)
+POSITION_LETTERS = frozenset("XYZABCUVWIJKR")
+PLACES = 6
 # Parameters a program may not set (LinuxCNC: read-only), what the last subroutine returned
 RETURNED = frozenset(("_value", "_value_returned"))
 FANUC_STOP = 3006  # Fanuc's stop-with-message variable: its assignment is an action, kept
@@ -192,11 +197,14 @@ def literal(block: Block, params: Parameters) -> Block | None:
 
 
 def number(letter: str, value: float) -> str:
-    """`value` as the program is to read it exactly: the shortest digits that read back as it, a
-    decimal point on every letter's but whole codes' (`WHOLE_LETTERS`), no exponent."""
-    if letter.upper() in WHOLE_LETTERS and value == int(value):
+    """`value` as the program is to read it: the shortest digits that read back as it (a position's
+    to PLACES decimals), a decimal point on every letter's but whole codes' (`WHOLE_LETTERS`), no
+    exponent."""
+    upper = letter.upper()
+    if upper in WHOLE_LETTERS and value == int(value):
         return str(int(value))
-    return np.format_float_positional(value, unique=True, trim="." if letter != "#" else "-")
+    places = PLACES if upper in POSITION_LETTERS else None
+    return np.format_float_positional(value, precision=places, unique=True, trim="." if letter != "#" else "-")
 
 
 def _word(letter: str, text: str, at: int) -> Word:
