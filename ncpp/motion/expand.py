@@ -32,10 +32,10 @@ from collections.abc import Callable
 import numpy as np
 
 from ncpp.errors import Location, NcppError
-from ncpp.motion.expressions import Parameters, evaluate, normalise_name, vacant
-from ncpp.motion.flow import RUN, SKIP, TEXT, Flow, control_of
+from ncpp.motion.expressions import ExpressionError, OutOfScope, Parameters, evaluate, normalise_name, vacant
+from ncpp.motion.flow import RUN, SKIP, TEXT, Control, Flow, control_of
 from ncpp.motion.segments import Event, Pass
-from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
+from ncpp.program.blocks import AnyItem, Block, Comment, ExprWord, Statement, Word
 
 # Blocks that loops and subroutines may be written out in at most: each is a line of the output
 # (or a few, for an arc written in pieces); past it the program is refused, not written for hours
@@ -51,6 +51,7 @@ PLACES = 6
 # Parameters a program may not set (LinuxCNC: read-only), what the last subroutine returned
 RETURNED = frozenset(("_value", "_value_returned"))
 FANUC_STOP = 3006  # Fanuc's stop-with-message variable: its assignment is an action, kept
+Running = Callable[[Block], Event | tuple[Event, ...]]  # the interpreter's reading of one block
 
 
 class Expansion:
@@ -73,7 +74,7 @@ class Expansion:
         after the end is kept."""
         if done or (kind is not SKIP and kind is not TEXT):
             return False
-        control = control_of(block) if block.signature is None else None  # (a control line is no plain block)
+        control = control_of(block) if block.signature is None else None  # (no plain block is one)
         if kind is SKIP and self._defines(control):
             return False
         if kind is TEXT and control is not None:
@@ -82,12 +83,12 @@ class Expansion:
         self.started, self.settled = True, False
         return True
 
-    def _defines(self, control) -> bool:
+    def _defines(self, control: Control | None) -> bool:
         """Whether a line that does not run is one of a subroutine's definition (`sub` to `endsub`)."""
-        if self.defining is None and control is not None and control.keyword == "sub":
-            self.defining = control.name
-        elif self.defining is not None and control is not None and control.keyword == "endsub" \
-                and control.name == self.defining:
+        keyword, name = (control.keyword, control.name) if control is not None else ("", None)
+        if self.defining is None and keyword == "sub":
+            self.defining = str(name)
+        elif self.defining is not None and keyword == "endsub" and name == self.defining:
             self.defining = None
             return True
         return self.defining is not None
@@ -99,8 +100,7 @@ class Expansion:
         return self.started and (len(flow.frames) > 1 or bool(main.labels) or self.branches > 0
                                  or flow.skipping is not None or main.pc in flow.looped)  # fmt: skip
 
-    def event(self, run: Callable[[Block], Event | tuple[Event, ...]], block: Block, kind: str
-              ) -> tuple[Event | tuple[Event, ...], Block]:  # fmt: skip
+    def event(self, run: Running, block: Block, kind: str) -> tuple[Event | tuple[Event, ...], Block]:
         """The events of a block the flow runs, run by `run` (the interpreter's), and the block they
         are written as: a main-program line as it is (after the assignments that settle the
         parameters it may read), a body's line as the numbers of this run (`literal`)."""
@@ -110,26 +110,32 @@ class Expansion:
             events = run(block)
             if block.signature is None and _assigns(block):
                 self.written = self._snapshot()
-            if not settling:
-                return events, block
-            return (*settling, *(events if type(events) is tuple else (events,))), block  # type: ignore[misc]
+            return ((*settling, *_each(events)) if settling else events), block
         self.started, self.settled = True, False
         if kind is not RUN:
-            self.expanded += 1
-            if self.expanded > MAX_EXPANDED:
-                raise NcppError(f"--expand: the loops and subroutines make more than {MAX_EXPANDED:,} blocks "
-                                "written out; leave --expand out (their moves then pass through uncompensated)",
-                                Location(self.file, block.line, 1))  # fmt: skip
+            self._count(block)
         written = literal(block, self.params)
         events = run(block)  # (an expression `literal` cannot evaluate fails here, as without --expand)
         if written is None:
-            raise NcppError("--expand: the line cannot be written with numbers", Location(self.file, block.line, 1))
-        each = events if type(events) is tuple else (events,)
+            raise NcppError(
+                "--expand: the line cannot be written with numbers", Location(self.file, block.line, 1)
+            )
+        each = _each(events)
         if not written.items and all(type(ev) is Pass for ev in each):  # (assignments only: nothing to write)
             return (), written
-        for ev in each:  # type: ignore[union-attr]
+        for ev in each:
             ev.block = written
         return events, written
+
+    def _count(self, block: Block) -> None:
+        """One more block written out of a loop or a subroutine: refused past MAX_EXPANDED."""
+        self.expanded += 1
+        if self.expanded > MAX_EXPANDED:
+            raise NcppError(
+                f"--expand: the loops and subroutines make more than {MAX_EXPANDED:,} blocks written out; "
+                "leave --expand out (their moves then pass through uncompensated)",
+                Location(self.file, block.line, 1),
+            )
 
     def _begin(self) -> None:
         if self.written is None:
@@ -165,35 +171,45 @@ class Expansion:
         return tuple(Pass(_assignment(text, block)) for text in lines)
 
 
+def _each(events: Event | tuple[Event, ...]) -> tuple[Event, ...]:
+    return events if type(events) is tuple else (events,)  # type: ignore[return-value]
+
+
 def literal(block: Block, params: Parameters) -> Block | None:
     """The block as it runs now: each expression word as its value's number (a vacant one left
     out), its parameter assignments left out (but Fanuc's stop with a message), the rest as
     written.  None where an expression cannot be evaluated (the interpreter then says why)."""
-    raw, pieces, items = block.raw, [], []
+    raw = block.raw
+    pieces: list[str] = []
+    items: list[AnyItem] = []
     at = last = 0  # where the new text and the old one are
     for item in block.items:
-        kind = type(item)
-        text: str | None = raw[item.start : item.end]
-        if kind is ExprWord:
-            try:
-                value = None if vacant(item.expr, params) else evaluate(item.expr, params)  # type: ignore[union-attr]
-            except Exception:  # (ExpressionError, OutOfScope: the interpreter reports them)
-                return None
-            text = None if value is None else item.letter + number(item.letter, value)  # type: ignore[union-attr]
-        elif kind is Statement and item.kind in ("assignment", "if") and not _stops(item):  # type: ignore[union-attr]
-            text = None
+        try:
+            text = _text(item, raw, params)
+        except (ExpressionError, OutOfScope):
+            return None
         gap = raw[last : item.start]
         last = item.end
         if text is None:
             continue
-        pieces.append(gap)
+        pieces += (gap, text)
         at += len(gap)
-        items.append(_moved(item, text, at) if kind is not ExprWord else _word(item.letter, text, at))  # type: ignore[union-attr]
-        pieces.append(text)
+        items.append(_placed(item, text, at))
         at += len(text)
     pieces.append(raw[last:])
     written = "".join(pieces)
-    return Block(written.rstrip() if not items else written, block.eol, tuple(items), block.line)
+    return Block(written if items else written.rstrip(), block.eol, tuple(items), block.line)
+
+
+def _text(item: AnyItem, raw: str, params: Parameters) -> str | None:
+    """An item's text in the block of this run (None: left out)."""
+    if isinstance(item, ExprWord):
+        if vacant(item.expr, params):
+            return None
+        return item.letter + number(item.letter, evaluate(item.expr, params))
+    if isinstance(item, Statement) and item.kind in ("assignment", "if") and not _stops(item):
+        return None
+    return raw[item.start : item.end]
 
 
 def number(letter: str, value: float) -> str:
@@ -204,21 +220,20 @@ def number(letter: str, value: float) -> str:
     if upper in WHOLE_LETTERS and value == int(value):
         return str(int(value))
     places = PLACES if upper in POSITION_LETTERS else None
-    return np.format_float_positional(value, precision=places, unique=True, trim="." if letter != "#" else "-")
+    return np.format_float_positional(
+        value, precision=places, unique=True, trim="-" if letter == "#" else "."
+    )
 
 
-def _word(letter: str, text: str, at: int) -> Word:
-    digits = text[len(letter) :]
-    return Word(letter, float(digits), digits, at, at + len(text))
-
-
-def _moved(item, text: str, at: int):
-    """A copy of `item` at `at` in the new text."""
+def _placed(item: AnyItem, text: str, at: int) -> AnyItem:
+    """`item` as `text` at `at` in the new text (an expression word as a plain word)."""
     end = at + len(text)
-    kind = type(item)
-    if kind is Word:
+    if isinstance(item, ExprWord):
+        digits = text[len(item.letter) :]
+        return Word(item.letter, float(digits), digits, at, end)
+    if isinstance(item, Word):
         return Word(item.letter, item.value, item.number, at, end)
-    if kind is Comment:
+    if isinstance(item, Comment):
         return Comment(item.text, item.style, at, end)
     return Statement(item.kind, item.node, at, end)
 
@@ -237,8 +252,11 @@ def _reads_returned(block: Block) -> bool:
     cannot set: the block is written with numbers."""
     if block.signature is not None:  # (plain words: no parameter)
         return False
-    return any(_names_returned(i.expr if type(i) is ExprWord else i.node) for i in block.items  # type: ignore[union-attr]
-               if type(i) is ExprWord or type(i) is Statement)  # fmt: skip
+    return any(
+        _names_returned(item.expr if isinstance(item, ExprWord) else item.node)
+        for item in block.items
+        if isinstance(item, (ExprWord, Statement))
+    )
 
 
 def _names_returned(node: object) -> bool:

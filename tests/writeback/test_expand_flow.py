@@ -24,7 +24,7 @@ import ncpp.motion.expand as expand_module
 from ncpp.errors import NcppError, Warnings
 from ncpp.pipeline import ErrorSource, process
 from tests.compensation.accuracy import rs274_calls
-from tests.conftest import CORPUS, ROOT, SHARED
+from tests.conftest import CORPUS, READING, ROOT, SHARED
 from tests.motion.test_fanuc_macro import TWINS
 from tests.verify.test_corpus_pathcheck import rs274_environment, tool_table
 from tests.writeback.conftest import compensate_file
@@ -34,15 +34,17 @@ PATHCHECK = SHARED / "tools" / "pathcheck"
 WIDE = SHARED / "machines" / "wide.toml"
 HEAD = "G21 G90 G17\nG0 X0 Y0 Z10\nM3 S1200\n"
 # An o-word control line of LinuxCNC, or a Fanuc subprogram call, loop or jump
-FLOW_LINE = re.compile(r"^[ \t]*(N\d+[ \t]*)?(o[ \t]*(\d+|<[^>]*>)[ \t]*(sub|endsub|call|while|endwhile|do|repeat|"
-                       r"endrepeat|if|elseif|else|endif|break|continue|return)\b|M98|M99|WHILE|END[ \t]*\d|GOTO|IF\b|G6[567])",
+KEYWORDS = "sub|endsub|call|while|endwhile|do|repeat|endrepeat|if|elseif|else|endif|break|continue|return"
+FLOW_LINE = re.compile(rf"^[ \t]*(N\d+[ \t]*)?(o[ \t]*(\d+|<[^>]*>)[ \t]*({KEYWORDS})\b"
+                       r"|M98|M99|WHILE|END[ \t]*\d|GOTO|IF\b|G6[567])",
                        re.IGNORECASE | re.MULTILINE)  # fmt: skip
 # A subroutine's definition, which stays (the control skips it)
 DEFINITION = re.compile(r"^\s*o\s*(\d+|<[^>]*>)\s*sub\b.*?^\s*o\s*\1\s*endsub.*?$", re.I | re.M | re.S)
 
 PROGRAMS = {
     # a helical-free pocket corner subroutine with three arguments, called three times
-    "subroutine called three times": HEAD + """o100 sub
+    "subroutine called three times": HEAD
+    + """o100 sub
   G0 X[#1] Y[#2] Z2
   G1 Z-1 F200
   G1 X[#1 + #3] F400
@@ -57,7 +59,8 @@ G0 X0 Y0
 M5
 M2
 """,
-    "while loop": HEAD + """#<x> = -150
+    "while loop": HEAD
+    + """#<x> = -150
 o1 while [#<x> LT 160]
   G0 X[#<x>] Y-100 Z2
   G1 Z-2 F150
@@ -68,7 +71,8 @@ o1 endwhile
 M5
 M2
 """,
-    "repeat loop": HEAD + """G0 X-180 Y-180 Z2
+    "repeat loop": HEAD
+    + """G0 X-180 Y-180 Z2
 G1 Z-1 F200
 o2 repeat [6]
   G91 G1 X60 F500
@@ -79,7 +83,8 @@ G0 Z10
 M5
 M2
 """,
-    "loop around a call": HEAD + """o10 sub
+    "loop around a call": HEAD
+    + """o10 sub
   G0 X[#1] Y[#2] Z2
   G1 Z[#3] F150
   G1 X[#1 + 30] Y[#2 + 20] F400
@@ -97,7 +102,8 @@ o11 endwhile
 M5
 M2
 """,
-    "if and else in a loop": HEAD + """#<i> = 0
+    "if and else in a loop": HEAD
+    + """#<i> = 0
 o20 while [#<i> LT 4]
   G0 X[#<i> * 80 - 120] Y150 Z2
   G1 Z-1 F200
@@ -115,7 +121,8 @@ M9
 M5
 M2
 """,
-    "drilling cycle in a loop": HEAD + """G0 Z25
+    "drilling cycle in a loop": HEAD
+    + """G0 Z25
 #<k> = 0
 o30 while [#<k> LT 5]
   G99 G81 X[#<k> * 60 - 100] Y[120 - #<k> * 50] Z-12 R3 F120
@@ -127,7 +134,8 @@ M5
 M2
 """,
     # the main program reads what loops and subroutines left: a global, a return value, a counter
-    "parameters read after the loops": HEAD + """o40 sub
+    "parameters read after the loops": HEAD
+    + """o40 sub
   #<_total> = [#<_total> + #1]
   G1 X[#<_total>] Y[#1 * 2] F300
 o40 endsub [#1 * 3]
@@ -176,7 +184,8 @@ def _pathcheck(original: Path, output: Path, *options: str) -> subprocess.Comple
     if not PATHCHECK.exists():
         pytest.skip(f"pathcheck not found under {SHARED}")
     return subprocess.run([sys.executable, str(PATHCHECK), str(original), str(output), *options],
-                          capture_output=True, text=True, timeout=600, env=rs274_environment(original.parent))  # fmt: skip
+                          capture_output=True, text=True, timeout=600,
+                          env=rs274_environment(original.parent))  # fmt: skip
 
 
 @pytest.mark.parametrize("name", PROGRAMS)
@@ -193,7 +202,7 @@ def test_expanded_bodies_land_where_programmed_and_rs274_runs_the_same_path(tmp_
 
 def _expanded(text: str, file: str = "t.ngc", warnings: Warnings | None = None) -> str:
     out = io.BytesIO()
-    process(io.BytesIO(text.encode()), out, file=file, source=ErrorSource.from_machine_file(str(ROOT / "tests" / "machines" / "reading.toml")),
+    process(io.BytesIO(text.encode()), out, file=file, source=ErrorSource.from_machine_file(str(READING)),
             warnings=warnings or Warnings(stream=io.StringIO()), expand=True)  # fmt: skip
     return out.getvalue().decode()
 
@@ -210,7 +219,7 @@ def test_without_expand_the_warning_tells_of_it():
     stream = io.StringIO()
     out = io.BytesIO()
     process(io.BytesIO(PROGRAMS["while loop"].encode()), out, file="t.ngc", warnings=Warnings(stream=stream),
-            source=ErrorSource.from_machine_file(str(ROOT / "tests" / "machines" / "reading.toml")))  # fmt: skip
+            source=ErrorSource.from_machine_file(str(READING)))  # fmt: skip
     assert "loop or subroutine: its moves pass through uncompensated" in stream.getvalue()
     assert "--expand writes" in stream.getvalue()
     assert "o1 while" in out.getvalue().decode()
@@ -218,7 +227,9 @@ def test_without_expand_the_warning_tells_of_it():
 
 def test_more_blocks_than_the_bound_are_refused_where_the_bound_is_passed(monkeypatch):
     monkeypatch.setattr(expand_module, "MAX_EXPANDED", 20)
-    with pytest.raises(NcppError, match=r"t\.ngc:5:1: --expand: the loops and subroutines make more than 20 blocks"):
+    with pytest.raises(
+        NcppError, match=r"t\.ngc:5:1: --expand: the loops and subroutines make more than 20 blocks"
+    ):
         _expanded(HEAD + "o1 repeat [11]\n  G1 X1 F100\n  G1 X2\no1 endrepeat\nM2\n")
 
 
@@ -257,8 +268,9 @@ def test_both_commands_take_the_option_and_refuse_with_the_place(tmp_path, comma
     environ.update(PYTHONPATH=str(ROOT), HOME=str(tmp_path))
 
     def run(name: str) -> subprocess.CompletedProcess:
-        return subprocess.run([sys.executable, "-m", *command, "--machine", "machine.toml", "--expand", name, "-o",
-                               "out.ngc"], capture_output=True, text=True, cwd=tmp_path, env=environ, timeout=300)  # fmt: skip
+        arguments = ["--machine", "machine.toml", "--expand", name, "-o", "out.ngc"]
+        return subprocess.run([sys.executable, "-m", *command, *arguments], capture_output=True, text=True,
+                              cwd=tmp_path, env=environ, timeout=300)  # fmt: skip
 
     done = run("p.ngc")
     assert done.returncode == 0, done.stderr
@@ -275,11 +287,14 @@ def test_the_corpus_mount_program_expanded_runs_in_rs274_as_the_original(tmp_pat
         pytest.skip("the corpus or wide.toml is not there")
     tools = tool_table(tmp_path)
     var = tmp_path / "mmount.var"  # inch, as the tool table: the stations' zeros 10 in apart
-    var.write_text("5220 1\n5241 2\n5242 1.5\n5243 -3\n5261 12\n5262 1.5\n5263 -3\n5281 22\n5282 1.5\n5283 -3\n")
+    var.write_text(
+        "5220 1\n5241 2\n5242 1.5\n5243 -3\n5261 12\n5262 1.5\n5263 -3\n5281 22\n5282 1.5\n5283 -3\n"
+    )
     output = tmp_path / "mmount-expanded.ngc"
-    done = subprocess.run([sys.executable, "-m", "ncpp", "compensate", "--machine", str(WIDE), "--var-file", str(var),
-                           "--tool-table", str(tools), "--var-units", "inch", "--expand", str(program), "-o", str(output)],
-                          capture_output=True, text=True, timeout=600, env=dict(os.environ, PYTHONPATH=str(ROOT)))  # fmt: skip
+    arguments = ["--machine", str(WIDE), "--var-file", str(var), "--tool-table", str(tools),
+                 "--var-units", "inch", "--expand", str(program), "-o", str(output)]  # fmt: skip
+    done = subprocess.run([sys.executable, "-m", "ncpp", "compensate", *arguments], capture_output=True,
+                          text=True, timeout=600, env=dict(os.environ, PYTHONPATH=str(ROOT)))  # fmt: skip
     assert done.returncode == 0, done.stderr
     assert "in loops or subroutines" not in done.stderr and not FLOW_LINE.search(_running(output.read_text()))
     check = _pathcheck(program, output, "--var-file", str(var), "--tool-table", str(tools), "--tol-mm", "0.5")
