@@ -163,7 +163,8 @@ UNCOMPENSATED = {
     "program puts them, with the machine's errors); compensation resumes with the next move",
     FLOW: "loop or subroutine: its moves pass through uncompensated (one text runs several times, "
     "or away from where it stands, so it cannot carry one correction); compensation resumes with the next move after it "
-    "(--expand writes an ISO program's loops and subroutines out as straight code, each move compensated)",
+    "(--expand writes an ISO program's loops and subroutines out as straight code, "
+    "each move compensated)",
     COMP: "cutter compensation: its moves pass through uncompensated (the control offsets them by the tool radius, "
     "so the tool is not where their points are); compensation resumes after the first move with it off (after G40, or R0)",
 }

@@ -398,8 +398,8 @@ class Interpreter:
         where = "this line" if owner is None else f"line {owner.line}, which runs it,"
         source = self.flow.source() if self.flow is not None else None
         if self.expansion is not None and self.flow is not None and self.expansion.refuses_leaving(self.flow):
-            raise NcppError(f"--expand: {reason} is outside the motion interpreter's scope, inside a loop, a branch "
-                            "or a subroutine written out: the rest cannot pass through as it is",
+            raise NcppError(f"--expand: {reason} is outside the motion interpreter's scope, inside a loop, "
+                            "a branch or a subroutine written out: the rest cannot pass through as it is",
                             Location(source or self.file, block.line, col))  # fmt: skip
         self.warnings.warn(  # type: ignore[union-attr]
             f"{reason} is outside the motion interpreter's scope; from {where} on the "
