@@ -200,6 +200,52 @@ def test_expanded_bodies_land_where_programmed_and_rs274_runs_the_same_path(tmp_
     assert _worst_point_um(original, plain) > 2.0
 
 
+# Programs judged by pathcheck alone (their points are not machine coordinates, or their cycles
+# are written as moves): name -> (program, options)
+PATH_ONLY = {
+    "offset set in a loop": (
+        HEAD
+        + """#<k> = 0
+o1 while [#<k> LT 3]
+  G0 X[50 + #<k> * 60] Y20
+  G92 X0 Y0
+  G1 X40 F300
+  G1 Y40
+  G92.1
+  #<k> = [#<k> + 1]
+o1 endwhile
+G0 X0 Y0
+M5
+M2
+""",
+        {},
+    ),
+    "dwelling cycle in a loop, written as moves": (
+        HEAD
+        + """#<k> = 0
+o1 repeat [3]
+  G82 X[#<k> * 70 - 60] Y90 Z-4 R2 P0.4 F120 M8
+  #<k> = [#<k> + 1]
+o1 endrepeat
+G80
+M9
+M5
+M2
+""",
+        {"expand_cycles": True},
+    ),
+}
+
+
+@pytest.mark.parametrize("name", PATH_ONLY)
+def test_expanded_offsets_and_cycles_run_in_rs274_as_the_original(tmp_path, name):
+    program, options = PATH_ONLY[name]
+    original, output = _compensated(tmp_path, program, expand=True, **options)
+    assert not FLOW_LINE.search(output.read_text())
+    check = _pathcheck(original, output, "--tol-mm", "0.02")
+    assert check.returncode == 0, check.stdout + check.stderr
+
+
 def _expanded(text: str, file: str = "t.ngc", warnings: Warnings | None = None) -> str:
     out = io.BytesIO()
     process(io.BytesIO(text.encode()), out, file=file, source=ErrorSource.from_machine_file(str(READING)),
