@@ -40,6 +40,7 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_expanded_bodies_land_where_programmed_and_rs274_runs_the_same_path",
             "test_expanded_fanuc_macros_move_as_rs274_runs_their_o_word_twins",
             "test_expanded_offsets_and_cycles_run_in_rs274_as_the_original",
+            "test_debug_messages_show_each_runs_values_as_rs274_shows_the_originals",
             "test_the_corpus_mount_program_expanded_runs_in_rs274_as_the_original",
         ),
         "motion/test_fanuc_macro.py": (

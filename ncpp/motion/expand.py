@@ -27,6 +27,7 @@ MAX_EXPANDED blocks.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable
 
 import numpy as np
@@ -51,6 +52,9 @@ PLACES = 6
 # Parameters a program may not set (LinuxCNC: read-only), what the last subroutine returned
 RETURNED = frozenset(("_value", "_value_returned"))
 FANUC_STOP = 3006  # Fanuc's stop-with-message variable: its assignment is an action, kept
+# LinuxCNC's comments that show parameters' values where they run, and the parameters they name
+_SHOWING = re.compile(r"\s*(debug|print|log)\s*,", re.IGNORECASE)
+_PARAMETER = re.compile(r"#(\d+|<[^>]*>)")
 Running = Callable[[Block], Event | tuple[Event, ...]]  # the interpreter's reading of one block
 
 
@@ -67,21 +71,29 @@ class Expansion:
         self.written: tuple[dict, dict, frozenset] | None = None
         self.defining: str | None = None  # the subroutine whose definition's lines go by (kept)
         self.branches = 0  # if chains of the main program whose `if` was left out and `endif` not yet
+        self._owed: tuple[Pass, ...] = ()  # assignments due before a line that failed to run (`owed`)
 
-    def leaves_out(self, kind: str, done: bool, block: Block) -> bool:
-        """Whether a line the flow does not run here is left out: text that does not run (SKIP) but
-        a subroutine's definition, and a control line (TEXT before the program's end); the text
-        after the end is kept."""
-        if done or (kind is not SKIP and kind is not TEXT):
-            return False
+    def text(self, kind: str, done: bool, block: Block) -> tuple[Pass, ...] | None:
+        """A line the flow does not run here: None where it is left out (text that does not run,
+        SKIP, but a subroutine's definition, and a control line, TEXT, before the program's end),
+        else the assignments to write before it: after the program's end or where it passes
+        through uninterpreted, the parameters its text may read (`_settle`)."""
+        if done:
+            return self._settle(block)
         control = control_of(block) if block.signature is None else None  # (no plain block is one)
         if kind is SKIP and self._defines(control):
-            return False
+            return ()
         if kind is TEXT and control is not None:
             self.branches += (control.keyword == "if") - (control.keyword == "endif")
         self._begin()
         self.started, self.settled = True, False
-        return True
+        return None
+
+    def owed(self) -> tuple[Pass, ...]:
+        """The assignments due before a main-program line the interpreter could not read, which
+        passes through as it is (and the rest with it)."""
+        owed, self._owed = self._owed, ()
+        return owed
 
     def _defines(self, control: Control | None) -> bool:
         """Whether a line that does not run is one of a subroutine's definition (`sub` to `endsub`)."""
@@ -107,7 +119,11 @@ class Expansion:
         self._begin()
         if kind is RUN and not _reads_returned(block):
             settling = self._settle(block)
-            events = run(block)
+            try:
+                events = run(block)
+            except Exception:
+                self._owed = settling  # (its text passes through: after them, `owed`)
+                raise
             if block.signature is None and _assigns(block):
                 self.written = self._snapshot()
             return ((*settling, *_each(events)) if settling else events), block
@@ -209,7 +225,18 @@ def _text(item: AnyItem, raw: str, params: Parameters) -> str | None:
         return item.letter + number(item.letter, evaluate(item.expr, params))
     if isinstance(item, Statement) and item.kind in ("assignment", "if") and not _stops(item):
         return None
+    if isinstance(item, Comment) and _SHOWING.match(item.text):
+        return _PARAMETER.sub(lambda found: _shown(found, params), raw[item.start : item.end])
     return raw[item.start : item.end]
+
+
+def _shown(found: re.Match, params: Parameters) -> str:
+    """A parameter a DEBUG, PRINT or LOG comment shows, as LinuxCNC shows it there (`%lf`)."""
+    name = found.group(1)
+    try:
+        return f"{params.read(normalise_name(name) if name.startswith('<') else int(name)):.6f}"
+    except (ExpressionError, OutOfScope):
+        return found.group(0)
 
 
 def number(letter: str, value: float) -> str:

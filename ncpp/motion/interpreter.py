@@ -316,8 +316,14 @@ class Interpreter:
         expansion = self.expansion
         for block, kind, owner in flow.steps(blocks):
             if kind is not RUN and kind is not FIXED:  # text that does not run here
-                if expansion is not None and expansion.leaves_out(kind, self.done, block):
-                    continue
+                if expansion is not None:
+                    kept = expansion.text(kind, self.done, block)  # (None: left out)
+                    if kept is None:
+                        continue
+                    if pending is not None:
+                        held.extend(kept)
+                    else:
+                        yield from kept
                 if block.signature is None:
                     _warn_unreadable(block, warnings)
                 text = Pass(
@@ -357,6 +363,8 @@ class Interpreter:
                     yield from self._unrounded(pending, held)
                     pending = None
                 if owner is None:  # (a block that runs out of the text's order is written in its place)
+                    if expansion is not None:
+                        yield from expansion.owed()
                     yield Pass(block)
                 continue
             if pending is None and self.corner is None and type(event) is not tuple:

@@ -28,7 +28,7 @@ from tests.conftest import CORPUS, READING, ROOT, SHARED
 from tests.motion.test_fanuc_macro import TWINS
 from tests.verify.test_corpus_pathcheck import rs274_environment, tool_table
 from tests.writeback.conftest import compensate_file
-from tests.writeback.test_compensated_holes import MACHINE, square
+from tests.writeback.test_compensated_holes import MACHINE, _rs274_text, square
 
 PATHCHECK = SHARED / "tools" / "pathcheck"
 WIDE = SHARED / "machines" / "wide.toml"
@@ -289,6 +289,23 @@ def test_a_construct_out_of_scope_in_a_loop_is_refused_at_the_main_level_it_pass
     assert "t.ngc:10:1: warning: threading G33.1 is outside" in warned.getvalue()
     assert _running(text).count("G1 X") == 2 and "o1 repeat" not in text  # expanded up to there
     assert "o2 sub" in text and text.endswith("G33.1 Z-1 K1\no2 call [7]\nM2\n")  # the definition stays
+
+
+@pytest.mark.parametrize(
+    "rest", ["G33.1 Z[-#<x>] K1\nG0 X#<x>\nM2\n", "o<missing> call [#<x>]\nG0 X#<x>\nM2\n"]
+)
+def test_a_line_that_passes_through_uninterpreted_finds_the_parameters_set(rest):
+    text = _expanded(
+        HEAD + "#<x> = 1\no1 repeat [2]\n  G1 X[#<x>] F100\n  #<x> = [#<x> + 1]\no1 endrepeat\n" + rest
+    )
+    assert text.endswith("  G1 X2.0000 F100\n#<x>=3\n" + rest)
+
+
+def test_debug_messages_show_each_runs_values_as_rs274_shows_the_originals(tmp_path):
+    program = HEAD + "o1 sub\n(DEBUG, hole #1 of #<_n>)\nG1 X[#1 * 10] F100\no1 endsub\n#<_n> = 2\n"
+    original, output = _compensated(tmp_path, program + "o1 call [1]\no1 call [2]\nM2\n", expand=True)
+    messages = [re.findall(r"MESSAGE\((.*)\)", _rs274_text(path)) for path in (original, output)]
+    assert messages[0] == messages[1] == ['" hole 1.000000 of 2.000000"', '" hole 2.000000 of 2.000000"']
 
 
 @pytest.mark.parametrize("name", [name for name in TWINS if name != "IF THEN"])  # (rs274 reads no IF THEN)
