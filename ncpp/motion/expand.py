@@ -52,6 +52,9 @@ PLACES = 6
 # Parameters a program may not set (LinuxCNC: read-only), what the last subroutine returned
 RETURNED = frozenset(("_value", "_value_returned"))
 FANUC_STOP = 3006  # Fanuc's stop-with-message variable: its assignment is an action, kept
+# Fanuc's alarm and stop-with-message variables: setting one is an action (the control stops), never
+# a value to give the written program
+ACTIONS = frozenset((3000, FANUC_STOP))
 # LinuxCNC's comments that show parameters' values where they run, and the parameters they name
 _SHOWING = re.compile(r"\s*(debug|print|log)\s*,", re.IGNORECASE)
 _PARAMETER = re.compile(r"#(\d+|<[^>]*>)")
@@ -175,7 +178,7 @@ class Expansion:
             return ()
         was, was_named, was_vacant = before
         lines = []
-        for key in sorted(numbered.keys() | was.keys()):
+        for key in sorted((numbered.keys() | was.keys()) - ACTIONS):
             if key in vacant_now:
                 if key not in was_vacant:
                     lines.append(f"#{key}=#0")

@@ -301,6 +301,15 @@ def test_a_line_that_passes_through_uninterpreted_finds_the_parameters_set(rest)
     assert text.endswith("  G1 X2.0000 F100\n#<x>=3\n" + rest)
 
 
+def test_a_fanuc_stop_with_a_message_stops_each_run_and_is_no_parameter_to_set():
+    text = _expanded("O0010\nG21 G90 G17\nG0 X0 Y0 Z5\n#100=0\nM98 P200 L3\nG1 X#100 F100\nM30\n"
+                     "O200\n#100=#100+10\nG1 X#100 Y5 F300\n#3006=1 (CHECK)\nM99\n", file="t.nc")  # fmt: skip
+    running = text[: text.index("M30")]
+    assert re.findall(r"G1 X\S+|#\d+=\S+", running) == [
+        "#100=0", "G1 X9.9999", "#3006=1", "G1 X19.9998", "#3006=1", "G1 X29.9997", "#3006=1", "#100=30",
+        "G1 X29.9997"]  # fmt: skip
+
+
 def test_debug_messages_show_each_runs_values_as_rs274_shows_the_originals(tmp_path):
     program = HEAD + "o1 sub\n(DEBUG, hole #1 of #<_n>)\nG1 X[#1 * 10] F100\no1 endsub\n#<_n> = 2\n"
     original, output = _compensated(tmp_path, program + "o1 call [1]\no1 call [2]\nM2\n", expand=True)
