@@ -70,8 +70,8 @@ class Expansion:
         self.started = False  # something was expanded or left out: the rest cannot pass through as text
         self.expanded = 0  # blocks written out of loops and subroutines
         self.settled = True  # the written program's parameters are the program's (at the main level)
-        # The written program's parameters where they were last the same: numbered, named, vacant
-        self.written: tuple[dict, dict, frozenset] | None = None
+        # The written program's parameters where they were last the program's: numbered, named, vacant
+        self.written: tuple[dict, dict, frozenset] = ({}, {}, frozenset())
         self.defining: str | None = None  # the subroutine whose definition's lines go by (kept)
         self.branches = 0  # if chains of the main program whose `if` was left out and `endif` not yet
         self._owed: tuple[Pass, ...] = ()  # assignments due before a line that failed to run (`owed`)
@@ -88,8 +88,7 @@ class Expansion:
             return ()
         if kind is TEXT and control is not None:
             self.branches += (control.keyword == "if") - (control.keyword == "endif")
-        self._begin()
-        self.started, self.settled = True, False
+        self._unsettle()
         return None
 
     def owed(self) -> tuple[Pass, ...]:
@@ -119,7 +118,6 @@ class Expansion:
         """The events of a block the flow runs, run by `run` (the interpreter's), and the block they
         are written as: a main-program line as it is (after the assignments that settle the
         parameters it may read), a body's line as the numbers of this run (`literal`)."""
-        self._begin()
         if kind is RUN and not _reads_returned(block):
             settling = self._settle(block)
             try:
@@ -127,10 +125,8 @@ class Expansion:
             except Exception:
                 self._owed = settling  # (its text passes through: after them, `owed`)
                 raise
-            if block.signature is None and _assigns(block):
-                self.written = self._snapshot()
             return ((*settling, *_each(events)) if settling else events), block
-        self.started, self.settled = True, False
+        self._unsettle()
         if kind is not RUN:
             self._count(block)
         written = literal(block, self.params)
@@ -156,14 +152,18 @@ class Expansion:
                 Location(self.file, block.line, 1),
             )
 
-    def _begin(self) -> None:
-        if self.written is None:
+    def _unsettle(self) -> None:
+        """A stretch written out starts (or goes on): the parameters the written program has are
+        the program's now, before any of its blocks runs, until the next main-program line."""
+        if self.settled:
             self.written = self._snapshot()
+            self.settled = False
+        self.started = True
 
     def _snapshot(self) -> tuple[dict, dict, frozenset]:
-        params = self.params
-        named = {k: v for k, v in params.named.items() if k not in RETURNED}
-        return dict(params.numbered), named, frozenset(params.vacant)
+        """The parameters the main program has now (a macro G66 calls may be under way)."""
+        numbered, named, vacant_now = self.params.main_level()
+        return numbered, {k: v for k, v in named.items() if k not in RETURNED}, vacant_now
 
     def _settle(self, block: Block) -> tuple[Pass, ...]:
         """Assignments that give the written program the parameters the program has before `block`
@@ -172,11 +172,7 @@ class Expansion:
             return ()
         self.settled = True
         numbered, named, vacant_now = self._snapshot()
-        before = self.written
-        self.written = (numbered, named, vacant_now)
-        if before is None:
-            return ()
-        was, was_named, was_vacant = before
+        was, was_named, was_vacant = self.written
         lines = []
         for key in sorted((numbered.keys() | was.keys()) - ACTIONS):
             if key in vacant_now:
@@ -271,10 +267,6 @@ def _placed(item: AnyItem, text: str, at: int) -> AnyItem:
 def _stops(statement: Statement) -> bool:
     """Fanuc's `#3006 = n (MESSAGE)`: the control stops there (an action of each run)."""
     return statement.kind == "assignment" and statement.node[0][1] == FANUC_STOP
-
-
-def _assigns(block: Block) -> bool:
-    return any(type(i) is Statement and i.kind in ("assignment", "if") for i in block.items)
 
 
 def _reads_returned(block: Block) -> bool:

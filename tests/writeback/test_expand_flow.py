@@ -22,6 +22,7 @@ import pytest
 
 import ncpp.motion.expand as expand_module
 from ncpp.errors import NcppError, Warnings
+from ncpp.motion.expressions import Parameters
 from ncpp.pipeline import ErrorSource, process
 from tests.compensation.accuracy import rs274_calls
 from tests.conftest import CORPUS, READING, ROOT, SHARED
@@ -269,6 +270,20 @@ def test_without_expand_the_warning_tells_of_it():
     assert "loop or subroutine: its moves pass through uncompensated" in stream.getvalue()
     assert "--expand writes" in stream.getvalue()
     assert "o1 while" in out.getvalue().decode()
+
+
+def test_the_main_programs_parameters_are_those_the_first_call_saved():
+    params = Parameters()
+    params.write(1, 5.0)
+    params.write("x", 2.0)
+    params.write("_g", 3.0)
+    params.enter([7.0])  # an o-word call: #1.. and the local names are its own
+    params.write("x", 9.0)
+    params.write("_g", 4.0)
+    params.enter(None)  # an M98 call in it shares them
+    numbered, named, _ = params.main_level()
+    assert numbered[1] == 5.0 and params.read(1) == 7.0
+    assert {k: named[k] for k in ("x", "_g")} == {"x": 2.0, "_g": 4.0}
 
 
 def test_more_blocks_than_the_bound_are_refused_where_the_bound_is_passed(monkeypatch):
