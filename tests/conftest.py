@@ -41,6 +41,7 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_expanded_fanuc_macros_move_as_rs274_runs_their_o_word_twins",
             "test_expanded_offsets_and_cycles_run_in_rs274_as_the_original",
             "test_debug_messages_show_each_runs_values_as_rs274_shows_the_originals",
+            "test_corpus_programs_with_loops_expanded_run_in_rs274_as_the_originals",
             "test_the_corpus_mount_program_expanded_runs_in_rs274_as_the_original",
         ),
         "motion/test_fanuc_macro.py": (
@@ -124,6 +125,7 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
         "writeback/test_expand_flow.py": (
             "test_both_commands_take_the_option_and_refuse_with_the_place",
             "test_the_corpus_mount_program_expanded_runs_in_rs274_as_the_original",
+            "test_corpus_programs_with_loops_expanded_run_in_rs274_as_the_originals",
         ),
         "shop/test_linuxcnc_filter.py": (
             "test_the_parameter_file_places_the_program_as_linuxcnc_does",

@@ -25,9 +25,15 @@ from ncpp.errors import NcppError, Warnings
 from ncpp.motion.expressions import Parameters
 from ncpp.pipeline import ErrorSource, process
 from tests.compensation.accuracy import rs274_calls
-from tests.conftest import CORPUS, READING, ROOT, SHARED
+from tests.conftest import CORPUS, READING, ROOT, SHARED, corpus_id
 from tests.motion.test_fanuc_macro import TWINS
-from tests.verify.test_corpus_pathcheck import rs274_environment, tool_table
+from tests.verify.test_corpus_pathcheck import (
+    as_linuxcnc_reads,
+    programs,
+    rs274_environment,
+    rs274_runs,
+    tool_table,
+)
 from tests.writeback.conftest import compensate_file
 from tests.writeback.test_compensated_holes import MACHINE, _rs274_text, square
 
@@ -385,4 +391,39 @@ def test_the_corpus_mount_program_expanded_runs_in_rs274_as_the_original(tmp_pat
     assert done.returncode == 0, done.stderr
     assert "in loops or subroutines" not in done.stderr and not FLOW_LINE.search(_running(output.read_text()))
     check = _pathcheck(program, output, "--var-file", str(var), "--tool-table", str(tools), "--tol-mm", "0.5")
+    assert check.returncode == 0, check.stdout + check.stderr
+
+
+# A corpus program with a loop, a subroutine or a Fanuc subprogram or macro loop
+_FLOWING = re.compile(rb"^\s*(N\d+\s*)?o\s*(\d+|<[^>]*>)\s*(sub|while|repeat|do)\b|M98|WHILE", re.I | re.M)
+
+
+def _flowing() -> list[Path]:
+    return [path for path in programs() if _FLOWING.search(path.read_bytes())]
+
+
+@pytest.mark.parametrize("program", _flowing(), ids=corpus_id)
+def test_corpus_programs_with_loops_expanded_run_in_rs274_as_the_originals(program, tmp_path):
+    """Every corpus program with loops or subroutines that rs274 runs, written out on the wide
+    machine: pathcheck passes, or ncpp refuses it as it does without --expand, or --expand
+    refuses a construct out of scope inside a loop or subroutine."""
+    if not WIDE.exists():
+        pytest.skip("wide.toml is not there")
+    tools = tool_table(tmp_path)
+    original = as_linuxcnc_reads(program, tmp_path)
+    if not rs274_runs(original, tools, rs274_environment(tmp_path)):
+        pytest.skip("rs274 refuses the original: nothing to compare")
+
+    def compensate(*options: str) -> subprocess.CompletedProcess:
+        arguments = ["--machine", str(WIDE), "--tool-table", str(tools), "--var-units", "inch", *options]
+        return subprocess.run([sys.executable, "-m", "ncpp", "compensate", *arguments, str(program), "-o",
+                               str(tmp_path / "out.ngc")], capture_output=True, text=True, timeout=600,
+                              env=dict(os.environ, PYTHONPATH=str(ROOT)))  # fmt: skip
+
+    done = compensate("--expand")
+    if done.returncode != 0:
+        error = done.stderr.strip().splitlines()[-1]
+        assert "--expand: " in error and "inside a loop" in error or compensate().returncode != 0, error
+        return
+    check = _pathcheck(original, tmp_path / "out.ngc", "--tool-table", str(tools), "--tol-mm", "0.5")
     assert check.returncode == 0, check.stdout + check.stderr
