@@ -162,7 +162,9 @@ UNCOMPENSATED = {
     CYCLE: "canned cycle: its moves pass through uncompensated, from its programmed start (the holes are where the "
     "program puts them, with the machine's errors); compensation resumes with the next move",
     FLOW: "loop or subroutine: its moves pass through uncompensated (one text runs several times, "
-    "or away from where it stands, so it cannot carry one correction); compensation resumes with the next move after it",
+    "or away from where it stands, so it cannot carry one correction); compensation resumes with the next move after it "
+    "(--expand writes an ISO program's loops and subroutines out as straight code, "
+    "each move compensated)",
     COMP: "cutter compensation: its moves pass through uncompensated (the control offsets them by the tool radius, "
     "so the tool is not where their points are); compensation resumes after the first move with it off (after G40, or R0)",
 }
@@ -326,6 +328,7 @@ def process(
     verify: bool = True,
     guard: Placement | None = None,
     expand_cycles: bool = False,
+    expand: bool = False,
 ) -> Stats:
     """Read, interpret, compensate (when `source` is given) and write one program.
 
@@ -333,7 +336,8 @@ def process(
     it picks the interpreter and the writer (`ncpp.program.dialects.UNITS`).  `offsets`: the zeros
     the control holds (machine mm; none: the program zero is the machine zero),
     which place the program on the machine whose errors are compensated.
-    `expand_cycles`: an ISO program's canned cycles are written as G0/G1 blocks (and G4 dwells).
+    `expand_cycles`: an ISO program's canned cycles are written as G0/G1 blocks (and G4 dwells);
+    `expand`: its loops and subroutines are written out as straight code (`motion/expand.py`).
 
     A compensated program is verified as it is written (`ncpp/verify.py`): read back
     and compared with the interpreter's reading of the input; where they part an
@@ -356,7 +360,7 @@ def process(
         blocks = without_guard(blocks)
     offsets = offsets or AT_MACHINE_ZERO  # the control's zeros place the program on the machine
     expanding = (
-        {"expand_cycles": True} if expand_cycles and FAMILY[name] == "iso" else {}
+        {"expand_cycles": expand_cycles, "expand": expand} if FAMILY[name] == "iso" else {}
     )  # (the others have none)
     events: Iterable[Event] = interpret(
         blocks, file=file, warnings=warnings, strict=strict, offsets=offsets, **expanding

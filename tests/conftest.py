@@ -36,6 +36,14 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
         "motion/test_oracle.py": None,
         "writeback/test_compensated_holes.py": None,
         "writeback/test_expand_cycles.py": ("test_expanded_cycles_dwell_as_programmed_and_hit_every_hole",),
+        "writeback/test_expand_flow.py": (
+            "test_expanded_bodies_land_where_programmed_and_rs274_runs_the_same_path",
+            "test_expanded_fanuc_macros_move_as_rs274_runs_their_o_word_twins",
+            "test_expanded_offsets_and_cycles_run_in_rs274_as_the_original",
+            "test_debug_messages_show_each_runs_values_as_rs274_shows_the_originals",
+            "test_corpus_programs_with_loops_expanded_run_in_rs274_as_the_originals",
+            "test_the_corpus_mount_program_expanded_runs_in_rs274_as_the_original",
+        ),
         "motion/test_fanuc_macro.py": (
             "test_fanuc_macros_move_as_rs274_runs_their_o_word_twins",
             "test_random_fanuc_macros_move_as_rs274_runs_their_o_word_twins",
@@ -114,6 +122,11 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_moves_after_a_return_are_corrected_from_the_home_position",
         ),
         "verify/test_verifier.py": ("test_a_path_over_itself_too_often_is_refused_with_a_way_out",),
+        "writeback/test_expand_flow.py": (
+            "test_both_commands_take_the_option_and_refuse_with_the_place",
+            "test_the_corpus_mount_program_expanded_runs_in_rs274_as_the_original",
+            "test_corpus_programs_with_loops_expanded_run_in_rs274_as_the_originals",
+        ),
         "shop/test_linuxcnc_filter.py": (
             "test_the_parameter_file_places_the_program_as_linuxcnc_does",
             "test_the_configuration_linuxcnc_runs_gives_its_parameter_file_and_tool_table",

@@ -41,12 +41,18 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def add_expand_argument(p: argparse.ArgumentParser) -> None:
-    """`--expand-cycles`, of the commands that compensate a program (not the CL-data post)."""
+    """`--expand-cycles` and `--expand`, of the commands that compensate a program (not the CL-data post)."""
     p.add_argument(
         "--expand-cycles",
         action="store_true",
         help="write each canned cycle of an ISO program as G0/G1 blocks (G4 where it dwells), each move "
         "compensated, for controls without canned cycles (tapping, G86 and G87 are refused)",
+    )
+    p.add_argument(
+        "--expand",
+        action="store_true",
+        help="write the loops and subroutines of an ISO program (o-word, M98, WHILE, GOTO) out as straight code, "
+        "every run of a body where it runs, each move compensated (without it their moves pass through uncompensated)",
     )
 
 
@@ -179,7 +185,7 @@ def run(args: argparse.Namespace) -> int:
             "or name a machine file in ./ncpp.toml or ~/.config/ncpp/config.toml"
         )
     job = Job(source, tolerance, args.strict, args.force, args.dialect, offsets, args.verify, guard,
-              args.expand_cycles)  # fmt: skip
+              args.expand_cycles, args.expand)  # fmt: skip
     folder = args.output is not None and os.path.isdir(args.output)
     if len(args.input) > 1 or folder:
         if args.output is None:
@@ -206,6 +212,7 @@ class Job:
     verify: bool = True
     guard: object = None  # guard.Placement: the placement guard at the program's start (None: none)
     expand_cycles: bool = False  # canned cycles written as G0/G1 blocks
+    expand: bool = False  # loops and subroutines written out as straight code
 
     def compensate(self, stream: BinaryIO, out: BinaryIO, name: str, progress: Progress = None):
         """`pipeline.process` of one program, with warnings of its own."""
@@ -216,7 +223,7 @@ class Job:
             tolerance=self.tolerance, strict=self.strict, force=self.force,
             warnings=Warnings(strict=self.strict), progress=progress, dialect=self.dialect,
             offsets=self.offsets, verify=self.verify, guard=self.guard,  # type: ignore[arg-type]
-            expand_cycles=self.expand_cycles,
+            expand_cycles=self.expand_cycles, expand=self.expand,
         )  # fmt: skip
 
 

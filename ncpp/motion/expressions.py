@@ -205,6 +205,22 @@ class Parameters:
                 }
         self.named["_value"], self.named["_value_returned"] = (0.0, 0.0) if value is None else (value, 1.0)
 
+    def main_level(self) -> tuple[dict[int, float], dict[str, float], frozenset[int]]:
+        """Copies of the numbered and named parameters and of the vacant numbers as the main
+        program has them: while calls are under way, its own #1.. and local names as the first
+        call that took them saved them (`leave` gives them back so)."""
+        numbered, named, vacant = dict(self.numbered), dict(self.named), set(self.vacant)
+        if not self._callers:
+            return numbered, named, frozenset(vacant)
+        named = {k: v for k, v in named.items() if k.startswith("_")}
+        named.update(self._callers[0][1])
+        for saved, _, was_vacant in self._callers:
+            if saved is not None:  # (None: an M98 call shares its caller's #1..)
+                numbered.update(zip(range(1, len(saved) + 1), saved))
+                vacant = {k for k in vacant if k > len(saved)} | {k for k in was_vacant if k <= len(saved)}
+                break
+        return numbered, named, frozenset(vacant)
+
     def key(self, key, evaluate: Callable[[tuple], float]) -> int | str:
         if isinstance(key, tuple):  # `#[expr]`, `##1`
             value = evaluate(key[1])

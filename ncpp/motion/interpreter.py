@@ -49,6 +49,7 @@ from ncpp.motion.cycles import (
     back_bore,
     hole,
 )
+from ncpp.motion.expand import Expansion
 from ncpp.motion.expressions import ExpressionError, OutOfScope, Parameters, evaluate, vacant
 from ncpp.motion.flow import FIXED, RUN, SKIP, Flow
 from ncpp.motion.offsets import SYSTEMS, WorkOffsets
@@ -188,6 +189,7 @@ def interpreting(flavour: type[Interpreter]) -> Callable[..., Iterator[Event]]:
         strict: bool = False,
         offsets: WorkOffsets | None = None,
         expand_cycles: bool = False,
+        expand: bool = False,
     ) -> Iterator[Event]:
         """Motion events of a program's blocks, lazily, as the flavour reads them (see the
         module docstring).
@@ -202,10 +204,12 @@ def interpreting(flavour: type[Interpreter]) -> Callable[..., Iterator[Event]]:
         `warnings` (stderr by default) and end interpretation; with `strict`
         (or a strict `warnings`) they raise NcppError instead.
 
-        `expand_cycles`: a canned cycle's block is to be written as its moves (`expanded`).
+        `expand_cycles`: a canned cycle's block is to be written as its moves (`expanded`);
+        `expand`: loops and subroutines are to be written out as straight code (`expand.py`).
         """
         interpreter = flavour(file, offsets)
         interpreter.expand_cycles = expand_cycles
+        interpreter.expansion = Expansion(interpreter.params, file) if expand else None
         return run(interpreter, blocks, warnings, strict)
 
     return interpret
@@ -249,6 +253,7 @@ class Interpreter:
         self.cycle_holes = False  # the series' cycles are compensated hole by hole (`Hole`)
         self.cycle_p = 0.0  # G82 G89's dwell, seconds (sticky within the cycle)
         self.expand_cycles = False  # cycles are written as their moves (`expanded`)
+        self.expansion: Expansion | None = None  # --expand: loops and subroutines written out
         self.spindle = 0  # M3 1, M4 -1, stopped 0 (tapping and boring cycles check it)
         self.coord_system = 1
         self.g5x = [[0.0] * 9 for _ in range(10)]  # index 1..9: G54..G59.3
@@ -308,8 +313,17 @@ class Interpreter:
         flow = self.flow = Flow(
             self.file, self._evaluate, self.params, lambda: self.done, self._leave_scope, self.subroutine_path
         )
+        expansion = self.expansion
         for block, kind, owner in flow.steps(blocks):
             if kind is not RUN and kind is not FIXED:  # text that does not run here
+                if expansion is not None:
+                    kept = expansion.text(kind, self.done, block)  # (None: left out)
+                    if kept is None:
+                        continue
+                    if pending is not None:
+                        held.extend(kept)
+                    else:
+                        yield from kept
                 if block.signature is None:
                     _warn_unreadable(block, warnings)
                 text = Pass(
@@ -321,8 +335,11 @@ class Interpreter:
                     yield text
                 continue
             try:
-                event = block_event(block)  # verbatim blocks (after the closing %) have no items
-                if kind is FIXED:
+                if expansion is not None:  # each block where it runs, a body's as this run's numbers
+                    event, block = expansion.event(block_event, block, kind)
+                else:
+                    event = block_event(block)  # verbatim blocks (after the closing %) have no items
+                if kind is FIXED and expansion is None:
                     event = self._in_flow(event, owner)
                 if flow.modal is not None and _moves(event):  # a move under G66: the macro next
                     flow.moved = True
@@ -346,6 +363,8 @@ class Interpreter:
                     yield from self._unrounded(pending, held)
                     pending = None
                 if owner is None:  # (a block that runs out of the text's order is written in its place)
+                    if expansion is not None:
+                        yield from expansion.owed()
                     yield Pass(block)
                 continue
             if pending is None and self.corner is None and type(event) is not tuple:
@@ -386,6 +405,10 @@ class Interpreter:
         self.done = True
         where = "this line" if owner is None else f"line {owner.line}, which runs it,"
         source = self.flow.source() if self.flow is not None else None
+        if self.expansion is not None and self.flow is not None and self.expansion.refuses_leaving(self.flow):
+            raise NcppError(f"--expand: {reason} is outside the motion interpreter's scope, inside a loop, "
+                            "a branch or a subroutine written out: the rest cannot pass through as it is",
+                            Location(source or self.file, block.line, col))  # fmt: skip
         self.warnings.warn(  # type: ignore[union-attr]
             f"{reason} is outside the motion interpreter's scope; from {where} on the "
             "program passes through uninterpreted (its modal state is unknown)",
