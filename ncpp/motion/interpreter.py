@@ -65,6 +65,7 @@ from ncpp.motion.segments import (
     Hole,
     Line,
     Pass,
+    Point,
     Setting,
     mark_off_path,
 )
@@ -273,6 +274,7 @@ class Interpreter:
             None  # its tool radius, program units, where known (G41.1/G42.1's D; G41/G42: the tool table's)
         )
         self.off_path = False  # the tool centre is off the programmed path: from the first move under comp to the first after G40
+        self.centre_at: Point = (0.0, 0.0, 0.0)  # the tool centre minus the programmed point (`_centre_shift`)
         self.arc_refused = False  # after G40 ended compensation that moved the tool off the path: until a G0/G1 move (rs274ngc)
         self.untold: set[int] = set()  # coordinate systems whose zero nobody said (warned when selected)
         self.warnings: Warnings | None = None
@@ -440,12 +442,46 @@ class Interpreter:
             self.arc_refused = moves[0].fixed in (CYCLE, HOLE) or _expanding(events[0]) or _homes(block)
         if self.cutter_comp is not None and self.comp_radius:
             self._check_radius(moves, block, self.comp_radius)
-        # (a loop's or a cycle's moves too: that the tool is off the path matters more)
-        self.off_path = mark_off_path(moves, self.cutter_comp is not None, self.off_path)
+        compensating = self.cutter_comp is not None
+        if compensating or self.off_path:
+            shifts = [self._centre_shift(move, compensating) for move in moves]
+            if _followed(moves):
+                for move, shift in zip(moves, shifts):
+                    move.centre_shift = shift
+                self.off_path = compensating
+            else:  # (a loop's or a cycle's moves too: that the tool is off the path matters more)
+                self.off_path = mark_off_path(moves, compensating, self.off_path)
         if moves[0].fixed and any(_expanding(ev) for ev in events):  # a cycle left as programmed stays one
             kept = tuple(ev for ev in events if not _expanding(ev))
             return kept if len(kept) != 1 else kept[0]
         return event
+
+    def _centre_shift(self, move: Line | Arc, compensating: bool) -> tuple[Point, Point]:
+        """Where the tool centre stands off the move's programmed start and end: the end's by the
+        radius to the left (G41) or right (G42) of the move's own direction there, as the control
+        offsets the contour (zero where the radius is unknown); the start's is the move before's
+        end's (the entry move starts on its programmed point, the exit move after G40 ends on it).
+        A move with no motion in the plane keeps the tool centre where it stands."""
+        start = self.centre_at
+        radius = self.comp_radius if compensating and self.comp_radius else 0.0
+        if compensating and not radius:
+            end: Point = (0.0, 0.0, 0.0)
+        elif not compensating:
+            end = (0.0, 0.0, 0.0)
+        else:
+            side = radius if self.cutter_comp in (41.0, 41.1) else -radius
+            (x0, y0, _), (x1, y1, _) = move.start, move.end
+            if type(move) is Arc:  # left of the tangent: towards the centre counter-clockwise
+                cx, cy, _ = move.center
+                length = math.hypot(x1 - cx, y1 - cy)
+                side = -side if move.turn > 0 else side
+                end = (side * (x1 - cx) / length, side * (y1 - cy) / length, 0.0)
+            elif (length := math.hypot(x1 - x0, y1 - y0)) > 0.0:
+                end = (-side * (y1 - y0) / length, side * (x1 - x0) / length, 0.0)
+            else:
+                end = start
+        self.centre_at = end
+        return start, end
 
     def _check_radius(self, moves: list, block: Block, radius: float) -> None:
         """rs274ngc's checks of moves under compensation against the tool radius: the entry move
@@ -494,6 +530,10 @@ class Interpreter:
             raise NcppError(str(err), where) from None
         if first.fixed == COMP or second.fixed == COMP:  # the control rounds the contour, then offsets it
             pieces[1].fixed = COMP  # type: ignore[union-attr]  # (the lines keep their own)
+        if first.centre_shift is not None or second.centre_shift is not None:  # (the same: left as programmed)
+            for piece in pieces:
+                if piece.centre_shift is not None or piece is pieces[1]:
+                    piece.fixed, piece.centre_shift = COMP, None  # type: ignore[union-attr]
         return pieces
 
     def context(self) -> Context:
@@ -1067,6 +1107,13 @@ class Interpreter:
                 if self.tools is None
                 else self.tools.diameter(number) / 2 / (MM_PER_INCH if self.inch else 1.0)
             )
+            if self.comp_radius is None and self.plane == 17:
+                self.warnings.warn(  # type: ignore[union-attr]
+                    f"G{code:g}: the tool radius is not known (no tool table: --tool-table), so the moves under "
+                    "cutter compensation are corrected for their programmed points, from which the tool centre "
+                    "stands off by that radius",
+                    Location(self.file, block.line, item.start + 1),
+                )
         self.cutter_comp = code
 
     def _check_scope(self, words: dict, gcodes: dict) -> None:
@@ -1095,6 +1142,7 @@ class Interpreter:
                 vector[i] *= scale
         if self.comp_radius is not None:
             self.comp_radius *= scale
+        self.centre_at = (self.centre_at[0] * scale, self.centre_at[1] * scale, 0.0)
         self._set(inch=inch)
 
     def _shift(self, old: list[float], new: list[float]) -> None:
@@ -1182,6 +1230,7 @@ class Interpreter:
         self._set(plane=17, absolute=True, inverse_time=False)
         self.motion = 1.0
         self.cutter_comp, self.comp_radius, self.off_path, self.arc_refused = None, None, False, False
+        self.centre_at = (0.0, 0.0, 0.0)
         self.done = True
 
     def _machine(self, i: int) -> float:
@@ -1760,6 +1809,12 @@ def _moves(event: Event | tuple[Event, ...]) -> bool:
     if type(event) is tuple:
         return any(type(e) is not Pass for e in event)
     return type(event) is not Pass
+
+
+def _followed(moves: list[Line | Arc]) -> bool:
+    """Whether compensation follows a block's moves under cutter compensation (`Line.centre_shift`):
+    in G17 and G90, and none of them left as programmed for another reason (a loop's, a cycle's)."""
+    return all(not m.fixed and m.context.plane == 17 and m.context.absolute for m in moves)
 
 
 def _homes(block: Block) -> bool:

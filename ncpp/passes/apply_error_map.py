@@ -247,6 +247,11 @@ class _Rows:
     carried: NDArray  # (n,) moves left as programmed that run from where the control is (`_carry`)
     kept: NDArray  # (n,3) their axes that do so (the others the control puts at their programmed end)
     lead_in: NDArray  # (n,) a canned cycle's first move after a compensated one: a step to its start first
+    # under cutter compensation: each segment's (`Line.centre_shift`) and the end shifts (n,3) of the lines to
+    # compensate (zero elsewhere), and the lines that move no axis of the plane (`_pin_plane`); None: none is
+    comp: NDArray | None = None
+    shift: NDArray | None = None
+    still: NDArray | None = None
 
 
 def _rows_before(rows: _Rows, line: int | None) -> _Rows | None:
@@ -279,8 +284,38 @@ def _rows(segs: list, directional: bool, fixed_before: bool = True) -> _Rows:
         start, end, offsets, scales, tools, free, changed, changed & line,
         _arc_assumed(segs, np.flatnonzero(changed & arc), start, end) if directional else None,
         np.fromiter([e.block.line for e in segs], dtype=np.int64, count=len(segs)), (kind & 8) != 0, any3(kept), kept,
-        lead_in,
+        lead_in, *_under_comp(segs, free, start, end),
     )  # fmt: skip
+
+
+def _under_comp(segs: list, free: NDArray, start: NDArray, end: NDArray) -> tuple[NDArray | None, ...]:
+    """`_Rows.comp`, `.shift` and `.still` of the segments (all None: none is under compensation).  A
+    line under compensation that moves no axis of the plane (G17: X Y) leaves the tool centre where it
+    stands (`Interpreter._centre_shift`): the same shift at both ends."""
+    if all(e.centre_shift is None for e in segs):
+        return None, None, None
+    comp = np.fromiter((e.centre_shift is not None for e in segs), dtype=bool, count=len(segs))
+    shift = np.zeros((len(segs), 3))
+    own = np.flatnonzero(comp & free)
+    shift[own] = [segs[k].centre_shift[1] for k in own.tolist()]
+    same = np.zeros(len(segs), dtype=bool)
+    same[own] = [segs[k].centre_shift[0] == segs[k].centre_shift[1] for k in own.tolist()]
+    still = same & (start[:, :2] == end[:, :2]).all(axis=1)
+    return comp, shift, still
+
+
+def _pin_plane(rows: _Rows, out_end: NDArray, before: NDArray | None) -> None:
+    """The lines under compensation that move no axis of the plane keep the X Y of the end before
+    them: a correction that differs there (with Z) would be a tiny move in the plane, which the
+    control offsets along its own direction.  `before`: the previous chunk's last end, in the first
+    row's frame (None: none)."""
+    if rows.still is None:
+        return
+    for k in np.flatnonzero(rows.still).tolist():  # in order: a run of them keeps the first's X Y
+        if k > 0 and (rows.offsets[k] == rows.offsets[k - 1]).all() and rows.scales[k] == rows.scales[k - 1]:
+            out_end[k, :2] = out_end[k - 1, :2]
+        elif k == 0 and before is not None:
+            out_end[k, :2] = before[:2]
 
 
 def _kept_axes(segs: list, kind: NDArray) -> NDArray:
@@ -482,8 +517,9 @@ def _plain(rows: _Rows, ctx: PassContext, travel: Travel) -> _Solved:
     at_end = np.zeros(end.shape, dtype=bool)
     if at.size:
         ends = np.zeros((at.size, 3), dtype=bool)
+        shift = 0.0 if rows.shift is None else rows.shift[at]
         end[at] = compensate(
-            end[at],
+            end[at] + shift,
             offsets[at],
             scales[at],
             rows.lines[at],
@@ -491,10 +527,12 @@ def _plain(rows: _Rows, ctx: PassContext, travel: Travel) -> _Solved:
             np.sign(end[at] - start[at]),
             rows_of(rows.tools, at),
             ends,
-        )
+        ) - shift
         at_end[at] = ends
+    before = None if travel.last is None else travel.last / scales[0] - offsets[0]
+    _pin_plane(rows, end, before)
     if rows.carried.any():
-        _carry(rows, end, None if travel.last is None else travel.last / scales[0] - offsets[0])
+        _carry(rows, end, before)
     travel.last = (end[-1] + offsets[-1]) * scales[-1]
     none = np.zeros(len(free), dtype=bool)
     keep = np.ones(start.shape, dtype=bool)
@@ -521,8 +559,10 @@ class _Commands:
         if todo.size:
             segs = self.rows
             ends = np.zeros((todo.size, 3), dtype=bool)
-            c = compensate(self.wanted[which][todo], segs.offsets[todo], segs.scales[todo], segs.lines[todo], self.ctx, d_todo,
-                           rows_of(segs.tools, todo), ends)  # fmt: skip
+            # (under cutter compensation a line's end is corrected where the tool centre is: `_Rows.shift`)
+            shift = 0.0 if segs.shift is None or which != "end" else segs.shift[todo]
+            c = compensate(self.wanted[which][todo] + shift, segs.offsets[todo], segs.scales[todo], segs.lines[todo], self.ctx,
+                           d_todo, rows_of(segs.tools, todo), ends) - shift  # fmt: skip
             self.values[which][todo] = quantize(c, self.step[todo])
             self.at_end[which][todo] = ends
             self.directions[which][todo] = d_todo
@@ -541,6 +581,9 @@ def _directional(rows: _Rows, ctx: PassContext, travel: Travel) -> _Solved:
     first = travel.last if travel.last is not None else start_m[0]
     before = None if travel.last is None else travel.last / scales[0] - offsets[0]  # in the first row's frame
     limit = _snap_limit(step, scales)
+    # arc pieces under cutter compensation move onto the end before them, however far: a connecting step
+    # there would be a move the control offsets along its own direction
+    joined = limit if rows.comp is None else np.where(rows.comp & arc, np.inf, limit)
 
     out_start, out_end = start_p.copy(), end_p.copy()
     compensated = end_p.copy()  # line ends before _settle leaves axes standing
@@ -561,7 +604,8 @@ def _directional(rows: _Rows, ctx: PassContext, travel: Travel) -> _Solved:
         used[redo], used[shift] = d[redo], d[shift]
         out_end[free] = compensated[free]
         _hold_pieces_still(pieces, d, travel.held, limit, out_start, out_end)
-        _settle(free, arc, d, travel.held, offsets, scales, limit, out_start, out_end, before)
+        _settle(free, arc, d, travel.held, offsets, scales, joined, out_start, out_end, before)
+        _pin_plane(rows, out_end, before)
         if rows.carried.any():
             _carry(rows, out_end, before)
         cur_end, cur_start = machine(out_end), machine(out_start)
@@ -581,6 +625,8 @@ def _directional(rows: _Rows, ctx: PassContext, travel: Travel) -> _Solved:
     before = np.vstack([travel.held[None, :], d[:-1]])
     flips = (d != before) & (before != 0)
     turn = free & any3(flips)
+    if rows.comp is not None:  # (no reversal step under cutter compensation: `joined`)
+        turn &= ~rows.comp
     turn_start = np.full(start_p.shape, np.nan)
     turned = np.flatnonzero(turn)
     if turned.size:
