@@ -456,13 +456,15 @@ class Interpreter:
             return kept if len(kept) != 1 else kept[0]
         return event
 
-    def _centre_shift(self, move: Line | Arc, compensating: bool) -> tuple[Point, Point]:
+    def _centre_shift(self, move: Line | Arc, compensating: bool) -> tuple[Point | None, Point]:
         """Where the tool centre stands off the move's programmed start and end: the end's by the
         radius to the left (G41) or right (G42) of the move's own direction there, as the control
         offsets the contour (zero where the radius is unknown); the start's is the move before's
-        end's (the entry move starts on its programmed point, the exit move after G40 ends on it).
-        A move with no motion in the plane keeps the tool centre where it stands."""
-        start = self.centre_at
+        end's (the exit move after G40 ends on it).  The entry move's start is None: the tool centre
+        starts on the programmed point, and the control makes the move whole (rs274ngc checks its
+        length against the radius).  A move with no motion in the plane keeps the tool centre where
+        it stands."""
+        start = self.centre_at if self.off_path else None
         radius = self.comp_radius if compensating and self.comp_radius else 0.0
         if compensating and not radius:
             end: Point = (0.0, 0.0, 0.0)
@@ -479,7 +481,7 @@ class Interpreter:
             elif (length := math.hypot(x1 - x0, y1 - y0)) > 0.0:
                 end = (-side * (y1 - y0) / length, side * (x1 - x0) / length, 0.0)
             else:
-                end = start
+                end = self.centre_at
         self.centre_at = end
         return start, end
 

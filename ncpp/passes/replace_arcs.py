@@ -192,8 +192,9 @@ class _ArcRows:
     lines: NDArray  # (n,) the line of each arc's block, for messages
     normal: NDArray  # (n,) the direction each arc's normal axis is compensated for (`Motion`)
     # under cutter compensation (`Arc.centre_shift`): how far the tool centre stands off the arc towards
-    # its outside (n,) (negative: inside), and off its start (n,3), program units; None: no arc is
-    tool_centre: tuple[NDArray, NDArray] | None = None
+    # its outside (n,) (negative: inside), and off its start (n,3), program units, and the entry arcs (n,),
+    # which stay whole; None: no arc is under compensation
+    tool_centre: tuple[NDArray, NDArray, NDArray] | None = None
 
     @classmethod
     def of(cls, arcs: list[Arc], normals: list[int]) -> _ArcRows:
@@ -206,17 +207,19 @@ class _ArcRows:
         )  # fmt: skip
 
 
-def _centre_offsets(arcs: list[Arc]) -> tuple[NDArray, NDArray] | None:
+def _centre_offsets(arcs: list[Arc]) -> tuple[NDArray, NDArray, NDArray] | None:
     """`_ArcRows.tool_centre` of the arcs: the radial offset read from the shift at each one's end."""
     if all(a.centre_shift is None for a in arcs):
         return None
-    radial, start = np.zeros(len(arcs)), np.zeros((len(arcs), 3))
+    radial, start, entry = np.zeros(len(arcs)), np.zeros((len(arcs), 3)), np.zeros(len(arcs), dtype=bool)
     for k, arc in enumerate(arcs):
         if arc.centre_shift is not None:
-            start[k], (sx, sy, _) = arc.centre_shift
+            at_start, (sx, sy, _) = arc.centre_shift
+            entry[k] = at_start is None
+            start[k] = (0.0, 0.0, 0.0) if at_start is None else at_start
             dx, dy = arc.end[0] - arc.center[0], arc.end[1] - arc.center[1]  # (followed in G17 only)
             radial[k] = (sx * dx + sy * dy) / math.hypot(dx, dy)
-    return radial, start
+    return radial, start, entry
 
 
 @dataclass
@@ -279,11 +282,16 @@ class _ArcGeometry:
         corner belongs to the move that ends there).  None: no arc is under compensation."""
         if self.tool_centre is None:
             return None
-        radial, start = self.tool_centre
+        radial, start, _ = self.tool_centre
         k = radial[arc, None]
         shift = from_plane(k * np.cos(angles), k * np.sin(angles), np.zeros_like(angles), self.axes[arc])
         first = angles == self.a0[arc, None]  # (the first piece starts at the arc's angle, exactly)
         return np.where(first[..., None], start[arc, None, :], shift)
+
+    def whole(self, arc: NDArray) -> NDArray:
+        """(p,) the arcs (of `arc`) that stay one piece: the entry arcs of cutter compensation (the
+        control checks that arc against the tool radius, and offsets only its end)."""
+        return np.zeros(len(arc), dtype=bool) if self.tool_centre is None else self.tool_centre[2][arc]
 
 
 def _sweeps(a0: NDArray, a1: NDArray, turn: NDArray) -> NDArray:
@@ -308,6 +316,20 @@ def _initial_pieces(geometry: _ArcGeometry, directional: bool) -> _Pieces:
     step = (geometry.sweep / counts)[arc]
     nth = np.arange(len(arc)) - np.repeat(np.cumsum(counts) - counts, counts)
     return _Pieces(arc, geometry.a0[arc] + nth * step, step)
+
+
+def _whole(pieces: _Pieces, geometry: _ArcGeometry) -> _Pieces:
+    """The pieces, those of an arc that stays whole (`_ArcGeometry.whole`) made one again."""
+    whole = geometry.whole(pieces.arc)
+    if not whole.any():
+        return pieces
+    arcs = np.unique(pieces.arc[whole])
+    keep = ~whole
+    return _Pieces(
+        np.concatenate([pieces.arc[keep], arcs]),
+        np.concatenate([pieces.a0[keep], geometry.a0[arcs]]),
+        np.concatenate([pieces.sweep[keep], geometry.sweep[arcs]]),
+    )
 
 
 def _quadrant_pieces(geometry: _ArcGeometry) -> _Pieces:
@@ -340,7 +362,7 @@ def _replace(arcs: _ArcRows, ctx: PassContext) -> _Fitted:
         )
     geometry = _ArcGeometry(arcs)
     offsets, scales, tools, line_of = arcs.offsets, arcs.scales, arcs.tools, arcs.lines
-    pending = _initial_pieces(geometry, ctx.directional)
+    pending = _whole(_initial_pieces(geometry, ctx.directional), geometry)
     done = _Fitted(geometry.a0, np.where(geometry.sweep >= 0, 1.0, -1.0))
     for _ in range(MAX_ROUNDS):
         if len(pending.arc) == 0:
@@ -434,8 +456,9 @@ def _round(
     # piece that reverses an axis inside but bulges less than a quarter of the tolerance
     chord = norm3(q[:, -1] - q[:, 0]) * scale
     flat = chord**2 / (8 * np.maximum(geometry.radius[pending.arc] * scale, 1e-12)) <= ctx.tolerance / 4
-    straight = (length < SLIVER) | (~one_way & flat)
-    ok &= one_way & ~straight
+    whole = geometry.whole(pending.arc)
+    straight = ((length < SLIVER) | (~one_way & flat)) & ~whole
+    ok = (ok & one_way & ~straight) | whole
     give_up = ~ok & ~straight & (length < MIN_PIECE)
     lines = np.flatnonzero(straight | give_up)
     if lines.size and ctx.directional:
