@@ -466,10 +466,8 @@ class Interpreter:
         it stands."""
         start = self.centre_at if self.off_path else None
         radius = self.comp_radius if compensating and self.comp_radius else 0.0
-        if compensating and not radius:
+        if not radius or move.context.plane != 17:  # (followed in the XY plane only: `_followed`)
             end: Point = (0.0, 0.0, 0.0)
-        elif not compensating:
-            end = (0.0, 0.0, 0.0)
         else:
             side = radius if self.cutter_comp in (41.0, 41.1) else -radius
             (x0, y0, _), (x1, y1, _) = move.start, move.end
