@@ -163,7 +163,8 @@ UNCOMPENSATED = {
     FLOW: "loop or subroutine: its moves pass through uncompensated (one text runs several times, "
     "or away from where it stands, so it cannot carry one correction); compensation resumes with the next move after it",
     COMP: "cutter compensation: its moves pass through uncompensated (the control offsets them by the tool radius, "
-    "so the tool is not where their points are); compensation resumes after the first move with it off (after G40, or R0)",
+    "so the tool is not where their points are; ncpp follows it in ISO programs in G17 and G90 only, outside loops, "
+    "subroutines and Fanuc corners); compensation resumes after the first move with it off (after G40, or R0)",
 }
 INCREMENTAL_CYCLE = (
     "a G91 move right after a canned cycle in G90: it starts where the cycle left the tool (a G98 retract "

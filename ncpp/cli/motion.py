@@ -120,6 +120,8 @@ def run(args: argparse.Namespace) -> int:
                 event.fixed
             ):  # why compensation leaves it as programmed (a canned cycle, cutter compensation, ...)
                 record["fixed"] = event.fixed
+            if event.centre_shift is not None:  # under cutter compensation ncpp follows
+                record["centre_shift"] = event.centre_shift
             out.write(json.dumps(record) + "\n")
     warnings.finish()
     return 0

@@ -19,9 +19,10 @@ macro B (GOTO, IF ... GOTO, WHILE ... DO ... END, G65 and G66/G67 macro calls: `
 #5001-#5003 where known: here), and cutter compensation G40-G42.1
 (`_in_comp`): where the control offsets the path by the tool radius the moves
 are the programmed contour, not the tool centre, and after G40 the position is
-the program's again, as in rs274ngc.  The moves of cycles, loops, subroutines
-and macros, and those the tool makes off the programmed path (from the first
-move under G41/G42 to the first after G40), are marked `fixed`: compensation
+the program's again, as in rs274ngc.  The moves the tool makes off the programmed
+path (from the first move under G41/G42 to the first after G40) carry where the
+tool centre stands (`centre_shift`), in G17 and G90; elsewhere they are marked
+`fixed`, as are the moves of cycles, loops, subroutines and macros: compensation
 leaves them as programmed.  Anything else (subroutine files ncpp is not told
 of, a move of a subprogram under G66, a Fanuc system variable it does not know, M99
 in the main program, G88 (a manual retract) and the lathe cycles, splines,
