@@ -16,7 +16,7 @@ start is compensated with its own direction and a step move is inserted.
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, fields, replace
 from itertools import chain
 from typing import overload
@@ -248,10 +248,12 @@ class _Rows:
     kept: NDArray  # (n,3) their axes that do so (the others the control puts at their programmed end)
     lead_in: NDArray  # (n,) a canned cycle's first move after a compensated one: a step to its start first
     # under cutter compensation: each segment's (`Line.centre_shift`) and the end shifts (n,3) of the lines to
-    # compensate (zero elsewhere), and the lines that move no axis of the plane (`_pin_plane`); None: none is
+    # compensate (zero elsewhere), the lines that move no axis of the plane (`_pin_plane`), and those that
+    # turn a corner from a line (`_corners`); None: none is
     comp: NDArray | None = None
     shift: NDArray | None = None
     still: NDArray | None = None
+    corner: NDArray | None = None
 
 
 def _rows_before(rows: _Rows, line: int | None) -> _Rows | None:
@@ -289,19 +291,65 @@ def _rows(segs: list, directional: bool, fixed_before: bool = True) -> _Rows:
 
 
 def _under_comp(segs: list, free: NDArray, start: NDArray, end: NDArray) -> tuple[NDArray | None, ...]:
-    """`_Rows.comp`, `.shift` and `.still` of the segments (all None: none is under compensation).  A
-    line under compensation that moves no axis of the plane (G17: X Y) leaves the tool centre where it
-    stands (`Interpreter._centre_shift`): the same shift at both ends."""
+    """`_Rows.comp`, `.shift`, `.still` and `.corner` of the segments (all None: none is under
+    compensation).  A line under compensation that moves no axis of the plane (G17: X Y) leaves the
+    tool centre where it stands (`Interpreter._centre_shift`): the same shift at both ends."""
     if all(e.centre_shift is None for e in segs):
-        return None, None, None
+        return None, None, None, None
     comp = np.fromiter((e.centre_shift is not None for e in segs), dtype=bool, count=len(segs))
     shift = np.zeros((len(segs), 3))
     own = np.flatnonzero(comp & free)
     shift[own] = [segs[k].centre_shift[1] for k in own.tolist()]
     same = np.zeros(len(segs), dtype=bool)
     same[own] = [segs[k].centre_shift[0] == segs[k].centre_shift[1] for k in own.tolist()]
-    still = same & (start[:, :2] == end[:, :2]).all(axis=1)
-    return comp, shift, still
+    moves = (start[:, :2] != end[:, :2]).any(axis=1)
+    still = same & ~moves
+    # a line whose tool centre stands off it by a radius (not the entry move, nor the exit move after G40),
+    # after a line under compensation in the same frame
+    entry = np.zeros(len(segs), dtype=bool)
+    entry[own] = [segs[k].centre_shift[0] is None for k in own.tolist()]
+    offset = comp & free & moves & any3(shift != 0) & ~entry
+    corner = np.zeros(len(segs), dtype=bool)
+    corner[1:] = offset[1:] & (comp & free & moves)[:-1]
+    for k in np.flatnonzero(corner).tolist():
+        a, b = segs[k - 1].context, segs[k].context
+        corner[k] = a.offset == b.offset and a.inch == b.inch
+    return comp, shift, still, corner
+
+
+# |sin| of the turn between two lines below which their corner is left to the line that ends there
+# (the lines' crossing, `_corners`, moves far along them for a small shift across), and the cosine of a
+# turn back beyond which it is too
+SHALLOW = 0.2
+HAIRPIN = -0.9
+
+
+def _corners(
+    rows: _Rows, out_end: NDArray, crossing: Callable[[NDArray], NDArray], step: NDArray | None = None
+) -> None:
+    """Corners between two lines under cutter compensation: the control offsets each line by the
+    radius, and the corner point corrected for the first line's tool centre leaves the second line
+    off by the error's gradient times the radius times the turn.  The corner is put where the first
+    line's corrected contour crosses the second's: `out_end` of the first, moved along it.
+    `crossing(rows)`: the second lines' corrected starts (their own tool centre's correction); `step`
+    (n,): the output grid the moved ends are put on (None: none)."""
+    if rows.corner is None or not rows.corner.any():
+        return
+    k = np.flatnonzero(rows.corner)
+    d1 = rows.end[k - 1, :2] - rows.start[k - 1, :2]
+    d2 = rows.end[k, :2] - rows.start[k, :2]
+    d1 /= np.linalg.norm(d1, axis=1)[:, None]
+    d2 /= np.linalg.norm(d2, axis=1)[:, None]
+    across = d1[:, 1] * d2[:, 0] - d1[:, 0] * d2[:, 1]  # d1 · n2, n2 = d2 turned a quarter
+    turn = (np.abs(across) >= SHALLOW) & ((d1 * d2).sum(axis=1) >= HAIRPIN)
+    k, d1, d2, across = k[turn], d1[turn], d2[turn], across[turn]
+    if k.size == 0:
+        return
+    gap = crossing(k)[:, :2] - out_end[k - 1, :2]
+    along = (gap[:, 1] * d2[:, 0] - gap[:, 0] * d2[:, 1]) / across  # (gap · n2) / (d1 · n2)
+    out_end[k - 1, :2] += along[:, None] * d1
+    if step is not None:
+        out_end[k - 1] = quantize(out_end[k - 1], step[k - 1])
 
 
 def _pin_plane(rows: _Rows, out_end: NDArray, before: NDArray | None) -> None:
@@ -529,6 +577,9 @@ def _plain(rows: _Rows, ctx: PassContext, travel: Travel) -> _Solved:
             ends,
         ) - shift
         at_end[at] = ends
+    crossing = lambda k: compensate(start[k] + rows.shift[k], offsets[k], scales[k], rows.lines[k], ctx,  # noqa: E731
+                                    np.sign(rows.end[k] - start[k]), rows_of(rows.tools, k)) - rows.shift[k]  # type: ignore[index]  # fmt: skip
+    _corners(rows, end, crossing)
     before = None if travel.last is None else travel.last / scales[0] - offsets[0]
     _pin_plane(rows, end, before)
     if rows.carried.any():
@@ -560,7 +611,7 @@ class _Commands:
             segs = self.rows
             ends = np.zeros((todo.size, 3), dtype=bool)
             # (under cutter compensation a line's end is corrected where the tool centre is: `_Rows.shift`)
-            shift = 0.0 if segs.shift is None or which != "end" else segs.shift[todo]
+            shift = 0.0 if segs.shift is None else segs.shift[todo]  # (a line's is the same at its start)
             c = compensate(self.wanted[which][todo] + shift, segs.offsets[todo], segs.scales[todo], segs.lines[todo], self.ctx,
                            d_todo, rows_of(segs.tools, todo), ends) - shift  # fmt: skip
             self.values[which][todo] = quantize(c, self.step[todo])
@@ -603,6 +654,7 @@ def _directional(rows: _Rows, ctx: PassContext, travel: Travel) -> _Solved:
             _shift_arcs(shift, rows, d, assumed, step, ctx, out_start, out_end)
         used[redo], used[shift] = d[redo], d[shift]
         out_end[free] = compensated[free]
+        _corners(rows, out_end, lambda k: commands("start", k, d[k]), step)
         _hold_pieces_still(pieces, d, travel.held, limit, out_start, out_end)
         _settle(free, arc, d, travel.held, offsets, scales, joined, out_start, out_end, before)
         _pin_plane(rows, out_end, before)

@@ -68,6 +68,12 @@ POCKET = HEAD + (
     "G3 X90 Y90 I-20 J0\nG1 X30 Y90\nG3 X10 Y70 R20\nG1 X10 Y30\nG3 X30 Y10 I20 J0\nG1 X50 Y10\nG40\n"
     "G1 X50 Y40\nG0 Z5\nM2\n"
 )
+# a polygon, the tool (10 mm) on the right: corners between lines only, put where the lines' corrected
+# contours cross (the point corrected for the first line's tool centre would leave the second off by µm)
+POLYGON = HEAD + (
+    "G0 X-30 Y-30 Z5\nG1 Z-1 F300\nG42.1 D20\nG1 X0 Y0\nG1 X0 Y100\nG1 X120 Y140\nG1 X150 Y30\nG1 X60 Y-10\n"
+    "G1 X0 Y0\nG40\nG1 X-30 Y-30\nG0 Z5\nM2\n"
+)
 # G41 with the radius of the tool table's tool 3, an entry arc, a Z move under compensation
 TABLE = HEAD + (
     "T3 M6 G43\nG0 X-30 Y-10 Z5\nG1 Z-3 F250\nG41 D3\nG3 X0 Y0 R30\nG1 Y60\nG2 X20 Y80 R20\nG1 X70\n"
@@ -95,7 +101,9 @@ def pathcheck(original: Path, rewritten: Path, *options: str) -> None:
 
 
 @needs_oracles
-@pytest.mark.parametrize("text", [OUTSIDE, POCKET, TABLE], ids=["outside-g41.1", "pocket-g42.1", "table-g41"])
+@pytest.mark.parametrize(
+    "text", [OUTSIDE, POCKET, POLYGON, TABLE], ids=["outside-g41.1", "pocket-g42.1", "polygon-g42.1", "table-g41"]
+)
 def test_the_tool_centre_lands_on_the_original_path_within_half_a_micron(tmp_path, text):
     """The original's tool-centre path is where the tool centre should be; the rewritten program's,
     run on the machine, is within 0.5 µm of it all along (the arcs fitted to 0.1 µm), where the
@@ -106,7 +114,7 @@ def test_the_tool_centre_lands_on_the_original_path_within_half_a_micron(tmp_pat
     original, out, _ = written(tmp_path, text, "contour.ngc", "--tolerance", "0.0001", "--tool-table", str(tools),
                                "--var-units", "inch")  # fmt: skip
     before, after = (feed_moves(p, tools, home=tmp_path) for p in (original, out))
-    assert sum(m.comp > 0 for m in before) >= 10
+    assert sum(m.comp > 0 for m in before) >= 8
     assert deviation(before, before, closed_form).max() > 0.005
     assert deviation(before, after, closed_form).max() <= 0.0005
     pathcheck(original, out, "--tool-table", str(tools))
