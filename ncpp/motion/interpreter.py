@@ -275,7 +275,8 @@ class Interpreter:
             None  # its tool radius, program units, where known (G41.1/G42.1's D; G41/G42: the tool table's)
         )
         self.off_path = False  # the tool centre is off the programmed path: from the first move under comp to the first after G40
-        self.centre_at: Point = (0.0, 0.0, 0.0)  # the tool centre minus the programmed point (`_centre_shift`)
+        # the tool centre minus the programmed point (`_centre_shift`)
+        self.centre_at: Point = (0.0, 0.0, 0.0)
         self.arc_refused = False  # after G40 ended compensation that moved the tool off the path: until a G0/G1 move (rs274ngc)
         self.untold: set[int] = set()  # coordinate systems whose zero nobody said (warned when selected)
         self.warnings: Warnings | None = None
@@ -531,10 +532,11 @@ class Interpreter:
             raise NcppError(str(err), where) from None
         if first.fixed == COMP or second.fixed == COMP:  # the control rounds the contour, then offsets it
             pieces[1].fixed = COMP  # type: ignore[union-attr]  # (the lines keep their own)
-        if first.centre_shift is not None or second.centre_shift is not None:  # (the same: left as programmed)
-            for piece in pieces:
+        if first.centre_shift is not None or second.centre_shift is not None:
+            # (the same: every piece left as programmed, the lines too)
+            for piece in cast(list[Line | Arc], pieces):
                 if piece.centre_shift is not None or piece is pieces[1]:
-                    piece.fixed, piece.centre_shift = COMP, None  # type: ignore[union-attr]
+                    piece.fixed, piece.centre_shift = COMP, None
         return pieces
 
     def context(self) -> Context:

@@ -566,20 +566,29 @@ def _plain(rows: _Rows, ctx: PassContext, travel: Travel) -> _Solved:
     if at.size:
         ends = np.zeros((at.size, 3), dtype=bool)
         shift = 0.0 if rows.shift is None else rows.shift[at]
-        end[at] = compensate(
-            end[at] + shift,
-            offsets[at],
-            scales[at],
-            rows.lines[at],
-            ctx,
-            np.sign(end[at] - start[at]),
-            rows_of(rows.tools, at),
-            ends,
-        ) - shift
+        end[at] = (
+            compensate(
+                end[at] + shift,
+                offsets[at],
+                scales[at],
+                rows.lines[at],
+                ctx,
+                np.sign(end[at] - start[at]),
+                rows_of(rows.tools, at),
+                ends,
+            )
+            - shift
+        )
         at_end[at] = ends
-    crossing = lambda k: compensate(start[k] + rows.shift[k], offsets[k], scales[k], rows.lines[k], ctx,  # noqa: E731
-                                    np.sign(rows.end[k] - start[k]), rows_of(rows.tools, k)) - rows.shift[k]  # type: ignore[index]  # fmt: skip
-    _corners(rows, end, crossing)
+    if rows.shift is not None:
+        centre = rows.shift
+
+        def crossing(k: NDArray) -> NDArray:
+            direction, wanted = np.sign(rows.end[k] - start[k]), start[k] + centre[k]
+            tools = rows_of(rows.tools, k)
+            return compensate(wanted, offsets[k], scales[k], rows.lines[k], ctx, direction, tools) - centre[k]
+
+        _corners(rows, end, crossing)
     before = None if travel.last is None else travel.last / scales[0] - offsets[0]
     _pin_plane(rows, end, before)
     if rows.carried.any():
@@ -654,7 +663,7 @@ def _directional(rows: _Rows, ctx: PassContext, travel: Travel) -> _Solved:
             _shift_arcs(shift, rows, d, assumed, step, ctx, out_start, out_end)
         used[redo], used[shift] = d[redo], d[shift]
         out_end[free] = compensated[free]
-        _corners(rows, out_end, lambda k: commands("start", k, d[k]), step)
+        _corners(rows, out_end, lambda k: commands("start", k, d[k]), step)  # noqa: B023  # (called here)
         _hold_pieces_still(pieces, d, travel.held, limit, out_start, out_end)
         _settle(free, arc, d, travel.held, offsets, scales, joined, out_start, out_end, before)
         _pin_plane(rows, out_end, before)

@@ -7,7 +7,6 @@ pathcheck must accept it."""
 
 from __future__ import annotations
 
-import io
 import subprocess
 import sys
 from pathlib import Path
@@ -82,7 +81,9 @@ TABLE = HEAD + (
 TOOLS = "T3 P3 Z0.5 D0.3 ;tool 3: 7.62 mm\n"  # (inches: the stand-alone rs274 reads its table so)
 
 
-def written(tmp_path: Path, text: str, name: str, *options: str) -> tuple[Path, Path, subprocess.CompletedProcess]:
+def written(
+    tmp_path: Path, text: str, name: str, *options: str
+) -> tuple[Path, Path, subprocess.CompletedProcess]:
     """The program as `name` and ncpp's output of it on AFFINE's machine."""
     (tmp_path / "affine.toml").write_text(AFFINE)
     program, out = tmp_path / name, tmp_path / f"{name}.out.ngc"
@@ -102,7 +103,9 @@ def pathcheck(original: Path, rewritten: Path, *options: str) -> None:
 
 @needs_oracles
 @pytest.mark.parametrize(
-    "text", [OUTSIDE, POCKET, POLYGON, TABLE], ids=["outside-g41.1", "pocket-g42.1", "polygon-g42.1", "table-g41"]
+    "text",
+    [OUTSIDE, POCKET, POLYGON, TABLE],
+    ids=["outside-g41.1", "pocket-g42.1", "polygon-g42.1", "table-g41"],
 )
 def test_the_tool_centre_lands_on_the_original_path_within_half_a_micron(tmp_path, text):
     """The original's tool-centre path is where the tool centre should be; the rewritten program's,
@@ -139,7 +142,10 @@ def test_without_the_radius_the_points_are_corrected_where_they_are_and_the_warn
     form C = (I + A)⁻¹ P for AFFINE's linear error A."""
     text = OUTSIDE.replace("G41.1 D10", "G41 D1")
     _, out, proc = written(tmp_path, text, "unknown.ngc")
-    assert "unknown.ngc:4:1: warning: G41: the tool radius is not known (no tool table: --tool-table)" in proc.stderr
+    assert (
+        "unknown.ngc:4:1: warning: G41: the tool radius is not known (no tool table: --tool-table)"
+        in proc.stderr
+    )
     assert "pass through uncompensated" not in proc.stderr
     inverse = np.linalg.inv(np.array([[1 + 1e-4, -1e-4], [0.0, 1 - 0.8e-4]]))
     lines = out.read_text().splitlines()

@@ -18,8 +18,10 @@ from numpy.typing import NDArray
 
 from tests.conftest import RS274
 
-_CALL = re.compile(r"\b(STRAIGHT_FEED|STRAIGHT_TRAVERSE|ARC_FEED|SET_G5X_OFFSET|SET_G92_OFFSET|USE_LENGTH_UNITS"
-                   r"|COMMENT)\((\"interpreter: cutter radius compensation (?:on|off)|[^)]*)")
+_CALL = re.compile(
+    r"\b(STRAIGHT_FEED|STRAIGHT_TRAVERSE|ARC_FEED|SET_G5X_OFFSET|SET_G92_OFFSET|USE_LENGTH_UNITS"
+    r"|COMMENT)\((\"interpreter: cutter radius compensation (?:on|off)|[^)]*)"
+)
 
 
 @dataclass(frozen=True)
@@ -43,7 +45,9 @@ class Move:
         a0, r0, sweep, r1 = self.polar()
         angle, radius = a0 + t * sweep, r0 + t * (r1 - r0)
         z = self.start[2] + t * (self.end[2] - self.start[2])
-        return np.column_stack([self.centre[0] + radius * np.cos(angle), self.centre[1] + radius * np.sin(angle), z])
+        return np.column_stack(
+            [self.centre[0] + radius * np.cos(angle), self.centre[1] + radius * np.sin(angle), z]
+        )
 
     def polar(self) -> tuple[float, float, float, float]:
         """An arc's start angle and radius, signed sweep (rad) and end radius."""
@@ -54,8 +58,9 @@ class Move:
         return a0, float(np.hypot(*s)), math.copysign(span, self.turn), float(np.hypot(*e))
 
 
-def feed_moves(program: Path, tool_table: Path | None = None, var_file: Path | None = None,
-               home: Path | None = None) -> list[Move]:
+def feed_moves(
+    program: Path, tool_table: Path | None = None, var_file: Path | None = None, home: Path | None = None
+) -> list[Move]:
     """The program's feed moves of the tool centre, program coordinates, as rs274 prints them."""
     env = dict(os.environ, RS274_DIGITS="7")
     if tool_table is not None:
@@ -89,12 +94,12 @@ def feed_moves(program: Path, tool_table: Path | None = None, var_file: Path | N
         if name == "SET_G92_OFFSET":
             g92 = np.array(v[:3]) * scale
             continue
-        place = lambda p: np.asarray(p) * scale + (g5x + g92)[: len(p)]  # noqa: E731
+        offset = g5x + g92
         if name == "ARC_FEED":
-            end = place([v[0], v[1], v[5]])
-            moves.append(Move(at, end, place([v[2], v[3]]), int(v[4]), comp or leaving))
+            end = np.array([v[0], v[1], v[5]]) * scale + offset
+            moves.append(Move(at, end, np.array(v[2:4]) * scale + offset[:2], int(v[4]), comp or leaving))
         else:
-            end = place(v[:3])
+            end = np.array(v[:3]) * scale + offset
             if name == "STRAIGHT_FEED":
                 moves.append(Move(at, end, comp=comp or leaving))
         leaving = 0
@@ -102,8 +107,9 @@ def feed_moves(program: Path, tool_table: Path | None = None, var_file: Path | N
     return moves
 
 
-def deviation(original: list[Move], rewritten: list[Move], machine: Callable[[NDArray], NDArray],
-              count: int = 16) -> NDArray:
+def deviation(
+    original: list[Move], rewritten: list[Move], machine: Callable[[NDArray], NDArray], count: int = 16
+) -> NDArray:
     """(m,) for each rewritten move, the largest distance (mm) of its tool centre, run on `machine`
     (command points (n,3), machine mm -> where the tool goes), from the original's tool-centre path."""
     path = _Path(original)
@@ -131,8 +137,12 @@ class _Path:
         best = np.full(len(p), np.inf)
         at = p[:, None, :]
         if len(self.a):
-            t = np.clip(((at - self.a) * self.ab).sum(-1) / np.maximum((self.ab**2).sum(-1), 1e-300), 0.0, 1.0)
-            best = np.minimum(best, np.linalg.norm(at - (self.a + t[..., None] * self.ab), axis=-1).min(axis=1))
+            t = np.clip(
+                ((at - self.a) * self.ab).sum(-1) / np.maximum((self.ab**2).sum(-1), 1e-300), 0.0, 1.0
+            )
+            best = np.minimum(
+                best, np.linalg.norm(at - (self.a + t[..., None] * self.ab), axis=-1).min(axis=1)
+            )
         if len(self.centre):
             rel = at[..., :2] - self.centre
             travelled = (self.turn * (np.arctan2(rel[..., 1], rel[..., 0]) - self.a0)) % (2 * math.pi)

@@ -100,7 +100,10 @@ def test_in_iso_they_are_compensated():
     source, lines = text.splitlines(), out.splitlines()
     start = next(k for k, line in enumerate(lines) if line.startswith("G41 D1 G1 X0.0"))
     assert all(lines[start + k] != source[first - 1 + k] for k in range(count))
-    assert warned.count("warning") == 1 and f"{name}:{first}:1: warning: G41: the tool radius is not known" in warned
+    assert (
+        warned.count("warning") == 1
+        and f"{name}:{first}:1: warning: G41: the tool radius is not known" in warned
+    )
 
 
 def test_the_same_part_compensates_alike_after_compensation_in_every_dialect():
