@@ -277,6 +277,9 @@ class Interpreter:
         self.off_path = False  # the tool centre is off the programmed path: from the first move under comp to the first after G40
         # the tool centre minus the programmed point (`_centre_shift`)
         self.centre_at: Point = (0.0, 0.0, 0.0)
+        # under it, whether the output stands at a corrected point in the plane (not where a move left as
+        # programmed put the tool: `_in_comp`)
+        self.corrected = True
         self.arc_refused = False  # after G40 ended compensation that moved the tool off the path: until a G0/G1 move (rs274ngc)
         self.untold: set[int] = set()  # coordinate systems whose zero nobody said (warned when selected)
         self.warnings: Warnings | None = None
@@ -446,13 +449,18 @@ class Interpreter:
             self._check_radius(moves, block, self.comp_radius)
         compensating = self.cutter_comp is not None
         if compensating or self.off_path:
+            corrected = self.corrected or not self.off_path  # (the entry move starts from a compensated move)
             shifts = [self._centre_shift(move, compensating) for move in moves]
-            if _followed(moves):
+            # an arc from where a move left as programmed ended starts there: it is left as programmed too
+            # (compensated, it would start at its corrected start, a step away, which the control would offset)
+            if _followed(moves) and (corrected or type(moves[0]) is not Arc):
                 for move, shift in zip(moves, shifts):
                     move.centre_shift = shift
                 self.off_path = compensating
+                self.corrected = corrected or any(m.start[:2] != m.end[:2] for m in moves)
             else:  # (a loop's or a cycle's moves too: that the tool is off the path matters more)
                 self.off_path = mark_off_path(moves, compensating, self.off_path)
+                self.corrected = False
         if moves[0].fixed and any(_expanding(ev) for ev in events):  # a cycle left as programmed stays one
             kept = tuple(ev for ev in events if not _expanding(ev))
             return kept if len(kept) != 1 else kept[0]

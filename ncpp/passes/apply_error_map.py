@@ -591,14 +591,40 @@ def _plain(rows: _Rows, ctx: PassContext, travel: Travel) -> _Solved:
         _corners(rows, end, crossing)
     before = None if travel.last is None else travel.last / scales[0] - offsets[0]
     _pin_plane(rows, end, before)
+    out_start, moved = _joined(rows, end, before)
     if rows.carried.any():
         _carry(rows, end, before)
     travel.last = (end[-1] + offsets[-1]) * scales[-1]
     none = np.zeros(len(free), dtype=bool)
     keep = np.ones(start.shape, dtype=bool)
     return _Solved(
-        start, end, free, none, none, start, keep, np.zeros(len(free)), at_end, np.zeros(start.shape)
+        out_start, end, free, moved, none, start, keep, np.zeros(len(free)), at_end, np.zeros(start.shape)
     )
+
+
+def _joined(rows: _Rows, out_end: NDArray, before: NDArray | None) -> tuple[NDArray, NDArray]:
+    """(n,3) the starts of the segments and (n,) the arc pieces moved: an arc piece under cutter
+    compensation that does not start where the end before it is (after a move along Z alone kept in
+    the plane, `_pin_plane`) moves onto it, `out_end` with it, and the pieces after it of its arc: a
+    connecting step there would be a move the control offsets along its own direction.  (With
+    reversal errors `_settle` does it.)"""
+    moved = np.zeros(len(rows.start), dtype=bool)
+    if rows.comp is None:
+        return rows.start, moved
+    pieces = rows.comp & rows.arc
+    out_start = rows.start.copy()
+    for k in np.flatnonzero(pieces).tolist():  # in order: a piece moved moves the next
+        same = (
+            k > 0 and (rows.offsets[k] == rows.offsets[k - 1]).all() and rows.scales[k] == rows.scales[k - 1]
+        )
+        previous = out_end[k - 1] if same else (before if k == 0 else None)
+        if previous is None or not _apart(previous[None], out_start[k][None])[0]:
+            continue
+        gap = previous - out_start[k]
+        out_start[k] += gap
+        out_end[k] += gap
+        moved[k] = True
+    return out_start, moved
 
 
 class _Commands:
@@ -665,8 +691,8 @@ def _directional(rows: _Rows, ctx: PassContext, travel: Travel) -> _Solved:
         out_end[free] = compensated[free]
         _corners(rows, out_end, lambda k: commands("start", k, d[k]), step)  # noqa: B023  # (called here)
         _hold_pieces_still(pieces, d, travel.held, limit, out_start, out_end)
-        _settle(free, arc, d, travel.held, offsets, scales, joined, out_start, out_end, before)
         _pin_plane(rows, out_end, before)
+        _settle(free, arc, d, travel.held, offsets, scales, joined, out_start, out_end, before)
         if rows.carried.any():
             _carry(rows, out_end, before)
         cur_end, cur_start = machine(out_end), machine(out_start)

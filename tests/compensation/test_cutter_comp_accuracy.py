@@ -156,23 +156,26 @@ def test_without_the_radius_the_points_are_corrected_where_they_are_and_the_warn
         assert np.allclose([words["X"], words["Y"]], inverse @ point, atol=0.6e-4), (line, inverse @ point)
 
 
-def test_a_z_move_under_compensation_keeps_the_tool_centre_where_it_stands(tmp_path):
+@pytest.mark.parametrize("after", ["G1 Y40", "G3 X100 Y20 R20"], ids=["line", "arc"])
+def test_a_z_move_under_compensation_keeps_the_tool_centre_where_it_stands(tmp_path, after):
     """Z alone under G41: the control keeps the tool centre's X Y; a correction of X that varies with
     Z (squareness of Z to X) must not make it a move in the plane, which the control would offset
-    along its own direction."""
+    along its own direction.  Nor may a step join it to the move after it: a line starts where it
+    stands, an arc moves onto it."""
     machine = tmp_path / "leaning.toml"
     machine.write_text(AFFINE + "B0Z_urad = 200.0\n")
     program, out = tmp_path / "z.ngc", tmp_path / "z.out.ngc"
-    program.write_text(HEAD + "G0 X-20 Y-20 Z5\nG1 Z-1 F300\nG41.1 D10\nG1 X0 Y0\nG1 X80\nG1 Z-30\nG1 Y40\n"
-                       "G40\nG1 X100 Y50\nM2\n")  # fmt: skip
+    program.write_text(HEAD + f"G0 X-20 Y-20 Z5\nG1 Z-1 F300\nG41.1 D10\nG1 X0 Y0\nG1 X80\nG1 Z-30\n{after}\n"
+                       "G1 Y60\nG40\nG1 X120 Y80\nM2\n")  # fmt: skip
     proc = subprocess.run([sys.executable, "-m", "ncpp", "compensate", "--machine", str(machine), str(program),
                            "-o", str(out)], capture_output=True, text=True, cwd=ROOT, timeout=300)  # fmt: skip
     assert proc.returncode == 0, proc.stderr
     lines = out.read_text().splitlines()
     k = lines.index("G41.1 D10")
-    along, down = lines[k + 2], lines[k + 3]
+    along, down, then = lines[k + 2], lines[k + 3], lines[k + 4]
     assert along.startswith("G1 X79.99")  # compensated
     assert down.startswith("G1 Z-30.0") and "X" not in down and "Y" not in down  # X Y as they stand
+    assert then.startswith(after[:2]) and then != after
 
 
 def test_with_reversal_errors_no_step_is_put_between_the_moves(tmp_path):
