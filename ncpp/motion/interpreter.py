@@ -1118,13 +1118,6 @@ class Interpreter:
                 if self.tools is None
                 else self.tools.diameter(number) / 2 / (MM_PER_INCH if self.inch else 1.0)
             )
-            if self.comp_radius is None and self.plane == 17:
-                self.warnings.warn(  # type: ignore[union-attr]
-                    f"G{code:g}: the tool radius is not known (no tool table: --tool-table), so the moves under "
-                    "cutter compensation are corrected for their programmed points, from which the tool centre "
-                    "stands off by that radius",
-                    Location(self.file, block.line, item.start + 1),
-                )
         self.cutter_comp = code
 
     def _check_scope(self, words: dict, gcodes: dict) -> None:

@@ -143,7 +143,7 @@ def test_without_the_radius_the_points_are_corrected_where_they_are_and_the_warn
     text = OUTSIDE.replace("G41.1 D10", "G41 D1")
     _, out, proc = written(tmp_path, text, "unknown.ngc")
     assert (
-        "unknown.ngc:4:1: warning: G41: the tool radius is not known (no tool table: --tool-table)"
+        "unknown.ngc:5:1: warning: cutter compensation with the tool radius not known (G41/G42 and no tool table"
         in proc.stderr
     )
     assert "pass through uncompensated" not in proc.stderr

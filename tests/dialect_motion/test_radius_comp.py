@@ -102,7 +102,7 @@ def test_in_iso_they_are_compensated():
     assert all(lines[start + k] != source[first - 1 + k] for k in range(count))
     assert (
         warned.count("warning") == 1
-        and f"{name}:{first}:1: warning: G41: the tool radius is not known" in warned
+        and f"{name}:{first}:1: warning: cutter compensation with the tool radius not known" in warned
     )
 
 
