@@ -168,8 +168,14 @@ UNCOMPENSATED = {
     DRILLED: "drilling cycle: it drills where the move before it leaves the tool (X and Y compensated), its moves "
     "along the tool axis as programmed (the depth with the machine's error); compensation resumes with the next move",
     COMP: "cutter compensation: its moves pass through uncompensated (the control offsets them by the tool radius, "
-    "so the tool is not where their points are); compensation resumes after the first move with it off (after G40, or R0)",
+    "so the tool is not where their points are; ncpp follows it in ISO programs in G17 and G90 only, outside loops, "
+    "subroutines and Fanuc corners); compensation resumes after the first move with it off (after G40, or R0)",
 }
+# An entry move under cutter compensation whose tool centre ends on its point: the radius is unknown
+UNKNOWN_RADIUS = (
+    "cutter compensation with the tool radius not known (G41/G42 and no tool table: --tool-table): its moves are "
+    "corrected for their programmed points, from which the tool centre stands off by that radius"
+)
 INCREMENTAL_CYCLE = (
     "a G91 move right after a canned cycle in G90: it starts where the cycle left the tool (a G98 retract "
     "ends at the compensated level the cycle started from), which ncpp does not follow; from this line on "
@@ -209,6 +215,9 @@ def warn_fixed(events: Iterable[Event], warnings: Warnings, file: str) -> Iterat
                 fixed and fixed != series and fixed in UNCOMPENSATED
             ):  # (a G28/G30's moves are the control's own)
                 warnings.warn(UNCOMPENSATED[fixed], Location(file, event.block.line, 1))
+            shift = event.centre_shift  # type: ignore[union-attr]
+            if shift is not None and shift[0] is None and not any(shift[1]):
+                warnings.warn(UNKNOWN_RADIUS, Location(file, event.block.line, 1))
             series, absolute = fixed, event.context.absolute  # type: ignore[union-attr]
         elif kind is Pass and event.setting is not None and series in UNCOMPENSATED and absolute:  # type: ignore[union-attr]
             yield from _passed_on(event, events, warnings, file, UNKNOWN_SETTING)

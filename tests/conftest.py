@@ -33,6 +33,11 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_the_holes_moves_compensation_sees_are_the_ones_rs274_makes",
         ),
         "compensation/test_rs274_accepts.py": None,
+        "compensation/test_cutter_comp_accuracy.py": (
+            "test_the_tool_centre_lands_on_the_original_path_within_half_a_micron",
+            "test_the_entry_arc_stays_one_arc_the_control_accepts",
+            "test_mmount_contours_land_within_the_tolerance",
+        ),
         "motion/test_oracle.py": None,
         "writeback/test_compensated_holes.py": None,
         "writeback/test_expand_cycles.py": ("test_expanded_cycles_dwell_as_programmed_and_hit_every_hole",),
@@ -94,6 +99,7 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
     },
     # a second and a half or more on a 2-core machine, all parameters together
     "slow": {
+        "compensation/test_cutter_comp_accuracy.py": ("test_mmount_contours_land_within_the_tolerance",),
         "hostile/test_resources.py": (
             "test_compensating_a_loop_takes_the_same_memory_however_often_it_runs",
         ),

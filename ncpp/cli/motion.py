@@ -120,6 +120,8 @@ def run(args: argparse.Namespace) -> int:
                 event.fixed
             ):  # why compensation leaves it as programmed (a canned cycle, cutter compensation, ...)
                 record["fixed"] = event.fixed
+            if event.centre_shift is not None:  # under cutter compensation ncpp follows
+                record["centre_shift"] = event.centre_shift
             out.write(json.dumps(record) + "\n")
     warnings.finish()
     return 0
@@ -132,7 +134,9 @@ def warn_off_path(
     (`COMP`: the tool centre is off the programmed contour), saying `consequence`."""
     off = False
     for event in events:
-        if (type(event) is Line or type(event) is Arc) and (event.fixed == COMP) != off:
+        if (type(event) is Line or type(event) is Arc) and (
+            event.fixed == COMP or event.centre_shift is not None
+        ) != off:
             off = not off
             if off:
                 warnings.warn(f"cutter compensation: up to the first move after it is off (G40, R0) the tool centre is off the programmed contour; its moves are {consequence}",

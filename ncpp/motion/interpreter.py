@@ -19,9 +19,10 @@ macro B (GOTO, IF ... GOTO, WHILE ... DO ... END, G65 and G66/G67 macro calls: `
 #5001-#5003 where known: here), and cutter compensation G40-G42.1
 (`_in_comp`): where the control offsets the path by the tool radius the moves
 are the programmed contour, not the tool centre, and after G40 the position is
-the program's again, as in rs274ngc.  The moves of cycles, loops, subroutines
-and macros, and those the tool makes off the programmed path (from the first
-move under G41/G42 to the first after G40), are marked `fixed`: compensation
+the program's again, as in rs274ngc.  The moves the tool makes off the programmed
+path (from the first move under G41/G42 to the first after G40) carry where the
+tool centre stands (`centre_shift`), in G17 and G90; elsewhere they are marked
+`fixed`, as are the moves of cycles, loops, subroutines and macros: compensation
 leaves them as programmed.  Anything else (subroutine files ncpp is not told
 of, a move of a subprogram under G66, a Fanuc system variable it does not know, M99
 in the main program, G88 (a manual retract) and the lathe cycles, splines,
@@ -66,6 +67,7 @@ from ncpp.motion.segments import (
     Hole,
     Line,
     Pass,
+    Point,
     Setting,
     mark_off_path,
 )
@@ -278,6 +280,11 @@ class Interpreter:
             None  # its tool radius, program units, where known (G41.1/G42.1's D; G41/G42: the tool table's)
         )
         self.off_path = False  # the tool centre is off the programmed path: from the first move under comp to the first after G40
+        # the tool centre minus the programmed point (`_centre_shift`)
+        self.centre_at: Point = (0.0, 0.0, 0.0)
+        # under it, whether the output stands at a corrected point in the plane (not where a move left as
+        # programmed put the tool: `_in_comp`)
+        self.corrected = True
         self.arc_refused = False  # after G40 ended compensation that moved the tool off the path: until a G0/G1 move (rs274ngc)
         self.untold: set[int] = set()  # coordinate systems whose zero nobody said (warned when selected)
         self.warnings: Warnings | None = None
@@ -465,12 +472,51 @@ class Interpreter:
             self.arc_refused = moves[0].fixed in (CYCLE, HOLE) or _expanding(events[0]) or _homes(block)
         if self.cutter_comp is not None and self.comp_radius:
             self._check_radius(moves, block, self.comp_radius)
-        # (a loop's or a cycle's moves too: that the tool is off the path matters more)
-        self.off_path = mark_off_path(moves, self.cutter_comp is not None, self.off_path)
+        compensating = self.cutter_comp is not None
+        if compensating or self.off_path:
+            corrected = self.corrected or not self.off_path  # (the entry move starts from a compensated move)
+            shifts = [self._centre_shift(move, compensating) for move in moves]
+            # an arc from where a move left as programmed ended starts there: it is left as programmed too
+            # (compensated, it would start at its corrected start, a step away, which the control would offset)
+            if _followed(moves) and (corrected or type(moves[0]) is not Arc):
+                for move, shift in zip(moves, shifts):
+                    move.centre_shift = shift
+                self.off_path = compensating
+                self.corrected = corrected or any(m.start[:2] != m.end[:2] for m in moves)
+            else:  # (a loop's or a cycle's moves too: that the tool is off the path matters more)
+                self.off_path = mark_off_path(moves, compensating, self.off_path)
+                self.corrected = False
         if moves[0].fixed and any(_expanding(ev) for ev in events):  # a cycle left as programmed stays one
             kept = tuple(ev for ev in events if not _expanding(ev))
             return kept if len(kept) != 1 else kept[0]
         return event
+
+    def _centre_shift(self, move: Line | Arc, compensating: bool) -> tuple[Point | None, Point]:
+        """Where the tool centre stands off the move's programmed start and end: the end's by the
+        radius to the left (G41) or right (G42) of the move's own direction there, as the control
+        offsets the contour (zero where the radius is unknown); the start's is the move before's
+        end's (the exit move after G40 ends on it).  The entry move's start is None: the tool centre
+        starts on the programmed point, and the control makes the move whole (rs274ngc checks its
+        length against the radius).  A move with no motion in the plane keeps the tool centre where
+        it stands."""
+        start = self.centre_at if self.off_path else None
+        radius = self.comp_radius if compensating and self.comp_radius else 0.0
+        if not radius or move.context.plane != 17:  # (followed in the XY plane only: `_followed`)
+            end: Point = (0.0, 0.0, 0.0)
+        else:
+            side = radius if self.cutter_comp in (41.0, 41.1) else -radius
+            (x0, y0, _), (x1, y1, _) = move.start, move.end
+            if type(move) is Arc:  # left of the tangent: towards the centre counter-clockwise
+                cx, cy, _ = move.center
+                length = math.hypot(x1 - cx, y1 - cy)
+                side = -side if move.turn > 0 else side
+                end = (side * (x1 - cx) / length, side * (y1 - cy) / length, 0.0)
+            elif (length := math.hypot(x1 - x0, y1 - y0)) > 0.0:
+                end = (-side * (y1 - y0) / length, side * (x1 - x0) / length, 0.0)
+            else:
+                end = self.centre_at
+        self.centre_at = end
+        return start, end
 
     def _check_radius(self, moves: list, block: Block, radius: float) -> None:
         """rs274ngc's checks of moves under compensation against the tool radius: the entry move
@@ -519,6 +565,11 @@ class Interpreter:
             raise NcppError(str(err), where) from None
         if first.fixed == COMP or second.fixed == COMP:  # the control rounds the contour, then offsets it
             pieces[1].fixed = COMP  # type: ignore[union-attr]  # (the lines keep their own)
+        if first.centre_shift is not None or second.centre_shift is not None:
+            # (the same: every piece left as programmed, the lines too)
+            for piece in cast(list[Line | Arc], pieces):
+                if piece.centre_shift is not None or piece is pieces[1]:
+                    piece.fixed, piece.centre_shift = COMP, None
         return pieces
 
     def context(self) -> Context:
@@ -1120,6 +1171,7 @@ class Interpreter:
                 vector[i] *= scale
         if self.comp_radius is not None:
             self.comp_radius *= scale
+        self.centre_at = (self.centre_at[0] * scale, self.centre_at[1] * scale, 0.0)
         self._set(inch=inch)
 
     def _shift(self, old: list[float], new: list[float]) -> None:
@@ -1207,6 +1259,7 @@ class Interpreter:
         self._set(plane=17, absolute=True, inverse_time=False)
         self.motion = 1.0
         self.cutter_comp, self.comp_radius, self.off_path, self.arc_refused = None, None, False, False
+        self.centre_at = (0.0, 0.0, 0.0)
         self.done = True
 
     def _machine(self, i: int) -> float:
@@ -1788,6 +1841,12 @@ def _moves(event: Event | tuple[Event, ...]) -> bool:
     if type(event) is tuple:
         return any(type(e) is not Pass for e in event)
     return type(event) is not Pass
+
+
+def _followed(moves: list[Line | Arc]) -> bool:
+    """Whether compensation follows a block's moves under cutter compensation (`Line.centre_shift`):
+    in G17 and G90, and none of them left as programmed for another reason (a loop's, a cycle's)."""
+    return all(not m.fixed and m.context.plane == 17 and m.context.absolute for m in moves)
 
 
 def _homes(block: Block) -> bool:

@@ -136,6 +136,11 @@ class Line:
     ] = ()  # start positions of A B C U V W (as `extra`), when the program uses them
     # a compensated canned cycle's hole (`fixed` HOLE), the same for its block's moves
     hole: Hole | None = None
+    # under cutter compensation ncpp follows (`Interpreter._in_comp`): where the tool centre stands off
+    # the programmed start and end (program units, in the plane; zero where the radius is unknown), the
+    # control offsetting the contour by the radius; the start None: the entry move, which the control
+    # makes whole.  None: the tool centre is on the programmed path.  replace_arcs' pieces carry their arc's
+    centre_shift: tuple[Point | None, Point] | None = None
 
     def length(self) -> float:
         return math.dist(self.start, self.end)
@@ -165,6 +170,7 @@ class Arc:
     # (+1, -1: the one that axis last moved in, which the machine holds it in; 0: the mean)
     normal: int = 0
     extra_start: tuple[float, ...] = ()  # as `Line.extra_start`
+    centre_shift: tuple[Point | None, Point] | None = None  # as `Line.centre_shift`
 
     @property
     def clockwise(self) -> bool:

@@ -16,7 +16,7 @@ start is compensated with its own direction and a step move is inserted.
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, fields, replace
 from itertools import chain
 from typing import overload
@@ -263,6 +263,13 @@ class _Rows:
     carried: NDArray  # (n,) moves left as programmed that run from where the control is (`_carry`)
     kept: NDArray  # (n,3) their axes that do so (the others the control puts at their programmed end)
     lead_in: NDArray  # (n,) a canned cycle's first move after a compensated one: a step to its start first
+    # under cutter compensation: each segment's (`Line.centre_shift`) and the end shifts (n,3) of the lines to
+    # compensate (zero elsewhere), the lines that move no axis of the plane (`_pin_plane`), and those that
+    # turn a corner from a line (`_corners`); None: none is
+    comp: NDArray | None = None
+    shift: NDArray | None = None
+    still: NDArray | None = None
+    corner: NDArray | None = None
 
 
 def _rows_before(rows: _Rows, line: int | None) -> _Rows | None:
@@ -295,8 +302,84 @@ def _rows(segs: list, directional: bool, fixed_before: bool = True) -> _Rows:
         start, end, offsets, scales, tools, free, changed, changed & line,
         _arc_assumed(segs, np.flatnonzero(changed & arc), start, end) if directional else None,
         np.fromiter([e.block.line for e in segs], dtype=np.int64, count=len(segs)), (kind & 8) != 0, any3(kept), kept,
-        lead_in,
+        lead_in, *_under_comp(segs, free, start, end),
     )  # fmt: skip
+
+
+def _under_comp(segs: list, free: NDArray, start: NDArray, end: NDArray) -> tuple[NDArray | None, ...]:
+    """`_Rows.comp`, `.shift`, `.still` and `.corner` of the segments (all None: none is under
+    compensation).  A line under compensation that moves no axis of the plane (G17: X Y) leaves the
+    tool centre where it stands (`Interpreter._centre_shift`): the same shift at both ends."""
+    if all(e.centre_shift is None for e in segs):
+        return None, None, None, None
+    comp = np.fromiter((e.centre_shift is not None for e in segs), dtype=bool, count=len(segs))
+    shift = np.zeros((len(segs), 3))
+    own = np.flatnonzero(comp & free)
+    shift[own] = [segs[k].centre_shift[1] for k in own.tolist()]
+    same = np.zeros(len(segs), dtype=bool)
+    same[own] = [segs[k].centre_shift[0] == segs[k].centre_shift[1] for k in own.tolist()]
+    moves = (start[:, :2] != end[:, :2]).any(axis=1)
+    still = same & ~moves
+    # a line whose tool centre stands off it by a radius (not the entry move, nor the exit move after G40),
+    # after a line under compensation in the same frame
+    entry = np.zeros(len(segs), dtype=bool)
+    entry[own] = [segs[k].centre_shift[0] is None for k in own.tolist()]
+    offset = comp & free & moves & any3(shift != 0) & ~entry
+    corner = np.zeros(len(segs), dtype=bool)
+    corner[1:] = offset[1:] & (comp & free & moves)[:-1]
+    for k in np.flatnonzero(corner).tolist():
+        a, b = segs[k - 1].context, segs[k].context
+        corner[k] = a.offset == b.offset and a.inch == b.inch
+    return comp, shift, still, corner
+
+
+# |sin| of the turn between two lines below which their corner is left to the line that ends there
+# (the lines' crossing, `_corners`, moves far along them for a small shift across), and the cosine of a
+# turn back beyond which it is too
+SHALLOW = 0.2
+HAIRPIN = -0.9
+
+
+def _corners(
+    rows: _Rows, out_end: NDArray, crossing: Callable[[NDArray], NDArray], step: NDArray | None = None
+) -> None:
+    """Corners between two lines under cutter compensation: the control offsets each line by the
+    radius, and the corner point corrected for the first line's tool centre leaves the second line
+    off by the error's gradient times the radius times the turn.  The corner is put where the first
+    line's corrected contour crosses the second's: `out_end` of the first, moved along it.
+    `crossing(rows)`: the second lines' corrected starts (their own tool centre's correction); `step`
+    (n,): the output grid the moved ends are put on (None: none)."""
+    if rows.corner is None or not rows.corner.any():
+        return
+    k = np.flatnonzero(rows.corner)
+    d1 = rows.end[k - 1, :2] - rows.start[k - 1, :2]
+    d2 = rows.end[k, :2] - rows.start[k, :2]
+    d1 /= np.linalg.norm(d1, axis=1)[:, None]
+    d2 /= np.linalg.norm(d2, axis=1)[:, None]
+    across = d1[:, 1] * d2[:, 0] - d1[:, 0] * d2[:, 1]  # d1 · n2, n2 = d2 turned a quarter
+    turn = (np.abs(across) >= SHALLOW) & ((d1 * d2).sum(axis=1) >= HAIRPIN)
+    k, d1, d2, across = k[turn], d1[turn], d2[turn], across[turn]
+    if k.size == 0:
+        return
+    gap = crossing(k)[:, :2] - out_end[k - 1, :2]
+    along = (gap[:, 1] * d2[:, 0] - gap[:, 0] * d2[:, 1]) / across  # (gap · n2) / (d1 · n2)
+    out_end[k - 1, :2] += along[:, None] * d1
+    if step is not None:
+        out_end[k - 1] = quantize(out_end[k - 1], step[k - 1])
+
+
+def _pin_plane(rows: _Rows, out_end: NDArray, before: NDArray | None) -> None:
+    """The lines under compensation that move no axis of the plane keep the X Y of the end before
+    them: a correction that differs there (with Z) would be a tiny move in the plane, which the
+    control offsets along its own direction.  `before`: the previous chunk's last end, in the first
+    row's frame (None: none)."""
+    if rows.still is None:
+        return
+    for k in np.flatnonzero(rows.still).tolist():  # in order: a run of them keeps the first's X Y
+        if k > 0 and (rows.offsets[k] == rows.offsets[k - 1]).all() and rows.scales[k] == rows.scales[k - 1]:
+            out_end[k, :2] = out_end[k - 1, :2]
+        elif k == 0 and before is not None:
+            out_end[k, :2] = before[:2]
 
 
 def _kept_axes(segs: list, kind: NDArray) -> NDArray:
@@ -498,25 +581,66 @@ def _plain(rows: _Rows, ctx: PassContext, travel: Travel) -> _Solved:
     at_end = np.zeros(end.shape, dtype=bool)
     if at.size:
         ends = np.zeros((at.size, 3), dtype=bool)
-        end[at] = compensate(
-            end[at],
-            offsets[at],
-            scales[at],
-            rows.lines[at],
-            ctx,
-            np.sign(end[at] - start[at]),
-            rows_of(rows.tools, at),
-            ends,
+        shift = 0.0 if rows.shift is None else rows.shift[at]
+        end[at] = (
+            compensate(
+                end[at] + shift,
+                offsets[at],
+                scales[at],
+                rows.lines[at],
+                ctx,
+                np.sign(end[at] - start[at]),
+                rows_of(rows.tools, at),
+                ends,
+            )
+            - shift
         )
         at_end[at] = ends
+    if rows.shift is not None:
+        centre = rows.shift
+
+        def crossing(k: NDArray) -> NDArray:
+            direction, wanted = np.sign(rows.end[k] - start[k]), start[k] + centre[k]
+            tools = rows_of(rows.tools, k)
+            return compensate(wanted, offsets[k], scales[k], rows.lines[k], ctx, direction, tools) - centre[k]
+
+        _corners(rows, end, crossing)
+    before = None if travel.last is None else travel.last / scales[0] - offsets[0]
+    _pin_plane(rows, end, before)
+    out_start, moved = _joined(rows, end, before)
     if rows.carried.any():
-        _carry(rows, end, None if travel.last is None else travel.last / scales[0] - offsets[0])
+        _carry(rows, end, before)
     travel.last = (end[-1] + offsets[-1]) * scales[-1]
     none = np.zeros(len(free), dtype=bool)
     keep = np.ones(start.shape, dtype=bool)
     return _Solved(
-        start, end, free, none, none, start, keep, np.zeros(len(free)), at_end, np.zeros(start.shape)
+        out_start, end, free, moved, none, start, keep, np.zeros(len(free)), at_end, np.zeros(start.shape)
     )
+
+
+def _joined(rows: _Rows, out_end: NDArray, before: NDArray | None) -> tuple[NDArray, NDArray]:
+    """(n,3) the starts of the segments and (n,) the arc pieces moved: an arc piece under cutter
+    compensation that does not start where the end before it is (after a move along Z alone kept in
+    the plane, `_pin_plane`) moves onto it, `out_end` with it, and the pieces after it of its arc: a
+    connecting step there would be a move the control offsets along its own direction.  (With
+    reversal errors `_settle` does it.)"""
+    moved = np.zeros(len(rows.start), dtype=bool)
+    if rows.comp is None:
+        return rows.start, moved
+    pieces = rows.comp & rows.arc
+    out_start = rows.start.copy()
+    for k in np.flatnonzero(pieces).tolist():  # in order: a piece moved moves the next
+        same = (
+            k > 0 and (rows.offsets[k] == rows.offsets[k - 1]).all() and rows.scales[k] == rows.scales[k - 1]
+        )
+        previous = out_end[k - 1] if same else (before if k == 0 else None)
+        if previous is None or not _apart(previous[None], out_start[k][None])[0]:
+            continue
+        gap = previous - out_start[k]
+        out_start[k] += gap
+        out_end[k] += gap
+        moved[k] = True
+    return out_start, moved
 
 
 class _Commands:
@@ -537,8 +661,10 @@ class _Commands:
         if todo.size:
             segs = self.rows
             ends = np.zeros((todo.size, 3), dtype=bool)
-            c = compensate(self.wanted[which][todo], segs.offsets[todo], segs.scales[todo], segs.lines[todo], self.ctx, d_todo,
-                           rows_of(segs.tools, todo), ends)  # fmt: skip
+            # (under cutter compensation a line's end is corrected where the tool centre is: `_Rows.shift`)
+            shift = 0.0 if segs.shift is None else segs.shift[todo]  # (a line's is the same at its start)
+            c = compensate(self.wanted[which][todo] + shift, segs.offsets[todo], segs.scales[todo], segs.lines[todo], self.ctx,
+                           d_todo, rows_of(segs.tools, todo), ends) - shift  # fmt: skip
             self.values[which][todo] = quantize(c, self.step[todo])
             self.at_end[which][todo] = ends
             self.directions[which][todo] = d_todo
@@ -557,6 +683,9 @@ def _directional(rows: _Rows, ctx: PassContext, travel: Travel) -> _Solved:
     first = travel.last if travel.last is not None else start_m[0]
     before = None if travel.last is None else travel.last / scales[0] - offsets[0]  # in the first row's frame
     limit = _snap_limit(step, scales)
+    # arc pieces under cutter compensation move onto the end before them, however far: a connecting step
+    # there would be a move the control offsets along its own direction
+    joined = limit if rows.comp is None else np.where(rows.comp & arc, np.inf, limit)
 
     out_start, out_end = start_p.copy(), end_p.copy()
     compensated = end_p.copy()  # line ends before _settle leaves axes standing
@@ -576,8 +705,10 @@ def _directional(rows: _Rows, ctx: PassContext, travel: Travel) -> _Solved:
             _shift_arcs(shift, rows, d, assumed, step, ctx, out_start, out_end)
         used[redo], used[shift] = d[redo], d[shift]
         out_end[free] = compensated[free]
+        _corners(rows, out_end, lambda k: commands("start", k, d[k]), step)  # noqa: B023  # (called here)
         _hold_pieces_still(pieces, d, travel.held, limit, out_start, out_end)
-        _settle(free, arc, d, travel.held, offsets, scales, limit, out_start, out_end, before)
+        _pin_plane(rows, out_end, before)
+        _settle(free, arc, d, travel.held, offsets, scales, joined, out_start, out_end, before)
         if rows.carried.any():
             _carry(rows, out_end, before)
         cur_end, cur_start = machine(out_end), machine(out_start)
@@ -597,6 +728,8 @@ def _directional(rows: _Rows, ctx: PassContext, travel: Travel) -> _Solved:
     before = np.vstack([travel.held[None, :], d[:-1]])
     flips = (d != before) & (before != 0)
     turn = free & any3(flips)
+    if rows.comp is not None:  # (no reversal step under cutter compensation: `joined`)
+        turn &= ~rows.comp
     turn_start = np.full(start_p.shape, np.nan)
     turned = np.flatnonzero(turn)
     if turned.size:

@@ -191,6 +191,10 @@ class _ArcRows:
     tools: NDArray | None  # (n,3) tool length offsets, mm (None: none)
     lines: NDArray  # (n,) the line of each arc's block, for messages
     normal: NDArray  # (n,) the direction each arc's normal axis is compensated for (`Motion`)
+    # under cutter compensation (`Arc.centre_shift`): how far the tool centre stands off the arc towards
+    # its outside (n,) (negative: inside), and off its start (n,3), program units, and the entry arcs (n,),
+    # which stay whole; None: no arc is under compensation
+    tool_centre: tuple[NDArray, NDArray, NDArray] | None = None
 
     @classmethod
     def of(cls, arcs: list[Arc], normals: list[int]) -> _ArcRows:
@@ -199,8 +203,23 @@ class _ArcRows:
             points([a.start for a in arcs]), points([a.end for a in arcs]), points([a.center for a in arcs]),
             plane_axes(arcs), np.fromiter([a.turn for a in arcs], dtype=float, count=len(arcs)),
             offsets, scales, tools, np.fromiter([a.block.line for a in arcs], dtype=np.int64, count=len(arcs)),
-            np.array(normals, dtype=float),
+            np.array(normals, dtype=float), _centre_offsets(arcs),
         )  # fmt: skip
+
+
+def _centre_offsets(arcs: list[Arc]) -> tuple[NDArray, NDArray, NDArray] | None:
+    """`_ArcRows.tool_centre` of the arcs: the radial offset read from the shift at each one's end."""
+    if all(a.centre_shift is None for a in arcs):
+        return None
+    radial, start, entry = np.zeros(len(arcs)), np.zeros((len(arcs), 3)), np.zeros(len(arcs), dtype=bool)
+    for k, arc in enumerate(arcs):
+        if arc.centre_shift is not None:
+            at_start, (sx, sy, _) = arc.centre_shift
+            entry[k] = at_start is None
+            start[k] = (0.0, 0.0, 0.0) if at_start is None else at_start
+            dx, dy = arc.end[0] - arc.center[0], arc.end[1] - arc.center[1]  # (followed in G17 only)
+            radial[k] = (sx * dx + sy * dy) / math.hypot(dx, dy)
+    return radial, start, entry
 
 
 @dataclass
@@ -232,6 +251,7 @@ class _ArcGeometry:
 
     def __init__(self, rows: _ArcRows):
         self.axes = rows.axes
+        self.tool_centre = rows.tool_centre
         (su, sv, sw), (eu, ev, ew), (cu, cv, _) = (
             in_plane(p, self.axes) for p in (rows.start, rows.end, rows.centre)
         )
@@ -256,6 +276,23 @@ class _ArcGeometry:
         v = self.centre_v[arc, None] + r * np.sin(angles)
         return from_plane(u, v, self.w0[arc, None] + frac * self.rise[arc, None], self.axes[arc])
 
+    def centre_shifts(self, arc: NDArray, angles: NDArray) -> NDArray | None:
+        """(p,m,3) where the tool centre stands off the points at `angles` under cutter compensation
+        (`Arc.centre_shift`): radially, but at an arc's start where the move before left it (a
+        corner belongs to the move that ends there).  None: no arc is under compensation."""
+        if self.tool_centre is None:
+            return None
+        radial, start, _ = self.tool_centre
+        k = radial[arc, None]
+        shift = from_plane(k * np.cos(angles), k * np.sin(angles), np.zeros_like(angles), self.axes[arc])
+        first = angles == self.a0[arc, None]  # (the first piece starts at the arc's angle, exactly)
+        return np.where(first[..., None], start[arc, None, :], shift)
+
+    def whole(self, arc: NDArray) -> NDArray:
+        """(p,) the arcs (of `arc`) that stay one piece: the entry arcs of cutter compensation (the
+        control checks that arc against the tool radius, and offsets only its end)."""
+        return np.zeros(len(arc), dtype=bool) if self.tool_centre is None else self.tool_centre[2][arc]
+
 
 def _sweeps(a0: NDArray, a1: NDArray, turn: NDArray) -> NDArray:
     """(n,) signed sweeps, rad (+ counter-clockwise), of arcs from angle a0 to a1 turning `turn`:
@@ -279,6 +316,20 @@ def _initial_pieces(geometry: _ArcGeometry, directional: bool) -> _Pieces:
     step = (geometry.sweep / counts)[arc]
     nth = np.arange(len(arc)) - np.repeat(np.cumsum(counts) - counts, counts)
     return _Pieces(arc, geometry.a0[arc] + nth * step, step)
+
+
+def _whole(pieces: _Pieces, geometry: _ArcGeometry) -> _Pieces:
+    """The pieces, those of an arc that stays whole (`_ArcGeometry.whole`) made one again."""
+    whole = geometry.whole(pieces.arc)
+    if not whole.any():
+        return pieces
+    arcs = np.unique(pieces.arc[whole])
+    keep = ~whole
+    return _Pieces(
+        np.concatenate([pieces.arc[keep], arcs]),
+        np.concatenate([pieces.a0[keep], geometry.a0[arcs]]),
+        np.concatenate([pieces.sweep[keep], geometry.sweep[arcs]]),
+    )
 
 
 def _quadrant_pieces(geometry: _ArcGeometry) -> _Pieces:
@@ -311,7 +362,7 @@ def _replace(arcs: _ArcRows, ctx: PassContext) -> _Fitted:
         )
     geometry = _ArcGeometry(arcs)
     offsets, scales, tools, line_of = arcs.offsets, arcs.scales, arcs.tools, arcs.lines
-    pending = _initial_pieces(geometry, ctx.directional)
+    pending = _whole(_initial_pieces(geometry, ctx.directional), geometry)
     done = _Fitted(geometry.a0, np.where(geometry.sweep >= 0, 1.0, -1.0))
     for _ in range(MAX_ROUNDS):
         if len(pending.arc) == 0:
@@ -369,8 +420,11 @@ def _round(
     )
     direction = np.broadcast_to(direction, nominal.shape)
     scale = scales[pending.arc]
+    # under cutter compensation the correction is the one where the tool centre is, off the contour
+    shift = geometry.centre_shifts(pending.arc, angles)
+    at = nominal if shift is None else nominal + shift
     q = compensate(
-        nominal,
+        at,
         offsets[pending.arc],
         scale,
         line_of[pending.arc],
@@ -378,6 +432,8 @@ def _round(
         direction,
         rows_of(tools, pending.arc),
     )
+    if shift is not None:
+        q -= shift
     centre, deviation = _fit(q, geometry.axes[pending.arc], t, ctx.tolerance / scale)
     ok = deviation <= ctx.tolerance / scale
     if ctx.directional:  # ends on the output grid (after the fit: a short piece's chord fixes the bisector)
@@ -400,16 +456,17 @@ def _round(
     # piece that reverses an axis inside but bulges less than a quarter of the tolerance
     chord = norm3(q[:, -1] - q[:, 0]) * scale
     flat = chord**2 / (8 * np.maximum(geometry.radius[pending.arc] * scale, 1e-12)) <= ctx.tolerance / 4
-    straight = (length < SLIVER) | (~one_way & flat)
-    ok &= one_way & ~straight
+    whole = geometry.whole(pending.arc)
+    straight = ((length < SLIVER) | (~one_way & flat)) & ~whole
+    ok = (ok & one_way & ~straight) | whole
     give_up = ~ok & ~straight & (length < MIN_PIECE)
     lines = np.flatnonzero(straight | give_up)
     if lines.size and ctx.directional:
         # lines are compensated for the mean direction: apply_error_map moves them to the real one
         arc = pending.arc[lines]
         q[lines] = _mean_compensated(
-            nominal[lines], offsets[arc], scale[lines], line_of[arc], ctx, rows_of(tools, arc)
-        )
+            at[lines], offsets[arc], scale[lines], line_of[arc], ctx, rows_of(tools, arc)
+        ) - (0.0 if shift is None else shift[lines])
     for rows, pts in (
         (np.flatnonzero(straight), lambda r: q[r][:, [0, -1]]),
         (np.flatnonzero(give_up), lambda r: q[r]),
@@ -547,7 +604,8 @@ def _minimax_step(uv: NDArray, q0: NDArray, c: NDArray, normal: NDArray) -> NDAr
 def _line_pieces(arc: Arc, q: list[list[float]]) -> list[Event]:
     pts = cast(list[tuple[float, float, float]], [tuple(p) for p in q])  # (q's points are 3-vectors)
     return [
-        Line(a, b, False, arc.feed, arc.block, arc.context, arc.extra, True) for a, b in zip(pts, pts[1:])
+        Line(a, b, False, arc.feed, arc.block, arc.context, arc.extra, True, centre_shift=arc.centre_shift)
+        for a, b in zip(pts, pts[1:])
     ]
 
 
@@ -582,6 +640,7 @@ def _assemble(arcs: list[Arc], fitted: _Fitted, normals: list[int]) -> list[list
                     True,
                     "",
                     normals[k],
+                    centre_shift=arc.centre_shift,
                 )
             )
         else:

@@ -1,7 +1,8 @@
 """Cutter compensation (G40-G42.1) against LinuxCNC's rs274: the interpreter follows the
-programmed positions through it, marks the moves the tool makes off the programmed path
-(`COMP`), is back on the program's positions after the first move after G40, and refuses
-what rs274 refuses with compensation on, on the same line."""
+programmed positions through it, gives the moves the tool makes off the programmed path where
+the tool centre stands (`centre_shift`; in a plane other than XY it marks them `COMP`), is back
+on the program's positions after the first move after G40, and refuses what rs274 refuses with
+compensation on, on the same line."""
 
 from __future__ import annotations
 
@@ -45,18 +46,25 @@ def moves(events) -> list:
 
 
 def test_moves_off_the_path_are_marked_from_the_first_under_comp_to_the_first_after_g40():
-    lines = [(e.block.line, e.fixed) for e in moves(events_of(CONTOUR))]
-    assert lines == [
-        (2, ""),
-        (3, ""),
-        (5, COMP),
-        (6, COMP),
-        (7, COMP),
-        (8, COMP),
-        (10, COMP),
-        (11, ""),
-        (12, ""),
+    lines = [(e.block.line, e.fixed, e.centre_shift is not None) for e in moves(events_of(CONTOUR))]
+    assert lines == [(2, "", False), (3, "", False)] + [(n, "", True) for n in (5, 6, 7, 8, 10)] + [
+        (11, "", False),
+        (12, "", False),
     ]
+    in_xz = moves(events_of(CONTOUR.replace("G41.1", "G18 G41.1").replace("G2 X20 Y20 R10", "G2 X20 Z-1 R10")
+                            .replace("G2 X40 Y50 I10", "G17 G2 X40 Y50 I10")))  # fmt: skip
+    assert [(e.block.line, e.fixed) for e in in_xz[2:7]] == [(n, COMP) for n in (5, 6, 7, 8, 10)]
+
+
+def test_the_tool_centre_stands_off_each_move_by_the_radius_to_the_left_of_its_own_direction():
+    """G41.1 D10: 5 mm left of the line's direction and radially on the arc, at the end of each move;
+    a move starts where the move before left the tool centre (the entry move on its programmed point,
+    None), and the exit move after G40 ends on its programmed point."""
+    shifts = [e.centre_shift for e in moves(events_of(CONTOUR))[2:7]]
+    left_of_x, left_of_y = (0.0, 5.0, 0.0), (-5.0, 0.0, 0.0)
+    ends = [left_of_x, left_of_y, left_of_x, left_of_y, (0.0, 0.0, 0.0)]
+    assert all(math.dist(s[1], end) < 1e-12 for s, end in zip(shifts, ends))
+    assert shifts[0][0] is None and [s[0] for s in shifts[1:]] == [s[1] for s in shifts[:-1]]
 
 
 def test_after_g40_the_position_is_the_programs():
@@ -169,7 +177,7 @@ def test_the_ccomp_parameter_says_the_mode():
 
 def test_program_end_ends_compensation():
     events = moves(events_of(HEAD + "G41.1 D2\nG1 X10\nM2\n"))
-    assert events[-1].fixed == COMP
+    assert events[-1].centre_shift is not None
     from ncpp.motion.interpreter import Interpreter
 
     interpreter = Interpreter("t.ngc")
@@ -203,9 +211,11 @@ def test_fanuc_corners_under_compensation_are_the_controls_and_the_position_is_f
 
 
 # -- compensation ---------------------------------------------------------------------------------
+# in the XZ plane: compensation that ncpp does not follow
 POCKET = (
     HEAD
-    + "G1 X-20 Y-20\nG1 X-5\nG41.1 D6\nG1 X0 Y0\nG1 X40\nG3 X50 Y10 R10\nG1 Y40\nG40\nG1 X55 Y45\nG1 X70\nG2 X80 Y55 R10\nG0 Z10\nM2\n"
+    + "G1 X-20 Y-20\nG1 X-5\nG18\nG41.1 D6\nG1 X0 Z0\nG1 X40\nG2 X50 Z10 R10\nG1 Z40\nG40\nG1 X55 Z45\nG1 X70\n"
+    "G17\nG2 X80 Y-10 R10\nG0 Z10\nM2\n"
 )
 
 
@@ -213,25 +223,20 @@ def test_moves_off_the_path_pass_through_and_compensation_resumes_after_the_exit
     out, warned = compensate(POCKET, "comp.ngc")
     original, lines = POCKET.splitlines(), out.splitlines()[1:]  # (the header)
     start = lines.index("G41.1 D6")
-    assert lines[start - 1].startswith("X-4.97")  # `G1 X-5` compensated before it
-    assert lines[start : start + 7] == original[5:12]  # from G41.1 to the exit move: verbatim
+    assert lines[start - 2].startswith("X-4.97")  # `G1 X-5` compensated before it
+    assert lines[start : start + 7] == original[6:13]  # from G41.1 to the exit move: verbatim
     after = lines[start + 7 :]
-    # from the exit move's end (as programmed) to the compensated start of the next line, every axis said; then that line
-    assert (
-        after[0].startswith("G1 X55.0")
-        and "Y45.0" in after[0]
-        and "Z-0.9" in after[0]
-        and after[1].startswith("X70.0")
-    )
+    # from the exit move's end (as programmed) to the compensated end of the next line, every axis said
+    assert after[0].startswith("G1 X70.0") and "Y-19.9" in after[0] and "Z45.0" in after[0]
     assert any(line.startswith("G2 ") and "I" in line for line in after)  # the arc after it replaced
     assert (
         warned.count("warning") == 1
-        and "comp.ngc:7:1: warning: cutter compensation: its moves pass through uncompensated" in warned
+        and "comp.ngc:8:1: warning: cutter compensation: its moves pass through uncompensated" in warned
     )
 
 
-def test_strict_refuses_moves_under_compensation():
-    with pytest.raises(NcppError, match="comp.ngc:7:1: cutter compensation"):
+def test_strict_refuses_moves_under_compensation_it_does_not_follow():
+    with pytest.raises(NcppError, match="comp.ngc:8:1: cutter compensation"):
         compensate(POCKET, "comp.ngc", strict=True)
 
 
@@ -257,16 +262,15 @@ def test_rs274_runs_the_compensated_program_with_the_same_moves_under_compensati
     calls, messages = rs274(str(after))
     assert rs274_error(messages) is None, messages
     original, compensated = read_canon(rs274(str(before))[0]), read_canon(calls)
-    # the tool centre's moves from the corner after the entry move to the exit move: the same
+    # the tool centre's moves from the arc after the entry move to the exit move: the same
     # (their Z is where the compensated line before them left it); the entry move's end moves a
     # little with its start (rs274 offsets it square to the move), which compensation moved
+    # (in the XZ plane: X and Z, an arc's Z X ends and centre)
     k, n = (next(i for i, c in enumerate(calls) if c.name == "ARC_FEED") for calls in (original, compensated))
-    plane = [(a.name, a.args[:4] if a.name == "ARC_FEED" else a.args[:2]) for a in original[k : k + 5]]
-    assert plane == [
-        (a.name, a.args[:4] if a.name == "ARC_FEED" else a.args[:2]) for a in compensated[n : n + 5]
-    ]
-    assert math.dist(original[k - 1].args[:2], compensated[n - 1].args[:2]) < 0.005
-    assert compensated[n + 5].args[:2] != original[k + 5].args[:2]  # compensated again after the exit move
+    xz = lambda a: (a.name, a.args[:4] if a.name == "ARC_FEED" else a.args[:3:2])  # noqa: E731
+    assert [xz(a) for a in original[k : k + 3]] == [xz(a) for a in compensated[n : n + 3]]
+    assert math.dist(original[k - 1].args[:3:2], compensated[n - 1].args[:3:2]) < 0.005
+    assert compensated[n + 3].args[:2] != original[k + 3].args[:2]  # compensated again after the exit move
 
 
 def test_motion_and_simulate_say_where_the_tool_leaves_the_programmed_contour(tmp_path):

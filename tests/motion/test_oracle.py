@@ -142,7 +142,7 @@ def ours(
                 if call is not None:
                     calls.append(call)
                     if off_path is not None:
-                        off_path.append(event.fixed == COMP)  # type: ignore[union-attr]
+                        off_path.append(event.fixed == COMP or event.centre_shift is not None)  # type: ignore[union-attr]
         except NcppError as err:
             error = err
     return calls, error, stream.getvalue()

@@ -44,17 +44,17 @@ def test_the_figures_of_a_hand_made_program():
     source = ErrorSource(Shift(), "shift", "0" * 16, 0.5)
     stats = process(io.BytesIO(PROGRAM), io.BytesIO(), file="hand.ngc", source=source, warnings=None)
     s = stats.summary
-    # G0 X10 Y10 Z5, G1 Z-1, X40 Y10, X40 Y30, G0 Z5; 4 a hole (up to R: the series started below it, over, down, up)
-    assert s.moves == 5 + 8
-    # the feed moves: Z5 to Z-1, then 30 and 20 mm; each hole 5 mm down from R
-    assert s.feed_mm == pytest.approx(6 + 30 + 20 + 2 * 5)
+    # G0 X10 Y10 Z5, G1 Z-1, X40 Y10, X40 Y30, G0 Z5; 4 a hole (up to R: the series started below it, over,
+    # down, up); the G41, G1 and G40 moves (compensated where the tool centre stands)
+    assert s.moves == 5 + 8 + 3
+    # the feed moves: Z5 to Z-1, then 30 and 20 mm; each hole 5 mm down from R; 10√2, 10 and 10 mm
+    assert s.feed_mm == pytest.approx(6 + 30 + 20 + 2 * 5 + 10 * 2**0.5 + 20)
     assert s.largest_mm == pytest.approx(0.010, abs=2e-7)
-    assert s.left_moves == {"cutter compensation": 3}  # G41, G1, G40 moves
-    assert s.left == {"cutter compensation": [[10, 12]]}
+    assert s.left_moves == {} and s.left == {}
     assert (s.lines_in, s.lines_out) == (13, stats.lines_out)
     line = s.line()
-    assert "compensated 13 moves (66.0 mm of feed path), largest correction 10.0 µm" in line
-    assert "left as programmed: 3 moves under cutter compensation (lines 10-12);" in line
+    assert "compensated 16 moves (100.1 mm of feed path), largest correction 10.0 µm" in line
+    assert "left as programmed: nothing;" in line
 
 
 def test_out_of_scope_is_counted_from_its_line():
@@ -94,9 +94,8 @@ def test_the_summary_is_on_stderr_without_a_terminal_and_in_the_report(tmp_path,
     summary = [ln for ln in proc.stderr.decode().splitlines() if ln.startswith("ncpp: hand.ngc: compensated")]
     assert len(summary) == 1 and "13 lines in" in summary[0]
     report = json.loads((tmp_path / "r.json").read_text())
-    assert report["moves_compensated"] == 13 and report["feed_path_compensated_mm"] == 66.0
-    assert "canned cycle" not in report["left_as_programmed"]
-    assert report["left_as_programmed"]["cutter compensation"] == {"moves": 3, "lines": [[10, 12]]}
+    assert report["moves_compensated"] == 16 and report["feed_path_compensated_mm"] == 100.1421
+    assert report["left_as_programmed"] == {}
     assert 1.0 < report["largest_correction_um"] < 100.0 and report["lines_in"] == 13
 
 
@@ -154,7 +153,7 @@ def test_compensate_and_simulate_find_the_machine_file_as_ncpp_does(tmp_path):
 
 
 def test_several_programs_each_tell_their_summary_and_the_report_lists_them(tmp_path):
-    (tmp_path / "a.ngc").write_bytes(PROGRAM)
+    (tmp_path / "a.ngc").write_bytes(PROGRAM.replace(b"G41 D1", b"G18 G41 D1"))  # (in XZ: left as programmed)
     (tmp_path / "b.ngc").write_bytes(PROGRAM.replace(b"G41 D1 G1 X70 Y40 F200\n", b"G1 X70 Y40 F200\n"))
     proc = _ncpp(
         "ncpp", "compensate", "--machine", str(MACHINE), "--work-offset", "400,350,300",
