@@ -23,7 +23,7 @@ from ncpp import __version__
 from ncpp.errors import Location, NcppError, Warnings
 from ncpp.guard import Placement, with_guard, without_guard
 from ncpp.motion.offsets import AT_MACHINE_ZERO, WorkOffsets
-from ncpp.motion.segments import COMP, CYCLE, FLOW, HOLE, Arc, Event, Line, Pass
+from ncpp.motion.segments import COMP, CYCLE, DRILLED, FLOW, HOLE, Arc, Event, Line, Pass
 from ncpp.passes import PASSES, PassContext, run_passes
 from ncpp.passes.context import ErrorMap, is_directional
 from ncpp.passes.inverse import iterations_for
@@ -165,6 +165,8 @@ UNCOMPENSATED = {
     "or away from where it stands, so it cannot carry one correction); compensation resumes with the next move after it "
     "(--expand writes an ISO program's loops and subroutines out as straight code, "
     "each move compensated)",
+    DRILLED: "drilling cycle: it drills where the move before it leaves the tool (X and Y compensated), its moves "
+    "along the tool axis as programmed (the depth with the machine's error); compensation resumes with the next move",
     COMP: "cutter compensation: its moves pass through uncompensated (the control offsets them by the tool radius, "
     "so the tool is not where their points are); compensation resumes after the first move with it off (after G40, or R0)",
 }

@@ -23,6 +23,7 @@ from __future__ import annotations
 import itertools
 import math
 from collections.abc import Iterable, Iterator
+from dataclasses import dataclass
 from typing import cast
 
 from ncpp.errors import Location, Warnings
@@ -35,7 +36,7 @@ from ncpp.motion.modal import (
     placed_interpreting,
     plane_of,
 )
-from ncpp.motion.segments import FLOW, MACHINE, PLANE_AXES, Event, Pass
+from ncpp.motion.segments import DRILLED, FLOW, MACHINE, PLANE_AXES, Event, Pass
 from ncpp.motion.sinumerik_flow import SinumerikFlow
 from ncpp.motion.tools import ToolTable, UntoldLengths
 from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
@@ -86,6 +87,21 @@ TOOL_CHANGE = 6.0  # M6 loads the tool T selected, with its cutting edge D1 unle
 
 
 _FROM_THE_CALLER = "(the caller's value)"  # a PROC parameter's value: not told
+# Drilling cycles followed, and how many parameters each reads (`_drilling`)
+DRILLING = {"CYCLE81": 5, "CYCLE82": 6}
+
+
+@dataclass(frozen=True)
+class Drilling:
+    """A drilling cycle's levels along the tool axis (program coordinates) and its dwell (s)."""
+
+    name: str
+    retract: float
+    clearance: float  # the reference plane plus the safety clearance
+    depth: float
+    dwell: float
+
+
 MAX_ELEMENTS = 65_536  # the elements of an array this interpreter holds (each is a variable)
 
 
@@ -108,6 +124,7 @@ class SinumerikInterpreter(ModalInterpreter):
         self.integers: set[str] = set()  # DEF INT variables round on assignment
         self.arrays: dict[str, tuple[int, ...]] = {}  # DEF arrays' sizes (their elements are variables)
         self.started = False  # a block has run (a PROC opens the program or is out of scope)
+        self.modal_cycle: Drilling | None = None  # MCALL's drilling cycle, run after each block that moves
         # A frame's offset is traversed with the axis's next incremental move (MD 42440
         # FRAME_OFFSET_INCR_PROG = 1): IC(d) after TRANS goes d from the old program position.
         self.frame_shift = [0.0, 0.0, 0.0]
@@ -279,6 +296,8 @@ class SinumerikInterpreter(ModalInterpreter):
         path: str | None = None
         frame: Statement | None = None
         machine = False  # SUPA: the block's coordinates are the machine's
+        mcall = False  # MCALL: the drilling cycle of the block is called after each move from here on
+        drilling: Drilling | None = None  # a drilling cycle the block runs where it ends
         end = False
         tool_words: list = []  # the block's T, M6 and D words, in order
         previous: Word | ExprWord | Statement | None = None
@@ -301,6 +320,12 @@ class SinumerikInterpreter(ModalInterpreter):
                     frame = item
                 elif what == "call" and item.node[0] == "SUPA" and not item.node[1]:
                     machine = True
+                elif what == "call" and item.node[0] == "MCALL":
+                    mcall, self.modal_cycle = True, None  # (alone it ends the modal call)
+                elif what == "call" and item.node[0] in DRILLING:
+                    drilling = self._drilling(item.node, block, item)
+                    if mcall:
+                        self.modal_cycle, drilling = drilling, None
                 elif what == "call" and (
                     item.node[0] in HARMLESS_CALLS
                     or item.node[0] in SETTING_CALLS
@@ -376,7 +401,57 @@ class SinumerikInterpreter(ModalInterpreter):
                 )
         if end:
             self.done = True
-        return self.radius_compensation(events, turn)
+        events = self.radius_compensation(events, turn)
+        if drilling is None and not mcall and self.modal_cycle is not None and events:
+            drilling = self.modal_cycle
+        if drilling is not None:
+            if self.radius_comp or self.plane != 17:
+                raise OutOfScope(
+                    "a drilling cycle under radius compensation or outside G17", block.items[0].start + 1
+                )
+            events = [*events, *self._drill(block, drilling)]
+        return events
+
+    # -- drilling cycles ----------------------------------------------------------------------
+    def _drilling(self, node: tuple, block: Block, item) -> Drilling:
+        """`CYCLE81(RTP, RFP, SDIS, DP, DPR)` or `CYCLE82(RTP, RFP, SDIS, DP, DPR, DTB)` (840D
+        Programming Guide Cycles, "Drilling, centering - CYCLE81", "Drilling, counterboring -
+        CYCLE82"): the retraction plane, the reference plane, the safety clearance (no sign), the
+        final depth, absolute or (DPR, no sign) below the reference plane, which counts when
+        given, and the dwell at the depth (s).  The later versions' further parameters (GMODE,
+        DMODE, AMODE) change what the others mean: given, they are out of scope."""
+        name, args = node
+        known = DRILLING[name]
+        if len(args) > known and any(a is not None for a in args[known:]):
+            raise OutOfScope(f"{name} with more than {known} parameters", item.start + 1)
+        values = [
+            None if a is None else self.value(a, block, item) for a in (*args, *(None,) * known)[:known]
+        ]
+        rtp, rfp, sdis, dp, dpr = values[:5]
+        if rtp is None or rfp is None or (dp is None and dpr is None):
+            self.fail(f"{name}: RTP, RFP and DP or DPR are needed", block, item)
+        depth = rfp - abs(dpr) if dpr is not None else cast(float, dp)
+        clearance = rfp + abs(sdis or 0.0)
+        if not depth < clearance:  # (the cycle drills down from above the plane)
+            self.fail(f"{name}: the depth {depth:g} is not below the reference plane and safety clearance "
+                      f"{clearance:g}", block, item)  # fmt: skip
+        return Drilling(name, rtp, clearance, depth, (values[5] or 0.0) if known > 5 else 0.0)
+
+    def _drill(self, block: Block, drilling: Drilling) -> list[Event]:
+        """The cycle's moves where the block leaves the tool: G0 down the tool axis to the
+        reference plane plus the safety clearance, G1 to the depth at the programmed feed, the
+        dwell, G0 back to the retraction plane.  X and Y are where the control stands (the
+        block's move, compensated), Z the cycle's: `fixed`, placed in Z only."""
+        events: list[Event] = []
+        for level, rapid in ((drilling.clearance, True), (drilling.depth, False), (drilling.retract, True)):
+            if not rapid and self.feed <= 0:
+                self.fail(f"{drilling.name}: no feed rate programmed before it", block)
+            line = self.line(block, [*self.pos[:2], level], rapid)
+            line.fixed, line.placed = DRILLED, (False, False, True)
+            events.append(line)
+            if not rapid and drilling.dwell > 0:
+                events.append(Pass(block, dwell=drilling.dwell))
+        return events
 
     def _exponent(self, block: Block, expression, word: Word) -> None:
         """Refuse `X=1e3`: the grammar reads `X=1` and an address E, as a Sinumerik would."""

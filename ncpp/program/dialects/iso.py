@@ -17,7 +17,7 @@ from dataclasses import replace
 from operator import itemgetter
 
 from ncpp.motion.cycles import CANNED
-from ncpp.motion.segments import CYCLE, EXTRA_AXES, Arc, Context, Event, Line, Pass, Setting
+from ncpp.motion.segments import CYCLE, DRILLED, EXTRA_AXES, Arc, Context, Event, Line, Pass, Setting
 from ncpp.passes.rotary import time_shares, turns
 from ncpp.program.blocks import DIGITS_AS_ONE, Block, Comment, ExprWord, Statement, Word
 from ncpp.program.numbers import NumberStyle, format_number
@@ -175,14 +175,21 @@ class IsoWriter:
                 lines.append(block.text)
             self._after_verbatim(block, motion)
             return lines
+        called = len(motion)  # a drilling cycle the block calls after its move: the control's, from its text
+        while called > 1 and motion[called - 1].fixed == DRILLED:
+            called -= 1
+        cycle, motion = called < len(motion), motion[:called]
         if not facts.plain:
             block = _literal_geometry(block)
         eol = block.eol
         if len(motion) > 1 and (motion[0].context.inverse_time or motion[0].extra):
-            return lines + self._write_pieces(block, motion, eol)
-        lines.append(self._edit_block(block, motion[0]) + eol)
-        if len(motion) > 1:
-            lines += self._new_blocks(block, motion[1:], eol)
+            lines += self._write_pieces(block, motion, eol)
+        else:
+            lines.append(self._edit_block(block, motion[0]) + eol)
+            if len(motion) > 1:
+                lines += self._new_blocks(block, motion[1:], eol)
+        if cycle:  # the cycle leaves the tool elsewhere: the next block writes every axis it knows
+            self._last_end = None
         return lines
 
     def _write_pieces(self, block: Block, pieces: list, eol: str) -> list[str]:

@@ -1,0 +1,85 @@
+"""Sinumerik drilling cycles CYCLE81 and CYCLE82, called once or modally with MCALL (840D
+Programming Guide Cycles, "Drilling, centering - CYCLE81", "Drilling, counterboring - CYCLE82",
+"Modal call of drilling cycles"): G0 down the tool axis to the reference plane plus the safety
+clearance, G1 to the final depth at the feed programmed before, the dwell (CYCLE82), G0 to the
+retraction plane; with MCALL after every block that moves, until an MCALL alone.
+
+No Sinumerik interpreter outside ncpp runs these cycles here: the moves are checked against
+the manual's sequence worked out by hand, and the compensated holes by mapping ncpp's reading
+of the written program through a machine whose errors are written here (a squareness)."""
+
+from __future__ import annotations
+
+import io
+
+import numpy as np
+import pytest
+
+from ncpp.errors import NcppError, Warnings
+from ncpp.motion.segments import DRILLED, Line, Pass
+from ncpp.motion.sinumerik import interpret
+from ncpp.program.dialects import parse_program
+from tests.writeback.conftest import SQUARE, compensate_file
+
+HEAD = "G17 G90 G71 G54\nT1 D1\nM6\nG0 X10 Y20 Z50\nF200\n"
+
+
+def _events(text: str) -> tuple[list, str]:
+    warned = io.StringIO()
+    _, blocks = parse_program(io.BytesIO(text.encode()), "d.mpf", "sinumerik")
+    return list(interpret(blocks, file="d.mpf", warnings=Warnings(stream=warned))), warned.getvalue()
+
+
+def _moves(events: list) -> list[tuple]:
+    return [(tuple(round(v, 6) for v in e.end), e.rapid, e.fixed) for e in events if type(e) is Line]
+
+
+def test_a_modal_cycle_drills_after_each_move_until_mcall_alone():
+    events, _ = _events(HEAD + "MCALL CYCLE81(10, 0, 2, -4)\nX40 Y30\nX-40\nMCALL\nG0 X20\nM30\n")
+    drill = lambda x, y: [
+        ((x, y, 2.0), True, DRILLED),
+        ((x, y, -4.0), False, DRILLED),
+        ((x, y, 10.0), True, DRILLED),
+    ]  # noqa: E731
+    assert _moves(events)[1:] == [((40.0, 30.0, 50.0), True, ""), *drill(40.0, 30.0),
+                                  ((-40.0, 30.0, 10.0), True, ""), *drill(-40.0, 30.0),
+                                  ((20.0, 30.0, 10.0), True, "")]  # fmt: skip
+
+
+def test_a_relative_depth_counts_and_cycle82_dwells_at_the_bottom():
+    events, _ = _events(HEAD + "G0 X5 Y5\nCYCLE82(10, 1, 2, -99, 5, 0.5)\nM30\n")
+    assert _moves(events)[2:] == [((5.0, 5.0, 3.0), True, DRILLED), ((5.0, 5.0, -4.0), False, DRILLED),
+                                  ((5.0, 5.0, 10.0), True, DRILLED)]  # fmt: skip
+    assert [e.dwell for e in events if type(e) is Pass and e.dwell is not None] == [0.5]
+
+
+@pytest.mark.parametrize(
+    "call, said",
+    [("CYCLE81(10, 0, 2, -4, , 0, 0, 10)", "CYCLE81 with more than 5 parameters"),
+     ("G18\nCYCLE81(10, 0, 2, -4)", "outside G17")],
+)  # fmt: skip
+def test_what_the_cycle_would_mean_otherwise_ends_interpretation(call, said):
+    events, warned = _events(HEAD + call + "\nG0 X1\nM30\n")
+    assert said in warned and not any(type(e) is Line and e.fixed == DRILLED for e in events)
+
+
+def test_a_depth_above_the_reference_plane_is_an_error_at_its_line():
+    with pytest.raises(NcppError, match="d.mpf:6:.*CYCLE81: the depth 5 is not below"):
+        _events(HEAD + "CYCLE81(10, 0, 2, 5)\nM30\n")
+
+
+def test_the_holes_are_compensated_and_compensation_goes_on(tmp_path):
+    """The positioning blocks are compensated (the machine's X is off by 50 µm/m of Y): each hole's
+    bottom lands where the program puts it, the cycle's text stays, and the move after it is
+    compensated too."""
+    text = HEAD + "MCALL CYCLE81(10, 0, 2, -4)\nX40 Y300\nX-40 Y-300\nMCALL\nG1 X60 Y400 F300\nM30\n"
+    program = tmp_path / "d.mpf"
+    program.write_text(text)
+    written = compensate_file(program, SQUARE, tmp_path).read_text()
+    assert "MCALL CYCLE81(10, 0, 2, -4)\n" in written and written.count("MCALL") == 2
+    events, _ = _events(written)
+    bottoms = np.array([e.end for e in events if type(e) is Line and e.fixed == DRILLED and not e.rapid])
+    landed = bottoms + np.column_stack([-50e-6 * bottoms[:, 1], 0 * bottoms[:, 1], 0 * bottoms[:, 1]])
+    assert np.abs(landed - [[40, 300, -4], [-40, -300, -4]]).max() < 0.5e-3
+    last = [e for e in events if type(e) is Line][-1]
+    assert abs(last.end[0] - 50e-6 * 400 - 60) < 0.5e-3 and last.end[0] != 60
