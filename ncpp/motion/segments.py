@@ -36,8 +36,6 @@ COMP = "cutter compensation"  # the control offsets the path by the tool's radiu
 HOME = "G28/G30 return"  # the control homes the axes it names (machine coordinates); the others stay where they stand
 # Klartext M91 and M140 MB, Sinumerik SUPA, G53 and G153: positions of the control's own
 MACHINE = "machine-coordinate move"
-# a Klartext drilling cycle (M99, CYCL CALL): in the tool axis, from where the control stands
-DRILLED = "drilling cycle"
 # Axis letters of `Line.end` / `Arc.end` beyond XYZ, in rs274's order.
 EXTRA_AXES = ("A", "B", "C", "U", "V", "W")
 
@@ -236,7 +234,6 @@ def mark_off_path(moves: list, compensating: bool, off_path: bool) -> bool:
 __all__ = [
     "COMP",
     "CYCLE",
-    "DRILLED",
     "HOLE",
     "Hole",
     "FLOW",
