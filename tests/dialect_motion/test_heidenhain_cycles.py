@@ -185,12 +185,15 @@ def compensate(text: str) -> tuple[str, object]:
     return out.getvalue().decode(), stats
 
 
-@pytest.mark.parametrize("call", ["M99", "CYCL CALL"])
+INCREMENTAL = ["L FMAX M99", "L  IX+65 FMAX M99", "L  IY-35 FMAX M99", "L  IX-65 FMAX M99"]
+
+
+@pytest.mark.parametrize("call", ["M99", "CYCL CALL", "IX IY"])
 def test_compensation_goes_on_through_the_holes_and_keeps_the_cycle_text(call):
     """The positioning moves' X gains 5e-5 · Y; the cycle's text, and each M99 once, are written as
     read; the moves after the drilling are compensated; read back, every hole is drilled at its
-    compensated X Y."""
-    holes = HOLES if call == "M99" else [h.replace(" M99", "") + "\nCYCL CALL" for h in HOLES]
+    compensated X Y (IX IY written as increments from where the cycle before leaves the tool)."""
+    holes = {"M99": HOLES, "IX IY": INCREMENTAL}.get(call) or [h.replace(" M99", "") + "\nCYCL CALL" for h in HOLES]
     text = program(holes=holes)
     written, stats = compensate(text)
     assert CYCLE_200 in written and written.count("M99") == text.count("M99")
