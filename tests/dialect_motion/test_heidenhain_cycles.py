@@ -21,6 +21,7 @@ from ncpp.motion.segments import DRILLED, Line
 from ncpp.pipeline import ErrorSource, dialect_tools, process
 from ncpp.program.dialects import parse_program
 from ncpp.summary import REASONS
+from tests.conftest import SHARED
 from tests.writeback.conftest import SQUARE
 
 CYCLE_200 = """CYCL DEF 200 DRILLING ~
@@ -172,12 +173,12 @@ def test_an_old_style_datum_shift_ends_interpretation():
     assert "CYCL DEF 7.0 (it moves the datum) is outside" in warned.getvalue()
 
 
-def compensate(text: str) -> tuple[str, object]:
-    """`text` compensated for the SQUARE machine, verified as it is written (`process`'s default)."""
+def compensate(text: str, machine_toml: str = SQUARE) -> tuple[str, object]:
+    """`text` compensated for a machine file (SQUARE), verified as it is written (`process`'s default)."""
     folder = os.environ.get("TMPDIR", "/tmp")
     machine = os.path.join(folder, f"square-{os.getpid()}.toml")
     with open(machine, "w") as stream:
-        stream.write(SQUARE)
+        stream.write(machine_toml)
     out = io.BytesIO()
     stats = process(io.BytesIO(text.encode()), out, file="drill.h", source=ErrorSource.from_machine_file(machine),
                     warnings=Warnings(stream=io.StringIO()), dialect="heidenhain")  # fmt: skip
@@ -207,3 +208,22 @@ def test_compensation_goes_on_through_the_holes_and_keeps_the_cycle_text(call):
     assert last.end[:2] == pytest.approx((0.005, 100.0), abs=6e-5)
     bottoms = [run[1][2] for run in runs(moves(written))]
     assert bottoms == [-6.0] * 4  # (the cycle's levels are the control's: as programmed)
+
+
+
+WIDE = SHARED / "machines" / "wide.toml"
+
+
+@pytest.mark.skipif(not WIDE.exists(), reason="the shared machine files are not here")
+def test_a_positioning_move_written_in_pieces_calls_its_cycle_from_the_last():
+    """On the shared wide machine (reversal tables, backlash), the feed from the hole at X90 Y-7.5 to
+    Y-42.5 is written as a step (X, held, would reverse) and the line: the M99 goes with the line,
+    so the hole is drilled at Y-42.5, not where the step ends, above the hole before."""
+    text = program(holes=["L FMAX M99", "L  X+90 F500 M99", "L  Y-42.5 F500 M99"], after=["L  Z+21 FMAX"])
+    written, _ = compensate(text, WIDE.read_text())
+    assert written.count("M99") == 3 and CYCLE_200 in written
+    lines = written.splitlines()
+    call = next(n for n, line in enumerate(lines) if "Y-42" in line)
+    assert lines[call].endswith(" M99") and lines[call - 1].endswith(" F500")  # the step, then the line
+    holes = [run[1][:2] for run in runs(moves(written))]
+    assert holes[2][1] == pytest.approx(-42.5, abs=0.01) and holes[1][1] == pytest.approx(-7.5, abs=0.01)
