@@ -37,7 +37,13 @@ from dataclasses import dataclass
 
 from ncpp.errors import Location, NcppError, Warnings
 from ncpp.motion.corners import CornerError, round_corner
-from ncpp.motion.heidenhain_cycles import DEFINITION_ACTIVE, REQUIRED, Drilling, cycle_number, parameters_needed
+from ncpp.motion.heidenhain_cycles import (
+    DEFINITION_ACTIVE,
+    REQUIRED,
+    Drilling,
+    cycle_number,
+    parameters_needed,
+)
 from ncpp.motion.heidenhain_cycles import steps as cycle_steps
 from ncpp.motion.heidenhain_flow import FIXED, JUMPS, SKIP, TEXT, KlartextFlow, jump_parts, label_key
 from ncpp.motion.modal import (
@@ -236,7 +242,7 @@ class HeidenhainInterpreter(ModalInterpreter):
         end = False
         machine_datum = False  # M91: the block's coordinates are the machine datum's
         retract: float | str | None = None  # M140 MB: a retract along the tool axis after the move
-        call: tuple[str, int] | None = None  # M99 or CYCL CALL (and its column): the cycle runs after the move
+        call: tuple[str, int] | None = None  # M99 or CYCL CALL and its column: the cycle runs after the move
         defined: str | None = None  # CYCL DEF of a drilling cycle: its number
         for item in block.items:
             if type(item) is Comment:
@@ -377,7 +383,7 @@ class HeidenhainInterpreter(ModalInterpreter):
         if self.radius_comp:
             raise OutOfScope(f"the cycle call {how} with radius compensation RL/RR", col)
         if self.tool_axis in self.unknown_axes:
-            raise OutOfScope(f"the cycle call {how} where the tool axis is not known (after M140 MB MAX)", col)
+            raise OutOfScope(f"the cycle call {how} where the tool axis is unknown (after M140 MB MAX)", col)
         changed = [name.upper() for name, value in cycle.q.items() if self.q.get(name) != value]
         if changed:
             raise OutOfScope(f"the cycle call {how}: {changed[0]} changed since CYCL DEF {cycle.number}", col)
@@ -386,7 +392,8 @@ class HeidenhainInterpreter(ModalInterpreter):
         except OutOfScope as out:
             out.col = col
             raise
-        programmed_feed, moves = self.feed, []
+        programmed_feed = self.feed
+        moves: list[Event] = []
         for step in run:
             if step.level == self.pos[self.tool_axis]:
                 continue

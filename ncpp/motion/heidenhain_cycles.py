@@ -87,7 +87,7 @@ def steps(cycle: Drilling) -> list[Step]:
     if depth == 0:
         return []  # (the manual: with DEPTH = 0 the control does not run the cycle)
     if depth > 0:
-        raise OutOfScope(f"CYCL DEF {cycle.number} with a positive depth Q201 (drilling away from the surface)")
+        raise OutOfScope(f"CYCL DEF {cycle.number} with a positive depth Q201 (away from the surface)")
     if cycle["q200"] < 0:
         raise OutOfScope(f"CYCL DEF {cycle.number} with a negative set-up clearance Q200")
     if cycle["q395"] or cycle["q343"]:

@@ -37,7 +37,9 @@ HOLES = ["L FMAX M99", "L  X+90 FMAX M99", "L  Y-42.5 FMAX M99", "L  X+25 FMAX M
 AFTER = ["L  Z+21 FMAX", "L  X+0 Y+100 F500"]
 
 
-def program(cycle: str = CYCLE_200, holes: list[str] = HOLES, after: list[str] = AFTER, before: str = "") -> str:
+def program(
+    cycle: str = CYCLE_200, holes: list[str] = HOLES, after: list[str] = AFTER, before: str = ""
+) -> str:
     """A Fusion-style drilling program: its blocks numbered, the cycle's continuation lines as written."""
     body = [*before.splitlines(), "TOOL CALL 7 Z S10000", "L  X+25 Y-7.5 R0 FMAX", "L  Z+21 R0 FMAX",
             cycle, *holes, *after, "M30"]  # fmt: skip
@@ -75,7 +77,9 @@ ONE_HOLE = [(5.0, None), (-6.0, 30.0), (5.0, None), (11.0, None)]
 
 def test_drilling_200_runs_at_every_hole_an_m99_block_ends_at():
     found = moves(program())
-    assert runs(found) == [drilled(x, y, ONE_HOLE) for x, y in ((25, -7.5), (90, -7.5), (90, -42.5), (25, -42.5))]
+    assert runs(found) == [
+        drilled(x, y, ONE_HOLE) for x, y in ((25, -7.5), (90, -7.5), (90, -42.5), (25, -42.5))
+    ]
     up, across = found[-2:]  # after the cycles: from where the last one ends, interpreted
     assert not up.fixed and up.start == (25.0, -42.5, 11.0) and up.end == (25.0, -42.5, 21.0)
     assert not across.fixed and across.end == (0.0, 100.0, 21.0) and across.feed == 500.0
@@ -128,8 +132,9 @@ def test_universal_drilling_203_decreases_its_plunge_and_breaks_chips():
     Q208=+400 ;RETRACTION FEED RATE ~
     Q256=+0.5 ;DIST FOR CHIP BRKNG"""
     (first, *_) = runs(moves(program(universal, ["L FMAX M99"])))
-    assert first == drilled(25, -7.5, [(2, None), (-8, 150), (-7.5, 400), (-14, 150), (2, 400), (-12, None),
-                                       (-18, 150), (-17.5, 400), (-20, 150), (2, 400), (50, None)])  # fmt: skip
+    levels = [(2, None), (-8, 150), (-7.5, 400), (-14, 150), (2, 400), (-12, None),
+              (-18, 150), (-17.5, 400), (-20, 150), (2, 400), (50, None)]  # fmt: skip
+    assert first == drilled(25, -7.5, levels)
 
 
 def test_centering_240_goes_to_its_depth_and_back_at_fmax():
@@ -180,7 +185,8 @@ def compensate(text: str, machine_toml: str = SQUARE) -> tuple[str, object]:
     with open(machine, "w") as stream:
         stream.write(machine_toml)
     out = io.BytesIO()
-    stats = process(io.BytesIO(text.encode()), out, file="drill.h", source=ErrorSource.from_machine_file(machine),
+    source = ErrorSource.from_machine_file(machine)
+    stats = process(io.BytesIO(text.encode()), out, file="drill.h", source=source,
                     warnings=Warnings(stream=io.StringIO()), dialect="heidenhain")  # fmt: skip
     os.remove(machine)
     return out.getvalue().decode(), stats
@@ -194,7 +200,9 @@ def test_compensation_goes_on_through_the_holes_and_keeps_the_cycle_text(call):
     """The positioning moves' X gains 5e-5 · Y; the cycle's text, and each M99 once, are written as
     read; the moves after the drilling are compensated; read back, every hole is drilled at its
     compensated X Y (IX IY written as increments from where the cycle before leaves the tool)."""
-    holes = {"M99": HOLES, "IX IY": INCREMENTAL}.get(call) or [h.replace(" M99", "") + "\nCYCL CALL" for h in HOLES]
+    holes = {"M99": HOLES, "IX IY": INCREMENTAL}.get(call) or [
+        h.replace(" M99", "") + "\nCYCL CALL" for h in HOLES
+    ]
     text = program(holes=holes)
     written, stats = compensate(text)
     assert CYCLE_200 in written and written.count("M99") == text.count("M99")
@@ -208,7 +216,6 @@ def test_compensation_goes_on_through_the_holes_and_keeps_the_cycle_text(call):
     assert last.end[:2] == pytest.approx((0.005, 100.0), abs=6e-5)
     bottoms = [run[1][2] for run in runs(moves(written))]
     assert bottoms == [-6.0] * 4  # (the cycle's levels are the control's: as programmed)
-
 
 
 WIDE = SHARED / "machines" / "wide.toml"
