@@ -308,6 +308,7 @@ class HeidenhainInterpreter(ModalInterpreter):
                     raise OutOfScope(f"CYCL DEF {node[0]} (it moves the datum)", item.start + 1)
                 if number not in REQUIRED:  # (a cycle ncpp does not follow: a call of it leaves the scope)
                     self.cycle = self.cycle if number in DEFINITION_ACTIVE else f"CYCL DEF {number}"
+                    self._forget_assigned(block)
                     return []
                 defined = number  # (its Q parameters follow as assignments)
             elif what == "cycle_call" and node[0] is None:
@@ -370,6 +371,12 @@ class HeidenhainInterpreter(ModalInterpreter):
             return
         needed = parameters_needed(number)
         self.cycle = Drilling(number, {name: self.q[name] for name in needed if name in self.q}, block.line)
+
+    def _forget_assigned(self, block: Block) -> None:
+        """The Q parameters a CYCL DEF ncpp does not read sets are unknown from here on."""
+        for item in block.items:
+            if type(item) is Statement and item.kind == "assignment":
+                self.q.pop(item.node[0][1], None)
 
     def _call_cycle(self, block: Block, how: str, col: int) -> list[Event]:
         """M99 (after the block's move) or CYCL CALL: the drilling cycle's moves where the tool
