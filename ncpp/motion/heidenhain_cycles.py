@@ -15,7 +15,8 @@ Q204 2nd set-up clearance count from the workpiece surface Q203):
 * 203 UNIVERSAL DRILLING: as 200, the plunge decreased after each infeed by the decrement
   Q212 down to the minimum Q205; with chip breaking (Q213 breaks) the tool goes back by Q256
   after an infeed, and out to the set-up clearance after every Q213 breaks; out of the hole at
-  the retraction feed Q208 (0: at Q206).
+  the retraction feed Q208 (0: at Q206), the chip breaks' short retracts too (the manual names
+  no other feed for them), in again at FMAX to the set-up clearance above the depth reached.
 * 240 CENTERING: FMAX to Q203+Q200; centre to the depth Q201 (Q343=0) at Q206; FMAX to the
   set-up clearance, then to the 2nd set-up clearance.
 
