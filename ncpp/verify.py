@@ -55,8 +55,9 @@ ACTION_G = {4.0, 43.0, 43.1, 43.2, 49.0}
 # length and radius offset numbers
 ACTION_LETTERS = {"M", "T", "S", "H", "D"}
 # M functions that act after the block's motion (RS274/NGC 3 "order of execution"; the
-# Heidenhain and Sinumerik manuals place program stops and ends at the block's end too)
-AFTER_MOTION = {0.0, 1.0, 2.0, 30.0, 60.0}
+# Heidenhain and Sinumerik manuals place program stops and ends at the block's end too; Klartext's
+# M99 calls its cycle where the block's move ends, and ends a subprogram after the move in ISO)
+AFTER_MOTION = {0.0, 1.0, 2.0, 30.0, 60.0, 99.0}
 # Statements that are actions: Klartext's TOOL CALL, CYCL CALL and END PGM
 ACTION_STATEMENTS = {"tool_call", "cycle_call", "program_end"}
 CHUNK_MOVES = 4096  # moves of the input compared at a time between two actions

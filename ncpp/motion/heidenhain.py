@@ -9,7 +9,9 @@ half circle), `CT` (tangential arc), `LP`/`CP` polar with PR/IPR/PA/IPA (a
 helix with IZ, several turns with |IPA| > 360), Q parameters with arithmetic,
 labels, subprograms (`CALL LBL n` ... `LBL 0`), program-section repeats (`CALL LBL n REP k`)
 and the jumps FN 9-12 (`heidenhain_flow`: a block that runs again is left as programmed,
-FLOW), `CYCL DEF` of machining cycles (they only define), M2/M30
+FLOW), `CYCL DEF` of machining cycles (they only define), the drilling cycles 200, 201, 203
+and 240 called by M99 or `CYCL CALL` (`heidenhain_cycles`: their moves along the tool axis are
+left as programmed, DRILLED), M2/M30
 and `END PGM` (end), and `RND R..` / `CHF ..` between two feed lines in the
 working plane (the fillet arc or chamfer line is the RND/CHF block's event; a
 feed line waits for the next move to know whether its corner is cut).
@@ -17,8 +19,8 @@ Radius compensation RL/RR is followed to R0: the moves from the first with RL/RR
 to the R0 block's are the programmed contour, the tool centre off it by the radius,
 and are marked `fixed` (`ModalInterpreter.radius_compensation`).  Paraxial R+/R-,
 RND/CHF next to an arc or a rapid, FK free contours,
-APPR/DEP, `CALL PGM`, `CYCL CALL`, M99, FN 14 and later FN functions and cycles
-that move the datum make the position unknown: one warning (an error with
+APPR/DEP, `CALL PGM`, calls of other cycles, `CYCL CALL POS`/`PAT`, M89, FN 14 and later FN
+functions and cycles that move the datum make the position unknown: one warning (an error with
 `strict`) and the rest passes through.
 
 A `CC` block yields a `Pole` event (a `Pass` that carries the pole) so that a
@@ -35,6 +37,14 @@ from dataclasses import dataclass
 
 from ncpp.errors import Location, NcppError, Warnings
 from ncpp.motion.corners import CornerError, round_corner
+from ncpp.motion.heidenhain_cycles import (
+    DEFINITION_ACTIVE,
+    REQUIRED,
+    Drilling,
+    cycle_number,
+    parameters_needed,
+)
+from ncpp.motion.heidenhain_cycles import steps as cycle_steps
 from ncpp.motion.heidenhain_flow import FIXED, JUMPS, SKIP, TEXT, KlartextFlow, jump_parts, label_key
 from ncpp.motion.modal import (
     MM_PER_INCH,
@@ -44,7 +54,7 @@ from ncpp.motion.modal import (
     as_point,
     placed_interpreting,
 )
-from ncpp.motion.segments import COMP, FLOW, MACHINE, PLANE_AXES, Arc, Event, Line, Pass, Point
+from ncpp.motion.segments import COMP, DRILLED, FLOW, MACHINE, PLANE_AXES, Arc, Event, Line, Pass, Point
 from ncpp.motion.tools import ToolTable, UntoldLengths
 from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
 
@@ -154,6 +164,7 @@ class HeidenhainInterpreter(ModalInterpreter):
         self.preset: float | None = None  # the preset CYCL DEF 247 activated (the program zero told)
         self.ended = False  # the program ended (M2, M30, END PGM), not left the scope
         self.flow: KlartextFlow | None = None  # the order the blocks run in (labels, calls, jumps)
+        self.cycle: Drilling | str | None = None  # the cycle M99 / CYCL CALL runs (str: one not followed)
 
     def run(self, blocks: Iterable[Block], warnings: Warnings) -> Iterator[Event]:
         """Events as `ModalInterpreter.run`; a feed line waits (with the events after it)
@@ -231,6 +242,8 @@ class HeidenhainInterpreter(ModalInterpreter):
         end = False
         machine_datum = False  # M91: the block's coordinates are the machine datum's
         retract: float | str | None = None  # M140 MB: a retract along the tool axis after the move
+        call: tuple[str, int] | None = None  # M99 or CYCL CALL and its column: the cycle runs after the move
+        defined: str | None = None  # CYCL DEF of a drilling cycle: its number
         for item in block.items:
             if type(item) is Comment:
                 continue
@@ -240,8 +253,11 @@ class HeidenhainInterpreter(ModalInterpreter):
                 if letter == "N":
                     continue
                 if letter == "M":
-                    if value in (89.0, 99.0):
-                        raise OutOfScope(f"the cycle call M{value:g}", item.start + 1)
+                    if value == 99.0:
+                        call = ("M99", item.start + 1)
+                        continue
+                    if value == 89.0:  # (whether it calls after every block is a machine parameter)
+                        raise OutOfScope("the cycle call M89", item.start + 1)
                     if value == 128.0:
                         raise OutOfScope("M128 (tool-centre-point control)", item.start + 1)
                     if value == 92.0:  # (its datum is a machine parameter ncpp is not told)
@@ -284,12 +300,19 @@ class HeidenhainInterpreter(ModalInterpreter):
                 if node[1][0] != "str":
                     self.q[node[0][1]] = self.value(node[1], block, item)
             elif what == "cycle_def":
-                if node[0] == PRESET_CYCLE:
+                number = cycle_number(node[0])
+                if number == PRESET_CYCLE:
                     self._preset(block, item)
                     return []
-                if node[0] in DATUM_CYCLES:
+                if number in DATUM_CYCLES:
                     raise OutOfScope(f"CYCL DEF {node[0]} (it moves the datum)", item.start + 1)
-                return []
+                if number not in REQUIRED:  # (a cycle ncpp does not follow: a call of it leaves the scope)
+                    self.cycle = self.cycle if number in DEFINITION_ACTIVE else f"CYCL DEF {number}"
+                    self._forget_assigned(block)
+                    return []
+                defined = number  # (its Q parameters follow as assignments)
+            elif what == "cycle_call" and node[0] is None:
+                call = ("CYCL CALL", item.start + 1)
             elif (
                 what == "keyword"
                 and node
@@ -313,6 +336,9 @@ class HeidenhainInterpreter(ModalInterpreter):
                 reason = {"call_label": "CALL LBL", "call_program": "CALL PGM", "cycle_call": "CYCL CALL",
                           "fn": f"FN {node[0]}", "keyword": " ".join(map(str, node))}.get(what, what)  # fmt: skip
                 raise OutOfScope(reason, item.start + 1)
+        if defined is not None:
+            self._define_cycle(defined, block)
+            return []
         if function in ("RND", "CHF"):
             return [self._corner(block, function_item, words)]
         if "F" in words and function is not None:
@@ -324,12 +350,68 @@ class HeidenhainInterpreter(ModalInterpreter):
         if self.unknown_axes:
             self._from_unknown(events, words)
         if retract is not None:
+            if call is not None:
+                raise OutOfScope(f"M140 and the cycle call {call[0]} in one block", call[1])
             events.append(self._retract(block, retract))
+        events = self.radius_compensation(events, None if comp is None else comp != "R0")
+        if call is not None:
+            events = events + self._call_cycle(block, *call)
         if events and isinstance(events[-1], (Line, Arc)):
             self.last_move, self.corner_waits = events[-1], False
         if end:
             self.done = self.ended = True
-        return self.radius_compensation(events, None if comp is None else comp != "R0")
+        return events
+
+    def _define_cycle(self, number: str, block: Block) -> None:
+        """CYCL DEF of a drilling cycle, its Q parameters just assigned: the cycle M99 and CYCL
+        CALL run from now on (`ncpp.motion.heidenhain_cycles`)."""
+        missing = [name.upper() for name in REQUIRED[number] if name not in self.q]
+        if missing:
+            self.cycle = f"CYCL DEF {number} without {', '.join(missing)}"
+            return
+        needed = parameters_needed(number)
+        self.cycle = Drilling(number, {name: self.q[name] for name in needed if name in self.q}, block.line)
+
+    def _forget_assigned(self, block: Block) -> None:
+        """The Q parameters a CYCL DEF ncpp does not read sets are unknown from here on."""
+        for item in block.items:
+            if type(item) is Statement and item.kind == "assignment":
+                self.q.pop(item.node[0][1], None)
+
+    def _call_cycle(self, block: Block, how: str, col: int) -> list[Event]:
+        """M99 (after the block's move) or CYCL CALL: the drilling cycle's moves where the tool
+        stands, in the tool axis.  Left as programmed (DRILLED): the control runs them from
+        where it stands, which is the compensated end of the positioning before."""
+        cycle = self.cycle
+        if not isinstance(cycle, Drilling):
+            raise OutOfScope(f"the cycle call {how} ({cycle or 'no cycle defined'})", col)
+        if self.tool_axis != 2:
+            raise OutOfScope(f"the cycle call {how} with the tool axis {AXES[self.tool_axis]}", col)
+        if self.radius_comp:
+            raise OutOfScope(f"the cycle call {how} with radius compensation RL/RR", col)
+        if self.tool_axis in self.unknown_axes:
+            raise OutOfScope(f"the cycle call {how} where the tool axis is unknown (after M140 MB MAX)", col)
+        changed = [name.upper() for name, value in cycle.q.items() if self.q.get(name) != value]
+        if changed:
+            raise OutOfScope(f"the cycle call {how}: {changed[0]} changed since CYCL DEF {cycle.number}", col)
+        try:
+            run = cycle_steps(cycle)
+        except OutOfScope as out:
+            out.col = col
+            raise
+        programmed_feed = self.feed
+        moves: list[Event] = []
+        for step in run:
+            if step.level == self.pos[self.tool_axis]:
+                continue
+            end = list(self.pos)
+            end[self.tool_axis] = step.level
+            self.feed = step.feed if not step.rapid else programmed_feed
+            move = self.line(block, end, step.rapid)
+            move.fixed, move.placed = DRILLED, (False, False, True)
+            moves.append(move)
+        self.feed = programmed_feed
+        return moves
 
     def _tool_def(self, block: Block, statement) -> list[Event]:
         """`TOOL DEF n L.. R..`: the program defines tool n's length (without L: it only prepares the tool)."""

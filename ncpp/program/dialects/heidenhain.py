@@ -238,7 +238,7 @@ HEIDENHAIN = Dialect(
 
 from dataclasses import replace  # noqa: E402
 
-from ncpp.motion.segments import FLOW, PLANE_AXES, Arc, Line, Pass  # noqa: E402
+from ncpp.motion.segments import DRILLED, FLOW, PLANE_AXES, Arc, Line, Pass  # noqa: E402
 from ncpp.program.blocks import Block  # noqa: E402
 from ncpp.program.dialects.editing import splice  # noqa: E402
 from ncpp.program.dialects.iso import IsoWriter, _Units, written_apart  # noqa: E402
@@ -359,6 +359,8 @@ class HeidenhainWriter(IsoWriter):
         # the block itself says the first segment of its own kind; steps before and pieces after are new blocks
         own_kind = Line if function in ("L", "LP", "CHF") else Arc
         own = next((n for n, e in enumerate(motion) if type(e) is own_kind), 0)
+        # M99 calls its cycle after the block's move: with the move in pieces, on the last piece's block
+        call, last_piece = _called_on(block, motion, own)
         for n, segment in enumerate(motion):
             if (
                 n > own and segment.fixed
@@ -370,9 +372,11 @@ class HeidenhainWriter(IsoWriter):
                 yield self._inserted(self._cc_text(*centre_plane))
                 self.output_pole = centre_plane
             if n == own:
-                yield self._numbered(block, self._edit(block, segment, feed))
+                yield self._numbered(block, self._edit(block, segment, feed, () if call is None else (call,)))
             else:
-                yield self._inserted(self._fresh(segment) + feed)
+                word = block.items[call] if n == last_piece and call is not None else None
+                moved = "" if word is None else " " + block.raw[word.start : word.end]
+                yield self._inserted(self._fresh(segment) + feed + moved)
             feed = ""  # on the first block written
             self._remember_end(segment)
 
@@ -465,9 +469,9 @@ class HeidenhainWriter(IsoWriter):
         first, second = sorted((a, b))
         return f"C {self._word(_AXES[first], segment.end[first], segment)} {self._word(_AXES[second], segment.end[second], segment)} {rotation}"
 
-    def _edit(self, block: Block, segment: Line | Arc, feed: str = "") -> str:
-        """The block's raw text made to say `segment` (its other words, F, M, comments kept;
-        `feed` added)."""
+    def _edit(self, block: Block, segment: Line | Arc, feed: str = "", dropped: tuple[int, ...] = ()) -> str:
+        """The block's raw text made to say `segment` (its other words, F, M, comments kept,
+        but the items at `dropped`; `feed` added)."""
         index, function = _function(block)
         assert index is not None  # a block that moves has its path function
         arc = segment if isinstance(segment, Arc) else None
@@ -481,7 +485,7 @@ class HeidenhainWriter(IsoWriter):
                      or (type(i) is Statement and i.kind == "rotation")}  # fmt: skip
             texts[index] = self._arc_text(arc)
             return splice(block, texts, feed)
-        texts = {}
+        texts = dict.fromkeys(dropped)
         if arc is None and function != "L":  # LP, or a line where the program had an arc: the block becomes L
             texts[index] = "L"
             texts.update({n: None for n, i in enumerate(block.items)
@@ -530,6 +534,17 @@ class HeidenhainWriter(IsoWriter):
                         self.known_axes.add(axis)
             elif type(item) is ExprWord and item.letter[-1:] in _AXES and item.letter.lstrip("I") == item.letter[-1]:  # fmt: skip
                 self.known_axes.add(item.letter[-1])  # `X+Q1932` positions X as a number does
+
+
+def _called_on(block: Block, motion: list, own: int) -> tuple[int | None, int | None]:
+    """(the index of the block's M99, the piece it goes to) where the block's own move, in pieces
+    after `own`, calls a drilling cycle; (None, None) where the M99 stays in the block."""
+    if not any(e.fixed == DRILLED for e in motion):
+        return None, None
+    after = [n for n, e in enumerate(motion) if n > own and not e.fixed]
+    call = next((n for n, i in enumerate(block.items)
+                 if type(i) is Word and i.letter == "M" and i.value == 99.0), None)  # fmt: skip
+    return (call, after[-1]) if after and call is not None else (None, None)
 
 
 _NO_LESSON = ()

@@ -1,0 +1,148 @@
+"""Klartext drilling cycles: the moves the control makes in the tool axis when one is called.
+
+A `CYCL DEF` only defines a cycle; `M99` at the end of a block (after its move) or `CYCL CALL`
+runs it where the tool stands.  Its Q parameters are the Q assignments of the `CYCL DEF`
+block.  Heidenhain TNC 640 / iTNC 530 "Cycle programming" manual, "Fixed cycles: drilling",
+each cycle's "Cycle run" (levels along the tool axis; Q200 set-up clearance, Q201 depth and
+Q204 2nd set-up clearance count from the workpiece surface Q203):
+
+* 200 DRILLING: FMAX to Q203+Q200; drill by Q202 at Q206; back at FMAX to the set-up
+  clearance, and at FMAX down to the set-up clearance above the depth reached; again until
+  the depth Q201; at FMAX to the set-up clearance, then to the 2nd set-up clearance if it is
+  higher.
+* 201 REAMING: FMAX to Q203+Q200; ream to Q201 at Q206; back to the set-up clearance at
+  Q208 (0: at Q206); FMAX to the 2nd set-up clearance.
+* 203 UNIVERSAL DRILLING: as 200, the plunge decreased after each infeed by the decrement
+  Q212 down to the minimum Q205; with chip breaking (Q213 breaks) the tool goes back by Q256
+  after an infeed, and out to the set-up clearance after every Q213 breaks; out of the hole at
+  the retraction feed Q208 (0: at Q206), the chip breaks' short retracts too (the manual names
+  no other feed for them), in again at FMAX to the set-up clearance above the depth reached.
+* 240 CENTERING: FMAX to Q203+Q200; centre to the depth Q201 (Q343=0) at Q206; FMAX to the
+  set-up clearance, then to the 2nd set-up clearance.
+
+Dwells (Q210, Q211) move nothing.  The manual's depth sign gives the direction: a depth of
+0 runs no cycle; a positive depth (the control refuses it unless a machine parameter allows
+it), a depth measured on the tool's diameter (Q395=1, Q343=1: they need the tool's point
+angle) and the other cycles (202 with its spindle orientation, 204, 205, 208, tapping,
+pockets, contours) are outside ncpp's scope (`OutOfScope`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ncpp.motion.modal import OutOfScope
+
+# The cycles followed and the Q parameters each needs (the others default to 0)
+REQUIRED = {
+    "200": ("q200", "q201", "q206", "q202", "q203", "q204"),
+    "201": ("q200", "q201", "q206", "q203", "q204"),
+    "203": ("q200", "q201", "q206", "q202", "q203", "q204"),
+    "240": ("q200", "q201", "q206", "q203", "q204"),
+}
+OPTIONAL = {
+    "200": ("q210", "q211", "q395"),
+    "201": ("q211", "q208"),
+    "203": ("q210", "q212", "q213", "q205", "q211", "q208", "q256", "q395"),
+    "240": ("q343", "q344", "q211"),
+}
+# Cycles a CYCL DEF makes active at once, which leave the called cycle as it is: dwell (9),
+# tolerance (32), preset (247), and the datum cycles (out of scope themselves)
+DEFINITION_ACTIVE = frozenset(("7", "8", "9", "10", "11", "19", "26", "32", "247"))
+MAX_INFEEDS = 10_000  # infeeds of one hole: beyond, the parameters are a mistake, not a hole
+
+
+@dataclass(frozen=True)
+class Drilling:
+    """A defined drilling cycle: its number and Q parameters (name -> value, program units)."""
+
+    number: str
+    q: dict[str, float]
+    line: int | None = None  # the CYCL DEF's line
+
+    def __getitem__(self, name: str) -> float:
+        return self.q.get(name, 0.0)
+
+
+@dataclass(frozen=True)
+class Step:
+    """One move of a cycle run: to `level` in the tool axis, at rapid or at `feed`."""
+
+    level: float
+    rapid: bool
+    feed: float = 0.0
+
+
+def cycle_number(text: str) -> str:
+    """`200` -> '200', `9.0` -> '9' (the old form numbers a cycle's lines)."""
+    return text.split(".")[0].lstrip("0") or "0"
+
+
+def parameters_needed(number: str) -> tuple[str, ...]:
+    return REQUIRED[number] + OPTIONAL[number]
+
+
+def steps(cycle: Drilling) -> list[Step]:
+    """The moves of one run of `cycle`, from the level the tool stands at (see the module docstring)."""
+    depth = cycle["q201"]
+    if depth == 0:
+        return []  # (the manual: with DEPTH = 0 the control does not run the cycle)
+    if depth > 0:
+        raise OutOfScope(f"CYCL DEF {cycle.number} with a positive depth Q201 (away from the surface)")
+    if cycle["q200"] < 0:
+        raise OutOfScope(f"CYCL DEF {cycle.number} with a negative set-up clearance Q200")
+    if cycle["q395"] or cycle["q343"]:
+        raise OutOfScope(f"CYCL DEF {cycle.number} with the depth on the tool's diameter (Q395 or Q343 = 1)")
+    surface = cycle["q203"]
+    clearance = surface + cycle["q200"]
+    bottom = surface + depth
+    plunge, out = cycle["q206"], cycle["q208"] or cycle["q206"]
+    if cycle.number in ("201", "240"):
+        rapid_out = cycle.number == "240"
+        run = [Step(clearance, True), Step(bottom, False, plunge)]
+        return run + [Step(clearance, rapid_out, 0.0 if rapid_out else out)] + _second(cycle, clearance)
+    run = [Step(clearance, True)]
+    breaks = int(cycle["q213"]) if cycle.number == "203" else 0
+    reached, broken, infeed = clearance, 0, 0
+    for cut in _infeeds(cycle, depth):
+        if infeed:
+            if breaks and broken < breaks:
+                broken += 1
+                run.append(Step(reached + cycle["q256"], False, out))
+            else:
+                broken = 0
+                run += [Step(clearance, cycle.number == "200", out), Step(reached + cycle["q200"], True)]
+        reached = surface - cut
+        run.append(Step(reached, False, plunge))
+        infeed += 1
+    rapid_out = cycle.number == "200"
+    return run + [Step(clearance, rapid_out, 0.0 if rapid_out else out)] + _second(cycle, clearance)
+
+
+def _infeeds(cycle: Drilling, depth: float) -> list[float]:
+    """The depths below the surface each infeed ends at (positive), the last the full depth."""
+    total, plunge = -depth, cycle["q202"]
+    if plunge <= 0 or plunge >= total:
+        return [total]  # (the manual: to depth in one move when the plunge is the depth or more)
+    decrement = cycle["q212"] if cycle.number == "203" else 0.0
+    least = cycle["q205"] if cycle.number == "203" else 0.0
+    cuts: list[float] = []
+    reached = 0.0
+    while reached < total:
+        if len(cuts) >= MAX_INFEEDS:
+            raise OutOfScope(f"CYCL DEF {cycle.number} with more than {MAX_INFEEDS} infeeds")
+        reached = min(total, reached + plunge)
+        cuts.append(reached)
+        plunge = max(plunge - decrement, least)
+        if plunge <= 0:
+            raise OutOfScope(f"CYCL DEF {cycle.number} whose decrement Q212 leaves no plunge (no Q205)")
+    return cuts
+
+
+def _second(cycle: Drilling, clearance: float) -> list[Step]:
+    """FMAX to the 2nd set-up clearance, where it is above the set-up clearance."""
+    second = cycle["q203"] + cycle["q204"]
+    return [Step(second, True)] if second > clearance else []
+
+
+__all__ = ["DEFINITION_ACTIVE", "Drilling", "Step", "cycle_number", "parameters_needed", "steps"]

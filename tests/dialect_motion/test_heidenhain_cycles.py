@@ -1,0 +1,242 @@
+"""Klartext drilling cycles called with M99 and CYCL CALL: the moves the control makes, and
+compensation going on through them.
+
+The expected moves are worked out by hand from the Heidenhain TNC 640 / iTNC 530 "Cycle
+programming" manual, each cycle's "Cycle run" (`ncpp.motion.heidenhain_cycles` sums them up):
+the levels count from the surface Q203 (set-up clearance Q200, depth Q201, 2nd set-up
+clearance Q204), the cycle runs in the tool axis where the tool stands (after the move of the
+block M99 ends).  No Klartext interpreter ncpp did not write is at hand: the written programs
+are read back by ncpp's own interpreter (and its verifier, on in `process`), and judged against
+a closed-form machine (`SQUARE`: X is off by -50 µm/m · Y, so a compensated X gains 5e-5 · Y)."""
+
+from __future__ import annotations
+
+import io
+import os
+
+import pytest
+
+from ncpp.errors import Warnings
+from ncpp.motion.segments import DRILLED, Line
+from ncpp.pipeline import ErrorSource, dialect_tools, process
+from ncpp.program.dialects import parse_program
+from ncpp.summary import REASONS
+from tests.conftest import SHARED
+from tests.writeback.conftest import SQUARE
+
+CYCLE_200 = """CYCL DEF 200 DRILLING ~
+    Q200=+5    ;SET-UP CLEARANCE ~
+    Q201=-6    ;DEPTH ~
+    Q206=+30   ;FEED RATE FOR PLNGNG ~
+    Q202=+6    ;PLUNGING DEPTH ~
+    Q210=+0    ;DWELL TIME AT TOP ~
+    Q203=+0    ;SURFACE COORDINATE ~
+    Q204=+11   ;2ND SET-UP CLEARANCE ~
+    Q211=+0    ;DWELL TIME AT DEPTH"""
+HOLES = ["L FMAX M99", "L  X+90 FMAX M99", "L  Y-42.5 FMAX M99", "L  X+25 FMAX M99"]
+AFTER = ["L  Z+21 FMAX", "L  X+0 Y+100 F500"]
+
+
+def program(
+    cycle: str = CYCLE_200, holes: list[str] = HOLES, after: list[str] = AFTER, before: str = ""
+) -> str:
+    """A Fusion-style drilling program: its blocks numbered, the cycle's continuation lines as written."""
+    body = [*before.splitlines(), "TOOL CALL 7 Z S10000", "L  X+25 Y-7.5 R0 FMAX", "L  Z+21 R0 FMAX",
+            cycle, *holes, *after, "M30"]  # fmt: skip
+    lines = ["0  BEGIN PGM DRILL MM"] + [f"{n}  {text}" for n, text in enumerate(body, 1)]
+    return "\n".join(lines + [f"{len(body) + 1}  END PGM DRILL MM"]) + "\n"
+
+
+def moves(text: str, warned: io.StringIO | None = None) -> list[Line]:
+    interpret, _ = dialect_tools("heidenhain")
+    _, blocks = parse_program(io.BytesIO(text.encode()), "drill.h", "heidenhain")
+    events = interpret(blocks, file="drill.h", warnings=Warnings(stream=warned or io.StringIO()))
+    return [e for e in events if type(e) is Line]
+
+
+def runs(found: list[Line]) -> list[list[tuple]]:
+    """Each cycle run's moves as (X, Y, Z end, rapid, feed: None for a rapid)."""
+    out: list[list[tuple]] = []
+    for k, move in enumerate(found):
+        if move.fixed != DRILLED:
+            continue
+        if k == 0 or found[k - 1].fixed != DRILLED or found[k - 1].block is not move.block:
+            out.append([])
+        out[-1].append((*move.end, move.rapid, None if move.rapid else move.feed))
+    return out
+
+
+def drilled(x: float, y: float, levels: list[tuple[float, float | None]]) -> list[tuple]:
+    return [(x, y, z, feed is None, feed) for z, feed in levels]
+
+
+# Cycle 200 with Q200=5 Q201=-6 Q202=6 Q203=0 Q204=11, from Z21: FMAX to 5, drill to -6 at 30,
+# FMAX to 5, FMAX to the 2nd set-up clearance 11 (above 5)
+ONE_HOLE = [(5.0, None), (-6.0, 30.0), (5.0, None), (11.0, None)]
+
+
+def test_drilling_200_runs_at_every_hole_an_m99_block_ends_at():
+    found = moves(program())
+    assert runs(found) == [
+        drilled(x, y, ONE_HOLE) for x, y in ((25, -7.5), (90, -7.5), (90, -42.5), (25, -42.5))
+    ]
+    up, across = found[-2:]  # after the cycles: from where the last one ends, interpreted
+    assert not up.fixed and up.start == (25.0, -42.5, 11.0) and up.end == (25.0, -42.5, 21.0)
+    assert not across.fixed and across.end == (0.0, 100.0, 21.0) and across.feed == 500.0
+
+
+def test_drilling_200_pecks_back_to_the_set_up_clearance_and_down_to_it_above_the_depth_reached():
+    """Q202=2, Q201=-5: infeeds to -2, -4, -5; out at FMAX to 5 after each, in at FMAX to the set-up
+    clearance above the depth reached (-2+5, -4+5)."""
+    cycle = CYCLE_200.replace("Q201=-6 ", "Q201=-5 ").replace("Q202=+6 ", "Q202=+2 ")
+    (first, *_) = runs(moves(program(cycle)))
+    assert first == drilled(25, -7.5, [(5, None), (-2, 30), (5, None), (3, None), (-4, 30), (5, None),
+                                       (1, None), (-5, 30), (5, None), (11, None)])  # fmt: skip
+
+
+def test_cycl_call_runs_the_cycle_where_the_tool_stands_and_reaming_201_retracts_at_its_feed():
+    """201 REAMING: FMAX to Q203+Q200 = 2+2, ream to 2-10 at Q206=100, back to 4 at Q208=250 (0: at Q206),
+    FMAX to Q203+Q204 = 52."""
+    reaming = """CYCL DEF 201 REAMING ~
+    Q200=+2 ;SET-UP CLEARANCE ~
+    Q201=-10 ;DEPTH ~
+    Q206=+100 ;FEED RATE FOR PLNGNG ~
+    Q211=+0.5 ;DWELL TIME AT DEPTH ~
+    Q208=+250 ;RETRACTION FEED RATE ~
+    Q203=+2 ;SURFACE COORDINATE ~
+    Q204=+50 ;2ND SET-UP CLEARANCE"""
+    found = moves(program(reaming, ["L  X+40 Y+10 FMAX", "CYCL CALL M13"]))
+    expected = drilled(40, 10, [(4, None), (-8, 100), (4, 250), (52, None)])
+    assert runs(found) == [expected]
+    no_retraction_feed = runs(moves(program(reaming.replace("Q208=+250", "Q208=+0"), ["CYCL CALL"])))
+    assert no_retraction_feed == [drilled(25, -7.5, [(4, None), (-8, 100), (4, 100), (52, None)])]
+    assert found[-2].start == (40.0, 10.0, 52.0) and not found[-2].fixed
+
+
+def test_universal_drilling_203_decreases_its_plunge_and_breaks_chips():
+    """Q201=-20 Q202=8 Q212=2 Q205=3: plunges 8, 6, 4, then 3 (the minimum) cut to the depth: to -8,
+    -14, -18, -20.  Q213=1: a chip break (back by Q256=0.5 at Q208=400) then, the next time, out to the
+    set-up clearance 2 at Q208 and in at FMAX to 2 above the depth reached; out at Q208, FMAX to 50."""
+    universal = """CYCL DEF 203 UNIVERSAL DRILLING ~
+    Q200=+2 ;SET-UP CLEARANCE ~
+    Q201=-20 ;DEPTH ~
+    Q206=+150 ;FEED RATE FOR PLNGNG ~
+    Q202=+8 ;PLUNGING DEPTH ~
+    Q210=+0 ;DWELL TIME AT TOP ~
+    Q203=+0 ;SURFACE COORDINATE ~
+    Q204=+50 ;2ND SET-UP CLEARANCE ~
+    Q212=+2 ;DECREMENT ~
+    Q213=+1 ;BREAKS ~
+    Q205=+3 ;MIN. PLUNGING DEPTH ~
+    Q211=+0 ;DWELL TIME AT DEPTH ~
+    Q208=+400 ;RETRACTION FEED RATE ~
+    Q256=+0.5 ;DIST FOR CHIP BRKNG"""
+    (first, *_) = runs(moves(program(universal, ["L FMAX M99"])))
+    levels = [(2, None), (-8, 150), (-7.5, 400), (-14, 150), (2, 400), (-12, None),
+              (-18, 150), (-17.5, 400), (-20, 150), (2, 400), (50, None)]  # fmt: skip
+    assert first == drilled(25, -7.5, levels)
+
+
+def test_centering_240_goes_to_its_depth_and_back_at_fmax():
+    centering = """CYCL DEF 240 CENTERING ~
+    Q200=+2 ;SET-UP CLEARANCE ~
+    Q343=+0 ;SELECT DIA./DEPTH ~
+    Q201=-1.5 ;DEPTH ~
+    Q344=-9 ;DIAMETER ~
+    Q206=+80 ;FEED RATE FOR PLNGNG ~
+    Q211=+0.1 ;DWELL TIME AT DEPTH ~
+    Q203=+0 ;SURFACE COORDINATE ~
+    Q204=+20 ;2ND SET-UP CLEARANCE"""
+    assert runs(moves(program(centering, ["L FMAX M99"]))) == [
+        drilled(25, -7.5, [(2, None), (-1.5, 80), (2, None), (20, None)])
+    ]
+
+
+def test_incremental_positioning_and_q_parameters_from_formulas():
+    """Q201 = -Q1 * 2 with Q1 = 3 is the depth -6, Q206 = Q2 the feed 45; IX+20 IY-10 put the next
+    hole 20 right of and 10 below the one before."""
+    cycle = CYCLE_200.replace("Q201=-6 ", "Q201=-Q1*2 ").replace("Q206=+30 ", "Q206=Q2 ")
+    found = moves(program(cycle, ["L FMAX M99", "L  IX+20 IY-10 FMAX M99"], before="Q1 = 3\nFN 0: Q2 = +45"))
+    hole = [(5.0, None), (-6.0, 45.0), (5.0, None), (11.0, None)]
+    assert runs(found) == [drilled(25, -7.5, hole), drilled(45, -17.5, hole)]
+
+
+def test_cycles_ncpp_does_not_follow_and_changed_parameters_still_end_interpretation():
+    warned = io.StringIO()
+    boring = "CYCL DEF 202 BORING ~\n    Q200=+2 ;SET-UP CLEARANCE ~\n    Q201=-15 ;DEPTH"
+    assert runs(moves(program(boring), warned)) == []
+    assert "drill.h:8:11: warning: the cycle call M99 (CYCL DEF 202) is outside" in warned.getvalue()
+    warned = io.StringIO()  # a cycle ncpp does not read sets its Q parameters: they are not known after it
+    found = moves(
+        program(holes=["L FMAX M99", "CYCL DEF 207 RIGID TAPPING ~\n    Q201=-31 ;DEPTH", "L  Z-Q201 FMAX"]),
+        warned,
+    )
+    assert len(runs(found)) == 1 and "the parameter Q201 (not set in the program)" in warned.getvalue()
+    warned = io.StringIO()
+    found = moves(program(holes=["L FMAX M99", "Q201 = -8", "L  X+90 FMAX M99"]), warned)
+    assert len(runs(found)) == 1 and "Q201 changed since CYCL DEF 200" in warned.getvalue()
+
+
+def test_an_old_style_datum_shift_ends_interpretation():
+    """`CYCL DEF 7.0 DATUM SHIFT` with `CYCL DEF 7.1 X+10` moves the datum as `CYCL DEF 7` does."""
+    warned = io.StringIO()
+    moves(program(holes=["CYCL DEF 7.0 DATUM SHIFT", "CYCL DEF 7.1  X+10", "L FMAX M99"]), warned)
+    assert "CYCL DEF 7.0 (it moves the datum) is outside" in warned.getvalue()
+
+
+def compensate(text: str, machine_toml: str = SQUARE) -> tuple[str, object]:
+    """`text` compensated for a machine file (SQUARE), verified as it is written (`process`'s default)."""
+    folder = os.environ.get("TMPDIR", "/tmp")
+    machine = os.path.join(folder, f"square-{os.getpid()}.toml")
+    with open(machine, "w") as stream:
+        stream.write(machine_toml)
+    out = io.BytesIO()
+    source = ErrorSource.from_machine_file(machine)
+    stats = process(io.BytesIO(text.encode()), out, file="drill.h", source=source,
+                    warnings=Warnings(stream=io.StringIO()), dialect="heidenhain")  # fmt: skip
+    os.remove(machine)
+    return out.getvalue().decode(), stats
+
+
+INCREMENTAL = ["L FMAX M99", "L  IX+65 FMAX M99", "L  IY-35 FMAX M99", "L  IX-65 FMAX M99"]
+
+
+@pytest.mark.parametrize("call", ["M99", "CYCL CALL", "IX IY"])
+def test_compensation_goes_on_through_the_holes_and_keeps_the_cycle_text(call):
+    """The positioning moves' X gains 5e-5 · Y; the cycle's text, and each M99 once, are written as
+    read; the moves after the drilling are compensated; read back, every hole is drilled at its
+    compensated X Y (IX IY written as increments from where the cycle before leaves the tool)."""
+    holes = {"M99": HOLES, "IX IY": INCREMENTAL}.get(call) or [
+        h.replace(" M99", "") + "\nCYCL CALL" for h in HOLES
+    ]
+    text = program(holes=holes)
+    written, stats = compensate(text)
+    assert CYCLE_200 in written and written.count("M99") == text.count("M99")
+    assert written.count("CYCL CALL") == text.count("CYCL CALL")
+    assert stats.summary.passed_on_from is None  # nothing passed through uninterpreted
+    assert list(stats.summary.left) == [REASONS[DRILLED]]  # only the cycles' own moves left as programmed
+    holes_written = [c for x, y, *_ in (run[1] for run in runs(moves(written))) for c in (x, y)]
+    programmed = [(25, -7.5), (90, -7.5), (90, -42.5), (25, -42.5)]
+    assert holes_written == pytest.approx([c for x, y in programmed for c in (x + 5e-5 * y, y)], abs=6e-5)
+    last = moves(written)[-1]  # after the drilling: X0 Y100 compensated
+    assert last.end[:2] == pytest.approx((0.005, 100.0), abs=6e-5)
+    bottoms = [run[1][2] for run in runs(moves(written))]
+    assert bottoms == [-6.0] * 4  # (the cycle's levels are the control's: as programmed)
+
+
+WIDE = SHARED / "machines" / "wide.toml"
+
+
+@pytest.mark.skipif(not WIDE.exists(), reason="the shared machine files are not here")
+def test_a_positioning_move_written_in_pieces_calls_its_cycle_from_the_last():
+    """On the shared wide machine (reversal tables, backlash), the feed from the hole at X90 Y-7.5 to
+    Y-42.5 is written as a step (X, held, would reverse) and the line: the M99 goes with the line,
+    so the hole is drilled at Y-42.5, not where the step ends, above the hole before."""
+    text = program(holes=["L FMAX M99", "L  X+90 F500 M99", "L  Y-42.5 F500 M99"], after=["L  Z+21 FMAX"])
+    written, _ = compensate(text, WIDE.read_text())
+    assert written.count("M99") == 3 and CYCLE_200 in written
+    lines = written.splitlines()
+    call = next(n for n, line in enumerate(lines) if "Y-42" in line)
+    assert lines[call].endswith(" M99") and lines[call - 1].endswith(" F500")  # the step, then the line
+    holes = [run[1][:2] for run in runs(moves(written))]
+    assert holes[2][1] == pytest.approx(-42.5, abs=0.01) and holes[1][1] == pytest.approx(-7.5, abs=0.01)
