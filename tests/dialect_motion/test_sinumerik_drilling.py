@@ -36,11 +36,10 @@ def _moves(events: list) -> list[tuple]:
 
 def test_a_modal_cycle_drills_after_each_move_until_mcall_alone():
     events, _ = _events(HEAD + "MCALL CYCLE81(10, 0, 2, -4)\nX40 Y30\nX-40\nMCALL\nG0 X20\nM30\n")
-    drill = lambda x, y: [
-        ((x, y, 2.0), True, DRILLED),
-        ((x, y, -4.0), False, DRILLED),
-        ((x, y, 10.0), True, DRILLED),
-    ]  # noqa: E731
+
+    def drill(x: float, y: float) -> list[tuple]:
+        return [((x, y, 2.0), True, DRILLED), ((x, y, -4.0), False, DRILLED), ((x, y, 10.0), True, DRILLED)]
+
     assert _moves(events)[1:] == [((40.0, 30.0, 50.0), True, ""), *drill(40.0, 30.0),
                                   ((-40.0, 30.0, 10.0), True, ""), *drill(-40.0, 30.0),
                                   ((20.0, 30.0, 10.0), True, "")]  # fmt: skip
