@@ -75,6 +75,10 @@ HARMLESS_CALLS = frozenset(("MSG", "BNAT", "ENAT", "BTAN", "ETAN", "BAUTO", "EAU
 # arguments sets the contour tolerance and smoothing only ("High-speed settings - CYCLE832").
 RESETTING_CALLS = frozenset(("CYCLE800", "CYCLE832"))
 SETTING_CALLS = frozenset(("CYCLE832",))
+# Hole patterns that run the modal drilling cycle at positions of their own (Programming Guide Cycles,
+# "Drilling patterns"): their positioning moves are the control's, made from one block that cannot
+# carry their corrections, and the order and height of those moves are not followed here
+HOLE_PATTERNS = frozenset(("HOLES1", "HOLES2", "CYCLE801", "CYCLE802"))
 END_M = frozenset((2.0, 17.0, 30.0))
 # Addresses that say where the tool goes in a way this interpreter does not follow
 UNREAD_GEOMETRY = {"AR": "the opening angle", "AP": "the polar angle", "RP": "the polar radius"}
@@ -314,6 +318,11 @@ class SinumerikInterpreter(ModalInterpreter):
                     drilling = self._drilling(item.node, block, item)
                     if mcall:
                         self.modal_cycle, drilling = drilling, None
+                elif what == "call" and item.node[0] in HOLE_PATTERNS:
+                    raise OutOfScope(
+                        f"the hole pattern {item.node[0]} (the control places its holes itself)",
+                        item.start + 1,
+                    )
                 elif what == "call" and (
                     item.node[0] in HARMLESS_CALLS
                     or item.node[0] in SETTING_CALLS

@@ -141,3 +141,14 @@ def test_cycle83_holes_are_compensated(tmp_path):
     assert len(drilled) == 14
     landed = drilled[:, 0] - 50e-6 * drilled[:, 1]
     assert np.abs(landed - np.repeat([40, -40], 7)).max() < 0.5e-3 and np.all(drilled[:, 0] != 40)
+
+
+@pytest.mark.parametrize("pattern", ["HOLES1(20, 30, 0, 10, 15, 4)", "HOLES2(50, 50, 20, 0, 90, 4)"])
+def test_a_hole_pattern_under_mcall_ends_interpretation_before_its_holes(pattern):
+    """The pattern's positioning moves are the control's, from one block: they are not followed
+    (out of scope, the rest of the program passes through), the moves before it are."""
+    events, warned = _events(
+        HEAD + "MCALL CYCLE83(10, 0, 2, -5, , -5, , 5, 0, 0, 1, 0)\n" + pattern + "\nMCALL\nM30\n"
+    )
+    assert f"the hole pattern {pattern[:6]}" in warned
+    assert len([e for e in events if type(e) is Line]) == 1
