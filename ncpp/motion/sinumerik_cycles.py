@@ -16,8 +16,11 @@ final depth DP absolute or DPR below RFP, no sign, which counts when given):
   at that feed.  Chip removal (VARI=1) goes back to RFP+SDIS, dwells DTS and comes down at G0
   to the last depth less an anticipation distance the cycle works out internally: with more
   than one infeed it is out of scope, as are strokes that do not all have the same length
-  (the manual shares out the last strokes of a degression its own way) and a depth the strokes
-  do not reach exactly; one infeed (FDEP at DP) runs as CYCLE82 with the feed factor.
+  (the manual shares out the last strokes of a degression its own way), a depth the strokes
+  do not reach exactly, a safety clearance above DAM (with which the second stroke would
+  differ as the first counts from RFP or from RFP+SDIS) and chip breaking in inches (the
+  retract is given in mm).  One infeed (the first depth at DP) runs as CYCLE82 with the feed
+  factor, in either mode.
 
 The later versions' further parameters (CYCLE83: AXN, MDEP, VRT, DTD, DIS1; all: GMODE, DMODE,
 AMODE) change what the others mean: given, they are out of scope, as is an FRF outside (0, 1]
@@ -79,6 +82,7 @@ def drilling(name: str, values: list[float | None], inch: bool = False) -> Drill
 
 def _deep_hole(values: list[float | None], rfp: float, depth: float, inch: bool) -> list[Step]:
     """CYCLE83's infeeds (and chip-breaking retracts) from RFP+SDIS down to `depth`."""
+    sdis = values[2]
     fdep, fdpr, dam, dtb, _dts, frf, vari = values[5:12]
     if fdep is None and fdpr is None:
         raise OutOfScope("CYCLE83 without a first drilling depth FDEP or FDPR")
@@ -94,6 +98,9 @@ def _deep_hole(values: list[float | None], rfp: float, depth: float, inch: bool)
             f"CYCLE83 with the first drilling depth {first:g} outside the hole ({rfp:g} to {depth:g})"
         )
     levels = _infeeds(rfp, first, depth, abs(dam or 0.0))
+    if len(levels) > 1 and abs(sdis or 0.0) > abs(dam or 0.0):
+        raise OutOfScope("CYCLE83 with the safety clearance SDIS above the degression DAM (the second stroke "
+                         "would depend on whether the first counts from RFP or from RFP+SDIS)")  # fmt: skip
     if len(levels) > 1 and vari == 1.0:
         raise OutOfScope("CYCLE83 with chip removal (VARI=1) in more than one infeed: the control comes back "
                          "down to an anticipation distance it works out itself")  # fmt: skip

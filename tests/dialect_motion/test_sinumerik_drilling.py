@@ -118,6 +118,7 @@ def test_cycle83_in_one_infeed_drills_to_the_depth_at_the_reduced_feed():
      ("CYCLE83(10, 0, 2, -15, , -5, , 2, 0, 0, 1, 0)", "strokes of different lengths"),
      ("CYCLE83(10, 0, 2, -14, , -5, , 5, 0, 0, 1, 0)", "do not reach the depth -14 exactly"),
      ("CYCLE83(10, 0, 2, -15, , -5, , 5, 0, 0, , 0)", "the feed factor FRF left out"),
+     ("CYCLE83(10, 0, 6, -15, , -5, , 5, 0, 0, 1, 0)", "the safety clearance SDIS above the degression"),
      ("CYCLE83(10, 0, 2, -15, , , , 5, 0, 0, 1, 0)", "without a first drilling depth"),
      ("CYCLE83(10, 0, 2, -15, , -20, , 5, 0, 0, 1, 0)", "first drilling depth -20 outside the hole"),
      ("CYCLE83(10, 0, 2, -15, , -5, , 5, 0, 0, 1, 0, 3)", "CYCLE83 with more than 12 parameters"),
