@@ -153,3 +153,21 @@ def test_a_hole_pattern_under_mcall_ends_interpretation_before_its_holes(pattern
     )
     assert f"the hole pattern {pattern[:6]}" in warned
     assert len([e for e in events if type(e) is Line]) == 1
+
+
+def test_the_chip_breaking_cycle_ncpp_posts_is_followed():
+    """`ncpp post` writes CL chip breaking (CYCLE/DRILL, BRKCHP, STEP s) as CYCLE83 with FDEP one
+    step below RFP and DAM the step: read back, each hole's moves reach the CL depth in strokes
+    of the step, 1 mm back up between them."""
+    from ncpp.post import post
+
+    cl = ("UNITS / MM\nLOADTL / 1\nSPINDL / RPM, 1500, CLW\nFROM / 0, 0, 80\nRAPID\nGOTO / 20, 100, 50\n"
+          "CYCLE/DRILL,BRKCHP,RAPTO,2,FEDTO,-8,STEP,2,MMPM,120\nGOTO / 120, 100, 4\nGOTO / 140, -300, 4\n"
+          "CYCLE/OFF\nFINI\n")  # fmt: skip
+    out = io.BytesIO()
+    post(io.StringIO(cl), out, file="h.cls", dialect="sinumerik", warnings=Warnings(stream=io.StringIO()))
+    events, warned = _events(out.getvalue().decode())
+    hole = [(6.0, True), (2.0, False), (3.0, False), (0.0, False), (1.0, False), (-2.0, False), (-1.0, False),
+            (-4.0, False), (6.0, True)]  # fmt: skip
+    assert [(round(z, 6), rapid) for z, rapid, _ in _feeds(events)] == hole * 2
+    assert "outside" not in warned
