@@ -10,9 +10,10 @@ or `T="NAME"` selects, M6 loads it with cutting edge D1, `D n` picks an edge
 (D0 none); the edge's lengths 1-3 from the control's tool offsets (`_N_TO_INI`,
 `tools.py`) act along the plane's axes (G17: length 1 along Z).  Control flow (GOTOF,
 GOTOB, GOTO, GOTOC, CASE, IF, WHILE, FOR, REPEAT, LOOP) runs as `sinumerik_flow.py` says: a
-loop's moves are left as programmed (FLOW).  Calls of cycles and subprograms (by name or
-`L<n>`), splines, other frames, polar coordinates (AP=, RP=), arcs by opening angle (AR=)
-and unknown G codes make the position unknown: one warning (an error with `strict`) and the
+loop's moves are left as programmed (FLOW).  The drilling cycles CYCLE81-CYCLE83, called once
+or under MCALL, are followed (`sinumerik_cycles.py`); calls of other cycles, hole patterns
+and subprograms (by name or `L<n>`), splines, other frames, polar coordinates (AP=, RP=),
+arcs by opening angle (AR=) and unknown G codes make the position unknown: one warning (an error with `strict`) and the
 rest passes through.  Under cutter compensation (G41/G42 to the first move after
 G40) the moves are the programmed contour, the tool centre off it by the radius:
 they are marked `fixed` (`ModalInterpreter.radius_compensation`).
