@@ -10,9 +10,10 @@ or `T="NAME"` selects, M6 loads it with cutting edge D1, `D n` picks an edge
 (D0 none); the edge's lengths 1-3 from the control's tool offsets (`_N_TO_INI`,
 `tools.py`) act along the plane's axes (G17: length 1 along Z).  Control flow (GOTOF,
 GOTOB, GOTO, GOTOC, CASE, IF, WHILE, FOR, REPEAT, LOOP) runs as `sinumerik_flow.py` says: a
-loop's moves are left as programmed (FLOW).  Calls of cycles and subprograms (by name or
-`L<n>`), splines, other frames, polar coordinates (AP=, RP=), arcs by opening angle (AR=)
-and unknown G codes make the position unknown: one warning (an error with `strict`) and the
+loop's moves are left as programmed (FLOW).  The drilling cycles CYCLE81-CYCLE83, called once
+or under MCALL, are followed (`sinumerik_cycles.py`); calls of other cycles, hole patterns
+and subprograms (by name or `L<n>`), splines, other frames, polar coordinates (AP=, RP=),
+arcs by opening angle (AR=) and unknown G codes make the position unknown: one warning (an error with `strict`) and the
 rest passes through.  Under cutter compensation (G41/G42 to the first move after
 G40) the moves are the programmed contour, the tool centre off it by the radius:
 they are marked `fixed` (`ModalInterpreter.radius_compensation`).
@@ -23,7 +24,6 @@ from __future__ import annotations
 import itertools
 import math
 from collections.abc import Iterable, Iterator
-from dataclasses import dataclass
 from typing import cast
 
 from ncpp.errors import Location, Warnings
@@ -37,6 +37,8 @@ from ncpp.motion.modal import (
     plane_of,
 )
 from ncpp.motion.segments import DRILLED, FLOW, MACHINE, PLANE_AXES, Event, Pass
+from ncpp.motion.sinumerik_cycles import PARAMETERS as DRILLING
+from ncpp.motion.sinumerik_cycles import CycleError, Drilling, drilling
 from ncpp.motion.sinumerik_flow import SinumerikFlow
 from ncpp.motion.tools import ToolTable, UntoldLengths
 from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
@@ -74,6 +76,10 @@ HARMLESS_CALLS = frozenset(("MSG", "BNAT", "ENAT", "BTAN", "ETAN", "BAUTO", "EAU
 # arguments sets the contour tolerance and smoothing only ("High-speed settings - CYCLE832").
 RESETTING_CALLS = frozenset(("CYCLE800", "CYCLE832"))
 SETTING_CALLS = frozenset(("CYCLE832",))
+# Hole patterns that run the modal drilling cycle at positions of their own (Programming Guide Cycles,
+# "Drilling patterns"): their positioning moves are the control's, made from one block that cannot
+# carry their corrections, and the order and height of those moves are not followed here
+HOLE_PATTERNS = frozenset(("HOLES1", "HOLES2", "CYCLE801", "CYCLE802"))
 END_M = frozenset((2.0, 17.0, 30.0))
 # Addresses that say where the tool goes in a way this interpreter does not follow
 UNREAD_GEOMETRY = {"AR": "the opening angle", "AP": "the polar angle", "RP": "the polar radius"}
@@ -87,19 +93,6 @@ TOOL_CHANGE = 6.0  # M6 loads the tool T selected, with its cutting edge D1 unle
 
 
 _FROM_THE_CALLER = "(the caller's value)"  # a PROC parameter's value: not told
-# Drilling cycles followed, and how many parameters each reads (`_drilling`)
-DRILLING = {"CYCLE81": 5, "CYCLE82": 6}
-
-
-@dataclass(frozen=True)
-class Drilling:
-    """A drilling cycle's levels along the tool axis (program coordinates) and its dwell (s)."""
-
-    name: str
-    retract: float
-    clearance: float  # the reference plane plus the safety clearance
-    depth: float
-    dwell: float
 
 
 MAX_ELEMENTS = 65_536  # the elements of an array this interpreter holds (each is a variable)
@@ -326,6 +319,11 @@ class SinumerikInterpreter(ModalInterpreter):
                     drilling = self._drilling(item.node, block, item)
                     if mcall:
                         self.modal_cycle, drilling = drilling, None
+                elif what == "call" and item.node[0] in HOLE_PATTERNS:
+                    raise OutOfScope(
+                        f"the hole pattern {item.node[0]} (the control places its holes itself)",
+                        item.start + 1,
+                    )
                 elif what == "call" and (
                     item.node[0] in HARMLESS_CALLS
                     or item.node[0] in SETTING_CALLS
@@ -414,12 +412,9 @@ class SinumerikInterpreter(ModalInterpreter):
 
     # -- drilling cycles ----------------------------------------------------------------------
     def _drilling(self, node: tuple, block: Block, item) -> Drilling:
-        """`CYCLE81(RTP, RFP, SDIS, DP, DPR)` or `CYCLE82(RTP, RFP, SDIS, DP, DPR, DTB)` (840D
-        Programming Guide Cycles, "Drilling, centering - CYCLE81", "Drilling, counterboring -
-        CYCLE82"): the retraction plane, the reference plane, the safety clearance (no sign), the
-        final depth, absolute or (DPR, no sign) below the reference plane, which counts when
-        given, and the dwell at the depth (s).  The later versions' further parameters (GMODE,
-        DMODE, AMODE) change what the others mean: given, they are out of scope."""
+        """CYCLE81, CYCLE82 or CYCLE83 with its parameters (`sinumerik_cycles.py`).  The later
+        versions' further parameters (AXN, GMODE, DMODE, AMODE, ...) change what the others
+        mean: given, they are out of scope."""
         name, args = node
         known = DRILLING[name]
         if len(args) > known and any(a is not None for a in args[known:]):
@@ -427,30 +422,30 @@ class SinumerikInterpreter(ModalInterpreter):
         values = [
             None if a is None else self.value(a, block, item) for a in (*args, *(None,) * known)[:known]
         ]
-        rtp, rfp, sdis, dp, dpr = values[:5]
-        if rtp is None or rfp is None or (dp is None and dpr is None):
-            self.fail(f"{name}: RTP, RFP and DP or DPR are needed", block, item)
-        depth = rfp - abs(dpr) if dpr is not None else cast(float, dp)
-        clearance = rfp + abs(sdis or 0.0)
-        if not depth < clearance:  # (the cycle drills down from above the plane)
-            self.fail(f"{name}: the depth {depth:g} is not below the reference plane and safety clearance "
-                      f"{clearance:g}", block, item)  # fmt: skip
-        return Drilling(name, rtp, clearance, depth, (values[5] or 0.0) if known > 5 else 0.0)
+        try:
+            return drilling(name, values, self.inch)
+        except CycleError as error:
+            self.fail(str(error), block, item)
+        except OutOfScope as out:
+            out.col = item.start + 1
+            raise
 
-    def _drill(self, block: Block, drilling: Drilling) -> list[Event]:
-        """The cycle's moves where the block leaves the tool: G0 down the tool axis to the
-        reference plane plus the safety clearance, G1 to the depth at the programmed feed, the
-        dwell, G0 back to the retraction plane.  X and Y are where the control stands (the
-        block's move, compensated), Z the cycle's: `fixed`, placed in Z only."""
+    def _drill(self, block: Block, cycle: Drilling) -> list[Event]:
+        """The cycle's moves where the block leaves the tool, its feeds from the feed programmed
+        before, its dwells as dwell events.  X and Y are where the control stands (the block's
+        move, compensated), Z the cycle's: `fixed`, placed in Z only."""
         events: list[Event] = []
-        for level, rapid in ((drilling.clearance, True), (drilling.depth, False), (drilling.retract, True)):
-            if not rapid and self.feed <= 0:
-                self.fail(f"{drilling.name}: no feed rate programmed before it", block)
-            line = self.line(block, [*self.pos[:2], level], rapid)
+        programmed = self.feed
+        for step in cycle.steps:
+            if step.feed and programmed <= 0:
+                self.fail(f"{cycle.name}: no feed rate programmed before it", block)
+            self.feed = programmed * step.feed if step.feed else programmed
+            line = self.line(block, [*self.pos[:2], step.level], not step.feed)
             line.fixed, line.placed = DRILLED, (False, False, True)
             events.append(line)
-            if not rapid and drilling.dwell > 0:
-                events.append(Pass(block, dwell=drilling.dwell))
+            if step.dwell > 0:
+                events.append(Pass(block, dwell=step.dwell))
+        self.feed = programmed
         return events
 
     def _exponent(self, block: Block, expression, word: Word) -> None:

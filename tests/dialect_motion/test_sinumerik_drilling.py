@@ -82,3 +82,92 @@ def test_the_holes_are_compensated_and_compensation_goes_on(tmp_path):
     assert np.abs(landed - [[40, 300, -4], [-40, -300, -4]]).max() < 0.5e-3
     last = [e for e in events if type(e) is Line][-1]
     assert abs(last.end[0] - 50e-6 * 400 - 60) < 0.5e-3 and last.end[0] != 60
+
+
+# -- deep-hole drilling CYCLE83 (Programming Guide Cycles, "Deep-hole drilling - CYCLE83") --
+
+
+def _feeds(events: list) -> list[tuple]:
+    return [(round(e.end[2], 6), e.rapid, e.feed) for e in events if type(e) is Line and e.fixed == DRILLED]
+
+
+def test_cycle83_breaks_chips_one_mm_up_after_each_infeed():
+    """VARI=0: G0 to RFP+SDIS, G1 to the first depth FDEP at F times FRF, dwell DTB; back up
+    1 mm at G1 and the programmed feed, G1 down to the next depth (strokes of DAM = the first
+    stroke), dwell; ...; G0 to RTP.  Under MCALL, at each position."""
+    call = "MCALL CYCLE83(10, 0, 2, -15, , -5, , 5, 0.5, 3, 0.5, 0)\nX40 Y30\nX-40\nMCALL\nM30\n"
+    events, _ = _events(HEAD + call)
+    one_hole = [(2.0, True, 200.0), (-5.0, False, 100.0), (-4.0, False, 200.0), (-10.0, False, 200.0),
+                (-9.0, False, 200.0), (-15.0, False, 200.0), (10.0, True, 200.0)]  # fmt: skip
+    assert _feeds(events) == one_hole * 2
+    assert {e.end[:2] for e in events if type(e) is Line and e.fixed == DRILLED} == {(40, 30), (-40, 30)}
+    assert [e.dwell for e in events if type(e) is Pass and e.dwell is not None] == [0.5] * 6
+
+
+def test_cycle83_in_one_infeed_drills_to_the_depth_at_the_reduced_feed():
+    """The first depth (FDPR below RFP, as DPR) is the final depth: one infeed, in either mode;
+    DTS, the dwell at the start between infeeds, does not come in."""
+    events, _ = _events(HEAD + "G0 X5 Y5\nCYCLE83(10, 1, 2, -7, , , 8, 0, 1, 3, 0.25, 1)\nM30\n")
+    assert _feeds(events) == [(3.0, True, 200.0), (-7.0, False, 50.0), (10.0, True, 200.0)]
+    assert [e.dwell for e in events if type(e) is Pass and e.dwell is not None] == [1.0]
+
+
+@pytest.mark.parametrize(
+    "call, said",
+    [("CYCLE83(10, 0, 2, -15, , -5, , 5, 0, 0, 1, 1)", "chip removal (VARI=1) in more than one infeed"),
+     ("CYCLE83(10, 0, 2, -15, , -5, , 2, 0, 0, 1, 0)", "strokes of different lengths"),
+     ("CYCLE83(10, 0, 2, -14, , -5, , 5, 0, 0, 1, 0)", "do not reach the depth -14 exactly"),
+     ("CYCLE83(10, 0, 2, -15, , -5, , 5, 0, 0, , 0)", "the feed factor FRF left out"),
+     ("CYCLE83(10, 0, 6, -15, , -5, , 5, 0, 0, 1, 0)", "the safety clearance SDIS above the degression"),
+     ("CYCLE83(10, 0, 2, -15, , , , 5, 0, 0, 1, 0)", "without a first drilling depth"),
+     ("CYCLE83(10, 0, 2, -15, , -20, , 5, 0, 0, 1, 0)", "first drilling depth -20 outside the hole"),
+     ("CYCLE83(10, 0, 2, -15, , -5, , 5, 0, 0, 1, 0, 3)", "CYCLE83 with more than 12 parameters"),
+     ("G70\nCYCLE83(10, 0, 2, -15, , -5, , 5, 0, 0, 1, 0)", "in inches")],
+)  # fmt: skip
+def test_what_cycle83_leaves_to_the_control_ends_interpretation(call, said):
+    events, warned = _events(HEAD + "G0 X5 Y5\n" + call + "\nG0 X1\nM30\n")
+    assert said in warned and not any(type(e) is Line and e.fixed == DRILLED for e in events)
+
+
+def test_cycle83_holes_are_compensated(tmp_path):
+    """The positioning blocks before a modal CYCLE83 are compensated (the machine's X off by
+    50 µm/m of Y): every move of each hole lands on the hole's axis, the call stays as written."""
+    call = "MCALL CYCLE83(10, 0, 2, -15, , -5, , 5, 0.5, 0, 1, 0)"
+    program = tmp_path / "d.mpf"
+    program.write_text(HEAD + call + "\nX40 Y300\nX-40 Y-300\nMCALL\nG0 X0 Y0\nM30\n")
+    written = compensate_file(program, SQUARE, tmp_path).read_text()
+    assert call + "\n" in written
+    events, _ = _events(written)
+    drilled = np.array([e.end for e in events if type(e) is Line and e.fixed == DRILLED])
+    assert len(drilled) == 14
+    landed = drilled[:, 0] - 50e-6 * drilled[:, 1]
+    assert np.abs(landed - np.repeat([40, -40], 7)).max() < 0.5e-3 and np.all(drilled[:, 0] != 40)
+
+
+@pytest.mark.parametrize("pattern", ["HOLES1(20, 30, 0, 10, 15, 4)", "HOLES2(50, 50, 20, 0, 90, 4)"])
+def test_a_hole_pattern_under_mcall_ends_interpretation_before_its_holes(pattern):
+    """The pattern's positioning moves are the control's, from one block: they are not followed
+    (out of scope, the rest of the program passes through), the moves before it are."""
+    events, warned = _events(
+        HEAD + "MCALL CYCLE83(10, 0, 2, -5, , -5, , 5, 0, 0, 1, 0)\n" + pattern + "\nMCALL\nM30\n"
+    )
+    assert f"the hole pattern {pattern[:6]}" in warned
+    assert len([e for e in events if type(e) is Line]) == 1
+
+
+def test_the_chip_breaking_cycle_ncpp_posts_is_followed():
+    """`ncpp post` writes CL chip breaking (CYCLE/DRILL, BRKCHP, STEP s) as CYCLE83 with FDEP one
+    step below RFP and DAM the step: read back, each hole's moves reach the CL depth in strokes
+    of the step, 1 mm back up between them."""
+    from ncpp.post import post
+
+    cl = ("UNITS / MM\nLOADTL / 1\nSPINDL / RPM, 1500, CLW\nFROM / 0, 0, 80\nRAPID\nGOTO / 20, 100, 50\n"
+          "CYCLE/DRILL,BRKCHP,RAPTO,2,FEDTO,-8,STEP,2,MMPM,120\nGOTO / 120, 100, 4\nGOTO / 140, -300, 4\n"
+          "CYCLE/OFF\nFINI\n")  # fmt: skip
+    out = io.BytesIO()
+    post(io.StringIO(cl), out, file="h.cls", dialect="sinumerik", warnings=Warnings(stream=io.StringIO()))
+    events, warned = _events(out.getvalue().decode())
+    hole = [(6.0, True), (2.0, False), (3.0, False), (0.0, False), (1.0, False), (-2.0, False), (-1.0, False),
+            (-4.0, False), (6.0, True)]  # fmt: skip
+    assert [(round(z, 6), rapid) for z, rapid, _ in _feeds(events)] == hole * 2
+    assert "outside" not in warned
