@@ -68,9 +68,10 @@ def drilling(name: str, values: list[float | None], inch: bool = False) -> Drill
     rtp, rfp, sdis, dp, dpr = values[:5]
     if rtp is None or rfp is None or (dp is None and dpr is None):
         raise CycleError(f"{name}: RTP, RFP and DP or DPR are needed")
-    depth = rfp - abs(dpr) if dpr is not None else dp
+    # a parameter left out is 0 to the cycle, which cannot tell it from a 0 written: DPR counts
+    # when it is not 0 ("DP and DPR both given: the depth is derived from DPR"), else DP
+    depth = rfp - abs(dpr) if dpr else (dp or 0.0)
     clearance = rfp + abs(sdis or 0.0)
-    assert depth is not None
     if not depth < clearance:  # (the cycle drills down from above the plane)
         raise CycleError(f"{name}: the depth {depth:g} is not below the reference plane and safety clearance "
                          f"{clearance:g}")  # fmt: skip
@@ -84,10 +85,9 @@ def _deep_hole(values: list[float | None], rfp: float, depth: float, inch: bool)
     """CYCLE83's infeeds (and chip-breaking retracts) from RFP+SDIS down to `depth`."""
     sdis = values[2]
     fdep, fdpr, dam, dtb, _dts, frf, vari = values[5:12]
-    if fdep is None and fdpr is None:
+    if not fdep and not fdpr:
         raise OutOfScope("CYCLE83 without a first drilling depth FDEP or FDPR")
-    first = rfp - abs(fdpr) if fdpr is not None else fdep
-    assert first is not None
+    first = rfp - abs(fdpr) if fdpr else (fdep or 0.0)  # (as DPR and DP: `drilling`)
     if frf is None or not 0 < frf <= 1:
         raise OutOfScope(f"CYCLE83 with the feed factor FRF {'left out' if frf is None else f'{frf:g}'} "
                          "(the manual's range is 0.001 to 1)")  # fmt: skip

@@ -171,3 +171,12 @@ def test_the_chip_breaking_cycle_ncpp_posts_is_followed():
             (-4.0, False), (6.0, True)]  # fmt: skip
     assert [(round(z, 6), rapid) for z, rapid, _ in _feeds(events)] == hole * 2
     assert "outside" not in warned
+
+
+@pytest.mark.parametrize(
+    "call", ["CYCLE81(10, 0, 2, -4, 0)", "CYCLE81(10, 0, 2, -4)", "CYCLE81(10, 0, 2, -9, 4)"]
+)
+def test_a_relative_depth_of_0_is_one_left_out_and_dp_counts(call):
+    """The cycle cannot tell a DPR written as 0 from one left out (both are 0 to it): DP counts."""
+    events, _ = _events(HEAD + "G0 X5 Y5\n" + call + "\nM30\n")
+    assert [m[0][2] for m in _moves(events) if m[2] == DRILLED and not m[1]] == [-4.0]
