@@ -375,7 +375,7 @@ def process(
     )  # (the others have none)
     if verify:  # the verifier's own reading of the input: the blocks are held between the two
         # readings, not the events (a loop's runs read its few blocks again and again)
-        blocks, again = tee(blocks)
+        blocks, again = _twice(blocks)
         from ncpp.verify import unsaid
 
         original = interpret(again, file=file, warnings=unsaid(), offsets=offsets, **expanding)
@@ -412,6 +412,25 @@ def process(
         stats.summary.lines_in, stats.summary.lines_out = stats.lines_in, stats.lines_out
     warnings.finish()
     return stats
+
+
+def _twice(blocks: Iterable[Block]) -> tuple[Iterator[Block], Iterator[Block]]:
+    """Two readings of the blocks, each raising the parser's fault where it meets it (`tee` hands
+    an error to the reading that meets it first, and the other finds the program ended there)."""
+    def carried() -> Iterator[Block | NcppError]:
+        try:
+            yield from blocks
+        except NcppError as err:
+            yield err
+
+    def raised(items: Iterator[Block | NcppError]) -> Iterator[Block]:
+        for item in items:
+            if isinstance(item, NcppError):
+                raise item
+            yield item
+
+    one, two = tee(carried())
+    return raised(one), raised(two)
 
 
 def _copied(
