@@ -417,6 +417,7 @@ def process(
 def _twice(blocks: Iterable[Block]) -> tuple[Iterator[Block], Iterator[Block]]:
     """Two readings of the blocks, each raising the parser's fault where it meets it (`tee` hands
     an error to the reading that meets it first, and the other finds the program ended there)."""
+
     def carried() -> Iterator[Block | NcppError]:
         try:
             yield from blocks

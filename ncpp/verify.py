@@ -65,6 +65,9 @@ CHUNK_MOVES = 4096  # moves of the input compared at a time between two actions
 ACROSS = 0.25  # the share of a neighbouring chunk's samples each side is also compared with
 
 
+Position = tuple[int, int]  # where in the input a chunk ends: (blocks run, moves of the last of them before)
+
+
 @dataclass(frozen=True)
 class Action:
     """What a block does besides moving, as text two programs can be compared by."""
@@ -89,12 +92,10 @@ class Section:
     inverse_time: float  # minutes the G93 moves take
     action: Action | None
     first_line: int
-    # a chunk's end, where the next chunk starts: (input blocks run, moves of the last of them run before)
-    cut: Position | None = None
+    cut: Position | None = None  # a chunk's end, where the next chunk starts (None: not a chunk)
 
 
 NO_EXTRA = (0.0,) * len(EXTRA_AXES)
-Position = tuple[int, int]
 
 
 @dataclass
@@ -428,12 +429,13 @@ def verified(lines: Iterable[str], reached: Callable[[], tuple[int, int, int]], 
     NcppError where they part, or the program's first fault: the reading of the input runs
     ahead of the passes, so a fault it meets waits until the passes have had the lines before."""
     from ncpp.pipeline import dialect_tools
-    from ncpp.program.dialects.iso import written_at_once
+    from ncpp.program.dialects.iso import IsoWriter, written_at_once
     from ncpp.program.parser import parse_stream
 
     feed = _Feed(lines, reached)
     held = _Held(original)
-    divisible = written_at_once if dialect_tools(dialect)[1].control_at_once else None
+    writer: type[IsoWriter] = dialect_tools(dialect)[1]
+    divisible = written_at_once if writer.control_at_once else None
     cut: list[Position | None] = [None]  # where the input's chunk under way ends (None: at an action)
 
     def input_cut(block: Block, moves: int, run: int, into: int) -> Position | None:
