@@ -351,7 +351,7 @@ def process(
     `expand`: its loops and subroutines are written out as straight code (`motion/expand.py`).
 
     A compensated program is verified as it is written (`ncpp/verify.py`): read back
-    and compared with the interpreter's reading of the input; where they part an
+    and compared with a reading of the input of its own; where they part an
     NcppError stops the run, and what `out` took so far must be thrown away (the
     command line writes to a temporary file or a spool).  `verify=False` skips it.  `guard`: where
     the program must find the control's work offset, checked at its start (`ncpp/guard.py`)."""
@@ -373,11 +373,15 @@ def process(
     expanding = (
         {"expand_cycles": expand_cycles, "expand": expand} if FAMILY[name] == "iso" else {}
     )  # (the others have none)
+    if verify:  # the verifier's own reading of the input: the blocks are held between the two
+        # readings, not the events (a loop's runs read its few blocks again and again)
+        blocks, again = _twice(blocks)
+        from ncpp.verify import unsaid
+
+        original = interpret(again, file=file, warnings=unsaid(), offsets=offsets, **expanding)
     events: Iterable[Event] = interpret(
         blocks, file=file, warnings=warnings, strict=strict, offsets=offsets, **expanding
     )
-    if verify:
-        events, original = tee(events)
     events = warn_fixed(events, warnings, file)  # cycles, loops, subroutines (ISO), cutter compensation
     stats.summary = summary = Summary(file)
     warnings.listeners.append(summary.heard)
@@ -408,6 +412,26 @@ def process(
         stats.summary.lines_in, stats.summary.lines_out = stats.lines_in, stats.lines_out
     warnings.finish()
     return stats
+
+
+def _twice(blocks: Iterable[Block]) -> tuple[Iterator[Block], Iterator[Block]]:
+    """Two readings of the blocks, each raising the parser's fault where it meets it (`tee` hands
+    an error to the reading that meets it first, and the other finds the program ended there)."""
+
+    def carried() -> Iterator[Block | NcppError]:
+        try:
+            yield from blocks
+        except NcppError as err:
+            yield err
+
+    def raised(items: Iterator[Block | NcppError]) -> Iterator[Block]:
+        for item in items:
+            if isinstance(item, NcppError):
+                raise item
+            yield item
+
+    one, two = tee(carried())
+    return raised(one), raised(two)
 
 
 def _copied(

@@ -29,7 +29,8 @@ A long run of moves between two actions is compared in chunks of about
 each written line with the input line the writer had reached (`verified`), and
 the written program's chunk ends where the input's does by those tags; as a
 writer may be a block ahead of the lines it hands out, each side of a chunk is
-also compared with the other side's samples just across the cut.
+also compared with the other side's samples just across the cut.  A loop's or a
+call's runs are its control line's moves, cut at the same counts on both sides.
 """
 
 from __future__ import annotations
@@ -64,6 +65,9 @@ CHUNK_MOVES = 4096  # moves of the input compared at a time between two actions
 ACROSS = 0.25  # the share of a neighbouring chunk's samples each side is also compared with
 
 
+Position = tuple[int, int]  # where in the input a chunk ends: (blocks run, moves of the last of them before)
+
+
 @dataclass(frozen=True)
 class Action:
     """What a block does besides moving, as text two programs can be compared by."""
@@ -88,7 +92,7 @@ class Section:
     inverse_time: float  # minutes the G93 moves take
     action: Action | None
     first_line: int
-    cut: int = 0  # a chunk's end: how many input blocks have run where the next chunk starts (0: not a chunk)
+    cut: Position | None = None  # a chunk's end, where the next chunk starts (None: not a chunk)
 
 
 NO_EXTRA = (0.0,) * len(EXTRA_AXES)
@@ -111,6 +115,12 @@ class _Moves:
     feed: float = math.nan  # the last feed move's F and units (a new one is looked at)
     feed_inch: bool = False
     inverse_time: float = 0.0
+
+    def chunk(self, cut: Position, first_line: int) -> Section:
+        """The moves sampled as a chunk that ends where the next starts, at `cut`."""
+        section = self.sample(None, first_line)
+        section.cut = cut
+        return section
 
     def sample(self, action: Action | None, first_line: int) -> Section:
         """The moves sampled every `step` (each from its start to its end, both included)."""
@@ -232,16 +242,20 @@ def actions_of(block: Block) -> tuple[list[str], list[str]]:
     return before, after
 
 
-# (a block, the chunk's moves so far, the blocks run so far with it) -> where the next chunk starts (0: no cut)
-Cut = Callable[[Block, int, int], int]
+# (a block, the chunk's moves so far, the blocks run so far with it, its moves run so far) -> where
+# the next chunk starts (None: no cut)
+Cut = Callable[[Block, int, int, int], Position | None]
 
 
-def sections(events: Iterable[Event], bound: Bound, cut: Cut = lambda block, moves, run: 0,
-             line_of: Callable[[int], int] | None = None) -> Iterator[Section]:  # fmt: skip
+def sections(events: Iterable[Event], bound: Bound, cut: Cut = lambda block, moves, run, into: None,
+             line_of: Callable[[int], int] | None = None,
+             divisible: Callable[[Event], bool] | None = None) -> Iterator[Section]:  # fmt: skip
     """The motion of a program's events between its actions, in the order it runs; a chunk
-    ends before a block where `cut` says.  `line_of` gives the line a block's samples are
-    told by (its own by default)."""
+    ends before a block where `cut` says, or every `CHUNK_MOVES` moves into a block whose
+    first event is `divisible` (a loop's end line, which owns the moves of all its runs but the
+    first).  `line_of` gives the line a block's samples are told by (its own by default)."""
     moves = _Moves(bound)
+    into = 0  # moves of the block run so far, where it is divisible (-1: it is not)
     extra: tuple[float, ...] = NO_EXTRA
     last: Block | None = None
     after: list[str] = []
@@ -258,10 +272,9 @@ def sections(events: Iterable[Event], bound: Bound, cut: Cut = lambda block, mov
             after = []
             last = block
             run += 1
-            if moves.ends and (at := cut(block, len(moves.ends), run)):
-                chunk = moves.sample(None, first_line)
-                chunk.cut = at
-                yield chunk
+            into = 0 if divisible is not None and divisible(event) else -1
+            if moves.ends and (at := cut(block, len(moves.ends), run, 0)):
+                yield moves.chunk(at, first_line)
                 moves, first_line = _Moves(bound), block.line
             if not (kind is Pass and event.skipped) and _may_act(block.signature):  # type: ignore[union-attr]
                 before, after = actions_of(block)
@@ -270,6 +283,11 @@ def sections(events: Iterable[Event], bound: Bound, cut: Cut = lambda block, mov
                     yield moves.sample(Action(text, block.line), first_line)
                     moves, first_line = _Moves(bound), block.line
         if kind is Line or kind is Arc:
+            if into >= 0:
+                if into and into % CHUNK_MOVES == 0 and (at := cut(block, len(moves.ends), run, into)):
+                    yield moves.chunk(at, first_line)
+                    moves, first_line = _Moves(bound), block.line
+                into += 1
             extra = _add(moves, event, extra, inverse_time, line_of(block.line) if line_of else block.line)  # type: ignore[arg-type]
         elif kind is Pass and event.dwell is not None:  # type: ignore[union-attr]  # a cycle's, written G4 P
             for text in ("G4", f"P{event.dwell:g}"):  # type: ignore[union-attr]
@@ -369,9 +387,12 @@ def _interpreted(
 
     interpret, _ = dialect_tools(dialect)
     blocks = without_guard(blocks)  # (it neither moves nor acts, and reads the control's parameters)
-    return interpret(
-        blocks, file=file, warnings=Warnings(stream=_Discard()), offsets=offsets or AT_MACHINE_ZERO
-    )
+    return interpret(blocks, file=file, warnings=unsaid(), offsets=offsets or AT_MACHINE_ZERO)
+
+
+def unsaid() -> Warnings:
+    """Warnings that go unsaid: a second reading of a program warns of nothing the first did not."""
+    return Warnings(stream=_Discard())
 
 
 class _Discard:
@@ -398,25 +419,38 @@ def verify(original: BinaryIO, written: BinaryIO, *, file: str, dialect: str | N
 def verified(lines: Iterable[str], reached: Callable[[], tuple[int, int, int]], original: Iterable[Event], *, file: str, dialect: str,
              offsets: WorkOffsets | None, bound: Bound) -> Iterator[str]:  # fmt: skip
     """The written program's `lines`, handed on as they are verified against the `original`
-    events (the interpreter's reading of the input): each chunk of the input's motion is
+    events (an interpreter's reading of the input of its own): each chunk of the input's motion is
     compared with the written lines read back up to where the writer had reached the same
     input blocks (`reached()` as it hands out a line: its input line, the one before, and how
-    many input blocks have run, which loops make other than the lines).  Raises
+    many input blocks have run, which loops make other than the lines).  A loop's end line owns the
+    moves of its runs but the first; the writer writes its text at its first event (`written_at_once`),
+    so its moves are cut into chunks at the same counts on both sides: a loop of any length is
+    compared a chunk at a time (its text runs the same moves read back as in the input).  Raises
     NcppError where they part, or the program's first fault: the reading of the input runs
     ahead of the passes, so a fault it meets waits until the passes have had the lines before."""
+    from ncpp.pipeline import dialect_tools
+    from ncpp.program.dialects.iso import IsoWriter, written_at_once
     from ncpp.program.parser import parse_stream
 
     feed = _Feed(lines, reached)
     held = _Held(original)
-    state = {"cut": 0}  # where the input's chunk under way ends (0: at an action)
-    mine = sections(held, bound, lambda block, moves, run: run if moves >= CHUNK_MOVES else 0)
-    theirs = sections(_interpreted(parse_stream(feed, file, dialect), file, dialect, offsets), bound,
-                      lambda block, moves, run: state["cut"] if state["cut"] and feed.run(block.line) >= state["cut"] else 0,
-                      lambda number: feed.tag(number, before=True))  # fmt: skip
+    writer: type[IsoWriter] = dialect_tools(dialect)[1]
+    divisible = written_at_once if writer.control_at_once else None
+    cut: list[Position | None] = [None]  # where the input's chunk under way ends (None: at an action)
+
+    def input_cut(block: Block, moves: int, run: int, into: int) -> Position | None:
+        return (run, into) if moves >= CHUNK_MOVES else None
+
+    def written_cut(block: Block, moves: int, run: int, into: int) -> Position | None:
+        return cut[0] if cut[0] and (feed.run(block.line), into) >= cut[0] else None
+
+    mine = sections(held, bound, input_cut, divisible=divisible)
+    theirs = sections(_interpreted(parse_stream(feed, file, dialect), file, dialect, offsets), bound, written_cut,
+                      lambda number: feed.tag(number, before=True), divisible)  # fmt: skip
     comparison = _Comparison(file, bound, feed.text, tagged=True)
     try:
         for a in mine:
-            state["cut"] = a.cut
+            cut[0] = a.cut
             comparison.step(a, theirs)
             yield from feed.handed()
         comparison.end(theirs)

@@ -37,6 +37,7 @@ def peak_kb(*args: str) -> int:
 
 
 @pytest.mark.skipif(not MACHINE.exists(), reason="no shared machine file")
+@pytest.mark.parametrize("verify", [(), ("--no-verify",)], ids=["verified", "unverified"])
 @pytest.mark.parametrize(
     "body, times",
     [
@@ -44,17 +45,14 @@ def peak_kb(*args: str) -> int:
         ("G1 X1 Y1\nG1 X0 Y0\n", 40_000),
     ],
 )
-def test_compensating_a_loop_takes_the_same_memory_however_often_it_runs(tmp_path, body, times):
+def test_compensating_a_loop_takes_the_same_memory_however_often_it_runs(tmp_path, body, times, verify):
     def program(times: int) -> str:
         path = tmp_path / f"loop{times}.ngc"
         path.write_text(f"G21 G17 G90 F200\nG0 X0 Y0 Z5\no100 repeat [{times}]\n{body}o100 endrepeat\nM2\n")
         return str(path)
 
     few, many = (
-        # (the verifier holds a loop's moves, told by its one end line, in one chunk: docs/guide.md)
-        peak_kb(
-            "compensate", "--machine", str(MACHINE), program(n), "-o", str(tmp_path / "out.nc"), "--no-verify"
-        )
+        peak_kb("compensate", "--machine", str(MACHINE), program(n), "-o", str(tmp_path / "out.nc"), *verify)
         for n in (2, times)
     )
     assert many - few < 12_000, (few, many)  # (each pass kept: 1.7 MB more a pass of the cycle)

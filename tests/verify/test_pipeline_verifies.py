@@ -97,3 +97,80 @@ def test_a_long_program_is_verified_in_chunks(tmp_path: Path, monkeypatch, capsy
     monkeypatch.setattr(ncpp.pipeline, "PASSES", (*ncpp.pipeline.PASSES, shifted_at_line(2000, 2.0)))
     assert compensate(path) != 0
     assert "long.ngc:2000:1: verification:" in capsys.readouterr().err
+
+
+LOOP = """G21 G90 G17
+T1 M6
+S1000 M3
+G0 X10 Y10 Z5
+G1 Z-1 F200
+#1 = 0
+o101 repeat [400]
+#1 = [#1 + 0.9]
+G1 X[10 + #1] Y10
+X10 Y[10 + #1 / 2]
+o102 call
+o101 endrepeat
+G0 Z5
+M5
+M30
+o102 sub
+G1 X12 Y12
+o103 repeat [2]
+G1 X11
+Y11
+o103 endrepeat
+o102 endsub
+"""
+
+
+def test_a_long_loop_is_verified_a_chunk_at_a_time(tmp_path: Path, monkeypatch):
+    """A loop's runs, whose moves are its end line's, are compared in chunks as they run (memory
+    stays flat in the number of runs), the read-back's cut where the input's is: runs that
+    differ (#1 grows) and a subroutine call with a loop of its own in them pass."""
+    import ncpp.verify
+
+    monkeypatch.setattr(ncpp.verify, "CHUNK_MOVES", 64)
+    compared: list[int] = []  # the input's moves in each chunk compared
+    step = ncpp.verify._Comparison.step
+
+    def counted(self, a, theirs):
+        compared.append(len(a.starts))
+        step(self, a, theirs)
+
+    monkeypatch.setattr(ncpp.verify._Comparison, "step", counted)
+    path = tmp_path / "loop.ngc"
+    path.write_text(LOOP)
+    assert compensate(path) == 0
+    assert len(compared) > 400 * 7 // 64 and max(compared) <= 2 * 64, compared  # (7 moves a run)
+
+
+def test_a_fault_in_a_loop_body_is_refused_with_its_line(tmp_path: Path, monkeypatch, capsys):
+    import ncpp.verify
+
+    monkeypatch.setattr(ncpp.verify, "CHUNK_MOVES", 64)
+    monkeypatch.setattr(ncpp.pipeline, "PASSES", (*ncpp.pipeline.PASSES, shifted_at_line(10, 2.0)))
+    path = tmp_path / "loop.ngc"
+    path.write_text(LOOP)
+    assert compensate(path) != 0
+    err = capsys.readouterr().err
+    # (the runs after the first are the loop end's moves: the fault may be told at line 12)
+    assert "loop.ngc:10:1: verification:" in err or "loop.ngc:12:1: verification:" in err, err
+    assert not path.with_suffix(".out.ngc").exists()
+
+
+def test_a_written_loop_that_runs_once_less_is_refused(tmp_path: Path, monkeypatch, capsys):
+    """The last runs of a loop are compared too: a writer that gets the count wrong is stopped (each
+    run goes 0.9 mm further than the one before: the last one's path lies off the others')."""
+    import ncpp.verify
+    from ncpp.program.dialects.iso import IsoWriter
+
+    monkeypatch.setattr(ncpp.verify, "CHUNK_MOVES", 64)
+    write_control = IsoWriter._write_control
+    monkeypatch.setattr(IsoWriter, "_write_control", lambda self, block, first: [
+        text.replace("[400]", "[399]") for text in write_control(self, block, first)])  # fmt: skip
+    path = tmp_path / "loop.ngc"
+    path.write_text(LOOP)
+    assert compensate(path) != 0
+    err = capsys.readouterr().err
+    assert "loop.ngc:12:1: verification:" in err, err

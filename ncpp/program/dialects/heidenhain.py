@@ -267,6 +267,8 @@ class HeidenhainWriter(IsoWriter):
     block after an edited line (which then ends at the tangent point) becomes
     `CC` + `C ... DR±` or an `L` to the end of its fillet or chamfer."""
 
+    control_at_once = False  # (a call line's group carries the pole its text needs)
+
     comment_open, comment_close = "; ", ""
 
     def __init__(self, mm_decimals: int = 4, inch_decimals: int = 5):

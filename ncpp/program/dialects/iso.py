@@ -78,10 +78,22 @@ _MAX_UNITS = 64  # sets of number styles remembered with their compiled lines (a
 _LONG_GROUP = 1024  # events of one block past which the writer asks whether it needs them all
 
 
+def written_at_once(event: Event) -> bool:
+    """Whether the writer writes the block of its first `event` from that event alone, at once: a
+    control line's (an o-word, M98, M99) that runs, whose text depends only on its `Pass`; the
+    moves it runs after it (a loop's next runs, a subroutine's) are left as programmed and not
+    kept, so a loop of any length is written (and verified, `ncpp.verify`) as it runs."""
+    if type(event) is not Pass or event.skipped or event.cycle is not None:
+        return False
+    signature = event.block.signature  # (a plain block is a control line by its M98 or M99 only)
+    return (signature is None or "M" in signature) and _Facts(event.block).flow
+
+
 class IsoWriter:
     """Stateful writer; feed it the whole event stream once, in order."""
 
     comment_open, comment_close = "(", ")"
+    control_at_once = True  # control lines are written at their first event (`written_at_once`)
 
     def __init__(self, mm_decimals: int = 4, inch_decimals: int = 5):
         self.mm_decimals = mm_decimals
@@ -138,6 +150,9 @@ class IsoWriter:
             if group:
                 yield from write_group(group)
             block, group, control = event.block, [event], False
+            if self.control_at_once and written_at_once(event):
+                yield from write_group(group)
+                group, control = [], True
         if group:
             yield from write_group(group)
 
