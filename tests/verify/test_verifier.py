@@ -173,7 +173,7 @@ def test_a_path_over_itself_too_often_is_refused_with_a_way_out(tmp_path, capsys
 LOOP = """G21 G90 G17
 G0 X0 Y0 Z5
 G1 Z-1 F200
-o100 repeat [5000]
+o100 repeat [500]
 G1 X50 Y0
 G1 X50 Y{y}
 G1 X0 Y0
@@ -183,7 +183,7 @@ M2
 
 
 def test_a_loop_is_verified_run_by_run():
-    """Five thousand runs of one body: each distinct segment is looked up once, and a body
+    """Five hundred runs of one body: each distinct segment is looked up once, and a body
     that leaves the path is refused all the same."""
     assert check(LOOP.format(y=20), LOOP.format(y=20.04)) >= 1
     assert "verification" in str(refused(LOOP.format(y=20), LOOP.format(y=20.2)))
