@@ -145,6 +145,42 @@ def test_a_long_loop_is_verified_a_chunk_at_a_time(tmp_path: Path, monkeypatch):
     assert len(compared) > 400 * 7 // 64 and max(compared) <= 2 * 64, compared  # (7 moves a run)
 
 
+FANUC_LOOP = """%
+O1000
+G90 G21 G17 G54
+G0 X0 Y0 Z5
+#1=0
+WHILE [#1 LT 400] DO1
+G1 X[#1*0.1] Y10 F500
+G1 Y0
+#1=#1+1
+END1
+G1 X20 Y5
+M30
+%
+"""
+
+
+def test_a_long_fanuc_while_loop_is_verified_a_chunk_at_a_time(tmp_path: Path, monkeypatch):
+    """As an o-word loop: the runs after the first are the END line's moves, written and
+    compared as they run; runs that differ (X grows) pass, in chunks."""
+    import ncpp.verify
+
+    monkeypatch.setattr(ncpp.verify, "CHUNK_MOVES", 64)
+    compared: list[int] = []
+    step = ncpp.verify._Comparison.step
+
+    def counted(self, a, theirs):
+        compared.append(len(a.starts))
+        step(self, a, theirs)
+
+    monkeypatch.setattr(ncpp.verify._Comparison, "step", counted)
+    path = tmp_path / "loop.nc"
+    path.write_text(FANUC_LOOP)
+    assert compensate(path) == 0
+    assert len(compared) > 400 * 2 // 64 and max(compared) <= 2 * 64, compared
+
+
 def test_a_fault_in_a_loop_body_is_refused_with_its_line(tmp_path: Path, monkeypatch, capsys):
     import ncpp.verify
 

@@ -78,6 +78,10 @@ _MAX_UNITS = 64  # sets of number styles remembered with their compiled lines (a
 _LONG_GROUP = 1024  # events of one block past which the writer asks whether it needs them all
 
 
+# Fanuc macro B's control statements (`ncpp.motion.flow`): a loop's runs belong to its END line
+_FANUC_CONTROL = frozenset(("goto", "if", "while", "end"))  # (statement kinds)
+
+
 def written_at_once(event: Event) -> bool:
     """Whether the writer writes the block of its first `event` from that event alone, at once: a
     control line's (an o-word, M98, M99) that runs, whose text depends only on its `Pass`; the
@@ -840,7 +844,8 @@ class _Facts:
             None  # (n, number as written) of its first G0-G3 word, the n-th word
         )
         self.machine = False  # it moves in machine coordinates (G53)
-        self.flow = False  # a control line: an o-word (not `O<name>` alone, a program's name), M98, M99
+        self.flow = False  # a control line: an o-word (not `O<name>` alone, a program's name), M98, M99,
+        # a Fanuc GOTO, IF ... GOTO, WHILE or END
         self.settles = False  # its axis words are a G10 / G28 / G30 / G52 / G92 / G43.1's, not a move's
         self.expression_axes = ""  # the X Y Z words it writes as expressions (`Y[0]`, `Y#5`)
         for item in block.items if block is not None else ():
@@ -852,7 +857,9 @@ class _Facts:
                 self.plain = False
                 if kind is ExprWord and item.letter in AXES:  # type: ignore[union-attr]  # (as above)
                     self.expression_axes += item.letter  # type: ignore[union-attr]
-                if kind is Statement and item.kind == "oword" and len(item.node) >= 2:  # type: ignore[union-attr]
+                if kind is Statement and (
+                    (item.kind == "oword" and len(item.node) >= 2) or item.kind in _FANUC_CONTROL  # type: ignore[union-attr]
+                ):
                     self.flow = True
         self._sum_up()
 
