@@ -113,6 +113,8 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
         "passes/test_compensate_cli.py": (
             "test_an_arc_of_more_turns_than_compensation_holds_is_refused_with_its_line",
             "test_simulate_refuses_motion_outside_the_travel_and_paths_past_its_sample_budget",
+            "test_contour_error_shrinks_on_the_virtual_machine",
+            "test_second_compensation_is_refused_unless_forced",
         ),
         "benchmarks/test_harness.py": (
             "test_a_timed_run_in_a_fresh_process",
@@ -141,7 +143,23 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
         ),
         "shop/test_guard.py": (
             "test_the_guard_is_written_only_where_the_offset_was_told_and_not_with_no_guard",
+            "test_the_post_writes_the_guard_of_its_dialect",
+            "test_a_sinumerik_program_gets_its_settable_frame_checked_and_ncpp_still_reads_it",
+            "test_rs274_runs_the_guarded_program_where_g54_matches_and_stops_it_where_not",
         ),
+        "hostile/test_fuzz.py": ("test_fuzzed_inputs_are_refused_located_in_bounded_time_and_memory",),
+        "hostile/test_cli_contained.py": (
+            "test_a_terminated_run_removes_its_temporaries",
+            "test_a_subroutine_name_stays_inside_the_subroutine_path",
+        ),
+        "hostile/test_parser_limits.py": ("test_fifty_megabytes_of_one_line_are_refused_in_bounded_time",),
+        "instruments/test_analyze_cli.py": ("test_plot_writes_a_png_for_every_kind",),
+        "shop/test_summary.py": ("test_compensate_and_simulate_find_the_machine_file_as_ncpp_does",),
+        "motion/test_flow.py": ("test_compensate_with_a_subroutine_path",),
+        "motion/test_cutter_comp.py": (
+            "test_motion_and_simulate_say_where_the_tool_leaves_the_programmed_contour",
+        ),
+        "dialects/test_corpus.py": ("test_cli_dialect_option_overrides_and_errors_name_the_line",),
         "compensation/test_parsed_ahead.py": (
             "test_runs_of_any_length_write_what_one_line_at_a_time_writes",
         ),
