@@ -124,27 +124,6 @@ o102 endsub
 """
 
 
-def test_a_long_loop_is_verified_a_chunk_at_a_time(tmp_path: Path, monkeypatch):
-    """A loop's runs, whose moves are its end line's, are compared in chunks as they run (memory
-    stays flat in the number of runs), the read-back's cut where the input's is: runs that
-    differ (#1 grows) and a subroutine call with a loop of its own in them pass."""
-    import ncpp.verify
-
-    monkeypatch.setattr(ncpp.verify, "CHUNK_MOVES", 64)
-    compared: list[int] = []  # the input's moves in each chunk compared
-    step = ncpp.verify._Comparison.step
-
-    def counted(self, a, theirs):
-        compared.append(len(a.starts))
-        step(self, a, theirs)
-
-    monkeypatch.setattr(ncpp.verify._Comparison, "step", counted)
-    path = tmp_path / "loop.ngc"
-    path.write_text(LOOP)
-    assert compensate(path) == 0
-    assert len(compared) > 400 * 7 // 64 and max(compared) <= 2 * 64, compared  # (7 moves a run)
-
-
 FANUC_LOOP = """%
 O1000
 G90 G21 G17 G54
@@ -161,13 +140,17 @@ M30
 """
 
 
-def test_a_long_fanuc_while_loop_is_verified_a_chunk_at_a_time(tmp_path: Path, monkeypatch):
-    """As an o-word loop: the runs after the first are the END line's moves, written and
-    compared as they run; runs that differ (X grows) pass, in chunks."""
+@pytest.mark.parametrize("program, name, moves_a_run", [(LOOP, "loop.ngc", 7), (FANUC_LOOP, "loop.nc", 2)],
+                         ids=["o-words", "Fanuc WHILE"])  # fmt: skip
+def test_a_long_loop_is_verified_a_chunk_at_a_time(tmp_path: Path, monkeypatch, program, name, moves_a_run):
+    """A loop's runs, whose moves are its end line's (`endrepeat`, `END1`), are compared in
+    chunks as they run (memory stays flat in the number of runs), the read-back's cut where
+    the input's is: runs that differ (#1 grows) and a subroutine call with a loop of its own
+    in them pass."""
     import ncpp.verify
 
     monkeypatch.setattr(ncpp.verify, "CHUNK_MOVES", 64)
-    compared: list[int] = []
+    compared: list[int] = []  # the input's moves in each chunk compared
     step = ncpp.verify._Comparison.step
 
     def counted(self, a, theirs):
@@ -175,10 +158,10 @@ def test_a_long_fanuc_while_loop_is_verified_a_chunk_at_a_time(tmp_path: Path, m
         step(self, a, theirs)
 
     monkeypatch.setattr(ncpp.verify._Comparison, "step", counted)
-    path = tmp_path / "loop.nc"
-    path.write_text(FANUC_LOOP)
+    path = tmp_path / name
+    path.write_text(program)
     assert compensate(path) == 0
-    assert len(compared) > 400 * 2 // 64 and max(compared) <= 2 * 64, compared
+    assert len(compared) > 400 * moves_a_run // 64 and max(compared) <= 2 * 64, compared
 
 
 def test_a_fault_in_a_loop_body_is_refused_with_its_line(tmp_path: Path, monkeypatch, capsys):
