@@ -54,7 +54,7 @@ from ncpp.motion.modal import (
     as_point,
     placed_interpreting,
 )
-from ncpp.motion.segments import COMP, DRILLED, FLOW, MACHINE, PLANE_AXES, Arc, Event, Line, Pass, Point
+from ncpp.motion.segments import COMP, FLOW, MACHINE, PLANE_AXES, Arc, Event, Line, Pass, Point
 from ncpp.motion.tools import ToolTable, UntoldLengths
 from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
 
@@ -399,19 +399,11 @@ class HeidenhainInterpreter(ModalInterpreter):
         except OutOfScope as out:
             out.col = col
             raise
-        programmed_feed = self.feed
-        moves: list[Event] = []
-        for step in run:
-            if step.level == self.pos[self.tool_axis]:
-                continue
-            end = list(self.pos)
-            end[self.tool_axis] = step.level
-            self.feed = step.feed if not step.rapid else programmed_feed
-            move = self.line(block, end, step.rapid)
-            move.fixed, move.placed = DRILLED, (False, False, True)
-            moves.append(move)
-        self.feed = programmed_feed
-        return moves
+        here = self.pos[self.tool_axis]  # (a step to where the tool stands is none: the cycle starts there)
+        steps = [
+            (s.level, None if s.rapid else s.feed, 0.0) for s in run if s.level != here or s is not run[0]
+        ]
+        return self.drilled(block, steps, self.tool_axis)
 
     def _tool_def(self, block: Block, statement) -> list[Event]:
         """`TOOL DEF n L.. R..`: the program defines tool n's length (without L: it only prepares the tool)."""

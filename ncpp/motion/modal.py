@@ -15,7 +15,7 @@ from typing import NoReturn
 
 from ncpp.errors import Location, NcppError, Warnings, resolve_warnings
 from ncpp.motion.offsets import WorkOffsets
-from ncpp.motion.segments import PLANE_AXES, Arc, Context, Event, Line, Pass, Point, mark_off_path
+from ncpp.motion.segments import DRILLED, PLANE_AXES, Arc, Context, Event, Line, Pass, Point, mark_off_path
 from ncpp.program.blocks import Block
 
 MM_PER_INCH = 25.4
@@ -189,6 +189,26 @@ class ModalInterpreter:
         )
 
     # -- events ---------------------------------------------------------------------------
+    def drilled(
+        self, block: Block, steps: Iterable[tuple[float, float | None, float]], axis: int = 2
+    ) -> list[Event]:
+        """A called drilling cycle's moves along the tool `axis`, each step (level, feed: None for
+        a rapid, dwell s after it): left as programmed (DRILLED), placed along the axis only (the
+        control runs them from where the positioning before left it); the programmed feed is kept."""
+        programmed = self.feed
+        events: list[Event] = []
+        for level, feed, dwell in steps:
+            end = list(self.pos)
+            end[axis] = level
+            self.feed = programmed if feed is None else feed
+            line = self.line(block, end, feed is None)
+            line.fixed, line.placed = DRILLED, (axis == 0, axis == 1, axis == 2)
+            events.append(line)
+            if dwell > 0:
+                events.append(Pass(block, dwell=dwell))
+        self.feed = programmed
+        return events
+
     def line(self, block: Block, end: list[float], rapid: bool, absolute: bool = True) -> Line:
         start = as_point(self.pos)
         d = [e - s for e, s in zip(end, start)]

@@ -36,7 +36,7 @@ from ncpp.motion.modal import (
     placed_interpreting,
     plane_of,
 )
-from ncpp.motion.segments import DRILLED, FLOW, MACHINE, PLANE_AXES, Event, Pass
+from ncpp.motion.segments import FLOW, MACHINE, PLANE_AXES, Event, Pass
 from ncpp.motion.sinumerik_cycles import PARAMETERS as DRILLING
 from ncpp.motion.sinumerik_cycles import CycleError, Drilling, drilling
 from ncpp.motion.sinumerik_flow import SinumerikFlow
@@ -431,22 +431,14 @@ class SinumerikInterpreter(ModalInterpreter):
             raise
 
     def _drill(self, block: Block, cycle: Drilling) -> list[Event]:
-        """The cycle's moves where the block leaves the tool, its feeds from the feed programmed
-        before, its dwells as dwell events.  X and Y are where the control stands (the block's
-        move, compensated), Z the cycle's: `fixed`, placed in Z only."""
-        events: list[Event] = []
-        programmed = self.feed
-        for step in cycle.steps:
-            if step.feed and programmed <= 0:
-                self.fail(f"{cycle.name}: no feed rate programmed before it", block)
-            self.feed = programmed * step.feed if step.feed else programmed
-            line = self.line(block, [*self.pos[:2], step.level], not step.feed)
-            line.fixed, line.placed = DRILLED, (False, False, True)
-            events.append(line)
-            if step.dwell > 0:
-                events.append(Pass(block, dwell=step.dwell))
-        self.feed = programmed
-        return events
+        """The cycle's moves where the block leaves the tool (`drilled`), its feeds from the feed
+        programmed before."""
+        feed = self.feed
+        if feed <= 0 and any(step.feed for step in cycle.steps):
+            self.fail(f"{cycle.name}: no feed rate programmed before it", block)
+        return self.drilled(
+            block, [(s.level, feed * s.feed if s.feed else None, s.dwell) for s in cycle.steps]
+        )
 
     def _exponent(self, block: Block, expression, word: Word) -> None:
         """Refuse `X=1e3`: the grammar reads `X=1` and an address E, as a Sinumerik would."""
