@@ -33,6 +33,10 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_the_holes_moves_compensation_sees_are_the_ones_rs274_makes",
         ),
         "compensation/test_rs274_accepts.py": None,
+        "compensation/test_rigid_tap.py": (
+            "test_each_tap_runs_on_the_programmed_line_within_half_a_micron",
+            "test_the_motor_mount_written_out_cuts_twenty_times_closer",
+        ),
         "compensation/test_cutter_comp_accuracy.py": (
             "test_the_tool_centre_lands_on_the_original_path_within_half_a_micron",
             "test_the_entry_arc_stays_one_arc_the_control_accepts",
@@ -100,6 +104,10 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
     # a second and a half or more on a 2-core machine, all parameters together
     "slow": {
         "compensation/test_cutter_comp_accuracy.py": ("test_mmount_contours_land_within_the_tolerance",),
+        "compensation/test_rigid_tap.py": (
+            "test_a_machine_with_reversal_errors_gets_no_step_inside_a_tap",
+            "test_the_motor_mount_written_out_cuts_twenty_times_closer",
+        ),
         "hostile/test_resources.py": (
             "test_compensating_a_loop_takes_the_same_memory_however_often_it_runs",
         ),

@@ -39,7 +39,7 @@ from collections.abc import Iterable, Iterator
 from ncpp.cli.compensate import add_placement_arguments, work_offsets
 from ncpp.cli.io import add_dialect_argument
 from ncpp.errors import Location, Warnings
-from ncpp.motion.segments import COMP, Arc, Event, Line
+from ncpp.motion.segments import COMP, TAP_IN, Arc, Event, Line
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -98,7 +98,9 @@ def run(args: argparse.Namespace) -> int:
             if type(event) is not Line and type(event) is not Arc:
                 continue
             if args.format == "rs274":
-                out.write(format_event(event) + "\n")  # type: ignore[operator]  # (a move: never None)
+                text = format_event(event)
+                if text is not None:  # (None: a rigid tap's return, which rs274 does not print)
+                    out.write(text + "\n")
                 continue
             record: dict[str, object] = {
                 "line": event.block.line,
@@ -122,6 +124,8 @@ def run(args: argparse.Namespace) -> int:
                 record["fixed"] = event.fixed
             if event.centre_shift is not None:  # under cutter compensation ncpp follows
                 record["centre_shift"] = event.centre_shift
+            if type(event) is Line and event.tap:  # a rigid tap's (G33.1) tap or return
+                record["kind"] = "rigid tap" if event.tap == TAP_IN else "rigid tap return"
             out.write(json.dumps(record) + "\n")
     warnings.finish()
     return 0

@@ -7,10 +7,13 @@ program units:
     STRAIGHT_TRAVERSE(x, y, z, a, b, c)
     STRAIGHT_FEED(x, y, z, a, b, c)
     ARC_FEED(first_end, second_end, first_axis, second_axis, rotation, axis_end_point, a, b, c)
+    RIGID_TAP(x, y, z)
+
+(rs274 prints no call for a rigid tap's return to its start: neither does `format_event`.)
 
 `format_event` prints a `Line` or `Arc` the same way (None for a `Pass`), so
 `ncpp motion FILE --format rs274` can be compared with
-`rs274 FILE | grep -oE '(STRAIGHT_TRAVERSE|STRAIGHT_FEED|ARC_FEED)\\(.*\\)'`
+`rs274 FILE | grep -oE '(STRAIGHT_TRAVERSE|STRAIGHT_FEED|ARC_FEED|RIGID_TAP)\\(.*\\)'`
 line by line.
 """
 
@@ -19,10 +22,10 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
-from ncpp.motion.segments import PLANE_AXES, Arc, Event, Line
+from ncpp.motion.segments import PLANE_AXES, TAP_IN, Arc, Event, Line
 
-MOTION_CALLS = ("STRAIGHT_TRAVERSE", "STRAIGHT_FEED", "ARC_FEED")
-_CALL = re.compile(r"(STRAIGHT_TRAVERSE|STRAIGHT_FEED|ARC_FEED)\(([^)]*)\)")
+MOTION_CALLS = ("STRAIGHT_TRAVERSE", "STRAIGHT_FEED", "ARC_FEED", "RIGID_TAP")
+_CALL = re.compile(r"(STRAIGHT_TRAVERSE|STRAIGHT_FEED|ARC_FEED|RIGID_TAP)\(([^)]*)\)")
 
 
 def _rotary(extra: tuple[float, ...]) -> tuple[float, float, float]:
@@ -61,8 +64,11 @@ def read_canon(text: str) -> list[CanonCall]:
 
 
 def canon_call(event: Event) -> CanonCall | None:
-    """The rs274 canonical call of a motion event, at full precision; None for a Pass."""
+    """The rs274 canonical call of a motion event, at full precision; None for a Pass (and for a
+    rigid tap's return)."""
     if type(event) is Line:
+        if event.tap:
+            return CanonCall("RIGID_TAP", event.end) if event.tap == TAP_IN else None
         return CanonCall(
             "STRAIGHT_TRAVERSE" if event.rapid else "STRAIGHT_FEED", (*event.end, *_rotary(event.extra))
         )

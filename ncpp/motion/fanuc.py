@@ -36,6 +36,7 @@ HAAS_UNFOLLOWED = {**FANUC_UNFOLLOWED, ("G", 154.0): "G154 (an additional work o
 class FanucInterpreter(Interpreter):
     settings: dict[float, frozenset[str]] = FANUC_SETTINGS
     unfollowed: dict[tuple[str, float], str] = FANUC_UNFOLLOWED
+    rigid_tapping = False  # (Fanuc taps rigidly with M29 and G84: G33.1 is LinuxCNC's)
 
     def block(self, block: Block) -> Event | tuple[Event, ...]:
         signature = block.signature

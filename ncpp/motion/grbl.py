@@ -31,6 +31,7 @@ _MOVING = {"$H": "grbl homing ($H)", "$J=": "a grbl jog ($J=)"}
 
 class GrblInterpreter(Interpreter):
     arc_normal_offset_ignored = True
+    rigid_tapping = False  # (grbl has no spindle-synchronised motion)
 
     def block(self, block: Block) -> Event | tuple[Event, ...]:
         signature = block.signature

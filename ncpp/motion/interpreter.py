@@ -12,8 +12,8 @@ G52, G53, G28/G30, T, M6, M61, G43 / G43.1 / G43.2 H / G49 (lengths from the
 control's tool table, `tools.py`; zero when it is not told), F and inverse time, IJK and R arcs, helices,
 P turns, parameters and expressions, Fanuc corner rounding and
 chamfering between two lines (`,R` `,C`, `G1 ... R`: a one-move look-ahead),
-the canned cycles G73 G74 G81-G87 G89 with G98/G99 (`cycles.py`), and
-o-word subroutines, branches and loops, Fanuc M98/M99 subprograms and Fanuc
+the canned cycles G73 G74 G81-G87 G89 with G98/G99 (`cycles.py`), LinuxCNC's
+rigid tap G33.1 (`_rigid_tap`), and o-word subroutines, branches and loops, Fanuc M98/M99 subprograms and Fanuc
 macro B (GOTO, IF ... GOTO, WHILE ... DO ... END, G65 and G66/G67 macro calls: `flow.py`;
 `IF [..] THEN #i = ..`, vacant variables, #3000 alarms and #3006 stops,
 #5001-#5003 where known: here), and cutter compensation G40-G42.1
@@ -26,7 +26,7 @@ tool centre stands (`centre_shift`), in G17 and G90; elsewhere they are marked
 leaves them as programmed.  Anything else (subroutine files ncpp is not told
 of, a move of a subprogram under G66, a Fanuc system variable it does not know, M99
 in the main program, G88 (a manual retract) and the lathe cycles, splines,
-threading, probing) makes the interpreter's state unknown: that block and
+G33 threading, probing) makes the interpreter's state unknown: that block and
 every later block pass through as `Pass` after ONE warning (an error with
 `strict`).
 """
@@ -61,6 +61,8 @@ from ncpp.motion.segments import (
     HOLE,
     HOME,
     PLANE_AXES,
+    TAP_IN,
+    TAP_OUT,
     Arc,
     Context,
     Event,
@@ -143,6 +145,7 @@ IGNORED_STATEMENTS = frozenset(("tape", "checksum", "block_delete", "program_nam
 _ARC_LIKE = {2.0, 3.0, 5.0, 5.1, 76.0, 87.0, 71.0}
 _CYCLES = {73.0, 81.0, 82.0, 83.0, 84.0, 85.0, 86.0, 87.0, 88.0, 89.0}
 _K_MOTIONS = {2.0, 3.0, 33.0, 33.1, 71.0, 76.0, 87.0}
+RIGID_TAP = 33.1
 _P_MOTIONS = {76.0, 82.0, 86.0, 88.0, 89.0, 5.0, 5.2, 2.0, 3.0, 71.0, 74.0, 84.0}
 _P_MCODES = {50.0, 51.0, 52.0, 53.0, 62.0, 63.0, 64.0, 65.0, 66.0, 19.0}
 _Q_MOTIONS = {83.0, 73.0, 5.0, 71.0, 76.0}
@@ -232,6 +235,8 @@ class Interpreter:
 
     # An arc's offset word along the plane's normal (K in G17): rs274ngc refuses it
     arc_normal_offset_ignored = False
+    # G33.1 is LinuxCNC's rigid tap (`_rigid_tap`); a control without it leaves it out of scope
+    rigid_tapping = True
 
     def __init__(self, file: str = "<stdin>", offsets: WorkOffsets | None = None):
         self.file = file
@@ -925,6 +930,8 @@ class Interpreter:
                 self.corner = _corner_word(words, motion)
             elif motion in CANNED:
                 events = self._cycle(block, words, motion, previous, motion_word)
+            elif motion == RIGID_TAP:
+                events = self._rigid_tap(block, words, motion_word)
             else:
                 events = self._arc(block, words, motion, motion_word, mode1_item)
         if 2.0 in mcodes or 30.0 in mcodes:
@@ -1026,8 +1033,17 @@ class Interpreter:
             self._fail("E word with no G70, G76, M66, M67 or M68 to use it", block, words["E"][1])
         if "H" in words and gcodes.get(8, (None,))[0] not in (43.0, 43.2, 43.4, 43.5) and motion != 76.0:
             self._fail("H word with no G43 or G76 to use it", block, words["H"][1])
+        if motion == RIGID_TAP and self.rigid_tapping:
+            self._check_rigid_tap(block, words, mode0_item or mode1_item)
         for letter in "IJ":
-            if letter in words and motion not in _ARC_LIKE and mode0 != 10.0:
+            if (
+                letter in words
+                and motion not in _ARC_LIKE
+                and mode0 != 10.0
+                and not (
+                    letter == "I" and motion == RIGID_TAP  # (G33.1's I: the return's spindle speed factor)
+                )
+            ):
                 self._fail(
                     f"{letter} word with no G2, G3, G5, G5.1, G10, G71, G76, or G87 to use it",
                     block,
@@ -1148,7 +1164,11 @@ class Interpreter:
     def _check_scope(self, words: dict, gcodes: dict) -> None:
         for value, item in gcodes.values():
             reason = OUT_OF_SCOPE_G.get(value)
-            if reason is not None and not (value == 43.2 and "H" in words):
+            if (
+                reason is not None
+                and not (value == 43.2 and "H" in words)
+                and not (value == RIGID_TAP and self.rigid_tapping)
+            ):
                 raise _OutOfScope(f"{reason} G{value:g}", item.start + 1)
         g10 = gcodes.get(0, (None,))[0] == 10.0
         if g10 and words.get("L", (None,))[0] in (1.0, 10.0, 11.0):
@@ -1424,6 +1444,32 @@ class Interpreter:
             r, a = math.hypot(y, x), math.atan2(y, x) + math.radians(theta[0])
             x, y = r * math.cos(a), r * math.sin(a)
         return x, y
+
+    def _check_rigid_tap(self, block: Block, words: dict, item) -> None:
+        """rs274ngc's checks of a G33.1 block: its K (the pitch) given, no F (the spindle sets the feed)."""
+        if "K" not in words:
+            self._fail("K word missing with g33/g33.1", block, item)
+        if "F" in words:
+            self._fail("F word used with a g33/g33.1", block, words["F"][1])
+
+    def _rigid_tap(self, block: Block, words: dict, item) -> tuple[Line, Line]:
+        """G33.1: a tap to the block's point, synchronised with the spindle, and the control's own
+        return to where it started, where the position is after the block (LinuxCNC G-code
+        manual, G33.1: "an unsynchronized move back to the original coordinate"; rs274ngc prints
+        one RIGID_TAP call and goes on from the start).  A tap that turns a rotary axis (rs274ngc
+        drops its A B C), or under cutter compensation (rs274ngc offsets no tap), is out of scope."""
+        if self.spindle == 0:
+            self._fail("Spindle not turning in G33.1", block, item)
+        turning = next((words[a][1] for a in ("A", "B", "C", "U", "V", "W") if a in words), None)
+        if turning is not None:
+            raise _OutOfScope("a rigid tap G33.1 with a rotary or parallel axis word", turning.start + 1)
+        if self.cutter_comp is not None:
+            raise _OutOfScope("a rigid tap G33.1 under cutter compensation", item.start + 1)
+        start = list(self.pos)
+        tap = self._line(block, self._move_end(block, words), False)
+        back = self._line(block, start, False)
+        tap.tap, back.tap = TAP_IN, TAP_OUT
+        return tap, back
 
     def _straight(self, block: Block, words: dict, motion: float, machine: bool | None) -> Line:
         if motion == 1.0:

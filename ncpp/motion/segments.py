@@ -36,6 +36,10 @@ COMP = "cutter compensation"  # the control offsets the path by the tool's radiu
 HOME = "G28/G30 return"  # the control homes the axes it names (machine coordinates); the others stay where they stand
 # Klartext M91 and M140 MB, Sinumerik SUPA, G53 and G153: positions of the control's own
 MACHINE = "machine-coordinate move"
+# A rigid tap's two moves (`Line.tap`; LinuxCNC's G33.1): the tap, which passes correct like any feed
+# move but never split (the control runs it as one motion synchronised with the spindle), and its
+# return to where the tap started, which the control makes on its own (no block writes it)
+TAP_IN, TAP_OUT = 1, 2
 # Axis letters of `Line.end` / `Arc.end` beyond XYZ, in rs274's order.
 EXTRA_AXES = ("A", "B", "C", "U", "V", "W")
 
@@ -141,6 +145,7 @@ class Line:
     # control offsetting the contour by the radius; the start None: the entry move, which the control
     # makes whole.  None: the tool centre is on the programmed path.  replace_arcs' pieces carry their arc's
     centre_shift: tuple[Point | None, Point] | None = None
+    tap: int = 0  # TAP_IN, TAP_OUT: a rigid tap's move (0: none)
 
     def length(self) -> float:
         return math.dist(self.start, self.end)

@@ -259,7 +259,7 @@ class _Rows:
         NDArray | None
     )  # (n,3) directions replace_arcs compensated the pieces with (reversal errors only)
     lines: NDArray  # (n,) the line of each segment's block, for messages
-    rapid: NDArray  # (n,) rapid moves (G0): no reversal step before them
+    rapid: NDArray  # (n,) rapid moves (G0) and rigid taps: no reversal step before them
     carried: NDArray  # (n,) moves left as programmed that run from where the control is (`_carry`)
     kept: NDArray  # (n,3) their axes that do so (the others the control puts at their programmed end)
     lead_in: NDArray  # (n,) a canned cycle's first move after a compensated one: a step to its start first
@@ -286,10 +286,12 @@ def _rows_before(rows: _Rows, line: int | None) -> _Rows | None:
 def _rows(segs: list, directional: bool, fixed_before: bool = True) -> _Rows:
     offsets, scales, tools = frames(segs)
     start, end = points([e.start for e in segs]), points([e.end for e in segs])
-    # one walk over the events for six flags (1 arc, 2 fixed: a move left as programmed, 4 changed, 8 rapid,
+    # one walk over the events for six flags (1 arc, 2 fixed: a move left as programmed, 4 changed, 8 rapid or tap,
     # 16 carried: fixed in G91, 32 a canned cycle's)
+    # (a rigid tap's moves count as rapids there: no reversal step can be written inside its block)
     kind = np.fromiter([(type(e) is Arc) + (0 if not e.fixed else (2 if e.context.absolute else 18) + 32 * (e.fixed == CYCLE))
-                        + 4 * bool(e.changed) + 8 * (type(e) is Line and e.rapid) for e in segs], dtype=np.int8, count=len(segs))  # fmt: skip
+                        + 4 * bool(e.changed) + 8 * (type(e) is Line and (e.rapid or e.tap > 0)) for e in segs],
+                       dtype=np.int8, count=len(segs))  # fmt: skip
     arc, changed = (kind & 1) != 0, (kind & 4) != 0
     line = (kind & 3) == 0
     free = line & ~changed
@@ -519,6 +521,7 @@ def _written(chunk: list[Event], segs: list, rows: _Rows, solved: _Solved, last)
                     seg.extra,
                     True,
                     extra_start=seg.extra_start,
+                    tap=seg.tap,
                 )
             )
         else:

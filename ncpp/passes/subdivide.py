@@ -65,11 +65,17 @@ def _with_rows(
     chunk: list[Event], ctx: PassContext, bound: BowBound | None = None
 ) -> tuple[list[Event], list[int], list[Line], _LineRows | None]:
     """The chunk, where its lines to check are, those lines, and their rows (None: none)."""
-    # (not under cutter compensation: each piece would be a move the control offsets by itself)
+    # (not under cutter compensation: each piece would be a move the control offsets by itself; nor a
+    # rigid tap: each piece would be a tap of its own)
     index = [
         k
         for k, e in enumerate(chunk)
-        if type(e) is Line and not e.rapid and not e.changed and not e.fixed and e.centre_shift is None
+        if type(e) is Line
+        and not e.rapid
+        and not e.changed
+        and not e.fixed
+        and e.centre_shift is None
+        and not e.tap
     ]
     if not index:
         return chunk, [], [], None

@@ -19,16 +19,17 @@ from numpy.typing import NDArray
 from tests.conftest import RS274
 
 _CALL = re.compile(
-    r"\b(STRAIGHT_FEED|STRAIGHT_TRAVERSE|ARC_FEED|SET_G5X_OFFSET|SET_G92_OFFSET|USE_LENGTH_UNITS"
+    r"\b(STRAIGHT_FEED|STRAIGHT_TRAVERSE|ARC_FEED|RIGID_TAP|SET_G5X_OFFSET|SET_G92_OFFSET|USE_LENGTH_UNITS"
+    r"|USE_TOOL_LENGTH_OFFSET"
     r"|COMMENT)\((\"interpreter: cutter radius compensation (?:on|off)|[^)]*)"
 )
 
 
 @dataclass(frozen=True)
 class Move:
-    """A feed move of the tool centre (an arc's centre and turn: rs274's ARC_FEED), machine
-    coordinates in mm as the program puts them (its work offsets and G92 added, no tool length:
-    the test machines' errors do not depend on Z)."""
+    """A feed move of the tool centre (an arc's centre and turn: rs274's ARC_FEED; a rigid tap's
+    way down: RIGID_TAP, whose return retraces it), machine coordinates in mm as the program puts
+    them: its work offsets, G92 and tool length offset added, where the machine's axes stand."""
 
     start: NDArray  # (3,)
     end: NDArray  # (3,)
@@ -75,7 +76,8 @@ def feed_moves(
     assert not errors or errors[0].startswith("File ended with no percent sign"), proc.stderr
     moves: list[Move] = []
     at = np.zeros(3)
-    g5x, g92, scale = np.zeros(3), np.zeros(3), 1.0  # the offsets in mm (rs274 prints them in the units then)
+    # the offsets in mm (rs274 prints them in the units then)
+    g5x, g92, tool, scale = np.zeros(3), np.zeros(3), np.zeros(3), 1.0
     comp = leaving = sections = 0
     for name, args in _CALL.findall(proc.stdout):
         if name == "COMMENT":
@@ -94,14 +96,19 @@ def feed_moves(
         if name == "SET_G92_OFFSET":
             g92 = np.array(v[:3]) * scale
             continue
-        offset = g5x + g92
+        if name == "USE_TOOL_LENGTH_OFFSET":
+            tool = np.array(v[:3]) * scale
+            continue
+        offset = g5x + g92 + tool
         if name == "ARC_FEED":
             end = np.array([v[0], v[1], v[5]]) * scale + offset
             moves.append(Move(at, end, np.array(v[2:4]) * scale + offset[:2], int(v[4]), comp or leaving))
         else:
             end = np.array(v[:3]) * scale + offset
-            if name == "STRAIGHT_FEED":
+            if name == "STRAIGHT_FEED" or name == "RIGID_TAP":
                 moves.append(Move(at, end, comp=comp or leaving))
+            if name == "RIGID_TAP":  # (the control returns to where the tap started)
+                end = at
         leaving = 0
         at = end
     return moves

@@ -56,7 +56,6 @@ OUT_OF_SCOPE = {
     "iso_gcode/fanuc_macroB_sheet/RECTANGLE.NC": "a write to the Fanuc system variable #2001",
     "iso_gcode/fanuc_macroB_sheet/WASHER.NC": "M98 P9010: a subprogram the program does not define",
     "iso_gcode/linuxcnc/g76.ngc": "canned cycle G76",
-    "iso_gcode/linuxcnc/mmount.ngc": "threading G33.1",
     "iso_gcode/linuxcnc/nurbs_G5_butterfly-xy.ngc": "spline G5.2",
     "iso_gcode/linuxcnc/plasmac_metric_pipe.ngc": "probing G38.2",
     "iso_gcode/linuxcnc/systems.ngc": "spline G5.1",

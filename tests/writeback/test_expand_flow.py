@@ -301,19 +301,19 @@ def test_more_blocks_than_the_bound_are_refused_where_the_bound_is_passed(monkey
 
 
 def test_a_construct_out_of_scope_in_a_loop_is_refused_at_the_main_level_it_passes_the_rest_on():
-    with pytest.raises(NcppError, match=r"t\.ngc:6:3: --expand: threading G33\.1 is outside the motion "
+    with pytest.raises(NcppError, match=r"t\.ngc:6:3: --expand: threading G33 is outside the motion "
                                         r"interpreter's scope, inside a loop"):  # fmt: skip
-        _expanded(HEAD + "o1 repeat [2]\n  G1 X1 F100\n  G33.1 Z-1 K1\no1 endrepeat\nM2\n")
+        _expanded(HEAD + "o1 repeat [2]\n  G1 X1 F100\n  G33 Z-1 K1\no1 endrepeat\nM2\n")
     warned = io.StringIO()
     text = _expanded(HEAD + "o2 sub\n  G1 X[#1] F100\no2 endsub\no1 repeat [2]\n  o2 call [5]\no1 endrepeat\n"
-                     "G33.1 Z-1 K1\no2 call [7]\nM2\n", warnings=Warnings(stream=warned))  # fmt: skip
-    assert "t.ngc:10:1: warning: threading G33.1 is outside" in warned.getvalue()
+                     "G33 Z-1 K1\no2 call [7]\nM2\n", warnings=Warnings(stream=warned))  # fmt: skip
+    assert "t.ngc:10:1: warning: threading G33 is outside" in warned.getvalue()
     assert _running(text).count("G1 X") == 2 and "o1 repeat" not in text  # expanded up to there
-    assert "o2 sub" in text and text.endswith("G33.1 Z-1 K1\no2 call [7]\nM2\n")  # the definition stays
+    assert "o2 sub" in text and text.endswith("G33 Z-1 K1\no2 call [7]\nM2\n")  # the definition stays
 
 
 @pytest.mark.parametrize(
-    "rest", ["G33.1 Z[-#<x>] K1\nG0 X#<x>\nM2\n", "o<missing> call [#<x>]\nG0 X#<x>\nM2\n"]
+    "rest", ["G33 Z[-#<x>] K1\nG0 X#<x>\nM2\n", "o<missing> call [#<x>]\nG0 X#<x>\nM2\n"]
 )
 def test_a_line_that_passes_through_uninterpreted_finds_the_parameters_set(rest):
     text = _expanded(
@@ -356,7 +356,7 @@ def test_expanded_fanuc_macros_move_as_rs274_runs_their_o_word_twins(tmp_path, n
 def test_both_commands_take_the_option_and_refuse_with_the_place(tmp_path, command):
     (tmp_path / "machine.toml").write_text(MACHINE)
     (tmp_path / "p.ngc").write_text(PROGRAMS["repeat loop"])
-    (tmp_path / "bad.ngc").write_text(HEAD + "o1 repeat [2]\n  G33.1 Z-1 K1\no1 endrepeat\nM2\n")
+    (tmp_path / "bad.ngc").write_text(HEAD + "o1 repeat [2]\n  G33 Z-1 K1\no1 endrepeat\nM2\n")
     environ = {k: v for k, v in os.environ.items() if k not in ("NCPP_MACHINE", "XDG_CONFIG_HOME")}
     environ.update(PYTHONPATH=str(ROOT), HOME=str(tmp_path))
 
@@ -369,7 +369,7 @@ def test_both_commands_take_the_option_and_refuse_with_the_place(tmp_path, comma
     assert done.returncode == 0, done.stderr
     assert "o2 repeat" not in (tmp_path / "out.ngc").read_text() and "loop or subroutine" not in done.stderr
     refused = run("bad.ngc")
-    assert refused.returncode != 0 and "bad.ngc:5:3: --expand: threading G33.1" in refused.stderr
+    assert refused.returncode != 0 and "bad.ngc:5:3: --expand: threading G33" in refused.stderr
 
 
 def test_the_corpus_mount_program_expanded_runs_in_rs274_as_the_original(tmp_path):

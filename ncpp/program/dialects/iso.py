@@ -17,7 +17,19 @@ from dataclasses import replace
 from operator import itemgetter
 
 from ncpp.motion.cycles import CANNED
-from ncpp.motion.segments import CYCLE, DRILLED, EXTRA_AXES, Arc, Context, Event, Line, Pass, Setting
+from ncpp.motion.segments import (
+    CYCLE,
+    DRILLED,
+    EXTRA_AXES,
+    TAP_IN,
+    TAP_OUT,
+    Arc,
+    Context,
+    Event,
+    Line,
+    Pass,
+    Setting,
+)
 from ncpp.passes.rotary import time_shares, turns
 from ncpp.program.blocks import DIGITS_AS_ONE, Block, Comment, ExprWord, Statement, Word
 from ncpp.program.numbers import NumberStyle, format_number
@@ -194,8 +206,9 @@ class IsoWriter:
                 lines.append(block.text)
             self._after_verbatim(block, motion)
             return lines
-        called = len(motion)  # a drilling cycle the block calls after its move: the control's, from its text
-        while called > 1 and motion[called - 1].fixed == DRILLED:
+        # a drilling cycle the block calls after its move, a rigid tap's return: the control's, from its text
+        called = len(motion)
+        while called > 1 and (motion[called - 1].fixed == DRILLED or _returns(motion[called - 1])):
             called -= 1
         cycle, motion = called < len(motion), motion[:called]
         if not facts.plain:
@@ -589,6 +602,8 @@ class IsoWriter:
         }
 
     def _edit_block(self, block: Block, segment: Line | Arc, more: dict[str, str] | None = None) -> str:
+        if type(segment) is Line and segment.tap == TAP_IN:
+            return self._edit_tap(block, segment)
         facts = self._facts_value if block is self._facts_block else self._facts(block)  # `_facts`, inlined
         code = (
             (3 if segment.turn > 0 else 2) if type(segment) is Arc else 0 if segment.rapid else 1
@@ -612,6 +627,14 @@ class IsoWriter:
             segment.context,
         )  # `_remember_end`
         return raw
+
+    def _edit_tap(self, block: Block, tap: Line) -> str:
+        """A rigid tap's block (G33.1) with its corrected end: its G33.1, K (the pitch) and I stay.  The
+        output's motion mode is the tap's, which a block written after it does not rely on."""
+        texts = self._texts(block, tap)
+        spelled = None if self._facts(block).letters.issuperset(texts) else self._spelling(block)
+        self.output_motion = self.program_motion = None
+        return set_words(block, texts, [], spelled)
 
     def _planned_edit(
         self, block: Block, facts: _Facts, segment: Line | Arc, motion: int | None, units: _Written
@@ -897,7 +920,7 @@ class _Facts:
                 self.motion_word, self.motion = True, code
                 if self.first_motion is None:
                     self.first_motion, self.motion_at = code, (self.words - 1, number)
-            elif 73 <= value <= 89:
+            elif 73 <= value <= 89 or value == 33.1:  # a canned cycle's, a rigid tap's
                 self.motion_word, self.motion = True, None
             elif value == 53.0:
                 self.machine = True
@@ -907,6 +930,11 @@ class _Facts:
                 )
         elif letter in MOVING_LETTERS:
             self.moves = True
+
+
+def _returns(move: Line | Arc) -> bool:
+    """A rigid tap's return: the control's own move, no block writes it."""
+    return type(move) is Line and move.tap == TAP_OUT
 
 
 def _words(block: Block, facts: _Facts) -> tuple[Word, ...]:
