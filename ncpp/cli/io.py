@@ -44,8 +44,21 @@ def add_dialect_argument(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--dialect",
         default=None,
-        help="NC dialect: iso (LinuxCNC), grbl, heidenhain or sinumerik (default: detected from the content)",
+        type=dialect_name,
+        help="NC dialect: iso (LinuxCNC's; `linuxcnc` says the same), fanuc, haas, grbl, heidenhain or "
+        "sinumerik (default: detected from the content)",
     )
+
+
+def dialect_name(text: str) -> str:
+    """A dialect's name as ncpp knows it (case-insensitive; `linuxcnc` is iso): a name it does not
+    know is a usage error, before any program is read."""
+    from ncpp.program.dialects import DIALECTS
+
+    name = "iso" if text.lower() == "linuxcnc" else text.lower()
+    if name not in DIALECTS:
+        raise argparse.ArgumentTypeError(f"unknown dialect {text!r} (known: {', '.join(DIALECTS)}, linuxcnc)")
+    return name
 
 
 @contextlib.contextmanager

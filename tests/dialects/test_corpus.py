@@ -151,7 +151,12 @@ def test_cli_dialect_option_overrides_and_errors_name_the_line(tmp_path):
     proc = subprocess.run(
         [sys.executable, "-m", "ncpp", "--dialect", "klingon", str(bad)], capture_output=True, text=True
     )
-    assert proc.returncode != 0 and "unknown dialect" in proc.stderr
+    assert proc.returncode != 0 and "unknown dialect" in proc.stderr and "<stdin>" not in proc.stderr
+    good = tmp_path / "good.ngc"
+    good.write_bytes(b"G21 G90\nG0 X1\nM2\n")
+    proc = subprocess.run([sys.executable, "-m", "ncpp", "motion", "--dialect", "LinuxCNC", str(good)],
+                          capture_output=True, text=True)  # fmt: skip
+    assert proc.returncode == 0 and "STRAIGHT_TRAVERSE(1.0000" in proc.stdout, proc.stderr
 
 
 @pytest.mark.parametrize("path", corpus_files("."), ids=corpus_id)
