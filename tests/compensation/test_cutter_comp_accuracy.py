@@ -200,6 +200,28 @@ def test_in_g18_and_in_g91_the_tool_centre_lands_on_the_original_path(tmp_path, 
     pathcheck(original, out)
 
 
+# moves under G41.1 in a subroutine (a parameter in its words) and in a while loop
+IN_BODIES = HEAD + (
+    "o100 sub\nG1 X80 Y0\nG3 X100 Y20 R20\nG1 X100 Y[#1]\nG3 X80 Y[#1 + 20] I-20 J0\nG1 X30 Y[#1 + 20]\n"
+    "o100 endsub\nG0 X-20 Y-20 Z5\nG1 Z-1 F300\nG41.1 D10\nG1 X0 Y0\no100 call [60]\n#2 = 0\n"
+    "o200 while [#2 LT 2]\nG1 X[20 - #2 * 20] Y[80 - #2 * 15]\n#2 = [#2 + 1]\no200 endwhile\nG1 X0 Y0\nG40\n"
+    "G1 X-20 Y-20\nG0 Z5\nM2\n"
+)
+
+
+@needs_oracles
+def test_with_expand_the_moves_under_compensation_in_loops_and_subroutines_land_on_the_path(tmp_path):
+    """--expand writes the bodies out as plain moves: under compensation they are compensated where
+    the tool centre stands like any other (without it they are left as programmed, µm off)."""
+    original, out, proc = written(tmp_path, IN_BODIES, "bodies.ngc", "--tolerance", "0.0001", "--expand")
+    assert "warning" not in proc.stderr, proc.stderr
+    before, after = (feed_moves(p, home=tmp_path) for p in (original, out))
+    assert sum(m.comp > 0 for m in after) >= 10
+    assert deviation(before, before, closed_form).max() > 0.005
+    assert deviation(before, after, closed_form).max() <= 0.0005
+    pathcheck(original, out)
+
+
 @needs_oracles
 def test_the_entry_arc_stays_one_arc_the_control_accepts(tmp_path):
     """rs274 checks an entry arc against the tool radius: split, its first piece would be refused."""
