@@ -168,8 +168,9 @@ UNCOMPENSATED = {
     DRILLED: "drilling cycle: it drills where the move before it leaves the tool (X and Y compensated), its moves "
     "along the tool axis as programmed (the depth with the machine's error); compensation resumes with the next move",
     COMP: "cutter compensation: its moves pass through uncompensated (the control offsets them by the tool radius, "
-    "so the tool is not where their points are; ncpp follows it in ISO programs in G17 and G90 only, outside loops, "
-    "subroutines and Fanuc corners); compensation resumes after the first move with it off (after G40, or R0)",
+    "so the tool is not where their points are; ncpp follows it in ISO programs in G17 and G18 only, with no lathe "
+    "tool orientation, outside loops, subroutines and Fanuc corners); compensation resumes after the first move "
+    "with it off (after G40, or R0)",
 }
 # An entry move under cutter compensation whose tool centre ends on its point: the radius is unknown
 UNKNOWN_RADIUS = (

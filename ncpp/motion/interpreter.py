@@ -21,9 +21,10 @@ macro B (GOTO, IF ... GOTO, WHILE ... DO ... END, G65 and G66/G67 macro calls: `
 are the programmed contour, not the tool centre, and after G40 the position is
 the program's again, as in rs274ngc.  The moves the tool makes off the programmed
 path (from the first move under G41/G42 to the first after G40) carry where the
-tool centre stands (`centre_shift`), in G17 and G90; elsewhere they are marked
-`fixed`, as are the moves of cycles, loops, subroutines and macros: compensation
-leaves them as programmed.  Anything else (subroutine files ncpp is not told
+tool centre stands (`centre_shift`), in G17 and G18 (LinuxCNC compensates in
+those two planes only), in G90 and G91; with a lathe tool's orientation (1-8) they
+are marked `fixed`, as are the moves of cycles, loops, subroutines and macros:
+compensation leaves them as programmed.  Anything else (subroutine files ncpp is not told
 of, a move of a subprogram under G66, a Fanuc system variable it does not know, M99
 in the main program, G88 (a manual retract) and the lathe cycles, splines,
 G33 threading, probing) makes the interpreter's state unknown: that block and
@@ -284,6 +285,9 @@ class Interpreter:
         self.comp_radius: float | None = (
             None  # its tool radius, program units, where known (G41.1/G42.1's D; G41/G42: the tool table's)
         )
+        # its lathe tool orientation (G41.1/G42.1's L, the tool table's Q; 0 and 9: the tool centre is
+        # controlled), kept after G40 for the exit move
+        self.comp_orientation = 0
         self.off_path = False  # the tool centre is off the programmed path: from the first move under comp to the first after G40
         # the tool centre minus the programmed point (`_centre_shift`)
         self.centre_at: Point = (0.0, 0.0, 0.0)
@@ -483,7 +487,7 @@ class Interpreter:
             shifts = [self._centre_shift(move, compensating) for move in moves]
             # an arc from where a move left as programmed ended starts there: it is left as programmed too
             # (compensated, it would start at its corrected start, a step away, which the control would offset)
-            if _followed(moves) and (corrected or type(moves[0]) is not Arc):
+            if _followed(moves, self.comp_orientation) and (corrected or type(moves[0]) is not Arc):
                 for move, shift in zip(moves, shifts):
                     move.centre_shift = shift
                 self.off_path = compensating
@@ -506,18 +510,23 @@ class Interpreter:
         it stands."""
         start = self.centre_at if self.off_path else None
         radius = self.comp_radius if compensating and self.comp_radius else 0.0
-        if not radius or move.context.plane != 17:  # (followed in the XY plane only: `_followed`)
-            end: Point = (0.0, 0.0, 0.0)
-        else:
+        end: Point = (0.0, 0.0, 0.0)
+        if radius:
+            # left as seen from the plane's normal (+Z in G17, +Y in G18): in the plane's own (u, v)
+            # axes, X Y or Z X, as LinuxCNC's manual (G41, G42) and rs274ngc's ARC_FEED have them
+            a, b, _ = PLANE_AXES[move.context.plane]
             side = radius if self.cutter_comp in (41.0, 41.1) else -radius
-            (x0, y0, _), (x1, y1, _) = move.start, move.end
+            u0, v0, u1, v1 = move.start[a], move.start[b], move.end[a], move.end[b]
+            shift = [0.0, 0.0, 0.0]
             if type(move) is Arc:  # left of the tangent: towards the centre counter-clockwise
-                cx, cy, _ = move.center
-                length = math.hypot(x1 - cx, y1 - cy)
+                cu, cv = move.center[a], move.center[b]
+                length = math.hypot(u1 - cu, v1 - cv)
                 side = -side if move.turn > 0 else side
-                end = (side * (x1 - cx) / length, side * (y1 - cy) / length, 0.0)
-            elif (length := math.hypot(x1 - x0, y1 - y0)) > 0.0:
-                end = (-side * (y1 - y0) / length, side * (x1 - x0) / length, 0.0)
+                shift[a], shift[b] = side * (u1 - cu) / length, side * (v1 - cv) / length
+                end = (shift[0], shift[1], shift[2])
+            elif (length := math.hypot(u1 - u0, v1 - v0)) > 0.0:
+                shift[a], shift[b] = -side * (v1 - v0) / length, side * (u1 - u0) / length
+                end = (shift[0], shift[1], shift[2])
             else:
                 end = self.centre_at
         self.centre_at = end
@@ -1129,7 +1138,9 @@ class Interpreter:
 
     def _cutter_compensation(self, block: Block, code_item: tuple, words: dict) -> None:
         """G40 off; G41/G42 (the radius of tool D, or of the tool in the spindle, where ncpp is
-        told the tool table) and G41.1/G42.1 (D the diameter) on, in the XY or XZ plane.  The
+        told the tool table) and G41.1/G42.1 (D the diameter) on, in the XY or XZ plane
+        (LinuxCNC's manual, G41 G42: "It is an error if the YZ plane is active"), with a lathe
+        tool's orientation (the table's Q, G41.1's L) in the XZ plane only.  The
         moves are followed as programmed (`_in_comp`); the radius is what rs274ngc checks
         them against (`_check_radius`), and a radius of 0 leaves the tool on the path."""
         code, item = code_item
@@ -1144,6 +1155,7 @@ class Interpreter:
             if d is None:
                 self._fail(f"G{code:g} with no D word", block, item)
             self.comp_radius = abs(d[0]) / 2
+            self.comp_orientation = self._orientation(block, code, words.get("L"))
         elif d is not None:
             if d[0] < 0.0 or abs(d[0] - round(d[0])) > 0.0001:
                 self._fail(f"G{code:g} requires D word to be a whole number", block, d[1])
@@ -1159,7 +1171,22 @@ class Interpreter:
                 if self.tools is None
                 else self.tools.diameter(number) / 2 / (MM_PER_INCH if self.inch else 1.0)
             )
+            self.comp_orientation = 0 if self.tools is None else self.tools.orientation(number)
+            if self.plane != 18 and self.comp_orientation not in (0, 9):
+                self._fail(f"G{code:g} with lathe tool, but plane is not G18", block, item)
         self.cutter_comp = code
+
+    def _orientation(self, block: Block, code: float, word: tuple | None) -> int:
+        """G41.1/G42.1's lathe tool orientation, its L word (0 without one): in G18 only, as
+        rs274ngc checks it."""
+        if word is None:
+            return 0
+        value, item = word
+        if value != round(value):
+            self._fail("Non integer value for integer", block, item)
+        if self.plane != 18:
+            self._fail(f"G{code:g} with L word, but plane is not G18", block, item)
+        return int(value)
 
     def _check_scope(self, words: dict, gcodes: dict) -> None:
         for value, item in gcodes.values():
@@ -1889,10 +1916,12 @@ def _moves(event: Event | tuple[Event, ...]) -> bool:
     return type(event) is not Pass
 
 
-def _followed(moves: list[Line | Arc]) -> bool:
+def _followed(moves: list[Line | Arc], orientation: int) -> bool:
     """Whether compensation follows a block's moves under cutter compensation (`Line.centre_shift`):
-    in G17 and G90, and none of them left as programmed for another reason (a loop's, a cycle's)."""
-    return all(not m.fixed and m.context.plane == 17 and m.context.absolute for m in moves)
+    in G17 and G18 (in G90 or G91: the moves' points are absolute here), with no lathe tool
+    `orientation` (1-8: the control moves its tip, not its centre, along the offset contour), and
+    none of them left as programmed for another reason (a loop's, a cycle's)."""
+    return orientation in (0, 9) and all(not m.fixed and m.context.plane in (17, 18) for m in moves)
 
 
 def _homes(block: Block) -> bool:

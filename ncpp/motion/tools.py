@@ -12,8 +12,9 @@ LinuxCNC's tool table, one tool per line (`tool.tbl`):
     T2 P2 X0.100 Z-1.500 D3.000
 
 T is the tool number, P its pocket, X Y Z A B C U V W its offsets, D its
-diameter (cutter compensation G41/G42 checks moves against its radius), I J Q
-lathe data (not used here); a `;` starts the comment.  Values are in the
+diameter (cutter compensation G41/G42 checks moves against its radius), Q a
+lathe tool's orientation (G41/G42 in G18 with one of 1-8 is left as programmed),
+I J its angles (not used here); a `;` starts the comment.  Values are in the
 machine's units ([TRAJ]LINEAR_UNITS).
 
 Heidenhain's tool table (`TOOL.T`), fixed columns under a header line, its
@@ -54,7 +55,7 @@ from ncpp.fileio import read_small
 
 OFFSET_LETTERS = "XYZABCUVW"  # a tool's offsets, in the interpreter's axis order
 _LINEAR = frozenset("XYZUVW")  # the offsets in length units (A B C are degrees)
-_OTHER_LETTERS = frozenset("PIJQ")  # pocket, lathe angles and orientation
+_OTHER_LETTERS = frozenset("PIJ")  # pocket, lathe angles
 _WORD = re.compile(r"\S+")
 
 
@@ -76,6 +77,9 @@ class ToolTable:
     diameters: Mapping[int, float] = field(
         default_factory=dict, hash=False
     )  # LinuxCNC's D per tool number, mm
+    orientations: Mapping[int, int] = field(
+        default_factory=dict, hash=False
+    )  # LinuxCNC's Q per tool number: a lathe tool's orientation (1-9)
 
     @classmethod
     def from_file(cls, path: str | Path, unit_mm: float = 1.0) -> ToolTable:
@@ -92,8 +96,8 @@ class ToolTable:
         if lines and lines[0].lstrip().upper().startswith("BEGIN"):
             edges, names = read_tool_t(lines, str(path))
             return cls({}, str(path), names, edges)
-        offsets, diameters = read_tool_lines(lines, str(path), unit_mm)
-        return cls(offsets, str(path), diameters=diameters)
+        offsets, diameters, orientations = read_tool_lines(lines, str(path), unit_mm)
+        return cls(offsets, str(path), diameters=diameters, orientations=orientations)
 
     def offset(self, number: int) -> tuple[float, ...] | None:
         """Tool `number`'s offsets (tool 0, no tool: all zero), None when the table has no such tool."""
@@ -104,6 +108,10 @@ class ToolTable:
     def diameter(self, number: int) -> float:
         """Tool `number`'s diameter in mm (0: no tool, or none in the table)."""
         return self.diameters.get(number, 0.0)
+
+    def orientation(self, number: int) -> int:
+        """Tool `number`'s lathe tool orientation (0: none, or no such tool)."""
+        return self.orientations.get(number, 0)
 
 
 class UntoldLengths:
@@ -126,14 +134,16 @@ class UntoldLengths:
 
 def read_tool_lines(
     lines: list[str], file: str, unit_mm: float
-) -> tuple[dict[int, tuple[float, ...]], dict[int, float]]:
-    """Per tool number its offsets (mm and degrees), and the diameters the table gives (mm)."""
+) -> tuple[dict[int, tuple[float, ...]], dict[int, float], dict[int, int]]:
+    """Per tool number its offsets (mm and degrees), and the diameters (mm) and lathe tool
+    orientations (Q) the table gives."""
     tools: dict[int, tuple[float, ...]] = {}
     diameters: dict[int, float] = {}
+    orientations: dict[int, int] = {}
     for n, line in enumerate(lines, 1):
         data = line.split(";", 1)[0]
         offsets = [0.0] * len(OFFSET_LETTERS)
-        number, diameter = None, 0.0
+        number, diameter, orientation = None, 0.0, 0
         for word in _WORD.finditer(data):
             letter, value = word.group()[0].upper(), word.group()[1:]
             where = Location(file, n, word.start() + 1)
@@ -144,6 +154,8 @@ def read_tool_lines(
                 offsets[OFFSET_LETTERS.index(letter)] = _number(value, where) * scale
             elif letter == "D":
                 diameter = _number(value, where) * unit_mm
+            elif letter == "Q":
+                orientation = round(_number(value, where))
             elif letter in _OTHER_LETTERS:
                 _number(value, where)
             else:
@@ -157,7 +169,9 @@ def read_tool_lines(
         tools[number] = tuple(offsets)
         if diameter:
             diameters[number] = diameter
-    return tools, diameters
+        if orientation:
+            orientations[number] = orientation
+    return tools, diameters, orientations
 
 
 def _number(text: str, where: Location) -> float:

@@ -264,12 +264,13 @@ class _Rows:
     kept: NDArray  # (n,3) their axes that do so (the others the control puts at their programmed end)
     lead_in: NDArray  # (n,) a canned cycle's first move after a compensated one: a step to its start first
     # under cutter compensation: each segment's (`Line.centre_shift`) and the end shifts (n,3) of the lines to
-    # compensate (zero elsewhere), the lines that move no axis of the plane (`_pin_plane`), and those that
-    # turn a corner from a line (`_corners`); None: none is
+    # compensate (zero elsewhere), the lines that move no axis of the plane (`_pin_plane`), those that
+    # turn a corner from a line (`_corners`), and each segment's plane axes (n,3) (`PLANE_AXES`); None: none is
     comp: NDArray | None = None
     shift: NDArray | None = None
     still: NDArray | None = None
     corner: NDArray | None = None
+    axes: NDArray | None = None
 
 
 def _rows_before(rows: _Rows, line: int | None) -> _Rows | None:
@@ -309,18 +310,20 @@ def _rows(segs: list, directional: bool, fixed_before: bool = True) -> _Rows:
 
 
 def _under_comp(segs: list, free: NDArray, start: NDArray, end: NDArray) -> tuple[NDArray | None, ...]:
-    """`_Rows.comp`, `.shift`, `.still` and `.corner` of the segments (all None: none is under
-    compensation).  A line under compensation that moves no axis of the plane (G17: X Y) leaves the
-    tool centre where it stands (`Interpreter._centre_shift`): the same shift at both ends."""
+    """`_Rows.comp`, `.shift`, `.still`, `.corner` and `.axes` of the segments (all None: none is under
+    compensation).  A line under compensation that moves no axis of the plane (G17: X Y, G18: Z X)
+    leaves the tool centre where it stands (`Interpreter._centre_shift`): the same shift at both ends."""
     if all(e.centre_shift is None for e in segs):
-        return None, None, None, None
+        return None, None, None, None, None
     comp = np.fromiter((e.centre_shift is not None for e in segs), dtype=bool, count=len(segs))
     shift = np.zeros((len(segs), 3))
     own = np.flatnonzero(comp & free)
     shift[own] = [segs[k].centre_shift[1] for k in own.tolist()]
     same = np.zeros(len(segs), dtype=bool)
     same[own] = [segs[k].centre_shift[0] == segs[k].centre_shift[1] for k in own.tolist()]
-    moves = (start[:, :2] != end[:, :2]).any(axis=1)
+    axes = plane_axes(segs)
+    (su, sv, _), (eu, ev, _) = in_plane(start, axes), in_plane(end, axes)
+    moves = (su != eu) | (sv != ev)
     still = same & ~moves
     # a line whose tool centre stands off it by a radius (not the entry move, nor the exit move after G40),
     # after a line under compensation in the same frame
@@ -331,8 +334,8 @@ def _under_comp(segs: list, free: NDArray, start: NDArray, end: NDArray) -> tupl
     corner[1:] = offset[1:] & (comp & free & moves)[:-1]
     for k in np.flatnonzero(corner).tolist():
         a, b = segs[k - 1].context, segs[k].context
-        corner[k] = a.offset == b.offset and a.inch == b.inch
-    return comp, shift, still, corner
+        corner[k] = a.offset == b.offset and a.inch == b.inch and a.plane == b.plane
+    return comp, shift, still, corner, axes
 
 
 # |sin| of the turn between two lines below which their corner is left to the line that ends there
@@ -351,37 +354,39 @@ def _corners(
     line's corrected contour crosses the second's: `out_end` of the first, moved along it.
     `crossing(rows)`: the second lines' corrected starts (their own tool centre's correction); `step`
     (n,): the output grid the moved ends are put on (None: none)."""
-    if rows.corner is None or not rows.corner.any():
+    if rows.corner is None or rows.axes is None or not rows.corner.any():
         return
     k = np.flatnonzero(rows.corner)
-    d1 = rows.end[k - 1, :2] - rows.start[k - 1, :2]
-    d2 = rows.end[k, :2] - rows.start[k, :2]
+    axes = rows.axes[k]  # (the two lines' plane: `_under_comp`)
+    d1 = np.stack(in_plane(rows.end[k - 1] - rows.start[k - 1], axes)[:2], axis=1)
+    d2 = np.stack(in_plane(rows.end[k] - rows.start[k], axes)[:2], axis=1)
     d1 /= np.linalg.norm(d1, axis=1)[:, None]
     d2 /= np.linalg.norm(d2, axis=1)[:, None]
     across = d1[:, 1] * d2[:, 0] - d1[:, 0] * d2[:, 1]  # d1 · n2, n2 = d2 turned a quarter
     turn = (np.abs(across) >= SHALLOW) & ((d1 * d2).sum(axis=1) >= HAIRPIN)
-    k, d1, d2, across = k[turn], d1[turn], d2[turn], across[turn]
+    k, d1, d2, across, axes = k[turn], d1[turn], d2[turn], across[turn], axes[turn]
     if k.size == 0:
         return
-    gap = crossing(k)[:, :2] - out_end[k - 1, :2]
+    gap = np.stack(in_plane(crossing(k) - out_end[k - 1], axes)[:2], axis=1)
     along = (gap[:, 1] * d2[:, 0] - gap[:, 0] * d2[:, 1]) / across  # (gap · n2) / (d1 · n2)
-    out_end[k - 1, :2] += along[:, None] * d1
+    out_end[k - 1] += from_plane(along * d1[:, 0], along * d1[:, 1], np.zeros(len(k)), axes)
     if step is not None:
         out_end[k - 1] = quantize(out_end[k - 1], step[k - 1])
 
 
 def _pin_plane(rows: _Rows, out_end: NDArray, before: NDArray | None) -> None:
-    """The lines under compensation that move no axis of the plane keep the X Y of the end before
-    them: a correction that differs there (with Z) would be a tiny move in the plane, which the
-    control offsets along its own direction.  `before`: the previous chunk's last end, in the first
-    row's frame (None: none)."""
-    if rows.still is None:
+    """The lines under compensation that move no axis of the plane keep the plane's axes (G17: X Y)
+    of the end before them: a correction that differs there (with the normal axis) would be a tiny
+    move in the plane, which the control offsets along its own direction.  `before`: the previous
+    chunk's last end, in the first row's frame (None: none)."""
+    if rows.still is None or rows.axes is None:
         return
-    for k in np.flatnonzero(rows.still).tolist():  # in order: a run of them keeps the first's X Y
+    for k in np.flatnonzero(rows.still).tolist():  # in order: a run of them keeps the first's
+        plane = rows.axes[k, :2]
         if k > 0 and (rows.offsets[k] == rows.offsets[k - 1]).all() and rows.scales[k] == rows.scales[k - 1]:
-            out_end[k, :2] = out_end[k - 1, :2]
+            out_end[k, plane] = out_end[k - 1, plane]
         elif k == 0 and before is not None:
-            out_end[k, :2] = before[:2]
+            out_end[k, plane] = before[plane]
 
 
 def _kept_axes(segs: list, kind: NDArray) -> NDArray:

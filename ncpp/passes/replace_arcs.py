@@ -214,11 +214,12 @@ def _centre_offsets(arcs: list[Arc]) -> tuple[NDArray, NDArray, NDArray] | None:
     radial, start, entry = np.zeros(len(arcs)), np.zeros((len(arcs), 3)), np.zeros(len(arcs), dtype=bool)
     for k, arc in enumerate(arcs):
         if arc.centre_shift is not None:
-            at_start, (sx, sy, _) = arc.centre_shift
+            at_start, shift = arc.centre_shift
             entry[k] = at_start is None
             start[k] = (0.0, 0.0, 0.0) if at_start is None else at_start
-            dx, dy = arc.end[0] - arc.center[0], arc.end[1] - arc.center[1]  # (followed in G17 only)
-            radial[k] = (sx * dx + sy * dy) / math.hypot(dx, dy)
+            a, b, _ = PLANE_AXES[arc.context.plane]
+            du, dv = arc.end[a] - arc.center[a], arc.end[b] - arc.center[b]
+            radial[k] = (shift[a] * du + shift[b] * dv) / math.hypot(du, dv)
     return radial, start, entry
 
 

@@ -1,4 +1,4 @@
-"""Moves under cutter compensation (G41/G42, G41.1/G42.1 in G17 and G90) compensated where the
+"""Moves under cutter compensation (G41/G42, G41.1/G42.1 in G17 and G18, G90 and G91) compensated where the
 tool centre stands, judged by oracles ncpp did not write: LinuxCNC's rs274 prints the tool
 centre's path (under compensation its STRAIGHT_FEED and ARC_FEED calls are the tool centre's) of
 the original and of the rewritten program; the rewritten one, run on a machine whose errors are
@@ -121,6 +121,105 @@ def test_the_tool_centre_lands_on_the_original_path_within_half_a_micron(tmp_pat
     assert deviation(before, before, closed_form).max() > 0.005
     assert deviation(before, after, closed_form).max() <= 0.0005
     pathcheck(original, out, "--tool-table", str(tools))
+
+
+# X runs 200 µm/m long and Z 150 µm/m short, X moves Z by 250 µm/m of x (its straightness in Z, EZX) and
+# Z moves X by -100 µm/m of z (EXZ): the tool lands at (x + 2e-4·x - 1e-4·z, y, z - 1.5e-4·z + 2.5e-4·x)
+AFFINE_XZ = """[machine]
+name = "affine-xz"
+chain = "XYFZ"
+
+[limits]
+X = [-500.0, 500.0]
+Y = [-500.0, 500.0]
+Z = [-500.0, 500.0]
+
+[errors.EXX]
+kind = "polynomial"
+coefficients_um = [0.0, 0.2]
+
+[errors.EZZ]
+kind = "polynomial"
+coefficients_um = [0.0, -0.15]
+
+[errors.EZX]
+kind = "polynomial"
+coefficients_um = [0.0, 0.25]
+
+[errors.EXZ]
+kind = "polynomial"
+coefficients_um = [0.0, -0.1]
+"""
+
+
+def closed_form_xz(command: np.ndarray) -> np.ndarray:
+    """Where AFFINE_XZ's machine puts the tool for commands (n,3), machine mm."""
+    x, z = command[:, 0], command[:, 2]
+    reached = command.copy()
+    reached[:, 0] = x + 2e-4 * x - 1e-4 * z
+    reached[:, 2] = z - 1.5e-4 * z + 2.5e-4 * x
+    return reached
+
+
+# a lathe-like profile turned in the XZ plane (G18: arcs' I K, the tool right of the contour as seen from
+# +Y, LinuxCNC's G41/G42), with a face, a shoulder's fillet, a convex round, a taper and a Y offset
+TURNED = (
+    "G21 G90 G18 G94 G64\nG0 X70 Y5 Z10\nG1 X60 F200\nG42.1 D8\nG1 X20 Z0\nG1 Z-20\nG2 X30 Z-30 R10\n"
+    "G1 X40\nG3 X50 Z-40 K-10 I0\nG1 Z-60\nG1 X60 Z-70\nG3 X60 Z-90 K-10 I0\nG1 Z-110\nG40\n"
+    "G1 X80 Z-120\nG0 Z10\nM2\n"
+)
+# a G17 contour in G91: its increments under G41.1 from the compensated points before them
+INCREMENTAL = HEAD + (
+    "G0 X-20 Y-20 Z5\nG1 Z-1 F300\nG91\nG41.1 D12\nG1 X20 Y20\nG1 X90\nG3 X20 Y20 R20\nG1 Y50\n"
+    "G3 X-20 Y20 I-20 J0\nG1 X-60\nG1 X-30 Y-40\nG2 X0 Y-50 I10 J-25\nG40\nG1 X-20 Y-20\nG90\nG0 Z5\nM2\n"
+)
+
+
+@needs_oracles
+@pytest.mark.parametrize(
+    "text, machine, reached",
+    [(TURNED, AFFINE_XZ, closed_form_xz), (INCREMENTAL, AFFINE, closed_form)],
+    ids=["g18-turned-profile", "g91-g17-contour"],
+)
+def test_in_g18_and_in_g91_the_tool_centre_lands_on_the_original_path(tmp_path, text, machine, reached):
+    """G18 (the tool centre left or right as seen from +Y, in the plane's Z X order) and G91 (each
+    compensated end written as the increment from the compensated end before it): within 0.5 µm of
+    the original's tool-centre path, where the program left as programmed misses it by µm."""
+    (tmp_path / "machine.toml").write_text(machine)
+    original, out = tmp_path / "plane.ngc", tmp_path / "plane.out.ngc"
+    original.write_text(text)
+    proc = subprocess.run([sys.executable, "-m", "ncpp", "compensate", "--machine", str(tmp_path / "machine.toml"),
+                           "--tolerance", "0.0001", str(original), "-o", str(out)],
+                          capture_output=True, text=True, cwd=ROOT, timeout=300, stdin=subprocess.DEVNULL)  # fmt: skip
+    assert proc.returncode == 0 and "warning" not in proc.stderr, proc.stderr
+    before, after = (feed_moves(p, home=tmp_path) for p in (original, out))
+    under = [m for m in after if m.comp > 0]
+    assert len(under) >= 9 and sum(m.centre is not None for m in under) >= 3
+    assert deviation(before, [m for m in before if m.comp > 0], reached).max() > 0.005
+    assert deviation(before, after, reached).max() <= 0.0005
+    pathcheck(original, out)
+
+
+# moves under G41.1 in a subroutine (a parameter in its words) and in a while loop
+IN_BODIES = HEAD + (
+    "o100 sub\nG1 X80 Y0\nG3 X100 Y20 R20\nG1 X100 Y[#1]\nG3 X80 Y[#1 + 20] I-20 J0\nG1 X30 Y[#1 + 20]\n"
+    "o100 endsub\nG0 X-20 Y-20 Z5\nG1 Z-1 F300\nG41.1 D10\nG1 X0 Y0\no100 call [60]\n#2 = 0\n"
+    "o200 while [#2 LT 2]\nG1 X[20 - #2 * 20] Y[80 - #2 * 15]\n#2 = [#2 + 1]\no200 endwhile\nG1 X0 Y0\nG40\n"
+    "G1 X-20 Y-20\nG0 Z5\nM2\n"
+)
+
+
+@needs_oracles
+def test_with_expand_the_moves_under_compensation_in_loops_and_subroutines_land_on_the_path(tmp_path):
+    """--expand writes the bodies out as plain moves: under compensation they are compensated where
+    the tool centre stands like any other (without it they are left as programmed, µm off)."""
+    original, out, proc = written(tmp_path, IN_BODIES, "bodies.ngc", "--tolerance", "0.0001", "--expand")
+    assert "warning" not in proc.stderr, proc.stderr
+    before, after = (feed_moves(p, home=tmp_path) for p in (original, out))
+    assert sum(m.comp > 0 for m in after) >= 10
+    assert deviation(before, before, closed_form).max() > 0.005
+    assert deviation(before, after, closed_form).max() <= 0.0005
+    pathcheck(original, out)
 
 
 @needs_oracles

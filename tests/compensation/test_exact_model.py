@@ -98,22 +98,23 @@ def test_reversal_spots_within_tolerance(name):
     assert before.max_um / after.max_um >= 20
 
 
-G91_COMP = b"""G21 G17 G90 G94 F500
+# (in G18 with a lathe tool's orientation, L3: moves under compensation that ncpp leaves as programmed)
+G91_COMP = b"""G21 G18 G90 G94 F500
 G0 X0 Y0 Z0
 G91
-G1 X30 Y5
-G1 X10 Y20
-G2 X20 Y0 R15
-G41.1 D6
-G1 X10 Y10
+G1 X30 Z5
+G1 X10 Z20
+G2 X20 Z0 R15
+G41.1 D6 L3
+G1 X10 Z10
 G1 X40
-G3 X10 Y10 R10
-G1 Y30
+G3 X10 Z10 R10
+G1 Z30
 G40
-G1 X-10 Y10
-G1 X-40 Y5
-G2 X-20 Y0 R12
-G1 X-5 Y-60 Z-2
+G1 X-10 Z10
+G1 X-40 Z5
+G2 X-20 Z0 R12
+G1 X-5 Z-60 Y-2
 M2
 """
 
@@ -164,21 +165,21 @@ def test_in_g91_the_carry_crosses_the_passes_windows():
     from ncpp.motion.segments import Arc, Line
 
     series = [
-        "G1 X3 Y1",
-        "G1 X1 Y2",
-        "G41.1 D4",
-        "G1 X2 Y2",
+        "G1 X3 Z1",
+        "G1 X1 Z2",
+        "G41.1 D4 L3",  # (a lathe tool's orientation: left as programmed, G91_COMP)
+        "G1 X2 Z2",
         "G1 X3",
         "G40",
-        "G1 X-2 Y1",
-        "G1 X-4 Y-3",
-        "G1 X-3 Y-3",
+        "G1 X-2 Z1",
+        "G1 X-4 Z-3",
+        "G1 X-3 Z-3",
     ]  # nets 0
-    head = ["G21 G17 G90 G94 F500", "G0 X0 Y0 Z0", "G91"]
+    head = ["G21 G18 G90 G94 F500", "G0 X0 Y0 Z0", "G91"]
     filler = ["G1 X1", "G1 X-1"] * ((1016 - len(head) - len(series)) // 2)
     lines = head + series + filler + series + series + ["G90", "M2"]
     assert (
-        lines.index("G1 X-2 Y1", len(head) + len(series) + len(filler)) + 1 == 1023
+        lines.index("G1 X-2 Z1", len(head) + len(series) + len(filler)) + 1 == 1023
     )  # the exit move ends the first window
     data = ("\n".join(lines) + "\n").encode()
     model = load_machine(ROOT / "samples/machines/hr5b.toml")

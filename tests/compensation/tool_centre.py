@@ -20,9 +20,12 @@ from tests.conftest import RS274
 
 _CALL = re.compile(
     r"\b(STRAIGHT_FEED|STRAIGHT_TRAVERSE|ARC_FEED|RIGID_TAP|SET_G5X_OFFSET|SET_G92_OFFSET|USE_LENGTH_UNITS"
-    r"|USE_TOOL_LENGTH_OFFSET"
+    r"|USE_TOOL_LENGTH_OFFSET|SELECT_PLANE"
     r"|COMMENT)\((\"interpreter: cutter radius compensation (?:on|off)|[^)]*)"
 )
+# rs274's ARC_FEED(first_end, second_end, first_axis, second_axis, rotation, axis_end_point, ...): the
+# plane's first, second and normal axis, and the rotation counter-clockwise from first to second
+_PLANES = {"CANON_PLANE_XY": (0, 1, 2), "CANON_PLANE_XZ": (2, 0, 1), "CANON_PLANE_YZ": (1, 2, 0)}
 
 
 @dataclass(frozen=True)
@@ -33,9 +36,10 @@ class Move:
 
     start: NDArray  # (3,)
     end: NDArray  # (3,)
-    centre: NDArray | None = None  # (2,) an arc's
+    centre: NDArray | None = None  # (2,) an arc's, in its plane's first and second axis
     turn: int = 0  # +1 counter-clockwise, -1 clockwise
     comp: int = 0  # under cutter compensation, or the exit move after it: the number of its G41/G42 (from 1)
+    axes: tuple[int, int, int] = (0, 1, 2)  # an arc's plane: its first, second and normal axis
 
     def samples(self, count: int = 16) -> NDArray:
         """(count,3) points along the move, ends included (an arc whose end radius differs from its
@@ -45,14 +49,17 @@ class Move:
             return self.start + t[:, None] * (self.end - self.start)
         a0, r0, sweep, r1 = self.polar()
         angle, radius = a0 + t * sweep, r0 + t * (r1 - r0)
-        z = self.start[2] + t * (self.end[2] - self.start[2])
-        return np.column_stack(
-            [self.centre[0] + radius * np.cos(angle), self.centre[1] + radius * np.sin(angle), z]
-        )
+        u, v, w = self.axes
+        out = np.empty((count, 3))
+        out[:, u] = self.centre[0] + radius * np.cos(angle)
+        out[:, v] = self.centre[1] + radius * np.sin(angle)
+        out[:, w] = self.start[w] + t * (self.end[w] - self.start[w])
+        return out
 
     def polar(self) -> tuple[float, float, float, float]:
         """An arc's start angle and radius, signed sweep (rad) and end radius."""
-        s, e = self.start[:2] - self.centre, self.end[:2] - self.centre  # type: ignore[operator]
+        plane = list(self.axes[:2])
+        s, e = self.start[plane] - self.centre, self.end[plane] - self.centre  # type: ignore[operator]
         a0, a1 = math.atan2(s[1], s[0]), math.atan2(e[1], e[0])
         span = (a1 - a0) % (2 * math.pi) if self.turn > 0 else (a0 - a1) % (2 * math.pi)
         span = (span if span > 1e-12 else 2 * math.pi) + 2 * math.pi * (abs(self.turn) - 1)
@@ -79,12 +86,16 @@ def feed_moves(
     # the offsets in mm (rs274 prints them in the units then)
     g5x, g92, tool, scale = np.zeros(3), np.zeros(3), np.zeros(3), 1.0
     comp = leaving = sections = 0
+    axes = (0, 1, 2)
     for name, args in _CALL.findall(proc.stdout):
         if name == "COMMENT":
             if args.startswith('"interpreter: cutter radius compensation'):
                 if args.endswith("on"):
                     sections += 1
                 comp, leaving = sections if args.endswith("on") else 0, comp if args.endswith("off") else 0
+            continue
+        if name == "SELECT_PLANE":
+            axes = _PLANES[args.strip()]
             continue
         if name == "USE_LENGTH_UNITS":
             scale = 25.4 if "INCH" in args else 1.0
@@ -101,8 +112,11 @@ def feed_moves(
             continue
         offset = g5x + g92 + tool
         if name == "ARC_FEED":
-            end = np.array([v[0], v[1], v[5]]) * scale + offset
-            moves.append(Move(at, end, np.array(v[2:4]) * scale + offset[:2], int(v[4]), comp or leaving))
+            end = np.empty(3)
+            end[list(axes)] = v[0], v[1], v[5]
+            end = end * scale + offset
+            centre = np.array(v[2:4]) * scale + offset[list(axes[:2])]
+            moves.append(Move(at, end, centre, int(v[4]), comp or leaving, axes))
         else:
             end = np.array(v[:3]) * scale + offset
             if name == "STRAIGHT_FEED" or name == "RIGID_TAP":
@@ -133,8 +147,9 @@ class _Path:
         self.ab = np.array([m.end for m in lines]).reshape(-1, 3) - self.a
         self.ends = np.array([p for m in arcs for p in (m.start, m.end)]).reshape(-1, 3)
         self.centre = np.array([m.centre for m in arcs]).reshape(-1, 2)
-        self.z0 = np.array([m.start[2] for m in arcs])
-        self.rise = np.array([m.end[2] - m.start[2] for m in arcs])
+        self.axes = np.array([m.axes for m in arcs], dtype=np.intp).reshape(-1, 3)
+        self.z0 = np.array([m.start[m.axes[2]] for m in arcs])
+        self.rise = np.array([m.end[m.axes[2]] - m.start[m.axes[2]] for m in arcs])
         self.a0, self.r0, sweep, self.r1 = np.array([m.polar() for m in arcs]).reshape(-1, 4).T
         self.turn, self.span = np.sign(sweep), np.abs(sweep)
 
@@ -150,13 +165,16 @@ class _Path:
             best = np.minimum(
                 best, np.linalg.norm(at - (self.a + t[..., None] * self.ab), axis=-1).min(axis=1)
             )
-        if len(self.centre):
-            rel = at[..., :2] - self.centre
+        if len(self.centre):  # each point in each arc's plane axes (n,m,3)
+            local = np.take_along_axis(
+                np.broadcast_to(at, (len(p), len(self.axes), 3)), self.axes[None], axis=-1
+            )
+            rel = local[..., :2] - self.centre
             travelled = (self.turn * (np.arctan2(rel[..., 1], rel[..., 0]) - self.a0)) % (2 * math.pi)
             inside = travelled <= self.span  # (one turn at most: the test programs' arcs)
             part = travelled / self.span
             radial = np.abs(np.linalg.norm(rel, axis=-1) - (self.r0 + part * (self.r1 - self.r0)))
-            height = at[..., 2] - (self.z0 + self.rise * part)
+            height = local[..., 2] - (self.z0 + self.rise * part)
             best = np.minimum(best, np.where(inside, np.hypot(radial, height), np.inf).min(axis=1))
             best = np.minimum(best, np.linalg.norm(at - self.ends, axis=-1).min(axis=1))
         return best

@@ -51,9 +51,18 @@ def test_moves_off_the_path_are_marked_from_the_first_under_comp_to_the_first_af
         (11, "", False),
         (12, "", False),
     ]
-    in_xz = moves(events_of(CONTOUR.replace("G41.1", "G18 G41.1").replace("G2 X20 Y20 R10", "G2 X20 Z-1 R10")
-                            .replace("G2 X40 Y50 I10", "G17 G2 X40 Y50 I10")))  # fmt: skip
-    assert [(e.block.line, e.fixed) for e in in_xz[2:7]] == [(n, COMP) for n in (5, 6, 7, 8, 10)]
+    in_xz = (
+        CONTOUR.replace("G41.1", "G18 G41.1")
+        .replace("G2 X20 Y20 R10", "G2 X20 Z-1 R10")
+        .replace("G2 X40 Y50 I10", "G17 G2 X40 Y50 I10")
+    )
+    followed = moves(events_of(in_xz))[2:7]
+    assert [(e.block.line, e.fixed, e.centre_shift is not None) for e in followed] == [
+        (n, "", True) for n in (5, 6, 7, 8, 10)
+    ]
+    # a lathe tool's orientation (L 1-8): the control moves its tip along the offset contour
+    lathe = moves(events_of(in_xz.replace("G41.1 D10", "G41.1 D10 L3")))
+    assert [(e.block.line, e.fixed) for e in lathe[2:7]] == [(n, COMP) for n in (5, 6, 7, 8, 10)]
 
 
 def test_the_tool_centre_stands_off_each_move_by_the_radius_to_the_left_of_its_own_direction():
@@ -65,6 +74,15 @@ def test_the_tool_centre_stands_off_each_move_by_the_radius_to_the_left_of_its_o
     ends = [left_of_x, left_of_y, left_of_x, left_of_y, (0.0, 0.0, 0.0)]
     assert all(math.dist(s[1], end) < 1e-12 for s, end in zip(shifts, ends))
     assert shifts[0][0] is None and [s[0] for s in shifts[1:]] == [s[1] for s in shifts[:-1]]
+
+
+def test_in_g18_left_is_as_seen_from_plus_y():
+    """G18 G41.1 D10: left of the direction as seen from +Y, in the plane's Z X order (LinuxCNC's
+    G41; rs274 puts the tool centre of `G1 X10` from X0 Z-1 at Z-6): moving +X, the tool centre
+    stands at -Z; moving +Z, at +X; on an arc turning G2 (clockwise seen from +Y) away from its centre."""
+    text = HEAD + "G18 G41.1 D10\nG1 X10\nG1 Z20\nG2 X30 Z40 I20 K0\nG40\nG1 X40\nM2\n"
+    shifts = [e.centre_shift[1] for e in moves(events_of(text))[2:5]]
+    assert all(math.dist(s, end) < 1e-12 for s, end in zip(shifts, [(0, 0, -5), (5, 0, 0), (0, 0, 5)]))
 
 
 def test_after_g40_the_position_is_the_programs():
@@ -161,6 +179,8 @@ def test_moves_after_compensation_agree_with_rs274(tmp_path, body):
         ("G41.1 D10\nG3 X8 I4\n", 5),
         ("G41.1 D10\nG1 X10\nG3 X14 I2\n", 6),
         ("G41.1 D10\nG1 X10\nG3 X14 R2\n", 6),
+        ("G41.1 D10 L3\nG1 X20\n", 4),  # a lathe tool's orientation outside G18
+        ("G18\nG41.1 D10 L2.5\nG1 X20\n", 5),
     ],
 )
 def test_refused_with_compensation_as_rs274_refuses(tmp_path, body, line):
@@ -211,10 +231,10 @@ def test_fanuc_corners_under_compensation_are_the_controls_and_the_position_is_f
 
 
 # -- compensation ---------------------------------------------------------------------------------
-# in the XZ plane: compensation that ncpp does not follow
+# in the XZ plane with a lathe tool's orientation: compensation that ncpp does not follow
 POCKET = (
     HEAD
-    + "G1 X-20 Y-20\nG1 X-5\nG18\nG41.1 D6\nG1 X0 Z0\nG1 X40\nG2 X50 Z10 R10\nG1 Z40\nG40\nG1 X55 Z45\nG1 X70\n"
+    + "G1 X-20 Y-20\nG1 X-5\nG18\nG41.1 D6 L3\nG1 X0 Z0\nG1 X40\nG2 X50 Z10 R10\nG1 Z40\nG40\nG1 X55 Z45\nG1 X70\n"
     "G17\nG2 X80 Y-10 R10\nG0 Z10\nM2\n"
 )
 
@@ -222,7 +242,7 @@ POCKET = (
 def test_moves_off_the_path_pass_through_and_compensation_resumes_after_the_exit_move():
     out, warned = compensate(POCKET, "comp.ngc")
     original, lines = POCKET.splitlines(), out.splitlines()[1:]  # (the header)
-    start = lines.index("G41.1 D6")
+    start = lines.index("G41.1 D6 L3")
     assert lines[start - 2].startswith("X-4.97")  # `G1 X-5` compensated before it
     assert lines[start : start + 7] == original[6:13]  # from G41.1 to the exit move: verbatim
     after = lines[start + 7 :]
@@ -240,19 +260,22 @@ def test_strict_refuses_moves_under_compensation_it_does_not_follow():
         compensate(POCKET, "comp.ngc", strict=True)
 
 
-def test_in_g91_compensation_resumes_from_where_the_moves_left_as_programmed_leave_the_tool():
-    """G91 under compensation: its increments run from the compensated point before them, and
-    the moves after the exit move are compensated from there (`apply_error_map._carry`;
-    test_exact_model measures them on the machine)."""
+def test_in_g91_the_moves_under_compensation_are_compensated_as_increments():
+    """G91 under compensation: each move is corrected where the tool centre stands, written as
+    the increment from the compensated end before it (test_cutter_comp_accuracy measures them
+    with rs274); with a lathe tool's orientation in G18 they run as programmed from the
+    compensated point before them (`apply_error_map._carry`, test_exact_model)."""
     text = HEAD + "G1 X-20 Y-20\nG41.1 D6\nG91 G1 X20\nG1 Y20\nG40\nG1 X10 Y10\nG1 X30\nG90\nG1 X0 Y0\n"
     out, warned = compensate(text, "comp.ngc")
     lines = out.splitlines()
     start = lines.index("G41.1 D6")
-    assert lines[start : start + 5] == text.splitlines()[4:9]  # to the exit move: as written
-    assert lines[start + 5] != "G1 X30" and lines[start + 5].startswith(
-        "G1 X30.0"
-    )  # compensated, an increment
-    assert "in G91" not in warned and warned.count("cutter compensation") == 1
+    written, programmed = lines[start + 1 : start + 7], text.splitlines()[5:11]
+    kept = [w == p for w, p in zip(written, programmed)]
+    assert kept == [False, False, True, False, False, True]  # (G40, G90)
+    for w, p in zip(written, programmed):  # increments within the corrections (tens of µm) of the program's
+        words, theirs = (dict((t[0], float(t[1:])) for t in line.split() if t[0] in "XY") for line in (w, p))
+        assert all(abs(words[k] - v) < 0.05 for k, v in theirs.items()), (w, p)
+    assert "cutter compensation" not in warned
 
 
 @needs_rs274
@@ -317,6 +340,9 @@ def test_motion_and_simulate_say_where_the_tool_leaves_the_programmed_contour(tm
         ("T1 M6\nG41 D2\nG1 X38.11\nG40\nG1 X0\n", None),
         ("G20\nT1 M6\nG41\nG1 X4.99\n", 7),
         ("G20\nT1 M6\nG41\nG1 X5.001\nG40\nG1 X0\n", None),
+        ("T3 M6\nG41\nG1 X20\n", 5),  # a lathe tool (orientation Q3) outside G18
+        ("T3 M6\nG18\nG41\nG1 X20 Z20\nG40\nG1 X0\n", None),
+        ("T4 M6\nG41\nG1 X20\nG40\nG1 X0\n", None),  # (Q9: the tool centre, any plane)
     ],
 )
 def test_g41_checks_against_the_radius_of_the_tool_table_ncpp_is_told(tmp_path, body, refused):
@@ -329,7 +355,7 @@ def test_g41_checks_against_the_radius_of_the_tool_table_ncpp_is_told(tmp_path, 
     from ncpp.motion.tools import ToolTable
 
     table = tmp_path / "tool.tbl"
-    table.write_text("T1 P1 D10 Z0\nT2 P2 D3 Z0\n")
+    table.write_text("T1 P1 D10 Z0\nT2 P2 D3 Z0\nT3 P3 D0.2 Z0 Q3\nT4 P4 D0.2 Z0 Q9\n")
     path = write_program(tmp_path, HEAD + body)
     proc = subprocess.run(
         [str(RS274), "-t", str(table), str(path)], capture_output=True, text=True, timeout=60

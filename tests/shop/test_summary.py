@@ -153,7 +153,8 @@ def test_compensate_and_simulate_find_the_machine_file_as_ncpp_does(tmp_path):
 
 
 def test_several_programs_each_tell_their_summary_and_the_report_lists_them(tmp_path):
-    (tmp_path / "a.ngc").write_bytes(PROGRAM.replace(b"G41 D1", b"G18 G41 D1"))  # (in XZ: left as programmed)
+    lathe = PROGRAM.replace(b"G41 D1", b"G18 G41.1 D2 L3")  # (a lathe tool: left as programmed)
+    (tmp_path / "a.ngc").write_bytes(lathe)
     (tmp_path / "b.ngc").write_bytes(PROGRAM.replace(b"G41 D1 G1 X70 Y40 F200\n", b"G1 X70 Y40 F200\n"))
     proc = _ncpp(
         "ncpp", "compensate", "--machine", str(MACHINE), "--work-offset", "400,350,300",
