@@ -19,12 +19,16 @@ Q204 2nd set-up clearance count from the workpiece surface Q203):
   no other feed for them), in again at FMAX to the set-up clearance above the depth reached.
 * 240 CENTERING: FMAX to Q203+Q200; centre to the depth Q201 (Q343=0) at Q206; FMAX to the
   set-up clearance, then to the 2nd set-up clearance.
+* 207 RIGID TAPPING: FMAX to Q203+Q200; tap to Q201 in one move, the spindle reversed back to
+  the set-up clearance, both at the feed the spindle speed and the thread pitch Q239 make
+  (the TOOL CALL's S times |Q239|, the manual names no other for the retract); FMAX to the 2nd
+  set-up clearance.  Without a spindle speed the feed is not known: out of scope.
 
 Dwells (Q210, Q211) move nothing.  The manual's depth sign gives the direction: a depth of
 0 runs no cycle; a positive depth (the control refuses it unless a machine parameter allows
 it), a depth measured on the tool's diameter (Q395=1, Q343=1: they need the tool's point
-angle) and the other cycles (202 with its spindle orientation, 204, 205, 208, tapping,
-pockets, contours) are outside ncpp's scope (`OutOfScope`).
+angle) and the other cycles (202 with its spindle orientation, 204, 205 with its advanced stop
+distances, 206, 208, 209, pockets, contours) are outside ncpp's scope (`OutOfScope`).
 """
 
 from __future__ import annotations
@@ -39,12 +43,14 @@ REQUIRED = {
     "201": ("q200", "q201", "q206", "q203", "q204"),
     "203": ("q200", "q201", "q206", "q202", "q203", "q204"),
     "240": ("q200", "q201", "q206", "q203", "q204"),
+    "207": ("q200", "q201", "q239", "q203", "q204"),
 }
 OPTIONAL = {
     "200": ("q210", "q211", "q395"),
     "201": ("q211", "q208"),
     "203": ("q210", "q212", "q213", "q205", "q211", "q208", "q256", "q395"),
     "240": ("q343", "q344", "q211"),
+    "207": ("q336",),
 }
 # Cycles a CYCL DEF makes active at once, which leave the called cycle as it is: dwell (9),
 # tolerance (32), preset (247), and the datum cycles (out of scope themselves)
@@ -82,8 +88,9 @@ def parameters_needed(number: str) -> tuple[str, ...]:
     return REQUIRED[number] + OPTIONAL[number]
 
 
-def steps(cycle: Drilling) -> list[Step]:
-    """The moves of one run of `cycle`, from the level the tool stands at (see the module docstring)."""
+def steps(cycle: Drilling, spindle: float = 0.0) -> list[Step]:
+    """The moves of one run of `cycle`, from the level the tool stands at, the spindle turning at
+    `spindle` (rev/min; see the module docstring)."""
     depth = cycle["q201"]
     if depth == 0:
         return []  # (the manual: with DEPTH = 0 the control does not run the cycle)
@@ -97,6 +104,13 @@ def steps(cycle: Drilling) -> list[Step]:
     clearance = surface + cycle["q200"]
     bottom = surface + depth
     plunge, out = cycle["q206"], cycle["q208"] or cycle["q206"]
+    if cycle.number == "207":
+        if not spindle > 0 or not cycle["q239"]:
+            raise OutOfScope("CYCL DEF 207 without a spindle speed (TOOL CALL S) or a thread pitch Q239: "
+                             "its feed is not known")  # fmt: skip
+        tapping = spindle * abs(cycle["q239"])
+        run = [Step(clearance, True), Step(bottom, False, tapping), Step(clearance, False, tapping)]
+        return run + _second(cycle, clearance)
     if cycle.number in ("201", "240"):
         rapid_out = cycle.number == "240"
         run = [Step(clearance, True), Step(bottom, False, plunge)]

@@ -356,6 +356,9 @@ class HeidenhainWriter(IsoWriter):
                 self._remember_end(segment)
             return
         self.changed_any = self.edited_last = True
+        if _position_call(block) is not None:
+            yield from self._position_call(block, motion)
+            return
         if corner and any(type(i) in (Word, ExprWord) and i.letter == "F" for i in block.items):
             self.restore_feed = True  # `RND R5 F200`: F200 holds for the fillet only, a C block's F is modal
         # the block itself says the first segment of its own kind; steps before and pieces after are new blocks
@@ -380,6 +383,29 @@ class HeidenhainWriter(IsoWriter):
                 moved = "" if word is None else " " + block.raw[word.start : word.end]
                 yield self._inserted(self._fresh(segment) + feed + moved)
             feed = ""  # on the first block written
+            self._remember_end(segment)
+
+    def _position_call(self, block: Block, motion: list):
+        """`CYCL CALL POS` whose move in the plane is compensated: its X and Y say where that move
+        ends (its Z, the cycle's datum shift, and the cycle's moves stay as written); the move's
+        pieces before the last are `L` blocks before it, each with the call's feed."""
+        call = _position_call(block) or 0
+        pieces = [e for e in motion if not e.fixed]
+        style = self.styles.get("F") or NumberStyle(decimals=3)
+        for piece in pieces[:-1]:
+            feed = "" if piece.rapid else " F" + format_number(piece.feed, style)
+            yield self._inserted(self._fresh(piece) + feed)
+            self._remember_end(piece)
+            self.restore_feed = self.restore_feed or not piece.rapid  # (the call's feed is for its move only)
+        if pieces:
+            last = pieces[-1]
+            texts = {n: self._word(item.letter, last.end[_AXES.index(item.letter)], last)
+                     for n, item in enumerate(block.items)
+                     if n > call and isinstance(item, (Word, ExprWord)) and item.letter in ("X", "Y")}  # fmt: skip
+            yield self._numbered(block, splice(block, texts))
+        else:
+            yield self._numbered(block, block.raw)
+        for segment in motion[len(pieces) - 1 if pieces else 0 :]:
             self._remember_end(segment)
 
     def _restored_feed(self, block: Block, motion: list) -> str:
@@ -536,6 +562,12 @@ class HeidenhainWriter(IsoWriter):
                         self.known_axes.add(axis)
             elif type(item) is ExprWord and item.letter[-1:] in _AXES and item.letter.lstrip("I") == item.letter[-1]:  # fmt: skip
                 self.known_axes.add(item.letter[-1])  # `X+Q1932` positions X as a number does
+
+
+def _position_call(block: Block) -> int | None:
+    """The index of a `CYCL CALL POS` in the block, if it is one."""
+    return next((n for n, i in enumerate(block.items)
+                 if type(i) is Statement and i.kind == "cycle_call" and i.node[0] == "POS"), None)  # fmt: skip
 
 
 def _called_on(block: Block, motion: list, own: int) -> tuple[int | None, int | None]:
