@@ -11,7 +11,8 @@ labels, subprograms (`CALL LBL n` ... `LBL 0`), program-section repeats (`CALL L
 and the jumps FN 9-12 (`heidenhain_flow`: a block that runs again is left as programmed,
 FLOW), `CYCL DEF` of machining cycles (they only define), the drilling cycles 200, 201, 203,
 207 and 240 called by M99, `CYCL CALL` or `CYCL CALL POS` (`heidenhain_cycles`: their moves
-along the tool axis are left as programmed, DRILLED), M2/M30
+along the tool axis are left as programmed, DRILLED) or `CYCL CALL PAT` at the holes of a
+`PATTERN DEF` (all its moves left as programmed, PATTERN), M2/M30
 and `END PGM` (end), and `RND R..` / `CHF ..` between two feed lines in the
 working plane (the fillet arc or chamfer line is the RND/CHF block's event; a
 feed line waits for the next move to know whether its corner is cut).
@@ -19,7 +20,7 @@ Radius compensation RL/RR is followed to R0: the moves from the first with RL/RR
 to the R0 block's are the programmed contour, the tool centre off it by the radius,
 and are marked `fixed` (`ModalInterpreter.radius_compensation`).  Paraxial R+/R-,
 RND/CHF next to an arc or a rapid, FK free contours,
-APPR/DEP, `CALL PGM`, calls of other cycles, `CYCL CALL PAT`, M89, FN 14 and later FN
+APPR/DEP, `CALL PGM`, calls of other cycles, point tables, M89, FN 14 and later FN
 functions and cycles that move the datum make the position unknown: one warning (an error with
 `strict`) and the rest passes through.
 
@@ -40,10 +41,13 @@ from ncpp.motion.corners import CornerError, round_corner
 from ncpp.motion.heidenhain_cycles import (
     DEFINITION_ACTIVE,
     REQUIRED,
+    SHAPES,
     Drilling,
+    Hole,
     Step,
     cycle_number,
     parameters_needed,
+    pattern_holes,
 )
 from ncpp.motion.heidenhain_cycles import steps as cycle_steps
 from ncpp.motion.heidenhain_flow import FIXED, JUMPS, SKIP, TEXT, KlartextFlow, jump_parts, label_key
@@ -55,7 +59,7 @@ from ncpp.motion.modal import (
     as_point,
     placed_interpreting,
 )
-from ncpp.motion.segments import COMP, FLOW, MACHINE, PLANE_AXES, Arc, Event, Line, Pass, Point
+from ncpp.motion.segments import COMP, FLOW, MACHINE, PATTERN, PLANE_AXES, Arc, Event, Line, Pass, Point
 from ncpp.motion.tools import ToolTable, UntoldLengths
 from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
 
@@ -167,6 +171,7 @@ class HeidenhainInterpreter(ModalInterpreter):
         self.flow: KlartextFlow | None = None  # the order the blocks run in (labels, calls, jumps)
         self.cycle: Drilling | str | None = None  # the cycle M99 / CYCL CALL runs (str: one not followed)
         self.spindle = 0.0  # the speed TOOL CALL S set (rev/min): a tapping cycle's feed follows it
+        self.pattern: tuple[str, list[Hole]] | str | None = None  # PATTERN DEF's holes (str: not followed)
 
     def run(self, blocks: Iterable[Block], warnings: Warnings) -> Iterator[Event]:
         """Events as `ModalInterpreter.run`; a feed line waits (with the events after it)
@@ -246,6 +251,7 @@ class HeidenhainInterpreter(ModalInterpreter):
         retract: float | str | None = None  # M140 MB: a retract along the tool axis after the move
         call: tuple[str, int] | None = None  # M99 or CYCL CALL and its column: the cycle runs after the move
         at_position = False  # CYCL CALL POS: the block's X Y Z are where the cycle runs
+        at_pattern = False  # CYCL CALL PAT: the cycle runs at the holes of the PATTERN DEF
         defined: str | None = None  # CYCL DEF of a drilling cycle: its number
         for item in block.items:
             if type(item) is Comment:
@@ -315,9 +321,12 @@ class HeidenhainInterpreter(ModalInterpreter):
                     self._forget_assigned(block)
                     return []
                 defined = number  # (its Q parameters follow as assignments)
-            elif what == "cycle_call" and node[0] in (None, "POS"):
-                call = ("CYCL CALL" if node[0] is None else "CYCL CALL POS", item.start + 1)
-                at_position = node[0] == "POS"
+            elif what == "cycle_call":
+                call = ("CYCL CALL" if node[0] is None else f"CYCL CALL {node[0]}", item.start + 1)
+                at_position, at_pattern = node[0] == "POS", node[0] == "PAT"
+            elif what == "pattern_def":
+                self.pattern = self._pattern(block, item)
+                return []
             elif (
                 what == "keyword"
                 and node
@@ -346,11 +355,11 @@ class HeidenhainInterpreter(ModalInterpreter):
             return []
         if function in ("RND", "CHF"):
             return [self._corner(block, function_item, words)]
-        if at_position and call is not None:
+        if (at_position or at_pattern) and call is not None:
             if function is not None or machine_datum or retract is not None or comp not in (None, "R0"):
-                raise OutOfScope(
-                    "CYCL CALL POS with a path function, M91, M140 or RL/RR in its block", call[1]
-                )
+                raise OutOfScope(f"{call[0]} with a path function, M91, M140 or RL/RR in its block", call[1])
+            if at_pattern:
+                return self._call_pattern(block, words, rapid, call[1])
             return self._call_at_position(block, words, rapid, call[1])
         if "F" in words and function is not None:
             self.feed = words["F"][0]
@@ -453,6 +462,66 @@ class HeidenhainInterpreter(ModalInterpreter):
         steps = [(shift, approach, 0.0)] if shift != self.pos[self.tool_axis] else []
         steps += [(s.level, None if s.rapid else s.feed, 0.0) for s in run]
         return [plane, *self.drilled(block, steps, self.tool_axis)]
+
+    def _pattern(self, block: Block, item) -> tuple[str, list[Hole]] | str:
+        """`PATTERN DEF`: its holes (`heidenhain_cycles.pattern_holes`) and the last shape's name,
+        or why ncpp does not follow them (a `CYCL CALL PAT` then leaves the scope)."""
+        holes: list[Hole] = []
+        try:
+            for name, _, words in item.node:
+                values = {letter: self.value(expr, block, item) for letter, expr in words}
+                if name not in SHAPES or len(values) != len(words):
+                    return f"PATTERN DEF {name}{' with a word twice' if name in SHAPES else ''}"
+                holes += pattern_holes(name, values)
+        except OutOfScope as out:
+            return out.reason
+        return (item.node[-1][0] if item.node else "", holes) if holes else "PATTERN DEF without a hole"
+
+    def _call_pattern(self, block: Block, words: dict, rapid: bool, col: int) -> list[Event]:
+        """`CYCL CALL PAT FMAX|F..`: the cycle runs at each hole of the PATTERN DEF, the tool
+        moving between them at the 2nd set-up clearance (TNC 640 cycle programming manual,
+        "Pattern definition PATTERN DEF" and "Calling a cycle with CYCL CALL PAT"; each
+        shape's Z is added to Q203).  The control computes the holes and its own moves
+        between them, which a rewritten program could not correct: all the call's moves
+        are left as programmed (PATTERN) and the holes are where the pattern puts them;
+        compensation resumes after the call.  Only from above the 2nd set-up clearance and
+        with one surface for all holes (the moves between two surfaces are the control's);
+        after a PAT or FRAME grid, whose order the manual does not give, X and Y are not
+        known until a block names them."""
+        pattern = self.pattern
+        if not isinstance(pattern, tuple):
+            raise OutOfScope(f"the cycle call CYCL CALL PAT ({pattern or 'no PATTERN DEF'})", col)
+        if not rapid and "F" not in words:
+            raise OutOfScope("CYCL CALL PAT without F or FMAX (its feed between the holes)", col)
+        shape, holes = pattern
+        if len({z for _, _, z in holes}) > 1:
+            raise OutOfScope("CYCL CALL PAT with holes at different surfaces Z", col)
+        surface = holes[0][2]
+        run = self._cycle_run("CYCL CALL PAT", col, surface)
+        assert isinstance(self.cycle, Drilling)  # (`_cycle_run` checked it)
+        top = surface + self.cycle["q203"] + max(self.cycle["q200"], self.cycle["q204"])
+        if self.pos[self.tool_axis] < top:
+            raise OutOfScope(f"CYCL CALL PAT from below the 2nd set-up clearance {top:g} (the control's "
+                             "move up to it is not followed)", col)  # fmt: skip
+        programmed, approach = self.feed, None if rapid else words["F"][0]
+        events: list[Event] = []
+        for x, y, _ in holes:
+            end = list(self.pos)
+            end[0], end[1] = x, y
+            self.feed = programmed if approach is None else approach
+            events.append(self.line(block, end, rapid))
+            self.feed = programmed
+            here = self.pos[self.tool_axis]
+            steps = [
+                (s.level, None if s.rapid else s.feed, 0.0) for s in run if s.level != here or s is not run[0]
+            ]
+            events += self.drilled(block, steps, self.tool_axis)
+        for event in events:
+            if type(event) is Line:
+                event.fixed, event.placed = PATTERN, (True, True, True)
+        if shape in ("PAT", "FRAME"):
+            self.unknown_axes |= {0, 1}
+        return events
 
     def _tool_def(self, block: Block, statement) -> list[Event]:
         """`TOOL DEF n L.. R..`: the program defines tool n's length (without L: it only prepares the tool)."""

@@ -33,7 +33,10 @@ distances, 206, 208, 209, pockets, contours) are outside ncpp's scope (`OutOfSco
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
+
+import numpy as np
 
 from ncpp.motion.modal import OutOfScope
 
@@ -159,4 +162,68 @@ def _second(cycle: Drilling, clearance: float) -> list[Step]:
     return [Step(second, True)] if second > clearance else []
 
 
-__all__ = ["DEFINITION_ACTIVE", "Drilling", "Step", "cycle_number", "parameters_needed", "steps"]
+__all__ = ["DEFINITION_ACTIVE", "Drilling", "Hole", "Step", "cycle_number", "parameters_needed", "pattern_holes",
+           "steps"]  # fmt: skip
+
+
+# -- hole patterns (PATTERN DEF) -------------------------------------------------------------------
+# Each shape's words (TNC 640 cycle programming manual, "Pattern definition PATTERN DEF"): those
+# it needs, then those it may leave out (0).  POS: a position; ROW: start X Y, spacing D, count
+# NUM, rotation ROT about the start; PAT/FRAME: start X Y, spacings DX DY, counts NUMX NUMY,
+# rotation ROT, distortions ROTX ROTY; CIRC: centre X Y, diameter D, starting angle START,
+# count NUM; PITCHCIRC: as CIRC with the stepping angle STEP.  Z, in every shape, is the
+# workpiece surface, added to the cycle's Q203.
+SHAPES = {
+    "POS": (("X", "Y"), ("Z",)),
+    "ROW": (("X", "Y", "D", "NUM"), ("ROT", "Z")),
+    "PAT": (("X", "Y", "DX", "DY", "NUMX", "NUMY"), ("ROT", "ROTX", "ROTY", "Z")),
+    "FRAME": (("X", "Y", "DX", "DY", "NUMX", "NUMY"), ("ROT", "ROTX", "ROTY", "Z")),
+    "CIRC": (("X", "Y", "D", "NUM"), ("START", "Z")),
+    "PITCHCIRC": (("X", "Y", "D", "STEP", "NUM"), ("START", "Z")),
+}
+MAX_HOLES = 10_000  # holes of one pattern: beyond, the counts are a mistake, not a part
+Hole = tuple[float, float, float]  # X, Y and the workpiece surface the pattern gives it
+
+
+def pattern_holes(name: str, words: dict[str, float]) -> list[Hole]:
+    """The holes of one PATTERN DEF shape, in the order they are defined (a grid's row by row:
+    see `ncpp.motion.heidenhain` for what follows from the order the manual leaves open)."""
+    needed, optional = SHAPES[name]
+    missing = [w for w in needed if w not in words]
+    unknown = [w for w in words if w not in needed + optional]
+    if missing or unknown:
+        raise OutOfScope(f"PATTERN DEF {name} {'with ' + unknown[0] if unknown else 'without ' + missing[0]}")
+    w = {k: words.get(k, 0.0) for k in needed + optional}
+    surface = w["Z"]
+    if name == "POS":
+        return [(w["X"], w["Y"], surface)]
+    count = _count(name, w["NUMX"] * w["NUMY"] if name in ("PAT", "FRAME") else w["NUM"])
+    if name in ("CIRC", "PITCHCIRC"):
+        step = w["STEP"] if name == "PITCHCIRC" else 360.0 / count
+        radius = w["D"] / 2.0
+        angles = np.radians(w["START"] + step * np.arange(count))
+        xs, ys = w["X"] + radius * np.cos(angles), w["Y"] + radius * np.sin(angles)
+        return [(float(x), float(y), surface) for x, y in zip(xs, ys)]
+    if name == "ROW":
+        grid = np.stack([w["D"] * np.arange(count), np.zeros(count)], axis=1)
+    else:
+        if w["ROTX"] or w["ROTY"]:
+            raise OutOfScope(f"PATTERN DEF {name} with a distortion ROTX or ROTY")
+        columns, rows = int(w["NUMX"]), int(w["NUMY"])
+        i, j = np.meshgrid(np.arange(columns), np.arange(rows))
+        keep = (
+            np.ones_like(i, bool)
+            if name == "PAT"
+            else (i == 0) | (i == columns - 1) | (j == 0) | (j == rows - 1)
+        )
+        grid = np.stack([w["DX"] * i[keep], w["DY"] * j[keep]], axis=1)
+    turn = math.radians(w["ROT"])
+    rotation = np.array([[math.cos(turn), -math.sin(turn)], [math.sin(turn), math.cos(turn)]])
+    points = grid @ rotation.T + (w["X"], w["Y"])
+    return [(float(x), float(y), surface) for x, y in points]
+
+
+def _count(name: str, value: float) -> int:
+    if value != int(value) or not 1 <= value <= MAX_HOLES:
+        raise OutOfScope(f"PATTERN DEF {name} with {value:g} holes")
+    return int(value)

@@ -160,6 +160,9 @@ class HeidenhainBuilder(Transformer):
         words = str(children[0]).split()
         return (words[2].upper() if len(words) > 2 else None,)
 
+    def _pattern_def(children: list) -> tuple:  # type: ignore[misc]
+        return tuple(children[1:])
+
     def _fn(children: list) -> tuple:  # type: ignore[misc]
         number = int("".join(ch for ch in str(children[0]) if ch.isdigit()))
         return (number, str(children[1]).strip() if len(children) > 1 else "")
@@ -179,13 +182,39 @@ class HeidenhainBuilder(Transformer):
     call_program = _statement("call_program", lambda c: (str(c[1]).strip('"'),))
     cycle_def = _statement("cycle_def", _cycle_def)
     cycle_call = _statement("cycle_call", _cycle_call)
+    pattern_def = _statement("pattern_def", _pattern_def)
     fn = _statement("fn", _fn)
     keyword = _statement("keyword", lambda c: tuple(str(t).upper() for t in c))
     radius_comp = _statement("radius_comp", lambda c: (str(c[0]).upper(),))
     feed = _statement("feed", lambda c: (str(c[0]).upper(),))
     rotation = _statement("rotation", lambda c: (str(c[0])[-1],))
     retract = _statement("retract", lambda c: (_retract_distance(str(c[0])),))
-    del _statement, _text, _pgm, _blk, _tool_call, _call_label, _cycle_def, _cycle_call, _fn, _path
+    del (
+        _statement,
+        _text,
+        _pgm,
+        _blk,
+        _tool_call,
+        _call_label,
+        _cycle_def,
+        _cycle_call,
+        _pattern_def,
+        _fn,
+        _path,
+    )
+
+    def pattern_shape(self, children):
+        head, *words = children
+        name, number = _split_address(str(head))
+        shape = []
+        for token in words:
+            letter, value = _split_address(str(token))
+            if token.type == "QWORD":
+                param = ("param", value.lstrip("+-").lower())
+                shape.append((letter, ("neg", param) if value.startswith("-") else param))
+            else:
+                shape.append((letter, ("num", number_value(value))))
+        return (name, int(number_value(number)), tuple(shape))
 
     @v_args(meta=True)
     def assignment(self, meta, children):
