@@ -23,12 +23,17 @@ Q204 2nd set-up clearance count from the workpiece surface Q203):
   the set-up clearance, both at the feed the spindle speed and the thread pitch Q239 make
   (the TOOL CALL's S times |Q239|, the manual names no other for the retract); FMAX to the 2nd
   set-up clearance.  Without a spindle speed the feed is not known: out of scope.
+* 205 UNIVERSAL PECKING, in one infeed (the plunging depth Q202 0 or the depth or more, no chip
+  breaking Q257 within it, no deepened starting point Q379): FMAX to Q203+Q200; drill to Q201
+  at Q206; out to the set-up clearance at the retraction feed Q208 (0: at Q206); FMAX to the 2nd
+  set-up clearance.  More infeeds come back down to the advanced stop distances Q258/Q259,
+  which the control varies between the first and the last infeed itself: out of scope.
 
 Dwells (Q210, Q211) move nothing.  The manual's depth sign gives the direction: a depth of
 0 runs no cycle; a positive depth (the control refuses it unless a machine parameter allows
 it), a depth measured on the tool's diameter (Q395=1, Q343=1: they need the tool's point
-angle) and the other cycles (202 with its spindle orientation, 204, 205 with its advanced stop
-distances, 206, 208, 209, pockets, contours) are outside ncpp's scope (`OutOfScope`).
+angle) and the other cycles (202 with its spindle orientation, 204, 206, 208, 209, pockets,
+contours) are outside ncpp's scope (`OutOfScope`).
 """
 
 from __future__ import annotations
@@ -47,6 +52,7 @@ REQUIRED = {
     "203": ("q200", "q201", "q206", "q202", "q203", "q204"),
     "240": ("q200", "q201", "q206", "q203", "q204"),
     "207": ("q200", "q201", "q239", "q203", "q204"),
+    "205": ("q200", "q201", "q206", "q202", "q203", "q204"),
 }
 OPTIONAL = {
     "200": ("q210", "q211", "q395"),
@@ -54,6 +60,7 @@ OPTIONAL = {
     "203": ("q210", "q212", "q213", "q205", "q211", "q208", "q256", "q395"),
     "240": ("q343", "q344", "q211"),
     "207": ("q336",),
+    "205": ("q212", "q205", "q258", "q259", "q257", "q256", "q211", "q379", "q253", "q208", "q395"),
 }
 # Cycles a CYCL DEF makes active at once, which leave the called cycle as it is: dwell (9),
 # tolerance (32), preset (247), and the datum cycles (out of scope themselves)
@@ -113,6 +120,14 @@ def steps(cycle: Drilling, spindle: float = 0.0) -> list[Step]:
                              "its feed is not known")  # fmt: skip
         tapping = spindle * abs(cycle["q239"])
         run = [Step(clearance, True), Step(bottom, False, tapping), Step(clearance, False, tapping)]
+        return run + _second(cycle, clearance)
+    if cycle.number == "205":
+        if cycle["q379"]:
+            raise OutOfScope("CYCL DEF 205 with a deepened starting point Q379")
+        if len(_infeeds(cycle, depth)) > 1 or 0 < cycle["q257"] < -depth:
+            raise OutOfScope("CYCL DEF 205 in more than one infeed or with chip breaking Q257 (the control "
+                             "comes back down to advanced stop distances it works out itself)")  # fmt: skip
+        run = [Step(clearance, True), Step(bottom, False, plunge), Step(clearance, False, out)]
         return run + _second(cycle, clearance)
     if cycle.number in ("201", "240"):
         rapid_out = cycle.number == "240"

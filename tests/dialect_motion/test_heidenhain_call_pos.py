@@ -127,3 +127,36 @@ def test_the_command_line_compensates_and_verifies_cycl_call_pos_on_the_wide_mac
     assert holes == pytest.approx([90, -7.5, 90, -42.5], abs=0.01)  # the machine's corrections are µm
     assert holes != [90, -7.5, 90, -42.5]  # (and corrected)
     assert not moves(written)[-1].fixed
+
+
+UNIVERSAL_PECKING = """CYCL DEF 205 UNIVERSAL PECKING ~
+    Q200=+2 ;SET-UP CLEARANCE ~
+    Q201=-15 ;DEPTH ~
+    Q206=+150 ;FEED RATE FOR PLNGNG ~
+    Q202=+15 ;PLUNGING DEPTH ~
+    Q203=+1 ;SURFACE COORDINATE ~
+    Q204=+50 ;2ND SET-UP CLEARANCE ~
+    Q212=+0 ;DECREMENT ~
+    Q205=+0 ;MIN. PLUNGING DEPTH ~
+    Q258=+0.2 ;UPPER ADV STOP DIST ~
+    Q259=+0.2 ;LOWER ADV STOP DIST ~
+    Q257=+0 ;DEPTH FOR CHIP BRKNG ~
+    Q256=+0.2 ;DIST FOR CHIP BRKNG ~
+    Q211=+0 ;DWELL TIME AT DEPTH ~
+    Q379=+0 ;STARTING POINT ~
+    Q253=+750 ;F PRE-POSITIONING ~
+    Q208=+600 ;RETRACTION FEED RATE"""
+
+
+@pytest.mark.parametrize(
+    "change", [("Q202=+15 ", "Q202=+5 "), ("Q257=+0 ", "Q257=+4 "), ("Q379=+0 ", "Q379=+2 ")]
+)
+def test_universal_pecking_205_in_one_infeed_and_its_pecks_out_of_scope(change):
+    """Q203=1: FMAX to 3, to 1-15 = -14 at Q206=150, out to 3 at Q208=600, FMAX to 51.  More
+    infeeds, chip breaking within the infeed and a deepened start end interpretation."""
+    assert runs(moves(program(UNIVERSAL_PECKING, ["L FMAX M99"]))) == [
+        drilled(25, -7.5, [(3, None), (-14, 150.0), (3, 600.0), (51, None)])
+    ]
+    warned = io.StringIO()
+    assert runs(moves(program(UNIVERSAL_PECKING.replace(*change), ["L FMAX M99"]), warned)) == []
+    assert "CYCL DEF 205 " in warned.getvalue() and "passes through uninterpreted" in warned.getvalue()
