@@ -43,7 +43,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ncpp.motion.modal import OutOfScope
+from ncpp.motion.modal import MAX_HOLES, OutOfScope
 
 # The cycles followed and the Q parameters each needs (the others default to 0)
 REQUIRED = {
@@ -196,7 +196,6 @@ SHAPES = {
     "CIRC": (("X", "Y", "D", "NUM"), ("START", "Z")),
     "PITCHCIRC": (("X", "Y", "D", "STEP", "NUM"), ("START", "Z")),
 }
-MAX_HOLES = 10_000  # holes of one pattern: beyond, the counts are a mistake, not a part
 Hole = tuple[float, float, float]  # X, Y and the workpiece surface the pattern gives it
 
 
