@@ -360,7 +360,10 @@ class HeidenhainInterpreter(ModalInterpreter):
                 raise OutOfScope(f"{call[0]} with a path function, M91, M140 or RL/RR in its block", call[1])
             if at_pattern:
                 return self._call_pattern(block, words, rapid, call[1])
-            return self._call_at_position(block, words, rapid, call[1])
+            events = self._call_at_position(block, words, rapid, call[1])
+            if self.unknown_axes:  # (the move in the plane goes from where ncpp is not told)
+                self._from_unknown(events[:1], words)
+            return events
         if "F" in words and function is not None:
             self.feed = words["F"][0]
         if machine_datum and function is not None:
@@ -521,6 +524,8 @@ class HeidenhainInterpreter(ModalInterpreter):
                 event.fixed, event.placed = PATTERN, (True, True, True)
         if shape in ("PAT", "FRAME"):
             self.unknown_axes |= {0, 1}
+        else:  # (the last hole is where the tool stands)
+            self.unknown_axes -= {0, 1}
         return events
 
     def _tool_def(self, block: Block, statement) -> list[Event]:

@@ -114,19 +114,20 @@ WIDE = SHARED / "machines" / "wide.toml"
 
 @pytest.mark.skipif(not WIDE.exists(), reason="the shared machine files are not here")
 def test_the_command_line_compensates_and_verifies_cycl_call_pos_on_the_wide_machine(tmp_path):
-    source = tmp_path / "pos.h"
-    source.write_text(program(holes=POS, after=AFTER))
+    source = tmp_path / "pos.h"  # (the calls' F is for their own moves: the last line runs at F700)
+    third = "CYCL CALL POS X+40 Y-42.5 Z-2 F300"
+    source.write_text(program(holes=["L  X+26 F700", *POS, third], after=["L  Z+21 FMAX", "L  X+0 Y+100"]))
     out = tmp_path / "out.h"
     proc = subprocess.run([sys.executable, "-m", "ncpp", "compensate", "--machine", str(WIDE), str(source),
                            "-o", str(out)], capture_output=True, cwd=ROOT)  # fmt: skip
     assert proc.returncode == 0, proc.stderr.decode()
     assert "passes through" not in proc.stderr.decode()
     written = out.read_text()
-    assert written.count("CYCL CALL POS") == 2 and CYCLE_200 in written
+    assert written.count("CYCL CALL POS") == 3 and CYCLE_200 in written
     holes = [c for run in runs(moves(written)) for c in run[-1][:2]]
-    assert holes == pytest.approx([90, -7.5, 90, -42.5], abs=0.01)  # the machine's corrections are µm
-    assert holes != [90, -7.5, 90, -42.5]  # (and corrected)
-    assert not moves(written)[-1].fixed
+    assert holes == pytest.approx([90, -7.5, 90, -42.5, 40, -42.5], abs=0.01)  # the corrections are µm
+    assert holes != [90, -7.5, 90, -42.5, 40, -42.5]  # (and corrected)
+    assert not moves(written)[-1].fixed and moves(written)[-1].feed == 700.0
 
 
 UNIVERSAL_PECKING = """CYCL DEF 205 UNIVERSAL PECKING ~

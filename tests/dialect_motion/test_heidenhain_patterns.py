@@ -17,7 +17,7 @@ import sys
 
 import pytest
 
-from ncpp.motion.segments import MACHINE, PATTERN
+from ncpp.motion.segments import DRILLED, MACHINE, PATTERN
 from ncpp.summary import REASONS
 from tests.conftest import ROOT, SHARED
 from tests.dialect_motion.test_heidenhain_cycles import CYCLE_200, compensate, moves, program
@@ -146,3 +146,19 @@ def test_the_command_line_compensates_around_a_pattern_and_verifies_it_on_the_wi
         and across.end[:2] != (0.0, 100.0)
         and across.end[:2] == pytest.approx((0, 100), abs=0.01)
     )
+
+
+def test_a_row_after_a_grid_and_a_cycl_call_pos_put_x_and_y_where_the_holes_are_again():
+    """After a PAT the plane position is not known; a ROW's last hole (or a CYCL CALL POS, whose
+    move in the plane then starts from a place ncpp is not told: left as programmed) makes it
+    known, and the move after is compensated."""
+    grid = "PATTERN DEF ~\n   PAT1 (X+10 Y+10 DX+10 DY+5 NUMX3 NUMY2 ROT+0 ROTX+0 ROTY+0 Z+0)"
+    row = "PATTERN DEF ~\n   ROW1 (X+10 Y+5 D+8 NUM4 ROT+0 Z+0)"
+    for then in ([row, "CYCL CALL PAT FMAX"], ["CYCL CALL POS X+90 Y-7.5 Z+0 FMAX"]):
+        found = moves(program(CYCLE_200, [grid, "CYCL CALL PAT FMAX", *then], ["L  X+0 Y+100 F500"]))
+        assert not found[-1].fixed and found[-1].start[:2] == (
+            (34.0, 5.0) if then[0] == row else (90.0, -7.5)
+        )
+    position = moves(program(CYCLE_200, [grid, "CYCL CALL PAT FMAX", "CYCL CALL POS X+90 Y-7.5 Z+0 FMAX"]))
+    plane = next(m for m in position if m.end[:2] == (90.0, -7.5) and m.fixed != DRILLED)
+    assert plane.fixed == MACHINE and not position[-1].fixed

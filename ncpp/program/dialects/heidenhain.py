@@ -356,7 +356,9 @@ class HeidenhainWriter(IsoWriter):
         # a corner piece follows the line before it: that line's output ends at the corner
         # itself (RND/CHF verbatim) or, edited, at the tangent point (the piece written out)
         corner = function in ("RND", "CHF")
-        feed = self._restored_feed(block, motion) if motion and not corner else ""
+        # (a CYCL CALL POS's F is for its own move: the next move still gets the program's back)
+        restores = motion and not corner and _position_call(block) is None
+        feed = self._restored_feed(block, motion) if restores else ""
         if (not corner and not any(e.changed for e in motion)) or (corner and not (motion and edited_before)):
             # a subprogram or loop a call or jump line runs uses the pole as the program has it there
             calls = function is None and any(m.fixed == FLOW for m in motion)
