@@ -360,10 +360,10 @@ class HeidenhainInterpreter(ModalInterpreter):
                 raise OutOfScope(f"{call[0]} with a path function, M91, M140 or RL/RR in its block", call[1])
             if at_pattern:
                 return self._call_pattern(block, words, rapid, call[1])
-            events = self._call_at_position(block, words, rapid, call[1])
+            positioned = self._call_at_position(block, words, rapid, call[1])
             if self.unknown_axes:  # (the move in the plane goes from where ncpp is not told)
-                self._from_unknown(events[:1], words)
-            return events
+                self._from_unknown(positioned[:1], words)
+            return positioned
         if "F" in words and function is not None:
             self.feed = words["F"][0]
         if machine_datum and function is not None:
