@@ -1,4 +1,5 @@
-"""Klartext drilling cycles: the moves the control makes in the tool axis when one is called.
+"""Klartext drilling cycles: the moves the control makes in the tool axis when one is called,
+and the holes of a `PATTERN DEF` it calls them at (`pattern_holes`).
 
 A `CYCL DEF` only defines a cycle; `M99` at the end of a block (after its move) or `CYCL CALL`
 runs it where the tool stands.  Its Q parameters are the Q assignments of the `CYCL DEF`
