@@ -178,10 +178,6 @@ def _second(cycle: Drilling, clearance: float) -> list[Step]:
     return [Step(second, True)] if second > clearance else []
 
 
-__all__ = ["DEFINITION_ACTIVE", "Drilling", "Hole", "Step", "cycle_number", "parameters_needed", "pattern_holes",
-           "steps"]  # fmt: skip
-
-
 # -- hole patterns (PATTERN DEF) -------------------------------------------------------------------
 # Each shape's words (TNC 640 cycle programming manual, "Pattern definition PATTERN DEF"): those
 # it needs, then those it may leave out (0).  POS: a position; ROW: start X Y, spacing D, count
@@ -212,7 +208,9 @@ def pattern_holes(name: str, words: dict[str, float]) -> list[Hole]:
     surface = w["Z"]
     if name == "POS":
         return [(w["X"], w["Y"], surface)]
-    count = _count(name, w["NUMX"] * w["NUMY"] if name in ("PAT", "FRAME") else w["NUM"])
+    grid_of = name in ("PAT", "FRAME")
+    columns, rows = (_count(name, w["NUMX"]), _count(name, w["NUMY"])) if grid_of else (0, 0)
+    count = _count(name, columns * rows if grid_of else w["NUM"])
     if name in ("CIRC", "PITCHCIRC"):
         step = w["STEP"] if name == "PITCHCIRC" else 360.0 / count
         radius = w["D"] / 2.0
@@ -224,7 +222,6 @@ def pattern_holes(name: str, words: dict[str, float]) -> list[Hole]:
     else:
         if w["ROTX"] or w["ROTY"]:
             raise OutOfScope(f"PATTERN DEF {name} with a distortion ROTX or ROTY")
-        columns, rows = int(w["NUMX"]), int(w["NUMY"])
         i, j = np.meshgrid(np.arange(columns), np.arange(rows))
         keep = (
             np.ones_like(i, bool)
@@ -239,6 +236,10 @@ def pattern_holes(name: str, words: dict[str, float]) -> list[Hole]:
 
 
 def _count(name: str, value: float) -> int:
-    if value != int(value) or not 1 <= value <= MAX_HOLES:
+    if not 1 <= value <= MAX_HOLES or value != int(value):
         raise OutOfScope(f"PATTERN DEF {name} with {value:g} holes")
     return int(value)
+
+
+__all__ = ["DEFINITION_ACTIVE", "SHAPES", "Drilling", "Hole", "Step", "cycle_number", "parameters_needed",
+           "pattern_holes", "steps"]  # fmt: skip

@@ -100,6 +100,11 @@ def test_a_grid_and_its_frame_drill_their_holes_and_leave_x_and_y_unknown():
             "holes at different surfaces Z",
         ),
         ("CIRC1 (X+0 Y+0 D10 NUM2.5 Z+0)", "CYCL CALL PAT FMAX", "PATTERN DEF CIRC with 2.5 holes"),
+        (
+            "PAT1 (X+0 Y+0 DX+5 DY+5 NUMX2.5 NUMY2 Z+0)",
+            "CYCL CALL PAT FMAX",
+            "PATTERN DEF PAT with 2.5 holes",
+        ),
         ("CIRC1 (X+0 Y+0 D10 NUM4 Z+0)", "CYCL CALL PAT", "CYCL CALL PAT without F or FMAX"),
         ("CIRC1 (X+0 Y+0 D10 NUM4 Z+20)", "CYCL CALL PAT FMAX", "from below the 2nd set-up clearance 31"),
     ],
