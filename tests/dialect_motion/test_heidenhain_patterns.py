@@ -167,3 +167,20 @@ def test_a_row_after_a_grid_and_a_cycl_call_pos_put_x_and_y_where_the_holes_are_
     position = moves(program(CYCLE_200, [grid, "CYCL CALL PAT FMAX", "CYCL CALL POS X+90 Y-7.5 Z+0 FMAX"]))
     plane = next(m for m in position if m.end[:2] == (90.0, -7.5) and m.fixed != DRILLED)
     assert plane.fixed == MACHINE and not position[-1].fixed
+
+
+def test_ncpp_motion_prints_a_circles_holes_at_their_angles(tmp_path):
+    """`ncpp motion` (rs274's canonical calls): each STRAIGHT_FEED is a hole's bottom, at Z-6."""
+    source = tmp_path / "circle.h"
+    source.write_text(patterned("CIRC1 (X+50 Y+20 D40 START+30 NUM6 Z+0)"))
+    proc = subprocess.run(
+        [sys.executable, "-m", "ncpp", "motion", str(source)], capture_output=True, cwd=ROOT
+    )
+    feeds = [line for line in proc.stdout.decode().splitlines() if line.startswith("STRAIGHT_FEED")]
+    bottoms = [
+        tuple(float(v) for v in line[len("STRAIGHT_FEED(") : -1].split(", ")[:3]) for line in feeds[:-2]
+    ]
+    angles = [math.radians(30 + 60 * k) for k in range(6)]
+    expected = [(50 + 20 * math.cos(a), 20 + 20 * math.sin(a), -6.0) for a in angles]
+    assert proc.returncode == 0 and len(bottoms) == 6
+    assert all(math.dist(b, e) < 1e-4 for b, e in zip(bottoms, expected))  # (printed to 4 places)

@@ -175,3 +175,18 @@ def test_the_command_line_compensates_around_holes1_and_holes2_on_the_wide_machi
     assert len(holes(events)) == 10 and holes(events) == holes(_events(source.read_text())[0])
     last = [e for e in events if type(e) is Line][-1]
     assert not last.fixed and last.end[:2] != (0.0, 0.0) and last.end[:2] == pytest.approx((0, 0), abs=0.01)
+
+
+def test_ncpp_motion_prints_a_circle_of_holes_at_their_angles(tmp_path):
+    """`ncpp motion` (rs274's canonical calls): each STRAIGHT_FEED is a hole's bottom, at Z-4."""
+    source = tmp_path / "circle.mpf"
+    source.write_text(HEAD + "MCALL CYCLE81(10, 0, 2, -4)\nHOLES2(50, 20, 20, 30, 0, 6)\nMCALL\nM30\n")
+    proc = subprocess.run(
+        [sys.executable, "-m", "ncpp", "motion", str(source)], capture_output=True, cwd=ROOT
+    )
+    feeds = [line for line in proc.stdout.decode().splitlines() if line.startswith("STRAIGHT_FEED")]
+    bottoms = [tuple(float(v) for v in line[len("STRAIGHT_FEED(") : -1].split(", ")[:3]) for line in feeds]
+    angles = [math.radians(30 + 60 * k) for k in range(6)]
+    expected = [(50 + 20 * math.cos(a), 20 + 20 * math.sin(a), -4.0) for a in angles]
+    assert proc.returncode == 0 and len(bottoms) == 6
+    assert all(math.dist(b, e) < 1e-4 for b, e in zip(bottoms, expected))  # (printed to 4 places)
