@@ -23,7 +23,7 @@ from ncpp import __version__
 from ncpp.errors import Location, NcppError, Warnings
 from ncpp.guard import Placement, with_guard, without_guard
 from ncpp.motion.offsets import AT_MACHINE_ZERO, WorkOffsets
-from ncpp.motion.segments import COMP, CYCLE, DRILLED, FLOW, HOLE, Arc, Event, Line, Pass
+from ncpp.motion.segments import COMP, CYCLE, DRILLED, FLOW, HOLE, PATTERN, Arc, Event, Line, Pass
 from ncpp.passes import PASSES, PassContext, run_passes
 from ncpp.passes.context import ErrorMap, is_directional
 from ncpp.passes.inverse import iterations_for
@@ -167,6 +167,9 @@ UNCOMPENSATED = {
     "each move compensated)",
     DRILLED: "drilling cycle: it drills where the move before it leaves the tool (X and Y compensated), its moves "
     "along the tool axis as programmed (the depth with the machine's error); compensation resumes with the next move",
+    PATTERN: "hole pattern: the control places its holes and moves between them itself, from one block that "
+    "cannot carry a correction for each: its holes and moves pass through uncompensated, where the pattern puts "
+    "them; compensation resumes with the next move",
     COMP: "cutter compensation: its moves pass through uncompensated (the control offsets them by the tool radius, "
     "so the tool is not where their points are; ncpp follows it in ISO programs in G17 and G18 only, with no lathe "
     "tool orientation, outside loops, subroutines and Fanuc corners); compensation resumes after the first move "

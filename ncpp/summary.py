@@ -15,12 +15,26 @@ from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
 
 from ncpp.errors import Location
-from ncpp.motion.segments import COMP, CYCLE, DRILLED, FLOW, HOLE, HOME, MACHINE, PLANE_AXES, Arc, Event, Line
+from ncpp.motion.segments import (
+    COMP,
+    CYCLE,
+    DRILLED,
+    FLOW,
+    HOLE,
+    HOME,
+    MACHINE,
+    PATTERN,
+    PLANE_AXES,
+    Arc,
+    Event,
+    Line,
+)
 
 # Why moves are left as programmed, as the summary names it
 REASONS = {
     CYCLE: "canned cycle",
     DRILLED: "drilling cycle (along the tool axis)",
+    PATTERN: "hole pattern",
     FLOW: "loop or subroutine",
     COMP: "cutter compensation",
     HOME: "G28/G30 return",

@@ -236,7 +236,9 @@ def actions_of(block: Block) -> tuple[list[str], list[str]]:
                 text = f"{letter}{value:g}" if value is not None else f"{letter}{block.source(item).upper()}"
                 (after if letter == "M" and value in AFTER_MOTION else before).append(text)
         elif kind is Statement and item.kind in ACTION_STATEMENTS:  # type: ignore[union-attr]
-            before.append("".join(block.source(item).upper().split()))
+            # (`CYCL CALL POS` runs its cycle where its own move ends, as M99 does)
+            at_end = item.kind == "cycle_call" and item.node[0] == "POS"  # type: ignore[union-attr]
+            (after if at_end else before).append("".join(block.source(item).upper().split()))
     if dwell:  # the dwell's time: P (ISO), F or S (Sinumerik); X would be an axis of the block's move
         before.extend(f"{w.letter.upper()}{w.value:g}" for w in block.words() if w.letter.upper() in "PFS")
     return before, after

@@ -120,6 +120,12 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_simulate_plot_draws_the_contour_error_along_the_path_and_a_map_coloured_by_it",
         ),
         "dialects/test_written_apart.py": ("test_as_round_says",),
+        "dialect_motion/test_heidenhain_patterns.py": (
+            "test_the_command_line_compensates_around_a_pattern_and_verifies_it_on_the_wide_machine",
+        ),
+        "dialect_motion/test_sinumerik_patterns.py": (
+            "test_the_command_line_compensates_around_holes1_and_holes2_on_the_wide_machine",
+        ),
         "passes/test_compensate_cli.py": (
             "test_an_arc_of_more_turns_than_compensation_holds_is_refused_with_its_line",
             "test_simulate_refuses_motion_outside_the_travel_and_paths_past_its_sample_budget",

@@ -9,9 +9,10 @@ half circle), `CT` (tangential arc), `LP`/`CP` polar with PR/IPR/PA/IPA (a
 helix with IZ, several turns with |IPA| > 360), Q parameters with arithmetic,
 labels, subprograms (`CALL LBL n` ... `LBL 0`), program-section repeats (`CALL LBL n REP k`)
 and the jumps FN 9-12 (`heidenhain_flow`: a block that runs again is left as programmed,
-FLOW), `CYCL DEF` of machining cycles (they only define), the drilling cycles 200, 201, 203
-and 240 called by M99 or `CYCL CALL` (`heidenhain_cycles`: their moves along the tool axis are
-left as programmed, DRILLED), M2/M30
+FLOW), `CYCL DEF` of machining cycles (they only define), the drilling cycles 200, 201, 203,
+207 and 240 called by M99, `CYCL CALL` or `CYCL CALL POS` (`heidenhain_cycles`: their moves
+along the tool axis are left as programmed, DRILLED) or `CYCL CALL PAT` at the holes of a
+`PATTERN DEF` (all its moves left as programmed, PATTERN), M2/M30
 and `END PGM` (end), and `RND R..` / `CHF ..` between two feed lines in the
 working plane (the fillet arc or chamfer line is the RND/CHF block's event; a
 feed line waits for the next move to know whether its corner is cut).
@@ -19,7 +20,7 @@ Radius compensation RL/RR is followed to R0: the moves from the first with RL/RR
 to the R0 block's are the programmed contour, the tool centre off it by the radius,
 and are marked `fixed` (`ModalInterpreter.radius_compensation`).  Paraxial R+/R-,
 RND/CHF next to an arc or a rapid, FK free contours,
-APPR/DEP, `CALL PGM`, calls of other cycles, `CYCL CALL POS`/`PAT`, M89, FN 14 and later FN
+APPR/DEP, `CALL PGM`, calls of other cycles, point tables, M89, FN 14 and later FN
 functions and cycles that move the datum make the position unknown: one warning (an error with
 `strict`) and the rest passes through.
 
@@ -40,9 +41,13 @@ from ncpp.motion.corners import CornerError, round_corner
 from ncpp.motion.heidenhain_cycles import (
     DEFINITION_ACTIVE,
     REQUIRED,
+    SHAPES,
     Drilling,
+    Hole,
+    Step,
     cycle_number,
     parameters_needed,
+    pattern_holes,
 )
 from ncpp.motion.heidenhain_cycles import steps as cycle_steps
 from ncpp.motion.heidenhain_flow import FIXED, JUMPS, SKIP, TEXT, KlartextFlow, jump_parts, label_key
@@ -54,7 +59,7 @@ from ncpp.motion.modal import (
     as_point,
     placed_interpreting,
 )
-from ncpp.motion.segments import COMP, FLOW, MACHINE, PLANE_AXES, Arc, Event, Line, Pass, Point
+from ncpp.motion.segments import COMP, FLOW, MACHINE, PATTERN, PLANE_AXES, Arc, Event, Line, Pass, Point
 from ncpp.motion.tools import ToolTable, UntoldLengths
 from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
 
@@ -165,6 +170,8 @@ class HeidenhainInterpreter(ModalInterpreter):
         self.ended = False  # the program ended (M2, M30, END PGM), not left the scope
         self.flow: KlartextFlow | None = None  # the order the blocks run in (labels, calls, jumps)
         self.cycle: Drilling | str | None = None  # the cycle M99 / CYCL CALL runs (str: one not followed)
+        self.spindle = 0.0  # the speed TOOL CALL S set (rev/min): a tapping cycle's feed follows it
+        self.pattern: tuple[str, list[Hole]] | str | None = None  # PATTERN DEF's holes (str: not followed)
 
     def run(self, blocks: Iterable[Block], warnings: Warnings) -> Iterator[Event]:
         """Events as `ModalInterpreter.run`; a feed line waits (with the events after it)
@@ -243,6 +250,8 @@ class HeidenhainInterpreter(ModalInterpreter):
         machine_datum = False  # M91: the block's coordinates are the machine datum's
         retract: float | str | None = None  # M140 MB: a retract along the tool axis after the move
         call: tuple[str, int] | None = None  # M99 or CYCL CALL and its column: the cycle runs after the move
+        at_position = False  # CYCL CALL POS: the block's X Y Z are where the cycle runs
+        at_pattern = False  # CYCL CALL PAT: the cycle runs at the holes of the PATTERN DEF
         defined: str | None = None  # CYCL DEF of a drilling cycle: its number
         for item in block.items:
             if type(item) is Comment:
@@ -257,7 +266,8 @@ class HeidenhainInterpreter(ModalInterpreter):
                         call = ("M99", item.start + 1)
                         continue
                     if value == 89.0:  # (whether it calls after every block is a machine parameter)
-                        raise OutOfScope("the cycle call M89", item.start + 1)
+                        raise OutOfScope("M89 (a modal cycle call or a free M function: the machine "
+                                         "tool builder decides)", item.start + 1)  # fmt: skip
                     if value == 128.0:
                         raise OutOfScope("M128 (tool-centre-point control)", item.start + 1)
                     if value == 92.0:  # (its datum is a machine parameter ncpp is not told)
@@ -311,8 +321,12 @@ class HeidenhainInterpreter(ModalInterpreter):
                     self._forget_assigned(block)
                     return []
                 defined = number  # (its Q parameters follow as assignments)
-            elif what == "cycle_call" and node[0] is None:
-                call = ("CYCL CALL", item.start + 1)
+            elif what == "cycle_call":
+                call = ("CYCL CALL" if node[0] is None else f"CYCL CALL {node[0]}", item.start + 1)
+                at_position, at_pattern = node[0] == "POS", node[0] == "PAT"
+            elif what == "pattern_def":
+                self.pattern = self._pattern(block, item)
+                return []
             elif (
                 what == "keyword"
                 and node
@@ -341,6 +355,15 @@ class HeidenhainInterpreter(ModalInterpreter):
             return []
         if function in ("RND", "CHF"):
             return [self._corner(block, function_item, words)]
+        if (at_position or at_pattern) and call is not None:
+            if function is not None or machine_datum or retract is not None or comp not in (None, "R0"):
+                raise OutOfScope(f"{call[0]} with a path function, M91, M140 or RL/RR in its block", call[1])
+            if at_pattern:
+                return self._call_pattern(block, words, rapid, call[1])
+            positioned = self._call_at_position(block, words, rapid, call[1])
+            if self.unknown_axes:  # (the move in the plane goes from where ncpp is not told)
+                self._from_unknown(positioned[:1], words)
+            return positioned
         if "F" in words and function is not None:
             self.feed = words["F"][0]
         if machine_datum and function is not None:
@@ -382,6 +405,16 @@ class HeidenhainInterpreter(ModalInterpreter):
         """M99 (after the block's move) or CYCL CALL: the drilling cycle's moves where the tool
         stands, in the tool axis.  Left as programmed (DRILLED): the control runs them from
         where it stands, which is the compensated end of the positioning before."""
+        run = self._cycle_run(how, col)
+        here = self.pos[self.tool_axis]  # (a step to where the tool stands is none: the cycle starts there)
+        steps = [
+            (s.level, None if s.rapid else s.feed, 0.0) for s in run if s.level != here or s is not run[0]
+        ]
+        return self.drilled(block, steps, self.tool_axis)
+
+    def _cycle_run(self, how: str, col: int, shift: float = 0.0) -> list[Step]:
+        """The steps of one run of the cycle defined (its levels `shift`ed along the tool axis),
+        or out of scope where ncpp cannot call it here."""
         cycle = self.cycle
         if not isinstance(cycle, Drilling):
             raise OutOfScope(f"the cycle call {how} ({cycle or 'no cycle defined'})", col)
@@ -395,15 +428,105 @@ class HeidenhainInterpreter(ModalInterpreter):
         if changed:
             raise OutOfScope(f"the cycle call {how}: {changed[0]} changed since CYCL DEF {cycle.number}", col)
         try:
-            run = cycle_steps(cycle)
+            run = cycle_steps(cycle, self.spindle)
         except OutOfScope as out:
             out.col = col
             raise
-        here = self.pos[self.tool_axis]  # (a step to where the tool stands is none: the cycle starts there)
-        steps = [
-            (s.level, None if s.rapid else s.feed, 0.0) for s in run if s.level != here or s is not run[0]
-        ]
-        return self.drilled(block, steps, self.tool_axis)
+        return [Step(s.level + shift, s.rapid, s.feed) for s in run]
+
+    def _call_at_position(self, block: Block, words: dict, rapid: bool, col: int) -> list[Event]:
+        """`CYCL CALL POS X.. Y.. Z.. FMAX|F..`: the cycle runs at the block's position.  TNC 640
+        Klartext manual, "Calling a cycle with CYCL CALL POS": all three axes are programmed; from
+        above the workpiece surface Q203 the control moves first in the working plane, then in
+        the tool axis (below it, first to a clearance height: out of scope); the tool-axis
+        coordinate is an additional datum shift of the cycle; the feed is for this approach only;
+        the move is without radius compensation.  The move in the plane positions the tool
+        (compensated, the block's X and Y); the one in the tool axis and the cycle's are left as
+        programmed (DRILLED), as the block's Z stays what the cycle's levels count from."""
+        if any(axis not in words for axis in AXES):
+            raise OutOfScope("CYCL CALL POS without absolute X, Y and Z (the control needs all three)", col)
+        if not rapid and "F" not in words:
+            raise OutOfScope("CYCL CALL POS without F or FMAX (its feed is the last CYCL CALL POS's)", col)
+        shift = words[AXES[self.tool_axis]][0]
+        run = self._cycle_run("CYCL CALL POS", col, shift)
+        assert isinstance(self.cycle, Drilling)  # (`_cycle_run` checked it)
+        surface = self.cycle["q203"] + shift
+        if not self.pos[self.tool_axis] > surface:
+            raise OutOfScope(f"CYCL CALL POS from below the workpiece surface Q203 ({surface:g} with the "
+                             "call's datum shift): the control goes to a clearance height first", col)  # fmt: skip
+        programmed, approach = self.feed, None if rapid else words["F"][0]
+        self.feed = programmed if approach is None else approach
+        end = list(self.pos)
+        for n, axis in enumerate(AXES):
+            if n != self.tool_axis:
+                end[n] = words[axis][0]
+        plane = self.line(block, end, rapid)
+        self.feed = programmed
+        steps = [(shift, approach, 0.0)] if shift != self.pos[self.tool_axis] else []
+        steps += [(s.level, None if s.rapid else s.feed, 0.0) for s in run]
+        return [plane, *self.drilled(block, steps, self.tool_axis)]
+
+    def _pattern(self, block: Block, item) -> tuple[str, list[Hole]] | str:
+        """`PATTERN DEF`: its holes (`heidenhain_cycles.pattern_holes`) and the last shape's name,
+        or why ncpp does not follow them (a `CYCL CALL PAT` then leaves the scope)."""
+        holes: list[Hole] = []
+        try:
+            for name, _, words in item.node:
+                values = {letter: self.value(expr, block, item) for letter, expr in words}
+                if name not in SHAPES or len(values) != len(words):
+                    return f"PATTERN DEF {name}{' with a word twice' if name in SHAPES else ''}"
+                holes += pattern_holes(name, values)
+        except OutOfScope as out:
+            return out.reason
+        return (item.node[-1][0] if item.node else "", holes) if holes else "PATTERN DEF without a hole"
+
+    def _call_pattern(self, block: Block, words: dict, rapid: bool, col: int) -> list[Event]:
+        """`CYCL CALL PAT FMAX|F..`: the cycle runs at each hole of the PATTERN DEF, the tool
+        moving between them at the 2nd set-up clearance (TNC 640 cycle programming manual,
+        "Pattern definition PATTERN DEF" and "Calling a cycle with CYCL CALL PAT"; each
+        shape's Z is added to Q203).  The control computes the holes and its own moves
+        between them, which a rewritten program could not correct: all the call's moves
+        are left as programmed (PATTERN) and the holes are where the pattern puts them;
+        compensation resumes after the call.  Only from above the 2nd set-up clearance and
+        with one surface for all holes (the moves between two surfaces are the control's);
+        after a PAT or FRAME grid, whose order the manual does not give, X and Y are not
+        known until a block names them."""
+        pattern = self.pattern
+        if not isinstance(pattern, tuple):
+            raise OutOfScope(f"the cycle call CYCL CALL PAT ({pattern or 'no PATTERN DEF'})", col)
+        if not rapid and "F" not in words:
+            raise OutOfScope("CYCL CALL PAT without F or FMAX (its feed between the holes)", col)
+        shape, holes = pattern
+        if len({z for _, _, z in holes}) > 1:
+            raise OutOfScope("CYCL CALL PAT with holes at different surfaces Z", col)
+        surface = holes[0][2]
+        run = self._cycle_run("CYCL CALL PAT", col, surface)
+        assert isinstance(self.cycle, Drilling)  # (`_cycle_run` checked it)
+        top = surface + self.cycle["q203"] + max(self.cycle["q200"], self.cycle["q204"])
+        if self.pos[self.tool_axis] < top:
+            raise OutOfScope(f"CYCL CALL PAT from below the 2nd set-up clearance {top:g} (the control's "
+                             "move up to it is not followed)", col)  # fmt: skip
+        programmed, approach = self.feed, None if rapid else words["F"][0]
+        events: list[Event] = []
+        for x, y, _ in holes:
+            end = list(self.pos)
+            end[0], end[1] = x, y
+            self.feed = programmed if approach is None else approach
+            events.append(self.line(block, end, rapid))
+            self.feed = programmed
+            here = self.pos[self.tool_axis]
+            steps = [
+                (s.level, None if s.rapid else s.feed, 0.0) for s in run if s.level != here or s is not run[0]
+            ]
+            events += self.drilled(block, steps, self.tool_axis)
+        for event in events:
+            if type(event) is Line:
+                event.fixed, event.placed = PATTERN, (True, True, True)
+        if shape in ("PAT", "FRAME"):
+            self.unknown_axes |= {0, 1}
+        else:  # (the last hole is where the tool stands)
+            self.unknown_axes -= {0, 1}
+        return events
 
     def _tool_def(self, block: Block, statement) -> list[Event]:
         """`TOOL DEF n L.. R..`: the program defines tool n's length (without L: it only prepares the tool)."""
@@ -420,6 +543,8 @@ class HeidenhainInterpreter(ModalInterpreter):
         for item in block.items:
             if type(item) is Word and item.letter == "F":
                 self.auto_feed = item.value
+            elif (type(item) is Word or type(item) is ExprWord) and item.letter == "S":
+                self.spindle = self._word_value(item, block)
             elif (type(item) is Word or type(item) is ExprWord) and item.letter == "DL":
                 dl = self._word_value(item, block)
         called = statement.node[0]

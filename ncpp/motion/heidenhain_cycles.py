@@ -1,4 +1,5 @@
-"""Klartext drilling cycles: the moves the control makes in the tool axis when one is called.
+"""Klartext drilling cycles: the moves the control makes in the tool axis when one is called,
+and the holes of a `PATTERN DEF` it calls them at (`pattern_holes`).
 
 A `CYCL DEF` only defines a cycle; `M99` at the end of a block (after its move) or `CYCL CALL`
 runs it where the tool stands.  Its Q parameters are the Q assignments of the `CYCL DEF`
@@ -19,19 +20,31 @@ Q204 2nd set-up clearance count from the workpiece surface Q203):
   no other feed for them), in again at FMAX to the set-up clearance above the depth reached.
 * 240 CENTERING: FMAX to Q203+Q200; centre to the depth Q201 (Q343=0) at Q206; FMAX to the
   set-up clearance, then to the 2nd set-up clearance.
+* 207 RIGID TAPPING: FMAX to Q203+Q200; tap to Q201 in one move, the spindle reversed back to
+  the set-up clearance, both at the feed the spindle speed and the thread pitch Q239 make
+  (the TOOL CALL's S times |Q239|, the manual names no other for the retract); FMAX to the 2nd
+  set-up clearance.  Without a spindle speed the feed is not known: out of scope.
+* 205 UNIVERSAL PECKING, in one infeed (the plunging depth Q202 0 or the depth or more, no chip
+  breaking Q257 within it, no deepened starting point Q379): FMAX to Q203+Q200; drill to Q201
+  at Q206; out to the set-up clearance at the retraction feed Q208 (0: at Q206); FMAX to the 2nd
+  set-up clearance.  More infeeds come back down to the advanced stop distances Q258/Q259,
+  which the control varies between the first and the last infeed itself: out of scope.
 
 Dwells (Q210, Q211) move nothing.  The manual's depth sign gives the direction: a depth of
 0 runs no cycle; a positive depth (the control refuses it unless a machine parameter allows
 it), a depth measured on the tool's diameter (Q395=1, Q343=1: they need the tool's point
-angle) and the other cycles (202 with its spindle orientation, 204, 205, 208, tapping,
-pockets, contours) are outside ncpp's scope (`OutOfScope`).
+angle) and the other cycles (202 with its spindle orientation, 204, 206, 208, 209, pockets,
+contours) are outside ncpp's scope (`OutOfScope`).
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
-from ncpp.motion.modal import OutOfScope
+import numpy as np
+
+from ncpp.motion.modal import MAX_HOLES, OutOfScope
 
 # The cycles followed and the Q parameters each needs (the others default to 0)
 REQUIRED = {
@@ -39,12 +52,16 @@ REQUIRED = {
     "201": ("q200", "q201", "q206", "q203", "q204"),
     "203": ("q200", "q201", "q206", "q202", "q203", "q204"),
     "240": ("q200", "q201", "q206", "q203", "q204"),
+    "207": ("q200", "q201", "q239", "q203", "q204"),
+    "205": ("q200", "q201", "q206", "q202", "q203", "q204"),
 }
 OPTIONAL = {
     "200": ("q210", "q211", "q395"),
     "201": ("q211", "q208"),
     "203": ("q210", "q212", "q213", "q205", "q211", "q208", "q256", "q395"),
     "240": ("q343", "q344", "q211"),
+    "207": ("q336",),
+    "205": ("q212", "q205", "q258", "q259", "q257", "q256", "q211", "q379", "q253", "q208", "q395"),
 }
 # Cycles a CYCL DEF makes active at once, which leave the called cycle as it is: dwell (9),
 # tolerance (32), preset (247), and the datum cycles (out of scope themselves)
@@ -82,8 +99,9 @@ def parameters_needed(number: str) -> tuple[str, ...]:
     return REQUIRED[number] + OPTIONAL[number]
 
 
-def steps(cycle: Drilling) -> list[Step]:
-    """The moves of one run of `cycle`, from the level the tool stands at (see the module docstring)."""
+def steps(cycle: Drilling, spindle: float = 0.0) -> list[Step]:
+    """The moves of one run of `cycle`, from the level the tool stands at, the spindle turning at
+    `spindle` (rev/min; see the module docstring)."""
     depth = cycle["q201"]
     if depth == 0:
         return []  # (the manual: with DEPTH = 0 the control does not run the cycle)
@@ -97,6 +115,21 @@ def steps(cycle: Drilling) -> list[Step]:
     clearance = surface + cycle["q200"]
     bottom = surface + depth
     plunge, out = cycle["q206"], cycle["q208"] or cycle["q206"]
+    if cycle.number == "207":
+        if not spindle > 0 or not cycle["q239"]:
+            raise OutOfScope("CYCL DEF 207 without a spindle speed (TOOL CALL S) or a thread pitch Q239: "
+                             "its feed is not known")  # fmt: skip
+        tapping = spindle * abs(cycle["q239"])
+        run = [Step(clearance, True), Step(bottom, False, tapping), Step(clearance, False, tapping)]
+        return run + _second(cycle, clearance)
+    if cycle.number == "205":
+        if cycle["q379"]:
+            raise OutOfScope("CYCL DEF 205 with a deepened starting point Q379")
+        if len(_infeeds(cycle, depth)) > 1 or 0 < cycle["q257"] < -depth:
+            raise OutOfScope("CYCL DEF 205 in more than one infeed or with chip breaking Q257 (the control "
+                             "comes back down to advanced stop distances it works out itself)")  # fmt: skip
+        run = [Step(clearance, True), Step(bottom, False, plunge), Step(clearance, False, out)]
+        return run + _second(cycle, clearance)
     if cycle.number in ("201", "240"):
         rapid_out = cycle.number == "240"
         run = [Step(clearance, True), Step(bottom, False, plunge)]
@@ -145,4 +178,68 @@ def _second(cycle: Drilling, clearance: float) -> list[Step]:
     return [Step(second, True)] if second > clearance else []
 
 
-__all__ = ["DEFINITION_ACTIVE", "Drilling", "Step", "cycle_number", "parameters_needed", "steps"]
+# -- hole patterns (PATTERN DEF) -------------------------------------------------------------------
+# Each shape's words (TNC 640 cycle programming manual, "Pattern definition PATTERN DEF"): those
+# it needs, then those it may leave out (0).  POS: a position; ROW: start X Y, spacing D, count
+# NUM, rotation ROT about the start; PAT/FRAME: start X Y, spacings DX DY, counts NUMX NUMY,
+# rotation ROT, distortions ROTX ROTY; CIRC: centre X Y, diameter D, starting angle START,
+# count NUM; PITCHCIRC: as CIRC with the stepping angle STEP.  Z, in every shape, is the
+# workpiece surface, added to the cycle's Q203.
+SHAPES = {
+    "POS": (("X", "Y"), ("Z",)),
+    "ROW": (("X", "Y", "D", "NUM"), ("ROT", "Z")),
+    "PAT": (("X", "Y", "DX", "DY", "NUMX", "NUMY"), ("ROT", "ROTX", "ROTY", "Z")),
+    "FRAME": (("X", "Y", "DX", "DY", "NUMX", "NUMY"), ("ROT", "ROTX", "ROTY", "Z")),
+    "CIRC": (("X", "Y", "D", "NUM"), ("START", "Z")),
+    "PITCHCIRC": (("X", "Y", "D", "STEP", "NUM"), ("START", "Z")),
+}
+Hole = tuple[float, float, float]  # X, Y and the workpiece surface the pattern gives it
+
+
+def pattern_holes(name: str, words: dict[str, float]) -> list[Hole]:
+    """The holes of one PATTERN DEF shape, in the order they are defined (a grid's row by row:
+    see `ncpp.motion.heidenhain` for what follows from the order the manual leaves open)."""
+    needed, optional = SHAPES[name]
+    missing = [w for w in needed if w not in words]
+    unknown = [w for w in words if w not in needed + optional]
+    if missing or unknown:
+        raise OutOfScope(f"PATTERN DEF {name} {'with ' + unknown[0] if unknown else 'without ' + missing[0]}")
+    w = {k: words.get(k, 0.0) for k in needed + optional}
+    surface = w["Z"]
+    if name == "POS":
+        return [(w["X"], w["Y"], surface)]
+    grid_of = name in ("PAT", "FRAME")
+    columns, rows = (_count(name, w["NUMX"]), _count(name, w["NUMY"])) if grid_of else (0, 0)
+    count = _count(name, columns * rows if grid_of else w["NUM"])
+    if name in ("CIRC", "PITCHCIRC"):
+        step = w["STEP"] if name == "PITCHCIRC" else 360.0 / count
+        radius = w["D"] / 2.0
+        angles = np.radians(w["START"] + step * np.arange(count))
+        xs, ys = w["X"] + radius * np.cos(angles), w["Y"] + radius * np.sin(angles)
+        return [(float(x), float(y), surface) for x, y in zip(xs, ys)]
+    if name == "ROW":
+        grid = np.stack([w["D"] * np.arange(count), np.zeros(count)], axis=1)
+    else:
+        if w["ROTX"] or w["ROTY"]:
+            raise OutOfScope(f"PATTERN DEF {name} with a distortion ROTX or ROTY")
+        i, j = np.meshgrid(np.arange(columns), np.arange(rows))
+        keep = (
+            np.ones_like(i, bool)
+            if name == "PAT"
+            else (i == 0) | (i == columns - 1) | (j == 0) | (j == rows - 1)
+        )
+        grid = np.stack([w["DX"] * i[keep], w["DY"] * j[keep]], axis=1)
+    turn = math.radians(w["ROT"])
+    rotation = np.array([[math.cos(turn), -math.sin(turn)], [math.sin(turn), math.cos(turn)]])
+    points = grid @ rotation.T + (w["X"], w["Y"])
+    return [(float(x), float(y), surface) for x, y in points]
+
+
+def _count(name: str, value: float) -> int:
+    if not 1 <= value <= MAX_HOLES or value != int(value):
+        raise OutOfScope(f"PATTERN DEF {name} with {value:g} holes")
+    return int(value)
+
+
+__all__ = ["DEFINITION_ACTIVE", "SHAPES", "Drilling", "Hole", "Step", "cycle_number", "parameters_needed",
+           "pattern_holes", "steps"]  # fmt: skip

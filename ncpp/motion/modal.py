@@ -23,6 +23,7 @@ RADIUS_TOLERANCE = (
     0.01  # mm: start and end radius of a centre-format arc may differ this much (controller default)
 )
 PLANE_OF_TOOL_AXIS = {"Z": 17, "Y": 18, "X": 19}
+MAX_HOLES = 10_000  # holes of one pattern a control computes: beyond, the counts are a mistake, not a part
 
 
 class OutOfScope(Exception):

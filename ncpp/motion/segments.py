@@ -32,6 +32,9 @@ HOLE = "compensated canned cycle"
 FLOW = "loop or subroutine"  # one text runs many times (or out of the text's order)
 # a called drilling cycle's moves along the tool axis, in X Y where the block's move leaves the tool
 DRILLED = "drilling cycle"
+# the holes of a pattern the control computes (Klartext PATTERN DEF, Sinumerik HOLES1 ...) and its moves
+# between them, at the pattern's own positions
+PATTERN = "hole pattern"
 COMP = "cutter compensation"  # the control offsets the path by the tool's radius: the tool is not on it
 HOME = "G28/G30 return"  # the control homes the axes it names (machine coordinates); the others stay where they stand
 # Klartext M91 and M140 MB, Sinumerik SUPA, G53 and G153: positions of the control's own
@@ -249,6 +252,7 @@ __all__ = [
     "Hole",
     "FLOW",
     "DRILLED",
+    "PATTERN",
     "HOME",
     "MACHINE",
     "mark_off_path",

@@ -10,9 +10,10 @@ or `T="NAME"` selects, M6 loads it with cutting edge D1, `D n` picks an edge
 (D0 none); the edge's lengths 1-3 from the control's tool offsets (`_N_TO_INI`,
 `tools.py`) act along the plane's axes (G17: length 1 along Z).  Control flow (GOTOF,
 GOTOB, GOTO, GOTOC, CASE, IF, WHILE, FOR, REPEAT, LOOP) runs as `sinumerik_flow.py` says: a
-loop's moves are left as programmed (FLOW).  The drilling cycles CYCLE81-CYCLE83, called once
-or under MCALL, are followed (`sinumerik_cycles.py`); calls of other cycles, hole patterns
-and subprograms (by name or `L<n>`), splines, other frames, polar coordinates (AP=, RP=),
+loop's moves are left as programmed (FLOW).  The drilling, tapping and boring cycles
+CYCLE81-CYCLE89 and CYCLE840, called once or under MCALL, are followed (`sinumerik_cycles.py`),
+as are the hole patterns HOLES1 and HOLES2 under MCALL (their moves left as programmed,
+PATTERN); calls of other cycles, the patterns CYCLE801 and CYCLE802 and subprograms (by name or `L<n>`), splines, other frames, polar coordinates (AP=, RP=),
 arcs by opening angle (AR=) and unknown G codes make the position unknown: one warning (an error with `strict`) and the
 rest passes through.  Under cutter compensation (G41/G42 to the first move after
 G40) the moves are the programmed contour, the tool centre off it by the radius:
@@ -26,9 +27,12 @@ import math
 from collections.abc import Iterable, Iterator
 from typing import cast
 
+import numpy as np
+
 from ncpp.errors import Location, Warnings
 from ncpp.motion.flow import FIXED, RUN, SKIP
 from ncpp.motion.modal import (
+    MAX_HOLES,
     MM_PER_INCH,
     ModalInterpreter,
     OutOfScope,
@@ -36,7 +40,7 @@ from ncpp.motion.modal import (
     placed_interpreting,
     plane_of,
 )
-from ncpp.motion.segments import FLOW, MACHINE, PLANE_AXES, Event, Pass
+from ncpp.motion.segments import FLOW, MACHINE, PATTERN, PLANE_AXES, Event, Line, Pass
 from ncpp.motion.sinumerik_cycles import PARAMETERS as DRILLING
 from ncpp.motion.sinumerik_cycles import CycleError, Drilling, drilling
 from ncpp.motion.sinumerik_flow import SinumerikFlow
@@ -78,8 +82,10 @@ RESETTING_CALLS = frozenset(("CYCLE800", "CYCLE832"))
 SETTING_CALLS = frozenset(("CYCLE832",))
 # Hole patterns that run the modal drilling cycle at positions of their own (Programming Guide Cycles,
 # "Drilling patterns"): their positioning moves are the control's, made from one block that cannot
-# carry their corrections, and the order and height of those moves are not followed here
+# carry their corrections.  HOLES1 and HOLES2 are followed (`_pattern`); the order of a grid's
+# (CYCLE801) holes is the cycle's own and CYCLE802's positions come with a mask of its own: not followed
 HOLE_PATTERNS = frozenset(("HOLES1", "HOLES2", "CYCLE801", "CYCLE802"))
+FOLLOWED_PATTERNS = {"HOLES1": 6, "HOLES2": 6}  # and how many parameters each reads
 END_M = frozenset((2.0, 17.0, 30.0))
 # Addresses that say where the tool goes in a way this interpreter does not follow
 UNREAD_GEOMETRY = {"AR": "the opening angle", "AP": "the polar angle", "RP": "the polar radius"}
@@ -118,6 +124,7 @@ class SinumerikInterpreter(ModalInterpreter):
         self.arrays: dict[str, tuple[int, ...]] = {}  # DEF arrays' sizes (their elements are variables)
         self.started = False  # a block has run (a PROC opens the program or is out of scope)
         self.modal_cycle: Drilling | None = None  # MCALL's drilling cycle, run after each block that moves
+        self.spindle = 0.0  # the spindle speed S programmed (rev/min): a tapping cycle's feed follows it
         # A frame's offset is traversed with the axis's next incremental move (MD 42440
         # FRAME_OFFSET_INCR_PROG = 1): IC(d) after TRANS goes d from the old program position.
         self.frame_shift = [0.0, 0.0, 0.0]
@@ -291,6 +298,7 @@ class SinumerikInterpreter(ModalInterpreter):
         machine = False  # SUPA: the block's coordinates are the machine's
         mcall = False  # MCALL: the drilling cycle of the block is called after each move from here on
         drilling: Drilling | None = None  # a drilling cycle the block runs where it ends
+        holes: list[tuple[float, float]] | None = None  # HOLES1 / HOLES2: the modal cycle runs at each
         end = False
         tool_words: list = []  # the block's T, M6 and D words, in order
         previous: Word | ExprWord | Statement | None = None
@@ -319,6 +327,8 @@ class SinumerikInterpreter(ModalInterpreter):
                     drilling = self._drilling(item.node, block, item)
                     if mcall:
                         self.modal_cycle, drilling = drilling, None
+                elif what == "call" and item.node[0] in FOLLOWED_PATTERNS:
+                    holes = self._holes(item.node, block, item)
                 elif what == "call" and item.node[0] in HOLE_PATTERNS:
                     raise OutOfScope(
                         f"the hole pattern {item.node[0]} (the control places its holes itself)",
@@ -371,6 +381,8 @@ class SinumerikInterpreter(ModalInterpreter):
                     raise OutOfScope(f"the subprogram call L{value:g}", item.start + 1)
                 if letter in words:
                     self.fail(f"the address {letter} twice in one block", block, item)
+                if letter == "S":
+                    self.spindle = value
                 words[letter] = (value, mode, item)
         self.started = self.started or previous is not None  # (comments do not start the program)
         plane = self.plane
@@ -400,6 +412,8 @@ class SinumerikInterpreter(ModalInterpreter):
         if end:
             self.done = True
         events = self.radius_compensation(events, turn)
+        if holes is not None:
+            return self._pattern(block, holes, events, mcall or drilling is not None)
         if drilling is None and not mcall and self.modal_cycle is not None and events:
             drilling = self.modal_cycle
         if drilling is not None:
@@ -423,12 +437,68 @@ class SinumerikInterpreter(ModalInterpreter):
             None if a is None else self.value(a, block, item) for a in (*args, *(None,) * known)[:known]
         ]
         try:
-            return drilling(name, values, self.inch)
+            return drilling(name, values, self.inch, self.spindle)
         except CycleError as error:
             self.fail(str(error), block, item)
         except OutOfScope as out:
             out.col = item.start + 1
             raise
+
+    def _holes(self, node: tuple, block: Block, item) -> list[tuple[float, float]]:
+        """HOLES1 and HOLES2's holes in the plane, in the order the cycle drills them (840D
+        Programming Guide Cycles, "Row of holes - HOLES1": SPCA SPCO a reference point on the
+        row, STA1 its angle to the abscissa, FDIS the first hole's distance from the reference
+        point, DBH the distance between holes, NUM holes; "to avoid idle travel" the cycle starts
+        at the end of the row nearer the tool; "Circle of holes - HOLES2": CPA CPO the centre,
+        RAD the radius, STA1 the first hole's angle, INDA the angle between holes (0: 360/NUM
+        over a full circle), NUM holes)."""
+        name, args = node
+        known = FOLLOWED_PATTERNS[name]
+        if len(args) > known and any(a is not None for a in args[known:]):
+            raise OutOfScope(f"{name} with more than {known} parameters", item.start + 1)
+        values = [
+            None if a is None else self.value(a, block, item) for a in (*args, *(None,) * known)[:known]
+        ]
+        a, b, angle, first, between, count = values  # (HOLES2: CPA CPO RAD STA1 INDA NUM)
+        if a is None or b is None or count is None or count != int(count) or not 1 <= count <= MAX_HOLES:
+            self.fail(f"{name}: the reference point and a whole number of holes NUM are needed", block, item)
+        k = np.arange(int(count))
+        if name == "HOLES2":
+            radius, start, step = abs(angle or 0.0), first or 0.0, between or 360.0 / count
+            turns = np.radians(start + step * k)
+            return list(zip((a + radius * np.cos(turns)).tolist(), (b + radius * np.sin(turns)).tolist()))
+        along = abs(first or 0.0) + abs(between or 0.0) * k
+        direction = math.radians(angle or 0.0)
+        row = list(
+            zip((a + along * math.cos(direction)).tolist(), (b + along * math.sin(direction)).tolist())
+        )
+        near_first, near_last = (math.dist(self.pos[:2], row[end]) for end in (0, -1))
+        if len(row) > 1 and math.isclose(near_first, near_last, abs_tol=1e-9):
+            raise OutOfScope("HOLES1 with the tool as far from either end of the row (the cycle picks the end)",
+                             item.start + 1)  # fmt: skip
+        return row if near_first < near_last or len(row) == 1 else row[::-1]
+
+    def _pattern(
+        self, block: Block, holes: list[tuple[float, float]], events: list, called: bool
+    ) -> list[Event]:
+        """The modal drilling cycle (MCALL) at each hole of HOLES1/HOLES2, the tool moving to each
+        at G0 in the plane: the control's moves, from one block that cannot carry a correction
+        for each hole, left as programmed (PATTERN); compensation resumes after the block."""
+        where = block.items[0].start + 1
+        cycle = self.modal_cycle
+        if cycle is None or called or events:
+            raise OutOfScope("a hole pattern without a drilling cycle under MCALL, or with a move or a cycle "
+                             "of its own in its block", where)  # fmt: skip
+        if self.radius_comp or self.plane != 17:
+            raise OutOfScope("a hole pattern under radius compensation or outside G17", where)
+        moves: list[Event] = []
+        for x, y in holes:
+            moves.append(self.line(block, [x, y, self.pos[2]], True, self.absolute))
+            moves += self._drill(block, cycle)
+        for move in moves:
+            if type(move) is Line:
+                move.fixed, move.placed = PATTERN, (True, True, True)
+        return moves
 
     def _drill(self, block: Block, cycle: Drilling) -> list[Event]:
         """The cycle's moves where the block leaves the tool (`drilled`), its feeds from the feed
@@ -437,7 +507,8 @@ class SinumerikInterpreter(ModalInterpreter):
         if feed <= 0 and any(step.feed for step in cycle.steps):
             self.fail(f"{cycle.name}: no feed rate programmed before it", block)
         return self.drilled(
-            block, [(s.level, feed * s.feed if s.feed else None, s.dwell) for s in cycle.steps]
+            block,
+            [(s.level, s.rate or (feed * s.feed if s.feed else None), s.dwell) for s in cycle.steps],
         )
 
     def _exponent(self, block: Block, expression, word: Word) -> None:

@@ -22,9 +22,30 @@ final depth DP absolute or DPR below RFP, no sign, which counts when given):
   retract is given in mm).  One infeed (the first depth at DP) runs as CYCLE82 with the feed
   factor, in either mode.
 
-The later versions' further parameters (CYCLE83: AXN, MDEP, VRT, DTD, DIS1; all: GMODE, DMODE,
-AMODE) change what the others mean: given, they are out of scope, as is an FRF outside (0, 1]
-(the feed factor the manual defines; 0, or left out, is not one).
+* CYCLE84(..., DPR, DTB, SDAC, MPIT, PIT, POSS, SST, SST1), "Rigid tapping": G0 to RFP+SDIS,
+  tapping to the depth at the speed SST, the dwell DTB, back to RFP+SDIS at the speed SST1 (0:
+  SST), G0 to RTP; the feed along the tool axis is the speed times the thread pitch PIT (the
+  pitch as a thread size MPIT is out of scope, as is a speed of 0).
+* CYCLE840(..., DPR, DTB, SDR, SDAC, ENC, MPIT, PIT), "Tapping with compensating chuck": G0
+  to RFP+SDIS, tapping to the depth, the dwell DTB, back to RFP+SDIS with the spindle
+  reversed, G0 to RTP; without an encoder (ENC=1) and no pitch at the feed programmed before,
+  else at the spindle speed programmed before times PIT (MPIT out of scope).
+* CYCLE85(..., DPR, DTB, FFR, RFF), "Boring 1": G0 to RFP+SDIS, G1 to the depth at FFR, the
+  dwell, G1 back to RFP+SDIS at RFF, G0 to RTP.
+* CYCLE86(..., DPR, DTB, SDIR, RPA, RPO, RPAP, POSS), "Boring 2": G0 to RFP+SDIS, G1 to the
+  depth at the feed programmed before, the dwell, an oriented spindle stop, G0 back to
+  RFP+SDIS and to RTP; the lift-off RPA RPO RPAP away from the wall (a move in the plane the
+  cycle makes from the hole) is out of scope unless all three are 0.
+* CYCLE87(..., DPR, SDIR) and CYCLE88(..., DPR, DTB, SDIR), "Boring 3" and "Boring 4": G0 to
+  RFP+SDIS, G1 to the depth at the feed programmed before, (CYCLE88: the dwell), the spindle
+  stopped with M5 and the program with M0, then on NC start G0 to RTP.
+* CYCLE89(..., DPR, DTB), "Boring 5": G0 to RFP+SDIS, G1 to the depth, the dwell, G1 back to
+  RFP+SDIS at the same feed, G0 to RTP.
+
+The later versions' further parameters (CYCLE83: AXN, MDEP, VRT, DTD, DIS1; CYCLE84: AXN, PTAB,
+TECHNO, VARI, DAM, VRT; CYCLE840: AXN, PTAB, TECHNO; all: GMODE, DMODE, AMODE) change what the
+others mean: given, they are out of scope, as is an FRF outside (0, 1] (the feed factor the
+manual defines; 0, or left out, is not one).
 """
 
 from __future__ import annotations
@@ -35,19 +56,21 @@ from dataclasses import dataclass
 from ncpp.motion.modal import OutOfScope
 
 # Drilling cycles followed, and how many parameters each reads
-PARAMETERS = {"CYCLE81": 5, "CYCLE82": 6, "CYCLE83": 12}
+PARAMETERS = {"CYCLE81": 5, "CYCLE82": 6, "CYCLE83": 12, "CYCLE84": 12, "CYCLE840": 11, "CYCLE85": 8,
+              "CYCLE86": 11, "CYCLE87": 6, "CYCLE88": 7, "CYCLE89": 6}  # fmt: skip
 CHIP_BREAK = 1.0  # mm the chip-breaking retract goes back up (CYCLE83, VARI=0)
 MAX_INFEEDS = 10_000  # infeeds of one hole: beyond, the parameters are a mistake, not a hole
 
 
 @dataclass(frozen=True)
 class Step:
-    """One move of a cycle: to `level` along the tool axis at G0 (`feed` 0) or at G1 with the
-    programmed feed times `feed`, then a dwell of `dwell` s."""
+    """One move of a cycle: to `level` along the tool axis at G0 (`feed` and `rate` 0), at G1
+    with the programmed feed times `feed` or at `rate`, then a dwell of `dwell` s."""
 
     level: float
     feed: float = 0.0
     dwell: float = 0.0
+    rate: float = 0.0  # a feed of the cycle's own (program units/min), in place of the programmed one
 
 
 @dataclass(frozen=True)
@@ -62,9 +85,9 @@ class CycleError(ValueError):
     """A cycle's parameters the control refuses (the message says which)."""
 
 
-def drilling(name: str, values: list[float | None], inch: bool = False) -> Drilling:
+def drilling(name: str, values: list[float | None], inch: bool = False, spindle: float = 0.0) -> Drilling:
     """The cycle `name` with its evaluated parameters (None: left out), in a program in inches
-    or not."""
+    or not, the spindle speed programmed before it `spindle` (rev/min)."""
     rtp, rfp, sdis, dp, dpr = values[:5]
     if rtp is None or rfp is None or (dp is None and dpr is None):
         raise CycleError(f"{name}: RTP, RFP and DP or DPR are needed")
@@ -75,10 +98,65 @@ def drilling(name: str, values: list[float | None], inch: bool = False) -> Drill
     if not depth < clearance:  # (the cycle drills down from above the plane)
         raise CycleError(f"{name}: the depth {depth:g} is not below the reference plane and safety clearance "
                          f"{clearance:g}")  # fmt: skip
+    if name in BORING or name in TAPPING:
+        return Drilling(
+            name, (Step(clearance), *_in_and_out(name, values, clearance, depth, spindle), Step(rtp))
+        )
     if name != "CYCLE83":
         dwell = (values[5] or 0.0) if name == "CYCLE82" else 0.0
         return Drilling(name, (Step(clearance), Step(depth, 1.0, dwell), Step(rtp)))
     return Drilling(name, (Step(clearance), *_deep_hole(values, rfp, depth, inch), Step(rtp)))
+
+
+# Boring cycles: (the index of the dwell DTB or None, how the tool comes out: "G0", "G1" at the
+# feed it went in at, or "RFF" at its own parameter)
+BORING = {"CYCLE85": (5, "RFF"), "CYCLE86": (5, "G0"), "CYCLE87": (None, "G0"), "CYCLE88": (5, "G0"),
+          "CYCLE89": (5, "G1")}  # fmt: skip
+TAPPING = frozenset(("CYCLE84", "CYCLE840"))
+
+
+def _in_and_out(
+    name: str, values: list[float | None], clearance: float, depth: float, spindle: float
+) -> list[Step]:
+    """The steps between RFP+SDIS and back (or straight to RTP) of a boring or tapping cycle."""
+    if name in TAPPING:
+        return _tapping(name, values, clearance, depth, spindle)
+    dwell_at, out = BORING[name]
+    dwell = (values[dwell_at] or 0.0) if dwell_at is not None else 0.0
+    if name == "CYCLE86" and any(values[7:10]):
+        raise OutOfScope(
+            "CYCLE86 with a lift-off RPA, RPO or RPAP (the cycle's move in the plane away from the wall)"
+        )
+    if name == "CYCLE85":
+        ffr, rff = values[6], values[7]
+        if not ffr or not rff or ffr < 0 or rff < 0:
+            raise CycleError("CYCLE85: the feeds FFR and RFF are needed, above 0")
+        return [Step(depth, rate=ffr, dwell=dwell), Step(clearance, rate=rff)]
+    down = Step(depth, 1.0, dwell)
+    if name in ("CYCLE87", "CYCLE88"):
+        return [down]  # (M5 and M0 at the depth; on NC start G0 to RTP)
+    return [down, Step(clearance, 1.0 if out == "G1" else 0.0)]
+
+
+def _tapping(
+    name: str, values: list[float | None], clearance: float, depth: float, spindle: float
+) -> list[Step]:
+    """CYCLE84's and CYCLE840's tapping in and back out to RFP+SDIS (the module docstring)."""
+    dtb = values[5] or 0.0
+    mpit, pit = (values[7], values[8]) if name == "CYCLE84" else (values[9], values[10])
+    if mpit:
+        raise OutOfScope(f"{name} with the thread pitch as a thread size MPIT")
+    if name == "CYCLE840" and values[8] == 1.0 and not pit:  # without encoder: the programmed feed
+        return [Step(depth, 1.0, dtb), Step(clearance, 1.0)]
+    if name == "CYCLE840" and values[8] not in (None, 0.0, 1.0):
+        raise OutOfScope(f"CYCLE840 with ENC={values[8]:g} (0: with encoder, 1: without)")
+    if not pit:
+        raise OutOfScope(f"{name} without a thread pitch PIT")
+    speed_in = (values[10] or 0.0) if name == "CYCLE84" else spindle
+    speed_out = ((values[11] or 0.0) or speed_in) if name == "CYCLE84" else spindle
+    if not speed_in > 0 or not speed_out > 0:
+        raise OutOfScope(f"{name} without a spindle speed ({'SST' if name == 'CYCLE84' else 'S before it'})")
+    return [Step(depth, rate=speed_in * abs(pit), dwell=dtb), Step(clearance, rate=speed_out * abs(pit))]
 
 
 def _deep_hole(values: list[float | None], rfp: float, depth: float, inch: bool) -> list[Step]:

@@ -168,7 +168,9 @@ def test_cycles_ncpp_does_not_follow_and_changed_parameters_still_end_interpreta
     assert "drill.h:8:11: warning: the cycle call M99 (CYCL DEF 202) is outside" in warned.getvalue()
     warned = io.StringIO()  # a cycle ncpp does not read sets its Q parameters: they are not known after it
     found = moves(
-        program(holes=["L FMAX M99", "CYCL DEF 207 RIGID TAPPING ~\n    Q201=-31 ;DEPTH", "L  Z-Q201 FMAX"]),
+        program(
+            holes=["L FMAX M99", "CYCL DEF 209 TAPPING CHIP BRKG ~\n    Q201=-31 ;DEPTH", "L  Z-Q201 FMAX"]
+        ),
         warned,
     )
     assert len(runs(found)) == 1 and "the parameter Q201 (not set in the program)" in warned.getvalue()

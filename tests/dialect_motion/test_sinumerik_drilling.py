@@ -144,14 +144,17 @@ def test_cycle83_holes_are_compensated(tmp_path):
     assert np.abs(landed - np.repeat([40, -40], 7)).max() < 0.5e-3 and np.all(drilled[:, 0] != 40)
 
 
-@pytest.mark.parametrize("pattern", ["HOLES1(20, 30, 0, 10, 15, 4)", "HOLES2(50, 50, 20, 0, 90, 4)"])
+@pytest.mark.parametrize(
+    "pattern", ["CYCLE801(20, 30, 0, 10, 15, 4, 2)", "CYCLE802(111111111, 111111111, 0, 0)"]
+)
 def test_a_hole_pattern_under_mcall_ends_interpretation_before_its_holes(pattern):
-    """The pattern's positioning moves are the control's, from one block: they are not followed
-    (out of scope, the rest of the program passes through), the moves before it are."""
+    """A grid's order and CYCLE802's positions are the cycle's own: not followed (out of scope,
+    the rest of the program passes through), the moves before it are (HOLES1 and HOLES2:
+    test_sinumerik_patterns)."""
     events, warned = _events(
         HEAD + "MCALL CYCLE83(10, 0, 2, -5, , -5, , 5, 0, 0, 1, 0)\n" + pattern + "\nMCALL\nM30\n"
     )
-    assert f"the hole pattern {pattern[:6]}" in warned
+    assert f"the hole pattern {pattern[:8]}" in warned
     assert len([e for e in events if type(e) is Line]) == 1
 
 

@@ -160,6 +160,9 @@ class HeidenhainBuilder(Transformer):
         words = str(children[0]).split()
         return (words[2].upper() if len(words) > 2 else None,)
 
+    def _pattern_def(children: list) -> tuple:  # type: ignore[misc]
+        return tuple(children[1:])
+
     def _fn(children: list) -> tuple:  # type: ignore[misc]
         number = int("".join(ch for ch in str(children[0]) if ch.isdigit()))
         return (number, str(children[1]).strip() if len(children) > 1 else "")
@@ -179,13 +182,39 @@ class HeidenhainBuilder(Transformer):
     call_program = _statement("call_program", lambda c: (str(c[1]).strip('"'),))
     cycle_def = _statement("cycle_def", _cycle_def)
     cycle_call = _statement("cycle_call", _cycle_call)
+    pattern_def = _statement("pattern_def", _pattern_def)
     fn = _statement("fn", _fn)
     keyword = _statement("keyword", lambda c: tuple(str(t).upper() for t in c))
     radius_comp = _statement("radius_comp", lambda c: (str(c[0]).upper(),))
     feed = _statement("feed", lambda c: (str(c[0]).upper(),))
     rotation = _statement("rotation", lambda c: (str(c[0])[-1],))
     retract = _statement("retract", lambda c: (_retract_distance(str(c[0])),))
-    del _statement, _text, _pgm, _blk, _tool_call, _call_label, _cycle_def, _cycle_call, _fn, _path
+    del (
+        _statement,
+        _text,
+        _pgm,
+        _blk,
+        _tool_call,
+        _call_label,
+        _cycle_def,
+        _cycle_call,
+        _pattern_def,
+        _fn,
+        _path,
+    )
+
+    def pattern_shape(self, children):
+        head, *words = children
+        name, number = _split_address(str(head))
+        shape = []
+        for token in words:
+            letter, value = _split_address(str(token))
+            if token.type == "QWORD":
+                param = ("param", value.lstrip("+-").lower())
+                shape.append((letter, ("neg", param) if value.startswith("-") else param))
+            else:
+                shape.append((letter, ("num", number_value(value))))
+        return (name, int(number_value(number)), tuple(shape))
 
     @v_args(meta=True)
     def assignment(self, meta, children):
@@ -327,7 +356,9 @@ class HeidenhainWriter(IsoWriter):
         # a corner piece follows the line before it: that line's output ends at the corner
         # itself (RND/CHF verbatim) or, edited, at the tangent point (the piece written out)
         corner = function in ("RND", "CHF")
-        feed = self._restored_feed(block, motion) if motion and not corner else ""
+        # (a CYCL CALL POS's F is for its own move: the next move still gets the program's back)
+        restores = motion and not corner and _position_call(block) is None
+        feed = self._restored_feed(block, motion) if restores else ""
         if (not corner and not any(e.changed for e in motion)) or (corner and not (motion and edited_before)):
             # a subprogram or loop a call or jump line runs uses the pole as the program has it there
             calls = function is None and any(m.fixed == FLOW for m in motion)
@@ -356,6 +387,9 @@ class HeidenhainWriter(IsoWriter):
                 self._remember_end(segment)
             return
         self.changed_any = self.edited_last = True
+        if _position_call(block) is not None:
+            yield from self._position_call(block, motion)
+            return
         if corner and any(type(i) in (Word, ExprWord) and i.letter == "F" for i in block.items):
             self.restore_feed = True  # `RND R5 F200`: F200 holds for the fillet only, a C block's F is modal
         # the block itself says the first segment of its own kind; steps before and pieces after are new blocks
@@ -380,6 +414,29 @@ class HeidenhainWriter(IsoWriter):
                 moved = "" if word is None else " " + block.raw[word.start : word.end]
                 yield self._inserted(self._fresh(segment) + feed + moved)
             feed = ""  # on the first block written
+            self._remember_end(segment)
+
+    def _position_call(self, block: Block, motion: list):
+        """`CYCL CALL POS` whose move in the plane is compensated: its X and Y say where that move
+        ends (its Z, the cycle's datum shift, and the cycle's moves stay as written); the move's
+        pieces before the last are `L` blocks before it, each with the call's feed."""
+        call = _position_call(block) or 0
+        pieces = [e for e in motion if not e.fixed]
+        style = self.styles.get("F") or NumberStyle(decimals=3)
+        for piece in pieces[:-1]:
+            feed = "" if piece.rapid else " F" + format_number(piece.feed, style)
+            yield self._inserted(self._fresh(piece) + feed)
+            self._remember_end(piece)
+            self.restore_feed = self.restore_feed or not piece.rapid  # (the call's feed is for its move only)
+        if pieces:
+            last = pieces[-1]
+            texts = {n: self._word(item.letter, last.end[_AXES.index(item.letter)], last)
+                     for n, item in enumerate(block.items)
+                     if n > call and isinstance(item, (Word, ExprWord)) and item.letter in ("X", "Y")}  # fmt: skip
+            yield self._numbered(block, splice(block, texts))
+        else:
+            yield self._numbered(block, block.raw)
+        for segment in motion[len(pieces) - 1 if pieces else 0 :]:
             self._remember_end(segment)
 
     def _restored_feed(self, block: Block, motion: list) -> str:
@@ -536,6 +593,12 @@ class HeidenhainWriter(IsoWriter):
                         self.known_axes.add(axis)
             elif type(item) is ExprWord and item.letter[-1:] in _AXES and item.letter.lstrip("I") == item.letter[-1]:  # fmt: skip
                 self.known_axes.add(item.letter[-1])  # `X+Q1932` positions X as a number does
+
+
+def _position_call(block: Block) -> int | None:
+    """The index of a `CYCL CALL POS` in the block, if it is one."""
+    return next((n for n, i in enumerate(block.items)
+                 if type(i) is Statement and i.kind == "cycle_call" and i.node[0] == "POS"), None)  # fmt: skip
 
 
 def _called_on(block: Block, motion: list, own: int) -> tuple[int | None, int | None]:
