@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Iterable, Iterator, Sequence
+from pathlib import Path
 from typing import NoReturn
 
 from ncpp.errors import Location, NcppError, Warnings, resolve_warnings
@@ -55,6 +56,7 @@ def placed_interpreting(dialect: type[ModalInterpreter]) -> Callable[..., Iterat
         warnings = resolve_warnings(warnings, strict)
         told = offsets is None or offsets.tools is not None
         interpreter.untold_lengths = UntoldLengths(not told, warnings)  # type: ignore[attr-defined]
+        interpreter.subroutine_path = offsets.subroutine_path if offsets is not None else ()
         return interpreter.run(blocks, warnings)
 
     return interpret
@@ -88,6 +90,7 @@ class ModalInterpreter:
         self.off_path = False  # the tool centre off the programmed path: from the first move with it on to the first after
         self.tool_id = ""  # the tool in the spindle as the program names it (Context.tool_id)
         self._context: Context | None = None
+        self.subroutine_path: tuple[Path, ...] = ()  # the folders of the program files it calls
 
     # -- the event stream -------------------------------------------------------------
     def run(self, blocks: Iterable[Block], warnings: Warnings) -> Iterator[Event]:

@@ -23,10 +23,14 @@ from __future__ import annotations
 
 import itertools
 import math
+import re
 from collections.abc import Iterable, Iterator
+from dataclasses import dataclass
+from pathlib import Path
 from typing import cast
 
 from ncpp.errors import Location, Warnings
+from ncpp.motion.called import find_file, read_blocks, searched
 from ncpp.motion.flow import FIXED, RUN, SKIP
 from ncpp.motion.modal import (
     MM_PER_INCH,
@@ -97,6 +101,34 @@ _FROM_THE_CALLER = "(the caller's value)"  # a PROC parameter's value: not told
 
 MAX_ELEMENTS = 65_536  # the elements of an array this interpreter holds (each is a variable)
 
+# Subprograms (840D sl Programming Manual, Fundamentals, "Subprogram technique"): a program runs
+# another by its name (`MYSUB`, `MYSUB(1, 2)` for `PROC MYSUB(REAL A, INT B)`) or its number
+# (`L100`; leading zeros count: L0100 is another), `P` times (1-9999); M17 or RET returns.  The
+# control nests up to 16 program levels, the main program's among them.
+MAX_RUNS = 9999
+MAX_PROGRAM_LEVELS = 16
+# A name a subprogram can be called by: two letters or `_` and a letter first ("Subprogram names")
+_SUBPROGRAM_NAME = re.compile(r"(?:[A-Z]{2}|_[A-Z])\w*", re.I)
+# The Siemens cycles and their helpers, which stay as the cycles they are (`block`), not files
+KNOWN_CYCLE = re.compile(r"CYCLE\d|POCKET\d|SLOT\d|LONGHOLE|HOLES\d|E_|F_", re.I)
+# PROC attributes that change nothing the motion depends on: the display and single-block
+# behaviour of the subprogram's blocks (SAVE, which restores the caller's modal state, is not followed)
+HARMLESS_PROC_ATTRIBUTES = frozenset(("DISPLOF", "DISPLON", "SBLOF", "SBLON", "ACTBLOCNO"))
+_R_PARAMETER = re.compile(r"r\d+")  # the channel's R parameters: shared by every program level
+# `_N_MYSUB_SPF`, `MYSUB_SPF`: a name with the control's own prefix and type (all are the same program)
+_CONTROL_NAME = re.compile(r"(?:_N_)?(\w+?)(?:_(SPF|MPF))?", re.I)
+
+
+@dataclass(frozen=True)
+class _Call:
+    """A subprogram call: the file, its blocks, its PROC parameters' values, its runs."""
+
+    name: str
+    path: Path
+    blocks: list[Block]
+    parameters: dict
+    runs: int
+
 
 class SinumerikInterpreter(ModalInterpreter):
     def __init__(
@@ -123,18 +155,32 @@ class SinumerikInterpreter(ModalInterpreter):
         self.frame_shift = [0.0, 0.0, 0.0]
         self.told_frame: float | None = None  # the settable frame the program selected first
         self.zero_frame: float | None = None  # the one in effect (None: as when the program started)
+        self.calls: list[str] = []  # the subprograms running, outermost first
+        self.called: _Call | None = None  # the subprogram the block just run calls
+        self.returned = False  # M17 or RET ended the subprogram running
+        self._files: dict[Path, list[Block]] = {}  # subprogram files read, by path
 
     # -- the event stream ---------------------------------------------------------------
     def run(self, blocks: Iterable[Block], warnings: Warnings) -> Iterator[Event]:
         """Events block by block, in the order the blocks run (`sinumerik_flow.py`): a block
         run out of the text's order gives its moves, left as programmed, to the line that
         runs it (its `owner`), so that every block's text is written once, where it stands."""
+        return self._run(blocks, warnings, None)
+
+    def _run(self, blocks: Iterable[Block], warnings: Warnings, caller: Block | None) -> Iterator[Event]:
+        """`run` over the program (`caller` None) or over a subprogram file the line `caller`
+        calls: its blocks all run out of the text's order, their moves the caller's, and its
+        text is no part of the output."""
 
         def leave(reason: str, block: Block, col: int | None, owner: Block | None) -> None:
-            self.leave_scope(warnings, reason, block, col, owner)
+            self.leave_scope(warnings, reason, block, col, caller or owner)
 
-        flow = SinumerikFlow(self.file, self.value, self.assign, lambda: self.done, leave)
+        flow = SinumerikFlow(self.file, self.value, self.assign, lambda: self.done or self.returned, leave)
         for block, kind, owner in flow.steps(blocks):
+            if caller is not None:
+                if kind is not RUN and kind is not FIXED:
+                    continue
+                kind, owner = FIXED, caller
             if (kind is not RUN and kind is not FIXED) or not block.items:
                 if owner is None:  # (a block run out of the text's order is written in its place)
                     yield Pass(block, kind is SKIP)
@@ -142,6 +188,7 @@ class SinumerikInterpreter(ModalInterpreter):
             try:
                 events = self.block(block)
             except OutOfScope as stop:
+                self.called = None
                 self.leave_scope(warnings, stop.reason, block, stop.col, owner)
                 if owner is None:  # (a block run out of the text's order is written in its place)
                     yield Pass(block)
@@ -152,12 +199,104 @@ class SinumerikInterpreter(ModalInterpreter):
                     move.fixed = move.fixed or FLOW  # type: ignore[union-attr]
                     if owner is not None:
                         move.block = owner
-                if owner is not None:
-                    yield from moves
-                    continue
             elif moves:
                 flow.last_run_move = flow.pc
-            yield from events or (Pass(block),)
+            if kind is FIXED and owner is not None:
+                yield from moves
+            else:
+                yield from events or (Pass(block),)
+            if self.called is not None:
+                call, self.called = self.called, None
+                yield from self._subprogram(call, owner or block, warnings)
+
+    # -- subprogram calls (840D sl Programming Manual, Fundamentals, "Subprogram technique") --
+    def _call(self, block: Block, item: Word | Statement, name: str, args: tuple) -> _Call:
+        """A call of subprogram `name` (`L100`, `MYSUB`, `MYSUB(1, 2)`), alone in its block but for
+        its block number, labels, comments and `P` (the number of runs, 1-9999): its file from
+        the subroutine path, its `PROC` parameters given the call's values."""
+        runs = 1
+        for other in block.items:
+            if other is item or type(other) is Comment or (type(other) is Word and other.letter in "N:"):
+                continue
+            if type(other) is Statement and other.kind == "label":
+                continue
+            if (type(other) is Word or type(other) is ExprWord) and other.letter == "P":
+                value = self._word_value(other, block)[0] if type(other) is ExprWord else other.value
+                if value != round(value) or not 1 <= value <= MAX_RUNS:
+                    self.fail(f"P{value:g}: a subprogram runs 1 to {MAX_RUNS} times", block, other)
+                runs = int(value)
+                continue
+            raise OutOfScope(f"the subprogram call {name} with more in its block", other.start + 1)
+        if len(self.calls) + 1 >= MAX_PROGRAM_LEVELS:
+            self.fail(f"the subprogram call {name} nests deeper than the control's {MAX_PROGRAM_LEVELS} "
+                      "program levels (the main program's and its subprograms')", block, item)  # fmt: skip
+        names = _subprogram_files(name)
+        path = find_file(self.subroutine_path, names)
+        if path is None:  # (a name may be a predefined procedure ncpp does not follow, or a subprogram)
+            what = "the subprogram call" if type(item) is Word else "call"
+            raise OutOfScope(
+                f"{what} {name} (its file not found: {searched(self.subroutine_path, names)})", item.start + 1
+            )
+        blocks = self._files.get(path)
+        if blocks is None:
+            blocks = self._files[path] = read_blocks(path, "sinumerik")
+        parameters = self._parameters(blocks, name, args, block, item)
+        if parameters and runs > 1:
+            raise OutOfScope(f"the subprogram call {name} with parameters and P (later runs keep the "
+                             "values the first left)", item.start + 1)  # fmt: skip
+        return _Call(name, path, blocks, parameters, runs)
+
+    def _parameters(self, blocks: list[Block], name: str, args: tuple, block: Block, item) -> dict:
+        """The subprogram's PROC parameters (its first block, if any) given the call's values
+        (840D sl Job Planning manual, "Subprograms with parameter transfer": an omitted value
+        parameter is 0, an empty string); parameters by reference (VAR) and arrays are not followed."""
+        proc = next((i for b in blocks for i in b.items if type(i) is Statement and i.kind == "proc"), None)
+        declared = () if proc is None else proc.node[1]
+        if len(args) > len(declared):
+            self.fail(f"{name} takes {len(declared)} parameters, not {len(args)}", block, item)
+        if proc is not None:
+            extra = [a for a in proc.node[2] if a.upper() not in HARMLESS_PROC_ATTRIBUTES]
+            if extra:
+                raise OutOfScope(f"the subprogram {name} with PROC ... {extra[0].upper()}", item.start + 1)
+        values: dict[str, float | str] = {}
+        for (kind, parameter, by_reference, dims), arg in zip(declared, (*args, *(None,) * len(declared))):
+            if by_reference or dims is not None or kind not in ("REAL", "INT", "BOOL", "STRING"):
+                what = "VAR " if by_reference else ""
+                raise OutOfScope(f"the subprogram {name}'s parameter {what}{kind} {parameter.upper()}",
+                                 item.start + 1)  # fmt: skip
+            if kind == "STRING":
+                if arg is not None and arg[0] != "str":
+                    self.fail(f"{name}: the STRING parameter {parameter.upper()} given a number", block, item)
+                values[parameter] = "" if arg is None else arg[1]
+                continue
+            value = 0.0 if arg is None else self.value(arg, block, item)
+            values[parameter] = float(round(value)) if kind == "INT" else value
+        return values
+
+    def _subprogram(self, call: _Call, caller: Block, warnings: Warnings) -> Iterator[Event]:
+        """The subprogram's runs: its blocks run as the program's, with variables of their own
+        (the R parameters are the channel's, shared), to M17 or RET."""
+        outer = (self.file, self.variables, self.integers, self.arrays, self.started)
+        self.calls.append(call.name)
+        self.file = str(call.path)
+        try:
+            for _ in range(call.runs):
+                self.variables = {k: v for k, v in outer[1].items() if _R_PARAMETER.fullmatch(k)}
+                self.variables.update(call.parameters)
+                self.integers, self.arrays, self.started = set(), {}, False
+                yield from self._run(call.blocks, warnings, caller)
+                shared = {k: v for k, v in self.variables.items() if _R_PARAMETER.fullmatch(k)}
+                outer[1].update(shared)
+                if self.done:
+                    return
+                if not self.returned:
+                    self.leave_scope(warnings, f"the subprogram {call.name} ends without M17 or RET",
+                                     call.blocks[-1] if call.blocks else caller, None, caller)  # fmt: skip
+                    return
+                self.returned = False
+        finally:
+            self.calls.pop()
+            self.file, self.variables, self.integers, self.arrays, self.started = outer
 
     # -- variables --------------------------------------------------------------------
     def _procedure(self, node: tuple, block: Block, item) -> None:
@@ -166,6 +305,8 @@ class SinumerikInterpreter(ModalInterpreter):
         interpretation; its other blocks are followed.  A PROC anywhere else is out of scope."""
         if self.started:
             raise OutOfScope("PROC below the program's first block", item.start + 1)
+        if self.calls:  # (a subprogram's: the call gave its parameters their values)
+            return
         for _type, name, _by_reference, _dims in node[1]:
             self.variables[name] = _FROM_THE_CALLER
 
@@ -292,6 +433,8 @@ class SinumerikInterpreter(ModalInterpreter):
         mcall = False  # MCALL: the drilling cycle of the block is called after each move from here on
         drilling: Drilling | None = None  # a drilling cycle the block runs where it ends
         end = False
+        returning = False  # M17 or RET in a subprogram: back to the caller after the block
+        call: _Call | None = None  # a subprogram the block calls
         tool_words: list = []  # the block's T, M6 and D words, in order
         previous: Word | ExprWord | Statement | None = None
         for item in block.items:
@@ -324,12 +467,22 @@ class SinumerikInterpreter(ModalInterpreter):
                         f"the hole pattern {item.node[0]} (the control places its holes itself)",
                         item.start + 1,
                     )
+                elif what == "call" and item.node[0] == "EXTERN":
+                    return []  # (it declares a subprogram's parameters)
+                elif what == "call" and item.node[0] == "RET" and self.calls:
+                    if item.node[1]:
+                        raise OutOfScope("RET with parameters (a return elsewhere)", item.start + 1)
+                    returning = True
                 elif what == "call" and (
                     item.node[0] in HARMLESS_CALLS
                     or item.node[0] in SETTING_CALLS
                     or (item.node[0] in RESETTING_CALLS and not item.node[1])
                 ):
                     pass
+                elif what == "call" and _SUBPROGRAM_NAME.fullmatch(item.node[0]) and not KNOWN_CYCLE.match(
+                    item.node[0]
+                ):
+                    call = self._call(block, item, item.node[0].upper(), item.node[1])
                 elif what not in ("label", "program_name", "block_delete"):
                     name = item.node[0] if what in ("call", "path", "frame") else what.upper()
                     raise OutOfScope(
@@ -353,7 +506,11 @@ class SinumerikInterpreter(ModalInterpreter):
             if letter == "G":
                 gcodes.append((value, item))
             elif letter == "M":
-                end = end or value in END_M
+                if value in END_M and self.calls:
+                    if value != 17.0:
+                        raise OutOfScope(f"M{value:g} in a subprogram (M17 or RET ends one)", item.start + 1)
+                    returning = True
+                end = end or (value in END_M and not self.calls)
                 if value == TOOL_CHANGE:
                     tool_words.append((item, value))
             elif letter in ("T", "D"):
@@ -367,7 +524,11 @@ class SinumerikInterpreter(ModalInterpreter):
                     raise OutOfScope(
                         f"the rotary axis {letter} (this interpreter follows X Y Z)", item.start + 1
                     )
-                if letter == "L":  # `L100`: runs subprogram L100.SPF, which may move the tool anywhere
+                if letter == "L" and type(item) is Word and item.number.isdigit():
+                    # (leading zeros name another subprogram: L0100 is not L100)
+                    call = self._call(block, item, f"L{item.number}", ())
+                    continue
+                if letter == "L":
                     raise OutOfScope(f"the subprogram call L{value:g}", item.start + 1)
                 if letter in words:
                     self.fail(f"the address {letter} twice in one block", block, item)
@@ -399,6 +560,8 @@ class SinumerikInterpreter(ModalInterpreter):
                 )
         if end:
             self.done = True
+        self.returned = self.returned or returning
+        self.called = call
         events = self.radius_compensation(events, turn)
         if drilling is None and not mcall and self.modal_cycle is not None and events:
             drilling = self.modal_cycle
@@ -629,6 +792,15 @@ def _frame_name(code: float | None) -> str:
 
 
 interpret = placed_interpreting(SinumerikInterpreter)
+
+
+def _subprogram_files(name: str) -> list[str]:
+    """The files subprogram `name` may be kept in on a PC: `MYSUB.SPF`, the control's own
+    `_N_MYSUB_SPF`, and a main program (a program called by its name may be either)."""
+    found = _CONTROL_NAME.fullmatch(name)
+    base, kind = (found.group(1), found.group(2)) if found else (name, None)
+    kinds = [kind.upper()] if kind else ["SPF", "MPF"]
+    return [f for k in kinds for f in (f"{base}.{k}", f"_N_{base}_{k}", f"_N_{base}_{k}.{k}")]
 
 
 def _element_key(name: str, index: tuple[int, ...]) -> str:
