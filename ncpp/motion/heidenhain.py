@@ -34,8 +34,10 @@ import operator
 import re
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
+from pathlib import Path
 
 from ncpp.errors import Location, NcppError, Warnings
+from ncpp.motion.called import find_file, read_blocks, searched
 from ncpp.motion.corners import CornerError, round_corner
 from ncpp.motion.heidenhain_cycles import (
     DEFINITION_ACTIVE,
@@ -61,6 +63,9 @@ from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
 AXES = "XYZ"
 ROTARY = ("A", "B", "C")
 # Cycles that move or turn the datum (datum shift, mirror, rotation, scaling, working plane, presets)
+# Programs CALL PGM runs nest this deep (TNC 640 Klartext manual, "Nesting": "Maximum nesting
+# depth for calling NC main programs")
+MAX_PROGRAM_NESTING = 19
 DATUM_CYCLES = frozenset(("7", "8", "10", "11", "19", "26"))
 # CYCL DEF 247 DATUM SETTING activates the preset Q339 of the preset table (TNC 640 Klartext manual,
 # "Cycle 247 DATUM SETTING"): the program zero ncpp is told is that preset's; another preset later
@@ -165,6 +170,11 @@ class HeidenhainInterpreter(ModalInterpreter):
         self.ended = False  # the program ended (M2, M30, END PGM), not left the scope
         self.flow: KlartextFlow | None = None  # the order the blocks run in (labels, calls, jumps)
         self.cycle: Drilling | str | None = None  # the cycle M99 / CYCL CALL runs (str: one not followed)
+        self.programs: list[Path] = []  # the programs CALL PGM runs, outermost first
+        self.main_path: Path | None = Path(file).resolve() if file != "<stdin>" else None
+        self.called: Path | None = None  # the program the block just run calls
+        self.returned = False  # the called program's END PGM ran
+        self._files: dict[Path, list[Block]] = {}  # called programs read, by path
 
     def run(self, blocks: Iterable[Block], warnings: Warnings) -> Iterator[Event]:
         """Events as `ModalInterpreter.run`; a feed line waits (with the events after it)
@@ -240,6 +250,8 @@ class HeidenhainInterpreter(ModalInterpreter):
         rotation: str | None = None
         comp: str | None = None  # RL, RR or R0
         end = False
+        returning = False  # a called program's END PGM: back to the caller
+        called: Path | None = None  # the file of the program CALL PGM runs
         machine_datum = False  # M91: the block's coordinates are the machine datum's
         retract: float | str | None = None  # M140 MB: a retract along the tool axis after the move
         call: tuple[str, int] | None = None  # M99 or CYCL CALL and its column: the cycle runs after the move
@@ -263,6 +275,9 @@ class HeidenhainInterpreter(ModalInterpreter):
                     if value == 92.0:  # (its datum is a machine parameter ncpp is not told)
                         raise OutOfScope("M92 (a position the machine tool builder sets)", item.start + 1)
                     machine_datum = machine_datum or value == 91.0
+                    if value in END_M and self.programs:
+                        raise OutOfScope(f"M{value:g} in a program CALL PGM runs (its END PGM returns)",
+                                         item.start + 1)  # fmt: skip
                     end = end or value in END_M
                     continue
                 if letter in ROTARY:  # (its moves would be compensated as if the axis stood)
@@ -279,7 +294,12 @@ class HeidenhainInterpreter(ModalInterpreter):
             elif what == "program_end":
                 if self.flow is not None and self.flow.frames:  # (where the control goes is not told)
                     raise OutOfScope("END PGM in a subprogram (no LBL 0 before it)", item.start + 1)
-                end = True
+                if self.programs:  # a called program's END PGM returns to the caller
+                    returning = True
+                else:
+                    end = True
+            elif what == "call_program":
+                called = self._call_program(block, item)
             elif what == "tool_call":
                 if node[1] is not None:
                     self.plane = PLANE_OF_TOOL_AXIS[node[1]]
@@ -333,7 +353,7 @@ class HeidenhainInterpreter(ModalInterpreter):
             elif what == "fn" and node[0] in JUMPS and self.flow is not None:
                 self._jump(block, item)
             else:
-                reason = {"call_label": "CALL LBL", "call_program": "CALL PGM", "cycle_call": "CYCL CALL",
+                reason = {"call_label": "CALL LBL", "cycle_call": "CYCL CALL",
                           "fn": f"FN {node[0]}", "keyword": " ".join(map(str, node))}.get(what, what)  # fmt: skip
                 raise OutOfScope(reason, item.start + 1)
         if defined is not None:
@@ -360,6 +380,7 @@ class HeidenhainInterpreter(ModalInterpreter):
             self.last_move, self.corner_waits = events[-1], False
         if end:
             self.done = self.ended = True
+        self.returned, self.called = self.returned or returning, called
         return events
 
     def _define_cycle(self, number: str, block: Block) -> None:
@@ -474,12 +495,22 @@ class HeidenhainInterpreter(ModalInterpreter):
         """Events as `ModalInterpreter.run`, block by block in the order they run: the moves of
         a block that runs again are left as programmed (FLOW) and, where it runs out of the
         text's order, belong to the line that runs it (a call, a jump back), written once."""
-        flow = self.flow = KlartextFlow(self.file, blocks)
+        return self._run_flow(KlartextFlow(self.file, blocks), warnings, None)
+
+    def _run_flow(self, flow: KlartextFlow, warnings: Warnings, caller: Block | None) -> Iterator[Event]:
+        """`_flowing` over the program (`caller` None) or over a program the line `caller` calls
+        by CALL PGM: its blocks all run out of the text's order, their moves the caller's, and
+        its text is no part of the output."""
+        self.flow = flow
 
         def stop(reason: str, owner: Block) -> None:  # (where the flow itself cannot go on)
-            self.leave_scope(warnings, reason, owner, None)
+            self.leave_scope(warnings, reason, owner, None, caller)
 
-        for block, kind, owner in flow.steps(lambda: self.done, stop):
+        for block, kind, owner in flow.steps(lambda: self.done or self.returned, stop):
+            if caller is not None:
+                if kind is SKIP or kind is TEXT:
+                    continue
+                kind, owner = FIXED, caller
             if kind is SKIP or kind is TEXT or self.done or not block.items:
                 if owner is None:  # (after M2/M30/END PGM: a subprogram's text, run where it is called)
                     yield Pass(block, kind is SKIP or (kind is TEXT and self.ended))
@@ -487,6 +518,7 @@ class HeidenhainInterpreter(ModalInterpreter):
             try:
                 events = self.block(block)
             except OutOfScope as out:
+                self.called = None
                 self.leave_scope(warnings, out.reason, block, out.col, owner)
                 if owner is None:
                     yield Pass(block)
@@ -496,6 +528,56 @@ class HeidenhainInterpreter(ModalInterpreter):
             elif flow.labels and any(type(e) is Line or type(e) is Arc for e in events):
                 flow.moved()  # (before the first label nothing can jump back over it)
             yield from events or ((Pass(block),) if owner is None else ())
+            if self.called is not None:
+                path, self.called = self.called, None
+                yield from self._program(path, owner or block, warnings)
+                self.flow = flow
+
+    # -- CALL PGM (TNC 640 Klartext manual, "Calling any program as a subprogram") ------------
+    def _call_program(self, block: Block, item) -> Path:
+        """`CALL PGM name`: the called program's file, `name` (its drive and folders aside, which
+        are the control's: `TNC:\\PARTS\\PLAN.H` is PLAN.H) on the subroutine path, `.H` if
+        the name has no type.  Alone in its block but for comments."""
+        if any(other is not item and type(other) is not Comment and not (type(other) is Word and other.letter == "N")
+               for other in block.items):  # fmt: skip
+            raise OutOfScope("CALL PGM with more in its block", item.start + 1)
+        name = re.split(r"[\\/:]", item.node[0])[-1]
+        stem, dot, kind = name.rpartition(".")
+        if dot and kind.upper() != "H":
+            raise OutOfScope(f"CALL PGM {item.node[0]} (a program that is not Klartext, .H)", item.start + 1)
+        names = [name] if dot else [f"{name}.h", name]
+        if len(self.programs) >= MAX_PROGRAM_NESTING:
+            raise OutOfScope(f"programs called more than {MAX_PROGRAM_NESTING} deep", item.start + 1)
+        path = find_file(self.subroutine_path, names)
+        if path is None:
+            raise OutOfScope(
+                f"CALL PGM {item.node[0]} (its file not found: {searched(self.subroutine_path, names)})",
+                item.start + 1,
+            )
+        if path.resolve() in self.programs or path.resolve() == self.main_path:
+            raise OutOfScope(f"CALL PGM {item.node[0]}, a program that calls itself (for ever)", item.start + 1)
+        return path
+
+    def _program(self, path: Path, caller: Block, warnings: Warnings) -> Iterator[Event]:
+        """The called program from its first block to its END PGM, in the caller's state: the Q
+        parameters are global (what it sets, the caller reads after), and so is the modal
+        state; its own units (BEGIN PGM ... MM|INCH) hold while it runs."""
+        blocks = self._files.get(path)
+        if blocks is None:
+            blocks = self._files[path] = read_blocks(path, "heidenhain")
+        outer_file, outer_inch = self.file, self.inch
+        self.programs.append(path.resolve())
+        self.file = str(path)
+        try:
+            yield from self._run_flow(KlartextFlow(str(path), blocks), warnings, caller)
+            if not self.done and not self.returned:
+                self.leave_scope(warnings, f"the called program {path.name} ends without END PGM",
+                                 blocks[-1] if blocks else caller, None, caller)  # fmt: skip
+        finally:
+            self.programs.pop()
+            self.file, self.returned = outer_file, False
+        if not self.done:
+            self.set_units(outer_inch)
 
     def _call_label(self, block: Block, item) -> None:
         """`CALL LBL n [REP k]`: a subprogram call or a program-section repeat."""
