@@ -9,7 +9,8 @@ half circle), `CT` (tangential arc), `LP`/`CP` polar with PR/IPR/PA/IPA (a
 helix with IZ, several turns with |IPA| > 360), Q parameters with arithmetic,
 labels, subprograms (`CALL LBL n` ... `LBL 0`), program-section repeats (`CALL LBL n REP k`)
 and the jumps FN 9-12 (`heidenhain_flow`: a block that runs again is left as programmed,
-FLOW), `CYCL DEF` of machining cycles (they only define), the drilling cycles 200, 201, 203
+FLOW), `CALL PGM` of a program file on the subroutine path (`_call_program`: its moves are left
+as programmed, FLOW, and the caller's after it compensated), `CYCL DEF` of machining cycles (they only define), the drilling cycles 200, 201, 203
 and 240 called by M99 or `CYCL CALL` (`heidenhain_cycles`: their moves along the tool axis are
 left as programmed, DRILLED), M2/M30
 and `END PGM` (end), and `RND R..` / `CHF ..` between two feed lines in the
@@ -19,7 +20,7 @@ Radius compensation RL/RR is followed to R0: the moves from the first with RL/RR
 to the R0 block's are the programmed contour, the tool centre off it by the radius,
 and are marked `fixed` (`ModalInterpreter.radius_compensation`).  Paraxial R+/R-,
 RND/CHF next to an arc or a rapid, FK free contours,
-APPR/DEP, `CALL PGM`, calls of other cycles, `CYCL CALL POS`/`PAT`, M89, FN 14 and later FN
+APPR/DEP, `CALL PGM` of a file not found, calls of other cycles, `CYCL CALL POS`/`PAT`, M89, FN 14 and later FN
 functions and cycles that move the datum make the position unknown: one warning (an error with
 `strict`) and the rest passes through.
 
@@ -555,7 +556,9 @@ class HeidenhainInterpreter(ModalInterpreter):
                 item.start + 1,
             )
         if path.resolve() in self.programs or path.resolve() == self.main_path:
-            raise OutOfScope(f"CALL PGM {item.node[0]}, a program that calls itself (for ever)", item.start + 1)
+            raise OutOfScope(
+                f"CALL PGM {item.node[0]}, a program that calls itself (for ever)", item.start + 1
+            )
         return path
 
     def _program(self, path: Path, caller: Block, warnings: Warnings) -> Iterator[Event]:

@@ -11,8 +11,11 @@ or `T="NAME"` selects, M6 loads it with cutting edge D1, `D n` picks an edge
 `tools.py`) act along the plane's axes (G17: length 1 along Z).  Control flow (GOTOF,
 GOTOB, GOTO, GOTOC, CASE, IF, WHILE, FOR, REPEAT, LOOP) runs as `sinumerik_flow.py` says: a
 loop's moves are left as programmed (FLOW).  The drilling cycles CYCLE81-CYCLE83, called once
-or under MCALL, are followed (`sinumerik_cycles.py`); calls of other cycles, hole patterns
-and subprograms (by name or `L<n>`), splines, other frames, polar coordinates (AP=, RP=),
+or under MCALL, are followed (`sinumerik_cycles.py`).  A subprogram call (`L<n>`, a name, value
+parameters of its PROC, `P` runs) runs the subprogram's file from the subroutine path to M17
+or RET (`_call`): its moves are left as programmed (FLOW), and the moves after the call are
+compensated.  Calls of other cycles, hole patterns, subprogram files not found,
+splines, other frames, polar coordinates (AP=, RP=),
 arcs by opening angle (AR=) and unknown G codes make the position unknown: one warning (an error with `strict`) and the
 rest passes through.  Under cutter compensation (G41/G42 to the first move after
 G40) the moves are the programmed contour, the tool centre off it by the radius:
@@ -479,8 +482,10 @@ class SinumerikInterpreter(ModalInterpreter):
                     or (item.node[0] in RESETTING_CALLS and not item.node[1])
                 ):
                     pass
-                elif what == "call" and _SUBPROGRAM_NAME.fullmatch(item.node[0]) and not KNOWN_CYCLE.match(
-                    item.node[0]
+                elif (
+                    what == "call"
+                    and _SUBPROGRAM_NAME.fullmatch(item.node[0])
+                    and not KNOWN_CYCLE.match(item.node[0])
                 ):
                     call = self._call(block, item, item.node[0].upper(), item.node[1])
                 elif what not in ("label", "program_name", "block_delete"):

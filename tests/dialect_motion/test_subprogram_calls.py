@@ -69,11 +69,11 @@ def _folder(tmp_path: Path, files: dict[str, str]) -> Path:
     return folder
 
 
-def _events(interpret, dialect: str, text: str, folder: Path | None, strict: bool = False) -> tuple[list, str]:
+def _events(interpret, dialect: str, text: str, folder: Path | None) -> tuple[list, str]:
     warned = io.StringIO()
     _, blocks = parse_program(io.BytesIO(text.encode()), "main", dialect)
     offsets = WorkOffsets.given({}, subroutine_path=[folder] if folder else [])
-    warnings = Warnings(stream=warned, strict=strict)
+    warnings = Warnings(stream=warned)
     return list(interpret(blocks, file="main", warnings=warnings, offsets=offsets)), warned.getvalue()
 
 
@@ -177,13 +177,20 @@ def test_a_missing_file_warns_naming_it_and_the_folders_or_is_refused_strictly(
     assert status == 0 and message.format("warning:") in err and str(empty) in err, err
     assert after in out  # the rest as it was
     status, out, err = _compensate_cli(capsys, program, empty, "--strict")
-    assert status != 0 and out == "" and message.format("").replace("  ", " ") in err.replace("error: ", ""), err
+    assert (
+        status != 0 and out == "" and message.format("").replace("  ", " ") in err.replace("error: ", "")
+    ), err
 
 
 def test_sinumerik_file_names_ignore_case_and_accept_the_control_s_own(tmp_path):
     folder = _folder(tmp_path, {"l7.spf": "G1 X7 F100\nM17\n", "_N_PART2_MPF": "G1 Y3 F100\nRET\n"})
     events, warned = _events(sinumerik, "sinumerik", "G0 X0 Y0\nL7\n_N_PART2_MPF\nG1 X1\nM30\n", folder)
-    assert warned == "" and _path(events) == [(0, 0, 1, False), (7, 0, 2, True), (7, 3, 3, True), (1, 3, 4, False)]
+    assert warned == "" and _path(events) == [
+        (0, 0, 1, False),
+        (7, 0, 2, True),
+        (7, 3, 3, True),
+        (1, 3, 4, False),
+    ]
 
 
 def test_sinumerik_subprogram_variables_are_its_own_r_parameters_the_channel_s(tmp_path):
@@ -197,7 +204,11 @@ def test_sinumerik_subprogram_variables_are_its_own_r_parameters_the_channel_s(t
 @pytest.mark.parametrize(
     "files, call, reason",
     [
-        ({"DEEP.SPF": "G91 G1 X1 F100\nDEEP\nM17\n"}, "DEEP", "nests deeper than the control's 16 program levels"),
+        (
+            {"DEEP.SPF": "G91 G1 X1 F100\nDEEP\nM17\n"},
+            "DEEP",
+            "nests deeper than the control's 16 program levels",
+        ),
     ],
 )
 def test_sinumerik_a_subprogram_that_calls_itself_for_ever_is_refused(tmp_path, files, call, reason):
