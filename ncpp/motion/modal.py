@@ -66,7 +66,8 @@ class ModalInterpreter:
     """Position and modal state of one program run (program units throughout)."""
 
     def __init__(self, file: str = "<stdin>", zero: tuple[float, float, float] = (0.0, 0.0, 0.0)):
-        self.file = file
+        self.file = file  # the file of the blocks running (a called one's, while it runs)
+        self.program_file = file
         self.pos: list[float] = [0.0, 0.0, 0.0]
         self.plane = 17
         self.inch = False
@@ -110,13 +111,18 @@ class ModalInterpreter:
         self, warnings: Warnings, reason: str, block: Block, col: int | None, owner: Block | None = None
     ) -> None:
         """A construct outside the scope: the state is unknown from here on (an error with strict).
-        `owner`: the line that ran the block (a loop's end, a backward jump), from which the rest passes."""
+        `owner`: the line that ran the block (a loop's end, a backward jump, a call), from which the
+        rest passes.  In a called file, the warning stands at the calling line of the program (where
+        the program passes through from) and names the place in that file."""
         self.done = True
         where = "this line" if owner is None else f"line {owner.line}, which runs it,"
+        place = Location(self.file, block.line, col)
+        if self.file != self.program_file and owner is not None:
+            reason, place = f"{reason} (at {place})", Location(self.program_file, owner.line, None)
         warnings.warn(
             f"{reason} is outside the motion interpreter's scope; from {where} on the "
             "program passes through uninterpreted (its modal state is unknown)",
-            Location(self.file, block.line, col),
+            place,
         )
 
     def block(self, block: Block) -> list[Event]:

@@ -114,6 +114,8 @@ MAX_PROGRAM_LEVELS = 16
 _SUBPROGRAM_NAME = re.compile(r"(?:[A-Z]{2}|_[A-Z])\w*", re.I)
 # The Siemens cycles and their helpers, which stay as the cycles they are (`block`), not files
 KNOWN_CYCLE = re.compile(r"CYCLE\d|POCKET\d|SLOT\d|LONGHOLE|HOLES\d|E_|F_", re.I)
+# Predefined procedures that call programs in ways not followed here (absolute path, external memory)
+CALL_KEYWORDS = frozenset(("PCALL", "EXTCALL", "CALLPATH", "MCALL"))
 # PROC attributes that change nothing the motion depends on: the display and single-block
 # behaviour of the subprogram's blocks (SAVE, which restores the caller's modal state, is not followed)
 HARMLESS_PROC_ATTRIBUTES = frozenset(("DISPLOF", "DISPLON", "SBLOF", "SBLON", "ACTBLOCNO"))
@@ -248,6 +250,14 @@ class SinumerikInterpreter(ModalInterpreter):
             raise OutOfScope(f"the subprogram call {name} with parameters and P (later runs keep the "
                              "values the first left)", item.start + 1)  # fmt: skip
         return _Call(name, path, blocks, parameters, runs)
+
+    def _indirect(self, expr: tuple, block: Block, item) -> str:
+        """The program `CALL` names: a string, or a string variable's value (Job Planning manual,
+        "Indirect program call (CALL)"); its folders, the control's, dropped."""
+        name = expr[1] if expr[0] == "str" else self.variables.get(expr[1]) if expr[0] == "param" else None
+        if type(name) is not str or not name.strip("/"):
+            raise OutOfScope("CALL of a program named other than by a string", item.start + 1)
+        return name.rstrip("/").rsplit("/", 1)[-1].upper()
 
     def _parameters(self, blocks: list[Block], name: str, args: tuple, block: Block, item) -> dict:
         """The subprogram's PROC parameters (its first block, if any) given the call's values
@@ -470,6 +480,8 @@ class SinumerikInterpreter(ModalInterpreter):
                         f"the hole pattern {item.node[0]} (the control places its holes itself)",
                         item.start + 1,
                     )
+                elif what == "call" and item.node[0] == "CALL" and len(item.node[1]) == 1:
+                    call = self._call(block, item, self._indirect(item.node[1][0], block, item), ())
                 elif what == "call" and item.node[0] == "EXTERN":
                     return []  # (it declares a subprogram's parameters)
                 elif what == "call" and item.node[0] == "RET" and self.calls:
@@ -485,6 +497,7 @@ class SinumerikInterpreter(ModalInterpreter):
                 elif (
                     what == "call"
                     and _SUBPROGRAM_NAME.fullmatch(item.node[0])
+                    and item.node[0] not in CALL_KEYWORDS
                     and not KNOWN_CYCLE.match(item.node[0])
                 ):
                     call = self._call(block, item, item.node[0].upper(), item.node[1])

@@ -262,3 +262,13 @@ def test_klartext_called_program_in_inch_keeps_the_caller_s_millimetres(tmp_path
     moves = [e for e in events if type(e) is Line]
     assert warned == "" and [round(m.end[0], 6) for m in moves] == [0.0, 1.0, 26.4]  # 25.4 mm, then 1 mm more
     assert [m.context.inch for m in moves] == [False, True, False]
+
+
+def test_sinumerik_indirect_call_by_a_string_or_a_string_variable(tmp_path):
+    """`CALL "NAME"` and `CALL variable` (Job Planning manual, "Indirect program call"); the parser
+    refused `CALL "NAME"` as a syntax error."""
+    folder = _folder(tmp_path, {"PART2.SPF": "G1 X7 F100\nM17\n", "L0100.SPF": "G1 Y3 F100\nM17\n"})
+    text = 'DEF STRING[20] P="l0100"\nG0 X0 Y0\nCALL "/_N_WKS_DIR/PART2"\nCALL P\nG1 X1\nM30\n'
+    events, warned = _events(sinumerik, "sinumerik", text, folder)
+    assert warned == ""
+    assert _path(events) == [(0, 0, 2, False), (7, 0, 3, True), (7, 3, 4, True), (1, 3, 5, False)]
