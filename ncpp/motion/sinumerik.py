@@ -551,7 +551,9 @@ class SinumerikInterpreter(ModalInterpreter):
                 if letter in words:
                     self.fail(f"the address {letter} twice in one block", block, item)
                 words[letter] = (value, mode, item)
-        self.started = self.started or previous is not None  # (comments do not start the program)
+        # (comments and the program's name, `%_N_MYSUB_SPF` above its PROC, do not start the program)
+        self.started = self.started or any(type(i) is not Comment and getattr(i, "kind", "") != "program_name"
+                                           for i in block.items)  # fmt: skip
         plane = self.plane
         codes = {code for code, _ in gcodes}
         turn = True if codes & {41.0, 42.0} else False if 40.0 in codes else None  # cutter compensation

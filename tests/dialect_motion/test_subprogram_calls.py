@@ -272,3 +272,12 @@ def test_sinumerik_indirect_call_by_a_string_or_a_string_variable(tmp_path):
     events, warned = _events(sinumerik, "sinumerik", text, folder)
     assert warned == ""
     assert _path(events) == [(0, 0, 2, False), (7, 0, 3, True), (7, 3, 4, True), (1, 3, 5, False)]
+
+
+def test_sinumerik_subprogram_file_as_the_control_writes_it_out(tmp_path):
+    """Its name and path lines above the PROC (as a control writes a subprogram out)."""
+    sub = "%_N_HOLE_SPF\n;$PATH=/_N_SPF_DIR\nPROC HOLE(REAL X0) SBLOF\nG1 X=X0 F100\nM17\n"
+    events, warned = _events(
+        sinumerik, "sinumerik", "G0 X0\nHOLE(4)\nM30\n", _folder(tmp_path, {"HOLE.SPF": sub})
+    )
+    assert warned == "" and _path(events) == [(0, 0, 1, False), (4, 0, 2, True)]
