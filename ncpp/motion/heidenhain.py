@@ -251,8 +251,6 @@ class HeidenhainInterpreter(ModalInterpreter):
         rotation: str | None = None
         comp: str | None = None  # RL, RR or R0
         end = False
-        returning = False  # a called program's END PGM: back to the caller
-        called: Path | None = None  # the file of the program CALL PGM runs
         machine_datum = False  # M91: the block's coordinates are the machine datum's
         retract: float | str | None = None  # M140 MB: a retract along the tool axis after the move
         call: tuple[str, int] | None = None  # M99 or CYCL CALL and its column: the cycle runs after the move
@@ -296,11 +294,11 @@ class HeidenhainInterpreter(ModalInterpreter):
                 if self.flow is not None and self.flow.frames:  # (where the control goes is not told)
                     raise OutOfScope("END PGM in a subprogram (no LBL 0 before it)", item.start + 1)
                 if self.programs:  # a called program's END PGM returns to the caller
-                    returning = True
+                    self.returned = True
                 else:
                     end = True
             elif what == "call_program":
-                called = self._call_program(block, item)
+                self.called = self._call_program(block, item)
             elif what == "tool_call":
                 if node[1] is not None:
                     self.plane = PLANE_OF_TOOL_AXIS[node[1]]
@@ -381,7 +379,6 @@ class HeidenhainInterpreter(ModalInterpreter):
             self.last_move, self.corner_waits = events[-1], False
         if end:
             self.done = self.ended = True
-        self.returned, self.called = self.returned or returning, called
         return events
 
     def _define_cycle(self, number: str, block: Block) -> None:

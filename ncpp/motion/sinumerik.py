@@ -446,8 +446,6 @@ class SinumerikInterpreter(ModalInterpreter):
         mcall = False  # MCALL: the drilling cycle of the block is called after each move from here on
         drilling: Drilling | None = None  # a drilling cycle the block runs where it ends
         end = False
-        returning = False  # M17 or RET in a subprogram: back to the caller after the block
-        call: _Call | None = None  # a subprogram the block calls
         tool_words: list = []  # the block's T, M6 and D words, in order
         previous: Word | ExprWord | Statement | None = None
         for item in block.items:
@@ -481,13 +479,13 @@ class SinumerikInterpreter(ModalInterpreter):
                         item.start + 1,
                     )
                 elif what == "call" and item.node[0] == "CALL" and len(item.node[1]) == 1:
-                    call = self._call(block, item, self._indirect(item.node[1][0], block, item), ())
+                    self.called = self._call(block, item, self._indirect(item.node[1][0], block, item), ())
                 elif what == "call" and item.node[0] == "EXTERN":
                     return []  # (it declares a subprogram's parameters)
                 elif what == "call" and item.node[0] == "RET" and self.calls:
                     if item.node[1]:
                         raise OutOfScope("RET with parameters (a return elsewhere)", item.start + 1)
-                    returning = True
+                    self.returned = True  # (after the block)
                 elif what == "call" and (
                     item.node[0] in HARMLESS_CALLS
                     or item.node[0] in SETTING_CALLS
@@ -500,7 +498,7 @@ class SinumerikInterpreter(ModalInterpreter):
                     and item.node[0] not in CALL_KEYWORDS
                     and not KNOWN_CYCLE.match(item.node[0])
                 ):
-                    call = self._call(block, item, item.node[0].upper(), item.node[1])
+                    self.called = self._call(block, item, item.node[0].upper(), item.node[1])
                 elif what not in ("label", "program_name", "block_delete"):
                     name = item.node[0] if what in ("call", "path", "frame") else what.upper()
                     raise OutOfScope(
@@ -527,7 +525,7 @@ class SinumerikInterpreter(ModalInterpreter):
                 if value in END_M and self.calls:
                     if value != 17.0:
                         raise OutOfScope(f"M{value:g} in a subprogram (M17 or RET ends one)", item.start + 1)
-                    returning = True
+                    self.returned = True  # (after the block)
                 end = end or (value in END_M and not self.calls)
                 if value == TOOL_CHANGE:
                     tool_words.append((item, value))
@@ -544,7 +542,7 @@ class SinumerikInterpreter(ModalInterpreter):
                     )
                 if letter == "L" and type(item) is Word and item.number.isdigit():
                     # (leading zeros name another subprogram: L0100 is not L100)
-                    call = self._call(block, item, f"L{item.number}", ())
+                    self.called = self._call(block, item, f"L{item.number}", ())
                     continue
                 if letter == "L":
                     raise OutOfScope(f"the subprogram call L{value:g}", item.start + 1)
@@ -580,8 +578,6 @@ class SinumerikInterpreter(ModalInterpreter):
                 )
         if end:
             self.done = True
-        self.returned = self.returned or returning
-        self.called = call
         events = self.radius_compensation(events, turn)
         if drilling is None and not mcall and self.modal_cycle is not None and events:
             drilling = self.modal_cycle
