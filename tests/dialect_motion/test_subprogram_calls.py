@@ -18,6 +18,7 @@ from ncpp.motion.offsets import WorkOffsets
 from ncpp.motion.segments import FLOW, Arc, Line
 from ncpp.motion.sinumerik import interpret as sinumerik
 from ncpp.program.dialects import parse_program
+from tests.conftest import CORPUS
 
 WIDE = "/work/shared/machines/wide.toml"
 ROOT = Path(__file__).resolve().parents[2]
@@ -281,3 +282,40 @@ def test_sinumerik_subprogram_file_as_the_control_writes_it_out(tmp_path):
         sinumerik, "sinumerik", "G0 X0\nHOLE(4)\nM30\n", _folder(tmp_path, {"HOLE.SPF": sub})
     )
     assert warned == "" and _path(events) == [(0, 0, 1, False), (4, 0, 2, True)]
+
+
+PLAN = CORPUS / "heidenhain" / "jstjst_Heidenhain-Cycles"
+
+
+@pytest.mark.skipif(not (PLAN / "Plan.h").is_file(), reason="no corpus")
+def test_the_corpus_face_milling_cycle_runs_where_its_example_calls_it(tmp_path, capsys):
+    """Plan-Beispiel.h calls Plan.h (a face-milling spiral: labels, FN 9-12 jumps, RND, CT) by
+    `CALL PGM TNC:\\Plan.h`.  Plan.h reads Q108, the tool radius the control sets at TOOL CALL from
+    its tool table (TNC 640 Klartext manual, "Preassigned Q parameters"), which ncpp does not read:
+    as given, interpretation stops in Plan.h at its first use, the warning at the calling line;
+    with Q108 set in the caller (5 mm, a stand-in for the table), the whole cycle runs."""
+    main_text = (PLAN / "Plan-Beispiel.h").read_text()
+    program = tmp_path / "Plan-Beispiel.h"
+    program.write_text(main_text)
+    status, lines, err = _motion_cli(capsys, program, PLAN)
+    assert (
+        status == 0 and "Plan-Beispiel.h:23:1: warning: the parameter Q108" in err and "Plan.h:41:4)" in err
+    )
+    assert len(lines) == 1  # the move before the call
+
+    program.write_text(main_text.replace("R0 FMAX M3\n", "R0 FMAX M3\n4 Q108 = 5\n"))
+    events, warned = _events(heidenhain, "heidenhain", program.read_text(), PLAN)
+    moves = [e for e in events if type(e) is Line or type(e) is Arc]
+    called = [m for m in moves if m.block.line == 24]
+    assert "Q108" not in warned and len(called) == len(moves) - 2 and all(m.fixed == FLOW for m in called)
+    # From its Q parameters: start X = Q1800 - Q108 - Q1832 = -210; Y = Q1803 - (Q1962 - Q108) - Q108 -
+    # Q1832 with the side step Q1962 = (200 + 2 * 0.05 * 5) / INT(200.5 / (2 * 0.7 * 5) + 0.999) = 200.5 / 29
+    y = 100 - 200.5 / 29 - 5
+    assert [tuple(round(v, 6) for v in m.end) for m in called[:3]] == [
+        (-210.0, round(y, 6), 50.0),
+        (-210.0, round(y, 6), 50.0),  # to the second safety height Q1804 + Q1831, where it stands
+        (-210.0, round(y, 6), -1.0),  # the first of three infeeds of 1 mm (Q1805 = -3, Q1810 = 1)
+    ]
+    assert {m.end[2] for m in called if not (type(m) is Line and m.rapid)} == {-1.0, -2.0, -3.0}
+    assert called[-1].end[2] == 5.0 and called[-1].rapid  # out to the safety height Q1804 + Q1830
+    assert moves[-1].end == (0.0, 200.0, 300.0) and not moves[-1].fixed  # the caller's, compensated
