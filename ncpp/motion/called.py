@@ -14,6 +14,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from ncpp.errors import Location, NcppError
+from ncpp.motion.flow import MAX_RERUN
 from ncpp.program.blocks import Block
 from ncpp.program.parser import parse_stream
 
@@ -40,6 +41,15 @@ def searched(folders: Sequence[Path], names: Sequence[str]) -> str:
     if not folders:
         return "no --subroutine-path gives the folders of called files"
     return f"none of {', '.join(names)} in {os.pathsep.join(map(str, folders))}"
+
+
+def count_called(count: int, file: str, caller: Block) -> int:
+    """`count` blocks run in called files, and one more: past MAX_RERUN the program is taken for
+    one that never ends (calls nested and repeated multiply) and refused at the calling line."""
+    if count >= MAX_RERUN:
+        raise NcppError(f"more than {MAX_RERUN:,} blocks run in called files: a program that never ends "
+                        "(ncpp follows a program to its end)", Location(file, caller.line, None))  # fmt: skip
+    return count + 1
 
 
 def read_blocks(path: Path, dialect: str) -> list[Block]:

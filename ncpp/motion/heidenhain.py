@@ -38,7 +38,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ncpp.errors import Location, NcppError, Warnings
-from ncpp.motion.called import find_file, read_blocks, searched
+from ncpp.motion.called import count_called, find_file, read_blocks, searched
 from ncpp.motion.corners import CornerError, round_corner
 from ncpp.motion.heidenhain_cycles import (
     DEFINITION_ACTIVE,
@@ -175,6 +175,7 @@ class HeidenhainInterpreter(ModalInterpreter):
         self.main_path: Path | None = Path(file).resolve() if file != "<stdin>" else None
         self.called: Path | None = None  # the program the block just run calls
         self.returned = False  # the called program's END PGM ran
+        self.called_blocks = 0  # blocks run in called programs so far
         self._files: dict[Path, list[Block]] = {}  # called programs read, by path
 
     def run(self, blocks: Iterable[Block], warnings: Warnings) -> Iterator[Event]:
@@ -509,6 +510,7 @@ class HeidenhainInterpreter(ModalInterpreter):
                 if kind is SKIP or kind is TEXT:
                     continue
                 kind, owner = FIXED, caller
+                self.called_blocks = count_called(self.called_blocks, self.program_file, caller)
             if kind is SKIP or kind is TEXT or self.done or not block.items:
                 if owner is None:  # (after M2/M30/END PGM: a subprogram's text, run where it is called)
                     yield Pass(block, kind is SKIP or (kind is TEXT and self.ended))

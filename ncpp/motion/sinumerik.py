@@ -33,7 +33,7 @@ from pathlib import Path
 from typing import cast
 
 from ncpp.errors import Location, Warnings
-from ncpp.motion.called import find_file, read_blocks, searched
+from ncpp.motion.called import count_called, find_file, read_blocks, searched
 from ncpp.motion.flow import FIXED, RUN, SKIP
 from ncpp.motion.modal import (
     MM_PER_INCH,
@@ -115,7 +115,7 @@ _SUBPROGRAM_NAME = re.compile(r"(?:[A-Z]{2}|_[A-Z])\w*", re.I)
 # The Siemens cycles and their helpers, which stay as the cycles they are (`block`), not files
 KNOWN_CYCLE = re.compile(r"CYCLE\d|POCKET\d|SLOT\d|LONGHOLE|HOLES\d|E_|F_", re.I)
 # Predefined procedures that call programs in ways not followed here (absolute path, external memory)
-CALL_KEYWORDS = frozenset(("PCALL", "EXTCALL", "CALLPATH", "MCALL"))
+CALL_KEYWORDS = frozenset(("PCALL", "EXTCALL", "CALLPATH", "MCALL", "RET"))
 # PROC attributes that change nothing the motion depends on: the display and single-block
 # behaviour of the subprogram's blocks (SAVE, which restores the caller's modal state, is not followed)
 HARMLESS_PROC_ATTRIBUTES = frozenset(("DISPLOF", "DISPLON", "SBLOF", "SBLON", "ACTBLOCNO"))
@@ -163,6 +163,7 @@ class SinumerikInterpreter(ModalInterpreter):
         self.calls: list[str] = []  # the subprograms running, outermost first
         self.called: _Call | None = None  # the subprogram the block just run calls
         self.returned = False  # M17 or RET ended the subprogram running
+        self.called_blocks = 0  # blocks run in subprogram files so far
         self._files: dict[Path, list[Block]] = {}  # subprogram files read, by path
 
     # -- the event stream ---------------------------------------------------------------
@@ -186,6 +187,7 @@ class SinumerikInterpreter(ModalInterpreter):
                 if kind is not RUN and kind is not FIXED:
                     continue
                 kind, owner = FIXED, caller
+                self.called_blocks = count_called(self.called_blocks, self.program_file, caller)
             if (kind is not RUN and kind is not FIXED) or not block.items:
                 if owner is None:  # (a block run out of the text's order is written in its place)
                     yield Pass(block, kind is SKIP)

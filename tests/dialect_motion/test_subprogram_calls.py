@@ -319,3 +319,30 @@ def test_the_corpus_face_milling_cycle_runs_where_its_example_calls_it(tmp_path,
     assert {m.end[2] for m in called if not (type(m) is Line and m.rapid)} == {-1.0, -2.0, -3.0}
     assert called[-1].end[2] == 5.0 and called[-1].rapid  # out to the safety height Q1804 + Q1830
     assert moves[-1].end == (0.0, 200.0, 300.0) and not moves[-1].fixed  # the caller's, compensated
+
+
+@pytest.mark.parametrize(
+    "interpret, dialect, text, files",
+    [
+        (sinumerik, "sinumerik", "G0 X0\nOUTER P9999\nM30\n",
+         {"OUTER.SPF": "INNER P9999\nM17\n", "INNER.SPF": "G91 G1 X1 F100\nM17\n"}),
+        (heidenhain, "heidenhain", "0 BEGIN PGM M MM\n1 CALL PGM OUTER\n2 END PGM M MM\n",
+         {"OUTER.H": "0 BEGIN PGM OUTER MM\n1 LBL 1\n2 CALL PGM INNER\n3 CALL LBL 1 REP 9999\n"
+          "4 END PGM OUTER MM\n", "INNER.H": "0 BEGIN PGM INNER MM\n1 L IX+1 R0 F100\n2 END PGM INNER MM\n"}),
+    ],
+    ids=["sinumerik", "heidenhain"],
+)  # fmt: skip
+def test_calls_repeated_past_the_rerun_limit_are_refused_as_never_ending(
+    tmp_path, monkeypatch, interpret, dialect, text, files
+):
+    import ncpp.motion.called as called
+
+    monkeypatch.setattr(called, "MAX_RERUN", 1000)  # (the real limit, 5,000,000 blocks, takes a minute)
+    with pytest.raises(NcppError) as err:
+        _events(interpret, dialect, text, _folder(tmp_path, files))
+    assert "more than 1,000 blocks run in called files" in str(err.value) and "main:2:" in str(err.value)
+
+
+def test_sinumerik_ret_in_the_main_program_is_no_subprogram_call(tmp_path):
+    _, warned = _events(sinumerik, "sinumerik", "G0 X0\nRET\nM30\n", _folder(tmp_path, {"RET.SPF": "M17\n"}))
+    assert "main:2:1: warning: call RET is outside" in warned
