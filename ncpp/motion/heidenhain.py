@@ -10,7 +10,8 @@ helix with IZ, several turns with |IPA| > 360), Q parameters with arithmetic,
 labels, subprograms (`CALL LBL n` ... `LBL 0`), program-section repeats (`CALL LBL n REP k`)
 and the jumps FN 9-12 (`heidenhain_flow`: a block that runs again is left as programmed,
 FLOW), `CALL PGM` of a program file on the subroutine path (`_call_program`: its moves are left
-as programmed, FLOW, and the caller's after it compensated), `CYCL DEF` of machining cycles (they only define), the drilling cycles 200, 201, 203
+as programmed, FLOW, and the caller's after it compensated), `CYCL DEF` of machining cycles
+(they only define), the drilling cycles 200, 201, 203
 and 240 called by M99 or `CYCL CALL` (`heidenhain_cycles`: their moves along the tool axis are
 left as programmed, DRILLED), M2/M30
 and `END PGM` (end), and `RND R..` / `CHF ..` between two feed lines in the
@@ -20,7 +21,8 @@ Radius compensation RL/RR is followed to R0: the moves from the first with RL/RR
 to the R0 block's are the programmed contour, the tool centre off it by the radius,
 and are marked `fixed` (`ModalInterpreter.radius_compensation`).  Paraxial R+/R-,
 RND/CHF next to an arc or a rapid, FK free contours,
-APPR/DEP, `CALL PGM` of a file not found, calls of other cycles, `CYCL CALL POS`/`PAT`, M89, FN 14 and later FN
+APPR/DEP, `CALL PGM` of a file not found, calls of other cycles, `CYCL CALL POS`/`PAT`, M89, FN 14
+and later FN
 functions and cycles that move the datum make the position unknown: one warning (an error with
 `strict`) and the rest passes through.
 
@@ -538,11 +540,15 @@ class HeidenhainInterpreter(ModalInterpreter):
         """`CALL PGM name`: the called program's file, `name` (its drive and folders aside, which
         are the control's: `TNC:\\PARTS\\PLAN.H` is PLAN.H) on the subroutine path, `.H` if
         the name has no type.  Alone in its block but for comments."""
-        if any(other is not item and type(other) is not Comment and not (type(other) is Word and other.letter == "N")
-               for other in block.items):  # fmt: skip
-            raise OutOfScope("CALL PGM with more in its block", item.start + 1)
+        for other in block.items:
+            if (
+                other is not item
+                and type(other) is not Comment
+                and not (type(other) is Word and other.letter == "N")
+            ):
+                raise OutOfScope("CALL PGM with more in its block", other.start + 1)
         name = re.split(r"[\\/:]", item.node[0])[-1]
-        stem, dot, kind = name.rpartition(".")
+        _, dot, kind = name.rpartition(".")
         if dot and kind.upper() != "H":
             raise OutOfScope(f"CALL PGM {item.node[0]} (a program that is not Klartext, .H)", item.start + 1)
         names = [name] if dot else [f"{name}.h", name]

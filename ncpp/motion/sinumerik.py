@@ -552,8 +552,9 @@ class SinumerikInterpreter(ModalInterpreter):
                     self.fail(f"the address {letter} twice in one block", block, item)
                 words[letter] = (value, mode, item)
         # (comments and the program's name, `%_N_MYSUB_SPF` above its PROC, do not start the program)
-        self.started = self.started or any(type(i) is not Comment and getattr(i, "kind", "") != "program_name"
-                                           for i in block.items)  # fmt: skip
+        self.started = self.started or any(
+            type(i) is not Comment and not _program_name(i) for i in block.items
+        )
         plane = self.plane
         codes = {code for code, _ in gcodes}
         turn = True if codes & {41.0, 42.0} else False if 40.0 in codes else None  # cutter compensation
@@ -810,6 +811,10 @@ def _frame_name(code: float | None) -> str:
 
 
 interpret = placed_interpreting(SinumerikInterpreter)
+
+
+def _program_name(item) -> bool:
+    return type(item) is Statement and item.kind == "program_name"
 
 
 def _subprogram_files(name: str) -> list[str]:

@@ -37,7 +37,8 @@ N70 M30
 SINUMERIK_FILES = {
     "L0100.SPF": "%_N_L0100_SPF\nN10 G91 G1 X1 Y2\nN20 G90\nN30 M17\n",
     "L100.SPF": "N10 G1 X999\nM17\n",  # another subprogram: leading zeros count
-    "_N_MYSUB_SPF": "PROC MYSUB(REAL A, INT B) DISPLOF\nDEF REAL C=0.4\nN10 G1 X=A Y=B+C\nN20 R1=A*2\nN30 RET\n",
+    "_N_MYSUB_SPF": "PROC MYSUB(REAL A, INT B) DISPLOF\nDEF REAL C=0.4\nN10 G1 X=A Y=B+C\nN20 R1=A*2\n"
+    "N30 RET\n",
 }
 # (x, y, line of the main program the move belongs to, left as programmed)
 SINUMERIK_PATH = [(0, 0, 1, False), (10, 0, 2, False), (11, 2, 3, True), (12, 4, 3, True),
@@ -222,11 +223,13 @@ def test_sinumerik_a_subprogram_that_calls_itself_for_ever_is_refused(tmp_path, 
     "files, call, where, reason",
     [
         ({"END.SPF": "G1 X1 F100\nM30\n"}, "END", "END.SPF:2:1", "M30 in a subprogram"),
-        ({"NORET.SPF": "G1 X1 F100\n"}, "NORET", "NORET.SPF:1:", "the subprogram NORET ends without M17 or RET"),
+        ({"NORET.SPF": "G1 X1 F100\n"}, "NORET", "NORET.SPF:1:",
+         "the subprogram NORET ends without M17 or RET"),
         ({"SAVED.SPF": "PROC SAVED SAVE\nG1 X1 F100\nM17\n"}, "SAVED", "main:2:1",
          "the subprogram SAVED with PROC ... SAVE"),
         ({"REF.SPF": "PROC REF(VAR REAL A)\nM17\n"}, "REF(R1)", "main:2:1", "parameter VAR REAL A"),
-        ({"TWO.SPF": "PROC TWO(REAL A)\nG1 X=A F100\nM17\n"}, "TWO(1) P2", "main:2:1", "with parameters and P"),
+        ({"TWO.SPF": "PROC TWO(REAL A)\nG1 X=A F100\nM17\n"}, "TWO(1) P2", "main:2:1",
+         "with parameters and P"),
         ({"ALONE.SPF": "G1 X1 F100\nM17\n"}, "G1 Y2 L100", "main:2:1", "the subprogram call L100 with more"),
     ],
     ids=["m30", "no return", "save", "by reference", "parameters and runs", "not alone"],

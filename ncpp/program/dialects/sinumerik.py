@@ -15,8 +15,8 @@ Statement kinds and nodes (Sinumerik):
   assignment   (target, expr)             target ("param", "r1") | ("index", "feld", (exprs))
   label        (NAME,)                    `LABEL_1:` (upper case, no colon)
   call         (NAME, args)               `CYCLE81(10,0,2,-5)`, `MSG("x")`, `SETAL(1)`, `BNAT`,
-                                          `MATERIAL_UPDATE`: passed through; args tuple of exprs, None if empty;
-                                          `CALL "PART2"` (an indirect call) is ("CALL", (expr,))
+                                          `MATERIAL_UPDATE`: passed through; args tuple of exprs, None if
+                                          empty; `CALL "PART2"` (an indirect call) is ("CALL", (expr,))
   path         (NAME,)                    CIP CT ASPLINE BSPLINE CSPLINE POLY (words follow)
   frame        (NAME,)                    TRANS ATRANS ROT AROT SCALE ASCALE MIRROR AMIRROR ... (words follow)
   def          (type, length, vars)       `DEF STRING[8] A="x", B` -> ('STRING', ("num", 8.0), ((target, init|None), ...))
