@@ -34,7 +34,7 @@ from typing import cast
 
 from ncpp.errors import Location, Warnings
 from ncpp.motion.called import count_called, find_file, read_blocks, searched
-from ncpp.motion.flow import FIXED, RUN, SKIP
+from ncpp.motion.flow import FIXED, RUN, SKIP, TEXT
 from ncpp.motion.modal import (
     MM_PER_INCH,
     ModalInterpreter,
@@ -116,6 +116,8 @@ _SUBPROGRAM_NAME = re.compile(r"(?:[A-Z]{2}|_[A-Z])\w*", re.I)
 KNOWN_CYCLE = re.compile(r"CYCLE\d|POCKET\d|SLOT\d|LONGHOLE|HOLES\d|E_|F_", re.I)
 # Predefined procedures that call programs in ways not followed here (absolute path, external memory)
 CALL_KEYWORDS = frozenset(("PCALL", "EXTCALL", "CALLPATH", "MCALL", "RET"))
+# Control statements after which the flow may run blocks again (`sinumerik_flow`): their moves the line's
+RUNS_OTHERS = frozenset(("endwhile", "endfor", "until", "endloop", "goto", "case"))
 # PROC attributes that change nothing the motion depends on: the display and single-block
 # behaviour of the subprogram's blocks (SAVE, which restores the caller's modal state, is not followed)
 HARMLESS_PROC_ATTRIBUTES = frozenset(("DISPLOF", "DISPLON", "SBLOF", "SBLON", "ACTBLOCNO"))
@@ -190,7 +192,8 @@ class SinumerikInterpreter(ModalInterpreter):
                 self.called_blocks = count_called(self.called_blocks, self.program_file, caller)
             if (kind is not RUN and kind is not FIXED) or not block.items:
                 if owner is None:  # (a block run out of the text's order is written in its place)
-                    yield Pass(block, kind is SKIP)
+                    runs_others = kind is TEXT and not self.done and _runs_others(block)
+                    yield Pass(block, kind is SKIP, self.motion if runs_others else None)
                 continue
             try:
                 events = self.block(block)
@@ -210,8 +213,8 @@ class SinumerikInterpreter(ModalInterpreter):
                 flow.last_run_move = flow.pc
             if kind is FIXED and owner is not None:
                 yield from moves
-            else:
-                yield from events or (Pass(block),)
+            else:  # (a call's line: the mode its subprogram starts in, `SinumerikWriter.written_at_once`)
+                yield from events or (Pass(block, False, self.motion if self.called is not None else None),)
             if self.called is not None:
                 call, self.called = self.called, None
                 yield from self._subprogram(call, owner or block, warnings)
@@ -811,6 +814,12 @@ def _frame_name(code: float | None) -> str:
 
 
 interpret = placed_interpreting(SinumerikInterpreter)
+
+
+def _runs_others(block: Block) -> bool:
+    """A control line after whose text other blocks' moves may run, owned by it: a loop's end,
+    a jump, a CASE."""
+    return any(type(i) is Statement and i.kind in RUNS_OTHERS for i in block.items)
 
 
 def _program_name(item) -> bool:

@@ -98,6 +98,7 @@ class IsoWriter:
 
     comment_open, comment_close = "(", ")"
     control_at_once = True  # control lines are written at their first event (`written_at_once`)
+    written_at_once = staticmethod(written_at_once)
 
     def __init__(self, mm_decimals: int = 4, inch_decimals: int = 5):
         self.mm_decimals = mm_decimals
@@ -154,7 +155,7 @@ class IsoWriter:
             if group:
                 yield from write_group(group)
             block, group, control = event.block, [event], False
-            if self.control_at_once and written_at_once(event):
+            if self.control_at_once and self.written_at_once(event):
                 yield from write_group(group)
                 group, control = [], True
         if group:
