@@ -349,3 +349,28 @@ def test_calls_repeated_past_the_rerun_limit_are_refused_as_never_ending(
 def test_sinumerik_ret_in_the_main_program_is_no_subprogram_call(tmp_path):
     _, warned = _events(sinumerik, "sinumerik", "G0 X0\nRET\nM30\n", _folder(tmp_path, {"RET.SPF": "M17\n"}))
     assert "main:2:1: warning: call RET is outside" in warned
+
+
+def _long_zigzag(runs: int) -> str:
+    return "".join(f"G1 X{(n % 50) * 0.1:.1f} Y{n * 0.01:.2f}\n" for n in range(runs))
+
+
+@pytest.mark.parametrize(
+    "main_text, files",
+    [
+        ("G0 X0 Y0 Z5\nG1 Z0 F100\nLONG\nG1 X50 Y50\nM30\n", {"LONG.SPF": "G1 F100\n" + _long_zigzag(6000) + "M17\n"}),
+        ("G0 X0 Y0 Z5\nG1 Z0 F100\nZIG P3000\nG1 X50 Y50\nM30\n",
+         {"ZIG.SPF": "G91 G1 X0.01 Y0.01 F100\nG1 X-0.01\nG90\nM17\n"}),
+        ("DEF INT I\nG0 X0 Y0 Z5\nG1 Z0 F100\nFOR I=1 TO 3000\nG91 G1 X0.01 Y0.01\nG1 X-0.01\nG90\nENDFOR\n"
+         "G1 X50 Y50\nM30\n", {}),
+    ],
+    ids=["a long subprogram", "a subprogram run 3000 times", "a loop run 3000 times"],
+)  # fmt: skip
+def test_sinumerik_long_runs_are_written_and_verified_a_chunk_at_a_time(tmp_path, capsys, main_text, files):
+    """Over 4096 moves owned by one line (the call, the loop's end): the verifier compared them as one
+    piece and refused the program ("the written path leaves the original's")."""
+    program = tmp_path / "long.mpf"
+    program.write_text(main_text)
+    status, out, err = _compensate_cli(capsys, program, _folder(tmp_path, files))
+    assert status == 0 and "verification" not in err, err
+    assert "\nG1 X50 Y50\n" not in out and "X50.0" in out  # the move after the runs, compensated
