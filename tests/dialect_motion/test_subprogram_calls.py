@@ -369,8 +369,29 @@ def _long_zigzag(runs: int) -> str:
 def test_sinumerik_long_runs_are_written_and_verified_a_chunk_at_a_time(tmp_path, capsys, main_text, files):
     """Over 4096 moves owned by one line (the call, the loop's end): the verifier compared them as one
     piece and refused the program ("the written path leaves the original's")."""
-    program = tmp_path / "long.mpf"
+    _long_runs_compensate(tmp_path, capsys, "long.mpf", main_text, files, "\nG1 X50 Y50\n")
+
+
+def _long_runs_compensate(tmp_path, capsys, name: str, main_text: str, files: dict, after: str) -> None:
+    program = tmp_path / name
     program.write_text(main_text)
     status, out, err = _compensate_cli(capsys, program, _folder(tmp_path, files))
     assert status == 0 and "verification" not in err, err
-    assert "\nG1 X50 Y50\n" not in out and "X50.0" in out  # the move after the runs, compensated
+    assert after not in out and ("X50.0" in out or "X+50.0" in out)  # the move after the runs, compensated
+
+
+@pytest.mark.parametrize(
+    "main_text, files",
+    [
+        ("0 BEGIN PGM M MM\n1 L X+0 Y+0 Z+5 R0 FMAX\n2 L Z+0 R0 F100\n3 CALL PGM LONG\n4 L X+50 Y+50 R0 F100\n"
+         "5 END PGM M MM\n", {"LONG.H": "0 BEGIN PGM LONG MM\n" + "".join(
+             f"{n + 1} L X+{(n % 50) * 0.1:.1f} Y+{n * 0.01:.2f} R0 F100\n" for n in range(6000))
+             + "6001 END PGM LONG MM\n"}),
+        ("0 BEGIN PGM M MM\n1 L X+0 Y+0 Z+5 R0 FMAX\n2 L Z+0 R0 F100\n3 LBL 1\n4 L IX+0.01 IY+0.01 R0 F100\n"
+         "5 L IX-0.01\n6 CALL LBL 1 REP 3000\n7 L X+50 Y+50 R0 F100\n8 END PGM M MM\n", {}),
+    ],
+    ids=["a long called program", "a section repeated 3000 times"],
+)  # fmt: skip
+def test_klartext_long_runs_are_written_and_verified_a_chunk_at_a_time(tmp_path, capsys, main_text, files):
+    """As for Sinumerik: a call or repeat line owning over 4096 moves was refused by the verifier."""
+    _long_runs_compensate(tmp_path, capsys, "long.h", main_text, files, " L X+50 Y+50 R0 F100\n")
