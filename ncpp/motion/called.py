@@ -22,6 +22,27 @@ from ncpp.program.parser import parse_stream
 MAX_CALLED_BLOCKS = 200_000
 
 
+class Files:
+    """The files an interpreter's calls name, looked up once per name (a call in a loop is
+    looked up once) and read once per file."""
+
+    def __init__(self, folders: Sequence[Path], dialect: str):
+        self.folders, self.dialect = tuple(folders), dialect
+        self._found: dict[tuple[str, ...], Path | None] = {}
+        self._read: dict[Path, list[Block]] = {}
+
+    def find(self, names: Sequence[str]) -> Path | None:
+        key = tuple(names)
+        if key not in self._found:
+            self._found[key] = find_file(self.folders, names)
+        return self._found[key]
+
+    def blocks(self, path: Path) -> list[Block]:
+        if path not in self._read:
+            self._read[path] = read_blocks(path, self.dialect)
+        return self._read[path]
+
+
 def find_file(folders: Sequence[Path], names: Sequence[str]) -> Path | None:
     """The first file of `names` (any case) in the first folder of `folders` that holds one."""
     for folder in folders:

@@ -40,7 +40,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ncpp.errors import Location, NcppError, Warnings
-from ncpp.motion.called import count_called, find_file, read_blocks, searched
+from ncpp.motion.called import Files, count_called, searched
 from ncpp.motion.corners import CornerError, round_corner
 from ncpp.motion.heidenhain_cycles import (
     DEFINITION_ACTIVE,
@@ -178,7 +178,7 @@ class HeidenhainInterpreter(ModalInterpreter):
         self.called: Path | None = None  # the program the block just run calls
         self.returned = False  # the called program's END PGM ran
         self.called_blocks = 0  # blocks run in called programs so far
-        self._files: dict[Path, list[Block]] = {}  # called programs read, by path
+        self._files: Files | None = None  # the called programs' files, once a call needs them
 
     def run(self, blocks: Iterable[Block], warnings: Warnings) -> Iterator[Event]:
         """Events as `ModalInterpreter.run`; a feed line waits (with the events after it)
@@ -554,7 +554,8 @@ class HeidenhainInterpreter(ModalInterpreter):
         names = [name] if dot else [f"{name}.h", name]
         if len(self.programs) >= MAX_PROGRAM_NESTING:
             raise OutOfScope(f"programs called more than {MAX_PROGRAM_NESTING} deep", item.start + 1)
-        path = find_file(self.subroutine_path, names)
+        files = self._files = self._files or Files(self.subroutine_path, "heidenhain")
+        path = files.find(names)
         if path is None:
             raise OutOfScope(
                 f"CALL PGM {item.node[0]} (its file not found: {searched(self.subroutine_path, names)})",
@@ -570,9 +571,8 @@ class HeidenhainInterpreter(ModalInterpreter):
         """The called program from its first block to its END PGM, in the caller's state: the Q
         parameters are global (what it sets, the caller reads after), and so is the modal
         state; its own units (BEGIN PGM ... MM|INCH) hold while it runs."""
-        blocks = self._files.get(path)
-        if blocks is None:
-            blocks = self._files[path] = read_blocks(path, "heidenhain")
+        assert self._files is not None  # (`_call_program` found the file)
+        blocks = self._files.blocks(path)
         outer_file, outer_inch = self.file, self.inch
         self.programs.append(path.resolve())
         self.file = str(path)

@@ -33,7 +33,7 @@ from pathlib import Path
 from typing import cast
 
 from ncpp.errors import Location, Warnings
-from ncpp.motion.called import count_called, find_file, read_blocks, searched
+from ncpp.motion.called import Files, count_called, searched
 from ncpp.motion.flow import FIXED, RUN, SKIP, TEXT
 from ncpp.motion.modal import (
     MM_PER_INCH,
@@ -166,7 +166,7 @@ class SinumerikInterpreter(ModalInterpreter):
         self.called: _Call | None = None  # the subprogram the block just run calls
         self.returned = False  # M17 or RET ended the subprogram running
         self.called_blocks = 0  # blocks run in subprogram files so far
-        self._files: dict[Path, list[Block]] = {}  # subprogram files read, by path
+        self._files: Files | None = None  # the subprogram files, once a call needs them
 
     # -- the event stream ---------------------------------------------------------------
     def run(self, blocks: Iterable[Block], warnings: Warnings) -> Iterator[Event]:
@@ -241,15 +241,14 @@ class SinumerikInterpreter(ModalInterpreter):
             self.fail(f"the subprogram call {name} nests deeper than the control's {MAX_PROGRAM_LEVELS} "
                       "program levels (the main program's and its subprograms')", block, item)  # fmt: skip
         names = _subprogram_files(name)
-        path = find_file(self.subroutine_path, names)
+        files = self._files = self._files or Files(self.subroutine_path, "sinumerik")
+        path = files.find(names)
         if path is None:  # (a name may be a predefined procedure ncpp does not follow, or a subprogram)
             what = "the subprogram call" if type(item) is Word else "call"
             raise OutOfScope(
                 f"{what} {name} (its file not found: {searched(self.subroutine_path, names)})", item.start + 1
             )
-        blocks = self._files.get(path)
-        if blocks is None:
-            blocks = self._files[path] = read_blocks(path, "sinumerik")
+        blocks = files.blocks(path)
         parameters = self._parameters(blocks, name, args, block, item)
         if parameters and runs > 1:
             raise OutOfScope(f"the subprogram call {name} with parameters and P (later runs keep the "
