@@ -431,13 +431,13 @@ def verified(lines: Iterable[str], reached: Callable[[], tuple[int, int, int]], 
     NcppError where they part, or the program's first fault: the reading of the input runs
     ahead of the passes, so a fault it meets waits until the passes have had the lines before."""
     from ncpp.pipeline import dialect_tools
-    from ncpp.program.dialects.iso import IsoWriter, written_at_once
+    from ncpp.program.dialects.iso import IsoWriter
     from ncpp.program.parser import parse_stream
 
     feed = _Feed(lines, reached)
     held = _Held(original)
     writer: type[IsoWriter] = dialect_tools(dialect)[1]
-    divisible = written_at_once if writer.control_at_once else None
+    divisible = writer.written_at_once if writer.control_at_once else None
     cut: list[Position | None] = [None]  # where the input's chunk under way ends (None: at an action)
 
     def input_cut(block: Block, moves: int, run: int, into: int) -> Position | None:

@@ -146,6 +146,10 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_moves_after_a_return_are_corrected_from_the_home_position",
         ),
         "verify/test_verifier.py": ("test_a_path_over_itself_too_often_is_refused_with_a_way_out",),
+        "dialect_motion/test_subprogram_calls.py": (
+            "test_sinumerik_long_runs_are_written_and_verified_a_chunk_at_a_time",
+            "test_klartext_long_runs_are_written_and_verified_a_chunk_at_a_time",
+        ),
         "writeback/test_expand_flow.py": (
             "test_both_commands_take_the_option_and_refuse_with_the_place",
             "test_the_corpus_mount_program_expanded_runs_in_rs274_as_the_original",

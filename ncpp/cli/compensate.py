@@ -134,8 +134,10 @@ def add_placement_arguments(p: argparse.ArgumentParser) -> None:
         metavar="DIR[:DIR...]",
         type=lambda text: [d for d in text.split(os.pathsep) if d],
         default=[],
-        help="folders of subroutine files, as the INI's [RS274NGC]SUBROUTINE_PATH: `o<name> call` of a subroutine the "
-        "program does not define runs DIR/name.ngc (without it, such a call ends interpretation with a warning)",
+        help="folders of subroutine files, as the INI's [RS274NGC]SUBROUTINE_PATH: `o<name> call` of a "
+        "subroutine the program does not define runs DIR/name.ngc, Fanuc's M98 P<n> DIR/O<n>, Sinumerik's "
+        "L<n> or NAME DIR/NAME.SPF (or _N_NAME_SPF), Klartext's CALL PGM NAME DIR/NAME.H (without it, such a "
+        "call ends interpretation with a warning)",
     )
 
 

@@ -9,10 +9,12 @@ half circle), `CT` (tangential arc), `LP`/`CP` polar with PR/IPR/PA/IPA (a
 helix with IZ, several turns with |IPA| > 360), Q parameters with arithmetic,
 labels, subprograms (`CALL LBL n` ... `LBL 0`), program-section repeats (`CALL LBL n REP k`)
 and the jumps FN 9-12 (`heidenhain_flow`: a block that runs again is left as programmed,
-FLOW), `CYCL DEF` of machining cycles (they only define), the drilling cycles 200, 201, 203,
-207 and 240 called by M99, `CYCL CALL` or `CYCL CALL POS` (`heidenhain_cycles`: their moves
-along the tool axis are left as programmed, DRILLED) or `CYCL CALL PAT` at the holes of a
-`PATTERN DEF` (all its moves left as programmed, PATTERN), M2/M30
+FLOW), `CALL PGM` of a program file on the subroutine path (`_call_program`: its moves are left
+as programmed, FLOW, and the caller's after it compensated), `CYCL DEF` of machining cycles
+(they only define), the drilling cycles 200, 201, 203, 207 and 240 called by M99, `CYCL CALL`
+or `CYCL CALL POS` (`heidenhain_cycles`: their moves along the tool axis are left as
+programmed, DRILLED) or `CYCL CALL PAT` at the holes of a `PATTERN DEF` (all its moves left as
+programmed, PATTERN), M2/M30
 and `END PGM` (end), and `RND R..` / `CHF ..` between two feed lines in the
 working plane (the fillet arc or chamfer line is the RND/CHF block's event; a
 feed line waits for the next move to know whether its corner is cut).
@@ -20,7 +22,8 @@ Radius compensation RL/RR is followed to R0: the moves from the first with RL/RR
 to the R0 block's are the programmed contour, the tool centre off it by the radius,
 and are marked `fixed` (`ModalInterpreter.radius_compensation`).  Paraxial R+/R-,
 RND/CHF next to an arc or a rapid, FK free contours,
-APPR/DEP, `CALL PGM`, calls of other cycles, point tables, M89, FN 14 and later FN
+APPR/DEP, `CALL PGM` of a file not found, calls of other cycles, point tables, M89, FN 14 and
+later FN
 functions and cycles that move the datum make the position unknown: one warning (an error with
 `strict`) and the rest passes through.
 
@@ -35,8 +38,10 @@ import operator
 import re
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
+from pathlib import Path
 
 from ncpp.errors import Location, NcppError, Warnings
+from ncpp.motion.called import Files, count_called, searched
 from ncpp.motion.corners import CornerError, round_corner
 from ncpp.motion.heidenhain_cycles import (
     DEFINITION_ACTIVE,
@@ -66,6 +71,9 @@ from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
 AXES = "XYZ"
 ROTARY = ("A", "B", "C")
 # Cycles that move or turn the datum (datum shift, mirror, rotation, scaling, working plane, presets)
+# Programs CALL PGM runs nest this deep (TNC 640 Klartext manual, "Nesting": "Maximum nesting
+# depth for calling NC main programs")
+MAX_PROGRAM_NESTING = 19
 DATUM_CYCLES = frozenset(("7", "8", "10", "11", "19", "26"))
 # CYCL DEF 247 DATUM SETTING activates the preset Q339 of the preset table (TNC 640 Klartext manual,
 # "Cycle 247 DATUM SETTING"): the program zero ncpp is told is that preset's; another preset later
@@ -172,6 +180,12 @@ class HeidenhainInterpreter(ModalInterpreter):
         self.cycle: Drilling | str | None = None  # the cycle M99 / CYCL CALL runs (str: one not followed)
         self.spindle = 0.0  # the speed TOOL CALL S set (rev/min): a tapping cycle's feed follows it
         self.pattern: tuple[str, list[Hole]] | str | None = None  # PATTERN DEF's holes (str: not followed)
+        self.programs: list[Path] = []  # the programs CALL PGM runs, outermost first
+        self.main_path: Path | None = Path(file).resolve() if file != "<stdin>" else None
+        self.called: Path | None = None  # the program the block just run calls
+        self.returned = False  # the called program's END PGM ran
+        self.called_blocks = 0  # blocks run in called programs so far
+        self._files: Files | None = None  # the called programs' files, once a call needs them
 
     def run(self, blocks: Iterable[Block], warnings: Warnings) -> Iterator[Event]:
         """Events as `ModalInterpreter.run`; a feed line waits (with the events after it)
@@ -273,6 +287,9 @@ class HeidenhainInterpreter(ModalInterpreter):
                     if value == 92.0:  # (its datum is a machine parameter ncpp is not told)
                         raise OutOfScope("M92 (a position the machine tool builder sets)", item.start + 1)
                     machine_datum = machine_datum or value == 91.0
+                    if value in END_M and self.programs:
+                        raise OutOfScope(f"M{value:g} in a program CALL PGM runs (its END PGM returns)",
+                                         item.start + 1)  # fmt: skip
                     end = end or value in END_M
                     continue
                 if letter in ROTARY:  # (its moves would be compensated as if the axis stood)
@@ -289,7 +306,12 @@ class HeidenhainInterpreter(ModalInterpreter):
             elif what == "program_end":
                 if self.flow is not None and self.flow.frames:  # (where the control goes is not told)
                     raise OutOfScope("END PGM in a subprogram (no LBL 0 before it)", item.start + 1)
-                end = True
+                if self.programs:  # a called program's END PGM returns to the caller
+                    self.returned = True
+                else:
+                    end = True
+            elif what == "call_program":
+                self.called = self._call_program(block, item)
             elif what == "tool_call":
                 if node[1] is not None:
                     self.plane = PLANE_OF_TOOL_AXIS[node[1]]
@@ -347,7 +369,7 @@ class HeidenhainInterpreter(ModalInterpreter):
             elif what == "fn" and node[0] in JUMPS and self.flow is not None:
                 self._jump(block, item)
             else:
-                reason = {"call_label": "CALL LBL", "call_program": "CALL PGM", "cycle_call": "CYCL CALL",
+                reason = {"call_label": "CALL LBL", "cycle_call": "CYCL CALL",
                           "fn": f"FN {node[0]}", "keyword": " ".join(map(str, node))}.get(what, what)  # fmt: skip
                 raise OutOfScope(reason, item.start + 1)
         if defined is not None:
@@ -599,12 +621,23 @@ class HeidenhainInterpreter(ModalInterpreter):
         """Events as `ModalInterpreter.run`, block by block in the order they run: the moves of
         a block that runs again are left as programmed (FLOW) and, where it runs out of the
         text's order, belong to the line that runs it (a call, a jump back), written once."""
-        flow = self.flow = KlartextFlow(self.file, blocks)
+        return self._run_flow(KlartextFlow(self.file, blocks), warnings, None)
+
+    def _run_flow(self, flow: KlartextFlow, warnings: Warnings, caller: Block | None) -> Iterator[Event]:
+        """`_flowing` over the program (`caller` None) or over a program the line `caller` calls
+        by CALL PGM: its blocks all run out of the text's order, their moves the caller's, and
+        its text is no part of the output."""
+        self.flow = flow
 
         def stop(reason: str, owner: Block) -> None:  # (where the flow itself cannot go on)
-            self.leave_scope(warnings, reason, owner, None)
+            self.leave_scope(warnings, reason, owner, None, caller)
 
-        for block, kind, owner in flow.steps(lambda: self.done, stop):
+        for block, kind, owner in flow.steps(lambda: self.done or self.returned, stop):
+            if caller is not None:
+                if kind is SKIP or kind is TEXT:
+                    continue
+                kind, owner = FIXED, caller
+                self.called_blocks = count_called(self.called_blocks, self.program_file, caller)
             if kind is SKIP or kind is TEXT or self.done or not block.items:
                 if owner is None:  # (after M2/M30/END PGM: a subprogram's text, run where it is called)
                     yield Pass(block, kind is SKIP or (kind is TEXT and self.ended))
@@ -612,6 +645,7 @@ class HeidenhainInterpreter(ModalInterpreter):
             try:
                 events = self.block(block)
             except OutOfScope as out:
+                self.called = None
                 self.leave_scope(warnings, out.reason, block, out.col, owner)
                 if owner is None:
                     yield Pass(block)
@@ -621,6 +655,62 @@ class HeidenhainInterpreter(ModalInterpreter):
             elif flow.labels and any(type(e) is Line or type(e) is Arc for e in events):
                 flow.moved()  # (before the first label nothing can jump back over it)
             yield from events or ((Pass(block),) if owner is None else ())
+            if self.called is not None:
+                path, self.called = self.called, None
+                yield from self._program(path, owner or block, warnings)
+                self.flow = flow
+
+    # -- CALL PGM (TNC 640 Klartext manual, "Calling any program as a subprogram") ------------
+    def _call_program(self, block: Block, item) -> Path:
+        """`CALL PGM name`: the called program's file, `name` (its drive and folders aside, which
+        are the control's: `TNC:\\PARTS\\PLAN.H` is PLAN.H) on the subroutine path, `.H` if
+        the name has no type.  Alone in its block but for comments."""
+        for other in block.items:
+            if (
+                other is not item
+                and type(other) is not Comment
+                and not (type(other) is Word and other.letter == "N")
+            ):
+                raise OutOfScope("CALL PGM with more in its block", other.start + 1)
+        name = re.split(r"[\\/:]", item.node[0])[-1]
+        _, dot, kind = name.rpartition(".")
+        if dot and kind.upper() != "H":
+            raise OutOfScope(f"CALL PGM {item.node[0]} (a program that is not Klartext, .H)", item.start + 1)
+        names = [name] if dot else [f"{name}.h", name]
+        if len(self.programs) >= MAX_PROGRAM_NESTING:
+            raise OutOfScope(f"programs called more than {MAX_PROGRAM_NESTING} deep", item.start + 1)
+        files = self._files = self._files or Files(self.subroutine_path, "heidenhain")
+        path = files.find(names)
+        if path is None:
+            raise OutOfScope(
+                f"CALL PGM {item.node[0]} (its file not found: {searched(self.subroutine_path, names)})",
+                item.start + 1,
+            )
+        if path.resolve() in self.programs or path.resolve() == self.main_path:
+            raise OutOfScope(
+                f"CALL PGM {item.node[0]}, a program that calls itself (for ever)", item.start + 1
+            )
+        return path
+
+    def _program(self, path: Path, caller: Block, warnings: Warnings) -> Iterator[Event]:
+        """The called program from its first block to its END PGM, in the caller's state: the Q
+        parameters are global (what it sets, the caller reads after), and so is the modal
+        state; its own units (BEGIN PGM ... MM|INCH) hold while it runs."""
+        assert self._files is not None  # (`_call_program` found the file)
+        blocks = self._files.blocks(path)
+        outer_file, outer_inch = self.file, self.inch
+        self.programs.append(path.resolve())
+        self.file = str(path)
+        try:
+            yield from self._run_flow(KlartextFlow(str(path), blocks), warnings, caller)
+            if not self.done and not self.returned:
+                self.leave_scope(warnings, f"the called program {path.name} ends without END PGM",
+                                 blocks[-1] if blocks else caller, None, caller)  # fmt: skip
+        finally:
+            self.programs.pop()
+            self.file, self.returned = outer_file, False
+        if not self.done:
+            self.set_units(outer_inch)
 
     def _call_label(self, block: Block, item) -> None:
         """`CALL LBL n [REP k]`: a subprogram call or a program-section repeat."""

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Iterable, Iterator, Sequence
+from pathlib import Path
 from typing import NoReturn
 
 from ncpp.errors import Location, NcppError, Warnings, resolve_warnings
@@ -56,6 +57,7 @@ def placed_interpreting(dialect: type[ModalInterpreter]) -> Callable[..., Iterat
         warnings = resolve_warnings(warnings, strict)
         told = offsets is None or offsets.tools is not None
         interpreter.untold_lengths = UntoldLengths(not told, warnings)  # type: ignore[attr-defined]
+        interpreter.subroutine_path = offsets.subroutine_path if offsets is not None else ()
         return interpreter.run(blocks, warnings)
 
     return interpret
@@ -65,7 +67,8 @@ class ModalInterpreter:
     """Position and modal state of one program run (program units throughout)."""
 
     def __init__(self, file: str = "<stdin>", zero: tuple[float, float, float] = (0.0, 0.0, 0.0)):
-        self.file = file
+        self.file = file  # the file of the blocks running (a called one's, while it runs)
+        self.program_file = file
         self.pos: list[float] = [0.0, 0.0, 0.0]
         self.plane = 17
         self.inch = False
@@ -89,6 +92,7 @@ class ModalInterpreter:
         self.off_path = False  # the tool centre off the programmed path: from the first move with it on to the first after
         self.tool_id = ""  # the tool in the spindle as the program names it (Context.tool_id)
         self._context: Context | None = None
+        self.subroutine_path: tuple[Path, ...] = ()  # the folders of the program files it calls
 
     # -- the event stream -------------------------------------------------------------
     def run(self, blocks: Iterable[Block], warnings: Warnings) -> Iterator[Event]:
@@ -108,13 +112,18 @@ class ModalInterpreter:
         self, warnings: Warnings, reason: str, block: Block, col: int | None, owner: Block | None = None
     ) -> None:
         """A construct outside the scope: the state is unknown from here on (an error with strict).
-        `owner`: the line that ran the block (a loop's end, a backward jump), from which the rest passes."""
+        `owner`: the line that ran the block (a loop's end, a backward jump, a call), from which the
+        rest passes.  In a called file, the warning stands at the calling line of the program (where
+        the program passes through from) and names the place in that file."""
         self.done = True
         where = "this line" if owner is None else f"line {owner.line}, which runs it,"
+        place = Location(self.file, block.line, col)
+        if self.file != self.program_file and owner is not None:
+            reason, place = f"{reason} (at {place})", Location(self.program_file, owner.line, None)
         warnings.warn(
             f"{reason} is outside the motion interpreter's scope; from {where} on the "
             "program passes through uninterpreted (its modal state is unknown)",
-            Location(self.file, block.line, col),
+            place,
         )
 
     def block(self, block: Block) -> list[Event]:

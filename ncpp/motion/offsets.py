@@ -50,7 +50,8 @@ class WorkOffsets:
     the program's start; the G92 offset in effect; the G28 and G30 positions; its
     tool table (None: not told, G43 applies length 0); and the folders it finds
     subroutine files in (LinuxCNC's [RS274NGC]SUBROUTINE_PATH: `o<name> call` of a
-    subroutine the program does not define runs `name.ngc`)."""
+    subroutine the program does not define runs `name.ngc`; Fanuc's, Sinumerik's and
+    Klartext's called programs too)."""
 
     systems: tuple[Vector | None, ...] = (None,) * 9
     active: int = 1

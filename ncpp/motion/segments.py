@@ -222,7 +222,9 @@ class Pass:
 
     block: Block
     skipped: bool = False  # the program does not run it (an untaken branch, a subroutine's definition)
-    motion: float | None = None  # an o-word control line's: the modal motion (G0-G3, a cycle) where it runs
+    # a control line's (an o-word; Sinumerik's loop end, jump or subprogram call, which runs other
+    # blocks' moves after its text): the modal motion (G0-G3, a cycle; Sinumerik's CIP, CT) where it runs
+    motion: float | str | None = None
     setting: Setting | None = None  # a G92 or G10 L20 block's
     # --expand-cycles: `cycle` the G code of a canned cycle's block whose moves are written as G0/G1 blocks
     # (the first of its events), `dwell` the seconds it dwells between two of them (G82 G89's P)

@@ -13,7 +13,11 @@ GOTOB, GOTO, GOTOC, CASE, IF, WHILE, FOR, REPEAT, LOOP) runs as `sinumerik_flow.
 loop's moves are left as programmed (FLOW).  The drilling, tapping and boring cycles
 CYCLE81-CYCLE89 and CYCLE840, called once or under MCALL, are followed (`sinumerik_cycles.py`),
 as are the hole patterns HOLES1 and HOLES2 under MCALL (their moves left as programmed,
-PATTERN); calls of other cycles, the patterns CYCLE801 and CYCLE802 and subprograms (by name or `L<n>`), splines, other frames, polar coordinates (AP=, RP=),
+PATTERN).  A subprogram call (`L<n>`, a name, value parameters of its PROC, `P` runs) runs the
+subprogram's file from the subroutine path to M17 or RET (`_call`): its moves are left as
+programmed (FLOW), and the moves after the call are compensated.  Calls of other cycles, the
+patterns CYCLE801 and CYCLE802, subprogram files not found, splines, other frames, polar
+coordinates (AP=, RP=),
 arcs by opening angle (AR=) and unknown G codes make the position unknown: one warning (an error with `strict`) and the
 rest passes through.  Under cutter compensation (G41/G42 to the first move after
 G40) the moves are the programmed contour, the tool centre off it by the radius:
@@ -24,13 +28,17 @@ from __future__ import annotations
 
 import itertools
 import math
+import re
 from collections.abc import Iterable, Iterator
+from dataclasses import dataclass
+from pathlib import Path
 from typing import cast
 
 import numpy as np
 
 from ncpp.errors import Location, Warnings
-from ncpp.motion.flow import FIXED, RUN, SKIP
+from ncpp.motion.called import Files, count_called, searched
+from ncpp.motion.flow import FIXED, RUN, SKIP, TEXT
 from ncpp.motion.modal import (
     MAX_HOLES,
     MM_PER_INCH,
@@ -103,6 +111,38 @@ _FROM_THE_CALLER = "(the caller's value)"  # a PROC parameter's value: not told
 
 MAX_ELEMENTS = 65_536  # the elements of an array this interpreter holds (each is a variable)
 
+# Subprograms (840D sl Programming Manual, Fundamentals, "Subprogram technique"): a program runs
+# another by its name (`MYSUB`, `MYSUB(1, 2)` for `PROC MYSUB(REAL A, INT B)`) or its number
+# (`L100`; leading zeros count: L0100 is another), `P` times (1-9999); M17 or RET returns.  The
+# control nests up to 16 program levels, the main program's among them.
+MAX_RUNS = 9999
+MAX_PROGRAM_LEVELS = 16
+# A name a subprogram can be called by: two letters or `_` and a letter first ("Subprogram names")
+_SUBPROGRAM_NAME = re.compile(r"(?:[A-Z]{2}|_[A-Z])\w*", re.I)
+# The Siemens cycles and their helpers, which stay as the cycles they are (`block`), not files
+KNOWN_CYCLE = re.compile(r"CYCLE\d|POCKET\d|SLOT\d|LONGHOLE|HOLES\d|E_|F_", re.I)
+# Predefined procedures that call programs in ways not followed here (absolute path, external memory)
+CALL_KEYWORDS = frozenset(("PCALL", "EXTCALL", "CALLPATH", "MCALL", "RET"))
+# Control statements after which the flow may run blocks again (`sinumerik_flow`): their moves the line's
+RUNS_OTHERS = frozenset(("endwhile", "endfor", "until", "endloop", "goto", "case"))
+# PROC attributes that change nothing the motion depends on: the display and single-block
+# behaviour of the subprogram's blocks (SAVE, which restores the caller's modal state, is not followed)
+HARMLESS_PROC_ATTRIBUTES = frozenset(("DISPLOF", "DISPLON", "SBLOF", "SBLON", "ACTBLOCNO"))
+_R_PARAMETER = re.compile(r"r\d+")  # the channel's R parameters: shared by every program level
+# `_N_MYSUB_SPF`, `MYSUB_SPF`: a name with the control's own prefix and type (all are the same program)
+_CONTROL_NAME = re.compile(r"(?:_N_)?(\w+?)(?:_(SPF|MPF))?", re.I)
+
+
+@dataclass(frozen=True)
+class _Call:
+    """A subprogram call: the file, its blocks, its PROC parameters' values, its runs."""
+
+    name: str
+    path: Path
+    blocks: list[Block]
+    parameters: dict
+    runs: int
+
 
 class SinumerikInterpreter(ModalInterpreter):
     def __init__(
@@ -130,25 +170,43 @@ class SinumerikInterpreter(ModalInterpreter):
         self.frame_shift = [0.0, 0.0, 0.0]
         self.told_frame: float | None = None  # the settable frame the program selected first
         self.zero_frame: float | None = None  # the one in effect (None: as when the program started)
+        self.calls: list[str] = []  # the subprograms running, outermost first
+        self.called: _Call | None = None  # the subprogram the block just run calls
+        self.returned = False  # M17 or RET ended the subprogram running
+        self.called_blocks = 0  # blocks run in subprogram files so far
+        self._files: Files | None = None  # the subprogram files, once a call needs them
 
     # -- the event stream ---------------------------------------------------------------
     def run(self, blocks: Iterable[Block], warnings: Warnings) -> Iterator[Event]:
         """Events block by block, in the order the blocks run (`sinumerik_flow.py`): a block
         run out of the text's order gives its moves, left as programmed, to the line that
         runs it (its `owner`), so that every block's text is written once, where it stands."""
+        return self._run(blocks, warnings, None)
+
+    def _run(self, blocks: Iterable[Block], warnings: Warnings, caller: Block | None) -> Iterator[Event]:
+        """`run` over the program (`caller` None) or over a subprogram file the line `caller`
+        calls: its blocks all run out of the text's order, their moves the caller's, and its
+        text is no part of the output."""
 
         def leave(reason: str, block: Block, col: int | None, owner: Block | None) -> None:
-            self.leave_scope(warnings, reason, block, col, owner)
+            self.leave_scope(warnings, reason, block, col, caller or owner)
 
-        flow = SinumerikFlow(self.file, self.value, self.assign, lambda: self.done, leave)
+        flow = SinumerikFlow(self.file, self.value, self.assign, lambda: self.done or self.returned, leave)
         for block, kind, owner in flow.steps(blocks):
+            if caller is not None:
+                if kind is not RUN and kind is not FIXED:
+                    continue
+                kind, owner = FIXED, caller
+                self.called_blocks = count_called(self.called_blocks, self.program_file, caller)
             if (kind is not RUN and kind is not FIXED) or not block.items:
                 if owner is None:  # (a block run out of the text's order is written in its place)
-                    yield Pass(block, kind is SKIP)
+                    runs_others = kind is TEXT and not self.done and _runs_others(block)
+                    yield Pass(block, kind is SKIP, self.motion if runs_others else None)
                 continue
             try:
                 events = self.block(block)
             except OutOfScope as stop:
+                self.called = None
                 self.leave_scope(warnings, stop.reason, block, stop.col, owner)
                 if owner is None:  # (a block run out of the text's order is written in its place)
                     yield Pass(block)
@@ -159,12 +217,111 @@ class SinumerikInterpreter(ModalInterpreter):
                     move.fixed = move.fixed or FLOW  # type: ignore[union-attr]
                     if owner is not None:
                         move.block = owner
-                if owner is not None:
-                    yield from moves
-                    continue
             elif moves:
                 flow.last_run_move = flow.pc
-            yield from events or (Pass(block),)
+            if kind is FIXED and owner is not None:
+                yield from moves
+            else:  # (a call's line: the mode its subprogram starts in, `SinumerikWriter.written_at_once`)
+                yield from events or (Pass(block, False, self.motion if self.called is not None else None),)
+            if self.called is not None:
+                call, self.called = self.called, None
+                yield from self._subprogram(call, owner or block, warnings)
+
+    # -- subprogram calls (840D sl Programming Manual, Fundamentals, "Subprogram technique") --
+    def _call(self, block: Block, item: Word | Statement, name: str, args: tuple) -> _Call:
+        """A call of subprogram `name` (`L100`, `MYSUB`, `MYSUB(1, 2)`), alone in its block but for
+        its block number, labels, comments and `P` (the number of runs, 1-9999): its file from
+        the subroutine path, its `PROC` parameters given the call's values."""
+        runs = 1
+        for other in block.items:
+            if other is item or type(other) is Comment or (type(other) is Word and other.letter in "N:"):
+                continue
+            if type(other) is Statement and other.kind == "label":
+                continue
+            if (type(other) is Word or type(other) is ExprWord) and other.letter == "P":
+                value = self._word_value(other, block)[0] if type(other) is ExprWord else other.value
+                if value != round(value) or not 1 <= value <= MAX_RUNS:
+                    self.fail(f"P{value:g}: a subprogram runs 1 to {MAX_RUNS} times", block, other)
+                runs = int(value)
+                continue
+            raise OutOfScope(f"the subprogram call {name} with more in its block", other.start + 1)
+        if len(self.calls) + 1 >= MAX_PROGRAM_LEVELS:
+            self.fail(f"the subprogram call {name} nests deeper than the control's {MAX_PROGRAM_LEVELS} "
+                      "program levels (the main program's and its subprograms')", block, item)  # fmt: skip
+        names = _subprogram_files(name)
+        files = self._files = self._files or Files(self.subroutine_path, "sinumerik")
+        path = files.find(names)
+        if path is None:  # (a name may be a predefined procedure ncpp does not follow, or a subprogram)
+            what = "the subprogram call" if type(item) is Word else "call"
+            raise OutOfScope(
+                f"{what} {name} (its file not found: {searched(self.subroutine_path, names)})", item.start + 1
+            )
+        blocks = files.blocks(path)
+        parameters = self._parameters(blocks, name, args, block, item)
+        if parameters and runs > 1:
+            raise OutOfScope(f"the subprogram call {name} with parameters and P (later runs keep the "
+                             "values the first left)", item.start + 1)  # fmt: skip
+        return _Call(name, path, blocks, parameters, runs)
+
+    def _indirect(self, expr: tuple, block: Block, item) -> str:
+        """The program `CALL` names: a string, or a string variable's value (Job Planning manual,
+        "Indirect program call (CALL)"); its folders, the control's, dropped."""
+        name = expr[1] if expr[0] == "str" else self.variables.get(expr[1]) if expr[0] == "param" else None
+        if type(name) is not str or not name.strip("/"):
+            raise OutOfScope("CALL of a program named other than by a string", item.start + 1)
+        return name.rstrip("/").rsplit("/", 1)[-1].upper()
+
+    def _parameters(self, blocks: list[Block], name: str, args: tuple, block: Block, item) -> dict:
+        """The subprogram's PROC parameters (its first block, if any) given the call's values
+        (840D sl Job Planning manual, "Subprograms with parameter transfer": an omitted value
+        parameter is 0, an empty string); parameters by reference (VAR) and arrays are not followed."""
+        proc = next((i for b in blocks for i in b.items if type(i) is Statement and i.kind == "proc"), None)
+        declared = () if proc is None else proc.node[1]
+        if len(args) > len(declared):
+            self.fail(f"{name} takes {len(declared)} parameters, not {len(args)}", block, item)
+        if proc is not None:
+            extra = [a for a in proc.node[2] if a.upper() not in HARMLESS_PROC_ATTRIBUTES]
+            if extra:
+                raise OutOfScope(f"the subprogram {name} with PROC ... {extra[0].upper()}", item.start + 1)
+        values: dict[str, float | str] = {}
+        for (kind, parameter, by_reference, dims), arg in zip(declared, (*args, *(None,) * len(declared))):
+            if by_reference or dims is not None or kind not in ("REAL", "INT", "BOOL", "STRING"):
+                what = "VAR " if by_reference else ""
+                raise OutOfScope(f"the subprogram {name}'s parameter {what}{kind} {parameter.upper()}",
+                                 item.start + 1)  # fmt: skip
+            if kind == "STRING":
+                if arg is not None and arg[0] != "str":
+                    self.fail(f"{name}: the STRING parameter {parameter.upper()} given a number", block, item)
+                values[parameter] = "" if arg is None else arg[1]
+                continue
+            value = 0.0 if arg is None else self.value(arg, block, item)
+            values[parameter] = float(round(value)) if kind == "INT" else value
+        return values
+
+    def _subprogram(self, call: _Call, caller: Block, warnings: Warnings) -> Iterator[Event]:
+        """The subprogram's runs: its blocks run as the program's, with variables of their own
+        (the R parameters are the channel's, shared), to M17 or RET."""
+        outer = (self.file, self.variables, self.integers, self.arrays, self.started)
+        self.calls.append(call.name)
+        self.file = str(call.path)
+        try:
+            for _ in range(call.runs):
+                self.variables = {k: v for k, v in outer[1].items() if _R_PARAMETER.fullmatch(k)}
+                self.variables.update(call.parameters)
+                self.integers, self.arrays, self.started = set(), {}, False
+                yield from self._run(call.blocks, warnings, caller)
+                shared = {k: v for k, v in self.variables.items() if _R_PARAMETER.fullmatch(k)}
+                outer[1].update(shared)
+                if self.done:
+                    return
+                if not self.returned:
+                    self.leave_scope(warnings, f"the subprogram {call.name} ends without M17 or RET",
+                                     call.blocks[-1] if call.blocks else caller, None, caller)  # fmt: skip
+                    return
+                self.returned = False
+        finally:
+            self.calls.pop()
+            self.file, self.variables, self.integers, self.arrays, self.started = outer
 
     # -- variables --------------------------------------------------------------------
     def _procedure(self, node: tuple, block: Block, item) -> None:
@@ -173,6 +330,8 @@ class SinumerikInterpreter(ModalInterpreter):
         interpretation; its other blocks are followed.  A PROC anywhere else is out of scope."""
         if self.started:
             raise OutOfScope("PROC below the program's first block", item.start + 1)
+        if self.calls:  # (a subprogram's: the call gave its parameters their values)
+            return
         for _type, name, _by_reference, _dims in node[1]:
             self.variables[name] = _FROM_THE_CALLER
 
@@ -334,12 +493,27 @@ class SinumerikInterpreter(ModalInterpreter):
                         f"the hole pattern {item.node[0]} (the control places its holes itself)",
                         item.start + 1,
                     )
+                elif what == "call" and item.node[0] == "CALL" and len(item.node[1]) == 1:
+                    self.called = self._call(block, item, self._indirect(item.node[1][0], block, item), ())
+                elif what == "call" and item.node[0] == "EXTERN":
+                    return []  # (it declares a subprogram's parameters)
+                elif what == "call" and item.node[0] == "RET" and self.calls:
+                    if item.node[1]:
+                        raise OutOfScope("RET with parameters (a return elsewhere)", item.start + 1)
+                    self.returned = True  # (after the block)
                 elif what == "call" and (
                     item.node[0] in HARMLESS_CALLS
                     or item.node[0] in SETTING_CALLS
                     or (item.node[0] in RESETTING_CALLS and not item.node[1])
                 ):
                     pass
+                elif (
+                    what == "call"
+                    and _SUBPROGRAM_NAME.fullmatch(item.node[0])
+                    and item.node[0] not in CALL_KEYWORDS
+                    and not KNOWN_CYCLE.match(item.node[0])
+                ):
+                    self.called = self._call(block, item, item.node[0].upper(), item.node[1])
                 elif what not in ("label", "program_name", "block_delete"):
                     name = item.node[0] if what in ("call", "path", "frame") else what.upper()
                     raise OutOfScope(
@@ -363,7 +537,11 @@ class SinumerikInterpreter(ModalInterpreter):
             if letter == "G":
                 gcodes.append((value, item))
             elif letter == "M":
-                end = end or value in END_M
+                if value in END_M and self.calls:
+                    if value != 17.0:
+                        raise OutOfScope(f"M{value:g} in a subprogram (M17 or RET ends one)", item.start + 1)
+                    self.returned = True  # (after the block)
+                end = end or (value in END_M and not self.calls)
                 if value == TOOL_CHANGE:
                     tool_words.append((item, value))
             elif letter in ("T", "D"):
@@ -377,14 +555,21 @@ class SinumerikInterpreter(ModalInterpreter):
                     raise OutOfScope(
                         f"the rotary axis {letter} (this interpreter follows X Y Z)", item.start + 1
                     )
-                if letter == "L":  # `L100`: runs subprogram L100.SPF, which may move the tool anywhere
+                if letter == "L" and type(item) is Word and item.number.isdigit():
+                    # (leading zeros name another subprogram: L0100 is not L100)
+                    self.called = self._call(block, item, f"L{item.number}", ())
+                    continue
+                if letter == "L":
                     raise OutOfScope(f"the subprogram call L{value:g}", item.start + 1)
                 if letter in words:
                     self.fail(f"the address {letter} twice in one block", block, item)
                 if letter == "S":
                     self.spindle = value
                 words[letter] = (value, mode, item)
-        self.started = self.started or previous is not None  # (comments do not start the program)
+        # (comments and the program's name, `%_N_MYSUB_SPF` above its PROC, do not start the program)
+        self.started = self.started or any(
+            type(i) is not Comment and not _program_name(i) for i in block.items
+        )
         plane = self.plane
         codes = {code for code, _ in gcodes}
         turn = True if codes & {41.0, 42.0} else False if 40.0 in codes else None  # cutter compensation
@@ -700,6 +885,25 @@ def _frame_name(code: float | None) -> str:
 
 
 interpret = placed_interpreting(SinumerikInterpreter)
+
+
+def _runs_others(block: Block) -> bool:
+    """A control line after whose text other blocks' moves may run, owned by it: a loop's end,
+    a jump, a CASE."""
+    return any(type(i) is Statement and i.kind in RUNS_OTHERS for i in block.items)
+
+
+def _program_name(item) -> bool:
+    return type(item) is Statement and item.kind == "program_name"
+
+
+def _subprogram_files(name: str) -> list[str]:
+    """The files subprogram `name` may be kept in on a PC: `MYSUB.SPF`, the control's own
+    `_N_MYSUB_SPF`, and a main program (a program called by its name may be either)."""
+    found = _CONTROL_NAME.fullmatch(name)
+    base, kind = (found.group(1), found.group(2)) if found else (name, None)
+    kinds = [kind.upper()] if kind else ["SPF", "MPF"]
+    return [f for k in kinds for f in (f"{base}.{k}", f"_N_{base}_{k}", f"_N_{base}_{k}.{k}")]
 
 
 def _element_key(name: str, index: tuple[int, ...]) -> str:

@@ -267,7 +267,7 @@ HEIDENHAIN = Dialect(
 
 from dataclasses import replace  # noqa: E402
 
-from ncpp.motion.segments import DRILLED, FLOW, PLANE_AXES, Arc, Line, Pass  # noqa: E402
+from ncpp.motion.segments import DRILLED, FLOW, PLANE_AXES, Arc, Event, Line, Pass  # noqa: E402
 from ncpp.program.blocks import Block  # noqa: E402
 from ncpp.program.dialects.editing import splice  # noqa: E402
 from ncpp.program.dialects.iso import IsoWriter, _Units, written_apart  # noqa: E402
@@ -275,6 +275,7 @@ from ncpp.program.numbers import NumberStyle, format_number, style_pattern  # no
 
 _AXES = "XYZ"
 _POLAR_WORDS = frozenset(("R", "PR", "PA", "IPR", "IPA"))
+_JUMPS = frozenset((9, 10, 11, 12))  # FN 9-12: IF ... GOTO LBL
 _POLE_FUNCTIONS = frozenset(("C", "CP", "LP", "CTP", "CRP"))  # path functions that use the pole
 ANGLE_STYLE = NumberStyle(decimals=7, plus_sign=True)
 
@@ -296,7 +297,18 @@ class HeidenhainWriter(IsoWriter):
     block after an edited line (which then ends at the tangent point) becomes
     `CC` + `C ... DR±` or an `L` to the end of its fillet or chamfer."""
 
-    control_at_once = False  # (a call line's group carries the pole its text needs)
+    @staticmethod
+    def written_at_once(event: Event) -> bool:
+        """A line that runs other blocks after its text (CALL LBL, CALL PGM, a jump FN 9-12), written
+        from its `Pass` alone: the moves of its runs are left as programmed and not kept (the poles
+        they set are followed, `_ran`), so a loop or a called program of any length is written and
+        verified (`ncpp.verify`) as it runs."""
+        if type(event) is not Pass or event.skipped:
+            return False
+        head = next((i for i in event.block.items if type(i) is Statement), None)
+        return head is not None and (
+            head.kind in ("call_label", "call_program") or (head.kind == "fn" and head.node[0] in _JUMPS)
+        )
 
     comment_open, comment_close = "; ", ""
 
@@ -312,6 +324,14 @@ class HeidenhainWriter(IsoWriter):
         self.restore_feed = False  # an edited corner block's F: the next move gets the program's feed back
         self.edited_last = False  # the last block was written edited (an RND/CHF after it must be too)
         self._lessons: dict[tuple[str, str], tuple] = {}  # by (letter, number pattern): see `_learn_styles`
+
+    def _ran(self, event: Event) -> None:
+        """A pole the runs of a call or jump line set (their CC blocks): the program's and the
+        output's pole after them."""
+        from ncpp.motion.heidenhain import Pole
+
+        if type(event) is Pole:
+            self.program_pole = self.output_pole = (event.center, event.plane)
 
     def with_header(self, lines, header: str):
         """The header goes after `BEGIN PGM` as a numbered comment block (set before writing)."""
@@ -361,7 +381,8 @@ class HeidenhainWriter(IsoWriter):
         feed = self._restored_feed(block, motion) if restores else ""
         if (not corner and not any(e.changed for e in motion)) or (corner and not (motion and edited_before)):
             # a subprogram or loop a call or jump line runs uses the pole as the program has it there
-            calls = function is None and any(m.fixed == FLOW for m in motion)
+            at_once = self.written_at_once(group[0])
+            calls = function is None and (at_once or any(m.fixed == FLOW for m in motion))
             if (
                 (function in _POLE_FUNCTIONS or calls)
                 and self.program_pole
@@ -385,6 +406,8 @@ class HeidenhainWriter(IsoWriter):
                 self.header = None
             for segment in motion:
                 self._remember_end(segment)
+            if at_once:  # (where its runs leave the tool is the control's)
+                self._last_end = None
             return
         self.changed_any = self.edited_last = True
         if _position_call(block) is not None:

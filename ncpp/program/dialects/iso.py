@@ -110,6 +110,7 @@ class IsoWriter:
 
     comment_open, comment_close = "(", ")"
     control_at_once = True  # control lines are written at their first event (`written_at_once`)
+    written_at_once = staticmethod(written_at_once)
 
     def __init__(self, mm_decimals: int = 4, inch_decimals: int = 5):
         self.mm_decimals = mm_decimals
@@ -150,23 +151,29 @@ class IsoWriter:
     def comment(self, text: str) -> str:
         return f"{self.comment_open}{text}{self.comment_close}"
 
+    def _ran(self, event: Event) -> None:
+        """An event of the runs of a control line written at once (`written_at_once`), not kept."""
+
     # -- the stream -----------------------------------------------------------
     def write(self, events: Iterable[Event]) -> Iterator[str]:
         group: list[Event] = []
         block = None
         write_group = self._write_group
         control = False  # the group is a control line's, whose writing reads only its first event
+        ran = self._ran if type(self)._ran is not IsoWriter._ran else None  # (ISO's does nothing)
         for event in events:
             if event.block is block:
                 if not control:
                     group.append(event)
                     # (a loop's end or a call owns every move it runs, millions for a long loop: not kept)
                     control = len(group) == _LONG_GROUP and self._facts(block).flow
+                elif ran is not None:
+                    ran(event)
                 continue
             if group:
                 yield from write_group(group)
             block, group, control = event.block, [event], False
-            if self.control_at_once and written_at_once(event):
+            if self.control_at_once and self.written_at_once(event):
                 yield from write_group(group)
                 group, control = [], True
         if group:

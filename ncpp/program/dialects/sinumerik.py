@@ -15,7 +15,8 @@ Statement kinds and nodes (Sinumerik):
   assignment   (target, expr)             target ("param", "r1") | ("index", "feld", (exprs))
   label        (NAME,)                    `LABEL_1:` (upper case, no colon)
   call         (NAME, args)               `CYCLE81(10,0,2,-5)`, `MSG("x")`, `SETAL(1)`, `BNAT`,
-                                          `MATERIAL_UPDATE`: passed through; args tuple of exprs, None if empty
+                                          `MATERIAL_UPDATE`: passed through; args tuple of exprs, None if
+                                          empty; `CALL "PART2"` (an indirect call) is ("CALL", (expr,))
   path         (NAME,)                    CIP CT ASPLINE BSPLINE CSPLINE POLY (words follow)
   frame        (NAME,)                    TRANS ATRANS ROT AROT SCALE ASCALE MIRROR AMIRROR ... (words follow)
   def          (type, length, vars)       `DEF STRING[8] A="x", B` -> ('STRING', ("num", 8.0), ((target, init|None), ...))
@@ -123,6 +124,7 @@ class SinumerikBuilder(Transformer):
         return (expr, branches, default)
 
     call = _statement("call", _call)
+    indirect_call = _statement("call", lambda c: ("CALL", (c[1],)))  # `CALL "PART2"`, `CALL NAME_VARIABLE`
     label = _statement("label", lambda c: (str(c[0])[:-1].upper(),))
     path = _statement("path", lambda c: (str(c[0]).upper(),))
     frame = _statement("frame", lambda c: (str(c[0]).upper(),))
@@ -221,7 +223,7 @@ SINUMERIK = Dialect(
 
 # ---- writer ------------------------------------------------------------------------------
 
-from ncpp.motion.segments import Arc, Line  # noqa: E402  (the writer half of the module)
+from ncpp.motion.segments import Arc, Event, Line, Pass  # noqa: E402  (the writer half of the module)
 from ncpp.program.blocks import Block  # noqa: E402
 from ncpp.program.dialects.editing import splice  # noqa: E402
 from ncpp.program.dialects.iso import AXES, IsoWriter, new_block_key  # noqa: E402
@@ -243,6 +245,35 @@ class SinumerikWriter(IsoWriter):
     blocks that rely on it)."""
 
     comment_open, comment_close = "; ", ""
+
+    @staticmethod
+    def written_at_once(event: Event) -> bool:
+        """A line that runs other blocks' moves after its text (a subprogram call, a loop's end, a
+        jump), as the interpreter tells by the mode it runs in on the line's `Pass`: written from
+        that alone, its runs' moves (left as programmed) not kept, so a loop or a subprogram of
+        any length is written and verified (`ncpp.verify`) as it runs."""
+        return type(event) is Pass and event.motion is not None and not event.skipped and event.cycle is None
+
+    def _write_group(self, group: list[Event]) -> Iterable[str]:
+        first = group[0]
+        return (
+            self._write_control(first.block, first)
+            if self.written_at_once(first)
+            else super()._write_group(group)
+        )
+
+    def _write_control(self, block: Block, first: Event) -> list[str]:
+        """Its text, in the motion mode the program has there (the blocks it runs may rely on
+        it); after it the mode and the position are the control's: the next edited block writes
+        its motion word and every axis it knows."""
+        mode = first.motion if type(first) is Pass else None
+        restore = mode is not None and self.output_motion is not None and self.output_motion != mode
+        if restore:
+            self.program_motion = mode  # type: ignore[assignment]  # (a Sinumerik mode: a G code or CIP / CT)
+        lines = [self._restore_mode_line(block), block.text] if restore else [block.text]
+        self.program_motion = self.output_motion = None
+        self._last_end = None
+        return lines
 
     def with_header(self, lines: Iterable[str], header: str) -> Iterator[str]:
         """The header's comment lines first, after a `%_N_..` name line and after a `PROC`
