@@ -72,6 +72,8 @@ DATUM_CYCLES = frozenset(("7", "8", "10", "11", "19", "26"))
 # is a zero ncpp is not told
 PRESET_CYCLE = "247"
 END_M = frozenset((2.0, 30.0))
+SIDES = {"RL": 1, "RR": -1, "R0": 0}  # radius compensation's side of the contour (0: off)
+INCREMENTAL = frozenset(("IX", "IY", "IZ"))  # (moves under RL/RR with them are left as programmed)
 HARMLESS_KEYWORDS = frozenset(("STOP",))
 # Resets of what this interpreter never follows (a tilted plane, TCPM: it stops at any that sets
 # one), which move no axis: `PLANE RESET STAY` keeps the rotary axes where they are (TNC 640
@@ -158,6 +160,8 @@ class HeidenhainInterpreter(ModalInterpreter):
         )
         self.tool_axis = 2  # the axis its length is along (TOOL CALL's axis)
         self.call_dl = 0.0  # the last TOOL CALL's DL (an oversize), program units
+        self.call_dr = 0.0  # and its DR, added to the tool's radius
+        self.defined_radii: dict[float, float] = {}  # tool radii the program defines (TOOL DEF n R..)
         self.untold_lengths = UntoldLengths()  # warns at a TOOL CALL whose tool length nothing tells
         self.q: dict[str, float] = {}
         self.pole: list[float] | None = None
@@ -197,6 +201,12 @@ class HeidenhainInterpreter(ModalInterpreter):
                 first, last = made[0], made[-1]
                 assert not isinstance(first, Pass) and not isinstance(last, Pass)  # round_corner's lines
                 held[0], event = first, last
+                if first.centre_shift is not None or last.centre_shift is not None:
+                    # under RL/RR the control rounds the contour, then offsets it: the lines and the
+                    # piece are left as programmed, as ISO's corners are (`Interpreter._round_corner`)
+                    for cut in made:
+                        if not isinstance(cut, Pass):
+                            cut.fixed, cut.centre_shift = COMP, None
                 piece = made[1] if len(made) == 3 else Pass(corner.block)
                 kept = next((f for f in (first.fixed, last.fixed) if f in (COMP, FLOW)), None)
                 if kept is not None and not isinstance(piece, Pass):  # (the contour's, or runs again)
@@ -376,7 +386,8 @@ class HeidenhainInterpreter(ModalInterpreter):
             if call is not None:
                 raise OutOfScope(f"M140 and the cycle call {call[0]} in one block", call[1])
             events.append(self._retract(block, retract))
-        events = self.radius_compensation(events, None if comp is None else comp != "R0")
+        incremental = any(type(i) in (Word, ExprWord) and i.letter in INCREMENTAL for i in block.items)
+        events = self.radius_compensation(events, None if comp is None else SIDES[comp], not incremental)
         if call is not None:
             events = events + self._call_cycle(block, *call)
         if events and isinstance(events[-1], (Line, Arc)):
@@ -529,17 +540,23 @@ class HeidenhainInterpreter(ModalInterpreter):
         return events
 
     def _tool_def(self, block: Block, statement) -> list[Event]:
-        """`TOOL DEF n L.. R..`: the program defines tool n's length (without L: it only prepares the tool)."""
+        """`TOOL DEF n L.. R..`: the program defines tool n's length and radius (without L: it only
+        prepares the tool)."""
         number = self._tool_number(statement.node[0], block, statement)
         for item in block.items:
-            if (type(item) is Word or type(item) is ExprWord) and item.letter == "L" and number is not None:
-                self.defined[number] = self._word_value(item, block)
+            if (type(item) is Word or type(item) is ExprWord) and number is not None:
+                if item.letter == "L":
+                    self.defined[number] = self._word_value(item, block)
+                elif item.letter == "R":
+                    self.defined_radii[number] = self._word_value(item, block)
         return []
 
     def _tool_call(self, block: Block, statement) -> list[Event]:
         """`TOOL CALL n|"NAME" [axis] [DL..]`: tool n's length L + DL (table) + DL (call) along
         the tool axis; without a tool, the tool stays and so does its DL unless the call gives one."""
-        dl = None
+        if self.radius_comp:  # (which radius the control then offsets by, and how it gets there, is its own)
+            raise OutOfScope("TOOL CALL with radius compensation RL/RR", statement.start + 1)
+        dl = dr = None
         for item in block.items:
             if type(item) is Word and item.letter == "F":
                 self.auto_feed = item.value
@@ -547,13 +564,17 @@ class HeidenhainInterpreter(ModalInterpreter):
                 self.spindle = self._word_value(item, block)
             elif (type(item) is Word or type(item) is ExprWord) and item.letter == "DL":
                 dl = self._word_value(item, block)
+            elif (type(item) is Word or type(item) is ExprWord) and item.letter == "DR":
+                dr = self._word_value(item, block)
         called = statement.node[0]
         if called is not None:
             self.tool_number = self._tool_number(called, block, statement)
             self.tool_id = f'"{called}"' if type(called) is str else f"{self.tool_number:g}"
-            self.call_dl = 0.0
+            self.call_dl = self.call_dr = 0.0
         if dl is not None:
             self.call_dl = dl
+        if dr is not None:
+            self.call_dr = dr
         tool = [0.0, 0.0, 0.0]
         tool[self.tool_axis] = self._length(self.tool_number, block, statement) + self.call_dl
         self.set_tool(tool)
@@ -590,6 +611,19 @@ class HeidenhainInterpreter(ModalInterpreter):
                 statement,
             )
         return lengths[0] / (MM_PER_INCH if self.inch else 1.0)
+
+    def tool_radius(self) -> float | None:
+        """The called tool's radius R + DR, program units: defined by the program (TOOL DEF n
+        R..), else the table's (TOOL.T), plus the call's DR (None: neither tells it)."""
+        number = self.tool_number
+        if number == 0:
+            return 0.0
+        if number is not None and number in self.defined_radii:
+            return self.defined_radii[number] + self.call_dr
+        if self.tools is None or number is None or number in self.defined:
+            return None  # (a tool the program defines without R: its radius is not the table's)
+        radius = self.tools.radii.get((number, 1))
+        return None if radius is None else radius / (MM_PER_INCH if self.inch else 1.0) + self.call_dr
 
     def _word_value(self, item, block: Block) -> float:
         return item.value if type(item) is Word else self.value(item.expr, block, item)

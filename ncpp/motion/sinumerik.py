@@ -95,6 +95,7 @@ FRAMES = frozenset(("TRANS", "ATRANS", "ROT", "SCALE", "MIRROR"))
 
 # The axis (X, Y, Z index) that lengths 1, 2 and 3 of a milling tool act along, per plane
 LENGTH_AXES = {17: (2, 1, 0), 18: (1, 0, 2), 19: (0, 2, 1)}
+SIDES = {41.0: 1, 42.0: -1, 40.0: 0}  # cutter compensation's side of the contour (0: off)
 TOOL_CHANGE = 6.0  # M6 loads the tool T selected, with its cutting edge D1 unless the block says another
 
 
@@ -387,7 +388,13 @@ class SinumerikInterpreter(ModalInterpreter):
         self.started = self.started or previous is not None  # (comments do not start the program)
         plane = self.plane
         codes = {code for code, _ in gcodes}
-        turn = True if codes & {41.0, 42.0} else False if 40.0 in codes else None  # cutter compensation
+        # cutter compensation: G41 left, G42 right, G40 off (the block's last of them)
+        turn = next((SIDES[code] for code, _ in reversed(gcodes) if code in SIDES), None)
+        changes = [item for item, _ in tool_words if item.letter in ("M", "D")]
+        if changes and self.radius_comp and not turn:  # (its radius is the edge's it was turned on with)
+            raise OutOfScope(
+                "a tool or cutting edge change under radius compensation G41/G42", changes[0].start + 1
+            )
         dwell = self._modal_codes(gcodes, block)
         if tool_words or (self.plane != plane and self.edge):
             self._place_tool(block, tool_words)
@@ -545,7 +552,7 @@ class SinumerikInterpreter(ModalInterpreter):
         """Lengths 1-3 (mm) of the loaded tool's cutting edge in effect (none: D0, no tool, no table)."""
         if self.tools is None or not self.edge or self.loaded in (0.0, ""):
             return (0.0, 0.0, 0.0)
-        number = self.loaded if type(self.loaded) is float else self.tools.names.get(self.loaded)  # type: ignore[arg-type]
+        number = self._loaded_number()
         if number is None:
             self.fail(f'tool "{self.loaded}" is not in {self.tools.source}', block, item)
         lengths = self.tools.edges.get((number, self.edge))
@@ -553,6 +560,22 @@ class SinumerikInterpreter(ModalInterpreter):
             self.fail(f"tool {self.loaded if type(self.loaded) is str else f'{number:g}'} has no cutting edge D{self.edge} in {self.tools.source}",
                       block, item)  # fmt: skip
         return lengths
+
+    def _loaded_number(self) -> float | None:
+        """The loaded tool's number (a name's, in the tool offsets), None: a name they lack."""
+        assert self.tools is not None
+        return self.loaded if type(self.loaded) is float else self.tools.names.get(self.loaded)  # type: ignore[arg-type]
+
+    def tool_radius(self) -> float | None:
+        """The radius of the loaded tool's cutting edge in effect (radius plus wear radius in the
+        control's tool offsets, `_N_TO_INI`), program units; 0 with D0 or no tool, None when the
+        offsets are not told or do not give it."""
+        if not self.edge or self.loaded in (0.0, ""):
+            return 0.0
+        if self.tools is None:
+            return None
+        radius = self.tools.radii.get((self._loaded_number(), self.edge))  # type: ignore[arg-type]
+        return None if radius is None else radius / (MM_PER_INCH if self.inch else 1.0)
 
     def _word_value(self, item: ExprWord, block: Block) -> tuple[float, str | None]:
         expr = item.expr
