@@ -161,6 +161,7 @@ class HeidenhainInterpreter(ModalInterpreter):
         self.tool_axis = 2  # the axis its length is along (TOOL CALL's axis)
         self.call_dl = 0.0  # the last TOOL CALL's DL (an oversize), program units
         self.call_dr = 0.0  # and its DR, added to the tool's radius
+        self.called = False  # a TOOL CALL named a tool (before it, the spindle's tool is not told)
         self.defined_radii: dict[float, float] = {}  # tool radii the program defines (TOOL DEF n R..)
         self.untold_lengths = UntoldLengths()  # warns at a TOOL CALL whose tool length nothing tells
         self.q: dict[str, float] = {}
@@ -571,6 +572,7 @@ class HeidenhainInterpreter(ModalInterpreter):
             self.tool_number = self._tool_number(called, block, statement)
             self.tool_id = f'"{called}"' if type(called) is str else f"{self.tool_number:g}"
             self.call_dl = self.call_dr = 0.0
+            self.called = True
         if dl is not None:
             self.call_dl = dl
         if dr is not None:
@@ -614,8 +616,11 @@ class HeidenhainInterpreter(ModalInterpreter):
 
     def tool_radius(self) -> float | None:
         """The called tool's radius R + DR, program units: defined by the program (TOOL DEF n
-        R..), else the table's (TOOL.T), plus the call's DR (None: neither tells it)."""
+        R..), else the table's (TOOL.T), plus the call's DR (None: neither tells it, or no TOOL
+        CALL did: the tool in the spindle is the control's)."""
         number = self.tool_number
+        if not self.called:
+            return None
         if number == 0:
             return 0.0
         if number is not None and number in self.defined_radii:

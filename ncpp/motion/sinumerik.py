@@ -117,6 +117,7 @@ class SinumerikInterpreter(ModalInterpreter):
         self.selected: float | str = 0.0  # the tool T selected: a number, or a name
         self.loaded: float | str = 0.0  # the tool M6 loaded (0: none)
         self.edge = 0  # the cutting edge D in effect (0: no tool offset)
+        self.edge_told = False  # M6 or D said the edge (before it, the control's own is in effect)
         self.untold_lengths = UntoldLengths()  # warns where a tool length applies that nothing tells
         self.motion: float | str = 0.0  # 0-3, 'CIP' or 'CT' (G0 after power on)
         self.absolute = True
@@ -538,6 +539,7 @@ class SinumerikInterpreter(ModalInterpreter):
                 self.tool_id = _tool_id(self.loaded)
             else:
                 self.edge, changed = int(value), True
+            self.edge_told = self.edge_told or changed
             if changed and self.tools is None and self.edge:
                 self.untold_lengths(
                     f"{item.letter}{value:g}", "_N_TO_INI", Location(self.file, block.line, item.start + 1)
@@ -568,11 +570,13 @@ class SinumerikInterpreter(ModalInterpreter):
 
     def tool_radius(self) -> float | None:
         """The radius of the loaded tool's cutting edge in effect (radius plus wear radius in the
-        control's tool offsets, `_N_TO_INI`), program units; 0 with D0 or no tool, None when the
-        offsets are not told or do not give it."""
-        if not self.edge or self.loaded in (0.0, ""):
+        control's tool offsets, `_N_TO_INI`), program units; 0 with D0, None when the offsets are
+        not told or do not give it (or no M6 or D said the edge, or no M6 loaded the tool)."""
+        if not self.edge_told:
+            return None
+        if not self.edge:
             return 0.0
-        if self.tools is None:
+        if self.tools is None or self.loaded in (0.0, ""):  # (no M6: the spindle's tool is the control's)
             return None
         radius = self.tools.radii.get((self._loaded_number(), self.edge))  # type: ignore[arg-type]
         return None if radius is None else radius / (MM_PER_INCH if self.inch else 1.0)

@@ -103,7 +103,7 @@ N140 G0 Z5
 N150 M30
 """
 # the control's tool offsets: the radius $TC_DP6 plus the wear radius $TC_DP15
-TO_INI = "$TC_TP2[1]=\"D8\"\n$TC_DP1[1,1]=120\n$TC_DP3[1,1]=0.0\n$TC_DP6[1,1]=3.9\n$TC_DP15[1,1]=0.1\n"
+TO_INI = '$TC_TP2[1]="D8"\n$TC_DP1[1,1]=120\n$TC_DP3[1,1]=0.0\n$TC_DP6[1,1]=3.9\n$TC_DP15[1,1]=0.1\n'
 
 
 def offset(contour: list, side: float, start=(-20.0, 0.0)) -> list[Move]:
@@ -277,7 +277,9 @@ def test_the_compensation_words_stay_on_their_blocks(tmp_path):
     assert re.search(r"^\d+ L X-(20\.0|19\.9)\d* Y-(20\.0|19\.9)\d* R0$", klartext, re.M), klartext
     assert "L X+80 " not in klartext and "X+80.0000 Y+0.0000" not in klartext  # (rewritten)
     (tmp_path / "_N_TO_INI").write_text(TO_INI)
-    sinumerik, _ = compensated(tmp_path, "OUTLINE.MPF", SINUMERIK, "--tool-table", str(tmp_path / "_N_TO_INI"))
+    sinumerik, _ = compensated(
+        tmp_path, "OUTLINE.MPF", SINUMERIK, "--tool-table", str(tmp_path / "_N_TO_INI")
+    )
     assert re.search(r"^N50 G42 G1 X", sinumerik, re.M) and re.search(r"^N130 G40 X-", sinumerik, re.M)
 
 
@@ -324,3 +326,34 @@ def test_klartext_moves_ncpp_does_not_follow_are_left_as_programmed(tmp_path, ch
     kept = next(line for line in why.splitlines() if "RL" in line).split(" ", 1)[1]
     assert any(line.endswith(kept) for line in lines), written
     assert not any(line.endswith(" L Y+60") for line in lines), written  # (followed again)
+
+
+def test_sinumerik_incremental_moves_under_g42_are_left_as_programmed(tmp_path):
+    """G91 under G42 (incremental: out of ncpp's scope under compensation, as in ISO) leaves the move
+    as programmed with the warning, the arc from where it ends too; the line after is followed."""
+    text = SINUMERIK.replace("N60 X80\nN70 G3", "N60 G91 X80\nN70 G90 G3")
+    (tmp_path / "_N_TO_INI").write_text(TO_INI)
+    written, messages = compensated(
+        tmp_path, "OUTLINE.MPF", text, "--tool-table", str(tmp_path / "_N_TO_INI")
+    )
+    assert "OUTLINE.MPF:7:1: warning: cutter compensation: its moves pass through uncompensated" in messages
+    lines = written.splitlines()
+    assert "N60 G91 X80" in lines and "N70 G90 G3 X100 Y20 I0 J20" in lines
+    assert "N80 G1 Y60" not in lines and any(line.startswith("N80 G1 Y60.0") for line in lines), written
+
+
+@pytest.mark.parametrize(
+    "name, text, change, new, why",
+    [
+        ("rect.h", KLARTEXT.format(tool="TOOL CALL 3 Z"), "10 L Y+60", "10 TOOL CALL 4 Z",
+         "rect.h:11:4: warning: TOOL CALL with radius compensation RL/RR is outside"),
+        ("OUTLINE.MPF", SINUMERIK, "N80 G1 Y60", "N80 D2",
+         "OUTLINE.MPF:9:5: warning: a tool or cutting edge change under radius compensation G41/G42 is outside"),
+    ],
+    ids=["klartext-tool-call", "sinumerik-edge"],
+)  # fmt: skip
+def test_a_tool_change_under_compensation_leaves_the_scope(tmp_path, name, text, change, new, why):
+    """The radius compensation offsets by is the one it was turned on with; a new tool under it is
+    the control's to follow: the rest passes through with the warning."""
+    _, messages = compensated(tmp_path, name, text.replace(change, new))
+    assert why in messages, messages
