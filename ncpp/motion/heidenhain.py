@@ -17,8 +17,12 @@ and `END PGM` (end), and `RND R..` / `CHF ..` between two feed lines in the
 working plane (the fillet arc or chamfer line is the RND/CHF block's event; a
 feed line waits for the next move to know whether its corner is cut).
 Radius compensation RL/RR is followed to R0: the moves from the first with RL/RR
-to the R0 block's are the programmed contour, the tool centre off it by the radius,
-and are marked `fixed` (`ModalInterpreter.radius_compensation`).  Paraxial R+/R-,
+to the R0 block's are the programmed contour, the tool centre off it by the radius
+(the called tool's R + DR from TOOL.T or TOOL DEF's R, plus TOOL CALL's DR); with
+TOOL CALL .. Z and absolute words they carry where the tool centre stands
+(`centre_shift`, `ModalInterpreter.radius_compensation`), else (IX/IY/IZ, another tool
+axis, RL/RR in an arc block, RND/CHF corners) they are marked `fixed`.  A TOOL CALL
+under RL/RR is out of scope.  Paraxial R+/R-,
 RND/CHF next to an arc or a rapid, FK free contours,
 APPR/DEP, `CALL PGM`, calls of other cycles, point tables, M89, FN 14 and later FN
 functions and cycles that move the datum make the position unknown: one warning (an error with
@@ -387,8 +391,11 @@ class HeidenhainInterpreter(ModalInterpreter):
             if call is not None:
                 raise OutOfScope(f"M140 and the cycle call {call[0]} in one block", call[1])
             events.append(self._retract(block, retract))
-        incremental = any(type(i) in (Word, ExprWord) and i.letter in INCREMENTAL for i in block.items)
-        events = self.radius_compensation(events, None if comp is None else SIDES[comp], not incremental)
+        if comp is not None or self.radius_comp or self.centre.off_path:
+            incremental = any(
+                isinstance(i, (Word, ExprWord)) and i.letter in INCREMENTAL for i in block.items
+            )
+            events = self.radius_compensation(events, None if comp is None else SIDES[comp], not incremental)
         if call is not None:
             events = events + self._call_cycle(block, *call)
         if events and isinstance(events[-1], (Line, Arc)):

@@ -21,8 +21,8 @@ macro B (GOTO, IF ... GOTO, WHILE ... DO ... END, G65 and G66/G67 macro calls: `
 are the programmed contour, not the tool centre, and after G40 the position is
 the program's again, as in rs274ngc.  The moves the tool makes off the programmed
 path (from the first move under G41/G42 to the first after G40) carry where the
-tool centre stands (`centre_shift`), in G17 and G18 (LinuxCNC compensates in
-those two planes only), in G90 and G91; with a lathe tool's orientation (1-8) they
+tool centre stands (`centre_shift`, `ncpp.motion.cutter`), in G17 and G18 (LinuxCNC
+compensates in those two planes only), in G90 and G91; with a lathe tool's orientation (1-8) they
 are marked `fixed`, as are the moves of cycles, loops, subroutines and macros:
 compensation leaves them as programmed.  Anything else (subroutine files ncpp is not told
 of, a move of a subprogram under G66, a Fanuc system variable it does not know, M99

@@ -136,6 +136,8 @@ class ModalInterpreter:
         Sinumerik approaches and leaves the contour on a line with NORM: 840D sl Programming
         Manual Fundamentals, "Contour approach and retraction"), and a block that changes
         sides under it."""
+        if turn is None and not self.radius_comp and not self.centre.off_path:
+            return events
         if turn is not None:
             also = also and not (turn and self.radius_comp and self._turned(turn))
             self.radius_comp = bool(turn)
