@@ -655,6 +655,7 @@ class HeidenhainInterpreter(ModalInterpreter):
                 if owner is None:  # (after M2/M30/END PGM: a subprogram's text, run where it is called)
                     yield Pass(block, kind is SKIP or (kind is TEXT and self.ended))
                 continue
+            self.again = kind is FIXED
             try:
                 events = self.block(block)
             except OutOfScope as out:

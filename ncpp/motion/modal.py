@@ -91,6 +91,7 @@ class ModalInterpreter:
         # unknown); None: off, or a tool of radius 0, which stays on the path
         self.comp_side: float | None = None
         self.centre = ToolCentre()  # where the tool centre stands off the programmed path
+        self.again = False  # the block runs again, or away from its text (its moves are left as programmed)
         self.tool_id = ""  # the tool in the spindle as the program names it (Context.tool_id)
         self._context: Context | None = None
 
@@ -130,8 +131,8 @@ class ModalInterpreter:
         path by the tool radius (`tool_radius`): the moves from the first with it on to the
         first after it is off (which ends on its programmed point) stay the programmed contour,
         as the control's positions do, and carry where the tool centre stands (`ToolCentre`).
-        Left as programmed (COMP) where ncpp does not follow them: outside G17, incremental
-        moves (the dialect's `also` False), an entry or exit move that is an arc (the TNC
+        Left as programmed (COMP) where ncpp does not follow them: outside G17, in a block that
+        runs again (`again`), incremental moves (the dialect's `also` False), an entry or exit move that is an arc (the TNC
         refuses RL/RR in an arc block: TNC 640 user's manual, "Radius compensation"; the
         Sinumerik approaches and leaves the contour on a line with NORM: 840D sl Programming
         Manual Fundamentals, "Contour approach and retraction"), and a block that changes
@@ -148,7 +149,7 @@ class ModalInterpreter:
             return events
         side = self.comp_side if self.radius_comp else None
         ends = side is None or not self.centre.off_path  # (the exit, or the entry move)
-        self.centre.follow(moves, side, also and not (ends and type(moves[0]) is Arc))
+        self.centre.follow(moves, side, also and not self.again and not (ends and type(moves[0]) is Arc))
         return events
 
     def _turned(self, turn: int) -> bool:

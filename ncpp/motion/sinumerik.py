@@ -150,6 +150,7 @@ class SinumerikInterpreter(ModalInterpreter):
                 if owner is None:  # (a block run out of the text's order is written in its place)
                     yield Pass(block, kind is SKIP)
                 continue
+            self.again = kind is FIXED
             try:
                 events = self.block(block)
             except OutOfScope as stop:

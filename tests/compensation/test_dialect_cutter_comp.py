@@ -30,6 +30,10 @@ import numpy as np
 import pytest
 
 from ncpp.cli import main
+from ncpp.errors import Warnings
+from ncpp.motion.segments import Arc, Line
+from ncpp.pipeline import dialect_tools
+from ncpp.program.dialects import parse_program
 from tests.compensation.test_cutter_comp_accuracy import AFFINE, closed_form
 from tests.compensation.tool_centre import Move, deviation
 
@@ -357,3 +361,25 @@ def test_a_tool_change_under_compensation_leaves_the_scope(tmp_path, name, text,
     the control's to follow: the rest passes through with the warning."""
     _, messages = compensated(tmp_path, name, text.replace(change, new))
     assert why in messages, messages
+
+
+LOOPS = {
+    "klartext": (KLARTEXT.format(tool="TOOL DEF 3 L+0 R+5\n3 TOOL CALL 3 Z").replace(
+        "12 L X+0\n", "12 LBL 1\n12 L X+0\n12 LBL 0\n12 CALL LBL 1 REP 1\n"), "rect.h"),
+    "sinumerik": (SINUMERIK.replace("N100 G1 X30\n", "N100 FOR R1=1 TO 2\nN101 G1 X30\nN102 ENDFOR\n"),
+                  "OUTLINE.MPF"),
+}  # fmt: skip
+
+
+@pytest.mark.parametrize("case", LOOPS.values(), ids=LOOPS.keys())
+def test_a_move_that_runs_again_under_compensation_is_left_as_programmed(case):
+    """A move in a loop or a repeated section under RL/G42 is one text run several times: it is left
+    as programmed, never also given where the tool centre stands (the arc after it would then start
+    from a corrected point it never reached)."""
+    text, name = case
+    dialect, blocks = parse_program(io.BytesIO(text.encode()), name, None)
+    interpret, _ = dialect_tools(dialect)
+    events = list(interpret(blocks, file=name, warnings=Warnings(stream=io.StringIO())))
+    moves = [e for e in events if type(e) is Line or type(e) is Arc]
+    assert any(m.fixed for m in moves) and any(m.centre_shift is not None for m in moves)
+    assert not [m for m in moves if m.fixed and m.centre_shift is not None]
