@@ -21,7 +21,8 @@ to the R0 block's are the programmed contour, the tool centre off it by the radi
 (the called tool's R + DR from TOOL.T or TOOL DEF's R, plus TOOL CALL's DR); with
 TOOL CALL .. Z and absolute words they carry where the tool centre stands
 (`centre_shift`, `ModalInterpreter.radius_compensation`), else (IX/IY/IZ, another tool
-axis, RL/RR in an arc block, RND/CHF corners) they are marked `fixed`.  A TOOL CALL
+axis, RL/RR in an arc block, RND/CHF next to the entry or exit move) they are marked
+`fixed`.  A TOOL CALL
 under RL/RR is out of scope.  Paraxial R+/R-,
 RND/CHF next to an arc or a rapid, FK free contours,
 APPR/DEP, `CALL PGM`, calls of other cycles, point tables, M89, FN 14 and later FN
@@ -42,6 +43,7 @@ from dataclasses import dataclass
 
 from ncpp.errors import Location, NcppError, Warnings
 from ncpp.motion.corners import CornerError, round_corner
+from ncpp.motion.cutter import centre_offset
 from ncpp.motion.heidenhain_cycles import (
     DEFINITION_ACTIVE,
     REQUIRED,
@@ -120,6 +122,30 @@ class Corner(Pass):
     size: float = 0.0
     feed: float | None = None  # `RND R5 F200`: the feed of the fillet only
     col: int | None = None
+
+
+def _offset_corner(made: list[Event], side: float | None) -> bool:
+    """An RND/CHF corner between two lines under RL/RR (on `side`: `centre_offset`), both
+    followed: the control rounds the contour, then offsets it, so the fillet or chamfer gets
+    where the tool centre stands along it as any move does, and the second line starts where it
+    ends.  The first line keeps its own: shortened, its direction is the same.  False where that
+    is not so (the first line the entry move, the second the exit move, either left as
+    programmed)."""
+    first, last = made[0], made[-1]
+    if not isinstance(first, Line) or not isinstance(last, Line) or first.fixed or last.fixed:
+        return False
+    if first.centre_shift is None or last.centre_shift is None or first.centre_shift[0] is None:
+        return False
+    at = first.centre_shift[1]
+    if side is None or math.dist(last.centre_shift[1], centre_offset(last, side, at)) > 1e-9 * (
+        1 + abs(side)
+    ):
+        return False  # (the exit move)
+    for piece in made[1:]:
+        if isinstance(piece, (Line, Arc)):
+            end = centre_offset(piece, side, at)
+            piece.centre_shift, at = (at, end), end
+    return True
 
 
 def _in_flow(events: list[Event], owner: Block | None) -> list[Event]:
@@ -206,9 +232,10 @@ class HeidenhainInterpreter(ModalInterpreter):
                 first, last = made[0], made[-1]
                 assert not isinstance(first, Pass) and not isinstance(last, Pass)  # round_corner's lines
                 held[0], event = first, last
-                if first.centre_shift is not None or last.centre_shift is not None:
-                    # under RL/RR the control rounds the contour, then offsets it: the lines and the
-                    # piece are left as programmed, as ISO's corners are (`Interpreter._round_corner`)
+                if (first.centre_shift is not None or last.centre_shift is not None) and not _offset_corner(
+                    made, self.comp_side if self.radius_comp else None
+                ):
+                    # (the entry or exit move, a side unknown: left as programmed, as ISO's corners are)
                     for cut in made:
                         if not isinstance(cut, Pass):
                             cut.fixed, cut.centre_shift = COMP, None
