@@ -32,6 +32,7 @@ import pytest
 from ncpp.cli import main
 from ncpp.errors import Warnings
 from ncpp.motion.segments import Arc, Line
+from ncpp.motion.tools import ToolTable
 from ncpp.pipeline import dialect_tools
 from ncpp.program.dialects import parse_program
 from tests.compensation.test_cutter_comp_accuracy import AFFINE, closed_form
@@ -448,3 +449,18 @@ def test_a_move_that_runs_again_under_compensation_is_left_as_programmed(case):
     moves = [e for e in events if type(e) is Line or type(e) is Arc]
     assert any(m.fixed for m in moves) and any(m.centre_shift is not None for m in moves)
     assert not [m for m in moves if m.fixed and m.centre_shift is not None]
+
+
+def test_the_tool_tables_give_the_radius_compensation_offsets_by(tmp_path):
+    """TOOL.T: R + DR in its units (a table without an R column gives none); _N_TO_INI: $TC_DP6 +
+    $TC_DP15 per tool and edge, in the machine's units."""
+    (tmp_path / "TOOL.T").write_text(TOOL_T.replace("MM\n", "INCH\n", 1), encoding="latin-1")
+    assert ToolTable.from_file(tmp_path / "TOOL.T").radii == {(3, 1): pytest.approx(4.95 * 25.4)}
+    (tmp_path / "TOOL.T").write_text(
+        "BEGIN TOOL    .T       MM\nT    L\n3    +10\n[END]\n", encoding="latin-1"
+    )
+    assert ToolTable.from_file(tmp_path / "TOOL.T").radii == {}
+    (tmp_path / "_N_TO_INI").write_text(TO_INI + "$TC_DP6[1,2]=2\n$TC_DP15[2,1]=-0.05\n")
+    assert ToolTable.from_file(tmp_path / "_N_TO_INI").radii == {
+        (1, 1): pytest.approx(4.0), (1, 2): 2.0, (2, 1): -0.05,
+    }  # fmt: skip
