@@ -131,12 +131,12 @@ class ModalInterpreter:
         path by the tool radius (`tool_radius`): the moves from the first with it on to the
         first after it is off (which ends on its programmed point) stay the programmed contour,
         as the control's positions do, and carry where the tool centre stands (`ToolCentre`).
-        Left as programmed (COMP) where ncpp does not follow them: outside G17, in a block that
-        runs again (`again`), incremental moves (the dialect's `also` False), an entry or exit move that is an arc (the TNC
-        refuses RL/RR in an arc block: TNC 640 user's manual, "Radius compensation"; the
-        Sinumerik approaches and leaves the contour on a line with NORM: 840D sl Programming
-        Manual Fundamentals, "Contour approach and retraction"), and a block that changes
-        sides under it."""
+        Left as programmed (COMP) where ncpp does not follow them: outside G17, in G91, in a block
+        that runs again (`again`), incremental words (the dialect's `also` False), an entry or
+        exit move that is an arc (the TNC refuses RL/RR in an arc block: TNC 640 user's manual,
+        "Radius compensation"; the Sinumerik approaches and leaves the contour on a line with
+        NORM: 840D sl Programming Manual Fundamentals, "Contour approach and retraction"), and a
+        block that changes sides under it."""
         if turn is None and not self.radius_comp and not self.centre.off_path:
             return events
         if turn is not None:
@@ -149,7 +149,12 @@ class ModalInterpreter:
             return events
         side = self.comp_side if self.radius_comp else None
         ends = side is None or not self.centre.off_path  # (the exit, or the entry move)
-        self.centre.follow(moves, side, also and not self.again and not (ends and type(moves[0]) is Arc))
+        in_scope = all(
+            m.context.plane == 17 and m.context.absolute for m in moves
+        )  # (G18, G19, G91: not yet)
+        self.centre.follow(
+            moves, side, also and in_scope and not self.again and not (ends and type(moves[0]) is Arc)
+        )
         return events
 
     def _turned(self, turn: int) -> bool:
