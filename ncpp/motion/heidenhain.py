@@ -400,6 +400,12 @@ class HeidenhainInterpreter(ModalInterpreter):
         if (at_position or at_pattern) and call is not None:
             if function is not None or machine_datum or retract is not None or comp not in (None, "R0"):
                 raise OutOfScope(f"{call[0]} with a path function, M91, M140 or RL/RR in its block", call[1])
+            if (
+                self.radius_comp or self.centre.off_path
+            ):  # (no move after R0 brought the tool back to its point)
+                raise OutOfScope(
+                    f"{call[0]} with the tool off the contour by radius compensation RL/RR", call[1]
+                )
             if at_pattern:
                 return self._call_pattern(block, words, rapid, call[1])
             positioned = self._call_at_position(block, words, rapid, call[1])
