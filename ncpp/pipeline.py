@@ -171,14 +171,16 @@ UNCOMPENSATED = {
     "cannot carry a correction for each: its holes and moves pass through uncompensated, where the pattern puts "
     "them; compensation resumes with the next move",
     COMP: "cutter compensation: its moves pass through uncompensated (the control offsets them by the tool radius, "
-    "so the tool is not where their points are; ncpp follows it in ISO programs in G17 and G18 only, with no lathe "
-    "tool orientation, outside loops, subroutines and Fanuc corners); compensation resumes after the first move "
+    "so the tool is not where their points are; ncpp follows it in ISO programs in G17 and G18, with no lathe "
+    "tool orientation, and in Klartext and Sinumerik in G17 with absolute coordinates, outside loops, subroutines "
+    "and Fanuc corners, from and to a line); compensation resumes after the first move "
     "with it off (after G40, or R0)",
 }
 # An entry move under cutter compensation whose tool centre ends on its point: the radius is unknown
 UNKNOWN_RADIUS = (
-    "cutter compensation with the tool radius not known (G41/G42 and no tool table: --tool-table): its moves are "
-    "corrected for their programmed points, from which the tool centre stands off by that radius"
+    "cutter compensation with the tool radius not known (G41/G42 and no tool table: --tool-table; in Klartext no "
+    "R in TOOL.T or TOOL DEF, in Sinumerik none in _N_TO_INI): its moves are corrected for their programmed points, "
+    "from which the tool centre stands off by that radius"
 )
 INCREMENTAL_CYCLE = (
     "a G91 move right after a canned cycle in G90: it starts where the cycle left the tool (a G98 retract "

@@ -19,8 +19,13 @@ and `END PGM` (end), and `RND R..` / `CHF ..` between two feed lines in the
 working plane (the fillet arc or chamfer line is the RND/CHF block's event; a
 feed line waits for the next move to know whether its corner is cut).
 Radius compensation RL/RR is followed to R0: the moves from the first with RL/RR
-to the R0 block's are the programmed contour, the tool centre off it by the radius,
-and are marked `fixed` (`ModalInterpreter.radius_compensation`).  Paraxial R+/R-,
+to the R0 block's are the programmed contour, the tool centre off it by the radius
+(the called tool's R + DR from TOOL.T or TOOL DEF's R, plus TOOL CALL's DR); with
+TOOL CALL .. Z and absolute words they carry where the tool centre stands
+(`centre_shift`, `ModalInterpreter.radius_compensation`), else (IX/IY/IZ, another tool
+axis, RL/RR in an arc block, RND/CHF next to the entry or exit move) they are marked
+`fixed`.  A TOOL CALL
+under RL/RR is out of scope.  Paraxial R+/R-,
 RND/CHF next to an arc or a rapid, FK free contours,
 APPR/DEP, `CALL PGM` of a file not found, calls of other cycles, point tables, M89, FN 14 and
 later FN
@@ -43,6 +48,7 @@ from pathlib import Path
 from ncpp.errors import Location, NcppError, Warnings
 from ncpp.motion.called import Files, count_called, searched
 from ncpp.motion.corners import CornerError, round_corner
+from ncpp.motion.cutter import centre_offset
 from ncpp.motion.heidenhain_cycles import (
     DEFINITION_ACTIVE,
     REQUIRED,
@@ -80,6 +86,8 @@ DATUM_CYCLES = frozenset(("7", "8", "10", "11", "19", "26"))
 # is a zero ncpp is not told
 PRESET_CYCLE = "247"
 END_M = frozenset((2.0, 30.0))
+SIDES = {"RL": 1, "RR": -1, "R0": 0}  # radius compensation's side of the contour (0: off)
+INCREMENTAL = frozenset(("IX", "IY", "IZ"))  # (moves under RL/RR with them are left as programmed)
 HARMLESS_KEYWORDS = frozenset(("STOP",))
 # Resets of what this interpreter never follows (a tilted plane, TCPM: it stops at any that sets
 # one), which move no axis: `PLANE RESET STAY` keeps the rotary axes where they are (TNC 640
@@ -124,6 +132,30 @@ class Corner(Pass):
     col: int | None = None
 
 
+def _offset_corner(made: list[Event], side: float | None) -> bool:
+    """An RND/CHF corner between two lines under RL/RR (on `side`: `centre_offset`), both
+    followed: the control rounds the contour, then offsets it, so the fillet or chamfer gets
+    where the tool centre stands along it as any move does, and the second line starts where it
+    ends.  The first line keeps its own: shortened, its direction is the same.  False where that
+    is not so (the first line the entry move, the second the exit move, either left as
+    programmed)."""
+    first, last = made[0], made[-1]
+    if not isinstance(first, Line) or not isinstance(last, Line) or first.fixed or last.fixed:
+        return False
+    if first.centre_shift is None or last.centre_shift is None or first.centre_shift[0] is None:
+        return False
+    at = first.centre_shift[1]
+    if side is None or math.dist(last.centre_shift[1], centre_offset(last, side, at)) > 1e-9 * (
+        1 + abs(side)
+    ):
+        return False  # (the exit move)
+    for piece in made[1:]:
+        if isinstance(piece, (Line, Arc)):
+            end = centre_offset(piece, side, at)
+            piece.centre_shift, at = (at, end), end
+    return True
+
+
 def _in_flow(events: list[Event], owner: Block | None) -> list[Event]:
     """A block's events where it runs again: its moves are left as programmed (FLOW) and, run
     out of the text's order, belong to `owner`, as do its pole and corner (the writer's state);
@@ -166,6 +198,9 @@ class HeidenhainInterpreter(ModalInterpreter):
         )
         self.tool_axis = 2  # the axis its length is along (TOOL CALL's axis)
         self.call_dl = 0.0  # the last TOOL CALL's DL (an oversize), program units
+        self.call_dr = 0.0  # and its DR, added to the tool's radius
+        self.tool_called = False  # a TOOL CALL named a tool (before it, the spindle's tool is not told)
+        self.defined_radii: dict[float, float] = {}  # tool radii the program defines (TOOL DEF n R..)
         self.untold_lengths = UntoldLengths()  # warns at a TOOL CALL whose tool length nothing tells
         self.q: dict[str, float] = {}
         self.pole: list[float] | None = None
@@ -211,6 +246,13 @@ class HeidenhainInterpreter(ModalInterpreter):
                 first, last = made[0], made[-1]
                 assert not isinstance(first, Pass) and not isinstance(last, Pass)  # round_corner's lines
                 held[0], event = first, last
+                if (first.centre_shift is not None or last.centre_shift is not None) and not _offset_corner(
+                    made, self.comp_side if self.radius_comp else None
+                ):
+                    # (the entry or exit move, a side unknown: left as programmed, as ISO's corners are)
+                    for cut in made:
+                        if not isinstance(cut, Pass):
+                            cut.fixed, cut.centre_shift = COMP, None
                 piece = made[1] if len(made) == 3 else Pass(corner.block)
                 kept = next((f for f in (first.fixed, last.fixed) if f in (COMP, FLOW)), None)
                 if kept is not None and not isinstance(piece, Pass):  # (the contour's, or runs again)
@@ -380,6 +422,12 @@ class HeidenhainInterpreter(ModalInterpreter):
         if (at_position or at_pattern) and call is not None:
             if function is not None or machine_datum or retract is not None or comp not in (None, "R0"):
                 raise OutOfScope(f"{call[0]} with a path function, M91, M140 or RL/RR in its block", call[1])
+            if (
+                self.radius_comp or self.centre.off_path
+            ):  # (no move after R0 brought the tool back to its point)
+                raise OutOfScope(
+                    f"{call[0]} with the tool off the contour by radius compensation RL/RR", call[1]
+                )
             if at_pattern:
                 return self._call_pattern(block, words, rapid, call[1])
             positioned = self._call_at_position(block, words, rapid, call[1])
@@ -398,7 +446,11 @@ class HeidenhainInterpreter(ModalInterpreter):
             if call is not None:
                 raise OutOfScope(f"M140 and the cycle call {call[0]} in one block", call[1])
             events.append(self._retract(block, retract))
-        events = self.radius_compensation(events, None if comp is None else comp != "R0")
+        if comp is not None or self.radius_comp or self.centre.off_path:
+            incremental = any(
+                isinstance(i, (Word, ExprWord)) and i.letter in INCREMENTAL for i in block.items
+            )
+            events = self.radius_compensation(events, None if comp is None else SIDES[comp], not incremental)
         if call is not None:
             events = events + self._call_cycle(block, *call)
         if events and isinstance(events[-1], (Line, Arc)):
@@ -551,17 +603,23 @@ class HeidenhainInterpreter(ModalInterpreter):
         return events
 
     def _tool_def(self, block: Block, statement) -> list[Event]:
-        """`TOOL DEF n L.. R..`: the program defines tool n's length (without L: it only prepares the tool)."""
+        """`TOOL DEF n L.. R..`: the program defines tool n's length and radius (without L: it only
+        prepares the tool)."""
         number = self._tool_number(statement.node[0], block, statement)
         for item in block.items:
-            if (type(item) is Word or type(item) is ExprWord) and item.letter == "L" and number is not None:
-                self.defined[number] = self._word_value(item, block)
+            if (type(item) is Word or type(item) is ExprWord) and number is not None:
+                if item.letter == "L":
+                    self.defined[number] = self._word_value(item, block)
+                elif item.letter == "R":
+                    self.defined_radii[number] = self._word_value(item, block)
         return []
 
     def _tool_call(self, block: Block, statement) -> list[Event]:
         """`TOOL CALL n|"NAME" [axis] [DL..]`: tool n's length L + DL (table) + DL (call) along
         the tool axis; without a tool, the tool stays and so does its DL unless the call gives one."""
-        dl = None
+        if self.radius_comp:  # (which radius the control then offsets by, and how it gets there, is its own)
+            raise OutOfScope("TOOL CALL with radius compensation RL/RR", statement.start + 1)
+        dl = dr = None
         for item in block.items:
             if type(item) is Word and item.letter == "F":
                 self.auto_feed = item.value
@@ -569,13 +627,18 @@ class HeidenhainInterpreter(ModalInterpreter):
                 self.spindle = self._word_value(item, block)
             elif (type(item) is Word or type(item) is ExprWord) and item.letter == "DL":
                 dl = self._word_value(item, block)
+            elif (type(item) is Word or type(item) is ExprWord) and item.letter == "DR":
+                dr = self._word_value(item, block)
         called = statement.node[0]
         if called is not None:
             self.tool_number = self._tool_number(called, block, statement)
             self.tool_id = f'"{called}"' if type(called) is str else f"{self.tool_number:g}"
-            self.call_dl = 0.0
+            self.call_dl = self.call_dr = 0.0
+            self.tool_called = True
         if dl is not None:
             self.call_dl = dl
+        if dr is not None:
+            self.call_dr = dr
         tool = [0.0, 0.0, 0.0]
         tool[self.tool_axis] = self._length(self.tool_number, block, statement) + self.call_dl
         self.set_tool(tool)
@@ -613,6 +676,22 @@ class HeidenhainInterpreter(ModalInterpreter):
             )
         return lengths[0] / (MM_PER_INCH if self.inch else 1.0)
 
+    def tool_radius(self) -> float | None:
+        """The called tool's radius R + DR, program units: defined by the program (TOOL DEF n
+        R..), else the table's (TOOL.T), plus the call's DR (None: neither tells it, or no TOOL
+        CALL did: the tool in the spindle is the control's)."""
+        number = self.tool_number
+        if not self.tool_called:
+            return None
+        if number == 0:
+            return 0.0
+        if number is not None and number in self.defined_radii:
+            return self.defined_radii[number] + self.call_dr
+        if self.tools is None or number is None or number in self.defined:
+            return None  # (a tool the program defines without R: its radius is not the table's)
+        radius = self.tools.radii.get((number, 1))
+        return None if radius is None else radius / (MM_PER_INCH if self.inch else 1.0) + self.call_dr
+
     def _word_value(self, item, block: Block) -> float:
         return item.value if type(item) is Word else self.value(item.expr, block, item)
 
@@ -642,6 +721,7 @@ class HeidenhainInterpreter(ModalInterpreter):
                 if owner is None:  # (after M2/M30/END PGM: a subprogram's text, run where it is called)
                     yield Pass(block, kind is SKIP or (kind is TEXT and self.ended))
                 continue
+            self.again = kind is FIXED
             try:
                 events = self.block(block)
             except OutOfScope as out:

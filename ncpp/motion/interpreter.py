@@ -21,8 +21,8 @@ macro B (GOTO, IF ... GOTO, WHILE ... DO ... END, G65 and G66/G67 macro calls: `
 are the programmed contour, not the tool centre, and after G40 the position is
 the program's again, as in rs274ngc.  The moves the tool makes off the programmed
 path (from the first move under G41/G42 to the first after G40) carry where the
-tool centre stands (`centre_shift`), in G17 and G18 (LinuxCNC compensates in
-those two planes only), in G90 and G91; with a lathe tool's orientation (1-8) they
+tool centre stands (`centre_shift`, `ncpp.motion.cutter`), in G17 and G18 (LinuxCNC
+compensates in those two planes only), in G90 and G91; with a lathe tool's orientation (1-8) they
 are marked `fixed`, as are the moves of cycles, loops, subroutines and macros:
 compensation leaves them as programmed.  Anything else (subroutine files ncpp is not told
 of, a move of a subprogram under G66, a Fanuc system variable it does not know, M99
@@ -41,6 +41,7 @@ from typing import NoReturn, cast
 
 from ncpp.errors import Location, NcppError, Warnings, resolve_warnings
 from ncpp.motion.corners import CornerError, round_corner
+from ncpp.motion.cutter import ToolCentre
 from ncpp.motion.cycles import (
     CANNED,
     DWELLING,
@@ -70,9 +71,7 @@ from ncpp.motion.segments import (
     Hole,
     Line,
     Pass,
-    Point,
     Setting,
-    mark_off_path,
 )
 from ncpp.motion.tools import UntoldLengths
 from ncpp.program.blocks import STRAY_TAPE, UNREADABLE, Block, Comment, ExprWord, Statement, Word
@@ -288,12 +287,7 @@ class Interpreter:
         # its lathe tool orientation (G41.1/G42.1's L, the tool table's Q; 0 and 9: the tool centre is
         # controlled), kept after G40 for the exit move
         self.comp_orientation = 0
-        self.off_path = False  # the tool centre is off the programmed path: from the first move under comp to the first after G40
-        # the tool centre minus the programmed point (`_centre_shift`)
-        self.centre_at: Point = (0.0, 0.0, 0.0)
-        # under it, whether the output stands at a corrected point in the plane (not where a move left as
-        # programmed put the tool: `_in_comp`)
-        self.corrected = True
+        self.centre = ToolCentre()  # where the tool centre stands off the programmed path (`_in_comp`)
         self.arc_refused = False  # after G40 ended compensation that moved the tool off the path: until a G0/G1 move (rs274ngc)
         self.untold: set[int] = set()  # coordinate systems whose zero nobody said (warned when selected)
         self.warnings: Warnings | None = None
@@ -363,7 +357,7 @@ class Interpreter:
                     if kind is RUN and _moves(event):  # in its place: no backward GOTO may run it again
                         flow.last_run_move = block.line
                     self._note_placed(block)
-                if self.off_path or self.cutter_comp is not None or self.arc_refused:
+                if self.centre.off_path or self.cutter_comp is not None or self.arc_refused:
                     event = self._in_comp(event, block)
             except NcppError as err:
                 source = flow.source()
@@ -481,56 +475,20 @@ class Interpreter:
             self.arc_refused = moves[0].fixed in (CYCLE, HOLE) or _expanding(events[0]) or _homes(block)
         if self.cutter_comp is not None and self.comp_radius:
             self._check_radius(moves, block, self.comp_radius)
-        compensating = self.cutter_comp is not None
-        if compensating or self.off_path:
-            corrected = self.corrected or not self.off_path  # (the entry move starts from a compensated move)
-            shifts = [self._centre_shift(move, compensating) for move in moves]
-            # an arc from where a move left as programmed ended starts there: it is left as programmed too
-            # (compensated, it would start at its corrected start, a step away, which the control would offset)
-            if _followed(moves, self.comp_orientation) and (corrected or type(moves[0]) is not Arc):
-                for move, shift in zip(moves, shifts):
-                    move.centre_shift = shift
-                self.off_path = compensating
-                self.corrected = corrected or any(m.start[:2] != m.end[:2] for m in moves)
-            else:  # (a loop's or a cycle's moves too: that the tool is off the path matters more)
-                self.off_path = mark_off_path(moves, compensating, self.off_path)
-                self.corrected = False
+        # (with a lathe tool's orientation 1-8 the control moves its tip, not its centre, along the offset contour)
+        self.centre.follow(moves, self._comp_side(), self.comp_orientation in (0, 9))
         if moves[0].fixed and any(_expanding(ev) for ev in events):  # a cycle left as programmed stays one
             kept = tuple(ev for ev in events if not _expanding(ev))
             return kept if len(kept) != 1 else kept[0]
         return event
 
-    def _centre_shift(self, move: Line | Arc, compensating: bool) -> tuple[Point | None, Point]:
-        """Where the tool centre stands off the move's programmed start and end: the end's by the
-        radius to the left (G41) or right (G42) of the move's own direction there, as the control
-        offsets the contour (zero where the radius is unknown); the start's is the move before's
-        end's (the exit move after G40 ends on it).  The entry move's start is None: the tool centre
-        starts on the programmed point, and the control makes the move whole (rs274ngc checks its
-        length against the radius).  A move with no motion in the plane keeps the tool centre where
-        it stands."""
-        start = self.centre_at if self.off_path else None
-        radius = self.comp_radius if compensating and self.comp_radius else 0.0
-        end: Point = (0.0, 0.0, 0.0)
-        if radius:
-            # left as seen from the plane's normal (+Z in G17, +Y in G18): in the plane's own (u, v)
-            # axes, X Y or Z X, as LinuxCNC's manual (G41, G42) and rs274ngc's ARC_FEED have them
-            a, b, _ = PLANE_AXES[move.context.plane]
-            side = radius if self.cutter_comp in (41.0, 41.1) else -radius
-            u0, v0, u1, v1 = move.start[a], move.start[b], move.end[a], move.end[b]
-            shift = [0.0, 0.0, 0.0]
-            if type(move) is Arc:  # left of the tangent: towards the centre counter-clockwise
-                cu, cv = move.center[a], move.center[b]
-                length = math.hypot(u1 - cu, v1 - cv)
-                side = -side if move.turn > 0 else side
-                shift[a], shift[b] = side * (u1 - cu) / length, side * (v1 - cv) / length
-                end = (shift[0], shift[1], shift[2])
-            elif (length := math.hypot(u1 - u0, v1 - v0)) > 0.0:
-                shift[a], shift[b] = -side * (v1 - v0) / length, side * (u1 - u0) / length
-                end = (shift[0], shift[1], shift[2])
-            else:
-                end = self.centre_at
-        self.centre_at = end
-        return start, end
+    def _comp_side(self) -> float | None:
+        """The radius compensation offsets by, positive to the left (G41, G41.1), negative to the
+        right (0: the radius is unknown); None: compensation is off (`ToolCentre.follow`)."""
+        if self.cutter_comp is None:
+            return None
+        radius = self.comp_radius or 0.0
+        return radius if self.cutter_comp in (41.0, 41.1) else -radius
 
     def _check_radius(self, moves: list, block: Block, radius: float) -> None:
         """rs274ngc's checks of moves under compensation against the tool radius: the entry move
@@ -541,7 +499,7 @@ class Interpreter:
         a, b, _ = PLANE_AXES[self.plane]
         first = moves[0]
         if (
-            not self.off_path
+            not self.centre.off_path
             and math.hypot(first.end[a] - first.start[a], first.end[b] - first.start[b]) <= radius
         ):
             what = (
@@ -1145,7 +1103,7 @@ class Interpreter:
         them against (`_check_radius`), and a radius of 0 leaves the tool on the path."""
         code, item = code_item
         if code == 40.0:
-            self.arc_refused = self.arc_refused or self.off_path
+            self.arc_refused = self.arc_refused or self.centre.off_path
             self.cutter_comp = self.comp_radius = None
             return
         if self.plane not in (17, 18):
@@ -1218,7 +1176,7 @@ class Interpreter:
                 vector[i] *= scale
         if self.comp_radius is not None:
             self.comp_radius *= scale
-        self.centre_at = (self.centre_at[0] * scale, self.centre_at[1] * scale, 0.0)
+        self.centre.scale(scale)
         self._set(inch=inch)
 
     def _shift(self, old: list[float], new: list[float]) -> None:
@@ -1305,8 +1263,8 @@ class Interpreter:
         self._coordinate_system(1)
         self._set(plane=17, absolute=True, inverse_time=False)
         self.motion = 1.0
-        self.cutter_comp, self.comp_radius, self.off_path, self.arc_refused = None, None, False, False
-        self.centre_at = (0.0, 0.0, 0.0)
+        self.cutter_comp, self.comp_radius, self.arc_refused = None, None, False
+        self.centre.reset()
         self.done = True
 
     def _machine(self, i: int) -> float:
@@ -1914,14 +1872,6 @@ def _moves(event: Event | tuple[Event, ...]) -> bool:
     if type(event) is tuple:
         return any(type(e) is not Pass for e in event)
     return type(event) is not Pass
-
-
-def _followed(moves: list[Line | Arc], orientation: int) -> bool:
-    """Whether compensation follows a block's moves under cutter compensation (`Line.centre_shift`):
-    in G17 and G18 (in G90 or G91: the moves' points are absolute here), with no lathe tool
-    `orientation` (1-8: the control moves its tip, not its centre, along the offset contour), and
-    none of them left as programmed for another reason (a loop's, a cycle's)."""
-    return orientation in (0, 9) and all(not m.fixed and m.context.plane in (17, 18) for m in moves)
 
 
 def _homes(block: Block) -> bool:

@@ -15,8 +15,9 @@ from pathlib import Path
 from typing import NoReturn
 
 from ncpp.errors import Location, NcppError, Warnings, resolve_warnings
+from ncpp.motion.cutter import ToolCentre
 from ncpp.motion.offsets import WorkOffsets
-from ncpp.motion.segments import DRILLED, PLANE_AXES, Arc, Context, Event, Line, Pass, Point, mark_off_path
+from ncpp.motion.segments import DRILLED, PLANE_AXES, Arc, Context, Event, Line, Pass, Point
 from ncpp.program.blocks import Block
 
 MM_PER_INCH = 25.4
@@ -89,7 +90,11 @@ class ModalInterpreter:
         self.tangent: tuple[float, float, float] | None = None  # direction at the end of the last move
         self.done = False
         self.radius_comp = False  # tool radius compensation on (G41/G42, RL/RR)
-        self.off_path = False  # the tool centre off the programmed path: from the first move with it on to the first after
+        # the radius it offsets by, positive to the left, negative to the right (0: the radius is
+        # unknown); None: off, or a tool of radius 0, which stays on the path
+        self.comp_side: float | None = None
+        self.centre = ToolCentre()  # where the tool centre stands off the programmed path
+        self.again = False  # the block runs again, or away from its text (its moves are left as programmed)
         self.tool_id = ""  # the tool in the spindle as the program names it (Context.tool_id)
         self._context: Context | None = None
         self.subroutine_path: tuple[Path, ...] = ()  # the folders of the program files it calls
@@ -129,18 +134,46 @@ class ModalInterpreter:
     def block(self, block: Block) -> list[Event]:
         raise NotImplementedError
 
-    def radius_compensation(self, events: list[Event], turn: bool | None) -> list[Event]:
-        """A block's events, `turn`ing tool radius compensation on (True), off (False) or
-        neither (None).  The control offsets the path by the tool radius: the moves from the
-        first with it on to the first after it is off (which ends on its programmed point)
-        are marked `fixed` (COMP); positions stay the programmed ones, as the control's do."""
+    def radius_compensation(self, events: list[Event], turn: int | None, also: bool = True) -> list[Event]:
+        """A block's events, `turn`ing tool radius compensation on to the left (+1: G41, RL) or
+        the right (-1: G42, RR), off (0: G40, R0) or neither (None).  The control offsets the
+        path by the tool radius (`tool_radius`): the moves from the first with it on to the
+        first after it is off (which ends on its programmed point) stay the programmed contour,
+        as the control's positions do, and carry where the tool centre stands (`ToolCentre`).
+        Left as programmed (COMP) where ncpp does not follow them: outside G17, in G91, in a block
+        that runs again (`again`), incremental words (the dialect's `also` False), an entry or
+        exit move that is an arc (the TNC refuses RL/RR in an arc block: TNC 640 user's manual,
+        "Radius compensation"; the Sinumerik approaches and leaves the contour on a line with
+        NORM: 840D sl Programming Manual Fundamentals, "Contour approach and retraction"), and a
+        block that changes sides under it."""
+        if turn is None and not self.radius_comp and not self.centre.off_path:
+            return events
         if turn is not None:
-            self.radius_comp = turn
-        if self.radius_comp or self.off_path:
-            self.off_path = mark_off_path(
-                [e for e in events if type(e) is Line or type(e) is Arc], self.radius_comp, self.off_path
-            )
+            also = also and not (turn and self.radius_comp and self._turned(turn))
+            self.radius_comp = bool(turn)
+            radius = self.tool_radius() if turn else 0.0
+            self.comp_side = None if radius == 0.0 else turn * (radius or 0.0)
+        moves: list[Line | Arc] = [e for e in events if type(e) is Line or type(e) is Arc]
+        if not moves or (self.radius_comp and self.comp_side is None):  # (radius 0: on the path)
+            return events
+        side = self.comp_side if self.radius_comp else None
+        ends = side is None or not self.centre.off_path  # (the exit, or the entry move)
+        in_scope = all(
+            m.context.plane == 17 and m.context.absolute for m in moves
+        )  # (G18, G19, G91: not yet)
+        self.centre.follow(
+            moves, side, also and in_scope and not self.again and not (ends and type(moves[0]) is Arc)
+        )
         return events
+
+    def _turned(self, turn: int) -> bool:
+        """Whether compensation on turns to the other side from the one in effect."""
+        return self.comp_side is not None and (self.comp_side > 0) != (turn > 0)
+
+    def tool_radius(self) -> float | None:
+        """The radius of the tool in effect, program units, which radius compensation offsets
+        by (None: not known); each dialect says where it comes from."""
+        raise NotImplementedError
 
     # -- modal state --------------------------------------------------------------------
     def context(self, plane: int | None = None, absolute: bool = True) -> Context:
@@ -159,6 +192,8 @@ class ModalInterpreter:
             self.offset = [v * scale for v in self.offset]
             self.tool = [v * scale for v in self.tool]
             self.zero = [v * scale for v in self.zero]
+            self.comp_side = None if self.comp_side is None else self.comp_side * scale
+            self.centre.scale(scale)
             self.inch = inch
             self._context = None
 

@@ -20,8 +20,10 @@ patterns CYCLE801 and CYCLE802, subprogram files not found, splines, other frame
 coordinates (AP=, RP=),
 arcs by opening angle (AR=) and unknown G codes make the position unknown: one warning (an error with `strict`) and the
 rest passes through.  Under cutter compensation (G41/G42 to the first move after
-G40) the moves are the programmed contour, the tool centre off it by the radius:
-they are marked `fixed` (`ModalInterpreter.radius_compensation`).
+G40) the moves are the programmed contour, the tool centre off it by the edge's radius
+($TC_DP6 + $TC_DP15 in `_N_TO_INI`): in G17 and G90 they carry where the tool centre
+stands (`centre_shift`, `ModalInterpreter.radius_compensation`), else (G18, G19, G91, an
+entry or exit arc) they are marked `fixed`; M6 or D under it is out of scope.
 """
 
 from __future__ import annotations
@@ -103,6 +105,7 @@ FRAMES = frozenset(("TRANS", "ATRANS", "ROT", "SCALE", "MIRROR"))
 
 # The axis (X, Y, Z index) that lengths 1, 2 and 3 of a milling tool act along, per plane
 LENGTH_AXES = {17: (2, 1, 0), 18: (1, 0, 2), 19: (0, 2, 1)}
+SIDES = {41.0: 1, 42.0: -1, 40.0: 0}  # cutter compensation's side of the contour (0: off)
 TOOL_CHANGE = 6.0  # M6 loads the tool T selected, with its cutting edge D1 unless the block says another
 
 
@@ -156,6 +159,7 @@ class SinumerikInterpreter(ModalInterpreter):
         self.selected: float | str = 0.0  # the tool T selected: a number, or a name
         self.loaded: float | str = 0.0  # the tool M6 loaded (0: none)
         self.edge = 0  # the cutting edge D in effect (0: no tool offset)
+        self.edge_told = False  # M6 or D said the edge (before it, the control's own is in effect)
         self.untold_lengths = UntoldLengths()  # warns where a tool length applies that nothing tells
         self.motion: float | str = 0.0  # 0-3, 'CIP' or 'CT' (G0 after power on)
         self.absolute = True
@@ -203,6 +207,7 @@ class SinumerikInterpreter(ModalInterpreter):
                     runs_others = kind is TEXT and not self.done and _runs_others(block)
                     yield Pass(block, kind is SKIP, self.motion if runs_others else None)
                 continue
+            self.again = kind is FIXED
             try:
                 events = self.block(block)
             except OutOfScope as stop:
@@ -572,7 +577,13 @@ class SinumerikInterpreter(ModalInterpreter):
         )
         plane = self.plane
         codes = {code for code, _ in gcodes}
-        turn = True if codes & {41.0, 42.0} else False if 40.0 in codes else None  # cutter compensation
+        # cutter compensation: G41 left, G42 right, G40 off (the block's last of them)
+        turn = next((SIDES[code] for code, _ in reversed(gcodes) if code in SIDES), None)
+        changes = [item for item, _ in tool_words if item.letter in ("M", "D")]
+        if changes and self.radius_comp and not turn:  # (its radius is the edge's it was turned on with)
+            raise OutOfScope(
+                "a tool or cutting edge change under radius compensation G41/G42", changes[0].start + 1
+            )
         dwell = self._modal_codes(gcodes, block)
         if tool_words or (self.plane != plane and self.edge):
             self._place_tool(block, tool_words)
@@ -716,6 +727,7 @@ class SinumerikInterpreter(ModalInterpreter):
                 self.tool_id = _tool_id(self.loaded)
             else:
                 self.edge, changed = int(value), True
+            self.edge_told = self.edge_told or changed
             if changed and self.tools is None and self.edge:
                 self.untold_lengths(
                     f"{item.letter}{value:g}", "_N_TO_INI", Location(self.file, block.line, item.start + 1)
@@ -730,7 +742,7 @@ class SinumerikInterpreter(ModalInterpreter):
         """Lengths 1-3 (mm) of the loaded tool's cutting edge in effect (none: D0, no tool, no table)."""
         if self.tools is None or not self.edge or self.loaded in (0.0, ""):
             return (0.0, 0.0, 0.0)
-        number = self.loaded if type(self.loaded) is float else self.tools.names.get(self.loaded)  # type: ignore[arg-type]
+        number = self._loaded_number()
         if number is None:
             self.fail(f'tool "{self.loaded}" is not in {self.tools.source}', block, item)
         lengths = self.tools.edges.get((number, self.edge))
@@ -738,6 +750,24 @@ class SinumerikInterpreter(ModalInterpreter):
             self.fail(f"tool {self.loaded if type(self.loaded) is str else f'{number:g}'} has no cutting edge D{self.edge} in {self.tools.source}",
                       block, item)  # fmt: skip
         return lengths
+
+    def _loaded_number(self) -> float | None:
+        """The loaded tool's number (a name's, in the tool offsets), None: a name they lack."""
+        assert self.tools is not None
+        return self.loaded if type(self.loaded) is float else self.tools.names.get(self.loaded)  # type: ignore[arg-type]
+
+    def tool_radius(self) -> float | None:
+        """The radius of the loaded tool's cutting edge in effect (radius plus wear radius in the
+        control's tool offsets, `_N_TO_INI`), program units; 0 with D0, None when the offsets are
+        not told or do not give it (or no M6 or D said the edge, or no M6 loaded the tool)."""
+        if not self.edge_told:
+            return None
+        if not self.edge:
+            return 0.0
+        if self.tools is None or self.loaded in (0.0, ""):  # (no M6: the spindle's tool is the control's)
+            return None
+        radius = self.tools.radii.get((self._loaded_number(), self.edge))  # type: ignore[arg-type]
+        return None if radius is None else radius / (MM_PER_INCH if self.inch else 1.0)
 
     def _word_value(self, item: ExprWord, block: Block) -> tuple[float, str | None]:
         expr = item.expr

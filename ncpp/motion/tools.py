@@ -26,7 +26,8 @@ units in the first line:
     [END]
 
 A tool's length is L + DL along the tool axis (the axis TOOL CALL names): its
-one cutting edge's length 1, as Sinumerik's below; numbers may have a decimal comma.
+one cutting edge's length 1, as Sinumerik's below; its radius is R + DR (radius
+compensation RL/RR offsets by it); numbers may have a decimal comma.
 
 Sinumerik's tool offsets, as the control saves them (`_N_TO_INI`), per tool T
 and cutting edge D:
@@ -36,6 +37,7 @@ and cutting edge D:
     $TC_DP3[1,1]=150.0   ; length 1 (geometry), + $TC_DP12 (wear) + $TC_DP21 (adapter)
     $TC_DP4[1,1]=0.0     ; length 2, + $TC_DP13 + $TC_DP22
     $TC_DP5[1,1]=0.0     ; length 3, + $TC_DP14 + $TC_DP23
+    $TC_DP6[1,1]=5.0     ; radius (G41/G42 offset by it), + $TC_DP15 (wear)
 
 Its lengths are in the machine's units; which axis each acts along depends on
 the plane (G17: length 1 along Z, 2 along Y, 3 along X), so they are kept per
@@ -80,6 +82,9 @@ class ToolTable:
     orientations: Mapping[int, int] = field(
         default_factory=dict, hash=False
     )  # LinuxCNC's Q per tool number: a lathe tool's orientation (1-9)
+    radii: Mapping[tuple[float, int], float] = field(
+        default_factory=dict, hash=False
+    )  # (T, D) -> Heidenhain's R + DR, Sinumerik's radius + wear radius, mm (where the table gives one)
 
     @classmethod
     def from_file(cls, path: str | Path, unit_mm: float = 1.0) -> ToolTable:
@@ -91,11 +96,11 @@ class ToolTable:
             raise NcppError(f"cannot read the tool table: {err.strerror}", Location(str(path))) from None
         lines = text.splitlines()
         if "$TC_DP" in text.upper():
-            edges, names = read_to_ini(lines, str(path), unit_mm)
-            return cls({}, str(path), names, edges)
+            edges, names, radii = read_to_ini(lines, str(path), unit_mm)
+            return cls({}, str(path), names, edges, radii=radii)
         if lines and lines[0].lstrip().upper().startswith("BEGIN"):
-            edges, names = read_tool_t(lines, str(path))
-            return cls({}, str(path), names, edges)
+            edges, names, radii = read_tool_t(lines, str(path))
+            return cls({}, str(path), names, edges, radii=radii)
         offsets, diameters, orientations = read_tool_lines(lines, str(path), unit_mm)
         return cls(offsets, str(path), diameters=diameters, orientations=orientations)
 
@@ -193,14 +198,18 @@ def _integer(text: str, where: Location) -> int:
 
 def read_tool_t(
     lines: list[str], file: str
-) -> tuple[dict[tuple[float, int], tuple[float, float, float]], dict[str, float]]:
-    """Heidenhain's TOOL.T: per (tool, its one edge) its lengths (L + DL, 0, 0) in mm, and the names."""
+) -> tuple[
+    dict[tuple[float, int], tuple[float, float, float]], dict[str, float], dict[tuple[float, int], float]
+]:
+    """Heidenhain's TOOL.T: per (tool, its one edge) its lengths (L + DL, 0, 0) in mm, the names,
+    and per (tool, edge) its radius R + DR in mm (a table without an R column gives none)."""
     unit_mm = 25.4 if "INCH" in lines[0].upper().split() else 1.0
     if len(lines) < 2:
         raise NcppError("TOOL.T without its column header", Location(file, 1, 1))
     columns = _columns(lines[1], file)
     tools: dict[tuple[float, int], tuple[float, float, float]] = {}
     names: dict[str, float] = {}
+    radii: dict[tuple[float, int], float] = {}
     for n, line in enumerate(lines[2:], 3):
         if line.strip().upper().startswith("[END]"):
             break
@@ -216,10 +225,12 @@ def read_tool_t(
         if (number, 1) in tools:
             raise NcppError(f"tool {text} is listed twice", Location(file, n, col))
         tools[number, 1] = ((decimal("L") + decimal("DL")) * unit_mm, 0.0, 0.0)
+        if "R" in columns:
+            radii[number, 1] = (decimal("R") + decimal("DR")) * unit_mm
         name = _field(line, columns, "NAME")[0]
         if name:
             names.setdefault(name, number)
-    return tools, names
+    return tools, names, radii
 
 
 def _columns(header: str, file: str) -> dict[str, tuple[int, int | None]]:
@@ -253,14 +264,21 @@ _TC_DP = re.compile(r"\$TC_DP(\d+)\[\s*(\d+)\s*,\s*(\d+)\s*\]\s*=\s*(\S*)", re.I
 _TC_TP2 = re.compile(r"\$TC_TP2\[\s*(\d+)\s*\]\s*=\s*\"([^\"]*)\"", re.IGNORECASE)
 # lengths 1-3 of an edge: geometry, wear and adapter parameters, added
 _LENGTH_PARAMETERS = {3: 0, 12: 0, 21: 0, 4: 1, 13: 1, 22: 1, 5: 2, 14: 2, 23: 2}
+# an edge's radius: geometry and wear, added (840D sl Programming Manual Job Planning, "Tool
+# parameters": "$TC_DP6 + $TC_DP15 for the radius")
+_RADIUS_PARAMETERS = frozenset((6, 15))
 
 
 def read_to_ini(
     lines: list[str], file: str, unit_mm: float
-) -> tuple[dict[tuple[float, int], tuple[float, float, float]], dict[str, float]]:
-    """Sinumerik's tool offsets: per (T, D) its lengths 1-3 in mm, and the tools' names."""
+) -> tuple[
+    dict[tuple[float, int], tuple[float, float, float]], dict[str, float], dict[tuple[float, int], float]
+]:
+    """Sinumerik's tool offsets: per (T, D) its lengths 1-3 in mm, the tools' names, and per
+    (T, D) its radius in mm (where the offsets give $TC_DP6 or $TC_DP15)."""
     lengths: dict[tuple[float, int], list[float]] = {}
     names: dict[str, float] = {}
+    radii: dict[tuple[float, int], float] = {}
     for n, line in enumerate(lines, 1):
         data = line.split(";", 1)[0]
         if (named := _TC_TP2.search(data)) is not None:
@@ -274,7 +292,9 @@ def read_to_ini(
         edge_lengths = lengths.setdefault((float(tool), edge), [0.0, 0.0, 0.0])
         if parameter in _LENGTH_PARAMETERS:
             edge_lengths[_LENGTH_PARAMETERS[parameter]] += value * unit_mm
-    return {key: (a, b, c) for key, (a, b, c) in lengths.items()}, names
+        elif parameter in _RADIUS_PARAMETERS:
+            radii[float(tool), edge] = radii.get((float(tool), edge), 0.0) + value * unit_mm
+    return {key: (a, b, c) for key, (a, b, c) in lengths.items()}, names, radii
 
 
 _QUOTED = 16  # the longest text of a table a message quotes

@@ -312,7 +312,7 @@ def _rows(segs: list, directional: bool, fixed_before: bool = True) -> _Rows:
 def _under_comp(segs: list, free: NDArray, start: NDArray, end: NDArray) -> tuple[NDArray | None, ...]:
     """`_Rows.comp`, `.shift`, `.still`, `.corner` and `.axes` of the segments (all None: none is under
     compensation).  A line under compensation that moves no axis of the plane (G17: X Y, G18: Z X)
-    leaves the tool centre where it stands (`Interpreter._centre_shift`): the same shift at both ends."""
+    leaves the tool centre where it stands (`ncpp.motion.cutter.centre_offset`): the same shift at both ends."""
     if all(e.centre_shift is None for e in segs):
         return None, None, None, None, None
     comp = np.fromiter((e.centre_shift is not None for e in segs), dtype=bool, count=len(segs))

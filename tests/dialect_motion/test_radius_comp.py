@@ -1,7 +1,8 @@
 """Tool radius compensation in the three dialects (G41/G42 ... G40, RL/RR ... R0): the moves the
-tool makes off the programmed contour are marked; in Heidenhain and Sinumerik they pass through
-compensation as written, and the same part compensates to the same moves after them in both.  In
-ISO (G17, G90) they are compensated where the tool centre stands (tests/compensation/test_cutter_comp_accuracy.py)."""
+tool makes off the programmed contour are marked; in G17 with absolute coordinates they are
+compensated where the tool centre stands (tests/compensation/test_cutter_comp_accuracy.py for ISO,
+tests/compensation/test_dialect_cutter_comp.py for Klartext and Sinumerik); elsewhere they pass
+through as written, and the same part compensates to the same moves after them in every dialect."""
 
 from __future__ import annotations
 
@@ -69,17 +70,21 @@ def test_the_moves_from_the_first_with_compensation_to_the_first_after_it_are_ma
     assert marked == [False, False, True, True, True, True, True, False, False, False]
 
 
-@pytest.mark.parametrize("dialect", ["heidenhain", "sinumerik"])
-def test_they_pass_through_and_compensation_resumes_after_them(dialect):
-    text, name, first, count = PROGRAMS[dialect]
-    out, warned = compensate(text, name)
-    unnumbered = (
-        (lambda line: line.split(" ", 1)[1]) if dialect == "heidenhain" else (lambda line: line)
-    )  # (Klartext renumbers)
+# the same part in G18 (Klartext: the tool along Y), which compensation does not follow
+IN_G18 = HEIDENHAIN.replace(
+    "0 BEGIN PGM COMP MM\n", "0 BEGIN PGM COMP MM\n0 TOOL DEF 1 L+0 R+2\n0 TOOL CALL 1 Y\n"
+)
+
+
+def test_outside_g17_they_pass_through_and_compensation_resumes_after_them():
+    """(Sinumerik's moves not followed: tests/compensation/test_dialect_cutter_comp.py.)"""
+    _, name, first, count = PROGRAMS["heidenhain"]
+    first += 2  # (the TOOL DEF and TOOL CALL lines)
+    out, warned = compensate(IN_G18, name)
     source, lines = (
-        [unnumbered(line) for line in text.splitlines()],
-        [unnumbered(line) for line in out.splitlines()[1:]],
-    )
+        [line.split(" ", 1)[1] for line in IN_G18.splitlines()],
+        [line.split(" ", 1)[1] for line in out.splitlines()[1:]],
+    )  # (Klartext renumbers)
     start = lines.index(source[first - 1])
     assert (
         lines[start : start + count] == source[first - 1 : first - 1 + count]
@@ -90,16 +95,24 @@ def test_they_pass_through_and_compensation_resumes_after_them(dialect):
         and f"{name}:{first}:1: warning: cutter compensation" in warned
     )
     with pytest.raises(NcppError, match=f"{name}:{first}:1: cutter compensation"):
-        compensate(text, name, strict=True)
+        compensate(IN_G18, name, strict=True)
 
 
-def test_in_iso_they_are_compensated():
+@pytest.mark.parametrize("dialect", PROGRAMS)
+def test_in_g17_they_are_compensated(dialect):
     """(Where the tool centre stands is not known without the tool table: the warning says so.)"""
-    text, name, first, count = PROGRAMS["iso"]
+    text, name, first, count = PROGRAMS[dialect]
     out, warned = compensate(text, name)
-    source, lines = text.splitlines(), out.splitlines()
-    start = next(k for k, line in enumerate(lines) if line.startswith("G41 D1 G1 X0.0"))
-    assert all(lines[start + k] != source[first - 1 + k] for k in range(count))
+    unnumbered = (lambda line: line.split(" ", 1)[1]) if dialect == "heidenhain" else (lambda line: line)
+    source, lines = (
+        [unnumbered(line) for line in text.splitlines()],
+        [unnumbered(line) for line in out.splitlines()],
+    )
+    entry = source[first - 1]
+    start = next(k for k, line in enumerate(lines) if line.startswith(entry[: entry.index("X") + 1]))
+    assert all(
+        lines[start + k] != source[first - 1 + k] for k in range(count) if "CC" not in source[first - 1 + k]
+    )
     assert (
         warned.count("warning") == 1
         and f"{name}:{first}:1: warning: cutter compensation with the tool radius not known" in warned

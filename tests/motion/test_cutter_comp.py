@@ -206,7 +206,7 @@ def test_program_end_ends_compensation():
             parse_stream(io.BytesIO((HEAD + "G41.1 D2\nG1 X10\nM2\n").encode()), "t.ngc"), Warnings()
         )
     )
-    assert interpreter.cutter_comp is None and not interpreter.off_path
+    assert interpreter.cutter_comp is None and not interpreter.centre.off_path
 
 
 @pytest.mark.xfail(

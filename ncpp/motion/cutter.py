@@ -1,0 +1,101 @@
+"""Where the tool centre stands under cutter (tool radius) compensation, in every dialect.
+
+ISO's G41/G42, Klartext's RL/RR and Sinumerik's G41/G42 make the control offset the
+programmed contour by the tool radius, to the left or the right of the direction of travel.
+The control joins the offset moves at their corners (a transition arc about the corner at an
+outside corner, the crossing of the offset paths at an inside one: TNC 640 user's manual,
+"Radius compensation: Machining corners"; 840D sl Programming Manual Fundamentals, "Corner
+behavior: G450, G451"; LinuxCNC's interpreter likewise), so at a move's end the tool centre
+stands square to the move's own direction there, by the radius (in G17, and in ISO programs G18
+too).  ncpp evaluates the machine's
+error where the tool centre stands (`Line.centre_shift`); `ToolCentre` follows it move by move,
+for the ISO interpreter and for `ModalInterpreter` alike.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from ncpp.motion.segments import PLANE_AXES, Arc, Line, Point, mark_off_path
+
+ON_PATH: Point = (0.0, 0.0, 0.0)
+
+
+def centre_offset(move: Line | Arc, side: float, standing: Point) -> Point:
+    """The tool centre minus the programmed point at the end of `move` under compensation:
+    `side` the radius, positive to the left of the move's direction there (G41, RL), negative
+    to the right (0: not compensating, or the radius is unknown: on the path).  Left as seen
+    from the plane's normal (+Z in G17, +Y in G18): in the plane's own (u, v) axes, X Y or Z X,
+    as LinuxCNC's manual (G41, G42) and rs274ngc's ARC_FEED have them.  A move with no motion
+    in the plane keeps the tool centre where it stands (`standing`)."""
+    if not side:
+        return ON_PATH
+    a, b, _ = PLANE_AXES[move.context.plane]
+    u0, v0, u1, v1 = move.start[a], move.start[b], move.end[a], move.end[b]
+    shift = [0.0, 0.0, 0.0]
+    if type(move) is Arc:  # left of the tangent: towards the centre counter-clockwise
+        cu, cv = move.center[a], move.center[b]
+        length = math.hypot(u1 - cu, v1 - cv)
+        side = -side if move.turn > 0 else side
+        shift[a], shift[b] = side * (u1 - cu) / length, side * (v1 - cv) / length
+    elif (length := math.hypot(u1 - u0, v1 - v0)) > 0.0:
+        shift[a], shift[b] = -side * (v1 - v0) / length, side * (u1 - u0) / length
+    else:
+        return standing
+    return (shift[0], shift[1], shift[2])
+
+
+def followed(moves: list[Line | Arc]) -> bool:
+    """Whether compensation follows a block's moves under cutter compensation: in G17 and G18 (in
+    G90 or G91: the moves' points are absolute here), and none of them left as programmed for
+    another reason (a loop's, a cycle's)."""
+    return all(not m.fixed and m.context.plane in (17, 18) for m in moves)
+
+
+@dataclass
+class ToolCentre:
+    """Where the tool centre stands off the programmed path, block after block."""
+
+    off_path: bool = False  # from the first move under compensation to the first after it is off
+    at: Point = ON_PATH  # the tool centre minus the programmed point where the last move ended
+    # whether the output stands at a corrected point in the plane (not where a move left as
+    # programmed put the tool)
+    corrected: bool = True
+
+    def follow(self, moves: list[Line | Arc], side: float | None, also: bool = True) -> None:
+        """A block's `moves` under compensation on `side` (`centre_offset`; None: it is off, the
+        first move after it brings the tool back to its programmed end) or the first after it:
+        each gets its `centre_shift`, where compensation follows them (`followed`, and `also`:
+        the dialect's own condition); else they are marked `fixed` (COMP), left as programmed.
+        The entry move's start is None: the tool centre starts on the programmed point, and the
+        control makes the move whole."""
+        if side is None and not self.off_path:
+            return
+        corrected = self.corrected or not self.off_path  # (the entry move starts from a compensated move)
+        shifts = [self._shift(move, side) for move in moves]
+        # an arc from where a move left as programmed ended starts there: it is left as programmed too
+        # (compensated, it would start at its corrected start, a step away, which the control would offset)
+        if also and followed(moves) and (corrected or type(moves[0]) is not Arc):
+            for move, shift in zip(moves, shifts):
+                move.centre_shift = shift
+            self.off_path = side is not None
+            self.corrected = corrected or any(m.start[:2] != m.end[:2] for m in moves)
+        else:  # (a loop's or a cycle's moves too: that the tool is off the path matters more)
+            self.off_path = mark_off_path(moves, side is not None, self.off_path)
+            self.corrected = False
+
+    def _shift(self, move: Line | Arc, side: float | None) -> tuple[Point | None, Point]:
+        """The move's (start, end) tool centre minus programmed point; the start is the move
+        before's end (the exit move after compensation ends on its programmed point)."""
+        start = self.at if self.off_path else None
+        self.at = centre_offset(move, side or 0.0, self.at)
+        return start, self.at
+
+    def scale(self, factor: float) -> None:
+        """The program units changed."""
+        self.at = (self.at[0] * factor, self.at[1] * factor, 0.0)
+
+    def reset(self) -> None:
+        """Compensation is off and the tool on the path (a program end)."""
+        self.off_path, self.at, self.corrected = False, ON_PATH, True
