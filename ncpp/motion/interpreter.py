@@ -146,6 +146,8 @@ _ARC_LIKE = {2.0, 3.0, 5.0, 5.1, 76.0, 87.0, 71.0}
 _CYCLES = {73.0, 81.0, 82.0, 83.0, 84.0, 85.0, 86.0, 87.0, 88.0, 89.0}
 _K_MOTIONS = {2.0, 3.0, 33.0, 33.1, 71.0, 76.0, 87.0}
 RIGID_TAP = 33.1
+ENTRY_TOO_SHORT = "Length of cutter compensation entry move is not greater than the tool radius"
+ENTRY_ARC_TOO_SHORT = "Radius of cutter compensation entry arc is not greater than the tool radius"
 _P_MOTIONS = {76.0, 82.0, 86.0, 88.0, 89.0, 5.0, 5.2, 2.0, 3.0, 71.0, 74.0, 84.0}
 _P_MCODES = {50.0, 51.0, 52.0, 53.0, 62.0, 63.0, 64.0, 65.0, 66.0, 19.0}
 _Q_MOTIONS = {83.0, 73.0, 5.0, 71.0, 76.0}
@@ -502,12 +504,8 @@ class Interpreter:
             not self.centre.off_path
             and math.hypot(first.end[a] - first.start[a], first.end[b] - first.start[b]) <= radius
         ):
-            what = (
-                "Radius of cutter compensation entry arc"
-                if type(first) is Arc
-                else "Length of cutter compensation entry move"
-            )
-            self._fail(f"{what} is not greater than the tool radius", block, item)
+            what = ENTRY_ARC_TOO_SHORT if type(first) is Arc else ENTRY_TOO_SHORT
+            self._fail(what, block, item)
         left = self.cutter_comp in (41.0, 41.1)
         for arc in moves:
             if type(arc) is Arc and (arc.turn > 0) == left:
@@ -1713,6 +1711,11 @@ class Interpreter:
         start = self.pos
         turns = round(words["P"][0]) if "P" in words else 1
         tolerance = TOLERANCE[self.inch]
+        comp_radius = self.comp_radius  # (None: not known)
+        if self.cutter_comp is not None and comp_radius and not self.centre.off_path:
+            # (rs274ngc's convert_arc_comp1 checks the entry arc's chord before it finds the centre)
+            if math.hypot(end[a] - start[a], end[b] - start[b]) <= comp_radius:
+                self._fail(ENTRY_ARC_TOO_SHORT, block, block.items[0])
         if radius is not None:
             ca, cb = self._center_r(block, word, start[a], start[b], end[a], end[b], radius[0], motion)
         else:

@@ -174,6 +174,7 @@ def test_moves_after_compensation_agree_with_rs274(tmp_path, body):
         ("G20\nG41.1 D0.3\nG1 X0.1\n", 6),
         ("G41.1 D10\nG2 X4 I2\n", 5),  # an entry arc's chord
         ("G42.1 D10\nG2 X4 I2\n", 5),  # (before its radius)
+        ("G1 Y0.001\nG41.1 D2\nG2 X0 Y0.001 R30\n", 6),  # (before the arc's centre: no chord at all)
         ("G41.1 D10\nG2 X3 Y3 Z-3 I1.5 J1.5\n", 5),  # a helix: in the plane
         ("G42.1 D10\nG2 X10 I5\n", 5),
         ("G41.1 D10\nG3 X8 I4\n", 5),
