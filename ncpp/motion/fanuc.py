@@ -52,9 +52,8 @@ class FanucInterpreter(Interpreter):
         if signature is not None and "G" not in signature and "M" not in signature:
             return super().block(block)  # axis words only (the most): no setting, nothing unfollowed
         words = [item for item in block.items if type(item) is Word]
-        code = float(self.additional[1:])
         for word in words:
-            if word.letter == "G" and word.value == code:
+            if word.letter == "G" and word.value == ADDITIONAL_CODES[self.additional][0]:
                 return self._additional_offset(block, word)
             if (
                 word.letter == "G"
@@ -85,7 +84,7 @@ class FanucInterpreter(Interpreter):
         p = ps[0]
         if any(item is not p and not (type(item) is Word and item.letter == "N") for item in others):
             raise _OutOfScope(f"{name} with other words in its block", col)
-        n = int(p.value) if p.value == int(p.value) and 1 <= p.value <= ADDITIONAL_CODES[name] else 0
+        n = int(p.value) if p.value == int(p.value) and 1 <= p.value <= ADDITIONAL_CODES[name][1] else 0
         number = ADDITIONAL + n
         if n == 0 or number not in self.g5x:
             told = f": give --work-offset {name}P{n}=X,Y,Z or --var-file" if n else ""

@@ -1214,7 +1214,8 @@ class Interpreter:
         if inch == self.inch:
             return
         scale = 1 / MM_PER_INCH if inch else MM_PER_INCH
-        for vector in (self.pos, self.g92, self.g92_saved, self.tool, *self.g5x.values(), *self.home.values()):
+        zeros = (*self.g5x.values(), *self.home.values())
+        for vector in (self.pos, self.g92, self.g92_saved, self.tool, *zeros):
             for i in LINEAR:
                 vector[i] *= scale
         if self.comp_radius is not None:

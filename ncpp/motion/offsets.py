@@ -51,7 +51,7 @@ _ACTIVE_SYSTEM, _G92_ON, _G92_X, _G28_X, _G30_X = 5220, 5210, 5211, 5161, 5181
 
 # Additional work offset n is system ADDITIONAL + n; Fanuc numbers P1-P48, Haas P1-P99
 ADDITIONAL = 100
-ADDITIONAL_CODES = {"G54.1": 48, "G154": 99}
+ADDITIONAL_CODES = {"G54.1": (54.1, 48), "G154": (154.0, 99)}  # name: the G code's value, the last n
 # Their X in a Fanuc or Haas control's variables: n's at 7001 + 20 (n - 1) (Fanuc's P1-P48, Haas's
 # P1-P20) and at 14001 + 20 (n - 1) (Haas's P1-P99)
 _ADDITIONAL_X = ((7001, 48), (14001, 99))
@@ -64,7 +64,8 @@ def _system_x(number: int) -> int:
 @dataclass(frozen=True)
 class WorkOffsets:
     """The zeros the control holds: per coordinate system (1..9: G54..G59.3) its
-    machine position in mm, None when ncpp is not told it; the system in effect at
+    machine position in mm, None when ncpp is not told it, and so per additional work
+    offset (`additional`: 1, 2 ..., system ADDITIONAL + n); the system in effect at
     the program's start; the G92 offset in effect; the G28 and G30 positions; its
     tool table (None: not told, G43 applies length 0); and the folders it finds
     subroutine files in (LinuxCNC's [RS274NGC]SUBROUTINE_PATH: `o<name> call` of a
@@ -178,7 +179,7 @@ def system_number(name: str) -> int:
     if key in SYSTEMS:
         return SYSTEMS.index(key) + 1
     code, p, n = key.replace(" ", "").partition("P")
-    if p and code in ADDITIONAL_CODES and n.isdigit() and 1 <= int(n) <= ADDITIONAL_CODES[code]:
+    if p and code in ADDITIONAL_CODES and n.isdigit() and 1 <= int(n) <= ADDITIONAL_CODES[code][1]:
         return ADDITIONAL + int(n)
     raise ValueError(f"not a work coordinate system: {name!r} (one of {', '.join(SYSTEMS)}, "
                      f"G54.1P1-G54.1P48, G154P1-G154P99)")  # fmt: skip
