@@ -18,7 +18,10 @@ starts with an O number):
   G20/G21, as rs274 reads them.
 * Fanuc and Haas (Custom Macro B: #4014 holds group 14's G code, 54-59; #5221-#5223
   G54's X Y Z, 20 per system; `#3000=n (text)` raises macro alarm n with the text and
-  stops; `IF [cond] THEN` one assignment): G54-G59 only.
+  stops; `IF [cond] THEN` one assignment): G54-G59 only.  An additional work offset
+  (G54.1 Pn, G154 Pn) in effect at the start gets no guard: #4014 reads 54 for it too,
+  and the variable that holds n differs between controls.  (One the program selects later
+  is not checked, as a G55 selected later is not.)
 
 * Sinumerik (840D sl System Variables parameter manual: `$P_UIFRNUM`, the number of the
   active settable frame, 1-4 for G54-G57; `$P_UIFR[n, axis, TR]` and `[n, axis, FI]`, its
@@ -39,7 +42,7 @@ from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 from itertools import chain, islice
 
-from ncpp.motion.offsets import WorkOffsets
+from ncpp.motion.offsets import WorkOffsets, system_name
 from ncpp.program.blocks import Block, Comment
 from ncpp.program.parser import LEADER_LINES
 
@@ -47,7 +50,6 @@ GUARD_MM = 0.1  # how far an axis's zero may be from the one told: re-touching a
 BEGIN = "ncpp placement guard:"
 END = "ncpp placement guard end"
 SCAN = 60  # blocks at the top searched for a guard
-SYSTEMS = ("G54", "G55", "G56", "G57", "G58", "G59", "G59.1", "G59.2", "G59.3")
 # A Fanuc program number line (`O1234`, perhaps with a comment); not an o-word line (`o100 sub`)
 _FANUC_PROGRAM_NUMBER = re.compile(r"\s*O\d+\s*(\(.*\))?\s*$")
 
@@ -70,7 +72,7 @@ class Placement:
 
     @property
     def name(self) -> str:
-        return SYSTEMS[self.system - 1]
+        return system_name(self.system)
 
     def values(self) -> list[str]:
         """X Y Z of the zero in the control's units, as the guard compares them."""
@@ -102,6 +104,8 @@ def _tolerance(placement: Placement) -> str:
 
 
 def _linuxcnc(placement: Placement) -> list[str]:
+    if placement.system > 9:
+        return []  # (the additional work offsets are Fanuc's and Haas's)
     x = 5221 + 20 * (placement.system - 1)
     tolerance = _tolerance(placement)
     far = " OR ".join(
@@ -119,7 +123,7 @@ def _linuxcnc(placement: Placement) -> list[str]:
 
 def _fanuc(placement: Placement) -> list[str]:
     if placement.system > 6:
-        return []  # (G59.1-G59.3 are LinuxCNC's)
+        return []  # (G59.1-G59.3 are LinuxCNC's; an additional work offset: the module docstring)
     x = 5221 + 20 * (placement.system - 1)
     tolerance = _tolerance(placement)
     lines = [

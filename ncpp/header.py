@@ -14,7 +14,7 @@ from __future__ import annotations
 import hashlib
 from pathlib import Path
 
-from ncpp.motion.offsets import SYSTEMS, WorkOffsets
+from ncpp.motion.offsets import WorkOffsets, system_name
 from ncpp.program.dialects import FAMILY
 
 SYSTEMS_PER_LINE = 3  # work offsets said on one header line
@@ -23,7 +23,7 @@ SYSTEMS_PER_LINE = 3  # work offsets said on one header line
 def placement_lines(offsets: WorkOffsets, dialect: str) -> list[str]:
     """The header's lines after its first: zeros (machine mm), G92, tool table, units."""
     if FAMILY.get(dialect, dialect) == "iso":
-        lines = _systems(offsets)
+        lines = _systems(offsets, dialect)
     else:  # one program zero: the system in effect with G92 (`WorkOffsets.program_zero`)
         lines = [f"ncpp program zero at {_point(offsets.program_zero())} machine mm"]
     if any(offsets.g92):
@@ -32,15 +32,17 @@ def placement_lines(offsets: WorkOffsets, dialect: str) -> list[str]:
     return lines
 
 
-def _systems(offsets: WorkOffsets) -> list[str]:
-    """The work offsets the control holds (the one in effect first), a few to a line."""
-    numbers = [offsets.active] + [n for n in range(1, 10) if n != offsets.active and offsets.told(n)]
+def _systems(offsets: WorkOffsets, dialect: str) -> list[str]:
+    """The work offsets the control holds (the one in effect first, the additional ones of a Fanuc
+    or Haas control last), a few to a line."""
+    told = [*range(1, 10), *offsets.told_additional()]
+    numbers = [offsets.active] + [n for n in told if n != offsets.active and offsets.told(n)]
     said = [
-        f"{SYSTEMS[n - 1]} {_point(offsets.zero(n))}{'' if offsets.told(n) else ' not given'}"
+        f"{system_name(n, dialect)} {_point(offsets.zero(n))}{'' if offsets.told(n) else ' not given'}"
         for n in numbers
     ]
     lines = [", ".join(said[k : k + SYSTEMS_PER_LINE]) for k in range(0, len(said), SYSTEMS_PER_LINE)]
-    active = SYSTEMS[offsets.active - 1]
+    active = system_name(offsets.active, dialect)
     lines[0] = f"ncpp work offsets in machine mm, {active} in effect at the start: {lines[0]}"
     return [lines[0]] + [f"ncpp work offsets: {line}" for line in lines[1:]]
 

@@ -33,6 +33,9 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_the_holes_moves_compensation_sees_are_the_ones_rs274_makes",
         ),
         "compensation/test_rs274_accepts.py": None,
+        "compensation/test_additional_offsets.py": (
+            "test_each_move_is_compensated_where_its_system_puts_it",
+        ),
         "compensation/test_rigid_tap.py": (
             "test_each_tap_runs_on_the_programmed_line_within_half_a_micron",
             "test_the_motor_mount_written_out_cuts_twenty_times_closer",

@@ -109,13 +109,15 @@ def add_placement_arguments(p: argparse.ArgumentParser) -> None:
         default=[],
         metavar="[G5x=]X,Y,Z",
         help="machine position (mm) of a coordinate system's zero, as the control holds it; without G5x= it is G54's "
-        "(default 0,0,0); repeat for G55-G59.3.  A program selecting a system nobody gave gets a warning",
+        "(default 0,0,0); repeat for G55-G59.3, and for Fanuc's G54.1P1-P48 or Haas's G154P1-P99.  A program "
+        "selecting a system nobody gave gets a warning",
     )
     p.add_argument(
         "--var-file",
         metavar="FILE",
         help="LinuxCNC parameter file (linuxcnc.var) holding the control's G54-G59.3 zeros, the system in effect, "
-        "G92 and the G28/G30 positions; --work-offset overrides its systems",
+        "G92 and the G28/G30 positions (a Fanuc or Haas control's additional offsets at #7001..., #14001...); "
+        "--work-offset overrides its systems",
     )
     p.add_argument(
         "--tool-table",

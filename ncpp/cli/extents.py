@@ -56,7 +56,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     from ncpp.cli.io import open_input
     from ncpp.cli.motion import interpreted, warn_off_path
-    from ncpp.motion.extents import iso_system_name
+    from ncpp.motion.offsets import system_name
 
     limits = None
     if args.machine:
@@ -73,7 +73,8 @@ def run(args: argparse.Namespace) -> int:
         )
         known = offsets if placed else None  # the zeros the control holds, where the user told them
         if FAMILY[dialect] == "iso":
-            found = extents(events, lambda c: known is not None and known.told(c.system), iso_system_name)
+            found = extents(events, lambda c: known is not None and known.told(c.system),
+                            lambda c: system_name(c.system, dialect))  # fmt: skip
         else:  # one program zero: the system in effect when the program starts
             found = extents(
                 events, lambda c: known is not None and known.told(known.active), lambda c: "program zero"

@@ -17,7 +17,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ncpp.motion.offsets import SYSTEMS
 from ncpp.motion.segments import PLANE_AXES, Arc, Context, Event, Line
 
 AXES = "XYZ"
@@ -106,10 +105,6 @@ def extents(
             else:
                 group.machine.add(machine, line)
     return whole, systems, tools
-
-
-def iso_system_name(context: Context) -> str:
-    return SYSTEMS[context.system - 1]
 
 
 @dataclass(frozen=True)

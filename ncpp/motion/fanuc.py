@@ -6,12 +6,19 @@ Fanuc and Haas posts write on lines of their own and that move no axis, where Li
 reads the same codes otherwise (G5.1 is a spline there, G8 lathe radius mode):
 
 * Fanuc (0i-MF / 30i operator's manuals): `G05.1 Q1` / `Q0`, AI contour control on and off;
-  `G08 P1` / `P0`, advanced preview control on and off.  `G54.1 P1`-`P48` selects an
-  additional work offset, whose zero ncpp is not told: it ends interpretation with a warning.
+  `G08 P1` / `P0`, advanced preview control on and off.
 * Haas (Mill Operator's Manual, "G-codes"): also `G187 P1-P3 [E..]`, the smoothness level and
-  corner tolerance; `G103 P..`, the limit of blocks looked ahead.  `G154 P1-P99` selects one
-  of Haas's additional work offsets, whose zero ncpp is not told, and `M97 P..` runs a local
-  subprogram at a sequence number: both end interpretation with a warning.
+  corner tolerance; `G103 P..`, the limit of blocks looked ahead.  `M97 P..` runs a local
+  subprogram at a sequence number: it ends interpretation with a warning.
+
+Both have additional work offsets: Fanuc's `G54.1 P1`-`P48` ("Additional workpiece coordinate
+systems"), Haas's `G154 P1`-`P99` ("G154 Select Work Coordinates P1-P99").  One whose zero ncpp
+is told (`--work-offset G54.1P3=X,Y,Z`, `G154P3=`, or a parameter file's #7001... / #14001...:
+`offsets.py`) is followed as G54-G59 are (`_additional_offset`); one not told ends interpretation
+with a warning, as does a block that selects one with other words in it (what else the block
+does would run in the control's order around the new zero: not guessed at).  `G10 L20` sets an
+additional work offset on these controls, where LinuxCNC's sets system P from the current
+point: out of scope.
 
 A setting code written with other words in its block is out of scope too: a block that
 both sets and moves is not one these controls' posts write.
@@ -20,22 +27,24 @@ both sets and moves is not one these controls' posts write.
 from __future__ import annotations
 
 from ncpp.motion.interpreter import Interpreter, _OutOfScope, interpreting
+from ncpp.motion.offsets import ADDITIONAL, ADDITIONAL_CODES
 from ncpp.motion.segments import Event, Pass
 from ncpp.program.blocks import Block, Comment, Word
 
 # G code -> the words it takes, for the settings each flavour reads past
 FANUC_SETTINGS: dict[float, frozenset[str]] = {5.1: frozenset("Q"), 8.0: frozenset("P")}
 HAAS_SETTINGS = {**FANUC_SETTINGS, 187.0: frozenset("PE"), 103.0: frozenset("P")}
-# Codes of the flavour that need what ncpp is not told (a zero, a sequence number's block):
-# Fanuc's additional work offsets `G54.1 P1`-`P48`, Haas's `G154 P1`-`P99`
-FANUC_UNFOLLOWED = {("G", 54.1): "G54.1 (an additional work offset ncpp is not told)"}
-HAAS_UNFOLLOWED = {**FANUC_UNFOLLOWED, ("G", 154.0): "G154 (an additional work offset ncpp is not told)",
+# Codes of the flavour that need what ncpp is not told (a sequence number's block; Haas does not
+# write Fanuc's G54.1)
+FANUC_UNFOLLOWED: dict[tuple[str, float], str] = {}
+HAAS_UNFOLLOWED = {("G", 54.1): "G54.1 (Fanuc's additional work offset; Haas selects its own with G154)",
                    ("M", 97.0): "M97 (a local subprogram at a sequence number)"}  # fmt: skip
 
 
 class FanucInterpreter(Interpreter):
     settings: dict[float, frozenset[str]] = FANUC_SETTINGS
     unfollowed: dict[tuple[str, float], str] = FANUC_UNFOLLOWED
+    additional = "G54.1"  # the code that selects an additional work offset, with P
     rigid_tapping = False  # (Fanuc taps rigidly with M29 and G84: G33.1 is LinuxCNC's)
 
     def block(self, block: Block) -> Event | tuple[Event, ...]:
@@ -44,6 +53,14 @@ class FanucInterpreter(Interpreter):
             return super().block(block)  # axis words only (the most): no setting, nothing unfollowed
         words = [item for item in block.items if type(item) is Word]
         for word in words:
+            if word.letter == "G" and word.value == ADDITIONAL_CODES[self.additional][0]:
+                return self._additional_offset(block, word)
+            if (
+                word.letter == "G"
+                and word.value == 10.0
+                and any(w.letter == "L" and w.value == 20 for w in words)
+            ):
+                raise _OutOfScope("G10 L20 (it sets an additional work offset here)", word.start + 1)
             reason = self.unfollowed.get((word.letter, word.value))
             if reason is not None:
                 raise _OutOfScope(reason, word.start + 1)
@@ -56,10 +73,32 @@ class FanucInterpreter(Interpreter):
             raise _OutOfScope(f"G{setting.number} with other words in its block", setting.start + 1)
         return Pass(block)
 
+    def _additional_offset(self, block: Block, code: Word) -> Pass:
+        """`G54.1 Pn` (Haas: `G154 Pn`) with nothing else but N and comments: additional work
+        offset n, in effect from here as a G54-G59 selected is, where its zero is told."""
+        name, col = self.additional, code.start + 1
+        others = [item for item in block.items if type(item) is not Comment and item is not code]
+        ps = [item for item in others if type(item) is Word and item.letter == "P"]
+        if len(ps) != 1:
+            raise _OutOfScope(f"{name} without one P (an additional work offset ncpp cannot tell)", col)
+        p = ps[0]
+        if any(item is not p and not (type(item) is Word and item.letter == "N") for item in others):
+            raise _OutOfScope(f"{name} with other words in its block", col)
+        n = int(p.value) if p.value == int(p.value) and 1 <= p.value <= ADDITIONAL_CODES[name][1] else 0
+        number = ADDITIONAL + n
+        if n == 0 or number not in self.g5x:
+            told = f": give --work-offset {name}P{n}=X,Y,Z or --var-file" if n else ""
+            raise _OutOfScope(f"{name} P{p.number} (an additional work offset ncpp is not told{told})", col)
+        if self.cutter_comp is not None:
+            raise _OutOfScope(f"{name} under cutter compensation", col)
+        self._coordinate_system(number)
+        return Pass(block)
+
 
 class HaasInterpreter(FanucInterpreter):
     settings = HAAS_SETTINGS
     unfollowed = HAAS_UNFOLLOWED
+    additional = "G154"
 
 
 interpret = interpreting(FanucInterpreter)

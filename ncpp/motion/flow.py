@@ -37,6 +37,14 @@ Fanuc macro B runs here too (the Fanuc operator's manuals, Series 16i/18i B-6368
   E #8, F #9, H #11, M #13, Q #17, R #18, S #19, T #20, U #21, V #22, W #23, X #24,
   Y #25, Z #26), the others vacant; M99 returns.  With L the macro runs again with the
   locals it left (as Haas, a Fanuc-compatible control, documents);
+* argument specification II (`_argument_variables`): A, B, C as in I and up to ten sets of
+  I J K, the n-th set #(3n+1) #(3n+2) #(3n+3), so I J K may repeat in a G65 or G66 block
+  (and only there).  The sets are counted in the order written, a letter not after the
+  last of its set opening the next, and the n-th I (J, K) written is the n-th set's: a
+  block these two readings place apart (`J1 I2`, `I1 J2 I3 K4`) is not guessed at, it
+  leaves the scope.  Both specifications in one block: "the type of argument specification
+  specified later takes precedence" for a variable both set (B-63684EN, "Mixture of argument
+  specifications I and II": `G65 A1.0 B2.0 I-3.0 I4.0 D5.0 P1000` leaves #7 = 5.0);
 * `G66 P<n> <arguments>` ... `G67`: the macro is called so after each block that moves
   (the interpreter says which: `moved`), not after its own moves (`_g66`).
 
@@ -83,6 +91,8 @@ MAX_CALL_LEVELS = 10
 MACRO_ARGUMENTS = {"A": 1, "B": 2, "C": 3, "I": 4, "J": 5, "K": 6, "D": 7, "E": 8, "F": 9, "H": 11,
                    "M": 13, "Q": 17, "R": 18, "S": 19, "T": 20, "U": 21, "V": 22, "W": 23, "X": 24,
                    "Y": 25, "Z": 26}  # fmt: skip
+# Fanuc argument specification II: I J K in sets, #4-#6 the first, #31-#33 the tenth
+IJK_SETS = 10
 _FANUC_FLOW = {"goto": "goto", "if": "fanuc_if", "while": "fanuc_while", "end": "fanuc_end"}
 _MACRO_CALLS = {65.0: "g65", 66.0: "g66", 67.0: "g67"}
 MAX_SEQUENCE_NUMBER = 99_999
@@ -712,9 +722,12 @@ class Flow:
         if runs < 1:
             raise NcppError(f"{control.keyword.upper()} L{runs}: a macro runs 1 to 9999 times",
                             Location(self.file, block.line, repeats.start + 1))  # fmt: skip
+        if type(arguments) is str:  # (I J K sets read two ways)
+            self.stop(arguments, block, control.item.start + 1)
+            return None
         values = {
-            MACRO_ARGUMENTS[item.letter]: self._number(item, block)
-            for item in arguments
+            variable: self._number(item, block)
+            for variable, item in arguments
             if type(item) is Word or not vacant(item.expr, self.parameters)  # (a vacant one: not given)
         }
         body = self._defined(self.subprograms, name) or self._program_from_file(name)
@@ -1168,8 +1181,9 @@ def _fanuc_control(block: Block, statement: Statement, words: dict) -> Control |
 
 
 def _macro_call(block: Block, g65: Word) -> Control | None:
-    """`G65 P.. L.. <arguments>` (argument specification I, each letter once), `G66` alike,
-    `G67` alone; else None."""
+    """`G65 P.. L.. <arguments>` (each letter once, but I J K, which specification II repeats),
+    `G66` alike, `G67` alone; else None.  The arguments: (variable, word) pairs in the order
+    written, or why their variables cannot be told (`_argument_variables`)."""
     keyword = _MACRO_CALLS[g65.value]
     if keyword == "g67":
         rest = block.items[block.items.index(g65) + 1 :]
@@ -1186,15 +1200,42 @@ def _macro_call(block: Block, g65: Word) -> Control | None:
         word: Word | ExprWord = item  # type: ignore[assignment]  # (`kind` says so)
         letter = word.letter
         if letter in seen or (letter not in MACRO_ARGUMENTS and letter not in "PL"):
-            return None  # (specification II repeats I J K: not read)
-        seen.add(letter)
+            return None
+        if letter not in "IJK":
+            seen.add(letter)
         if letter == "P":
             program = word
         elif letter == "L":
             repeats = word
         else:
             arguments.append(word)
-    return None if program is None else Control(None, keyword, (program, repeats, tuple(arguments)), g65)
+    if program is None:
+        return None
+    return Control(None, keyword, (program, repeats, _argument_variables(arguments, keyword)), g65)
+
+
+def _argument_variables(words: list[Word | ExprWord], keyword: str) -> tuple | str:
+    """Each argument word's local variable, (variable, word) in the order written (the module
+    docstring: argument specifications I and II); a str says why I J K cannot be read."""
+    pairs: list[tuple[int, Word | ExprWord]] = []
+    sets, last = 0, "K"  # the I J K sets opened, the letter the last one ends with so far
+    written = {"I": 0, "J": 0, "K": 0}  # how many of each letter so far
+    for word in words:
+        letter = word.letter
+        if letter not in written:
+            pairs.append((MACRO_ARGUMENTS[letter], word))
+            continue
+        if letter <= last:  # (I, J, K in alphabetical order)
+            sets += 1
+        last = letter
+        written[letter] += 1
+        if sets > IJK_SETS:
+            return f"{keyword.upper()} with more than {IJK_SETS} sets of I J K arguments"
+        if written[letter] != sets:
+            return (f"{keyword.upper()} with I J K arguments out of order ({letter} number {written[letter]} "
+                    f"in set {sets}): which local variable it sets is not ncpp's to guess")  # fmt: skip
+        pairs.append((3 * sets + 1 + "IJK".index(letter), word))
+    return tuple(pairs)
 
 
 def _numbered(space: list[Block], pc: int, number: int) -> int | None:

@@ -265,7 +265,8 @@ class Interpreter:
         self.expansion: Expansion | None = None  # --expand: loops and subroutines written out
         self.spindle = 0  # M3 1, M4 -1, stopped 0 (tapping and boring cycles check it)
         self.coord_system = 1
-        self.g5x = [[0.0] * 9 for _ in range(10)]  # index 1..9: G54..G59.3
+        # by system number: 1..9 G54..G59.3, then the additional work offsets told (`offsets.ADDITIONAL`)
+        self.g5x = {n: [0.0] * 9 for n in range(1, 10)}
         self.g92 = [0.0] * 9
         self.g92_saved = [0.0] * 9
         self.tool = [0.0] * 9  # the tool length offset in effect, program units
@@ -303,8 +304,8 @@ class Interpreter:
 
     def _start_from(self, offsets: WorkOffsets) -> None:
         """The control's zeros (mm, the interpreter starts in mm) and its system in effect."""
-        for n in range(1, 10):
-            self.g5x[n][:3] = offsets.zero(n)
+        for n in (*range(1, 10), *offsets.told_additional()):
+            self.g5x[n] = [*offsets.zero(n), *[0.0] * 6]
         self.coord_system = offsets.active
         self.g92[:3] = offsets.g92
         self.g92_saved = self.g92[:]
@@ -1169,7 +1170,8 @@ class Interpreter:
         if inch == self.inch:
             return
         scale = 1 / MM_PER_INCH if inch else MM_PER_INCH
-        for vector in (self.pos, self.g92, self.g92_saved, self.tool, *self.g5x, *self.home.values()):
+        zeros = (*self.g5x.values(), *self.home.values())
+        for vector in (self.pos, self.g92, self.g92_saved, self.tool, *zeros):
             for i in LINEAR:
                 vector[i] *= scale
         if self.comp_radius is not None:
@@ -1814,7 +1816,7 @@ class Interpreter:
             "_feed": self.feed,
             "_plane": self.plane * 10.0,
             "_motion_mode": 800.0 if self.motion is None else self.motion * 10,
-            "_coord_system": _COORD_SYSTEM_CODE[self.coord_system],
+            "_coord_system": _COORD_SYSTEM_CODE.get(self.coord_system),
             "_ccomp": 400.0 if self.cutter_comp is None else self.cutter_comp * 10,
         }.get(name)
         return value

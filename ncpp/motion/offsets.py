@@ -14,8 +14,18 @@ them.
     WorkOffsets.at((400, 350, 300))                 # G54 only
     WorkOffsets.from_var_file("linuxcnc.var")      # LinuxCNC's parameter file
     WorkOffsets.given({}, "linuxcnc.var", tool_table="tool.tbl")  # and its tool table
+    WorkOffsets.of({"G54.1P3": (100, 50, 0)})      # a Fanuc additional work offset
 
 Positions are machine mm (X, Y, Z).
+
+The additional work offsets of Fanuc and Haas controls come after rs274ngc's nine systems, as
+numbers `ADDITIONAL + n`: Fanuc's `G54.1 P1`-`P48` (0i-MF / 16i operator's manuals, "Additional
+workpiece coordinate systems"; their zeros are the system variables #7001-#7003 for P1, 20 per
+offset: "System variables for additional workpiece coordinate systems") and Haas's `G154 P1`-`P99`
+(Mill Operator's Manual, "G154 Select Work Coordinates P1-P99" and the "Macros" variable table:
+#14001-#14003 for P1, 20 per offset, and for P1-P20 also #7001-#7003 on, its G110-G129).  Offset
+n is one place on the control whichever name selects it: `G54.1P3` and `G154P3` name the same
+number.  A parameter file gives them by those variable numbers, which LinuxCNC's never holds.
 """
 
 from __future__ import annotations
@@ -39,6 +49,14 @@ UNIT_MM = {"mm": 1.0, "inch": 25.4}  # a parameter file's units (the INI's [TRAJ
 _ACTIVE_SYSTEM, _G92_ON, _G92_X, _G28_X, _G30_X = 5220, 5210, 5211, 5161, 5181
 
 
+# Additional work offset n is system ADDITIONAL + n; Fanuc numbers P1-P48, Haas P1-P99
+ADDITIONAL = 100
+ADDITIONAL_CODES = {"G54.1": (54.1, 48), "G154": (154.0, 99)}  # name: the G code's value, the last n
+# Their X in a Fanuc or Haas control's variables: n's at 7001 + 20 (n - 1) (Fanuc's P1-P48, Haas's
+# P1-P20) and at 14001 + 20 (n - 1) (Haas's P1-P99)
+_ADDITIONAL_X = ((7001, 48), (14001, 99))
+
+
 def _system_x(number: int) -> int:
     return 5201 + 20 * number
 
@@ -46,7 +64,8 @@ def _system_x(number: int) -> int:
 @dataclass(frozen=True)
 class WorkOffsets:
     """The zeros the control holds: per coordinate system (1..9: G54..G59.3) its
-    machine position in mm, None when ncpp is not told it; the system in effect at
+    machine position in mm, None when ncpp is not told it, and so per additional work
+    offset (`additional`: 1, 2 ..., system ADDITIONAL + n); the system in effect at
     the program's start; the G92 offset in effect; the G28 and G30 positions; its
     tool table (None: not told, G43 applies length 0); and the folders it finds
     subroutine files in (LinuxCNC's [RS274NGC]SUBROUTINE_PATH: `o<name> call` of a
@@ -61,14 +80,12 @@ class WorkOffsets:
     tools: ToolTable | None = None
     subroutine_path: tuple[Path, ...] = ()
     unit_mm: float = 1.0  # the units the parameter file and tool table were read in (the header says them)
+    additional: tuple[Vector | None, ...] = ()  # the additional work offsets 1, 2 ...: Fanuc, Haas
 
     @classmethod
     def of(cls, zeros: Mapping[str, Vector], active: str = "G54") -> WorkOffsets:
         """From G word -> machine mm (`{"G54": (400, 350, 300)}`)."""
-        systems: list[Vector | None] = [None] * 9
-        for name, zero in zeros.items():
-            systems[system_number(name) - 1] = _vector(zero)
-        return cls(tuple(systems), system_number(active))
+        return cls(active=system_number(active)).with_zeros(zeros)
 
     @classmethod
     def at(cls, zero: Vector) -> WorkOffsets:
@@ -85,7 +102,8 @@ class WorkOffsets:
         g92 = _from_var(values, _G92_X, unit_mm) if values.get(_G92_ON) == 1.0 else None
         zero = (0.0, 0.0, 0.0)
         homes = (_from_var(values, _G28_X, unit_mm) or zero, _from_var(values, _G30_X, unit_mm) or zero)
-        return cls(systems, active if 1 <= active <= 9 else 1, g92 or zero, *homes)
+        additional = _additional_from_var(values, unit_mm, str(path))
+        return cls(systems, active if 1 <= active <= 9 else 1, g92 or zero, *homes, additional=additional)
 
     @classmethod
     def given(
@@ -106,18 +124,33 @@ class WorkOffsets:
 
     def with_zeros(self, zeros: Mapping[str, Vector]) -> WorkOffsets:
         """These systems' zeros replaced (the command line over a parameter file)."""
-        systems = list(self.systems)
+        systems, additional = list(self.systems), list(self.additional)
         for name, zero in zeros.items():
-            systems[system_number(name) - 1] = _vector(zero)
-        return replace(self, systems=tuple(systems))
+            number = system_number(name)
+            if number > ADDITIONAL:
+                additional.extend([None] * (number - ADDITIONAL - len(additional)))
+                additional[number - ADDITIONAL - 1] = _vector(zero)
+            else:
+                systems[number - 1] = _vector(zero)
+        return replace(self, systems=tuple(systems), additional=tuple(additional))
+
+    def _zero_of(self, number: int) -> Vector | None:
+        if number > ADDITIONAL:
+            n = number - ADDITIONAL
+            return self.additional[n - 1] if n <= len(self.additional) else None
+        return self.systems[number - 1]
 
     def told(self, number: int) -> bool:
-        """Whether system `number` (1..9) has a known zero."""
-        return self.systems[number - 1] is not None
+        """Whether system `number` (1..9, or ADDITIONAL + n) has a known zero."""
+        return self._zero_of(number) is not None
 
     def zero(self, number: int) -> Vector:
         """System `number`'s zero in machine mm (the machine zero when not told)."""
-        return self.systems[number - 1] or (0.0, 0.0, 0.0)
+        return self._zero_of(number) or (0.0, 0.0, 0.0)
+
+    def told_additional(self) -> list[int]:
+        """The numbers (ADDITIONAL + n) of the additional work offsets whose zeros are told."""
+        return [ADDITIONAL + n for n, zero in enumerate(self.additional, 1) if zero is not None]
 
     def program_zero(self) -> Vector:
         """Machine mm of the program zero at the start: the system in effect plus G92
@@ -127,7 +160,8 @@ class WorkOffsets:
 
 
 def parse_zero(text: str) -> tuple[str, Vector]:
-    """`G55=600,350,300` -> ("G55", (600, 350, 300)); without `G5x=` it is G54's."""
+    """`G55=600,350,300` -> ("G55", (600, 350, 300)); without `G5x=` it is G54's; `G54.1P3=`
+    and `G154P3=` name an additional work offset."""
     name, _, numbers = text.rpartition("=")
     name = name.strip().upper() or "G54"
     system_number(name)
@@ -141,11 +175,22 @@ def parse_zero(text: str) -> tuple[str, Vector]:
 
 
 def system_number(name: str) -> int:
-    """`G55` -> 2 (rs274ngc's numbering, 1..9)."""
+    """`G55` -> 2 (rs274ngc's numbering, 1..9); `G54.1P3` or `G154 P3` -> ADDITIONAL + 3."""
     key = name.strip().upper()
-    if key not in SYSTEMS:
-        raise ValueError(f"not a work coordinate system: {name!r} (one of {', '.join(SYSTEMS)})")
-    return SYSTEMS.index(key) + 1
+    if key in SYSTEMS:
+        return SYSTEMS.index(key) + 1
+    code, p, n = key.replace(" ", "").partition("P")
+    if p and code in ADDITIONAL_CODES and n.isdigit() and 1 <= int(n) <= ADDITIONAL_CODES[code][1]:
+        return ADDITIONAL + int(n)
+    raise ValueError(f"not a work coordinate system: {name!r} (one of {', '.join(SYSTEMS)}, "
+                     f"G54.1P1-G54.1P48, G154P1-G154P99)")  # fmt: skip
+
+
+def system_name(number: int, dialect: str = "fanuc") -> str:
+    """2 -> `G55`; ADDITIONAL + 3 -> `G54.1 P3` (`G154 P3` in a Haas program)."""
+    if number <= len(SYSTEMS):
+        return SYSTEMS[number - 1]
+    return f"{'G154' if dialect == 'haas' else 'G54.1'} P{number - ADDITIONAL}"
 
 
 def read_var_file(path: str | Path) -> dict[int, float]:
@@ -174,6 +219,24 @@ def _from_var(values: Mapping[int, float], x: int, unit_mm: float) -> Vector | N
     if not any(k in values for k in (x, x + 1, x + 2)):
         return None
     return (values.get(x, 0.0) * unit_mm, values.get(x + 1, 0.0) * unit_mm, values.get(x + 2, 0.0) * unit_mm)
+
+
+def _additional_from_var(values: Mapping[int, float], unit_mm: float, path: str) -> tuple[Vector | None, ...]:
+    """The additional work offsets a Fanuc or Haas parameter file gives (`_ADDITIONAL_X`); an offset
+    given at both its numbers must be given the same."""
+    if not any(7001 <= k <= 15999 for k in values):
+        return ()
+    found: list[Vector | None] = [None] * max(count for _, count in _ADDITIONAL_X)
+    for first, count in _ADDITIONAL_X:
+        for n in range(1, count + 1):
+            zero = _from_var(values, first + 20 * (n - 1), unit_mm)
+            if zero is None:
+                continue
+            if found[n - 1] not in (None, zero):
+                raise NcppError(f"parameters #{7001 + 20 * (n - 1)} and #{first + 20 * (n - 1)} both give "
+                                f"additional work offset P{n}, and differ", Location(path))  # fmt: skip
+            found[n - 1] = zero
+    return tuple(found)
 
 
 def _vector(zero) -> Vector:

@@ -48,8 +48,12 @@ def test_a_setting_with_motion_in_its_block_ends_interpretation():
 
 @pytest.mark.parametrize(
     "block, reason, dialect",
-    [("G154 P1", "G154 (an additional work offset", "haas"), ("M97 P1000", "M97 (a local", "haas"),
-     ("G54.1 P1", "G54.1 (an additional work offset", "haas"), ("G54.1 P1", "G54.1 (an additional work", "fanuc")],
+    [("G154 P1", "G154 P1 (an additional work offset ncpp is not told: give --work-offset G154P1=X,Y,Z", "haas"),
+     ("M97 P1000", "M97 (a local", "haas"), ("G54.1 P1", "G54.1 (Fanuc's additional work offset", "haas"),
+     ("G54.1 P1", "G54.1 P1 (an additional work offset ncpp is not told: give --work-offset G54.1P1=", "fanuc"),
+     ("G54.1 P49", "G54.1 P49 (an additional work offset ncpp is not told)", "fanuc"),
+     ("G154 P3 G0 X1", "G154 with other words in its block", "haas"), ("G54.1", "G54.1 without one P", "fanuc"),
+     ("G10 L20 P1 X0 Y0 Z0", "G10 L20 (it sets an additional work offset here)", "fanuc")],
 )  # fmt: skip
 def test_what_fanuc_and_haas_programs_need_ncpp_is_not_told_ends_interpretation(block, reason, dialect):
     said = io.StringIO()

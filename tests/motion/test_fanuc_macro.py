@@ -99,6 +99,18 @@ TWINS = {
         "O9\nG1 Z#26\nG0 Z5\nM99\n",
         HEAD + "G0 X0\nG1 Z-1\nG0 Z5\nG0 X1\nG1 Z-1\nG0 Z5\nM2\n",
     ),
+    # argument specification II: A, then four sets of I J K (#4-#6, #7-#9, #10-#12, #13-#15), the
+    # points of a polyline the macro visits with #[4 + 3 n]; G66 passes them alike
+    "G65 argument specification II": (
+        HEAD + "G65 P600 A4. I10. J5. K-1. I20. J15. K-2. I30. J0 K-1.5 I5. J-5. K-0.5\n"
+        "G66 P600 A2. I1. J1. K-1. I2. J-1. K-2.\nG0 X40 Y40\nG67\nM30\n"
+        "O600\n#30=0\nWHILE [#30 LT #1] DO1\nG1 X#[4+3*#30] Y#[5+3*#30] Z#[6+3*#30] F200\n#30=#30+1\nEND1\n"
+        "G0 Z5\nM99\n",
+        HEAD + "o600 sub\n#30=0\no601 while [#30 LT #1]\nG1 X#[4+3*#30] Y#[5+3*#30] Z#[6+3*#30] F200\n"
+        "#30=[#30+1]\no601 endwhile\nG0 Z5\no600 endsub\n"
+        "o600 call [4] [0] [0] [10] [5] [-1] [20] [15] [-2] [30] [0] [-1.5] [5] [-5] [-0.5]\n"
+        "G0 X40 Y40\no600 call [2] [0] [0] [1] [1] [-1] [2] [-1] [-2]\nM2\n",
+    ),
     # M98 inside a G65 macro shares the macro's locals
     "M98 in a G65 macro": (
         HEAD + "G65 P400 A3\nM30\nO400\nM98 P401\nG1 X#1\nM99\nO401\n#1=#1*2\nG1 Y#1\nM99\n",
@@ -476,3 +488,58 @@ def test_a_program_file_without_its_number_is_an_error_at_the_file(tmp_path):
     assert (
         error is not None and "O12 ... M99 is not in the file" in str(error) and "O0012.nc:1:1" in str(error)
     )
+
+
+# A macro that moves to the first local variables of each I J K set: X#4 Y#7 Z#10, X#13 Y#16 Z#19,
+# X#22 Y#25 Z#28, X#31 Y#5 Z#33, vacant ones left out of the move (Fanuc: no address)
+SETS_MACRO = "O700\nG1 X#4 Y#7 Z#10 F100\nG1 X#13 Y#16 Z#19\nG1 X#22 Y#25 Z#28\nG1 X#31 Y#5 Z#33\nM99\n"
+
+
+@pytest.mark.parametrize("dialect", ["fanuc", "haas"])
+def test_ncpp_motion_prints_the_points_a_specification_ii_call_sets(tmp_path, capsys, dialect):
+    """Ten sets I1 J1 K1 ... I10 J10 K10 (I of set n = n, J = 10 n, K = -n): set n is #(3n+1),
+    #(3n+2), #(3n+3) (Fanuc B-63684EN, "Argument specification II")."""
+    from ncpp.cli import main
+
+    sets = " ".join(f"I{n}. J{10 * n}. K-{n}." for n in range(1, 11))
+    program = tmp_path / "sets.nc"
+    program.write_text(f"O1\nG21 G90 G17\nG0 X0 Y0 Z0\nG65 P700 A1. {sets}\nM30\n{SETS_MACRO}")
+    assert main(["motion", "--dialect", dialect, str(program)]) == 0
+    # #4 = I1, #7 = I2, #10 = I3; #13 = I4, #16 = I5, #19 = I6; #22 = I7, #25 = I8, #28 = I9;
+    # #31 = I10, #5 = J1, #33 = K10
+    want = [(0, 0, 0), (1, 2, 3), (4, 5, 6), (7, 8, 9), (10, 10, -10)]
+    printed = capsys.readouterr().out.splitlines()
+    assert printed == [
+        f"{'STRAIGHT_TRAVERSE' if n == 0 else 'STRAIGHT_FEED'}({x:.4f}, {y:.4f}, {z:.4f}, 0.0000, 0.0000, 0.0000)"
+        for n, (x, y, z) in enumerate(want)
+    ]
+
+
+def test_the_later_specification_sets_a_variable_both_give():
+    """The manual's mixture: `G65 A1.0 B2.0 I-3.0 I4.0 D5.0 P1000` leaves #1 1, #2 2, #4 -3, #5
+    and #6 vacant, #7 5.0 (D, written after the second I) (B-63684EN, "Mixture of argument
+    specifications I and II"); written the other way round, the second I's 4.0."""
+    macro = "O1000\nIF [#5 NE #0] GOTO 9\nIF [#6 NE #0] GOTO 9\nG1 X#1 Y#2 Z#4 F100\nG1 X#7\nN9 M99\n"
+    for arguments, last in (("A1.0 B2.0 I-3.0 I4.0 D5.0", 5.0), ("A1.0 B2.0 D5.0 I-3.0 I4.0", 4.0)):
+        events = _events(f"{HEAD}G65 {arguments} P1000\nM30\n{macro}")
+        assert [e.end for e in events if type(e) is Line][-2:] == [(1.0, 2.0, -3.0), (last, 2.0, -3.0)]
+
+
+@pytest.mark.parametrize(
+    "arguments, said",
+    [
+        ("J1. I2.", "G65 with I J K arguments out of order (I number 1 in set 2)"),
+        ("I1. J2. I3. K4.", "G65 with I J K arguments out of order (K number 1 in set 2)"),
+        (" ".join(["I1. J2. K3."] * 11), "G65 with more than 10 sets of I J K arguments"),
+    ],
+)
+def test_i_j_k_sets_that_cannot_be_told_apart_leave_the_scope(arguments, said):
+    _, warned = _warned(f"{HEAD}G65 P700 {arguments}\nM30\n{SETS_MACRO}")
+    assert f"t.nc:3:1: warning: {said}" in warned
+
+
+def test_i_j_k_repeat_only_in_a_macro_call():
+    """A move, M98 or G67 with two I words is refused as before (rs274: "Multiple i words")."""
+    for block in ("G2 X1 Y0 I0.5 I0.5 J0", "M98 P700 I1 I2", "G67 I1 I2"):
+        with pytest.raises(NcppError, match="Multiple i words on one line"):
+            _events(f"O1\n{HEAD}{block}\nM30\n{SETS_MACRO}")
