@@ -18,7 +18,10 @@ is told (`--work-offset G54.1P3=X,Y,Z`, `G154P3=`, or a parameter file's #7001..
 with a warning, as does a block that selects one with other words in it (what else the block
 does would run in the control's order around the new zero: not guessed at).  `G10 L20` sets an
 additional work offset on these controls, where LinuxCNC's sets system P from the current
-point: out of scope.
+point: out of scope.  So is `G10 L2 P0`, which sets the external workpiece zero offset that
+shifts every system (Fanuc operator's manual, "Changing workpiece coordinate system": P0 the
+external offset, P1-P6 G54-G59), where LinuxCNC's sets the system in effect; a P that is an
+expression may be 0 there.
 
 A setting code written with other words in its block is out of scope too: a block that
 both sets and moves is not one these controls' posts write.
@@ -29,7 +32,7 @@ from __future__ import annotations
 from ncpp.motion.interpreter import Interpreter, _OutOfScope, interpreting
 from ncpp.motion.offsets import ADDITIONAL, ADDITIONAL_CODES
 from ncpp.motion.segments import Event, Pass
-from ncpp.program.blocks import Block, Comment, Word
+from ncpp.program.blocks import Block, Comment, ExprWord, Word
 
 # G code -> the words it takes, for the settings each flavour reads past
 FANUC_SETTINGS: dict[float, frozenset[str]] = {5.1: frozenset("Q"), 8.0: frozenset("P")}
@@ -61,6 +64,9 @@ class FanucInterpreter(Interpreter):
                 and any(w.letter == "L" and w.value == 20 for w in words)
             ):
                 raise _OutOfScope("G10 L20 (it sets an additional work offset here)", word.start + 1)
+            if word.letter == "G" and word.value == 10.0 and _external_offset(block, words):
+                raise _OutOfScope("G10 L2 P0 (it sets the external work offset, which shifts every system)",
+                                  word.start + 1)  # fmt: skip
             reason = self.unfollowed.get((word.letter, word.value))
             if reason is not None:
                 raise _OutOfScope(reason, word.start + 1)
@@ -103,3 +109,11 @@ class HaasInterpreter(FanucInterpreter):
 
 interpret = interpreting(FanucInterpreter)
 interpret_haas = interpreting(HaasInterpreter)
+
+
+def _external_offset(block: Block, words: list[Word]) -> bool:
+    """A `G10 L2` block whose P is 0, or an expression that may be (Fanuc's external offset)."""
+    if not any(w.letter == "L" and w.value == 2 for w in words):
+        return False
+    p = next((item for item in block.items if type(item) in (Word, ExprWord) and item.letter == "P"), None)
+    return p is not None and (type(p) is ExprWord or p.value == 0)

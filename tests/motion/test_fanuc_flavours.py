@@ -53,7 +53,9 @@ def test_a_setting_with_motion_in_its_block_ends_interpretation():
      ("G54.1 P1", "G54.1 P1 (an additional work offset ncpp is not told: give --work-offset G54.1P1=", "fanuc"),
      ("G54.1 P49", "G54.1 P49 (an additional work offset ncpp is not told)", "fanuc"),
      ("G154 P3 G0 X1", "G154 with other words in its block", "haas"), ("G54.1", "G54.1 without one P", "fanuc"),
-     ("G10 L20 P1 X0 Y0 Z0", "G10 L20 (it sets an additional work offset here)", "fanuc")],
+     ("G10 L20 P1 X0 Y0 Z0", "G10 L20 (it sets an additional work offset here)", "fanuc"),
+     ("G10 L2 P0 X5", "G10 L2 P0 (it sets the external work offset", "fanuc"),
+     ("G10 L2 P[#1] X5", "G10 L2 P0 (it sets the external work offset", "haas")],
 )  # fmt: skip
 def test_what_fanuc_and_haas_programs_need_ncpp_is_not_told_ends_interpretation(block, reason, dialect):
     said = io.StringIO()
@@ -120,3 +122,10 @@ def test_the_header_and_guard_go_below_the_start_not_into_the_leader(tmp_path):
     assert (
         program_part.startswith("(ncpp compensated for") and "IF [#4014 NE 54] THEN #3000=1" in program_part
     )
+
+
+def test_g10_l2_of_a_numbered_system_is_followed():
+    """P1-P6: G54-G59 (the Fanuc manual's G10 L2), as LinuxCNC reads them."""
+    said = io.StringIO()
+    found = events("G10 L2 P1 X5\nG0 X1\nM30\n", "fanuc", Warnings(stream=said))
+    assert type(found[1]) is Line and said.getvalue() == ""
