@@ -115,5 +115,7 @@ def _external_offset(block: Block, words: list[Word]) -> bool:
     """A `G10 L2` block whose P is 0, or an expression that may be (Fanuc's external offset)."""
     if not any(w.letter == "L" and w.value == 2 for w in words):
         return False
-    p = next((item for item in block.items if type(item) in (Word, ExprWord) and item.letter == "P"), None)
-    return p is not None and (type(p) is ExprWord or p.value == 0)
+    for item in block.items:
+        if (type(item) is Word or type(item) is ExprWord) and item.letter == "P":
+            return type(item) is ExprWord or item.value == 0
+    return False
