@@ -1303,8 +1303,8 @@ def _subroutine_file(folder: Path, name: str) -> Path | None:
     """The file of subroutine `name` in `folder` as rs274ngc names it: the name joined to the
     folder as text (`find_ngc_file`: "folder/name.ngc"), so `o</etc/x>` is folder/etc/x.ngc;
     None for a name that leads out of the folder (`..`), which ncpp does not follow."""
-    path = os.path.normpath(f"{folder}/{name}.ngc")
-    inside = os.path.normpath(folder)
+    inside = os.path.abspath(folder)  # (a relative folder, `.`, counts from the working directory)
+    path = os.path.normpath(f"{inside}/{name}.ngc")
     return Path(path) if path.startswith(inside.rstrip(os.sep) + os.sep) else None
 
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import io
 import random
+from pathlib import Path
 
 import pytest
 
@@ -392,6 +393,15 @@ def test_subroutine_files_move_as_rs274_does(tmp_path):
 
     mine = [c for c in map(canon_call, events) if c is not None]
     assert len(mine) == len(reference) and same_calls(reference, mine)
+
+
+def test_a_relative_subroutine_folder_counts_from_the_working_directory(tmp_path, monkeypatch):
+    from ncpp.motion.offsets import WorkOffsets
+
+    (tmp_path / "step.ngc").write_text("o<step> sub\nG1 X[#1] F100\no<step> endsub\n")
+    monkeypatch.chdir(tmp_path)
+    found = _events(HEAD + "o<step> call [7]\n", offsets=WorkOffsets.given({}, subroutine_path=[Path(".")]))
+    assert [e.end[0] for e in found if type(e) is Line][-1] == 7.0
 
 
 def test_an_error_in_a_subroutine_file_names_that_file(tmp_path):
