@@ -174,7 +174,7 @@ UNCOMPENSATED = {
     "so the tool is not where their points are; ncpp follows it in ISO programs in G17 and G18, with no lathe "
     "tool orientation, and in Klartext and Sinumerik in G17 with absolute coordinates, outside loops, subroutines "
     "and Fanuc corners, from and to a line); compensation resumes after the first move "
-    "with it off (after G40, or R0)",
+    "with it off (after G40, or R0), or after the move that one's Fanuc corner rounds into",
 }
 # An entry move under cutter compensation whose tool centre ends on its point: the radius is unknown
 UNKNOWN_RADIUS = (

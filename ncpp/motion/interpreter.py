@@ -292,6 +292,8 @@ class Interpreter:
         self.comp_orientation = 0
         self.centre = ToolCentre()  # where the tool centre stands off the programmed path (`_in_comp`)
         self.arc_refused = False  # after G40 ended compensation that moved the tool off the path: until a G0/G1 move (rs274ngc)
+        # the exit move after G40 has a Fanuc corner (`,R` `,C`): the move it rounds into is left as programmed too
+        self.exit_corner = False
         self.untold: set[int] = set()  # coordinate systems whose zero nobody said (warned when selected)
         self.warnings: Warnings | None = None
         self.flow: Flow | None = None  # while `run` runs
@@ -360,7 +362,12 @@ class Interpreter:
                     if kind is RUN and _moves(event):  # in its place: no backward GOTO may run it again
                         flow.last_run_move = block.line
                     self._note_placed(block)
-                if self.centre.off_path or self.cutter_comp is not None or self.arc_refused:
+                if (
+                    self.centre.off_path
+                    or self.cutter_comp is not None
+                    or self.arc_refused
+                    or self.exit_corner
+                ):
                     event = self._in_comp(event, block)
             except NcppError as err:
                 source = flow.source()
@@ -468,6 +475,13 @@ class Interpreter:
         moves: list[Line | Arc] = [ev for ev in events if type(ev) is not Pass]  # type: ignore[misc]
         if not moves:
             return event
+        if self.exit_corner:  # (the control rounds the corner between the exit move's text and this one's)
+            self.exit_corner = False
+            for move in moves:
+                move.fixed = COMP
+            self.centre.corrected = False
+            return event
+        leaving = self.cutter_comp is None and self.centre.off_path
         if self.arc_refused:
             if type(moves[0]) is Arc:
                 self._fail(
@@ -480,6 +494,7 @@ class Interpreter:
             self._check_radius(moves, block, self.comp_radius)
         # (with a lathe tool's orientation 1-8 the control moves its tip, not its centre, along the offset contour)
         self.centre.follow(moves, self._comp_side(), self.comp_orientation in (0, 9))
+        self.exit_corner = leaving and self.corner is not None
         if moves[0].fixed and any(_expanding(ev) for ev in events):  # a cycle left as programmed stays one
             kept = tuple(ev for ev in events if not _expanding(ev))
             return kept if len(kept) != 1 else kept[0]

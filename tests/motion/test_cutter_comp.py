@@ -210,25 +210,24 @@ def test_program_end_ends_compensation():
     assert interpreter.cutter_comp is None and not interpreter.centre.off_path
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="the verifier refuses the written program: its `,R1` corner after a compensated move no longer fits "
-    "between the moves (ncpp's own interpreter refuses it); corners under cutter compensation are not yet rewritten",
-)
 def test_fanuc_corners_under_compensation_are_the_controls_and_the_position_is_followed():
     """A Fanuc `,R` / `,C` corner under G41/G42: the control rounds the contour, then offsets it.
-    Every piece is left as programmed; after the exit move the moves are those of the same
-    program without the corners."""
+    Every piece is left as programmed, and so is the move the exit move's corner rounds into (the
+    control rounds between the two texts: a corrected next move would not take the fillet);
+    after it the moves are those of the same program without the corners, compensated."""
     body = "G41.1 D2\nG1 X10 ,R1\nG1 Y10 ,C1\nG1 X0\nG40\nG1 X-5 Y-5 ,R1\nG1 X-20\nG1 Y20\n"
     rounded = moves(events_of(HEAD + body))
     plain = moves(events_of(HEAD + body.replace(" ,R1", "").replace(" ,C1", "")))
-    assert [e.fixed for e in rounded] == ["", ""] + [COMP] * 7 + [""] * 2  # (the exit move's fillet too)
+    assert [e.fixed for e in rounded] == ["", ""] + [COMP] * 8 + [
+        ""
+    ]  # (the exit move's fillet and partner too)
     assert [e.end for e in rounded[-2:]] == [e.end for e in plain[-2:]]
     out, warned = compensate(HEAD + body, "corner.ngc")
     lines, start = out.splitlines(), out.splitlines().index("G41.1 D2")
     assert (
-        lines[start : start + 6] == body.splitlines()[:6] and warned.count("cutter compensation") == 1
-    )  # to the exit move
+        lines[start : start + 7] == body.splitlines()[:7] and warned.count("cutter compensation") == 1
+    )  # to the move after the exit move
+    assert lines[start + 7] != body.splitlines()[7]  # compensated again
 
 
 # -- compensation ---------------------------------------------------------------------------------
