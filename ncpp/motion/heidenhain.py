@@ -789,8 +789,15 @@ class HeidenhainInterpreter(ModalInterpreter):
 
     def _refuse_leaving(self, reason: str, block: Block, col: int | None) -> None:
         """With --expand, an out-of-scope construct where the rest cannot pass through as it is
-        (`KlartextExpansion.refuses_leaving`) is refused."""
-        if self.expansion is not None and self.flow is not None and self.expansion.refuses_leaving(self.flow):
+        (`KlartextExpansion.refuses_leaving`) is refused (in a program CALL PGM runs, the rest
+        passes through from the calling line, which is written as it is)."""
+        expansion, flow = self.expansion, self.flow
+        if (
+            expansion is not None
+            and flow is not None
+            and not self.programs
+            and expansion.refuses_leaving(flow)
+        ):
             raise refused(reason, Location(self.file, block.line, col))
 
     # -- CALL PGM (TNC 640 Klartext manual, "Calling any program as a subprogram") ------------

@@ -157,9 +157,10 @@ class KlartextExpansion:
                 return raw
             if not cycle:
                 return None
+            self.written[target[1]] = value(expr, block, item)  # (the written program sets it too)
             if not _reads_parameter(expr):
                 return raw
-            return f"{parameter_name(target[1])}={number('Q', value(expr, block, item))}"
+            return f"{parameter_name(target[1])}={number('Q', self.written[target[1]])}"
         if item.kind == "fn" and item.node[0] in ARITHMETIC_FN:
             return None
         if item.kind == "call_program":
@@ -192,8 +193,14 @@ class KlartextExpansion:
         if self.settled:
             return ()
         self.settled = True
-        changed = sorted(name for name, v in self.q.items() if self.written.get(name) != v)
+        changed = sorted((name for name, v in self.q.items() if self.written.get(name) != v), key=_in_order)
         return tuple(Pass(_assignment(name, self.q[name], block)) for name in changed)
+
+
+def _in_order(name: str) -> tuple[str, int]:
+    """`q12` -> ("q", 12): Q parameters by kind and number."""
+    digits = name.lstrip("qlrs")
+    return name[: len(name) - len(digits)], int(digits) if digits.isdigit() else -1
 
 
 def _reads_parameter(node: object) -> bool:

@@ -157,6 +157,45 @@ def test_a_loops_counter_is_set_before_the_line_that_reads_it_and_a_jumped_line_
     assert "LBL 2" in written and "LBL 7" in written  # (labels stay where they stand)
 
 
+CYCLE_IN_REPEAT = """0 BEGIN PGM CYC MM
+1 TOOL CALL 1 Z S3000
+2 L X+0 Y+0 Z+20 R0 FMAX
+3 Q5 = 0
+4 LBL 1
+5 Q5 = Q5 - 2
+6 CYCL DEF 200 DRILLING ~
+  Q200=+2 ;SAFETY CLEARANCE ~
+  Q201=+Q5 ;DEPTH ~
+  Q206=+150 ;FEED RATE FOR PLNGNG ~
+  Q202=+5 ;PLUNGING DEPTH ~
+  Q210=+0 ;DWELL TIME AT TOP ~
+  Q203=+0 ;SURFACE COORDINATE ~
+  Q204=+50 ;2ND SET-UP CLEARANCE ~
+  Q211=+0 ;DWELL TIME AT DEPTH
+7 L X-Q5 Y+10 Z+5 FMAX
+8 CYCL CALL
+9 CALL LBL 1 REP 2
+10 L Z+Q5 FMAX
+11 FN 14: ERROR = 1000
+12 L Z+50 FMAX M30
+13 END PGM CYC MM
+"""
+
+
+def test_a_cycle_defined_in_a_repeated_section_keeps_its_parameters_as_each_runs_numbers(tmp_path):
+    """The cycle's own parameters stay in its definition, as the numbers of each run (Q201 = Q5:
+    -2, -4, -6); the program sets them there, so they are not set again after the stretch, but
+    the counter Q5 that the next line reads is.  The FN 14 after it, out of the interpreter's
+    scope in the main program, passes through as it is."""
+    written, messages = compensated(tmp_path, "cyc.h", CYCLE_IN_REPEAT, "--expand")
+    assert re.findall(r"Q201=([+-]\d+)", written) == ["-2", "-4", "-6"]
+    assert "FN 0: Q201" not in written and "CYCL CALL" in written and "CALL LBL" not in written
+    lines = written.splitlines()
+    settle = next(n for n, line in enumerate(lines) if "FN 0: Q5 = -6" in line)
+    assert " L Z-" in lines[settle + 1] and lines[settle + 2].endswith("FN 14: ERROR = 1000")
+    assert "FN 14 is outside the motion interpreter's scope" in messages
+
+
 @pytest.mark.parametrize("text", [REPEATED, SUBPROGRAM, LOOP], ids=["repeat", "subprogram", "jumps"])
 def test_ncpps_interpreter_reads_the_same_moves_from_both_texts(tmp_path, text):
     """Consistency: the moves ncpp's interpreter reads from the original with --expand are the
@@ -179,8 +218,9 @@ def test_ncpps_interpreter_reads_the_same_moves_from_both_texts(tmp_path, text):
             r"sub\.h:11:4: --expand: CYCL DEF 7\.0 \(it moves the datum\) is "
             r"outside the motion interpreter's scope, inside a loop",
         ),
+        ("10 TOOL CALL Q2 Z\n", r"sub\.h:11:4: --expand: a Q parameter in this statement cannot be written"),
     ],
-    ids=["call-pgm", "datum-shift"],
+    ids=["call-pgm", "datum-shift", "q-tool"],
 )
 def test_what_cannot_be_written_out_is_refused_with_its_line(tmp_path, capsys, body, message):
     text = SUBPROGRAM.replace("10 CC X+Q2 Y+40\n", body + "10 CC X+Q2 Y+40\n")
