@@ -9,7 +9,7 @@ half circle), `CT` (tangential arc), `LP`/`CP` polar with PR/IPR/PA/IPA (a
 helix with IZ, several turns with |IPA| > 360), Q parameters with arithmetic,
 labels, subprograms (`CALL LBL n` ... `LBL 0`), program-section repeats (`CALL LBL n REP k`)
 and the jumps FN 9-12 (`heidenhain_flow`: a block that runs again is left as programmed,
-FLOW), `CALL PGM` of a program file on the subroutine path (`_call_program`: its moves are left
+FLOW; with --expand each run is written out, `heidenhain_expand`), `CALL PGM` of a program file on the subroutine path (`_call_program`: its moves are left
 as programmed, FLOW, and the caller's after it compensated), `CYCL DEF` of machining cycles
 (they only define), the drilling cycles 200, 201, 203, 207 and 240 called by M99, `CYCL CALL`
 or `CYCL CALL POS` (`heidenhain_cycles`: their moves along the tool axis are left as
@@ -703,7 +703,8 @@ class HeidenhainInterpreter(ModalInterpreter):
     def _flowing(self, blocks: Iterable[Block], warnings: Warnings) -> Iterator[Event]:
         """Events as `ModalInterpreter.run`, block by block in the order they run: the moves of
         a block that runs again are left as programmed (FLOW) and, where it runs out of the
-        text's order, belong to the line that runs it (a call, a jump back), written once."""
+        text's order, belong to the line that runs it (a call, a jump back), written once; with
+        --expand (`expand`) each run of it is written where it runs (`heidenhain_expand`)."""
         self.expansion = KlartextExpansion(self.q, self.file) if self.expand else None
         return self._run_flow(KlartextFlow(self.file, blocks), warnings, None)
 

@@ -5,7 +5,7 @@ What --expand does is ISO's (`ncpp.motion.expand`); the order the blocks run in 
 repeats": `CALL LBL n` runs the blocks after `LBL n` up to `LBL 0`, `CALL LBL n REP k` the section
 from `LBL n` to the call k more times; "If-then decisions with Q parameters": FN 9-12 jump to a
 label when the comparison holds).  Every block a subprogram, a repeated section or a jump's loop
-runs is written where it runs, for that run (`literal`): its Q parameters in words as the numbers
+runs is written where it runs, for that run (`KlartextExpansion.body`): its Q parameters in words as the numbers
 they have there (`L X+Q1` -> `L X+12.5`), its Q parameter assignments (`Q1 = ...`, FN 0-8 and 13)
 left out, so its moves are plain moves compensated like any other.  A cycle definition's own
 parameters (`Q200=+2` in `CYCL DEF 200`) stay, as numbers, since the cycle reads them there.
@@ -16,7 +16,7 @@ passed through after an out-of-scope line may still need it); run again away fro
 back to it), it is not written again.  The subprograms after the program's end stay as text.
 The program's own lines, run once where they stand, are written as they are, and before the
 first of them after a stretch written out the Q parameters the stretch changed are set to the
-values they have there (`FN 0: Q1 = +12.5`), as a line there (or a program it calls) may read
+values they have there (`FN 0: Q1 = +12.5`, the manual's "Basic arithmetic" FN 0 ASSIGN), as a line there (or a program it calls) may read
 them.  The written program's blocks are numbered afresh (the writer's `renumber`).
 
 Refused (`ncpp.motion.expand.refused`, `counted`): an out-of-scope construct inside a stretch
