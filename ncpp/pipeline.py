@@ -163,7 +163,7 @@ UNCOMPENSATED = {
     "program puts them, with the machine's errors); compensation resumes with the next move",
     FLOW: "loop or subroutine: its moves pass through uncompensated (one text runs several times, "
     "or away from where it stands, so it cannot carry one correction); compensation resumes with the next move after it "
-    "(--expand writes an ISO program's loops and subroutines out as straight code, "
+    "(--expand writes an ISO or Klartext program's loops and subroutines out as straight code, "
     "each move compensated)",
     DRILLED: "drilling cycle: it drills where the move before it leaves the tool (X and Y compensated), its moves "
     "along the tool axis as programmed (the depth with the machine's error); compensation resumes with the next move",
@@ -376,9 +376,11 @@ def process(
     else:  # compensated again: the guard of the offset it was compensated for goes
         blocks = without_guard(blocks)
     offsets = offsets or AT_MACHINE_ZERO  # the control's zeros place the program on the machine
-    expanding = (
-        {"expand_cycles": expand_cycles, "expand": expand} if FAMILY[name] == "iso" else {}
-    )  # (the others have none)
+    expanding: dict[str, bool] = {}  # (Sinumerik has neither)
+    if FAMILY[name] == "iso":
+        expanding = {"expand_cycles": expand_cycles, "expand": expand}
+    elif FAMILY[name] == "heidenhain":
+        expanding = {"expand": expand}
     if verify:  # the verifier's own reading of the input: the blocks are held between the two
         # readings, not the events (a loop's runs read its few blocks again and again)
         blocks, again = _twice(blocks)
@@ -392,6 +394,8 @@ def process(
     stats.summary = summary = Summary(file)
     warnings.listeners.append(summary.heard)
     writer = writer_class()
+    if expand and FAMILY[name] == "heidenhain":  # (the blocks written out take numbers of their own)
+        writer.renumber = True
     keep_freed_memory()  # numpy's temporaries reuse the heap, not fresh pages (runtime.py)
     ctx = make_context(source, tolerance, warnings, file)
     reached = _Reached()

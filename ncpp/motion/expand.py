@@ -144,13 +144,7 @@ class Expansion:
 
     def _count(self, block: Block) -> None:
         """One more block written out of a loop or a subroutine: refused past MAX_EXPANDED."""
-        self.expanded += 1
-        if self.expanded > MAX_EXPANDED:
-            raise NcppError(
-                f"--expand: the loops and subroutines make more than {MAX_EXPANDED:,} blocks written out; "
-                "leave --expand out (their moves then pass through uncompensated)",
-                Location(self.file, block.line, 1),
-            )
+        self.expanded = counted(self.expanded, Location(self.file, block.line, 1))
 
     def _unsettle(self) -> None:
         """A stretch written out starts (or goes on): the parameters the written program has are
@@ -186,6 +180,25 @@ class Expansion:
         return tuple(Pass(_assignment(text, block)) for text in lines)
 
 
+def counted(expanded: int, where: Location) -> int:
+    """`expanded` blocks written out of loops and subroutines and one more (at `where`): refused
+    past MAX_EXPANDED."""
+    if expanded >= MAX_EXPANDED:
+        raise NcppError(
+            f"--expand: the loops and subroutines make more than {MAX_EXPANDED:,} blocks written out; "
+            "leave --expand out (their moves then pass through uncompensated)",
+            where,
+        )
+    return expanded + 1
+
+
+def refused(reason: str, where: Location) -> NcppError:
+    """The error for a construct out of scope where the rest of the program cannot pass through as
+    it is: inside a loop, a branch or a subroutine written out (its opening line is left out)."""
+    return NcppError(f"--expand: {reason} is outside the motion interpreter's scope, inside a loop, "
+                     "a branch or a subroutine written out: the rest cannot pass through as it is", where)  # fmt: skip
+
+
 def _each(events: Event | tuple[Event, ...]) -> tuple[Event, ...]:
     return events if type(events) is tuple else (events,)  # type: ignore[return-value]
 
@@ -194,15 +207,21 @@ def literal(block: Block, params: Parameters) -> Block | None:
     """The block as it runs now: each expression word as its value's number (a vacant one left
     out), its parameter assignments left out (but Fanuc's stop with a message), the rest as
     written.  None where an expression cannot be evaluated (the interpreter then says why)."""
+    try:
+        texts = [_text(item, block.raw, params) for item in block.items]
+    except (ExpressionError, OutOfScope):
+        return None
+    return rewritten(block, texts)
+
+
+def rewritten(block: Block, texts: list[str | None]) -> Block:
+    """The block with each item's text replaced by `texts`' (None: left out), the text between
+    them as it was; an expression word written as a number becomes a plain word."""
     raw = block.raw
     pieces: list[str] = []
     items: list[AnyItem] = []
     at = last = 0  # where the new text and the old one are
-    for item in block.items:
-        try:
-            text = _text(item, raw, params)
-        except (ExpressionError, OutOfScope):
-            return None
+    for item, text in zip(block.items, texts):
         gap = raw[last : item.start]
         last = item.end
         if text is None:

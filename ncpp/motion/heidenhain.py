@@ -9,7 +9,7 @@ half circle), `CT` (tangential arc), `LP`/`CP` polar with PR/IPR/PA/IPA (a
 helix with IZ, several turns with |IPA| > 360), Q parameters with arithmetic,
 labels, subprograms (`CALL LBL n` ... `LBL 0`), program-section repeats (`CALL LBL n REP k`)
 and the jumps FN 9-12 (`heidenhain_flow`: a block that runs again is left as programmed,
-FLOW), `CALL PGM` of a program file on the subroutine path (`_call_program`: its moves are left
+FLOW; with --expand each run is written out, `heidenhain_expand`), `CALL PGM` of a program file on the subroutine path (`_call_program`: its moves are left
 as programmed, FLOW, and the caller's after it compensated), `CYCL DEF` of machining cycles
 (they only define), the drilling cycles 200, 201, 203, 207 and 240 called by M99, `CYCL CALL`
 or `CYCL CALL POS` (`heidenhain_cycles`: their moves along the tool axis are left as
@@ -49,6 +49,7 @@ from ncpp.errors import Location, NcppError, Warnings
 from ncpp.motion.called import Files, count_called, searched
 from ncpp.motion.corners import CornerError, round_corner
 from ncpp.motion.cutter import centre_offset
+from ncpp.motion.expand import refused
 from ncpp.motion.heidenhain_cycles import (
     DEFINITION_ACTIVE,
     REQUIRED,
@@ -61,6 +62,7 @@ from ncpp.motion.heidenhain_cycles import (
     pattern_holes,
 )
 from ncpp.motion.heidenhain_cycles import steps as cycle_steps
+from ncpp.motion.heidenhain_expand import KlartextExpansion, is_control, is_label
 from ncpp.motion.heidenhain_flow import FIXED, JUMPS, SKIP, TEXT, KlartextFlow, jump_parts, label_key
 from ncpp.motion.modal import (
     MM_PER_INCH,
@@ -221,6 +223,7 @@ class HeidenhainInterpreter(ModalInterpreter):
         self.returned = False  # the called program's END PGM ran
         self.called_blocks = 0  # blocks run in called programs so far
         self._files: Files | None = None  # the called programs' files, once a call needs them
+        self.expansion: KlartextExpansion | None = None  # --expand: what it writes (`heidenhain_expand`)
 
     def run(self, blocks: Iterable[Block], warnings: Warnings) -> Iterator[Event]:
         """Events as `ModalInterpreter.run`; a feed line waits (with the events after it)
@@ -278,6 +281,7 @@ class HeidenhainInterpreter(ModalInterpreter):
         """[first line shortened, fillet or chamfer, second line] or None when out of scope."""
         where = Location(self.file, corner.block.line, corner.col)
         if not isinstance(second, Line) or second.rapid:
+            self._refuse_leaving("RND/CHF next to an arc or a rapid move", corner.block, corner.col)
             self.done = True
             warnings.warn("RND/CHF next to an arc or a rapid move is outside the motion interpreter's scope; "
                           "from this line on the program passes through uninterpreted", where)  # fmt: skip
@@ -699,7 +703,9 @@ class HeidenhainInterpreter(ModalInterpreter):
     def _flowing(self, blocks: Iterable[Block], warnings: Warnings) -> Iterator[Event]:
         """Events as `ModalInterpreter.run`, block by block in the order they run: the moves of
         a block that runs again are left as programmed (FLOW) and, where it runs out of the
-        text's order, belong to the line that runs it (a call, a jump back), written once."""
+        text's order, belong to the line that runs it (a call, a jump back), written once; with
+        --expand (`expand`) each run of it is written where it runs (`heidenhain_expand`)."""
+        self.expansion = KlartextExpansion(self.q, self.file) if self.expand else None
         return self._run_flow(KlartextFlow(self.file, blocks), warnings, None)
 
     def _run_flow(self, flow: KlartextFlow, warnings: Warnings, caller: Block | None) -> Iterator[Event]:
@@ -709,8 +715,11 @@ class HeidenhainInterpreter(ModalInterpreter):
         self.flow = flow
 
         def stop(reason: str, owner: Block) -> None:  # (where the flow itself cannot go on)
+            if caller is None:
+                self._refuse_leaving(reason, owner, None)
             self.leave_scope(warnings, reason, owner, None, caller)
 
+        expansion = self.expansion if caller is None else None  # (a called program's text is not written)
         for block, kind, owner in flow.steps(lambda: self.done or self.returned, stop):
             if caller is not None:
                 if kind is SKIP or kind is TEXT:
@@ -719,26 +728,78 @@ class HeidenhainInterpreter(ModalInterpreter):
                 self.called_blocks = count_called(self.called_blocks, self.program_file, caller)
             if kind is SKIP or kind is TEXT or self.done or not block.items:
                 if owner is None:  # (after M2/M30/END PGM: a subprogram's text, run where it is called)
+                    if expansion is not None and block.items and (kind is SKIP or kind is TEXT or self.done):
+                        kept = expansion.text(kind is SKIP, block)
+                        if kept is None:  # (text a jump goes over: left out)
+                            continue
+                        yield from kept
                     yield Pass(block, kind is SKIP or (kind is TEXT and self.ended))
                 continue
-            self.again = kind is FIXED
+            self.again = kind is FIXED and expansion is None
+            settling: tuple[Event, ...] = ()
+            written: Block | None = block
             try:
+                if expansion is not None:
+                    settling, written = self._written_out(expansion, block, kind, owner)
                 events = self.block(block)
             except OutOfScope as out:
                 self.called = None
+                if expansion is not None and expansion.refuses_leaving(flow):
+                    raise refused(out.reason, Location(self.file, block.line, out.col)) from None
                 self.leave_scope(warnings, out.reason, block, out.col, owner)
                 if owner is None:
+                    yield from settling
                     yield Pass(block)
                 continue
-            if kind is FIXED:
+            if expansion is not None:  # each block where it runs, a stretch's as this run's numbers
+                yield from settling
+                if written is not block:
+                    if written is not None:
+                        for event in events:
+                            event.block = written
+                        yield from events or (Pass(written),)
+                    continue
+            elif kind is FIXED:
                 events = _in_flow(events, owner)
-            elif flow.labels and any(type(e) is Line or type(e) is Arc for e in events):
+            if kind is not FIXED and flow.labels and any(type(e) is Line or type(e) is Arc for e in events):
                 flow.moved()  # (before the first label nothing can jump back over it)
             yield from events or ((Pass(block),) if owner is None else ())
             if self.called is not None:
                 path, self.called = self.called, None
                 yield from self._program(path, owner or block, warnings)
                 self.flow = flow
+
+    def _written_out(
+        self, expansion: KlartextExpansion, block: Block, kind: str, owner: Block | None
+    ) -> tuple[tuple[Event, ...], Block | None]:
+        """With --expand, before `block` runs: the assignments to write before it and the block
+        to write for it (itself where it stands and runs once, a stretch's block as this run's
+        numbers, None for a line left out: a call or jump, a label run again away from its text,
+        a block of assignments only)."""
+        if is_control(block):
+            expansion.control()
+            return (), None
+        if is_label(block):  # (its text stays where it stands, once)
+            if owner is None:
+                return (), block
+            expansion.control()
+            return (), None
+        if kind is not FIXED:
+            return expansion.in_place(block), block
+        return (), expansion.body(block, self.value, self.inch)
+
+    def _refuse_leaving(self, reason: str, block: Block, col: int | None) -> None:
+        """With --expand, an out-of-scope construct where the rest cannot pass through as it is
+        (`KlartextExpansion.refuses_leaving`) is refused (in a program CALL PGM runs, the rest
+        passes through from the calling line, which is written as it is)."""
+        expansion, flow = self.expansion, self.flow
+        if (
+            expansion is not None
+            and flow is not None
+            and not self.programs
+            and expansion.refuses_leaving(flow)
+        ):
+            raise refused(reason, Location(self.file, block.line, col))
 
     # -- CALL PGM (TNC 640 Klartext manual, "Calling any program as a subprogram") ------------
     def _call_program(self, block: Block, item) -> Path:

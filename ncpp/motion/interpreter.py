@@ -52,7 +52,7 @@ from ncpp.motion.cycles import (
     back_bore,
     hole,
 )
-from ncpp.motion.expand import Expansion
+from ncpp.motion.expand import Expansion, refused
 from ncpp.motion.expressions import ExpressionError, OutOfScope, Parameters, evaluate, vacant
 from ncpp.motion.flow import FIXED, RUN, SKIP, Flow
 from ncpp.motion.offsets import SYSTEMS, WorkOffsets
@@ -426,9 +426,7 @@ class Interpreter:
         where = "this line" if owner is None else f"line {owner.line}, which runs it,"
         source = self.flow.source() if self.flow is not None else None
         if self.expansion is not None and self.flow is not None and self.expansion.refuses_leaving(self.flow):
-            raise NcppError(f"--expand: {reason} is outside the motion interpreter's scope, inside a loop, "
-                            "a branch or a subroutine written out: the rest cannot pass through as it is",
-                            Location(source or self.file, block.line, col))  # fmt: skip
+            raise refused(reason, Location(source or self.file, block.line, col))
         self.warnings.warn(  # type: ignore[union-attr]
             f"{reason} is outside the motion interpreter's scope; from {where} on the "
             "program passes through uninterpreted (its modal state is unknown)",

@@ -49,8 +49,10 @@ def placed_interpreting(dialect: type[ModalInterpreter]) -> Callable[..., Iterat
         warnings: Warnings | None = None,
         strict: bool = False,
         offsets: WorkOffsets | None = None,
+        expand: bool = False,
     ) -> Iterator[Event]:
-        """Motion events of a program's blocks, lazily (see the dialect module's docstring)."""
+        """Motion events of a program's blocks, lazily (see the dialect module's docstring);
+        `expand`: its subprograms and loops are to be written out (a dialect that can: Klartext)."""
         from ncpp.motion.tools import UntoldLengths
 
         zero = offsets.program_zero() if offsets is not None else (0.0, 0.0, 0.0)
@@ -59,6 +61,7 @@ def placed_interpreting(dialect: type[ModalInterpreter]) -> Callable[..., Iterat
         told = offsets is None or offsets.tools is not None
         interpreter.untold_lengths = UntoldLengths(not told, warnings)  # type: ignore[attr-defined]
         interpreter.subroutine_path = offsets.subroutine_path if offsets is not None else ()
+        interpreter.expand = expand
         return interpreter.run(blocks, warnings)
 
     return interpret
@@ -98,6 +101,7 @@ class ModalInterpreter:
         self.tool_id = ""  # the tool in the spindle as the program names it (Context.tool_id)
         self._context: Context | None = None
         self.subroutine_path: tuple[Path, ...] = ()  # the folders of the program files it calls
+        self.expand = False  # --expand: subprograms and loops written out (the dialect's own)
 
     # -- the event stream -------------------------------------------------------------
     def run(self, blocks: Iterable[Block], warnings: Warnings) -> Iterator[Event]:

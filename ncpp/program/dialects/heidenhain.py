@@ -324,6 +324,9 @@ class HeidenhainWriter(IsoWriter):
         self.restore_feed = False  # an edited corner block's F: the next move gets the program's feed back
         self.edited_last = False  # the last block was written edited (an RND/CHF after it must be too)
         self._lessons: dict[tuple[str, str], tuple] = {}  # by (letter, number pattern): see `_learn_styles`
+        # every block numbered one after the last written (--expand: blocks written out where they
+        # run, lines left out), the TNC's numbering, rather than its number shifted
+        self.renumber = False
 
     def _ran(self, event: Event) -> None:
         """A pole the runs of a call or jump line set (their CC blocks): the program's and the
@@ -344,8 +347,8 @@ class HeidenhainWriter(IsoWriter):
         number = next((i for i in block.items if type(i) is Word and i.letter == "N"), None)
         if number is None:
             return raw + block.eol
-        self.last_number = int(number.value) + self.shift
-        if self.shift:
+        self.last_number = self.last_number + 1 if self.renumber else int(number.value) + self.shift
+        if self.shift or self.renumber:
             raw = raw[: number.start] + str(self.last_number) + raw[number.end :]
         return raw + block.eol
 
@@ -483,7 +486,12 @@ class HeidenhainWriter(IsoWriter):
 
     def _inserted_replacing(self, block: Block, text: str) -> str:
         number = next((i for i in block.items if type(i) is Word and i.letter == "N"), None)
-        self.last_number = (int(number.value) if number is not None else self.last_number + 1) + self.shift
+        if self.renumber:
+            self.last_number += 1
+        else:
+            self.last_number = (
+                int(number.value) if number is not None else self.last_number + 1
+            ) + self.shift
         return f"{self.last_number} {text}{block.eol}"
 
     # -- text -----------------------------------------------------------------------------
