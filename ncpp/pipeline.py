@@ -400,7 +400,9 @@ def process(
     compensated = summary.written(run_passes(summary.programmed(events), ctx, PASSES))
     header = header_text(source, tolerance, offsets, name)
     after = _tool_guard(name, offsets, warnings, file) if guard_tools else None
-    lines = with_header(writer.write(reached.follow(compensated), after), header, writer, get_dialect(name).leader)
+    lines = with_header(
+        writer.write(reached.follow(compensated), after), header, writer, get_dialect(name).leader
+    )
     if guard is not None:
         said = guard.said()
         lines = with_guard(lines, guard, name, HEADER_TAG, header.count("\n") + 1,

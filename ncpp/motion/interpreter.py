@@ -1854,13 +1854,15 @@ _PLAIN_LETTERS = {
 }
 
 
-def _marked(events: Event | tuple[Event, ...] | None, block: Block, told: tuple[int, float]) -> Event | tuple[Event, ...]:
+def _marked(
+    events: Event | tuple[Event, ...] | None, block: Block, told: tuple[int, float]
+) -> Event | tuple[Event, ...]:
     """A block's events with the tool guard's mark (`Pass.length_told`) last, where the check
     is written after the block (the first event stays the one that says how it is written)."""
     mark = Pass(block, length_told=told)
     if events is None:
         return mark
-    return (*(events if type(events) is tuple else (events,)), mark)  # type: ignore[misc]
+    return (*(events if type(events) is tuple else (events,)), mark)
 
 
 def _expanding(event: Event) -> bool:
