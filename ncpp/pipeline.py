@@ -426,12 +426,14 @@ def process(
 
 
 def _tool_guard(dialect: str, offsets: WorkOffsets, warnings: Warnings, file: str) -> ToolGuard | None:
-    """The tool guard's checks where ncpp was told the tool table (`guard.ToolGuard`), else None."""
+    """The tool guard's checks where ncpp was told the tool table (`guard.ToolGuard`), else None
+    (and a warning where the dialect has none)."""
     if offsets.tools is None:
         return None
     told = offsets.tools.source
-    return ToolGuard(dialect, offsets.unit_mm, lambda why: warnings.warn(
+    guard = ToolGuard(dialect, offsets.unit_mm, lambda why: warnings.warn(
         f"no tool guard: {why}; make sure the control's tool lengths are those of {told}", Location(file, 1, None)))  # fmt: skip
+    return guard if guard.why is None else None
 
 
 def _twice(blocks: Iterable[Block]) -> tuple[Iterator[Block], Iterator[Block]]:

@@ -163,6 +163,15 @@ def test_no_check_with_no_guard_without_a_table_or_for_another_tools_length(tmp_
     assert written.count(TOOL_BEGIN) == 1 and "tool 2 at length" in written
 
 
+def test_an_inch_machines_check_compares_the_tables_inches():
+    """LinuxCNC's #5403 holds the table's number, in the machine's units (rs274 shows it)."""
+    from ncpp.guard import tool_guard_lines
+
+    lines = tool_guard_lines(3, 50.8, 25.4, 7)
+    assert lines[0] == f"({TOOL_BEGIN} tool 3 at length Z2 inch within 0.1 mm)"
+    assert lines[1] == "o<ncpp_tool_guard_7> if [[#5400 NE 3] OR [ABS[#5403 - 2] GT 0.0039]]"
+
+
 def test_a_fanuc_program_gets_no_check_and_a_warning_why(tmp_path):
     fanuc = "%\nO1234\n" + PROGRAM.replace("M2\n", "M30\n%\n")
     written, warned = _compensated(tmp_path, fanuc)
