@@ -31,8 +31,27 @@ starts with an O number):
 Heidenhain programs get no guard (yet): the preset table's active row and values are read
 with `FN 18: SYSREAD` IDs that differ between TNC generations.
 
-Readers of a written program drop the guard (`without_guard`): ncpp's interpreter
-does not know the control's parameters, and the guard neither moves nor acts.
+The tool guard: compensation also depends on the tool lengths ncpp was told (`--tool-table`):
+the length moves the Z positions where the errors are evaluated and lengthens the Abbe arm.
+After each block that applies the length of the tool in the spindle from the told table
+(G43, G43 H0 or G43 H of that tool, G43.2 H of it; `interpreter._tool_length` marks it,
+`Pass.length_told`), a check stops the program when the control's tool in the spindle or its
+length is not the one told, within `GUARD_MM`.  The block's own move (`G43 H1 Z5`) runs before
+the check; the next does not.
+
+* LinuxCNC (G-code manual, "Numbered Parameters": #5400 the tool number, #5401-#5409 the tool
+  offsets X..W, volatile): they hold the table's entry of the tool in the spindle, set at M6 or
+  M61, not the offset G43 applies, so a G43 H of another tool is not checked.  They stand in the
+  machine's units, as the table.  Each check's `if` has a label of its own (rs274ngc refuses a
+  label defined twice); `(abort, ...)` says #5400 and #5403 with their values.
+* Fanuc and Haas: no check.  Their tool offset variables (#2001..., #10001..., #11001...) depend
+  on the offset memory type (A, B, C) and on the number of offsets, which ncpp cannot cite for
+  a given control.
+* Sinumerik and Heidenhain: no check yet (the active edge's length, `$P_TOOLL` or `$TC_DP3`, and
+  Klartext's tool data are not cited here).
+
+Readers of a written program drop both guards (`without_guard`): ncpp's interpreter
+does not know the control's parameters, and the guards neither move nor act.
 """
 
 from __future__ import annotations
@@ -43,13 +62,17 @@ from dataclasses import dataclass
 from itertools import chain, islice
 
 from ncpp.motion.offsets import WorkOffsets, system_name
+from ncpp.motion.segments import Event, Pass
 from ncpp.program.blocks import Block, Comment
 from ncpp.program.parser import LEADER_LINES
 
 GUARD_MM = 0.1  # how far an axis's zero may be from the one told: re-touching a fixture moves it microns
 BEGIN = "ncpp placement guard:"
 END = "ncpp placement guard end"
-SCAN = 60  # blocks at the top searched for a guard
+TOOL_BEGIN = "ncpp tool guard:"
+TOOL_END = "ncpp tool guard end"
+SCAN = 60  # blocks at the top searched for a placement guard
+GUARD_BLOCKS = 12  # the most blocks a guard has (a first comment without its last within them is no guard)
 # A Fanuc program number line (`O1234`, perhaps with a comment); not an o-word line (`o100 sub`)
 _FANUC_PROGRAM_NUMBER = re.compile(r"\s*O\d+\s*(\(.*\))?\s*$")
 
@@ -79,13 +102,16 @@ class Placement:
         return [_number(v / self.unit_mm) for v in self.zero]
 
     def said(self) -> str:
-        units = "mm" if self.unit_mm == 1.0 else "inch" if self.unit_mm == 25.4 else f"x{self.unit_mm:g} mm"
         x, y, z = self.values()
-        return f"{self.name} at X{x} Y{y} Z{z} {units}"
+        return f"{self.name} at X{x} Y{y} Z{z} {_units(self.unit_mm)}"
 
 
 def _number(value: float) -> str:
     return f"{value:.4f}".rstrip("0").rstrip(".") if value != 0 else "0"
+
+
+def _units(unit_mm: float) -> str:
+    return "mm" if unit_mm == 1.0 else "inch" if unit_mm == 25.4 else f"x{unit_mm:g} mm"
 
 
 def guard_lines(placement: Placement, dialect: str, first_lines: Iterable[str] = ()) -> list[str]:
@@ -204,16 +230,81 @@ def with_guard(
     yield from it
 
 
+def tool_guard_lines(tool: int, length_mm: float, unit_mm: float, label: int) -> list[str]:
+    """LinuxCNC's check (without line ends) that the control's tool in the spindle is `tool` and
+    its Z offset `length_mm` within GUARD_MM (its parameters in the machine's units, `unit_mm` mm
+    each); `label` numbers the check's `if` (a program's labels are each defined once)."""
+    length, units, name = _number(length_mm / unit_mm), _units(unit_mm), f"o<ncpp_tool_guard_{label}>"
+    told = f"tool {tool} at length Z{length} {units}"
+    return [
+        f"({TOOL_BEGIN} {told} within {_number(GUARD_MM)} mm)",
+        f"{name} if [[#5400 NE {tool}] OR [ABS[#5403 - {length}] GT {_number(GUARD_MM / unit_mm)}]]",
+        f"(abort, ncpp: compensated for {told}; the control has tool #5400 at Z#5403: "
+        "compensate again with its tool table, or set the length)",
+        f"{name} endif",
+        f"({TOOL_END})",
+    ]
+
+
+# Why a dialect's program gets no tool guard, as the warning says it
+TOOLS_UNGUARDED = {
+    "fanuc": "Fanuc's tool offset variables depend on the offset memory type and count",
+    "haas": "Haas's tool offset variables depend on the offset memory type and count",
+    "grbl": "grbl cannot test its tool length (it reads no parameters)",
+    "sinumerik": "ncpp writes no check of Sinumerik's active tool edge yet",
+    "heidenhain": "ncpp writes no check of Klartext's tool data yet",
+}
+
+
+class ToolGuard:
+    """The tool guard's checks, written after each block that applies a told length (the
+    writer's `after`): LinuxCNC's, in an ISO program that is not a Fanuc one (a program number
+    at its top).  Where there is none, `unguarded` is told why, once."""
+
+    def __init__(self, dialect: str, unit_mm: float, unguarded: Callable[[str], None] = lambda why: None):
+        self.unit_mm, self.unguarded = unit_mm, unguarded
+        self.why = None if dialect == "iso" else TOOLS_UNGUARDED.get(dialect, f"{dialect} has no tool guard")
+        self.looked = 0  # blocks looked at for a Fanuc program number
+        self.checks = 0
+        if self.why is not None:
+            unguarded(self.why)
+
+    def __call__(self, events: list[Event]) -> list[str]:
+        block = events[0].block
+        if self.looked < LEADER_LINES + 12 and self.why is None:
+            self.looked += 1
+            if _FANUC_PROGRAM_NUMBER.match(block.raw):
+                self.why = TOOLS_UNGUARDED["fanuc"]
+                self.unguarded(self.why)
+        last = events[-1]
+        told = last.length_told if type(last) is Pass else None
+        if told is None or self.why is not None or not block.eol:  # (a last line: nothing runs after it)
+            return []
+        self.checks += 1
+        return [line + block.eol for line in tool_guard_lines(*told, self.unit_mm, self.checks)]
+
+
 def without_guard(blocks: Iterable[Block]) -> Iterator[Block]:
-    """The blocks without a guard near the top: from its first comment to its last."""
-    blocks = iter(blocks)
-    inside = False
-    for block in islice(blocks, SCAN):
-        said = " ".join(item.text.lower() for item in block.items if type(item) is Comment)
-        if not inside and BEGIN in said:
-            inside = True
-        if not inside:
+    """The blocks without the guards: the placement guard in the first SCAN blocks and the tool
+    guard's checks anywhere, each from its first comment to its last (within GUARD_BLOCKS: a
+    first comment without its last is no guard, and its blocks stay)."""
+    held: list[Block] = []  # the blocks of a guard under way
+    end = ""
+    for n, block in enumerate(blocks):
+        raw = block.raw
+        if not held and "ncpp" not in raw and "NCPP" not in raw:  # (most blocks: no guard's text)
             yield block
-        elif END in said:
-            inside = False
-    yield from blocks
+            continue
+        said = " ".join(item.text.lower() for item in block.items if type(item) is Comment)
+        if not held:
+            end = TOOL_END if TOOL_BEGIN in said else END if n < SCAN and BEGIN in said else ""
+            if not end:
+                yield block
+                continue
+        held.append(block)
+        if end in said:
+            held = []
+        elif len(held) >= GUARD_BLOCKS:
+            yield from held
+            held = []
+    yield from held

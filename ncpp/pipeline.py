@@ -21,7 +21,7 @@ from typing import BinaryIO
 
 from ncpp import __version__
 from ncpp.errors import Location, NcppError, Warnings
-from ncpp.guard import Placement, with_guard, without_guard
+from ncpp.guard import Placement, ToolGuard, with_guard, without_guard
 from ncpp.motion.offsets import AT_MACHINE_ZERO, WorkOffsets
 from ncpp.motion.segments import COMP, CYCLE, DRILLED, FLOW, HOLE, PATTERN, Arc, Event, Line, Pass
 from ncpp.passes import PASSES, PassContext, run_passes
@@ -346,6 +346,7 @@ def process(
     guard: Placement | None = None,
     expand_cycles: bool = False,
     expand: bool = False,
+    guard_tools: bool = False,
 ) -> Stats:
     """Read, interpret, compensate (when `source` is given) and write one program.
 
@@ -360,7 +361,8 @@ def process(
     and compared with a reading of the input of its own; where they part an
     NcppError stops the run, and what `out` took so far must be thrown away (the
     command line writes to a temporary file or a spool).  `verify=False` skips it.  `guard`: where
-    the program must find the control's work offset, checked at its start (`ncpp/guard.py`)."""
+    the program must find the control's work offset, checked at its start (`ncpp/guard.py`);
+    `guard_tools`: the tool lengths of the told tool table are checked where the program applies them."""
     warnings = warnings or Warnings(strict=strict)
     if source is None:
         stats = _copied(stream, out, dialect, progress)
@@ -401,7 +403,10 @@ def process(
     reached = _Reached()
     compensated = summary.written(run_passes(summary.programmed(events), ctx, PASSES))
     header = header_text(source, tolerance, offsets, name)
-    lines = with_header(writer.write(reached.follow(compensated)), header, writer, get_dialect(name).leader)
+    after = _tool_guard(name, offsets, warnings, file) if guard_tools else None
+    lines = with_header(
+        writer.write(reached.follow(compensated), after), header, writer, get_dialect(name).leader
+    )
     if guard is not None:
         said = guard.said()
         lines = with_guard(lines, guard, name, HEADER_TAG, header.count("\n") + 1,
@@ -422,6 +427,17 @@ def process(
         stats.summary.lines_in, stats.summary.lines_out = stats.lines_in, stats.lines_out
     warnings.finish()
     return stats
+
+
+def _tool_guard(dialect: str, offsets: WorkOffsets, warnings: Warnings, file: str) -> ToolGuard | None:
+    """The tool guard's checks where ncpp was told the tool table (`guard.ToolGuard`), else None
+    (and a warning where the dialect has none)."""
+    if offsets.tools is None:
+        return None
+    told = offsets.tools.source
+    guard = ToolGuard(dialect, offsets.unit_mm, lambda why: warnings.warn(
+        f"no tool guard: {why}; make sure the control's tool lengths are those of {told}", Location(file, 1, None)))  # fmt: skip
+    return guard if guard.why is None else None
 
 
 def _twice(blocks: Iterable[Block]) -> tuple[Iterator[Block], Iterator[Block]]:

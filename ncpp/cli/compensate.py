@@ -88,8 +88,9 @@ def add_compensation_arguments(p: argparse.ArgumentParser) -> None:
         "--no-guard",
         dest="guard",
         action="store_false",
-        help="leave out the placement guard: the block at the program's start that stops it when "
-        "the control's work offset is not the one given with --work-offset / --var-file",
+        help="leave out the guards: the block at the program's start that stops it when "
+        "the control's work offset is not the one given with --work-offset / --var-file, and the check "
+        "after each G43 that stops it when the control's tool length is not the one in --tool-table",
     )
     add_placement_arguments(p)
 
@@ -190,7 +191,7 @@ def run(args: argparse.Namespace) -> int:
             "or name a machine file in ./ncpp.toml or ~/.config/ncpp/config.toml"
         )
     job = Job(source, tolerance, args.strict, args.force, args.dialect, offsets, args.verify, guard,
-              args.expand_cycles, args.expand)  # fmt: skip
+              args.expand_cycles, args.expand, args.guard)  # fmt: skip
     folder = args.output is not None and os.path.isdir(args.output)
     if len(args.input) > 1 or folder:
         if args.output is None:
@@ -218,6 +219,7 @@ class Job:
     guard: object = None  # guard.Placement: the placement guard at the program's start (None: none)
     expand_cycles: bool = False  # canned cycles written as G0/G1 blocks
     expand: bool = False  # loops and subroutines written out as straight code
+    guard_tools: bool = False  # the told tool lengths checked where the program applies them
 
     def compensate(self, stream: BinaryIO, out: BinaryIO, name: str, progress: Progress = None):
         """`pipeline.process` of one program, with warnings of its own."""
@@ -228,7 +230,7 @@ class Job:
             tolerance=self.tolerance, strict=self.strict, force=self.force,
             warnings=Warnings(strict=self.strict), progress=progress, dialect=self.dialect,
             offsets=self.offsets, verify=self.verify, guard=self.guard,  # type: ignore[arg-type]
-            expand_cycles=self.expand_cycles, expand=self.expand,
+            expand_cycles=self.expand_cycles, expand=self.expand, guard_tools=self.guard_tools,
         )  # fmt: skip
 
 

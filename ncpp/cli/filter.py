@@ -47,7 +47,8 @@ def run(args: argparse.Namespace) -> int:
     with open_input(args.input) as (stream, name), open_output(args.output) as out:
         stats = process(stream, out, file=name, source=source, tolerance=tolerance, strict=args.strict, force=args.force,
                         warnings=warnings, progress=progress, dialect=args.dialect, offsets=offsets, verify=args.verify,
-                        guard=guard, expand_cycles=args.expand_cycles, expand=args.expand)  # fmt: skip
+                        guard=guard, expand_cycles=args.expand_cycles, expand=args.expand,
+                        guard_tools=args.guard)  # fmt: skip
     if progress is not None:
         progress.done()
     if stats.summary is not None:

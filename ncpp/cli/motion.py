@@ -62,8 +62,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def interpreted(
     stream, name: str, dialect: str | None, warnings: Warnings, offsets
 ) -> tuple[str, Iterable[Event]]:
-    """A program's dialect and its motion events as the interpreter reads it (the placement
-    guard of a compensated program left out: it moves nothing)."""
+    """A program's dialect and its motion events as the interpreter reads it (the guards of a
+    compensated program left out: they move nothing)."""
     from ncpp.guard import without_guard
     from ncpp.pipeline import dialect_tools
     from ncpp.program.dialects import parse_program

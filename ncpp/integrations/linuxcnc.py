@@ -89,7 +89,7 @@ def run(path: str, err: TextIO, machine: str | None = None) -> None:
                 with tempfile.TemporaryFile() as written:
                     stats = process(stream, written, file=path, source=source, tolerance=settings.tolerance,
                                     warnings=Warnings(stream=err), progress=progress, offsets=offsets,
-                                    guard=placement_guard(settings, offsets))  # fmt: skip
+                                    guard=placement_guard(settings, offsets), guard_tools=True)  # fmt: skip
                     summary = stats.summary
                     assert summary is not None  # (a compensating run's)
                     print(summary.line(), file=err)

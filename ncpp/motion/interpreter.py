@@ -442,6 +442,7 @@ class Interpreter:
         out: list[Event] = []
         for ev in events:
             if type(ev) is Pass:
+                ev.length_told = None  # (the text runs again, or elsewhere, perhaps with another tool)
                 if ev.setting is not None:  # set from where each run of the text stands: no one shift
                     raise _OutOfScope("G92 or G10 L20 in a loop or subroutine (it sets an offset from where "
                                       "the control stands, which compensation moves)", None)  # fmt: skip
@@ -883,8 +884,9 @@ class Interpreter:
             self._set(spindle_tool=self.selected_tool)
         if 61.0 in mcodes and "Q" in words:
             self._set(spindle_tool=self._tool_number(words["Q"], block))
+        told = None
         if 8 in gcodes:
-            self._tool_length(gcodes[8], words, block, changed=6.0 in mcodes)
+            told = self._tool_length(gcodes[8], words, block, changed=6.0 in mcodes)
         if 12 in gcodes:
             number = _COORD_SYSTEM[gcodes[12][0]]
             if number in self.untold:
@@ -916,6 +918,8 @@ class Interpreter:
         if 2.0 in mcodes or 30.0 in mcodes:
             self._program_end()
         self._update_fast()
+        if told is not None:
+            return _marked(events, block, told)
         return Pass(block) if events is None else events
 
     # -- checks (interp_check.cc, enhance_block) ----------------------------------------
@@ -1208,9 +1212,14 @@ class Interpreter:
         base, self.unmoved = self.unmoved, None
         return base
 
-    def _tool_length(self, code_item: tuple, words: dict, block: Block, changed: bool = False) -> None:
+    def _tool_length(
+        self, code_item: tuple, words: dict, block: Block, changed: bool = False
+    ) -> tuple[int, float] | None:
         """G43 [H]: the offsets of tool H (0 or none: the tool in the spindle); G43.2 H: those
         added; G43.1: the axis words; G49: none.  In program units, as the control applies them.
+        Returns the tool in the spindle and its Z offset in mm where the block applies that
+        tool's offsets from the told table (what the tool guard can check: LinuxCNC's #5400 and
+        #5403 hold the spindle tool's, whatever H says), else None.
 
         The machine stays where it is and the program position moves the other way, but in a
         block that also changes the tool (`changed`, M6) rs274 keeps the program position for
@@ -1218,6 +1227,7 @@ class Interpreter:
         (`T4 M6 G43` then `G0 X1` moves Z): `unmoved` holds it for that move (`_base`)."""
         code, item = code_item
         new = [0.0] * 9
+        told = None
         if code == 43.1:  # the axes it names; the others keep their offset (rs274ngc)
             new = self.tool[:]
             given = [
@@ -1229,6 +1239,8 @@ class Interpreter:
         elif code in (43.0, 43.2):
             number = self._tool_number(words["H"], block) if "H" in words else 0
             table = self._table_offsets(number or self.spindle_tool, words.get("H", (0, item))[1], block)
+            if self.tools is not None and self.spindle_tool and number in (0, self.spindle_tool):
+                told = (self.spindle_tool, table[2])
             scale = 1 / MM_PER_INCH if self.inch else 1.0
             new = [value * scale if i in LINEAR else value for i, value in enumerate(table)]
             if code == 43.2:
@@ -1239,6 +1251,7 @@ class Interpreter:
         if changed:
             self.unmoved = held
             self._fast = False
+        return told
 
     def _tool_number(self, word: tuple, block: Block) -> int:
         value, item = word
@@ -1854,6 +1867,17 @@ _PLAIN_LETTERS = {
     3.0: frozenset("XYZABCUVWFIJKR"),
     **{code: frozenset() for code in CANNED},  # a cycle's words are checked in full
 }
+
+
+def _marked(
+    events: Event | tuple[Event, ...] | None, block: Block, told: tuple[int, float]
+) -> Event | tuple[Event, ...]:
+    """A block's events with the tool guard's mark (`Pass.length_told`) last, where the check
+    is written after the block (the first event stays the one that says how it is written)."""
+    mark = Pass(block, length_told=told)
+    if events is None:
+        return mark
+    return (*(events if type(events) is tuple else (events,)), mark)
 
 
 def _expanding(event: Event) -> bool:

@@ -230,6 +230,9 @@ class Pass:
     # (the first of its events), `dwell` the seconds it dwells between two of them (G82 G89's P)
     cycle: float | None = None
     dwell: float | None = None
+    # a block that applies the length of the tool in the spindle from the told tool table (G43):
+    # (the tool's number, its Z offset in mm), which the tool guard checks (`ncpp/guard.py`)
+    length_told: tuple[int, float] | None = None
 
 
 Segment = Line | Arc

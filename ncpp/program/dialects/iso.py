@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import replace
 from operator import itemgetter
 
@@ -155,10 +155,16 @@ class IsoWriter:
         """An event of the runs of a control line written at once (`written_at_once`), not kept."""
 
     # -- the stream -----------------------------------------------------------
-    def write(self, events: Iterable[Event]) -> Iterator[str]:
+    def write(
+        self, events: Iterable[Event], after: Callable[[list[Event]], list[str]] | None = None
+    ) -> Iterator[str]:
+        """The written lines, block by block; `after(events)` gives lines to follow a block's
+        (of its events: the tool guard's checks, `ncpp/guard.py`)."""
         group: list[Event] = []
         block = None
         write_group = self._write_group
+        if after is not None:
+            write_group = lambda group: [*self._write_group(group), *after(group)]  # noqa: E731
         control = False  # the group is a control line's, whose writing reads only its first event
         ran = self._ran if type(self)._ran is not IsoWriter._ran else None  # (ISO's does nothing)
         for event in events:

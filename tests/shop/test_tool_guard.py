@@ -1,0 +1,201 @@
+"""The tool guard: after each G43 that applies a length of the tool table ncpp was told, a
+LinuxCNC program checks the control's tool in the spindle (#5400) and its length (#5403).
+LinuxCNC's rs274 judges it: the program runs to its end with the told table and stops at the
+check with a table whose length differs."""
+
+from __future__ import annotations
+
+import io
+import os
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+from ncpp.errors import Warnings
+from ncpp.guard import without_guard
+from ncpp.motion.offsets import WorkOffsets
+from ncpp.pipeline import ErrorSource, process
+from tests.conftest import ROOT
+from tests.shop.rs274 import linuxcnc_root
+
+MACHINE = ROOT / "samples/machines/hr5b.toml"
+G54_MM = (400.0, 350.0, 300.0)
+TOOL_BEGIN = "ncpp tool guard:"  # (the check's first comment)
+TABLE = "T1 P1 Z50 D6\nT2 P2 Z75.5 D4\n"
+PROGRAM = (
+    "G21 G90 G54\n"
+    "T1 M6\n"
+    "G43 H1\n"  # (no move: the check comes before the first)
+    "G0 X10 Y10 Z5\n"
+    "G1 Z-1 F300\n"
+    "G1 X40 Y10\n"
+    "G0 Z5\n"
+    "T2 M6 G43 Z20\n"  # (its own move runs with the length, before the check)
+    "G0 X10 Y30\n"
+    "G1 Z-2 F300\n"
+    "G1 X40\n"
+    "G0 Z20\n"
+    "M2\n"
+)
+
+
+def _compensated(
+    tmp_path: Path, program: str = PROGRAM, table: str | None = TABLE, guard: bool = True
+) -> tuple[str, list[str]]:
+    """The written program and the warnings, compensated with G54 and the tool table told."""
+    tool_table = None
+    if table is not None:
+        tool_table = tmp_path / "told.tbl"
+        tool_table.write_text(table)
+    offsets = WorkOffsets.given({"G54": G54_MM}, tool_table=tool_table)
+    said = io.StringIO()
+    out = io.BytesIO()
+    process(io.BytesIO(program.encode()), out, file="p.ngc", source=ErrorSource.from_machine_file(str(MACHINE)),
+            offsets=offsets, warnings=Warnings(stream=said), guard_tools=guard)  # fmt: skip
+    return out.getvalue().decode(), said.getvalue().splitlines()
+
+
+def _rs274(tmp_path: Path, program: Path, table: str) -> subprocess.CompletedProcess:
+    """rs274 started with G54 at the zero told and this tool table (both read raw: the check
+    compares the table's numbers, in the machine's units, with the told ones)."""
+    home = linuxcnc_root(tmp_path)
+    var_file = tmp_path / "g54.var"
+    var_file.write_text("5220\t1\n" + "".join(f"{5221 + k}\t{v}\n" for k, v in enumerate(G54_MM)))
+    tool_table = tmp_path / "control.tbl"
+    tool_table.write_text(table)
+    env = {**os.environ, "LD_LIBRARY_PATH": f"{home}/usr/lib:{home}/usr/lib/x86_64-linux-gnu"}
+    return subprocess.run(
+        [str(home / "usr/bin/rs274"), "-t", str(tool_table), "-v", str(var_file), "-g", str(program)],
+        capture_output=True,
+        text=True,
+        env=env,
+        stdin=subprocess.DEVNULL,
+        timeout=60,
+    )
+
+
+def test_rs274_runs_the_program_with_the_told_table_and_stops_at_a_length_that_differs(tmp_path):
+    (tmp_path / "p.ngc").write_text(PROGRAM)
+    (tmp_path / "told.tbl").write_text(TABLE)
+    env = {k: v for k, v in os.environ.items() if k not in ("NCPP_MACHINE", "XDG_CONFIG_HOME")}
+    command = [
+        "compensate",
+        "--machine",
+        str(MACHINE),
+        "--work-offset",
+        "400,350,300",
+        "--tool-table",
+        "told.tbl",
+    ]
+    proc = subprocess.run([sys.executable, "-m", "ncpp", *command, "p.ngc", "-o", "out.ngc"], capture_output=True,
+                          text=True, cwd=tmp_path, env={**env, "PYTHONPATH": str(ROOT), "HOME": str(tmp_path)})  # fmt: skip
+    assert proc.returncode == 0, proc.stderr  # (verified)
+    program = tmp_path / "out.ngc"
+    written = program.read_text()
+    ran = _rs274(tmp_path, program, TABLE)
+    assert ran.returncode == 0 and "PROGRAM_END" in ran.stdout, ran.stderr
+    assert ran.stdout.count("STRAIGHT_FEED") >= 6
+    within = _rs274(tmp_path, program, "T1 P1 Z50.05 D6\nT2 P2 Z75.45 D4\n")  # within 0.1 mm
+    assert within.returncode == 0 and "PROGRAM_END" in within.stdout, within.stderr
+
+    second = _rs274(tmp_path, program, "T1 P1 Z50 D6\nT2 P2 Z75.7 D4\n")
+    assert second.returncode != 0 and "PROGRAM_END" not in second.stdout
+    assert "compensated for tool 2 at length Z75.5 mm" in second.stderr, second.stderr
+    assert "the control has tool 2.000000 at Z75.700000" in second.stderr  # (rs274 says #5400 and #5403)
+    before, after = second.stdout.split("CHANGE_TOOL(2)")
+    assert before.count("STRAIGHT_FEED") >= 3  # tool 1's cuts ran; after tool 2's G43 block's own move,
+    assert after.count("STRAIGHT_TRAVERSE") == 1 and "STRAIGHT_FEED" not in after  # none
+
+    # `ncpp motion` reads the guarded program's moves as rs274 runs them (rs274 reads the
+    # tables in inches, and prints program coordinates: the tool length's shift shows)
+    from tests.shop.rs274 import end_points
+
+    told = WorkOffsets.given({}, tmp_path / "g54.var", 25.4, tmp_path / "told.tbl")
+    read, run = _moves(written, told), end_points(ran.stdout)
+    assert len(read) == len(run) and max(abs(a - b) for m, r in zip(read, run) for a, b in zip(m, r)) < 1e-4
+
+    first = _rs274(tmp_path, program, "T1 P1 Z49.8 D6\nT2 P2 Z75.5 D4\n")
+    assert first.returncode != 0 and "compensated for tool 1 at length Z50 mm" in first.stderr, first.stderr
+    assert "STRAIGHT_TRAVERSE" not in first.stdout and "STRAIGHT_FEED" not in first.stdout
+
+
+def test_the_check_follows_the_g43_block_and_names_the_tool_and_length_told(tmp_path):
+    written, warned = _compensated(tmp_path)
+    lines = written.splitlines()
+    k = lines.index("G43 H1")
+    assert lines[k + 1] == f"({TOOL_BEGIN} tool 1 at length Z50 mm within 0.1 mm)"
+    assert lines[k + 2] == "o<ncpp_tool_guard_1> if [[#5400 NE 1] OR [ABS[#5403 - 50] GT 0.1]]"
+    assert lines[k + 3].startswith("(abort, ncpp: compensated for tool 1 at length Z50 mm;")
+    assert lines[k + 4:k + 6] == ["o<ncpp_tool_guard_1> endif", "(ncpp tool guard end)"]  # fmt: skip
+    assert lines[k + 6].startswith("G0 X10.0")
+    k = next(n for n, line in enumerate(lines) if line.startswith("T2 M6 G43 Z20"))
+    assert lines[k + 2] == "o<ncpp_tool_guard_2> if [[#5400 NE 2] OR [ABS[#5403 - 75.5] GT 0.1]]"
+    assert written.count(TOOL_BEGIN) == 2 and not warned
+
+
+def _moves(text: str, offsets: WorkOffsets) -> list[tuple[float, ...]]:
+    """The end points of the moves `ncpp motion` reads from a program."""
+    from ncpp.cli.motion import interpreted
+    from ncpp.motion.segments import Line
+
+    _, events = interpreted(io.BytesIO(text.encode()), "p.ngc", None, Warnings(), offsets)
+    return [event.end for event in events if type(event) is Line]
+
+
+def test_ncpp_motion_reads_the_written_program_as_if_the_checks_were_not_there(tmp_path):
+    """The verifier passed it (`process` verifies it against the input), and the motion command
+    reads the same moves from it as from its text with the checks cut out."""
+    written, _ = _compensated(tmp_path)
+    offsets = WorkOffsets.given({"G54": G54_MM}, tool_table=tmp_path / "told.tbl")
+    cut = re.sub(r"\(ncpp tool guard:.*?\(ncpp tool guard end\)\n", "", written, flags=re.S)
+    assert cut.count("\n") == written.count("\n") - 10
+    read = _moves(written, offsets)
+    assert read == _moves(cut, offsets) and len(read) > len(_moves(PROGRAM, offsets))
+
+
+def test_no_check_with_no_guard_without_a_table_or_for_another_tools_length(tmp_path):
+    assert "tool guard" not in _compensated(tmp_path, guard=False)[0]
+    assert "tool guard" not in _compensated(tmp_path, table=None)[0]
+    # G43 H2 with tool 1 in the spindle: #5403 holds tool 1's length, not the one applied
+    other = PROGRAM.replace("G43 H1", "G43 H2")
+    written = _compensated(tmp_path, other)[0]
+    assert written.count(TOOL_BEGIN) == 1 and "tool 2 at length" in written
+
+
+def test_an_inch_machines_check_compares_the_tables_inches():
+    """LinuxCNC's #5403 holds the table's number, in the machine's units (rs274 shows it)."""
+    from ncpp.guard import tool_guard_lines
+
+    lines = tool_guard_lines(3, 50.8, 25.4, 7)
+    assert lines[0] == f"({TOOL_BEGIN} tool 3 at length Z2 inch within 0.1 mm)"
+    assert lines[1] == "o<ncpp_tool_guard_7> if [[#5400 NE 3] OR [ABS[#5403 - 2] GT 0.0039]]"
+
+
+def test_a_fanuc_program_gets_no_check_and_a_warning_why(tmp_path):
+    fanuc = "%\nO1234\n" + PROGRAM.replace("M2\n", "M30\n%\n")
+    written, warned = _compensated(tmp_path, fanuc)
+    assert "tool guard" not in written
+    assert any("no tool guard: Fanuc's tool offset variables" in line for line in warned), warned
+
+
+def test_a_guard_without_its_last_comment_is_no_guard():
+    """A first comment alone (its check cut away by hand) leaves the program's blocks in place."""
+    from ncpp.program.dialects import parse_program
+
+    text = f"G0 X1\n({TOOL_BEGIN} tool 1 at length Z50 mm within 0.1 mm)\n" + "".join(
+        f"G1 X{n} F100\n" for n in range(2, 20)
+    )
+    blocks = list(without_guard(parse_program(io.BytesIO(text.encode()), "p.ngc", "iso")[1]))
+    assert len(blocks) == 20
+    guarded = text.replace("G1 X5 ", "(ncpp tool guard end)\nG1 X5 ")
+    kept = [b.raw for b in without_guard(parse_program(io.BytesIO(guarded.encode()), "p.ngc", "iso")[1])]
+    assert kept[:2] == ["G0 X1", "G1 X5 F100"] and len(kept) == 16
+
+
+def test_a_g43_in_a_loop_gets_no_check(tmp_path):
+    """A loop's text runs again, perhaps with another tool: no check is written inside it."""
+    loop = "o100 repeat [2]\nT1 M6 G43\nG0 X5\no100 endrepeat\n"
+    program = PROGRAM.replace("T1 M6\nG43 H1\n", loop + "T1 M6\nG43 H1\n")
+    written = _compensated(tmp_path, program)[0]
+    assert written.count(TOOL_BEGIN) == 2 and written.index("o100 endrepeat") < written.index(TOOL_BEGIN)
