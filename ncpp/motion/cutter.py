@@ -47,10 +47,11 @@ def centre_offset(move: Line | Arc, side: float, standing: Point) -> Point:
 
 
 def followed(moves: list[Line | Arc]) -> bool:
-    """Whether compensation follows a block's moves under cutter compensation: in G17 and G18 (in
-    G90 or G91: the moves' points are absolute here), and none of them left as programmed for
-    another reason (a loop's, a cycle's)."""
-    return all(not m.fixed and m.context.plane in (17, 18) for m in moves)
+    """Whether compensation follows a block's moves under cutter compensation: in a principal plane
+    (G17, G18, G19; in G90 or G91, absolute or incremental words: the moves' points are absolute
+    here, and the writers write an increment from the corrected end before it), and none of them
+    left as programmed for another reason (a loop's, a cycle's)."""
+    return all(not m.fixed and m.context.plane in PLANE_AXES for m in moves)
 
 
 @dataclass
@@ -80,7 +81,7 @@ class ToolCentre:
             for move, shift in zip(moves, shifts):
                 move.centre_shift = shift
             self.off_path = side is not None
-            self.corrected = corrected or any(m.start[:2] != m.end[:2] for m in moves)
+            self.corrected = corrected or any(_moves_in_plane(m) for m in moves)
         else:  # (a loop's or a cycle's moves too: that the tool is off the path matters more)
             self.off_path = mark_off_path(moves, side is not None, self.off_path)
             self.corrected = False
@@ -94,8 +95,14 @@ class ToolCentre:
 
     def scale(self, factor: float) -> None:
         """The program units changed."""
-        self.at = (self.at[0] * factor, self.at[1] * factor, 0.0)
+        self.at = (self.at[0] * factor, self.at[1] * factor, self.at[2] * factor)
 
     def reset(self) -> None:
         """Compensation is off and the tool on the path (a program end)."""
         self.off_path, self.at, self.corrected = False, ON_PATH, True
+
+
+def _moves_in_plane(move: Line | Arc) -> bool:
+    """Whether the move moves an axis of its plane (a line along the normal alone does not)."""
+    a, b, _ = PLANE_AXES[move.context.plane]
+    return move.start[a] != move.end[a] or move.start[b] != move.end[b]

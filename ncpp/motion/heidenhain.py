@@ -87,7 +87,6 @@ DATUM_CYCLES = frozenset(("7", "8", "10", "11", "19", "26"))
 PRESET_CYCLE = "247"
 END_M = frozenset((2.0, 30.0))
 SIDES = {"RL": 1, "RR": -1, "R0": 0}  # radius compensation's side of the contour (0: off)
-INCREMENTAL = frozenset(("IX", "IY", "IZ"))  # (moves under RL/RR with them are left as programmed)
 HARMLESS_KEYWORDS = frozenset(("STOP",))
 # Resets of what this interpreter never follows (a tilted plane, TCPM: it stops at any that sets
 # one), which move no axis: `PLANE RESET STAY` keeps the rotary axes where they are (TNC 640
@@ -447,10 +446,7 @@ class HeidenhainInterpreter(ModalInterpreter):
                 raise OutOfScope(f"M140 and the cycle call {call[0]} in one block", call[1])
             events.append(self._retract(block, retract))
         if comp is not None or self.radius_comp or self.centre.off_path:
-            incremental = any(
-                isinstance(i, (Word, ExprWord)) and i.letter in INCREMENTAL for i in block.items
-            )
-            events = self.radius_compensation(events, None if comp is None else SIDES[comp], not incremental)
+            events = self.radius_compensation(events, None if comp is None else SIDES[comp])
         if call is not None:
             events = events + self._call_cycle(block, *call)
         if events and isinstance(events[-1], (Line, Arc)):

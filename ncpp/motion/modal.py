@@ -158,12 +158,7 @@ class ModalInterpreter:
             return events
         side = self.comp_side if self.radius_comp else None
         ends = side is None or not self.centre.off_path  # (the exit, or the entry move)
-        in_scope = all(
-            m.context.plane == 17 and m.context.absolute for m in moves
-        )  # (G18, G19, G91: not yet)
-        self.centre.follow(
-            moves, side, also and in_scope and not self.again and not (ends and type(moves[0]) is Arc)
-        )
+        self.centre.follow(moves, side, also and not self.again and not (ends and type(moves[0]) is Arc))
         return events
 
     def _turned(self, turn: int) -> bool:
