@@ -6,10 +6,10 @@ The control joins the offset moves at their corners (a transition arc about the 
 outside corner, the crossing of the offset paths at an inside one: TNC 640 user's manual,
 "Radius compensation: Machining corners"; 840D sl Programming Manual Fundamentals, "Corner
 behavior: G450, G451"; LinuxCNC's interpreter likewise), so at a move's end the tool centre
-stands square to the move's own direction there, by the radius (in G17, and in ISO programs G18
-too).  ncpp evaluates the machine's
-error where the tool centre stands (`Line.centre_shift`); `ToolCentre` follows it move by move,
-for the ISO interpreter and for `ModalInterpreter` alike.
+stands square to the move's own direction there, by the radius, in the working plane (G17, G18,
+and in Klartext and Sinumerik G19 too: LinuxCNC refuses compensation there).  ncpp evaluates the
+machine's error where the tool centre stands (`Line.centre_shift`); `ToolCentre` follows it move
+by move, for the ISO interpreter and for `ModalInterpreter` alike.
 """
 
 from __future__ import annotations
@@ -26,9 +26,14 @@ def centre_offset(move: Line | Arc, side: float, standing: Point) -> Point:
     """The tool centre minus the programmed point at the end of `move` under compensation:
     `side` the radius, positive to the left of the move's direction there (G41, RL), negative
     to the right (0: not compensating, or the radius is unknown: on the path).  Left as seen
-    from the plane's normal (+Z in G17, +Y in G18): in the plane's own (u, v) axes, X Y or Z X,
-    as LinuxCNC's manual (G41, G42) and rs274ngc's ARC_FEED have them.  A move with no motion
-    in the plane keeps the tool centre where it stands (`standing`)."""
+    from the plane's normal (+Z in G17, +Y in G18, +X in G19): in the plane's own (u, v) axes,
+    X Y, Z X or Y Z, as LinuxCNC's manual (G41, G42) and rs274ngc's ARC_FEED have them, as the
+    TNC's working plane has them for the tool axis Z, Y or X (its principal and minor axis: TNC
+    640 user's manual, "Designation of the axes on milling machines"; left "based on the
+    direction of tool movement along the workpiece contour", "Radius compensation") and as the
+    840D sl's G17 G18 G19 have their abscissa and ordinate (Programming Manual Fundamentals,
+    "Selection of the working plane"; G41 left of the contour in the direction of travel).  A
+    move with no motion in the plane keeps the tool centre where it stands (`standing`)."""
     if not side:
         return ON_PATH
     a, b, _ = PLANE_AXES[move.context.plane]

@@ -139,9 +139,10 @@ class ModalInterpreter:
         the right (-1: G42, RR), off (0: G40, R0) or neither (None).  The control offsets the
         path by the tool radius (`tool_radius`): the moves from the first with it on to the
         first after it is off (which ends on its programmed point) stay the programmed contour,
-        as the control's positions do, and carry where the tool centre stands (`ToolCentre`).
-        Left as programmed (COMP) where ncpp does not follow them: outside G17, in G91, in a block
-        that runs again (`again`), incremental words (the dialect's `also` False), an entry or
+        as the control's positions do, and carry where the tool centre stands (`ToolCentre`), in
+        any working plane, their words absolute or incremental (the writers write an increment
+        from the corrected end before it).  Left as programmed (COMP) where ncpp does not follow
+        them: in a block that runs again (`again`), where the dialect's `also` is False, an entry or
         exit move that is an arc (the TNC refuses RL/RR in an arc block: TNC 640 user's manual,
         "Radius compensation"; the Sinumerik approaches and leaves the contour on a line with
         NORM: 840D sl Programming Manual Fundamentals, "Contour approach and retraction"), and a

@@ -21,9 +21,10 @@ coordinates (AP=, RP=),
 arcs by opening angle (AR=) and unknown G codes make the position unknown: one warning (an error with `strict`) and the
 rest passes through.  Under cutter compensation (G41/G42 to the first move after
 G40) the moves are the programmed contour, the tool centre off it by the edge's radius
-($TC_DP6 + $TC_DP15 in `_N_TO_INI`): in G17 and G90 they carry where the tool centre
-stands (`centre_shift`, `ModalInterpreter.radius_compensation`), else (G18, G19, G91, an
-entry or exit arc) they are marked `fixed`; M6 or D under it is out of scope.
+($TC_DP6 + $TC_DP15 in `_N_TO_INI`): in G17, G18 and G19 (left and right as seen from the
+positive applicate), in G90 or G91 and with AC()/IC() words, they carry where the tool centre
+stands (`centre_shift`, `ModalInterpreter.radius_compensation`), else (an entry or exit arc)
+they are marked `fixed`; M6 or D under it is out of scope.
 """
 
 from __future__ import annotations
