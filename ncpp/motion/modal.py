@@ -113,6 +113,20 @@ class ModalInterpreter:
                 continue
             yield from events or (Pass(block),)
 
+    def approached(self, events: Iterable[Event]) -> Iterator[Event]:
+        """`events` with those from a compensated entry move on held while its tool centre waits for
+        the next move in the plane (`ToolCentre.approach`): a move is passed on once it is told."""
+        held: list[Event] = []
+        for event in events:
+            if held or self.centre.waiting:
+                held.append(event)
+                if not self.centre.waiting:
+                    yield from held
+                    held = []
+            else:
+                yield event
+        yield from held
+
     def leave_scope(
         self, warnings: Warnings, reason: str, block: Block, col: int | None, owner: Block | None = None
     ) -> None:
@@ -121,6 +135,7 @@ class ModalInterpreter:
         rest passes.  In a called file, the warning stands at the calling line of the program (where
         the program passes through from) and names the place in that file."""
         self.done = True
+        self.centre.waiting = []  # (an entry move waiting keeps its tool centre square to it)
         where = "this line" if owner is None else f"line {owner.line}, which runs it,"
         place = Location(self.file, block.line, col)
         if self.file != self.program_file and owner is not None:

@@ -33,6 +33,7 @@ import pytest
 
 from ncpp.cli import main
 from ncpp.errors import Warnings
+from ncpp.motion.offsets import WorkOffsets
 from ncpp.motion.segments import PLANE_AXES, Arc, Line
 from ncpp.motion.tools import ToolTable
 from ncpp.pipeline import dialect_tools
@@ -144,7 +145,12 @@ TO_INI = '$TC_TP2[1]="D8"\n$TC_DP1[1,1]=120\n$TC_DP3[1,1]=0.0\n$TC_DP6[1,1]=3.9\
 
 
 def offset(
-    contour: list, side: float, start=(-20.0, 0.0), transitions: bool = False, depth: float = 0.0
+    contour: list,
+    side: float,
+    start=(-20.0, 0.0),
+    transitions: bool = False,
+    depth: float = 0.0,
+    norm: bool = False,
 ) -> list[Move]:
     """The tool centre's path for a contour (entry move first, exit move last) under compensation:
     `side` the radius, positive to the left of the direction of travel.  Each move under it offset
@@ -152,8 +158,9 @@ def offset(
     of a counter-clockwise arc), two lines that cross (an inside corner) cut where they cross, and
     with `transitions` an arc of the radius about the corner between two offset moves that do not
     meet (an outside corner); the entry starts at its programmed start, the exit ends on its
-    programmed end.  Points in the plane's (u, v) axes, with the coordinate along its normal third
-    (`depth` where a point has none)."""
+    programmed end; with `norm` (Sinumerik's NORM) the entry ends square to the next move at its
+    start instead of to its own direction.  Points in the plane's (u, v) axes, with the coordinate
+    along its normal third (`depth` where a point has none)."""
     moves: list[Move] = []
     at3 = _point(start, depth)
     corners = []  # the programmed point between each move and the next
@@ -164,6 +171,7 @@ def offset(
             d = (end - at) / np.linalg.norm(end - at)
             normal = side * np.array([-d[1], d[0]])
             if k == 0:  # the entry move: from its programmed start
+                normal = _normal_at_start(end, contour[1], side) if norm else normal
                 moves.append(_move(at, end + normal, at3[2], end3[2]))
             elif k == len(contour) - 1:  # the exit move: to its programmed end, from where the tool stands
                 moves.append(_move(moves[-1].end, end, moves[-1].end[2], end3[2]))
@@ -178,6 +186,17 @@ def offset(
         corners.append(end)
         at3 = end3
     return _joined(moves, corners, transitions)
+
+
+def _normal_at_start(at: np.ndarray, move: tuple, side: float) -> np.ndarray:
+    """The tool centre minus the programmed point at the start `at` of a contour's `move` (a line:
+    square to it; an arc: along its radius, towards its centre on the left of a counter-clockwise one)."""
+    end, centre, turn = move
+    if centre is None:
+        d = (np.array(end[:2], dtype=float) - at) / np.linalg.norm(np.array(end[:2], dtype=float) - at)
+        return side * np.array([-d[1], d[0]])
+    inward = (np.array(centre, dtype=float) - at) / np.linalg.norm(np.array(centre, dtype=float) - at)
+    return side * inward if turn > 0 else -side * inward
 
 
 def _point(p, depth: float) -> np.ndarray:
@@ -427,6 +446,19 @@ KLARTEXT_ZX = in_plane(KLARTEXT_TOOL_DEF, 18)
 KLARTEXT_YZ = in_plane(KLARTEXT_INCREMENTAL, 19)
 
 
+# Sinumerik's approach (NORM, the control's initial setting: the entry ends square to the next
+# element at its start, not to itself): the outline entered from inside the part, behind its first
+# edge, and from below onto its first arc; with KONT so from below (in front of the contour), and
+# from inside (behind it: the entry ends square to itself and the control goes round the corner)
+SINUMERIK_BEHIND = SINUMERIK.replace("N30 G0 X-20 Y0 Z5", "N30 G0 X0 Y20 Z5")
+OUTLINE_FROM_ARC = [*OUTLINE[1:-1], ((60, 0), None, 0), ((60, -20), None, 0)]
+SINUMERIK_ARC_FIRST = (
+    SINUMERIK.replace("N30 G0 X-20 Y0 Z5", "N30 G0 X80 Y-20 Z5")
+    .replace("N50 G42 G1 X0 Y0\nN60 X80\n", "N50 G42 G1 X80 Y0\n")
+    .replace("N130 G40 X-20 Y-20", "N125 X60\nN130 G40 X60 Y-20")
+)
+
+
 class Case(NamedTuple):
     text: str
     name: str
@@ -437,6 +469,8 @@ class Case(NamedTuple):
     read: Callable = klartext_contour
     plane: int = 17
     machine_text: str = AFFINE
+    start: tuple = (-20.0, 0.0)  # where the entry starts
+    norm: bool = False  # the entry ends square to the next move (Sinumerik's NORM, and KONT in front)
 
 
 CASES = {
@@ -455,6 +489,15 @@ CASES = {
                           18, affine_in(18)),
     "sinumerik-g19-g91": Case(SINUMERIK_YZ, "OUTLINE.MPF", OUTLINE, -4.0, "_N_TO_INI", TO_INI,
                               sinumerik_contour, 19, affine_in(19)),
+    "sinumerik-norm-from-behind": Case(SINUMERIK_BEHIND, "OUTLINE.MPF", OUTLINE, -4.0, "_N_TO_INI", TO_INI,
+                                       sinumerik_contour, start=(0.0, 20.0), norm=True),
+    "sinumerik-norm-onto-an-arc": Case(SINUMERIK_ARC_FIRST, "OUTLINE.MPF", OUTLINE_FROM_ARC, -4.0, "_N_TO_INI",
+                                       TO_INI, sinumerik_contour, start=(80.0, -20.0), norm=True),
+    "sinumerik-kont-in-front": Case(SINUMERIK_ARC_FIRST.replace("N40", "N35 KONT\nN40"), "OUTLINE.MPF",
+                                    OUTLINE_FROM_ARC, -4.0, "_N_TO_INI", TO_INI, sinumerik_contour,
+                                    start=(80.0, -20.0), norm=True),
+    "sinumerik-kont-behind": Case(SINUMERIK_BEHIND.replace("N40", "N35 KONT\nN40"), "OUTLINE.MPF", OUTLINE,
+                                  -4.0, "_N_TO_INI", TO_INI, sinumerik_contour, start=(0.0, 20.0)),
 }  # fmt: skip
 DEPTH = -1.0  # (the contours' programs cut at Z-1, or Y-1, X-1)
 
@@ -472,19 +515,22 @@ def test_the_tool_centre_lands_on_the_offset_contour_within_half_a_micron(tmp_pa
         options = ("--tool-table", str(tmp_path / case.table))
     reached = closed_form if case.machine_text is AFFINE else closed_form_in(case.plane)
     on = functools.partial(machine, plane=case.plane, reached=reached)
-    wanted = offset(case.contour, case.side, transitions=True, depth=DEPTH)
+    wanted = offset(case.contour, case.side, case.start, transitions=True, depth=DEPTH, norm=case.norm)
     assert deviation(wanted, wanted, on).max() > 0.010
     written, messages = compensated(tmp_path, case.name, case.text, *options, machine_text=case.machine_text)
     moves, start = case.read(written, case.plane)
     assert len(moves) >= len(case.contour)  # (arcs may come in pieces)
-    made = offset(moves, case.side, start)
+    made = offset(moves, case.side, start, norm=case.norm)
     assert deviation(wanted, made, on).max() <= 0.0005
     assert "left as programmed: nothing" in messages, messages
-    assert np.allclose(made[-1].end[:2], [-20, -20], atol=0.1)  # (the exit move: the section is whole)
+    assert np.allclose(
+        made[-1].end[:2], case.contour[-1][0], atol=0.1
+    )  # (the exit move: the section is whole)
 
 
 NEW = ("klartext-incremental", "klartext-tool-axis-y", "klartext-tool-axis-x-incremental", "sinumerik-g91",
-       "sinumerik-ic", "sinumerik-g18", "sinumerik-g19-g91")  # fmt: skip
+       "sinumerik-ic", "sinumerik-g18", "sinumerik-g19-g91", "sinumerik-norm-from-behind",
+       "sinumerik-norm-onto-an-arc", "sinumerik-kont-in-front", "sinumerik-kont-behind")  # fmt: skip
 
 
 @pytest.mark.skipif(not WIDE.exists(), reason="the shared machine file is not available")
@@ -499,6 +545,33 @@ def test_the_verifier_accepts_each_program_written_for_the_shared_machine(tmp_pa
         options = ("--tool-table", str(tmp_path / case.table))
     written, messages = compensated(tmp_path, case.name, case.text, *options, machine_text=WIDE.read_text())
     assert "left as programmed: nothing" in messages and written != case.text, messages
+
+
+def test_an_entry_waits_for_the_next_move_in_the_plane_past_an_infeed(tmp_path):
+    """NORM: the entry's tool centre is square to the first move in the plane, past a block that
+    moves along Z alone (the control looks ahead to it), which stands there too; the events come
+    in the program's order."""
+    text = SINUMERIK_ARC_FIRST.replace("N50 G42 G1 X80 Y0\n", "N50 G42 G1 X80 Y0\nN55 Z-2\n")
+    (tmp_path / "_N_TO_INI").write_text(TO_INI)
+    offsets = WorkOffsets(tools=ToolTable.from_file(tmp_path / "_N_TO_INI"))
+    dialect, blocks = parse_program(io.BytesIO(text.encode()), "OUTLINE.MPF", None)
+    interpret, _ = dialect_tools(dialect)
+    events = list(
+        interpret(blocks, file="OUTLINE.MPF", warnings=Warnings(stream=io.StringIO()), offsets=offsets)
+    )
+    assert [e.block.line for e in events] == sorted(e.block.line for e in events)
+    entry, infeed, arc = [e for e in events if type(e) is Line or type(e) is Arc][2:5]
+    square = pytest.approx((0.0, -4.0, 0.0))  # (G42, radius 4: outside the arc about (80, 20))
+    assert entry.centre_shift == (None, square) and infeed.centre_shift == (square, square)
+    assert arc.centre_shift[0] == square
+
+
+def test_kontc_and_kontt_are_out_of_scope(tmp_path):
+    """KONTC and KONTT approach on the control's own polynomials: the rest passes through."""
+    (tmp_path / "_N_TO_INI").write_text(TO_INI)
+    text = SINUMERIK.replace("N40", "N35 KONTC\nN40")
+    _, messages = compensated(tmp_path, "OUTLINE.MPF", text, "--tool-table", str(tmp_path / "_N_TO_INI"))
+    assert "OUTLINE.MPF:5:5: warning: the approach KONTC (the control's polynomial" in messages, messages
 
 
 def test_the_compensation_words_stay_on_their_blocks(tmp_path):
