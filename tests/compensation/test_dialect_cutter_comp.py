@@ -566,6 +566,24 @@ def test_an_entry_waits_for_the_next_move_in_the_plane_past_an_infeed(tmp_path):
     assert arc.centre_shift[0] == square
 
 
+def test_a_change_of_units_keeps_where_the_tool_centre_stands_in_every_axis(tmp_path):
+    """G70 under G42 in G18: the tool centre stands off along Z after a move along X, and stays there
+    in the new units."""
+    text = (
+        "N10 G18 G90 G71\nN20 T1 M6\nN30 G0 Z-20 X0 Y5\nN40 G1 Y-1 F300\nN50 G42 G1 Z0 X0\nN60 X80\nN70 G70\n"
+    )
+    text += "N80 Z1\nN90 G40 Z2 X4\nN100 M30\n"
+    (tmp_path / "_N_TO_INI").write_text(TO_INI)
+    offsets = WorkOffsets(tools=ToolTable.from_file(tmp_path / "_N_TO_INI"))
+    dialect, blocks = parse_program(io.BytesIO(text.encode()), "T.MPF", None)
+    interpret, _ = dialect_tools(dialect)
+    moves = [e for e in interpret(blocks, file="T.MPF", warnings=Warnings(stream=io.StringIO()), offsets=offsets)
+             if type(e) is Line]  # fmt: skip
+    along_x, in_inch = moves[3], moves[4]
+    assert along_x.centre_shift[1] == pytest.approx((0.0, 0.0, 4.0))  # (right of +X in Z X: +Z)
+    assert in_inch.centre_shift[0] == pytest.approx((0.0, 0.0, 4.0 / 25.4))
+
+
 def test_kontc_and_kontt_are_out_of_scope(tmp_path):
     """KONTC and KONTT approach on the control's own polynomials: the rest passes through."""
     (tmp_path / "_N_TO_INI").write_text(TO_INI)
