@@ -351,12 +351,12 @@ ZERO = np.array([200.0, 150.0, 0.0])
 
 def affine_in(plane: int) -> str:
     """AFFINE's errors in `plane`'s (u, v) axes (`PLANE_AXES`: G18 Z X, G19 Y Z): u runs 100 µm/m long
-    and v 80 µm/m short, v moves u by -100 µm/m of v, and the normal axis runs 50 µm/m long, so the
-    depth is corrected too.  (The normal axis's error does not change along the plane: where it does,
-    at an inside corner between two lines the depth is corrected for the tool centre's point square
-    to the first line, not for the lines' crossing: docs/guide.md "Under cutter compensation".)"""
+    and v 80 µm/m short, v moves u by -100 µm/m of v; and the normal axis runs 50 µm/m long, u moves it
+    by 120 µm/m of u and v by -100 µm/m of v, so the depth is corrected too, differently along the
+    contour (at an inside corner where the tool centre stands at the crossing of the offset lines)."""
     u, v, n = (AXES[k] for k in PLANE_AXES[plane])
-    errors = {f"E{u}{u}": 0.1, f"E{v}{v}": -0.08, f"E{u}{v}": -0.1, f"E{n}{n}": 0.05}
+    errors = {f"E{u}{u}": 0.1, f"E{v}{v}": -0.08, f"E{u}{v}": -0.1, f"E{n}{n}": 0.05, f"E{n}{u}": 0.12,
+              f"E{n}{v}": -0.1}  # fmt: skip
     return AFFINE.split("[errors.")[0] + "".join(
         f'[errors.{name}]\nkind = "polynomial"\ncoefficients_um = [0.0, {value}]\n\n'
         for name, value in errors.items()
@@ -370,7 +370,9 @@ def closed_form_in(plane: int) -> Callable[[np.ndarray], np.ndarray]:
     def reached(command: np.ndarray) -> np.ndarray:
         u, v, w = command[:, axes].T
         out = command.copy()
-        out[:, axes] = np.stack([u + 1e-4 * u - 1e-4 * v, v - 0.8e-4 * v, w + 0.5e-4 * w], axis=1)
+        out[:, axes] = np.stack(
+            [u + 1e-4 * u - 1e-4 * v, v - 0.8e-4 * v, w + 0.5e-4 * w + 1.2e-4 * u - 1e-4 * v], axis=1
+        )
         return out
 
     return reached
