@@ -491,6 +491,8 @@ CASES = {
                           18, affine_in(18)),
     "sinumerik-g19-g91": Case(SINUMERIK_YZ, "OUTLINE.MPF", OUTLINE, -4.0, "_N_TO_INI", TO_INI,
                               sinumerik_contour, 19, affine_in(19)),
+    "klartext-depth-at-an-inside-corner": Case(KLARTEXT_TOOL_DEF, "rect.h", RECTANGLE, 5.0,
+                                               machine_text=affine_in(17)),
     "sinumerik-norm-from-behind": Case(SINUMERIK_BEHIND, "OUTLINE.MPF", OUTLINE, -4.0, "_N_TO_INI", TO_INI,
                                        sinumerik_contour, start=(0.0, 20.0), norm=True),
     "sinumerik-norm-onto-an-arc": Case(SINUMERIK_ARC_FIRST, "OUTLINE.MPF", OUTLINE_FROM_ARC, -4.0, "_N_TO_INI",
