@@ -135,8 +135,9 @@ class ToolCentre:
         for move in standing:
             move.centre_shift = (at, at)
         if shifted:
-            end = moves[first].centre_shift[1]  # type: ignore[index]  # (given by `follow`)
-            moves[first].centre_shift = (at, end)
+            given = moves[first].centre_shift
+            assert given is not None  # (by `follow`)
+            moves[first].centre_shift = (at, given[1])
         else:
             self.at = at
 

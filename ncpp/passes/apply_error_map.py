@@ -371,27 +371,24 @@ def _corners(
         return
     gap = np.stack(in_plane(crossing(k) - out_end[k - 1], axes)[:2], axis=1)
     along = (gap[:, 1] * d2[:, 0] - gap[:, 0] * d2[:, 1]) / across  # (gap · n2) / (d1 · n2)
-    _depth_at_crossing(rows, out_end, crossing, k, d1, d2, across)
+    _depth_at_crossing(rows, out_end, crossing, k, (d1, d2, across, axes))
     out_end[k - 1] += from_plane(along * d1[:, 0], along * d1[:, 1], np.zeros(len(k)), axes)
     if step is not None:
         out_end[k - 1] = quantize(out_end[k - 1], step[k - 1])
 
 
 def _depth_at_crossing(
-    rows: _Rows,
-    out_end: NDArray,
-    crossing: Callable[[NDArray], NDArray],
-    k: NDArray,
-    d1: NDArray,
-    d2: NDArray,
-    across: NDArray,
+    rows: _Rows, out_end: NDArray, crossing: Callable[[NDArray], NDArray], k: NDArray, turns: tuple
 ) -> None:
     """At an inside corner the control stops the tool centre where the two offset lines cross, `a`
     along the first line from where it stands square to its end (`_Rows.shift`): the corner's
     coordinate along the plane's normal is corrected for the tool centre there, the first line's
-    correction changing along it as from its start to its end (`crossing` of its start)."""
-    axes, first = rows.axes[k], k - 1  # type: ignore[index]  # (under compensation: `_corners`)
-    gap = np.stack(in_plane(rows.shift[k] - rows.shift[first], axes)[:2], axis=1)  # type: ignore[index]
+    correction changing along it as from its start to its end (`crossing` of its start).  `turns`:
+    `_corners`' (d1, d2, across, axes) of the corners `k`."""
+    d1, d2, across, axes = turns
+    assert rows.shift is not None  # (under compensation: `_corners`)
+    first = k - 1
+    gap = np.stack(in_plane(rows.shift[k] - rows.shift[first], axes)[:2], axis=1)
     a = (gap[:, 1] * d2[:, 0] - gap[:, 0] * d2[:, 1]) / across  # (gap × d2) / (d1 × d2)
     inside = a < 0.0
     if not inside.any():

@@ -3,8 +3,12 @@ compensated where the tool centre stands, judged in closed form: the test offset
 contour by the tool radius itself (a line moves square to its direction, an arc's radius grows or
 shrinks by it) for the tool-centre path the drawing wants, and offsets the rewritten program's
 contour the same way for the path the control makes of it; a machine whose errors are linear in
-position (`AFFINE`, `closed_form`) must put the second on the first within 0.5 µm, where the
-original program misses it by more than 10 µm.
+position (`AFFINE`, `closed_form`; `affine_in`, `closed_form_in` for the other working planes and
+a depth error that changes along the plane) must put the second on the first within 0.5 µm, where
+the original program misses it by more than 10 µm.  Each contour is also written in the Z X and
+Y Z planes (`in_plane`: Klartext's tool axis Y and X, Sinumerik's G18 and G19, left and right as
+seen from the positive tool axis) and in incremental words (Klartext IX IY, Sinumerik G91, IC()),
+which the readers (`klartext_contour`, `sinumerik_contour`) take from the end before them.
 
 The controls' rules used: at a move's end the tool centre stands square to the move, by the
 radius, whatever the corner after it (outside corners: a transition arc about the corner, G450
@@ -12,8 +16,9 @@ and the TNC's; inside corners: the crossing of the offset paths; TNC 640 user's 
 "Radius compensation: Machining corners"; 840D sl Programming Manual Fundamentals, "Corner
 behavior: G450, G451"); the move that turns it on starts from the programmed point and the one
 that turns it off ends on its programmed point (840D sl Fundamentals, "Tool radius compensation
-OFF: G40").  The test contours approach the contour in line with its first edge, where the
-controls' approaches (NORM: square to the contour's tangent) agree with the move's own normal.
+OFF: G40").  The entry move ends square to itself (the TNC's), or with Sinumerik's NORM (and KONT
+in front of the contour) square to the next element at its start (`offset`'s `norm`: 840D sl
+Fundamentals, "Contour approach and retraction (NORM, KONT, KONTC, KONTT)").
 (The rewritten program's transition arcs at outside corners, about a corrected corner point, are
 not checked: they keep an error of the error's gradient times the radius.)"""
 
