@@ -111,7 +111,10 @@ class ToolCentre:
                 move.centre_shift = shift
             self.off_path = side is not None
             self.corrected = corrected or any(_moves_in_plane(m) for m in moves)
-            if entry and side is not None and self.approach is not None:
+            # (an entry along the normal alone: "If no geometry axis is programmed for the current
+            # plane in the block with the tool radius compensation selection, no selection takes
+            # place", 840D sl Function Manual W1, "Tool radius compensation 2D": not waited for)
+            if entry and side is not None and self.approach is not None and _moves_in_plane(moves[0]):
                 self.waiting = [moves[0]]
                 self._approached(moves[1:], side, shifted=True)
         else:  # (a loop's or a cycle's moves too: that the tool is off the path matters more)
