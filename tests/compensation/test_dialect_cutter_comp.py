@@ -575,6 +575,21 @@ def test_an_entry_waits_for_the_next_move_in_the_plane_past_an_infeed(tmp_path):
     assert arc.centre_shift[0] == square
 
 
+def test_an_entry_along_the_tool_axis_alone_does_not_wait(tmp_path):
+    """G42 in a block that moves no axis of the plane: no selection takes place there (840D sl
+    Function Manual W1), so that move keeps the tool centre on its point, not square to the next."""
+    text = SINUMERIK_ARC_FIRST.replace(
+        "N40 G1 Z-1 F300\nN50 G42 G1 X80 Y0", "N40 G42 G1 Z-1 F300\nN50 X80 Y0"
+    )
+    (tmp_path / "_N_TO_INI").write_text(TO_INI)
+    offsets = WorkOffsets(tools=ToolTable.from_file(tmp_path / "_N_TO_INI"))
+    dialect, blocks = parse_program(io.BytesIO(text.encode()), "OUTLINE.MPF", None)
+    interpret, _ = dialect_tools(dialect)
+    moves = [e for e in interpret(blocks, file="OUTLINE.MPF", warnings=Warnings(stream=io.StringIO()),
+                                  offsets=offsets) if type(e) is Line]  # fmt: skip
+    assert moves[1].centre_shift == (None, (0.0, 0.0, 0.0))
+
+
 def test_a_change_of_units_keeps_where_the_tool_centre_stands_in_every_axis(tmp_path):
     """G70 under G42 in G18: the tool centre stands off along Z after a move along X, and stays there
     in the new units."""
