@@ -172,7 +172,7 @@ UNCOMPENSATED = {
     "them; compensation resumes with the next move",
     COMP: "cutter compensation: its moves pass through uncompensated (the control offsets them by the tool radius, "
     "so the tool is not where their points are; ncpp follows it in ISO programs in G17 and G18, with no lathe "
-    "tool orientation, and in Klartext and Sinumerik in G17 with absolute coordinates, outside loops, subroutines "
+    "tool orientation, and in Klartext and Sinumerik in every working plane, outside loops, subroutines "
     "and Fanuc corners, from and to a line); compensation resumes after the first move "
     "with it off (after G40, or R0), or after the move that one's Fanuc corner rounds into",
 }

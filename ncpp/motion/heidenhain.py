@@ -20,11 +20,11 @@ working plane (the fillet arc or chamfer line is the RND/CHF block's event; a
 feed line waits for the next move to know whether its corner is cut).
 Radius compensation RL/RR is followed to R0: the moves from the first with RL/RR
 to the R0 block's are the programmed contour, the tool centre off it by the radius
-(the called tool's R + DR from TOOL.T or TOOL DEF's R, plus TOOL CALL's DR); with
-TOOL CALL .. Z and absolute words they carry where the tool centre stands
-(`centre_shift`, `ModalInterpreter.radius_compensation`), else (IX/IY/IZ, another tool
-axis, RL/RR in an arc block, RND/CHF next to the entry or exit move) they are marked
-`fixed`.  A TOOL CALL
+(the called tool's R + DR from TOOL.T or TOOL DEF's R, plus TOOL CALL's DR); they carry
+where the tool centre stands (`centre_shift`, `ModalInterpreter.radius_compensation`) in
+the working plane of the tool axis (TOOL CALL .. Z: X Y, .. Y: Z X, .. X: Y Z, left and right
+as seen from the positive tool axis), with X/Y/Z or IX/IY/IZ words, else (RL/RR in an arc
+block, RND/CHF next to the entry or exit move) they are marked `fixed`.  A TOOL CALL
 under RL/RR is out of scope.  Paraxial R+/R-,
 RND/CHF next to an arc or a rapid, FK free contours,
 APPR/DEP, `CALL PGM` of a file not found, calls of other cycles, point tables, M89, FN 14 and
@@ -89,7 +89,6 @@ DATUM_CYCLES = frozenset(("7", "8", "10", "11", "19", "26"))
 PRESET_CYCLE = "247"
 END_M = frozenset((2.0, 30.0))
 SIDES = {"RL": 1, "RR": -1, "R0": 0}  # radius compensation's side of the contour (0: off)
-INCREMENTAL = frozenset(("IX", "IY", "IZ"))  # (moves under RL/RR with them are left as programmed)
 HARMLESS_KEYWORDS = frozenset(("STOP",))
 # Resets of what this interpreter never follows (a tilted plane, TCPM: it stops at any that sets
 # one), which move no axis: `PLANE RESET STAY` keeps the rotary axes where they are (TNC 640
@@ -451,10 +450,7 @@ class HeidenhainInterpreter(ModalInterpreter):
                 raise OutOfScope(f"M140 and the cycle call {call[0]} in one block", call[1])
             events.append(self._retract(block, retract))
         if comp is not None or self.radius_comp or self.centre.off_path:
-            incremental = any(
-                isinstance(i, (Word, ExprWord)) and i.letter in INCREMENTAL for i in block.items
-            )
-            events = self.radius_compensation(events, None if comp is None else SIDES[comp], not incremental)
+            events = self.radius_compensation(events, None if comp is None else SIDES[comp])
         if call is not None:
             events = events + self._call_cycle(block, *call)
         if events and isinstance(events[-1], (Line, Arc)):

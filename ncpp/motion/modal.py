@@ -117,6 +117,20 @@ class ModalInterpreter:
                 continue
             yield from events or (Pass(block),)
 
+    def approached(self, events: Iterable[Event]) -> Iterator[Event]:
+        """`events` with those from a compensated entry move on held while its tool centre waits for
+        the next move in the plane (`ToolCentre.approach`): a move is passed on once it is told."""
+        held: list[Event] = []
+        for event in events:
+            if held or self.centre.waiting:
+                held.append(event)
+                if not self.centre.waiting:
+                    yield from held
+                    held = []
+            else:
+                yield event
+        yield from held
+
     def leave_scope(
         self, warnings: Warnings, reason: str, block: Block, col: int | None, owner: Block | None = None
     ) -> None:
@@ -125,6 +139,7 @@ class ModalInterpreter:
         rest passes.  In a called file, the warning stands at the calling line of the program (where
         the program passes through from) and names the place in that file."""
         self.done = True
+        self.centre.waiting = []  # (an entry move waiting keeps its tool centre square to it)
         where = "this line" if owner is None else f"line {owner.line}, which runs it,"
         place = Location(self.file, block.line, col)
         if self.file != self.program_file and owner is not None:
@@ -143,9 +158,10 @@ class ModalInterpreter:
         the right (-1: G42, RR), off (0: G40, R0) or neither (None).  The control offsets the
         path by the tool radius (`tool_radius`): the moves from the first with it on to the
         first after it is off (which ends on its programmed point) stay the programmed contour,
-        as the control's positions do, and carry where the tool centre stands (`ToolCentre`).
-        Left as programmed (COMP) where ncpp does not follow them: outside G17, in G91, in a block
-        that runs again (`again`), incremental words (the dialect's `also` False), an entry or
+        as the control's positions do, and carry where the tool centre stands (`ToolCentre`), in
+        any working plane, their words absolute or incremental (the writers write an increment
+        from the corrected end before it).  Left as programmed (COMP) where ncpp does not follow
+        them: in a block that runs again (`again`), where the dialect's `also` is False, an entry or
         exit move that is an arc (the TNC refuses RL/RR in an arc block: TNC 640 user's manual,
         "Radius compensation"; the Sinumerik approaches and leaves the contour on a line with
         NORM: 840D sl Programming Manual Fundamentals, "Contour approach and retraction"), and a
@@ -162,12 +178,7 @@ class ModalInterpreter:
             return events
         side = self.comp_side if self.radius_comp else None
         ends = side is None or not self.centre.off_path  # (the exit, or the entry move)
-        in_scope = all(
-            m.context.plane == 17 and m.context.absolute for m in moves
-        )  # (G18, G19, G91: not yet)
-        self.centre.follow(
-            moves, side, also and in_scope and not self.again and not (ends and type(moves[0]) is Arc)
-        )
+        self.centre.follow(moves, side, also and not self.again and not (ends and type(moves[0]) is Arc))
         return events
 
     def _turned(self, turn: int) -> bool:

@@ -21,9 +21,12 @@ coordinates (AP=, RP=),
 arcs by opening angle (AR=) and unknown G codes make the position unknown: one warning (an error with `strict`) and the
 rest passes through.  Under cutter compensation (G41/G42 to the first move after
 G40) the moves are the programmed contour, the tool centre off it by the edge's radius
-($TC_DP6 + $TC_DP15 in `_N_TO_INI`): in G17 and G90 they carry where the tool centre
-stands (`centre_shift`, `ModalInterpreter.radius_compensation`), else (G18, G19, G91, an
-entry or exit arc) they are marked `fixed`; M6 or D under it is out of scope.
+($TC_DP6 + $TC_DP15 in `_N_TO_INI`): in G17, G18 and G19 (left and right as seen from the
+positive applicate), in G90 or G91 and with AC()/IC() words, they carry where the tool centre
+stands (`centre_shift`, `ModalInterpreter.radius_compensation`), the entry move's end square
+to the contour's first element with NORM (and KONT in front of it: `ToolCentre.approach`),
+else (an entry or exit arc) they are marked `fixed`; M6 or D under it, and KONTC and KONTT,
+are out of scope.
 """
 
 from __future__ import annotations
@@ -106,6 +109,7 @@ FRAMES = frozenset(("TRANS", "ATRANS", "ROT", "SCALE", "MIRROR"))
 # The axis (X, Y, Z index) that lengths 1, 2 and 3 of a milling tool act along, per plane
 LENGTH_AXES = {17: (2, 1, 0), 18: (1, 0, 2), 19: (0, 2, 1)}
 SIDES = {41.0: 1, 42.0: -1, 40.0: 0}  # cutter compensation's side of the contour (0: off)
+APPROACHES = frozenset(("NORM", "KONT", "KONTC", "KONTT"))  # how compensation approaches the contour
 TOOL_CHANGE = 6.0  # M6 loads the tool T selected, with its cutting edge D1 unless the block says another
 
 
@@ -179,13 +183,14 @@ class SinumerikInterpreter(ModalInterpreter):
         self.returned = False  # M17 or RET ended the subprogram running
         self.called_blocks = 0  # blocks run in subprogram files so far
         self._files: Files | None = None  # the subprogram files, once a call needs them
+        self.centre.approach = "NORM"  # (the control's initial setting: `ToolCentre.approach`)
 
     # -- the event stream ---------------------------------------------------------------
     def run(self, blocks: Iterable[Block], warnings: Warnings) -> Iterator[Event]:
         """Events block by block, in the order the blocks run (`sinumerik_flow.py`): a block
         run out of the text's order gives its moves, left as programmed, to the line that
         runs it (its `owner`), so that every block's text is written once, where it stands."""
-        return self._run(blocks, warnings, None)
+        return self.approached(self._run(blocks, warnings, None))
 
     def _run(self, blocks: Iterable[Block], warnings: Warnings, caller: Block | None) -> Iterator[Event]:
         """`run` over the program (`caller` None) or over a subprogram file the line `caller`
@@ -500,6 +505,8 @@ class SinumerikInterpreter(ModalInterpreter):
                     )
                 elif what == "call" and item.node[0] == "CALL" and len(item.node[1]) == 1:
                     self.called = self._call(block, item, self._indirect(item.node[1][0], block, item), ())
+                elif what == "call" and item.node[0].upper() in APPROACHES and not item.node[1]:
+                    self._approach(item.node[0].upper(), item)
                 elif what == "call" and item.node[0] == "EXTERN":
                     return []  # (it declares a subprogram's parameters)
                 elif what == "call" and item.node[0] == "RET" and self.calls:
@@ -619,6 +626,14 @@ class SinumerikInterpreter(ModalInterpreter):
                 )
             events = [*events, *self._drill(block, drilling)]
         return events
+
+    def _approach(self, name: str, item: Statement) -> None:
+        """NORM or KONT: how compensation approaches the contour (`ToolCentre.approach`).  KONTC and
+        KONTT approach and leave it on polynomials the control makes (840D sl Programming Manual
+        Fundamentals, "Contour approach and retraction"), which ncpp does not follow."""
+        if name not in ("NORM", "KONT"):
+            raise OutOfScope(f"the approach {name} (the control's polynomial to the contour)", item.start + 1)
+        self.centre.approach = name
 
     # -- drilling cycles ----------------------------------------------------------------------
     def _drilling(self, node: tuple, block: Block, item) -> Drilling:

@@ -351,8 +351,10 @@ def _corners(
     """Corners between two lines under cutter compensation: the control offsets each line by the
     radius, and the corner point corrected for the first line's tool centre leaves the second line
     off by the error's gradient times the radius times the turn.  The corner is put where the first
-    line's corrected contour crosses the second's: `out_end` of the first, moved along it.
-    `crossing(rows)`: the second lines' corrected starts (their own tool centre's correction); `step`
+    line's corrected contour crosses the second's: `out_end` of the first, moved along it, its
+    coordinate along the plane's normal corrected for the tool centre there, at the crossing (the
+    first line's correction changes along it as from its start to its end: linearly).
+    `crossing(rows)`: the lines' corrected starts (their own tool centre's correction); `step`
     (n,): the output grid the moved ends are put on (None: none)."""
     if rows.corner is None or rows.axes is None or not rows.corner.any():
         return
@@ -369,9 +371,34 @@ def _corners(
         return
     gap = np.stack(in_plane(crossing(k) - out_end[k - 1], axes)[:2], axis=1)
     along = (gap[:, 1] * d2[:, 0] - gap[:, 0] * d2[:, 1]) / across  # (gap · n2) / (d1 · n2)
+    _depth_at_crossing(rows, out_end, crossing, k, (d1, d2, across, axes))
     out_end[k - 1] += from_plane(along * d1[:, 0], along * d1[:, 1], np.zeros(len(k)), axes)
     if step is not None:
         out_end[k - 1] = quantize(out_end[k - 1], step[k - 1])
+
+
+def _depth_at_crossing(
+    rows: _Rows, out_end: NDArray, crossing: Callable[[NDArray], NDArray], k: NDArray, turns: tuple
+) -> None:
+    """At an inside corner the control stops the tool centre where the two offset lines cross, `a`
+    along the first line from where it stands square to its end (`_Rows.shift`): the corner's
+    coordinate along the plane's normal is corrected for the tool centre there, the first line's
+    correction changing along it as from its start to its end (`crossing` of its start).  `turns`:
+    `_corners`' (d1, d2, across, axes) of the corners `k`."""
+    d1, d2, across, axes = turns
+    assert rows.shift is not None  # (under compensation: `_corners`)
+    first = k - 1
+    gap = np.stack(in_plane(rows.shift[k] - rows.shift[first], axes)[:2], axis=1)
+    a = (gap[:, 1] * d2[:, 0] - gap[:, 0] * d2[:, 1]) / across  # (gap × d2) / (d1 × d2)
+    inside = a < 0.0
+    if not inside.any():
+        return
+    k, first, a, axes = k[inside], first[inside], a[inside], axes[inside]
+    n = axes[:, 2]
+    length = np.hypot(*in_plane(rows.end[first] - rows.start[first], axes)[:2])
+    at_end = out_end[first, n] - rows.end[first, n]
+    at_start = crossing(first)[np.arange(len(k)), n] - rows.start[first, n]
+    out_end[first, n] += a * (at_end - at_start) / length
 
 
 def _pin_plane(rows: _Rows, out_end: NDArray, before: NDArray | None) -> None:
