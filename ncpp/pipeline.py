@@ -171,10 +171,11 @@ UNCOMPENSATED = {
     "cannot carry a correction for each: its holes and moves pass through uncompensated, where the pattern puts "
     "them; compensation resumes with the next move",
     COMP: "cutter compensation: its moves pass through uncompensated (the control offsets them by the tool radius, "
-    "so the tool is not where their points are; ncpp follows it in ISO programs in G17 and G18, with no lathe "
-    "tool orientation, and in Klartext and Sinumerik in every working plane, outside loops, subroutines "
-    "and Fanuc corners, from and to a line); compensation resumes after the first move "
-    "with it off (after G40, or R0), or after the move that one's Fanuc corner rounds into",
+    "so the tool is not where their points are; ncpp follows it in ISO programs in G17 and G18 without a lathe "
+    "tool orientation, and in Klartext and Sinumerik in every working plane, but not in loops and subroutines, "
+    "at Fanuc corners, in a Klartext or Sinumerik entry or exit arc, or where a block turns it to the other "
+    "side); compensation resumes with the next line it follows, or after the first move with it off (G40, R0), "
+    "or after the move that one's Fanuc corner rounds into",
 }
 # An entry move under cutter compensation whose tool centre ends on its point: the radius is unknown
 UNKNOWN_RADIUS = (
