@@ -90,7 +90,7 @@ def add_compensation_arguments(p: argparse.ArgumentParser) -> None:
         action="store_false",
         help="leave out the guards: the block at the program's start that stops it when "
         "the control's work offset is not the one given with --work-offset / --var-file, and the check "
-        "after each G43 that stops it when the control's tool length is not the one in --tool-table",
+        "after each G43 that stops it when the control's tool or its length is not the one in --tool-table",
     )
     add_placement_arguments(p)
 
@@ -124,8 +124,9 @@ def add_placement_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--tool-table",
         metavar="FILE",
-        help="the control's tool table (LinuxCNC's tool.tbl, Heidenhain's TOOL.T, Sinumerik's _N_TO_INI): the tool lengths G43, TOOL CALL or M6/D apply, "
-        "which move the axes and lengthen the Abbe arm; without it they apply length 0, with a warning",
+        help="the control's tool table (LinuxCNC's tool.tbl, Heidenhain's TOOL.T, Sinumerik's _N_TO_INI): "
+        "the tool lengths G43, TOOL CALL or M6/D apply, which move the axes and lengthen the Abbe arm "
+        "(without it they apply length 0, with a warning), and the radii cutter compensation offsets by",
     )
     p.add_argument(
         "--var-units",

@@ -8,7 +8,7 @@ Every block goes through the motion interpreter, so a program LinuxCNC
 would refuse (bad arc radius, conflicting words...) fails with
 `file:line:col: message`, a non-zero exit status and no output (output is
 spooled until the whole program was read), so that a pipeline stops.
-The dialect (ISO / Fanuc / LinuxCNC, Heidenhain, Sinumerik) is detected
+The dialect (ISO / LinuxCNC, Fanuc, Haas, grbl, Heidenhain, Sinumerik) is detected
 from the content (`--dialect` overrides), and the same pipeline as `ncpp
 compensate` runs (`ncpp.pipeline.process`).  A progress line goes to stderr
 when stderr is a terminal.

@@ -7,22 +7,24 @@ program coordinates):
     STRAIGHT_TRAVERSE(x, y, z, a, b, c)
     STRAIGHT_FEED(x, y, z, a, b, c)
     ARC_FEED(first_end, second_end, first_axis, second_axis, rotation, axis_end_point, a, b, c)
+    RIGID_TAP(x, y, z)
 
-Only these three calls are printed (no feed, unit, plane or spindle calls),
-so the output compares line by line with
-`rs274 FILE | grep -oE '(STRAIGHT_TRAVERSE|STRAIGHT_FEED|ARC_FEED)\\(.*\\)'`.
+Only these four calls are printed (no feed, unit, plane or spindle calls; nothing for a
+rigid tap's return, as rs274 prints nothing for it), so the output compares line by line with
+`rs274 FILE | grep -oE '(STRAIGHT_TRAVERSE|STRAIGHT_FEED|ARC_FEED|RIGID_TAP)\\(.*\\)'`.
 
 `--format json` prints one JSON object per move (JSON Lines): source line,
-kind (traverse / feed / arc), start, end, centre and turn of arcs, feed,
-plane, inch, the work offset (machine minus program position), and why
-compensation leaves a move as programmed ("fixed": a canned cycle, a loop or
-subroutine, cutter compensation), where it does.
+kind (traverse / feed / arc / rigid tap / rigid tap return), start, end, centre and turn of
+arcs, feed, plane, inch, the work offset (machine minus program position), the tool length
+offset, why compensation leaves a move as programmed or writes it its own way ("fixed": a
+canned cycle, a drilling cycle, a hole pattern, a loop or subroutine, cutter compensation, a
+G28/G30 return, a machine-coordinate move), where it does, and under cutter compensation that
+ncpp follows where the tool centre stands off the move's start and end ("centre_shift").
 
 `--var-file linuxcnc.var` / `--work-offset [G5x=]X,Y,Z` start the
 interpreter from the control's zeros, as `rs274 -v FILE` does (default: all
 zero, rs274's default parameter file), and `--tool-table` from its tool
-table (`rs274 -t`); the JSON records carry the tool length offset too.
-Heidenhain and Sinumerik programs print the same records (`--dialect`, or
+table (`rs274 -t`).  Heidenhain and Sinumerik programs print the same records (`--dialect`, or
 detected from the content).
 
 Under cutter compensation (G41/G42 or RL/RR, to the first move after G40 or R0) the moves

@@ -24,7 +24,8 @@ external offset, P1-P6 G54-G59), where LinuxCNC's sets the system in effect; a P
 expression may be 0 there.
 
 A setting code written with other words in its block is out of scope too: a block that
-both sets and moves is not one these controls' posts write.
+both sets and moves is not one these controls' posts write.  So is G33.1, LinuxCNC's rigid tap:
+these controls tap rigidly with M29 and G84.
 """
 
 from __future__ import annotations

@@ -10,6 +10,7 @@ grbl reads a subset of rs274ngc (its wiki page "G-code commands" and `grbl/gcode
   (`protocol.c` hands it to `system_execute_line`, never to the G-code parser): it passes
   through untouched; `$H` (homing) and `$J=` (jogging) move the machine where ncpp does not
   follow, so the state is unknown from there, as with any construct out of scope;
+* G33.1, LinuxCNC's rigid tap, is out of scope: grbl has no spindle-synchronised motion;
 * `?`, `~` and `!` are realtime commands (status report, cycle start, feed hold) that grbl
   picks out of the stream as they arrive (`serial.c`), never G code: a line of them
   passes through untouched.

@@ -11,7 +11,7 @@ labels, subprograms (`CALL LBL n` ... `LBL 0`), program-section repeats (`CALL L
 and the jumps FN 9-12 (`heidenhain_flow`: a block that runs again is left as programmed,
 FLOW; with --expand each run is written out, `heidenhain_expand`), `CALL PGM` of a program file on the subroutine path (`_call_program`: its moves are left
 as programmed, FLOW, and the caller's after it compensated), `CYCL DEF` of machining cycles
-(they only define), the drilling cycles 200, 201, 203, 207 and 240 called by M99, `CYCL CALL`
+(they only define), the drilling cycles 200, 201, 203, 205, 207 and 240 called by M99, `CYCL CALL`
 or `CYCL CALL POS` (`heidenhain_cycles`: their moves along the tool axis are left as
 programmed, DRILLED) or `CYCL CALL PAT` at the holes of a `PATTERN DEF` (all its moves left as
 programmed, PATTERN), M2/M30

@@ -7,7 +7,8 @@ exactly what rs274 prints in its canonical calls; `Context.offset` says where
 the program origin sits in machine coordinates.
 
 Scope: modal G0-G3, planes, G90/G91, G90.1/G91.1, G20/G21 (state converted
-on a switch, like LinuxCNC), G54-G59.3, G10 L2/L20 (no rotation), G92 family,
+on a switch, like LinuxCNC), G54-G59.3, G10 L2/L20 (no rotation; Fanuc's and Haas's
+additional work offsets and their readings of G10: `fanuc.py`), G92 family,
 G52, G53, G28/G30, T, M6, M61, G43 / G43.1 / G43.2 H / G49 (lengths from the
 control's tool table, `tools.py`; zero when it is not told), F and inverse time, IJK and R arcs, helices,
 P turns, parameters and expressions, Fanuc corner rounding and
@@ -22,12 +23,13 @@ are the programmed contour, not the tool centre, and after G40 the position is
 the program's again, as in rs274ngc.  The moves the tool makes off the programmed
 path (from the first move under G41/G42 to the first after G40) carry where the
 tool centre stands (`centre_shift`, `ncpp.motion.cutter`), in G17 and G18 (LinuxCNC
-compensates in those two planes only), in G90 and G91; with a lathe tool's orientation (1-8) they
-are marked `fixed`, as are the moves of cycles, loops, subroutines and macros:
-compensation leaves them as programmed.  Anything else (subroutine files ncpp is not told
-of, a move of a subprogram under G66, a Fanuc system variable it does not know, M99
-in the main program, G88 (a manual retract) and the lathe cycles, splines,
-G33 threading, probing) makes the interpreter's state unknown: that block and
+compensates in those two planes only), in G90 and G91; with a lathe tool's orientation (1-8), and
+about a Fanuc corner (its fillet or chamfer and the two lines it joins), they are marked `fixed`,
+as are the moves of cycles, loops, subroutines and macros: compensation leaves them as
+programmed.  Anything else (subroutine files ncpp is not told of, a move of a subprogram under
+G66, a Fanuc system variable it does not know, M99 in the main program, G88 (a manual retract)
+and the lathe cycles, splines, G33 threading, a rigid tap under cutter compensation or with a
+rotary axis word, probing) makes the interpreter's state unknown: that block and
 every later block pass through as `Pass` after ONE warning (an error with
 `strict`).
 """

@@ -32,7 +32,9 @@ Statement kinds and nodes (Heidenhain):
   call_program   (path,)                 `CALL PGM TNC:\\Plan.h`
   cycle_def      (number, words)         `CYCL DEF 200 BOHREN` -> ('200', ('BOHREN',)); its Q200=...
                                          parameters (continuation lines) follow as assignments
-  cycle_call     (variant,)              `CYCL CALL` None, `CYCL CALL POS` 'POS'
+  cycle_call     (variant,)              `CYCL CALL` None, `CYCL CALL POS` 'POS', `CYCL CALL PAT` 'PAT'
+  pattern_def    (shapes...)             `PATTERN DEF` with `POS1 (X+25 Y+33.5 Z+0)` on a continuation line ->
+                                         (('POS', 1, (('X', ("num", 25.0)), ('Y', ...), ('Z', ...))),)
   fn             (number, text)          `FN 9: IF +Q1 EQU +0 GOTO LBL "x"` -> (9, 'IF +Q1 ...'), passed through
   assignment     (("param", "q1950"), expr)  `Q1950 = Q1804 - Q1805`; a string ("str", text) for QS
   keyword        (words...)              anything else led by keywords (`STOP`, `PLANE ...`), passed through
