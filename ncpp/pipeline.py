@@ -197,8 +197,9 @@ UNKNOWN_SETTING = (
 
 def warn_fixed(events: Iterable[Event], warnings: Warnings, file: str) -> Iterator[Event]:
     """Pass events through; warn where a series of moves the passes leave as programmed
-    (`fixed`: a canned cycle's, a loop's or a subroutine's, or those under cutter compensation)
-    starts (refused with --strict).
+    (`fixed`, UNCOMPENSATED: a canned cycle's, a drilling cycle's along the tool axis, a hole
+    pattern's, a loop's or a subroutine's, or those under cutter compensation) starts (refused
+    with --strict).
 
     In G91 such a move starts from where the control is (the compensated position): the
     moves of loops and subroutines and those under cutter compensation run their increments

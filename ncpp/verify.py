@@ -6,7 +6,9 @@ reads the written text back with a fresh parser and interpreter (nothing of
 the passes' state) and compares it with the input program's motion:
 
 * the same actions in the same order: tool changes and length offsets,
-  spindle, coolant, dwells, stops, other M codes, program end;
+  spindle, coolant, dwells, stops, other M codes, Klartext's TOOL CALL and
+  cycle calls, program end (stops, ends, M99 and CYCL CALL POS counted after
+  their block's move, where the control acts);
 * between two actions, every point of the written path within the bound of
   the input's path, and every point of the input's path within it of the
   written path (rotary and other extra axes count their unit as a mm, so a
