@@ -23,8 +23,9 @@ to the R0 block's are the programmed contour, the tool centre off it by the radi
 (the called tool's R + DR from TOOL.T or TOOL DEF's R, plus TOOL CALL's DR); they carry
 where the tool centre stands (`centre_shift`, `ModalInterpreter.radius_compensation`) in
 the working plane of the tool axis (TOOL CALL .. Z: X Y, .. Y: Z X, .. X: Y Z, left and right
-as seen from the positive tool axis), with X/Y/Z or IX/IY/IZ words, else (RL/RR in an arc
-block, RND/CHF next to the entry or exit move) they are marked `fixed`.  A TOOL CALL
+as seen from the positive tool axis), with X/Y/Z or IX/IY/IZ words, else (RL/RR or R0 in an arc
+block, RND/CHF next to the entry or exit move, a block that turns it to the other side, a block
+that runs again) they are marked `fixed`.  A TOOL CALL
 under RL/RR is out of scope.  Paraxial R+/R-,
 RND/CHF next to an arc or a rapid, FK free contours,
 APPR/DEP, `CALL PGM` of a file not found, calls of other cycles, point tables, M89, FN 14 and

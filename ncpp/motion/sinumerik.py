@@ -25,8 +25,8 @@ G40) the moves are the programmed contour, the tool centre off it by the edge's 
 positive applicate), in G90 or G91 and with AC()/IC() words, they carry where the tool centre
 stands (`centre_shift`, `ModalInterpreter.radius_compensation`), the entry move's end square
 to the contour's first element with NORM (and KONT in front of it: `ToolCentre.approach`),
-else (an entry or exit arc) they are marked `fixed`; M6 or D under it, and KONTC and KONTT,
-are out of scope.
+else (an entry or exit arc, a block that turns it to the other side, a loop's) they are marked
+`fixed`; M6 or D under it, and KONTC and KONTT, are out of scope.
 """
 
 from __future__ import annotations
