@@ -10,7 +10,8 @@ or `T="NAME"` selects, M6 loads it with cutting edge D1, `D n` picks an edge
 (D0 none); the edge's lengths 1-3 from the control's tool offsets (`_N_TO_INI`,
 `tools.py`) act along the plane's axes (G17: length 1 along Z).  Control flow (GOTOF,
 GOTOB, GOTO, GOTOC, CASE, IF, WHILE, FOR, REPEAT, LOOP) runs as `sinumerik_flow.py` says: a
-loop's moves are left as programmed (FLOW).  The drilling, tapping and boring cycles
+loop's moves are left as programmed (FLOW), or with --expand each run is written out
+(`sinumerik_expand.py`), as are subprogram calls.  The drilling, tapping and boring cycles
 CYCLE81-CYCLE89 and CYCLE840, called once or under MCALL, are followed (`sinumerik_cycles.py`),
 as are the hole patterns HOLES1 and HOLES2 under MCALL (their moves left as programmed,
 PATTERN).  A subprogram call (`L<n>`, a name, value parameters of its PROC, `P` runs) runs the

@@ -101,7 +101,8 @@ class SinumerikExpansion:
     # -- where the rest of the program could pass through as it is ------------------------------
     def refuses_leaving(self, inside: bool) -> bool:
         """Whether the rest cannot pass through as it is from a block `inside` a stretch written out
-        (a loop, a jump's loop, a subprogram), or after a label was left out."""
+        (a loop, a jump's loop, a subprogram), or after a label of the main program was left out
+        where its text stands (a jump in the rest could not find it)."""
         return self.started and (inside or self.label_left_out)
 
     def refuse(self, reason: str, where: Location, inside: bool) -> None:
@@ -166,11 +167,8 @@ class SinumerikExpansion:
             return raw
         if item.kind in LEFT_OUT or (item.kind == "call" and item.node[0] == "RET"):
             return None
-        if item.kind == "label":
-            if not (main and first):
-                self.label_left_out = True
-                return None
-            return raw
+        if item.kind == "label":  # (run again, its text was written where it stands, or left out there)
+            return raw if main and first else None
         if item.kind == "def":
             if main:
                 raise NcppError("--expand: DEF inside a loop or a jump's loop cannot be written out (a "

@@ -186,6 +186,17 @@ def test_a_loops_counter_is_set_before_the_line_that_reads_it_and_a_jumped_line_
     assert written.count("START:") == 1  # (a label stays where its text stands, once)
 
 
+def test_after_a_loop_an_out_of_scope_line_of_the_main_program_passes_through_its_variables_set(tmp_path):
+    """Outside any loop the rest passes through as it is (as without --expand), after the lines
+    that set what the loop changed; the jump's label stays where it stands."""
+    text = JUMPS.replace("G0 Z50\n", "G0 Z50 ASPLINE\nG1 X=R1 Y30\n")
+    written, messages = compensated(tmp_path, "rest.mpf", text, "--expand")
+    lines = written.splitlines()
+    assert lines[-6] == "R1=50" and lines[-4:] == ["SKIPPED:", "G0 Z50 ASPLINE", "G1 X=R1 Y30", "M30"]
+    assert "ASPLINE is outside the motion interpreter's scope" in messages and "GOTO" not in written
+    assert written.count("START:") == 1
+
+
 def test_calls_are_left_out_and_the_subprogram_files_untouched(tmp_path):
     options = _with_subprograms(tmp_path)
     written, _ = compensated(tmp_path, "calls.mpf", CALLS, "--expand", *options)
