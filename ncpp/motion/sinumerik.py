@@ -856,13 +856,17 @@ class SinumerikInterpreter(ModalInterpreter):
 
     def _word_value(self, item: ExprWord, block: Block) -> tuple[float, str | None]:
         expr = item.expr
-        if expr[0] in ("ac", "ic"):
-            return self.value(expr[1], block, item), expr[0]
         if expr[0] in ("dc", "acp", "acn", "cac", "cic"):
             raise OutOfScope(f"the rotary-axis mode {expr[0].upper()}()", item.start + 1)
         if expr[0] == "str":
             return 0.0, None  # `T="MILL"`: a name, no motion
-        return self.value(expr, block, item), None
+        mode = expr[0] if expr[0] in ("ac", "ic") else None
+        value = self.value(expr[1] if mode else expr, block, item)
+        if (
+            self.expansion is not None
+        ):  # (the value where the word stands: the block's assignments go in order)
+            self.expansion.seen[id(item)] = value
+        return value, mode
 
     def _modal_codes(self, gcodes: list[tuple[float, Word | ExprWord]], block: Block) -> bool:
         """Apply the block's G codes; True for a dwell block (its F is a time)."""

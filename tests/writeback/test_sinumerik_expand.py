@@ -228,6 +228,22 @@ M30
     assert not any("WHILE" in raw or "R1+1" in raw for raw in raws) and raws[-2:] == ["R1=2", "M30"]
 
 
+def test_a_word_has_the_value_where_it_stands_in_its_block():
+    """A block's items run in order: a word before an assignment in its block reads the value
+    before it, a word after it the value after (`X=R1*10 R1=R1+1 Y=R1`)."""
+    program = """G17 G90 G71
+G0 X0 Y0 Z5
+R1=0
+WHILE R1<2
+  G1 X=R1*10 R1=R1+1 Y=R1
+ENDWHILE
+M30
+"""
+    interpret, _ = dialect_tools("sinumerik")
+    raws = [e.block.raw.strip() for e in interpret(_blocks(program), expand=True)]
+    assert raws[3:5] == ["G1 X0 Y1", "G1 X10 Y2"]
+
+
 @pytest.mark.parametrize("text, name, _", CASES, ids=IDS)
 def test_ncpps_interpreter_reads_the_same_moves_from_both_texts(tmp_path, text, name, _):
     """Consistency: the moves ncpp's interpreter reads from the original with --expand are the
