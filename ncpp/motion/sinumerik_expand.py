@@ -25,8 +25,8 @@ before the program's statements), before any stretch.
 Refused (`ncpp.motion.expand.refused`, `counted`): an out-of-scope construct inside a stretch
 written out (its opening line is left out: the rest cannot pass through as it is), a DEF in the
 main program's stretch, a call whose argument cannot be written as a number (a string's
-concatenation, a variable holding a string), such a call in a block whose assignments come
-before it, and more than MAX_EXPANDED blocks written out.
+concatenation, a variable holding a string), such a call in a block with an assignment, and
+more than MAX_EXPANDED blocks written out.
 """
 
 from __future__ import annotations
@@ -137,11 +137,11 @@ class SinumerikExpansion:
         where it writes nothing (assignments only, and their comments).  `main`: a block of the
         main program (else a subprogram's), `first`: run where its text stands (its label stays).
         Raises NcppError where it cannot be written."""
-        assigns = False
+        # (a call's arguments are read after the block ran: with an assignment beside it they may differ)
+        assigns = any(type(i) is Statement and i.kind in ("assignment", "def") for i in block.items)
         texts: dict[int, str | None] = {}
         for index, item in enumerate(block.items):
             text = self._text(item, block, value, main, first, assigns)
-            assigns = assigns or (type(item) is Statement and item.kind in ("assignment", "def"))
             if text != block.raw[item.start : item.end]:
                 texts[index] = text
         kept = [item for index, item in enumerate(block.items) if texts.get(index, "") is not None]
@@ -176,7 +176,7 @@ class SinumerikExpansion:
             return None  # (a subprogram's own variables: its words carry their values)
         if item.kind == "call" and reads_variable(item.node[1]):
             if assigns:
-                raise NcppError(f"--expand: {item.node[0]} after an assignment in its block cannot be "
+                raise NcppError(f"--expand: {item.node[0]} with an assignment in its block cannot be "
                                 "written with numbers; leave --expand out", where)  # fmt: skip
             return _call(item, block, value, where)
         return raw

@@ -278,11 +278,15 @@ def test_ncpps_interpreter_reads_the_same_moves_from_both_texts(tmp_path, text, 
             r"prog\.mpf:8:3: --expand: GOTOF inside FOR .* is outside the motion interpreter's scope",
         ),
         (
+            FOR_SQUARES.replace("  X40\n", "  CYCLE81(5, 0, 2, -I) R7=I\n"),
+            r"prog\.mpf:8:3: --expand: CYCLE81 with an assignment in its block",
+        ),
+        (
             CALLS.replace("HOLE(30)\n", "L200\n"),
             r"L200\.SPF:1:1: --expand: the subprogram L200 ending without M17 or RET",
         ),
     ],
-    ids=["rotary-axis", "def", "message", "jump-out", "no-return"],
+    ids=["rotary-axis", "def", "message", "jump-out", "cycle-with-assignment", "no-return"],
 )
 def test_what_cannot_be_written_out_is_refused_with_its_line(tmp_path, capsys, text, message):
     (tmp_path / "L200.SPF").write_text("G1 X1 Y1 Z1 F100\n")
