@@ -163,7 +163,7 @@ UNCOMPENSATED = {
     "program puts them, with the machine's errors); compensation resumes with the next move",
     FLOW: "loop or subroutine: its moves pass through uncompensated (one text runs several times, "
     "or away from where it stands, so it cannot carry one correction); compensation resumes with the next move after it "
-    "(--expand writes an ISO or Klartext program's loops and subroutines out as straight code, "
+    "(--expand writes an ISO, Klartext or Sinumerik program's loops and subroutines out as straight code, "
     "each move compensated)",
     DRILLED: "drilling cycle: it drills where the move before it leaves the tool (X and Y compensated), its moves "
     "along the tool axis as programmed (the depth with the machine's error); compensation resumes with the next move",
@@ -380,10 +380,10 @@ def process(
     else:  # compensated again: the guard of the offset it was compensated for goes
         blocks = without_guard(blocks)
     offsets = offsets or AT_MACHINE_ZERO  # the control's zeros place the program on the machine
-    expanding: dict[str, bool] = {}  # (Sinumerik has neither)
+    expanding: dict[str, bool] = {}
     if FAMILY[name] == "iso":
         expanding = {"expand_cycles": expand_cycles, "expand": expand}
-    elif FAMILY[name] == "heidenhain":
+    elif FAMILY[name] in ("heidenhain", "sinumerik"):
         expanding = {"expand": expand}
     if verify:  # the verifier's own reading of the input: the blocks are held between the two
         # readings, not the events (a loop's runs read its few blocks again and again)

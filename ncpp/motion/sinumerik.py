@@ -10,7 +10,8 @@ or `T="NAME"` selects, M6 loads it with cutting edge D1, `D n` picks an edge
 (D0 none); the edge's lengths 1-3 from the control's tool offsets (`_N_TO_INI`,
 `tools.py`) act along the plane's axes (G17: length 1 along Z).  Control flow (GOTOF,
 GOTOB, GOTO, GOTOC, CASE, IF, WHILE, FOR, REPEAT, LOOP) runs as `sinumerik_flow.py` says: a
-loop's moves are left as programmed (FLOW).  The drilling, tapping and boring cycles
+loop's moves are left as programmed (FLOW), or with --expand each run is written out
+(`sinumerik_expand.py`), as are subprogram calls.  The drilling, tapping and boring cycles
 CYCLE81-CYCLE89 and CYCLE840, called once or under MCALL, are followed (`sinumerik_cycles.py`),
 as are the hole patterns HOLES1 and HOLES2 under MCALL (their moves left as programmed,
 PATTERN).  A subprogram call (`L<n>`, a name, value parameters of its PROC, `P` runs) runs the
@@ -56,6 +57,7 @@ from ncpp.motion.modal import (
 from ncpp.motion.segments import FLOW, MACHINE, PATTERN, PLANE_AXES, Event, Line, Pass
 from ncpp.motion.sinumerik_cycles import PARAMETERS as DRILLING
 from ncpp.motion.sinumerik_cycles import CycleError, Drilling, drilling
+from ncpp.motion.sinumerik_expand import SinumerikExpansion
 from ncpp.motion.sinumerik_flow import SinumerikFlow
 from ncpp.motion.tools import ToolTable, UntoldLengths
 from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
@@ -184,20 +186,28 @@ class SinumerikInterpreter(ModalInterpreter):
         self.called_blocks = 0  # blocks run in subprogram files so far
         self._files: Files | None = None  # the subprogram files, once a call needs them
         self.centre.approach = "NORM"  # (the control's initial setting: `ToolCentre.approach`)
+        self.expansion: SinumerikExpansion | None = None  # --expand: what it writes (`sinumerik_expand`)
 
     # -- the event stream ---------------------------------------------------------------
     def run(self, blocks: Iterable[Block], warnings: Warnings) -> Iterator[Event]:
         """Events block by block, in the order the blocks run (`sinumerik_flow.py`): a block
         run out of the text's order gives its moves, left as programmed, to the line that
-        runs it (its `owner`), so that every block's text is written once, where it stands."""
+        runs it (its `owner`), so that every block's text is written once, where it stands;
+        with --expand (`expand`) each run of it is written where it runs (`sinumerik_expand`)."""
+        main = self.variables  # (the main program's: a subprogram runs with its own, `_subprogram`)
+        self.expansion = SinumerikExpansion(lambda: main, self.file) if self.expand else None
         return self.approached(self._run(blocks, warnings, None))
 
     def _run(self, blocks: Iterable[Block], warnings: Warnings, caller: Block | None) -> Iterator[Event]:
         """`run` over the program (`caller` None) or over a subprogram file the line `caller`
         calls: its blocks all run out of the text's order, their moves the caller's, and its
         text is no part of the output."""
+        expansion = self.expansion
 
         def leave(reason: str, block: Block, col: int | None, owner: Block | None) -> None:
+            if expansion is not None:  # (a control line out of scope inside a stretch written out)
+                inside = caller is not None or owner is not None or _inside(flow)
+                expansion.refuse(reason, Location(self.file, block.line, col), inside)
             self.leave_scope(warnings, reason, block, col, caller or owner)
 
         flow = SinumerikFlow(self.file, self.value, self.assign, lambda: self.done or self.returned, leave)
@@ -209,8 +219,16 @@ class SinumerikInterpreter(ModalInterpreter):
                 self.called_blocks = count_called(self.called_blocks, self.program_file, caller)
             if (kind is not RUN and kind is not FIXED) or not block.items:
                 if owner is None:  # (a block run out of the text's order is written in its place)
+                    if expansion is not None and block.items:
+                        kept = expansion.text(self.done, block)
+                        if kept is None:  # (a control line, text that does not run: left out)
+                            continue
+                        yield from kept
                     runs_others = kind is TEXT and not self.done and _runs_others(block)
                     yield Pass(block, kind is SKIP, self.motion if runs_others else None)
+                continue
+            if expansion is not None:
+                yield from self._expanded(expansion, flow, block, kind, owner, caller, warnings)
                 continue
             self.again = kind is FIXED
             try:
@@ -236,6 +254,54 @@ class SinumerikInterpreter(ModalInterpreter):
             if self.called is not None:
                 call, self.called = self.called, None
                 yield from self._subprogram(call, owner or block, warnings)
+
+    def _expanded(
+        self,
+        expansion: SinumerikExpansion,
+        flow: SinumerikFlow,
+        block: Block,
+        kind: str,
+        owner: Block | None,
+        caller: Block | None,
+        warnings: Warnings,
+    ) -> Iterator[Event]:
+        """With --expand, a block that runs: where it stands and runs once, as it is (after the
+        assignments that settle the variables it may read); in a loop, a jump's loop or a
+        subprogram, as this run's numbers; a call's line left out, the subprogram's runs written
+        in its place.  (No backward jump is refused for the moves it goes over: they are written
+        again, `flow.last_run_move` stays.)"""
+        in_place = kind is RUN and caller is None
+        self.again = False
+        settling: tuple[Event, ...] = ()
+        try:
+            if in_place:
+                settling = expansion.settle(block)
+            else:
+                expansion.start_body(block)
+            events = self.block(block)
+            written: Block | None = block
+            if self.called is not None:  # (a call's line: its subprogram's blocks written for it)
+                expansion.left_out(block)
+                written = None
+            elif not in_place:
+                written = expansion.body(block, self.value, caller is None, owner is None)
+        except OutOfScope as stop:
+            self.called = None
+            inside = not in_place or owner is not None or _inside(flow)
+            expansion.refuse(stop.reason, Location(self.file, block.line, stop.col), inside)
+            self.leave_scope(warnings, stop.reason, block, stop.col, owner)
+            if owner is None:
+                yield from settling
+                yield Pass(block)
+            return
+        yield from settling
+        if written is not None:
+            for event in events:
+                event.block = written
+            yield from events or (Pass(written),)
+        if self.called is not None:
+            call, self.called = self.called, None
+            yield from self._subprogram(call, owner or block, warnings)
 
     # -- subprogram calls (840D sl Programming Manual, Fundamentals, "Subprogram technique") --
     def _call(self, block: Block, item: Word | Statement, name: str, args: tuple) -> _Call:
@@ -325,6 +391,10 @@ class SinumerikInterpreter(ModalInterpreter):
                 if self.done:
                     return
                 if not self.returned:
+                    if self.expansion is not None:
+                        where = call.blocks[-1] if call.blocks else caller
+                        reason = f"the subprogram {call.name} ending without M17 or RET"
+                        self.expansion.refuse(reason, Location(self.file, where.line, None), True)
                     self.leave_scope(warnings, f"the subprogram {call.name} ends without M17 or RET",
                                      call.blocks[-1] if call.blocks else caller, None, caller)  # fmt: skip
                     return
@@ -786,13 +856,17 @@ class SinumerikInterpreter(ModalInterpreter):
 
     def _word_value(self, item: ExprWord, block: Block) -> tuple[float, str | None]:
         expr = item.expr
-        if expr[0] in ("ac", "ic"):
-            return self.value(expr[1], block, item), expr[0]
         if expr[0] in ("dc", "acp", "acn", "cac", "cic"):
             raise OutOfScope(f"the rotary-axis mode {expr[0].upper()}()", item.start + 1)
         if expr[0] == "str":
             return 0.0, None  # `T="MILL"`: a name, no motion
-        return self.value(expr, block, item), None
+        mode = expr[0] if expr[0] in ("ac", "ic") else None
+        value = self.value(expr[1] if mode else expr, block, item)
+        if (
+            self.expansion is not None
+        ):  # (the value where the word stands: the block's assignments go in order)
+            self.expansion.seen[id(item)] = value
+        return value, mode
 
     def _modal_codes(self, gcodes: list[tuple[float, Word | ExprWord]], block: Block) -> bool:
         """Apply the block's G codes; True for a dwell block (its F is a time)."""
@@ -936,6 +1010,11 @@ def _runs_others(block: Block) -> bool:
     """A control line after whose text other blocks' moves may run, owned by it: a loop's end,
     a jump, a CASE."""
     return any(type(i) is Statement and i.kind in RUNS_OTHERS for i in block.items)
+
+
+def _inside(flow: SinumerikFlow) -> bool:
+    """Whether the flow is inside a control structure or a stretch a backward jump runs again."""
+    return bool(flow.open) or flow.pc in flow.looped
 
 
 def _program_name(item) -> bool:
