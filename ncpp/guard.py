@@ -73,6 +73,10 @@ TOOL_BEGIN = "ncpp tool guard:"
 TOOL_END = "ncpp tool guard end"
 SCAN = 60  # blocks at the top searched for a placement guard
 GUARD_BLOCKS = 12  # the most blocks a guard has (a first comment without its last within them is no guard)
+# A Sinumerik line that defines a variable, or one a definition section may hold between them (a
+# comment, a blank line): the 840D wants definitions before the program's first statement
+# (Job Planning, "Definition of user variables (DEF)")
+_SINUMERIK_DEFINITION = re.compile(r"\s*(N\d+\s*)?(DEF\s|REDEF\s|;|$)", re.IGNORECASE)
 # A Fanuc program number line (`O1234`, perhaps with a comment); not an o-word line (`o100 sub`)
 _FANUC_PROGRAM_NUMBER = re.compile(r"\s*O\d+\s*(\(.*\))?\s*$")
 
@@ -112,6 +116,20 @@ def _number(value: float) -> str:
 
 def _units(unit_mm: float) -> str:
     return "mm" if unit_mm == 1.0 else "inch" if unit_mm == 25.4 else f"x{unit_mm:g} mm"
+
+
+def _after_definitions(head: list[str], at: int, rest: Iterator[str]) -> int:
+    """Where the guard goes in a Sinumerik program: after the definitions at its start (`head`
+    takes the lines it needs from `rest`)."""
+    while True:
+        if at == len(head):
+            line = next(rest, None)
+            if line is None:
+                return at
+            head.append(line)
+        if not _SINUMERIK_DEFINITION.match(head[at]):
+            return at
+        at += 1
 
 
 def guard_lines(placement: Placement, dialect: str, first_lines: Iterable[str] = ()) -> list[str]:
@@ -223,6 +241,8 @@ def with_guard(
         return
     while at < len(head) and _FANUC_PROGRAM_NUMBER.match(head[at]):
         at += 1
+    if dialect == "sinumerik":  # (the guard's IF is a statement: after the definitions)
+        at = _after_definitions(head, at, it)
     eol = "\r\n" if head[at - 1].endswith("\r\n") else "\n"
     yield from head[:at]
     yield from (line + eol for line in guard)

@@ -224,3 +224,22 @@ def test_an_o_word_line_is_no_fanuc_program_number():
     placement = Placement(1, G54_MM)
     assert guard_lines(placement, "iso", ["(header)\n", "o100 sub\n"])[1].startswith("o<ncpp_guard> if")
     assert guard_lines(placement, "iso", ["%\n", "O0100 (PART)\n"])[1].startswith("IF [#4014 NE 54]")
+
+
+def test_a_sinumerik_guard_comes_after_the_programs_definitions():
+    """The 840D wants its DEF lines before any statement (Job Planning, "Definition of user
+    variables (DEF)"): the guard's IF goes after them, and after the comments among them."""
+    from ncpp.guard import Placement, with_guard
+
+    program = [
+        "; ncpp header\n",
+        "N10 DEF REAL DEPTH=-2\n",
+        "\n",
+        "def int i ; a counter\n",
+        "G54 G90\n",
+        "M30\n",
+    ]
+    written = list(with_guard(program, Placement(1, (400.0, 350.0, 300.0)), "sinumerik", "ncpp header"))
+    first = next(n for n, line in enumerate(written) if line.startswith("IF "))
+    assert written[:4] == program[:4] and written[first - 1].startswith("; ncpp placement guard:")
+    assert written[-2:] == program[-2:] and "; ncpp placement guard end\n" in written
