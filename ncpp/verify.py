@@ -843,7 +843,7 @@ class _Nearby:
         off = np.maximum(distance[rest], near_end)
         width = self.ends.shape[1]
         vertex = self.ends[q].reshape(-1, width)
-        cut = _to_lines(vertex, closest[rest].reshape(-1, width), at_end.reshape(-1, width)).reshape(q.shape)
+        cut = _to_lines(vertex, closest[rest].reshape(-1, width), at_end.reshape(-1, width))[0].reshape(q.shape)
         return (joined & (off + cut <= within)).any(axis=1)
 
     def first_outside(
@@ -862,23 +862,31 @@ class _Nearby:
     def _along_the_nearest(self, starts: np.ndarray, ends: np.ndarray, within: float) -> np.ndarray:
         """Which segments lie within `within` of the segment q whose lookup point is nearest their
         start, or of the one before or after it (by both ends near one, or across a common vertex
-        as in `_across_a_vertex`)."""
+        as in `_across_a_vertex`).  Each way is tried only on the segments the ways before left
+        unproven (most lie along q or run from q onto the next)."""
         _, found = self.tree.query(starts, k=1, distance_upper_bound=within + self.reach)
-        missing = found >= len(self.segment)
-        nearest = self.segment[np.minimum(found, len(self.segment) - 1)]
-        q = np.clip(nearest[:, None] + np.array([-1, 0, 1]), 0, len(self.starts) - 1)
-        a, b = self.starts[q], self.ends[q]
-        near, at_start = _to_segments(starts, a, b)
-        far, at_end = _to_segments(ends, a, b)
-        proven = ((near <= within) & (far <= within)).any(axis=1)
-        # the start near one, the end near the one after it, across their common vertex
-        joined = (q[:, :2] < q[:, 1:]) & np.all(b[:, :2] == a[:, 1:], axis=2)
-        width = a.shape[2]
-        vertex = b[:, :2].reshape(-1, width)
-        cut = _to_lines(vertex, at_start[:, :2].reshape(-1, width), at_end[:, 1:].reshape(-1, width))
-        off = np.maximum(near[:, :2], far[:, 1:]) + cut.reshape(-1, 2)
-        proven |= (joined & (off <= within)).any(axis=1)
-        return ~missing & proven
+        proven = np.zeros(len(starts), dtype=bool)
+        rest = np.flatnonzero(found < len(self.segment))
+        nearest = self.segment[found[rest]]
+        last = len(self.starts) - 1
+        for first, second in ((0, 0), (0, 1), (1, 1), (-1, -1), (-1, 0)):
+            q, after = nearest + first, nearest + second
+            usable = (q >= 0) & (after <= last)
+            q, after = np.clip(q, 0, last), np.clip(after, 0, last)
+            near, at_start = _to_lines(starts[rest], self.starts[q], self.ends[q])
+            far, at_end = _to_lines(ends[rest], self.starts[after], self.ends[after])
+            if first == second:
+                ok = usable & (near <= within) & (far <= within)
+            else:  # the start near q, the end near the one after it, across their common vertex
+                vertex = self.ends[q]
+                cut, _ = _to_lines(vertex, at_start, at_end)
+                joined = np.all(vertex == self.starts[after], axis=1)
+                ok = usable & joined & (np.maximum(near, far) + cut <= within)
+            proven[rest[ok]] = True
+            rest, nearest = rest[~ok], nearest[~ok]
+            if not len(rest):
+                break
+        return proven
 
     def _first_outside(
         self, starts: np.ndarray, ends: np.ndarray, within: float
@@ -960,13 +968,14 @@ def _to_segments(points: np.ndarray, starts: np.ndarray, ends: np.ndarray) -> tu
     return np.sqrt(np.einsum("nkw,nkw->nk", off, off)), closest
 
 
-def _to_lines(points: np.ndarray, starts: np.ndarray, ends: np.ndarray) -> np.ndarray:
-    """(n,) distances of n points to n segments."""
+def _to_lines(points: np.ndarray, starts: np.ndarray, ends: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(n,) distances of n points to n segments, and (n, width) the segments' points closest to them."""
     d = ends - starts
     length2 = np.einsum("nw,nw->n", d, d)
     t = np.clip(np.einsum("nw,nw->n", points - starts, d) / np.where(length2 > 0, length2, 1.0), 0.0, 1.0)
-    off = points - starts - t[:, None] * d
-    return np.sqrt(np.einsum("nw,nw->n", off, off))
+    closest = starts + t[:, None] * d
+    off = points - closest
+    return np.sqrt(np.einsum("nw,nw->n", off, off)), closest
 
 
 def _line_text(stream: BinaryIO, number: int | None) -> str:

@@ -197,3 +197,25 @@ def test_equal_segments_are_looked_up_once():
     starts = np.array([[0.0, 0, 0], [1, 0, 0], [0, 0, 0], [2, 0, 0], [1, 0, 0]])
     ends = np.array([[1.0, 0, 0], [2, 0, 0], [1, 0, 0], [3, 0, 0], [2, 0, 0]])
     assert _first_of_each(starts, ends).tolist() == [0, 1, 3]
+
+
+CORNER = """\
+G21 G90 G17
+G0 X0 Y0 Z5
+G1 Z-1 F200
+X10 Y0
+{corner}X10 Y10
+M30
+"""
+
+
+@pytest.mark.parametrize("cut", [0.06, 0.3])
+def test_a_segment_across_a_corner_is_judged_by_its_middle(cut):
+    """Both ends of the written segment lie on the original path, one each side of its corner:
+    its middle lies cut / 2 from the path, within the bound (0.0625 mm with the chords) or not.
+    The written path comes back to the corner, so the original's points all lie on it."""
+    written = CORNER.format(corner=f"X{10 - cut:g} Y0\nX10 Y{cut:g}\nX10 Y0\n")
+    if cut / 2 <= Bound(0.05).within:
+        check(CORNER.format(corner=""), written)
+    else:
+        assert "leaves" in refused(CORNER.format(corner=""), written).message
