@@ -843,7 +843,8 @@ class _Nearby:
         off = np.maximum(distance[rest], near_end)
         width = self.ends.shape[1]
         vertex = self.ends[q].reshape(-1, width)
-        cut = _to_lines(vertex, closest[rest].reshape(-1, width), at_end.reshape(-1, width))[0].reshape(q.shape)
+        cut, _ = _to_lines(vertex, closest[rest].reshape(-1, width), at_end.reshape(-1, width))
+        cut = cut.reshape(q.shape)
         return (joined & (off + cut <= within)).any(axis=1)
 
     def first_outside(
