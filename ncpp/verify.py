@@ -791,8 +791,9 @@ def _widened(points: np.ndarray, width: int) -> np.ndarray:
 
 
 class _Nearby:
-    """The segments of a path, looked up by points spaced `Bound.coarse` along them: every
-    segment passing within r of a point has one of its points within r + coarse / 2."""
+    """The segments of a path, looked up by points: the middles of the pieces at most `Bound.coarse`
+    long each is cut into, so that every segment passing within r of a point has a lookup point
+    within r + coarse / 2."""
 
     FEW, MANY = 6, 96  # nearest lookup points asked for, then for the points that found none near
     BATCH = 1 << 15  # points looked at at once
@@ -801,9 +802,9 @@ class _Nearby:
         self.starts, self.ends, self.reach = starts, ends, bound.coarse / 2
         lengths = np.sqrt(((ends - starts) ** 2).sum(axis=1))
         counts = np.maximum(1, np.ceil(lengths / bound.coarse)).astype(np.int64)
-        self.segment = np.repeat(np.arange(len(counts)), counts + 1)
-        first = np.concatenate(([0], np.cumsum(counts + 1)[:-1]))
-        t = (np.arange(len(self.segment)) - first[self.segment]) / counts[self.segment]
+        self.segment = np.repeat(np.arange(len(counts)), counts)
+        first = np.concatenate(([0], np.cumsum(counts)[:-1]))
+        t = (np.arange(len(self.segment)) - first[self.segment] + 0.5) / counts[self.segment]
         points = starts[self.segment] + t[:, None] * (ends - starts)[self.segment]
         self.tree = cKDTree(points, balanced_tree=False)
         self.looked_at = 0
@@ -860,34 +861,44 @@ class _Nearby:
         far = self._first_outside(starts[rest], ends[rest], within)
         return None if far is None else (int(rest[far[0]]), far[1])
 
+    # Ways a segment is proven along the path near its start (`_along_the_nearest`), most
+    # frequent first: the segments its start and its end lie near, counted from q
+    WAYS = ((0, 0), (0, 1), (0, 2), (0, 3), (-1, -1), (1, 1))
+
     def _along_the_nearest(self, starts: np.ndarray, ends: np.ndarray, within: float) -> np.ndarray:
-        """Which segments lie within `within` of the segment q whose lookup point is nearest their
-        start, or of the one before or after it (by both ends near one, or across a common vertex
-        as in `_across_a_vertex`).  Each way is tried only on the segments the ways before left
-        unproven (most lie along q or run from q onto the next)."""
+        """Which segments lie within `within` of the path here, proven from their ends: the start
+        near segment q+i (q: the one whose lookup point is nearest the start), the end near q+j
+        (j >= i), the segments from q+i to q+j joined end to start.  A point of such a segment lies
+        no further than its ends do from the line between their closest points on the path, and a
+        point of that line no further from the path than the vertices between lie from the line
+        (the path runs from one end of the line to the other).  Each way of `WAYS` is tried only on
+        the segments the ways before left unproven."""
         _, found = self.tree.query(starts, k=1, distance_upper_bound=within + self.reach)
         proven = np.zeros(len(starts), dtype=bool)
         rest = np.flatnonzero(found < len(self.segment))
         nearest = self.segment[found[rest]]
         last = len(self.starts) - 1
-        for first, second in ((0, 0), (0, 1), (1, 1), (-1, -1), (-1, 0)):
+        for first, second in self.WAYS:
             q, after = nearest + first, nearest + second
             usable = (q >= 0) & (after <= last)
-            q, after = np.clip(q, 0, last), np.clip(after, 0, last)
-            near, at_start = _to_lines(starts[rest], self.starts[q], self.ends[q])
-            far, at_end = _to_lines(ends[rest], self.starts[after], self.ends[after])
-            if first == second:
-                ok = usable & (near <= within) & (far <= within)
-            else:  # the start near q, the end near the one after it, across their common vertex
-                vertex = self.ends[q]
-                cut, _ = _to_lines(vertex, at_start, at_end)
-                joined = np.all(vertex == self.starts[after], axis=1)
-                ok = usable & joined & (np.maximum(near, far) + cut <= within)
+            near, at_start = _to_lines(starts[rest], *self._segments(q))
+            far, at_end = _to_lines(ends[rest], *self._segments(after))
+            cut = np.zeros(len(rest))
+            for between in range(first, second):
+                vertex = self._segments(nearest + between)[1]
+                usable &= np.all(vertex == self._segments(nearest + between + 1)[0], axis=1)
+                cut = np.maximum(cut, _to_lines(vertex, at_start, at_end)[0])
+            ok = usable & (np.maximum(near, far) + cut <= within)
             proven[rest[ok]] = True
             rest, nearest = rest[~ok], nearest[~ok]
             if not len(rest):
                 break
         return proven
+
+    def _segments(self, which: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The starts and ends of segments `which` (clipped to those there are)."""
+        which = np.clip(which, 0, len(self.starts) - 1)
+        return self.starts[which], self.ends[which]
 
     def _first_outside(
         self, starts: np.ndarray, ends: np.ndarray, within: float

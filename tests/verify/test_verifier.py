@@ -219,3 +219,13 @@ def test_a_segment_across_a_corner_is_judged_by_its_middle(cut):
         check(CORNER.format(corner=""), written)
     else:
         assert "leaves" in refused(CORNER.format(corner=""), written).message
+
+
+def test_a_segment_across_a_turn_of_several_segments_is_judged_by_its_middle():
+    """The original turns back 0.2 mm over (two segments); the written program runs along all of
+    it, and once straight across the turn from the first segment to the third: both ends of that
+    segment lie on the original path, its middle 0.1 mm from it."""
+    original = "G21 G90 G17\nG0 X0 Y0 Z5\nG1 Z-1 F200\nX10 Y0\nX10 Y0.2\nX0 Y0.2\nM30\n"
+    written = original.replace("X10 Y0.2\n", "X5 Y0\nX5 Y0.2\nX10 Y0.2\nX10 Y0\nX10 Y0.2\n")
+    check(original, original.replace("X10 Y0.2\n", "X5 Y0\nX5 Y0.02\nX5 Y0\nX10 Y0\nX10 Y0.2\n"))
+    assert "leaves" in refused(original, written).message
