@@ -464,6 +464,7 @@ class _Reached:
     def __init__(self) -> None:
         self.line = self.before = self.blocks = 0
         self.block: Block | None = None
+        self.state = (0, 0, 0)  # (a new tuple only when it changes: the verifier tells it by `is`)
 
     def follow(self, events: Iterable[Event]) -> Iterator[Event]:
         for event in events:
@@ -473,10 +474,11 @@ class _Reached:
                 self.blocks += 1
                 if block.line != self.line:
                     self.before, self.line = self.line, block.line
+                self.state = (self.line, self.before, self.blocks)
             yield event
 
     def __call__(self) -> tuple[int, int, int]:
-        return self.line, self.before, self.blocks
+        return self.state
 
 
 @contextmanager

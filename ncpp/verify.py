@@ -268,6 +268,7 @@ def sections(events: Iterable[Event], bound: Bound, cut: Cut = lambda block, mov
         kind = type(event)
         block = event.block
         if block is not last:
+            told = line_of(block.line) if line_of else block.line
             for text in after:
                 yield moves.sample(Action(text, last.line), first_line)  # type: ignore[union-attr]
                 moves, first_line = _Moves(bound), last.line  # type: ignore[union-attr]
@@ -290,7 +291,7 @@ def sections(events: Iterable[Event], bound: Bound, cut: Cut = lambda block, mov
                     yield moves.chunk(at, first_line)
                     moves, first_line = _Moves(bound), block.line
                 into += 1
-            extra = _add(moves, event, extra, inverse_time, line_of(block.line) if line_of else block.line)  # type: ignore[arg-type]
+            extra = _add(moves, event, extra, inverse_time, told)  # type: ignore[arg-type]
         elif kind is Pass and event.dwell is not None:  # type: ignore[union-attr]  # a cycle's, written G4 P
             for text in ("G4", f"P{event.dwell:g}"):  # type: ignore[union-attr]
                 yield moves.sample(Action(text, block.line), first_line)
@@ -508,13 +509,15 @@ class _Feed:
         self.lines = iter(lines)
         self.reached = reached
         self.pending: list[str] = []
-        # (last written line of a text, its tag, the line before, the input blocks run so far)
+        # (first written line of the texts handed out at one `reached()`, their tag, the line
+        # before, the input blocks run so far): `reached()` is the same object until it changes
         self.tags: deque[tuple[int, int, int, int]] = deque()
         self.count = 0  # written lines read so far
         self.recent: deque[tuple[int, str]] = deque(maxlen=64)  # for messages
 
     def __iter__(self) -> Iterator[bytes]:
         lines = iter(self.lines)
+        last = None
         while True:
             try:
                 text = next(lines)
@@ -522,19 +525,22 @@ class _Feed:
                 return
             except NcppError as err:
                 raise _Upstream(err) from None
-            tag, before, run = self.reached()
+            reached = self.reached()
+            if reached is not last:
+                last = reached
+                self.tags.append((self.count + 1, *reached))
             self.pending.append(text)
             self.count += text.count("\n") or 1
-            self.tags.append((self.count, tag, before, run))
             self.recent.append((self.count, text))
             yield text.encode("latin-1")
 
     def tag(self, number: int, before: bool = False) -> int:
         """The tag of written line `number` (asked in increasing order): the input line the
         writer had reached, or (`before`) the one before it, where the line most likely is from."""
-        while len(self.tags) > 1 and self.tags[0][0] < number:
-            self.tags.popleft()
-        return self.tags[0][2 if before else 1] if self.tags else 0
+        tags = self.tags
+        while len(tags) > 1 and tags[1][0] <= number:
+            tags.popleft()
+        return tags[0][2 if before else 1] if tags else 0
 
     def run(self, number: int) -> int:
         """How many input blocks the writer had taken when it handed out written line `number`
@@ -806,7 +812,7 @@ class _Nearby:
         first = np.concatenate(([0], np.cumsum(counts)[:-1]))
         t = (np.arange(len(self.segment)) - first[self.segment] + 0.5) / counts[self.segment]
         points = starts[self.segment] + t[:, None] * (ends - starts)[self.segment]
-        self.tree = cKDTree(points, balanced_tree=False)
+        self.tree = cKDTree(points, balanced_tree=False, compact_nodes=False)  # (built faster, as fast)
         self.looked_at = 0
 
     def distances(self, points: np.ndarray, within: float, k: int) -> tuple[np.ndarray, np.ndarray]:
