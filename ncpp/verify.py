@@ -40,6 +40,7 @@ import re
 from collections import deque
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
+from functools import lru_cache
 from typing import BinaryIO
 
 import numpy as np
@@ -269,10 +270,11 @@ def sections(events: Iterable[Event], bound: Bound, cut: Cut = lambda block, mov
         block = event.block
         if block is not last:
             told = line_of(block.line) if line_of else block.line
-            for text in after:
-                yield moves.sample(Action(text, last.line), first_line)  # type: ignore[union-attr]
-                moves, first_line = _Moves(bound), last.line  # type: ignore[union-attr]
-            after = []
+            if after:
+                for text in after:
+                    yield moves.sample(Action(text, last.line), first_line)  # type: ignore[union-attr]
+                    moves, first_line = _Moves(bound), last.line  # type: ignore[union-attr]
+                after = []
             last = block
             run += 1
             into = 0 if divisible is not None and divisible(event) else -1
@@ -305,6 +307,7 @@ def sections(events: Iterable[Event], bound: Bound, cut: Cut = lambda block, mov
 _ACTING = re.compile(r"[MTSHDP]|G4|G9")
 
 
+@lru_cache(maxsize=4096)  # (a program's blocks have few signatures)
 def _may_act(signature: str | None) -> bool:
     """Whether a block may hold an action or a feed mode: its signature (the letters of a plain
     block's words, G words with their numbers) names one; None (not a plain block) may."""
