@@ -18,9 +18,10 @@ the passes' state) and compares it with the input program's motion:
 Paths are compared in machine coordinates (mm, tool length and work offsets
 applied) as straight segments, arcs in chords within an eighth of the bound:
 a segment of one path whose two ends lie within the bound of one segment of
-the other (or of two that follow one another, less what their chord cuts off
-the corner) lies within it along its length; any other is looked at at points
-a quarter of the bound apart.  Every point passed lies within 1.6 times the
+the other (or of two of a few that follow one another, less how far the
+vertices between lie from the line between the ends' closest points) lies
+within it along its length; any other is looked at at points a quarter of the
+bound apart.  Every point passed lies within 1.6 times the
 bound, and no correction within the bound is refused.  A violation is an
 `NcppError` at the input line where it happens.
 
