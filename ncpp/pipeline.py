@@ -394,8 +394,10 @@ def process(
     ctx = make_context(source, tolerance, warnings, file)
     reached = _Reached()
     compensated = summary.written(run_passes(summary.programmed(events), ctx, PASSES))
+    if verify:  # (how far the writer has read: the verifier tags the written lines by it)
+        compensated = reached.follow(compensated)
     header = header_text(source, tolerance, offsets, name)
-    lines = with_header(writer.write(reached.follow(compensated)), header, writer, get_dialect(name).leader)
+    lines = with_header(writer.write(compensated), header, writer, get_dialect(name).leader)
     if guard is not None:
         said = guard.said()
         lines = with_guard(lines, guard, name, HEADER_TAG, header.count("\n") + 1,
