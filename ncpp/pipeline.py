@@ -404,11 +404,11 @@ def process(
     ctx = make_context(source, tolerance, warnings, file)
     reached = _Reached()
     compensated = summary.written(run_passes(summary.programmed(events), ctx, PASSES))
+    if verify:  # (how far the writer has read: the verifier tags the written lines by it)
+        compensated = reached.follow(compensated)
     header = header_text(source, tolerance, offsets, name)
     after = _tool_guard(name, offsets, warnings, file) if guard_tools else None
-    lines = with_header(
-        writer.write(reached.follow(compensated), after), header, writer, get_dialect(name).leader
-    )
+    lines = with_header(writer.write(compensated, after), header, writer, get_dialect(name).leader)
     if guard is not None:
         said = guard.said()
         lines = with_guard(lines, guard, name, HEADER_TAG, header.count("\n") + 1,
@@ -488,6 +488,7 @@ class _Reached:
     def __init__(self) -> None:
         self.line = self.before = self.blocks = 0
         self.block: Block | None = None
+        self.state = (0, 0, 0)  # (a new tuple only when it changes: the verifier tells it by `is`)
 
     def follow(self, events: Iterable[Event]) -> Iterator[Event]:
         for event in events:
@@ -497,10 +498,11 @@ class _Reached:
                 self.blocks += 1
                 if block.line != self.line:
                     self.before, self.line = self.line, block.line
+                self.state = (self.line, self.before, self.blocks)
             yield event
 
     def __call__(self) -> tuple[int, int, int]:
-        return self.line, self.before, self.blocks
+        return self.state
 
 
 @contextmanager

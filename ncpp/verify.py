@@ -20,9 +20,10 @@ the passes' state) and compares it with the input program's motion:
 Paths are compared in machine coordinates (mm, tool length and work offsets
 applied) as straight segments, arcs in chords within an eighth of the bound:
 a segment of one path whose two ends lie within the bound of one segment of
-the other (or of two that follow one another, less what their chord cuts off
-the corner) lies within it along its length; any other is looked at at points
-a quarter of the bound apart.  Every point passed lies within 1.6 times the
+the other (or of two of a few that follow one another, less how far the
+vertices between lie from the line between the ends' closest points) lies
+within it along its length; any other is looked at at points a quarter of the
+bound apart.  Every point passed lies within 1.6 times the
 bound, and no correction within the bound is refused.  A violation is an
 `NcppError` at the input line where it happens.
 
@@ -42,6 +43,7 @@ import re
 from collections import deque
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
+from functools import lru_cache
 from typing import BinaryIO
 
 import numpy as np
@@ -270,10 +272,12 @@ def sections(events: Iterable[Event], bound: Bound, cut: Cut = lambda block, mov
         kind = type(event)
         block = event.block
         if block is not last:
-            for text in after:
-                yield moves.sample(Action(text, last.line), first_line)  # type: ignore[union-attr]
-                moves, first_line = _Moves(bound), last.line  # type: ignore[union-attr]
-            after = []
+            told = line_of(block.line) if line_of else block.line
+            if after:
+                for text in after:
+                    yield moves.sample(Action(text, last.line), first_line)  # type: ignore[union-attr]
+                    moves, first_line = _Moves(bound), last.line  # type: ignore[union-attr]
+                after = []
             last = block
             run += 1
             into = 0 if divisible is not None and divisible(event) else -1
@@ -292,7 +296,7 @@ def sections(events: Iterable[Event], bound: Bound, cut: Cut = lambda block, mov
                     yield moves.chunk(at, first_line)
                     moves, first_line = _Moves(bound), block.line
                 into += 1
-            extra = _add(moves, event, extra, inverse_time, line_of(block.line) if line_of else block.line)  # type: ignore[arg-type]
+            extra = _add(moves, event, extra, inverse_time, told)  # type: ignore[arg-type]
         elif kind is Pass and event.dwell is not None:  # type: ignore[union-attr]  # a cycle's, written G4 P
             for text in ("G4", f"P{event.dwell:g}"):  # type: ignore[union-attr]
                 yield moves.sample(Action(text, block.line), first_line)
@@ -306,6 +310,7 @@ def sections(events: Iterable[Event], bound: Bound, cut: Cut = lambda block, mov
 _ACTING = re.compile(r"[MTSHDP]|G4|G9")
 
 
+@lru_cache(maxsize=4096)  # (a program's blocks have few signatures)
 def _may_act(signature: str | None) -> bool:
     """Whether a block may hold an action or a feed mode: its signature (the letters of a plain
     block's words, G words with their numbers) names one; None (not a plain block) may."""
@@ -510,13 +515,15 @@ class _Feed:
         self.lines = iter(lines)
         self.reached = reached
         self.pending: list[str] = []
-        # (last written line of a text, its tag, the line before, the input blocks run so far)
+        # (first written line of the texts handed out at one `reached()`, their tag, the line
+        # before, the input blocks run so far): `reached()` is the same object until it changes
         self.tags: deque[tuple[int, int, int, int]] = deque()
         self.count = 0  # written lines read so far
         self.recent: deque[tuple[int, str]] = deque(maxlen=64)  # for messages
 
     def __iter__(self) -> Iterator[bytes]:
         lines = iter(self.lines)
+        last = None
         while True:
             try:
                 text = next(lines)
@@ -524,19 +531,22 @@ class _Feed:
                 return
             except NcppError as err:
                 raise _Upstream(err) from None
-            tag, before, run = self.reached()
+            reached = self.reached()
+            if reached is not last:
+                last = reached
+                self.tags.append((self.count + 1, *reached))
             self.pending.append(text)
             self.count += text.count("\n") or 1
-            self.tags.append((self.count, tag, before, run))
             self.recent.append((self.count, text))
             yield text.encode("latin-1")
 
     def tag(self, number: int, before: bool = False) -> int:
         """The tag of written line `number` (asked in increasing order): the input line the
         writer had reached, or (`before`) the one before it, where the line most likely is from."""
-        while len(self.tags) > 1 and self.tags[0][0] < number:
-            self.tags.popleft()
-        return self.tags[0][2 if before else 1] if self.tags else 0
+        tags = self.tags
+        while len(tags) > 1 and tags[1][0] <= number:
+            tags.popleft()
+        return tags[0][2 if before else 1] if tags else 0
 
     def run(self, number: int) -> int:
         """How many input blocks the writer had taken when it handed out written line `number`
@@ -793,8 +803,9 @@ def _widened(points: np.ndarray, width: int) -> np.ndarray:
 
 
 class _Nearby:
-    """The segments of a path, looked up by points spaced `Bound.coarse` along them: every
-    segment passing within r of a point has one of its points within r + coarse / 2."""
+    """The segments of a path, looked up by points: the middles of the pieces at most `Bound.coarse`
+    long each is cut into, so that every segment passing within r of a point has a lookup point
+    within r + coarse / 2."""
 
     FEW, MANY = 6, 96  # nearest lookup points asked for, then for the points that found none near
     BATCH = 1 << 15  # points looked at at once
@@ -803,11 +814,11 @@ class _Nearby:
         self.starts, self.ends, self.reach = starts, ends, bound.coarse / 2
         lengths = np.sqrt(((ends - starts) ** 2).sum(axis=1))
         counts = np.maximum(1, np.ceil(lengths / bound.coarse)).astype(np.int64)
-        self.segment = np.repeat(np.arange(len(counts)), counts + 1)
-        first = np.concatenate(([0], np.cumsum(counts + 1)[:-1]))
-        t = (np.arange(len(self.segment)) - first[self.segment]) / counts[self.segment]
+        self.segment = np.repeat(np.arange(len(counts)), counts)
+        first = np.concatenate(([0], np.cumsum(counts)[:-1]))
+        t = (np.arange(len(self.segment)) - first[self.segment] + 0.5) / counts[self.segment]
         points = starts[self.segment] + t[:, None] * (ends - starts)[self.segment]
-        self.tree = cKDTree(points, balanced_tree=False)
+        self.tree = cKDTree(points, balanced_tree=False, compact_nodes=False)  # (built faster, as fast)
         self.looked_at = 0
 
     def distances(self, points: np.ndarray, within: float, k: int) -> tuple[np.ndarray, np.ndarray]:
@@ -845,7 +856,8 @@ class _Nearby:
         off = np.maximum(distance[rest], near_end)
         width = self.ends.shape[1]
         vertex = self.ends[q].reshape(-1, width)
-        cut = _to_lines(vertex, closest[rest].reshape(-1, width), at_end.reshape(-1, width)).reshape(q.shape)
+        cut, _ = _to_lines(vertex, closest[rest].reshape(-1, width), at_end.reshape(-1, width))
+        cut = cut.reshape(q.shape)
         return (joined & (off + cut <= within)).any(axis=1)
 
     def first_outside(
@@ -861,26 +873,44 @@ class _Nearby:
         far = self._first_outside(starts[rest], ends[rest], within)
         return None if far is None else (int(rest[far[0]]), far[1])
 
+    # Ways a segment is proven along the path near its start (`_along_the_nearest`), most
+    # frequent first: the segments its start and its end lie near, counted from q
+    WAYS = ((0, 0), (0, 1), (0, 2), (0, 3), (-1, -1), (1, 1))
+
     def _along_the_nearest(self, starts: np.ndarray, ends: np.ndarray, within: float) -> np.ndarray:
-        """Which segments lie within `within` of the segment q whose lookup point is nearest their
-        start, or of the one before or after it (by both ends near one, or across a common vertex
-        as in `_across_a_vertex`)."""
+        """Which segments lie within `within` of the path here, proven from their ends: the start
+        near segment q+i (q: the one whose lookup point is nearest the start), the end near q+j
+        (j >= i), the segments from q+i to q+j joined end to start.  A point of such a segment lies
+        no further than its ends do from the line between their closest points on the path, and a
+        point of that line no further from the path than the vertices between lie from the line
+        (the path runs from one end of the line to the other).  Each way of `WAYS` is tried only on
+        the segments the ways before left unproven."""
         _, found = self.tree.query(starts, k=1, distance_upper_bound=within + self.reach)
-        missing = found >= len(self.segment)
-        nearest = self.segment[np.minimum(found, len(self.segment) - 1)]
-        q = np.clip(nearest[:, None] + np.array([-1, 0, 1]), 0, len(self.starts) - 1)
-        a, b = self.starts[q], self.ends[q]
-        near, at_start = _to_segments(starts, a, b)
-        far, at_end = _to_segments(ends, a, b)
-        proven = ((near <= within) & (far <= within)).any(axis=1)
-        # the start near one, the end near the one after it, across their common vertex
-        joined = (q[:, :2] < q[:, 1:]) & np.all(b[:, :2] == a[:, 1:], axis=2)
-        width = a.shape[2]
-        vertex = b[:, :2].reshape(-1, width)
-        cut = _to_lines(vertex, at_start[:, :2].reshape(-1, width), at_end[:, 1:].reshape(-1, width))
-        off = np.maximum(near[:, :2], far[:, 1:]) + cut.reshape(-1, 2)
-        proven |= (joined & (off <= within)).any(axis=1)
-        return ~missing & proven
+        proven = np.zeros(len(starts), dtype=bool)
+        rest = np.flatnonzero(found < len(self.segment))
+        nearest = self.segment[found[rest]]
+        last = len(self.starts) - 1
+        for first, second in self.WAYS:
+            q, after = nearest + first, nearest + second
+            usable = (q >= 0) & (after <= last)
+            near, at_start = _to_lines(starts[rest], *self._segments(q))
+            far, at_end = _to_lines(ends[rest], *self._segments(after))
+            cut = np.zeros(len(rest))
+            for between in range(first, second):
+                vertex = self._segments(nearest + between)[1]
+                usable &= np.all(vertex == self._segments(nearest + between + 1)[0], axis=1)
+                cut = np.maximum(cut, _to_lines(vertex, at_start, at_end)[0])
+            ok = usable & (np.maximum(near, far) + cut <= within)
+            proven[rest[ok]] = True
+            rest, nearest = rest[~ok], nearest[~ok]
+            if not len(rest):
+                break
+        return proven
+
+    def _segments(self, which: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The starts and ends of segments `which` (clipped to those there are)."""
+        which = np.clip(which, 0, len(self.starts) - 1)
+        return self.starts[which], self.ends[which]
 
     def _first_outside(
         self, starts: np.ndarray, ends: np.ndarray, within: float
@@ -962,13 +992,14 @@ def _to_segments(points: np.ndarray, starts: np.ndarray, ends: np.ndarray) -> tu
     return np.sqrt(np.einsum("nkw,nkw->nk", off, off)), closest
 
 
-def _to_lines(points: np.ndarray, starts: np.ndarray, ends: np.ndarray) -> np.ndarray:
-    """(n,) distances of n points to n segments."""
+def _to_lines(points: np.ndarray, starts: np.ndarray, ends: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(n,) distances of n points to n segments, and (n, width) the segments' points closest to them."""
     d = ends - starts
     length2 = np.einsum("nw,nw->n", d, d)
     t = np.clip(np.einsum("nw,nw->n", points - starts, d) / np.where(length2 > 0, length2, 1.0), 0.0, 1.0)
-    off = points - starts - t[:, None] * d
-    return np.sqrt(np.einsum("nw,nw->n", off, off))
+    closest = starts + t[:, None] * d
+    off = points - closest
+    return np.sqrt(np.einsum("nw,nw->n", off, off)), closest
 
 
 def _line_text(stream: BinaryIO, number: int | None) -> str:
