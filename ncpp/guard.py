@@ -58,7 +58,7 @@ from __future__ import annotations
 
 import re
 from collections.abc import Callable, Iterable, Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from itertools import chain, islice
 
 from ncpp.motion.offsets import WorkOffsets, system_name
@@ -77,6 +77,11 @@ GUARD_BLOCKS = 12  # the most blocks a guard has (a first comment without its la
 # comment, a blank line): the 840D wants definitions before the program's first statement
 # (Job Planning, "Definition of user variables (DEF)")
 _SINUMERIK_DEFINITION = re.compile(r"\s*(N\d+\s*)?(DEF\s|REDEF\s|;|$)", re.IGNORECASE)
+# A Sinumerik line of G codes alone (and a block number, a comment), and the settable frame
+# G54-G57 it may select; how many such lines after the definitions the guard may follow
+_SINUMERIK_SETTINGS = re.compile(r"\s*(N\d+\s*)?(G\d+\s*)*(;.*)?$", re.IGNORECASE)
+_SETTABLE_FRAME = re.compile(r"(?<![A-Z0-9_])G0*(5[4-7])(?![0-9.])", re.IGNORECASE)
+_SETTINGS_SCANNED = 8
 # A Fanuc program number line (`O1234`, perhaps with a comment); not an o-word line (`o100 sub`)
 _FANUC_PROGRAM_NUMBER = re.compile(r"\s*O\d+\s*(\(.*\))?\s*$")
 
@@ -118,17 +123,27 @@ def _units(unit_mm: float) -> str:
     return "mm" if unit_mm == 1.0 else "inch" if unit_mm == 25.4 else f"x{unit_mm:g} mm"
 
 
-def _after_definitions(head: list[str], at: int, rest: Iterator[str]) -> int:
-    """Where the guard goes in a Sinumerik program: after the definitions at its start (`head`
-    takes the lines it needs from `rest`)."""
+def _sinumerik_place(head: list[str], at: int, rest: Iterator[str]) -> tuple[int, int | None]:
+    """Where the guard goes in a Sinumerik program, and the settable frame (1-4: G54-G57) the
+    program has selected there (None: the one in effect counts): after the definitions at its
+    start, and after the lines of G codes alone that follow them up to one that selects a
+    settable frame, if one does (`head` takes the lines it needs from `rest`)."""
+    settings, start = 0, None  # (start: the first line after the definitions)
     while True:
         if at == len(head):
             line = next(rest, None)
             if line is None:
-                return at
+                return at if start is None else start, None
             head.append(line)
-        if not _SINUMERIK_DEFINITION.match(head[at]):
-            return at
+        text = head[at]
+        if not _SINUMERIK_DEFINITION.match(text) or start is not None:
+            start = at if start is None else start
+            if settings >= _SETTINGS_SCANNED or not _SINUMERIK_SETTINGS.match(text):
+                return start, None
+            settings += 1
+            frame = _SETTABLE_FRAME.search(text.split(";", 1)[0])
+            if frame is not None:
+                return at + 1, int(frame.group(1)) - 53
         at += 1
 
 
@@ -180,7 +195,8 @@ def _fanuc(placement: Placement) -> list[str]:
     return lines + [f"({END.upper()})"]
 
 
-def _sinumerik(placement: Placement) -> list[str]:
+def _sinumerik(placement: Placement, selected: bool = False) -> list[str]:
+    """`selected`: the program has selected the frame itself (only its translation is checked)."""
     if placement.system > 4:
         return []  # (G58, G59 are Sinumerik's programmable offsets, not a settable frame)
     n, tolerance = placement.system, _tolerance(placement)
@@ -190,7 +206,7 @@ def _sinumerik(placement: Placement) -> list[str]:
     )
     return [
         f"; {BEGIN} {placement.said()} within {_number(GUARD_MM)} mm",
-        f"IF ($P_UIFRNUM<>{n}) OR {far}",
+        f"IF {far}" if selected else f"IF ($P_UIFRNUM<>{n}) OR {far}",
         f'MSG("ncpp: compensated for {placement.said()}: the settable frame differs")',
         "SETAL(65000)",
         "M0",
@@ -242,7 +258,9 @@ def with_guard(
     while at < len(head) and _FANUC_PROGRAM_NUMBER.match(head[at]):
         at += 1
     if dialect == "sinumerik":  # (the guard's IF is a statement: after the definitions)
-        at = _after_definitions(head, at, it)
+        at, frame = _sinumerik_place(head, at, it)
+        if frame is not None:  # the zero told is that of the frame the program selects first
+            guard = _sinumerik(replace(placement, system=frame), selected=True)
     eol = "\r\n" if head[at - 1].endswith("\r\n") else "\n"
     yield from head[:at]
     yield from (line + eol for line in guard)

@@ -164,13 +164,14 @@ def test_a_sinumerik_program_gets_its_settable_frame_checked_and_ncpp_still_read
     lines = (tmp_path / "out.mpf").read_text().splitlines()
     k = next(
         n for n, line in enumerate(lines) if line.startswith("; ncpp placement guard:")
-    )  # after the header's lines
-    lines = lines[k - 1 :]  # (as if the header were one line)
-    assert lines[2] == (
-        "IF ($P_UIFRNUM<>1) OR (ABS($P_UIFR[1,X,TR]+$P_UIFR[1,X,FI]-400)>0.1) OR "
+    )  # after the program's line that selects G54
+    assert lines[k - 1] == "G54 G17 G90"
+    lines = lines[k - 1 :]
+    assert lines[2] == (  # (the program selects the frame: its translation is what counts)
+        "IF (ABS($P_UIFR[1,X,TR]+$P_UIFR[1,X,FI]-400)>0.1) OR "
         "(ABS($P_UIFR[1,Y,TR]+$P_UIFR[1,Y,FI]-350)>0.1) OR (ABS($P_UIFR[1,Z,TR]+$P_UIFR[1,Z,FI]-300)>0.1)"
     )
-    assert lines[4:7] == ["SETAL(65000)", "M0", "ENDIF"] and lines[8] == "G54 G17 G90"
+    assert lines[4:7] == ["SETAL(65000)", "M0", "ENDIF"] and lines[8].startswith("G0 X")
     simulated = run("simulate", "out.mpf", "--reference", "p.mpf")
     assert simulated.returncode == 0 and "outside the motion interpreter" not in simulated.stderr, (
         simulated.stderr
@@ -236,10 +237,31 @@ def test_a_sinumerik_guard_comes_after_the_programs_definitions():
         "N10 DEF REAL DEPTH=-2\n",
         "\n",
         "def int i ; a counter\n",
-        "G54 G90\n",
+        "G0 X1\n",
         "M30\n",
     ]
     written = list(with_guard(program, Placement(1, (400.0, 350.0, 300.0)), "sinumerik", "ncpp header"))
     first = next(n for n, line in enumerate(written) if line.startswith("IF "))
     assert written[:4] == program[:4] and written[first - 1].startswith("; ncpp placement guard:")
     assert written[-2:] == program[-2:] and "; ncpp placement guard end\n" in written
+
+
+@pytest.mark.parametrize(
+    "first, frame, active_checked",
+    [("G55 G17 G90\n", 2, False), ("N10 G17 G90 ; the plane\nN20 G57\n", 4, False), ("G0 X10\n", 1, True),
+     ("T1 D1 M6\nG55\n", 1, True)],
+)  # fmt: skip
+def test_a_sinumerik_guard_checks_the_frame_the_program_selects_first(first, frame, active_checked):
+    """The zero told is that of the frame the program selects first: where lines of G codes alone
+    select one before anything else runs, the guard follows them and checks that frame's
+    translation; else it checks the frame in effect ($P_UIFRNUM) as well, before anything runs."""
+    from ncpp.guard import Placement, with_guard
+
+    program = ["; ncpp header\n", "DEF INT I\n", *first.splitlines(keepends=True), "G1 X20 F100\n", "M30\n"]
+    written = list(with_guard(program, Placement(1, (400.0, 350.0, 300.0)), "sinumerik", "ncpp header"))
+    check = next(line for line in written if line.startswith("IF "))
+    assert f"$P_UIFR[{frame},X,TR]" in check and ("$P_UIFRNUM" in check) == active_checked
+    before = written[: written.index(check)]
+    assert [line for line in before if not line.startswith(";")] == (
+        ["DEF INT I\n"] if active_checked else ["DEF INT I\n", *first.splitlines(keepends=True)]
+    )
