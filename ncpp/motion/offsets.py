@@ -116,8 +116,13 @@ class WorkOffsets:
     ) -> WorkOffsets:
         """What a user says: a parameter file, if any (else G54 at the machine zero), with
         `zeros` (G word -> machine mm) over it, a tool table, if any (LinuxCNC's
-        files are both in the machine's units, `unit_mm`), and subroutine folders."""
+        files are both in the machine's units, `unit_mm`), and subroutine folders.  Without a
+        parameter file, the one system named is the one in effect at the start (`G55=` alone:
+        the program runs in G55 until it selects another)."""
         base = cls.from_var_file(var_file, unit_mm) if var_file else AT_MACHINE_ZERO
+        named = [system_number(name) for name in zeros]
+        if not var_file and len(named) == 1 and named[0] <= len(base.systems):
+            base = replace(base, active=named[0])
         tools = ToolTable.from_file(tool_table, unit_mm) if tool_table else None
         folders = tuple(Path(p) for p in subroutine_path)
         return replace(base.with_zeros(zeros), tools=tools, subroutine_path=folders, unit_mm=unit_mm)

@@ -277,3 +277,14 @@ def test_placement_agrees_with_linuxcnc_started_from_the_same_parameter_file(tmp
 def test_a_missing_parameter_file_is_a_located_error(tmp_path):
     with pytest.raises(NcppError, match=r"nowhere.var: cannot read the parameter file"):
         WorkOffsets.from_var_file(tmp_path / "nowhere.var")
+
+
+def test_one_zero_named_alone_is_the_system_in_effect_at_the_start():
+    """`--work-offset G55=...` alone: the program runs in G55 until it selects another (a
+    Sinumerik or Klartext program's one zero is it); with G54 named too, G54 is in effect."""
+    from ncpp.motion.offsets import WorkOffsets
+
+    alone = WorkOffsets.given({"G55": (400.0, 350.0, 300.0)})
+    assert alone.active == 2 and alone.program_zero() == (400.0, 350.0, 300.0)
+    both = WorkOffsets.given({"G54": (1.0, 2.0, 3.0), "G55": (400.0, 350.0, 300.0)})
+    assert both.active == 1 and both.program_zero() == (1.0, 2.0, 3.0)
