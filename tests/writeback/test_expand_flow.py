@@ -47,6 +47,7 @@ FLOW_LINE = re.compile(rf"^[ \t]*(N\d+[ \t]*)?(o[ \t]*(\d+|<[^>]*>)[ \t]*({KEYWO
                        re.IGNORECASE | re.MULTILINE)  # fmt: skip
 # A subroutine's definition, which stays (the control skips it)
 DEFINITION = re.compile(r"^\s*o\s*(\d+|<[^>]*>)\s*sub\b.*?^\s*o\s*\1\s*endsub.*?$", re.I | re.M | re.S)
+TOOL_GUARD = re.compile(r"^\(ncpp tool guard:.*?^\(ncpp tool guard end\)$", re.M | re.S)
 
 PROGRAMS = {
     # a helical-free pocket corner subroutine with three arguments, called three times
@@ -161,8 +162,9 @@ M2
 
 
 def _running(text: str) -> str:
-    """The written program without its subroutine definitions (they do not run)."""
-    return DEFINITION.sub("", text)
+    """The written program without its subroutine definitions (they do not run) and the tool
+    guard's checks (an o-word `if` of ncpp's own, not the program's flow)."""
+    return TOOL_GUARD.sub("", DEFINITION.sub("", text))
 
 
 def _compensated(tmp_path: Path, text: str, **options) -> tuple[Path, Path]:
