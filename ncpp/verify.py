@@ -796,11 +796,16 @@ class _Nearby:
 
     FEW, MANY = 6, 96  # nearest lookup points asked for, then for the points that found none near
     BATCH = 1 << 15  # points looked at at once
+    POINTS = 1 << 22  # lookup points along the path at most: a longer path's are spaced wider
 
     def __init__(self, starts: np.ndarray, ends: np.ndarray, bound: Bound):
-        self.starts, self.ends, self.reach = starts, ends, bound.coarse / 2
         lengths = np.sqrt(((ends - starts) ** 2).sum(axis=1))
-        counts = np.maximum(1, np.ceil(lengths / bound.coarse)).astype(np.int64)
+        if not np.isfinite(lengths).all():
+            raise NcppError("verification: a move too long to verify", Location("", 1, 1))
+        # (wider spacing widens the reach each lookup covers: the same segments are found)
+        spacing = max(bound.coarse, float(lengths.sum()) / self.POINTS)
+        self.starts, self.ends, self.reach = starts, ends, spacing / 2
+        counts = np.maximum(1, np.ceil(lengths / spacing)).astype(np.int64)
         self.segment = np.repeat(np.arange(len(counts)), counts + 1)
         first = np.concatenate(([0], np.cumsum(counts + 1)[:-1]))
         t = (np.arange(len(self.segment)) - first[self.segment]) / counts[self.segment]
