@@ -650,6 +650,11 @@ class _Comparison:
             line = along.first_line if written else int(path.lines[0])
             raise NcppError(f"verification: {message}: it has no move here", Location(file, line, 1))
         within = self.bound.within
+        endless = np.flatnonzero(~np.isfinite(np.sqrt(((path.ends - path.starts) ** 2).sum(axis=1))))
+        if len(endless):
+            raise NcppError(
+                "verification: a move too long to verify", Location(file, int(path.lines[endless[0]]), 1)
+            )
         (starts, ends), (a, b) = _alike((path.starts, path.ends), (along.starts, along.ends))
         # (a path that runs again, a loop's, is looked up by each segment once: a lookup tree of
         # many equal points looks at all of them)
@@ -796,7 +801,7 @@ class _Nearby:
 
     FEW, MANY = 6, 96  # nearest lookup points asked for, then for the points that found none near
     BATCH = 1 << 15  # points looked at at once
-    POINTS = 1 << 22  # lookup points along the path at most: a longer path's are spaced wider
+    POINTS = 1 << 20  # lookup points along the path at most: a longer path's are spaced wider
 
     def __init__(self, starts: np.ndarray, ends: np.ndarray, bound: Bound):
         lengths = np.sqrt(((ends - starts) ** 2).sum(axis=1))

@@ -103,25 +103,35 @@ def _heidenhain(rng: random.Random, folder: Path) -> tuple[str, list[str]]:
     s = lambda: ("+" if not n().startswith("-") else "") + n()  # noqa: E731
     pool = [
         lambda: f"PATTERN DEF ~\n   CIRC1 (X{s()} Y{s()} D{s()} START{s()} NUM{n()} Z{s()})",
-        lambda: f"PATTERN DEF ~\n   PAT1 (X{s()} Y{s()} DX{s()} DY{s()} NUMX{n()} NUMY{n()} ROT{s()} "
-        f"ROTX{s()} ROTY{s()} Z{s()})",
+        lambda: (
+            f"PATTERN DEF ~\n   PAT1 (X{s()} Y{s()} DX{s()} DY{s()} NUMX{n()} NUMY{n()} ROT{s()} "
+            f"ROTX{s()} ROTY{s()} Z{s()})"
+        ),
         lambda: f"PATTERN DEF ~\n   ROW1 (X{s()} Y{s()} D{s()} NUM{n()} ROT{s()} Z{s()})",
         lambda: f"PATTERN DEF ~\n   POS1 (X{s()} IY{s()} Z{s()})",
-        lambda: f"PATTERN DEF ~\n   FRAME1 (X{s()} Y{s()} DX{s()} DY{s()} NUMX{n()} NUMY{n()} ROT+0 "
-        "ROTX+0 ROTY+0 Z+0)",
+        lambda: (
+            f"PATTERN DEF ~\n   FRAME1 (X{s()} Y{s()} DX{s()} DY{s()} NUMX{n()} NUMY{n()} ROT+0 "
+            "ROTX+0 ROTY+0 Z+0)"
+        ),
         lambda: f"PATTERN DEF ~\n   PITCHCIRC1 (X{s()} Y{s()} D{s()} START{s()} STEP{s()} NUM{n()} Z{s()})",
         lambda: "CYCL CALL PAT FMAX M13",
         lambda: "CYCL CALL PAT F" + n(),
         lambda: f"CYCL CALL POS X{s()} Y{s()} Z{s()} FMAX",
         lambda: f"CYCL CALL POS IX{s()} Z{s()} F{n()}",
-        lambda: f"CYCL DEF 205 UNIVERSAL PECKING ~\n Q200={s()} ~\n Q201={s()} ~\n Q206={s()} ~\n"
-        f" Q202={s()} ~\n Q203={s()} ~\n Q204={s()} ~\n Q212={s()} ~\n Q205={s()} ~\n Q258={s()} ~\n"
-        f" Q259={s()} ~\n Q257={s()} ~\n Q256={s()} ~\n Q211={s()} ~\n Q379={s()} ~\n Q253={s()}",
-        lambda: f"CYCL DEF 207 RIGID TAPPING ~\n Q200={s()} ~\n Q201={s()} ~\n Q239={s()} ~\n"
-        f" Q203={s()} ~\n Q204={s()}",
+        lambda: (
+            f"CYCL DEF 205 UNIVERSAL PECKING ~\n Q200={s()} ~\n Q201={s()} ~\n Q206={s()} ~\n"
+            f" Q202={s()} ~\n Q203={s()} ~\n Q204={s()} ~\n Q212={s()} ~\n Q205={s()} ~\n Q258={s()} ~\n"
+            f" Q259={s()} ~\n Q257={s()} ~\n Q256={s()} ~\n Q211={s()} ~\n Q379={s()} ~\n Q253={s()}"
+        ),
+        lambda: (
+            f"CYCL DEF 207 RIGID TAPPING ~\n Q200={s()} ~\n Q201={s()} ~\n Q239={s()} ~\n"
+            f" Q203={s()} ~\n Q204={s()}"
+        ),
         lambda: f"CYCL DEF 207 RIGID TAPPING ~\n Q200={s()} ~\n Q201={s()}",
-        lambda: f"CYCL DEF 200 DRILLING ~\n Q200={s()} ~\n Q201={s()} ~\n Q206={s()} ~\n Q202={s()} ~\n"
-        f" Q210=+0 ~\n Q203={s()} ~\n Q204={s()} ~\n Q211=+0",
+        lambda: (
+            f"CYCL DEF 200 DRILLING ~\n Q200={s()} ~\n Q201={s()} ~\n Q206={s()} ~\n Q202={s()} ~\n"
+            f" Q210=+0 ~\n Q203={s()} ~\n Q204={s()} ~\n Q211=+0"
+        ),
         lambda: "L FMAX M99",
         lambda: f"L X{s()} Y{s()} FMAX M99",
         lambda: "CYCL CALL",
@@ -162,10 +172,14 @@ def _sinumerik(rng: random.Random, folder: Path) -> tuple[str, list[str]]:
         lambda: f"MYSUB({n()}, {n()}) P{n()}",
         lambda: "SELFSUB",
         lambda: f"MISSING({n()})",
-        lambda: f"MCALL CYCLE81({n()}, {n()}, {n()}, {n()})\nHOLES1({n()}, {n()}, {n()}, {n()}, {n()}, {n()})"
-        "\nMCALL",
-        lambda: f"MCALL CYCLE82(10, 0, 2, {n()}, , {n()})\nHOLES2({n()}, {n()}, {n()}, {n()}, {n()}, {n()})"
-        "\nMCALL",
+        lambda: (
+            f"MCALL CYCLE81({n()}, {n()}, {n()}, {n()})\nHOLES1({n()}, {n()}, {n()}, {n()}, {n()}, {n()})"
+            "\nMCALL"
+        ),
+        lambda: (
+            f"MCALL CYCLE82(10, 0, 2, {n()}, , {n()})\nHOLES2({n()}, {n()}, {n()}, {n()}, {n()}, {n()})"
+            "\nMCALL"
+        ),
         lambda: f"MCALL CYCLE85(10, 0, 2, -8, , 0.2, {n()}, {n()})\nHOLES2(0, 0, {n()}, 0, 0, {n()})\nMCALL",
         lambda: f"HOLES1({n()}, {n()}, {n()}, {n()}, {n()}, {n()})",
         lambda: f"CYCLE84({n()}, {n()}, {n()}, {n()}, , {n()}, {n()}, , {n()}, {n()}, {n()}, {n()})",
@@ -175,8 +189,10 @@ def _sinumerik(rng: random.Random, folder: Path) -> tuple[str, list[str]]:
         lambda: f"G{rng.choice(['17', '18', '19'])}",
         lambda: "G91",
         lambda: "G90",
-        lambda: f"G4{rng.choice('12')} {rng.choice(['NORM', 'KONT', ''])} D{rng.choice(['1', '0', '2'])}\n"
-        f"G1 X{n() or 0} Y{n() or 0} Z{n() or 0} F100\nG1 X{n() or 0} Y{n() or 0}\nG40 G1 X0 Y0",
+        lambda: (
+            f"G4{rng.choice('12')} {rng.choice(['NORM', 'KONT', ''])} D{rng.choice(['1', '0', '2'])}\n"
+            f"G1 X{n() or 0} Y{n() or 0} Z{n() or 0} F100\nG1 X{n() or 0} Y{n() or 0}\nG40 G1 X0 Y0"
+        ),
         lambda: f"G41 KONT\nG91 G1 X{n() or 0} Z{n() or 0} F100\nG2 X5 Z5 CR=5\nG40 G90",
         lambda: f"G0 X{n() or 0} Y{n() or 0} Z{n() or 0}",
         lambda: f"R1={n() or 0}",

@@ -1,0 +1,57 @@
+"""The minimal programs the construct fuzzer (`tests/hostile/constructs.py`, run by
+`test_fuzz.py`) reduced its faults to: each is refused at its place or followed, in bounded time
+and memory, never a traceback."""
+
+from __future__ import annotations
+
+import pytest
+
+from tests.conftest import RS274, SHARED
+
+MACHINE = SHARED / "machines/wide.toml"
+needs_machine = pytest.mark.skipif(not MACHINE.exists(), reason="shared machine file not found")
+
+
+def _rs274_refuses(program, message: str) -> None:
+    import subprocess
+
+    if not RS274.exists():
+        return
+    done = subprocess.run([str(RS274), str(program)], capture_output=True, text=True, timeout=30)
+    assert message in done.stdout + done.stderr
+
+
+def test_a_modal_rigid_tap_block_without_its_k_is_refused_as_rs274ngc_refuses_it(ncpp, tmp_path):
+    program = tmp_path / "tap.ngc"
+    program.write_text("S300 M3\nG0 X0 Y0 Z5\nG33.1 Z-4 K1\nX1\nM2\n")
+    _rs274_refuses(program, "K word missing with g33/g33.1")
+    done = ncpp("motion", str(program), timeout=30)
+    assert done.returncode == 2 and b"Traceback" not in done.stderr
+    assert done.stderr.decode().endswith(f"{program}:4:1: K word missing with g33/g33.1\n")
+
+
+def test_a_modal_rigid_tap_block_with_its_k_taps_again(ncpp, tmp_path):
+    program = tmp_path / "tap.ngc"
+    program.write_text("S300 M3\nG0 X0 Y0 Z5\nG33.1 Z-4 K1\nX1 K1\nM2\n")
+    done = ncpp("motion", str(program), timeout=30)
+    assert done.returncode == 0, done.stderr
+    taps = [line for line in done.stdout.decode().splitlines() if line.startswith("RIGID_TAP")]
+    assert taps == ["RIGID_TAP(0.0000, 0.0000, -4.0000)", "RIGID_TAP(1.0000, 0.0000, 5.0000)"]
+
+
+@needs_machine
+@pytest.mark.parametrize("depth", ["1" + "0" * 300, "1" + "0" * 8])
+def test_a_cycle_left_as_programmed_far_past_any_travel_is_verified_in_bounded_memory(ncpp, tmp_path, depth):
+    """A Sinumerik drilling cycle to 1e300 mm (or 1e8: a hundred million lookup points at 1 mm) is
+    written as programmed; the verifier refuses the first at its line and reads the second
+    along lookup points spaced wider, within 800 MB of address space."""
+    program = tmp_path / "deep.mpf"
+    program.write_text(f"G0 X10 Y20 Z50\nG1 F100\nCYCLE81(10, 0, 2, -{depth})\nM30\n")
+    done = ncpp("compensate", "--machine", str(MACHINE), str(program), "-o", str(tmp_path / "out.mpf"),
+                memory_mb=800, timeout=30)  # fmt: skip
+    assert b"Traceback" not in done.stderr and b"MemoryError" not in done.stderr
+    if len(depth) > 100:
+        assert done.returncode == 2
+        assert done.stderr.decode().endswith(f"{program}:3:1: verification: a move too long to verify\n")
+    else:
+        assert done.returncode == 0, done.stderr
