@@ -39,7 +39,7 @@ import math
 import re
 from collections import deque
 from collections.abc import Callable, Iterable, Iterator
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import BinaryIO
 
 import numpy as np
@@ -62,6 +62,7 @@ AFTER_MOTION = {0.0, 1.0, 2.0, 30.0, 60.0, 99.0}
 # Statements that are actions: Klartext's TOOL CALL, CYCL CALL and END PGM
 ACTION_STATEMENTS = {"tool_call", "cycle_call", "program_end"}
 CHUNK_MOVES = 4096  # moves of the input compared at a time between two actions
+MAX_CHORDS = 1 << 21  # chords the arcs of a section are sampled along at most (memory: under 700 MB)
 ACROSS = 0.25  # the share of a neighbouring chunk's samples each side is also compared with
 
 
@@ -151,6 +152,13 @@ class _Moves:
         arcs = _Arcs(self.arcs, starts, ends, offsets, units) if self.arcs else None
         if arcs is not None:
             counts[arcs.move] = arcs.chords(self.bound.chord)
+            if counts.sum() > MAX_CHORDS:  # (the section's samples are held at once)
+                k = int(np.argmax(counts))
+                raise NcppError(
+                    f"verification: an arc of {int(counts[k]):,} chords within the tolerance is more "
+                    f"than ncpp verifies at once ({MAX_CHORDS:,}): split it, or give a wider --tolerance",
+                    Location("", self.lines[k], 1),
+                )
         move = np.repeat(np.arange(len(counts)), counts + 1)
         first = np.concatenate(([0], np.cumsum(counts + 1)[:-1]))
         t = (np.arange(len(move)) - first[move]) / counts[move]
@@ -415,7 +423,17 @@ def verify(original: BinaryIO, written: BinaryIO, *, file: str, dialect: str | N
         original.seek(0)
     mine = sections(_interpreted(parse_program(original, file, dialect)[1], file, dialect, offsets), bound)
     theirs = sections(_interpreted(parse_program(written, file, dialect)[1], file, dialect, offsets), bound)
-    return _Comparison(file, bound, lambda number: (_line_text(written, number), 0)).run(mine, theirs)
+    try:
+        return _Comparison(file, bound, lambda number: (_line_text(written, number), 0)).run(mine, theirs)
+    except NcppError as err:
+        raise _in_file(err, file) from None
+
+
+def _in_file(err: NcppError, file: str) -> NcppError:
+    """`err`, told in `file` when it was raised where the file was not known (`_Moves.sample`)."""
+    if err.where.file == "":
+        err.where = replace(err.where, file=file)
+    return err
 
 
 def verified(lines: Iterable[str], reached: Callable[[], tuple[int, int, int]], original: Iterable[Event], *, file: str, dialect: str,
@@ -459,7 +477,7 @@ def verified(lines: Iterable[str], reached: Callable[[], tuple[int, int, int]], 
     except _Unread as err:  # the written program cut short where a fault of the input stopped it
         raise held.error or err from None
     except NcppError as err:
-        raise held.first(err) from None
+        raise held.first(_in_file(err, file)) from None
     if held.error is not None:
         raise held.error
     yield from feed.handed()
@@ -650,7 +668,7 @@ class _Comparison:
             line = along.first_line if written else int(path.lines[0])
             raise NcppError(f"verification: {message}: it has no move here", Location(file, line, 1))
         within = self.bound.within
-        endless = np.flatnonzero(~np.isfinite(np.sqrt(((path.ends - path.starts) ** 2).sum(axis=1))))
+        endless = np.flatnonzero(~np.isfinite(_lengths(path.starts, path.ends)))
         if len(endless):
             raise NcppError(
                 "verification: a move too long to verify", Location(file, int(path.lines[endless[0]]), 1)
@@ -795,6 +813,12 @@ def _widened(points: np.ndarray, width: int) -> np.ndarray:
     return out
 
 
+def _lengths(starts: np.ndarray, ends: np.ndarray) -> np.ndarray:
+    """The segments' lengths; inf for one too long to hold (a program's numbers may be huge)."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        return np.sqrt(((ends - starts) ** 2).sum(axis=1))
+
+
 class _Nearby:
     """The segments of a path, looked up by points spaced `Bound.coarse` along them: every
     segment passing within r of a point has one of its points within r + coarse / 2."""
@@ -804,7 +828,7 @@ class _Nearby:
     POINTS = 1 << 20  # lookup points along the path at most: a longer path's are spaced wider
 
     def __init__(self, starts: np.ndarray, ends: np.ndarray, bound: Bound):
-        lengths = np.sqrt(((ends - starts) ** 2).sum(axis=1))
+        lengths = _lengths(starts, ends)
         if not np.isfinite(lengths).all():
             raise NcppError("verification: a move too long to verify", Location("", 1, 1))
         # (wider spacing widens the reach each lookup covers: the same segments are found)
@@ -863,7 +887,11 @@ class _Nearby:
         here, and that point; None when all lie within.  Most segments lie along the segment
         whose lookup point is nearest their start, or along it and the next: those are set aside
         first, at a fraction of the cost of the search that looks at the others."""
-        rest = np.flatnonzero(~self._along_the_nearest(starts, ends, within))
+        along = [
+            self._along_the_nearest(starts[k : k + self.BATCH], ends[k : k + self.BATCH], within)
+            for k in range(0, len(starts), self.BATCH)  # (memory: each segment's three candidates at once)
+        ]
+        rest = np.flatnonzero(~np.concatenate(along))
         if not len(rest):
             return None
         far = self._first_outside(starts[rest], ends[rest], within)

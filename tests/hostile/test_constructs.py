@@ -55,3 +55,20 @@ def test_a_cycle_left_as_programmed_far_past_any_travel_is_verified_in_bounded_m
         assert done.stderr.decode().endswith(f"{program}:3:1: verification: a move too long to verify\n")
     else:
         assert done.returncode == 0, done.stderr
+
+
+@needs_machine
+def test_an_arc_round_a_centre_far_past_any_travel_is_refused_in_bounded_memory(ncpp, tmp_path):
+    """A Klartext circle round a centre 1e300 mm away: sampling it along chords within the
+    tolerance would take 6 million; the verifier refuses it at its line, no overflow warned."""
+    program = tmp_path / "far.h"
+    centre = "1" + "0" * 300
+    program.write_text(f"0 BEGIN PGM M MM\n1 L X+0 Y+0 Z+50 R0 FMAX\n2 CC X+{centre} Y-5\n"
+                       "3 C X+5 Y+4 DR+ F100\n4 END PGM M MM\n")  # fmt: skip
+    done = ncpp("compensate", "--machine", str(MACHINE), str(program), "-o", str(tmp_path / "out.h"),
+                memory_mb=600, timeout=30)  # fmt: skip
+    assert done.returncode == 2 and b"Traceback" not in done.stderr and b"Warning" not in done.stderr
+    assert done.stderr.decode().endswith(
+        f"{program}:4:1: verification: an arc of 6,283,186 chords within the tolerance is more than ncpp "
+        "verifies at once (2,097,152): split it, or give a wider --tolerance\n"
+    )
