@@ -73,7 +73,7 @@ def _fanuc(rng: random.Random) -> tuple[str, list[str]]:
     v = lambda: _iso_value(rng)  # noqa: E731
     letters = "ABCIJKDEFHMQRSTUVWXYZ"
     args = lambda: " ".join(f"{rng.choice(letters)}{v()}" for _ in range(rng.randint(0, 14)))  # noqa: E731
-    lines = ["%", "O1000", "G21 G90 G17 G94", "T1 M6", "G43 H1 Z50", "S300 M3", "G0 X0 Y0"]
+    lines = ["%", "O1000", "G21 G90 G17 G94", "T1 M6", "S300 M3", "G0 G43 H1 Z50", "G0 X0 Y0"]
     pool = [
         lambda: f"G65 P9010 {args()}",
         lambda: f"G65 P{v()} {args()}",
@@ -243,7 +243,8 @@ def case(rng: random.Random, folder: Path, n: int) -> list[str]:
     program.write_text(text)
     dialect = ["--dialect", kind] if kind == "fanuc" else []
     if kind == "fanuc" and rng.random() < 0.5:
-        extra = [*extra, "--work-offset", f"G54.1P{rng.randint(0, 50)}={rng.choice(['1,2,3', 'nan,0,0'])}"]
+        zero = rng.choice(["1,2,3", "1,2,3", "1,2,3", "nan,0,0"])
+        extra = [*extra, "--work-offset", f"G54.1P{rng.randint(0, 50)}={zero}"]
     mode = rng.choice(["compensate", "compensate", "motion", "plain"])
     out = ["-o", str(folder / f"out{n}{suffix}")]
     if mode == "compensate":

@@ -4,6 +4,8 @@ and memory, never a traceback."""
 
 from __future__ import annotations
 
+import subprocess
+
 import pytest
 
 from tests.conftest import RS274, SHARED
@@ -12,19 +14,20 @@ MACHINE = SHARED / "machines/wide.toml"
 needs_machine = pytest.mark.skipif(not MACHINE.exists(), reason="shared machine file not found")
 
 
-def _rs274_refuses(program, message: str) -> None:
-    import subprocess
+MODAL_TAP = "S300 M3\nG0 X0 Y0 Z5\nG33.1 Z-4 K1\nX1\nM2\n"  # (line 4: G33.1 again, without its K)
 
-    if not RS274.exists():
-        return
+
+@pytest.mark.skipif(not RS274.exists(), reason="rs274 not available")
+def test_rs274_refuses_a_modal_rigid_tap_block_without_its_k(tmp_path):
+    program = tmp_path / "tap.ngc"
+    program.write_text(MODAL_TAP)
     done = subprocess.run([str(RS274), str(program)], capture_output=True, text=True, timeout=30)
-    assert message in done.stdout + done.stderr
+    assert "K word missing with g33/g33.1" in done.stdout + done.stderr
 
 
 def test_a_modal_rigid_tap_block_without_its_k_is_refused_as_rs274ngc_refuses_it(ncpp, tmp_path):
     program = tmp_path / "tap.ngc"
-    program.write_text("S300 M3\nG0 X0 Y0 Z5\nG33.1 Z-4 K1\nX1\nM2\n")
-    _rs274_refuses(program, "K word missing with g33/g33.1")
+    program.write_text(MODAL_TAP)
     done = ncpp("motion", str(program), timeout=30)
     assert done.returncode == 2 and b"Traceback" not in done.stderr
     assert done.stderr.decode().endswith(f"{program}:4:1: K word missing with g33/g33.1\n")
