@@ -87,9 +87,11 @@ def _cases(folder: Path, count: int, seed: int) -> list[dict]:
     for n in range(count):
         kind = rng.choice([*sorted(seeds), "construct"])
         if kind == "construct":  # (a program built of the constructs each dialect's interpreter follows)
-            cases.append(
-                {"id": n, "kind": kind, "source": "constructs.py", "argv": construct(rng, folder, n)}
-            )
+            argv = construct(rng, folder, n)
+            if rng.random() < 0.5:  # (and damaged)
+                program = next(Path(a) for a in argv if Path(a).stem == f"gen{n}")
+                program.write_bytes(mutate(program.read_bytes(), rng, [program.read_bytes()]))
+            cases.append({"id": n, "kind": kind, "source": "constructs.py", "argv": argv})
             continue
         k = rng.randrange(len(seeds[kind]))
         source = seeds[kind][k]
