@@ -226,6 +226,23 @@ def write_called_files(folder: Path) -> None:
             (folder / name).symlink_to(target)
 
 
+def _control_files(rng: random.Random, folder: Path, n: int) -> list[str]:
+    """A tool table and a parameter file with odd entries (lengths, diameters, pockets, Fanuc's
+    additional offsets at #7001...)."""
+    tools = folder / f"tool{n}.tbl"
+    tools.write_text("".join(
+        f"T{rng.choice(['1', '2', '5', '0', '99999999'])} P{rng.choice(['1', '0', '-1', '7'])} "
+        f"Z{number(rng)} D{number(rng)}{rng.choice(['', ' X1 Y-2', ' ;comment', ' (x'])}\n"
+        for _ in range(rng.randint(0, 4))
+    ))  # fmt: skip
+    params = folder / f"var{n}.var"
+    keys = ["5221", "5222", "5223", "5220", "7001", "7002", "7003", "7021", "14001", "14002", "5211"]
+    params.write_text(
+        "".join(f"{rng.choice(keys)}\t{number(rng) or '0'}\n" for _ in range(rng.randint(0, 8)))
+    )
+    return ["--tool-table", str(tools), "--var-file", str(params)]
+
+
 def case(rng: random.Random, folder: Path, n: int) -> list[str]:
     """One generated program written to `folder` and the `ncpp` arguments that run it."""
     subs = folder / "subs"
@@ -245,6 +262,8 @@ def case(rng: random.Random, folder: Path, n: int) -> list[str]:
     if kind == "fanuc" and rng.random() < 0.5:
         zero = rng.choice(["1,2,3", "1,2,3", "1,2,3", "nan,0,0"])
         extra = [*extra, "--work-offset", f"G54.1P{rng.randint(0, 50)}={zero}"]
+    if kind in ("iso", "fanuc") and rng.random() < 0.3:
+        extra = [*extra, *_control_files(rng, folder, n)]
     mode = rng.choice(["compensate", "compensate", "motion", "plain"])
     out = ["-o", str(folder / f"out{n}{suffix}")]
     if mode == "compensate":

@@ -75,3 +75,20 @@ def test_an_arc_round_a_centre_far_past_any_travel_is_refused_in_bounded_memory(
         f"{program}:4:1: verification: an arc of 6,283,186 chords within the tolerance is more than ncpp "
         "verifies at once (2,097,152): split it, or give a wider --tolerance\n"
     )
+
+
+def test_a_parameter_file_giving_an_additional_offset_twice_differently_is_refused_at_its_line(
+    ncpp, tmp_path
+):
+    """#7001 (Fanuc's G54.1 P1) and #14001 (Haas's G154 P1) name one offset: told differently, the
+    refusal names the line that completes the second."""
+    var = tmp_path / "control.var"
+    var.write_text("14001 7\n5221 0\n7003 1\n7001 7\n")
+    program = tmp_path / "p.ngc"
+    program.write_text("G0 X1\nM2\n")
+    done = ncpp("motion", "--var-file", str(var), str(program), timeout=30)
+    assert done.returncode == 2
+    assert (
+        done.stderr.decode()
+        == f"{var}:4:1: parameters #7001 and #14001 both give additional work offset P1, and differ\n"
+    )
