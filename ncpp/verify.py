@@ -42,7 +42,7 @@ import math
 import re
 from collections import deque
 from collections.abc import Callable, Iterable, Iterator
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import lru_cache
 from typing import BinaryIO
 
@@ -66,6 +66,7 @@ AFTER_MOTION = {0.0, 1.0, 2.0, 30.0, 60.0, 99.0}
 # Statements that are actions: Klartext's TOOL CALL, CYCL CALL and END PGM
 ACTION_STATEMENTS = {"tool_call", "cycle_call", "program_end"}
 CHUNK_MOVES = 4096  # moves of the input compared at a time between two actions
+MAX_CHORDS = 1 << 21  # chords the arcs of a section are sampled along at most (memory: under 700 MB)
 ACROSS = 0.25  # the share of a neighbouring chunk's samples each side is also compared with
 
 
@@ -155,6 +156,13 @@ class _Moves:
         arcs = _Arcs(self.arcs, starts, ends, offsets, units) if self.arcs else None
         if arcs is not None:
             counts[arcs.move] = arcs.chords(self.bound.chord)
+            if counts.sum() > MAX_CHORDS:  # (the section's samples are held at once)
+                k = int(np.argmax(counts))
+                raise NcppError(
+                    f"verification: an arc of {int(counts[k]):,} chords within the tolerance is more "
+                    f"than ncpp verifies at once ({MAX_CHORDS:,}): split it, or give a wider --tolerance",
+                    Location("", self.lines[k], 1),
+                )
         move = np.repeat(np.arange(len(counts)), counts + 1)
         first = np.concatenate(([0], np.cumsum(counts + 1)[:-1]))
         t = (np.arange(len(move)) - first[move]) / counts[move]
@@ -422,7 +430,17 @@ def verify(original: BinaryIO, written: BinaryIO, *, file: str, dialect: str | N
         original.seek(0)
     mine = sections(_interpreted(parse_program(original, file, dialect)[1], file, dialect, offsets), bound)
     theirs = sections(_interpreted(parse_program(written, file, dialect)[1], file, dialect, offsets), bound)
-    return _Comparison(file, bound, lambda number: (_line_text(written, number), 0)).run(mine, theirs)
+    try:
+        return _Comparison(file, bound, lambda number: (_line_text(written, number), 0)).run(mine, theirs)
+    except NcppError as err:
+        raise _in_file(err, file) from None
+
+
+def _in_file(err: NcppError, file: str) -> NcppError:
+    """`err`, told in `file` when it was raised where the file was not known (`_Moves.sample`)."""
+    if err.where.file == "":
+        err.where = replace(err.where, file=file)
+    return err
 
 
 def verified(lines: Iterable[str], reached: Callable[[], tuple[int, int, int]], original: Iterable[Event], *, file: str, dialect: str,
@@ -466,7 +484,7 @@ def verified(lines: Iterable[str], reached: Callable[[], tuple[int, int, int]], 
     except _Unread as err:  # the written program cut short where a fault of the input stopped it
         raise held.error or err from None
     except NcppError as err:
-        raise held.first(err) from None
+        raise held.first(_in_file(err, file)) from None
     if held.error is not None:
         raise held.error
     yield from feed.handed()
@@ -662,6 +680,11 @@ class _Comparison:
             line = along.first_line if written else int(path.lines[0])
             raise NcppError(f"verification: {message}: it has no move here", Location(file, line, 1))
         within = self.bound.within
+        endless = np.flatnonzero(~np.isfinite(_lengths(path.starts, path.ends)))
+        if len(endless):
+            raise NcppError(
+                "verification: a move too long to verify", Location(file, int(path.lines[endless[0]]), 1)
+            )
         (starts, ends), (a, b) = _alike((path.starts, path.ends), (along.starts, along.ends))
         # (a path that runs again, a loop's, is looked up by each segment once: a lookup tree of
         # many equal points looks at all of them)
@@ -802,6 +825,12 @@ def _widened(points: np.ndarray, width: int) -> np.ndarray:
     return out
 
 
+def _lengths(starts: np.ndarray, ends: np.ndarray) -> np.ndarray:
+    """The segments' lengths; inf for one too long to hold (a program's numbers may be huge)."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        return np.sqrt(((ends - starts) ** 2).sum(axis=1))
+
+
 class _Nearby:
     """The segments of a path, looked up by points: the middles of the pieces at most `Bound.coarse`
     long each is cut into, so that every segment passing within r of a point has a lookup point
@@ -809,11 +838,16 @@ class _Nearby:
 
     FEW, MANY = 6, 96  # nearest lookup points asked for, then for the points that found none near
     BATCH = 1 << 15  # points looked at at once
+    POINTS = 1 << 20  # lookup points along the path at most: a longer path's are spaced wider
 
     def __init__(self, starts: np.ndarray, ends: np.ndarray, bound: Bound):
-        self.starts, self.ends, self.reach = starts, ends, bound.coarse / 2
-        lengths = np.sqrt(((ends - starts) ** 2).sum(axis=1))
-        counts = np.maximum(1, np.ceil(lengths / bound.coarse)).astype(np.int64)
+        lengths = _lengths(starts, ends)
+        if not np.isfinite(lengths).all():
+            raise NcppError("verification: a move too long to verify", Location("", 1, 1))
+        # (wider spacing widens the reach each lookup covers: the same segments are found)
+        spacing = max(bound.coarse, float(lengths.sum()) / self.POINTS)
+        self.starts, self.ends, self.reach = starts, ends, spacing / 2
+        counts = np.maximum(1, np.ceil(lengths / spacing)).astype(np.int64)
         self.segment = np.repeat(np.arange(len(counts)), counts)
         first = np.concatenate(([0], np.cumsum(counts)[:-1]))
         t = (np.arange(len(self.segment)) - first[self.segment] + 0.5) / counts[self.segment]
@@ -867,7 +901,11 @@ class _Nearby:
         here, and that point; None when all lie within.  Most segments lie along the segment
         whose lookup point is nearest their start, or along it and the next: those are set aside
         first, at a fraction of the cost of the search that looks at the others."""
-        rest = np.flatnonzero(~self._along_the_nearest(starts, ends, within))
+        along = [
+            self._along_the_nearest(starts[k : k + self.BATCH], ends[k : k + self.BATCH], within)
+            for k in range(0, len(starts), self.BATCH)  # (memory: each segment's three candidates at once)
+        ]
+        rest = np.flatnonzero(~np.concatenate(along))
         if not len(rest):
             return None
         far = self._first_outside(starts[rest], ends[rest], within)

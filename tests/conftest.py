@@ -48,6 +48,7 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_mmount_contours_land_within_the_tolerance",
         ),
         "motion/test_oracle.py": None,
+        "hostile/test_constructs.py": ("test_rs274_refuses_a_modal_rigid_tap_block_without_its_k",),
         "shop/test_tool_guard.py": (
             "test_rs274_runs_the_program_with_the_told_table_and_stops_at_a_length_that_differs",
         ),
@@ -174,6 +175,9 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_rs274_runs_the_guarded_program_where_g54_matches_and_stops_it_where_not",
         ),
         "hostile/test_fuzz.py": ("test_fuzzed_inputs_are_refused_located_in_bounded_time_and_memory",),
+        "hostile/test_constructs.py": (
+            "test_a_cycle_left_as_programmed_far_past_any_travel_is_verified_in_bounded_memory",
+        ),
         "hostile/test_cli_contained.py": (
             "test_a_terminated_run_removes_its_temporaries",
             "test_a_subroutine_name_stays_inside_the_subroutine_path",

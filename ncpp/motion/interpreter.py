@@ -1868,6 +1868,7 @@ _PLAIN_LETTERS = {
     2.0: frozenset("XYZABCUVWFIJKR"),
     3.0: frozenset("XYZABCUVWFIJKR"),
     **{code: frozenset() for code in CANNED},  # a cycle's words are checked in full
+    RIGID_TAP: frozenset(),  # a modal G33.1 block needs its K again (rs274ngc: "K word missing")
 }
 
 

@@ -96,13 +96,15 @@ class WorkOffsets:
     def from_var_file(cls, path: str | Path, unit_mm: float = 1.0) -> WorkOffsets:
         """LinuxCNC's parameter file (`linuxcnc.var`: `number value` lines), its values in
         the machine's units (`[TRAJ]LINEAR_UNITS`: 25.4 mm for inch)."""
-        values = read_var_file(path)
+        entries = _var_entries(path)
+        values = {number: value for number, (value, _) in entries.items()}
         systems = tuple(_from_var(values, _system_x(n), unit_mm) for n in range(1, 10))
         active = int(values.get(_ACTIVE_SYSTEM, 1.0) + 0.0001)
         g92 = _from_var(values, _G92_X, unit_mm) if values.get(_G92_ON) == 1.0 else None
         zero = (0.0, 0.0, 0.0)
         homes = (_from_var(values, _G28_X, unit_mm) or zero, _from_var(values, _G30_X, unit_mm) or zero)
-        additional = _additional_from_var(values, unit_mm, str(path))
+        lines = {number: line for number, (_, line) in entries.items()}
+        additional = _additional_from_var(values, unit_mm, str(path), lines)
         return cls(systems, active if 1 <= active <= 9 else 1, g92 or zero, *homes, additional=additional)
 
     @classmethod
@@ -200,7 +202,12 @@ def system_name(number: int, dialect: str = "fanuc") -> str:
 
 def read_var_file(path: str | Path) -> dict[int, float]:
     """`number value` lines; other lines are comments (as rs274ngc reads it)."""
-    values: dict[int, float] = {}
+    return {number: value for number, (value, _) in _var_entries(path).items()}
+
+
+def _var_entries(path: str | Path) -> dict[int, tuple[float, int]]:
+    """`read_var_file`'s values, each with the line that gives it (the last, as rs274ngc reads it)."""
+    values: dict[int, tuple[float, int]] = {}
     try:
         text = read_small(path, "a parameter file").decode("latin-1")
     except OSError as err:
@@ -216,7 +223,7 @@ def read_var_file(path: str | Path) -> dict[int, float]:
             raise NcppError(f"parameter {fields[0]} has no number: {quoted(fields[1])}", where) from None
         if not math.isfinite(value):
             raise NcppError(f"parameter {fields[0]} is not a finite number: {quoted(fields[1])}", where)
-        values[int(fields[0])] = value
+        values[int(fields[0])] = (value, n)
     return values
 
 
@@ -226,9 +233,11 @@ def _from_var(values: Mapping[int, float], x: int, unit_mm: float) -> Vector | N
     return (values.get(x, 0.0) * unit_mm, values.get(x + 1, 0.0) * unit_mm, values.get(x + 2, 0.0) * unit_mm)
 
 
-def _additional_from_var(values: Mapping[int, float], unit_mm: float, path: str) -> tuple[Vector | None, ...]:
+def _additional_from_var(
+    values: Mapping[int, float], unit_mm: float, path: str, lines: Mapping[int, int]
+) -> tuple[Vector | None, ...]:
     """The additional work offsets a Fanuc or Haas parameter file gives (`_ADDITIONAL_X`); an offset
-    given at both its numbers must be given the same."""
+    given at both its numbers must be given the same (refused at the last line of the two)."""
     if not any(7001 <= k <= 15999 for k in values):
         return ()
     found: list[Vector | None] = [None] * max(count for _, count in _ADDITIONAL_X)
@@ -238,8 +247,10 @@ def _additional_from_var(values: Mapping[int, float], unit_mm: float, path: str)
             if zero is None:
                 continue
             if found[n - 1] not in (None, zero):
-                raise NcppError(f"parameters #{7001 + 20 * (n - 1)} and #{first + 20 * (n - 1)} both give "
-                                f"additional work offset P{n}, and differ", Location(path))  # fmt: skip
+                x, fanuc_x = first + 20 * (n - 1), 7001 + 20 * (n - 1)
+                line = max(lines.get(k + d, 0) for k in (x, fanuc_x) for d in range(3))
+                raise NcppError(f"parameters #{fanuc_x} and #{x} both give additional work offset "
+                                f"P{n}, and differ", Location(path, line, 1))  # fmt: skip
             found[n - 1] = zero
     return tuple(found)
 

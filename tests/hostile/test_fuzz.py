@@ -18,12 +18,14 @@ from pathlib import Path
 import pytest
 
 from tests.conftest import CORPUS, NOT_PROGRAMS, ROOT, SHARED
+from tests.hostile.constructs import case as construct
+from tests.hostile.constructs import write_called_files
 from tests.hostile.fuzz import mutate
 
 MACHINE = SHARED / "machines/wide.toml"
 CASES = int(os.environ.get("NCPP_FUZZ_CASES", "12"))
 SEED = int(os.environ.get("NCPP_FUZZ_SEED", "0"))
-SECONDS_PER_CASE = 30.0  # (a loop that never ends is refused after MAX_RERUN lines: under a minute)
+SECONDS_PER_CASE = 60.0  # (a loop that never ends is refused after MAX_RERUN lines: under a minute)
 MEMORY_MB = 1536  # the worker's address space (a compensation run maps under 200 MB)
 LOCATED = re.compile(r"^(?!ncpp: )(?P<file>[^:\n]+):\d+:\d+: ")
 
@@ -80,9 +82,17 @@ def _cases(folder: Path, count: int, seed: int) -> list[dict]:
     rng = random.Random(seed)
     seeds = _seeds()
     texts = {kind: [p.read_bytes() for p in paths] for kind, paths in seeds.items()}
+    write_called_files(folder / "subs")
     cases = []
     for n in range(count):
-        kind = rng.choice(sorted(seeds))
+        kind = rng.choice([*sorted(seeds), "construct"])
+        if kind == "construct":  # (a program built of the constructs each dialect's interpreter follows)
+            argv = construct(rng, folder, n)
+            if rng.random() < 0.5:  # (and damaged)
+                program = next(Path(a) for a in argv if Path(a).stem == f"gen{n}")
+                program.write_bytes(mutate(program.read_bytes(), rng, [program.read_bytes()]))
+            cases.append({"id": n, "kind": kind, "source": "constructs.py", "argv": argv})
+            continue
         k = rng.randrange(len(seeds[kind]))
         source = seeds[kind][k]
         mutated = folder / f"case{n}{''.join(source.suffixes[-1:])}"
@@ -112,7 +122,17 @@ def _problems(case: dict, result: dict | None) -> list[str]:
         last = [line for line in result["stderr"].splitlines() if line.strip()][-1:]
         if not last or not LOCATED.match(last[0]):
             found.append(f"not a located error: {last}")
+    elif _passed_through(case["argv"]) is False:
+        found.append("without a machine file the output is not the input byte for byte")
     return found
+
+
+def _passed_through(argv: list[str]) -> bool | None:
+    """Whether plain `ncpp IN -o OUT` (no machine file) wrote its input unchanged (None: another command)."""
+    if argv[0] in ("compensate", "motion", "post", "analyze") or "--machine" in argv:
+        return None
+    output = Path(argv[argv.index("-o") + 1])
+    return output.read_bytes() == Path(argv[argv.index("-o") - 1]).read_bytes()
 
 
 @pytest.mark.skipif(
