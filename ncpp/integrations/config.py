@@ -38,7 +38,7 @@ from pathlib import Path
 
 from ncpp.errors import Location, NcppError
 from ncpp.fileio import read_small
-from ncpp.motion.offsets import UNIT_MM, Vector, WorkOffsets, system_number
+from ncpp.motion.offsets import UNIT_MM, Vector, WorkOffsets, check_zero, system_number
 
 KEYS = ("machine", "tolerance", "work_offset", "var_file", "var_units", "tool_table")
 PATH_KEYS = ("machine", "var_file", "tool_table")  # relative to the config file's folder
@@ -135,6 +135,7 @@ def _zeros(value, path: Path) -> dict[str, Vector]:
             )
         try:
             system_number(name)
+            check_zero(zero)
         except ValueError as err:
             raise NcppError(f"`work_offset`: {err}", Location(str(path))) from None
         zeros[name.upper()] = tuple(float(v) for v in zero)

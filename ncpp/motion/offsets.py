@@ -166,6 +166,9 @@ class WorkOffsets:
         return (zero[0] + self.g92[0], zero[1] + self.g92[1], zero[2] + self.g92[2])
 
 
+LARGEST_ZERO_MM = 1e6
+
+
 def parse_zero(text: str) -> tuple[str, Vector]:
     """`G55=600,350,300` -> ("G55", (600, 350, 300)); without `G5x=` it is G54's; `G54.1P3=`
     and `G154P3=` name an additional work offset."""
@@ -178,7 +181,17 @@ def parse_zero(text: str) -> tuple[str, Vector]:
         values = ()
     if len(values) != 3 or not all(math.isfinite(v) for v in values):
         raise ValueError(f"expected [G5x=]X,Y,Z in mm (three finite numbers), got {text!r}")
+    check_zero(values)
     return name, values
+
+
+def check_zero(values: Sequence[float]) -> None:
+    """A work offset's zero within LARGEST_ZERO_MM of the machine zero, as a machine file's
+    positions are (beyond, no machine reaches it, and its numbers would not fit a block)."""
+    if any(abs(v) > LARGEST_ZERO_MM for v in values):
+        raise ValueError(
+            f"a work offset's zero must be within ±{LARGEST_ZERO_MM:,.0f} mm, not {tuple(values)}"
+        )
 
 
 def system_number(name: str) -> int:

@@ -205,7 +205,7 @@ def test_command_line_var_file_and_work_offsets_say_the_same(tmp_path):
 def test_parse_zero():
     assert parse_zero("1,2,3") == ("G54", (1.0, 2.0, 3.0))
     assert parse_zero("g59.3=-1,0,2.5") == ("G59.3", (-1.0, 0.0, 2.5))
-    for bad in ("1,2", "G55=a,b,c", "G53=1,2,3"):
+    for bad in ("1,2", "G55=a,b,c", "G53=1,2,3", "G154P7=1e308,0,0", "0,-1000001,0"):  # (beyond any machine)
         with pytest.raises(ValueError):
             parse_zero(bad)
 

@@ -73,6 +73,7 @@ def test_no_machine_anywhere(shop):
         ("machine = 3\n", "path string"),
         ("tolerance = -1\n", "positive"),
         ("work_offset = [1, 2]\n", r"\[x, y, z\]"),
+        ("work_offset = {G55 = [1e308, 0, 0]}\n", "within ±1,000,000 mm"),
         ("mashine = 'a'\n", "unknown key"),
         ("machine = \n", "not a valid TOML"),
     ],
