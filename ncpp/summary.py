@@ -25,6 +25,7 @@ from ncpp.motion.segments import (
     MACHINE,
     PATTERN,
     PLANE_AXES,
+    TAP_OUT,
     Arc,
     Event,
     Line,
@@ -100,7 +101,8 @@ class Summary:
                         moves += 1
                         if not event.rapid:  # type: ignore[union-attr]
                             feed += dist(event.start, event.end) * event.context.unit_mm  # type: ignore[union-attr]
-                        programmed[id(event.block)] = event  # type: ignore[assignment]
+                        if event.tap != TAP_OUT:  # type: ignore[union-attr]  # (a tap's block ends at its bottom)
+                            programmed[id(event.block)] = event  # type: ignore[assignment]
                 elif kind is Arc:
                     if event.fixed:  # type: ignore[union-attr]
                         self._leave(REASONS.get(event.fixed, event.fixed), event.block.line)  # type: ignore[union-attr]
@@ -122,7 +124,8 @@ class Summary:
             kind = type(event)
             if kind is Line or kind is Arc:
                 if event.block is block:
-                    if not event.fixed or event.fixed == HOLE:  # type: ignore[union-attr]  # (not M140's retract)
+                    kept = not event.fixed or event.fixed == HOLE  # type: ignore[union-attr]  # (not M140's retract)
+                    if kept and not (kind is Line and event.tap == TAP_OUT):  # type: ignore[union-attr]  # (nor a tap's return)
                         last = event  # type: ignore[assignment]
                 elif not event.fixed or event.fixed == HOLE:  # type: ignore[union-attr]
                     self._settle(block, last)

@@ -5,6 +5,7 @@ original's; pathcheck must accept the program."""
 
 from __future__ import annotations
 
+import json
 import subprocess
 import sys
 from pathlib import Path
@@ -218,3 +219,19 @@ def test_the_motor_mount_written_out_cuts_twenty_times_closer(tmp_path):
     before, after = (feed_moves(p, tools, var, home=tmp_path) for p in (original, out))
     programmed, compensated = (deviation(before, moves, closed_form).max() for moves in (before, after))
     assert programmed > 0.04 and compensated * 20 < programmed, (programmed, compensated)
+
+
+def test_the_summary_measures_a_taps_correction_at_its_bottom(tmp_path):
+    """The tap's block ends at its bottom as the control runs it (its return is the control's):
+    the summary's largest correction is there, where Z's straightness moves it most."""
+    (tmp_path / "machine.toml").write_text(TAPPING)
+    program, report = tmp_path / "deep.ngc", tmp_path / "report.json"
+    program.write_text("G21 G90\nS300 M3\nG0 X0 Y0 Z5\nG33.1 Z-200 K1\nG0 Z50\nM2\n")
+    done = subprocess.run([sys.executable, "-m", "ncpp", "compensate", "--machine", str(tmp_path / "machine.toml"),
+                           "--report", str(report), str(program), "-o", str(tmp_path / "out.ngc")],
+                          capture_output=True, text=True, cwd=ROOT, timeout=60)  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    said = json.loads(report.read_text())
+    bottom = closed_form(np.array([[0.0, 0.0, -200.0]]))[0] - np.array([0.0, 0.0, -200.0])
+    assert said["largest_correction_line"] == 4
+    assert abs(said["largest_correction_um"] - np.linalg.norm(bottom) * 1000) < 0.5
