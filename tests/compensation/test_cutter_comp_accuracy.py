@@ -16,6 +16,7 @@ import pytest
 
 from tests.compensation.tool_centre import deviation, feed_moves
 from tests.conftest import CORPUS, ROOT, RS274, SHARED
+from tests.writeback.conftest import linear_errors, machine_file
 
 PATHCHECK = SHARED / "tools" / "pathcheck"
 needs_oracles = pytest.mark.skipif(
@@ -125,31 +126,7 @@ def test_the_tool_centre_lands_on_the_original_path_within_half_a_micron(tmp_pat
 
 # X runs 200 µm/m long and Z 150 µm/m short, X moves Z by 250 µm/m of x (its straightness in Z, EZX) and
 # Z moves X by -100 µm/m of z (EXZ): the tool lands at (x + 2e-4·x - 1e-4·z, y, z - 1.5e-4·z + 2.5e-4·x)
-AFFINE_XZ = """[machine]
-name = "affine-xz"
-chain = "XYFZ"
-
-[limits]
-X = [-500.0, 500.0]
-Y = [-500.0, 500.0]
-Z = [-500.0, 500.0]
-
-[errors.EXX]
-kind = "polynomial"
-coefficients_um = [0.0, 0.2]
-
-[errors.EZZ]
-kind = "polynomial"
-coefficients_um = [0.0, -0.15]
-
-[errors.EZX]
-kind = "polynomial"
-coefficients_um = [0.0, 0.25]
-
-[errors.EXZ]
-kind = "polynomial"
-coefficients_um = [0.0, -0.1]
-"""
+AFFINE_XZ = machine_file("affine-xz", linear_errors(EXX=0.2, EZZ=-0.15, EZX=0.25, EXZ=-0.1))
 
 
 def closed_form_xz(command: np.ndarray) -> np.ndarray:

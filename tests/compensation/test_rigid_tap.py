@@ -13,45 +13,20 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tests.compensation.tool_centre import deviation, feed_moves
-from tests.conftest import CORPUS, ROOT, RS274, SHARED
-
-PATHCHECK = SHARED / "tools" / "pathcheck"
-needs_oracles = pytest.mark.skipif(
-    not (RS274.exists() and PATHCHECK.exists()), reason="rs274 or pathcheck not available"
+from tests.compensation.test_cutter_comp_accuracy import (
+    MMOUNT,
+    MMOUNT_TOOLS,
+    MMOUNT_VAR,
+    PATHCHECK,
+    needs_oracles,
 )
+from tests.compensation.tool_centre import deviation, feed_moves
+from tests.conftest import ROOT
+from tests.writeback.conftest import linear_errors, machine_file
 
 # X runs 100 µm/m long, Y 80 µm/m short, Z 50 µm/m long, and Z travels off straight in X and Y
 # (docs/machine-file.md: EXZ, EYZ are the straightness of Z in X and Y)
-TAPPING = """[machine]
-name = "tapping"
-chain = "XYFZ"
-
-[limits]
-X = [-500.0, 500.0]
-Y = [-500.0, 500.0]
-Z = [-500.0, 500.0]
-
-[errors.EXX]
-kind = "polynomial"
-coefficients_um = [0.0, 0.1]
-
-[errors.EYY]
-kind = "polynomial"
-coefficients_um = [0.0, -0.08]
-
-[errors.EZZ]
-kind = "polynomial"
-coefficients_um = [0.0, 0.05]
-
-[errors.EXZ]
-kind = "polynomial"
-coefficients_um = [0.0, 0.1]
-
-[errors.EYZ]
-kind = "polynomial"
-coefficients_um = [0.0, -0.06]
-"""
+TAPPING = machine_file("tapping", linear_errors(EXX=0.1, EYY=-0.08, EZZ=0.05, EXZ=0.1, EYZ=-0.06))
 
 
 def closed_form(command: np.ndarray) -> np.ndarray:
@@ -185,16 +160,6 @@ def test_a_tap_ncpp_cannot_follow_passes_through(tmp_path, dialect, text):
     assert done.returncode == 0, done.stderr
     tail = text[text.index("G33.1") :]
     assert out.read_text().endswith(tail) and "G33.1" in done.stderr
-
-
-MMOUNT = CORPUS / "iso_gcode" / "linuxcnc" / "mmount.ngc"
-# G55-G57 (inches) placing the three stations apart on the machine, and the tools its comments list
-MMOUNT_VAR = "5220 1\n5241 4\n5242 3\n5243 -2\n5261 10\n5262 3\n5263 -2\n5281 16\n5282 3\n5283 -2\n"
-MMOUNT_TOOLS = "".join(
-    f"T{n} P{n} Z{z} D{d}\n"
-    for n, z, d in [(1, 1.1901, 0.25), (2, 0.2875, 0.209), (3, 0.0, 0.1406), (4, 1.663, 0.25), (5, 1.5042, 0.5),
-                    (15, 1.5042, 0.55), (6, 0.1833, 0.25)]
-)  # fmt: skip
 
 
 @needs_oracles

@@ -6,6 +6,8 @@ import io
 import os
 from pathlib import Path
 
+import numpy as np
+
 from ncpp.errors import Warnings
 from ncpp.motion.offsets import WorkOffsets
 from ncpp.pipeline import ErrorSource, process
@@ -35,6 +37,15 @@ def machine_file(name: str, errors: str) -> str:
     return head + errors
 
 
+def linear_errors(**per_mm: float) -> str:
+    """[errors...] tables of components linear in their axis's position, µm per mm (`EXZ=0.1`:
+    Z travelling carries X by 0.1 µm per mm of z), for `machine_file`."""
+    return "".join(
+        f'\n[errors.{name}]\nkind = "polynomial"\ncoefficients_um = [0.0, {slope!r}]\n'
+        for name, slope in per_mm.items()
+    )
+
+
 # A machine whose X is off by -50 µm/m · Y (a squareness), and a short program per dialect
 SQUARE = machine_file(
     "square",
@@ -48,3 +59,8 @@ PROGRAMS = {
     "heidenhain": "0 BEGIN PGM T MM\n1 L X+10 Y+10 Z+5 FMAX\n2 L Y+200 F500\n3 END PGM T MM\n",
     "sinumerik": "%_N_T_MPF\nG90 G71\nG0 X10 Y10 Z5\nG1 Y200 F500\nM30\n",
 }
+
+
+def misses(reached: np.ndarray, wanted: list[tuple[float, ...]]) -> np.ndarray:
+    """For each wanted point, how far (mm) the nearest of the points `reached` (n,3) is from it."""
+    return np.array([np.min(np.linalg.norm(reached - np.array(point), axis=1)) for point in wanted])

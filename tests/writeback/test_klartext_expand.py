@@ -26,6 +26,7 @@ from ncpp.pipeline import dialect_tools
 from ncpp.program.dialects import parse_program
 from tests.compensation.test_dialect_cutter_comp import compensated, machine
 from tests.conftest import CORPUS, SHARED
+from tests.writeback.conftest import misses
 
 # a square 40 x 40 at Z-1, its section run 3 more times, each 1 mm deeper (Q1 counts down)
 REPEATED = """0 BEGIN PGM REP MM
@@ -102,11 +103,10 @@ def points(text: str) -> np.ndarray:
     return np.array(ends)
 
 
-def misses(text: str, wanted: list[tuple[float, ...]]) -> np.ndarray:
+def landed(text: str, wanted: list[tuple[float, ...]]) -> np.ndarray:
     """For each programmed point, how far (mm) the nearest end point of the written program lands
     from it on AFFINE's machine."""
-    reached = machine(points(text))
-    return np.array([np.min(np.linalg.norm(reached - np.array(point), axis=1)) for point in wanted])
+    return misses(machine(points(text)), wanted)
 
 
 def squares() -> list[tuple[float, float, float]]:
@@ -124,9 +124,9 @@ def test_every_run_of_a_body_lands_on_its_programmed_points_within_half_a_micron
     """Each corner of each run, the written numbers mapped through the machine's formula, within
     0.5 µm of the point the test computes; the program as written misses them by microns."""
     written, _ = compensated(tmp_path, name, text, "--expand")
-    assert misses(written, wanted).max() < 0.5e-3
+    assert landed(written, wanted).max() < 0.5e-3
     plain, _ = compensated(tmp_path, "plain-" + name, text)
-    assert misses(plain, wanted).max() > 5e-3  # (the bodies left as programmed: the measure can fail)
+    assert landed(plain, wanted).max() > 5e-3  # (the bodies left as programmed: the measure can fail)
 
 
 def test_a_repeat_is_written_as_four_squares_without_its_call_and_its_q_parameter(tmp_path):

@@ -28,6 +28,7 @@ from ncpp.pipeline import dialect_tools
 from ncpp.program.dialects import parse_program
 from tests.compensation.test_dialect_cutter_comp import compensated, machine
 from tests.conftest import CORPUS, SHARED
+from tests.writeback.conftest import misses
 
 # 3 squares 40 x 40, each 1 mm deeper, by a FOR loop; the line after it reads the loop's variable
 FOR_SQUARES = """DEF INT I
@@ -127,11 +128,10 @@ def points(text: str) -> np.ndarray:
     return np.array(ends)
 
 
-def misses(text: str, wanted: list[tuple[float, ...]]) -> np.ndarray:
+def landed(text: str, wanted: list[tuple[float, ...]]) -> np.ndarray:
     """For each programmed point, how far (mm) the nearest end point of the written program lands
     from it on AFFINE's machine."""
-    reached = machine(points(text))
-    return np.array([np.min(np.linalg.norm(reached - np.array(point), axis=1)) for point in wanted])
+    return misses(machine(points(text)), wanted)
 
 
 def squares() -> list[tuple[float, float, float]]:
@@ -157,9 +157,9 @@ def test_every_run_of_a_body_lands_on_its_programmed_points_within_half_a_micron
     0.5 µm of the point the test computes; the program as written misses them by microns."""
     options = _with_subprograms(tmp_path)
     written, _ = compensated(tmp_path, name, text, "--expand", *options)
-    assert misses(written, wanted).max() < 0.5e-3
+    assert landed(written, wanted).max() < 0.5e-3
     plain, _ = compensated(tmp_path, "plain-" + name, text, *options)
-    assert misses(plain, wanted).max() > 5e-3  # (the bodies left as programmed: the measure can fail)
+    assert landed(plain, wanted).max() > 5e-3  # (the bodies left as programmed: the measure can fail)
 
 
 def test_a_for_loop_is_written_as_three_squares_its_variables_set_after_it(tmp_path):
