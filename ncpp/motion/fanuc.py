@@ -12,7 +12,10 @@ reads the same codes otherwise (G5.1 is a spline there, G8 lathe radius mode):
   subprogram at a sequence number: it ends interpretation with a warning.
 
 Both have additional work offsets: Fanuc's `G54.1 P1`-`P48` ("Additional workpiece coordinate
-systems"), Haas's `G154 P1`-`P99` ("G154 Select Work Coordinates P1-P99").  One whose zero ncpp
+systems", whose format is `G54.1 Pn` or `G54 Pn`: a G54 block with a P word selects the
+additional system; the GSK 980MDc manual, which follows Fanuc, writes the same), Haas's `G154
+P1`-`P99` ("G154 Select Work Coordinates P1-P99") and its older names G110-G129 for P1-P20
+(Haas's "G10 Set Offsets": "P1-P20 G110-G129 references auxiliary coordinates").  One whose zero ncpp
 is told (`--work-offset G54.1P3=X,Y,Z`, `G154P3=`, or a parameter file's #7001... / #14001...:
 `offsets.py`) is followed as G54-G59 are (`_additional_offset`); one not told ends interpretation
 with a warning, as does a block that selects one with other words in it (what else the block
@@ -49,6 +52,8 @@ class FanucInterpreter(Interpreter):
     settings: dict[float, frozenset[str]] = FANUC_SETTINGS
     unfollowed: dict[tuple[str, float], str] = FANUC_UNFOLLOWED
     additional = "G54.1"  # the code that selects an additional work offset, with P
+    g54_with_p = True  # `G54 Pn` selects additional work offset n as `G54.1 Pn` does
+    numbered = range(0)  # G codes that each select one additional work offset (Haas's G110-G129)
     rigid_tapping = False  # (Fanuc taps rigidly with M29 and G84: G33.1 is LinuxCNC's)
 
     def block(self, block: Block) -> Event | tuple[Event, ...]:
@@ -57,8 +62,13 @@ class FanucInterpreter(Interpreter):
             return super().block(block)  # axis words only (the most): no setting, nothing unfollowed
         words = [item for item in block.items if type(item) is Word]
         for word in words:
-            if word.letter == "G" and word.value == ADDITIONAL_CODES[self.additional][0]:
+            if word.letter == "G" and (
+                word.value == ADDITIONAL_CODES[self.additional][0]
+                or (word.value == 54.0 and self.g54_with_p and any(w.letter == "P" for w in words))
+            ):
                 return self._additional_offset(block, word)
+            if word.letter == "G" and word.value.is_integer() and int(word.value) in self.numbered:
+                return self._additional_offset(block, word, int(word.value) - self.numbered.start + 1)
             if (
                 word.letter == "G"
                 and word.value == 10.0
@@ -80,22 +90,28 @@ class FanucInterpreter(Interpreter):
             raise _OutOfScope(f"G{setting.number} with other words in its block", setting.start + 1)
         return Pass(block)
 
-    def _additional_offset(self, block: Block, code: Word) -> Pass:
-        """`G54.1 Pn` (Haas: `G154 Pn`) with nothing else but N and comments: additional work
-        offset n, in effect from here as a G54-G59 selected is, where its zero is told."""
-        name, col = self.additional, code.start + 1
+    def _additional_offset(self, block: Block, code: Word, fixed: int | None = None) -> Pass:
+        """`G54.1 Pn` (Haas: `G154 Pn`; or a code that names one, `fixed`: n) with nothing else
+        but N and comments: additional work offset n, in effect from here as a G54-G59 selected
+        is, where its zero is told."""
+        name, col = f"G{code.number}", code.start + 1
         others = [item for item in block.items if type(item) is not Comment and item is not code]
         ps = [item for item in others if type(item) is Word and item.letter == "P"]
-        if len(ps) != 1:
+        if fixed is None and len(ps) != 1:
             raise _OutOfScope(f"{name} without one P (an additional work offset ncpp cannot tell)", col)
-        p = ps[0]
-        if any(item is not p and not (type(item) is Word and item.letter == "N") for item in others):
+        given = ps[0] if fixed is None else None
+        if any(item is not given and not (type(item) is Word and item.letter == "N") for item in others):
             raise _OutOfScope(f"{name} with other words in its block", col)
-        n = int(p.value) if p.value == int(p.value) and 1 <= p.value <= ADDITIONAL_CODES[name][1] else 0
+        last = ADDITIONAL_CODES[self.additional][1]
+        if given is not None:
+            n = int(given.value) if given.value == int(given.value) and 1 <= given.value <= last else 0
+        else:
+            n = fixed or 0
+        said = f"{name} P{given.number}" if given is not None else name
         number = ADDITIONAL + n
         if n == 0 or number not in self.g5x:
-            told = f": give --work-offset {name}P{n}=X,Y,Z or --var-file" if n else ""
-            raise _OutOfScope(f"{name} P{p.number} (an additional work offset ncpp is not told{told})", col)
+            told = f": give --work-offset {self.additional}P{n}=X,Y,Z or --var-file" if n else ""
+            raise _OutOfScope(f"{said} (an additional work offset ncpp is not told{told})", col)
         if self.cutter_comp is not None:
             raise _OutOfScope(f"{name} under cutter compensation", col)
         self._coordinate_system(number)
@@ -106,6 +122,8 @@ class HaasInterpreter(FanucInterpreter):
     settings = HAAS_SETTINGS
     unfollowed = HAAS_UNFOLLOWED
     additional = "G154"
+    g54_with_p = False  # (Haas's manual gives G54 no P)
+    numbered = range(110, 130)
 
 
 interpret = interpreting(FanucInterpreter)

@@ -52,6 +52,7 @@ _ACTIVE_SYSTEM, _G92_ON, _G92_X, _G28_X, _G30_X = 5220, 5210, 5211, 5161, 5181
 # Additional work offset n is system ADDITIONAL + n; Fanuc numbers P1-P48, Haas P1-P99
 ADDITIONAL = 100
 ADDITIONAL_CODES = {"G54.1": (54.1, 48), "G154": (154.0, 99)}  # name: the G code's value, the last n
+HAAS_NUMBERED = [f"G{n}" for n in range(110, 130)]  # Haas's names of G154 P1-P20
 # Their X in a Fanuc or Haas control's variables: n's at 7001 + 20 (n - 1) (Fanuc's P1-P48, Haas's
 # P1-P20) and at 14001 + 20 (n - 1) (Haas's P1-P99)
 _ADDITIONAL_X = ((7001, 48), (14001, 99))
@@ -200,10 +201,13 @@ def system_number(name: str) -> int:
     if key in SYSTEMS:
         return SYSTEMS.index(key) + 1
     code, p, n = key.replace(" ", "").partition("P")
+    code = "G54.1" if code == "G54" else code  # (Fanuc's `G54 Pn` is `G54.1 Pn`)
     if p and code in ADDITIONAL_CODES and n.isdigit() and 1 <= int(n) <= ADDITIONAL_CODES[code][1]:
         return ADDITIONAL + int(n)
+    if not p and code in HAAS_NUMBERED:  # (Haas's G110-G129 are G154 P1-P20)
+        return ADDITIONAL + HAAS_NUMBERED.index(code) + 1
     raise ValueError(f"not a work coordinate system: {name!r} (one of {', '.join(SYSTEMS)}, "
-                     f"G54.1P1-G54.1P48, G154P1-G154P99)")  # fmt: skip
+                     f"G54.1P1-G54.1P48, G154P1-G154P99, G110-G129)")  # fmt: skip
 
 
 def system_name(number: int, dialect: str = "fanuc") -> str:

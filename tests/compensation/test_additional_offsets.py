@@ -28,6 +28,9 @@ G54 = (100.0, 50.0, -200.0)
 P2 = (-400.0, 300.0, -100.0)  # the additional work offset 2, 500 mm away in X
 # (the code that selects additional offset 2, the dialect)
 FLAVOURS = [("G54.1 P2", "fanuc"), ("G154 P2", "haas")]
+# the other names the controls give additional offset 2: Fanuc's `G54 P2` (operator's manual,
+# "Additional workpiece coordinate systems"), Haas's G111 (G110-G129 are G154 P1-P20)
+OTHER_NAMES = [("G54 P2", "fanuc", "G54.1 P2"), ("G111", "haas", "G154 P2")]
 SQUARE = [(0, 0), (60, 0), (60, 40), (0, 40), (0, 0)]
 CALL = re.compile(r"(STRAIGHT_TRAVERSE|STRAIGHT_FEED|SET_G5X_OFFSET)\(([^)]*)\)")
 
@@ -77,7 +80,7 @@ def missed_um(landed: np.ndarray, wanted: np.ndarray) -> float:
     return float(max(apart.min(axis=1).max(), apart.min(axis=0).max()) * 1000)
 
 
-@pytest.mark.parametrize("select, dialect", FLAVOURS)
+@pytest.mark.parametrize("select, dialect", FLAVOURS + [name[:2] for name in OTHER_NAMES])
 def test_each_move_is_compensated_where_its_system_puts_it(tmp_path, select, dialect):
     """G54 -> additional offset 2 -> G54: within 0.5 µm of every programmed point, where the
     program as written misses by microns."""
@@ -89,12 +92,12 @@ def test_each_move_is_compensated_where_its_system_puts_it(tmp_path, select, dia
     assert missed_um(square(machine_ends(written, select, tmp_path), np.ones(3)), wanted) < 0.5
 
 
-@pytest.mark.parametrize("select, dialect", FLAVOURS)
-def test_an_additional_offset_is_compensated_as_g55_with_the_same_zero(tmp_path, select, dialect):
+@pytest.mark.parametrize("select, dialect, said", [(*f, f[0]) for f in FLAVOURS] + OTHER_NAMES)
+def test_an_additional_offset_is_compensated_as_g55_with_the_same_zero(tmp_path, select, dialect, said):
     as_g55 = compensated(program("G55"), dialect, WorkOffsets.of({"G54": G54, "G55": P2}), tmp_path)
     told = WorkOffsets.of({"G54": G54, select.replace(" ", ""): P2})
     additional = compensated(program(select), dialect, told, tmp_path)
-    assert f"{select} X-400 Y300 Z-100" in additional  # (the header says the zero)
+    assert f"{said} X-400 Y300 Z-100" in additional  # (the header says the zero)
     body = additional[additional.index("G21 G90") :]
     assert body == as_g55[as_g55.index("G21 G90") :].replace("G55\n", select + "\n")
 
@@ -138,8 +141,10 @@ def test_an_offset_not_told_stays_out_of_scope(tmp_path):
 def test_parse_names_the_additional_offsets():
     assert parse_zero("g54.1p3=1,2,3") == ("G54.1P3", (1.0, 2.0, 3.0))
     assert parse_zero("G154 P99=1,2,3")[0] == "G154 P99"
+    assert WorkOffsets.of({"G54P3": (1, 2, 3), "G129": (4, 5, 6)}).told_additional() == [103, 120]
     assert WorkOffsets.of({"G54.1P3": (1, 2, 3)}).zero(WorkOffsets.of({"G154P3": (1, 2, 3)}).told_additional()[0]) == (
         1.0, 2.0, 3.0)  # fmt: skip
-    for bad in ("G54.1P49=1,2,3", "G154P100=1,2,3", "G54.1=1,2,3", "G154P0=1,2,3"):
+    bad_names = ("G54.1P49", "G154P100", "G54.1", "G154P0", "G130", "G110P1")
+    for bad in (f"{name}=1,2,3" for name in bad_names):
         with pytest.raises(ValueError, match="not a work coordinate system"):
             parse_zero(bad)
