@@ -89,6 +89,9 @@ DATUM_CYCLES = frozenset(("7", "8", "10", "11", "19", "26"))
 # is a zero ncpp is not told
 PRESET_CYCLE = "247"
 END_M = frozenset((2.0, 30.0))
+# The parameter the control sets to the active tool radius at each TOOL CALL: R (tool table or
+# TOOL DEF) + DR (tool table) + DR (TOOL CALL) (TNC 320 User's Manual, "Preassigned Q parameters")
+ACTIVE_TOOL_RADIUS = "q108"
 SIDES = {"RL": 1, "RR": -1, "R0": 0}  # radius compensation's side of the contour (0: off)
 HARMLESS_KEYWORDS = frozenset(("STOP",))
 # Resets of what this interpreter never follows (a tilted plane, TCPM: it stops at any that sets
@@ -294,9 +297,15 @@ class HeidenhainInterpreter(ModalInterpreter):
             raise NcppError(str(err), where) from None
 
     def lookup(self, name: str) -> float:
-        if name not in self.q:
-            raise OutOfScope(f"the parameter {name.upper()} (not set in the program)")
-        return self.q[name]
+        if name in self.q:
+            return self.q[name]
+        if name == ACTIVE_TOOL_RADIUS:
+            radius = self.tool_radius()
+            if radius is None:
+                raise OutOfScope("the parameter Q108 (the active tool radius, which ncpp is not told: "
+                                 "give --tool-table TOOL.T, or TOOL DEF with R)")  # fmt: skip
+            return radius
+        raise OutOfScope(f"the parameter {name.upper()} (not set in the program)")
 
     # -- one block ------------------------------------------------------------------------
     def block(self, block: Block) -> list[Event]:
@@ -640,6 +649,7 @@ class HeidenhainInterpreter(ModalInterpreter):
             self.call_dl = dl
         if dr is not None:
             self.call_dr = dr
+        self.q.pop(ACTIVE_TOOL_RADIUS, None)  # (the control sets it anew)
         tool = [0.0, 0.0, 0.0]
         tool[self.tool_axis] = self._length(self.tool_number, block, statement) + self.call_dl
         self.set_tool(tool)
