@@ -722,11 +722,12 @@ class HeidenhainInterpreter(ModalInterpreter):
         self.flow = flow
 
         def stop(reason: str, owner: Block) -> None:  # (where the flow itself cannot go on)
-            if caller is None:
-                self._refuse_leaving(reason, owner, None)
+            self._refuse_leaving(reason, owner, None)
             self.leave_scope(warnings, reason, owner, None, caller)
 
-        expansion = self.expansion if caller is None else None  # (a called program's text is not written)
+        # (with --expand a called program's blocks are written in place of its CALL PGM line, in the
+        # caller's units; without it, its text is no part of the output)
+        expansion, calling_inch = self.expansion, self.inch
         for block, kind, owner in flow.steps(lambda: self.done or self.returned, stop):
             if caller is not None:
                 if kind is SKIP or kind is TEXT:
@@ -751,7 +752,7 @@ class HeidenhainInterpreter(ModalInterpreter):
                 events = self.block(block)
             except OutOfScope as out:
                 self.called = None
-                if expansion is not None and expansion.refuses_leaving(flow):
+                if expansion is not None and (caller is not None or expansion.refuses_leaving(flow)):
                     raise refused(out.reason, Location(self.file, block.line, out.col)) from None
                 self.leave_scope(warnings, out.reason, block, out.col, owner)
                 if owner is None:
@@ -759,22 +760,35 @@ class HeidenhainInterpreter(ModalInterpreter):
                     yield Pass(block)
                 continue
             if expansion is not None:  # each block where it runs, a stretch's as this run's numbers
+                if caller is not None and self.inch != calling_inch:
+                    raise refused(f"a called program in {'inches' if self.inch else 'mm'} (its caller's "
+                                  "units differ)", Location(self.file, block.line, 1))  # fmt: skip
                 yield from settling
                 if written is not block:
                     if written is not None:
+                        if caller is not None:  # (told at its CALL PGM line, as the input's moves are)
+                            written.line = caller.line
                         for event in events:
                             event.block = written
                         yield from events or (Pass(written),)
+                    yield from self._called_program(
+                        flow, owner or block, warnings
+                    )  # (CALL PGM's line left out)
                     continue
             elif kind is FIXED:
                 events = _in_flow(events, owner)
             if kind is not FIXED and flow.labels and any(type(e) is Line or type(e) is Arc for e in events):
                 flow.moved()  # (before the first label nothing can jump back over it)
             yield from events or ((Pass(block),) if owner is None else ())
-            if self.called is not None:
-                path, self.called = self.called, None
-                yield from self._program(path, owner or block, warnings)
-                self.flow = flow
+            yield from self._called_program(flow, owner or block, warnings)
+
+    def _called_program(self, flow: KlartextFlow, caller: Block, warnings: Warnings) -> Iterator[Event]:
+        """The events of the program the block just run called by CALL PGM (none if it called none),
+        after which `flow` goes on."""
+        if self.called is not None:
+            path, self.called = self.called, None
+            yield from self._program(path, caller, warnings)
+            self.flow = flow
 
     def _written_out(
         self, expansion: KlartextExpansion, block: Block, kind: str, owner: Block | None
@@ -797,15 +811,10 @@ class HeidenhainInterpreter(ModalInterpreter):
 
     def _refuse_leaving(self, reason: str, block: Block, col: int | None) -> None:
         """With --expand, an out-of-scope construct where the rest cannot pass through as it is
-        (`KlartextExpansion.refuses_leaving`) is refused (in a program CALL PGM runs, the rest
-        passes through from the calling line, which is written as it is)."""
+        (`KlartextExpansion.refuses_leaving`, or anywhere in a program CALL PGM runs: its calling
+        line is left out) is refused."""
         expansion, flow = self.expansion, self.flow
-        if (
-            expansion is not None
-            and flow is not None
-            and not self.programs
-            and expansion.refuses_leaving(flow)
-        ):
+        if expansion is not None and flow is not None and (self.programs or expansion.refuses_leaving(flow)):
             raise refused(reason, Location(self.file, block.line, col))
 
     # -- CALL PGM (TNC 640 Klartext manual, "Calling any program as a subprogram") ------------
@@ -852,6 +861,7 @@ class HeidenhainInterpreter(ModalInterpreter):
         try:
             yield from self._run_flow(KlartextFlow(str(path), blocks), warnings, caller)
             if not self.done and not self.returned:
+                self._refuse_leaving(f"the called program {path.name} ends without END PGM", caller, None)
                 self.leave_scope(warnings, f"the called program {path.name} ends without END PGM",
                                  blocks[-1] if blocks else caller, None, caller)  # fmt: skip
         finally:

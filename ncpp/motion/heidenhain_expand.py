@@ -4,13 +4,16 @@ What --expand does is ISO's (`ncpp.motion.expand`); the order the blocks run in 
 `heidenhain_flow`'s, after the TNC 640 Klartext manual ("Subprograms and program section
 repeats": `CALL LBL n` runs the blocks after `LBL n` up to `LBL 0`, `CALL LBL n REP k` the section
 from `LBL n` to the call k more times; "If-then decisions with Q parameters": FN 9-12 jump to a
-label when the comparison holds).  Every block a subprogram, a repeated section or a jump's loop
-runs is written where it runs, for that run (`KlartextExpansion.body`): its Q parameters in words as the numbers
+label when the comparison holds; "Calling any program as a subprogram": `CALL PGM` runs another
+program's blocks from its BEGIN PGM to its END PGM).  Every block a subprogram, a repeated section,
+a jump's loop or a called program runs is written where it runs, for that run (`KlartextExpansion.body`): its Q parameters in words as the numbers
 they have there (`L X+Q1` -> `L X+12.5`), its Q parameter assignments (`Q1 = ...`, FN 0-8 and 13)
 left out, so its moves are plain moves compensated like any other.  A cycle definition's own
 parameters (`Q200=+2` in `CYCL DEF 200`) stay, as numbers, since the cycle reads them there.
 
-The control lines, `CALL LBL` and FN 9-12, are left out, and so is the text a jump goes over.  A
+The control lines, `CALL LBL`, `CALL PGM` and FN 9-12, are left out, and so is the text a jump
+goes over; so are a called program's BEGIN PGM and END PGM lines and its labels (its file is not
+touched: the written program no longer calls it).  A
 `LBL` line stays where its text stands (a label nothing calls any more is harmless, and a call
 passed through after an out-of-scope line may still need it); run again away from it (a jump
 back to it), it is not written again.  The subprograms after the program's end stay as text.
@@ -20,8 +23,8 @@ values they have there (`FN 0: Q1 = +12.5`, the manual's "Basic arithmetic" FN 0
 them.  The written program's blocks are numbered afresh (the writer's `renumber`).
 
 Refused (`ncpp.motion.expand.refused`, `counted`): an out-of-scope construct inside a stretch
-written out, `CALL PGM` inside one (the called program would read Q parameters the written-out
-stretch no longer sets), a statement whose Q parameter cannot be written as a number (`TOOL
+written out or anywhere in a called program, a called program in other units than its caller's
+(its numbers would be written in its own), a statement whose Q parameter cannot be written as a number (`TOOL
 CALL Q5`, `PATTERN DEF` with Q words) inside one, and more than MAX_EXPANDED blocks written out.
 """
 
@@ -60,9 +63,12 @@ def head(block: Block) -> Statement | None:
 
 
 def is_control(block: Block) -> bool:
-    """`CALL LBL` and FN 9-12: lines that only steer the flow (left out where --expand writes runs)."""
+    """`CALL LBL`, `CALL PGM` and FN 9-12: lines that only steer the flow (left out where --expand
+    writes runs)."""
     item = head(block)
-    return item is not None and (item.kind == "call_label" or (item.kind == "fn" and item.node[0] in JUMPS))
+    return item is not None and (
+        item.kind in ("call_label", "call_program") or (item.kind == "fn" and item.node[0] in JUMPS)
+    )
 
 
 def is_label(block: Block) -> bool:
@@ -92,7 +98,7 @@ def parameter_name(name: str) -> str:
 
 class KlartextExpansion:
     """What --expand does to one run of a Klartext program (`HeidenhainInterpreter._run_flow` asks
-    it at each block of the program itself, not of one CALL PGM runs)."""
+    it at each block that runs, a called program's too)."""
 
     def __init__(self, q: dict[str, float], file: str):
         self.q = q  # the interpreter's Q parameters (the same dict: read where asked)
@@ -163,13 +169,8 @@ class KlartextExpansion:
             return f"{parameter_name(target[1])}={number('Q', self.written[target[1]])}"
         if item.kind == "fn" and item.node[0] in ARITHMETIC_FN:
             return None
-        if item.kind == "call_program":
-            raise NcppError(
-                "--expand: CALL PGM inside a subprogram, a repeated section or a jump's loop cannot be "
-                "written out (the program it calls may read Q parameters the written-out stretch no "
-                "longer sets); leave --expand out",
-                Location(self.file, block.line, item.start + 1),
-            )
+        if item.kind in ("program_begin", "program_end"):  # (a called program's: its blocks are the caller's)
+            return None
         if _reads_parameter(item.node):
             raise NcppError(
                 "--expand: a Q parameter in this statement cannot be written as a number inside a "

@@ -13,6 +13,7 @@ original with --expand and the written program without it, is a consistency chec
 from __future__ import annotations
 
 import io
+import math
 import re
 from pathlib import Path
 
@@ -21,7 +22,8 @@ import pytest
 
 import ncpp.motion.expand as expand_module
 from ncpp.cli import main
-from ncpp.motion.segments import Arc, Line
+from ncpp.errors import Warnings
+from ncpp.motion.segments import PLANE_AXES, Arc, Line
 from ncpp.pipeline import dialect_tools
 from ncpp.program.dialects import parse_program
 from tests.compensation.test_dialect_cutter_comp import compensated, machine
@@ -212,7 +214,7 @@ def test_ncpps_interpreter_reads_the_same_moves_from_both_texts(tmp_path, text):
 @pytest.mark.parametrize(
     "body, message",
     [
-        ("10 CALL PGM OTHER.H\n", r"sub\.h:11:4: --expand: CALL PGM inside a subprogram"),
+        ("10 CALL PGM OTHER.H\n", r"sub\.h:11:4: --expand: CALL PGM OTHER\.H \(its file not found"),
         (
             "10 CYCL DEF 7.0 DATUM SHIFT\n",
             r"sub\.h:11:4: --expand: CYCL DEF 7\.0 \(it moves the datum\) is "
@@ -260,7 +262,99 @@ def test_the_command_line_writes_out_and_verifies_on_the_wide_machine(tmp_path):
         assert "CALL LBL" not in out.read_text().partition("M30")[0]
 
 
+# a program that calls another twice, which reads the caller's Q2 and repeats a section itself
+CALLER = """0 BEGIN PGM CALLER MM
+1 TOOL CALL 1 Z S3000
+2 L X-5 Y-5 Z+5 R0 FMAX
+3 Q2 = 100
+4 CALL PGM TNC:\\PARTS\\SLOT.H
+5 Q2 = 200
+6 CALL PGM SLOT
+7 L X+300 Y+0 Z+50 FMAX M30
+8 END PGM CALLER MM
+"""
+SLOT = """0 BEGIN PGM SLOT MM
+1 Q5 = 0
+2 LBL 1
+3 Q5 = Q5 + 20
+4 Q6 = Q2 + 10
+5 L X+Q2 Y+Q5 Z-2 F300
+6 L X+Q6
+7 CALL LBL 1 REP 1
+8 L Z+5 FMAX
+9 END PGM SLOT MM
+"""
+SLOTS = [(x + dx, y, -2) for x in (100, 200) for y in (20, 40) for dx in (0, 10)] + [(300, 0, 50)]
+
+
+def test_a_called_program_is_written_where_each_call_runs_it(tmp_path):
+    """CALL PGM (TNC 640 Klartext manual, "Calling any program as a subprogram") runs the called
+    program's blocks with the caller's Q parameters: with --expand each call is written in its
+    place, every point within 0.5 µm, the call lines, the called program's BEGIN PGM / END PGM
+    and its repeat gone, the Q parameters it set set after it, and the caller's last move after
+    both."""
+    (tmp_path / "SLOT.H").write_text(SLOT)
+    written, _ = compensated(tmp_path, "caller.h", CALLER, "--expand", "--subroutine-path", str(tmp_path))
+    assert landed(written, SLOTS).max() < 0.5e-3
+    assert not re.search(r"CALL PGM|LBL|BEGIN PGM SLOT|END PGM SLOT", written)
+    assert "FN 0: Q5 = +40" in written  # (Q parameters are global: the caller's as the call left them)
+    assert written.index("X+299") > written.rindex("X+209")
+    plain, _ = compensated(tmp_path, "plain.h", CALLER, "--subroutine-path", str(tmp_path))
+    assert "CALL PGM SLOT" in plain and landed(plain, SLOTS[:-1]).max() > 5e-3  # (left as programmed)
+
+
+def test_a_called_program_in_other_units_is_refused_with_expand(tmp_path, capsys):
+    (tmp_path / "SLOT.H").write_text(SLOT.replace(" MM\n", " INCH\n"))
+    program = tmp_path / "caller.h"
+    program.write_text(CALLER)
+    code = main(["compensate", "--machine", str(_wide(tmp_path)), "--expand", "--subroutine-path",
+                 str(tmp_path), str(program), "-o", str(tmp_path / "out.h")])  # fmt: skip
+    assert code != 0
+    assert re.search(r"SLOT\.H:1:1: --expand: a called program in inches \(its caller's units differ\)",
+                     capsys.readouterr().err)  # fmt: skip
+
+
 PLAN = CORPUS / "heidenhain" / "jstjst_Heidenhain-Cycles"
+PLAN_TOOL_T = """BEGIN TOOL    .T       MM
+T    NAME             L          R          DL      DR      TL RT
+1    FACEMILL         +50,000    +20,000    +0,000  +0,000
+[END]
+"""
+
+
+def test_the_corpus_face_milling_call_is_written_out_and_follows_the_original(tmp_path):
+    """Plan-Beispiel.h as it stands: it sets the cycle's parameters and calls Plan.h (FN 9-12
+    loops, a stepover from the tool radius Q108) by CALL PGM TNC:\\Plan.h.  With the folder on the
+    subroutine path and a tool table, --expand writes it all out, verified; its moves, read back,
+    lie within 20 µm of the original's as ncpp reads the original without --expand, and the
+    other way round (the largest correction on wide.toml is 12 µm)."""
+    if not PLAN.is_dir():
+        pytest.skip(f"corpus not found at {PLAN}")
+    (tmp_path / "TOOL.T").write_text(PLAN_TOOL_T)
+    options = ["--subroutine-path", str(PLAN), "--tool-table", str(tmp_path / "TOOL.T")]
+    out = tmp_path / "out.h"
+    code = main(["compensate", "--machine", str(_wide(tmp_path)), "--expand", *options,
+                 str(PLAN / "Plan-Beispiel.h"), "-o", str(out)])  # fmt: skip
+    assert code == 0
+    written = out.read_text(encoding="latin-1")
+    assert not re.search(r"CALL PGM|FN 1[0-2]:|FN 9:|[XYZF][+-]?Q\d", written)
+    original = _moves(PLAN / "Plan-Beispiel.h", options)
+    back = _moves(out, options)
+    assert len(original) > 100 and not any(fixed for _, fixed in back)
+    ours, theirs = np.array([end for end, _ in back]), np.array([end for end, _ in original])
+    assert misses(ours, [tuple(p) for p in theirs]).max() < 0.02
+    path = _along(_moves(PLAN / "Plan-Beispiel.h", options, events=True))
+    assert _off_the_path(ours, path).max() < 0.02  # (the written moves add split points)
+
+
+def _off_the_path(points: np.ndarray, ends: np.ndarray) -> np.ndarray:
+    """How far (mm) each point lies from the path through `ends` in order (straight between them)."""
+    a, b = ends[:-1], ends[1:]
+    ab = b - a
+    length2 = np.maximum((ab * ab).sum(axis=1), 1e-30)
+    t = np.clip(((points[:, None, :] - a[None]) * ab[None]).sum(axis=2) / length2, 0.0, 1.0)
+    nearest = a[None] + t[..., None] * ab[None]
+    return np.linalg.norm(points[:, None, :] - nearest, axis=2).min(axis=1)
 
 
 def test_the_corpus_face_milling_cycle_is_written_out_and_verified(tmp_path):
@@ -273,7 +367,7 @@ def test_the_corpus_face_milling_cycle_is_written_out_and_verified(tmp_path):
     given = [line.split(None, 1)[1] for line in caller if re.match(r"\d+ +Q18\d\d =", line)]
     plan = (PLAN / "Plan.h").read_text().splitlines()
     lines = [plan[0]] + [
-        f"{n} {text}" for n, text in enumerate(given + ["Q108 = 5", "TOOL CALL 1 Z S800"], 1)
+        f"{n} {text}" for n, text in enumerate(given + ["TOOL CALL 1 Z S800", "Q108 = 5"], 1)
     ]
     for line in plan[1:]:  # (renumbered after the lines put first; continuation lines as they are)
         number, _, text = line.partition(" ")
@@ -298,6 +392,40 @@ def _wide(tmp_path: Path) -> Path:
     if not wide.is_file():
         pytest.skip(f"{wide} not found")
     return wide
+
+
+def _moves(path: Path, options: list[str], events: bool = False) -> list:
+    """The moves of the Klartext program at `path` as ncpp reads it (no --expand), with the
+    subroutine path and tool table of `options`: (end, fixed) each, or the events."""
+    from dataclasses import replace
+
+    from ncpp.motion.offsets import WorkOffsets
+    from ncpp.motion.tools import ToolTable
+
+    offsets = replace(WorkOffsets.at((0.0, 0.0, 0.0)), tools=ToolTable.from_file(Path(options[3])),
+                      subroutine_path=(Path(options[1]),))  # fmt: skip
+    interpret, _ = dialect_tools("heidenhain")
+    _, parsed = parse_program(io.BytesIO(path.read_bytes()), str(path), "heidenhain")
+    read = interpret(parsed, file=str(path), warnings=Warnings(stream=io.StringIO()), offsets=offsets)
+    return [e for e in read if type(e) is Line or type(e) is Arc] if events else _ends(read)
+
+
+def _along(moves: list) -> np.ndarray:
+    """The path of `moves` as points in order: each line's ends, each arc at 128 points per turn."""
+    points = [np.array(moves[0].start)]
+    for move in moves:
+        if type(move) is Arc:
+            i, j, _ = PLANE_AXES[move.context.plane]
+            sweep, radius = move.sweep(), move.radius()
+            start = math.atan2(move.start[j] - move.center[j], move.start[i] - move.center[i])
+            for t in np.linspace(0.0, 1.0, max(2, int(abs(sweep) / (2 * math.pi) * 128) + 2))[1:]:
+                point = np.array(move.start) + t * (np.array(move.end) - np.array(move.start))
+                point[i] = move.center[i] + radius * math.cos(start + t * sweep)
+                point[j] = move.center[j] + radius * math.sin(start + t * sweep)
+                points.append(point)
+        else:
+            points.append(np.array(move.end))
+    return np.array(points)
 
 
 def _blocks(text: str):
