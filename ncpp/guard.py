@@ -61,7 +61,7 @@ from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, replace
 from itertools import chain, islice
 
-from ncpp.motion.offsets import WorkOffsets, system_name
+from ncpp.motion.offsets import _ADDITIONAL_X, ADDITIONAL, WorkOffsets, system_name
 from ncpp.motion.segments import Event, Pass
 from ncpp.program.blocks import Block, Comment
 from ncpp.program.parser import LEADER_LINES
@@ -71,7 +71,6 @@ BEGIN = "ncpp placement guard:"
 END = "ncpp placement guard end"
 TOOL_BEGIN = "ncpp tool guard:"
 TOOL_END = "ncpp tool guard end"
-SCAN = 60  # blocks at the top searched for a placement guard
 GUARD_BLOCKS = 12  # the most blocks a guard has (a first comment without its last within them is no guard)
 # A Sinumerik line that defines a variable, or one a definition section may hold between them (a
 # comment, a blank line): the 840D wants definitions before the program's first statement
@@ -94,6 +93,7 @@ class Placement:
     system: int
     zero: tuple[float, float, float]
     unit_mm: float = 1.0
+    dialect: str = "fanuc"  # whose name an additional work offset takes (Haas: G154 Pn)
 
     @classmethod
     def of(cls, offsets: WorkOffsets, unit_mm: float = 1.0) -> Placement | None:
@@ -104,7 +104,7 @@ class Placement:
 
     @property
     def name(self) -> str:
-        return system_name(self.system)
+        return system_name(self.system, self.dialect)
 
     def values(self) -> list[str]:
         """X Y Z of the zero in the control's units, as the guard compares them."""
@@ -147,48 +147,68 @@ def _sinumerik_place(head: list[str], at: int, rest: Iterator[str]) -> tuple[int
         at += 1
 
 
-def guard_lines(placement: Placement, dialect: str, first_lines: Iterable[str] = ()) -> list[str]:
+def guard_lines(
+    placement: Placement, dialect: str, first_lines: Iterable[str] = (), selected: bool = False, label: int = 0
+) -> list[str]:
     """The guard's lines (without line ends) for a program of `dialect` (a post's "linuxcnc" or
     "fanuc" says its syntax, and a Haas program's is Fanuc's; for "iso", `first_lines`, the
-    program's first lines, tell Fanuc's from LinuxCNC's).  [] where there is none."""
+    program's first lines, tell Fanuc's from LinuxCNC's).  [] where there is none.  `selected`:
+    the program selects the system itself (only its zero is checked); `label` numbers a
+    LinuxCNC check after the first (a program's labels are each defined once)."""
     if dialect == "iso":
         dialect = "fanuc" if any(_FANUC_PROGRAM_NUMBER.match(line) for line in first_lines) else "linuxcnc"
     # (grbl reads no parameters and has no conditionals: it cannot test its work offset)
-    written = {"linuxcnc": _linuxcnc, "fanuc": _fanuc, "haas": _fanuc, "sinumerik": _sinumerik}.get(dialect)
-    return [] if written is None else written(placement)
+    if dialect == "linuxcnc":
+        return _linuxcnc(placement, selected, label)
+    if dialect in ("fanuc", "haas"):
+        return _fanuc(replace(placement, dialect=dialect), selected)
+    return _sinumerik(placement, selected) if dialect == "sinumerik" else []
 
 
 def _tolerance(placement: Placement) -> str:
     return _number(GUARD_MM / placement.unit_mm)
 
 
-def _linuxcnc(placement: Placement) -> list[str]:
+def _linuxcnc(placement: Placement, selected: bool = False, label: int = 0) -> list[str]:
     if placement.system > 9:
         return []  # (the additional work offsets are Fanuc's and Haas's)
     x = 5221 + 20 * (placement.system - 1)
     tolerance = _tolerance(placement)
-    far = " OR ".join(
-        f"[ABS[#{x + k} - {value}] GT {tolerance}]" for k, value in enumerate(placement.values())
-    )
+    far = [f"[ABS[#{x + k} - {value}] GT {tolerance}]" for k, value in enumerate(placement.values())]
+    if not selected:
+        far.insert(0, f"[#5220 NE {placement.system}]")
+    name = f"o<ncpp_guard_{label}>" if label else "o<ncpp_guard>"
+    differs = f"the control's {placement.name} zero differs" if selected else "the control's work offset differs"
     return [
         f"({BEGIN} {placement.said()} within {_number(GUARD_MM)} mm)",
-        f"o<ncpp_guard> if [[#5220 NE {placement.system}] OR {far}]",
-        f"(abort, ncpp: compensated for {placement.said()}; the control's work offset differs: "
-        "compensate again for it, or set the offset)",
-        "o<ncpp_guard> endif",
+        f"{name} if [{' OR '.join(far)}]",
+        f"(abort, ncpp: compensated for {placement.said()}; {differs}: compensate again for it, or set the offset)",
+        f"{name} endif",
         f"({END})",
     ]
 
 
-def _fanuc(placement: Placement) -> list[str]:
-    if placement.system > 6:
-        return []  # (G59.1-G59.3 are LinuxCNC's; an additional work offset: the module docstring)
-    x = 5221 + 20 * (placement.system - 1)
+def _fanuc_x(placement: Placement) -> int | None:
+    """The variable of the X of the zero of the placement's system on a Fanuc or Haas control
+    (None: it has none): G54-G59 at #5221, 20 per system (Custom Macro B); an additional work
+    offset at Fanuc's #7001 or Haas's #14001, 20 per offset (`offsets.py`)."""
+    if placement.system > ADDITIONAL:
+        n = placement.system - ADDITIONAL
+        first, last = _ADDITIONAL_X[1 if placement.dialect == "haas" else 0]
+        return first + 20 * (n - 1) if n <= last else None
+    return 5221 + 20 * (placement.system - 1) if placement.system <= 6 else None  # (G59.1-G59.3: LinuxCNC's)
+
+
+def _fanuc(placement: Placement, selected: bool = False) -> list[str]:
+    """`selected`: the program selects the system itself (only its zero is checked); an
+    additional work offset only so, since #4014 reads 54 for it (the module docstring)."""
+    x = _fanuc_x(placement)
+    if x is None or (placement.system > ADDITIONAL and not selected):
+        return []
     tolerance = _tolerance(placement)
-    lines = [
-        f"({BEGIN.upper()} {placement.said().upper()} WITHIN {_number(GUARD_MM)} MM)",
-        f"IF [#4014 NE {53 + placement.system}] THEN #3000=1 (NCPP {placement.name} NOT ACTIVE)",
-    ]
+    lines = [f"({BEGIN.upper()} {placement.said().upper()} WITHIN {_number(GUARD_MM)} MM)"]
+    if not selected:
+        lines.append(f"IF [#4014 NE {53 + placement.system}] THEN #3000=1 (NCPP {placement.name} NOT ACTIVE)")
     for k, (axis, value) in enumerate(zip("XYZ", placement.values(), strict=True)):
         alarm = f"#3000={2 + k} (NCPP {placement.name} {axis} MOVED)"
         lines.append(f"IF [ABS[#{x + k}-{value}] GT {tolerance}] THEN {alarm}")
@@ -229,10 +249,13 @@ def with_guard(
     header: str,
     header_lines: int = 1,
     unguarded: Callable[[str], None] = lambda why: None,
+    checks: bool = False,
 ) -> Iterator[str]:
     """The written program's lines with the guard after the header comment (`header_lines` lines,
     the first holding `header`) and the program number that may follow it.  Where the dialect
-    (or the control's system) has no guard, `unguarded` is told why."""
+    (or the control's system) has no guard, `unguarded` is told why.  `checks`: the ISO program's
+    selections of told systems are checked where it makes them (`PlacementChecks`), so no guard
+    is written where it selects a system before anything relies on the one in effect."""
     # (lines are taken from `lines` no further than the guard's place: the verifier tags each
     # line with how far the writer had read when it was taken)
     it = iter(lines)
@@ -250,7 +273,9 @@ def with_guard(
             if not _FANUC_PROGRAM_NUMBER.match(line):
                 break
     guard = guard_lines(placement, dialect, head)
-    if not guard:
+    if checks and at is not None and dialect in ISO_SYNTAX and _iso_selects_first(head, at, it):
+        guard = []  # (the check of the system it selects stands before that line)
+    elif not guard:
         unguarded(UNGUARDED.get(dialect, f"{dialect} has no settable frame for {placement.name}"))
     if at is None or not guard:
         yield from chain(head, it)
@@ -266,6 +291,82 @@ def with_guard(
     yield from (line + eol for line in guard)
     yield from head[at:]
     yield from it
+
+
+ISO_SYNTAX = ("iso", "linuxcnc", "fanuc", "haas")  # the dialects whose guard is LinuxCNC's or Fanuc's
+# An ISO line that neither moves nor relies on the work offset in effect: N, modal G codes, M0-M9
+# (not M98 M99, calls), T S F H D words, comments; and one that selects a work offset (G54.1 P,
+# G154 P: Fanuc's and Haas's additional ones)
+_ISO_SETTINGS = re.compile(
+    r"\s*%?\s*((N\d+|G0*(0|1|2|3|17|18|19|20|21|40|43|49|5[4-8]|59(\.[123])?|61(\.1)?|64|80|9[01](\.1)?|9[3-9])"
+    r"|M0*\d|[TSFHD]\d+(\.\d*)?)(?![\d.])\s*)*",
+    re.IGNORECASE,
+)
+_ISO_SELECTION = re.compile(r"G0*(5[4-9]|154)(?![0-9])", re.IGNORECASE)
+_ISO_COMMENT = re.compile(r"\([^)]*\)|;.*")
+
+
+def _iso_selects_first(head: list[str], at: int, rest: Iterator[str]) -> bool:
+    """Whether an ISO program selects a work offset before anything relies on the one in effect:
+    in one of the lines of settings alone from `at` on, or in the first other line (whose
+    selection, in rs274ngc's order of execution and Fanuc's, comes before its move); a placement
+    check the writer put before a selection says so too, and the tool guard's checks are
+    skipped (`head` takes the lines it needs from `rest`)."""
+    settings, tool_check = 0, False
+    while settings <= _SETTINGS_SCANNED:
+        if at == len(head):
+            line = next(rest, None)
+            if line is None:
+                return False
+            head.append(line)
+        text, at = head[at], at + 1
+        said = text.lower()
+        if TOOL_BEGIN in said or tool_check:
+            tool_check = TOOL_END not in said
+            continue
+        if BEGIN in said:
+            return True
+        code = _ISO_COMMENT.sub("", text)
+        if _ISO_SELECTION.search(code):
+            return True
+        if _FANUC_PROGRAM_NUMBER.match(text):
+            continue
+        if not _ISO_SETTINGS.fullmatch(code.rstrip("\r\n")) or "/" in code:
+            return False
+        settings += 1
+    return False
+
+
+class PlacementChecks:
+    """The placement guard's check of the zero of each told system an ISO program selects, once,
+    before the first block that selects it (the writer's `before`): the interpreter marks the
+    block (`Pass.zero_told`) where it runs once and the zero is still the one told.  LinuxCNC's
+    syntax, or Fanuc's (Haas's) in a Fanuc program (a program number at its top)."""
+
+    def __init__(
+        self, offsets: WorkOffsets, dialect: str, unit_mm: float, unguarded: Callable[[str], None] = lambda why: None
+    ):
+        self.offsets, self.dialect, self.unit_mm, self.unguarded = offsets, dialect, unit_mm, unguarded
+        self.looked = 0  # blocks looked at for a Fanuc program number
+        self.checked: set[int] = set()
+
+    def __call__(self, events: list[Event]) -> list[str]:
+        block = events[0].block
+        if self.dialect == "iso" and self.looked < LEADER_LINES + 12:
+            self.looked += 1
+            if _FANUC_PROGRAM_NUMBER.match(block.raw):
+                self.dialect = "fanuc"
+        number = next((e.zero_told for e in events if type(e) is Pass and e.zero_told is not None), None)
+        if number is None or number in self.checked:
+            return []
+        self.checked.add(number)
+        placement = Placement(number, self.offsets.zero(number), self.unit_mm)
+        dialect = "linuxcnc" if self.dialect == "iso" else self.dialect
+        lines = guard_lines(placement, dialect, selected=True, label=len(self.checked))
+        if not lines:
+            self.unguarded(f"{dialect} has no variables of {placement.name}'s zero")
+        eol = block.eol or "\n"
+        return [line + eol for line in lines]
 
 
 def tool_guard_lines(tool: int, length_mm: float, unit_mm: float, label: int) -> list[str]:
@@ -323,19 +424,19 @@ class ToolGuard:
 
 
 def without_guard(blocks: Iterable[Block]) -> Iterator[Block]:
-    """The blocks without the guards: the placement guard in the first SCAN blocks and the tool
-    guard's checks anywhere, each from its first comment to its last (within GUARD_BLOCKS: a
-    first comment without its last is no guard, and its blocks stay)."""
+    """The blocks without the guards: the placement guard's and the tool guard's checks wherever
+    they stand, each from its first comment to its last (within GUARD_BLOCKS: a first comment
+    without its last is no guard, and its blocks stay)."""
     held: list[Block] = []  # the blocks of a guard under way
     end = ""
-    for n, block in enumerate(blocks):
+    for block in blocks:
         raw = block.raw
         if not held and "ncpp" not in raw and "NCPP" not in raw:  # (most blocks: no guard's text)
             yield block
             continue
         said = " ".join(item.text.lower() for item in block.items if type(item) is Comment)
         if not held:
-            end = TOOL_END if TOOL_BEGIN in said else END if n < SCAN and BEGIN in said else ""
+            end = TOOL_END if TOOL_BEGIN in said else END if BEGIN in said else ""
             if not end:
                 yield block
                 continue
