@@ -18,10 +18,18 @@ starts with an O number):
   G20/G21, as rs274 reads them.
 * Fanuc and Haas (Custom Macro B: #4014 holds group 14's G code, 54-59; #5221-#5223
   G54's X Y Z, 20 per system; `#3000=n (text)` raises macro alarm n with the text and
-  stops; `IF [cond] THEN` one assignment): G54-G59 only.  An additional work offset
-  (G54.1 Pn, G154 Pn) in effect at the start gets no guard: #4014 reads 54 for it too,
-  and the variable that holds n differs between controls.  (One the program selects later
-  is not checked, as a G55 selected later is not.)
+  stops; `IF [cond] THEN` one assignment): G54-G59.  An additional work offset
+  (G54.1 Pn, G154 Pn) in effect at the start gets no guard: #4014 reads 54 for it too.
+  One the program selects is checked at its zero's variables (Fanuc's #7001 on, Haas's
+  #14001 on, `motion/offsets.py`).
+
+An ISO program (LinuxCNC, Fanuc, Haas) that selects a told system checks its zero before the
+block that selects it (`PlacementChecks`; rs274ngc and Fanuc select the system before the
+block's move), once per system, where the zero is still the one told (not after the program's
+own G10 L2/L20 of it) and the block runs once (not in a loop or a subroutine).  The check at the
+start (with the system number) is written only where the program may rely on the system in
+effect before it selects one: not where its first lines, of settings alone (modal G codes,
+T M S F H D words), select one (`_iso_selects_first`).
 
 * Sinumerik (840D sl System Variables parameter manual: `$P_UIFRNUM`, the number of the
   active settable frame, 1-4 for G54-G57; `$P_UIFR[n, axis, TR]` and `[n, axis, FI]`, its
