@@ -52,11 +52,18 @@ the check; the next does not.
   M61, not the offset G43 applies, so a G43 H of another tool is not checked.  They stand in the
   machine's units, as the table.  Each check's `if` has a label of its own (rs274ngc refuses a
   label defined twice); `(abort, ...)` says #5400 and #5403 with their values.
-* Fanuc and Haas: no check.  Their tool offset variables (#2001..., #10001..., #11001...) depend
-  on the offset memory type (A, B, C) and on the number of offsets, which ncpp cannot cite for
-  a given control.
-* Sinumerik and Heidenhain: no check yet (the active edge's length, `$P_TOOLL` or `$TC_DP3`, and
-  Klartext's tool data are not cited here).
+* Haas (Mill Operator's Manual, "Macros", the system variables table: #2001-#2200 the tool
+  length offsets' geometry, #2201-#2400 their wear, by offset number; G43 Hn applies offset n's
+  sum): after a G43 whose H is the tool in the spindle (whose length ncpp was told), the check
+  raises macro alarm 5 (`#3000`) when #2000+n plus #2200+n is not the told length within
+  `GUARD_MM`, in the control's units, as the table.  A G43 without H, or with another H, gets
+  none (ncpp is not told which tool's length that register holds).
+* Fanuc: no check.  Its tool offset variables depend on the offset memory type the machine
+  builder sets (A: one value per offset at #10001 on or #2001 on; B and C: geometry and wear
+  apart, #11001 and #10001 on, C with the D offsets apart again), which a program cannot tell.
+* Sinumerik and Heidenhain: no check.  Sinumerik's active tool and edge (`$P_TOOLNO`, `$P_TOOL`)
+  and Klartext's active length (FN 18: SYSREAD ID200 NR2 in the iTNC 530's and TNC 426/430's
+  technical manuals) are not cited here from the manuals of the controls ncpp writes for.
 
 Readers of a written program drop both guards (`without_guard`): ncpp's interpreter
 does not know the control's parameters, and the guards neither move nor act.
@@ -71,7 +78,7 @@ from itertools import chain, islice
 
 from ncpp.motion.offsets import _ADDITIONAL_X, ADDITIONAL, WorkOffsets, system_name
 from ncpp.motion.segments import Event, Pass
-from ncpp.program.blocks import Block, Comment
+from ncpp.program.blocks import Block, Comment, Word
 from ncpp.program.parser import LEADER_LINES
 
 GUARD_MM = 0.1  # how far an axis's zero may be from the one told: re-touching a fixture moves it microns
@@ -393,10 +400,37 @@ def tool_guard_lines(tool: int, length_mm: float, unit_mm: float, label: int) ->
     ]
 
 
+HAAS_OFFSETS = 200  # Haas's tool length offsets in #2001-#2200 (geometry), #2201-#2400 (wear)
+
+
+def haas_tool_guard_lines(offset: int, length_mm: float, unit_mm: float) -> list[str]:
+    """Haas's check (without line ends) that tool length offset `offset` (G43's H), geometry plus
+    wear, is `length_mm` within GUARD_MM, in the control's units (`unit_mm` mm each): Haas Mill
+    Operator's Manual, "Macros", the system variables table: #2001-#2200 tool length offsets
+    (geometry), #2201-#2400 tool length wear, by offset number; `#3000=n (text)` raises alarm n
+    and stops; `IF [cond] THEN` one statement.  [] for an offset beyond #2200's."""
+    if not 1 <= offset <= HAAS_OFFSETS:
+        return []
+    length = _number(length_mm / unit_mm)
+    told = f"H{offset} AT LENGTH Z{length} {_units(unit_mm).upper()}"
+    return [
+        f"({TOOL_BEGIN.upper()} {told} WITHIN {_number(GUARD_MM)} MM)",
+        f"IF [ABS[#{2000 + offset}+#{2200 + offset}-{length}] GT {_number(GUARD_MM / unit_mm)}] "
+        f"THEN #3000=5 (NCPP H{offset} LENGTH DIFFERS)",
+        f"({TOOL_END.upper()})",
+    ]
+
+
+def _h_number(block: Block) -> int | None:
+    """The block's H word's offset number (None: none, or one from a variable)."""
+    words = [item for item in block.items if type(item) is Word and item.letter == "H"]
+    return int(words[0].value) if len(words) == 1 and words[0].value == int(words[0].value) else None
+
+
 # Why a dialect's program gets no tool guard, as the warning says it
 TOOLS_UNGUARDED = {
-    "fanuc": "Fanuc's tool offset variables depend on the offset memory type and count",
-    "haas": "Haas's tool offset variables depend on the offset memory type and count",
+    "fanuc": "Fanuc's tool offset variables depend on the offset memory type (A, B, C), which the machine "
+    "builder sets",
     "grbl": "grbl cannot test its tool length (it reads no parameters)",
     "sinumerik": "ncpp writes no check of Sinumerik's active tool edge yet",
     "heidenhain": "ncpp writes no check of Klartext's tool data yet",
@@ -406,11 +440,13 @@ TOOLS_UNGUARDED = {
 class ToolGuard:
     """The tool guard's checks, written after each block that applies a told length (the
     writer's `after`): LinuxCNC's, in an ISO program that is not a Fanuc one (a program number
-    at its top).  Where there is none, `unguarded` is told why, once."""
+    at its top), and Haas's, where the block's H is the tool in the spindle.  Where there is
+    none, `unguarded` is told why, once."""
 
     def __init__(self, dialect: str, unit_mm: float, unguarded: Callable[[str], None] = lambda why: None):
-        self.unit_mm, self.unguarded = unit_mm, unguarded
-        self.why = None if dialect == "iso" else TOOLS_UNGUARDED.get(dialect, f"{dialect} has no tool guard")
+        self.unit_mm, self.unguarded, self.haas = unit_mm, unguarded, dialect == "haas"
+        guarded = dialect in ("iso", "haas")
+        self.why = None if guarded else TOOLS_UNGUARDED.get(dialect, f"{dialect} has no tool guard")
         self.looked = 0  # blocks looked at for a Fanuc program number
         self.checks = 0
         if self.why is not None:
@@ -418,7 +454,7 @@ class ToolGuard:
 
     def __call__(self, events: list[Event]) -> list[str]:
         block = events[0].block
-        if self.looked < LEADER_LINES + 12 and self.why is None:
+        if self.looked < LEADER_LINES + 12 and self.why is None and not self.haas:
             self.looked += 1
             if _FANUC_PROGRAM_NUMBER.match(block.raw):
                 self.why = TOOLS_UNGUARDED["fanuc"]
@@ -427,6 +463,10 @@ class ToolGuard:
         told = last.length_told if type(last) is Pass else None
         if told is None or self.why is not None or not block.eol:  # (a last line: nothing runs after it)
             return []
+        if self.haas:
+            offset = _h_number(block)  # (G43 without H, or H of another tool: not the told length's offset)
+            lines = haas_tool_guard_lines(offset, told[1], self.unit_mm) if offset == told[0] else []
+            return [line + block.eol for line in lines]
         self.checks += 1
         return [line + block.eol for line in tool_guard_lines(*told, self.unit_mm, self.checks)]
 
