@@ -310,13 +310,16 @@ def with_guard(
 
 ISO_SYNTAX = ("iso", "linuxcnc", "fanuc", "haas")  # the dialects whose guard is LinuxCNC's or Fanuc's
 # An ISO line that neither moves nor relies on the work offset in effect: N, modal G codes, M0-M9
-# (not M98 M99, calls), T S F H D words, comments; and one that selects a work offset (G54.1 P,
-# G154 P: Fanuc's and Haas's additional ones)
+# (not M98 M99, calls), T S F H D words, comments, or a G28 G30 return or G53 move (the control's
+# own positions: ncpp leaves them as programmed, so no compensation rests on the offset); and one
+# that selects a work offset (G54.1 P, G154 P: Fanuc's and Haas's additional ones)
 _ISO_SETTINGS = re.compile(
-    r"\s*%?\s*((N\d+|G0*(0|1|2|3|17|18|19|20|21|40|43|49|5[4-8]|59(\.[123])?|61(\.1)?|64|80|9[01](\.1)?|9[3-9])"
-    r"|M0*\d|[TSFHD]\d+(\.\d*)?)(?![\d.])\s*)*",
+    r"\s*%?\s*((N\d+|G0*(0|1|2|3|17|18|19|20|21|28|30|40|43|49|53|5[4-8]|59(\.[123])?|61(\.1)?|64|80|9[01](\.1)?"
+    r"|9[3-9])|M0*\d|[TSFHD]\d+(\.\d*)?)(?![\d.])\s*)*",
     re.IGNORECASE,
 )
+_ISO_MACHINE_MOVE = re.compile(r"G0*(28|30|53)(?![\d.])", re.IGNORECASE)
+_ISO_AXIS_WORD = re.compile(r"[XYZABCUVW]\s*[-+]?(\d+\.?\d*|\.\d+)", re.IGNORECASE)
 _ISO_SELECTION = re.compile(r"G0*(5[4-9]|154)(?![0-9])", re.IGNORECASE)
 _ISO_COMMENT = re.compile(r"\([^)]*\)|;.*")
 
@@ -342,11 +345,15 @@ def _iso_selects_first(head: list[str], at: int, rest: Iterator[str]) -> bool:
         if BEGIN in said:
             return True
         code = _ISO_COMMENT.sub("", text)
+        if "/" in code:  # (block delete may skip it, or a division: an expression)
+            return False
         if _ISO_SELECTION.search(code):
             return True
         if _FANUC_PROGRAM_NUMBER.match(text):
             continue
-        if not _ISO_SETTINGS.fullmatch(code.rstrip("\r\n")) or "/" in code:
+        if _ISO_MACHINE_MOVE.search(code):
+            code = _ISO_AXIS_WORD.sub("", code)
+        if not _ISO_SETTINGS.fullmatch(code.rstrip("\r\n")):
             return False
         settings += 1
     return False

@@ -382,3 +382,25 @@ def test_a_linuxcnc_program_checks_only_zeros_that_are_still_the_ones_told(progr
     text, _ = _guarded(program.encode(), {"G54": G54_MM, "G55": G55_MM}, file="p.ngc")
     said = [line.split()[3] for line in text.splitlines() if line.startswith("(ncpp placement guard:")]
     assert said == checked
+
+
+@pytest.mark.parametrize(
+    "head, selects",
+    [
+        ("G21 G90\nG55\nG0 X1\n", True),
+        ("G21 G90\nG0 X1\nG55\n", False),  # (it moves in the system in effect first)
+        ("G90 G94 G17\nG21\nG28 G91 Z0.\nG90\nT1 M6\nS5000 M3\nG54\nG0 X1\n", True),  # (a CAM post's head)
+        ("G90\nG53 G0 Z0\nG0 G55 X1 Y1\n", True),  # (a selection in the first move's block comes first)
+        ("%\nO1234\nG21\n(PART)\nG0 G54 X10\n", True),
+        ("G90\nG92 X0\nG55\n", False),
+        ("G21\no100 call\nG55\n", False),
+        ("G21\n/G55\nG0 X1\n", False),  # (block delete may skip it)
+        ("G21\nM98 P100\nG55\n", False),
+        ("G21\n#1=5\nG55\n", False),
+    ],
+)  # fmt: skip
+def test_the_check_at_the_start_is_left_out_only_where_the_program_selects_first(head, selects):
+    from ncpp.guard import _iso_selects_first
+
+    lines = head.splitlines(keepends=True)
+    assert _iso_selects_first(lines[:1], 0, iter(lines[1:])) is selects
