@@ -310,15 +310,19 @@ def with_guard(
 
 ISO_SYNTAX = ("iso", "linuxcnc", "fanuc", "haas")  # the dialects whose guard is LinuxCNC's or Fanuc's
 # An ISO line that neither moves nor relies on the work offset in effect: N, modal G codes, M0-M9
-# (not M98 M99, calls), T S F H D words, comments, or a G28 G30 return or G53 move (the control's
-# own positions: ncpp leaves them as programmed, so no compensation rests on the offset); and one
-# that selects a work offset (G54.1 P, G154 P: Fanuc's and Haas's additional ones)
+# (not M98 M99, calls), T S F H D words, comments, a G28 G30 return or G53 move (the control's
+# own positions: ncpp leaves them as programmed, so no compensation rests on the offset), or a
+# G10 L2 P1-P9 (it sets that system's zero, whichever is in effect); and one that selects a work
+# offset (G54.1 P, G154 P: Fanuc's and Haas's additional ones)
 _ISO_SETTINGS = re.compile(
     r"\s*%?\s*((N\d+|G0*(0|1|2|3|17|18|19|20|21|28|30|40|43|49|53|5[4-8]|59(\.[123])?|61(\.1)?|64|80|9[01](\.1)?"
     r"|9[3-9])|M0*\d|[TSFHD]\d+(\.\d*)?)(?![\d.])\s*)*",
     re.IGNORECASE,
 )
+_ISO_SETTINGS_SCANNED = 16  # lines of settings (not comments alone) a CAM post's head may have before it selects
 _ISO_MACHINE_MOVE = re.compile(r"G0*(28|30|53)(?![\d.])", re.IGNORECASE)
+_ISO_ZERO_SET = (re.compile(r"G0*10(?![\d.])", re.I), re.compile(r"L0*2(?![\d.])", re.I),
+                 re.compile(r"P0*[1-9](?![\d.])", re.I))  # fmt: skip
 _ISO_AXIS_WORD = re.compile(r"[XYZABCUVW]\s*[-+]?(\d+\.?\d*|\.\d+)", re.IGNORECASE)
 _ISO_SELECTION = re.compile(r"G0*(5[4-9]|154)(?![0-9])", re.IGNORECASE)
 _ISO_COMMENT = re.compile(r"\([^)]*\)|;.*")
@@ -331,7 +335,9 @@ def _iso_selects_first(head: list[str], at: int, rest: Iterator[str]) -> bool:
     check the writer put before a selection says so too, and the tool guard's checks are
     skipped (`head` takes the lines it needs from `rest`)."""
     settings, tool_check = 0, False
-    while settings <= _SETTINGS_SCANNED:
+    for _ in range(LEADER_LINES + _ISO_SETTINGS_SCANNED):  # (comment lines too, boundedly)
+        if settings > _ISO_SETTINGS_SCANNED:
+            break
         if at == len(head):
             line = next(rest, None)
             if line is None:
@@ -353,9 +359,13 @@ def _iso_selects_first(head: list[str], at: int, rest: Iterator[str]) -> bool:
             continue
         if _ISO_MACHINE_MOVE.search(code):
             code = _ISO_AXIS_WORD.sub("", code)
+        elif all(word.search(code) for word in _ISO_ZERO_SET):
+            for word in _ISO_ZERO_SET:
+                code = word.sub("", code, count=1)
+            code = _ISO_AXIS_WORD.sub("", code)
         if not _ISO_SETTINGS.fullmatch(code.rstrip("\r\n")):
             return False
-        settings += 1
+        settings += bool(code.strip(" \t\r\n%"))
     return False
 
 

@@ -373,7 +373,7 @@ def test_an_additional_work_offset_the_program_selects_is_checked_at_its_variabl
     "program, checked",
     [
         ("G21 G90\nG55\nG0 X10 Y10 Z5\nG10 L2 P2 X1 Y2 Z3\nG54\nG55\nG0 X20\nM2\n", ["G55", "G54"]),
-        ("G21 G90\nG10 L2 P2 X1 Y2 Z3\nG55\nG0 X10 Y10 Z5\nM2\n", ["G54"]),  # G55 is the program's
+        ("G21 G90\nG10 L2 P2 X1 Y2 Z3\nG55\nG0 X10 Y10 Z5\nM2\n", []),  # G55 is the program's
         ("o<s> sub\nG55\no<s> endsub\nG21 G90\nG0 X10 Y10 Z5\no<s> call\nG0 X20\nM2\n", ["G54"]),
         ("G21 G90\nT1 M6 G43\nG56\nG0 X10 Y10 Z5\nM2\n", []),  # G56 not told: warned where it is selected
     ],
@@ -397,6 +397,9 @@ def test_a_linuxcnc_program_checks_only_zeros_that_are_still_the_ones_told(progr
         ("G21\n/G55\nG0 X1\n", False),  # (block delete may skip it)
         ("G21\nM98 P100\nG55\n", False),
         ("G21\n#1=5\nG55\n", False),
+        ("G21\nG10 L2 P1 X0 Y0 Z0\nG10 P2 L2 X0\nG55\n", True),  # (it sets zeros, whatever is in effect)
+        ("G21\nG10 L2 P0 X0\nG55\n", False),  # (P0: the system in effect)
+        ("G21\nG10 L20 P2 X0\nG55\n", False),  # (from where the control stands)
     ],
 )  # fmt: skip
 def test_the_check_at_the_start_is_left_out_only_where_the_program_selects_first(head, selects):
