@@ -29,7 +29,7 @@ block's move), once per system, where the zero is still the one told (not after 
 own G10 L2/L20 of it) and the block runs once (not in a loop or a subroutine).  The check at the
 start (with the system number) is written only where the program may rely on the system in
 effect before it selects one: not where its first lines, of settings alone (modal G codes,
-T M S F H D words), select one (`_iso_selects_first`).
+T M S F H D words, G28/G30, G53, G10 L2 P1-P9), select one (`_iso_selects_first`).
 
 * Sinumerik (840D sl System Variables parameter manual: `$P_UIFRNUM`, the number of the
   active settable frame, 1-4 for G54-G57; `$P_UIFR[n, axis, TR]` and `[n, axis, FI]`, its
