@@ -163,7 +163,11 @@ def _sinumerik_place(head: list[str], at: int, rest: Iterator[str]) -> tuple[int
 
 
 def guard_lines(
-    placement: Placement, dialect: str, first_lines: Iterable[str] = (), selected: bool = False, label: int = 0
+    placement: Placement,
+    dialect: str,
+    first_lines: Iterable[str] = (),
+    selected: bool = False,
+    label: int = 0,
 ) -> list[str]:
     """The guard's lines (without line ends) for a program of `dialect` (a post's "linuxcnc" or
     "fanuc" says its syntax, and a Haas program's is Fanuc's; for "iso", `first_lines`, the
@@ -193,7 +197,9 @@ def _linuxcnc(placement: Placement, selected: bool = False, label: int = 0) -> l
     if not selected:
         far.insert(0, f"[#5220 NE {placement.system}]")
     name = f"o<ncpp_guard_{label}>" if label else "o<ncpp_guard>"
-    differs = f"the control's {placement.name} zero differs" if selected else "the control's work offset differs"
+    differs = (
+        f"the control's {placement.name} zero differs" if selected else "the control's work offset differs"
+    )
     return [
         f"({BEGIN} {placement.said()} within {_number(GUARD_MM)} mm)",
         f"{name} if [{' OR '.join(far)}]",
@@ -319,7 +325,8 @@ _ISO_SETTINGS = re.compile(
     r"|9[3-9])|M0*\d|[TSFHD]\d+(\.\d*)?)(?![\d.])\s*)*",
     re.IGNORECASE,
 )
-_ISO_SETTINGS_SCANNED = 16  # lines of settings (not comments alone) a CAM post's head may have before it selects
+# lines of settings (not comments alone) a CAM post's head may have before it selects a system
+_ISO_SETTINGS_SCANNED = 16
 _ISO_MACHINE_MOVE = re.compile(r"G0*(28|30|53)(?![\d.])", re.IGNORECASE)
 _ISO_ZERO_SET = (re.compile(r"G0*10(?![\d.])", re.I), re.compile(r"L0*2(?![\d.])", re.I),
                  re.compile(r"P0*[1-9](?![\d.])", re.I))  # fmt: skip
@@ -376,7 +383,11 @@ class PlacementChecks:
     syntax, or Fanuc's (Haas's) in a Fanuc program (a program number at its top)."""
 
     def __init__(
-        self, offsets: WorkOffsets, dialect: str, unit_mm: float, unguarded: Callable[[str], None] = lambda why: None
+        self,
+        offsets: WorkOffsets,
+        dialect: str,
+        unit_mm: float,
+        unguarded: Callable[[str], None] = lambda why: None,
     ):
         self.offsets, self.dialect, self.unit_mm, self.unguarded = offsets, dialect, unit_mm, unguarded
         self.looked = 0  # blocks looked at for a Fanuc program number

@@ -117,7 +117,9 @@ def test_a_fanuc_program_gets_macro_b_alarms(tmp_path):
     from ncpp.motion.offsets import WorkOffsets
     from ncpp.pipeline import ErrorSource, process
 
-    program = b"%\nO1234\nG21 G90\nG0 X10 Y10 Z5\nG1 Z-1 F300\nG1 X40 Y10\nM30\n%\n"  # (in the system in effect)
+    program = (
+        b"%\nO1234\nG21 G90\nG0 X10 Y10 Z5\nG1 Z-1 F300\nG1 X40 Y10\nM30\n%\n"  # (in the system in effect)
+    )
     offsets = WorkOffsets.at(G54_MM)
     out = io.BytesIO()
     process(
@@ -304,9 +306,9 @@ def test_rs274_stops_a_program_before_a_system_it_selects_later_whose_zero_moved
     assert text.count("(ncpp placement guard end)") == 2 and "o<ncpp_guard> if [[#5220 NE 1]" in text
     program = tmp_path / "out.ngc"
     lines = program.read_text().splitlines()
-    assert lines[lines.index("(ncpp placement guard end)", lines.index("o<ncpp_guard_1> endif")) + 1].startswith(
-        "G0 G55 X"
-    )
+    assert lines[
+        lines.index("(ncpp placement guard end)", lines.index("o<ncpp_guard_1> endif")) + 1
+    ].startswith("G0 G55 X")
     ran = _rs274(told, program)
     assert ran.returncode == 0 and "PROGRAM_END" in ran.stdout and "SET_G5X_OFFSET(2," in ran.stdout
     moved = _rs274(_var_file(tmp_path / "moved.var", G54_MM, g55_mm=(600.0, 350.0, 299.5)), program)
@@ -317,7 +319,9 @@ def test_rs274_stops_a_program_before_a_system_it_selects_later_whose_zero_moved
     assert g54_moved.returncode != 0 and "STRAIGHT_FEED" not in g54_moved.stdout
 
 
-def _guarded(program: bytes, zeros: dict, dialect: str | None = None, file: str = "f.nc") -> tuple[str, bytes]:
+def _guarded(
+    program: bytes, zeros: dict, dialect: str | None = None, file: str = "f.nc"
+) -> tuple[str, bytes]:
     """The program compensated with the guard for `zeros` (verified: ncpp's reading of it
     passes), and compensated again from it with --force's reading (which drops the guard)."""
     import io
@@ -350,7 +354,11 @@ def test_a_fanuc_program_gets_the_zero_of_the_system_it_selects_checked_before_t
         "IF [ABS[#5243-300] GT 0.1] THEN #3000=4 (NCPP G55 Z MOVED)",
         "(NCPP PLACEMENT GUARD END)",
     ] and lines[k + 5].startswith("G0 G55 X")
-    assert text.count("PLACEMENT GUARD:") == 1 and again.count(b"PLACEMENT GUARD:") == 1 and again.count(b"#5241") == 1
+    assert (
+        text.count("PLACEMENT GUARD:") == 1
+        and again.count(b"PLACEMENT GUARD:") == 1
+        and again.count(b"#5241") == 1
+    )
 
 
 @pytest.mark.parametrize(
