@@ -18,10 +18,18 @@ starts with an O number):
   G20/G21, as rs274 reads them.
 * Fanuc and Haas (Custom Macro B: #4014 holds group 14's G code, 54-59; #5221-#5223
   G54's X Y Z, 20 per system; `#3000=n (text)` raises macro alarm n with the text and
-  stops; `IF [cond] THEN` one assignment): G54-G59 only.  An additional work offset
-  (G54.1 Pn, G154 Pn) in effect at the start gets no guard: #4014 reads 54 for it too,
-  and the variable that holds n differs between controls.  (One the program selects later
-  is not checked, as a G55 selected later is not.)
+  stops; `IF [cond] THEN` one assignment): G54-G59.  An additional work offset
+  (G54.1 Pn, G154 Pn) in effect at the start gets no guard: #4014 reads 54 for it too.
+  One the program selects is checked at its zero's variables (Fanuc's #7001 on, Haas's
+  #14001 on, `motion/offsets.py`).
+
+An ISO program (LinuxCNC, Fanuc, Haas) that selects a told system checks its zero before the
+block that selects it (`PlacementChecks`; rs274ngc and Fanuc select the system before the
+block's move), once per system, where the zero is still the one told (not after the program's
+own G10 L2/L20 of it) and the block runs once (not in a loop or a subroutine).  The check at the
+start (with the system number) is written only where the program may rely on the system in
+effect before it selects one: not where its first lines, of settings alone (modal G codes,
+T M S F H D words, G28/G30, G53, G10 L2 P1-P9), select one (`_iso_selects_first`).
 
 * Sinumerik (840D sl System Variables parameter manual: `$P_UIFRNUM`, the number of the
   active settable frame, 1-4 for G54-G57; `$P_UIFR[n, axis, TR]` and `[n, axis, FI]`, its
@@ -44,11 +52,18 @@ the check; the next does not.
   M61, not the offset G43 applies, so a G43 H of another tool is not checked.  They stand in the
   machine's units, as the table.  Each check's `if` has a label of its own (rs274ngc refuses a
   label defined twice); `(abort, ...)` says #5400 and #5403 with their values.
-* Fanuc and Haas: no check.  Their tool offset variables (#2001..., #10001..., #11001...) depend
-  on the offset memory type (A, B, C) and on the number of offsets, which ncpp cannot cite for
-  a given control.
-* Sinumerik and Heidenhain: no check yet (the active edge's length, `$P_TOOLL` or `$TC_DP3`, and
-  Klartext's tool data are not cited here).
+* Haas (Mill Operator's Manual, "Macros", the system variables table: #2001-#2200 the tool
+  length offsets' geometry, #2201-#2400 their wear, by offset number; G43 Hn applies offset n's
+  sum): after a G43 whose H is the tool in the spindle (whose length ncpp was told), the check
+  raises macro alarm 5 (`#3000`) when #2000+n plus #2200+n is not the told length within
+  `GUARD_MM`, in the control's units, as the table.  A G43 without H, or with another H, gets
+  none (ncpp is not told which tool's length that register holds).
+* Fanuc: no check.  Its tool offset variables depend on the offset memory type the machine
+  builder sets (A: one value per offset at #10001 on or #2001 on; B and C: geometry and wear
+  apart, #11001 and #10001 on, C with the D offsets apart again), which a program cannot tell.
+* Sinumerik and Heidenhain: no check.  Sinumerik's active tool and edge (`$P_TOOLNO`, `$P_TOOL`)
+  and Klartext's active length (FN 18: SYSREAD ID200 NR2 in the iTNC 530's and TNC 426/430's
+  technical manuals) are not cited here from the manuals of the controls ncpp writes for.
 
 Readers of a written program drop both guards (`without_guard`): ncpp's interpreter
 does not know the control's parameters, and the guards neither move nor act.
@@ -61,9 +76,9 @@ from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, replace
 from itertools import chain, islice
 
-from ncpp.motion.offsets import WorkOffsets, system_name
+from ncpp.motion.offsets import _ADDITIONAL_X, ADDITIONAL, WorkOffsets, system_name
 from ncpp.motion.segments import Event, Pass
-from ncpp.program.blocks import Block, Comment
+from ncpp.program.blocks import Block, Comment, Word
 from ncpp.program.parser import LEADER_LINES
 
 GUARD_MM = 0.1  # how far an axis's zero may be from the one told: re-touching a fixture moves it microns
@@ -71,7 +86,6 @@ BEGIN = "ncpp placement guard:"
 END = "ncpp placement guard end"
 TOOL_BEGIN = "ncpp tool guard:"
 TOOL_END = "ncpp tool guard end"
-SCAN = 60  # blocks at the top searched for a placement guard
 GUARD_BLOCKS = 12  # the most blocks a guard has (a first comment without its last within them is no guard)
 # A Sinumerik line that defines a variable, or one a definition section may hold between them (a
 # comment, a blank line): the 840D wants definitions before the program's first statement
@@ -94,6 +108,7 @@ class Placement:
     system: int
     zero: tuple[float, float, float]
     unit_mm: float = 1.0
+    dialect: str = "fanuc"  # whose name an additional work offset takes (Haas: G154 Pn)
 
     @classmethod
     def of(cls, offsets: WorkOffsets, unit_mm: float = 1.0) -> Placement | None:
@@ -104,7 +119,7 @@ class Placement:
 
     @property
     def name(self) -> str:
-        return system_name(self.system)
+        return system_name(self.system, self.dialect)
 
     def values(self) -> list[str]:
         """X Y Z of the zero in the control's units, as the guard compares them."""
@@ -147,48 +162,74 @@ def _sinumerik_place(head: list[str], at: int, rest: Iterator[str]) -> tuple[int
         at += 1
 
 
-def guard_lines(placement: Placement, dialect: str, first_lines: Iterable[str] = ()) -> list[str]:
+def guard_lines(
+    placement: Placement,
+    dialect: str,
+    first_lines: Iterable[str] = (),
+    selected: bool = False,
+    label: int = 0,
+) -> list[str]:
     """The guard's lines (without line ends) for a program of `dialect` (a post's "linuxcnc" or
     "fanuc" says its syntax, and a Haas program's is Fanuc's; for "iso", `first_lines`, the
-    program's first lines, tell Fanuc's from LinuxCNC's).  [] where there is none."""
+    program's first lines, tell Fanuc's from LinuxCNC's).  [] where there is none.  `selected`:
+    the program selects the system itself (only its zero is checked); `label` numbers a
+    LinuxCNC check after the first (a program's labels are each defined once)."""
     if dialect == "iso":
         dialect = "fanuc" if any(_FANUC_PROGRAM_NUMBER.match(line) for line in first_lines) else "linuxcnc"
     # (grbl reads no parameters and has no conditionals: it cannot test its work offset)
-    written = {"linuxcnc": _linuxcnc, "fanuc": _fanuc, "haas": _fanuc, "sinumerik": _sinumerik}.get(dialect)
-    return [] if written is None else written(placement)
+    if dialect == "linuxcnc":
+        return _linuxcnc(placement, selected, label)
+    if dialect in ("fanuc", "haas"):
+        return _fanuc(replace(placement, dialect=dialect), selected)
+    return _sinumerik(placement, selected) if dialect == "sinumerik" else []
 
 
 def _tolerance(placement: Placement) -> str:
     return _number(GUARD_MM / placement.unit_mm)
 
 
-def _linuxcnc(placement: Placement) -> list[str]:
+def _linuxcnc(placement: Placement, selected: bool = False, label: int = 0) -> list[str]:
     if placement.system > 9:
         return []  # (the additional work offsets are Fanuc's and Haas's)
     x = 5221 + 20 * (placement.system - 1)
     tolerance = _tolerance(placement)
-    far = " OR ".join(
-        f"[ABS[#{x + k} - {value}] GT {tolerance}]" for k, value in enumerate(placement.values())
+    far = [f"[ABS[#{x + k} - {value}] GT {tolerance}]" for k, value in enumerate(placement.values())]
+    if not selected:
+        far.insert(0, f"[#5220 NE {placement.system}]")
+    name = f"o<ncpp_guard_{label}>" if label else "o<ncpp_guard>"
+    differs = (
+        f"the control's {placement.name} zero differs" if selected else "the control's work offset differs"
     )
     return [
         f"({BEGIN} {placement.said()} within {_number(GUARD_MM)} mm)",
-        f"o<ncpp_guard> if [[#5220 NE {placement.system}] OR {far}]",
-        f"(abort, ncpp: compensated for {placement.said()}; the control's work offset differs: "
-        "compensate again for it, or set the offset)",
-        "o<ncpp_guard> endif",
+        f"{name} if [{' OR '.join(far)}]",
+        f"(abort, ncpp: compensated for {placement.said()}; {differs}: compensate again for it, or set the offset)",
+        f"{name} endif",
         f"({END})",
     ]
 
 
-def _fanuc(placement: Placement) -> list[str]:
-    if placement.system > 6:
-        return []  # (G59.1-G59.3 are LinuxCNC's; an additional work offset: the module docstring)
-    x = 5221 + 20 * (placement.system - 1)
+def _fanuc_x(placement: Placement) -> int | None:
+    """The variable of the X of the zero of the placement's system on a Fanuc or Haas control
+    (None: it has none): G54-G59 at #5221, 20 per system (Custom Macro B); an additional work
+    offset at Fanuc's #7001 or Haas's #14001, 20 per offset (`offsets.py`)."""
+    if placement.system > ADDITIONAL:
+        n = placement.system - ADDITIONAL
+        first, last = _ADDITIONAL_X[1 if placement.dialect == "haas" else 0]
+        return first + 20 * (n - 1) if n <= last else None
+    return 5221 + 20 * (placement.system - 1) if placement.system <= 6 else None  # (G59.1-G59.3: LinuxCNC's)
+
+
+def _fanuc(placement: Placement, selected: bool = False) -> list[str]:
+    """`selected`: the program selects the system itself (only its zero is checked); an
+    additional work offset only so, since #4014 reads 54 for it (the module docstring)."""
+    x = _fanuc_x(placement)
+    if x is None or (placement.system > ADDITIONAL and not selected):
+        return []
     tolerance = _tolerance(placement)
-    lines = [
-        f"({BEGIN.upper()} {placement.said().upper()} WITHIN {_number(GUARD_MM)} MM)",
-        f"IF [#4014 NE {53 + placement.system}] THEN #3000=1 (NCPP {placement.name} NOT ACTIVE)",
-    ]
+    lines = [f"({BEGIN.upper()} {placement.said().upper()} WITHIN {_number(GUARD_MM)} MM)"]
+    if not selected:
+        lines.append(f"IF [#4014 NE {53 + placement.system}] THEN #3000=1 (NCPP {placement.name} NOT ACTIVE)")
     for k, (axis, value) in enumerate(zip("XYZ", placement.values(), strict=True)):
         alarm = f"#3000={2 + k} (NCPP {placement.name} {axis} MOVED)"
         lines.append(f"IF [ABS[#{x + k}-{value}] GT {tolerance}] THEN {alarm}")
@@ -229,10 +270,13 @@ def with_guard(
     header: str,
     header_lines: int = 1,
     unguarded: Callable[[str], None] = lambda why: None,
+    checks: bool = False,
 ) -> Iterator[str]:
     """The written program's lines with the guard after the header comment (`header_lines` lines,
     the first holding `header`) and the program number that may follow it.  Where the dialect
-    (or the control's system) has no guard, `unguarded` is told why."""
+    (or the control's system) has no guard, `unguarded` is told why.  `checks`: the ISO program's
+    selections of told systems are checked where it makes them (`PlacementChecks`), so no guard
+    is written where it selects a system before anything relies on the one in effect."""
     # (lines are taken from `lines` no further than the guard's place: the verifier tags each
     # line with how far the writer had read when it was taken)
     it = iter(lines)
@@ -250,7 +294,9 @@ def with_guard(
             if not _FANUC_PROGRAM_NUMBER.match(line):
                 break
     guard = guard_lines(placement, dialect, head)
-    if not guard:
+    if checks and at is not None and dialect in ISO_SYNTAX and _iso_selects_first(head, at, it):
+        guard = []  # (the check of the system it selects stands before that line)
+    elif not guard:
         unguarded(UNGUARDED.get(dialect, f"{dialect} has no settable frame for {placement.name}"))
     if at is None or not guard:
         yield from chain(head, it)
@@ -266,6 +312,104 @@ def with_guard(
     yield from (line + eol for line in guard)
     yield from head[at:]
     yield from it
+
+
+ISO_SYNTAX = ("iso", "linuxcnc", "fanuc", "haas")  # the dialects whose guard is LinuxCNC's or Fanuc's
+# An ISO line that neither moves nor relies on the work offset in effect: N, modal G codes, M0-M9
+# (not M98 M99, calls), T S F H D words, comments, a G28 G30 return or G53 move (the control's
+# own positions: ncpp leaves them as programmed, so no compensation rests on the offset), or a
+# G10 L2 P1-P9 (it sets that system's zero, whichever is in effect); and one that selects a work
+# offset (G54.1 P, G154 P: Fanuc's and Haas's additional ones)
+_ISO_SETTINGS = re.compile(
+    r"\s*%?\s*((N\d+|G0*(0|1|2|3|17|18|19|20|21|28|30|40|43|49|53|5[4-8]|59(\.[123])?|61(\.1)?|64|80|9[01](\.1)?"
+    r"|9[3-9])|M0*\d|[TSFHD]\d+(\.\d*)?)(?![\d.])\s*)*",
+    re.IGNORECASE,
+)
+# lines of settings (not comments alone) a CAM post's head may have before it selects a system
+_ISO_SETTINGS_SCANNED = 16
+_ISO_MACHINE_MOVE = re.compile(r"G0*(28|30|53)(?![\d.])", re.IGNORECASE)
+_ISO_ZERO_SET = (re.compile(r"G0*10(?![\d.])", re.I), re.compile(r"L0*2(?![\d.])", re.I),
+                 re.compile(r"P0*[1-9](?![\d.])", re.I))  # fmt: skip
+_ISO_AXIS_WORD = re.compile(r"[XYZABCUVW]\s*[-+]?(\d+\.?\d*|\.\d+)", re.IGNORECASE)
+_ISO_SELECTION = re.compile(r"G0*(5[4-9]|154)(?![0-9])", re.IGNORECASE)
+_ISO_COMMENT = re.compile(r"\([^)]*\)|;.*")
+
+
+def _iso_selects_first(head: list[str], at: int, rest: Iterator[str]) -> bool:
+    """Whether an ISO program selects a work offset before anything relies on the one in effect:
+    in one of the lines of settings alone from `at` on, or in the first other line (whose
+    selection, in rs274ngc's order of execution and Fanuc's, comes before its move); a placement
+    check the writer put before a selection says so too, and the tool guard's checks are
+    skipped (`head` takes the lines it needs from `rest`)."""
+    settings, tool_check = 0, False
+    for _ in range(LEADER_LINES + _ISO_SETTINGS_SCANNED):  # (comment lines too, boundedly)
+        if settings > _ISO_SETTINGS_SCANNED:
+            break
+        if at == len(head):
+            line = next(rest, None)
+            if line is None:
+                return False
+            head.append(line)
+        text, at = head[at], at + 1
+        said = text.lower()
+        if TOOL_BEGIN in said or tool_check:
+            tool_check = TOOL_END not in said
+            continue
+        if BEGIN in said:
+            return True
+        code = _ISO_COMMENT.sub("", text)
+        if "/" in code:  # (block delete may skip it, or a division: an expression)
+            return False
+        if _ISO_SELECTION.search(code):
+            return True
+        if _FANUC_PROGRAM_NUMBER.match(text):
+            continue
+        if _ISO_MACHINE_MOVE.search(code):
+            code = _ISO_AXIS_WORD.sub("", code)
+        elif all(word.search(code) for word in _ISO_ZERO_SET):
+            for word in _ISO_ZERO_SET:
+                code = word.sub("", code, count=1)
+            code = _ISO_AXIS_WORD.sub("", code)
+        if not _ISO_SETTINGS.fullmatch(code.rstrip("\r\n")):
+            return False
+        settings += bool(code.strip(" \t\r\n%"))
+    return False
+
+
+class PlacementChecks:
+    """The placement guard's check of the zero of each told system an ISO program selects, once,
+    before the first block that selects it (the writer's `before`): the interpreter marks the
+    block (`Pass.zero_told`) where it runs once and the zero is still the one told.  LinuxCNC's
+    syntax, or Fanuc's (Haas's) in a Fanuc program (a program number at its top)."""
+
+    def __init__(
+        self,
+        offsets: WorkOffsets,
+        dialect: str,
+        unit_mm: float,
+        unguarded: Callable[[str], None] = lambda why: None,
+    ):
+        self.offsets, self.dialect, self.unit_mm, self.unguarded = offsets, dialect, unit_mm, unguarded
+        self.looked = 0  # blocks looked at for a Fanuc program number
+        self.checked: set[int] = set()
+
+    def __call__(self, events: list[Event]) -> list[str]:
+        block = events[0].block
+        if self.dialect == "iso" and self.looked < LEADER_LINES + 12:
+            self.looked += 1
+            if _FANUC_PROGRAM_NUMBER.match(block.raw):
+                self.dialect = "fanuc"
+        number = next((e.zero_told for e in events if type(e) is Pass and e.zero_told is not None), None)
+        if number is None or number in self.checked:
+            return []
+        self.checked.add(number)
+        placement = Placement(number, self.offsets.zero(number), self.unit_mm)
+        dialect = "linuxcnc" if self.dialect == "iso" else self.dialect
+        lines = guard_lines(placement, dialect, selected=True, label=len(self.checked))
+        if not lines:
+            self.unguarded(f"{dialect} has no variables of {placement.name}'s zero")
+        eol = block.eol or "\n"
+        return [line + eol for line in lines]
 
 
 def tool_guard_lines(tool: int, length_mm: float, unit_mm: float, label: int) -> list[str]:
@@ -284,10 +428,37 @@ def tool_guard_lines(tool: int, length_mm: float, unit_mm: float, label: int) ->
     ]
 
 
+HAAS_OFFSETS = 200  # Haas's tool length offsets in #2001-#2200 (geometry), #2201-#2400 (wear)
+
+
+def haas_tool_guard_lines(offset: int, length_mm: float, unit_mm: float) -> list[str]:
+    """Haas's check (without line ends) that tool length offset `offset` (G43's H), geometry plus
+    wear, is `length_mm` within GUARD_MM, in the control's units (`unit_mm` mm each): Haas Mill
+    Operator's Manual, "Macros", the system variables table: #2001-#2200 tool length offsets
+    (geometry), #2201-#2400 tool length wear, by offset number; `#3000=n (text)` raises alarm n
+    and stops; `IF [cond] THEN` one statement.  [] for an offset beyond #2200's."""
+    if not 1 <= offset <= HAAS_OFFSETS:
+        return []
+    length = _number(length_mm / unit_mm)
+    told = f"H{offset} AT LENGTH Z{length} {_units(unit_mm).upper()}"
+    return [
+        f"({TOOL_BEGIN.upper()} {told} WITHIN {_number(GUARD_MM)} MM)",
+        f"IF [ABS[#{2000 + offset}+#{2200 + offset}-{length}] GT {_number(GUARD_MM / unit_mm)}] "
+        f"THEN #3000=5 (NCPP H{offset} LENGTH DIFFERS)",
+        f"({TOOL_END.upper()})",
+    ]
+
+
+def _h_number(block: Block) -> int | None:
+    """The block's H word's offset number (None: none, or one from a variable)."""
+    words = [item for item in block.items if type(item) is Word and item.letter == "H"]
+    return int(words[0].value) if len(words) == 1 and words[0].value == int(words[0].value) else None
+
+
 # Why a dialect's program gets no tool guard, as the warning says it
 TOOLS_UNGUARDED = {
-    "fanuc": "Fanuc's tool offset variables depend on the offset memory type and count",
-    "haas": "Haas's tool offset variables depend on the offset memory type and count",
+    "fanuc": "Fanuc's tool offset variables depend on the offset memory type (A, B, C), which the machine "
+    "builder sets",
     "grbl": "grbl cannot test its tool length (it reads no parameters)",
     "sinumerik": "ncpp writes no check of Sinumerik's active tool edge yet",
     "heidenhain": "ncpp writes no check of Klartext's tool data yet",
@@ -297,11 +468,13 @@ TOOLS_UNGUARDED = {
 class ToolGuard:
     """The tool guard's checks, written after each block that applies a told length (the
     writer's `after`): LinuxCNC's, in an ISO program that is not a Fanuc one (a program number
-    at its top).  Where there is none, `unguarded` is told why, once."""
+    at its top), and Haas's, where the block's H is the tool in the spindle.  Where there is
+    none, `unguarded` is told why, once."""
 
     def __init__(self, dialect: str, unit_mm: float, unguarded: Callable[[str], None] = lambda why: None):
-        self.unit_mm, self.unguarded = unit_mm, unguarded
-        self.why = None if dialect == "iso" else TOOLS_UNGUARDED.get(dialect, f"{dialect} has no tool guard")
+        self.unit_mm, self.unguarded, self.haas = unit_mm, unguarded, dialect == "haas"
+        guarded = dialect in ("iso", "haas")
+        self.why = None if guarded else TOOLS_UNGUARDED.get(dialect, f"{dialect} has no tool guard")
         self.looked = 0  # blocks looked at for a Fanuc program number
         self.checks = 0
         if self.why is not None:
@@ -309,7 +482,7 @@ class ToolGuard:
 
     def __call__(self, events: list[Event]) -> list[str]:
         block = events[0].block
-        if self.looked < LEADER_LINES + 12 and self.why is None:
+        if self.looked < LEADER_LINES + 12 and self.why is None and not self.haas:
             self.looked += 1
             if _FANUC_PROGRAM_NUMBER.match(block.raw):
                 self.why = TOOLS_UNGUARDED["fanuc"]
@@ -318,24 +491,28 @@ class ToolGuard:
         told = last.length_told if type(last) is Pass else None
         if told is None or self.why is not None or not block.eol:  # (a last line: nothing runs after it)
             return []
+        if self.haas:
+            offset = _h_number(block)  # (G43 without H, or H of another tool: not the told length's offset)
+            lines = haas_tool_guard_lines(offset, told[1], self.unit_mm) if offset == told[0] else []
+            return [line + block.eol for line in lines]
         self.checks += 1
         return [line + block.eol for line in tool_guard_lines(*told, self.unit_mm, self.checks)]
 
 
 def without_guard(blocks: Iterable[Block]) -> Iterator[Block]:
-    """The blocks without the guards: the placement guard in the first SCAN blocks and the tool
-    guard's checks anywhere, each from its first comment to its last (within GUARD_BLOCKS: a
-    first comment without its last is no guard, and its blocks stay)."""
+    """The blocks without the guards: the placement guard's and the tool guard's checks wherever
+    they stand, each from its first comment to its last (within GUARD_BLOCKS: a first comment
+    without its last is no guard, and its blocks stay)."""
     held: list[Block] = []  # the blocks of a guard under way
     end = ""
-    for n, block in enumerate(blocks):
+    for block in blocks:
         raw = block.raw
         if not held and "ncpp" not in raw and "NCPP" not in raw:  # (most blocks: no guard's text)
             yield block
             continue
         said = " ".join(item.text.lower() for item in block.items if type(item) is Comment)
         if not held:
-            end = TOOL_END if TOOL_BEGIN in said else END if n < SCAN and BEGIN in said else ""
+            end = TOOL_END if TOOL_BEGIN in said else END if BEGIN in said else ""
             if not end:
                 yield block
                 continue

@@ -21,7 +21,7 @@ from typing import BinaryIO
 
 from ncpp import __version__
 from ncpp.errors import Location, NcppError, Warnings
-from ncpp.guard import Placement, ToolGuard, with_guard, without_guard
+from ncpp.guard import ISO_SYNTAX, Placement, PlacementChecks, ToolGuard, with_guard, without_guard
 from ncpp.motion.offsets import AT_MACHINE_ZERO, WorkOffsets
 from ncpp.motion.segments import COMP, CYCLE, DRILLED, FLOW, HOLE, PATTERN, Arc, Event, Line, Pass
 from ncpp.passes import PASSES, PassContext, run_passes
@@ -408,12 +408,15 @@ def process(
         compensated = reached.follow(compensated)
     header = header_text(source, tolerance, offsets, name)
     after = _tool_guard(name, offsets, warnings, file) if guard_tools else None
-    lines = with_header(writer.write(compensated, after), header, writer, get_dialect(name).leader)
+    checks = guard is not None and name in ISO_SYNTAX  # the zeros of the told systems it selects
+    before = PlacementChecks(offsets, name, guard.unit_mm, lambda why: warnings.warn(  # type: ignore[union-attr]
+        f"no placement guard: {why}", Location(file, 1, None))) if checks else None  # fmt: skip
+    lines = with_header(writer.write(compensated, after, before), header, writer, get_dialect(name).leader)
     if guard is not None:
         said = guard.said()
         lines = with_guard(lines, guard, name, HEADER_TAG, header.count("\n") + 1,
                            lambda why: warnings.warn(f"no placement guard: {why}; make sure the control has {said} "
-                                                     "before the program runs", Location(file, 1, None)))  # fmt: skip
+                                                     "before the program runs", Location(file, 1, None)), checks)  # fmt: skip
     if verify:
         from ncpp.verify import Bound, verified
 

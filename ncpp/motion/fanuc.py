@@ -115,7 +115,7 @@ class FanucInterpreter(Interpreter):
         if self.cutter_comp is not None:
             raise _OutOfScope(f"{name} under cutter compensation", col)
         self._coordinate_system(number)
-        return Pass(block)
+        return Pass(block, zero_told=number if number in self.told_zeros else None)
 
 
 class HaasInterpreter(FanucInterpreter):

@@ -297,6 +297,9 @@ class Interpreter:
         # the exit move after G40 has a Fanuc corner (`,R` `,C`): the move it rounds into is left as programmed too
         self.exit_corner = False
         self.untold: set[int] = set()  # coordinate systems whose zero nobody said (warned when selected)
+        # systems whose zero is still the one ncpp was told (the program has not set it with G10):
+        # the placement guard checks them where the program selects them (`Pass.zero_told`)
+        self.told_zeros: set[int] = set()
         self.warnings: Warnings | None = None
         self.flow: Flow | None = None  # while `run` runs
         # Fanuc: the axes (0 X, 1 Y, 2 Z) a move has put at a programmed position since the start or
@@ -315,6 +318,7 @@ class Interpreter:
         self.g92_saved = self.g92[:]
         self.home[28][:3], self.home[30][:3] = offsets.g28, offsets.g30
         self.untold = {n for n in range(1, 10) if not offsets.told(n)}
+        self.told_zeros = {n for n in (*range(1, 10), *offsets.told_additional()) if offsets.told(n)}
 
     # -- the event stream ---------------------------------------------------------
     def run(self, blocks: Iterable[Block], warnings: Warnings) -> Iterator[Event]:
@@ -445,6 +449,7 @@ class Interpreter:
         for ev in events:
             if type(ev) is Pass:
                 ev.length_told = None  # (the text runs again, or elsewhere, perhaps with another tool)
+                ev.zero_told = None  # (and perhaps after the program set the zero)
                 if ev.setting is not None:  # set from where each run of the text stands: no one shift
                     raise _OutOfScope("G92 or G10 L20 in a loop or subroutine (it sets an offset from where "
                                       "the control stands, which compensation moves)", None)  # fmt: skip
@@ -889,8 +894,9 @@ class Interpreter:
         told = None
         if 8 in gcodes:
             told = self._tool_length(gcodes[8], words, block, changed=6.0 in mcodes)
+        selected = None
         if 12 in gcodes:
-            number = _COORD_SYSTEM[gcodes[12][0]]
+            number = selected = _COORD_SYSTEM[gcodes[12][0]]
             if number in self.untold:
                 self._warn_untold(number, block, gcodes[12][1])
             self._coordinate_system(number)
@@ -920,8 +926,11 @@ class Interpreter:
         if 2.0 in mcodes or 30.0 in mcodes:
             self._program_end()
         self._update_fast()
+        marks = [Pass(block, zero_told=selected)] if selected in self.told_zeros else []
         if told is not None:
-            return _marked(events, block, told)
+            marks.append(Pass(block, length_told=told))
+        if marks:
+            return _marked(events, marks)
         return Pass(block) if events is None else events
 
     # -- checks (interp_check.cc, enhance_block) ----------------------------------------
@@ -1332,6 +1341,7 @@ class Interpreter:
             p = round(words.get("P", (0.0,))[0])
             number = self.coord_system if p == 0 else p
             old = self.g5x[number][:]
+            self.told_zeros.discard(number)
             if {0, 1, 2} <= {i for i, _ in given}:  # the program says where it is
                 self.untold.discard(number)
             for i, value in given:
@@ -1872,15 +1882,13 @@ _PLAIN_LETTERS = {
 }
 
 
-def _marked(
-    events: Event | tuple[Event, ...] | None, block: Block, told: tuple[int, float]
-) -> Event | tuple[Event, ...]:
-    """A block's events with the tool guard's mark (`Pass.length_told`) last, where the check
-    is written after the block (the first event stays the one that says how it is written)."""
-    mark = Pass(block, length_told=told)
+def _marked(events: Event | tuple[Event, ...] | None, marks: list[Pass]) -> Event | tuple[Event, ...]:
+    """A block's events with the guards' marks (`Pass.zero_told`, then `Pass.length_told`, which
+    the tool guard looks for last) after them (the first event stays the one that says how the
+    block is written)."""
     if events is None:
-        return mark
-    return (*(events if type(events) is tuple else (events,)), mark)
+        return marks[0] if len(marks) == 1 else tuple(marks)
+    return (*(events if type(events) is tuple else (events,)), *marks)
 
 
 def _expanding(event: Event) -> bool:

@@ -14,14 +14,18 @@ from tests.conftest import ROOT
 from tests.shop.rs274 import linuxcnc_root
 
 MACHINE = ROOT / "samples/machines/hr5b.toml"
-PROGRAM = "G21 G90 G54\nG0 X10 Y10 Z5\nG1 Z-1 F300\nG1 X40 Y10\nG1 X40 Y30\nG0 Z5\nM2\n"
+PROGRAM = "G21 G90\nG0 X10 Y10 Z5\nG1 Z-1 F300\nG1 X40 Y10\nG1 X40 Y30\nG0 Z5\nM2\n"
 G54_MM = (400.0, 350.0, 300.0)
 
 
-def _var_file(path: Path, g54_mm: tuple[float, float, float], system: int = 1) -> Path:
-    """A parameter file in inches (the stand-alone rs274's units)."""
-    x, y, z = (v / 25.4 for v in g54_mm)
-    path.write_text(f"5220\t{system}.000000\n5221\t{x:.6f}\n5222\t{y:.6f}\n5223\t{z:.6f}\n")
+def _var_file(
+    path: Path, g54_mm: tuple[float, float, float], system: int = 1, g55_mm: tuple[float, ...] = ()
+) -> Path:
+    """A parameter file in inches (the stand-alone rs274's units), with G55's zero where given."""
+    lines = [f"5220\t{system}.000000"]
+    for first, zero in ((5221, g54_mm), (5241, g55_mm)):
+        lines += [f"{first + k}\t{v / 25.4:.6f}" for k, v in enumerate(zero)]
+    path.write_text("\n".join(lines) + "\n")
     return path
 
 
@@ -40,8 +44,8 @@ def _rs274(var_file: Path, program: Path) -> subprocess.CompletedProcess:
     )
 
 
-def _compensate(tmp_path: Path, *args: str) -> tuple[str, str]:
-    (tmp_path / "p.ngc").write_text(PROGRAM)
+def _compensate(tmp_path: Path, *args: str, program: str = PROGRAM) -> tuple[str, str]:
+    (tmp_path / "p.ngc").write_text(program)
     env = {k: v for k, v in os.environ.items() if k not in ("NCPP_MACHINE", "XDG_CONFIG_HOME")}
     env.update(PYTHONPATH=str(ROOT), HOME=str(tmp_path))
     proc = subprocess.run(
@@ -113,7 +117,9 @@ def test_a_fanuc_program_gets_macro_b_alarms(tmp_path):
     from ncpp.motion.offsets import WorkOffsets
     from ncpp.pipeline import ErrorSource, process
 
-    program = b"%\nO1234\nG21 G90 G54\nG0 X10 Y10 Z5\nG1 Z-1 F300\nG1 X40 Y10\nM30\n%\n"
+    program = (
+        b"%\nO1234\nG21 G90\nG0 X10 Y10 Z5\nG1 Z-1 F300\nG1 X40 Y10\nM30\n%\n"  # (in the system in effect)
+    )
     offsets = WorkOffsets.at(G54_MM)
     out = io.BytesIO()
     process(
@@ -136,7 +142,7 @@ def test_a_fanuc_program_gets_macro_b_alarms(tmp_path):
         "IF [ABS[#5222-350] GT 0.1] THEN #3000=3 (NCPP G54 Y MOVED)",
         "IF [ABS[#5223-300] GT 0.1] THEN #3000=4 (NCPP G54 Z MOVED)",
     ]
-    assert lines[8] == "(NCPP PLACEMENT GUARD END)" and lines[9] == "G21 G90 G54"
+    assert lines[8] == "(NCPP PLACEMENT GUARD END)" and lines[9] == "G21 G90"
 
 
 def test_a_sinumerik_program_gets_its_settable_frame_checked_and_ncpp_still_reads_it(tmp_path):
@@ -265,3 +271,147 @@ def test_a_sinumerik_guard_checks_the_frame_the_program_selects_first(first, fra
     assert [line for line in before if not line.startswith(";")] == (
         ["DEF INT I\n"] if active_checked else ["DEF INT I\n", *first.splitlines(keepends=True)]
     )
+
+
+G55_MM = (600.0, 350.0, 300.0)
+SELECTS_G55 = "G21 G90\nG55\nG0 X10 Y10 Z5\nG1 Z-1 F300\nG1 X40 Y10\nG0 Z5\nM2\n"
+# moves in G54, then in G55
+SELECTS_G55_LATER = "G21 G90\nG0 X10 Y10 Z5\nG1 Z-1 F300\nG0 Z5\nG0 G55 X20 Y10\nG1 Z-1 F300\nG0 Z5\nM2\n"
+
+
+def test_rs274_runs_a_program_that_selects_its_system_whatever_system_the_control_was_left_in(tmp_path):
+    """The program selects G55 before it moves: the guard checks G55's zero before that line,
+    not the system in effect at the start (the control left in G54 is no fault)."""
+    text, _ = _compensate(tmp_path, "--work-offset", "G55=600,350,300", program=SELECTS_G55)
+    assert "#5220" not in text and "o<ncpp_guard_1> if [[ABS[#5241 - 600] GT 0.1]" in text
+    program = tmp_path / "out.ngc"
+    lines = program.read_text().splitlines()
+    assert lines[lines.index("(ncpp placement guard end)") + 1] == "G55"
+    inch = 25.4  # (the guard's values are mm, rs274's parameter file here inches: the raw numbers meet)
+    g54, g55 = tuple(v * inch for v in G54_MM), tuple(v * inch for v in G55_MM)
+    for system in (1, 2, 3):  # the control's system at the start
+        ran = _rs274(_var_file(tmp_path / "told.var", g54, system, g55), program)
+        assert ran.returncode == 0 and "PROGRAM_END" in ran.stdout, ran.stderr
+    assert ran.stdout.count("STRAIGHT_FEED") >= 2
+    moved = _rs274(_var_file(tmp_path / "moved.var", g54, 2, (600 * inch, 350.3 * inch, 300 * inch)), program)
+    assert moved.returncode != 0 and "compensated for G55 at X600 Y350 Z300 mm" in moved.stderr, moved.stderr
+    assert "STRAIGHT_TRAVERSE" not in moved.stdout and "PROGRAM_END" not in moved.stdout
+
+
+def test_rs274_stops_a_program_before_a_system_it_selects_later_whose_zero_moved(tmp_path):
+    """G54 is checked at the start (the program moves in it first), G55 before the block that
+    selects it: a G55 zero moved stops the program there, after its G54 moves."""
+    told = _var_file(tmp_path / "told.var", G54_MM, g55_mm=G55_MM)
+    text, _ = _compensate(tmp_path, "--var-file", str(told), "--var-units", "inch", program=SELECTS_G55_LATER)
+    assert text.count("(ncpp placement guard end)") == 2 and "o<ncpp_guard> if [[#5220 NE 1]" in text
+    program = tmp_path / "out.ngc"
+    lines = program.read_text().splitlines()
+    assert lines[
+        lines.index("(ncpp placement guard end)", lines.index("o<ncpp_guard_1> endif")) + 1
+    ].startswith("G0 G55 X")
+    ran = _rs274(told, program)
+    assert ran.returncode == 0 and "PROGRAM_END" in ran.stdout and "SET_G5X_OFFSET(2," in ran.stdout
+    moved = _rs274(_var_file(tmp_path / "moved.var", G54_MM, g55_mm=(600.0, 350.0, 299.5)), program)
+    assert moved.returncode != 0 and "the control's G55 zero differs" in moved.stderr, moved.stderr
+    assert "STRAIGHT_FEED" in moved.stdout and "SET_G5X_OFFSET(2," not in moved.stdout  # (stopped before G55)
+    assert "PROGRAM_END" not in moved.stdout
+    g54_moved = _rs274(_var_file(tmp_path / "g54.var", (400.0, 350.5, 300.0), g55_mm=G55_MM), program)
+    assert g54_moved.returncode != 0 and "STRAIGHT_FEED" not in g54_moved.stdout
+
+
+def _guarded(
+    program: bytes, zeros: dict, dialect: str | None = None, file: str = "f.nc"
+) -> tuple[str, bytes]:
+    """The program compensated with the guard for `zeros` (verified: ncpp's reading of it
+    passes), and compensated again from it with --force's reading (which drops the guard)."""
+    import io
+
+    from ncpp.guard import Placement
+    from ncpp.motion.offsets import WorkOffsets
+    from ncpp.pipeline import ErrorSource, process
+
+    offsets = WorkOffsets.given(zeros)
+    source = ErrorSource.from_machine_file(str(MACHINE))
+    out = io.BytesIO()
+    process(io.BytesIO(program), out, file=file, source=source, offsets=offsets, guard=Placement.of(offsets),
+            dialect=dialect)  # fmt: skip
+    again = io.BytesIO()
+    process(io.BytesIO(out.getvalue()), again, file=file, source=source, offsets=offsets, force=True,
+            guard=Placement.of(offsets), dialect=dialect)  # fmt: skip
+    return out.getvalue().decode(), again.getvalue()
+
+
+def test_a_fanuc_program_gets_the_zero_of_the_system_it_selects_checked_before_the_block():
+    """Custom Macro B: #5241-#5243 hold G55's X Y Z; the program's own G55 needs no #4014 test."""
+    program = b"%\nO1234\nG21 G90 G17\nG0 G55 X10 Y10 Z5\nG1 Z-1 F300\nG1 X40 Y10\nM30\n%\n"
+    text, again = _guarded(program, {"G55": G55_MM})
+    lines = text.splitlines()
+    k = lines.index("(NCPP PLACEMENT GUARD: G55 AT X600 Y350 Z300 MM WITHIN 0.1 MM)")
+    assert lines[k - 2 : k] == ["O1234", "G21 G90 G17"] and "#4014" not in text
+    assert lines[k + 1 : k + 5] == [
+        "IF [ABS[#5241-600] GT 0.1] THEN #3000=2 (NCPP G55 X MOVED)",
+        "IF [ABS[#5242-350] GT 0.1] THEN #3000=3 (NCPP G55 Y MOVED)",
+        "IF [ABS[#5243-300] GT 0.1] THEN #3000=4 (NCPP G55 Z MOVED)",
+        "(NCPP PLACEMENT GUARD END)",
+    ] and lines[k + 5].startswith("G0 G55 X")
+    assert (
+        text.count("PLACEMENT GUARD:") == 1
+        and again.count(b"PLACEMENT GUARD:") == 1
+        and again.count(b"#5241") == 1
+    )
+
+
+@pytest.mark.parametrize(
+    "dialect, select, variable",
+    [("fanuc", "G54.1 P2", "#7021"), ("haas", "G154 P3", "#14041")],
+)
+def test_an_additional_work_offset_the_program_selects_is_checked_at_its_variables(dialect, select, variable):
+    """Fanuc's P2 zero at #7021-#7023, Haas's P3 at #14041-#14043 (`motion/offsets.py`)."""
+    name = select.replace(" ", "")
+    program = f"%\nO1234\nG21 G90\n{select}\nG0 X10 Y10 Z5\nG1 Z-1 F300\nG1 X40 Y10\nM30\n%\n".encode()
+    text, _ = _guarded(program, {"G54": G54_MM, name: G55_MM}, dialect)
+    lines = text.splitlines()
+    k = lines.index(select)
+    assert lines[k - 5] == f"(NCPP PLACEMENT GUARD: {select} AT X600 Y350 Z300 MM WITHIN 0.1 MM)"
+    assert lines[k - 4] == f"IF [ABS[{variable}-600] GT 0.1] THEN #3000=2 (NCPP {select} X MOVED)"
+    assert "#4014" not in text  # (it selects before it moves: G54 is not relied on)
+
+
+@pytest.mark.parametrize(
+    "program, checked",
+    [
+        ("G21 G90\nG55\nG0 X10 Y10 Z5\nG10 L2 P2 X1 Y2 Z3\nG54\nG55\nG0 X20\nM2\n", ["G55", "G54"]),
+        ("G21 G90\nG10 L2 P2 X1 Y2 Z3\nG55\nG0 X10 Y10 Z5\nM2\n", []),  # G55 is the program's
+        ("o<s> sub\nG55\no<s> endsub\nG21 G90\nG0 X10 Y10 Z5\no<s> call\nG0 X20\nM2\n", ["G54"]),
+        ("G21 G90\nT1 M6 G43\nG56\nG0 X10 Y10 Z5\nM2\n", []),  # G56 not told: warned where it is selected
+    ],
+)  # fmt: skip
+def test_a_linuxcnc_program_checks_only_zeros_that_are_still_the_ones_told(program, checked):
+    text, _ = _guarded(program.encode(), {"G54": G54_MM, "G55": G55_MM}, file="p.ngc")
+    said = [line.split()[3] for line in text.splitlines() if line.startswith("(ncpp placement guard:")]
+    assert said == checked
+
+
+@pytest.mark.parametrize(
+    "head, selects",
+    [
+        ("G21 G90\nG55\nG0 X1\n", True),
+        ("G21 G90\nG0 X1\nG55\n", False),  # (it moves in the system in effect first)
+        ("G90 G94 G17\nG21\nG28 G91 Z0.\nG90\nT1 M6\nS5000 M3\nG54\nG0 X1\n", True),  # (a CAM post's head)
+        ("G90\nG53 G0 Z0\nG0 G55 X1 Y1\n", True),  # (a selection in the first move's block comes first)
+        ("%\nO1234\nG21\n(PART)\nG0 G54 X10\n", True),
+        ("G90\nG92 X0\nG55\n", False),
+        ("G21\no100 call\nG55\n", False),
+        ("G21\n/G55\nG0 X1\n", False),  # (block delete may skip it)
+        ("G21\nM98 P100\nG55\n", False),
+        ("G21\n#1=5\nG55\n", False),
+        ("G21\nG10 L2 P1 X0 Y0 Z0\nG10 P2 L2 X0\nG55\n", True),  # (it sets zeros, whatever is in effect)
+        ("G21\nG10 L2 P0 X0\nG55\n", False),  # (P0: the system in effect)
+        ("G21\nG10 L20 P2 X0\nG55\n", False),  # (from where the control stands)
+    ],
+)  # fmt: skip
+def test_the_check_at_the_start_is_left_out_only_where_the_program_selects_first(head, selects):
+    from ncpp.guard import _iso_selects_first
+
+    lines = head.splitlines(keepends=True)
+    assert _iso_selects_first(lines[:1], 0, iter(lines[1:])) is selects

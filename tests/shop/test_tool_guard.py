@@ -199,3 +199,48 @@ def test_a_g43_in_a_loop_gets_no_check(tmp_path):
     program = PROGRAM.replace("T1 M6\nG43 H1\n", loop + "T1 M6\nG43 H1\n")
     written = _compensated(tmp_path, program)[0]
     assert written.count(TOOL_BEGIN) == 2 and written.index("o100 endrepeat") < written.index(TOOL_BEGIN)
+
+
+HAAS = (
+    "%\nO01234\nG21 G90 G17\nT1 M06\nG0 G43 H01 Z50.\nG0 G54 X10 Y10\nG1 Z-1 F300\nG1 X40 Y10\nG0 Z50.\n"
+    "T2 M06\nG0 G43 H02 Z50.\nG0 X10 Y30\nG1 Z-2 F300\nG0 Z50.\nG187 P1\nM30\n%\n"
+)
+
+
+def _haas(tmp_path: Path, program: str) -> tuple[str, list[str], bytes]:
+    """The Haas program compensated with the table told, and compensated again from it (--force)."""
+    table = tmp_path / "told.tbl"
+    table.write_text(TABLE)
+    offsets = WorkOffsets.given({"G54": G54_MM}, tool_table=table)
+    source = ErrorSource.from_machine_file(str(MACHINE))
+    said, out, again = io.StringIO(), io.BytesIO(), io.BytesIO()
+    process(io.BytesIO(program.encode()), out, file="p.nc", source=source, offsets=offsets,
+            warnings=Warnings(stream=said), guard_tools=True, dialect="haas")  # fmt: skip
+    process(io.BytesIO(out.getvalue()), again, file="p.nc", source=source, offsets=offsets, force=True,
+            warnings=Warnings(stream=io.StringIO()), guard_tools=True, dialect="haas")  # fmt: skip
+    return out.getvalue().decode(), said.getvalue().splitlines(), again.getvalue()
+
+
+def test_a_haas_program_checks_the_length_offset_each_g43_applies(tmp_path):
+    """Haas Mill Operator's Manual, "Macros": #2001-#2200 hold the tool length offsets (geometry),
+    #2201-#2400 their wear; G43 Hn applies offset n's sum.  ncpp's verifier reads the written
+    program past the checks (`process` raises where it parts), and compensating it again writes
+    each check once."""
+    written, warned, again = _haas(tmp_path, HAAS)
+    lines = written.splitlines()
+    k = next(n for n, line in enumerate(lines) if line.startswith("G0 G43 H01"))
+    assert lines[k + 1 : k + 4] == [
+        "(NCPP TOOL GUARD: H1 AT LENGTH Z50 MM WITHIN 0.1 MM)",
+        "IF [ABS[#2001+#2201-50] GT 0.1] THEN #3000=5 (NCPP H1 LENGTH DIFFERS)",
+        "(NCPP TOOL GUARD END)",
+    ]
+    assert "IF [ABS[#2002+#2202-75.5] GT 0.1] THEN #3000=5 (NCPP H2 LENGTH DIFFERS)" in lines
+    assert not any("no tool guard" in line for line in warned), warned
+    assert again.count(b"TOOL GUARD:") == 2 and again.count(b"#2201") == 1
+
+
+def test_a_haas_g43_of_another_offset_than_the_spindles_tool_gets_no_check(tmp_path):
+    """ncpp knows the length the table gives the tool in the spindle; an H of another offset
+    (or none) applies a register it is not told of as that tool's."""
+    written = _haas(tmp_path, HAAS.replace("T2 M06\n", ""))[0]  # (G43 H02 with tool 1 in the spindle)
+    assert "#2001+#2201" in written and "#2002" not in written

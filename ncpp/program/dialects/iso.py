@@ -94,6 +94,10 @@ _LONG_GROUP = 1024  # events of one block past which the writer asks whether it 
 _FANUC_CONTROL = frozenset(("goto", "if", "while", "end"))  # (statement kinds)
 
 
+def _none(events: list[Event]) -> list[str]:
+    return []
+
+
 def written_at_once(event: Event) -> bool:
     """Whether the writer writes the block of its first `event` from that event alone, at once: a
     control line's (an o-word, M98, M99) that runs, whose text depends only on its `Pass`; the
@@ -156,15 +160,19 @@ class IsoWriter:
 
     # -- the stream -----------------------------------------------------------
     def write(
-        self, events: Iterable[Event], after: Callable[[list[Event]], list[str]] | None = None
+        self,
+        events: Iterable[Event],
+        after: Callable[[list[Event]], list[str]] | None = None,
+        before: Callable[[list[Event]], list[str]] | None = None,
     ) -> Iterator[str]:
-        """The written lines, block by block; `after(events)` gives lines to follow a block's
-        (of its events: the tool guard's checks, `ncpp/guard.py`)."""
+        """The written lines, block by block; `after(events)` and `before(events)` give lines to
+        follow and to precede a block's (of its events: the guards' checks, `ncpp/guard.py`)."""
         group: list[Event] = []
         block = None
         write_group = self._write_group
-        if after is not None:
-            write_group = lambda group: [*self._write_group(group), *after(group)]  # noqa: E731
+        if after is not None or before is not None:
+            ahead, behind = before or _none, after or _none
+            write_group = lambda group: [*ahead(group), *self._write_group(group), *behind(group)]  # noqa: E731
         control = False  # the group is a control line's, whose writing reads only its first event
         ran = self._ran if type(self)._ran is not IsoWriter._ran else None  # (ISO's does nothing)
         for event in events:
