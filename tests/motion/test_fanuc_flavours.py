@@ -120,7 +120,8 @@ def test_the_header_and_guard_go_below_the_start_not_into_the_leader(tmp_path):
     leader, program_part = proc.stdout.split(" %\n", 1)
     assert leader == LEADER.split(" %\n")[0]  # the leader as it was
     assert (
-        program_part.startswith("(ncpp compensated for") and "IF [ABS[#5221-10] GT 0.1] THEN #3000=2" in program_part
+        program_part.startswith("(ncpp compensated for")
+        and "IF [ABS[#5221-10] GT 0.1] THEN #3000=2" in program_part
     )  # (the program selects G54 itself: its zero is checked, not #4014)
 
 
