@@ -125,7 +125,7 @@ def _warnings(program: bytes, offsets: WorkOffsets, strict: bool = False, dialec
     return said.getvalue()
 
 
-UNTOLD = b"0 BEGIN PGM P MM\n1 TOOL CALL 1 Z S800\n2 L X+10 Y+10 FMAX\n3 TOOL CALL 2 Z\n4 END PGM P MM\n"
+UNTOLD = b"0 BEGIN PGM P MM\n1 TOOL CALL 1 Z S800\n2 L X+10 Y+10 Z+50 FMAX\n3 TOOL CALL 2 Z\n4 END PGM P MM\n"
 
 
 def test_without_a_tool_table_tool_call_is_warned_once(tmp_path):
@@ -215,8 +215,8 @@ def test_sinumerik_a_tool_or_edge_the_offsets_lack_is_a_located_error(tmp_path):
 @pytest.mark.parametrize(
     "program, where",
     [
-        (b'G0 X10 Y10\nT="MILL" M6\nD1\nG1 X20 F100\nM30\n', "t:2:10"),
-        (b"G0 X10 Y10\nD0\nG1 X20 D2 F100\nM30\n", "t:3:8"),
+        (b'G0 X10 Y10 Z50\nT="MILL" M6\nD1\nG1 X20 F100\nM30\n', "t:2:10"),
+        (b"G0 X10 Y10 Z50\nD0\nG1 X20 D2 F100\nM30\n", "t:3:8"),
     ],
 )
 def test_sinumerik_without_tool_offsets_the_first_length_applied_is_warned(tmp_path, program, where):

@@ -18,7 +18,7 @@ from tests.compensation.conftest import compensate, events_of, repeatable_machin
 
 ROOT = Path(__file__).resolve().parents[2]
 MACHINE = ROOT / "samples/machines/hr5b.toml"
-PROGRAM = b"G21 G90 G54\nG0 X10 Y10\nG55\nG1 X20 F100\nG56 G1 X5\nG55 X1\nG59.1 X2\nM2\n"
+PROGRAM = b"G21 G90 G54\nG0 X10 Y10 Z50\nG55\nG1 X20 F100\nG56 G1 X5\nG55 X1\nG59.1 X2\nM2\n"
 G54 = (400.0, 350.0, 300.0)
 
 

@@ -126,7 +126,7 @@ def test_an_unwritable_output_names_its_file(ncpp, tmp_path):
     "text, where",
     [
         ("o<s> sub\nG1 X1\n", "1:1: o<s> sub has no o<s> endsub"),
-        ("G1 X1 F100\n  o100 sub\nG1 X1\nM2\n", "2:3: o100 sub has no o100 endsub"),
+        ("G1 X1 Y1 Z1 F100\n  o100 sub\nG1 X1\nM2\n", "2:3: o100 sub has no o100 endsub"),
     ],
 )
 def test_an_open_subroutine_is_located(ncpp, tmp_path, text, where):

@@ -63,7 +63,7 @@ def test_unreadable_lines_that_do_not_run_pass_through_with_a_warning(tmp_path):
     """rs274 reads only the lines it runs: a broken line in an uncalled subroutine, an untaken
     branch or after M2 is no error there (was refused); it passes through with a warning,
     refused with --strict, and one that runs is refused with its own line and column."""
-    text = "G21 G90\no1 sub\nG1 X1 F100 Q\no1 endsub\nG1 Y2 F100\no2 if [0]\nG1 X[1+\no2 endif\nM2\nX?3 (notes)\n"
+    text = "G21 G90\no1 sub\nG1 X1 F100 Q\no1 endsub\nG1 X0 Y2 Z0 F100\no2 if [0]\nG1 X[1+\no2 endif\nM2\nX?3 (notes)\n"
     path = tmp_path / "dead.ngc"
     path.write_text(text)
     said = io.StringIO()

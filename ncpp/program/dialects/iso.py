@@ -36,6 +36,7 @@ from ncpp.program.numbers import NumberStyle, format_number
 from ncpp.program.writer import EditPlan, _literal, _with_motion, set_words, spelling
 
 AXES = "XYZ"
+_XYZ = frozenset(AXES)
 _NUMBERED_AXES = tuple(enumerate(AXES))  # ((0, "X"), ...): no enumerate object per line written
 CENTRE_WORDS = {
     17: (("I", 0), ("J", 1)),
@@ -125,6 +126,10 @@ class IsoWriter:
         # Axes the program has positioned; before that the control's position is not
         # the interpreter's assumed zero, so a word must not be added for them.
         self.known_axes: set[str] = set()
+        # told, once each, of the axes X Y Z the program has not positioned where a compensated move
+        # leaves out its correction along them (`_tell_unpositioned`: "Y" or "X and Y")
+        self.unpositioned: Callable[[str, Block], None] | None = None
+        self._told_unpositioned: set[str] = set()
         # Per layout of a plain block's text (`DIGITS_AS_ONE`): what its numbers teach, see `_read_layout`.
         self._layouts: dict[bytes, tuple] = {}
         self._layout: tuple[Block | None, bytes] = (None, b"")  # the last block whose layout was read, and it
@@ -193,6 +198,16 @@ class IsoWriter:
         if group:
             yield from write_group(group)
 
+    def _tell_unpositioned(self, block: Block) -> None:
+        """Before a compensated block is written: tell `unpositioned` of the axes X Y Z the program
+        has not positioned yet (each once), whose correction its moves leave out until it does."""
+        if self.unpositioned is None or len(self._told_unpositioned) == 3 or _XYZ <= self.known_axes:
+            return
+        new = sorted(_XYZ - self.known_axes - self._told_unpositioned)
+        if new:
+            self._told_unpositioned.update(new)
+            self.unpositioned(" and ".join(new), block)
+
     def _write_group(self, group: list[Event]) -> Iterable[str]:
         """The lines of one block's events (a list: cheaper than a generator per block)."""
         first = group[0]
@@ -227,6 +242,7 @@ class IsoWriter:
                 lines.append(block.text)
             self._after_verbatim(block, motion)
             return lines
+        self._tell_unpositioned(block)
         # a drilling cycle the block calls after its move, a rigid tap's return: the control's, from its text
         called = len(motion)
         while called > 1 and (motion[called - 1].fixed == DRILLED or _returns(motion[called - 1])):
