@@ -399,9 +399,9 @@ def process(
     warnings.listeners.append(summary.heard)
     writer = writer_class()
     writer.unpositioned = lambda axes, block: warnings.warn(
-        f"{axes} not positioned by the program yet: the correction along {axes} of this and the next "
-        "compensated moves is left out until the program positions them (a word written here would "
-        "move the axis from wherever the control has it)", Location(file, block.line, None))  # fmt: skip
+        f"{axes} not positioned by the program yet: the correction along {axes} of this feed move and "
+        "the next compensated moves is left out until the program positions them (a word written here "
+        "would move the axis from wherever the control has it)", Location(file, block.line, None))  # fmt: skip
     if expand and FAMILY[name] == "heidenhain":  # (the blocks written out take numbers of their own)
         writer.renumber = True
     keep_freed_memory()  # numpy's temporaries reuse the heap, not fresh pages (runtime.py)

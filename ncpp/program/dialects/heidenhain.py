@@ -415,7 +415,7 @@ class HeidenhainWriter(IsoWriter):
                 self._last_end = None
             return
         self.changed_any = self.edited_last = True
-        self._tell_unpositioned(block)
+        self._tell_unpositioned(block, motion)
         if _position_call(block) is not None:
             yield from self._position_call(block, motion)
             return

@@ -126,8 +126,8 @@ class IsoWriter:
         # Axes the program has positioned; before that the control's position is not
         # the interpreter's assumed zero, so a word must not be added for them.
         self.known_axes: set[str] = set()
-        # told, once each, of the axes X Y Z the program has not positioned where a compensated move
-        # leaves out its correction along them (`_tell_unpositioned`: "Y" or "X and Y")
+        # told, once each, of the axes X Y Z the program has not positioned where a compensated feed
+        # move leaves out its correction along them (`_tell_unpositioned`: "Y" or "X and Y")
         self.unpositioned: Callable[[str, Block], None] | None = None
         self._told_unpositioned: set[str] = set()
         # Per layout of a plain block's text (`DIGITS_AS_ONE`): what its numbers teach, see `_read_layout`.
@@ -198,10 +198,13 @@ class IsoWriter:
         if group:
             yield from write_group(group)
 
-    def _tell_unpositioned(self, block: Block) -> None:
-        """Before a compensated block is written: tell `unpositioned` of the axes X Y Z the program
-        has not positioned yet (each once), whose correction its moves leave out until it does."""
+    def _tell_unpositioned(self, block: Block, motion: list[Line | Arc]) -> None:
+        """Before a compensated block that feeds is written: tell `unpositioned` of the axes X Y Z
+        the program has not positioned yet (each once), whose correction its moves leave out until
+        it does (a rapid's, to a clearance before the first cut, matters to no part)."""
         if self.unpositioned is None or len(self._told_unpositioned) == 3 or _XYZ <= self.known_axes:
+            return
+        if all(type(m) is Line and m.rapid for m in motion):
             return
         new = sorted(_XYZ - self.known_axes - self._told_unpositioned)
         if new:
@@ -242,7 +245,7 @@ class IsoWriter:
                 lines.append(block.text)
             self._after_verbatim(block, motion)
             return lines
-        self._tell_unpositioned(block)
+        self._tell_unpositioned(block, motion)
         # a drilling cycle the block calls after its move, a rigid tap's return: the control's, from its text
         called = len(motion)
         while called > 1 and (motion[called - 1].fixed == DRILLED or _returns(motion[called - 1])):
