@@ -58,7 +58,7 @@ from ncpp.motion.segments import FLOW, MACHINE, PATTERN, PLANE_AXES, Event, Line
 from ncpp.motion.sinumerik_cycles import PARAMETERS as DRILLING
 from ncpp.motion.sinumerik_cycles import CycleError, Drilling, drilling
 from ncpp.motion.sinumerik_expand import SinumerikExpansion
-from ncpp.motion.sinumerik_flow import SinumerikFlow
+from ncpp.motion.sinumerik_flow import SinumerikFlow, is_repetition
 from ncpp.motion.tools import ToolTable, UntoldLengths
 from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
 
@@ -1009,7 +1009,7 @@ interpret = placed_interpreting(SinumerikInterpreter)
 def _runs_others(block: Block) -> bool:
     """A control line after whose text other blocks' moves may run, owned by it: a loop's end,
     a jump, a CASE."""
-    return any(type(i) is Statement and i.kind in RUNS_OTHERS for i in block.items)
+    return any(type(i) is Statement and i.kind in RUNS_OTHERS for i in block.items) or is_repetition(block)
 
 
 def _inside(flow: SinumerikFlow) -> bool:
