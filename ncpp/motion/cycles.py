@@ -2,7 +2,7 @@
 
 G73 (chip-breaking peck), G74/G84 (left/right-hand tapping), G81 (drill),
 G82 (drill, dwell), G83 (peck), G85 (bore, feed out), G86 (bore, spindle
-stop, rapid out), G87 (back bore, G17 only) and G89 (bore, dwell, feed out),
+stop, rapid out), G87 (back bore) and G89 (bore, dwell, feed out),
 in the G17, G18 or G19 plane.  Coordinates here are those of the plane, as
 rs274ngc names them: `aa` and `bb` in the plane, `cc` along its normal (the
 drilling axis).  G88 stays outside the interpreter's scope: the operator

@@ -1519,8 +1519,8 @@ class Interpreter:
             )  # fmt: skip
         self._check_cycle_size(block, words, repeats, (r - bottom) / peck if motion in PECKING else 0.0, item)
         if motion == 87.0:
-            i, j, k = self._back_bore_words(block, words, again, item)
-            middle = k if self.absolute else bottom + k
+            off_a, off_b, top = self._back_bore_words(block, words, again, item)
+            middle = top if self.absolute else bottom + top
         pos = self.pos
         moves, level, clear = approach(
             (pos[first], pos[second], pos[normal]), self.cycle_il, r, self.retract_to_r
@@ -1538,7 +1538,7 @@ class Interpreter:
             if level != r:
                 moves.append((aa, bb, r, True))
             if motion == 87.0:
-                moves += back_bore(aa, bb, aa + i, bb + j, r, clear, middle, bottom)
+                moves += back_bore(aa, bb, aa + off_a, bb + off_b, r, clear, middle, bottom)
             else:
                 moves += hole(motion, aa, bb, r, clear, bottom, peck, rapid_delta)
                 bottoms.append(len(moves) - 2)  # (the bottom, then out of the hole: `hole`)
@@ -1652,16 +1652,17 @@ class Interpreter:
             )
 
     def _back_bore_words(self, block: Block, words: dict, again: bool, item) -> tuple[float, float, float]:
-        """G87's I J (offsets in the plane) and K (the top of the bore), sticky within the cycle."""
-        if self.plane != 17:  # rs274ngc swaps I J K about in the other planes; not followed here
-            raise _OutOfScope("canned cycle G87 outside the XY plane", item.start + 1)
+        """G87's offsets along the plane's first and second axis and the top of the bore along its
+        normal, sticky within the cycle: each the word of its axis's letter (I for X, J for Y, K
+        for Z: G17 I J K, G18 K I J, G19 J K I), as rs274ngc's convert_cycle_zx and _yz pass them."""
         values = []
         for letter, kept in zip("IJK", self.cycle_ijk):
             if letter not in words and not again:
                 self._fail(f"{letter} word missing with G87", block, item)
             values.append(words[letter][0] if letter in words else kept)
         self.cycle_ijk = (values[0], values[1], values[2])
-        return self.cycle_ijk
+        first, second, normal = PLANE_AXES[self.plane]
+        return values[first], values[second], values[normal]
 
     def _check_cycle_size(self, block: Block, words: dict, repeats: int, pecks: float, item) -> None:
         """Refuse a cycle block of more than MAX_CYCLE_MOVES moves before making them (`G81 ... L99999999`,

@@ -53,6 +53,9 @@ AGREE = {
     + "S500 M3\nG99 G84 X1 Y1 Z-3 R2\nX2\nG98 G86 X3 Z-3 R2 P1\nG87 X4 Y4 Z-5 R2 I1 J0 K-3\nX6\nG80\nM4\nG74 X5 Y5 Z-2 R1\nG80\nM5\n",
     "incremental back bore, g18 boring": HEAD
     + "M3\nG91 G87 X1 Y1 Z-3 R2 I1 J1 K1 L2\nG90 G80\nG18 G86 X1 Z1 Y-3 R2 P1\nG17 G80\n",
+    # G87 in G18 and G19: I J K offset X Y Z, the normal's letter is the top of the bore
+    "back bore in g18 and g19": HEAD + "M3\nG18 G98 G87 X1 Z1 Y-3 R2 I0.5 J-1 K-0.7\nX2\nG80\n"
+    "G19 G99 G87 Y1 Z2 X-3 R2 I-1.5 J0.4 K0.6\nG91 G87 Y1 R-1 X-2 I1 L2\nG90 G80 G17\n",
     # the levels a series crosses at and retracts to (found by probing rs274)
     "g99 series changing r": "G21 G90\nG0 X0 Y0 Z7.077 F100\nG89 G99 X1 Y-1 R1.541 Z-2.5 P0.3\nG83 X-3 Y-1 R2.271 Z-1.2 Q1.2\nX-2 R1\nM2\n",
     "g98 after g99, higher r": "G21 G90\nG0 X0 Y0 Z10 F100\nG99 G81 X1 Z-3 R2\nG98 G82 X3 Z-3 R5 P1\nX4\nM2\n",
@@ -64,7 +67,6 @@ AGREE = {
 
 OUT_OF_SCOPE = {
     "tapping in g18": (HEAD + "M3 G18\nG84 X1 Z1 Y-3 R2\n", 4, "G84 outside the XY plane"),
-    "back bore in g19": (HEAD + "M3 G19\nG87 Y1 Z1 X-3 R2 I1 J1 K-1\n", 4, "G87 outside the XY plane"),
     "manual retract": (HEAD + "M3\nG88 X1 Y1 Z-3 R2 P1\n", 4, "canned cycle G88"),
 }
 
@@ -129,7 +131,7 @@ def _random_program(rng: random.Random) -> str:
             lines.append(extra)
             continue
         code = rng.choice(
-            ["G73", "G81", "G82", "G83", "G85", "G86", "G89"] + (["G84", "G87"] if plane == 17 else [])
+            ["G73", "G81", "G82", "G83", "G85", "G86", "G87", "G89"] + (["G84"] if plane == 17 else [])
         )
         normal = {17: "Z", 18: "Y", 19: "X"}[plane]
         incremental, r = rng.random() < 0.3, rng.uniform(0, 4)
@@ -143,7 +145,9 @@ def _random_program(rng: random.Random) -> str:
             "G82": ["P0.2"],
             "G86": ["P0.2"],
             "G89": ["P0.2"],
-            "G87": ["I0.6", "J-0.4", "K" + ("0.5" if incremental else "-1")],
+            # (the normal's letter is the top of the bore: `_back_bore_words`)
+            "G87": [f"{letter}{rng.uniform(-1, 1):.3f}" for letter in "IJK" if letter != "IJK"["XYZ".index(normal)]]
+            + ["IJK"["XYZ".index(normal)] + ("0.5" if incremental else "-1")],
         }.get(code, [])
         if rng.random() < 0.25:
             words.append(f"L{rng.randint(1, 3)}")
