@@ -134,6 +134,7 @@ def _random_program(rng: random.Random) -> str:
             ["G73", "G81", "G82", "G83", "G85", "G86", "G87", "G89"] + (["G84"] if plane == 17 else [])
         )
         normal = {17: "Z", 18: "Y", 19: "X"}[plane]
+        top = "IJK"["XYZ".index(normal)]
         incremental, r = rng.random() < 0.3, rng.uniform(0, 4)
         words = [code, rng.choice(["", "G98", "G99"]), "G91" if incremental else "G90"]
         words += [a + f"{rng.uniform(-5, 5):.3f}" for a in "XYZ" if a != normal and rng.random() < 0.8]
@@ -146,8 +147,8 @@ def _random_program(rng: random.Random) -> str:
             "G86": ["P0.2"],
             "G89": ["P0.2"],
             # (the normal's letter is the top of the bore: `_back_bore_words`)
-            "G87": [f"{letter}{rng.uniform(-1, 1):.3f}" for letter in "IJK" if letter != "IJK"["XYZ".index(normal)]]
-            + ["IJK"["XYZ".index(normal)] + ("0.5" if incremental else "-1")],
+            "G87": [f"{letter}{rng.uniform(-1, 1):.3f}" for letter in "IJK" if letter != top]
+            + [top + ("0.5" if incremental else "-1")],
         }.get(code, [])
         if rng.random() < 0.25:
             words.append(f"L{rng.randint(1, 3)}")
