@@ -320,6 +320,10 @@ class SinumerikFlow:
         if end is None:
             raise OutOfScope(f"{keyword}: the end label {end_label} is not found after {start_label}", where)
         self._check_section(keyword, start, end, where)
+        blocks = runs * (end - start + 1)
+        if blocks > MAX_RERUN - self.rerun:  # (refused before they run, as `steps` would)
+            raise NcppError(f"{keyword} P={runs:.15g}: {blocks:,.0f} blocks run again, more than the "
+                            f"{MAX_RERUN:,} ncpp follows", Location(self.file, block.line, where))  # fmt: skip
         self.section = _Section(start, end, int(runs), self.pc + 1)
         return start
 

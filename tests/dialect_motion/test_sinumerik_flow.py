@@ -188,3 +188,8 @@ def test_a_section_ahead_of_its_repeat_runs_there_then_in_its_place():
 def test_a_repetition_ncpp_does_not_follow_ends_interpretation(text, said):
     events, warned = _run("R1=0\nG90 G1 F100\n" + text + "X9\nM30\n")
     assert said in warned and 9.0 not in _xs(events)
+
+
+def test_a_repetition_of_more_blocks_than_ncpp_follows_is_refused_before_it_runs():
+    with pytest.raises(NcppError, match=r"flow.mpf:4:1: REPEAT P=1000000000: 2,000,000,000 blocks run again"):
+        _run("G90 G1 F100\nA: X1\nX2\nREPEAT A P=1000000000\nM30\n")
