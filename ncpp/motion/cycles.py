@@ -2,7 +2,7 @@
 
 G73 (chip-breaking peck), G74/G84 (left/right-hand tapping), G81 (drill),
 G82 (drill, dwell), G83 (peck), G85 (bore, feed out), G86 (bore, spindle
-stop, rapid out), G87 (back bore, G17 only) and G89 (bore, dwell, feed out),
+stop, rapid out), G87 (back bore) and G89 (bore, dwell, feed out),
 in the G17, G18 or G19 plane.  Coordinates here are those of the plane, as
 rs274ngc names them: `aa` and `bb` in the plane, `cc` along its normal (the
 drilling axis).  G88 stays outside the interpreter's scope: the operator
@@ -28,13 +28,14 @@ def approach(
 ) -> tuple[list[Move], float, float]:
     """How a cycle reaches its holes from where the tool is (`at`, plane coordinates) when its
     series started at the normal-axis level `start_level`: (the move up to R first, if any,
-    the level the tool crosses to the hole at, the level it retracts to).  Not below R
-    (G99) or the series' start level (G98); a series that started below R goes up to R
+    the level the tool crosses to the hole at, the level it retracts to).  It crosses not below
+    R (G99) or the series' start level (G98), and G98 retracts to that start level even where
+    an earlier, higher R left the tool above it; a series that started below R goes up to R
     first.  rs274ngc as LinuxCNC 2.9 runs it, found by probing it (test_cycles.py)."""
     if start_level < r:
         return [(at[0], at[1], r, True)], r, r
-    level = max(at[2], r if retract_to_r else start_level)
-    return [], level, r if retract_to_r else level
+    clear = r if retract_to_r else start_level
+    return [], at[2] if at[2] > r else clear, clear
 
 
 def hole(

@@ -260,7 +260,6 @@ class Interpreter:
         # normal-axis position its series of cycles started from (a series ends with any other motion)
         self.cycle_r = self.cycle_cc = self.cycle_q = self.cycle_il = 0.0
         self.cycle_ijk = (0.0, 0.0, 0.0)  # G87's sticky I J K
-        self.cycle_last_r = 0.0  # the R plane of the series' last cycle
         self.cycle_holes = False  # the series' cycles are compensated hole by hole (`Hole`)
         self.cycle_p = 0.0  # G82 G89's dwell, seconds (sticky within the cycle)
         self.expand_cycles = False  # cycles are written as their moves (`expanded`)
@@ -1509,20 +1508,15 @@ class Interpreter:
         self, block: Block, words: dict, motion: float, previous: float | None, item
     ) -> tuple[Event, ...]:
         """A canned cycle's moves (rs274ngc's convert_cycle and convert_cycle_xy, in any plane):
-        `Line`s marked `fixed`: HOLE, one hole in G17 and G90 that apply_error_map compensates as a
-        whole, or CYCLE, left as programmed; with --expand-cycles moves like any other (`_expanded`)."""
+        `Line`s marked `fixed`: HOLE, one hole that apply_error_map compensates as a whole (its
+        position in the plane, its R and bottom along the normal), or CYCLE, left as programmed;
+        with --expand-cycles moves like any other (`_expanded`)."""
         first, second, normal = PLANE_AXES[self.plane]
         again = previous == motion  # the same cycle again: R, the normal-axis word, P and Q are sticky
         if previous not in CANNED:  # a new series: G98 retracts to where it started
             self.cycle_il = self.pos[normal]
         aa, bb, step_a, step_b, r, bottom = self._cycle_geometry(block, words, again, item)
         repeats = self._repeats(block, words)
-        if previous in CANNED and not self.retract_to_r and r < self.cycle_last_r:
-            # the levels rs274ngc then crosses and retracts at depend on more than this follows
-            raise _OutOfScope(
-                "a G98 series of canned cycles lowering its R plane", words.get("R", (0, item))[1].start + 1
-            )
-        self.cycle_last_r = r
         peck = self._cycle_word(block, words, motion, again, item)
         if motion in (74.0, 84.0) and self.plane != 17:  # rs274ngc's taps move other axes there
             raise _OutOfScope(f"canned cycle G{motion:g} outside the XY plane", item.start + 1)
@@ -1535,8 +1529,8 @@ class Interpreter:
             )  # fmt: skip
         self._check_cycle_size(block, words, repeats, (r - bottom) / peck if motion in PECKING else 0.0, item)
         if motion == 87.0:
-            i, j, k = self._back_bore_words(block, words, again, item)
-            middle = k if self.absolute else bottom + k
+            off_a, off_b, top = self._back_bore_words(block, words, again, item)
+            middle = top if self.absolute else bottom + top
         pos = self.pos
         moves, level, clear = approach(
             (pos[first], pos[second], pos[normal]), self.cycle_il, r, self.retract_to_r
@@ -1544,7 +1538,7 @@ class Interpreter:
         rapid_delta = RAPID_DELTA_INCH if self.inch else RAPID_DELTA_INCH * MM_PER_INCH
         polar = not self.absolute and ("@" in words or "^" in words)
         bottoms = []  # the moves at a hole's bottom (a dwell follows them: `expanded`)
-        holes: list[tuple[int, float, float]] = []  # (its first move, X, Y) of each repeat's hole
+        holes: list[tuple[int, float, float]] = []  # (its first move, aa, bb) of each repeat's hole
         for _ in range(repeats):
             aa, bb = aa + step_a, bb + step_b
             if polar:
@@ -1554,7 +1548,7 @@ class Interpreter:
             if level != r:
                 moves.append((aa, bb, r, True))
             if motion == 87.0:
-                moves += back_bore(aa, bb, aa + i, bb + j, r, clear, middle, bottom)
+                moves += back_bore(aa, bb, aa + off_a, bb + off_b, r, clear, middle, bottom)
             else:
                 moves += hole(motion, aa, bb, r, clear, bottom, peck, rapid_delta)
                 bottoms.append(len(moves) - 2)  # (the bottom, then out of the hole: `hole`)
@@ -1563,16 +1557,15 @@ class Interpreter:
         if self.expand_cycles:
             self.cycle_holes = False
             return self._expanded(block, motion, lines, bottoms)
-        # holes apply_error_map compensates: in G17 (polar words written as X Y, repeats as a block
-        # each), the series' holes all such
-        self.cycle_holes = (previous not in CANNED or self.cycle_holes) and (
-            self.plane == 17 and motion != 87.0
-        )
+        # holes apply_error_map compensates: in any plane (polar words written as X Y, repeats as a
+        # block each), the series' holes all such
+        self.cycle_holes = (previous not in CANNED or self.cycle_holes) and motion != 87.0
         if self.cycle_holes:
             ends = [k for k, _, _ in holes[1:]] + [len(lines)]
-            for n, ((k, x, y), end) in enumerate(zip(holes, ends)):
-                drilled = Hole(motion, x, y, bottom, r, peck, rapid_delta, self.retract_to_r,
-                               previous not in CANNED and n == 0, n, len(holes))  # fmt: skip
+            for n, ((k, hole_a, hole_b), end) in enumerate(zip(holes, ends)):
+                drilled = Hole(motion, hole_a, hole_b, bottom, r, peck, rapid_delta, self.retract_to_r,
+                               previous not in CANNED and n == 0, n, len(holes),
+                               plane=self.plane)  # fmt: skip
                 for line in lines[k:end]:
                     line.fixed, line.hole = HOLE, drilled
         return lines
@@ -1669,16 +1662,17 @@ class Interpreter:
             )
 
     def _back_bore_words(self, block: Block, words: dict, again: bool, item) -> tuple[float, float, float]:
-        """G87's I J (offsets in the plane) and K (the top of the bore), sticky within the cycle."""
-        if self.plane != 17:  # rs274ngc swaps I J K about in the other planes; not followed here
-            raise _OutOfScope("canned cycle G87 outside the XY plane", item.start + 1)
+        """G87's offsets along the plane's first and second axis and the top of the bore along its
+        normal, sticky within the cycle: each the word of its axis's letter (I for X, J for Y, K
+        for Z: G17 I J K, G18 K I J, G19 J K I), as rs274ngc's convert_cycle_zx and _yz pass them."""
         values = []
         for letter, kept in zip("IJK", self.cycle_ijk):
             if letter not in words and not again:
                 self._fail(f"{letter} word missing with G87", block, item)
             values.append(words[letter][0] if letter in words else kept)
         self.cycle_ijk = (values[0], values[1], values[2])
-        return self.cycle_ijk
+        first, second, normal = PLANE_AXES[self.plane]
+        return values[first], values[second], values[normal]
 
     def _check_cycle_size(self, block: Block, words: dict, repeats: int, pecks: float, item) -> None:
         """Refuse a cycle block of more than MAX_CYCLE_MOVES moves before making them (`G81 ... L99999999`,

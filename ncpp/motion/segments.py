@@ -95,26 +95,40 @@ class Context:
 
 @dataclass(frozen=True, slots=True)
 class Hole:
-    """One hole of a G17 canned cycle (`fixed` HOLE): what the control drills it from, program
-    units, absolute.  apply_error_map writes its moves again from the corrected words
-    (`command`), as the control will run them (`cycles.drilled`); the writer writes each hole
-    of a block's repeats (L) as a block of its own."""
+    """One hole of a canned cycle (`fixed` HOLE), in its plane's coordinates as rs274ngc names
+    them (`PLANE_AXES`: `aa` `bb` in the plane, X Y in G17; the levels along its normal, the
+    drilling axis): what the control drills it from, program units, absolute.  apply_error_map
+    writes its moves again from the corrected words (`command`), as the control will run them
+    (`cycles.drilled`); the writer writes each hole of a block's repeats (L) as a block of its own."""
 
     motion: float  # the cycle's G code (81.0, 83.0, ...)
-    x: float
-    y: float
-    bottom: float  # Z
+    aa: float
+    bb: float
+    bottom: float  # along the normal (Z in G17)
     r: float  # the R plane
     peck: float  # G73 G83's Q (0: none)
     rapid_delta: float  # how far above the last peck G73 G83 rapid back in
     retract_to_r: bool  # G99 (True) or G98
-    series_start: bool  # the first cycle of a series: G98 retracts to the Z it starts from
+    series_start: bool  # the first cycle of a series: G98 retracts to the level it starts from
     repeat: int = 0  # which of its block's repeats (L) it is, from 0
     repeats: int = 1  # how many the block has
-    # with its correction: the X Y Z R written, absolute (None: as programmed), and the Z its
-    # series starts from as written (in G91 R counts from there)
+    # with its correction: the aa bb, bottom and R written, absolute (None: as programmed), and the
+    # level its series starts from as written (in G91 R counts from there)
     command: tuple[float, float, float, float] | None = None
     series_level: float = 0.0
+    plane: int = 17  # 17, 18, 19
+
+    def point(self, level: float) -> Point:
+        """The X Y Z of the hole at `level` along the plane's normal."""
+        return plane_point(self.plane, self.aa, self.bb, level)
+
+
+def plane_point(plane: int, aa: float, bb: float, cc: float) -> Point:
+    """The X Y Z of a point given in a plane's coordinates (`PLANE_AXES`: `cc` along its normal)."""
+    a, b, n = PLANE_AXES[plane]
+    out = [0.0, 0.0, 0.0]
+    out[a], out[b], out[n] = aa, bb, cc
+    return (out[0], out[1], out[2])
 
 
 # Events are not frozen: a pipeline makes several per output line, and a frozen
@@ -258,6 +272,7 @@ __all__ = [
     "CYCLE",
     "HOLE",
     "Hole",
+    "plane_point",
     "FLOW",
     "DRILLED",
     "PATTERN",

@@ -9,7 +9,8 @@ arithmetic, labels, `MSG`, G4 dwell, M2/M17/M30 (end), and tool lengths: `T n`
 or `T="NAME"` selects, M6 loads it with cutting edge D1, `D n` picks an edge
 (D0 none); the edge's lengths 1-3 from the control's tool offsets (`_N_TO_INI`,
 `tools.py`) act along the plane's axes (G17: length 1 along Z).  Control flow (GOTOF,
-GOTOB, GOTO, GOTOC, CASE, IF, WHILE, FOR, REPEAT, LOOP) runs as `sinumerik_flow.py` says: a
+GOTOB, GOTO, GOTOC, CASE, IF, WHILE, FOR, REPEAT, LOOP; REPEAT label and REPEATB, program
+section repetition) runs as `sinumerik_flow.py` says: a
 loop's moves are left as programmed (FLOW), or with --expand each run is written out
 (`sinumerik_expand.py`), as are subprogram calls.  The drilling, tapping and boring cycles
 CYCLE81-CYCLE89 and CYCLE840, called once or under MCALL, are followed (`sinumerik_cycles.py`),
@@ -58,7 +59,7 @@ from ncpp.motion.segments import FLOW, MACHINE, PATTERN, PLANE_AXES, Event, Line
 from ncpp.motion.sinumerik_cycles import PARAMETERS as DRILLING
 from ncpp.motion.sinumerik_cycles import CycleError, Drilling, drilling
 from ncpp.motion.sinumerik_expand import SinumerikExpansion
-from ncpp.motion.sinumerik_flow import SinumerikFlow
+from ncpp.motion.sinumerik_flow import SinumerikFlow, is_repetition
 from ncpp.motion.tools import ToolTable, UntoldLengths
 from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
 
@@ -1009,7 +1010,7 @@ interpret = placed_interpreting(SinumerikInterpreter)
 def _runs_others(block: Block) -> bool:
     """A control line after whose text other blocks' moves may run, owned by it: a loop's end,
     a jump, a CASE."""
-    return any(type(i) is Statement and i.kind in RUNS_OTHERS for i in block.items)
+    return any(type(i) is Statement and i.kind in RUNS_OTHERS for i in block.items) or is_repetition(block)
 
 
 def _inside(flow: SinumerikFlow) -> bool:

@@ -15,7 +15,14 @@ The rules are those of the SINUMERIK 840D sl Programming Manual, Job Planning
   ENDFOR` (the variable counts up by 1 while it is not above the end), `REPEAT ...
   UNTIL condition`, `LOOP ... ENDLOOP` (endless, left by a jump) are the control
   structures; they nest.  The manual advises against mixing control structures and
-  program jumps: ncpp does not follow a jump while a structure is open.
+  program jumps: ncpp does not follow a jump while a structure is open;
+* program section repetition ("Program section repetition (REPEAT, REPEATB, ENDLABEL, P)"):
+  `REPEATB label P=n` runs the block the label marks (searched toward the program's start,
+  then toward its end) n times, `REPEAT label P=n` the blocks from the label (before it) to the
+  line before the REPEAT, `REPEAT start end P=n` those from the start label (searched as
+  REPEATB's) to the end label after it; without P once; then the program goes on after the
+  REPEAT line.  Not followed: a section closed by ENDLABEL, one that holds its REPEAT line, a
+  control structure or a jump, or a repetition inside another or inside a structure.
 
 `SinumerikFlow.steps(blocks)` yields each block with what the interpreter is to do
 with it, as `ncpp.motion.flow` does for o-words (its RUN, FIXED, SKIP, TEXT): a block
@@ -38,7 +45,7 @@ from dataclasses import dataclass
 from ncpp.errors import Location, NcppError
 from ncpp.motion.flow import _TRIM, FIXED, MAX_RERUN, RUN, SKIP, TEXT
 from ncpp.motion.modal import OutOfScope
-from ncpp.program.blocks import Block, Comment, Statement, Word
+from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
 
 # Statements that steer the flow (the builder's kinds: ncpp/program/dialects/sinumerik.py)
 CONTROLS = frozenset(("if", "else", "endif", "while", "endwhile", "for", "endfor", "repeat", "until",
@@ -47,6 +54,9 @@ OPENERS = {"if": "endif", "while": "endwhile", "for": "endfor", "repeat": "until
 CLOSERS = frozenset(OPENERS.values())
 # Blocks a forward search for a jump destination reads ahead before it gives up (memory stays bounded)
 MAX_AHEAD = 100_000
+SECTION = "section"  # the kind `_controls` gives a program section repetition (`_repetition`)
+# The label that ends a section `REPEAT start P=n` repeats (not followed: `_repetition`)
+END_LABEL = "ENDLABEL"
 
 
 @dataclass
@@ -56,6 +66,16 @@ class _Open:
     kind: str  # if, while, for, repeat, loop
     start: int  # the index of its opening block
     end: float = 0.0  # FOR: the end value
+
+
+@dataclass
+class _Section:
+    """A program section repetition under way (REPEAT, REPEATB)."""
+
+    start: int  # the index of its first block
+    end: int  # the index of its last block
+    runs: int  # runs still to come after the one under way
+    back: int  # the index of the block after the REPEAT line, where the program goes on
 
 
 class SinumerikFlow:
@@ -79,6 +99,7 @@ class SinumerikFlow:
         self.looped: set[int] = set()  # blocks a backward jump read ahead runs again
         self.last_run_move = -1  # the index of the last block that moved in place (RUN): the interpreter's
         self.rerun = 0  # blocks run out of the text's order so far
+        self.section: _Section | None = None  # a REPEAT's section running
 
     # -- the stream ------------------------------------------------------------------
     def steps(self, blocks: Iterable[Block]) -> Iterator[tuple[Block, str, Block | None]]:
@@ -113,12 +134,22 @@ class SinumerikFlow:
             if in_place:
                 yield block, TEXT, None
                 self._wrote()
-            yield from self._go(target)
+            if self.section is not None and target == self.section.start:  # (the blocks between run later)
+                self.pc = target
+            else:
+                yield from self._go(target)
         yield from self._rest()
 
     def _advance(self) -> None:
         if self.pc == self.written:
             self._wrote()
+        section = self.section
+        if section is not None and self.pc == section.end:  # a run of a REPEAT's section is over
+            section.runs -= 1
+            self.pc = section.start if section.runs > 0 else section.back
+            if section.runs <= 0:
+                self.section = None
+            return
         self.pc += 1
 
     def _wrote(self) -> None:
@@ -177,11 +208,15 @@ class SinumerikFlow:
                     start = None if keyword == "GOTOF" else seen.get(destination.upper())
                     if start is not None:  # (GOTO may find one ahead first: FIXED too, which is safe)
                         self.looped.update(range(start, index + 1))
+                if statement.kind == SECTION:  # (a section before its REPEAT: its first run FIXED too)
+                    self.looped.update(_section_before(statement, seen, index))
 
     # -- control blocks ---------------------------------------------------------------
     def _decide(self, block: Block, control: list[Statement]) -> int:
         """Run a control block: the index of the block that runs next."""
         first = control[0]
+        if self.section is not None:
+            raise OutOfScope(f"{_name(first)} in a section a REPEAT runs (not followed)", first.start + 1)
         if first.kind == "if" and len(control) == 2 and control[1].kind == "goto":  # a conditional jump
             return (
                 self._jump(block, control[1], *control[1].node) if self._holds(block, first) else self.pc + 1
@@ -266,6 +301,56 @@ class SinumerikFlow:
     def _goto(self, block: Block, statement: Statement) -> int:
         return self._jump(block, statement, *statement.node)
 
+    def _section(self, block: Block, statement: Statement) -> int:
+        """REPEAT or REPEATB: on to the section's first block, the runs counted (`_advance`)."""
+        keyword, start_label, end_label, times = statement.node
+        where = statement.start + 1
+        if self.open:
+            raise OutOfScope(f"{keyword} inside {self.open[-1].kind.upper()} (not followed)", where)
+        runs = 1.0 if times is None else self.value(times, block, statement)
+        if runs != int(runs) or runs < 1:
+            raise OutOfScope(f"{keyword} with P={runs:g} (a whole number of runs, 1 or more)", where)
+        backward = keyword == "REPEAT" and end_label is None  # (the label before the REPEAT line)
+        start = self._backward(start_label, self.pc - 1)
+        if start is None and not backward:
+            start = self._forward(start_label)
+        if start is None:
+            raise OutOfScope(f"{keyword} {start_label}: the label is not found (or no longer held)", where)
+        end = start if keyword == "REPEATB" else self.pc - 1 if backward else self._after(start, end_label)
+        if end is None:
+            raise OutOfScope(f"{keyword}: the end label {end_label} is not found after {start_label}", where)
+        self._check_section(keyword, start, end, where)
+        blocks = runs * (end - start + 1)
+        if blocks > MAX_RERUN - self.rerun:  # (refused before they run, as `steps` would)
+            raise NcppError(f"{keyword} P={runs:.15g}: {blocks:,.0f} blocks run again, more than the "
+                            f"{MAX_RERUN:,} ncpp follows", Location(self.file, block.line, where))  # fmt: skip
+        self.section = _Section(start, end, int(runs), self.pc + 1)
+        return start
+
+    def _check_section(self, keyword: str, start: int, end: int, where: int) -> None:
+        """Refuse what the section may hold that this flow does not follow: its REPEAT line, a
+        control statement or a jump, ENDLABEL; and a backward run over moves compensated where
+        they stand (as `_jump`)."""
+        if start <= self.pc <= end:
+            raise OutOfScope(f"{keyword}: a section that holds its REPEAT line", where)
+        for index in range(start, end + 1):
+            block = self.buffer[index - self.base]
+            if END_LABEL in _destinations(block) and keyword == "REPEAT":
+                raise OutOfScope(f"{keyword}: a section with {END_LABEL} (not followed)", where)
+        looped = all(index in self.looped for index in range(start, end + 1))  # (a looped block runs FIXED)
+        if start <= self.pc and self.last_run_move >= start and not looped:
+            raise OutOfScope(f"{keyword}: a section of moves compensated where they stand, run again", where)
+
+    def _after(self, start: int, name: str) -> int | None:
+        """The first block from `start` on that the label `name` marks."""
+        for index in range(start, start + MAX_AHEAD):
+            block = self._block(index)
+            if block is None:
+                return None
+            if name in _destinations(block):
+                return index
+        return None
+
     def _case(self, block: Block, statement: Statement) -> int:
         expr, branches, default = statement.node
         value = self.value(expr, block, statement)
@@ -346,8 +431,8 @@ class SinumerikFlow:
                 return index
         return None
 
-    def _backward(self, name: str) -> int | None:
-        for index in range(self.pc, self.base - 1, -1):
+    def _backward(self, name: str, first: int | None = None) -> int | None:
+        for index in range(self.pc if first is None else first, self.base - 1, -1):
             if name in _destinations(self.buffer[index - self.base]):
                 return index
         return None
@@ -356,6 +441,9 @@ class SinumerikFlow:
 def _controls(block: Block) -> list[Statement]:
     """The block's control statements; OutOfScope when more than its block number, labels
     and comments stand beside them."""
+    repetition = _repetition(block)
+    if repetition is not None:
+        return [repetition]
     found = [i for i in block.items if type(i) is Statement and i.kind in CONTROLS]
     if found:
         for item in block.items:
@@ -392,3 +480,61 @@ def _jumps(statement: Statement) -> list[tuple[str, str]]:
             [default] if default else []
         )
     return []
+
+
+def _repetition(block: Block) -> Statement | None:
+    """A program section repetition (`REPEAT label P=n`, `REPEAT start end P=n`, `REPEATB label
+    P=n`) as one statement of kind SECTION: (keyword, start label, end label or None, P's
+    expression or None); None for a block that is none.  OutOfScope for one with more in its block."""
+    items = [i for i in block.items if not (type(i) is Comment or (type(i) is Word and i.letter in "N:")
+                                            or (type(i) is Statement and i.kind == "label"))]  # fmt: skip
+    if not items or type(items[0]) is not Statement:
+        return None
+    first = items[0]
+    if first.kind == "repeat" and len(items) > 1:
+        keyword = "REPEAT"
+    elif first.kind == "call" and first.node[0].upper() == "REPEATB" and not first.node[1]:
+        keyword = "REPEATB"
+    else:
+        return None
+    labels, times = [], None
+    for item in items[1:]:
+        if type(item) is Statement and item.kind == "call" and not item.node[1] and times is None:
+            labels.append(item.node[0].upper())
+        elif type(item) is ExprWord and item.letter == "P" and times is None:
+            times = item.expr
+        elif type(item) is Word and item.letter == "P" and times is None:
+            times = ("num", item.value)
+        else:
+            raise OutOfScope(f"{keyword} with more in its block", item.start + 1)
+    if not 1 <= len(labels) <= (1 if keyword == "REPEATB" else 2):
+        raise OutOfScope(f"{keyword} with {len(labels)} labels", first.start + 1)
+    node = (keyword, labels[0], labels[1] if len(labels) > 1 else None, times)
+    return Statement(SECTION, node, first.start, block.items[-1].end)
+
+
+def is_repetition(block: Block) -> bool:
+    """Whether the block repeats a program section (REPEAT, REPEATB: its line runs other blocks)."""
+    try:
+        return _repetition(block) is not None
+    except OutOfScope:
+        return False
+
+
+def _section_before(statement: Statement, seen: dict[str, int], index: int) -> range:
+    """The blocks before the REPEAT line at `index` its section runs again (`seen`: where each
+    label was first met); empty where the section lies ahead or is not found."""
+    keyword, start_label, end_label, _ = statement.node
+    start = seen.get(start_label)
+    if start is None:
+        return range(0)
+    if keyword == "REPEATB":
+        return range(start, start + 1)
+    if end_label is None:
+        return range(start, index)
+    end = seen.get(end_label)
+    return range(start, end + 1) if end is not None and end >= start else range(0)
+
+
+def _name(statement: Statement) -> str:
+    return statement.node[0] if statement.kind == SECTION else statement.kind.upper()

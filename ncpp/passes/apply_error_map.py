@@ -26,7 +26,7 @@ from numpy.typing import NDArray
 
 from ncpp.errors import Location, NcppError
 from ncpp.motion import cycles
-from ncpp.motion.segments import CYCLE, HOLE, Arc, Event, Hole, Line, Pass, Setting
+from ncpp.motion.segments import CYCLE, HOLE, PLANE_AXES, Arc, Event, Hole, Line, Pass, Setting, plane_point
 from ncpp.passes.context import PassContext, deviation
 from ncpp.passes.geometry import (
     any3,
@@ -110,14 +110,15 @@ def _at_holes(chunk: list[Event]) -> Iterator[tuple[list[Event], Hole | None]]:
 
 
 class _Holes:
-    """Compensated canned cycles (`Line.hole`): each block's X Y and Z corrected at the hole's bottom,
-    its R at the R point above the hole, its moves as the control runs them from those words
-    (`cycles.drilled`)."""
+    """Compensated canned cycles (`Line.hole`): each block's position in the plane and its depth
+    corrected at the hole's bottom, its R at the R point above the hole, its moves as the control
+    runs them from those words (`cycles.drilled`)."""
 
     def __init__(self, ctx: PassContext):
         self.ctx = ctx
         self.hole: Hole | None = None  # the last hole written again (its moves may span two chunks)
-        self.start_level = 0.0  # Z where the G98 series under way started, as the control stands there
+        # the level (along the normal) the series under way started at, as the control stands there
+        self.start_level = 0.0
         self.last: Line | None = None  # the last segment written, with its compensated end (`_chunks` tells)
 
     def drilled(self, moves: list[Event], held: NDArray) -> list[Event]:
@@ -129,87 +130,104 @@ class _Holes:
         if first.hole is self.hole:  # the rest of a hole cut by a chunk's end: written already
             return []
         self.hole = hole = first.hole
+        axes = PLANE_AXES[hole.plane]
         at = first.start if last is None else _end_in_frame_of(last, first)
         if hole.series_start:
-            self.start_level = at[2]
-        (x, y, z), (_, _, r) = self._commands(moves, hole, at, held).tolist()
+            self.start_level = at[axes[2]]
+        bottom, r_point = self._commands(moves, hole, at, held).tolist()
+        command = (bottom[axes[0]], bottom[axes[1]], bottom[axes[2]], r_point[axes[2]])
         if not first.context.absolute:
-            x, y, z, r = self._incremental(first, at, (x, y, z, r))
-        corrected = replace(hole, command=(x, y, z, r), series_level=self.start_level)
+            command = self._incremental(first, at, axes, command)
+        corrected = replace(hole, command=command, series_level=self.start_level)
+        aa, bb, level, r = command
         out: list[Event] = []
         start = tuple(at)
         # (not `changed`: that marks the pieces replace_arcs made, which the solve moves; the writer
         # tells a written hole by its `command`)
-        moves_run = cycles.drilled(
-            hole.motion, start, self.start_level, x, y, r, z, hole.peck, hole.rapid_delta, hole.retract_to_r
-        )
-        for end in moves_run:
-            out.append(replace(first, start=start, end=end[:3], rapid=end[3], hole=corrected))
-            start = end[:3]
+        here = (at[axes[0]], at[axes[1]], at[axes[2]])
+        moves_run = cycles.drilled(hole.motion, here, self.start_level, aa, bb, r, level, hole.peck,
+                                   hole.rapid_delta, hole.retract_to_r)  # fmt: skip
+        for move in moves_run:
+            end = plane_point(hole.plane, *move[:3])
+            out.append(replace(first, start=start, end=end, rapid=move[3], hole=corrected))
+            start = end
         return out
 
-    def _incremental(self, first: Line, at: tuple, command: tuple) -> tuple[float, float, float, float]:
-        """The command of a hole in G91 on the output's grid as the control adds it up: X Y from
-        where it stands, R from the series' start level, the bottom from R (rs274ngc's G91 cycle),
-        each a whole number of the last digit written, so that the roundings do not add up
+    def _incremental(
+        self, first: Line, at: tuple, axes: tuple[int, int, int], command: tuple
+    ) -> tuple[float, float, float, float]:
+        """The command of a hole in G91 on the output's grid as the control adds it up: the plane's
+        axes from where it stands, R from the series' start level, the bottom from R (rs274ngc's G91
+        cycle), each a whole number of the last digit written, so that the roundings do not add up
         along a row of holes."""
         step = float(grid(self.ctx, frames([first, first])[1][:1])[0])
 
         def on_grid(value: float, base: float) -> float:
             return base + round((value - base) / step) * step
 
-        x, y, z, r = command
+        aa, bb, bottom, r = command
         r = on_grid(r, self.start_level)
-        return on_grid(x, at[0]), on_grid(y, at[1]), on_grid(z, r), r
+        return on_grid(aa, at[axes[0]]), on_grid(bb, at[axes[1]]), on_grid(bottom, r), r
 
     def _commands(self, moves: list[Event], hole: Hole, at: tuple, held: NDArray) -> NDArray:
-        """(2,3) the commands for the hole's bottom and its R point (one X Y for both: the bottom's),
-        the control standing at `at`.  With reversal errors, an axis that the corrections alone move
-        on the way to the hole (X or Y the program keeps, Z to an R plane it stands at) may go against
-        the direction it holds: by a rounding step or so it stays where it is rather than reverse, by
-        more it reverses and is compensated so."""
+        """(2,3) the commands (X Y Z) for the hole's bottom and its R point (one position in the
+        plane for both: the bottom's), the control standing at `at`.  With reversal errors, an axis
+        that the corrections alone move on the way to the hole (an axis of the plane the program
+        keeps, the normal to an R plane it stands at) may go against the direction it holds: by a
+        rounding step or so it stays where it is rather than reverse, by more it reverses and is
+        compensated so."""
         first = moves[0]
         offsets, scales, tools = frames([first, first])  # type: ignore[list-item]
-        wanted = np.array([[hole.x, hole.y, hole.bottom], [hole.x, hole.y, hole.r]])
+        wanted = np.array([hole.point(hole.bottom), hole.point(hole.r)])
         lines = np.full(2, first.block.line)
         if not self.ctx.directional:
             return compensate(wanted, offsets, scales, lines, self.ctx, None, tools)
+        normal = PLANE_AXES[hole.plane][2]
+        reached = _reached(normal)
+        in_plane = np.arange(3) != normal
         direction, still = _hole_directions(moves, hole, held)
         command = compensate(wanted, offsets, scales, lines, self.ctx, direction, tools)
-        gap = command[_REACHED] - np.array(at)  # X Y over the hole, Z at R
-        against = still & (gap * direction[_REACHED] < 0)
+        gap = command[reached] - np.array(at)  # the plane's axes over the hole, the normal at R
+        against = still & (gap * direction[reached] < 0)
         if not against.any():
             return command
         stay = against & (np.abs(gap) <= _snap_limit(grid(self.ctx, scales[:1]), scales[:1]))
         turn = against & ~stay
-        if turn.any():  # (X and Y are reached once for both points)
-            direction[:, :2] = np.where(turn[:2], -direction[:, :2], direction[:, :2])
-            direction[1, 2] = -direction[1, 2] if turn[2] else direction[1, 2]
+        if turn.any():  # (the plane's axes are reached once for both points)
+            direction[:, turn & in_plane] *= -1.0
+            direction[1, normal] = -direction[1, normal] if turn[normal] else direction[1, normal]
             command = compensate(wanted, offsets, scales, lines, self.ctx, direction, tools)
             # reversed, the command may move the axis the way it held after all (an axis that runs
             # ahead on reversal cannot reach the points between): it stays, the nearest it gets
-            stay |= turn & ((command[_REACHED] - np.array(at)) * direction[_REACHED] < 0)
-        command[:, :2] = np.where(stay[:2], np.array(at[:2]), command[0, :2])
-        command[1, 2] = at[2] if stay[2] else command[1, 2]
+            stay |= turn & ((command[reached] - np.array(at)) * direction[reached] < 0)
+        over = np.where(stay, np.array(at), command[0])  # (the plane's axes: one position for both rows)
+        command[:, in_plane] = over[in_plane]
+        command[1, normal] = at[normal] if stay[normal] else command[1, normal]
         return command
 
 
-# Where `_Holes._commands`' rows reach the hole first: X and Y of the bottom's, Z of the R point's
-_REACHED = (np.array([0, 0, 1]), np.array([0, 1, 2]))
+def _reached(normal: int) -> tuple[NDArray, NDArray]:
+    """Where `_Holes._commands`' rows reach the hole first: the plane's axes of the bottom's row,
+    the normal (index `normal`) of the R point's."""
+    return (np.arange(3) == normal).astype(int), np.arange(3)
 
 
 def _hole_directions(moves: list[Event], hole: Hole, held: NDArray) -> tuple[NDArray, NDArray]:
-    """(2,3) the directions the hole's bottom and its R point are reached in: X and Y as the
-    rapid to the hole moves them, Z down to the bottom, and to R as the move that reaches it
-    (an axis that stands holds the direction it had); (3,) the axes the program keeps still
-    there (X Y over the hole, Z at R: `_REACHED`)."""
-    start = moves[0].start  # type: ignore[union-attr]
-    reach_r = next(m for m in moves if m.end == (hole.x, hole.y, hole.r))  # type: ignore[union-attr]
-    reach_z = reach_r.start[2]  # type: ignore[union-attr]
-    toward = np.sign([hole.x - start[0], hole.y - start[1], hole.r - reach_z])
+    """(2,3) the directions the hole's bottom and its R point are reached in: the plane's axes as
+    the rapid to the hole moves them, the normal down to the bottom, and to R as the move that
+    reaches it (an axis that stands holds the direction it had); (3,) the axes the program keeps
+    still there (the plane's over the hole, the normal at R: `_reached`)."""
+    normal = PLANE_AXES[hole.plane][2]
+    start = np.array(moves[0].start)  # type: ignore[union-attr]
+    r_point = hole.point(hole.r)
+    reach_r = next(m for m in moves if m.end == r_point)  # type: ignore[union-attr]
+    toward = np.sign(np.array(r_point) - start)
+    toward[normal] = np.sign(hole.r - reach_r.start[normal])  # type: ignore[union-attr]
     still = toward == 0
     toward = np.where(still, held, toward)
-    return np.array([[toward[0], toward[1], -1.0], toward]), still
+    bottom = toward.copy()
+    bottom[normal] = -1.0
+    return np.array([bottom, toward]), still
 
 
 def _warn_at_travel_ends(segs: list, rows: _Rows, solved: _Solved, ctx: PassContext) -> None:

@@ -129,3 +129,67 @@ def test_a_control_statement_with_more_in_its_block_ends_interpretation():
     events, warned = _run("G1 X1 F100\nR1=0\nWHILE R1<2\nR1=R1+1\nENDWHILE G1 X5\nX7\nM30\n")
     assert "flow.mpf:5:10: warning: ENDWHILE with more in its block" in warned
     assert _xs(events) == [1.0] and len(events) == 7  # every block written once
+
+
+# Program section repetition (840D sl Job Planning, "Program section repetition (REPEAT, REPEATB,
+# ENDLABEL, P)"): REPEAT ROW runs ROW's line to the line before it twice more, REPEATB one line
+# twice more, REPEAT FIRST LAST the lines between the two labels once more; each then goes on
+# after its REPEAT line.
+SECTIONS = """G17 G90 G71
+G0 X-5 Y-5 Z5
+R1=0
+ROW: R1=R1+10
+G1 X=R1 Y0 Z-1 F200
+Y=R1
+REPEAT ROW P=2
+G1 X50 Y=R1
+STEP: G1 X=R1+100 Y-10
+REPEATB STEP P=2
+FIRST: R1=R1+1
+G1 X=200+R1 Y-30
+LAST: Y-40
+G0 Z5
+REPEAT FIRST LAST P=1
+G1 X0 Y=R1
+M30
+"""
+SECTION_ENDS = [(-5, -5, 5), (10, 0, -1), (10, 10, -1), (20, 0, -1), (20, 20, -1), (30, 0, -1), (30, 30, -1),
+                (50, 30, -1), (130, -10, -1), (130, -10, -1), (130, -10, -1), (231, -30, -1), (231, -40, -1),
+                (231, -40, 5), (232, -30, 5), (232, -40, 5), (0, 32, 5)]  # fmt: skip
+
+
+def test_program_section_repetition_runs_each_section_its_p_times_more_then_goes_on():
+    events, warned = _run(SECTIONS)
+    ends = [tuple(round(v, 6) for v in e.end) for e in events if type(e) is Line]
+    assert warned == "" and ends == SECTION_ENDS
+    moves = [e for e in events if type(e) is Line]
+    # the sections' runs are left as programmed, their second and later runs the REPEAT line's
+    assert [m.block.line for m in moves if m.fixed == FLOW] == [5, 6, 7, 7, 7, 7, 9, 10, 10, 12, 13, 15, 15]
+    assert not moves[7].fixed and not moves[-1].fixed and not moves[13].fixed  # (lines 8, 16, 14)
+
+
+def test_a_section_ahead_of_its_repeat_runs_there_then_in_its_place():
+    text = "G90 G1 F100\nX1\nREPEAT AHEAD BEYOND\nX2\nAHEAD: X3\nBEYOND: X4\nX5\nM30\n"
+    events, warned = _run(text)
+    assert warned == "" and _xs(events) == [1.0, 3.0, 4.0, 2.0, 3.0, 4.0, 5.0]
+
+
+@pytest.mark.parametrize(
+    ("text", "said"),
+    [
+        ("A: X1\nREPEAT A P=2 X5\n", "REPEAT with more in its block"),
+        ("A: X1\nX2\nENDLABEL: X3\nREPEAT A P=2\n", "a section with ENDLABEL"),
+        ("A: X1\nIF R1==0 GOTOF B\nB: X2\nREPEAT A P=2\n", "IF in a section a REPEAT runs"),
+        ("REPEAT NOWHERE P=2\n", "REPEAT NOWHERE: the label is not found"),
+        ("A: X1\nWHILE R1<1\nR1=R1+1\nREPEATB A\nENDWHILE\n", "REPEATB inside WHILE"),
+        ("A: X1\nREPEAT A P=0.5\n", "REPEAT with P=0.5"),
+    ],
+)
+def test_a_repetition_ncpp_does_not_follow_ends_interpretation(text, said):
+    events, warned = _run("R1=0\nG90 G1 F100\n" + text + "X9\nM30\n")
+    assert said in warned and 9.0 not in _xs(events)
+
+
+def test_a_repetition_of_more_blocks_than_ncpp_follows_is_refused_before_it_runs():
+    with pytest.raises(NcppError, match=r"flow.mpf:4:1: REPEAT P=1000000000: 2,000,000,000 blocks run again"):
+        _run("G90 G1 F100\nA: X1\nX2\nREPEAT A P=1000000000\nM30\n")

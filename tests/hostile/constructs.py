@@ -63,6 +63,9 @@ def _iso(rng: random.Random) -> tuple[str, list[str]]:
         lambda: f"G2 X{v()} Y{v()} R{v()} F100",
         lambda: f"G81 X{v()} Y{v()} Z{v()} R{v()} F100\nG80",
         lambda: f"G84 X{v()} Z{v()} R{v()} F100\nG80",
+        lambda: f"G18 G98 G83 X{v()} Z{v()} Y{v()} R{v()} Q{v()} F100\nX{v()}\nG80 G17",
+        lambda: f"G19 G91 G81 Y{v()} Z{v()} X{v()} R{v()} L{v()} F100\nG90 G80 G17",
+        lambda: f"G18 G87 X{v()} Z{v()} Y{v()} R{v()} I{v()} J{v()} K{v()} F100\nG80 G17",
     ]
     lines += [rng.choice(pool)() for _ in range(rng.randint(1, 8))]
     extra = rng.choice([[], ["--expand"], ["--expand-cycles"], ["--expand", "--expand-cycles"]])
@@ -196,6 +199,10 @@ def _sinumerik(rng: random.Random, folder: Path) -> tuple[str, list[str]]:
         lambda: f"G41 KONT\nG91 G1 X{n() or 0} Z{n() or 0} F100\nG2 X5 Z5 CR=5\nG40 G90",
         lambda: f"G0 X{n() or 0} Y{n() or 0} Z{n() or 0}",
         lambda: f"R1={n() or 0}",
+        lambda: f"RA: G1 X{n() or 0} Y{n() or 0}\nG1 Z{n() or 0}\nREPEAT {rng.choice(['RA', 'RB', 'RA RA'])} "
+        f"P={n()}",
+        lambda: f"RB: G1 X{n() or 0}\nREPEATB {rng.choice(['RB', 'RA', 'RB RA'])} P={n()}",
+        lambda: f"REPEAT RC RD P={n()}\nRC: G1 Y{n() or 0}\nRD: G1 X{n() or 0}",
     ]
     lines = ["G17 G90 G71 G94", "T1 D1", "M6", "G0 X10 Y20 Z50", "G1 F200 S500 M3"]
     lines += [rng.choice(pool)() for _ in range(rng.randint(1, 8))]

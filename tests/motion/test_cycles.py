@@ -53,16 +53,20 @@ AGREE = {
     + "S500 M3\nG99 G84 X1 Y1 Z-3 R2\nX2\nG98 G86 X3 Z-3 R2 P1\nG87 X4 Y4 Z-5 R2 I1 J0 K-3\nX6\nG80\nM4\nG74 X5 Y5 Z-2 R1\nG80\nM5\n",
     "incremental back bore, g18 boring": HEAD
     + "M3\nG91 G87 X1 Y1 Z-3 R2 I1 J1 K1 L2\nG90 G80\nG18 G86 X1 Z1 Y-3 R2 P1\nG17 G80\n",
+    # G87 in G18 and G19: I J K offset X Y Z, the normal's letter is the top of the bore
+    "back bore in g18 and g19": HEAD + "M3\nG18 G98 G87 X1 Z1 Y-3 R2 I0.5 J-1 K-0.7\nX2\nG80\n"
+    "G19 G99 G87 Y1 Z2 X-3 R2 I-1.5 J0.4 K0.6\nG91 G87 Y1 R-1 X-2 I1 L2\nG90 G80 G17\n",
     # the levels a series crosses at and retracts to (found by probing rs274)
     "g99 series changing r": "G21 G90\nG0 X0 Y0 Z7.077 F100\nG89 G99 X1 Y-1 R1.541 Z-2.5 P0.3\nG83 X-3 Y-1 R2.271 Z-1.2 Q1.2\nX-2 R1\nM2\n",
     "g98 after g99, higher r": "G21 G90\nG0 X0 Y0 Z10 F100\nG99 G81 X1 Z-3 R2\nG98 G82 X3 Z-3 R5 P1\nX4\nM2\n",
     "g98 series from below r": "G21 G90\nG0 X0 Y0 Z1 F100\nG98 G81 X1 Z-3 R2\nG82 X3 Z-3 R2 P1\nX4\nM2\n",
+    # a G98 series lowering its R plane retracts to where it started (above R) or to R (below)
+    "g98 series lowering r": HEAD + "G98 G81 X1 Y1 Z-3 R2\nG82 X2 Z-3 R1 P1\nG80\nG0 Z6\n"
+    "G98 G81 X3 R5 Z-3\nX4 R7\nX5 R5.5\nX6 R3.5\nG80\nG0 Z1\nG98 G81 X7 R5 Z-5\nX8 R4\nX9 R4.5\nG80\n",
 }
 
 OUT_OF_SCOPE = {
-    "g98 series lowering r": (HEAD + "G98 G81 X1 Y1 Z-3 R2\nG82 X2 Z-3 R1 P1\n", 4, "lowering its R plane"),
     "tapping in g18": (HEAD + "M3 G18\nG84 X1 Z1 Y-3 R2\n", 4, "G84 outside the XY plane"),
-    "back bore in g19": (HEAD + "M3 G19\nG87 Y1 Z1 X-3 R2 I1 J1 K-1\n", 4, "G87 outside the XY plane"),
     "manual retract": (HEAD + "M3\nG88 X1 Y1 Z-3 R2 P1\n", 4, "canned cycle G88"),
 }
 
@@ -127,9 +131,10 @@ def _random_program(rng: random.Random) -> str:
             lines.append(extra)
             continue
         code = rng.choice(
-            ["G73", "G81", "G82", "G83", "G85", "G86", "G89"] + (["G84", "G87"] if plane == 17 else [])
+            ["G73", "G81", "G82", "G83", "G85", "G86", "G87", "G89"] + (["G84"] if plane == 17 else [])
         )
         normal = {17: "Z", 18: "Y", 19: "X"}[plane]
+        top = "IJK"["XYZ".index(normal)]
         incremental, r = rng.random() < 0.3, rng.uniform(0, 4)
         words = [code, rng.choice(["", "G98", "G99"]), "G91" if incremental else "G90"]
         words += [a + f"{rng.uniform(-5, 5):.3f}" for a in "XYZ" if a != normal and rng.random() < 0.8]
@@ -141,7 +146,9 @@ def _random_program(rng: random.Random) -> str:
             "G82": ["P0.2"],
             "G86": ["P0.2"],
             "G89": ["P0.2"],
-            "G87": ["I0.6", "J-0.4", "K" + ("0.5" if incremental else "-1")],
+            # (the normal's letter is the top of the bore: `_back_bore_words`)
+            "G87": [f"{letter}{rng.uniform(-1, 1):.3f}" for letter in "IJK" if letter != top]
+            + [top + ("0.5" if incremental else "-1")],
         }.get(code, [])
         if rng.random() < 0.25:
             words.append(f"L{rng.randint(1, 3)}")
@@ -178,11 +185,12 @@ def test_random_cycle_programs_agree_with_rs274(tmp_path):
 
 @pytest.mark.parametrize("cycle, why, holes", [("G81 X1 Y1 Z-3 R2", HOLE, 1), ("G81 X1 Y1 Z-3 R2 L1", HOLE, 1),
                                                ("G81 X1 Y1 Z-3 R2 L2", HOLE, 2), ("G91 G81 X1 Y1 Z-3 R-2 L3", HOLE, 3),
-                                               ("G81 @1 ^45 Z-3 R2", HOLE, 1), ("G18 G81 X1 Z1 Y-3 R2", CYCLE, 0),
+                                               ("G81 @1 ^45 Z-3 R2", HOLE, 1), ("G18 G81 X1 Z1 Y-3 R2", HOLE, 1),
+                                               ("G19 G83 Y1 Z1 X-3 R2 Q1 L2", HOLE, 2),
                                                ("G87 X1 Y1 Z-3 R2 I1 J0 K-1", CYCLE, 0)])  # fmt: skip
 def test_cycle_moves_are_fixed(cycle, why, holes):
-    """A hole in G17 is compensated as a whole (HOLE), each of a block's repeats its own; the
-    other planes and G87 leave the cycle as programmed (CYCLE)."""
+    """A hole is compensated as a whole (HOLE) in any plane, each of a block's repeats its own;
+    G87 leaves the cycle as programmed (CYCLE)."""
     text = HEAD + "M3 S1000\n" + cycle + "\nG80\nG1 X5\n"
     events = list(interpret(parse_stream(io.BytesIO(text.encode()), "t.ngc")))
     lines = [e for e in events if type(e) is Line]
@@ -198,14 +206,14 @@ def _compensate(text: str, strict: bool = False) -> tuple[str, str]:
 
 DRILL = (
     HEAD
-    + "G1 Z-1\nX40 Y12\nG0 Z5\nG18 G98 G81 X20 Z20 Y-3 R2 L2\nX30\n(between)\nX40 Z25\nG80 G17\nG0 X50 Y50\nG1 Z-1\nX70 Y40\nG3 X80 Y60 R15\nG0 Z10\nM2\n"
+    + "G1 Z-1\nX40 Y12\nG0 Z5 M3\nG98 G87 X20 Y20 Z-3 R2 I1 J0 K-1 L2\nX30\n(between)\nX40 Y25\nG80\nG0 X50 Y50\nG1 Z-1\nX70 Y40\nG3 X80 Y60 R15\nG0 Z10\nM2\n"
 )
 
 
 def test_cycles_pass_through_and_compensation_resumes():
     out, warned = _compensate(DRILL)
     lines = out.splitlines()
-    cycle = ["G18 G98 G81 X20 Z20 Y-3 R2 L2", "X30", "(between)", "X40 Z25", "G80 G17"]
+    cycle = ["G98 G87 X20 Y20 Z-3 R2 I1 J0 K-1 L2", "X30", "(between)", "X40 Y25", "G80"]
     start = lines.index(cycle[0])
     assert lines[start : start + len(cycle)] == cycle  # verbatim
     # one warning, naming the line where the series starts
@@ -219,18 +227,18 @@ def test_a_warning_repeated_hundreds_of_times_is_printed_five_times_then_counted
     """A drilling program warns at each of its 300 cycle series: five are printed (the fifth
     says the rest are counted), then one line at the end tells how many and where."""
     holes = "".join(
-        f"G0 X{k % 20 * 5} Y{k // 20 * 5}\nG19 G81 Y{k // 20 * 5} Z-3 X-3 R2 F100 L2\nG80 G17\nG1 X{k % 20 * 5 + 2}\n"
+        f"G0 X{k % 20 * 5} Y{k // 20 * 5}\nG87 Y{k // 20 * 5} Z-3 R2 I1 J0 K-1 F100 L2\nG80\nG1 X{k % 20 * 5 + 2}\n"
         for k in range(300)
     )
-    out, warned = _compensate(HEAD + holes + "M2\n")
+    out, warned = _compensate(HEAD + "M3\n" + holes + "M2\n")
     said = warned.splitlines()
-    series = [n + 1 for n, line in enumerate((HEAD + holes).splitlines()) if line.startswith("G19 G81")]
+    series = [n + 1 for n, line in enumerate((HEAD + "M3\n" + holes).splitlines()) if line.startswith("G87")]
     assert [line.split(": warning: ")[0] for line in said] == [
         f"drill.ngc:{n}:1" for n in (*series[:5], series[-1])
     ]
     assert said[4].endswith("(warned 5 times: more of these are counted, not printed)")
     assert said[5].endswith(f"(295 not printed, from line {series[5]} to this one)")
-    assert out.count("G81") == 300
+    assert out.count("G87") == 300
 
 
 def test_warnings_of_other_texts_are_printed_whatever_one_text_repeats():
@@ -288,7 +296,7 @@ def test_compensation_goes_on_after_a_g91_cycle(after):
     """A G91 cycle runs its increments from where the control stands, its G98 retract to the
     level it started from: apply_error_map carries it (test_exact_model measures the moves
     after it on the machine), and compensates the moves after it, in G90 or G91."""
-    text = HEAD + "G1 Z-1\nX40 Y12\nG0 Z5\nG18 G91 G98 G81 X10 Z10 Y-3 R-3 L2\nG17\n" + after
+    text = HEAD + "G1 Z-1\nX40 Y12\nG0 Z5 M3\nG91 G98 G87 X10 Y10 Z-3 R-3 I1 J0 K1 L2\nG17\n" + after
     out, warned = _compensate(text)
     assert (
         "in G91" not in warned
@@ -301,7 +309,7 @@ def test_compensation_goes_on_after_a_g91_cycle(after):
         written[-1] != original[-1]
         and 0 < abs(float(last[1]) - float(original[-1].split("X")[1].split()[0])) < 0.1
     )
-    assert "G18 G91 G98 G81 X10 Z10 Y-3 R-3 L2" in written
+    assert "G91 G98 G87 X10 Y10 Z-3 R-3 I1 J0 K1 L2" in written
 
 
 @pytest.mark.skipif(not RS274.exists(), reason="no rs274")

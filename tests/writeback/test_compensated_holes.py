@@ -1,5 +1,5 @@
-"""Canned cycles in G90 and G17 are compensated hole by hole: the control's tool lands on each
-hole's programmed bottom (X Y Z) and R plane.  Judged by LinuxCNC's rs274 running ncpp's output,
+"""Canned cycles in G90 and G91, in G17, G18 and G19, are compensated hole by hole: the control's
+tool lands on each hole's programmed bottom (X Y Z) and R plane.  Judged by LinuxCNC's rs274 running ncpp's output,
 its moves mapped through a machine written here by hand (scale errors on X Y Z, squareness of
 X-Y and X-Z), not by ncpp's interpreter or model."""
 
@@ -15,7 +15,7 @@ import pytest
 
 from tests.compensation.accuracy import Machine, _moves, actual_moves, rs274_calls
 from tests.conftest import RS274
-from tests.writeback.conftest import compensate_file, machine_file
+from tests.writeback.conftest import compensate_file, linear_errors, machine_file
 
 MACHINE = machine_file(
     "scales and squareness",
@@ -132,45 +132,146 @@ M2
 """
 
 
-def drilled(path: Path, machine: Machine | None) -> list[tuple[np.ndarray, float]]:
+# Cycles in G18 and G19, as rs274ngc runs them: the G17 programs' moves with their axes renamed
+# (rs274ngc's convert_cycle_zx and convert_cycle_yz: the first and second axis of the plane, and
+# the drilling axis along its normal, take the places of X Y and Z): no polar words, no taps there
+# (`G17 X Y Z` -> the plane's letters in that order)
+PLANE_LETTERS = {18: "ZXY", 19: "YZX"}
+# (first, second, normal) axis indices of each plane
+PLANE_INDICES = {17: (0, 1, 2), 18: (2, 0, 1), 19: (1, 2, 0)}
+AXES = "XYZ"
+HOLES_IN_PLANE = [
+    (100, 120, -16, 3), (30, 40, -16, 3), (150, -50, -20, 5), (-80, 60, -20, 5),
+    (200, 10, -5, 2), (210, 10, -7.5, 2.5), (220, 100, -9, 1), (230, 110, -3, 1), (240, 120, -3, 1),
+    (-200, 300, -6, 2), (-190, 300, -3, 1), (-190, -250, -3, 1),
+]  # fmt: skip
+PROGRAM_IN_PLANE = """G21 G90 G17
+G0 X40 Y30 Z25
+G1 X45 Y35 F300
+G0 Z25
+G99 G81 X100 Y120 R3 Z-16 F100
+X30 Y40
+G98 G83 X150 Y-50 R5 Z-20 Q4
+X-80 Y60
+G80
+G0 X0 Y0
+G99 G82 X200 Y10 R2 Z-5 P0.5
+G85 X210 R2.5 Z-7.5
+G73 X220 Y100 Z-9 R1 Q2.5
+M3 S500
+G86 X230 Y110 Z-3 R1 P1
+G89 X240 Y120 Z-3 R1 P1
+G80
+G1 X-190 Y290 Z4 F400
+G98 G81 X-200 Y300 R2 Z-6
+G99 X-190 Z-3 R1
+Y-250
+G80
+M5
+M2
+"""
+
+
+def in_plane(program: str, holes: list[tuple[float, ...]], plane: int) -> tuple[str, list[tuple[float, ...]]]:
+    """A G17 program and its holes (X Y Z R) moved to `plane`: its axis letters renamed, each hole's
+    bottom put on the plane's axes."""
+    text = program.replace("G17", f"G{plane}").translate(str.maketrans("XYZ", PLANE_LETTERS[plane]))
+    moved = []
+    for aa, bb, cc, r in holes:
+        point = [0.0, 0.0, 0.0]
+        for axis, value in zip(PLANE_INDICES[plane], (aa, bb, cc)):
+            point[axis] = value
+        moved.append((*point, r))
+    return text, moved
+
+
+def reversing_in(plane: int) -> tuple[str, Machine]:
+    """REVERSAL and `reversing` seen from `plane`: the roles of X, Y and Z taken by the plane's first
+    and second axis and its normal (the drilling axis plays, the first axis runs ahead, the normal
+    carries an error from the first's travel, the first one from the second's), so that each plane's
+    holes meet the same machine as G17's."""
+    first, second, normal = (AXES[k] for k in PLANE_INDICES[plane])
+    toml = machine_file(f"reversals of {first} and {normal}", f"""
+[errors.E{first}{first}]
+kind = "table"
+positions = [-1000.0, 1000.0]
+values_um = [-10.0, 10.0]
+values_um_minus = [-13.0, 7.0]
+[errors.E{normal}{normal}]
+kind = "table"
+positions = [-1000.0, 1000.0]
+values_um = [-20.0, 20.0]
+values_um_minus = [-18.0, 22.0]
+""" + linear_errors(**{f"E{normal}{first}": 0.02, f"E{first}{second}": -0.03}))  # fmt: skip
+    order = list(PLANE_INDICES[plane])
+
+    def machine(points: np.ndarray, directions: np.ndarray) -> np.ndarray:
+        out = np.empty_like(points)
+        out[:, order] = reversing(points[:, order], directions[order])
+        return out
+
+    return toml, machine
+
+
+def drilled(path: Path, machine: Machine | None, plane: int = 17) -> list[tuple[np.ndarray, float]]:
     """Per hole of `path` as rs274 runs it (mapped through `machine`, or as commanded: None): where
-    the tool is at its bottom, and its Z where it arrives above the hole at R.  A hole: a run
-    of moves ending at one commanded X Y with a feed down Z; its R point the end of the move
-    before its first feed, its bottom the lowest feed end."""
+    the tool is at its bottom, and its level along the plane's normal (Z in G17) where it arrives
+    above the hole at R.  A hole: a run of moves ending at one commanded position in the plane with
+    a feed down the normal; its R point the end of the move before its first feed, its bottom the
+    lowest feed end."""
+    first, second, normal = PLANE_INDICES[plane]
+    across = [first, second]
     commanded = _moves(path)
     actual = [b for _, b, _ in commanded] if machine is None else [m[-1] for m in actual_moves(path, machine)]
     runs: list[list[int]] = []
-    for k, (_, end, _) in enumerate(commanded):  # (moves written one by one: µm apart in X Y)
-        if runs and np.allclose(commanded[runs[-1][0]][1][:2], end[:2], atol=0.01):
+    for k, (_, end, _) in enumerate(commanded):  # (moves written one by one: µm apart in the plane)
+        if runs and np.allclose(commanded[runs[-1][0]][1][across], end[across], atol=0.01):
             runs[-1].append(k)
         else:
             runs.append([k])
     out = []
     for run in runs:
-        plunges = [k for k in run if commanded[k][2] and _plunges(*commanded[k][:2])]
+        plunges = [k for k in run if commanded[k][2] and _plunges(*commanded[k][:2], across, normal)]
         if plunges:
-            lowest = min(plunges, key=lambda k: commanded[k][1][2])
-            out.append((actual[lowest], float(actual[plunges[0] - 1][2])))
+            lowest = min(plunges, key=lambda k: commanded[k][1][normal])
+            out.append((actual[lowest], float(actual[plunges[0] - 1][normal])))
     return out
 
 
-def _plunges(start: np.ndarray, end: np.ndarray) -> bool:
-    return bool(np.allclose(start[:2], end[:2], atol=0.01) and end[2] < start[2] - 0.01)
+def _plunges(start: np.ndarray, end: np.ndarray, across: list[int], normal: int) -> bool:
+    return bool(np.allclose(start[across], end[across], atol=0.01) and end[normal] < start[normal] - 0.01)
 
 
-@pytest.mark.parametrize("machine_toml, machine", [(MACHINE, square), (REVERSAL, reversing)],
+PROGRAMS = [
+    (PROGRAM, HOLES, 17),
+    (PROGRAM_G91, HOLES_G91, 17),
+    *(
+        (*in_plane(program, holes, plane), plane)
+        for plane in (18, 19)
+        for program, holes in ((PROGRAM_IN_PLANE, HOLES_IN_PLANE), (PROGRAM_G91, HOLES_G91))
+    ),
+]
+
+
+@pytest.mark.parametrize("machine_toml, machine", [(MACHINE, square), ("reversals", None)],
                          ids=["scales and squareness", "reversals"])  # fmt: skip
 @pytest.mark.parametrize(
-    "program, holes", [(PROGRAM, HOLES), (PROGRAM_G91, HOLES_G91)], ids=["G90", "G91 repeats"]
+    "program, holes, plane",
+    PROGRAMS,
+    ids=["G90", "G91 repeats", "G18 G90", "G18 G91 repeats", "G19 G90", "G19 G91 repeats"],
 )
-def test_each_hole_bottom_and_r_plane_land_where_programmed(tmp_path, machine_toml, machine, program, holes):
+def test_each_hole_bottom_and_r_plane_land_where_programmed(
+    tmp_path, machine_toml, machine, program, holes, plane
+):
+    if machine is None:  # (the reversals as G17 meets them: `reversing_in`)
+        machine_toml, machine = (REVERSAL, reversing) if plane == 17 else reversing_in(plane)
     original = tmp_path / "holes.ngc"
     original.write_text(program)
     output = compensate_file(original, machine_toml, tmp_path)
     wanted = np.array(holes, dtype=float)
-    assert np.allclose([tuple(b) + (r,) for b, r in drilled(original, None)], wanted, atol=1e-6)
-    before = drilled(original, machine)
-    after = drilled(output, machine)
+    assert np.allclose([tuple(b) + (r,) for b, r in drilled(original, None, plane)], wanted, atol=1e-6)
+    before = drilled(original, machine, plane)
+    after = drilled(output, machine, plane)
     assert len(after) == len(holes)
     off_before = np.array([np.linalg.norm(b - h[:3]) for (b, _), h in zip(before, wanted)]) * 1000
     off_after = np.array([np.linalg.norm(b - h[:3]) for (b, _), h in zip(after, wanted)]) * 1000

@@ -1,5 +1,6 @@
-"""`--expand` on Sinumerik: loops (FOR, WHILE, REPEAT), jumps back (IF ... GOTOB) and subprogram
-calls (`L100`, `L100 P2`, a PROC by name) written out as straight code, each run's moves compensated.
+"""`--expand` on Sinumerik: loops (FOR, WHILE, REPEAT), jumps back (IF ... GOTOB), program section
+repetitions (REPEAT label, REPEATB) and subprogram calls (`L100`, `L100 P2`, a PROC by name) written
+out as straight code, each run's moves compensated.
 
 The judges: closed form, as for Klartext (`test_klartext_expand`): the test computes where each
 run of a body puts the tool (a FOR loop of 3 squares at Z-1, Z-2, Z-3), reads the numbers of the
@@ -28,6 +29,7 @@ from ncpp.pipeline import dialect_tools
 from ncpp.program.dialects import parse_program
 from tests.compensation.test_dialect_cutter_comp import compensated, machine
 from tests.conftest import CORPUS, SHARED
+from tests.dialect_motion.test_sinumerik_flow import SECTION_ENDS, SECTIONS
 from tests.writeback.conftest import misses
 
 # 3 squares 40 x 40, each 1 mm deeper, by a FOR loop; the line after it reads the loop's variable
@@ -145,8 +147,9 @@ def _with_subprograms(tmp_path: Path) -> tuple[str, ...]:
 
 
 CASES = [(FOR_SQUARES, "for.mpf", squares()), (WHILE_REPEAT, "while.mpf", WHILE_REPEATED),
-         (JUMPS, "jumps.mpf", JUMPED), (CALLS, "calls.mpf", CALLED_AT)]  # fmt: skip
-IDS = ["for", "while-repeat", "gotob", "calls"]
+         (JUMPS, "jumps.mpf", JUMPED), (CALLS, "calls.mpf", CALLED_AT),
+         (SECTIONS, "sections.mpf", SECTION_ENDS[1:])]  # fmt: skip
+IDS = ["for", "while-repeat", "gotob", "calls", "section repetition"]
 
 
 @pytest.mark.parametrize("text, name, wanted", CASES, ids=IDS)

@@ -21,6 +21,7 @@ from ncpp.motion.segments import (
     CYCLE,
     DRILLED,
     EXTRA_AXES,
+    PLANE_AXES,
     TAP_IN,
     TAP_OUT,
     Arc,
@@ -493,17 +494,21 @@ class IsoWriter:
         return lines
 
     def _hole_words(self, move: Line) -> dict[str, str]:
-        """The X Y Z R a hole is written with (letter -> number text): its corrected command, in
-        G91 as rs274ngc reads a cycle there: X Y from where the control stands, R from the Z the
+        """The words a hole is written with (letter -> number text): its position in the plane,
+        its bottom along the normal (G17: X Y Z) and R, its corrected command; in G91 as rs274ngc
+        reads a cycle there: the plane's axes from where the control stands, R from the level the
         series started at, the bottom from R."""
-        assert move.hole is not None and move.hole.command is not None  # (apply_error_map's)
-        x, y, z, r = move.hole.command
+        hole = move.hole
+        assert hole is not None and hole.command is not None  # (apply_error_map's)
+        first, second, normal = PLANE_AXES[hole.plane]
+        aa, bb, bottom, r = hole.command
         if not move.context.absolute:
-            sx, sy, _ = move.start
-            x, y, z, r = x - sx, y - sy, z - r, r - move.hole.series_level
+            aa, bb = aa - move.start[first], bb - move.start[second]
+            bottom, r = bottom - r, r - hole.series_level
+        letters = (AXES[first], AXES[second], AXES[normal], "R")
         return {
             letter: format_number(value, self._style(letter, move))
-            for letter, value in zip("XYZR", (x, y, z, r))
+            for letter, value in zip(letters, (aa, bb, bottom, r))
         }
 
     # -- o-word control lines ---------------------------------------------------
