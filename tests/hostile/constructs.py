@@ -199,8 +199,10 @@ def _sinumerik(rng: random.Random, folder: Path) -> tuple[str, list[str]]:
         lambda: f"G41 KONT\nG91 G1 X{n() or 0} Z{n() or 0} F100\nG2 X5 Z5 CR=5\nG40 G90",
         lambda: f"G0 X{n() or 0} Y{n() or 0} Z{n() or 0}",
         lambda: f"R1={n() or 0}",
-        lambda: f"RA: G1 X{n() or 0} Y{n() or 0}\nG1 Z{n() or 0}\nREPEAT {rng.choice(['RA', 'RB', 'RA RA'])} "
-        f"P={n()}",
+        lambda: (
+            f"RA: G1 X{n() or 0} Y{n() or 0}\nG1 Z{n() or 0}\nREPEAT {rng.choice(['RA', 'RB', 'RA RA'])} "
+            f"P={n()}"
+        ),
         lambda: f"RB: G1 X{n() or 0}\nREPEATB {rng.choice(['RB', 'RA', 'RB RA'])} P={n()}",
         lambda: f"REPEAT RC RD P={n()}\nRC: G1 Y{n() or 0}\nRD: G1 X{n() or 0}",
     ]

@@ -12,7 +12,9 @@ import pytest
 from tests.conftest import ROOT
 
 MACHINE = ROOT / "samples/machines/hr5b.toml"
-PROGRAM = "G21 G90 G54\nG0 X10 Y10 Z5 M3\nG1 X40 F300\nG98 G87 X50 Y50 Z-3 R2 I1 J0 K-1 F100 L2\nG80\nG0 Z5\nM2\n"
+PROGRAM = (
+    "G21 G90 G54\nG0 X10 Y10 Z5 M3\nG1 X40 F300\nG98 G87 X50 Y50 Z-3 R2 I1 J0 K-1 F100 L2\nG80\nG0 Z5\nM2\n"
+)
 
 
 @pytest.fixture
