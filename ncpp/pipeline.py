@@ -387,10 +387,15 @@ def process(
         expanding = {"expand": expand}
     if verify:  # the verifier's own reading of the input: the blocks are held between the two
         # readings, not the events (a loop's runs read its few blocks again and again)
-        blocks, again = _twice(blocks)
-        from ncpp.verify import unsaid
+        from ncpp.verify import same_motion, unsaid
 
+        written_out = any(expanding.values())
+        blocks, again, *plain = _copies(blocks, 3 if written_out else 2)
         original = interpret(again, file=file, warnings=unsaid(), offsets=offsets, **expanding)
+        if written_out:  # (and that reading against one without --expand: the program's own run)
+            original = same_motion(
+                original, interpret(plain[0], file=file, warnings=unsaid(), offsets=offsets), file
+            )
     events: Iterable[Event] = interpret(
         blocks, file=file, warnings=warnings, strict=strict, offsets=offsets, **expanding
     )
@@ -449,9 +454,9 @@ def _tool_guard(dialect: str, offsets: WorkOffsets, warnings: Warnings, file: st
     return guard if guard.why is None else None
 
 
-def _twice(blocks: Iterable[Block]) -> tuple[Iterator[Block], Iterator[Block]]:
-    """Two readings of the blocks, each raising the parser's fault where it meets it (`tee` hands
-    an error to the reading that meets it first, and the other finds the program ended there)."""
+def _copies(blocks: Iterable[Block], n: int) -> tuple[Iterator[Block], ...]:
+    """`n` readings of the blocks, each raising the parser's fault where it meets it (`tee` hands
+    an error to the reading that meets it first, and the others find the program ended there)."""
 
     def carried() -> Iterator[Block | NcppError]:
         try:
@@ -465,8 +470,7 @@ def _twice(blocks: Iterable[Block]) -> tuple[Iterator[Block], Iterator[Block]]:
                 raise item
             yield item
 
-    one, two = tee(carried())
-    return raised(one), raised(two)
+    return tuple(raised(copy) for copy in tee(carried(), n))
 
 
 def _copied(

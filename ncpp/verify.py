@@ -407,6 +407,57 @@ def _interpreted(
     return interpret(blocks, file=file, warnings=unsaid(), offsets=offsets or AT_MACHINE_ZERO)
 
 
+# mm: how far a move written out by --expand may lie from the same move of the program as it runs
+# (the two readings compute the same numbers; this is their rounding)
+EXPANDED_SLACK = 1e-6
+
+
+def same_motion(expanded: Iterable[Event], plain: Iterable[Event], file: str) -> Iterator[Event]:
+    """`expanded` (a reading of the input with --expand) as it comes, each move checked against the
+    next of `plain` (a reading without it): kind, rapid or feed, start and end in machine mm.  The
+    verifier compares the written program with the expanded reading; this ties that reading to
+    the program's own run, so a stretch written out of its place or with other numbers is refused.
+    Where either reading leaves the interpreter's scope the check ends (the rest is not compared)."""
+    theirs = _moves_of(plain)
+    done = False
+    for event in expanded:
+        kind = type(event)
+        if not done and (kind is Line or kind is Arc):
+            other = next(theirs, None)
+            if other is None:
+                done = True
+            elif not _alike_moves(event, other):  # type: ignore[arg-type]
+                raise _Misplaced(
+                    "verification: --expand wrote a move the program does not make here (its run "
+                    f"makes the move of line {other.block.line}); leave --expand out",
+                    Location(file, event.block.line, 1),
+                )
+        yield event
+
+
+class _Misplaced(NcppError):
+    """A move --expand wrote where the program does not make it: the first fault, wherever the
+    comparison that follows it stops."""
+
+
+def _moves_of(events: Iterable[Event]) -> Iterator[Line | Arc]:
+    """The moves of a reading, ending quietly where it meets a fault (the other reading reports it)."""
+    try:
+        for event in events:
+            if type(event) is Line or type(event) is Arc:
+                yield event  # type: ignore[misc]
+    except NcppError:
+        return
+
+
+def _alike_moves(a: Line | Arc, b: Line | Arc) -> bool:
+    if type(a) is not type(b) or (type(a) is Line and a.rapid != b.rapid):  # type: ignore[union-attr]
+        return False
+    ends = (a.context.to_machine(a.start), a.context.to_machine(a.end))
+    others = (b.context.to_machine(b.start), b.context.to_machine(b.end))
+    return all(math.dist(p, q) <= EXPANDED_SLACK for p, q in zip(ends, others))
+
+
 def unsaid() -> Warnings:
     """Warnings that go unsaid: a second reading of a program warns of nothing the first did not."""
     return Warnings(stream=_Discard())
@@ -505,9 +556,12 @@ class _Held:
             self.error = err
 
     def first(self, err: NcppError) -> NcppError:
-        """`err`, or the interpreter's fault where that comes first in the program."""
+        """`err`, or the interpreter's fault where that comes first in the program (or is a move
+        --expand misplaced)."""
         if self.error is not None and (
-            err.where.line is None or (self.error.where.line or 0) <= err.where.line
+            isinstance(self.error, _Misplaced)
+            or err.where.line is None
+            or (self.error.where.line or 0) <= err.where.line
         ):
             return self.error
         return err
