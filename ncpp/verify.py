@@ -445,7 +445,7 @@ def _moves_of(events: Iterable[Event]) -> Iterator[Line | Arc]:
     try:
         for event in events:
             if type(event) is Line or type(event) is Arc:
-                yield event  # type: ignore[misc]
+                yield event
     except NcppError:
         return
 
