@@ -416,7 +416,9 @@ class HeidenhainInterpreter(ModalInterpreter):
                 self._jump(block, item)
             else:
                 reason = {"call_label": "CALL LBL", "cycle_call": "CYCL CALL",
-                          "fn": f"FN {node[0]}", "keyword": " ".join(map(str, node))}.get(what, what)  # fmt: skip
+                          "fn": f"FN {node[0]}", "keyword": " ".join(map(str, node)),
+                          "touch_probe": f"TCH PROBE {node[0]} (a touch probe cycle: it probes, and may set"
+                                         " the datum or the tool's data)"}.get(what, what)  # fmt: skip
                 raise OutOfScope(reason, item.start + 1)
         if defined is not None:
             self._define_cycle(defined, block)

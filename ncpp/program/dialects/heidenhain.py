@@ -33,6 +33,8 @@ Statement kinds and nodes (Heidenhain):
   cycle_def      (number, words)         `CYCL DEF 200 BOHREN` -> ('200', ('BOHREN',)); its Q200=...
                                          parameters (continuation lines) follow as assignments
   cycle_call     (variant,)              `CYCL CALL` None, `CYCL CALL POS` 'POS', `CYCL CALL PAT` 'PAT'
+  touch_probe    (number, words)         `TCH PROBE 412 DATUM INSIDE CIRCLE` -> ('412', ('DATUM', 'INSIDE', 'CIRCLE'));
+                                         its Q parameters follow as assignments, as a cycle_def's
   pattern_def    (shapes...)             `PATTERN DEF` with `POS1 (X+25 Y+33.5 Z+0)` on a continuation line ->
                                          (('POS', 1, (('X', ("num", 25.0)), ('Y', ...), ('Z', ...))),)
   fn             (number, text)          `FN 9: IF +Q1 EQU +0 GOTO LBL "x"` -> (9, 'IF +Q1 ...'), passed through
@@ -184,6 +186,7 @@ class HeidenhainBuilder(Transformer):
     call_program = _statement("call_program", lambda c: (str(c[1]).strip('"'),))
     cycle_def = _statement("cycle_def", _cycle_def)
     cycle_call = _statement("cycle_call", _cycle_call)
+    touch_probe = _statement("touch_probe", _cycle_def)
     pattern_def = _statement("pattern_def", _pattern_def)
     fn = _statement("fn", _fn)
     keyword = _statement("keyword", lambda c: tuple(str(t).upper() for t in c))
