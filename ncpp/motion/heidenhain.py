@@ -52,6 +52,7 @@ from ncpp.motion.corners import CornerError, round_corner
 from ncpp.motion.cutter import centre_offset
 from ncpp.motion.expand import refused
 from ncpp.motion.heidenhain_cycles import (
+    RETRACT_FEED,
     DEFINITION_ACTIVE,
     REQUIRED,
     SHAPES,
@@ -375,7 +376,9 @@ class HeidenhainInterpreter(ModalInterpreter):
             elif what == "retract":
                 retract = node[0]
             elif what == "assignment":
-                if node[1][0] != "str":
+                if node[1][0] == "feed":
+                    self._feed_parameter(node, item)
+                elif node[1][0] != "str":
                     self.q[node[0][1]] = self.value(node[1], block, item)
             elif what == "cycle_def":
                 number = cycle_number(node[0])
@@ -471,6 +474,15 @@ class HeidenhainInterpreter(ModalInterpreter):
             return
         needed = parameters_needed(number)
         self.cycle = Drilling(number, {name: self.q[name] for name in needed if name in self.q}, block.line)
+
+    def _feed_parameter(self, node: tuple, item: Statement) -> None:
+        """`Q208= MAX`: the cycle retracts at rapid (TNC 640 Cycle Programming manual, cycles 200-205:
+        "Q208 Feed rate for retraction ... alternatively FMAX"); any other parameter so given is a
+        feed ncpp does not follow (AUTO: the tool table's)."""
+        name, (_, word) = node[0][1], node[1]
+        if name != RETRACT_FEED or word != "MAX":
+            raise OutOfScope(f"{name.upper()}={word} (a feed ncpp does not follow)", item.start + 1)
+        self.q[name] = math.inf
 
     def _forget_assigned(self, block: Block) -> None:
         """The Q parameters a CYCL DEF ncpp does not read sets are unknown from here on."""

@@ -140,6 +140,34 @@ def test_universal_drilling_203_decreases_its_plunge_and_breaks_chips():
     assert first == drilled(25, -7.5, levels)
 
 
+def test_a_retraction_feed_of_max_retracts_at_rapid():
+    """`Q208= MAX ;RETRACTION FEED RATE`, as Fusion's Heidenhain post writes cycle 203 (polymech-info/
+    heidenhain-simulator, `samples/a_phv3/motorflange/m7s.h`; refused as unreadable before).  TNC 640
+    Cycle Programming manual, cycle 203: "Q208 Feed rate for retraction ... alternatively FMAX": the
+    same moves as the test above, each one out at Q208 a rapid."""
+    universal = """CYCL DEF 203 UNIVERSAL DRILLING ~
+    Q200=+2 ;SET-UP CLEARANCE ~
+    Q201=-20 ;DEPTH ~
+    Q206=+150 ;FEED RATE FOR PLNGNG ~
+    Q202=+8 ;PLUNGING DEPTH ~
+    Q210=+0 ;DWELL TIME AT TOP ~
+    Q203=+0 ;SURFACE COORDINATE ~
+    Q204=+50 ;2ND SET-UP CLEARANCE ~
+    Q212=+2 ;DECREMENT ~
+    Q213=+1 ;BREAKS ~
+    Q205=+3 ;MIN. PLUNGING DEPTH ~
+    Q211=+0 ;DWELL TIME AT DEPTH ~
+    Q208= MAX ;RETRACTION FEED RATE ~
+    Q256=+0.5 ;DIST FOR CHIP BRKNG"""
+    (first, *_) = runs(moves(program(universal, ["L FMAX M99"])))
+    levels = [(2, None), (-8, 150), (-7.5, None), (-14, 150), (2, None), (-12, None),
+              (-18, 150), (-17.5, None), (-20, 150), (2, None), (50, None)]  # fmt: skip
+    assert first == drilled(25, -7.5, levels)
+    said = io.StringIO()
+    assert runs(moves(program(universal.replace("Q208= MAX", "Q208=AUTO"), ["L FMAX M99"]), said)) == []
+    assert "Q208=AUTO (a feed ncpp does not follow)" in said.getvalue()
+
+
 def test_centering_240_goes_to_its_depth_and_back_at_fmax():
     centering = """CYCL DEF 240 CENTERING ~
     Q200=+2 ;SET-UP CLEARANCE ~

@@ -38,7 +38,8 @@ Statement kinds and nodes (Heidenhain):
   pattern_def    (shapes...)             `PATTERN DEF` with `POS1 (X+25 Y+33.5 Z+0)` on a continuation line ->
                                          (('POS', 1, (('X', ("num", 25.0)), ('Y', ...), ('Z', ...))),)
   fn             (number, text)          `FN 9: IF +Q1 EQU +0 GOTO LBL "x"` -> (9, 'IF +Q1 ...'), passed through
-  assignment     (("param", "q1950"), expr)  `Q1950 = Q1804 - Q1805`; a string ("str", text) for QS
+  assignment     (("param", "q1950"), expr)  `Q1950 = Q1804 - Q1805`; a string ("str", text) for QS;
+                                         a cycle's feed `Q208= MAX` -> ("feed", "MAX") ('AUTO' for `=AUTO`)
   keyword        (words...)              anything else led by keywords (`STOP`, `PLANE ...`), passed through
 Expressions: ("num", v) ("param", "q12"|"ql1"|"qr1"|"qs1") ("neg", x) ("bin", op, a, b) with op in
 + - * / ** (`^`), ("call", NAME, x) for SIN COS TAN ASIN ACOS ATAN SQRT SQ LN LOG ABS INT FRAC NEG SGN.
@@ -224,7 +225,9 @@ class HeidenhainBuilder(Transformer):
     @v_args(meta=True)
     def assignment(self, meta, children):
         target, value = children
-        if isinstance(value, Token):  # a string for a QS parameter
+        if isinstance(value, Token) and value.type == "FEED_VALUE":  # `Q208= MAX`: rapid, `=AUTO` the tool's feed
+            value = ("feed", str(value).upper().lstrip("F"))
+        elif isinstance(value, Token):  # a string for a QS parameter
             value = ("str", str(value)[1:-1])
         return Statement("assignment", (("param", str(target).lower()), value), meta.start_pos, meta.end_pos)
 
