@@ -297,3 +297,14 @@ def test_a_touch_probe_cycle_ends_interpretation_with_a_warning(tmp_path):
     assert written[-len(tail):] == tail  # from the cycle on, as it was
     moved = next(line for line in written if line.startswith("L  X+10"))
     assert abs(float(moved.split()[1][1:]) - 10.00025) <= 0.00005  # (X gains 5e-5 * Y on the square machine)
+
+
+def test_a_warning_in_a_continued_block_names_the_line_its_word_is_on():
+    """A cycle definition spans `~`-continued lines (its Q parameters one a line, as the TNC writes it):
+    a warning at one of them names that line and its column, not the CYCL DEF's line with a column
+    counted through the block's other lines."""
+    said = io.StringIO()
+    text = program(CYCLE_200.replace("Q206=+30  ", "Q206=AUTO "), ["L FMAX M99"])
+    moves(text, said)
+    line = next(n for n, row in enumerate(text.splitlines(), 1) if "Q206=AUTO" in row)
+    assert said.getvalue().startswith(f"drill.h:{line}:5: warning: Q206=AUTO (a feed ncpp does not follow)")
