@@ -52,9 +52,9 @@ from ncpp.motion.corners import CornerError, round_corner
 from ncpp.motion.cutter import centre_offset
 from ncpp.motion.expand import refused
 from ncpp.motion.heidenhain_cycles import (
-    RETRACT_FEED,
     DEFINITION_ACTIVE,
     REQUIRED,
+    RETRACT_FEED,
     SHAPES,
     Drilling,
     Hole,

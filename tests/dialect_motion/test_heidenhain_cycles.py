@@ -294,7 +294,7 @@ def test_a_touch_probe_cycle_ends_interpretation_with_a_warning(tmp_path):
     assert "probe.h:5:4: warning: TCH PROBE 412 (a touch probe cycle" in proc.stderr
     written = [re.sub(r"^\d+ +", "", line) for line in out.read_text().splitlines()]  # (ncpp renumbers)
     tail = [re.sub(r"^\d+ +", "", line) for line in source.splitlines()[4:]]
-    assert written[-len(tail):] == tail  # from the cycle on, as it was
+    assert written[-len(tail) :] == tail  # from the cycle on, as it was
     moved = next(line for line in written if line.startswith("L  X+10"))
     assert abs(float(moved.split()[1][1:]) - 10.00025) <= 0.00005  # (X gains 5e-5 * Y on the square machine)
 

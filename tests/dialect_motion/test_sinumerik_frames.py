@@ -65,10 +65,11 @@ def test_what_cam_posts_write_that_moves_no_axis_is_read_past(block):
 
 @pytest.mark.parametrize("word", ["FNORM", "FLIN", "FCUB"])
 def test_a_feedrate_profile_is_read_past(word):
-    """`N60 G17 G710 G94 G90 FNORM` heads a CAM program for an 840D sl (121philip/SINUMERIK-840D-sl-CAS-Package,
-    `Approach A/CAM TEST.MPF`).  FNORM, FLIN and FCUB shape the feedrate along a block, not its path
-    (840D sl Programming Manual, Fundamentals, "Feedrate characteristic (FNORM, FLIN, FCUB)"): the moves are
-    those of the program without the word, and nothing is warned (before, the word ended interpretation)."""
+    """`N60 G17 G710 G94 G90 FNORM` heads a CAM program for an 840D sl
+    (121philip/SINUMERIK-840D-sl-CAS-Package, `Approach A/CAM TEST.MPF`).  FNORM, FLIN and FCUB shape
+    the feedrate along a block, not its path (840D sl Programming Manual, Fundamentals, "Feedrate
+    characteristic (FNORM, FLIN, FCUB)"): the moves are those of the program without the word, and
+    nothing is warned (before, the word ended interpretation)."""
     said = io.StringIO()
     body = "G0 X10 Y20 Z5\nG1 Z-1 F200\nX40 Y25\nM30\n"
     with_word = lines(f"G54 G17 G710 G94 G90 {word}\n{body}", Warnings(stream=said))

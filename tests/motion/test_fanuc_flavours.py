@@ -153,7 +153,9 @@ M30
 
 def rs274_twin(text: str) -> str:
     """The same program as LinuxCNC must be told it: the return, then the modal G0 on a line of its own."""
-    return text.replace("G0 G28 G91 Z0.\n", "G28 G91 Z0.\nG0\n").replace("G00 G91 G28 Z0.\n", "G91 G28 Z0.\nG0\n")
+    return text.replace("G0 G28 G91 Z0.\n", "G28 G91 Z0.\nG0\n").replace(
+        "G00 G91 G28 Z0.\n", "G91 G28 Z0.\nG0\n"
+    )
 
 
 def test_g0_in_a_return_block_is_the_modal_motion_after_it(tmp_path):
@@ -165,8 +167,8 @@ def test_g0_in_a_return_block_is_the_modal_motion_after_it(tmp_path):
     program = tmp_path / "p.nc"
     program.write_text(RETURN_WITH_G0)
     out = tmp_path / "out.nc"
-    proc = subprocess.run([sys.executable, "-m", "ncpp", "compensate", "--machine", str(READING), "--dialect", "fanuc",
-                           str(program), "-o", str(out)], capture_output=True, text=True, cwd=ROOT)  # fmt: skip
+    command = ["compensate", "--machine", str(READING), "--dialect", "fanuc", str(program), "-o", str(out)]
+    proc = subprocess.run([sys.executable, "-m", "ncpp", *command], capture_output=True, text=True, cwd=ROOT)
     assert proc.returncode == 0, proc.stderr
     written = out.read_text()
     assert "\nG0 G28 G91 Z0.\n" in written and "\nG00 G91 G28 Z0.\n" in written

@@ -94,7 +94,9 @@ def test_a_comment_inside_an_expression_is_named_so():
         process(io.BytesIO(b"G21\n#<d> = [80/SQRT(2)/2/25.4]\nG0 X#<d>\nM2\n"), io.BytesIO(), file="p.ngc",
                 source=reading())  # fmt: skip
     with pytest.raises(NcppError, match=r"unclosed comment: '\(2/2/25\.4\]'"):
-        process(io.BytesIO(b"G21\n#<d> = [80/SQRT(2/2/25.4]\nM2\n"), io.BytesIO(), file="p.ngc", source=reading())
+        process(
+            io.BytesIO(b"G21\n#<d> = [80/SQRT(2/2/25.4]\nM2\n"), io.BytesIO(), file="p.ngc", source=reading()
+        )
 
 
 def test_fast_path_agrees_with_lalr_parser_on_corpus(corpus):

@@ -33,7 +33,7 @@ Statement kinds and nodes (Heidenhain):
   cycle_def      (number, words)         `CYCL DEF 200 BOHREN` -> ('200', ('BOHREN',)); its Q200=...
                                          parameters (continuation lines) follow as assignments
   cycle_call     (variant,)              `CYCL CALL` None, `CYCL CALL POS` 'POS', `CYCL CALL PAT` 'PAT'
-  touch_probe    (number, words)         `TCH PROBE 412 DATUM INSIDE CIRCLE` -> ('412', ('DATUM', 'INSIDE', 'CIRCLE'));
+  touch_probe    (number, words)         `TCH PROBE 412 DATUM INSIDE CIRCLE` -> ('412', ('DATUM', ...));
                                          its Q parameters follow as assignments, as a cycle_def's
   pattern_def    (shapes...)             `PATTERN DEF` with `POS1 (X+25 Y+33.5 Z+0)` on a continuation line ->
                                          (('POS', 1, (('X', ("num", 25.0)), ('Y', ...), ('Z', ...))),)
@@ -225,7 +225,9 @@ class HeidenhainBuilder(Transformer):
     @v_args(meta=True)
     def assignment(self, meta, children):
         target, value = children
-        if isinstance(value, Token) and value.type == "FEED_VALUE":  # `Q208= MAX`: rapid, `=AUTO` the tool's feed
+        if (
+            isinstance(value, Token) and value.type == "FEED_VALUE"
+        ):  # `Q208= MAX`: rapid, `=AUTO` the tool's feed
             value = ("feed", str(value).upper().lstrip("F"))
         elif isinstance(value, Token):  # a string for a QS parameter
             value = ("str", str(value)[1:-1])
