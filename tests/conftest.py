@@ -79,6 +79,7 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_placement_agrees_with_linuxcnc_started_from_the_same_parameter_file",
         ),
         "motion/test_corner_rounding.py": ("test_compensated_corners_are_plain_arcs_linuxcnc_accepts",),
+        "motion/test_fanuc_flavours.py": ("test_g0_in_a_return_block_is_the_modal_motion_after_it",),
         "motion/test_cutter_comp.py": (
             "test_g41_checks_against_the_radius_of_the_tool_table_ncpp_is_told",
             "test_moves_after_compensation_agree_with_rs274",

@@ -26,6 +26,13 @@ shifts every system (Fanuc operator's manual, "Changing workpiece coordinate sys
 external offset, P1-P6 G54-G59), where LinuxCNC's sets the system in effect; a P that is an
 expression may be 0 there.
 
+A G00 written in a G28 or G30 block (`G0 G28 G91 Z0.`, which Mastercam's and Fusion's Fanuc and Haas
+posts write before each tool change) only sets the modal motion: these controls take G codes of
+different groups in one block, and the group-00 return takes the axis words (Fanuc 0i-MF
+operator's manual, "Preparatory function (G function)"; the page is not in ncpp's reference set,
+the rule is read from the posts that write the block).  LinuxCNC refuses the block ("Cannot use two
+g codes that both use axis values").
+
 A setting code written with other words in its block is out of scope too: a block that
 both sets and moves is not one these controls' posts write.  So is G33.1, LinuxCNC's rigid tap:
 these controls tap rigidly with M29 and G84.
@@ -41,6 +48,8 @@ from ncpp.program.blocks import Block, Comment, ExprWord, Word
 # G code -> the words it takes, for the settings each flavour reads past
 FANUC_SETTINGS: dict[float, frozenset[str]] = {5.1: frozenset("Q"), 8.0: frozenset("P")}
 HAAS_SETTINGS = {**FANUC_SETTINGS, 187.0: frozenset("PE"), 103.0: frozenset("P")}
+# The returns whose block may carry a G00 as well (module docstring)
+RETURNS = frozenset((28.0, 30.0))
 # Codes of the flavour that need what ncpp is not told (a sequence number's block; Haas does not
 # write Fanuc's G54.1)
 FANUC_UNFOLLOWED: dict[tuple[str, float], str] = {}
@@ -89,6 +98,12 @@ class FanucInterpreter(Interpreter):
                for item in block.items):  # fmt: skip
             raise _OutOfScope(f"G{setting.number} with other words in its block", setting.start + 1)
         return Pass(block)
+
+    def _motion_of_words(self, block, mode0, mode1, mode1_item, axis_item, polar_item) -> float | None:
+        """`G0 G28 ...`: the return takes the axis words, the G0 is only the modal motion after it."""
+        if mode0 in RETURNS and mode1 == 0.0:
+            mode1 = mode1_item = None
+        return super()._motion_of_words(block, mode0, mode1, mode1_item, axis_item, polar_item)
 
     def _additional_offset(self, block: Block, code: Word, fixed: int | None = None) -> Pass:
         """`G54.1 Pn` (Haas: `G154 Pn`; or a code that names one, `fixed`: n) with nothing else

@@ -54,6 +54,7 @@ from ncpp.motion.expand import refused
 from ncpp.motion.heidenhain_cycles import (
     DEFINITION_ACTIVE,
     REQUIRED,
+    RETRACT_FEED,
     SHAPES,
     Drilling,
     Hole,
@@ -384,7 +385,9 @@ class HeidenhainInterpreter(ModalInterpreter):
             elif what == "retract":
                 retract = node[0]
             elif what == "assignment":
-                if node[1][0] != "str":
+                if node[1][0] == "feed":
+                    self._feed_parameter(node, item)
+                elif node[1][0] != "str":
                     self.q[node[0][1]] = self.value(node[1], block, item)
             elif what == "cycle_def":
                 number = cycle_number(node[0])
@@ -425,7 +428,9 @@ class HeidenhainInterpreter(ModalInterpreter):
                 self._jump(block, item)
             else:
                 reason = {"call_label": "CALL LBL", "cycle_call": "CYCL CALL",
-                          "fn": f"FN {node[0]}", "keyword": " ".join(map(str, node))}.get(what, what)  # fmt: skip
+                          "fn": f"FN {node[0]}", "keyword": " ".join(map(str, node)),
+                          "touch_probe": f"TCH PROBE {node[0]} (a touch probe cycle: it probes, and may set"
+                                         " the datum or the tool's data)"}.get(what, what)  # fmt: skip
                 raise OutOfScope(reason, item.start + 1)
         if defined is not None:
             self._define_cycle(defined, block)
@@ -478,6 +483,15 @@ class HeidenhainInterpreter(ModalInterpreter):
             return
         needed = parameters_needed(number)
         self.cycle = Drilling(number, {name: self.q[name] for name in needed if name in self.q}, block.line)
+
+    def _feed_parameter(self, node: tuple, item: Statement) -> None:
+        """`Q208= MAX`: the cycle retracts at rapid (TNC 640 Cycle Programming manual, cycles 200-205:
+        "Q208 Feed rate for retraction ... alternatively FMAX"); any other parameter so given is a
+        feed ncpp does not follow (AUTO: the tool table's)."""
+        name, (_, word) = node[0][1], node[1]
+        if name != RETRACT_FEED or word != "MAX":
+            raise OutOfScope(f"{name.upper()}={word} (a feed ncpp does not follow)", item.start + 1)
+        self.q[name] = math.inf
 
     def _forget_assigned(self, block: Block) -> None:
         """The Q parameters a CYCL DEF ncpp does not read sets are unknown from here on."""

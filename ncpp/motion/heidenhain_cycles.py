@@ -66,6 +66,7 @@ OPTIONAL = {
 # Cycles a CYCL DEF makes active at once, which leave the called cycle as it is: dwell (9),
 # tolerance (32), preset (247), and the datum cycles (out of scope themselves)
 DEFINITION_ACTIVE = frozenset(("7", "8", "9", "10", "11", "19", "26", "32", "247"))
+RETRACT_FEED = "q208"  # the retraction feed: a number, 0 (at Q206), or MAX (rapid: infinite here)
 MAX_INFEEDS = 10_000  # infeeds of one hole: beyond, the parameters are a mistake, not a hole
 
 
@@ -114,7 +115,12 @@ def steps(cycle: Drilling, spindle: float = 0.0) -> list[Step]:
     surface = cycle["q203"]
     clearance = surface + cycle["q200"]
     bottom = surface + depth
-    plunge, out = cycle["q206"], cycle["q208"] or cycle["q206"]
+    plunge, out = cycle["q206"], cycle[RETRACT_FEED] or cycle["q206"]
+
+    def retract(level: float, rapid: bool = False) -> Step:
+        """A move out at the retraction feed Q208, or at rapid (the cycle's own, or Q208= MAX)."""
+        return Step(level, True) if rapid or math.isinf(out) else Step(level, False, out)
+
     if cycle.number == "207":
         if not spindle > 0 or not cycle["q239"]:
             raise OutOfScope("CYCL DEF 207 without a spindle speed (TOOL CALL S) or a thread pitch Q239: "
@@ -128,12 +134,12 @@ def steps(cycle: Drilling, spindle: float = 0.0) -> list[Step]:
         if len(_infeeds(cycle, depth)) > 1 or 0 < cycle["q257"] < -depth:
             raise OutOfScope("CYCL DEF 205 in more than one infeed or with chip breaking Q257 (the control "
                              "comes back down to advanced stop distances it works out itself)")  # fmt: skip
-        run = [Step(clearance, True), Step(bottom, False, plunge), Step(clearance, False, out)]
+        run = [Step(clearance, True), Step(bottom, False, plunge), retract(clearance)]
         return run + _second(cycle, clearance)
     if cycle.number in ("201", "240"):
         rapid_out = cycle.number == "240"
         run = [Step(clearance, True), Step(bottom, False, plunge)]
-        return run + [Step(clearance, rapid_out, 0.0 if rapid_out else out)] + _second(cycle, clearance)
+        return run + [retract(clearance, rapid_out)] + _second(cycle, clearance)
     run = [Step(clearance, True)]
     breaks = int(cycle["q213"]) if cycle.number == "203" else 0
     reached, broken, infeed = clearance, 0, 0
@@ -141,15 +147,14 @@ def steps(cycle: Drilling, spindle: float = 0.0) -> list[Step]:
         if infeed:
             if breaks and broken < breaks:
                 broken += 1
-                run.append(Step(reached + cycle["q256"], False, out))
+                run.append(retract(reached + cycle["q256"]))
             else:
                 broken = 0
-                run += [Step(clearance, cycle.number == "200", out), Step(reached + cycle["q200"], True)]
+                run += [retract(clearance, cycle.number == "200"), Step(reached + cycle["q200"], True)]
         reached = surface - cut
         run.append(Step(reached, False, plunge))
         infeed += 1
-    rapid_out = cycle.number == "200"
-    return run + [Step(clearance, rapid_out, 0.0 if rapid_out else out)] + _second(cycle, clearance)
+    return run + [retract(clearance, cycle.number == "200")] + _second(cycle, clearance)
 
 
 def _infeeds(cycle: Drilling, depth: float) -> list[float]:

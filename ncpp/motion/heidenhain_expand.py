@@ -159,7 +159,7 @@ class KlartextExpansion:
         assert type(item) is Statement
         if item.kind == "assignment":
             target, expr = item.node
-            if expr[0] == "str":  # (a QS string: ncpp does not read it; it stays, set in each run)
+            if expr[0] in ("str", "feed"):  # (a QS string, a cycle's `Q208= MAX`: it stays, set in each run)
                 return raw
             if not cycle:
                 return None

@@ -141,7 +141,7 @@ class ModalInterpreter:
         self.done = True
         self.centre.waiting = []  # (an entry move waiting keeps its tool centre square to it)
         where = "this line" if owner is None else f"line {owner.line}, which runs it,"
-        place = Location(self.file, block.line, col)
+        place = Location(self.file, *block.place(col))
         if self.file != self.program_file and owner is not None:
             reason, place = f"{reason} (at {place})", Location(self.program_file, owner.line, None)
         warnings.warn(

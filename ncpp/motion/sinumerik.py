@@ -89,7 +89,10 @@ HARMLESS_CALLS = frozenset(("MSG", "BNAT", "ENAT", "BTAN", "ETAN", "BAUTO", "EAU
                             # groups, radius programming, and a transformation off or its
                             # orientation modes (this interpreter stops at any that turns one on)
                             "COMPOF", "COMPCAD", "COMPCURV", "COMPSURF", "STOPRE", "WORKPIECE", "FGROUP",
-                            "UPATH", "SPATH", "DIAMOF", "TRAFOOF", "ORIWKS", "ORIMKS", "ORIAXES", "ORIVECT"))  # fmt: skip
+                            "UPATH", "SPATH", "DIAMOF", "TRAFOOF", "ORIWKS", "ORIMKS", "ORIAXES", "ORIVECT",
+                            # the feedrate profile over a block, not its path (840D sl Programming
+                            # Manual, Fundamentals, "Feedrate characteristic (FNORM, FLIN, FCUB)")
+                            "FNORM", "FLIN", "FCUB"))  # fmt: skip
 # Calls that move nothing when given no arguments: CYCLE800() deselects the swivelled plane without
 # turning an axis (SINUMERIK 840D sl Milling manual, "Swiveling plane - CYCLE800": "CYCLE800()"
 # resets the swivel frames); CYCLE832() deselects the high-speed settings.  CYCLE832 with its

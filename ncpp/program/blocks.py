@@ -152,3 +152,11 @@ class Block:
 
     def source(self, item: Item) -> str:
         return self.raw[item.start : item.end]
+
+    def place(self, col: int | None) -> tuple[int, int | None]:
+        """The file's line and column of a column counted in `raw`: a block continued over
+        several lines (Klartext's `~`) holds their line endings."""
+        head = self.raw[: col - 1] if col is not None else ""
+        if "\n" not in head:
+            return self.line, col
+        return self.line + head.count("\n"), len(head) - head.rfind("\n")

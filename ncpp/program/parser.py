@@ -770,6 +770,8 @@ def _describe(err: lark.exceptions.UnexpectedInput, raw: str) -> str:
     if isinstance(err, lark.exceptions.UnexpectedToken) and err.token.type == "$END":
         return "unexpected end of block"
     snippet = rest[:20]
+    if rest[0] == "(" and ")" in rest:  # (a closed comment where a value or a word had to come)
+        return f"a comment where a value belongs: {snippet!r}"
     if rest[0] == "(":
         return f"unclosed comment: {snippet!r}"
     if isinstance(err, lark.exceptions.UnexpectedToken):

@@ -13,6 +13,9 @@ from __future__ import annotations
 
 import io
 import os
+import re
+import subprocess
+import sys
 
 import pytest
 
@@ -21,7 +24,7 @@ from ncpp.motion.segments import DRILLED, Line
 from ncpp.pipeline import ErrorSource, dialect_tools, process
 from ncpp.program.dialects import parse_program
 from ncpp.summary import REASONS
-from tests.conftest import SHARED
+from tests.conftest import ROOT, SHARED
 from tests.writeback.conftest import SQUARE
 
 CYCLE_200 = """CYCL DEF 200 DRILLING ~
@@ -137,6 +140,34 @@ def test_universal_drilling_203_decreases_its_plunge_and_breaks_chips():
     assert first == drilled(25, -7.5, levels)
 
 
+def test_a_retraction_feed_of_max_retracts_at_rapid():
+    """`Q208= MAX ;RETRACTION FEED RATE`, as Fusion's Heidenhain post writes cycle 203 (polymech-info/
+    heidenhain-simulator, `samples/a_phv3/motorflange/m7s.h`; refused as unreadable before).  TNC 640
+    Cycle Programming manual, cycle 203: "Q208 Feed rate for retraction ... alternatively FMAX": the
+    same moves as the test above, each one out at Q208 a rapid."""
+    universal = """CYCL DEF 203 UNIVERSAL DRILLING ~
+    Q200=+2 ;SET-UP CLEARANCE ~
+    Q201=-20 ;DEPTH ~
+    Q206=+150 ;FEED RATE FOR PLNGNG ~
+    Q202=+8 ;PLUNGING DEPTH ~
+    Q210=+0 ;DWELL TIME AT TOP ~
+    Q203=+0 ;SURFACE COORDINATE ~
+    Q204=+50 ;2ND SET-UP CLEARANCE ~
+    Q212=+2 ;DECREMENT ~
+    Q213=+1 ;BREAKS ~
+    Q205=+3 ;MIN. PLUNGING DEPTH ~
+    Q211=+0 ;DWELL TIME AT DEPTH ~
+    Q208= MAX ;RETRACTION FEED RATE ~
+    Q256=+0.5 ;DIST FOR CHIP BRKNG"""
+    (first, *_) = runs(moves(program(universal, ["L FMAX M99"])))
+    levels = [(2, None), (-8, 150), (-7.5, None), (-14, 150), (2, None), (-12, None),
+              (-18, 150), (-17.5, None), (-20, 150), (2, None), (50, None)]  # fmt: skip
+    assert first == drilled(25, -7.5, levels)
+    said = io.StringIO()
+    assert runs(moves(program(universal.replace("Q208= MAX", "Q208=AUTO"), ["L FMAX M99"]), said)) == []
+    assert "Q208=AUTO (a feed ncpp does not follow)" in said.getvalue()
+
+
 def test_centering_240_goes_to_its_depth_and_back_at_fmax():
     centering = """CYCL DEF 240 CENTERING ~
     Q200=+2 ;SET-UP CLEARANCE ~
@@ -242,3 +273,38 @@ def test_a_positioning_move_written_in_pieces_calls_its_cycle_from_the_last():
     assert lines[call].endswith(" M99") and lines[call - 1].endswith(" F500")  # the step, then the line
     holes = [run[1][:2] for run in runs(moves(written))]
     assert holes[2][1] == pytest.approx(-42.5, abs=0.01) and holes[1][1] == pytest.approx(-7.5, abs=0.01)
+
+
+def test_a_touch_probe_cycle_ends_interpretation_with_a_warning(tmp_path):
+    """A probing program as Fusion's Heidenhain post writes it (polymech-info/heidenhain-simulator,
+    `samples/a_phv3/brackets/probe-40.h`): TCH PROBE 412 probes a bore and may set the datum (TNC 640
+    User's Manual, Touch Probe Cycles, "Cycle 412 DATUM INSIDE CIRCLE"), so the moves after it cannot be
+    placed: the program is compensated up to the cycle and passes through unchanged from it, with a
+    warning, where the block was refused as unreadable before."""
+    source = "\n".join(["0  BEGIN PGM probe MM", "1  TOOL CALL 100 Z S50", "2  L  X+10  Y+5 R0 FMAX",
+                        "3  L  Z+55 R0 FMAX", "4  TCH PROBE 412 DATUM INSIDE CIRCLE ~",
+                        "    Q321=+0    ;CENTER IN 1ST AXIS ~", "    Q262=+40   ;NOMINAL DIAMETER",
+                        "5  L  X+20 Z+55 FMAX", "6  M30", "7  END PGM probe MM", ""])  # fmt: skip
+    path, machine, out = tmp_path / "probe.h", tmp_path / "square.toml", tmp_path / "out.h"
+    path.write_text(source)
+    machine.write_text(SQUARE)
+    proc = subprocess.run([sys.executable, "-m", "ncpp", "compensate", "--machine", str(machine), str(path),
+                           "-o", str(out)], capture_output=True, text=True, cwd=ROOT)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    assert "probe.h:5:4: warning: TCH PROBE 412 (a touch probe cycle" in proc.stderr
+    written = [re.sub(r"^\d+ +", "", line) for line in out.read_text().splitlines()]  # (ncpp renumbers)
+    tail = [re.sub(r"^\d+ +", "", line) for line in source.splitlines()[4:]]
+    assert written[-len(tail) :] == tail  # from the cycle on, as it was
+    moved = next(line for line in written if line.startswith("L  X+10"))
+    assert abs(float(moved.split()[1][1:]) - 10.00025) <= 0.00005  # (X gains 5e-5 * Y on the square machine)
+
+
+def test_a_warning_in_a_continued_block_names_the_line_its_word_is_on():
+    """A cycle definition spans `~`-continued lines (its Q parameters one a line, as the TNC writes it):
+    a warning at one of them names that line and its column, not the CYCL DEF's line with a column
+    counted through the block's other lines."""
+    said = io.StringIO()
+    text = program(CYCLE_200.replace("Q206=+30  ", "Q206=AUTO "), ["L FMAX M99"])
+    moves(text, said)
+    line = next(n for n, row in enumerate(text.splitlines(), 1) if "Q206=AUTO" in row)
+    assert said.getvalue().startswith(f"drill.h:{line}:5: warning: Q206=AUTO (a feed ncpp does not follow)")

@@ -61,3 +61,18 @@ def test_what_cam_posts_write_that_moves_no_axis_is_read_past(block):
     said = io.StringIO()
     assert len(lines(f"G54\n{block}\nG0 X1 Y2 Z3\nM30\n", Warnings(stream=said))) == 1
     assert "scope" not in said.getvalue()
+
+
+@pytest.mark.parametrize("word", ["FNORM", "FLIN", "FCUB"])
+def test_a_feedrate_profile_is_read_past(word):
+    """`N60 G17 G710 G94 G90 FNORM` heads a CAM program for an 840D sl
+    (121philip/SINUMERIK-840D-sl-CAS-Package, `Approach A/CAM TEST.MPF`).  FNORM, FLIN and FCUB shape
+    the feedrate along a block, not its path (840D sl Programming Manual, Fundamentals, "Feedrate
+    characteristic (FNORM, FLIN, FCUB)"): the moves are those of the program without the word, and
+    nothing is warned (before, the word ended interpretation)."""
+    said = io.StringIO()
+    body = "G0 X10 Y20 Z5\nG1 Z-1 F200\nX40 Y25\nM30\n"
+    with_word = lines(f"G54 G17 G710 G94 G90 {word}\n{body}", Warnings(stream=said))
+    assert said.getvalue() == ""
+    assert [m.end for m in with_word] == [m.end for m in lines(f"G54 G17 G710 G94 G90\n{body}")]
+    assert len(with_word) == 3

@@ -124,6 +124,36 @@ def test_multi_line_cycle_definition_is_one_block_and_roundtrips():
     assert out.getvalue() == text
 
 
+def test_a_touch_probe_cycle_is_one_block_and_roundtrips():
+    """TCH PROBE blocks as TNC 640 programs write them, the cycle's name with a comma and its Q
+    parameters on `~` lines (Stugo/Heidenhain, `Tool-check.h`; polymech-info/heidenhain-simulator,
+    `samples/a_phv3/brackets/probe-40.h`); TNC 640 User's Manual, Touch Probe Cycles: `TCH PROBE 412
+    DATUM INSIDE CIRCLE`, `TCH PROBE 584 TOOL LENGTH, RADIUS` (here in Swedish)."""
+    text = (
+        b"TCH PROBE 584 VT-LAENGD, VT-RADIE ~\r\n    Q350=+3    ;MAETFORM ~\r\n"
+        b"    Q351=+1    ;MAETOMFANG\r\nM28\r\n"
+    )
+    blocks = list(parse_stream(io.BytesIO(text), "t.h", "heidenhain"))
+    assert len(blocks) == 2
+    assert blocks[0].items[0].kind == "touch_probe" and blocks[0].items[0].node == (
+        "584",
+        ("VT-LAENGD,", "VT-RADIE"),
+    )
+    assert [i.node[0][1] for i in blocks[0].items if type(i) is Statement and i.kind == "assignment"] == [
+        "q350",
+        "q351",
+    ]
+    assert statements("17 TCH PROBE 412 DATUM INSIDE CIRCLE") == [
+        ("touch_probe", ("412", ("DATUM", "INSIDE", "CIRCLE")))
+    ]
+    assert statements("TCH PROBE 0.0 REF PLANE Q10 Z-") == [
+        ("touch_probe", ("0.0", ("REF", "PLANE", "Q10 Z-")))
+    ]
+    out = io.BytesIO()
+    write_blocks(blocks, out)
+    assert out.getvalue() == text
+
+
 def test_q_formulas_and_fn_pass_through():
     (_, assign, comment) = items("30 Q1951 = INT ( ( Q1950 / Q1810 ) + 0.99999999 ) ;Anzahl")
     assert assign.node == (

@@ -17,7 +17,9 @@ from ncpp.errors import NcppError, Warnings
 from ncpp.motion.segments import Line, Pass
 from ncpp.pipeline import dialect_tools
 from ncpp.program.dialects import detect, parse_program
-from tests.conftest import READING, ROOT
+from tests.conftest import READING, ROOT, RS274, SHARED
+
+PATHCHECK = SHARED / "tools" / "pathcheck"
 
 
 def events(program: str, dialect: str, warnings: Warnings | None = None) -> list:
@@ -130,3 +132,57 @@ def test_g10_l2_of_a_numbered_system_is_followed():
     said = io.StringIO()
     found = events("G10 L2 P1 X5\nG0 X1\nM30\n", "fanuc", Warnings(stream=said))
     assert type(found[1]) is Line and said.getvalue() == ""
+
+
+# A Mastercam-style Fanuc/Haas tool change: `G0 G28 G91 Z0.` sends Z home and leaves G0 modal, so
+# the next block's axis words are a rapid (free-cnc-simulator-wine's `Mill/MM/Fanuc/G81 ABS.nc`
+# writes `G00 G28 G91 Z1`; Mastercam's Fanuc posts `G0 G28 G91 Z0.`)
+RETURN_WITH_G0 = """%
+O0025
+G21 G54 G90 G17
+G0 G28 G91 Z0.
+G90
+X10. Y20. Z5. S800 M3
+G1 Z-1. F100.
+X30. Y25.
+G00 G91 G28 Z0.
+G90 X40.
+M30
+%
+"""
+
+
+def rs274_twin(text: str) -> str:
+    """The same program as LinuxCNC must be told it: the return, then the modal G0 on a line of its own."""
+    return text.replace("G0 G28 G91 Z0.\n", "G28 G91 Z0.\nG0\n").replace(
+        "G00 G91 G28 Z0.\n", "G91 G28 Z0.\nG0\n"
+    )
+
+
+def test_g0_in_a_return_block_is_the_modal_motion_after_it(tmp_path):
+    """The return is left as programmed and the moves after it are compensated: the X Y Z block after
+    `G0 G28` is a rapid.  Judged by LinuxCNC's rs274 on the twins of input and output (pathcheck: same
+    actions, rapids where the original rapids, within 0.05 mm); ncpp refused the block before."""
+    if not (RS274.exists() and PATHCHECK.exists()):
+        pytest.skip("rs274 or pathcheck not available")
+    program = tmp_path / "p.nc"
+    program.write_text(RETURN_WITH_G0)
+    out = tmp_path / "out.nc"
+    command = ["compensate", "--machine", str(READING), "--dialect", "fanuc", str(program), "-o", str(out)]
+    proc = subprocess.run([sys.executable, "-m", "ncpp", *command], capture_output=True, text=True, cwd=ROOT)
+    assert proc.returncode == 0, proc.stderr
+    written = out.read_text()
+    assert "\nG0 G28 G91 Z0.\n" in written and "\nG00 G91 G28 Z0.\n" in written
+    assert "compensated 4 moves" in proc.stderr
+    twin_in, twin_out = tmp_path / "in.ngc", tmp_path / "out.ngc"
+    twin_in.write_text(rs274_twin(RETURN_WITH_G0))
+    twin_out.write_text(rs274_twin(written))
+    check = subprocess.run([sys.executable, str(PATHCHECK), str(twin_in), str(twin_out), "--tol-mm", "0.05"],
+                           capture_output=True, text=True, timeout=600)  # fmt: skip
+    assert check.returncode == 0, check.stdout + check.stderr
+
+
+def test_g1_in_a_return_block_is_still_refused():
+    """Only the G0 that posts write is read so: G1 with G28 stays LinuxCNC's refusal."""
+    with pytest.raises(NcppError, match="two g codes that both use axis values"):
+        events("G21 G90\nG1 G28 G91 Z0. F100\nM30\n", "fanuc")

@@ -85,6 +85,20 @@ def test_unreadable_lines_that_do_not_run_pass_through_with_a_warning(tmp_path):
     assert (err.value.where.line, err.value.where.col) == (7, 7)
 
 
+def test_a_comment_inside_an_expression_is_named_so():
+    """`#<d> = [80/SQRT(2)/2/25.4]` (Thaddeus-Maximus/lagun-linuxcnc, `nc_files/spr_hub_drill.ngc`):
+    parentheses are a comment in RS274/NGC, not grouping, so the function has no argument (rs274:
+    "Left bracket missing after unary operation name").  The comment is closed: the refusal says
+    where it stands, not that it is unclosed."""
+    with pytest.raises(NcppError, match=r"p\.ngc:2:16: a comment where a value belongs: '\(2\)/2/25\.4\]'"):
+        process(io.BytesIO(b"G21\n#<d> = [80/SQRT(2)/2/25.4]\nG0 X#<d>\nM2\n"), io.BytesIO(), file="p.ngc",
+                source=reading())  # fmt: skip
+    with pytest.raises(NcppError, match=r"unclosed comment: '\(2/2/25\.4\]'"):
+        process(
+            io.BytesIO(b"G21\n#<d> = [80/SQRT(2/2/25.4]\nM2\n"), io.BytesIO(), file="p.ngc", source=reading()
+        )
+
+
 def test_fast_path_agrees_with_lalr_parser_on_corpus(corpus):
     """The plain-line scanner must build exactly what the grammar builds."""
     parser = LineParser("iso")

@@ -33,10 +33,13 @@ Statement kinds and nodes (Heidenhain):
   cycle_def      (number, words)         `CYCL DEF 200 BOHREN` -> ('200', ('BOHREN',)); its Q200=...
                                          parameters (continuation lines) follow as assignments
   cycle_call     (variant,)              `CYCL CALL` None, `CYCL CALL POS` 'POS', `CYCL CALL PAT` 'PAT'
+  touch_probe    (number, words)         `TCH PROBE 412 DATUM INSIDE CIRCLE` -> ('412', ('DATUM', ...));
+                                         its Q parameters follow as assignments, as a cycle_def's
   pattern_def    (shapes...)             `PATTERN DEF` with `POS1 (X+25 Y+33.5 Z+0)` on a continuation line ->
                                          (('POS', 1, (('X', ("num", 25.0)), ('Y', ...), ('Z', ...))),)
   fn             (number, text)          `FN 9: IF +Q1 EQU +0 GOTO LBL "x"` -> (9, 'IF +Q1 ...'), passed through
-  assignment     (("param", "q1950"), expr)  `Q1950 = Q1804 - Q1805`; a string ("str", text) for QS
+  assignment     (("param", "q1950"), expr)  `Q1950 = Q1804 - Q1805`; a string ("str", text) for QS;
+                                         a cycle's feed `Q208= MAX` -> ("feed", "MAX") ('AUTO' for `=AUTO`)
   keyword        (words...)              anything else led by keywords (`STOP`, `PLANE ...`), passed through
 Expressions: ("num", v) ("param", "q12"|"ql1"|"qr1"|"qs1") ("neg", x) ("bin", op, a, b) with op in
 + - * / ** (`^`), ("call", NAME, x) for SIN COS TAN ASIN ACOS ATAN SQRT SQ LN LOG ABS INT FRAC NEG SGN.
@@ -184,6 +187,7 @@ class HeidenhainBuilder(Transformer):
     call_program = _statement("call_program", lambda c: (str(c[1]).strip('"'),))
     cycle_def = _statement("cycle_def", _cycle_def)
     cycle_call = _statement("cycle_call", _cycle_call)
+    touch_probe = _statement("touch_probe", _cycle_def)
     pattern_def = _statement("pattern_def", _pattern_def)
     fn = _statement("fn", _fn)
     keyword = _statement("keyword", lambda c: tuple(str(t).upper() for t in c))
@@ -221,7 +225,11 @@ class HeidenhainBuilder(Transformer):
     @v_args(meta=True)
     def assignment(self, meta, children):
         target, value = children
-        if isinstance(value, Token):  # a string for a QS parameter
+        if (
+            isinstance(value, Token) and value.type == "FEED_VALUE"
+        ):  # `Q208= MAX`: rapid, `=AUTO` the tool's feed
+            value = ("feed", str(value).upper().lstrip("F"))
+        elif isinstance(value, Token):  # a string for a QS parameter
             value = ("str", str(value)[1:-1])
         return Statement("assignment", (("param", str(target).lower()), value), meta.start_pos, meta.end_pos)
 
