@@ -82,6 +82,9 @@ class _Circle:
 
     def __init__(self, record: Record, start: Point):
         values = record.numbers
+        if record.words:  # NX's TIMES, n (turns of a helix), ...: the arc would be guessed
+            raise NcppError(f"CIRCLE with {', '.join(record.words)}: ncpp posts a CIRCLE of numbers only "
+                            "(centre, axis, radius, ...)", record.where)  # fmt: skip
         if len(values) < 6:
             raise NcppError(
                 f"CIRCLE needs centre and axis (6 values) and the radius, got {len(values)}", record.where
