@@ -74,7 +74,8 @@ class _ToRecord(Transformer):
         return item
 
     def text_record(self, major, text=None):
-        return " ".join(major.upper().split()), (str(text).strip().removeprefix("/").strip(),) if text is not None else ()
+        name = " ".join(major.upper().split())  # "TOOL  PATH" is TOOL PATH
+        return name, (str(text).strip().removeprefix("/").strip(),) if text is not None else ()
 
     def record(self, name, args=()):
         major = name.upper()

@@ -209,7 +209,9 @@ class Generator:
             self.line_parser = LineParser(self.grammar)
         block = self.line_parser.parse(text, line=rec.line, file=self.file)
         if any(isinstance(item, Statement) and item.kind == UNREADABLE for item in block.items):
-            self.warnings.warn("INSERT/ text is no block of the control; passed through as a comment", rec.where)
+            self.warnings.warn(
+                "INSERT/ text is no block of the control; passed through as a comment", rec.where
+            )
             yield from self.emit_comment(text)
             return
         yield text

@@ -169,7 +169,9 @@ def test_nx_motion_ncpp_cannot_follow_is_refused_at_its_line(excerpt, line, says
 def test_solidworks_cycle_init_is_no_cycle():
     """SolidWorks CAM writes `CYCLE/INIT` before each cycle (aamorim1913/AptPostProcessor,
     parts-2025/Paralelipipedo-furos.apt); the cycle record after it is what is judged."""
-    text = "RAPID/\nGOTO/8.,15.,25.\nCYCLE/INIT\nCYCLE/DRILL,FEDTO,7.85788,MMPM,326.770115,RAPTO,3.,RTRCTO,25.\n"
+    text = (
+        "RAPID/\nGOTO/8.,15.,25.\nCYCLE/INIT\nCYCLE/DRILL,FEDTO,7.85788,MMPM,326.770115,RAPTO,3.,RTRCTO,25.\n"
+    )
     with pytest.raises(NcppError) as err:
         posted(text + "GOTO/8.,15.,0\nCYCLE/OFF\n")
     assert "part.cls:4:" in str(err.value)
