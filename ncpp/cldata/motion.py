@@ -319,6 +319,9 @@ def motion(
             if driller is not None:  # the generator ends the canned cycle for the move: a new series
                 driller = Driller(driller.cycle, pos[2], context.inch)
             continue
+        elif major == "GOHOME":  # passed through, the move home would be missing
+            raise NcppError("GOHOME without a FROM point or a position before it: where home is is not "
+                            "known (NX's GOHOME/x,y,z names it)", rec.where)  # fmt: skip
         elif major == "RAPID":
             rapid_next = True
         elif major == "FEDRAT" and rec.numbers:

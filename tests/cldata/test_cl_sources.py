@@ -191,3 +191,31 @@ GOTO/-10,0,0
     calls = canon(tmp_path, text)
     (arc,) = arcs(calls)
     assert sweep((10.0, 0.0), arc) == pytest.approx(180.0, abs=1e-3)
+
+
+def test_gohome_without_a_home_is_refused():
+    """APT's GOHOME returns to the FROM point; without one (and without NX's x, y, z) the post
+    cannot know where the tool goes, and left out the move home would be missing."""
+    with pytest.raises(NcppError, match="GOHOME without a FROM point") as err:
+        posted("RAPID\nGOTO/10,0,50\nGOHOME\nGOTO/0,0,50\n")
+    assert "part.cls:3:" in str(err.value)
+
+
+def test_insert_text_no_control_reads_becomes_a_comment(tmp_path):
+    """SolidWorks CAM puts tool descriptions and operator notes into `INSERT/` (aamorim1913/
+    AptPostProcessor, parts-2021/basemach.apt); APT's INSERT text that is a block stays a block."""
+    text = """UNIT/MM
+INSERT/8MM CRB 2FL 20 LOC
+LOAD/TOOL,1
+RAPID/
+GOTO/46.615938,92.030152,25.
+INSERT/STOP  change fixture
+INSERT/M1
+RAPID/
+GOTO/17.969848,33.384062,25.
+FINI
+"""
+    program = posted(text).splitlines()
+    assert "(8MM CRB 2FL 20 LOC)" in program and "(STOP  change fixture)" in program and "M1" in program
+    ends = end_points(canon(tmp_path, text))
+    assert ends[-1] == pytest.approx((17.969848, 33.384062, 25.0), abs=1e-4)
