@@ -332,7 +332,7 @@ def motion(
             context = replace(context, inch=inch, offset=offset)  # program units
         elif major == "CYCLE" and rec.words[:1] == ("INIT",):
             if warnings is not None:  # SolidWorks CAM's mark before each cycle record: no motion of its own
-                warnings.warn("CYCLE/INIT has no machine function; passed through as a comment", rec.where)
+                warnings.warn("CYCLE/INIT has no machine function: nothing is written for it", rec.where)
         elif major == "CYCLE":
             cycle = parse_cycle(rec)
             if cycle is not None and pos is None:

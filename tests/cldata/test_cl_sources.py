@@ -168,14 +168,12 @@ def test_nx_motion_ncpp_cannot_follow_is_refused_at_its_line(excerpt, line, says
 
 def test_solidworks_cycle_init_is_no_cycle():
     """SolidWorks CAM writes `CYCLE/INIT` before each cycle (aamorim1913/AptPostProcessor,
-    parts-2025/Paralelipipedo-furos.apt); the cycle record after it is what is judged."""
+    parts-2025/Paralelipipedo-furos.apt): no machine function, the cycle after it is posted."""
     text = (
         "RAPID/\nGOTO/8.,15.,25.\nCYCLE/INIT\nCYCLE/DRILL,FEDTO,7.85788,MMPM,326.770115,RAPTO,3.,RTRCTO,25.\n"
     )
-    with pytest.raises(NcppError) as err:
-        posted(text + "GOTO/8.,15.,0\nCYCLE/OFF\n")
-    assert "part.cls:4:" in str(err.value)
-    posted("FEDRAT/326.770115,MMPM\n" + text.replace("CYCLE/DRILL", "$$ CYCLE/DRILL") + "GOTO/8.,15.,0\n")
+    program = posted(text + "GOTO/8.,15.,0\nCYCLE/OFF\n")
+    assert "G98 G81 X8. Y15. Z-7.8579 R3." in program.replace("  ", " ")
 
 
 def test_a_repeated_point_on_an_arc_adds_no_turn(tmp_path):
@@ -219,3 +217,35 @@ FINI
     assert "(8MM CRB 2FL 20 LOC)" in program and "(STOP  change fixture)" in program and "M1" in program
     ends = end_points(canon(tmp_path, text))
     assert ends[-1] == pytest.approx((17.969848, 33.384062, 25.0), abs=1e-4)
+
+
+SOLIDWORKS_DRILL = """PARTNO/1
+UNIT/MM
+INSERT/[HOLDER=C40-32ERP412] 14MM X 60DEG HSS CENTERDRILL
+LOAD/TOOL,1
+SPINDL/4948,RPM,CLW
+RAPID/
+GOTO/8.,15.,25.
+CYCLE/INIT
+CYCLE/DRILL,FEDTO,7.85788,MMPM,326.770115,RAPTO,3.,RTRCTO,25.,DWELL,0
+GOTO/8.,15.,0
+GOTO/27.,15.,0
+GOTO/43.,15.,-38.
+CYCLE/OFF
+FINI
+"""
+
+
+def test_solidworks_drill_cycle_depth_and_retract(tmp_path):
+    """SolidWorks CAM's `CYCLE/DRILL, FEDTO, d, ..., RAPTO, r, RTRCTO, v` (aamorim1913/
+    AptPostProcessor, parts-2025/Paralelipipedo-furos.apt; a hole 38 below as in
+    parts-2024/Suporte-parede-side-drill.apt, whose RTRCTO there is 63): each hole drilled `d`
+    below its top from `r` above it, and left at the level the cycle started from."""
+    text = SOLIDWORKS_DRILL.replace("GOTO/43.,15.,-38.\n", "")
+    ends = end_points(canon(tmp_path, text))
+    for x in (8.0, 27.0):
+        assert (x, 15.0, -7.85788) in [pytest.approx(e, abs=1e-4) for e in ends]
+    assert ends[-1] == pytest.approx((27.0, 15.0, 25.0), abs=1e-4)
+    with pytest.raises(NcppError, match=r"RTRCTO, 25 retracts to -13, not to the level") as err:
+        posted(SOLIDWORKS_DRILL)
+    assert "part.cls:9:" in str(err.value)
