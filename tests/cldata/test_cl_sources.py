@@ -249,3 +249,12 @@ def test_solidworks_drill_cycle_depth_and_retract(tmp_path):
     with pytest.raises(NcppError, match=r"RTRCTO, 25 retracts to -13, not to the level") as err:
         posted(SOLIDWORKS_DRILL)
     assert "part.cls:9:" in str(err.value)
+
+
+def test_solidworks_variable_peck_cycle_is_refused_by_name():
+    """SolidWorks CAM's `CYCLE/DEEP2` pecks `1STPECK` first and `SUBPECK` after (aamorim1913/
+    AptPostProcessor, parts-2024/Suporte-parede-side-drill.apt): no one canned cycle does that;
+    the record is read (a word may start with digits) and refused by its cycle's name."""
+    text = "RAPID/\nGOTO/20.,125.,25.\nCYCLE/DEEP2,FEDTO,5.03163,1STPECK,5.,SUBPECK,2.,MMPM,382.27,RAPTO,3.\n"
+    with pytest.raises(NcppError, match=r"part\.cls:3:1: CYCLE/DEEP2: ncpp posts the cycles"):
+        posted(text + "GOTO/20.,125.,0\nCYCLE/OFF\n")
