@@ -205,16 +205,24 @@ class Generator:
         """APT INSERT/: literal NC text for the control, when the control reads it as a block;
         SolidWorks CAM writes tool and stock descriptions there, which become comments."""
         text = " ".join(str(a) for a in rec.args)
-        if self.line_parser is None:
-            self.line_parser = LineParser(self.grammar)
-        block = self.line_parser.parse(text, line=rec.line, file=self.file)
-        if any(isinstance(item, Statement) and item.kind == UNREADABLE for item in block.items):
+        if not self._reads(text, rec):
             self.warnings.warn(
                 "INSERT/ text is no block of the control; passed through as a comment", rec.where
             )
             yield from self.emit_comment(text)
             return
         yield text
+
+    def _reads(self, text: str, rec: Record) -> bool:
+        """Does the control read `text` as a block?  (The ISO parser marks what it cannot read,
+        the Heidenhain one refuses it.)"""
+        if self.line_parser is None:
+            self.line_parser = LineParser(self.grammar)
+        try:
+            block = self.line_parser.parse(text, line=rec.line, file=self.file)
+        except NcppError:
+            return False
+        return not any(isinstance(item, Statement) and item.kind == UNREADABLE for item in block.items)
 
     def _hole(self, line: Line) -> Iterator[str]:
         """A hole's moves: the first writes the hole's canned cycle, each sets where it leaves the tool."""

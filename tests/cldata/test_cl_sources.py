@@ -16,9 +16,9 @@ from tests.shop.rs274 import end_points, run_rs274
 ARC = re.compile(r"ARC_FEED\((.*)\)")
 
 
-def posted(text: str, name: str = "part.cls") -> str:
+def posted(text: str, name: str = "part.cls", dialect: str = "linuxcnc") -> str:
     out = io.BytesIO()
-    post(io.StringIO(text), out, file=name, dialect="linuxcnc", warnings=Warnings(stream=io.StringIO()))
+    post(io.StringIO(text), out, file=name, dialect=dialect, warnings=Warnings(stream=io.StringIO()))
     return out.getvalue().decode("latin-1")
 
 
@@ -258,3 +258,15 @@ def test_solidworks_variable_peck_cycle_is_refused_by_name():
     text = "RAPID/\nGOTO/20.,125.,25.\nCYCLE/DEEP2,FEDTO,5.03163,1STPECK,5.,SUBPECK,2.,MMPM,382.27,RAPTO,3.\n"
     with pytest.raises(NcppError, match=r"part\.cls:3:1: CYCLE/DEEP2: ncpp posts the cycles"):
         posted(text + "GOTO/20.,125.,0\nCYCLE/OFF\n")
+
+
+@pytest.mark.parametrize("dialect", ["heidenhain", "sinumerik", "fanuc"])
+def test_insert_descriptions_are_comments_in_every_dialect(dialect):
+    """The Heidenhain parser refuses what it cannot read where the ISO one marks it: either way
+    SolidWorks CAM's tool description (aamorim1913/AptPostProcessor, parts-tools/boss.apt) is a comment."""
+    text = "UNIT/MM\nINSERT/[HOLDER=C40-M06EM2] 6MM CRB 2FL 19 LOC\nLOAD/TOOL,1\nRAPID/\nGOTO/89.2375,5.7625,25.\n"
+    program = posted(text, dialect=dialect)
+    assert any(
+        "6MM CRB 2FL 19 LOC" in line and line != "[HOLDER=C40-M06EM2] 6MM CRB 2FL 19 LOC"
+        for line in program.splitlines()
+    )
