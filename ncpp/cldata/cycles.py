@@ -9,7 +9,11 @@ writes by default and NX writes:
   CLEAR,c [, RAPTO,r] [, RETURN,e]`: `d` below the point; the R plane `c` above it,
   `r` further towards it (Creo's "CL Output for Holemaking Cycles");
 * NX: `CYCLE/DRILL[,DEEP|BRKCHP]|TAP|BORE, FEDTO,-d, [RAPTO,r | CLEAR,c,] RTRCTO,AUTO|v,
-  MMPM,f`: the bottom at `-d` and the R plane at `r` (else `c`) from the point.
+  MMPM,f`: the bottom at `-d` and the R plane at `r` (else `c`) from the point;
+* SolidWorks CAM: `CYCLE/DRILL, FEDTO,d, MMPM,f, RAPTO,r, RTRCTO,v [, DWELL,t]` with the
+  depth `d` above 0: the bottom `d` below the point, the R plane `r` and the retract level
+  `v` above it (its files retract to the level the cycle started from: `v` is checked
+  against it hole by hole).
 
 A hole is drilled from the R plane to its bottom and left at the R plane (G99),
 or, with `RTRCTO,AUTO` / `RETURN,0`, at the level the cycle started from (G98).
@@ -51,6 +55,7 @@ class Cycle:
     dwell: float  # seconds at the bottom; 0: none
     to_start: bool  # retract to the level the cycle started from (G98), else to the R plane (G99)
     record: Record
+    retract: float | None = None  # SolidWorks CAM's RTRCTO: the start level's height above each hole
 
     @property
     def code(self) -> int:
@@ -82,6 +87,7 @@ def parse_cycle(rec: Record) -> Cycle | None:
         dwell=_dwell(rec, kind, values),
         to_start=_to_start(rec, values),
         record=rec,
+        retract=_start_height(rec, values),
     )
 
 
@@ -118,6 +124,8 @@ def _bottom(rec: Record, values: dict[str, float | str]) -> float:
         raise NcppError(f"CYCLE/{rec.args[0]}: expected the hole's depth as DEPTH, d or FEDTO, -d", rec.where)
     bottom = -depth if depth is not None else fedto
     assert bottom is not None
+    if _solidworks(values):
+        bottom = -bottom  # the depth below the point
     if not bottom < 0:
         raise NcppError(
             f"CYCLE/{rec.args[0]}: the hole's bottom is {bottom:g} from the cycle point, not below it",
@@ -155,9 +163,24 @@ def _dwell(rec: Record, kind: str, values: dict[str, float | str]) -> float:
     return dwell
 
 
+def _solidworks(values: dict[str, float | str]) -> bool:
+    """SolidWorks CAM's form: FEDTO gives the hole's depth, above 0 (NX's FEDTO is below the point)."""
+    fedto = _number(values, "FEDTO")
+    return fedto is not None and fedto > 0
+
+
+def _start_height(rec: Record, values: dict[str, float | str]) -> float | None:
+    """SolidWorks CAM's RTRCTO, v other than the R plane: the start level's height above each hole."""
+    level = _number(values, "RTRCTO")
+    if level is None or not _solidworks(values) or abs(level - _r_plane(rec, values)) <= LEVEL_TOL:
+        return None
+    return level
+
+
 def _to_start(rec: Record, values: dict[str, float | str]) -> bool:
-    """G98 for RTRCTO, AUTO and Creo's RETURN, 0; a retract level elsewhere than the R plane is refused."""
-    if values.get("RTRCTO") == "AUTO" or values.get("RETURN") == 0.0:
+    """G98 for RTRCTO, AUTO, Creo's RETURN, 0 and SolidWorks CAM's RTRCTO above the R plane (checked
+    hole by hole against the start level); another retract level than the R plane is refused."""
+    if values.get("RTRCTO") == "AUTO" or values.get("RETURN") == 0.0 or _start_height(rec, values):
         return True
     for key in ("RTRCTO", "RETURN"):
         level = _number(values, key)
@@ -210,6 +233,10 @@ class Driller:
                 f"CYCLE/{cycle.kind}: the R plane {r:g} is not above the hole's bottom {bottom:g}",
                 cycle.record.where,
             )
+        if cycle.retract is not None and abs(top[2] + cycle.retract - self.start_z) > LEVEL_TOL:
+            raise NcppError(f"CYCLE/{cycle.kind}: RTRCTO, {cycle.retract:g} retracts to {top[2] + cycle.retract:g}, "
+                            f"not to the level the cycle started from ({self.start_z:g}): not posted",
+                            cycle.record.where)  # fmt: skip
         series = self.last_r is None or (cycle.to_start and r != self.last_r)
         if series and self.last_r is not None:  # G98 with another R: a new series from where the tool is
             self.start_z = pos[2]

@@ -4,14 +4,21 @@ interpreter makes, so that the compensation passes and writers serve both.
 APT semantics used here:
 * `RAPID` makes the next motion a rapid traverse only (it is not modal).
 * `CIRCLE/ x,y,z, i,j,k, r [, ...]` (Creo: 7 values; NX: 11, the extra
-  four are tolerance and tool data) announces that the following `GOTO`s run
+  four are tolerance and tool data; SolidWorks CAM: 6, no radius, the tool
+  being on the circle already) announces that the following `GOTO`s run
   on the circle with centre (x,y,z) around axis (i,j,k), turning by the right
-  hand rule about that axis.  Consecutive `GOTO`s that stay on the circle are
-  one arc (CAM systems split arcs at quadrants); the first `GOTO` off it is a
+  hand rule about that axis (Creo, "CL Output for Circular Interpolation"), or,
+  in NX's 11-value form, clockwise about it: NX CLSF files turn every arc by at
+  most a half turn that way, by the right-hand rule by more.  Consecutive `GOTO`s
+  that stay on the circle and go on in its direction are one arc (CAM systems
+  split arcs at quadrants); the first `GOTO` off it, or back against it, is a
   line again.  Axis must be ±X, ±Y or ±Z (planes G19, G18, G17).
 * `MULTAX` + `GOTO/ x,y,z,i,j,k`: a tool vector.  A 3-axis machine can follow
   it only while it stays constant; a changing vector is refused.
-* `GOHOME` returns to the `FROM` point (rapid); `GOHOME/Z` moves Z only.
+* `GOHOME` returns to the `FROM` point (rapid); `GOHOME/Z` moves Z only;
+  `GOHOME/x,y,z` (NX) names the home point itself.
+* Motion this module does not model (`NURBS/` splines, `GODLTA/`, ...) is refused:
+  passed through as a comment, its move would be missing from the program.
 * Under `CYCLE/DRILL` (and the other cycles of `ncpp.cldata.cycles`) a `GOTO` is a
   hole's top: its moves are the canned cycle's, marked `fixed` (compensation leaves
   them as programmed, as the NC interpreter's); `CYCLE/OFF` ends the cycle.
@@ -34,6 +41,7 @@ from ncpp.motion.segments import COMP, CYCLE, PLANE_AXES, Arc, Context, Event, L
 from ncpp.program.blocks import Block
 
 ON_CIRCLE_TOL = 1e-3  # mm (or inch): GOTO within this of the circle lies on it
+NX_CIRCLE_VALUES = 11  # NX: centre, axis, radius, tolerance, and three of tool data
 VECTOR_TOL = 1e-6  # tool vector components: "constant"
 AXIS_TOL = 1e-6
 
@@ -74,19 +82,24 @@ class _Circle:
 
     def __init__(self, record: Record, start: Point):
         values = record.numbers
-        if len(values) < 7:
+        if record.words:  # NX's TIMES, n (turns of a helix), ...: the arc would be guessed
+            raise NcppError(f"CIRCLE with {', '.join(record.words)}: ncpp posts a CIRCLE of numbers only "
+                            "(centre, axis, radius, ...)", record.where)  # fmt: skip
+        if len(values) < 6:
             raise NcppError(
-                f"CIRCLE needs centre, axis and radius (7 values), got {len(values)}", record.where
+                f"CIRCLE needs centre and axis (6 values) and the radius, got {len(values)}", record.where
             )
         self.record = record
         self.plane, self.sign = _plane(values[3:6], record)
+        if len(values) == NX_CIRCLE_VALUES:
+            self.sign = -self.sign  # NX turns clockwise about the axis it writes
         self.i, self.j, self.n = PLANE_AXES[self.plane]
-        self.radius = values[6]
         c = list(_position(record, values))
         c[self.n] = start[self.n]  # Arc.center carries the start's normal coordinate
         self.center: Point = (c[0], c[1], c[2])
         self.start = start
         r0 = self._in_plane_radius(start)
+        self.radius = values[6] if len(values) > 6 else r0  # without a radius: the tool is on the circle
         if abs(r0 - self.radius) > ON_CIRCLE_TOL:
             raise NcppError(
                 f"the tool ({start[0]:g}, {start[1]:g}, {start[2]:g}) is {r0:.4f} from the CIRCLE centre, "
@@ -111,7 +124,12 @@ class _Circle:
             abs(p[self.n] - last[self.n]) <= ON_CIRCLE_TOL
             and abs(last[self.n] - self.start[self.n]) <= ON_CIRCLE_TOL
         )
-        return flat and abs(self._in_plane_radius(p) - self.radius) <= ON_CIRCLE_TOL
+        on_circle = abs(self._in_plane_radius(p) - self.radius) <= ON_CIRCLE_TOL
+        return flat and on_circle and self._step(last, p) <= math.pi  # (a step back is a line)
+
+    def _step(self, a: Point, b: Point) -> float:
+        """The angle from a to b turning the circle's way, in [0, 2 pi)."""
+        return (self.sign * (self._angle(b) - self._angle(a))) % (2 * math.pi)
 
     def add(self, p: Point, record: Record) -> None:
         if not self.points and abs(self._in_plane_radius(p) - self.radius) > ON_CIRCLE_TOL:
@@ -120,9 +138,9 @@ class _Circle:
                 record.where,
             )
         prev = self.points[-1] if self.points else self.start
-        step = (self.sign * (self._angle(p) - self._angle(prev))) % (2 * math.pi)
-        if step <= 1e-12:
-            step = 2 * math.pi  # back where it was: a full turn
+        step = self._step(prev, p)
+        if step <= 1e-12 and not self.points:
+            step = 2 * math.pi  # the first GOTO back where the arc starts: a full turn
         self.sweep += step
         self.points.append(p)
 
@@ -180,6 +198,22 @@ def _check_along_z(unit: tuple[float, ...], rec: Record) -> None:
             "the post drives a 3-axis machine whose tool points along Z (0, 0, 1)",
             rec.where,
         )
+
+
+# Majors that move the tool along a path other than GOTO lines and CIRCLE arcs: NX CLSF's
+# NURBS/ (with KNOT/ and CNTRL/ records), APT's incremental and direction motion words
+UNMODELLED_MOTION = frozenset("NURBS GODLTA GOFWD GOBACK GOLFT GORGT GOUP GODOWN MOVARC".split())
+
+
+def _home_target(rec: Record, home: Point | None, pos: Point) -> Point:
+    """Where GOHOME goes: NX's `GOHOME/x,y,z[,i,j,k]` names the point; otherwise the FROM point,
+    for the axes named (`GOHOME/Z` moves Z only) or all three."""
+    if len(rec.numbers) >= 3:
+        return _position(rec, rec.numbers)
+    assert home is not None
+    named = [a for a in "XYZ" if a in rec.words] or list("XYZ")
+    x, y, z = (home[k] if a in named else pos[k] for k, a in enumerate("XYZ"))
+    return (x, y, z)
 
 
 def cutter_side(rec: Record) -> str:
@@ -275,16 +309,19 @@ def motion(
             if len(values) < 3:
                 raise NcppError("FROM needs x, y, z", rec.where)
             pos = home = _position(rec, values)
-        elif major == "GOHOME" and home is not None and pos is not None:
-            # GOHOME/Z (and the like) sends only the named axes home.
-            named = [a for a in "XYZ" if a in rec.words] or list("XYZ")
-            x, y, z = (home[k] if a in named else pos[k] for k, a in enumerate("XYZ"))
-            target: Point = (x, y, z)
+        elif major in UNMODELLED_MOTION:
+            raise NcppError(f"{major}/ moves the tool along a path ncpp does not post (it posts GOTO lines "
+                            "and CIRCLE arcs): passed through, the move would be missing", rec.where)  # fmt: skip
+        elif major == "GOHOME" and pos is not None and (home is not None or len(rec.numbers) >= 3):
+            target = _home_target(rec, home, pos)
             yield Line(pos, target, True, feed, _block(rec), context, fixed=fixed)
             pos, rapid_next = target, False
             if driller is not None:  # the generator ends the canned cycle for the move: a new series
                 driller = Driller(driller.cycle, pos[2], context.inch)
             continue
+        elif major == "GOHOME":  # passed through, the move home would be missing
+            raise NcppError("GOHOME without a FROM point or a position before it: where home is is not "
+                            "known (NX's GOHOME/x,y,z names it)", rec.where)  # fmt: skip
         elif major == "RAPID":
             rapid_next = True
         elif major == "FEDRAT" and rec.numbers:
@@ -293,6 +330,9 @@ def motion(
             inch = units_inch(rec)
             offset: Point = (zero[0] / 25.4, zero[1] / 25.4, zero[2] / 25.4) if inch else zero
             context = replace(context, inch=inch, offset=offset)  # program units
+        elif major == "CYCLE" and rec.words[:1] == ("INIT",):
+            if warnings is not None:  # SolidWorks CAM's mark before each cycle record: no motion of its own
+                warnings.warn("CYCLE/INIT has no machine function: nothing is written for it", rec.where)
         elif major == "CYCLE":
             cycle = parse_cycle(rec)
             if cycle is not None and pos is None:

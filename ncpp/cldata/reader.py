@@ -25,9 +25,11 @@ KNOWN = frozenset(
     """PARTNO UNITS MULTAX FROM GOTO RAPID FEDRAT SPINDL LOADTL LOAD CUTTER COOLNT CIRCLE
     INDIRV TLAXIS GOHOME FINI MACHIN PPRINT INSERT REMARK TITLE OPERATOR END STOP OPSTOP
     CYCLE DELAY CUTCOM""".split()
-)
+) | {"TOOL PATH"}  # NX CLSF's operation header: a comment
 
 Value = float | str
+# Other spellings of a major word, read as the one ncpp knows (SolidWorks CAM writes UNIT/MM)
+ALIASES = {"UNIT": "UNITS"}
 
 
 @dataclass(frozen=True, slots=True)
@@ -72,10 +74,12 @@ class _ToRecord(Transformer):
         return item
 
     def text_record(self, major, text=None):
-        return major.upper(), (str(text).strip().removeprefix("/").strip(),) if text is not None else ()
+        name = " ".join(major.upper().split())  # "TOOL  PATH" is TOOL PATH
+        return name, (str(text).strip().removeprefix("/").strip(),) if text is not None else ()
 
     def record(self, name, args=()):
-        return name.upper(), tuple(args)
+        major = name.upper()
+        return ALIASES.get(major, major), tuple(args)
 
     def args(self, *items):
         return [i for i in items if i is not None]

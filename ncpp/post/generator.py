@@ -19,7 +19,8 @@ from ncpp.cldata.motion import MAX_WORD, cutter_side, units_inch
 from ncpp.cldata.reader import Record
 from ncpp.errors import Location, NcppError, Warnings
 from ncpp.motion.segments import PLANE_AXES, Arc, Event, Line, Pass, Point, replace
-from ncpp.program.blocks import Block
+from ncpp.program.blocks import UNREADABLE, Block, Statement
+from ncpp.program.parser import LineParser
 
 SetupLookup = Callable[[Event], "Record | None"]
 # Records that only set the interpretation of later motion: nothing to write.
@@ -88,6 +89,7 @@ class Generator:
 
     decimals_mm = 4
     decimals_inch = 5
+    grammar = "iso"  # the NC grammar (ncpp.program.parser) that reads what the generator writes
 
     def __init__(
         self, warnings: Warnings | None = None, header: str | None = None, file: str = "<stdin>"
@@ -101,6 +103,7 @@ class Generator:
         self.position: list[str | None] = [None, None, None]  # coordinate text last written per axis
         self.feed: float | None = None
         self.tool: int | None = None
+        self.line_parser: LineParser | None = None  # made for the first INSERT/
 
     # -- the stream -------------------------------------------------------------
     def write(self, events: Iterable[Event], setup: SetupLookup) -> Iterator[str]:
@@ -181,7 +184,7 @@ class Generator:
         elif major in ("PPRINT", "REMARK", "TITLE", "OPERATOR"):
             yield from self.emit_comment(" ".join(str(a) for a in rec.args))
         elif major == "INSERT":
-            yield " ".join(str(a) for a in rec.args)  # APT: literal NC text for the control
+            yield from self._insert(rec)
         elif major == "STOP":
             yield from self.emit_m(0)
         elif major == "OPSTOP":
@@ -197,6 +200,29 @@ class Generator:
             yield from self.emit_cutcom(cutter_side(rec))
         else:  # vendor words: ncpp.cldata.motion has warned already
             yield from self.emit_comment(_one_line(rec.text))
+
+    def _insert(self, rec: Record) -> Iterator[str]:
+        """APT INSERT/: literal NC text for the control, when the control reads it as a block;
+        SolidWorks CAM writes tool and stock descriptions there, which become comments."""
+        text = " ".join(str(a) for a in rec.args)
+        if not self._reads(text, rec):
+            self.warnings.warn(
+                "INSERT/ text is no block of the control; passed through as a comment", rec.where
+            )
+            yield from self.emit_comment(text)
+            return
+        yield text
+
+    def _reads(self, text: str, rec: Record) -> bool:
+        """Does the control read `text` as a block?  (The ISO parser marks what it cannot read,
+        the Heidenhain one refuses it.)"""
+        if self.line_parser is None:
+            self.line_parser = LineParser(self.grammar)
+        try:
+            block = self.line_parser.parse(text, line=rec.line, file=self.file)
+        except NcppError:
+            return False
+        return not any(isinstance(item, Statement) and item.kind == UNREADABLE for item in block.items)
 
     def _hole(self, line: Line) -> Iterator[str]:
         """A hole's moves: the first writes the hole's canned cycle, each sets where it leaves the tool."""

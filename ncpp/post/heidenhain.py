@@ -33,6 +33,8 @@ def signed(value: float, decimals: int) -> str:
 
 
 class HeidenhainGenerator(Generator):
+    grammar = "heidenhain"
+
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
         self.pending_tool: int | None = None

@@ -15,6 +15,7 @@ from ncpp.post.iso import IsoGenerator
 
 
 class SinumerikGenerator(IsoGenerator):
+    grammar = "sinumerik"
     tape_marks = False
     keep_point = False
 

@@ -74,7 +74,7 @@ FROM/0,0,50
 RAPID
 GOTO/10,0,0
 FEDRAT/MMPM,300
-CIRCLE/0,0,0,0,0,1,10,0.01,0.5,10,0
+CIRCLE/0,0,0,0,0,-1,10,0.01,0.5,10,0
 GOTO/0,10,0
 GOTO/-10,0,0
 GOTO/0,-10,0
@@ -86,6 +86,7 @@ FINI
 
 
 def test_nx_circle_gotos_collapse_into_one_full_turn():
+    # NX's 11-value CIRCLE turns clockwise about its axis: about -Z, counterclockwise in XY.
     events = events_of(NX_ARC)
     moves = [e for e in events if not isinstance(e, Pass)]
     kinds = [type(e).__name__ for e in moves]
