@@ -26,6 +26,7 @@ from ncpp.motion.segments import (
     PATTERN,
     PLANE_AXES,
     TAP_OUT,
+    UNPLACED,
     Arc,
     Event,
     Line,
@@ -40,6 +41,7 @@ REASONS = {
     COMP: "cutter compensation",
     HOME: "G28/G30 return",
     MACHINE: "machine-coordinate move",
+    UNPLACED: "move from a position ncpp is not told",
 }
 OUT_OF_SCOPE = "out of scope"
 TRAVEL_END = "at a travel end"
@@ -207,6 +209,7 @@ _WHY = {
     "cutter compensation": "under cutter compensation",
     "G28/G30 return": "of G28/G30 returns",
     "machine-coordinate move": "in machine coordinates",
+    "move from a position ncpp is not told": "from a position ncpp is not told (after M140 MB MAX)",
     TRAVEL_END: "with an axis held at a travel end",
 }
 

@@ -74,7 +74,19 @@ from ncpp.motion.modal import (
     as_point,
     placed_interpreting,
 )
-from ncpp.motion.segments import COMP, FLOW, MACHINE, PATTERN, PLANE_AXES, Arc, Event, Line, Pass, Point
+from ncpp.motion.segments import (
+    COMP,
+    FLOW,
+    MACHINE,
+    PATTERN,
+    PLANE_AXES,
+    UNPLACED,
+    Arc,
+    Event,
+    Line,
+    Pass,
+    Point,
+)
 from ncpp.motion.tools import ToolTable, UntoldLengths
 from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
 
@@ -1073,7 +1085,7 @@ class HeidenhainInterpreter(ModalInterpreter):
         block that names the axis absolutely, which puts it where the program says."""
         for event in events:
             if type(event) is Line or type(event) is Arc:
-                event.fixed = MACHINE
+                event.fixed = UNPLACED
         self.unknown_axes -= {n for n, axis in enumerate(AXES) if axis in words}
 
     def _set_pole(self, block: Block, end: list[float], written: set[int]) -> Pole:

@@ -14,7 +14,7 @@ import sys
 
 from ncpp.errors import Warnings
 from ncpp.motion.offsets import WorkOffsets
-from ncpp.motion.segments import MACHINE, Line
+from ncpp.motion.segments import MACHINE, UNPLACED, Line
 from ncpp.pipeline import dialect_tools
 from ncpp.program.dialects import parse_program
 from tests.conftest import READING, ROOT
@@ -73,7 +73,7 @@ def test_after_mb_max_moves_are_left_as_programmed_until_a_block_names_the_tool_
     )
     moves = lines(text)
     retract, across, down, cut = moves[4:8]
-    assert [m.fixed for m in (retract, across, down)] == [MACHINE] * 3 and not cut.fixed
+    assert [m.fixed for m in (retract, across, down)] == [MACHINE, UNPLACED, UNPLACED] and not cut.fixed
     assert down.end[2] == 5.0 and cut.start == down.end
 
 
