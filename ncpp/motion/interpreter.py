@@ -336,18 +336,19 @@ class Interpreter:
         expansion = self.expansion
         for block, kind, owner in flow.steps(blocks):
             if kind is not RUN and kind is not FIXED:  # text that does not run here
+                ended = self.done or block.verbatim  # (verbatim: after the closing `%`)
                 if expansion is not None:
-                    kept = expansion.text(kind, self.done, block)  # (None: left out)
+                    kept = expansion.text(kind, ended, block)  # (None: left out)
                     if kept is None:
                         continue
                     if pending is not None:
                         held.extend(kept)
                     else:
                         yield from kept
-                if block.signature is None:
+                if block.signature is None and not block.verbatim:
                     _warn_unreadable(block, warnings)
                 text = Pass(
-                    block, kind is SKIP, None if self.done else self.motion
+                    block, kind is SKIP or block.verbatim, None if ended else self.motion
                 )  # (after the end: no mode the control is in)
                 if pending is not None:
                     held.append(text)
