@@ -134,7 +134,13 @@ class FanucInterpreter(Interpreter):
 
 
 class HaasInterpreter(FanucInterpreter):
+    """Haas: also a P on G73 and G83, the pause at the bottom of each hole after its last peck, which
+    holds for the cycle's next blocks until it is cancelled (Haas Mill Operator's Manual 96-8000, "G73
+    High-Speed Peck Drilling Canned Cycle" and "G83 Normal Peck Drilling Canned Cycle": "P Optional
+    pause at end of last peck, in seconds"): the holes' moves are those without it."""
+
     settings = HAAS_SETTINGS
+    peck_dwell = True
     unfollowed = HAAS_UNFOLLOWED
     additional = "G154"
     g54_with_p = False  # (Haas's manual gives G54 no P)

@@ -21,6 +21,9 @@ that run out of the text's order yield nothing.
 Fanuc subprograms run the same way: `M98 P<n> [L<repeats>]` calls the
 program `O<n>` of the file, or of a file `O<n>` (`O<n>.nc`) on the subroutine path, which
 ends with `M99` (#1-#30 are the caller's, as in LinuxCNC; the other scoping is a call's).
+A Fanuc or Haas file may hold more programs after the first one's closing `%`, each a program
+in the control's memory that a call finds (`Dialect.programs_after_end`); the main program
+ends at that `%`, and the text after it runs only where called.
 
 Fanuc macro B runs here too (the Fanuc operator's manuals, Series 16i/18i B-63684EN and 0i,
 "Custom macro": "Branch and repetition", "Macro call"):
@@ -219,6 +222,9 @@ class Flow:
         # A Fanuc subprogram's lines to the next program number (`_rest_of_program`), by the id of
         # its lines to its first M99 (kept in `subprograms`, so an id is never another's)
         self._whole_programs: dict[int, list[Block]] = {}
+        # The verbatim blocks the text starts with: a Fanuc tape leader (`parser._leader`, within
+        # the blocks read ahead); a verbatim block after them stands after the closing `%`
+        self.leader = 0
 
     # -- the stream ------------------------------------------------------------
     def steps(self, blocks: Iterable[Block]) -> Iterator[tuple[Block, str, Block | None]]:
@@ -254,7 +260,7 @@ class Flow:
                         or "O" in signature
                         or "P" in signature
                         or "G6" in signature
-                    ) and _notable(block):
+                    ) and (block.verbatim or _notable(block)):
                         if not hold:
                             self.base = self.read
                         self._keep(block)
@@ -272,6 +278,8 @@ class Flow:
                     return
                 continue
             block = self._block(frame, frame.pc)
+            if block is not None and block.verbatim and frame.space is None and frame.pc >= self.leader:
+                break  # past the closing `%`: the programs after it run only when called
             if block is None:  # the end of the text (a subroutine's ends with its endsub)
                 if frame.space is not None:  # skipped past its endsub
                     skipped = self.skipping or ""
@@ -352,6 +360,8 @@ class Flow:
                 break
             index = self.read - 1
             block = self.buffer[index]
+            if block.verbatim and index == self.leader:
+                self.leader += 1
             number = sequence_number(block)
             if number is not None:
                 first.setdefault(number, index)
@@ -452,8 +462,8 @@ class Flow:
             if not fanuc:
                 self._definitions[lines[0].line] = lines
             self._defining = None
-        elif fanuc and len(lines) > MAX_SUBPROGRAM:  # a program's own number, not a subprogram
-            self._defining = None
+        elif fanuc and (len(lines) > MAX_SUBPROGRAM or _starts_program(block)):
+            self._defining = None  # a program's own number (or one ended by `%`), not a subprogram
 
     # -- control lines -----------------------------------------------------------
     # _NAMED: an o-word line's handler sees its name as a str (`_control` evaluates `o[expr]`
@@ -868,6 +878,8 @@ class Flow:
             return found
         index = frame.pc + 1
         while (ahead := self._block(frame, index)) is not None:
+            if ahead.verbatim and index >= self.leader:  # past the closing `%`: another program
+                break
             if sequence_number(ahead) == number:
                 return index
             index += 1

@@ -241,6 +241,8 @@ class Interpreter:
     arc_normal_offset_ignored = False
     # G33.1 is LinuxCNC's rigid tap (`_rigid_tap`); a control without it leaves it out of scope
     rigid_tapping = True
+    # G73/G83 take a P, the dwell at the bottom of each hole (Haas); rs274ngc refuses it there
+    peck_dwell = False
 
     def __init__(self, file: str = "<stdin>", offsets: WorkOffsets | None = None):
         self.file = file
@@ -261,7 +263,7 @@ class Interpreter:
         self.cycle_r = self.cycle_cc = self.cycle_q = self.cycle_il = 0.0
         self.cycle_ijk = (0.0, 0.0, 0.0)  # G87's sticky I J K
         self.cycle_holes = False  # the series' cycles are compensated hole by hole (`Hole`)
-        self.cycle_p = 0.0  # G82 G89's dwell, seconds (sticky within the cycle)
+        self.cycle_p = 0.0  # G82 G89's dwell, seconds (sticky within the cycle; Haas: G73 G83 too)
         self.expand_cycles = False  # cycles are written as their moves (`expanded`)
         self.expansion: Expansion | None = None  # --expand: loops and subroutines written out
         self.spindle = 0  # M3 1, M4 -1, stopped 0 (tapping and boring cycles check it)
@@ -336,18 +338,19 @@ class Interpreter:
         expansion = self.expansion
         for block, kind, owner in flow.steps(blocks):
             if kind is not RUN and kind is not FIXED:  # text that does not run here
+                ended = self.done or block.verbatim  # (verbatim: after the closing `%`)
                 if expansion is not None:
-                    kept = expansion.text(kind, self.done, block)  # (None: left out)
+                    kept = expansion.text(kind, ended, block)  # (None: left out)
                     if kept is None:
                         continue
                     if pending is not None:
                         held.extend(kept)
                     else:
                         yield from kept
-                if block.signature is None:
+                if block.signature is None and not block.verbatim:
                     _warn_unreadable(block, warnings)
                 text = Pass(
-                    block, kind is SKIP, None if self.done else self.motion
+                    block, kind is SKIP or block.verbatim, None if ended else self.motion
                 )  # (after the end: no mode the control is in)
                 if pending is not None:
                     held.append(text)
@@ -1054,8 +1057,9 @@ class Interpreter:
         if "P" in words:
             p, p_item = words["P"]
             user_m = any(100.0 <= m <= 199.0 for m in mcodes)
+            peck_p = self.peck_dwell and motion in PECKING
             if not (mode0 in (10.0, 4.0) or gcodes.get(13, (None,))[0] == 64.0 or motion in _P_MOTIONS
-                    or mcodes.keys() & _P_MCODES or user_m):  # fmt: skip
+                    or mcodes.keys() & _P_MCODES or user_m or peck_p):  # fmt: skip
                 self._fail("P word with no G2 G3 G4 G10 G64 G5 G5.2 G71 G76 G82 G86 G88 G89 or M50 M51 M52 M53 "
                            "M62 M63 M64 M65 M66 or user M code to use it", block, p_item)  # fmt: skip
             if motion in (2.0, 3.0):
@@ -1513,11 +1517,16 @@ class Interpreter:
         with --expand-cycles moves like any other (`_expanded`)."""
         first, second, normal = PLANE_AXES[self.plane]
         again = previous == motion  # the same cycle again: R, the normal-axis word, P and Q are sticky
-        if previous not in CANNED:  # a new series: G98 retracts to where it started
-            self.cycle_il = self.pos[normal]
+        if previous not in CANNED:  # a new series: G98 retracts to where it started, no dwell yet
+            self.cycle_il, self.cycle_p = self.pos[normal], 0.0
         aa, bb, step_a, step_b, r, bottom = self._cycle_geometry(block, words, again, item)
         repeats = self._repeats(block, words)
         peck = self._cycle_word(block, words, motion, again, item)
+        if self.expand_cycles and self.peck_dwell and motion in PECKING and self.cycle_p > 0.0:
+            self._fail(f"--expand-cycles: G{motion:g} with a dwell P cannot be written as G0/G1 moves and a "
+                       "G4 (whether this control reads a G4's P as the cycle's is not known to ncpp); leave "
+                       "the option out, the cycle is then compensated", block,
+                       words.get("P", (0, item))[1])  # fmt: skip
         if motion in (74.0, 84.0) and self.plane != 17:  # rs274ngc's taps move other axes there
             raise _OutOfScope(f"canned cycle G{motion:g} outside the XY plane", item.start + 1)
         if motion in SPINDLE:

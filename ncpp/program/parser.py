@@ -207,6 +207,10 @@ class Dialect:
     before it is scanned, which keeps the time and memory of a line bounded.
     `leader`: text before the program start `%` (within the first `LEADER_LINES` lines) is a
     tape leader the control skips, as Fanuc's do.
+    `programs_after_end`: the text after the closing `%` may hold more programs, each O-number
+    program one the control keeps in memory for M98 and G65 to call (Fanuc operator's manual,
+    "Program configuration"; Haas Mill Operator's Manual, "Subprograms"): it is parsed too, its
+    blocks still `verbatim` (`_after_end`).
     `read_where_run`: a line the grammar cannot read is an error where it runs, not where it stands (rs274ngc reads only the
     lines it runs: an uncalled subroutine, an untaken branch, the text after M2
     may hold anything): it becomes a block of one `unreadable` statement.
@@ -221,6 +225,7 @@ class Dialect:
     max_line: int = 256
     max_line_source: str = "rs274ngc (LinuxCNC) holds a line in LINELEN, 256 characters"
     leader: bool = False  # lines before a first `%` line are a tape leader, not read (`_leader`)
+    programs_after_end: bool = False  # the lines after the closing `%` are parsed (`_after_end`)
 
 
 def dialect_syntax(dialect: str | Dialect) -> Dialect:
@@ -816,12 +821,14 @@ def parse_stream(
     stream: Iterable[bytes], file: str = "<stdin>", grammar: str | Dialect = "iso"
 ) -> Iterator[Block]:
     """Blocks of a program, lazily.  After the closing `%` lines are kept verbatim
-    (a control stops reading there).  `grammar` names the dialect (or is one)."""
+    (a control stops reading there; `Dialect.programs_after_end`: parsed as well).  `grammar`
+    names the dialect (or is one)."""
     parser = LineParser(grammar)
     if parser.dialect.continuation:
         yield from _parse_continued(parser, iter_lines(stream), file)
         return
     tape_marks = 0
+    after_end = parser.dialect.programs_after_end
     lines: Iterable[tuple[str, str]] = iter_lines(stream)
     skipped: list[tuple[str, str]] = []
     if parser.dialect.leader:
@@ -830,7 +837,10 @@ def parse_stream(
             yield Block(content, eol, (), number, verbatim=True)
     for number, (content, eol) in enumerate(lines, start=len(skipped) + 1):
         if tape_marks >= 2:
-            yield Block(content, eol, (), number, verbatim=True)
+            if after_end:
+                yield _after_end(parser, content, eol, number, file)
+            else:
+                yield Block(content, eol, (), number, verbatim=True)
             continue
         block = parser.parse(content, eol, number, file)
         if block.items and type(block.items[0]) is Statement and block.items[0].kind == "tape":
@@ -856,6 +866,17 @@ def _leader(lines: Iterable[tuple[str, str]]) -> tuple[list[tuple[str, str]], It
     head = list(islice(lines, LEADER_LINES))
     start = next((k for k, (content, _) in enumerate(head) if _TAPE_MARK.match(content)), 0)
     return head[:start], chain(head[start:], lines)
+
+
+def _after_end(parser: LineParser, content: str, eol: str, number: int, file: str) -> Block:
+    """A line after the closing `%` of a file that may hold more programs: verbatim (text the
+    program does not run), with its items for a call to find and run; a line the parser refuses
+    (too long, CR line ends) is a line it cannot read, an error only where a call runs it."""
+    try:
+        items = parser.parse(content, eol, number, file).items
+    except NcppError as err:
+        items = (Statement(UNREADABLE, (err,), 0, len(content)),)
+    return Block(content, eol, items, number, verbatim=True)  # (no signature: no fast path takes it)
 
 
 def _stray_tape_mark(block: Block) -> Block:

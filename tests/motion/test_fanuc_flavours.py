@@ -186,3 +186,68 @@ def test_g1_in_a_return_block_is_still_refused():
     """Only the G0 that posts write is read so: G1 with G28 stays LinuxCNC's refusal."""
     with pytest.raises(NcppError, match="two g codes that both use axis values"):
         events("G21 G90\nG1 G28 G91 Z0. F100\nM30\n", "fanuc")
+
+
+# Haas G73/G83 with P: from (0, 0, 5), G98, holes at X10 and X20, R2, bottom -10, pecks of 4 mm; between
+# pecks G83 goes out to R and G73 up by rs274ngc's 0.254 mm, both back in to 0.254 mm above the last peck
+PECK_DWELL = "%\nO1\nG21 G90 G54\nG0 X0 Y0 Z5\nG{g} G98 X10 Y0 Z-10 R2 Q4 P500 F100\nX20\nG80\nM30\n%\n"
+
+
+def peck_hole(x: float, g: int) -> list[tuple[str, tuple[float, float, float]]]:
+    moves = [("STRAIGHT_TRAVERSE", (x, 0, 5)), ("STRAIGHT_TRAVERSE", (x, 0, 2))]
+    for depth in (-2, -6):
+        moves.append(("STRAIGHT_FEED", (x, 0, depth)))
+        moves += [("STRAIGHT_TRAVERSE", (x, 0, 2))] if g == 83 else []
+        moves.append(("STRAIGHT_TRAVERSE", (x, 0, round(depth + 0.254, 9))))
+    return moves + [("STRAIGHT_FEED", (x, 0, -10)), ("STRAIGHT_TRAVERSE", (x, 0, 5))]
+
+
+@pytest.mark.parametrize("g", [73, 83])
+def test_haas_g73_g83_take_a_dwell_p_and_drill_the_same_holes(g):
+    """Haas Mill Operator's Manual 96-8000, "G73 High-Speed Peck Drilling Canned Cycle" and "G83 Normal
+    Peck Drilling Canned Cycle": P, the pause at the bottom of each hole after its last peck.  The
+    holes' moves, computed by hand, are those without it; Fanuc's formats take no P (refused, as rs274)."""
+    from ncpp.motion.canon import canon_call
+
+    calls = [canon_call(e) for e in events(PECK_DWELL.format(g=g), "haas")]
+    found = [(c.name, tuple(round(v, 9) for v in c.args[:3])) for c in calls if c is not None]
+    assert found == [("STRAIGHT_TRAVERSE", (0, 0, 5)), *peck_hole(10, g), *peck_hole(20, g)]
+    with pytest.raises(NcppError, match="P word with no G2 G3 G4"):
+        events(PECK_DWELL.format(g=g), "fanuc")
+
+
+@pytest.mark.parametrize("g", [73, 83])
+def test_a_haas_peck_cycle_with_p_is_compensated_with_its_p_and_verified(tmp_path, g):
+    program, out = tmp_path / "p.nc", tmp_path / "out.nc"
+    program.write_text(PECK_DWELL.format(g=g))
+    command = ["compensate", "--machine", str(READING), "--dialect", "haas", str(program), "-o", str(out)]
+    proc = subprocess.run([sys.executable, "-m", "ncpp", *command], capture_output=True, text=True, cwd=ROOT)
+    moves = 1 + len(peck_hole(10, g)) * 2
+    assert proc.returncode == 0 and f"compensated {moves} moves" in proc.stderr, proc.stderr
+    cycle = next(line for line in out.read_text().splitlines() if line.startswith(f"G{g} "))
+    assert cycle.endswith(" Q4 P500 F100") and cycle != f"G{g} G98 X10 Y0 Z-10 R2 Q4 P500 F100"
+    # written as G0/G1 moves the dwell would need a G4, whose P this control may read otherwise: refused
+    expand = [sys.executable, "-m", "ncpp", *command, "--expand-cycles"]
+    expanded = subprocess.run(expand, capture_output=True, text=True, cwd=ROOT)
+    assert expanded.returncode != 0 and "p.nc:5:" in expanded.stderr and "with a dwell P" in expanded.stderr
+    # a G82's dwell holds in the G83 after it, until G80 cancels it (the manual: "The same dwell time
+    # applies to all subsequent blocks that do not specify a dwell time")
+    for between, refused in (("", True), ("G80\n", False)):
+        program.write_text(f"%\nO1\nG21 G90\nG0 X0 Y0 Z5\nG82 X10 Y0 Z-10 R2 P1 F100\n{between}"
+                           f"G{g} X20 Y0 Z-10 R2 Q4\nG80\nM30\n%\n")  # fmt: skip
+        proc = subprocess.run(expand, capture_output=True, text=True, cwd=ROOT)
+        assert (proc.returncode != 0) is refused and ("with a dwell P" in proc.stderr) is refused, proc.stderr
+
+
+@pytest.mark.parametrize("g", [73, 83])
+def test_haas_peck_holes_are_rs274s_of_the_cycle_without_p(tmp_path, g):
+    from ncpp.motion.canon import canon_call, read_canon
+    from tests.motion.test_oracle import rs274, same_calls
+
+    if not RS274.exists():
+        pytest.skip("rs274 not available")
+    twin = tmp_path / "twin.ngc"
+    twin.write_text(PECK_DWELL.format(g=g).replace(" P500", ""))
+    reference = read_canon(rs274(str(twin))[0])
+    mine = [c for c in (canon_call(e) for e in events(PECK_DWELL.format(g=g), "haas")) if c is not None]
+    assert len(mine) == len(reference) and same_calls(reference, mine), (reference, mine)

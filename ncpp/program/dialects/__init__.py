@@ -94,11 +94,13 @@ ISO = Dialect("iso", "iso", _ItemBuilder, fast_terminals=LineParser.FAST_TERMINA
 # runs, it reaches the interpreter as a line the grammar cannot read
 GRBL = Dialect("grbl", "iso", _ItemBuilder, fast_terminals=LineParser.FAST_TERMINALS, read_where_run=True)
 FANUC = Dialect(
-    "fanuc", "iso", _ItemBuilder, fast_terminals=LineParser.FAST_TERMINALS, read_where_run=True, leader=True
-)
+    "fanuc", "iso", _ItemBuilder, fast_terminals=LineParser.FAST_TERMINALS, read_where_run=True, leader=True,
+    programs_after_end=True,
+)  # fmt: skip
 HAAS = Dialect(
-    "haas", "iso", _ItemBuilder, fast_terminals=LineParser.FAST_TERMINALS, read_where_run=True, leader=True
-)
+    "haas", "iso", _ItemBuilder, fast_terminals=LineParser.FAST_TERMINALS, read_where_run=True, leader=True,
+    programs_after_end=True,
+)  # fmt: skip
 # File name endings that name a dialect when the content does not tell.
 SUFFIXES = {".h": "heidenhain", ".mpf": "sinumerik", ".spf": "sinumerik"}
 

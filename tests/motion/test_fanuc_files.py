@@ -1,0 +1,147 @@
+"""A Fanuc or Haas file that holds several programs, each between `%` marks or one after another:
+each O-number program is one the control keeps in memory, which `M98 Pn` and `G65 Pn` call (Fanuc
+operator's manual, "Program configuration" and "Subprogram"; Haas Mill Operator's Manual,
+"Subprograms": M98 calls a program in memory by its O number).  The text after the first program's
+closing `%` runs only when called, and passes through as it is.
+
+Judged by moves computed by hand, and by LinuxCNC's rs274 on the twin that holds the subprogram in
+the first program's text (rs274 reads a Fanuc-style `O1002 ... M99` there, not after the `%`)."""
+
+from __future__ import annotations
+
+import io
+import subprocess
+import sys
+
+import pytest
+
+from ncpp.errors import NcppError, Warnings
+from ncpp.motion.canon import canon_call, read_canon
+from ncpp.program.parser import parse_text
+from tests.conftest import READING, ROOT, RS274
+from tests.motion.test_fanuc_flavours import PATHCHECK, events
+from tests.motion.test_oracle import rs274, same_calls
+
+MAIN = "%\nO1001\nG21 G90 G54\nG0 X0 Y0 Z5\nM98 P1002 L2\nG0 X1\n"
+SUB = "O1002\nG91 G1 Z-1 F100\nG90 X10\nM99\n%\n"
+# The ways a file holds the two programs: each between its own `%` marks, one after the other
+# behind one `%`, and a first program that its closing `%` ends (no M30)
+LAYOUTS = {
+    "each between % marks": MAIN + "M30\n%\n%\n" + SUB,
+    "one after the other": MAIN + "M30\n%\n(the subprogram)\n" + SUB,
+    "ended by its %": MAIN + "%\n%\n" + SUB,
+}
+# The same moves as LinuxCNC reads them: the subprogram after M30, inside the first program's `%`
+TWIN = MAIN + "M30\n" + SUB
+# O1002 runs twice from (0, 0, 5): down 1 mm, across to X10, down 1 mm, X10 again; then X1
+BY_HAND = [
+    ("STRAIGHT_TRAVERSE", (0, 0, 5)),
+    ("STRAIGHT_FEED", (0, 0, 4)), ("STRAIGHT_FEED", (10, 0, 4)),
+    ("STRAIGHT_FEED", (10, 0, 3)), ("STRAIGHT_FEED", (10, 0, 3)),
+    ("STRAIGHT_TRAVERSE", (1, 0, 3)),
+]  # fmt: skip
+
+
+def moves(program: str, dialect: str, said: io.StringIO | None = None) -> list[tuple[str, tuple]]:
+    calls = [canon_call(e) for e in events(program, dialect, Warnings(stream=said or io.StringIO()))]
+    return [(c.name, tuple(round(v, 9) for v in c.args[:3])) for c in calls if c is not None]
+
+
+@pytest.mark.parametrize("layout", LAYOUTS)
+@pytest.mark.parametrize("dialect", ["fanuc", "haas"])
+def test_m98_runs_a_program_that_stands_after_the_closing_percent(layout, dialect):
+    said = io.StringIO()
+    assert moves(LAYOUTS[layout], dialect, said) == BY_HAND
+    assert said.getvalue() == ""
+
+
+@pytest.mark.parametrize("dialect", ["fanuc", "haas"])
+def test_g65_calls_a_macro_after_the_closing_percent_with_its_arguments(dialect):
+    program = "%\nO1\nG21 G90\nG0 X0 Y0 Z5\nG65 P2 A3 B-2\nM30\n%\n%\nO2\nG1 X#1 Y#2 F100\nM99\n%\n"
+    assert moves(program, dialect) == [("STRAIGHT_TRAVERSE", (0, 0, 5)), ("STRAIGHT_FEED", (3, -2, 5))]
+
+
+@pytest.mark.parametrize("layout", LAYOUTS)
+def test_the_moves_are_rs274s_of_the_twin_with_the_subprogram_in_the_first_program(tmp_path, layout):
+    if not RS274.exists():
+        pytest.skip("rs274 not available")
+    twin = tmp_path / "twin.ngc"
+    twin.write_text(TWIN)
+    reference = read_canon(rs274(str(twin))[0])
+    mine = [c for c in (canon_call(e) for e in events(LAYOUTS[layout], "fanuc")) if c is not None]
+    assert len(mine) == len(reference) == len(BY_HAND) and same_calls(reference, mine), (reference, mine)
+
+
+def compensate(tmp_path, text: str, *options: str) -> tuple[str, subprocess.CompletedProcess]:
+    program, out = tmp_path / "p.nc", tmp_path / "out.nc"
+    program.write_text(text)
+    command = ["compensate", "--machine", str(READING), "--dialect", "fanuc", *options, str(program),
+               "-o", str(out)]  # fmt: skip
+    proc = subprocess.run([sys.executable, "-m", "ncpp", *command], capture_output=True, text=True, cwd=ROOT)
+    assert proc.returncode == 0, proc.stderr
+    return out.read_text(), proc
+
+
+@pytest.mark.parametrize("layout", LAYOUTS)
+def test_the_text_after_the_closing_percent_passes_through_as_it_is(tmp_path, layout):
+    """Compensated (the call's moves left as programmed) and verified; the subprogram's text
+    unchanged, though the main program's mode (G0) is another than its own where it stands (no
+    motion code put before its M99); and with no machine file the whole file unchanged."""
+    text = LAYOUTS[layout]
+    written, proc = compensate(tmp_path, text)
+    rest = text.split("%\n", 2)[2]
+    assert written.endswith(rest) and "M98 P1002 L2\n" in written
+    assert "left as programmed: 4 moves in loops or subroutines (line 5)" in proc.stderr
+    bare = {"PATH": "/usr/bin:/bin", "HOME": str(tmp_path)}  # (no machine file from the environment)
+    plain = subprocess.run([sys.executable, "-m", "ncpp", "filter", str(tmp_path / "p.nc")],
+                           capture_output=True, cwd=ROOT, env=bare)  # fmt: skip
+    assert plain.returncode == 0 and plain.stdout == text.encode(), plain.stderr
+
+
+@pytest.mark.parametrize("layout", [name for name, text in LAYOUTS.items() if "M30" in text])  # (as the twin)
+def test_expanded_the_calls_follow_rs274s_path_of_the_twin(tmp_path, layout):
+    """--expand writes the calls as straight code, each move compensated; rs274 runs the result
+    (it would not find O1002 after the `%`) along the twin's path (pathcheck: same actions,
+    within 0.05 mm, rapids where the twin rapids), and the text after the end is kept."""
+    if not (RS274.exists() and PATHCHECK.exists()):
+        pytest.skip("rs274 or pathcheck not available")
+    written, _ = compensate(tmp_path, LAYOUTS[layout], "--expand")
+    assert "M98" not in written and written.endswith(SUB)
+    expanded, twin = tmp_path / "expanded.ngc", tmp_path / "twin.ngc"
+    expanded.write_text(written)
+    twin.write_text(TWIN)
+    check = subprocess.run([sys.executable, str(PATHCHECK), str(twin), str(expanded), "--tol-mm", "0.05"],
+                           capture_output=True, text=True, timeout=600)  # fmt: skip
+    assert check.returncode == 0, check.stdout + check.stderr
+
+
+def test_a_goto_of_the_first_program_does_not_jump_into_a_program_after_it():
+    program = "%\nO1\nG21 G90\nG0 X0 Y0 Z5\nGOTO 7\nN5 G0 X2\nM30\n%\n%\nO2\nN7 G0 X3\nM99\n%\n"
+    with pytest.raises(NcppError, match="GOTO 7: the program has no block N7"):
+        events(program, "fanuc")
+
+
+def test_a_line_after_the_end_that_cannot_be_read_is_an_error_only_where_a_call_runs_it():
+    long_line = "G1 X" + "1" * 300 + "\n"
+    uncalled = "%\nO1\nG21 G90\nG0 X0 Y0 Z5\nM30\n%\n%\nO2\n" + long_line + "G1 X1 [\nM99\n%\n"
+    said = io.StringIO()
+    assert moves(uncalled, "fanuc", said) == [("STRAIGHT_TRAVERSE", (0, 0, 5))] and said.getvalue() == ""
+    called = uncalled.replace("M30", "M98 P2\nM30")
+    with pytest.raises(NcppError, match="block too long") as err:
+        events(called, "fanuc")
+    assert err.value.where is not None and err.value.where.line == 10
+
+
+def test_a_program_the_percent_ends_before_its_m99_is_not_a_subprogram():
+    said = io.StringIO()
+    program = "%\nO1\nG21 G90\nG0 X0 Y0 Z5\nM98 P2\nM30\n%\nO2\nG1 X1 F100\n%\nG1 X2\nM99\n"
+    assert moves(program, "fanuc", said) == [("STRAIGHT_TRAVERSE", (0, 0, 5))]
+    assert "M98 P2: a subprogram the program does not define" in said.getvalue()
+
+
+def test_linuxcnc_reads_nothing_after_the_closing_percent():
+    """rs274ngc stops reading a file at its closing `%`: the lines after it stay unparsed there."""
+    text = "%\nG0 X1\n%\nO2\nG1 X1\nM99\n"
+    for dialect, parsed in (("iso", False), ("fanuc", True)):
+        after = parse_text(text, grammar=dialect)[3:]
+        assert all(b.verbatim for b in after) and all(bool(b.items) is parsed for b in after)
