@@ -19,6 +19,8 @@ from operator import itemgetter
 from pathlib import Path
 from typing import BinaryIO
 
+import numpy as np
+
 from ncpp import __version__
 from ncpp.errors import Location, NcppError, Warnings
 from ncpp.guard import Placement, ToolGuard, with_guard, without_guard
@@ -430,7 +432,9 @@ def process(
         lines = verified(lines, reached, original, file=file, dialect=name, offsets=offsets,
                          bound=Bound(source.max_correction + tolerance))  # fmt: skip
     lines = iter(lines)
-    with _rare_collections():
+    # (a number past a float's range, such as a tool 1e308 mm long, becomes inf or NaN, which the
+    # checks before writing refuse with its line: numpy's warnings on the way would say it first, unlocated)
+    with _rare_collections(), np.errstate(over="ignore", invalid="ignore"):
         while batch := list(islice(lines, 4096)):  # written in batches: one encode and write per 4096 lines
             text = "".join(batch)
             out.write(text.encode("latin-1"))
