@@ -8,6 +8,7 @@ import subprocess
 
 import pytest
 
+from ncpp.verify import MAX_CHORDS
 from tests.conftest import RS274, SHARED
 
 MACHINE = SHARED / "machines/wide.toml"
@@ -73,7 +74,7 @@ def test_an_arc_round_a_centre_far_past_any_travel_is_refused_in_bounded_memory(
     assert done.returncode == 2 and b"Traceback" not in done.stderr and b"Warning" not in done.stderr
     assert done.stderr.decode().endswith(
         f"{program}:4:1: verification: an arc of 6,283,186 chords within the tolerance is more than ncpp "
-        "verifies at once (2,097,152): split it, or give a wider --tolerance\n"
+        f"verifies at once ({MAX_CHORDS:,}): split it, or give a wider --tolerance\n"
     )
 
 
