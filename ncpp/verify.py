@@ -982,7 +982,14 @@ class _Nearby:
             return None
         step = within / 4
         a, b = starts[rest], ends[rest]
-        counts = np.maximum(1, np.ceil(np.sqrt(((b - a) ** 2).sum(axis=1)) / step)).astype(np.int64)
+        lengths = np.sqrt(((b - a) ** 2).sum(axis=1))
+        samples = np.maximum(1, np.ceil(lengths / step))
+        if samples.sum() > self.LOOKED_AT:  # (the points are held at once)
+            raise NcppError(
+                f"verification: a move of {lengths.max():,.0f} mm, too long to verify at points {step:g} mm "
+                "apart (--no-verify writes the program unverified)"
+            )
+        counts = samples.astype(np.int64)
         which = np.repeat(np.arange(len(rest)), counts + 1)
         first = np.concatenate(([0], np.cumsum(counts + 1)[:-1]))
         t = (np.arange(len(which)) - first[which]) / counts[which]
@@ -1000,7 +1007,7 @@ class _Nearby:
                     return int(rest[which[batch + k]]), some[k]
         return None
 
-    LOOKED_AT = 2_000_000  # segments a run may look at one by one (`_beyond`)
+    LOOKED_AT = 2_000_000  # segments a run may look at one by one (`_beyond`), and points of moves set aside
 
     def _beyond(self, point: np.ndarray, allowed: float) -> bool:
         """Whether no segment here passes within `allowed` of the point, looked at one by one
