@@ -67,9 +67,9 @@ def _beside(target: Path) -> Iterator[tuple[BinaryIO, Callable[[], None]]]:
         fd, named[0] = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=str(target.parent))
 
     def put_in_place() -> None:
-        if named[0] is None:
-            named[0] = _link_beside(fd, target)
-        os.replace(named[0], target)
+        name = named[0] if named[0] is not None else _link_beside(fd, target)
+        named[0] = name
+        os.replace(name, target)
 
     try:
         with os.fdopen(fd, "wb") as out:

@@ -91,7 +91,8 @@ class KlartextFlow:
         self.counters: dict[int, int] = {}  # a REP call's index -> the repeats still to run
         self.marks: dict[int, int] = {}  # a REP call's index -> `CountedPasses.ended`'s mark
         self.label_indices: set[int] = set()  # the indices of the LBL blocks read
-        self.label_steps: dict[int, int] = {}  # a LBL's index -> the steps when it last ran (a section's start)
+        # a LBL's index -> `CountedPasses.steps` when it last ran (where a section's first pass starts)
+        self.label_steps: dict[int, int] = {}
         self.current = -1  # the index of the block the interpreter runs
         self.next: int | None = None  # where the block running sends the program (None: the next)
         self.last_run_move = -1  # the index of the last block whose moves ran in place (RUN)
@@ -186,7 +187,9 @@ class KlartextFlow:
                 self.counters[self.current] = left - 1
                 line = self.held[self.current - self.base].line
                 mark = self.marks.get(self.current, self.label_steps.get(index))
-                self.marks[self.current] = self.passes.ended(mark, self.rerun, left - 1, line, "CALL LBL ... REP")
+                self.marks[self.current] = self.passes.ended(
+                    mark, self.rerun, left - 1, line, "CALL LBL ... REP"
+                )
                 self.next = index + 1
             else:
                 del self.counters[self.current]

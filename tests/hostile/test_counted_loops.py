@@ -58,22 +58,32 @@ M30
 @pytest.mark.parametrize("expand", [(), ("--expand",)], ids=["", "expand"])
 @pytest.mark.parametrize(
     "name, text, line",
-    [("repeat.ngc", REPEAT, 3), ("nested.ngc", NESTED_REPEAT, 3), ("loop.h", KLARTEXT, 11),
-     ("loop.mpf", SINUMERIK, 8)],  # fmt: skip
+    [
+        ("repeat.ngc", REPEAT, 3),
+        ("nested.ngc", NESTED_REPEAT, 3),
+        ("loop.h", KLARTEXT, 11),
+        ("loop.mpf", SINUMERIK, 8),
+    ],  # fmt: skip
 )
-def test_a_counted_loop_past_the_bound_is_refused_at_its_line_at_once(ncpp, tmp_path, name, text, line, expand):
+def test_a_counted_loop_past_the_bound_is_refused_at_its_line_at_once(
+    ncpp, tmp_path, name, text, line, expand
+):
     program = tmp_path / name
     program.write_text(text)
     done = ncpp("compensate", "--machine", str(MACHINE), str(program), "-o", str(tmp_path / "out"), *expand,
                 timeout=20 if expand else 15)  # fmt: skip
     assert done.returncode == 2
     message = done.stderr.decode()
-    assert f"{program}:{line}:1: " in message and f"more than {MAX_RERUN:,} lines run again" in message, message
+    assert f"{program}:{line}:1: " in message and f"more than {MAX_RERUN:,} lines run again" in message, (
+        message
+    )
     assert not (tmp_path / "out").exists()
 
 
 def test_a_loop_of_a_hundred_thousand_passes_still_runs(ncpp, tmp_path):
     program = tmp_path / "many.ngc"
     program.write_text(REPEAT.replace("1000000000", "100000"))
-    done = ncpp("compensate", "--machine", str(MACHINE), str(program), "-o", str(tmp_path / "out"), timeout=120)
+    done = ncpp(
+        "compensate", "--machine", str(MACHINE), str(program), "-o", str(tmp_path / "out"), timeout=120
+    )
     assert done.returncode == 0, done.stderr

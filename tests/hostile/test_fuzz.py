@@ -28,7 +28,9 @@ SEED = int(os.environ.get("NCPP_FUZZ_SEED", "0"))
 SECONDS_PER_CASE = 60.0  # (a loop that never ends is refused after MAX_RERUN lines: under a minute)
 MEMORY_MB = 1536  # the worker's address space (a compensation run maps under 200 MB)
 LOCATED = re.compile(r"^(?!ncpp: )(?P<file>[^:\n]+):\d+:\d+: ")
-USAGE = re.compile(r"^ncpp[\w -]*: error: argument ")  # argparse refusing an option's value (`--work-offset nan,0,0`)
+USAGE = re.compile(
+    r"^ncpp[\w -]*: error: argument "
+)  # argparse refusing an option's value (`--work-offset nan,0,0`)
 
 
 def _files(folder: Path, *suffixes: str) -> list[Path]:
