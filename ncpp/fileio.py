@@ -1,6 +1,7 @@
 """Atomic output files: written to a temporary file beside the target and
 renamed into place only when complete, so a failed run never leaves a
-partial program or table behind.  And what the program files read are: their
+partial program or table behind (on Linux an anonymous file, named only then,
+so that not even a killed run leaves one).  And what the program files read are: their
 paths (`program_file`) and line counts."""
 
 from __future__ import annotations
@@ -8,10 +9,11 @@ from __future__ import annotations
 import contextlib
 import errno
 import os
+import secrets
 import shutil
 import stat
 import tempfile
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import BinaryIO
 
@@ -34,12 +36,12 @@ def atomic_output(path: str | os.PathLike[str]) -> Iterator[BinaryIO]:
         with _into_special(target) as out:
             yield out
         return
-    with _beside(target) as (out, tmp):
+    with _beside(target) as (out, put_in_place):
         yield out
         out.flush()
         os.fsync(out.fileno())
-        os.chmod(out.fileno(), held.st_mode & 0o777 if held is not None else 0o644)
-        os.replace(tmp, target)
+        os.chmod(out.fileno(), held.st_mode & 0o777 if held is not None else 0o666 & ~_umask())
+        put_in_place()
 
 
 @contextlib.contextmanager
@@ -55,16 +57,69 @@ def _into_special(target: Path) -> Iterator[BinaryIO]:
 
 
 @contextlib.contextmanager
-def _beside(target: Path) -> Iterator[tuple[BinaryIO, str]]:
-    """A temporary file in the target's folder, removed on error (a SIGTERM is one: `cli`)."""
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=str(target.parent))
+def _beside(target: Path) -> Iterator[tuple[BinaryIO, Callable[[], None]]]:
+    """A file in the target's folder, and the call that puts it in the target's place.  Where
+    Linux makes one, an anonymous file (O_TMPFILE) named only then, which a SIGKILL leaves no
+    trace of; elsewhere a named temporary, removed on error (a SIGTERM is one: `cli`)."""
+    fd = _anonymous_file(target.parent)
+    named: list[str | None] = [None]
+    if fd is None:
+        fd, named[0] = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=str(target.parent))
+
+    def put_in_place() -> None:
+        name = named[0] if named[0] is not None else _link_beside(fd, target)
+        named[0] = name
+        os.replace(name, target)
+
     try:
         with os.fdopen(fd, "wb") as out:
-            yield out, tmp
+            yield out, put_in_place
     except BaseException:
-        with contextlib.suppress(FileNotFoundError):
-            os.unlink(tmp)
+        if named[0] is not None:
+            with contextlib.suppress(FileNotFoundError):
+                os.unlink(named[0])
         raise
+
+
+def _anonymous_file(folder: Path) -> int | None:
+    """A descriptor of a new file in `folder` no name holds (Linux's O_TMPFILE, mode from the umask
+    as for any file created), or None where the system or its file system makes none."""
+    flag = getattr(os, "O_TMPFILE", None)
+    if flag is None or not os.path.isdir("/proc/self/fd"):  # (`_link_beside` names it through /proc)
+        return None
+    try:
+        return os.open(folder, flag | os.O_WRONLY, 0o666)
+    except OSError as err:
+        if err.errno in (errno.EOPNOTSUPP, errno.EISDIR, errno.EINVAL):
+            return None
+        raise
+
+
+def _link_beside(fd: int, target: Path) -> str:
+    """A name beside `target` given to the anonymous file `fd` (a name no file holds yet)."""
+    folder = os.open(target.parent, os.O_RDONLY | os.O_DIRECTORY)
+    try:
+        while True:
+            name = f".{target.name}.{secrets.token_hex(4)}.tmp"
+            try:  # (a folder's descriptor: Python 3.11's os.link calls linkat, which follows /proc's link)
+                os.link(f"/proc/self/fd/{fd}", name, dst_dir_fd=folder, follow_symlinks=True)
+                return str(target.parent / name)
+            except FileExistsError:
+                continue
+    finally:
+        os.close(folder)
+
+
+def _umask() -> int:
+    """This process's umask: Linux says it in /proc; elsewhere it is set and set back."""
+    with contextlib.suppress(OSError, ValueError):
+        with open("/proc/self/status", encoding="ascii", errors="replace") as status:
+            for line in status:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
 
 
 def write_text_atomic(path: str | os.PathLike[str], text: str, encoding: str = "utf-8") -> None:

@@ -19,6 +19,8 @@ from operator import itemgetter
 from pathlib import Path
 from typing import BinaryIO
 
+import numpy as np
+
 from ncpp import __version__
 from ncpp.errors import Location, NcppError, Warnings
 from ncpp.guard import ISO_SYNTAX, Placement, PlacementChecks, ToolGuard, with_guard, without_guard
@@ -287,6 +289,13 @@ def _reported(
         yield block
 
 
+def _continued(blocks: Iterable[Block], tally: list[int]) -> Iterator[Block]:
+    """The blocks, adding to tally[0] the lines past its first each spans (its raw text holds their ends)."""
+    for block in blocks:
+        tally[0] += block.raw.count("\n")
+        yield block
+
+
 def with_header(lines: Iterable[str], header: str, writer: IsoWriter, leader: bool = False) -> Iterator[str]:
     """Put the header comment first (a comment line per line of it), after a leading `%`
     tape mark line, or the first `%` below a tape leader the dialect's controls skip
@@ -375,6 +384,9 @@ def process(
     interpret, writer_class = dialect_tools(name)
     counter = count()
     blocks: Iterable[Block] = _counted(_parsed_ahead(parsed), counter, progress)
+    continued = [0]  # the lines past their first that `~`-continued blocks span
+    if get_dialect(name).continuation is not None:
+        blocks = _continued(blocks, continued)
     if not force:
         blocks = refuse_compensated(blocks, file)
     else:  # compensated again: the guard of the offset it was compensated for goes
@@ -432,11 +444,14 @@ def process(
         lines = verified(lines, reached, original, file=file, dialect=name, offsets=offsets,
                          bound=Bound(source.max_correction + tolerance))  # fmt: skip
     lines = iter(lines)
-    with _rare_collections():
+    # (a number past a float's range, such as a tool 1e308 mm long, becomes inf or NaN, which the
+    # checks before writing refuse with its line: numpy's warnings on the way would say it first, unlocated)
+    with _rare_collections(), np.errstate(over="ignore", invalid="ignore"):
         while batch := list(islice(lines, 4096)):  # written in batches: one encode and write per 4096 lines
-            out.write("".join(batch).encode("latin-1"))
-            stats.lines_out += len(batch)
-    stats.lines_in = next(counter)
+            text = "".join(batch)
+            out.write(text.encode("latin-1"))
+            stats.lines_out += text.count("\n") + (not text.endswith("\n"))  # (a block may be continued)
+    stats.lines_in = next(counter) + continued[0]
     if stats.summary is not None:
         stats.summary.lines_in, stats.summary.lines_out = stats.lines_in, stats.lines_out
     warnings.finish()

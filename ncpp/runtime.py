@@ -93,3 +93,23 @@ def terminate_as_interrupt() -> None:
         raise Terminated()
 
     signal.signal(signal.SIGTERM, raise_terminated)
+
+
+_PR_SET_PDEATHSIG = 1  # prctl's option (linux/prctl.h)
+
+
+def die_with_parent(parent: int) -> None:
+    """End this process (SIGKILL) when process `parent`, which started it, ends: a worker of
+    `compensate --jobs` must not go on writing programs for a run that was killed.  Linux only;
+    elsewhere nothing changes."""
+    import signal
+
+    if not sys.platform.startswith("linux"):
+        return
+    try:
+        prctl = ctypes.CDLL(None, use_errno=True).prctl
+    except (OSError, AttributeError):
+        return
+    prctl(_PR_SET_PDEATHSIG, int(signal.SIGKILL), 0, 0, 0)
+    if os.getppid() != parent:  # (it ended before the request was made)
+        os.kill(os.getpid(), signal.SIGKILL)

@@ -66,7 +66,7 @@ AFTER_MOTION = {0.0, 1.0, 2.0, 30.0, 60.0, 99.0}
 # Statements that are actions: Klartext's TOOL CALL, CYCL CALL and END PGM
 ACTION_STATEMENTS = {"tool_call", "cycle_call", "program_end"}
 CHUNK_MOVES = 4096  # moves of the input compared at a time between two actions
-MAX_CHORDS = 1 << 21  # chords the arcs of a section are sampled along at most (memory: under 700 MB)
+MAX_CHORDS = 1 << 19  # chords the arcs of a section are sampled along at most (about 1 kB of memory each)
 ACROSS = 0.25  # the share of a neighbouring chunk's samples each side is also compared with
 
 
@@ -156,7 +156,9 @@ class _Moves:
         arcs = _Arcs(self.arcs, starts, ends, offsets, units) if self.arcs else None
         if arcs is not None:
             counts[arcs.move] = arcs.chords(self.bound.chord)
-            if counts.sum() > MAX_CHORDS:  # (the section's samples are held at once)
+            # (the section's samples are held at once; a move's chords are rounded up, so the pieces a
+            # written program makes of an arc take up to one more each than the arc)
+            if counts.sum() > MAX_CHORDS + len(counts):
                 k = int(np.argmax(counts))
                 raise NcppError(
                     f"verification: an arc of {int(counts[k]):,} chords within the tolerance is more "
@@ -1034,7 +1036,14 @@ class _Nearby:
             return None
         step = within / 4
         a, b = starts[rest], ends[rest]
-        counts = np.maximum(1, np.ceil(np.sqrt(((b - a) ** 2).sum(axis=1)) / step)).astype(np.int64)
+        lengths = np.sqrt(((b - a) ** 2).sum(axis=1))
+        samples = np.maximum(1, np.ceil(lengths / step))
+        if samples.sum() > self.LOOKED_AT:  # (the points are held at once)
+            raise NcppError(
+                f"verification: a move of {lengths.max():,.0f} mm, too long to verify at points {step:g} mm "
+                "apart (--no-verify writes the program unverified)"
+            )
+        counts = samples.astype(np.int64)
         which = np.repeat(np.arange(len(rest)), counts + 1)
         first = np.concatenate(([0], np.cumsum(counts + 1)[:-1]))
         t = (np.arange(len(which)) - first[which]) / counts[which]
@@ -1052,7 +1061,7 @@ class _Nearby:
                     return int(rest[which[batch + k]]), some[k]
         return None
 
-    LOOKED_AT = 2_000_000  # segments a run may look at one by one (`_beyond`)
+    LOOKED_AT = 2_000_000  # segments a run may look at one by one (`_beyond`), and points of moves set aside
 
     def _beyond(self, point: np.ndarray, allowed: float) -> bool:
         """Whether no segment here passes within `allowed` of the point, looked at one by one

@@ -180,6 +180,16 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_rs274_runs_the_guarded_program_where_g54_matches_and_stops_it_where_not",
         ),
         "hostile/test_fuzz.py": ("test_fuzzed_inputs_are_refused_located_in_bounded_time_and_memory",),
+        "hostile/test_killed.py": (
+            "test_a_killed_run_leaves_no_file_beside_its_output",
+            "test_a_new_output_file_takes_its_mode_from_the_umask",
+        ),
+        "hostile/test_counted_loops.py": (
+            "test_a_counted_loop_past_the_bound_is_refused_at_its_line_at_once",
+            "test_a_loop_of_a_hundred_thousand_passes_still_runs",
+        ),
+        "hostile/test_many_turns.py": ("test_an_arc_of_ten_thousand_turns_is_compensated_in_bounded_memory",),
+        "hostile/test_huge_numbers.py": ("test_a_tool_1e308_mm_long_is_refused_without_a_numpy_warning",),
         "hostile/test_constructs.py": (
             "test_a_cycle_left_as_programmed_far_past_any_travel_is_verified_in_bounded_memory",
         ),
@@ -245,6 +255,7 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
         "compensation/test_several_programs.py": (
             "test_two_processes_write_each_program_as_its_own_run_does_and_report_the_one_that_fails",
         ),
+        "hostile/test_killed.py": ("test_the_workers_of_a_killed_run_stop_with_it",),
     },
 }
 

@@ -25,6 +25,7 @@ from ncpp.cli.io import add_io_arguments, open_input, open_output
 from ncpp.cli.options import at_least, positive
 from ncpp.cli.progress import progress_printer
 from ncpp.errors import NcppError, Warnings
+from ncpp.runtime import die_with_parent
 from ncpp.summary import write_report
 
 
@@ -321,14 +322,19 @@ def _executor(job: Job, workers: int) -> Executor:
     if workers <= 1:
         return _InProcess(job)
     context = multiprocessing.get_context("spawn")
-    return ProcessPoolExecutor(workers, mp_context=context, initializer=_start_worker, initargs=(job,))
+    return ProcessPoolExecutor(
+        workers, mp_context=context, initializer=_start_worker, initargs=(job, os.getpid())
+    )
 
 
 _job: Job | None = None  # the run's job, in each process that compensates
 
 
-def _start_worker(job: Job) -> None:
+def _start_worker(job: Job, parent: int | None = None) -> None:
+    """The job, in a process `parent` started: that process's end ends it (`die_with_parent`)."""
     global _job
+    if parent is not None:
+        die_with_parent(parent)
     _job = job
 
 

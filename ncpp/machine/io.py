@@ -76,6 +76,7 @@ from __future__ import annotations
 import math
 import os
 import re
+import sys
 import tomllib
 from collections.abc import Iterator
 from pathlib import Path
@@ -248,7 +249,17 @@ def loads_toml(text: str, file: str) -> dict:
                 raise NcppError(f"arrays or tables nested deeper than {MAX_TOML_NESTING}", where)
         elif char in "]}":
             depth = max(depth - 1, 0)
-    return tomllib.loads(text)
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError:
+        raise
+    except ValueError:  # (an integer of more digits than Python converts: sys.get_int_max_str_digits)
+        most = sys.get_int_max_str_digits()
+        found = re.search(rf"[0-9_]{{{most + 1},}}", text)
+        at = found.start() if found is not None else 0
+        line_start = text.rfind("\n", 0, at) + 1
+        where = Location(file, text.count("\n", 0, at) + 1, at - line_start + 1)
+        raise NcppError(f"a number of more than {most:,} digits", where) from None
 
 
 def loads_machine(text: str, file: str = "<string>") -> Machine:

@@ -120,6 +120,7 @@ class _Label:
     kind: str  # while, do, repeat; fanuc (WHILE ... DOm)
     start: int  # the line's index in its frame's space
     count: int = -1  # repeat: iterations still to run (-1: not counted yet)
+    mark: int | None = None  # repeat: `CountedPasses.ended`'s mark
 
 
 @dataclass
@@ -140,6 +141,27 @@ class _Frame:
     source: str | None = None  # the subroutine file its lines are from (None: the program's)
     macro: bool = False  # a Fanuc G65 macro call (its own level of local variables)
     modal: bool = False  # a macro G66 calls after a move
+
+
+class CountedPasses:
+    """The passes of counted loops (LinuxCNC's repeat, Klartext's CALL LBL REP, Sinumerik's FOR), each
+    measured in blocks stepped through: a loop whose passes still to run, each as long as the one just
+    ended, would run more than MAX_RERUN lines again is refused at once, at its line, not after them."""
+
+    def __init__(self, file: str):
+        self.file = file
+        self.steps = 0  # blocks the flow stepped through (in place or again): its flow counts them
+
+    def ended(self, mark: int | None, rerun: int, left: int, line: int | None, what: str) -> int:
+        """A loop ended a pass with `rerun` lines run again so far and `left` passes to run; `mark` is
+        what this returned when its previous pass ended (None: this is its first).  Returns the mark."""
+        if mark is not None and rerun + (self.steps - mark) * left > MAX_RERUN:
+            raise NcppError(
+                f"{what} would run {left:,} more passes of {self.steps - mark:,} blocks: more than "
+                f"{MAX_RERUN:,} lines run again, taken for a loop that does not end",
+                Location(self.file, line, 1),
+            )
+        return self.steps
 
 
 @dataclass(frozen=True)
@@ -206,6 +228,7 @@ class Flow:
         self.executed_if = False  # a branch of the if chain under way has run
         self.doing_break = self.doing_continue = False
         self.rerun = 0  # blocks run out of the text's order so far
+        self.passes = CountedPasses(file)
         # Control lines of the blocks held (a loop goes over them again and again), by id: an
         # entry leaves with its block (`_drop`), so an id is never that of another block
         self._controls: dict[int, Control | None] = {}
@@ -290,6 +313,7 @@ class Flow:
                         Location(self.file, frame.space[-1].line, None),
                     )
                 return  # LinuxCNC too ends a program whose file ends, in a loop or skipping
+            self.passes.steps += 1
             if not self._in_place(frame):
                 self.rerun += 1
                 if self.rerun > MAX_RERUN:
@@ -1004,9 +1028,11 @@ class Flow:
                 label.count = int(round_half_away(count))
             if label.count > 0:
                 label.count -= 1
+                what = f"o{_shown(control.name)} repeat"
+                label.mark = self.passes.ended(label.mark, self.rerun, label.count, block.line, what)
                 self._on(frame, None)()
             else:
-                label.count = -1
+                label.count, label.mark = -1, None
                 self._on(frame, control.name)()
 
         return test

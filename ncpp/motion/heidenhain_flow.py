@@ -25,7 +25,7 @@ import re
 from collections.abc import Callable, Iterable, Iterator
 
 from ncpp.errors import Location, NcppError
-from ncpp.motion.flow import FIXED, MAX_RERUN, RUN, SKIP, TEXT
+from ncpp.motion.flow import FIXED, MAX_RERUN, RUN, SKIP, TEXT, CountedPasses
 from ncpp.motion.modal import OutOfScope
 from ncpp.program.blocks import Block, Statement
 
@@ -89,10 +89,15 @@ class KlartextFlow:
         self.named_by_q = False  # a label defined by a Q parameter: no call or jump can be followed
         self.frames: list[tuple[int, float | str]] = []  # subprogram calls: (index to return to, label)
         self.counters: dict[int, int] = {}  # a REP call's index -> the repeats still to run
+        self.marks: dict[int, int] = {}  # a REP call's index -> `CountedPasses.ended`'s mark
+        self.label_indices: set[int] = set()  # the indices of the LBL blocks read
+        # a LBL's index -> `CountedPasses.steps` when it last ran (where a section's first pass starts)
+        self.label_steps: dict[int, int] = {}
         self.current = -1  # the index of the block the interpreter runs
         self.next: int | None = None  # where the block running sends the program (None: the next)
         self.last_run_move = -1  # the index of the last block whose moves ran in place (RUN)
         self.rerun = 0  # blocks run out of the text's order
+        self.passes = CountedPasses(file)
 
     # -- reading ------------------------------------------------------------------------
     def _read(self) -> None:
@@ -113,6 +118,7 @@ class KlartextFlow:
                 self.twice.add(label_key(item.node[0]))
             else:
                 self.labels[label_key(item.node[0])] = index
+                self.label_indices.add(index)
             return
         name = _reference(item)
         if name is not None and type(name) is not tuple and self.labels.get(label_key(name), index) < index:
@@ -179,9 +185,15 @@ class KlartextFlow:
             left = self.counters.get(self.current, repeat)
             if left:
                 self.counters[self.current] = left - 1
+                line = self.held[self.current - self.base].line
+                mark = self.marks.get(self.current, self.label_steps.get(index))
+                self.marks[self.current] = self.passes.ended(
+                    mark, self.rerun, left - 1, line, "CALL LBL ... REP"
+                )
                 self.next = index + 1
             else:
                 del self.counters[self.current]
+                self.marks.pop(self.current, None)
             return
         if any(label == key for _, label in self.frames):
             raise OutOfScope("a subprogram that calls itself", col)
@@ -220,6 +232,9 @@ class KlartextFlow:
                     stop("a subprogram without LBL 0 before the end of the program", owner)
                 break
             self.current, self.next = pc, None
+            self.passes.steps += 1
+            if pc in self.label_indices:
+                self.label_steps[pc] = self.passes.steps
             if in_place:
                 again = self.again and any(a <= pc <= b for a, b in self.again)
                 yield block, FIXED if again else RUN, None

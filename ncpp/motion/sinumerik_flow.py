@@ -43,7 +43,7 @@ from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 
 from ncpp.errors import Location, NcppError
-from ncpp.motion.flow import _TRIM, FIXED, MAX_RERUN, RUN, SKIP, TEXT
+from ncpp.motion.flow import _TRIM, FIXED, MAX_RERUN, RUN, SKIP, TEXT, CountedPasses
 from ncpp.motion.modal import OutOfScope
 from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
 
@@ -66,6 +66,7 @@ class _Open:
     kind: str  # if, while, for, repeat, loop
     start: int  # the index of its opening block
     end: float = 0.0  # FOR: the end value
+    mark: int | None = None  # FOR: `CountedPasses.ended`'s mark
 
 
 @dataclass
@@ -100,6 +101,7 @@ class SinumerikFlow:
         self.last_run_move = -1  # the index of the last block that moved in place (RUN): the interpreter's
         self.rerun = 0  # blocks run out of the text's order so far
         self.section: _Section | None = None  # a REPEAT's section running
+        self.passes = CountedPasses(file)
 
     # -- the stream ------------------------------------------------------------------
     def steps(self, blocks: Iterable[Block]) -> Iterator[tuple[Block, str, Block | None]]:
@@ -112,6 +114,7 @@ class SinumerikFlow:
                 break
             in_place = self.pc == self.written
             owner = None if in_place else self.buffer[self.written - 1 - self.base]
+            self.passes.steps += 1
             if not in_place:
                 self.rerun += 1
                 if self.rerun > MAX_RERUN:
@@ -267,7 +270,7 @@ class SinumerikFlow:
         self.assign(target, ("num", self.value(start, block, statement)), block, statement)
         last = self.value(end, block, statement)
         if self.value(target, block, statement) <= last:
-            self.open.append(_Open("for", self.pc, last))
+            self.open.append(_Open("for", self.pc, last, self.passes.steps))
             return self.pc + 1
         return self._match(self.pc, "for", statement) + 1
 
@@ -275,7 +278,10 @@ class SinumerikFlow:
         opened = self._top("for", statement)
         counter = _controls(self.buffer[opened.start - self.base])[0].node[0]  # (held while the loop runs)
         self.assign(counter, ("bin", "+", counter, ("num", 1.0)), block, statement)
-        if self.value(counter, block, statement) <= opened.end:
+        value = self.value(counter, block, statement)
+        if value <= opened.end:
+            left = int(min(opened.end - value, MAX_RERUN))  # (an end of 1e308 runs no more than this)
+            opened.mark = self.passes.ended(opened.mark, self.rerun, left, block.line, "FOR ... ENDFOR")
             return opened.start + 1
         self.open.pop()
         return self.pc + 1

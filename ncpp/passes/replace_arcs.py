@@ -64,6 +64,8 @@ BATCH_EVENTS = 4096
 # Turns of one arc at most: an arc's pieces are made at once (~8 kB a turn: 10,000 turns take
 # 170 MB; a helix of 10⁸ turns ran out of 24 GB).
 MAX_TURNS = 10_000
+# Pieces sampled and fitted together in a round of `_replace` (their samples' memory: `_slices`)
+ROUND_PIECES = 8192
 SLIVER = (
     0.01  # mm of arc length below which a piece becomes a line (its bulge is < 0.1 µm for radii over 0.1 mm)
 )
@@ -371,8 +373,7 @@ def _replace(arcs: _ArcRows, ctx: PassContext) -> _Fitted:
         length = np.abs(pending.sweep) * geometry.radius[pending.arc] * scales[pending.arc]
         counts = np.select([length < 2.0, length < 10.0], [3, 5], SAMPLES)  # see SAMPLES
         split = np.zeros(len(pending.arc), dtype=bool)
-        for m in np.unique(counts).tolist():
-            rows = np.flatnonzero(counts == m)
+        for m, rows in _slices(counts):
             some = _Pieces(pending.arc[rows], pending.a0[rows], pending.sweep[rows])
             split[rows] = _round(
                 some,
@@ -393,6 +394,16 @@ def _replace(arcs: _ArcRows, ctx: PassContext) -> _Fitted:
             np.repeat(half, 2),
         )
     return done
+
+
+def _slices(counts: NDArray) -> Iterator[tuple[int, NDArray]]:
+    """The pieces to sample `m` times, for each `m` in `counts`, ROUND_PIECES at a time: a round's
+    samples and their temporaries (a few kB a piece) are held for so many pieces at most, however
+    many turns an arc makes."""
+    for m in np.unique(counts).tolist():
+        rows = np.flatnonzero(counts == m)
+        for start in range(0, len(rows), ROUND_PIECES):
+            yield m, rows[start : start + ROUND_PIECES]
 
 
 def _round(

@@ -278,5 +278,6 @@ def case(rng: random.Random, folder: Path, n: int) -> list[str]:
     if mode == "compensate":
         return ["compensate", "--machine", MACHINE, *dialect, *extra, str(program), *out]
     if mode == "motion":
-        return ["motion", *dialect, *[e for e in extra if not e.startswith("--expand")], str(program)]
+        options = [e for e in extra if e not in ("--expand", "--expand-cycles")]  # (compensate's only)
+        return ["motion", *dialect, *options, str(program)]
     return [*dialect, str(program), *out]

@@ -143,6 +143,8 @@ def run_cases(cases: list[dict], seconds: float, results: Path) -> None:
                 result["status"] = main(case["argv"])
         except CaseTimeout:
             result["exception"] = "timeout"
+        except SystemExit as usage:  # (argparse's: a command line it refuses, said on stderr)
+            result["status"] = usage.code
         except BaseException as caught:  # a traceback the user would see
             result["exception"] = "".join(traceback.format_exception(caught))[-3000:]
         finally:

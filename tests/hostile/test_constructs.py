@@ -8,6 +8,7 @@ import subprocess
 
 import pytest
 
+from ncpp.verify import MAX_CHORDS
 from tests.conftest import RS274, SHARED
 
 MACHINE = SHARED / "machines/wide.toml"
@@ -61,6 +62,21 @@ def test_a_cycle_left_as_programmed_far_past_any_travel_is_verified_in_bounded_m
 
 
 @needs_machine
+def test_holes_of_a_modal_cycle_far_past_any_travel_are_refused_in_bounded_memory(ncpp, tmp_path):
+    """Incremental MCALL CYCLE81 holes a thousand kilometres apart: moves the verifier cannot
+    prove from their ends, whose points a quarter of the bound apart would number billions."""
+    program = tmp_path / "far.mpf"
+    program.write_text("G17 G90 G71 G94\nT1 D1\nM6\nG0 X10 Y20 Z50\nG1 F200 S500 M3\nG91\n"
+                       "MCALL CYCLE81(-1000000000, 1000000000, 0, 7)\nHOLES1(-5, -5, , 0.0001, -20, 12)\n"
+                       "MCALL\nM30\n")  # fmt: skip
+    done = ncpp("compensate", "--machine", str(MACHINE), str(program), "-o", str(tmp_path / "out.mpf"),
+                memory_mb=800, timeout=30)  # fmt: skip
+    said = done.stderr.decode()
+    assert done.returncode == 2 and "Traceback" not in said, said
+    assert f"{program}:8:1: verification: a move of 1,000,000,007 mm, too long to verify" in said, said
+
+
+@needs_machine
 def test_an_arc_round_a_centre_far_past_any_travel_is_refused_in_bounded_memory(ncpp, tmp_path):
     """A Klartext circle round a centre 1e300 mm away: sampling it along chords within the
     tolerance would take 6 million; the verifier refuses it at its line, no overflow warned."""
@@ -73,7 +89,7 @@ def test_an_arc_round_a_centre_far_past_any_travel_is_refused_in_bounded_memory(
     assert done.returncode == 2 and b"Traceback" not in done.stderr and b"Warning" not in done.stderr
     assert done.stderr.decode().endswith(
         f"{program}:4:1: verification: an arc of 6,283,186 chords within the tolerance is more than ncpp "
-        "verifies at once (2,097,152): split it, or give a wider --tolerance\n"
+        f"verifies at once ({MAX_CHORDS:,}): split it, or give a wider --tolerance\n"
     )
 
 

@@ -28,6 +28,9 @@ SEED = int(os.environ.get("NCPP_FUZZ_SEED", "0"))
 SECONDS_PER_CASE = 60.0  # (a loop that never ends is refused after MAX_RERUN lines: under a minute)
 MEMORY_MB = 1536  # the worker's address space (a compensation run maps under 200 MB)
 LOCATED = re.compile(r"^(?!ncpp: )(?P<file>[^:\n]+):\d+:\d+: ")
+USAGE = re.compile(
+    r"^ncpp[\w -]*: error: argument "
+)  # argparse refusing an option's value (`--work-offset nan,0,0`)
 
 
 def _files(folder: Path, *suffixes: str) -> list[Path]:
@@ -120,7 +123,7 @@ def _problems(case: dict, result: dict | None) -> list[str]:
         found.append(f"exit status {result['status']}")
     elif result["status"] == 2:
         last = [line for line in result["stderr"].splitlines() if line.strip()][-1:]
-        if not last or not LOCATED.match(last[0]):
+        if not last or not (LOCATED.match(last[0]) or USAGE.match(last[0])):
             found.append(f"not a located error: {last}")
     elif _passed_through(case["argv"]) is False:
         found.append("without a machine file the output is not the input byte for byte")

@@ -41,3 +41,10 @@ def test_a_measurement_problem_of_the_whole_file_points_at_its_instrument_line(n
     done = ncpp("analyze", str(path))
     assert done.returncode == 2 and b"\x1b" not in done.stderr
     assert done.stderr.decode().startswith(f"{path}:2:1: ")
+
+
+def test_an_integer_of_thousands_of_digits_is_a_located_error():
+    """(past Python's int digit limit tomllib's int() raised a ValueError: a traceback)"""
+    with pytest.raises(NcppError) as caught:
+        loads_machine("[machine]\nname = 'm'\n\n[limits]\nX = [-5, 1" + "0" * 5000 + "]\n", "m.toml")
+    assert str(caught.value) == "m.toml:5:10: a number of more than 4,300 digits"
