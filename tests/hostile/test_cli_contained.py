@@ -73,7 +73,9 @@ def test_a_terminated_run_removes_its_temporaries(tmp_path, sig, status):
         time.sleep(0.05)
     assert _writing_into(run.pid, tmp_path), "the run never started writing"
     run.send_signal(sig)
-    assert run.wait(timeout=60) == status, run.stderr.read()
+    # (a shell reports 128 + the signal either way: CPython ends a process by the signal itself when
+    # the KeyboardInterrupt it caught was raised in an import under way, as scipy's may be)
+    assert run.wait(timeout=60) in (status, -sig), run.stderr.read()
     assert b"Traceback" not in run.stderr.read()
     assert not list(tmp_path.glob(".out.nc.*")) and not out.exists() and not list(tmp.iterdir())
 
