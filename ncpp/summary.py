@@ -209,7 +209,7 @@ _WHY = {
     "cutter compensation": "under cutter compensation",
     "G28/G30 return": "of G28/G30 returns",
     "machine-coordinate move": "in machine coordinates",
-    "move from a position ncpp is not told": "from a position ncpp is not told (after M140 MB MAX)",
+    "move from a position ncpp is not told": "from a position ncpp is not told",
     TRAVEL_END: "with an axis held at a travel end",
 }
 

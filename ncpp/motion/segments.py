@@ -39,8 +39,8 @@ COMP = "cutter compensation"  # the control offsets the path by the tool's radiu
 HOME = "G28/G30 return"  # the control homes the axes it names (machine coordinates); the others stay where they stand
 # Klartext M91 and M140 MB, Sinumerik SUPA, G53 and G153: positions of the control's own
 MACHINE = "machine-coordinate move"
-# Klartext: moves from where `M140 MB MAX` left the tool, which ncpp is not told, up to the block that
-# names the tool axis again (in work coordinates, as programmed)
+# Klartext: moves from where the control left the tool on an axis ncpp is not told the position of
+# (after `M140 MB MAX`, a pattern's last hole), up to the block that names the axis again
 UNPLACED = "move from a position ncpp is not told"
 # A rigid tap's two moves (`Line.tap`; LinuxCNC's G33.1): the tap, which passes correct like any feed
 # move but never split (the control runs it as one motion synchronised with the spindle), and its

@@ -17,7 +17,7 @@ import sys
 
 import pytest
 
-from ncpp.motion.segments import DRILLED, MACHINE, PATTERN
+from ncpp.motion.segments import DRILLED, PATTERN, UNPLACED
 from ncpp.summary import REASONS
 from tests.conftest import ROOT, SHARED
 from tests.dialect_motion.test_heidenhain_cycles import CYCLE_200, compensate, moves, program
@@ -69,7 +69,7 @@ def test_a_row_turned_by_rot_and_single_positions_in_the_order_defined():
 
 def test_a_grid_and_its_frame_drill_their_holes_and_leave_x_and_y_unknown():
     """The manual does not give the order of a grid's holes: after it, the moves are the
-    control's (MACHINE) up to and with the first block naming X and Y."""
+    control's (UNPLACED) up to and with the first block naming X and Y."""
     grid = holes_drilled(patterned("PAT1 (X+10 Y+10 DX+10 DY+5 NUMX3 NUMY2 ROT+0 ROTX+0 ROTY+0 Z+0)"))
     assert sorted(grid) == sorted((10 + 10 * i, 10 + 5 * j) for i in range(3) for j in range(2))
     turn = math.radians(30)
@@ -81,7 +81,7 @@ def test_a_grid_and_its_frame_drill_their_holes_and_leave_x_and_y_unknown():
     found = sorted(holes_drilled(text))
     assert [c for h in found for c in h] == pytest.approx([c for h in sorted(expected) for c in h], abs=1e-9)
     after = [m for m in moves(text) if m.fixed != PATTERN]
-    assert [m.fixed for m in after[-3:]] == [MACHINE, MACHINE, ""]
+    assert [m.fixed for m in after[-3:]] == [UNPLACED, UNPLACED, ""]
 
 
 @pytest.mark.parametrize(
@@ -166,7 +166,7 @@ def test_a_row_after_a_grid_and_a_cycl_call_pos_put_x_and_y_where_the_holes_are_
         )
     position = moves(program(CYCLE_200, [grid, "CYCL CALL PAT FMAX", "CYCL CALL POS X+90 Y-7.5 Z+0 FMAX"]))
     plane = next(m for m in position if m.end[:2] == (90.0, -7.5) and m.fixed != DRILLED)
-    assert plane.fixed == MACHINE and not position[-1].fixed
+    assert plane.fixed == UNPLACED and not position[-1].fixed
 
 
 def test_ncpp_motion_prints_a_circles_holes_at_their_angles(tmp_path):
