@@ -48,6 +48,10 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_mmount_contours_land_within_the_tolerance",
         ),
         "motion/test_oracle.py": None,
+        "motion/test_fanuc_files.py": (
+            "test_the_moves_are_rs274s_of_the_twin_with_the_subprogram_in_the_first_program",
+            "test_expanded_the_calls_follow_rs274s_path_of_the_twin",
+        ),
         "hostile/test_constructs.py": ("test_rs274_refuses_a_modal_rigid_tap_block_without_its_k",),
         "shop/test_tool_guard.py": (
             "test_rs274_runs_the_program_with_the_told_table_and_stops_at_a_length_that_differs",
@@ -79,7 +83,10 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_placement_agrees_with_linuxcnc_started_from_the_same_parameter_file",
         ),
         "motion/test_corner_rounding.py": ("test_compensated_corners_are_plain_arcs_linuxcnc_accepts",),
-        "motion/test_fanuc_flavours.py": ("test_g0_in_a_return_block_is_the_modal_motion_after_it",),
+        "motion/test_fanuc_flavours.py": (
+            "test_g0_in_a_return_block_is_the_modal_motion_after_it",
+            "test_haas_peck_holes_are_rs274s_of_the_cycle_without_p",
+        ),
         "motion/test_cutter_comp.py": (
             "test_g41_checks_against_the_radius_of_the_tool_table_ncpp_is_told",
             "test_moves_after_compensation_agree_with_rs274",
@@ -117,6 +124,10 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
     },
     # a second and a half or more on a 2-core machine, all parameters together
     "slow": {
+        "interop/test_pygcode.py": ("test_block_to_pygcode_and_back_keeps_every_word_value",),
+        "motion/test_fanuc_flavours.py": (
+            "test_a_haas_peck_cycle_with_p_is_compensated_with_its_p_and_verified",
+        ),
         "compensation/test_cutter_comp_accuracy.py": ("test_mmount_contours_land_within_the_tolerance",),
         "compensation/test_rigid_tap.py": (
             "test_a_machine_with_reversal_errors_gets_no_step_inside_a_tap",
