@@ -1038,19 +1038,20 @@ class _Nearby:
         a, b = starts[rest], ends[rest]
         lengths = np.sqrt(((b - a) ** 2).sum(axis=1))
         samples = np.maximum(1, np.ceil(lengths / step))
-        if samples.sum() > self.LOOKED_AT:  # (the points are held at once)
+        if samples.sum() > self.SAMPLED:
             raise NcppError(
                 f"verification: a move of {lengths.max():,.0f} mm, too long to verify at points {step:g} mm "
                 "apart (--no-verify writes the program unverified)"
             )
         counts = samples.astype(np.int64)
-        which = np.repeat(np.arange(len(rest)), counts + 1)
-        first = np.concatenate(([0], np.cumsum(counts + 1)[:-1]))
-        t = (np.arange(len(which)) - first[which]) / counts[which]
-        points = a[which] + t[:, None] * (b - a)[which]
+        held = np.cumsum(counts + 1)  # the points of the segments up to each, its ends included
+        first = held - (counts + 1)
         allowed = within + step / 2
-        for batch in range(0, len(points), self.BATCH):  # (memory: k segments of each point at once)
-            some = points[batch : batch + self.BATCH]
+        for batch in range(0, int(held[-1]), self.BATCH):  # (memory: a batch of points at once)
+            index = np.arange(batch, min(batch + self.BATCH, int(held[-1])))
+            which = np.searchsorted(held, index, side="right")
+            t = (index - first[which]) / counts[which]
+            some = a[which] + t[:, None] * (b - a)[which]
             _, distance = self.distances(some, allowed, self.FEW)
             low = distance.min(axis=1) > allowed
             if low.any():
@@ -1058,10 +1059,11 @@ class _Nearby:
                 low[np.flatnonzero(low)] = again.min(axis=1) > allowed
             for k in np.flatnonzero(low).tolist():  # the nearest found were not all: every one within reach
                 if self._beyond(some[k], allowed):
-                    return int(rest[which[batch + k]]), some[k]
+                    return int(rest[which[k]]), some[k]
         return None
 
-    LOOKED_AT = 2_000_000  # segments a run may look at one by one (`_beyond`), and points of moves set aside
+    LOOKED_AT = 2_000_000  # segments a run may look at one by one (`_beyond`)
+    SAMPLED = 50_000_000  # points of moves set aside a run may look at (a batch at a time: time, not memory)
 
     def _beyond(self, point: np.ndarray, allowed: float) -> bool:
         """Whether no segment here passes within `allowed` of the point, looked at one by one

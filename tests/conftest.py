@@ -124,7 +124,6 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
     },
     # a second and a half or more on a 2-core machine, all parameters together
     "slow": {
-        "interop/test_pygcode.py": ("test_block_to_pygcode_and_back_keeps_every_word_value",),
         "motion/test_fanuc_flavours.py": (
             "test_a_haas_peck_cycle_with_p_is_compensated_with_its_p_and_verified",
         ),
@@ -251,7 +250,10 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_planned_lines_are_the_general_lines",
             "test_sinumerik_lines_by_plans_and_templates_are_the_general_ones",
         ),
-        "interop/test_pygcode.py": ("test_word_values_agree_with_pygcode_on_corpus",),
+        "interop/test_pygcode.py": (
+            "test_word_values_agree_with_pygcode_on_corpus",
+            "test_block_to_pygcode_and_back_keeps_every_word_value",
+        ),
         "identify/test_ballbar_fit.py": (
             "test_fit_and_predict_commands_with_ballbar_files",
             "test_a_laser_file_of_one_axis_fixes_the_scale_and_the_comparator_follows",

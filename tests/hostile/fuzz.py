@@ -124,7 +124,6 @@ class CaseTimeout(BaseException):
 def run_cases(cases: list[dict], seconds: float, results: Path) -> None:
     """Run each case (`argv` for `ncpp.cli.main`) and write a JSON line per case to `results`
     (standard output is the program's, which goes nowhere)."""
-    import resource
     import signal
     import traceback
 
@@ -150,9 +149,21 @@ def run_cases(cases: list[dict], seconds: float, results: Path) -> None:
         finally:
             signal.setitimer(signal.ITIMER_REAL, 0)
         result["stderr"] = "\n".join(line[:400] for line in err.getvalue().splitlines()[-20:])
-        result["peak_kb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+        result["peak_kb"] = _peak_kb()
         with open(results, "a") as f:
             f.write(json.dumps(result) + "\n")
+
+
+def _peak_kb() -> int:
+    """This process's own peak memory (/proc's VmHWM: getrusage's maxrss keeps that of the
+    process it was forked from, the test runner's, across exec)."""
+    import resource
+
+    try:
+        with open("/proc/self/status") as status:
+            return next(int(line.split()[1]) for line in status if line.startswith("VmHWM:"))
+    except (OSError, StopIteration):
+        return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
 
 
 if __name__ == "__main__":
