@@ -138,6 +138,7 @@ class _Frame:
     opened: dict[str, tuple[int, str, int]] = field(default_factory=dict)
     # a Fanuc subprogram (M98, G65): the runs still to make after this one; -1: an o-word call
     repeats: int = 0
+    mark: int | None = None  # its runs: `CountedPasses.ended`'s mark
     source: str | None = None  # the subroutine file its lines are from (None: the program's)
     macro: bool = False  # a Fanuc G65 macro call (its own level of local variables)
     modal: bool = False  # a macro G66 calls after a move
@@ -152,14 +153,16 @@ class CountedPasses:
         self.file = file
         self.steps = 0  # blocks the flow stepped through (in place or again): its flow counts them
 
-    def ended(self, mark: int | None, rerun: int, left: int, line: int | None, what: str) -> int:
+    def ended(self, mark: int | None, rerun: int, left: int, line: int | None, what: str,
+              file: str | None = None) -> int:  # fmt: skip
         """A loop ended a pass with `rerun` lines run again so far and `left` passes to run; `mark` is
-        what this returned when its previous pass ended (None: this is its first).  Returns the mark."""
+        what this returned when its previous pass ended (None: this is its first).  Returns the mark.
+        `file`: where `line` is, where not the program's."""
         if mark is not None and rerun + (self.steps - mark) * left > MAX_RERUN:
             raise NcppError(
                 f"{what} would run {left:,} more passes of {self.steps - mark:,} blocks: more than "
                 f"{MAX_RERUN:,} lines run again, taken for a loop that does not end",
-                Location(self.file, line, 1),
+                Location(file or self.file, line, 1),
             )
         return self.steps
 
@@ -680,6 +683,8 @@ class Flow:
         def leave():
             if frame.repeats > 0:  # L: once more (a G65 macro with the locals it left)
                 frame.repeats -= 1
+                frame.mark = self.passes.ended(frame.mark, self.rerun, frame.repeats, block.line,
+                                               "a subprogram's L repeats", frame.source)  # fmt: skip
                 frame.pc, frame.labels = 1, {}
                 if not frame.macro:
                     self.parameters.leave(None)

@@ -43,6 +43,18 @@ KLARTEXT = """0 BEGIN PGM LOOP MM
 11 L Z+50 R0 FMAX
 12 END PGM LOOP MM
 """
+# Fanuc's M98 P<n> L<repeats> (and G65's L): the subprogram's runs are a counted loop too
+FANUC_L = """O1000
+G21 G90 G54
+G0 X0 Y0 Z5
+M98 P1001 L999999999
+M30
+O1001
+G91 G1 X1 F100
+X-1
+G90
+M99
+"""
 SINUMERIK = """G17 G90 G71 F200
 G0 X0 Y0 Z5
 FOR R1=1 TO 100000
@@ -63,6 +75,7 @@ M30
         ("nested.ngc", NESTED_REPEAT, 3),
         ("loop.h", KLARTEXT, 11),
         ("loop.mpf", SINUMERIK, 8),
+        ("subs.nc", FANUC_L, 10),
     ],  # fmt: skip
 )
 def test_a_counted_loop_past_the_bound_is_refused_at_its_line_at_once(
