@@ -429,13 +429,7 @@ class SinumerikFlow:
         return found
 
     def _forward(self, name: str) -> int | None:
-        for index in range(self.pc + 1, self.pc + 1 + MAX_AHEAD):
-            block = self._block(index)
-            if block is None:
-                return None
-            if name in _destinations(block):
-                return index
-        return None
+        return self._after(self.pc + 1, name)
 
     def _backward(self, name: str, first: int | None = None) -> int | None:
         for index in range(self.pc if first is None else first, self.base - 1, -1):

@@ -116,11 +116,7 @@ def test_cycl_call_runs_the_cycle_where_the_tool_stands_and_reaming_201_retracts
     assert found[-2].start == (40.0, 10.0, 52.0) and not found[-2].fixed
 
 
-def test_universal_drilling_203_decreases_its_plunge_and_breaks_chips():
-    """Q201=-20 Q202=8 Q212=2 Q205=3: plunges 8, 6, 4, then 3 (the minimum) cut to the depth: to -8,
-    -14, -18, -20.  Q213=1: a chip break (back by Q256=0.5 at Q208=400) then, the next time, out to the
-    set-up clearance 2 at Q208 and in at FMAX to 2 above the depth reached; out at Q208, FMAX to 50."""
-    universal = """CYCL DEF 203 UNIVERSAL DRILLING ~
+UNIVERSAL_203 = """CYCL DEF 203 UNIVERSAL DRILLING ~
     Q200=+2 ;SET-UP CLEARANCE ~
     Q201=-20 ;DEPTH ~
     Q206=+150 ;FEED RATE FOR PLNGNG ~
@@ -134,10 +130,17 @@ def test_universal_drilling_203_decreases_its_plunge_and_breaks_chips():
     Q211=+0 ;DWELL TIME AT DEPTH ~
     Q208=+400 ;RETRACTION FEED RATE ~
     Q256=+0.5 ;DIST FOR CHIP BRKNG"""
-    (first, *_) = runs(moves(program(universal, ["L FMAX M99"])))
-    levels = [(2, None), (-8, 150), (-7.5, 400), (-14, 150), (2, 400), (-12, None),
+# its levels and feeds (None: FMAX)
+LEVELS_203 = [(2, None), (-8, 150), (-7.5, 400), (-14, 150), (2, 400), (-12, None),
               (-18, 150), (-17.5, 400), (-20, 150), (2, 400), (50, None)]  # fmt: skip
-    assert first == drilled(25, -7.5, levels)
+
+
+def test_universal_drilling_203_decreases_its_plunge_and_breaks_chips():
+    """Q201=-20 Q202=8 Q212=2 Q205=3: plunges 8, 6, 4, then 3 (the minimum) cut to the depth: to -8,
+    -14, -18, -20.  Q213=1: a chip break (back by Q256=0.5 at Q208=400) then, the next time, out to the
+    set-up clearance 2 at Q208 and in at FMAX to 2 above the depth reached; out at Q208, FMAX to 50."""
+    (first, *_) = runs(moves(program(UNIVERSAL_203, ["L FMAX M99"])))
+    assert first == drilled(25, -7.5, LEVELS_203)
 
 
 def test_a_retraction_feed_of_max_retracts_at_rapid():
@@ -145,23 +148,9 @@ def test_a_retraction_feed_of_max_retracts_at_rapid():
     heidenhain-simulator, `samples/a_phv3/motorflange/m7s.h`; refused as unreadable before).  TNC 640
     Cycle Programming manual, cycle 203: "Q208 Feed rate for retraction ... alternatively FMAX": the
     same moves as the test above, each one out at Q208 a rapid."""
-    universal = """CYCL DEF 203 UNIVERSAL DRILLING ~
-    Q200=+2 ;SET-UP CLEARANCE ~
-    Q201=-20 ;DEPTH ~
-    Q206=+150 ;FEED RATE FOR PLNGNG ~
-    Q202=+8 ;PLUNGING DEPTH ~
-    Q210=+0 ;DWELL TIME AT TOP ~
-    Q203=+0 ;SURFACE COORDINATE ~
-    Q204=+50 ;2ND SET-UP CLEARANCE ~
-    Q212=+2 ;DECREMENT ~
-    Q213=+1 ;BREAKS ~
-    Q205=+3 ;MIN. PLUNGING DEPTH ~
-    Q211=+0 ;DWELL TIME AT DEPTH ~
-    Q208= MAX ;RETRACTION FEED RATE ~
-    Q256=+0.5 ;DIST FOR CHIP BRKNG"""
+    universal = UNIVERSAL_203.replace("Q208=+400", "Q208= MAX")
     (first, *_) = runs(moves(program(universal, ["L FMAX M99"])))
-    levels = [(2, None), (-8, 150), (-7.5, None), (-14, 150), (2, None), (-12, None),
-              (-18, 150), (-17.5, None), (-20, 150), (2, None), (50, None)]  # fmt: skip
+    levels = [(level, None if feed == 400 else feed) for level, feed in LEVELS_203]
     assert first == drilled(25, -7.5, levels)
     said = io.StringIO()
     assert runs(moves(program(universal.replace("Q208= MAX", "Q208=AUTO"), ["L FMAX M99"]), said)) == []

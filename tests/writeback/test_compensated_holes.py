@@ -140,36 +140,11 @@ PLANE_LETTERS = {18: "ZXY", 19: "YZX"}
 # (first, second, normal) axis indices of each plane
 PLANE_INDICES = {17: (0, 1, 2), 18: (2, 0, 1), 19: (1, 2, 0)}
 AXES = "XYZ"
-HOLES_IN_PLANE = [
-    (100, 120, -16, 3), (30, 40, -16, 3), (150, -50, -20, 5), (-80, 60, -20, 5),
-    (200, 10, -5, 2), (210, 10, -7.5, 2.5), (220, 100, -9, 1), (230, 110, -3, 1), (240, 120, -3, 1),
-    (-200, 300, -6, 2), (-190, 300, -3, 1), (-190, -250, -3, 1),
-]  # fmt: skip
-PROGRAM_IN_PLANE = """G21 G90 G17
-G0 X40 Y30 Z25
-G1 X45 Y35 F300
-G0 Z25
-G99 G81 X100 Y120 R3 Z-16 F100
-X30 Y40
-G98 G83 X150 Y-50 R5 Z-20 Q4
-X-80 Y60
-G80
-G0 X0 Y0
-G99 G82 X200 Y10 R2 Z-5 P0.5
-G85 X210 R2.5 Z-7.5
-G73 X220 Y100 Z-9 R1 Q2.5
-M3 S500
-G86 X230 Y110 Z-3 R1 P1
-G89 X240 Y120 Z-3 R1 P1
-G80
-G1 X-190 Y290 Z4 F400
-G98 G81 X-200 Y300 R2 Z-6
-G99 X-190 Z-3 R1
-Y-250
-G80
-M5
-M2
-"""
+# (the G17 program's holes and lines but its taps, with the M4 before G74, and its polar words)
+HOLES_IN_PLANE = HOLES[:9] + HOLES[11:14]
+PROGRAM_IN_PLANE = "".join(
+    line for line in PROGRAM.splitlines(keepends=True) if not line.startswith(("G84 ", "M4\n", "G74 ", "@"))
+)
 
 
 def in_plane(program: str, holes: list[tuple[float, ...]], plane: int) -> tuple[str, list[tuple[float, ...]]]:
