@@ -134,8 +134,8 @@ MAX_PROGRAM_LEVELS = 16
 _SUBPROGRAM_NAME = re.compile(r"(?:[A-Z]{2}|_[A-Z])\w*", re.I)
 # The Siemens cycles and their helpers, which stay as the cycles they are (`block`), not files
 KNOWN_CYCLE = re.compile(r"CYCLE\d|POCKET\d|SLOT\d|LONGHOLE|HOLES\d|E_|F_", re.I)
-# Predefined procedures that call programs in ways not followed here (absolute path, external memory)
-CALL_KEYWORDS = frozenset(("PCALL", "EXTCALL", "CALLPATH", "MCALL", "RET"))
+# Predefined procedures that call programs in ways not followed here (PCALL: by an absolute path)
+CALL_KEYWORDS = frozenset(("PCALL", "CALLPATH", "MCALL", "RET"))
 # Control statements after which the flow may run blocks again (`sinumerik_flow`): their moves the line's
 RUNS_OTHERS = frozenset(("endwhile", "endfor", "until", "endloop", "goto", "case"))
 # PROC attributes that change nothing the motion depends on: the display and single-block
@@ -344,12 +344,16 @@ class SinumerikInterpreter(ModalInterpreter):
         return _Call(name, path, blocks, parameters, runs)
 
     def _indirect(self, expr: tuple, block: Block, item) -> str:
-        """The program `CALL` names: a string, or a string variable's value (Job Planning manual,
-        "Indirect program call (CALL)"); its folders, the control's, dropped."""
+        """The program `CALL` or `EXTCALL` names: a string, or a string variable's value (Job Planning
+        manual, "Indirect program call (CALL)"; Function Manual Basic Functions K1, "Program control",
+        EXTCALL: `EXTCALL("<path/><program name>")`, the name with or without `_N_` and its type
+        after `_` or `.`); its folders, the control's or a drive's, dropped: the file is looked for
+        in the subroutine path, as the control looks in its program memories."""
         name = expr[1] if expr[0] == "str" else self.variables.get(expr[1]) if expr[0] == "param" else None
-        if type(name) is not str or not name.strip("/"):
-            raise OutOfScope("CALL of a program named other than by a string", item.start + 1)
-        return name.rstrip("/").rsplit("/", 1)[-1].upper()
+        if type(name) is not str or not name.strip("/\\"):
+            raise OutOfScope(f"{item.node[0]} of a program named other than by a string", item.start + 1)
+        name = re.split(r"[/\\:]", name.rstrip("/\\"))[-1].upper()
+        return re.sub(r"\.(SPF|MPF)$", r"_\1", name)
 
     def _parameters(self, blocks: list[Block], name: str, args: tuple, block: Block, item) -> dict:
         """The subprogram's PROC parameters (its first block, if any) given the call's values
@@ -577,7 +581,7 @@ class SinumerikInterpreter(ModalInterpreter):
                         f"the hole pattern {item.node[0]} (the control places its holes itself)",
                         item.start + 1,
                     )
-                elif what == "call" and item.node[0] == "CALL" and len(item.node[1]) == 1:
+                elif what == "call" and item.node[0] in ("CALL", "EXTCALL") and len(item.node[1]) == 1:
                     self.called = self._call(block, item, self._indirect(item.node[1][0], block, item), ())
                 elif what == "call" and item.node[0].upper() in APPROACHES and not item.node[1]:
                     self._approach(item.node[0].upper(), item)

@@ -278,6 +278,21 @@ def test_sinumerik_indirect_call_by_a_string_or_a_string_variable(tmp_path):
     assert _path(events) == [(0, 0, 2, False), (7, 0, 3, True), (7, 3, 4, True), (1, 3, 5, False)]
 
 
+@pytest.mark.parametrize(
+    "call",
+    ['EXTCALL("/_N_WKS_DIR/_N_SHAFT_WPD/part2.spf")', 'EXTCALL "PART2"', 'extcall ("LOCAL_DRIVE:PART2_SPF")',
+     'EXTCALL("\\\\server\\cam\\PART2.SPF")'],
+)  # fmt: skip
+def test_sinumerik_external_call_runs_the_named_program(tmp_path, call):
+    """`EXTCALL("<path/><program name>")` (Function Manual Basic Functions K1, "Program control":
+    a path, a drive's short name, the type after `_` or `.`) runs the program from the subroutine
+    path, as an indirect CALL; the parser refused `EXTCALL "NAME"`, and the call ended interpretation."""
+    folder = _folder(tmp_path, {"PART2.SPF": "G1 X7 F100\nRET\n"})
+    events, warned = _events(sinumerik, "sinumerik", f"G0 X0 Y0\n{call}\nG1 Y1\nM30\n", folder)
+    assert warned == ""
+    assert _path(events) == [(0, 0, 1, False), (7, 0, 2, True), (7, 1, 3, False)]
+
+
 def test_sinumerik_subprogram_file_as_the_control_writes_it_out(tmp_path):
     """Its name and path lines above the PROC (as a control writes a subprogram out)."""
     sub = "%_N_HOLE_SPF\n;$PATH=/_N_SPF_DIR\nPROC HOLE(REAL X0) SBLOF\nG1 X=X0 F100\nM17\n"

@@ -16,7 +16,8 @@ Statement kinds and nodes (Sinumerik):
   label        (NAME,)                    `LABEL_1:` (upper case, no colon)
   call         (NAME, args)               `CYCLE81(10,0,2,-5)`, `MSG("x")`, `SETAL(1)`, `BNAT`,
                                           `MATERIAL_UPDATE`: passed through; args tuple of exprs, None if
-                                          empty; `CALL "PART2"` (an indirect call) is ("CALL", (expr,))
+                                          empty; `CALL "PART2"` (an indirect call) is ("CALL", (expr,)),
+                                          `EXTCALL "PART2"` ("EXTCALL", (expr,))
   path         (NAME,)                    CIP CT ASPLINE BSPLINE CSPLINE POLY (words follow)
   frame        (NAME,)                    TRANS ATRANS ROT AROT SCALE ASCALE MIRROR AMIRROR ... (words follow)
   def          (type, length, vars)       `DEF STRING[8] A="x", B` -> ('STRING', ("num", 8.0), ((target, init|None), ...))
@@ -124,7 +125,8 @@ class SinumerikBuilder(Transformer):
         return (expr, branches, default)
 
     call = _statement("call", _call)
-    indirect_call = _statement("call", lambda c: ("CALL", (c[1],)))  # `CALL "PART2"`, `CALL NAME_VARIABLE`
+    # `CALL "PART2"`, `CALL NAME_VARIABLE`, `EXTCALL ("PART2")`
+    indirect_call = _statement("call", lambda c: (str(c[0]).upper(), (c[1],)))
     label = _statement("label", lambda c: (str(c[0])[:-1].upper(),))
     path = _statement("path", lambda c: (str(c[0]).upper(),))
     frame = _statement("frame", lambda c: (str(c[0]).upper(),))
