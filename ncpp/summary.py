@@ -140,7 +140,10 @@ class Summary:
         if programmed is None:
             return
         context = last.context  # type: ignore[union-attr]
-        moved = math.dist(context.to_machine(last.end), programmed.context.to_machine(programmed.end))  # type: ignore[union-attr]
+        if context is programmed.context:  # (mostly: the same offsets and units, so only the points differ)
+            moved = math.dist(last.end, programmed.end) * context.unit_mm  # type: ignore[union-attr]
+        else:
+            moved = math.dist(context.to_machine(last.end), programmed.context.to_machine(programmed.end))  # type: ignore[union-attr]
         if moved > self.largest_mm:
             self.largest_mm, self.largest_line = moved, block.line
 
