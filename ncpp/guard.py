@@ -36,8 +36,20 @@ T M S F H D words, G28/G30, G53, G10 L2 P1-P9), select one (`_iso_selects_first`
   coarse and fine translation; Job Planning manual: `MSG("text")` shows the text, `SETAL(n)`
   raises cycle alarm n, 65000-67999 being the user's; `M0` stops): G54-G57 only.
 
-Heidenhain programs get no guard (yet): the preset table's active row and values are read
-with `FN 18: SYSREAD` IDs that differ between TNC generations.
+Heidenhain programs get no guard.  ncpp's program zero of a Klartext program is the preset it
+runs under (`--work-offset`, the zero of CYCL DEF 247's first preset), so the guard would read the
+active preset's row and its X Y Z with `FN 18: SYSREAD` and stop with `FN 14: ERROR`, each as the
+manual of the controls Klartext programs are written for (TNC 640, TNC7) gives it.  Those rows
+are cited only from the previous generation: the iTNC 530 HSCI Technical Manual (07/2013, 9.5.4
+"Data transfer NC > NC program (FN18: SYSREAD)") has ID530 NR1, the active row of the preset
+table, and ID502/ID503 with the row as NR and the column as IDX, a row's values with and without
+conversion to the active coordinate system.  HEIDENHAIN's TNC7 User's Manual (81762x-16, -17,
+"Preset table") says that the table's active row is the workpiece preset, its X Y Z a basic
+transformation in the basic coordinate system B-CS; the TNC7 basic manual (81762x-19, "System
+data") that FN 18 returns system data in mm whatever the program's unit; 81762x-17's list of FN
+functions that an FN 14 with the NC CANCEL reaction aborts the program with an error message
+unless ID13 NR2 names a label it jumps to instead.  The rows of the active preset are not cited
+here from them, nor from the TNC 640's or TNC 620's user's manuals.
 
 The tool guard: compensation also depends on the tool lengths ncpp was told (`--tool-table`):
 the length moves the Z positions where the errors are evaluated and lengthens the Abbe arm.
@@ -62,8 +74,12 @@ the check; the next does not.
   builder sets (A: one value per offset at #10001 on or #2001 on; B and C: geometry and wear
   apart, #11001 and #10001 on, C with the D offsets apart again), which a program cannot tell.
 * Sinumerik and Heidenhain: no check.  Sinumerik's active tool and edge (`$P_TOOLNO`, `$P_TOOL`)
-  and Klartext's active length (FN 18: SYSREAD ID200 NR2 in the iTNC 530's and TNC 426/430's
-  technical manuals) are not cited here from the manuals of the controls ncpp writes for.
+  and their lengths are not cited here from an 840D sl System Variables parameter manual.
+  Klartext's active length is FN 18: SYSREAD ID200 NR2 in the iTNC 530 HSCI's and TNC 426/430's
+  technical manuals ("Active length (including oversizes)"); the TNC 620 Klartext User's Manual
+  (01/2022, "System data") has "Active length" as NR2 of its tool group, with IDX 1 without
+  oversize, 2 with the table's DL, 3 with it and TOOL CALL's DL (the length ncpp applies), but
+  that group's number and the stop (`FN 14: ERROR`) are not cited from a TNC 640 or TNC7 manual.
 
 Readers of a written program drop both guards (`without_guard`): ncpp's interpreter
 does not know the control's parameters, and the guards neither move nor act.
@@ -259,7 +275,7 @@ def _sinumerik(placement: Placement, selected: bool = False) -> list[str]:
 # Why a dialect's program gets no guard, as the warning says it
 UNGUARDED = {
     "grbl": "grbl cannot test its work offset (it reads no parameters)",
-    "heidenhain": "Klartext reads the preset with FN 18 IDs that differ between TNC generations",
+    "heidenhain": "ncpp cites no FN 18 read of the active preset from a TNC 640 or TNC7 manual",
 }
 
 
