@@ -36,8 +36,20 @@ T M S F H D words, G28/G30, G53, G10 L2 P1-P9), select one (`_iso_selects_first`
   coarse and fine translation; Job Planning manual: `MSG("text")` shows the text, `SETAL(n)`
   raises cycle alarm n, 65000-67999 being the user's; `M0` stops): G54-G57 only.
 
-Heidenhain programs get no guard (yet): the preset table's active row and values are read
-with `FN 18: SYSREAD` IDs that differ between TNC generations.
+Heidenhain programs get no guard.  ncpp's program zero of a Klartext program is the preset it
+runs under (`--work-offset`, the zero of CYCL DEF 247's first preset), so the guard would read the
+active preset's row and its X Y Z with `FN 18: SYSREAD` and stop with `FN 14: ERROR`, each as the
+manual of the controls Klartext programs are written for (TNC 640, TNC7) gives it.  Those rows
+are cited only from the previous generation: the iTNC 530 HSCI Technical Manual (07/2013, 9.5.4
+"Data transfer NC > NC program (FN18: SYSREAD)") has ID530 NR1, the active row of the preset
+table, and ID502/ID503 with the row as NR and the column as IDX, a row's values with and without
+conversion to the active coordinate system.  HEIDENHAIN's TNC7 User's Manual (81762x-16, -17,
+"Preset table") says that the table's active row is the workpiece preset, its X Y Z a basic
+transformation in the basic coordinate system B-CS; the TNC7 basic manual (81762x-19, "System
+data") that FN 18 returns system data in mm whatever the program's unit; 81762x-17's list of FN
+functions that an FN 14 with the NC CANCEL reaction aborts the program with an error message
+unless ID13 NR2 names a label it jumps to instead.  The rows of the active preset are not cited
+here from them, nor from the TNC 640's or TNC 620's user's manuals.
 
 The tool guard: compensation also depends on the tool lengths ncpp was told (`--tool-table`):
 the length moves the Z positions where the errors are evaluated and lengthens the Abbe arm.
@@ -61,9 +73,23 @@ the check; the next does not.
 * Fanuc: no check.  Its tool offset variables depend on the offset memory type the machine
   builder sets (A: one value per offset at #10001 on or #2001 on; B and C: geometry and wear
   apart, #11001 and #10001 on, C with the D offsets apart again), which a program cannot tell.
-* Sinumerik and Heidenhain: no check.  Sinumerik's active tool and edge (`$P_TOOLNO`, `$P_TOOL`)
-  and Klartext's active length (FN 18: SYSREAD ID200 NR2 in the iTNC 530's and TNC 426/430's
-  technical manuals) are not cited here from the manuals of the controls ncpp writes for.
+* Sinumerik (Basic Functions Function Manual, 09/2011, 6FC5397-0BP40-2BA0, W1 "Tool offset",
+  18.2 "Tool": "The compensation values $TC_DP1 to $TC_DP25 of the active tool compensation can be
+  read with system variable $P_AD[n]"; Job Planning, 03/2006, 6FC5398-2BP10-1BA0, 8.1 "Offset
+  memory": length 1 is $TC_DP3 (geometry), $TC_DP12 (wear) and $TC_DP21 (base dimension/adapter),
+  "added together to produce a value (e.g. total length 1)"): after each M6 or D that selects an
+  edge of the told offsets (`_N_TO_INI`), outside a loop, the check raises cycle alarm 65001 and
+  stops (the placement guard's MSG, SETAL, M0) when $P_AD[3] + $P_AD[12] + $P_AD[21] is not the
+  told length 1 within `GUARD_MM`, in the control's units, as the offsets.  It reads the
+  compensation the program selected, not which tool is in the spindle ($P_TOOLNO and $P_TOOL are
+  not cited here from a Siemens manual), nor a sum or setup offset DL (`$TC_SCP`, `$TC_ECP`) the
+  control adds, which ncpp does not model.
+* Heidenhain: no check.  Klartext's active length is FN 18: SYSREAD ID200 NR2 in the iTNC 530
+  HSCI's and TNC 426/430's technical manuals ("Active length (including oversizes)"); the TNC
+  620 Klartext User's Manual (01/2022, "System data") has "Active length" as NR2 of its tool
+  group, with IDX 1 without oversize, 2 with the table's DL, 3 with it and TOOL CALL's DL (the
+  length ncpp applies), but that group's number and the stop (`FN 14: ERROR`) are not cited from
+  a TNC 640 or TNC7 manual.
 
 Readers of a written program drop both guards (`without_guard`): ncpp's interpreter
 does not know the control's parameters, and the guards neither move nor act.
@@ -259,7 +285,7 @@ def _sinumerik(placement: Placement, selected: bool = False) -> list[str]:
 # Why a dialect's program gets no guard, as the warning says it
 UNGUARDED = {
     "grbl": "grbl cannot test its work offset (it reads no parameters)",
-    "heidenhain": "Klartext reads the preset with FN 18 IDs that differ between TNC generations",
+    "heidenhain": "ncpp cites no FN 18 read of the active preset from a TNC 640 or TNC7 manual",
 }
 
 
@@ -449,6 +475,29 @@ def haas_tool_guard_lines(offset: int, length_mm: float, unit_mm: float) -> list
     ]
 
 
+# Sinumerik's lengths 1 of the active tool offset: geometry, wear and base/adapter ($TC_DP3,
+# $TC_DP12, $TC_DP21 of the edge D selects, `$P_AD[n]` its $TC_DPn; the module docstring)
+_SINUMERIK_LENGTH_1 = "$P_AD[3]+$P_AD[12]+$P_AD[21]"
+
+
+def sinumerik_tool_guard_lines(edge: int, length_mm: float, unit_mm: float) -> list[str]:
+    """Sinumerik's check (without line ends) that the active tool offset's length 1 (geometry,
+    wear and adapter: `_SINUMERIK_LENGTH_1`) is `length_mm` within GUARD_MM, in the control's
+    units (`unit_mm` mm each), with the placement guard's MSG, SETAL and M0 (cycle alarm 65001)."""
+    length = _number(length_mm / unit_mm)
+    told = f"D{edge} at length 1 = {length} {_units(unit_mm)}"
+    less = f"+{length[1:]}" if length.startswith("-") else f"-{length}"  # (not `--5`)
+    return [
+        f"; {TOOL_BEGIN} {told} within {_number(GUARD_MM)} mm",
+        f"IF ABS({_SINUMERIK_LENGTH_1}{less})>{_number(GUARD_MM / unit_mm)}",
+        f'MSG("ncpp: compensated for {told}: the control\'s active tool offset differs")',
+        "SETAL(65001)",
+        "M0",
+        "ENDIF",
+        f"; {TOOL_END}",
+    ]
+
+
 def _h_number(block: Block) -> int | None:
     """The block's H word's offset number (None: none, or one from a variable)."""
     words = [item for item in block.items if type(item) is Word and item.letter == "H"]
@@ -460,7 +509,6 @@ TOOLS_UNGUARDED = {
     "fanuc": "Fanuc's tool offset variables depend on the offset memory type (A, B, C), which the machine "
     "builder sets",
     "grbl": "grbl cannot test its tool length (it reads no parameters)",
-    "sinumerik": "ncpp writes no check of Sinumerik's active tool edge yet",
     "heidenhain": "ncpp writes no check of Klartext's tool data yet",
 }
 
@@ -468,12 +516,13 @@ TOOLS_UNGUARDED = {
 class ToolGuard:
     """The tool guard's checks, written after each block that applies a told length (the
     writer's `after`): LinuxCNC's, in an ISO program that is not a Fanuc one (a program number
-    at its top), and Haas's, where the block's H is the tool in the spindle.  Where there is
-    none, `unguarded` is told why, once."""
+    at its top), Haas's, where the block's H is the tool in the spindle, and Sinumerik's, after
+    each M6 or D that selects a told edge.  Where there is none, `unguarded` is told why, once."""
 
     def __init__(self, dialect: str, unit_mm: float, unguarded: Callable[[str], None] = lambda why: None):
         self.unit_mm, self.unguarded, self.haas = unit_mm, unguarded, dialect == "haas"
-        guarded = dialect in ("iso", "haas")
+        self.sinumerik = dialect == "sinumerik"
+        guarded = dialect in ("iso", "haas", "sinumerik")
         self.why = None if guarded else TOOLS_UNGUARDED.get(dialect, f"{dialect} has no tool guard")
         self.looked = 0  # blocks looked at for a Fanuc program number
         self.checks = 0
@@ -482,7 +531,7 @@ class ToolGuard:
 
     def __call__(self, events: list[Event]) -> list[str]:
         block = events[0].block
-        if self.looked < LEADER_LINES + 12 and self.why is None and not self.haas:
+        if self.looked < LEADER_LINES + 12 and self.why is None and not (self.haas or self.sinumerik):
             self.looked += 1
             if _FANUC_PROGRAM_NUMBER.match(block.raw):
                 self.why = TOOLS_UNGUARDED["fanuc"]
@@ -491,6 +540,8 @@ class ToolGuard:
         told = last.length_told if type(last) is Pass else None
         if told is None or self.why is not None or not block.eol:  # (a last line: nothing runs after it)
             return []
+        if self.sinumerik:
+            return [line + block.eol for line in sinumerik_tool_guard_lines(*told, self.unit_mm)]
         if self.haas:
             offset = _h_number(block)  # (G43 without H, or H of another tool: not the told length's offset)
             lines = haas_tool_guard_lines(offset, told[1], self.unit_mm) if offset == told[0] else []

@@ -248,7 +248,8 @@ class Pass:
     cycle: float | None = None
     dwell: float | None = None
     # a block that applies the length of the tool in the spindle from the told tool table (G43):
-    # (the tool's number, its Z offset in mm), which the tool guard checks (`ncpp/guard.py`)
+    # (the tool's number, its Z offset in mm; Sinumerik's M6 or D: the edge D, its length 1 in mm),
+    # which the tool guard checks (`ncpp/guard.py`)
     length_told: tuple[int, float] | None = None
     # a block that selects a work coordinate system whose zero is still the one ncpp was told (its
     # number, 1..9 or ADDITIONAL + n), which the placement guard checks before the block

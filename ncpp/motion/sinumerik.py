@@ -170,6 +170,9 @@ class SinumerikInterpreter(ModalInterpreter):
         self.loaded: float | str = 0.0  # the tool M6 loaded (0: none)
         self.edge = 0  # the cutting edge D in effect (0: no tool offset)
         self.edge_told = False  # M6 or D said the edge (before it, the control's own is in effect)
+        # the block just run applied a told edge's lengths: (D, its length 1 in mm), which the
+        # tool guard checks after the block (`guard.sinumerik_tool_guard_lines`)
+        self.length_told: tuple[int, float] | None = None
         self.untold_lengths = UntoldLengths()  # warns where a tool length applies that nothing tells
         self.motion: float | str = 0.0  # 0-3, 'CIP' or 'CT' (G0 after power on)
         self.absolute = True
@@ -235,6 +238,7 @@ class SinumerikInterpreter(ModalInterpreter):
                 yield from self._expanded(expansion, flow, block, kind, owner, caller, warnings)
                 continue
             self.again = kind is FIXED
+            self.length_told = None
             try:
                 events = self.block(block)
             except OutOfScope as stop:
@@ -255,6 +259,8 @@ class SinumerikInterpreter(ModalInterpreter):
                 yield from moves
             else:  # (a call's line: the mode its subprogram starts in, `SinumerikWriter.written_at_once`)
                 yield from events or (Pass(block, False, self.motion if self.called is not None else None),)
+                if self.length_told is not None and kind is RUN:  # (a block that runs again: none)
+                    yield Pass(block, length_told=self.length_told)
             if self.called is not None:
                 call, self.called = self.called, None
                 yield from self._subprogram(call, owner or block, warnings)
@@ -275,7 +281,7 @@ class SinumerikInterpreter(ModalInterpreter):
         in its place.  (No backward jump is refused for the moves it goes over: they are written
         again, `flow.last_run_move` stays.)"""
         in_place = kind is RUN and caller is None
-        self.again = False
+        self.again, self.length_told = False, None
         settling: tuple[Event, ...] = ()
         try:
             if in_place:
@@ -303,6 +309,8 @@ class SinumerikInterpreter(ModalInterpreter):
             for event in events:
                 event.block = written
             yield from events or (Pass(written),)
+            if self.length_told is not None and in_place:  # (a run written out of a loop: none)
+                yield Pass(written, length_told=self.length_told)
         if self.called is not None:
             call, self.called = self.called, None
             yield from self._subprogram(call, owner or block, warnings)
@@ -826,6 +834,8 @@ class SinumerikInterpreter(ModalInterpreter):
                     f"{item.letter}{value:g}", "_N_TO_INI", Location(self.file, block.line, item.start + 1)
                 )
         lengths = self._edge_lengths(block, tool_words[-1][0] if tool_words else None)
+        if changed and self.tools is not None and self.edge and self.loaded not in (0.0, ""):
+            self.length_told = (self.edge, lengths[0])
         tool = [0.0, 0.0, 0.0]
         for length, axis in zip(lengths, LENGTH_AXES[self.plane]):
             tool[axis] = length / (MM_PER_INCH if self.inch else 1.0)

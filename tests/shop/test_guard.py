@@ -415,3 +415,17 @@ def test_the_check_at_the_start_is_left_out_only_where_the_program_selects_first
 
     lines = head.splitlines(keepends=True)
     assert _iso_selects_first(lines[:1], 0, iter(lines[1:])) is selects
+
+
+def test_a_klartext_program_passes_unguarded_and_the_warning_says_which_manual_is_missing():
+    """No FN 18 read of the active preset is cited from a TNC 640 or TNC7 manual (the module
+    docstring of `ncpp/guard.py`): the program's lines pass as written, and the warning says so
+    rather than asserting that the TNC generations' IDs differ."""
+    from ncpp.guard import Placement, guard_lines, with_guard
+
+    program = ["0 BEGIN PGM P MM\n", "1 ; ncpp header\n", "2 L X+10 Y+10 R0 FMAX\n", "3 END PGM P MM\n"]
+    told: list[str] = []
+    placement = Placement(1, G54_MM)
+    assert list(with_guard(program, placement, "heidenhain", "ncpp header", unguarded=told.append)) == program
+    assert guard_lines(placement, "heidenhain") == []
+    assert told == ["ncpp cites no FN 18 read of the active preset from a TNC 640 or TNC7 manual"]
