@@ -160,6 +160,12 @@ def _number(value: float) -> str:
     return f"{value:.4f}".rstrip("0").rstrip(".") if value != 0 else "0"
 
 
+def _less(number: str, gap: str = "") -> str:
+    """A number written as subtracted (`-5`, `+5` for -5; `gap` after the sign): `--5` is no
+    expression the Fanuc or Siemens manuals define."""
+    return f"+{gap}{number[1:]}" if number.startswith("-") else f"-{gap}{number}"
+
+
 def _units(unit_mm: float) -> str:
     return "mm" if unit_mm == 1.0 else "inch" if unit_mm == 25.4 else f"x{unit_mm:g} mm"
 
@@ -219,7 +225,9 @@ def _linuxcnc(placement: Placement, selected: bool = False, label: int = 0) -> l
         return []  # (the additional work offsets are Fanuc's and Haas's)
     x = 5221 + 20 * (placement.system - 1)
     tolerance = _tolerance(placement)
-    far = [f"[ABS[#{x + k} - {value}] GT {tolerance}]" for k, value in enumerate(placement.values())]
+    far = [
+        f"[ABS[#{x + k} {_less(value, ' ')}] GT {tolerance}]" for k, value in enumerate(placement.values())
+    ]
     if not selected:
         far.insert(0, f"[#5220 NE {placement.system}]")
     name = f"o<ncpp_guard_{label}>" if label else "o<ncpp_guard>"
@@ -258,7 +266,7 @@ def _fanuc(placement: Placement, selected: bool = False) -> list[str]:
         lines.append(f"IF [#4014 NE {53 + placement.system}] THEN #3000=1 (NCPP {placement.name} NOT ACTIVE)")
     for k, (axis, value) in enumerate(zip("XYZ", placement.values(), strict=True)):
         alarm = f"#3000={2 + k} (NCPP {placement.name} {axis} MOVED)"
-        lines.append(f"IF [ABS[#{x + k}-{value}] GT {tolerance}] THEN {alarm}")
+        lines.append(f"IF [ABS[#{x + k}{_less(value)}] GT {tolerance}] THEN {alarm}")
     return lines + [f"({END.upper()})"]
 
 
@@ -268,7 +276,7 @@ def _sinumerik(placement: Placement, selected: bool = False) -> list[str]:
         return []  # (G58, G59 are Sinumerik's programmable offsets, not a settable frame)
     n, tolerance = placement.system, _tolerance(placement)
     far = " OR ".join(
-        f"(ABS($P_UIFR[{n},{axis},TR]+$P_UIFR[{n},{axis},FI]-{value})>{tolerance})"
+        f"(ABS($P_UIFR[{n},{axis},TR]+$P_UIFR[{n},{axis},FI]{_less(value)})>{tolerance})"
         for axis, value in zip("XYZ", placement.values(), strict=True)
     )
     return [
@@ -446,7 +454,7 @@ def tool_guard_lines(tool: int, length_mm: float, unit_mm: float, label: int) ->
     told = f"tool {tool} at length Z{length} {units}"
     return [
         f"({TOOL_BEGIN} {told} within {_number(GUARD_MM)} mm)",
-        f"{name} if [[#5400 NE {tool}] OR [ABS[#5403 - {length}] GT {_number(GUARD_MM / unit_mm)}]]",
+        f"{name} if [[#5400 NE {tool}] OR [ABS[#5403 {_less(length, ' ')}] GT {_number(GUARD_MM / unit_mm)}]]",
         f"(abort, ncpp: compensated for {told}; the control has tool #5400 at Z#5403: "
         "compensate again with its tool table, or set the length)",
         f"{name} endif",
@@ -469,7 +477,7 @@ def haas_tool_guard_lines(offset: int, length_mm: float, unit_mm: float) -> list
     told = f"H{offset} AT LENGTH Z{length} {_units(unit_mm).upper()}"
     return [
         f"({TOOL_BEGIN.upper()} {told} WITHIN {_number(GUARD_MM)} MM)",
-        f"IF [ABS[#{2000 + offset}+#{2200 + offset}-{length}] GT {_number(GUARD_MM / unit_mm)}] "
+        f"IF [ABS[#{2000 + offset}+#{2200 + offset}{_less(length)}] GT {_number(GUARD_MM / unit_mm)}] "
         f"THEN #3000=5 (NCPP H{offset} LENGTH DIFFERS)",
         f"({TOOL_END.upper()})",
     ]
@@ -486,10 +494,9 @@ def sinumerik_tool_guard_lines(edge: int, length_mm: float, unit_mm: float) -> l
     units (`unit_mm` mm each), with the placement guard's MSG, SETAL and M0 (cycle alarm 65001)."""
     length = _number(length_mm / unit_mm)
     told = f"D{edge} at length 1 = {length} {_units(unit_mm)}"
-    less = f"+{length[1:]}" if length.startswith("-") else f"-{length}"  # (not `--5`)
     return [
         f"; {TOOL_BEGIN} {told} within {_number(GUARD_MM)} mm",
-        f"IF ABS({_SINUMERIK_LENGTH_1}{less})>{_number(GUARD_MM / unit_mm)}",
+        f"IF ABS({_SINUMERIK_LENGTH_1}{_less(length)})>{_number(GUARD_MM / unit_mm)}",
         f'MSG("ncpp: compensated for {told}: the control\'s active tool offset differs")',
         "SETAL(65001)",
         "M0",

@@ -429,3 +429,19 @@ def test_a_klartext_program_passes_unguarded_and_the_warning_says_which_manual_i
     assert list(with_guard(program, placement, "heidenhain", "ncpp header", unguarded=told.append)) == program
     assert guard_lines(placement, "heidenhain") == []
     assert told == ["ncpp cites no FN 18 read of the active preset from a TNC 640 or TNC7 manual"]
+
+
+def test_a_negative_zero_or_length_is_added_not_subtracted_twice():
+    """`#5221--100` is no expression the Fanuc Custom Macro B or Siemens manuals define (a
+    control that refuses it would stop every program with a negative zero at its guard)."""
+    from ncpp.guard import Placement, _fanuc, _linuxcnc, _sinumerik, haas_tool_guard_lines, tool_guard_lines
+
+    placement = Placement(1, (-100.0, 50.0, -20.5))
+    written = [*_fanuc(placement), *_sinumerik(placement), *_linuxcnc(placement),
+               *haas_tool_guard_lines(1, -5.25, 1.0), *tool_guard_lines(1, -5.25, 1.0, 1)]  # fmt: skip
+    text = "\n".join(written)
+    assert "--" not in text and "- -" not in text
+    assert "IF [ABS[#5221+100] GT 0.1]" in text and "IF [ABS[#5222-50] GT 0.1]" in text
+    assert "$P_UIFR[1,X,FI]+100)" in text and "$P_UIFR[1,Z,FI]+20.5)" in text
+    assert "[ABS[#5221 + 100] GT" in text and "[ABS[#5403 + 5.25] GT" in text
+    assert "IF [ABS[#2001+#2201+5.25] GT" in text
