@@ -233,7 +233,7 @@ def test_a_haas_peck_cycle_with_p_is_compensated_with_its_p_and_verified(tmp_pat
     # a G82's dwell holds in the G83 after it, until G80 cancels it (the manual: "The same dwell time
     # applies to all subsequent blocks that do not specify a dwell time")
     for between, refused in (("", True), ("G80\n", False)):
-        program.write_text(f"%\nO1\nG21 G90\nG0 X0 Y0 Z5\nG82 X10 Y0 Z-10 R2 P1 F100\n{between}"
+        program.write_text(f"%\nO1\nG21 G90\nG0 X0 Y0 Z5\nG82 X10 Y0 Z-10 R2 P1. F100\n{between}"
                            f"G{g} X20 Y0 Z-10 R2 Q4\nG80\nM30\n%\n")  # fmt: skip
         proc = subprocess.run(expand, capture_output=True, text=True, cwd=ROOT)
         assert (proc.returncode != 0) is refused and ("with a dwell P" in proc.stderr) is refused, proc.stderr
