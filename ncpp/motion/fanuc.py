@@ -37,8 +37,8 @@ A setting code written with other words in its block is out of scope too: a bloc
 both sets and moves is not one these controls' posts write.  So is G33.1, LinuxCNC's rigid tap:
 these controls tap rigidly with M29 and G84.
 
-With --expand-cycles, G82's and G89's dwell is written as a G04 with the cycle's P as the program
-gave it, where the control reads both alike (`_dwell_word`).  Fanuc: a G04's P takes no decimal
+With --expand-cycles, G82's and G89's dwell (Haas: G73's and G83's too) is written as a G04 with
+the cycle's P as the program gave it, where the control reads both alike (`_dwell_word`).  Fanuc: a G04's P takes no decimal
 point and counts 0.001 s, as a drilling cycle's P (SINUMERIK ISO Milling manual, which documents
 Fanuc's dialect, "Dwell (G04)": "P_: Specify a time (decimal point not permitted)"); with feed per
 revolution (G95) a G04 counts spindle revolutions.  Haas (Mill Operator's Manual, "G04 Dwell"):

@@ -1525,11 +1525,6 @@ class Interpreter:
         aa, bb, step_a, step_b, r, bottom = self._cycle_geometry(block, words, again, item)
         repeats = self._repeats(block, words)
         peck = self._cycle_word(block, words, motion, again, item)
-        if self.expand_cycles and self.peck_dwell and motion in PECKING and self.cycle_p > 0.0:
-            self._fail(f"--expand-cycles: G{motion:g} with a dwell P cannot be written as G0/G1 moves and a "
-                       "G4 (whether this control reads a G4's P as the cycle's is not known to ncpp); leave "
-                       "the option out, the cycle is then compensated", block,
-                       words.get("P", (0, item))[1])  # fmt: skip
         if motion in (74.0, 84.0) and self.plane != 17:  # rs274ngc's taps move other axes there
             raise _OutOfScope(f"canned cycle G{motion:g} outside the XY plane", item.start + 1)
         if motion in SPINDLE:
@@ -1568,7 +1563,8 @@ class Interpreter:
         lines = tuple(self._fixed_line(block, (first, second, normal), move) for move in moves)
         if self.expand_cycles:
             self.cycle_holes = False
-            dwell = self._dwell_word(block, words.get("P", (0, item))[1]) if motion in DWELLING else None
+            dwells = motion in DWELLING or (self.peck_dwell and motion in PECKING and self.cycle_p > 0.0)
+            dwell = self._dwell_word(block, words.get("P", (0, item))[1]) if dwells else None
             return self._expanded(block, motion, lines, bottoms, dwell)
         # holes apply_error_map compensates: in any plane (polar words written as X Y, repeats as a
         # block each), the series' holes all such
@@ -1643,8 +1639,8 @@ class Interpreter:
         self, block: Block, motion: float, lines: tuple[Line, ...], bottoms: list[int], dwell: str | None
     ) -> tuple[Event, ...]:
         """A cycle's moves to be written as G0/G1 blocks (--expand-cycles): moves like any other,
-        after a `Pass` that tells the writer, with a dwell after each bottom of G82 G89 (`dwell`: its
-        G4's P word)."""
+        after a `Pass` that tells the writer, with a dwell after each bottom of G82 G89 (Haas: after
+        the last peck of G73 G83 with a P) (`dwell`: its G4's P word)."""
         events: list[Event] = [Pass(block, cycle=motion)]
         dwells = set(bottoms) if dwell is not None else set()  # (P0 too: rs274 dwells 0 s)
         for k, line in enumerate(lines):
