@@ -1521,7 +1521,7 @@ class Interpreter:
         first, second, normal = PLANE_AXES[self.plane]
         again = previous == motion  # the same cycle again: R, the normal-axis word, P and Q are sticky
         if previous not in CANNED:  # a new series: G98 retracts to where it started, no dwell yet
-            self.cycle_il, self.cycle_p = self.pos[normal], 0.0
+            self.cycle_il, self.cycle_p, self.cycle_p_word = self.pos[normal], 0.0, None
         aa, bb, step_a, step_b, r, bottom = self._cycle_geometry(block, words, again, item)
         repeats = self._repeats(block, words)
         peck = self._cycle_word(block, words, motion, again, item)
@@ -1653,8 +1653,9 @@ class Interpreter:
     def _dwell_word(self, block: Block, item) -> str:
         """The P word of the G4 that dwells as long as the cycle's P (--expand-cycles): rs274ngc reads
         both in seconds (LinuxCNC G-code manual, "G4 Dwell" and "G82"), so the P's value, written as
-        the program gave it where it is a number (grbl, whose G4 P is seconds too, reads cycles as
-        LinuxCNC).  `item`: where a refusal points (flavours refuse what they cannot tell)."""
+        the program gave it where it is a number (grbl's flavour reads cycles as LinuxCNC, and its G4 P
+        in seconds too: `motion_control.c`, `mc_dwell`).  `item`: where a refusal points (flavours
+        refuse what they cannot tell)."""
         word = self.cycle_p_word
         return "P" + (word.number if type(word) is Word else number("P", self.cycle_p))
 
