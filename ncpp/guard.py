@@ -97,15 +97,16 @@ does not know the control's parameters, and the guards neither move nor act.
 
 from __future__ import annotations
 
-import re
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, replace
+from functools import cache
 from itertools import chain, islice
 
+from ncpp.errors import NcppError
 from ncpp.motion.offsets import _ADDITIONAL_X, ADDITIONAL, WorkOffsets, system_name
 from ncpp.motion.segments import Event, Pass
-from ncpp.program.blocks import Block, Comment, Word
-from ncpp.program.parser import LEADER_LINES
+from ncpp.program.blocks import AnyItem, Block, Comment, Statement, Word
+from ncpp.program.parser import LEADER_LINES, LineParser
 
 GUARD_MM = 0.1  # how far an axis's zero may be from the one told: re-touching a fixture moves it microns
 BEGIN = "ncpp placement guard:"
@@ -113,17 +114,36 @@ END = "ncpp placement guard end"
 TOOL_BEGIN = "ncpp tool guard:"
 TOOL_END = "ncpp tool guard end"
 GUARD_BLOCKS = 12  # the most blocks a guard has (a first comment without its last within them is no guard)
-# A Sinumerik line that defines a variable, or one a definition section may hold between them (a
-# comment, a blank line): the 840D wants definitions before the program's first statement
-# (Job Planning, "Definition of user variables (DEF)")
-_SINUMERIK_DEFINITION = re.compile(r"\s*(N\d+\s*)?(DEF\s|REDEF\s|;|$)", re.IGNORECASE)
-# A Sinumerik line of G codes alone (and a block number, a comment), and the settable frame
-# G54-G57 it may select; how many such lines after the definitions the guard may follow
-_SINUMERIK_SETTINGS = re.compile(r"\s*(N\d+\s*)?(G\d+\s*)*(;.*)?$", re.IGNORECASE)
-_SETTABLE_FRAME = re.compile(r"(?<![A-Z0-9_])G0*(5[4-7])(?![0-9.])", re.IGNORECASE)
-_SETTINGS_SCANNED = 8
-# A Fanuc program number line (`O1234`, perhaps with a comment); not an o-word line (`o100 sub`)
-_FANUC_PROGRAM_NUMBER = re.compile(r"\s*O\d+\s*(\(.*\))?\s*$")
+_SETTINGS_SCANNED = 8  # the Sinumerik lines of G codes alone after the definitions the guard may follow
+
+
+@cache
+def _parser(dialect: str) -> LineParser:
+    """The parser of a written program's lines: the dialect's grammar (a post's "linuxcnc" writes ISO)."""
+    return LineParser(dialect if dialect in ("heidenhain", "sinumerik") else "iso")
+
+
+def _items(dialect: str, line: str) -> tuple[AnyItem, ...] | None:
+    """The items the dialect's grammar reads in a written line (None: a line it cannot read)."""
+    try:
+        return _parser(dialect).parse(line.rstrip("\r\n")).items
+    except NcppError:
+        return None
+
+
+def _program_number(items: tuple[AnyItem, ...] | None) -> bool:
+    """A Fanuc program number line (`O1234`, perhaps with a `( )` comment); not an o-word line
+    (`o100 sub`), nor `O1 ; ...`: a `;` comment is LinuxCNC's, which reads Fanuc-style subprograms
+    too (its interpreter tests, `m98m99`), and whose guard is its own."""
+    if not items or type(items[0]) is not Word:
+        return False
+    first, rest = items[0], items[1:]
+    return (first.letter == "O" and first.number.isdigit()
+            and all(type(item) is Comment and item.style == "(" for item in rest))  # fmt: skip
+
+
+def _comments(items: tuple[AnyItem, ...] | None) -> str:
+    return " ".join(item.text.lower() for item in items or () if type(item) is Comment)
 
 
 @dataclass(frozen=True)
@@ -182,16 +202,52 @@ def _sinumerik_place(head: list[str], at: int, rest: Iterator[str]) -> tuple[int
             if line is None:
                 return at if start is None else start, None
             head.append(line)
-        text = head[at]
-        if not _SINUMERIK_DEFINITION.match(text) or start is not None:
+        items = _items("sinumerik", head[at])
+        if not _sinumerik_definition(items) or start is not None:
             start = at if start is None else start
-            if settings >= _SETTINGS_SCANNED or not _SINUMERIK_SETTINGS.match(text):
+            codes = _sinumerik_settings(items)
+            if settings >= _SETTINGS_SCANNED or codes is None:
                 return start, None
             settings += 1
-            frame = _SETTABLE_FRAME.search(text.split(";", 1)[0])
+            frame = next((code for code in codes if 54 <= code <= 57), None)
             if frame is not None:
-                return at + 1, int(frame.group(1)) - 53
+                return at + 1, frame - 53
         at += 1
+
+
+def _without_block_number(items: tuple[AnyItem, ...]) -> tuple[AnyItem, ...]:
+    first = items[0] if items else None
+    return items[1:] if type(first) is Word and first.letter == "N" else items
+
+
+def _sinumerik_definition(items: tuple[AnyItem, ...] | None) -> bool:
+    """A line that defines a variable (DEF; REDEF, which the grammar reads as a call of that name),
+    or one a definition section may hold between them (a comment, a blank line): the 840D wants
+    definitions before the program's first statement (Job Planning, "Definition of user variables
+    (DEF)")."""
+    if items is None:
+        return False
+    rest = _without_block_number(items)
+    if not rest or type(rest[0]) is Comment:
+        return True
+    first = rest[0]
+    return type(first) is Statement and (
+        first.kind == "def" or (first.kind == "call" and first.node[0].upper() == "REDEF")
+    )
+
+
+def _sinumerik_settings(items: tuple[AnyItem, ...] | None) -> list[int] | None:
+    """The G codes of a Sinumerik line of whole G codes alone (and a block number, a comment);
+    None for any other line."""
+    if items is None:
+        return None
+    codes = []
+    for item in _without_block_number(items):
+        if type(item) is Word and item.letter == "G" and item.number.isdigit():
+            codes.append(int(item.value))
+        elif type(item) is not Comment:
+            return None
+    return codes
 
 
 def guard_lines(
@@ -207,7 +263,8 @@ def guard_lines(
     the program selects the system itself (only its zero is checked); `label` numbers a
     LinuxCNC check after the first (a program's labels are each defined once)."""
     if dialect == "iso":
-        dialect = "fanuc" if any(_FANUC_PROGRAM_NUMBER.match(line) for line in first_lines) else "linuxcnc"
+        fanuc = any(_program_number(_items(dialect, line)) for line in first_lines)
+        dialect = "fanuc" if fanuc else "linuxcnc"
     # (grbl reads no parameters and has no conditionals: it cannot test its work offset)
     if dialect == "linuxcnc":
         return _linuxcnc(placement, selected, label)
@@ -325,7 +382,7 @@ def with_guard(
         at = len(head)
         for line in it:  # a Fanuc program's number comes first
             head.append(line)
-            if not _FANUC_PROGRAM_NUMBER.match(line):
+            if not _program_number(_items(dialect, line)):
                 break
     guard = guard_lines(placement, dialect, head)
     if checks and at is not None and dialect in ISO_SYNTAX and _iso_selects_first(head, at, it):
@@ -335,7 +392,7 @@ def with_guard(
     if at is None or not guard:
         yield from chain(head, it)
         return
-    while at < len(head) and _FANUC_PROGRAM_NUMBER.match(head[at]):
+    while at < len(head) and _program_number(_items(dialect, head[at])):
         at += 1
     if dialect == "sinumerik":  # (the guard's IF is a statement: after the definitions)
         at, frame = _sinumerik_place(head, at, it)
@@ -349,24 +406,16 @@ def with_guard(
 
 
 ISO_SYNTAX = ("iso", "linuxcnc", "fanuc", "haas")  # the dialects whose guard is LinuxCNC's or Fanuc's
-# An ISO line that neither moves nor relies on the work offset in effect: N, modal G codes, M0-M9
-# (not M98 M99, calls), T S F H D words, comments, a G28 G30 return or G53 move (the control's
-# own positions: ncpp leaves them as programmed, so no compensation rests on the offset), or a
-# G10 L2 P1-P9 (it sets that system's zero, whichever is in effect); and one that selects a work
-# offset (G54.1 P, G154 P: Fanuc's and Haas's additional ones)
-_ISO_SETTINGS = re.compile(
-    r"\s*%?\s*((N\d+|G0*(0|1|2|3|17|18|19|20|21|28|30|40|43|49|53|5[4-8]|59(\.[123])?|61(\.1)?|64|80|9[01](\.1)?"
-    r"|9[3-9])|M0*\d|[TSFHD]\d+(\.\d*)?)(?![\d.])\s*)*",
-    re.IGNORECASE,
-)
+# The G codes of an ISO line of settings, one that neither moves nor relies on the work offset in
+# effect: modal ones, G28 G30 (returns) and G53 (a move in machine coordinates: ncpp leaves them as
+# programmed, so no compensation rests on the offset), and G10 with L2 P1-P9 (it sets that system's
+# zero, whichever is in effect); with M0-M9 (not M98 M99, calls), T S F H D and N words, comments
+_SETTING_G = frozenset((0, 1, 2, 3, 17, 18, 19, 20, 21, 28, 30, 40, 43, 49, 53, 61, 61.1, 64, 80, 90, 91,
+                        90.1, 91.1, 93, 94, 95, 96, 97, 98, 99))  # fmt: skip
+_MACHINE_MOVES = frozenset((28, 30, 53))  # (whose axis words are the control's own positions)
+_AXIS_LETTERS = frozenset("XYZABCUVW")
 # lines of settings (not comments alone) a CAM post's head may have before it selects a system
 _ISO_SETTINGS_SCANNED = 16
-_ISO_MACHINE_MOVE = re.compile(r"G0*(28|30|53)(?![\d.])", re.IGNORECASE)
-_ISO_ZERO_SET = (re.compile(r"G0*10(?![\d.])", re.I), re.compile(r"L0*2(?![\d.])", re.I),
-                 re.compile(r"P0*[1-9](?![\d.])", re.I))  # fmt: skip
-_ISO_AXIS_WORD = re.compile(r"[XYZABCUVW]\s*[-+]?(\d+\.?\d*|\.\d+)", re.IGNORECASE)
-_ISO_SELECTION = re.compile(r"G0*(5[4-9]|154)(?![0-9])", re.IGNORECASE)
-_ISO_COMMENT = re.compile(r"\([^)]*\)|;.*")
 
 
 def _iso_selects_first(head: list[str], at: int, rest: Iterator[str]) -> bool:
@@ -384,30 +433,66 @@ def _iso_selects_first(head: list[str], at: int, rest: Iterator[str]) -> bool:
             if line is None:
                 return False
             head.append(line)
-        text, at = head[at], at + 1
-        said = text.lower()
+        items, at = _items("iso", head[at]), at + 1
+        said = _comments(items)
         if TOOL_BEGIN in said or tool_check:
             tool_check = TOOL_END not in said
             continue
         if BEGIN in said:
             return True
-        code = _ISO_COMMENT.sub("", text)
-        if "/" in code:  # (block delete may skip it, or a division: an expression)
+        setting = _iso_setting(items)
+        if setting is None:
             return False
-        if _ISO_SELECTION.search(code):
+        if setting == "selects":
             return True
-        if _FANUC_PROGRAM_NUMBER.match(text):
-            continue
-        if _ISO_MACHINE_MOVE.search(code):
-            code = _ISO_AXIS_WORD.sub("", code)
-        elif all(word.search(code) for word in _ISO_ZERO_SET):
-            for word in _ISO_ZERO_SET:
-                code = word.sub("", code, count=1)
-            code = _ISO_AXIS_WORD.sub("", code)
-        if not _ISO_SETTINGS.fullmatch(code.rstrip("\r\n")):
-            return False
-        settings += bool(code.strip(" \t\r\n%"))
+        settings += setting == "codes"
     return False
+
+
+def _iso_setting(items: tuple[AnyItem, ...] | None) -> str | None:
+    """What an ISO line is to `_iso_selects_first`: "selects" a work offset (G54-G59.3, G54.1 P and
+    G154 P, Fanuc's and Haas's additional ones), "codes" of settings alone (`_SETTING_G`), "none"
+    (comments, a tape mark, a Fanuc program number), or None: anything else, a block delete among
+    it (the control may skip the line)."""
+    if items is None or any(type(item) is Statement and item.kind == "block_delete" for item in items):
+        return None
+    words = [item for item in items if type(item) is Word]
+    if any(word.letter == "G" and (54 <= word.value < 60 or int(word.value) == 154) for word in words):
+        return "selects"
+    if _program_number(items) or all(type(item) is Comment or _tape_mark(item) for item in items):
+        return "none"
+    if len(words) + sum(type(item) is Comment for item in items) < len(items):
+        return None  # (an expression, an o-word, an assignment, a call)
+    codes = {word.value for word in words if word.letter == "G"}
+    axes = bool(codes & _MACHINE_MOVES)
+    zero_set = not axes and _zero_set(words)
+    if zero_set:
+        words = [word for word in words if word not in zero_set]
+    if all(_setting_word(word, axes or bool(zero_set)) for word in words):
+        return "codes"
+    return None
+
+
+def _tape_mark(item: AnyItem) -> bool:
+    return type(item) is Statement and item.kind == "tape" and item.node[0].strip() == "%"
+
+
+def _zero_set(words: list[Word]) -> list[Word]:
+    """The G10, L2 and P1-P9 of a G10 L2 that sets the zero of system P ([] for none)."""
+    firsts = [next((word for word in words if test(word)), None) for test in (
+        lambda w: w.letter == "G" and w.value == 10, lambda w: w.letter == "L" and w.value == 2,
+        lambda w: w.letter == "P" and w.value in range(1, 10))]  # fmt: skip
+    return [word for word in firsts if word is not None] if all(firsts) else []
+
+
+def _setting_word(word: Word, axes: bool) -> bool:
+    """A word a line of settings may hold (`axes`: axis words too, of a machine move or a zero set)."""
+    letter, value = word.letter, word.value
+    if letter == "G":
+        return value in _SETTING_G
+    if letter in "NM":
+        return value == int(value) and value >= 0 and (letter == "N" or value < 10)
+    return letter in "TSFHD" and value >= 0 or axes and letter in _AXIS_LETTERS
 
 
 class PlacementChecks:
@@ -431,7 +516,7 @@ class PlacementChecks:
         block = events[0].block
         if self.dialect == "iso" and self.looked < LEADER_LINES + 12:
             self.looked += 1
-            if _FANUC_PROGRAM_NUMBER.match(block.raw):
+            if _program_number(block.items):
                 self.dialect = "fanuc"
         number = next((e.zero_told for e in events if type(e) is Pass and e.zero_told is not None), None)
         if number is None or number in self.checked:
@@ -540,7 +625,7 @@ class ToolGuard:
         block = events[0].block
         if self.looked < LEADER_LINES + 12 and self.why is None and not (self.haas or self.sinumerik):
             self.looked += 1
-            if _FANUC_PROGRAM_NUMBER.match(block.raw):
+            if _program_number(block.items):
                 self.why = TOOLS_UNGUARDED["fanuc"]
                 self.unguarded(self.why)
         last = events[-1]

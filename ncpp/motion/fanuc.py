@@ -36,6 +36,15 @@ g codes that both use axis values").
 A setting code written with other words in its block is out of scope too: a block that
 both sets and moves is not one these controls' posts write.  So is G33.1, LinuxCNC's rigid tap:
 these controls tap rigidly with M29 and G84.
+
+With --expand-cycles, G82's and G89's dwell (Haas: G73's and G83's too) is written as a G04 with
+the cycle's P as the program gave it, where the control reads both alike (`_dwell_word`).  Fanuc: a G04's P takes no decimal
+point and counts 0.001 s, as a drilling cycle's P (SINUMERIK ISO Milling manual, which documents
+Fanuc's dialect, "Dwell (G04)": "P_: Specify a time (decimal point not permitted)"); with feed per
+revolution (G95) a G04 counts spindle revolutions.  Haas (Mill Operator's Manual, "G04 Dwell"):
+"G04 P10. is a dwell of 10 seconds; G04 P10 is 10 milliseconds", and a cycle's P is in seconds
+("G82", whose example is `P0.3`; "G83": "in seconds").  A P these rules leave open (a decimal point
+on Fanuc, none on Haas, a variable, G95) is refused: the dwell would be a guess.
 """
 
 from __future__ import annotations
@@ -99,6 +108,23 @@ class FanucInterpreter(Interpreter):
             raise _OutOfScope(f"G{setting.number} with other words in its block", setting.start + 1)
         return Pass(block)
 
+    # the P of a cycle that a G04 P reads alike: whether it has a decimal point (module docstring)
+    dwell_point = False
+
+    def _dwell_word(self, block: Block, item) -> str:
+        """The cycle's P as the program gave it, where a G04 P reads it alike (module docstring)."""
+        word = self.cycle_p_word
+        told = f"P{word.number}" if type(word) is Word else "from a variable"
+        point = "in seconds with" if self.dwell_point else "as a whole number, without"
+        if self.per_revolution:
+            why = "with feed per revolution (G95) a G04 may count spindle revolutions"
+        elif type(word) is not Word or ("." in word.number) != self.dwell_point:
+            why = f"this control's G04 reads only a P {point} a decimal point as the cycle's"
+        else:
+            return told
+        self._fail(f"--expand-cycles: the canned cycle's dwell {told} cannot be written as a G04 ({why}); "
+                   "leave the option out, the cycle is then compensated", block, item)  # fmt: skip
+
     def _motion_of_words(self, block, mode0, mode1, mode1_item, axis_item, polar_item) -> float | None:
         """`G0 G28 ...`: the return takes the axis words, the G0 is only the modal motion after it."""
         if mode0 in RETURNS and mode1 == 0.0:
@@ -141,6 +167,7 @@ class HaasInterpreter(FanucInterpreter):
 
     settings = HAAS_SETTINGS
     peck_dwell = True
+    dwell_point = True
     unfollowed = HAAS_UNFOLLOWED
     additional = "G154"
     g54_with_p = False  # (Haas's manual gives G54 no P)

@@ -54,7 +54,7 @@ from ncpp.motion.cycles import (
     back_bore,
     hole,
 )
-from ncpp.motion.expand import Expansion, refused
+from ncpp.motion.expand import Expansion, number, refused
 from ncpp.motion.expressions import ExpressionError, OutOfScope, Parameters, evaluate, vacant
 from ncpp.motion.flow import FIXED, RUN, SKIP, Flow
 from ncpp.motion.offsets import SYSTEMS, WorkOffsets
@@ -263,7 +263,10 @@ class Interpreter:
         self.cycle_r = self.cycle_cc = self.cycle_q = self.cycle_il = 0.0
         self.cycle_ijk = (0.0, 0.0, 0.0)  # G87's sticky I J K
         self.cycle_holes = False  # the series' cycles are compensated hole by hole (`Hole`)
-        self.cycle_p = 0.0  # G82 G89's dwell, seconds (sticky within the cycle; Haas: G73 G83 too)
+        # G82 G89's dwell, in the control's unit (sticky within the cycle; Haas: G73 G83 too), and its word
+        self.cycle_p = 0.0
+        self.cycle_p_word: Word | ExprWord | None = None
+        self.per_revolution = False  # G95 (a Fanuc G04 may then count revolutions: `_dwell_word`)
         self.expand_cycles = False  # cycles are written as their moves (`expanded`)
         self.expansion: Expansion | None = None  # --expand: loops and subroutines written out
         self.spindle = 0  # M3 1, M4 -1, stopped 0 (tapping and boring cycles check it)
@@ -875,7 +878,7 @@ class Interpreter:
 
         # rs274ngc's order of execution (interp_execute.cc, convert_g)
         if 5 in gcodes:
-            self._set(inverse_time=gcodes[5][0] == 93.0)
+            self._set(inverse_time=gcodes[5][0] == 93.0, per_revolution=gcodes[5][0] == 95.0)
         if "F" in words:
             self._set_feed(block, words["F"])
         if 2 in gcodes:
@@ -1301,7 +1304,7 @@ class Interpreter:
     def _program_end(self) -> None:
         """M2/M30: rs274ngc resets some modes and stops reading the program."""
         self._coordinate_system(1)
-        self._set(plane=17, absolute=True, inverse_time=False)
+        self._set(plane=17, absolute=True, inverse_time=False, per_revolution=False)
         self.motion = 1.0
         self.cutter_comp, self.comp_radius, self.arc_refused = None, None, False
         self.centre.reset()
@@ -1518,15 +1521,10 @@ class Interpreter:
         first, second, normal = PLANE_AXES[self.plane]
         again = previous == motion  # the same cycle again: R, the normal-axis word, P and Q are sticky
         if previous not in CANNED:  # a new series: G98 retracts to where it started, no dwell yet
-            self.cycle_il, self.cycle_p = self.pos[normal], 0.0
+            self.cycle_il, self.cycle_p, self.cycle_p_word = self.pos[normal], 0.0, None
         aa, bb, step_a, step_b, r, bottom = self._cycle_geometry(block, words, again, item)
         repeats = self._repeats(block, words)
         peck = self._cycle_word(block, words, motion, again, item)
-        if self.expand_cycles and self.peck_dwell and motion in PECKING and self.cycle_p > 0.0:
-            self._fail(f"--expand-cycles: G{motion:g} with a dwell P cannot be written as G0/G1 moves and a "
-                       "G4 (whether this control reads a G4's P as the cycle's is not known to ncpp); leave "
-                       "the option out, the cycle is then compensated", block,
-                       words.get("P", (0, item))[1])  # fmt: skip
         if motion in (74.0, 84.0) and self.plane != 17:  # rs274ngc's taps move other axes there
             raise _OutOfScope(f"canned cycle G{motion:g} outside the XY plane", item.start + 1)
         if motion in SPINDLE:
@@ -1565,7 +1563,9 @@ class Interpreter:
         lines = tuple(self._fixed_line(block, (first, second, normal), move) for move in moves)
         if self.expand_cycles:
             self.cycle_holes = False
-            return self._expanded(block, motion, lines, bottoms)
+            dwells = motion in DWELLING or (self.peck_dwell and motion in PECKING and self.cycle_p > 0.0)
+            dwell = self._dwell_word(block, words.get("P", (0, item))[1]) if dwells else None
+            return self._expanded(block, motion, lines, bottoms, dwell)
         # holes apply_error_map compensates: in any plane (polar words written as X Y, repeats as a
         # block each), the series' holes all such
         self.cycle_holes = (previous not in CANNED or self.cycle_holes) and motion != 87.0
@@ -1636,18 +1636,28 @@ class Interpreter:
         )
 
     def _expanded(
-        self, block: Block, motion: float, lines: tuple[Line, ...], bottoms: list[int]
+        self, block: Block, motion: float, lines: tuple[Line, ...], bottoms: list[int], dwell: str | None
     ) -> tuple[Event, ...]:
         """A cycle's moves to be written as G0/G1 blocks (--expand-cycles): moves like any other,
-        after a `Pass` that tells the writer, with a dwell after each bottom of G82 G89."""
+        after a `Pass` that tells the writer, with a dwell after each bottom of G82 G89 (Haas: after
+        the last peck of G73 G83 with a P) (`dwell`: its G4's P word)."""
         events: list[Event] = [Pass(block, cycle=motion)]
-        dwells = set(bottoms) if motion in DWELLING else set()  # (P0 too: rs274 dwells 0 s)
+        dwells = set(bottoms) if dwell is not None else set()  # (P0 too: rs274 dwells 0 s)
         for k, line in enumerate(lines):
             line.fixed = ""
             events.append(line)
             if k in dwells:
-                events.append(Pass(block, dwell=self.cycle_p))
+                events.append(Pass(block, dwell=self.cycle_p, dwell_word=dwell))
         return tuple(events)
+
+    def _dwell_word(self, block: Block, item) -> str:
+        """The P word of the G4 that dwells as long as the cycle's P (--expand-cycles): rs274ngc reads
+        both in seconds (LinuxCNC G-code manual, "G4 Dwell" and "G82"), so the P's value, written as
+        the program gave it where it is a number (grbl's flavour reads cycles as LinuxCNC, and its G4 P
+        in seconds too: `motion_control.c`, `mc_dwell`).  `item`: where a refusal points (flavours
+        refuse what they cannot tell)."""
+        word = self.cycle_p_word
+        return "P" + (word.number if type(word) is Word else number("P", self.cycle_p))
 
     def _fixed_line(
         self, block: Block, axes: tuple[int, int, int], move: tuple[float, float, float, bool]
@@ -1713,7 +1723,7 @@ class Interpreter:
         if motion in DWELLING and "P" not in words and not again:
             self._fail(f"Dwell time P word missing with {code}", block, item)
         if "P" in words:
-            self.cycle_p = words["P"][0]
+            self.cycle_p, self.cycle_p_word = words["P"]
         if motion not in PECKING:
             return 0.0
         if "Q" not in words and not again:

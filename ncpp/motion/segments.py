@@ -244,9 +244,11 @@ class Pass:
     motion: float | str | None = None
     setting: Setting | None = None  # a G92 or G10 L20 block's
     # --expand-cycles: `cycle` the G code of a canned cycle's block whose moves are written as G0/G1 blocks
-    # (the first of its events), `dwell` the seconds it dwells between two of them (G82 G89's P)
+    # (the first of its events), `dwell` how long it dwells between two of them (G82 G89's P, in the
+    # control's unit) and `dwell_word` the P of the G4 that dwells as long on that control
     cycle: float | None = None
     dwell: float | None = None
+    dwell_word: str | None = None
     # a block that applies the length of the tool in the spindle from the told tool table (G43):
     # (the tool's number, its Z offset in mm; Sinumerik's M6 or D: the edge D, its length 1 in mm),
     # which the tool guard checks (`ncpp/guard.py`)

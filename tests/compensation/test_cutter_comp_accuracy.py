@@ -25,26 +25,9 @@ needs_oracles = pytest.mark.skipif(
 
 # X runs 100 µm/m long, Y 80 µm/m short, and Y leans 100 µrad towards -X (docs/machine-file.md):
 # the tool lands at (x + 1e-4·x - 1e-4·y, y - 0.8e-4·y) for the command (x, y)
-AFFINE = """[machine]
-name = "affine"
-chain = "XYFZ"
-
-[limits]
-X = [-500.0, 500.0]
-Y = [-500.0, 500.0]
-Z = [-500.0, 500.0]
-
-[errors.EXX]
-kind = "polynomial"
-coefficients_um = [0.0, 0.1]
-
-[errors.EYY]
-kind = "polynomial"
-coefficients_um = [0.0, -0.08]
-
-[squareness]
-C0Y_urad = 100.0
-"""
+AFFINE = machine_file(
+    "affine", linear_errors(EXX=0.1, EYY=-0.08) + "\n[squareness]\nC0Y_urad = 100.0\n", 500.0
+)
 
 
 def closed_form(command: np.ndarray) -> np.ndarray:

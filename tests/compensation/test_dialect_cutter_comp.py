@@ -46,6 +46,7 @@ from ncpp.program.dialects import parse_program
 from tests.compensation.test_cutter_comp_accuracy import AFFINE, closed_form
 from tests.compensation.tool_centre import Move, deviation
 from tests.conftest import SHARED
+from tests.writeback.conftest import linear_errors, machine_file
 
 # ---- the contours: lines, and arcs (centre, turn +1 counter-clockwise), from (-20, 0) -------------
 
@@ -362,10 +363,7 @@ def affine_in(plane: int) -> str:
     u, v, n = (AXES[k] for k in PLANE_AXES[plane])
     errors = {f"E{u}{u}": 0.1, f"E{v}{v}": -0.08, f"E{u}{v}": -0.1, f"E{n}{n}": 0.05, f"E{n}{u}": 0.12,
               f"E{n}{v}": -0.1}  # fmt: skip
-    return AFFINE.split("[errors.")[0] + "".join(
-        f'[errors.{name}]\nkind = "polynomial"\ncoefficients_um = [0.0, {value}]\n\n'
-        for name, value in errors.items()
-    )
+    return machine_file("affine", linear_errors(**errors), 500.0)
 
 
 def closed_form_in(plane: int) -> Callable[[np.ndarray], np.ndarray]:

@@ -8,8 +8,10 @@ P1)"; Haas Mill Operator's Manual: "G187 Accuracy Control", "G103 Limit Block Bu
 from __future__ import annotations
 
 import io
+import re
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -226,17 +228,33 @@ def test_a_haas_peck_cycle_with_p_is_compensated_with_its_p_and_verified(tmp_pat
     assert proc.returncode == 0 and f"compensated {moves} moves" in proc.stderr, proc.stderr
     cycle = next(line for line in out.read_text().splitlines() if line.startswith(f"G{g} "))
     assert cycle.endswith(" Q4 P500 F100") and cycle != f"G{g} G98 X10 Y0 Z-10 R2 Q4 P500 F100"
-    # written as G0/G1 moves the dwell would need a G4, whose P this control may read otherwise: refused
+    # written as G0/G1 moves the pause is a G4 after each hole's last peck, with the P as given where a
+    # Haas G04 reads it in seconds too (a decimal point); P500, which a G04 reads in milliseconds, is refused
     expand = [sys.executable, "-m", "ncpp", *command, "--expand-cycles"]
     expanded = subprocess.run(expand, capture_output=True, text=True, cwd=ROOT)
-    assert expanded.returncode != 0 and "p.nc:5:" in expanded.stderr and "with a dwell P" in expanded.stderr
+    assert (
+        expanded.returncode != 0
+        and "p.nc:5:" in expanded.stderr
+        and "P500 cannot be written as a G04" in expanded.stderr
+    )
+    program.write_text(PECK_DWELL.format(g=g).replace("P500", "P0.5"))
+    assert _dwells(expand, out) == [-10.0, -10.0]
     # a G82's dwell holds in the G83 after it, until G80 cancels it (the manual: "The same dwell time
     # applies to all subsequent blocks that do not specify a dwell time")
-    for between, refused in (("", True), ("G80\n", False)):
-        program.write_text(f"%\nO1\nG21 G90\nG0 X0 Y0 Z5\nG82 X10 Y0 Z-10 R2 P1 F100\n{between}"
+    for between, holes in (("", 2), ("G80\n", 1)):
+        program.write_text(f"%\nO1\nG21 G90\nG0 X0 Y0 Z5\nG82 X10 Y0 Z-10 R2 P1. F100\n{between}"
                            f"G{g} X20 Y0 Z-10 R2 Q4\nG80\nM30\n%\n")  # fmt: skip
-        proc = subprocess.run(expand, capture_output=True, text=True, cwd=ROOT)
-        assert (proc.returncode != 0) is refused and ("with a dwell P" in proc.stderr) is refused, proc.stderr
+        assert _dwells(expand, out, "P1.") == [-10.0] * holes
+
+
+def _dwells(command: list[str], out: Path, p: str = "P0.5") -> list[float]:
+    """The Z (to 0.01 mm) of the move before each `G4 {p}` of the program `command` writes to `out`."""
+    proc = subprocess.run(command, capture_output=True, text=True, cwd=ROOT)
+    assert proc.returncode == 0, proc.stderr
+    lines = out.read_text().splitlines()
+    assert not any(line.startswith("G4") and line != f"G4 {p}" for line in lines)
+    return [round(float(re.findall(r"Z(-?[\d.]+)", lines[k - 1])[0]), 2) for k, line in enumerate(lines)
+            if line == f"G4 {p}"]  # fmt: skip
 
 
 @pytest.mark.parametrize("g", [73, 83])

@@ -403,6 +403,7 @@ def test_a_linuxcnc_program_checks_only_zeros_that_are_still_the_ones_told(progr
         ("G90\nG92 X0\nG55\n", False),
         ("G21\no100 call\nG55\n", False),
         ("G21\n/G55\nG0 X1\n", False),  # (block delete may skip it)
+        ("G21\nG0 G55 X[10/2]\n", True),  # (a division in its move is no block delete)
         ("G21\nM98 P100\nG55\n", False),
         ("G21\n#1=5\nG55\n", False),
         ("G21\nG10 L2 P1 X0 Y0 Z0\nG10 P2 L2 X0\nG55\n", True),  # (it sets zeros, whatever is in effect)

@@ -27,12 +27,13 @@ def compensate_file(program: Path, machine_toml: str, folder: Path, offsets: Wor
     return output
 
 
-def machine_file(name: str, errors: str) -> str:
-    """A machine file of X Y Z with 2 m travels at zero offsets, named `name`, with `errors`
-    (its [errors...] and [squareness] tables): the closed-form machines these tests judge by."""
+def machine_file(name: str, errors: str, travel_mm: float = 1000.0) -> str:
+    """A machine file of X Y Z with travels of +-`travel_mm` at zero offsets, named `name`, with
+    `errors` (its [errors...] and [squareness] tables): the closed-form machines these tests judge by."""
+    limits = "".join(f"{axis} = [{-travel_mm!r}, {travel_mm!r}]\n" for axis in "XYZ")
     head = (
         f'[machine]\nname = "{name}"\nchain = "XYFZ"\n[offsets]\ntool = [0.0, 0.0, 0.0]\nwork = [0.0, 0.0, 0.0]\n'
-        "[limits]\nX = [-1000.0, 1000.0]\nY = [-1000.0, 1000.0]\nZ = [-1000.0, 1000.0]\n"
+        f"[limits]\n{limits}"
     )
     return head + errors
 

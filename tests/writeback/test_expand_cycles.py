@@ -93,3 +93,60 @@ def test_both_commands_take_the_option(tmp_path, command):
     assert proc.returncode == 0, proc.stderr
     written = (tmp_path / "out.ngc").read_text()
     assert "G82" not in written and "G4 P0.2" in written and "canned cycle" not in proc.stderr.decode()
+
+
+def test_linuxcnc_dwells_keep_every_digit_of_their_seconds(tmp_path):
+    """rs274ngc reads a cycle's P and a G4's P in seconds: the G4 dwells exactly as long, however small
+    or large the P, and a P from an expression is written as its value."""
+    original = tmp_path / "dwells.ngc"
+    original.write_text("G21 G90\nG0 X0 Y0 Z5\nG82 X10 Y10 Z-1 R1 P0.0000125 F100\nX20 P1234567.25\n"
+                        "G89 X30 Z-2 R1 P[2 * 0.75]\nG80\nM2\n")  # fmt: skip
+    output = compensate_file(original, MACHINE, tmp_path, expand_cycles=True)
+    dwells = [re.findall(r"DWELL\(([^)]*)\)", _rs274_text(p)) for p in (original, output)]
+    assert dwells[0] == dwells[1] == ["0.0000125", "1234567.2500000", "1.5000000"]
+
+
+def _expanded_text(program: str, dialect: str) -> str:
+    out = io.BytesIO()
+    process(io.BytesIO(program.encode()), out, file="t.nc", source=ErrorSource(Shift(), "shift", "0" * 16, 0.5),
+            warnings=Warnings(stream=open(os.devnull, "w")), dialect=dialect, expand_cycles=True)  # fmt: skip
+    return out.getvalue().decode()
+
+
+FLAVOUR_DWELLS = (
+    "%\nO1\nG21 G90 G17\nG0 X0 Y0 Z5\nG99 G82 X10 Y10 Z-1 R1 P{first} F100\nX20 P{second}\nG80\nM30\n%\n"
+)
+
+
+@pytest.mark.parametrize("dialect, first, second", [("fanuc", "12345678", "0500"), ("haas", "0.3", "2.")])
+def test_fanuc_and_haas_dwells_are_written_with_the_programs_p(dialect, first, second):
+    """Fanuc reads a G04's P as a cycle's, whole units of 0.001 s without a decimal point; Haas reads a
+    G04's P with a decimal point in seconds, as a cycle's: the P as the program gave it is the same time."""
+    text = _expanded_text(FLAVOUR_DWELLS.format(first=first, second=second), dialect)
+    assert re.findall(r"^G4 (P\S*)$", text, re.M) == [f"P{first}", f"P{second}"]
+    assert "G82" not in text
+
+
+@pytest.mark.parametrize("dialect, p, why", [
+    ("fanuc", "2.5", "only a P as a whole number, without a decimal point"),
+    ("fanuc", "#1", "only a P as a whole number"),
+    ("haas", "300", "only a P in seconds with a decimal point"),
+    ("haas", "[0.1 * 3]", "only a P in seconds"),
+])  # fmt: skip
+def test_a_dwell_whose_g04_the_control_may_read_otherwise_is_refused(dialect, p, why):
+    program = "%\nO1\n#1 = 2.5\nG21 G90\nG0 X0 Y0 Z5\nG82 X10 Y10 Z-1 R1 P" + p + " F100\nG80\nM30\n%\n"
+    with pytest.raises(
+        NcppError, match=rf"t\.nc:6:\d+: --expand-cycles: the canned cycle's dwell .*{re.escape(why)}"
+    ):
+        _expanded_text(program, dialect)
+
+
+@pytest.mark.parametrize("dialect", ["fanuc", "haas"])
+def test_a_dwell_under_feed_per_revolution_is_refused(dialect):
+    """With G95 a Fanuc G04 may count spindle revolutions (parameter DWL), not time."""
+    p = "500" if dialect == "fanuc" else "0.5"
+    program = FLAVOUR_DWELLS.format(first=p, second=p)
+    program = program.replace("G17\n", "G17 G95\nM3 S1000\n").replace("F100", "F0.1")
+    with pytest.raises(NcppError, match=r"t\.nc:6:\d+: --expand-cycles: .*G95"):
+        _expanded_text(program, dialect)
+    assert "G4 P" in _expanded_text(program.replace("G95", "G94"), dialect)

@@ -28,6 +28,7 @@ from ncpp.pipeline import dialect_tools
 from ncpp.program.dialects import parse_program
 from tests.compensation.test_dialect_cutter_comp import compensated, machine
 from tests.conftest import CORPUS, SHARED
+from tests.writeback.closed_form import end_points, landed, squares
 from tests.writeback.conftest import misses
 
 # a square 40 x 40 at Z-1, its section run 3 more times, each 1 mm deeper (Q1 counts down)
@@ -49,7 +50,6 @@ REPEATED = """0 BEGIN PGM REP MM
 15 L Z+50 FMAX M30
 16 END PGM REP MM
 """
-SQUARE = [(0, 0), (40, 0), (40, 40), (0, 40), (0, 0)]
 # a subprogram after the program's end, called at X 100 and X 200 (Q2), with an arc about its pole
 SUBPROGRAM = """0 BEGIN PGM SUB MM
 1 TOOL CALL 1 Z S3000
@@ -91,33 +91,13 @@ _WORD = re.compile(r"\b(X|Y|Z)([+-]\d+(?:\.\d*)?)")
 
 
 def points(text: str) -> np.ndarray:
-    """Where each `L` and `C` block of a Klartext program (absolute words) ends, in order: the
-    test's own reading of the written numbers."""
-    here = [0.0, 0.0, 0.0]
-    ends = []
-    for line in text.splitlines():
-        head = line.split(";")[0].split()
-        if len(head) < 2 or head[1] not in ("L", "C"):
-            continue
-        for axis, value in _WORD.findall(line.split(";")[0]):
-            here["XYZ".index(axis)] = float(value)
-        ends.append(list(here))
-    return np.array(ends)
-
-
-def landed(text: str, wanted: list[tuple[float, ...]]) -> np.ndarray:
-    """For each programmed point, how far (mm) the nearest end point of the written program lands
-    from it on AFFINE's machine."""
-    return misses(machine(points(text)), wanted)
-
-
-def squares() -> list[tuple[float, float, float]]:
-    return [(x, y, -float(level)) for level in range(1, 5) for x, y in SQUARE]
+    """Where each `L` and `C` block of a Klartext program ends: the test's own reading of the numbers."""
+    return end_points(text, _WORD, lambda code: code.split()[1:2] in (["L"], ["C"]))
 
 
 @pytest.mark.parametrize(
     "text, name, wanted",
-    [(REPEATED, "rep.h", squares()), (SUBPROGRAM, "sub.h", CALLED_AT), (LOOP, "loop.h", LOOPED)],
+    [(REPEATED, "rep.h", squares(4)), (SUBPROGRAM, "sub.h", CALLED_AT), (LOOP, "loop.h", LOOPED)],
     ids=["repeat", "subprogram", "jumps"],
 )
 def test_every_run_of_a_body_lands_on_its_programmed_points_within_half_a_micron(
@@ -126,9 +106,9 @@ def test_every_run_of_a_body_lands_on_its_programmed_points_within_half_a_micron
     """Each corner of each run, the written numbers mapped through the machine's formula, within
     0.5 µm of the point the test computes; the program as written misses them by microns."""
     written, _ = compensated(tmp_path, name, text, "--expand")
-    assert landed(written, wanted).max() < 0.5e-3
+    assert landed(points(written), wanted).max() < 0.5e-3
     plain, _ = compensated(tmp_path, "plain-" + name, text)
-    assert landed(plain, wanted).max() > 5e-3  # (the bodies left as programmed: the measure can fail)
+    assert landed(points(plain), wanted).max() > 5e-3  # (the bodies left as programmed: the measure can fail)
 
 
 def test_a_repeat_is_written_as_four_squares_without_its_call_and_its_q_parameter(tmp_path):
@@ -295,12 +275,12 @@ def test_a_called_program_is_written_where_each_call_runs_it(tmp_path):
     both."""
     (tmp_path / "SLOT.H").write_text(SLOT)
     written, _ = compensated(tmp_path, "caller.h", CALLER, "--expand", "--subroutine-path", str(tmp_path))
-    assert landed(written, SLOTS).max() < 0.5e-3
+    assert landed(points(written), SLOTS).max() < 0.5e-3
     assert not re.search(r"CALL PGM|LBL|BEGIN PGM SLOT|END PGM SLOT", written)
     assert "FN 0: Q5 = +40" in written  # (Q parameters are global: the caller's as the call left them)
     assert written.index("X+299") > written.rindex("X+209")
     plain, _ = compensated(tmp_path, "plain.h", CALLER, "--subroutine-path", str(tmp_path))
-    assert "CALL PGM SLOT" in plain and landed(plain, SLOTS[:-1]).max() > 5e-3  # (left as programmed)
+    assert "CALL PGM SLOT" in plain and landed(points(plain), SLOTS[:-1]).max() > 5e-3  # (left as programmed)
 
 
 def test_a_called_program_in_other_units_is_refused_with_expand(tmp_path, capsys):

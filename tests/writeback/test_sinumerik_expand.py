@@ -30,7 +30,8 @@ from ncpp.program.dialects import parse_program
 from tests.compensation.test_dialect_cutter_comp import compensated, machine
 from tests.conftest import CORPUS, SHARED
 from tests.dialect_motion.test_sinumerik_flow import SECTION_ENDS, SECTIONS
-from tests.writeback.conftest import misses
+from tests.writeback.closed_form import end_points, landed, squares
+from tests.writeback.conftest import linear_errors, machine_file
 
 # 3 squares 40 x 40, each 1 mm deeper, by a FOR loop; the line after it reads the loop's variable
 FOR_SQUARES = """DEF INT I
@@ -48,7 +49,6 @@ ENDFOR
 G0 Z=5-DEPTH
 M30
 """
-SQUARE = [(0, 0), (40, 0), (40, 40), (0, 40), (0, 0)]
 # WHILE and REPEAT, each 3 runs with an R parameter counter; the lines after them read it
 WHILE_REPEAT = """G17 G90 G71
 G0 X-5 Y-5 Z5
@@ -115,29 +115,11 @@ _WORD = re.compile(r"(?<![A-Z\d_])([XYZ])=?(-?\d+(?:\.\d*)?)")
 
 
 def points(text: str) -> np.ndarray:
-    """Where each block of a Sinumerik program (absolute words, G90) that names X, Y or Z ends, in
-    order: the test's own reading of the written numbers."""
-    here = [0.0, 0.0, 0.0]
-    ends = []
-    for line in text.splitlines():
-        code = line.split(";")[0]
-        words = _WORD.findall(code)
-        if not words or '"' in code or "$" in code:  # (the placement guard's check and message)
-            continue
-        for axis, value in words:
-            here["XYZ".index(axis)] = float(value)
-        ends.append(list(here))
-    return np.array(ends)
-
-
-def landed(text: str, wanted: list[tuple[float, ...]]) -> np.ndarray:
-    """For each programmed point, how far (mm) the nearest end point of the written program lands
-    from it on AFFINE's machine."""
-    return misses(machine(points(text)), wanted)
-
-
-def squares() -> list[tuple[float, float, float]]:
-    return [(x, y, -float(level)) for level in range(1, 4) for x, y in SQUARE]
+    """Where each block of a Sinumerik program that names X, Y or Z ends (not the placement guard's
+    check and message): the test's own reading of the numbers."""
+    return end_points(
+        text, _WORD, lambda code: _WORD.search(code) is not None and not ('"' in code or "$" in code)
+    )
 
 
 def _with_subprograms(tmp_path: Path) -> tuple[str, ...]:
@@ -146,7 +128,7 @@ def _with_subprograms(tmp_path: Path) -> tuple[str, ...]:
     return ("--subroutine-path", str(tmp_path))
 
 
-CASES = [(FOR_SQUARES, "for.mpf", squares()), (WHILE_REPEAT, "while.mpf", WHILE_REPEATED),
+CASES = [(FOR_SQUARES, "for.mpf", squares(3)), (WHILE_REPEAT, "while.mpf", WHILE_REPEATED),
          (JUMPS, "jumps.mpf", JUMPED), (CALLS, "calls.mpf", CALLED_AT),
          (SECTIONS, "sections.mpf", SECTION_ENDS[1:])]  # fmt: skip
 IDS = ["for", "while-repeat", "gotob", "calls", "section repetition"]
@@ -160,9 +142,9 @@ def test_every_run_of_a_body_lands_on_its_programmed_points_within_half_a_micron
     0.5 µm of the point the test computes; the program as written misses them by microns."""
     options = _with_subprograms(tmp_path)
     written, _ = compensated(tmp_path, name, text, "--expand", *options)
-    assert landed(written, wanted).max() < 0.5e-3
+    assert landed(points(written), wanted).max() < 0.5e-3
     plain, _ = compensated(tmp_path, "plain-" + name, text, *options)
-    assert landed(plain, wanted).max() > 5e-3  # (the bodies left as programmed: the measure can fail)
+    assert landed(points(plain), wanted).max() > 5e-3  # (the bodies left as programmed: the measure can fail)
 
 
 def test_a_for_loop_is_written_as_three_squares_its_variables_set_after_it(tmp_path):
@@ -333,19 +315,7 @@ def test_the_command_line_writes_out_and_verifies_on_the_wide_machine(tmp_path):
 CEAD = CORPUS / "sinumerik" / "CEAD_nc-gcode-interpreter"
 # the corpus programs with loops, jumps, CASE or IF that stay in ncpp's scope
 LOOPED = ["loop.mpf", "goto.mpf", "case.mpf", "arrays.mpf", "if_statement.mpf", "logic_operators.mpf"]
-NO_ERRORS = """[machine]
-name = "no-errors"
-chain = "XYFZ"
-
-[limits]
-X = [-5000.0, 5000.0]
-Y = [-5000.0, 5000.0]
-Z = [-5000.0, 5000.0]
-
-[errors.EXX]
-kind = "polynomial"
-coefficients_um = [0.0, 0.0]
-"""
+NO_ERRORS = machine_file("no-errors", linear_errors(EXX=0.0), 5000.0)
 
 
 @pytest.mark.parametrize("name", LOOPED)

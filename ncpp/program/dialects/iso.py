@@ -466,7 +466,7 @@ class IsoWriter:
         for event in group[1:]:
             if type(event) is Pass and event.dwell is not None:
                 lines += self._new_blocks(block, run, eol)
-                dwell = f"G4{separator}P{event.dwell:g}"
+                dwell = f"G4{separator}{event.dwell_word}"
                 lines.append((dwell.lower() if lower else dwell) + eol)
                 run = []
             elif type(event) is Line or type(event) is Arc:
