@@ -33,6 +33,12 @@ operator's manual, "Preparatory function (G function)"; the page is not in ncpp'
 the rule is read from the posts that write the block).  LinuxCNC refuses the block ("Cannot use two
 g codes that both use axis values").
 
+A D word needs no G41/G42 in its block: the control keeps it and a later G41/G42 without D uses it
+(`G43 H1 D1`, as Fanuc programs write with the tool length; Fanuc Series 15i-MA operator's manual,
+"Cutter compensation C": the compensation values are assigned to the D codes, D0 always means 0,
+and a value changed in offset mode takes effect from that block's end, which ncpp does not follow).
+LinuxCNC refuses a D without G41/G42 ("D word with no G41 ...").
+
 A setting code written with other words in its block is out of scope too: a block that
 both sets and moves is not one these controls' posts write.  So is G33.1, LinuxCNC's rigid tap:
 these controls tap rigidly with M29 and G84.
@@ -64,6 +70,7 @@ class FanucInterpreter(Interpreter):
     g54_with_p = True  # `G54 Pn` selects additional work offset n as `G54.1 Pn` does
     numbered = range(0)  # G codes that each select one additional work offset (Haas's G110-G129)
     rigid_tapping = False  # (Fanuc taps rigidly with M29 and G84: G33.1 is LinuxCNC's)
+    modal_d = True  # `G43 H1 D1`: D alone selects the radius offset (module docstring)
 
     def block(self, block: Block) -> Event | tuple[Event, ...]:
         signature = block.signature
