@@ -367,6 +367,8 @@ class HeidenhainInterpreter(ModalInterpreter):
                 words[letter] = (value, item)
                 continue
             what, node = item.kind, item.node
+            if what == "block_delete":  # (the block runs, block skip off: as ISO's `/`)
+                continue
             if what == "path":
                 function, function_item = node[0], item
             elif what == "program_begin":
