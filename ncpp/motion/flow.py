@@ -76,6 +76,7 @@ from pathlib import Path
 
 from ncpp.errors import Location, NcppError, printable
 from ncpp.motion.expressions import SUBROUTINE_PARAMETERS, normalise_name, round_half_away, vacant
+from ncpp.motion.modal import OutOfScope
 from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
 from ncpp.program.parser import parse_stream
 
@@ -501,23 +502,29 @@ class Flow:
         """Run one control line: decide (errors point at it), write it, then jump."""
         if control.keyword not in ("m98", "m99", "g65", "g66", "g67"):
             self._nothing_after(block, control)
+        try:
+            jump = self._decide(frame, block, control)
+        except OutOfScope as leaving:  # (`IF [#1005 EQ 0]`: a value ncpp is not told decides)
+            self.stop(leaving.reason, block, leaving.col)
+            jump = _nothing
+        if self._in_place(frame):
+            yield block, (SKIP if control.keyword == "sub" else TEXT), None
+            self._wrote(frame.pc)
+        result = jump()
+        if result is not None:
+            yield from result
+
+    def _decide(self, frame: _Frame, block: Block, control: Control):
+        """Evaluate and check a control line: a function that moves the frame(s) on, or a
+        generator doing so."""
         if type(control.name) is tuple:
             value = self.evaluate(control.name, block, control.item)
             control = Control(
                 str(int(round_half_away(value))), control.keyword, control.arguments, control.item
             )
-        keyword = control.keyword
-        act = getattr(self, "_" + keyword)
+        act = getattr(self, "_" + control.keyword)
         arrived, self.skipping = self.skipping is not None, None  # (skipping to this line: it runs)
-        jump = act(
-            frame, block, control, arrived
-        )  # a function that moves the frame(s) on, or a generator doing so
-        if self._in_place(frame):
-            yield block, (SKIP if keyword == "sub" else TEXT), None
-            self._wrote(frame.pc)
-        result = jump()
-        if result is not None:
-            yield from result
+        return act(frame, block, control, arrived)
 
     # Each handler decides (evaluates, checks) and returns what moves the program on, run once
     # the line is written; `arrived`: the program was skipping to this line (rs274ngc's skipping_o).
@@ -1349,6 +1356,10 @@ def _subroutine_file(folder: Path, name: str) -> Path | None:
     inside = os.path.abspath(folder)  # (a relative folder, `.`, counts from the working directory)
     path = os.path.normpath(f"{inside}/{name}.ngc")
     return Path(path) if path.startswith(inside.rstrip(os.sep) + os.sep) else None
+
+
+def _nothing() -> None:
+    """The jump of a control line the program left the scope at: none."""
 
 
 def _program_files(folder: Path, name: str) -> list[Path]:

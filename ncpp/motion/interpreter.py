@@ -56,6 +56,7 @@ from ncpp.motion.cycles import (
 )
 from ncpp.motion.expand import Expansion, refused
 from ncpp.motion.expressions import ExpressionError, OutOfScope, Parameters, evaluate, vacant
+from ncpp.motion import modal
 from ncpp.motion.flow import FIXED, RUN, SKIP, Flow
 from ncpp.motion.offsets import SYSTEMS, WorkOffsets
 from ncpp.motion.segments import (
@@ -180,11 +181,8 @@ _MOTION_WITH_COMP = {
 }
 
 
-class _OutOfScope(Exception):
-    def __init__(self, reason: str, col: int | None):
-        super().__init__(reason)
-        self.reason = reason
-        self.col = col
+class _OutOfScope(modal.OutOfScope):
+    """The ISO interpreter's: a control line's expression raises it in `flow.py` too."""
 
 
 def interpreting(flavour: type[Interpreter]) -> Callable[..., Iterator[Event]]:
