@@ -303,3 +303,17 @@ def test_a_d_word_under_compensation_ends_interpretation():
                    Warnings(stream=said))  # fmt: skip
     assert "a D word under cutter compensation" in said.getvalue() and "p.nc:4:1" in said.getvalue()
     assert [type(e) for e in found][3:] == [Pass, Pass, Pass, Pass]
+
+
+def test_a_fanuc_dwell_in_x_is_read_past():
+    """`G04 X2.0 (wait 2.0s)` (mojimould/mould_moji, Created_NC_Programs/sub_programs/O410000.nc): Fanuc's
+    dwell in seconds ("Dwell (G04)": `G04 X_ ;` or `G04 P_ ;`), no axis word; LinuxCNC and Haas read P only."""
+    program = "G21 G90\nG0 X0 Y0 Z5\nG04 X2.0 (wait 2.0s)\nG1 X10 F100\nM30\n"
+    assert [type(e) for e in events(program, "fanuc")] == [Pass, Line, Pass, Line, Pass]
+    for dialect in ("haas", "iso"):
+        with pytest.raises(NcppError, match="Dwell time missing with G4"):
+            events(program, dialect)
+    said = io.StringIO()
+    found = events(program.replace("X2.0 (wait", "X2.0 Y1 (wait"), "fanuc", Warnings(stream=said))
+    assert [type(e) for e in found] == [Pass, Line, Pass, Pass, Pass] and "G04 X (a dwell) with other" in (
+        said.getvalue())
