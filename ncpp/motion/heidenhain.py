@@ -500,12 +500,16 @@ class HeidenhainInterpreter(ModalInterpreter):
 
     def _feed_parameter(self, node: tuple, item: Statement) -> None:
         """`Q208= MAX`: the cycle retracts at rapid (TNC 640 Cycle Programming manual, cycles 200-205:
-        "Q208 Feed rate for retraction ... alternatively FMAX"); any other parameter so given is a
-        feed ncpp does not follow (AUTO: the tool table's)."""
+        "Q208 Feed rate for retraction ... alternatively FMAX"); `Q206= AUTO`: the feed of the TOOL CALL,
+        as `FAUTO` on a move ("Q206 Feed rate for plunging ... alternatively FAUTO"), followed where the
+        TOOL CALL gives one.  Any other parameter so given is a feed ncpp does not follow."""
         name, (_, word) = node[0][1], node[1]
-        if name != RETRACT_FEED or word != "MAX":
+        if name == RETRACT_FEED and word == "MAX":
+            self.q[name] = math.inf
+        elif word == "AUTO" and self.auto_feed > 0.0:
+            self.q[name] = self.auto_feed
+        else:
             raise OutOfScope(f"{name.upper()}={word} (a feed ncpp does not follow)", item.start + 1)
-        self.q[name] = math.inf
 
     def _forget_assigned(self, block: Block) -> None:
         """The Q parameters a CYCL DEF ncpp does not read sets are unknown from here on."""

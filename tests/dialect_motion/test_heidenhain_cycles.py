@@ -297,3 +297,15 @@ def test_a_warning_in_a_continued_block_names_the_line_its_word_is_on():
     moves(text, said)
     line = next(n for n, row in enumerate(text.splitlines(), 1) if "Q206=AUTO" in row)
     assert said.getvalue().startswith(f"drill.h:{line}:5: warning: Q206=AUTO (a feed ncpp does not follow)")
+
+
+def test_a_plunging_feed_of_auto_is_the_tool_calls_feed():
+    """`Q206= AUTO ;WARTOSC POSUWU WGL.` after `TOOL CALL 8 Z S1500 F120` (janforys/cnc-programming,
+    cnc-programming/Heidenhain/DENKO-OTW-BOKI.H; TNC 640 Cycle Programming manual, cycle 200: "Q206 Feed rate
+    for plunging ... alternatively FAUTO", the TOOL CALL's feed): the moves of `Q206=+30`.  Without a feed in
+    the TOOL CALL, the feed is not told: interpretation ends there."""
+    auto = program(CYCLE_200.replace("Q206=+30 ", "Q206= AUTO"))
+    told = auto.replace("TOOL CALL 7 Z S10000", "TOOL CALL 7 Z S10000 F30")
+    assert runs(moves(told)) == runs(moves(program()))
+    said = io.StringIO()
+    assert runs(moves(auto, said)) == [] and "Q206=AUTO (a feed ncpp does not follow)" in said.getvalue()

@@ -234,3 +234,13 @@ def test_a_plane_function_is_read_whole_with_its_words_as_written(text):
     found = statements(text)
     assert found[0][0] == "keyword" and " ".join(found[0][1]) == text.split(" ", 1)[1].split(";")[0].strip()
     assert [type(i) for i in items(text)][-1] is (Comment if ";" in text else Statement)
+
+
+@pytest.mark.parametrize(
+    "text, feed",
+    [("79 L  Y+42.9 RL F AUTO", "FAUTO"), ("61 L X160.5 Y-35 R0 F MAX M3", "FMAX"), ("5 L X+1 FMAX", "FMAX")],
+)
+def test_a_feed_keyword_may_have_a_blank_after_its_f(text, feed):
+    """`F AUTO` (janforys/cnc-programming, cnc-programming/Heidenhain/CHWYT-125.h, a TNC's own file) and
+    `F MAX` (hyperMILL's Heidenhain post) are FAUTO and FMAX."""
+    assert ("feed", (feed,)) in statements(text)

@@ -22,7 +22,7 @@ Statement kinds and nodes (Heidenhain):
                                          FSELECT 'APPR LT' 'DEP LCT' ...; words follow
                  ('CHF', length)         `CHF 2` chamfer with its length
   radius_comp    ('R0' | 'RL' | 'RR',)
-  feed           ('FMAX' | 'FAUTO',)     `F200` is a Word
+  feed           ('FMAX' | 'FAUTO',)     `F200` is a Word; `F MAX` is 'FMAX' too
   rotation       ('+' | '-',)            `DR+` counter-clockwise, `DR-` clockwise
   retract        (distance | 'MAX',)     M140's `MB 50` -> (50.0,), `MB MAX` -> ('MAX',)
   tool_call      (tool, axis)            `TOOL CALL 1 Z S800`: tool int | float | "name" | ("param", q)
@@ -197,7 +197,7 @@ class HeidenhainBuilder(Transformer):
     keyword = _statement("keyword", lambda c: tuple(str(t).upper() for t in c))
     plane = _statement("keyword", lambda c: tuple(str(c[0]).upper().split()))
     radius_comp = _statement("radius_comp", lambda c: (str(c[0]).upper(),))
-    feed = _statement("feed", lambda c: (str(c[0]).upper(),))
+    feed = _statement("feed", lambda c: ("".join(str(c[0]).split()).upper(),))
     rotation = _statement("rotation", lambda c: (str(c[0])[-1],))
     retract = _statement("retract", lambda c: (_retract_distance(str(c[0])),))
     del (
