@@ -1364,8 +1364,9 @@ def _nothing() -> None:
 
 def _program_files(folder: Path, name: str) -> list[Path]:
     """The files Fanuc program `name` may be kept in: `O1234`, `O1234.nc` (and `.NC`, `.txt`),
-    the number also as written (`O12` besides `O0012`)."""
-    stems = dict.fromkeys((f"O{int(name):04d}", f"O{name}"))
+    the number also as written (`O12` besides `O0012`), or without its O (`1234.nc`, as PC folders of
+    programs name them); the file must say `O1234` itself (`_program_from_file`)."""
+    stems = dict.fromkeys((f"O{int(name):04d}", f"O{name}", f"{int(name):04d}", name))
     return [Path(folder) / f"{stem}{suffix}" for stem in stems for suffix in ("", ".nc", ".NC", ".txt")]
 
 
