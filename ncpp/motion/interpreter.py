@@ -243,6 +243,8 @@ class Interpreter:
     peck_dwell = False
     # A D word alone selects the radius offset a later G41/G42 without D uses (Fanuc); rs274ngc refuses it
     modal_d = False
+    # The motion mode a program starts in (grbl: G0); rs274ngc starts in none
+    start_motion: float | None = None
 
     def __init__(self, file: str = "<stdin>", offsets: WorkOffsets | None = None):
         self.file = file
@@ -256,7 +258,7 @@ class Interpreter:
         self.inch = False
         self.inverse_time = False
         self.feed = 0.0
-        self.motion: float | None = None  # modal motion G code (0-3, a canned cycle), None for G80 / none yet
+        self.motion: float | None = self.start_motion  # modal motion G code (0-3, a canned cycle), None for G80 / none yet
         self.retract_to_r = True  # G99 (rs274ngc's default) / G98: where a cycle retracts to
         # A canned cycle's sticky words (R, the normal axis's, Q; P is a dwell: no move) and the
         # normal-axis position its series of cycles started from (a series ends with any other motion)
