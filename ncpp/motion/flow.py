@@ -644,6 +644,10 @@ class Flow:
         """The subroutine file the running block is from (None: the program)."""
         return self.frames[-1].source
 
+    def _searched(self) -> str:
+        """Where a called Fanuc program was looked for, for a message (nothing without a path)."""
+        return f", nor is it in {os.pathsep.join(map(str, self.path))}" if self.path else ""
+
     def _m98(self, frame, block, control, arrived):
         """A Fanuc subprogram call: `M98 P<n> L<repeats>`."""
         number, repeats = (None if item is None else self._number(item, block) for item in control.arguments)
@@ -653,9 +657,8 @@ class Flow:
         )
         body = self._defined(self.subprograms, name) or self._program_from_file(name)
         if body is None:
-            where = f", nor is it in {os.pathsep.join(map(str, self.path))}" if self.path else ""
-            self.stop(f"M98 P{name}: a subprogram the program does not define (O{name} to M99){where}",
-                      block, control.item.start + 1)  # fmt: skip
+            said = f"M98 P{name}: a subprogram the program does not define (O{name} to M99)"
+            self.stop(said + self._searched(), block, control.item.start + 1)
             return lambda: None
 
         self._check_level(block, control)
@@ -779,8 +782,8 @@ class Flow:
         body = self._defined(self.subprograms, name) or self._program_from_file(name)
         if body is None:
             what = control.keyword.upper()
-            self.stop(f"{what} P{name}: a macro the program does not define (O{name} to M99)", block,
-                      control.item.start + 1)  # fmt: skip
+            said = f"{what} P{name}: a macro the program does not define (O{name} to M99)"
+            self.stop(said + self._searched(), block, control.item.start + 1)
             return None
         return body, runs, values
 

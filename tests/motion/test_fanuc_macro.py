@@ -477,6 +477,10 @@ def test_m98_runs_a_program_kept_in_a_file_of_the_subroutine_path(tmp_path):
         f"M98 P9010: a subprogram the program does not define (O9010 to M99), nor is it in {tmp_path}"
         in warning
     )
+    # G65's says where it looked too (`G65P3003...` of dennisselyaev/gcode 3.nc, its file not on the path)
+    macro = write_program(tmp_path, "O1000\n" + HEAD + "G65 P9010 X1.\nM30\n", "macro.nc")
+    _, error, warning = ours(macro, offsets=WorkOffsets.given({}, subroutine_path=[tmp_path]))
+    assert f"G65 P9010: a macro the program does not define (O9010 to M99), nor is it in {tmp_path}" in warning
 
 
 def test_a_program_file_without_its_number_is_an_error_at_the_file(tmp_path):
