@@ -33,6 +33,17 @@ operator's manual, "Preparatory function (G function)"; the page is not in ncpp'
 the rule is read from the posts that write the block).  LinuxCNC refuses the block ("Cannot use two
 g codes that both use axis values").
 
+A D word needs no G41/G42 in its block: the control keeps it and a later G41/G42 without D uses it
+(`G43 H1 D1`, as Fanuc programs write with the tool length; Fanuc Series 15i-MA operator's manual,
+"Cutter compensation C": the compensation values are assigned to the D codes, D0 always means 0,
+and a value changed in offset mode takes effect from that block's end, which ncpp does not follow).
+LinuxCNC refuses a D without G41/G42 ("D word with no G41 ...").
+
+Fanuc's dwell takes its time in X as well as in P: `G04 X1.5` dwells 1.5 s (Fanuc Series 0i-MF / 16i
+operator's manuals, "Dwell (G04)": "G04 X_ ; or G04 P_ ;", X with a decimal point in seconds, P in
+milliseconds); the X is no axis word there.  LinuxCNC reads only P ("Cannot use axis values without a g
+code that uses them").
+
 A setting code written with other words in its block is out of scope too: a block that
 both sets and moves is not one these controls' posts write.  So is G33.1, LinuxCNC's rigid tap:
 these controls tap rigidly with M29 and G84.
@@ -73,12 +84,16 @@ class FanucInterpreter(Interpreter):
     g54_with_p = True  # `G54 Pn` selects additional work offset n as `G54.1 Pn` does
     numbered = range(0)  # G codes that each select one additional work offset (Haas's G110-G129)
     rigid_tapping = False  # (Fanuc taps rigidly with M29 and G84: G33.1 is LinuxCNC's)
+    modal_d = True  # `G43 H1 D1`: D alone selects the radius offset (module docstring)
+    dwell_x = True  # `G04 X1.5`: a dwell of 1.5 s (module docstring)
 
     def block(self, block: Block) -> Event | tuple[Event, ...]:
         signature = block.signature
         if signature is not None and "G" not in signature and "M" not in signature:
             return super().block(block)  # axis words only (the most): no setting, nothing unfollowed
         words = [item for item in block.items if type(item) is Word]
+        if self.dwell_x and _dwell_in_x(block, words):
+            return Pass(block)
         for word in words:
             if word.letter == "G" and (
                 word.value == ADDITIONAL_CODES[self.additional][0]
@@ -172,10 +187,25 @@ class HaasInterpreter(FanucInterpreter):
     additional = "G154"
     g54_with_p = False  # (Haas's manual gives G54 no P)
     numbered = range(110, 130)
+    dwell_x = False  # (Haas's manual gives G04 a P only)
 
 
 interpret = interpreting(FanucInterpreter)
 interpret_haas = interpreting(HaasInterpreter)
+
+
+def _dwell_in_x(block: Block, words: list[Word]) -> bool:
+    """`G04 X1.5`: a dwell whose time is X; out of scope with other words in its block (what else the
+    block does is not a dwell's)."""
+    g4 = next((w for w in words if w.letter == "G" and w.value == 4.0), None)
+    times = [i for i in block.items if (type(i) is Word or type(i) is ExprWord) and i.letter in "XP"]
+    if g4 is None or [i.letter for i in times] != ["X"]:
+        return False
+    kept = (g4, times[0])
+    others = (i for i in block.items if type(i) is not Comment and i not in kept)
+    if any(not (type(i) is Word and i.letter == "N") for i in others):
+        raise _OutOfScope("G04 X (a dwell) with other words in its block", g4.start + 1)
+    return True
 
 
 def _external_offset(block: Block, words: list[Word]) -> bool:

@@ -76,6 +76,7 @@ from pathlib import Path
 
 from ncpp.errors import Location, NcppError, printable
 from ncpp.motion.expressions import SUBROUTINE_PARAMETERS, normalise_name, round_half_away, vacant
+from ncpp.motion.modal import OutOfScope
 from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
 from ncpp.program.parser import parse_stream
 
@@ -501,23 +502,29 @@ class Flow:
         """Run one control line: decide (errors point at it), write it, then jump."""
         if control.keyword not in ("m98", "m99", "g65", "g66", "g67"):
             self._nothing_after(block, control)
+        try:
+            jump = self._decide(frame, block, control)
+        except OutOfScope as leaving:  # (`IF [#1005 EQ 0]`: a value ncpp is not told decides)
+            self.stop(leaving.reason, block, leaving.col)
+            jump = _nothing
+        if self._in_place(frame):
+            yield block, (SKIP if control.keyword == "sub" else TEXT), None
+            self._wrote(frame.pc)
+        result = jump()
+        if result is not None:
+            yield from result
+
+    def _decide(self, frame: _Frame, block: Block, control: Control):
+        """Evaluate and check a control line: a function that moves the frame(s) on, or a
+        generator doing so."""
         if type(control.name) is tuple:
             value = self.evaluate(control.name, block, control.item)
             control = Control(
                 str(int(round_half_away(value))), control.keyword, control.arguments, control.item
             )
-        keyword = control.keyword
-        act = getattr(self, "_" + keyword)
+        act = getattr(self, "_" + control.keyword)
         arrived, self.skipping = self.skipping is not None, None  # (skipping to this line: it runs)
-        jump = act(
-            frame, block, control, arrived
-        )  # a function that moves the frame(s) on, or a generator doing so
-        if self._in_place(frame):
-            yield block, (SKIP if keyword == "sub" else TEXT), None
-            self._wrote(frame.pc)
-        result = jump()
-        if result is not None:
-            yield from result
+        return act(frame, block, control, arrived)
 
     # Each handler decides (evaluates, checks) and returns what moves the program on, run once
     # the line is written; `arrived`: the program was skipping to this line (rs274ngc's skipping_o).
@@ -637,6 +644,10 @@ class Flow:
         """The subroutine file the running block is from (None: the program)."""
         return self.frames[-1].source
 
+    def _searched(self) -> str:
+        """Where a called Fanuc program was looked for, for a message (nothing without a path)."""
+        return f", nor is it in {os.pathsep.join(map(str, self.path))}" if self.path else ""
+
     def _m98(self, frame, block, control, arrived):
         """A Fanuc subprogram call: `M98 P<n> L<repeats>`."""
         number, repeats = (None if item is None else self._number(item, block) for item in control.arguments)
@@ -646,9 +657,8 @@ class Flow:
         )
         body = self._defined(self.subprograms, name) or self._program_from_file(name)
         if body is None:
-            where = f", nor is it in {os.pathsep.join(map(str, self.path))}" if self.path else ""
-            self.stop(f"M98 P{name}: a subprogram the program does not define (O{name} to M99){where}",
-                      block, control.item.start + 1)  # fmt: skip
+            said = f"M98 P{name}: a subprogram the program does not define (O{name} to M99)"
+            self.stop(said + self._searched(), block, control.item.start + 1)
             return lambda: None
 
         self._check_level(block, control)
@@ -772,8 +782,8 @@ class Flow:
         body = self._defined(self.subprograms, name) or self._program_from_file(name)
         if body is None:
             what = control.keyword.upper()
-            self.stop(f"{what} P{name}: a macro the program does not define (O{name} to M99)", block,
-                      control.item.start + 1)  # fmt: skip
+            said = f"{what} P{name}: a macro the program does not define (O{name} to M99)"
+            self.stop(said + self._searched(), block, control.item.start + 1)
             return None
         return body, runs, values
 
@@ -1351,10 +1361,15 @@ def _subroutine_file(folder: Path, name: str) -> Path | None:
     return Path(path) if path.startswith(inside.rstrip(os.sep) + os.sep) else None
 
 
+def _nothing() -> None:
+    """The jump of a control line the program left the scope at: none."""
+
+
 def _program_files(folder: Path, name: str) -> list[Path]:
     """The files Fanuc program `name` may be kept in: `O1234`, `O1234.nc` (and `.NC`, `.txt`),
-    the number also as written (`O12` besides `O0012`)."""
-    stems = dict.fromkeys((f"O{int(name):04d}", f"O{name}"))
+    the number also as written (`O12` besides `O0012`), or without its O (`1234.nc`, as PC folders of
+    programs name them); the file must say `O1234` itself (`_program_from_file`)."""
+    stems = dict.fromkeys((f"O{int(name):04d}", f"O{name}", f"{int(name):04d}", name))
     return [Path(folder) / f"{stem}{suffix}" for stem in stems for suffix in ("", ".nc", ".NC", ".txt")]
 
 

@@ -11,6 +11,8 @@ grbl reads a subset of rs274ngc (its wiki page "G-code commands" and `grbl/gcode
   through untouched; `$H` (homing) and `$J=` (jogging) move the machine where ncpp does not
   follow, so the state is unknown from there, as with any construct out of scope;
 * G33.1, LinuxCNC's rigid tap, is out of scope: grbl has no spindle-synchronised motion;
+* the parser starts in G0 (`gcode.h`: "MOTION_MODE_SEEK 0 // G0 (Default: Must be zero)", the state
+  `gc_init` clears), so axis words before any motion code are a rapid, where rs274ngc refuses them;
 * `?`, `~` and `!` are realtime commands (status report, cycle start, feed hold) that grbl
   picks out of the stream as they arrive (`serial.c`), never G code: a line of them
   passes through untouched.
@@ -33,6 +35,7 @@ _MOVING = {"$H": "grbl homing ($H)", "$J=": "a grbl jog ($J=)"}
 class GrblInterpreter(Interpreter):
     arc_normal_offset_ignored = True
     rigid_tapping = False  # (grbl has no spindle-synchronised motion)
+    start_motion = 0.0  # (grbl's parser starts in G0)
 
     def block(self, block: Block) -> Event | tuple[Event, ...]:
         signature = block.signature

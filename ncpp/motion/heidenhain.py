@@ -96,7 +96,11 @@ ROTARY = ("A", "B", "C")
 # Programs CALL PGM runs nest this deep (TNC 640 Klartext manual, "Nesting": "Maximum nesting
 # depth for calling NC main programs")
 MAX_PROGRAM_NESTING = 19
-DATUM_CYCLES = frozenset(("7", "8", "10", "11", "19", "26"))
+DATUM_CYCLES = frozenset(("8", "10", "11", "19", "26"))
+# CYCL DEF 7 DATUM SHIFT (TNC 640 Cycle Programming manual, "DATUM SHIFT (Cycle 7)"): `7.0` heads it, each
+# of `7.1 X..` `7.2 Y..` `7.3 Z..` shifts one axis's datum, an absolute value from the preset, an incremental
+# one (`IY-11.75`) from the datum in effect; a datum table's line (`7.1 #5`) is not read
+SHIFT_CYCLE = "7"
 # CYCL DEF 247 DATUM SETTING activates the preset Q339 of the preset table (TNC 640 Klartext manual,
 # "Cycle 247 DATUM SETTING"): the program zero ncpp is told is that preset's; another preset later
 # is a zero ncpp is not told
@@ -228,6 +232,7 @@ class HeidenhainInterpreter(ModalInterpreter):
         self.corner_waits = False  # an RND/CHF block came after the last move
         self.unknown_axes: set[int] = set()  # axes whose position ncpp is not told (after M140 MB MAX)
         self.preset: float | None = None  # the preset CYCL DEF 247 activated (the program zero told)
+        self.shift = [0.0, 0.0, 0.0]  # the datum CYCL DEF 7 shifted X Y Z by, from the preset
         self.ended = False  # the program ended (M2, M30, END PGM), not left the scope
         self.flow: KlartextFlow | None = None  # the order the blocks run in (labels, calls, jumps)
         self.cycle: Drilling | str | None = None  # the cycle M99 / CYCL CALL runs (str: one not followed)
@@ -367,6 +372,8 @@ class HeidenhainInterpreter(ModalInterpreter):
                 words[letter] = (value, item)
                 continue
             what, node = item.kind, item.node
+            if what == "block_delete":  # (the block runs, block skip off: as ISO's `/`)
+                continue
             if what == "path":
                 function, function_item = node[0], item
             elif what == "program_begin":
@@ -405,6 +412,9 @@ class HeidenhainInterpreter(ModalInterpreter):
                 number = cycle_number(node[0])
                 if number == PRESET_CYCLE:
                     self._preset(block, item)
+                    return []
+                if number == SHIFT_CYCLE:
+                    self._datum_shift(block, item)
                     return []
                 if number in DATUM_CYCLES:
                     raise OutOfScope(f"CYCL DEF {node[0]} (it moves the datum)", item.start + 1)
@@ -498,12 +508,16 @@ class HeidenhainInterpreter(ModalInterpreter):
 
     def _feed_parameter(self, node: tuple, item: Statement) -> None:
         """`Q208= MAX`: the cycle retracts at rapid (TNC 640 Cycle Programming manual, cycles 200-205:
-        "Q208 Feed rate for retraction ... alternatively FMAX"); any other parameter so given is a
-        feed ncpp does not follow (AUTO: the tool table's)."""
+        "Q208 Feed rate for retraction ... alternatively FMAX"); `Q206= AUTO`: the feed of the TOOL CALL,
+        as `FAUTO` on a move ("Q206 Feed rate for plunging ... alternatively FAUTO"), followed where the
+        TOOL CALL gives one.  Any other parameter so given is a feed ncpp does not follow."""
         name, (_, word) = node[0][1], node[1]
-        if name != RETRACT_FEED or word != "MAX":
+        if name == RETRACT_FEED and word == "MAX":
+            self.q[name] = math.inf
+        elif word == "AUTO" and self.auto_feed > 0.0:
+            self.q[name] = self.auto_feed
+        else:
             raise OutOfScope(f"{name.upper()}={word} (a feed ncpp does not follow)", item.start + 1)
-        self.q[name] = math.inf
 
     def _forget_assigned(self, block: Block) -> None:
         """The Q parameters a CYCL DEF ncpp does not read sets are unknown from here on."""
@@ -1055,6 +1069,9 @@ class HeidenhainInterpreter(ModalInterpreter):
         )  # fmt: skip
         if number is None:
             self.fail("CYCL DEF 247 without Q339 (the preset number)", block, item)
+        if any(self.shift):
+            raise OutOfScope("CYCL DEF 247 with a datum shift of CYCL DEF 7 in effect (whether it stays "
+                             "is not followed)", item.start + 1)  # fmt: skip
         if self.preset is None:
             self.preset = number
         elif number != self.preset:
@@ -1063,6 +1080,25 @@ class HeidenhainInterpreter(ModalInterpreter):
                 "program zero)",
                 item.start + 1,
             )
+
+    def _datum_shift(self, block: Block, item: Statement) -> None:
+        """A line of CYCL DEF 7 (`SHIFT_CYCLE`): the datum moves, and with it the program coordinates
+        of every point (the offset from program to machine); under radius compensation it is not
+        followed, as a TOOL CALL there is not."""
+        words = [i for i in block.items if (type(i) is Word or type(i) is ExprWord) and i.letter != "N"]
+        if not words and item.node[0] in ("7", "7.0"):
+            return  # (the cycle's head: its axes follow, a line each)
+        axis = words[0].letter.removeprefix("I") if len(words) == 1 else ""
+        if len(axis) != 1 or axis not in AXES:
+            raise OutOfScope(f"CYCL DEF {item.node[0]} (a datum shift ncpp does not read)", item.start + 1)
+        if self.radius_comp:
+            raise OutOfScope("CYCL DEF 7 with radius compensation RL/RR", item.start + 1)
+        k = AXES.index(axis)
+        shift = self._word_value(words[0], block) + (self.shift[k] if words[0].letter[0] == "I" else 0.0)
+        offset = list(self.offset)
+        offset[k] += shift - self.shift[k]
+        self.shift[k] = shift
+        self.set_offset(offset)
 
     def _retract(self, block: Block, distance: float | str) -> Line:
         """M140 MB: after the block's move, the control retracts along the tool axis (away from the

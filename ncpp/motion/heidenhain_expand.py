@@ -58,8 +58,9 @@ Evaluate = Callable[[tuple, Block, AnyItem], float]  # the interpreter's value o
 
 
 def head(block: Block) -> Statement | None:
-    """The block's statement (a Klartext block has one at most that leads it)."""
-    return next((i for i in block.items if type(i) is Statement), None)
+    """The block's statement (a Klartext block has one at most that leads it; a block delete `/` before
+    its number is none)."""
+    return next((i for i in block.items if type(i) is Statement and i.kind != "block_delete"), None)
 
 
 def is_control(block: Block) -> bool:

@@ -108,7 +108,7 @@ class KlartextFlow:
             return
         index = self.base + len(self.held)
         self.held.append(block)
-        item = next((i for i in block.items if type(i) is Statement), None)  # (a block has one head)
+        item = next((i for i in block.items if type(i) is Statement and i.kind != "block_delete"), None)
         if item is None:
             return
         if item.kind == "label":

@@ -56,6 +56,7 @@ from ncpp.motion.cycles import (
 )
 from ncpp.motion.expand import Expansion, number, refused
 from ncpp.motion.expressions import ExpressionError, OutOfScope, Parameters, evaluate, vacant
+from ncpp.motion import modal
 from ncpp.motion.flow import FIXED, RUN, SKIP, Flow
 from ncpp.motion.offsets import SYSTEMS, WorkOffsets
 from ncpp.motion.segments import (
@@ -180,11 +181,8 @@ _MOTION_WITH_COMP = {
 }
 
 
-class _OutOfScope(Exception):
-    def __init__(self, reason: str, col: int | None):
-        super().__init__(reason)
-        self.reason = reason
-        self.col = col
+class _OutOfScope(modal.OutOfScope):
+    """The ISO interpreter's: a control line's expression raises it in `flow.py` too."""
 
 
 def interpreting(flavour: type[Interpreter]) -> Callable[..., Iterator[Event]]:
@@ -243,6 +241,10 @@ class Interpreter:
     rigid_tapping = True
     # G73/G83 take a P, the dwell at the bottom of each hole (Haas); rs274ngc refuses it there
     peck_dwell = False
+    # A D word alone selects the radius offset a later G41/G42 without D uses (Fanuc); rs274ngc refuses it
+    modal_d = False
+    # The motion mode a program starts in (grbl: G0); rs274ngc starts in none
+    start_motion: float | None = None
 
     def __init__(self, file: str = "<stdin>", offsets: WorkOffsets | None = None):
         self.file = file
@@ -256,7 +258,7 @@ class Interpreter:
         self.inch = False
         self.inverse_time = False
         self.feed = 0.0
-        self.motion: float | None = None  # modal motion G code (0-3, a canned cycle), None for G80 / none yet
+        self.motion: float | None = self.start_motion  # modal motion G code (0-3, a canned cycle), None for G80 / none yet
         self.retract_to_r = True  # G99 (rs274ngc's default) / G98: where a cycle retracts to
         # A canned cycle's sticky words (R, the normal axis's, Q; P is a dwell: no move) and the
         # normal-axis position its series of cycles started from (a series ends with any other motion)
@@ -296,6 +298,7 @@ class Interpreter:
         # its lathe tool orientation (G41.1/G42.1's L, the tool table's Q; 0 and 9: the tool centre is
         # controlled), kept after G40 for the exit move
         self.comp_orientation = 0
+        self.radius_offset: int | None = None  # the D in effect where D is modal (`modal_d`)
         self.centre = ToolCentre()  # where the tool centre stands off the programmed path (`_in_comp`)
         self.arc_refused = False  # after G40 ended compensation that moved the tool off the path: until a G0/G1 move (rs274ngc)
         # the exit move after G40 has a Fanuc corner (`,R` `,C`): the move it rounds into is left as programmed too
@@ -885,6 +888,8 @@ class Interpreter:
             self._set(plane=int(gcodes[2][0]))
         if 6 in gcodes:
             self._set_units(gcodes[6][0] == 20.0)
+        if "D" in words and self.modal_d:
+            self._set(radius_offset=self._radius_offset(block, words["D"], 7 in gcodes))
         if 7 in gcodes:
             self._cutter_compensation(block, gcodes[7], words)
         if "T" in words:
@@ -1023,6 +1028,7 @@ class Interpreter:
                 )
         if (
             "D" in words
+            and not self.modal_d
             and g7 not in (41.0, 42.0, 41.1, 42.1)
             and gcodes.get(14, (None,))[0] != 96.0
             and motion != 71.0
@@ -1156,7 +1162,8 @@ class Interpreter:
             41.0,
             42.0,
         ):  # the radius of tool D, or of the tool in the spindle, from the table ncpp is told
-            number = self.spindle_tool if d is None else round(d[0])
+            number = round(d[0]) if d is not None else self.radius_offset
+            number = self.spindle_tool if number is None else number
             self.comp_radius = (
                 None
                 if self.tools is None
@@ -1166,6 +1173,17 @@ class Interpreter:
             if self.plane != 18 and self.comp_orientation not in (0, 9):
                 self._fail(f"G{code:g} with lathe tool, but plane is not G18", block, item)
         self.cutter_comp = code
+
+    def _radius_offset(self, block: Block, word: tuple, with_code: bool) -> int:
+        """A modal D: a whole offset number, 0 for none (Fanuc's D00).  One without G40/G41/G42
+        under compensation changes the radius (or, D0, ends it) from its block's end: not followed."""
+        value, item = word
+        if value < 0.0 or abs(value - round(value)) > 0.0001:
+            self._fail("D word must be a whole number", block, item)
+        if self.cutter_comp is not None and not with_code:
+            raise _OutOfScope("a D word under cutter compensation (a new radius from its block's end)",
+                              item.start + 1)  # fmt: skip
+        return round(value)
 
     def _orientation(self, block: Block, code: float, word: tuple | None) -> int:
         """G41.1/G42.1's lathe tool orientation, its L word (0 without one): in G18 only, as

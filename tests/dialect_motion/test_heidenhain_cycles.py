@@ -199,11 +199,23 @@ def test_cycles_ncpp_does_not_follow_and_changed_parameters_still_end_interpreta
     assert len(runs(found)) == 1 and "Q201 changed since CYCL DEF 200" in warned.getvalue()
 
 
-def test_an_old_style_datum_shift_ends_interpretation():
-    """`CYCL DEF 7.0 DATUM SHIFT` with `CYCL DEF 7.1 X+10` moves the datum as `CYCL DEF 7` does."""
+def test_a_datum_shift_moves_the_program_coordinates_of_the_holes():
+    """`CYCL DEF 7.0 PUNKT BAZOWY` / `CYCL DEF 7.1 IY-11.75` (janforys/cnc-programming, Heidenhain/JF/AD/
+    N021.00/OTW.H; TNC 640 Cycle Programming manual, "DATUM SHIFT (Cycle 7)": absolute values from the
+    preset, incremental ones from the datum in effect): each hole, its X and Y programmed, is drilled where
+    the same program without the shift drills it moved by the shift, machine point for machine point."""
+    holes = [f"L  X+{x} Y{y} FMAX M99" for x, y in ((25, -7.5), (90, -7.5), (90, -42.5), (25, -42.5))]
+    shifted = moves(program(holes=["CYCL DEF 7.0 DATUM SHIFT", "CYCL DEF 7.1  X+10", "CYCL DEF 7.2 IY-11.75",
+                                   "CYCL DEF 7.2 IY+1.75", *holes]))  # fmt: skip
+    plain = moves(program(holes=holes))
+    machine = [m.context.to_machine(m.end) for m in shifted if m.fixed == DRILLED]
+    expected = [tuple(a + b for a, b in zip(m.context.to_machine(m.end), (10.0, -10.0, 0.0)))
+                for m in plain if m.fixed == DRILLED]  # fmt: skip
+    assert len(machine) == len(expected) == 16
+    assert all(abs(a - b) < 1e-9 for p, q in zip(machine, expected) for a, b in zip(p, q))
     warned = io.StringIO()
-    moves(program(holes=["CYCL DEF 7.0 DATUM SHIFT", "CYCL DEF 7.1  X+10", "L FMAX M99"]), warned)
-    assert "CYCL DEF 7.0 (it moves the datum) is outside" in warned.getvalue()
+    assert runs(moves(program(holes=["CYCL DEF 7.0 DATUM SHIFT", "CYCL DEF 7.1 #5", *HOLES]), warned)) == []
+    assert "CYCL DEF 7.1 (a datum shift ncpp does not read)" in warned.getvalue()
 
 
 def compensate(text: str, machine_toml: str = SQUARE) -> tuple[str, object]:
@@ -297,3 +309,15 @@ def test_a_warning_in_a_continued_block_names_the_line_its_word_is_on():
     moves(text, said)
     line = next(n for n, row in enumerate(text.splitlines(), 1) if "Q206=AUTO" in row)
     assert said.getvalue().startswith(f"drill.h:{line}:5: warning: Q206=AUTO (a feed ncpp does not follow)")
+
+
+def test_a_plunging_feed_of_auto_is_the_tool_calls_feed():
+    """`Q206= AUTO ;WARTOSC POSUWU WGL.` after `TOOL CALL 8 Z S1500 F120` (janforys/cnc-programming,
+    cnc-programming/Heidenhain/DENKO-OTW-BOKI.H; TNC 640 Cycle Programming manual, cycle 200: "Q206 Feed rate
+    for plunging ... alternatively FAUTO", the TOOL CALL's feed): the moves of `Q206=+30`.  Without a feed in
+    the TOOL CALL, the feed is not told: interpretation ends there."""
+    auto = program(CYCLE_200.replace("Q206=+30 ", "Q206= AUTO"))
+    told = auto.replace("TOOL CALL 7 Z S10000", "TOOL CALL 7 Z S10000 F30")
+    assert runs(moves(told)) == runs(moves(program()))
+    said = io.StringIO()
+    assert runs(moves(auto, said)) == [] and "Q206=AUTO (a feed ncpp does not follow)" in said.getvalue()

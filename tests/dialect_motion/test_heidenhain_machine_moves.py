@@ -122,3 +122,21 @@ def test_resets_of_a_plane_or_tcpm_that_move_nothing_are_read_past():
     )
     turning = PROGRAM.replace("2 TOOL CALL 1 Z S1000", "2 PLANE RESET TURN FMAX\n2 TOOL CALL 1 Z S1000")
     assert lines(turning, Warnings(stream=stream)) == [] and "PLANE RESET TURN" in stream.getvalue()
+
+
+def test_a_hidden_block_runs_as_the_control_runs_it_with_block_skip_off():
+    """`/ 5 L Z-1 F100`: the `/` before the number hides the block only when the operator switches block
+    skip on; ncpp follows it as it follows ISO's `/` (janforys/cnc-programming, Heidenhain/FAZ.H: `/ 16 STOP`)."""
+    hidden = PROGRAM.replace("5 L Z-1 F100", "/ 5 L Z-1 F100").replace("8 L Z-2", "/ 8 STOP\n8 L Z-2")
+    assert [(m.start, m.end) for m in lines(hidden)] == [(m.start, m.end) for m in lines(PROGRAM)]
+
+
+def test_a_plane_function_with_its_words_ends_interpretation_with_a_warning():
+    """`PLANE SPATIAL SPA-90 SPB+0 SPC+90 TURN F5555 SEQ- TABLE ROT` (janforys/cnc-programming,
+    Heidenhain/CHWYT-125.h) tilts the working plane: out of scope, not a line ncpp cannot read."""
+    stream = io.StringIO()
+    plane = "7 PLANE SPATIAL SPA-90 SPB+0 SPC+90 TURN F5555 SEQ- TABLE ROT"
+    text = PROGRAM.replace("7 L X+0 Y+0 FMAX", plane)
+    assert len(lines(text, Warnings(stream=stream))) == len([m for m in lines(PROGRAM) if m.block.line < 8])
+    assert "p.h:8:3: warning: PLANE SPATIAL SPA-90 SPB+0 SPC+90 TURN F5555 SEQ- TABLE ROT is outside" in (
+        stream.getvalue())

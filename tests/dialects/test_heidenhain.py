@@ -207,3 +207,40 @@ def test_bad_input_names_file_line_and_column(text, line, col):
         list(parse_stream(io.BytesIO(text), "bad.h", "heidenhain"))
     where = err.value.where
     assert (where.file, where.line, where.col) == ("bad.h", line, col)
+
+
+def test_a_hidden_block_keeps_its_slash_before_the_number_and_roundtrips():
+    """A TNC writes a hidden block (skipped when block skip is on) with `/` before its number:
+    `/ 16 STOP` (janforys/cnc-programming, cnc-programming/Heidenhain/FAZ.H), also in a `~` block."""
+    assert statements("/ 16 STOP") == [("block_delete", ("/",)), ("keyword", ("STOP",))]
+    assert words("/ 24 L  A+0 FMAX") == {"N": 24.0, "A": 0.0}
+    assert words("/16 L X+5 F100")["N"] == 16.0
+    text = "/ 23 TCH PROBE 419 PKT.BAZOW.POJED. OSI ~\n    Q263=+0    ;1.PKT POMIAROW 1.OSI\n/ 57 L M30\n"
+    blocks = list(parse_stream(io.BytesIO(text.encode()), "p.h", "heidenhain"))
+    assert [s.kind for s in blocks[0].items if type(s) is Statement][:2] == ["block_delete", "touch_probe"]
+    out = io.BytesIO()
+    write_blocks(blocks, out)
+    assert out.getvalue().decode() == text
+
+
+@pytest.mark.parametrize(
+    "text",
+    ["32 PLANE SPATIAL SPA-90 SPB+0 SPC+90 TURN F5555 SEQ- TABLE ROT",  # janforys, Heidenhain/CHWYT-125.h
+     "55 PLANE SPATIAL SPA0 SPB0 SPC0 STAY SEQ+ TABLE ROT", "7 PLANE AXIAL B+45 TURN MB MAX FMAX ; tilt"],
+)  # fmt: skip
+def test_a_plane_function_is_read_whole_with_its_words_as_written(text):
+    """PLANE's words mix keywords, angles, a feed and M140's MB (TNC 640 Klartext manual, "PLANE
+    function"): the block is one statement, its words as written (the interpreter leaves it out of scope)."""
+    found = statements(text)
+    assert found[0][0] == "keyword" and " ".join(found[0][1]) == text.split(" ", 1)[1].split(";")[0].strip()
+    assert [type(i) for i in items(text)][-1] is (Comment if ";" in text else Statement)
+
+
+@pytest.mark.parametrize(
+    "text, feed",
+    [("79 L  Y+42.9 RL F AUTO", "FAUTO"), ("61 L X160.5 Y-35 R0 F MAX M3", "FMAX"), ("5 L X+1 FMAX", "FMAX")],
+)
+def test_a_feed_keyword_may_have_a_blank_after_its_f(text, feed):
+    """`F AUTO` (janforys/cnc-programming, cnc-programming/Heidenhain/CHWYT-125.h, a TNC's own file) and
+    `F MAX` (hyperMILL's Heidenhain post) are FAUTO and FMAX."""
+    assert ("feed", (feed,)) in statements(text)

@@ -145,3 +145,17 @@ def test_linuxcnc_reads_nothing_after_the_closing_percent():
     for dialect, parsed in (("iso", False), ("fanuc", True)):
         after = parse_text(text, grammar=dialect)[3:]
         assert all(b.verbatim for b in after) and all(bool(b.items) is parsed for b in after)
+
+
+@pytest.mark.parametrize("name", ["1002.nc", "O1002.nc", "1002.NC"])
+def test_a_subprogram_file_named_for_its_number_without_the_o_is_found(tmp_path, name):
+    """`G65P3003...` with O3003 in `3003.nc` (dennisselyaev/gcode, 3.nc and 3003.nc, a Fanuc 0i-MD's
+    programs as a PC folder keeps them): the file on the subroutine path, which must say `O1002` itself."""
+    (tmp_path / name).write_text("%\n" + SUB)
+    written, proc = compensate(tmp_path, MAIN + "M30\n%\n", "--subroutine-path", str(tmp_path), "--expand")
+    assert "not define" not in proc.stderr and written.count("G91 G1 Z-1") == 2, (proc.stderr, written)
+    (tmp_path / name).write_text("%\n" + SUB.replace("O1002", "O1003"))
+    command = ["compensate", "--machine", str(READING), "--dialect", "fanuc", "--subroutine-path", str(tmp_path),
+               str(tmp_path / "p.nc"), "-o", str(tmp_path / "out.nc")]  # fmt: skip
+    proc = subprocess.run([sys.executable, "-m", "ncpp", *command], capture_output=True, text=True, cwd=ROOT)
+    assert proc.returncode != 0 and f"{name}:1:1: O1002 ... M99 is not in the file" in proc.stderr, proc.stderr

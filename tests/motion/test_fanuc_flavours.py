@@ -269,3 +269,69 @@ def test_haas_peck_holes_are_rs274s_of_the_cycle_without_p(tmp_path, g):
     reference = read_canon(rs274(str(twin))[0])
     mine = [c for c in (canon_call(e) for e in events(PECK_DWELL.format(g=g), "haas")) if c is not None]
     assert len(mine) == len(reference) and same_calls(reference, mine), (reference, mine)
+
+
+def test_a_d_word_in_a_tool_length_block_is_read():
+    """`G43H1D1Z150.` (dennisselyaev/gcode, 3.nc, a Fanuc 0i-MD program): a Fanuc control keeps the D for
+    the G41/G42 to come; LinuxCNC refuses a D without G41/G42."""
+    program = "G90G54G0X0.Y0.;\nG43H1D1Z150.;\nG0X10.\nM30\n"
+    for dialect in ("fanuc", "haas"):
+        assert [type(e) for e in events(program, dialect)] == [Line, Line, Line, Pass]
+    with pytest.raises(NcppError, match="D word with no G41"):
+        events(program, "iso")
+
+
+@pytest.mark.parametrize(
+    "body, refused",
+    [("T1 M6\nD2\nG41\nG1 X38.09\n", 7), ("T1 M6\nD2\nG41\nG1 X38.11\nG40\nG1 X0\n", None),
+     ("T2 M6\nD1\nG41\nG1 X126.99\n", 7), ("T2 M6\nD1\nG41\nG1 X127.01\nG40\nG1 X0\n", None)],
+)  # fmt: skip
+def test_g41_without_d_takes_the_radius_of_the_d_in_effect(tmp_path, body, refused):
+    """Fanuc's D is modal: `D2` then `G41` offsets by tool 2's radius (1.5 in), as LinuxCNC's `G41 D2`, which
+    rs274 judges here (its refusal of a move shorter than the radius, a line earlier there)."""
+    from dataclasses import replace
+
+    from ncpp.motion.offsets import WorkOffsets
+    from ncpp.motion.tools import ToolTable
+    from tests.motion.test_oracle import rs274_error, write_program
+
+    if not RS274.exists():
+        pytest.skip("rs274 not available")
+    table = tmp_path / "tool.tbl"
+    table.write_text("T1 P1 D10 Z0\nT2 P2 D3 Z0\n")
+    head = "G21 G90 G17 G94\nG0 X0 Y0 Z5\nG1 Z-1 F100\n"
+    twin = write_program(tmp_path, head + body.replace("D2\nG41", "G41 D2").replace("D1\nG41", "G41 D1"))
+    theirs = rs274_error(subprocess.run([str(RS274), "-t", str(table), str(twin)], capture_output=True,
+                                        text=True, timeout=60).stderr)  # fmt: skip
+    offsets = replace(WorkOffsets.at((0.0, 0.0, 0.0)), tools=ToolTable.from_file(table, unit_mm=25.4))
+    interpret, _ = dialect_tools("fanuc")
+    _, blocks = parse_program(io.BytesIO((head + body + "M30\n").encode()), "p.nc", "fanuc")
+    try:
+        list(interpret(blocks, file="p.nc", offsets=offsets, warnings=Warnings(stream=io.StringIO())))
+        error = None
+    except NcppError as err:
+        error = err
+    assert (theirs is None) is (refused is None) and (error is None) is (refused is None), (theirs, error)
+    assert refused is None or (error.where.line == refused and error.message == theirs[0]), (theirs, error)
+
+
+def test_a_d_word_under_compensation_ends_interpretation():
+    said = io.StringIO()
+    found = events("G21 G90\nG0 X0 Y0\nG41 D1 G1 X10 F100\nD2\nG1 X20\nG40 G1 X30\nM30\n", "fanuc",
+                   Warnings(stream=said))  # fmt: skip
+    assert "a D word under cutter compensation" in said.getvalue() and "p.nc:4:1" in said.getvalue()
+    assert [type(e) for e in found][3:] == [Pass, Pass, Pass, Pass]
+
+
+def test_a_fanuc_dwell_in_x_is_read_past():
+    """`G04 X2.0 (wait 2.0s)` (mojimould/mould_moji, Created_NC_Programs/sub_programs/O410000.nc): Fanuc's
+    dwell in seconds ("Dwell (G04)": `G04 X_ ;` or `G04 P_ ;`), no axis word; LinuxCNC and Haas read P only."""
+    program = "G21 G90\nG0 X0 Y0 Z5\nG04 X2.0 (wait 2.0s)\nG1 X10 F100\nM30\n"
+    assert [type(e) for e in events(program, "fanuc")] == [Pass, Line, Pass, Line, Pass]
+    for dialect in ("haas", "iso"):
+        with pytest.raises(NcppError, match="Dwell time missing with G4"):
+            events(program, dialect)
+    said = io.StringIO()
+    found = events(program.replace("X2.0 (wait", "X2.0 Y1 (wait"), "fanuc", Warnings(stream=said))
+    assert [type(e) for e in found] == [Pass, Line, Pass, Pass, Pass] and "G04 X (a dwell) with other" in (
+        said.getvalue())

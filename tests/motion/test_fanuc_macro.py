@@ -477,6 +477,10 @@ def test_m98_runs_a_program_kept_in_a_file_of_the_subroutine_path(tmp_path):
         f"M98 P9010: a subprogram the program does not define (O9010 to M99), nor is it in {tmp_path}"
         in warning
     )
+    # G65's says where it looked too (`G65P3003...` of dennisselyaev/gcode 3.nc, its file not on the path)
+    macro = write_program(tmp_path, "O1000\n" + HEAD + "G65 P9010 X1.\nM30\n", "macro.nc")
+    _, error, warning = ours(macro, offsets=WorkOffsets.given({}, subroutine_path=[tmp_path]))
+    assert f"G65 P9010: a macro the program does not define (O9010 to M99), nor is it in {tmp_path}" in warning
 
 
 def test_a_program_file_without_its_number_is_an_error_at_the_file(tmp_path):
@@ -543,3 +547,24 @@ def test_i_j_k_repeat_only_in_a_macro_call():
     for block in ("G2 X1 Y0 I0.5 I0.5 J0", "M98 P700 I1 I2", "G67 I1 I2"):
         with pytest.raises(NcppError, match="Multiple i words on one line"):
             _events(f"O1\n{HEAD}{block}\nM30\n{SETS_MACRO}")
+
+
+@pytest.mark.parametrize(
+    "program, line",
+    [  # mojimould/mould_moji, Created_NC_Programs/main_program_examples/O80000001 (a horizontal MC's Fanuc):
+     # a sensor input (#1000-#1015) decides the branch
+     ("%\nO80000001\nG21 G90\nG0 X0 Y0 Z5\nN0002\nIF[#1005EQ0]GOTO0003\nM00 (sensor low battery)\nN0003\n"
+      "G1 X10 F100\nM30\n%\n", 6),
+     ("%\nO1\nG21 G90\nG0 X0 Y0 Z5\nWHILE[#1004EQ0]DO1\nG1 X10 F100\nEND1\nM30\n%\n", 5),
+     ("G21 G90\nG0 X0 Y0 Z5\no1 if [#<_hal[motion.probe-input]> EQ 0]\nG1 X10 F100\no1 endif\nM2\n", 3)],
+)  # fmt: skip
+def test_a_control_line_whose_value_ncpp_is_not_told_ends_interpretation_there(program, line):
+    """The branch an input signal or a HAL pin decides is not followed: from that line the program
+    passes through with a warning (it stopped with a traceback), the moves before it followed."""
+    said = io.StringIO()
+    found = list(interpret(parse_stream(io.BytesIO(program.encode()), "p.nc"), file="p.nc",
+                           warnings=Warnings(stream=said)))  # fmt: skip
+    assert f"p.nc:{line}:1: warning: " in said.getvalue() and "outside the motion interpreter's scope" in (
+        said.getvalue())
+    assert [type(e) for e in found if type(e) is Line] == [Line]
+    assert all(type(e) is Pass for e in found if e.block.line >= line)

@@ -105,3 +105,24 @@ def test_grbl_programs_are_compensated_and_read_back_as_grbl(tmp_path):
     assert proc.returncode == 0, proc.stderr
     assert "compensated 2 moves" in proc.stderr and "left as programmed: nothing" in proc.stderr
     assert "\nG2 X9.9999 Y0.0000 Z1.0000 I5.0000 J0.0001 F300\n" in proc.stdout
+
+
+def test_axis_words_before_any_motion_code_are_a_rapid_as_grbl_starts_in_g0(tmp_path):
+    """`G91` then `Z2` (svenhb/GRBL-Plotter, GRBL-Plotter/data/examples/gcode_relative.nc): grbl's parser starts
+    in G0 (`gcode.h`: MOTION_MODE_SEEK 0, "Default: Must be zero"), so Z2 is `G0 Z2`; rs274 runs the twin that
+    says so, and refuses the program as written, as ncpp's LinuxCNC reading does."""
+    from ncpp.motion.canon import canon_call, read_canon
+    from tests.conftest import RS274
+    from tests.motion.test_oracle import rs274, same_calls
+
+    program = b"( Test relative moves)\nG91\nZ2\nG0 X-10 Y-10\nG1 Z-5 F300\nY20\nX20\nM30\n"
+    with pytest.raises(NcppError, match="Cannot use axis values without a g code that uses them"):
+        events(program, "iso")
+    mine = [c for c in (canon_call(e) for e in events(program, "grbl")) if c is not None]
+    assert mine[0].name == "STRAIGHT_TRAVERSE" and mine[0].end[:3] == (0.0, 0.0, 2.0) and len(mine) == 5
+    if not RS274.exists():
+        pytest.skip("rs274 not available")
+    twin = tmp_path / "twin.ngc"
+    twin.write_bytes(program.replace(b"\nZ2\n", b"\nG0 Z2\n"))
+    reference = read_canon(rs274(str(twin))[0])
+    assert same_calls(reference, mine), (reference, mine)

@@ -3,7 +3,8 @@
 Blocks map onto the common item classes so that interpreters and writers
 handle every dialect alike:
 
-* the block number `15` is `Word('N', 15.0, '15')` (its span has no letter);
+* the block number `15` is `Word('N', 15.0, '15')` (its span has no letter); a `/` before it,
+  which hides the block (`/ 16 STOP`), is `Statement('block_delete', ('/',))`, as ISO's;
 * `X+10,5` `IX-5` `PA+30` `IPA+90` `PR+50` `R+5` `F200` `S800` `M3` `DL+0.1`
   are `Word`s: the letter as written upper-cased (`IX`, `PA`, ...), the value
   a float, the number text as written (sign and decimal comma kept);
@@ -21,7 +22,7 @@ Statement kinds and nodes (Heidenhain):
                                          FSELECT 'APPR LT' 'DEP LCT' ...; words follow
                  ('CHF', length)         `CHF 2` chamfer with its length
   radius_comp    ('R0' | 'RL' | 'RR',)
-  feed           ('FMAX' | 'FAUTO',)     `F200` is a Word
+  feed           ('FMAX' | 'FAUTO',)     `F200` is a Word; `F MAX` is 'FMAX' too
   rotation       ('+' | '-',)            `DR+` counter-clockwise, `DR-` clockwise
   retract        (distance | 'MAX',)     M140's `MB 50` -> (50.0,), `MB MAX` -> ('MAX',)
   tool_call      (tool, axis)            `TOOL CALL 1 Z S800`: tool int | float | "name" | ("param", q)
@@ -40,7 +41,8 @@ Statement kinds and nodes (Heidenhain):
   fn             (number, text)          `FN 9: IF +Q1 EQU +0 GOTO LBL "x"` -> (9, 'IF +Q1 ...'), passed through
   assignment     (("param", "q1950"), expr)  `Q1950 = Q1804 - Q1805`; a string ("str", text) for QS;
                                          a cycle's feed `Q208= MAX` -> ("feed", "MAX") ('AUTO' for `=AUTO`)
-  keyword        (words...)              anything else led by keywords (`STOP`, `PLANE ...`), passed through
+  keyword        (words...)              anything else led by keywords (`STOP`), passed through; a PLANE
+                                         function's words as written (`PLANE SPATIAL SPA+0 ... STAY`)
 Expressions: ("num", v) ("param", "q12"|"ql1"|"qr1"|"qs1") ("neg", x) ("bin", op, a, b) with op in
 + - * / ** (`^`), ("call", NAME, x) for SIN COS TAN ASIN ACOS ATAN SQRT SQ LN LOG ABS INT FRAC NEG SGN.
 """
@@ -96,7 +98,9 @@ class HeidenhainBuilder(Transformer):
     def start(self, children):
         items = []
         for child in children:
-            if isinstance(child, Token):  # the block number
+            if isinstance(child, Token) and child.type == "BLOCK_DELETE":
+                items.append(Statement("block_delete", (str(child),), child.start_pos, child.end_pos))
+            elif isinstance(child, Token):  # the block number
                 items.append(Word("N", float(child), str(child), child.start_pos, child.end_pos))
             else:
                 items.append(child)
@@ -191,8 +195,9 @@ class HeidenhainBuilder(Transformer):
     pattern_def = _statement("pattern_def", _pattern_def)
     fn = _statement("fn", _fn)
     keyword = _statement("keyword", lambda c: tuple(str(t).upper() for t in c))
+    plane = _statement("keyword", lambda c: tuple(str(c[0]).upper().split()))
     radius_comp = _statement("radius_comp", lambda c: (str(c[0]).upper(),))
-    feed = _statement("feed", lambda c: (str(c[0]).upper(),))
+    feed = _statement("feed", lambda c: ("".join(str(c[0]).split()).upper(),))
     rotation = _statement("rotation", lambda c: (str(c[0])[-1],))
     retract = _statement("retract", lambda c: (_retract_distance(str(c[0])),))
     del (
@@ -315,7 +320,7 @@ class HeidenhainWriter(IsoWriter):
         verified (`ncpp.verify`) as it runs."""
         if type(event) is not Pass or event.skipped:
             return False
-        head = next((i for i in event.block.items if type(i) is Statement), None)
+        head = next((i for i in event.block.items if type(i) is Statement and i.kind != "block_delete"), None)
         return head is not None and (
             head.kind in ("call_label", "call_program") or (head.kind == "fn" and head.node[0] in _JUMPS)
         )
