@@ -75,6 +75,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ncpp.errors import Location, NcppError, printable
+from ncpp.motion.endless import Journal, Revisits, endless, exact
 from ncpp.motion.expressions import SUBROUTINE_PARAMETERS, normalise_name, round_half_away, vacant
 from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
 from ncpp.program.parser import parse_stream
@@ -185,7 +186,10 @@ class Flow:
     returns; `done()` says the program has ended (M2, M30, or a construct
     outside the interpreter's scope), after which the rest is text;
     `stop(reason, block, col)` ends it where the flow leaves the scope;
-    `path`: the folders of subroutine files."""
+    `path`: the folders of subroutine files; `state()`: the interpreter's state but for the
+    parameters (`endless.exact`; None where it cannot be told) and `position()` a cheap part of
+    it, with which a loop that comes back to the state it had is refused (`endless.py`; None:
+    only at MAX_RERUN)."""
 
     def __init__(
         self,
@@ -195,6 +199,8 @@ class Flow:
         done: Callable[[], bool],
         stop: Callable,
         path: Sequence[Path] = (),
+        state: Callable[[], object] | None = None,
+        position: Callable[[], object] = lambda: None,
     ):
         self.file, self.evaluate, self.parameters, self.done, self.stop, self.path = (
             file,
@@ -251,6 +257,11 @@ class Flow:
         # The verbatim blocks the text starts with: a Fanuc tape leader (`parser._leader`, within
         # the blocks read ahead); a verbatim block after them stands after the closing `%`
         self.leader = 0
+        self.revisits: Revisits | None = None
+        if state is not None:
+            parameters.journal = Journal()
+            self.revisits = Revisits(parameters.journal, parameters.entry, position,
+                                     lambda: self._with_flow(state()))  # fmt: skip
 
     # -- the stream ------------------------------------------------------------
     def steps(self, blocks: Iterable[Block]) -> Iterator[tuple[Block, str, Block | None]]:
@@ -824,7 +835,7 @@ class Flow:
         if inner:
             raise NcppError(f"END{m} closes DO{m} across the loop {inner[0]}: loops nest, they do not cross "
                             "(a Fanuc alarm)", where)  # fmt: skip
-        return lambda: setattr(frame, "pc", label.start)
+        return self._back(frame, label.start, block, control)
 
     def _loop_name(self, m: int, block: Block, control: Control) -> str:
         if m not in (1, 2, 3):
@@ -862,7 +873,7 @@ class Flow:
                 n for n, label in frame.labels.items() if label.kind == "fanuc" and label.start >= index
             ]:
                 del frame.labels[name]  # left: the jump goes back before its WHILE
-            frame.pc = index
+            self._back(frame, index, block, control)()
 
         return back
 
@@ -988,7 +999,7 @@ class Flow:
         again = self._condition(block, control)
         if label is not None and label.kind == "do":  # the end of a do loop
             if again and not self.doing_break:
-                return lambda: setattr(frame, "pc", label.start)
+                return self._back(frame, label.start, block, control)
             self.doing_break = False
             return self._ended(frame, control.name)
 
@@ -1012,7 +1023,7 @@ class Flow:
             if not self.doing_continue:
                 return self._ended(frame, control.name)
             self.doing_continue = False  # (only here: a `continue` in a do loop leaves it set)
-        return lambda: setattr(frame, "pc", label.start)
+        return self._back(frame, label.start, block, control)
 
     def _do(self, frame, block, control, arrived):
         frame.opened.setdefault(control.name, (frame.pc, "do", block.line))
@@ -1062,6 +1073,36 @@ class Flow:
             raise self._error(
                 f"is a duplicate O-word label: already defined in line {first[2]}", block, control
             )
+
+    def _back(self, frame: _Frame, head: int, block: Block, control: Control) -> Callable[[], None]:
+        """Back to a loop's head (its index in the frame), where a loop that comes back to a state
+        it had is refused (`endless.py`), at the line that goes back."""
+
+        def step():
+            frame.pc = head
+            passes = self.revisits and self.revisits.arrived((len(self.frames), id(frame.space), head, id(block)))
+            if passes:
+                where = Location(frame.source or self.file, block.line, control.item.start + 1)
+                raise endless(passes, self._block(frame, head).line, where)  # type: ignore[union-attr]
+
+        return step
+
+    def _with_flow(self, state: object) -> tuple | None:
+        """The interpreter's `state` and the flow's own (None: not told): its calls, loops and
+        branches, where it stands in the text, what it has read; not its counts of lines run."""
+        if state is None:
+            return None
+        frames = tuple((id(f.space), f.pc, tuple((n, b.kind, b.start, b.count) for n, b in f.labels.items()),
+                        frozenset(f.ifs), tuple(f.opened.items()), f.repeats, f.source, f.macro, f.modal)
+                       for f in self.frames)  # fmt: skip
+        modal = self.modal and (id(self.modal.body), self.modal.runs, exact(self.modal.values), self.modal.depth)
+        defining = self._defining and (self._defining[1], len(self._defining[2]))
+        held = (self.written, self.base, self.read, self.leader, id(self.owner), self._fault is None, defining,
+                self.last_run_move, self.fanuc, len(self.dropped), len(self.looped), len(self.subroutines),
+                len(self.subprograms), len(self.defined_at), len(self.files), len(self.program_files),
+                len(self._whole_programs), len(self._definitions))  # fmt: skip
+        flags = (self.skipping, self.executed_if, self.doing_break, self.doing_continue, self.moved)
+        return state, frames, modal, flags, held
 
     def _on(self, frame: _Frame, skipping: str | None) -> Callable[[], None]:
         """On to the next line, skipping to the next line of o-word `skipping` (None: not)."""

@@ -1,0 +1,123 @@
+"""Loops that never end, refused where they first come back to a state they were in before.
+
+A program's run is deterministic: nothing comes in from outside while it runs (ncpp leaves a
+program that reads the machine's own state, a probe or an operator's input out of its scope).
+So if the flow arrives at the same backward jump (a loop's end, a GOTO back) with exactly the
+state it had at an earlier arrival -- every parameter, the position, the modes, the flow's own
+loops, calls and branches -- the stretch between the two arrivals runs again and again, for
+ever.  That is the test here, and it refuses no loop that ends: a run that ends never repeats
+a state.  A loop whose state keeps changing (a counter that counts for ever) is left to the
+bound on lines run again (`flow.MAX_RERUN`).
+
+The arrivals are checked as Brent's cycle finding does: the state is taken whole at the 1st,
+2nd, 4th, 8th ... arrival and each arrival after it is compared with it, so a loop that repeats
+after p arrivals is found within about twice p arrivals once it repeats.  Comparing whole states
+at every arrival would cost more than the loop's own lines, so the parameters are journalled
+(`Journal`: the ones written since the state was taken, with their values then) and the whole
+state is built and compared only where the jump, the parameters and the cheap part of the state
+(`quick`: the position) are all as they were.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Callable, Hashable
+
+import numpy as np
+
+from ncpp.errors import Location, NcppError
+
+ABSENT = object()  # a parameter that has no value (a name not defined, a number never written)
+
+
+def exact(value: object) -> object:
+    """`value` as something that compares equal to another's only where the two are the same
+    state: floats to the bit (0.0 is not -0.0, NaN is no NaN), containers item by item,
+    dataclasses field by field, arrays byte by byte; any other object equal to nothing."""
+    kind = type(value)
+    if kind is float:
+        return (0.0, math.copysign(1.0, value)) if value == 0.0 else value  # type: ignore[arg-type]
+    if value is None or kind in (int, bool, str):
+        return value
+    if kind is list or isinstance(value, tuple):
+        return tuple(exact(item) for item in value)  # type: ignore[union-attr]
+    if kind is dict:
+        return {key: exact(item) for key, item in value.items()}  # type: ignore[union-attr]
+    if kind in (set, frozenset):
+        return frozenset(value)  # type: ignore[arg-type]  # (of numbers and names)
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        return kind, tuple(exact(getattr(value, f.name)) for f in dataclasses.fields(value))
+    if isinstance(value, np.ndarray):
+        return value.dtype.str, value.shape, value.tobytes()
+    return object()  # (an object whose state is not told: equal to nothing, no loop refused over it)
+
+
+class Journal:
+    """The values parameters had when the journal (re)started (`before`), of those written since:
+    the parameters' keeper sets a key's, where it is not there yet, before each write;
+    `changed(current)` says whether any differs now (`current(key)` gives a parameter's value as
+    kept here, `ABSENT` for none)."""
+
+    def __init__(self) -> None:
+        self.before: dict[Hashable, object] = {}
+
+    def restart(self) -> None:
+        self.before.clear()
+
+    def changed(self, current: Callable[[Hashable], object]) -> bool:
+        return any(current(key) != was for key, was in self.before.items())
+
+
+
+class Revisits:
+    """The arrivals of one program run at its backward jumps (the module docstring).
+
+    `journal` notes the parameters' writes, `current` reads one as the journal keeps it;
+    `quick()` and `state()` give the rest of the state (`exact` values), `quick` a cheap part
+    compared first; `state()` may return None where the state cannot be told whole (a corner
+    waiting for its next move), and no loop is refused there."""
+
+    def __init__(
+        self,
+        journal: Journal,
+        current: Callable[[Hashable], object],
+        quick: Callable[[], object],
+        state: Callable[[], object],
+    ):
+        self.journal, self.current, self.quick, self.state = journal, current, quick, state
+        self.arrivals = 0
+        self.taken_at = 0  # the arrival whose state is kept (0: none yet)
+        self.power = 1  # arrivals compared with it before the state is taken again
+        self.site: Hashable = None
+        self.kept_quick: object = None
+        self.kept: object = None
+
+    def arrived(self, site: Hashable) -> int:
+        """The flow went back to a loop's head at `site` (which jump, in which call): the arrivals
+        since the one with this same state, where there was one (a loop that does not end), else 0."""
+        self.arrivals += 1
+        if self.taken_at and self._same(site):
+            return self.arrivals - self.taken_at
+        if self.arrivals - self.taken_at >= self.power:
+            self.taken_at, self.site, self.power = self.arrivals, site, 2 * self.power
+            self.journal.restart()
+            self.kept_quick, self.kept = self.quick(), self.state()
+        return 0
+
+    def _same(self, site: Hashable) -> bool:
+        if site != self.site or self.journal.changed(self.current) or self.quick() != self.kept_quick:
+            return False
+        state = self.state()
+        return state is not None and self.kept is not None and state == self.kept
+
+
+def endless(passes: int, head: int, where: Location) -> NcppError:
+    """The refusal of a loop that came back to its head (line `head`) as it was `passes` passes
+    before."""
+    before = "the pass before" if passes == 1 else f"{passes:,} passes before"
+    return NcppError(
+        f"a loop that does not end: it comes back to line {head} with every parameter, the position and "
+        f"the modes as {before} (the control would run it for ever; ncpp follows a program to its end)",
+        where,
+    )
