@@ -22,11 +22,13 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from pathlib import PurePath
 from collections.abc import Callable, Hashable
 
 import numpy as np
 
 from ncpp.errors import Location, NcppError
+from ncpp.program.blocks import Block, Item
 
 ABSENT = object()  # a parameter that has no value (a name not defined, a number never written)
 
@@ -34,7 +36,8 @@ ABSENT = object()  # a parameter that has no value (a name not defined, a number
 def exact(value: object) -> object:
     """`value` as something that compares equal to another's only where the two are the same
     state: floats to the bit (0.0 is not -0.0, NaN is no NaN), containers item by item,
-    dataclasses field by field, arrays byte by byte; any other object equal to nothing."""
+    dataclasses field by field, arrays byte by byte, the program's text as it reads; any other
+    object equal to nothing."""
     kind = type(value)
     if kind is float:
         return (0.0, math.copysign(1.0, value)) if value == 0.0 else value  # type: ignore[arg-type]
@@ -46,8 +49,12 @@ def exact(value: object) -> object:
         return {key: exact(item) for key, item in value.items()}  # type: ignore[union-attr]
     if kind in (set, frozenset):
         return frozenset(value)  # type: ignore[arg-type]  # (of numbers and names)
+    if isinstance(value, (Block, Item)):  # (a program's parsed text: never changed, compared as it reads)
+        return value
     if dataclasses.is_dataclass(value) and not isinstance(value, type):
         return kind, tuple(exact(getattr(value, f.name)) for f in dataclasses.fields(value))
+    if isinstance(value, PurePath):
+        return str(value)
     if isinstance(value, np.ndarray):
         return value.dtype.str, value.shape, value.tobytes()
     return object()  # (an object whose state is not told: equal to nothing, no loop refused over it)
@@ -73,15 +80,16 @@ class Journal:
 class Revisits:
     """The arrivals of one program run at its backward jumps (the module docstring).
 
-    `journal` notes the parameters' writes, `current` reads one as the journal keeps it;
-    `quick()` and `state()` give the rest of the state (`exact` values), `quick` a cheap part
-    compared first; `state()` may return None where the state cannot be told whole (a corner
-    waiting for its next move), and no loop is refused there."""
+    `journal` notes the parameters' writes, `current` reads one as the journal keeps it (None:
+    `quick` and `state` hold the parameters); `state()` gives the rest of the state (`exact`
+    values), `quick()` a cheap part of it compared first (a copy: equal where the states are);
+    `state()` may return None where the state cannot be told whole (a corner waiting for its next
+    move), and no loop is refused there."""
 
     def __init__(
         self,
-        journal: Journal,
-        current: Callable[[Hashable], object],
+        journal: Journal | None,
+        current: Callable[[Hashable], object] | None,
         quick: Callable[[], object],
         state: Callable[[], object],
     ):
@@ -101,12 +109,15 @@ class Revisits:
             return self.arrivals - self.taken_at
         if self.arrivals - self.taken_at >= self.power:
             self.taken_at, self.site, self.power = self.arrivals, site, 2 * self.power
-            self.journal.restart()
+            if self.journal is not None:
+                self.journal.restart()
             self.kept_quick, self.kept = self.quick(), self.state()
         return 0
 
     def _same(self, site: Hashable) -> bool:
-        if site != self.site or self.journal.changed(self.current) or self.quick() != self.kept_quick:
+        if site != self.site or self.quick() != self.kept_quick:
+            return False
+        if self.journal is not None and self.journal.changed(self.current):  # type: ignore[arg-type]
             return False
         state = self.state()
         return state is not None and self.kept is not None and state == self.kept

@@ -121,6 +121,7 @@ class _Label:
     kind: str  # while, do, repeat; fanuc (WHILE ... DOm)
     start: int  # the line's index in its frame's space
     count: int = -1  # repeat: iterations still to run (-1: not counted yet)
+    total: int = 0  # repeat: its iterations, all told
     mark: int | None = None  # repeat: `CountedPasses.ended`'s mark
 
 
@@ -148,24 +149,57 @@ class _Frame:
 class CountedPasses:
     """The passes of counted loops (LinuxCNC's repeat, Klartext's CALL LBL REP, Sinumerik's FOR), each
     measured in blocks stepped through: a loop whose passes still to run, each as long as the one just
-    ended, would run more than MAX_RERUN lines again is refused at once, at its line, not after them."""
+    ended, would run more than MAX_RERUN lines again is refused at once, at its line, not after them.
+    So is a counted loop around it whose passes, each a whole run of the inner loop, would: at its
+    own line, as soon as the inner loop's first pass has shown its length, not after that run."""
 
     def __init__(self, file: str):
         self.file = file
         self.steps = 0  # blocks the flow stepped through (in place or again): its flow counts them
 
     def ended(self, mark: int | None, rerun: int, left: int, line: int | None, what: str,
-              file: str | None = None) -> int:  # fmt: skip
+              file: str | None = None, around: Callable[[], list[Around]] | None = None,
+              total: int = 0) -> int:  # fmt: skip
         """A loop ended a pass with `rerun` lines run again so far and `left` passes to run; `mark` is
         what this returned when its previous pass ended (None: this is its first).  Returns the mark.
-        `file`: where `line` is, where not the program's."""
-        if mark is not None and rerun + (self.steps - mark) * left > MAX_RERUN:
-            raise NcppError(
-                f"{what} would run {left:,} more passes of {self.steps - mark:,} blocks: more than "
-                f"{MAX_RERUN:,} lines run again, taken for a loop that does not end",
-                Location(file or self.file, line, 1),
-            )
+        `file`: where `line` is, where not the program's.  `around()`: the counted loops around it,
+        innermost first, given with the pass that first shows its length (`total`: its passes)."""
+        if mark is not None:
+            length = self.steps - mark
+            if rerun + length * left > MAX_RERUN:
+                raise NcppError(
+                    f"{what} would run {left:,} more passes of {length:,} blocks: more than "
+                    f"{MAX_RERUN:,} lines run again, taken for a loop that does not end",
+                    Location(file or self.file, line, 1),
+                )
+            if around is not None:
+                self._around(around(), length * total, rerun)
         return self.steps
+
+    def _around(self, loops: list[Around], run: int, rerun: int) -> None:
+        """Refuse the first of the counted `loops` around a loop whose runs (`run` blocks each, one a
+        pass of the next loop out) would make more than MAX_RERUN lines run again."""
+        for loop in loops:
+            if rerun + run * loop.left > MAX_RERUN:
+                raise NcppError(
+                    f"{loop.what} would run {loop.left:,} more passes of about {run:,} blocks each (the "
+                    f"loops inside it run through): more than {MAX_RERUN:,} lines run again, taken for a "
+                    "loop that does not end",
+                    Location(loop.file or self.file, loop.line, 1),
+                )
+            run *= max(loop.total, 1)
+
+
+@dataclass(frozen=True)
+class Around:
+    """A counted loop under way around another (`CountedPasses.ended`): its passes still to run
+    after the one under way, all its passes, its line (in `file`, None: the program's)."""
+
+    left: int
+    total: int
+    line: int | None
+    what: str
+    file: str | None = None
 
 
 @dataclass(frozen=True)
@@ -1041,17 +1075,39 @@ class Flow:
         def test():
             label = frame.labels.setdefault(control.name, _Label("repeat", frame.pc))
             if label.count == -1:  # counted where the loop starts
-                label.count = int(round_half_away(count))
+                label.count = label.total = int(round_half_away(count))
             if label.count > 0:
                 label.count -= 1
                 what = f"o{_shown(control.name)} repeat"
-                label.mark = self.passes.ended(label.mark, self.rerun, label.count, block.line, what)
+                around = (lambda: self._around(frame, label.start)) if label.count == label.total - 2 else None
+                label.mark = self.passes.ended(label.mark, self.rerun, label.count, block.line, what,
+                                               frame.source, around, label.total)  # fmt: skip
                 self._on(frame, None)()
             else:
                 label.count, label.mark = -1, None
                 self._on(frame, control.name)()
 
         return test
+
+    def _around(self, frame: _Frame, start: int) -> list[Around]:
+        """The counted loops around the loop at `start` of `frame`, innermost first, as far as
+        counted loops go: o-word repeats, and Fanuc subprograms' L repeats around their calls."""
+        loops: list[Around] = []
+        for depth in range(len(self.frames) - 1, -1, -1):
+            level = self.frames[depth]
+            opened = sorted(((n, b) for n, b in level.labels.items() if level is not frame or b.start < start),
+                            key=lambda item: -item[1].start)  # fmt: skip
+            for name, label in opened:
+                if label.kind != "repeat" or label.count < 0:
+                    return loops
+                line = self._block(level, label.start).line  # type: ignore[union-attr]  # (held: under way)
+                loops.append(Around(label.count, label.total, line, f"o{_shown(name)} repeat", level.source))
+            if level.repeats > 0 and depth > 0:  # (its caller's line before its pc called it)
+                caller = self.frames[depth - 1]
+                line = self._block(caller, caller.pc - 1).line  # type: ignore[union-attr]
+                loops.append(Around(level.repeats, level.repeats + 1, line, "a subprogram's L repeats",
+                                    caller.source))  # fmt: skip
+        return loops
 
     def _break(self, frame, block, control, arrived):
         self._label(frame, block, control, ("while", "do"))
