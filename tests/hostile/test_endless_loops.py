@@ -146,3 +146,72 @@ def test_zero_and_minus_zero_are_different_states():
 
     assert exact(0.0) != exact(-0.0) and exact([1.0, -0.0]) != exact([1.0, 0.0])
     assert exact(float("nan")) != exact(float("nan"))
+
+
+def _sinumerik(text: str) -> list:
+    from ncpp.motion.sinumerik import interpret as run
+    from ncpp.program.dialects import parse_program
+
+    _, blocks = parse_program(io.BytesIO(text.encode()), "t.mpf", "sinumerik")
+    return list(run(blocks, file="t.mpf"))
+
+
+def _klartext(text: str) -> list:
+    from ncpp.pipeline import dialect_tools
+    from ncpp.program.dialects import parse_program
+
+    run, _ = dialect_tools("heidenhain")
+    _, blocks = parse_program(io.BytesIO(text.encode()), "t.h", "heidenhain")
+    return list(run(blocks, file="t.h"))
+
+
+SINUMERIK_HEAD = "G17 G90 G71 F200\nG0 X0 Y0 Z5\n"
+ENDLESS_SINUMERIK = {
+    "LOOP ... ENDLOOP": ("LOOP\nG1 X10 Y10\nG1 X0 Y0\nENDLOOP\nM30\n", 6, 4),
+    "WHILE 1": ("R1=0\nWHILE R1<5\nG1 X10\nR2=R2*0\nENDWHILE\nM30\n", 7, 4),
+    "REPEAT ... UNTIL 0": ("REPEAT\nG1 X10\nG1 X0\nUNTIL R1>0\nM30\n", 6, 4),
+    "GOTOB": ("BACK:\nR1=1-R1\nG1 X=R1*10\nGOTOB BACK\nM30\n", 6, 3),
+}
+
+
+@pytest.mark.parametrize("name", ENDLESS_SINUMERIK)
+def test_a_sinumerik_loop_back_at_a_state_it_had_is_refused_at_once(monkeypatch, name):
+    import ncpp.motion.sinumerik_flow as sinumerik_flow
+
+    monkeypatch.setattr(sinumerik_flow, "MAX_RERUN", BOUND)
+    text, line, head = ENDLESS_SINUMERIK[name]
+    with pytest.raises(NcppError, match=rf"a loop that does not end: it comes back to line {head} with") as err:
+        _sinumerik(SINUMERIK_HEAD + text)
+    assert (err.value.where.file, err.value.where.line) == ("t.mpf", line)
+
+
+def test_a_sinumerik_loop_with_a_counter_or_a_toggle_it_ends_runs_to_its_end():
+    text = SINUMERIK_HEAD + "R1=0\nR2=0\nWHILE R2<4\nR1=1-R1\nG1 X=R1*10\nR2=R2+1\nENDWHILE\nG1 Y5\nM30\n"
+    assert [x for x, _, _ in _ends(_sinumerik(text))] == [0.0, 10.0, 0.0, 10.0, 0.0, 0.0]
+
+
+KLARTEXT = """0 BEGIN PGM LOOP MM
+1 TOOL CALL 1 Z S1000
+2 L X+0 Y+0 Z+2 R0 FMAX
+3 FN 0: Q1 = +0
+4 LBL 2
+5 L X+Q1 Y+20 R0 FMAX
+6 FN 3: Q1 = +Q1 * +0
+7 FN 9: IF +0 EQU +0 GOTO LBL 2
+8 L Z+50 FMAX
+9 END PGM LOOP MM
+"""
+
+
+def test_a_klartext_jump_back_at_a_state_it_had_is_refused_at_once(monkeypatch):
+    from ncpp.motion import heidenhain_flow
+
+    monkeypatch.setattr(heidenhain_flow, "MAX_RERUN", BOUND)
+    with pytest.raises(NcppError, match="a loop that does not end: it comes back to line 5 with") as err:
+        _klartext(KLARTEXT)
+    assert (err.value.where.file, err.value.where.line) == ("t.h", 8)
+
+
+def test_a_klartext_jump_back_whose_parameter_counts_runs_to_its_end():
+    text = KLARTEXT.replace("FN 3: Q1 = +Q1 * +0", "FN 1: Q1 = +Q1 + +5").replace("FN 9: IF +0 EQU +0", "FN 12: IF +Q1 LT +15")
+    assert [x for x, y, z in _ends(_klartext(text)) if (y, z) == (20.0, 2.0)] == [0.0, 5.0, 10.0]
