@@ -22,8 +22,8 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from pathlib import PurePath
 from collections.abc import Callable, Hashable
+from pathlib import PurePath
 
 import numpy as np
 
@@ -38,21 +38,20 @@ def exact(value: object) -> object:
     state: floats to the bit (0.0 is not -0.0, NaN is no NaN), containers item by item,
     dataclasses field by field, arrays byte by byte, the program's text as it reads; any other
     object equal to nothing."""
-    kind = type(value)
-    if kind is float:
-        return (0.0, math.copysign(1.0, value)) if value == 0.0 else value  # type: ignore[arg-type]
-    if value is None or kind in (int, bool, str):
+    if isinstance(value, float):
+        return (0.0, math.copysign(1.0, value)) if value == 0.0 else value
+    if value is None or isinstance(value, (int, str)):  # (bool an int)
         return value
-    if kind is list or isinstance(value, tuple):
-        return tuple(exact(item) for item in value)  # type: ignore[union-attr]
-    if kind is dict:
-        return {key: exact(item) for key, item in value.items()}  # type: ignore[union-attr]
-    if kind in (set, frozenset):
-        return frozenset(value)  # type: ignore[arg-type]  # (of numbers and names)
+    if isinstance(value, (list, tuple)):
+        return tuple(exact(item) for item in value)
+    if isinstance(value, dict):
+        return {key: exact(item) for key, item in value.items()}
+    if isinstance(value, (set, frozenset)):
+        return frozenset(value)  # (of numbers and names)
     if isinstance(value, (Block, Item)):  # (a program's parsed text: never changed, compared as it reads)
         return value
     if dataclasses.is_dataclass(value) and not isinstance(value, type):
-        return kind, tuple(exact(getattr(value, f.name)) for f in dataclasses.fields(value))
+        return type(value), tuple(exact(getattr(value, f.name)) for f in dataclasses.fields(value))
     if isinstance(value, PurePath):
         return str(value)
     if isinstance(value, np.ndarray):
@@ -74,7 +73,6 @@ class Journal:
 
     def changed(self, current: Callable[[Hashable], object]) -> bool:
         return any(current(key) != was for key, was in self.before.items())
-
 
 
 class Revisits:

@@ -160,7 +160,7 @@ class Parameters:
     def entry(self, key: Hashable) -> object:
         """A parameter's value as the journal compares it (`exact`; a number's vacancy with it)."""
         if type(key) is int:
-            value = self.numbered.get(key, ABSENT)  # type: ignore[call-overload]
+            value = self.numbered.get(key, ABSENT)
             return (ABSENT if value is ABSENT else exact(value)), key in self.vacant
         value = self.named.get(key, ABSENT)  # type: ignore[call-overload]
         return ABSENT if value is ABSENT else exact(value)

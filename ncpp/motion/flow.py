@@ -1079,7 +1079,9 @@ class Flow:
             if label.count > 0:
                 label.count -= 1
                 what = f"o{_shown(control.name)} repeat"
-                around = (lambda: self._around(frame, label.start)) if label.count == label.total - 2 else None
+                around = (
+                    (lambda: self._around(frame, label.start)) if label.count == label.total - 2 else None
+                )
                 label.mark = self.passes.ended(label.mark, self.rerun, label.count, block.line, what,
                                                frame.source, around, label.total)  # fmt: skip
                 self._on(frame, None)()
@@ -1095,8 +1097,8 @@ class Flow:
         loops: list[Around] = []
         for depth in range(len(self.frames) - 1, -1, -1):
             level = self.frames[depth]
-            opened = sorted(((n, b) for n, b in level.labels.items() if level is not frame or b.start < start),
-                            key=lambda item: -item[1].start)  # fmt: skip
+            inside = [(n, b) for n, b in level.labels.items() if level is not frame or b.start < start]
+            opened = sorted(inside, key=lambda item: -item[1].start)
             for name, label in opened:
                 if label.kind != "repeat" or label.count < 0:
                     return loops
@@ -1136,10 +1138,12 @@ class Flow:
 
         def step():
             frame.pc = head
-            passes = self.revisits and self.revisits.arrived((len(self.frames), id(frame.space), head, id(block)))
+            passes = self.revisits and self.revisits.arrived(
+                (len(self.frames), id(frame.space), head, id(block))
+            )
             if passes:
                 where = Location(frame.source or self.file, block.line, control.item.start + 1)
-                raise endless(passes, self._block(frame, head).line, where)  # type: ignore[union-attr]
+                raise endless(passes, self._block(frame, head).line, where)
 
         return step
 
@@ -1151,12 +1155,17 @@ class Flow:
         frames = tuple((id(f.space), f.pc, tuple((n, b.kind, b.start, b.count) for n, b in f.labels.items()),
                         frozenset(f.ifs), tuple(f.opened.items()), f.repeats, f.source, f.macro, f.modal)
                        for f in self.frames)  # fmt: skip
-        modal = self.modal and (id(self.modal.body), self.modal.runs, exact(self.modal.values), self.modal.depth)
+        modal = self.modal and (
+            id(self.modal.body),
+            self.modal.runs,
+            exact(self.modal.values),
+            self.modal.depth,
+        )
         defining = self._defining and (self._defining[1], len(self._defining[2]))
-        held = (self.written, self.base, self.read, self.leader, id(self.owner), self._fault is None, defining,
-                self.last_run_move, self.fanuc, len(self.dropped), len(self.looped), len(self.subroutines),
-                len(self.subprograms), len(self.defined_at), len(self.files), len(self.program_files),
-                len(self._whole_programs), len(self._definitions))  # fmt: skip
+        held = (self.written, self.base, self.read, self.leader, id(self.owner), self._fault is None,
+                defining, self.last_run_move, self.fanuc, len(self.dropped), len(self.looped),
+                len(self.subroutines), len(self.subprograms), len(self.defined_at), len(self.files),
+                len(self.program_files), len(self._whole_programs), len(self._definitions))  # fmt: skip
         flags = (self.skipping, self.executed_if, self.doing_break, self.doing_continue, self.moved)
         return state, frames, modal, flags, held
 

@@ -229,7 +229,10 @@ class KlartextFlow:
                 start = self.labels.get(label_key(name)) if repeat and type(name) is not tuple else None
                 if start is None or start >= label:
                     break
-                left, passes = self.counters.get(index, repeat), self.sections.get(index, (start, repeat + 1))[1]
+                left, passes = (
+                    self.counters.get(index, repeat),
+                    self.sections.get(index, (start, repeat + 1))[1],
+                )
                 loops.append(Around(left, passes, block.line, "CALL LBL ... REP"))
                 label = start
             index += 1

@@ -334,8 +334,8 @@ class Interpreter:
         corner: tuple = ()  # its corner word: (kind, size, item); read only with a pending line
         held: list[Event] = []  # non-moving events after it
         flow = self.flow = Flow(
-            self.file, self._evaluate, self.params, lambda: self.done, self._leave_scope, self.subroutine_path,
-            state=self._loop_state, position=lambda: exact(self.pos),
+            self.file, self._evaluate, self.params, lambda: self.done, self._leave_scope,
+            self.subroutine_path, state=self._loop_state, position=lambda: exact(self.pos),
         )  # fmt: skip
         self.rounding = False
         expansion = self.expansion
@@ -1881,8 +1881,9 @@ class Interpreter:
 # The interpreter's attributes that are no state a loop's check compares (`_loop_state`): kept
 # elsewhere (the parameters, the flow), only written or warned from, fixed for the run, or derived
 # from the others (the context, the fast path)
-_NOT_LOOP_STATE = frozenset(("params", "flow", "warnings", "untold_lengths", "expansion", "tools", "file",
-                             "subroutine_path", "expand_cycles", "_context", "_fast", "rounding"))  # fmt: skip
+_NOT_LOOP_STATE = frozenset(("params", "flow", "warnings", "untold_lengths", "expansion", "tools",
+                             "file", "subroutine_path", "expand_cycles", "_context", "_fast",
+                             "rounding"))  # fmt: skip
 _COORD_SYSTEM = {float(name[1:]): n for n, name in enumerate(SYSTEMS, 1)}  # 54.0: 1 ... 59.3: 9
 _COORD_SYSTEM_CODE = {n: code * 10 for code, n in _COORD_SYSTEM.items()}
 _PLANE_LETTERS = {17: "XY", 18: "ZX", 19: "YZ"}

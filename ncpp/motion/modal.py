@@ -73,8 +73,9 @@ class ModalInterpreter:
 
     # Attributes that are no state a loop's check compares (`loop_state`): fixed for the run, only
     # written or warned from, caches and counts of blocks run, the flow (its own)
-    not_loop_state = frozenset(("_context", "subroutine_path", "expand", "untold_lengths", "expansion", "tools",
-                                "called_blocks", "_files", "flow", "main_path", "program_file"))  # fmt: skip
+    not_loop_state = frozenset(("_context", "subroutine_path", "expand", "untold_lengths", "expansion",
+                                "tools", "called_blocks", "_files", "flow", "main_path",
+                                "program_file"))  # fmt: skip
 
     def __init__(self, file: str = "<stdin>", zero: tuple[float, float, float] = (0.0, 0.0, 0.0)):
         self.file = file  # the file of the blocks running (a called one's, while it runs)

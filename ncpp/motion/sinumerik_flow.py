@@ -97,7 +97,8 @@ class SinumerikFlow:
         self.file, self.value, self.assign, self.done, self.stop = file, value, assign, done, stop
         self.revisits = revisits
         if revisits is not None:  # (the interpreter's state, then the flow's)
-            revisits.state = lambda state=revisits.state: self._with_flow(state())
+            interpreters = revisits.state
+            revisits.state = lambda: self._with_flow(interpreters())
         self.stream: Iterator[Block] = iter(())
         self.buffer: list[Block] = []  # blocks read and still held, from index `base`
         self.base = 0

@@ -44,9 +44,12 @@ def _ends(events: list) -> list[tuple[float, ...]]:
 ENDLESS_ISO = {
     "while [1]": (HEAD + "o100 while [1]\nG1 X1\nG1 X0\no100 endwhile\nM2\n", 6, 3),
     "do while [1]": (HEAD + "o1 do\nG1 X1\nG1 X0\no1 while [1]\nM2\n", 6, 3),
-    "a parameter set to the same value": (HEAD + "o1 while [#1 LT 5]\n#1 = 2\nG1 X#1\no1 endwhile\nM2\n", 6, 3),
+    "a parameter set to the same value": (
+        HEAD + "o1 while [#1 LT 5]\n#1 = 2\nG1 X#1\no1 endwhile\nM2\n", 6, 3,
+    ),
     "a toggle: the state of two passes before": (
-        HEAD + "o1 while [1]\n#1 = [1 - #1]\no2 if [#1 EQ 1]\nG1 X1\no2 else\nG1 X0\no2 endif\no1 endwhile\nM2\n",
+        HEAD + "o1 while [1]\n#1 = [1 - #1]\no2 if [#1 EQ 1]\nG1 X1\no2 else\nG1 X0\no2 endif\n"
+        + "o1 endwhile\nM2\n",
         10, 3,
     ),
     "a subroutine call and a counted loop inside": (
@@ -64,13 +67,19 @@ ENDLESS_ISO = {
 @pytest.mark.parametrize("name", ENDLESS_ISO)
 def test_an_iso_loop_back_at_a_state_it_had_is_refused_at_once(name):
     text, line, head = ENDLESS_ISO[name]
-    with pytest.raises(NcppError, match=rf"a loop that does not end: it comes back to line {head} with") as err:
+    with pytest.raises(
+        NcppError, match=rf"a loop that does not end: it comes back to line {head} with"
+    ) as err:
         _iso(text)
     assert (err.value.where.file, err.value.where.line) == ("t.ngc", line)
 
 
 ENDLESS_FANUC = {
-    "WHILE [1 GT 0] DO1": (FANUC_HEAD + "WHILE [1 GT 0] DO1\nG1 X1 F100\nG1 X0\n#1 = 1\nEND1\nM30\n%\n", 9, 5),
+    "WHILE [1 GT 0] DO1": (
+        FANUC_HEAD + "WHILE [1 GT 0] DO1\nG1 X1 F100\nG1 X0\n#1 = 1\nEND1\nM30\n%\n",
+        9,
+        5,
+    ),
     "IF [..] GOTO back": (FANUC_HEAD + "N10 G1 X1 F100\nG1 X0\nIF [1 EQ 1] GOTO 10\nM30\n%\n", 7, 5),
     "GOTO back": (FANUC_HEAD + "#1 = 0\nN20 G1 X1 F100\nG1 X[#1 * 0]\nGOTO 20\nM30\n%\n", 8, 6),
 }
@@ -79,7 +88,9 @@ ENDLESS_FANUC = {
 @pytest.mark.parametrize("name", ENDLESS_FANUC)
 def test_a_fanuc_loop_back_at_a_state_it_had_is_refused_at_once(name):
     text, line, head = ENDLESS_FANUC[name]
-    with pytest.raises(NcppError, match=rf"a loop that does not end: it comes back to line {head} with") as err:
+    with pytest.raises(
+        NcppError, match=rf"a loop that does not end: it comes back to line {head} with"
+    ) as err:
         _fanuc(text)
     assert (err.value.where.file, err.value.where.line) == ("t.nc", line)
 
@@ -109,7 +120,8 @@ def test_a_loop_ended_by_a_mode_it_changes_runs_to_its_end():
 def test_a_loop_ended_by_a_global_a_subroutine_sets_runs_to_its_end():
     """The subroutine's own parameters come and go with each call; its global one counts."""
     text = ("o<s> sub\n#<_n> = [#<_n> + 1]\n#<local> = 1\n#1 = 7\no<s> endsub\n" + HEAD
-            + "#<_n> = 0\no1 while [#<_n> LT 4]\no<s> call [3]\nG1 X1\nG1 X0\no1 endwhile\nG1 Y1\nM2\n")  # fmt: skip
+            + "#<_n> = 0\no1 while [#<_n> LT 4]\no<s> call [3]\nG1 X1\nG1 X0\no1 endwhile\n"
+            + "G1 Y1\nM2\n")  # fmt: skip
     assert len(_ends(_iso(text))) == 1 + 8 + 1
 
 
@@ -180,7 +192,9 @@ def test_a_sinumerik_loop_back_at_a_state_it_had_is_refused_at_once(monkeypatch,
 
     monkeypatch.setattr(sinumerik_flow, "MAX_RERUN", BOUND)
     text, line, head = ENDLESS_SINUMERIK[name]
-    with pytest.raises(NcppError, match=rf"a loop that does not end: it comes back to line {head} with") as err:
+    with pytest.raises(
+        NcppError, match=rf"a loop that does not end: it comes back to line {head} with"
+    ) as err:
         _sinumerik(SINUMERIK_HEAD + text)
     assert (err.value.where.file, err.value.where.line) == ("t.mpf", line)
 
@@ -213,5 +227,7 @@ def test_a_klartext_jump_back_at_a_state_it_had_is_refused_at_once(monkeypatch):
 
 
 def test_a_klartext_jump_back_whose_parameter_counts_runs_to_its_end():
-    text = KLARTEXT.replace("FN 3: Q1 = +Q1 * +0", "FN 1: Q1 = +Q1 + +5").replace("FN 9: IF +0 EQU +0", "FN 12: IF +Q1 LT +15")
+    text = KLARTEXT.replace("FN 3: Q1 = +Q1 * +0", "FN 1: Q1 = +Q1 + +5").replace(
+        "FN 9: IF +0 EQU +0", "FN 12: IF +Q1 LT +15"
+    )
     assert [x for x, y, z in _ends(_klartext(text)) if (y, z) == (20.0, 2.0)] == [0.0, 5.0, 10.0]

@@ -54,8 +54,12 @@ def _moves_before_refusal(events: Iterator) -> tuple[int, NcppError]:
     return moves, err.value
 
 
-ISO = "G21 G90 G17 F200\nG0 X0 Y0 Z5\no1 repeat [100]\no2 repeat [{inner}]\nG1 X10\nG1 X0\no2 endrepeat\no1 endrepeat\nM2\n"
-SINUMERIK = "G17 G90 G71 F200\nG0 X0 Y0 Z5\nFOR R1=1 TO 100\nFOR R2=1 TO {inner}\nG1 X10\nG1 X0\nENDFOR\nENDFOR\nM30\n"
+ISO = "G21 G90 G17 F200\nG0 X0 Y0 Z5\no1 repeat [100]\no2 repeat [{inner}]\nG1 X10\nG1 X0\n" + (
+    "o2 endrepeat\no1 endrepeat\nM2\n"
+)
+SINUMERIK = "G17 G90 G71 F200\nG0 X0 Y0 Z5\nFOR R1=1 TO 100\nFOR R2=1 TO {inner}\nG1 X10\nG1 X0\n" + (
+    "ENDFOR\nENDFOR\nM30\n"
+)
 KLARTEXT = """0 BEGIN PGM LOOP MM
 1 TOOL CALL 1 Z S1000
 2 L X+0 Y+0 Z+5 R0 FMAX
@@ -96,8 +100,10 @@ def test_nested_loops_within_the_bound_run_all_their_passes(name, moves):
 
 def test_a_klartext_section_whose_outer_repeat_a_jump_passes_over_is_not_refused():
     """The REP call after a jump may never run: the inner section's passes alone count."""
-    text = KLARTEXT.replace("{inner}", "2000").replace(
-        "{between}", "7 FN 9: IF +0 EQU +0 GOTO LBL 3\n"
-    ).replace("9 L Z+50 R0 FMAX", "9 LBL 3\n9 L Z+50 R0 FMAX")
+    text = (
+        KLARTEXT.replace("{inner}", "2000")
+        .replace("{between}", "7 FN 9: IF +0 EQU +0 GOTO LBL 3\n")
+        .replace("9 L Z+50 R0 FMAX", "9 LBL 3\n9 L Z+50 R0 FMAX")
+    )
     moves = [e for e in _klartext(text) if type(e) is Line]
     assert len(moves) == 1 + 2 * 2001 + 1
