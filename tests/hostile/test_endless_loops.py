@@ -17,6 +17,7 @@ from ncpp.motion import interpret
 from ncpp.motion.fanuc import FanucInterpreter, interpreting
 from ncpp.motion.segments import Line
 from ncpp.program.parser import parse_stream
+from tests.conftest import SHARED
 
 BOUND = 200_000  # lines run again: a loop refused by its state is refused long before
 HEAD = "G21 G90 G17\nG0 X0 Y0 Z10 F200\n"
@@ -231,3 +232,26 @@ def test_a_klartext_jump_back_whose_parameter_counts_runs_to_its_end():
         "FN 9: IF +0 EQU +0", "FN 12: IF +Q1 LT +15"
     )
     assert [x for x, y, z in _ends(_klartext(text)) if (y, z) == (20.0, 2.0)] == [0.0, 5.0, 10.0]
+
+
+MACHINE = SHARED / "machines/wide.toml"
+PROGRAMS = {
+    "while.ngc": (ENDLESS_ISO["while [1]"][0], 6),
+    "while.nc": (ENDLESS_FANUC["WHILE [1 GT 0] DO1"][0], 9),
+    "loop.mpf": (SINUMERIK_HEAD + ENDLESS_SINUMERIK["LOOP ... ENDLOOP"][0], 6),
+    "jump.h": (KLARTEXT, 8),
+}
+
+
+@pytest.mark.skipif(not MACHINE.exists(), reason="no shared machine file")
+@pytest.mark.parametrize("expand", [(), ("--expand",)], ids=["", "expand"])
+@pytest.mark.parametrize("name", PROGRAMS)
+def test_the_command_refuses_a_loop_back_at_a_state_it_had_in_seconds(ncpp, tmp_path, name, expand):
+    """Not after the 5,000,000 lines run again of the bound (20 s to minutes a program)."""
+    text, line = PROGRAMS[name]
+    program = tmp_path / name
+    program.write_text(text)
+    out = tmp_path / f"out-{name}"
+    done = ncpp("compensate", "--machine", str(MACHINE), str(program), "-o", str(out), *expand, timeout=10)
+    assert done.returncode == 2 and not out.exists()
+    assert f"{program}:{line}:1: a loop that does not end: it comes back to line" in done.stderr.decode()
