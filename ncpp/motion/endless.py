@@ -72,7 +72,10 @@ class Journal:
         self.before.clear()
 
     def changed(self, current: Callable[[Hashable], object]) -> bool:
-        return any(current(key) != was for key, was in self.before.items())
+        for key, was in self.before.items():  # (a loop, not any(): this runs at every arrival)
+            if current(key) != was:
+                return True
+        return False
 
 
 class Revisits:

@@ -161,6 +161,8 @@ class Parameters:
         """A parameter's value as the journal compares it (`exact`; a number's vacancy with it)."""
         if type(key) is int:
             value = self.numbered.get(key, ABSENT)
+            if type(value) is float and value != 0.0:  # (the common case, as `exact` has it)
+                return value, key in self.vacant
             return (ABSENT if value is ABSENT else exact(value)), key in self.vacant
         value = self.named.get(key, ABSENT)  # type: ignore[call-overload]
         return ABSENT if value is ABSENT else exact(value)

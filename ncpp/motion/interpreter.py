@@ -335,7 +335,7 @@ class Interpreter:
         held: list[Event] = []  # non-moving events after it
         flow = self.flow = Flow(
             self.file, self._evaluate, self.params, lambda: self.done, self._leave_scope,
-            self.subroutine_path, state=self._loop_state, position=lambda: exact(self.pos),
+            self.subroutine_path, state=self._loop_state, position=lambda: self.pos[:],
         )  # fmt: skip
         self.rounding = False
         expansion = self.expansion
