@@ -24,6 +24,7 @@ import dataclasses
 import math
 from collections.abc import Callable, Hashable
 from pathlib import PurePath
+from typing import Any
 
 import numpy as np
 
@@ -101,19 +102,27 @@ class Revisits:
         self.site: Hashable = None
         self.kept_quick: object = None
         self.kept: object = None
+        # The outermost jump since the state was taken: its rank and what the flow tells it by
+        self.outer: tuple[tuple, Any] = ((), None)
 
-    def arrived(self, site: Hashable) -> int:
-        """The flow went back to a loop's head at `site` (which jump, in which call): the arrivals
-        since the one with this same state, where there was one (a loop that does not end), else 0."""
+    def arrived(self, site: Hashable, rank: tuple, place: Any) -> tuple[int, Any] | None:
+        """The flow went back to a loop's head at `site` (which jump, in which call); `rank` orders
+        the jumps outermost first ((the call depth, the head's index): a loop's head stands before
+        those of the loops inside it), `place` is what the flow tells this jump by.  Where the
+        state is one it had before: the jumps back since then and the `place` of the outermost
+        (the loop that does not end: the others run inside it), else None."""
         self.arrivals += 1
+        if rank < self.outer[0]:
+            self.outer = (rank, place)
         if self.taken_at and self._same(site):
-            return self.arrivals - self.taken_at
+            return self.arrivals - self.taken_at, self.outer[1]
         if self.arrivals - self.taken_at >= self.power:
             self.taken_at, self.site, self.power = self.arrivals, site, 2 * self.power
+            self.outer = (rank, place)
             if self.journal is not None:
                 self.journal.restart()
             self.kept_quick, self.kept = self.quick(), self.state()
-        return 0
+        return None
 
     def _same(self, site: Hashable) -> bool:
         if site != self.site or self.quick() != self.kept_quick:
@@ -124,12 +133,13 @@ class Revisits:
         return state is not None and self.kept is not None and state == self.kept
 
 
-def endless(passes: int, head: int, where: Location) -> NcppError:
-    """The refusal of a loop that came back to its head (line `head`) as it was `passes` passes
-    before."""
-    before = "the pass before" if passes == 1 else f"{passes:,} passes before"
+def endless(jumps: int, head: int, where: Location) -> NcppError:
+    """The refusal of a loop that came back to its head (line `head`) with the state it had `jumps`
+    jumps back (to it or to the heads of loops inside it) before."""
+    before = "at the jump back before" if jumps == 1 else f"{jumps:,} jumps back before"
     return NcppError(
         f"a loop that does not end: it comes back to line {head} with every parameter, the position and "
-        f"the modes as {before} (the control would run it for ever; ncpp follows a program to its end)",
+        f"the modes as they were {before} (the control would run it for ever; ncpp follows a program to "
+        "its end)",
         where,
     )

@@ -1138,12 +1138,16 @@ class Flow:
 
         def step():
             frame.pc = head
-            passes = self.revisits and self.revisits.arrived(
-                (len(self.frames), id(frame.space), head, id(block))
+            if self.revisits is None:
+                return
+            depth = len(self.frames)
+            found = self.revisits.arrived(
+                (depth, id(frame.space), head, id(block)), (depth, head), (frame, head, block, control)
             )
-            if passes:
-                where = Location(frame.source or self.file, block.line, control.item.start + 1)
-                raise endless(passes, self._block(frame, head).line, where)
+            if found is not None:
+                jumps, (level, start, end, its) = found
+                where = Location(level.source or self.file, end.line, its.item.start + 1)
+                raise endless(jumps, self._block(level, start).line, where)
 
         return step
 

@@ -262,10 +262,12 @@ class KlartextFlow:
     def _arrived(self, block: Block, pc: int, written: int) -> None:
         """Back at a label (`pc`) from `block`: refused where the state is one it had there."""
         self.at = (pc, written)
-        passes = self.revisits.arrived((pc, id(block), len(self.frames)))  # type: ignore[union-attr]
-        if passes:
-            head = self.held[pc - self.base].line
-            raise endless(passes, head, Location(self.file, block.line, 1))
+        depth, revisits = len(self.frames), self.revisits
+        assert revisits is not None  # (`steps` asks only when watching)
+        found = revisits.arrived((pc, id(block), depth), (depth, pc), (pc, block))
+        if found is not None:
+            jumps, (start, end) = found
+            raise endless(jumps, self.held[start - self.base].line, Location(self.file, end.line, 1))
 
     # -- the order ----------------------------------------------------------------------
     def steps(self, done: Callable[[], bool], stop: Callable[[str, Block], None]) -> Iterator[tuple]:

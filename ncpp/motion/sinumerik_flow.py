@@ -157,10 +157,12 @@ class SinumerikFlow:
 
     def _arrived(self, block: Block) -> None:
         """Back at a loop's head (`pc`) from `block`: refused where the state is one it had there."""
-        passes = self.revisits.arrived((self.pc, id(block)))  # type: ignore[union-attr]
-        if passes:
-            head = self.buffer[self.pc - self.base].line
-            raise endless(passes, head, Location(self.file, block.line, 1))
+        revisits = self.revisits
+        assert revisits is not None  # (`steps` asks only when watching)
+        found = revisits.arrived((self.pc, id(block)), (self.pc,), (self.pc, block))
+        if found is not None:
+            jumps, (start, end) = found
+            raise endless(jumps, self.buffer[start - self.base].line, Location(self.file, end.line, 1))
 
     def _with_flow(self, state: object) -> tuple:
         """The interpreter's `state` and the flow's own: where it stands, its structures and

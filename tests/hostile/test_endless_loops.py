@@ -56,7 +56,7 @@ ENDLESS_ISO = {
     "a subroutine call and a counted loop inside": (
         "o<s> sub\n#2 = [#1 + 1]\nG1 X#2\no<s> endsub\n" + HEAD
         + "o1 while [1]\no<s> call [5]\no2 repeat [3]\nG1 Y1\nG1 Y0\no2 endrepeat\no1 endwhile\nM2\n",
-        12, 9,
+        13, 7,  # (the loop that does not end, not the counted one inside it that repeats too)
     ),
     "incremental moves that come back": (HEAD + "G91\no1 while [1]\nG1 X1\nG1 X-1\no1 endwhile\nM2\n", 7, 4),
     "inside a subroutine": (
