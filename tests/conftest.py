@@ -194,6 +194,9 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_a_killed_run_leaves_no_file_beside_its_output",
             "test_a_new_output_file_takes_its_mode_from_the_umask",
         ),
+        "hostile/test_endless_loops.py": (
+            "test_the_command_refuses_a_loop_back_at_a_state_it_had_in_seconds",
+        ),
         "hostile/test_counted_loops.py": (
             "test_a_counted_loop_past_the_bound_is_refused_at_its_line_at_once",
             "test_a_loop_of_a_hundred_thousand_passes_still_runs",

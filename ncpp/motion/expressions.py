@@ -10,7 +10,9 @@ is never negative, ROUND rounds half away from zero.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Hashable
+
+from ncpp.motion.endless import ABSENT, Journal, exact
 
 # rs274ngc: numbered parameters 1..RS274NGC_MAX_PARAMETERS-1 (#0 is Fanuc's null, read as 0)
 MAX_PARAMETER = 5601
@@ -153,6 +155,25 @@ class Parameters:
         self.vacant: set[int] = set()
         self.fanuc = False  # a Fanuc program: #1000 and up are the control's system variables
         self.fanuc_system = fanuc_system  # those the interpreter knows (None: not known)
+        self.journal: Journal | None = None  # the writes a loop's check follows (`endless.py`)
+
+    def entry(self, key: Hashable) -> object:
+        """A parameter's value as the journal compares it (`exact`; a number's vacancy with it)."""
+        if type(key) is int:
+            value = self.numbered.get(key, ABSENT)
+            if type(value) is float and value != 0.0:  # (the common case, as `exact` has it)
+                return value, key in self.vacant
+            return (ABSENT if value is ABSENT else exact(value)), key in self.vacant
+        value = self.named.get(key, ABSENT)  # type: ignore[call-overload]
+        return ABSENT if value is ABSENT else exact(value)
+
+    def _note(self, keys) -> None:
+        """Parameters about to change, for the journal (when a loop's check follows them)."""
+        journal = self.journal
+        if journal is not None:
+            for key in keys:
+                if key not in journal.before:
+                    journal.before[key] = self.entry(key)
 
     def start_fanuc(self) -> None:
         """A Fanuc macro program starts: its local variables #1-#33 vacant, and #1000 and up the
@@ -172,6 +193,7 @@ class Parameters:
             else [self.numbered.get(n, 0.0) for n in range(1, SUBROUTINE_PARAMETERS + 1)]
         )
         local = {k: v for k, v in self.named.items() if not k.startswith("_")}
+        self._note((*local, *range(1, SUBROUTINE_PARAMETERS + 1)))
         for k in local:
             del self.named[k]
         self._callers.append((saved, local, set(self.vacant)))
@@ -183,6 +205,7 @@ class Parameters:
     def enter_macro(self, arguments: dict[int, float]) -> None:
         """A Fanuc G65 macro call: a new level of #1..#33, those `arguments` names set, the rest
         vacant (the caller's come back at `leave`)."""
+        self._note(range(1, MACRO_LOCALS + 1))
         self._callers.append(
             ([self.numbered.get(n, 0.0) for n in range(1, MACRO_LOCALS + 1)], {}, set(self.vacant))
         )
@@ -194,6 +217,8 @@ class Parameters:
     def leave(self, value: float | None) -> None:
         """The subroutine returns (`value`: what its return or endsub gave, if anything)."""
         saved, local, vacant = self._callers.pop()
+        if self.journal is not None:
+            self._note((*self.named, *local, *range(1, MACRO_LOCALS + 1)))
         for k in [k for k in self.named if not k.startswith("_")]:
             del self.named[k]
         self.named.update(local)
@@ -279,6 +304,9 @@ class Parameters:
             ):  # the control's zeros follow it, in its own units
                 raise OutOfScope(f"a write to the machine-state parameter #{key}" if not self.fanuc else
                                  f"a write to the Fanuc system variable #{key}")  # fmt: skip
+            journal = self.journal
+            if journal is not None and key not in journal.before:
+                journal.before[key] = self.entry(key)
             self.numbered[key] = value
             if self.vacant:
                 self.vacant.discard(key)
@@ -286,6 +314,9 @@ class Parameters:
         name: str = key  # type: ignore[assignment]  # not an int
         if name.startswith("_") and self.system is not None and self.system(name) is not None:
             raise ExpressionError(f"Cannot assign to read-only parameter #<{name}>")
+        journal = self.journal
+        if journal is not None and name not in journal.before:
+            journal.before[name] = self.entry(name)
         self.named[name] = value
 
 

@@ -75,6 +75,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ncpp.errors import Location, NcppError, printable
+from ncpp.motion.endless import Journal, Revisits, endless, exact
 from ncpp.motion.expressions import SUBROUTINE_PARAMETERS, normalise_name, round_half_away, vacant
 from ncpp.motion.modal import OutOfScope
 from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
@@ -121,6 +122,7 @@ class _Label:
     kind: str  # while, do, repeat; fanuc (WHILE ... DOm)
     start: int  # the line's index in its frame's space
     count: int = -1  # repeat: iterations still to run (-1: not counted yet)
+    total: int = 0  # repeat: its iterations, all told
     mark: int | None = None  # repeat: `CountedPasses.ended`'s mark
 
 
@@ -148,24 +150,57 @@ class _Frame:
 class CountedPasses:
     """The passes of counted loops (LinuxCNC's repeat, Klartext's CALL LBL REP, Sinumerik's FOR), each
     measured in blocks stepped through: a loop whose passes still to run, each as long as the one just
-    ended, would run more than MAX_RERUN lines again is refused at once, at its line, not after them."""
+    ended, would run more than MAX_RERUN lines again is refused at once, at its line, not after them.
+    So is a counted loop around it whose passes, each a whole run of the inner loop, would: at its
+    own line, as soon as the inner loop's first pass has shown its length, not after that run."""
 
     def __init__(self, file: str):
         self.file = file
         self.steps = 0  # blocks the flow stepped through (in place or again): its flow counts them
 
     def ended(self, mark: int | None, rerun: int, left: int, line: int | None, what: str,
-              file: str | None = None) -> int:  # fmt: skip
+              file: str | None = None, around: Callable[[], list[Around]] | None = None,
+              total: int = 0) -> int:  # fmt: skip
         """A loop ended a pass with `rerun` lines run again so far and `left` passes to run; `mark` is
         what this returned when its previous pass ended (None: this is its first).  Returns the mark.
-        `file`: where `line` is, where not the program's."""
-        if mark is not None and rerun + (self.steps - mark) * left > MAX_RERUN:
-            raise NcppError(
-                f"{what} would run {left:,} more passes of {self.steps - mark:,} blocks: more than "
-                f"{MAX_RERUN:,} lines run again, taken for a loop that does not end",
-                Location(file or self.file, line, 1),
-            )
+        `file`: where `line` is, where not the program's.  `around()`: the counted loops around it,
+        innermost first, given with the pass that first shows its length (`total`: its passes)."""
+        if mark is not None:
+            length = self.steps - mark
+            if rerun + length * left > MAX_RERUN:
+                raise NcppError(
+                    f"{what} would run {left:,} more passes of {length:,} blocks: more than "
+                    f"{MAX_RERUN:,} lines run again, taken for a loop that does not end",
+                    Location(file or self.file, line, 1),
+                )
+            if around is not None:
+                self._around(around(), length * total, rerun)
         return self.steps
+
+    def _around(self, loops: list[Around], run: int, rerun: int) -> None:
+        """Refuse the first of the counted `loops` around a loop whose runs (`run` blocks each, one a
+        pass of the next loop out) would make more than MAX_RERUN lines run again."""
+        for loop in loops:
+            if rerun + run * loop.left > MAX_RERUN:
+                raise NcppError(
+                    f"{loop.what} would run {loop.left:,} more passes of about {run:,} blocks each (the "
+                    f"loops inside it run through): more than {MAX_RERUN:,} lines run again, taken for a "
+                    "loop that does not end",
+                    Location(loop.file or self.file, loop.line, 1),
+                )
+            run *= max(loop.total, 1)
+
+
+@dataclass(frozen=True)
+class Around:
+    """A counted loop under way around another (`CountedPasses.ended`): its passes still to run
+    after the one under way, all its passes, its line (in `file`, None: the program's)."""
+
+    left: int
+    total: int
+    line: int | None
+    what: str
+    file: str | None = None
 
 
 @dataclass(frozen=True)
@@ -186,7 +221,10 @@ class Flow:
     returns; `done()` says the program has ended (M2, M30, or a construct
     outside the interpreter's scope), after which the rest is text;
     `stop(reason, block, col)` ends it where the flow leaves the scope;
-    `path`: the folders of subroutine files."""
+    `path`: the folders of subroutine files; `state()`: the interpreter's state but for the
+    parameters (`endless.exact`; None where it cannot be told) and `position()` a cheap part of
+    it, with which a loop that comes back to the state it had is refused (`endless.py`; None:
+    only at MAX_RERUN)."""
 
     def __init__(
         self,
@@ -196,6 +234,8 @@ class Flow:
         done: Callable[[], bool],
         stop: Callable,
         path: Sequence[Path] = (),
+        state: Callable[[], object] | None = None,
+        position: Callable[[], object] = lambda: None,
     ):
         self.file, self.evaluate, self.parameters, self.done, self.stop, self.path = (
             file,
@@ -252,6 +292,11 @@ class Flow:
         # The verbatim blocks the text starts with: a Fanuc tape leader (`parser._leader`, within
         # the blocks read ahead); a verbatim block after them stands after the closing `%`
         self.leader = 0
+        self.revisits: Revisits | None = None
+        if state is not None:
+            parameters.journal = Journal()
+            self.revisits = Revisits(parameters.journal, parameters.entry, position,
+                                     lambda: self._with_flow(state()))  # fmt: skip
 
     # -- the stream ------------------------------------------------------------
     def steps(self, blocks: Iterable[Block]) -> Iterator[tuple[Block, str, Block | None]]:
@@ -834,7 +879,7 @@ class Flow:
         if inner:
             raise NcppError(f"END{m} closes DO{m} across the loop {inner[0]}: loops nest, they do not cross "
                             "(a Fanuc alarm)", where)  # fmt: skip
-        return lambda: setattr(frame, "pc", label.start)
+        return self._back(frame, label.start, block, control)
 
     def _loop_name(self, m: int, block: Block, control: Control) -> str:
         if m not in (1, 2, 3):
@@ -872,7 +917,7 @@ class Flow:
                 n for n, label in frame.labels.items() if label.kind == "fanuc" and label.start >= index
             ]:
                 del frame.labels[name]  # left: the jump goes back before its WHILE
-            frame.pc = index
+            self._back(frame, index, block, control)()
 
         return back
 
@@ -998,7 +1043,7 @@ class Flow:
         again = self._condition(block, control)
         if label is not None and label.kind == "do":  # the end of a do loop
             if again and not self.doing_break:
-                return lambda: setattr(frame, "pc", label.start)
+                return self._back(frame, label.start, block, control)
             self.doing_break = False
             return self._ended(frame, control.name)
 
@@ -1022,7 +1067,7 @@ class Flow:
             if not self.doing_continue:
                 return self._ended(frame, control.name)
             self.doing_continue = False  # (only here: a `continue` in a do loop leaves it set)
-        return lambda: setattr(frame, "pc", label.start)
+        return self._back(frame, label.start, block, control)
 
     def _do(self, frame, block, control, arrived):
         frame.opened.setdefault(control.name, (frame.pc, "do", block.line))
@@ -1040,17 +1085,41 @@ class Flow:
         def test():
             label = frame.labels.setdefault(control.name, _Label("repeat", frame.pc))
             if label.count == -1:  # counted where the loop starts
-                label.count = int(round_half_away(count))
+                label.count = label.total = int(round_half_away(count))
             if label.count > 0:
                 label.count -= 1
                 what = f"o{_shown(control.name)} repeat"
-                label.mark = self.passes.ended(label.mark, self.rerun, label.count, block.line, what)
+                around = (
+                    (lambda: self._around(frame, label.start)) if label.count == label.total - 2 else None
+                )
+                label.mark = self.passes.ended(label.mark, self.rerun, label.count, block.line, what,
+                                               frame.source, around, label.total)  # fmt: skip
                 self._on(frame, None)()
             else:
                 label.count, label.mark = -1, None
                 self._on(frame, control.name)()
 
         return test
+
+    def _around(self, frame: _Frame, start: int) -> list[Around]:
+        """The counted loops around the loop at `start` of `frame`, innermost first, as far as
+        counted loops go: o-word repeats, and Fanuc subprograms' L repeats around their calls."""
+        loops: list[Around] = []
+        for depth in range(len(self.frames) - 1, -1, -1):
+            level = self.frames[depth]
+            inside = [(n, b) for n, b in level.labels.items() if level is not frame or b.start < start]
+            opened = sorted(inside, key=lambda item: -item[1].start)
+            for name, label in opened:
+                if label.kind != "repeat" or label.count < 0:
+                    return loops
+                line = self._block(level, label.start).line  # type: ignore[union-attr]  # (held: under way)
+                loops.append(Around(label.count, label.total, line, f"o{_shown(name)} repeat", level.source))
+            if level.repeats > 0 and depth > 0:  # (its caller's line before its pc called it)
+                caller = self.frames[depth - 1]
+                line = self._block(caller, caller.pc - 1).line  # type: ignore[union-attr]
+                loops.append(Around(level.repeats, level.repeats + 1, line, "a subprogram's L repeats",
+                                    caller.source))  # fmt: skip
+        return loops
 
     def _break(self, frame, block, control, arrived):
         self._label(frame, block, control, ("while", "do"))
@@ -1072,6 +1141,47 @@ class Flow:
             raise self._error(
                 f"is a duplicate O-word label: already defined in line {first[2]}", block, control
             )
+
+    def _back(self, frame: _Frame, head: int, block: Block, control: Control) -> Callable[[], None]:
+        """Back to a loop's head (its index in the frame), where a loop that comes back to a state
+        it had is refused (`endless.py`), at the line that goes back."""
+
+        def step():
+            frame.pc = head
+            if self.revisits is None:
+                return
+            depth = len(self.frames)
+            found = self.revisits.arrived(
+                (depth, id(frame.space), head, id(block)), (depth, head), (frame, head, block, control)
+            )
+            if found is not None:
+                jumps, (level, start, end, its) = found
+                where = Location(level.source or self.file, end.line, its.item.start + 1)
+                raise endless(jumps, self._block(level, start).line, where)
+
+        return step
+
+    def _with_flow(self, state: object) -> tuple | None:
+        """The interpreter's `state` and the flow's own (None: not told): its calls, loops and
+        branches, where it stands in the text, what it has read; not its counts of lines run."""
+        if state is None:
+            return None
+        frames = tuple((id(f.space), f.pc, tuple((n, b.kind, b.start, b.count) for n, b in f.labels.items()),
+                        frozenset(f.ifs), tuple(f.opened.items()), f.repeats, f.source, f.macro, f.modal)
+                       for f in self.frames)  # fmt: skip
+        modal = self.modal and (
+            id(self.modal.body),
+            self.modal.runs,
+            exact(self.modal.values),
+            self.modal.depth,
+        )
+        defining = self._defining and (self._defining[1], len(self._defining[2]))
+        held = (self.written, self.base, self.read, self.leader, id(self.owner), self._fault is None,
+                defining, self.last_run_move, self.fanuc, len(self.dropped), len(self.looped),
+                len(self.subroutines), len(self.subprograms), len(self.defined_at), len(self.files),
+                len(self.program_files), len(self._whole_programs), len(self._definitions))  # fmt: skip
+        flags = (self.skipping, self.executed_if, self.doing_break, self.doing_continue, self.moved)
+        return state, frames, modal, flags, held
 
     def _on(self, frame: _Frame, skipping: str | None) -> Callable[[], None]:
         """On to the next line, skipping to the next line of o-word `skipping` (None: not)."""

@@ -747,6 +747,10 @@ class HeidenhainInterpreter(ModalInterpreter):
         return item.value if type(item) is Word else self.value(item.expr, block, item)
 
     # -- control flow (`heidenhain_flow`) ------------------------------------------------------
+    def loop_quick(self) -> object:
+        """The position and the Q parameters (copies), compared first of a loop's state."""
+        return self.pos[:], dict(self.q)
+
     def _flowing(self, blocks: Iterable[Block], warnings: Warnings) -> Iterator[Event]:
         """Events as `ModalInterpreter.run`, block by block in the order they run: the moves of
         a block that runs again are left as programmed (FLOW) and, where it runs out of the
@@ -760,6 +764,7 @@ class HeidenhainInterpreter(ModalInterpreter):
         by CALL PGM: its blocks all run out of the text's order, their moves the caller's, and
         its text is no part of the output."""
         self.flow = flow
+        flow.watch(self.loop_quick, self.loop_state)
 
         def stop(reason: str, owner: Block) -> None:  # (where the flow itself cannot go on)
             self._refuse_leaving(reason, owner, None)

@@ -25,10 +25,13 @@ import re
 from collections.abc import Callable, Iterable, Iterator
 
 from ncpp.errors import Location, NcppError
-from ncpp.motion.flow import FIXED, MAX_RERUN, RUN, SKIP, TEXT, CountedPasses
+from ncpp.motion.endless import Revisits, endless
+from ncpp.motion.flow import FIXED, MAX_RERUN, RUN, SKIP, TEXT, Around, CountedPasses
 from ncpp.motion.modal import OutOfScope
-from ncpp.program.blocks import Block, Statement
+from ncpp.program.blocks import Block, Statement, Word
 
+# Blocks after a REP call searched for the REP calls of the sections around it (`_around`)
+MAX_AROUND = 10_000
 LOOKAHEAD = 20_000  # blocks read ahead of the one that runs, to find the calls and jumps back
 MAX_AHEAD = 200_000  # blocks read ahead to find a label a call or jump names
 MAX_BEHIND = 200_000  # blocks held behind the one that runs, for calls and jumps back
@@ -90,6 +93,7 @@ class KlartextFlow:
         self.frames: list[tuple[int, float | str]] = []  # subprogram calls: (index to return to, label)
         self.counters: dict[int, int] = {}  # a REP call's index -> the repeats still to run
         self.marks: dict[int, int] = {}  # a REP call's index -> `CountedPasses.ended`'s mark
+        self.sections: dict[int, tuple[int, int]] = {}  # a REP call's index -> (its label's index, passes)
         self.label_indices: set[int] = set()  # the indices of the LBL blocks read
         # a LBL's index -> `CountedPasses.steps` when it last ran (where a section's first pass starts)
         self.label_steps: dict[int, int] = {}
@@ -98,6 +102,8 @@ class KlartextFlow:
         self.last_run_move = -1  # the index of the last block whose moves ran in place (RUN)
         self.rerun = 0  # blocks run out of the text's order
         self.passes = CountedPasses(file)
+        self.revisits: Revisits | None = None  # refuses a loop back at a state it had (`watch`)
+        self.at = (0, 0)  # where `steps` stands: the block to run, the next to write in place
 
     # -- reading ------------------------------------------------------------------------
     def _read(self) -> None:
@@ -186,14 +192,18 @@ class KlartextFlow:
             if left:
                 self.counters[self.current] = left - 1
                 line = self.held[self.current - self.base].line
+                first = self.current not in self.marks  # (the section's first pass ended)
                 mark = self.marks.get(self.current, self.label_steps.get(index))
+                self.sections[self.current] = (index, repeat + 1)
+                around = (lambda current=self.current: self._around(index, current)) if first else None
                 self.marks[self.current] = self.passes.ended(
-                    mark, self.rerun, left - 1, line, "CALL LBL ... REP"
+                    mark, self.rerun, left - 1, line, "CALL LBL ... REP", None, around, repeat + 1
                 )
                 self.next = index + 1
             else:
                 del self.counters[self.current]
                 self.marks.pop(self.current, None)
+                self.sections.pop(self.current, None)
             return
         if any(label == key for _, label in self.frames):
             raise OutOfScope("a subprogram that calls itself", col)
@@ -201,6 +211,32 @@ class KlartextFlow:
             raise OutOfScope(f"subprograms nested more than {MAX_NESTING} deep", col)
         self.frames.append((self.current + 1, key))
         self.next = index + 1
+
+    def _around(self, label: int, call: int) -> list[Around]:
+        """The REP sections around the section from `label` to its REP `call`, innermost first: the
+        REP calls the program comes to from `call` on, before any other call, jump or end, each of
+        a section that holds the one before (its label before that one's).  One not under way yet
+        runs its REP k passes after the one under way."""
+        loops: list[Around] = []
+        index = call + 1
+        while index < call + MAX_AROUND and (block := self.block(index)) is not None:
+            item = next((i for i in block.items if type(i) is Statement), None)
+            if item is None and any(type(w) is Word and w.letter == "M" and w.value in (2.0, 30.0)
+                                    for w in block.items):  # fmt: skip
+                break
+            if item is not None and item.kind != "label":
+                name, repeat = item.node if item.kind == "call_label" else (None, 0)
+                start = self.labels.get(label_key(name)) if repeat and type(name) is not tuple else None
+                if start is None or start >= label:
+                    break
+                left, passes = (
+                    self.counters.get(index, repeat),
+                    self.sections.get(index, (start, repeat + 1))[1],
+                )
+                loops.append(Around(left, passes, block.line, "CALL LBL ... REP"))
+                label = start
+            index += 1
+        return loops
 
     def end_subprogram(self) -> None:
         """`LBL 0`: back after the call (in the main program it only marks a place)."""
@@ -210,6 +246,28 @@ class KlartextFlow:
     def moved(self) -> None:
         """The block running in its place moved (its text may be rewritten for that run)."""
         self.last_run_move = self.current
+
+    def watch(self, quick: Callable[[], object], state: Callable[[], object]) -> None:
+        """Refuse a loop that comes back to a state it had (`endless.py`): `state()` is the
+        interpreter's, `quick()` a cheap part of it (a copy)."""
+        self.revisits = Revisits(None, None, quick, lambda: self._with_flow(state()))
+
+    def _with_flow(self, state: object) -> tuple:
+        """The interpreter's `state` and the flow's own: where it stands, its calls and REP counts,
+        what it has read and holds; not its counts of blocks run."""
+        held = (self.base, len(self.held), self.exhausted, len(self.labels), len(self.again), len(self.twice),
+                self.named_by_q, self.last_run_move)  # fmt: skip
+        return state, self.at, tuple(self.frames), tuple(self.counters.items()), held
+
+    def _arrived(self, block: Block, pc: int, written: int) -> None:
+        """Back at a label (`pc`) from `block`: refused where the state is one it had there."""
+        self.at = (pc, written)
+        depth, revisits = len(self.frames), self.revisits
+        assert revisits is not None  # (`steps` asks only when watching)
+        found = revisits.arrived((pc, id(block), depth), (depth, pc), (pc, block))
+        if found is not None:
+            jumps, (start, end) = found
+            raise endless(jumps, self.held[start - self.base].line, Location(self.file, end.line, 1))
 
     # -- the order ----------------------------------------------------------------------
     def steps(self, done: Callable[[], bool], stop: Callable[[str, Block], None]) -> Iterator[tuple]:
@@ -249,6 +307,8 @@ class KlartextFlow:
                         Location(self.file, owner.line if owner is not None else None),
                     )
                 yield block, FIXED, owner
+            if self.next is not None and self.next <= pc and self.revisits is not None:
+                self._arrived(block, self.next, written)
             pc = self.next if self.next is not None else pc + 1
             if min(pc, written - 1) - self.base >= _DROP:
                 self._trim(min([pc, written - 1] + [i for i, _ in self.frames]))

@@ -42,6 +42,7 @@ from collections.abc import Callable, Iterable, Iterator
 from typing import NoReturn, cast
 
 from ncpp.errors import Location, NcppError, Warnings, resolve_warnings
+from ncpp.motion import modal
 from ncpp.motion.corners import CornerError, round_corner
 from ncpp.motion.cutter import ToolCentre
 from ncpp.motion.cycles import (
@@ -54,9 +55,9 @@ from ncpp.motion.cycles import (
     back_bore,
     hole,
 )
+from ncpp.motion.endless import exact
 from ncpp.motion.expand import Expansion, number, refused
 from ncpp.motion.expressions import ExpressionError, OutOfScope, Parameters, evaluate, vacant
-from ncpp.motion import modal
 from ncpp.motion.flow import FIXED, RUN, SKIP, Flow
 from ncpp.motion.offsets import SYSTEMS, WorkOffsets
 from ncpp.motion.segments import (
@@ -258,7 +259,9 @@ class Interpreter:
         self.inch = False
         self.inverse_time = False
         self.feed = 0.0
-        self.motion: float | None = self.start_motion  # modal motion G code (0-3, a canned cycle), None for G80 / none yet
+        self.motion: float | None = (
+            self.start_motion
+        )  # modal motion G code (0-3, a canned cycle), None for G80 / none yet
         self.retract_to_r = True  # G99 (rs274ngc's default) / G98: where a cycle retracts to
         # A canned cycle's sticky words (R, the normal axis's, Q; P is a dwell: no move) and the
         # normal-axis position its series of cycles started from (a series ends with any other motion)
@@ -339,8 +342,10 @@ class Interpreter:
         corner: tuple = ()  # its corner word: (kind, size, item); read only with a pending line
         held: list[Event] = []  # non-moving events after it
         flow = self.flow = Flow(
-            self.file, self._evaluate, self.params, lambda: self.done, self._leave_scope, self.subroutine_path
-        )
+            self.file, self._evaluate, self.params, lambda: self.done, self._leave_scope,
+            self.subroutine_path, state=self._loop_state, position=lambda: self.pos[:],
+        )  # fmt: skip
+        self.rounding = False
         expansion = self.expansion
         for block, kind, owner in flow.steps(blocks):
             if kind is not RUN and kind is not FIXED:  # text that does not run here
@@ -395,7 +400,7 @@ class Interpreter:
                 self._leave_scope(stop.reason, block, stop.col, owner)
                 if pending is not None:
                     yield from self._unrounded(pending, held)
-                    pending = None
+                    pending, self.rounding = None, False
                 if owner is None:  # (a block that runs out of the text's order is written in its place)
                     if expansion is not None:
                         yield from expansion.owed()
@@ -415,15 +420,15 @@ class Interpreter:
                     rounded = self._round_corner(pending, corner, ev, warnings)
                     if rounded is None:  # out of scope: everything from the corner on passes
                         yield from self._unrounded(pending, held)
-                        pending = None
+                        pending, self.rounding = None, False
                         yield Pass(ev.block)
                         break
                     yield from rounded[:-1]
                     yield from held
                     ev = rounded[-1]
-                    pending, held = None, []
+                    pending, held, self.rounding = None, [], False
                 if new_corner is not None and type(ev) is Line and ev.block is block:
-                    pending, corner = ev, new_corner
+                    pending, corner, self.rounding = ev, new_corner, True
                     continue
                 yield ev
         if pending is not None:
@@ -432,6 +437,14 @@ class Interpreter:
                 "corner rounding/chamfer has no following move",
                 Location(self.file, pending.block.line, item.start + 1),
             )
+
+    def _loop_state(self) -> tuple | None:
+        """The modal state a loop's check compares (`endless.py`): all but the parameters (the
+        flow journals them), the flow (its own), what only writes or warns, and what does not change
+        in a run; None while a corner waits for its next move (`run`'s own, not told)."""
+        if self.rounding:
+            return None
+        return tuple(exact(value) for name, value in vars(self).items() if name not in _NOT_LOOP_STATE)
 
     def _leave_scope(self, reason: str, block: Block, col: int | None, owner: Block | None = None) -> None:
         """A construct outside the scope: the state is unknown from here on (an error with strict).
@@ -1895,6 +1908,12 @@ class Interpreter:
         raise NcppError(message, Location(self.file, block.line, col))
 
 
+# The interpreter's attributes that are no state a loop's check compares (`_loop_state`): kept
+# elsewhere (the parameters, the flow), only written or warned from, fixed for the run, or derived
+# from the others (the context, the fast path)
+_NOT_LOOP_STATE = frozenset(("params", "flow", "warnings", "untold_lengths", "expansion", "tools",
+                             "file", "subroutine_path", "expand_cycles", "_context", "_fast",
+                             "rounding"))  # fmt: skip
 _COORD_SYSTEM = {float(name[1:]): n for n, name in enumerate(SYSTEMS, 1)}  # 54.0: 1 ... 59.3: 9
 _COORD_SYSTEM_CODE = {n: code * 10 for code, n in _COORD_SYSTEM.items()}
 _PLANE_LETTERS = {17: "XY", 18: "ZX", 19: "YZ"}

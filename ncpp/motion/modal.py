@@ -16,6 +16,7 @@ from typing import NoReturn
 
 from ncpp.errors import Location, NcppError, Warnings, resolve_warnings
 from ncpp.motion.cutter import ToolCentre
+from ncpp.motion.endless import exact
 from ncpp.motion.offsets import WorkOffsets
 from ncpp.motion.segments import DRILLED, PLANE_AXES, Arc, Context, Event, Line, Pass, Point
 from ncpp.program.blocks import Block
@@ -70,6 +71,12 @@ def placed_interpreting(dialect: type[ModalInterpreter]) -> Callable[..., Iterat
 class ModalInterpreter:
     """Position and modal state of one program run (program units throughout)."""
 
+    # Attributes that are no state a loop's check compares (`loop_state`): fixed for the run, only
+    # written or warned from, caches and counts of blocks run, the flow (its own)
+    not_loop_state = frozenset(("_context", "subroutine_path", "expand", "untold_lengths", "expansion",
+                                "tools", "called_blocks", "_files", "flow", "main_path",
+                                "program_file"))  # fmt: skip
+
     def __init__(self, file: str = "<stdin>", zero: tuple[float, float, float] = (0.0, 0.0, 0.0)):
         self.file = file  # the file of the blocks running (a called one's, while it runs)
         self.program_file = file
@@ -102,6 +109,15 @@ class ModalInterpreter:
         self._context: Context | None = None
         self.subroutine_path: tuple[Path, ...] = ()  # the folders of the program files it calls
         self.expand = False  # --expand: subprograms and loops written out (the dialect's own)
+
+    def loop_state(self) -> tuple:
+        """The state a loop that comes back to it repeats for ever with (`endless.py`), but the
+        flow's: every attribute but those of `not_loop_state`, as `exact` values."""
+        return tuple(exact(value) for name, value in vars(self).items() if name not in self.not_loop_state)
+
+    def loop_quick(self) -> object:
+        """A cheap part of `loop_state` (a copy, compared first): the position."""
+        return self.pos[:]
 
     # -- the event stream -------------------------------------------------------------
     def run(self, blocks: Iterable[Block], warnings: Warnings) -> Iterator[Event]:

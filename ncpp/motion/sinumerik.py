@@ -45,6 +45,7 @@ import numpy as np
 
 from ncpp.errors import Location, Warnings
 from ncpp.motion.called import Files, count_called, searched
+from ncpp.motion.endless import Revisits
 from ncpp.motion.flow import FIXED, RUN, SKIP, TEXT
 from ncpp.motion.modal import (
     MAX_HOLES,
@@ -195,6 +196,10 @@ class SinumerikInterpreter(ModalInterpreter):
         self.centre.approach = "NORM"  # (the control's initial setting: `ToolCentre.approach`)
         self.expansion: SinumerikExpansion | None = None  # --expand: what it writes (`sinumerik_expand`)
 
+    def loop_quick(self) -> object:
+        """The position and the variables (copies), compared first of a loop's state."""
+        return self.pos[:], dict(self.variables)
+
     # -- the event stream ---------------------------------------------------------------
     def run(self, blocks: Iterable[Block], warnings: Warnings) -> Iterator[Event]:
         """Events block by block, in the order the blocks run (`sinumerik_flow.py`): a block
@@ -217,7 +222,8 @@ class SinumerikInterpreter(ModalInterpreter):
                 expansion.refuse(reason, Location(self.file, block.line, col), inside)
             self.leave_scope(warnings, reason, block, col, caller or owner)
 
-        flow = SinumerikFlow(self.file, self.value, self.assign, lambda: self.done or self.returned, leave)
+        flow = SinumerikFlow(self.file, self.value, self.assign, lambda: self.done or self.returned, leave,
+                             Revisits(None, None, self.loop_quick, self.loop_state))  # fmt: skip
         for block, kind, owner in flow.steps(blocks):
             if caller is not None:
                 if kind is not RUN and kind is not FIXED:

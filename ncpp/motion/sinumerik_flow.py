@@ -43,7 +43,8 @@ from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 
 from ncpp.errors import Location, NcppError
-from ncpp.motion.flow import _TRIM, FIXED, MAX_RERUN, RUN, SKIP, TEXT, CountedPasses
+from ncpp.motion.endless import Revisits, endless, exact
+from ncpp.motion.flow import _TRIM, FIXED, MAX_RERUN, RUN, SKIP, TEXT, Around, CountedPasses
 from ncpp.motion.modal import OutOfScope
 from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
 
@@ -67,6 +68,8 @@ class _Open:
     start: int  # the index of its opening block
     end: float = 0.0  # FOR: the end value
     mark: int | None = None  # FOR: `CountedPasses.ended`'s mark
+    total: int = 0  # FOR: its passes, all told (as counted where it starts)
+    left: int = 0  # FOR: its passes after the one under way
 
 
 @dataclass
@@ -84,12 +87,18 @@ class SinumerikFlow:
 
     `value(expr, block, item)` and `assign(target, expr, block, item)` are the
     interpreter's; `done()` says the program has ended; `stop(reason, block, col, owner)`
-    ends interpretation where the flow leaves the scope."""
+    ends interpretation where the flow leaves the scope; `revisits`, given the interpreter's
+    state, refuses a loop that comes back to a state it had (`endless.py`)."""
 
     def __init__(
-        self, file: str, value: Callable, assign: Callable, done: Callable[[], bool], stop: Callable
-    ):
+        self, file: str, value: Callable, assign: Callable, done: Callable[[], bool], stop: Callable,
+        revisits: Revisits | None = None,
+    ):  # fmt: skip
         self.file, self.value, self.assign, self.done, self.stop = file, value, assign, done, stop
+        self.revisits = revisits
+        if revisits is not None:  # (the interpreter's state, then the flow's)
+            interpreters = revisits.state
+            revisits.state = lambda: self._with_flow(interpreters())
         self.stream: Iterator[Block] = iter(())
         self.buffer: list[Block] = []  # blocks read and still held, from index `base`
         self.base = 0
@@ -140,8 +149,28 @@ class SinumerikFlow:
             if self.section is not None and target == self.section.start:  # (the blocks between run later)
                 self.pc = target
             else:
+                back = target <= self.pc
                 yield from self._go(target)
+                if back and self.revisits is not None:
+                    self._arrived(block)
         yield from self._rest()
+
+    def _arrived(self, block: Block) -> None:
+        """Back at a loop's head (`pc`) from `block`: refused where the state is one it had there."""
+        revisits = self.revisits
+        assert revisits is not None  # (`steps` asks only when watching)
+        found = revisits.arrived((self.pc, id(block)), (self.pc,), (self.pc, block))
+        if found is not None:
+            jumps, (start, end) = found
+            raise endless(jumps, self.buffer[start - self.base].line, Location(self.file, end.line, 1))
+
+    def _with_flow(self, state: object) -> tuple:
+        """The interpreter's `state` and the flow's own: where it stands, its structures and
+        section under way, what it has read and holds; not its counts of blocks run."""
+        opened = tuple((o.kind, o.start, exact(o.end)) for o in self.open)
+        section = self.section and exact(self.section)
+        held = (self.written, self.base, self.read, self.last_run_move, len(self.looped))
+        return state, self.pc, opened, section, held
 
     def _advance(self) -> None:
         if self.pc == self.written:
@@ -270,7 +299,8 @@ class SinumerikFlow:
         self.assign(target, ("num", self.value(start, block, statement)), block, statement)
         last = self.value(end, block, statement)
         if self.value(target, block, statement) <= last:
-            self.open.append(_Open("for", self.pc, last, self.passes.steps))
+            passes = int(min(last - self.value(target, block, statement), MAX_RERUN)) + 1
+            self.open.append(_Open("for", self.pc, last, self.passes.steps, passes, passes - 1))
             return self.pc + 1
         return self._match(self.pc, "for", statement) + 1
 
@@ -281,10 +311,23 @@ class SinumerikFlow:
         value = self.value(counter, block, statement)
         if value <= opened.end:
             left = int(min(opened.end - value, MAX_RERUN))  # (an end of 1e308 runs no more than this)
-            opened.mark = self.passes.ended(opened.mark, self.rerun, left, block.line, "FOR ... ENDFOR")
+            around = self._around if opened.left == opened.total - 1 else None  # (its first pass ended)
+            opened.left = left
+            opened.mark = self.passes.ended(opened.mark, self.rerun, left, block.line, "FOR ... ENDFOR",
+                                            None, around, opened.total)  # fmt: skip
             return opened.start + 1
         self.open.pop()
         return self.pc + 1
+
+    def _around(self) -> list[Around]:
+        """The FOR loops around the innermost structure, innermost first, as far as FOR loops go."""
+        loops: list[Around] = []
+        for opened in reversed(self.open[:-1]):
+            if opened.kind != "for":
+                break
+            line = self.buffer[opened.start - self.base].line  # (held while the loop runs)
+            loops.append(Around(opened.left, opened.total, line, "FOR ... ENDFOR"))
+        return loops
 
     def _repeat(self, block: Block, statement: Statement) -> int:
         self.open.append(_Open("repeat", self.pc))

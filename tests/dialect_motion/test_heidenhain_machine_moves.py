@@ -139,4 +139,5 @@ def test_a_plane_function_with_its_words_ends_interpretation_with_a_warning():
     text = PROGRAM.replace("7 L X+0 Y+0 FMAX", plane)
     assert len(lines(text, Warnings(stream=stream))) == len([m for m in lines(PROGRAM) if m.block.line < 8])
     assert "p.h:8:3: warning: PLANE SPATIAL SPA-90 SPB+0 SPC+90 TURN F5555 SEQ- TABLE ROT is outside" in (
-        stream.getvalue())
+        stream.getvalue()
+    )

@@ -74,7 +74,7 @@ M30
         ("repeat.ngc", REPEAT, 3),
         ("nested.ngc", NESTED_REPEAT, 3),
         ("loop.h", KLARTEXT, 11),
-        ("loop.mpf", SINUMERIK, 8),
+        ("loop.mpf", SINUMERIK, 3),  # (the outer FOR, refused at the inner loop's first pass)
         ("subs.nc", FANUC_L, 10),
     ],  # fmt: skip
 )

@@ -158,4 +158,6 @@ def test_a_subprogram_file_named_for_its_number_without_the_o_is_found(tmp_path,
     command = ["compensate", "--machine", str(READING), "--dialect", "fanuc", "--subroutine-path", str(tmp_path),
                str(tmp_path / "p.nc"), "-o", str(tmp_path / "out.nc")]  # fmt: skip
     proc = subprocess.run([sys.executable, "-m", "ncpp", *command], capture_output=True, text=True, cwd=ROOT)
-    assert proc.returncode != 0 and f"{name}:1:1: O1002 ... M99 is not in the file" in proc.stderr, proc.stderr
+    assert proc.returncode != 0 and f"{name}:1:1: O1002 ... M99 is not in the file" in proc.stderr, (
+        proc.stderr
+    )

@@ -334,4 +334,5 @@ def test_a_fanuc_dwell_in_x_is_read_past():
     said = io.StringIO()
     found = events(program.replace("X2.0 (wait", "X2.0 Y1 (wait"), "fanuc", Warnings(stream=said))
     assert [type(e) for e in found] == [Pass, Line, Pass, Pass, Pass] and "G04 X (a dwell) with other" in (
-        said.getvalue())
+        said.getvalue()
+    )

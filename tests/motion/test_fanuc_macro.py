@@ -480,7 +480,9 @@ def test_m98_runs_a_program_kept_in_a_file_of_the_subroutine_path(tmp_path):
     # G65's says where it looked too (`G65P3003...` of dennisselyaev/gcode 3.nc, its file not on the path)
     macro = write_program(tmp_path, "O1000\n" + HEAD + "G65 P9010 X1.\nM30\n", "macro.nc")
     _, error, warning = ours(macro, offsets=WorkOffsets.given({}, subroutine_path=[tmp_path]))
-    assert f"G65 P9010: a macro the program does not define (O9010 to M99), nor is it in {tmp_path}" in warning
+    assert (
+        f"G65 P9010: a macro the program does not define (O9010 to M99), nor is it in {tmp_path}" in warning
+    )
 
 
 def test_a_program_file_without_its_number_is_an_error_at_the_file(tmp_path):
@@ -565,6 +567,7 @@ def test_a_control_line_whose_value_ncpp_is_not_told_ends_interpretation_there(p
     found = list(interpret(parse_stream(io.BytesIO(program.encode()), "p.nc"), file="p.nc",
                            warnings=Warnings(stream=said)))  # fmt: skip
     assert f"p.nc:{line}:1: warning: " in said.getvalue() and "outside the motion interpreter's scope" in (
-        said.getvalue())
+        said.getvalue()
+    )
     assert [type(e) for e in found if type(e) is Line] == [Line]
     assert all(type(e) is Pass for e in found if e.block.line >= line)

@@ -228,12 +228,13 @@ def test_out_of_scope_inside_a_subroutine_names_the_call():
 
 
 def test_a_loop_that_does_not_end_is_refused_at_its_line(monkeypatch):
-    """LinuxCNC would run it for ever; a pass over the program must end, at a stated bound."""
+    """LinuxCNC would run it for ever; a pass over the program must end, at a stated bound (here
+    its counter changes the state at each pass: no pass comes back to a state it had)."""
     import ncpp.motion.flow as flow
 
     monkeypatch.setattr(flow, "MAX_RERUN", 1000)
     with pytest.raises(NcppError, match=r"a loop that does not end: 1,000 lines run again") as err:
-        _events(HEAD + "o1 while [1]\n G0 X1\n G0 X2\no1 endwhile\nG0 Y5\n")
+        _events(HEAD + "o1 while [1]\n G0 X1\n #1 = [#1 + 1]\no1 endwhile\nG0 Y5\n")
     assert (err.value.where.file, err.value.where.line) == ("t.ngc", 6)
 
 
