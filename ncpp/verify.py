@@ -105,17 +105,18 @@ NO_EXTRA = (0.0,) * len(EXTRA_AXES)
 
 @dataclass
 class _Moves:
-    """Moves collected for one section, sampled when it closes."""
+    """Moves collected for one section, sampled when it closes (in flat lists: a move's own work
+    is a few appends, and one array is made of each list)."""
 
     bound: Bound
-    ends: list = field(default_factory=list)  # per move: (x0, y0, z0, x1, y1, z1) program coordinates
-    frames: list = field(default_factory=list)  # the contexts the moves were made in, each once in a row
-    frame_of: list = field(default_factory=list)  # per move: its context's index in `frames`
+    points: list = field(default_factory=list)  # per move x0 y0 z0 x1 y1 z1, program coordinates
+    lines: list = field(default_factory=list)  # per move the line its samples are told by
+    frames: list = field(default_factory=list)  # (first move, context) where the context changes
     frame: object = None  # the last context
     extra: dict = field(default_factory=dict)  # move -> its extra axes' start and end, where any is not 0
-    rapid: list = field(default_factory=list)
-    lines: list = field(default_factory=list)
-    arcs: list = field(default_factory=list)  # (move, plane, centre (program coordinates), turn)
+    rapids: list = field(default_factory=list)  # the moves that are rapids
+    arcs: list = field(default_factory=list)  # per arc: its move and its turn
+    centres: list = field(default_factory=list)  # per arc its centre's x y z, program coordinates
     feeds: list = field(default_factory=list)
     feed: float = math.nan  # the last feed move's F and units (a new one is looked at)
     feed_inch: bool = False
@@ -129,7 +130,7 @@ class _Moves:
 
     def sample(self, action: Action | None, first_line: int) -> Section:
         """The moves sampled every `step` (each from its start to its end, both included)."""
-        if not self.ends:
+        if not self.lines:
             empty = np.zeros((0, 4))
             return Section(
                 empty,
@@ -141,10 +142,11 @@ class _Moves:
                 action,
                 first_line,
             )
-        raw = np.array(self.ends)
-        frame = np.array(self.frame_of)
-        offsets = np.array([f.offset for f in self.frames])[frame]
-        units = np.array([f.unit_mm for f in self.frames])[frame][:, None]
+        raw = np.array(self.points).reshape(-1, 6)
+        firsts = [first for first, _ in self.frames]
+        frame = np.repeat(np.arange(len(firsts)), np.diff(firsts + [len(raw)]))
+        offsets = np.array([f.offset for _, f in self.frames])[frame]
+        units = np.array([f.unit_mm for _, f in self.frames])[frame][:, None]
         starts, ends = (raw[:, :3] + offsets) * units, (raw[:, 3:] + offsets) * units
         if self.extra:
             extra = np.zeros((len(raw), 2 * len(EXTRA_AXES)))
@@ -153,7 +155,10 @@ class _Moves:
             starts = np.hstack((starts, extra[:, : len(EXTRA_AXES)]))
             ends = np.hstack((ends, extra[:, len(EXTRA_AXES) :]))
         counts = np.ones(len(starts), dtype=np.int64)
-        arcs = _Arcs(self.arcs, starts, ends, offsets, units) if self.arcs else None
+        arcs = None
+        if self.arcs:
+            axes = np.array([PLANE_AXES[f.plane][:2] for _, f in self.frames], dtype=np.int64)[frame]
+            arcs = _Arcs(self.arcs, self.centres, axes, starts, ends, offsets, units)
         if arcs is not None:
             counts[arcs.move] = arcs.chords(self.bound.chord)
             # (the section's samples are held at once; a move's chords are rounded up, so the pieces a
@@ -173,7 +178,8 @@ class _Moves:
         points[:, :width] = starts[move] + t[:, None] * (ends - starts)[move]
         if arcs is not None:
             arcs.bend(points, move, t)
-        rapid = np.array(self.rapid)
+        rapid = np.zeros(len(counts), dtype=bool)
+        rapid[self.rapids] = True
         points[:, width] = rapid[move] * self.bound.apart
         begins = np.ones(len(move), dtype=bool)  # each point but a move's last begins a segment
         begins[first + counts] = False
@@ -186,22 +192,20 @@ class _Moves:
 class _Arcs:
     """A section's arcs, as arrays: what their samples need to lie on them."""
 
-    def __init__(
-        self, arcs: list, starts: np.ndarray, ends: np.ndarray, offsets: np.ndarray, units: np.ndarray
-    ):
-        table = np.array([(m, *PLANE_AXES[plane][:2], *centre, turn) for m, plane, centre, turn in arcs])
-        self.move = table[:, 0].astype(np.int64)
-        i, j = table[:, 1].astype(np.int64), table[:, 2].astype(np.int64)
-        centre = (table[:, 3:6] + offsets[self.move]) * units[self.move]  # machine mm
-        rows = np.arange(len(table))
-        self.i, self.j, self.ci, self.cj = i, j, centre[rows, i], centre[rows, j]
-        table = np.column_stack((table[:, :3], table[:, 6]))  # (move, i, j, turn)
-        rows = self.move
+    def __init__(self, arcs: list, centres: list, axes: np.ndarray, starts: np.ndarray, ends: np.ndarray,
+                 offsets: np.ndarray, units: np.ndarray):  # fmt: skip
+        """`arcs`, `centres`: `_Moves`'; `axes` (the two of the plane), `offsets`, `units`: per move."""
+        table = np.array(arcs, dtype=np.int64).reshape(-1, 2)  # (move, turn)
+        self.move = rows = table[:, 0]
+        i, j = axes[rows].T
+        centre = (np.array(centres).reshape(-1, 3) + offsets[rows]) * units[rows]  # machine mm
+        at = np.arange(len(rows))
+        self.i, self.j, self.ci, self.cj = i, j, centre[at, i], centre[at, j]
         s_i, s_j = starts[rows, i] - self.ci, starts[rows, j] - self.cj
         e_i, e_j = ends[rows, i] - self.ci, ends[rows, j] - self.cj
         self.a0 = np.arctan2(s_j, s_i)
         self.r0, self.r1 = np.hypot(s_i, s_j), np.hypot(e_i, e_j)
-        self.sweep = _sweeps(self.a0, np.arctan2(e_j, e_i), table[:, 3])
+        self.sweep = _sweeps(self.a0, np.arctan2(e_j, e_i), table[:, 1])
 
     def chords(self, within: float) -> np.ndarray:
         """How many chords each arc takes for none to lie further than `within` from it."""
@@ -291,7 +295,7 @@ def sections(events: Iterable[Event], bound: Bound, cut: Cut = lambda block, mov
             last = block
             run += 1
             into = 0 if divisible is not None and divisible(event) else -1
-            if moves.ends and (at := cut(block, len(moves.ends), run, 0)):
+            if moves.lines and (at := cut(block, len(moves.lines), run, 0)):
                 yield moves.chunk(at, first_line)
                 moves, first_line = _Moves(bound), block.line
             if not (kind is Pass and event.skipped) and _may_act(block.signature):  # type: ignore[union-attr]
@@ -302,7 +306,7 @@ def sections(events: Iterable[Event], bound: Bound, cut: Cut = lambda block, mov
                     moves, first_line = _Moves(bound), block.line
         if kind is Line or kind is Arc:
             if into >= 0:
-                if into and into % CHUNK_MOVES == 0 and (at := cut(block, len(moves.ends), run, into)):
+                if into and into % CHUNK_MOVES == 0 and (at := cut(block, len(moves.lines), run, into)):
                     yield moves.chunk(at, first_line)
                     moves, first_line = _Moves(bound), block.line
                 into += 1
@@ -333,24 +337,29 @@ def _add(
     """Add a move (told by `line`); return the extra axes' positions after it.  (A move's own
     work is a few appends: the numbers are turned to machine mm a section at a time.)"""
     ctx = event.context
+    n = len(moves.lines)  # the move's index
     if ctx is not moves.frame:
         moves.frame = ctx
-        moves.frames.append(ctx)
-    moves.frame_of.append(len(moves.frames) - 1)
-    moves.ends.append(event.start + event.end)
+        moves.frames.append((n, ctx))
+    moves.points += event.start
+    moves.points += event.end
+    moves.lines.append(line)
     if event.extra:
         end_extra = (tuple(event.extra) + NO_EXTRA)[: len(EXTRA_AXES)]
-        moves.extra[len(moves.ends) - 1] = (extra, end_extra)
+        moves.extra[n] = (extra, end_extra)
     elif extra is not NO_EXTRA:
-        moves.extra[len(moves.ends) - 1] = (extra, extra)
+        moves.extra[n] = (extra, extra)
         end_extra = extra
     else:
         end_extra = extra
-    rapid = type(event) is Line and event.rapid
-    moves.rapid.append(rapid)
-    moves.lines.append(line)
     if type(event) is Arc:
-        moves.arcs.append((len(moves.ends) - 1, ctx.plane, event.center, event.turn))
+        rapid = False
+        moves.arcs += (n, event.turn)
+        moves.centres += event.center
+    else:
+        rapid = event.rapid
+        if rapid:
+            moves.rapids.append(n)
     if not rapid:
         if inverse_time:
             moves.inverse_time += 1.0 / event.feed if event.feed > 0 else math.inf
