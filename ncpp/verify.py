@@ -142,12 +142,14 @@ class _Moves:
                 action,
                 first_line,
             )
-        raw = np.array(self.points).reshape(-1, 6)
+        raw = np.array(self.points, dtype=float).reshape(-1, 2, 3)  # (move, its start and end, X Y Z)
         firsts = [first for first, _ in self.frames]
         frame = np.repeat(np.arange(len(firsts)), np.diff(firsts + [len(raw)]))
         offsets = np.array([f.offset for _, f in self.frames])[frame]
         units = np.array([f.unit_mm for _, f in self.frames])[frame][:, None]
-        starts, ends = (raw[:, :3] + offsets) * units, (raw[:, 3:] + offsets) * units
+        raw += offsets[:, None]
+        raw *= units[:, None]
+        starts, ends = raw[:, 0], raw[:, 1]
         if self.extra:
             extra = np.zeros((len(raw), 2 * len(EXTRA_AXES)))
             for k, (s, e) in self.extra.items():
@@ -170,23 +172,27 @@ class _Moves:
                     f"than ncpp verifies at once ({MAX_CHORDS:,}): split it, or give a wider --tolerance",
                     Location("", self.lines[k], 1),
                 )
-        move = np.repeat(np.arange(len(counts)), counts + 1)
-        first = np.concatenate(([0], np.cumsum(counts + 1)[:-1]))
-        t = (np.arange(len(move)) - first[move]) / counts[move]
+        # each segment starts at its piece's start (t from 0 on) and ends where the next starts, but a
+        # move's last, which ends at the move's end
+        move = np.repeat(np.arange(len(counts)), counts)  # each segment's move
+        last = np.cumsum(counts) - 1  # each move's last segment
         width = starts.shape[1]
-        points = np.empty((len(move), width + 1))
-        points[:, :width] = starts[move] + t[:, None] * (ends - starts)[move]
-        if arcs is not None:
-            arcs.bend(points, move, t)
+        begins = np.empty((len(move), width + 1))
+        if arcs is None:  # (a segment a move)
+            begins[:, :width] = starts
+        else:
+            t = (np.arange(len(move)) - (last + 1 - counts)[move]) / counts[move]
+            begins[:, :width] = starts[move] + t[:, None] * (ends - starts)[move]
+            arcs.bend(begins, move, t)
         rapid = np.zeros(len(counts), dtype=bool)
         rapid[self.rapids] = True
-        points[:, width] = rapid[move] * self.bound.apart
-        begins = np.ones(len(move), dtype=bool)  # each point but a move's last begins a segment
-        begins[first + counts] = False
-        segment = np.flatnonzero(begins)
-        kept = move[segment]
-        return Section(points[segment], points[segment + 1], rapid[kept], np.array(self.lines)[kept], self.feeds,
-                       self.inverse_time, action, first_line)  # fmt: skip
+        begins[:, width] = rapid[move] * self.bound.apart
+        finish = np.empty_like(begins)
+        finish[:-1] = begins[1:]
+        finish[last, :width] = ends
+        finish[last, width] = begins[last, width]
+        return Section(begins, finish, rapid[move], np.array(self.lines)[move], self.feeds, self.inverse_time,
+                       action, first_line)  # fmt: skip
 
 
 class _Arcs:
