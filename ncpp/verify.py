@@ -867,14 +867,20 @@ Segments = tuple[np.ndarray, np.ndarray]
 
 def _first_of_each(starts: np.ndarray, ends: np.ndarray) -> np.ndarray:
     """The indices of the segments not equal to one before them, in order.  (Equal segments are
-    found next to one another when sorted by a mix of their coordinates, which equal ones share.)"""
-    rows = np.hstack((starts, ends))
-    key = rows @ np.linspace(1.0, 1.0 + 1 / np.e, rows.shape[1])
+    found next to one another when sorted by a mix of their coordinates, which equal ones share:
+    weights of no simple ratio, so that other segments of a program's grid seldom share it.)"""
+    columns = (*starts.T, *ends.T)
+    key = np.zeros(len(starts))
+    for column, weight in zip(columns, np.random.default_rng(0).uniform(1.0, 2.0, len(columns))):
+        key += column * weight  # (a column at a time: a matrix product may round equal rows apart)
     order = np.argsort(key, kind="stable")
-    ordered = rows[order]
-    new = np.ones(len(rows), dtype=bool)
-    new[1:] = np.any(ordered[1:] != ordered[:-1], axis=1)
-    return np.sort(order[new])
+    ordered = key[order]
+    same = np.flatnonzero(ordered[1:] == ordered[:-1]) + 1  # (only these may be equal segments)
+    one, other = order[same], order[same - 1]
+    equal = np.all(starts[one] == starts[other], axis=1) & np.all(ends[one] == ends[other], axis=1)
+    first = np.ones(len(key), dtype=bool)
+    first[one[equal]] = False
+    return np.flatnonzero(first)
 
 
 def _alike(one: Segments, other: Segments) -> tuple[Segments, Segments]:
@@ -898,8 +904,9 @@ def _widened(points: np.ndarray, width: int) -> np.ndarray:
 
 def _lengths(starts: np.ndarray, ends: np.ndarray) -> np.ndarray:
     """The segments' lengths; inf for one too long to hold (a program's numbers may be huge)."""
+    d = ends - starts
     with np.errstate(over="ignore", invalid="ignore"):
-        return np.sqrt(((ends - starts) ** 2).sum(axis=1))
+        return np.sqrt(np.einsum("nw,nw->n", d, d))
 
 
 class _Nearby:
@@ -924,6 +931,8 @@ class _Nearby:
         t = (np.arange(len(self.segment)) - first[self.segment] + 0.5) / counts[self.segment]
         points = starts[self.segment] + t[:, None] * (ends - starts)[self.segment]
         self.tree = cKDTree(points, balanced_tree=False, compact_nodes=False)  # (built faster, as fast)
+        self.joined = np.zeros(len(starts), dtype=bool)  # each segment's end the next one's start
+        self.joined[:-1] = np.all(ends[:-1] == starts[1:], axis=1)
         self.looked_at = 0
 
     def distances(self, points: np.ndarray, within: float, k: int) -> tuple[np.ndarray, np.ndarray]:
@@ -982,44 +991,44 @@ class _Nearby:
         far = self._first_outside(starts[rest], ends[rest], within)
         return None if far is None else (int(rest[far[0]]), far[1])
 
-    # Ways a segment is proven along the path near its start (`_along_the_nearest`), most
-    # frequent first: the segments its start and its end lie near, counted from q
-    WAYS = ((0, 0), (0, 1), (0, 2), (0, 3), (-1, -1), (1, 1))
+    FOLLOWING = 3  # segments after q a segment's end is looked for near (`_along_the_nearest`)
 
     def _along_the_nearest(self, starts: np.ndarray, ends: np.ndarray, within: float) -> np.ndarray:
         """Which segments lie within `within` of the path here, proven from their ends: the start
-        near segment q+i (q: the one whose lookup point is nearest the start), the end near q+j
-        (j >= i), the segments from q+i to q+j joined end to start.  A point of such a segment lies
-        no further than its ends do from the line between their closest points on the path, and a
-        point of that line no further from the path than the vertices between lie from the line
-        (the path runs from one end of the line to the other).  Each way of `WAYS` is tried only on
-        the segments the ways before left unproven."""
+        near segment q (the one whose lookup point is nearest the start), the end near q+j (0 <= j
+        <= `FOLLOWING`), the segments from q to q+j joined end to start; or both ends near q-1, or
+        both near q+1.  A point of such a segment lies no further than its ends do from the line
+        between their closest points on the path, and a point of that line no further from the path
+        than the vertices between lie from the line (the path runs from one end of the line to the
+        other).  Each way is tried only on the segments the ways before left unproven, most
+        frequent first."""
         _, found = self.tree.query(starts, k=1, distance_upper_bound=within + self.reach)
         proven = np.zeros(len(starts), dtype=bool)
         rest = np.flatnonzero(found < len(self.segment))
-        nearest = self.segment[found[rest]]
+        q = self.segment[found[rest]]
         last = len(self.starts) - 1
-        for first, second in self.WAYS:
-            q, after = nearest + first, nearest + second
-            usable = (q >= 0) & (after <= last)
-            near, at_start = _to_lines(starts[rest], *self._segments(q))
-            far, at_end = _to_lines(ends[rest], *self._segments(after))
+        near, at_start = _to_lines(starts[rest], self.starts[q], self.ends[q])
+        chained = np.ones(len(rest), dtype=bool)  # the segments from q to q+j joined end to start
+        for j in range(self.FOLLOWING + 1):
+            after = np.minimum(q + j, last)
+            if j:
+                chained &= (q + j <= last) & self.joined[after - 1]
+            far, at_end = _to_lines(ends[rest], self.starts[after], self.ends[after])
             cut = np.zeros(len(rest))
-            for between in range(first, second):
-                vertex = self._segments(nearest + between)[1]
-                usable &= np.all(vertex == self._segments(nearest + between + 1)[0], axis=1)
+            for between in range(j):
+                vertex = self.ends[np.minimum(q + between, last)]
                 cut = np.maximum(cut, _to_lines(vertex, at_start, at_end)[0])
-            ok = usable & (np.maximum(near, far) + cut <= within)
+            ok = chained & (np.maximum(near, far) + cut <= within)
             proven[rest[ok]] = True
-            rest, nearest = rest[~ok], nearest[~ok]
-            if not len(rest):
-                break
+            rest, q, near, at_start, chained = rest[~ok], q[~ok], near[~ok], at_start[~ok], chained[~ok]
+        for side in (-1, 1):
+            which = np.clip(q + side, 0, last)
+            near, _ = _to_lines(starts[rest], self.starts[which], self.ends[which])
+            far, _ = _to_lines(ends[rest], self.starts[which], self.ends[which])
+            ok = (q + side >= 0) & (q + side <= last) & (np.maximum(near, far) <= within)
+            proven[rest[ok]] = True
+            rest, q = rest[~ok], q[~ok]
         return proven
-
-    def _segments(self, which: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The starts and ends of segments `which` (clipped to those there are)."""
-        which = np.clip(which, 0, len(self.starts) - 1)
-        return self.starts[which], self.ends[which]
 
     def _first_outside(
         self, starts: np.ndarray, ends: np.ndarray, within: float
