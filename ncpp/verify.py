@@ -144,9 +144,10 @@ class _Moves:
             )
         raw = np.array(self.points, dtype=float).reshape(-1, 2, 3)  # (move, its start and end, X Y Z)
         firsts = [first for first, _ in self.frames]
-        frame = np.repeat(np.arange(len(firsts)), np.diff(firsts + [len(raw)]))
-        offsets = np.array([f.offset for _, f in self.frames])[frame]
-        units = np.array([f.unit_mm for _, f in self.frames])[frame][:, None]
+        spans = np.diff(firsts + [len(raw)])  # each context's moves
+        # (np.repeat, not indexing: numpy's indexing by an array of rows is many times slower)
+        offsets = np.repeat([f.offset for _, f in self.frames], spans, axis=0)
+        units = np.repeat([f.unit_mm for _, f in self.frames], spans)[:, None]
         raw += offsets[:, None]
         raw *= units[:, None]
         starts, ends = raw[:, 0], raw[:, 1]
@@ -159,7 +160,7 @@ class _Moves:
         counts = np.ones(len(starts), dtype=np.int64)
         arcs = None
         if self.arcs:
-            axes = np.array([PLANE_AXES[f.plane][:2] for _, f in self.frames], dtype=np.int64)[frame]
+            axes = np.repeat([PLANE_AXES[f.plane][:2] for _, f in self.frames], spans, axis=0)
             arcs = _Arcs(self.arcs, self.centres, axes, starts, ends, offsets, units)
         if arcs is not None:
             counts[arcs.move] = arcs.chords(self.bound.chord)
@@ -182,7 +183,8 @@ class _Moves:
             begins[:, :width] = starts
         else:
             t = (np.arange(len(move)) - (last + 1 - counts)[move]) / counts[move]
-            begins[:, :width] = starts[move] + t[:, None] * (ends - starts)[move]
+            along = t[:, None] * np.repeat(ends - starts, counts, axis=0)
+            begins[:, :width] = np.repeat(starts, counts, axis=0) + along
             arcs.bend(begins, move, t)
         rapid = np.zeros(len(counts), dtype=bool)
         rapid[self.rapids] = True
@@ -929,7 +931,7 @@ class _Nearby:
         self.segment = np.repeat(np.arange(len(counts)), counts)
         first = np.concatenate(([0], np.cumsum(counts)[:-1]))
         t = (np.arange(len(self.segment)) - first[self.segment] + 0.5) / counts[self.segment]
-        points = starts[self.segment] + t[:, None] * (ends - starts)[self.segment]
+        points = np.repeat(starts, counts, axis=0) + t[:, None] * np.repeat(ends - starts, counts, axis=0)
         self.tree = cKDTree(points, balanced_tree=False, compact_nodes=False)  # (built faster, as fast)
         self.joined = np.zeros(len(starts), dtype=bool)  # each segment's end the next one's start
         self.joined[:-1] = np.all(ends[:-1] == starts[1:], axis=1)
@@ -947,7 +949,7 @@ class _Nearby:
         found = found.reshape(len(points), k)
         missing = found >= len(self.segment)
         segments = np.where(missing, -1, self.segment[np.minimum(found, len(self.segment) - 1)])
-        distance, closest = _to_segments(points, self.starts[segments], self.ends[segments])
+        distance, closest = _to_segments(points, *self._segments(segments))
         distance[missing] = np.inf
         return segments, distance, closest
 
@@ -1007,28 +1009,35 @@ class _Nearby:
         rest = np.flatnonzero(found < len(self.segment))
         q = self.segment[found[rest]]
         last = len(self.starts) - 1
-        near, at_start = _to_lines(starts[rest], self.starts[q], self.ends[q])
+        near, at_start = _to_lines(starts.take(rest, axis=0), *self._segments(q))
         chained = np.ones(len(rest), dtype=bool)  # the segments from q to q+j joined end to start
         for j in range(self.FOLLOWING + 1):
             after = np.minimum(q + j, last)
             if j:
                 chained &= (q + j <= last) & self.joined[after - 1]
-            far, at_end = _to_lines(ends[rest], self.starts[after], self.ends[after])
+            far, at_end = _to_lines(ends.take(rest, axis=0), *self._segments(after))
             cut = np.zeros(len(rest))
             for between in range(j):
-                vertex = self.ends[np.minimum(q + between, last)]
+                vertex = self.ends.take(np.minimum(q + between, last), axis=0)
                 cut = np.maximum(cut, _to_lines(vertex, at_start, at_end)[0])
             ok = chained & (np.maximum(near, far) + cut <= within)
             proven[rest[ok]] = True
-            rest, q, near, at_start, chained = rest[~ok], q[~ok], near[~ok], at_start[~ok], chained[~ok]
+            left = np.flatnonzero(~ok)
+            rest, q, near, chained = rest[left], q[left], near[left], chained[left]
+            at_start = at_start.take(left, axis=0)
         for side in (-1, 1):
             which = np.clip(q + side, 0, last)
-            near, _ = _to_lines(starts[rest], self.starts[which], self.ends[which])
-            far, _ = _to_lines(ends[rest], self.starts[which], self.ends[which])
+            near, _ = _to_lines(starts.take(rest, axis=0), *self._segments(which))
+            far, _ = _to_lines(ends.take(rest, axis=0), *self._segments(which))
             ok = (q + side >= 0) & (q + side <= last) & (np.maximum(near, far) <= within)
             proven[rest[ok]] = True
             rest, q = rest[~ok], q[~ok]
         return proven
+
+    def _segments(self, which: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The starts and ends of segments `which` (-1: the last).  (`take`: numpy's indexing by an
+        array of rows is many times slower.)"""
+        return self.starts.take(which, axis=0), self.ends.take(which, axis=0)
 
     def _first_outside(
         self, starts: np.ndarray, ends: np.ndarray, within: float
@@ -1049,8 +1058,8 @@ class _Nearby:
         near = distance <= within
         # a segment near one end, near the other too (looked at from both ends: segments lying
         # over one another, as a peck's, crowd the nearest points of either)
-        ends_to_start, _ = _to_segments(ends, self.starts[segments[:n]], self.ends[segments[:n]])
-        starts_to_end, _ = _to_segments(starts, self.starts[segments[n:]], self.ends[segments[n:]])
+        ends_to_start, _ = _to_segments(ends, *self._segments(segments[:n]))
+        starts_to_end, _ = _to_segments(starts, *self._segments(segments[n:]))
         common = (near[:n] & (segments[:n] >= 0) & (ends_to_start <= within)).any(axis=1)
         common |= (near[n:] & (segments[n:] >= 0) & (starts_to_end <= within)).any(axis=1)
         rest = np.flatnonzero(~common)
