@@ -42,6 +42,7 @@ import math
 import re
 from collections import deque
 from collections.abc import Callable, Iterable, Iterator
+from itertools import islice
 from dataclasses import dataclass, field, replace
 from functools import lru_cache
 from typing import BinaryIO
@@ -602,6 +603,10 @@ class _Feed:
     """Written lines as the parser reads them (bytes), each remembered with the input line the
     writer had reached when it handed the line out (its tag), until the lines are handed on."""
 
+    # Lines taken from the writer at a time, each tagged as it comes: the writer and the parser
+    # each run over many lines in turn, faster than taking turns a line at a time
+    AHEAD = 256
+
     def __init__(self, lines: Iterable[str], reached: Callable[[], tuple[int, int, int]]):
         self.lines = iter(lines)
         self.reached = reached
@@ -609,27 +614,32 @@ class _Feed:
         # (first written line of the texts handed out at one `reached()`, their tag, the line
         # before, the input blocks run so far): `reached()` is the same object until it changes
         self.tags: deque[tuple[int, int, int, int]] = deque()
-        self.count = 0  # written lines read so far
-        self.recent: deque[tuple[int, str]] = deque(maxlen=64)  # for messages
+        self.count = 0  # written lines taken so far
+        self.recent: deque[tuple[int, str]] = deque(maxlen=self.AHEAD + 64)  # for messages
+        self.fault: NcppError | None = None  # the writer's, where it stopped
 
     def __iter__(self) -> Iterator[bytes]:
-        lines = iter(self.lines)
         last = None
         while True:
+            taken = len(self.pending)
             try:
-                text = next(lines)
-            except StopIteration:
+                for text in islice(self.lines, self.AHEAD):
+                    reached = self.reached()
+                    if reached is not last:
+                        last = reached
+                        self.tags.append((self.count + 1, *reached))
+                    self.pending.append(text)
+                    self.count += text.count("\n") or 1
+                    self.recent.append((self.count, text))
+            except NcppError as err:  # (the lines before it are read first)
+                self.fault = err
+            batch = self.pending[taken:]
+            for text in batch:
+                yield text.encode("latin-1")
+            if self.fault is not None:
+                raise _Upstream(self.fault) from None
+            if len(batch) < self.AHEAD:
                 return
-            except NcppError as err:
-                raise _Upstream(err) from None
-            reached = self.reached()
-            if reached is not last:
-                last = reached
-                self.tags.append((self.count + 1, *reached))
-            self.pending.append(text)
-            self.count += text.count("\n") or 1
-            self.recent.append((self.count, text))
-            yield text.encode("latin-1")
 
     def tag(self, number: int, before: bool = False) -> int:
         """The tag of written line `number` (asked in increasing order): the input line the
@@ -651,7 +661,9 @@ class _Feed:
 
     def rest(self) -> Iterator[str]:
         """Lines after the parser's last (after the program's end: it reads no further)."""
-        return self.lines
+        yield from self.lines
+        if self.fault is not None:
+            raise self.fault
 
     def text(self, number: int | None) -> tuple[str, int]:
         """Written line `number` (one of the last read) and its tag."""
