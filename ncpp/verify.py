@@ -42,9 +42,9 @@ import math
 import re
 from collections import deque
 from collections.abc import Callable, Iterable, Iterator
-from itertools import islice
 from dataclasses import dataclass, field, replace
 from functools import lru_cache
+from itertools import islice
 from typing import BinaryIO
 
 import numpy as np
