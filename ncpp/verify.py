@@ -44,6 +44,7 @@ from collections import deque
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field, replace
 from functools import lru_cache
+from itertools import islice
 from typing import BinaryIO
 
 import numpy as np
@@ -105,17 +106,18 @@ NO_EXTRA = (0.0,) * len(EXTRA_AXES)
 
 @dataclass
 class _Moves:
-    """Moves collected for one section, sampled when it closes."""
+    """Moves collected for one section, sampled when it closes (in flat lists: a move's own work
+    is a few appends, and one array is made of each list)."""
 
     bound: Bound
-    ends: list = field(default_factory=list)  # per move: (x0, y0, z0, x1, y1, z1) program coordinates
-    frames: list = field(default_factory=list)  # the contexts the moves were made in, each once in a row
-    frame_of: list = field(default_factory=list)  # per move: its context's index in `frames`
+    points: list = field(default_factory=list)  # per move x0 y0 z0 x1 y1 z1, program coordinates
+    lines: list = field(default_factory=list)  # per move the line its samples are told by
+    frames: list = field(default_factory=list)  # (first move, context) where the context changes
     frame: object = None  # the last context
     extra: dict = field(default_factory=dict)  # move -> its extra axes' start and end, where any is not 0
-    rapid: list = field(default_factory=list)
-    lines: list = field(default_factory=list)
-    arcs: list = field(default_factory=list)  # (move, plane, centre (program coordinates), turn)
+    rapids: list = field(default_factory=list)  # the moves that are rapids
+    arcs: list = field(default_factory=list)  # per arc: its move and its turn
+    centres: list = field(default_factory=list)  # per arc its centre's x y z, program coordinates
     feeds: list = field(default_factory=list)
     feed: float = math.nan  # the last feed move's F and units (a new one is looked at)
     feed_inch: bool = False
@@ -129,7 +131,7 @@ class _Moves:
 
     def sample(self, action: Action | None, first_line: int) -> Section:
         """The moves sampled every `step` (each from its start to its end, both included)."""
-        if not self.ends:
+        if not self.lines:
             empty = np.zeros((0, 4))
             return Section(
                 empty,
@@ -141,11 +143,15 @@ class _Moves:
                 action,
                 first_line,
             )
-        raw = np.array(self.ends)
-        frame = np.array(self.frame_of)
-        offsets = np.array([f.offset for f in self.frames])[frame]
-        units = np.array([f.unit_mm for f in self.frames])[frame][:, None]
-        starts, ends = (raw[:, :3] + offsets) * units, (raw[:, 3:] + offsets) * units
+        raw = np.array(self.points, dtype=float).reshape(-1, 2, 3)  # (move, its start and end, X Y Z)
+        firsts = [first for first, _ in self.frames]
+        spans = np.diff(firsts + [len(raw)])  # each context's moves
+        # (np.repeat, not indexing: numpy's indexing by an array of rows is many times slower)
+        offsets = np.repeat([f.offset for _, f in self.frames], spans, axis=0)
+        units = np.repeat([f.unit_mm for _, f in self.frames], spans)[:, None]
+        raw += offsets[:, None]
+        raw *= units[:, None]
+        starts, ends = raw[:, 0], raw[:, 1]
         if self.extra:
             extra = np.zeros((len(raw), 2 * len(EXTRA_AXES)))
             for k, (s, e) in self.extra.items():
@@ -153,7 +159,10 @@ class _Moves:
             starts = np.hstack((starts, extra[:, : len(EXTRA_AXES)]))
             ends = np.hstack((ends, extra[:, len(EXTRA_AXES) :]))
         counts = np.ones(len(starts), dtype=np.int64)
-        arcs = _Arcs(self.arcs, starts, ends, offsets, units) if self.arcs else None
+        arcs = None
+        if self.arcs:
+            axes = np.repeat([PLANE_AXES[f.plane][:2] for _, f in self.frames], spans, axis=0)
+            arcs = _Arcs(self.arcs, self.centres, axes, starts, ends, offsets, units)
         if arcs is not None:
             counts[arcs.move] = arcs.chords(self.bound.chord)
             # (the section's samples are held at once; a move's chords are rounded up, so the pieces a
@@ -165,43 +174,47 @@ class _Moves:
                     f"than ncpp verifies at once ({MAX_CHORDS:,}): split it, or give a wider --tolerance",
                     Location("", self.lines[k], 1),
                 )
-        move = np.repeat(np.arange(len(counts)), counts + 1)
-        first = np.concatenate(([0], np.cumsum(counts + 1)[:-1]))
-        t = (np.arange(len(move)) - first[move]) / counts[move]
+        # each segment starts at its piece's start (t from 0 on) and ends where the next starts, but a
+        # move's last, which ends at the move's end
+        move = np.repeat(np.arange(len(counts)), counts)  # each segment's move
+        last = np.cumsum(counts) - 1  # each move's last segment
         width = starts.shape[1]
-        points = np.empty((len(move), width + 1))
-        points[:, :width] = starts[move] + t[:, None] * (ends - starts)[move]
-        if arcs is not None:
-            arcs.bend(points, move, t)
-        rapid = np.array(self.rapid)
-        points[:, width] = rapid[move] * self.bound.apart
-        begins = np.ones(len(move), dtype=bool)  # each point but a move's last begins a segment
-        begins[first + counts] = False
-        segment = np.flatnonzero(begins)
-        kept = move[segment]
-        return Section(points[segment], points[segment + 1], rapid[kept], np.array(self.lines)[kept], self.feeds,
-                       self.inverse_time, action, first_line)  # fmt: skip
+        begins = np.empty((len(move), width + 1))
+        if arcs is None:  # (a segment a move)
+            begins[:, :width] = starts
+        else:
+            t = (np.arange(len(move)) - (last + 1 - counts)[move]) / counts[move]
+            along = t[:, None] * np.repeat(ends - starts, counts, axis=0)
+            begins[:, :width] = np.repeat(starts, counts, axis=0) + along
+            arcs.bend(begins, move, t)
+        rapid = np.zeros(len(counts), dtype=bool)
+        rapid[self.rapids] = True
+        begins[:, width] = rapid[move] * self.bound.apart
+        finish = np.empty_like(begins)
+        finish[:-1] = begins[1:]
+        finish[last, :width] = ends
+        finish[last, width] = begins[last, width]
+        return Section(begins, finish, rapid[move], np.array(self.lines)[move], self.feeds, self.inverse_time,
+                       action, first_line)  # fmt: skip
 
 
 class _Arcs:
     """A section's arcs, as arrays: what their samples need to lie on them."""
 
-    def __init__(
-        self, arcs: list, starts: np.ndarray, ends: np.ndarray, offsets: np.ndarray, units: np.ndarray
-    ):
-        table = np.array([(m, *PLANE_AXES[plane][:2], *centre, turn) for m, plane, centre, turn in arcs])
-        self.move = table[:, 0].astype(np.int64)
-        i, j = table[:, 1].astype(np.int64), table[:, 2].astype(np.int64)
-        centre = (table[:, 3:6] + offsets[self.move]) * units[self.move]  # machine mm
-        rows = np.arange(len(table))
-        self.i, self.j, self.ci, self.cj = i, j, centre[rows, i], centre[rows, j]
-        table = np.column_stack((table[:, :3], table[:, 6]))  # (move, i, j, turn)
-        rows = self.move
+    def __init__(self, arcs: list, centres: list, axes: np.ndarray, starts: np.ndarray, ends: np.ndarray,
+                 offsets: np.ndarray, units: np.ndarray):  # fmt: skip
+        """`arcs`, `centres`: `_Moves`'; `axes` (the two of the plane), `offsets`, `units`: per move."""
+        table = np.array(arcs, dtype=np.int64).reshape(-1, 2)  # (move, turn)
+        self.move = rows = table[:, 0]
+        i, j = axes[rows].T
+        centre = (np.array(centres).reshape(-1, 3) + offsets[rows]) * units[rows]  # machine mm
+        at = np.arange(len(rows))
+        self.i, self.j, self.ci, self.cj = i, j, centre[at, i], centre[at, j]
         s_i, s_j = starts[rows, i] - self.ci, starts[rows, j] - self.cj
         e_i, e_j = ends[rows, i] - self.ci, ends[rows, j] - self.cj
         self.a0 = np.arctan2(s_j, s_i)
         self.r0, self.r1 = np.hypot(s_i, s_j), np.hypot(e_i, e_j)
-        self.sweep = _sweeps(self.a0, np.arctan2(e_j, e_i), table[:, 3])
+        self.sweep = _sweeps(self.a0, np.arctan2(e_j, e_i), table[:, 1])
 
     def chords(self, within: float) -> np.ndarray:
         """How many chords each arc takes for none to lie further than `within` from it."""
@@ -291,7 +304,7 @@ def sections(events: Iterable[Event], bound: Bound, cut: Cut = lambda block, mov
             last = block
             run += 1
             into = 0 if divisible is not None and divisible(event) else -1
-            if moves.ends and (at := cut(block, len(moves.ends), run, 0)):
+            if moves.lines and (at := cut(block, len(moves.lines), run, 0)):
                 yield moves.chunk(at, first_line)
                 moves, first_line = _Moves(bound), block.line
             if not (kind is Pass and event.skipped) and _may_act(block.signature):  # type: ignore[union-attr]
@@ -302,7 +315,7 @@ def sections(events: Iterable[Event], bound: Bound, cut: Cut = lambda block, mov
                     moves, first_line = _Moves(bound), block.line
         if kind is Line or kind is Arc:
             if into >= 0:
-                if into and into % CHUNK_MOVES == 0 and (at := cut(block, len(moves.ends), run, into)):
+                if into and into % CHUNK_MOVES == 0 and (at := cut(block, len(moves.lines), run, into)):
                     yield moves.chunk(at, first_line)
                     moves, first_line = _Moves(bound), block.line
                 into += 1
@@ -333,24 +346,29 @@ def _add(
     """Add a move (told by `line`); return the extra axes' positions after it.  (A move's own
     work is a few appends: the numbers are turned to machine mm a section at a time.)"""
     ctx = event.context
+    n = len(moves.lines)  # the move's index
     if ctx is not moves.frame:
         moves.frame = ctx
-        moves.frames.append(ctx)
-    moves.frame_of.append(len(moves.frames) - 1)
-    moves.ends.append(event.start + event.end)
+        moves.frames.append((n, ctx))
+    moves.points += event.start
+    moves.points += event.end
+    moves.lines.append(line)
     if event.extra:
         end_extra = (tuple(event.extra) + NO_EXTRA)[: len(EXTRA_AXES)]
-        moves.extra[len(moves.ends) - 1] = (extra, end_extra)
+        moves.extra[n] = (extra, end_extra)
     elif extra is not NO_EXTRA:
-        moves.extra[len(moves.ends) - 1] = (extra, extra)
+        moves.extra[n] = (extra, extra)
         end_extra = extra
     else:
         end_extra = extra
-    rapid = type(event) is Line and event.rapid
-    moves.rapid.append(rapid)
-    moves.lines.append(line)
     if type(event) is Arc:
-        moves.arcs.append((len(moves.ends) - 1, ctx.plane, event.center, event.turn))
+        rapid = False
+        moves.arcs += (n, event.turn)
+        moves.centres += event.center
+    else:
+        rapid = event.rapid
+        if rapid:
+            moves.rapids.append(n)
     if not rapid:
         if inverse_time:
             moves.inverse_time += 1.0 / event.feed if event.feed > 0 else math.inf
@@ -585,6 +603,10 @@ class _Feed:
     """Written lines as the parser reads them (bytes), each remembered with the input line the
     writer had reached when it handed the line out (its tag), until the lines are handed on."""
 
+    # Lines taken from the writer at a time, each tagged as it comes: the writer and the parser
+    # each run over many lines in turn, faster than taking turns a line at a time
+    AHEAD = 256
+
     def __init__(self, lines: Iterable[str], reached: Callable[[], tuple[int, int, int]]):
         self.lines = iter(lines)
         self.reached = reached
@@ -592,27 +614,32 @@ class _Feed:
         # (first written line of the texts handed out at one `reached()`, their tag, the line
         # before, the input blocks run so far): `reached()` is the same object until it changes
         self.tags: deque[tuple[int, int, int, int]] = deque()
-        self.count = 0  # written lines read so far
-        self.recent: deque[tuple[int, str]] = deque(maxlen=64)  # for messages
+        self.count = 0  # written lines taken so far
+        self.recent: deque[tuple[int, str]] = deque(maxlen=self.AHEAD + 64)  # for messages
+        self.fault: NcppError | None = None  # the writer's, where it stopped
 
     def __iter__(self) -> Iterator[bytes]:
-        lines = iter(self.lines)
         last = None
         while True:
+            taken = len(self.pending)
             try:
-                text = next(lines)
-            except StopIteration:
+                for text in islice(self.lines, self.AHEAD):
+                    reached = self.reached()
+                    if reached is not last:
+                        last = reached
+                        self.tags.append((self.count + 1, *reached))
+                    self.pending.append(text)
+                    self.count += text.count("\n") or 1
+                    self.recent.append((self.count, text))
+            except NcppError as err:  # (the lines before it are read first)
+                self.fault = err
+            batch = self.pending[taken:]
+            for text in batch:
+                yield text.encode("latin-1")
+            if self.fault is not None:
+                raise _Upstream(self.fault) from None
+            if len(batch) < self.AHEAD:
                 return
-            except NcppError as err:
-                raise _Upstream(err) from None
-            reached = self.reached()
-            if reached is not last:
-                last = reached
-                self.tags.append((self.count + 1, *reached))
-            self.pending.append(text)
-            self.count += text.count("\n") or 1
-            self.recent.append((self.count, text))
-            yield text.encode("latin-1")
 
     def tag(self, number: int, before: bool = False) -> int:
         """The tag of written line `number` (asked in increasing order): the input line the
@@ -634,7 +661,9 @@ class _Feed:
 
     def rest(self) -> Iterator[str]:
         """Lines after the parser's last (after the program's end: it reads no further)."""
-        return self.lines
+        yield from self.lines
+        if self.fault is not None:
+            raise self.fault
 
     def text(self, number: int | None) -> tuple[str, int]:
         """Written line `number` (one of the last read) and its tag."""
@@ -852,14 +881,20 @@ Segments = tuple[np.ndarray, np.ndarray]
 
 def _first_of_each(starts: np.ndarray, ends: np.ndarray) -> np.ndarray:
     """The indices of the segments not equal to one before them, in order.  (Equal segments are
-    found next to one another when sorted by a mix of their coordinates, which equal ones share.)"""
-    rows = np.hstack((starts, ends))
-    key = rows @ np.linspace(1.0, 1.0 + 1 / np.e, rows.shape[1])
+    found next to one another when sorted by a mix of their coordinates, which equal ones share:
+    weights of no simple ratio, so that other segments of a program's grid seldom share it.)"""
+    columns = (*starts.T, *ends.T)
+    key = np.zeros(len(starts))
+    for column, weight in zip(columns, np.random.default_rng(0).uniform(1.0, 2.0, len(columns))):
+        key += column * weight  # (a column at a time: a matrix product may round equal rows apart)
     order = np.argsort(key, kind="stable")
-    ordered = rows[order]
-    new = np.ones(len(rows), dtype=bool)
-    new[1:] = np.any(ordered[1:] != ordered[:-1], axis=1)
-    return np.sort(order[new])
+    ordered = key[order]
+    same = np.flatnonzero(ordered[1:] == ordered[:-1]) + 1  # (only these may be equal segments)
+    one, other = order[same], order[same - 1]
+    equal = np.all(starts[one] == starts[other], axis=1) & np.all(ends[one] == ends[other], axis=1)
+    first = np.ones(len(key), dtype=bool)
+    first[one[equal]] = False
+    return np.flatnonzero(first)
 
 
 def _alike(one: Segments, other: Segments) -> tuple[Segments, Segments]:
@@ -883,8 +918,9 @@ def _widened(points: np.ndarray, width: int) -> np.ndarray:
 
 def _lengths(starts: np.ndarray, ends: np.ndarray) -> np.ndarray:
     """The segments' lengths; inf for one too long to hold (a program's numbers may be huge)."""
+    d = ends - starts
     with np.errstate(over="ignore", invalid="ignore"):
-        return np.sqrt(((ends - starts) ** 2).sum(axis=1))
+        return np.sqrt(np.einsum("nw,nw->n", d, d))
 
 
 class _Nearby:
@@ -907,8 +943,10 @@ class _Nearby:
         self.segment = np.repeat(np.arange(len(counts)), counts)
         first = np.concatenate(([0], np.cumsum(counts)[:-1]))
         t = (np.arange(len(self.segment)) - first[self.segment] + 0.5) / counts[self.segment]
-        points = starts[self.segment] + t[:, None] * (ends - starts)[self.segment]
+        points = np.repeat(starts, counts, axis=0) + t[:, None] * np.repeat(ends - starts, counts, axis=0)
         self.tree = cKDTree(points, balanced_tree=False, compact_nodes=False)  # (built faster, as fast)
+        self.joined = np.zeros(len(starts), dtype=bool)  # each segment's end the next one's start
+        self.joined[:-1] = np.all(ends[:-1] == starts[1:], axis=1)
         self.looked_at = 0
 
     def distances(self, points: np.ndarray, within: float, k: int) -> tuple[np.ndarray, np.ndarray]:
@@ -923,7 +961,7 @@ class _Nearby:
         found = found.reshape(len(points), k)
         missing = found >= len(self.segment)
         segments = np.where(missing, -1, self.segment[np.minimum(found, len(self.segment) - 1)])
-        distance, closest = _to_segments(points, self.starts[segments], self.ends[segments])
+        distance, closest = _to_segments(points, *self._segments(segments))
         distance[missing] = np.inf
         return segments, distance, closest
 
@@ -967,44 +1005,51 @@ class _Nearby:
         far = self._first_outside(starts[rest], ends[rest], within)
         return None if far is None else (int(rest[far[0]]), far[1])
 
-    # Ways a segment is proven along the path near its start (`_along_the_nearest`), most
-    # frequent first: the segments its start and its end lie near, counted from q
-    WAYS = ((0, 0), (0, 1), (0, 2), (0, 3), (-1, -1), (1, 1))
+    FOLLOWING = 3  # segments after q a segment's end is looked for near (`_along_the_nearest`)
 
     def _along_the_nearest(self, starts: np.ndarray, ends: np.ndarray, within: float) -> np.ndarray:
         """Which segments lie within `within` of the path here, proven from their ends: the start
-        near segment q+i (q: the one whose lookup point is nearest the start), the end near q+j
-        (j >= i), the segments from q+i to q+j joined end to start.  A point of such a segment lies
-        no further than its ends do from the line between their closest points on the path, and a
-        point of that line no further from the path than the vertices between lie from the line
-        (the path runs from one end of the line to the other).  Each way of `WAYS` is tried only on
-        the segments the ways before left unproven."""
+        near segment q (the one whose lookup point is nearest the start), the end near q+j (0 <= j
+        <= `FOLLOWING`), the segments from q to q+j joined end to start; or both ends near q-1, or
+        both near q+1.  A point of such a segment lies no further than its ends do from the line
+        between their closest points on the path, and a point of that line no further from the path
+        than the vertices between lie from the line (the path runs from one end of the line to the
+        other).  Each way is tried only on the segments the ways before left unproven, most
+        frequent first."""
         _, found = self.tree.query(starts, k=1, distance_upper_bound=within + self.reach)
         proven = np.zeros(len(starts), dtype=bool)
         rest = np.flatnonzero(found < len(self.segment))
-        nearest = self.segment[found[rest]]
+        q = self.segment[found[rest]]
         last = len(self.starts) - 1
-        for first, second in self.WAYS:
-            q, after = nearest + first, nearest + second
-            usable = (q >= 0) & (after <= last)
-            near, at_start = _to_lines(starts[rest], *self._segments(q))
-            far, at_end = _to_lines(ends[rest], *self._segments(after))
+        near, at_start = _to_lines(starts.take(rest, axis=0), *self._segments(q))
+        chained = np.ones(len(rest), dtype=bool)  # the segments from q to q+j joined end to start
+        for j in range(self.FOLLOWING + 1):
+            after = np.minimum(q + j, last)
+            if j:
+                chained &= (q + j <= last) & self.joined[after - 1]
+            far, at_end = _to_lines(ends.take(rest, axis=0), *self._segments(after))
             cut = np.zeros(len(rest))
-            for between in range(first, second):
-                vertex = self._segments(nearest + between)[1]
-                usable &= np.all(vertex == self._segments(nearest + between + 1)[0], axis=1)
+            for between in range(j):
+                vertex = self.ends.take(np.minimum(q + between, last), axis=0)
                 cut = np.maximum(cut, _to_lines(vertex, at_start, at_end)[0])
-            ok = usable & (np.maximum(near, far) + cut <= within)
+            ok = chained & (np.maximum(near, far) + cut <= within)
             proven[rest[ok]] = True
-            rest, nearest = rest[~ok], nearest[~ok]
-            if not len(rest):
-                break
+            left = np.flatnonzero(~ok)
+            rest, q, near, chained = rest[left], q[left], near[left], chained[left]
+            at_start = at_start.take(left, axis=0)
+        for side in (-1, 1):
+            which = np.clip(q + side, 0, last)
+            near, _ = _to_lines(starts.take(rest, axis=0), *self._segments(which))
+            far, _ = _to_lines(ends.take(rest, axis=0), *self._segments(which))
+            ok = (q + side >= 0) & (q + side <= last) & (np.maximum(near, far) <= within)
+            proven[rest[ok]] = True
+            rest, q = rest[~ok], q[~ok]
         return proven
 
     def _segments(self, which: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The starts and ends of segments `which` (clipped to those there are)."""
-        which = np.clip(which, 0, len(self.starts) - 1)
-        return self.starts[which], self.ends[which]
+        """The starts and ends of segments `which` (-1: the last).  (`take`: numpy's indexing by an
+        array of rows is many times slower.)"""
+        return self.starts.take(which, axis=0), self.ends.take(which, axis=0)
 
     def _first_outside(
         self, starts: np.ndarray, ends: np.ndarray, within: float
@@ -1025,8 +1070,8 @@ class _Nearby:
         near = distance <= within
         # a segment near one end, near the other too (looked at from both ends: segments lying
         # over one another, as a peck's, crowd the nearest points of either)
-        ends_to_start, _ = _to_segments(ends, self.starts[segments[:n]], self.ends[segments[:n]])
-        starts_to_end, _ = _to_segments(starts, self.starts[segments[n:]], self.ends[segments[n:]])
+        ends_to_start, _ = _to_segments(ends, *self._segments(segments[:n]))
+        starts_to_end, _ = _to_segments(starts, *self._segments(segments[n:]))
         common = (near[:n] & (segments[:n] >= 0) & (ends_to_start <= within)).any(axis=1)
         common |= (near[n:] & (segments[n:] >= 0) & (starts_to_end <= within)).any(axis=1)
         rest = np.flatnonzero(~common)
