@@ -98,6 +98,7 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_cycles_refused_where_rs274_refuses",
             "test_random_cycle_programs_agree_with_rs274",
             "test_rs274_accepts_the_compensated_cycles",
+            "test_rs274_taps_in_g18_and_g19_feed_other_axes",
         ),
         "motion/test_flow.py": (
             "test_flow_moves_as_rs274_does",

@@ -48,6 +48,11 @@ A setting code written with other words in its block is out of scope too: a bloc
 both sets and moves is not one these controls' posts write.  So is G33.1, LinuxCNC's rigid tap:
 these controls tap rigidly with M29 and G84.
 
+A canned cycle drills along the axis normal to its plane, the taps G74 and G84 too: Y in G18, X
+in G19 (Fanuc operator's manuals, "Canned cycle for drilling": "Positioning plane and drilling
+axis", G17 Zp, G18 Yp, G19 Xp; the drilling axis is the basic axis not used to define the
+positioning plane), as rs274ngc drills but does not tap there (`Interpreter.taps_in_any_plane`).
+
 With --expand-cycles, G82's and G89's dwell (Haas: G73's and G83's too) is written as a G04 with
 the cycle's P as the program gave it, where the control reads both alike (`_dwell_word`).  Fanuc: a G04's P takes no decimal
 point and counts 0.001 s, as a drilling cycle's P (SINUMERIK ISO Milling manual, which documents
@@ -86,6 +91,7 @@ class FanucInterpreter(Interpreter):
     rigid_tapping = False  # (Fanuc taps rigidly with M29 and G84: G33.1 is LinuxCNC's)
     modal_d = True  # `G43 H1 D1`: D alone selects the radius offset (module docstring)
     dwell_x = True  # `G04 X1.5`: a dwell of 1.5 s (module docstring)
+    taps_in_any_plane = True  # G74/G84 in G18/G19 tap along the normal (module docstring)
 
     def block(self, block: Block) -> Event | tuple[Event, ...]:
         signature = block.signature

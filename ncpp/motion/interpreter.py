@@ -246,6 +246,10 @@ class Interpreter:
     modal_d = False
     # The motion mode a program starts in (grbl: G0); rs274ngc starts in none
     start_motion: float | None = None
+    # The taps G74/G84 in G18 and G19 feed along the plane's normal (Fanuc); rs274ngc's do not:
+    # its convert_cycle_g74_g84 hands cycle_feed the plane's coordinates already permuted, so the
+    # tap feeds other axes (in G18 X to the Y word, Y to the Z word, Z to the X word)
+    taps_in_any_plane = False
 
     def __init__(self, file: str = "<stdin>", offsets: WorkOffsets | None = None):
         self.file = file
@@ -1556,7 +1560,7 @@ class Interpreter:
         aa, bb, step_a, step_b, r, bottom = self._cycle_geometry(block, words, again, item)
         repeats = self._repeats(block, words)
         peck = self._cycle_word(block, words, motion, again, item)
-        if motion in (74.0, 84.0) and self.plane != 17:  # rs274ngc's taps move other axes there
+        if motion in (74.0, 84.0) and self.plane != 17 and not self.taps_in_any_plane:
             raise _OutOfScope(f"canned cycle G{motion:g} outside the XY plane", item.start + 1)
         if motion in SPINDLE:
             self._check_spindle(block, motion, item)

@@ -16,8 +16,10 @@ import pytest
 
 from ncpp.errors import Location, NcppError, Warnings
 from ncpp.motion import interpret
+from ncpp.motion.fanuc import interpret as interpret_fanuc
 from ncpp.motion.segments import CYCLE, HOLE, Line
 from ncpp.program.parser import parse_stream
+from tests.compensation.accuracy import rs274_calls
 from tests.conftest import RS274
 from tests.motion.compensating import compensate
 from tests.motion.test_oracle import (
@@ -114,6 +116,33 @@ def test_cycles_out_of_scope(name):
         )
     )
     assert f"t.ngc:{line}:" in warned.getvalue() and reason in warned.getvalue(), warned.getvalue()
+
+
+@pytest.mark.parametrize(
+    "plane, block, moves",
+    [(18, "G84 X1 Z2 Y-3 R2", [(1, 5, 2, True), (1, 2, 2, True), (1, -3, 2, False), (1, 2, 2, False)]),
+     (19, "G84 Y1 Z2 X-3 R2", [(5, 1, 2, True), (2, 1, 2, True), (-3, 1, 2, False), (2, 1, 2, False)])],
+    ids=["G18", "G19"],
+)  # fmt: skip
+def test_fanuc_taps_in_g18_and_g19_feed_along_the_planes_normal(plane, block, moves):
+    """Fanuc drills along the axis normal to the plane, and taps so too (G18 Y, G19 X): over the hole
+    at the level it stands at, down to R, a feed to the bottom and one back out to R (G99), as holes
+    compensation corrects; where rs274ngc's taps feed other axes (LinuxCNC's stay out of scope)."""
+    text = f"G21 G90 G{plane}\nG0 X5 Y5 Z5\nM3 S500\nG99 {block} F100\nG80\nM30\n"
+    warned = io.StringIO()
+    events = interpret_fanuc(parse_stream(io.BytesIO(text.encode()), "t.nc"), file="t.nc",
+                             warnings=Warnings(stream=warned))  # fmt: skip
+    holes = [e for e in events if type(e) is Line and e.fixed == HOLE]
+    assert [(*e.end[:3], e.rapid) for e in holes] == moves and not warned.getvalue()
+
+
+def test_rs274_taps_in_g18_and_g19_feed_other_axes(tmp_path):
+    """Why LinuxCNC's taps outside G17 stay out of scope: rs274 feeds a G18 tap over X Y Z to the Y,
+    Z and X words (the bottom on X), and a G19 one to the Z, X and Y words, not along the normal."""
+    text = HEAD + "M3\nG18 G84 X1 Z2 Y-3 R4\nG80\nG19 G84 Y5 Z6 X-7 R8\nG80 G17\n"
+    feeds = [args[:3] for name, args in rs274_calls(write_program(tmp_path, text, "taps.ngc"))
+             if name == "STRAIGHT_FEED"]  # fmt: skip
+    assert feeds == [[-3, 2, 1], [4, 2, 1], [6, -7, 5], [6, 8, 5]]
 
 
 def _random_program(rng: random.Random) -> str:

@@ -8,13 +8,15 @@ from __future__ import annotations
 import os
 import re
 import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from tests.compensation.accuracy import Machine, _moves, actual_moves, rs274_calls
-from tests.conftest import RS274
+from tests.conftest import RS274, SHARED
+from tests.verify.test_corpus_pathcheck import rs274_environment
 from tests.writeback.conftest import compensate_file, linear_errors, machine_file
 
 MACHINE = machine_file(
@@ -279,3 +281,78 @@ def test_a_g92_after_a_compensated_hole_sets_the_programs_offset(tmp_path):
     wanted = np.array([[20, 10, 20], [-5, 40, 3]], dtype=float) + shift
     got = np.array([args[:3] for name, args in rs274_calls(output) if name == "STRAIGHT_FEED"][-2:]) + shift
     assert np.abs(square(got, np.ones(3)) - wanted).max() * 1000 <= 0.5
+
+
+# Taps in G18 and G19 (Fanuc: the drilling axis is the plane's normal for every cycle), G90 and G91
+# with repeats, G98 and G99: the G17 program's holes (X Y Z bottom, R), moved to each plane by `in_plane`
+HOLES_TAPPED = [(100, 120, -16, 3), (30, 40, -16, 3), (150, -50, -20, 5),
+                (170, -45, -2, 8), (190, -40, -2, 8), (210, -35, -2, 8), (200, -5, 23, 29), (190, 25, 23, 29),
+                (-128, -107, -1, 2.5), (-108, -107, -1, 2.5)]  # fmt: skip
+PROGRAM_TAPPED = """G21 G90 G17
+G0 X40 Y30 Z25
+M3 S500
+G99 G84 X100 Y120 R3 Z-16 F100
+X30 Y40
+G98 G84 X150 Y-50 R5 Z-20
+G80
+G0 Z30
+G91 G99 G84 X20 Y5 R-22 Z-10 L3
+G98 X-10 Y30 R-1 Z-6 L2
+G90 G80
+M4
+G0 X-148 Y-107 Z4
+G91 G98 G74 X20 R-1.5 Z-3.5
+X20
+G90 G80
+M5
+M2
+"""
+
+
+def _as_bored(path: Path) -> Path:
+    """`path` with its taps as G89 P0, which rs274ngc moves as a tap along the plane's normal: feed
+    to the bottom, feed back out (LinuxCNC G-code manual, G84 and G89), where rs274ngc's own
+    G74/G84 in G18 and G19 feed other axes (`Interpreter.taps_in_any_plane`)."""
+    bored = path.with_name(path.stem + "-bored" + path.suffix)
+    bored.write_text(re.sub(r"G[78]4(?![.\d])", "G89 P0", path.read_text()))
+    return bored
+
+
+@pytest.mark.parametrize("plane", [18, 19])
+@pytest.mark.parametrize("machine_name", ["scales and squareness", "reversals"])
+def test_fanuc_taps_in_g18_and_g19_land_where_programmed(tmp_path, plane, machine_name):
+    """Each tap's bottom and R point, as rs274 runs the written program (its taps as G89 P0), mapped
+    through the hand-written machine: within 0.5 µm of the programmed point."""
+    program, holes = in_plane(PROGRAM_TAPPED, HOLES_TAPPED, plane)
+    machine_toml, machine = (
+        (MACHINE, square) if machine_name == "scales and squareness" else reversing_in(plane)
+    )
+    original = tmp_path / "taps.nc"
+    original.write_text(program)
+    output = compensate_file(original, machine_toml, tmp_path, dialect="fanuc")
+    assert re.search(r"^G91 G99 G84 ", output.read_text(), re.M)  # still a tap, not moves
+    wanted = np.array(holes, dtype=float)
+    as_programmed = drilled(_as_bored(original), None, plane)
+    assert np.allclose([tuple(b) + (r,) for b, r in as_programmed], wanted, atol=1e-6)
+    before = drilled(_as_bored(original), machine, plane)
+    after = drilled(_as_bored(output), machine, plane)
+    assert len(after) == len(holes)
+    off_before = np.array([np.linalg.norm(b - h[:3]) for (b, _), h in zip(before, wanted)]) * 1000
+    off_after = np.array([np.linalg.norm(b - h[:3]) for (b, _), h in zip(after, wanted)]) * 1000
+    r_after = np.array([abs(r - h[3]) for (_, r), h in zip(after, wanted)]) * 1000
+    assert off_before.min() > 1.5
+    assert off_after.max() <= 0.5, off_after
+    assert r_after.max() <= 0.5, r_after
+    for pair in ((original, output), (_as_bored(original), _as_bored(output))):
+        assert _passes_pathcheck(*pair)
+
+
+def _passes_pathcheck(original: Path, output: Path) -> bool:
+    """pathcheck's verdict on `output` written for `original` (rs274 with a home of its own)."""
+    pathcheck = SHARED / "tools" / "pathcheck"
+    if not pathcheck.exists():
+        pytest.skip(f"pathcheck not found under {SHARED}")
+    check = subprocess.run([sys.executable, str(pathcheck), str(original), str(output)], capture_output=True,
+                           text=True, timeout=600, env=rs274_environment(original.parent))  # fmt: skip
+    assert check.returncode == 0, check.stdout + check.stderr
+    return True
