@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import atexit
 import os
+import shutil
+import tempfile
 from pathlib import Path
 
 import pytest
@@ -286,6 +289,19 @@ def pytest_addoption(parser: pytest.Parser) -> None:
 def pytest_configure(config: pytest.Config) -> None:
     if config.getoption("--all"):
         config.option.markexpr = ""  # overrides the tier selection in pyproject's addopts
+    _home_of_its_own()
+
+
+def _home_of_its_own() -> None:
+    """A $HOME of the test run's own: rs274 keeps its tool data in $HOME/.tool.mmap, which another
+    rs274 running meanwhile (another test run, a user's) rewrites under it (wrong tool offsets, a bus
+    error).  The unpacked rs274 and ncpp's parser cache stay where they are."""
+    real = Path.home()
+    os.environ.setdefault("RS274_HOME", str(real / ".cache" / "ncpp-rs274"))
+    os.environ.setdefault("XDG_CACHE_HOME", str(real / ".cache"))
+    home = Path(tempfile.mkdtemp(prefix="ncpp-tests-home-"))
+    atexit.register(shutil.rmtree, home, ignore_errors=True)
+    os.environ["HOME"] = str(home)
 
 
 def tiers_of(item: pytest.Item) -> set[str]:
