@@ -69,6 +69,9 @@ def test_rs274_accepts_compensated_program(path, machines, tools, tmp_path):
         data += b"\nM2\n"
         (tmp_path / "original.ngc").write_bytes(data)
         before = rs274(tmp_path / "original.ngc", tools)
+    assert before.returncode < 128, (
+        f"rs274 crashed (signal {before.returncode - 128}): {before.stderr[-300:]}"
+    )
     if before.returncode != 0:
         pytest.skip(f"rs274 refuses the original: {before.stderr.strip().splitlines()[-2:]}")
     nominal = sample_events(events_of(data, str(path)), step_mm=5.0)
