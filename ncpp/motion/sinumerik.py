@@ -450,6 +450,8 @@ class SinumerikInterpreter(ModalInterpreter):
         return value
 
     def assign(self, target: tuple, expr: tuple, block: Block, item) -> None:
+        if expr[0] == "list":
+            raise OutOfScope(f"the value list assigned to {target[1].upper()}", item.start + 1)
         if target[0] == "index":
             self._assign_elements(target, expr, block, item)
             return

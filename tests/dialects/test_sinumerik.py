@@ -233,3 +233,32 @@ def test_geometry_the_interpreter_does_not_follow_ends_interpretation(block, wha
     events = list(interpret(blocks, file="a.mpf", warnings=Warnings(stream=said)))
     assert "a.mpf:2:" in said.getvalue() and f"warning: {what} is outside" in said.getvalue()
     assert all(type(e) is Pass for e in events if e.block.line >= 2)
+
+
+def test_a_string_parameter_of_a_procedure_carries_its_length():
+    """`proc ms100(string[32] alat, ...)` (NadjImre/NC-Programi-za-FB422, CMA.DIR/MS100.SPF) was
+    refused as a syntax error: the Job Planning manual's PROC takes the types DEF takes, STRING[n] too."""
+    assert statements("proc ms100(string[32] alat,int ivica, real duz_mer)") == [
+        ("proc", ("MS100", (("STRING", "alat", False, None), ("INT", "ivica", False, None),
+                            ("REAL", "duz_mer", False, None)), ()))
+    ]
+    said = io.StringIO()
+    text = "PROC P(STRING[8] NAME, REAL D)\nG0 X0 Y0 Z0\nG1 X5 F100\nM17\n"
+    events = list(interpret(parse_stream(io.BytesIO(text.encode()), "p.spf", "sinumerik"), file="p.spf",
+                            warnings=Warnings(stream=said)))
+    assert not said.getvalue() and [type(e) is Pass for e in events if e.block.line == 3] == [False]
+
+
+def test_a_value_list_is_read_and_left_out_of_scope():
+    """`OSCTRL[Z]=(1+2,16+32+64)` (NadjImre/NC-Programi-za-FB422, CMA.DIR/SH100.SPF), the oscillation
+    options of the Job Planning manual ("OSCTRL[<axis>]=(<set option>,<reset option>)"), was refused as
+    a syntax error; a value in parentheses alone stays arithmetic."""
+    ((kind, (target, value)),) = statements("OSCTRL[Z]=(1+2,16+32+64)")
+    assert (kind, target[:2], value[0], len(value[1])) == ("assignment", ("index", "osctrl"), "list", 2)
+    assert statements("R1=(2+3)")[0][1][1][0] == "bin"
+    said = io.StringIO()
+    text = "G0 X0 Y0 Z0\nOSCTRL[Z]=(1+2,16+32+64)\nG1 X3 F100\nM30\n"
+    events = list(interpret(parse_stream(io.BytesIO(text.encode()), "a.mpf", "sinumerik"), file="a.mpf",
+                            warnings=Warnings(stream=said)))
+    assert "a.mpf:2:1: warning: the value list assigned to OSCTRL is outside" in said.getvalue()
+    assert all(type(e) is Pass for e in events if e.block.line >= 2)

@@ -12,7 +12,8 @@ Blocks map onto the common item classes:
 * `;` comments are `Comment`s; parentheses are arithmetic.
 
 Statement kinds and nodes (Sinumerik):
-  assignment   (target, expr)             target ("param", "r1") | ("index", "feld", (exprs))
+  assignment   (target, expr)             target ("param", "r1") | ("index", "feld", (exprs)); a value
+                                          list `OSCTRL[Z]=(1,2)` has the expr ("list", (exprs))
   label        (NAME,)                    `LABEL_1:` (upper case, no colon)
   call         (NAME, args)               `CYCLE81(10,0,2,-5)`, `MSG("x")`, `SETAL(1)`, `BNAT`,
                                           `MATERIAL_UPDATE`: passed through; args tuple of exprs, None if
@@ -92,6 +93,13 @@ class SinumerikBuilder(Transformer):
             return ExprWord(target[1].upper(), value, meta.start_pos, meta.end_pos)
         return Statement("assignment", (target, value), meta.start_pos, meta.end_pos)
 
+    @v_args(meta=True)
+    def assign_list(self, meta, children):
+        # A value list, `OSCTRL[Z]=(1+2,16+32+64)` (Job Planning manual, "Oscillation": the set and
+        # the reset options): one ("list", exprs) value
+        target, *values = children
+        return Statement("assignment", (target, ("list", tuple(values))), meta.start_pos, meta.end_pos)
+
     # Helpers that build the rule methods, called in the class body: plain functions, not
     # methods, which mypy cannot tell (hence their `type: ignore[misc]`)
     def _statement(kind: str, shape):  # type: ignore[misc]
@@ -159,7 +167,8 @@ class SinumerikBuilder(Transformer):
         by_reference = isinstance(children[0], Token) and children[0].type == "VAR"
         rest = children[1:] if by_reference else children
         dims = rest[2] if len(rest) > 2 else None
-        return (str(rest[0]).upper(), str(rest[1]).lower(), by_reference, dims)
+        # The type comes from def_type: a STRING parameter carries its length (`STRING[32] NAME`).
+        return (rest[0][0], str(rest[1]).lower(), by_reference, dims)
 
     def case_branch(self, children):
         value, keyword, target = children
