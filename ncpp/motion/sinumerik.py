@@ -620,6 +620,8 @@ class SinumerikInterpreter(ModalInterpreter):
                     and not KNOWN_CYCLE.match(item.node[0])
                 ):
                     self.called = self._call(block, item, item.node[0].upper(), item.node[1])
+                elif what == "sync_action":
+                    raise OutOfScope("the synchronized action (it acts beside the blocks)", item.start + 1)
                 elif what not in ("label", "program_name", "block_delete"):
                     name = item.node[0] if what in ("call", "path", "frame") else what.upper()
                     raise OutOfScope(

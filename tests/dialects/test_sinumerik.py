@@ -251,8 +251,8 @@ def test_a_string_parameter_of_a_procedure_carries_its_length():
 
 def test_a_value_list_is_read_and_left_out_of_scope():
     """`OSCTRL[Z]=(1+2,16+32+64)` (NadjImre/NC-Programi-za-FB422, CMA.DIR/SH100.SPF), the oscillation
-    options of the Job Planning manual ("OSCTRL[<axis>]=(<set option>,<reset option>)"), was refused as
-    a syntax error; a value in parentheses alone stays arithmetic."""
+    options of Function Manual Extended Functions, "Oscillation (P5)" (`OSCTRL[<axis>]=(<set>,<reset>)`),
+    was refused as a syntax error; a value in parentheses alone stays arithmetic."""
     ((kind, (target, value)),) = statements("OSCTRL[Z]=(1+2,16+32+64)")
     assert (kind, target[:2], value[0], len(value[1])) == ("assignment", ("index", "osctrl"), "list", 2)
     assert statements("R1=(2+3)")[0][1][1][0] == "bin"
@@ -262,3 +262,32 @@ def test_a_value_list_is_read_and_left_out_of_scope():
                             warnings=Warnings(stream=said)))
     assert "a.mpf:2:1: warning: the value list assigned to OSCTRL is outside" in said.getvalue()
     assert all(type(e) is Pass for e in events if e.block.line >= 2)
+
+
+@pytest.mark.parametrize(
+    "block",
+    [
+        "ID=7 EVERY $A_IN[7]<>0 DO $R1=1",
+        "ID=8 EVERY ($AA_IM[Z]<>$SA_OSCILL_REVERSE_POS1[Z]) AND ($R2<=0) DO $R1=1 ; note",
+        "IDS=2 WHENEVER $R1==0 DO $AA_OVR[X]=0",
+        "WHEN $AA_IW[X]>5 DO M120",
+        "DO $A_OUTA[1]=$AA_IN[X]",
+    ],
+)
+def test_a_synchronized_action_is_read_whole_and_left_out_of_scope(block):
+    """`ID=7 EVERY $A_IN[7]<>0 DO $R1=1` (NadjImre/Paket-NC-programa-za-418, CMA.DIR/SH200.SPF) was refused
+    as a syntax error at `<>`. Function Manual Synchronized Actions, "Definition of a synchronized action":
+    `[ID=<n>|IDS=<n>] [WHEN|WHENEVER|FROM|EVERY] <condition> DO <actions>`, alone in its block."""
+    ((kind, (text,)),) = statements(block)
+    assert (kind, text) == ("sync_action", block)
+    said = io.StringIO()
+    text = f"G0 X0 Y0 Z0\n{block}\nG1 X3 F100\nM30\n"
+    events = list(interpret(parse_stream(io.BytesIO(text.encode()), "a.mpf", "sinumerik"), file="a.mpf",
+                            warnings=Warnings(stream=said)))
+    assert "a.mpf:2:1: warning: the synchronized action (it acts beside the blocks) is outside" in said.getvalue()
+    assert all(type(e) is Pass for e in events if e.block.line >= 2)
+
+
+def test_names_that_begin_like_a_synchronized_action_stay_names():
+    assert statements("DOX=5 FROM_A=1")[0] == ("assignment", (("param", "dox"), ("num", 5.0)))
+    assert statements("N10 G1 X5 WHENX")[0] == ("call", ("WHENX", ()))

@@ -29,6 +29,7 @@ Statement kinds and nodes (Sinumerik):
   goto         (KEYWORD, TARGET)          ('GOTOF' | 'GOTOB' | 'GOTOC' | 'GOTO', 'LABEL' | 'N100' | '90')
   case         (expr, branches, default)  branches ((value_expr, KEYWORD, TARGET), ...), default (KEYWORD, TARGET) | None
   program_name (text,)                    `%_N_PART_MPF`
+  sync_action  (text,)                    `ID=7 EVERY $A_IN[7]<>0 DO $R1=1`, to the end of the line
 A main block number `:10` is `Word(':', 10.0, '10')`.
 Expressions: ("num", v) ("str", s) ("param", name) ("index", name, (exprs)) ("neg", x) ("not", x)
 ("bnot", x) ("bin", op, a, b) with op + - * / DIV MOD == <> < > <= >= AND OR XOR B_AND B_OR B_XOR <<,
@@ -95,8 +96,8 @@ class SinumerikBuilder(Transformer):
 
     @v_args(meta=True)
     def assign_list(self, meta, children):
-        # A value list, `OSCTRL[Z]=(1+2,16+32+64)` (Job Planning manual, "Oscillation": the set and
-        # the reset options): one ("list", exprs) value
+        # A value list, `OSCTRL[Z]=(1+2,16+32+64)` (Function Manual Extended Functions, "Oscillation
+        # (P5)": the set and the reset options): one ("list", exprs) value
         target, *values = children
         return Statement("assignment", (target, ("list", tuple(values))), meta.start_pos, meta.end_pos)
 
@@ -147,6 +148,7 @@ class SinumerikBuilder(Transformer):
     goto = _statement("goto", _goto)
     case = _statement("case", _case)
     program_name = _statement("program_name", lambda c: (str(c[0]),))
+    sync_action = _statement("sync_action", lambda c: (str(c[0]),))
     else_ = _statement("else", lambda c: ())
     endif = _statement("endif", lambda c: ())
     endwhile = _statement("endwhile", lambda c: ())
