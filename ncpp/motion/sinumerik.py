@@ -108,7 +108,20 @@ HOLE_PATTERNS = frozenset(("HOLES1", "HOLES2", "CYCLE801", "CYCLE802"))
 FOLLOWED_PATTERNS = {"HOLES1": 6, "HOLES2": 6}  # and how many parameters each reads
 END_M = frozenset((2.0, 17.0, 30.0))
 # Addresses that say where the tool goes in a way this interpreter does not follow
-UNREAD_GEOMETRY = {"AR": "the opening angle", "AP": "the polar angle", "RP": "the polar radius"}
+UNREAD_GEOMETRY = {
+    "AR": "the opening angle",
+    "AP": "the polar angle",
+    "RP": "the polar radius",
+    # The control inserts a chamfer or an arc at the corner the block ends in, or finds the end point
+    # from the angle; a measuring move stops where the probe switches (MEAS) or records that place.
+    "CHF": "the chamfer",
+    "CHR": "the chamfer",
+    "RND": "the rounding",
+    "RNDM": "the modal rounding",
+    "ANG": "the contour angle",
+    "MEAS": "the measuring move",
+    "MEAW": "the measuring move",
+}
 # Frame instructions followed: translations; a bare substituting ROT / SCALE / MIRROR resets the frame.
 FRAMES = frozenset(("TRANS", "ATRANS", "ROT", "SCALE", "MIRROR"))
 

@@ -291,3 +291,30 @@ def test_a_synchronized_action_is_read_whole_and_left_out_of_scope(block):
 def test_names_that_begin_like_a_synchronized_action_stay_names():
     assert statements("DOX=5 FROM_A=1")[0] == ("assignment", (("param", "dox"), ("num", 5.0)))
     assert statements("N10 G1 X5 WHENX")[0] == ("call", ("WHENX", ()))
+
+
+@pytest.mark.parametrize(
+    "block, what",
+    [
+        ("G1 X5 Y2 RND=1 F100", "the rounding RND="),
+        ("G1 X5 Y2 CHF=1 F100", "the chamfer CHF="),
+        ("G1 X5 CHR=1 F100", "the chamfer CHR="),
+        ("RNDM=0.5", "the modal rounding RNDM="),
+        ("G1 X5 ANG=30 F100", "the contour angle ANG="),
+        ("G1 X5 MEAS=1 F100", "the measuring move MEAS="),
+        ("G1 X5 MEAW=1 F100", "the measuring move MEAW="),
+    ],
+)
+def test_corner_contour_and_measuring_words_end_interpretation(block, what):
+    """`G1 X=xpos-duz_mer MEAS=1 F=brz_mer` (NadjImre/NC-Programi-za-FB422, CMA.DIR/MS100.SPF) and
+    `RND=1` were read as assignments to user variables and dropped: the probing move was compensated as
+    a plain move, and RND=1 stayed on the first piece of the split move, rounding the wrong corner.
+    They are words of the block (Fundamentals, "Chamfer, rounding (CHF, CHR, RND, RNDM, FRC, FRCM)",
+    "Contour definitions"; Job Planning, "Measurements with touch trigger probe (MEAS, MEAW)")."""
+    word = block.split()[-2] if block.endswith("F100") else block
+    assert exprs(block).keys() >= {word.split("=")[0]}
+    said = io.StringIO()
+    blocks = parse_stream(io.BytesIO(f"G0 X0 Y0 Z0\n{block}\nG1 X3\nM30\n".encode()), "a.mpf", "sinumerik")
+    events = list(interpret(blocks, file="a.mpf", warnings=Warnings(stream=said)))
+    assert "a.mpf:2:" in said.getvalue() and f"warning: {what} is outside" in said.getvalue()
+    assert all(type(e) is Pass for e in events if e.block.line >= 2)

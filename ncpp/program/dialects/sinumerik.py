@@ -49,9 +49,13 @@ from lark import Token, Transformer, v_args
 from ncpp.program.blocks import Comment, ExprWord, Statement, Word
 from ncpp.program.parser import Dialect, _word
 
-# Multi-letter addresses that take `=`: interpolation and spline parameters, polar words.
+# Multi-letter addresses that take `=`: interpolation and spline parameters, polar words, the
+# chamfer / rounding and contour-angle words (Fundamentals, "Chamfer, rounding (CHF, CHR, RND, RNDM,
+# FRC, FRCM)", "Contour definitions": ANG) and the measuring words (Job Planning, "Measurements with
+# touch trigger probe (MEAS, MEAW)"): words of the block, not user variables.
 ADDRESSES = frozenset(
     {"CR", "TURN", "AR", "AP", "RP", "PW", "SD", "PL", "SF", "SPOS", "OFFN", "ACC", "SR", "SRA"}
+    | {"CHF", "CHR", "RND", "RNDM", "ANG", "MEAS", "MEAW"}
 )
 COORDINATE_MODES = frozenset({"AC", "IC", "DC", "ACP", "ACN", "CAC", "CIC"})
 _ADDRESS = re.compile(r"[A-QS-Za-qs-z]\d*|[Rr]")
