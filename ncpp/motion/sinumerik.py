@@ -93,7 +93,11 @@ HARMLESS_CALLS = frozenset(("MSG", "BNAT", "ENAT", "BTAN", "ETAN", "BAUTO", "EAU
                             "UPATH", "SPATH", "DIAMOF", "TRAFOOF", "ORIWKS", "ORIMKS", "ORIAXES", "ORIVECT",
                             # the feedrate profile over a block, not its path (840D sl Programming
                             # Manual, Fundamentals, "Feedrate characteristic (FNORM, FLIN, FCUB)")
-                            "FNORM", "FLIN", "FCUB"))  # fmt: skip
+                            "FNORM", "FLIN", "FCUB",
+                            # waits and settings that move no axis of the path (Job Planning manual):
+                            # the wait for a positioning axis or a spindle, the master spindle, the end
+                            # of an interrupt assignment
+                            "WAITP", "WAITS", "SETMS", "CLRINT"))  # fmt: skip
 # Calls that move nothing when given no arguments: CYCLE800() deselects the swivelled plane without
 # turning an axis (SINUMERIK 840D sl Milling manual, "Swiveling plane - CYCLE800": "CYCLE800()"
 # resets the swivel frames); CYCLE832() deselects the high-speed settings.  CYCLE832 with its
@@ -150,6 +154,14 @@ _SUBPROGRAM_NAME = re.compile(r"(?:[A-Z]{2}|_[A-Z])\w*", re.I)
 KNOWN_CYCLE = re.compile(r"CYCLE\d|POCKET\d|SLOT\d|LONGHOLE|HOLES\d|E_|F_", re.I)
 # Predefined procedures that call programs in ways not followed here (PCALL: by an absolute path)
 CALL_KEYWORDS = frozenset(("PCALL", "CALLPATH", "MCALL", "RET"))
+# Predefined procedures of the control (Job Planning manual, "Tables: list of instructions"), not
+# subprograms: the transformations, diameter programming, curve tables, interrupt routines, a block
+# run from a string, the tool-management functions.  Not followed, and named as what they are.
+PREDEFINED_PROCEDURES = frozenset((
+    "TRAORI", "TRANSMIT", "TRACYL", "TRAANG", "TRACON", "DIAMON", "DIAM90", "DIAMCYCOF", "CTABDEF", "CTABEND",
+    "SETINT", "EXECSTRING", "EXECTAB", "GETT", "GETSELT", "GETEXET", "FIFOCTRL", "CUT2DF", "CUT3DC", "CUT3DF",
+    "CUT3DFF", "CUT3DFS", "POSA", "SPOSA", "LEADON", "EGON", "COUPON",
+))  # fmt: skip
 # Control statements after which the flow may run blocks again (`sinumerik_flow`): their moves the line's
 RUNS_OTHERS = frozenset(("endwhile", "endfor", "until", "endloop", "goto", "case"))
 # PROC attributes that change nothing the motion depends on: the display and single-block
@@ -626,6 +638,8 @@ class SinumerikInterpreter(ModalInterpreter):
                     or (item.node[0] in RESETTING_CALLS and not item.node[1])
                 ):
                     pass
+                elif what == "call" and item.node[0] in PREDEFINED_PROCEDURES:
+                    raise OutOfScope(f"the predefined procedure {item.node[0]}", item.start + 1)
                 elif (
                     what == "call"
                     and _SUBPROGRAM_NAME.fullmatch(item.node[0])

@@ -284,7 +284,8 @@ def test_a_synchronized_action_is_read_whole_and_left_out_of_scope(block):
     text = f"G0 X0 Y0 Z0\n{block}\nG1 X3 F100\nM30\n"
     events = list(interpret(parse_stream(io.BytesIO(text.encode()), "a.mpf", "sinumerik"), file="a.mpf",
                             warnings=Warnings(stream=said)))
-    assert "a.mpf:2:1: warning: the synchronized action (it acts beside the blocks) is outside" in said.getvalue()
+    warning = "a.mpf:2:1: warning: the synchronized action (it acts beside the blocks) is outside"
+    assert warning in said.getvalue()
     assert all(type(e) is Pass for e in events if e.block.line >= 2)
 
 
@@ -318,3 +319,32 @@ def test_corner_contour_and_measuring_words_end_interpretation(block, what):
     events = list(interpret(blocks, file="a.mpf", warnings=Warnings(stream=said)))
     assert "a.mpf:2:" in said.getvalue() and f"warning: {what} is outside" in said.getvalue()
     assert all(type(e) is Pass for e in events if e.block.line >= 2)
+
+
+@pytest.mark.parametrize("block, name", [
+    ("DIAMON", "DIAMON"), ("TRAORI", "TRAORI"), ("TRACYL(40)", "TRACYL"),
+    ('CTABDEF(X,C,1,1,"DRAM")', "CTABDEF"),
+    ("SETINT(8) PRIO=1 SH600", "SETINT"), ('EXECSTRING("G1 X4")', "EXECSTRING"),
+])  # fmt: skip
+def test_a_predefined_procedure_is_named_as_such_not_looked_for_as_a_file(block, name):
+    """`DIAMON`, `CTABDEF(X,C,1,1,"DRAM")`, `SETINT(8) PRIO=1 SH600`, `EXECSTRING( NAZPROG )`
+    (NadjImre/NC-Programi-za-FB422, CMA.DIR/SH000.SPF, TB100.SPF) were looked for as subprogram files and
+    the warning asked for a --subroutine-path; they are the control's own procedures."""
+    said = io.StringIO()
+    blocks = parse_stream(io.BytesIO(f"G0 X0 Y0 Z0\n{block}\nG1 X3\nM30\n".encode()), "a.mpf", "sinumerik")
+    events = list(interpret(blocks, file="a.mpf", warnings=Warnings(stream=said)))
+    assert f"a.mpf:2:1: warning: the predefined procedure {name} is outside" in said.getvalue()
+    assert "file not found" not in said.getvalue()
+    assert all(type(e) is Pass for e in events if e.block.line >= 2)
+
+
+@pytest.mark.parametrize("block", ["WAITP(Z)", "WAITS(2)", "SETMS(1)", "CLRINT(8)"])
+def test_waits_and_settings_that_move_nothing_are_followed_through(block):
+    """`WAITP(Z)`, `CLRINT(8)`, `WAITS(2)` (NadjImre/NC-Programi-za-FB422, SH100.SPF, SH000.SPF;
+    Paket-NC-programa-za-418, ML000.SPF) ended interpretation as calls of missing files."""
+    said = io.StringIO()
+    text = f"G0 X0 Y0 Z0\n{block}\nG1 X3 F100\nM30\n"
+    blocks = parse_stream(io.BytesIO(text.encode()), "a.mpf", "sinumerik")
+    events = list(interpret(blocks, file="a.mpf", warnings=Warnings(stream=said)))
+    assert not said.getvalue()
+    assert [type(e) is Pass for e in events if e.block.line == 3] == [False]
