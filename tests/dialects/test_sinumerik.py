@@ -239,13 +239,28 @@ def test_a_string_parameter_of_a_procedure_carries_its_length():
     """`proc ms100(string[32] alat, ...)` (NadjImre/NC-Programi-za-FB422, CMA.DIR/MS100.SPF) was
     refused as a syntax error: the Job Planning manual's PROC takes the types DEF takes, STRING[n] too."""
     assert statements("proc ms100(string[32] alat,int ivica, real duz_mer)") == [
-        ("proc", ("MS100", (("STRING", "alat", False, None), ("INT", "ivica", False, None),
-                            ("REAL", "duz_mer", False, None)), ()))
+        (
+            "proc",
+            (
+                "MS100",
+                (
+                    ("STRING", "alat", False, None),
+                    ("INT", "ivica", False, None),
+                    ("REAL", "duz_mer", False, None),
+                ),
+                (),
+            ),
+        )
     ]
     said = io.StringIO()
     text = "PROC P(STRING[8] NAME, REAL D)\nG0 X0 Y0 Z0\nG1 X5 F100\nM17\n"
-    events = list(interpret(parse_stream(io.BytesIO(text.encode()), "p.spf", "sinumerik"), file="p.spf",
-                            warnings=Warnings(stream=said)))
+    events = list(
+        interpret(
+            parse_stream(io.BytesIO(text.encode()), "p.spf", "sinumerik"),
+            file="p.spf",
+            warnings=Warnings(stream=said),
+        )
+    )
     assert not said.getvalue() and [type(e) is Pass for e in events if e.block.line == 3] == [False]
 
 
@@ -258,8 +273,13 @@ def test_a_value_list_is_read_and_left_out_of_scope():
     assert statements("R1=(2+3)")[0][1][1][0] == "bin"
     said = io.StringIO()
     text = "G0 X0 Y0 Z0\nOSCTRL[Z]=(1+2,16+32+64)\nG1 X3 F100\nM30\n"
-    events = list(interpret(parse_stream(io.BytesIO(text.encode()), "a.mpf", "sinumerik"), file="a.mpf",
-                            warnings=Warnings(stream=said)))
+    events = list(
+        interpret(
+            parse_stream(io.BytesIO(text.encode()), "a.mpf", "sinumerik"),
+            file="a.mpf",
+            warnings=Warnings(stream=said),
+        )
+    )
     assert "a.mpf:2:1: warning: the value list assigned to OSCTRL is outside" in said.getvalue()
     assert all(type(e) is Pass for e in events if e.block.line >= 2)
 
@@ -282,8 +302,13 @@ def test_a_synchronized_action_is_read_whole_and_left_out_of_scope(block):
     assert (kind, text) == ("sync_action", block)
     said = io.StringIO()
     text = f"G0 X0 Y0 Z0\n{block}\nG1 X3 F100\nM30\n"
-    events = list(interpret(parse_stream(io.BytesIO(text.encode()), "a.mpf", "sinumerik"), file="a.mpf",
-                            warnings=Warnings(stream=said)))
+    events = list(
+        interpret(
+            parse_stream(io.BytesIO(text.encode()), "a.mpf", "sinumerik"),
+            file="a.mpf",
+            warnings=Warnings(stream=said),
+        )
+    )
     warning = "a.mpf:2:1: warning: the synchronized action (it acts beside the blocks) is outside"
     assert warning in said.getvalue()
     assert all(type(e) is Pass for e in events if e.block.line >= 2)
