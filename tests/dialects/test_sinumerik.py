@@ -373,3 +373,17 @@ def test_waits_and_settings_that_move_nothing_are_followed_through(block):
     events = list(interpret(blocks, file="a.mpf", warnings=Warnings(stream=said)))
     assert not said.getvalue()
     assert [type(e) is Pass for e in events if e.block.line == 3] == [False]
+
+
+def test_the_concatenation_operator_alone_converts_to_a_string():
+    """`SETAL(65017,<<(BROJ))` (NadjImre/Paket-NC-programa-za-418, CMA.DIR/SM000.SPF) was refused as a
+    syntax error: Job Planning manual, "String operations": `STRING_ERG = <<any type`."""
+    assert statements("SETAL(65017,<<(BROJ))") == [
+        ("call", ("SETAL", (("num", 65017.0), ("bin", "<<", ("str", ""), ("param", "broj")))))
+    ]
+    assert statements('MSG("A"<< <<R2)')[0][1][1][0] == (
+        "bin",
+        "<<",
+        ("str", "A"),
+        ("bin", "<<", ("str", ""), ("param", "r2")),
+    )

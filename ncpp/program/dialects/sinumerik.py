@@ -209,6 +209,11 @@ class SinumerikBuilder(Transformer):
             return (name.lower(), args[0])
         return ("call", name, *args)
 
+    def to_string(self, children):
+        # `<<R1` alone converts to STRING (Job Planning manual, "String operations"): the
+        # concatenation with an empty string
+        return ("bin", "<<", ("str", ""), children[1])
+
     def neg(self, children):
         return ("neg", children[0])
 
