@@ -686,6 +686,10 @@ class SinumerikInterpreter(ModalInterpreter):
             else:
                 if letter in UNREAD_GEOMETRY:
                     raise OutOfScope(f"{UNREAD_GEOMETRY[letter]} {letter}=", item.start + 1)
+                if letter == "OFFN" and value != 0.0:
+                    # The contour offset widens the tool radius the control compensates by (Fundamentals,
+                    # "Tool radius compensation (G40, G41, G42, OFFN)"); 0, the reset value, changes nothing.
+                    raise OutOfScope("the contour offset OFFN=", item.start + 1)
                 if letter in ROTARY:  # (its moves would be compensated as if the axis stood)
                     raise OutOfScope(
                         f"the rotary axis {letter} (this interpreter follows X Y Z)", item.start + 1

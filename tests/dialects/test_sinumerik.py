@@ -387,3 +387,29 @@ def test_the_concatenation_operator_alone_converts_to_a_string():
         ("str", "A"),
         ("bin", "<<", ("str", ""), ("param", "r2")),
     )
+
+
+def test_a_contour_offset_ends_interpretation_and_its_reset_does_not():
+    """`OFFN=2` was read and ignored: under G41/G42 the control cuts 2 mm further from the contour
+    (Fundamentals, "Tool radius compensation (G40, G41, G42, OFFN)")."""
+    said = io.StringIO()
+    text = "G0 X0 Y0 Z0\nG1 X5 Y1 OFFN=2 F100\nG1 X3\nOFFN=0\nM30\n"
+    events = list(
+        interpret(
+            parse_stream(io.BytesIO(text.encode()), "a.mpf", "sinumerik"),
+            file="a.mpf",
+            warnings=Warnings(stream=said),
+        )
+    )
+    assert "a.mpf:2:10: warning: the contour offset OFFN= is outside" in said.getvalue()
+    assert all(type(e) is Pass for e in events if e.block.line >= 2)
+    said = io.StringIO()
+    text = "G0 X0 Y0 Z0\nG1 X5 Y1 OFFN=0 F100\nG1 X3\nM30\n"
+    events = list(
+        interpret(
+            parse_stream(io.BytesIO(text.encode()), "a.mpf", "sinumerik"),
+            file="a.mpf",
+            warnings=Warnings(stream=said),
+        )
+    )
+    assert not said.getvalue() and [type(e) is Pass for e in events if e.block.line == 3] == [False]
