@@ -93,7 +93,11 @@ HARMLESS_CALLS = frozenset(("MSG", "BNAT", "ENAT", "BTAN", "ETAN", "BAUTO", "EAU
                             "UPATH", "SPATH", "DIAMOF", "TRAFOOF", "ORIWKS", "ORIMKS", "ORIAXES", "ORIVECT",
                             # the feedrate profile over a block, not its path (840D sl Programming
                             # Manual, Fundamentals, "Feedrate characteristic (FNORM, FLIN, FCUB)")
-                            "FNORM", "FLIN", "FCUB"))  # fmt: skip
+                            "FNORM", "FLIN", "FCUB",
+                            # waits and settings that move no axis of the path (Job Planning manual):
+                            # the wait for a positioning axis or a spindle, the master spindle, the end
+                            # of an interrupt assignment
+                            "WAITP", "WAITS", "SETMS", "CLRINT"))  # fmt: skip
 # Calls that move nothing when given no arguments: CYCLE800() deselects the swivelled plane without
 # turning an axis (SINUMERIK 840D sl Milling manual, "Swiveling plane - CYCLE800": "CYCLE800()"
 # resets the swivel frames); CYCLE832() deselects the high-speed settings.  CYCLE832 with its
@@ -108,7 +112,20 @@ HOLE_PATTERNS = frozenset(("HOLES1", "HOLES2", "CYCLE801", "CYCLE802"))
 FOLLOWED_PATTERNS = {"HOLES1": 6, "HOLES2": 6}  # and how many parameters each reads
 END_M = frozenset((2.0, 17.0, 30.0))
 # Addresses that say where the tool goes in a way this interpreter does not follow
-UNREAD_GEOMETRY = {"AR": "the opening angle", "AP": "the polar angle", "RP": "the polar radius"}
+UNREAD_GEOMETRY = {
+    "AR": "the opening angle",
+    "AP": "the polar angle",
+    "RP": "the polar radius",
+    # The control inserts a chamfer or an arc at the corner the block ends in, or finds the end point
+    # from the angle; a measuring move stops where the probe switches (MEAS) or records that place.
+    "CHF": "the chamfer",
+    "CHR": "the chamfer",
+    "RND": "the rounding",
+    "RNDM": "the modal rounding",
+    "ANG": "the contour angle",
+    "MEAS": "the measuring move",
+    "MEAW": "the measuring move",
+}
 # Frame instructions followed: translations; a bare substituting ROT / SCALE / MIRROR resets the frame.
 FRAMES = frozenset(("TRANS", "ATRANS", "ROT", "SCALE", "MIRROR"))
 
@@ -137,6 +154,14 @@ _SUBPROGRAM_NAME = re.compile(r"(?:[A-Z]{2}|_[A-Z])\w*", re.I)
 KNOWN_CYCLE = re.compile(r"CYCLE\d|POCKET\d|SLOT\d|LONGHOLE|HOLES\d|E_|F_", re.I)
 # Predefined procedures that call programs in ways not followed here (PCALL: by an absolute path)
 CALL_KEYWORDS = frozenset(("PCALL", "CALLPATH", "MCALL", "RET"))
+# Predefined procedures of the control (Job Planning manual, "Tables: list of instructions"), not
+# subprograms: the transformations, diameter programming, curve tables, interrupt routines, a block
+# run from a string, the tool-management functions.  Not followed, and named as what they are.
+PREDEFINED_PROCEDURES = frozenset((
+    "TRAORI", "TRANSMIT", "TRACYL", "TRAANG", "TRACON", "DIAMON", "DIAM90", "DIAMCYCOF", "CTABDEF", "CTABEND",
+    "SETINT", "EXECSTRING", "EXECTAB", "GETT", "GETSELT", "GETEXET", "FIFOCTRL", "CUT2DF", "CUT3DC", "CUT3DF",
+    "CUT3DFF", "CUT3DFS", "POSA", "SPOSA", "LEADON", "EGON", "COUPON",
+))  # fmt: skip
 # Control statements after which the flow may run blocks again (`sinumerik_flow`): their moves the line's
 RUNS_OTHERS = frozenset(("endwhile", "endfor", "until", "endloop", "goto", "case"))
 # PROC attributes that change nothing the motion depends on: the display and single-block
@@ -450,6 +475,8 @@ class SinumerikInterpreter(ModalInterpreter):
         return value
 
     def assign(self, target: tuple, expr: tuple, block: Block, item) -> None:
+        if expr[0] == "list":
+            raise OutOfScope(f"the value list assigned to {target[1].upper()}", item.start + 1)
         if target[0] == "index":
             self._assign_elements(target, expr, block, item)
             return
@@ -611,6 +638,8 @@ class SinumerikInterpreter(ModalInterpreter):
                     or (item.node[0] in RESETTING_CALLS and not item.node[1])
                 ):
                     pass
+                elif what == "call" and item.node[0] in PREDEFINED_PROCEDURES:
+                    raise OutOfScope(f"the predefined procedure {item.node[0]}", item.start + 1)
                 elif (
                     what == "call"
                     and _SUBPROGRAM_NAME.fullmatch(item.node[0])
@@ -618,6 +647,8 @@ class SinumerikInterpreter(ModalInterpreter):
                     and not KNOWN_CYCLE.match(item.node[0])
                 ):
                     self.called = self._call(block, item, item.node[0].upper(), item.node[1])
+                elif what == "sync_action":
+                    raise OutOfScope("the synchronized action (it acts beside the blocks)", item.start + 1)
                 elif what not in ("label", "program_name", "block_delete"):
                     name = item.node[0] if what in ("call", "path", "frame") else what.upper()
                     raise OutOfScope(
@@ -655,6 +686,10 @@ class SinumerikInterpreter(ModalInterpreter):
             else:
                 if letter in UNREAD_GEOMETRY:
                     raise OutOfScope(f"{UNREAD_GEOMETRY[letter]} {letter}=", item.start + 1)
+                if letter == "OFFN" and value != 0.0:
+                    # The contour offset widens the tool radius the control compensates by (Fundamentals,
+                    # "Tool radius compensation (G40, G41, G42, OFFN)"); 0, the reset value, changes nothing.
+                    raise OutOfScope("the contour offset OFFN=", item.start + 1)
                 if letter in ROTARY:  # (its moves would be compensated as if the axis stood)
                     raise OutOfScope(
                         f"the rotary axis {letter} (this interpreter follows X Y Z)", item.start + 1

@@ -233,3 +233,183 @@ def test_geometry_the_interpreter_does_not_follow_ends_interpretation(block, wha
     events = list(interpret(blocks, file="a.mpf", warnings=Warnings(stream=said)))
     assert "a.mpf:2:" in said.getvalue() and f"warning: {what} is outside" in said.getvalue()
     assert all(type(e) is Pass for e in events if e.block.line >= 2)
+
+
+def test_a_string_parameter_of_a_procedure_carries_its_length():
+    """`proc ms100(string[32] alat, ...)` (NadjImre/NC-Programi-za-FB422, CMA.DIR/MS100.SPF) was
+    refused as a syntax error: the Job Planning manual's PROC takes the types DEF takes, STRING[n] too."""
+    assert statements("proc ms100(string[32] alat,int ivica, real duz_mer)") == [
+        (
+            "proc",
+            (
+                "MS100",
+                (
+                    ("STRING", "alat", False, None),
+                    ("INT", "ivica", False, None),
+                    ("REAL", "duz_mer", False, None),
+                ),
+                (),
+            ),
+        )
+    ]
+    said = io.StringIO()
+    text = "PROC P(STRING[8] NAME, REAL D)\nG0 X0 Y0 Z0\nG1 X5 F100\nM17\n"
+    events = list(
+        interpret(
+            parse_stream(io.BytesIO(text.encode()), "p.spf", "sinumerik"),
+            file="p.spf",
+            warnings=Warnings(stream=said),
+        )
+    )
+    assert not said.getvalue() and [type(e) is Pass for e in events if e.block.line == 3] == [False]
+
+
+def test_a_value_list_is_read_and_left_out_of_scope():
+    """`OSCTRL[Z]=(1+2,16+32+64)` (NadjImre/NC-Programi-za-FB422, CMA.DIR/SH100.SPF), the oscillation
+    options of Function Manual Extended Functions, "Oscillation (P5)" (`OSCTRL[<axis>]=(<set>,<reset>)`),
+    was refused as a syntax error; a value in parentheses alone stays arithmetic."""
+    ((kind, (target, value)),) = statements("OSCTRL[Z]=(1+2,16+32+64)")
+    assert (kind, target[:2], value[0], len(value[1])) == ("assignment", ("index", "osctrl"), "list", 2)
+    assert statements("R1=(2+3)")[0][1][1][0] == "bin"
+    said = io.StringIO()
+    text = "G0 X0 Y0 Z0\nOSCTRL[Z]=(1+2,16+32+64)\nG1 X3 F100\nM30\n"
+    events = list(
+        interpret(
+            parse_stream(io.BytesIO(text.encode()), "a.mpf", "sinumerik"),
+            file="a.mpf",
+            warnings=Warnings(stream=said),
+        )
+    )
+    assert "a.mpf:2:1: warning: the value list assigned to OSCTRL is outside" in said.getvalue()
+    assert all(type(e) is Pass for e in events if e.block.line >= 2)
+
+
+@pytest.mark.parametrize(
+    "block",
+    [
+        "ID=7 EVERY $A_IN[7]<>0 DO $R1=1",
+        "ID=8 EVERY ($AA_IM[Z]<>$SA_OSCILL_REVERSE_POS1[Z]) AND ($R2<=0) DO $R1=1 ; note",
+        "IDS=2 WHENEVER $R1==0 DO $AA_OVR[X]=0",
+        "WHEN $AA_IW[X]>5 DO M120",
+        "DO $A_OUTA[1]=$AA_IN[X]",
+    ],
+)
+def test_a_synchronized_action_is_read_whole_and_left_out_of_scope(block):
+    """`ID=7 EVERY $A_IN[7]<>0 DO $R1=1` (NadjImre/Paket-NC-programa-za-418, CMA.DIR/SH200.SPF) was refused
+    as a syntax error at `<>`. Function Manual Synchronized Actions, "Definition of a synchronized action":
+    `[ID=<n>|IDS=<n>] [WHEN|WHENEVER|FROM|EVERY] <condition> DO <actions>`, alone in its block."""
+    ((kind, (text,)),) = statements(block)
+    assert (kind, text) == ("sync_action", block)
+    said = io.StringIO()
+    text = f"G0 X0 Y0 Z0\n{block}\nG1 X3 F100\nM30\n"
+    events = list(
+        interpret(
+            parse_stream(io.BytesIO(text.encode()), "a.mpf", "sinumerik"),
+            file="a.mpf",
+            warnings=Warnings(stream=said),
+        )
+    )
+    warning = "a.mpf:2:1: warning: the synchronized action (it acts beside the blocks) is outside"
+    assert warning in said.getvalue()
+    assert all(type(e) is Pass for e in events if e.block.line >= 2)
+
+
+def test_names_that_begin_like_a_synchronized_action_stay_names():
+    assert statements("DOX=5 FROM_A=1")[0] == ("assignment", (("param", "dox"), ("num", 5.0)))
+    assert statements("N10 G1 X5 WHENX")[0] == ("call", ("WHENX", ()))
+
+
+@pytest.mark.parametrize(
+    "block, what",
+    [
+        ("G1 X5 Y2 RND=1 F100", "the rounding RND="),
+        ("G1 X5 Y2 CHF=1 F100", "the chamfer CHF="),
+        ("G1 X5 CHR=1 F100", "the chamfer CHR="),
+        ("RNDM=0.5", "the modal rounding RNDM="),
+        ("G1 X5 ANG=30 F100", "the contour angle ANG="),
+        ("G1 X5 MEAS=1 F100", "the measuring move MEAS="),
+        ("G1 X5 MEAW=1 F100", "the measuring move MEAW="),
+    ],
+)
+def test_corner_contour_and_measuring_words_end_interpretation(block, what):
+    """`G1 X=xpos-duz_mer MEAS=1 F=brz_mer` (NadjImre/NC-Programi-za-FB422, CMA.DIR/MS100.SPF) and
+    `RND=1` were read as assignments to user variables and dropped: the probing move was compensated as
+    a plain move, and RND=1 stayed on the first piece of the split move, rounding the wrong corner.
+    They are words of the block (Fundamentals, "Chamfer, rounding (CHF, CHR, RND, RNDM, FRC, FRCM)",
+    "Contour definitions"; Job Planning, "Measurements with touch trigger probe (MEAS, MEAW)")."""
+    word = block.split()[-2] if block.endswith("F100") else block
+    assert exprs(block).keys() >= {word.split("=")[0]}
+    said = io.StringIO()
+    blocks = parse_stream(io.BytesIO(f"G0 X0 Y0 Z0\n{block}\nG1 X3\nM30\n".encode()), "a.mpf", "sinumerik")
+    events = list(interpret(blocks, file="a.mpf", warnings=Warnings(stream=said)))
+    assert "a.mpf:2:" in said.getvalue() and f"warning: {what} is outside" in said.getvalue()
+    assert all(type(e) is Pass for e in events if e.block.line >= 2)
+
+
+@pytest.mark.parametrize("block, name", [
+    ("DIAMON", "DIAMON"), ("TRAORI", "TRAORI"), ("TRACYL(40)", "TRACYL"),
+    ('CTABDEF(X,C,1,1,"DRAM")', "CTABDEF"),
+    ("SETINT(8) PRIO=1 SH600", "SETINT"), ('EXECSTRING("G1 X4")', "EXECSTRING"),
+])  # fmt: skip
+def test_a_predefined_procedure_is_named_as_such_not_looked_for_as_a_file(block, name):
+    """`DIAMON`, `CTABDEF(X,C,1,1,"DRAM")`, `SETINT(8) PRIO=1 SH600`, `EXECSTRING( NAZPROG )`
+    (NadjImre/NC-Programi-za-FB422, CMA.DIR/SH000.SPF, TB100.SPF) were looked for as subprogram files and
+    the warning asked for a --subroutine-path; they are the control's own procedures."""
+    said = io.StringIO()
+    blocks = parse_stream(io.BytesIO(f"G0 X0 Y0 Z0\n{block}\nG1 X3\nM30\n".encode()), "a.mpf", "sinumerik")
+    events = list(interpret(blocks, file="a.mpf", warnings=Warnings(stream=said)))
+    assert f"a.mpf:2:1: warning: the predefined procedure {name} is outside" in said.getvalue()
+    assert "file not found" not in said.getvalue()
+    assert all(type(e) is Pass for e in events if e.block.line >= 2)
+
+
+@pytest.mark.parametrize("block", ["WAITP(Z)", "WAITS(2)", "SETMS(1)", "CLRINT(8)"])
+def test_waits_and_settings_that_move_nothing_are_followed_through(block):
+    """`WAITP(Z)`, `CLRINT(8)`, `WAITS(2)` (NadjImre/NC-Programi-za-FB422, SH100.SPF, SH000.SPF;
+    Paket-NC-programa-za-418, ML000.SPF) ended interpretation as calls of missing files."""
+    said = io.StringIO()
+    text = f"G0 X0 Y0 Z0\n{block}\nG1 X3 F100\nM30\n"
+    blocks = parse_stream(io.BytesIO(text.encode()), "a.mpf", "sinumerik")
+    events = list(interpret(blocks, file="a.mpf", warnings=Warnings(stream=said)))
+    assert not said.getvalue()
+    assert [type(e) is Pass for e in events if e.block.line == 3] == [False]
+
+
+def test_the_concatenation_operator_alone_converts_to_a_string():
+    """`SETAL(65017,<<(BROJ))` (NadjImre/Paket-NC-programa-za-418, CMA.DIR/SM000.SPF) was refused as a
+    syntax error: Job Planning manual, "String operations": `STRING_ERG = <<any type`."""
+    assert statements("SETAL(65017,<<(BROJ))") == [
+        ("call", ("SETAL", (("num", 65017.0), ("bin", "<<", ("str", ""), ("param", "broj")))))
+    ]
+    assert statements('MSG("A"<< <<R2)')[0][1][1][0] == (
+        "bin",
+        "<<",
+        ("str", "A"),
+        ("bin", "<<", ("str", ""), ("param", "r2")),
+    )
+
+
+def test_a_contour_offset_ends_interpretation_and_its_reset_does_not():
+    """`OFFN=2` was read and ignored: under G41/G42 the control cuts 2 mm further from the contour
+    (Fundamentals, "Tool radius compensation (G40, G41, G42, OFFN)")."""
+    said = io.StringIO()
+    text = "G0 X0 Y0 Z0\nG1 X5 Y1 OFFN=2 F100\nG1 X3\nOFFN=0\nM30\n"
+    events = list(
+        interpret(
+            parse_stream(io.BytesIO(text.encode()), "a.mpf", "sinumerik"),
+            file="a.mpf",
+            warnings=Warnings(stream=said),
+        )
+    )
+    assert "a.mpf:2:10: warning: the contour offset OFFN= is outside" in said.getvalue()
+    assert all(type(e) is Pass for e in events if e.block.line >= 2)
+    said = io.StringIO()
+    text = "G0 X0 Y0 Z0\nG1 X5 Y1 OFFN=0 F100\nG1 X3\nM30\n"
+    events = list(
+        interpret(
+            parse_stream(io.BytesIO(text.encode()), "a.mpf", "sinumerik"),
+            file="a.mpf",
+            warnings=Warnings(stream=said),
+        )
+    )
+    assert not said.getvalue() and [type(e) is Pass for e in events if e.block.line == 3] == [False]

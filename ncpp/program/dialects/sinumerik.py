@@ -12,7 +12,8 @@ Blocks map onto the common item classes:
 * `;` comments are `Comment`s; parentheses are arithmetic.
 
 Statement kinds and nodes (Sinumerik):
-  assignment   (target, expr)             target ("param", "r1") | ("index", "feld", (exprs))
+  assignment   (target, expr)             target ("param", "r1") | ("index", "feld", (exprs)); a value
+                                          list `OSCTRL[Z]=(1,2)` has the expr ("list", (exprs))
   label        (NAME,)                    `LABEL_1:` (upper case, no colon)
   call         (NAME, args)               `CYCLE81(10,0,2,-5)`, `MSG("x")`, `SETAL(1)`, `BNAT`,
                                           `MATERIAL_UPDATE`: passed through; args tuple of exprs, None if
@@ -28,6 +29,7 @@ Statement kinds and nodes (Sinumerik):
   goto         (KEYWORD, TARGET)          ('GOTOF' | 'GOTOB' | 'GOTOC' | 'GOTO', 'LABEL' | 'N100' | '90')
   case         (expr, branches, default)  branches ((value_expr, KEYWORD, TARGET), ...), default (KEYWORD, TARGET) | None
   program_name (text,)                    `%_N_PART_MPF`
+  sync_action  (text,)                    `ID=7 EVERY $A_IN[7]<>0 DO $R1=1`, to the end of the line
 A main block number `:10` is `Word(':', 10.0, '10')`.
 Expressions: ("num", v) ("str", s) ("param", name) ("index", name, (exprs)) ("neg", x) ("not", x)
 ("bnot", x) ("bin", op, a, b) with op + - * / DIV MOD == <> < > <= >= AND OR XOR B_AND B_OR B_XOR <<,
@@ -47,9 +49,13 @@ from lark import Token, Transformer, v_args
 from ncpp.program.blocks import Comment, ExprWord, Statement, Word
 from ncpp.program.parser import Dialect, _word
 
-# Multi-letter addresses that take `=`: interpolation and spline parameters, polar words.
+# Multi-letter addresses that take `=`: interpolation and spline parameters, polar words, the
+# chamfer / rounding and contour-angle words (Fundamentals, "Chamfer, rounding (CHF, CHR, RND, RNDM,
+# FRC, FRCM)", "Contour definitions": ANG) and the measuring words (Job Planning, "Measurements with
+# touch trigger probe (MEAS, MEAW)"): words of the block, not user variables.
 ADDRESSES = frozenset(
     {"CR", "TURN", "AR", "AP", "RP", "PW", "SD", "PL", "SF", "SPOS", "OFFN", "ACC", "SR", "SRA"}
+    | {"CHF", "CHR", "RND", "RNDM", "ANG", "MEAS", "MEAW"}
 )
 COORDINATE_MODES = frozenset({"AC", "IC", "DC", "ACP", "ACN", "CAC", "CIC"})
 _ADDRESS = re.compile(r"[A-QS-Za-qs-z]\d*|[Rr]")
@@ -91,6 +97,13 @@ class SinumerikBuilder(Transformer):
         if target[0] == "param" and _is_address(target[1]) and not _R_PARAMETER.fullmatch(target[1]):
             return ExprWord(target[1].upper(), value, meta.start_pos, meta.end_pos)
         return Statement("assignment", (target, value), meta.start_pos, meta.end_pos)
+
+    @v_args(meta=True)
+    def assign_list(self, meta, children):
+        # A value list, `OSCTRL[Z]=(1+2,16+32+64)` (Function Manual Extended Functions, "Oscillation
+        # (P5)": the set and the reset options): one ("list", exprs) value
+        target, *values = children
+        return Statement("assignment", (target, ("list", tuple(values))), meta.start_pos, meta.end_pos)
 
     # Helpers that build the rule methods, called in the class body: plain functions, not
     # methods, which mypy cannot tell (hence their `type: ignore[misc]`)
@@ -139,6 +152,7 @@ class SinumerikBuilder(Transformer):
     goto = _statement("goto", _goto)
     case = _statement("case", _case)
     program_name = _statement("program_name", lambda c: (str(c[0]),))
+    sync_action = _statement("sync_action", lambda c: (str(c[0]),))
     else_ = _statement("else", lambda c: ())
     endif = _statement("endif", lambda c: ())
     endwhile = _statement("endwhile", lambda c: ())
@@ -159,7 +173,8 @@ class SinumerikBuilder(Transformer):
         by_reference = isinstance(children[0], Token) and children[0].type == "VAR"
         rest = children[1:] if by_reference else children
         dims = rest[2] if len(rest) > 2 else None
-        return (str(rest[0]).upper(), str(rest[1]).lower(), by_reference, dims)
+        # The type comes from def_type: a STRING parameter carries its length (`STRING[32] NAME`).
+        return (rest[0][0], str(rest[1]).lower(), by_reference, dims)
 
     def case_branch(self, children):
         value, keyword, target = children
@@ -193,6 +208,11 @@ class SinumerikBuilder(Transformer):
         if name in COORDINATE_MODES and len(args) == 1:
             return (name.lower(), args[0])
         return ("call", name, *args)
+
+    def to_string(self, children):
+        # `<<R1` alone converts to STRING (Job Planning manual, "String operations"): the
+        # concatenation with an empty string
+        return ("bin", "<<", ("str", ""), children[1])
 
     def neg(self, children):
         return ("neg", children[0])
