@@ -125,6 +125,15 @@ UNREAD_GEOMETRY = {
     "ANG": "the contour angle",
     "MEAS": "the measuring move",
     "MEAW": "the measuring move",
+    # The tool's length or radius changed in the program, or by a sum offset from the control's table
+    "TOFFL": "the programmable tool length offset",
+    "TOFFR": "the programmable tool radius offset",
+    "DL": "the sum offset",
+    # A corner's transition circle, and a smooth approach or retraction the control shapes itself
+    "DISC": "the transition circle",
+    "DISR": "the approach distance",
+    "DISCL": "the approach distance",
+    "DISRP": "the approach distance",
 }
 # Frame instructions followed: translations; a bare substituting ROT / SCALE / MIRROR resets the frame.
 FRAMES = frozenset(("TRANS", "ATRANS", "ROT", "SCALE", "MIRROR"))

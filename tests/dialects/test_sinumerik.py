@@ -329,6 +329,11 @@ def test_names_that_begin_like_a_synchronized_action_stay_names():
         ("G1 X5 ANG=30 F100", "the contour angle ANG="),
         ("G1 X5 MEAS=1 F100", "the measuring move MEAS="),
         ("G1 X5 MEAW=1 F100", "the measuring move MEAW="),
+        ("G1 X5 TOFFL=5 F100", "the programmable tool length offset TOFFL="),
+        ("G1 X5 TOFFR=0.2 F100", "the programmable tool radius offset TOFFR="),
+        ("G1 X5 DL=1 F100", "the sum offset DL="),
+        ("G1 X5 DISC=2 F100", "the transition circle DISC="),
+        ("G1 X5 DISR=4 F100", "the approach distance DISR="),
     ],
 )
 def test_corner_contour_and_measuring_words_end_interpretation(block, what):
@@ -336,7 +341,10 @@ def test_corner_contour_and_measuring_words_end_interpretation(block, what):
     `RND=1` were read as assignments to user variables and dropped: the probing move was compensated as
     a plain move, and RND=1 stayed on the first piece of the split move, rounding the wrong corner.
     They are words of the block (Fundamentals, "Chamfer, rounding (CHF, CHR, RND, RNDM, FRC, FRCM)",
-    "Contour definitions"; Job Planning, "Measurements with touch trigger probe (MEAS, MEAW)")."""
+    "Contour definitions"; Job Planning, "Measurements with touch trigger probe (MEAS, MEAW)").  So are
+    the tool offsets a program sets (TOFFL, TOFFR, the sum offset DL), which change the length the moves
+    are placed with, and the transition circle and approach distances (DISC, DISR), whose path the
+    control shapes."""
     word = block.split()[-2] if block.endswith("F100") else block
     assert exprs(block).keys() >= {word.split("=")[0]}
     said = io.StringIO()

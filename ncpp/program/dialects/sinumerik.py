@@ -52,10 +52,15 @@ from ncpp.program.parser import Dialect, _word
 # Multi-letter addresses that take `=`: interpolation and spline parameters, polar words, the
 # chamfer / rounding and contour-angle words (Fundamentals, "Chamfer, rounding (CHF, CHR, RND, RNDM,
 # FRC, FRCM)", "Contour definitions": ANG) and the measuring words (Job Planning, "Measurements with
-# touch trigger probe (MEAS, MEAW)"): words of the block, not user variables.
+# touch trigger probe (MEAS, MEAW)"), the programmable tool offsets and the sum offset (Fundamentals,
+# "Programmable tool offset (TOFFL, TOFF, TOFFR)"; "Tool offsets": DL), the transition circle at
+# outside corners and the smooth approach and retraction words (Fundamentals, "Compensation at the
+# outside corners (G450, G451, DISC)", "Smooth approach and retraction": DISR, DISCL, DISRP, FAD):
+# words of the block, not user variables.
 ADDRESSES = frozenset(
     {"CR", "TURN", "AR", "AP", "RP", "PW", "SD", "PL", "SF", "SPOS", "OFFN", "ACC", "SR", "SRA"}
     | {"CHF", "CHR", "RND", "RNDM", "ANG", "MEAS", "MEAW"}
+    | {"TOFFL", "TOFFR", "DL", "DISC", "DISR", "DISCL", "DISRP", "FAD"}
 )
 COORDINATE_MODES = frozenset({"AC", "IC", "DC", "ACP", "ACN", "CAC", "CIC"})
 _ADDRESS = re.compile(r"[A-QS-Za-qs-z]\d*|[Rr]")
