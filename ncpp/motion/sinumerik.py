@@ -256,7 +256,7 @@ class SinumerikInterpreter(ModalInterpreter):
                 expansion.refuse(reason, Location(self.file, block.line, col), inside)
             self.leave_scope(warnings, reason, block, col, caller or owner)
 
-        flow = SinumerikFlow(self.file, self.value, self.assign, lambda: self.done or self.returned, leave,
+        flow = SinumerikFlow(self.file, self.value, self._count, lambda: self.done or self.returned, leave,
                              Revisits(None, None, self.loop_quick, self.loop_state))  # fmt: skip
         for block, kind, owner in flow.steps(blocks):
             if caller is not None:
@@ -492,11 +492,22 @@ class SinumerikInterpreter(ModalInterpreter):
         if target[0] != "param" or target[1].startswith("$"):
             raise OutOfScope(f"the assignment to {target[1].upper()}", item.start + 1)
         name = target[1]
+        if name not in self.variables and not _R_PARAMETER.fullmatch(name):
+            # (a global variable defined in a file of the control's, or an address this reading does not
+            # know: the control reads either its own way)
+            raise OutOfScope(f"the assignment to {name.upper()} (not defined in the program)", item.start + 1)
         if expr[0] == "str":
             self.variables[name] = expr[1]
             return
         value = self.value(expr, block, item)
         self.variables[name] = float(round(value)) if name in self.integers else value
+
+    def _count(self, target: tuple, expr: tuple, block: Block, item) -> None:
+        """A FOR loop's counter set: one the program did not define is taken as a REAL of its own
+        (as the CEAD interpreter takes it)."""
+        if target[0] == "param":
+            self.variables.setdefault(target[1], 0.0)
+        self.assign(target, expr, block, item)
 
     def define(self, node: tuple, block: Block, item) -> None:
         type_name, _, variables = node
@@ -506,9 +517,9 @@ class SinumerikInterpreter(ModalInterpreter):
                 self.integers.add(name)
             if target[0] == "index":
                 self._define_array(type_name, target, init, block, item)
-            elif init is None:
-                self.variables[name] = "" if type_name == "STRING" else 0.0
-            else:
+                continue
+            self.variables[name] = "" if type_name == "STRING" else 0.0
+            if init is not None:
                 self.assign(target, init, block, item)
 
     # -- arrays (Job Planning manual, "Definition and initialization of array variables (DEF,

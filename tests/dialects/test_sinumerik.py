@@ -7,7 +7,7 @@ import io
 import pytest
 
 from ncpp.errors import NcppError, Warnings
-from ncpp.motion.segments import Pass
+from ncpp.motion.segments import Line, Pass
 from ncpp.motion.sinumerik import interpret
 from ncpp.program.blocks import Comment, ExprWord, Statement, Word
 from ncpp.program.parser import LineParser, parse_stream
@@ -421,3 +421,29 @@ def test_a_contour_offset_ends_interpretation_and_its_reset_does_not():
         )
     )
     assert not said.getvalue() and [type(e) is Pass for e in events if e.block.line == 3] == [False]
+
+
+@pytest.mark.parametrize("block", ["FB=50", "MYGUD=3", "ADISX=1"])
+def test_an_assignment_to_a_name_the_program_does_not_define_ends_interpretation(block):
+    """A name the program does not DEF is a global variable of the control's files or an address
+    ncpp does not read (`FB=`, the feed of one block, which a split move would carry on its first
+    piece only): both were stored as a variable of the program and the block's effect dropped."""
+    said = io.StringIO()
+    text = f"G0 X0 Y0 Z0\nG1 X1 F100\n{block}\nG1 X3\nM30\n"
+    events = list(interpret(parse_stream(io.BytesIO(text.encode()), "a.mpf", "sinumerik"), file="a.mpf",
+                            warnings=Warnings(stream=said)))  # fmt: skip
+    assert "a.mpf:3:1: warning: the assignment to " in said.getvalue() and "not defined" in said.getvalue()
+    assert all(type(e) is Pass for e in events if e.block.line >= 3)
+
+
+def test_settings_cam_posts_write_and_defined_variables_are_followed():
+    """`ADIS=`, `CTOL=` and the like set smoothing and tolerances, no path (they are words, not
+    variables); a DEF'd variable, an R parameter and a FOR counter are the program's own."""
+    said = io.StringIO()
+    text = ("DEF REAL DEPTH=2\nG0 X0 Y0 Z0\nADIS=0.5 CTOL=0.01 G642\nR1=4\nDEPTH=DEPTH+1\n"
+            "FOR K=1 TO 2\nG1 X=K*R1 Z=-DEPTH F100\nENDFOR\nM30\n")  # fmt: skip
+    events = list(interpret(parse_stream(io.BytesIO(text.encode()), "a.mpf", "sinumerik"), file="a.mpf",
+                            warnings=Warnings(stream=said)))  # fmt: skip
+    assert "outside" not in said.getvalue(), said.getvalue()
+    ends = [e.end for e in events if type(e) is Line]
+    assert ends[-2:] == [(4.0, 0.0, -3.0), (8.0, 0.0, -3.0)]

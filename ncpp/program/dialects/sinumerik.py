@@ -55,12 +55,15 @@ from ncpp.program.parser import Dialect, _word
 # touch trigger probe (MEAS, MEAW)"), the programmable tool offsets and the sum offset (Fundamentals,
 # "Programmable tool offset (TOFFL, TOFF, TOFFR)"; "Tool offsets": DL), the transition circle at
 # outside corners and the smooth approach and retraction words (Fundamentals, "Compensation at the
-# outside corners (G450, G451, DISC)", "Smooth approach and retraction": DISR, DISCL, DISRP, FAD):
-# words of the block, not user variables.
+# outside corners (G450, G451, DISC)", "Smooth approach and retraction": DISR, DISCL, DISRP, FAD),
+# and the settings CAM posts write beside the path: the smoothing distance (ADIS, ADISPOS), the
+# compressor's tolerances (CTOL, OTOL, ATOL, G0TOL, STOLF), overrides (OVR, OVRRAP), a spindle's
+# positioning and speed limit (SPOSA, LIMS): words of the block, not user variables.
 ADDRESSES = frozenset(
     {"CR", "TURN", "AR", "AP", "RP", "PW", "SD", "PL", "SF", "SPOS", "OFFN", "ACC", "SR", "SRA"}
     | {"CHF", "CHR", "RND", "RNDM", "ANG", "MEAS", "MEAW"}
     | {"TOFFL", "TOFFR", "DL", "DISC", "DISR", "DISCL", "DISRP", "FAD"}
+    | {"ADIS", "ADISPOS", "CTOL", "OTOL", "ATOL", "G0TOL", "STOLF", "OVR", "OVRRAP", "SPOSA", "LIMS"}
 )
 COORDINATE_MODES = frozenset({"AC", "IC", "DC", "ACP", "ACN", "CAC", "CIC"})
 _ADDRESS = re.compile(r"[A-QS-Za-qs-z]\d*|[Rr]")
