@@ -12,6 +12,9 @@ written, or the held direction of an axis that stands.  The command depends
 on that direction and the direction on the commands, so a chunk is solved by
 a few rounds of fixed-point iteration.  Where an axis reverses, the line's
 start is compensated with its own direction and a step move is inserted.
+
+The solve gathers rows of its (n,3) arrays with `take` (and masks them with `compress`):
+numpy's indexing by an array of rows is several times slower on a chunk's few hundred rows.
 """
 
 from __future__ import annotations
@@ -709,19 +712,20 @@ class _Commands:
 
     def __call__(self, which: str, rows: NDArray, d: NDArray) -> NDArray:
         """(r,3) commands for the `which` ("start"/"end") points of `rows` travelled in `d` (r,3)."""
-        stale = any3(self.directions[which][rows] != d)
-        todo, d_todo = rows[stale], d[stale]
+        stale = any3(self.directions[which].take(rows, axis=0) != d)
+        todo, d_todo = rows[stale], d.compress(stale, axis=0)
         if todo.size:
             segs = self.rows
             ends = np.zeros((todo.size, 3), dtype=bool)
-            # (under cutter compensation a line's end is corrected where the tool centre is: `_Rows.shift`)
-            shift = 0.0 if segs.shift is None else segs.shift[todo]  # (a line's is the same at its start)
-            c = compensate(self.wanted[which][todo] + shift, segs.offsets[todo], segs.scales[todo], segs.lines[todo], self.ctx,
+            # (under cutter compensation a line's end is corrected where the tool centre is: `_Rows.shift`;
+            # a line's is the same at its start)
+            shift = 0.0 if segs.shift is None else segs.shift.take(todo, axis=0)
+            c = compensate(self.wanted[which].take(todo, axis=0) + shift, segs.offsets.take(todo, axis=0), segs.scales[todo], segs.lines[todo], self.ctx,
                            d_todo, rows_of(segs.tools, todo), ends) - shift  # fmt: skip
             self.values[which][todo] = quantize(c, self.step[todo])
             self.at_end[which][todo] = ends
             self.directions[which][todo] = d_todo
-        return self.values[which][rows]
+        return self.values[which].take(rows, axis=0)
 
 
 def _directional(rows: _Rows, ctx: PassContext, travel: Travel) -> _Solved:
@@ -752,13 +756,13 @@ def _directional(rows: _Rows, ctx: PassContext, travel: Travel) -> _Solved:
     for round_ in range(ROUNDS):
         redo = np.flatnonzero(free & any3(d != used))
         if redo.size:
-            compensated[redo] = commands("end", redo, d[redo])
+            compensated[redo] = commands("end", redo, d.take(redo, axis=0))
         shift = np.flatnonzero(arc & any3(d != used))
         if shift.size:
             _shift_arcs(shift, rows, d, assumed, step, ctx, out_start, out_end)
-        used[redo], used[shift] = d[redo], d[shift]
-        out_end[free] = compensated[free]
-        _corners(rows, out_end, lambda k: commands("start", k, d[k]), step)  # noqa: B023  # (called here)
+        used[redo], used[shift] = d.take(redo, axis=0), d.take(shift, axis=0)
+        np.copyto(out_end, compensated, where=free[:, None])
+        _corners(rows, out_end, lambda k: commands("start", k, d.take(k, axis=0)), step)  # noqa: B023  # (called here)
         _hold_pieces_still(pieces, d, travel.held, limit, out_start, out_end)
         _pin_plane(rows, out_end, before)
         _settle(free, arc, d, travel.held, offsets, scales, joined, out_start, out_end, before)
@@ -786,7 +790,7 @@ def _directional(rows: _Rows, ctx: PassContext, travel: Travel) -> _Solved:
     turn_start = np.full(start_p.shape, np.nan)
     turned = np.flatnonzero(turn)
     if turned.size:
-        turn_start[turned] = commands("start", turned, d[turned])
+        turn_start[turned] = commands("start", turned, d.take(turned, axis=0))
     travel.held = d[-1].copy()
     travel.last = machine(out_end[-1:], slice(len(free) - 1, None))[0]
     return _Solved(
@@ -929,10 +933,15 @@ def _hold_pieces_still(pieces, d, held, limit, out_start, out_end) -> None:
     rows = np.flatnonzero(pieces)
     if rows.size == 0:
         return
-    before = np.vstack([held[None, :], d[:-1]])[rows]
-    motion = out_end[rows] - out_start[rows]
-    keep = (np.sign(motion) == -before) & (d[rows] == before) & (np.abs(motion) <= limit[rows, None])
-    out_end[rows] = np.where(keep, out_start[rows], out_end[rows])
+    before = np.vstack([held[None, :], d[:-1]]).take(rows, axis=0)
+    start, end = out_start.take(rows, axis=0), out_end.take(rows, axis=0)
+    motion = end - start
+    keep = (
+        (np.sign(motion) == -before)
+        & (d.take(rows, axis=0) == before)
+        & (np.abs(motion) <= limit[rows, None])
+    )
+    out_end[rows] = np.where(keep, start, end)
 
 
 def _own_motion(moved, d, free, start_p, end_p, scales, threshold, commands: _Commands, travel) -> NDArray:
@@ -949,15 +958,15 @@ def _own_motion(moved, d, free, start_p, end_p, scales, threshold, commands: _Co
     rows = np.flatnonzero(any3(flips))
     if rows.size == 0:
         return d
+    along = d.take(rows, axis=0)
     own = steps(
-        (commands("end", rows, d[rows]) - commands("start", rows, d[rows])) * scales[rows, None],
-        threshold[rows],
+        (commands("end", rows, along) - commands("start", rows, along)) * scales[rows, None], threshold[rows]
     )
-    contrary = flips[rows] & (own != 0) & (own != d[rows])
+    contrary = flips.take(rows, axis=0) & (own != 0) & (own != along)
     if not contrary.any():
         return d
     moved = moved.copy()
-    moved[rows] = np.where(contrary, own, moved[rows])
+    moved[rows] = np.where(contrary, own, moved.take(rows, axis=0))
     return hold(moved, travel.held)
 
 
@@ -987,11 +996,11 @@ def _arc_assumed(segs: list, rows: NDArray, start: NDArray, end: NDArray) -> NDA
 def _shift_arcs(at, rows: _Rows, d, assumed, step, ctx, out_start, out_end) -> None:
     """Move arc pieces (rows `at`) by the change of the error between the directions
     they were compensated with (`assumed`) and those they are travelled in (`d`)."""
-    pts = np.stack([rows.start[at], rows.end[at]], axis=1)  # (r,2,3) program
+    pts = np.stack([rows.start.take(at, axis=0), rows.end.take(at, axis=0)], axis=1)  # (r,2,3) program
     scale = rows.scales[at, None, None]
-    pairs = ((pts + rows.offsets[at, None, :]) * scale).reshape(-1, 3)
-    act, was = np.repeat(d[at], 2, axis=0), np.repeat(assumed[at], 2, axis=0)
-    tool = None if rows.tools is None else np.tile(np.repeat(rows.tools[at], 2, axis=0), (2, 1))
+    pairs = ((pts + rows.offsets.take(at, axis=0)[:, None, :]) * scale).reshape(-1, 3)
+    act, was = np.repeat(d.take(at, axis=0), 2, axis=0), np.repeat(assumed.take(at, axis=0), 2, axis=0)
+    tool = None if rows.tools is None else np.tile(np.repeat(rows.tools.take(at, axis=0), 2, axis=0), (2, 1))
     # both directions in one call (the map's cost per call is that of some 500 points)
     both = deviation(ctx.model, np.vstack([pairs, pairs]), np.vstack([act, was]), tool)
     change = both[: len(pairs)] - both[len(pairs) :]
