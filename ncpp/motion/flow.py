@@ -70,6 +70,7 @@ bodies for the call.
 from __future__ import annotations
 
 import os
+import re
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -661,7 +662,8 @@ class Flow:
                             return lines
                     if len(lines) > MAX_SUBPROGRAM:
                         break
-            raise NcppError(f"O{name} ... M99 is not in the file", Location(str(path), 1, 1))
+            raise NcppError(f"O{name} ... M99 is not in the file{_above_the_tape(path, name)}",
+                            Location(str(path), 1, 1))  # fmt: skip
         return None
 
     def _from_file(self, name: str) -> list[Block] | None:
@@ -1485,3 +1487,19 @@ def _program_files(folder: Path, name: str) -> list[Path]:
 
 def _shown(name: str) -> str:
     return name if name.isdigit() else f"<{printable(name)}>"
+
+
+def _above_the_tape(path: Path, name: str) -> str:
+    """Why a program file's `O<name>` was not read, where it stands above the file's first `%`
+    (the tape's leader, which a Fanuc control skips); else nothing."""
+    with open(path, "rb") as stream:
+        head = stream.read(1 << 16)
+    start = re.search(rb"^[ \t]*%", head, re.MULTILINE)
+    if start is not None and re.search(
+        rb"(?im)^[ \t]*O0*" + name.lstrip("0").encode() + rb"\b", head[: start.start()]
+    ):
+        return (
+            ": it stands above the file's first `%`, and a Fanuc control reads the text before that as "
+            "the tape's leader and skips it (put a `%` line above it)"
+        )
+    return ""

@@ -496,6 +496,21 @@ def test_a_program_file_without_its_number_is_an_error_at_the_file(tmp_path):
     )
 
 
+def test_a_program_above_its_files_first_percent_is_said_to_stand_in_the_leader(tmp_path):
+    """`O1002 ... M99 %` with no `%` above it (as a PC may keep a program): the control reads the text
+    before the first `%` as the tape's leader and skips it; the error said only that O1002 is not in
+    the file, where it plainly stands."""
+    from ncpp.motion.offsets import WorkOffsets
+
+    (tmp_path / "O1002.nc").write_text("O1002\nG91 G1 Z-1 F100\nM99\n%\n")
+    program = write_program(tmp_path, "O1000\n" + HEAD + "M98 P1002\nM30\n", "main.nc")
+    _, error, _ = ours(program, offsets=WorkOffsets.given({}, subroutine_path=[tmp_path]))
+    assert (
+        error is not None
+        and "O1002 ... M99 is not in the file: it stands above the file's first `%`" in str(error)
+    )
+
+
 # A macro that moves to the first local variables of each I J K set: X#4 Y#7 Z#10, X#13 Y#16 Z#19,
 # X#22 Y#25 Z#28, X#31 Y#5 Z#33, vacant ones left out of the move (Fanuc: no address)
 SETS_MACRO = "O700\nG1 X#4 Y#7 Z#10 F100\nG1 X#13 Y#16 Z#19\nG1 X#22 Y#25 Z#28\nG1 X#31 Y#5 Z#33\nM99\n"
