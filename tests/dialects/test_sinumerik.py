@@ -15,6 +15,14 @@ from ncpp.program.parser import LineParser, parse_stream
 PARSER = LineParser("sinumerik")
 
 
+def interpreted(text: str, file: str = "a.mpf") -> tuple[list, str]:
+    """The events of a Sinumerik program's text, and the warnings said while reading it."""
+    said = io.StringIO()
+    events = list(interpret(parse_stream(io.BytesIO(text.encode()), file, "sinumerik"), file=file,
+                            warnings=Warnings(stream=said)))  # fmt: skip
+    return events, said.getvalue()
+
+
 def items(text: str) -> tuple:
     return PARSER.parse(text).items
 
@@ -228,10 +236,8 @@ def test_an_exponent_written_with_ex_is_a_number():
 )
 def test_geometry_the_interpreter_does_not_follow_ends_interpretation(block, what):
     """`G2 AR=90 I5` was read as a full circle about I5 (AR ignored), and AR=90 copied into every piece."""
-    said = io.StringIO()
-    blocks = parse_stream(io.BytesIO(f"G0 X0 Y0 Z0\n{block}\nG1 X3\nM30\n".encode()), "a.mpf", "sinumerik")
-    events = list(interpret(blocks, file="a.mpf", warnings=Warnings(stream=said)))
-    assert "a.mpf:2:" in said.getvalue() and f"warning: {what} is outside" in said.getvalue()
+    events, said = interpreted(f"G0 X0 Y0 Z0\n{block}\nG1 X3\nM30\n")
+    assert "a.mpf:2:" in said and f"warning: {what} is outside" in said
     assert all(type(e) is Pass for e in events if e.block.line >= 2)
 
 
@@ -252,16 +258,9 @@ def test_a_string_parameter_of_a_procedure_carries_its_length():
             ),
         )
     ]
-    said = io.StringIO()
     text = "PROC P(STRING[8] NAME, REAL D)\nG0 X0 Y0 Z0\nG1 X5 F100\nM17\n"
-    events = list(
-        interpret(
-            parse_stream(io.BytesIO(text.encode()), "p.spf", "sinumerik"),
-            file="p.spf",
-            warnings=Warnings(stream=said),
-        )
-    )
-    assert not said.getvalue() and [type(e) is Pass for e in events if e.block.line == 3] == [False]
+    events, said = interpreted(text, "p.spf")
+    assert not said and [type(e) is Pass for e in events if e.block.line == 3] == [False]
 
 
 def test_a_value_list_is_read_and_left_out_of_scope():
@@ -271,16 +270,9 @@ def test_a_value_list_is_read_and_left_out_of_scope():
     ((kind, (target, value)),) = statements("OSCTRL[Z]=(1+2,16+32+64)")
     assert (kind, target[:2], value[0], len(value[1])) == ("assignment", ("index", "osctrl"), "list", 2)
     assert statements("R1=(2+3)")[0][1][1][0] == "bin"
-    said = io.StringIO()
     text = "G0 X0 Y0 Z0\nOSCTRL[Z]=(1+2,16+32+64)\nG1 X3 F100\nM30\n"
-    events = list(
-        interpret(
-            parse_stream(io.BytesIO(text.encode()), "a.mpf", "sinumerik"),
-            file="a.mpf",
-            warnings=Warnings(stream=said),
-        )
-    )
-    assert "a.mpf:2:1: warning: the value list assigned to OSCTRL is outside" in said.getvalue()
+    events, said = interpreted(text)
+    assert "a.mpf:2:1: warning: the value list assigned to OSCTRL is outside" in said
     assert all(type(e) is Pass for e in events if e.block.line >= 2)
 
 
@@ -300,17 +292,10 @@ def test_a_synchronized_action_is_read_whole_and_left_out_of_scope(block):
     `[ID=<n>|IDS=<n>] [WHEN|WHENEVER|FROM|EVERY] <condition> DO <actions>`, alone in its block."""
     ((kind, (text,)),) = statements(block)
     assert (kind, text) == ("sync_action", block)
-    said = io.StringIO()
     text = f"G0 X0 Y0 Z0\n{block}\nG1 X3 F100\nM30\n"
-    events = list(
-        interpret(
-            parse_stream(io.BytesIO(text.encode()), "a.mpf", "sinumerik"),
-            file="a.mpf",
-            warnings=Warnings(stream=said),
-        )
-    )
+    events, said = interpreted(text)
     warning = "a.mpf:2:1: warning: the synchronized action (it acts beside the blocks) is outside"
-    assert warning in said.getvalue()
+    assert warning in said
     assert all(type(e) is Pass for e in events if e.block.line >= 2)
 
 
@@ -347,10 +332,8 @@ def test_corner_contour_and_measuring_words_end_interpretation(block, what):
     control shapes."""
     word = block.split()[-2] if block.endswith("F100") else block
     assert exprs(block).keys() >= {word.split("=")[0]}
-    said = io.StringIO()
-    blocks = parse_stream(io.BytesIO(f"G0 X0 Y0 Z0\n{block}\nG1 X3\nM30\n".encode()), "a.mpf", "sinumerik")
-    events = list(interpret(blocks, file="a.mpf", warnings=Warnings(stream=said)))
-    assert "a.mpf:2:" in said.getvalue() and f"warning: {what} is outside" in said.getvalue()
+    events, said = interpreted(f"G0 X0 Y0 Z0\n{block}\nG1 X3\nM30\n")
+    assert "a.mpf:2:" in said and f"warning: {what} is outside" in said
     assert all(type(e) is Pass for e in events if e.block.line >= 2)
 
 
@@ -363,11 +346,9 @@ def test_a_predefined_procedure_is_named_as_such_not_looked_for_as_a_file(block,
     """`DIAMON`, `CTABDEF(X,C,1,1,"DRAM")`, `SETINT(8) PRIO=1 SH600`, `EXECSTRING( NAZPROG )`
     (NadjImre/NC-Programi-za-FB422, CMA.DIR/SH000.SPF, TB100.SPF) were looked for as subprogram files and
     the warning asked for a --subroutine-path; they are the control's own procedures."""
-    said = io.StringIO()
-    blocks = parse_stream(io.BytesIO(f"G0 X0 Y0 Z0\n{block}\nG1 X3\nM30\n".encode()), "a.mpf", "sinumerik")
-    events = list(interpret(blocks, file="a.mpf", warnings=Warnings(stream=said)))
-    assert f"a.mpf:2:1: warning: the predefined procedure {name} is outside" in said.getvalue()
-    assert "file not found" not in said.getvalue()
+    events, said = interpreted(f"G0 X0 Y0 Z0\n{block}\nG1 X3\nM30\n")
+    assert f"a.mpf:2:1: warning: the predefined procedure {name} is outside" in said
+    assert "file not found" not in said
     assert all(type(e) is Pass for e in events if e.block.line >= 2)
 
 
@@ -375,11 +356,8 @@ def test_a_predefined_procedure_is_named_as_such_not_looked_for_as_a_file(block,
 def test_waits_and_settings_that_move_nothing_are_followed_through(block):
     """`WAITP(Z)`, `CLRINT(8)`, `WAITS(2)` (NadjImre/NC-Programi-za-FB422, SH100.SPF, SH000.SPF;
     Paket-NC-programa-za-418, ML000.SPF) ended interpretation as calls of missing files."""
-    said = io.StringIO()
-    text = f"G0 X0 Y0 Z0\n{block}\nG1 X3 F100\nM30\n"
-    blocks = parse_stream(io.BytesIO(text.encode()), "a.mpf", "sinumerik")
-    events = list(interpret(blocks, file="a.mpf", warnings=Warnings(stream=said)))
-    assert not said.getvalue()
+    events, said = interpreted(f"G0 X0 Y0 Z0\n{block}\nG1 X3 F100\nM30\n")
+    assert not said
     assert [type(e) is Pass for e in events if e.block.line == 3] == [False]
 
 
@@ -400,27 +378,13 @@ def test_the_concatenation_operator_alone_converts_to_a_string():
 def test_a_contour_offset_ends_interpretation_and_its_reset_does_not():
     """`OFFN=2` was read and ignored: under G41/G42 the control cuts 2 mm further from the contour
     (Fundamentals, "Tool radius compensation (G40, G41, G42, OFFN)")."""
-    said = io.StringIO()
     text = "G0 X0 Y0 Z0\nG1 X5 Y1 OFFN=2 F100\nG1 X3\nOFFN=0\nM30\n"
-    events = list(
-        interpret(
-            parse_stream(io.BytesIO(text.encode()), "a.mpf", "sinumerik"),
-            file="a.mpf",
-            warnings=Warnings(stream=said),
-        )
-    )
-    assert "a.mpf:2:10: warning: the contour offset OFFN= is outside" in said.getvalue()
+    events, said = interpreted(text)
+    assert "a.mpf:2:10: warning: the contour offset OFFN= is outside" in said
     assert all(type(e) is Pass for e in events if e.block.line >= 2)
-    said = io.StringIO()
     text = "G0 X0 Y0 Z0\nG1 X5 Y1 OFFN=0 F100\nG1 X3\nM30\n"
-    events = list(
-        interpret(
-            parse_stream(io.BytesIO(text.encode()), "a.mpf", "sinumerik"),
-            file="a.mpf",
-            warnings=Warnings(stream=said),
-        )
-    )
-    assert not said.getvalue() and [type(e) is Pass for e in events if e.block.line == 3] == [False]
+    events, said = interpreted(text)
+    assert not said and [type(e) is Pass for e in events if e.block.line == 3] == [False]
 
 
 @pytest.mark.parametrize("block", ["FB=50", "MYGUD=3", "ADISX=1"])
@@ -428,11 +392,9 @@ def test_an_assignment_to_a_name_the_program_does_not_define_ends_interpretation
     """A name the program does not DEF is a global variable of the control's files or an address
     ncpp does not read (`FB=`, the feed of one block, which a split move would carry on its first
     piece only): both were stored as a variable of the program and the block's effect dropped."""
-    said = io.StringIO()
     text = f"G0 X0 Y0 Z0\nG1 X1 F100\n{block}\nG1 X3\nM30\n"
-    events = list(interpret(parse_stream(io.BytesIO(text.encode()), "a.mpf", "sinumerik"), file="a.mpf",
-                            warnings=Warnings(stream=said)))  # fmt: skip
-    assert "a.mpf:3:1: warning: the assignment to " in said.getvalue() and "not defined" in said.getvalue()
+    events, said = interpreted(text)
+    assert "a.mpf:3:1: warning: the assignment to " in said and "not defined" in said
     assert all(type(e) is Pass for e in events if e.block.line >= 3)
 
 
@@ -444,6 +406,6 @@ def test_settings_cam_posts_write_and_defined_variables_are_followed():
             "FOR K=1 TO 2\nG1 X=K*R1 Z=-DEPTH F100\nENDFOR\nM30\n")  # fmt: skip
     events = list(interpret(parse_stream(io.BytesIO(text.encode()), "a.mpf", "sinumerik"), file="a.mpf",
                             warnings=Warnings(stream=said)))  # fmt: skip
-    assert "outside" not in said.getvalue(), said.getvalue()
+    assert "outside" not in said, said
     ends = [e.end for e in events if type(e) is Line]
     assert ends[-2:] == [(4.0, 0.0, -3.0), (8.0, 0.0, -3.0)]
