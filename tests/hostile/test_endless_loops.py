@@ -38,6 +38,15 @@ def _fanuc(text: str) -> list:
     return list(run(parse_stream(io.BytesIO(text.encode()), "t.nc", "fanuc"), file="t.nc"))
 
 
+def _refused_at(read, text: str, file: str, line: int, head: int) -> None:
+    """`read(text)` refuses the loop at `line`, naming the loop's head, `head`."""
+    with pytest.raises(
+        NcppError, match=rf"a loop that does not end: it comes back to line {head} with"
+    ) as err:
+        read(text)
+    assert (err.value.where.file, err.value.where.line) == (file, line)
+
+
 def _ends(events: list) -> list[tuple[float, ...]]:
     return [tuple(round(v, 6) for v in e.end[:3]) for e in events if type(e) is Line]
 
@@ -68,11 +77,7 @@ ENDLESS_ISO = {
 @pytest.mark.parametrize("name", ENDLESS_ISO)
 def test_an_iso_loop_back_at_a_state_it_had_is_refused_at_once(name):
     text, line, head = ENDLESS_ISO[name]
-    with pytest.raises(
-        NcppError, match=rf"a loop that does not end: it comes back to line {head} with"
-    ) as err:
-        _iso(text)
-    assert (err.value.where.file, err.value.where.line) == ("t.ngc", line)
+    _refused_at(_iso, text, "t.ngc", line, head)
 
 
 ENDLESS_FANUC = {
@@ -89,11 +94,7 @@ ENDLESS_FANUC = {
 @pytest.mark.parametrize("name", ENDLESS_FANUC)
 def test_a_fanuc_loop_back_at_a_state_it_had_is_refused_at_once(name):
     text, line, head = ENDLESS_FANUC[name]
-    with pytest.raises(
-        NcppError, match=rf"a loop that does not end: it comes back to line {head} with"
-    ) as err:
-        _fanuc(text)
-    assert (err.value.where.file, err.value.where.line) == ("t.nc", line)
+    _refused_at(_fanuc, text, "t.nc", line, head)
 
 
 def test_a_loop_whose_counter_counts_for_ever_is_left_to_the_bound(monkeypatch):
@@ -193,11 +194,7 @@ def test_a_sinumerik_loop_back_at_a_state_it_had_is_refused_at_once(monkeypatch,
 
     monkeypatch.setattr(sinumerik_flow, "MAX_RERUN", BOUND)
     text, line, head = ENDLESS_SINUMERIK[name]
-    with pytest.raises(
-        NcppError, match=rf"a loop that does not end: it comes back to line {head} with"
-    ) as err:
-        _sinumerik(SINUMERIK_HEAD + text)
-    assert (err.value.where.file, err.value.where.line) == ("t.mpf", line)
+    _refused_at(_sinumerik, SINUMERIK_HEAD + text, "t.mpf", line, head)
 
 
 def test_a_sinumerik_loop_with_a_counter_or_a_toggle_it_ends_runs_to_its_end():
@@ -222,9 +219,7 @@ def test_a_klartext_jump_back_at_a_state_it_had_is_refused_at_once(monkeypatch):
     from ncpp.motion import heidenhain_flow
 
     monkeypatch.setattr(heidenhain_flow, "MAX_RERUN", BOUND)
-    with pytest.raises(NcppError, match="a loop that does not end: it comes back to line 5 with") as err:
-        _klartext(KLARTEXT)
-    assert (err.value.where.file, err.value.where.line) == ("t.h", 8)
+    _refused_at(_klartext, KLARTEXT, "t.h", 8, 5)
 
 
 def test_a_klartext_jump_back_whose_parameter_counts_runs_to_its_end():
