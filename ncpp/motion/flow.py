@@ -6,6 +6,10 @@ with what the interpreter is to do with it (`kind`):
 * RUN   — execute it in its place in the text;
 * FIXED — execute it as part of a loop or a subroutine: its moves are left
   as programmed (a body runs many times from one text);
+* ONCE  — execute it in its place, in a loop's first pass: whether its text runs
+  again is told by the next block the flow yields (RUN: the loop ended and the
+  body ran once, its moves may be rewritten for that run as RUN's; a block run
+  again, FIXED: they are left as programmed as FIXED's);
 * SKIP  — write its text; it does not run (an untaken branch, a subroutine's
   definition, a loop that runs no time);
 * TEXT  — write its text: a control line this module has executed
@@ -82,7 +86,7 @@ from ncpp.motion.modal import OutOfScope
 from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
 from ncpp.program.parser import parse_stream
 
-RUN, FIXED, SKIP, TEXT = "run", "fixed", "skip", "text"
+RUN, FIXED, ONCE, SKIP, TEXT = "run", "fixed", "once", "skip", "text"
 _TRIM = 4096  # blocks no loop can go back to are dropped in runs of this many
 # Blocks after an `O<n>` line kept as Fanuc subprogram `n` until its M99: a longer one is a
 # program's own number (`O1000` at its top), not a subprogram, and memory stays bounded.
@@ -280,6 +284,7 @@ class Flow:
         self.dropped: set[int] = set()  # sequence numbers of main-program blocks no longer held
         self.looped: set[int] = set()  # main-program lines a backward GOTO read ahead runs again
         self.last_run_move = -1  # the text line of the last move run in place (RUN): the interpreter's
+        self.once_move = -1  # and of a loop's first pass (ONCE) not yet told: it may be rewritten too
         # A Fanuc macro program: a macro statement or G65 among the blocks read ahead (which
         # LinuxCNC refuses; its M98, M99 and O numbers may be LinuxCNC's): its locals start
         # vacant, #1000 and up are the control's system variables, #3000 an alarm
@@ -390,8 +395,14 @@ class Flow:
 
     def _kind(self, frame: _Frame) -> tuple[str, Block | None]:
         if self._in_place(frame):
-            return (FIXED if frame.labels or frame.pc in self.looped else RUN), None
+            if frame.pc in self.looped:
+                return FIXED, None
+            return (ONCE if frame.labels else RUN), None
         return FIXED, self.owner
+
+    def in_straight_code(self) -> bool:
+        """Whether the program runs its main text with no loop under way (none can go back)."""
+        return len(self.frames) == 1 and not self.frames[0].labels
 
     def _in_place(self, frame: _Frame) -> bool:
         return frame.space is None and frame.pc == self.written
@@ -908,7 +919,7 @@ class Flow:
             self.stop(f"GOTO {number} back, the program's first macro statement past the {_TRIM:,} blocks "
                       "read ahead", block, col)  # fmt: skip
             return lambda: None
-        if frame.space is None and self.last_run_move >= target_line:
+        if frame.space is None and max(self.last_run_move, self.once_move) >= target_line:
             self.stop(f"GOTO {number} back over moves that ran once in their place (their text may be "
                       "rewritten for that run; a WHILE ... DO loop or a loop near the top of the program is "
                       "followed)", block, col)  # fmt: skip
@@ -1179,7 +1190,7 @@ class Flow:
         )
         defining = self._defining and (self._defining[1], len(self._defining[2]))
         held = (self.written, self.base, self.read, self.leader, id(self.owner), self._fault is None,
-                defining, self.last_run_move, self.fanuc, len(self.dropped), len(self.looped),
+                defining, self.last_run_move, self.once_move, self.fanuc, len(self.dropped), len(self.looped),
                 len(self.subroutines), len(self.subprograms), len(self.defined_at), len(self.files),
                 len(self.program_files), len(self._whole_programs), len(self._definitions))  # fmt: skip
         flags = (self.skipping, self.executed_if, self.doing_break, self.doing_continue, self.moved)

@@ -58,7 +58,7 @@ from ncpp.motion.cycles import (
 from ncpp.motion.endless import exact
 from ncpp.motion.expand import Expansion, number, refused
 from ncpp.motion.expressions import ExpressionError, OutOfScope, Parameters, evaluate, vacant
-from ncpp.motion.flow import FIXED, RUN, SKIP, Flow
+from ncpp.motion.flow import FIXED, ONCE, RUN, SKIP, Flow
 from ncpp.motion.offsets import SYSTEMS, WorkOffsets
 from ncpp.motion.segments import (
     COMP,
@@ -100,6 +100,9 @@ CENTER_ARC_ABS = {False: 2 * 0.01 * math.sqrt(2), True: 2 * 0.001 * math.sqrt(2)
 CENTER_ARC_REL = 0.001
 TINY = 1e-12
 # Moves of one canned-cycle block (L repeats, pecks): held at once, so bounded; a real one makes thousands
+# Events of a loop's first pass held until the flow tells whether its text runs again: a longer
+# pass is left as programmed (memory stays bounded)
+MAX_ONCE = 50_000
 MAX_CYCLE_MOVES = 1_000_000
 
 _GROUP_CODES = {
@@ -297,6 +300,7 @@ class Interpreter:
         self._context: Context | None = None
         self._fast = False
         self.done = False  # program end (M2/M30) reached or state unknown
+        self.ended = False  # program end (M2/M30) reached
         self.corner: tuple[str, float, Word | ExprWord] | None = None  # Fanuc ,R / ,C of the last block
         self.cutter_comp: float | None = None  # G41, G41.1, G42 or G42.1 in effect (None: G40)
         self.comp_radius: float | None = (
@@ -339,12 +343,15 @@ class Interpreter:
         """Events block by block, in the order the blocks run (o-word control flow,
         `flow.py`).  A line with a Fanuc corner word (`,R` `,C`, `G1 ... R`) waits
         for the next move, which decides the corner; the blocks in between wait
-        with it (bounded by the program's own layout)."""
+        with it (bounded by the program's own layout).  The events of a loop's first pass in
+        its place (ONCE) wait until the flow tells whether its text runs again (`_told`)."""
         block_event = self.block
         self.warnings = self.untold_lengths.warnings = warnings
         pending: Line | None = None  # the line whose end corner is rounded
         corner: tuple = ()  # its corner word: (kind, size, item); read only with a pending line
         held: list[Event] = []  # non-moving events after it
+        once: _FirstPass | None = None  # a loop's first pass in its place, while the flow has not told
+        spent = False  # the loop under way left its first pass as programmed: its body stays so
         flow = self.flow = Flow(
             self.file, self._evaluate, self.params, lambda: self.done, self._leave_scope,
             self.subroutine_path, state=self._loop_state, position=lambda: self.pos[:],
@@ -352,7 +359,22 @@ class Interpreter:
         self.rounding = False
         expansion = self.expansion
         for block, kind, owner in flow.steps(blocks):
-            if kind is not RUN and kind is not FIXED:  # text that does not run here
+            if once is not None and len(once.events) > MAX_ONCE:
+                yield from self._told(once, again=True)
+                once, spent = None, True
+            if kind is ONCE and (
+                spent or expansion is not None or pending is not None or self.corner is not None
+            ):
+                kind = FIXED
+            if once is not None and (self.done or flow.in_straight_code()):
+                yield from self._told(once, again=self.done and not self.ended)
+                once = None
+            if kind is ONCE and once is None:
+                once = _FirstPass()
+            elif once is not None and kind is FIXED and owner is not None:
+                once.rerun(block)
+            spent = spent and kind is not RUN
+            if kind is not RUN and kind is not FIXED and kind is not ONCE:  # text that does not run here
                 ended = self.done or block.verbatim  # (verbatim: after the closing `%`)
                 if expansion is not None:
                     kept = expansion.text(kind, ended, block)  # (None: left out)
@@ -369,6 +391,8 @@ class Interpreter:
                 )  # (after the end: no mode the control is in)
                 if pending is not None:
                     held.append(text)
+                elif once is not None:
+                    once.add(text, block, again=False)
                 else:
                     yield text
                 continue
@@ -377,6 +401,10 @@ class Interpreter:
                     event, block = expansion.event(block_event, block, kind)
                 else:
                     event = block_event(block)  # verbatim blocks (after the closing %) have no items
+                if kind is ONCE and (self.corner is not None or _sets_offset(event) or self._compensating()):
+                    if once is not None:
+                        yield from self._told(once, again=True)  # (`_in_flow` tells why, below)
+                    once, spent, kind = None, True, FIXED
                 if kind is FIXED and expansion is None:
                     event = self._in_flow(event, owner)
                 if flow.modal is not None and _moves(event):  # a move under G66: the macro next
@@ -384,13 +412,10 @@ class Interpreter:
                 if self.params.fanuc:
                     if kind is RUN and _moves(event):  # in its place: no backward GOTO may run it again
                         flow.last_run_move = block.line
+                    elif kind is ONCE and _moves(event):
+                        flow.once_move = block.line
                     self._note_placed(block)
-                if (
-                    self.centre.off_path
-                    or self.cutter_comp is not None
-                    or self.arc_refused
-                    or self.exit_corner
-                ):
+                if self._compensating():
                     event = self._in_comp(event, block)
             except NcppError as err:
                 source = flow.source()
@@ -402,6 +427,9 @@ class Interpreter:
                 ) from None
             except _OutOfScope as stop:
                 self._leave_scope(stop.reason, block, stop.col, owner)
+                if once is not None:
+                    yield from self._told(once, again=True)
+                    once = None
                 if pending is not None:
                     yield from self._unrounded(pending, held)
                     pending, self.rounding = None, False
@@ -412,7 +440,10 @@ class Interpreter:
                 continue
             if pending is None and self.corner is None and type(event) is not tuple:
                 # the common case: no corner waits, none starts (and not a tuple)
-                yield event  # type: ignore[misc]
+                if once is None:
+                    yield event  # type: ignore[misc]
+                else:
+                    once.add(event, block, again=kind is FIXED)  # type: ignore[arg-type]
                 continue
             events: tuple[Event, ...] = event if type(event) is tuple else (event,)  # type: ignore[assignment]
             new_corner, self.corner = self.corner, None
@@ -434,7 +465,12 @@ class Interpreter:
                 if new_corner is not None and type(ev) is Line and ev.block is block:
                     pending, corner, self.rounding = ev, new_corner, True
                     continue
-                yield ev
+                if once is None:
+                    yield ev
+                else:
+                    once.add(ev, block, again=kind is FIXED)
+        if once is not None:
+            yield from self._told(once, again=not self.ended)
         if pending is not None:
             _, _, item = corner
             raise NcppError(
@@ -469,28 +505,27 @@ class Interpreter:
         and, where it runs out of the text's order, belong to `owner` (its text is elsewhere)."""
         if self.corner is not None:
             raise _OutOfScope("Fanuc corner rounding in a loop or subroutine", None)
+        if _sets_offset(event):  # set from where each run of the text stands: no one shift
+            raise _OutOfScope("G92 or G10 L20 in a loop or subroutine (it sets an offset from where "
+                              "the control stands, which compensation moves)", None)  # fmt: skip
         events: tuple[Event, ...] = event if type(event) is tuple else (event,)  # type: ignore[assignment]
-        out: list[Event] = []
-        for ev in events:
-            if type(ev) is Pass:
-                ev.length_told = None  # (the text runs again, or elsewhere, perhaps with another tool)
-                ev.zero_told = None  # (and perhaps after the program set the zero)
-                if ev.setting is not None:  # set from where each run of the text stands: no one shift
-                    raise _OutOfScope("G92 or G10 L20 in a loop or subroutine (it sets an offset from where "
-                                      "the control stands, which compensation moves)", None)  # fmt: skip
-                if owner is None and not _expanding(ev):  # (a cycle there stays one: as programmed)
-                    out.append(ev)
-                continue
-            if ev.fixed in (HOLE, CYCLE):  # type: ignore[union-attr]  # (a move: `type(ev) is Pass` above)
-                # each run may need a correction of its own: the cycle is left as programmed; in a
-                # body written in place it starts from where each run stands (a step to its
-                # programmed start written there would run every time): a loop's move
-                ev.fixed, ev.hole = (CYCLE if owner is not None else FLOW), None  # type: ignore[union-attr]
-            ev.fixed = ev.fixed or FLOW  # type: ignore[union-attr]
-            if owner is not None:
-                ev.block = owner
-            out.append(ev)
+        out = [kept for ev in events if (kept := _as_programmed(ev, owner)) is not None]
         return tuple(out) if len(out) != 1 else out[0]
+
+    def _compensating(self) -> bool:
+        """Whether cutter compensation, or the way out of it, decides where the block's moves go."""
+        return self.centre.off_path or self.cutter_comp is not None or self.arc_refused or self.exit_corner
+
+    def _told(self, once: _FirstPass, again: bool) -> list[Event]:
+        """A loop's first pass in its place (ONCE), once the flow has told whether its text runs
+        again: then left as programmed (`_in_flow`'s marks), else as it ran but for the text an
+        inner loop ran again; a backward GOTO may no longer run what ran so."""
+        events = once.told(again)
+        if self.params.fanuc and self.flow is not None:
+            lines = [ev.block.line for ev in events if type(ev) is not Pass and not ev.fixed]  # type: ignore[union-attr]
+            self.flow.last_run_move = max([self.flow.last_run_move, *lines])
+            self.flow.once_move = -1
+        return events
 
     def _in_comp(self, event: Event | tuple[Event, ...], block: Block) -> Event | tuple[Event, ...]:
         """A block's events with cutter compensation on, or the first move after G40: its
@@ -1343,7 +1378,7 @@ class Interpreter:
         self.motion = 1.0
         self.cutter_comp, self.comp_radius, self.arc_refused = None, None, False
         self.centre.reset()
-        self.done = True
+        self.done = self.ended = True
 
     def _machine(self, i: int) -> float:
         return self.pos[i] + self.g5x[self.coord_system][i] + self.g92[i] + self.tool[i]
@@ -1943,6 +1978,65 @@ def _marked(events: Event | tuple[Event, ...] | None, marks: list[Pass]) -> Even
     if events is None:
         return marks[0] if len(marks) == 1 else tuple(marks)
     return (*(events if type(events) is tuple else (events,)), *marks)
+
+
+class _FirstPass:
+    """The events of a loop's first pass in its place (ONCE), held until the flow tells whether
+    their text runs again, each marked where it is known to: a block run in place as part of a
+    loop (FIXED) and, when a block of the pass runs again (an inner loop's second pass), the
+    events from that block's first on (the runs again come after them)."""
+
+    def __init__(self) -> None:
+        self.events: list[Event] = []
+        self.again: list[bool] = []  # the event's text runs again
+        self.first: dict[int, int] = {}  # the id of a block run once so far -> its first event's index
+        self.again_from = 0  # the events from this index on all run again
+
+    def add(self, event: Event, block: Block, again: bool) -> None:
+        if not again:
+            self.first.setdefault(id(block), len(self.events))
+            self.again_from = len(self.events) + 1
+        self.events.append(event)
+        self.again.append(again)
+
+    def rerun(self, block: Block) -> None:
+        """`block` runs again: its text, and that of the blocks after it, runs more than once."""
+        start = self.first.pop(id(block), None)
+        if start is not None and start < self.again_from:
+            self.again[start : self.again_from] = [True] * (self.again_from - start)
+            self.again_from = start
+
+    def told(self, again: bool) -> list[Event]:
+        """The events, all left as programmed if the pass runs again, else those marked so."""
+        marked = (
+            _as_programmed(ev, None) if again or twice else ev for ev, twice in zip(self.events, self.again)
+        )
+        return [ev for ev in marked if ev is not None]
+
+
+def _sets_offset(event: Event | tuple[Event, ...]) -> bool:
+    """Whether the events set an offset from where the control stands (G92, G10 L20)."""
+    events = event if type(event) is tuple else (event,)
+    return any(type(ev) is Pass and ev.setting is not None for ev in events)
+
+
+def _as_programmed(ev: Event, owner: Block | None) -> Event | None:
+    """An event of a loop's or a subroutine's text (`Interpreter._in_flow`): a move left as
+    programmed, belonging to `owner` where it runs out of the text's order; a text event kept
+    in the text's place (None: not there)."""
+    if type(ev) is Pass:
+        ev.length_told = None  # (the text runs again, or elsewhere, perhaps with another tool)
+        ev.zero_told = None  # (and perhaps after the program set the zero)
+        return ev if owner is None and not _expanding(ev) else None  # (a cycle there stays one)
+    if ev.fixed in (HOLE, CYCLE):  # type: ignore[union-attr]
+        # each run may need a correction of its own: the cycle is left as programmed; in a
+        # body written in place it starts from where each run stands (a step to its
+        # programmed start written there would run every time): a loop's move
+        ev.fixed, ev.hole = (CYCLE if owner is not None else FLOW), None  # type: ignore[union-attr]
+    ev.fixed = ev.fixed or FLOW  # type: ignore[union-attr]
+    if owner is not None:
+        ev.block = owner
+    return ev
 
 
 def _expanding(event: Event) -> bool:
