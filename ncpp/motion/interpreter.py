@@ -102,7 +102,7 @@ TINY = 1e-12
 # Moves of one canned-cycle block (L repeats, pecks): held at once, so bounded; a real one makes thousands
 # Events of a loop's first pass held until the flow tells whether its text runs again: a longer
 # pass is left as programmed (memory stays bounded)
-MAX_ONCE = 50_000
+MAX_ONCE = 10_000
 MAX_CYCLE_MOVES = 1_000_000
 
 _GROUP_CODES = {
@@ -371,8 +371,9 @@ class Interpreter:
                 once = None
             if kind is ONCE and once is None:
                 once = _FirstPass()
-            elif once is not None and kind is FIXED and owner is not None:
-                once.rerun(block)
+            elif once is not None and kind is FIXED and owner is not None and once.rerun(block):
+                yield from self._told(once, again=True)  # (all of it runs again: nothing to hold)
+                once = None
             spent = spent and kind is not RUN
             if kind is not RUN and kind is not FIXED and kind is not ONCE:  # text that does not run here
                 ended = self.done or block.verbatim  # (verbatim: after the closing `%`)
@@ -1999,12 +2000,14 @@ class _FirstPass:
         self.events.append(event)
         self.again.append(again)
 
-    def rerun(self, block: Block) -> None:
-        """`block` runs again: its text, and that of the blocks after it, runs more than once."""
+    def rerun(self, block: Block) -> bool:
+        """`block` runs again: its text, and that of the blocks after it, runs more than once.
+        Whether all of the pass does."""
         start = self.first.pop(id(block), None)
         if start is not None and start < self.again_from:
             self.again[start : self.again_from] = [True] * (self.again_from - start)
             self.again_from = start
+        return self.again_from == 0
 
     def told(self, again: bool) -> list[Event]:
         """The events, all left as programmed if the pass runs again, else those marked so."""

@@ -63,3 +63,21 @@ def test_compensating_a_loop_takes_the_same_memory_however_often_it_runs(tmp_pat
         for n in (2, times)
     )
     assert many - few < 12_000, (few, many)  # (each pass kept: 1.7 MB more a pass of the cycle)
+
+
+@pytest.mark.skipif(not MACHINE.exists(), reason="no shared machine file")
+def test_a_loop_run_once_around_one_run_often_takes_bounded_memory(tmp_path):
+    """The first pass of the outer loop is held until the program goes on past its end
+    (`Interpreter.run`, ONCE): the inner loop's passes in it are held up to a bound, not all."""
+
+    def program(times: int) -> str:
+        path = tmp_path / f"loop{times}.ngc"
+        path.write_text(f"G21 G17 G90 F200\nG0 X0 Y0 Z5\no1 repeat [1]\nG0 X5\no100 repeat [{times}]\n"
+                        "G1 X1 Y1\nG1 X0 Y0\no100 endrepeat\no1 endrepeat\nM2\n")  # fmt: skip
+        return str(path)
+
+    few, many = (
+        peak_kb("compensate", "--machine", str(MACHINE), program(n), "-o", str(tmp_path / "out.nc"))
+        for n in (2, 40_000)
+    )
+    assert many - few < 12_000, (few, many)
