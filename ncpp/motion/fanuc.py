@@ -64,6 +64,13 @@ intermediate point and restores it after the return (NCT 2000M manual, "The Tool
 control that follows Fanuc's compensation C; Fanuc 15i-MA, "Cutter compensation C"), which ncpp does
 not follow.  LinuxCNC refuses it ("Cannot use g28 or g30 with cutter radius comp").
 
+Macro B's external output statements, `POPEN`, `DPRNT[..]`, `BPRNT[..]` and `PCLOS`, send a line of text and
+values to a printer or a PC (NCT 2000M manual, "Custom Macro": `DPRNT[ a #b [ c d ] ... ]`, characters,
+variables and their digits before and after the point; Allen-Bradley 8520 manual, "Paramacros": `BPRNT[s
+#p[d]...]`, `POPEN`, `PCLOS`; Haas writes DPRNT for its cycle logs).  They move nothing: ncpp passes them
+through as they are, the text in the brackets unread.  LinuxCNC refuses them ("Unknown word where unary
+operation could be").
+
 With --expand-cycles, G82's and G89's dwell (Haas: G73's and G83's too) is written as a G04 with
 the cycle's P as the program gave it, where the control reads both alike (`_dwell_word`).  Fanuc: a G04's P takes no decimal
 point and counts 0.001 s, as a drilling cycle's P (SINUMERIK ISO Milling manual, which documents
@@ -105,6 +112,7 @@ class FanucInterpreter(Interpreter):
     taps_in_any_plane = True  # G74/G84 in G18/G19 tap along the normal (module docstring)
     cycles_own_group = True  # G80 leaves the G0-G3 mode before the cycle in effect (module docstring)
     returns_under_comp = True  # G28/G30 under G41/G42: out of scope (module docstring)
+    external_output = True  # POPEN, DPRNT[..], BPRNT[..], PCLOS pass through (module docstring)
 
     def block(self, block: Block) -> Event | tuple[Event, ...]:
         signature = block.signature

@@ -256,6 +256,9 @@ class Interpreter:
     # G28/G30 under cutter compensation (Fanuc: the offset is dropped at the intermediate point and
     # restored after the return): not followed, out of scope; rs274ngc refuses it
     returns_under_comp = False
+    # Macro B's external output (POPEN, DPRNT[..], BPRNT[..], PCLOS: Fanuc, Haas) moves nothing and
+    # passes through; rs274ngc refuses it
+    external_output = False
 
     def __init__(self, file: str = "<stdin>", offsets: WorkOffsets | None = None):
         self.file = file
@@ -688,6 +691,9 @@ class Interpreter:
                         block,
                         item,
                     )
+                elif what == "external_output":
+                    if not self.external_output:
+                        self._fail("Unknown word where unary operation could be", block, item)
                 elif what not in IGNORED_STATEMENTS:
                     raise _OutOfScope(OUT_OF_SCOPE_STATEMENT.get(what, what), item.start + 1)
                 continue

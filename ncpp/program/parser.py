@@ -138,6 +138,7 @@ class _ItemBuilder(Transformer):
     fanuc_while = _statement("while")
     fanuc_end = _statement("end")
     fanuc_goto = _statement("goto")
+    external_output = _statement("external_output")
     del _statement
 
     @v_args(meta=True)

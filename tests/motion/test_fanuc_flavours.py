@@ -384,3 +384,40 @@ def test_a_return_under_cutter_compensation_ends_interpretation():
     assert [type(e) for e in found][5:] == [Pass, Pass, Pass]
     with pytest.raises(NcppError, match="Cannot use g28 or g30 with cutter radius comp"):
         events(program, "iso")
+
+
+# Haas's cycle log (aaronrzt/SistemasTecnologias4.0 DPRNTer/2003.nc writes such lines above its O number)
+EXTERNAL_OUTPUT = (
+    "%\nO1\nG21 G90 G54\nPOPEN\nDPRNT[FECHA (AAMMDD): #3011]\nG0 X10 Y10 Z5\n"
+    "DPRNT[X#5021[44]*Y#5022[44]]\nBPRNT[C*/X#110[3]]\npclos\nG1 X20 F100\nM30\n%\n"
+)
+
+
+def test_external_output_is_read_whole_and_moves_nothing():
+    """`DPRNT[ a #b [ c d ] ... ]` (NCT 2000M manual, "Custom Macro"), `BPRNT[..]`, `POPEN`, `PCLOS`: one
+    statement each, to the line's end, the `(` and the format brackets in it unread; the moves around
+    them are followed.  LinuxCNC refuses the line as rs274 does ("Unknown word where unary ...")."""
+    _, blocks = parse_program(io.BytesIO(EXTERNAL_OUTPUT.encode()), "p.nc", "fanuc")
+    outputs = [b for b in blocks if b.items and getattr(b.items[0], "kind", None) == "external_output"]
+    assert [len(b.items) for b in outputs] == [1, 1, 1, 1, 1]
+    assert [b.items[0].end - b.items[0].start for b in outputs] == [len(b.raw) for b in outputs]
+    for dialect in ("fanuc", "haas"):
+        said = io.StringIO()
+        found = events(EXTERNAL_OUTPUT, dialect, Warnings(stream=said))
+        assert [type(e) for e in found].count(Line) == 2 and not said.getvalue()
+        assert [e.end for e in found if type(e) is Line] == [(10, 10, 5), (20, 10, 5)]
+    with pytest.raises(NcppError, match=r"p.nc:4:1: Unknown word where unary operation could be"):
+        events(EXTERNAL_OUTPUT, "iso")
+
+
+def test_external_output_passes_through_the_compensated_program(tmp_path):
+    program = tmp_path / "p.nc"
+    program.write_text(EXTERNAL_OUTPUT)
+    out = tmp_path / "out.nc"
+    command = ["compensate", "--machine", str(READING), "--dialect", "haas", str(program), "-o", str(out)]
+    proc = subprocess.run([sys.executable, "-m", "ncpp", *command], capture_output=True, text=True, cwd=ROOT)
+    assert proc.returncode == 0, proc.stderr
+    written = out.read_text()
+    for line in EXTERNAL_OUTPUT.splitlines()[3:5] + EXTERNAL_OUTPUT.splitlines()[6:9]:
+        assert f"\n{line}\n" in written
+    assert "compensated 2 moves" in proc.stderr
