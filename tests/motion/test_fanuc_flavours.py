@@ -360,7 +360,8 @@ def test_g80_leaves_the_motion_mode_the_cycle_interrupted(tmp_path, mode, dialec
     assert rs274_error(messages) is None, messages
     theirs = read_canon(calls)
     last = theirs[-1]
-    assert last.name == ("STRAIGHT_TRAVERSE" if mode == "G0" else "STRAIGHT_FEED") and last.args[:3] == (20, 5, 1)
+    assert last.name == ("STRAIGHT_TRAVERSE" if mode == "G0" else "STRAIGHT_FEED")
+    assert last.args[:3] == (20, 5, 1)
     assert [c.name for c in mine] == [c.name for c in theirs]
     assert all(abs(a - b) <= 1e-6 for want, got in zip(theirs, mine) for a, b in zip(want.args, got.args))
     with pytest.raises(NcppError, match="Cannot use axis values without a g code that uses them"):
@@ -370,7 +371,8 @@ def test_g80_leaves_the_motion_mode_the_cycle_interrupted(tmp_path, mode, dialec
 def test_g80_on_a_line_of_its_own_keeps_the_g0_in_effect():
     """A safety line's G80 with no cycle running changes nothing in group 01: the X after it is a rapid."""
     found = events("G21 G90 G54\nG0 X0 Y0 Z5\nG17 G40 G80\nX10\nM30\n", "fanuc")
-    assert [type(e) for e in found] == [Pass, Line, Pass, Line, Pass] and found[3].rapid and found[3].end[0] == 10
+    assert [type(e) for e in found] == [Pass, Line, Pass, Line, Pass]
+    assert found[3].rapid and found[3].end[0] == 10
 
 
 def test_a_return_under_cutter_compensation_ends_interpretation():
