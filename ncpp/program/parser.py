@@ -782,6 +782,8 @@ def _describe(err: lark.exceptions.UnexpectedInput, raw: str) -> str:
         return f"unclosed comment: {snippet!r}"
     if isinstance(err, lark.exceptions.UnexpectedToken):
         return f"unexpected {snippet!r}"
+    if rest[0] == ")" and "(" in raw[:pos]:  # (a comment ends at its first ')': a '(' in it opens none)
+        return f"a ')' after the comment closed, comments do not nest: {snippet!r}"
     return f"cannot read {snippet!r}"
 
 
