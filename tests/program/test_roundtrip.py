@@ -89,7 +89,9 @@ def test_a_parenthesis_inside_a_comment_is_named_so():
     """`( #500 = TIPO de pieza (1-6, 0 = sin pieza)   )` (Tomasarmiento/Spirax O0001.nc): the comment ends at
     its first `)`, the last `)` closes none (rs274: "Nested comment found").  The refusal says so, at that `)`."""
     line = b"(   #500 = TIPO de pieza (1-6, 0 = sin pieza)                  )\n"
-    with pytest.raises(NcppError, match=r"p\.ngc:2:64: a '\)' after the comment closed, comments do not nest"):
+    with pytest.raises(
+        NcppError, match=r"p\.ngc:2:64: a '\)' after the comment closed, comments do not nest"
+    ):
         process(io.BytesIO(b"G21\n" + line + b"M2\n"), io.BytesIO(), file="p.ngc", source=reading())
 
 
