@@ -53,6 +53,24 @@ in G19 (Fanuc operator's manuals, "Canned cycle for drilling": "Positioning plan
 axis", G17 Zp, G18 Yp, G19 Xp; the drilling axis is the basic axis not used to define the
 positioning plane), as rs274ngc drills but does not tap there (`Interpreter.taps_in_any_plane`).
 
+Canned cycles are a modal group of their own, group 09 beside group 01's G00-G03 (Fanuc 0i-MD /
+15i-MA operator's manuals, "List of G codes"; Haas Mill Operator's Manual, "G80 Canned Cycle Cancel
+(Group 09)"), so G80 cancels the cycle and leaves the G00-G03 mode it interrupted in effect: `G00 Z.1`,
+`G81 ...`, `G80`, `G91 A45.` is a rapid.  rs274ngc keeps cycles in the motion group, and G80 leaves no
+motion mode there ("Cannot use axis values without a g code that uses them").
+
+A G28 or G30 under cutter compensation is out of scope: the control drops the offset vector at the
+intermediate point and restores it after the return (NCT 2000M manual, "The Tool Compensation", a
+control that follows Fanuc's compensation C; Fanuc 15i-MA, "Cutter compensation C"), which ncpp does
+not follow.  LinuxCNC refuses it ("Cannot use g28 or g30 with cutter radius comp").
+
+Macro B's external output statements, `POPEN`, `DPRNT[..]`, `BPRNT[..]` and `PCLOS`, send a line of text and
+values to a printer or a PC (NCT 2000M manual, "Custom Macro": `DPRNT[ a #b [ c d ] ... ]`, characters,
+variables and their digits before and after the point; Allen-Bradley 8520 manual, "Paramacros": `BPRNT[s
+#p[d]...]`, `POPEN`, `PCLOS`; Haas writes DPRNT for its cycle logs).  They move nothing: ncpp passes them
+through as they are, the text in the brackets unread.  LinuxCNC refuses them ("Unknown word where unary
+operation could be").
+
 With --expand-cycles, G82's and G89's dwell (Haas: G73's and G83's too) is written as a G04 with
 the cycle's P as the program gave it, where the control reads both alike (`_dwell_word`).  Fanuc: a G04's P takes no decimal
 point and counts 0.001 s, as a drilling cycle's P (SINUMERIK ISO Milling manual, which documents
@@ -92,6 +110,9 @@ class FanucInterpreter(Interpreter):
     modal_d = True  # `G43 H1 D1`: D alone selects the radius offset (module docstring)
     dwell_x = True  # `G04 X1.5`: a dwell of 1.5 s (module docstring)
     taps_in_any_plane = True  # G74/G84 in G18/G19 tap along the normal (module docstring)
+    cycles_own_group = True  # G80 leaves the G0-G3 mode before the cycle in effect (module docstring)
+    returns_under_comp = True  # G28/G30 under G41/G42: out of scope (module docstring)
+    external_output = True  # POPEN, DPRNT[..], BPRNT[..], PCLOS pass through (module docstring)
 
     def block(self, block: Block) -> Event | tuple[Event, ...]:
         signature = block.signature

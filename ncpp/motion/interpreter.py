@@ -253,6 +253,15 @@ class Interpreter:
     # its convert_cycle_g74_g84 hands cycle_feed the plane's coordinates already permuted, so the
     # tap feeds other axes (in G18 X to the Y word, Y to the Z word, Z to the X word)
     taps_in_any_plane = False
+    # Canned cycles are a modal group of their own (Fanuc, Haas: group 09, G0-G3 group 01), so G80
+    # leaves the G0-G3 mode the cycle interrupted in effect; rs274ngc leaves no motion mode
+    cycles_own_group = False
+    # G28/G30 under cutter compensation (Fanuc: the offset is dropped at the intermediate point and
+    # restored after the return): not followed, out of scope; rs274ngc refuses it
+    returns_under_comp = False
+    # Macro B's external output (POPEN, DPRNT[..], BPRNT[..], PCLOS: Fanuc, Haas) moves nothing and
+    # passes through; rs274ngc refuses it
+    external_output = False
 
     def __init__(self, file: str = "<stdin>", offsets: WorkOffsets | None = None):
         self.file = file
@@ -269,6 +278,7 @@ class Interpreter:
         self.motion: float | None = (
             self.start_motion
         )  # modal motion G code (0-3, a canned cycle), None for G80 / none yet
+        self.before_cycle: float | None = None  # the G0-G3 mode a canned cycle replaced (`cycles_own_group`)
         self.retract_to_r = True  # G99 (rs274ngc's default) / G98: where a cycle retracts to
         # A canned cycle's sticky words (R, the normal axis's, Q; P is a dwell: no move) and the
         # normal-axis position its series of cycles started from (a series ends with any other motion)
@@ -717,6 +727,9 @@ class Interpreter:
                         block,
                         item,
                     )
+                elif what == "external_output":
+                    if not self.external_output:
+                        self._fail("Unknown word where unary operation could be", block, item)
                 elif what not in IGNORED_STATEMENTS:
                     raise _OutOfScope(OUT_OF_SCOPE_STATEMENT.get(what, what), item.start + 1)
                 continue
@@ -974,7 +987,7 @@ class Interpreter:
         if mode0 is not None and mode0 not in (4.0, 53.0):
             events = self._non_modal(block, words, mode0)
         if mode1 is not None:
-            self.motion = None if mode1 == 80.0 else mode1
+            self.motion = self._motion_mode_after(mode1, previous)
         if motion is not None:
             motion_word = mode1_item if mode1_item is not None else axis_item
             if motion <= 1.0:
@@ -1031,6 +1044,16 @@ class Interpreter:
                 self._fail("Cannot use axis values without a g code that uses them", block, any_item)
             return self.motion
         return None
+
+    def _motion_mode_after(self, mode1: float, previous: float | None) -> float | None:
+        """The modal motion once `mode1` (a motion code or G80) is read, `previous` in effect."""
+        if mode1 in CANNED and previous not in CANNED:
+            self.before_cycle = previous
+        if mode1 != 80.0:
+            return mode1
+        if not self.cycles_own_group:
+            return None
+        return self.before_cycle if previous in CANNED else previous
 
     def _check_polar(self, block: Block, words: dict, item) -> None:
         """enhance_block's checks of polar words (`@` radius, `^` angle, LinuxCNC): in the XY
@@ -1180,6 +1203,8 @@ class Interpreter:
             and round(words["P"][0]) in (0, self.coord_system)
         ):
             message = "Cannot change the active coordinate system with cutter radius compensation on"
+        if message is not None and mode0 in (28.0, 30.0) and self.returns_under_comp:
+            raise _OutOfScope(f"G{mode0:g} under cutter compensation", mode0_item.start + 1)
         if message is not None:
             self._fail(message, block, mode0_item)
         message = _MOTION_WITH_COMP.get(motion)

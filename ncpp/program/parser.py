@@ -138,6 +138,7 @@ class _ItemBuilder(Transformer):
     fanuc_while = _statement("while")
     fanuc_end = _statement("end")
     fanuc_goto = _statement("goto")
+    external_output = _statement("external_output")
     del _statement
 
     @v_args(meta=True)
@@ -781,6 +782,8 @@ def _describe(err: lark.exceptions.UnexpectedInput, raw: str) -> str:
         return f"unclosed comment: {snippet!r}"
     if isinstance(err, lark.exceptions.UnexpectedToken):
         return f"unexpected {snippet!r}"
+    if rest[0] == ")" and "(" in raw[:pos]:  # (a comment ends at its first ')': a '(' in it opens none)
+        return f"a ')' after the comment closed, comments do not nest: {snippet!r}"
     return f"cannot read {snippet!r}"
 
 

@@ -336,3 +336,90 @@ def test_a_fanuc_dwell_in_x_is_read_past():
     assert [type(e) for e in found] == [Pass, Line, Pass, Pass, Pass] and "G04 X (a dwell) with other" in (
         said.getvalue()
     )
+
+
+# A drilling cycle interrupts the G0 or G1 of the line before it; after G80 a block of axis words alone
+CYCLE_THEN_G80 = "G21 G90 G17 G94\nG0 X0 Y0 Z5\n{mode} Z1 F100\nG98 G81 X10 Y0 Z-2 R1 F50\nG80\nX20 Y5\n"
+
+
+@pytest.mark.parametrize("dialect", ["fanuc", "haas"])
+@pytest.mark.parametrize("mode", ["G0", "G1"])
+def test_g80_leaves_the_motion_mode_the_cycle_interrupted(tmp_path, mode, dialect):
+    """`G0 Z.1`, `G81 ...`, `G80`, `G91 A[360.0 / #2]` (z64/cncbook stdbc.nc, a Haas bolt circle): cycles are
+    group 09 and G80 leaves group 01's mode in effect (fanuc.py).  Judged by rs274 on the twin that writes
+    the mode again after G80; LinuxCNC, where G80 leaves no motion mode, refuses the block."""
+    from ncpp.motion.canon import canon_call, read_canon
+    from tests.motion.test_oracle import rs274_error, run_rs274, write_program
+
+    if not RS274.exists():
+        pytest.skip("rs274 not available")
+    program = CYCLE_THEN_G80.format(mode=mode) + "M30\n"
+    mine = [call for call in map(canon_call, events(program, dialect)) if call is not None]
+    twin = write_program(tmp_path, program.replace("G80\nX20", f"G80\n{mode} X20"))
+    calls, messages = run_rs274(twin)
+    assert rs274_error(messages) is None, messages
+    theirs = read_canon(calls)
+    last = theirs[-1]
+    assert last.name == ("STRAIGHT_TRAVERSE" if mode == "G0" else "STRAIGHT_FEED")
+    assert last.args[:3] == (20, 5, 1)
+    assert [c.name for c in mine] == [c.name for c in theirs]
+    assert all(abs(a - b) <= 1e-6 for want, got in zip(theirs, mine) for a, b in zip(want.args, got.args))
+    with pytest.raises(NcppError, match="Cannot use axis values without a g code that uses them"):
+        events(program, "iso")
+
+
+def test_g80_on_a_line_of_its_own_keeps_the_g0_in_effect():
+    """A safety line's G80 with no cycle running changes nothing in group 01: the X after it is a rapid."""
+    found = events("G21 G90 G54\nG0 X0 Y0 Z5\nG17 G40 G80\nX10\nM30\n", "fanuc")
+    assert [type(e) for e in found] == [Pass, Line, Pass, Line, Pass]
+    assert found[3].rapid and found[3].end[0] == 10
+
+
+def test_a_return_under_cutter_compensation_ends_interpretation():
+    """`G41 D01 ...` never cancelled, then `G28 Z0` (MechatronicsCherepanovMA/CNCLearn O0005.nc): Fanuc drops
+    the offset at the intermediate point and restores it after (fanuc.py); ncpp does not follow that and
+    passes the rest through, located, where LinuxCNC refuses the block."""
+    program = "G21 G90 G17\nG0 X0 Y0 Z5\nG1 Z-2 F100\nG41 D1 Y-5\nG1 X10\nG28 Z0\nG28 X0 Y0\nM30\n"
+    said = io.StringIO()
+    found = events(program, "fanuc", Warnings(stream=said))
+    assert "p.nc:6:1: warning: G28 under cutter compensation" in said.getvalue()
+    assert [type(e) for e in found][5:] == [Pass, Pass, Pass]
+    with pytest.raises(NcppError, match="Cannot use g28 or g30 with cutter radius comp"):
+        events(program, "iso")
+
+
+# Haas's cycle log (aaronrzt/SistemasTecnologias4.0 DPRNTer/2003.nc writes such lines above its O number)
+EXTERNAL_OUTPUT = (
+    "%\nO1\nG21 G90 G54\nPOPEN\nDPRNT[FECHA (AAMMDD): #3011]\nG0 X10 Y10 Z5\n"
+    "DPRNT[X#5021[44]*Y#5022[44]]\nBPRNT[C*/X#110[3]]\npclos\nG1 X20 F100\nM30\n%\n"
+)
+
+
+def test_external_output_is_read_whole_and_moves_nothing():
+    """`DPRNT[ a #b [ c d ] ... ]` (NCT 2000M manual, "Custom Macro"), `BPRNT[..]`, `POPEN`, `PCLOS`: one
+    statement each, to the line's end, the `(` and the format brackets in it unread; the moves around
+    them are followed.  LinuxCNC refuses the line as rs274 does ("Unknown word where unary ...")."""
+    _, blocks = parse_program(io.BytesIO(EXTERNAL_OUTPUT.encode()), "p.nc", "fanuc")
+    outputs = [b for b in blocks if b.items and getattr(b.items[0], "kind", None) == "external_output"]
+    assert [len(b.items) for b in outputs] == [1, 1, 1, 1, 1]
+    assert [b.items[0].end - b.items[0].start for b in outputs] == [len(b.raw) for b in outputs]
+    for dialect in ("fanuc", "haas"):
+        said = io.StringIO()
+        found = events(EXTERNAL_OUTPUT, dialect, Warnings(stream=said))
+        assert [type(e) for e in found].count(Line) == 2 and not said.getvalue()
+        assert [e.end for e in found if type(e) is Line] == [(10, 10, 5), (20, 10, 5)]
+    with pytest.raises(NcppError, match=r"p.nc:4:1: Unknown word where unary operation could be"):
+        events(EXTERNAL_OUTPUT, "iso")
+
+
+def test_external_output_passes_through_the_compensated_program(tmp_path):
+    program = tmp_path / "p.nc"
+    program.write_text(EXTERNAL_OUTPUT)
+    out = tmp_path / "out.nc"
+    command = ["compensate", "--machine", str(READING), "--dialect", "haas", str(program), "-o", str(out)]
+    proc = subprocess.run([sys.executable, "-m", "ncpp", *command], capture_output=True, text=True, cwd=ROOT)
+    assert proc.returncode == 0, proc.stderr
+    written = out.read_text()
+    for line in EXTERNAL_OUTPUT.splitlines()[3:5] + EXTERNAL_OUTPUT.splitlines()[6:9]:
+        assert f"\n{line}\n" in written
+    assert "compensated 2 moves" in proc.stderr

@@ -85,6 +85,16 @@ def test_unreadable_lines_that_do_not_run_pass_through_with_a_warning(tmp_path):
     assert (err.value.where.line, err.value.where.col) == (7, 7)
 
 
+def test_a_parenthesis_inside_a_comment_is_named_so():
+    """`( #500 = TIPO de pieza (1-6, 0 = sin pieza)   )` (Tomasarmiento/Spirax O0001.nc): the comment ends at
+    its first `)`, the last `)` closes none (rs274: "Nested comment found").  The refusal says so, at that `)`."""
+    line = b"(   #500 = TIPO de pieza (1-6, 0 = sin pieza)                  )\n"
+    with pytest.raises(
+        NcppError, match=r"p\.ngc:2:64: a '\)' after the comment closed, comments do not nest"
+    ):
+        process(io.BytesIO(b"G21\n" + line + b"M2\n"), io.BytesIO(), file="p.ngc", source=reading())
+
+
 def test_a_comment_inside_an_expression_is_named_so():
     """`#<d> = [80/SQRT(2)/2/25.4]` (Thaddeus-Maximus/lagun-linuxcnc, `nc_files/spr_hub_drill.ngc`):
     parentheses are a comment in RS274/NGC, not grouping, so the function has no argument (rs274:
