@@ -450,6 +450,7 @@ class HeidenhainInterpreter(ModalInterpreter):
                 self._jump(block, item)
             else:
                 reason = {"call_label": "CALL LBL", "cycle_call": "CYCL CALL",
+                          "contour_label": "a label list `/n` away from CYCL DEF 14.1",
                           "fn": f"FN {node[0]}", "keyword": " ".join(map(str, node)),
                           "touch_probe": f"TCH PROBE {node[0]} (a touch probe cycle: it probes, and may set"
                                          " the datum or the tool's data)"}.get(what, what)  # fmt: skip

@@ -321,3 +321,18 @@ def test_a_plunging_feed_of_auto_is_the_tool_calls_feed():
     assert runs(moves(told)) == runs(moves(program()))
     said = io.StringIO()
     assert runs(moves(auto, said)) == [] and "Q206=AUTO (a feed ncpp does not follow)" in said.getvalue()
+
+
+def test_a_contour_cycle_call_leaves_the_scope_and_a_tolerance_cycle_changes_nothing():
+    """The SL cycles (14 CONTOUR GEOMETRY, 20 CONTOUR DATA, 22 ROUGH-OUT) cut a pocket the control works
+    out itself: their CYCL CALL is out of scope, told at its line.  Cycle 32 TOLERANCE is active once
+    defined and moves nothing: the moves after it are followed (drunsinn/language-klartext,
+    `testprogramme/SLII001.klartext`, `Krivka.klartext`)."""
+    sl = "CYCL DEF 14.0 KONTUR\nCYCL DEF 14.1 KONTURLABEL1 /2 /3\n" + CYCLE_200.replace("200 DRILLING", "20 KONTUR")
+    warned = io.StringIO()
+    found = moves(program(sl, holes=["CYCL CALL M8"]), warned)
+    assert "drill.h:16:4: warning: the cycle call CYCL CALL (CYCL DEF 20) is outside" in warned.getvalue()
+    assert len(found) == 2  # (the two moves before the call)
+    tolerance = "CYCL DEF 32.0 TOLERANCE\nCYCL DEF 32.1 T0,01\nCYCL DEF 32.2 HSC-MODE:0 TA0"
+    followed = moves(program(tolerance, holes=[]))
+    assert [m.end for m in followed][-2:] == [(25.0, -7.5, 21.0), (0.0, 100.0, 21.0)]

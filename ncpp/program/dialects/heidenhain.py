@@ -25,6 +25,7 @@ Statement kinds and nodes (Heidenhain):
   feed           ('FMAX' | 'FAUTO',)     `F200` is a Word; `F MAX` is 'FMAX' too
   rotation       ('+' | '-',)            `DR+` counter-clockwise, `DR-` clockwise
   retract        (distance | 'MAX',)     M140's `MB 50` -> (50.0,), `MB MAX` -> ('MAX',)
+  contour_label  (label,)                cycle 14's further subprograms: `LABEL1 /2 /3` -> (2,), (3,)
   tool_call      (tool, axis)            `TOOL CALL 1 Z S800`: tool int | float | "name" | ("param", q)
                                          | None, axis 'X' | 'Y' | 'Z' | None; S F DL DR words follow
   tool_def       (tool,)                 `TOOL DEF 5 L+0 R+5`
@@ -200,6 +201,7 @@ class HeidenhainBuilder(Transformer):
     feed = _statement("feed", lambda c: ("".join(str(c[0]).split()).upper(),))
     rotation = _statement("rotation", lambda c: (str(c[0])[-1],))
     retract = _statement("retract", lambda c: (_retract_distance(str(c[0])),))
+    contour_label = _statement("contour_label", lambda c: (int(str(c[0]).lstrip("/ \t")),))
     del (
         _statement,
         _text,
