@@ -328,7 +328,9 @@ def test_a_contour_cycle_call_leaves_the_scope_and_a_tolerance_cycle_changes_not
     out itself: their CYCL CALL is out of scope, told at its line.  Cycle 32 TOLERANCE is active once
     defined and moves nothing: the moves after it are followed (drunsinn/language-klartext,
     `testprogramme/SLII001.klartext`, `Krivka.klartext`)."""
-    sl = "CYCL DEF 14.0 KONTUR\nCYCL DEF 14.1 KONTURLABEL1 /2 /3\n" + CYCLE_200.replace("200 DRILLING", "20 KONTUR")
+    sl = "CYCL DEF 14.0 KONTUR\nCYCL DEF 14.1 KONTURLABEL1 /2 /3\n" + CYCLE_200.replace(
+        "200 DRILLING", "20 KONTUR"
+    )
     warned = io.StringIO()
     found = moves(program(sl, holes=["CYCL CALL M8"]), warned)
     assert "drill.h:16:4: warning: the cycle call CYCL CALL (CYCL DEF 20) is outside" in warned.getvalue()

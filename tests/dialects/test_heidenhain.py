@@ -260,5 +260,8 @@ def test_contour_geometry_and_tolerance_cycles_parse_as_the_manual_writes_them()
     assert labels == [("contour_label", (n,)) for n in (2, 3, 4)]
     assert statements("CYCL DEF 32.2 HSC-MODE:0 TA0") == [("cycle_def", ("32.2", ("HSC-MODE:0",)))]
     assert statements("Q51 = ( 3 / 4 ) * Q91") == [
-        ("assignment", (("param", "q51"), ("bin", "*", ("bin", "/", ("num", 3.0), ("num", 4.0)), ("param", "q91"))))
+        (
+            "assignment",
+            (("param", "q51"), ("bin", "*", ("bin", "/", ("num", 3.0), ("num", 4.0)), ("param", "q91"))),
+        )
     ]
