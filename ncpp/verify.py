@@ -640,7 +640,7 @@ class _Feed:
             except NcppError as err:  # (the lines before it are read first)
                 self.fault = err
             batch = self.pending[taken:]
-            for text in batch:  # (a line at a time: the parser numbers a `~`-continued block's lines as `count`)
+            for text in batch:  # (a line at a time: the parser numbers a continued block's lines as `count`)
                 yield from (line.encode("latin-1") for line in _physical_lines(text))
             if self.fault is not None:
                 raise _Upstream(self.fault) from None
