@@ -920,6 +920,9 @@ class HeidenhainInterpreter(ModalInterpreter):
         """`CALL LBL n [REP k]`: a subprogram call or a program-section repeat."""
         assert self.flow is not None
         name, repeat = item.node
+        if type(repeat) is not int:  # (the manual's REP takes a number: a count of Q9 = 35.5 is not defined)
+            raise OutOfScope(f"CALL LBL ... REP{repeat[1].upper()} (a repeat count from a Q parameter)",
+                             item.start + 1)  # fmt: skip
         index = self.flow.target(name, lambda q: self.value(q, block, item), item.start + 1)
         key = label_key(self.value(name, block, item) if type(name) is tuple else name)
         self.flow.call(index, repeat, key, item.start + 1)
