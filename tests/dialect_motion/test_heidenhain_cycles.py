@@ -338,3 +338,14 @@ def test_a_contour_cycle_call_leaves_the_scope_and_a_tolerance_cycle_changes_not
     tolerance = "CYCL DEF 32.0 TOLERANCE\nCYCL DEF 32.1 T0,01\nCYCL DEF 32.2 HSC-MODE:0 TA0"
     followed = moves(program(tolerance, holes=[]))
     assert [m.end for m in followed][-2:] == [(25.0, -7.5, 21.0), (0.0, 100.0, 21.0)]
+
+
+@pytest.mark.parametrize("angle, followed", [("ROT+0", True), ("IROT+0,000", True), ("ROT+30", False)])
+def test_a_rotation_of_zero_is_followed_and_any_other_leaves_the_scope(angle, followed):
+    """`CYCL DEF 10.1 ROT+0` resets cycle 10 ROTATION (Cycle Programming manual, "ROTATION (Cycle
+    10)"; drunsinn/language-klartext, `programm-zirkularnut-fraesen.klartext` writes it before its
+    moves): no rotation is in effect where ncpp follows a program, so it changes nothing."""
+    warned = io.StringIO()
+    found = moves(program(f"CYCL DEF 10.0 ROTATION\nCYCL DEF 10.1 {angle}", holes=[]), warned)
+    assert (len(found) == 4) is followed
+    assert ("CYCL DEF 10.1 (it moves the datum) is outside" in warned.getvalue()) is not followed
