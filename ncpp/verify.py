@@ -599,6 +599,12 @@ class _Upstream(Exception):
         self.error = error
 
 
+def _physical_lines(text: str) -> list[str]:
+    """A written text's lines, each with its LF (only LF ends a line in a program file)."""
+    *whole, last = text.split("\n")
+    return [line + "\n" for line in whole] + ([last] if last or not whole else [])
+
+
 class _Feed:
     """Written lines as the parser reads them (bytes), each remembered with the input line the
     writer had reached when it handed the line out (its tag), until the lines are handed on."""
@@ -634,8 +640,8 @@ class _Feed:
             except NcppError as err:  # (the lines before it are read first)
                 self.fault = err
             batch = self.pending[taken:]
-            for text in batch:
-                yield text.encode("latin-1")
+            for text in batch:  # (a line at a time: the parser numbers a continued block's lines as `count`)
+                yield from (line.encode("latin-1") for line in _physical_lines(text))
             if self.fault is not None:
                 raise _Upstream(self.fault) from None
             if len(batch) < self.AHEAD:

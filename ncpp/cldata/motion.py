@@ -24,6 +24,9 @@ APT semantics used here:
   them as programmed, as the NC interpreter's); `CYCLE/OFF` ends the cycle.
 * Between `CUTCOM/LEFT|RIGHT` and `CUTCOM/OFF` the control offsets the path by the
   tool radius: the moves are marked `fixed` too.
+* SolidWorks CAM's `CSYS/` other than the identity (a setup turned or moved: its tool vector
+  and GOTO points are the part's, aamorim1913/AptPostProcessor `parts-2022/shimemcunha.apt`) is
+  refused: the points would be posted untransformed.
 
 Each event's block is a synthetic `Block` holding the record text (no
 items), so a writer can show it as a comment and errors can name its line.
@@ -55,6 +58,13 @@ def units_inch(record: Record) -> bool:
     if unit in ("MM", "MILLIMETERS", "MILLIMETRES"):
         return False
     raise NcppError(f"UNITS/{unit or '?'}: expected MM or INCHES", record.where)
+
+
+def _identity_frame(values: Sequence[float]) -> bool:
+    """Whether SolidWorks CAM's `CSYS/` 3x4 matrix (rotation rows, each with its translation) leaves
+    the GOTO points where they are."""
+    identity = (1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0)
+    return len(values) == len(identity) and all(abs(v - w) <= AXIS_TOL for v, w in zip(values, identity))
 
 
 def _block(record: Record) -> Block:
@@ -359,6 +369,9 @@ def motion(
                 )
             _check_along_z(vector, rec)
             tool_vector, vector_line = vector, rec.line
+        elif major == "CSYS" and not _identity_frame(rec.numbers):
+            raise NcppError("CSYS/ places the GOTO points in a coordinate system of its own (a setup turned or "
+                            "moved): ncpp posts them as written and does not transform them", rec.where)  # fmt: skip
         elif rec.vendor and warnings is not None:
             warnings.warn(f"{major}/ is not understood; passed through as a comment", rec.where)
         yield Pass(_block(rec))

@@ -101,6 +101,9 @@ DATUM_CYCLES = frozenset(("8", "10", "11", "19", "26"))
 # of `7.1 X..` `7.2 Y..` `7.3 Z..` shifts one axis's datum, an absolute value from the preset, an incremental
 # one (`IY-11.75`) from the datum in effect; a datum table's line (`7.1 #5`) is not read
 SHIFT_CYCLE = "7"
+# Cycle 10 ROTATION: `ROT+0` is its reset (Cycle Programming manual, "ROTATION (Cycle 10)"), no change
+# where ncpp follows a program (it does not follow a rotation), and the cycle's head alone moves nothing
+ROTATION_CYCLE = "10"
 # CYCL DEF 247 DATUM SETTING activates the preset Q339 of the preset table (TNC 640 Klartext manual,
 # "Cycle 247 DATUM SETTING"): the program zero ncpp is told is that preset's; another preset later
 # is a zero ncpp is not told
@@ -133,6 +136,19 @@ def _fn_operand(text: str) -> tuple:
     sign, value = re.fullmatch(_FN_OPERAND, text.strip(), re.I).groups()  # type: ignore[union-attr]
     expr = ("param", value.lower()) if value[0] in "Qq" else ("num", float(value.replace(",", ".")))
     return ("neg", expr) if sign == "-" else expr
+
+
+def _no_rotation(block: Block, number: str) -> bool:
+    """Whether a line of CYCL DEF 10 rotates nothing: its head, or `ROT+0` / `IROT+0`."""
+    words = [i for i in block.items if (type(i) is Word or type(i) is ExprWord) and i.letter != "N"]
+    if not words:
+        return number in ("10", "10.0")
+    return (
+        len(words) == 1
+        and type(words[0]) is Word
+        and words[0].letter in ("ROT", "IROT")
+        and not words[0].value
+    )
 
 
 @dataclass(slots=True)
@@ -416,6 +432,8 @@ class HeidenhainInterpreter(ModalInterpreter):
                 if number == SHIFT_CYCLE:
                     self._datum_shift(block, item)
                     return []
+                if number == ROTATION_CYCLE and _no_rotation(block, node[0]):
+                    return []
                 if number in DATUM_CYCLES:
                     raise OutOfScope(f"CYCL DEF {node[0]} (it moves the datum)", item.start + 1)
                 if number not in REQUIRED:  # (a cycle ncpp does not follow: a call of it leaves the scope)
@@ -450,6 +468,7 @@ class HeidenhainInterpreter(ModalInterpreter):
                 self._jump(block, item)
             else:
                 reason = {"call_label": "CALL LBL", "cycle_call": "CYCL CALL",
+                          "contour_label": "a label list `/n` away from CYCL DEF 14.1",
                           "fn": f"FN {node[0]}", "keyword": " ".join(map(str, node)),
                           "touch_probe": f"TCH PROBE {node[0]} (a touch probe cycle: it probes, and may set"
                                          " the datum or the tool's data)"}.get(what, what)  # fmt: skip
@@ -919,6 +938,9 @@ class HeidenhainInterpreter(ModalInterpreter):
         """`CALL LBL n [REP k]`: a subprogram call or a program-section repeat."""
         assert self.flow is not None
         name, repeat = item.node
+        if type(repeat) is not int:  # (the manual's REP takes a number: a count of Q9 = 35.5 is not defined)
+            raise OutOfScope(f"CALL LBL ... REP{repeat[1].upper()} (a repeat count from a Q parameter)",
+                             item.start + 1)  # fmt: skip
         index = self.flow.target(name, lambda q: self.value(q, block, item), item.start + 1)
         key = label_key(self.value(name, block, item) if type(name) is tuple else name)
         self.flow.call(index, repeat, key, item.start + 1)

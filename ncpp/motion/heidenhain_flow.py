@@ -226,6 +226,8 @@ class KlartextFlow:
                 break
             if item is not None and item.kind != "label":
                 name, repeat = item.node if item.kind == "call_label" else (None, 0)
+                if type(repeat) is not int:  # (a count from a Q parameter: out of scope where it runs)
+                    break
                 start = self.labels.get(label_key(name)) if repeat and type(name) is not tuple else None
                 if start is None or start >= label:
                     break

@@ -157,8 +157,9 @@ MAX_ELEMENTS = 65_536  # the elements of an array this interpreter holds (each i
 # control nests up to 16 program levels, the main program's among them.
 MAX_RUNS = 9999
 MAX_PROGRAM_LEVELS = 16
-# A name a subprogram can be called by: two letters or `_` and a letter first ("Subprogram names")
-_SUBPROGRAM_NAME = re.compile(r"(?:[A-Z]{2}|_[A-Z])\w*", re.I)
+# A name a subprogram can be called by: two letters or `_` and a letter first ("Subprogram names"),
+# or L and 1-7 digits, a subprogram's by number, which a PROC's parameters may follow, `L140(2)`
+_SUBPROGRAM_NAME = re.compile(r"(?:[A-Z]{2}|_[A-Z])\w*|L\d{1,7}", re.I)
 # The Siemens cycles and their helpers, which stay as the cycles they are (`block`), not files
 KNOWN_CYCLE = re.compile(r"CYCLE\d|POCKET\d|SLOT\d|LONGHOLE|HOLES\d|E_|F_", re.I)
 # Predefined procedures that call programs in ways not followed here (PCALL: by an absolute path)

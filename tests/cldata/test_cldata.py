@@ -180,3 +180,27 @@ def test_gohome_with_axis_words_moves_only_those_axes():
     moves = [e for e in motion(read_cldata(path.open(), str(path))) if isinstance(e, Line)]
     assert moves[-1].block.raw.startswith("GOHOME")
     assert moves[-1].start == (150, 150, 0) and moves[-1].end == (150, 150, 100)
+
+
+SETUP = """UNIT/MM
+TRNTYP/WORLD,0,0,0
+CSYS/{}
+RAPID/
+GOTO/10.,20.,25.
+FEDRAT/500.,MMPM
+GOTO/10.,20.,-1.
+GOTO/30.,20.,-1.
+"""
+
+
+def test_a_turned_setup_csys_is_refused_and_the_identity_posts():
+    """SolidWorks CAM writes each operation's setup as `CSYS/` (aamorim1913/AptPostProcessor,
+    parts-2022/shimemcunha.apt: `CSYS/0,.999987,.005061,0,-1.,0,0,0,0,-0.005061,.999987,0`, its GOTO tool
+    vector the setup's Z in the part's frame).  A setup turned 90 degrees about Z keeps the tool along +Z:
+    posted untransformed its points land turned by 90 degrees on the machine."""
+    turned = "0,1.,0,0,-1.,0,0,0,0,0,1.,0"
+    with pytest.raises(NcppError, match="CSYS/ places the GOTO points") as err:
+        events_of(SETUP.format(turned))
+    assert err.value.where.line == 3
+    moves = [e for e in events_of(SETUP.format("1.,0,0,0,0,1.,0,0,0,0,1.,0")) if isinstance(e, Line)]
+    assert [m.end for m in moves] == [(10.0, 20.0, 25.0), (10.0, 20.0, -1.0), (30.0, 20.0, -1.0)]

@@ -321,3 +321,31 @@ def test_a_plunging_feed_of_auto_is_the_tool_calls_feed():
     assert runs(moves(told)) == runs(moves(program()))
     said = io.StringIO()
     assert runs(moves(auto, said)) == [] and "Q206=AUTO (a feed ncpp does not follow)" in said.getvalue()
+
+
+def test_a_contour_cycle_call_leaves_the_scope_and_a_tolerance_cycle_changes_nothing():
+    """The SL cycles (14 CONTOUR GEOMETRY, 20 CONTOUR DATA, 22 ROUGH-OUT) cut a pocket the control works
+    out itself: their CYCL CALL is out of scope, told at its line.  Cycle 32 TOLERANCE is active once
+    defined and moves nothing: the moves after it are followed (drunsinn/language-klartext,
+    `testprogramme/SLII001.klartext`, `Krivka.klartext`)."""
+    sl = "CYCL DEF 14.0 KONTUR\nCYCL DEF 14.1 KONTURLABEL1 /2 /3\n" + CYCLE_200.replace(
+        "200 DRILLING", "20 KONTUR"
+    )
+    warned = io.StringIO()
+    found = moves(program(sl, holes=["CYCL CALL M8"]), warned)
+    assert "drill.h:16:4: warning: the cycle call CYCL CALL (CYCL DEF 20) is outside" in warned.getvalue()
+    assert len(found) == 2  # (the two moves before the call)
+    tolerance = "CYCL DEF 32.0 TOLERANCE\nCYCL DEF 32.1 T0,01\nCYCL DEF 32.2 HSC-MODE:0 TA0"
+    followed = moves(program(tolerance, holes=[]))
+    assert [m.end for m in followed][-2:] == [(25.0, -7.5, 21.0), (0.0, 100.0, 21.0)]
+
+
+@pytest.mark.parametrize("angle, followed", [("ROT+0", True), ("IROT+0,000", True), ("ROT+30", False)])
+def test_a_rotation_of_zero_is_followed_and_any_other_leaves_the_scope(angle, followed):
+    """`CYCL DEF 10.1 ROT+0` resets cycle 10 ROTATION (Cycle Programming manual, "ROTATION (Cycle
+    10)"; drunsinn/language-klartext, `programm-zirkularnut-fraesen.klartext` writes it before its
+    moves): no rotation is in effect where ncpp follows a program, so it changes nothing."""
+    warned = io.StringIO()
+    found = moves(program(f"CYCL DEF 10.0 ROTATION\nCYCL DEF 10.1 {angle}", holes=[]), warned)
+    assert (len(found) == 4) is followed
+    assert ("CYCL DEF 10.1 (it moves the datum) is outside" in warned.getvalue()) is not followed

@@ -278,3 +278,28 @@ def test_blocks_are_held_only_so_far_back_and_a_call_past_them_ends_interpretati
         held = max(held, len(interpreter.flow.held))
     assert held <= 1000 + 100 + 4096 + 1
     assert "LBL 1 (more than 1000 blocks back)" in stream.getvalue()
+
+
+def test_a_repeat_count_from_a_q_parameter_is_out_of_scope_not_read_as_a_plain_call():
+    """`CALL LBL 1 REPQ9` (drunsinn/language-klartext, `testprogramme/programm-zirkularnut-fraesen.klartext`):
+    the manual's REP takes a number.  Read as `CALL LBL 1` with a stray word, the section ran once
+    and the next move was written where the tool is not (`L Z+100` got X+7.5 Y+4 added, the control
+    having repeated the slot's passes 35 times further in Y).  It stops interpretation at its line."""
+    text = """0 BEGIN PGM REPQ MM
+1 TOOL CALL 1 Z S1000
+2 FN 0: Q9 =+35.5
+3 L X+0 Y+0 Z+10 R0 FMAX
+4 LBL 1
+5 L IY+2 F100
+6 LBL 0
+7 CALL LBL 1 REPQ9
+8 L Z+100 R0 FMAX M30
+9 END PGM REPQ MM
+"""
+    stream = io.StringIO()
+    found = moves(text, Warnings(stream=stream))
+    assert (
+        "p.h:8:3: warning: CALL LBL ... REPQ9 (a repeat count from a Q parameter) is outside"
+        in stream.getvalue()
+    )
+    assert [end for _, end, _ in found] == [(0.0, 0.0, 10.0), (0.0, 2.0, 10.0)]  # (nothing after the call)

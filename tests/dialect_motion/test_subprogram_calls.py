@@ -410,3 +410,19 @@ def _long_runs_compensate(tmp_path, capsys, name: str, main_text: str, files: di
 def test_klartext_long_runs_are_written_and_verified_a_chunk_at_a_time(tmp_path, capsys, main_text, files):
     """As for Sinumerik: a call or repeat line owning over 4096 moves was refused by the verifier."""
     _long_runs_compensate(tmp_path, capsys, "long.h", main_text, files, " L X+50 Y+50 R0 F100\n")
+
+
+def test_sinumerik_a_subprogram_by_number_takes_parameters(tmp_path):
+    """`L140(2)` calls the subprogram L140 with a PROC parameter (PDubovikov/SinumerikLanguage,
+    `SinumerikLanguage/test/123.mpf`: `N12 L140(2)`, `N15 L143(90)`; 840D sl Programming Manual,
+    Fundamentals, "Program names": a subprogram may be named L and 1-7 digits).  It was left out of
+    scope as an unknown call, even with its file at hand, and without saying the file was missing."""
+    folder = _folder(tmp_path, {"L140.SPF": "PROC L140(REAL A)\nG1 X=A*10 F100\nM17\n"})
+    events, warned = _events(sinumerik, "sinumerik", "G0 X0 Y0 Z10\nL140(2)\nG1 Y5\nM30\n", folder)
+    assert warned == "" and _path(events) == [
+        (0.0, 0.0, 1, False),
+        (20.0, 0.0, 2, True),
+        (20.0, 5.0, 3, False),
+    ]
+    _, warned = _events(sinumerik, "sinumerik", "G0 X0 Y0 Z10\nL143(90)\nM30\n", folder)
+    assert "main:2:1: warning: call L143 (its file not found: none of L143.SPF" in warned

@@ -244,3 +244,24 @@ def test_a_feed_keyword_may_have_a_blank_after_its_f(text, feed):
     """`F AUTO` (janforys/cnc-programming, cnc-programming/Heidenhain/CHWYT-125.h, a TNC's own file) and
     `F MAX` (hyperMILL's Heidenhain post) are FAUTO and FMAX."""
     assert ("feed", (feed,)) in statements(text)
+
+
+def test_contour_geometry_and_tolerance_cycles_parse_as_the_manual_writes_them():
+    """Cycle 14 CONTOUR GEOMETRY names its subcontours `CYCL DEF 14.1 CONTOUR LABEL1 /2 /3` and cycle 32
+    TOLERANCE its mode `CYCL DEF 32.2 HSC-MODE:0 TA0` (TNC 640 / iTNC 530 User's Manual, Cycle
+    Programming, "CONTOUR GEOMETRY (Cycle 14)" and "TOLERANCE (Cycle 32)"; drunsinn/language-klartext,
+    `testprogramme/SLII001.klartext`, `Krivka.klartext`).  A `/` in a formula stays a division."""
+    assert statements("CYCL DEF 14.1 KONTURLABEL1 /2 /3") == [
+        ("cycle_def", ("14.1", ())),
+        ("contour_label", (2,)),
+        ("contour_label", (3,)),
+    ]
+    labels = statements("CYCL DEF 14.1 CONTOUR LABEL 1 /2 /3 /4")[1:]
+    assert labels == [("contour_label", (n,)) for n in (2, 3, 4)]
+    assert statements("CYCL DEF 32.2 HSC-MODE:0 TA0") == [("cycle_def", ("32.2", ("HSC-MODE:0",)))]
+    assert statements("Q51 = ( 3 / 4 ) * Q91") == [
+        (
+            "assignment",
+            (("param", "q51"), ("bin", "*", ("bin", "/", ("num", 3.0), ("num", 4.0)), ("param", "q91"))),
+        )
+    ]

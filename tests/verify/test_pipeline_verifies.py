@@ -140,8 +140,29 @@ M30
 """
 
 
-@pytest.mark.parametrize("program, name, moves_a_run", [(LOOP, "loop.ngc", 7), (FANUC_LOOP, "loop.nc", 2)],
-                         ids=["o-words", "Fanuc WHILE"])  # fmt: skip
+# (its formulas on `~` continuation lines: the read-back counts a block's lines as the file has them,
+# drunsinn/language-klartext, `testprogramme/Krivka.klartext`)
+KLARTEXT_LOOP = """0  BEGIN PGM LOOP MM
+1  TOOL CALL 1 Z S900
+2  L  X+0  Y+0  Z+5 R0 FMAX M3
+3  L  Z-1 F300
+4  Q4 = 0
+5  LBL 2
+6  Q4 = Q4 + ~
+    0,1
+7  Q2 = Q4 * 2 + ~
+    10
+8  L  X+Q4  Y+Q2 R0 F500
+9  L  Y+0
+10 FN 12: IF +Q4 LT +40 GOTO LBL 2
+11 L  Z+5 R0 FMAX M30
+12 END PGM LOOP MM
+"""
+
+
+@pytest.mark.parametrize("program, name, moves_a_run", [(LOOP, "loop.ngc", 7), (FANUC_LOOP, "loop.nc", 2),
+                                                        (KLARTEXT_LOOP, "loop.h", 2)],
+                         ids=["o-words", "Fanuc WHILE", "Klartext FN 12"])  # fmt: skip
 def test_a_long_loop_is_verified_a_chunk_at_a_time(tmp_path: Path, monkeypatch, program, name, moves_a_run):
     """A loop's runs, whose moves are its end line's (`endrepeat`, `END1`), are compared in
     chunks as they run (memory stays flat in the number of runs), the read-back's cut where

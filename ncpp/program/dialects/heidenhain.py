@@ -25,11 +25,13 @@ Statement kinds and nodes (Heidenhain):
   feed           ('FMAX' | 'FAUTO',)     `F200` is a Word; `F MAX` is 'FMAX' too
   rotation       ('+' | '-',)            `DR+` counter-clockwise, `DR-` clockwise
   retract        (distance | 'MAX',)     M140's `MB 50` -> (50.0,), `MB MAX` -> ('MAX',)
+  contour_label  (label,)                cycle 14's further subprograms: `LABEL1 /2 /3` -> (2,), (3,)
   tool_call      (tool, axis)            `TOOL CALL 1 Z S800`: tool int | float | "name" | ("param", q)
                                          | None, axis 'X' | 'Y' | 'Z' | None; S F DL DR words follow
   tool_def       (tool,)                 `TOOL DEF 5 L+0 R+5`
   label          (label,)                `LBL 1` -> 1, `LBL "name"` -> 'name' (`LBL 0` ends a subprogram)
-  call_label     (label, repeat)         `CALL LBL 1 REP 2/2` -> (1, 2); repeat 0 without REP
+  call_label     (label, repeat)         `CALL LBL 1 REP 2/2` -> (1, 2); repeat 0 without REP, a Q
+                                         parameter tuple for `REPQ9` -> (1, ('param', 'q9'))
   call_program   (path,)                 `CALL PGM TNC:\\Plan.h`
   cycle_def      (number, words)         `CYCL DEF 200 BOHREN` -> ('200', ('BOHREN',)); its Q200=...
                                          parameters (continuation lines) follow as assignments
@@ -160,7 +162,8 @@ class HeidenhainBuilder(Transformer):
 
     def _call_label(children: list) -> tuple:  # type: ignore[misc]
         ints = [c for c in children[2:] if isinstance(c, Token) and c.type == "INT"]
-        return (_tool_ref(children[1]), int(ints[0]) if ints else 0)
+        counts = [_tool_ref(c) for c in children[2:] if isinstance(c, Token) and c.type == "QPARAM"]
+        return (_tool_ref(children[1]), counts[0] if counts else int(ints[0]) if ints else 0)
 
     def _cycle_def(children: list) -> tuple:  # type: ignore[misc]
         return (str(children[1]), tuple(str(c).strip() for c in children[2:]))
@@ -200,6 +203,7 @@ class HeidenhainBuilder(Transformer):
     feed = _statement("feed", lambda c: ("".join(str(c[0]).split()).upper(),))
     rotation = _statement("rotation", lambda c: (str(c[0])[-1],))
     retract = _statement("retract", lambda c: (_retract_distance(str(c[0])),))
+    contour_label = _statement("contour_label", lambda c: (int(str(c[0]).lstrip("/ \t")),))
     del (
         _statement,
         _text,
