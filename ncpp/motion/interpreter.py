@@ -60,6 +60,7 @@ from ncpp.motion.expand import Expansion, number, refused
 from ncpp.motion.expressions import ExpressionError, OutOfScope, Parameters, evaluate, vacant
 from ncpp.motion.flow import FIXED, ONCE, RUN, SKIP, Flow
 from ncpp.motion.offsets import SYSTEMS, WorkOffsets
+from ncpp.motion.once import FirstPass
 from ncpp.motion.segments import (
     COMP,
     CYCLE,
@@ -100,9 +101,6 @@ CENTER_ARC_ABS = {False: 2 * 0.01 * math.sqrt(2), True: 2 * 0.001 * math.sqrt(2)
 CENTER_ARC_REL = 0.001
 TINY = 1e-12
 # Moves of one canned-cycle block (L repeats, pecks): held at once, so bounded; a real one makes thousands
-# Events of a loop's first pass held until the flow tells whether its text runs again: a longer
-# pass is left as programmed (memory stays bounded)
-MAX_ONCE = 10_000
 MAX_CYCLE_MOVES = 1_000_000
 
 _GROUP_CODES = {
@@ -360,7 +358,7 @@ class Interpreter:
         pending: Line | None = None  # the line whose end corner is rounded
         corner: tuple = ()  # its corner word: (kind, size, item); read only with a pending line
         held: list[Event] = []  # non-moving events after it
-        once: _FirstPass | None = None  # a loop's first pass in its place, while the flow has not told
+        once: FirstPass | None = None  # a loop's first pass in its place, while the flow has not told
         spent = False  # the loop under way left its first pass as programmed: its body stays so
         flow = self.flow = Flow(
             self.file, self._evaluate, self.params, lambda: self.done, self._leave_scope,
@@ -369,7 +367,7 @@ class Interpreter:
         self.rounding = False
         expansion = self.expansion
         for block, kind, owner in flow.steps(blocks):
-            if once is not None and len(once.events) > MAX_ONCE:
+            if once is not None and once.full():
                 yield from self._told(once, again=True)
                 once, spent = None, True
             if kind is ONCE and (
@@ -380,7 +378,7 @@ class Interpreter:
                 yield from self._told(once, again=self.done and not self.ended)
                 once = None
             if kind is ONCE and once is None:
-                once = _FirstPass()
+                once = FirstPass(lambda ev: _as_programmed(ev, None))
             elif once is not None and kind is FIXED and owner is not None and once.rerun(block):
                 yield from self._told(once, again=True)  # (all of it runs again: nothing to hold)
                 once = None
@@ -527,7 +525,7 @@ class Interpreter:
         """Whether cutter compensation, or the way out of it, decides where the block's moves go."""
         return self.centre.off_path or self.cutter_comp is not None or self.arc_refused or self.exit_corner
 
-    def _told(self, once: _FirstPass, again: bool) -> list[Event]:
+    def _told(self, once: FirstPass, again: bool) -> list[Event]:
         """A loop's first pass in its place (ONCE), once the flow has told whether its text runs
         again: then left as programmed (`_in_flow`'s marks), else as it ran but for the text an
         inner loop ran again; a backward GOTO may no longer run what ran so."""
@@ -2004,42 +2002,6 @@ def _marked(events: Event | tuple[Event, ...] | None, marks: list[Pass]) -> Even
     if events is None:
         return marks[0] if len(marks) == 1 else tuple(marks)
     return (*(events if type(events) is tuple else (events,)), *marks)
-
-
-class _FirstPass:
-    """The events of a loop's first pass in its place (ONCE), held until the flow tells whether
-    their text runs again, each marked where it is known to: a block run in place as part of a
-    loop (FIXED) and, when a block of the pass runs again (an inner loop's second pass), the
-    events from that block's first on (the runs again come after them)."""
-
-    def __init__(self) -> None:
-        self.events: list[Event] = []
-        self.again: list[bool] = []  # the event's text runs again
-        self.first: dict[int, int] = {}  # the id of a block run once so far -> its first event's index
-        self.again_from = 0  # the events from this index on all run again
-
-    def add(self, event: Event, block: Block, again: bool) -> None:
-        if not again:
-            self.first.setdefault(id(block), len(self.events))
-            self.again_from = len(self.events) + 1
-        self.events.append(event)
-        self.again.append(again)
-
-    def rerun(self, block: Block) -> bool:
-        """`block` runs again: its text, and that of the blocks after it, runs more than once.
-        Whether all of the pass does."""
-        start = self.first.pop(id(block), None)
-        if start is not None and start < self.again_from:
-            self.again[start : self.again_from] = [True] * (self.again_from - start)
-            self.again_from = start
-        return self.again_from == 0
-
-    def told(self, again: bool) -> list[Event]:
-        """The events, all left as programmed if the pass runs again, else those marked so."""
-        marked = (
-            _as_programmed(ev, None) if again or twice else ev for ev, twice in zip(self.events, self.again)
-        )
-        return [ev for ev in marked if ev is not None]
 
 
 def _sets_offset(event: Event | tuple[Event, ...]) -> bool:

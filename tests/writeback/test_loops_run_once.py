@@ -16,7 +16,7 @@ import io
 import numpy as np
 import pytest
 
-import ncpp.motion.interpreter as interpreter_module
+import ncpp.motion.once as once_module
 from ncpp.errors import Warnings
 from ncpp.pipeline import ErrorSource, process
 from tests.conftest import READING
@@ -147,7 +147,7 @@ M30
 
 
 def test_a_first_pass_longer_than_the_bound_stays_as_programmed(monkeypatch):
-    monkeypatch.setattr(interpreter_module, "MAX_ONCE", 3)
+    monkeypatch.setattr(once_module, "MAX_ONCE", 3)
     warned, out = io.StringIO(), io.BytesIO()
     machine = ErrorSource.from_machine_file(str(READING))
     process(io.BytesIO(ONCE["while that runs once"].encode()), out, file="t.ngc", source=machine,

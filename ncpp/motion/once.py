@@ -1,0 +1,61 @@
+"""A loop's first pass in its place, held until the flow tells whether its text runs again.
+
+The flows (`flow.py`, `sinumerik_flow.py`) yield the blocks of a loop's first pass where they
+stand as ONCE: whether the loop goes back is told only later, by the next block the flow
+yields.  A body whose text runs once can carry that run's corrections (it is written in place,
+as a RUN block's); one that runs again cannot (FIXED).  The interpreters hold the pass's events
+here until then: the flow back in straight code tells "once", a block of the pass run again
+(an inner loop's second pass) marks the events from that block's first on, and leaving the
+interpreter's scope tells "again".  The held pass is bounded (MAX_ONCE events: memory).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from ncpp.motion.segments import Event
+from ncpp.program.blocks import Block
+
+# Events of a loop's first pass held until the flow tells whether its text runs again: a longer
+# pass is left as programmed (memory stays bounded)
+MAX_ONCE = 10_000
+
+
+class FirstPass:
+    """The events of a loop's first pass in its place, each marked where it is known to run
+    again: a block run in place as part of a loop (FIXED), and, when a block of the pass runs
+    again, the events from that block's first on (the runs again come after them).  `as_programmed`
+    is the dialect's mark of an event whose text runs again (None: the event is not written)."""
+
+    def __init__(self, as_programmed: Callable[[Event], Event | None]) -> None:
+        self.as_programmed = as_programmed
+        self.events: list[Event] = []
+        self.again: list[bool] = []  # the event's text runs again
+        self.first: dict[int, int] = {}  # the id of a block run once so far -> its first event's index
+        self.again_from = 0  # the events from this index on all run again
+
+    def add(self, event: Event, block: Block, again: bool) -> None:
+        if not again:
+            self.first.setdefault(id(block), len(self.events))
+            self.again_from = len(self.events) + 1
+        self.events.append(event)
+        self.again.append(again)
+
+    def rerun(self, block: Block) -> bool:
+        """`block` runs again: its text, and that of the blocks after it, runs more than once.
+        Whether all of the pass does."""
+        start = self.first.pop(id(block), None)
+        if start is not None and start < self.again_from:
+            self.again[start : self.again_from] = [True] * (self.again_from - start)
+            self.again_from = start
+        return self.again_from == 0
+
+    def full(self) -> bool:
+        return len(self.events) > MAX_ONCE
+
+    def told(self, again: bool) -> list[Event]:
+        """The events, all left as programmed if the pass runs again, else those marked so."""
+        marked = (
+            self.as_programmed(ev) if again or twice else ev for ev, twice in zip(self.events, self.again)
+        )
+        return [ev for ev in marked if ev is not None]
