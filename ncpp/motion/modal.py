@@ -99,6 +99,7 @@ class ModalInterpreter:
         )  # the program zero the control holds (preset, settable frame), program units
         self.tangent: tuple[float, float, float] | None = None  # direction at the end of the last move
         self.done = False
+        self.left = False  # the program left the interpreter's scope (`done` too)
         self.radius_comp = False  # tool radius compensation on (G41/G42, RL/RR)
         # the radius it offsets by, positive to the left, negative to the right (0: the radius is
         # unknown); None: off, or a tool of radius 0, which stays on the path
@@ -154,7 +155,7 @@ class ModalInterpreter:
         `owner`: the line that ran the block (a loop's end, a backward jump, a call), from which the
         rest passes.  In a called file, the warning stands at the calling line of the program (where
         the program passes through from) and names the place in that file."""
-        self.done = True
+        self.done = self.left = True
         self.centre.waiting = []  # (an entry move waiting keeps its tool centre square to it)
         where = "this line" if owner is None else f"line {owner.line}, which runs it,"
         place = Location(self.file, *block.place(col))

@@ -46,7 +46,7 @@ import numpy as np
 from ncpp.errors import Location, Warnings
 from ncpp.motion.called import Files, count_called, searched
 from ncpp.motion.endless import Revisits
-from ncpp.motion.flow import FIXED, RUN, SKIP, TEXT
+from ncpp.motion.flow import FIXED, ONCE, RUN, SKIP, TEXT
 from ncpp.motion.modal import (
     MAX_HOLES,
     MM_PER_INCH,
@@ -56,6 +56,7 @@ from ncpp.motion.modal import (
     placed_interpreting,
     plane_of,
 )
+from ncpp.motion.once import FirstPass
 from ncpp.motion.segments import FLOW, MACHINE, PATTERN, PLANE_AXES, Event, Line, Pass
 from ncpp.motion.sinumerik_cycles import PARAMETERS as DRILLING
 from ncpp.motion.sinumerik_cycles import CycleError, Drilling, drilling
@@ -259,52 +260,87 @@ class SinumerikInterpreter(ModalInterpreter):
 
         flow = SinumerikFlow(self.file, self.value, self._count, lambda: self.done or self.returned, leave,
                              Revisits(None, None, self.loop_quick, self.loop_state))  # fmt: skip
+        once: FirstPass | None = None  # a loop's first pass in its place, while the flow has not told
         for block, kind, owner in flow.steps(blocks):
             if caller is not None:
-                if kind is not RUN and kind is not FIXED:
+                if kind is not RUN and kind is not FIXED and kind is not ONCE:
                     continue
                 kind, owner = FIXED, caller
                 self.called_blocks = count_called(self.called_blocks, self.program_file, caller)
-            if (kind is not RUN and kind is not FIXED) or not block.items:
-                if owner is None:  # (a block run out of the text's order is written in its place)
-                    if expansion is not None and block.items:
-                        kept = expansion.text(self.done, block)
-                        if kept is None:  # (a control line, text that does not run: left out)
-                            continue
-                        yield from kept
-                    runs_others = kind is TEXT and not self.done and _runs_others(block)
-                    yield Pass(block, kind is SKIP, self.motion if runs_others else None)
-                continue
-            if expansion is not None:
-                yield from self._expanded(expansion, flow, block, kind, owner, caller, warnings)
-                continue
-            self.again = kind is FIXED
-            self.length_told = None
-            try:
-                events = self.block(block)
-            except OutOfScope as stop:
-                self.called = None
-                self.leave_scope(warnings, stop.reason, block, stop.col, owner)
-                if owner is None:  # (a block run out of the text's order is written in its place)
-                    yield Pass(block)
-                continue
-            moves = [event for event in events if type(event) is not Pass]
-            if kind is FIXED:
-                for move in moves:
-                    move.fixed = move.fixed or FLOW  # type: ignore[union-attr]
-                    if owner is not None:
-                        move.block = owner
-            elif moves:
-                flow.last_run_move = flow.pc
-            if kind is FIXED and owner is not None:
-                yield from moves
-            else:  # (a call's line: the mode its subprogram starts in, `SinumerikWriter.written_at_once`)
-                yield from events or (Pass(block, False, self.motion if self.called is not None else None),)
-                if self.length_told is not None and kind is RUN:  # (a block that runs again: none)
-                    yield Pass(block, length_told=self.length_told)
-            if self.called is not None:
-                call, self.called = self.called, None
-                yield from self._subprogram(call, owner or block, warnings)
+            if kind is ONCE and (expansion is not None or (once is not None and once.full())):
+                kind = FIXED  # (--expand writes each run out; a longer first pass stays as programmed)
+            if once is not None and (self.done or flow.in_straight_code() or once.full()):
+                yield from self._told(once, flow, again=self.left or once.full())
+                once = None
+            if kind is ONCE and once is None:
+                once = FirstPass(_as_programmed)
+            elif once is not None and kind is FIXED and owner is not None and once.rerun(block):
+                yield from self._told(once, flow, again=True)  # (all of it runs again: nothing to hold)
+                once = None
+            events = self._events_of(block, kind, owner, flow, caller, warnings)
+            if once is None:
+                yield from events
+            else:
+                for event in events:
+                    once.add(event, block, again=kind is FIXED)
+
+    def _events_of(
+        self, block: Block, kind: str, owner: Block | None, flow: SinumerikFlow, caller: Block | None,
+        warnings: Warnings,
+    ) -> Iterator[Event]:  # fmt: skip
+        """The events of one block the flow yields (`_run`)."""
+        expansion = self.expansion
+        if (kind is not RUN and kind is not FIXED and kind is not ONCE) or not block.items:
+            if owner is None:  # (a block run out of the text's order is written in its place)
+                if expansion is not None and block.items:
+                    kept = expansion.text(self.done, block)
+                    if kept is None:  # (a control line, text that does not run: left out)
+                        return
+                    yield from kept
+                runs_others = kind is TEXT and not self.done and _runs_others(block)
+                yield Pass(block, kind is SKIP, self.motion if runs_others else None)
+            return
+        if expansion is not None:
+            yield from self._expanded(expansion, flow, block, kind, owner, caller, warnings)
+            return
+        # (a first pass's moves are not followed under cutter compensation: they may run again)
+        self.again = kind is not RUN
+        self.length_told = None
+        try:
+            events = self.block(block)
+        except OutOfScope as stop:
+            self.called = None
+            self.leave_scope(warnings, stop.reason, block, stop.col, owner)
+            if owner is None:  # (a block run out of the text's order is written in its place)
+                yield Pass(block)
+            return
+        moves = [event for event in events if type(event) is not Pass]
+        if kind is FIXED:
+            for move in moves:
+                move.fixed = move.fixed or FLOW  # type: ignore[union-attr]
+                if owner is not None:
+                    move.block = owner
+        elif moves and kind is RUN:
+            flow.last_run_move = flow.pc
+        elif moves:
+            flow.once_move = flow.pc
+        if kind is FIXED and owner is not None:
+            yield from moves
+        else:  # (a call's line: the mode its subprogram starts in, `SinumerikWriter.written_at_once`)
+            yield from events or (Pass(block, False, self.motion if self.called is not None else None),)
+            if self.length_told is not None and kind is not FIXED:  # (a block that runs again: none)
+                yield Pass(block, length_told=self.length_told)
+        if self.called is not None:
+            call, self.called = self.called, None
+            yield from self._subprogram(call, owner or block, warnings)
+
+    def _told(self, once: FirstPass, flow: SinumerikFlow, again: bool) -> list[Event]:
+        """A loop's first pass in its place, once the flow has told whether its text runs again
+        (`ncpp.motion.once`); a backward jump may no longer run what ran so."""
+        if not again:
+            flow.last_run_move = max(flow.last_run_move, flow.once_move)
+        flow.once_move = -1
+        return once.told(again)
 
     def _expanded(
         self,
@@ -1084,6 +1120,15 @@ def _frame_name(code: float | None) -> str:
 
 
 interpret = placed_interpreting(SinumerikInterpreter)
+
+
+def _as_programmed(event: Event) -> Event | None:
+    """An event of a loop's first pass whose text runs again: a move left as programmed, the
+    tool guard's mark dropped (none is written for a block that runs again)."""
+    if type(event) is Pass:
+        return None if event.length_told is not None else event
+    event.fixed = event.fixed or FLOW  # type: ignore[union-attr]
+    return event
 
 
 def _runs_others(block: Block) -> bool:

@@ -25,12 +25,13 @@ The rules are those of the SINUMERIK 840D sl Programming Manual, Job Planning
   control structure or a jump, or a repetition inside another or inside a structure.
 
 `SinumerikFlow.steps(blocks)` yields each block with what the interpreter is to do
-with it, as `ncpp.motion.flow` does for o-words (its RUN, FIXED, SKIP, TEXT): a block
-that runs once where it stands is RUN; the body of a loop (WHILE, FOR, REPEAT, LOOP)
-and the blocks a backward jump among the first `_TRIM` blocks goes back over are FIXED
-from their first pass (one text runs many times: its moves are left as programmed);
-their second and later passes come again, FIXED, with an `owner`, the line that sent
-the program back (ENDWHILE, UNTIL, a GOTOB), whose text holds them.  Past the first
+with it, as `ncpp.motion.flow` does for o-words (its RUN, FIXED, ONCE, SKIP, TEXT): a
+block that runs once where it stands is RUN; the first pass of a loop (WHILE, FOR, REPEAT,
+LOOP) where it stands is ONCE (whether its text runs again is told later: `ncpp.motion.once`);
+the blocks a backward jump among the first `_TRIM` blocks goes back over are FIXED from their
+first pass (one text runs many times: its moves are left as programmed); a loop's second and
+later passes come again, FIXED, with an `owner`, the line that sent the program back
+(ENDWHILE, UNTIL, a GOTOB), whose text holds them.  Past the first
 `_TRIM` blocks, a backward jump over a move that ran in place (its text may be
 rewritten for that one run) leaves the scope.  A jump into or out of an open
 structure, a destination not found (but GOTOC's) or no longer held (blocks are held
@@ -44,7 +45,7 @@ from dataclasses import dataclass
 
 from ncpp.errors import Location, NcppError
 from ncpp.motion.endless import Revisits, endless, exact
-from ncpp.motion.flow import _TRIM, FIXED, MAX_RERUN, RUN, SKIP, TEXT, Around, CountedPasses
+from ncpp.motion.flow import _TRIM, FIXED, MAX_RERUN, ONCE, RUN, SKIP, TEXT, Around, CountedPasses
 from ncpp.motion.modal import OutOfScope
 from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
 
@@ -108,6 +109,7 @@ class SinumerikFlow:
         self.open: list[_Open] = []
         self.looped: set[int] = set()  # blocks a backward jump read ahead runs again
         self.last_run_move = -1  # the index of the last block that moved in place (RUN): the interpreter's
+        self.once_move = -1  # and of a loop's first pass (ONCE) not yet told: it may be rewritten too
         self.rerun = 0  # blocks run out of the text's order so far
         self.section: _Section | None = None  # a REPEAT's section running
         self.passes = CountedPasses(file)
@@ -139,8 +141,10 @@ class SinumerikFlow:
                 self.stop(leave.reason, block, leave.col, owner)
                 break
             if target is None:
-                looping = self.pc in self.looped or self._looping()
-                yield block, (FIXED if looping or not in_place else RUN), owner
+                if self.pc in self.looped or not in_place:
+                    yield block, FIXED, owner
+                else:
+                    yield block, (ONCE if self._looping() else RUN), owner
                 self._advance()
                 continue
             if in_place:
@@ -169,7 +173,7 @@ class SinumerikFlow:
         section under way, what it has read and holds; not its counts of blocks run."""
         opened = tuple((o.kind, o.start, exact(o.end)) for o in self.open)
         section = self.section and exact(self.section)
-        held = (self.written, self.base, self.read, self.last_run_move, len(self.looped))
+        held = (self.written, self.base, self.read, self.last_run_move, self.once_move, len(self.looped))
         return state, self.pc, opened, section, held
 
     def _advance(self) -> None:
@@ -191,6 +195,14 @@ class SinumerikFlow:
             if keep > 0:
                 del self.buffer[:keep]
                 self.base += keep
+
+    def in_straight_code(self) -> bool:
+        """Whether the program runs its text with no loop or section under way (none can go back)."""
+        return not self._looping() and self.section is None
+
+    def _ran_in_place(self) -> int:
+        """The index of the last block whose moves ran in place, or may have (ONCE, not yet told)."""
+        return max(self.last_run_move, self.once_move)
 
     def _looping(self) -> bool:
         """A loop is under way: its blocks run again (an IF's do not: they are not held for it)."""
@@ -387,7 +399,7 @@ class SinumerikFlow:
             if END_LABEL in _destinations(block) and keyword == "REPEAT":
                 raise OutOfScope(f"{keyword}: a section with {END_LABEL} (not followed)", where)
         looped = all(index in self.looped for index in range(start, end + 1))  # (a looped block runs FIXED)
-        if start <= self.pc and self.last_run_move >= start and not looped:
+        if start <= self.pc and self._ran_in_place() >= start and not looped:
             raise OutOfScope(f"{keyword}: a section of moves compensated where they stand, run again", where)
 
     def _after(self, start: int, name: str) -> int | None:
@@ -464,7 +476,7 @@ class SinumerikFlow:
                 else "not found"
             )
             raise OutOfScope(f"{keyword} {destination}, a jump destination {held}", statement.start + 1)
-        if found <= self.pc and self.last_run_move >= found:  # (a looped block runs FIXED)
+        if found <= self.pc and self._ran_in_place() >= found:  # (a looped block runs FIXED)
             raise OutOfScope(
                 f"{keyword} {destination}, a backward jump over moves compensated where they stand",
                 statement.start + 1,

@@ -1,13 +1,14 @@
 """Without --expand, the body of a loop that runs once where it stands (a `while` whose test fails
-the second time, `repeat [1]`, a `do` that does not go back, a Fanuc `WHILE ... DO1` of one pass)
-is compensated in place: its text runs once, so it can carry that run's corrections.  A body whose
+the second time, `repeat [1]`, a `do` that does not go back, a Fanuc `WHILE ... DO1` of one pass,
+Sinumerik's FOR, WHILE and REPEAT ... UNTIL of one pass) is compensated in place: its text runs once, so it can carry that run's corrections.  A body whose
 text runs again stays as programmed, with the warning.
 
 Judged by oracles ncpp did not write: LinuxCNC's rs274 runs the written program, its feed moves'
 end points are mapped through the machine the test writes by hand (`square`: scale errors and
 squareness), and every programmed point must be reached within 0.5 µm; pathcheck checks the
 same actions and path.  The Fanuc program, which rs274 does not read, is judged by its o-word
-twin."""
+twin; the Sinumerik ones by the closed form of `closed_form.py` (the written numbers mapped through
+a machine whose errors are linear in position)."""
 
 from __future__ import annotations
 
@@ -19,10 +20,13 @@ import pytest
 import ncpp.motion.once as once_module
 from ncpp.errors import Warnings
 from ncpp.pipeline import ErrorSource, process
+from tests.compensation.test_dialect_cutter_comp import compensated as sinumerik_compensated
 from tests.conftest import READING
+from tests.writeback.closed_form import landed
 from tests.writeback.conftest import compensate_file
 from tests.writeback.test_compensated_holes import MACHINE, square
 from tests.writeback.test_expand_flow import _compensated, _feed_ends, _pathcheck, _worst_point_um
+from tests.writeback.test_sinumerik_expand import points as sinumerik_points
 
 HEAD = "G21 G90 G17\nG0 X0 Y0 Z10\nM3 S1200\n"
 ONCE = {
@@ -168,3 +172,69 @@ def test_a_backward_goto_over_a_loop_run_once_in_place_is_not_followed(tmp_path)
     written = compensate_file(program, MACHINE, tmp_path, warnings=Warnings(stream=warned)).read_text()
     assert "O1002.nc:13:1: warning: GOTO 10 back over moves that ran once in their place" in warned.getvalue()
     assert "\nG91 G1 X10 F300\n" in written
+
+
+# Sinumerik: FOR of one pass, a REPEAT ... UNTIL whose test holds at once, a WHILE of one pass;
+# the points each reaches (a square at Z-1, then three corners)
+SINUMERIK_ONCE = """DEF INT I
+G17 G90 G71
+G0 X-5 Y-5 Z5
+FOR I=1 TO 1
+  G1 X0 Y0 Z-1 F300
+  X40
+  Y40
+  X0
+  Y0
+ENDFOR
+R1=0
+REPEAT
+  R1=R1+1
+  G1 X60 Y-20
+UNTIL R1>=1
+WHILE R1<2
+  R1=R1+1
+  G1 X-30 Y70
+ENDWHILE
+G0 Z5
+M30
+"""
+SINUMERIK_POINTS = [
+    (0, 0, -1),
+    (40, 0, -1),
+    (40, 40, -1),
+    (0, 40, -1),
+    (0, 0, -1),
+    (60, -20, -1),
+    (-30, 70, -1),
+]
+# a WHILE run twice inside a FOR of one pass: its point stays as programmed, the others do not
+SINUMERIK_TWICE_INSIDE = """G17 G90 G71
+G0 X-5 Y-5 Z5
+FOR R2=1 TO 1
+  G1 X0 Y0 Z-1 F300
+  R1=0
+  WHILE R1<2
+    R1=R1+1
+    G1 X50 Y-40
+  ENDWHILE
+  G1 X70 Y30
+ENDFOR
+G0 Z5
+M30
+"""
+
+
+def test_a_sinumerik_loop_of_one_pass_is_compensated_in_place(tmp_path):
+    """Closed form (`tests/writeback/closed_form.py`): the written numbers mapped through the
+    machine's formula land within 0.5 µm of every programmed point; the control lines stay."""
+    written, messages = sinumerik_compensated(tmp_path, "once.mpf", SINUMERIK_ONCE)
+    assert landed(sinumerik_points(written), SINUMERIK_POINTS).max() < 0.5e-3
+    assert "loop or subroutine" not in messages
+    assert all(line in written for line in ("FOR I=1 TO 1", "ENDFOR", "REPEAT", "UNTIL R1>=1", "ENDWHILE"))
+
+
+def test_a_sinumerik_loop_run_twice_stays_as_programmed_inside_one_of_one_pass(tmp_path):
+    written, messages = sinumerik_compensated(tmp_path, "twice.mpf", SINUMERIK_TWICE_INSIDE)
+    misses = landed(sinumerik_points(written), [(0, 0, -1), (50, -40, -1), (70, 30, -1)])
+    assert misses[1] > 2e-3 and max(misses[0], misses[2]) < 0.5e-3
+    assert "twice.mpf:8:1: warning: loop or subroutine" in messages
