@@ -92,6 +92,7 @@ class FanucInterpreter(Interpreter):
     modal_d = True  # `G43 H1 D1`: D alone selects the radius offset (module docstring)
     dwell_x = True  # `G04 X1.5`: a dwell of 1.5 s (module docstring)
     taps_in_any_plane = True  # G74/G84 in G18/G19 tap along the normal (module docstring)
+    repeats_in_p = True  # `M98 P51002`: O1002 five times (`Flow._m98`)
 
     def block(self, block: Block) -> Event | tuple[Event, ...]:
         signature = block.signature
@@ -194,6 +195,9 @@ class HaasInterpreter(FanucInterpreter):
     g54_with_p = False  # (Haas's manual gives G54 no P)
     numbered = range(110, 130)
     dwell_x = False  # (Haas's manual gives G04 a P only)
+    # ("M98 Sub Program Call": "M98 Pnnnn (Pnnnn is the number of the program being called)", runs in L;
+    # its programs are numbered to O99999)
+    repeats_in_p = False
 
 
 interpret = interpreting(FanucInterpreter)

@@ -212,11 +212,13 @@ class KlartextFlow:
         self.frames.append((self.current + 1, key))
         self.next = index + 1
 
-    def _around(self, label: int, call: int) -> list[Around]:
+    def _around(self, label: int, call: int, depth: int | None = None) -> list[Around]:
         """The REP sections around the section from `label` to its REP `call`, innermost first: the
         REP calls the program comes to from `call` on, before any other call, jump or end, each of
         a section that holds the one before (its label before that one's).  One not under way yet
-        runs its REP k passes after the one under way."""
+        runs its REP k passes after the one under way.  In a subprogram (`depth` calls deep, None:
+        as deep as the flow is), its LBL 0 goes on with the sections around its call."""
+        depth = len(self.frames) if depth is None else depth
         loops: list[Around] = []
         index = call + 1
         while index < call + MAX_AROUND and (block := self.block(index)) is not None:
@@ -224,6 +226,9 @@ class KlartextFlow:
             if item is None and any(type(w) is Word and w.letter == "M" and w.value in (2.0, 30.0)
                                     for w in block.items):  # fmt: skip
                 break
+            if item is not None and item.kind == "label" and item.node[0] == 0 and depth > 0:
+                caller = self.frames[depth - 1][0] - 1  # (the call's index: it returns to the next)
+                return loops + self._around(caller, caller, depth - 1)
             if item is not None and item.kind != "label":
                 name, repeat = item.node if item.kind == "call_label" else (None, 0)
                 start = self.labels.get(label_key(name)) if repeat and type(name) is not tuple else None

@@ -250,6 +250,8 @@ class Interpreter:
     # its convert_cycle_g74_g84 hands cycle_feed the plane's coordinates already permuted, so the
     # tap feeds other axes (in G18 X to the Y word, Y to the Z word, Z to the X word)
     taps_in_any_plane = False
+    # `M98 P51002` runs O1002 five times (Fanuc, `Flow._m98`); rs274ngc calls O51002
+    repeats_in_p = False
 
     def __init__(self, file: str = "<stdin>", offsets: WorkOffsets | None = None):
         self.file = file
@@ -348,6 +350,7 @@ class Interpreter:
         flow = self.flow = Flow(
             self.file, self._evaluate, self.params, lambda: self.done, self._leave_scope,
             self.subroutine_path, state=self._loop_state, position=lambda: self.pos[:],
+            repeats_in_p=self.repeats_in_p,
         )  # fmt: skip
         self.rounding = False
         expansion = self.expansion

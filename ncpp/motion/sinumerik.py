@@ -36,7 +36,7 @@ from __future__ import annotations
 import itertools
 import math
 import re
-from collections.abc import Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import cast
@@ -46,7 +46,7 @@ import numpy as np
 from ncpp.errors import Location, Warnings
 from ncpp.motion.called import Files, count_called, searched
 from ncpp.motion.endless import Revisits
-from ncpp.motion.flow import FIXED, RUN, SKIP, TEXT
+from ncpp.motion.flow import FIXED, RUN, SKIP, TEXT, Around, CountedPasses
 from ncpp.motion.modal import (
     MAX_HOLES,
     MM_PER_INCH,
@@ -193,6 +193,9 @@ class _Call:
 
 
 class SinumerikInterpreter(ModalInterpreter):
+    # (the counts of blocks run and the counted loops around a subprogram's run: no loop's state)
+    not_loop_state = ModalInterpreter.not_loop_state | {"passes", "outside"}
+
     def __init__(
         self,
         file: str = "<stdin>",
@@ -226,6 +229,11 @@ class SinumerikInterpreter(ModalInterpreter):
         self.called: _Call | None = None  # the subprogram the block just run calls
         self.returned = False  # M17 or RET ended the subprogram running
         self.called_blocks = 0  # blocks run in subprogram files so far
+        # The passes of counted loops, measured in blocks of the program and the subprograms it calls
+        # (one count for all: a FOR around a call runs the subprogram's blocks in each pass)
+        self.passes = CountedPasses(file)
+        # The counted loops around the subprogram running, innermost first (`_subprogram`)
+        self.outside: Callable[[], list[Around]] = list
         self._files: Files | None = None  # the subprogram files, once a call needs them
         self.centre.approach = "NORM"  # (the control's initial setting: `ToolCentre.approach`)
         self.expansion: SinumerikExpansion | None = None  # --expand: what it writes (`sinumerik_expand`)
@@ -257,7 +265,8 @@ class SinumerikInterpreter(ModalInterpreter):
             self.leave_scope(warnings, reason, block, col, caller or owner)
 
         flow = SinumerikFlow(self.file, self.value, self._count, lambda: self.done or self.returned, leave,
-                             Revisits(None, None, self.loop_quick, self.loop_state))  # fmt: skip
+                             Revisits(None, None, self.loop_quick, self.loop_state), self.passes,
+                             self.outside)  # fmt: skip
         for block, kind, owner in flow.steps(blocks):
             if caller is not None:
                 if kind is not RUN and kind is not FIXED:
@@ -303,7 +312,7 @@ class SinumerikInterpreter(ModalInterpreter):
                     yield Pass(block, length_told=self.length_told)
             if self.called is not None:
                 call, self.called = self.called, None
-                yield from self._subprogram(call, owner or block, warnings)
+                yield from self._subprogram(call, owner or block, warnings, flow, block)
 
     def _expanded(
         self,
@@ -353,7 +362,7 @@ class SinumerikInterpreter(ModalInterpreter):
                 yield Pass(written, length_told=self.length_told)
         if self.called is not None:
             call, self.called = self.called, None
-            yield from self._subprogram(call, owner or block, warnings)
+            yield from self._subprogram(call, owner or block, warnings, flow, block)
 
     # -- subprogram calls (840D sl Programming Manual, Fundamentals, "Subprogram technique") --
     def _call(self, block: Block, item: Word | Statement, name: str, args: tuple) -> _Call:
@@ -430,14 +439,28 @@ class SinumerikInterpreter(ModalInterpreter):
             values[parameter] = float(round(value)) if kind == "INT" else value
         return values
 
-    def _subprogram(self, call: _Call, caller: Block, warnings: Warnings) -> Iterator[Event]:
+    def _subprogram(
+        self, call: _Call, caller: Block, warnings: Warnings, flow: SinumerikFlow, at: Block
+    ) -> Iterator[Event]:
         """The subprogram's runs: its blocks run as the program's, with variables of their own
-        (the R parameters are the channel's, shared), to M17 or RET."""
+        (the R parameters are the channel's, shared), to M17 or RET.  Its P runs are a counted
+        loop at the calling line `at` of `flow` (`CountedPasses`), inside the loops around the call."""
         outer = (self.file, self.variables, self.integers, self.arrays, self.started)
+        outside, around_call = self.outside, flow.enclosing
+        what = f"the subprogram call {call.name} P{call.runs}"
+
+        def around_run(
+            left: int,
+        ) -> Callable[[], list[Around]]:  # (the loops around one run: its P runs left)
+            return lambda: [Around(left, call.runs, at.line, what, outer[0]), *around_call()]
+
         self.calls.append(call.name)
         self.file = str(call.path)
+        mark: int | None = self.passes.steps
         try:
-            for _ in range(call.runs):
+            for run in range(call.runs):
+                left = call.runs - 1 - run
+                self.outside = around_run(left)
                 self.variables = {k: v for k, v in outer[1].items() if _R_PARAMETER.fullmatch(k)}
                 self.variables.update(call.parameters)
                 self.integers, self.arrays, self.started = set(), {}, False
@@ -455,8 +478,13 @@ class SinumerikInterpreter(ModalInterpreter):
                                      call.blocks[-1] if call.blocks else caller, None, caller)  # fmt: skip
                     return
                 self.returned = False
+                if left:
+                    around = around_call if run == 0 else None  # (its first run ended: the loops around it)
+                    mark = self.passes.ended(mark, self.called_blocks, left, at.line, what, outer[0], around,
+                                             call.runs)  # fmt: skip
         finally:
             self.calls.pop()
+            self.outside = outside
             self.file, self.variables, self.integers, self.arrays, self.started = outer
 
     # -- variables --------------------------------------------------------------------

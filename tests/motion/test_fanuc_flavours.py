@@ -336,3 +336,31 @@ def test_a_fanuc_dwell_in_x_is_read_past():
     assert [type(e) for e in found] == [Pass, Line, Pass, Pass, Pass] and "G04 X (a dwell) with other" in (
         said.getvalue()
     )
+
+
+SUBPROGRAM_IN_P = (
+    "%\nO1000\nG21 G90 G17\nG0 X0 Y0 Z5 F200\nM98 P31002\nG1 Y1\nM30\nO{n}\nG91 G1 X1\nG90\nM99\n%\n"
+)
+
+
+def test_fanuc_m98_p_gives_the_runs_before_the_program_number():
+    """Fanuc Series 0i-MC operator's manual (B-64124EN), "Subprogram (M98, M99)": `M98 P51002` calls
+    subprogram 1002 five times; a program numbered with all of P (eight-digit numbers) is called once."""
+    ends = [e.end[:2] for e in events(SUBPROGRAM_IN_P.format(n=1002), "fanuc") if type(e) is Line]
+    assert [round(x, 6) for x, _ in ends] == [0.0, 1.0, 2.0, 3.0, 3.0] and ends[-1][1] == 1.0
+    ends = [e.end[:2] for e in events(SUBPROGRAM_IN_P.format(n=31002), "fanuc") if type(e) is Line]
+    assert [round(x, 6) for x, _ in ends] == [0.0, 1.0, 1.0]
+
+
+@pytest.mark.parametrize("dialect", ["haas", "iso"])
+def test_haas_and_linuxcnc_m98_p_is_the_program_number(dialect):
+    """Haas Mill Operator's Manual, "M98 Sub Program Call": "M98 Pnnnn (Pnnnn is the number of the
+    program being called)"; rs274ngc alike: `M98 P31002` with only O1002 in the program is not followed."""
+    said = io.StringIO()
+    ends = [
+        e for e in events(SUBPROGRAM_IN_P.format(n=1002), dialect, Warnings(stream=said)) if type(e) is Line
+    ]
+    assert (
+        len(ends) == 1
+        and "p.nc:5:1: warning: M98 P31002: a subprogram the program does not define" in said.getvalue()
+    )
