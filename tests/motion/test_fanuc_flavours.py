@@ -19,6 +19,7 @@ from ncpp.errors import NcppError, Warnings
 from ncpp.motion.segments import Line, Pass
 from ncpp.pipeline import dialect_tools
 from ncpp.program.dialects import detect, parse_program
+from tests import rs274 as oracle
 from tests.conftest import READING, ROOT, RS274, SHARED
 
 PATHCHECK = SHARED / "tools" / "pathcheck"
@@ -301,8 +302,7 @@ def test_g41_without_d_takes_the_radius_of_the_d_in_effect(tmp_path, body, refus
     table.write_text("T1 P1 D10 Z0\nT2 P2 D3 Z0\n")
     head = "G21 G90 G17 G94\nG0 X0 Y0 Z5\nG1 Z-1 F100\n"
     twin = write_program(tmp_path, head + body.replace("D2\nG41", "G41 D2").replace("D1\nG41", "G41 D1"))
-    theirs = rs274_error(subprocess.run([str(RS274), "-t", str(table), str(twin)], capture_output=True,
-                                        text=True, timeout=60).stderr)  # fmt: skip
+    theirs = rs274_error(oracle.run(twin, tool_table=table, timeout=60).stderr)
     offsets = replace(WorkOffsets.at((0.0, 0.0, 0.0)), tools=ToolTable.from_file(table, unit_mm=25.4))
     interpret, _ = dialect_tools("fanuc")
     _, blocks = parse_program(io.BytesIO((head + body + "M30\n").encode()), "p.nc", "fanuc")
