@@ -137,6 +137,20 @@ M99
 """
 # Fanuc 0i: `M98 P<runs><program>`, the program's number in P's last four digits
 FANUC_P_AROUND_P = FANUC_L_AROUND_L.replace("P2000 L9999", "P99992000").replace("P3000 L9999", "P99993000")
+# An o-word subroutine's blocks run in the pass of the repeat around its call (counted so before)
+ISO_REPEAT_AROUND_CALL = """o<s> sub
+o2 repeat [20000]
+G1 X1
+G1 X0
+o2 endrepeat
+o<s> endsub
+G21 G90 G17
+G0 X0 Y0 Z5 F200
+o1 repeat [65534]
+o<s> call
+o1 endrepeat
+M2
+"""
 SINUMERIK_FOR_AROUND_P = """G17 G90 G71 F200
 G0 X0 Y0 Z5
 FOR R1=1 TO 1000
@@ -172,7 +186,8 @@ KLARTEXT_REP_AROUND_CALL = """0 BEGIN PGM LOOP MM
 @pytest.mark.parametrize(
     "name, text, line",
     [
-        ("repeat-l.ngc", ISO_REPEAT_AROUND_L, 3),  # (the repeat: before, after its first pass, 25 s)
+        ("repeat-l.ngc", ISO_REPEAT_AROUND_L, 3),
+        ("repeat-call.ngc", ISO_REPEAT_AROUND_CALL, 9),  # (the repeat: before, after its first pass, 25 s)
         ("l-l.nc", FANUC_L_AROUND_L, 5),  # (the outer M98: before, its M99 in O2000)
         ("p-p.nc", FANUC_P_AROUND_P, 5),  # (before, P99992000 was a program O99992000 not found)
         ("for-p.mpf", SINUMERIK_FOR_AROUND_P, 3),  # (the FOR: before, 5,000,000 blocks in called files)
