@@ -194,7 +194,7 @@ class _Call:
 
 class SinumerikInterpreter(ModalInterpreter):
     # (the counts of blocks run and the counted loops around a subprogram's run: no loop's state)
-    not_loop_state = ModalInterpreter.not_loop_state | {"passes", "outside"}
+    not_loop_state = ModalInterpreter.not_loop_state | {"called_passes", "outside"}
 
     def __init__(
         self,
@@ -229,9 +229,9 @@ class SinumerikInterpreter(ModalInterpreter):
         self.called: _Call | None = None  # the subprogram the block just run calls
         self.returned = False  # M17 or RET ended the subprogram running
         self.called_blocks = 0  # blocks run in subprogram files so far
-        # The passes of counted loops, measured in blocks of the program and the subprograms it calls
-        # (one count for all: a FOR around a call runs the subprogram's blocks in each pass)
-        self.passes = CountedPasses(file)
+        # A call's P runs and the counted loops around it, measured in blocks run in subprogram files
+        # (`called_blocks`, whose bound a program that calls for ever passes)
+        self.called_passes = CountedPasses(file)
         # The counted loops around the subprogram running, innermost first (`_subprogram`)
         self.outside: Callable[[], list[Around]] = list
         self._files: Files | None = None  # the subprogram files, once a call needs them
@@ -265,14 +265,14 @@ class SinumerikInterpreter(ModalInterpreter):
             self.leave_scope(warnings, reason, block, col, caller or owner)
 
         flow = SinumerikFlow(self.file, self.value, self._count, lambda: self.done or self.returned, leave,
-                             Revisits(None, None, self.loop_quick, self.loop_state), self.passes,
-                             self.outside)  # fmt: skip
+                             Revisits(None, None, self.loop_quick, self.loop_state), self.outside)  # fmt: skip
         for block, kind, owner in flow.steps(blocks):
             if caller is not None:
                 if kind is not RUN and kind is not FIXED:
                     continue
                 kind, owner = FIXED, caller
                 self.called_blocks = count_called(self.called_blocks, self.program_file, caller)
+                self.called_passes.steps = self.called_blocks
             if (kind is not RUN and kind is not FIXED) or not block.items:
                 if owner is None:  # (a block run out of the text's order is written in its place)
                     if expansion is not None and block.items:
@@ -456,7 +456,7 @@ class SinumerikInterpreter(ModalInterpreter):
 
         self.calls.append(call.name)
         self.file = str(call.path)
-        mark: int | None = self.passes.steps
+        mark: int | None = self.called_passes.steps
         try:
             for run in range(call.runs):
                 left = call.runs - 1 - run
@@ -480,7 +480,7 @@ class SinumerikInterpreter(ModalInterpreter):
                 self.returned = False
                 if left:
                     around = around_call if run == 0 else None  # (its first run ended: the loops around it)
-                    mark = self.passes.ended(mark, self.called_blocks, left, at.line, what, outer[0], around,
+                    mark = self.called_passes.ended(mark, self.called_blocks, left, at.line, what, outer[0], around,
                                              call.runs)  # fmt: skip
         finally:
             self.calls.pop()

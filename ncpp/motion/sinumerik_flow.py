@@ -92,8 +92,7 @@ class SinumerikFlow:
 
     def __init__(
         self, file: str, value: Callable, assign: Callable, done: Callable[[], bool], stop: Callable,
-        revisits: Revisits | None = None, passes: CountedPasses | None = None,
-        outside: Callable[[], list[Around]] = list,
+        revisits: Revisits | None = None, outside: Callable[[], list[Around]] = list,
     ):  # fmt: skip
         self.file, self.value, self.assign, self.done, self.stop = file, value, assign, done, stop
         self.outside = outside  # the counted loops around this program's run (a subprogram's call's)
@@ -112,7 +111,7 @@ class SinumerikFlow:
         self.last_run_move = -1  # the index of the last block that moved in place (RUN): the interpreter's
         self.rerun = 0  # blocks run out of the text's order so far
         self.section: _Section | None = None  # a REPEAT's section running
-        self.passes = passes or CountedPasses(file)  # (shared with the subprograms': `SinumerikInterpreter`)
+        self.passes = CountedPasses(file)
 
     # -- the stream ------------------------------------------------------------------
     def steps(self, blocks: Iterable[Block]) -> Iterator[tuple[Block, str, Block | None]]:

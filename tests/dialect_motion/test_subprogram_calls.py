@@ -361,6 +361,30 @@ def test_calls_repeated_past_the_rerun_limit_are_refused_as_never_ending(
     assert "more than 1,000 blocks run in called files" in str(err.value) and "main:2:" in str(err.value)
 
 
+@pytest.mark.parametrize("passes, refused", [(3500, False), (6000, True)])
+def test_a_for_around_calls_is_bound_by_its_blocks_and_the_called_blocks_apart(
+    tmp_path, monkeypatch, passes, refused
+):
+    """A FOR whose passes run 2 blocks of the program and 4 of a subprogram's file: the blocks run
+    again in the program and those run in called files have a bound each (20,000 here), so 3,500
+    passes (7,000 and 14,000 blocks, 21,000 together) run to the end and 6,000 passes are refused
+    when the called blocks pass theirs."""
+    import ncpp.motion.called as called
+    import ncpp.motion.flow as flow
+    import ncpp.motion.sinumerik_flow as sinumerik_flow
+
+    for module in (called, flow, sinumerik_flow):
+        monkeypatch.setattr(module, "MAX_RERUN", 20_000)
+    text = f"G0 X0\nFOR R1=1 TO {passes}\nL123\nENDFOR\nM30\n"
+    folder = _folder(tmp_path, {"L123.SPF": "G91 G1 X1 F100\nX-1\nG90\nM17\n"})
+    if refused:
+        with pytest.raises(NcppError, match="main:4:1: more than 20,000 blocks run in called files"):
+            _events(sinumerik, "sinumerik", text, folder)
+    else:
+        events, _ = _events(sinumerik, "sinumerik", text, folder)
+        assert len([e for e in events if type(e) is Line]) == 1 + 2 * passes
+
+
 def test_sinumerik_ret_in_the_main_program_is_no_subprogram_call(tmp_path):
     _, warned = _events(sinumerik, "sinumerik", "G0 X0\nRET\nM30\n", _folder(tmp_path, {"RET.SPF": "M17\n"}))
     assert "main:2:1: warning: call RET is outside" in warned
