@@ -449,9 +449,8 @@ class SinumerikInterpreter(ModalInterpreter):
         outside, around_call = self.outside, flow.enclosing
         what = f"the subprogram call {call.name} P{call.runs}"
 
-        def around_run(
-            left: int,
-        ) -> Callable[[], list[Around]]:  # (the loops around one run: its P runs left)
+        def around_run(left: int) -> Callable[[], list[Around]]:
+            """The counted loops around one run: its P runs still to run, those around the call."""
             return lambda: [Around(left, call.runs, at.line, what, outer[0]), *around_call()]
 
         self.calls.append(call.name)
