@@ -159,7 +159,9 @@ ENDFOR
 M30
 """
 SINUMERIK_P_AROUND_P = "G17 G90 G71 F200\nG0 X0 Y0 Z5\nL124 P9999\nM30\n"
-SUBPROGRAMS = {"L123.SPF": "G91 G1 X1\nX-1\nG90\nM17\n", "L124.SPF": "L123 P9999\nM17\n"}
+INNER = "0 BEGIN PGM INNER MM\n1 LBL 3\n2 L X+10 Y+10 R0 F200\n3 L X+0 Y+0 R0 F200\n4 CALL LBL 3 REP 20000\n"
+SUBPROGRAMS = {"L123.SPF": "G91 G1 X1\nX-1\nG90\nM17\n", "L124.SPF": "L123 P9999\nM17\n",
+               "INNER.H": INNER + "5 END PGM INNER MM\n"}  # fmt: skip
 # A REP section around a subprogram call whose REP sections run about 3,000,000 blocks a call
 KLARTEXT_REP_AROUND_CALL = """0 BEGIN PGM LOOP MM
 1 BLK FORM 0.1 Z X+0 Y+0 Z-20
@@ -182,6 +184,17 @@ KLARTEXT_REP_AROUND_CALL = """0 BEGIN PGM LOOP MM
 18 END PGM LOOP MM
 """
 
+# A REP section around a CALL PGM whose program's REP section runs 60,000 blocks
+KLARTEXT_REP_AROUND_PGM = """0 BEGIN PGM LOOP MM
+1 TOOL CALL 1 Z S1000
+2 L Z+5 R0 FMAX
+3 LBL 1
+4 CALL PGM INNER
+5 CALL LBL 1 REP 1000
+6 L Z+50 R0 FMAX
+7 END PGM LOOP MM
+"""
+
 
 @pytest.mark.parametrize(
     "name, text, line",
@@ -193,6 +206,7 @@ KLARTEXT_REP_AROUND_CALL = """0 BEGIN PGM LOOP MM
         ("for-p.mpf", SINUMERIK_FOR_AROUND_P, 3),  # (the FOR: before, 5,000,000 blocks in called files)
         ("p-p.mpf", SINUMERIK_P_AROUND_P, 3),
         ("rep-call.h", KLARTEXT_REP_AROUND_CALL, 8),  # (the outer REP call: before, after its first pass)
+        ("rep-pgm.h", KLARTEXT_REP_AROUND_PGM, 6),  # (before, 5,000,000 blocks in called files: 190 s)
     ],
 )
 def test_a_counted_loop_around_a_subprograms_repeated_runs_is_refused_at_its_line_at_once(
