@@ -204,6 +204,8 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
         "hostile/test_counted_loops.py": (
             "test_a_counted_loop_past_the_bound_is_refused_at_its_line_at_once",
             "test_a_loop_of_a_hundred_thousand_passes_still_runs",
+            "test_a_counted_loop_around_a_subprograms_repeated_runs_is_refused_at_its_line_at_once",
+            "test_subprogram_runs_that_stay_under_the_bound_run_to_their_end",
         ),
         "hostile/test_many_turns.py": ("test_an_arc_of_ten_thousand_turns_is_compensated_in_bounded_memory",),
         "hostile/test_huge_numbers.py": ("test_a_tool_1e308_mm_long_is_refused_without_a_numpy_warning",),

@@ -113,6 +113,7 @@ class FanucInterpreter(Interpreter):
     cycles_own_group = True  # G80 leaves the G0-G3 mode before the cycle in effect (module docstring)
     returns_under_comp = True  # G28/G30 under G41/G42: out of scope (module docstring)
     external_output = True  # POPEN, DPRNT[..], BPRNT[..], PCLOS pass through (module docstring)
+    repeats_in_p = True  # `M98 P51002`: O1002 five times (`Flow._m98`)
 
     def block(self, block: Block) -> Event | tuple[Event, ...]:
         signature = block.signature
@@ -215,6 +216,9 @@ class HaasInterpreter(FanucInterpreter):
     g54_with_p = False  # (Haas's manual gives G54 no P)
     numbered = range(110, 130)
     dwell_x = False  # (Haas's manual gives G04 a P only)
+    # ("M98 Sub Program Call": "M98 Pnnnn (Pnnnn is the number of the program being called)", runs in L;
+    # its programs are numbered to O99999)
+    repeats_in_p = False
 
 
 interpret = interpreting(FanucInterpreter)

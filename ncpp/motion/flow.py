@@ -146,7 +146,8 @@ class _Frame:
     opened: dict[str, tuple[int, str, int]] = field(default_factory=dict)
     # a Fanuc subprogram (M98, G65): the runs still to make after this one; -1: an o-word call
     repeats: int = 0
-    mark: int | None = None  # its runs: `CountedPasses.ended`'s mark
+    runs: int = 0  # a Fanuc subprogram's runs, all told (M98's or G65's L)
+    mark: int | None = None  # its runs: `CountedPasses.ended`'s mark (set at the call: its first run counts)
     source: str | None = None  # the subroutine file its lines are from (None: the program's)
     macro: bool = False  # a Fanuc G65 macro call (its own level of local variables)
     modal: bool = False  # a macro G66 calls after a move
@@ -241,6 +242,7 @@ class Flow:
         path: Sequence[Path] = (),
         state: Callable[[], object] | None = None,
         position: Callable[[], object] = lambda: None,
+        repeats_in_p: bool = False,
     ):
         self.file, self.evaluate, self.parameters, self.done, self.stop, self.path = (
             file,
@@ -298,6 +300,7 @@ class Flow:
         # The verbatim blocks the text starts with: a Fanuc tape leader (`parser._leader`, within
         # the blocks read ahead); a verbatim block after them stands after the closing `%`
         self.leader = 0
+        self.repeats_in_p = repeats_in_p  # Fanuc: `M98 P51002` runs O1002 five times (`_m98`)
         self.revisits: Revisits | None = None
         if state is not None:
             parameters.journal = Journal()
@@ -707,13 +710,21 @@ class Flow:
         return f", nor is it in {os.pathsep.join(map(str, self.path))}" if self.path else ""
 
     def _m98(self, frame, block, control, arrived):
-        """A Fanuc subprogram call: `M98 P<n> L<repeats>`."""
+        """A Fanuc subprogram call: `M98 P<n> L<repeats>`, or, where the flow reads repeats in P
+        (`repeats_in_p`), `M98 P<repeats><n>`: P's last four digits the program's number, those
+        before them its runs, 1 where none (Fanuc Series 0i-MC operator's manual, B-64124EN,
+        "Subprogram (M98, M99)": `M98 P51002` calls subprogram 1002 five times in succession).  A
+        program whose own number is the whole P (eight-digit program numbers) is the one called."""
         number, repeats = (None if item is None else self._number(item, block) for item in control.arguments)
         name, runs = (
             str(int(round_half_away(number))),
             1 if repeats is None else int(round_half_away(repeats)),
         )
         body = self._defined(self.subprograms, name) or self._program_from_file(name)
+        if body is None and self.repeats_in_p and repeats is None and int(name) > 9_999:
+            runs, program = divmod(int(name), 10_000)
+            body = self._defined(self.subprograms, str(program)) or self._program_from_file(str(program))
+            name = name if body is None else str(program)
         if body is None:
             said = f"M98 P{name}: a subprogram the program does not define (O{name} to M99)"
             self.stop(said + self._searched(), block, control.item.start + 1)
@@ -725,7 +736,8 @@ class Flow:
             frame.pc += 1
             self.parameters.enter(None)
             if runs > 0:
-                self.frames.append(_Frame(body, 1, repeats=runs - 1, source=self._source_of(body)))
+                self.frames.append(_Frame(body, 1, repeats=runs - 1, runs=runs, mark=self.passes.steps,
+                                          source=self._source_of(body)))  # fmt: skip
             else:  # L0: rs274ngc runs nothing but stays a call level deeper: the caller's names, loops and ifs are gone
                 frame.labels.clear()
                 frame.ifs.clear()
@@ -751,8 +763,15 @@ class Flow:
         def leave():
             if frame.repeats > 0:  # L: once more (a G65 macro with the locals it left)
                 frame.repeats -= 1
+                caller, depth = self.frames[-2], len(self.frames) - 2
+                around = (  # (after its first run: the counted loops around the call, with it)
+                    (lambda: self._around(caller, caller.pc, depth))
+                    if frame.repeats == frame.runs - 2
+                    else None
+                )
                 frame.mark = self.passes.ended(frame.mark, self.rerun, frame.repeats, block.line,
-                                               "a subprogram's L repeats", frame.source)  # fmt: skip
+                                               "a subprogram's L repeats", frame.source, around,
+                                               frame.runs)  # fmt: skip
                 frame.pc, frame.labels = 1, {}
                 if not frame.macro:
                     self.parameters.leave(None)
@@ -774,7 +793,8 @@ class Flow:
         def call():
             frame.pc += 1
             self.parameters.enter_macro(values)
-            self.frames.append(_Frame(body, 1, repeats=runs - 1, macro=True, source=self._source_of(body)))
+            self.frames.append(_Frame(body, 1, repeats=runs - 1, runs=runs, mark=self.passes.steps, macro=True,
+                                      source=self._source_of(body)))  # fmt: skip
 
         return call
 
@@ -818,8 +838,8 @@ class Flow:
             raise NcppError(f"Too many subroutine levels: calls nest at most {MAX_CALL_LEVELS - 1} deep",
                             Location(self.file, block.line, None))  # fmt: skip
         self.parameters.enter_macro(modal.values)
-        self.frames.append(_Frame(modal.body, 1, repeats=modal.runs - 1, macro=True, modal=True,
-                                  source=self._source_of(modal.body)))  # fmt: skip
+        self.frames.append(_Frame(modal.body, 1, repeats=modal.runs - 1, runs=modal.runs, mark=self.passes.steps,
+                                  macro=True, modal=True, source=self._source_of(modal.body)))  # fmt: skip
 
     def _macro(self, block: Block, control: Control) -> tuple[list[Block], int, dict[int, float]] | None:
         """The body, runs and arguments of a G65 or G66 line (None: the program lacks the macro)."""
@@ -1114,11 +1134,12 @@ class Flow:
 
         return test
 
-    def _around(self, frame: _Frame, start: int) -> list[Around]:
-        """The counted loops around the loop at `start` of `frame`, innermost first, as far as
-        counted loops go: o-word repeats, and Fanuc subprograms' L repeats around their calls."""
+    def _around(self, frame: _Frame, start: int, top: int | None = None) -> list[Around]:
+        """The counted loops around the loop at `start` of `frame` (the frame at depth `top`, None:
+        the innermost), innermost first, as far as counted loops go: o-word repeats, and Fanuc
+        subprograms' L repeats around their calls."""
         loops: list[Around] = []
-        for depth in range(len(self.frames) - 1, -1, -1):
+        for depth in range(len(self.frames) - 1 if top is None else top, -1, -1):
             level = self.frames[depth]
             inside = [(n, b) for n, b in level.labels.items() if level is not frame or b.start < start]
             opened = sorted(inside, key=lambda item: -item[1].start)

@@ -923,7 +923,8 @@ class HeidenhainInterpreter(ModalInterpreter):
         self.programs.append(path.resolve())
         self.file = str(path)
         try:
-            yield from self._run_flow(KlartextFlow(str(path), blocks), warnings, caller)
+            around = self.flow.around_call if self.flow is not None else list  # (the caller's flow)
+            yield from self._run_flow(KlartextFlow(str(path), blocks, around), warnings, caller)
             if not self.done and not self.returned:
                 self._refuse_leaving(f"the called program {path.name} ends without END PGM", caller, None)
                 self.leave_scope(warnings, f"the called program {path.name} ends without END PGM",

@@ -80,7 +80,8 @@ class KlartextFlow:
     `done()` says the program has ended; `stop(reason, block)` ends it where the
     flow itself cannot go on."""
 
-    def __init__(self, file: str, blocks: Iterable[Block]):
+    def __init__(self, file: str, blocks: Iterable[Block], outside: Callable[[], list[Around]] = list):
+        self.outside = outside  # the REP sections around this program's run (its CALL PGM's: `around_call`)
         self.file = file
         self.stream = iter(blocks)
         self.held: list[Block] = []  # blocks read and still wanted, from index `base`
@@ -212,11 +213,14 @@ class KlartextFlow:
         self.frames.append((self.current + 1, key))
         self.next = index + 1
 
-    def _around(self, label: int, call: int) -> list[Around]:
+    def _around(self, label: int, call: int, depth: int | None = None) -> list[Around]:
         """The REP sections around the section from `label` to its REP `call`, innermost first: the
         REP calls the program comes to from `call` on, before any other call, jump or end, each of
         a section that holds the one before (its label before that one's).  One not under way yet
-        runs its REP k passes after the one under way."""
+        runs its REP k passes after the one under way.  In a subprogram (`depth` calls deep, None:
+        as deep as the flow is), its LBL 0 goes on with the sections around its call; the END PGM of
+        a program CALL PGM runs, with those around the CALL PGM (`outside`)."""
+        depth = len(self.frames) if depth is None else depth
         loops: list[Around] = []
         index = call + 1
         while index < call + MAX_AROUND and (block := self.block(index)) is not None:
@@ -224,6 +228,11 @@ class KlartextFlow:
             if item is None and any(type(w) is Word and w.letter == "M" and w.value in (2.0, 30.0)
                                     for w in block.items):  # fmt: skip
                 break
+            if item is not None and item.kind == "label" and item.node[0] == 0 and depth > 0:
+                caller = self.frames[depth - 1][0] - 1  # (the call's index: it returns to the next)
+                return loops + self._around(caller, caller, depth - 1)
+            if item is not None and item.kind == "program_end" and depth == 0:
+                return loops + self.outside()
             if item is not None and item.kind != "label":
                 name, repeat = item.node if item.kind == "call_label" else (None, 0)
                 if type(repeat) is not int:  # (a count from a Q parameter: out of scope where it runs)
@@ -235,10 +244,14 @@ class KlartextFlow:
                     self.counters.get(index, repeat),
                     self.sections.get(index, (start, repeat + 1))[1],
                 )
-                loops.append(Around(left, passes, block.line, "CALL LBL ... REP"))
+                loops.append(Around(left, passes, block.line, "CALL LBL ... REP", self.file))
                 label = start
             index += 1
         return loops
+
+    def around_call(self) -> list[Around]:
+        """The REP sections around the block running (a CALL PGM), innermost first (`_around`)."""
+        return self._around(self.current, self.current)
 
     def end_subprogram(self) -> None:
         """`LBL 0`: back after the call (in the main program it only marks a place)."""

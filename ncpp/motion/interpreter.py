@@ -260,6 +260,8 @@ class Interpreter:
     # Macro B's external output (POPEN, DPRNT[..], BPRNT[..], PCLOS: Fanuc, Haas) moves nothing and
     # passes through; rs274ngc refuses it
     external_output = False
+    # `M98 P51002` runs O1002 five times (Fanuc, `Flow._m98`); rs274ngc calls O51002
+    repeats_in_p = False
 
     def __init__(self, file: str = "<stdin>", offsets: WorkOffsets | None = None):
         self.file = file
@@ -363,6 +365,7 @@ class Interpreter:
         flow = self.flow = Flow(
             self.file, self._evaluate, self.params, lambda: self.done, self._leave_scope,
             self.subroutine_path, state=self._loop_state, position=lambda: self.pos[:],
+            repeats_in_p=self.repeats_in_p,
         )  # fmt: skip
         self.rounding = False
         expansion = self.expansion

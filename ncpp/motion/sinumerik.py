@@ -36,7 +36,7 @@ from __future__ import annotations
 import itertools
 import math
 import re
-from collections.abc import Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import cast
@@ -46,7 +46,7 @@ import numpy as np
 from ncpp.errors import Location, Warnings
 from ncpp.motion.called import Files, count_called, searched
 from ncpp.motion.endless import Revisits
-from ncpp.motion.flow import FIXED, ONCE, RUN, SKIP, TEXT
+from ncpp.motion.flow import FIXED, ONCE, RUN, SKIP, TEXT, Around, CountedPasses
 from ncpp.motion.modal import (
     MAX_HOLES,
     MM_PER_INCH,
@@ -195,6 +195,9 @@ class _Call:
 
 
 class SinumerikInterpreter(ModalInterpreter):
+    # (the counts of blocks run and the counted loops around a subprogram's run: no loop's state)
+    not_loop_state = ModalInterpreter.not_loop_state | {"called_passes", "outside"}
+
     def __init__(
         self,
         file: str = "<stdin>",
@@ -228,6 +231,11 @@ class SinumerikInterpreter(ModalInterpreter):
         self.called: _Call | None = None  # the subprogram the block just run calls
         self.returned = False  # M17 or RET ended the subprogram running
         self.called_blocks = 0  # blocks run in subprogram files so far
+        # A call's P runs and the counted loops around it, measured in blocks run in subprogram files
+        # (`called_blocks`, whose bound a program that calls for ever passes)
+        self.called_passes = CountedPasses(file)
+        # The counted loops around the subprogram running, innermost first (`_subprogram`)
+        self.outside: Callable[[], list[Around]] = list
         self._files: Files | None = None  # the subprogram files, once a call needs them
         self.centre.approach = "NORM"  # (the control's initial setting: `ToolCentre.approach`)
         self.expansion: SinumerikExpansion | None = None  # --expand: what it writes (`sinumerik_expand`)
@@ -259,7 +267,7 @@ class SinumerikInterpreter(ModalInterpreter):
             self.leave_scope(warnings, reason, block, col, caller or owner)
 
         flow = SinumerikFlow(self.file, self.value, self._count, lambda: self.done or self.returned, leave,
-                             Revisits(None, None, self.loop_quick, self.loop_state))  # fmt: skip
+                             Revisits(None, None, self.loop_quick, self.loop_state), self.outside)  # fmt: skip
         once: FirstPass | None = None  # a loop's first pass in its place, while the flow has not told
         for block, kind, owner in flow.steps(blocks):
             if caller is not None:
@@ -267,6 +275,7 @@ class SinumerikInterpreter(ModalInterpreter):
                     continue
                 kind, owner = FIXED, caller
                 self.called_blocks = count_called(self.called_blocks, self.program_file, caller)
+                self.called_passes.steps = self.called_blocks
             if kind is ONCE and (expansion is not None or (once is not None and once.full())):
                 kind = FIXED  # (--expand writes each run out; a longer first pass stays as programmed)
             if once is not None and (self.done or flow.in_straight_code() or once.full()):
@@ -332,7 +341,7 @@ class SinumerikInterpreter(ModalInterpreter):
                 yield Pass(block, length_told=self.length_told)
         if self.called is not None:
             call, self.called = self.called, None
-            yield from self._subprogram(call, owner or block, warnings)
+            yield from self._subprogram(call, owner or block, warnings, flow, block)
 
     def _told(self, once: FirstPass, flow: SinumerikFlow, again: bool) -> list[Event]:
         """A loop's first pass in its place, once the flow has told whether its text runs again
@@ -390,7 +399,7 @@ class SinumerikInterpreter(ModalInterpreter):
                 yield Pass(written, length_told=self.length_told)
         if self.called is not None:
             call, self.called = self.called, None
-            yield from self._subprogram(call, owner or block, warnings)
+            yield from self._subprogram(call, owner or block, warnings, flow, block)
 
     # -- subprogram calls (840D sl Programming Manual, Fundamentals, "Subprogram technique") --
     def _call(self, block: Block, item: Word | Statement, name: str, args: tuple) -> _Call:
@@ -467,14 +476,27 @@ class SinumerikInterpreter(ModalInterpreter):
             values[parameter] = float(round(value)) if kind == "INT" else value
         return values
 
-    def _subprogram(self, call: _Call, caller: Block, warnings: Warnings) -> Iterator[Event]:
+    def _subprogram(
+        self, call: _Call, caller: Block, warnings: Warnings, flow: SinumerikFlow, at: Block
+    ) -> Iterator[Event]:
         """The subprogram's runs: its blocks run as the program's, with variables of their own
-        (the R parameters are the channel's, shared), to M17 or RET."""
+        (the R parameters are the channel's, shared), to M17 or RET.  Its P runs are a counted
+        loop at the calling line `at` of `flow` (`CountedPasses`), inside the loops around the call."""
         outer = (self.file, self.variables, self.integers, self.arrays, self.started)
+        outside, around_call = self.outside, flow.enclosing
+        what = f"the subprogram call {call.name} P{call.runs}"
+
+        def around_run(left: int) -> Callable[[], list[Around]]:
+            """The counted loops around one run: its P runs still to run, those around the call."""
+            return lambda: [Around(left, call.runs, at.line, what, outer[0]), *around_call()]
+
         self.calls.append(call.name)
         self.file = str(call.path)
+        mark: int | None = self.called_passes.steps
         try:
-            for _ in range(call.runs):
+            for run in range(call.runs):
+                left = call.runs - 1 - run
+                self.outside = around_run(left)
                 self.variables = {k: v for k, v in outer[1].items() if _R_PARAMETER.fullmatch(k)}
                 self.variables.update(call.parameters)
                 self.integers, self.arrays, self.started = set(), {}, False
@@ -492,8 +514,13 @@ class SinumerikInterpreter(ModalInterpreter):
                                      call.blocks[-1] if call.blocks else caller, None, caller)  # fmt: skip
                     return
                 self.returned = False
+                if left:
+                    around = around_call if run == 0 else None  # (its first run ended: the loops around it)
+                    mark = self.called_passes.ended(mark, self.called_blocks, left, at.line, what, outer[0], around,
+                                             call.runs)  # fmt: skip
         finally:
             self.calls.pop()
+            self.outside = outside
             self.file, self.variables, self.integers, self.arrays, self.started = outer
 
     # -- variables --------------------------------------------------------------------

@@ -93,9 +93,10 @@ class SinumerikFlow:
 
     def __init__(
         self, file: str, value: Callable, assign: Callable, done: Callable[[], bool], stop: Callable,
-        revisits: Revisits | None = None,
+        revisits: Revisits | None = None, outside: Callable[[], list[Around]] = list,
     ):  # fmt: skip
         self.file, self.value, self.assign, self.done, self.stop = file, value, assign, done, stop
+        self.outside = outside  # the counted loops around this program's run (a subprogram's call's)
         self.revisits = revisits
         if revisits is not None:  # (the interpreter's state, then the flow's)
             interpreters = revisits.state
@@ -326,20 +327,26 @@ class SinumerikFlow:
             around = self._around if opened.left == opened.total - 1 else None  # (its first pass ended)
             opened.left = left
             opened.mark = self.passes.ended(opened.mark, self.rerun, left, block.line, "FOR ... ENDFOR",
-                                            None, around, opened.total)  # fmt: skip
+                                            self.file, around, opened.total)  # fmt: skip
             return opened.start + 1
         self.open.pop()
         return self.pc + 1
 
     def _around(self) -> list[Around]:
-        """The FOR loops around the innermost structure, innermost first, as far as FOR loops go."""
+        """The counted loops around the innermost structure (`enclosing`)."""
+        return self.enclosing(self.open[:-1])
+
+    def enclosing(self, structures: list[_Open] | None = None) -> list[Around]:
+        """The counted loops around the block running (inside `structures`, None: all under way),
+        innermost first, as far as counted loops go: the FOR loops, then those around this
+        program's run (a subprogram's P runs, the loops around its call)."""
         loops: list[Around] = []
-        for opened in reversed(self.open[:-1]):
+        for opened in reversed(self.open if structures is None else structures):
             if opened.kind != "for":
-                break
+                return loops
             line = self.buffer[opened.start - self.base].line  # (held while the loop runs)
-            loops.append(Around(opened.left, opened.total, line, "FOR ... ENDFOR"))
-        return loops
+            loops.append(Around(opened.left, opened.total, line, "FOR ... ENDFOR", self.file))
+        return loops + self.outside()
 
     def _repeat(self, block: Block, statement: Statement) -> int:
         self.open.append(_Open("repeat", self.pc))

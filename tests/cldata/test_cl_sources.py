@@ -11,7 +11,8 @@ import pytest
 
 from ncpp.errors import NcppError, Warnings
 from ncpp.post import post
-from tests.shop.rs274 import end_points, run_rs274
+from tests import rs274
+from tests.rs274 import end_points
 
 ARC = re.compile(r"ARC_FEED\((.*)\)")
 
@@ -26,7 +27,7 @@ def canon(tmp_path, text: str) -> str:
     """rs274's canonical calls for the program posted from `text` (fails on any rs274 error)."""
     program = tmp_path / "part.ngc"
     program.write_text(posted(text))
-    return run_rs274(program)
+    return rs274.canon(program, timeout=300)
 
 
 def arcs(calls: str) -> list[tuple[float, ...]]:

@@ -10,16 +10,13 @@ parameter file), in G17, so rs274's coordinates are machine coordinates.
 
 from __future__ import annotations
 
-import os
 import re
-import subprocess
 from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
-import pytest
 
-from tests.conftest import RS274
+from tests import rs274
 
 _CALL = re.compile(r"(STRAIGHT_TRAVERSE|STRAIGHT_FEED|ARC_FEED|USE_LENGTH_UNITS)\(([^)]*)\)")
 # (n,3) commanded points, (3,) direction each axis travels in (+1, -1) -> (n,3) actual points, mm
@@ -30,28 +27,9 @@ STEP_MM = 0.05  # how densely paths are sampled
 def rs274_calls(path: Path) -> list[tuple[str, list[float]]]:
     """rs274's motion calls of a program (7 decimals), their lengths in mm (rs274 says them in
     the units in effect); fails the test if rs274 refuses it."""
-    if not RS274.exists():
-        pytest.skip("rs274 oracle not available")
-    env = {**os.environ, "RS274_DIGITS": "7"}
-    for _ in range(
-        5
-    ):  # (the stand-alone rs274 now and then dies of a bus error, whatever the program: run it again)
-        proc = subprocess.run(
-            [str(RS274), str(path)],
-            capture_output=True,
-            text=True,
-            env=env,
-            timeout=120,
-            stdin=subprocess.DEVNULL,
-        )
-        if "Bus error" not in proc.stderr:
-            break
-    if "executing" not in proc.stderr:
-        pytest.skip(f"rs274 oracle did not run: {proc.stderr.strip()[:200]}")
-    messages = [line for line in proc.stderr.splitlines() if line.strip() and line.strip() != "executing"]
-    assert proc.returncode == 0 and not messages, f"rs274 refused {path.name}: {messages[:3]}"
+    # (the stand-alone rs274 now and then dies of a bus error, whatever the program: run again)
     calls, unit = [], 1.0
-    for name, args in _CALL.findall(proc.stdout):
+    for name, args in _CALL.findall(rs274.canon(path, digits=7, retries=4)):
         if name == "USE_LENGTH_UNITS":
             unit = 25.4 if "INCHES" in args else 1.0
             continue

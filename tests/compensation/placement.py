@@ -4,19 +4,18 @@ compensation for it, and LinuxCNC's rs274 (7 decimals) as the judge of where the
 from __future__ import annotations
 
 import io
-import os
 import re
 import subprocess
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-import pytest
 
 from ncpp.errors import Warnings
 from ncpp.motion.offsets import WorkOffsets
 from ncpp.pipeline import ErrorSource, process
-from tests.conftest import RS274, SHARED
+from tests import rs274 as oracle
+from tests.conftest import SHARED
 
 PATHCHECK = SHARED / "tools" / "pathcheck"
 SCALE = np.array([5e-5, -4e-5, 3e-5])  # each axis's scale error: the tool lands at M * (1 + SCALE)
@@ -63,18 +62,8 @@ def compensate(data: bytes, var: Path, limits=LIMITS) -> tuple[bytes, str]:
 
 def rs274(program: Path, var: Path) -> list[tuple[str, tuple[float, ...]]]:
     """rs274's canonical calls (name, numbers) of a program it must accept, 7 decimals."""
-    if not RS274.exists():
-        pytest.skip("rs274 oracle not available")
-    env = {**os.environ, "RS274_DIGITS": "7", "RS274_VAR_FILE": str(var)}
-    proc = subprocess.run(
-        [str(RS274), str(program)],
-        capture_output=True,
-        text=True,
-        env=env,
-        timeout=120,
-        stdin=subprocess.DEVNULL,
-    )
-    messages = [line for line in proc.stderr.splitlines() if line.strip() and line.strip() != "executing"]
+    proc = oracle.run(program, var_file=var, digits=7)
+    messages = oracle.messages(proc)
     assert proc.returncode == 0 and not messages, f"rs274 refused {program.name}: {messages[:3]}"
     calls = []
     for line in proc.stdout.splitlines():

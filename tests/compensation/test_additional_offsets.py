@@ -11,9 +11,7 @@ in: not by ncpp's interpreter or model."""
 from __future__ import annotations
 
 import io
-import os
 import re
-import subprocess
 
 import numpy as np
 import pytest
@@ -21,7 +19,7 @@ import pytest
 from ncpp.errors import NcppError, Warnings
 from ncpp.motion.offsets import WorkOffsets, parse_zero
 from ncpp.pipeline import ErrorSource, process
-from tests.conftest import RS274
+from tests import rs274
 from tests.writeback.test_compensated_holes import MACHINE, square
 
 G54 = (100.0, 50.0, -200.0)
@@ -56,13 +54,10 @@ def compensated(text: str, dialect: str, offsets: WorkOffsets, tmp_path) -> str:
 def machine_ends(written: str, select: str, tmp_path) -> np.ndarray:
     """The end points of `written`'s moves as rs274 runs it (the additional offset's line as G55,
     every zero 0), each placed at the zero of the system rs274 says it runs in (SET_G5X_OFFSET)."""
-    if not RS274.exists():
-        pytest.skip("rs274 oracle not available")
     path = tmp_path / "run.ngc"
     path.write_text(written.replace(select, "G55").replace("M30", "M2"))
-    done = subprocess.run([str(RS274), str(path)], capture_output=True, text=True, timeout=120,
-                          env={**os.environ, "RS274_DIGITS": "7"}, stdin=subprocess.DEVNULL)  # fmt: skip
-    assert done.returncode == 0 and "executing" in done.stderr, done.stderr
+    done = rs274.run(path, digits=7)
+    assert done.returncode == 0 and rs274.ran(done), done.stderr
     zero, ends = np.array(G54), []
     for name, args in CALL.findall(done.stdout):
         values = [float(v) for v in args.split(",")]

@@ -23,6 +23,7 @@ import pytest
 from ncpp.machine import load_machine
 from ncpp.motion.offsets import SYSTEMS, WorkOffsets
 from ncpp.simulate import sample_events
+from tests import rs274 as oracle
 from tests.compensation.conftest import compensate, events_of, placement
 from tests.conftest import CORPUS, ROOT, RS274, SHARED, corpus_files, corpus_id
 
@@ -39,9 +40,7 @@ def programs() -> list:
 
 
 def rs274(path, tools) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [str(RS274), "-t", str(tools), str(path)], capture_output=True, text=True, timeout=120
-    )
+    return oracle.run(path, tool_table=tools)
 
 
 @pytest.fixture(scope="module")

@@ -185,12 +185,12 @@ ORACLE_TABLE = (
 
 
 def test_tool_lengths_agree_with_linuxcnc_started_from_the_same_tool_table(tmp_path):
-    from tests.shop.rs274 import end_points, run_rs274_from
+    from tests.rs274 import calls_from, end_points
 
     var, program = tmp_path / "sim.var", tmp_path / "p.ngc"
     var.write_text("5220 1.0\n")
     program.write_bytes(ORACLE_PROGRAM)
-    canon = run_rs274_from(var, program, ORACLE_TABLE)
+    canon = calls_from(var, program, ORACLE_TABLE)
     told = replace(WorkOffsets.at((0.0, 0.0, 0.0)), tools=_tools(tmp_path, ORACLE_TABLE, 25.4))
     events = [e for e in events_of(ORACLE_PROGRAM, offsets=told) if type(e).__name__ == "Line"]
     want = end_points(canon)

@@ -249,7 +249,7 @@ def test_placement_agrees_with_linuxcnc_started_from_the_same_parameter_file(tmp
     G10 L2, G53, G92 and G28 from the file's G28 position all land where LinuxCNC puts them."""
     import re
 
-    from tests.shop.rs274 import end_points, run_rs274_from
+    from tests.rs274 import calls_from, end_points
 
     var, program = tmp_path / "sim.var", tmp_path / "p.ngc"
     var.write_text(ORACLE_VAR)
@@ -259,7 +259,7 @@ def test_placement_agrees_with_linuxcnc_started_from_the_same_parameter_file(tmp
 
     assert main(["motion", str(program), "--var-file", str(var), "--var-units", "inch"]) == 0
     listed = capsys.readouterr().out.splitlines()
-    canon = run_rs274_from(var, program)
+    canon = calls_from(var, program)
     assert listed == re.findall(
         r"(?:STRAIGHT_TRAVERSE|STRAIGHT_FEED|ARC_FEED)\(.*\)", canon
     )  # `ncpp motion` says the same

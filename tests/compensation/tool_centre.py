@@ -6,9 +6,7 @@ Nothing of ncpp's own interpreter or simulator is used."""
 from __future__ import annotations
 
 import math
-import os
 import re
-import subprocess
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -16,7 +14,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from tests.conftest import RS274
+from tests import rs274
 
 _CALL = re.compile(
     r"\b(STRAIGHT_FEED|STRAIGHT_TRAVERSE|ARC_FEED|RIGID_TAP|SET_G5X_OFFSET|SET_G92_OFFSET|USE_LENGTH_UNITS"
@@ -70,16 +68,9 @@ def feed_moves(
     program: Path, tool_table: Path | None = None, var_file: Path | None = None, home: Path | None = None
 ) -> list[Move]:
     """The program's feed moves of the tool centre, program coordinates, as rs274 prints them."""
-    env = dict(os.environ, RS274_DIGITS="7")
-    if tool_table is not None:
-        env["RS274_TOOL_TABLE"] = str(tool_table)
-    if var_file is not None:
-        env["RS274_VAR_FILE"] = str(var_file)
-    if home is not None:
-        env["HOME"] = str(home)
-    proc = subprocess.run([str(RS274), str(program)], capture_output=True, text=True, env=env, timeout=600,
-                          cwd=program.parent, stdin=subprocess.DEVNULL)  # fmt: skip
-    errors = [ln for ln in proc.stderr.splitlines() if ln.strip() and ln.strip() != "executing"]
+    proc = rs274.run(program, var_file=var_file, tool_table=tool_table, digits=7, home=home,
+                     cwd=program.parent, timeout=600)  # fmt: skip
+    errors = rs274.messages(proc)
     assert not errors or errors[0].startswith("File ended with no percent sign"), proc.stderr
     moves: list[Move] = []
     at = np.zeros(3)

@@ -342,8 +342,8 @@ def test_the_corpus_face_milling_cycle_runs_where_its_example_calls_it(tmp_path,
 @pytest.mark.parametrize(
     "interpret, dialect, text, files",
     [
-        (sinumerik, "sinumerik", "G0 X0\nOUTER P9999\nM30\n",
-         {"OUTER.SPF": "INNER P9999\nM17\n", "INNER.SPF": "G91 G1 X1 F100\nM17\n"}),
+        (sinumerik, "sinumerik", "G0 X0\nOUTER P40\nM30\n",  # (P9999 P9999: refused as a counted loop at once)
+         {"OUTER.SPF": "INNER P40\nM17\n", "INNER.SPF": "G91 G1 X1 F100\nM17\n"}),
         (heidenhain, "heidenhain", "0 BEGIN PGM M MM\n1 CALL PGM OUTER\n2 END PGM M MM\n",
          {"OUTER.H": "0 BEGIN PGM OUTER MM\n1 LBL 1\n2 CALL PGM INNER\n3 CALL LBL 1 REP 9999\n"
           "4 END PGM OUTER MM\n", "INNER.H": "0 BEGIN PGM INNER MM\n1 L IX+1 R0 F100\n2 END PGM INNER MM\n"}),
@@ -359,6 +359,30 @@ def test_calls_repeated_past_the_rerun_limit_are_refused_as_never_ending(
     with pytest.raises(NcppError) as err:
         _events(interpret, dialect, text, _folder(tmp_path, files))
     assert "more than 1,000 blocks run in called files" in str(err.value) and "main:2:" in str(err.value)
+
+
+@pytest.mark.parametrize("passes, refused", [(3500, False), (6000, True)])
+def test_a_for_around_calls_is_bound_by_its_blocks_and_the_called_blocks_apart(
+    tmp_path, monkeypatch, passes, refused
+):
+    """A FOR whose passes run 2 blocks of the program and 4 of a subprogram's file: the blocks run
+    again in the program and those run in called files have a bound each (20,000 here), so 3,500
+    passes (7,000 and 14,000 blocks, 21,000 together) run to the end and 6,000 passes are refused
+    when the called blocks pass theirs."""
+    import ncpp.motion.called as called
+    import ncpp.motion.flow as flow
+    import ncpp.motion.sinumerik_flow as sinumerik_flow
+
+    for module in (called, flow, sinumerik_flow):
+        monkeypatch.setattr(module, "MAX_RERUN", 20_000)
+    text = f"G0 X0\nFOR R1=1 TO {passes}\nL123\nENDFOR\nM30\n"
+    folder = _folder(tmp_path, {"L123.SPF": "G91 G1 X1 F100\nX-1\nG90\nM17\n"})
+    if refused:
+        with pytest.raises(NcppError, match="main:4:1: more than 20,000 blocks run in called files"):
+            _events(sinumerik, "sinumerik", text, folder)
+    else:
+        events, _ = _events(sinumerik, "sinumerik", text, folder)
+        assert len([e for e in events if type(e) is Line]) == 1 + 2 * passes
 
 
 def test_sinumerik_ret_in_the_main_program_is_no_subprogram_call(tmp_path):

@@ -4,11 +4,10 @@ and memory, never a traceback."""
 
 from __future__ import annotations
 
-import subprocess
-
 import pytest
 
 from ncpp.verify import MAX_CHORDS
+from tests import rs274
 from tests.conftest import RS274, SHARED
 
 MACHINE = SHARED / "machines/wide.toml"
@@ -22,7 +21,7 @@ MODAL_TAP = "S300 M3\nG0 X0 Y0 Z5\nG33.1 Z-4 K1\nX1\nM2\n"  # (line 4: G33.1 aga
 def test_rs274_refuses_a_modal_rigid_tap_block_without_its_k(tmp_path):
     program = tmp_path / "tap.ngc"
     program.write_text(MODAL_TAP)
-    done = subprocess.run([str(RS274), str(program)], capture_output=True, text=True, timeout=30)
+    done = rs274.run(program, timeout=30)
     assert "K word missing with g33/g33.1" in done.stdout + done.stderr
 
 

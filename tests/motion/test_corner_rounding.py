@@ -12,6 +12,7 @@ from ncpp.errors import NcppError
 from ncpp.motion import interpret
 from ncpp.motion.segments import Arc, Line
 from ncpp.program.parser import parse_text
+from tests import rs274
 from tests.conftest import ROOT, RS274
 
 SQUARE = "G21 G17 G90 F100\nG1 X0 Y0\nG1 X10 ,R2\n(held comment)\nY10 ,C1\nX0\nG1 X-10 R1\nY0\nM2\n"
@@ -79,7 +80,7 @@ def test_compensated_corners_are_plain_arcs_linuxcnc_accepts(tmp_path):
     assert proc.returncode == 0, proc.stderr
     text = out.read_text()
     assert ",R" not in text and ",C" not in text and " R1" not in text
-    oracle = subprocess.run([str(RS274), str(out)], capture_output=True, text=True)
+    oracle = rs274.run(out)
     assert oracle.stdout.count("ARC_FEED") == 2 and "error" not in (oracle.stdout + oracle.stderr).lower()
 
 

@@ -15,6 +15,7 @@ from ncpp.errors import NcppError, Warnings
 from ncpp.motion import interpret
 from ncpp.motion.segments import COMP, Arc, Line
 from ncpp.program.parser import parse_stream
+from tests import rs274 as oracle
 from tests.conftest import RS274
 from tests.motion.compensating import compensate
 from tests.motion.test_oracle import (
@@ -348,7 +349,6 @@ def test_motion_and_simulate_say_where_the_tool_leaves_the_programmed_contour(tm
 def test_g41_checks_against_the_radius_of_the_tool_table_ncpp_is_told(tmp_path, body, refused):
     """With `--tool-table` the radius of G41/G42 is the table's D over 2, in the machine's units,
     as rs274 reads it (the stand-alone rs274's are inches: `--var-units inch`)."""
-    import subprocess
     from dataclasses import replace
 
     from ncpp.motion.offsets import WorkOffsets
@@ -357,9 +357,7 @@ def test_g41_checks_against_the_radius_of_the_tool_table_ncpp_is_told(tmp_path, 
     table = tmp_path / "tool.tbl"
     table.write_text("T1 P1 D10 Z0\nT2 P2 D3 Z0\nT3 P3 D0.2 Z0 Q3\nT4 P4 D0.2 Z0 Q9\n")
     path = write_program(tmp_path, HEAD + body)
-    proc = subprocess.run(
-        [str(RS274), "-t", str(table), str(path)], capture_output=True, text=True, timeout=60
-    )
+    proc = oracle.run(path, tool_table=table, timeout=60)
     theirs = rs274_error(proc.stderr)
     offsets = replace(WorkOffsets.at((0.0, 0.0, 0.0)), tools=ToolTable.from_file(table, unit_mm=25.4))
     try:

@@ -19,6 +19,7 @@ from ncpp.errors import NcppError, Warnings
 from ncpp.motion.segments import Line, Pass
 from ncpp.pipeline import dialect_tools
 from ncpp.program.dialects import detect, parse_program
+from tests import rs274 as oracle
 from tests.conftest import READING, ROOT, RS274, SHARED
 
 PATHCHECK = SHARED / "tools" / "pathcheck"
@@ -301,8 +302,7 @@ def test_g41_without_d_takes_the_radius_of_the_d_in_effect(tmp_path, body, refus
     table.write_text("T1 P1 D10 Z0\nT2 P2 D3 Z0\n")
     head = "G21 G90 G17 G94\nG0 X0 Y0 Z5\nG1 Z-1 F100\n"
     twin = write_program(tmp_path, head + body.replace("D2\nG41", "G41 D2").replace("D1\nG41", "G41 D1"))
-    theirs = rs274_error(subprocess.run([str(RS274), "-t", str(table), str(twin)], capture_output=True,
-                                        text=True, timeout=60).stderr)  # fmt: skip
+    theirs = rs274_error(oracle.run(twin, tool_table=table, timeout=60).stderr)
     offsets = replace(WorkOffsets.at((0.0, 0.0, 0.0)), tools=ToolTable.from_file(table, unit_mm=25.4))
     interpret, _ = dialect_tools("fanuc")
     _, blocks = parse_program(io.BytesIO((head + body + "M30\n").encode()), "p.nc", "fanuc")
@@ -423,3 +423,31 @@ def test_external_output_passes_through_the_compensated_program(tmp_path):
     for line in EXTERNAL_OUTPUT.splitlines()[3:5] + EXTERNAL_OUTPUT.splitlines()[6:9]:
         assert f"\n{line}\n" in written
     assert "compensated 2 moves" in proc.stderr
+
+
+SUBPROGRAM_IN_P = (
+    "%\nO1000\nG21 G90 G17\nG0 X0 Y0 Z5 F200\nM98 P31002\nG1 Y1\nM30\nO{n}\nG91 G1 X1\nG90\nM99\n%\n"
+)
+
+
+def test_fanuc_m98_p_gives_the_runs_before_the_program_number():
+    """Fanuc Series 0i-MC operator's manual (B-64124EN), "Subprogram (M98, M99)": `M98 P51002` calls
+    subprogram 1002 five times; a program numbered with all of P (eight-digit numbers) is called once."""
+    ends = [e.end[:2] for e in events(SUBPROGRAM_IN_P.format(n=1002), "fanuc") if type(e) is Line]
+    assert [round(x, 6) for x, _ in ends] == [0.0, 1.0, 2.0, 3.0, 3.0] and ends[-1][1] == 1.0
+    ends = [e.end[:2] for e in events(SUBPROGRAM_IN_P.format(n=31002), "fanuc") if type(e) is Line]
+    assert [round(x, 6) for x, _ in ends] == [0.0, 1.0, 1.0]
+
+
+@pytest.mark.parametrize("dialect", ["haas", "iso"])
+def test_haas_and_linuxcnc_m98_p_is_the_program_number(dialect):
+    """Haas Mill Operator's Manual, "M98 Sub Program Call": "M98 Pnnnn (Pnnnn is the number of the
+    program being called)"; rs274ngc alike: `M98 P31002` with only O1002 in the program is not followed."""
+    said = io.StringIO()
+    ends = [
+        e for e in events(SUBPROGRAM_IN_P.format(n=1002), dialect, Warnings(stream=said)) if type(e) is Line
+    ]
+    assert (
+        len(ends) == 1
+        and "p.nc:5:1: warning: M98 P31002: a subprogram the program does not define" in said.getvalue()
+    )

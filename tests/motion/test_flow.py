@@ -20,6 +20,7 @@ from ncpp.motion import interpret
 from ncpp.motion.flow import _TRIM, Flow
 from ncpp.motion.segments import FLOW, Arc, Line, Pass
 from ncpp.program.parser import parse_stream
+from tests import rs274 as oracle
 from tests.conftest import ROOT, RS274
 from tests.motion.compensating import compensate
 from tests.motion.test_oracle import (
@@ -374,15 +375,12 @@ def _library(tmp_path):
 
 @pytest.mark.skipif(not RS274.exists(), reason="no rs274")
 def test_subroutine_files_move_as_rs274_does(tmp_path):
-    import subprocess
 
     from ncpp.motion.offsets import WorkOffsets
 
     folder, ini = _library(tmp_path)
     path = _program(tmp_path, HEAD + "o<square> call [1] [2] [5]\nG0 X0 Y0\no<square> call [10] [10] [2]\n")
-    proc = subprocess.run(
-        [str(RS274), "-i", str(ini), str(path)], capture_output=True, text=True, cwd=tmp_path
-    )
+    proc = oracle.run(path, ini=ini, cwd=tmp_path)
     reference = read_canon(proc.stdout)
     assert rs274_error(proc.stderr) is None and len(reference) == 16, proc.stderr
     events = interpret(

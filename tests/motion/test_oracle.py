@@ -29,7 +29,6 @@ import functools
 import io
 import os
 import subprocess
-import tempfile
 from pathlib import Path
 
 import pytest
@@ -39,11 +38,13 @@ from ncpp.motion import interpret
 from ncpp.motion.canon import CanonCall, canon_call, read_canon
 from ncpp.motion.segments import COMP
 from ncpp.program.parser import parse_stream
-from tests.conftest import CORPUS, RS274, corpus_files, corpus_id
+from tests import rs274 as oracle
+from tests.conftest import CORPUS, corpus_files, corpus_id
+from tests.rs274 import error as rs274_error
+from tests.rs274 import many_tools as tool_table
 
 TOLERANCE = 1e-4
 PROGRAMS = corpus_files("iso_gcode") + sorted((CORPUS / "malformed/linuxcnc_interp_good").glob("*.ngc"))
-EOF_NOTE = "File ended with no percent sign or program end"
 
 # file name -> the construct the interpreter's out-of-scope warning names
 OUT_OF_SCOPE = {
@@ -74,18 +75,6 @@ RS274_ONLY_REFUSES = {
 }
 
 
-@functools.cache
-@functools.cache
-def tool_table() -> Path:
-    """A tool table of tools 1-99 (0.01 across, in the stand-alone rs274's inches; length 0) for
-    rs274 (its last -t is the one it reads; the wrapper's holds T1 alone, 6 across): programs
-    changing tools, and the entry moves of cutter compensation, which rs274 refuses where they
-    are not longer than the radius.  Written once per test session."""
-    path = Path(tempfile.mkdtemp(prefix="ncpp-oracle-")) / "tools.tbl"
-    path.write_text("".join(f"T{n} P{n} D0.01 Z0\n" for n in range(1, 100)))
-    return path
-
-
 # Examples of a property test against rs274: each runs it (about 50 ms); NCPP_HYPOTHESIS_EXAMPLES=600
 # for a deeper search.
 ORACLE_EXAMPLES = max(int(os.environ.get("NCPP_HYPOTHESIS_EXAMPLES", "300")) // 8, 20)
@@ -94,19 +83,12 @@ ORACLE_EXAMPLES = max(int(os.environ.get("NCPP_HYPOTHESIS_EXAMPLES", "300")) // 
 def run_rs274(path) -> tuple[str, str]:
     """rs274's (canonical calls, messages) for the program at `path`, with `tool_table`."""
     try:
-        proc = subprocess.run(
-            [str(RS274), "-t", str(tool_table()), str(path)],
-            capture_output=True,
-            text=True,
-            errors="replace",
-            timeout=300,
-            stdin=subprocess.DEVNULL,
-        )
+        done = oracle.run(Path(path), tool_table=tool_table(), timeout=300)
     except (OSError, subprocess.TimeoutExpired) as err:
         pytest.skip(f"rs274 oracle unavailable: {err}")
-    if "executing" not in proc.stderr:
-        pytest.skip(f"rs274 oracle did not run: {proc.stderr.strip()[:200]}")
-    return proc.stdout, proc.stderr
+    if not oracle.ran(done):
+        pytest.skip(f"rs274 oracle did not run: {done.stderr.strip()[:200]}")
+    return done.stdout, done.stderr
 
 
 @functools.cache
@@ -114,14 +96,6 @@ def rs274(path: str) -> tuple[str, str]:
     """`run_rs274`, cached for this test session (the corpus's programs do not change; a
     property test rewrites one file, and runs `run_rs274` itself)."""
     return run_rs274(path)
-
-
-def rs274_error(messages: str) -> tuple[str, str] | None:
-    """(message, source text) of the error rs274 stopped at, if any (rs274 prints both on stderr)."""
-    lines = [line for line in messages.splitlines() if line.strip() and line != "executing"]
-    if len(lines) < 2 or lines[0] == EOF_NOTE:
-        return None
-    return lines[0], lines[1]
 
 
 def ours(

@@ -7,8 +7,6 @@ machine by the difference.  Judged by rs274 itself, with tools of different leng
 from __future__ import annotations
 
 import io
-import os
-import subprocess
 from pathlib import Path
 
 import pytest
@@ -18,7 +16,7 @@ from ncpp.motion import interpret
 from ncpp.motion.canon import canon_call, read_canon
 from ncpp.motion.offsets import UNIT_MM, WorkOffsets
 from ncpp.program.parser import parse_stream
-from tests.conftest import RS274
+from tests import rs274
 
 pytestmark = pytest.mark.oracle
 
@@ -45,22 +43,11 @@ TOOLS = "".join(f"T{n} P{n} Z{0.4 + 0.02 * n:.2f} D0.01\n" for n in range(1, 10)
 
 
 def test_tool_lengths_applied_with_a_tool_change_follow_rs274(tmp_path: Path):
-    if not RS274.exists():
-        pytest.skip("rs274 oracle not available")
     program, table = tmp_path / "lengths.ngc", tmp_path / "tools.tbl"
     program.write_text(PROGRAM)
     table.write_text(TOOLS)
-    unpacked = os.environ.get("RS274_HOME") or str(Path.home() / ".cache" / "ncpp-rs274")
-    env = dict(os.environ, RS274_TOOL_TABLE=str(table), HOME=str(tmp_path), RS274_HOME=unpacked)
-    proc = subprocess.run(
-        [str(RS274), str(program)],
-        capture_output=True,
-        text=True,
-        env=env,
-        timeout=60,
-        stdin=subprocess.DEVNULL,
-    )
-    if "executing" not in proc.stderr:
+    proc = rs274.run(program, tool_table=table, home=tmp_path, timeout=60)
+    if not rs274.ran(proc):
         pytest.skip(f"rs274 oracle did not run: {proc.stderr.strip()[:200]}")
     theirs = read_canon(proc.stdout)
     offsets = WorkOffsets.given(

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import pytest
 
+from tests import rs274
 from tests.conftest import ROOT, RS274
 
 MACHINE = ROOT / "samples/machines/hr5b.toml"
@@ -101,7 +102,7 @@ def test_contour_error_shrinks_on_the_virtual_machine(compensated, tmp_path):
 
 @pytest.mark.skipif(not RS274.exists(), reason="rs274 oracle not available")
 def test_linuxcnc_accepts_every_compensated_arc(compensated):
-    proc = subprocess.run([str(RS274), str(compensated)], capture_output=True, text=True)
+    proc = rs274.run(compensated)
     assert "ARC_FEED" in proc.stdout
     assert "error" not in (proc.stdout + proc.stderr).lower()
 

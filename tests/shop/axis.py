@@ -18,7 +18,7 @@ from pathlib import Path
 
 import pytest
 
-from tests.shop.rs274 import linuxcnc_root
+from tests.rs274 import linuxcnc_root
 
 
 @dataclass

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from tests.conftest import ROOT
-from tests.shop.rs274 import end_points, run_rs274
+from tests.rs274 import canon, end_points
 
 
 def _freecadcmd() -> str | None:
@@ -78,8 +78,8 @@ def test_freecad_posts_a_compensated_program(posted):
 
 def test_linuxcnc_accepts_it_and_the_path_is_corrected_by_microns(posted):
     compensated, plain, _ = posted
-    plain_ends = np.array(end_points(run_rs274(plain)))
-    compensated_ends = np.array(end_points(run_rs274(compensated)))
+    plain_ends = np.array(end_points(canon(plain, timeout=300)))
+    compensated_ends = np.array(end_points(canon(compensated, timeout=300)))
     assert len(plain_ends) > 10
     # Every programmed end point is reached within the correction (lines may be subdivided).
     nearest = np.array([np.abs(compensated_ends - p).max(axis=1).min() for p in plain_ends[1:]])

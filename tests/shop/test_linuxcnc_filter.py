@@ -13,8 +13,8 @@ import pytest
 from ncpp.errors import Warnings
 from ncpp.post import post
 from tests.conftest import CORPUS, ROOT
+from tests.rs274 import calls_from, canon, end_points
 from tests.shop.axis import filter_program
-from tests.shop.rs274 import end_points, run_rs274, run_rs274_from
 
 FILTER = ROOT / "plugins/linuxcnc/ncpp-linuxcnc-filter"
 MACHINE = ROOT / "samples/machines/hr5b.toml"
@@ -72,7 +72,7 @@ def test_filter_compensates_reports_progress_and_rs274_accepts_it(program, tmp_p
         tmp_path / "g54.var"
     )  # the G54 the placement guard checks (its raw values: rs274's units are inches)
     var.write_text("5220\t1.000000\n5221\t400.000000\n5222\t350.000000\n5223\t300.000000\n")
-    compensated, plain = end_points(run_rs274_from(var, out)), end_points(run_rs274(program))
+    compensated, plain = end_points(calls_from(var, out)), end_points(canon(program, timeout=300))
     assert len(compensated) >= len(plain) and compensated != plain
 
 
@@ -295,7 +295,7 @@ def test_the_operator_sees_the_summary_and_each_kind_of_warning_when_the_program
     out.write_bytes(proc.stdout)
     var = tmp_path / "g54.var"
     var.write_text("5220\t1.000000\n5221\t400.000000\n5222\t350.000000\n5223\t300.000000\n")
-    canon = run_rs274_from(var, out, "T1 P1 D0.1 Z0\n")
+    canon = calls_from(var, out, "T1 P1 D0.1 Z0\n")
     messages = re.findall(r'MESSAGE\("\s*(.*)"\)', canon)
     assert (
         messages[0].startswith("ncpp: drill.ngc: compensated 3 moves") and "largest correction" in messages[0]

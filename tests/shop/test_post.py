@@ -20,7 +20,7 @@ from ncpp.post import GENERATORS, post
 from ncpp.post.generator import single_turns
 from ncpp.program.blocks import Block
 from tests.conftest import CORPUS, ROOT, corpus_files, corpus_id
-from tests.shop.rs274 import end_points, run_rs274
+from tests.rs274 import canon, end_points
 
 CL_FILES = corpus_files("apt_cldata")
 MACHINE = ROOT / "samples/machines/hr5b.toml"
@@ -80,7 +80,7 @@ def test_every_cl_file_posts_in_every_dialect(path, dialect):
 def test_linuxcnc_runs_the_post_to_the_cl_end_points(path, dialect, tmp_path):
     program = tmp_path / "posted.ngc"
     program.write_text(posted(path, dialect))
-    got = distinct(end_points(run_rs274(program)))
+    got = distinct(end_points(canon(program, timeout=300)))
     want = distinct(cl_end_points(path))
     assert len(got) == len(want)
     assert np.abs(np.array(got) - np.array(want)).max() <= 1e-4
@@ -115,7 +115,7 @@ def test_posted_with_a_machine_file_is_compensated(path, tmp_path):
     assert text.splitlines()[0].startswith(f"({HEADER_TAG} for hr5b.toml")
     program = tmp_path / "compensated.ngc"
     program.write_text(text)
-    got = np.array(end_points(run_rs274(program)))
+    got = np.array(end_points(canon(program, timeout=300)))
     want = np.array(distinct(cl_end_points(path)))
     # Compensated lines may be subdivided: every CL end point is still reached, moved by the correction.
     nearest = np.array([np.abs(got - w).max(axis=1).min() for w in want])

@@ -15,7 +15,7 @@ import pytest
 from ncpp.errors import NcppError, Warnings
 from ncpp.post import post
 from tests.conftest import CORPUS, ROOT, SHARED
-from tests.shop.rs274 import run_rs274
+from tests.rs274 import canon
 
 BOHREN = CORPUS / "apt_cldata/creo_ncl/bohren_1.ncl.8"  # Creo: CYCLE/DEEP, DEPTH 3.5, STEP 1, CLEAR 1
 WIDE = SHARED / "machines/wide.toml"
@@ -110,7 +110,7 @@ def small_tool(tmp_path, monkeypatch):
 def _rs274(tmp_path: Path, program: str, name: str = "holes.ngc") -> list[tuple[str, float, float, float]]:
     path = tmp_path / name
     path.write_text(program)
-    return _moves(run_rs274(path))
+    return _moves(canon(path, timeout=300))
 
 
 @pytest.mark.parametrize("dialect", ["linuxcnc", "iso"])
@@ -144,7 +144,8 @@ def test_rs274_dwells_where_the_cl_data_delays(tmp_path):
     program, _ = _post(NX, "linuxcnc")
     path = tmp_path / "holes.ngc"
     path.write_text(program)
-    assert re.findall(r"DWELL\(([\d.]+)\)", run_rs274(path)) == ["0.7500", "2.5000"]  # the bore's, the DELAY
+    dwells = re.findall(r"DWELL\(([\d.]+)\)", canon(path, timeout=300))
+    assert dwells == ["0.7500", "2.5000"]  # the bore's, the DELAY
 
 
 def test_compensated_holes_stay_where_programmed_with_the_pipeline_warning(tmp_path):

@@ -19,7 +19,8 @@ from pathlib import Path
 import pytest
 
 from ncpp.program.dialects import SNIFF_BYTES, detect
-from tests.conftest import CORPUS, RS274, SHARED, corpus_files, corpus_id
+from tests import rs274
+from tests.conftest import CORPUS, SHARED, corpus_files, corpus_id
 
 pytestmark = [pytest.mark.oracle, pytest.mark.slow]
 
@@ -57,12 +58,10 @@ def rs274_environment(home: Path) -> dict[str, str]:
 
 
 def rs274_runs(program: Path, tools: Path, env: dict[str, str]) -> bool:
-    env = dict(env, RS274_TOOL_TABLE=str(tools))
-    proc = subprocess.run([str(RS274), str(program)], capture_output=True, text=True, errors="replace", timeout=600,
-                          cwd=program.parent, env=env, stdin=subprocess.DEVNULL)  # fmt: skip
-    if "executing" not in proc.stderr:
+    proc = rs274.run(program, tool_table=tools, home=Path(env["HOME"]), cwd=program.parent, timeout=600)
+    if not rs274.ran(proc):
         pytest.skip(f"rs274 oracle did not run: {proc.stderr.strip()[:200]}")
-    errors = [line for line in proc.stderr.splitlines() if line.strip() and line.strip() != "executing"]
+    errors = rs274.messages(proc)
     return not errors or errors[0].startswith("File ended with no percent sign or program end")
 
 

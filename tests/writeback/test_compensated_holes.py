@@ -5,7 +5,6 @@ X-Y and X-Z), not by ncpp's interpreter or model."""
 
 from __future__ import annotations
 
-import os
 import re
 import subprocess
 import sys
@@ -14,8 +13,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from tests import rs274
 from tests.compensation.accuracy import Machine, _moves, actual_moves, rs274_calls
-from tests.conftest import RS274, SHARED
+from tests.conftest import SHARED
 from tests.verify.test_corpus_pathcheck import rs274_environment
 from tests.writeback.conftest import compensate_file, linear_errors, machine_file
 
@@ -259,10 +259,7 @@ def test_each_hole_bottom_and_r_plane_land_where_programmed(
 
 
 def _rs274_text(path: Path) -> str:
-    if not RS274.exists():
-        pytest.skip("rs274 oracle not available")
-    proc = subprocess.run([str(RS274), str(path)], capture_output=True, text=True, timeout=120,
-                          env={**os.environ, "RS274_DIGITS": "7"}, stdin=subprocess.DEVNULL)  # fmt: skip
+    proc = rs274.run(path, digits=7)
     assert proc.returncode == 0, proc.stderr
     return proc.stdout
 

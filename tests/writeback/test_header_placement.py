@@ -8,7 +8,6 @@ import hashlib
 import io
 import os
 import re
-import subprocess
 
 import pytest
 
@@ -17,7 +16,7 @@ from ncpp.motion.offsets import WorkOffsets
 from ncpp.pipeline import ErrorSource, process
 from ncpp.program.blocks import Comment
 from ncpp.program.dialects import parse_program
-from tests.compensation.accuracy import RS274
+from tests import rs274
 from tests.writeback.conftest import PROGRAMS
 from tests.writeback.conftest import SQUARE as MACHINE
 
@@ -52,8 +51,8 @@ def test_iso_header_says_the_placement_and_rs274_reads_it(placed, tmp_path):
     text = compensated(PROGRAMS["iso"].replace("G21 G90\n", "G21 G90 G55\n"), source, offsets, "iso")
     path = tmp_path / "out.ngc"
     path.write_text(text)
-    proc = subprocess.run([str(RS274), str(path)], capture_output=True, text=True, stdin=subprocess.DEVNULL)
-    if "executing" not in proc.stderr:
+    proc = rs274.run(path)
+    if not rs274.ran(proc):
         pytest.skip("rs274 oracle not available")
     assert proc.returncode == 0 and "error" not in proc.stderr.lower(), proc.stderr
     said = " ".join(re.findall(r'COMMENT\("(.*)"\)', proc.stdout))
