@@ -37,6 +37,7 @@ in radius mode, G8, without its lathe cycles) cannot be told from a mill's progr
 from __future__ import annotations
 
 from collections.abc import Iterable, Iterator
+from dataclasses import dataclass
 from itertools import islice
 
 from ncpp.errors import Location, NcppError
@@ -57,13 +58,13 @@ _DIAMETER_MODE = 7.0  # LinuxCNC's G7
 _SPINDLE_LIMIT = 50.0  # G50 with S
 
 
+@dataclass(frozen=True)
 class _Rules:
     """The lathe constructs of one dialect (module docstring)."""
 
-    def __init__(self, cycles: frozenset[float], cycle_words: frozenset[str], diameter_mode: bool):
-        self.cycles = cycles
-        self.cycle_words = cycle_words
-        self.diameter_mode = diameter_mode
+    cycles: frozenset[float]  # the G codes of its lathe cycles
+    cycle_words: frozenset[str]  # the words that make them a lathe's
+    diameter_mode: bool  # whether G7 is LinuxCNC's diameter mode
 
     def construct(self, block: Block) -> tuple[Word, str] | None:
         """The block's lathe construct (its G word and what it is), or None."""
@@ -90,7 +91,7 @@ class _Rules:
 
 def _drilling(codes: list[Word]) -> bool:
     """A drilling cycle's code (G73-G89) among the block's: a Haas mill's bolt-hole pattern may share it."""
-    return any(73.0 <= code.value <= 89.0 for code in codes)
+    return any(73.0 <= code.value <= 89.0 and code.value != 80.0 for code in codes)
 
 
 RULES = {
@@ -109,7 +110,9 @@ def lathe_construct(block: Block, dialect: str) -> tuple[Word, str] | None:
 
 def refuse_lathe(blocks: Iterable[Block], dialect: str, file: str) -> Iterator[Block]:
     """The blocks, after the first HEAD are looked at (none goes on before), each checked: a
-    lathe construct stops the run with an error at its G word."""
+    lathe construct stops the run with an error at its G word.  It comes before the errors the
+    interpreter would find in earlier lines, which are often a lathe's words read as a mill's
+    (`G72 W1. R0.5`); a line the parser refuses before it comes first (nothing is read past it)."""
     rules = RULES.get(dialect)
     blocks = iter(blocks)
     if rules is None:
@@ -124,6 +127,7 @@ def refuse_lathe(blocks: Iterable[Block], dialect: str, file: str) -> Iterator[B
     for block in head:
         _refuse(rules, block, file)
     yield from head
+    head.clear()  # (not held while the rest streams)
     if fault is not None:  # (after the head's blocks: an earlier error of a later stage comes first)
         raise fault
     for block in blocks:

@@ -63,7 +63,9 @@ def test_a_lathe_construct_refuses_the_program_at_its_place_with_nothing_written
         process(io.BytesIO(program.encode()), out, file="p.nc", source=ErrorSource.from_machine_file(str(WIDE)),
                 dialect=dialect, warnings=Warnings(stream=io.StringIO()))  # fmt: skip
     assert str(caught.value.where) == f"p.nc:{line}:{col}"
-    assert "a lathe program" in caught.value.message and "compensates milling programs" in caught.value.message
+    assert (
+        "a lathe program" in caught.value.message and "compensates milling programs" in caught.value.message
+    )
     assert out.getvalue() == b""
 
 
@@ -122,7 +124,9 @@ def _corpus_programs() -> list:
     if not manifest.exists():
         return []
     rows = [row.split("\t") for row in manifest.read_text().splitlines()[1:]]
-    return sorted(row[0] for row in rows if row[10] == "iso_gcode" and not any(n in row[0] for n in NOT_PROGRAMS))
+    return sorted(
+        row[0] for row in rows if row[10] == "iso_gcode" and not any(n in row[0] for n in NOT_PROGRAMS)
+    )
 
 
 @pytest.mark.skipif(not _corpus_programs(), reason="no corpus")
