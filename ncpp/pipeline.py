@@ -24,6 +24,7 @@ import numpy as np
 from ncpp import __version__
 from ncpp.errors import Location, NcppError, Warnings
 from ncpp.guard import ISO_SYNTAX, Placement, PlacementChecks, ToolGuard, with_guard, without_guard
+from ncpp.lathe import refuse_lathe
 from ncpp.motion.offsets import AT_MACHINE_ZERO, WorkOffsets
 from ncpp.motion.segments import COMP, CYCLE, DRILLED, FLOW, HOLE, PATTERN, Arc, Event, Line, Pass
 from ncpp.passes import PASSES, PassContext, run_passes
@@ -391,6 +392,7 @@ def process(
         blocks = refuse_compensated(blocks, file)
     else:  # compensated again: the guard of the offset it was compensated for goes
         blocks = without_guard(blocks)
+    blocks = refuse_lathe(blocks, name, file)  # (ncpp's machine is a machining centre)
     offsets = offsets or AT_MACHINE_ZERO  # the control's zeros place the program on the machine
     expanding: dict[str, bool] = {}
     if FAMILY[name] == "iso":
