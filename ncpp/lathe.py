@@ -69,8 +69,8 @@ class _Rules:
     def construct(self, block: Block) -> tuple[Word, str] | None:
         """The block's lathe construct (its G word and what it is), or None."""
         signature = block.signature
-        if block.verbatim or (signature is not None and "G" not in signature):
-            return None  # (most blocks: axis words alone)
+        if block.verbatim or (signature is not None and "G5" not in signature and "G7" not in signature):
+            return None  # (most blocks: no G5x or G7x code, G50 and G7-G72 among them)
         words = [item for item in block.items if type(item) is Word or type(item) is ExprWord]
         codes = [w for w in words if type(w) is Word and w.letter == "G"]
         letters = {w.letter for w in words}
