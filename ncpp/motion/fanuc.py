@@ -9,7 +9,10 @@ reads the same codes otherwise (G5.1 is a spline there, G8 lathe radius mode):
   `G08 P1` / `P0`, advanced preview control on and off.
 * Haas (Mill Operator's Manual, "G-codes"): also `G187 P1-P3 [E..]`, the smoothness level and
   corner tolerance; `G103 P..`, the limit of blocks looked ahead.  `M97 P..` runs a local
-  subprogram at a sequence number: it ends interpretation with a warning.
+  subprogram at a sequence number: it ends interpretation with a warning.  So do `G12`/`G13`,
+  circular pocket milling clockwise / counterclockwise: the control spirals out from the point it
+  stands on over I, K, Q with the D offset's cutter compensation (Haas VF-series manual 96-8000,
+  "Circular Pocket Milling"), a path ncpp does not compute.
 
 Both have additional work offsets: Fanuc's `G54.1 P1`-`P48` ("Additional workpiece coordinate
 systems", whose format is `G54.1 Pn` or `G54 Pn`: a G54 block with a P word selects the
@@ -97,7 +100,9 @@ RETURNS = frozenset((28.0, 30.0))
 # write Fanuc's G54.1)
 FANUC_UNFOLLOWED: dict[tuple[str, float], str] = {}
 HAAS_UNFOLLOWED = {("G", 54.1): "G54.1 (Fanuc's additional work offset; Haas selects its own with G154)",
-                   ("M", 97.0): "M97 (a local subprogram at a sequence number)"}  # fmt: skip
+                   ("M", 97.0): "M97 (a local subprogram at a sequence number)",
+                   ("G", 12.0): "G12 (Haas circular pocket milling, a path the control computes)",
+                   ("G", 13.0): "G13 (Haas circular pocket milling, a path the control computes)"}  # fmt: skip
 
 
 class FanucInterpreter(Interpreter):

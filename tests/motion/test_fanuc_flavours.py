@@ -59,7 +59,9 @@ def test_a_setting_with_motion_in_its_block_ends_interpretation():
      ("G154 P3 G0 X1", "G154 with other words in its block", "haas"), ("G54.1", "G54.1 without one P", "fanuc"),
      ("G10 L20 P1 X0 Y0 Z0", "G10 L20 (it sets an additional work offset here)", "fanuc"),
      ("G10 L2 P0 X5", "G10 L2 P0 (it sets the external work offset", "fanuc"),
-     ("G10 L2 P[#1] X5", "G10 L2 P0 (it sets the external work offset", "haas")],
+     ("G10 L2 P[#1] X5", "G10 L2 P0 (it sets the external work offset", "haas"),
+     ("G13 Z-0.3 I0.1875 K0.2 Q0.1875 D02 F10.", "G13 (Haas circular pocket milling", "haas"),
+     ("G12 I1.5 F10. Z-1.2 D01", "G12 (Haas circular pocket milling", "haas")],
 )  # fmt: skip
 def test_what_fanuc_and_haas_programs_need_ncpp_is_not_told_ends_interpretation(block, reason, dialect):
     said = io.StringIO()
@@ -423,3 +425,38 @@ def test_external_output_passes_through_the_compensated_program(tmp_path):
     for line in EXTERNAL_OUTPUT.splitlines()[3:5] + EXTERNAL_OUTPUT.splitlines()[6:9]:
         assert f"\n{line}\n" in written
     assert "compensated 2 moves" in proc.stderr
+
+
+# A Haas student program's circular pocket (enier290188/cnc src/mill_hp_4/mill_hp_4_ok_v2.nc), shortened
+CIRCULAR_POCKET = (
+    "G17 G20 G40 G49 G80\nT02 M06\nG00 G90 G54 X1.7 Y1.6\nS10000 M03\nG43 H02 Z0.1\nG01 Z-0.05 F10.\n"
+    "X1.9 Y1.8\nG13 Z-0.3 I0.1875 K0.2 Q0.1875 D02 F10.0\nG01 X1.7125 Y1.6 F650.0\nY0.9\nG00 Z0.1\nM30\n"
+)
+
+
+def test_a_haas_circular_pocket_passes_through_and_the_moves_before_it_are_compensated(tmp_path):
+    """G12/G13 spiral a pocket out from where the tool stands (Haas VF-series manual 96-8000, "Circular
+    Pocket Milling"): ncpp leaves the rest of the program as it is, located, where it refused the line
+    with LinuxCNC's "Unknown g code used"; rs274 judges the compensated moves before it."""
+    program = tmp_path / "p.nc"
+    program.write_text(CIRCULAR_POCKET)
+    out = tmp_path / "out.nc"
+    tools = tmp_path / "tools.tbl"
+    tools.write_text("T2 P2 Z1.5 D0.375 ; 3/8 end mill\n")
+    command = ["compensate", "--machine", str(READING), "--dialect", "haas", "--no-guard", "--tool-table", str(tools),
+               "--var-units", "inch", str(program), "-o", str(out)]  # fmt: skip
+    proc = subprocess.run([sys.executable, "-m", "ncpp", *command], capture_output=True, text=True, cwd=ROOT)
+    assert proc.returncode == 0, proc.stderr
+    assert f"{program}:8:1: warning: G13 (Haas circular pocket milling" in proc.stderr
+    written = out.read_text()
+    tail = "".join(CIRCULAR_POCKET.splitlines(keepends=True)[7:])
+    assert written.endswith(tail) and "compensated 4 moves" in proc.stderr
+    if not RS274.exists():
+        pytest.skip("rs274 not available")
+    head = written[: -len(tail)]
+    before, after = tmp_path / "before.ngc", tmp_path / "after.ngc"
+    before.write_text(CIRCULAR_POCKET[: -len(tail)] + "M30\n")
+    after.write_text(head + "M30\n")
+    check = subprocess.run([sys.executable, str(PATHCHECK), str(before), str(after), "--tol-mm", "0.02",
+                            "--tool-table", str(tools)], capture_output=True, text=True)  # fmt: skip
+    assert check.returncode == 0, check.stdout + check.stderr
