@@ -74,6 +74,12 @@ variables and their digits before and after the point; Allen-Bradley 8520 manual
 through as they are, the text in the brackets unread.  LinuxCNC refuses them ("Unknown word where unary
 operation could be").
 
+An R arc whose end point is its start point (`G03 X40 Y50 R20` from X40 Y50, or `G02 R20` with no axis
+word) is an arc of 0 degrees: the cutter does not move (Fanuc Series 16/18/160/180-C operator's manual,
+"Circular interpolation": "if the end point is located at the same position as the start point and when R
+is used, an arc of 0° is programmed"); ncpp passes the block through as it is, where LinuxCNC refuses it
+("Current point same as end point of arc").  Under cutter compensation it is still refused.
+
 With --expand-cycles, G82's and G89's dwell (Haas: G73's and G83's too) is written as a G04 with
 the cycle's P as the program gave it, where the control reads both alike (`_dwell_word`).  Fanuc: a G04's P takes no decimal
 point and counts 0.001 s, as a drilling cycle's P (SINUMERIK ISO Milling manual, which documents
@@ -118,6 +124,7 @@ class FanucInterpreter(Interpreter):
     cycles_own_group = True  # G80 leaves the G0-G3 mode before the cycle in effect (module docstring)
     returns_under_comp = True  # G28/G30 under G41/G42: out of scope (module docstring)
     external_output = True  # POPEN, DPRNT[..], BPRNT[..], PCLOS pass through (module docstring)
+    still_r_arc = True  # `G02 R..` ending where it starts does not move (module docstring)
 
     def block(self, block: Block) -> Event | tuple[Event, ...]:
         signature = block.signature

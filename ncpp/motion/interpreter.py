@@ -262,6 +262,8 @@ class Interpreter:
     # Macro B's external output (POPEN, DPRNT[..], BPRNT[..], PCLOS: Fanuc, Haas) moves nothing and
     # passes through; rs274ngc refuses it
     external_output = False
+    # An R arc that ends where it starts is an arc of 0 degrees, no move (Fanuc); rs274ngc refuses it
+    still_r_arc = False
 
     def __init__(self, file: str = "<stdin>", offsets: WorkOffsets | None = None):
         self.file = file
@@ -1836,7 +1838,7 @@ class Interpreter:
         if self.inverse_time and "F" not in words:
             self._fail(missing, block, block.items[0])
 
-    def _arc(self, block: Block, words: dict, motion: float, motion_item, mode1_item) -> Arc:
+    def _arc(self, block: Block, words: dict, motion: float, motion_item, mode1_item) -> Arc | Pass:
         word = motion_item if motion_item is not None else next(item for _, item in words.values())
         plane = self.plane
         first_letter, second_letter, normal_letter = _ARC_LETTERS[plane]
@@ -1858,6 +1860,8 @@ class Interpreter:
         end = self._move_end(block, words)
         a, b, c = PLANE_AXES[plane]
         start = self.pos
+        if radius is not None and self.still_r_arc and list(end) == list(start) and self.cutter_comp is None:
+            return Pass(block)  # (the block passes as it is: the modal G2/G3 and F it sets are kept)
         turns = round(words["P"][0]) if "P" in words else 1
         tolerance = TOLERANCE[self.inch]
         comp_radius = self.comp_radius  # (None: not known)

@@ -16,7 +16,7 @@ from pathlib import Path
 import pytest
 
 from ncpp.errors import NcppError, Warnings
-from ncpp.motion.segments import Line, Pass
+from ncpp.motion.segments import Arc, Line, Pass
 from ncpp.pipeline import dialect_tools
 from ncpp.program.dialects import detect, parse_program
 from tests.conftest import READING, ROOT, RS274, SHARED
@@ -459,4 +459,43 @@ def test_a_haas_circular_pocket_passes_through_and_the_moves_before_it_are_compe
     after.write_text(head + "M30\n")
     check = subprocess.run([sys.executable, str(PATHCHECK), str(before), str(after), "--tol-mm", "0.02",
                             "--tool-table", str(tools)], capture_output=True, text=True)  # fmt: skip
+    assert check.returncode == 0, check.stdout + check.stderr
+
+
+# A Fanuc student program's circles (IIIVENDETTAIII/CNC-Programming, SSCNC "Phase 2 ... Work Wersion Update")
+STILL_ARC = "O0025\nG21 G17 G40 G49 G90\nG00 G54 X40 Y50 Z5\nG01 Z-3 F100.0\nG03 X40 Y50 R20\nG03 X80 Y50 R20\nG00 Z50\nM30\n"
+
+
+def test_an_r_arc_that_ends_where_it_starts_does_not_move():
+    """Fanuc 16/18/160/180-C operator's manual, "Circular interpolation": with R, an end point at the start
+    point is an arc of 0 degrees, the cutter does not move (`G02 R_;` too); the next arc keeps G03.
+    LinuxCNC refuses it ("Current point same as end point of arc"), under cutter compensation ncpp too."""
+    for program in (STILL_ARC, STILL_ARC.replace("G03 X40 Y50 R20", "G03 R20")):
+        found = events(program, "fanuc")
+        assert [type(e) for e in found][3:6] == [Line, Pass, Arc]
+        assert found[5].start == (40, 50, -3) and found[5].end == (80, 50, -3)
+    with pytest.raises(NcppError, match="p.nc:5:1: Current point same as end point of arc"):
+        events(STILL_ARC, "iso")
+    with pytest.raises(NcppError, match="Current point same as end point of arc"):
+        events(STILL_ARC.replace("G01 Z-3 F100.0", "G01 Z-3 F100.0\nG41 D0 X40 Y50"), "fanuc")
+
+
+def test_an_r_arc_that_ends_where_it_starts_passes_through_and_rs274_judges_the_rest(tmp_path):
+    """The compensated program (the 0-degree arc as written) against the original without that block, which
+    is what the control runs: rs274 judges both."""
+    program, out = tmp_path / "p.nc", tmp_path / "out.nc"
+    program.write_text(STILL_ARC)
+    command = ["compensate", "--machine", str(READING), "--dialect", "fanuc", "--no-guard", str(program), "-o",
+               str(out)]  # fmt: skip
+    proc = subprocess.run([sys.executable, "-m", "ncpp", *command], capture_output=True, text=True, cwd=ROOT)
+    assert proc.returncode == 0, proc.stderr
+    assert "\nG03 X40 Y50 R20\n" in out.read_text()
+    if not RS274.exists():
+        pytest.skip("rs274 not available")
+    meant = tmp_path / "meant.ngc"
+    meant.write_text(STILL_ARC.replace("O0025\n", "").replace("G03 X40 Y50 R20\n", ""))
+    written = tmp_path / "written.ngc"
+    written.write_text(out.read_text().replace("O0025\n", ""))
+    check = subprocess.run([sys.executable, str(PATHCHECK), str(meant), str(written), "--tol-mm", "0.02"],
+                           capture_output=True, text=True)  # fmt: skip
     assert check.returncode == 0, check.stdout + check.stderr
