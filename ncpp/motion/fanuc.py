@@ -78,7 +78,7 @@ An R arc whose end point is its start point (`G03 X40 Y50 R20` from X40 Y50, or 
 word) is an arc of 0 degrees: the cutter does not move (Fanuc Series 16/18/160/180-C operator's manual,
 "Circular interpolation": "if the end point is located at the same position as the start point and when R
 is used, an arc of 0° is programmed"); ncpp passes the block through as it is, where LinuxCNC refuses it
-("Current point same as end point of arc").  Under cutter compensation it is still refused.
+("Current point same as end point of arc").  Under cutter compensation, and on Haas, it is still refused.
 
 With --expand-cycles, G82's and G89's dwell (Haas: G73's and G83's too) is written as a G04 with
 the cycle's P as the program gave it, where the control reads both alike (`_dwell_word`).  Fanuc: a G04's P takes no decimal
@@ -227,6 +227,7 @@ class HaasInterpreter(FanucInterpreter):
     g54_with_p = False  # (Haas's manual gives G54 no P)
     numbered = range(110, 130)
     dwell_x = False  # (Haas's manual gives G04 a P only)
+    still_r_arc = False  # (no Haas manual page in ncpp's reference set says a 0-degree R arc does not move)
 
 
 interpret = interpreting(FanucInterpreter)

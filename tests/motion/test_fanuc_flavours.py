@@ -469,13 +469,15 @@ STILL_ARC = "O0025\nG21 G17 G40 G49 G90\nG00 G54 X40 Y50 Z5\nG01 Z-3 F100.0\nG03
 def test_an_r_arc_that_ends_where_it_starts_does_not_move():
     """Fanuc 16/18/160/180-C operator's manual, "Circular interpolation": with R, an end point at the start
     point is an arc of 0 degrees, the cutter does not move (`G02 R_;` too); the next arc keeps G03.
-    LinuxCNC refuses it ("Current point same as end point of arc"), under cutter compensation ncpp too."""
+    LinuxCNC refuses it ("Current point same as end point of arc"), ncpp too on Haas and under cutter
+    compensation."""
     for program in (STILL_ARC, STILL_ARC.replace("G03 X40 Y50 R20", "G03 R20")):
         found = events(program, "fanuc")
         assert [type(e) for e in found][3:6] == [Line, Pass, Arc]
         assert found[5].start == (40, 50, -3) and found[5].end == (80, 50, -3)
-    with pytest.raises(NcppError, match="p.nc:5:1: Current point same as end point of arc"):
-        events(STILL_ARC, "iso")
+    for dialect in ("iso", "haas"):
+        with pytest.raises(NcppError, match="p.nc:5:1: Current point same as end point of arc"):
+            events(STILL_ARC, dialect)
     with pytest.raises(NcppError, match="Current point same as end point of arc"):
         events(STILL_ARC.replace("G01 Z-3 F100.0", "G01 Z-3 F100.0\nG41 D0 X40 Y50"), "fanuc")
 
