@@ -79,6 +79,10 @@ word) is an arc of 0 degrees: the cutter does not move (Fanuc Series 16/18/160/1
 "Circular interpolation": "if the end point is located at the same position as the start point and when R
 is used, an arc of 0° is programmed"); ncpp passes the block through as it is, where LinuxCNC refuses it
 ("Current point same as end point of arc").  Under cutter compensation, and on Haas, it is still refused.
+The same page: "If I, J, K, and R addresses are specified simultaneously, the arc specified by address R takes
+precedence and the other are ignored": ncpp reads the arc from R, and the writer gives the compensated arc its
+own centre words in place of them all, where LinuxCNC refuses the block ("Mixed radius ijk format for arc");
+on Haas it is still refused.
 
 With --expand-cycles, G82's and G89's dwell (Haas: G73's and G83's too) is written as a G04 with
 the cycle's P as the program gave it, where the control reads both alike (`_dwell_word`).  Fanuc: a G04's P takes no decimal
@@ -125,6 +129,7 @@ class FanucInterpreter(Interpreter):
     returns_under_comp = True  # G28/G30 under G41/G42: out of scope (module docstring)
     external_output = True  # POPEN, DPRNT[..], BPRNT[..], PCLOS pass through (module docstring)
     still_r_arc = True  # `G02 R..` ending where it starts does not move (module docstring)
+    r_over_ijk = True  # `G02 X.. Y.. R.. I.. J..`: R's arc, I J ignored (module docstring)
 
     def block(self, block: Block) -> Event | tuple[Event, ...]:
         signature = block.signature
@@ -228,6 +233,7 @@ class HaasInterpreter(FanucInterpreter):
     numbered = range(110, 130)
     dwell_x = False  # (Haas's manual gives G04 a P only)
     still_r_arc = False  # (no Haas manual page in ncpp's reference set says a 0-degree R arc does not move)
+    r_over_ijk = False  # (nor that R wins over I, J, K)
 
 
 interpret = interpreting(FanucInterpreter)

@@ -264,6 +264,8 @@ class Interpreter:
     external_output = False
     # An R arc that ends where it starts is an arc of 0 degrees, no move (Fanuc); rs274ngc refuses it
     still_r_arc = False
+    # R with I, J or K in an arc block: the arc is R's, the others are ignored (Fanuc); rs274ngc refuses it
+    r_over_ijk = False
 
     def __init__(self, file: str = "<stdin>", offsets: WorkOffsets | None = None):
         self.file = file
@@ -1847,7 +1849,9 @@ class Interpreter:
         if radius is None and not has_ijk:
             self._fail("R i j k words all missing for arc", block, word)
         if radius is not None and has_ijk:
-            self._fail("Mixed radius ijk format for arc", block, word)
+            if not self.r_over_ijk:
+                self._fail("Mixed radius ijk format for arc", block, word)
+            words = {k: v for k, v in words.items() if k not in "IJK"}  # (R wins: the others are ignored)
         self._check_feed(
             block, words, "Cannot make arc with zero feed rate", "F word missing with inverse time arc move"
         )

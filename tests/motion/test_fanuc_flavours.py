@@ -501,3 +501,32 @@ def test_an_r_arc_that_ends_where_it_starts_passes_through_and_rs274_judges_the_
     check = subprocess.run([sys.executable, str(PATHCHECK), str(meant), str(written), "--tol-mm", "0.02"],
                            capture_output=True, text=True)  # fmt: skip
     assert check.returncode == 0, check.stdout + check.stderr
+
+
+# R and I J in one arc block: the second arc's I J point nowhere near its centre
+R_AND_IJ = "G21 G90 G17\nG0 X0 Y0 Z5\nG1 Z-1 F100\nG2 X20 Y0 R10 I10 J0\nG2 X40 Y0 R10 I3 J7\nG0 Z5\nM30\n"
+
+
+def test_r_wins_over_i_j_k_in_a_fanuc_arc_block(tmp_path):
+    """Fanuc 16/18/160/180-C operator's manual, "Circular interpolation": with I, J, K and R in one block the
+    arc is R's and the others are ignored.  rs274 judges the compensated program against the original
+    without its I and J; LinuxCNC refuses the block ("Mixed radius ijk format for arc"), ncpp too on Haas."""
+    found = [e for e in events(R_AND_IJ, "fanuc") if type(e) is Arc]
+    assert [(a.center[0], a.center[1]) for a in found] == [pytest.approx((10, 0)), pytest.approx((30, 0))]
+    for dialect in ("iso", "haas"):
+        with pytest.raises(NcppError, match="p.nc:4:1: Mixed radius ijk format for arc"):
+            events(R_AND_IJ, dialect)
+    program, out = tmp_path / "p.nc", tmp_path / "out.nc"
+    program.write_text(R_AND_IJ)
+    command = ["compensate", "--machine", str(READING), "--dialect", "fanuc", "--no-guard", str(program), "-o",
+               str(out)]  # fmt: skip
+    proc = subprocess.run([sys.executable, "-m", "ncpp", *command], capture_output=True, text=True, cwd=ROOT)
+    assert proc.returncode == 0, proc.stderr
+    assert " R10" not in out.read_text()
+    if not RS274.exists():
+        pytest.skip("rs274 not available")
+    meant = tmp_path / "meant.ngc"
+    meant.write_text(R_AND_IJ.replace(" I10 J0", "").replace(" I3 J7", ""))
+    check = subprocess.run([sys.executable, str(PATHCHECK), str(meant), str(out), "--tol-mm", "0.02"],
+                           capture_output=True, text=True)  # fmt: skip
+    assert check.returncode == 0, check.stdout + check.stderr
