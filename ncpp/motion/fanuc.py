@@ -9,7 +9,10 @@ reads the same codes otherwise (G5.1 is a spline there, G8 lathe radius mode):
   `G08 P1` / `P0`, advanced preview control on and off.
 * Haas (Mill Operator's Manual, "G-codes"): also `G187 P1-P3 [E..]`, the smoothness level and
   corner tolerance; `G103 P..`, the limit of blocks looked ahead.  `M97 P..` runs a local
-  subprogram at a sequence number: it ends interpretation with a warning.
+  subprogram at a sequence number: it ends interpretation with a warning.  So do `G12`/`G13`,
+  circular pocket milling clockwise / counterclockwise: the control spirals out from the point it
+  stands on over I, K, Q with the D offset's cutter compensation (Haas VF-series manual 96-8000,
+  "Circular Pocket Milling"), a path ncpp does not compute.
 
 Both have additional work offsets: Fanuc's `G54.1 P1`-`P48` ("Additional workpiece coordinate
 systems", whose format is `G54.1 Pn` or `G54 Pn`: a G54 block with a P word selects the
@@ -71,6 +74,16 @@ variables and their digits before and after the point; Allen-Bradley 8520 manual
 through as they are, the text in the brackets unread.  LinuxCNC refuses them ("Unknown word where unary
 operation could be").
 
+An R arc whose end point is its start point (`G03 X40 Y50 R20` from X40 Y50, or `G02 R20` with no axis
+word) is an arc of 0 degrees: the cutter does not move (Fanuc Series 16/18/160/180-C operator's manual,
+"Circular interpolation": "if the end point is located at the same position as the start point and when R
+is used, an arc of 0° is programmed"); ncpp passes the block through as it is, where LinuxCNC refuses it
+("Current point same as end point of arc").  Under cutter compensation, and on Haas, it is still refused.
+The same page: "If I, J, K, and R addresses are specified simultaneously, the arc specified by address R takes
+precedence and the other are ignored": ncpp reads the arc from R, and the writer gives the compensated arc its
+own centre words in place of them all, where LinuxCNC refuses the block ("Mixed radius ijk format for arc");
+on Haas it is still refused.
+
 With --expand-cycles, G82's and G89's dwell (Haas: G73's and G83's too) is written as a G04 with
 the cycle's P as the program gave it, where the control reads both alike (`_dwell_word`).  Fanuc: a G04's P takes no decimal
 point and counts 0.001 s, as a drilling cycle's P (SINUMERIK ISO Milling manual, which documents
@@ -97,7 +110,9 @@ RETURNS = frozenset((28.0, 30.0))
 # write Fanuc's G54.1)
 FANUC_UNFOLLOWED: dict[tuple[str, float], str] = {}
 HAAS_UNFOLLOWED = {("G", 54.1): "G54.1 (Fanuc's additional work offset; Haas selects its own with G154)",
-                   ("M", 97.0): "M97 (a local subprogram at a sequence number)"}  # fmt: skip
+                   ("M", 97.0): "M97 (a local subprogram at a sequence number)",
+                   ("G", 12.0): "G12 (Haas circular pocket milling, a path the control computes)",
+                   ("G", 13.0): "G13 (Haas circular pocket milling, a path the control computes)"}  # fmt: skip
 
 
 class FanucInterpreter(Interpreter):
@@ -114,6 +129,8 @@ class FanucInterpreter(Interpreter):
     returns_under_comp = True  # G28/G30 under G41/G42: out of scope (module docstring)
     external_output = True  # POPEN, DPRNT[..], BPRNT[..], PCLOS pass through (module docstring)
     repeats_in_p = True  # `M98 P51002`: O1002 five times (`Flow._m98`)
+    still_r_arc = True  # `G02 R..` ending where it starts does not move (module docstring)
+    r_over_ijk = True  # `G02 X.. Y.. R.. I.. J..`: R's arc, I J ignored (module docstring)
 
     def block(self, block: Block) -> Event | tuple[Event, ...]:
         signature = block.signature
@@ -219,6 +236,8 @@ class HaasInterpreter(FanucInterpreter):
     # ("M98 Sub Program Call": "M98 Pnnnn (Pnnnn is the number of the program being called)", runs in L;
     # its programs are numbered to O99999)
     repeats_in_p = False
+    still_r_arc = False  # (no Haas manual page in ncpp's reference set says a 0-degree R arc does not move)
+    r_over_ijk = False  # (nor that R wins over I, J, K)
 
 
 interpret = interpreting(FanucInterpreter)

@@ -262,6 +262,10 @@ class Interpreter:
     external_output = False
     # `M98 P51002` runs O1002 five times (Fanuc, `Flow._m98`); rs274ngc calls O51002
     repeats_in_p = False
+    # An R arc that ends where it starts is an arc of 0 degrees, no move (Fanuc); rs274ngc refuses it
+    still_r_arc = False
+    # R with I, J or K in an arc block: the arc is R's, the others are ignored (Fanuc); rs274ngc refuses it
+    r_over_ijk = False
 
     def __init__(self, file: str = "<stdin>", offsets: WorkOffsets | None = None):
         self.file = file
@@ -1837,7 +1841,7 @@ class Interpreter:
         if self.inverse_time and "F" not in words:
             self._fail(missing, block, block.items[0])
 
-    def _arc(self, block: Block, words: dict, motion: float, motion_item, mode1_item) -> Arc:
+    def _arc(self, block: Block, words: dict, motion: float, motion_item, mode1_item) -> Arc | Pass:
         word = motion_item if motion_item is not None else next(item for _, item in words.values())
         plane = self.plane
         first_letter, second_letter, normal_letter = _ARC_LETTERS[plane]
@@ -1846,7 +1850,9 @@ class Interpreter:
         if radius is None and not has_ijk:
             self._fail("R i j k words all missing for arc", block, word)
         if radius is not None and has_ijk:
-            self._fail("Mixed radius ijk format for arc", block, word)
+            if not self.r_over_ijk:
+                self._fail("Mixed radius ijk format for arc", block, word)
+            words = {k: v for k, v in words.items() if k not in "IJK"}  # (R wins: the others are ignored)
         self._check_feed(
             block, words, "Cannot make arc with zero feed rate", "F word missing with inverse time arc move"
         )
@@ -1859,6 +1865,8 @@ class Interpreter:
         end = self._move_end(block, words)
         a, b, c = PLANE_AXES[plane]
         start = self.pos
+        if radius is not None and self.still_r_arc and list(end) == list(start) and self.cutter_comp is None:
+            return Pass(block)  # (the block passes as it is: the modal G2/G3 and F it sets are kept)
         turns = round(words["P"][0]) if "P" in words else 1
         tolerance = TOLERANCE[self.inch]
         comp_radius = self.comp_radius  # (None: not known)

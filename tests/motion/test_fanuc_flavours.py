@@ -16,7 +16,7 @@ from pathlib import Path
 import pytest
 
 from ncpp.errors import NcppError, Warnings
-from ncpp.motion.segments import Line, Pass
+from ncpp.motion.segments import Arc, Line, Pass
 from ncpp.pipeline import dialect_tools
 from ncpp.program.dialects import detect, parse_program
 from tests import rs274 as oracle
@@ -60,7 +60,9 @@ def test_a_setting_with_motion_in_its_block_ends_interpretation():
      ("G154 P3 G0 X1", "G154 with other words in its block", "haas"), ("G54.1", "G54.1 without one P", "fanuc"),
      ("G10 L20 P1 X0 Y0 Z0", "G10 L20 (it sets an additional work offset here)", "fanuc"),
      ("G10 L2 P0 X5", "G10 L2 P0 (it sets the external work offset", "fanuc"),
-     ("G10 L2 P[#1] X5", "G10 L2 P0 (it sets the external work offset", "haas")],
+     ("G10 L2 P[#1] X5", "G10 L2 P0 (it sets the external work offset", "haas"),
+     ("G13 Z-0.3 I0.1875 K0.2 Q0.1875 D02 F10.", "G13 (Haas circular pocket milling", "haas"),
+     ("G12 I1.5 F10. Z-1.2 D01", "G12 (Haas circular pocket milling", "haas")],
 )  # fmt: skip
 def test_what_fanuc_and_haas_programs_need_ncpp_is_not_told_ends_interpretation(block, reason, dialect):
     said = io.StringIO()
@@ -451,3 +453,108 @@ def test_haas_and_linuxcnc_m98_p_is_the_program_number(dialect):
         len(ends) == 1
         and "p.nc:5:1: warning: M98 P31002: a subprogram the program does not define" in said.getvalue()
     )
+
+
+# A Haas student program's circular pocket (enier290188/cnc src/mill_hp_4/mill_hp_4_ok_v2.nc), shortened
+CIRCULAR_POCKET = (
+    "G17 G20 G40 G49 G80\nT02 M06\nG00 G90 G54 X1.7 Y1.6\nS10000 M03\nG43 H02 Z0.1\nG01 Z-0.05 F10.\n"
+    "X1.9 Y1.8\nG13 Z-0.3 I0.1875 K0.2 Q0.1875 D02 F10.0\nG01 X1.7125 Y1.6 F650.0\nY0.9\nG00 Z0.1\nM30\n"
+)
+
+
+def test_a_haas_circular_pocket_passes_through_and_the_moves_before_it_are_compensated(tmp_path):
+    """G12/G13 spiral a pocket out from where the tool stands (Haas VF-series manual 96-8000, "Circular
+    Pocket Milling"): ncpp leaves the rest of the program as it is, located, where it refused the line
+    with LinuxCNC's "Unknown g code used"; rs274 judges the compensated moves before it."""
+    program = tmp_path / "p.nc"
+    program.write_text(CIRCULAR_POCKET)
+    out = tmp_path / "out.nc"
+    tools = tmp_path / "tools.tbl"
+    tools.write_text("T2 P2 Z1.5 D0.375 ; 3/8 end mill\n")
+    command = ["compensate", "--machine", str(READING), "--dialect", "haas", "--no-guard", "--tool-table", str(tools),
+               "--var-units", "inch", str(program), "-o", str(out)]  # fmt: skip
+    proc = subprocess.run([sys.executable, "-m", "ncpp", *command], capture_output=True, text=True, cwd=ROOT)
+    assert proc.returncode == 0, proc.stderr
+    assert f"{program}:8:1: warning: G13 (Haas circular pocket milling" in proc.stderr
+    written = out.read_text()
+    tail = "".join(CIRCULAR_POCKET.splitlines(keepends=True)[7:])
+    assert written.endswith(tail) and "compensated 4 moves" in proc.stderr
+    if not RS274.exists():
+        pytest.skip("rs274 not available")
+    head = written[: -len(tail)]
+    before, after = tmp_path / "before.ngc", tmp_path / "after.ngc"
+    before.write_text(CIRCULAR_POCKET[: -len(tail)] + "M30\n")
+    after.write_text(head + "M30\n")
+    check = subprocess.run([sys.executable, str(PATHCHECK), str(before), str(after), "--tol-mm", "0.02",
+                            "--tool-table", str(tools)], capture_output=True, text=True)  # fmt: skip
+    assert check.returncode == 0, check.stdout + check.stderr
+
+
+# A Fanuc student program's circles (IIIVENDETTAIII/CNC-Programming, SSCNC "Phase 2 ... Work Wersion Update")
+STILL_ARC = "O0025\nG21 G17 G40 G49 G90\nG00 G54 X40 Y50 Z5\nG01 Z-3 F100.0\nG03 X40 Y50 R20\nG03 X80 Y50 R20\nG00 Z50\nM30\n"
+
+
+def test_an_r_arc_that_ends_where_it_starts_does_not_move():
+    """Fanuc 16/18/160/180-C operator's manual, "Circular interpolation": with R, an end point at the start
+    point is an arc of 0 degrees, the cutter does not move (`G02 R_;` too); the next arc keeps G03.
+    LinuxCNC refuses it ("Current point same as end point of arc"), ncpp too on Haas and under cutter
+    compensation."""
+    for program in (STILL_ARC, STILL_ARC.replace("G03 X40 Y50 R20", "G03 R20")):
+        found = events(program, "fanuc")
+        assert [type(e) for e in found][3:6] == [Line, Pass, Arc]
+        assert found[5].start == (40, 50, -3) and found[5].end == (80, 50, -3)
+    for dialect in ("iso", "haas"):
+        with pytest.raises(NcppError, match="p.nc:5:1: Current point same as end point of arc"):
+            events(STILL_ARC, dialect)
+    with pytest.raises(NcppError, match="Current point same as end point of arc"):
+        events(STILL_ARC.replace("G01 Z-3 F100.0", "G01 Z-3 F100.0\nG41 D0 X40 Y50"), "fanuc")
+
+
+def test_an_r_arc_that_ends_where_it_starts_passes_through_and_rs274_judges_the_rest(tmp_path):
+    """The compensated program (the 0-degree arc as written) against the original without that block, which
+    is what the control runs: rs274 judges both."""
+    program, out = tmp_path / "p.nc", tmp_path / "out.nc"
+    program.write_text(STILL_ARC)
+    command = ["compensate", "--machine", str(READING), "--dialect", "fanuc", "--no-guard", str(program), "-o",
+               str(out)]  # fmt: skip
+    proc = subprocess.run([sys.executable, "-m", "ncpp", *command], capture_output=True, text=True, cwd=ROOT)
+    assert proc.returncode == 0, proc.stderr
+    assert "\nG03 X40 Y50 R20\n" in out.read_text()
+    if not RS274.exists():
+        pytest.skip("rs274 not available")
+    meant = tmp_path / "meant.ngc"
+    meant.write_text(STILL_ARC.replace("O0025\n", "").replace("G03 X40 Y50 R20\n", ""))
+    written = tmp_path / "written.ngc"
+    written.write_text(out.read_text().replace("O0025\n", ""))
+    check = subprocess.run([sys.executable, str(PATHCHECK), str(meant), str(written), "--tol-mm", "0.02"],
+                           capture_output=True, text=True)  # fmt: skip
+    assert check.returncode == 0, check.stdout + check.stderr
+
+
+# R and I J in one arc block: the second arc's I J point nowhere near its centre
+R_AND_IJ = "G21 G90 G17\nG0 X0 Y0 Z5\nG1 Z-1 F100\nG2 X20 Y0 R10 I10 J0\nG2 X40 Y0 R10 I3 J7\nG0 Z5\nM30\n"
+
+
+def test_r_wins_over_i_j_k_in_a_fanuc_arc_block(tmp_path):
+    """Fanuc 16/18/160/180-C operator's manual, "Circular interpolation": with I, J, K and R in one block the
+    arc is R's and the others are ignored.  rs274 judges the compensated program against the original
+    without its I and J; LinuxCNC refuses the block ("Mixed radius ijk format for arc"), ncpp too on Haas."""
+    found = [e for e in events(R_AND_IJ, "fanuc") if type(e) is Arc]
+    assert [(a.center[0], a.center[1]) for a in found] == [pytest.approx((10, 0)), pytest.approx((30, 0))]
+    for dialect in ("iso", "haas"):
+        with pytest.raises(NcppError, match="p.nc:4:1: Mixed radius ijk format for arc"):
+            events(R_AND_IJ, dialect)
+    program, out = tmp_path / "p.nc", tmp_path / "out.nc"
+    program.write_text(R_AND_IJ)
+    command = ["compensate", "--machine", str(READING), "--dialect", "fanuc", "--no-guard", str(program), "-o",
+               str(out)]  # fmt: skip
+    proc = subprocess.run([sys.executable, "-m", "ncpp", *command], capture_output=True, text=True, cwd=ROOT)
+    assert proc.returncode == 0, proc.stderr
+    assert " R10" not in out.read_text()
+    if not RS274.exists():
+        pytest.skip("rs274 not available")
+    meant = tmp_path / "meant.ngc"
+    meant.write_text(R_AND_IJ.replace(" I10 J0", "").replace(" I3 J7", ""))
+    check = subprocess.run([sys.executable, str(PATHCHECK), str(meant), str(out), "--tol-mm", "0.02"],
+                           capture_output=True, text=True)  # fmt: skip
+    assert check.returncode == 0, check.stdout + check.stderr
