@@ -96,6 +96,26 @@ _LONG_GROUP = 1024  # events of one block past which the writer asks whether it 
 _FANUC_CONTROL = frozenset(("goto", "if", "while", "end"))  # (statement kinds)
 
 
+def _lines_ended(
+    write_group: Callable[[list[Event]], Iterable[str]],
+) -> Callable[[list[Event]], Iterable[str]]:
+    """`write_group` whose lines each end a line but the last of a block that ends none (a file's
+    last line without a newline): split in several lines, or followed by a guard's, they would run
+    into one (`G1 X0.0004 Y0G2 ...`), a block the control reads otherwise or refuses."""
+    eol = "\n"
+
+    def ended(group: list[Event]) -> Iterable[str]:
+        nonlocal eol
+        end = group[0].block.eol
+        if end:
+            eol = end  # (a file's lines end alike: its last line's new neighbours end as the one before)
+            return write_group(group)
+        lines = list(write_group(group))
+        return [line if line.endswith("\n") else line + eol for line in lines[:-1]] + lines[-1:]
+
+    return ended
+
+
 def _none(events: list[Event]) -> list[str]:
     return []
 
@@ -175,10 +195,11 @@ class IsoWriter:
         follow and to precede a block's (of its events: the guards' checks, `ncpp/guard.py`)."""
         group: list[Event] = []
         block = None
-        write_group = self._write_group
+        written: Callable[[list[Event]], Iterable[str]] = self._write_group
         if after is not None or before is not None:
             ahead, behind = before or _none, after or _none
-            write_group = lambda group: [*ahead(group), *self._write_group(group), *behind(group)]  # noqa: E731
+            written = lambda group: [*ahead(group), *self._write_group(group), *behind(group)]  # noqa: E731
+        write_group = _lines_ended(written)
         control = False  # the group is a control line's, whose writing reads only its first event
         ran = self._ran if type(self)._ran is not IsoWriter._ran else None  # (ISO's does nothing)
         for event in events:
