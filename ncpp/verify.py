@@ -599,10 +599,11 @@ class _Upstream(Exception):
         self.error = error
 
 
-def _physical_lines(text: str) -> list[str]:
-    """A written text's lines, each with its LF (only LF ends a line in a program file)."""
+def _physical_lines(text: str) -> tuple[list[str], str]:
+    """A written text's lines, each with its LF (only LF ends a line in a program file), and what
+    follows the last LF: the start of a line the next text goes on (the file holds them so)."""
     *whole, last = text.split("\n")
-    return [line + "\n" for line in whole] + ([last] if last or not whole else [])
+    return [line + "\n" for line in whole], last
 
 
 class _Feed:
@@ -623,6 +624,8 @@ class _Feed:
         self.count = 0  # written lines taken so far
         self.recent: deque[tuple[int, str]] = deque(maxlen=self.AHEAD + 64)  # for messages
         self.fault: NcppError | None = None  # the writer's, where it stopped
+        self.rest_of_line = ""  # written text after the last LF handed to the parser
+        self.open_line = False  # the texts taken so far end inside a line (the next goes on it)
 
     def __iter__(self) -> Iterator[bytes]:
         last = None
@@ -631,17 +634,27 @@ class _Feed:
             try:
                 for text in islice(self.lines, self.AHEAD):
                     reached = self.reached()
+                    first = self.count + (0 if self.open_line else 1)  # (the line it starts on)
                     if reached is not last:
                         last = reached
-                        self.tags.append((self.count + 1, *reached))
+                        self.tags.append((first, *reached))
                     self.pending.append(text)
-                    self.count += text.count("\n") or 1
+                    if text:
+                        self.count = first + text.count("\n") - text.endswith("\n")  # (the last it is on)
+                        self.open_line = not text.endswith("\n")
                     self.recent.append((self.count, text))
             except NcppError as err:  # (the lines before it are read first)
                 self.fault = err
             batch = self.pending[taken:]
-            for text in batch:  # (a line at a time: the parser numbers a continued block's lines as `count`)
-                yield from (line.encode("latin-1") for line in _physical_lines(text))
+            for (
+                text
+            ) in batch:  # (a line at a time, as the file holds them: the parser numbers them as `count`)
+                lines, self.rest_of_line = _physical_lines(self.rest_of_line + text)
+                yield from (line.encode("latin-1") for line in lines)
+            if self.fault is not None or len(batch) < self.AHEAD:
+                if self.rest_of_line:  # (the file's last line, unended)
+                    yield self.rest_of_line.encode("latin-1")
+                    self.rest_of_line = ""
             if self.fault is not None:
                 raise _Upstream(self.fault) from None
             if len(batch) < self.AHEAD:

@@ -10,6 +10,7 @@ from pathlib import Path
 import pytest
 
 import ncpp.pipeline
+import ncpp.program.dialects.iso
 from ncpp.cli import main
 from ncpp.motion.segments import Line
 
@@ -214,3 +215,16 @@ def test_a_written_loop_that_runs_once_less_is_refused(tmp_path: Path, monkeypat
     assert compensate(path) != 0
     err = capsys.readouterr().err
     assert "loop.ngc:12:1: verification:" in err, err
+
+
+def test_written_lines_are_read_back_as_the_file_holds_them(tmp_path: Path, monkeypatch, capsys):
+    """A writer whose lines do not each end theirs (here: the ISO writer's ending of an unended last
+    line's pieces taken away) makes a file in which they run into one (`G1 X0.0004 Y0G1 X10 ...`):
+    the read-back reads that line, as the control would, and refuses the program; it read each
+    piece as a line of its own and let the file be written."""
+    monkeypatch.setattr(ncpp.program.dialects.iso, "_lines_ended", lambda write_group: write_group)
+    path = tmp_path / "part.ngc"
+    path.write_text("G21 G90 G17\nG0 X0 Y0 Z1\nG1 Z0 F100\nG1 X10 Y0")  # (the last line unended)
+    assert compensate(path) != 0
+    assert "verification: ncpp cannot read back the program it wrote" in capsys.readouterr().err
+    assert not path.with_suffix(".out.ngc").exists()
