@@ -89,7 +89,16 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
         "motion/test_fanuc_flavours.py": (
             "test_g0_in_a_return_block_is_the_modal_motion_after_it",
             "test_haas_peck_holes_are_rs274s_of_the_cycle_without_p",
+            "test_an_r_arc_that_ends_where_it_starts_passes_through_and_rs274_judges_the_rest",
+            "test_r_wins_over_i_j_k_in_a_fanuc_arc_block",
+            "test_a_haas_circular_pocket_passes_through_and_the_moves_before_it_are_compensated",
+            "test_g80_leaves_the_motion_mode_the_cycle_interrupted",
         ),
+        "writeback/test_loops_run_once.py": (
+            "test_a_body_that_runs_once_is_compensated_in_place",
+            "test_a_loop_that_runs_twice_stays_as_programmed_inside_one_that_runs_once",
+        ),
+        "writeback/test_last_line_unended.py": ("test_rs274_reads_the_output_as_the_input_within_20_um",),
         "motion/test_cutter_comp.py": (
             "test_g41_checks_against_the_radius_of_the_tool_table_ncpp_is_told",
             "test_moves_after_compensation_agree_with_rs274",
@@ -130,6 +139,7 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
     "slow": {
         "motion/test_fanuc_flavours.py": (
             "test_a_haas_peck_cycle_with_p_is_compensated_with_its_p_and_verified",
+            "test_external_output_passes_through_the_compensated_program",
         ),
         "compensation/test_cutter_comp_accuracy.py": ("test_mmount_contours_land_within_the_tolerance",),
         "compensation/test_rigid_tap.py": (
@@ -138,7 +148,9 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
         ),
         "hostile/test_resources.py": (
             "test_compensating_a_loop_takes_the_same_memory_however_often_it_runs",
+            "test_a_loop_run_once_around_one_run_often_takes_bounded_memory",
         ),
+        "writeback/test_last_line_unended.py": ("test_the_lines_written_for_an_unended_last_line_each_end",),
         "cldata/test_cldata.py": ("test_corpus_file_reads_and_moves_where_the_gotos_say",),
         "compensation/test_lathe.py": ("test_no_iso_program_of_the_corpus_is_taken_for_a_lathe_program",),
         "identify/test_thesis_sample.py": ("test_make_reproduces_the_committed_comparison",),
