@@ -164,21 +164,36 @@ def rs274_twin(text: str) -> str:
     )
 
 
+def compensated_by_cli(tmp_path: Path, text: str, dialect: str, *options: str) -> tuple[str, str, Path]:
+    """`text` compensated by `ncpp compensate` on READING's machine as `dialect` (the test fails on a
+    non-zero exit): the written program, the messages, and the program's file."""
+    program, out = tmp_path / "p.nc", tmp_path / "out.nc"
+    program.write_text(text)
+    command = [
+        "compensate",
+        "--machine",
+        str(READING),
+        "--dialect",
+        dialect,
+        *options,
+        str(program),
+        "-o",
+        str(out),
+    ]
+    proc = subprocess.run([sys.executable, "-m", "ncpp", *command], capture_output=True, text=True, cwd=ROOT)
+    assert proc.returncode == 0, proc.stderr
+    return out.read_text(), proc.stderr, program
+
+
 def test_g0_in_a_return_block_is_the_modal_motion_after_it(tmp_path):
     """The return is left as programmed and the moves after it are compensated: the X Y Z block after
     `G0 G28` is a rapid.  Judged by LinuxCNC's rs274 on the twins of input and output (pathcheck: same
     actions, rapids where the original rapids, within 0.05 mm); ncpp refused the block before."""
     if not (RS274.exists() and PATHCHECK.exists()):
         pytest.skip("rs274 or pathcheck not available")
-    program = tmp_path / "p.nc"
-    program.write_text(RETURN_WITH_G0)
-    out = tmp_path / "out.nc"
-    command = ["compensate", "--machine", str(READING), "--dialect", "fanuc", str(program), "-o", str(out)]
-    proc = subprocess.run([sys.executable, "-m", "ncpp", *command], capture_output=True, text=True, cwd=ROOT)
-    assert proc.returncode == 0, proc.stderr
-    written = out.read_text()
+    written, messages, _ = compensated_by_cli(tmp_path, RETURN_WITH_G0, "fanuc")
     assert "\nG0 G28 G91 Z0.\n" in written and "\nG00 G91 G28 Z0.\n" in written
-    assert "compensated 4 moves" in proc.stderr
+    assert "compensated 4 moves" in messages
     twin_in, twin_out = tmp_path / "in.ngc", tmp_path / "out.ngc"
     twin_in.write_text(rs274_twin(RETURN_WITH_G0))
     twin_out.write_text(rs274_twin(written))
@@ -415,16 +430,10 @@ def test_external_output_is_read_whole_and_moves_nothing():
 
 
 def test_external_output_passes_through_the_compensated_program(tmp_path):
-    program = tmp_path / "p.nc"
-    program.write_text(EXTERNAL_OUTPUT)
-    out = tmp_path / "out.nc"
-    command = ["compensate", "--machine", str(READING), "--dialect", "haas", str(program), "-o", str(out)]
-    proc = subprocess.run([sys.executable, "-m", "ncpp", *command], capture_output=True, text=True, cwd=ROOT)
-    assert proc.returncode == 0, proc.stderr
-    written = out.read_text()
+    written, messages, _ = compensated_by_cli(tmp_path, EXTERNAL_OUTPUT, "haas")
     for line in EXTERNAL_OUTPUT.splitlines()[3:5] + EXTERNAL_OUTPUT.splitlines()[6:9]:
         assert f"\n{line}\n" in written
-    assert "compensated 2 moves" in proc.stderr
+    assert "compensated 2 moves" in messages
 
 
 SUBPROGRAM_IN_P = (
@@ -466,19 +475,14 @@ def test_a_haas_circular_pocket_passes_through_and_the_moves_before_it_are_compe
     """G12/G13 spiral a pocket out from where the tool stands (Haas VF-series manual 96-8000, "Circular
     Pocket Milling"): ncpp leaves the rest of the program as it is, located, where it refused the line
     with LinuxCNC's "Unknown g code used"; rs274 judges the compensated moves before it."""
-    program = tmp_path / "p.nc"
-    program.write_text(CIRCULAR_POCKET)
-    out = tmp_path / "out.nc"
     tools = tmp_path / "tools.tbl"
     tools.write_text("T2 P2 Z1.5 D0.375 ; 3/8 end mill\n")
-    command = ["compensate", "--machine", str(READING), "--dialect", "haas", "--no-guard", "--tool-table", str(tools),
-               "--var-units", "inch", str(program), "-o", str(out)]  # fmt: skip
-    proc = subprocess.run([sys.executable, "-m", "ncpp", *command], capture_output=True, text=True, cwd=ROOT)
-    assert proc.returncode == 0, proc.stderr
-    assert f"{program}:8:1: warning: G13 (Haas circular pocket milling" in proc.stderr
-    written = out.read_text()
+    written, messages, program = compensated_by_cli(
+        tmp_path, CIRCULAR_POCKET, "haas", "--no-guard", "--tool-table", str(tools), "--var-units", "inch"
+    )
+    assert f"{program}:8:1: warning: G13 (Haas circular pocket milling" in messages
     tail = "".join(CIRCULAR_POCKET.splitlines(keepends=True)[7:])
-    assert written.endswith(tail) and "compensated 4 moves" in proc.stderr
+    assert written.endswith(tail) and "compensated 4 moves" in messages
     if not RS274.exists():
         pytest.skip("rs274 not available")
     head = written[: -len(tail)]
@@ -513,19 +517,14 @@ def test_an_r_arc_that_ends_where_it_starts_does_not_move():
 def test_an_r_arc_that_ends_where_it_starts_passes_through_and_rs274_judges_the_rest(tmp_path):
     """The compensated program (the 0-degree arc as written) against the original without that block, which
     is what the control runs: rs274 judges both."""
-    program, out = tmp_path / "p.nc", tmp_path / "out.nc"
-    program.write_text(STILL_ARC)
-    command = ["compensate", "--machine", str(READING), "--dialect", "fanuc", "--no-guard", str(program), "-o",
-               str(out)]  # fmt: skip
-    proc = subprocess.run([sys.executable, "-m", "ncpp", *command], capture_output=True, text=True, cwd=ROOT)
-    assert proc.returncode == 0, proc.stderr
-    assert "\nG03 X40 Y50 R20\n" in out.read_text()
+    compensated, _, _ = compensated_by_cli(tmp_path, STILL_ARC, "fanuc", "--no-guard")
+    assert "\nG03 X40 Y50 R20\n" in compensated
     if not RS274.exists():
         pytest.skip("rs274 not available")
     meant = tmp_path / "meant.ngc"
     meant.write_text(STILL_ARC.replace("O0025\n", "").replace("G03 X40 Y50 R20\n", ""))
     written = tmp_path / "written.ngc"
-    written.write_text(out.read_text().replace("O0025\n", ""))
+    written.write_text(compensated.replace("O0025\n", ""))
     check = subprocess.run([sys.executable, str(PATHCHECK), str(meant), str(written), "--tol-mm", "0.02"],
                            capture_output=True, text=True)  # fmt: skip
     assert check.returncode == 0, check.stdout + check.stderr
@@ -544,17 +543,14 @@ def test_r_wins_over_i_j_k_in_a_fanuc_arc_block(tmp_path):
     for dialect in ("iso", "haas"):
         with pytest.raises(NcppError, match="p.nc:4:1: Mixed radius ijk format for arc"):
             events(R_AND_IJ, dialect)
-    program, out = tmp_path / "p.nc", tmp_path / "out.nc"
-    program.write_text(R_AND_IJ)
-    command = ["compensate", "--machine", str(READING), "--dialect", "fanuc", "--no-guard", str(program), "-o",
-               str(out)]  # fmt: skip
-    proc = subprocess.run([sys.executable, "-m", "ncpp", *command], capture_output=True, text=True, cwd=ROOT)
-    assert proc.returncode == 0, proc.stderr
-    assert " R10" not in out.read_text()
+    compensated, _, _ = compensated_by_cli(tmp_path, R_AND_IJ, "fanuc", "--no-guard")
+    assert " R10" not in compensated
     if not RS274.exists():
         pytest.skip("rs274 not available")
     meant = tmp_path / "meant.ngc"
     meant.write_text(R_AND_IJ.replace(" I10 J0", "").replace(" I3 J7", ""))
-    check = subprocess.run([sys.executable, str(PATHCHECK), str(meant), str(out), "--tol-mm", "0.02"],
+    written = tmp_path / "written.ngc"
+    written.write_text(compensated)
+    check = subprocess.run([sys.executable, str(PATHCHECK), str(meant), str(written), "--tol-mm", "0.02"],
                            capture_output=True, text=True)  # fmt: skip
     assert check.returncode == 0, check.stdout + check.stderr
