@@ -31,12 +31,16 @@ o101 endrepeat
 o100 endrepeat
 M2
 """
-KLARTEXT = """0 BEGIN PGM LOOP MM
+# The head of the Klartext programs: a blank, a tool, the tool up
+KLARTEXT_HEAD = """0 BEGIN PGM LOOP MM
 1 BLK FORM 0.1 Z X+0 Y+0 Z-20
 2 BLK FORM 0.2 X+100 Y+100 Z+0
 3 TOOL CALL 1 Z S1000
 4 L Z+5 R0 FMAX
-5 LBL 1
+"""
+KLARTEXT = (
+    KLARTEXT_HEAD
+    + """5 LBL 1
 6 LBL 2
 7 L X+10 Y+10 R0 F200
 8 L X+0 Y+0 R0 F200
@@ -45,6 +49,7 @@ KLARTEXT = """0 BEGIN PGM LOOP MM
 11 L Z+50 R0 FMAX
 12 END PGM LOOP MM
 """
+)
 # Fanuc's M98 P<n> L<repeats> (and G65's L): the subprogram's runs are a counted loop too
 FANUC_L = """O1000
 G21 G90 G54
@@ -163,12 +168,9 @@ INNER = "0 BEGIN PGM INNER MM\n1 LBL 3\n2 L X+10 Y+10 R0 F200\n3 L X+0 Y+0 R0 F2
 SUBPROGRAMS = {"L123.SPF": "G91 G1 X1\nX-1\nG90\nM17\n", "L124.SPF": "L123 P9999\nM17\n",
                "INNER.H": INNER + "5 END PGM INNER MM\n"}  # fmt: skip
 # A REP section around a subprogram call whose REP sections run about 3,000,000 blocks a call
-KLARTEXT_REP_AROUND_CALL = """0 BEGIN PGM LOOP MM
-1 BLK FORM 0.1 Z X+0 Y+0 Z-20
-2 BLK FORM 0.2 X+100 Y+100 Z+0
-3 TOOL CALL 1 Z S1000
-4 L Z+5 R0 FMAX
-5 LBL 1
+KLARTEXT_REP_AROUND_CALL = (
+    KLARTEXT_HEAD
+    + """5 LBL 1
 6 CALL LBL 2
 7 CALL LBL 1 REP 1000
 8 L Z+50 R0 FMAX
@@ -183,6 +185,7 @@ KLARTEXT_REP_AROUND_CALL = """0 BEGIN PGM LOOP MM
 17 LBL 0
 18 END PGM LOOP MM
 """
+)
 
 # A REP section around a CALL PGM whose program's REP section runs 60,000 blocks
 KLARTEXT_REP_AROUND_PGM = """0 BEGIN PGM LOOP MM
