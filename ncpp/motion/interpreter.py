@@ -365,7 +365,6 @@ class Interpreter:
         corner: tuple = ()  # its corner word: (kind, size, item); read only with a pending line
         held: list[Event] = []  # non-moving events after it
         once: FirstPass | None = None  # a loop's first pass in its place, while the flow has not told
-        spent = False  # the loop under way left its first pass as programmed: its body stays so
         flow = self.flow = Flow(
             self.file, self._evaluate, self.params, lambda: self.done, self._leave_scope,
             self.subroutine_path, state=self._loop_state, position=lambda: self.pos[:],
@@ -374,22 +373,16 @@ class Interpreter:
         self.rounding = False
         expansion = self.expansion
         for block, kind, owner in flow.steps(blocks):
-            if once is not None and once.full():
-                yield from self._told(once, again=True)
-                once, spent = None, True
-            if kind is ONCE and (
-                spent or expansion is not None or pending is not None or self.corner is not None
-            ):
-                kind = FIXED
-            if once is not None and (self.done or flow.in_straight_code()):
-                yield from self._told(once, again=self.done and not self.ended)
+            if kind is ONCE and (expansion is not None or pending is not None or self.corner is not None):
+                kind = FIXED  # (--expand writes each run out; a corner waiting: `_in_flow` tells why)
+            if once is not None and (self.done or flow.in_straight_code() or once.full()):
+                yield from self._told(once, again=(self.done and not self.ended) or once.full())
                 once = None
             if kind is ONCE and once is None:
                 once = FirstPass(lambda ev: _as_programmed(ev, None))
             elif once is not None and kind is FIXED and owner is not None and once.rerun(block):
                 yield from self._told(once, again=True)  # (all of it runs again: nothing to hold)
                 once = None
-            spent = spent and kind is not RUN
             if kind is not RUN and kind is not FIXED and kind is not ONCE:  # text that does not run here
                 ended = self.done or block.verbatim  # (verbatim: after the closing `%`)
                 if expansion is not None:
@@ -420,7 +413,7 @@ class Interpreter:
                 if kind is ONCE and (self.corner is not None or _sets_offset(event) or self._compensating()):
                     if once is not None:
                         yield from self._told(once, again=True)  # (`_in_flow` tells why, below)
-                    once, spent, kind = None, True, FIXED
+                    once, kind = None, FIXED
                 if kind is FIXED and expansion is None:
                     event = self._in_flow(event, owner)
                 if flow.modal is not None and _moves(event):  # a move under G66: the macro next
