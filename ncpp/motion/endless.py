@@ -16,6 +16,10 @@ at every arrival would cost more than the loop's own lines, so the parameters ar
 (`Journal`: the ones written since the state was taken, with their values then) and the whole
 state is built and compared only where the jump, the parameters and the cheap part of the state
 (`quick`: the position) are all as they were.
+
+Before that, at the end of its first pass, a while loop whose condition is a constant true and
+whose body has no way out (`flow.Flow._way_out`: no break, return, jump, program end or alarm, and
+no call of a body that has one or cannot be seen) is refused at once, whatever its state does.
 """
 
 from __future__ import annotations
@@ -131,6 +135,26 @@ class Revisits:
             return False
         state = self.state()
         return state is not None and self.kept is not None and state == self.kept
+
+
+def constant(expr: tuple) -> bool:
+    """Whether an expression (`expressions.py`'s tuples) reads no parameter: its value never changes."""
+    kind = expr[0]
+    if kind == "num":
+        return True
+    if kind in ("param", "exists"):
+        return False
+    return all(constant(part) for part in expr[1:] if type(part) is tuple)
+
+
+def without_way_out(head: int, where: Location) -> NcppError:
+    """The refusal of a while loop (at line `head`) that can never end (`constant` condition, no way out)."""
+    return NcppError(
+        f"a loop that does not end: the loop at line {head} runs while a constant is true and nothing in it "
+        "leaves it (no break, return, jump, program end or alarm) (the control would run it for ever; ncpp "
+        "follows a program to its end)",
+        where,
+    )
 
 
 def endless(jumps: int, head: int, where: Location) -> NcppError:

@@ -80,7 +80,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ncpp.errors import Location, NcppError, printable
-from ncpp.motion.endless import Journal, Revisits, endless, exact
+from ncpp.motion.endless import Journal, Revisits, constant, endless, exact, without_way_out
 from ncpp.motion.expressions import SUBROUTINE_PARAMETERS, normalise_name, round_half_away, vacant
 from ncpp.motion.modal import OutOfScope
 from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
@@ -129,6 +129,7 @@ class _Label:
     count: int = -1  # repeat: iterations still to run (-1: not counted yet)
     total: int = 0  # repeat: its iterations, all told
     mark: int | None = None  # repeat: `CountedPasses.ended`'s mark
+    checked: bool = False  # while: whether it may end was looked at (`Flow._refuse_without_way_out`)
 
 
 @dataclass
@@ -912,6 +913,8 @@ class Flow:
         if inner:
             raise NcppError(f"END{m} closes DO{m} across the loop {inner[0]}: loops nest, they do not cross "
                             "(a Fanuc alarm)", where)  # fmt: skip
+        opening = self._control_of(self._block(frame, label.start))
+        self._refuse_without_way_out(frame, label, opening.arguments[0], block, control)
         return self._back(frame, label.start, block, control)
 
     def _loop_name(self, m: int, block: Block, control: Control) -> str:
@@ -1076,6 +1079,7 @@ class Flow:
         again = self._condition(block, control)
         if label is not None and label.kind == "do":  # the end of a do loop
             if again and not self.doing_break:
+                self._refuse_without_way_out(frame, label, control.arguments[0], block, control)
                 return self._back(frame, label.start, block, control)
             self.doing_break = False
             return self._ended(frame, control.name)
@@ -1100,6 +1104,9 @@ class Flow:
             if not self.doing_continue:
                 return self._ended(frame, control.name)
             self.doing_continue = False  # (only here: a `continue` in a do loop leaves it set)
+        if kind == "while":
+            opening = self._control_of(self._block(frame, label.start))
+            self._refuse_without_way_out(frame, label, opening.arguments[0], block, control)
         return self._back(frame, label.start, block, control)
 
     def _do(self, frame, block, control, arrived):
@@ -1194,6 +1201,51 @@ class Flow:
                 raise endless(jumps, self._block(level, start).line, where)
 
         return step
+
+    def _refuse_without_way_out(self, frame: _Frame, label: _Label, condition: tuple, block: Block,
+                                control: Control) -> None:  # fmt: skip
+        """At the end of a while loop's first pass: refuse it where it can never end (`endless.py`)."""
+        if label.checked:
+            return
+        label.checked = True
+        if not constant(condition):
+            return
+        body = (self._block(frame, index) for index in range(label.start + 1, frame.pc))
+        if not any(self._way_out(b, True, set()) for b in body):  # type: ignore[arg-type]  # (held: under way)
+            where = Location(frame.source or self.file, block.line, control.item.start + 1)
+            raise without_way_out(self._block(frame, label.start).line, where)  # type: ignore[union-attr]
+
+    def _way_out(self, block: Block, in_loop: bool, seen: set[str]) -> bool:
+        """Whether running `block` may end the program or, `in_loop`, leave the loop it stands in: a
+        break, return, jump or M99 there; anywhere a program end, an alarm (an `(abort, ...)`
+        comment, a Fanuc `#3000`), or a call of a body that does (one that cannot be seen counts)."""
+        control = self._control_of(block)
+        if control is None:
+            return _ends_program(block) or any(
+                type(item) is Statement
+                and "3000" in block.raw[item.start : item.end]
+                or type(item) is Comment
+                and item.text.lstrip().lower().startswith("abort")
+                for item in block.items
+            )
+        keyword = control.keyword
+        if keyword in ("break", "return", "goto", "fanuc_if", "m99", "endsub"):
+            return in_loop
+        if keyword not in ("call", "m98", "g65", "g66"):
+            return False
+        name = control.name
+        if keyword != "call":
+            number = control.arguments[0]
+            if type(number) is not Word:
+                return True
+            name = str(int(round_half_away(number.value)))
+        if type(name) is not str:
+            return True  # (a name computed where the call runs)
+        if name in seen:
+            return False
+        seen.add(name)
+        body = (self.subroutines if keyword == "call" else self.subprograms).get(name)
+        return body is None or any(self._way_out(b, False, seen) for b in body)
 
     def _with_flow(self, state: object) -> tuple | None:
         """The interpreter's `state` and the flow's own (None: not told): its calls, loops and

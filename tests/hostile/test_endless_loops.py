@@ -52,24 +52,24 @@ def _ends(events: list) -> list[tuple[float, ...]]:
 
 
 ENDLESS_ISO = {
-    "while [1]": (HEAD + "o100 while [1]\nG1 X1\nG1 X0\no100 endwhile\nM2\n", 6, 3),
-    "do while [1]": (HEAD + "o1 do\nG1 X1\nG1 X0\no1 while [1]\nM2\n", 6, 3),
+    "while": (HEAD + "o100 while [#9 EQ 0]\nG1 X1\nG1 X0\no100 endwhile\nM2\n", 6, 3),
+    "do while": (HEAD + "o1 do\nG1 X1\nG1 X0\no1 while [#9 EQ 0]\nM2\n", 6, 3),
     "a parameter set to the same value": (
         HEAD + "o1 while [#1 LT 5]\n#1 = 2\nG1 X#1\no1 endwhile\nM2\n", 6, 3,
     ),
     "a toggle: the state of two passes before": (
-        HEAD + "o1 while [1]\n#1 = [1 - #1]\no2 if [#1 EQ 1]\nG1 X1\no2 else\nG1 X0\no2 endif\n"
+        HEAD + "o1 while [#9 EQ 0]\n#1 = [1 - #1]\no2 if [#1 EQ 1]\nG1 X1\no2 else\nG1 X0\no2 endif\n"
         + "o1 endwhile\nM2\n",
         10, 3,
     ),
     "a subroutine call and a counted loop inside": (
         "o<s> sub\n#2 = [#1 + 1]\nG1 X#2\no<s> endsub\n" + HEAD
-        + "o1 while [1]\no<s> call [5]\no2 repeat [3]\nG1 Y1\nG1 Y0\no2 endrepeat\no1 endwhile\nM2\n",
+        + "o1 while [#9 EQ 0]\no<s> call [5]\no2 repeat [3]\nG1 Y1\nG1 Y0\no2 endrepeat\no1 endwhile\nM2\n",
         13, 7,  # (the loop that does not end, not the counted one inside it that repeats too)
     ),
-    "incremental moves that come back": (HEAD + "G91\no1 while [1]\nG1 X1\nG1 X-1\no1 endwhile\nM2\n", 7, 4),
+    "incremental moves that come back": (HEAD + "G91\no1 while [#9 EQ 0]\nG1 X1\nG1 X-1\no1 endwhile\nM2\n", 7, 4),
     "inside a subroutine": (
-        "o<s> sub\no1 while [1]\nG1 X1\nG1 X0\no1 endwhile\no<s> endsub\n" + HEAD + "o<s> call\nM2\n", 5, 2,
+        "o<s> sub\no1 while [#9 EQ 0]\nG1 X1\nG1 X0\no1 endwhile\no<s> endsub\n" + HEAD + "o<s> call\nM2\n", 5, 2,
     ),
 }  # fmt: skip
 
@@ -81,8 +81,8 @@ def test_an_iso_loop_back_at_a_state_it_had_is_refused_at_once(name):
 
 
 ENDLESS_FANUC = {
-    "WHILE [1 GT 0] DO1": (
-        FANUC_HEAD + "WHILE [1 GT 0] DO1\nG1 X1 F100\nG1 X0\n#1 = 1\nEND1\nM30\n%\n",
+    "WHILE [..] DO1": (
+        FANUC_HEAD + "WHILE [#1 NE 2] DO1\nG1 X1 F100\nG1 X0\n#1 = 1\nEND1\nM30\n%\n",
         9,
         5,
     ),
@@ -100,7 +100,52 @@ def test_a_fanuc_loop_back_at_a_state_it_had_is_refused_at_once(name):
 def test_a_loop_whose_counter_counts_for_ever_is_left_to_the_bound(monkeypatch):
     monkeypatch.setattr(flow, "MAX_RERUN", 20_000)
     with pytest.raises(NcppError, match="a loop that does not end: 20,000 lines run again"):
-        _iso(HEAD + "o1 while [1]\nG1 X1\n#1 = [#1 + 1]\no1 endwhile\nM2\n")
+        _iso(HEAD + "o1 while [#1 GE 0]\nG1 X1\n#1 = [#1 + 1]\no1 endwhile\nM2\n")
+
+
+WITHOUT_WAY_OUT = {  # a constant condition and nothing that leaves: refused at the end of the first pass
+    "while [1] and a counter": (_iso, HEAD + "o1 while [1]\nG1 X1\n#1 = [#1 + 1]\no1 endwhile\nM2\n", 6, 3),
+    "do ... while [2 GT 1]": (_iso, HEAD + "o1 do\n#1 = [#1 + 1]\nG1 X#1\no1 while [2 GT 1]\nM2\n", 6, 3),
+    "a call whose body has no way out": (
+        _iso, "o<s> sub\nG1 X#1\no<s> endsub\n" + HEAD + "o1 while [1]\n#2 = [#2 + 1]\no<s> call [#2]\n"
+        "o1 endwhile\nM2\n", 9, 6,
+    ),
+    "Fanuc WHILE [1 EQ 1] and a counter": (
+        _fanuc, FANUC_HEAD + "#1 = 0\nWHILE [1 EQ 1] DO1\n#1 = #1 + 1\nG1 X#1 F100\nEND1\nM30\n%\n", 9, 6,
+    ),
+}  # fmt: skip
+
+
+@pytest.mark.parametrize("name", WITHOUT_WAY_OUT)
+def test_a_while_of_a_constant_with_no_way_out_is_refused_after_its_first_pass(name):
+    read, text, line, head = WITHOUT_WAY_OUT[name]
+    with pytest.raises(
+        NcppError, match=rf"does not end: the loop at line {head} runs while a constant"
+    ) as err:
+        read(text)
+    assert err.value.where.line == line
+
+
+WAYS_OUT = {  # the same loops, each with a way out the first pass does not take
+    "a break": (_iso, HEAD + "o1 while [1]\n#1 = [#1 + 1]\nG1 X#1\no2 if [#1 GT 4]\no1 break\no2 endif\n"
+                "o1 endwhile\nM2\n"),
+    "a program end": (_iso, HEAD + "o1 while [1]\n#1 = [#1 + 1]\nG1 X#1\no2 if [#1 GT 4]\nM2\no2 endif\n"
+                      "o1 endwhile\nM2\n"),
+    "a return": (_iso, "o<s> sub\no1 while [1]\n#1 = [#1 + 1]\nG1 X#1\no2 if [#1 GT 4]\no<s> return\no2 endif\n"
+                 "o1 endwhile\no<s> endsub\n" + HEAD + "o<s> call\nM2\n"),
+    "a Fanuc jump out": (_fanuc, FANUC_HEAD + "#1 = 0\nWHILE [1 EQ 1] DO1\n#1 = #1 + 1\nG1 X#1 F100\n"
+                         "IF [#1 GT 4] GOTO 10\nEND1\nN10 M30\n%\n"),
+    "a Fanuc subprogram that ends the program": (
+        _fanuc, FANUC_HEAD + "#1 = 0\nWHILE [1 EQ 1] DO1\n#1 = #1 + 1\nM98 P2000\nEND1\nM30\n%\n"
+        "O2000\nG1 X#1 F100\nIF [#1 LT 5] GOTO 5\nM30\nN5 M99\n%\n",
+    ),
+}  # fmt: skip
+
+
+@pytest.mark.parametrize("name", WAYS_OUT)
+def test_a_while_of_a_constant_with_a_way_out_runs_to_its_end(name):
+    read, text = WAYS_OUT[name]
+    assert max(x for x, y, z in _ends(read(text))) == 5.0
 
 
 def test_a_loop_with_a_counter_runs_to_its_end():
@@ -231,8 +276,8 @@ def test_a_klartext_jump_back_whose_parameter_counts_runs_to_its_end():
 
 MACHINE = SHARED / "machines/wide.toml"
 PROGRAMS = {
-    "while.ngc": (ENDLESS_ISO["while [1]"][0], 6),
-    "while.nc": (ENDLESS_FANUC["WHILE [1 GT 0] DO1"][0], 9),
+    "while.ngc": (ENDLESS_ISO["while"][0], 6),
+    "while.nc": (ENDLESS_FANUC["WHILE [..] DO1"][0], 9),
     "loop.mpf": (SINUMERIK_HEAD + ENDLESS_SINUMERIK["LOOP ... ENDLOOP"][0], 6),
     "jump.h": (KLARTEXT, 8),
 }

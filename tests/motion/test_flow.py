@@ -235,7 +235,7 @@ def test_a_loop_that_does_not_end_is_refused_at_its_line(monkeypatch):
 
     monkeypatch.setattr(flow, "MAX_RERUN", 1000)
     with pytest.raises(NcppError, match=r"a loop that does not end: 1,000 lines run again") as err:
-        _events(HEAD + "o1 while [1]\n G0 X1\n #1 = [#1 + 1]\no1 endwhile\nG0 Y5\n")
+        _events(HEAD + "o1 while [#1 GE 0]\n G0 X1\n #1 = [#1 + 1]\no1 endwhile\nG0 Y5\n")
     assert (err.value.where.file, err.value.where.line) == ("t.ngc", 6)
 
 
