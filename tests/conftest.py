@@ -190,6 +190,10 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_moves_after_a_return_are_corrected_from_the_home_position",
         ),
         "verify/test_verifier.py": ("test_a_path_over_itself_too_often_is_refused_with_a_way_out",),
+        "compensation/test_machine_files.py": (
+            "test_compensated_programs_land_on_the_path_on_each_machine",
+            "test_simulate_runs_a_program_on_a_machine_whose_travel_does_not_hold_zero",
+        ),
         "dialect_motion/test_subprogram_calls.py": (
             "test_sinumerik_long_runs_are_written_and_verified_a_chunk_at_a_time",
             "test_klartext_long_runs_are_written_and_verified_a_chunk_at_a_time",

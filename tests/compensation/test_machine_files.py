@@ -250,3 +250,22 @@ def test_a_run_of_g91_increments_does_not_drift_by_their_roundings(tmp_path):
 
     assert accuracy.worst_um(program, program, machine) > 2.0
     assert accuracy.worst_um(program, out, machine) <= 0.1
+
+
+def test_simulate_runs_a_program_on_a_machine_whose_travel_does_not_hold_zero(tmp_path):
+    """The control starts wherever its axes are, not at the interpreter's zero: a machine whose Y
+    travel is 200-900 mm simulates a program that places itself there, and still refuses one
+    that moves Y outside it, at the word that does."""
+    inside, outside = tmp_path / "inside.ngc", tmp_path / "outside.ngc"
+    inside.write_text("G21 G90 G54\nG10 L2 P1 X0 Y550 Z0\nG0 X-50 Y-40 Z10\nG1 Z-2 F400\nG1 X50\nG1 Y40\nM2\n")
+    outside.write_text("G21 G90 G54\nG0 X-50 Y300 Z10\nG1 Z-2 F400\nG1 X50 Y100\nM2\n")
+
+    def simulate(program: Path) -> subprocess.CompletedProcess:
+        return subprocess.run([sys.executable, "-m", "ncpp", "simulate", "--machine", str(FILES / "y_axis.toml"),
+                               str(program)], capture_output=True, text=True, cwd=ROOT, timeout=300)  # fmt: skip
+
+    ran = simulate(inside)
+    assert ran.returncode == 0 and "contour error: max" in ran.stdout, ran.stderr
+    refused = simulate(outside)
+    assert refused.returncode != 0
+    assert "outside.ngc:4:8: the motion reaches Y" in refused.stderr and "travel [200, 900]" in refused.stderr
