@@ -269,3 +269,28 @@ def test_simulate_runs_a_program_on_a_machine_whose_travel_does_not_hold_zero(tm
     refused = simulate(outside)
     assert refused.returncode != 0
     assert "outside.ngc:4:8: the motion reaches Y" in refused.stderr and "travel [200, 900]" in refused.stderr
+
+
+def test_a_run_of_klartext_increments_does_not_drift_by_their_roundings(tmp_path):
+    """The same in Heidenhain's IX: the written program's increments, added up as the control does
+    and mapped through the machine, land on the programmed points."""
+    (tmp_path / "drift.toml").write_text(DRIFT)
+    program, out = tmp_path / "steps.h", tmp_path / "steps.out.h"
+    body = ["L X-75 Y+0 Z+1 FMAX", "L Z+0 F300", *["L IX+1"] * 150, "L IY+1", "L IX-150"]
+    program.write_text("0 BEGIN PGM STEPS MM\n" + "".join(f"{n} {b}\n" for n, b in enumerate(body, 1))
+                       + f"{len(body) + 1} END PGM STEPS MM\n")  # fmt: skip
+    done = subprocess.run([sys.executable, "-m", "ncpp", "compensate", "--machine", str(tmp_path / "drift.toml"),
+                           str(program), "-o", str(out)],
+                          capture_output=True, text=True, cwd=ROOT, timeout=300, stdin=subprocess.DEVNULL)  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    x, landed = None, []
+    for line in out.read_text().splitlines():
+        absolute, step = re.search(r"\bX([-+][0-9.]+)", line), re.search(r"\bIX([-+][0-9.]+)", line)
+        if absolute:
+            x = float(absolute[1])
+        elif step and line.split()[1] == "L" and x is not None:
+            x += float(step[1])
+            landed.append(x * (1 + 33.3e-6))  # where the machine puts the tool
+    wanted = [-75.0 + k for k in range(1, 151)] + [-75.0]
+    assert len(landed) == len(wanted)
+    assert np.abs(np.array(landed) - wanted).max() * 1000 <= 0.1
