@@ -98,16 +98,17 @@ def _polynomial(coefficients: list[float], reference: float, span: list[float] |
     return value
 
 
-def _curve(spec: dict) -> tuple[Curve, str]:
+def _curve(spec: dict) -> Curve:
+    """A component's table or polynomial, as the documentation's keys say (the unit in their names)."""
     unit = "um" if any(key.endswith("_um") for key in spec) else "urad"
     scale = 1e-3 if unit == "um" else 1e-6  # to mm, to rad
     if "coefficients_" + unit in spec:
         return Curve(_polynomial(spec["coefficients_" + unit], spec.get("reference_mm", 0.0),
-                                 spec.get("range_mm"), scale)), unit  # fmt: skip
+                                 spec.get("range_mm"), scale))  # fmt: skip
     smooth = spec.get("interpolation", "linear") == "smooth"
     plus = _table(spec["positions"], spec["values_" + unit], smooth, scale)
     minus = spec.get(f"values_{unit}_minus")
-    return Curve(plus, None if minus is None else _table(spec["positions"], minus, smooth, scale)), unit
+    return Curve(plus, None if minus is None else _table(spec["positions"], minus, smooth, scale))
 
 
 @dataclass
@@ -127,7 +128,7 @@ class ClosedMachine:
         curves = {}
         for name, spec in data.get("errors", {}).items():
             iso = ALIASES.get(name, ALIASES.get(name.lower(), name.upper()))
-            curves[iso] = _curve(spec)[0]
+            curves[iso] = _curve(spec)
         square = {"C0Y": 0.0, "B0Z": 0.0, "A0Z": 0.0}
         for key, value in data.get("squareness", {}).items():  # `_urad` and `_um_per_m` say the same number
             name = re.sub(r"_(urad|um_per_m)$", "", key)
@@ -143,7 +144,9 @@ class ClosedMachine:
                 out[:, ISO[iso][1]] += curve(k, direction)
         for effect in self.effects:  # the static effects the model treats as error motions
             if effect["kind"] == "angular" and ISO[effect["component"]][0] == axis:
-                out[:, ISO[effect["component"]][1]] += effect["urad_per_m"] * 1e-9 * (k - effect.get("ref_mm", 0.0))
+                out[:, ISO[effect["component"]][1]] += (
+                    effect["urad_per_m"] * 1e-9 * (k - effect.get("ref_mm", 0.0))
+                )
         return out[:, :3], out[:, 3:]
 
     def direction(self, axis: str) -> NDArray:
@@ -155,7 +158,9 @@ class ClosedMachine:
             return rotation(np.array([[self.squareness["A0Z"], self.squareness["B0Z"], 0.0]]))[0] @ e
         return e
 
-    def tip(self, P: NDArray, tool_offset: NDArray | float = 0.0, direction: NDArray | None = None) -> NDArray:
+    def tip(
+        self, P: NDArray, tool_offset: NDArray | float = 0.0, direction: NDArray | None = None
+    ) -> NDArray:
         """(n,3) the actual tool tip in the workpiece, for axis positions P (n,3) with the tool length
         offset (a number: along Z; or (3,) or (n,3)) in effect; `direction` (n,3) each axis's travel
         sign or None."""

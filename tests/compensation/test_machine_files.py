@@ -102,8 +102,13 @@ def to_inches(text: str) -> str:
     def inch(match: re.Match[str]) -> str:
         return f"{match[1]}{float(match[2]) / 25.4:.5f}"
 
-    body = re.sub(r"\b([XYZIJKRF])(-?[0-9.]+)", inch, text.replace("G21 ", "G20 ", 1))
-    return body
+    return re.sub(r"\b([XYZIJKRF])(-?[0-9.]+)", inch, text.replace("G21 ", "G20 ", 1))
+
+
+def ncpp(*arguments: str | Path) -> subprocess.CompletedProcess:
+    """The command line run as a user runs it (from the checkout)."""
+    return subprocess.run([sys.executable, "-m", "ncpp", *map(str, arguments)], capture_output=True,
+                          text=True, cwd=ROOT, timeout=600, stdin=subprocess.DEVNULL)  # fmt: skip
 
 
 def compensated(tmp_path: Path, name: str) -> tuple[Path, Path, Path]:
@@ -111,10 +116,9 @@ def compensated(tmp_path: Path, name: str) -> tuple[Path, Path, Path]:
     program, tools, out = tmp_path / f"{name}.ngc", tmp_path / "tools.tbl", tmp_path / f"{name}.out.ngc"
     program.write_text(program_for(name))
     tools.write_text(TOOLS)
-    done = subprocess.run([sys.executable, "-m", "ncpp", "compensate", "--machine", str(FILES / f"{name}.toml"),
-                           "--tool-table", str(tools), "--var-units", "inch", "--tolerance", "0.0002",
-                           str(program), "-o", str(out)],
-                          capture_output=True, text=True, cwd=ROOT, timeout=600, stdin=subprocess.DEVNULL)  # fmt: skip
+    machine = FILES / f"{name}.toml"
+    done = ncpp("compensate", "--machine", machine, "--tool-table", tools, "--var-units", "inch",
+                "--tolerance", "0.0002", program, "-o", out)  # fmt: skip
     assert done.returncode == 0, done.stderr
     return program, tools, out
 
@@ -160,18 +164,24 @@ def test_the_closed_form_is_the_documented_first_order_formulas():
     square = ClosedMachine.read(FILES / "squareness.toml")
     c0y, b0z, a0z = 40e-6, -30e-6, 25e-6
     first_order = np.column_stack([-c0y * P[:, 1] + b0z * P[:, 2], -a0z * P[:, 2], np.zeros(2)])
-    np.testing.assert_allclose(square.reached(P) - P, first_order, atol=1e-6)  # (second-order terms: below a nm)
+    np.testing.assert_allclose(
+        square.reached(P) - P, first_order, atol=1e-6
+    )  # (second-order terms: below a nm)
     x = ClosedMachine(chain="XYFZ", tool=np.array([0.0, 0.0, -150.0]),
                       references={a: np.array([0.0, 0.0, -250.0]) for a in "XYZ"},
                       curves={"EBX": ClosedMachine.read(FILES / "x_axis.toml").curves["EBX"]},
                       squareness={"C0Y": 0.0, "B0Z": 0.0, "A0Z": 0.0})  # fmt: skip
     pitch = (-8.0 + 0.04 * P[:, 0] + 2e-5 * P[:, 0] ** 2) * 1e-6
     arm_z = P[:, 2] - 150.0 - 50.8 + 250.0  # z + tool − L − the reference point's z
-    np.testing.assert_allclose((x.reached(P, 50.8) - P)[:, 0], pitch * arm_z, atol=1e-6)  # (second-order terms: below a nm)
+    np.testing.assert_allclose(
+        (x.reached(P, 50.8) - P)[:, 0], pitch * arm_z, atol=1e-6
+    )  # (second-order terms: below a nm)
     z = ClosedMachine.read(FILES / "z_axis.toml")
     z.curves = {"ECZ": z.curves["ECZ"]}
     yaw = (8.0 + 0.02 * P[:, 2]) * 1e-6
-    np.testing.assert_allclose((z.reached(P) - P)[:, 1], yaw * (25.0 - 0.0), atol=1e-6)  # (second-order terms: below a nm)
+    np.testing.assert_allclose(
+        (z.reached(P) - P)[:, 1], yaw * (25.0 - 0.0), atol=1e-6
+    )  # (second-order terms: below a nm)
 
 
 @needs_rs274
@@ -217,9 +227,9 @@ def reversal_machine(commands: np.ndarray, direction: np.ndarray) -> np.ndarray:
 def test_reversal_tables_of_both_signs_are_compensated_for_the_direction_travelled(tmp_path):
     program, out = tmp_path / "reversal.ngc", tmp_path / "reversal.out.ngc"
     program.write_text(REVERSAL)
-    done = subprocess.run([sys.executable, "-m", "ncpp", "compensate", "--machine", str(FILES / "reversal.toml"),
-                           "--tolerance", "0.0002", str(program), "-o", str(out)],
-                          capture_output=True, text=True, cwd=ROOT, timeout=600, stdin=subprocess.DEVNULL)  # fmt: skip
+    done = ncpp(
+        "compensate", "--machine", FILES / "reversal.toml", "--tolerance", "0.0002", program, "-o", out
+    )
     assert done.returncode == 0, done.stderr
     before = accuracy.worst_um(program, program, reversal_machine)
     after = accuracy.worst_um(program, out, reversal_machine)
@@ -240,9 +250,7 @@ def test_a_run_of_g91_increments_does_not_drift_by_their_roundings(tmp_path):
     (tmp_path / "drift.toml").write_text(DRIFT)
     program, out = tmp_path / "steps.ngc", tmp_path / "steps.out.ngc"
     program.write_text(STEPS)
-    done = subprocess.run([sys.executable, "-m", "ncpp", "compensate", "--machine", str(tmp_path / "drift.toml"),
-                           str(program), "-o", str(out)],
-                          capture_output=True, text=True, cwd=ROOT, timeout=600, stdin=subprocess.DEVNULL)  # fmt: skip
+    done = ncpp("compensate", "--machine", tmp_path / "drift.toml", program, "-o", out)
     assert done.returncode == 0, done.stderr
 
     def machine(commands: np.ndarray, direction: np.ndarray) -> np.ndarray:
@@ -257,12 +265,13 @@ def test_simulate_runs_a_program_on_a_machine_whose_travel_does_not_hold_zero(tm
     travel is 200-900 mm simulates a program that places itself there, and still refuses one
     that moves Y outside it, at the word that does."""
     inside, outside = tmp_path / "inside.ngc", tmp_path / "outside.ngc"
-    inside.write_text("G21 G90 G54\nG10 L2 P1 X0 Y550 Z0\nG0 X-50 Y-40 Z10\nG1 Z-2 F400\nG1 X50\nG1 Y40\nM2\n")
+    inside.write_text(
+        "G21 G90 G54\nG10 L2 P1 X0 Y550 Z0\nG0 X-50 Y-40 Z10\nG1 Z-2 F400\nG1 X50\nG1 Y40\nM2\n"
+    )
     outside.write_text("G21 G90 G54\nG0 X-50 Y300 Z10\nG1 Z-2 F400\nG1 X50 Y100\nM2\n")
 
     def simulate(program: Path) -> subprocess.CompletedProcess:
-        return subprocess.run([sys.executable, "-m", "ncpp", "simulate", "--machine", str(FILES / "y_axis.toml"),
-                               str(program)], capture_output=True, text=True, cwd=ROOT, timeout=300)  # fmt: skip
+        return ncpp("simulate", "--machine", FILES / "y_axis.toml", program)
 
     ran = simulate(inside)
     assert ran.returncode == 0 and "contour error: max" in ran.stdout, ran.stderr
@@ -279,9 +288,7 @@ def test_a_run_of_klartext_increments_does_not_drift_by_their_roundings(tmp_path
     body = ["L X-75 Y+0 Z+1 FMAX", "L Z+0 F300", *["L IX+1"] * 150, "L IY+1", "L IX-150"]
     program.write_text("0 BEGIN PGM STEPS MM\n" + "".join(f"{n} {b}\n" for n, b in enumerate(body, 1))
                        + f"{len(body) + 1} END PGM STEPS MM\n")  # fmt: skip
-    done = subprocess.run([sys.executable, "-m", "ncpp", "compensate", "--machine", str(tmp_path / "drift.toml"),
-                           str(program), "-o", str(out)],
-                          capture_output=True, text=True, cwd=ROOT, timeout=300, stdin=subprocess.DEVNULL)  # fmt: skip
+    done = ncpp("compensate", "--machine", tmp_path / "drift.toml", program, "-o", out)
     assert done.returncode == 0, done.stderr
     x, landed = None, []
     for line in out.read_text().splitlines():

@@ -640,7 +640,12 @@ class IsoWriter:
         context, end = segment.context, segment.end
         if not context.absolute:
             start = segment.start
-            end = tuple(round(e, p) - round(s, p) for e, s, p in zip(end, start, places))
+            x, y, z = places
+            end = (
+                round(end[0], x) - round(start[0], x),
+                round(end[1], y) - round(start[1], y),
+                round(end[2], z) - round(start[2], z),
+            )
         if type(segment) is not Arc:
             return end
         centre, (a, b) = segment.center, _CENTRE_AXES[context.plane]
@@ -738,7 +743,9 @@ class IsoWriter:
             )
         # (`_numbers`, inlined for an absolute line)
         numbers = (
-            segment.end if type(segment) is Line and segment.context.absolute else self._numbers(segment, units.places)
+            segment.end
+            if type(segment) is Line and segment.context.absolute
+            else self._numbers(segment, units.places)
         )
         if type(edit) is str:
             return edit.format(*numbers)
