@@ -36,6 +36,11 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_the_holes_moves_compensation_sees_are_the_ones_rs274_makes",
         ),
         "compensation/test_rs274_accepts.py": None,
+        "compensation/test_machine_files.py": (
+            "test_compensated_programs_land_on_the_path_on_each_machine",
+            "test_reversal_tables_of_both_signs_are_compensated_for_the_direction_travelled",
+            "test_a_run_of_g91_increments_does_not_drift_by_their_roundings",
+        ),
         "compensation/test_additional_offsets.py": (
             "test_each_move_is_compensated_where_its_system_puts_it",
         ),
@@ -185,6 +190,11 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_moves_after_a_return_are_corrected_from_the_home_position",
         ),
         "verify/test_verifier.py": ("test_a_path_over_itself_too_often_is_refused_with_a_way_out",),
+        "compensation/test_machine_files.py": (
+            "test_compensated_programs_land_on_the_path_on_each_machine",
+            "test_simulate_runs_a_program_on_a_machine_whose_travel_does_not_hold_zero",
+            "test_a_run_of_klartext_increments_does_not_drift_by_their_roundings",
+        ),
         "dialect_motion/test_subprogram_calls.py": (
             "test_sinumerik_long_runs_are_written_and_verified_a_chunk_at_a_time",
             "test_klartext_long_runs_are_written_and_verified_a_chunk_at_a_time",

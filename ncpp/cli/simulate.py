@@ -10,11 +10,15 @@ from __future__ import annotations
 import argparse
 import json
 import math
+from typing import TYPE_CHECKING
 
 from ncpp.cli.compensate import add_placement_arguments, work_offsets
 from ncpp.cli.io import add_dialect_argument
 from ncpp.cli.options import between
 from ncpp.errors import Location, NcppError, Warnings
+
+if TYPE_CHECKING:
+    from numpy.typing import NDArray
 
 # Contour errors are microns: finer sampling shows nothing more, and costs memory by the path's length.
 MIN_STEP_MM = 0.001
@@ -130,6 +134,7 @@ def check_travel(path, limits, file: str, events: list, slack_mm: float = 1e-6) 
 
     lo, hi = (np.array([limits.get(axis, (-math.inf, math.inf))[end] for axis in "XYZ"]) for end in (0, 1))
     outside = (path.points < lo - slack_mm) | (path.points > hi + slack_mm)
+    outside &= _positioned(path, events)
     rows = np.flatnonzero(outside.any(axis=1))
     if rows.size:
         k = int(rows[0])
@@ -139,6 +144,23 @@ def check_travel(path, limits, file: str, events: list, slack_mm: float = 1e-6) 
                           "(place the program with --work-offset or --var-file)", Location(file, int(path.line[k]), word=axis))  # fmt: skip
         error.locate(e.block for e in events)
         raise error
+
+
+def _positioned(path, events: list) -> NDArray:
+    """(n,3) whether each sample's axis stands where the program put it: the path starts at the
+    interpreter's zero, but the control starts wherever the axes are, so an axis is known from the
+    end of the first move whose block names it on (a travel that does not hold zero is no error)."""
+    import numpy as np
+
+    known = np.zeros(path.points.shape, dtype=bool)
+    moves = [e for e in events if type(e).__name__ in ("Line", "Arc")]
+    for n, axis in enumerate("XYZ"):
+        line = next((e.block.line for e in moves if any(w.letter == axis for w in e.block.words())), None)
+        rows = np.flatnonzero(path.line == line)
+        if rows.size:
+            run = np.flatnonzero(np.diff(rows) != 1)  # (the first run of the block's samples)
+            known[rows[int(run[0]) if run.size else -1] :, n] = True
+    return known
 
 
 def plot_report(report, commanded, path: str) -> None:

@@ -24,7 +24,8 @@ straightness          bow δ(direction) = um·4u(1−u), u = (k − lo)/(hi − 
 cyclic                δk = um·sin(2π·k/period_mm + phase_deg)
 angular               rotation ε(k) = urad_per_m·(k − ref_mm) about the
                       component's axis, moving the tool through the machine's
-                      Abbe offset (or through P itself when no machine is given)
+                      Abbe offset at the tool length offset in effect (or
+                      through P itself when no machine is given)
 ====================  =========================================================
 """
 
@@ -72,7 +73,9 @@ class Effect:
     # direction of travel): compensation can cancel it like a geometric error.
     static: ClassVar[bool] = False
 
-    def apply(self, trajectory: Trajectory, machine: Machine | None = None) -> NDArray:
+    def apply(
+        self, trajectory: Trajectory, machine: Machine | None = None, tool_offset: NDArray | None = None
+    ) -> NDArray:
         raise NotImplementedError
 
     def to_dict(self) -> dict[str, Any]:
@@ -164,7 +167,9 @@ class Scale(Effect):
     def __post_init__(self) -> None:
         _axis(self.axis)
 
-    def apply(self, trajectory: Trajectory, machine: Machine | None = None) -> NDArray:
+    def apply(
+        self, trajectory: Trajectory, machine: Machine | None = None, tool_offset: NDArray | None = None
+    ) -> NDArray:
         i = _axis(self.axis)
         out = _zeros(trajectory)
         out[:, i] = self.um_per_m * 1e-6 * (trajectory.positions[:, i] - self.ref_mm)
@@ -206,7 +211,9 @@ class Backlash(Effect):
     def __post_init__(self) -> None:
         _axis(self.axis)
 
-    def apply(self, trajectory: Trajectory, machine: Machine | None = None) -> NDArray:
+    def apply(
+        self, trajectory: Trajectory, machine: Machine | None = None, tool_offset: NDArray | None = None
+    ) -> NDArray:
         i = _axis(self.axis)
         c = trajectory.positions[:, i]
         out = _zeros(trajectory)
@@ -226,7 +233,9 @@ class LateralPlay(Effect):
         if self.direction is not None and _axis(self.direction, "direction") == _axis(self.axis):
             raise ValueError("lateral_play: direction must differ from axis")
 
-    def apply(self, trajectory: Trajectory, machine: Machine | None = None) -> NDArray:
+    def apply(
+        self, trajectory: Trajectory, machine: Machine | None = None, tool_offset: NDArray | None = None
+    ) -> NDArray:
         i = _axis(self.axis)
         j = _axis(self.direction or LATERAL_DEFAULT[self.axis])
         out = _zeros(trajectory)
@@ -250,7 +259,9 @@ class ReversalSpike(Effect):
             if v is not None and not v > 0:
                 raise ValueError("reversal_spike: decay must be positive")
 
-    def apply(self, trajectory: Trajectory, machine: Machine | None = None) -> NDArray:
+    def apply(
+        self, trajectory: Trajectory, machine: Machine | None = None, tool_offset: NDArray | None = None
+    ) -> NDArray:
         i = _axis(self.axis)
         out = _zeros(trajectory)
         turns = trajectory.reversals(i)
@@ -283,7 +294,9 @@ class ServoMismatch(Effect):
             raise ValueError(f"servo_mismatch: axes must name two different axes, e.g. XY, not {self.axes!r}")
         _axis(self.axes[0], "axes"), _axis(self.axes[1], "axes")
 
-    def apply(self, trajectory: Trajectory, machine: Machine | None = None) -> NDArray:
+    def apply(
+        self, trajectory: Trajectory, machine: Machine | None = None, tool_offset: NDArray | None = None
+    ) -> NDArray:
         first, second = _axis(self.axes[0]), _axis(self.axes[1])
         half_tau = 0.5e-3 * self.ms  # s
         v = trajectory.velocity
@@ -304,7 +317,9 @@ class Squareness(Effect):
         if self.plane not in tuple(PLANE_TERMS):
             raise ValueError(f"squareness: plane must be XY, YZ or ZX, not {self.plane!r}")
 
-    def apply(self, trajectory: Trajectory, machine: Machine | None = None) -> NDArray:
+    def apply(
+        self, trajectory: Trajectory, machine: Machine | None = None, tool_offset: NDArray | None = None
+    ) -> NDArray:
         dev, drive = PLANE_TERMS[self.plane]
         out = _zeros(trajectory)
         out[:, dev] = self.um_per_m * 1e-6 * trajectory.positions[:, drive]
@@ -328,7 +343,9 @@ class Straightness(Effect):
             if not lo < hi:
                 raise ValueError("straightness: range_mm must be [lo, hi] with lo < hi")
 
-    def apply(self, trajectory: Trajectory, machine: Machine | None = None) -> NDArray:
+    def apply(
+        self, trajectory: Trajectory, machine: Machine | None = None, tool_offset: NDArray | None = None
+    ) -> NDArray:
         i, j = _axis(self.axis), _axis(self.direction)
         k = trajectory.positions[:, i]
         lo, hi = self.range_mm if self.range_mm is not None else (k.min(), k.max())
@@ -353,7 +370,9 @@ class Cyclic(Effect):
         if not self.period_mm > 0:
             raise ValueError("cyclic: period_mm must be positive")
 
-    def apply(self, trajectory: Trajectory, machine: Machine | None = None) -> NDArray:
+    def apply(
+        self, trajectory: Trajectory, machine: Machine | None = None, tool_offset: NDArray | None = None
+    ) -> NDArray:
         i = _axis(self.axis)
         out = _zeros(trajectory)
         phase = 2 * np.pi * trajectory.positions[:, i] / self.period_mm + np.deg2rad(self.phase_deg)
@@ -376,13 +395,15 @@ class Angular(Effect):
                 f"angular: component must be an angular error such as ECZ, not {self.component!r}"
             )
 
-    def apply(self, trajectory: Trajectory, machine: Machine | None = None) -> NDArray:
+    def apply(
+        self, trajectory: Trajectory, machine: Machine | None = None, tool_offset: NDArray | None = None
+    ) -> NDArray:
         info = COMPONENTS[self.component]
         P = trajectory.positions
         i = AXES.index(info.axis)
         eps = np.zeros(P.shape)
         eps[:, info.index] = self.urad_per_m * 1e-9 * (P[:, i] - self.ref_mm)  # µrad/m · mm
-        lever = P if machine is None else machine.abbe_offset(info.axis, P)
+        lever = P if machine is None else machine.abbe_offset(info.axis, P, tool_offset)
         return np.cross(eps, lever)
 
 

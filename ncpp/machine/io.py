@@ -499,9 +499,11 @@ def _max_correction(comp: dict, loc: _Locator) -> float:
 
 
 def _key_named_in(message: str, spec: Any) -> str | None:
-    """The key of `spec` an error message talks about (longest match), if any."""
+    """The key of `spec` an error message talks about (longest match), if any: the keys it lists
+    as expected (after `; expected`) only when it names none before them."""
     keys = sorted(spec, key=len, reverse=True) if isinstance(spec, dict) else []
-    return next((k for k in keys if k in message), None)
+    said, _, _ = message.partition("; expected")
+    return next((k for k in keys if k in said), None) or next((k for k in keys if k in message), None)
 
 
 def _meta(head: dict, data: dict, loc: _Locator) -> dict:

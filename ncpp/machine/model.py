@@ -280,27 +280,28 @@ class Machine:
         static = [e for e in self.effects if e.static]
         if static and len(pts):
             padded = pts if len(pts) >= 2 else np.vstack([pts, pts])
+            tools = None if tool_offset is None else _per_point(tool_offset, padded.shape)
             trajectory = Trajectory(padded, 1000.0)
             for effect in static:
                 if isinstance(effect, Straightness) and effect.range_mm is None:
                     lo, hi = self.limits.get(effect.axis, (-math.inf, math.inf))
                     if math.isfinite(lo) and math.isfinite(hi):
                         effect = dataclasses.replace(effect, range_mm=(lo, hi))
-                total = total + effect.apply(trajectory, machine=self)[: len(pts)]
+                total = total + effect.apply(trajectory, self, tools)[: len(pts)]
         return _shaped_like(total, P)
 
     def deviation_linear(self, P: ArrayLike, direction: ArrayLike | None = None) -> NDArray:
         """First-order deviation (Rahman 2004, eqs. 28–30), mm."""
         return self._blockwise(linear_deviation, P, direction)
 
-    def abbe_offset(self, axis: str, P: ArrayLike) -> NDArray:
-        """Lever arm L_K (mm) through which axis K's rotation moves the tool point."""
+    def abbe_offset(self, axis: str, P: ArrayLike, tool_offset: ArrayLike | None = None) -> NDArray:
+        """Lever arm L_K (mm) through which axis K's rotation moves the tool point; `tool_offset`:
+        (n,3) tool length offsets in effect, as in `deviation` (the tip that much nearer)."""
         pts = as_points(P)
+        tool = np.asarray(self.tool)
+        tool = tool if tool_offset is None else tool - _per_point(tool_offset, pts.shape)
         return _shaped_like(
-            abbe_offset(
-                Chain(self.chain), axis, pts, np.asarray(self.tool), np.asarray(self.references[axis])
-            ),
-            P,
+            abbe_offset(Chain(self.chain), axis, pts, tool, np.asarray(self.references[axis])), P
         )
 
     def rotation(self, P: ArrayLike, direction: ArrayLike | None = None) -> NDArray:
@@ -347,8 +348,9 @@ class Machine:
         (n,3): the tool length offsets in effect, as in `deviation`) + effects."""
         pts = trajectory.positions
         actual = pts + self.deviation(pts, trajectory.directions(), tool_offset)
+        tools = None if tool_offset is None else _per_point(tool_offset, pts.shape)
         for effect in self.effects:
-            actual = actual + effect.apply(trajectory, machine=self)
+            actual = actual + effect.apply(trajectory, self, tools)
         return actual
 
     # ---------------------------------------------------------------- values

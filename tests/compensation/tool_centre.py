@@ -8,7 +8,7 @@ from __future__ import annotations
 import math
 import re
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -38,6 +38,7 @@ class Move:
     turn: int = 0  # +1 counter-clockwise, -1 clockwise
     comp: int = 0  # under cutter compensation, or the exit move after it: the number of its G41/G42 (from 1)
     axes: tuple[int, int, int] = (0, 1, 2)  # an arc's plane: its first, second and normal axis
+    tool: NDArray = field(default_factory=lambda: np.zeros(3))  # the tool length offset in effect, mm
 
     def samples(self, count: int = 16) -> NDArray:
         """(count,3) points along the move, ends included (an arc whose end radius differs from its
@@ -107,11 +108,11 @@ def feed_moves(
             end[list(axes)] = v[0], v[1], v[5]
             end = end * scale + offset
             centre = np.array(v[2:4]) * scale + offset[list(axes[:2])]
-            moves.append(Move(at, end, centre, int(v[4]), comp or leaving, axes))
+            moves.append(Move(at, end, centre, int(v[4]), comp or leaving, axes, tool))
         else:
             end = np.array(v[:3]) * scale + offset
             if name == "STRAIGHT_FEED" or name == "RIGID_TAP":
-                moves.append(Move(at, end, comp=comp or leaving))
+                moves.append(Move(at, end, comp=comp or leaving, tool=tool))
             if name == "RIGID_TAP":  # (the control returns to where the tap started)
                 end = at
         leaving = 0

@@ -155,6 +155,13 @@ POLY_OVERFLOW = "coefficients_um = [" + ", ".join(["1e-3"] * 400) + "]"
             21,
             "errors.EYY: range_mm must be two numbers [lo, hi] in mm, not [500.0]",
         ),
+        # (the unknown key's line, not that of a key as long named among those expected)
+        (
+            "range_mm = [0.0, 500.0]",
+            "range_mm = [0.0, 500.0]\nvalues_um_minus = [1.0]",
+            22,
+            "errors.EYY: unknown key(s) values_um_minus",
+        ),
         ("coefficients_um = [0.0, 0.01]", POLY_OVERFLOW, 19, "coefficients_um overflow between 0 and 500 mm"),
         (
             "positions = [0.0, 400.0, 800.0]",

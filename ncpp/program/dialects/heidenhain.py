@@ -535,6 +535,13 @@ class HeidenhainWriter(IsoWriter):
     def _word(self, letter: str, value: float, segment: Line | Arc) -> str:
         return letter + format_number(value, self._style(letter, segment))
 
+    def _increment(self, letter: str, n: int, segment: Line | Arc) -> float:
+        """The increment along axis `n` an `I` word (IX, IZ) writes: the difference of the end and the
+        start as written with its decimals, so that the control, adding them up, stands where the
+        absolute positions would put it (rounded one by one, a run of increments drifts by their sum)."""
+        places = self._style(letter, segment).decimals
+        return round(segment.end[n], places) - round(segment.start[n], places)
+
     def _cc_text(self, centre, plane: int) -> str:
         a, b, _ = PLANE_AXES[plane]
         first, second = sorted((a, b))
@@ -549,7 +556,7 @@ class HeidenhainWriter(IsoWriter):
 
     def _is_helix(self, segment: Arc) -> bool:
         n = PLANE_AXES[segment.context.plane][2]
-        return float(self._format(_AXES[n], segment.end[n] - segment.start[n], segment)) != 0.0
+        return self._increment("I" + _AXES[n], n, segment) != 0.0
 
     def _fresh(self, segment: Line | Arc) -> str:
         """A new block for a further piece of a changed block."""
@@ -575,7 +582,7 @@ class HeidenhainWriter(IsoWriter):
         a, b, n = PLANE_AXES[segment.context.plane]
         if self._is_helix(segment):
             sweep = format_number(segment.sweep() * 180 / 3.141592653589793, ANGLE_STYLE)
-            return f"CP IPA{sweep} {self._word('I' + _AXES[n], segment.end[n] - segment.start[n], segment)} {rotation}"
+            return f"CP IPA{sweep} {self._word('I' + _AXES[n], self._increment('I' + _AXES[n], n, segment), segment)} {rotation}"
         first, second = sorted((a, b))
         return f"C {self._word(_AXES[first], segment.end[first], segment)} {self._word(_AXES[second], segment.end[second], segment)} {rotation}"
 
@@ -612,7 +619,7 @@ class HeidenhainWriter(IsoWriter):
             ):
                 axis = _AXES.index(item.letter[-1])
                 incremental = item.letter.startswith("I")
-                value = segment.end[axis] - segment.start[axis] if incremental else segment.end[axis]
+                value = self._increment(item.letter, axis, segment) if incremental else segment.end[axis]
                 texts[n] = self._word(item.letter, value, segment)
                 written.add(axis)
                 anchor = item

@@ -632,12 +632,20 @@ class IsoWriter:
         return _bits_written(facts, segment, units.places, self.known_axes, last, places, named=False)
 
     @staticmethod
-    def _numbers(segment: Line | Arc) -> tuple[float, ...]:
-        """The numbers the segment writes, indexed as in `_WRITTEN`."""
+    def _numbers(segment: Line | Arc, places: tuple[int, int, int]) -> tuple[float, ...]:
+        """The numbers the segment writes, indexed as in `_WRITTEN`; `places`: the decimals of X, Y, Z.
+        An increment (G91) is the difference of its end and start as written with those places, so
+        that the control, adding them up, stands where the absolute positions would put it: rounded
+        one by one, a run of increments drifts by their roundings' sum."""
         context, end = segment.context, segment.end
         if not context.absolute:
             start = segment.start
-            end = (end[0] - start[0], end[1] - start[1], end[2] - start[2])
+            x, y, z = places
+            end = (
+                round(end[0], x) - round(start[0], x),
+                round(end[1], y) - round(start[1], y),
+                round(end[2], z) - round(start[2], z),
+            )
         if type(segment) is not Arc:
             return end
         centre, (a, b) = segment.center, _CENTRE_AXES[context.plane]
@@ -649,7 +657,7 @@ class IsoWriter:
     def _texts(self, block: Block, segment: Line | Arc) -> dict[str, str]:
         """The words to write for the segment, letter -> number as the output writes it."""
         units = self._units(segment.context.inch)
-        numbers = self._numbers(segment)
+        numbers = self._numbers(segment, units.places)
         styles = units.styles
         return {
             letter: format_number(numbers[n], styles[letter])
@@ -735,7 +743,9 @@ class IsoWriter:
             )
         # (`_numbers`, inlined for an absolute line)
         numbers = (
-            segment.end if type(segment) is Line and segment.context.absolute else self._numbers(segment)
+            segment.end
+            if type(segment) is Line and segment.context.absolute
+            else self._numbers(segment, units.places)
         )
         if type(edit) is str:
             return edit.format(*numbers)
@@ -824,7 +834,7 @@ class IsoWriter:
             code = (3 if segment.turn > 0 else 2) if type(segment) is Arc else 0 if segment.rapid else 1
             bits = _bits_written(facts, segment, places, known, last, last_places)
             motion = code if code != output_motion else None
-            values = segment.end if code < 2 and absolute else self._numbers(segment)
+            values = segment.end if code < 2 and absolute else self._numbers(segment, places)
             words = more[len(lines)] if more else None  # (a piece's own words: `_write_pieces`)
             if words:
                 texts = {
@@ -891,7 +901,7 @@ def _bits_written(facts: _Facts, segment: Line | Arc, places: tuple, known: set[
     elif absent:
         start = segment.start
         for n, _axis, bit in absent:
-            if round(end[n] - start[n], places[n]) != 0.0:
+            if round(end[n], places[n]) != round(start[n], places[n]):  # (the increment `_numbers` writes)
                 bits |= bit
     if type(segment) is Arc:
         bits |= _CENTRE_BITS[segment.context.plane]

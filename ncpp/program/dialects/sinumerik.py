@@ -415,7 +415,7 @@ class SinumerikWriter(IsoWriter):
                 template = templates[key] = sep.join(
                     fields + [letter + field for letter, field in units.fields(bits).items()]
                 )
-            text = template.format(*self._numbers(segment))
+            text = template.format(*self._numbers(segment, units.places))
         else:
             words = self._texts(block, segment)
             parts = [f"G{motion}"] if motion is not None else []
