@@ -13,6 +13,13 @@ reads the same codes otherwise (G5.1 is a spline there, G8 lathe radius mode):
   circular pocket milling clockwise / counterclockwise: the control spirals out from the point it
   stands on over I, K, Q with the D offset's cutter compensation (Haas VF-series manual 96-8000,
   "Circular Pocket Milling"), a path ncpp does not compute.
+* Fanuc: `G45`-`G48`, tool position offset: the axes the block names move their programmed
+  distance lengthened (G45), shortened (G46), lengthened twice (G47) or shortened twice (G48) by the
+  offset value its D (or H) selects (Mitsubishi M700V/M70V programming manual, M system, "Tool Position
+  Offset; G45 to G48"; NCT 2000M manual, "The Tool Compensation"; Mazak's and GSK's Fanuc-style EIA
+  controls read them too): a move by an offset value ncpp is not told.  It ends interpretation with a
+  warning from that block, where LinuxCNC refuses the code ("Unknown g code used").  (Haas's G47 is
+  engraving, G45-G46 and G48 are none of its codes: not read so there.)
 
 Both have additional work offsets: Fanuc's `G54.1 P1`-`P48` ("Additional workpiece coordinate
 systems", whose format is `G54.1 Pn` or `G54 Pn`: a G54 block with a P word selects the
@@ -108,7 +115,10 @@ HAAS_SETTINGS = {**FANUC_SETTINGS, 187.0: frozenset("PE"), 103.0: frozenset("P")
 RETURNS = frozenset((28.0, 30.0))
 # Codes of the flavour that need what ncpp is not told (a sequence number's block; Haas does not
 # write Fanuc's G54.1)
-FANUC_UNFOLLOWED: dict[tuple[str, float], str] = {}
+_POSITION_OFFSET = "tool position offset: the control lengthens or shortens the move by an offset value"
+FANUC_UNFOLLOWED = {("G", 45.0): f"G45 ({_POSITION_OFFSET})", ("G", 46.0): f"G46 ({_POSITION_OFFSET})",
+                    ("G", 47.0): f"G47 ({_POSITION_OFFSET} twice)",
+                    ("G", 48.0): f"G48 ({_POSITION_OFFSET} twice)"}  # fmt: skip
 HAAS_UNFOLLOWED = {("G", 54.1): "G54.1 (Fanuc's additional work offset; Haas selects its own with G154)",
                    ("M", 97.0): "M97 (a local subprogram at a sequence number)",
                    ("G", 12.0): "G12 (Haas circular pocket milling, a path the control computes)",
