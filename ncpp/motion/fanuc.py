@@ -43,6 +43,13 @@ operator's manual, "Preparatory function (G function)"; the page is not in ncpp'
 the rule is read from the posts that write the block).  LinuxCNC refuses the block ("Cannot use two
 g codes that both use axis values").
 
+An H word needs no G43 in its block either: Fanuc takes it on its own (Fanuc Series 0i-MB operator's
+manual, "G53, G28, and G30 commands in tool length offset mode": "independent specification of the H
+command"), as the tool length offset number a later G43 uses or, in G43 mode, in place of the offset in
+effect (Allen-Bradley 9/Series mill manual, "Modal G43, G44 and modal H-words": `H02` alone changes the
+offset in G43 mode, `H0` gives it no value).  ncpp follows neither: such a block (`G53 G00 H0 Z-110`)
+ends interpretation with a warning, where LinuxCNC refuses it ("H word with no G43 or G76 to use it").
+
 A D word needs no G41/G42 in its block: the control keeps it and a later G41/G42 without D uses it
 (`G43 H1 D1`, as Fanuc programs write with the tool length; Fanuc Series 15i-MA operator's manual,
 "Cutter compensation C": the compensation values are assigned to the D codes, D0 always means 0,
@@ -125,6 +132,11 @@ HAAS_UNFOLLOWED = {("G", 54.1): "G54.1 (Fanuc's additional work offset; Haas sel
                    ("G", 13.0): "G13 (Haas circular pocket milling, a path the control computes)"}  # fmt: skip
 
 
+# The G codes whose block takes an H: the tool length offsets, the tool position offsets (whose number
+# Mazak's and Mitsubishi's G45-G48 take in H or D) and the macro calls' arguments
+_H_CODES = frozenset((43.0, 43.2, 43.4, 43.5, 44.0, 45.0, 46.0, 47.0, 48.0, 65.0, 66.0))
+
+
 class FanucInterpreter(Interpreter):
     settings: dict[float, frozenset[str]] = FANUC_SETTINGS
     unfollowed: dict[tuple[str, float], str] = FANUC_UNFOLLOWED
@@ -141,9 +153,15 @@ class FanucInterpreter(Interpreter):
     repeats_in_p = True  # `M98 P51002`: O1002 five times (`Flow._m98`)
     still_r_arc = True  # `G02 R..` ending where it starts does not move (module docstring)
     r_over_ijk = True  # `G02 X.. Y.. R.. I.. J..`: R's arc, I J ignored (module docstring)
+    independent_h = True  # `G53 G00 H0 Z-110`: an H without G43, out of scope (module docstring)
 
     def block(self, block: Block) -> Event | tuple[Event, ...]:
         signature = block.signature
+        if self.independent_h and (signature is None or "H" in signature):
+            h = _independent_h(block)
+            if h is not None:
+                raise _OutOfScope("an H word without G43 (Fanuc's tool length offset number on its own)",
+                                  h.start + 1)  # fmt: skip
         if signature is not None and "G" not in signature and "M" not in signature:
             return super().block(block)  # axis words only (the most): no setting, nothing unfollowed
         words = [item for item in block.items if type(item) is Word]
@@ -248,10 +266,20 @@ class HaasInterpreter(FanucInterpreter):
     repeats_in_p = False
     still_r_arc = False  # (no Haas manual page in ncpp's reference set says a 0-degree R arc does not move)
     r_over_ijk = False  # (nor that R wins over I, J, K)
+    independent_h = False  # (nor that an H goes without G43)
 
 
 interpret = interpreting(FanucInterpreter)
 interpret_haas = interpreting(HaasInterpreter)
+
+
+def _independent_h(block: Block) -> Word | ExprWord | None:
+    """The block's H word where no G code of the block takes it (module docstring), else None."""
+    words = [item for item in block.items if type(item) is Word or type(item) is ExprWord]
+    h = next((w for w in words if w.letter == "H"), None)
+    if h is None or any(type(w) is Word and w.letter == "G" and w.value in _H_CODES for w in words):
+        return None
+    return h
 
 
 def _dwell_in_x(block: Block, words: list[Word]) -> bool:
