@@ -97,6 +97,8 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_an_r_arc_that_ends_where_it_starts_passes_through_and_rs274_judges_the_rest",
             "test_r_wins_over_i_j_k_in_a_fanuc_arc_block",
             "test_a_haas_circular_pocket_passes_through_and_the_moves_before_it_are_compensated",
+            "test_a_fanuc_tool_position_offset_passes_through_and_the_moves_before_it_are_compensated",
+            "test_a_fanuc_h_word_without_g43_passes_through_and_the_moves_before_it_are_compensated",
             "test_g80_leaves_the_motion_mode_the_cycle_interrupted",
         ),
         "writeback/test_loops_run_once.py": (

@@ -13,6 +13,13 @@ reads the same codes otherwise (G5.1 is a spline there, G8 lathe radius mode):
   circular pocket milling clockwise / counterclockwise: the control spirals out from the point it
   stands on over I, K, Q with the D offset's cutter compensation (Haas VF-series manual 96-8000,
   "Circular Pocket Milling"), a path ncpp does not compute.
+* Fanuc: `G45`-`G48`, tool position offset: the axes the block names move their programmed
+  distance lengthened (G45), shortened (G46), lengthened twice (G47) or shortened twice (G48) by the
+  offset value its D (or H) selects (Mitsubishi M700V/M70V programming manual, M system, "Tool Position
+  Offset; G45 to G48"; NCT 2000M manual, "The Tool Compensation"; Mazak's and GSK's Fanuc-style EIA
+  controls read them too): a move by an offset value ncpp is not told.  It ends interpretation with a
+  warning from that block, where LinuxCNC refuses the code ("Unknown g code used").  (Haas's G47 is
+  engraving, G45-G46 and G48 are none of its codes: not read so there.)
 
 Both have additional work offsets: Fanuc's `G54.1 P1`-`P48` ("Additional workpiece coordinate
 systems", whose format is `G54.1 Pn` or `G54 Pn`: a G54 block with a P word selects the
@@ -35,6 +42,13 @@ different groups in one block, and the group-00 return takes the axis words (Fan
 operator's manual, "Preparatory function (G function)"; the page is not in ncpp's reference set,
 the rule is read from the posts that write the block).  LinuxCNC refuses the block ("Cannot use two
 g codes that both use axis values").
+
+An H word needs no G43 in its block either: Fanuc takes it on its own (Fanuc Series 0i-MB operator's
+manual, "G53, G28, and G30 commands in tool length offset mode": "independent specification of the H
+command"), as the tool length offset number a later G43 uses or, in G43 mode, in place of the offset in
+effect (Allen-Bradley 9/Series mill manual, "Modal G43, G44 and modal H-words": `H02` alone changes the
+offset in G43 mode, `H0` gives it no value).  ncpp follows neither: such a block (`G53 G00 H0 Z-110`)
+ends interpretation with a warning, where LinuxCNC refuses it ("H word with no G43 or G76 to use it").
 
 A D word needs no G41/G42 in its block: the control keeps it and a later G41/G42 without D uses it
 (`G43 H1 D1`, as Fanuc programs write with the tool length; Fanuc Series 15i-MA operator's manual,
@@ -108,11 +122,19 @@ HAAS_SETTINGS = {**FANUC_SETTINGS, 187.0: frozenset("PE"), 103.0: frozenset("P")
 RETURNS = frozenset((28.0, 30.0))
 # Codes of the flavour that need what ncpp is not told (a sequence number's block; Haas does not
 # write Fanuc's G54.1)
-FANUC_UNFOLLOWED: dict[tuple[str, float], str] = {}
+_POSITION_OFFSET = "tool position offset: the control lengthens or shortens the move by an offset value"
+FANUC_UNFOLLOWED = {("G", 45.0): f"G45 ({_POSITION_OFFSET})", ("G", 46.0): f"G46 ({_POSITION_OFFSET})",
+                    ("G", 47.0): f"G47 ({_POSITION_OFFSET} twice)",
+                    ("G", 48.0): f"G48 ({_POSITION_OFFSET} twice)"}  # fmt: skip
 HAAS_UNFOLLOWED = {("G", 54.1): "G54.1 (Fanuc's additional work offset; Haas selects its own with G154)",
                    ("M", 97.0): "M97 (a local subprogram at a sequence number)",
                    ("G", 12.0): "G12 (Haas circular pocket milling, a path the control computes)",
                    ("G", 13.0): "G13 (Haas circular pocket milling, a path the control computes)"}  # fmt: skip
+
+
+# The G codes whose block takes an H: the tool length offsets, the tool position offsets (whose number
+# Mazak's and Mitsubishi's G45-G48 take in H or D) and the macro calls' arguments
+_H_CODES = frozenset((43.0, 43.2, 43.4, 43.5, 44.0, 45.0, 46.0, 47.0, 48.0, 65.0, 66.0))
 
 
 class FanucInterpreter(Interpreter):
@@ -131,9 +153,15 @@ class FanucInterpreter(Interpreter):
     repeats_in_p = True  # `M98 P51002`: O1002 five times (`Flow._m98`)
     still_r_arc = True  # `G02 R..` ending where it starts does not move (module docstring)
     r_over_ijk = True  # `G02 X.. Y.. R.. I.. J..`: R's arc, I J ignored (module docstring)
+    independent_h = True  # `G53 G00 H0 Z-110`: an H without G43, out of scope (module docstring)
 
     def block(self, block: Block) -> Event | tuple[Event, ...]:
         signature = block.signature
+        if self.independent_h and (signature is None or "H" in signature):
+            h = _independent_h(block)
+            if h is not None:
+                raise _OutOfScope("an H word without G43 (Fanuc's tool length offset number on its own)",
+                                  h.start + 1)  # fmt: skip
         if signature is not None and "G" not in signature and "M" not in signature:
             return super().block(block)  # axis words only (the most): no setting, nothing unfollowed
         words = [item for item in block.items if type(item) is Word]
@@ -238,10 +266,20 @@ class HaasInterpreter(FanucInterpreter):
     repeats_in_p = False
     still_r_arc = False  # (no Haas manual page in ncpp's reference set says a 0-degree R arc does not move)
     r_over_ijk = False  # (nor that R wins over I, J, K)
+    independent_h = False  # (nor that an H goes without G43)
 
 
 interpret = interpreting(FanucInterpreter)
 interpret_haas = interpreting(HaasInterpreter)
+
+
+def _independent_h(block: Block) -> Word | ExprWord | None:
+    """The block's H word where no G code of the block takes it (module docstring), else None."""
+    words = [item for item in block.items if type(item) is Word or type(item) is ExprWord]
+    h = next((w for w in words if w.letter == "H"), None)
+    if h is None or any(type(w) is Word and w.letter == "G" and w.value in _H_CODES for w in words):
+        return None
+    return h
 
 
 def _dwell_in_x(block: Block, words: list[Word]) -> bool:

@@ -62,7 +62,11 @@ def test_a_setting_with_motion_in_its_block_ends_interpretation():
      ("G10 L2 P0 X5", "G10 L2 P0 (it sets the external work offset", "fanuc"),
      ("G10 L2 P[#1] X5", "G10 L2 P0 (it sets the external work offset", "haas"),
      ("G13 Z-0.3 I0.1875 K0.2 Q0.1875 D02 F10.", "G13 (Haas circular pocket milling", "haas"),
-     ("G12 I1.5 F10. Z-1.2 D01", "G12 (Haas circular pocket milling", "haas")],
+     ("G12 I1.5 F10. Z-1.2 D01", "G12 (Haas circular pocket milling", "haas"),
+     ("G00 G45 H03 Z2.0", "G45 (tool position offset", "fanuc"), ("G46 X10. D15", "G46 (tool position", "fanuc"),
+     ("G91 G47 G01 X10. D1", "G47 (tool position offset", "fanuc"), ("G48 Z-2. D2", "G48 (tool position", "fanuc"),
+     ("N20 G53 G00 H0 Z -110 M05;", "an H word without G43 (Fanuc's", "fanuc"), ("H2", "an H word without G43", "fanuc"),
+     ("G49 H0", "an H word without G43", "fanuc"), ("G0 H#1 Z5", "an H word without G43", "fanuc")],
 )  # fmt: skip
 def test_what_fanuc_and_haas_programs_need_ncpp_is_not_told_ends_interpretation(block, reason, dialect):
     said = io.StringIO()
@@ -491,6 +495,64 @@ def test_a_haas_circular_pocket_passes_through_and_the_moves_before_it_are_compe
     after.write_text(head + "M30\n")
     check = subprocess.run([sys.executable, str(PATHCHECK), str(before), str(after), "--tol-mm", "0.02",
                             "--tool-table", str(tools)], capture_output=True, text=True)  # fmt: skip
+    assert check.returncode == 0, check.stdout + check.stderr
+
+
+# A Mazak EIA program's tool position offset (obirimelvin/machinist 2002.nc, "Machine Mazak v7.5": its line 14),
+# after moves of its own
+POSITION_OFFSET = (
+    "%\nO2002\nG00 G20 G17 G40 G49 G54 G80 G90\nG00 G90 X0.5 Y0.5 Z1.\nG01 X1.5 Y1.0 F20.\nG00 G45 H03 Z2.0\n"
+    "G00 Z.1\nG01 X0.5 F20.\nM30\n%\n"
+)
+
+
+def test_a_fanuc_tool_position_offset_passes_through_and_the_moves_before_it_are_compensated(tmp_path):
+    """G45-G48 lengthen or shorten the block's move by an offset value (Mitsubishi M700V/M70V programming
+    manual, "Tool Position Offset; G45 to G48"): ncpp leaves the rest of the program as it is, located,
+    where it refused the line with LinuxCNC's "Unknown g code used"; rs274 judges the moves before it."""
+    written, messages, program = compensated_by_cli(tmp_path, POSITION_OFFSET, "fanuc", "--no-guard")
+    assert f"{program}:6:5: warning: G45 (tool position offset" in messages
+    tail = "".join(POSITION_OFFSET.splitlines(keepends=True)[5:])
+    assert written.endswith(tail) and "compensated 3 moves" in messages
+    with pytest.raises(NcppError, match="p.nc:6:5: Unknown g code used"):
+        events(POSITION_OFFSET, "iso")
+    if not RS274.exists():
+        pytest.skip("rs274 not available")
+    before, after = tmp_path / "before.ngc", tmp_path / "after.ngc"
+    before.write_text(POSITION_OFFSET[: -len(tail)] + "M30\n")
+    after.write_text(written[: -len(tail)] + "M30\n")
+    check = subprocess.run([sys.executable, str(PATHCHECK), str(before), str(after), "--tol-mm", "0.02"],
+                           capture_output=True, text=True)  # fmt: skip
+    assert check.returncode == 0, check.stdout + check.stderr
+
+
+# A Fanuc course program's retract to the machine's Z zero with H0 and no G43 (rodolforavellli23/Projects
+# GCode/new_college_project.nc, its line 7), after moves of the program's own
+INDEPENDENT_H = (
+    "%\nO0001\nN10 G17 G21 G90 G94;\nN12 G00 G54 X10 Y10 Z20;\nN14 G01 X40 Y25 F500;\n"
+    "N20 G53 G00 H0 Z -110 M05; (This is the Z 0 position for the machine targeted by this program)\n"
+    "N30 T13;\nN40 M06;\nM30;\n%\n"
+)
+
+
+def test_a_fanuc_h_word_without_g43_passes_through_and_the_moves_before_it_are_compensated(tmp_path):
+    """Fanuc takes an H on its own (0i-MB operator's manual: "independent specification of the H command"):
+    ncpp leaves the rest of the program as it is, located, where it refused the line with LinuxCNC's "H word
+    with no G43 or G76 to use it" (as it still does for LinuxCNC and Haas); rs274 judges the moves before."""
+    written, messages, program = compensated_by_cli(tmp_path, INDEPENDENT_H, "fanuc", "--no-guard")
+    assert f"{program}:6:13: warning: an H word without G43" in messages
+    tail = "".join(INDEPENDENT_H.splitlines(keepends=True)[5:])
+    assert written.endswith(tail) and "compensated 2 moves" in messages
+    for dialect in ("iso", "haas"):
+        with pytest.raises(NcppError, match="p.nc:6:13: H word with no G43 or G76 to use it"):
+            events(INDEPENDENT_H, dialect)
+    if not RS274.exists():
+        pytest.skip("rs274 not available")
+    before, after = tmp_path / "before.ngc", tmp_path / "after.ngc"
+    before.write_text(INDEPENDENT_H[: -len(tail)] + "M30\n")
+    after.write_text(written[: -len(tail)] + "M30\n")
+    check = subprocess.run([sys.executable, str(PATHCHECK), str(before), str(after), "--tol-mm", "0.02"],
+                           capture_output=True, text=True)  # fmt: skip
     assert check.returncode == 0, check.stdout + check.stderr
 
 
