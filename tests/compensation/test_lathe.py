@@ -12,7 +12,7 @@ import pytest
 
 from ncpp.errors import NcppError, Warnings
 from ncpp.lathe import HEAD, lathe_construct
-from ncpp.pipeline import ErrorSource, process
+from ncpp.pipeline import ErrorSource, dialect_tools, process
 from ncpp.program.dialects import parse_program
 from tests.conftest import CORPUS, NOT_PROGRAMS, SHARED
 
@@ -104,6 +104,18 @@ def test_grbl_refuses_a_lathe_code_as_no_grbl_command():
     refused = r'G7 is not a grbl 1\.1 command \(grbl stops at it with error 20, "Unsupported or invalid g-code'
     with pytest.raises(NcppError, match=refused):
         compensate(program, dialect)
+
+
+@pytest.mark.parametrize("dialect", ["fanuc", "haas", "iso"])
+def test_motion_names_a_lathes_g50_s_a_spindle_limit_not_scaling(dialect):
+    """`ncpp motion` (no machine file) stops following the program at a lathe's G50 S and says what it is."""
+    interpret, _ = dialect_tools(dialect)
+    said = io.StringIO()
+    _, blocks = parse_program(io.BytesIO(b"G0 X1\nG50 S1600\nG0 X2\n"), "p.nc", dialect)
+    list(interpret(blocks, file="p.nc", warnings=Warnings(stream=said)))
+    assert "p.nc:2:1: warning: G50 with S, a lathe's spindle speed limit (a lathe program: ncpp reads milling" in (
+        said.getvalue()
+    ) and "scaling" not in said.getvalue()
 
 
 def test_without_a_machine_file_a_lathe_program_passes_through_byte_for_byte():
