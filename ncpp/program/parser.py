@@ -488,6 +488,9 @@ class LineParser:
             line += max(getattr(err, "line", 1) or 1, 1) - 1
             if raw.startswith(_BOM):
                 raise NcppError(BOM_MESSAGE, Location(file, line, 1)) from None
+            atan = _lone_atan(raw, _error_pos(err)) if self.grammar == "iso" else None
+            if atan is not None:
+                raise NcppError(ATAN_FORM, Location(file, line, atan + 1)) from None
             raise NcppError(_describe(err, raw), Location(file, line, col)) from None
         except RecursionError:  # the builder walks the tree recursively: brackets hundreds deep
             raise NcppError("expression nested too deeply", Location(file, line, 1)) from None
@@ -803,10 +806,37 @@ def _flatten(items: Iterable) -> Iterator[AnyItem]:
             yield item
 
 
-def _describe(err: lark.exceptions.UnexpectedInput, raw: str) -> str:
+# The arc tangent's one form in Fanuc macro B ("#i=ATAN[#j]/[#k]", Fanuc operator's manual, "Custom
+# macro", arithmetic and logic operations), Haas's macros (ATAN[#j]/[#k]) and LinuxCNC's ("ATAN[Y]/[X]",
+# G-code overview, "Functions"; rs274 stops at an ATAN without it: "Slash missing after first atan
+# argument"); none of the manuals gives ATAN one argument
+ATAN_FORM = (
+    "ATAN without `/[x]` after its bracket: ncpp reads the arc tangent in the two-argument form ATAN[y]/[x] "
+    "of Fanuc macro B, Haas and LinuxCNC, and no other (a one-argument ATAN is in none of their manuals)"
+)
+_ATAN = re.compile(r"(?i)atan[ \t]*\[")
+
+
+def _lone_atan(raw: str, pos: int) -> int | None:
+    """Where the ATAN starts whose bracket no `/` follows, at or before the parse error's `pos`."""
+    for found in _ATAN.finditer(raw, 0, pos + 1):
+        depth, end = 0, found.end() - 1
+        for end in range(found.end() - 1, len(raw)):
+            depth += {"[": 1, "]": -1}.get(raw[end], 0)
+            if depth == 0:
+                break
+        if depth == 0 and not raw[end + 1 :].lstrip(" \t").startswith("/"):
+            return found.start()
+    return None
+
+
+def _error_pos(err: lark.exceptions.UnexpectedInput) -> int:
     pos = getattr(err, "pos_in_stream", None)
-    if pos is None:
-        pos = (getattr(err, "column", 1) or 1) - 1
+    return pos if pos is not None else (getattr(err, "column", 1) or 1) - 1
+
+
+def _describe(err: lark.exceptions.UnexpectedInput, raw: str) -> str:
+    pos = _error_pos(err)
     rest = raw[pos:].strip()
     if isinstance(err, lark.exceptions.UnexpectedEOF) or not rest:
         return "unexpected end of block"

@@ -101,7 +101,7 @@ def test_a_construct_past_the_head_is_refused_too():
 def test_grbl_refuses_a_lathe_code_as_no_grbl_command():
     """grbl 1.1 has no G7 ("List of Supported G-Codes in Grbl v1.1"): it stops at it with error 20."""
     dialect, program, _ = LATHE["grbl G7"]
-    refused = r'G7 is not a grbl 1\.1 command \(grbl stops at it with error 20, "Unsupported or invalid g-code'
+    refused = r'G7 is not a grbl 1\.1 command \(grbl stops at it with error 20, "Unsupported or invalid'
     with pytest.raises(NcppError, match=refused):
         compensate(program, dialect)
 
@@ -113,9 +113,9 @@ def test_motion_names_a_lathes_g50_s_a_spindle_limit_not_scaling(dialect):
     said = io.StringIO()
     _, blocks = parse_program(io.BytesIO(b"G0 X1\nG50 S1600\nG0 X2\n"), "p.nc", dialect)
     list(interpret(blocks, file="p.nc", warnings=Warnings(stream=said)))
-    assert "p.nc:2:1: warning: G50 with S, a lathe's spindle speed limit (a lathe program: ncpp reads milling" in (
-        said.getvalue()
-    ) and "scaling" not in said.getvalue()
+    warned = said.getvalue()
+    assert "p.nc:2:1: warning: G50 with S, a lathe's spindle speed limit (a lathe program" in warned
+    assert "scaling" not in warned
 
 
 def test_without_a_machine_file_a_lathe_program_passes_through_byte_for_byte():

@@ -60,6 +60,7 @@ def test_a_semicolon_is_a_comment_to_the_end_of_the_line_in_linuxcnc():
 def test_compensating_refuses_the_line_with_nothing_written():
     out = io.BytesIO()
     with pytest.raises(NcppError, match="words follow `;`") as caught:
-        process(io.BytesIO(PROGRAM.encode()), out, file="p.nc", source=ErrorSource.from_machine_file(str(WIDE)),
-                dialect="haas", warnings=Warnings(stream=io.StringIO()))  # fmt: skip
+        source = ErrorSource.from_machine_file(str(WIDE))
+        process(io.BytesIO(PROGRAM.encode()), out, file="p.nc", source=source, dialect="haas",
+                warnings=Warnings(stream=io.StringIO()))  # fmt: skip
     assert caught.value.where.line == 9 and out.getvalue() == b""
