@@ -152,6 +152,8 @@ def _drilling(codes: list[Word]) -> bool:
 
 def _heidenhain(block: Block) -> Construct | None:
     """The Klartext block's turning construct: `FUNCTION MODE TURN` or a turning cycle's `CYCL DEF`."""
+    if block.signature is not None:  # (words and comments only)
+        return None
     for item in block.items:
         if type(item) is not Statement:
             continue
@@ -165,6 +167,8 @@ def _heidenhain(block: Block) -> Construct | None:
 
 def _sinumerik(block: Block) -> Construct | None:
     """The Sinumerik block's turning construct: diameter programming or a turning cycle's call."""
+    if block.signature is not None:  # (words and comments only)
+        return None
     for item in block.items:
         if type(item) is not Statement or item.kind != "call":
             continue
