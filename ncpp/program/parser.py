@@ -289,7 +289,7 @@ def _words_after_eob(block: Block, dialect: Dialect, file: str) -> Block:
             continue
         col = item.start + 2 + word.start(1)
         error = NcppError(
-            f"words follow `;` on the line (`{item.text[word.start(1):].split()[0]}`): a "
+            f"words follow `;` on the line (`{item.text[word.start(1) :].split()[0]}`): a "
             f"{dialect.name.capitalize()} control shows its end of block as `;` and may read them as a "
             "block of their own, where ncpp would read `;` as a comment and skip them; put them on a "
             "line of their own, or in parentheses if they are a comment",

@@ -22,12 +22,15 @@ def events(program: str, dialect: str) -> list:
 
 @pytest.mark.parametrize("dialect", ["fanuc", "haas", "iso"])
 @pytest.mark.parametrize(
-    "line, col", [("#2=ATAN[#1]", 4), ("#2=[ATAN [#1]]", 5), ("#3=ATAN[#1]/[2.]+ATAN[3.]", 18), ("#3=ATAN[1,2]", 4)]
+    "line, col",
+    [("#2=ATAN[#1]", 4), ("#2=[ATAN [#1]]", 5), ("#3=ATAN[#1]/[2.]+ATAN[3.]", 18), ("#3=ATAN[1,2]", 4)],
 )
 def test_an_atan_without_its_second_argument_is_refused_at_the_atan(dialect, line, col):
     with pytest.raises(NcppError) as caught:
         events(f"#1=1.\n{line}\nG0 X1.\nM30\n", dialect)
-    assert caught.value.message.startswith("ATAN without `/[x]` after its bracket: ncpp reads the arc tangent")
+    assert caught.value.message.startswith(
+        "ATAN without `/[x]` after its bracket: ncpp reads the arc tangent"
+    )
     assert str(caught.value.where) == f"p.nc:2:{col}"
 
 
