@@ -159,7 +159,7 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
         ),
         "writeback/test_last_line_unended.py": ("test_the_lines_written_for_an_unended_last_line_each_end",),
         "cldata/test_cldata.py": ("test_corpus_file_reads_and_moves_where_the_gotos_say",),
-        "compensation/test_lathe.py": ("test_no_iso_program_of_the_corpus_is_taken_for_a_lathe_program",),
+        "compensation/test_lathe.py": ("test_no_program_of_the_corpus_is_taken_for_a_lathe_program",),
         "identify/test_thesis_sample.py": ("test_make_reproduces_the_committed_comparison",),
         "diagnose/test_diagnose.py": ("test_one_hidden_effect_is_named_sized_and_closes_the_gap",),
         "shop/test_plots.py": (

@@ -42,6 +42,7 @@ from collections.abc import Callable, Iterable, Iterator
 from typing import NoReturn, cast
 
 from ncpp.errors import Location, NcppError, Warnings, resolve_warnings
+from ncpp.lathe import SPINDLE_LIMIT
 from ncpp.motion import modal
 from ncpp.motion.corners import CornerError, round_corner
 from ncpp.motion.cutter import ToolCentre
@@ -1275,6 +1276,8 @@ class Interpreter:
 
     def _check_scope(self, words: dict, gcodes: dict) -> None:
         for value, item in gcodes.values():
+            if value == 50.0 and "S" in words:  # (a lathe's spindle limit, not a mill's scaling cancel)
+                raise _OutOfScope(SPINDLE_LIMIT, item.start + 1)
             reason = OUT_OF_SCOPE_G.get(value)
             if (
                 reason is not None

@@ -227,6 +227,7 @@ class Dialect:
     max_line_source: str = "rs274ngc (LinuxCNC) holds a line in LINELEN, 256 characters"
     leader: bool = False  # lines before a first `%` line are a tape leader, not read (`_leader`)
     programs_after_end: bool = False  # the lines after the closing `%` are parsed (`_after_end`)
+    eob_semicolon: bool = False  # `;` is the end of block as the control shows it (`_words_after_eob`)
 
 
 def dialect_syntax(dialect: str | Dialect) -> Dialect:
@@ -264,6 +265,40 @@ def _refuse_cr_line_ends(raw: str, line: int, file: str) -> None:
             "the program's lines end in a carriage return (CR) alone: convert them to LF or CR LF",
             Location(file, line, bare.start() + 1),
         )
+
+
+# A word's start (a letter, then a number, a parameter or a bracket) after a `;`, past blanks and
+# parenthesised comments
+_WORD_AFTER_EOB = re.compile(r"(?:[ \t]|\([^)]*\))*([A-Za-z][ \t]*[-+]?[ \t]*[0-9.#\[])")
+
+
+def _words_after_eob(block: Block, dialect: Dialect, file: str) -> Block:
+    """The block, unless words follow a `;` on its line.  Fanuc's manuals write the end of block
+    as `;` (operator's manuals: "the end of block code is indicated by ; (semicolon)", the actual
+    code being LF in ISO code, CR in EIA), the control's screen shows it so, Haas's editor too, and
+    hand-written programs carry it (`G43; H01 (USE TOOL OFFSET #1)`).  Where a control reads a `;`
+    in a file as the end of a block, the words after it are a block of their own; where as a
+    comment (LinuxCNC's rule, the ISO grammar's), they are skipped.  No manual says which, so
+    such a line is refused where it runs, not read either way; a `;` with only blanks or a `(...)`
+    comment after it ends the block in both readings."""
+    for item in block.items:
+        if type(item) is not Comment or item.style != ";":
+            continue
+        word = _WORD_AFTER_EOB.match(item.text)
+        if word is None:
+            continue
+        col = item.start + 2 + word.start(1)
+        error = NcppError(
+            f"words follow `;` on the line (`{item.text[word.start(1) :].split()[0]}`): a "
+            f"{dialect.name.capitalize()} control shows its end of block as `;` and may read them as a "
+            "block of their own, where ncpp would read `;` as a comment and skip them; put them on a "
+            "line of their own, or in parentheses if they are a comment",
+            Location(file, *block.place(col)),
+        )
+        if not dialect.read_where_run:
+            raise error
+        return Block(block.raw, block.eol, (Statement(UNREADABLE, (error,), 0, len(block.raw)),), block.line)
+    return block
 
 
 def _refuse_long(raw: str, dialect: Dialect, line: int, file: str) -> None:
@@ -331,6 +366,8 @@ class LineParser:
             _refuse_cr_line_ends(raw, line, file)
         if plain is None and raw.count("[") + raw.count("(") > MAX_NESTING:  # (else it cannot nest deeper)
             _refuse_deep(block, file)
+        if self.dialect.eob_semicolon and ";" in raw:
+            block = _words_after_eob(block, self.dialect, file)
         return block
 
     def _scan_plain(self, raw: str) -> tuple | None:
@@ -451,6 +488,9 @@ class LineParser:
             line += max(getattr(err, "line", 1) or 1, 1) - 1
             if raw.startswith(_BOM):
                 raise NcppError(BOM_MESSAGE, Location(file, line, 1)) from None
+            atan = _lone_atan(raw, _error_pos(err)) if self.grammar == "iso" else None
+            if atan is not None:
+                raise NcppError(ATAN_FORM, Location(file, line, atan + 1)) from None
             raise NcppError(_describe(err, raw), Location(file, line, col)) from None
         except RecursionError:  # the builder walks the tree recursively: brackets hundreds deep
             raise NcppError("expression nested too deeply", Location(file, line, 1)) from None
@@ -766,10 +806,37 @@ def _flatten(items: Iterable) -> Iterator[AnyItem]:
             yield item
 
 
-def _describe(err: lark.exceptions.UnexpectedInput, raw: str) -> str:
+# The arc tangent's one form in Fanuc macro B ("#i=ATAN[#j]/[#k]", Fanuc operator's manual, "Custom
+# macro", arithmetic and logic operations), Haas's macros (ATAN[#j]/[#k]) and LinuxCNC's ("ATAN[Y]/[X]",
+# G-code overview, "Functions"; rs274 stops at an ATAN without it: "Slash missing after first atan
+# argument"); none of the manuals gives ATAN one argument
+ATAN_FORM = (
+    "ATAN without `/[x]` after its bracket: ncpp reads the arc tangent in the two-argument form ATAN[y]/[x] "
+    "of Fanuc macro B, Haas and LinuxCNC, and no other (a one-argument ATAN is in none of their manuals)"
+)
+_ATAN = re.compile(r"(?i)atan[ \t]*\[")
+
+
+def _lone_atan(raw: str, pos: int) -> int | None:
+    """Where the ATAN starts whose bracket no `/` follows, at or before the parse error's `pos`."""
+    for found in _ATAN.finditer(raw, 0, pos + 1):
+        depth, end = 0, found.end() - 1
+        for end in range(found.end() - 1, len(raw)):
+            depth += {"[": 1, "]": -1}.get(raw[end], 0)
+            if depth == 0:
+                break
+        if depth == 0 and not raw[end + 1 :].lstrip(" \t").startswith("/"):
+            return found.start()
+    return None
+
+
+def _error_pos(err: lark.exceptions.UnexpectedInput) -> int:
     pos = getattr(err, "pos_in_stream", None)
-    if pos is None:
-        pos = (getattr(err, "column", 1) or 1) - 1
+    return pos if pos is not None else (getattr(err, "column", 1) or 1) - 1
+
+
+def _describe(err: lark.exceptions.UnexpectedInput, raw: str) -> str:
+    pos = _error_pos(err)
     rest = raw[pos:].strip()
     if isinstance(err, lark.exceptions.UnexpectedEOF) or not rest:
         return "unexpected end of block"

@@ -1,6 +1,6 @@
-"""A lathe program of the ISO family is refused when ncpp is to compensate it (`ncpp/lathe.py`): its
-X is a diameter, and the machine file is a machining centre's.  Each program below has mill-like
-moves before its lathe construct, which were compensated as a mill's before the rule; now the run
+"""A lathe program is refused when ncpp is to compensate it (`ncpp/lathe.py`): its X is a diameter,
+and the machine file is a machining centre's.  Each program below has mill-like moves before its
+lathe (or turning) construct, which were compensated as a mill's before the rule; now the run
 stops at the construct with nothing written.  The constructs mills write too are not taken for a
 lathe's, and no program of the corpus is."""
 
@@ -12,7 +12,7 @@ import pytest
 
 from ncpp.errors import NcppError, Warnings
 from ncpp.lathe import HEAD, lathe_construct
-from ncpp.pipeline import ErrorSource, process
+from ncpp.pipeline import ErrorSource, dialect_tools, process
 from ncpp.program.dialects import parse_program
 from tests.conftest import CORPUS, NOT_PROGRAMS, SHARED
 
@@ -23,6 +23,10 @@ pytestmark = pytest.mark.skipif(not WIDE.exists(), reason="no shared machine fil
 # Moves a mill program could start with, compensated before the construct is met
 START = "G21 G90 G54\nG0 X10. Z5.\nG1 Z0.5 F100.\nX20.\n"
 FANUC_HEAD = "%\nO1003\n"
+# The same moves in Klartext (up to block 6) and Sinumerik
+KLARTEXT_HEAD = ("0 BEGIN PGM T MM\n1 TOOL CALL 1 Z S3000\n2 L X+10 Y+5 Z+5 R0 FMAX\n3 L Z+0.5 F100\n"
+                 "4 L X+20\n5 L Z+1 FMAX\n6 L X+30\n")  # fmt: skip
+SINUMERIK_HEAD = "G90 G54 G17\nG0 X10 Y5 Z5\nG1 Z0.5 F100\nX20\n"
 
 # (dialect, program, the construct's line and column): a Fanuc lathe's two-block G71 (CNCLearn
 # 1003.NC's form), Haas's one-block G71 with D (CadeKiely O58214's), G70 and G72, the spindle speed
@@ -45,6 +49,16 @@ LATHE = {
     "iso G70 Q": ("iso", START + "o100 sub\nG1 X3 Z-1\no100 endsub\nG18\nG70 Q100 X15 Z3 P2\nM2\n", (9, 1)),
     "iso G72.1 Q": ("iso", START + "o100 sub\nG1 X3 Z-1\no100 endsub\nG18\nG72.1 Q100 X15 Z3 D0.5\nM2\n",
                     (9, 1)),
+    "heidenhain FUNCTION MODE TURN": ("heidenhain", KLARTEXT_HEAD + "7 FUNCTION MODE TURN\n"
+                                      "8 L X+40 Z+2 FMAX\n9 END PGM T MM\n", (8, 3)),
+    "heidenhain CYCL DEF 812": ("heidenhain", KLARTEXT_HEAD + "7 CYCL DEF 812 SHOULDER LONG. EXTENDED ~\n"
+                                "  Q215=+0 ;MACHINING OPERATION\n8 END PGM T MM\n", (8, 3)),
+    "sinumerik DIAMON": ("sinumerik", SINUMERIK_HEAD + "G18 DIAMON\nG0 X40 Z2\nM30\n", (5, 5)),
+    "sinumerik DIAM90": ("sinumerik", SINUMERIK_HEAD + "N50 DIAM90\nM30\n", (5, 5)),
+    "sinumerik CYCLE95": ("sinumerik", SINUMERIK_HEAD + 'CYCLE95("KONTUR",2,0.1,0.1,,0.2,0.1,0.1,9,,,1)\n'
+                          "M30\n", (5, 1)),
+    "sinumerik CYCLE952": ("sinumerik", SINUMERIK_HEAD + 'G18 CYCLE952("CONT",,"",2101311,0.3,0.2,0,2)\n'
+                           "M30\n", (5, 5)),
 }  # fmt: skip
 
 
@@ -63,9 +77,9 @@ def test_a_lathe_construct_refuses_the_program_at_its_place_with_nothing_written
         process(io.BytesIO(program.encode()), out, file="p.nc", source=ErrorSource.from_machine_file(str(WIDE)),
                 dialect=dialect, warnings=Warnings(stream=io.StringIO()))  # fmt: skip
     assert str(caught.value.where) == f"p.nc:{line}:{col}"
-    assert (
-        "a lathe program" in caught.value.message and "compensates milling programs" in caught.value.message
-    )
+    message = caught.value.message
+    assert "a lathe program" in message or "a turning program" in message
+    assert "compensates milling programs" in message
     assert out.getvalue() == b""
 
 
@@ -82,6 +96,26 @@ def test_a_construct_past_the_head_is_refused_too():
     with pytest.raises(NcppError) as caught:
         compensate(START + moves + "G7\nM2\n", "iso")
     assert caught.value.where.line == 4 + HEAD + 1
+
+
+def test_grbl_refuses_a_lathe_code_as_no_grbl_command():
+    """grbl 1.1 has no G7 ("List of Supported G-Codes in Grbl v1.1"): it stops at it with error 20."""
+    dialect, program, _ = LATHE["grbl G7"]
+    refused = r'G7 is not a grbl 1\.1 command \(grbl stops at it with error 20, "Unsupported or invalid'
+    with pytest.raises(NcppError, match=refused):
+        compensate(program, dialect)
+
+
+@pytest.mark.parametrize("dialect", ["fanuc", "haas", "iso"])
+def test_motion_names_a_lathes_g50_s_a_spindle_limit_not_scaling(dialect):
+    """`ncpp motion` (no machine file) stops following the program at a lathe's G50 S and says what it is."""
+    interpret, _ = dialect_tools(dialect)
+    said = io.StringIO()
+    _, blocks = parse_program(io.BytesIO(b"G0 X1\nG50 S1600\nG0 X2\n"), "p.nc", dialect)
+    list(interpret(blocks, file="p.nc", warnings=Warnings(stream=said)))
+    warned = said.getvalue()
+    assert "p.nc:2:1: warning: G50 with S, a lathe's spindle speed limit (a lathe program" in warned
+    assert "scaling" not in warned
 
 
 def test_without_a_machine_file_a_lathe_program_passes_through_byte_for_byte():
@@ -110,6 +144,17 @@ MILL = [
     ("iso", "G76 P0.05 Z-1 I-.075 J0.008 K0.045 Q29.5"),  # LinuxCNC's threading: on mills too
     ("fanuc", "G7.1 C57299"),  # cylindrical interpolation
     ("fanuc", "G07 X1."),  # Fanuc's hypothetical axis interpolation, not a diameter mode
+    ("fanuc", "G92 S3000"),  # a Fanuc machining centre's maximum speed clamp (lathe systems B/C's too)
+    ("fanuc", "G92 X0. Y0. Z0."),
+    ("iso", "G17 G8 G21 G40 G49 G64 P0.001 G80 G90 G91.1 G92.2 G94 G97 G98"),  # a mill's reset, radius mode
+    ("heidenhain", "1 FUNCTION MODE MILL"),
+    ("heidenhain", "1 CYCL DEF 200 DRILLING"),
+    ("heidenhain", "1 CYCL DEF 7.0 DATUM SHIFT"),
+    ("sinumerik", "DIAMOF"),
+    ("sinumerik", "G96 S200 LIMS=3000"),
+    ("sinumerik", 'CYCLE800(1,"TC1",0,57,0,0,0,0,0,0,0,0,0,-1,100,1)'),  # swivel: the prefix only
+    ("sinumerik", "CYCLE832(0.01,1,1)"),
+    ("sinumerik", "CYCLE81(10,0,1,-5,)"),
 ]
 
 
@@ -125,18 +170,20 @@ def _corpus_programs() -> list:
         return []
     rows = [row.split("\t") for row in manifest.read_text().splitlines()[1:]]
     return sorted(
-        row[0] for row in rows if row[10] == "iso_gcode" and not any(n in row[0] for n in NOT_PROGRAMS)
+        row[0]
+        for row in rows
+        if row[10] in ("iso_gcode", "heidenhain", "sinumerik") and not any(n in row[0] for n in NOT_PROGRAMS)
     )
 
 
 @pytest.mark.skipif(not _corpus_programs(), reason="no corpus")
-def test_no_iso_program_of_the_corpus_is_taken_for_a_lathe_program():
-    """Its programs, as detected and as Fanuc's and Haas's: mill programs, and LinuxCNC lathe
-    programs in radius mode without lathe cycles (`g76.ngc`, `lathe_pawn.ngc`), which the rule
-    cannot tell from a mill program in G18."""
+def test_no_program_of_the_corpus_is_taken_for_a_lathe_program():
+    """Its ISO programs as detected and as Fanuc's, Haas's and grbl's, its Klartext and Sinumerik
+    programs as detected: mill programs, and LinuxCNC lathe programs in radius mode without lathe
+    cycles (`g76.ngc`, `lathe_pawn.ngc`), which the rule cannot tell from a mill program in G18."""
     flagged = []
     for name in _corpus_programs():
-        for dialect in (None, "fanuc", "haas"):
+        for dialect in (None, "fanuc", "haas", "grbl") if name.startswith("iso_gcode/") else (None,):
             with open(CORPUS / name, "rb") as stream:
                 read, blocks = parse_program(stream, name, dialect)
                 found = next((b.line for b in blocks if lathe_construct(b, read) is not None), None)

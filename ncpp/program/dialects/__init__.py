@@ -95,11 +95,11 @@ ISO = Dialect("iso", "iso", _ItemBuilder, fast_terminals=LineParser.FAST_TERMINA
 GRBL = Dialect("grbl", "iso", _ItemBuilder, fast_terminals=LineParser.FAST_TERMINALS, read_where_run=True)
 FANUC = Dialect(
     "fanuc", "iso", _ItemBuilder, fast_terminals=LineParser.FAST_TERMINALS, read_where_run=True, leader=True,
-    programs_after_end=True,
+    programs_after_end=True, eob_semicolon=True,
 )  # fmt: skip
 HAAS = Dialect(
     "haas", "iso", _ItemBuilder, fast_terminals=LineParser.FAST_TERMINALS, read_where_run=True, leader=True,
-    programs_after_end=True,
+    programs_after_end=True, eob_semicolon=True,
 )  # fmt: skip
 # File name endings that name a dialect when the content does not tell.
 SUFFIXES = {".h": "heidenhain", ".mpf": "sinumerik", ".spf": "sinumerik"}
