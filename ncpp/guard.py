@@ -48,8 +48,18 @@ conversion to the active coordinate system.  HEIDENHAIN's TNC7 User's Manual (81
 transformation in the basic coordinate system B-CS; the TNC7 basic manual (81762x-19, "System
 data") that FN 18 returns system data in mm whatever the program's unit; 81762x-17's list of FN
 functions that an FN 14 with the NC CANCEL reaction aborts the program with an error message
-unless ID13 NR2 names a label it jumps to instead.  The rows of the active preset are not cited
-here from them, nor from the TNC 640's or TNC 620's user's manuals.
+unless ID13 NR2 names a label it jumps to instead; the TNC 640 DIN/ISO User's Manual (34059x-05,
+1/2015, 19.3 "Technical information") that FN 14's error number is 0 to 1199.  The group that
+reads the active preset is not cited here from them, nor from the FN 18 tables of the TNC 640
+Conversational User's Manual (10/2017, 10 "Programming Q parameters") or the TNC 620 Klartext
+User's Manual (01/2022, 15 "Tables and overviews | System data"), whose pages found list tool data
+and coordinate transformations (ID210) only.  The older technical manuals do not stand in for
+it: the TNC 426/430's ID220 ("Current datum shift" NR2, "Difference between reference point and
+datum point" NR3, IDX 1-9 the axes) predates the preset table, and its ID500/ID501 read the
+datum table.  Nor do the Klartext programs at hand show it: those that use FN 18 read the tool
+in the spindle and its table length (ID20 NR1, ID50 NR1 IDX, on a TNC 640), the datum shift and
+the position (ID220 NR2, ID270 NR1, on a TNC 620), the traverse range (ID230) or the REF position
+(ID240), never the active preset.
 
 The tool guard: compensation also depends on the tool lengths ncpp was told (`--tool-table`):
 the length moves the Z positions where the errors are evaluated and lengthens the Abbe arm.
@@ -70,9 +80,16 @@ the check; the next does not.
   raises macro alarm 5 (`#3000`) when #2000+n plus #2200+n is not the told length within
   `GUARD_MM`, in the control's units, as the table.  A G43 without H, or with another H, gets
   none (ncpp is not told which tool's length that register holds).
-* Fanuc: no check.  Its tool offset variables depend on the offset memory type the machine
-  builder sets (A: one value per offset at #10001 on or #2001 on; B and C: geometry and wear
-  apart, #11001 and #10001 on, C with the D offsets apart again), which a program cannot tell.
+* Fanuc: no check.  Where a Fanuc control keeps a tool's length depends on its tool
+  compensation memory, which the machine builder chooses: with memory C "Memory for geometry
+  compensation and wear compensation is separate", and "Separate memories are prepared for
+  cutter compensation (for D code) and for tool length compensation (for H code)" (Series 0i/0i
+  Mate Model B Connection Manual (Function), B-63833EN-1/02, 10 "Tool functions", "Tool
+  compensation memory C"), while memory A keeps one value per offset.  The system variables of
+  each memory's H offsets (geometry, wear) are not cited here from a Fanuc operator's manual, nor
+  is a variable of the tool in the spindle: Fanuc has no standard one, and #4120, the T code of
+  the modal information, is the last T commanded (cited only from Mitsubishi's Fanuc-style M700V
+  manual, 13.5 "User Macro Specifications"), not the tool an M6 put in the spindle.
 * Sinumerik (Basic Functions Function Manual, 09/2011, 6FC5397-0BP40-2BA0, W1 "Tool offset",
   18.2 "Tool": "The compensation values $TC_DP1 to $TC_DP25 of the active tool compensation can be
   read with system variable $P_AD[n]"; Job Planning, 03/2006, 6FC5398-2BP10-1BA0, 8.1 "Offset
@@ -88,8 +105,8 @@ the check; the next does not.
   HSCI's and TNC 426/430's technical manuals ("Active length (including oversizes)"); the TNC
   620 Klartext User's Manual (01/2022, "System data") has "Active length" as NR2 of its tool
   group, with IDX 1 without oversize, 2 with the table's DL, 3 with it and TOOL CALL's DL (the
-  length ncpp applies), but that group's number and the stop (`FN 14: ERROR`) are not cited from
-  a TNC 640 or TNC7 manual.
+  length ncpp applies), but that group's number is not cited from a TNC 640, TNC 620 or TNC7
+  manual (nor the active tool's, ID20 NR1 in the iTNC 530 HSCI's, which a TNC 640 program reads).
 
 Readers of a written program drop both guards (`without_guard`): ncpp's interpreter
 does not know the control's parameters, and the guards neither move nor act.
@@ -154,7 +171,7 @@ class Placement:
     system: int
     zero: tuple[float, float, float]
     unit_mm: float = 1.0
-    dialect: str = "fanuc"  # whose name an additional work offset takes (Haas: G154 Pn)
+    dialect: str = "fanuc"  # whose names the systems take (Haas: G154 Pn; Klartext: the preset)
 
     @classmethod
     def of(cls, offsets: WorkOffsets, unit_mm: float = 1.0) -> Placement | None:
@@ -165,7 +182,8 @@ class Placement:
 
     @property
     def name(self) -> str:
-        return system_name(self.system, self.dialect)
+        """The system as the dialect names it; a Klartext program's zero is the preset it runs under."""
+        return "the active preset" if self.dialect == "heidenhain" else system_name(self.system, self.dialect)
 
     def values(self) -> list[str]:
         """X Y Z of the zero in the control's units, as the guard compares them."""
@@ -350,7 +368,8 @@ def _sinumerik(placement: Placement, selected: bool = False) -> list[str]:
 # Why a dialect's program gets no guard, as the warning says it
 UNGUARDED = {
     "grbl": "grbl cannot test its work offset (it reads no parameters)",
-    "heidenhain": "ncpp cites no FN 18 read of the active preset from a TNC 640 or TNC7 manual",
+    "heidenhain": "ncpp cites the FN 18 reads of the active preset (ID530 NR1, ID502/ID503) only from the "
+    "iTNC 530's technical manual, not from a TNC 640, TNC 620 or TNC7 manual",
 }
 
 
@@ -598,10 +617,12 @@ def _h_number(block: Block) -> int | None:
 
 # Why a dialect's program gets no tool guard, as the warning says it
 TOOLS_UNGUARDED = {
-    "fanuc": "Fanuc's tool offset variables depend on the offset memory type (A, B, C), which the machine "
-    "builder sets",
+    "fanuc": "a Fanuc control keeps the H offsets' lengths in system variables that depend on its tool "
+    "compensation memory (A, B or C, the machine builder's choice), which ncpp cites from no Fanuc manual, "
+    "and has no standard variable of the tool in the spindle (#4120 is the last T commanded)",
     "grbl": "grbl cannot test its tool length (it reads no parameters)",
-    "heidenhain": "ncpp writes no check of Klartext's tool data yet",
+    "heidenhain": "ncpp cites the FN 18 read of the active tool length (ID200 NR2) only from the iTNC 530's "
+    "and TNC 426/430's technical manuals, not from a TNC 640, TNC 620 or TNC7 manual",
 }
 
 

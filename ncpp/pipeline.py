@@ -13,7 +13,7 @@ import gc
 import hashlib
 from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from itertools import chain, count, islice, tee
 from operator import itemgetter
 from pathlib import Path
@@ -436,7 +436,7 @@ def process(
         f"no placement guard: {why}", Location(file, 1, None))) if checks else None  # fmt: skip
     lines = with_header(writer.write(compensated, after, before), header, writer, get_dialect(name).leader)
     if guard is not None:
-        said = guard.said()
+        said = replace(guard, dialect=name).said()  # (as the program's dialect names the system)
         lines = with_guard(lines, guard, name, HEADER_TAG, header.count("\n") + 1,
                            lambda why: warnings.warn(f"no placement guard: {why}; make sure the control has {said} "
                                                      "before the program runs", Location(file, 1, None)), checks)  # fmt: skip

@@ -412,9 +412,9 @@ def test_the_check_at_the_start_is_left_out_only_where_the_program_selects_first
 
 
 def test_a_klartext_program_passes_unguarded_and_the_warning_says_which_manual_is_missing():
-    """No FN 18 read of the active preset is cited from a TNC 640 or TNC7 manual (the module
-    docstring of `ncpp/guard.py`): the program's lines pass as written, and the warning says so
-    rather than asserting that the TNC generations' IDs differ."""
+    """The FN 18 reads of the active preset are cited only from the iTNC 530's technical manual,
+    not from a TNC 640, TNC 620 or TNC7 manual (the module docstring of `ncpp/guard.py`): the
+    program's lines pass as written, and the warning names the reads and the manuals."""
     from ncpp.guard import Placement, guard_lines, with_guard
 
     program = ["0 BEGIN PGM P MM\n", "1 ; ncpp header\n", "2 L X+10 Y+10 R0 FMAX\n", "3 END PGM P MM\n"]
@@ -422,7 +422,25 @@ def test_a_klartext_program_passes_unguarded_and_the_warning_says_which_manual_i
     placement = Placement(1, G54_MM)
     assert list(with_guard(program, placement, "heidenhain", "ncpp header", unguarded=told.append)) == program
     assert guard_lines(placement, "heidenhain") == []
-    assert told == ["ncpp cites no FN 18 read of the active preset from a TNC 640 or TNC7 manual"]
+    assert len(told) == 1 and "FN 18 reads of the active preset (ID530 NR1, ID502/ID503)" in told[0]
+    assert told[0].endswith(
+        "only from the iTNC 530's technical manual, not from a TNC 640, TNC 620 or TNC7 manual"
+    )
+
+
+def test_the_klartext_warning_names_the_preset_to_set_not_a_g54(tmp_path):
+    """A Klartext program's zero is the preset it runs under (`--work-offset`): the warning says
+    which preset the control must have, not an ISO system a TNC does not select."""
+    klartext = "0 BEGIN PGM P MM\n1 L X+10 Y+10 Z+5 R0 FMAX\n2 L X+40 F300\n3 END PGM P MM\n"
+    out, err = _compensate(
+        tmp_path, "--dialect", "heidenhain", "--work-offset", "400,350,300", program=klartext
+    )
+    assert "FN 18" not in out
+    said = [line for line in err.splitlines() if "no placement guard" in line]
+    assert len(said) == 1, err
+    assert said[0].endswith(
+        "make sure the control has the active preset at X400 Y350 Z300 mm before the program runs"
+    )
 
 
 def test_a_negative_zero_or_length_is_added_not_subtracted_twice():

@@ -165,11 +165,30 @@ def test_an_inch_machines_check_compares_the_tables_inches():
     assert lines[1] == "o<ncpp_tool_guard_7> if [[#5400 NE 3] OR [ABS[#5403 - 2] GT 0.0039]]"
 
 
-def test_a_fanuc_program_gets_no_check_and_a_warning_why(tmp_path):
+def test_a_fanuc_program_gets_no_check_and_a_warning_that_says_what_is_not_cited(tmp_path):
+    """No Fanuc manual at hand gives the system variables of the H offsets for each tool
+    compensation memory, nor a variable of the tool in the spindle (`ncpp/guard.py`): the
+    program gets no check, and the warning names both and the table to set on the control."""
     fanuc = "%\nO1234\n" + PROGRAM.replace("M2\n", "M30\n%\n")
     written, warned = _compensated(tmp_path, fanuc)
-    assert "tool guard" not in written
-    assert any("no tool guard: Fanuc's tool offset variables" in line for line in warned), warned
+    assert "tool guard" not in written.lower() and "#3000=5" not in written
+    said = [line for line in warned if "no tool guard" in line]
+    assert len(said) == 1, warned
+    assert "tool compensation memory (A, B or C" in said[0] and "cites from no Fanuc manual" in said[0]
+    assert "no standard variable of the tool in the spindle (#4120 is the last T commanded)" in said[0]
+    assert said[0].endswith("make sure the control's tool lengths are those of " + str(tmp_path / "told.tbl"))
+
+
+def test_a_klartext_program_gets_no_tool_check_and_the_warning_says_which_manual_is_missing():
+    """Klartext's active tool length (FN 18 ID200 NR2) is cited only from the iTNC 530's and
+    TNC 426/430's technical manuals (`ncpp/guard.py`)."""
+    from ncpp.guard import ToolGuard
+
+    told: list[str] = []
+    guard = ToolGuard("heidenhain", 1.0, told.append)
+    assert guard.why is not None and told == [guard.why]
+    assert "FN 18 read of the active tool length (ID200 NR2)" in told[0]
+    assert "not from a TNC 640, TNC 620 or TNC7 manual" in told[0]
 
 
 def test_a_guard_without_its_last_comment_is_no_guard():
