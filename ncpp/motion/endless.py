@@ -137,22 +137,28 @@ class Revisits:
         return state is not None and self.kept is not None and state == self.kept
 
 
-def constant(expr: tuple) -> bool:
-    """Whether an expression (`expressions.py`'s tuples) reads no parameter: its value never changes."""
+# The expression nodes whose value depends on their operands alone (`expressions.py`'s tuples, and
+# the Sinumerik parser's, which adds strings and boolean operators), and the functions of them that do
+_PURE_NODES = frozenset(("num", "str", "neg", "pos", "not", "bnot", "bin", "atan2", "call"))
+_PURE_FUNCTIONS = frozenset(("SIN", "COS", "TAN", "ASIN", "ACOS", "ATAN", "ATAN2", "SQRT", "ABS", "POT", "LN",
+                             "EXP", "FIX", "FUP", "ROUND", "TRUNC", "MINVAL", "MAXVAL"))  # fmt: skip
+
+
+def never_changes(expr: tuple) -> bool:
+    """Whether an expression reads nothing that may change (no parameter, variable or system
+    value): its value never changes."""
     kind = expr[0]
-    if kind == "num":
-        return True
-    if kind in ("param", "exists"):
+    if kind not in _PURE_NODES or kind == "call" and str(expr[1]).upper() not in _PURE_FUNCTIONS:
         return False
-    return all(constant(part) for part in expr[1:] if type(part) is tuple)
+    return all(never_changes(part) for part in expr[1:] if type(part) is tuple)
 
 
 def without_way_out(head: int, where: Location) -> NcppError:
-    """The refusal of a while loop (at line `head`) that can never end (`constant` condition, no way out)."""
+    """The refusal of a loop (at line `head`) that can never end: no condition that changes, no way out."""
     return NcppError(
-        f"a loop that does not end: the loop at line {head} runs while a constant is true and nothing in it "
-        "leaves it (no break, return, jump, program end or alarm) (the control would run it for ever; ncpp "
-        "follows a program to its end)",
+        f"a loop that does not end: the loop at line {head} has no condition that can end it (a constant, or "
+        "none) and nothing in it leaves it (no break, return, jump, program end, alarm, or call that may) (the "
+        "control would run it for ever; ncpp follows a program to its end)",
         where,
     )
 

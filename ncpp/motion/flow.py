@@ -80,7 +80,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ncpp.errors import Location, NcppError, printable
-from ncpp.motion.endless import Journal, Revisits, constant, endless, exact, without_way_out
+from ncpp.motion.endless import Journal, Revisits, endless, exact, never_changes, without_way_out
 from ncpp.motion.expressions import SUBROUTINE_PARAMETERS, normalise_name, round_half_away, vacant
 from ncpp.motion.modal import OutOfScope
 from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
@@ -1208,7 +1208,7 @@ class Flow:
         if label.checked:
             return
         label.checked = True
-        if not constant(condition):
+        if not never_changes(condition):
             return
         body = (self._block(frame, index) for index in range(label.start + 1, frame.pc))
         if not any(self._way_out(b, True, set()) for b in body):  # type: ignore[arg-type]  # (held: under way)

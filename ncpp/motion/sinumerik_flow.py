@@ -44,7 +44,7 @@ from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 
 from ncpp.errors import Location, NcppError
-from ncpp.motion.endless import Revisits, endless, exact
+from ncpp.motion.endless import Revisits, endless, exact, never_changes, without_way_out
 from ncpp.motion.flow import _TRIM, FIXED, MAX_RERUN, ONCE, RUN, SKIP, TEXT, Around, CountedPasses
 from ncpp.motion.modal import OutOfScope
 from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
@@ -57,6 +57,8 @@ CLOSERS = frozenset(OPENERS.values())
 # Blocks a forward search for a jump destination reads ahead before it gives up (memory stays bounded)
 MAX_AHEAD = 100_000
 SECTION = "section"  # the kind `_controls` gives a program section repetition (`_repetition`)
+# Calls that neither end nor leave anything: a message and the frame instructions (`sinumerik.FRAMES`)
+_NO_WAY_OUT = frozenset(("MSG", "TRANS", "ATRANS", "ROT", "AROT", "SCALE", "ASCALE", "MIRROR", "AMIRROR"))
 # The label that ends a section `REPEAT start P=n` repeats (not followed: `_repetition`)
 END_LABEL = "ENDLABEL"
 
@@ -71,6 +73,7 @@ class _Open:
     mark: int | None = None  # FOR: `CountedPasses.ended`'s mark
     total: int = 0  # FOR: its passes, all told (as counted where it starts)
     left: int = 0  # FOR: its passes after the one under way
+    checked: bool = False  # WHILE, LOOP: whether it may end was looked at (`_refuse_without_way_out`)
 
 
 @dataclass
@@ -305,7 +308,10 @@ class SinumerikFlow:
         return self._match(self.pc, "while", statement) + 1
 
     def _endwhile(self, block: Block, statement: Statement) -> int:
-        return self._top("while", statement).start
+        opened = self._top("while", statement)
+        condition = _controls(self.buffer[opened.start - self.base])[0].node[0]  # (held while the loop runs)
+        self._refuse_without_way_out(opened, never_changes(condition), block, statement)
+        return opened.start
 
     def _for(self, block: Block, statement: Statement) -> int:
         target, start, end = statement.node
@@ -364,7 +370,23 @@ class SinumerikFlow:
         return self.pc + 1
 
     def _endloop(self, block: Block, statement: Statement) -> int:
-        return self._top("loop", statement).start + 1
+        opened = self._top("loop", statement)
+        self._refuse_without_way_out(opened, True, block, statement)
+        return opened.start + 1
+
+    def _refuse_without_way_out(
+        self, opened: _Open, endless_condition: bool, block: Block, statement: Statement
+    ) -> None:
+        """At the end of a WHILE's (of a constant condition: `endless_condition`) or a LOOP's first pass: refuse
+        it where nothing in it can leave it (`endless.py`).  A jump out of it leaves the scope (`_jump`),
+        so the ways out are the program's or the subprogram's end and a call (what it does is not seen)."""
+        if opened.checked:
+            return
+        opened.checked = True
+        body = self.buffer[opened.start + 1 - self.base : self.pc - self.base]
+        if endless_condition and not any(_way_out(b) for b in body):
+            where = Location(self.file, block.line, statement.start + 1)
+            raise without_way_out(self.buffer[opened.start - self.base].line, where)
 
     def _goto(self, block: Block, statement: Statement) -> int:
         return self._jump(block, statement, *statement.node)
@@ -513,6 +535,21 @@ def _controls(block: Block) -> list[Statement]:
                     or (type(item) is Statement and item.kind == "label")):  # fmt: skip
                 raise OutOfScope(f"{found[0].kind.upper()} with more in its block", item.start + 1)
     return found
+
+
+def _way_out(block: Block) -> bool:
+    """Whether the block may end the program or the subprogram, or leave a loop: M2, M17 or M30, a
+    jump, or a call (RET, an alarm's SETAL, a subprogram's; a message's MSG and a frame's are none)."""
+    for item in block.items:
+        if type(item) is Word and item.letter == "M" and item.value in (2.0, 17.0, 30.0):
+            return True
+        if type(item) is Statement and (
+            item.kind in ("goto", "case")
+            or item.kind == "call"
+            and str(item.node[0]).upper() not in _NO_WAY_OUT
+        ):
+            return True
+    return False
 
 
 def _conditional_jump(block: Block, statement: Statement) -> bool:

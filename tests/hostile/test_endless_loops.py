@@ -120,7 +120,7 @@ WITHOUT_WAY_OUT = {  # a constant condition and nothing that leaves: refused at 
 def test_a_while_of_a_constant_with_no_way_out_is_refused_after_its_first_pass(name):
     read, text, line, head = WITHOUT_WAY_OUT[name]
     with pytest.raises(
-        NcppError, match=rf"does not end: the loop at line {head} runs while a constant"
+        NcppError, match=rf"does not end: the loop at line {head} has no condition that can end it"
     ) as err:
         read(text)
     assert err.value.where.line == line
@@ -226,7 +226,7 @@ def _klartext(text: str) -> list:
 
 SINUMERIK_HEAD = "G17 G90 G71 F200\nG0 X0 Y0 Z5\n"
 ENDLESS_SINUMERIK = {
-    "LOOP ... ENDLOOP": ("LOOP\nG1 X10 Y10\nG1 X0 Y0\nENDLOOP\nM30\n", 6, 4),
+    "LOOP ... ENDLOOP": ("LOOP\nG1 X10 Y10\nIF R9>0\nM30\nENDIF\nG1 X0 Y0\nENDLOOP\nM30\n", 9, 4),
     "WHILE 1": ("R1=0\nWHILE R1<5\nG1 X10\nR2=R2*0\nENDWHILE\nM30\n", 7, 4),
     "REPEAT ... UNTIL 0": ("REPEAT\nG1 X10\nG1 X0\nUNTIL R1>0\nM30\n", 6, 4),
     "GOTOB": ("BACK:\nR1=1-R1\nG1 X=R1*10\nGOTOB BACK\nM30\n", 6, 3),
@@ -240,6 +240,26 @@ def test_a_sinumerik_loop_back_at_a_state_it_had_is_refused_at_once(monkeypatch,
     monkeypatch.setattr(sinumerik_flow, "MAX_RERUN", BOUND)
     text, line, head = ENDLESS_SINUMERIK[name]
     _refused_at(_sinumerik, SINUMERIK_HEAD + text, "t.mpf", line, head)
+
+
+SINUMERIK_WITHOUT_WAY_OUT = {  # (the ISO and Fanuc ones: `WITHOUT_WAY_OUT`)
+    "LOOP and a counter": ("R1=0\nLOOP\nR1=R1+1\nG1 X=R1\nENDLOOP\nM30\n", 7, 4),
+    "WHILE TRUE and a counter": ("R1=0\nWHILE TRUE\nR1=R1+1\nG1 X=R1\nENDWHILE\nM30\n", 7, 4),
+    "a message and a frame": ("R1=0\nLOOP\nMSG(\"X\")\nTRANS X=R1\nR1=R1+1\nG1 X1\nENDLOOP\nM30\n", 9, 4),
+}
+
+
+@pytest.mark.parametrize("name", SINUMERIK_WITHOUT_WAY_OUT)
+def test_a_sinumerik_loop_with_no_way_out_is_refused_after_its_first_pass(name):
+    text, line, head = SINUMERIK_WITHOUT_WAY_OUT[name]
+    with pytest.raises(NcppError, match=rf"does not end: the loop at line {head} has no condition") as err:
+        _sinumerik(SINUMERIK_HEAD + text)
+    assert err.value.where.line == line
+
+
+def test_a_sinumerik_loop_left_by_the_program_end_runs_to_its_end():
+    text = SINUMERIK_HEAD + "R1=0\nLOOP\nR1=R1+1\nG1 X=R1\nIF R1>4\nM30\nENDIF\nENDLOOP\nM30\n"
+    assert max(x for x, _, _ in _ends(_sinumerik(text))) == 5.0
 
 
 def test_a_sinumerik_loop_with_a_counter_or_a_toggle_it_ends_runs_to_its_end():
@@ -278,7 +298,7 @@ MACHINE = SHARED / "machines/wide.toml"
 PROGRAMS = {
     "while.ngc": (ENDLESS_ISO["while"][0], 6),
     "while.nc": (ENDLESS_FANUC["WHILE [..] DO1"][0], 9),
-    "loop.mpf": (SINUMERIK_HEAD + ENDLESS_SINUMERIK["LOOP ... ENDLOOP"][0], 6),
+    "loop.mpf": (SINUMERIK_HEAD + ENDLESS_SINUMERIK["LOOP ... ENDLOOP"][0], 9),
     "jump.h": (KLARTEXT, 8),
 }
 
