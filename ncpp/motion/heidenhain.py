@@ -50,6 +50,7 @@ from ncpp.errors import Location, NcppError, Warnings
 from ncpp.motion.called import Files, count_called, searched
 from ncpp.motion.corners import CornerError, round_corner
 from ncpp.motion.cutter import centre_offset
+from ncpp.motion.endless import never_changes
 from ncpp.motion.expand import refused
 from ncpp.motion.heidenhain_cycles import (
     DEFINITION_ACTIVE,
@@ -958,9 +959,13 @@ class HeidenhainInterpreter(ModalInterpreter):
         ):
             self.fail(f"FN {number}: expected IF a {JUMPS[number]} b GOTO LBL n", block, item)
         left, test, right, name = parts
-        a, b = (self.value(_fn_operand(o), block, item) for o in (left, right))
+        operands = [_fn_operand(o) for o in (left, right)]
+        a, b = (self.value(operand, block, item) for operand in operands)
         if {"EQU": a == b, "NE": a != b, "GT": a > b, "LT": a < b}[test]:
-            self.flow.goto(self.flow.target(name, lambda q: self.value(q, block, item), item.start + 1))
+            index = self.flow.target(name, lambda q: self.value(q, block, item), item.start + 1)
+            if all(never_changes(operand) for operand in operands):  # (a jump back that nothing may leave)
+                self.flow.refuse_without_way_out(index, block, item.start + 1)
+            self.flow.goto(index)
 
     def _corner(self, block: Block, item, words: dict) -> Corner:
         function = item.node[0]

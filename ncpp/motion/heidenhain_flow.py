@@ -25,7 +25,7 @@ import re
 from collections.abc import Callable, Iterable, Iterator
 
 from ncpp.errors import Location, NcppError
-from ncpp.motion.endless import Revisits, endless
+from ncpp.motion.endless import Revisits, endless, without_way_out
 from ncpp.motion.flow import FIXED, MAX_RERUN, RUN, SKIP, TEXT, Around, CountedPasses
 from ncpp.motion.modal import OutOfScope
 from ncpp.program.blocks import Block, Statement, Word
@@ -184,6 +184,16 @@ class KlartextFlow:
         """FN 9-12 whose condition holds: on at the label."""
         self.next = index
 
+    def refuse_without_way_out(self, index: int, block: Block, col: int) -> None:
+        """A jump back to `index` whose condition never changes (its operands are numbers): refused
+        where no block from the label to the jump can leave the loop (`endless.py`): no other jump,
+        call, FN 14 error or program end."""
+        if index > self.current or any(
+            _way_out(self.held[i - self.base]) for i in range(index, self.current)
+        ):
+            return
+        raise without_way_out(self.held[index - self.base].line, Location(self.file, block.line, col))
+
     def call(self, index: int, repeat: int, key: float | str, col: int) -> None:
         """`CALL LBL n [REP k]`: the subprogram at `index`, or the section from it once more."""
         if repeat:
@@ -331,6 +341,19 @@ class KlartextFlow:
             yield rest, TEXT, None
             written += 1
             self._trim(written)
+
+
+def _way_out(block: Block) -> bool:
+    """Whether the block may leave a loop or end the program: a jump (FN 9-12), a call of a label
+    or a program, an FN 14 error, M2 or M30."""
+    for item in block.items:
+        if type(item) is Word and item.letter == "M" and item.value in (2.0, 30.0):
+            return True
+        if type(item) is Statement and (
+            item.kind in ("call_label", "call_program") or item.kind == "fn" and item.node[0] in (*JUMPS, 14)
+        ):
+            return True
+    return False
 
 
 __all__ = ["FIXED", "RUN", "SKIP", "TEXT", "KlartextFlow", "JUMPS", "jump_parts", "label_key"]

@@ -137,7 +137,7 @@ def test_each_comparison_jumps_back_while_it_holds(number, condition, passes):
 def test_a_loop_that_never_ends_is_refused(monkeypatch):
     monkeypatch.setattr(heidenhain_flow, "MAX_RERUN", 1000)
     with pytest.raises(NcppError, match="never ends"):
-        moves(LOOP.replace("FN 12: IF +Q1 LT +15", "FN 9: IF +0 EQU +0"))
+        moves(LOOP.replace("FN 12: IF +Q1 LT +15", "FN 12: IF -1 LT +Q1"))
 
 
 @pytest.mark.parametrize(

@@ -245,7 +245,7 @@ def test_a_sinumerik_loop_back_at_a_state_it_had_is_refused_at_once(monkeypatch,
 SINUMERIK_WITHOUT_WAY_OUT = {  # (the ISO and Fanuc ones: `WITHOUT_WAY_OUT`)
     "LOOP and a counter": ("R1=0\nLOOP\nR1=R1+1\nG1 X=R1\nENDLOOP\nM30\n", 7, 4),
     "WHILE TRUE and a counter": ("R1=0\nWHILE TRUE\nR1=R1+1\nG1 X=R1\nENDWHILE\nM30\n", 7, 4),
-    "a message and a frame": ("R1=0\nLOOP\nMSG(\"X\")\nTRANS X=R1\nR1=R1+1\nG1 X1\nENDLOOP\nM30\n", 9, 4),
+    "a message and a frame": ('R1=0\nLOOP\nMSG("X")\nTRANS X=R1\nR1=R1+1\nG1 X1\nENDLOOP\nM30\n', 9, 4),
 }
 
 
@@ -274,7 +274,7 @@ KLARTEXT = """0 BEGIN PGM LOOP MM
 4 LBL 2
 5 L X+Q1 Y+20 R0 FMAX
 6 FN 3: Q1 = +Q1 * +0
-7 FN 9: IF +0 EQU +0 GOTO LBL 2
+7 FN 9: IF +Q1 EQU +0 GOTO LBL 2
 8 L Z+50 FMAX
 9 END PGM LOOP MM
 """
@@ -287,9 +287,22 @@ def test_a_klartext_jump_back_at_a_state_it_had_is_refused_at_once(monkeypatch):
     _refused_at(_klartext, KLARTEXT, "t.h", 8, 5)
 
 
+def test_a_klartext_jump_back_of_numbers_with_no_way_out_is_refused_at_once():
+    text = KLARTEXT.replace("FN 3: Q1 = +Q1 * +0", "FN 1: Q1 = +Q1 + +5").replace("+Q1 EQU", "+0 EQU")
+    with pytest.raises(NcppError, match=r"does not end: the loop at line 5 has no condition") as err:
+        _klartext(text)
+    assert err.value.where.line == 8
+
+
+def test_a_klartext_jump_back_of_numbers_left_by_another_jump_runs_to_its_end():
+    text = KLARTEXT.replace("FN 3: Q1 = +Q1 * +0", "FN 1: Q1 = +Q1 + +5\n6 FN 11: IF +Q1 GT +10 GOTO LBL 3")
+    text = text.replace("+Q1 EQU", "+0 EQU").replace("8 L Z+50", "8 LBL 3\n8 L Z+50")
+    assert max(x for x, y, z in _ends(_klartext(text)) if (y, z) == (20.0, 2.0)) == 10.0
+
+
 def test_a_klartext_jump_back_whose_parameter_counts_runs_to_its_end():
     text = KLARTEXT.replace("FN 3: Q1 = +Q1 * +0", "FN 1: Q1 = +Q1 + +5").replace(
-        "FN 9: IF +0 EQU +0", "FN 12: IF +Q1 LT +15"
+        "FN 9: IF +Q1 EQU +0", "FN 12: IF +Q1 LT +15"
     )
     assert [x for x, y, z in _ends(_klartext(text)) if (y, z) == (20.0, 2.0)] == [0.0, 5.0, 10.0]
 
