@@ -303,6 +303,7 @@ class Flow:
         self.leader = 0
         self.repeats_in_p = repeats_in_p  # Fanuc: `M98 P51002` runs O1002 five times (`_m98`)
         self.revisits: Revisits | None = None
+        self._jumps_checked: set[tuple[int, int, int]] = set()  # (`_refuse_jump_without_way_out`)
         if state is not None:
             parameters.journal = Journal()
             self.revisits = Revisits(parameters.journal, parameters.entry, position,
@@ -947,6 +948,8 @@ class Flow:
                       "rewritten for that run; a WHILE ... DO loop or a loop near the top of the program is "
                       "followed)", block, col)  # fmt: skip
             return lambda: None
+        if control.keyword == "goto" or never_changes(control.arguments[0]):
+            self._refuse_jump_without_way_out(frame, index, block, control)
 
         def back():
             for name in [
@@ -1214,6 +1217,18 @@ class Flow:
         if not any(self._way_out(b, True, set()) for b in body):  # type: ignore[arg-type]  # (held: under way)
             where = Location(frame.source or self.file, block.line, control.item.start + 1)
             raise without_way_out(self._block(frame, label.start).line, where)  # type: ignore[union-attr]
+
+    def _refuse_jump_without_way_out(self, frame: _Frame, index: int, block: Block, control: Control) -> None:
+        """A GOTO back (or an IF of a constant): refused where no block from its target on can leave
+        the loop it makes (`endless.py`); each jump looked at once."""
+        key = (id(frame.space), index, id(block))
+        if key in self._jumps_checked:
+            return
+        self._jumps_checked.add(key)
+        body = (self._block(frame, i) for i in range(index, frame.pc))
+        if not any(self._way_out(b, True, set()) for b in body):  # type: ignore[arg-type]  # (held)
+            where = Location(frame.source or self.file, block.line, control.item.start + 1)
+            raise without_way_out(self._block(frame, index).line, where)  # type: ignore[union-attr]
 
     def _way_out(self, block: Block, in_loop: bool, seen: set[str]) -> bool:
         """Whether running `block` may end the program or, `in_loop`, leave the loop it stands in: a

@@ -86,8 +86,12 @@ ENDLESS_FANUC = {
         9,
         5,
     ),
-    "IF [..] GOTO back": (FANUC_HEAD + "N10 G1 X1 F100\nG1 X0\nIF [1 EQ 1] GOTO 10\nM30\n%\n", 7, 5),
-    "GOTO back": (FANUC_HEAD + "#1 = 0\nN20 G1 X1 F100\nG1 X[#1 * 0]\nGOTO 20\nM30\n%\n", 8, 6),
+    "IF [..] GOTO back": (FANUC_HEAD + "N10 G1 X1 F100\nG1 X0\nIF [#1 NE 2] GOTO 10\nM30\n%\n", 7, 5),
+    "IF [..] GOTO back, a parameter set to the same value": (
+        FANUC_HEAD + "#1 = 0\nN20 G1 X1 F100\nG1 X[#1 * 0]\nIF [#1 EQ 0] GOTO 20\nM30\n%\n",
+        8,
+        6,
+    ),
 }
 
 
@@ -109,6 +113,9 @@ WITHOUT_WAY_OUT = {  # a constant condition and nothing that leaves: refused at 
     "a call whose body has no way out": (
         _iso, "o<s> sub\nG1 X#1\no<s> endsub\n" + HEAD + "o1 while [1]\n#2 = [#2 + 1]\no<s> call [#2]\n"
         "o1 endwhile\nM2\n", 9, 6,
+    ),
+    "Fanuc GOTO back and a counter": (
+        _fanuc, FANUC_HEAD + "#1 = 0\nN10 #1 = #1 + 1\nG1 X#1 F100\nGOTO 10\nM30\n%\n", 8, 6,
     ),
     "Fanuc WHILE [1 EQ 1] and a counter": (
         _fanuc, FANUC_HEAD + "#1 = 0\nWHILE [1 EQ 1] DO1\n#1 = #1 + 1\nG1 X#1 F100\nEND1\nM30\n%\n", 9, 6,
@@ -135,6 +142,8 @@ WAYS_OUT = {  # the same loops, each with a way out the first pass does not take
                  "o1 endwhile\no<s> endsub\n" + HEAD + "o<s> call\nM2\n"),
     "a Fanuc jump out": (_fanuc, FANUC_HEAD + "#1 = 0\nWHILE [1 EQ 1] DO1\n#1 = #1 + 1\nG1 X#1 F100\n"
                          "IF [#1 GT 4] GOTO 10\nEND1\nN10 M30\n%\n"),
+    "a Fanuc jump out of a GOTO loop": (_fanuc, FANUC_HEAD + "#1 = 0\nN10 #1 = #1 + 1\nG1 X#1 F100\n"
+                                        "IF [#1 GT 4] GOTO 20\nGOTO 10\nN20 M30\n%\n"),
     "a Fanuc subprogram that ends the program": (
         _fanuc, FANUC_HEAD + "#1 = 0\nWHILE [1 EQ 1] DO1\n#1 = #1 + 1\nM98 P2000\nEND1\nM30\n%\n"
         "O2000\nG1 X#1 F100\nIF [#1 LT 5] GOTO 5\nM30\nN5 M99\n%\n",
