@@ -410,13 +410,18 @@ def process(
             original = same_motion(
                 original, interpret(plain[0], file=file, warnings=unsaid(), offsets=offsets), file
             )
+    # the blocks of a subroutine that runs once, rewritten for that run where its definition stands
+    at_definition: dict[str, set[int]] = (
+        {"at_definition": set()} if FAMILY[name] == "iso" and not expand else {}
+    )
     events: Iterable[Event] = interpret(
-        blocks, file=file, warnings=warnings, strict=strict, offsets=offsets, **expanding
+        blocks, file=file, warnings=warnings, strict=strict, offsets=offsets, **expanding, **at_definition
     )
     events = warn_fixed(events, warnings, file)  # cycles, loops, subroutines (ISO), cutter compensation
     stats.summary = summary = Summary(file)
     warnings.listeners.append(summary.heard)
     writer = writer_class()
+    writer.at_definition = at_definition.get("at_definition")
     writer.unpositioned = lambda axes, block: warnings.warn(
         f"{axes} not positioned by the program yet: the correction along {axes} of this feed move and "
         "the next compensated moves is left out until the program positions them (a word written here "

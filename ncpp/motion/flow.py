@@ -10,6 +10,10 @@ with what the interpreter is to do with it (`kind`):
   again is told by the next block the flow yields (RUN: the loop ended and the
   body ran once, its moves may be rewritten for that run as RUN's; a block run
   again, FIXED: they are left as programmed as FIXED's);
+* CALLED — execute it in the first run of a subroutine called from straight code whose
+  definition stands after the call (`_runs_once`): its owner is the call; if no other call runs
+  it before the program ends, its text ran once and may be rewritten for that run where it
+  stands (`called_again` names the subroutines another call ran);
 * SKIP  — write its text; it does not run (an untaken branch, a subroutine's
   definition, a loop that runs no time);
 * TEXT  — write its text: a control line this module has executed
@@ -86,7 +90,7 @@ from ncpp.motion.modal import OutOfScope
 from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
 from ncpp.program.parser import parse_stream
 
-RUN, FIXED, ONCE, SKIP, TEXT = "run", "fixed", "once", "skip", "text"
+RUN, FIXED, ONCE, CALLED, SKIP, TEXT = "run", "fixed", "once", "called", "skip", "text"
 _TRIM = 4096  # blocks no loop can go back to are dropped in runs of this many
 # Blocks after an `O<n>` line kept as Fanuc subprogram `n` until its M99: a longer one is a
 # program's own number (`O1000` at its top), not a subprogram, and memory stays bounded.
@@ -152,6 +156,7 @@ class _Frame:
     source: str | None = None  # the subroutine file its lines are from (None: the program's)
     macro: bool = False  # a Fanuc G65 macro call (its own level of local variables)
     modal: bool = False  # a macro G66 calls after a move
+    called: str | None = None  # a run that may be its subroutine's only one: its name (`_runs_once`)
 
 
 class CountedPasses:
@@ -244,6 +249,7 @@ class Flow:
         state: Callable[[], object] | None = None,
         position: Callable[[], object] = lambda: None,
         repeats_in_p: bool = False,
+        once_calls: bool = False,
     ):
         self.file, self.evaluate, self.parameters, self.done, self.stop, self.path = (
             file,
@@ -302,6 +308,10 @@ class Flow:
         # the blocks read ahead); a verbatim block after them stands after the closing `%`
         self.leader = 0
         self.repeats_in_p = repeats_in_p  # Fanuc: `M98 P51002` runs O1002 five times (`_m98`)
+        self.once_calls = once_calls  # whether a subroutine's first run may be CALLED (`_runs_once`)
+        self.calls: dict[str, int] = {}  # subroutine name -> its runs so far (o-word calls, M98)
+        self.called_again: list[str] = []  # the CALLED subroutines another call has run since told
+        self.once_called: set[str] = set()  # the subroutines whose first run was CALLED
         self.revisits: Revisits | None = None
         self._jumps_checked: set[tuple[int, int, int]] = set()  # (`_refuse_jump_without_way_out`)
         if state is not None:
@@ -403,7 +413,42 @@ class Flow:
             if frame.pc in self.looped:
                 return FIXED, None
             return (ONCE if frame.labels else RUN), None
-        return FIXED, self.owner
+        return (CALLED if frame.called is not None else FIXED), self.owner
+
+    def _runs_once(self, frame: _Frame, block: Block, name: str, body: list[Block], runs: int) -> bool:
+        """Whether a call may be its subroutine's only run, whose text may then be rewritten for
+        it where the definition stands: one run, called from the main program's straight code in its
+        place, the subroutine's first, defined in the program's own text after the call (where the
+        program's end comes before its text is written), with no control line in its body (no
+        loop, branch, call or return: each of its lines runs once, in order)."""
+        return (
+            self.once_calls
+            and runs == 1
+            and frame.space is None
+            and len(self.frames) == 1
+            and not frame.labels
+            and self.modal is None
+            and self._in_place(frame)
+            and frame.pc not in self.looped
+            and name not in self.calls
+            and name not in self.files
+            and self._source_of(body) is None
+            and body[0].line > block.line
+            and all(self._control_of(b) is None for b in body[1:-1])
+        )
+
+    def _once(self, name: str, once: bool) -> str | None:
+        """The `called` of a run (`_runs_once`): its name where it may be the only one."""
+        if not once:
+            return None
+        self.once_called.add(name)
+        return name
+
+    def _count_call(self, name: str) -> None:
+        """A run of subroutine `name` starts: a CALLED one's text runs again."""
+        if name in self.calls and name in self.once_called:
+            self.called_again.append(name)
+        self.calls[name] = self.calls.get(name, 0) + 1
 
     def in_straight_code(self) -> bool:
         """Whether the program runs its main text with no loop under way (none can go back)."""
@@ -646,11 +691,15 @@ class Flow:
         self._check_level(block, control)
         if name not in self.files:  # (a file's definition is no line of the program)
             self.defined_at.setdefault(name, body[0].line)
+        once = self._runs_once(frame, block, name, body, 1)
 
         def call():
             frame.pc += 1
             self.parameters.enter(arguments)
-            self.frames.append(_Frame(body, 1, repeats=-1, source=self.files.get(name)))
+            self._count_call(name)
+            self.frames.append(
+                _Frame(body, 1, repeats=-1, source=self.files.get(name), called=self._once(name, once))
+            )
 
         return call
 
@@ -733,13 +782,15 @@ class Flow:
             return lambda: None
 
         self._check_level(block, control)
+        once = self._runs_once(frame, block, name, body, runs)
 
         def call():
             frame.pc += 1
             self.parameters.enter(None)
             if runs > 0:
+                self._count_call(name)
                 self.frames.append(_Frame(body, 1, repeats=runs - 1, runs=runs, mark=self.passes.steps,
-                                          source=self._source_of(body)))  # fmt: skip
+                                          source=self._source_of(body), called=self._once(name, once)))  # fmt: skip
             else:  # L0: rs274ngc runs nothing but stays a call level deeper: the caller's names, loops and ifs are gone
                 frame.labels.clear()
                 frame.ifs.clear()
@@ -865,6 +916,7 @@ class Flow:
             said = f"{what} P{name}: a macro the program does not define (O{name} to M99)"
             self.stop(said + self._searched(), block, control.item.start + 1)
             return None
+        self._count_call(name)  # (G66's calls after each move run it again)
         return body, runs, values
 
     # -- Fanuc branches and loops ------------------------------------------------

@@ -59,9 +59,9 @@ from ncpp.motion.cycles import (
 from ncpp.motion.endless import exact
 from ncpp.motion.expand import Expansion, number, refused
 from ncpp.motion.expressions import ExpressionError, OutOfScope, Parameters, evaluate, vacant
-from ncpp.motion.flow import FIXED, ONCE, RUN, SKIP, Flow
+from ncpp.motion.flow import CALLED, FIXED, ONCE, RUN, SKIP, Flow
 from ncpp.motion.offsets import SYSTEMS, WorkOffsets
-from ncpp.motion.once import FirstPass
+from ncpp.motion.once import MAX_ONCE, FirstPass
 from ncpp.motion.segments import (
     COMP,
     CYCLE,
@@ -200,6 +200,7 @@ def interpreting(flavour: type[Interpreter]) -> Callable[..., Iterator[Event]]:
         offsets: WorkOffsets | None = None,
         expand_cycles: bool = False,
         expand: bool = False,
+        at_definition: set[int] | None = None,
     ) -> Iterator[Event]:
         """Motion events of a program's blocks, lazily, as the flavour reads them (see the
         module docstring).
@@ -216,8 +217,11 @@ def interpreting(flavour: type[Interpreter]) -> Callable[..., Iterator[Event]]:
 
         `expand_cycles`: a canned cycle's block is to be written as its moves (`expanded`);
         `expand`: loops and subroutines are to be written out as straight code (`expand.py`).
+        `at_definition`: given, a subroutine that runs once is followed as its run (`Interpreter.run`)
+        and the ids of its blocks are added, to be written where its definition stands.
         """
         interpreter = flavour(file, offsets)
+        interpreter.at_definition = at_definition
         interpreter.expand_cycles = expand_cycles
         interpreter.expansion = Expansion(interpreter.params, file) if expand else None
         return run(interpreter, blocks, warnings, strict)
@@ -338,6 +342,8 @@ class Interpreter:
         # Fanuc: the axes (0 X, 1 Y, 2 Z) a move has put at a programmed position since the start or
         # the last program stop (where the operator may jog the machine): #5001-#5003 read them
         self.placed: set[int] = set()
+        # the blocks of the subroutines whose one run is written where their definition stands (`run`)
+        self.at_definition: set[int] | None = None
         self.subroutine_path = offsets.subroutine_path if offsets is not None else ()
         if offsets is not None:
             self._start_from(offsets)
@@ -355,8 +361,53 @@ class Interpreter:
 
     # -- the event stream ---------------------------------------------------------
     def run(self, blocks: Iterable[Block], warnings: Warnings) -> Iterator[Event]:
+        """Events block by block, in the order the blocks run (`_run`).  The run of a subroutine that
+        may be its only one (CALLED, `flow.py`) is followed as a run in place, its events and all
+        after them held until the program ends: if no other call ran it (`Flow.called_again`), its
+        text ran once and is rewritten for that run where its definition stands (`at_definition`);
+        else, or where the program leaves the scope or the events held pass MAX_ONCE, its moves are
+        left as programmed, as a FIXED run's."""
+        if self.at_definition is None:  # (no run is CALLED)
+            yield from self._run(blocks, warnings)  # type: ignore[misc]
+            return
+        held: list[tuple[Event, tuple[str, Block] | None]] = []
+        pending: set[str] = set()  # the CALLED subroutines among the events held
+        again: set[str] = set()
+        for item in self._run(blocks, warnings):
+            run, event = item if type(item) is tuple else (None, item)
+            if run is not None:
+                pending.add(run[0])
+            elif not held:
+                yield event  # (the common case: nothing held)
+                continue
+            held.append((event, run))
+            again.update(self.flow.called_again)  # type: ignore[union-attr]
+            self.flow.called_again.clear()  # type: ignore[union-attr]
+            if self.done or len(held) > MAX_ONCE or pending <= again:
+                yield from self._told_runs(held, again if self.ended else pending)
+                held, pending, again = [], set(), set()
+        if held:
+            yield from self._told_runs(held, again if self.ended else pending)
+
+    def _told_runs(
+        self, held: list[tuple[Event, tuple[str, Block] | None]], again: set[str]
+    ) -> Iterator[Event]:
+        """The events held from a CALLED run on: the runs of the subroutines in `again` left as
+        programmed, the others as they ran, their blocks to be written at the definition."""
+        for event, run in held:
+            if run is None:
+                yield event
+            elif run[0] in again:
+                kept = _as_programmed(event, run[1])
+                if kept is not None:
+                    yield kept
+            else:
+                self.at_definition.add(id(event.block))  # type: ignore[union-attr]  # (CALLED: given)
+                yield event
+
+    def _run(self, blocks: Iterable[Block], warnings: Warnings) -> Iterator[Event | tuple]:
         """Events block by block, in the order the blocks run (o-word control flow,
-        `flow.py`).  A line with a Fanuc corner word (`,R` `,C`, `G1 ... R`) waits
+        `flow.py`), a CALLED run's as (its subroutine's name and call, event).  A line with a Fanuc corner word (`,R` `,C`, `G1 ... R`) waits
         for the next move, which decides the corner; the blocks in between wait
         with it (bounded by the program's own layout).  The events of a loop's first pass in
         its place (ONCE) wait until the flow tells whether its text runs again (`_told`)."""
@@ -369,13 +420,24 @@ class Interpreter:
         flow = self.flow = Flow(
             self.file, self._evaluate, self.params, lambda: self.done, self._leave_scope,
             self.subroutine_path, state=self._loop_state, position=lambda: self.pos[:],
-            repeats_in_p=self.repeats_in_p,
+            repeats_in_p=self.repeats_in_p, once_calls=self.at_definition is not None,
         )  # fmt: skip
         self.rounding = False
         expansion = self.expansion
         for block, kind, owner in flow.steps(blocks):
             if kind is ONCE and (expansion is not None or pending is not None or self.corner is not None):
                 kind = FIXED  # (--expand writes each run out; a corner waiting: `_in_flow` tells why)
+            called = None  # a CALLED run's (subroutine, call)
+            if kind is CALLED:
+                called = (flow.frames[-1].called, owner)
+                if (
+                    expansion is not None
+                    or pending is not None
+                    or self.corner is not None
+                    or once is not None
+                ):
+                    flow.called_again.append(called[0])  # type: ignore[arg-type]  # (the run as a FIXED one)
+                    kind, called = FIXED, None
             if once is not None and (self.done or flow.in_straight_code() or once.full()):
                 yield from self._told(once, again=(self.done and not self.ended) or once.full())
                 once = None
@@ -384,7 +446,9 @@ class Interpreter:
             elif once is not None and kind is FIXED and owner is not None and once.rerun(block):
                 yield from self._told(once, again=True)  # (all of it runs again: nothing to hold)
                 once = None
-            if kind is not RUN and kind is not FIXED and kind is not ONCE:  # text that does not run here
+            if (
+                kind is not RUN and kind is not FIXED and kind is not ONCE and kind is not CALLED
+            ):  # text not run here
                 ended = self.done or block.verbatim  # (verbatim: after the closing `%`)
                 if expansion is not None:
                     kept = expansion.text(kind, ended, block)  # (None: left out)
@@ -415,6 +479,11 @@ class Interpreter:
                     if once is not None:
                         yield from self._told(once, again=True)  # (`_in_flow` tells why, below)
                     once, kind = None, FIXED
+                if called is not None and (
+                    self.corner is not None or _sets_offset(event) or self._compensating()
+                ):
+                    flow.called_again.append(called[0])  # type: ignore[arg-type]  # the run as a FIXED one
+                    kind, called = FIXED, None
                 if kind is FIXED and expansion is None:
                     event = self._in_flow(event, owner)
                 if flow.modal is not None and _moves(event):  # a move under G66: the macro next
@@ -422,6 +491,8 @@ class Interpreter:
                 if self.params.fanuc:
                     if kind is RUN and _moves(event):  # in its place: no backward GOTO may run it again
                         flow.last_run_move = block.line
+                    elif called is not None and _moves(event):  # (nor the call that ran it)
+                        flow.last_run_move = max(flow.last_run_move, owner.line)  # type: ignore[union-attr]
                     elif kind is ONCE and _moves(event):
                         flow.once_move = block.line
                     self._note_placed(block)
@@ -451,7 +522,7 @@ class Interpreter:
             if pending is None and self.corner is None and type(event) is not tuple:
                 # the common case: no corner waits, none starts (and not a tuple)
                 if once is None:
-                    yield event  # type: ignore[misc]
+                    yield event if called is None else (called, event)
                 else:
                     once.add(event, block, again=kind is FIXED)  # type: ignore[arg-type]
                 continue
@@ -476,7 +547,7 @@ class Interpreter:
                     pending, corner, self.rounding = ev, new_corner, True
                     continue
                 if once is None:
-                    yield ev
+                    yield ev if called is None else (called, ev)
                 else:
                     once.add(ev, block, again=kind is FIXED)
         if once is not None:

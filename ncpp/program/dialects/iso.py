@@ -116,6 +116,26 @@ def _lines_ended(
     return ended
 
 
+def _at_definition(
+    write_group: Callable[[list[Event]], Iterable[str]], blocks: set[int]
+) -> Callable[[list[Event]], Iterable[str]]:
+    """`write_group`, with the lines of a block among `blocks` (a subroutine's, whose one run came
+    before its definition's text: `Interpreter.run`) kept from its run and written in place of its
+    text where the definition stands."""
+    kept: dict[int, Iterable[str]] = {}
+
+    def write(group: list[Event]) -> Iterable[str]:
+        key = id(group[0].block)
+        if key not in blocks:
+            return write_group(group)
+        if key in kept:  # (the definition's text)
+            return kept.pop(key)
+        kept[key] = list(write_group(group))
+        return ()
+
+    return write
+
+
 def _none(events: list[Event]) -> list[str]:
     return []
 
@@ -151,6 +171,8 @@ class IsoWriter:
         # move leaves out its correction along them (`_tell_unpositioned`: "Y" or "X and Y")
         self.unpositioned: Callable[[str, Block], None] | None = None
         self._told_unpositioned: set[str] = set()
+        # the blocks of subroutines run once, written where their definition stands (`_at_definition`)
+        self.at_definition: set[int] | None = None
         # Per layout of a plain block's text (`DIGITS_AS_ONE`): what its numbers teach, see `_read_layout`.
         self._layouts: dict[bytes, tuple] = {}
         self._layout: tuple[Block | None, bytes] = (None, b"")  # the last block whose layout was read, and it
@@ -200,6 +222,8 @@ class IsoWriter:
             ahead, behind = before or _none, after or _none
             written = lambda group: [*ahead(group), *self._write_group(group), *behind(group)]  # noqa: E731
         write_group = _lines_ended(written)
+        if self.at_definition is not None:
+            write_group = _at_definition(write_group, self.at_definition)
         control = False  # the group is a control line's, whose writing reads only its first event
         ran = self._ran if type(self)._ran is not IsoWriter._ran else None  # (ISO's does nothing)
         for event in events:

@@ -1,0 +1,135 @@
+"""Without --expand, a subroutine that runs once -- called once, from the main program's straight
+code, and defined after the call (after M2, or a Fanuc subprogram after M30) -- is compensated
+where its definition stands: its text runs once, so it can carry that run's corrections.  One that
+runs again, or whose definition the program has written before the call, stays as programmed,
+with the warning.
+
+Judged by oracles ncpp did not write: LinuxCNC's rs274 runs the written program, its feed moves'
+end points are mapped through the machine the test writes by hand (`square`), and every programmed
+point must be reached within 0.5 µm; pathcheck checks the same actions and path."""
+
+from __future__ import annotations
+
+import io
+
+import numpy as np
+import pytest
+
+import ncpp.motion.interpreter as interpreter_module
+from ncpp.errors import Warnings
+from tests.writeback.test_expand_flow import _compensated, _feed_ends, _pathcheck, _worst_point_um
+from tests.writeback.test_loops_run_once import _misses_um
+
+HEAD = "G21 G90 G17\nG0 X0 Y0 Z10\nM3 S1200\nG0 X-150 Y-100 Z2\nG1 Z-2 F150\n"
+BODY = "G1 X#1 Y#2 F500\nG1 X100 Y-140\nG2 X160 Y-80 I0 J60\n"
+ONCE = {
+    "an o-word subroutine after M2": HEAD
+    + "o<body> call [160] [120]\nG1 X-100 Y150\nG0 Z10\nM2\no<body> sub\n"
+    + BODY
+    + "o<body> endsub\n",
+    "Fanuc subprograms after M30, each called once": HEAD
+    + "#1 = 160\n#2 = 120\nM98 P1001\nG1 X-100 Y150\nM98 P1002\nG0 Z10\nM30\nO1001\n"
+    + BODY
+    + "M99\nO1002\nG1 X-40 Y-20\nX0 Y-160\nM99\n",
+}
+TWICE = (
+    HEAD
+    + "o<body> call [160] [120]\nG1 X-100 Y150\no<body> call [160] [120]\nG0 Z10\nM2\no<body> sub\n"
+    + BODY
+    + "o<body> endsub\n"
+)
+DEFINED_BEFORE = (
+    "o<body> sub\n"
+    + BODY
+    + "o<body> endsub\n"
+    + HEAD
+    + "o<body> call [160] [120]\nG1 X-100 Y150\nG0 Z10\nM2\n"
+)
+BODY_POINTS = [[160, 120, -2], [100, -140, -2], [160, -80, -2]]
+
+
+@pytest.mark.parametrize("name", ONCE)
+def test_a_subroutine_that_runs_once_is_compensated_where_it_is_defined(tmp_path, name):
+    warned = io.StringIO()
+    original, output = _compensated(tmp_path, ONCE[name], warnings=Warnings(stream=warned))
+    assert _worst_point_um(original, output) <= 0.5
+    assert "loop or subroutine" not in warned.getvalue()
+    text = output.read_text()
+    assert text.index("G2 X") > text.index("M30" if "M30" in text else "M2")  # (still at its definition)
+    check = _pathcheck(original, output, "--tol-mm", "0.02")
+    assert check.returncode == 0, check.stdout + check.stderr
+
+
+@pytest.mark.parametrize(("name", "program"), [("called twice", TWICE), ("defined before", DEFINED_BEFORE)])
+def test_a_subroutine_called_twice_or_defined_before_its_call_stays_as_programmed(tmp_path, name, program):
+    warned = io.StringIO()
+    original, output = _compensated(tmp_path, program, warnings=Warnings(stream=warned))
+    misses = _misses_um(original, output)
+    body = np.any(np.all(np.isclose(_feed_ends(original)[:, None, :], BODY_POINTS), axis=2), axis=1)
+    assert misses[body].min() > 2.0  # (its text runs twice, or was written before the run: the error stays)
+    assert misses[~body].max() <= 0.5
+    assert "warning: loop or subroutine" in warned.getvalue()
+    assert BODY in output.read_text()
+    check = _pathcheck(original, output, "--tol-mm", "0.02")
+    assert check.returncode == 0, check.stdout + check.stderr
+
+
+def test_the_events_held_past_the_bound_leave_the_run_as_programmed(tmp_path, monkeypatch):
+    monkeypatch.setattr(interpreter_module, "MAX_ONCE", 3)
+    warned = io.StringIO()
+    original, output = _compensated(
+        tmp_path, ONCE["an o-word subroutine after M2"], warnings=Warnings(stream=warned)
+    )
+    assert BODY in output.read_text()
+    assert "warning: loop or subroutine" in warned.getvalue()
+    assert _misses_um(original, output).max() > 2.0
+
+
+FANUC = "%\nO1000\nG21 G90 G17\nG0 X0 Y0 Z10\nG0 X-150 Y-100 Z2\nG1 Z-2 F150\n"
+
+
+def _fanuc(tmp_path, text: str) -> tuple[str, str]:
+    from tests.writeback.conftest import compensate_file
+    from tests.writeback.test_compensated_holes import MACHINE
+
+    program = tmp_path / "O1000.nc"
+    program.write_text(text)
+    warned = io.StringIO()
+    written = compensate_file(program, MACHINE, tmp_path, warnings=Warnings(stream=warned)).read_text()
+    return written, warned.getvalue()
+
+
+@pytest.mark.parametrize(
+    "again",
+    ["M98 P1001\n", "G65 P1001\n", "G66 P1001\nG1 X-60 Y150\nG67\n"],
+    ids=["M98", "G65", "G66"],
+)
+def test_a_fanuc_subprogram_run_again_by_a_later_call_stays_as_programmed(tmp_path, again):
+    text = (
+        FANUC
+        + "M98 P1001\nG1 X-100 Y150\n"
+        + again
+        + "G0 Z10\nM30\nO1001\nG1 X160 Y120 F500\nX100 Y-140\nM99\n%\n"
+    )
+    written, warned = _fanuc(tmp_path, text)
+    assert "\nO1001\nG1 X160 Y120 F500\nX100 Y-140\nM99\n" in written
+    assert "loop or subroutine" in warned
+
+
+def test_a_subprogram_called_in_a_goto_loop_stays_as_programmed(tmp_path):
+    """A backward GOTO over the call runs it again: the lines it goes back over run as a loop's."""
+    text = (FANUC + "#1 = 0\nN10 #1 = #1 + 1\nM98 P1001\nIF [#1 LT 2] GOTO 10\nG0 Z10\nM30\n"
+            "O1001\nG91 G1 X10 F500\nG90\nM99\n%\n")  # fmt: skip
+    written, warned = _fanuc(tmp_path, text)
+    assert "\nO1001\nG91 G1 X10 F500\nG90\nM99\n" in written
+    assert "loop or subroutine" in warned
+
+
+def test_a_subprogram_with_a_control_line_in_its_body_stays_as_programmed(tmp_path):
+    text = (
+        FANUC
+        + "M98 P1001\nG0 Z10\nM30\nO1001\n#2 = 0\nWHILE [#2 LT 1] DO1\nG1 X160 Y120 F500\n#2 = #2 + 1\nEND1\nM99\n%\n"
+    )
+    written, warned = _fanuc(tmp_path, text)
+    assert "\nG1 X160 Y120 F500\n" in written
+    assert "loop or subroutine" in warned
