@@ -51,7 +51,6 @@ from ncpp.motion.called import Files, count_called, searched
 from ncpp.motion.corners import CornerError, round_corner
 from ncpp.motion.cutter import centre_offset
 from ncpp.motion.expand import refused
-from ncpp.passes.rotary import turns
 from ncpp.motion.heidenhain_cycles import (
     DEFINITION_ACTIVE,
     REQUIRED,
@@ -89,6 +88,7 @@ from ncpp.motion.segments import (
     Point,
 )
 from ncpp.motion.tools import ToolTable, UntoldLengths
+from ncpp.passes.rotary import turns
 from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
 
 AXES = "XYZ"
@@ -328,9 +328,10 @@ class HeidenhainInterpreter(ModalInterpreter):
         where = Location(self.file, corner.block.line, corner.col)
         first = held[0]
         assert isinstance(first, Line)  # `run` holds back a feed line and what follows it
-        what = ("an arc or a rapid move" if not isinstance(second, Line) or second.rapid
-                else "a move that turns a rotary axis" if turns(first) or turns(second) else None)  # fmt: skip
-        if what is not None:  # (the fillet or chamfer would not be given its share of the turn)
+        what = None if isinstance(second, Line) and not second.rapid else "an arc or a rapid move"
+        if what is None and (turns(first) or turns(second)):  # (its fillet or chamfer would not turn a share)
+            what = "a move that turns a rotary axis"
+        if what is not None or not isinstance(second, Line):
             self._refuse_leaving(f"RND/CHF next to {what}", corner.block, corner.col)
             self.done = True
             warnings.warn(f"RND/CHF next to {what} is outside the motion interpreter's scope; "
@@ -518,7 +519,9 @@ class HeidenhainInterpreter(ModalInterpreter):
         if machine_datum and function is not None:
             events: list[Event] = [self._machine_move(block, function, function_item, words, rapid)]
         else:
-            events = self._path(block, function, function_item, words, rapid, rotation, rotary) if function else []
+            events = (
+                self._path(block, function, function_item, words, rapid, rotation, rotary) if function else []
+            )
         if self.unknown_axes:
             self._from_unknown(events, words)
         if retract is not None:

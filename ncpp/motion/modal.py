@@ -310,7 +310,12 @@ class ModalInterpreter:
         return tuple(self.rotary), start
 
     def line(
-        self, block: Block, end: list[float], rapid: bool, absolute: bool = True, rotary: list[float] | None = None
+        self,
+        block: Block,
+        end: list[float],
+        rapid: bool,
+        absolute: bool = True,
+        rotary: list[float] | None = None,
     ) -> Line:
         """A line from the position to `end`, turning A B C to `rotary` (None: they stand)."""
         start = as_point(self.pos)

@@ -812,8 +812,9 @@ class SinumerikInterpreter(ModalInterpreter):
             self._frame(frame, words)
             return []
         events: list[Event] = []
-        if dwell and any(letter in words for letter in ROTARY):
-            raise OutOfScope("a rotary axis word in a dwell block", words[next(a for a in ROTARY if a in words)][2].start + 1)
+        dwelling = next((words[a][2] for a in ROTARY if a in words), None) if dwell else None
+        if dwelling is not None:
+            raise OutOfScope("a rotary axis word in a dwell block", dwelling.start + 1)  # type: ignore[attr-defined]
         if not dwell:
             if "F" in words:
                 self.feed = words["F"][0]
@@ -1068,7 +1069,9 @@ class SinumerikInterpreter(ModalInterpreter):
         if not given:
             return None
         for k, value, mode, item in given:  # (DC: followed where the shortest way is none)
-            if mode == "dc" and not math.isclose(math.remainder(value - self.rotary[k], 360.0), 0.0, abs_tol=1e-9):
+            if mode == "dc" and not math.isclose(
+                math.remainder(value - self.rotary[k], 360.0), 0.0, abs_tol=1e-9
+            ):
                 raise OutOfScope(f"{item.letter}=DC() turning the axis (the shortest way within a turn)",
                                  item.start + 1)  # fmt: skip
         end = self.rotary_end((k, self.rotary[k] if mode == "dc" else value,

@@ -287,11 +287,11 @@ HEIDENHAIN = Dialect(
 from dataclasses import replace  # noqa: E402
 
 from ncpp.motion.segments import DRILLED, FLOW, PLANE_AXES, Arc, Event, Line, Pass  # noqa: E402
+from ncpp.passes.rotary import ROTARY, turns  # noqa: E402
 from ncpp.program.blocks import Block  # noqa: E402
 from ncpp.program.dialects.editing import splice  # noqa: E402
 from ncpp.program.dialects.iso import IsoWriter, _Units, written_apart  # noqa: E402
 from ncpp.program.numbers import NumberStyle, format_number, style_pattern  # noqa: E402
-from ncpp.passes.rotary import ROTARY, turns  # noqa: E402
 
 _AXES = "XYZ"
 _POLAR_WORDS = frozenset(("R", "PR", "PA", "IPR", "IPA"))

@@ -405,7 +405,10 @@ class SinumerikWriter(IsoWriter):
 
     def _new_blocks(self, block: Block, segments: list, eol: str, more: list[dict[str, str]] | None = None
                     ) -> list[str]:  # fmt: skip
-        return [self._new_block(block, segment, more[k] if more else None) + eol for k, segment in enumerate(segments)]
+        return [
+            self._new_block(block, segment, more[k] if more else None) + eol
+            for k, segment in enumerate(segments)
+        ]
 
     def _new_block(self, block: Block, segment: Line | Arc, more: dict[str, str] | None = None) -> str:
         inch = segment.context.inch
