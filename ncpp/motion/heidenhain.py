@@ -1025,16 +1025,17 @@ class HeidenhainInterpreter(ModalInterpreter):
     def _rotary(
         self, words: list[tuple[Word | ExprWord, float]], on_line: bool, machine_datum: bool
     ) -> list[float] | None:
-        """Where the block's rotary words (`ROTARY_WORDS`) turn A B C to; None where they stand
-        there already, which any block may say.  A turn is followed on a line (`on_line`: L or LP,
-        without M91 or a cycle call) where the control turns by the difference (not under M126)."""
+        """Where the block's rotary words (`ROTARY_WORDS`) put A B C, on a line (`on_line`: L or LP,
+        without M91 or a cycle call), a move as ISO's `G0 A0` is; None in another block, which may
+        name them where they stand.  A turn is followed where the control turns by the difference
+        (not under M126)."""
         item = words[0][0]
         if machine_datum:  # (the machine datum's rotary positions are not told)
             raise OutOfScope(f"the rotary axis word {item.letter} with M91", item.start + 1)
         axes = [ROTARY_WORDS[i.letter] for i, _ in words]
         end = self.rotary_end((k, value, incremental) for (k, incremental), (_, value) in zip(axes, words))
         if end == self.rotary:
-            return None
+            return end if on_line else None
         turned = next(i for (k, _), (i, _) in zip(axes, words) if end[k] != self.rotary[k])
         if not on_line:
             raise OutOfScope(f"a turn of the rotary axis {turned.letter[-1]} in a block other than a line L or LP",

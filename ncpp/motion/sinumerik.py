@@ -1063,8 +1063,9 @@ class SinumerikInterpreter(ModalInterpreter):
         return end
 
     def _rotary(self, words: dict, line: bool) -> list[float] | None:
-        """Where the block's rotary words (`ROTARY`) turn A B C to; None where they stand there
-        already (or no word names them).  A turn is followed on a `line` only."""
+        """Where the block's rotary words (`ROTARY`) put A B C on a `line` (G0 / G1), a move as ISO's
+        `G0 A0` is; None where no word names them, or in another move where they stand.  A turn is
+        followed on a line only."""
         given = [(ROTARY.index(a), *words[a]) for a in ROTARY if a in words]
         if not given:
             return None
@@ -1075,10 +1076,10 @@ class SinumerikInterpreter(ModalInterpreter):
                 raise OutOfScope(f"{item.letter}=DC() turning the axis (the shortest way within a turn)",
                                  item.start + 1)  # fmt: skip
         end = self.rotary_end((k, self.rotary[k] if mode == "dc" else value,
-                               mode == "dc" or mode == "ic" or (mode is None and not self.absolute))
+                               mode == "ic" or (mode is None and not self.absolute))
                               for k, value, mode, _ in given)  # fmt: skip
         if end == self.rotary:
-            return None
+            return end if line else None
         if not line:
             turned = next(item for k, _, _, item in given if end[k] != self.rotary[k])
             raise OutOfScope(f"a turn of the rotary axis {turned.letter} in a move other than G0 or G1",
@@ -1090,7 +1091,11 @@ class SinumerikInterpreter(ModalInterpreter):
         has_axes = any(a in words for a in AXES)
         arc_words = any(k in words for k in ("I", "J", "K", "CR", "TURN", *INTERMEDIATE))
         rotary = self._rotary(words, motion in (0.0, 1.0))
-        if not has_axes and not (arc_words and motion in (2.0, 3.0)) and rotary is None:
+        if (
+            not has_axes
+            and not (arc_words and motion in (2.0, 3.0))
+            and (rotary is None or motion not in (0.0, 1.0))
+        ):
             return []
         end = self._target(words)
         absolute = self.absolute  # the modal mode: a rewritten word is written plain, in that mode
