@@ -2,7 +2,8 @@
 
 Scope: `BEGIN PGM ... MM|INCH`, `TOOL CALL n|"NAME" Z DL..` (the tool axis gives the
 working plane; the tool's length L + DL from the tool table, TOOL.T, or from the
-program's `TOOL DEF n L..`, plus the call's DL, along that axis), `L` with X/Y/Z (absolute) and IX/IY/IZ (incremental) per word, `R0`,
+program's `TOOL DEF n L..`, plus the call's DL, along that axis), `L` with X/Y/Z (absolute) and IX/IY/IZ (incremental) per word
+and the rotary axes A/B/C and IA/IB/IC (`ROTARY_WORDS`), `R0`,
 `F`, `FMAX` (rapid, this block only), `FAUTO`, `CC` (the pole; its plane from
 the axes written), `C ... DR±` about the pole, `CR ... R± DR±` (R+: less than a
 half circle), `CT` (tangential arc), `LP`/`CP` polar with PR/IPR/PA/IPA (a
