@@ -1003,13 +1003,11 @@ class SinumerikInterpreter(ModalInterpreter):
 
     def _word_value(self, item: ExprWord, block: Block) -> tuple[float, str | None]:
         expr = item.expr
-        if expr[0] == "dc" and item.letter in ROTARY:
-            return self.value(expr[1], block, item), "dc"
-        if expr[0] in ("dc", "acp", "acn", "cac", "cic"):
+        if expr[0] in ("dc", "acp", "acn", "cac", "cic") and not (expr[0] == "dc" and item.letter in ROTARY):
             raise OutOfScope(f"the rotary-axis mode {expr[0].upper()}()", item.start + 1)
         if expr[0] == "str":
             return 0.0, None  # `T="MILL"`: a name, no motion
-        mode = expr[0] if expr[0] in ("ac", "ic") else None
+        mode = expr[0] if expr[0] in ("ac", "ic", "dc") else None
         value = self.value(expr[1] if mode else expr, block, item)
         if (
             self.expansion is not None
