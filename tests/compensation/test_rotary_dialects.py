@@ -186,3 +186,19 @@ def test_a_turn_ncpp_does_not_follow_ends_interpretation(tmp_path, name, program
     if name.endswith(".h"):  # (Klartext's blocks numbered again after the header)
         rest, tail = ([line.split(" ", 1)[1] for line in lines] for lines in (rest, tail))
     assert tail == rest
+
+
+def test_a_loop_written_out_turns_as_each_run_does(tmp_path):
+    """--expand: each run of `A=IC(5)` turns from where the run before left A (5, 10, 15), `C=DC(R1)`
+    is written with its value."""
+    program = ("DEF INT I\nR1=0\nG0 X-5 Y-5 Z5 C=DC(R1)\nFOR I=1 TO 3\n  G1 X0 Y0 Z=-I F300 C=DC(R1)\n"
+               "  X40 A=IC(5)\n  Y40\nENDFOR\nM30\n")  # fmt: skip
+    said, out = io.StringIO(), io.BytesIO()
+    process(io.BytesIO(program.encode()), out, file="l.mpf", source=_machine(tmp_path, turns=True),
+            warnings=Warnings(stream=said), offsets=PLACED, guard=None, expand=True)  # fmt: skip
+    written = out.getvalue().decode()
+    assert "FOR" not in written and "C=DC(0)" in written and "warning" not in said.getvalue()
+    ends = [
+        round(move.extra[0], 9) for move in _moves(written, "l.mpf") if move.extra_start[0] != move.extra[0]
+    ]
+    assert ends == [5.0, 10.0, 15.0]
