@@ -103,7 +103,7 @@ def test_a_rotary_word_where_the_axis_stands_is_a_plain_move(tmp_path, program, 
     programmed = next(line for line in program.splitlines() if "A0.0" in line or "A+0 C+0" in line)
     assert first != programmed  # (its X Y corrected, the rotary words kept)
     for letter in "XY":
-        assert 0 < abs(_word(first, letter) - _word(programmed, letter)) < 0.1  # type: ignore[operator]
+        assert 0 < abs(_word(first, letter) - _word(programmed, letter)) < 0.1
 
 
 @pytest.mark.parametrize("name", sorted(THREE_PLUS_TWO))

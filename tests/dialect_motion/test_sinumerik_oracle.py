@@ -79,7 +79,7 @@ def _ncpp(program: Path) -> tuple[list[tuple[float, ...]], str | None]:
                 point = tuple(round(e + o, 6) for e, o in zip(event.end, event.context.offset))
                 point += tuple(event.extra[:3]) if event.extra else (0.0, 0.0, 0.0)
                 if not positions or point != positions[-1]:
-                    positions.append(point)  # type: ignore[arg-type]
+                    positions.append(point)
     except NcppError as err:
         stopped = str(err)
     return positions, stopped or (warnings.getvalue() or None)
