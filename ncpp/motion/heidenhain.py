@@ -2,7 +2,8 @@
 
 Scope: `BEGIN PGM ... MM|INCH`, `TOOL CALL n|"NAME" Z DL..` (the tool axis gives the
 working plane; the tool's length L + DL from the tool table, TOOL.T, or from the
-program's `TOOL DEF n L..`, plus the call's DL, along that axis), `L` with X/Y/Z (absolute) and IX/IY/IZ (incremental) per word, `R0`,
+program's `TOOL DEF n L..`, plus the call's DL, along that axis), `L` with X/Y/Z (absolute) and IX/IY/IZ (incremental) per word
+and the rotary axes A/B/C and IA/IB/IC (`ROTARY_WORDS`), `R0`,
 `F`, `FMAX` (rapid, this block only), `FAUTO`, `CC` (the pole; its plane from
 the axes written), `C ... DR±` about the pole, `CR ... R± DR±` (R+: less than a
 half circle), `CT` (tangential arc), `LP`/`CP` polar with PR/IPR/PA/IPA (a
@@ -89,10 +90,18 @@ from ncpp.motion.segments import (
     Point,
 )
 from ncpp.motion.tools import ToolTable, UntoldLengths
+from ncpp.passes.rotary import turns
 from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
 
 AXES = "XYZ"
-ROTARY = ("A", "B", "C")
+# A B C, absolute (`A+90`) or incremental (`IA+10`) (TNC 640 Klartext manual, "Path functions": a straight
+# line L with rotary axis words); a turn is followed in an L or LP block, and where the control does not
+# take its own way: M126 turns a rotary axis the shortest way ("Shortest-path traverse of rotary axes: M126",
+# without it the axis turns by the difference of the positions, as ncpp follows them), and M94 reduces the
+# display of its position below 360 degrees ("Reducing display of a rotary axis to a value less than 360°")
+ROTARY_WORDS = {"A": (0, False), "B": (1, False), "C": (2, False), "IA": (0, True), "IB": (1, True),
+                "IC": (2, True)}  # fmt: skip
+SHORTEST_WAY, LONGER_WAY, REDUCED_DISPLAY = 126.0, 127.0, 94.0
 # Cycles that move or turn the datum (datum shift, mirror, rotation, scaling, working plane, presets)
 # Programs CALL PGM runs nest this deep (TNC 640 Klartext manual, "Nesting": "Maximum nesting
 # depth for calling NC main programs")
@@ -262,6 +271,7 @@ class HeidenhainInterpreter(ModalInterpreter):
         self.called_blocks = 0  # blocks run in called programs so far
         self._files: Files | None = None  # the called programs' files, once a call needs them
         self.expansion: KlartextExpansion | None = None  # --expand: what it writes (`heidenhain_expand`)
+        self.shortest_way = False  # M126: rotary axes turn the shortest way (ROTARY_WORDS)
 
     def run(self, blocks: Iterable[Block], warnings: Warnings) -> Iterator[Event]:
         """Events as `ModalInterpreter.run`; a feed line waits (with the events after it)
@@ -318,14 +328,17 @@ class HeidenhainInterpreter(ModalInterpreter):
     ) -> list[Event] | None:
         """[first line shortened, fillet or chamfer, second line] or None when out of scope."""
         where = Location(self.file, corner.block.line, corner.col)
-        if not isinstance(second, Line) or second.rapid:
-            self._refuse_leaving("RND/CHF next to an arc or a rapid move", corner.block, corner.col)
-            self.done = True
-            warnings.warn("RND/CHF next to an arc or a rapid move is outside the motion interpreter's scope; "
-                          "from this line on the program passes through uninterpreted", where)  # fmt: skip
-            return None
         first = held[0]
         assert isinstance(first, Line)  # `run` holds back a feed line and what follows it
+        what = None if isinstance(second, Line) and not second.rapid else "an arc or a rapid move"
+        if what is None and (turns(first) or turns(second)):  # (its fillet or chamfer would not turn a share)
+            what = "a move that turns a rotary axis"
+        if what is not None or not isinstance(second, Line):
+            self._refuse_leaving(f"RND/CHF next to {what}", corner.block, corner.col)
+            self.done = True
+            warnings.warn(f"RND/CHF next to {what} is outside the motion interpreter's scope; "
+                          "from this line on the program passes through uninterpreted", where)  # fmt: skip
+            return None
         try:
             return round_corner(first, second, corner.kind, corner.size, corner.block, corner.feed)
         except CornerError as err:
@@ -357,6 +370,7 @@ class HeidenhainInterpreter(ModalInterpreter):
         at_position = False  # CYCL CALL POS: the block's X Y Z are where the cycle runs
         at_pattern = False  # CYCL CALL PAT: the cycle runs at the holes of the PATTERN DEF
         defined: str | None = None  # CYCL DEF of a drilling cycle: its number
+        rotary_words: list[tuple[Word | ExprWord, float]] = []
         for item in block.items:
             if type(item) is Comment:
                 continue
@@ -376,16 +390,20 @@ class HeidenhainInterpreter(ModalInterpreter):
                         raise OutOfScope("M128 (tool-centre-point control)", item.start + 1)
                     if value == 92.0:  # (its datum is a machine parameter ncpp is not told)
                         raise OutOfScope("M92 (a position the machine tool builder sets)", item.start + 1)
+                    if value == REDUCED_DISPLAY and (self.uses_rotary or rotary_words):
+                        raise OutOfScope("M94 (it reduces a rotary axis's position below 360 degrees)",
+                                         item.start + 1)  # fmt: skip
+                    if value in (SHORTEST_WAY, LONGER_WAY):
+                        self.shortest_way = value == SHORTEST_WAY
                     machine_datum = machine_datum or value == 91.0
                     if value in END_M and self.programs:
                         raise OutOfScope(f"M{value:g} in a program CALL PGM runs (its END PGM returns)",
                                          item.start + 1)  # fmt: skip
                     end = end or value in END_M
                     continue
-                if letter in ROTARY:  # (its moves would be compensated as if the axis stood)
-                    raise OutOfScope(
-                        f"the rotary axis {letter} (this interpreter follows X Y Z)", item.start + 1
-                    )
+                if letter in ROTARY_WORDS:
+                    rotary_words.append((item, value))
+                    continue
                 words[letter] = (value, item)
                 continue
             what, node = item.kind, item.node
@@ -474,6 +492,10 @@ class HeidenhainInterpreter(ModalInterpreter):
                           "touch_probe": f"TCH PROBE {node[0]} (a touch probe cycle: it probes, and may set"
                                          " the datum or the tool's data)"}.get(what, what)  # fmt: skip
                 raise OutOfScope(reason, item.start + 1)
+        rotary = None
+        if rotary_words:
+            on_line = function in ("L", "LP") and not machine_datum and call is None
+            rotary = self._rotary(rotary_words, on_line, machine_datum)
         if defined is not None:
             self._define_cycle(defined, block)
             return []
@@ -499,7 +521,9 @@ class HeidenhainInterpreter(ModalInterpreter):
         if machine_datum and function is not None:
             events: list[Event] = [self._machine_move(block, function, function_item, words, rapid)]
         else:
-            events = self._path(block, function, function_item, words, rapid, rotation) if function else []
+            events = (
+                self._path(block, function, function_item, words, rapid, rotation, rotary) if function else []
+            )
         if self.unknown_axes:
             self._from_unknown(events, words)
         if retract is not None:
@@ -1004,12 +1028,42 @@ class HeidenhainInterpreter(ModalInterpreter):
                 written.add(n)
         return end, written
 
+    def _rotary(
+        self, words: list[tuple[Word | ExprWord, float]], on_line: bool, machine_datum: bool
+    ) -> list[float] | None:
+        """Where the block's rotary words (`ROTARY_WORDS`) put A B C, on a line (`on_line`: L or LP,
+        without M91 or a cycle call), a move as ISO's `G0 A0` is; None in another block, which may
+        name them where they stand.  A turn is followed where the control turns by the difference
+        (not under M126)."""
+        item = words[0][0]
+        if machine_datum:  # (the machine datum's rotary positions are not told)
+            raise OutOfScope(f"the rotary axis word {item.letter} with M91", item.start + 1)
+        axes = [ROTARY_WORDS[i.letter] for i, _ in words]
+        end = self.rotary_end((k, value, incremental) for (k, incremental), (_, value) in zip(axes, words))
+        if end == self.rotary:
+            return end if on_line else None
+        turned = next(i for (k, _), (i, _) in zip(axes, words) if end[k] != self.rotary[k])
+        if not on_line:
+            raise OutOfScope(f"a turn of the rotary axis {turned.letter[-1]} in a block other than a line L or LP",
+                             turned.start + 1)  # fmt: skip
+        if self.shortest_way:
+            raise OutOfScope(f"a turn of the rotary axis {turned.letter[-1]} under M126 (the shortest way)",
+                             turned.start + 1)  # fmt: skip
+        return end
+
     def _path(
-        self, block: Block, function: str, item, words: dict, rapid: bool, rotation: str | None
+        self,
+        block: Block,
+        function: str,
+        item,
+        words: dict,
+        rapid: bool,
+        rotation: str | None,
+        rotary: list[float] | None = None,
     ) -> list[Event]:
         end, written = self._target(words)
         if function == "L":
-            return [self.line(block, end, rapid)] if written else []
+            return [self.line(block, end, rapid, rotary=rotary)] if written or rotary else []
         if function == "CC":
             return [self._set_pole(block, end, written)]
         if function == "C":
@@ -1023,7 +1077,7 @@ class HeidenhainInterpreter(ModalInterpreter):
         if function == "CT":
             return [self.tangential(block, end)]
         if function == "LP":
-            return [self.line(block, self._polar(block, item, words, end), rapid)]
+            return [self.line(block, self._polar(block, item, words, end), rapid, rotary=rotary)]
         if function == "CP":
             return [self._polar_arc(block, item, words, end, rotation)]
         raise OutOfScope(f"the path function {function}", item.start + 1)

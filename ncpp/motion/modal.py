@@ -26,6 +26,7 @@ RADIUS_TOLERANCE = (
     0.01  # mm: start and end radius of a centre-format arc may differ this much (controller default)
 )
 PLANE_OF_TOOL_AXIS = {"Z": 17, "Y": 18, "X": 19}
+ROTARY = "ABC"  # the rotary axes whose words the dialects follow, in `Line.extra`'s order
 MAX_HOLES = 10_000  # holes of one pattern a control computes: beyond, the counts are a mistake, not a part
 
 
@@ -110,6 +111,10 @@ class ModalInterpreter:
         self._context: Context | None = None
         self.subroutine_path: tuple[Path, ...] = ()  # the folders of the program files it calls
         self.expand = False  # --expand: subprograms and loops written out (the dialect's own)
+        # A B C where the program turned them; 0 before a word names them, as rs274ngc assumes of an
+        # axis not yet positioned (the ISO reading).  Moves carry them (`Line.extra`) once a word did.
+        self.rotary = [0.0, 0.0, 0.0]
+        self.uses_rotary = False
 
     def loop_state(self) -> tuple:
         """The state a loop that comes back to it repeats for ever with (`endless.py`), but the
@@ -286,14 +291,42 @@ class ModalInterpreter:
         self.feed = programmed
         return events
 
-    def line(self, block: Block, end: list[float], rapid: bool, absolute: bool = True) -> Line:
+    def rotary_end(self, given: Iterable[tuple[int, float, bool]]) -> list[float]:
+        """Where a block's rotary words turn A B C to: (axis 0-2, value, incremental) each."""
+        self.uses_rotary = True
+        end = list(self.rotary)
+        for k, value, incremental in given:
+            end[k] = self.rotary[k] + value if incremental else value
+        return end
+
+    def _rotary_move(self, rotary: list[float] | None) -> tuple[tuple[float, ...], tuple[float, ...]]:
+        """A move's (end, start) of A B C, turning them to `rotary` (None: they stand); none
+        before a word named them."""
+        if not self.uses_rotary:
+            return (), ()
+        start = tuple(self.rotary)
+        if rotary is not None:
+            self.rotary = list(rotary)
+        return tuple(self.rotary), start
+
+    def line(
+        self,
+        block: Block,
+        end: list[float],
+        rapid: bool,
+        absolute: bool = True,
+        rotary: list[float] | None = None,
+    ) -> Line:
+        """A line from the position to `end`, turning A B C to `rotary` (None: they stand)."""
         start = as_point(self.pos)
         d = [e - s for e, s in zip(end, start)]
         length = math.sqrt(sum(v * v for v in d))
         if length > 0:
             self.tangent = (d[0] / length, d[1] / length, d[2] / length)
         self.pos = list(end)
-        return Line(start, as_point(end), rapid, self.feed, block, self.context(absolute=absolute))
+        extra, extra_start = self._rotary_move(rotary)
+        return Line(start, as_point(end), rapid, self.feed, block, self.context(absolute=absolute), extra,
+                    extra_start=extra_start)  # fmt: skip
 
     def arc(
         self,
@@ -310,7 +343,9 @@ class ModalInterpreter:
         start = as_point(self.pos)
         c = list(centre)
         c[n] = start[n]
-        event = Arc(start, as_point(end), as_point(c), turn, self.feed, block, self.context(plane, absolute))
+        extra, extra_start = self._rotary_move(None)  # (a dialect leaves an arc that turns them out of scope)
+        event = Arc(start, as_point(end), as_point(c), turn, self.feed, block, self.context(plane, absolute),
+                    extra, extra_start=extra_start)  # fmt: skip
         # tangent at the end: perpendicular to the radius, turning with the arc, plus the helix rise
         ra, rb = end[a] - c[a], end[b] - c[b]
         sign = 1.0 if turn > 0 else -1.0

@@ -3,7 +3,7 @@
 Scope: G0-G3 with I/J/K (incremental, `I=AC(..)` absolute) or `CR=` (negative:
 more than a half circle), `TURN=` extra helix turns, `CIP` with `I1=/J1=/K1=`
 (an arc through an intermediate point, in a principal plane), `CT` (tangential
-arc), G90/G91 and `AC()`/`IC()` per word, G17/G18/G19, G70/G71/G700/G710,
+arc), G90/G91 and `AC()`/`IC()` per word, the rotary axes A B C (`ROTARY`), G17/G18/G19, G70/G71/G700/G710,
 `TRANS`/`ATRANS` (translation only), R parameters and `DEF` variables with
 arithmetic, labels, `MSG`, G4 dwell, M2/M17/M30 (end), and tool lengths: `T n`
 or `T="NAME"` selects, M6 loads it with cutting edge D1, `D n` picks an edge
@@ -66,6 +66,11 @@ from ncpp.motion.tools import ToolTable, UntoldLengths
 from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
 
 AXES = "XYZ"
+# The rotary axes A B C: `A90` absolute in G90, incremental in G91, `A=AC(..)` / `A=IC(..)` absolute /
+# incremental in either; `A=DC(..)` turns by the shortest way to its position within a turn (840D sl
+# Programming Manual Fundamentals, "Absolute dimensions for rotary axes (DC, ACP, ACN)"): followed where
+# the axis stands there (the shortest way is none), else, and ACP / ACN, out of scope.  A turn is followed
+# on a line G0 / G1 (`_move`).
 ROTARY = ("A", "B", "C")
 CENTRE_LETTERS = "IJK"
 INTERMEDIATE = ("I1", "J1", "K1")
@@ -774,10 +779,6 @@ class SinumerikInterpreter(ModalInterpreter):
                     # The contour offset widens the tool radius the control compensates by (Fundamentals,
                     # "Tool radius compensation (G40, G41, G42, OFFN)"); 0, the reset value, changes nothing.
                     raise OutOfScope("the contour offset OFFN=", item.start + 1)
-                if letter in ROTARY:  # (its moves would be compensated as if the axis stood)
-                    raise OutOfScope(
-                        f"the rotary axis {letter} (this interpreter follows X Y Z)", item.start + 1
-                    )
                 if letter == "L" and type(item) is Word and item.number.isdigit():
                     # (leading zeros name another subprogram: L0100 is not L100)
                     self.called = self._call(block, item, f"L{item.number}", ())
@@ -811,6 +812,9 @@ class SinumerikInterpreter(ModalInterpreter):
             self._frame(frame, words)
             return []
         events: list[Event] = []
+        dwelling = next((words[a][2] for a in ROTARY if a in words), None) if dwell else None
+        if dwelling is not None:
+            raise OutOfScope("a rotary axis word in a dwell block", dwelling.start + 1)  # type: ignore[attr-defined]
         if not dwell:
             if "F" in words:
                 self.feed = words["F"][0]
@@ -999,11 +1003,11 @@ class SinumerikInterpreter(ModalInterpreter):
 
     def _word_value(self, item: ExprWord, block: Block) -> tuple[float, str | None]:
         expr = item.expr
-        if expr[0] in ("dc", "acp", "acn", "cac", "cic"):
+        if expr[0] in ("dc", "acp", "acn", "cac", "cic") and not (expr[0] == "dc" and item.letter in ROTARY):
             raise OutOfScope(f"the rotary-axis mode {expr[0].upper()}()", item.start + 1)
         if expr[0] == "str":
             return 0.0, None  # `T="MILL"`: a name, no motion
-        mode = expr[0] if expr[0] in ("ac", "ic") else None
+        mode = expr[0] if expr[0] in ("ac", "ic", "dc") else None
         value = self.value(expr[1] if mode else expr, block, item)
         if (
             self.expansion is not None
@@ -1056,16 +1060,45 @@ class SinumerikInterpreter(ModalInterpreter):
                 self.frame_shift[n] = 0.0
         return end
 
+    def _rotary(self, words: dict, line: bool) -> list[float] | None:
+        """Where the block's rotary words (`ROTARY`) put A B C on a `line` (G0 / G1), a move as ISO's
+        `G0 A0` is; None where no word names them, or in another move where they stand.  A turn is
+        followed on a line only."""
+        given = [(ROTARY.index(a), *words[a]) for a in ROTARY if a in words]
+        if not given:
+            return None
+        for k, value, mode, item in given:  # (DC: followed where the shortest way is none)
+            if mode == "dc" and not math.isclose(
+                math.remainder(value - self.rotary[k], 360.0), 0.0, abs_tol=1e-9
+            ):
+                raise OutOfScope(f"{item.letter}=DC() turning the axis (the shortest way within a turn)",
+                                 item.start + 1)  # fmt: skip
+        end = self.rotary_end((k, self.rotary[k] if mode == "dc" else value,
+                               mode == "ic" or (mode is None and not self.absolute))
+                              for k, value, mode, _ in given)  # fmt: skip
+        if end == self.rotary:
+            return end if line else None
+        if not line:
+            turned = next(item for k, _, _, item in given if end[k] != self.rotary[k])
+            raise OutOfScope(f"a turn of the rotary axis {turned.letter} in a move other than G0 or G1",
+                             turned.start + 1)  # fmt: skip
+        return end
+
     def _move(self, block: Block, words: dict) -> list[Event]:
         motion = self.motion
         has_axes = any(a in words for a in AXES)
         arc_words = any(k in words for k in ("I", "J", "K", "CR", "TURN", *INTERMEDIATE))
-        if not has_axes and not (arc_words and motion in (2.0, 3.0)):
+        rotary = self._rotary(words, motion in (0.0, 1.0))
+        if (
+            not has_axes
+            and not (arc_words and motion in (2.0, 3.0))
+            and (rotary is None or motion not in (0.0, 1.0))
+        ):
             return []
         end = self._target(words)
         absolute = self.absolute  # the modal mode: a rewritten word is written plain, in that mode
         if motion in (0.0, 1.0):
-            return [self.line(block, end, motion == 0.0, absolute)]
+            return [self.line(block, end, motion == 0.0, absolute, rotary)]
         if motion == "CT":
             return [self.tangential(block, end, absolute)]
         if motion == "CIP":
@@ -1080,6 +1113,9 @@ class SinumerikInterpreter(ModalInterpreter):
     def _machine_move(self, block: Block, words: dict) -> list[Event]:
         """A G0/G1 block in machine coordinates (G53, G153, SUPA): left as programmed (MACHINE);
         the axes it names end at the machine positions it says."""
+        rotary = next((words[a][2] for a in ROTARY if a in words), None)
+        if rotary is not None:  # (the rotary axes' machine positions are not told)
+            raise OutOfScope(f"the rotary axis word {rotary.letter} in machine coordinates", rotary.start + 1)
         if not any(a in words for a in AXES):
             return []
         item = next(iter(words.values()))[2]

@@ -186,7 +186,7 @@ class SinumerikExpansion:
         seen = self.seen.get(id(item))
         if seen is not None:
             return seen
-        expr = item.expr[1] if item.expr[0] in ("ac", "ic") else item.expr
+        expr = item.expr[1] if item.expr[0] in ("ac", "ic", "dc") else item.expr
         return value(expr, block, item)
 
     # -- the variables the written program has ----------------------------------------------------
@@ -222,9 +222,9 @@ def _is_label(item: AnyItem) -> bool:
 
 
 def _word(item: ExprWord, value: float) -> str:
-    """`X12.5`, `X=AC(7)`, `CR=5`: the word with its value, in the block's own form."""
+    """`X12.5`, `X=AC(7)`, `C=DC(0)`, `CR=5`: the word with its value, in the block's own form."""
     mode = item.expr[0]
-    if mode in ("ac", "ic"):
+    if mode in ("ac", "ic", "dc"):
         return f"{item.letter}={mode.upper()}({number(value)})"
     if len(item.letter) == 1:
         return item.letter + number(value, item.letter)

@@ -287,6 +287,7 @@ HEIDENHAIN = Dialect(
 from dataclasses import replace  # noqa: E402
 
 from ncpp.motion.segments import DRILLED, FLOW, PLANE_AXES, Arc, Event, Line, Pass  # noqa: E402
+from ncpp.passes.rotary import ROTARY, turns  # noqa: E402
 from ncpp.program.blocks import Block  # noqa: E402
 from ncpp.program.dialects.editing import splice  # noqa: E402
 from ncpp.program.dialects.iso import IsoWriter, _Units, written_apart  # noqa: E402
@@ -443,6 +444,7 @@ class HeidenhainWriter(IsoWriter):
         own = next((n for n, e in enumerate(motion) if type(e) is own_kind), 0)
         # M99 calls its cycle after the block's move: with the move in pieces, on the last piece's block
         call, last_piece = _called_on(block, motion, own)
+        rotary = self._rotary_words(block, motion, own)
         for n, segment in enumerate(motion):
             if (
                 n > own and segment.fixed
@@ -454,13 +456,31 @@ class HeidenhainWriter(IsoWriter):
                 yield self._inserted(self._cc_text(*centre_plane))
                 self.output_pole = centre_plane
             if n == own:
-                yield self._numbered(block, self._edit(block, segment, feed, () if call is None else (call,)))
+                dropped = () if call is None else (call,)
+                yield self._numbered(block, self._edit(block, segment, feed, dropped, rotary[n]))
             else:
                 word = block.items[call] if n == last_piece and call is not None else None
                 moved = "" if word is None else " " + block.raw[word.start : word.end]
-                yield self._inserted(self._fresh(segment) + feed + moved)
+                yield self._inserted(self._fresh(segment, rotary[n]) + feed + moved)
             feed = ""  # on the first block written
             self._remember_end(segment)
+
+    def _rotary_words(self, block: Block, motion: list, own: int) -> list[dict[str, str]]:
+        """Per move of a block that turns a rotary axis in pieces: the absolute rotary words
+        (`A+22.5`) each piece writes, as ISO's `_piece_words`: the block's own piece those its words
+        name that it does not turn to their end, every other piece those it turns."""
+        if len(motion) < 2 or not any(type(m) is Line and turns(m) for m in motion):
+            return [{}] * len(motion)
+        named = {i.letter[-1] for i in block.items
+                 if isinstance(i, (Word, ExprWord)) and i.letter.lstrip("I") in ROTARY and len(i.letter) <= 2}  # fmt: skip
+        final = motion[-1].extra
+        out = []
+        for n, piece in enumerate(motion):
+            axes = (range(len(piece.extra)) if type(piece) is Line and turns(piece) else ()) if n != own else [
+                k for k, letter in enumerate(ROTARY) if letter in named and piece.extra[k] != final[k]]  # fmt: skip
+            out.append({ROTARY[k]: self._word(ROTARY[k], piece.extra[k], piece) for k in axes
+                        if n == own or piece.extra[k] != piece.extra_start[k]})  # fmt: skip
+        return out
 
     def _position_call(self, block: Block, motion: list):
         """`CYCL CALL POS` whose move in the plane is compensated: its X and Y say where that move
@@ -558,8 +578,8 @@ class HeidenhainWriter(IsoWriter):
         n = PLANE_AXES[segment.context.plane][2]
         return self._increment("I" + _AXES[n], n, segment) != 0.0
 
-    def _fresh(self, segment: Line | Arc) -> str:
-        """A new block for a further piece of a changed block."""
+    def _fresh(self, segment: Line | Arc, rotary: dict[str, str] | None = None) -> str:
+        """A new block for a further piece of a changed block (with its `rotary` words)."""
         if isinstance(segment, Arc):
             return self._arc_text(segment)
         # the axes that moved in the output (`_moved`, with the units' places read once per line)
@@ -575,7 +595,7 @@ class HeidenhainWriter(IsoWriter):
             for n, axis in enumerate(_AXES)
             if last is None or written_apart(end[n], places[n], last[n], last_places[n])
         ]
-        return "L " + " ".join(words) + (" FMAX" if segment.rapid else "")
+        return "L " + " ".join(words + list((rotary or {}).values())) + (" FMAX" if segment.rapid else "")
 
     def _arc_text(self, segment: Arc) -> str:
         rotation = "DR+" if segment.turn > 0 else "DR-"
@@ -586,9 +606,10 @@ class HeidenhainWriter(IsoWriter):
         first, second = sorted((a, b))
         return f"C {self._word(_AXES[first], segment.end[first], segment)} {self._word(_AXES[second], segment.end[second], segment)} {rotation}"
 
-    def _edit(self, block: Block, segment: Line | Arc, feed: str = "", dropped: tuple[int, ...] = ()) -> str:
+    def _edit(self, block: Block, segment: Line | Arc, feed: str = "", dropped: tuple[int, ...] = (),
+              rotary: dict[str, str] | None = None) -> str:  # fmt: skip
         """The block's raw text made to say `segment` (its other words, F, M, comments kept,
-        but the items at `dropped`; `feed` added)."""
+        but the items at `dropped`; `feed` added; its rotary words those of `rotary`, where it names them)."""
         index, function = _function(block)
         assert index is not None  # a block that moves has its path function
         arc = segment if isinstance(segment, Arc) else None
@@ -625,6 +646,8 @@ class HeidenhainWriter(IsoWriter):
                 anchor = item
             elif type(item) is Statement and item.kind == "rotation" and arc is not None:
                 texts[n] = "DR+" if arc.turn > 0 else "DR-"
+            elif rotary and isinstance(item, (Word, ExprWord)) and item.letter.lstrip("I") in rotary:
+                texts[n] = rotary[item.letter.lstrip("I")]  # (`IA+90` too: a piece writes where it ends)
         extra = [self._word(_AXES[k], segment.end[k], segment) for k in range(3) if k not in written and (
             k in plane_axes or (_AXES[k] in self.known_axes and self._moved(_AXES[k], segment.end[k], segment)))]  # fmt: skip
         if arc is not None and not any(type(i) is Statement and i.kind == "rotation" for i in block.items):

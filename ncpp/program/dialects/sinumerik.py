@@ -359,21 +359,30 @@ class SinumerikWriter(IsoWriter):
             texts["CR"] = self._format("CR", radius, segment)
         return texts
 
-    # (no `more`: ISO's `_write_pieces` gives it for the axes beyond X Y Z and for G93, which the
-    # Sinumerik reading lacks: so as `_new_blocks`)
-    def _edit_block(self, block: Block, segment: Line | Arc) -> str:  # type: ignore[override]
+    # (`more`: a piece's own words, ISO's `_write_pieces`: the rotary axes' positions, `_piece_words`)
+    def _edit_block(self, block: Block, segment: Line | Arc, more: dict[str, str] | None = None) -> str:
         facts = self._facts(block)
         if block.signature is not None and not facts.machine and facts.letters.isdisjoint(_ISO_ONLY):
             # one-letter words and comments only (`X10.5 Y2.25`): ISO's edit, by compiled plans, says the same
-            return super()._edit_block(block, segment)
-        return self._edit_in_general(block, segment)
+            return super()._edit_block(block, segment, more)
+        return self._edit_in_general(block, segment, more)
 
-    def _edit_in_general(self, block: Block, segment: Line | Arc) -> str:
-        words = self._texts(block, segment)
+    def _piece_words(self, block: Block, pieces: list) -> list[dict[str, str]]:
+        """ISO's, a position written `=AC(..)` in G91, where a plain word would be an increment (840D sl
+        Programming Manual Fundamentals, "Absolute dimensions (G90, AC)")."""
+        out = super()._piece_words(block, pieces)
+        for words, piece in zip(out, pieces):
+            if not piece.context.absolute:
+                words.update((letter, f"=AC({text})") for letter, text in words.items() if letter in "ABC")
+        return out
+
+    def _edit_in_general(self, block: Block, segment: Line | Arc, more: dict[str, str] | None = None) -> str:
+        words = {**self._texts(block, segment), **(more or {})}
         texts: dict[int, str | None] = {}
         for n, item in enumerate(block.items):
             if type(item) is ExprWord and item.letter in words:
-                texts[n] = f"{item.letter}={words.pop(item.letter)}"
+                text = words.pop(item.letter)
+                texts[n] = item.letter + text if text.startswith("=") else f"{item.letter}={text}"
             elif type(item) is ExprWord and item.letter in _ARC_ONLY + tuple("IJK") + tuple(AXES):
                 texts[n] = None  # (an axis the block does not move after a change of units: `_bits_written`)
             elif type(item) is Statement and item.kind == "path" and item.node[0] in _MOTION_PATHS:
@@ -394,17 +403,21 @@ class SinumerikWriter(IsoWriter):
         self._remember_end(segment)
         return raw
 
-    def _new_blocks(self, block: Block, segments: list, eol: str) -> list[str]:  # type: ignore[override]
-        return [self._new_block(block, segment) + eol for segment in segments]
+    def _new_blocks(self, block: Block, segments: list, eol: str, more: list[dict[str, str]] | None = None
+                    ) -> list[str]:  # fmt: skip
+        return [
+            self._new_block(block, segment, more[k] if more else None) + eol
+            for k, segment in enumerate(segments)
+        ]
 
-    def _new_block(self, block: Block, segment: Line | Arc) -> str:
+    def _new_block(self, block: Block, segment: Line | Arc, more: dict[str, str] | None = None) -> str:
         inch = segment.context.inch
         units = self._resolved.get(inch) or self._units(inch)
         code = self._motion_code(segment)
         motion = code if code != self.output_motion else None
         sep = self._spelling(block)[0]  # packed blocks: new ones are spaced (`X1=...` needs it)
         sep = sep if sep and not sep.strip() else " "
-        if units.plain and (type(segment) is Line or not self._uses_cr(block)):
+        if units.plain and not more and (type(segment) is Line or not self._uses_cr(block)):
             # one template per letters written, motion and separator: `G1 X{0:z.4f} Y{1:z.4f}`
             bits = self._written_bits(self._facts(block), segment, units)
             templates = units.new_lines.setdefault(("sinumerik", sep), {})
@@ -417,7 +430,7 @@ class SinumerikWriter(IsoWriter):
                 )
             text = template.format(*self._numbers(segment, units.places))
         else:
-            words = self._texts(block, segment)
+            words = {**self._texts(block, segment), **(more or {})}
             parts = [f"G{motion}"] if motion is not None else []
             parts += [
                 f"{letter}={text}" if len(letter) > 1 else letter + text for letter, text in words.items()
