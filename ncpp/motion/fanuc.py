@@ -35,6 +35,10 @@ point: out of scope.  So is `G10 L2 P0`, which sets the external workpiece zero 
 shifts every system (Fanuc operator's manual, "Changing workpiece coordinate system": P0 the
 external offset, P1-P6 G54-G59), where LinuxCNC's sets the system in effect; a P that is an
 expression may be 0 there.
+`G10 L2 Pn` in G91 adds its values to system n's zero, where in G90 it sets them (Fanuc Series
+0i-MD operator's manual, "Changing workpiece coordinate system": with an incremental command the
+value is added to the offset; Haas's "Programmable Offsets": `G10 L2 P1 G91 X60.` moves G54's X
+60 mm); LinuxCNC's sets them in either.
 
 A G00 written in a G28 or G30 block (`G0 G28 G91 Z0.`, which Mastercam's and Fusion's Fanuc and Haas
 posts write before each tool change) only sets the modal motion: these controls take G codes of
@@ -154,6 +158,7 @@ class FanucInterpreter(Interpreter):
     still_r_arc = True  # `G02 R..` ending where it starts does not move (module docstring)
     r_over_ijk = True  # `G02 X.. Y.. R.. I.. J..`: R's arc, I J ignored (module docstring)
     independent_h = True  # `G53 G00 H0 Z-110`: an H without G43, out of scope (module docstring)
+    incremental_zero_set = True  # `G91 G10 L2 P1 X10.` adds 10 to G54's X (module docstring)
 
     def block(self, block: Block) -> Event | tuple[Event, ...]:
         signature = block.signature

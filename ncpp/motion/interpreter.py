@@ -267,6 +267,8 @@ class Interpreter:
     still_r_arc = False
     # R with I, J or K in an arc block: the arc is R's, the others are ignored (Fanuc); rs274ngc refuses it
     r_over_ijk = False
+    # G10 L2 in G91 adds its values to the offset (Fanuc, Haas); rs274ngc sets them whatever G90/G91
+    incremental_zero_set = False
 
     def __init__(self, file: str = "<stdin>", offsets: WorkOffsets | None = None):
         self.file = file
@@ -333,6 +335,8 @@ class Interpreter:
         # systems whose zero is still the one ncpp was told (the program has not set it with G10):
         # the placement guard checks them where the program selects them (`Pass.zero_told`)
         self.told_zeros: set[int] = set()
+        # systems whose zero the program has set (G10): whether it is known from then on (`_zero_set`)
+        self.zeros_set: dict[int, bool] = {}
         self.warnings: Warnings | None = None
         self.flow: Flow | None = None  # while `run` runs
         # Fanuc: the axes (0 X, 1 Y, 2 Z) a move has put at a programmed position since the start or
@@ -647,6 +651,7 @@ class Interpreter:
                 self.inverse_time,
                 self.coord_system,
                 str(self.spindle_tool) if self.spindle_tool else "",
+                self.zeros_set.get(self.coord_system),
             )
         return self._context
 
@@ -1444,12 +1449,14 @@ class Interpreter:
             p = round(words.get("P", (0.0,))[0])
             number = self.coord_system if p == 0 else p
             old = self.g5x[number][:]
+            added = self.incremental_zero_set and not self.absolute
+            self._zero_set(number, {i for i, _ in given}, words["L"][0] == 20.0, added)
             self.told_zeros.discard(number)
             if {0, 1, 2} <= {i for i, _ in given}:  # the program says where it is
                 self.untold.discard(number)
             for i, value in given:
                 if words["L"][0] == 2.0:
-                    self.g5x[number][i] = value
+                    self.g5x[number][i] = value + (old[i] if added else 0.0)
                 else:  # L20: the current point gets the given coordinates
                     self.g5x[number][i] = self.pos[i] + self.g5x[self.coord_system][i] - value
             if number == self.coord_system:
@@ -1459,6 +1466,17 @@ class Interpreter:
         elif code in (28.0, 30.0):
             return self._go_home(block, given, self.home[int(code)])
         return setting
+
+    def _zero_set(self, number: int, axes: set[int], l20: bool, added: bool) -> None:
+        """Whether system `number`'s zero is known after a G10 of `axes` sets it (`zeros_set`): G10 L2
+        giving X Y Z from the machine zero makes it known; G10 L20 sets it from where the tool
+        stands, which may be where the operator jogged it: not known; other axes, or values added to
+        it (G91 G10 L2 on Fanuc), leave it as known as it was (where the program did not set it
+        before, as ncpp is told it)."""
+        if l20:
+            self.zeros_set[number] = False
+        elif not added and {0, 1, 2} <= axes:
+            self.zeros_set[number] = True
 
     def _go_home(self, block: Block, given: list[tuple[int, float]], home: list[float]) -> tuple[Event, ...]:
         """G28/G30: rapid to the (optional) intermediate point, then home the given axes (all if none).
