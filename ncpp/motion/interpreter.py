@@ -269,6 +269,9 @@ class Interpreter:
     r_over_ijk = False
     # G10 L2 in G91 adds its values to the offset (Fanuc, Haas); rs274ngc sets them whatever G90/G91
     incremental_zero_set = False
+    # G92 with S and no axis words is a spindle speed clamp (Fanuc's lathes and machining centres): the
+    # refusal says so (`G92_SPEED_CLAMP`); rs274ngc has no G92 S and refuses it as a G92 without axes
+    g92_speed_clamp = False
 
     def __init__(self, file: str = "<stdin>", offsets: WorkOffsets | None = None):
         self.file = file
@@ -1032,7 +1035,7 @@ class Interpreter:
                 if any_item is not None and not covets_axes:
                     self._fail("Cannot use axis values with G80", block, any_item)
                 if axis_item is None and mode0 in (52.0, 92.0):
-                    self._fail("All axes missing with g52 or g92", block, block.items[0])
+                    self._no_axes(block, mode0)
                 return None
             if covets_axes:
                 self._fail("Cannot use two g codes that both use axis values", block, mode1_item)
@@ -1041,7 +1044,7 @@ class Interpreter:
             return mode1
         if covets_axes:
             if axis_item is None and mode0 in (52.0, 92.0):
-                self._fail("All axes missing with g52 or g92", block, block.items[0])
+                self._no_axes(block, mode0)
             return None
         if any_item is not None:
             if self.motion is None:
@@ -1991,6 +1994,17 @@ class Interpreter:
         }.get(name)
         return value
 
+    def _no_axes(self, block: Block, mode0: float) -> NoReturn:
+        """G52 or G92 without axis words: refused, as rs274ngc does; where a G92 with S is a spindle
+        speed clamp (`g92_speed_clamp`), the refusal says what it is."""
+        words = [item for item in block.items if type(item) is Word or type(item) is ExprWord]
+        if mode0 == 92.0 and self.g92_speed_clamp and any(w.letter == "S" for w in words):
+            g92 = next(
+                (w for w in words if type(w) is Word and w.letter == "G" and w.value == 92.0), words[0]
+            )
+            self._fail(G92_SPEED_CLAMP, block, g92)
+        self._fail("All axes missing with g52 or g92", block, block.items[0])
+
     def _fail(self, message: str, block: Block, item) -> NoReturn:
         col = item.start + 1 if item is not None else None
         raise NcppError(message, Location(self.file, block.line, col))
@@ -2002,6 +2016,12 @@ class Interpreter:
 _NOT_LOOP_STATE = frozenset(("params", "flow", "warnings", "untold_lengths", "expansion", "tools",
                              "file", "subroutine_path", "expand_cycles", "_context", "_fast",
                              "rounding"))  # fmt: skip
+# Fanuc lathes' maximum spindle speed clamp in G-code systems B and C (system A's G50 S), and Fanuc
+# machining centres' under constant surface speed (their G code list: G92 "setting for workpiece
+# coordinate system or clamp at maximum spindle speed"; `lathe.py`): no move, no offset
+G92_SPEED_CLAMP = ("G92 with S and no axis words (a spindle speed clamp: Fanuc lathe G-code systems B "
+                   "and C, or a machining centre's maximum speed under constant surface speed): ncpp "
+                   "does not follow it")  # fmt: skip
 _COORD_SYSTEM = {float(name[1:]): n for n, name in enumerate(SYSTEMS, 1)}  # 54.0: 1 ... 59.3: 9
 _COORD_SYSTEM_CODE = {n: code * 10 for code, n in _COORD_SYSTEM.items()}
 _PLANE_LETTERS = {17: "XY", 18: "ZX", 19: "YZ"}
