@@ -446,9 +446,13 @@ def process(
     lines = iter(lines)
     # (a number past a float's range, such as a tool 1e308 mm long, becomes inf or NaN, which the
     # checks before writing refuse with its line: numpy's warnings on the way would say it first, unlocated)
-    with _rare_collections(), np.errstate(over="ignore", invalid="ignore"), warnings.in_line_order() as said:
+    with (
+        _rare_collections(),
+        np.errstate(over="ignore", invalid="ignore"),
+        warnings.in_line_order() as release,
+    ):
         while batch := list(islice(lines, 4096)):  # written in batches: one encode and write per 4096 lines
-            said(reached.before - 1)  # (the writer may still warn of the block before the one it took)
+            release(reached.before - 1)  # (the writer may still warn of the block before the one it took)
             text = "".join(batch)
             out.write(text.encode("latin-1"))
             stats.lines_out += text.count("\n") + (not text.endswith("\n"))  # (a block may be continued)
