@@ -311,7 +311,9 @@ def test_a_scale_effect_is_exported_as_the_same_error_in_a_table_is(tmp_path, fm
         assert np.allclose(err.forward(x), 20e-6 * x, atol=1e-12)  # (closed form: 20 µm/m)
         assert np.allclose(err.forward(x), machine.static_deviation(np.c_[x, 0 * x, 0 * x])[:, 0])
         text_out, _ = export_table(machine, "X", fmt, spacing=50.0)
-        tables[way] = [line for line in text_out.splitlines() if not re.search(r"EXX|effect|ncpp", line, re.I)]
+        tables[way] = [
+            line for line in text_out.splitlines() if not re.search(r"EXX|effect|ncpp", line, re.I)
+        ]
     assert tables["effect"] == tables["table"] == tables["effect alone"]
 
 
