@@ -115,7 +115,7 @@ def as_text(report: dict) -> str:
         (f"work offset {g['name']}", g) for g in report["work_offsets"]
     ] + [(f"tool {g['tool']}" if g["tool"] else "no tool", g) for g in report["tools"]]:  # fmt: skip
         if group.get("zero_from_program"):
-            title += " (its zero set by the program itself, G10 L2)"
+            title += " (its zero set by the program itself, G10)"
         lines += _group_text(title, group)
     if report["all"]["moves_zero_unknown"]:
         lines.append("machine positions need the zeros the control holds: give --work-offset or --var-file")

@@ -144,7 +144,7 @@ def test_a_zero_the_program_sets_itself_gives_machine_positions(tmp_path, capsys
     assert systems["G55"]["machine_mm"] is None and not systems["G55"]["zero_from_program"]
     program = tmp_path / "part.ngc"
     assert main(["extents", str(program)]) == 0
-    assert "work offset G54 (its zero set by the program itself, G10 L2)" in capsys.readouterr().out
+    assert "work offset G54 (its zero set by the program itself, G10)" in capsys.readouterr().out
 
 
 def test_the_programs_zero_wins_over_the_one_told(tmp_path, capsys):
@@ -177,3 +177,16 @@ def test_linuxcnc_g91_g10_l2_sets_the_zero_as_rs274_does(tmp_path, capsys):
     text = "G21 G90\nG10 L2 P1 X100 Y50 Z-20\nG91 G10 L2 P1 X60\nG90 G54\nG0 X0 Y0 Z5\nM2\n"
     report = extents(tmp_path, capsys, text=text)
     assert by(report["work_offsets"], "name")["G54"]["machine_mm"] == box((60, 60), (50, 50), (-15, -15))
+
+
+@pytest.mark.parametrize("dialect, select", [("fanuc", "G54.1 P3"), ("haas", "G154 P3"), ("haas", "G112")])
+def test_an_additional_offset_the_program_sets_with_g10_l20(tmp_path, capsys, dialect, select):
+    # Fanuc 0i-MF "Additional workpiece coordinate systems": G10 L20 Pn sets G54.1 Pn's zero; Haas
+    # "Programmable Offsets": G10 L20 P1-P20 set G110-G129 (G154 P1-P20); in G91 added to it
+    text = (f"O1000\nG21 G90\nG10 L20 P3 X100. Y50. Z-20.\n{select}\nG0 X0 Y0 Z5.\nG1 X10. Y10. F100.\n"
+            "G91 G10 L20 P3 X5.\nG90 G0 X0 Y0\nM30\n")  # fmt: skip
+    report = extents(tmp_path, capsys, "--dialect", dialect, text=text)
+    (system,) = report["work_offsets"]
+    assert system["name"] == ("G154 P3" if dialect == "haas" else "G54.1 P3") and system["zero_from_program"]
+    assert system["machine_mm"] == box((100, 110), (50, 60), (-15, -15))  # (line 8 at X105: inside)
+    assert system["lines"] == [5, 8]
