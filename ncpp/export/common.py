@@ -5,9 +5,10 @@
 dependent), in mm, actual minus nominal, on a grid that a writer asks for: its
 component EXX plus the machine file's `[[effects]]` that are a positioning
 error of X by its own position (`scale`, `cyclic`: static, as compensation
-cancels them), either of them alone where the file gives only one.  `uniform_grid` picks that grid within a controller's limits and
-says in `notes` what it had to change (more spacing, fewer points); every
-writer copies the notes into its file as comments and the CLI prints them.
+cancels them), either of them alone where the file gives only one.
+`uniform_grid` picks that grid within a controller's limits and says in
+`notes` what it had to change (more spacing, fewer points); every writer
+copies the notes into its file as comments and the CLI prints them.
 
 The component is the error motion measured at the axis's reference point
 (see ncpp.machine.chain); Abbe offsets to a particular tool point are not

@@ -7,7 +7,7 @@ the tool stands before the first move is not known.
 Boxes are kept in program coordinates (mm) and, where the zero the control holds
 is known, in machine axis positions (mm): the program plus the work offset, G92
 and the tool length in effect, as `Context.to_machine` says.  A zero is known where ncpp is told it
-or where the program sets it itself (G10 L2 with X Y Z: `Context.zero_set`).
+or where the program sets it itself (G10 L2 with X Y Z, Fanuc's G10 L20: `Context.zero_set`).
 """
 
 from __future__ import annotations
@@ -56,7 +56,7 @@ class Extent:
     program: Box = field(default_factory=Box)
     machine: Box = field(default_factory=Box)
     unknown_zero: int = 0  # moves whose zero the control holds is not known
-    zero_from_program: bool = False  # some of its moves run where the program set the zero itself (G10 L2)
+    zero_from_program: bool = False  # some of its moves run where the program set the zero itself (G10)
 
 
 def move_points(move: Line | Arc) -> np.ndarray:

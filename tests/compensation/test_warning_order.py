@@ -27,8 +27,9 @@ def said_lines(text: str) -> list[int]:
 @pytest.mark.parametrize("verify", [True, False])
 def test_the_writers_warning_comes_before_a_later_lines_of_the_interpreter(verify):
     said = io.StringIO()
-    process(io.BytesIO(PROGRAM.encode()), io.BytesIO(), file="p.ngc", source=ErrorSource.from_machine_file(
-        str(WIDE)), warnings=Warnings(stream=said), verify=verify)  # fmt: skip
+    source = ErrorSource.from_machine_file(str(WIDE))
+    process(io.BytesIO(PROGRAM.encode()), io.BytesIO(), file="p.ngc", source=source,
+            warnings=Warnings(stream=said), verify=verify)  # fmt: skip
     assert said_lines(said.getvalue()) == [3, 5]
 
 
@@ -37,8 +38,8 @@ def test_the_warnings_held_are_said_when_the_run_is_refused():
     said = io.StringIO()
     program = PROGRAM.replace("G10 L2 P1 R30\n", "").replace("G1 X30", "G1 X30 F-1")
     with pytest.raises(NcppError, match="Negative f word"):
-        process(io.BytesIO(program.encode()), io.BytesIO(), file="p.ngc", source=ErrorSource.from_machine_file(
-            str(WIDE)), warnings=Warnings(stream=said))  # fmt: skip
+        process(io.BytesIO(program.encode()), io.BytesIO(), file="p.ngc",
+                source=ErrorSource.from_machine_file(str(WIDE)), warnings=Warnings(stream=said))  # fmt: skip
     assert said_lines(said.getvalue()) == [3]
 
 

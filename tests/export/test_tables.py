@@ -294,7 +294,8 @@ SCALE_WAYS = {
              "values_um = [0.0, 5.0, 10.0]\n",
     "effect": 'effects = [{ kind = "scale", axis = "X", um_per_m = 20.0 }]\n[machine]\nchain = "XYFZ"\n'
               '[errors.EXX]\nkind = "table"\npositions = [0.0, 250.0, 500.0]\nvalues_um = [0.0, 0.0, 0.0]\n',
-    "effect alone": 'effects = [{ kind = "scale", axis = "X", um_per_m = 20.0 }]\n[machine]\nchain = "XYFZ"\n',
+    "effect alone": 'effects = [{ kind = "scale", axis = "X", um_per_m = 20.0 }]\n'
+                    '[machine]\nchain = "XYFZ"\n',
 }  # fmt: skip
 
 
@@ -322,7 +323,8 @@ def test_a_cyclic_effect_adds_to_exx_and_backlash_does_not(tmp_path):
     path.write_text('effects = [{ kind = "cyclic", axis = "X", um = 2.0, period_mm = 100.0 },\n'
                     '           { kind = "backlash", axis = "X", um = 8.0 }]\n'
                     '[machine]\nname = "m"\nchain = "XYFZ"\n[limits]\nX = [0.0, 500.0]\n'
-                    '[errors.EXX]\nkind = "table"\npositions = [0.0, 500.0]\nvalues_um = [0.0, 10.0]\n')  # fmt: skip
+                    '[errors.EXX]\nkind = "table"\npositions = [0.0, 500.0]\n'
+                    'values_um = [0.0, 10.0]\n')  # fmt: skip
     err = axis_error(load_machine(path), "X")
     x = np.array([0.0, 25.0, 75.0, 250.0])
     assert np.allclose(err.forward(x), 20e-6 * x + 2e-3 * np.sin(2 * np.pi * x / 100.0), atol=1e-12)
