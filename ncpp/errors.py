@@ -7,8 +7,10 @@ traceback.
 
 from __future__ import annotations
 
+import heapq
 import sys
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
@@ -85,6 +87,8 @@ class NcppError(Exception):
 # terminal and fills the pipe a LinuxCNC screen reads a line at a time (QtVCP: one a tick).
 SHOWN_PER_TEXT = 5
 _TEXTS_COUNTED = 1000  # texts whose repeats are counted (memory stays flat in program length)
+# warnings held to be printed in line order (`Warnings.in_line_order`) at most: past it the first goes
+_HELD_MOST = 1000
 
 
 class Warnings:
@@ -104,6 +108,7 @@ class Warnings:
         ] = {}  # where each text was first and last not printed
         # told every warning (`summary.Summary.heard`)
         self.listeners: list[Callable[[str, Location], None]] = []
+        self._held: list[tuple[int, int, str]] | None = None  # (line, order, text): `in_line_order`
 
     def warn(self, message: str, where: Location) -> None:
         if self.strict:
@@ -120,14 +125,42 @@ class Warnings:
             self._times[message] = times
         message = printable(message)
         if times < SHOWN_PER_TEXT:
-            print(f"{where}: warning: {message}", file=self.stream)
+            self._print(f"{where}: warning: {message}", where)
         elif times == SHOWN_PER_TEXT:
-            print(
+            self._print(
                 f"{where}: warning: {message} (warned {times} times: more of these are counted, not printed)",
-                file=self.stream,
+                where,
             )
         else:
             self._hidden[message] = (self._hidden.get(message, (where,))[0], where)
+
+    def _print(self, text: str, where: Location) -> None:
+        if self._held is None:
+            print(text, file=self.stream)
+            return
+        heapq.heappush(self._held, (where.line or 0, self.count, text))
+        if len(self._held) > _HELD_MOST:  # (memory stays flat: the earliest line goes now)
+            print(heapq.heappop(self._held)[2], file=self.stream)
+
+    @contextmanager
+    def in_line_order(self) -> Iterator[Callable[[int | None], None]]:
+        """Hold the warnings printed meanwhile and print them in the order of their lines: the
+        stages of a run warn as they meet a line, and an early one (the interpreter, which reads
+        ahead) meets a later line before a late one (the passes, the writer) is done with an earlier
+        line.  The function yielded prints those up to a line the run is past (None: all); the
+        rest go at the end, and past _HELD_MOST held the earliest goes at once.  A line a stage
+        warns of after the run is past it (a subroutine's, run from a later call) comes out late."""
+        self._held = []
+        try:
+            yield self._release
+        finally:
+            self._release(None)
+            self._held = None
+
+    def _release(self, line: int | None) -> None:
+        held = self._held
+        while held and (line is None or held[0][0] <= line):
+            print(heapq.heappop(held)[2], file=self.stream)
 
     def finish(self) -> None:
         """At the end of a run: how many warnings of each text were not printed, and where."""

@@ -430,10 +430,8 @@ def process(
         writer.renumber = True
     keep_freed_memory()  # numpy's temporaries reuse the heap, not fresh pages (runtime.py)
     ctx = make_context(source, tolerance, warnings, file)
-    reached = _Reached()
-    compensated = summary.written(run_passes(summary.programmed(events), ctx, PASSES))
-    if verify:  # (how far the writer has read: the verifier tags the written lines by it)
-        compensated = reached.follow(compensated)
+    reached = _Reached()  # (how far the writer has read: the verifier tags the written lines by it)
+    compensated = reached.follow(summary.written(run_passes(summary.programmed(events), ctx, PASSES)))
     header = header_text(source, tolerance, offsets, name)
     after = _tool_guard(name, offsets, warnings, file) if guard_tools else None
     checks = guard is not None and name in ISO_SYNTAX  # the zeros of the told systems it selects
@@ -453,8 +451,13 @@ def process(
     lines = iter(lines)
     # (a number past a float's range, such as a tool 1e308 mm long, becomes inf or NaN, which the
     # checks before writing refuse with its line: numpy's warnings on the way would say it first, unlocated)
-    with _rare_collections(), np.errstate(over="ignore", invalid="ignore"):
+    with (
+        _rare_collections(),
+        np.errstate(over="ignore", invalid="ignore"),
+        warnings.in_line_order() as release,
+    ):
         while batch := list(islice(lines, 4096)):  # written in batches: one encode and write per 4096 lines
+            release(reached.before - 1)  # (the writer may still warn of the block before the one it took)
             text = "".join(batch)
             out.write(text.encode("latin-1"))
             stats.lines_out += text.count("\n") + (not text.endswith("\n"))  # (a block may be continued)

@@ -45,6 +45,7 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
         "compensation/test_additional_offsets.py": (
             "test_each_move_is_compensated_where_its_system_puts_it",
         ),
+        "compensation/test_lathe.py": ("test_linuxcncs_g92_s_is_refused_in_rs274s_words",),
         "compensation/test_rigid_tap.py": (
             "test_each_tap_runs_on_the_programmed_line_within_half_a_micron",
             "test_the_motor_mount_written_out_cuts_twenty_times_closer",

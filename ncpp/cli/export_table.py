@@ -1,8 +1,11 @@
 """`ncpp export-table --machine M.toml --axis X --format F [-o FILE]`: controller tables.
 
-Writes the positioning error of one axis (its E<axis><axis> component, with
-reversal where the table is direction dependent) as a controller's own
-compensation table:
+Writes the positioning error of one axis as a controller's own compensation
+table: its E<axis><axis> component (with reversal where the table is direction
+dependent) plus the machine file's [[effects]] of kind `scale` and `cyclic` on
+that axis, either alone where the file gives only one.  Not `backlash` (a
+control has its own parameter for it) nor the effects that move other axes.
+Formats:
 
   linuxcnc    COMP_FILE for [JOINT_n] (--type 0: nominal, actual forward,
               actual reverse; --type 1: nominal and the trims), <= 256 entries
@@ -26,7 +29,7 @@ from ncpp.cli.options import finite, positive
 def register(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "export-table",
-        help="write an axis's error as a controller compensation table",
+        help="write an axis's positioning error (EXX ..., scale and cyclic effects) as a controller table",
         description=__doc__,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )

@@ -11,8 +11,9 @@ counts from the point it goes to: where the tool stands when the program
 starts is not known (the interpreter starts at 0,0,0, as rs274 does).
 
 Each box is given in program coordinates (mm) and, where the zero the control
-holds is known (`--work-offset`, `--var-file`), in machine axis positions (mm,
-with the tool length in effect from `--tool-table`).  With `--machine M.toml`
+holds is known (`--work-offset`, `--var-file`, or the program's own `G10 L2 P..
+X.. Y.. Z..`, which wins over them), in machine axis positions (mm, with the
+tool length in effect from `--tool-table`).  With `--machine M.toml`
 each machine box is compared with the machine's [limits]: per axis it fits, or
 it leaves the travel by so many mm at an end.  Try another `--work-offset`
 until it fits.
@@ -90,7 +91,9 @@ def as_report(name: str, whole: Extent, systems: dict[str, Extent], tools: dict[
         "file": name,
         "moves": MOVES,
         "all": _group(whole, limits),
-        "work_offsets": [_group(e, limits) for e in systems.values()],
+        "work_offsets": [
+            _group(e, limits) | {"zero_from_program": e.zero_from_program} for e in systems.values()
+        ],
         "tools": [_group(e, limits, tool=True) for e in tools.values()],
     }
 
@@ -111,6 +114,8 @@ def as_text(report: dict) -> str:
     for title, group in [("whole program", report["all"])] + [
         (f"work offset {g['name']}", g) for g in report["work_offsets"]
     ] + [(f"tool {g['tool']}" if g["tool"] else "no tool", g) for g in report["tools"]]:  # fmt: skip
+        if group.get("zero_from_program"):
+            title += " (its zero set by the program itself, G10)"
         lines += _group_text(title, group)
     if report["all"]["moves_zero_unknown"]:
         lines.append("machine positions need the zeros the control holds: give --work-offset or --var-file")

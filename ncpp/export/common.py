@@ -1,11 +1,14 @@
 """What every controller table is made from: an axis error sampled on a grid.
 
-`axis_error(machine, "X")` evaluates the positioning component EXX for
-travel in + and in − direction (the same curve twice when the table is not
-direction dependent), in mm, actual minus nominal, on a grid that a writer
-asks for.  `uniform_grid` picks that grid within a controller's limits and
-says in `notes` what it had to change (more spacing, fewer points); every
-writer copies the notes into its file as comments and the CLI prints them.
+`axis_error(machine, "X")` evaluates the positioning error of X for travel in
++ and in − direction (the same curve twice when the table is not direction
+dependent), in mm, actual minus nominal, on a grid that a writer asks for: its
+component EXX plus the machine file's `[[effects]]` that are a positioning
+error of X by its own position (`scale`, `cyclic`: static, as compensation
+cancels them), either of them alone where the file gives only one.
+`uniform_grid` picks that grid within a controller's limits and says in
+`notes` what it had to change (more spacing, fewer points); every writer
+copies the notes into its file as comments and the CLI prints them.
 
 The component is the error motion measured at the axis's reference point
 (see ncpp.machine.chain); Abbe offsets to a particular tool point are not
@@ -22,8 +25,15 @@ from numpy.typing import NDArray
 
 from ncpp.errors import NcppError
 from ncpp.machine import Machine, Polynomial, Table
+from ncpp.machine.effects import Effect
+from ncpp.machine.trajectory import Trajectory
 
 AXES = "XYZ"
+# The effects that are an axis's positioning error by its own position alone (machine-file.md,
+# `[[effects]]`): a positioning table carries them.  Backlash and reversal spikes depend on the
+# travel's history, lateral play, straightness and squareness move other axes, an angular error
+# moves the tool through an Abbe arm no axis table carries.
+ALONG_AXIS = ("scale", "cyclic")
 
 
 @dataclass(frozen=True)
@@ -31,20 +41,34 @@ class AxisError:
     """An error component of one axis, ready to be sampled (mm, actual − nominal)."""
 
     axis: str
-    name: str  # ISO name, e.g. EXX or EYX
-    component: Table | Polynomial
+    name: str  # ISO name, e.g. EXX or EYX, with the effects added to it ("EXX + scale")
+    component: Table | Polynomial | None  # None: the effects alone
     lo: float  # range the table should cover, mm
     hi: float
+    effects: tuple[Effect, ...] = ()  # of kinds ALONG_AXIS, on this axis
 
     @property
     def directional(self) -> bool:
-        return bool(self.component.directional)
+        return self.component is not None and bool(self.component.directional)
 
     def forward(self, x: NDArray) -> NDArray:
-        return np.asarray(self.component(x, np.ones_like(x)), dtype=float)
+        return self._error(x, 1.0)
 
     def reverse(self, x: NDArray) -> NDArray:
-        return np.asarray(self.component(x, -np.ones_like(x)), dtype=float)
+        return self._error(x, -1.0)
+
+    def _error(self, x: NDArray, direction: float) -> NDArray:
+        x = np.asarray(x, dtype=float)
+        total = np.zeros_like(x)
+        if self.component is not None:
+            total = total + np.asarray(self.component(x, np.full_like(x, direction)), dtype=float)
+        if self.effects and x.size:
+            points = np.zeros((max(x.size, 2), 3))  # (a trajectory has two points at least)
+            points[: x.size, AXES.index(self.axis)] = x.ravel()
+            along = Trajectory(points, 1000.0)  # (static effects: the feed does not count)
+            for effect in self.effects:
+                total = total + effect.apply(along)[: x.size, AXES.index(self.axis)].reshape(x.shape)
+        return total
 
     def mean(self, x: NDArray) -> NDArray:
         return 0.5 * (self.forward(x) + self.reverse(x))
@@ -62,23 +86,30 @@ def axis_error(machine: Machine, axis: str, name: str | None = None) -> AxisErro
     axis = axis.upper()
     if axis not in AXES:
         raise NcppError(f"unknown axis {axis!r}: use X, Y or Z")
-    name = name or f"E{axis}{axis}"
+    positioning = f"E{axis}{axis}"
+    name = name or positioning
     comp = machine.components.get(name)
-    if comp is None:
-        raise NcppError(f"the machine file has no {name} component for axis {axis}")
+    effects = tuple(e for e in machine.effects if e.kind in ALONG_AXIS and getattr(e, "axis", "") == axis)
+    effects = effects if name == positioning else ()
+    if comp is None and not effects:
+        also = " nor a scale or cyclic effect" if name == positioning else ""
+        raise NcppError(f"the machine file has no {name} component{also} for axis {axis}")
     lo, hi = machine.limits[axis]
-    if isinstance(comp, Table):
+    # the effects hold over the whole travel, where a table past its ends holds its end values
+    whole_travel = bool(effects) and math.isfinite(lo) and math.isfinite(hi)
+    if isinstance(comp, Table) and not whole_travel:
         # The table is a measurement; outside it the model only holds end values.
         lo = max(lo, comp.positions[0]) if math.isfinite(lo) else comp.positions[0]
         hi = min(hi, comp.positions[-1]) if math.isfinite(hi) else comp.positions[-1]
-    elif comp.limits is not None:
+    elif isinstance(comp, Polynomial) and comp.limits is not None:
         lo = comp.limits[0] if not math.isfinite(lo) else lo
         hi = comp.limits[1] if not math.isfinite(hi) else hi
     if not (math.isfinite(lo) and math.isfinite(hi) and hi > lo):
         raise NcppError(
             f"{name}: give [limits] {axis} in the machine file; the travel to tabulate is unknown"
         )
-    return AxisError(axis, name, comp, float(lo), float(hi))
+    said = " + ".join(([name] if comp is not None else []) + [f"{e.kind} effect" for e in effects])
+    return AxisError(axis, said, comp, float(lo), float(hi), effects)
 
 
 @dataclass

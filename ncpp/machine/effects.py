@@ -10,7 +10,9 @@ kind                  definition (k: position of `axis`, d: its travel sign)
 ====================  =========================================================
 scale                 δk = um_per_m·(k − ref_mm)
 backlash              play operator of width `um`: the axis lags ±um/2 behind
-                      the command; a reversal costs `um` of lost motion
+                      the command; a reversal costs `um` of lost motion (um < 0:
+                      it runs |um|/2 ahead and jumps |um| ahead on reversal, a
+                      backlash compensation set larger than the play)
 lateral_play          δ(direction) = ±um/2 with the travel sign of `axis`
                       (direction defaults: X→Y, Y→X, Z→X)
 reversal_spike        after each reversal of `axis`: δk = −d·um·exp(−s/decay),

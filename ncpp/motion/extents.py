@@ -6,7 +6,8 @@ move counts by where it goes: its start is the previous move's end, and where
 the tool stands before the first move is not known.
 Boxes are kept in program coordinates (mm) and, where the zero the control holds
 is known, in machine axis positions (mm): the program plus the work offset, G92
-and the tool length in effect, as `Context.to_machine` says.
+and the tool length in effect, as `Context.to_machine` says.  A zero is known where ncpp is told it
+or where the program sets it itself (G10 L2 with X Y Z, Fanuc's G10 L20: `Context.zero_set`).
 """
 
 from __future__ import annotations
@@ -55,6 +56,7 @@ class Extent:
     program: Box = field(default_factory=Box)
     machine: Box = field(default_factory=Box)
     unknown_zero: int = 0  # moves whose zero the control holds is not known
+    zero_from_program: bool = False  # some of its moves run where the program set the zero itself (G10)
 
 
 def move_points(move: Line | Arc) -> np.ndarray:
@@ -82,7 +84,8 @@ def extents(
     events: Iterable[Event], zero_known: Callable[[Context], bool], system_name: Callable[[Context], str]
 ) -> tuple[Extent, dict[str, Extent], dict[str, Extent]]:
     """The whole program's extent, and per work coordinate system (named by `system_name`)
-    and per tool ("" none); machine boxes only of moves where `zero_known`."""
+    and per tool ("" none); machine boxes only of moves whose zero is known: where the program set
+    it (G10), as the interpreter says (`Context.zero_set`), elsewhere as `zero_known` says."""
     whole = Extent("all moves")
     systems: dict[str, Extent] = {}
     tools: dict[str, Extent] = {}
@@ -97,7 +100,9 @@ def extents(
             systems.setdefault(name, Extent(name)),
             tools.setdefault(context.tool_id, Extent(context.tool_id)),
         )
-        machine = (program + np.array(context.offset)) * context.unit_mm if zero_known(context) else None
+        known = zero_known(context) if context.zero_set is None else context.zero_set
+        machine = (program + np.array(context.offset)) * context.unit_mm if known else None
+        groups[1].zero_from_program |= context.zero_set is True
         for group in groups:
             group.program.add(program * context.unit_mm, line)
             if machine is None:

@@ -29,12 +29,19 @@ P1`-`P99` ("G154 Select Work Coordinates P1-P99") and its older names G110-G129 
 is told (`--work-offset G54.1P3=X,Y,Z`, `G154P3=`, or a parameter file's #7001... / #14001...:
 `offsets.py`) is followed as G54-G59 are (`_additional_offset`); one not told ends interpretation
 with a warning, as does a block that selects one with other words in it (what else the block
-does would run in the control's order around the new zero: not guessed at).  `G10 L20` sets an
-additional work offset on these controls, where LinuxCNC's sets system P from the current
-point: out of scope.  So is `G10 L2 P0`, which sets the external workpiece zero offset that
-shifts every system (Fanuc operator's manual, "Changing workpiece coordinate system": P0 the
-external offset, P1-P6 G54-G59), where LinuxCNC's sets the system in effect; a P that is an
-expression may be 0 there.
+does would run in the control's order around the new zero: not guessed at).  `G10 L20 Pn X.. Y..
+Z..` sets additional work offset n's zero in machine coordinates on these controls (Fanuc 0i-MF
+operator's manual, "Additional workpiece coordinate systems": "G10 L20 Pn IP_"; Haas's
+"Programmable Offsets": `G10 L20 P2 G90 X100. Y80.` sets G111's), where LinuxCNC's sets system
+P from the current point: followed as G10 L2 is (`_set_additional`), but out of scope where it
+would leave a zero ncpp is not told partly unknown.  `G10 L2 P0` is out of scope: it sets the
+external workpiece zero offset that shifts every system (Fanuc operator's manual, "Changing
+workpiece coordinate system": P0 the external offset, P1-P6 G54-G59), where LinuxCNC's sets the
+system in effect; a P that is an expression may be 0 there.
+`G10 L2 Pn` in G91 adds its values to system n's zero, where in G90 it sets them (Fanuc Series
+0i-MD operator's manual, "Changing workpiece coordinate system": with an incremental command the
+value is added to the offset; Haas's "Programmable Offsets": `G10 L2 P1 G91 X60.` moves G54's X
+60 mm); LinuxCNC's sets them in either.
 
 A G00 written in a G28 or G30 block (`G0 G28 G91 Z0.`, which Mastercam's and Fusion's Fanuc and Haas
 posts write before each tool change) only sets the modal motion: these controls take G codes of
@@ -110,6 +117,8 @@ on Fanuc, none on Haas, a variable, G95) is refused: the dwell would be a guess.
 
 from __future__ import annotations
 
+from typing import cast
+
 from ncpp.motion.interpreter import Interpreter, _OutOfScope, interpreting
 from ncpp.motion.offsets import ADDITIONAL, ADDITIONAL_CODES
 from ncpp.motion.segments import Event, Pass
@@ -154,6 +163,8 @@ class FanucInterpreter(Interpreter):
     still_r_arc = True  # `G02 R..` ending where it starts does not move (module docstring)
     r_over_ijk = True  # `G02 X.. Y.. R.. I.. J..`: R's arc, I J ignored (module docstring)
     independent_h = True  # `G53 G00 H0 Z-110`: an H without G43, out of scope (module docstring)
+    incremental_zero_set = True  # `G91 G10 L2 P1 X10.` adds 10 to G54's X (module docstring)
+    g92_speed_clamp = True  # `G92 S4000`: refused as the spindle speed clamp it is (`G92_SPEED_CLAMP`)
 
     def block(self, block: Block) -> Event | tuple[Event, ...]:
         signature = block.signature
@@ -180,7 +191,7 @@ class FanucInterpreter(Interpreter):
                 and word.value == 10.0
                 and any(w.letter == "L" and w.value == 20 for w in words)
             ):
-                raise _OutOfScope("G10 L20 (it sets an additional work offset here)", word.start + 1)
+                return self._set_additional(block, word)
             if word.letter == "G" and word.value == 10.0 and _external_offset(block, words):
                 raise _OutOfScope("G10 L2 P0 (it sets the external work offset, which shifts every system)",
                                   word.start + 1)  # fmt: skip
@@ -245,6 +256,44 @@ class FanucInterpreter(Interpreter):
             raise _OutOfScope(f"{name} under cutter compensation", col)
         self._coordinate_system(number)
         return Pass(block, zero_told=number if number in self.told_zeros else None)
+
+    def _set_additional(self, block: Block, code: Word) -> Pass:
+        """`G10 L20 Pn X.. Y.. Z..`: additional work offset n's zero in machine coordinates, added to
+        it in G91 (module docstring), with nothing else but G90/G91, N and comments in the block.
+        Out of scope where it would leave the zero partly unknown (some axes of an offset ncpp is
+        not told) or takes a value from a variable."""
+        col, last = code.start + 1, ADDITIONAL_CODES[self.additional][1]
+        others = [item for item in block.items if type(item) is not Comment and item is not code]
+        if any(type(item) is not Word for item in others):
+            raise _OutOfScope("G10 L20 with a value from a variable (it sets an additional work offset)", col)
+        words = cast(list[Word], others)
+        ps = [w for w in words if w.letter == "P"]
+        if len(ps) != 1 or not (ps[0].value.is_integer() and 1 <= ps[0].value <= last):
+            raise _OutOfScope(f"G10 L20 without one P of 1-{last} (the additional work offset it sets)", col)
+        modes = [w.value for w in words if w.letter == "G"]
+        if any(m not in (90.0, 91.0) for m in modes) or any(w.letter not in "LPNXYZG" for w in words):
+            raise _OutOfScope("G10 L20 with other words in its block", col)
+        absolute = modes[-1] == 90.0 if modes else self.absolute
+        number = ADDITIONAL + int(ps[0].value)
+        given = {"XYZ".index(w.letter): w.value for w in words if w.letter in "XYZ"}
+        if number not in self.g5x and (not absolute or len(given) < 3):
+            told = f"give --work-offset {self.additional}P{int(ps[0].value)}=X,Y,Z"
+            raise _OutOfScope(f"G10 L20 P{ps[0].number} of some axes of an additional work offset ncpp is "
+                              f"not told ({told})", col)  # fmt: skip
+        if number == self.coord_system and self.cutter_comp is not None:
+            raise _OutOfScope("G10 L20 of the work offset in effect under cutter compensation", col)
+        old = self.g5x.get(number, [0.0] * 9)
+        new = old[:]
+        for i, value in given.items():
+            new[i] = value + (0.0 if absolute else old[i])
+        self._zero_set(number, set(given), l20=False, added=not absolute)
+        self.told_zeros.discard(number)
+        self.g5x[number] = new
+        if modes:
+            self._set(absolute=absolute)
+        if number == self.coord_system:
+            self._shift(old, new)
+        return Pass(block)
 
 
 class HaasInterpreter(FanucInterpreter):

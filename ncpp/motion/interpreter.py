@@ -271,6 +271,11 @@ class Interpreter:
     still_r_arc = False
     # R with I, J or K in an arc block: the arc is R's, the others are ignored (Fanuc); rs274ngc refuses it
     r_over_ijk = False
+    # G10 L2 in G91 adds its values to the offset (Fanuc, Haas); rs274ngc sets them whatever G90/G91
+    incremental_zero_set = False
+    # G92 with S and no axis words is a spindle speed clamp (Fanuc's lathes and machining centres): the
+    # refusal says so (`G92_SPEED_CLAMP`); rs274ngc has no G92 S and refuses it as a G92 without axes
+    g92_speed_clamp = False
 
     def __init__(self, file: str = "<stdin>", offsets: WorkOffsets | None = None):
         self.file = file
@@ -337,6 +342,8 @@ class Interpreter:
         # systems whose zero is still the one ncpp was told (the program has not set it with G10):
         # the placement guard checks them where the program selects them (`Pass.zero_told`)
         self.told_zeros: set[int] = set()
+        # systems whose zero the program has set (G10): whether it is known from then on (`_zero_set`)
+        self.zeros_set: dict[int, bool] = {}
         self.warnings: Warnings | None = None
         self.flow: Flow | None = None  # while `run` runs
         # Fanuc: the axes (0 X, 1 Y, 2 Z) a move has put at a programmed position since the start or
@@ -718,6 +725,7 @@ class Interpreter:
                 self.inverse_time,
                 self.coord_system,
                 str(self.spindle_tool) if self.spindle_tool else "",
+                self.zeros_set.get(self.coord_system),
             )
         return self._context
 
@@ -1098,7 +1106,7 @@ class Interpreter:
                 if any_item is not None and not covets_axes:
                     self._fail("Cannot use axis values with G80", block, any_item)
                 if axis_item is None and mode0 in (52.0, 92.0):
-                    self._fail("All axes missing with g52 or g92", block, block.items[0])
+                    self._no_axes(block, mode0)
                 return None
             if covets_axes:
                 self._fail("Cannot use two g codes that both use axis values", block, mode1_item)
@@ -1107,7 +1115,7 @@ class Interpreter:
             return mode1
         if covets_axes:
             if axis_item is None and mode0 in (52.0, 92.0):
-                self._fail("All axes missing with g52 or g92", block, block.items[0])
+                self._no_axes(block, mode0)
             return None
         if any_item is not None:
             if self.motion is None:
@@ -1515,12 +1523,14 @@ class Interpreter:
             p = round(words.get("P", (0.0,))[0])
             number = self.coord_system if p == 0 else p
             old = self.g5x[number][:]
+            added = self.incremental_zero_set and not self.absolute
+            self._zero_set(number, {i for i, _ in given}, words["L"][0] == 20.0, added)
             self.told_zeros.discard(number)
             if {0, 1, 2} <= {i for i, _ in given}:  # the program says where it is
                 self.untold.discard(number)
             for i, value in given:
                 if words["L"][0] == 2.0:
-                    self.g5x[number][i] = value
+                    self.g5x[number][i] = value + (old[i] if added else 0.0)
                 else:  # L20: the current point gets the given coordinates
                     self.g5x[number][i] = self.pos[i] + self.g5x[self.coord_system][i] - value
             if number == self.coord_system:
@@ -1530,6 +1540,17 @@ class Interpreter:
         elif code in (28.0, 30.0):
             return self._go_home(block, given, self.home[int(code)])
         return setting
+
+    def _zero_set(self, number: int, axes: set[int], l20: bool, added: bool) -> None:
+        """Whether system `number`'s zero is known after a G10 of `axes` sets it (`zeros_set`): G10 L2
+        giving X Y Z from the machine zero makes it known; G10 L20 sets it from where the tool
+        stands, which may be where the operator jogged it: not known; other axes, or values added to
+        it (G91 G10 L2 on Fanuc), leave it as known as it was (where the program did not set it
+        before, as ncpp is told it)."""
+        if l20:
+            self.zeros_set[number] = False
+        elif not added and {0, 1, 2} <= axes:
+            self.zeros_set[number] = True
 
     def _go_home(self, block: Block, given: list[tuple[int, float]], home: list[float]) -> tuple[Event, ...]:
         """G28/G30: rapid to the (optional) intermediate point, then home the given axes (all if none).
@@ -2044,6 +2065,17 @@ class Interpreter:
         }.get(name)
         return value
 
+    def _no_axes(self, block: Block, mode0: float) -> NoReturn:
+        """G52 or G92 without axis words: refused, as rs274ngc does; where a G92 with S is a spindle
+        speed clamp (`g92_speed_clamp`), the refusal says what it is."""
+        words = [item for item in block.items if type(item) is Word or type(item) is ExprWord]
+        if mode0 == 92.0 and self.g92_speed_clamp and any(w.letter == "S" for w in words):
+            g92 = next(
+                (w for w in words if type(w) is Word and w.letter == "G" and w.value == 92.0), words[0]
+            )
+            self._fail(G92_SPEED_CLAMP, block, g92)
+        self._fail("All axes missing with g52 or g92", block, block.items[0])
+
     def _fail(self, message: str, block: Block, item) -> NoReturn:
         col = item.start + 1 if item is not None else None
         raise NcppError(message, Location(self.file, block.line, col))
@@ -2055,6 +2087,12 @@ class Interpreter:
 _NOT_LOOP_STATE = frozenset(("params", "flow", "warnings", "untold_lengths", "expansion", "tools",
                              "file", "subroutine_path", "expand_cycles", "_context", "_fast",
                              "rounding"))  # fmt: skip
+# Fanuc lathes' maximum spindle speed clamp in G-code systems B and C (system A's G50 S), and Fanuc
+# machining centres' under constant surface speed (their G code list: G92 "setting for workpiece
+# coordinate system or clamp at maximum spindle speed"; `lathe.py`): no move, no offset
+G92_SPEED_CLAMP = ("G92 with S and no axis words (a spindle speed clamp: Fanuc lathe G-code systems B "
+                   "and C, or a machining centre's maximum speed under constant surface speed): ncpp "
+                   "does not follow it")  # fmt: skip
 _COORD_SYSTEM = {float(name[1:]): n for n, name in enumerate(SYSTEMS, 1)}  # 54.0: 1 ... 59.3: 9
 _COORD_SYSTEM_CODE = {n: code * 10 for code, n in _COORD_SYSTEM.items()}
 _PLANE_LETTERS = {17: "XY", 18: "ZX", 19: "YZ"}

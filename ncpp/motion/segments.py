@@ -76,6 +76,8 @@ class Context:
     inverse_time: bool = False  # G93: a feed move's F is 1 / its time in minutes
     system: int = 1  # the work coordinate system in effect, 1..9: G54..G59.3 (one program zero: 1)
     tool_id: str = ""  # the tool in the spindle as the program names it ("3", '"MILL"'; "": none)
+    # the program set the system's zero (G10): whether it is known (None: it did not, the control's holds)
+    zero_set: bool | None = None
 
     @property
     def tool_mm(self) -> Point:

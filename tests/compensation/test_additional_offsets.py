@@ -143,3 +143,16 @@ def test_parse_names_the_additional_offsets():
     for bad in (f"{name}=1,2,3" for name in bad_names):
         with pytest.raises(ValueError, match="not a work coordinate system"):
             parse_zero(bad)
+
+
+@pytest.mark.parametrize("select, dialect", FLAVOURS)
+def test_a_zero_the_program_sets_with_g10_l20_is_compensated_as_one_told(tmp_path, select, dialect):
+    """Fanuc's and Haas's `G10 L20 P2 X.. Y.. Z..` sets additional offset 2's zero (Fanuc 0i-MF
+    operator's manual, "Additional workpiece coordinate systems"; Haas "Programmable Offsets"): the
+    program compensates as it does with the zero told, whose moves rs274 judges above."""
+    told = compensated(program(select), dialect, WorkOffsets.of({"G54": G54, select.replace(" ", ""): P2}),
+                       tmp_path)  # fmt: skip
+    setting = "G10 L20 P2 X{:g} Y{:g} Z{:g}\n".format(*P2)
+    own = compensated(setting + program(select), dialect, WorkOffsets.of({"G54": G54}), tmp_path)
+    assert own[: own.index("G21 G90")].endswith(")\n" + setting)  # (after the header, as it was)
+    assert own[own.index("G21 G90") :] == told[told.index("G21 G90") :]

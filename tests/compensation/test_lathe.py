@@ -190,3 +190,27 @@ def test_no_program_of_the_corpus_is_taken_for_a_lathe_program():
             if found is not None:
                 flagged.append((name, read, found))
     assert len(_corpus_programs()) > 100 and flagged == []
+
+
+@pytest.mark.parametrize("dialect", ["fanuc", "haas"])
+def test_a_g92_s_is_refused_as_the_spindle_speed_clamp_it_is(dialect):
+    """Fanuc lathe G-code systems B and C clamp the spindle speed with `G92 S` (system A: G50 S), as
+    a Fanuc machining centre does under constant surface speed: refused, saying so."""
+    program = FANUC_HEAD + "G92 S4000\n" + START + "M30\n%\n"
+    with pytest.raises(NcppError) as caught:
+        compensate(program, dialect)
+    assert str(caught.value.where) == "p.nc:3:1"
+    assert caught.value.message.startswith("G92 with S and no axis words (a spindle speed clamp: Fanuc lathe")
+    assert "ncpp does not follow it" in caught.value.message
+
+
+def test_linuxcncs_g92_s_is_refused_in_rs274s_words():
+    """LinuxCNC has no G92 S: rs274 refuses the block as a G92 without axes, and ncpp with its words."""
+    from tests import rs274
+
+    program = "G92 S4000\n" + START + "M2\n"
+    said = rs274.error(rs274.run(program).stderr)
+    assert said is not None
+    with pytest.raises(NcppError) as caught:
+        compensate(program, "iso")
+    assert caught.value.message == said[0] == "All axes missing with g52 or g92"

@@ -285,3 +285,48 @@ def test_missing_component_is_a_clear_error(tmp_path, capsys):
     m = long_axis_machine()
     with pytest.raises(NcppError, match="no EYY"):
         export_table(m, "Y", "fanuc")
+
+
+# One positioning error of X, 20 µm/m from X0, written three ways in a machine file: as the EXX
+# table, as a `scale` effect beside a zero EXX, and as the effect alone (machine-file.md, [[effects]]).
+SCALE_WAYS = {
+    "table": 'chain = "XYFZ"\n[errors.EXX]\nkind = "table"\npositions = [0.0, 250.0, 500.0]\n'
+             "values_um = [0.0, 5.0, 10.0]\n",
+    "effect": 'effects = [{ kind = "scale", axis = "X", um_per_m = 20.0 }]\n[machine]\nchain = "XYFZ"\n'
+              '[errors.EXX]\nkind = "table"\npositions = [0.0, 250.0, 500.0]\nvalues_um = [0.0, 0.0, 0.0]\n',
+    "effect alone": 'effects = [{ kind = "scale", axis = "X", um_per_m = 20.0 }]\n'
+                    '[machine]\nchain = "XYFZ"\n',
+}  # fmt: skip
+
+
+@pytest.mark.parametrize("fmt", ["linuxcnc", "fanuc", "sinumerik", "heidenhain"])
+def test_a_scale_effect_is_exported_as_the_same_error_in_a_table_is(tmp_path, fmt):
+    tables = {}
+    for way, text in SCALE_WAYS.items():
+        path = tmp_path / f"{way}.toml"
+        body = text if way != "table" else "[machine]\n" + text
+        path.write_text(body.replace("[machine]", '[machine]\nname = "m"') + "[limits]\nX = [0.0, 500.0]\n")
+        machine = load_machine(path)
+        err = axis_error(machine, "X")
+        x = np.linspace(0.0, 500.0, 11)
+        assert np.allclose(err.forward(x), 20e-6 * x, atol=1e-12)  # (closed form: 20 µm/m)
+        assert np.allclose(err.forward(x), machine.static_deviation(np.c_[x, 0 * x, 0 * x])[:, 0])
+        text_out, _ = export_table(machine, "X", fmt, spacing=50.0)
+        tables[way] = [
+            line for line in text_out.splitlines() if not re.search(r"EXX|effect|ncpp", line, re.I)
+        ]
+    assert tables["effect"] == tables["table"] == tables["effect alone"]
+
+
+def test_a_cyclic_effect_adds_to_exx_and_backlash_does_not(tmp_path):
+    path = tmp_path / "m.toml"
+    path.write_text('effects = [{ kind = "cyclic", axis = "X", um = 2.0, period_mm = 100.0 },\n'
+                    '           { kind = "backlash", axis = "X", um = 8.0 }]\n'
+                    '[machine]\nname = "m"\nchain = "XYFZ"\n[limits]\nX = [0.0, 500.0]\n'
+                    '[errors.EXX]\nkind = "table"\npositions = [0.0, 500.0]\n'
+                    'values_um = [0.0, 10.0]\n')  # fmt: skip
+    err = axis_error(load_machine(path), "X")
+    x = np.array([0.0, 25.0, 75.0, 250.0])
+    assert np.allclose(err.forward(x), 20e-6 * x + 2e-3 * np.sin(2 * np.pi * x / 100.0), atol=1e-12)
+    assert np.allclose(err.reverse(x), err.forward(x))  # (backlash is the control's own parameter)
+    assert err.name == "EXX + cyclic effect"

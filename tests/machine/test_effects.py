@@ -47,6 +47,20 @@ def test_backlash_is_a_play_operator():
     assert np.ptp(d) == pytest.approx(6.0)
 
 
+def test_negative_backlash_leads_and_jumps_ahead_on_reversal():
+    # machine-file.md, [[effects]]: um < 0 is a control's backlash compensation set larger than the
+    # play (as ISO 230-4's signed backlash of a ball-bar trace says, `instruments/iso230_4.py`)
+    traj = there_and_back()
+    d = Backlash("X", -6.0).apply(traj)[:, 0] * 1e3
+    n = len(traj) // 2
+    assert np.allclose(d[5 : n - 1], 3.0)  # ahead of the command by half of it going +
+    assert np.allclose(d[n + 1 :], -3.0)  # and going −, from the first step after the turn
+    x = traj.positions[:, 0]
+    turn = int(np.argmax(x))
+    jump = (x[turn + 1] + d[turn + 1] * 1e-3) - (x[turn] + d[turn] * 1e-3)
+    assert jump == pytest.approx(-(0.5 + 6e-3))  # one step back and 6 µm more: the overshoot
+
+
 def test_backlash_step_on_circle_at_axis_reversal():
     c = np.array([0.0, 0.0, 0.0])
     traj = Trajectory.circle("XY", c, 100.0, "CCW", step_deg=0.1)

@@ -118,3 +118,75 @@ def test_text_says_what_counts_and_what_does_not_fit(tmp_path, capsys):
     out = capsys.readouterr().out
     assert "feed and rapid moves, arcs by their true extent" in out
     assert "X does NOT fit the travel [0, 800]: 20.000 mm above its high end" in out
+
+
+# The program sets G54's zero itself (LinuxCNC G-code manual, "G10 L2 Set Coordinate System"), and
+# G55's X and Y only: G54's machine box is the program's plus (100, 50, -20), G55's is not known.
+OWN_ZERO = """G21 G90
+G10 L2 P1 X100 Y50 Z-20
+G10 L2 P2 X300 Y50
+G54
+G0 X0 Y0 Z5
+G1 Z-1 F100
+G1 X10 Y10
+G55
+G0 X0 Y0
+M2
+"""
+
+
+def test_a_zero_the_program_sets_itself_gives_machine_positions(tmp_path, capsys):
+    report = extents(tmp_path, capsys, "--machine", str(HR5B), text=OWN_ZERO)
+    systems = by(report["work_offsets"], "name")
+    assert systems["G54"]["machine_mm"] == box((100, 110), (50, 60), (-21, -15))
+    assert systems["G54"]["zero_from_program"] and systems["G54"]["moves_zero_unknown"] == 0
+    assert not systems["G54"]["travel"]["Z"]["fits"]  # (Z -21 is below HR5B's travel 0..700)
+    assert systems["G55"]["machine_mm"] is None and not systems["G55"]["zero_from_program"]
+    program = tmp_path / "part.ngc"
+    assert main(["extents", str(program)]) == 0
+    assert "work offset G54 (its zero set by the program itself, G10)" in capsys.readouterr().out
+
+
+def test_the_programs_zero_wins_over_the_one_told(tmp_path, capsys):
+    report = extents(tmp_path, capsys, "--work-offset", "G54=1,2,3", "--work-offset", "G55=500,200,300",
+                     text=OWN_ZERO)  # fmt: skip
+    systems = by(report["work_offsets"], "name")
+    assert systems["G54"]["machine_mm"] == box((100, 110), (50, 60), (-21, -15))
+    assert systems["G55"]["machine_mm"] == box((300, 300), (50, 50), (-21, -21))  # (Z stays where it was)
+
+
+def test_a_zero_set_from_where_the_tool_stands_is_not_known(tmp_path, capsys):
+    text = OWN_ZERO.replace("G55\n", "G10 L20 P1 X0 Y0 Z0\n")
+    report = extents(tmp_path, capsys, text=text)
+    g54 = by(report["work_offsets"], "name")["G54"]
+    assert g54["machine_mm"] == box((100, 110), (50, 60), (-21, -15))  # (the moves before the G10 L20)
+    assert g54["moves_zero_unknown"] == 1
+
+
+@pytest.mark.parametrize("dialect", ["fanuc", "haas"])
+def test_fanuc_and_haas_g91_g10_l2_adds_to_the_zero(tmp_path, capsys, dialect):
+    # Fanuc 0i-MD operator's manual, "Changing workpiece coordinate system"; Haas "Programmable
+    # Offsets": `G10 L2 P1 G91 X60.` moves G54's X offset 60 mm
+    text = ("O1000\nG21 G90\nG10 L2 P1 X100. Y50. Z-20.\nG10 L2 P1 G91 X60.\nG90 G54\nG0 X0 Y0 Z5.\n"
+            "G1 X10. Y10. F100.\nM30\n")  # fmt: skip
+    report = extents(tmp_path, capsys, "--dialect", dialect, text=text)
+    assert by(report["work_offsets"], "name")["G54"]["machine_mm"] == box((160, 170), (50, 60), (-15, -15))
+
+
+def test_linuxcnc_g91_g10_l2_sets_the_zero_as_rs274_does(tmp_path, capsys):
+    text = "G21 G90\nG10 L2 P1 X100 Y50 Z-20\nG91 G10 L2 P1 X60\nG90 G54\nG0 X0 Y0 Z5\nM2\n"
+    report = extents(tmp_path, capsys, text=text)
+    assert by(report["work_offsets"], "name")["G54"]["machine_mm"] == box((60, 60), (50, 50), (-15, -15))
+
+
+@pytest.mark.parametrize("dialect, select", [("fanuc", "G54.1 P3"), ("haas", "G154 P3"), ("haas", "G112")])
+def test_an_additional_offset_the_program_sets_with_g10_l20(tmp_path, capsys, dialect, select):
+    # Fanuc 0i-MF "Additional workpiece coordinate systems": G10 L20 Pn sets G54.1 Pn's zero; Haas
+    # "Programmable Offsets": G10 L20 P1-P20 set G110-G129 (G154 P1-P20); in G91 added to it
+    text = (f"O1000\nG21 G90\nG10 L20 P3 X100. Y50. Z-20.\n{select}\nG0 X0 Y0 Z5.\nG1 X10. Y10. F100.\n"
+            "G91 G10 L20 P3 X5.\nG90 G0 X0 Y0\nM30\n")  # fmt: skip
+    report = extents(tmp_path, capsys, "--dialect", dialect, text=text)
+    (system,) = report["work_offsets"]
+    assert system["name"] == ("G154 P3" if dialect == "haas" else "G54.1 P3") and system["zero_from_program"]
+    assert system["machine_mm"] == box((100, 110), (50, 60), (-15, -15))  # (line 8 at X105: inside)
+    assert system["lines"] == [5, 8]
