@@ -2086,7 +2086,7 @@ class Interpreter:
 # from the others (the context, the fast path)
 _NOT_LOOP_STATE = frozenset(("params", "flow", "warnings", "untold_lengths", "expansion", "tools",
                              "file", "subroutine_path", "expand_cycles", "_context", "_fast",
-                             "rounding"))  # fmt: skip
+                             "rounding", "at_definition"))  # fmt: skip
 # Fanuc lathes' maximum spindle speed clamp in G-code systems B and C (system A's G50 S), and Fanuc
 # machining centres' under constant surface speed (their G code list: G92 "setting for workpiece
 # coordinate system or clamp at maximum spindle speed"; `lathe.py`): no move, no offset
