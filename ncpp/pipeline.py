@@ -26,6 +26,7 @@ from ncpp.errors import Location, NcppError, Warnings
 from ncpp.guard import ISO_SYNTAX, Placement, PlacementChecks, ToolGuard, with_guard, without_guard
 from ncpp.lathe import refuse_lathe
 from ncpp.motion.offsets import AT_MACHINE_ZERO, WorkOffsets
+from ncpp.motion.once import OnceRuns
 from ncpp.motion.segments import COMP, CYCLE, DRILLED, FLOW, HOLE, PATTERN, Arc, Event, Line, Pass
 from ncpp.passes import PASSES, PassContext, run_passes
 from ncpp.passes.context import ErrorMap, is_directional
@@ -399,29 +400,33 @@ def process(
         expanding = {"expand_cycles": expand_cycles, "expand": expand}
     elif FAMILY[name] in ("heidenhain", "sinumerik"):
         expanding = {"expand": expand}
+    # a subroutine that runs once is rewritten for that run where its definition stands (ISO family):
+    # its blocks, which the interpreter tells the writer (both readings of the input follow it so)
+    once_runs = FAMILY[name] == "iso" and not expand
+    runs = OnceRuns() if once_runs else None
     if verify:  # the verifier's own reading of the input: the blocks are held between the two
         # readings, not the events (a loop's runs read its few blocks again and again)
         from ncpp.verify import same_motion, unsaid
 
         written_out = any(expanding.values())
         blocks, again, *plain = _copies(blocks, 3 if written_out else 2)
-        original = interpret(again, file=file, warnings=unsaid(), offsets=offsets, **expanding)
+        held = {"once_runs": OnceRuns()} if once_runs else {}  # (the other families have none)
+        original = interpret(again, file=file, warnings=unsaid(), offsets=offsets, **expanding, **held)
         if written_out:  # (and that reading against one without --expand: the program's own run)
             original = same_motion(
                 original, interpret(plain[0], file=file, warnings=unsaid(), offsets=offsets), file
             )
-    # the blocks of a subroutine that runs once, rewritten for that run where its definition stands
-    at_definition: dict[str, set[int]] = (
-        {"at_definition": set()} if FAMILY[name] == "iso" and not expand else {}
-    )
     events: Iterable[Event] = interpret(
-        blocks, file=file, warnings=warnings, strict=strict, offsets=offsets, **expanding, **at_definition
-    )
+        blocks, file=file, warnings=warnings, strict=strict, offsets=offsets, **expanding,
+        **({"once_runs": runs} if runs is not None else {}),
+    )  # fmt: skip
     events = warn_fixed(events, warnings, file)  # cycles, loops, subroutines (ISO), cutter compensation
     stats.summary = summary = Summary(file)
     warnings.listeners.append(summary.heard)
     writer = writer_class()
-    writer.at_definition = at_definition.get("at_definition")
+    writer.at_definition = runs.blocks if runs is not None else None
+    reached = _Reached()  # (how far the writer has read: the verifier tags the written lines by it)
+    writer.stamps = reached
     writer.unpositioned = lambda axes, block: warnings.warn(
         f"{axes} not positioned by the program yet: the correction along {axes} of this feed move and "
         "the next compensated moves is left out until the program positions them (a word written here "
@@ -430,7 +435,6 @@ def process(
         writer.renumber = True
     keep_freed_memory()  # numpy's temporaries reuse the heap, not fresh pages (runtime.py)
     ctx = make_context(source, tolerance, warnings, file)
-    reached = _Reached()  # (how far the writer has read: the verifier tags the written lines by it)
     compensated = reached.follow(summary.written(run_passes(summary.programmed(events), ctx, PASSES)))
     header = header_text(source, tolerance, offsets, name)
     after = _tool_guard(name, offsets, warnings, file) if guard_tools else None
@@ -446,7 +450,7 @@ def process(
     if verify:
         from ncpp.verify import Bound, verified
 
-        lines = verified(lines, reached, original, file=file, dialect=name, offsets=offsets,
+        lines = verified(lines, reached, original, file=file, dialect=name, offsets=offsets, runs=runs,
                          bound=Bound(source.max_correction + tolerance))  # fmt: skip
     lines = iter(lines)
     # (a number past a float's range, such as a tool 1e308 mm long, becomes inf or NaN, which the
@@ -525,6 +529,7 @@ class _Reached:
         self.line = self.before = self.blocks = 0
         self.block: Block | None = None
         self.state = (0, 0, 0)  # (a new tuple only when it changes: the verifier tells it by `is`)
+        self.pinned: tuple[int, int, int] | None = None  # the state the lines handed out now are tagged with
 
     def follow(self, events: Iterable[Event]) -> Iterator[Event]:
         for event in events:
@@ -537,8 +542,13 @@ class _Reached:
                 self.state = (self.line, self.before, self.blocks)
             yield event
 
+    def pin(self, state: tuple[int, int, int] | None) -> None:
+        """Tag the lines handed out from now with `state` (a subroutine's run written at its
+        definition: `IsoWriter.at_definition`); None: with the state again."""
+        self.pinned = state
+
     def __call__(self) -> tuple[int, int, int]:
-        return self.state
+        return self.state if self.pinned is None else self.pinned
 
 
 @contextmanager

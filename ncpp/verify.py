@@ -33,13 +33,16 @@ each written line with the input line the writer had reached (`verified`), and
 the written program's chunk ends where the input's does by those tags; as a
 writer may be a block ahead of the lines it hands out, each side of a chunk is
 also compared with the other side's samples just across the cut.  A loop's or a
-call's runs are its control line's moves, cut at the same counts on both sides.
+call's runs are its control line's moves, cut at the same counts on both sides; the
+one run of a subroutine written where its definition stands (`Interpreter.run`) is
+read so on both sides, its lines tagged as where they ran.
 """
 
 from __future__ import annotations
 
 import math
 import re
+from bisect import bisect_right
 from collections import deque
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field, replace
@@ -52,6 +55,7 @@ from scipy.spatial import cKDTree
 
 from ncpp.errors import Location, NcppError, Warnings
 from ncpp.motion.offsets import AT_MACHINE_ZERO, WorkOffsets
+from ncpp.motion.once import MAX_ONCE, OnceRuns
 from ncpp.motion.segments import EXTRA_AXES, PLANE_AXES, Arc, Event, Line, Pass
 from ncpp.program.blocks import Block, ExprWord, Statement, Word
 
@@ -67,6 +71,9 @@ AFTER_MOTION = {0.0, 1.0, 2.0, 30.0, 60.0, 99.0}
 # Statements that are actions: Klartext's TOOL CALL, CYCL CALL and END PGM
 ACTION_STATEMENTS = {"tool_call", "cycle_call", "program_end"}
 CHUNK_MOVES = 4096  # moves of the input compared at a time between two actions
+# Events of a written program held for a subroutine's one run (`_interpreted`): the written lines of
+# the input's MAX_ONCE (its moves split into pieces, with steps between them)
+WRITTEN_HELD = 8 * MAX_ONCE
 MAX_CHORDS = 1 << 19  # chords the arcs of a section are sampled along at most (about 1 kB of memory each)
 ACROSS = 0.25  # the share of a neighbouring chunk's samples each side is also compared with
 
@@ -416,15 +423,24 @@ class Bound:
 
 
 def _interpreted(
-    blocks: Iterable[Block], file: str, dialect: str, offsets: WorkOffsets | None
+    blocks: Iterable[Block],
+    file: str,
+    dialect: str,
+    offsets: WorkOffsets | None,
+    runs: OnceRuns | None = None,
 ) -> Iterator[Event]:
-    """A program's events as ncpp's interpreter reads its blocks, its warnings unsaid."""
+    """A program's events as ncpp's interpreter reads its blocks, its warnings unsaid; `runs`: the
+    subroutines whose one run the reading of the input found (`Interpreter.run`), read so here too,
+    their blocks each its own as the writer took them (and held to WRITTEN_HELD events: a written
+    run has more lines than the input's, which was held to MAX_ONCE)."""
     from ncpp.guard import without_guard
     from ncpp.pipeline import dialect_tools
 
     interpret, _ = dialect_tools(dialect)
     blocks = without_guard(blocks)  # (it neither moves nor acts, and reads the control's parameters)
-    return interpret(blocks, file=file, warnings=unsaid(), offsets=offsets or AT_MACHINE_ZERO)
+    once = None if runs is None else OnceRuns(only=runs.names, held_most=WRITTEN_HELD)
+    once_runs = {} if once is None else {"once_runs": once}  # (the dialects outside the ISO family have none)
+    return interpret(blocks, file=file, warnings=unsaid(), offsets=offsets or AT_MACHINE_ZERO, **once_runs)
 
 
 # mm: how far a move written out by --expand may lie from the same move of the program as it runs
@@ -515,7 +531,7 @@ def _in_file(err: NcppError, file: str) -> NcppError:
 
 
 def verified(lines: Iterable[str], reached: Callable[[], tuple[int, int, int]], original: Iterable[Event], *, file: str, dialect: str,
-             offsets: WorkOffsets | None, bound: Bound) -> Iterator[str]:  # fmt: skip
+             offsets: WorkOffsets | None, bound: Bound, runs: OnceRuns | None = None) -> Iterator[str]:  # fmt: skip
     """The written program's `lines`, handed on as they are verified against the `original`
     events (an interpreter's reading of the input of its own): each chunk of the input's motion is
     compared with the written lines read back up to where the writer had reached the same
@@ -543,7 +559,7 @@ def verified(lines: Iterable[str], reached: Callable[[], tuple[int, int, int]], 
         return cut[0] if cut[0] and (feed.run(block.line), into) >= cut[0] else None
 
     mine = sections(held, bound, input_cut, divisible=divisible)
-    theirs = sections(_interpreted(parse_stream(feed, file, dialect), file, dialect, offsets), bound, written_cut,
+    theirs = sections(_interpreted(parse_stream(feed, file, dialect), file, dialect, offsets, runs), bound, written_cut,
                       lambda number: feed.tag(number, before=True), divisible)  # fmt: skip
     comparison = _Comparison(file, bound, feed.text, tagged=True)
     try:
@@ -613,14 +629,19 @@ class _Feed:
     # Lines taken from the writer at a time, each tagged as it comes: the writer and the parser
     # each run over many lines in turn, faster than taking turns a line at a time
     AHEAD = 256
+    # Tags looked up behind the last (`_tag_of`; at most twice as many held): more than the input
+    # blocks a subroutine's run held to MAX_ONCE events spans, whose lines are written further on
+    KEPT_TAGS = 2 * MAX_ONCE
 
     def __init__(self, lines: Iterable[str], reached: Callable[[], tuple[int, int, int]]):
         self.lines = iter(lines)
         self.reached = reached
         self.pending: list[str] = []
         # (first written line of the texts handed out at one `reached()`, their tag, the line
-        # before, the input blocks run so far): `reached()` is the same object until it changes
-        self.tags: deque[tuple[int, int, int, int]] = deque()
+        # before, the input blocks run so far), in the order of the lines: `reached()` is the same
+        # object until it changes; the first lines' (`firsts`) for looking a line's up
+        self.tags: list[tuple[int, int, int, int]] = []
+        self.firsts: list[int] = []
         self.count = 0  # written lines taken so far
         self.recent: deque[tuple[int, str]] = deque(maxlen=self.AHEAD + 64)  # for messages
         self.fault: NcppError | None = None  # the writer's, where it stopped
@@ -638,6 +659,7 @@ class _Feed:
                     if reached is not last:
                         last = reached
                         self.tags.append((first, *reached))
+                        self.firsts.append(first)
                     self.pending.append(text)
                     if text:
                         self.count = first + text.count("\n") - text.endswith("\n")  # (the last it is on)
@@ -661,18 +683,26 @@ class _Feed:
                 return
 
     def tag(self, number: int, before: bool = False) -> int:
-        """The tag of written line `number` (asked in increasing order): the input line the
-        writer had reached, or (`before`) the one before it, where the line most likely is from."""
-        tags = self.tags
-        while len(tags) > 1 and tags[1][0] <= number:
-            tags.popleft()
-        return tags[0][2 if before else 1] if tags else 0
+        """The tag of written line `number`: the input line the writer had reached, or (`before`)
+        the one before it, where the line most likely is from."""
+        found = self._tag_of(number)
+        return found[2 if before else 1] if found else 0
 
     def run(self, number: int) -> int:
-        """How many input blocks the writer had taken when it handed out written line `number`
-        (asked in increasing order)."""
-        self.tag(number)
-        return self.tags[0][3] if self.tags else 0
+        """How many input blocks the writer had taken when it handed out written line `number`."""
+        found = self._tag_of(number)
+        return found[3] if found else 0
+
+    def _tag_of(self, number: int) -> tuple[int, int, int, int] | None:
+        """The tag of written line `number`, asked in the order the lines run (a subroutine's, written
+        further on, before the lines after its call); the tags more than KEPT_TAGS back go, and a
+        line of theirs gets the first kept (memory stays flat)."""
+        tags, firsts = self.tags, self.firsts
+        if len(tags) > 2 * self.KEPT_TAGS:
+            del tags[: self.KEPT_TAGS], firsts[: self.KEPT_TAGS]
+        if not tags:
+            return None
+        return tags[max(bisect_right(firsts, number) - 1, 0)]
 
     def handed(self) -> list[str]:
         done, self.pending = self.pending, []

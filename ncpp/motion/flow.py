@@ -249,7 +249,7 @@ class Flow:
         state: Callable[[], object] | None = None,
         position: Callable[[], object] = lambda: None,
         repeats_in_p: bool = False,
-        once_calls: bool = False,
+        once_calls: Callable[[str], bool] | None = None,
     ):
         self.file, self.evaluate, self.parameters, self.done, self.stop, self.path = (
             file,
@@ -308,7 +308,9 @@ class Flow:
         # the blocks read ahead); a verbatim block after them stands after the closing `%`
         self.leader = 0
         self.repeats_in_p = repeats_in_p  # Fanuc: `M98 P51002` runs O1002 five times (`_m98`)
-        self.once_calls = once_calls  # whether a subroutine's first run may be CALLED (`_runs_once`)
+        self.once_calls = (
+            once_calls  # whether a subroutine's first run may be CALLED (`_runs_once`; None: none)
+        )
         self.calls: dict[str, int] = {}  # subroutine name -> its runs so far (o-word calls, M98)
         self.called_again: list[str] = []  # the CALLED subroutines another call has run since told
         self.once_called: set[str] = set()  # the subroutines whose first run was CALLED
@@ -422,7 +424,8 @@ class Flow:
         program's end comes before its text is written), with no control line in its body (no
         loop, branch, call or return: each of its lines runs once, in order)."""
         return (
-            self.once_calls
+            self.once_calls is not None
+            and self.once_calls(name)
             and runs == 1
             and frame.space is None
             and len(self.frames) == 1

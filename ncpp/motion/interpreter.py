@@ -61,7 +61,7 @@ from ncpp.motion.expand import Expansion, number, refused
 from ncpp.motion.expressions import ExpressionError, OutOfScope, Parameters, evaluate, vacant
 from ncpp.motion.flow import CALLED, FIXED, ONCE, RUN, SKIP, Flow
 from ncpp.motion.offsets import SYSTEMS, WorkOffsets
-from ncpp.motion.once import MAX_ONCE, FirstPass
+from ncpp.motion.once import FirstPass, OnceRuns
 from ncpp.motion.segments import (
     COMP,
     CYCLE,
@@ -200,7 +200,7 @@ def interpreting(flavour: type[Interpreter]) -> Callable[..., Iterator[Event]]:
         offsets: WorkOffsets | None = None,
         expand_cycles: bool = False,
         expand: bool = False,
-        at_definition: set[int] | None = None,
+        once_runs: OnceRuns | None = None,
     ) -> Iterator[Event]:
         """Motion events of a program's blocks, lazily, as the flavour reads them (see the
         module docstring).
@@ -217,11 +217,11 @@ def interpreting(flavour: type[Interpreter]) -> Callable[..., Iterator[Event]]:
 
         `expand_cycles`: a canned cycle's block is to be written as its moves (`expanded`);
         `expand`: loops and subroutines are to be written out as straight code (`expand.py`).
-        `at_definition`: given, a subroutine that runs once is followed as its run (`Interpreter.run`)
-        and the ids of its blocks are added, to be written where its definition stands.
+        `once_runs`: given, a subroutine that runs once is followed as its run (`Interpreter.run`)
+        and told there, to be written where its definition stands.
         """
         interpreter = flavour(file, offsets)
-        interpreter.at_definition = at_definition
+        interpreter.once_runs = once_runs
         interpreter.expand_cycles = expand_cycles
         interpreter.expansion = Expansion(interpreter.params, file) if expand else None
         return run(interpreter, blocks, warnings, strict)
@@ -350,7 +350,7 @@ class Interpreter:
         # the last program stop (where the operator may jog the machine): #5001-#5003 read them
         self.placed: set[int] = set()
         # the blocks of the subroutines whose one run is written where their definition stands (`run`)
-        self.at_definition: set[int] | None = None
+        self.once_runs: OnceRuns | None = None
         self.subroutine_path = offsets.subroutine_path if offsets is not None else ()
         if offsets is not None:
             self._start_from(offsets)
@@ -371,17 +371,24 @@ class Interpreter:
         """Events block by block, in the order the blocks run (`_run`).  The run of a subroutine that
         may be its only one (CALLED, `flow.py`) is followed as a run in place, its events and all
         after them held until the program ends: if no other call ran it (`Flow.called_again`), its
-        text ran once and is rewritten for that run where its definition stands (`at_definition`);
-        else, or where the program leaves the scope or the events held pass MAX_ONCE, its moves are
-        left as programmed, as a FIXED run's."""
-        if self.at_definition is None:  # (no run is CALLED)
+        text ran once and is rewritten for that run where its definition stands (`once_runs`);
+        else, or where the program leaves the scope or the events held pass `once_runs.held_most`,
+        its moves are left as programmed, as a FIXED run's."""
+        runs = self.once_runs
+        if runs is None:  # (no run is CALLED)
             yield from self._run(blocks, warnings)  # type: ignore[misc]
             return
         held: list[tuple[Event, tuple[str, Block] | None]] = []
         pending: set[str] = set()  # the CALLED subroutines among the events held
         again: set[str] = set()
+        programmed: set[str] = set()  # those told to stay as programmed (the rest of a run too)
         for item in self._run(blocks, warnings):
             run, event = item if type(item) is tuple else (None, item)
+            if run is not None and run[0] in programmed:  # (the rest of a run told past the bound)
+                kept = _as_programmed(event, run[1])
+                if kept is None:
+                    continue
+                run, event = None, kept
             if run is not None:
                 pending.add(run[0])
             elif not held:
@@ -390,8 +397,10 @@ class Interpreter:
             held.append((event, run))
             again.update(self.flow.called_again)  # type: ignore[union-attr]
             self.flow.called_again.clear()  # type: ignore[union-attr]
-            if self.done or len(held) > MAX_ONCE or pending <= again:
-                yield from self._told_runs(held, again if self.ended else pending)
+            if self.done or len(held) > runs.held_most or pending <= again:
+                told = again if self.ended else pending
+                programmed |= told
+                yield from self._told_runs(held, told)
                 held, pending, again = [], set(), set()
         if held:
             yield from self._told_runs(held, again if self.ended else pending)
@@ -409,7 +418,8 @@ class Interpreter:
                 if kept is not None:
                     yield kept
             else:
-                self.at_definition.add(id(event.block))  # type: ignore[union-attr]  # (CALLED: given)
+                self.once_runs.names.add(run[0])  # type: ignore[union-attr]  # (CALLED: given)
+                self.once_runs.blocks.add(id(event.block))  # type: ignore[union-attr]
                 yield event
 
     def _run(self, blocks: Iterable[Block], warnings: Warnings) -> Iterator[Event | tuple]:
@@ -427,7 +437,7 @@ class Interpreter:
         flow = self.flow = Flow(
             self.file, self._evaluate, self.params, lambda: self.done, self._leave_scope,
             self.subroutine_path, state=self._loop_state, position=lambda: self.pos[:],
-            repeats_in_p=self.repeats_in_p, once_calls=self.at_definition is not None,
+            repeats_in_p=self.repeats_in_p, once_calls=None if self.once_runs is None else self.once_runs.may_run_once,
         )  # fmt: skip
         self.rounding = False
         expansion = self.expansion
@@ -2086,7 +2096,7 @@ class Interpreter:
 # from the others (the context, the fast path)
 _NOT_LOOP_STATE = frozenset(("params", "flow", "warnings", "untold_lengths", "expansion", "tools",
                              "file", "subroutine_path", "expand_cycles", "_context", "_fast",
-                             "rounding", "at_definition"))  # fmt: skip
+                             "rounding", "once_runs"))  # fmt: skip
 # Fanuc lathes' maximum spindle speed clamp in G-code systems B and C (system A's G50 S), and Fanuc
 # machining centres' under constant surface speed (their G code list: G92 "setting for workpiece
 # coordinate system or clamp at maximum spindle speed"; `lathe.py`): no move, no offset

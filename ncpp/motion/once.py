@@ -12,6 +12,7 @@ interpreter's scope tells "again".  The held pass is bounded (MAX_ONCE events: m
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass, field
 
 from ncpp.motion.segments import Event
 from ncpp.program.blocks import Block
@@ -19,6 +20,22 @@ from ncpp.program.blocks import Block
 # Events of a loop's first pass held until the flow tells whether its text runs again: a longer
 # pass is left as programmed (memory stays bounded)
 MAX_ONCE = 10_000
+
+
+@dataclass
+class OnceRuns:
+    """The subroutines whose one run a reading finds, to be written where their definition stands
+    (`Interpreter.run`): their names and the ids of their blocks (which the writer places).  A
+    reading of a written program looks only for those the input's reading found (`only`), whose
+    runs it holds to `held_most` events (the written lines of a run are more than the input's)."""
+
+    blocks: set[int] = field(default_factory=set)
+    names: set[str] = field(default_factory=set)
+    only: set[str] | None = None
+    held_most: int = field(default_factory=lambda: MAX_ONCE)
+
+    def may_run_once(self, name: str) -> bool:
+        return self.only is None or name in self.only
 
 
 class FirstPass:

@@ -15,7 +15,7 @@ import io
 import numpy as np
 import pytest
 
-import ncpp.motion.interpreter as interpreter_module
+import ncpp.motion.once as once_module
 from ncpp.errors import Warnings
 from tests.writeback.test_expand_flow import _compensated, _feed_ends, _pathcheck, _worst_point_um
 from tests.writeback.test_loops_run_once import _misses_um
@@ -75,7 +75,7 @@ def test_a_subroutine_called_twice_or_defined_before_its_call_stays_as_programme
 
 
 def test_the_events_held_past_the_bound_leave_the_run_as_programmed(tmp_path, monkeypatch):
-    monkeypatch.setattr(interpreter_module, "MAX_ONCE", 3)
+    monkeypatch.setattr(once_module, "MAX_ONCE", 3)
     warned = io.StringIO()
     original, output = _compensated(
         tmp_path, ONCE["an o-word subroutine after M2"], warnings=Warnings(stream=warned)
@@ -133,3 +133,40 @@ def test_a_subprogram_with_a_control_line_in_its_body_stays_as_programmed(tmp_pa
     written, warned = _fanuc(tmp_path, text)
     assert "\nG1 X160 Y120 F500\n" in written
     assert "loop or subroutine" in warned
+
+
+def _circle(n: int, radius: float, centre: float) -> str:
+    return "".join(
+        f"X{centre + radius * np.cos(i / 50):.3f} Y{centre + radius * np.sin(i / 50):.3f}\n" for i in range(n)
+    )
+
+
+@pytest.mark.parametrize(
+    ("before", "after", "body"),
+    [(3000, 3000, 3000), (4000, 100, 8000), (100, 500, 9000), (8000, 8000, 1500)],
+    ids=["even", "long body", "longest body", "long main"],
+)
+def test_a_long_run_is_verified_chunk_by_chunk_where_it_runs(tmp_path, before, after, body):
+    """The verifier compares a long program a chunk of moves at a time, tagging each written line
+    with how far the writer had read: the run's lines, written further on, are tagged as where they
+    ran, and a chunk may end inside the run or after it."""
+    text = (FANUC + _circle(before, 50, 100) + "M98 P1001\n" + _circle(after, 40, 150) + "G0 Z10\nM30\nO1001\n"
+            + "G1 X10 Y10\n" + _circle(body, 30, -100) + "M99\n%\n")  # fmt: skip
+    written, warned = _fanuc(tmp_path, text)
+    assert "loop or subroutine" not in warned
+    definition = written[written.index("\nO1001\n") :]
+    assert definition.count("\n") > body  # (the run's lines, pieces and steps, at the definition)
+
+
+def test_a_run_held_past_the_bound_is_read_back_as_programmed(tmp_path):
+    """Past MAX_ONCE events the input's run stays as programmed; the reading of the written program
+    takes it so too, though its own lines would fit its larger hold."""
+    text = (
+        FANUC
+        + "M98 P1001\nG1 X-100 Y150\nG0 Z10\nM30\nO1001\nG1 X10 Y10\n"
+        + _circle(12_000, 30, -100)
+        + "M99\n%\n"
+    )
+    written, warned = _fanuc(tmp_path, text)
+    assert "loop or subroutine" in warned
+    assert "\nO1001\nG1 X10 Y10\n" + _circle(12_000, 30, -100) + "M99\n" in written

@@ -15,6 +15,7 @@ import re
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import replace
 from operator import itemgetter
+from typing import Protocol
 
 from ncpp.motion.cycles import CANNED
 from ncpp.motion.segments import (
@@ -116,21 +117,39 @@ def _lines_ended(
     return ended
 
 
+class Stamps(Protocol):
+    """How far the writer has read (`pipeline._Reached`), which the verifier tags written lines by:
+    `state` now, and `pin` to tag the lines handed out next with an earlier one (None: now again)."""
+
+    state: tuple[int, int, int]
+
+    def pin(self, state: tuple[int, int, int] | None) -> None: ...
+
+
 def _at_definition(
-    write_group: Callable[[list[Event]], Iterable[str]], blocks: set[int]
+    write_group: Callable[[list[Event]], Iterable[str]], blocks: set[int], stamps: Stamps | None
 ) -> Callable[[list[Event]], Iterable[str]]:
     """`write_group`, with the lines of a block among `blocks` (a subroutine's, whose one run came
     before its definition's text: `Interpreter.run`) kept from its run and written in place of its
-    text where the definition stands."""
-    kept: dict[int, Iterable[str]] = {}
+    text where the definition stands, tagged (`stamps`) as where the writer had read when it wrote
+    them: the verifier cuts the run into the same chunks as the input's."""
+    kept: dict[int, tuple[list[str], tuple[int, int, int] | None]] = {}
+
+    def placed(lines: list[str], state: tuple[int, int, int] | None) -> Iterator[str]:
+        if stamps is None:
+            yield from lines
+            return
+        stamps.pin(state)
+        yield from lines
+        stamps.pin(None)
 
     def write(group: list[Event]) -> Iterable[str]:
         key = id(group[0].block)
         if key not in blocks:
             return write_group(group)
         if key in kept:  # (the definition's text)
-            return kept.pop(key)
-        kept[key] = list(write_group(group))
+            return placed(*kept.pop(key))
+        kept[key] = (list(write_group(group)), stamps.state if stamps is not None else None)
         return ()
 
     return write
@@ -173,6 +192,7 @@ class IsoWriter:
         self._told_unpositioned: set[str] = set()
         # the blocks of subroutines run once, written where their definition stands (`_at_definition`)
         self.at_definition: set[int] | None = None
+        self.stamps: Stamps | None = None  # how far it has read, where a verifier tags its lines by it
         # Per layout of a plain block's text (`DIGITS_AS_ONE`): what its numbers teach, see `_read_layout`.
         self._layouts: dict[bytes, tuple] = {}
         self._layout: tuple[Block | None, bytes] = (None, b"")  # the last block whose layout was read, and it
@@ -223,7 +243,7 @@ class IsoWriter:
             written = lambda group: [*ahead(group), *self._write_group(group), *behind(group)]  # noqa: E731
         write_group = _lines_ended(written)
         if self.at_definition is not None:
-            write_group = _at_definition(write_group, self.at_definition)
+            write_group = _at_definition(write_group, self.at_definition, self.stamps)
         control = False  # the group is a control line's, whose writing reads only its first event
         ran = self._ran if type(self)._ran is not IsoWriter._ran else None  # (ISO's does nothing)
         for event in events:
