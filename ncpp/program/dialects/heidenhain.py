@@ -74,13 +74,14 @@ def _retract_distance(text: str) -> float | str:
 
 
 def _split_address(text: str) -> tuple[str, str]:
-    """`IX-5` -> ('IX', '-5'); `DR2+0` -> ('DR2', '+0'); `RQ1832` -> ('R', 'Q1832')."""
+    """`IX-5` -> ('IX', '-5'); `DR2+0` -> ('DR2', '+0'); `RQ1832` -> ('R', 'Q1832'); `RADIUS 16` ->
+    ('RADIUS', '16')."""
     if text[:3].upper() == "DR2" and len(text) > 3 and text[3] in "+-":
         return "DR2", text[3:]
     end = 0
     while end < len(text) and text[end] not in _ADDRESS_END:
         end += 1
-    return text[:end].upper(), text[end:]
+    return text[:end].upper().rstrip(" \t"), text[end:]
 
 
 def _tool_ref(tok) -> object:
