@@ -108,6 +108,9 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_a_loop_that_runs_twice_stays_as_programmed_inside_one_that_runs_once",
         ),
         "writeback/test_last_line_unended.py": ("test_rs274_reads_the_output_as_the_input_within_20_um",),
+        "writeback/test_expression_word_spelling.py": (
+            "test_the_g43_move_gains_its_x_once_and_rs274_runs_the_path",
+        ),
         "motion/test_cutter_comp.py": (
             "test_g41_checks_against_the_radius_of_the_tool_table_ncpp_is_told",
             "test_moves_after_compensation_agree_with_rs274",

@@ -1256,8 +1256,10 @@ class Interpreter:
                     words["R"][1],
                 )
             if motion == 0.0 and mode0 is None:
-                raise _OutOfScope("R word with G0", words["R"][1].start + 1)
-            if motion == 1.0 and mode0 is None:
+                # (an R of a G code out of scope, `G68 X0. Y0. R45.` under G0: `_check_scope` names it)
+                if not any(value in OUT_OF_SCOPE_G for value, _ in gcodes.values()):
+                    raise _OutOfScope("R word with G0", words["R"][1].start + 1)
+            elif motion == 1.0 and mode0 is None:
                 pass  # Fanuc corner rounding `G1 X.. Y.. R..` (rs274ngc refuses it)
             elif not (motion in _R_MOTIONS or g7 in (41.1, 42.1) or mode0 == 10.0 or 19.0 in mcodes):
                 self._fail("R word with no g code that uses it", block, words["R"][1])

@@ -12,7 +12,7 @@ import copy
 from collections.abc import Collection, Iterable, Mapping, Sequence
 from typing import BinaryIO
 
-from ncpp.program.blocks import AnyItem, Block, Comment, Word
+from ncpp.program.blocks import AnyItem, Block, Comment, ExprWord, Word
 from ncpp.program.numbers import NumberStyle, format_number
 
 AXIS_LETTERS = frozenset("XYZABCUVWIJKR")
@@ -30,22 +30,26 @@ def write_blocks(blocks: Iterable[Block], out: BinaryIO) -> int:
 def spelling(block: Block) -> tuple[str, bool]:
     """How the block spells its words: (separator, lower case).
 
-    The separator is what stands between its first two words ('' when packed,
-    ' ' when it has fewer than two); lower case when a word has a letter and none
-    of their letters is a capital (`^60`, LinuxCNC's polar words, has none: capitals).
+    The separator is what stands between its first two adjacent words, a word given by an
+    expression (`H#33`) one of them ('' when packed, ' ' when it has none); lower case when a
+    word has a letter and none of their letters is a capital (`^60`, LinuxCNC's polar words,
+    has none: capitals).
     """
     raw = block.raw
     separator = None
     previous_end = -1
     letters = capital = False
     for item in block.items:
-        if type(item) is Word:
-            if separator is None and previous_end >= 0:
-                separator = raw[previous_end : item.start]
-            previous_end = item.end
-            first = raw[item.start]
-            if first.isalpha():
-                letters, capital = True, capital or not first.islower()
+        kind = type(item)
+        if kind is not Word and kind is not ExprWord:
+            previous_end = -1  # (no separator measured across a comment or a statement)
+            continue
+        if separator is None and previous_end >= 0:
+            separator = raw[previous_end : item.start]
+        previous_end = item.end
+        first = raw[item.start]
+        if first.isalpha():
+            letters, capital = True, capital or not first.islower()
     return (" " if separator is None else separator), letters and not capital
 
 

@@ -349,3 +349,32 @@ def test_a_rotation_of_zero_is_followed_and_any_other_leaves_the_scope(angle, fo
     found = moves(program(f"CYCL DEF 10.0 ROTATION\nCYCL DEF 10.1 {angle}", holes=[]), warned)
     assert (len(found) == 4) is followed
     assert ("CYCL DEF 10.1 (it moves the datum) is outside" in warned.getvalue()) is not followed
+
+
+POCKET_4 = [  # an iTNC 530 program's cycle 4 POCKET MILLING (a DMU 50's, its blocks N35-N41)
+    "CYCL DEF 4.0 TASCHENFRAESEN",
+    "CYCL DEF 4.1 ABST 1",
+    "CYCL DEF 4.2 TIEFE -4",
+    "CYCL DEF 4.3 ZUSTLG 4 F100",
+    "CYCL DEF 4.4 X+145",
+    "CYCL DEF 4.5 Y+35.065",
+    "CYCL DEF 4.6 F200 DR- RADIUS 16",
+]
+
+
+def test_the_old_pocket_cycle_is_read_and_its_call_ends_interpretation():
+    """Cycle 4's last line writes the corner radius after a blank, `RADIUS 16` (iTNC 530 User's Manual,
+    Conversational Programming, "POCKET MILLING (Cycle 4)"): the program is read, its moves before the
+    cycle's call are compensated (X gains 5e-5 · Y), the definition is written as read, and the call,
+    a cycle ncpp does not follow, passes through with the rest."""
+    body = ["TOOL CALL 2 Z S2020 F200", "L  X+60 Y+45 Z+1 R0 FMAX", *POCKET_4, "L  X+60 Y+85 Z+1 FMAX",
+            "CYCL CALL", "L  X+200 Y+200 Z+100 FMAX", "M30"]  # fmt: skip
+    lines = ["0  BEGIN PGM POCKET MM"] + [f"{n}  {text}" for n, text in enumerate(body, 1)]
+    text = "\n".join(lines + [f"{len(body) + 1}  END PGM POCKET MM"]) + "\n"
+    written, stats = compensate(text)
+    assert all(line in written for line in POCKET_4)
+    tail = [line.split(" ", 1)[1] for line in written.splitlines()[-4:]]  # (renumbered after the header)
+    assert tail == [line.split(" ", 1)[1] for line in lines[-3:]] + [" END PGM POCKET MM"]
+    assert stats.summary.passed_on_from == len(body) - 2 + 1  # the CYCL CALL's line
+    ends = [c for m in moves(written)[:2] for c in m.end[:2]]
+    assert ends == pytest.approx([60 + 5e-5 * 45, 45, 60 + 5e-5 * 85, 85], abs=6e-5)

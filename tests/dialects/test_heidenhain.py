@@ -246,6 +246,21 @@ def test_a_feed_keyword_may_have_a_blank_after_its_f(text, feed):
     assert ("feed", (feed,)) in statements(text)
 
 
+def test_the_old_pocket_cycle_writes_its_corner_radius_after_a_blank():
+    """Cycle 4 POCKET MILLING ends its definition with the feed, the direction and the corner radius,
+    `RADIUS` and the number apart (iTNC 530 User's Manual, Conversational Programming, "POCKET MILLING
+    (Cycle 4)": `CYCL DEF 4.6 F275 DR+ RADIUS 5`); the line is a DMU 50 program's (iTNC 530), its
+    block number as a TNC writes it.  Cycle 5's `RADIUS 39` reads the same way."""
+    line = "41 CYCL DEF 4.6 F200 DR- RADIUS 16"
+    assert statements(line) == [("cycle_def", ("4.6", ())), ("rotation", ("-",))]
+    assert words(line) == {"N": 41.0, "F": 200.0, "RADIUS": 16.0}
+    assert words("32 CYCL DEF 5.4 RADIUS 39")["RADIUS"] == 39.0
+    text = (line + "\n").encode()
+    out = io.BytesIO()
+    write_blocks(list(parse_stream(io.BytesIO(text), "p.h", "heidenhain")), out)
+    assert out.getvalue() == text
+
+
 def test_contour_geometry_and_tolerance_cycles_parse_as_the_manual_writes_them():
     """Cycle 14 CONTOUR GEOMETRY names its subcontours `CYCL DEF 14.1 CONTOUR LABEL1 /2 /3` and cycle 32
     TOLERANCE its mode `CYCL DEF 32.2 HSC-MODE:0 TA0` (TNC 640 / iTNC 530 User's Manual, Cycle

@@ -67,7 +67,11 @@ def test_a_setting_with_motion_in_its_block_ends_interpretation():
      ("G00 G45 H03 Z2.0", "G45 (tool position offset", "fanuc"), ("G46 X10. D15", "G46 (tool position", "fanuc"),
      ("G91 G47 G01 X10. D1", "G47 (tool position offset", "fanuc"), ("G48 Z-2. D2", "G48 (tool position", "fanuc"),
      ("N20 G53 G00 H0 Z -110 M05;", "an H word without G43 (Fanuc's", "fanuc"), ("H2", "an H word without G43", "fanuc"),
-     ("G49 H0", "an H word without G43", "fanuc"), ("G0 H#1 Z5", "an H word without G43", "fanuc")],
+     ("G49 H0", "an H word without G43", "fanuc"), ("G0 H#1 Z5", "an H word without G43", "fanuc"),
+     # a Haas macro program's rotations under G0 (their R is G68's angle, not a G0 word)
+     ("/ G68 X0. Y0. R0. ", "2:3: warning: coordinate rotation G68", "haas"),
+     ("G68 X0. Y0. R#21", "2:1: warning: coordinate rotation G68", "haas"),
+     ("G68 X0. Y0. R45.", "2:1: warning: coordinate rotation G68", "fanuc")],
 )  # fmt: skip
 def test_what_fanuc_and_haas_programs_need_ncpp_is_not_told_ends_interpretation(block, reason, dialect):
     said = io.StringIO()

@@ -74,13 +74,14 @@ def _retract_distance(text: str) -> float | str:
 
 
 def _split_address(text: str) -> tuple[str, str]:
-    """`IX-5` -> ('IX', '-5'); `DR2+0` -> ('DR2', '+0'); `RQ1832` -> ('R', 'Q1832')."""
+    """`IX-5` -> ('IX', '-5'); `DR2+0` -> ('DR2', '+0'); `RQ1832` -> ('R', 'Q1832'); `RADIUS 16` ->
+    ('RADIUS', '16')."""
     if text[:3].upper() == "DR2" and len(text) > 3 and text[3] in "+-":
         return "DR2", text[3:]
     end = 0
     while end < len(text) and text[end] not in _ADDRESS_END:
         end += 1
-    return text[:end].upper(), text[end:]
+    return text[:end].upper().rstrip(" \t"), text[end:]
 
 
 def _tool_ref(tok) -> object:
@@ -461,6 +462,9 @@ class HeidenhainWriter(IsoWriter):
             else:
                 word = block.items[call] if n == last_piece and call is not None else None
                 moved = "" if word is None else " " + block.raw[word.start : word.end]
+                # (the block's F holds from its start: a step before its own move feeds at it)
+                if n < own and not feed and not segment.rapid and _sets_feed(block):
+                    feed = self._feed_word(segment)
                 yield self._inserted(self._fresh(segment, rotary[n]) + feed + moved)
             feed = ""  # on the first block written
             self._remember_end(segment)
@@ -505,6 +509,9 @@ class HeidenhainWriter(IsoWriter):
         for segment in motion[len(pieces) - 1 if pieces else 0 :]:
             self._remember_end(segment)
 
+    def _feed_word(self, segment: Line | Arc) -> str:
+        return " F" + format_number(segment.feed, self.styles.get("F") or NumberStyle(decimals=3))
+
     def _restored_feed(self, block: Block, motion: list) -> str:
         """` F500` for the first move after an edited `RND ... F`, unless it sets its own feed."""
         if not self.restore_feed:
@@ -516,7 +523,7 @@ class HeidenhainWriter(IsoWriter):
         self.restore_feed = False
         if feeds:
             return ""
-        return " F" + format_number(motion[0].feed, self.styles.get("F") or NumberStyle(decimals=3))
+        return self._feed_word(motion[0])
 
     def _header_first(self, block: Block, header: str) -> list[str]:
         self.last_number = -1
@@ -674,6 +681,13 @@ class HeidenhainWriter(IsoWriter):
                         self.known_axes.add(axis)
             elif type(item) is ExprWord and item.letter[-1:] in _AXES and item.letter.lstrip("I") == item.letter[-1]:  # fmt: skip
                 self.known_axes.add(item.letter[-1])  # `X+Q1932` positions X as a number does
+
+
+def _sets_feed(block: Block) -> bool:
+    """Whether the block programs a feed (`F1000`, `FQ53`, `FAUTO`), not FMAX."""
+    return any((isinstance(i, (Word, ExprWord)) and i.letter == "F")
+               or (type(i) is Statement and i.kind == "feed" and i.node[0] == "FAUTO")
+               for i in block.items)  # fmt: skip
 
 
 def _position_call(block: Block) -> int | None:
