@@ -149,6 +149,10 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
     },
     # a second and a half or more on a 2-core machine, all parameters together
     "slow": {
+        "shop/test_extents.py": None,  # (each runs the command line)
+        "compensation/test_warning_order.py": None,
+        "export/test_tables.py": None,
+        "compensation/test_rotary_dialects.py": None,
         "motion/test_fanuc_flavours.py": (
             "test_a_haas_peck_cycle_with_p_is_compensated_with_its_p_and_verified",
             "test_external_output_passes_through_the_compensated_program",
