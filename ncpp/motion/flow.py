@@ -311,7 +311,7 @@ class Flow:
         self.once_calls = (
             once_calls  # whether a subroutine's first run may be CALLED (`_runs_once`; None: none)
         )
-        self.calls: dict[str, int] = {}  # subroutine name -> its runs so far (o-word calls, M98)
+        self.ran: set[str] = set()  # the subroutines a call has run (o-word calls, M98, G65, G66)
         self.called_again: list[str] = []  # the CALLED subroutines another call has run since told
         self.once_called: set[str] = set()  # the subroutines whose first run was CALLED
         self.revisits: Revisits | None = None
@@ -433,7 +433,7 @@ class Flow:
             and self.modal is None
             and self._in_place(frame)
             and frame.pc not in self.looped
-            and name not in self.calls
+            and name not in self.ran
             and name not in self.files
             and self._source_of(body) is None
             and body[0].line > block.line
@@ -449,9 +449,9 @@ class Flow:
 
     def _count_call(self, name: str) -> None:
         """A run of subroutine `name` starts: a CALLED one's text runs again."""
-        if name in self.calls and name in self.once_called:
+        if name in self.ran and name in self.once_called:
             self.called_again.append(name)
-        self.calls[name] = self.calls.get(name, 0) + 1
+        self.ran.add(name)
 
     def in_straight_code(self) -> bool:
         """Whether the program runs its main text with no loop under way (none can go back)."""
