@@ -18,7 +18,9 @@ from pathlib import Path
 import pytest
 
 from ncpp.motion.segments import PLANE_AXES
-from tests.conftest import RS274
+from tests.conftest import RS274, SHARED
+
+PATHCHECK = SHARED / "tools" / "pathcheck"
 
 EXECUTING = "executing"  # what rs274 says on stderr as it starts the program
 # rs274's note on a program without `%` or M2 at its end: a warning, not a refusal
@@ -147,3 +149,15 @@ def calls_from(var_file: Path, program: Path, tool_table: str = "T1 P1 D6.0 Z0\n
         pytest.skip(f"rs274 oracle did not run: {done.stderr.strip()[:200]}")
     assert done.returncode == 0, done.stderr
     return done.stdout
+
+
+def pathcheck(original: Path, rewritten: Path, *options: str) -> None:
+    """`../shared/tools/pathcheck` on the two programs (rs274 runs both): the test fails where it
+    finds the rewritten one doing other actions or leaving the path; skipped without the tools."""
+    if not (RS274.exists() and PATHCHECK.exists()):
+        pytest.skip("rs274 or pathcheck not available")
+    import sys
+
+    check = subprocess.run([sys.executable, str(PATHCHECK), str(original), str(rewritten), *options],
+                           capture_output=True, text=True, timeout=600)  # fmt: skip
+    assert check.returncode == 0, check.stdout + check.stderr

@@ -521,14 +521,16 @@ def test_a_fanuc_tool_position_offset_passes_through_and_the_moves_before_it_are
     assert written.endswith(tail) and "compensated 3 moves" in messages
     with pytest.raises(NcppError, match="p.nc:6:5: Unknown g code used"):
         events(POSITION_OFFSET, "iso")
-    if not RS274.exists():
-        pytest.skip("rs274 not available")
+    _heads_take_one_path(tmp_path, POSITION_OFFSET, written, tail)
+
+
+def _heads_take_one_path(tmp_path: Path, program: str, written: str, tail: str) -> None:
+    """The program and the written one up to the `tail` they share (where interpretation ended),
+    each closed by M30: rs274 runs them along one path (pathcheck)."""
     before, after = tmp_path / "before.ngc", tmp_path / "after.ngc"
-    before.write_text(POSITION_OFFSET[: -len(tail)] + "M30\n")
+    before.write_text(program[: -len(tail)] + "M30\n")
     after.write_text(written[: -len(tail)] + "M30\n")
-    check = subprocess.run([sys.executable, str(PATHCHECK), str(before), str(after), "--tol-mm", "0.02"],
-                           capture_output=True, text=True)  # fmt: skip
-    assert check.returncode == 0, check.stdout + check.stderr
+    oracle.pathcheck(before, after, "--tol-mm", "0.02")
 
 
 # A Fanuc course program's retract to the machine's Z zero with H0 and no G43 (rodolforavellli23/Projects
@@ -551,14 +553,7 @@ def test_a_fanuc_h_word_without_g43_passes_through_and_the_moves_before_it_are_c
     for dialect in ("iso", "haas"):
         with pytest.raises(NcppError, match="p.nc:6:13: H word with no G43 or G76 to use it"):
             events(INDEPENDENT_H, dialect)
-    if not RS274.exists():
-        pytest.skip("rs274 not available")
-    before, after = tmp_path / "before.ngc", tmp_path / "after.ngc"
-    before.write_text(INDEPENDENT_H[: -len(tail)] + "M30\n")
-    after.write_text(written[: -len(tail)] + "M30\n")
-    check = subprocess.run([sys.executable, str(PATHCHECK), str(before), str(after), "--tol-mm", "0.02"],
-                           capture_output=True, text=True)  # fmt: skip
-    assert check.returncode == 0, check.stdout + check.stderr
+    _heads_take_one_path(tmp_path, INDEPENDENT_H, written, tail)
 
 
 # A Fanuc student program's circles (IIIVENDETTAIII/CNC-Programming, SSCNC "Phase 2 ... Work Wersion Update")

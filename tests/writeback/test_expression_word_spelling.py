@@ -12,10 +12,10 @@ import pytest
 
 from ncpp.program.parser import LineParser
 from ncpp.program.writer import set_words, spelling
-from tests.conftest import ROOT, RS274, SHARED
+from tests.conftest import ROOT, SHARED
+from tests.rs274 import pathcheck
 
 WIDE = SHARED / "machines" / "wide.toml"
-PATHCHECK = SHARED / "tools" / "pathcheck"
 PROGRAM = (
     "G00 G17 G40 G49 G80 G90\nG54 \nG52 X [ 0. ] Y [ 0. ] Z [ 0. ] \n\n#33= 10 ( NOMER INSTRUMENTA) \n\n"
     "T#33 M06 \nG43 H#33 Z150. \nG00 X0. Y [ 195. / 2 ] \nM30\n"
@@ -49,10 +49,6 @@ def test_the_g43_move_gains_its_x_once_and_rs274_runs_the_path(tmp_path):
     assert proc.returncode == 0, proc.stderr  # (the verifier refused a second H#33)
     g43 = next(line for line in out.read_text().splitlines() if line.startswith("G43"))
     assert g43.count("H#33") == 1 and " X" in g43, g43
-    if not (RS274.exists() and PATHCHECK.exists()):
-        pytest.skip("rs274 not available")
     tools = tmp_path / "tool.tbl"
     tools.write_text("T10 P10 Z0 D10 ;\n")  # (rs274 needs the tool #33 calls)
-    check = subprocess.run([sys.executable, str(PATHCHECK), str(program), str(out), "--tool-table", str(tools),
-                            "--tol-mm", "0.02"], capture_output=True, text=True)  # fmt: skip
-    assert check.returncode == 0, check.stdout + check.stderr
+    pathcheck(program, out, "--tool-table", str(tools), "--tol-mm", "0.02")
