@@ -40,6 +40,7 @@ read so on both sides, its lines tagged as where they ran.
 
 from __future__ import annotations
 
+import io
 import math
 import re
 from bisect import bisect_right
@@ -615,13 +616,6 @@ class _Upstream(Exception):
         self.error = error
 
 
-def _physical_lines(text: str) -> tuple[list[str], str]:
-    """A written text's lines, each with its LF (only LF ends a line in a program file), and what
-    follows the last LF: the start of a line the next text goes on (the file holds them so)."""
-    *whole, last = text.split("\n")
-    return [line + "\n" for line in whole], last
-
-
 class _Feed:
     """Written lines as the parser reads them (bytes), each remembered with the input line the
     writer had reached when it handed the line out (its tag), until the lines are handed on."""
@@ -647,32 +641,40 @@ class _Feed:
         self.fault: NcppError | None = None  # the writer's, where it stopped
         self.rest_of_line = ""  # written text after the last LF handed to the parser
         self.open_line = False  # the texts taken so far end inside a line (the next goes on it)
+        self.found: tuple[int, tuple[int, int, int, int]] | None = None  # the last line looked up, its tag
 
     def __iter__(self) -> Iterator[bytes]:
         last = None
+        recent, tags, firsts = self.recent, self.tags, self.firsts
         while True:
-            taken = len(self.pending)
+            pending = self.pending  # (`handed` takes the list the lines before went to)
+            taken = len(pending)
+            count, open_line = self.count, self.open_line
             try:
                 for text in islice(self.lines, self.AHEAD):
                     reached = self.reached()
-                    first = self.count + (0 if self.open_line else 1)  # (the line it starts on)
+                    first = count if open_line else count + 1  # (the line it starts on)
                     if reached is not last:
                         last = reached
-                        self.tags.append((first, *reached))
-                        self.firsts.append(first)
-                    self.pending.append(text)
+                        tags.append((first, *reached))
+                        firsts.append(first)
+                        self.found = None
+                    pending.append(text)
                     if text:
-                        self.count = first + text.count("\n") - text.endswith("\n")  # (the last it is on)
-                        self.open_line = not text.endswith("\n")
-                    self.recent.append((self.count, text))
+                        ended = text.endswith("\n")
+                        count = first + text.count("\n") - ended  # (the last line it is on)
+                        open_line = not ended
+                    recent.append((count, text))
             except NcppError as err:  # (the lines before it are read first)
                 self.fault = err
-            batch = self.pending[taken:]
-            for (
-                text
-            ) in batch:  # (a line at a time, as the file holds them: the parser numbers them as `count`)
-                lines, self.rest_of_line = _physical_lines(self.rest_of_line + text)
-                yield from (line.encode("latin-1") for line in lines)
+            self.count, self.open_line = count, open_line
+            batch = pending[taken:]
+            # (a line at a time, as the file holds them: the parser numbers them as `count`; only
+            # LF ends a line in a program file, as binary reading splits them)
+            text = self.rest_of_line + "".join(batch)
+            end = text.rfind("\n") + 1
+            self.rest_of_line = text[end:]
+            yield from io.BytesIO(text[:end].encode("latin-1"))
             if self.fault is not None or len(batch) < self.AHEAD:
                 if self.rest_of_line:  # (the file's last line, unended)
                     yield self.rest_of_line.encode("latin-1")
@@ -697,12 +699,16 @@ class _Feed:
         """The tag of written line `number`, asked in the order the lines run (a subroutine's, written
         further on, before the lines after its call); the tags more than KEPT_TAGS back go, and a
         line of theirs gets the first kept (memory stays flat)."""
+        if self.found is not None and self.found[0] == number:  # (a block's line is asked twice)
+            return self.found[1]
         tags, firsts = self.tags, self.firsts
         if len(tags) > 2 * self.KEPT_TAGS:
             del tags[: self.KEPT_TAGS], firsts[: self.KEPT_TAGS]
         if not tags:
             return None
-        return tags[max(bisect_right(firsts, number) - 1, 0)]
+        found = tags[max(bisect_right(firsts, number) - 1, 0)]
+        self.found = (number, found)
+        return found
 
     def handed(self) -> list[str]:
         done, self.pending = self.pending, []
