@@ -164,6 +164,7 @@ class FanucInterpreter(Interpreter):
     r_over_ijk = True  # `G02 X.. Y.. R.. I.. J..`: R's arc, I J ignored (module docstring)
     independent_h = True  # `G53 G00 H0 Z-110`: an H without G43, out of scope (module docstring)
     incremental_zero_set = True  # `G91 G10 L2 P1 X10.` adds 10 to G54's X (module docstring)
+    rotating_g10 = False  # (an R in G10 L2 is no rotation there)
     g92_speed_clamp = True  # `G92 S4000`: refused as the spindle speed clamp it is (`G92_SPEED_CLAMP`)
 
     def block(self, block: Block) -> Event | tuple[Event, ...]:

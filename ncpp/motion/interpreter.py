@@ -71,6 +71,7 @@ from ncpp.motion.segments import (
     PLANE_AXES,
     TAP_IN,
     TAP_OUT,
+    turn_xy,
     Arc,
     Context,
     Event,
@@ -276,6 +277,9 @@ class Interpreter:
     # G92 with S and no axis words is a spindle speed clamp (Fanuc's lathes and machining centres): the
     # refusal says so (`G92_SPEED_CLAMP`); rs274ngc has no G92 S and refuses it as a G92 without axes
     g92_speed_clamp = False
+    # G10 L2 R turns the system's X Y about Z (LinuxCNC G-code manual, G10 L2: "optionally program R to
+    # indicate the rotation of the XY axis around the Z"); elsewhere an R there is out of scope
+    rotating_g10 = True
 
     def __init__(self, file: str = "<stdin>", offsets: WorkOffsets | None = None):
         self.file = file
@@ -309,6 +313,7 @@ class Interpreter:
         self.coord_system = 1
         # by system number: 1..9 G54..G59.3, then the additional work offsets told (`offsets.ADDITIONAL`)
         self.g5x = {n: [0.0] * 9 for n in range(1, 10)}
+        self.rotations: dict[int, float] = {}  # by system number: its G10 L2 R, degrees (absent: 0)
         self.g92 = [0.0] * 9
         self.g92_saved = [0.0] * 9
         self.tool = [0.0] * 9  # the tool length offset in effect, program units
@@ -736,12 +741,24 @@ class Interpreter:
                 self.coord_system,
                 str(self.spindle_tool) if self.spindle_tool else "",
                 self.zeros_set.get(self.coord_system),
+                self._rotation(),
             )
         return self._context
 
+    def _rotation(self) -> tuple[float, float, float] | None:
+        """`Context.rotation` in effect: the active system's G10 L2 R, about its zero, where the G92 offset
+        is added before the control turns the point (rs274ngc's canon: machine = R (p + G92) + G5x + tool)."""
+        angle = self.rotations.get(self.coord_system)
+        return None if angle is None else (angle, -self.g92[0], -self.g92[1])
+
     # -- one block ------------------------------------------------------------------
     def block(self, block: Block) -> Event | tuple[Event, ...]:
-        """The event(s) of one block; updates the modal state."""
+        """The event(s) of one block; updates the modal state.  Under a rotation of the coordinate
+        system the moves are in the turned frame, a translation of the machine's (`Context.turned`)."""
+        events = self._block_events(block)
+        return _turned(events) if self.rotations else events
+
+    def _block_events(self, block: Block) -> Event | tuple[Event, ...]:
         items = block.items
         if not items:
             return Pass(block)
@@ -1315,6 +1332,8 @@ class Interpreter:
             return
         if self.plane not in (17, 18):
             self._fail("Cutter radius compensation allowed only in XY, XZ planes", block, item)
+        if self.rotations.get(self.coord_system):
+            raise _OutOfScope(f"cutter compensation G{code:g} under a coordinate system rotation", item.start + 1)
         d = words.get("D")
         if code in (41.1, 42.1):
             if d is None:
@@ -1379,8 +1398,20 @@ class Interpreter:
         g10 = gcodes.get(0, (None,))[0] == 10.0
         if g10 and words.get("L", (None,))[0] in (1.0, 10.0, 11.0):
             raise _OutOfScope("tool table change G10 L1/L10/L11", gcodes[0][1].start + 1)
-        if g10 and words.get("R", (0.0,))[0] != 0.0:
+        if g10 and words.get("R", (0.0,))[0] != 0.0 and not (self.rotating_g10 and words["L"][0] == 2.0):
             raise _OutOfScope("coordinate system rotation G10 R", words["R"][1].start + 1)
+        if self._rotation() is not None:
+            self._check_turned(words, gcodes)
+
+    def _check_turned(self, words: dict, gcodes: dict) -> None:
+        """What ncpp does not follow under a rotation of the coordinate system: an offset set from where
+        the tool stands (its words would have to be turned with the correction: G92, G10 L20), and a G28 or
+        G30 whose intermediate point names X or Y (the axes it places are the turned frame's)."""
+        code, item = gcodes.get(0, (None, None))
+        if code == 92.0 or (code == 10.0 and words["L"][0] == 20.0):
+            raise _OutOfScope(f"G{code:g} under a coordinate system rotation", item.start + 1)
+        if code in (28.0, 30.0) and ("X" in words or "Y" in words):
+            raise _OutOfScope(f"G{code:g} with X or Y under a coordinate system rotation", item.start + 1)
 
     # -- modal state -------------------------------------------------------------------------
     def _set(self, **changes) -> None:
@@ -1451,8 +1482,11 @@ class Interpreter:
             if code == 43.2:
                 new = [old + added for old, added in zip(self.tool, new)]
         held = self.pos[:] if changed else None
-        self._shift(self.tool, new)
-        self.tool = new
+        if self.rotations.get(self.coord_system):  # (the tool's X Y offsets are not turned)
+            self._keeping_machine(lambda: setattr(self, "tool", new))
+        else:
+            self._shift(self.tool, new)
+            self.tool = new
         if changed:
             self.unmoved = held
             self._fast = False
@@ -1485,9 +1519,39 @@ class Interpreter:
             )
 
     def _coordinate_system(self, number: int) -> None:
+        if self.rotations.get(self.coord_system) or self.rotations.get(number):
+            self._keeping_machine(lambda: setattr(self, "coord_system", number))
+            return
         self._shift(self.g5x[self.coord_system], self.g5x[number])
         self.coord_system = number
         self._context = None
+
+    def _keeping_machine(self, change: Callable[[], None]) -> None:
+        """An offset or a rotation changes where one is in effect before or after: the machine stays
+        where it is, and the program position is its point in the new frame, as rs274ngc keeps it."""
+        held = [self._to_machine(v) for v in (self.pos, self.unmoved) if v is not None]
+        change()
+        self.pos = self._from_machine(held[0])
+        if self.unmoved is not None:
+            self.unmoved = self._from_machine(held[1])
+        self._context = None
+
+    def _to_machine(self, p: list[float]) -> list[float]:
+        """The machine position (program units, all axes) of program point `p`: rs274ngc's canon adds
+        G92, turns X Y by the system's rotation, then adds its zero and the tool length."""
+        q = [v + g for v, g in zip(p, self.g92)]
+        angle = self.rotations.get(self.coord_system)
+        if angle:
+            q[0], q[1] = turn_xy(q[0], q[1], (angle, 0.0, 0.0))
+        return [v + z + t for v, z, t in zip(q, self.g5x[self.coord_system], self.tool)]
+
+    def _from_machine(self, m: list[float]) -> list[float]:
+        """The program point of machine position `m` (`_to_machine`'s inverse)."""
+        q = [v - z - t for v, z, t in zip(m, self.g5x[self.coord_system], self.tool)]
+        angle = self.rotations.get(self.coord_system)
+        if angle:
+            q[0], q[1] = turn_xy(q[0], q[1], (angle, 0.0, 0.0), -1.0)
+        return [v - g for v, g in zip(q, self.g92)]
 
     def _program_end(self) -> None:
         """M2/M30: rs274ngc resets some modes and stops reading the program."""
@@ -1499,6 +1563,8 @@ class Interpreter:
         self.done = self.ended = True
 
     def _machine(self, i: int) -> float:
+        if self.rotations.get(self.coord_system):
+            return self._to_machine(self.pos)[i]
         return self.pos[i] + self.g5x[self.coord_system][i] + self.g92[i] + self.tool[i]
 
     def _non_modal(self, block: Block, words: dict, code: float) -> Event | tuple[Event, ...] | None:
@@ -1540,11 +1606,11 @@ class Interpreter:
             self.told_zeros.discard(number)
             if {0, 1, 2} <= {i for i, _ in given}:  # the program says where it is
                 self.untold.discard(number)
-            for i, value in given:
-                if words["L"][0] == 2.0:
-                    self.g5x[number][i] = value + (old[i] if added else 0.0)
-                else:  # L20: the current point gets the given coordinates
-                    self.g5x[number][i] = self.pos[i] + self.g5x[self.coord_system][i] - value
+            angle = words["R"][0] if "R" in words and self.rotating_g10 else None
+            if number == self.coord_system and (self.rotations.get(number) or angle):
+                self._keeping_machine(lambda: self._set_zero(number, given, words["L"][0], added, angle))
+                return setting
+            self._set_zero(number, given, words["L"][0], added, angle)
             if number == self.coord_system:
                 self._shift(old, self.g5x[number])
         elif code in (28.1, 30.1):
@@ -1552,6 +1618,22 @@ class Interpreter:
         elif code in (28.0, 30.0):
             return self._go_home(block, given, self.home[int(code)])
         return setting
+
+    def _set_zero(
+        self, number: int, given: list[tuple[int, float]], l_number: float, added: bool, angle: float | None
+    ) -> None:
+        """G10 L2 / L20: system `number`'s zero from the given axes, and its rotation where R gives it."""
+        old = self.g5x[number][:]
+        for i, value in given:
+            if l_number == 2.0:
+                self.g5x[number][i] = value + (old[i] if added else 0.0)
+            else:  # L20: the current point gets the given coordinates
+                self.g5x[number][i] = self.pos[i] + self.g5x[self.coord_system][i] - value
+        if angle is not None:
+            if angle:
+                self.rotations[number] = angle
+            else:
+                self.rotations.pop(number, None)
 
     def _zero_set(self, number: int, axes: set[int], l20: bool, added: bool) -> None:
         """Whether system `number`'s zero is known after a G10 of `axes` sets it (`zeros_set`): G10 L2
@@ -1574,10 +1656,7 @@ class Interpreter:
         first = self._line(block, middle, True)
         first.fixed, first.placed = HOME, named if self.absolute else (False, False, False)
         axes = [i for i, _ in given] or range(9)
-        end = middle[:]
-        for i in axes:
-            end[i] = home[i] - (self.g5x[self.coord_system][i] + self.g92[i] + self.tool[i])
-        second = self._line(block, end, True)
+        second = self._line(block, self._at_machine(middle, [(i, home[i]) for i in axes]), True)
         second.fixed, second.placed = HOME, named if given else (True, True, True)
         return first, second
 
@@ -1589,14 +1668,25 @@ class Interpreter:
     def _ends(self, given: list[tuple[int, float]], machine: bool) -> list[float]:
         end = self._base()
         if machine:  # G53: machine coordinates, always absolute
-            for i, value in given:
-                end[i] = value - (self.g5x[self.coord_system][i] + self.g92[i] + self.tool[i])
-        elif self.absolute:
+            return self._at_machine(end, given)
+        if self.absolute:
             for i, value in given:
                 end[i] = value
         else:
             for i, value in given:
                 end[i] += value
+        return end
+
+    def _at_machine(self, end: list[float], given: list[tuple[int, float]]) -> list[float]:
+        """Program point `end` with the given axes put at machine positions (G53, a G28/G30 home)."""
+        if self.rotations.get(self.coord_system):
+            at = self._to_machine(end)
+            for i, value in given:
+                at[i] = value
+            return self._from_machine(at)
+        end = end[:]
+        for i, value in given:
+            end[i] = value - (self.g5x[self.coord_system][i] + self.g92[i] + self.tool[i])
         return end
 
     def _line(self, block: Block, end: list[float], rapid: bool) -> Line:
@@ -1719,6 +1809,8 @@ class Interpreter:
         `Line`s marked `fixed`: HOLE, one hole that apply_error_map compensates as a whole (its
         position in the plane, its R and bottom along the normal), or CYCLE, left as programmed;
         with --expand-cycles moves like any other (`_expanded`)."""
+        if self.rotations.get(self.coord_system):
+            raise _OutOfScope(f"canned cycle G{motion:g} under a coordinate system rotation", item.start + 1)
         first, second, normal = PLANE_AXES[self.plane]
         again = previous == motion  # the same cycle again: R, the normal-axis word, P and Q are sticky
         if previous not in CANNED:  # a new series: G98 retracts to where it started, no dwell yet
@@ -1944,6 +2036,8 @@ class Interpreter:
     def _arc(self, block: Block, words: dict, motion: float, motion_item, mode1_item) -> Arc | Pass:
         word = motion_item if motion_item is not None else next(item for _, item in words.values())
         plane = self.plane
+        if plane != 17 and self.rotations.get(self.coord_system):  # (its plane turns off the machine's)
+            raise _OutOfScope(f"an arc in G{plane} under a coordinate system rotation", word.start + 1)
         first_letter, second_letter, normal_letter = _ARC_LETTERS[plane]
         radius = words.get("R")
         has_ijk = "I" in words or "J" in words or "K" in words
@@ -2121,6 +2215,19 @@ _PLAIN_LETTERS = {
     **{code: frozenset() for code in CANNED},  # a cycle's words are checked in full
     RIGID_TAP: frozenset(),  # a modal G33.1 block needs its K again (rs274ngc: "K word missing")
 }
+
+
+def _turned(events: Event | tuple[Event, ...]) -> Event | tuple[Event, ...]:
+    """The moves of `events` (new ones) moved into the frame their context's rotation turns the
+    program's points into (`Context.turned`): arcs in the XY plane stay arcs about the turned centre."""
+    for event in events if type(events) is tuple else (events,):
+        if type(event) is Pass or event.context.rotation is None:  # type: ignore[union-attr]
+            continue
+        turned = event.context.turned  # type: ignore[union-attr]
+        event.start, event.end = turned(event.start), turned(event.end)  # type: ignore[union-attr]
+        if type(event) is Arc:
+            event.center = turned(event.center)
+    return events
 
 
 def _marked(events: Event | tuple[Event, ...] | None, marks: list[Pass]) -> Event | tuple[Event, ...]:
