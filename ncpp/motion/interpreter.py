@@ -1402,6 +1402,22 @@ class Interpreter:
             raise _OutOfScope("coordinate system rotation G10 R", words["R"][1].start + 1)
         if self._rotation() is not None:
             self._check_turned(words, gcodes)
+        if any(self.g92[:2]) and (self.rotations or (g10 and words.get("R", (0.0,))[0])):
+            self._check_reframed(words, gcodes)
+
+    def _check_reframed(self, words: dict, gcodes: dict) -> None:
+        """rs274ngc puts the program position after a new zero or rotation of the system in effect (G10
+        L2 of it, another system selected) as if no G92 offset were in effect: with one, where a rotation
+        is in effect before or after, its position and the machine's part (not followed)."""
+        code, item = gcodes.get(0, (None, None))
+        if code == 10.0 and round(words.get("P", (0.0,))[0]) in (0, self.coord_system):
+            if self.rotations.get(self.coord_system) or words.get("R", (0.0,))[0]:
+                raise _OutOfScope("G10 L2 of the system in effect under a rotation and a G92 offset",
+                                  item.start + 1)  # fmt: skip
+        selected = _COORD_SYSTEM[gcodes[12][0]] if 12 in gcodes else None
+        if selected is not None and (self.rotations.get(self.coord_system) or self.rotations.get(selected)):
+            raise _OutOfScope(f"G{gcodes[12][0]:g} under a coordinate system rotation and a G92 offset",
+                              gcodes[12][1].start + 1)  # fmt: skip
 
     def _check_turned(self, words: dict, gcodes: dict) -> None:
         """What ncpp does not follow under a rotation of the coordinate system: an offset set from where
@@ -1481,12 +1497,11 @@ class Interpreter:
             new = [value * scale if i in LINEAR else value for i, value in enumerate(table)]
             if code == 43.2:
                 new = [old + added for old, added in zip(self.tool, new)]
+        if self.rotations.get(self.coord_system) and new[:2] != self.tool[:2]:  # (rs274ngc does not turn them)
+            raise _OutOfScope("a tool offset in X or Y under a coordinate system rotation", item.start + 1)
         held = self.pos[:] if changed else None
-        if self.rotations.get(self.coord_system):  # (the tool's X Y offsets are not turned)
-            self._keeping_machine(lambda: setattr(self, "tool", new))
-        else:
-            self._shift(self.tool, new)
-            self.tool = new
+        self._shift(self.tool, new)
+        self.tool = new
         if changed:
             self.unmoved = held
             self._fast = False
@@ -1527,8 +1542,9 @@ class Interpreter:
         self._context = None
 
     def _keeping_machine(self, change: Callable[[], None]) -> None:
-        """An offset or a rotation changes where one is in effect before or after: the machine stays
-        where it is, and the program position is its point in the new frame, as rs274ngc keeps it."""
+        """A zero or a rotation changes where one is in effect before or after: the machine stays where it
+        is, and the program position is its point in the new frame, as rs274ngc keeps it (without a G92
+        offset: `_check_reframed`)."""
         held = [self._to_machine(v) for v in (self.pos, self.unmoved) if v is not None]
         change()
         self.pos = self._from_machine(held[0])
