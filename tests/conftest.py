@@ -49,6 +49,7 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
         "compensation/test_rotation.py": (
             "test_the_whole_path_under_g10_l2_r_lands_on_the_original_in_rs274",
             "test_the_interpreter_follows_rs274_through_offsets_changed_under_a_rotation",
+            "test_the_whole_path_under_g68_lands_on_the_original_in_rs274",
         ),
         "compensation/test_rigid_tap.py": (
             "test_each_tap_runs_on_the_programmed_line_within_half_a_micron",

@@ -314,6 +314,10 @@ class Interpreter:
         # by system number: 1..9 G54..G59.3, then the additional work offsets told (`offsets.ADDITIONAL`)
         self.g5x = {n: [0.0] * 9 for n in range(1, 10)}
         self.rotations: dict[int, float] = {}  # by system number: its G10 L2 R, degrees (absent: 0)
+        # Fanuc's G68 in effect: (degrees, centre X, centre Y in program units); and after G68 or G69 (its
+        # code) until a move puts X and Y at absolute positions (`_settle_rotation`)
+        self.g68: tuple[float, float, float] | None = None
+        self.unsettled_rotation: float | None = None
         self.g92 = [0.0] * 9
         self.g92_saved = [0.0] * 9
         self.tool = [0.0] * 9  # the tool length offset in effect, program units
@@ -746,8 +750,11 @@ class Interpreter:
         return self._context
 
     def _rotation(self) -> tuple[float, float, float] | None:
-        """`Context.rotation` in effect: the active system's G10 L2 R, about its zero, where the G92 offset
-        is added before the control turns the point (rs274ngc's canon: machine = R (p + G92) + G5x + tool)."""
+        """`Context.rotation` in effect: Fanuc's G68 about its centre, or the active system's G10 L2 R about
+        the system's zero, where the G92 offset is added before the control turns the point (rs274ngc's
+        canon: machine = R (p + G92) + G5x + tool, that is R (p - c) + c + G92 + G5x + tool, c = -G92)."""
+        if self.g68 is not None:
+            return self.g68
         angle = self.rotations.get(self.coord_system)
         return None if angle is None else (angle, -self.g92[0], -self.g92[1])
 
@@ -756,7 +763,25 @@ class Interpreter:
         """The event(s) of one block; updates the modal state.  Under a rotation of the coordinate
         system the moves are in the turned frame, a translation of the machine's (`Context.turned`)."""
         events = self._block_events(block)
-        return _turned(events) if self.rotations else events
+        if self.unsettled_rotation is not None and _moves(events):
+            self._settle_rotation(block)
+        return _turned(events) if self.rotations or self.g68 is not None else events
+
+    def _settle_rotation(self, block: Block) -> None:
+        """Fanuc: after G68, moves in G91 run from where the tool stood at G68 (the centre for them,
+        Fanuc Series 16/18-MC operator's manual, "Coordinate system rotation"), as they do here; after G69
+        the first move must be absolute (its WARNING).  Until a move gives X and Y absolutely, a move
+        that gives one of them alone takes the other from a position the manual does not say: not
+        followed; nor a G91 move after G69."""
+        given = [item for item in block.items if type(item) in (Word, ExprWord) and item.letter in "XY"]
+        if not given or any(type(item) is Word and item.letter == "G" and item.value == 53.0 for item in block.items):
+            return
+        if self.absolute and len({item.letter for item in given}) == 2:
+            self.unsettled_rotation = None
+        elif self.absolute or self.unsettled_rotation == 69.0:
+            mode = "absolute" if self.absolute else "incremental"
+            raise _OutOfScope(f"an {mode} move of X or Y alone after G{self.unsettled_rotation:g}",
+                              given[0].start + 1)  # fmt: skip
 
     def _block_events(self, block: Block) -> Event | tuple[Event, ...]:
         items = block.items
@@ -1332,7 +1357,7 @@ class Interpreter:
             return
         if self.plane not in (17, 18):
             self._fail("Cutter radius compensation allowed only in XY, XZ planes", block, item)
-        if self.rotations.get(self.coord_system):
+        if self._rotation() is not None:
             raise _OutOfScope(f"cutter compensation G{code:g} under a coordinate system rotation", item.start + 1)
         d = words.get("D")
         if code in (41.1, 42.1):
@@ -1497,7 +1522,7 @@ class Interpreter:
             new = [value * scale if i in LINEAR else value for i, value in enumerate(table)]
             if code == 43.2:
                 new = [old + added for old, added in zip(self.tool, new)]
-        if self.rotations.get(self.coord_system) and new[:2] != self.tool[:2]:  # (rs274ngc does not turn them)
+        if self._rotation() is not None and new[:2] != self.tool[:2]:  # (rs274ngc does not turn them)
             raise _OutOfScope("a tool offset in X or Y under a coordinate system rotation", item.start + 1)
         held = self.pos[:] if changed else None
         self._shift(self.tool, new)
@@ -1553,21 +1578,21 @@ class Interpreter:
         self._context = None
 
     def _to_machine(self, p: list[float]) -> list[float]:
-        """The machine position (program units, all axes) of program point `p`: rs274ngc's canon adds
-        G92, turns X Y by the system's rotation, then adds its zero and the tool length."""
-        q = [v + g for v, g in zip(p, self.g92)]
-        angle = self.rotations.get(self.coord_system)
-        if angle:
-            q[0], q[1] = turn_xy(q[0], q[1], (angle, 0.0, 0.0))
-        return [v + z + t for v, z, t in zip(q, self.g5x[self.coord_system], self.tool)]
+        """The machine position (program units, all axes) of program point `p`: X Y turned about the
+        rotation's centre (`_rotation`), then G92, the system's zero and the tool length added."""
+        q = list(p)
+        rotation = self._rotation()
+        if rotation is not None:
+            q[0], q[1] = turn_xy(q[0], q[1], rotation)
+        return [v + g + z + t for v, g, z, t in zip(q, self.g92, self.g5x[self.coord_system], self.tool)]
 
     def _from_machine(self, m: list[float]) -> list[float]:
         """The program point of machine position `m` (`_to_machine`'s inverse)."""
-        q = [v - z - t for v, z, t in zip(m, self.g5x[self.coord_system], self.tool)]
-        angle = self.rotations.get(self.coord_system)
-        if angle:
-            q[0], q[1] = turn_xy(q[0], q[1], (angle, 0.0, 0.0), -1.0)
-        return [v - g for v, g in zip(q, self.g92)]
+        q = [v - g - z - t for v, g, z, t in zip(m, self.g92, self.g5x[self.coord_system], self.tool)]
+        rotation = self._rotation()
+        if rotation is not None:
+            q[0], q[1] = turn_xy(q[0], q[1], rotation, -1.0)
+        return q
 
     def _program_end(self) -> None:
         """M2/M30: rs274ngc resets some modes and stops reading the program."""
@@ -1579,7 +1604,7 @@ class Interpreter:
         self.done = self.ended = True
 
     def _machine(self, i: int) -> float:
-        if self.rotations.get(self.coord_system):
+        if self._rotation() is not None:
             return self._to_machine(self.pos)[i]
         return self.pos[i] + self.g5x[self.coord_system][i] + self.g92[i] + self.tool[i]
 
@@ -1695,7 +1720,7 @@ class Interpreter:
 
     def _at_machine(self, end: list[float], given: list[tuple[int, float]]) -> list[float]:
         """Program point `end` with the given axes put at machine positions (G53, a G28/G30 home)."""
-        if self.rotations.get(self.coord_system):
+        if self._rotation() is not None:
             at = self._to_machine(end)
             for i, value in given:
                 at[i] = value
@@ -1825,7 +1850,7 @@ class Interpreter:
         `Line`s marked `fixed`: HOLE, one hole that apply_error_map compensates as a whole (its
         position in the plane, its R and bottom along the normal), or CYCLE, left as programmed;
         with --expand-cycles moves like any other (`_expanded`)."""
-        if self.rotations.get(self.coord_system):
+        if self._rotation() is not None:
             raise _OutOfScope(f"canned cycle G{motion:g} under a coordinate system rotation", item.start + 1)
         first, second, normal = PLANE_AXES[self.plane]
         again = previous == motion  # the same cycle again: R, the normal-axis word, P and Q are sticky
@@ -2052,7 +2077,7 @@ class Interpreter:
     def _arc(self, block: Block, words: dict, motion: float, motion_item, mode1_item) -> Arc | Pass:
         word = motion_item if motion_item is not None else next(item for _, item in words.values())
         plane = self.plane
-        if plane != 17 and self.rotations.get(self.coord_system):  # (its plane turns off the machine's)
+        if plane != 17 and self._rotation() is not None:  # (its plane turns off the machine's)
             raise _OutOfScope(f"an arc in G{plane} under a coordinate system rotation", word.start + 1)
         first_letter, second_letter, normal_letter = _ARC_LETTERS[plane]
         radius = words.get("R")
