@@ -77,6 +77,15 @@ in G19 (Fanuc operator's manuals, "Canned cycle for drilling": "Positioning plan
 axis", G17 Zp, G18 Yp, G19 Xp; the drilling axis is the basic axis not used to define the
 positioning plane), as rs274ngc drills but does not tap there (`Interpreter.taps_in_any_plane`).
 
+Coordinate system rotation `G68 X_ Y_ R_` / `G69` in G17 is followed (`_coordinate_rotation`, and
+`Interpreter._settle_rotation` for the moves after it) where the Fanuc manual's rules leave nothing to a
+parameter (Fanuc Series 16/18/160/180-MC operator's manual, "Coordinate system rotation": X Y the
+centre, absolute; R the angle, counter-clockwise; without X Y the tool's position is the centre, without
+R a parameter's angle; no G17-G19 in its mode; G91 moves after it run from where the tool stood at
+G68; the first move after G69 absolute), Haas's alike (Mill Operator's Manual, "G68 Rotation": R
+from Setting 72 when not given, added in G91 with Setting 73).  Scaling (G51), the programmable
+mirror image (G51.1), G68.1 and the tilted working plane (G68.2-G68.4) end interpretation by name.
+
 Canned cycles are a modal group of their own, group 09 beside group 01's G00-G03 (Fanuc 0i-MD /
 15i-MA operator's manuals, "List of G codes"; Haas Mill Operator's Manual, "G80 Canned Cycle Cancel
 (Group 09)"), so G80 cancels the cycle and leaves the G00-G03 mode it interrupted in effect: `G00 Z.1`,

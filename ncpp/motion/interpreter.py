@@ -4,11 +4,13 @@
 `Pass`; a G28/G30 block gives two `Line`s), in the order the blocks run
 (o-word control flow, `flow.py`), state bounded whatever the program length.  Positions are program (work) coordinates in program units,
 exactly what rs274 prints in its canonical calls; `Context.offset` says where
-the program origin sits in machine coordinates.
+the program origin sits in machine coordinates.  Under a rotation of the coordinate system
+(G10 L2 R, Fanuc's G68: `Context.rotation`) they are turned as the control turns them, a
+translation of the machine position (`canon_call` turns them back to rs274's).
 
 Scope: modal G0-G3, planes, G90/G91, G90.1/G91.1, G20/G21 (state converted
-on a switch, like LinuxCNC), G54-G59.3, G10 L2/L20 (no rotation; Fanuc's and Haas's
-additional work offsets and their readings of G10: `fanuc.py`), G92 family,
+on a switch, like LinuxCNC), G54-G59.3, G10 L2/L20 (L2's R: the system turned about Z; Fanuc's and
+Haas's G68, additional work offsets and their readings of G10: `fanuc.py`), G92 family,
 G52, G53, G28/G30, T, M6, M61, G43 / G43.1 / G43.2 H / G49 (lengths from the
 control's tool table, `tools.py`; zero when it is not told), F and inverse time, IJK and R arcs, helices,
 P turns, parameters and expressions, Fanuc corner rounding and
@@ -756,7 +758,7 @@ class Interpreter:
         if self.g68 is not None:
             return self.g68
         angle = self.rotations.get(self.coord_system)
-        return None if angle is None else (angle, -self.g92[0], -self.g92[1])
+        return None if angle is None else (angle, 0.0 - self.g92[0], 0.0 - self.g92[1])
 
     # -- one block ------------------------------------------------------------------
     def block(self, block: Block) -> Event | tuple[Event, ...]:

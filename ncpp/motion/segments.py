@@ -11,7 +11,8 @@ The interpreter turns each block into zero or more events:
 Every segment points at its source `Block` and carries the modal context a
 writer needs to turn it back into NC text in the program's own style.
 Coordinates are program (work) coordinates in program units, as rs274
-reports them; `Context.to_machine` converts to machine axis positions in mm,
+reports them (under a rotation of the coordinate system, turned as the control turns
+them: `Context.rotation`); `Context.to_machine` converts to machine axis positions in mm,
 where the error model lives.
 """
 
