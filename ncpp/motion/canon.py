@@ -71,7 +71,9 @@ def canon_call(event: Event) -> CanonCall | None:
         end = event.context.turned(event.end, -1.0)
         if event.tap:
             return CanonCall("RIGID_TAP", end) if event.tap == TAP_IN else None
-        return CanonCall("STRAIGHT_TRAVERSE" if event.rapid else "STRAIGHT_FEED", (*end, *_rotary(event.extra)))
+        return CanonCall(
+            "STRAIGHT_TRAVERSE" if event.rapid else "STRAIGHT_FEED", (*end, *_rotary(event.extra))
+        )
     if type(event) is Arc:
         a, b, n = PLANE_AXES[event.context.plane]
         e, c = event.context.turned(event.end, -1.0), event.context.turned(event.center, -1.0)

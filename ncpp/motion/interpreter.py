@@ -73,7 +73,6 @@ from ncpp.motion.segments import (
     PLANE_AXES,
     TAP_IN,
     TAP_OUT,
-    turn_xy,
     Arc,
     Context,
     Event,
@@ -81,6 +80,7 @@ from ncpp.motion.segments import (
     Line,
     Pass,
     Setting,
+    turn_xy,
 )
 from ncpp.motion.tools import UntoldLengths
 from ncpp.program.blocks import STRAY_TAPE, UNREADABLE, Block, Comment, ExprWord, Statement, Word
@@ -775,8 +775,10 @@ class Interpreter:
         the first move must be absolute (its WARNING).  Until a move gives X and Y absolutely, a move
         that gives one of them alone takes the other from a position the manual does not say: not
         followed; nor a G91 move after G69."""
-        given = [item for item in block.items if type(item) in (Word, ExprWord) and item.letter in "XY"]
-        if not given or any(type(item) is Word and item.letter == "G" and item.value == 53.0 for item in block.items):
+        given = [item for item in block.items if isinstance(item, (Word, ExprWord)) and item.letter in "XY"]
+        if not given or any(
+            type(item) is Word and item.letter == "G" and item.value == 53.0 for item in block.items
+        ):
             return
         if self.absolute and len({item.letter for item in given}) == 2:
             self.unsettled_rotation = None
@@ -1360,7 +1362,9 @@ class Interpreter:
         if self.plane not in (17, 18):
             self._fail("Cutter radius compensation allowed only in XY, XZ planes", block, item)
         if self._rotation() is not None:
-            raise _OutOfScope(f"cutter compensation G{code:g} under a coordinate system rotation", item.start + 1)
+            raise _OutOfScope(
+                f"cutter compensation G{code:g} under a coordinate system rotation", item.start + 1
+            )
         d = words.get("D")
         if code in (41.1, 42.1):
             if d is None:

@@ -110,7 +110,9 @@ class Context:
         return (x, y, p[2])
 
 
-def turn_xy(x: float, y: float, rotation: tuple[float, float, float], sign: float = 1.0) -> tuple[float, float]:
+def turn_xy(
+    x: float, y: float, rotation: tuple[float, float, float], sign: float = 1.0
+) -> tuple[float, float]:
     """(x, y) turned by `rotation` (degrees, centre x, centre y) about its centre; `sign` -1: back."""
     angle, cx, cy = rotation
     c, s = math.cos(math.radians(angle)), sign * math.sin(math.radians(angle))

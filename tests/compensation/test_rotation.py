@@ -39,10 +39,14 @@ SETUP = "".join(
     f"G10 L2 P{code - 53} X{x:g} Y{y:g} Z{z:g} R{angle:g}\n" for code, ((x, y, z), angle) in SYSTEMS.items()
 )
 # lines, arcs (R and I J, both turns), G91 increments, a G53 retract, two systems turned either way
-PROGRAM = "G21 G90 G17 G94 G64\n" + SETUP + (
-    "G54\nG0 X-10 Y-10 Z5\nG1 Z-1 F300\nG1 X100 Y0\nG3 X120 Y20 R20\nG1 Y80\nG3 X80 Y120 I-40 J0\n"
-    "G91 G1 X-50 Y-20\nG1 Y-40\nG90 G1 X0 Y0\nG0 Z5\n"
-    "G55\nG0 X0 Y0\nG1 Z-2 F300\nG1 X60 Y30\nG2 X60 Y-30 R35\nG1 X0 Y0\nG0 Z5\nG53 G0 Z0\nG54\nM2\n"
+PROGRAM = (
+    "G21 G90 G17 G94 G64\n"
+    + SETUP
+    + (
+        "G54\nG0 X-10 Y-10 Z5\nG1 Z-1 F300\nG1 X100 Y0\nG3 X120 Y20 R20\nG1 Y80\nG3 X80 Y120 I-40 J0\n"
+        "G91 G1 X-50 Y-20\nG1 Y-40\nG90 G1 X0 Y0\nG0 Z5\n"
+        "G55\nG0 X0 Y0\nG1 Z-2 F300\nG1 X60 Y30\nG2 X60 Y-30 R35\nG1 X0 Y0\nG0 Z5\nG53 G0 Z0\nG54\nM2\n"
+    )
 )
 _WORD = re.compile(r"([XYZ])\s*(-?[\d.]+)")
 _MOTION = re.compile(r"G0*[0-3](?!\d)")
@@ -156,7 +160,9 @@ def turned_twice(segment):
 
 @pytest.mark.parametrize("dialect", ["iso", "fanuc"])
 @pytest.mark.parametrize("wrong", [lambda segment: segment, turned_twice], ids=["unturned", "turned-twice"])
-def test_the_verifier_refuses_a_writer_that_gets_the_rotation_wrong(tmp_path, monkeypatch, capsys, wrong, dialect):
+def test_the_verifier_refuses_a_writer_that_gets_the_rotation_wrong(
+    tmp_path, monkeypatch, capsys, wrong, dialect
+):
     """A writer that writes the turned frame's points as the program's words, or turns them the wrong
     way, is caught by the verifier: nothing is written."""
     monkeypatch.setattr(ncpp.program.dialects.iso, "as_written", wrong)
@@ -178,7 +184,12 @@ def test_the_verifier_refuses_a_writer_that_gets_the_rotation_wrong(tmp_path, mo
         ("F100", "G81 X10 Y10 Z-3 R2", "G81", "canned cycle G81 under a coordinate system rotation"),
         ("F100", "G92 X0 Y0", "G92", "G92 under a coordinate system rotation"),
         ("F100", "G28 X0 Y0", "G28", "G28 with X or Y under a coordinate system rotation"),
-        ("F100", "G41.1 D6 G1 X10 Y10", "G41.1", "cutter compensation G41.1 under a coordinate system rotation"),
+        (
+            "F100",
+            "G41.1 D6 G1 X10 Y10",
+            "G41.1",
+            "cutter compensation G41.1 under a coordinate system rotation",
+        ),
         ("G52 X1", "G55", "G55", "G55 under a coordinate system rotation and a G92 offset"),
         ("G52 Y1", "G10 L2 P0 X3", "G10", "G10 L2 of the system in effect under a rotation and a G92 offset"),
     ],
@@ -332,8 +343,16 @@ def test_the_whole_path_under_g68_lands_on_the_original_in_rs274(tmp_path):
         ("G68 X0 Y0 R30\nG18", "G18", "G18 under coordinate system rotation G68"),
         ("G68 X0 Y0 R30\nG55", "G55", "G55 under coordinate system rotation G68"),
         ("G68 X0 Y0 R30\nG1 X5 F100", "X5", "an absolute move of X or Y alone after G68"),
-        ("G68 X0 Y0 R30\nG1 X5 Y5 F100\nG69\nG91 G1 X1", "X1", "an incremental move of X or Y alone after G69"),
-        ("G68 X0 Y0 R30\nG81 X1 Y1 Z-1 R1 F100", "G81", "canned cycle G81 under a coordinate system rotation"),
+        (
+            "G68 X0 Y0 R30\nG1 X5 Y5 F100\nG69\nG91 G1 X1",
+            "X1",
+            "an incremental move of X or Y alone after G69",
+        ),
+        (
+            "G68 X0 Y0 R30\nG81 X1 Y1 Z-1 R1 F100",
+            "G81",
+            "canned cycle G81 under a coordinate system rotation",
+        ),
         ("G68.2 X0 Y0 Z0 I0 J30 K0", "G68.2", "tilted working plane G68.2"),
         ("G51 X0 Y0 P2", "G51", "scaling G51"),
     ],
