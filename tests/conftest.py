@@ -50,6 +50,7 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_the_whole_path_under_g10_l2_r_lands_on_the_original_in_rs274",
             "test_the_interpreter_follows_rs274_through_offsets_changed_under_a_rotation",
             "test_the_whole_path_under_g68_lands_on_the_original_in_rs274",
+            "test_a_parameter_files_rotation_is_followed_as_rs274_follows_it",
         ),
         "compensation/test_rigid_tap.py": (
             "test_each_tap_runs_on_the_programmed_line_within_half_a_micron",

@@ -367,7 +367,8 @@ class Interpreter:
             self._start_from(offsets)
 
     def _start_from(self, offsets: WorkOffsets) -> None:
-        """The control's zeros (mm, the interpreter starts in mm) and its system in effect."""
+        """The control's zeros (mm, the interpreter starts in mm), its system in effect and the systems'
+        rotations (LinuxCNC's parameter file holds them: `WorkOffsets.rotations`)."""
         for n in (*range(1, 10), *offsets.told_additional()):
             self.g5x[n] = [*offsets.zero(n), *[0.0] * 6]
         self.coord_system = offsets.active
@@ -375,6 +376,8 @@ class Interpreter:
         self.g92_saved = self.g92[:]
         self.home[28][:3], self.home[30][:3] = offsets.g28, offsets.g30
         self.untold = {n for n in range(1, 10) if not offsets.told(n)}
+        if self.rotating_g10:  # (a Fanuc control's #5230 is an axis of G54, no rotation)
+            self.rotations = {n: angle for n, angle in enumerate(offsets.rotations, 1) if angle}
         self.told_zeros = {n for n in (*range(1, 10), *offsets.told_additional()) if offsets.told(n)}
 
     # -- the event stream ---------------------------------------------------------

@@ -25,6 +25,7 @@ import ncpp.program.dialects.iso
 from ncpp.cli import main
 from ncpp.errors import Warnings
 from ncpp.motion.canon import canon_call, read_canon
+from ncpp.motion.offsets import WorkOffsets
 from ncpp.pipeline import dialect_tools
 from ncpp.program.dialects import parse_program
 from tests import rs274
@@ -147,6 +148,45 @@ def test_the_interpreter_follows_rs274_through_offsets_changed_under_a_rotation(
     assert [c.name for c in mine] == [c.name for c in theirs]
     for a, b in zip(mine, theirs):
         assert np.allclose(a.args, b.args, atol=1e-6), (a, b)
+
+
+def test_a_parameter_files_rotation_is_followed_as_rs274_follows_it(tmp_path):
+    """LinuxCNC's parameter file holds each system's rotation (#5230 for G54's, 20 on for the next): the
+    program starts turned, and ncpp's moves agree with rs274's started from the same file (the
+    stand-alone rs274 reads it in inches)."""
+    var = tmp_path / "turned.var"
+    var.write_text("5220 2.0\n5221 1.0\n5222 2.0\n5223 0.0\n5241 4.0\n5242 -2.0\n5243 0.0\n5250 -35.0\n")
+    text = "G21 G90 G17\nG0 X10 Y0 Z5\nG1 X20 Y5 F100\nG2 X30 Y-5 R12\nG53 G0 X0 Y0\nG54 G0 X5 Y5\nM2\n"
+    interpret, _ = dialect_tools("iso")
+    _, blocks = parse_program(io.BytesIO(text.encode()), "t.ngc", "iso")
+    offsets = WorkOffsets.from_var_file(var, unit_mm=25.4)
+    events = interpret(blocks, file="t.ngc", warnings=Warnings(stream=io.StringIO()), offsets=offsets)
+    mine = [call for call in map(canon_call, events) if call is not None]
+    theirs = read_canon(rs274.canon(text, var_file=var, digits=7))
+    assert [c.name for c in mine] == [c.name for c in theirs]
+    for a, b in zip(mine, theirs):
+        assert np.allclose(a.args, b.args, atol=1e-6), (a, b)
+
+
+def test_a_parameter_files_rotation_is_compensated_and_said_in_the_header(tmp_path):
+    """A program run in a system the parameter file turns (no G10 in it) reaches its turned points within
+    0.5 µm on the machine, and the header says the rotation it was compensated for."""
+    (tmp_path / "affine.toml").write_text(AFFINE)
+    var, program, out = tmp_path / "turned.var", tmp_path / "plain.ngc", tmp_path / "plain.out.ngc"
+    var.write_text("5220 1.0\n5221 100.0\n5222 50.0\n5223 0.0\n5230 30.0\n")
+    points = [(10.0, 0.0, 5.0), (20.0, 5.0, -1.0), (160.0, 5.0, -1.0), (160.0, 90.0, -1.0), (-20.0, 90.0, -1.0)]
+    program.write_text("G21 G90 G17\n" + "".join(f"G1 X{x:g} Y{y:g} Z{z:g} F300\n" for x, y, z in points) + "M2\n")
+    assert main(["compensate", "--machine", str(tmp_path / "affine.toml"), "--var-file", str(var),
+                 "--var-units", "mm", "--tolerance", "0.0001", str(program), "-o", str(out)]) == 0  # fmt: skip
+    text = out.read_text()
+    assert "turned about Z, degrees, from the parameter file: G54 R30" in text
+    place = lambda p: [*(turning(30.0) @ np.array(p[:2]) + [100.0, 50.0]), p[2]]  # noqa: E731
+    wanted = np.array([place(p) for p in points])
+    written = [tuple(float(v) for v in re.findall(r"[XYZ](-?[\d.]+)", line)) for line in text.splitlines()
+               if line.startswith("G1 ")]  # fmt: skip
+    reached = closed_form(np.array([place(p) for p in written]))
+    assert misses(closed_form(wanted), wanted.tolist()).max() > 0.010
+    assert misses(reached, wanted.tolist()).max() < 0.0005
 
 
 def turned_twice(segment):
