@@ -28,7 +28,9 @@ def placement_lines(offsets: WorkOffsets, dialect: str) -> list[str]:
         lines = [f"ncpp program zero at {_point(offsets.program_zero())} machine mm"]
     if any(offsets.g92):
         lines.append(f"ncpp G92/G52 offset {_point(offsets.g92)} mm, from the parameter file")
-    turned = [f"{system_name(n, dialect)} R{angle:g}" for n, angle in enumerate(offsets.rotations, 1) if angle]
+    turned = [
+        f"{system_name(n, dialect)} R{angle:g}" for n, angle in enumerate(offsets.rotations, 1) if angle
+    ]
     if turned and dialect == "iso":  # (LinuxCNC's G10 L2 R; a Fanuc file's #5230 is no rotation)
         lines.append(f"ncpp systems turned about Z, degrees, from the parameter file: {', '.join(turned)}")
     lines.append(_tool_table(offsets))

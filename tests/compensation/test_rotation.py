@@ -174,8 +174,16 @@ def test_a_parameter_files_rotation_is_compensated_and_said_in_the_header(tmp_pa
     (tmp_path / "affine.toml").write_text(AFFINE)
     var, program, out = tmp_path / "turned.var", tmp_path / "plain.ngc", tmp_path / "plain.out.ngc"
     var.write_text("5220 1.0\n5221 100.0\n5222 50.0\n5223 0.0\n5230 30.0\n")
-    points = [(10.0, 0.0, 5.0), (20.0, 5.0, -1.0), (160.0, 5.0, -1.0), (160.0, 90.0, -1.0), (-20.0, 90.0, -1.0)]
-    program.write_text("G21 G90 G17\n" + "".join(f"G1 X{x:g} Y{y:g} Z{z:g} F300\n" for x, y, z in points) + "M2\n")
+    points = [
+        (10.0, 0.0, 5.0),
+        (20.0, 5.0, -1.0),
+        (160.0, 5.0, -1.0),
+        (160.0, 90.0, -1.0),
+        (-20.0, 90.0, -1.0),
+    ]
+    program.write_text(
+        "G21 G90 G17\n" + "".join(f"G1 X{x:g} Y{y:g} Z{z:g} F300\n" for x, y, z in points) + "M2\n"
+    )
     assert main(["compensate", "--machine", str(tmp_path / "affine.toml"), "--var-file", str(var),
                  "--var-units", "mm", "--tolerance", "0.0001", str(program), "-o", str(out)]) == 0  # fmt: skip
     text = out.read_text()
