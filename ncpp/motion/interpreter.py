@@ -777,18 +777,27 @@ class Interpreter:
         Fanuc Series 16/18-MC operator's manual, "Coordinate system rotation"), as they do here; after G69
         the first move must be absolute (its WARNING).  Until a move gives X and Y absolutely, a move
         that gives one of them alone takes the other from a position the manual does not say: not
-        followed; nor a G91 move after G69."""
+        followed; nor a G91 move of X or Y after G69.  A G53 move leaves this as it is; a G28/G30 in G91
+        whose X Y increments are 0 (the return posts write) moves from where the tool stands, and homing
+        both X and Y settles it."""
         given = [item for item in block.items if isinstance(item, (Word, ExprWord)) and item.letter in "XY"]
-        if not given or any(
-            type(item) is Word and item.letter == "G" and item.value == 53.0 for item in block.items
-        ):
+        codes = {item.value for item in block.items if type(item) is Word and item.letter == "G"}
+        if not given or 53.0 in codes:
             return
-        if self.absolute and len({item.letter for item in given}) == 2:
+        both = len({item.letter for item in given}) == 2
+        if (
+            codes & {28.0, 30.0}
+            and not self.absolute
+            and all(type(i) is Word and i.value == 0.0 for i in given)
+        ):
+            self.unsettled_rotation = None if both else self.unsettled_rotation
+        elif self.absolute and both:
             self.unsettled_rotation = None
-        elif self.absolute or self.unsettled_rotation == 69.0:
-            mode = "absolute" if self.absolute else "incremental"
-            raise _OutOfScope(f"an {mode} move of X or Y alone after G{self.unsettled_rotation:g}",
+        elif self.absolute:
+            raise _OutOfScope(f"an absolute move of X or Y alone after G{self.unsettled_rotation:g}",
                               given[0].start + 1)  # fmt: skip
+        elif self.unsettled_rotation == 69.0:
+            raise _OutOfScope("an incremental move of X or Y after G69", given[0].start + 1)
 
     def _block_events(self, block: Block) -> Event | tuple[Event, ...]:
         items = block.items

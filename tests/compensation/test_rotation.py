@@ -380,6 +380,15 @@ def test_the_whole_path_under_g68_lands_on_the_original_in_rs274(tmp_path):
     rs274.pathcheck(*linuxcnc)
 
 
+def test_the_returns_posts_write_after_g69_are_followed():
+    """`G91 G28 Z0.` and `G28 X0. Y0.` after G69 (a Fanuc post's ending) move from where the tool stands
+    and home the axes: no warning, and the absolute move after them is read."""
+    text = "G21 G90 G17\nG0 X1 Y1 Z5\nG68 X0 Y0 R30\nG1 X5 Y5 F100\nG69\nG91 G28 Z0.\nG28 X0. Y0.\nG90 G0 X7\nM30\n"
+    events, warning = interpreted(text, "fanuc")
+    assert not warning, warning
+    assert [e.block.line for e in events if type(e).__name__ == "Line"][-1] == 8
+
+
 @pytest.mark.parametrize(
     "body, at, construct",
     [
@@ -394,7 +403,7 @@ def test_the_whole_path_under_g68_lands_on_the_original_in_rs274(tmp_path):
         (
             "G68 X0 Y0 R30\nG1 X5 Y5 F100\nG69\nG91 G1 X1",
             "X1",
-            "an incremental move of X or Y alone after G69",
+            "an incremental move of X or Y after G69",
         ),
         (
             "G68 X0 Y0 R30\nG81 X1 Y1 Z-1 R1 F100",
