@@ -21,13 +21,18 @@ SYSTEMS_PER_LINE = 3  # work offsets said on one header line
 
 
 def placement_lines(offsets: WorkOffsets, dialect: str) -> list[str]:
-    """The header's lines after its first: zeros (machine mm), G92, tool table, units."""
+    """The header's lines after its first: zeros (machine mm), G92, rotations, tool table, units."""
     if FAMILY.get(dialect, dialect) == "iso":
         lines = _systems(offsets, dialect)
     else:  # one program zero: the system in effect with G92 (`WorkOffsets.program_zero`)
         lines = [f"ncpp program zero at {_point(offsets.program_zero())} machine mm"]
     if any(offsets.g92):
         lines.append(f"ncpp G92/G52 offset {_point(offsets.g92)} mm, from the parameter file")
+    turned = [
+        f"{system_name(n, dialect)} R{angle:g}" for n, angle in enumerate(offsets.rotations, 1) if angle
+    ]
+    if turned and dialect == "iso":  # (LinuxCNC's G10 L2 R; a Fanuc file's #5230 is no rotation)
+        lines.append(f"ncpp systems turned about Z, degrees, from the parameter file: {', '.join(turned)}")
     lines.append(_tool_table(offsets))
     return lines
 

@@ -46,6 +46,12 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_each_move_is_compensated_where_its_system_puts_it",
         ),
         "compensation/test_lathe.py": ("test_linuxcncs_g92_s_is_refused_in_rs274s_words",),
+        "compensation/test_rotation.py": (
+            "test_the_whole_path_under_g10_l2_r_lands_on_the_original_in_rs274",
+            "test_the_interpreter_follows_rs274_through_offsets_changed_under_a_rotation",
+            "test_the_whole_path_under_g68_lands_on_the_original_in_rs274",
+            "test_a_parameter_files_rotation_is_followed_as_rs274_follows_it",
+        ),
         "compensation/test_rigid_tap.py": (
             "test_each_tap_runs_on_the_programmed_line_within_half_a_micron",
             "test_the_motor_mount_written_out_cuts_twenty_times_closer",

@@ -20,6 +20,10 @@ offset, why compensation leaves a move as programmed or writes it its own way ("
 canned cycle, a drilling cycle, a hole pattern, a loop or subroutine, cutter compensation, a
 G28/G30 return, a machine-coordinate move), where it does, and under cutter compensation that
 ncpp follows where the tool centre stands off the move's start and end ("centre_shift").
+Under a rotation of the coordinate system (LinuxCNC's G10 L2 R, Fanuc's and Haas's G68) a
+record's points are where the control turns the program's to (machine position minus "offset"),
+and "rotation" gives the turn: degrees counter-clockwise and its centre X Y in program
+coordinates; `--format rs274` prints the program's own coordinates, as rs274 does.
 
 `--var-file linuxcnc.var` / `--work-offset [G5x=]X,Y,Z` start the
 interpreter from the control's zeros, as `rs274 -v FILE` does (default: all
@@ -120,6 +124,8 @@ def run(args: argparse.Namespace) -> int:
                 record["turn"] = event.turn
             if event.extra:
                 record["extra"] = event.extra
+            if event.context.rotation is not None:  # (the points are in the turned frame)
+                record["rotation"] = event.context.rotation
             if (
                 event.fixed
             ):  # why compensation leaves it as programmed (a canned cycle, cutter compensation, ...)

@@ -65,16 +65,18 @@ def read_canon(text: str) -> list[CanonCall]:
 
 def canon_call(event: Event) -> CanonCall | None:
     """The rs274 canonical call of a motion event, at full precision; None for a Pass (and for a
-    rigid tap's return)."""
+    rigid tap's return).  Under a rotation of the coordinate system its points are the program's, as
+    rs274 prints them (the control turns them: `Context.turned`)."""
     if type(event) is Line:
+        end = event.context.turned(event.end, -1.0)
         if event.tap:
-            return CanonCall("RIGID_TAP", event.end) if event.tap == TAP_IN else None
+            return CanonCall("RIGID_TAP", end) if event.tap == TAP_IN else None
         return CanonCall(
-            "STRAIGHT_TRAVERSE" if event.rapid else "STRAIGHT_FEED", (*event.end, *_rotary(event.extra))
+            "STRAIGHT_TRAVERSE" if event.rapid else "STRAIGHT_FEED", (*end, *_rotary(event.extra))
         )
     if type(event) is Arc:
         a, b, n = PLANE_AXES[event.context.plane]
-        e, c = event.end, event.center
+        e, c = event.context.turned(event.end, -1.0), event.context.turned(event.center, -1.0)
         return CanonCall("ARC_FEED", (e[a], e[b], c[a], c[b], float(event.turn), e[n], *_rotary(event.extra)))
     return None
 

@@ -77,6 +77,15 @@ in G19 (Fanuc operator's manuals, "Canned cycle for drilling": "Positioning plan
 axis", G17 Zp, G18 Yp, G19 Xp; the drilling axis is the basic axis not used to define the
 positioning plane), as rs274ngc drills but does not tap there (`Interpreter.taps_in_any_plane`).
 
+Coordinate system rotation `G68 X_ Y_ R_` / `G69` in G17 is followed (`_coordinate_rotation`, and
+`Interpreter._settle_rotation` for the moves after it) where the Fanuc manual's rules leave nothing to a
+parameter (Fanuc Series 16/18/160/180-MC operator's manual, "Coordinate system rotation": X Y the
+centre, absolute; R the angle, counter-clockwise; without X Y the tool's position is the centre, without
+R a parameter's angle; no G17-G19 in its mode; G91 moves after it run from where the tool stood at
+G68; the first move after G69 absolute), Haas's alike (Mill Operator's Manual, "G68 Rotation": R
+from Setting 72 when not given, added in G91 with Setting 73).  Scaling (G51), the programmable
+mirror image (G51.1), G68.1 and the tilted working plane (G68.2-G68.4) end interpretation by name.
+
 Canned cycles are a modal group of their own, group 09 beside group 01's G00-G03 (Fanuc 0i-MD /
 15i-MA operator's manuals, "List of G codes"; Haas Mill Operator's Manual, "G80 Canned Cycle Cancel
 (Group 09)"), so G80 cancels the cycle and leaves the G00-G03 mode it interrupted in effect: `G00 Z.1`,
@@ -119,10 +128,10 @@ from __future__ import annotations
 
 from typing import cast
 
-from ncpp.motion.interpreter import Interpreter, _OutOfScope, interpreting
+from ncpp.motion.interpreter import IGNORED_STATEMENTS, Interpreter, _OutOfScope, interpreting
 from ncpp.motion.offsets import ADDITIONAL, ADDITIONAL_CODES
 from ncpp.motion.segments import Event, Pass
-from ncpp.program.blocks import Block, Comment, ExprWord, Word
+from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
 
 # G code -> the words it takes, for the settings each flavour reads past
 FANUC_SETTINGS: dict[float, frozenset[str]] = {5.1: frozenset("Q"), 8.0: frozenset("P")}
@@ -139,6 +148,18 @@ HAAS_UNFOLLOWED = {("G", 54.1): "G54.1 (Fanuc's additional work offset; Haas sel
                    ("M", 97.0): "M97 (a local subprogram at a sequence number)",
                    ("G", 12.0): "G12 (Haas circular pocket milling, a path the control computes)",
                    ("G", 13.0): "G13 (Haas circular pocket milling, a path the control computes)"}  # fmt: skip
+
+
+# What is out of scope under G68: codes that change the plane it turns in (Fanuc: "G17, G18 or G19 must not be
+# designated in the mode of coordinate system rotation") or the frame its centre is in, and offsets set in it
+NOT_UNDER_G68 = frozenset((17.0, 18.0, 19.0, 10.0, 52.0, 92.0, 92.1, 92.2, 92.3, 54.0, 55.0, 56.0, 57.0, 58.0,
+                           59.0, 54.1, 154.0, *(float(n) for n in range(110, 130))))  # fmt: skip
+
+# Frames these controls turn, scale or tilt that ncpp does not follow, named before the block's words are
+# checked (a G51's P is its scale, no dwell): scaling, the programmable mirror image, G68.1's rotation (a
+# lathe's), and the tilted working plane G68.2-G68.4 (Fanuc 30i-MB operator's manual)
+UNFOLLOWED_FRAMES = {51.0: "scaling", 51.1: "mirroring", 68.1: "coordinate rotation",
+                     **{code: "tilted working plane" for code in (68.2, 68.3, 68.4)}}  # fmt: skip
 
 
 # The G codes whose block takes an H: the tool length offsets, the tool position offsets (whose number
@@ -164,6 +185,7 @@ class FanucInterpreter(Interpreter):
     r_over_ijk = True  # `G02 X.. Y.. R.. I.. J..`: R's arc, I J ignored (module docstring)
     independent_h = True  # `G53 G00 H0 Z-110`: an H without G43, out of scope (module docstring)
     incremental_zero_set = True  # `G91 G10 L2 P1 X10.` adds 10 to G54's X (module docstring)
+    rotating_g10 = False  # (an R in G10 L2 is no rotation there)
     g92_speed_clamp = True  # `G92 S4000`: refused as the spindle speed clamp it is (`G92_SPEED_CLAMP`)
 
     def block(self, block: Block) -> Event | tuple[Event, ...]:
@@ -178,6 +200,13 @@ class FanucInterpreter(Interpreter):
         words = [item for item in block.items if type(item) is Word]
         if self.dwell_x and _dwell_in_x(block, words):
             return Pass(block)
+        for word in words:
+            if word.letter == "G" and word.value in (68.0, 69.0):
+                return self._coordinate_rotation(block, word)
+            if word.letter == "G" and word.value in UNFOLLOWED_FRAMES:
+                raise _OutOfScope(f"{UNFOLLOWED_FRAMES[word.value]} G{word.number}", word.start + 1)
+            if word.letter == "G" and word.value in NOT_UNDER_G68 and self.g68 is not None:
+                raise _OutOfScope(f"G{word.number} under coordinate system rotation G68", word.start + 1)
         for word in words:
             if word.letter == "G" and (
                 word.value == ADDITIONAL_CODES[self.additional][0]
@@ -229,6 +258,49 @@ class FanucInterpreter(Interpreter):
         if mode0 in RETURNS and mode1 == 0.0:
             mode1 = mode1_item = None
         return super()._motion_of_words(block, mode0, mode1, mode1_item, axis_item, polar_item)
+
+    def _coordinate_rotation(self, block: Block, code: Word) -> Pass:
+        """`G68 X_ Y_ R_` in G17 (`G17` may stand in its block): the program's X Y turned about the centre X
+        Y (absolute) by R degrees counter-clockwise, from the next block on; `G69` cancels it (Fanuc Series
+        16/18-MC operator's manual, "Coordinate system rotation"; Haas Mill Operator's Manual, "G68
+        Rotation").  The machine stays where it is; the moves after it follow `_settle_rotation`'s rules.
+        Out of scope: another plane, other words in the block, a G68 under G68 or under cutter
+        compensation, a G68 without R or in G91, whose angle a parameter gives or adds to (Fanuc No. 5410
+        and, 15i, No. 6400 bit 0; Haas Settings 72 and 73), and one without X or Y: the control then turns
+        about where the tool stands, which compensation moves (the program's turned points with it)."""
+        col, name = code.start + 1, f"G{code.number}"
+        others = [item for item in block.items if type(item) is not Comment and item is not code
+                  and not (type(item) is Statement and item.kind in IGNORED_STATEMENTS)]  # fmt: skip
+        if any(type(item) is not Word for item in others):
+            raise _OutOfScope(f"{name} with a value from a variable", col)
+        words = cast(list[Word], others)
+        if code.value == 69.0:
+            if any(w.letter != "N" for w in words):
+                raise _OutOfScope("G69 with other words in its block", col)
+            if self.g68 is not None:
+                self._keeping_machine(lambda: setattr(self, "g68", None))
+                self.unsettled_rotation = 69.0
+            return Pass(block)
+        if any(w.letter not in "NXYRG" or (w.letter == "G" and w.value != 17.0) for w in words):
+            raise _OutOfScope("G68 with other words in its block than G17, X, Y and R", col)
+        if any(w.letter == "G" for w in words):
+            self._set(plane=17)
+        given = {w.letter: w.value for w in words}
+        why = (
+            "in G18 or G19 (a turn about another axis than Z)" if self.plane != 17
+            else "while a rotation is in effect" if self.g68 is not None
+            else "under cutter compensation" if self.cutter_comp is not None
+            else "without R (its angle is then a parameter's)" if "R" not in given
+            else "in G91 (a parameter makes its R absolute or added)" if not self.absolute
+            else "without X and Y (its centre is then where the tool stands, which compensation moves)"
+            if not {"X", "Y"} <= given.keys()
+            else None
+        )  # fmt: skip
+        if why is not None:
+            raise _OutOfScope(f"G68 {why}", col)
+        self._keeping_machine(lambda: setattr(self, "g68", (given["R"], given["X"], given["Y"])))
+        self.unsettled_rotation = 68.0
+        return Pass(block)
 
     def _additional_offset(self, block: Block, code: Word, fixed: int | None = None) -> Pass:
         """`G54.1 Pn` (Haas: `G154 Pn`; or a code that names one, `fixed`: n) with nothing else

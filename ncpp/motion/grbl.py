@@ -35,6 +35,7 @@ _MOVING = {"$H": "grbl homing ($H)", "$J=": "a grbl jog ($J=)"}
 class GrblInterpreter(Interpreter):
     arc_normal_offset_ignored = True
     rigid_tapping = False  # (grbl has no spindle-synchronised motion)
+    rotating_g10 = False  # (grbl's G10 L2 takes no R)
     start_motion = 0.0  # (grbl's parser starts in G0)
 
     def block(self, block: Block) -> Event | tuple[Event, ...]:

@@ -4,11 +4,13 @@
 `Pass`; a G28/G30 block gives two `Line`s), in the order the blocks run
 (o-word control flow, `flow.py`), state bounded whatever the program length.  Positions are program (work) coordinates in program units,
 exactly what rs274 prints in its canonical calls; `Context.offset` says where
-the program origin sits in machine coordinates.
+the program origin sits in machine coordinates.  Under a rotation of the coordinate system
+(G10 L2 R, Fanuc's G68: `Context.rotation`) they are turned as the control turns them, a
+translation of the machine position (`canon_call` turns them back to rs274's).
 
 Scope: modal G0-G3, planes, G90/G91, G90.1/G91.1, G20/G21 (state converted
-on a switch, like LinuxCNC), G54-G59.3, G10 L2/L20 (no rotation; Fanuc's and Haas's
-additional work offsets and their readings of G10: `fanuc.py`), G92 family,
+on a switch, like LinuxCNC), G54-G59.3, G10 L2/L20 (L2's R: the system turned about Z; Fanuc's and
+Haas's G68, additional work offsets and their readings of G10: `fanuc.py`), G92 family,
 G52, G53, G28/G30, T, M6, M61, G43 / G43.1 / G43.2 H / G49 (lengths from the
 control's tool table, `tools.py`; zero when it is not told), F and inverse time, IJK and R arcs, helices,
 P turns, parameters and expressions, Fanuc corner rounding and
@@ -78,6 +80,7 @@ from ncpp.motion.segments import (
     Line,
     Pass,
     Setting,
+    turn_xy,
 )
 from ncpp.motion.tools import UntoldLengths
 from ncpp.program.blocks import STRAY_TAPE, UNREADABLE, Block, Comment, ExprWord, Statement, Word
@@ -276,6 +279,9 @@ class Interpreter:
     # G92 with S and no axis words is a spindle speed clamp (Fanuc's lathes and machining centres): the
     # refusal says so (`G92_SPEED_CLAMP`); rs274ngc has no G92 S and refuses it as a G92 without axes
     g92_speed_clamp = False
+    # G10 L2 R turns the system's X Y about Z (LinuxCNC G-code manual, G10 L2: "optionally program R to
+    # indicate the rotation of the XY axis around the Z"); elsewhere an R there is out of scope
+    rotating_g10 = True
 
     def __init__(self, file: str = "<stdin>", offsets: WorkOffsets | None = None):
         self.file = file
@@ -309,6 +315,11 @@ class Interpreter:
         self.coord_system = 1
         # by system number: 1..9 G54..G59.3, then the additional work offsets told (`offsets.ADDITIONAL`)
         self.g5x = {n: [0.0] * 9 for n in range(1, 10)}
+        self.rotations: dict[int, float] = {}  # by system number: its G10 L2 R, degrees (absent: 0)
+        # Fanuc's G68 in effect: (degrees, centre X, centre Y in program units); and after G68 or G69 (its
+        # code) until a move puts X and Y at absolute positions (`_settle_rotation`)
+        self.g68: tuple[float, float, float] | None = None
+        self.unsettled_rotation: float | None = None
         self.g92 = [0.0] * 9
         self.g92_saved = [0.0] * 9
         self.tool = [0.0] * 9  # the tool length offset in effect, program units
@@ -356,7 +367,8 @@ class Interpreter:
             self._start_from(offsets)
 
     def _start_from(self, offsets: WorkOffsets) -> None:
-        """The control's zeros (mm, the interpreter starts in mm) and its system in effect."""
+        """The control's zeros (mm, the interpreter starts in mm), its system in effect and the systems'
+        rotations (LinuxCNC's parameter file holds them: `WorkOffsets.rotations`)."""
         for n in (*range(1, 10), *offsets.told_additional()):
             self.g5x[n] = [*offsets.zero(n), *[0.0] * 6]
         self.coord_system = offsets.active
@@ -364,6 +376,8 @@ class Interpreter:
         self.g92_saved = self.g92[:]
         self.home[28][:3], self.home[30][:3] = offsets.g28, offsets.g30
         self.untold = {n for n in range(1, 10) if not offsets.told(n)}
+        if self.rotating_g10:  # (a Fanuc control's #5230 is an axis of G54, no rotation)
+            self.rotations = {n: angle for n, angle in enumerate(offsets.rotations, 1) if angle}
         self.told_zeros = {n for n in (*range(1, 10), *offsets.told_additional()) if offsets.told(n)}
 
     # -- the event stream ---------------------------------------------------------
@@ -736,12 +750,56 @@ class Interpreter:
                 self.coord_system,
                 str(self.spindle_tool) if self.spindle_tool else "",
                 self.zeros_set.get(self.coord_system),
+                self._rotation(),
             )
         return self._context
 
+    def _rotation(self) -> tuple[float, float, float] | None:
+        """`Context.rotation` in effect: Fanuc's G68 about its centre, or the active system's G10 L2 R about
+        the system's zero, where the G92 offset is added before the control turns the point (rs274ngc's
+        canon: machine = R (p + G92) + G5x + tool, that is R (p - c) + c + G92 + G5x + tool, c = -G92)."""
+        if self.g68 is not None:
+            return self.g68
+        angle = self.rotations.get(self.coord_system)
+        return None if angle is None else (angle, 0.0 - self.g92[0], 0.0 - self.g92[1])
+
     # -- one block ------------------------------------------------------------------
     def block(self, block: Block) -> Event | tuple[Event, ...]:
-        """The event(s) of one block; updates the modal state."""
+        """The event(s) of one block; updates the modal state.  Under a rotation of the coordinate
+        system the moves are in the turned frame, a translation of the machine's (`Context.turned`)."""
+        events = self._block_events(block)
+        if self.unsettled_rotation is not None and _moves(events):
+            self._settle_rotation(block)
+        return _turned(events) if self.rotations or self.g68 is not None else events
+
+    def _settle_rotation(self, block: Block) -> None:
+        """Fanuc: after G68, moves in G91 run from where the tool stood at G68 (the centre for them,
+        Fanuc Series 16/18-MC operator's manual, "Coordinate system rotation"), as they do here; after G69
+        the first move must be absolute (its WARNING).  Until a move gives X and Y absolutely, a move
+        that gives one of them alone takes the other from a position the manual does not say: not
+        followed; nor a G91 move of X or Y after G69.  A G53 move leaves this as it is; a G28/G30 in G91
+        whose X Y increments are 0 (the return posts write) moves from where the tool stands, and homing
+        both X and Y settles it."""
+        given = [item for item in block.items if isinstance(item, (Word, ExprWord)) and item.letter in "XY"]
+        codes = {item.value for item in block.items if type(item) is Word and item.letter == "G"}
+        if not given or 53.0 in codes:
+            return
+        both = len({item.letter for item in given}) == 2
+        if (
+            codes & {28.0, 30.0}
+            and not self.absolute
+            and all(type(i) is Word and i.value == 0.0 for i in given)
+        ):
+            self.unsettled_rotation = None if both else self.unsettled_rotation
+        elif self.absolute and both:
+            self.unsettled_rotation = None
+        elif self.absolute:
+            raise _OutOfScope(f"an absolute move of X or Y alone after G{self.unsettled_rotation:g}",
+                              given[0].start + 1)  # fmt: skip
+        elif self.unsettled_rotation == 69.0:
+            raise _OutOfScope("an incremental move of X or Y after G69", given[0].start + 1)
+
+    def _block_events(self, block: Block) -> Event | tuple[Event, ...]:
         items = block.items
         if not items:
             return Pass(block)
@@ -1315,6 +1373,10 @@ class Interpreter:
             return
         if self.plane not in (17, 18):
             self._fail("Cutter radius compensation allowed only in XY, XZ planes", block, item)
+        if self._rotation() is not None:
+            raise _OutOfScope(
+                f"cutter compensation G{code:g} under a coordinate system rotation", item.start + 1
+            )
         d = words.get("D")
         if code in (41.1, 42.1):
             if d is None:
@@ -1379,8 +1441,36 @@ class Interpreter:
         g10 = gcodes.get(0, (None,))[0] == 10.0
         if g10 and words.get("L", (None,))[0] in (1.0, 10.0, 11.0):
             raise _OutOfScope("tool table change G10 L1/L10/L11", gcodes[0][1].start + 1)
-        if g10 and words.get("R", (0.0,))[0] != 0.0:
+        if g10 and words.get("R", (0.0,))[0] != 0.0 and not (self.rotating_g10 and words["L"][0] == 2.0):
             raise _OutOfScope("coordinate system rotation G10 R", words["R"][1].start + 1)
+        if self._rotation() is not None:
+            self._check_turned(words, gcodes)
+        if any(self.g92[:2]) and (self.rotations or (g10 and words.get("R", (0.0,))[0])):
+            self._check_reframed(words, gcodes)
+
+    def _check_reframed(self, words: dict, gcodes: dict) -> None:
+        """rs274ngc puts the program position after a new zero or rotation of the system in effect (G10
+        L2 of it, another system selected) as if no G92 offset were in effect: with one, where a rotation
+        is in effect before or after, its position and the machine's part (not followed)."""
+        code, item = gcodes.get(0, (None, None))
+        if code == 10.0 and round(words.get("P", (0.0,))[0]) in (0, self.coord_system):
+            if self.rotations.get(self.coord_system) or words.get("R", (0.0,))[0]:
+                raise _OutOfScope("G10 L2 of the system in effect under a rotation and a G92 offset",
+                                  item.start + 1)  # fmt: skip
+        selected = _COORD_SYSTEM[gcodes[12][0]] if 12 in gcodes else None
+        if selected is not None and (self.rotations.get(self.coord_system) or self.rotations.get(selected)):
+            raise _OutOfScope(f"G{gcodes[12][0]:g} under a coordinate system rotation and a G92 offset",
+                              gcodes[12][1].start + 1)  # fmt: skip
+
+    def _check_turned(self, words: dict, gcodes: dict) -> None:
+        """What ncpp does not follow under a rotation of the coordinate system: an offset set from where
+        the tool stands (its words would have to be turned with the correction: G92, G10 L20), and a G28 or
+        G30 whose intermediate point names X or Y (the axes it places are the turned frame's)."""
+        code, item = gcodes.get(0, (None, None))
+        if code == 92.0 or (code == 10.0 and words["L"][0] == 20.0):
+            raise _OutOfScope(f"G{code:g} under a coordinate system rotation", item.start + 1)
+        if code in (28.0, 30.0) and ("X" in words or "Y" in words):
+            raise _OutOfScope(f"G{code:g} with X or Y under a coordinate system rotation", item.start + 1)
 
     # -- modal state -------------------------------------------------------------------------
     def _set(self, **changes) -> None:
@@ -1450,6 +1540,8 @@ class Interpreter:
             new = [value * scale if i in LINEAR else value for i, value in enumerate(table)]
             if code == 43.2:
                 new = [old + added for old, added in zip(self.tool, new)]
+        if self._rotation() is not None and new[:2] != self.tool[:2]:  # (rs274ngc does not turn them)
+            raise _OutOfScope("a tool offset in X or Y under a coordinate system rotation", item.start + 1)
         held = self.pos[:] if changed else None
         self._shift(self.tool, new)
         self.tool = new
@@ -1485,9 +1577,40 @@ class Interpreter:
             )
 
     def _coordinate_system(self, number: int) -> None:
+        if self.rotations.get(self.coord_system) or self.rotations.get(number):
+            self._keeping_machine(lambda: setattr(self, "coord_system", number))
+            return
         self._shift(self.g5x[self.coord_system], self.g5x[number])
         self.coord_system = number
         self._context = None
+
+    def _keeping_machine(self, change: Callable[[], None]) -> None:
+        """A zero or a rotation changes where one is in effect before or after: the machine stays where it
+        is, and the program position is its point in the new frame, as rs274ngc keeps it (without a G92
+        offset: `_check_reframed`)."""
+        held = [self._to_machine(v) for v in (self.pos, self.unmoved) if v is not None]
+        change()
+        self.pos = self._from_machine(held[0])
+        if self.unmoved is not None:
+            self.unmoved = self._from_machine(held[1])
+        self._context = None
+
+    def _to_machine(self, p: list[float]) -> list[float]:
+        """The machine position (program units, all axes) of program point `p`: X Y turned about the
+        rotation's centre (`_rotation`), then G92, the system's zero and the tool length added."""
+        q = list(p)
+        rotation = self._rotation()
+        if rotation is not None:
+            q[0], q[1] = turn_xy(q[0], q[1], rotation)
+        return [v + g + z + t for v, g, z, t in zip(q, self.g92, self.g5x[self.coord_system], self.tool)]
+
+    def _from_machine(self, m: list[float]) -> list[float]:
+        """The program point of machine position `m` (`_to_machine`'s inverse)."""
+        q = [v - g - z - t for v, g, z, t in zip(m, self.g92, self.g5x[self.coord_system], self.tool)]
+        rotation = self._rotation()
+        if rotation is not None:
+            q[0], q[1] = turn_xy(q[0], q[1], rotation, -1.0)
+        return q
 
     def _program_end(self) -> None:
         """M2/M30: rs274ngc resets some modes and stops reading the program."""
@@ -1499,6 +1622,8 @@ class Interpreter:
         self.done = self.ended = True
 
     def _machine(self, i: int) -> float:
+        if self._rotation() is not None:
+            return self._to_machine(self.pos)[i]
         return self.pos[i] + self.g5x[self.coord_system][i] + self.g92[i] + self.tool[i]
 
     def _non_modal(self, block: Block, words: dict, code: float) -> Event | tuple[Event, ...] | None:
@@ -1540,11 +1665,11 @@ class Interpreter:
             self.told_zeros.discard(number)
             if {0, 1, 2} <= {i for i, _ in given}:  # the program says where it is
                 self.untold.discard(number)
-            for i, value in given:
-                if words["L"][0] == 2.0:
-                    self.g5x[number][i] = value + (old[i] if added else 0.0)
-                else:  # L20: the current point gets the given coordinates
-                    self.g5x[number][i] = self.pos[i] + self.g5x[self.coord_system][i] - value
+            angle = words["R"][0] if "R" in words and self.rotating_g10 else None
+            if number == self.coord_system and (self.rotations.get(number) or angle):
+                self._keeping_machine(lambda: self._set_zero(number, given, words["L"][0], added, angle))
+                return setting
+            self._set_zero(number, given, words["L"][0], added, angle)
             if number == self.coord_system:
                 self._shift(old, self.g5x[number])
         elif code in (28.1, 30.1):
@@ -1552,6 +1677,22 @@ class Interpreter:
         elif code in (28.0, 30.0):
             return self._go_home(block, given, self.home[int(code)])
         return setting
+
+    def _set_zero(
+        self, number: int, given: list[tuple[int, float]], l_number: float, added: bool, angle: float | None
+    ) -> None:
+        """G10 L2 / L20: system `number`'s zero from the given axes, and its rotation where R gives it."""
+        old = self.g5x[number][:]
+        for i, value in given:
+            if l_number == 2.0:
+                self.g5x[number][i] = value + (old[i] if added else 0.0)
+            else:  # L20: the current point gets the given coordinates
+                self.g5x[number][i] = self.pos[i] + self.g5x[self.coord_system][i] - value
+        if angle is not None:
+            if angle:
+                self.rotations[number] = angle
+            else:
+                self.rotations.pop(number, None)
 
     def _zero_set(self, number: int, axes: set[int], l20: bool, added: bool) -> None:
         """Whether system `number`'s zero is known after a G10 of `axes` sets it (`zeros_set`): G10 L2
@@ -1574,10 +1715,7 @@ class Interpreter:
         first = self._line(block, middle, True)
         first.fixed, first.placed = HOME, named if self.absolute else (False, False, False)
         axes = [i for i, _ in given] or range(9)
-        end = middle[:]
-        for i in axes:
-            end[i] = home[i] - (self.g5x[self.coord_system][i] + self.g92[i] + self.tool[i])
-        second = self._line(block, end, True)
+        second = self._line(block, self._at_machine(middle, [(i, home[i]) for i in axes]), True)
         second.fixed, second.placed = HOME, named if given else (True, True, True)
         return first, second
 
@@ -1589,14 +1727,25 @@ class Interpreter:
     def _ends(self, given: list[tuple[int, float]], machine: bool) -> list[float]:
         end = self._base()
         if machine:  # G53: machine coordinates, always absolute
-            for i, value in given:
-                end[i] = value - (self.g5x[self.coord_system][i] + self.g92[i] + self.tool[i])
-        elif self.absolute:
+            return self._at_machine(end, given)
+        if self.absolute:
             for i, value in given:
                 end[i] = value
         else:
             for i, value in given:
                 end[i] += value
+        return end
+
+    def _at_machine(self, end: list[float], given: list[tuple[int, float]]) -> list[float]:
+        """Program point `end` with the given axes put at machine positions (G53, a G28/G30 home)."""
+        if self._rotation() is not None:
+            at = self._to_machine(end)
+            for i, value in given:
+                at[i] = value
+            return self._from_machine(at)
+        end = end[:]
+        for i, value in given:
+            end[i] = value - (self.g5x[self.coord_system][i] + self.g92[i] + self.tool[i])
         return end
 
     def _line(self, block: Block, end: list[float], rapid: bool) -> Line:
@@ -1719,6 +1868,8 @@ class Interpreter:
         `Line`s marked `fixed`: HOLE, one hole that apply_error_map compensates as a whole (its
         position in the plane, its R and bottom along the normal), or CYCLE, left as programmed;
         with --expand-cycles moves like any other (`_expanded`)."""
+        if self._rotation() is not None:
+            raise _OutOfScope(f"canned cycle G{motion:g} under a coordinate system rotation", item.start + 1)
         first, second, normal = PLANE_AXES[self.plane]
         again = previous == motion  # the same cycle again: R, the normal-axis word, P and Q are sticky
         if previous not in CANNED:  # a new series: G98 retracts to where it started, no dwell yet
@@ -1944,6 +2095,8 @@ class Interpreter:
     def _arc(self, block: Block, words: dict, motion: float, motion_item, mode1_item) -> Arc | Pass:
         word = motion_item if motion_item is not None else next(item for _, item in words.values())
         plane = self.plane
+        if plane != 17 and self._rotation() is not None:  # (its plane turns off the machine's)
+            raise _OutOfScope(f"an arc in G{plane} under a coordinate system rotation", word.start + 1)
         first_letter, second_letter, normal_letter = _ARC_LETTERS[plane]
         radius = words.get("R")
         has_ijk = "I" in words or "J" in words or "K" in words
@@ -2121,6 +2274,19 @@ _PLAIN_LETTERS = {
     **{code: frozenset() for code in CANNED},  # a cycle's words are checked in full
     RIGID_TAP: frozenset(),  # a modal G33.1 block needs its K again (rs274ngc: "K word missing")
 }
+
+
+def _turned(events: Event | tuple[Event, ...]) -> Event | tuple[Event, ...]:
+    """The moves of `events` (new ones) moved into the frame their context's rotation turns the
+    program's points into (`Context.turned`): arcs in the XY plane stay arcs about the turned centre."""
+    for event in events if type(events) is tuple else (events,):
+        if type(event) is Pass or event.context.rotation is None:  # type: ignore[union-attr]
+            continue
+        turned = event.context.turned  # type: ignore[union-attr]
+        event.start, event.end = turned(event.start), turned(event.end)  # type: ignore[union-attr]
+        if type(event) is Arc:
+            event.center = turned(event.center)
+    return events
 
 
 def _marked(events: Event | tuple[Event, ...] | None, marks: list[Pass]) -> Event | tuple[Event, ...]:

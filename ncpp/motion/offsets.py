@@ -44,9 +44,10 @@ SYSTEMS = ("G54", "G55", "G56", "G57", "G58", "G59", "G59.1", "G59.2", "G59.3") 
 UNIT_MM = {"mm": 1.0, "inch": 25.4}  # a parameter file's units (the INI's [TRAJ]LINEAR_UNITS) in mm
 
 # LinuxCNC's parameter file (rs274ngc interp_parameter_def.hh): the systems' X at 5221 + 20 (n - 1),
-# Y and Z after it; the system in effect at 5220; G92 at 5211-5213, applied when 5210 is 1;
+# Y and Z after it, their rotation about Z (G10 L2 R, degrees) 9 after X; the system in effect at 5220; G92 at 5211-5213, applied when 5210 is 1;
 # the G28 and G30 positions (machine coordinates) at 5161 and 5181.
 _ACTIVE_SYSTEM, _G92_ON, _G92_X, _G28_X, _G30_X = 5220, 5210, 5211, 5161, 5181
+_ROTATION_AFTER_X = 9
 
 
 # Additional work offset n is system ADDITIONAL + n; Fanuc numbers P1-P48, Haas P1-P99
@@ -68,7 +69,8 @@ class WorkOffsets:
     machine position in mm, None when ncpp is not told it, and so per additional work
     offset (`additional`: 1, 2 ..., system ADDITIONAL + n); the system in effect at
     the program's start; the G92 offset in effect; the G28 and G30 positions; its
-    tool table (None: not told, G43 applies length 0); and the folders it finds
+    tool table (None: not told, G43 applies length 0); per system its rotation about Z
+    (LinuxCNC's G10 L2 R, degrees: `rotations`); and the folders it finds
     subroutine files in (LinuxCNC's [RS274NGC]SUBROUTINE_PATH: `o<name> call` of a
     subroutine the program does not define runs `name.ngc`; Fanuc's, Sinumerik's and
     Klartext's called programs too)."""
@@ -82,6 +84,7 @@ class WorkOffsets:
     subroutine_path: tuple[Path, ...] = ()
     unit_mm: float = 1.0  # the units the parameter file and tool table were read in (the header says them)
     additional: tuple[Vector | None, ...] = ()  # the additional work offsets 1, 2 ...: Fanuc, Haas
+    rotations: tuple[float, ...] = (0.0,) * 9  # systems 1..9 turned about Z, degrees (LinuxCNC's #5230 ...)
 
     @classmethod
     def of(cls, zeros: Mapping[str, Vector], active: str = "G54") -> WorkOffsets:
@@ -106,7 +109,9 @@ class WorkOffsets:
         homes = (_from_var(values, _G28_X, unit_mm) or zero, _from_var(values, _G30_X, unit_mm) or zero)
         lines = {number: line for number, (_, line) in entries.items()}
         additional = _additional_from_var(values, unit_mm, str(path), lines)
-        return cls(systems, active if 1 <= active <= 9 else 1, g92 or zero, *homes, additional=additional)
+        rotations = tuple(values.get(_system_x(n) + _ROTATION_AFTER_X, 0.0) for n in range(1, 10))
+        return cls(systems, active if 1 <= active <= 9 else 1, g92 or zero, *homes, additional=additional,
+                   rotations=rotations)  # fmt: skip
 
     @classmethod
     def given(

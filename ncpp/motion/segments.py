@@ -11,7 +11,8 @@ The interpreter turns each block into zero or more events:
 Every segment points at its source `Block` and carries the modal context a
 writer needs to turn it back into NC text in the program's own style.
 Coordinates are program (work) coordinates in program units, as rs274
-reports them; `Context.to_machine` converts to machine axis positions in mm,
+reports them (under a rotation of the coordinate system, turned as the control turns
+them: `Context.rotation`); `Context.to_machine` converts to machine axis positions in mm,
 where the error model lives.
 """
 
@@ -78,6 +79,9 @@ class Context:
     tool_id: str = ""  # the tool in the spindle as the program names it ("3", '"MILL"'; "": none)
     # the program set the system's zero (G10): whether it is known (None: it did not, the control's holds)
     zero_set: bool | None = None
+    # the control turns the program's X Y about Z (LinuxCNC's G10 L2 R): (degrees counter-clockwise, the
+    # centre's X Y, program units); segments are in the turned frame, the program's words are not (`turned`)
+    rotation: tuple[float, float, float] | None = None
 
     @property
     def tool_mm(self) -> Point:
@@ -96,6 +100,24 @@ class Context:
     def to_program(self, m: Point) -> Point:
         s = self.unit_mm
         return (m[0] / s - self.offset[0], m[1] / s - self.offset[1], m[2] / s - self.offset[2])
+
+    def turned(self, p: Point, sign: float = 1.0) -> Point:
+        """A point the program writes as the control moves to it under `rotation` (the frame of the
+        segments, a translation of the machine's); `sign` -1: the program's point of a turned one."""
+        if self.rotation is None:
+            return p
+        x, y = turn_xy(p[0], p[1], self.rotation, sign)
+        return (x, y, p[2])
+
+
+def turn_xy(
+    x: float, y: float, rotation: tuple[float, float, float], sign: float = 1.0
+) -> tuple[float, float]:
+    """(x, y) turned by `rotation` (degrees, centre x, centre y) about its centre; `sign` -1: back."""
+    angle, cx, cy = rotation
+    c, s = math.cos(math.radians(angle)), sign * math.sin(math.radians(angle))
+    dx, dy = x - cx, y - cy
+    return cx + c * dx - s * dy, cy + s * dx + c * dy
 
 
 @dataclass(frozen=True, slots=True)

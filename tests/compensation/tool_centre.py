@@ -5,6 +5,7 @@ Nothing of ncpp's own interpreter or simulator is used."""
 
 from __future__ import annotations
 
+import functools
 import math
 import re
 from collections.abc import Callable
@@ -17,7 +18,8 @@ from numpy.typing import NDArray
 from tests import rs274
 
 _CALL = re.compile(
-    r"\b(STRAIGHT_FEED|STRAIGHT_TRAVERSE|ARC_FEED|RIGID_TAP|SET_G5X_OFFSET|SET_G92_OFFSET|USE_LENGTH_UNITS"
+    r"\b(STRAIGHT_FEED|STRAIGHT_TRAVERSE|ARC_FEED|RIGID_TAP|SET_G5X_OFFSET|SET_G92_OFFSET|SET_XY_ROTATION"
+    r"|USE_LENGTH_UNITS"
     r"|USE_TOOL_LENGTH_OFFSET|SELECT_PLANE"
     r"|COMMENT)\((\"interpreter: cutter radius compensation (?:on|off)|[^)]*)"
 )
@@ -30,7 +32,8 @@ _PLANES = {"CANON_PLANE_XY": (0, 1, 2), "CANON_PLANE_XZ": (2, 0, 1), "CANON_PLAN
 class Move:
     """A feed move of the tool centre (an arc's centre and turn: rs274's ARC_FEED; a rigid tap's
     way down: RIGID_TAP, whose return retraces it), machine coordinates in mm as the program puts
-    them: its work offsets, G92 and tool length offset added, where the machine's axes stand."""
+    them: its work offsets, G92 and tool length offset added, where the machine's axes stand (under
+    LinuxCNC's G10 L2 R the point plus G92 turned about Z before the rest is added: `_placed`)."""
 
     start: NDArray  # (3,)
     end: NDArray  # (3,)
@@ -77,6 +80,7 @@ def feed_moves(
     at = np.zeros(3)
     # the offsets in mm (rs274 prints them in the units then)
     g5x, g92, tool, scale = np.zeros(3), np.zeros(3), np.zeros(3), 1.0
+    turn = 0.0  # SET_XY_ROTATION's, degrees
     comp = leaving = sections = 0
     axes = (0, 1, 2)
     for name, args in _CALL.findall(proc.stdout):
@@ -102,15 +106,20 @@ def feed_moves(
         if name == "USE_TOOL_LENGTH_OFFSET":
             tool = np.array(v[:3]) * scale
             continue
-        offset = g5x + g92 + tool
+        if name == "SET_XY_ROTATION":
+            turn = v[0]
+            continue
+        placed = functools.partial(_placed, g92=g92, turn=turn, after=g5x + tool)
         if name == "ARC_FEED":
+            assert turn == 0.0 or axes == (0, 1, 2), "an arc out of the XY plane under G10 L2 R"
             end = np.empty(3)
             end[list(axes)] = v[0], v[1], v[5]
-            end = end * scale + offset
-            centre = np.array(v[2:4]) * scale + offset[list(axes[:2])]
+            end = placed(end * scale)
+            centre = placed(np.array([v[2], v[3], 0.0]) * scale)[:2] if turn else (
+                np.array(v[2:4]) * scale + (g5x + g92 + tool)[list(axes[:2])])  # fmt: skip
             moves.append(Move(at, end, centre, int(v[4]), comp or leaving, axes, tool))
         else:
-            end = np.array(v[:3]) * scale + offset
+            end = placed(np.array(v[:3]) * scale)
             if name == "STRAIGHT_FEED" or name == "RIGID_TAP":
                 moves.append(Move(at, end, comp=comp or leaving, tool=tool))
             if name == "RIGID_TAP":  # (the control returns to where the tap started)
@@ -118,6 +127,16 @@ def feed_moves(
         leaving = 0
         at = end
     return moves
+
+
+def _placed(point: NDArray, g92: NDArray, turn: float, after: NDArray) -> NDArray:
+    """Where the control puts a program point (mm): rs274ngc's canon adds G92, turns X Y by the
+    rotation (degrees), then adds the work offset and the tool length (`after`)."""
+    p = point + g92
+    if turn:
+        c, s = math.cos(math.radians(turn)), math.sin(math.radians(turn))
+        p = np.array([c * p[0] - s * p[1], s * p[0] + c * p[1], p[2]])
+    return p + after
 
 
 def deviation(

@@ -290,7 +290,7 @@ class IsoWriter:
             return self._write_control(block, first)
         if type(first) is Pass and first.setting is not None and first.setting.shift is not None:
             return [self._setting_text(block, first.setting) + block.eol]
-        motion = [e for e in group if type(e) is Line or type(e) is Arc]
+        motion = [as_written(e) for e in group if type(e) is Line or type(e) is Arc]
         lead = 0  # steps to a canned cycle's start (`apply_error_map._lead_in`): new blocks before it
         while lead < len(motion) and motion[lead].fixed == CYCLE and motion[lead].changed:
             lead += 1
@@ -712,7 +712,7 @@ class IsoWriter:
         """`_texts` of a G53 line, whose numbers are machine coordinates (in program units):
         what it writes is decided in program coordinates, like every other block's."""
         units = self._units(segment.context.inch)
-        end, offset = segment.end, segment.context.offset
+        end, offset = segment.context.turned(segment.end), segment.context.offset
         machine = (end[0] + offset[0], end[1] + offset[1], end[2] + offset[2])
         return {
             letter: format_number(machine[n], units.styles[letter])
@@ -1064,15 +1064,35 @@ def _words(block: Block, facts: _Facts) -> tuple[Word, ...]:
 
 
 def reframed(before: Context, after: Context) -> bool:
-    """Whether the program's numbers mean other machine positions after than before (units, offsets)."""
-    return before.inch != after.inch or before.offset != after.offset
+    """Whether the program's numbers mean other machine positions after than before (units, offsets,
+    the rotation of the coordinate system)."""
+    return before.inch != after.inch or before.offset != after.offset or before.rotation != after.rotation
+
+
+def as_written(segment: Line | Arc) -> Line | Arc:
+    """The segment in the program's own frame: under a rotation of the coordinate system (LinuxCNC's
+    G10 L2 R) the segments' points are turned as the control turns the program's (`Context.turned`), and
+    the words written are those that the control, turning them, moves to the (corrected) points."""
+    context = segment.context
+    if context.rotation is None:
+        return segment
+    back = context.turned
+    if type(segment) is Arc:
+        return replace(
+            segment,
+            start=back(segment.start, -1.0),
+            end=back(segment.end, -1.0),
+            center=back(segment.center, -1.0),
+        )
+    return replace(segment, start=back(segment.start, -1.0), end=back(segment.end, -1.0))
 
 
 def seen_from(last: tuple, places: tuple, before: Context, after: Context, after_places: tuple) -> tuple[tuple, tuple]:  # fmt: skip
     """The point the output wrote as `last` (with `places` decimals) in the frame `before`, as
     the control holds it in the frame `after`, with the decimal places to compare it with there."""
     written = (round(last[0], places[0]), round(last[1], places[1]), round(last[2], places[2]))
-    return after.to_program(before.to_machine(written)), after_places
+    machine = before.to_machine(before.turned(written))
+    return after.turned(after.to_program(machine), -1.0), after_places
 
 
 def written_apart(value: float, places: int, last: float, last_places: int) -> bool:
