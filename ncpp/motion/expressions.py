@@ -193,7 +193,8 @@ class Parameters:
             else [self.numbered.get(n, 0.0) for n in range(1, SUBROUTINE_PARAMETERS + 1)]
         )
         local = {k: v for k, v in self.named.items() if not k.startswith("_")}
-        self._note((*local, *range(1, SUBROUTINE_PARAMETERS + 1)))
+        # (an M98 call shares the caller's #1..: only a call with arguments changes them)
+        self._note((*local, *(() if arguments is None else range(1, SUBROUTINE_PARAMETERS + 1))))
         for k in local:
             del self.named[k]
         self._callers.append((saved, local, set(self.vacant)))
@@ -217,8 +218,8 @@ class Parameters:
     def leave(self, value: float | None) -> None:
         """The subroutine returns (`value`: what its return or endsub gave, if anything)."""
         saved, local, vacant = self._callers.pop()
-        if self.journal is not None:
-            self._note((*self.named, *local, *range(1, MACRO_LOCALS + 1)))
+        if self.journal is not None:  # (#1.. come back only where the call saved them)
+            self._note((*self.named, *local, *(() if saved is None else range(1, MACRO_LOCALS + 1))))
         for k in [k for k in self.named if not k.startswith("_")]:
             del self.named[k]
         self.named.update(local)

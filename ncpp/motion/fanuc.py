@@ -167,6 +167,11 @@ UNFOLLOWED_FRAMES = {51.0: "scaling", 51.1: "mirroring", 68.1: "coordinate rotat
 _H_CODES = frozenset((43.0, 43.2, 43.4, 43.5, 44.0, 45.0, 46.0, 47.0, 48.0, 65.0, 66.0))
 
 
+# Signatures of plain blocks (per interpreter class) and whether their G codes are all ones
+# `FanucInterpreter.block` hands on unchecked (`_plain_g`)
+_PLAIN_SIGNATURES: dict[tuple[type, str], bool] = {}
+
+
 class FanucInterpreter(Interpreter):
     settings: dict[float, frozenset[str]] = FANUC_SETTINGS
     unfollowed: dict[tuple[str, float], str] = FANUC_UNFOLLOWED
@@ -195,8 +200,8 @@ class FanucInterpreter(Interpreter):
             if h is not None:
                 raise _OutOfScope("an H word without G43 (Fanuc's tool length offset number on its own)",
                                   h.start + 1)  # fmt: skip
-        if signature is not None and "G" not in signature and "M" not in signature:
-            return super().block(block)  # axis words only (the most): no setting, nothing unfollowed
+        if signature is not None and "M" not in signature and self._plain_g(signature, block):
+            return super().block(block)  # no G code checked below (the most): no setting, nothing unfollowed
         words = [item for item in block.items if type(item) is Word]
         if self.dwell_x and _dwell_in_x(block, words):
             return Pass(block)
@@ -235,6 +240,28 @@ class FanucInterpreter(Interpreter):
                for item in block.items):  # fmt: skip
             raise _OutOfScope(f"G{setting.number} with other words in its block", setting.start + 1)
         return Pass(block)
+
+    def _plain_g(self, signature: str, block: Block) -> bool:
+        """Whether a plain block of this signature has no G code that `block` checks (its G words'
+        numbers are in the signature: one answer for all its blocks)."""
+        key = (type(self), signature)
+        plain = _PLAIN_SIGNATURES.get(key)
+        if plain is None:
+            checked = self._checked_g()
+            plain = not any(type(w) is Word and w.letter == "G" and w.value in checked for w in block.items)
+            if len(_PLAIN_SIGNATURES) >= 4096:  # (a program has few; memory stays flat)
+                _PLAIN_SIGNATURES.clear()
+            _PLAIN_SIGNATURES[key] = plain
+        return plain
+
+    @classmethod
+    def _checked_g(cls) -> frozenset[float]:
+        """The G codes `block` looks at before it hands a block on: dwells, frames, offsets, settings
+        and those it does not follow."""
+        additional = ADDITIONAL_CODES[cls.additional][0]
+        return frozenset((4.0, 10.0, 54.0, 68.0, 69.0, additional, *UNFOLLOWED_FRAMES, *NOT_UNDER_G68,
+                          *(float(n) for n in cls.numbered), *cls.settings,
+                          *(value for letter, value in cls.unfollowed if letter == "G")))  # fmt: skip
 
     # the P of a cycle that a G04 P reads alike: whether it has a decimal point (module docstring)
     dwell_point = False
