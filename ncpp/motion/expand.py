@@ -169,6 +169,7 @@ class Expansion:
         was, was_named, was_vacant = self.written
         lines = []
         for key in sorted((numbered.keys() | was.keys()) - ACTIONS):
+            self._known(key, block)
             if key in vacant_now:
                 if key not in was_vacant:
                     lines.append(f"#{key}=#0")
@@ -176,8 +177,16 @@ class Expansion:
                 lines.append(f"#{key}={number('#', numbered.get(key, 0.0))}")
         for name, value in named.items():
             if was_named.get(name) != value:
+                self._known(name, block)
                 lines.append(f"#<{name}>={number('#', value)}")
         return tuple(Pass(_assignment(text, block)) for text in lines)
+
+    def _known(self, key: int | str, block: Block) -> None:
+        """Refuse a parameter the written program would set to a number where its value is one ncpp
+        cannot know (`Parameters.set_unknown`): the number would be a guess."""
+        whence = self.params.unknown.get(key)
+        if whence is not None:
+            raise refused(whence, Location(self.file, block.line, 1))
 
 
 def counted(expanded: int, where: Location) -> int:

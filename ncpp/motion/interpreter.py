@@ -273,6 +273,11 @@ class Interpreter:
     r_over_ijk = False
     # G10 L2 in G91 adds its values to the offset (Fanuc, Haas); rs274ngc sets them whatever G90/G91
     incremental_zero_set = False
+    # #1000 and up are the control's system variables (Fanuc, Haas), not only where the program's flow
+    # shows a Fanuc macro (`Flow`): rs274ngc numbers its parameters to #5601 and reads an unset one as 0
+    fanuc_variables = False
+    # numbered variables past #1000 that are the program's own, kept from before it (Haas's #10000-)
+    kept_variables = range(0)
     # G92 with S and no axis words is a spindle speed clamp (Fanuc's lathes and machining centres): the
     # refusal says so (`G92_SPEED_CLAMP`); rs274ngc has no G92 S and refuses it as a G92 without axes
     g92_speed_clamp = False
@@ -321,6 +326,8 @@ class Interpreter:
         self.home = {28: [0.0] * 9, 30: [0.0] * 9}  # G28/G30 positions, machine coordinates
         self.uses_extra_axes = False
         self.params = Parameters(self._system_parameter, self._fanuc_system_variable)
+        self.params.kept = self.kept_variables
+        self.params.fanuc = self.fanuc_variables
         self._context: Context | None = None
         self._fast = False
         self.done = False  # program end (M2/M30) reached or state unknown
@@ -803,8 +810,7 @@ class Interpreter:
                         # the value's expression too, reads 0; the value is set after the line
                         self.params.write(key, 0.0)
                     assignments = assignments or []
-                    assigned = None if vacant(expr, self.params) else self._evaluate(expr, block, item)
-                    assignments.append((key, assigned, item))
+                    assignments.append((key, self._assigned(key, expr, block, item), item))
                 elif what == "oword" and len(statement.node) == 1:  # `O<name>` alone: a program's name
                     pass
                 elif what == UNREADABLE:  # read where it runs, as rs274ngc reads it
@@ -847,11 +853,15 @@ class Interpreter:
                 words[letter] = (value, item)  # type: ignore[assignment]  # (a word: `kind`)
         if assignments is not None:  # rs274ngc: after the whole line is read
             for key, assigned, item in assignments:
-                if key in _FANUC_MESSAGES and self.flow is not None and self.flow.fanuc:
+                if key in _FANUC_MESSAGES and self.params.fanuc:
+                    if type(assigned) is str:  # (an alarm number ncpp cannot know)
+                        raise _OutOfScope(assigned, item.start + 1)
                     self._fanuc_message(key, assigned, block, item)
                     continue
                 try:
-                    if assigned is None and type(key) is int:  # `#i = #0`: vacant, as Fanuc assigns it
+                    if type(assigned) is str:
+                        self.params.set_unknown(key, assigned)
+                    elif assigned is None and type(key) is int:  # `#i = #0`: vacant, as Fanuc assigns it
                         self.params.vacate(key)
                     else:
                         self.params.write(key, 0.0 if assigned is None else assigned)
@@ -2048,6 +2058,18 @@ class Interpreter:
         except OutOfScope as err:
             raise _OutOfScope(str(err), item.start + 1) from None
         raise AssertionError("unreachable")
+
+    def _assigned(self, key: int | str, expr: tuple, block: Block, item) -> float | str | None:
+        """The value an assignment gives `key`: None for a vacant one, or, where the value is one ncpp
+        cannot know (a system variable's), why, for `Parameters.set_unknown`: only a later read of
+        `key` is then out of scope."""
+        try:
+            return None if vacant(expr, self.params) else evaluate(expr, self.params)
+        except ExpressionError as err:
+            self._fail(str(err), block, item)
+        except OutOfScope as err:
+            name = f"#{key}" if type(key) is int else f"#<{key}>"
+            return f"{name}, which line {block.line} set from {err}"
 
     def _param_key(self, target: tuple, block: Block, item) -> int | str:
         try:
