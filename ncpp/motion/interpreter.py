@@ -294,6 +294,7 @@ class Interpreter:
         self.inch = False
         self.inverse_time = False
         self.feed = 0.0
+        self.feed_given = False  # an F word has set the feed (`_check_feed`)
         self.motion: float | None = (
             self.start_motion
         )  # modal motion G code (0-3, a canned cycle), None for G80 / none yet
@@ -932,13 +933,20 @@ class Interpreter:
         if word[0] < 0.0:
             self._fail("Negative f word used", block, word[1])
         self.feed = word[0]
+        self.feed_given = True
+        if self.feed == 0.0:  # (a feed move is refused now: `_check_feed`, not the fast path)
+            self._fast = False
+
+    def _zero_feed(self) -> bool:
+        """Whether an F word has set the feed to 0 (a feed move is then refused: `_check_feed`)."""
+        return self.feed == 0.0 and self.feed_given
 
     def _update_fast(self) -> None:
         """Whether a block of plain X/Y/Z words can take the fast path (nothing to check)."""
         motion = self.motion
         self._fast = (
             self.absolute
-            and (motion == 0.0 or (motion == 1.0 and not self.inverse_time))
+            and (motion == 0.0 or (motion == 1.0 and not self.inverse_time and not self._zero_feed()))
             and self.unmoved is None
         )
 
@@ -964,7 +972,7 @@ class Interpreter:
     def _enter_straight_motion(self, code: float) -> bool:
         """Make `code` the modal motion when it is a `G0` / `G1` whose axis words need no
         check (as `_motion_move` would); False (nothing changed) leaves the block to the checks."""
-        if not self.absolute or code > 1.0 or (code == 1.0 and self.inverse_time):
+        if not self.absolute or code > 1.0 or (code == 1.0 and (self.inverse_time or self._zero_feed())):
             return False
         self.motion = code
         self._fast = True
@@ -993,7 +1001,7 @@ class Interpreter:
             self._update_fast()
         if motion > 1.0:
             return self._arc(block, words, motion, None, None)
-        if motion == 1.0 and self.inverse_time:
+        if motion == 1.0 and (self.inverse_time or self.feed == 0.0):
             self._check_feed(
                 block, words, "Cannot do g1 with zero feed rate", "F word missing with inverse time g1 move"
             )
@@ -1946,10 +1954,15 @@ class Interpreter:
         return peck
 
     def _check_feed(self, block: Block, words: dict, zero: str, missing: str) -> None:
-        # A zero feed rate (`zero`) is not refused, unlike rs274ngc: program fragments often
-        # leave the feed to the control (a default feed, or one set before the program runs).
+        # A feed never set is not refused, unlike rs274ngc: program fragments often leave the feed
+        # to the control (a default feed, or one set before the program runs).  One an F word set to 0
+        # is (`zero`): the control stops there, rs274ngc as grbl (error 22, "Feed rate has not yet been
+        # set or is undefined") and Fanuc (alarm PS0011 "FEED ZERO (COMMAND)", Fanuc Series 30i
+        # specification A-91417, "Improvement of the feedrate command when G93/G94/G95 is changed").
         if self.inverse_time and "F" not in words:
             self._fail(missing, block, block.items[0])
+        if self._zero_feed() and not self.inverse_time:
+            self._fail(zero, block, words["F"][1] if "F" in words else block.items[0])
 
     def _arc(self, block: Block, words: dict, motion: float, motion_item, mode1_item) -> Arc | Pass:
         word = motion_item if motion_item is not None else next(item for _, item in words.values())
