@@ -79,3 +79,16 @@ def test_expand_refuses_to_write_a_number_for_an_unknown_value(tmp_path):
                           capture_output=True, text=True, cwd=ROOT)  # fmt: skip
     assert proc.returncode == 2 and not out.exists()
     assert "p.nc:13:1: --expand: #5, which line 10 set from the Fanuc system variable #3020" in proc.stderr
+
+
+def test_expand_writes_a_loop_out_after_the_timer(tmp_path):
+    """The timer set before the loop keeps its line; the loop's moves are written out, compensated."""
+    loop = "#1= 0.\nWHILE [ #1 LT 2. ] DO1\n#1= #1 + 1.\nG01 X[#1 * 10.] F500.\nEND1\n"
+    program, out = tmp_path / "p.nc", tmp_path / "out.nc"
+    program.write_text(HEAD + "G00 X0. Y0. Z10.\n" + loop + "G00 Z50.\nM30\n%\n")
+    command = ["compensate", "--machine", str(WIDE), "--dialect", "haas", "--no-guard", "--expand"]
+    proc = subprocess.run([sys.executable, "-m", "ncpp", *command, str(program), "-o", str(out)],
+                          capture_output=True, text=True, cwd=ROOT)  # fmt: skip
+    assert proc.returncode == 0 and "left as programmed: nothing" in proc.stderr, proc.stderr
+    written = out.read_text()
+    assert TIMER in written and "#10002=" not in written.replace(TIMER, "")
