@@ -117,6 +117,10 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
         "writeback/test_expression_word_spelling.py": (
             "test_the_g43_move_gains_its_x_once_and_rs274_runs_the_path",
         ),
+        "motion/test_haas_kept_variables.py": (
+            "test_a_timer_kept_in_a_variable_leaves_the_moves_compensated",
+        ),
+        "motion/test_zero_feed.py": ("test_a_feed_move_at_a_zero_feed_is_refused_where_rs274_refuses_it",),
         "motion/test_cutter_comp.py": (
             "test_g41_checks_against_the_radius_of_the_tool_table_ncpp_is_told",
             "test_moves_after_compensation_agree_with_rs274",
@@ -332,6 +336,8 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_command_line_tool_table",
             "test_motion_and_simulate_take_the_dialect_and_its_tool_table",
         ),
+        "motion/test_haas_kept_variables.py": None,
+        "motion/test_zero_feed.py": None,
     },
     # runs ncpp in two processes (a test parametrized with jobs >= 2 is one too)
     "multiprocess": {

@@ -72,6 +72,7 @@ class Expansion:
         self.settled = True  # the written program's parameters are the program's (at the main level)
         # The written program's parameters where they were last the program's: numbered, named, vacant
         self.written: tuple[dict, dict, frozenset] = ({}, {}, frozenset())
+        self.unknown: dict[int | str, str] = {}  # the parameters of unknown value when `written` was taken
         self.defining: str | None = None  # the subroutine whose definition's lines go by (kept)
         self.branches = 0  # if chains of the main program whose `if` was left out and `endif` not yet
         self._owed: tuple[Pass, ...] = ()  # assignments due before a line that failed to run (`owed`)
@@ -151,6 +152,7 @@ class Expansion:
         the program's now, before any of its blocks runs, until the next main-program line."""
         if self.settled:
             self.written = self._snapshot()
+            self.unknown = dict(self.params.unknown)
             self.settled = False
         self.started = True
 
@@ -168,6 +170,8 @@ class Expansion:
         numbered, named, vacant_now = self._snapshot()
         was, was_named, was_vacant = self.written
         lines = []
+        for key in self.params.unknown.keys() - ACTIONS:
+            self._known(key, block)
         for key in sorted((numbered.keys() | was.keys()) - ACTIONS):
             if key in vacant_now:
                 if key not in was_vacant:
@@ -178,6 +182,14 @@ class Expansion:
             if was_named.get(name) != value:
                 lines.append(f"#<{name}>={number('#', value)}")
         return tuple(Pass(_assignment(text, block)) for text in lines)
+
+    def _known(self, key: int | str, block: Block) -> None:
+        """Refuse a parameter the stretch written out set to a value ncpp cannot know
+        (`Parameters.set_unknown`): its assignment is left out, and the written program cannot give it
+        that value as a number (one set so before the stretch keeps its own assignment)."""
+        whence = self.params.unknown[key]
+        if self.unknown.get(key) != whence:
+            raise refused(whence, Location(self.file, block.line, 1))
 
 
 def counted(expanded: int, where: Location) -> int:

@@ -155,6 +155,8 @@ class Parameters:
         self.vacant: set[int] = set()
         self.fanuc = False  # a Fanuc program: #1000 and up are the control's system variables
         self.fanuc_system = fanuc_system  # those the interpreter knows (None: not known)
+        self.kept: range = range(0)  # general-purpose variables past #1000 (Haas's), set before the program
+        self.unknown: dict[int | str, str] = {}  # parameters set from a value ncpp cannot know: whence
         self.journal: Journal | None = None  # the writes a loop's check follows (`endless.py`)
 
     def entry(self, key: Hashable) -> object:
@@ -254,10 +256,19 @@ class Parameters:
             if abs(key - value) > EQUAL_TOLERANCE:
                 raise ExpressionError("Parameter number out of range")
         if isinstance(key, int):
-            if not 1 <= key <= MAX_PARAMETER and key != 0:
+            # (a Fanuc or Haas control numbers its variables past rs274ngc's last: `read` and `write`
+            # take those from #1000 on as its system variables, but for `kept`)
+            if not 1 <= key <= MAX_PARAMETER and key != 0 and not (self.fanuc and key > 0):
                 raise ExpressionError("Parameter number out of range")
             return key
         return normalise_name(key)
+
+    def set_unknown(self, key: int | str, whence: str) -> None:
+        """`key` takes a value ncpp cannot know (a timer's, the machine's): a block that reads it later
+        is out of scope for `whence`, one that never does runs on (`#10002 = #3020 - #10000`, a cycle timer
+        at a Haas program's start)."""
+        self.write(key, 0.0)
+        self.unknown[key] = whence
 
     def is_vacant(self, key: int | str) -> bool:
         """Fanuc's vacant variable: #0, or one the program left vacant (`vacant`)."""
@@ -269,7 +280,14 @@ class Parameters:
         self.vacant.add(key)
 
     def read(self, key: int | str) -> float:
+        if self.unknown and key in self.unknown:
+            raise OutOfScope(self.unknown[key])
         if type(key) is int:
+            if key in self.kept:
+                value = self.numbered.get(key)
+                if value is None:
+                    raise OutOfScope(f"#{key}, a variable the control keeps from before the program")
+                return value
             if _machine_state(key) or key >= 1000 and self.fanuc:
                 known = self.fanuc_system(key) if self.fanuc and self.fanuc_system is not None else None
                 if known is not None:
@@ -299,10 +317,12 @@ class Parameters:
         )
 
     def write(self, key: int | str, value: float) -> None:
+        if self.unknown:
+            self.unknown.pop(key, None)
         if type(key) is int:
             if (
                 _machine_state(key) or key >= 1000 and self.fanuc
-            ):  # the control's zeros follow it, in its own units
+            ) and key not in self.kept:  # the control's zeros follow it, in its own units
                 raise OutOfScope(f"a write to the machine-state parameter #{key}" if not self.fanuc else
                                  f"a write to the Fanuc system variable #{key}")  # fmt: skip
             journal = self.journal

@@ -192,6 +192,7 @@ class FanucInterpreter(Interpreter):
     incremental_zero_set = True  # `G91 G10 L2 P1 X10.` adds 10 to G54's X (module docstring)
     rotating_g10 = False  # (an R in G10 L2 is no rotation there)
     g92_speed_clamp = True  # `G92 S4000`: refused as the spindle speed clamp it is (`G92_SPEED_CLAMP`)
+    fanuc_variables = True  # `#5003`, `#3020`: the control's system variables, in every program
 
     def block(self, block: Block) -> Event | tuple[Event, ...]:
         signature = block.signature
@@ -415,6 +416,11 @@ class HaasInterpreter(FanucInterpreter):
     still_r_arc = False  # (no Haas manual page in ncpp's reference set says a 0-degree R arc does not move)
     r_over_ijk = False  # (nor that R wins over I, J, K)
     independent_h = False  # (nor that an H goes without G43)
+    # The NGC control's general-purpose variables, kept at power off, where its system variables
+    # (#1000-#9999, #11000 on) are the control's (the Haas NGC manual's "System Variables" table, as
+    # zappettiniconsulting.com/wiki/haas-system-variables quotes it: #10000-#10999 general-purpose,
+    # r/w, #100-#999 their legacy numbers; #3020 the power-on timer, read only)
+    kept_variables = range(10000, 11000)
 
 
 interpret = interpreting(FanucInterpreter)

@@ -276,6 +276,11 @@ class Interpreter:
     r_over_ijk = False
     # G10 L2 in G91 adds its values to the offset (Fanuc, Haas); rs274ngc sets them whatever G90/G91
     incremental_zero_set = False
+    # #1000 and up are the control's system variables (Fanuc, Haas), not only where the program's flow
+    # shows a Fanuc macro (`Flow`): rs274ngc numbers its parameters to #5601 and reads an unset one as 0
+    fanuc_variables = False
+    # numbered variables past #1000 that are the program's own, kept from before it (Haas's #10000-)
+    kept_variables = range(0)
     # G92 with S and no axis words is a spindle speed clamp (Fanuc's lathes and machining centres): the
     # refusal says so (`G92_SPEED_CLAMP`); rs274ngc has no G92 S and refuses it as a G92 without axes
     g92_speed_clamp = False
@@ -295,6 +300,7 @@ class Interpreter:
         self.inch = False
         self.inverse_time = False
         self.feed = 0.0
+        self.feed_given = False  # an F word has set the feed (`_check_feed`)
         self.motion: float | None = (
             self.start_motion
         )  # modal motion G code (0-3, a canned cycle), None for G80 / none yet
@@ -332,6 +338,8 @@ class Interpreter:
         self.home = {28: [0.0] * 9, 30: [0.0] * 9}  # G28/G30 positions, machine coordinates
         self.uses_extra_axes = False
         self.params = Parameters(self._system_parameter, self._fanuc_system_variable)
+        self.params.kept = self.kept_variables
+        self.params.fanuc = self.fanuc_variables
         self._context: Context | None = None
         self._fast = False
         self.done = False  # program end (M2/M30) reached or state unknown
@@ -861,8 +869,7 @@ class Interpreter:
                         # the value's expression too, reads 0; the value is set after the line
                         self.params.write(key, 0.0)
                     assignments = assignments or []
-                    assigned = None if vacant(expr, self.params) else self._evaluate(expr, block, item)
-                    assignments.append((key, assigned, item))
+                    assignments.append((key, self._assigned(key, expr, block, item), item))
                 elif what == "oword" and len(statement.node) == 1:  # `O<name>` alone: a program's name
                     pass
                 elif what == UNREADABLE:  # read where it runs, as rs274ngc reads it
@@ -905,11 +912,15 @@ class Interpreter:
                 words[letter] = (value, item)  # type: ignore[assignment]  # (a word: `kind`)
         if assignments is not None:  # rs274ngc: after the whole line is read
             for key, assigned, item in assignments:
-                if key in _FANUC_MESSAGES and self.flow is not None and self.flow.fanuc:
+                if key in _FANUC_MESSAGES and self.params.fanuc:
+                    if type(assigned) is str:  # (an alarm number ncpp cannot know)
+                        raise _OutOfScope(assigned, item.start + 1)
                     self._fanuc_message(key, assigned, block, item)
                     continue
                 try:
-                    if assigned is None and type(key) is int:  # `#i = #0`: vacant, as Fanuc assigns it
+                    if type(assigned) is str:
+                        self.params.set_unknown(key, assigned)
+                    elif assigned is None and type(key) is int:  # `#i = #0`: vacant, as Fanuc assigns it
                         self.params.vacate(key)
                     else:
                         self.params.write(key, 0.0 if assigned is None else assigned)
@@ -980,13 +991,20 @@ class Interpreter:
         if word[0] < 0.0:
             self._fail("Negative f word used", block, word[1])
         self.feed = word[0]
+        self.feed_given = True
+        if self.feed == 0.0:  # (a feed move is refused now: `_check_feed`, not the fast path)
+            self._fast = False
+
+    def _zero_feed(self) -> bool:
+        """Whether an F word has set the feed to 0 (a feed move is then refused: `_check_feed`)."""
+        return self.feed == 0.0 and self.feed_given
 
     def _update_fast(self) -> None:
         """Whether a block of plain X/Y/Z words can take the fast path (nothing to check)."""
         motion = self.motion
         self._fast = (
             self.absolute
-            and (motion == 0.0 or (motion == 1.0 and not self.inverse_time))
+            and (motion == 0.0 or (motion == 1.0 and not self.inverse_time and not self._zero_feed()))
             and self.unmoved is None
         )
 
@@ -1012,7 +1030,7 @@ class Interpreter:
     def _enter_straight_motion(self, code: float) -> bool:
         """Make `code` the modal motion when it is a `G0` / `G1` whose axis words need no
         check (as `_motion_move` would); False (nothing changed) leaves the block to the checks."""
-        if not self.absolute or code > 1.0 or (code == 1.0 and self.inverse_time):
+        if not self.absolute or code > 1.0 or (code == 1.0 and (self.inverse_time or self._zero_feed())):
             return False
         self.motion = code
         self._fast = True
@@ -1041,7 +1059,7 @@ class Interpreter:
             self._update_fast()
         if motion > 1.0:
             return self._arc(block, words, motion, None, None)
-        if motion == 1.0 and self.inverse_time:
+        if motion == 1.0 and (self.inverse_time or self.feed == 0.0):
             self._check_feed(
                 block, words, "Cannot do g1 with zero feed rate", "F word missing with inverse time g1 move"
             )
@@ -2087,10 +2105,15 @@ class Interpreter:
         return peck
 
     def _check_feed(self, block: Block, words: dict, zero: str, missing: str) -> None:
-        # A zero feed rate (`zero`) is not refused, unlike rs274ngc: program fragments often
-        # leave the feed to the control (a default feed, or one set before the program runs).
+        # A feed never set is not refused, unlike rs274ngc: program fragments often leave the feed
+        # to the control (a default feed, or one set before the program runs).  One an F word set to 0
+        # is (`zero`): the control stops there, rs274ngc as grbl (error 22, "Feed rate has not yet been
+        # set or is undefined") and Fanuc (alarm PS0011 "FEED ZERO (COMMAND)", Fanuc Series 30i
+        # specification A-91417, "Improvement of the feedrate command when G93/G94/G95 is changed").
         if self.inverse_time and "F" not in words:
             self._fail(missing, block, block.items[0])
+        if self._zero_feed() and not self.inverse_time:
+            self._fail(zero, block, words["F"][1] if "F" in words else block.items[0])
 
     def _arc(self, block: Block, words: dict, motion: float, motion_item, mode1_item) -> Arc | Pass:
         word = motion_item if motion_item is not None else next(item for _, item in words.values())
@@ -2201,6 +2224,18 @@ class Interpreter:
         except OutOfScope as err:
             raise _OutOfScope(str(err), item.start + 1) from None
         raise AssertionError("unreachable")
+
+    def _assigned(self, key: int | str, expr: tuple, block: Block, item) -> float | str | None:
+        """The value an assignment gives `key`: None for a vacant one, or, where the value is one ncpp
+        cannot know (a system variable's), why, for `Parameters.set_unknown`: only a later read of
+        `key` is then out of scope."""
+        try:
+            return None if vacant(expr, self.params) else evaluate(expr, self.params)
+        except ExpressionError as err:
+            self._fail(str(err), block, item)
+        except OutOfScope as err:
+            name = f"#{key}" if type(key) is int else f"#<{key}>"
+            return f"{name}, which line {block.line} set from {err}"
 
     def _param_key(self, target: tuple, block: Block, item) -> int | str:
         try:

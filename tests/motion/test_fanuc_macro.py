@@ -226,9 +226,10 @@ def test_3000_is_an_alarm_in_a_fanuc_program_a_parameter_in_a_linuxcnc_one():
 
 def test_a_fanuc_programs_system_variables_are_out_of_scope():
     """#5021 is where the machine stands, which the operator may have jogged it to; #2001 a tool
-    offset: read as a plain parameter (0) they would be a guess."""
+    offset: read as a plain parameter (0) they would be a guess.  #1 set from #5021 is as unknown:
+    the IF that reads it is where interpretation ends."""
     _, warned = _warned("O1\n" + HEAD + "#1=#5021\nIF [#1 GT 0] GOTO 3\nN3 G1 X#1\nM30\n")
-    assert "t.nc:4:1: warning: the Fanuc system variable #5021 is outside" in warned
+    assert "t.nc:5:1: warning: #1, which line 4 set from the Fanuc system variable #5021 is outside" in warned
     _, warned = _warned("O1\n" + HEAD + "#2001=0.1\nWHILE [0 EQ 1] DO1\nEND1\nM30\n")
     assert "t.nc:4:1: warning: a write to the Fanuc system variable #2001" in warned
 
@@ -283,14 +284,15 @@ def test_the_block_end_position_is_read_where_a_move_placed_the_axis():
     body = "G21 G90 G0 X10 Y20\nG1 X12 F100\n#1=#5001\n#2=#5002\nG1 X[#1+1] Y[#2+1]\nN9 M30\n"
     events, warned = _warned(top + body)
     assert not warned and [e.end[:2] for e in events if type(e) is Line][-1] == (13.0, 21.0)
-    for text, line in (
-        (top + "G0 X1\n#1=#5003\nN9 M30\n", 4),
-        (top + "G0 X1 Z2\nM0\n#1=#5001\nN9 M30\n", 5),
-        (top + "G0 X1\nG92 X0\n#1=#5001\nN9 M30\n", 5),
-        (top + "#2=#0\nG0 X1 Y#2\n#1=#5002\nN9 M30\n", 5),
+    for text, line in (  # (#1, set from what ncpp does not know, stops where a move reads it)
+        (top + "G0 X1\n#1=#5003\nG0 Z#1\nN9 M30\n", 4),
+        (top + "G0 X1 Z2\nM0\n#1=#5001\nG0 Z#1\nN9 M30\n", 5),
+        (top + "G0 X1\nG92 X0\n#1=#5001\nG0 Z#1\nN9 M30\n", 5),
+        (top + "#2=#0\nG0 X1 Y#2\n#1=#5002\nG0 Z#1\nN9 M30\n", 5),
     ):
         _, warned = _warned(text)
-        assert f"t.nc:{line}:1: warning: the Fanuc system variable #500" in warned
+        whence = f"#1, which line {line} set from the Fanuc system variable #500"
+        assert f"t.nc:{line + 1}:4: warning: {whence}" in warned
     # a program that may be LinuxCNC's (no macro statement): #5001 is a parameter as rs274 reads it
     events = _events("O1\nG0 X1\n#5001=3\nG0 Y#5001\nM30\n")
     assert [e.end[1] for e in events if type(e) is Line] == [0.0, 3.0]
