@@ -15,8 +15,7 @@ from tests.rs274 import error, ran, run
 
 WIDE = SHARED / "machines" / "wide.toml"
 FREECAD = (
-    "(Engrave)\nG0 F0.000000 Z6.000000\nG0 F0.000000 X16.98 Y57.06\n"
-    "G1 F0.000000 X16.98 Y57.06 Z-5.000000\n"
+    "(Engrave)\nG0 F0.000000 Z6.000000\nG0 F0.000000 X16.98 Y57.06\nG1 F0.000000 X16.98 Y57.06 Z-5.000000\n"
 )
 
 pytestmark = pytest.mark.skipif(not WIDE.exists(), reason="the shared machine files are not here")
