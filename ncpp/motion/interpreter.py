@@ -913,12 +913,12 @@ class Interpreter:
         if assignments is not None:  # rs274ngc: after the whole line is read
             for key, assigned, item in assignments:
                 if key in _FANUC_MESSAGES and self.params.fanuc:
-                    if type(assigned) is str:  # (an alarm number ncpp cannot know)
+                    if isinstance(assigned, str):  # (an alarm number ncpp cannot know)
                         raise _OutOfScope(assigned, item.start + 1)
                     self._fanuc_message(key, assigned, block, item)
                     continue
                 try:
-                    if type(assigned) is str:
+                    if isinstance(assigned, str):
                         self.params.set_unknown(key, assigned)
                     elif assigned is None and type(key) is int:  # `#i = #0`: vacant, as Fanuc assigns it
                         self.params.vacate(key)
