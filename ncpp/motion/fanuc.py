@@ -193,6 +193,16 @@ class FanucInterpreter(Interpreter):
     rotating_g10 = False  # (an R in G10 L2 is no rotation there)
     g92_speed_clamp = True  # `G92 S4000`: refused as the spindle speed clamp it is (`G92_SPEED_CLAMP`)
     fanuc_variables = True  # `#5003`, `#3020`: the control's system variables, in every program
+    # Polar coordinates, scaling, programmable mirror image and coordinate rotation cancel (Fanuc Series
+    # 0i-MD operator's manual, G code list: G15, G50, G50.1, G69)
+    idle_cancels = frozenset((15.0, 50.0, 50.1, 69.0))
+
+    def _cancels_nothing(self, code: float, block: Block) -> bool:
+        if code == 69.0:
+            return self.g68 is None
+        if code == 50.0:  # (`G50 S..`: a lathe's spindle speed clamp, which `_check_scope` names)
+            return not any(type(item) is Word and item.letter == "S" for item in block.items)
+        return True
 
     def block(self, block: Block) -> Event | tuple[Event, ...]:
         signature = block.signature
@@ -207,7 +217,7 @@ class FanucInterpreter(Interpreter):
         if self.dwell_x and _dwell_in_x(block, words):
             return Pass(block)
         for word in words:
-            if word.letter == "G" and word.value in (68.0, 69.0):
+            if word.letter == "G" and (word.value == 68.0 or word.value == 69.0 and self.g68 is not None):
                 return self._coordinate_rotation(block, word)
             if word.letter == "G" and word.value in UNFOLLOWED_FRAMES:
                 raise _OutOfScope(f"{UNFOLLOWED_FRAMES[word.value]} G{word.number}", word.start + 1)
@@ -403,6 +413,9 @@ class HaasInterpreter(FanucInterpreter):
     pause at end of last peck, in seconds"): the holes' moves are those without it."""
 
     settings = HAAS_SETTINGS
+    # (Haas Mill Operator's Manual, G code list: "G50 Cancel Scaling", "G69 Cancel G68 Rotation"; its mirror
+    # image is G100/G101, and it lists no polar coordinates)
+    idle_cancels = frozenset((50.0, 69.0))
     peck_dwell = True
     dwell_point = True
     unfollowed = HAAS_UNFOLLOWED

@@ -287,6 +287,9 @@ class Interpreter:
     # G10 L2 R turns the system's X Y about Z (LinuxCNC G-code manual, G10 L2: "optionally program R to
     # indicate the rotation of the XY axis around the Z"); elsewhere an R there is out of scope
     rotating_g10 = True
+    # Codes that cancel a mode ncpp does not follow (which, while it interprets, is not in effect): in a
+    # block they cancel nothing and are passed over (Fanuc's and Haas's safety lines, `G40 G49 G69 G80`)
+    idle_cancels: frozenset[float] = frozenset()
 
     def __init__(self, file: str = "<stdin>", offsets: WorkOffsets | None = None):
         self.file = file
@@ -887,6 +890,8 @@ class Interpreter:
                     raise _OutOfScope(OUT_OF_SCOPE_STATEMENT.get(what, what), item.start + 1)
                 continue
             if letter == "G":
+                if value in self.idle_cancels and self._cancels_nothing(value, block):
+                    continue
                 group = G_GROUP.get(value)
                 if group is None:
                     self._fail("Unknown g code used", block, item)
@@ -1444,6 +1449,11 @@ class Interpreter:
         if self.plane != 18:
             self._fail(f"G{code:g} with L word, but plane is not G18", block, item)
         return int(value)
+
+    def _cancels_nothing(self, code: float, block: Block) -> bool:
+        """Whether `code`, one of `idle_cancels`, cancels nothing in `block` (a dialect whose cancel
+        codes may be in effect, or mean something else in some blocks, tells it)."""
+        return True
 
     def _check_scope(self, words: dict, gcodes: dict) -> None:
         for value, item in gcodes.values():

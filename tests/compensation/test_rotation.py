@@ -423,3 +423,50 @@ def test_what_fanuc_g68_needs_and_ncpp_does_not_follow_stays_out_of_scope_at_its
     line = min(n for n, code in enumerate(lines, 1) if n > 2 and at in code.split())
     assert warning.count("warning") == 1, warning
     assert f"t.ngc:{line}:{lines[line - 1].index(at) + 1}: " in warning and construct in warning, warning
+
+
+SAFETY = {  # a post's safety line, and the cancels in it the control has (G code lists of their manuals)
+    "fanuc": ("G90 G17 G40 G49 G80 G15 G50 G50.1 G69", ("G15", "G50", "G50.1", "G69")),
+    "haas": ("G90 G17 G40 G49 G80 G50 G69", ("G50", "G69")),
+}
+
+
+@pytest.mark.parametrize("dialect", ["fanuc", "haas"])
+def test_a_safety_lines_cancels_of_modes_not_in_effect_change_nothing(tmp_path, dialect):
+    """`G15`, `G50`, `G50.1` and `G69` where no polar coordinates, scaling, mirror image or rotation is in
+    effect cancel nothing: the program is compensated to its end, and its written text is that of the
+    same program without them, but for the cancels, kept where they stand."""
+    line, cancels = SAFETY[dialect]
+    program = "%\nO1000\n" + line + "\nG21 G54\nG0 X10. Y10. Z5.\nG1 Z-1. F300.\nX60. Y40.\nG0 Z5.\nM30\n%\n"
+    plain = program.replace(line, " ".join(w for w in line.split() if w not in cancels))
+    outputs = []
+    for name, text in (("with.nc", program), ("without.nc", plain)):
+        source = tmp_path / name
+        source.write_text(text)
+        run = subprocess.run([sys.executable, "-m", "ncpp", "compensate", "--dialect", dialect, "--no-guard",
+                              "--machine", str(ROOT / "samples/machines/hr5b.toml"), "--work-offset", "400,350,300",
+                              str(source)], capture_output=True, text=True, cwd=tmp_path)  # fmt: skip
+        assert run.returncode == 0 and "warning" not in run.stderr, run.stderr
+        outputs.append(run.stdout)
+    assert outputs[0].replace(line, " ".join(w for w in line.split() if w not in cancels)) == outputs[1]
+
+
+@pytest.mark.parametrize(
+    "dialect, body, at, construct",
+    [
+        ("fanuc", "G68 X0 Y0 R30\nG1 X5 Y5 F100\nG69 G40", "G69", "G69 with other words in its block"),
+        ("fanuc", "G50 S2000", "G50", "G50 with S"),
+        ("haas", "G15 G40", "G15", "polar coordinates G15"),
+    ],
+)
+def test_a_cancel_that_cancels_something_or_means_something_else_stays_out_of_scope(
+    dialect, body, at, construct
+):
+    """A G69 while G68 is in effect among other words, a G50 with S (a lathe's spindle speed clamp), and a
+    G15 on Haas (whose manual lists no polar coordinates) each end interpretation at their word."""
+    text = f"G21 G90 G17\nG0 X1 Y1 Z5\n{body}\nG0 X5 Y5\nM30\n"
+    _, warning = interpreted(text, dialect)
+    lines = text.splitlines()
+    line = min(n for n, code in enumerate(lines, 1) if n > 2 and at in code.split())
+    assert warning.count("warning") == 1, warning
+    assert f"t.ngc:{line}:{lines[line - 1].index(at) + 1}: " in warning and construct in warning, warning
