@@ -90,10 +90,34 @@ def test_what_fanuc_and_haas_programs_need_ncpp_is_not_told_ends_interpretation(
         (b"G65 P9810 X1. Y2.\n", "fanuc"),
         (b"o100 sub\nG0 X1\no100 endsub\nO1000\n", "iso"),  # LinuxCNC's o-words win
         (b"G21 G90\nG0 X1 Y2 (G187 in a comment)\n", "iso"),
+        # axis words after a G80 that gave no motion code: Fanuc's G00 before the cycle moves them, rs274 refuses
+        (b"G0 X0. Y14.249\nG98 G73 X0. Y14.249 Z-1. R5. Q0.25 F250.\nG80\nZ5.533\n", "fanuc"),
+        (b"G81 X1 Y1 Z-1 R1 F100\nG80\n(next)\n\nN20 X1. Y2.\n", "fanuc"),
+        (b"G81 X1 Y1 Z-1 R1 F100\nG80 G0 Z5\nX1\n", "iso"),  # (the G80 line gives G0)
+        (b"G81 X1 Y1 Z-1 R1 F100\nG80\nG0 X1\n", "iso"),
     ],
 )
 def test_fanuc_and_haas_are_told_by_what_only_they_write(head, dialect):
     assert detect(head) == dialect
+
+
+def test_a_fusion_drilling_program_with_axis_words_after_g80_is_compensated_as_fanuc(tmp_path):
+    """A Fusion 360 post's drilling (no program number: `G80` then `Z5.533` alone, which the G00 before
+    the cycle moves on a Fanuc control) is read as Fanuc without `--dialect`: compensated as with it."""
+    program = tmp_path / "drill.tap"
+    program.write_text(
+        "G90 G94 G17 G40 G49\nG21\nT1 M6\nS10000 M3\nG54\nG0 X0. Y14.249\nG43 Z10. H1\nZ5.\n"
+        "G98 G73 X0. Y14.249 Z-1. R5. Q0.25 F250.\nG80\nZ5.533\nG73 X-4.369 Y7.315 Z-1. R5.533 Q0.25 F250.\n"
+        "X4.369\nG80\nX0. Y-14.249 Z5.533\nZ10.\nM30\n"
+    )
+    outputs = []
+    for told in ((), ("--dialect", "fanuc")):
+        run = subprocess.run([sys.executable, "-m", "ncpp", "compensate", *told, "--no-guard", "--machine",
+                              str(ROOT / "samples/machines/hr5b.toml"), "--work-offset", "400,350,300", str(program)],
+                             capture_output=True, text=True, cwd=tmp_path)  # fmt: skip
+        assert run.returncode == 0, run.stderr
+        outputs.append(run.stdout)
+    assert outputs[0] == outputs[1]
 
 
 def test_a_haas_program_gets_the_fanuc_guard(tmp_path):

@@ -198,6 +198,26 @@ _FANUC = re.compile(
 )
 
 
+_G80 = re.compile(r"(?<![\w#.])G0*80(?![\d.])", re.I)
+_MOTION_CODE = re.compile(r"(?<![\w#.])G0*([0-3]|7[346]|8[1-9])(?![\d.])", re.I)
+_AXIS_FIRST = re.compile(r"^[ \t]*(N\d+[ \t]*)?[XYZ][ \t]*[-+.\d]", re.I)
+
+
+def _axes_after_g80(code: str) -> bool:
+    """Whether a line of axis words with no motion code follows a G80 that gave none: Fanuc's G80
+    cancels the canned cycle alone (group 09), and the G00 or G01 before it moves them (Fanuc Series
+    0i-MD operator's manual, G code list); LinuxCNC's G80 cancels the motion mode (group 1) and
+    rs274ngc refuses them ("Cannot use axis values without a g code that uses them")."""
+    after_g80 = False
+    for line in code.splitlines():
+        if not line.strip() or line.strip() in ("%",):
+            continue
+        if after_g80 and _AXIS_FIRST.match(line) and not _MOTION_CODE.search(line):
+            return True
+        after_g80 = bool(_G80.search(line)) and not _MOTION_CODE.search(line)
+    return False
+
+
 def detect(first_bytes: bytes, name: str | None = None) -> str:
     """'iso', 'fanuc', 'haas', 'grbl', 'heidenhain' or 'sinumerik' from the start of a program.
 
@@ -208,8 +228,8 @@ def detect(first_bytes: bytes, name: str | None = None) -> str:
     means Sinumerik, unless LinuxCNC's o-word lines or `#<name>` parameters
     are there too.  When the content is plain ISO-looking G code, a file name
     ending in .h / .mpf / .spf decides; then Haas's settings (G187, G103, G154) mean Haas,
-    and a Fanuc program number line, G65, #3000, G05.1 Q or G08 P mean Fanuc (unless
-    LinuxCNC's o-word lines are there); any other is LinuxCNC's ISO.
+    and a Fanuc program number line, G65, #3000, G05.1 Q, G08 P or axis words after a G80 with no
+    motion code mean Fanuc (unless LinuxCNC's o-word lines are there); any other is LinuxCNC's ISO.
     """
     text = first_bytes.decode("latin-1")
     if _HEIDENHAIN.search(text) or len(_HEIDENHAIN_BLOCK.findall(text)) >= 2:
@@ -225,7 +245,7 @@ def detect(first_bytes: bytes, name: str | None = None) -> str:
                 return dialect
     if _HAAS.search(code):
         return "haas"
-    if _FANUC.search(code) and not _LINUXCNC.search(code):
+    if (_FANUC.search(code) or _axes_after_g80(code)) and not _LINUXCNC.search(code):
         return "fanuc"
     return "iso"
 
