@@ -293,7 +293,7 @@ class Parameters:
                 if known is not None:
                     return known
                 raise OutOfScope(f"machine-state parameter #{key}" if not self.fanuc else
-                                 f"the Fanuc system variable #{key}")  # fmt: skip
+                                 f"the control's system variable #{key}")  # fmt: skip
             return self.numbered.get(key, 0.0)  # (a vacant one: 0 in arithmetic, as Fanuc reads it)
         name: str = key  # type: ignore[assignment]  # not an int (`type() is`, for speed, narrows no else)
         value = self.named.get(name)
@@ -324,7 +324,7 @@ class Parameters:
                 _machine_state(key) or key >= 1000 and self.fanuc
             ) and key not in self.kept:  # the control's zeros follow it, in its own units
                 raise OutOfScope(f"a write to the machine-state parameter #{key}" if not self.fanuc else
-                                 f"a write to the Fanuc system variable #{key}")  # fmt: skip
+                                 f"a write to the control's system variable #{key}")  # fmt: skip
             journal = self.journal
             if journal is not None and key not in journal.before:
                 journal.before[key] = self.entry(key)

@@ -229,9 +229,9 @@ def test_a_fanuc_programs_system_variables_are_out_of_scope():
     offset: read as a plain parameter (0) they would be a guess.  #1 set from #5021 is as unknown:
     the IF that reads it is where interpretation ends."""
     _, warned = _warned("O1\n" + HEAD + "#1=#5021\nIF [#1 GT 0] GOTO 3\nN3 G1 X#1\nM30\n")
-    assert "t.nc:5:1: warning: #1, which line 4 set from the Fanuc system variable #5021 is outside" in warned
+    assert "t.nc:5:1: warning: #1, which line 4 set from the control's system variable #5021 is outside" in warned
     _, warned = _warned("O1\n" + HEAD + "#2001=0.1\nWHILE [0 EQ 1] DO1\nEND1\nM30\n")
-    assert "t.nc:4:1: warning: a write to the Fanuc system variable #2001" in warned
+    assert "t.nc:4:1: warning: a write to the control's system variable #2001" in warned
 
 
 def test_a_backward_goto_past_the_read_ahead_over_moves_run_once_is_out_of_scope(monkeypatch):
@@ -291,7 +291,7 @@ def test_the_block_end_position_is_read_where_a_move_placed_the_axis():
         (top + "#2=#0\nG0 X1 Y#2\n#1=#5002\nG0 Z#1\nN9 M30\n", 5),
     ):
         _, warned = _warned(text)
-        whence = f"#1, which line {line} set from the Fanuc system variable #500"
+        whence = f"#1, which line {line} set from the control's system variable #500"
         assert f"t.nc:{line + 1}:4: warning: {whence}" in warned
     # a program that may be LinuxCNC's (no macro statement): #5001 is a parameter as rs274 reads it
     events = _events("O1\nG0 X1\n#5001=3\nG0 Y#5001\nM30\n")

@@ -49,7 +49,7 @@ def test_a_block_that_reads_the_unknown_value_is_out_of_scope_from_there(tmp_pat
     proc, _, _ = compensate(tmp_path, text)
     assert proc.returncode == 0, proc.stderr
     # (#1, set from #10002, is as unknown: the move that reads it is where interpretation ends)
-    whence = "#1, which line 11 set from #10002, which line 3 set from the Fanuc system variable #3020"
+    whence = "#1, which line 11 set from #10002, which line 3 set from the control's system variable #3020"
     assert f"p.nc:12:5: warning: {whence}" in proc.stderr, proc.stderr
     assert "everything from line 12 on" in proc.stderr, proc.stderr
 
@@ -78,7 +78,7 @@ def test_expand_refuses_to_write_a_number_for_an_unknown_value(tmp_path):
     proc = subprocess.run([sys.executable, "-m", "ncpp", *command, str(program), "-o", str(out)],
                           capture_output=True, text=True, cwd=ROOT)  # fmt: skip
     assert proc.returncode == 2 and not out.exists()
-    assert "p.nc:13:1: --expand: #5, which line 10 set from the Fanuc system variable #3020" in proc.stderr
+    assert "p.nc:13:1: --expand: #5, which line 10 set from the control's system variable #3020" in proc.stderr
 
 
 def test_expand_writes_a_loop_out_after_the_timer(tmp_path):

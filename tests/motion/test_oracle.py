@@ -51,10 +51,10 @@ OUT_OF_SCOPE = {
     "iso_gcode/camotics_tests/offsetTests__ToolOffsetTest__data__stdin": "tool table change G10 L1/L10/L11",
     "iso_gcode/camotics_tests/offsetTests__ToolRelativeOffsetTest__data__stdin": "tool table change G10 L1/L10/L11",
     # the machine position, where the operator jogged it to at M0
-    "iso_gcode/fanuc_macroB_sheet/7997A.NC": "the Fanuc system variable #5021",
+    "iso_gcode/fanuc_macroB_sheet/7997A.NC": "the control's system variable #5021",
     # a tool offset (G41 D2's radius)
-    "iso_gcode/fanuc_macroB_sheet/CIRCLE.NC": "a write to the Fanuc system variable #2002",
-    "iso_gcode/fanuc_macroB_sheet/RECTANGLE.NC": "a write to the Fanuc system variable #2001",
+    "iso_gcode/fanuc_macroB_sheet/CIRCLE.NC": "a write to the control's system variable #2002",
+    "iso_gcode/fanuc_macroB_sheet/RECTANGLE.NC": "a write to the control's system variable #2001",
     "iso_gcode/fanuc_macroB_sheet/WASHER.NC": "M98 P9010: a subprogram the program does not define",
     "iso_gcode/linuxcnc/g76.ngc": "canned cycle G76",
     "iso_gcode/linuxcnc/nurbs_G5_butterfly-xy.ngc": "spline G5.2",
