@@ -229,7 +229,10 @@ def test_a_fanuc_programs_system_variables_are_out_of_scope():
     offset: read as a plain parameter (0) they would be a guess.  #1 set from #5021 is as unknown:
     the IF that reads it is where interpretation ends."""
     _, warned = _warned("O1\n" + HEAD + "#1=#5021\nIF [#1 GT 0] GOTO 3\nN3 G1 X#1\nM30\n")
-    assert "t.nc:5:1: warning: #1, which line 4 set from the control's system variable #5021 is outside" in warned
+    assert (
+        "t.nc:5:1: warning: #1, which line 4 set from the control's system variable #5021 is outside"
+        in warned
+    )
     _, warned = _warned("O1\n" + HEAD + "#2001=0.1\nWHILE [0 EQ 1] DO1\nEND1\nM30\n")
     assert "t.nc:4:1: warning: a write to the control's system variable #2001" in warned
 

@@ -78,7 +78,9 @@ def test_expand_refuses_to_write_a_number_for_an_unknown_value(tmp_path):
     proc = subprocess.run([sys.executable, "-m", "ncpp", *command, str(program), "-o", str(out)],
                           capture_output=True, text=True, cwd=ROOT)  # fmt: skip
     assert proc.returncode == 2 and not out.exists()
-    assert "p.nc:13:1: --expand: #5, which line 10 set from the control's system variable #3020" in proc.stderr
+    assert (
+        "p.nc:13:1: --expand: #5, which line 10 set from the control's system variable #3020" in proc.stderr
+    )
 
 
 def test_expand_writes_a_loop_out_after_the_timer(tmp_path):

@@ -189,11 +189,13 @@ _GRBL = re.compile(
 
 
 # Haas's own settings (G187 smoothness, G103 look-ahead, G154 work offsets); Fanuc's program
-# number line (`O1000`, `O1000 (NAME)`, `:1000`), macro call, alarm, AI contour and preview control
+# number line (`O1000`, `O1000 (NAME)`, `:1000`), macro call, alarm, AI contour and preview control,
+# and its macro statements (LinuxCNC's loops and conditions are o-word lines; Sinumerik's take no brackets)
 _HAAS = re.compile(r"(?<![\w#.])G0*(187|103|154)(?![\d.])", re.I)
 _FANUC = re.compile(
     r"^[ \t]*[O:]\d+[ \t]*(\(.*\))?[ \t]*\r?$|(?<![\w#.])G0*65[ \t]*P|#3000[ \t]*=|(?<![\w#.])G0*5\.1[ \t]*Q"
-    r"|(?<![\w#.])G0*8[ \t]*P",
+    r"|(?<![\w#.])G0*8[ \t]*P"
+    r"|^[ \t]*(N\d+[ \t]*)?(WHILE[ \t]*\[.*\][ \t]*DO[ \t]*\d|IF[ \t]*\[.*\][ \t]*(GOTO|THEN))",
     re.M | re.I,
 )
 
@@ -228,8 +230,8 @@ def detect(first_bytes: bytes, name: str | None = None) -> str:
     means Sinumerik, unless LinuxCNC's o-word lines or `#<name>` parameters
     are there too.  When the content is plain ISO-looking G code, a file name
     ending in .h / .mpf / .spf decides; then Haas's settings (G187, G103, G154) mean Haas,
-    and a Fanuc program number line, G65, #3000, G05.1 Q, G08 P or axis words after a G80 with no
-    motion code mean Fanuc (unless LinuxCNC's o-word lines are there); any other is LinuxCNC's ISO.
+    and a Fanuc program number line, G65, #3000, G05.1 Q, G08 P, a macro `WHILE [..] DOn` or
+    `IF [..] GOTOn / THEN`, or axis words after a G80 with no motion code mean Fanuc (unless LinuxCNC's o-word lines are there); any other is LinuxCNC's ISO.
     """
     text = first_bytes.decode("latin-1")
     if _HEIDENHAIN.search(text) or len(_HEIDENHAIN_BLOCK.findall(text)) >= 2:
