@@ -276,6 +276,10 @@ def interpreted(text: str, dialect: str, name: str) -> tuple[list, str]:
         ("L X+5 Y+5 F100\nTOOL CALL 2 X", "TOOL", "TOOL CALL with the tool axis X under a rotation"),
         ("L X+5 Y+5 F100\nL X+0 M91", "L", "M91 with X or Y under a rotation of CYCL DEF 10"),
         ("L X+5 Y+5 F100\nCYCL DEF 11.0 SCALING", "CYCL", "CYCL DEF 11.0 (it moves the datum)"),
+        ("L X+5 Y+5 F100\nCC X+0 Y+0\nCYCL DEF 10.1 ROT+45\nL X+5 Y+0\nC X+0 Y+5 DR+", "C",
+         "a pole CC set before CYCL DEF 10 changed the rotation"),
+        ("L X+5 Y+5 F100\nL X+20 Y+5\nCYCL DEF 10.1 ROT+45\nRND R2", "RND", "RND after CYCL DEF 10 changed"),
+        ("L X+5 Y+5 F100\nCYCL DEF 10.1 SCL+2", "CYCL", "CYCL DEF 10.1 (a rotation ncpp does not read)"),
     ],
 )
 def test_what_klartext_cycle_10_needs_and_ncpp_does_not_follow_stays_out_of_scope_at_its_word(body, at, construct):
@@ -306,6 +310,9 @@ def test_what_klartext_cycle_10_needs_and_ncpp_does_not_follow_stays_out_of_scop
         ("ROT RPL=30\nG1 X5 Y5 F100\nG53 G0 X0", "X0", "a move of X or Y in machine coordinates under a rotation"),
         ("ROT RPL=30\nG1 X5 Y5 F100\nAROT X10", "X10", "AROT about X"),
         ("ROT RPL=30\nG1 X5 Y5 F100\nASCALE X2", "ASCALE", "frame ASCALE"),
+        ("ROT Z=AC(30)", "Z", "ROT with AC() or IC()"),
+        ("ROT RPL=30\nG1 X5 Y5 F100\nSUPA G0 X0", "X0", "a move of X or Y in machine coordinates under a"),
+        ("TRANS X5 RPL=30", "RPL", "TRANS with RPL="),
     ],
 )
 def test_what_a_sinumerik_rotation_needs_and_ncpp_does_not_follow_stays_out_of_scope_at_its_word(
