@@ -416,7 +416,7 @@ class HeidenhainInterpreter(ModalInterpreter):
                 self.called = self._call_program(block, item)
             elif what == "tool_call":
                 if node[1] not in (None, "Z") and self.rotation is not None:
-                    raise OutOfScope(f"TOOL CALL with the tool axis {node[1]} under a rotation of CYCL DEF 10",
+                    raise OutOfScope(f"TOOL CALL with the tool axis {node[1]} under a rotation (CYCL DEF 10)",
                                      item.start + 1)  # fmt: skip
                 if node[1] is not None:
                     self.plane = PLANE_OF_TOOL_AXIS[node[1]]
@@ -426,7 +426,9 @@ class HeidenhainInterpreter(ModalInterpreter):
             elif what == "radius_comp":
                 comp = node[0]
                 if comp != "R0" and self.rotation is not None:
-                    raise OutOfScope(f"radius compensation {comp} under a rotation of CYCL DEF 10", item.start + 1)
+                    raise OutOfScope(
+                        f"radius compensation {comp} under a rotation of CYCL DEF 10", item.start + 1
+                    )
             elif what == "feed":
                 rapid = node[0] == "FMAX"
                 if node[0] == "FAUTO":

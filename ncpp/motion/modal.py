@@ -19,7 +19,7 @@ from ncpp.motion.cutter import ToolCentre
 from ncpp.motion.endless import exact
 from ncpp.motion.offsets import WorkOffsets
 from ncpp.motion.segments import DRILLED, PLANE_AXES, Arc, Context, Event, Line, Pass, Point
-from ncpp.program.blocks import Block
+from ncpp.program.blocks import Block, Item
 
 MM_PER_INCH = 25.4
 RADIUS_TOLERANCE = (
@@ -251,14 +251,15 @@ class ModalInterpreter:
         the direction of the last move (for a tangential arc) turns with the frame."""
         before = self.context()
         held = [p + old - new for p, old, new in zip(before.turned(as_point(self.pos)), self.offset, offset)]
-        tangent = None if self.tangent is None else before.turned(self.tangent)  # (about the zero: as a point)
+        # (a rotation about the zero turns a direction as it turns a point)
+        tangent = None if self.tangent is None else before.turned(self.tangent)
         self.offset, self.rotation, self._context = list(offset), rotation, None
         after = self.context()
         self.pos = list(after.turned(as_point(held), -1.0))
         self.tangent = None if tangent is None else after.turned(tangent, -1.0)
         self._context = None  # (a tool length set with the offset is in the next context)
 
-    def settle_rotation(self, absolute_xy: bool, named: object | None) -> None:
+    def settle_rotation(self, absolute_xy: bool, named: Item | None) -> None:
         """A block after a rotation turned or moved the frame (`unsettled`): one that gives X and Y absolutely
         puts the tool where the turned frame says; before it, one that names X or Y otherwise (`named`, its
         first such word) is not followed: the control turns the working plane's axes once both are
@@ -270,8 +271,8 @@ class ModalInterpreter:
         if absolute_xy:
             self.unsettled = None
         elif named is not None:
-            raise OutOfScope(f"a move of X or Y alone, or incremental, after {self.unsettled} (before a "
-                             "move gives both absolutely)", named.start + 1)  # type: ignore[attr-defined]  # fmt: skip
+            why = f"after {self.unsettled} (before a move gives both absolutely)"
+            raise OutOfScope(f"a move of X or Y alone, or incremental, {why}", named.start + 1)
 
     def set_tool(self, tool: list[float]) -> None:
         """A tool length offset (program units) takes effect: the machine's controlled point
@@ -359,8 +360,10 @@ class ModalInterpreter:
         self.pos = list(end)
         extra, extra_start = self._rotary_move(rotary)
         context = self.context(absolute=absolute)  # (under a rotation, the points turned: `Context.turned`)
-        return Line(context.turned(start), context.turned(as_point(end)), rapid, self.feed, block, context, extra,
-                    extra_start=extra_start)  # fmt: skip
+        end_point = context.turned(as_point(end))
+        return Line(
+            context.turned(start), end_point, rapid, self.feed, block, context, extra, extra_start=extra_start
+        )
 
     def arc(
         self,
@@ -380,8 +383,8 @@ class ModalInterpreter:
         extra, extra_start = self._rotary_move(None)  # (a dialect leaves an arc that turns them out of scope)
         context = self.context(plane, absolute)  # (under a rotation, in G17: the points turned, an arc still)
         turned = context.turned
-        event = Arc(turned(start), turned(as_point(end)), turned(as_point(c)), turn, self.feed, block, context,
-                    extra, extra_start=extra_start)  # fmt: skip
+        points = turned(start), turned(as_point(end)), turned(as_point(c))
+        event = Arc(*points, turn, self.feed, block, context, extra, extra_start=extra_start)
         # tangent at the end: perpendicular to the radius, turning with the arc, plus the helix rise
         ra, rb = end[a] - c[a], end[b] - c[b]
         sign = 1.0 if turn > 0 else -1.0

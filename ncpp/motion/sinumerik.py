@@ -689,7 +689,8 @@ class SinumerikInterpreter(ModalInterpreter):
             if type(item) is Statement:
                 what = item.kind
                 if what == "assignment" and item.node[0] == ("param", "rpl") and frame is not None:
-                    rpl = (self.value(item.node[1], block, item), item)  # (an address of the frame, no variable)
+                    # (RPL= is an address of the frame's, no variable)
+                    rpl = (self.value(item.node[1], block, item), item)
                 elif what == "assignment":
                     target, expr = item.node
                     self.assign(target, expr, block, item)
@@ -804,9 +805,10 @@ class SinumerikInterpreter(ModalInterpreter):
         # cutter compensation: G41 left, G42 right, G40 off (the block's last of them)
         turn = next((SIDES[code] for code, _ in reversed(gcodes) if code in SIDES), None)
         if turn and self.rotation is not None:
-            side = next(item for code, item in reversed(gcodes) if code in SIDES)
-            raise OutOfScope(f"cutter compensation {side.letter}{side.value:g} under a rotation of the frame (ROT)",
-                             side.start + 1)  # fmt: skip
+            code, side = next((code, item) for code, item in reversed(gcodes) if code in SIDES)
+            raise OutOfScope(
+                f"cutter compensation G{code:g} under a rotation of the frame (ROT)", side.start + 1
+            )
         changes = [item for item, _ in tool_words if item.letter in ("M", "D")]
         if changes and self.radius_comp and not turn:  # (its radius is the edge's it was turned on with)
             raise OutOfScope(
@@ -977,7 +979,8 @@ class SinumerikInterpreter(ModalInterpreter):
         tool = [0.0, 0.0, 0.0]
         for length, axis in zip(lengths, LENGTH_AXES[self.plane]):
             tool[axis] = length / (MM_PER_INCH if self.inch else 1.0)
-        if self.rotation is not None and tool[:2] != self.tool[:2]:  # (whether the frame turns them: not said)
+        # (whether the frame turns a length in X or Y the manual does not say)
+        if self.rotation is not None and tool[:2] != self.tool[:2]:
             where = tool_words[-1][0].start + 1 if tool_words else None
             raise OutOfScope("a tool length in X or Y under a rotation of the frame (ROT)", where)
         self.set_tool(tool)
@@ -1089,7 +1092,9 @@ class SinumerikInterpreter(ModalInterpreter):
         name = frame.node[0]
         other = next((item for letter, (_, _, item) in words.items() if letter != "Z"), None)
         if other is not None:
-            raise OutOfScope(f"{name} about {other.letter} (a rotation out of the plane G17)", other.start + 1)
+            raise OutOfScope(
+                f"{name} about {other.letter} (a rotation out of the plane G17)", other.start + 1
+            )
         if rpl is not None and words:
             raise OutOfScope(f"{name} with RPL= and Z", rpl[1].start + 1)
         angle, item = rpl if rpl is not None else (words["Z"][0], words["Z"][2])
@@ -1159,7 +1164,8 @@ class SinumerikInterpreter(ModalInterpreter):
         ):
             return []
         if self.unsettled is not None:
-            given = [a for a in "XY" if a in words and (words[a][1] == "ac" or (words[a][1] is None and self.absolute))]
+            placing = ("ac", None) if self.absolute else ("ac",)  # (the modes of an absolute word)
+            given = [a for a in "XY" if a in words and words[a][1] in placing]
             named = next((words[k][2] for k in ("X", "Y", "I", "J", "CR", "I1", "J1") if k in words), None)
             self.settle_rotation(len(given) == 2, named)
         end = self._target(words)

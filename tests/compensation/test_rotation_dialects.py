@@ -211,7 +211,8 @@ def written(tmp_path: Path, dialect: str) -> Path:
     proc = subprocess.run([sys.executable, "-m", "ncpp", "compensate", "--dialect", dialect, "--machine",
                            str(tmp_path / "affine.toml"), "--work-offset", zero, "--tolerance", "0.0001",
                            str(program), "-o", str(out)],
-                          capture_output=True, text=True, cwd=ROOT, timeout=300, stdin=subprocess.DEVNULL)  # fmt: skip
+                          capture_output=True, text=True, cwd=ROOT, timeout=300,
+                          stdin=subprocess.DEVNULL)  # fmt: skip
     assert proc.returncode == 0, proc.stderr
     assert "scope" not in proc.stderr, proc.stderr
     return out
@@ -241,7 +242,9 @@ def test_the_readings_turn_the_points_as_the_manuals_say():
 
 @pytest.mark.parametrize("dialect", DIALECTS)
 @pytest.mark.parametrize("wrong", [lambda segment: segment, turned_twice], ids=["unturned", "turned-twice"])
-def test_the_verifier_refuses_a_writer_that_gets_the_rotation_wrong(tmp_path, monkeypatch, capsys, wrong, dialect):
+def test_the_verifier_refuses_a_writer_that_gets_the_rotation_wrong(
+    tmp_path, monkeypatch, capsys, wrong, dialect
+):
     """A writer that writes the turned frame's points as the program's words, or turns them the wrong way,
     is caught by the verifier: nothing is written."""
     module = ncpp.program.dialects.heidenhain if dialect == "heidenhain" else ncpp.program.dialects.iso
@@ -251,8 +254,9 @@ def test_the_verifier_refuses_a_writer_that_gets_the_rotation_wrong(tmp_path, mo
     program, out = tmp_path / name, tmp_path / ("out." + name)
     program.write_text(text)
     zero = ",".join(f"{v:g}" for v in ZERO)
-    assert main(["compensate", "--dialect", dialect, "--machine", str(tmp_path / "affine.toml"), "--work-offset",
-                 zero, str(program), "-o", str(out)]) != 0  # fmt: skip
+    machine = str(tmp_path / "affine.toml")
+    assert main(["compensate", "--dialect", dialect, "--machine", machine, "--work-offset", zero,
+                 str(program), "-o", str(out)]) != 0  # fmt: skip
     err = capsys.readouterr().err
     assert f"{name}:" in err and "verification" in err, err
     assert not out.exists()
@@ -276,17 +280,23 @@ def interpreted(text: str, dialect: str, name: str) -> tuple[list, str]:
         ("L X+5 Y+5 F100\nTOOL CALL 2 X", "TOOL", "TOOL CALL with the tool axis X under a rotation"),
         ("L X+5 Y+5 F100\nL X+0 M91", "L", "M91 with X or Y under a rotation of CYCL DEF 10"),
         ("L X+5 Y+5 F100\nCYCL DEF 11.0 SCALING", "CYCL", "CYCL DEF 11.0 (it moves the datum)"),
-        ("L X+5 Y+5 F100\nCC X+0 Y+0\nCYCL DEF 10.1 ROT+45\nL X+5 Y+0\nC X+0 Y+5 DR+", "C",
-         "a pole CC set before CYCL DEF 10 changed the rotation"),
+        (
+            "L X+5 Y+5 F100\nCC X+0 Y+0\nCYCL DEF 10.1 ROT+45\nL X+5 Y+0\nC X+0 Y+5 DR+",
+            "C",
+            "a pole CC set before CYCL DEF 10 changed the rotation",
+        ),
         ("L X+5 Y+5 F100\nL X+20 Y+5\nCYCL DEF 10.1 ROT+45\nRND R2", "RND", "RND after CYCL DEF 10 changed"),
         ("L X+5 Y+5 F100\nCYCL DEF 10.1 SCL+2", "CYCL", "CYCL DEF 10.1 (a rotation ncpp does not read)"),
     ],
 )
-def test_what_klartext_cycle_10_needs_and_ncpp_does_not_follow_stays_out_of_scope_at_its_word(body, at, construct):
+def test_what_klartext_cycle_10_needs_and_ncpp_does_not_follow_stays_out_of_scope_at_its_word(
+    body, at, construct
+):
     """Each ends interpretation with one warning at its word (the first move after Cycle 10 gives X and Y,
     the manual's "move both axes of the working plane"; what else ncpp does not follow under it)."""
-    lines = ["0 BEGIN PGM T MM", "1 TOOL CALL 1 Z S1000", "2 L X+1 Y+1 Z+5 R0 FMAX", "3 CYCL DEF 10.0 ROTATION",
-             "4 CYCL DEF 10.1 ROT+30", *(f"{n} {row}" for n, row in enumerate(body.splitlines(), 5))]  # fmt: skip
+    lines = ["0 BEGIN PGM T MM", "1 TOOL CALL 1 Z S1000", "2 L X+1 Y+1 Z+5 R0 FMAX",
+             "3 CYCL DEF 10.0 ROTATION", "4 CYCL DEF 10.1 ROT+30",
+             *(f"{n} {row}" for n, row in enumerate(body.splitlines(), 5))]  # fmt: skip
     lines += [f"{len(lines)} L X+5 Y+5 FMAX", f"{len(lines) + 1} END PGM T MM"]
     text = "\n".join(lines) + "\n"
     _, warning = interpreted(text, "heidenhain", "t.h")
@@ -302,12 +312,20 @@ def test_what_klartext_cycle_10_needs_and_ncpp_does_not_follow_stays_out_of_scop
     [
         ("ROT RPL=30\nG1 X5 F100", "X5", "a move of X or Y alone, or incremental, after ROT"),
         ("ROT RPL=30\nG91 G1 X5 Y5 F100", "X5", "a move of X or Y alone, or incremental, after ROT"),
-        ("ROT RPL=30\nG1 X5 Y5 F100\nATRANS X2\nG1 Y1", "Y1", "a move of X or Y alone, or incremental, after ATRANS"),
+        (
+            "ROT RPL=30\nG1 X5 Y5 F100\nATRANS X2\nG1 Y1",
+            "Y1",
+            "a move of X or Y alone, or incremental, after ATRANS",
+        ),
         ("ROT X30", "X30", "ROT about X (a rotation out of the plane G17)"),
         ("G18\nROT RPL=30", "RPL", "ROT in G18"),
         ("ROT RPL=30\nG1 X5 Y5 F100\nG19", "G19", "G19 under a rotation of the frame"),
         ("ROT RPL=30\nG1 X5 Y5 F100\nG41 G1 X10 Y5", "G41", "cutter compensation G41 under a rotation"),
-        ("ROT RPL=30\nG1 X5 Y5 F100\nG53 G0 X0", "X0", "a move of X or Y in machine coordinates under a rotation"),
+        (
+            "ROT RPL=30\nG1 X5 Y5 F100\nG53 G0 X0",
+            "X0",
+            "a move of X or Y in machine coordinates under a rotation",
+        ),
         ("ROT RPL=30\nG1 X5 Y5 F100\nAROT X10", "X10", "AROT about X"),
         ("ROT RPL=30\nG1 X5 Y5 F100\nASCALE X2", "ASCALE", "frame ASCALE"),
         ("ROT Z=AC(30)", "Z", "ROT with AC() or IC()"),
@@ -335,4 +353,7 @@ def test_a_sinumerik_rotation_turns_an_increment_and_atrans_follows_the_turned_a
     events, warning = interpreted(text, "sinumerik", "t.mpf")
     assert not warning, warning
     ends = [e.context.to_machine(e.end) for e in events if type(e).__name__ == "Line"]
-    assert ends[-2:] == [pytest.approx((0.0, 10.0, 5.0), abs=1e-12), pytest.approx((0.0, 15.0, 5.0), abs=1e-12)]
+    assert ends[-2:] == [
+        pytest.approx((0.0, 10.0, 5.0), abs=1e-12),
+        pytest.approx((0.0, 15.0, 5.0), abs=1e-12),
+    ]
