@@ -357,3 +357,45 @@ def test_a_sinumerik_rotation_turns_an_increment_and_atrans_follows_the_turned_a
         pytest.approx((0.0, 10.0, 5.0), abs=1e-12),
         pytest.approx((0.0, 15.0, 5.0), abs=1e-12),
     ]
+
+
+# A rotation added to in each run of a loop (Klartext: a label's section repeated; Sinumerik: FOR, AROT with
+# RPL= from an R parameter), and the program the runs make, written by hand
+LOOPS = {
+    "heidenhain": (
+        "0 BEGIN PGM LOOP MM\n1 TOOL CALL 1 Z S1000\n2 L X+0 Y+0 Z+5 R0 FMAX\n3 LBL 1\n"
+        "4 CYCL DEF 10.0 ROTATION\n5 CYCL DEF 10.1 IROT+90\n6 L X+50 Y+0 FMAX\n7 L Z-1 F200\n8 L X+60 Y+10\n"
+        "9 L Z+5 FMAX\n10 LBL 0\n"
+        "11 CALL LBL 1 REP 2\n12 L X+20 Y+0 FMAX\n13 L X+40 Y+20 F200\n14 END PGM LOOP MM\n",
+        "1 L X+0 Y+0 Z+5 FMAX\n"
+        + "1 CYCL DEF 10.1 IROT+90\n1 L X+50 Y+0 FMAX\n1 L Z-1 F200\n1 L X+60 Y+10\n1 L Z+5 FMAX\n" * 3
+        + "1 L X+20 Y+0 FMAX\n1 L X+40 Y+20 F200\n",
+    ),
+    "sinumerik": (
+        "G17 G90 G71\nG0 X0 Y0 Z5\nTRANS X10 Y10\nR2=15\nFOR R1 = 1 TO 3\nAROT RPL=R2*2\nG0 X20 Y0\n"
+        "G1 Z-1 F200\nG1 X30 Y5\nG0 Z5\nENDFOR\nG0 X0 Y0\nG1 X15 Y5\nROT\nG0 X0 Y0\nM30\n",
+        "G0 X0 Y0 Z5\nTRANS X10 Y10\n"
+        + "AROT RPL=30\nG0 X20 Y0\nG1 Z-1 F200\nG1 X30 Y5\nG0 Z5\n" * 3
+        + "G0 X0 Y0\nG1 X15 Y5\nROT\nG0 X0 Y0\n",
+    ),
+}
+
+
+@pytest.mark.parametrize("dialect", LOOPS)
+def test_a_rotation_added_to_in_a_loop_is_written_out_by_expand_and_compensated(tmp_path, dialect):
+    """--expand writes each run of the loop with its rotation (Sinumerik: `AROT RPL=30`, the parameter's
+    value); every end point of the runs is reached within 0.5 µm."""
+    text, runs = LOOPS[dialect]
+    _, name, end_points, _ = DIALECTS[dialect]
+    (tmp_path / "affine.toml").write_text(AFFINE)
+    program, out = tmp_path / name, tmp_path / ("out." + name)
+    program.write_text(text)
+    zero = ",".join(f"{v:g}" for v in ZERO)
+    machine = str(tmp_path / "affine.toml")
+    assert main(["compensate", "--expand", "--dialect", dialect, "--machine", machine, "--work-offset", zero,
+                 "--tolerance", "0.0001", str(program), "-o", str(out)]) == 0  # fmt: skip
+    written_out = out.read_text()
+    assert dialect == "heidenhain" or written_out.count("AROT RPL=30") == 3
+    wanted = end_points(runs)
+    assert misses(closed_form(wanted), wanted.tolist()).max() > 0.010
+    assert misses(closed_form(end_points(written_out)), wanted.tolist()).max() < 0.0005
