@@ -15,7 +15,8 @@ as programmed, FLOW, and the caller's after it compensated), `CYCL DEF` of machi
 (they only define), the drilling cycles 200, 201, 203, 205, 207 and 240 called by M99, `CYCL CALL`
 or `CYCL CALL POS` (`heidenhain_cycles`: their moves along the tool axis are left as
 programmed, DRILLED) or `CYCL CALL PAT` at the holes of a `PATTERN DEF` (all its moves left as
-programmed, PATTERN), M2/M30
+programmed, PATTERN), the datum shift of CYCL DEF 7 and the rotation of CYCL DEF 10 with the tool
+axis Z (`_rotation_cycle`: the moves in the turned frame, `Context.rotation`), M2/M30
 and `END PGM` (end), and `RND R..` / `CHF ..` between two feed lines in the
 working plane (the fillet arc or chamfer line is the RND/CHF block's event; a
 feed line waits for the next move to know whether its corner is cut).
@@ -106,7 +107,7 @@ SHORTEST_WAY, LONGER_WAY, REDUCED_DISPLAY = 126.0, 127.0, 94.0
 # Programs CALL PGM runs nest this deep (TNC 640 Klartext manual, "Nesting": "Maximum nesting
 # depth for calling NC main programs")
 MAX_PROGRAM_NESTING = 19
-DATUM_CYCLES = frozenset(("8", "10", "11", "19", "26"))
+DATUM_CYCLES = frozenset(("8", "11", "19", "26"))  # (10, a rotation: `_rotation_cycle`)
 # CYCL DEF 7 DATUM SHIFT (TNC 640 Cycle Programming manual, "DATUM SHIFT (Cycle 7)"): `7.0` heads it, each
 # of `7.1 X..` `7.2 Y..` `7.3 Z..` shifts one axis's datum, an absolute value from the preset, an incremental
 # one (`IY-11.75`) from the datum in effect; a datum table's line (`7.1 #5`) is not read

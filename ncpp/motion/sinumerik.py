@@ -4,7 +4,8 @@ Scope: G0-G3 with I/J/K (incremental, `I=AC(..)` absolute) or `CR=` (negative:
 more than a half circle), `TURN=` extra helix turns, `CIP` with `I1=/J1=/K1=`
 (an arc through an intermediate point, in a principal plane), `CT` (tangential
 arc), G90/G91 and `AC()`/`IC()` per word, the rotary axes A B C (`ROTARY`), G17/G18/G19, G70/G71/G700/G710,
-`TRANS`/`ATRANS` (translation only), R parameters and `DEF` variables with
+`TRANS`/`ATRANS` and `ROT`/`AROT` in G17 (`_frame`: the moves in the turned frame, `Context.rotation`),
+R parameters and `DEF` variables with
 arithmetic, labels, `MSG`, G4 dwell, M2/M17/M30 (end), and tool lengths: `T n`
 or `T="NAME"` selects, M6 loads it with cutting edge D1, `D n` picks an edge
 (D0 none); the edge's lengths 1-3 from the control's tool offsets (`_N_TO_INI`,
