@@ -15,7 +15,8 @@ as programmed, FLOW, and the caller's after it compensated), `CYCL DEF` of machi
 (they only define), the drilling cycles 200, 201, 203, 205, 207 and 240 called by M99, `CYCL CALL`
 or `CYCL CALL POS` (`heidenhain_cycles`: their moves along the tool axis are left as
 programmed, DRILLED) or `CYCL CALL PAT` at the holes of a `PATTERN DEF` (all its moves left as
-programmed, PATTERN), M2/M30
+programmed, PATTERN), the datum shift of CYCL DEF 7 and the rotation of CYCL DEF 10 with the tool
+axis Z (`_rotation_cycle`: the moves in the turned frame, `Context.rotation`), M2/M30
 and `END PGM` (end), and `RND R..` / `CHF ..` between two feed lines in the
 working plane (the fillet arc or chamfer line is the RND/CHF block's event; a
 feed line waits for the next move to know whether its corner is cut).
@@ -106,14 +107,18 @@ SHORTEST_WAY, LONGER_WAY, REDUCED_DISPLAY = 126.0, 127.0, 94.0
 # Programs CALL PGM runs nest this deep (TNC 640 Klartext manual, "Nesting": "Maximum nesting
 # depth for calling NC main programs")
 MAX_PROGRAM_NESTING = 19
-DATUM_CYCLES = frozenset(("8", "10", "11", "19", "26"))
+DATUM_CYCLES = frozenset(("8", "11", "19", "26"))  # (10, a rotation: `_rotation_cycle`)
 # CYCL DEF 7 DATUM SHIFT (TNC 640 Cycle Programming manual, "DATUM SHIFT (Cycle 7)"): `7.0` heads it, each
 # of `7.1 X..` `7.2 Y..` `7.3 Z..` shifts one axis's datum, an absolute value from the preset, an incremental
 # one (`IY-11.75`) from the datum in effect; a datum table's line (`7.1 #5`) is not read
 SHIFT_CYCLE = "7"
-# Cycle 10 ROTATION: `ROT+0` is its reset (Cycle Programming manual, "ROTATION (Cycle 10)"), no change
-# where ncpp follows a program (it does not follow a rotation), and the cycle's head alone moves nothing
+# CYCL DEF 10 ROTATION (TNC 640 Cycle Programming manual, "ROTATION (Cycle 10)"): `10.1 ROT+30` turns the
+# coordinate system in the working plane about the active datum, counter-clockwise from the reference axis
+# (X in the XY plane), `IROT` adds to the angle in effect, `ROT+0` resets it; the head `10.0` alone moves
+# nothing (`_rotation_cycle`)
 ROTATION_CYCLE = "10"
+# The words that place a move in the working plane XY (`settle_rotation` after Cycle 10)
+PLANE_WORDS = ("X", "Y", "IX", "IY", "PR", "PA", "IPR", "IPA")
 # CYCL DEF 247 DATUM SETTING activates the preset Q339 of the preset table (TNC 640 Klartext manual,
 # "Cycle 247 DATUM SETTING"): the program zero ncpp is told is that preset's; another preset later
 # is a zero ncpp is not told
@@ -146,19 +151,6 @@ def _fn_operand(text: str) -> tuple:
     sign, value = re.fullmatch(_FN_OPERAND, text.strip(), re.I).groups()  # type: ignore[union-attr]
     expr = ("param", value.lower()) if value[0] in "Qq" else ("num", float(value.replace(",", ".")))
     return ("neg", expr) if sign == "-" else expr
-
-
-def _no_rotation(block: Block, number: str) -> bool:
-    """Whether a line of CYCL DEF 10 rotates nothing: its head, or `ROT+0` / `IROT+0`."""
-    words = [i for i in block.items if (type(i) is Word or type(i) is ExprWord) and i.letter != "N"]
-    if not words:
-        return number in ("10", "10.0")
-    return (
-        len(words) == 1
-        and type(words[0]) is Word
-        and words[0].letter in ("ROT", "IROT")
-        and not words[0].value
-    )
 
 
 @dataclass(slots=True)
@@ -252,6 +244,7 @@ class HeidenhainInterpreter(ModalInterpreter):
         self.untold_lengths = UntoldLengths()  # warns at a TOOL CALL whose tool length nothing tells
         self.q: dict[str, float] = {}
         self.pole: list[float] | None = None
+        self.pole_rotation: tuple[float, float, float] | None = None  # the rotation in effect where CC set it
         self.pole_plane = 17
         self.auto_feed = 0.0
         self.last_move: Line | Arc | None = None
@@ -423,6 +416,9 @@ class HeidenhainInterpreter(ModalInterpreter):
             elif what == "call_program":
                 self.called = self._call_program(block, item)
             elif what == "tool_call":
+                if node[1] not in (None, "Z") and self.rotation is not None:
+                    raise OutOfScope(f"TOOL CALL with the tool axis {node[1]} under a rotation (CYCL DEF 10)",
+                                     item.start + 1)  # fmt: skip
                 if node[1] is not None:
                     self.plane = PLANE_OF_TOOL_AXIS[node[1]]
                     self.tool_axis = AXES.index(node[1])
@@ -430,6 +426,10 @@ class HeidenhainInterpreter(ModalInterpreter):
                 return self._tool_call(block, item)
             elif what == "radius_comp":
                 comp = node[0]
+                if comp != "R0" and self.rotation is not None:
+                    raise OutOfScope(
+                        f"radius compensation {comp} under a rotation of CYCL DEF 10", item.start + 1
+                    )
             elif what == "feed":
                 rapid = node[0] == "FMAX"
                 if node[0] == "FAUTO":
@@ -451,7 +451,8 @@ class HeidenhainInterpreter(ModalInterpreter):
                 if number == SHIFT_CYCLE:
                     self._datum_shift(block, item)
                     return []
-                if number == ROTATION_CYCLE and _no_rotation(block, node[0]):
+                if number == ROTATION_CYCLE:
+                    self._rotation_cycle(block, item)
                     return []
                 if number in DATUM_CYCLES:
                     raise OutOfScope(f"CYCL DEF {node[0]} (it moves the datum)", item.start + 1)
@@ -501,6 +502,8 @@ class HeidenhainInterpreter(ModalInterpreter):
             return []
         if function in ("RND", "CHF"):
             return [self._corner(block, function_item, words)]
+        if self.unsettled is not None and (function is not None or at_position):
+            self._settle(function, function_item, words)
         if (at_position or at_pattern) and call is not None:
             if function is not None or machine_datum or retract is not None or comp not in (None, "R0"):
                 raise OutOfScope(f"{call[0]} with a path function, M91, M140 or RL/RR in its block", call[1])
@@ -539,6 +542,39 @@ class HeidenhainInterpreter(ModalInterpreter):
         if end:
             self.done = self.ended = True
         return events
+
+    def _rotation_cycle(self, block: Block, item: Statement) -> None:
+        """A line of CYCL DEF 10 (`ROTATION_CYCLE`): the coordinate system turns about the datum in the
+        working plane XY (`ModalInterpreter.set_frame`: the tool stays where it stands, the moves after it are
+        in the turned frame until a block gives X and Y, `_settle`).  Not followed: another working plane
+        (a turn about X or Y), a rotation under radius compensation RL/RR (the control cancels it: the
+        manual's "Please note")."""
+        words = [i for i in block.items if (type(i) is Word or type(i) is ExprWord) and i.letter != "N"]
+        if not words and item.node[0] in ("10", "10.0"):
+            return  # (the cycle's head: its angle follows)
+        if len(words) != 1 or words[0].letter not in ("ROT", "IROT"):
+            raise OutOfScope(f"CYCL DEF {item.node[0]} (a rotation ncpp does not read)", item.start + 1)
+        before = self.rotation[0] if self.rotation is not None else 0.0
+        angle = self._word_value(words[0], block) + (before if words[0].letter == "IROT" else 0.0)
+        if angle == before:
+            return
+        why = ("with the tool axis " + AXES[self.tool_axis] if self.tool_axis != 2
+               else "under radius compensation RL/RR" if self.radius_comp else None)  # fmt: skip
+        if why is not None:
+            raise OutOfScope(f"CYCL DEF 10 ROTATION {why}", item.start + 1)
+        self.set_frame(self.offset, (angle, 0.0, 0.0) if angle else None)
+        self.unsettled = "CYCL DEF 10"
+
+    def _settle(self, function: str | None, item, words: dict) -> None:
+        """`settle_rotation` for a block after Cycle 10: an absolute X and Y settle it (a CC's only set the
+        pole); a circle from where the tool stands (no word in the plane) is placed as one axis alone is."""
+        both = "X" in words and "Y" in words
+        named = next((words[k][1] for k in PLANE_WORDS if k in words), None)
+        if function in ("C", "CP", "CT", "CR") and named is None:
+            named = item
+        if function == "CC":
+            both, named = False, None if both else named
+        self.settle_rotation(both, named)
 
     def _define_cycle(self, number: str, block: Block) -> None:
         """CYCL DEF of a drilling cycle, its Q parameters just assigned: the cycle M99 and CYCL
@@ -996,6 +1032,8 @@ class HeidenhainInterpreter(ModalInterpreter):
         if self.corner_waits:
             self.fail(f"{function} right after another RND/CHF block", block, item)
         previous = self.last_move
+        if previous is not None and previous.context.rotation != self.rotation:
+            raise OutOfScope(f"{function} after CYCL DEF 10 changed the rotation", item.start + 1)
         if type(previous) is not Line or previous.rapid:
             raise OutOfScope(
                 f"{function} after {'no move' if previous is None else 'an arc or a rapid move'}",
@@ -1090,6 +1128,8 @@ class HeidenhainInterpreter(ModalInterpreter):
         the axes it names end there, the others stay where they stand."""
         if function != "L":
             raise OutOfScope(f"M91 with the path function {function}", item.start + 1)
+        if self.rotation is not None and ("X" in words or "Y" in words):
+            raise OutOfScope("M91 with X or Y under a rotation of CYCL DEF 10", item.start + 1)
         end, written = self._target(words)
         context = self.context()
         for n, axis in enumerate(AXES):
@@ -1156,6 +1196,8 @@ class HeidenhainInterpreter(ModalInterpreter):
         )  # fmt: skip
         if number is None:
             self.fail("CYCL DEF 247 without Q339 (the preset number)", block, item)
+        if self.rotation is not None:  # (the preset's own basic rotation replaces it: not followed)
+            raise OutOfScope("CYCL DEF 247 under a rotation of CYCL DEF 10", item.start + 1)
         if any(self.shift):
             raise OutOfScope("CYCL DEF 247 with a datum shift of CYCL DEF 7 in effect (whether it stays "
                              "is not followed)", item.start + 1)  # fmt: skip
@@ -1180,6 +1222,8 @@ class HeidenhainInterpreter(ModalInterpreter):
             raise OutOfScope(f"CYCL DEF {item.node[0]} (a datum shift ncpp does not read)", item.start + 1)
         if self.radius_comp:
             raise OutOfScope("CYCL DEF 7 with radius compensation RL/RR", item.start + 1)
+        if self.rotation is not None:  # (whether it shifts along the turned axes is not followed)
+            raise OutOfScope("CYCL DEF 7 under a rotation of CYCL DEF 10", item.start + 1)
         k = AXES.index(axis)
         shift = self._word_value(words[0], block) + (self.shift[k] if words[0].letter[0] == "I" else 0.0)
         offset = list(self.offset)
@@ -1212,13 +1256,15 @@ class HeidenhainInterpreter(ModalInterpreter):
         self.unknown_axes -= {n for n, axis in enumerate(AXES) if axis in words}
 
     def _set_pole(self, block: Block, end: list[float], written: set[int]) -> Pole:
-        self.pole = end
+        self.pole, self.pole_rotation = end, self.rotation
         self.pole_plane = _plane_of_axes(written, self.plane)
         return Pole(block, center=as_point(end), plane=self.pole_plane)
 
     def _need_pole(self, block: Block, item) -> list[float]:
         if self.pole is None:
             self.fail("a circle or polar move with no pole: program CC first", block, item)
+        if self.pole_rotation != self.rotation:  # (whether the control turns it with the frame is not said)
+            raise OutOfScope("a pole CC set before CYCL DEF 10 changed the rotation", item.start + 1)
         return self.pole
 
     def _circle(self, block: Block, item, end: list[float], rotation: str | None):

@@ -19,7 +19,7 @@ from ncpp.motion.cutter import ToolCentre
 from ncpp.motion.endless import exact
 from ncpp.motion.offsets import WorkOffsets
 from ncpp.motion.segments import DRILLED, PLANE_AXES, Arc, Context, Event, Line, Pass, Point
-from ncpp.program.blocks import Block
+from ncpp.program.blocks import Block, Item
 
 MM_PER_INCH = 25.4
 RADIUS_TOLERANCE = (
@@ -115,6 +115,12 @@ class ModalInterpreter:
         # axis not yet positioned (the ISO reading).  Moves carry them (`Line.extra`) once a word did.
         self.rotary = [0.0, 0.0, 0.0]
         self.uses_rotary = False
+        # The coordinate system turned in the working plane XY about the program zero (Klartext Cycle 10,
+        # Sinumerik ROT / AROT): `Context.rotation`, moves in the turned frame (`line`, `arc`); None: unturned
+        self.rotation: tuple[float, float, float] | None = None
+        # The instruction that last turned or moved the frame under a rotation, until a move gives X and Y
+        # absolutely (`settle_rotation`); None: settled
+        self.unsettled: str | None = None
 
     def loop_state(self) -> tuple:
         """The state a loop that comes back to it repeats for ever with (`endless.py`), but the
@@ -218,7 +224,8 @@ class ModalInterpreter:
         if self._context is None or self._context.plane != plane or self._context.absolute != absolute:
             offset = as_point([z + o for z, o in zip(self.zero, self.offset)])
             tool = as_point(self.tool)
-            self._context = Context(plane, absolute, False, self.inch, offset, tool, tool_id=self.tool_id)
+            self._context = Context(plane, absolute, False, self.inch, offset, tool, tool_id=self.tool_id,
+                                    rotation=self.rotation)  # fmt: skip
         return self._context
 
     def set_units(self, inch: bool) -> None:
@@ -236,9 +243,36 @@ class ModalInterpreter:
 
     def set_offset(self, offset: list[float]) -> None:
         """A frame moved the program origin: the same machine point gets new program coordinates."""
-        self.pos = [p + old - new for p, old, new in zip(self.pos, self.offset, offset)]
-        self.offset = list(offset)
-        self._context = None
+        self.set_frame(offset, self.rotation)
+
+    def set_frame(self, offset: list[float], rotation: tuple[float, float, float] | None) -> None:
+        """A frame moved or turned the program origin (`rotation` about the program zero): the machine stays
+        where it is, its point (machine = turned program point + offset) gets new program coordinates, and
+        the direction of the last move (for a tangential arc) turns with the frame."""
+        before = self.context()
+        held = [p + old - new for p, old, new in zip(before.turned(as_point(self.pos)), self.offset, offset)]
+        # (a rotation about the zero turns a direction as it turns a point)
+        tangent = None if self.tangent is None else before.turned(self.tangent)
+        self.offset, self.rotation, self._context = list(offset), rotation, None
+        after = self.context()
+        self.pos = list(after.turned(as_point(held), -1.0))
+        self.tangent = None if tangent is None else after.turned(tangent, -1.0)
+        self._context = None  # (a tool length set with the offset is in the next context)
+
+    def settle_rotation(self, absolute_xy: bool, named: Item | None) -> None:
+        """A block after a rotation turned or moved the frame (`unsettled`): one that gives X and Y absolutely
+        puts the tool where the turned frame says; before it, one that names X or Y otherwise (`named`, its
+        first such word) is not followed: the control turns the working plane's axes once both are
+        programmed (TNC 640 Cycle Programming manual, "ROTATION (Cycle 10)": "move both axes of the working
+        plane to activate rotation for all axes"), and where the other axis of a one-axis move goes is not
+        said."""
+        if self.unsettled is None:
+            return
+        if absolute_xy:
+            self.unsettled = None
+        elif named is not None:
+            why = f"after {self.unsettled} (before a move gives both absolutely)"
+            raise OutOfScope(f"a move of X or Y alone, or incremental, {why}", named.start + 1)
 
     def set_tool(self, tool: list[float]) -> None:
         """A tool length offset (program units) takes effect: the machine's controlled point
@@ -325,8 +359,11 @@ class ModalInterpreter:
             self.tangent = (d[0] / length, d[1] / length, d[2] / length)
         self.pos = list(end)
         extra, extra_start = self._rotary_move(rotary)
-        return Line(start, as_point(end), rapid, self.feed, block, self.context(absolute=absolute), extra,
-                    extra_start=extra_start)  # fmt: skip
+        context = self.context(absolute=absolute)  # (under a rotation, the points turned: `Context.turned`)
+        end_point = context.turned(as_point(end))
+        return Line(
+            context.turned(start), end_point, rapid, self.feed, block, context, extra, extra_start=extra_start
+        )
 
     def arc(
         self,
@@ -344,8 +381,10 @@ class ModalInterpreter:
         c = list(centre)
         c[n] = start[n]
         extra, extra_start = self._rotary_move(None)  # (a dialect leaves an arc that turns them out of scope)
-        event = Arc(start, as_point(end), as_point(c), turn, self.feed, block, self.context(plane, absolute),
-                    extra, extra_start=extra_start)  # fmt: skip
+        context = self.context(plane, absolute)  # (under a rotation, in G17: the points turned, an arc still)
+        turned = context.turned
+        points = turned(start), turned(as_point(end)), turned(as_point(c))
+        event = Arc(*points, turn, self.feed, block, context, extra, extra_start=extra_start)
         # tangent at the end: perpendicular to the radius, turning with the arc, plus the helix rise
         ra, rb = end[a] - c[a], end[b] - c[b]
         sign = 1.0 if turn > 0 else -1.0

@@ -4,7 +4,8 @@ Scope: G0-G3 with I/J/K (incremental, `I=AC(..)` absolute) or `CR=` (negative:
 more than a half circle), `TURN=` extra helix turns, `CIP` with `I1=/J1=/K1=`
 (an arc through an intermediate point, in a principal plane), `CT` (tangential
 arc), G90/G91 and `AC()`/`IC()` per word, the rotary axes A B C (`ROTARY`), G17/G18/G19, G70/G71/G700/G710,
-`TRANS`/`ATRANS` (translation only), R parameters and `DEF` variables with
+`TRANS`/`ATRANS` and `ROT`/`AROT` in G17 (`_frame`: the moves in the turned frame, `Context.rotation`),
+R parameters and `DEF` variables with
 arithmetic, labels, `MSG`, G4 dwell, M2/M17/M30 (end), and tool lengths: `T n`
 or `T="NAME"` selects, M6 loads it with cutting edge D1, `D n` picks an edge
 (D0 none); the edge's lengths 1-3 from the control's tool offsets (`_N_TO_INI`,
@@ -52,6 +53,7 @@ from ncpp.motion.modal import (
     MM_PER_INCH,
     ModalInterpreter,
     OutOfScope,
+    as_point,
     circle_through,
     placed_interpreting,
     plane_of,
@@ -141,8 +143,9 @@ UNREAD_GEOMETRY = {
     "DISCL": "the approach distance",
     "DISRP": "the approach distance",
 }
-# Frame instructions followed: translations; a bare substituting ROT / SCALE / MIRROR resets the frame.
-FRAMES = frozenset(("TRANS", "ATRANS", "ROT", "SCALE", "MIRROR"))
+# Frame instructions followed (`_frame`): translations, rotations in the plane G17 (about Z); a bare
+# substituting ROT / SCALE / MIRROR resets the frame.
+FRAMES = frozenset(("TRANS", "ATRANS", "ROT", "AROT", "SCALE", "MIRROR"))
 
 
 # The axis (X, Y, Z index) that lengths 1, 2 and 3 of a milling tool act along, per plane
@@ -672,6 +675,7 @@ class SinumerikInterpreter(ModalInterpreter):
         gcodes: list[tuple[float, Word | ExprWord]] = []
         path: str | None = None
         frame: Statement | None = None
+        rpl: tuple[float, Statement] | None = None  # `ROT RPL=30`: the rotation in the plane, its item
         machine = False  # SUPA: the block's coordinates are the machine's
         mcall = False  # MCALL: the drilling cycle of the block is called after each move from here on
         drilling: Drilling | None = None  # a drilling cycle the block runs where it ends
@@ -685,7 +689,10 @@ class SinumerikInterpreter(ModalInterpreter):
             before, previous = previous, item
             if type(item) is Statement:
                 what = item.kind
-                if what == "assignment":
+                if what == "assignment" and item.node[0] == ("param", "rpl") and frame is not None:
+                    # (RPL= is an address of the frame's, no variable)
+                    rpl = (self.value(item.node[1], block, item), item)
+                elif what == "assignment":
                     target, expr = item.node
                     self.assign(target, expr, block, item)
                 elif what == "def":
@@ -798,6 +805,11 @@ class SinumerikInterpreter(ModalInterpreter):
         codes = {code for code, _ in gcodes}
         # cutter compensation: G41 left, G42 right, G40 off (the block's last of them)
         turn = next((SIDES[code] for code, _ in reversed(gcodes) if code in SIDES), None)
+        if turn and self.rotation is not None:
+            code, side = next((code, item) for code, item in reversed(gcodes) if code in SIDES)
+            raise OutOfScope(
+                f"cutter compensation G{code:g} under a rotation of the frame (ROT)", side.start + 1
+            )
         changes = [item for item, _ in tool_words if item.letter in ("M", "D")]
         if changes and self.radius_comp and not turn:  # (its radius is the edge's it was turned on with)
             raise OutOfScope(
@@ -809,7 +821,7 @@ class SinumerikInterpreter(ModalInterpreter):
         if path is not None:
             self.motion = path
         if frame is not None:
-            self._frame(frame, words)
+            self._frame(frame, words, rpl)
             return []
         events: list[Event] = []
         dwelling = next((words[a][2] for a in ROTARY if a in words), None) if dwell else None
@@ -968,6 +980,10 @@ class SinumerikInterpreter(ModalInterpreter):
         tool = [0.0, 0.0, 0.0]
         for length, axis in zip(lengths, LENGTH_AXES[self.plane]):
             tool[axis] = length / (MM_PER_INCH if self.inch else 1.0)
+        # (whether the frame turns a length in X or Y the manual does not say)
+        if self.rotation is not None and tool[:2] != self.tool[:2]:
+            where = tool_words[-1][0].start + 1 if tool_words else None
+            raise OutOfScope("a tool length in X or Y under a rotation of the frame (ROT)", where)
         self.set_tool(tool)
 
     def _edge_lengths(self, block: Block, item) -> tuple[float, float, float]:
@@ -1022,6 +1038,8 @@ class SinumerikInterpreter(ModalInterpreter):
             if code in (0.0, 1.0, 2.0, 3.0):
                 self.motion = code
             elif code in (17.0, 18.0, 19.0):
+                if code != 17.0 and self.rotation is not None:  # (the rotation is about Z: in G17's plane)
+                    raise OutOfScope(f"G{code:g} under a rotation of the frame (ROT)", item.start + 1)
                 self.plane = int(code)
             elif code in (90.0, 91.0):
                 self.absolute = code == 90.0
@@ -1036,19 +1054,70 @@ class SinumerikInterpreter(ModalInterpreter):
                 raise OutOfScope(f"{reason} G{code:g}", item.start + 1)
         return dwell
 
-    def _frame(self, frame: Statement, words: dict) -> None:
+    def _frame(self, frame: Statement, words: dict, rpl: tuple[float, Statement] | None) -> None:
+        """A programmable frame instruction (840D sl Programming Manual Fundamentals, "Coordinate
+        transformations (frames)"): TRANS, ROT, SCALE and MIRROR replace the programmable frame (bare, they
+        reset it), ATRANS and AROT add to it in the frame in effect, so that ATRANS after a rotation
+        translates along the turned axes.  The frame holds its translation (`offset`, with the tool's
+        lengths) and its rotation about Z in G17 (`rotation`, about the zero of the settable frame plus the
+        translation: `_rotated`); a change under a rotation leaves X and Y to a move that gives both
+        (`settle_rotation`)."""
         name = frame.node[0]
+        if name in ("ROT", "AROT") and (words or rpl is not None):
+            return self._rotated(frame, words, rpl)
+        if rpl is not None:
+            raise OutOfScope(f"{name} with RPL=", rpl[1].start + 1)
         if name not in ("TRANS", "ATRANS") and words:
             raise OutOfScope(f"frame {name}", frame.start + 1)
         offset = (
             list(self.offset) if name == "ATRANS" else list(self.tool)
         )  # TRANS replaces the frame, not the tool length
+        moved = [0.0, 0.0, 0.0]
         for letter, (value, _, item) in words.items():
             if letter not in AXES:
                 raise OutOfScope(f"{frame.node[0]} of the {letter} axis", item.start + 1)
-            offset[AXES.index(letter)] += value
+            moved[AXES.index(letter)] = value
+        rotation = self.rotation if name == "ATRANS" else None
+        if rotation is not None:  # (ATRANS under a rotation: along the turned axes)
+            moved = list(self.context().turned(as_point(moved)))
+        for k in range(3):
+            if moved[k] or AXES[k] in words:
+                offset[k] += moved[k]
+        self._set_frame(name, offset, rotation)
+
+    def _rotated(self, frame: Statement, words: dict, rpl: tuple[float, Statement] | None) -> None:
+        """`ROT RPL=a` / `ROT Z a` (the frame replaced by a rotation of a degrees counter-clockwise in the
+        plane G17, about the settable frame's zero) and `AROT RPL=a` / `AROT Z a` (a added to the rotation in
+        effect, about the frame's zero).  Not followed: a rotation about X or Y, or in G18 / G19 (the plane
+        turns off the machine's), or under cutter compensation."""
+        name = frame.node[0]
+        other = next((item for letter, (_, _, item) in words.items() if letter != "Z"), None)
+        if other is not None:
+            raise OutOfScope(
+                f"{name} about {other.letter} (a rotation out of the plane G17)", other.start + 1
+            )
+        if rpl is not None and words:
+            raise OutOfScope(f"{name} with RPL= and Z", rpl[1].start + 1)
+        angle, item = rpl if rpl is not None else (words["Z"][0], words["Z"][2])
+        why = (f"in G{self.plane}" if self.plane != 17 else "under cutter compensation" if self.radius_comp
+               else "with AC() or IC()" if rpl is None and words["Z"][1] is not None else None)  # fmt: skip
+        if why is not None:
+            raise OutOfScope(f"{name} {why}", item.start + 1)
+        before = self.rotation[0] if self.rotation is not None else 0.0
+        turned = angle + before if name == "AROT" else angle
+        self._set_frame(name, list(self.offset) if name == "AROT" else list(self.tool),
+                        (turned, 0.0, 0.0) if turned else None)  # fmt: skip
+
+    def _set_frame(self, name: str, offset: list[float], rotation: tuple[float, float, float] | None) -> None:
+        """The frame's translation and rotation set: the machine stays (`set_frame`); a translation's
+        offset is traversed with the axis's next incremental move (`frame_shift`), and under a rotation
+        before or after, the next move in the plane gives X and Y (`settle_rotation`)."""
+        if (self.rotation is not None or rotation is not None) and (
+            rotation != self.rotation or offset[:2] != self.offset[:2]
+        ):
+            self.unsettled = name
         self.frame_shift = [s + new - old for s, new, old in zip(self.frame_shift, offset, self.offset)]
-        self.set_offset(offset)
+        self.set_frame(offset, rotation)
 
     def _target(self, words: dict) -> list[float]:
         end = list(self.pos)
@@ -1095,6 +1164,11 @@ class SinumerikInterpreter(ModalInterpreter):
             and (rotary is None or motion not in (0.0, 1.0))
         ):
             return []
+        if self.unsettled is not None:
+            placing = ("ac", None) if self.absolute else ("ac",)  # (the modes of an absolute word)
+            given = [a for a in "XY" if a in words and words[a][1] in placing]
+            named = next((words[k][2] for k in ("X", "Y", "I", "J", "CR", "I1", "J1") if k in words), None)
+            self.settle_rotation(len(given) == 2, named)
         end = self._target(words)
         absolute = self.absolute  # the modal mode: a rewritten word is written plain, in that mode
         if motion in (0.0, 1.0):
@@ -1119,6 +1193,9 @@ class SinumerikInterpreter(ModalInterpreter):
         if not any(a in words for a in AXES):
             return []
         item = next(iter(words.values()))[2]
+        if self.rotation is not None and ("X" in words or "Y" in words):
+            raise OutOfScope("a move of X or Y in machine coordinates under a rotation of the frame (ROT)",
+                             item.start + 1)  # fmt: skip
         if self.motion not in (0.0, 1.0) or any(words[a][1] is not None for a in AXES if a in words):
             raise OutOfScope(
                 "a move in machine coordinates other than G0/G1 to absolute positions", item.start + 1

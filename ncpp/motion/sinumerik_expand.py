@@ -165,6 +165,10 @@ class SinumerikExpansion:
             return None if not main and item.letter == "M" and item.value == 17.0 else raw
         if type(item) is not Statement:
             return raw
+        if item.kind == "assignment" and item.node[0] == ("param", "rpl") and _framed(block):
+            # (`ROT RPL=30`: the frame's address, no variable; its value as the block ran)
+            expr = item.node[1]
+            return raw if not reads_variable(expr) else f"RPL={number(value(expr, block, item))}"
         if item.kind in LEFT_OUT or (item.kind == "call" and item.node[0] == "RET"):
             return None
         if item.kind == "label":  # (run again, its text was written where it stands, or left out there)
@@ -246,6 +250,11 @@ def _call(item: Statement, block: Block, value: Evaluate, where: Location) -> st
         else:
             texts.append(number(value(arg, block, item)))
     return f"{name}({','.join(texts)})"
+
+
+def _framed(block: Block) -> bool:
+    """Whether the block is a frame instruction's (`ROT`, `AROT` ...), whose `RPL=` is its address."""
+    return any(type(i) is Statement and i.kind == "frame" for i in block.items)
 
 
 def _assignment(key: str, value: float | str, block: Block) -> Block:

@@ -12,6 +12,7 @@ a closed-form machine (`SQUARE`: X is off by -50 µm/m · Y, so a compensated X 
 from __future__ import annotations
 
 import io
+import math
 import os
 import re
 import subprocess
@@ -340,15 +341,19 @@ def test_a_contour_cycle_call_leaves_the_scope_and_a_tolerance_cycle_changes_not
     assert [m.end for m in followed][-2:] == [(25.0, -7.5, 21.0), (0.0, 100.0, 21.0)]
 
 
-@pytest.mark.parametrize("angle, followed", [("ROT+0", True), ("IROT+0,000", True), ("ROT+30", False)])
-def test_a_rotation_of_zero_is_followed_and_any_other_leaves_the_scope(angle, followed):
+@pytest.mark.parametrize("angle, turned", [("ROT+0", 0.0), ("IROT+0,000", 0.0), ("ROT+30", 30.0)])
+def test_cycle_10_turns_the_moves_after_it_and_a_rotation_of_zero_changes_nothing(angle, turned):
     """`CYCL DEF 10.1 ROT+0` resets cycle 10 ROTATION (Cycle Programming manual, "ROTATION (Cycle
     10)"; drunsinn/language-klartext, `programm-zirkularnut-fraesen.klartext` writes it before its
-    moves): no rotation is in effect where ncpp follows a program, so it changes nothing."""
+    moves): it changes nothing; `ROT+30` turns the moves after it about the datum (the last one's
+    X+0 Y+100 ends at 100 mm along 120 degrees), the Z move before X and Y are given in place."""
     warned = io.StringIO()
     found = moves(program(f"CYCL DEF 10.0 ROTATION\nCYCL DEF 10.1 {angle}", holes=[]), warned)
-    assert (len(found) == 4) is followed
-    assert ("CYCL DEF 10.1 (it moves the datum) is outside" in warned.getvalue()) is not followed
+    assert not warned.getvalue(), warned.getvalue()
+    assert len(found) == 4
+    assert found[-2].end == pytest.approx((25.0, -7.5, 21.0), abs=1e-12)
+    along = math.radians(90.0 + turned)
+    assert found[-1].end == pytest.approx((100 * math.cos(along), 100 * math.sin(along), 21.0), abs=1e-12)
 
 
 POCKET_4 = [  # an iTNC 530 program's cycle 4 POCKET MILLING (a DMU 50's, its blocks N35-N41)

@@ -291,7 +291,7 @@ from ncpp.motion.segments import DRILLED, FLOW, PLANE_AXES, Arc, Event, Line, Pa
 from ncpp.passes.rotary import ROTARY, turns  # noqa: E402
 from ncpp.program.blocks import Block  # noqa: E402
 from ncpp.program.dialects.editing import splice  # noqa: E402
-from ncpp.program.dialects.iso import IsoWriter, _Units, written_apart  # noqa: E402
+from ncpp.program.dialects.iso import IsoWriter, _Units, as_written, written_apart  # noqa: E402
 from ncpp.program.numbers import NumberStyle, format_number, style_pattern  # noqa: E402
 
 _AXES = "XYZ"
@@ -391,7 +391,8 @@ class HeidenhainWriter(IsoWriter):
         ):
             yield from self._header_first(block, self.header)
         self._learn_styles(block)
-        motion = [e for e in group if type(e) is Line or type(e) is Arc]
+        # (under Cycle 10's rotation in the program's own frame, which the control turns: ISO's `as_written`)
+        motion = [as_written(e) for e in group if type(e) is Line or type(e) is Arc]
         pole = next((e for e in reversed(group) if type(e) is Pole), None)  # (a call's: its last)
         _, function = _function(block)
         edited_before = self.edited_last
