@@ -689,7 +689,7 @@ class Flow:
             index += 1
             if self._block(frame, index) is None:
                 return
-        if lines is None or lines[0] is not block or any(self._control_of(b) is not None for b in lines[1:-1]):
+        if lines is None or lines[0] is not block or any(self._control_of(b) for b in lines[1:-1]):
             return
         self.ahead[name] = lines
         once.meet(name, lines)
@@ -727,7 +727,7 @@ class Flow:
             self.defined_at.setdefault(name, body[0].line)
         once = self._runs_once(frame, block, name, body, 1)
         if not once and name in self.ahead:
-            self.once.refuse(name)  # type: ignore[union-attr]  # (its definition waits no more)
+            self.once.refuse(name)  # (its definition waits no more)
 
         def call():
             frame.pc += 1

@@ -29,10 +29,10 @@ class OnceRuns:
     reading of a written program looks only for those the input's reading found (`only`), whose
     runs it holds to `held_most` events (the written lines of a run are more than the input's).
 
-    A definition the flow meets before its call (`Flow._sub`) waits (`waiting`): the writer holds
-    the lines written from its text on (`ahead`: the ids of its lines) until its run is told, to
-    write the run there, or it is told to stay as programmed (`programmed`: called again or
-    never, or the events from the first definition waiting passed `held_most`)."""
+    A definition the flow meets before its call (`Flow._wait_for_call`) waits (`waiting`): the
+    writer holds the lines written from its text on (`ahead`: the ids of its lines) until its run
+    is told, to write the run there, or it is told to stay as programmed (`programmed`: called
+    again or never, or the events from the first definition waiting passed `held_most`)."""
 
     blocks: set[int] = field(default_factory=set)
     names: set[str] = field(default_factory=set)

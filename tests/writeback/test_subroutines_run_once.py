@@ -53,7 +53,7 @@ BEFORE = {
     + "o<side> call\no<body> call [160] [120]\nG1 X-100 Y150\nG0 Z10\nM2\n",
     "one before and one after": "o<body> sub\n" + BODY + "o<body> endsub\n" + HEAD
     + "o<body> call [160] [120]\no<side> call\nG1 X-100 Y150\nG0 Z10\nM2\n" + SIDE,
-}
+}  # fmt: skip
 TWICE_BEFORE = (
     "o<body> sub\n"
     + BODY
@@ -100,7 +100,9 @@ def test_a_subroutine_defined_before_and_never_called_is_written_as_it_stands(tm
     assert "loop or subroutine" not in warned.getvalue()
 
 
-@pytest.mark.parametrize(("name", "program"), [("called twice", TWICE), ("defined before, called twice", TWICE_BEFORE)])
+@pytest.mark.parametrize(
+    ("name", "program"), [("called twice", TWICE), ("defined before, called twice", TWICE_BEFORE)]
+)
 def test_a_subroutine_called_twice_stays_as_programmed(tmp_path, name, program):
     warned = io.StringIO()
     original, output = _compensated(tmp_path, program, warnings=Warnings(stream=warned))
@@ -114,7 +116,9 @@ def test_a_subroutine_called_twice_stays_as_programmed(tmp_path, name, program):
     assert check.returncode == 0, check.stdout + check.stderr
 
 
-@pytest.mark.parametrize("program", [ONCE["an o-word subroutine after M2"], DEFINED_BEFORE], ids=["after", "before"])
+@pytest.mark.parametrize(
+    "program", [ONCE["an o-word subroutine after M2"], DEFINED_BEFORE], ids=["after", "before"]
+)
 def test_the_events_held_past_the_bound_leave_the_run_as_programmed(tmp_path, monkeypatch, program):
     monkeypatch.setattr(once_module, "MAX_ONCE", 3)
     warned = io.StringIO()
@@ -220,7 +224,8 @@ def test_a_long_run_defined_before_its_call_is_verified_chunk_by_chunk(tmp_path,
     where the writer wrote it: the verifier reads the written program in the same chunks.  (The
     events from the definition to the program's end, its text and its run among them, fit MAX_ONCE.)"""
     text = ("o<body> sub\nG1 X10 Y10 F500\n" + _circle(body, 30, -100) + "o<body> endsub\n" + HEAD
-            + _circle(before, 50, 100) + "o<body> call\n" + _circle(after, 40, 150) + "G0 Z10\nM2\n")  # fmt: skip
+            + _circle(before, 50, 100) + "o<body> call\n" + _circle(after, 40, 150)
+            + "G0 Z10\nM2\n")  # fmt: skip
     warned = io.StringIO()
     original, output = _compensated(tmp_path, text, warnings=Warnings(stream=warned))
     assert "loop or subroutine" not in warned.getvalue()
@@ -230,7 +235,9 @@ def test_a_long_run_defined_before_its_call_is_verified_chunk_by_chunk(tmp_path,
 
 
 @pytest.mark.parametrize("breaking", ["a line of the run left out", "the run's lines in reverse"])
-def test_the_verifier_refuses_a_run_written_wrong_at_a_definition_before_its_call(tmp_path, monkeypatch, breaking):
+def test_the_verifier_refuses_a_run_written_wrong_at_a_definition_before_its_call(
+    tmp_path, monkeypatch, breaking
+):
     from ncpp.errors import NcppError
     from ncpp.program.dialects import iso
 
