@@ -311,7 +311,10 @@ def sections(events: Iterable[Event], bound: Bound, cut: Cut = lambda block, mov
             last = block
             run += 1
             into = 0 if divisible is not None and divisible(event) else -1
-            if moves.lines and (at := cut(block, len(moves.lines), run, 0)):
+            # (not before text that does not run: a definition's lines written with its run where it
+            # stands are tagged as where the run is, further on)
+            runs_here = not (kind is Pass and event.skipped)  # type: ignore[union-attr]
+            if moves.lines and runs_here and (at := cut(block, len(moves.lines), run, 0)):
                 yield moves.chunk(at, first_line)
                 moves, first_line = _Moves(bound), block.line
             if not (kind is Pass and event.skipped) and _may_act(block.signature):  # type: ignore[union-attr]

@@ -215,16 +215,19 @@ def test_a_long_run_is_verified_chunk_by_chunk_where_it_runs(tmp_path, before, a
 
 
 @pytest.mark.parametrize(
-    ("before", "after", "body"),
-    [(2000, 2000, 2000), (200, 300, 4400), (5000, 100, 300), (100, 5000, 300)],
-    ids=["even", "long body", "long main before", "long main after"],
-)
-def test_a_long_run_defined_before_its_call_is_verified_chunk_by_chunk(tmp_path, before, after, body):
+    ("ahead", "before", "after", "body"),
+    [(0, 2000, 2000, 2000), (0, 200, 300, 4400), (0, 5000, 100, 300), (0, 100, 5000, 300),
+     (3000, 3000, 500, 50), (1000, 2000, 2000, 2000)],
+    ids=["even", "long body", "long main before", "long main after", "defined mid-chunk", "defined mid-run"],
+)  # fmt: skip
+def test_a_long_run_defined_before_its_call_is_verified_chunk_by_chunk(tmp_path, ahead, before, after, body):
     """The lines held from the definition on are handed out after the run's lines, each tagged as
-    where the writer wrote it: the verifier reads the written program in the same chunks.  (The
-    events from the definition to the program's end, its text and its run among them, fit MAX_ONCE.)"""
-    text = ("o<body> sub\nG1 X10 Y10 F500\n" + _circle(body, 30, -100) + "o<body> endsub\n" + HEAD
-            + _circle(before, 50, 100) + "o<body> call\n" + _circle(after, 40, 150)
+    where the writer wrote it: the verifier reads the written program in the same chunks (a chunk
+    may end between the definition and the call, the definition's lines tagged as where the run is).
+    The events from the definition to the program's end, its text and its run among them, fit
+    MAX_ONCE; `ahead` moves come before the definition."""
+    text = (HEAD + _circle(ahead, 50, 100) + "o<body> sub\nG1 X10 Y10 F500\n" + _circle(body, 30, -100)
+            + "o<body> endsub\n" + _circle(before, 50, 100) + "o<body> call\n" + _circle(after, 40, 150)
             + "G0 Z10\nM2\n")  # fmt: skip
     warned = io.StringIO()
     original, output = _compensated(tmp_path, text, warnings=Warnings(stream=warned))
