@@ -91,6 +91,23 @@ def test_a_subroutine_defined_before_its_one_call_is_compensated_where_it_is_def
     assert check.returncode == 0, check.stdout + check.stderr
 
 
+def test_of_two_defined_before_their_calls_the_one_called_once_is_compensated(tmp_path):
+    """The lines held wait for both definitions: the one called twice is told to stay as
+    programmed, the other's run is written at its definition."""
+    calls = "o<side> call\no<body> call [160] [120]\no<side> call\nG1 X-100 Y150\nG0 Z10\nM2\n"
+    program = "o<body> sub\n" + BODY + "o<body> endsub\n" + SIDE + HEAD + calls
+    warned = io.StringIO()
+    original, output = _compensated(tmp_path, program, warnings=Warnings(stream=warned))
+    misses = _misses_um(original, output)
+    ends = _feed_ends(original)[:, None, :]
+    side = np.any(np.all(np.isclose(ends, [[-40, -20, -2], [0, -160, -2]]), axis=2), axis=1)
+    assert misses[side].max() > 2.0 and misses[~side].max() <= 0.5  # (one side point is near the zero)
+    assert SIDE in output.read_text() and BODY not in output.read_text()
+    assert "warning: loop or subroutine" in warned.getvalue()
+    check = _pathcheck(original, output, "--tol-mm", "0.02")
+    assert check.returncode == 0, check.stdout + check.stderr
+
+
 def test_a_subroutine_defined_before_and_never_called_is_written_as_it_stands(tmp_path):
     program = "o<body> sub\n" + BODY + "o<body> endsub\n" + HEAD + "G1 X-100 Y150\nG0 Z10\nM2\n"
     warned = io.StringIO()

@@ -190,32 +190,34 @@ class _AtDefinition:
         return []
 
     def _hold(self, group: list[Event], key: int) -> Iterable[str]:
+        """A group while lines are held, or a line of a definition's text met before its call."""
         first = group[0]
         name = self.runs.ahead.get(key)
-        run = None  # the name whose run's line this is
-        if name is not None and type(first) is Pass and first.skipped:  # its definition's text
-            piece = (list(self.write_group(group)), self._state())
-            if name in self.runs.programmed:
-                if self.held is None:
-                    return piece[0]
-                self.held.append(piece)
-            else:
-                if self.held is None:
-                    self.held = []
-                self.names.add(name)
-                self.held.append(_Text(key, name, piece))
-        elif name is not None and key in self.runs.blocks and name in self.names:  # its run
+        text = name is not None and type(first) is Pass and first.skipped  # the definition's text
+        run = name if not text and name in self.names and key in self.runs.blocks else None  # its run
+        # (told since the last group: what is held goes first, and this group may start another hold)
+        pieces = self._released() if self.held is not None and self._told(run) else []
+        if text and name is not None and name not in self.runs.programmed:
+            if self.held is None:
+                self.held = []
+            self.names.add(name)
+            self.held.append(_Text(key, name, (list(self.write_group(group)), self._state())))
+        elif run is not None:
             self.ran.setdefault(key, []).append((list(self.write_group(group)), self._state()))
-            self.written.add(run := name)
-        elif self.held is None:
-            return self.write_group(group)
+            self.written.add(run)
         else:
-            self.held.extend(self._after(key, group) if key in self.runs.blocks else
-                             [(list(self.write_group(group)), self._state())])  # fmt: skip
+            lines = (self._after(key, group) if key in self.runs.blocks else
+                     [(list(self.write_group(group)), self._state())])  # fmt: skip
+            (pieces if self.held is None else self.held).extend(lines)
+        if self.held is not None and self._told(run):
+            pieces += self._released()
+        return self._placed(pieces) if pieces else ()
+
+    def _told(self, run: str | None) -> bool:
+        """Whether each definition the lines held wait for is told: to stay as programmed, or its
+        run's lines written (but `run`'s, whose lines are coming)."""
         programmed = self.runs.programmed
-        if all(n in programmed or (n in self.written and n != run) for n in self.names):
-            return self._placed(self._released())
-        return ()
+        return all(n in programmed or (n in self.written and n != run) for n in self.names)
 
     def _released(self) -> list[Piece]:
         """The lines held, a run's in place of its definition's text, and no more held."""
