@@ -35,7 +35,8 @@ writer may be a block ahead of the lines it hands out, each side of a chunk is
 also compared with the other side's samples just across the cut.  A loop's or a
 call's runs are its control line's moves, cut at the same counts on both sides; the
 one run of a subroutine written where its definition stands (`Interpreter.run`) is
-read so on both sides, its lines tagged as where they ran.
+read so on both sides, its lines tagged as where they ran (a definition before its call: no
+chunk ends before text that does not run, which its lines also are where they stand).
 """
 
 from __future__ import annotations
