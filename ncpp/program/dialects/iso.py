@@ -159,6 +159,7 @@ class _AtDefinition:
     ):
         self.write_group = write_group
         self.runs = runs
+        self.ahead, self.blocks = runs.ahead, runs.blocks  # (filled in place as the reading goes on)
         self.stamps = stamps
         self.kept: dict[int, Piece] = {}  # a run's lines, by its block's id, until its definition's text
         self.held: list[Piece | _Text] | None = None  # the lines from a definition before its call on
@@ -168,8 +169,8 @@ class _AtDefinition:
 
     def write(self, group: list[Event]) -> Iterable[str]:
         key = id(group[0].block)
-        if self.held is None and key not in self.runs.ahead:
-            if key not in self.runs.blocks:
+        if self.held is None and key not in self.ahead:
+            if key not in self.blocks:
                 return self.write_group(group)
             return self._placed(self._after(key, group))
         return self._hold(group, key)
