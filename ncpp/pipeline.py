@@ -424,7 +424,7 @@ def process(
     stats.summary = summary = Summary(file)
     warnings.listeners.append(summary.heard)
     writer = writer_class()
-    writer.at_definition = runs.blocks if runs is not None else None
+    writer.once_runs = runs
     reached = _Reached()  # (how far the writer has read: the verifier tags the written lines by it)
     writer.stamps = reached
     writer.unpositioned = lambda axes, block: warnings.warn(
@@ -544,7 +544,7 @@ class _Reached:
 
     def pin(self, state: tuple[int, int, int] | None) -> None:
         """Tag the lines handed out from now with `state` (a subroutine's run written at its
-        definition: `IsoWriter.at_definition`); None: with the state again."""
+        definition: `iso._AtDefinition`); None: with the state again."""
         self.pinned = state
 
     def __call__(self) -> tuple[int, int, int]:

@@ -35,7 +35,8 @@ writer may be a block ahead of the lines it hands out, each side of a chunk is
 also compared with the other side's samples just across the cut.  A loop's or a
 call's runs are its control line's moves, cut at the same counts on both sides; the
 one run of a subroutine written where its definition stands (`Interpreter.run`) is
-read so on both sides, its lines tagged as where they ran.
+read so on both sides, its lines tagged as where they ran (a definition before its call: no
+chunk ends before text that does not run, which its lines also are where they stand).
 """
 
 from __future__ import annotations
@@ -312,7 +313,10 @@ def sections(events: Iterable[Event], bound: Bound, cut: Cut = lambda block, mov
             last = block
             run += 1
             into = 0 if divisible is not None and divisible(event) else -1
-            if moves.lines and (at := cut(block, len(moves.lines), run, 0)):
+            # (not before text that does not run: a definition's lines written with its run where it
+            # stands are tagged as where the run is, further on)
+            runs_here = not (kind is Pass and event.skipped)  # type: ignore[union-attr]
+            if moves.lines and runs_here and (at := cut(block, len(moves.lines), run, 0)):
                 yield moves.chunk(at, first_line)
                 moves, first_line = _Moves(bound), block.line
             if not (kind is Pass and event.skipped) and _may_act(block.signature):  # type: ignore[union-attr]

@@ -11,9 +11,10 @@ with what the interpreter is to do with it (`kind`):
   body ran once, its moves may be rewritten for that run as RUN's; a block run
   again, FIXED: they are left as programmed as FIXED's);
 * CALLED — execute it in the first run of a subroutine called from straight code whose
-  definition stands after the call (`_runs_once`): its owner is the call; if no other call runs
-  it before the program ends, its text ran once and may be rewritten for that run where it
-  stands (`called_again` names the subroutines another call ran);
+  definition stands after the call, or before it where the program met it in straight code
+  (`_runs_once`, `_wait_for_call`): its owner is the call; if no other call runs it before the
+  program ends, its text ran once and may be rewritten for that run where it stands
+  (`called_again` names the subroutines another call ran);
 * SKIP  — write its text; it does not run (an untaken branch, a subroutine's
   definition, a loop that runs no time);
 * TEXT  — write its text: a control line this module has executed
@@ -87,6 +88,7 @@ from ncpp.errors import Location, NcppError, printable
 from ncpp.motion.endless import Journal, Revisits, endless, exact, never_changes, without_way_out
 from ncpp.motion.expressions import SUBROUTINE_PARAMETERS, normalise_name, round_half_away, vacant
 from ncpp.motion.modal import OutOfScope
+from ncpp.motion.once import OnceRuns
 from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
 from ncpp.program.parser import parse_stream
 
@@ -249,7 +251,7 @@ class Flow:
         state: Callable[[], object] | None = None,
         position: Callable[[], object] = lambda: None,
         repeats_in_p: bool = False,
-        once_calls: Callable[[str], bool] | None = None,
+        once: OnceRuns | None = None,
     ):
         self.file, self.evaluate, self.parameters, self.done, self.stop, self.path = (
             file,
@@ -308,9 +310,9 @@ class Flow:
         # the blocks read ahead); a verbatim block after them stands after the closing `%`
         self.leader = 0
         self.repeats_in_p = repeats_in_p  # Fanuc: `M98 P51002` runs O1002 five times (`_m98`)
-        self.once_calls = (
-            once_calls  # whether a subroutine's first run may be CALLED (`_runs_once`; None: none)
-        )
+        self.once = once  # the subroutines whose first run may be CALLED (`_runs_once`; None: none)
+        # definitions met before any call of them that wait for it (`_wait_for_call`): name -> lines
+        self.ahead: dict[str, list[Block]] = {}
         self.ran: set[str] = set()  # the subroutines a call has run (o-word calls, M98, G65, G66)
         self.called_again: list[str] = []  # the CALLED subroutines another call has run since told
         self.once_called: set[str] = set()  # the subroutines whose first run was CALLED
@@ -421,11 +423,12 @@ class Flow:
         """Whether a call may be its subroutine's only run, whose text may then be rewritten for
         it where the definition stands: one run, called from the main program's straight code in its
         place, the subroutine's first, defined in the program's own text after the call (where the
-        program's end comes before its text is written), with no control line in its body (no
+        program's end comes before its text is written) or before it, met in straight code
+        (`_wait_for_call`: the writer holds its text), with no control line in its body (no
         loop, branch, call or return: each of its lines runs once, in order)."""
         return (
-            self.once_calls is not None
-            and self.once_calls(name)
+            self.once is not None
+            and self.once.may_run_once(name)
             and runs == 1
             and frame.space is None
             and len(self.frames) == 1
@@ -436,7 +439,7 @@ class Flow:
             and name not in self.ran
             and name not in self.files
             and self._source_of(body) is None
-            and body[0].line > block.line
+            and (body[0].line > block.line or self.ahead.get(name) is body)
             and all(self._control_of(b) is None for b in body[1:-1])
         )
 
@@ -652,6 +655,7 @@ class Flow:
             if first != -1:
                 raise self._error(f"sub redefines the subroutine defined in line {first}", block, control)
             self.defined_at[control.name] = block.line
+            self._wait_for_call(frame, block, control.name)
 
         def skip():
             yield from self._skip_definition(frame, control.name)
@@ -662,6 +666,33 @@ class Flow:
                 self.subroutines[control.name] = met
 
         return skip
+
+    def _wait_for_call(self, frame: _Frame, block: Block, name: str) -> None:
+        """A definition the main program's straight code meets before any call of it, whose lines
+        (read ahead to its endsub, at most `held_most`) hold no control line: if the program calls
+        it once, its run may be written here (`OnceRuns.meet`: the writer holds the lines from here
+        on until the run is told).  Whether it is called once is known only at the program's end."""
+        once = self.once
+        if (
+            once is None
+            or not once.may_run_once(name)
+            or not self.in_straight_code()
+            or not self._in_place(frame)
+            or self.modal is not None
+            or frame.pc in self.looped
+            or name in self.ran
+            or name in self.files
+        ):
+            return
+        index = frame.pc
+        while (lines := self._definitions.get(block.line)) is None and index - frame.pc < once.held_most:
+            index += 1
+            if self._block(frame, index) is None:
+                return
+        if lines is None or lines[0] is not block or any(self._control_of(b) for b in lines[1:-1]):
+            return
+        self.ahead[name] = lines
+        once.meet(name, lines)
 
     def _endsub(self, frame, block, control, arrived):
         return self._return(frame, block, control, arrived)
@@ -695,6 +726,8 @@ class Flow:
         if name not in self.files:  # (a file's definition is no line of the program)
             self.defined_at.setdefault(name, body[0].line)
         once = self._runs_once(frame, block, name, body, 1)
+        if not once and name in self.ahead:
+            self.once.refuse(name)  # (its definition waits no more)
 
         def call():
             frame.pc += 1

@@ -401,7 +401,9 @@ class Interpreter:
         after them held until the program ends: if no other call ran it (`Flow.called_again`), its
         text ran once and is rewritten for that run where its definition stands (`once_runs`);
         else, or where the program leaves the scope or the events held pass `once_runs.held_most`,
-        its moves are left as programmed, as a FIXED run's."""
+        its moves are left as programmed, as a FIXED run's.  A definition met before its call waits
+        (`OnceRuns.waiting`: the writer holds its lines): it stays as programmed too where the events
+        from the first one waiting pass `held_most` (the lines the writer holds are bounded)."""
         runs = self.once_runs
         if runs is None:  # (no run is CALLED)
             yield from self._run(blocks, warnings)  # type: ignore[misc]
@@ -410,7 +412,17 @@ class Interpreter:
         pending: set[str] = set()  # the CALLED subroutines among the events held
         again: set[str] = set()
         programmed: set[str] = set()  # those told to stay as programmed (the rest of a run too)
+        waited = 0  # events since a definition met before its call began to wait
         for item in self._run(blocks, warnings):
+            if runs.waiting:
+                waited += 1
+                if self.done:  # (never called; one whose run is held is told with it, below)
+                    for name in runs.waiting - pending:
+                        runs.refuse(name)
+                elif waited > runs.held_most:
+                    again |= runs.refuse_waiting()  # (a run under way is told so, the rest of it too)
+            else:
+                waited = 0
             run, event = item if type(item) is tuple else (None, item)
             if run is not None and run[0] in programmed:  # (the rest of a run told past the bound)
                 kept = _as_programmed(event, run[1])
@@ -430,6 +442,8 @@ class Interpreter:
                 programmed |= told
                 yield from self._told_runs(held, told)
                 held, pending, again = [], set(), set()
+        for name in runs.waiting - pending:  # (never called)
+            runs.refuse(name)
         if held:
             yield from self._told_runs(held, again if self.ended else pending)
 
@@ -442,12 +456,12 @@ class Interpreter:
             if run is None:
                 yield event
             elif run[0] in again:
+                self.once_runs.refuse(run[0])  # type: ignore[union-attr]  # (CALLED: given)
                 kept = _as_programmed(event, run[1])
                 if kept is not None:
                     yield kept
             else:
-                self.once_runs.names.add(run[0])  # type: ignore[union-attr]  # (CALLED: given)
-                self.once_runs.blocks.add(id(event.block))  # type: ignore[union-attr]
+                self.once_runs.ran_once(run[0], event.block)  # type: ignore[union-attr]
                 yield event
 
     def _run(self, blocks: Iterable[Block], warnings: Warnings) -> Iterator[Event | tuple]:
@@ -465,7 +479,7 @@ class Interpreter:
         flow = self.flow = Flow(
             self.file, self._evaluate, self.params, lambda: self.done, self._leave_scope,
             self.subroutine_path, state=self._loop_state, position=lambda: self.pos[:],
-            repeats_in_p=self.repeats_in_p, once_calls=None if self.once_runs is None else self.once_runs.may_run_once,
+            repeats_in_p=self.repeats_in_p, once=self.once_runs,
         )  # fmt: skip
         self.rounding = False
         expansion = self.expansion
@@ -482,6 +496,7 @@ class Interpreter:
                     or once is not None
                 ):
                     flow.called_again.append(called[0])  # type: ignore[arg-type]  # (the run as a FIXED one)
+                    self.once_runs.refuse(called[0])  # type: ignore[union-attr,arg-type]
                     kind, called = FIXED, None
             if once is not None and (self.done or flow.in_straight_code() or once.full()):
                 yield from self._told(once, again=(self.done and not self.ended) or once.full())
@@ -528,6 +543,7 @@ class Interpreter:
                     self.corner is not None or _sets_offset(event) or self._compensating()
                 ):
                     flow.called_again.append(called[0])  # type: ignore[arg-type]  # the run as a FIXED one
+                    self.once_runs.refuse(called[0])  # type: ignore[union-attr,arg-type]
                     kind, called = FIXED, None
                 if kind is FIXED and expansion is None:
                     event = self._in_flow(event, owner)

@@ -27,15 +27,46 @@ class OnceRuns:
     """The subroutines whose one run a reading finds, to be written where their definition stands
     (`Interpreter.run`): their names and the ids of their blocks (which the writer places).  A
     reading of a written program looks only for those the input's reading found (`only`), whose
-    runs it holds to `held_most` events (the written lines of a run are more than the input's)."""
+    runs it holds to `held_most` events (the written lines of a run are more than the input's).
+
+    A definition the flow meets before its call (`Flow._wait_for_call`) waits (`waiting`): the
+    writer holds the lines written from its text on (`ahead`: the ids of its lines) until its run
+    is told, to write the run there, or it is told to stay as programmed (`programmed`: called
+    again or never, or the events from the first definition waiting passed `held_most`)."""
 
     blocks: set[int] = field(default_factory=set)
     names: set[str] = field(default_factory=set)
     only: set[str] | None = None
     held_most: int = field(default_factory=lambda: MAX_ONCE)
+    ahead: dict[int, str] = field(default_factory=dict)  # id of a line of a waiting definition -> its name
+    waiting: set[str] = field(default_factory=set)
+    programmed: set[str] = field(default_factory=set)
 
     def may_run_once(self, name: str) -> bool:
-        return self.only is None or name in self.only
+        return (self.only is None or name in self.only) and name not in self.programmed
+
+    def meet(self, name: str, lines: list[Block]) -> None:
+        """A definition met before any call of it, `sub` to `endsub`: it waits for its run."""
+        self.ahead.update((id(line), name) for line in lines)
+        self.waiting.add(name)
+
+    def ran_once(self, name: str, block: Block) -> None:
+        """`block` ran in the one run of `name`: written where the definition stands."""
+        self.names.add(name)
+        self.blocks.add(id(block))
+        self.waiting.discard(name)
+
+    def refuse(self, name: str) -> None:
+        """`name` stays as programmed (its run, if any, is told so: a FIXED one's)."""
+        if name not in self.names:
+            self.programmed.add(name)
+            self.waiting.discard(name)
+
+    def refuse_waiting(self) -> set[str]:
+        """All definitions waiting stay as programmed: those refused."""
+        refused, self.waiting = self.waiting, set()
+        self.programmed |= refused
+        return refused
 
 
 class FirstPass:

@@ -375,7 +375,8 @@ def test_an_additional_work_offset_the_program_selects_is_checked_at_its_variabl
     [
         ("G21 G90\nG55\nG0 X10 Y10 Z5\nG10 L2 P2 X1 Y2 Z3\nG54\nG55\nG0 X20\nM2\n", ["G55", "G54"]),
         ("G21 G90\nG10 L2 P2 X1 Y2 Z3\nG55\nG0 X10 Y10 Z5\nM2\n", []),  # G55 is the program's
-        ("o<s> sub\nG55\no<s> endsub\nG21 G90\nG0 X10 Y10 Z5\no<s> call\nG0 X20\nM2\n", ["G54"]),
+        # (a subroutine run once is written with its run where it is defined: G55 is checked there)
+        ("o<s> sub\nG55\no<s> endsub\nG21 G90\nG0 X10 Y10 Z5\no<s> call\nG0 X20\nM2\n", ["G54", "G55"]),
         ("G21 G90\nT1 M6 G43\nG56\nG0 X10 Y10 Z5\nM2\n", []),  # G56 not told: warned where it is selected
     ],
 )  # fmt: skip

@@ -18,6 +18,7 @@ from operator import itemgetter
 from typing import Protocol
 
 from ncpp.motion.cycles import CANNED
+from ncpp.motion.once import OnceRuns
 from ncpp.motion.segments import (
     CYCLE,
     DRILLED,
@@ -126,33 +127,123 @@ class Stamps(Protocol):
     def pin(self, state: tuple[int, int, int] | None) -> None: ...
 
 
-def _at_definition(
-    write_group: Callable[[list[Event]], Iterable[str]], blocks: set[int], stamps: Stamps | None
-) -> Callable[[list[Event]], Iterable[str]]:
-    """`write_group`, with the lines of a block among `blocks` (a subroutine's, whose one run came
-    before its definition's text: `Interpreter.run`) kept from its run and written in place of its
-    text where the definition stands, tagged (`stamps`) as where the writer had read when it wrote
-    them: the verifier cuts the run into the same chunks as the input's."""
-    kept: dict[int, tuple[list[str], tuple[int, int, int] | None]] = {}
+Piece = tuple[list[str], "tuple[int, int, int] | None"]  # written lines and their tag (None: no stamps)
 
-    def placed(lines: list[str], state: tuple[int, int, int] | None) -> Iterator[str]:
-        if stamps is None:
-            yield from lines
-            return
-        stamps.pin(state)
-        yield from lines
-        stamps.pin(None)
 
-    def write(group: list[Event]) -> Iterable[str]:
+class _Text:
+    """A line of a definition's text held (`_AtDefinition`): written so unless its run stands in
+    its place."""
+
+    __slots__ = ("key", "name", "piece")
+
+    def __init__(self, key: int, name: str, piece: Piece):
+        self.key, self.name, self.piece = key, name, piece
+
+
+class _AtDefinition:
+    """`write_group`, with the one run of a subroutine (`Interpreter.run`, `OnceRuns`) written where
+    its definition stands, each line tagged (`stamps`) as where the writer had read when it wrote it:
+    the verifier cuts the run into the same chunks as the input's.  The run's lines are written
+    where the run comes (the writer's state follows the program as it runs) and placed:
+
+    * a definition after the call: the lines of a block among `runs.blocks` are kept from its run
+      and written in place of its text;
+    * a definition before the call (`runs.ahead`): the lines from its text on are held until its
+      run has been written, then written with the run's lines in place of its text, the lines held
+      after them; one told to stay as programmed (`runs.programmed`) keeps its text.  What is held
+      is bounded: `Interpreter.run` tells a definition as programmed where the events from the first
+      one waiting pass `runs.held_most`."""
+
+    def __init__(
+        self, write_group: Callable[[list[Event]], Iterable[str]], runs: OnceRuns, stamps: Stamps | None
+    ):
+        self.write_group = write_group
+        self.runs = runs
+        self.ahead, self.blocks = runs.ahead, runs.blocks  # (filled in place as the reading goes on)
+        self.stamps = stamps
+        self.kept: dict[int, Piece] = {}  # a run's lines, by its block's id, until its definition's text
+        self.held: list[Piece | _Text] | None = None  # the lines from a definition before its call on
+        self.names: set[str] = set()  # the definitions the lines held wait for
+        self.ran: dict[int, list[Piece]] = {}  # the run's lines of a line held, by the line's id
+        self.written: set[str] = set()  # those of the names whose run's lines came
+
+    def write(self, group: list[Event]) -> Iterable[str]:
         key = id(group[0].block)
-        if key not in blocks:
-            return write_group(group)
-        if key in kept:  # (the definition's text)
-            return placed(*kept.pop(key))
-        kept[key] = (list(write_group(group)), stamps.state if stamps is not None else None)
-        return ()
+        if self.held is None and key not in self.ahead:
+            if key not in self.blocks:
+                return self.write_group(group)
+            return self._placed(self._after(key, group))
+        return self._hold(group, key)
 
-    return write
+    def finish(self) -> Iterable[str]:
+        """The lines still held where the program's lines end (a definition never told: its text)."""
+        return () if self.held is None else self._placed(self._released())
+
+    def _state(self) -> tuple[int, int, int] | None:
+        return self.stamps.state if self.stamps is not None else None
+
+    def _after(self, key: int, group: list[Event]) -> list[Piece]:
+        """A block of a run whose definition comes after it: its lines kept, then at the definition's
+        text, written there."""
+        if key in self.kept:  # (the definition's text)
+            return [self.kept.pop(key)]
+        self.kept[key] = (list(self.write_group(group)), self._state())
+        return []
+
+    def _hold(self, group: list[Event], key: int) -> Iterable[str]:
+        """A group while lines are held, or a line of a definition's text met before its call."""
+        first = group[0]
+        name = self.runs.ahead.get(key)
+        text = name is not None and type(first) is Pass and first.skipped  # the definition's text
+        run = name if not text and name in self.names and key in self.runs.blocks else None  # its run
+        # (told since the last group: what is held goes first, and this group may start another hold)
+        pieces = self._released() if self.held is not None and self._told(run) else []
+        if text and name is not None and name not in self.runs.programmed:
+            if self.held is None:
+                self.held = []
+            self.names.add(name)
+            self.held.append(_Text(key, name, (list(self.write_group(group)), self._state())))
+        elif run is not None:
+            self.ran.setdefault(key, []).append((list(self.write_group(group)), self._state()))
+            self.written.add(run)
+        else:
+            lines = (self._after(key, group) if key in self.runs.blocks else
+                     [(list(self.write_group(group)), self._state())])  # fmt: skip
+            (pieces if self.held is None else self.held).extend(lines)
+        if self.held is not None and self._told(run):
+            pieces += self._released()
+        return self._placed(pieces) if pieces else ()
+
+    def _told(self, run: str | None) -> bool:
+        """Whether each definition the lines held wait for is told: to stay as programmed, or its
+        run's lines written (but `run`'s, whose lines are coming)."""
+        programmed = self.runs.programmed
+        return all(n in programmed or (n in self.written and n != run) for n in self.names)
+
+    def _released(self) -> list[Piece]:
+        """The lines held, a run's in place of its definition's text, and no more held."""
+        pieces: list[Piece] = []
+        for item in self.held or ():
+            if type(item) is _Text:
+                ran = self.ran.pop(item.key, None) if item.name in self.written else None
+                pieces += ran or [item.piece]
+            else:
+                pieces.append(item)  # type: ignore[arg-type]
+        self.held, self.ran = None, {}
+        self.names.clear()
+        self.written.clear()
+        return pieces
+
+    def _placed(self, pieces: list[Piece]) -> Iterator[str]:
+        stamps = self.stamps
+        if stamps is None:
+            for lines, _ in pieces:
+                yield from lines
+            return
+        for lines, state in pieces:
+            stamps.pin(state)
+            yield from lines
+        stamps.pin(None)
 
 
 def _none(events: list[Event]) -> list[str]:
@@ -190,8 +281,8 @@ class IsoWriter:
         # move leaves out its correction along them (`_tell_unpositioned`: "Y" or "X and Y")
         self.unpositioned: Callable[[str, Block], None] | None = None
         self._told_unpositioned: set[str] = set()
-        # the blocks of subroutines run once, written where their definition stands (`_at_definition`)
-        self.at_definition: set[int] | None = None
+        # the subroutines run once, written where their definition stands (`_AtDefinition`)
+        self.once_runs: OnceRuns | None = None
         self.stamps: Stamps | None = None  # how far it has read, where a verifier tags its lines by it
         # Per layout of a plain block's text (`DIGITS_AS_ONE`): what its numbers teach, see `_read_layout`.
         self._layouts: dict[bytes, tuple] = {}
@@ -242,8 +333,10 @@ class IsoWriter:
             ahead, behind = before or _none, after or _none
             written = lambda group: [*ahead(group), *self._write_group(group), *behind(group)]  # noqa: E731
         write_group = _lines_ended(written)
-        if self.at_definition is not None:
-            write_group = _at_definition(write_group, self.at_definition, self.stamps)
+        placing = None
+        if self.once_runs is not None:
+            placing = _AtDefinition(write_group, self.once_runs, self.stamps)
+            write_group = placing.write
         control = False  # the group is a control line's, whose writing reads only its first event
         ran = self._ran if type(self)._ran is not IsoWriter._ran else None  # (ISO's does nothing)
         for event in events:
@@ -263,6 +356,8 @@ class IsoWriter:
                 group, control = [], True
         if group:
             yield from write_group(group)
+        if placing is not None:
+            yield from placing.finish()
 
     def _tell_unpositioned(self, block: Block, motion: list[Line | Arc]) -> None:
         """Before a compensated block that feeds is written: tell `unpositioned` of the axes X Y Z
