@@ -196,7 +196,6 @@ class FanucInterpreter(Interpreter):
     # Polar coordinates, scaling, programmable mirror image and coordinate rotation cancel (Fanuc Series
     # 0i-MD operator's manual, G code list: G15, G50, G50.1, G69)
     idle_cancels = frozenset((15.0, 50.0, 50.1, 69.0))
-    bare_operations = True  # `#1 = #2 * 2`, `X#140/2` (Fanuc macro B: brackets only group)
 
     def _cancels_nothing(self, code: float, block: Block) -> bool:
         if code == 69.0:

@@ -290,9 +290,6 @@ class Interpreter:
     # Codes that cancel a mode ncpp does not follow (which, while it interprets, is not in effect): in a
     # block they cancel nothing and are passed over (Fanuc's and Haas's safety lines, `G40 G49 G69 G80`)
     idle_cancels: frozenset[float] = frozenset()
-    # A binary operation stands only inside brackets in rs274ngc (`#1 = [#2 * 2]`; `#1 = #2 * 2` and
-    # `X#2+1` are "Bad character '*' used"); Fanuc's macro B takes it bare
-    bare_operations = False
 
     def __init__(self, file: str = "<stdin>", offsets: WorkOffsets | None = None):
         self.file = file
@@ -875,10 +872,6 @@ class Interpreter:
                 computed: ExprWord = item  # type: ignore[assignment]  # (as above)
                 if vacant(computed.expr, self.params):  # Fanuc: `X#1`, #1 vacant, is no X word
                     continue
-                if not self.bare_operations:
-                    self._bracketed(
-                        computed.expr, block.raw[computed.start + 1 : computed.end], block, computed
-                    )
                 letter, value = computed.letter, self._evaluate(computed.expr, block, computed)
             else:
                 statement: Statement = item  # type: ignore[assignment]  # (as above)
@@ -889,9 +882,6 @@ class Interpreter:
                     statement, what = statement.node[3], "assignment"
                 if what == "assignment":
                     target, expr = statement.node
-                    if not self.bare_operations:
-                        text = block.source(statement)
-                        self._bracketed(expr, text[text.find("=") + 1 :], block, statement)
                     key = self._param_key(target, block, item)
                     if type(key) is str and not self.params.exists(key):
                         # rs274ngc creates the name (at 0) as it reads it: the rest of the line,
@@ -2252,25 +2242,6 @@ class Interpreter:
             )
 
     # -- parameters -------------------------------------------------------------------------
-    def _bracketed(self, expr: tuple, text: str, block: Block, item) -> None:
-        """Refuse a value (`text`, read as `expr`) whose binary operation stands outside brackets, as
-        rs274ngc's reader does (`bare_operations`): after its signs, such a value is one bracket group."""
-        while expr[0] == "neg" or expr[0] == "pos":
-            expr = expr[1]
-        if expr[0] != "bin":
-            return
-        text = text.strip().lstrip("+- \t")
-        depth = 0
-        for n, char in enumerate(text):
-            depth += (char == "[") - (char == "]")
-            if depth == 0:
-                if n == len(text) - 1 and char == "]":
-                    return
-                break
-        op = expr[1]  # (rs274ngc's messages: a word operator reads as a word where a value could stand)
-        said = "Unknown word where unary operation could be" if op.isalpha() else f"Bad character '{op}' used"
-        self._fail(f"{said} (a binary operation outside brackets)", block, item)
-
     def _evaluate(self, expr: tuple, block: Block, item) -> float:
         try:
             return evaluate(expr, self.params)
