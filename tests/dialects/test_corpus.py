@@ -22,7 +22,10 @@ FANUC = [CORPUS / "iso_gcode/haas_fanuc_macroB/O9250-DynamicOffsetRotation.nc"] 
     for name in ("01-basics__test.ngc", "05-M98-loops__test.ngc", "07-nested-subs__test.ngc",
                  "08-sub-follows-main__test.ngc", "09-disable-fanuc-subs__test-fanuc.ngc", "10-M98-P001__test.ngc",
                  "13-named-program__test-numbered.ngc")
-] + [CORPUS / "malformed/linuxcnc_m98m99/03-error-M98-no-P-word__test.ngc"]  # fmt: skip
+] + [CORPUS / "malformed/linuxcnc_m98m99/03-error-M98-no-P-word__test.ngc"] + [
+    # or a macro statement (`IF [..] GOTO`, `WHILE [..] DO1`) of a program named `OCIRCLE(...)`
+    CORPUS / f"iso_gcode/fanuc_macroB_sheet/{name}.NC" for name in ("7997A", "CIRCLE", "RECTANGLE")
+]  # fmt: skip
 PLAN_H = CORPUS / "heidenhain/jstjst_Heidenhain-Cycles/Plan.h"  # continuation lines, a cycle, a GPL header
 # Plain G code with `;` comments: nothing in it is Sinumerik-only, only its name tells.
 CONTENT_AMBIGUOUS = {"multiple_m_codes.mpf"}
