@@ -159,16 +159,33 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
     },
     # a second and a half or more on a 2-core machine, all parameters together
     "slow": {
+        "dialect_motion/test_heidenhain_corners.py": (
+            "test_compensated_klartext_has_explicit_arcs_and_consistent_numbers",
+        ),
+        "writeback/test_expand_cycles.py": ("test_both_commands_take_the_option",),
+        "compensation/test_rotation_dialects.py": (
+            "test_the_programmed_points_are_reached_under_a_rotation_within_half_a_micron",
+        ),
+        "compensation/test_several_programs.py": ("test_one_process_does_the_same",),
+        "compensation/test_rotation.py": (
+            "test_the_programmed_points_are_reached_under_g68_within_half_a_micron",
+            "test_a_safety_lines_cancels_of_modes_not_in_effect_change_nothing",
+        ),
         "shop/test_extents.py": None,  # (each runs the command line)
         "compensation/test_warning_order.py": None,
         "export/test_tables.py": None,
         "compensation/test_rotary_dialects.py": None,
         "motion/test_fanuc_flavours.py": (
+            "test_a_fusion_drilling_program_with_axis_words_after_g80_is_compensated_as_fanuc",
             "test_a_haas_peck_cycle_with_p_is_compensated_with_its_p_and_verified",
             "test_external_output_passes_through_the_compensated_program",
         ),
-        "compensation/test_cutter_comp_accuracy.py": ("test_mmount_contours_land_within_the_tolerance",),
+        "compensation/test_cutter_comp_accuracy.py": (
+            "test_a_z_move_under_compensation_keeps_the_tool_centre_where_it_stands",
+            "test_mmount_contours_land_within_the_tolerance",
+        ),
         "compensation/test_rigid_tap.py": (
+            "test_a_tap_rs274_refuses_is_refused",
             "test_a_machine_with_reversal_errors_gets_no_step_inside_a_tap",
             "test_the_motor_mount_written_out_cuts_twenty_times_closer",
             "test_a_tap_ncpp_cannot_follow_passes_through",
@@ -234,6 +251,7 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_corpus_programs_with_loops_expanded_run_in_rs274_as_the_originals",
         ),
         "shop/test_linuxcnc_filter.py": (
+            "test_without_machine_file_the_program_loads_unchanged",
             "test_the_parameter_file_places_the_program_as_linuxcnc_does",
             "test_the_configuration_linuxcnc_runs_gives_its_parameter_file_and_tool_table",
             "test_a_compensated_program_is_not_compensated_again",
@@ -271,6 +289,7 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_the_text_after_the_closing_percent_passes_through_as_it_is",
         ),
         "hostile/test_cli_contained.py": (
+            "test_an_open_subroutine_is_located",
             "test_a_terminated_run_removes_its_temporaries",
             "test_a_subroutine_name_stays_inside_the_subroutine_path",
         ),
@@ -279,7 +298,10 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_a_million_brackets_are_refused_in_a_second",
         ),
         "instruments/test_analyze_cli.py": ("test_plot_writes_a_png_for_every_kind",),
-        "shop/test_summary.py": ("test_compensate_and_simulate_find_the_machine_file_as_ncpp_does",),
+        "shop/test_summary.py": (
+            "test_the_summary_is_on_stderr_without_a_terminal_and_in_the_report",
+            "test_compensate_and_simulate_find_the_machine_file_as_ncpp_does",
+        ),
         "motion/test_flow.py": (
             "test_compensate_with_a_subroutine_path",
             "test_memory_stays_flat_around_loops_and_calls",
