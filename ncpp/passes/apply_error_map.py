@@ -339,7 +339,7 @@ def _under_comp(segs: list, free: NDArray, start: NDArray, end: NDArray) -> tupl
     comp = np.fromiter((e.centre_shift is not None for e in segs), dtype=bool, count=len(segs))
     shift = np.zeros((len(segs), 3))
     own = np.flatnonzero(comp & free)
-    shift[own] = [segs[k].centre_shift[1] for k in own.tolist()]
+    shift[own] = np.array([segs[k].centre_shift[1] for k in own.tolist()], dtype=float).reshape(-1, 3)
     same = np.zeros(len(segs), dtype=bool)
     same[own] = [segs[k].centre_shift[0] == segs[k].centre_shift[1] for k in own.tolist()]
     axes = plane_axes(segs)

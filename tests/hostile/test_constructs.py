@@ -107,3 +107,15 @@ def test_a_parameter_file_giving_an_additional_offset_twice_differently_is_refus
         done.stderr.decode()
         == f"{var}:4:1: parameters #7001 and #14001 both give additional work offset P1, and differ\n"
     )
+
+
+@needs_machine
+@pytest.mark.parametrize("after", ["G40\n", "G3 X-5 Y0 R5\nG40\n"])
+def test_arcs_alone_under_cutter_compensation_are_compensated_without_a_traceback(ncpp, tmp_path, after):
+    """The moves under G41 of a program (or of a batch of the passes) are arcs only: no line takes its
+    tool-centre shift, and the arcs are compensated as any other."""
+    program = tmp_path / "arcs.ngc"
+    program.write_text("G21 G90 G17\nF100\nG41 D1\nG2 X0 Y5 R3\n" + after + "M2\n")
+    done = ncpp("compensate", "--machine", str(MACHINE), str(program), timeout=60)
+    assert done.returncode == 0 and b"Traceback" not in done.stderr, done.stderr
+    assert b"compensated 1 moves" in done.stderr or b"compensated 2 moves" in done.stderr, done.stderr
