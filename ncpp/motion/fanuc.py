@@ -128,7 +128,7 @@ from __future__ import annotations
 
 from typing import cast
 
-from ncpp.motion.interpreter import IGNORED_STATEMENTS, Interpreter, _OutOfScope, interpreting
+from ncpp.motion.interpreter import IGNORED_STATEMENTS, MM_PER_INCH, Interpreter, _OutOfScope, interpreting
 from ncpp.motion.offsets import ADDITIONAL, ADDITIONAL_CODES
 from ncpp.motion.segments import Event, Pass
 from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
@@ -196,6 +196,10 @@ class FanucInterpreter(Interpreter):
     # Polar coordinates, scaling, programmable mirror image and coordinate rotation cancel (Fanuc Series
     # 0i-MD operator's manual, G code list: G15, G50, G50.1, G69)
     idle_cancels = frozenset((15.0, 50.0, 50.1, 69.0))
+    g10_l_numbers = frozenset((1.0, 2.0, 10.0, 11.0, 12.0, 13.0, 20.0))  # (L10-L13: tool offset memory)
+    # A G10 L11 (or L1) of an H offset whose geometry the program has not set: its meaning depends on
+    # the control's tool compensation memory (module docstring); Haas's is the wear
+    wear_alone = False
 
     def _cancels_nothing(self, code: float, block: Block) -> bool:
         if code == 69.0:
@@ -405,6 +409,38 @@ class FanucInterpreter(Interpreter):
             self._shift(old, new)
         return Pass(block)
 
+    def _set_tool_offsets(self, block: Block, words: dict, given: list[tuple[int, float]]) -> None:
+        """`G10 L10-L13 P<n> R<value>`: H offset n's geometry (L10) or wear (L11, and L1), D offset n's
+        geometry (L12) or wear (L13), set in G90 and added to in G91 (module docstring).  G43 Hn then
+        applies geometry plus wear; a D offset set so is a radius ncpp does not know."""
+        l_number, col = words["L"][0], words["L"][1].start + 1
+        name = f"G10 L{l_number:g}"
+        if given or words.keys() - {"L", "P", "R"}:
+            raise _OutOfScope(f"{name} with other words than P and R (a tool offset's number and value)", col)
+        if "P" not in words or "R" not in words:
+            raise _OutOfScope(f"{name} without P or R (a tool offset's number and value)", col)
+        p, p_item = words["P"]
+        if p != int(p) or p < 1:
+            raise _OutOfScope(f"{name} with P{p:g}, no tool offset number", p_item.start + 1)
+        number, value = int(p), words["R"][0] * (MM_PER_INCH if self.inch else 1.0)
+        if l_number in (12.0, 13.0):
+            self.set_radii[number] = None  # (a radius or a diameter, as the control is set up)
+            return
+        wear = l_number in (1.0, 11.0)
+        if wear and not self.wear_alone and number not in self.h_memory:
+            raise _OutOfScope(f"{name} of H offset {number}, whose geometry the program has not set with "
+                              "G10 L10 (with tool compensation memory A it sets the whole offset, with B "
+                              "and C its wear)", col)  # fmt: skip
+        told = self.tools.offset(number) if self.tools is not None else None
+        geometry, worn = self.h_memory.get(number, (None if told is None else told[2], 0.0))
+        if wear:
+            worn = value + (0.0 if self.absolute else worn)
+        elif self.absolute or geometry is not None:
+            geometry = value + (0.0 if self.absolute else geometry or 0.0)
+        self.h_memory[number] = (geometry, worn)
+        if geometry is not None:
+            self.set_offsets[number] = {2: geometry + worn}
+
 
 class HaasInterpreter(FanucInterpreter):
     """Haas: also a P on G73 and G83, the pause at the bottom of each hole after its last peck, which
@@ -429,6 +465,7 @@ class HaasInterpreter(FanucInterpreter):
     still_r_arc = False  # (no Haas manual page in ncpp's reference set says a 0-degree R arc does not move)
     r_over_ijk = False  # (nor that R wins over I, J, K)
     independent_h = False  # (nor that an H goes without G43)
+    wear_alone = True  # ("G10 Set Offsets": "L1 or L11 Tool wear offset amount (for H code)")
     # The NGC control's general-purpose variables, kept at power off, where its system variables
     # (#1000-#9999, #11000 on) are the control's (the Haas NGC manual's "System Variables" table, as
     # zappettiniconsulting.com/wiki/haas-system-variables quotes it: #10000-#10999 general-purpose,
