@@ -1804,7 +1804,7 @@ class Interpreter:
         if not self._in_table(number):
             self._fail(f"Requested tool {number} not found in the tool table", block, p_item)
         if not given and not words.keys() & set("RQIJ"):
-            self._fail(f"G10 L{l_number:g} without offsets has no effect", block, words["L"][1])
+            self._fail("G10 L1 without offsets has no effect", block, words["L"][1])  # (rs274's, for each L)
         if l_number != 1.0:
             self._check_from_here(block, words, given)
         scale = MM_PER_INCH if self.inch else 1.0
