@@ -43,6 +43,24 @@ system in effect; a P that is an expression may be 0 there.
 value is added to the offset; Haas's "Programmable Offsets": `G10 L2 P1 G91 X60.` moves G54's X
 60 mm); LinuxCNC's sets them in either.
 
+Tool offsets a program sets, with `G10 L<n> P<offset> R<value>` (the value set in G90, added in G91):
+L10 an H offset's geometry, L11 its wear, L12 a D offset's geometry, L13 its wear (the Fanuc-style
+"G10: Programmable data input" of the PowerRoute Mill Programming Manual, 1.2.10; Mitsubishi M700V
+programming manual, 12.7 "Programmed Compensation Input", tool compensation memory II; Haas's "G10
+Set Offsets": "L10 Length offset amount (for H code)", "L1 or L11 Tool wear offset amount (for H
+code)", "L12 Diameter offset amount (for D code)", "L13 Diameter wear offset amount (for D code)").
+G43 Hn then applies geometry plus wear, as tool compensation memory C keeps them (Series 0i/0i Mate
+Model B Connection Manual (Function), B-63833EN-1/02, 10 "Tool compensation memory C"); the length
+--tool-table tells for offset n is its geometry, its wear 0.  With memory A the one value of an
+offset is set by `G10 L11 P_ R_` (Series 16i/18i-PA operator's manual, B-63124EN/01, 15.3
+"Tool compensation values, number of compensation values, and entering values from the program
+(G10)": "the system allows L1 to be specified instead of L11"): so on Fanuc an L11 or L1 of an H
+offset whose geometry the program has not set with L10 is out of scope (with memory A it would be
+the whole length, with B and C the wear); on Haas it is the wear.  A D offset set so is a radius or
+a diameter as the control is set up: G41/G42 with it offsets by a radius ncpp does not know (its
+moves are corrected for their programmed points, with the warning a radius not told gets).  Any
+other word in such a block is out of scope.
+
 A G00 written in a G28 or G30 block (`G0 G28 G91 Z0.`, which Mastercam's and Fusion's Fanuc and Haas
 posts write before each tool change) only sets the modal motion: these controls take G codes of
 different groups in one block, and the group-00 return takes the axis words (Fanuc 0i-MF

@@ -12,7 +12,8 @@ Scope: modal G0-G3, planes, G90/G91, G90.1/G91.1, G20/G21 (state converted
 on a switch, like LinuxCNC), G54-G59.3, G10 L2/L20 (L2's R: the system turned about Z; Fanuc's and
 Haas's G68, additional work offsets and their readings of G10: `fanuc.py`), G92 family,
 G52, G53, G28/G30, T, M6, M61, G43 / G43.1 / G43.2 H / G49 (lengths from the
-control's tool table, `tools.py`; zero when it is not told), F and inverse time, IJK and R arcs, helices,
+control's tool table, `tools.py`, or as the program set them with G10 L1/L10/L11:
+`_set_tool_offsets`; zero when neither tells them), F and inverse time, IJK and R arcs, helices,
 P turns, parameters and expressions, Fanuc corner rounding and
 chamfering between two lines (`,R` `,C`, `G1 ... R`: a one-move look-ahead),
 the canned cycles G73 G74 G81-G87 G89 with G98/G99 (`cycles.py`), LinuxCNC's
