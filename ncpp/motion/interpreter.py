@@ -819,14 +819,17 @@ class Interpreter:
         """The axes X Y Z a block's move puts at a known position (off `unpositioned`): those it
         names in G90 (a canned cycle's X Y: where it leaves Z depends on where it started), and
         those a G28/G30 homes (the named ones, or all)."""
+        homes = _homes(block)
+        if not (homes or self.absolute):
+            return
         named = {
             "XYZ".index(item.letter)
             for item in block.items
             if (type(item) is Word or type(item) is ExprWord) and item.letter in "XYZ"
         }
-        if _homes(block):
+        if homes:
             self.unpositioned -= named or {0, 1, 2}
-        elif self.absolute:
+        else:
             self.unpositioned -= named - {2} if self.motion in CANNED else named
 
     def _settle_rotation(self, block: Block) -> None:
