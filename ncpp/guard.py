@@ -68,7 +68,10 @@ After each block that applies the length of the tool in the spindle from the tol
 (G43, G43 H0 or G43 H of that tool, G43.2 H of it; `interpreter._tool_length` marks it,
 `Pass.length_told`), a check stops the program when the control's tool in the spindle or its
 length is not the one told, within `GUARD_MM`.  The block's own move (`G43 H1 Z5`) runs before
-the check; the next does not.
+the check; the next does not.  A length the program set itself (LinuxCNC's G10 L1/L10/L11, Haas's
+G10 L10/L11) is the one told from there on: the control holds it too (rs274 writes it into the
+spindle's #5401-#5409 at the G10, Haas into #2001-#2400), so the check finds the G10 run as the
+program says, and a tool table or wear that differs.
 
 * LinuxCNC (G-code manual, "Numbered Parameters": #5400 the tool number, #5401-#5409 the tool
   offsets X..W, volatile): they hold the table's entry of the tool in the spindle, set at M6 or

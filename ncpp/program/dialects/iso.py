@@ -700,9 +700,9 @@ class IsoWriter:
         self._last_end = None
         return lines
 
-    # -- G92, G10 L20 -------------------------------------------------------------
+    # -- G92, G10 L10/L11/L20 -------------------------------------------------------------
     def _setting_text(self, block: Block, setting: Setting) -> str:
-        """A G92 / G10 L20 block with its axis values moved by where the control stands off the
+        """A G92 / G10 L10/L11/L20 block with its axis values moved by where the control stands off the
         programmed point (`Setting.shift`): the offset the control computes from them is the
         program's.  After it the output's position is in another frame: the next move writes
         every axis it knows."""
