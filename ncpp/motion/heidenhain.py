@@ -68,7 +68,8 @@ from ncpp.motion.heidenhain_cycles import (
 )
 from ncpp.motion.heidenhain_cycles import steps as cycle_steps
 from ncpp.motion.heidenhain_expand import KlartextExpansion, is_control, is_label
-from ncpp.motion.heidenhain_flow import FIXED, JUMPS, SKIP, TEXT, KlartextFlow, jump_parts, label_key
+from ncpp.motion.heidenhain_flow import CALLED, FIXED, JUMPS, SKIP, TEXT, KlartextFlow, jump_parts, label_key
+from ncpp.motion.once import OnceRuns, held_to_the_end
 from ncpp.motion.modal import (
     MM_PER_INCH,
     PLANE_OF_TOOL_AXIS,
@@ -214,6 +215,12 @@ def _in_flow(events: list[Event], owner: Block | None) -> list[Event]:
     return out
 
 
+def _as_programmed(event: Event, owner: Block) -> Event | None:
+    """An event of a CALLED run whose text runs again (`once.held_to_the_end`): as a FIXED run's."""
+    kept = _in_flow([event], owner)
+    return kept[0] if kept else None
+
+
 def _plane_of_axes(axes: set[int], default: int) -> int:
     for plane, (a, b, _) in PLANE_AXES.items():
         if axes == {a, b}:
@@ -265,6 +272,8 @@ class HeidenhainInterpreter(ModalInterpreter):
         self._files: Files | None = None  # the called programs' files, once a call needs them
         self.expansion: KlartextExpansion | None = None  # --expand: what it writes (`heidenhain_expand`)
         self.shortest_way = False  # M126: rotary axes turn the shortest way (ROTARY_WORDS)
+        # the subprograms whose one run is written where their text stands (`_flowing`; None: none)
+        self.once_runs: OnceRuns | None = None
 
     def run(self, blocks: Iterable[Block], warnings: Warnings) -> Iterator[Event]:
         """Events as `ModalInterpreter.run`; a feed line waits (with the events after it)
@@ -835,14 +844,26 @@ class HeidenhainInterpreter(ModalInterpreter):
         """Events as `ModalInterpreter.run`, block by block in the order they run: the moves of
         a block that runs again are left as programmed (FLOW) and, where it runs out of the
         text's order, belong to the line that runs it (a call, a jump back), written once; with
-        --expand (`expand`) each run of it is written where it runs (`heidenhain_expand`)."""
+        --expand (`expand`) each run of it is written where it runs (`heidenhain_expand`).  The
+        run of a subprogram that may be its only one (CALLED, `heidenhain_flow`) is followed as a
+        run in place and held to the program's end (`once.held_to_the_end`, `once_runs`): run
+        once, it is written where its text stands; else its moves are left as programmed."""
         self.expansion = KlartextExpansion(self.q, self.file) if self.expand else None
-        return self._run_flow(KlartextFlow(self.file, blocks), warnings, None)
+        runs = self.once_runs if self.expansion is None else None
+        flow = KlartextFlow(self.file, blocks, once=runs)
+        events = self._run_flow(flow, warnings, None)
+        if runs is None:
+            return events  # type: ignore[return-value]  # (no run is CALLED)
+        return held_to_the_end(events, runs, lambda: (self.done, self.ended), lambda: flow.called_again,
+                               lambda event, call: _as_programmed(event, call))  # fmt: skip
 
-    def _run_flow(self, flow: KlartextFlow, warnings: Warnings, caller: Block | None) -> Iterator[Event]:
+    def _run_flow(
+        self, flow: KlartextFlow, warnings: Warnings, caller: Block | None
+    ) -> Iterator[Event | tuple[tuple[str, Block], Event]]:
         """`_flowing` over the program (`caller` None) or over a program the line `caller` calls
         by CALL PGM: its blocks all run out of the text's order, their moves the caller's, and
-        its text is no part of the output."""
+        its text is no part of the output.  A CALLED run's events come as ((its subprogram, its
+        call), event)."""
         self.flow = flow
         flow.watch(self.loop_quick, self.loop_state)
 
@@ -868,6 +889,7 @@ class HeidenhainInterpreter(ModalInterpreter):
                         yield from kept
                     yield Pass(block, kind is SKIP or (kind is TEXT and self.ended))
                 continue
+            called = (flow.called, owner) if kind is CALLED else None  # (its run as a run in place)
             self.again = kind is FIXED and expansion is None
             settling: tuple[Event, ...] = ()
             written: Block | None = block
@@ -904,6 +926,9 @@ class HeidenhainInterpreter(ModalInterpreter):
                 events = _in_flow(events, owner)
             if kind is not FIXED and flow.labels and any(type(e) is Line or type(e) is Arc for e in events):
                 flow.moved()  # (before the first label nothing can jump back over it)
+            if called is not None:
+                yield from ((called, event) for event in events or (Pass(block),))
+                continue
             yield from events or ((Pass(block),) if owner is None else ())
             yield from self._called_program(flow, owner or block, warnings)
 
@@ -1005,7 +1030,7 @@ class HeidenhainInterpreter(ModalInterpreter):
                              item.start + 1)  # fmt: skip
         index = self.flow.target(name, lambda q: self.value(q, block, item), item.start + 1)
         key = label_key(self.value(name, block, item) if type(name) is tuple else name)
-        self.flow.call(index, repeat, key, item.start + 1)
+        self.flow.call(index, repeat, key, item.start + 1, self.radius_comp or self.centre.off_path)
 
     def _jump(self, block: Block, item) -> None:
         """FN 9-12: `IF a EQU|NE|GT|LT b GOTO LBL n` jumps to the label when the comparison holds."""
