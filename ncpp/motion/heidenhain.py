@@ -69,7 +69,6 @@ from ncpp.motion.heidenhain_cycles import (
 from ncpp.motion.heidenhain_cycles import steps as cycle_steps
 from ncpp.motion.heidenhain_expand import KlartextExpansion, is_control, is_label
 from ncpp.motion.heidenhain_flow import CALLED, FIXED, JUMPS, SKIP, TEXT, KlartextFlow, jump_parts, label_key
-from ncpp.motion.once import OnceRuns, held_to_the_end
 from ncpp.motion.modal import (
     MM_PER_INCH,
     PLANE_OF_TOOL_AXIS,
@@ -78,6 +77,7 @@ from ncpp.motion.modal import (
     as_point,
     placed_interpreting,
 )
+from ncpp.motion.once import OnceRuns, held_to_the_end
 from ncpp.motion.segments import (
     COMP,
     FLOW,
@@ -889,7 +889,9 @@ class HeidenhainInterpreter(ModalInterpreter):
                         yield from kept
                     yield Pass(block, kind is SKIP or (kind is TEXT and self.ended))
                 continue
-            called = (flow.called, owner) if kind is CALLED else None  # (its run as a run in place)
+            called = None  # a CALLED run's (subprogram, call): its run as a run in place
+            if kind is CALLED and flow.called is not None and owner is not None:
+                called = (flow.called, owner)
             self.again = kind is FIXED and expansion is None
             settling: tuple[Event, ...] = ()
             written: Block | None = block
@@ -1010,7 +1012,8 @@ class HeidenhainInterpreter(ModalInterpreter):
         self.file = str(path)
         try:
             around = self.flow.around_call if self.flow is not None else list  # (the caller's flow)
-            yield from self._run_flow(KlartextFlow(str(path), blocks, around), warnings, caller)
+            flow = KlartextFlow(str(path), blocks, around)  # (with no CALLED run: all its blocks run FIXED)
+            yield from self._run_flow(flow, warnings, caller)  # type: ignore[misc]
             if not self.done and not self.returned:
                 self._refuse_leaving(f"the called program {path.name} ends without END PGM", caller, None)
                 self.leave_scope(warnings, f"the called program {path.name} ends without END PGM",

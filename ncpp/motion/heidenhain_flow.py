@@ -378,7 +378,9 @@ class KlartextFlow:
                 self.label_steps[pc] = self.passes.steps
                 self._entered(self.label_at[pc])
             if in_place:  # (a subprogram's text that a call ran runs again here)
-                again = any(a <= pc <= b for a, b in self.again) or any(a <= pc <= b for a, b in self.called_text)
+                again = (self.again or self.called_text) and (
+                    _within(pc, self.again) or _within(pc, self.called_text)
+                )
                 self.straight = not again
                 yield block, FIXED if again else RUN, None
                 written = pc + 1
@@ -406,6 +408,10 @@ class KlartextFlow:
 
 # Statements that keep a subprogram's text from being rewritten for its one run (`_runs_once`)
 _NOT_ONCE = frozenset(("label", "program_end", "contour_label"))
+
+
+def _within(index: int, ranges: Iterable[tuple[int, int]]) -> bool:
+    return any(a <= index <= b for a, b in ranges)
 
 
 def label_name(key: float | str) -> str:
@@ -436,4 +442,4 @@ def _way_out(block: Block) -> bool:
     return False
 
 
-__all__ = ["CALLED", "FIXED", "RUN", "SKIP", "TEXT", "KlartextFlow", "JUMPS", "jump_parts", "label_key", "label_name"]
+__all__ = ["CALLED", "FIXED", "RUN", "SKIP", "TEXT", "KlartextFlow", "JUMPS", "jump_parts", "label_key"]

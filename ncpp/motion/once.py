@@ -148,7 +148,9 @@ def held_to_the_end(
                 rerun |= runs.refuse_waiting()  # (a run under way is told so, the rest of it too)
         else:
             waited = 0
-        run, event = item if type(item) is tuple else (None, item)
+        run: Run | None
+        event: Event
+        run, event = item if type(item) is tuple else (None, item)  # type: ignore[assignment]
         if run is not None and run[0] in programmed:  # (the rest of a run told past the bound)
             kept = as_programmed(event, run[1])
             if kept is None:

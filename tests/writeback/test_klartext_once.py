@@ -181,7 +181,9 @@ def test_the_events_held_past_the_bound_leave_the_run_as_programmed(tmp_path, mo
     assert "warning: loop or subroutine" in messages
 
 
-def test_a_run_written_where_it_runs_and_at_its_text_is_refused_by_the_verifier(tmp_path, monkeypatch, capsys):
+def test_a_run_written_where_it_runs_and_at_its_text_is_refused_by_the_verifier(
+    tmp_path, monkeypatch, capsys
+):
     """A writer that does not place the run (its lines after the call, the text after M30 as well:
     the control would run the contour twice) is refused: the verifier reads the written program
     as the control runs it, not as the writer meant it."""
@@ -194,7 +196,9 @@ def test_a_run_written_where_it_runs_and_at_its_text_is_refused_by_the_verifier(
     monkeypatch.setattr(HeidenhainWriter, "write", unplaced)
     program = tmp_path / "once.h"
     program.write_text(ONCE["a contour"])
-    code = main(["compensate", "--machine", str(_wide(tmp_path)), str(program), "-o", str(tmp_path / "out.h")])
+    code = main(
+        ["compensate", "--machine", str(_wide(tmp_path)), str(program), "-o", str(tmp_path / "out.h")]
+    )
     assert code != 0 and "verification" in capsys.readouterr().err
 
 
