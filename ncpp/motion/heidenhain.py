@@ -10,7 +10,8 @@ half circle), `CT` (tangential arc), `LP`/`CP` polar with PR/IPR/PA/IPA (a
 helix with IZ, several turns with |IPA| > 360), Q parameters with arithmetic,
 labels, subprograms (`CALL LBL n` ... `LBL 0`), program-section repeats (`CALL LBL n REP k`)
 and the jumps FN 9-12 (`heidenhain_flow`: a block that runs again is left as programmed,
-FLOW; with --expand each run is written out, `heidenhain_expand`), `CALL PGM` of a program file on the subroutine path (`_call_program`: its moves are left
+FLOW, a subprogram that runs once is compensated where its text stands, `_flowing`; with
+--expand each run is written out, `heidenhain_expand`), `CALL PGM` of a program file on the subroutine path (`_call_program`: its moves are left
 as programmed, FLOW, and the caller's after it compensated), `CYCL DEF` of machining cycles
 (they only define), the drilling cycles 200, 201, 203, 205, 207 and 240 called by M99, `CYCL CALL`
 or `CYCL CALL POS` (`heidenhain_cycles`: their moves along the tool axis are left as
