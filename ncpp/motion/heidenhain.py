@@ -1032,6 +1032,10 @@ class HeidenhainInterpreter(ModalInterpreter):
         if type(repeat) is not int:  # (the manual's REP takes a number: a count of Q9 = 35.5 is not defined)
             raise OutOfScope(f"CALL LBL ... REP{repeat[1].upper()} (a repeat count from a Q parameter)",
                              item.start + 1)  # fmt: skip
+        words = block.raw[item.start : item.end].rpartition('"')[2]  # (after a quoted name)
+        if repeat == 0 and "REP" in words.upper():  # (the parser reads no REP as REP 0)
+            raise OutOfScope("CALL LBL ... REP 0 (REP counts the section's runs after the first, TNC 640 "
+                             "Klartext manual: how the control reads none is not told)", item.start + 1)  # fmt: skip
         index = self.flow.target(name, lambda q: self.value(q, block, item), item.start + 1)
         key = label_key(self.value(name, block, item) if type(name) is tuple else name)
         self.flow.call(index, repeat, key, item.start + 1, self.radius_comp or self.centre.off_path)

@@ -208,3 +208,18 @@ def test_the_command_line_compensates_and_verifies_on_the_wide_machine(tmp_path,
     program.write_text(ONCE[name])
     assert main(["compensate", "--machine", str(_wide(tmp_path)), str(program), "-o", str(out)]) == 0
     assert "CALL LBL 1" in out.read_text().partition("M30")[0]
+
+
+def test_a_repeat_of_zero_more_runs_is_not_guessed_at(tmp_path):
+    """`CALL LBL n REP k` runs the section k more times (TNC 640 Klartext manual, "Program section
+    repeats"); the parser reads `REP 0` as a call with no REP, which the control may not: it leaves
+    the interpreter's scope at its word.  A label whose name holds REP is no repeat."""
+    repeated = program("LBL 2\nL X+10 Y+140 F300\nCALL LBL 2 REP 0\n")
+    _, messages = compensated(tmp_path, "rep0.h", repeated)
+    assert re.search(
+        r"rep0\.h:\d+:3: warning: CALL LBL \.\.\. REP 0 .* outside the motion interpreter's scope", messages
+    )
+    named = ONCE["a contour"].replace("LBL 1", 'LBL "REPAIR"')
+    written, messages = compensated(tmp_path, "repair.h", named)
+    assert "scope" not in messages and "loop or subroutine" not in messages
+    assert landed(points(run_order(written)), WANTED["a contour"]).max() < 0.5e-3
