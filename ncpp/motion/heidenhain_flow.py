@@ -14,7 +14,10 @@ runs out of the text's order (a subprogram's, a repeat's, a loop's second pass) 
 the line that runs it, whose text the output is at, so that every text is written once where
 it stands.  A block that will run again (it lies between a label and a later call of or jump
 back to it, read ahead up to `LOOKAHEAD` blocks once a label is read) is FIXED from its first pass: its one text
-cannot be rewritten for each run; so is a subprogram's text the program runs in its place after a call ran it.  A call or jump back over a move that ran in place (RUN)
+cannot be rewritten for each run; so is a subprogram's text the program runs in its place after a call ran it.
+A block whose only such runs again are those of jumps back (FN 9-12) is ONCE in its first pass (as
+`ncpp.motion.flow`'s loops): whether the jump goes back is told later, by the flow going on past it
+in straight code (`in_straight_code`: the pass ran once) or running a block of it again.  A call or jump back over a move that ran in place (RUN)
 leaves the scope, and so does a label more than `MAX_AHEAD` blocks ahead or no longer held
 (blocks are held from the first label before the position, up to `MAX_BEHIND` back).
 
@@ -32,7 +35,7 @@ from collections.abc import Callable, Iterable, Iterator
 
 from ncpp.errors import Location, NcppError
 from ncpp.motion.endless import Revisits, endless, without_way_out
-from ncpp.motion.flow import CALLED, FIXED, MAX_RERUN, RUN, SKIP, TEXT, Around, CountedPasses
+from ncpp.motion.flow import CALLED, FIXED, MAX_RERUN, ONCE, RUN, SKIP, TEXT, Around, CountedPasses
 from ncpp.motion.modal import OutOfScope
 from ncpp.motion.once import OnceRuns
 from ncpp.program.blocks import Block, Statement, Word
@@ -103,6 +106,7 @@ class KlartextFlow:
         self.labels: dict[float | str, int] = {}  # label -> the index of its LBL block
         self.again: list[tuple[int, int]] = []  # [label, call or jump back]: blocks that run again
         self.called_text: set[tuple[int, int]] = set()  # [label, LBL 0] of the subprograms a call ran
+        self.jumps_back: set[int] = set()  # the indices of the FN 9-12 among the ends of `again`
         self.twice: set[float | str] = set()  # labels defined more than once (the control refuses them)
         self.named_by_q = False  # a label defined by a Q parameter: no call or jump can be followed
         self.frames: list[tuple[int, float | str]] = []  # subprogram calls: (index to return to, label)
@@ -115,6 +119,7 @@ class KlartextFlow:
         self.current = -1  # the index of the block the interpreter runs
         self.next: int | None = None  # where the block running sends the program (None: the next)
         self.last_run_move = -1  # the index of the last block whose moves ran in place (RUN)
+        self.once_move = -1  # and of a jump's loop's first pass (ONCE) not yet told: it may be rewritten too
         self.rerun = 0  # blocks run out of the text's order
         self.passes = CountedPasses(file)
         self.revisits: Revisits | None = None  # refuses a loop back at a state it had (`watch`)
@@ -150,6 +155,8 @@ class KlartextFlow:
         name = _reference(item)
         if name is not None and type(name) is not tuple and self.labels.get(label_key(name), index) < index:
             self.again.append((self.labels[label_key(name)], index))
+            if item.kind == "fn":
+                self.jumps_back.add(index)
 
     def block(self, index: int) -> Block | None:
         """The block at `index`, read ahead to it (None past the end)."""
@@ -175,6 +182,7 @@ class KlartextFlow:
             self.base = keep
             self.again = [(a, b) for a, b in self.again if b >= keep]
             self.called_text = {(a, b) for a, b in self.called_text if b >= keep}
+            self.jumps_back = {b for b in self.jumps_back if b >= keep}
 
     # -- what the interpreter tells ---------------------------------------------------
     def target(self, name: object, value: Callable[[tuple], float], col: int) -> int:
@@ -325,10 +333,24 @@ class KlartextFlow:
             if not self.frames:
                 self.called = None
 
-    def moved(self) -> None:
+    def moved(self, once: bool = False) -> None:
         """The block running in its place, or in a CALLED run (then: its call), moved (its text may
-        be rewritten for that run)."""
-        self.last_run_move = self.frames[0][0] - 1 if self.frames else self.current
+        be rewritten for that run); `once`: in a loop's first pass (ONCE), not yet told."""
+        if once:
+            self.once_move = self.current
+        else:
+            self.last_run_move = self.frames[0][0] - 1 if self.frames else self.current
+
+    def told(self, again: bool) -> None:
+        """A loop's first pass was told (`ncpp.motion.once`): run once, its moves are as those run in
+        place (no jump back may run them again)."""
+        if not again:
+            self.last_run_move = max(self.last_run_move, self.once_move)
+        self.once_move = -1
+
+    def in_straight_code(self) -> bool:
+        """Whether the block running runs in its place with no loop under way (none can go back)."""
+        return self.straight
 
     def watch(self, quick: Callable[[], object], state: Callable[[], object]) -> None:
         """Refuse a loop that comes back to a state it had (`endless.py`): `state()` is the
@@ -339,7 +361,7 @@ class KlartextFlow:
         """The interpreter's `state` and the flow's own: where it stands, its calls and REP counts,
         what it has read and holds; not its counts of blocks run."""
         held = (self.base, len(self.held), self.exhausted, len(self.labels), len(self.again), len(self.twice),
-                self.named_by_q, self.last_run_move)  # fmt: skip
+                self.named_by_q, self.last_run_move, self.once_move)  # fmt: skip
         return state, self.at, tuple(self.frames), tuple(self.counters.items()), held, self.called
 
     def _arrived(self, block: Block, pc: int, written: int) -> None:
@@ -351,6 +373,18 @@ class KlartextFlow:
         if found is not None:
             jumps, (start, end) = found
             raise endless(jumps, self.held[start - self.base].line, Location(self.file, end.line, 1))
+
+    def _in_place(self, pc: int) -> str:
+        """RUN, or FIXED for a block in its place that runs again (between a label and a later call
+        of it, a subprogram's text a call ran), or ONCE where only jumps back may run it again."""
+        if not self.again and not self.called_text:
+            return RUN
+        if _within(pc, self.called_text):
+            return FIXED
+        ends = [b for a, b in self.again if a <= pc <= b]
+        if not ends:
+            return RUN
+        return ONCE if all(b in self.jumps_back for b in ends) else FIXED
 
     # -- the order ----------------------------------------------------------------------
     def steps(self, done: Callable[[], bool], stop: Callable[[str, Block], None]) -> Iterator[tuple]:
@@ -377,12 +411,10 @@ class KlartextFlow:
             if pc in self.label_at:
                 self.label_steps[pc] = self.passes.steps
                 self._entered(self.label_at[pc])
-            if in_place:  # (a subprogram's text that a call ran runs again here)
-                again = (self.again or self.called_text) and (
-                    _within(pc, self.again) or _within(pc, self.called_text)
-                )
-                self.straight = not again
-                yield block, FIXED if again else RUN, None
+            if in_place:
+                kind = self._in_place(pc)
+                self.straight = kind is RUN
+                yield block, kind, None
                 written = pc + 1
             else:
                 owner = self.block(written - 1)
@@ -442,4 +474,15 @@ def _way_out(block: Block) -> bool:
     return False
 
 
-__all__ = ["CALLED", "FIXED", "RUN", "SKIP", "TEXT", "KlartextFlow", "JUMPS", "jump_parts", "label_key"]
+__all__ = [
+    "CALLED",
+    "FIXED",
+    "ONCE",
+    "RUN",
+    "SKIP",
+    "TEXT",
+    "KlartextFlow",
+    "JUMPS",
+    "jump_parts",
+    "label_key",
+]

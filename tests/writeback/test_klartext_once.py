@@ -9,7 +9,8 @@ There is no oracle that runs Klartext: the judge is closed form.  The test reads
 program in the order the control runs it (`run_order`: each call followed by its subprogram's
 lines) with a reader of its own (`points`), maps the numbers through the formula of a machine
 whose errors are linear in position (`machine`), and every programmed point must be reached
-within 0.5 µm, where the program as written misses them by more than 5 µm."""
+within 0.5 µm, where the program as written misses them by more than 5 µm.  A loop of FN 9-12 jumps
+back whose first pass does not go back is compensated in its place too."""
 
 from __future__ import annotations
 
@@ -223,3 +224,35 @@ def test_a_repeat_of_zero_more_runs_is_not_guessed_at(tmp_path):
     written, messages = compensated(tmp_path, "repair.h", named)
     assert "scope" not in messages and "loop or subroutine" not in messages
     assert landed(points(run_order(written)), WANTED["a contour"]).max() < 0.5e-3
+
+
+# a jump back (TNC 640 Klartext manual, "If-then decisions with Q parameters") whose loop runs once:
+# Q1 is 10 after the first pass, and FN 12 goes back while it is below `{end}`
+JUMP_BACK = "FN 0: Q1 = +0\nLBL 2\nFN 1: Q1 = +Q1 + +10\n{body}FN 12: IF +Q1 LT +{end} GOTO LBL 2\nL X+10 Y+140 F300\n"
+
+
+def test_a_jumps_loop_that_runs_once_is_compensated_in_its_place(tmp_path):
+    """Its first pass is held until the flow goes on past the jump: the loop did not go back, so
+    its text ran once and is compensated, the FN lines as they are."""
+    text = program(JUMP_BACK.format(body=BODY, end=10), "")
+    written, messages = compensated(tmp_path, "jump.h", text)
+    assert landed(points(written), MAIN + CONTOUR).max() < 0.5e-3
+    assert landed(points(text), MAIN + CONTOUR).max() > 5e-3
+    assert "loop or subroutine" not in messages
+    assert "FN 12: IF +Q1 LT +10 GOTO LBL 2" in written and "FN 1: Q1 = +Q1 + +10" in written
+
+
+def test_a_jumps_loop_that_goes_back_stays_as_programmed(tmp_path):
+    written, messages = compensated(tmp_path, "jump.h", program(JUMP_BACK.format(body=BODY, end=20), ""))
+    assert BODY.strip() in _code(written)
+    assert "warning: loop or subroutine" in messages
+    ends = points(written)
+    assert landed(ends, MAIN[1:3]).max() < 0.5e-3 and landed(ends, CONTOUR).min() > 2e-3
+
+
+def test_a_loops_first_pass_held_past_the_bound_stays_as_programmed(tmp_path, monkeypatch):
+    """What a first pass holds past MAX_ONCE events stays as programmed (the held events go)."""
+    monkeypatch.setattr(once_module, "MAX_ONCE", 3)
+    written, messages = compensated(tmp_path, "jump.h", program(JUMP_BACK.format(body=BODY, end=10), ""))
+    assert "L X+160 Y+20 F500\nL X+180 Y+120" in _code(written)
+    assert "warning: loop or subroutine" in messages
