@@ -13,12 +13,13 @@ FN 12 LT) jumps to `LBL n` when the condition holds.
 runs out of the text's order (a subprogram's, a repeat's, a loop's second pass) belongs to
 the line that runs it, whose text the output is at, so that every text is written once where
 it stands.  A block that will run again (it lies between a label and a later call of or jump
-back to it, read ahead up to `LOOKAHEAD` blocks once a label is read) is FIXED from its first pass: its one text
-cannot be rewritten for each run; so is a subprogram's text the program runs in its place after a call ran it.
-A block whose only such runs again are those of jumps back (FN 9-12) is ONCE in its first pass (as
-`ncpp.motion.flow`'s loops): whether the jump goes back is told later, by the flow going on past it
-in straight code (`in_straight_code`: the pass ran once) or running a block of it again.  A call or jump back over a move that ran in place (RUN)
-leaves the scope, and so does a label more than `MAX_AHEAD` blocks ahead or no longer held
+back to it, read ahead up to `LOOKAHEAD` blocks once a label is read) is FIXED from its first
+pass: its one text cannot be rewritten for each run; so is a subprogram's text the program runs
+in its place after a call ran it.  A block whose only runs again would be those of jumps back
+(FN 9-12) is ONCE in its first pass (as `ncpp.motion.flow`'s loops): whether a jump goes back
+is told later, by the flow going on past it in straight code (`in_straight_code`: the pass ran
+once) or running a block of the pass again.  A call or jump back over a move that ran in place
+(RUN) leaves the scope, and so does a label more than `MAX_AHEAD` blocks ahead or no longer held
 (blocks are held from the first label before the position, up to `MAX_BEHIND` back).
 
 A subprogram called from the main program's straight code whose text stands after the call (after

@@ -286,6 +286,7 @@ HEIDENHAIN = Dialect(
 
 # ---- writer ------------------------------------------------------------------------------
 
+from collections.abc import Callable, Iterable, Iterator  # noqa: E402
 from dataclasses import replace  # noqa: E402
 
 from ncpp.motion.segments import DRILLED, FLOW, PLANE_AXES, Arc, Event, Line, Pass  # noqa: E402
@@ -352,13 +353,18 @@ class HeidenhainWriter(IsoWriter):
         self.renumber = False
         self.placed = False  # a subprogram's run was written to stand at its text (`_AtDefinition`)
 
-    def write(self, events, after=None, before=None):
+    def write(
+        self,
+        events: Iterable[Event],
+        after: Callable[[list[Event]], list[str]] | None = None,
+        before: Callable[[list[Event]], list[str]] | None = None,
+    ) -> Iterator[str]:
         """`IsoWriter.write`; where a subprogram's run is written at its text, the blocks from it on
         are numbered in the order they stand (`_in_order`)."""
         lines = super().write(events, after, before)
         return lines if self.once_runs is None else self._in_order(lines)
 
-    def _in_order(self, lines):
+    def _in_order(self, lines: Iterable[str]) -> Iterator[str]:
         """The written lines, each block's number one after the last once a subprogram's run was
         written to stand at its text, after M30 (its blocks were numbered as they ran, before the
         main program's blocks after its call): numbered one after another, as the TNC numbers."""
