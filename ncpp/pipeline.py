@@ -400,16 +400,16 @@ def process(
         expanding = {"expand_cycles": expand_cycles, "expand": expand}
     elif FAMILY[name] in ("heidenhain", "sinumerik"):
         expanding = {"expand": expand}
-    # a subroutine that runs once is rewritten for that run where its definition stands (ISO family):
-    # its blocks, which the interpreter tells the writer (both readings of the input follow it so)
-    runs = OnceRuns() if FAMILY[name] == "iso" and not expand else None
+    # a subroutine that runs once is rewritten for that run where its definition stands (ISO family,
+    # Klartext): its blocks, which the interpreter tells the writer (both readings of the input follow it so)
+    runs = OnceRuns() if FAMILY[name] in ("iso", "heidenhain") and not expand else None
     if verify:  # the verifier's own reading of the input: the blocks are held between the two
         # readings, not the events (a loop's runs read its few blocks again and again)
         from ncpp.verify import same_motion, unsaid
 
         written_out = any(expanding.values())
         blocks, again, *plain = _copies(blocks, 3 if written_out else 2)
-        held = {"once_runs": OnceRuns()} if runs is not None else {}  # (the other families have none)
+        held = {"once_runs": OnceRuns()} if runs is not None else {}  # (Sinumerik has none)
         original = interpret(again, file=file, warnings=unsaid(), offsets=offsets, **expanding, **held)
         if written_out:  # (and that reading against one without --expand: the program's own run)
             original = same_motion(

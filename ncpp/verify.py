@@ -444,7 +444,7 @@ def _interpreted(
     interpret, _ = dialect_tools(dialect)
     blocks = without_guard(blocks)  # (it neither moves nor acts, and reads the control's parameters)
     once = None if runs is None else OnceRuns(only=runs.names, held_most=WRITTEN_HELD)
-    once_runs = {} if once is None else {"once_runs": once}  # (the dialects outside the ISO family have none)
+    once_runs = {} if once is None else {"once_runs": once}  # (Sinumerik has none)
     return interpret(blocks, file=file, warnings=unsaid(), offsets=offsets or AT_MACHINE_ZERO, **once_runs)
 
 

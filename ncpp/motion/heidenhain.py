@@ -10,7 +10,8 @@ half circle), `CT` (tangential arc), `LP`/`CP` polar with PR/IPR/PA/IPA (a
 helix with IZ, several turns with |IPA| > 360), Q parameters with arithmetic,
 labels, subprograms (`CALL LBL n` ... `LBL 0`), program-section repeats (`CALL LBL n REP k`)
 and the jumps FN 9-12 (`heidenhain_flow`: a block that runs again is left as programmed,
-FLOW; with --expand each run is written out, `heidenhain_expand`), `CALL PGM` of a program file on the subroutine path (`_call_program`: its moves are left
+FLOW, a subprogram that runs once is compensated where its text stands, `_flowing`, and so is a
+jump's loop of one pass, `_run_flow`; with --expand each run is written out, `heidenhain_expand`), `CALL PGM` of a program file on the subroutine path (`_call_program`: its moves are left
 as programmed, FLOW, and the caller's after it compensated), `CYCL DEF` of machining cycles
 (they only define), the drilling cycles 200, 201, 203, 205, 207 and 240 called by M99, `CYCL CALL`
 or `CYCL CALL POS` (`heidenhain_cycles`: their moves along the tool axis are left as
@@ -68,7 +69,17 @@ from ncpp.motion.heidenhain_cycles import (
 )
 from ncpp.motion.heidenhain_cycles import steps as cycle_steps
 from ncpp.motion.heidenhain_expand import KlartextExpansion, is_control, is_label
-from ncpp.motion.heidenhain_flow import FIXED, JUMPS, SKIP, TEXT, KlartextFlow, jump_parts, label_key
+from ncpp.motion.heidenhain_flow import (
+    CALLED,
+    FIXED,
+    JUMPS,
+    ONCE,
+    SKIP,
+    TEXT,
+    KlartextFlow,
+    jump_parts,
+    label_key,
+)
 from ncpp.motion.modal import (
     MM_PER_INCH,
     PLANE_OF_TOOL_AXIS,
@@ -77,6 +88,7 @@ from ncpp.motion.modal import (
     as_point,
     placed_interpreting,
 )
+from ncpp.motion.once import FirstPass, OnceRuns, held_to_the_end
 from ncpp.motion.segments import (
     COMP,
     FLOW,
@@ -214,6 +226,13 @@ def _in_flow(events: list[Event], owner: Block | None) -> list[Event]:
     return out
 
 
+def _as_programmed(event: Event, owner: Block | None) -> Event | None:
+    """An event of a text that runs again (a CALLED run's, `once.held_to_the_end`; a loop's first pass,
+    `FirstPass`): as a FIXED run's (`owner`: the call; None: in its place)."""
+    kept = _in_flow([event], owner)
+    return kept[0] if kept else None
+
+
 def _plane_of_axes(axes: set[int], default: int) -> int:
     for plane, (a, b, _) in PLANE_AXES.items():
         if axes == {a, b}:
@@ -265,6 +284,8 @@ class HeidenhainInterpreter(ModalInterpreter):
         self._files: Files | None = None  # the called programs' files, once a call needs them
         self.expansion: KlartextExpansion | None = None  # --expand: what it writes (`heidenhain_expand`)
         self.shortest_way = False  # M126: rotary axes turn the shortest way (ROTARY_WORDS)
+        # the subprograms whose one run is written where their text stands (`_flowing`; None: none)
+        self.once_runs: OnceRuns | None = None
 
     def run(self, blocks: Iterable[Block], warnings: Warnings) -> Iterator[Event]:
         """Events as `ModalInterpreter.run`; a feed line waits (with the events after it)
@@ -835,14 +856,27 @@ class HeidenhainInterpreter(ModalInterpreter):
         """Events as `ModalInterpreter.run`, block by block in the order they run: the moves of
         a block that runs again are left as programmed (FLOW) and, where it runs out of the
         text's order, belong to the line that runs it (a call, a jump back), written once; with
-        --expand (`expand`) each run of it is written where it runs (`heidenhain_expand`)."""
+        --expand (`expand`) each run of it is written where it runs (`heidenhain_expand`).  The
+        run of a subprogram that may be its only one (CALLED, `heidenhain_flow`) is followed as a
+        run in place and held to the program's end (`once.held_to_the_end`, `once_runs`): run
+        once, it is written where its text stands; else its moves are left as programmed."""
         self.expansion = KlartextExpansion(self.q, self.file) if self.expand else None
-        return self._run_flow(KlartextFlow(self.file, blocks), warnings, None)
+        runs = self.once_runs if self.expansion is None else None
+        flow = KlartextFlow(self.file, blocks, once=runs)
+        events = self._run_flow(flow, warnings, None)
+        if runs is None:
+            return events  # type: ignore[return-value]  # (no run is CALLED)
+        return held_to_the_end(events, runs, lambda: (self.done, self.ended), lambda: flow.called_again,
+                               lambda event, call: _as_programmed(event, call))  # fmt: skip
 
-    def _run_flow(self, flow: KlartextFlow, warnings: Warnings, caller: Block | None) -> Iterator[Event]:
+    def _run_flow(
+        self, flow: KlartextFlow, warnings: Warnings, caller: Block | None
+    ) -> Iterator[Event | tuple[tuple[str, Block], Event]]:
         """`_flowing` over the program (`caller` None) or over a program the line `caller` calls
         by CALL PGM: its blocks all run out of the text's order, their moves the caller's, and
-        its text is no part of the output."""
+        its text is no part of the output.  A CALLED run's events come as ((its subprogram, its
+        call), event); those of a jump's loop's first pass in its place (ONCE) wait until the flow
+        tells whether its text runs again (`ncpp.motion.once.FirstPass`)."""
         self.flow = flow
         flow.watch(self.loop_quick, self.loop_state)
 
@@ -850,62 +884,98 @@ class HeidenhainInterpreter(ModalInterpreter):
             self._refuse_leaving(reason, owner, None)
             self.leave_scope(warnings, reason, owner, None, caller)
 
-        # (with --expand a called program's blocks are written in place of its CALL PGM line, in the
-        # caller's units; without it, its text is no part of the output)
-        expansion, calling_inch = self.expansion, self.inch
+        once: FirstPass | None = None  # a loop's first pass in its place, while the flow has not told
+        calling_inch = self.inch  # (a called program's units must be its caller's with --expand)
         for block, kind, owner in flow.steps(lambda: self.done or self.returned, stop):
             if caller is not None:
                 if kind is SKIP or kind is TEXT:
                     continue
                 kind, owner = FIXED, caller
                 self.called_blocks = count_called(self.called_blocks, self.program_file, caller)
-            if kind is SKIP or kind is TEXT or self.done or not block.items:
-                if owner is None:  # (after M2/M30/END PGM: a subprogram's text, run where it is called)
-                    if expansion is not None and block.items and (kind is SKIP or kind is TEXT or self.done):
-                        kept = expansion.text(kind is SKIP, block)
-                        if kept is None:  # (text a jump goes over: left out)
-                            continue
-                        yield from kept
-                    yield Pass(block, kind is SKIP or (kind is TEXT and self.ended))
+            if kind is ONCE and (self.expansion is not None or (once is not None and once.full())):
+                kind = FIXED  # (--expand writes each run out; a longer first pass stays as programmed)
+            if once is not None and (self.done or flow.in_straight_code() or once.full()):
+                yield from self._told(once, flow, again=(self.done and not self.ended) or once.full())
+                once = None
+            if kind is ONCE and once is None:
+                once = FirstPass(lambda event: _as_programmed(event, None))
+            elif once is not None and kind is FIXED and owner is not None and once.rerun(block):
+                yield from self._told(once, flow, again=True)  # (all of it runs again: nothing to hold)
+                once = None
+            events = self._events_of(flow, block, kind, owner, caller, calling_inch, warnings)
+            if once is None:
+                yield from events
                 continue
-            self.again = kind is FIXED and expansion is None
-            settling: tuple[Event, ...] = ()
-            written: Block | None = block
-            try:
-                if expansion is not None:
-                    settling, written = self._written_out(expansion, block, kind, owner)
-                events = self.block(block)
-            except OutOfScope as out:
-                self.called = None
-                if expansion is not None and (caller is not None or expansion.refuses_leaving(flow)):
-                    raise refused(out.reason, Location(self.file, block.line, out.col)) from None
-                self.leave_scope(warnings, out.reason, block, out.col, owner)
-                if owner is None:
-                    yield from settling
-                    yield Pass(block)
-                continue
-            if expansion is not None:  # each block where it runs, a stretch's as this run's numbers
-                if caller is not None and self.inch != calling_inch:
-                    raise refused(f"a called program in {'inches' if self.inch else 'mm'} (its caller's "
-                                  "units differ)", Location(self.file, block.line, 1))  # fmt: skip
+            for event in events:  # (no CALLED run in a loop's pass)
+                once.add(event, block, again=kind is FIXED)  # type: ignore[arg-type]
+        if once is not None:
+            yield from self._told(once, flow, again=not self.ended)
+
+    def _told(self, once: FirstPass, flow: KlartextFlow, again: bool) -> list[Event]:
+        """A loop's first pass in its place, once the flow has told whether its text runs again."""
+        flow.told(again)
+        return once.told(again)
+
+    def _events_of(
+        self, flow: KlartextFlow, block: Block, kind: str, owner: Block | None, caller: Block | None,
+        calling_inch: bool, warnings: Warnings,
+    ) -> Iterator[Event | tuple[tuple[str, Block], Event]]:  # fmt: skip
+        """The events of one block the flow yields (`_run_flow`)."""
+        # (with --expand a called program's blocks are written in place of its CALL PGM line, in the
+        # caller's units; without it, its text is no part of the output)
+        expansion = self.expansion
+        if kind is SKIP or kind is TEXT or self.done or not block.items:
+            if owner is None:  # (after M2/M30/END PGM: a subprogram's text, run where it is called)
+                if expansion is not None and block.items and (kind is SKIP or kind is TEXT or self.done):
+                    kept = expansion.text(kind is SKIP, block)
+                    if kept is None:  # (text a jump goes over: left out)
+                        return
+                    yield from kept
+                yield Pass(block, kind is SKIP or (kind is TEXT and self.ended))
+            return
+        called = None  # a CALLED run's (subprogram, call): its run as a run in place
+        if kind is CALLED and flow.called is not None and owner is not None:
+            called = (flow.called, owner)
+        # (a first pass's moves are not followed under radius compensation: they may run again)
+        self.again = (kind is FIXED or kind is ONCE) and expansion is None
+        settling: tuple[Event, ...] = ()
+        written: Block | None = block
+        try:
+            if expansion is not None:
+                settling, written = self._written_out(expansion, block, kind, owner)
+            events = self.block(block)
+        except OutOfScope as out:
+            self.called = None
+            if expansion is not None and (caller is not None or expansion.refuses_leaving(flow)):
+                raise refused(out.reason, Location(self.file, block.line, out.col)) from None
+            self.leave_scope(warnings, out.reason, block, out.col, owner)
+            if owner is None:
                 yield from settling
-                if written is not block:
-                    if written is not None:
-                        if caller is not None:  # (told at its CALL PGM line, as the input's moves are)
-                            written.line = caller.line
-                        for event in events:
-                            event.block = written
-                        yield from events or (Pass(written),)
-                    yield from self._called_program(
-                        flow, owner or block, warnings
-                    )  # (CALL PGM's line left out)
-                    continue
-            elif kind is FIXED:
-                events = _in_flow(events, owner)
-            if kind is not FIXED and flow.labels and any(type(e) is Line or type(e) is Arc for e in events):
-                flow.moved()  # (before the first label nothing can jump back over it)
-            yield from events or ((Pass(block),) if owner is None else ())
-            yield from self._called_program(flow, owner or block, warnings)
+                yield Pass(block)
+            return
+        if expansion is not None:  # each block where it runs, a stretch's as this run's numbers
+            if caller is not None and self.inch != calling_inch:
+                raise refused(f"a called program in {'inches' if self.inch else 'mm'} (its caller's "
+                              "units differ)", Location(self.file, block.line, 1))  # fmt: skip
+            yield from settling
+            if written is not block:
+                if written is not None:
+                    if caller is not None:  # (told at its CALL PGM line, as the input's moves are)
+                        written.line = caller.line
+                    for event in events:
+                        event.block = written
+                    yield from events or (Pass(written),)
+                yield from self._called_program(flow, owner or block, warnings)  # (CALL PGM's line left out)
+                return
+        elif kind is FIXED:
+            events = _in_flow(events, owner)
+        if kind is not FIXED and flow.labels and any(type(e) is Line or type(e) is Arc for e in events):
+            flow.moved(kind is ONCE)  # (before the first label nothing can jump back over it)
+        if called is not None:
+            yield from ((called, event) for event in events or (Pass(block),))
+            return
+        yield from events or ((Pass(block),) if owner is None else ())
+        yield from self._called_program(flow, owner or block, warnings)
 
     def _called_program(self, flow: KlartextFlow, caller: Block, warnings: Warnings) -> Iterator[Event]:
         """The events of the program the block just run called by CALL PGM (none if it called none),
@@ -985,7 +1055,8 @@ class HeidenhainInterpreter(ModalInterpreter):
         self.file = str(path)
         try:
             around = self.flow.around_call if self.flow is not None else list  # (the caller's flow)
-            yield from self._run_flow(KlartextFlow(str(path), blocks, around), warnings, caller)
+            flow = KlartextFlow(str(path), blocks, around)  # (with no CALLED run: all its blocks run FIXED)
+            yield from self._run_flow(flow, warnings, caller)  # type: ignore[misc]
             if not self.done and not self.returned:
                 self._refuse_leaving(f"the called program {path.name} ends without END PGM", caller, None)
                 self.leave_scope(warnings, f"the called program {path.name} ends without END PGM",
@@ -1003,9 +1074,13 @@ class HeidenhainInterpreter(ModalInterpreter):
         if type(repeat) is not int:  # (the manual's REP takes a number: a count of Q9 = 35.5 is not defined)
             raise OutOfScope(f"CALL LBL ... REP{repeat[1].upper()} (a repeat count from a Q parameter)",
                              item.start + 1)  # fmt: skip
+        words = block.raw[item.start : item.end].rpartition('"')[2]  # (after a quoted name)
+        if repeat == 0 and "REP" in words.upper():  # (the parser reads no REP as REP 0)
+            raise OutOfScope("CALL LBL ... REP 0 (REP counts the section's runs after the first, TNC 640 "
+                             "Klartext manual: how the control reads none is not told)", item.start + 1)  # fmt: skip
         index = self.flow.target(name, lambda q: self.value(q, block, item), item.start + 1)
         key = label_key(self.value(name, block, item) if type(name) is tuple else name)
-        self.flow.call(index, repeat, key, item.start + 1)
+        self.flow.call(index, repeat, key, item.start + 1, self.radius_comp or self.centre.off_path)
 
     def _jump(self, block: Block, item) -> None:
         """FN 9-12: `IF a EQU|NE|GT|LT b GOTO LBL n` jumps to the label when the comparison holds."""

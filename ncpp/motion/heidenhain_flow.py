@@ -13,10 +13,20 @@ FN 12 LT) jumps to `LBL n` when the condition holds.
 runs out of the text's order (a subprogram's, a repeat's, a loop's second pass) belongs to
 the line that runs it, whose text the output is at, so that every text is written once where
 it stands.  A block that will run again (it lies between a label and a later call of or jump
-back to it, read ahead up to `LOOKAHEAD` blocks once a label is read) is FIXED from its first pass: its one text
-cannot be rewritten for each run.  A call or jump back over a move that ran in place (RUN)
-leaves the scope, and so does a label more than `MAX_AHEAD` blocks ahead or no longer held
+back to it, read ahead up to `LOOKAHEAD` blocks once a label is read) is FIXED from its first
+pass: its one text cannot be rewritten for each run; so is a subprogram's text the program runs
+in its place after a call ran it.  A block whose only runs again would be those of jumps back
+(FN 9-12) is ONCE in its first pass (as `ncpp.motion.flow`'s loops): whether a jump goes back
+is told later, by the flow going on past it in straight code (`in_straight_code`: the pass ran
+once) or running a block of the pass again.  A call or jump back over a move that ran in place
+(RUN) leaves the scope, and so does a label more than `MAX_AHEAD` blocks ahead or no longer held
 (blocks are held from the first label before the position, up to `MAX_BEHIND` back).
+
+A subprogram called from the main program's straight code whose text stands after the call (after
+M30, where the manual puts subprograms) may run once: its run's blocks are CALLED (`_runs_once`,
+as `ncpp.motion.flow`'s), and if its text runs again -- another call of its label (with or
+without REP), its `LBL` block run (the program running into it, a jump to it) -- the flow names
+it in `called_again`: whether it ran once is known only where the program ends (`ncpp.motion.once`).
 """
 
 from __future__ import annotations
@@ -26,8 +36,9 @@ from collections.abc import Callable, Iterable, Iterator
 
 from ncpp.errors import Location, NcppError
 from ncpp.motion.endless import Revisits, endless, without_way_out
-from ncpp.motion.flow import FIXED, MAX_RERUN, RUN, SKIP, TEXT, Around, CountedPasses
+from ncpp.motion.flow import CALLED, FIXED, MAX_RERUN, ONCE, RUN, SKIP, TEXT, Around, CountedPasses
 from ncpp.motion.modal import OutOfScope
+from ncpp.motion.once import OnceRuns
 from ncpp.program.blocks import Block, Statement, Word
 
 # Blocks after a REP call searched for the REP calls of the sections around it (`_around`)
@@ -80,7 +91,13 @@ class KlartextFlow:
     `done()` says the program has ended; `stop(reason, block)` ends it where the
     flow itself cannot go on."""
 
-    def __init__(self, file: str, blocks: Iterable[Block], outside: Callable[[], list[Around]] = list):
+    def __init__(
+        self,
+        file: str,
+        blocks: Iterable[Block],
+        outside: Callable[[], list[Around]] = list,
+        once: OnceRuns | None = None,
+    ):
         self.outside = outside  # the REP sections around this program's run (its CALL PGM's: `around_call`)
         self.file = file
         self.stream = iter(blocks)
@@ -89,22 +106,31 @@ class KlartextFlow:
         self.exhausted = False
         self.labels: dict[float | str, int] = {}  # label -> the index of its LBL block
         self.again: list[tuple[int, int]] = []  # [label, call or jump back]: blocks that run again
+        self.called_text: set[tuple[int, int]] = set()  # [label, LBL 0] of the subprograms a call ran
+        self.jumps_back: set[int] = set()  # the indices of the FN 9-12 among the ends of `again`
         self.twice: set[float | str] = set()  # labels defined more than once (the control refuses them)
         self.named_by_q = False  # a label defined by a Q parameter: no call or jump can be followed
         self.frames: list[tuple[int, float | str]] = []  # subprogram calls: (index to return to, label)
         self.counters: dict[int, int] = {}  # a REP call's index -> the repeats still to run
         self.marks: dict[int, int] = {}  # a REP call's index -> `CountedPasses.ended`'s mark
         self.sections: dict[int, tuple[int, int]] = {}  # a REP call's index -> (its label's index, passes)
-        self.label_indices: set[int] = set()  # the indices of the LBL blocks read
+        self.label_at: dict[int, float | str] = {}  # the index of a LBL block read -> its label
         # a LBL's index -> `CountedPasses.steps` when it last ran (where a section's first pass starts)
         self.label_steps: dict[int, int] = {}
         self.current = -1  # the index of the block the interpreter runs
         self.next: int | None = None  # where the block running sends the program (None: the next)
         self.last_run_move = -1  # the index of the last block whose moves ran in place (RUN)
+        self.once_move = -1  # and of a jump's loop's first pass (ONCE) not yet told: it may be rewritten too
         self.rerun = 0  # blocks run out of the text's order
         self.passes = CountedPasses(file)
         self.revisits: Revisits | None = None  # refuses a loop back at a state it had (`watch`)
         self.at = (0, 0)  # where `steps` stands: the block to run, the next to write in place
+        self.straight = False  # the block running runs in its place, once (RUN)
+        self.once = once  # the subprograms whose first run may be CALLED (`_runs_once`; None: none)
+        self.called: str | None = None  # the subprogram of the CALLED run under way
+        self.entered: set[float | str] = set()  # the labels called or whose LBL block ran
+        self.once_called: dict[float | str, str] = {}  # a label whose run was CALLED -> its name
+        self.called_again: list[str] = []  # the CALLED subprograms whose text ran again since read
 
     # -- reading ------------------------------------------------------------------------
     def _read(self) -> None:
@@ -125,11 +151,13 @@ class KlartextFlow:
                 self.twice.add(label_key(item.node[0]))
             else:
                 self.labels[label_key(item.node[0])] = index
-                self.label_indices.add(index)
+                self.label_at[index] = label_key(item.node[0])
             return
         name = _reference(item)
         if name is not None and type(name) is not tuple and self.labels.get(label_key(name), index) < index:
             self.again.append((self.labels[label_key(name)], index))
+            if item.kind == "fn":
+                self.jumps_back.add(index)
 
     def block(self, index: int) -> Block | None:
         """The block at `index`, read ahead to it (None past the end)."""
@@ -154,6 +182,8 @@ class KlartextFlow:
             del self.held[: keep - self.base]
             self.base = keep
             self.again = [(a, b) for a, b in self.again if b >= keep]
+            self.called_text = {(a, b) for a, b in self.called_text if b >= keep}
+            self.jumps_back = {b for b in self.jumps_back if b >= keep}
 
     # -- what the interpreter tells ---------------------------------------------------
     def target(self, name: object, value: Callable[[tuple], float], col: int) -> int:
@@ -194,8 +224,11 @@ class KlartextFlow:
             return
         raise without_way_out(self.held[index - self.base].line, Location(self.file, block.line, col))
 
-    def call(self, index: int, repeat: int, key: float | str, col: int) -> None:
-        """`CALL LBL n [REP k]`: the subprogram at `index`, or the section from it once more."""
+    def call(self, index: int, repeat: int, key: float | str, col: int, compensating: bool = False) -> None:
+        """`CALL LBL n [REP k]`: the subprogram at `index`, or the section from it once more;
+        `compensating`: radius compensation is in effect (no run of it is CALLED)."""
+        first = key not in self.entered
+        self._entered(key)
         if repeat:
             if index >= self.current:
                 raise OutOfScope("CALL LBL ... REP with the label after the call", col)
@@ -220,8 +253,37 @@ class KlartextFlow:
             raise OutOfScope("a subprogram that calls itself", col)
         if len(self.frames) >= MAX_NESTING:
             raise OutOfScope(f"subprograms nested more than {MAX_NESTING} deep", col)
+        if first and not compensating and self._runs_once(index, key):
+            self.called = self.once_called[key] = label_name(key)
         self.frames.append((self.current + 1, key))
         self.next = index + 1
+
+    def _runs_once(self, index: int, key: float | str) -> bool:
+        """Whether a call may be its subprogram's only run, whose text may then be rewritten for it
+        where it stands: called from the main program's straight code (in its place, in no section
+        that runs again), its text after the call, from its label to the first LBL 0 (within
+        `held_most` blocks) a run of blocks with no control line (no label, call, jump, FN 14,
+        program end, M2 or M30: each runs once, in order) and no radius compensation RL/RR."""
+        once = self.once
+        if once is None or not once.may_run_once(label_name(key)) or self.frames or not self.straight:
+            return False
+        if index <= self.current:
+            return False
+        end = index + 1
+        while (block := self.block(end)) is not None and end - index <= once.held_most:
+            head = _head(block)
+            if head is not None and head.kind == "label" and head.node[0] == 0:
+                return True
+            if _way_out(block) or (head is not None and head.kind in _NOT_ONCE) or _compensates(block):
+                return False
+            end += 1
+        return False
+
+    def _entered(self, key: float | str) -> None:
+        """The text after label `key` runs (a call of it, its LBL block): a CALLED one's again."""
+        if key in self.once_called:
+            self.called_again.append(self.once_called[key])
+        self.entered.add(key)
 
     def _around(self, label: int, call: int, depth: int | None = None) -> list[Around]:
         """The REP sections around the section from `label` to its REP `call`, innermost first: the
@@ -266,11 +328,30 @@ class KlartextFlow:
     def end_subprogram(self) -> None:
         """`LBL 0`: back after the call (in the main program it only marks a place)."""
         if self.frames:
-            self.next = self.frames.pop()[0]
+            back, key = self.frames.pop()
+            self.next = back
+            self.called_text.add((self.labels[key], self.current))
+            if not self.frames:
+                self.called = None
 
-    def moved(self) -> None:
-        """The block running in its place moved (its text may be rewritten for that run)."""
-        self.last_run_move = self.current
+    def moved(self, once: bool = False) -> None:
+        """The block running in its place, or in a CALLED run (then: its call), moved (its text may
+        be rewritten for that run); `once`: in a loop's first pass (ONCE), not yet told."""
+        if once:
+            self.once_move = self.current
+        else:
+            self.last_run_move = self.frames[0][0] - 1 if self.frames else self.current
+
+    def told(self, again: bool) -> None:
+        """A loop's first pass was told (`ncpp.motion.once`): run once, its moves are as those run in
+        place (no jump back may run them again)."""
+        if not again:
+            self.last_run_move = max(self.last_run_move, self.once_move)
+        self.once_move = -1
+
+    def in_straight_code(self) -> bool:
+        """Whether the block running runs in its place with no loop under way (none can go back)."""
+        return self.straight
 
     def watch(self, quick: Callable[[], object], state: Callable[[], object]) -> None:
         """Refuse a loop that comes back to a state it had (`endless.py`): `state()` is the
@@ -281,8 +362,8 @@ class KlartextFlow:
         """The interpreter's `state` and the flow's own: where it stands, its calls and REP counts,
         what it has read and holds; not its counts of blocks run."""
         held = (self.base, len(self.held), self.exhausted, len(self.labels), len(self.again), len(self.twice),
-                self.named_by_q, self.last_run_move)  # fmt: skip
-        return state, self.at, tuple(self.frames), tuple(self.counters.items()), held
+                self.named_by_q, self.last_run_move, self.once_move)  # fmt: skip
+        return state, self.at, tuple(self.frames), tuple(self.counters.items()), held, self.called
 
     def _arrived(self, block: Block, pc: int, written: int) -> None:
         """Back at a label (`pc`) from `block`: refused where the state is one it had there."""
@@ -293,6 +374,18 @@ class KlartextFlow:
         if found is not None:
             jumps, (start, end) = found
             raise endless(jumps, self.held[start - self.base].line, Location(self.file, end.line, 1))
+
+    def _in_place(self, pc: int) -> str:
+        """RUN, or FIXED for a block in its place that runs again (between a label and a later call
+        of it, a subprogram's text a call ran), or ONCE where only jumps back may run it again."""
+        if not self.again and not self.called_text:
+            return RUN
+        if _within(pc, self.called_text):
+            return FIXED
+        ends = [b for a, b in self.again if a <= pc <= b]
+        if not ends:
+            return RUN
+        return ONCE if all(b in self.jumps_back for b in ends) else FIXED
 
     # -- the order ----------------------------------------------------------------------
     def steps(self, done: Callable[[], bool], stop: Callable[[str, Block], None]) -> Iterator[tuple]:
@@ -316,11 +409,13 @@ class KlartextFlow:
                 break
             self.current, self.next = pc, None
             self.passes.steps += 1
-            if pc in self.label_indices:
+            if pc in self.label_at:
                 self.label_steps[pc] = self.passes.steps
+                self._entered(self.label_at[pc])
             if in_place:
-                again = self.again and any(a <= pc <= b for a, b in self.again)
-                yield block, FIXED if again else RUN, None
+                kind = self._in_place(pc)
+                self.straight = kind is RUN
+                yield block, kind, None
                 written = pc + 1
             else:
                 owner = self.block(written - 1)
@@ -331,7 +426,8 @@ class KlartextFlow:
                         "a loop that never ends?",
                         Location(self.file, owner.line if owner is not None else None),
                     )
-                yield block, FIXED, owner
+                self.straight = False
+                yield block, FIXED if self.called is None else CALLED, owner
             if self.next is not None and self.next <= pc and self.revisits is not None:
                 self._arrived(block, self.next, written)
             pc = self.next if self.next is not None else pc + 1
@@ -341,6 +437,29 @@ class KlartextFlow:
             yield rest, TEXT, None
             written += 1
             self._trim(written)
+
+
+# Statements that keep a subprogram's text from being rewritten for its one run (`_runs_once`)
+_NOT_ONCE = frozenset(("label", "program_end", "contour_label"))
+
+
+def _within(index: int, ranges: Iterable[tuple[int, int]]) -> bool:
+    return any(a <= index <= b for a, b in ranges)
+
+
+def label_name(key: float | str) -> str:
+    """A label as a subprogram's name (`OnceRuns`): `5`, `"CONTOUR"`."""
+    return f'"{key}"' if type(key) is str else f"{key:g}"
+
+
+def _head(block: Block) -> Statement | None:
+    """The block's first statement (a `/` aside)."""
+    return next((i for i in block.items if type(i) is Statement and i.kind != "block_delete"), None)
+
+
+def _compensates(block: Block) -> bool:
+    """Whether the block turns radius compensation RL or RR on."""
+    return any(type(i) is Statement and i.kind == "radius_comp" and i.node[0] != "R0" for i in block.items)
 
 
 def _way_out(block: Block) -> bool:
@@ -356,4 +475,15 @@ def _way_out(block: Block) -> bool:
     return False
 
 
-__all__ = ["FIXED", "RUN", "SKIP", "TEXT", "KlartextFlow", "JUMPS", "jump_parts", "label_key"]
+__all__ = [
+    "CALLED",
+    "FIXED",
+    "ONCE",
+    "RUN",
+    "SKIP",
+    "TEXT",
+    "KlartextFlow",
+    "JUMPS",
+    "jump_parts",
+    "label_key",
+]

@@ -64,7 +64,7 @@ from ncpp.motion.expand import Expansion, number, refused
 from ncpp.motion.expressions import ExpressionError, OutOfScope, Parameters, evaluate, vacant
 from ncpp.motion.flow import CALLED, FIXED, ONCE, RUN, SKIP, Flow
 from ncpp.motion.offsets import SYSTEMS, WorkOffsets
-from ncpp.motion.once import FirstPass, OnceRuns
+from ncpp.motion.once import FirstPass, OnceRuns, held_to_the_end
 from ncpp.motion.segments import (
     COMP,
     CYCLE,
@@ -409,71 +409,17 @@ class Interpreter:
     def run(self, blocks: Iterable[Block], warnings: Warnings) -> Iterator[Event]:
         """Events block by block, in the order the blocks run (`_run`).  The run of a subroutine that
         may be its only one (CALLED, `flow.py`) is followed as a run in place, its events and all
-        after them held until the program ends: if no other call ran it (`Flow.called_again`), its
-        text ran once and is rewritten for that run where its definition stands (`once_runs`);
-        else, or where the program leaves the scope or the events held pass `once_runs.held_most`,
-        its moves are left as programmed, as a FIXED run's.  A definition met before its call waits
-        (`OnceRuns.waiting`: the writer holds its lines): it stays as programmed too where the events
-        from the first one waiting pass `held_most` (the lines the writer holds are bounded)."""
+        after them held until the program ends (`once.held_to_the_end`): if no other call ran it
+        (`Flow.called_again`), its text ran once and is rewritten for that run where its definition
+        stands (`once_runs`); else its moves are left as programmed, as a FIXED run's."""
         runs = self.once_runs
         if runs is None:  # (no run is CALLED)
             yield from self._run(blocks, warnings)  # type: ignore[misc]
             return
-        held: list[tuple[Event, tuple[str, Block] | None]] = []
-        pending: set[str] = set()  # the CALLED subroutines among the events held
-        again: set[str] = set()
-        programmed: set[str] = set()  # those told to stay as programmed (the rest of a run too)
-        waited = 0  # events since a definition met before its call began to wait
-        for item in self._run(blocks, warnings):
-            if runs.waiting:
-                waited += 1
-                if self.done:  # (never called; one whose run is held is told with it, below)
-                    for name in runs.waiting - pending:
-                        runs.refuse(name)
-                elif waited > runs.held_most:
-                    again |= runs.refuse_waiting()  # (a run under way is told so, the rest of it too)
-            else:
-                waited = 0
-            run, event = item if type(item) is tuple else (None, item)
-            if run is not None and run[0] in programmed:  # (the rest of a run told past the bound)
-                kept = _as_programmed(event, run[1])
-                if kept is None:
-                    continue
-                run, event = None, kept
-            if run is not None:
-                pending.add(run[0])
-            elif not held:
-                yield event  # (the common case: nothing held)
-                continue
-            held.append((event, run))
-            again.update(self.flow.called_again)  # type: ignore[union-attr]
-            self.flow.called_again.clear()  # type: ignore[union-attr]
-            if self.done or len(held) > runs.held_most or pending <= again:
-                told = again if self.ended else pending
-                programmed |= told
-                yield from self._told_runs(held, told)
-                held, pending, again = [], set(), set()
-        for name in runs.waiting - pending:  # (never called)
-            runs.refuse(name)
-        if held:
-            yield from self._told_runs(held, again if self.ended else pending)
-
-    def _told_runs(
-        self, held: list[tuple[Event, tuple[str, Block] | None]], again: set[str]
-    ) -> Iterator[Event]:
-        """The events held from a CALLED run on: the runs of the subroutines in `again` left as
-        programmed, the others as they ran, their blocks to be written at the definition."""
-        for event, run in held:
-            if run is None:
-                yield event
-            elif run[0] in again:
-                self.once_runs.refuse(run[0])  # type: ignore[union-attr]  # (CALLED: given)
-                kept = _as_programmed(event, run[1])
-                if kept is not None:
-                    yield kept
-            else:
-                self.once_runs.ran_once(run[0], event.block)  # type: ignore[union-attr]
-                yield event
+        yield from held_to_the_end(
+            self._run(blocks, warnings), runs, lambda: (self.done, self.ended),
+            lambda: self.flow.called_again, _as_programmed,  # type: ignore[union-attr]  # (`_run` made it)
+        )  # fmt: skip
 
     def _run(self, blocks: Iterable[Block], warnings: Warnings) -> Iterator[Event | tuple]:
         """Events block by block, in the order the blocks run (o-word control flow,

@@ -18,6 +18,7 @@ from ncpp.errors import Location, NcppError, Warnings, resolve_warnings
 from ncpp.motion.cutter import ToolCentre
 from ncpp.motion.endless import exact
 from ncpp.motion.offsets import WorkOffsets
+from ncpp.motion.once import OnceRuns
 from ncpp.motion.segments import DRILLED, PLANE_AXES, Arc, Context, Event, Line, Pass, Point
 from ncpp.program.blocks import Block, Item
 
@@ -52,9 +53,12 @@ def placed_interpreting(dialect: type[ModalInterpreter]) -> Callable[..., Iterat
         strict: bool = False,
         offsets: WorkOffsets | None = None,
         expand: bool = False,
+        once_runs: OnceRuns | None = None,
     ) -> Iterator[Event]:
         """Motion events of a program's blocks, lazily (see the dialect module's docstring);
-        `expand`: its subprograms and loops are to be written out (a dialect that can: Klartext)."""
+        `expand`: its subprograms and loops are to be written out (a dialect that can: Klartext);
+        `once_runs`: given, a subprogram that runs once is followed as its run and told there, to
+        be written where its text stands (a dialect that can: Klartext, `HeidenhainInterpreter`)."""
         from ncpp.motion.tools import UntoldLengths
 
         zero = offsets.program_zero() if offsets is not None else (0.0, 0.0, 0.0)
@@ -64,6 +68,8 @@ def placed_interpreting(dialect: type[ModalInterpreter]) -> Callable[..., Iterat
         interpreter.untold_lengths = UntoldLengths(not told, warnings)  # type: ignore[attr-defined]
         interpreter.subroutine_path = offsets.subroutine_path if offsets is not None else ()
         interpreter.expand = expand
+        if once_runs is not None:
+            interpreter.once_runs = once_runs  # type: ignore[attr-defined]
         return interpreter.run(blocks, warnings)
 
     return interpret
@@ -76,7 +82,7 @@ class ModalInterpreter:
     # written or warned from, caches and counts of blocks run, the flow (its own)
     not_loop_state = frozenset(("_context", "subroutine_path", "expand", "untold_lengths", "expansion",
                                 "tools", "called_blocks", "_files", "flow", "main_path",
-                                "program_file"))  # fmt: skip
+                                "program_file", "once_runs"))  # fmt: skip
 
     def __init__(self, file: str = "<stdin>", zero: tuple[float, float, float] = (0.0, 0.0, 0.0)):
         self.file = file  # the file of the blocks running (a called one's, while it runs)

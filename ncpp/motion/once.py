@@ -7,11 +7,15 @@ as a RUN block's); one that runs again cannot (FIXED).  The interpreters hold th
 here until then: the flow back in straight code tells "once", a block of the pass run again
 (an inner loop's second pass) marks the events from that block's first on, and leaving the
 interpreter's scope tells "again".  The held pass is bounded (MAX_ONCE events: memory).
+
+A subprogram's run that may be its only one (a flow's CALLED: ISO's `flow.py`, Klartext's
+`heidenhain_flow.py`) is held the same way, with all the events after it, until the program ends
+(`held_to_the_end`): only there is it known that no other call ran its text.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
 
 from ncpp.motion.segments import Event
@@ -107,3 +111,87 @@ class FirstPass:
             self.as_programmed(ev) if again or twice else ev for ev, twice in zip(self.events, self.again)
         )
         return [ev for ev in marked if ev is not None]
+
+
+Run = tuple[str, Block]  # a CALLED run's subprogram and the line that called it
+
+
+def held_to_the_end(
+    items: Iterable[Event | tuple[Run, Event]],
+    runs: OnceRuns,
+    state: Callable[[], tuple[bool, bool]],
+    again: Callable[[], list[str]],
+    as_programmed: Callable[[Event, Block], Event | None],
+) -> Iterator[Event]:
+    """An interpreter's events, a CALLED run's as (its `Run`, event), with each such run and the
+    events after it held until the program ends (`state()`: (done, ended)): if no other call ran
+    the subprogram (`again()`: the names the flow found run again, emptied as read), its text ran
+    once and is written for that run where its definition stands (`OnceRuns.ran_once`); else, or
+    where the program leaves the interpreter's scope or the events held pass `runs.held_most`, its
+    moves are left as programmed (`as_programmed(event, call)`, `OnceRuns.refuse`).  A definition
+    met before its call waits (`OnceRuns.waiting`: the writer holds its lines): it stays as
+    programmed too where the events from the first one waiting pass `held_most` (the lines the
+    writer holds are bounded)."""
+    held: list[tuple[Event, Run | None]] = []
+    pending: set[str] = set()  # the CALLED subprograms among the events held
+    rerun: set[str] = set()
+    programmed: set[str] = set()  # those told to stay as programmed (the rest of a run too)
+    waited = 0  # events since a definition met before its call began to wait
+    for item in items:
+        done, ended = state()
+        if runs.waiting:
+            waited += 1
+            if done:  # (never called; one whose run is held is told with it, below)
+                for name in runs.waiting - pending:
+                    runs.refuse(name)
+            elif waited > runs.held_most:
+                rerun |= runs.refuse_waiting()  # (a run under way is told so, the rest of it too)
+        else:
+            waited = 0
+        run: Run | None
+        event: Event
+        run, event = item if type(item) is tuple else (None, item)  # type: ignore[assignment]
+        if run is not None and run[0] in programmed:  # (the rest of a run told past the bound)
+            kept = as_programmed(event, run[1])
+            if kept is None:
+                continue
+            run, event = None, kept
+        if run is not None:
+            pending.add(run[0])
+        elif not held:
+            yield event  # (the common case: nothing held)
+            continue
+        held.append((event, run))
+        found = again()
+        rerun.update(found)
+        found.clear()
+        if done or len(held) > runs.held_most or pending <= rerun:
+            told = rerun if ended else pending
+            programmed |= told
+            yield from _told_runs(held, told, runs, as_programmed)
+            held, pending, rerun = [], set(), set()
+    for name in runs.waiting - pending:  # (never called)
+        runs.refuse(name)
+    if held:
+        yield from _told_runs(held, rerun if state()[1] else pending, runs, as_programmed)
+
+
+def _told_runs(
+    held: list[tuple[Event, Run | None]],
+    again: set[str],
+    runs: OnceRuns,
+    as_programmed: Callable[[Event, Block], Event | None],
+) -> Iterator[Event]:
+    """The events held from a CALLED run on: the runs of the subprograms in `again` left as
+    programmed, the others as they ran, their blocks to be written at the definition."""
+    for event, run in held:
+        if run is None:
+            yield event
+        elif run[0] in again:
+            runs.refuse(run[0])
+            kept = as_programmed(event, run[1])
+            if kept is not None:
+                yield kept
+        else:
+            runs.ran_once(run[0], event.block)
+            yield event

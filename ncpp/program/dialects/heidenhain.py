@@ -53,6 +53,7 @@ from __future__ import annotations
 
 import functools
 import math
+import re
 
 from lark import Token, Transformer, v_args
 
@@ -285,6 +286,7 @@ HEIDENHAIN = Dialect(
 
 # ---- writer ------------------------------------------------------------------------------
 
+from collections.abc import Callable, Iterable, Iterator  # noqa: E402
 from dataclasses import replace  # noqa: E402
 
 from ncpp.motion.segments import DRILLED, FLOW, PLANE_AXES, Arc, Event, Line, Pass  # noqa: E402
@@ -298,6 +300,7 @@ _AXES = "XYZ"
 _POLAR_WORDS = frozenset(("R", "PR", "PA", "IPR", "IPA"))
 _JUMPS = frozenset((9, 10, 11, 12))  # FN 9-12: IF ... GOTO LBL
 _POLE_FUNCTIONS = frozenset(("C", "CP", "LP", "CTP", "CRP"))  # path functions that use the pole
+_BLOCK_NUMBER = re.compile(r"([ \t]*(?:/[ \t]*)?)(\d+)(?![\d.,])")  # (a `/` may hide the block)
 ANGLE_STYLE = NumberStyle(decimals=7, plus_sign=True)
 
 
@@ -348,6 +351,33 @@ class HeidenhainWriter(IsoWriter):
         # every block numbered one after the last written (--expand: blocks written out where they
         # run, lines left out), the TNC's numbering, rather than its number shifted
         self.renumber = False
+        self.placed = False  # a subprogram's run was written to stand at its text (`_AtDefinition`)
+
+    def write(
+        self,
+        events: Iterable[Event],
+        after: Callable[[list[Event]], list[str]] | None = None,
+        before: Callable[[list[Event]], list[str]] | None = None,
+    ) -> Iterator[str]:
+        """`IsoWriter.write`; where a subprogram's run is written at its text, the blocks from it on
+        are numbered in the order they stand (`_in_order`)."""
+        lines = super().write(events, after, before)
+        return lines if self.once_runs is None else self._in_order(lines)
+
+    def _in_order(self, lines: Iterable[str]) -> Iterator[str]:
+        """The written lines, each block's number one after the last once a subprogram's run was
+        written to stand at its text, after M30 (its blocks were numbered as they ran, before the
+        main program's blocks after its call): numbered one after another, as the TNC numbers."""
+        last = -1
+        for text in lines:
+            found = _BLOCK_NUMBER.match(text)
+            if found is not None:
+                if self.placed:
+                    text = f"{text[: found.start(2)]}{last + 1}{text[found.end(2) :]}"
+                    last += 1
+                else:
+                    last = int(found.group(2))
+            yield text
 
     def _ran(self, event: Event) -> None:
         """A pole the runs of a call or jump line set (their CC blocks): the program's and the
@@ -384,6 +414,8 @@ class HeidenhainWriter(IsoWriter):
 
         block = group[0].block
         self.eol = block.eol or self.eol
+        if self.once_runs is not None and id(block) in self.once_runs.blocks:
+            self.placed = True
         if (
             self.header is not None
             and self.last_number < 0
