@@ -270,6 +270,8 @@ class Interpreter:
     external_output = False
     # `M98 P51002` runs O1002 five times (Fanuc, `Flow._m98`); rs274ngc calls O51002
     repeats_in_p = False
+    # `M97 P1000` runs the program's own blocks from N1000 to M99 (Haas, `Flow._m97`); rs274ngc has no M97
+    local_calls = False
     # An R arc that ends where it starts is an arc of 0 degrees, no move (Fanuc); rs274ngc refuses it
     still_r_arc = False
     # R with I, J or K in an arc block: the arc is R's, the others are ignored (Fanuc); rs274ngc refuses it
@@ -476,7 +478,7 @@ class Interpreter:
         flow = self.flow = Flow(
             self.file, self._evaluate, self.params, lambda: self.done, self._leave_scope,
             self.subroutine_path, state=self._loop_state, position=lambda: self.pos[:],
-            repeats_in_p=self.repeats_in_p, once=self.once_runs,
+            repeats_in_p=self.repeats_in_p, once=self.once_runs, local_calls=self.local_calls,
         )  # fmt: skip
         self.rounding = False
         expansion = self.expansion
@@ -529,7 +531,7 @@ class Interpreter:
                 continue
             try:
                 if expansion is not None:  # each block where it runs, a body's as this run's numbers
-                    event, block = expansion.event(block_event, block, kind)
+                    event, block = expansion.event(block_event, block, kind, flow.frames[-1].local)
                 else:
                     event = block_event(block)  # verbatim blocks (after the closing %) have no items
                 if kind is ONCE and (self.corner is not None or _sets_offset(event) or self._compensating()):
