@@ -5,7 +5,7 @@ order; without --expand their moves are left as programmed (FLOW).  With it ever
 runs is written where it runs, as a block of its own for that run: its expressions written as
 the numbers they have there (`literal`), so the moves are plain moves that compensation
 corrects like any other, and its other words (M codes, tools, dwells, spindle) act once per run,
-in the order they run.  The control lines (`o100 call`, `while`, `endwhile`, `if`, `M98`, `M99`,
+in the order they run.  The control lines (`o100 call`, `while`, `endwhile`, `if`, `M97`, `M98`, `M99`,
 `WHILE`, `END`, `GOTO` ...) and the text that does not run (untaken branches, loops that run no
 time) are left out.  Subroutine definitions stay, as the control skips them: a line out of the
 interpreter's scope in the main program, outside any loop or branch, passes the rest of the

@@ -880,7 +880,9 @@ class Flow:
                             "no block has it (a Haas alarm)", Location(self.file, block.line, col))  # fmt: skip
         runs = 1 if repeats is None else int(round_half_away(repeats))
         why = (
-            f"L{printable(f'{repeats:g}')} (Haas runs a local subprogram 1 to 99 times)"
+            "(a sequence number is a whole number: which block a fraction finds is not ncpp's to guess)"
+            if number != n
+            else f"L{printable(f'{repeats:g}')} (Haas runs a local subprogram 1 to 99 times)"
             if repeats is not None and not (repeats == runs and 1 <= runs <= 99)
             else "in a subprogram M98 or G65 runs (its own program's sequence numbers)"
             if frame.space is not None and not frame.local
@@ -889,7 +891,7 @@ class Flow:
         body = self._local_body(frame, n, block, col) if why is None else None
         if body is None:
             if why is not None:
-                self.stop(f"M97 P{n} {why}", block, col)
+                self.stop(f"M97 P{printable(f'{number:g}')} {why}", block, col)
             return lambda: None
         name = f"N{n}"
         self._check_level(block, control)

@@ -16,7 +16,8 @@ control's tool table, `tools.py`; zero when it is not told), F and inverse time,
 P turns, parameters and expressions, Fanuc corner rounding and
 chamfering between two lines (`,R` `,C`, `G1 ... R`: a one-move look-ahead),
 the canned cycles G73 G74 G81-G87 G89 with G98/G99 (`cycles.py`), LinuxCNC's
-rigid tap G33.1 (`_rigid_tap`), and o-word subroutines, branches and loops, Fanuc M98/M99 subprograms and Fanuc
+rigid tap G33.1 (`_rigid_tap`), and o-word subroutines, branches and loops, Fanuc M98/M99 subprograms, Haas's
+M97 local subprograms and Fanuc
 macro B (GOTO, IF ... GOTO, WHILE ... DO ... END, G65 and G66/G67 macro calls: `flow.py`;
 `IF [..] THEN #i = ..`, vacant variables, #3000 alarms and #3006 stops,
 #5001-#5003 where known: here), and cutter compensation G40-G42.1

@@ -134,6 +134,7 @@ def test_a_label_the_program_lacks_is_refused_at_the_call():
     [("N100 G0 X0\nM97 P100\nM30\nN100\nG1 X1 F100\nM99\n", "2:1: warning: M97 P100 with a block N100 before the call"),
      ("G0 X0\nM97 P100 L0\nM30\nN100\nG1 X1 F100\nM99\n", "M97 P100 L0 (Haas runs a local subprogram 1 to 99 times)"),
      ("G0 X0\nM97 P100 L100\nM30\nN100\nG1 X1 F100\nM99\n", "M97 P100 L100 (Haas runs"),
+     ("G0 X0\nM97 P100.5\nM30\nN100\nG1 X1 F100\nM99\n", "M97 P100.5 (a sequence number is a whole number"),
      ("G0 X0\nM97 P100\nM30\nN100\nG1 X1 F100\n", "M97 P100 (no M99 ends the local subprogram N100"),
      ("G0 X0\nM98 P300\nM30\nN100\nG1 X1 F100\nM99\nO300\nM97 P100\nM99\n", "8:1: warning: M97 P100 in a subprogram M98"),
      ("G0 X0\nM97 P100\nM30\nN100\nG1 X1 F100\nGOTO 110\nN110 X2\nM99\n", "6:1: warning: GOTO in a Haas local subprogram"),
