@@ -6,7 +6,7 @@ Call"): M97 calls "a subroutine referenced by a line number (N) within the same 
 "must match a line number within the same program"; "the subprogram must end with an M99"; "an
 Lnn code in the M97 block will repeat the subroutine call that nn times" (NGC: L "1-99"); "the
 subprogram is within the body of the main program, placed after the M30".  Fanuc's and LinuxCNC's
-codes have no M97: there the line is refused as rs274 refuses it (a P word no code uses).
+codes have no M97: there ncpp refuses the line's P word (rs274 the M97 itself, "Unknown m code used").
 
 Judged move by move by LinuxCNC's rs274 on the same programs written out by hand, each call
 replaced by the lines it runs (`BY_HAND`): the moves ncpp's interpretation prints are rs274's."""
@@ -156,7 +156,7 @@ def test_a_block_n_before_the_call_is_found_past_the_blocks_held():
 
 
 @pytest.mark.parametrize("dialect", ["fanuc", "iso"])
-def test_controls_without_m97_refuse_its_p_as_rs274_does(dialect):
+def test_controls_without_m97_refuse_its_p(dialect):
     with pytest.raises(NcppError, match="P word with no"):
         events("G0 X0\nM97 P100\nM30\nN100\nG1 X1 F100\nM99\n", dialect)
 

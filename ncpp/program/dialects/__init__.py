@@ -193,7 +193,7 @@ _GRBL = re.compile(
 # and its macro statements (LinuxCNC's loops and conditions are o-word lines; Sinumerik's take no brackets)
 _HAAS = re.compile(r"(?<![\w#.])G0*(187|103|154)(?![\d.])", re.I)
 # Haas's local subprogram call `M97 P1000` (Haas Mill Operator's Manual, "M97 Local Sub-Program Call"):
-# neither Fanuc's code lists nor LinuxCNC's M codes have an M97, and both refuse its P
+# neither Fanuc's code lists nor LinuxCNC's M codes have an M97 (rs274 refuses it; ncpp there refuses its P)
 _HAAS_CALL = re.compile(r"(?<![\w#.])M0*97[ \t]*P[ \t]*\d", re.I)
 _FANUC = re.compile(
     r"^[ \t]*[O:]\d+[ \t]*(\(.*\))?[ \t]*\r?$|(?<![\w#.])G0*65[ \t]*P|#3000[ \t]*=|(?<![\w#.])G0*5\.1[ \t]*Q"
