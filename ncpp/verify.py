@@ -627,8 +627,9 @@ class _Feed:
     # Lines taken from the writer at a time, each tagged as it comes: the writer and the parser
     # each run over many lines in turn, faster than taking turns a line at a time
     AHEAD = 256
-    # Tags looked up behind the last (`_tag_of`; at most twice as many held): more than the input
-    # blocks a subroutine's run held to MAX_ONCE events spans, whose lines are written further on
+    # Tags looked up behind the line asked (`_tag_of`; at most twice as many held but for those of the
+    # lines after it): more than the input blocks a subroutine's run held to MAX_ONCE events spans,
+    # whose lines are written further on
     KEPT_TAGS = 2 * MAX_ONCE
 
     def __init__(self, lines: Iterable[str], reached: Callable[[], tuple[int, int, int]]):
@@ -701,16 +702,19 @@ class _Feed:
 
     def _tag_of(self, number: int) -> tuple[int, int, int, int] | None:
         """The tag of written line `number`, asked in the order the lines run (a subroutine's, written
-        further on, before the lines after its call); the tags more than KEPT_TAGS back go, and a
-        line of theirs gets the first kept (memory stays flat)."""
+        further on, before the lines after its call); the tags more than KEPT_TAGS behind the one
+        asked go, and a line of theirs gets the first kept (memory stays flat but for the lines the
+        reading holds ahead: a call that finds its subprogram after M30 has read the lines to it)."""
         if self.found is not None and self.found[0] == number:  # (a block's line is asked twice)
             return self.found[1]
         tags, firsts = self.tags, self.firsts
-        if len(tags) > 2 * self.KEPT_TAGS:
+        at = bisect_right(firsts, number) - 1
+        if len(tags) > 2 * self.KEPT_TAGS and at >= 2 * self.KEPT_TAGS:
             del tags[: self.KEPT_TAGS], firsts[: self.KEPT_TAGS]
+            at -= self.KEPT_TAGS
         if not tags:
             return None
-        found = tags[max(bisect_right(firsts, number) - 1, 0)]
+        found = tags[max(at, 0)]
         self.found = (number, found)
         return found
 

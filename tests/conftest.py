@@ -37,6 +37,8 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
         ),
         "compensation/test_rs274_accepts.py": None,
         "writeback/test_subroutines_run_once.py": None,
+        "writeback/test_haas_local_subprograms.py": None,
+        "motion/test_haas_local_calls.py": ("test_the_moves_are_rs274s_of_the_program_written_out_by_hand",),
         "compensation/test_machine_files.py": (
             "test_compensated_programs_land_on_the_path_on_each_machine",
             "test_reversal_tables_of_both_signs_are_compensated_for_the_direction_travelled",

@@ -52,7 +52,7 @@ def add_expand_argument(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--expand",
         action="store_true",
-        help="write the loops and subroutines of an ISO program (o-word, M98, WHILE, GOTO), a Klartext program "
+        help="write the loops and subroutines of an ISO program (o-word, M98, Haas's M97, WHILE, GOTO), a Klartext program "
         "(CALL LBL, CALL LBL REP, FN 9-12) or a Sinumerik program (WHILE, FOR, REPEAT, LOOP, GOTOB, L100, "
         "subprograms by name) out as straight code, every run of a body where it runs, each move "
         "compensated (without it their moves pass through uncompensated)",

@@ -5,7 +5,7 @@ order; without --expand their moves are left as programmed (FLOW).  With it ever
 runs is written where it runs, as a block of its own for that run: its expressions written as
 the numbers they have there (`literal`), so the moves are plain moves that compensation
 corrects like any other, and its other words (M codes, tools, dwells, spindle) act once per run,
-in the order they run.  The control lines (`o100 call`, `while`, `endwhile`, `if`, `M98`, `M99`,
+in the order they run.  The control lines (`o100 call`, `while`, `endwhile`, `if`, `M97`, `M98`, `M99`,
 `WHILE`, `END`, `GOTO` ...) and the text that does not run (untaken branches, loops that run no
 time) are left out.  Subroutine definitions stay, as the control skips them: a line out of the
 interpreter's scope in the main program, outside any loop or branch, passes the rest of the
@@ -115,10 +115,14 @@ class Expansion:
         return self.started and (len(flow.frames) > 1 or bool(main.labels) or self.branches > 0
                                  or flow.skipping is not None or main.pc in flow.looped)  # fmt: skip
 
-    def event(self, run: Running, block: Block, kind: str) -> tuple[Event | tuple[Event, ...], Block]:
+    def event(
+        self, run: Running, block: Block, kind: str, local: bool = False
+    ) -> tuple[Event | tuple[Event, ...], Block]:
         """The events of a block the flow runs, run by `run` (the interpreter's), and the block they
         are written as: a main-program line as it is (after the assignments that settle the
-        parameters it may read), a body's line as the numbers of this run (`literal`)."""
+        parameters it may read), a body's line as the numbers of this run (`literal`).  A line of a
+        Haas local subprogram (`local`) is written without its sequence number: an M97 left in the
+        program (where the rest passes through) is to find its subprogram's Nn, not a copy of it."""
         if kind is RUN and not _reads_returned(block):
             settling = self._settle(block)
             try:
@@ -130,7 +134,7 @@ class Expansion:
         self._unsettle()
         if kind is not RUN:
             self._count(block)
-        written = literal(block, self.params)
+        written = literal(block, self.params, unnumbered=local)
         events = run(block)  # (an expression `literal` cannot evaluate fails here, as without --expand)
         if written is None:
             raise NcppError(
@@ -215,15 +219,28 @@ def _each(events: Event | tuple[Event, ...]) -> tuple[Event, ...]:
     return events if type(events) is tuple else (events,)  # type: ignore[return-value]
 
 
-def literal(block: Block, params: Parameters) -> Block | None:
+def literal(block: Block, params: Parameters, unnumbered: bool = False) -> Block | None:
     """The block as it runs now: each expression word as its value's number (a vacant one left
-    out), its parameter assignments left out (but Fanuc's stop with a message), the rest as
-    written.  None where an expression cannot be evaluated (the interpreter then says why)."""
+    out), its parameter assignments left out (but Fanuc's stop with a message), its N word too where
+    `unnumbered`, the rest as written.  None where an expression cannot be evaluated (the
+    interpreter then says why)."""
     try:
-        texts = [_text(item, block.raw, params) for item in block.items]
+        texts = [None if unnumbered and type(item) is Word and item.letter == "N" else _text(item, block.raw, params)
+                 for item in block.items]  # fmt: skip
     except (ExpressionError, OutOfScope):
         return None
-    return rewritten(block, texts)
+    written = rewritten(block, texts)
+    return _unindented(written) if unnumbered and texts and texts[0] is None else written
+
+
+def _unindented(block: Block) -> Block:
+    """The block without the blanks its text now starts with (those after a leading word left out)."""
+    raw = block.raw
+    cut = len(raw) - len(raw.lstrip(" \t"))
+    if cut == 0:
+        return block
+    items = tuple(_placed(item, raw[item.start : item.end], item.start - cut) for item in block.items)
+    return Block(raw[cut:], block.eol, items, block.line)
 
 
 def rewritten(block: Block, texts: list[str | None]) -> Block:

@@ -8,8 +8,9 @@ reads the same codes otherwise (G5.1 is a spline there, G8 lathe radius mode):
 * Fanuc (0i-MF / 30i operator's manuals): `G05.1 Q1` / `Q0`, AI contour control on and off;
   `G08 P1` / `P0`, advanced preview control on and off.
 * Haas (Mill Operator's Manual, "G-codes"): also `G187 P1-P3 [E..]`, the smoothness level and
-  corner tolerance; `G103 P..`, the limit of blocks looked ahead.  `M97 P..` runs a local
-  subprogram at a sequence number: it ends interpretation with a warning.  So do `G12`/`G13`,
+  corner tolerance; `G103 P..`, the limit of blocks looked ahead.  `M97 P<n> L<runs>` runs the
+  program's own blocks from Nn to M99, a local subprogram (`Flow._m97`, `local_calls`); an M97 with
+  other words in its block ends interpretation with a warning.  So do `G12`/`G13`,
   circular pocket milling clockwise / counterclockwise: the control spirals out from the point it
   stands on over I, K, Q with the D offset's cutter compensation (Haas VF-series manual 96-8000,
   "Circular Pocket Milling"), a path ncpp does not compute.
@@ -163,7 +164,7 @@ FANUC_UNFOLLOWED = {("G", 45.0): f"G45 ({_POSITION_OFFSET})", ("G", 46.0): f"G46
                     ("G", 47.0): f"G47 ({_POSITION_OFFSET} twice)",
                     ("G", 48.0): f"G48 ({_POSITION_OFFSET} twice)"}  # fmt: skip
 HAAS_UNFOLLOWED = {("G", 54.1): "G54.1 (Fanuc's additional work offset; Haas selects its own with G154)",
-                   ("M", 97.0): "M97 (a local subprogram at a sequence number)",
+                   ("M", 97.0): "M97 with other words in its block than P and L (a local subprogram call)",
                    ("G", 12.0): "G12 (Haas circular pocket milling, a path the control computes)",
                    ("G", 13.0): "G13 (Haas circular pocket milling, a path the control computes)"}  # fmt: skip
 
@@ -480,6 +481,8 @@ class HaasInterpreter(FanucInterpreter):
     # ("M98 Sub Program Call": "M98 Pnnnn (Pnnnn is the number of the program being called)", runs in L;
     # its programs are numbered to O99999)
     repeats_in_p = False
+    # ("M97 Local Sub-Program Call": the blocks from Nn of the same program to its M99, L times; `Flow._m97`)
+    local_calls = True
     still_r_arc = False  # (no Haas manual page in ncpp's reference set says a 0-degree R arc does not move)
     r_over_ijk = False  # (nor that R wins over I, J, K)
     independent_h = False  # (nor that an H goes without G43)

@@ -34,6 +34,15 @@ A Fanuc or Haas file may hold more programs after the first one's closing `%`, e
 in the control's memory that a call finds (`Dialect.programs_after_end`); the main program
 ends at that `%`, and the text after it runs only where called.
 
+Haas's local subprograms run the same way (`_m97`): `M97 P<n> [L<repeats>]` runs the blocks of
+the program's own text from the one numbered Nn to its M99, then goes on after the call (Haas
+Mill Operator's Manual 96-8000 and its NGC edition, M-codes, "M97 Local Sub-Program Call": "a
+subroutine referenced by a line number (N) within the same program", which "must end with an
+M99"; "Lnn ... repeats the subprogram call nn times", 1-99; "The subprogram is within the body
+of the main program, placed after the M30").  Nn is searched forward from the call; a block Nn
+before the call makes the call out of scope (which of them the control runs is not ncpp's to
+guess), and so does a local call in a program M98 or G65 calls (its own text).
+
 Fanuc macro B runs here too (the Fanuc operator's manuals, Series 16i/18i B-63684EN and 0i,
 "Custom macro": "Branch and repetition", "Macro call"):
 
@@ -111,6 +120,7 @@ MACRO_ARGUMENTS = {"A": 1, "B": 2, "C": 3, "I": 4, "J": 5, "K": 6, "D": 7, "E": 
 IJK_SETS = 10
 _FANUC_FLOW = {"goto": "goto", "if": "fanuc_if", "while": "fanuc_while", "end": "fanuc_end"}
 _MACRO_CALLS = {65.0: "g65", 66.0: "g66", 67.0: "g67"}
+_CALLS = {97.0: "m97", 98.0: "m98"}  # M97: Haas's local call, a control line only where the flow reads it
 MAX_SEQUENCE_NUMBER = 99_999
 
 
@@ -121,8 +131,8 @@ class Control:
     name: (
         str | tuple | None
     )  # a tuple: `o[expr]`, an expression evaluated where the line runs; None: M98, M99
-    keyword: str  # sub, call, while, ...; m98, m99; goto, fanuc_if, fanuc_while, fanuc_end; g65, g66, g67
-    arguments: tuple  # expressions; M98's P and L words; G65's and G66's P, L and argument words
+    keyword: str  # sub, call, while, ...; m97-m99; goto, fanuc_if, fanuc_while, fanuc_end; g65, g66, g67
+    arguments: tuple  # expressions; M97's and M98's P and L words; G65's and G66's P, L and argument words
     item: Statement | Word | ExprWord  # where messages point
 
 
@@ -159,6 +169,7 @@ class _Frame:
     macro: bool = False  # a Fanuc G65 macro call (its own level of local variables)
     modal: bool = False  # a macro G66 calls after a move
     called: str | None = None  # a run that may be its subroutine's only one: its name (`_runs_once`)
+    local: bool = False  # a Haas local subprogram (M97): its space starts with its Nn block, which runs
 
 
 class CountedPasses:
@@ -252,6 +263,7 @@ class Flow:
         position: Callable[[], object] = lambda: None,
         repeats_in_p: bool = False,
         once: OnceRuns | None = None,
+        local_calls: bool = False,
     ):
         self.file, self.evaluate, self.parameters, self.done, self.stop, self.path = (
             file,
@@ -310,6 +322,12 @@ class Flow:
         # the blocks read ahead); a verbatim block after them stands after the closing `%`
         self.leader = 0
         self.repeats_in_p = repeats_in_p  # Fanuc: `M98 P51002` runs O1002 five times (`_m98`)
+        # Haas: `M97 P<n>` runs the program's own blocks from Nn to M99 (`_m97`); the main program's
+        # sequence numbers are noted (`dropped`, `_numbered_before`) to tell a block Nn before a call
+        self.local_calls = local_calls
+        self.locals: dict[str, list[Block]] = {}  # "N<n>" -> the local subprogram's lines, Nn to M99
+        self._first_numbered: dict[int, int] = {}  # sequence number -> its first main-program line looked at
+        self._numbers_read = 0  # the main-program lines looked at so far for `_first_numbered`
         self.once = once  # the subroutines whose first run may be CALLED (`_runs_once`; None: none)
         # definitions met before any call of them that wait for it (`_wait_for_call`): name -> lines
         self.ahead: dict[str, list[Block]] = {}
@@ -344,8 +362,9 @@ class Flow:
                 and self.modal is None
             ):
                 # the common case, nothing read ahead and no loop to go back to: straight from the
-                # stream (a Fanuc program's last blocks held for a backward GOTO)
-                buffer, hold = self.buffer, self.fanuc
+                # stream (a Fanuc program's last blocks held for a backward GOTO; a Haas program's
+                # sequence numbers noted for its local calls, `_numbered_before`)
+                buffer, hold, numbered, dropped = self.buffer, self.fanuc, self.local_calls, self.dropped
                 self._raise_fault()
                 if not hold:
                     self._drop(len(buffer))
@@ -366,6 +385,10 @@ class Flow:
                         buffer.append(block)
                         if len(buffer) > 2 * _TRIM:
                             self._drop(_TRIM)
+                    elif numbered and (signature is None or "N" in signature):
+                        number = sequence_number(block)
+                        if number is not None:
+                            dropped.add(number)
                     self.owner, self.read = block, self.read + 1
                     self.written = main.pc = self.read
                     yield block, RUN, None
@@ -419,13 +442,15 @@ class Flow:
             return (ONCE if frame.labels else RUN), None
         return (CALLED if frame.called is not None else FIXED), self.owner
 
-    def _runs_once(self, frame: _Frame, block: Block, name: str, body: list[Block], runs: int) -> bool:
+    def _runs_once(self, frame: _Frame, block: Block, name: str, body: list[Block], runs: int,
+                   first: int = 1) -> bool:  # fmt: skip
         """Whether a call may be its subroutine's only run, whose text may then be rewritten for
         it where the definition stands: one run, called from the main program's straight code in its
         place, the subroutine's first, defined in the program's own text after the call (where the
         program's end comes before its text is written) or before it, met in straight code
         (`_wait_for_call`: the writer holds its text), with no control line in its body (no
-        loop, branch, call or return: each of its lines runs once, in order)."""
+        loop, branch, call or return: each of its lines runs once, in order).  `first`: the index of
+        its first line that runs (a Haas local subprogram's Nn line runs, an `O<n>` or `sub` line not)."""
         return (
             self.once is not None
             and self.once.may_run_once(name)
@@ -440,7 +465,7 @@ class Flow:
             and name not in self.files
             and self._source_of(body) is None
             and (body[0].line > block.line or self.ahead.get(name) is body)
-            and all(self._control_of(b) is None for b in body[1:-1])
+            and all(self._control_of(b) is None for b in body[first:-1])
         )
 
     def _once(self, name: str, once: bool) -> str | None:
@@ -482,7 +507,7 @@ class Flow:
         """The first `n` blocks of the buffer, no longer wanted."""
         for block in self.buffer[:n]:
             self._controls.pop(id(block), None)
-            number = sequence_number(block) if self.fanuc else None
+            number = sequence_number(block) if self.fanuc or self.local_calls else None
             if number is not None:
                 self.dropped.add(number)
         del self.buffer[:n]
@@ -529,7 +554,10 @@ class Flow:
         try:
             return self._controls[key]
         except KeyError:
-            found = self._controls[key] = control_of(block)
+            found = control_of(block)
+            if found is not None and found.keyword == "m97" and not self.local_calls:
+                found = None  # (Haas's call: elsewhere the interpreter reads the line)
+            self._controls[key] = found
             return found
 
     def _nothing_after(self, block: Block, control: Control) -> None:
@@ -613,7 +641,7 @@ class Flow:
         self, frame: _Frame, block: Block, control: Control
     ) -> Iterator[tuple[Block, str, Block | None]]:
         """Run one control line: decide (errors point at it), write it, then jump."""
-        if control.keyword not in ("m98", "m99", "g65", "g66", "g67"):
+        if control.keyword not in ("m97", "m98", "m99", "g65", "g66", "g67"):
             self._nothing_after(block, control)
         try:
             jump = self._decide(frame, block, control)
@@ -839,6 +867,101 @@ class Flow:
             raise NcppError(f"Too many subroutine levels: calls nest at most {MAX_CALL_LEVELS - 1} deep (as in rs274ngc)",
                             Location(self.file, block.line, control.item.start + 1))  # fmt: skip
 
+    def _m97(self, frame, block, control, arrived):
+        """Haas's local subprogram call `M97 P<n> L<repeats>` (the module docstring): the lines from
+        the main program's block Nn to its M99, run L times (1-99).  A P no block can have and an Nn
+        the program lacks are the control's alarms; an Nn before the call, an L out of 1-99 and a call
+        from a program M98 or G65 runs are out of scope."""
+        number, repeats = (None if item is None else self._number(item, block) for item in control.arguments)
+        col = control.item.start + 1
+        n = int(round_half_away(number))
+        if not 1 <= n <= MAX_SEQUENCE_NUMBER:
+            raise NcppError(f"M97 P{printable(f'{number:g}')}: a sequence number is 1 to {MAX_SEQUENCE_NUMBER}, "
+                            "no block has it (a Haas alarm)", Location(self.file, block.line, col))  # fmt: skip
+        runs = 1 if repeats is None else int(round_half_away(repeats))
+        why = (
+            "(a sequence number is a whole number: which block a fraction finds is not ncpp's to guess)"
+            if number != n
+            else f"L{printable(f'{repeats:g}')} (Haas runs a local subprogram 1 to 99 times)"
+            if repeats is not None and not (repeats == runs and 1 <= runs <= 99)
+            else "in a subprogram M98 or G65 runs (its own program's sequence numbers)"
+            if frame.space is not None and not frame.local
+            else None
+        )
+        body = self._local_body(frame, n, block, col) if why is None else None
+        if body is None:
+            if why is not None:
+                self.stop(f"M97 P{printable(f'{number:g}')} {why}", block, col)
+            return lambda: None
+        name = f"N{n}"
+        self._check_level(block, control)
+        once = _label_only(body[0]) and self._runs_once(frame, block, name, body, runs, first=0)
+
+        def call():
+            frame.pc += 1
+            self.parameters.enter(None)
+            self._count_call(name)
+            self.frames.append(_Frame(body, 0, repeats=runs - 1, runs=runs, mark=self.passes.steps, local=True,
+                                      called=self._once(name, once)))  # fmt: skip
+
+        return call
+
+    def _local_body(self, frame: _Frame, number: int, block: Block, col: int) -> list[Block] | None:
+        """The lines of local subprogram Nn, from the first block Nn after the call to the first M99
+        after it, held (None: out of scope, the flow has stopped).  Refused where the program (up to
+        its closing `%`) has no block Nn after the call."""
+        call = frame.pc if frame.space is None else self._main_index(block)
+        if call is None:  # (a nested call whose line is no longer held: not looked for)
+            self.stop(f"M97 P{number} whose line is further back than the blocks ncpp holds", block, col)
+            return None
+        if self._numbered_before(call, number):
+            self.stop(f"M97 P{number} with a block N{number} before the call (which of them the control runs is not "
+                      "ncpp's to guess; Haas places a local subprogram after M30)", block, col)  # fmt: skip
+            return None
+        name = f"N{number}"
+        main, index = self.frames[0], call + 1
+        while (ahead := self._block(main, index)) is not None and (index < self.leader or not ahead.verbatim):
+            if sequence_number(ahead) == number:
+                break
+            index += 1
+        else:
+            raise NcppError(f"M97 P{number}: the program has no block N{number} after the call (a Haas alarm)",
+                            Location(self.file, block.line, col))  # fmt: skip
+        known = self.locals.get(name)
+        if known is not None and known[0] is ahead:
+            return known
+        lines: list[Block] = []
+        while (line := self._block(main, index)) is not None and len(lines) < MAX_SUBPROGRAM:
+            if lines and (_starts_program(line) or program_number(line) is not None):
+                break
+            lines.append(line)
+            control = self._control_of(line)
+            if control is not None and control.keyword == "m99":
+                self.locals[name] = lines
+                return lines
+            index += 1
+        self.stop(f"M97 P{number} (no M99 ends the local subprogram N{number} within {MAX_SUBPROGRAM:,} blocks, "
+                  "before the next program or the end of the file)", block, col)  # fmt: skip
+        return None
+
+    def _main_index(self, block: Block) -> int | None:
+        """Where `block` (a line of the main program's text) stands in it, if it is still held."""
+        at = next((i for i, held in enumerate(self.buffer) if held is block), None)
+        return None if at is None else self.base + at
+
+    def _numbered_before(self, call: int, number: int) -> bool:
+        """Whether a block of the main program's text before line `call` has sequence number `number`
+        (the lines no longer held are noted as they are dropped: `dropped`)."""
+        if number in self.dropped:
+            return True
+        first = self._first_numbered
+        for index in range(max(self._numbers_read, self.base), call):
+            found = sequence_number(self.buffer[index - self.base])
+            if found is not None:
+                first.setdefault(found, index)
+        self._numbers_read = max(self._numbers_read, call)
+        return first.get(number, call) < call
+
     def _m99(self, frame, block, control, arrived):
         if frame.space is None:
             self.stop("M99 in the main program (an endless main program)", block, control.item.start + 1)
@@ -861,7 +984,7 @@ class Flow:
                 frame.mark = self.passes.ended(frame.mark, self.rerun, frame.repeats, block.line,
                                                "a subprogram's L repeats", frame.source, around,
                                                frame.runs)  # fmt: skip
-                frame.pc, frame.labels = 1, {}
+                frame.pc, frame.labels = 0 if frame.local else 1, {}
                 if not frame.macro:
                     self.parameters.leave(None)
                     self.parameters.enter(None)
@@ -1015,6 +1138,9 @@ class Flow:
     def _jump(self, frame: _Frame, block: Block, control: Control, target: tuple) -> Callable:
         """GOTO: on at the block numbered `target`, forward (the blocks between are skipped) or back."""
         col = control.item.start + 1
+        if frame.local:  # (which text the control searches from there is not documented)
+            self.stop("GOTO in a Haas local subprogram (M97)", block, col)
+            return lambda: None
         value = self.evaluate(target, block, control.item)
         number = int(round_half_away(value))
         if not 1 <= number <= MAX_SEQUENCE_NUMBER:
@@ -1334,20 +1460,21 @@ class Flow:
         keyword = control.keyword
         if keyword in ("break", "return", "goto", "fanuc_if", "m99", "endsub"):
             return in_loop
-        if keyword not in ("call", "m98", "g65", "g66"):
+        if keyword not in ("call", "m97", "m98", "g65", "g66"):
             return False
         name = control.name
         if keyword != "call":
             number = control.arguments[0]
             if type(number) is not Word:
                 return True
-            name = str(int(round_half_away(number.value)))
+            name = ("N" if keyword == "m97" else "") + str(int(round_half_away(number.value)))
         if type(name) is not str:
             return True  # (a name computed where the call runs)
         if name in seen:
             return False
         seen.add(name)
-        body = (self.subroutines if keyword == "call" else self.subprograms).get(name)
+        bodies = {"call": self.subroutines, "m97": self.locals}.get(keyword, self.subprograms)
+        body = bodies.get(name)
         return body is None or any(self._way_out(b, False, seen) for b in body)
 
     def _with_flow(self, state: object) -> tuple | None:
@@ -1467,7 +1594,7 @@ class Flow:
 
 def control_of(block: Block) -> Control | None:
     """The block's control line, if it is one: an o-word (`O<name>` alone, a program
-    name, is not), a line of only M98 P.. L.. or M99, a Fanuc GOTO, IF ... GOTO, WHILE or
+    name, is not), a line of only M97 P.. L.., M98 P.. L.. or M99, a Fanuc GOTO, IF ... GOTO, WHILE or
     END, or a G65, G66 or G67 line (N, comments and a leading `/` aside)."""
     words: dict[str, Word | ExprWord] = {}
     for item in block.items:
@@ -1507,8 +1634,8 @@ def control_of(block: Block) -> Control | None:
     m = words.get("M")
     if m is None or type(m) is not Word:
         return None
-    if m.value == 98.0 and "P" in words and words.keys() <= {"M", "P", "L"}:
-        return Control(None, "m98", (words["P"], words.get("L")), m)
+    if m.value in _CALLS and "P" in words and words.keys() <= {"M", "P", "L"}:
+        return Control(None, _CALLS[m.value], (words["P"], words.get("L")), m)
     if m.value == 99.0 and len(words) == 1:
         return Control(None, "m99", (), m)
     return None
@@ -1596,6 +1723,12 @@ def _numbered(space: list[Block], pc: int, number: int) -> int | None:
         if sequence_number(space[index]) == number:
             return index
     return None
+
+
+def _label_only(block: Block) -> bool:
+    """Whether the block is a sequence number and comments alone (`N1000 (FACING)`): the line a
+    local subprogram's call finds, which compensation writes as it is."""
+    return all(type(item) is Comment or (type(item) is Word and item.letter == "N") for item in block.items)
 
 
 def _starts_program(block: Block) -> bool:

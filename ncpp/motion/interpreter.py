@@ -17,7 +17,8 @@ control's tool table, `tools.py`, or as the program set them with G10 L1/L10/L11
 P turns, parameters and expressions, Fanuc corner rounding and
 chamfering between two lines (`,R` `,C`, `G1 ... R`: a one-move look-ahead),
 the canned cycles G73 G74 G81-G87 G89 with G98/G99 (`cycles.py`), LinuxCNC's
-rigid tap G33.1 (`_rigid_tap`), and o-word subroutines, branches and loops, Fanuc M98/M99 subprograms and Fanuc
+rigid tap G33.1 (`_rigid_tap`), and o-word subroutines, branches and loops, Fanuc M98/M99 subprograms, Haas's
+M97 local subprograms and Fanuc
 macro B (GOTO, IF ... GOTO, WHILE ... DO ... END, G65 and G66/G67 macro calls: `flow.py`;
 `IF [..] THEN #i = ..`, vacant variables, #3000 alarms and #3006 stops,
 #5001-#5003 where known: here), and cutter compensation G40-G42.1
@@ -271,6 +272,8 @@ class Interpreter:
     external_output = False
     # `M98 P51002` runs O1002 five times (Fanuc, `Flow._m98`); rs274ngc calls O51002
     repeats_in_p = False
+    # `M97 P1000` runs the program's own blocks from N1000 to M99 (Haas, `Flow._m97`); rs274ngc has no M97
+    local_calls = False
     # An R arc that ends where it starts is an arc of 0 degrees, no move (Fanuc); rs274ngc refuses it
     still_r_arc = False
     # R with I, J or K in an arc block: the arc is R's, the others are ignored (Fanuc); rs274ngc refuses it
@@ -436,7 +439,7 @@ class Interpreter:
         flow = self.flow = Flow(
             self.file, self._evaluate, self.params, lambda: self.done, self._leave_scope,
             self.subroutine_path, state=self._loop_state, position=lambda: self.pos[:],
-            repeats_in_p=self.repeats_in_p, once=self.once_runs,
+            repeats_in_p=self.repeats_in_p, once=self.once_runs, local_calls=self.local_calls,
         )  # fmt: skip
         self.rounding = False
         expansion = self.expansion
@@ -489,7 +492,7 @@ class Interpreter:
                 continue
             try:
                 if expansion is not None:  # each block where it runs, a body's as this run's numbers
-                    event, block = expansion.event(block_event, block, kind)
+                    event, block = expansion.event(block_event, block, kind, flow.frames[-1].local)
                 else:
                     event = block_event(block)  # verbatim blocks (after the closing %) have no items
                 if kind is ONCE and (self.corner is not None or _sets_offset(event) or self._compensating()):

@@ -91,6 +91,7 @@ def _fanuc(rng: random.Random) -> tuple[str, list[str]]:
         lambda: f"G18 G42 D1\nG1 X{v()} Z{v()} F100\nG1 X{v()}\nG40\nG17",
         lambda: f"G91 G41 D1\nG1 X{v()} Y{v()} F100\nG2 X{v()} Y{v()} R{v()}\nG40 G90",
         lambda: f"M98 P9010 L{v()}",
+        lambda: f"M97 P{rng.choice(['9020', v()])} L{v()}",  # (Haas's local call: the program is Haas's)
         lambda: f"#{rng.choice(['1', '7001', '5221', '14001', '100'])}={v()}",
         lambda: f"G0 X{v()} Y{v()} Z{v()}",
     ]
@@ -98,6 +99,7 @@ def _fanuc(rng: random.Random) -> tuple[str, list[str]]:
     body = ["O9010", "#100=#1+#4+#7", "G1 X#24 Y#25 F100", f"G1 Z[#26+{v()}]", "M99"]
     if rng.random() < 0.2:
         body.insert(1, "G65 P9010 A1")
+    body = ["N9020 (LOCAL)", f"G91 G1 X{v()} F100", "G90", "M99"] + body
     return "\n".join(lines + ["M30"] + body + ["%"]) + "\n", []
 
 

@@ -187,6 +187,30 @@ KLARTEXT_REP_AROUND_CALL = (
 """
 )
 
+# Haas's local subprograms, each run L99 times (1-99, "M97 Local Sub-Program Call") by the one before
+HAAS_L_AROUND_L = """%
+O1000
+G21 G90 G17
+G0 X0 Y0 Z5 F200
+M97 P100 L99
+M30
+N100
+M97 P200 L99
+M99
+N200
+M97 P300 L99
+M99
+N300
+M97 P400 L99
+M99
+N400
+G91 G1 X1
+X-1
+G90
+M99
+%
+"""
+
 # A REP section around a CALL PGM whose program's REP section runs 60,000 blocks
 KLARTEXT_REP_AROUND_PGM = """0 BEGIN PGM LOOP MM
 1 TOOL CALL 1 Z S1000
@@ -205,6 +229,7 @@ KLARTEXT_REP_AROUND_PGM = """0 BEGIN PGM LOOP MM
         ("repeat-l.ngc", ISO_REPEAT_AROUND_L, 3),
         ("repeat-call.ngc", ISO_REPEAT_AROUND_CALL, 9),  # (the repeat: before, after its first pass, 25 s)
         ("l-l.nc", FANUC_L_AROUND_L, 5),  # (the outer M98: before, its M99 in O2000)
+        ("m97.nc", HAAS_L_AROUND_L, 5),  # (the outer M97, once the innermost run has shown its length)
         ("p-p.nc", FANUC_P_AROUND_P, 5),  # (before, P99992000 was a program O99992000 not found)
         ("for-p.mpf", SINUMERIK_FOR_AROUND_P, 3),  # (the FOR: before, 5,000,000 blocks in called files)
         ("p-p.mpf", SINUMERIK_P_AROUND_P, 3),

@@ -54,7 +54,7 @@ def test_a_setting_with_motion_in_its_block_ends_interpretation():
 @pytest.mark.parametrize(
     "block, reason, dialect",
     [("G154 P1", "G154 P1 (an additional work offset ncpp is not told: give --work-offset G154P1=X,Y,Z", "haas"),
-     ("M97 P1000", "M97 (a local", "haas"), ("G54.1 P1", "G54.1 (Fanuc's additional work offset", "haas"),
+     ("M97 P1000 X1.", "M97 with other words in its block", "haas"), ("G54.1 P1", "G54.1 (Fanuc's additional work offset", "haas"),
      ("G54.1 P1", "G54.1 P1 (an additional work offset ncpp is not told: give --work-offset G54.1P1=", "fanuc"),
      ("G54.1 P49", "G54.1 P49 (an additional work offset ncpp is not told)", "fanuc"),
      ("G154 P3 G0 X1", "G154 with other words in its block", "haas"), ("G54.1", "G54.1 without one P", "fanuc"),
@@ -89,6 +89,10 @@ def test_what_fanuc_and_haas_programs_need_ncpp_is_not_told_ends_interpretation(
         (b"G21\nG05.1 Q1\n", "fanuc"),
         (b"G65 P9810 X1. Y2.\n", "fanuc"),
         (b"o100 sub\nG0 X1\no100 endsub\nO1000\n", "iso"),  # LinuxCNC's o-words win
+        (b"%\nO1000\nM97 P100 L2\nM30\nN100\nG0 X1\nM99\n", "haas"),  # Haas's local call
+        (b"G21\nM97P100\nM30\n", "haas"),
+        (b"o100 sub\nM97 P100\no100 endsub\n", "iso"),
+        (b"G21\nM97\n(M97 P100)\n", "iso"),  # (no P: not the call; a comment's text is none)
         (b"G21 G90\nG0 X1 Y2 (G187 in a comment)\n", "iso"),
         # axis words after a G80 that gave no motion code: Fanuc's G00 before the cycle moves them, rs274 refuses
         (b"G0 X0. Y14.249\nG98 G73 X0. Y14.249 Z-1. R5. Q0.25 F250.\nG80\nZ5.533\n", "fanuc"),

@@ -228,3 +228,42 @@ def test_written_lines_are_read_back_as_the_file_holds_them(tmp_path: Path, monk
     assert compensate(path) != 0
     assert "verification: ncpp cannot read back the program it wrote" in capsys.readouterr().err
     assert not path.with_suffix(".out.ngc").exists()
+
+
+@pytest.mark.parametrize("call, label", [("M98 P9000 L2", "O9000"), ("M97 P9000 L2", "N9000")],
+                         ids=["Fanuc M98", "Haas M97"])  # fmt: skip
+def test_a_call_reading_on_to_its_subprogram_after_m30_is_verified(tmp_path: Path, monkeypatch, call, label):
+    """The read-back of a call near the top finds its subprogram after M30 by reading the written
+    lines to it: their tags are kept until the lines are read in turn (few tags kept here, a long
+    program's many in use), so the chunks are cut where the input's are."""
+    import ncpp.verify
+
+    monkeypatch.setattr(ncpp.verify, "CHUNK_MOVES", 64)
+    monkeypatch.setattr(ncpp.verify._Feed, "KEPT_TAGS", 40)
+    moves = "".join(f"X{10 + (k % 40)} Y{10 + (k * 7) % 30}\n" for k in range(600))
+    path = tmp_path / "call.nc"
+    path.write_text(f"G21 G90 G17\nT1 M6\nS1000 M3\nG0 X10 Y10 Z5\nG1 Z-1 F200\n{call}\n{moves}G0 Z5\nM5\nM30\n"
+                    f"{label} (THE SUBPROGRAM)\nG91 G1 X1.\nG90\nM99\n")  # fmt: skip
+    assert compensate(path) == 0
+
+
+def test_the_runs_of_a_haas_local_subprogram_are_verified_a_chunk_at_a_time(tmp_path: Path, monkeypatch):
+    """`M97 P100 L99` is a control line to the writer (its runs' moves are its own, written at
+    once): they are compared in chunks as they run, not held whole."""
+    import ncpp.verify
+
+    monkeypatch.setattr(ncpp.verify, "CHUNK_MOVES", 64)
+    compared: list[int] = []
+    step = ncpp.verify._Comparison.step
+
+    def counted(self, a, theirs):
+        compared.append(len(a.starts))
+        step(self, a, theirs)
+
+    monkeypatch.setattr(ncpp.verify._Comparison, "step", counted)
+    path = tmp_path / "runs.nc"
+    body = "G91 G1 X0.1 Y10. F500\nG1 Y-10.\n" * 5
+    head = "%\nO1000\nG90 G21 G17 G54\nG0 X0 Y0 Z5\nM97 P100 L99\nG90 G1 X20. Y5.\nM30\n"
+    path.write_text(f"{head}N100\n{body}G90\nM99\n%\n")
+    assert compensate(path) == 0
+    assert len(compared) > 99 * 10 // 64 and max(compared) <= 2 * 64, compared

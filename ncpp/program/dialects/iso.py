@@ -252,12 +252,12 @@ def _none(events: list[Event]) -> list[str]:
 
 def written_at_once(event: Event) -> bool:
     """Whether the writer writes the block of its first `event` from that event alone, at once: a
-    control line's (an o-word, M98, M99) that runs, whose text depends only on its `Pass`; the
+    control line's (an o-word, M97, M98, M99) that runs, whose text depends only on its `Pass`; the
     moves it runs after it (a loop's next runs, a subroutine's) are left as programmed and not
     kept, so a loop of any length is written (and verified, `ncpp.verify`) as it runs."""
     if type(event) is not Pass or event.skipped or event.cycle is not None:
         return False
-    signature = event.block.signature  # (a plain block is a control line by its M98 or M99 only)
+    signature = event.block.signature  # (a plain block is a control line by its M97-M99 only)
     return (signature is None or "M" in signature) and _Facts(event.block).flow
 
 
@@ -1077,7 +1077,7 @@ class _Facts:
 
     __slots__ = ("letters", "motion_word", "motion", "first_motion", "moves", "plain", "words", "styled",
                  "word_letters", "motion_at", "bits", "axis_bits", "absent_axes", "machine", "flow", "settles",
-                 "expression_axes")  # fmt: skip
+                 "expression_axes", "local_call")  # fmt: skip
 
     def __init__(self, block: Block | None = None):
         """The facts of `block`, read in one walk over its items (none: a block without words)."""
@@ -1097,7 +1097,8 @@ class _Facts:
         )
         self.machine = False  # it moves in machine coordinates (G53)
         self.flow = False  # a control line: an o-word (not `O<name>` alone, a program's name), M98, M99,
-        # a Fanuc GOTO, IF ... GOTO, WHILE or END
+        # Haas's M97 P, a Fanuc GOTO, IF ... GOTO, WHILE or END
+        self.local_call = False  # an M97, Haas's local call where the block has a P (`_sum_up`)
         self.settles = False  # its axis words are a G10 / G28 / G30 / G52 / G92 / G43.1's, not a move's
         self.expression_axes = ""  # the X Y Z words it writes as expressions (`Y[0]`, `Y#5`)
         for item in block.items if block is not None else ():
@@ -1125,6 +1126,8 @@ class _Facts:
         return facts
 
     def _sum_up(self) -> None:
+        if self.local_call and "P" in self.letters:
+            self.flow = True
         if self.settles:
             self.moves = False
         self.bits = sum(
@@ -1138,6 +1141,8 @@ class _Facts:
     def _read_word(self, letter: str, value: float, number: str) -> None:
         if letter == "M" and (value == 98.0 or value == 99.0):
             self.flow = True
+        elif letter == "M" and value == 97.0:
+            self.local_call = True
         self.letters.add(letter)
         self.word_letters.append(letter)
         if letter in STYLED_LETTERS:
