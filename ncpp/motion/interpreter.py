@@ -1492,8 +1492,10 @@ class Interpreter:
         l_number = words.get("L", (None,))[0] if g10 else None
         if l_number in (10.0, 11.0) or (l_number == 1.0 and not self.sets_tool_table):
             raise _OutOfScope("tool table change G10 L1/L10/L11", gcodes[0][1].start + 1)
-        if l_number not in (None, 1.0) and words.get("R", (0.0,))[0] != 0.0 and not (
-            self.rotating_g10 and l_number == 2.0
+        if (
+            l_number not in (None, 1.0)
+            and words.get("R", (0.0,))[0] != 0.0
+            and not (self.rotating_g10 and l_number == 2.0)
         ):
             raise _OutOfScope("coordinate system rotation G10 R", words["R"][1].start + 1)
         if self._rotation() is not None:
