@@ -759,6 +759,10 @@ class SinumerikInterpreter(ModalInterpreter):
                     or self._own_program(item.node[0])
                 ):
                     self.called = self._call(block, item, item.node[0].upper(), item.node[1])
+                elif what == "call" and SHOP_CYCLE.fullmatch(item.node[0]):
+                    names = _subprogram_files(item.node[0].upper())
+                    raise OutOfScope(f"call {item.node[0]} (a Siemens cycle's name; as a program of the user's, its "
+                                     f"file not found: {searched(self.subroutine_path, names)})", item.start + 1)  # fmt: skip
                 elif what == "sync_action":
                     raise OutOfScope("the synchronized action (it acts beside the blocks)", item.start + 1)
                 elif what not in ("label", "program_name", "block_delete"):

@@ -470,4 +470,7 @@ def test_sinumerik_a_program_of_the_user_s_under_a_cycle_prefix_runs_when_its_fi
         (30.0, 20.0, 3, False),
     ]
     _, warned = _events(sinumerik, "sinumerik", "G0 X0 Y0 Z5\nF_DRILL(1, 2)\nG1 X30\nM30\n", folder)
-    assert "main:2:1: warning: call F_DRILL is outside" in warned
+    assert (
+        "main:2:1: warning: call F_DRILL (a Siemens cycle's name; as a program of the user's, its file not found: none of F_DRILL.SPF"
+        in warned
+    )
