@@ -194,7 +194,6 @@ class FanucInterpreter(Interpreter):
     independent_h = True  # `G53 G00 H0 Z-110`: an H without G43, out of scope (module docstring)
     incremental_zero_set = True  # `G91 G10 L2 P1 X10.` adds 10 to G54's X (module docstring)
     rotating_g10 = False  # (an R in G10 L2 is no rotation there)
-    sets_tool_table = False  # (G10 L1 is not LinuxCNC's tool table entry there)
     g92_speed_clamp = True  # `G92 S4000`: refused as the spindle speed clamp it is (`G92_SPEED_CLAMP`)
     fanuc_variables = True  # `#5003`, `#3020`: the control's system variables, in every program
     # Polar coordinates, scaling, programmable mirror image and coordinate rotation cancel (Fanuc Series

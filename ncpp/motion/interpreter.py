@@ -82,7 +82,7 @@ from ncpp.motion.segments import (
     Setting,
     turn_xy,
 )
-from ncpp.motion.tools import SetTool, UntoldLengths
+from ncpp.motion.tools import UntoldLengths
 from ncpp.program.blocks import STRAY_TAPE, UNREADABLE, Block, Comment, ExprWord, Statement, Word
 
 MM_PER_INCH = 25.4
@@ -287,11 +287,6 @@ class Interpreter:
     # G10 L2 R turns the system's X Y about Z (LinuxCNC G-code manual, G10 L2: "optionally program R to
     # indicate the rotation of the XY axis around the Z"); elsewhere an R there is out of scope
     rotating_g10 = True
-    # G10 L1 sets a tool's entry in the tool table: the axis words its offsets, R its radius, Q its lathe
-    # orientation, each left as it was where the block does not name it, applied by a later G43 or G41/G42
-    # (LinuxCNC G-code manual, "G10 L1 Set Tool Table"); elsewhere (Fanuc's G10 L1 is another offset
-    # memory, grbl has none) it is out of scope
-    sets_tool_table = True
     # Codes that cancel a mode ncpp does not follow (which, while it interprets, is not in effect): in a
     # block they cancel nothing and are passed over (Fanuc's and Haas's safety lines, `G40 G49 G69 G80`)
     idle_cancels: frozenset[float] = frozenset()
@@ -338,7 +333,6 @@ class Interpreter:
         self.g92_saved = [0.0] * 9
         self.tool = [0.0] * 9  # the tool length offset in effect, program units
         self.tools = offsets.tools if offsets is not None else None  # the control's tool table
-        self.set_tools: dict[int, SetTool] = {}  # by tool number: the entries G10 L1 set (`_set_tool`)
         self.selected_tool = 0  # T
         self.spindle_tool = 0  # M6, M61 (0: none)
         self.untold_lengths = UntoldLengths(
@@ -1437,20 +1431,20 @@ class Interpreter:
         elif d is not None:
             if d[0] < 0.0 or abs(d[0] - round(d[0])) > 0.0001:
                 self._fail(f"G{code:g} requires D word to be a whole number", block, d[1])
-            number = round(d[0])
-            if self.tools is not None and number not in self.set_tools and number != 0:
-                if self.tools.offset(number) is None:
-                    self._fail(f"Requested tool {number} not found in the tool table", block, d[1])
+            if self.tools is not None and round(d[0]) != 0 and self.tools.offset(round(d[0])) is None:
+                self._fail(f"Requested tool {round(d[0])} not found in the tool table", block, d[1])
         if code in (
             41.0,
             42.0,
         ):  # the radius of tool D, or of the tool in the spindle, from the table ncpp is told
             number = round(d[0]) if d is not None else self.radius_offset
             number = self.spindle_tool if number is None else number
-            known = self.tools is not None or number in self.set_tools
-            entry = self._tool_entry(number)
-            self.comp_radius = entry.diameter / 2 / (MM_PER_INCH if self.inch else 1.0) if known else None
-            self.comp_orientation = entry.orientation
+            self.comp_radius = (
+                None
+                if self.tools is None
+                else self.tools.diameter(number) / 2 / (MM_PER_INCH if self.inch else 1.0)
+            )
+            self.comp_orientation = 0 if self.tools is None else self.tools.orientation(number)
             if self.plane != 18 and self.comp_orientation not in (0, 9):
                 self._fail(f"G{code:g} with lathe tool, but plane is not G18", block, item)
         self.cutter_comp = code
@@ -1495,14 +1489,9 @@ class Interpreter:
             ):
                 raise _OutOfScope(f"{reason} G{value:g}", item.start + 1)
         g10 = gcodes.get(0, (None,))[0] == 10.0
-        l_number = words.get("L", (None,))[0] if g10 else None
-        if l_number in (10.0, 11.0) or (l_number == 1.0 and not self.sets_tool_table):
+        if g10 and words.get("L", (None,))[0] in (1.0, 10.0, 11.0):
             raise _OutOfScope("tool table change G10 L1/L10/L11", gcodes[0][1].start + 1)
-        if (
-            l_number not in (None, 1.0)
-            and words.get("R", (0.0,))[0] != 0.0
-            and not (self.rotating_g10 and l_number == 2.0)
-        ):
+        if g10 and words.get("R", (0.0,))[0] != 0.0 and not (self.rotating_g10 and words["L"][0] == 2.0):
             raise _OutOfScope("coordinate system rotation G10 R", words["R"][1].start + 1)
         if self._rotation() is not None:
             self._check_turned(words, gcodes)
@@ -1616,43 +1605,12 @@ class Interpreter:
         if value != int(value) or value < 0:
             self._fail(f"{item.letter} word is not a tool number", block, item)
         number = int(value)
-        if self.tools is not None and number not in self.set_tools and self.tools.offset(number) is None:
+        if self.tools is not None and self.tools.offset(number) is None:
             self._fail(f"Requested tool {number} not found in the tool table", block, item)
         return number
 
-    def _set_tool(self, block: Block, words: dict) -> None:
-        """G10 L1 P..: tool P's entry in the tool table, the given words over what it held (module
-        attribute `sets_tool_table`); the offsets in effect change at the next G43 that reads them."""
-        if "P" not in words or round(words["P"][0]) < 1:
-            self._fail("P value out of range with G10 L1", block, words["P"][1] if "P" in words else None)
-        number = self._tool_number(words["P"], block)
-        scale = MM_PER_INCH if self.inch else 1.0
-        offsets, diameter, orientation = self._tool_entry(number)
-        given = list(offsets)
-        for letter, (value, _) in words.items():
-            if letter in AXIS_INDEX:
-                i = AXIS_INDEX[letter]
-                given[i] = value * scale if i in LINEAR else value
-        if "R" in words:
-            diameter = 2 * abs(words["R"][0]) * scale
-        if "Q" in words:
-            orientation = round(words["Q"][0])
-        self.set_tools[number] = SetTool(tuple(given), diameter, orientation)
-
-    def _tool_entry(self, number: int) -> SetTool:
-        """Tool `number`'s entry, mm: as G10 L1 set it, else from the told table, else all zero."""
-        if number in self.set_tools:
-            return self.set_tools[number]
-        if self.tools is None or self.tools.offset(number) is None:
-            return SetTool((0.0,) * 9, 0.0, 0)
-        offsets = self.tools.offset(number)
-        assert offsets is not None
-        return SetTool(offsets, self.tools.diameter(number), self.tools.orientation(number))
-
     def _table_offsets(self, number: int, item, block: Block) -> tuple[float, ...]:
         """Tool `number`'s offsets in mm; zero when ncpp is not told the table (warned once)."""
-        if number in self.set_tools:
-            return self.set_tools[number].offsets
         if self.tools is None:
             self.untold_lengths("G43", "tool.tbl", Location(self.file, block.line, item.start + 1))
             return (0.0,) * 9
@@ -1748,8 +1706,6 @@ class Interpreter:
             for i, value in given:
                 self.g92[i] = value
             self._shift(old, self.g92)
-        elif code == 10.0 and words["L"][0] == 1.0:
-            self._set_tool(block, words)
         elif code == 10.0:
             p = round(words.get("P", (0.0,))[0])
             number = self.coord_system if p == 0 else p

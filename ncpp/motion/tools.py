@@ -51,7 +51,6 @@ import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import NamedTuple
 
 from ncpp.errors import Location, NcppError, Warnings, quoted
 from ncpp.fileio import read_small
@@ -118,15 +117,6 @@ class ToolTable:
     def orientation(self, number: int) -> int:
         """Tool `number`'s lathe tool orientation (0: none, or no such tool)."""
         return self.orientations.get(number, 0)
-
-
-class SetTool(NamedTuple):
-    """A tool table entry a program set itself (LinuxCNC's G10 L1): offsets along X Y Z A B C U V W
-    (mm and degrees), diameter (mm), lathe orientation."""
-
-    offsets: tuple[float, ...]
-    diameter: float
-    orientation: int
 
 
 class UntoldLengths:
