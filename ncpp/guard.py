@@ -12,10 +12,11 @@ Per control (the ISO dialect: LinuxCNC's syntax, or Fanuc's for a program that
 starts with an O number):
 
 * LinuxCNC (G-code manual, "G Code Overview": numbered parameters #5220, the active
-  system 1-9, and #5221-#5223, ..., G54's X Y Z, with 20 per system; its comments
-  section: `(abort, text)` ends the program with the text, `(MSG, text)` shows it):
-  the values stand in the machine's units (the INI's [TRAJ]LINEAR_UNITS), whatever
-  G20/G21, as rs274 reads them.
+  system 1-9, and #5221-#5223, ..., G54's X Y Z, #5230 its rotation about Z (G10 L2 R,
+  degrees), with 20 per system; its comments section: `(abort, text)` ends the program with
+  the text, `(MSG, text)` shows it): the zeros stand in the machine's units (the INI's
+  [TRAJ]LINEAR_UNITS), whatever G20/G21, as rs274 reads them.  The rotation must be the one
+  told within `GUARD_DEG`: a system turned other than told puts every point elsewhere.
 * Fanuc and Haas (Custom Macro B: #4014 holds group 14's G code, 54-59; #5221-#5223
   G54's X Y Z, 20 per system; `#3000=n (text)` raises macro alarm n with the text and
   stops; `IF [cond] THEN` one assignment): G54-G59.  An additional work offset
@@ -67,7 +68,10 @@ After each block that applies the length of the tool in the spindle from the tol
 (G43, G43 H0 or G43 H of that tool, G43.2 H of it; `interpreter._tool_length` marks it,
 `Pass.length_told`), a check stops the program when the control's tool in the spindle or its
 length is not the one told, within `GUARD_MM`.  The block's own move (`G43 H1 Z5`) runs before
-the check; the next does not.
+the check; the next does not.  A length the program set itself (LinuxCNC's G10 L1/L10/L11, Haas's
+G10 L10/L11) is the one told from there on: the control holds it too (rs274 writes it into the
+spindle's #5401-#5409 at the G10, Haas into #2001-#2400), so the check finds the G10 run as the
+program says, and a tool table or wear that differs.
 
 * LinuxCNC (G-code manual, "Numbered Parameters": #5400 the tool number, #5401-#5409 the tool
   offsets X..W, volatile): they hold the table's entry of the tool in the spindle, set at M6 or
@@ -120,12 +124,13 @@ from functools import cache
 from itertools import chain, islice
 
 from ncpp.errors import NcppError
-from ncpp.motion.offsets import _ADDITIONAL_X, ADDITIONAL, WorkOffsets, system_name
+from ncpp.motion.offsets import _ADDITIONAL_X, _ROTATION_AFTER_X, ADDITIONAL, WorkOffsets, system_name
 from ncpp.motion.segments import Event, Pass
 from ncpp.program.blocks import AnyItem, Block, Comment, Statement, Word
 from ncpp.program.parser import LEADER_LINES, LineParser
 
 GUARD_MM = 0.1  # how far an axis's zero may be from the one told: re-touching a fixture moves it microns
+GUARD_DEG = 0.001  # how far a LinuxCNC system's rotation may be from the one told: 17 µm a metre out
 BEGIN = "ncpp placement guard:"
 END = "ncpp placement guard end"
 TOOL_BEGIN = "ncpp tool guard:"
@@ -172,13 +177,20 @@ class Placement:
     zero: tuple[float, float, float]
     unit_mm: float = 1.0
     dialect: str = "fanuc"  # whose names the systems take (Haas: G154 Pn; Klartext: the preset)
+    rotation: float = 0.0  # degrees about Z (LinuxCNC's G10 L2 R; the other controls' guards leave it)
 
     @classmethod
     def of(cls, offsets: WorkOffsets, unit_mm: float = 1.0) -> Placement | None:
         """The placement `offsets` tell (None: the system in effect is not told)."""
         if not offsets.told(offsets.active):
             return None
-        return cls(offsets.active, offsets.zero(offsets.active), unit_mm)
+        return cls.of_system(offsets, offsets.active, unit_mm)
+
+    @classmethod
+    def of_system(cls, offsets: WorkOffsets, system: int, unit_mm: float = 1.0) -> Placement:
+        """The placement of coordinate system `system` as `offsets` tell it."""
+        rotation = offsets.rotations[system - 1] if system <= len(offsets.rotations) else 0.0
+        return cls(system, offsets.zero(system), unit_mm, rotation=rotation)
 
     @property
     def name(self) -> str:
@@ -191,7 +203,8 @@ class Placement:
 
     def said(self) -> str:
         x, y, z = self.values()
-        return f"{self.name} at X{x} Y{y} Z{z} {_units(self.unit_mm)}"
+        turned = f" turned R{_number(self.rotation)}" if self.rotation else ""
+        return f"{self.name} at X{x} Y{y} Z{z} {_units(self.unit_mm)}{turned}"
 
 
 def _number(value: float) -> str:
@@ -303,6 +316,7 @@ def _linuxcnc(placement: Placement, selected: bool = False, label: int = 0) -> l
     far = [
         f"[ABS[#{x + k} {_less(value, ' ')}] GT {tolerance}]" for k, value in enumerate(placement.values())
     ]
+    far.append(f"[ABS[#{x + _ROTATION_AFTER_X} {_less(_number(placement.rotation), ' ')}] GT {GUARD_DEG}]")
     if not selected:
         far.insert(0, f"[#5220 NE {placement.system}]")
     name = f"o<ncpp_guard_{label}>" if label else "o<ncpp_guard>"
@@ -541,7 +555,7 @@ class PlacementChecks:
         if number is None or number in self.checked:
             return []
         self.checked.add(number)
-        placement = Placement(number, self.offsets.zero(number), self.unit_mm)
+        placement = Placement.of_system(self.offsets, number, self.unit_mm)
         dialect = "linuxcnc" if self.dialect == "iso" else self.dialect
         lines = guard_lines(placement, dialect, selected=True, label=len(self.checked))
         if not lines:

@@ -194,7 +194,7 @@ INCREMENTAL_CYCLE = (
 )
 
 UNKNOWN_SETTING = (
-    "G92 or G10 L20 right after moves left as programmed in G90: it sets an offset from where the control "
+    "G92 or G10 L10/L11/L20 right after moves left as programmed in G90: it sets an offset from where the control "
     "stands, which ncpp does not know exactly there; from this line on the program passes through uncompensated"
 )
 
@@ -430,6 +430,11 @@ def process(
         f"{axes} not positioned by the program yet: the correction along {axes} of this feed move and "
         "the next compensated moves is left out until the program positions them (a word written here "
         "would move the axis from wherever the control has it)", Location(file, block.line, None))  # fmt: skip
+    writer.unplaced_setting = lambda axes, block: warnings.warn(
+        f"this block sets its offset from where the control stands, and the program has not positioned "
+        f"{axes} yet: ncpp compensates the moves after it as if the tool stood at the program's zero there "
+        "(the work offset's zero); jog it there before the program runs, or set the zero as a work offset "
+        "(G10 L20, touch-off) and compensate for it", Location(file, block.line, None))  # fmt: skip
     if expand and FAMILY[name] == "heidenhain":  # (the blocks written out take numbers of their own)
         writer.renumber = True
     keep_freed_memory()  # numpy's temporaries reuse the heap, not fresh pages (runtime.py)

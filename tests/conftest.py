@@ -64,6 +64,12 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_mmount_contours_land_within_the_tolerance",
         ),
         "motion/test_oracle.py": None,
+        "compensation/test_program_tool_offsets.py": (
+            "test_g10_l1_l10_l11_set_the_offsets_rs274_applies_at_the_next_g43",
+            "test_rs274_and_ncpp_refuse_the_same_g10",
+            "test_the_abbe_arm_is_compensated_at_the_length_the_program_sets",
+            "test_pathcheck_passes_the_output_with_the_lengths_the_program_sets",
+        ),
         "motion/test_fanuc_files.py": (
             "test_the_moves_are_rs274s_of_the_twin_with_the_subprogram_in_the_first_program",
             "test_expanded_the_calls_follow_rs274s_path_of_the_twin",

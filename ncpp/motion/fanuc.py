@@ -45,6 +45,24 @@ system in effect; a P that is an expression may be 0 there.
 value is added to the offset; Haas's "Programmable Offsets": `G10 L2 P1 G91 X60.` moves G54's X
 60 mm); LinuxCNC's sets them in either.
 
+Tool offsets a program sets, with `G10 L<n> P<offset> R<value>` (the value set in G90, added in G91):
+L10 an H offset's geometry, L11 its wear, L12 a D offset's geometry, L13 its wear (the Fanuc-style
+"G10: Programmable data input" of the PowerRoute Mill Programming Manual, 1.2.10; Mitsubishi M700V
+programming manual, 12.7 "Programmed Compensation Input", tool compensation memory II; Haas's "G10
+Set Offsets": "L10 Length offset amount (for H code)", "L1 or L11 Tool wear offset amount (for H
+code)", "L12 Diameter offset amount (for D code)", "L13 Diameter wear offset amount (for D code)").
+G43 Hn then applies geometry plus wear, as tool compensation memory C keeps them (Series 0i/0i Mate
+Model B Connection Manual (Function), B-63833EN-1/02, 10 "Tool compensation memory C"); the length
+--tool-table tells for offset n is its geometry, its wear 0.  With memory A the one value of an
+offset is set by `G10 L11 P_ R_` (Series 16i/18i-PA operator's manual, B-63124EN/01, 15.3
+"Tool compensation values, number of compensation values, and entering values from the program
+(G10)": "the system allows L1 to be specified instead of L11"): so on Fanuc an L11 or L1 of an H
+offset whose geometry the program has not set with L10 is out of scope (with memory A it would be
+the whole length, with B and C the wear); on Haas it is the wear.  A D offset set so is a radius or
+a diameter as the control is set up: G41/G42 with it offsets by a radius ncpp does not know (its
+moves are corrected for their programmed points, with the warning a radius not told gets).  Any
+other word in such a block is out of scope.
+
 A G00 written in a G28 or G30 block (`G0 G28 G91 Z0.`, which Mastercam's and Fusion's Fanuc and Haas
 posts write before each tool change) only sets the modal motion: these controls take G codes of
 different groups in one block, and the group-00 return takes the axis words (Fanuc 0i-MF
@@ -130,7 +148,7 @@ from __future__ import annotations
 
 from typing import cast
 
-from ncpp.motion.interpreter import IGNORED_STATEMENTS, Interpreter, _OutOfScope, interpreting
+from ncpp.motion.interpreter import IGNORED_STATEMENTS, MM_PER_INCH, Interpreter, _OutOfScope, interpreting
 from ncpp.motion.offsets import ADDITIONAL, ADDITIONAL_CODES
 from ncpp.motion.segments import Event, Pass
 from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
@@ -199,6 +217,10 @@ class FanucInterpreter(Interpreter):
     # Polar coordinates, scaling, programmable mirror image and coordinate rotation cancel (Fanuc Series
     # 0i-MD operator's manual, G code list: G15, G50, G50.1, G69)
     idle_cancels = frozenset((15.0, 50.0, 50.1, 69.0))
+    g10_l_numbers = frozenset((1.0, 2.0, 10.0, 11.0, 12.0, 13.0, 20.0))  # (L10-L13: tool offset memory)
+    # A G10 L11 (or L1) of an H offset whose geometry the program has not set: its meaning depends on
+    # the control's tool compensation memory (module docstring); Haas's is the wear
+    wear_alone = False
 
     def _cancels_nothing(self, code: float, block: Block) -> bool:
         if code == 69.0:
@@ -408,6 +430,38 @@ class FanucInterpreter(Interpreter):
             self._shift(old, new)
         return Pass(block)
 
+    def _set_tool_offsets(self, block: Block, words: dict, given: list[tuple[int, float]]) -> None:
+        """`G10 L10-L13 P<n> R<value>`: H offset n's geometry (L10) or wear (L11, and L1), D offset n's
+        geometry (L12) or wear (L13), set in G90 and added to in G91 (module docstring).  G43 Hn then
+        applies geometry plus wear; a D offset set so is a radius ncpp does not know."""
+        l_number, col = words["L"][0], words["L"][1].start + 1
+        name = f"G10 L{l_number:g}"
+        if given or words.keys() - {"L", "P", "R"}:
+            raise _OutOfScope(f"{name} with other words than P and R (a tool offset's number and value)", col)
+        if "P" not in words or "R" not in words:
+            raise _OutOfScope(f"{name} without P or R (a tool offset's number and value)", col)
+        p, p_item = words["P"]
+        if p != int(p) or p < 1:
+            raise _OutOfScope(f"{name} with P{p:g}, no tool offset number", p_item.start + 1)
+        number, value = int(p), words["R"][0] * (MM_PER_INCH if self.inch else 1.0)
+        if l_number in (12.0, 13.0):
+            self.set_radii[number] = None  # (a radius or a diameter, as the control is set up)
+            return
+        wear = l_number in (1.0, 11.0)
+        if wear and not self.wear_alone and number not in self.h_memory:
+            raise _OutOfScope(f"{name} of H offset {number}, whose geometry the program has not set with "
+                              "G10 L10 (with tool compensation memory A it sets the whole offset, with B "
+                              "and C its wear)", col)  # fmt: skip
+        told = self.tools.offset(number) if self.tools is not None else None
+        geometry, worn = self.h_memory.get(number, (None if told is None else told[2], 0.0))
+        if wear:
+            worn = value + (0.0 if self.absolute else worn)
+        elif self.absolute or geometry is not None:
+            geometry = value + (0.0 if self.absolute else geometry or 0.0)
+        self.h_memory[number] = (geometry, worn)
+        if geometry is not None:
+            self.set_offsets[number] = {2: geometry + worn}
+
 
 class HaasInterpreter(FanucInterpreter):
     """Haas: also a P on G73 and G83, the pause at the bottom of each hole after its last peck, which
@@ -432,6 +486,7 @@ class HaasInterpreter(FanucInterpreter):
     still_r_arc = False  # (no Haas manual page in ncpp's reference set says a 0-degree R arc does not move)
     r_over_ijk = False  # (nor that R wins over I, J, K)
     independent_h = False  # (nor that an H goes without G43)
+    wear_alone = True  # ("G10 Set Offsets": "L1 or L11 Tool wear offset amount (for H code)")
     # The NGC control's general-purpose variables, kept at power off, where its system variables
     # (#1000-#9999, #11000 on) are the control's (the Haas NGC manual's "System Variables" table, as
     # zappettiniconsulting.com/wiki/haas-system-variables quotes it: #10000-#10999 general-purpose,

@@ -36,6 +36,7 @@ class GrblInterpreter(Interpreter):
     arc_normal_offset_ignored = True
     rigid_tapping = False  # (grbl has no spindle-synchronised motion)
     rotating_g10 = False  # (grbl's G10 L2 takes no R)
+    tool_table_g10 = False  # (grbl has no tool table: G43.1 gives the offset itself)
     start_motion = 0.0  # (grbl's parser starts in G0)
 
     def block(self, block: Block) -> Event | tuple[Event, ...]:

@@ -12,7 +12,8 @@ Scope: modal G0-G3, planes, G90/G91, G90.1/G91.1, G20/G21 (state converted
 on a switch, like LinuxCNC), G54-G59.3, G10 L2/L20 (L2's R: the system turned about Z; Fanuc's and
 Haas's G68, additional work offsets and their readings of G10: `fanuc.py`), G92 family,
 G52, G53, G28/G30, T, M6, M61, G43 / G43.1 / G43.2 H / G49 (lengths from the
-control's tool table, `tools.py`; zero when it is not told), F and inverse time, IJK and R arcs, helices,
+control's tool table, `tools.py`, or as the program set them with G10 L1/L10/L11:
+`_set_tool_offsets`; zero when neither tells them), F and inverse time, IJK and R arcs, helices,
 P turns, parameters and expressions, Fanuc corner rounding and
 chamfering between two lines (`,R` `,C`, `G1 ... R`: a one-move look-ahead),
 the canned cycles G73 G74 G81-G87 G89 with G98/G99 (`cycles.py`), LinuxCNC's
@@ -287,6 +288,10 @@ class Interpreter:
     # G10 L2 R turns the system's X Y about Z (LinuxCNC G-code manual, G10 L2: "optionally program R to
     # indicate the rotation of the XY axis around the Z"); elsewhere an R there is out of scope
     rotating_g10 = True
+    # G10 L1/L10/L11 set a tool's offsets in the control's tool table (`_set_tool_offsets`); grbl has none
+    tool_table_g10 = True
+    # The L numbers a G10 takes (rs274ngc's; Fanuc's and Haas's also L12 L13, their D offsets)
+    g10_l_numbers = frozenset((1.0, 2.0, 10.0, 11.0, 20.0))
     # Codes that cancel a mode ncpp does not follow (which, while it interprets, is not in effect): in a
     # block they cancel nothing and are passed over (Fanuc's and Haas's safety lines, `G40 G49 G69 G80`)
     idle_cancels: frozenset[float] = frozenset()
@@ -335,6 +340,15 @@ class Interpreter:
         self.tools = offsets.tools if offsets is not None else None  # the control's tool table
         self.selected_tool = 0  # T
         self.spindle_tool = 0  # M6, M61 (0: none)
+        # what the program set in the control's tool table (G10 L1/L10/L11, Fanuc's and Haas's G10 L10-L13):
+        # per tool (offset) number its offsets by axis in mm, over the told table's (`_table_offsets`),
+        # its radius in mm (None: set to a value ncpp does not read) and its lathe tool orientation
+        self.set_offsets: dict[int, dict[int, float]] = {}
+        self.set_radii: dict[int, float | None] = {}
+        self.set_orientations: dict[int, int] = {}
+        # Fanuc's and Haas's H offsets the program set: (geometry, wear) in mm (geometry None: not known)
+        self.h_memory: dict[int, tuple[float | None, float]] = {}
+        self.unpositioned = {0, 1, 2}  # the axes X Y Z no move has put at a known position yet
         self.untold_lengths = UntoldLengths(
             offsets is not None and offsets.tools is None
         )  # warned at the first G43 that reads the table
@@ -651,8 +665,8 @@ class Interpreter:
         if self.corner is not None:
             raise _OutOfScope("Fanuc corner rounding in a loop or subroutine", None)
         if _sets_offset(event):  # set from where each run of the text stands: no one shift
-            raise _OutOfScope("G92 or G10 L20 in a loop or subroutine (it sets an offset from where "
-                              "the control stands, which compensation moves)", None)  # fmt: skip
+            raise _OutOfScope("G92 or G10 L10/L11/L20 in a loop or subroutine (it sets an offset from "
+                              "where the control stands, which compensation moves)", None)  # fmt: skip
         events: tuple[Event, ...] = event if type(event) is tuple else (event,)  # type: ignore[assignment]
         out = [kept for ev in events if (kept := _as_programmed(ev, owner)) is not None]
         return tuple(out) if len(out) != 1 else out[0]
@@ -801,9 +815,28 @@ class Interpreter:
         """The event(s) of one block; updates the modal state.  Under a rotation of the coordinate
         system the moves are in the turned frame, a translation of the machine's (`Context.turned`)."""
         events = self._block_events(block)
+        if self.unpositioned and _moves(events):
+            self._note_positioned(block)
         if self.unsettled_rotation is not None and _moves(events):
             self._settle_rotation(block)
         return _turned(events) if self.rotations or self.g68 is not None else events
+
+    def _note_positioned(self, block: Block) -> None:
+        """The axes X Y Z a block's move puts at a known position (off `unpositioned`): those it
+        names in G90 (a canned cycle's X Y: where it leaves Z depends on where it started), and
+        those a G28/G30 homes (the named ones, or all)."""
+        homes = _homes(block)
+        if not (homes or self.absolute):
+            return
+        named = {
+            "XYZ".index(item.letter)
+            for item in block.items
+            if (type(item) is Word or type(item) is ExprWord) and item.letter in "XYZ"
+        }
+        if homes:
+            self.unpositioned -= named or {0, 1, 2}
+        else:
+            self.unpositioned -= named - {2} if self.motion in CANNED else named
 
     def _settle_rotation(self, block: Block) -> None:
         """Fanuc: after G68, moves in G91 run from where the tool stood at G68 (the centre for them,
@@ -1272,7 +1305,7 @@ class Interpreter:
                 self._fail("Cannot use g53 incremental", block, mode0_item)
         if mode0 == 10.0:
             l_number = words.get("L", (None,))[0]
-            if l_number not in (1.0, 2.0, 10.0, 11.0, 20.0):
+            if l_number not in self.g10_l_numbers:
                 self._fail("Line with G10 does not have L1, L10, L11, L2, or L20", block, mode0_item)
             p = words.get("P", (0.0,))[0]
             if abs(p - round(p)) > 0.0001:
@@ -1431,7 +1464,7 @@ class Interpreter:
         elif d is not None:
             if d[0] < 0.0 or abs(d[0] - round(d[0])) > 0.0001:
                 self._fail(f"G{code:g} requires D word to be a whole number", block, d[1])
-            if self.tools is not None and round(d[0]) != 0 and self.tools.offset(round(d[0])) is None:
+            if not self._in_table(round(d[0])):
                 self._fail(f"Requested tool {round(d[0])} not found in the tool table", block, d[1])
         if code in (
             41.0,
@@ -1439,15 +1472,20 @@ class Interpreter:
         ):  # the radius of tool D, or of the tool in the spindle, from the table ncpp is told
             number = round(d[0]) if d is not None else self.radius_offset
             number = self.spindle_tool if number is None else number
-            self.comp_radius = (
-                None
-                if self.tools is None
-                else self.tools.diameter(number) / 2 / (MM_PER_INCH if self.inch else 1.0)
-            )
-            self.comp_orientation = 0 if self.tools is None else self.tools.orientation(number)
+            radius = self._radius_mm(number)
+            self.comp_radius = None if radius is None else radius / (MM_PER_INCH if self.inch else 1.0)
+            told = 0 if self.tools is None else self.tools.orientation(number)
+            self.comp_orientation = self.set_orientations.get(number, told)
             if self.plane != 18 and self.comp_orientation not in (0, 9):
                 self._fail(f"G{code:g} with lathe tool, but plane is not G18", block, item)
         self.cutter_comp = code
+
+    def _radius_mm(self, number: int) -> float | None:
+        """Tool (D offset) `number`'s radius in mm, as the program set it or the told table gives it
+        (None: not known)."""
+        if number in self.set_radii:
+            return self.set_radii[number]
+        return None if self.tools is None else self.tools.diameter(number) / 2
 
     def _radius_offset(self, block: Block, word: tuple, with_code: bool) -> int:
         """A modal D: a whole offset number, 0 for none (Fanuc's D00).  One without G40/G41/G42
@@ -1489,9 +1527,14 @@ class Interpreter:
             ):
                 raise _OutOfScope(f"{reason} G{value:g}", item.start + 1)
         g10 = gcodes.get(0, (None,))[0] == 10.0
-        if g10 and words.get("L", (None,))[0] in (1.0, 10.0, 11.0):
+        l_number = words["L"][0] if g10 else None
+        if l_number in (1.0, 10.0, 11.0) and not self.tool_table_g10:
             raise _OutOfScope("tool table change G10 L1/L10/L11", gcodes[0][1].start + 1)
-        if g10 and words.get("R", (0.0,))[0] != 0.0 and not (self.rotating_g10 and words["L"][0] == 2.0):
+        if (
+            l_number in (2.0, 20.0)
+            and words.get("R", (0.0,))[0] != 0.0
+            and not (self.rotating_g10 and l_number == 2.0)
+        ):
             raise _OutOfScope("coordinate system rotation G10 R", words["R"][1].start + 1)
         if self._rotation() is not None:
             self._check_turned(words, gcodes)
@@ -1503,7 +1546,11 @@ class Interpreter:
         L2 of it, another system selected) as if no G92 offset were in effect: with one, where a rotation
         is in effect before or after, its position and the machine's part (not followed)."""
         code, item = gcodes.get(0, (None, None))
-        if code == 10.0 and round(words.get("P", (0.0,))[0]) in (0, self.coord_system):
+        if (
+            code == 10.0
+            and words["L"][0] in (2.0, 20.0)
+            and round(words.get("P", (0.0,))[0]) in (0, self.coord_system)
+        ):
             if self.rotations.get(self.coord_system) or words.get("R", (0.0,))[0]:
                 raise _OutOfScope("G10 L2 of the system in effect under a rotation and a G92 offset",
                                   item.start + 1)  # fmt: skip
@@ -1515,10 +1562,13 @@ class Interpreter:
     def _check_turned(self, words: dict, gcodes: dict) -> None:
         """What ncpp does not follow under a rotation of the coordinate system: an offset set from where
         the tool stands (its words would have to be turned with the correction: G92, G10 L20), and a G28 or
-        G30 whose intermediate point names X or Y (the axes it places are the turned frame's)."""
+        G30 whose intermediate point names X or Y (the axes it places are the turned frame's); so a
+        tool's offsets set from where it stands (G10 L10/L11: rs274ngc turns the point first)."""
         code, item = gcodes.get(0, (None, None))
         if code == 92.0 or (code == 10.0 and words["L"][0] == 20.0):
             raise _OutOfScope(f"G{code:g} under a coordinate system rotation", item.start + 1)
+        if code == 10.0 and words["L"][0] in (10.0, 11.0):
+            raise _OutOfScope(f"G10 L{words['L'][0]:g} under a coordinate system rotation", item.start + 1)
         if code in (28.0, 30.0) and ("X" in words or "Y" in words):
             raise _OutOfScope(f"G{code:g} with X or Y under a coordinate system rotation", item.start + 1)
 
@@ -1584,7 +1634,11 @@ class Interpreter:
         elif code in (43.0, 43.2):
             number = self._tool_number(words["H"], block) if "H" in words else 0
             table = self._table_offsets(number or self.spindle_tool, words.get("H", (0, item))[1], block)
-            if self.tools is not None and self.spindle_tool and number in (0, self.spindle_tool):
+            if (
+                self.spindle_tool
+                and number in (0, self.spindle_tool)
+                and self._length_known(self.spindle_tool)
+            ):
                 told = (self.spindle_tool, table[2])
             scale = 1 / MM_PER_INCH if self.inch else 1.0
             new = [value * scale if i in LINEAR else value for i, value in enumerate(table)]
@@ -1605,16 +1659,31 @@ class Interpreter:
         if value != int(value) or value < 0:
             self._fail(f"{item.letter} word is not a tool number", block, item)
         number = int(value)
-        if self.tools is not None and self.tools.offset(number) is None:
+        if not self._in_table(number):
             self._fail(f"Requested tool {number} not found in the tool table", block, item)
         return number
 
+    def _in_table(self, number: int) -> bool:
+        """Whether the control's tool table has tool (offset) `number`, as far as ncpp knows: any where
+        ncpp is not told the table, else the told table's and those the program set."""
+        if self.tools is None or self.tools.offset(number) is not None:
+            return True
+        return number in self.set_offsets or number in self.set_radii
+
+    def _length_known(self, number: int) -> bool:
+        """Whether ncpp knows tool `number`'s length: told in the table, or set by the program."""
+        return self.tools is not None or 2 in self.set_offsets.get(number, {})
+
     def _table_offsets(self, number: int, item, block: Block) -> tuple[float, ...]:
-        """Tool `number`'s offsets in mm; zero when ncpp is not told the table (warned once)."""
-        if self.tools is None:
+        """Tool `number`'s offsets in mm, as the program set them over the told table's; zero where
+        neither tells them (warned once where the length is not known)."""
+        if not self._length_known(number):
             self.untold_lengths("G43", "tool.tbl", Location(self.file, block.line, item.start + 1))
-            return (0.0,) * 9
-        return self.tools.offset(number)  # type: ignore[return-value]  # checked by `_tool_number`
+        told = (self.tools.offset(number) if self.tools is not None else None) or (0.0,) * 9
+        changed = self.set_offsets.get(number)
+        if not changed:
+            return told
+        return tuple(changed.get(i, value) for i, value in enumerate(told))
 
     def _warn_untold(self, number: int, block: Block, item) -> None:
         """Once per system: its zero is taken as the machine zero, which is likely wrong."""
@@ -1706,6 +1775,8 @@ class Interpreter:
             for i, value in given:
                 self.g92[i] = value
             self._shift(old, self.g92)
+        elif code == 10.0 and words["L"][0] not in (2.0, 20.0):
+            return self._set_tool_offsets(block, words, given)
         elif code == 10.0:
             p = round(words.get("P", (0.0,))[0])
             number = self.coord_system if p == 0 else p
@@ -1727,6 +1798,63 @@ class Interpreter:
         elif code in (28.0, 30.0):
             return self._go_home(block, given, self.home[int(code)])
         return setting
+
+    def _set_tool_offsets(self, block: Block, words: dict, given: list[tuple[int, float]]) -> Pass | None:
+        """LinuxCNC's G10 L1/L10/L11 P<tool>: the tool's offsets in the control's tool table, for the
+        axes the block names (LinuxCNC G-code manual, "G10 L1 Set Tool Table": the given values;
+        "G10 L10 Set Tool Table": such that the current point, with the work offsets in effect and
+        the new offset applied, reads them; "G10 L11 Set Tool Table": as L10, but as if G59.3 were
+        in effect and no G92 offset), R its radius and Q its lathe orientation.  The offset in effect
+        changes only at the next G43 (rs274 applies none at the G10).  L10 and L11 set the offset
+        from where the control stands, which compensation moves: their `Setting` carries it."""
+        l_number, (p, p_item) = words["L"][0], words.get("P", (0.0, words["L"][1]))
+        number = round(p)
+        if number <= 0:
+            self._fail(f"P value out of range with G10 L{l_number:g}", block, p_item)
+        if not self._in_table(number):
+            self._fail(f"Requested tool {number} not found in the tool table", block, p_item)
+        if not given and not words.keys() & set("RQIJ"):
+            self._fail("G10 L1 without offsets has no effect", block, words["L"][1])  # (rs274's, for each L)
+        if l_number != 1.0:
+            self._check_from_here(block, words, given)
+        scale = MM_PER_INCH if self.inch else 1.0
+        entry = self.set_offsets.setdefault(number, {})
+        for i, value in given:
+            entry[i] = self._tool_offset_value(l_number, i, value) * (scale if i in LINEAR else 1.0)
+        if "R" in words:
+            self.set_radii[number] = abs(words["R"][0]) * scale
+        if "Q" in words:
+            self.set_orientations[number] = round(words["Q"][0])
+        if l_number == 1.0 or not given:
+            return None
+        here = (self.pos[0], self.pos[1], self.pos[2])
+        return Pass(block, setting=Setting(tuple(given), self.context(), here))
+
+    def _tool_offset_value(self, l_number: float, i: int, value: float) -> float:
+        """Axis `i`'s tool offset (program units) that G10 L`l_number` sets from its word `value`."""
+        if l_number == 1.0:
+            return value
+        here = self.pos[i] + self.tool[i]  # (the machine position less the work offsets in effect)
+        if l_number == 10.0:
+            return here - value
+        return here + self.g5x[self.coord_system][i] + self.g92[i] - self.g5x[9][i] - value
+
+    def _check_from_here(self, block: Block, words: dict, given: list[tuple[int, float]]) -> None:
+        """G10 L10/L11 read where the tool stands: out of scope where ncpp does not know it (an axis
+        no move has placed since the start, or one held over a tool change in its block, or under
+        cutter compensation), and for axes past X Y Z (compensation moves them too)."""
+        col = words["L"][1].start + 1
+        name = f"G10 L{words['L'][0]:g}"
+        if any(i >= 3 for i, _ in given):
+            raise _OutOfScope(f"{name} of an axis other than X Y Z", col)
+        unknown = [AXES[i] for i, _ in given if i in self.unpositioned]
+        if unknown or self.unmoved is not None:
+            what = f"{' '.join(unknown)} no move has put at a known position" if unknown else "a tool change"
+            raise _OutOfScope(
+                f"{name} after {what} (it sets the tool offset from where the tool stands)", col
+            )
+        if self._compensating():
+            raise _OutOfScope(f"{name} under cutter compensation", col)
 
     def _set_zero(
         self, number: int, given: list[tuple[int, float]], l_number: float, added: bool, angle: float | None
@@ -2366,7 +2494,7 @@ def _marked(events: Event | tuple[Event, ...] | None, marks: list[Pass]) -> Even
 
 
 def _sets_offset(event: Event | tuple[Event, ...]) -> bool:
-    """Whether the events set an offset from where the control stands (G92, G10 L20)."""
+    """Whether the events set an offset from where the control stands (G92, G10 L10/L11/L20)."""
     events = event if type(event) is tuple else (event,)
     return any(type(ev) is Pass and ev.setting is not None for ev in events)
 

@@ -246,7 +246,7 @@ class Arc:
 
 @dataclass(frozen=True, slots=True)
 class Setting:
-    """What a G92 or G10 L20 block sets from where the control stands: the offset that gives the
+    """What a G92 or G10 L10/L11/L20 block sets from where the control stands: the offset that gives the
     current point the block's coordinates.  The control stands at the compensated point, off
     `position` by `shift`; written with their values moved by it, the block sets the offset the
     program means (apply_error_map fills `shift`, the writer writes it)."""
@@ -266,7 +266,7 @@ class Pass:
     # a control line's (an o-word; Sinumerik's loop end, jump or subprogram call, which runs other
     # blocks' moves after its text): the modal motion (G0-G3, a cycle; Sinumerik's CIP, CT) where it runs
     motion: float | str | None = None
-    setting: Setting | None = None  # a G92 or G10 L20 block's
+    setting: Setting | None = None  # a G92 or G10 L10/L11/L20 block's
     # --expand-cycles: `cycle` the G code of a canned cycle's block whose moves are written as G0/G1 blocks
     # (the first of its events), `dwell` how long it dwells between two of them (G82 G89's P, in the
     # control's unit) and `dwell_word` the P of the G4 that dwells as long on that control

@@ -594,7 +594,7 @@ def _written(chunk: list[Event], segs: list, rows: _Rows, solved: _Solved, last)
 
 
 def _placed(events: list[Event], last: Line | Arc | None) -> list[Event]:
-    """The events, a G92 / G10 L20's `Setting` told where the control stands (`last`: the last
+    """The events, a G92 / G10 L10/L11/L20 block's `Setting` told where the control stands (`last`: the last
     segment written, with its compensated end; None: nothing written yet, no shift)."""
     if last is None:
         return events

@@ -15,8 +15,8 @@ from tests.conftest import SHARED
 WIDE = SHARED / "machines" / "wide.toml"
 
 # The writer warns at line 3 (Y not positioned yet) when it writes it; the interpreter at line 5
-# (G10 L1, out of its scope) when it reads it, ahead of the writer
-PROGRAM = "G21 G90\nG0 Z5\nG1 X10 F100\nG1 X20\nG10 L1 P1 Z5\nG1 X30\nM2\n"
+# (G38.2, probing, out of its scope) when it reads it, ahead of the writer
+PROGRAM = "G21 G90\nG0 Z5\nG1 X10 F100\nG1 X20\nG38.2 Z-5 F10\nG1 X30\nM2\n"
 
 
 def said_lines(text: str) -> list[int]:
@@ -36,7 +36,7 @@ def test_the_writers_warning_comes_before_a_later_lines_of_the_interpreter(verif
 @pytest.mark.skipif(not WIDE.exists(), reason="no shared machine file")
 def test_the_warnings_held_are_said_when_the_run_is_refused():
     said = io.StringIO()
-    program = PROGRAM.replace("G10 L1 P1 Z5\n", "").replace("G1 X30", "G1 X30 F-1")
+    program = PROGRAM.replace("G38.2 Z-5 F10\n", "").replace("G1 X30", "G1 X30 F-1")
     with pytest.raises(NcppError, match="Negative f word"):
         process(io.BytesIO(program.encode()), io.BytesIO(), file="p.ngc",
                 source=ErrorSource.from_machine_file(str(WIDE)), warnings=Warnings(stream=said))  # fmt: skip

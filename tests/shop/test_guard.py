@@ -20,12 +20,19 @@ G54_MM = (400.0, 350.0, 300.0)
 
 
 def _var_file(
-    path: Path, g54_mm: tuple[float, float, float], system: int = 1, g55_mm: tuple[float, ...] = ()
+    path: Path,
+    g54_mm: tuple[float, float, float],
+    system: int = 1,
+    g55_mm: tuple[float, ...] = (),
+    g54_turned: float = 0.0,
 ) -> Path:
-    """A parameter file in inches (the stand-alone rs274's units), with G55's zero where given."""
-    lines = [f"5220\t{system}.000000"]
+    """A parameter file in inches (the stand-alone rs274's units), with G55's zero where given
+    and G54 turned `g54_turned` degrees about Z (#5230, G10 L2 R)."""
+    values = {5220: float(system), 5230: g54_turned}
     for first, zero in ((5221, g54_mm), (5241, g55_mm)):
-        lines += [f"{first + k}\t{v / 25.4:.6f}" for k, v in enumerate(zero)]
+        values.update({first + k: v / 25.4 for k, v in enumerate(zero)})
+    # (rs274 wants the parameters in order)
+    lines = [f"{number}\t{value:.6f}" for number, value in sorted(values.items())]
     path.write_text("\n".join(lines) + "\n")
     return path
 
@@ -80,6 +87,23 @@ def test_rs274_runs_the_guarded_program_where_g54_matches_and_stops_it_where_not
     assert other_system.returncode != 0 and "PROGRAM_END" not in other_system.stdout, other_system.stderr
     within = _rs274(_var_file(tmp_path / "near.var", (400.05, 349.95, 300.0)), program)
     assert within.returncode == 0 and "PROGRAM_END" in within.stdout, within.stderr  # within 0.1 mm
+
+
+def test_rs274_stops_the_guarded_program_where_g54_is_turned_other_than_told(tmp_path):
+    """LinuxCNC G-code manual, "Numbered Parameters": #5230 is G54's rotation about Z (R)."""
+    told = _var_file(tmp_path / "told.var", G54_MM, g54_turned=30.0)
+    text, _ = _compensate(tmp_path, "--var-file", str(told), "--var-units", "inch")
+    assert "turned R30" in text
+    program = tmp_path / "out.ngc"
+    ran = _rs274(told, program)
+    assert ran.returncode == 0 and "PROGRAM_END" in ran.stdout, ran.stderr
+    for turned in (0.0, 30.01, -30.0):
+        stopped = _rs274(_var_file(tmp_path / "turned.var", G54_MM, g54_turned=turned), program)
+        assert stopped.returncode != 0 and "turned R30" in stopped.stderr, stopped.stderr
+        assert "STRAIGHT_FEED" not in stopped.stdout
+    unturned = _var_file(tmp_path / "unturned.var", G54_MM)
+    _compensate(tmp_path, "--var-file", str(unturned), "--var-units", "inch")
+    assert _rs274(_var_file(tmp_path / "turned.var", G54_MM, g54_turned=0.5), program).returncode != 0
 
 
 def test_the_guard_is_written_only_where_the_offset_was_told_and_not_with_no_guard(tmp_path):

@@ -256,3 +256,13 @@ def test_a_haas_g43_of_another_offset_than_the_spindles_tool_gets_no_check(tmp_p
     (or none) applies a register it is not told of as that tool's."""
     written = _haas(tmp_path, HAAS.replace("T2 M06\n", ""))[0]  # (G43 H02 with tool 1 in the spindle)
     assert "#2001+#2201" in written and "#2002" not in written
+
+
+def test_a_haas_program_that_sets_its_length_offsets_is_checked_at_them(tmp_path):
+    """Haas's "G10 Set Offsets": `G10 L10 P1 R..` sets offset 1's length, `G10 L11 P1 R..` its wear;
+    the control then holds them in #2001 and #2201, which the check after G43 H01 reads."""
+    set_at_top = HAAS.replace("G21 G90 G17\n", "G21 G90 G17\nG10 L10 P1 R120.\nG10 L11 P1 R0.02\n")
+    written, warned, _ = _haas(tmp_path, set_at_top)
+    assert "IF [ABS[#2001+#2201-120.02] GT 0.1] THEN #3000=5 (NCPP H1 LENGTH DIFFERS)" in written
+    assert "IF [ABS[#2002+#2202-75.5] GT 0.1] THEN #3000=5 (NCPP H2 LENGTH DIFFERS)" in written
+    assert not any("outside" in line for line in warned), warned

@@ -43,3 +43,18 @@ def test_klartext_names_them_too():
 def test_rapids_before_the_first_cut_or_a_program_that_positions_every_axis_say_nothing():
     assert compensated(CAMOTICS.replace(b"G0 Z3\n", b"G0 X0 Y0 Z3\n"))[1] == ""
     assert compensated(CAMOTICS.replace(b"G1 Z-1.5\n", b"G0 Y-5\nG1 Z-1.5\n"))[1] == ""
+
+
+# a hobby program's start: the tool jogged to the part's corner, G92 makes it the zero
+G92_FIRST = b"G21 G90\nG92 X0 Y0 Z0\nG0 X10 Y10 Z5\nG1 Z-1 F300\nG1 X40\nM2\n"
+
+
+def test_a_g92_before_the_program_positions_its_axes_says_where_ncpp_takes_the_tool_to_stand():
+    """G92 sets its offset from where the control stands (LinuxCNC G-code manual, "G92 Coordinate
+    System Offset"), which a program that has not positioned the axes does not say."""
+    _, said = compensated(G92_FIRST)
+    assert said.startswith("p.nc:2:1: warning: this block sets its offset from where the control stands")
+    assert "has not positioned X and Y and Z yet" in said and said.count("warning") == 1
+    _, said = compensated(G92_FIRST.replace(b"G92 X0 Y0 Z0", b"G0 X5 Y5\nG92 X0 Y0 Z0"))
+    assert "has not positioned Z yet" in said
+    assert compensated(G92_FIRST.replace(b"G92 X0 Y0 Z0", b"G0 X5 Y5 Z5\nG92 X0 Y0 Z0"))[1] == ""

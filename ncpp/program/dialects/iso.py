@@ -281,6 +281,9 @@ class IsoWriter:
         # move leaves out its correction along them (`_tell_unpositioned`: "Y" or "X and Y")
         self.unpositioned: Callable[[str, Block], None] | None = None
         self._told_unpositioned: set[str] = set()
+        # told of a G92 / G10 L20 that sets its offset from axes X Y Z the program has not positioned
+        # yet: from where the control stands, which ncpp takes to be its assumed start ("X and Y")
+        self.unplaced_setting: Callable[[str, Block], None] | None = None
         # the subroutines run once, written where their definition stands (`_AtDefinition`)
         self.once_runs: OnceRuns | None = None
         self.stamps: Stamps | None = None  # how far it has read, where a verifier tags its lines by it
@@ -372,6 +375,15 @@ class IsoWriter:
             self._told_unpositioned.update(new)
             self.unpositioned(" and ".join(new), block)
 
+    def _tell_unplaced(self, block: Block, setting: Setting) -> None:
+        """Before a G92 / G10 L20 is written (its words then position its axes): tell
+        `unplaced_setting` of the axes X Y Z it sets that the program has not positioned yet."""
+        if self.unplaced_setting is None:
+            return
+        unplaced = sorted({AXES[i] for i, _ in setting.values} - self.known_axes)
+        if unplaced:
+            self.unplaced_setting(" and ".join(unplaced), block)
+
     def _write_group(self, group: list[Event]) -> Iterable[str]:
         """The lines of one block's events (a list: cheaper than a generator per block)."""
         first = group[0]
@@ -380,6 +392,8 @@ class IsoWriter:
             return [block.text]
         if type(first) is Pass and first.cycle is not None:
             return self._expanded(block, group)
+        if type(first) is Pass and first.setting is not None:
+            self._tell_unplaced(block, first.setting)
         facts = self._read_block(block)
         if facts.flow:
             return self._write_control(block, first)
@@ -686,9 +700,9 @@ class IsoWriter:
         self._last_end = None
         return lines
 
-    # -- G92, G10 L20 -------------------------------------------------------------
+    # -- G92, G10 L10/L11/L20 -------------------------------------------------------------
     def _setting_text(self, block: Block, setting: Setting) -> str:
-        """A G92 / G10 L20 block with its axis values moved by where the control stands off the
+        """A G92 / G10 L10/L11/L20 block with its axis values moved by where the control stands off the
         programmed point (`Setting.shift`): the offset the control computes from them is the
         program's.  After it the output's position is in another frame: the next move writes
         every axis it knows."""
