@@ -20,7 +20,9 @@ reads the same codes otherwise (G5.1 is a spline there, G8 lathe radius mode):
   Offset; G45 to G48"; NCT 2000M manual, "The Tool Compensation"; Mazak's and GSK's Fanuc-style EIA
   controls read them too): a move by an offset value ncpp is not told.  It ends interpretation with a
   warning from that block, where LinuxCNC refuses the code ("Unknown g code used").  (Haas's G47 is
-  engraving, G45-G46 and G48 are none of its codes: not read so there.)
+  text engraving, "G47 Text Engraving (Group 00)": the strokes of the letters of its P0 comment, or of
+  a serial number, from the control's font, a path ncpp does not compute; it ends interpretation
+  with a warning too.  G45-G46 and G48 are none of Haas's codes: not read so there.)
 
 Both have additional work offsets: Fanuc's `G54.1 P1`-`P48` ("Additional workpiece coordinate
 systems", whose format is `G54.1 Pn` or `G54 Pn`: a G54 block with a P word selects the
@@ -166,7 +168,8 @@ FANUC_UNFOLLOWED = {("G", 45.0): f"G45 ({_POSITION_OFFSET})", ("G", 46.0): f"G46
 HAAS_UNFOLLOWED = {("G", 54.1): "G54.1 (Fanuc's additional work offset; Haas selects its own with G154)",
                    ("M", 97.0): "M97 with other words in its block than P and L (a local subprogram call)",
                    ("G", 12.0): "G12 (Haas circular pocket milling, a path the control computes)",
-                   ("G", 13.0): "G13 (Haas circular pocket milling, a path the control computes)"}  # fmt: skip
+                   ("G", 13.0): "G13 (Haas circular pocket milling, a path the control computes)",
+                   ("G", 47.0): "G47 (Haas text engraving, a path the control computes from its font)"}  # fmt: skip
 
 
 # What is out of scope under G68: codes that change the plane it turns in (Fanuc: "G17, G18 or G19 must not be

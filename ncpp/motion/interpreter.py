@@ -592,14 +592,20 @@ class Interpreter:
         """A construct outside the scope: the state is unknown from here on (an error with strict).
         `owner`: the line that ran the block (a call, a loop's end), from which the rest passes."""
         self.done = True
-        where = "this line" if owner is None else f"line {owner.line}, which runs it,"
         source = self.flow.source() if self.flow is not None else None
         if self.expansion is not None and self.flow is not None and self.expansion.refuses_leaving(self.flow):
             raise refused(reason, Location(source or self.file, block.line, col))
+        place = Location(source or self.file, block.line, col)
+        runs_it = owner.line if owner is not None else None
+        if source is not None:  # (in a called file: the warning stands at the program's line that runs it, as
+            # `modal.ModalInterpreter.leave_scope` places it, and names the place in the file)
+            runs_it = runs_it if runs_it is not None else self.flow.frames[0].pc  # type: ignore[union-attr]
+            reason, place = f"{reason} (at {place})", Location(self.file, runs_it, None)
+        where = "this line" if runs_it is None else f"line {runs_it}, which runs it,"
         self.warnings.warn(  # type: ignore[union-attr]
             f"{reason} is outside the motion interpreter's scope; from {where} on the "
             "program passes through uninterpreted (its modal state is unknown)",
-            Location(source or self.file, block.line, col),
+            place,
         )
 
     def _in_flow(self, event: Event | tuple[Event, ...], owner: Block | None) -> Event | tuple[Event, ...]:

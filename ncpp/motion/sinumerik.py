@@ -171,6 +171,11 @@ MAX_PROGRAM_LEVELS = 16
 _SUBPROGRAM_NAME = re.compile(r"(?:[A-Z]{2}|_[A-Z])\w*|L\d{1,7}", re.I)
 # The Siemens cycles and their helpers, which stay as the cycles they are (`block`), not files
 KNOWN_CYCLE = re.compile(r"CYCLE\d|POCKET\d|SLOT\d|LONGHOLE|HOLES\d|E_|F_", re.I)
+# The prefixes Siemens reserves for its cycles that a name of letters and underscores may still begin with
+# (Programming Manual Fundamentals 12/2019, "Naming rules": "The first two characters should be letters or
+# underscores"; E_ and F_ "reserved for SIEMENS cycles"): the control runs the program of the called name,
+# so one found on the subroutine path is the user's own (`_own_program`)
+SHOP_CYCLE = re.compile(r"[EF]_\w+", re.I)
 # Predefined procedures that call programs in ways not followed here (PCALL: by an absolute path)
 CALL_KEYWORDS = frozenset(("PCALL", "CALLPATH", "MCALL", "RET"))
 # Predefined procedures of the control (Job Planning manual, "Tables: list of instructions"), not
@@ -444,6 +449,15 @@ class SinumerikInterpreter(ModalInterpreter):
             raise OutOfScope(f"the subprogram call {name} with parameters and P (later runs keep the "
                              "values the first left)", item.start + 1)  # fmt: skip
         return _Call(name, path, blocks, parameters, runs)
+
+    def _own_program(self, name: str) -> bool:
+        """Whether `name`, one of the ShopMill/ShopTurn cycles' (`E_...`, `F_...`), is a program of
+        the user's on the subroutine path (`F_TP_GRINDING(..)` beside its main program), which the
+        control runs as any called program; a cycle of the control's is not there."""
+        if not SHOP_CYCLE.fullmatch(name) or not self.subroutine_path:
+            return False
+        files = self._files = self._files or Files(self.subroutine_path, "sinumerik")
+        return files.find(_subprogram_files(name.upper())) is not None
 
     def _indirect(self, expr: tuple, block: Block, item) -> str:
         """The program `CALL` or `EXTCALL` names: a string, or a string variable's value (Job Planning
@@ -736,13 +750,19 @@ class SinumerikInterpreter(ModalInterpreter):
                     pass
                 elif what == "call" and item.node[0] in PREDEFINED_PROCEDURES:
                     raise OutOfScope(f"the predefined procedure {item.node[0]}", item.start + 1)
-                elif (
-                    what == "call"
-                    and _SUBPROGRAM_NAME.fullmatch(item.node[0])
-                    and item.node[0] not in CALL_KEYWORDS
-                    and not KNOWN_CYCLE.match(item.node[0])
+                elif what == "call" and (
+                    (
+                        _SUBPROGRAM_NAME.fullmatch(item.node[0])
+                        and item.node[0] not in CALL_KEYWORDS
+                        and not KNOWN_CYCLE.match(item.node[0])
+                    )
+                    or self._own_program(item.node[0])
                 ):
                     self.called = self._call(block, item, item.node[0].upper(), item.node[1])
+                elif what == "call" and SHOP_CYCLE.fullmatch(item.node[0]):
+                    names = _subprogram_files(item.node[0].upper())
+                    raise OutOfScope(f"call {item.node[0]} (a Siemens cycle's name; as a program of the user's, its "
+                                     f"file not found: {searched(self.subroutine_path, names)})", item.start + 1)  # fmt: skip
                 elif what == "sync_action":
                     raise OutOfScope("the synchronized action (it acts beside the blocks)", item.start + 1)
                 elif what not in ("label", "program_name", "block_delete"):

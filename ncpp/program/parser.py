@@ -835,6 +835,10 @@ def _error_pos(err: lark.exceptions.UnexpectedInput) -> int:
     return pos if pos is not None else (getattr(err, "column", 1) or 1) - 1
 
 
+# A LinuxCNC o-word's name, where its keyword must follow (`o<frame_circ> call [1]`, `o100 sub`)
+_OWORD_NAME = re.compile(r"[ \t]*(?:[Nn][ \t]*\d+[ \t]*)?[Oo][ \t]*(?:<[^>]*>|\d+)[ \t]*")
+
+
 def _describe(err: lark.exceptions.UnexpectedInput, raw: str) -> str:
     pos = _error_pos(err)
     rest = raw[pos:].strip()
@@ -843,6 +847,10 @@ def _describe(err: lark.exceptions.UnexpectedInput, raw: str) -> str:
     if isinstance(err, lark.exceptions.UnexpectedToken) and err.token.type == "$END":
         return "unexpected end of block"
     snippet = rest[:20]
+    oword = _OWORD_NAME.match(raw)
+    if oword is not None and oword.end() == pos and not rest[0].isalpha():
+        # (rs274ngc: "Unknown control command in o word"; `o<name> [1]` lacks the `call`)
+        return f"an o-word without its keyword (call, sub, if, while...) before {snippet!r}"
     if rest[0] == "(" and ")" in rest:  # (a closed comment where a value or a word had to come)
         return f"a comment where a value belongs: {snippet!r}"
     if rest[0] == "(":

@@ -450,3 +450,27 @@ def test_sinumerik_a_subprogram_by_number_takes_parameters(tmp_path):
     ]
     _, warned = _events(sinumerik, "sinumerik", "G0 X0 Y0 Z10\nL143(90)\nM30\n", folder)
     assert "main:2:1: warning: call L143 (its file not found: none of L143.SPF" in warned
+
+
+def test_sinumerik_a_program_of_the_user_s_under_a_cycle_prefix_runs_when_its_file_is_there(tmp_path):
+    """A user's subprogram named like a Siemens cycle (nie11kun/TP_Worm, `NC code/MAIN.MPF`:
+    `F_TP_GRINDING_PARAMETERS(pRad-(cyT*fR-cyR*fR), alpha, ...)`, its file beside the main program):
+    E_ and F_ are the prefixes Siemens reserves for its cycles (Programming Manual Fundamentals
+    12/2019, "Naming rules"), but the control runs the program of the called name, which is the
+    user's where its file is on the subroutine path.  One not there stays a cycle ncpp does not follow."""
+    folder = _folder(
+        tmp_path, {"F_TP_STEP.SPF": "PROC F_TP_STEP(REAL A, REAL B) DISPLOF\nG1 X=A Y=B F500\nRET\n"}
+    )
+    events, warned = _events(
+        sinumerik, "sinumerik", "G0 X0 Y0 Z5\nF_TP_STEP(10, 2*10)\nG1 X30\nM30\n", folder
+    )
+    assert warned == "" and _path(events) == [
+        (0.0, 0.0, 1, False),
+        (10.0, 20.0, 2, True),
+        (30.0, 20.0, 3, False),
+    ]
+    _, warned = _events(sinumerik, "sinumerik", "G0 X0 Y0 Z5\nF_DRILL(1, 2)\nG1 X30\nM30\n", folder)
+    assert (
+        "main:2:1: warning: call F_DRILL (a Siemens cycle's name; as a program of the user's, its file not found: none of F_DRILL.SPF"
+        in warned
+    )

@@ -64,6 +64,9 @@ def test_a_setting_with_motion_in_its_block_ends_interpretation():
      ("G10 L2 P[#1] X5", "G10 L2 P0 (it sets the external work offset", "haas"),
      ("G13 Z-0.3 I0.1875 K0.2 Q0.1875 D02 F10.", "G13 (Haas circular pocket milling", "haas"),
      ("G12 I1.5 F10. Z-1.2 D01", "G12 (Haas circular pocket milling", "haas"),
+     # Haas's text engraving (CadeKiely/Hass-CNC-Programs, "CNC MILL/4x3 block - o78244.nc"), which the
+     # Haas dialect refused as an unknown G code
+     ("G47 P0 (CADE KIELY) X.01 Y-2.95 I0. J0.1 R0.05 Z-0.005 F15. E10.", "G47 (Haas text engraving", "haas"),
      ("G00 G45 H03 Z2.0", "G45 (tool position offset", "fanuc"), ("G46 X10. D15", "G46 (tool position", "fanuc"),
      ("G91 G47 G01 X10. D1", "G47 (tool position offset", "fanuc"), ("G48 Z-2. D2", "G48 (tool position", "fanuc"),
      ("N20 G53 G00 H0 Z -110 M05;", "an H word without G43 (Fanuc's", "fanuc"), ("H2", "an H word without G43", "fanuc"),

@@ -415,6 +415,33 @@ def test_an_error_in_a_subroutine_file_names_that_file(tmp_path):
     )
 
 
+def test_a_construct_out_of_scope_in_a_subroutine_file_is_warned_at_the_program_s_calling_line(tmp_path):
+    """`o<pocket_circ> call [0][0] [0.75] ...` of a subroutine file that reads the tool's diameter #5410
+    (Thaddeus-Maximus/lagun-linuxcnc, `nc_files/spr_hub_mill.ngc` and `nc_files/pocket_circ.ngc`): the
+    program passes through from its calling line, where the warning stands, naming the place in the file
+    (it stood at the file's line, which the summary counted as the program's: "from line 40 on (-7 lines)")."""
+    import io as _io
+
+    from ncpp.motion.offsets import WorkOffsets
+    from ncpp.pipeline import ErrorSource, process
+    from tests.conftest import SHARED
+
+    (tmp_path / "pocket_circ.ngc").write_text("o<pocket_circ> sub\nG1 X#1 F100\n#<td> = #5410\nG1 X#<td>\n"
+                                              "o<pocket_circ> endsub\n")  # fmt: skip
+    program = HEAD + "o<pocket_circ> call [1]\nG1 X2\nM2\n"
+    said = _io.StringIO()
+    source = ErrorSource.from_machine_file(str(SHARED / "machines" / "wide.toml"))
+    stats = process(_io.BytesIO(program.encode()), _io.BytesIO(), file="p.ngc", source=source,
+                    warnings=Warnings(stream=said), offsets=WorkOffsets.given({}, subroutine_path=[tmp_path]))  # fmt: skip
+    where = f"(at {tmp_path / 'pocket_circ.ngc'}:4:4)"
+    assert (
+        f"p.ngc:3:1: warning: #<td>, which line 3 set from machine-state parameter #5410 {where}"
+        in said.getvalue()
+    )
+    assert "from line 3, which runs it, on the program passes through" in said.getvalue()
+    assert "everything from line 3 on (3 lines)" in stats.summary.line()
+
+
 def test_the_linuxcnc_ini_names_the_subroutine_folders(tmp_path):
     from ncpp.integrations.config import Settings, with_linuxcnc_ini
 

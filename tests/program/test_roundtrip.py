@@ -109,6 +109,17 @@ def test_a_comment_inside_an_expression_is_named_so():
         )
 
 
+def test_an_o_word_without_its_keyword_is_named_so():
+    """`o<frame_circ> [0][0] [8.0] [+1][-5]  [0.1] [+4+8]` (Thaddeus-Maximus/lagun-linuxcnc,
+    `nc_files/programs/HEMA-P057.ngc`): the `call` is missing (rs274: "Unknown control command in o
+    word").  The refusal says what is missing, at the arguments."""
+    line = b"o<frame_circ> [0][0] [8.0] [+1][-5]  [0.1] [+4+8]\n"
+    with pytest.raises(NcppError, match=r"p\.ngc:2:15: an o-word without its keyword \(call, sub, if"):
+        process(io.BytesIO(b"G21\n" + line + b"M2\n"), io.BytesIO(), file="p.ngc", source=reading())
+    with pytest.raises(NcppError, match=r"p\.ngc:2:6: an o-word without its keyword"):
+        process(io.BytesIO(b"G21\no100 [1]\nM2\n"), io.BytesIO(), file="p.ngc", source=reading())
+
+
 def test_fast_path_agrees_with_lalr_parser_on_corpus(corpus):
     """The plain-line scanner must build exactly what the grammar builds."""
     parser = LineParser("iso")
