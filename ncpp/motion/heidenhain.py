@@ -252,6 +252,11 @@ def _written_positions(item: Statement) -> bool:
     )
 
 
+def _skippable(block: Block) -> bool:
+    """Whether the block has the block skip `/` (the control runs it or not, as the operator sets)."""
+    return any(type(i) is Statement and i.kind == "block_delete" for i in block.items)
+
+
 def _plane_of_axes(axes: set[int], default: int) -> int:
     for plane, (a, b, _) in PLANE_AXES.items():
         if axes == {a, b}:
@@ -507,7 +512,7 @@ class HeidenhainInterpreter(ModalInterpreter):
                 at_position, at_pattern = node[0] == "POS", node[0] == "PAT"
             elif what == "pattern_def":
                 self.pattern = self._pattern(block, item)
-                self.positions = block if _written_positions(item) else None
+                self.positions = block if _written_positions(item) and not _skippable(block) else None
                 return []
             elif (
                 what == "keyword"
@@ -753,7 +758,7 @@ class HeidenhainInterpreter(ModalInterpreter):
         if self.pos[self.tool_axis] < top:
             raise OutOfScope(f"CYCL CALL PAT from below the 2nd set-up clearance {top:g} (the control's "
                              "move up to it is not followed)", col)  # fmt: skip
-        if self._compensated_pattern(rapid):
+        if self._compensated_pattern(rapid, block):
             # (the moves to the holes compensated as a CYCL CALL POS's, the cycle's left as programmed)
             return [Positions(block, pattern=self.positions), *self._at_holes(block, holes, run, None)]
         events = self._at_holes(block, holes, run, None if rapid else words["F"][0])
@@ -766,14 +771,14 @@ class HeidenhainInterpreter(ModalInterpreter):
             self.unknown_axes -= {0, 1}
         return events
 
-    def _compensated_pattern(self, rapid: bool) -> bool:
+    def _compensated_pattern(self, rapid: bool, call: Block) -> bool:
         """Whether the holes of the PATTERN DEF are compensated one by one: single positions, all
         numbers, which the control reaches at FMAX (a rapid is never written in pieces, which
         the control's moves between the holes could not be), from where ncpp knows the tool
-        stands in the plane, without a rotation of CYCL DEF 10."""
-        return (
-            self.positions is not None and rapid and not self.unknown_axes & {0, 1} and self.rotation is None
-        )
+        stands in the plane, without a rotation of CYCL DEF 10; neither the PATTERN DEF nor the
+        `call` skippable (the PATTERN DEFs written around the call run whatever the skip says)."""
+        known = not self.unknown_axes & {0, 1} and self.rotation is None
+        return self.positions is not None and rapid and known and not _skippable(call)
 
     def _at_holes(
         self, block: Block, holes: list[Hole], run: list[Step], approach: float | None

@@ -171,3 +171,13 @@ def test_the_command_line_writes_the_corrected_pattern_and_warns_once_for_the_ca
     assert said.count("warning: drilling cycle:") == 1 and "hole pattern" not in said
     patterns = written_positions(out.read_text())
     assert len(patterns) == 3 and not np.array_equal(patterns[1], patterns[0])
+
+
+@pytest.mark.parametrize("skipped", ["PATTERN DEF", "CYCL CALL PAT"])
+def test_a_skippable_pattern_or_call_stays_as_programmed(skipped: str):
+    """Block skip `/`: the PATTERN DEFs written around the call would run whatever the operator sets."""
+    text = program(CYCLE_200, [POSITIONS, "CYCL CALL PAT FMAX"], AFTER)
+    text = re.sub(rf"^(\d+  {skipped})", r"/ \1", text, flags=re.MULTILINE)
+    assert "/ " in text
+    written, stats = compensate(text, SCALES)
+    assert written.count("PATTERN DEF") == 1 and REASONS[PATTERN] in stats.summary.left
