@@ -215,18 +215,22 @@ def warn_fixed(events: Iterable[Event], warnings: Warnings, file: str) -> Iterat
     events = iter(events)
     series = ""  # why the moves of the series under way are fixed ("": none is)
     absolute = True  # whether the series' last move was in G90
+    # the last warning's reason and block, while that block's moves go on (a pattern's holes: one warning)
+    said: tuple[str, Block] | None = None
     for event in events:
         kind = type(event)
         if kind is Line or kind is Arc:  # (not a Pass, nor a dialect's own: Klartext's pole)
             fixed = event.fixed  # type: ignore[union-attr]
+            if said is not None and said[1] is not event.block:
+                said = None
             cycle = series == CYCLE or series == HOLE
             if not fixed and cycle and absolute and not event.context.absolute:  # type: ignore[union-attr]
                 yield from _passed_on(event, events, warnings, file)
                 return
-            if (
-                fixed and fixed != series and fixed in UNCOMPENSATED
-            ):  # (a G28/G30's moves are the control's own)
+            # (a G28/G30's moves are the control's own)
+            if fixed and fixed != series and fixed in UNCOMPENSATED and (said is None or said[0] != fixed):
                 warnings.warn(UNCOMPENSATED[fixed], Location(file, event.block.line, 1))
+                said = (fixed, event.block)
             shift = event.centre_shift  # type: ignore[union-attr]
             if shift is not None and shift[0] is None and not any(shift[1]):
                 warnings.warn(UNKNOWN_RADIUS, Location(file, event.block.line, 1))

@@ -221,6 +221,9 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
         "dialect_motion/test_heidenhain_patterns.py": (
             "test_the_command_line_compensates_around_a_pattern_and_verifies_it_on_the_wide_machine",
         ),
+        "dialect_motion/test_heidenhain_pattern_positions.py": (
+            "test_the_command_line_writes_the_corrected_pattern_and_warns_once_for_the_call",
+        ),
         "dialect_motion/test_sinumerik_patterns.py": (
             "test_the_command_line_compensates_around_holes1_and_holes2_on_the_wide_machine",
         ),

@@ -16,7 +16,8 @@ as programmed, FLOW, and the caller's after it compensated), `CYCL DEF` of machi
 (they only define), the drilling cycles 200, 201, 203, 205, 207 and 240 called by M99, `CYCL CALL`
 or `CYCL CALL POS` (`heidenhain_cycles`: their moves along the tool axis are left as
 programmed, DRILLED) or `CYCL CALL PAT` at the holes of a `PATTERN DEF` (all its moves left as
-programmed, PATTERN), the datum shift of CYCL DEF 7 and the rotation of CYCL DEF 10 with the tool
+programmed, PATTERN; but single positions at FMAX, whose moves in the plane are compensated,
+`Positions`), the datum shift of CYCL DEF 7 and the rotation of CYCL DEF 10 with the tool
 axis Z (`_rotation_cycle`: the moves in the turned frame, `Context.rotation`), M2/M30
 and `END PGM` (end), and `RND R..` / `CHF ..` between two feed lines in the
 working plane (the fillet arc or chamfer line is the RND/CHF block's event; a
@@ -184,6 +185,15 @@ class Corner(Pass):
     col: int | None = None
 
 
+@dataclass(slots=True)
+class Positions(Pass):
+    """The first event of a `CYCL CALL PAT` whose holes are a `PATTERN DEF`'s single positions, all
+    numbers (`pattern`, that block): the moves to the holes are compensated, and the writer writes
+    the PATTERN DEF again before the call, each POS's X and Y where the move to it ends."""
+
+    pattern: Block | None = None
+
+
 def _offset_corner(made: list[Event], side: float | None) -> bool:
     """An RND/CHF corner between two lines under RL/RR (on `side`: `centre_offset`), both
     followed: the control rounds the contour, then offsets it, so the fillet or chamfer gets
@@ -233,6 +243,20 @@ def _as_programmed(event: Event, owner: Block | None) -> Event | None:
     return kept[0] if kept else None
 
 
+def _written_positions(item: Statement) -> bool:
+    """Whether a `PATTERN DEF` gives its holes one by one, each `POSn` with X and Y as numbers (TNC 640
+    cycle programming manual, "Pattern definition PATTERN DEF", "Defining individual machining
+    positions"): where each hole is, the block says in words a corrected value can stand in."""
+    return bool(item.node) and all(
+        name == "POS" and all(expr[0] == "num" for _, expr in words) for name, _, words in item.node
+    )
+
+
+def _skippable(block: Block) -> bool:
+    """Whether the block has the block skip `/` (the control runs it or not, as the operator sets)."""
+    return any(type(i) is Statement and i.kind == "block_delete" for i in block.items)
+
+
 def _plane_of_axes(axes: set[int], default: int) -> int:
     for plane, (a, b, _) in PLANE_AXES.items():
         if axes == {a, b}:
@@ -276,6 +300,7 @@ class HeidenhainInterpreter(ModalInterpreter):
         self.cycle: Drilling | str | None = None  # the cycle M99 / CYCL CALL runs (str: one not followed)
         self.spindle = 0.0  # the speed TOOL CALL S set (rev/min): a tapping cycle's feed follows it
         self.pattern: tuple[str, list[Hole]] | str | None = None  # PATTERN DEF's holes (str: not followed)
+        self.positions: Block | None = None  # the PATTERN DEF, where its holes are POS words of numbers only
         self.programs: list[Path] = []  # the programs CALL PGM runs, outermost first
         self.main_path: Path | None = Path(file).resolve() if file != "<stdin>" else None
         self.called: Path | None = None  # the program the block just run calls
@@ -487,6 +512,7 @@ class HeidenhainInterpreter(ModalInterpreter):
                 at_position, at_pattern = node[0] == "POS", node[0] == "PAT"
             elif what == "pattern_def":
                 self.pattern = self._pattern(block, item)
+                self.positions = block if _written_positions(item) and not _skippable(block) else None
                 return []
             elif (
                 what == "keyword"
@@ -712,10 +738,11 @@ class HeidenhainInterpreter(ModalInterpreter):
         shape's Z is added to Q203).  The control computes the holes and its own moves
         between them, which a rewritten program could not correct: all the call's moves
         are left as programmed (PATTERN) and the holes are where the pattern puts them;
-        compensation resumes after the call.  Only from above the 2nd set-up clearance and
-        with one surface for all holes (the moves between two surfaces are the control's);
-        after a PAT or FRAME grid, whose order the manual does not give, X and Y are not
-        known until a block names them."""
+        compensation resumes after the call.  Single positions (POS1-POS9, numbers) at FMAX
+        are the exception (`_compensated_pattern`): the block says where each hole is.  Only
+        from above the 2nd set-up clearance and with one surface for all holes (the moves
+        between two surfaces are the control's); after a PAT or FRAME grid, whose order the
+        manual does not give, X and Y are not known until a block names them."""
         pattern = self.pattern
         if not isinstance(pattern, tuple):
             raise OutOfScope(f"the cycle call CYCL CALL PAT ({pattern or 'no PATTERN DEF'})", col)
@@ -731,19 +758,10 @@ class HeidenhainInterpreter(ModalInterpreter):
         if self.pos[self.tool_axis] < top:
             raise OutOfScope(f"CYCL CALL PAT from below the 2nd set-up clearance {top:g} (the control's "
                              "move up to it is not followed)", col)  # fmt: skip
-        programmed, approach = self.feed, None if rapid else words["F"][0]
-        events: list[Event] = []
-        for x, y, _ in holes:
-            end = list(self.pos)
-            end[0], end[1] = x, y
-            self.feed = programmed if approach is None else approach
-            events.append(self.line(block, end, rapid))
-            self.feed = programmed
-            here = self.pos[self.tool_axis]
-            steps = [
-                (s.level, None if s.rapid else s.feed, 0.0) for s in run if s.level != here or s is not run[0]
-            ]
-            events += self.drilled(block, steps, self.tool_axis)
+        if self._compensated_pattern(rapid, block):
+            # (the moves to the holes compensated as a CYCL CALL POS's, the cycle's left as programmed)
+            return [Positions(block, pattern=self.positions), *self._at_holes(block, holes, run, None)]
+        events = self._at_holes(block, holes, run, None if rapid else words["F"][0])
         for event in events:
             if type(event) is Line:
                 event.fixed, event.placed = PATTERN, (True, True, True)
@@ -751,6 +769,35 @@ class HeidenhainInterpreter(ModalInterpreter):
             self.unknown_axes |= {0, 1}
         else:  # (the last hole is where the tool stands)
             self.unknown_axes -= {0, 1}
+        return events
+
+    def _compensated_pattern(self, rapid: bool, call: Block) -> bool:
+        """Whether the holes of the PATTERN DEF are compensated one by one: single positions, all
+        numbers, which the control reaches at FMAX (a rapid is never written in pieces, which
+        the control's moves between the holes could not be), from where ncpp knows the tool
+        stands in the plane, without a rotation of CYCL DEF 10; neither the PATTERN DEF nor the
+        `call` skippable (the PATTERN DEFs written around the call run whatever the skip says)."""
+        known = not self.unknown_axes & {0, 1} and self.rotation is None
+        return self.positions is not None and rapid and known and not _skippable(call)
+
+    def _at_holes(
+        self, block: Block, holes: list[Hole], run: list[Step], approach: float | None
+    ) -> list[Event]:
+        """The tool to each hole in the plane at the height it stands (at `approach`, None: FMAX),
+        then the cycle's `run` there along the tool axis (DRILLED)."""
+        programmed = self.feed
+        events: list[Event] = []
+        for x, y, _ in holes:
+            end = list(self.pos)
+            end[0], end[1] = x, y
+            self.feed = programmed if approach is None else approach
+            events.append(self.line(block, end, approach is None))
+            self.feed = programmed
+            here = self.pos[self.tool_axis]
+            steps = [
+                (s.level, None if s.rapid else s.feed, 0.0) for s in run if s.level != here or s is not run[0]
+            ]
+            events += self.drilled(block, steps, self.tool_axis)
         return events
 
     def _tool_def(self, block: Block, statement) -> list[Event]:

@@ -297,6 +297,9 @@ from ncpp.program.dialects.iso import IsoWriter, _Units, as_written, written_apa
 from ncpp.program.numbers import NumberStyle, format_number, style_pattern  # noqa: E402
 
 _AXES = "XYZ"
+# a PATTERN DEF's single position `POS1 (X+25 Y+33.5 Z+0)`, and its X and Y words
+_POSITION = re.compile(r"POS\d+\s*\([^)]*\)", re.IGNORECASE)
+_PLANE_WORD = re.compile(r"\b([XY])\s*([+-]?(?:\d+[.,]?\d*|[.,]\d+))", re.IGNORECASE)
 _POLAR_WORDS = frozenset(("R", "PR", "PA", "IPR", "IPA"))
 _JUMPS = frozenset((9, 10, 11, 12))  # FN 9-12: IF ... GOTO LBL
 _POLE_FUNCTIONS = frozenset(("C", "CP", "LP", "CTP", "CRP"))  # path functions that use the pole
@@ -410,7 +413,7 @@ class HeidenhainWriter(IsoWriter):
 
     # -- the stream -----------------------------------------------------------------------
     def _write_group(self, group):
-        from ncpp.motion.heidenhain import Pole
+        from ncpp.motion.heidenhain import Pole, Positions
 
         block = group[0].block
         self.eol = block.eol or self.eol
@@ -470,6 +473,10 @@ class HeidenhainWriter(IsoWriter):
         self._tell_unpositioned(block, motion)
         if _position_call(block) is not None:
             yield from self._position_call(block, motion)
+            return
+        positions = next((e for e in group if type(e) is Positions), None)
+        if positions is not None and positions.pattern is not None:
+            yield from self._pattern_call(block, positions.pattern, motion)
             return
         if corner and any(type(i) in (Word, ExprWord) and i.letter == "F" for i in block.items):
             self.restore_feed = True  # `RND R5 F200`: F200 holds for the fillet only, a C block's F is modal
@@ -540,6 +547,28 @@ class HeidenhainWriter(IsoWriter):
         else:
             yield self._numbered(block, block.raw)
         for segment in motion[len(pieces) - 1 if pieces else 0 :]:
+            self._remember_end(segment)
+
+    def _pattern_call(self, block: Block, pattern: Block, motion: list):
+        """`CYCL CALL PAT` at single positions whose moves to the holes are compensated: the PATTERN
+        DEF written again just before it, each POS's X and Y where the move to its hole ends (a
+        PATTERN DEF holds until the next: the call runs the one before it), the call as read, and
+        the PATTERN DEF as the program has it after the call, for whatever else calls it."""
+        moves = iter(e for e in motion if not e.fixed)
+
+        def corrected(shape: re.Match) -> str:
+            move = next(moves)
+            return _PLANE_WORD.sub(lambda w: self._word(w[1].upper(), move.end["XY".index(w[1].upper())], move),
+                                   shape[0])  # fmt: skip
+
+        statement = next(i for i in pattern.items if type(i) is Statement and i.kind == "pattern_def")
+        programmed = pattern.raw[statement.start : statement.end]
+        text = _POSITION.sub(corrected, programmed)
+        assert next(moves, None) is None  # (one rapid to each POS: `ncpp.motion.heidenhain.Positions`)
+        yield self._inserted(text)
+        yield self._numbered(block, block.raw)
+        yield self._inserted(programmed)
+        for segment in motion:
             self._remember_end(segment)
 
     def _feed_word(self, segment: Line | Arc) -> str:
