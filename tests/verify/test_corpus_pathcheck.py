@@ -85,8 +85,25 @@ _ARC_OFFSET = re.compile(r"\b[IJ][-+.\d]")
 _NORMAL_K = re.compile(r"\s*\bK[-+]?[\d.]+")
 
 
-def programs() -> list[Path]:
-    return corpus_files("iso_gcode") if CORPUS.is_dir() else []
+# A known defect, stated in docs/guide.md: a block that sets an offset from where the control stands
+# (here G10 L10 under a G10 L2 R rotation), met right after a compensated move, ends interpretation
+# and is written as programmed, so the offset it sets carries that move's correction (microns).
+# strict: the test fails once the defect is mended, so the entry goes with it.
+KNOWN_DEFECTS = {
+    "iso_gcode/linuxcnc_interp_oracle/interp__g10__g10-l1-l10/test.ngc": "G10 L10 under a rotation right "
+    "after a compensated move sets the tool offset from the compensated point",
+}
+
+
+def programs() -> list:
+    if not CORPUS.is_dir():
+        return []
+    return [
+        pytest.param(path, marks=pytest.mark.xfail(reason=KNOWN_DEFECTS[corpus_id(path)], strict=True))
+        if corpus_id(path) in KNOWN_DEFECTS
+        else path
+        for path in corpus_files("iso_gcode")
+    ]
 
 
 @pytest.fixture(scope="module")
