@@ -32,7 +32,10 @@ program `O<n>` of the file, or of a file `O<n>` (`O<n>.nc`) on the subroutine pa
 ends with `M99` (#1-#30 are the caller's, as in LinuxCNC; the other scoping is a call's).
 A Fanuc or Haas file may hold more programs after the first one's closing `%`, each a program
 in the control's memory that a call finds (`Dialect.programs_after_end`); the main program
-ends at that `%`, and the text after it runs only where called.
+ends at that `%`, and the text after it runs only where called.  Where a Fanuc or Haas file's
+first program ends with M99, its subprograms stand before its main program: the one later program
+that ends with M30 or M2 runs as the main one, and those before it only where called
+(`_stored_first`).
 
 Haas's local subprograms run the same way (`_m97`): `M97 P<n> [L<repeats>]` runs the blocks of
 the program's own text from the one numbered Nn to its M99, then goes on after the call (Haas
