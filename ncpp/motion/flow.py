@@ -517,11 +517,12 @@ class Flow:
                 self._drop(keep - _TRIM)
 
     def _drop(self, n: int) -> None:
-        """The first `n` blocks of the buffer, no longer wanted."""
-        for block in self.buffer[:n]:
+        """The first `n` blocks of the buffer, no longer wanted (the sequence numbers of the main program's
+        noted: those of programs stored before it, `main_top`, are theirs)."""
+        for index, block in enumerate(self.buffer[:n], self.base):
             self._controls.pop(id(block), None)
             number = sequence_number(block) if self.fanuc or self.local_calls else None
-            if number is not None:
+            if number is not None and index >= self.main_top:
                 self.dropped.add(number)
         del self.buffer[:n]
         self.base += n
@@ -1081,7 +1082,7 @@ class Flow:
         if number in self.dropped:
             return True
         first = self._first_numbered
-        for index in range(max(self._numbers_read, self.base), call):
+        for index in range(max(self._numbers_read, self.base, self.main_top), call):
             found = sequence_number(self.buffer[index - self.base])
             if found is not None:
                 first.setdefault(found, index)

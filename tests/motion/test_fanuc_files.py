@@ -240,10 +240,12 @@ def test_where_the_main_program_is_not_told_nothing_runs_and_the_warning_says_wh
 def test_where_the_main_program_is_not_told_the_file_passes_through_and_strict_refuses(tmp_path, name):
     program = UNTOLD[name][0]
     written, proc = compensate(tmp_path, program)
-    assert written.replace("".join(f"{line}\n" for line in written.splitlines() if line.startswith("(ncpp ")), "") == program
+    unheaded = [line for line in written.splitlines(keepends=True) if not line.startswith("(ncpp ")]
+    assert "".join(unheaded) == program
     assert "passes through uninterpreted" in proc.stderr and "compensated 0 moves" in proc.stderr
-    command = ["compensate", "--strict", "--machine", str(READING), "--dialect", "fanuc", str(tmp_path / "p.nc")]
-    refused = subprocess.run([sys.executable, "-m", "ncpp", *command], capture_output=True, text=True, cwd=ROOT)
+    command = ["compensate", "--strict", "--machine", str(READING), "--dialect", "fanuc", str(tmp_path / "p.nc")]  # fmt: skip
+    refused = subprocess.run([sys.executable, "-m", "ncpp", *command], capture_output=True, text=True,
+                             cwd=ROOT)  # fmt: skip
     assert refused.returncode != 0 and "(refused in strict mode)" in refused.stderr, refused.stderr
 
 
@@ -261,3 +263,17 @@ def test_linuxcnc_runs_a_file_of_subprograms_first_from_its_top():
     said = io.StringIO()
     assert moves(SUB_FIRST["one subprogram"][0], "iso", said) == [("STRAIGHT_FEED", (10, 0, 0))]
     assert "p.nc:5:1: warning: M99 in the main program" in said.getvalue()
+
+
+def test_the_main_programs_jumps_and_local_calls_find_its_own_sequence_numbers():
+    """A GOTO searched back from the top of the main program, and a Haas M97, find the main program's
+    block Nn, not one of a subprogram stored before it."""
+    stored = "%\nO2000\nN10 G1 X99 F100\nN20 G1 Y99\nM99\n"
+    goto = stored + "O1000\nG21 G90\n#1 = 0\nN10 G0 X#1 Y0 Z5\n#1 = #1 + 1\nIF [#1 LT 2] GOTO 10\nM30\n%\n"
+    assert moves(goto, "fanuc") == [("STRAIGHT_TRAVERSE", (0, 0, 5)), ("STRAIGHT_TRAVERSE", (1, 0, 5))]
+    local = stored + "O1000\nG21 G90\nG0 X0 Y0 Z5\nM97 P20\nG0 X3\nM30\nN20 G1 Y7 F100\nM99\n%\n"
+    said = io.StringIO()
+    assert moves(local, "haas", said) == [
+        ("STRAIGHT_TRAVERSE", (0, 0, 5)), ("STRAIGHT_FEED", (0, 7, 5)), ("STRAIGHT_TRAVERSE", (3, 7, 5))
+    ]  # fmt: skip
+    assert "ncpp runs O1000 as the main program" in said.getvalue() and "outside" not in said.getvalue()
