@@ -823,9 +823,9 @@ class Flow:
         return found
 
     def _program_end(self, start: int, most: int | None) -> tuple[str | None, int]:
-        """How the program whose O line stands at `start` ends first (M99, M30, M2; None: neither
-        before the next program, `%` or the end of the file, or within `most` blocks), and where the
-        next program's O line (or the end of the text) stands."""
+        """How the program whose O line stands at `start` ends first (M99, M30, M2, `_end_code`; None:
+        neither before the next program, `%` or the end of the file, or within `most` blocks), and
+        where the next program's O line (or the end of the text) stands."""
         main, index, end = self.frames[0], start + 1, None
         while (block := self._block(main, index)) is not None:
             if program_number(block) is not None:
@@ -833,15 +833,7 @@ class Flow:
             if end is None:
                 if _starts_program(block) or most is not None and index - start > most:
                     return None, index
-                control = self._control_of(block)
-                if control is not None and control.keyword == "m99":
-                    end = "M99"
-                elif _ends_program(block):
-                    end = (
-                        "M30"
-                        if any(type(i) is Word and i.letter == "M" and i.value == 30.0 for i in block.items)
-                        else "M2"
-                    )
+                end = _end_code(block)
                 if end is not None and most is not None:
                     return end, index
             index += 1
@@ -1898,6 +1890,17 @@ def _main_program(programs: list[_Program]) -> tuple[_Program | None, str]:
     if between is not None:
         return None, f"{between.name}, before {main.name}, ends with neither M99 nor M30 or M2"
     return main, ""
+
+
+_ENDS = {99.0: "M99", 30.0: "M30", 2.0: "M2"}
+
+
+def _end_code(block: Block) -> str | None:
+    """The code that ends a program in the block, M99 (with other words too: `G90 M99`), M30 or M2."""
+    if block.signature is not None and "M" not in block.signature:
+        return None
+    return next((_ENDS[item.value] for item in block.items
+                 if type(item) is Word and item.letter == "M" and item.value in _ENDS), None)  # fmt: skip
 
 
 def _no_code(block: Block) -> bool:

@@ -277,3 +277,14 @@ def test_the_main_programs_jumps_and_local_calls_find_its_own_sequence_numbers()
         ("STRAIGHT_TRAVERSE", (0, 0, 5)), ("STRAIGHT_FEED", (0, 7, 5)), ("STRAIGHT_TRAVERSE", (3, 7, 5))
     ]  # fmt: skip
     assert "ncpp runs O1000 as the main program" in said.getvalue() and "outside" not in said.getvalue()
+
+
+def test_a_stored_subprograms_m99_with_other_words_ends_it_there_too():
+    """`G90 M99`: O2000 is a subprogram stored before the main program still, not run as the main
+    one; its call, which ncpp does not follow (the M99 of a subprogram's run shares its line), passes
+    the rest through."""
+    program = "%\nO2000\nG91 G1 X10 F300\nG90 M99\nO1000\nG21 G90\nG0 X0 Y0 Z5\nM98 P2000\nG0 Z6\nM30\n%\n"
+    said = io.StringIO()
+    assert moves(program, "fanuc", said) == [("STRAIGHT_TRAVERSE", (0, 0, 5))]
+    assert "p.nc:5:1: warning: the file's first program ends with M99: ncpp runs O1000" in said.getvalue()
+    assert "p.nc:8:1: warning: M98 P2000: a subprogram the program does not define" in said.getvalue()
