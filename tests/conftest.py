@@ -37,6 +37,7 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
         ),
         "compensation/test_rs274_accepts.py": None,
         "writeback/test_subroutines_run_once.py": None,
+        "compensation/test_subprograms_first.py": None,
         "writeback/test_haas_local_subprograms.py": None,
         "motion/test_haas_local_calls.py": ("test_the_moves_are_rs274s_of_the_program_written_out_by_hand",),
         "compensation/test_machine_files.py": (
@@ -75,6 +76,7 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
         "motion/test_fanuc_files.py": (
             "test_the_moves_are_rs274s_of_the_twin_with_the_subprogram_in_the_first_program",
             "test_expanded_the_calls_follow_rs274s_path_of_the_twin",
+            "test_subprograms_before_the_main_program_run_where_it_calls_them_as_rs274_runs_the_twin",
         ),
         "hostile/test_constructs.py": ("test_rs274_refuses_a_modal_rigid_tap_block_without_its_k",),
         "shop/test_tool_guard.py": (
@@ -298,6 +300,7 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
         "motion/test_fanuc_files.py": (
             "test_a_subprogram_file_named_for_its_number_without_the_o_is_found",
             "test_the_text_after_the_closing_percent_passes_through_as_it_is",
+            "test_where_the_main_program_is_not_told_the_file_passes_through_and_strict_refuses",
         ),
         "hostile/test_cli_contained.py": (
             "test_an_open_subroutine_is_located",

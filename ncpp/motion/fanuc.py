@@ -208,6 +208,7 @@ class FanucInterpreter(Interpreter):
     returns_under_comp = True  # G28/G30 under G41/G42: out of scope (module docstring)
     external_output = True  # POPEN, DPRNT[..], BPRNT[..], PCLOS pass through (module docstring)
     repeats_in_p = True  # `M98 P51002`: O1002 five times (`Flow._m98`)
+    main_after_subprograms = True  # subprograms before the main program in a file (`Flow._stored_first`)
     still_r_arc = True  # `G02 R..` ending where it starts does not move (module docstring)
     r_over_ijk = True  # `G02 X.. Y.. R.. I.. J..`: R's arc, I J ignored (module docstring)
     independent_h = True  # `G53 G00 H0 Z-110`: an H without G43, out of scope (module docstring)

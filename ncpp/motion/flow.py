@@ -32,7 +32,10 @@ program `O<n>` of the file, or of a file `O<n>` (`O<n>.nc`) on the subroutine pa
 ends with `M99` (#1-#30 are the caller's, as in LinuxCNC; the other scoping is a call's).
 A Fanuc or Haas file may hold more programs after the first one's closing `%`, each a program
 in the control's memory that a call finds (`Dialect.programs_after_end`); the main program
-ends at that `%`, and the text after it runs only where called.
+ends at that `%`, and the text after it runs only where called.  Where a Fanuc or Haas file's
+first program ends with M99, its subprograms stand before its main program: the one later program
+that ends with M30 or M2 runs as the main one, and those before it only where called
+(`_stored_first`).
 
 Haas's local subprograms run the same way (`_m97`): `M97 P<n> [L<repeats>]` runs the blocks of
 the program's own text from the one numbered Nn to its M99, then goes on after the call (Haas
@@ -264,6 +267,8 @@ class Flow:
         repeats_in_p: bool = False,
         once: OnceRuns | None = None,
         local_calls: bool = False,
+        main_after_subprograms: bool = False,
+        warn: Callable[[str, Block], None] | None = None,
     ):
         self.file, self.evaluate, self.parameters, self.done, self.stop, self.path = (
             file,
@@ -334,6 +339,12 @@ class Flow:
         self.ran: set[str] = set()  # the subroutines a call has run (o-word calls, M98, G65, G66)
         self.called_again: list[str] = []  # the CALLED subroutines another call has run since told
         self.once_called: set[str] = set()  # the subroutines whose first run was CALLED
+        # Fanuc: a file whose first program ends with M99 runs a later one as the main program
+        # (`_stored_first`); `stored`: the lines yielded are the programs' before it, `main_top` its O line
+        self.main_after_subprograms = main_after_subprograms
+        self.warn = warn or (lambda message, block: None)
+        self.stored = False
+        self.main_top = 0
         self.revisits: Revisits | None = None
         self._jumps_checked: set[tuple[int, int, int]] = set()  # (`_refuse_jump_without_way_out`)
         if state is not None:
@@ -351,6 +362,8 @@ class Flow:
         self._read_ahead()
         if self.fanuc:
             self.parameters.start_fanuc()
+        if self.main_after_subprograms:
+            yield from self._stored_first()
         while not self.done():
             frame = self.frames[-1]
             if (
@@ -504,11 +517,12 @@ class Flow:
                 self._drop(keep - _TRIM)
 
     def _drop(self, n: int) -> None:
-        """The first `n` blocks of the buffer, no longer wanted."""
-        for block in self.buffer[:n]:
+        """The first `n` blocks of the buffer, no longer wanted (the sequence numbers of the main program's
+        noted: those of programs stored before it, `main_top`, are theirs)."""
+        for index, block in enumerate(self.buffer[:n], self.base):
             self._controls.pop(id(block), None)
             number = sequence_number(block) if self.fanuc or self.local_calls else None
-            if number is not None:
+            if number is not None and index >= self.main_top:
                 self.dropped.add(number)
         del self.buffer[:n]
         self.base += n
@@ -695,11 +709,14 @@ class Flow:
 
         return skip
 
-    def _wait_for_call(self, frame: _Frame, block: Block, name: str) -> None:
+    def _wait_for_call(
+        self, frame: _Frame, block: Block, name: str, lines: list[Block] | None = None
+    ) -> None:
         """A definition the main program's straight code meets before any call of it, whose lines
-        (read ahead to its endsub, at most `held_most`) hold no control line: if the program calls
-        it once, its run may be written here (`OnceRuns.meet`: the writer holds the lines from here
-        on until the run is told).  Whether it is called once is known only at the program's end."""
+        (read ahead to its endsub, at most `held_most`; a Fanuc program's, `O<n>` to M99, given)
+        hold no control line: if the program calls it once, its run may be written here
+        (`OnceRuns.meet`: the writer holds the lines from here on until the run is told).  Whether
+        it is called once is known only at the program's end."""
         once = self.once
         if (
             once is None
@@ -713,14 +730,114 @@ class Flow:
         ):
             return
         index = frame.pc
-        while (lines := self._definitions.get(block.line)) is None and index - frame.pc < once.held_most:
-            index += 1
-            if self._block(frame, index) is None:
-                return
+        while lines is None and index - frame.pc < once.held_most:
+            if (lines := self._definitions.get(block.line)) is None:
+                index += 1
+                if self._block(frame, index) is None:
+                    return
         if lines is None or lines[0] is not block or any(self._control_of(b) for b in lines[1:-1]):
             return
         self.ahead[name] = lines
         once.meet(name, lines)
+
+    def _stored_first(self) -> Iterator[tuple[Block, str, Block | None]]:
+        """Fanuc: a file whose first program ends with M99 before any M30 or M2 holds subprograms
+        before its main program, the one later program that ends with M30 or M2 (a control stores
+        each program of a file as its own, and the operator runs the main one; Fanuc Series 0i-MC
+        operator's manual, B-64124EN, "Subprogram (M98, M99)": a subprogram ends with M99).  The
+        programs before it are yielded as definitions that do not run (SKIP, `stored`), each
+        waiting for a call that may be its only run (`_wait_for_call`), and the flow goes on at the
+        main program's O line.  Where no later program, or more than one, ends with M30 or M2, or one
+        before it ends with neither, which program runs is not guessed: the flow stops at the first.
+        A file of one program ending with M99 is an endless main program (`_m99`)."""
+        first = self._first_subprogram()
+        if first is None:
+            return
+        programs = self._programs(first)
+        if len(programs) == 1:
+            return
+        main, why = _main_program(programs)
+        if main is None:
+            self.stop(f"a file whose first program {programs[0].name} ends with M99 (a subprogram) while {why} "
+                      "(which program the operator runs as the main one is not ncpp's to guess)",
+                      self._block(self.frames[0], first), 1)  # fmt: skip
+            return
+        names = [p.name for p in programs if p.index < main.index]
+        said = (
+            f"{names[0]} is a subprogram"
+            if len(names) == 1
+            else f"{', '.join(names[:-1])} and {names[-1]} are subprograms"
+        )
+        self.warn(f"the file's first program ends with M99: ncpp runs {main.name} as the main program; {said} "
+                  "(run where M98 or G65 calls it)", main.block)  # fmt: skip
+        yield from self._skip_stored(first, main.index)
+
+    def _skip_stored(self, first: int, main_index: int) -> Iterator[tuple[Block, str, Block | None]]:
+        """The lines before the main program's O line: the leader and comments before `first` run,
+        the programs from it on are text that does not run, each a definition a call may run once."""
+        main = self.frames[0]
+        self.stored = True
+        while main.pc < main_index:
+            block = self._block(main, main.pc)
+            assert block is not None  # (read by `_programs`)
+            number = program_number(block)
+            if number is not None and main.pc >= first:
+                lines = self.subprograms.get(number)
+                if lines is not None and lines[0] is block:
+                    self._wait_for_call(main, block, number, lines)
+            yield block, (RUN if main.pc < first else SKIP), None
+            self._advance(main)
+        self.stored = False
+        self.main_top = main_index
+
+    def _first_subprogram(self) -> int | None:
+        """Where the file's first program starts (its O line) if only the tape's leader, `%` and
+        comments stand before it and it ends with M99 within MAX_SUBPROGRAM blocks, before any M30
+        or M2 (a subprogram, as `_keep` tells them), else None."""
+        main, index = self.frames[0], 0
+        while (block := self._block(main, index)) is not None and index < MAX_SUBPROGRAM:
+            if block.verbatim and index >= self.leader:
+                return None
+            if program_number(block) is not None:
+                end = self._program_end(index, MAX_SUBPROGRAM)[0]
+                return index if end == "M99" else None
+            if index >= self.leader and not _no_code(block):
+                return None
+            index += 1
+        return None
+
+    def _programs(self, first: int) -> list[_Program]:
+        """The numbered programs of the file from the one at `first` to its end (the text is read to
+        there, as a call of a subprogram after M30 reads on to it)."""
+        found: list[_Program] = []
+        main, index = self.frames[0], first
+        while (block := self._block(main, index)) is not None:
+            if program_number(block) is None:
+                index += 1
+                continue
+            end, after = self._program_end(index, None)
+            found.append(
+                _Program(index, block, _program_name(block), end, block.verbatim and index >= self.leader)
+            )
+            index = after
+        return found
+
+    def _program_end(self, start: int, most: int | None) -> tuple[str | None, int]:
+        """How the program whose O line stands at `start` ends first (M99, M30, M2, `_end_code`; None:
+        neither before the next program, `%` or the end of the file, or within `most` blocks), and
+        where the next program's O line (or the end of the text) stands."""
+        main, index, end = self.frames[0], start + 1, None
+        while (block := self._block(main, index)) is not None:
+            if program_number(block) is not None:
+                break
+            if end is None:
+                if _starts_program(block) or most is not None and index - start > most:
+                    return None, index
+                end = _end_code(block)
+                if end is not None and most is not None:
+                    return end, index
+            index += 1
+        return end, index
 
     def _endsub(self, frame, block, control, arrived):
         return self._return(frame, block, control, arrived)
@@ -847,6 +964,8 @@ class Flow:
 
         self._check_level(block, control)
         once = self._runs_once(frame, block, name, body, runs)
+        if not once and name in self.ahead:
+            self.once.refuse(name)  # (its definition waits no more)
 
         def call():
             frame.pc += 1
@@ -955,7 +1074,7 @@ class Flow:
         if number in self.dropped:
             return True
         first = self._first_numbered
-        for index in range(max(self._numbers_read, self.base), call):
+        for index in range(max(self._numbers_read, self.base, self.main_top), call):
             found = sequence_number(self.buffer[index - self.base])
             if found is not None:
                 first.setdefault(found, index)
@@ -1227,7 +1346,7 @@ class Flow:
         if number in self.dropped or not self.fanuc and self.base > 0:  # (not a Fanuc one: none noted)
             self.stop(f"GOTO {number}: N{number} is further back than the blocks ncpp holds", block, col)
             return None
-        for index in range(self.base, frame.pc + 1):
+        for index in range(max(self.base, self.main_top), frame.pc + 1):  # (the main program's own)
             if sequence_number(self.buffer[index - self.base]) == number:
                 return index
         raise NcppError(f"GOTO {number}: the program has no block N{number} (a Fanuc alarm)",
@@ -1740,6 +1859,60 @@ def _ends_program(block: Block) -> bool:
     return any(
         type(item) is Word and item.letter == "M" and item.value in (2.0, 30.0) for item in block.items
     )
+
+
+@dataclass(frozen=True)
+class _Program:
+    """A numbered program of a file (`Flow._programs`): where its O line stands, the line, its name
+    as written, how it ends first (M99, M30, M2; None: neither before the next program, `%` or the
+    end of the file) and whether it stands after the closing `%`."""
+
+    index: int
+    block: Block
+    name: str
+    end: str | None
+    after: bool
+
+
+def _main_program(programs: list[_Program]) -> tuple[_Program | None, str]:
+    """Of a file's programs, the first of which ends with M99, the main one: the one later program
+    that ends with M30 or M2, within the first `%` ... `%`, with only programs that end with M99
+    before it; else None and why not."""
+    ends = [p for p in programs if p.end in ("M2", "M30")]
+    if not ends:
+        return None, "no later program of the file ends with M30 or M2"
+    if len(ends) > 1:
+        return None, f"{len(ends)} later programs end with M30 or M2 ({', '.join(p.name for p in ends)})"
+    main = ends[0]
+    if main.after:
+        return None, f"the one that ends with M30 or M2, {main.name}, stands after the file's closing %"
+    between = next((p for p in programs if p.index < main.index and p.end != "M99"), None)
+    if between is not None:
+        return None, f"{between.name}, before {main.name}, ends with neither M99 nor M30 or M2"
+    return main, ""
+
+
+_ENDS = {99.0: "M99", 30.0: "M30", 2.0: "M2"}
+
+
+def _end_code(block: Block) -> str | None:
+    """The code that ends a program in the block, M99 (with other words too: `G90 M99`), M30 or M2."""
+    if block.signature is not None and "M" not in block.signature:
+        return None
+    return next((_ENDS[item.value] for item in block.items
+                 if type(item) is Word and item.letter == "M" and item.value in _ENDS), None)  # fmt: skip
+
+
+def _no_code(block: Block) -> bool:
+    """A line of comments, a `%` or nothing."""
+    return all(
+        type(item) is Comment or type(item) is Statement and item.kind == "tape" for item in block.items
+    )
+
+
+def _program_name(block: Block) -> str:
+    """`O2000` of a line `O2000 (SUB)`, as written."""
+    return next(f"O{item.number}" for item in block.items if type(item) is Word and item.letter == "O")
 
 
 def _macro_b(block: Block) -> bool:

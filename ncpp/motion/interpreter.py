@@ -274,6 +274,9 @@ class Interpreter:
     repeats_in_p = False
     # `M97 P1000` runs the program's own blocks from N1000 to M99 (Haas, `Flow._m97`); rs274ngc has no M97
     local_calls = False
+    # A file whose first program ends with M99 runs a later one as the main program (Fanuc, Haas:
+    # `Flow._stored_first`); rs274ngc runs the file from its top, an M99 there ending an endless main program
+    main_after_subprograms = False
     # An R arc that ends where it starts is an arc of 0 degrees, no move (Fanuc); rs274ngc refuses it
     still_r_arc = False
     # R with I, J or K in an arc block: the arc is R's, the others are ignored (Fanuc); rs274ngc refuses it
@@ -440,6 +443,8 @@ class Interpreter:
             self.file, self._evaluate, self.params, lambda: self.done, self._leave_scope,
             self.subroutine_path, state=self._loop_state, position=lambda: self.pos[:],
             repeats_in_p=self.repeats_in_p, once=self.once_runs, local_calls=self.local_calls,
+            main_after_subprograms=self.main_after_subprograms,
+            warn=lambda message, block: warnings.warn(message, Location(self.file, block.line, 1)),
         )  # fmt: skip
         self.rounding = False
         expansion = self.expansion
@@ -469,7 +474,8 @@ class Interpreter:
             if (
                 kind is not RUN and kind is not FIXED and kind is not ONCE and kind is not CALLED
             ):  # text not run here
-                ended = self.done or block.verbatim  # (verbatim: after the closing `%`)
+                # (verbatim: after the closing `%`; stored: a program before the main one, text as those are)
+                ended = self.done or block.verbatim or flow.stored
                 if expansion is not None:
                     kept = expansion.text(kind, ended, block)  # (None: left out)
                     if kept is None:

@@ -161,3 +161,130 @@ def test_a_subprogram_file_named_for_its_number_without_the_o_is_found(tmp_path,
     assert proc.returncode != 0 and f"{name}:1:1: O1002 ... M99 is not in the file" in proc.stderr, (
         proc.stderr
     )
+
+
+# A file whose first program ends with M99: a subprogram stored before the main program, which the
+# operator runs (Fanuc Series 0i-MC operator's manual, B-64124EN, "Subprogram (M98, M99)": a subprogram
+# ends with M99, and runs where M98 calls it); `ncpp motion` follows the main program, the twin
+# written by hand in LinuxCNC's o-word form is what rs274 runs
+SUB_FIRST = {
+    "one subprogram": (
+        "%\nO2000 (SUB)\nG91 G1 X10 F300\nG90\nM99\n"
+        "O1000 (MAIN)\nG21 G90 G54\nG0 X0 Y0 Z5\nG1 Z-1 F200\nM98 P2000\nG0 Z5\nM30\n%\n",
+        "o2000 sub\nG91 G1 X10 F300\nG90\no2000 endsub\n"
+        "G21 G90 G54\nG0 X0 Y0 Z5\nG1 Z-1 F200\no2000 call\nG0 Z5\nM30\n",
+    ),
+    "two, one called twice, an arc": (
+        "%\nO2000\nG91 G1 X10 F300\nG3 X5 Y5 I0 J5\nG90\nM99\n(the second)\nO3000\nG1 Y20\nM99\n"
+        "O1000\nG21 G90 G17\nG0 X0 Y0 Z5\nG1 Z-1 F200\nM98 P2000\nM98 P3000\nG1 X30\nM98 P2000\nG0 Z5\nM30\n%\n",
+        "o2000 sub\nG91 G1 X10 F300\nG3 X5 Y5 I0 J5\nG90\no2000 endsub\no3000 sub\nG1 Y20\no3000 endsub\n"
+        "G21 G90 G17\nG0 X0 Y0 Z5\nG1 Z-1 F200\no2000 call\no3000 call\nG1 X30\no2000 call\nG0 Z5\nM30\n",
+    ),
+}
+
+
+def motion_command(path, dialect: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "ncpp", "motion", "--dialect", dialect, str(path)],
+                          capture_output=True, text=True, cwd=ROOT)  # fmt: skip
+
+
+@pytest.mark.parametrize("name", SUB_FIRST)
+@pytest.mark.parametrize("dialect", ["fanuc", "haas"])
+def test_subprograms_before_the_main_program_run_where_it_calls_them_as_rs274_runs_the_twin(
+    tmp_path, name, dialect
+):
+    if not RS274.exists():
+        pytest.skip("rs274 not available")
+    program, twin = SUB_FIRST[name]
+    (tmp_path / "p.nc").write_text(program)
+    (tmp_path / "twin.ngc").write_text(twin)
+    reference = read_canon(rs274(str(tmp_path / "twin.ngc"))[0])
+    shown = motion_command(tmp_path / "p.nc", dialect)
+    assert shown.returncode == 0, shown.stderr
+    mine = read_canon(shown.stdout)
+    assert len(mine) == len(reference) >= 4 and same_calls(reference, mine), (reference, mine)
+    main = program.splitlines().index(next(line for line in program.splitlines() if line.startswith("O1000")))
+    subprograms = "O2000 is a subprogram" if "O3000" not in program else "O2000 and O3000 are subprograms"
+    said = f"p.nc:{main + 1}:1: warning: the file's first program ends with M99: ncpp runs O1000 as the main program; {subprograms}"
+    assert said in shown.stderr and shown.stderr.count("warning") == 1, shown.stderr
+
+
+FIRST = "%\nO2000 (SUB)\nG21 G91 G1 X10 F300\nG90\nM99\n"
+# Files whose first program ends with M99 where which one is the main program is not told: what the
+# warning says of each
+UNTOLD = {
+    "two end with M30": (FIRST + "O1000\nG0 X0 Y0 Z5\nM98 P2000\nM30\nO3000\nG0 X5 Y5 Z5\nM30\n%\n",
+                         "2 later programs end with M30 or M2 (O1000, O3000)"),
+    "none ends with M30": (FIRST + "O1000\nG0 X5 Y5\nM98 P2000\nM99\n%\n",
+                           "no later program of the file ends with M30 or M2"),
+    "the main one after the closing %": (FIRST + "%\n%\nO1000\nG0 X5 Y5\nM98 P2000\nM30\n%\n",
+                                         "the one that ends with M30 or M2, O1000, stands after the file's closing %"),
+    "one before it with neither end": (FIRST + "O3000\nG1 X1\nO1000\nG0 X5 Y5\nM98 P2000\nM2\n%\n",
+                                       "O3000, before O1000, ends with neither M99 nor M30 or M2"),
+}  # fmt: skip
+
+
+@pytest.mark.parametrize("name", UNTOLD)
+def test_where_the_main_program_is_not_told_nothing_runs_and_the_warning_says_why(name):
+    program, why = UNTOLD[name]
+    said = io.StringIO()
+    assert moves(program, "fanuc", said) == []
+    assert said.getvalue() == (
+        f"p.nc:2:1: warning: a file whose first program O2000 ends with M99 (a subprogram) while {why} (which "
+        "program the operator runs as the main one is not ncpp's to guess) is outside the motion interpreter's "
+        "scope; from this line on the program passes through uninterpreted (its modal state is unknown)\n"
+    )
+
+
+@pytest.mark.parametrize("name", ["two end with M30", "none ends with M30"])
+def test_where_the_main_program_is_not_told_the_file_passes_through_and_strict_refuses(tmp_path, name):
+    program = UNTOLD[name][0]
+    written, proc = compensate(tmp_path, program)
+    unheaded = [line for line in written.splitlines(keepends=True) if not line.startswith("(ncpp ")]
+    assert "".join(unheaded) == program
+    assert "passes through uninterpreted" in proc.stderr and "compensated 0 moves" in proc.stderr
+    command = ["compensate", "--strict", "--machine", str(READING), "--dialect", "fanuc", str(tmp_path / "p.nc")]  # fmt: skip
+    refused = subprocess.run([sys.executable, "-m", "ncpp", *command], capture_output=True, text=True,
+                             cwd=ROOT)  # fmt: skip
+    assert refused.returncode != 0 and "(refused in strict mode)" in refused.stderr, refused.stderr
+
+
+@pytest.mark.parametrize("dialect", ["fanuc", "haas", "iso"])
+def test_a_file_of_one_program_that_ends_with_m99_is_an_endless_main_program(dialect):
+    """Its moves run up to the M99, which ends interpretation there."""
+    said = io.StringIO()
+    assert moves(FIRST + "%\n", dialect, said) == [("STRAIGHT_FEED", (10, 0, 0))]
+    assert "p.nc:5:1: warning: M99 in the main program (an endless main program)" in said.getvalue()
+
+
+def test_linuxcnc_runs_a_file_of_subprograms_first_from_its_top():
+    """rs274ngc reads a file from its top, an M99 there ending an endless main program: the ISO
+    reading is unchanged."""
+    said = io.StringIO()
+    assert moves(SUB_FIRST["one subprogram"][0], "iso", said) == [("STRAIGHT_FEED", (10, 0, 0))]
+    assert "p.nc:5:1: warning: M99 in the main program" in said.getvalue()
+
+
+def test_the_main_programs_jumps_and_local_calls_find_its_own_sequence_numbers():
+    """A GOTO searched back from the top of the main program, and a Haas M97, find the main program's
+    block Nn, not one of a subprogram stored before it."""
+    stored = "%\nO2000\nN10 G1 X99 F100\nN20 G1 Y99\nM99\n"
+    goto = stored + "O1000\nG21 G90\n#1 = 0\nN10 G0 X#1 Y0 Z5\n#1 = #1 + 1\nIF [#1 LT 2] GOTO 10\nM30\n%\n"
+    assert moves(goto, "fanuc") == [("STRAIGHT_TRAVERSE", (0, 0, 5)), ("STRAIGHT_TRAVERSE", (1, 0, 5))]
+    local = stored + "O1000\nG21 G90\nG0 X0 Y0 Z5\nM97 P20\nG0 X3\nM30\nN20 G1 Y7 F100\nM99\n%\n"
+    said = io.StringIO()
+    assert moves(local, "haas", said) == [
+        ("STRAIGHT_TRAVERSE", (0, 0, 5)), ("STRAIGHT_FEED", (0, 7, 5)), ("STRAIGHT_TRAVERSE", (3, 7, 5))
+    ]  # fmt: skip
+    assert "ncpp runs O1000 as the main program" in said.getvalue() and "outside" not in said.getvalue()
+
+
+def test_a_stored_subprograms_m99_with_other_words_ends_it_there_too():
+    """`G90 M99`: O2000 is a subprogram stored before the main program still, not run as the main
+    one; its call, which ncpp does not follow (the M99 of a subprogram's run shares its line), passes
+    the rest through."""
+    program = "%\nO2000\nG91 G1 X10 F300\nG90 M99\nO1000\nG21 G90\nG0 X0 Y0 Z5\nM98 P2000\nG0 Z6\nM30\n%\n"
+    said = io.StringIO()
+    assert moves(program, "fanuc", said) == [("STRAIGHT_TRAVERSE", (0, 0, 5))]
+    assert "p.nc:5:1: warning: the file's first program ends with M99: ncpp runs O1000" in said.getvalue()
+    assert "p.nc:8:1: warning: M98 P2000: a subprogram the program does not define" in said.getvalue()

@@ -267,3 +267,25 @@ def test_the_runs_of_a_haas_local_subprogram_are_verified_a_chunk_at_a_time(tmp_
     path.write_text(f"{head}N100\n{body}G90\nM99\n%\n")
     assert compensate(path) == 0
     assert len(compared) > 99 * 10 // 64 and max(compared) <= 2 * 64, compared
+
+
+SUBPROGRAM_FIRST = ("%\nO2000 (SUB)\nG91 G1 X10 F300\nG90\nM99\n"
+                    "O1000 (MAIN)\nG21 G90 G54\nG0 X0 Y0 Z5\nG1 Z-1 F200\nM98 P2000\nG0 Z5\nM30\n%\n")  # fmt: skip
+
+
+def test_a_subprogram_stored_before_the_main_program_is_read_back_where_the_call_runs_it(
+    tmp_path: Path, monkeypatch, capsys
+):
+    """The read-back runs O1000 as the main program and O2000 where M98 calls it, as the input's
+    reading does: its one run, written where its text stands, is verified; a pass that moves it off
+    is stopped at its line."""
+    path = tmp_path / "part.nc"
+    path.write_text(SUBPROGRAM_FIRST)
+    assert compensate(path, "--dialect", "fanuc") == 0
+    written = path.with_suffix(".out.ngc").read_text()
+    assert "G91 G1 X10 F300" not in written and written.index("G91 G1 X") < written.index("O1000")
+    path.with_suffix(".out.ngc").unlink()
+    monkeypatch.setattr(ncpp.pipeline, "PASSES", (*ncpp.pipeline.PASSES, shifted_at_line(3, 0.5)))
+    assert compensate(path, "--dialect", "fanuc") != 0
+    assert "part.nc:3:1: verification:" in capsys.readouterr().err
+    assert not path.with_suffix(".out.ngc").exists()
