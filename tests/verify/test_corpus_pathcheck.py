@@ -95,14 +95,17 @@ KNOWN_DEFECTS = {
 }
 
 
-def programs() -> list:
-    if not CORPUS.is_dir():
-        return []
+def programs() -> list[Path]:
+    return corpus_files("iso_gcode") if CORPUS.is_dir() else []
+
+
+def _cases() -> list:
+    """`programs()`, the known defects marked as expected to fail."""
     return [
         pytest.param(path, marks=pytest.mark.xfail(reason=KNOWN_DEFECTS[corpus_id(path)], strict=True))
         if corpus_id(path) in KNOWN_DEFECTS
         else path
-        for path in corpus_files("iso_gcode")
+        for path in programs()
     ]
 
 
@@ -111,7 +114,7 @@ def tools(tmp_path_factory) -> Path:
     return tool_table(tmp_path_factory.mktemp("tools"))
 
 
-@pytest.mark.parametrize("program", programs(), ids=corpus_id)
+@pytest.mark.parametrize("program", _cases(), ids=corpus_id)
 def test_pathcheck_passes_on_the_compensated_program(program: Path, tools: Path, tmp_path: Path):
     if not (PATHCHECK.exists() and WIDE.exists()):
         pytest.skip(f"pathcheck or wide.toml not found under {SHARED}")
