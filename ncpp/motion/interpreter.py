@@ -190,7 +190,14 @@ _MOTION_WITH_COMP = {
 
 
 class _OutOfScope(modal.OutOfScope):
-    """The ISO interpreter's: a control line's expression raises it in `flow.py` too."""
+    """The ISO interpreter's: a control line's expression raises it in `flow.py` too.  `setting`: the
+    offset a block that leaves the scope sets from where the control stands, which the writer moves
+    by the correction there as it does an offset set in scope (the control stands at the corrected
+    point, and the block must set the offset the program means)."""
+
+    def __init__(self, reason: str, col: int | None = None, setting: Setting | None = None):
+        super().__init__(reason, col)
+        self.setting = setting
 
 
 def interpreting(flavour: type[Interpreter]) -> Callable[..., Iterator[Event]]:
@@ -544,7 +551,7 @@ class Interpreter:
                 if owner is None:  # (a block that runs out of the text's order is written in its place)
                     if expansion is not None:
                         yield from expansion.owed()
-                    yield Pass(block)
+                    yield Pass(block, setting=stop.setting)
                 continue
             if pending is None and self.corner is None and type(event) is not tuple:
                 # the common case: no corner waits, none starts (and not a tuple)
@@ -1521,11 +1528,28 @@ class Interpreter:
         tool's offsets set from where it stands (G10 L10/L11: rs274ngc turns the point first)."""
         code, item = gcodes.get(0, (None, None))
         if code == 92.0 or (code == 10.0 and words["L"][0] == 20.0):
-            raise _OutOfScope(f"G{code:g} under a coordinate system rotation", item.start + 1)
+            raise _OutOfScope(f"G{code:g} under a coordinate system rotation", item.start + 1,
+                              self._turned_setting(words, gcodes))  # fmt: skip
         if code == 10.0 and words["L"][0] in (10.0, 11.0):
-            raise _OutOfScope(f"G10 L{words['L'][0]:g} under a coordinate system rotation", item.start + 1)
+            raise _OutOfScope(f"G10 L{words['L'][0]:g} under a coordinate system rotation", item.start + 1,
+                              self._turned_setting(words, gcodes))  # fmt: skip
         if code in (28.0, 30.0) and ("X" in words or "Y" in words):
             raise _OutOfScope(f"G{code:g} with X or Y under a coordinate system rotation", item.start + 1)
+
+    def _turned_setting(self, words: dict, gcodes: dict) -> Setting | None:
+        """The offset a G92, G10 L10 or G10 L20 of the system in effect sets under the rotation, from
+        where the control stands in the turned frame (None: a block that turns another frame: G10 L11
+        reads G59.3's, G10 L20 of another system that system's, a G92 or G10 L20 under a rotation and a
+        G92 offset, which rs274ngc places apart)."""
+        code = gcodes[0][0]
+        other = code == 10.0 and (
+            words["L"][0] == 11.0 or round(words.get("P", (0.0,))[0]) not in (0, self.coord_system)
+        )
+        if other or (code != 10.0 or words["L"][0] == 20.0) and any(self.g92[:2]):
+            return None
+        values = tuple((i, words[letter][0]) for i, letter in enumerate("XYZ") if letter in words)
+        context = self.context()
+        return Setting(values, context, context.turned((self.pos[0], self.pos[1], self.pos[2])), leaves=True)
 
     # -- modal state -------------------------------------------------------------------------
     def _set(self, **changes) -> None:

@@ -255,6 +255,7 @@ class Setting:
     context: Context  # the frame the block is read in
     position: Point  # the programmed point the tool stands at, in that frame
     shift: Point | None = None  # where the control stands minus `position` (None: not known, or none)
+    leaves: bool = False  # the block ends interpretation: what runs after it is not followed
 
 
 @dataclass(slots=True)

@@ -470,3 +470,52 @@ def test_a_cancel_that_cancels_something_or_means_something_else_stays_out_of_sc
     line = min(n for n, code in enumerate(lines, 1) if n > 2 and at in code.split())
     assert warning.count("warning") == 1, warning
     assert f"t.ngc:{line}:{lines[line - 1].index(at) + 1}: " in warning and construct in warning, warning
+
+
+_SETS = re.compile(r"(SET_G92_OFFSET|SET_G5X_OFFSET|SET_TOOL_TABLE_ENTRY)\((.*)\)")
+_MOVES = re.compile(r"(STRAIGHT_TRAVERSE|STRAIGHT_FEED)\(([^)]*)\)")
+
+
+@pytest.mark.oracle
+@pytest.mark.parametrize("setting", ["G92 X0 Y0", "G10 L20 P0 X2 Y3", "G10 L10 P1 X0 Y0 Z0"])
+@pytest.mark.parametrize("mode", ["G0", "G1 F300"])
+def test_an_offset_set_from_a_compensated_point_where_interpretation_ends_is_the_programs(
+    tmp_path, setting, mode
+):
+    """A block that sets an offset from where the control stands (LinuxCNC G-code manual: G92, G10
+    L20, G10 L10) ends interpretation under a rotation; the move before it was compensated, so ncpp
+    writes a step back to the programmed point first, in the program's mode: rs274 then sets the
+    offsets the original sets, and every move after it (uninterpreted, as programmed) ends where the
+    original's does, however many setting blocks follow."""
+    text = (
+        f"G20 G90 G17\nT1 M6\nG43\nG10 L2 P1 X1 Y2 Z0 R30\n{mode}\nX4 Y3 Z0.5\n"
+        f"{setting}\nG10 L10 P1 X0.5\nX1 Y0\nG91 X0.5\nM2\n"
+    )
+    (tmp_path / "t.tbl").write_text("T1 P1 Z0 D0.25\n")
+    program, out, proc = _written_out(tmp_path, text)
+    runs = [
+        rs274.run(p, tool_table=tmp_path / "t.tbl", digits=7, home=tmp_path).stdout for p in (program, out)
+    ]
+    before, after = ([m.groups() for m in _SETS.finditer(run)] for run in runs)
+    assert before and after == before, (before, after)
+    moves = [[m.group(1) for m in _MOVES.finditer(run)] for run in runs]
+    assert moves[1] == moves[0][:1] + [moves[0][0]] + moves[0][1:]  # the step, in the program's mode
+    last = [
+        [tuple(float(v) for v in m.group(2).split(",")[:3]) for m in _MOVES.finditer(run)][-3:]
+        for run in runs
+    ]
+    assert np.allclose(last[0], last[1], atol=1e-7), last
+    assert "(its modal state is unknown)" in proc.stderr
+
+
+def _written_out(tmp_path: Path, text: str) -> tuple[Path, Path, subprocess.CompletedProcess]:
+    """`written`, for a program that leaves the scope (its warning expected)."""
+    (tmp_path / "affine.toml").write_text(AFFINE)
+    program, out = tmp_path / "turned.ngc", tmp_path / "turned.out.ngc"
+    program.write_text(text)
+    proc = subprocess.run([sys.executable, "-m", "ncpp", "compensate", "--machine", str(tmp_path / "affine.toml"),
+                           "--tool-table", str(tmp_path / "t.tbl"), "--var-units", "inch",
+                           str(program), "-o", str(out)],
+                          capture_output=True, text=True, cwd=ROOT, timeout=300, stdin=subprocess.DEVNULL)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    return program, out, proc

@@ -85,28 +85,8 @@ _ARC_OFFSET = re.compile(r"\b[IJ][-+.\d]")
 _NORMAL_K = re.compile(r"\s*\bK[-+]?[\d.]+")
 
 
-# A known defect, stated in docs/guide.md: a block that sets an offset from where the control stands
-# (here G10 L10 under a G10 L2 R rotation), met right after a compensated move, ends interpretation
-# and is written as programmed, so the offset it sets carries that move's correction (microns).
-# strict: the test fails once the defect is mended, so the entry goes with it.
-KNOWN_DEFECTS = {
-    "iso_gcode/linuxcnc_interp_oracle/interp__g10__g10-l1-l10/test.ngc": "G10 L10 under a rotation right "
-    "after a compensated move sets the tool offset from the compensated point",
-}
-
-
 def programs() -> list[Path]:
     return corpus_files("iso_gcode") if CORPUS.is_dir() else []
-
-
-def _cases() -> list:
-    """`programs()`, the known defects marked as expected to fail."""
-    return [
-        pytest.param(path, marks=pytest.mark.xfail(reason=KNOWN_DEFECTS[corpus_id(path)], strict=True))
-        if corpus_id(path) in KNOWN_DEFECTS
-        else path
-        for path in programs()
-    ]
 
 
 @pytest.fixture(scope="module")
@@ -114,7 +94,7 @@ def tools(tmp_path_factory) -> Path:
     return tool_table(tmp_path_factory.mktemp("tools"))
 
 
-@pytest.mark.parametrize("program", _cases(), ids=corpus_id)
+@pytest.mark.parametrize("program", programs(), ids=corpus_id)
 def test_pathcheck_passes_on_the_compensated_program(program: Path, tools: Path, tmp_path: Path):
     if not (PATHCHECK.exists() and WIDE.exists()):
         pytest.skip(f"pathcheck or wide.toml not found under {SHARED}")

@@ -398,6 +398,8 @@ class IsoWriter:
         if facts.flow:
             return self._write_control(block, first)
         if type(first) is Pass and first.setting is not None and first.setting.shift is not None:
+            if first.setting.leaves and self.program_motion in (0, 1):
+                return self._stepped_back(block, first.setting)
             return [self._setting_text(block, first.setting) + block.eol]
         motion = [as_written(e) for e in group if type(e) is Line or type(e) is Arc]
         lead = 0  # steps to a canned cycle's start (`apply_error_map._lead_in`): new blocks before it
@@ -701,14 +703,26 @@ class IsoWriter:
         return lines
 
     # -- G92, G10 L10/L11/L20 -------------------------------------------------------------
+    def _stepped_back(self, block: Block, setting: Setting) -> list[str]:
+        """A block that sets an offset from where the control stands and ends interpretation: a step
+        back to the programmed point first, in the program's G0 or G1 mode, so that the block and
+        the blocks after it, which ncpp does not follow, read the point the program means."""
+        at, shift = setting.position, setting.shift
+        assert shift is not None
+        here = (at[0] + shift[0], at[1] + shift[1], at[2] + shift[2])
+        step = Line(here, at, self.program_motion == 0, 0.0, block, setting.context)
+        lines = self._new_blocks(block, [as_written(step)], block.eol)
+        self._last_end = None  # (the block sets another frame)
+        return [*lines, block.text]
+
     def _setting_text(self, block: Block, setting: Setting) -> str:
         """A G92 / G10 L10/L11/L20 block with its axis values moved by where the control stands off the
         programmed point (`Setting.shift`): the offset the control computes from them is the
         program's.  After it the output's position is in another frame: the next move writes
         every axis it knows."""
         self._last_end = None
-        shift = setting.shift
-        assert shift is not None  # (the pass told it, or the block was not handed here)
+        assert setting.shift is not None  # (the pass told it, or the block was not handed here)
+        shift = _program_shift(setting)
         moved = [(axis, value + shift[axis]) for axis, value in setting.values if shift[axis] != 0.0]
         if not moved:
             return block.raw
@@ -1295,3 +1309,16 @@ def _literal_geometry(block: Block, letters: str = GEOMETRY_LETTERS) -> Block:
         for i in block.items
     )
     return replace(block, items=items, signature=None)  # the signature is that of the old items
+
+
+def _program_shift(setting: Setting) -> tuple[float, float, float]:
+    """A setting's shift (`Setting.shift`, in the frame of the segments) as the program's words take
+    it: turned back under a rotation of the coordinate system (`Context.turned`)."""
+    shift = setting.shift
+    assert shift is not None
+    if setting.context.rotation is None:
+        return shift
+    at = setting.position
+    back = setting.context.turned((at[0] + shift[0], at[1] + shift[1], at[2] + shift[2]), -1.0)
+    here = setting.context.turned(at, -1.0)
+    return (back[0] - here[0], back[1] - here[1], back[2] - here[2])
