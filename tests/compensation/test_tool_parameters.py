@@ -34,7 +34,9 @@ from tests.compensation.tool_centre import deviation, feed_moves
 from tests.conftest import ROOT
 
 # Two tools with every column a program can read; the stand-alone rs274 reads it in its inches
-TABLE = "T1 P1 X0.02 Y-0.01 Z2.0 A1.5 B-2 C3 U0.1 V0.2 W0.3 D0.25 I10 J20 Q3 ;end mill\nT2 P2 Z4.5 D0.5 ;drill\n"
+TABLE = (
+    "T1 P1 X0.02 Y-0.01 Z2.0 A1.5 B-2 C3 U0.1 V0.2 W0.3 D0.25 I10 J20 Q3 ;end mill\nT2 P2 Z4.5 D0.5 ;drill\n"
+)
 # Each parameter read into a move after M6, after G10 L1 of the tool in the spindle and of another,
 # after the next M6, and in a subroutine that sizes its pass by the diameter (as `pocket_circ` does)
 PROGRAM = """{units} G90 G17 G54
@@ -114,9 +116,14 @@ def test_an_mm_machine_running_in_g20_reads_mm(tmp_path):
     it from inches (Z1 is 25.4 mm): rs274ngc keeps the table in the machine's units."""
     table = tmp_path / "mm.tbl"
     table.write_text("T1 P1 Z50 D6\n")
-    text = "G20 G90\nT1 M6\nG0 X0 Y0 Z1\nG1 X[#5410] Z[#5403] F10\nG10 L1 P1 Z1 R0.5\nG1 X[#5410] Z[#5403]\nM2\n"
+    text = (
+        "G20 G90\nT1 M6\nG0 X0 Y0 Z1\nG1 X[#5410] Z[#5403] F10\nG10 L1 P1 Z1 R0.5\nG1 X[#5410] Z[#5403]\nM2\n"
+    )
     calls = _ncpp_calls(text, table, UNIT_MM["mm"])
-    assert [c.args[:3] for c in calls[1:]] == [pytest.approx((6.0, 0.0, 50.0)), pytest.approx((25.4, 0.0, 25.4))]
+    assert [c.args[:3] for c in calls[1:]] == [
+        pytest.approx((6.0, 0.0, 50.0)),
+        pytest.approx((25.4, 0.0, 25.4)),
+    ]
 
 
 @pytest.mark.parametrize(
