@@ -156,8 +156,10 @@ def test_without_a_tool_table_a_read_after_m6_stays_out_of_scope():
 
 def test_m61_loads_the_tool_whose_entry_the_parameters_then_read(tmp_path):
     """M61 Q sets the tool in the spindle without a change (LinuxCNC G-code manual, "M61 Set Current
-    Tool"); rs274ngc sets #5400-#5413 from its entry as at M6.  (The stand-alone rs274's canon does not
-    load the tool at M61: its own G43 applies the old tool's offsets after it, so it is no judge here.)"""
+    Tool"); rs274ngc then syncs with the control and sets #5400-#5413 from the new spindle entry, as
+    at M6 (LinuxCNC's remap example of "the same thing as the builtin M61": CHANGE_TOOL_NUMBER, a
+    sync, set_tool_parameters).  The stand-alone rs274's canon does not load the tool at M61 (its own
+    G43 applies the old tool's offsets after it), so it is no judge here."""
     text = "G20 G90\nM61 Q2\nG0 X0 Y0 Z1\nG1 X[#5400] Y[#5403] Z[#5410] F10\nM2\n"
     calls = _ncpp_calls(text, _table(tmp_path), UNIT_MM["inch"])
     assert calls[-1].args[:3] == pytest.approx((2.0, 4.5, 0.5))
