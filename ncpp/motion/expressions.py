@@ -132,13 +132,15 @@ class Parameters:
     parameters the interpreter keeps in machine state (work offsets, G28
     positions, current position: 5161-5390, 5400-5428) are out of scope,
     read or written, because their values depend on the control's own files
-    and units.
+    and units, but for the reads `control` answers (the tool in the spindle's,
+    where ncpp knows it; it may raise OutOfScope saying why it does not).
     """
 
     def __init__(
         self,
         system: Callable[[str], float | None] | None = None,
         fanuc_system: Callable[[int], float | None] | None = None,
+        control: Callable[[int], float | None] | None = None,
     ):
         self.numbered: dict[int, float] = {}
         self.named: dict[str, float] = {
@@ -155,6 +157,7 @@ class Parameters:
         self.vacant: set[int] = set()
         self.fanuc = False  # a Fanuc program: #1000 and up are the control's system variables
         self.fanuc_system = fanuc_system  # those the interpreter knows (None: not known)
+        self.control = control  # LinuxCNC's machine-state parameters the interpreter knows (None: not known)
         self.kept: range = range(0)  # general-purpose variables past #1000 (Haas's), set before the program
         self.unknown: dict[int | str, str] = {}  # parameters set from a value ncpp cannot know: whence
         self.journal: Journal | None = None  # the writes a loop's check follows (`endless.py`)
@@ -289,7 +292,8 @@ class Parameters:
                     raise OutOfScope(f"#{key}, a variable the control keeps from before the program")
                 return value
             if _machine_state(key) or key >= 1000 and self.fanuc:
-                known = self.fanuc_system(key) if self.fanuc and self.fanuc_system is not None else None
+                lookup = self.fanuc_system if self.fanuc else self.control
+                known = lookup(key) if lookup is not None else None
                 if known is not None:
                     return known
                 raise OutOfScope(f"machine-state parameter #{key}" if not self.fanuc else

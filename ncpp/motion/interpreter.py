@@ -84,7 +84,7 @@ from ncpp.motion.segments import (
     Setting,
     turn_xy,
 )
-from ncpp.motion.tools import UntoldLengths
+from ncpp.motion.tools import OFFSET_LETTERS, UntoldLengths
 from ncpp.program.blocks import STRAY_TAPE, UNREADABLE, Block, Comment, ExprWord, Statement, Word
 
 MM_PER_INCH = 25.4
@@ -98,6 +98,10 @@ UNEXPANDED = {
 AXES = "XYZABCUVW"
 AXIS_INDEX = {letter: i for i, letter in enumerate(AXES)}
 LINEAR = (0, 1, 2, 6, 7, 8)  # axes that change with G20/G21 (not the rotary A B C)
+# LinuxCNC's parameters of the tool in the spindle: #5400 its number, #5401-#5409 its offsets X..W,
+# #5410 its diameter, #5411 #5412 its front and back angles, #5413 its orientation (`_tool_parameter`)
+TOOL_PARAMETERS = range(5400, 5414)
+TOOL_DIAMETER, TOOL_ORIENTATION = 5410, 5413
 
 # rs274ngc tolerances (interp_internal.hh), in program units
 TOLERANCE = {False: 0.002, True: 0.0002}  # zero-radius checks: mm, inch
@@ -351,14 +355,18 @@ class Interpreter:
         self.g92_saved = [0.0] * 9
         self.tool = [0.0] * 9  # the tool length offset in effect, program units
         self.tools = offsets.tools if offsets is not None else None  # the control's tool table
+        self.unit_mm = offsets.unit_mm if offsets is not None else 1.0  # its units (the machine's)
         self.selected_tool = 0  # T
         self.spindle_tool = 0  # M6, M61 (0: none)
+        self.tool_changed = False  # the program has changed the tool: ncpp knows which is in the spindle
         # what the program set in the control's tool table (G10 L1/L10/L11, Fanuc's and Haas's G10 L10-L13):
         # per tool (offset) number its offsets by axis in mm, over the told table's (`_table_offsets`),
-        # its radius in mm (None: set to a value ncpp does not read) and its lathe tool orientation
+        # its radius in mm as given, signed (None: set to a value ncpp does not read), its lathe tool
+        # orientation and its front and back angles (by letter, I J)
         self.set_offsets: dict[int, dict[int, float]] = {}
         self.set_radii: dict[int, float | None] = {}
         self.set_orientations: dict[int, int] = {}
+        self.set_angles: dict[int, dict[str, float]] = {}
         # Fanuc's and Haas's H offsets the program set: (geometry, wear) in mm (geometry None: not known)
         self.h_memory: dict[int, tuple[float | None, float]] = {}
         self.unpositioned = {0, 1, 2}  # the axes X Y Z no move has put at a known position yet
@@ -367,7 +375,7 @@ class Interpreter:
         )  # warned at the first G43 that reads the table
         self.home = {28: [0.0] * 9, 30: [0.0] * 9}  # G28/G30 positions, machine coordinates
         self.uses_extra_axes = False
-        self.params = Parameters(self._system_parameter, self._fanuc_system_variable)
+        self.params = Parameters(self._system_parameter, self._fanuc_system_variable, self._tool_parameter)
         self.params.kept = self.kept_variables
         self.params.fanuc = self.fanuc_variables
         self._context: Context | None = None
@@ -1150,9 +1158,9 @@ class Interpreter:
             if code in mcodes:
                 self.spindle = turning
         if 6.0 in mcodes:
-            self._set(spindle_tool=self.selected_tool)
+            self._set(spindle_tool=self.selected_tool, tool_changed=True)
         if 61.0 in mcodes and "Q" in words:
-            self._set(spindle_tool=self._tool_number(words["Q"], block))
+            self._set(spindle_tool=self._tool_number(words["Q"], block), tool_changed=True)
         told = None
         if 8 in gcodes:
             told = self._tool_length(gcodes[8], words, block, changed=6.0 in mcodes)
@@ -1446,7 +1454,8 @@ class Interpreter:
         """Tool (D offset) `number`'s radius in mm, as the program set it or the told table gives it
         (None: not known)."""
         if number in self.set_radii:
-            return self.set_radii[number]
+            radius = self.set_radii[number]
+            return None if radius is None else abs(radius)
         return None if self.tools is None else self.tools.diameter(number) / 2
 
     def _radius_offset(self, block: Block, word: tuple, with_code: bool) -> int:
@@ -1658,11 +1667,47 @@ class Interpreter:
         neither tells them (warned once where the length is not known)."""
         if not self._length_known(number):
             self.untold_lengths("G43", "tool.tbl", Location(self.file, block.line, item.start + 1))
+        return self._offsets_mm(number)
+
+    def _offsets_mm(self, number: int) -> tuple[float, ...]:
+        """Tool `number`'s offsets in mm and degrees, as the program set them over the told table's."""
         told = (self.tools.offset(number) if self.tools is not None else None) or (0.0,) * 9
         changed = self.set_offsets.get(number)
         if not changed:
             return told
         return tuple(changed.get(i, value) for i, value in enumerate(told))
+
+    def _tool_parameter(self, key: int) -> float | None:
+        """LinuxCNC's #5400-#5413, the tool in the spindle's number, offsets X Y Z A B C U V W,
+        diameter, front and back angles and orientation (G-code manual, "Numbered Parameters"), which
+        rs274ngc sets from the tool table's entry at M6 and M61 and at a G10 L1/L10/L11 of that tool:
+        in the machine's units (the table's) whatever G20/G21, as rs274 reads them.  Known after the
+        program's own change to a tool of the told table; None for the other parameters the control
+        keeps."""
+        if not TOOL_PARAMETERS[0] <= key <= TOOL_PARAMETERS[-1]:
+            return None
+        if self.tools is None:
+            raise OutOfScope(f"machine-state parameter #{key} of the tool in the spindle, without the tool "
+                             "table (--tool-table)")  # fmt: skip
+        if not self.tool_changed:  # (the control's tool, from before the program)
+            raise OutOfScope(f"machine-state parameter #{key} of the tool in the spindle before the "
+                             "program's first tool change (M6, M61)")  # fmt: skip
+        number = self.spindle_tool
+        if number == 0:
+            raise OutOfScope(f"machine-state parameter #{key} with no tool in the spindle")
+        if key == TOOL_PARAMETERS[0]:
+            return float(number)
+        index = key - TOOL_PARAMETERS[1]
+        if index < len(OFFSET_LETTERS):  # #5401-#5409
+            value = self._offsets_mm(number)[index]
+            return value / self.unit_mm if index in LINEAR else value
+        if key == TOOL_DIAMETER:
+            radius = self.set_radii.get(number)
+            return (2 * radius if radius is not None else self.tools.diameter(number)) / self.unit_mm
+        if key == TOOL_ORIENTATION:
+            return float(self.set_orientations.get(number, self.tools.orientation(number)))
+        letter = "IJ"[key - TOOL_DIAMETER - 1]  # the front and back angles, degrees
+        return self.set_angles.get(number, {}).get(letter, self.tools.angle(number, letter))
 
     def _warn_untold(self, number: int, block: Block, item) -> None:
         """Once per system: its zero is taken as the machine zero, which is likely wrong."""
@@ -1801,9 +1846,12 @@ class Interpreter:
         for i, value in given:
             entry[i] = self._tool_offset_value(l_number, i, value) * (scale if i in LINEAR else 1.0)
         if "R" in words:
-            self.set_radii[number] = abs(words["R"][0]) * scale
+            self.set_radii[number] = words["R"][0] * scale
         if "Q" in words:
             self.set_orientations[number] = round(words["Q"][0])
+        for letter in "IJ":
+            if letter in words:
+                self.set_angles.setdefault(number, {})[letter] = words[letter][0]
         if l_number == 1.0 or not given:
             return None
         here = (self.pos[0], self.pos[1], self.pos[2])

@@ -14,8 +14,9 @@ LinuxCNC's tool table, one tool per line (`tool.tbl`):
 T is the tool number, P its pocket, X Y Z A B C U V W its offsets, D its
 diameter (cutter compensation G41/G42 checks moves against its radius), Q a
 lathe tool's orientation (G41/G42 in G18 with one of 1-8 is left as programmed),
-I J its angles (not used here); a `;` starts the comment.  Values are in the
-machine's units ([TRAJ]LINEAR_UNITS).
+I J a lathe tool's front and back angles (degrees; a program reads them as
+#5411 #5412); a `;` starts the comment.  Values are in the machine's units
+([TRAJ]LINEAR_UNITS).
 
 Heidenhain's tool table (`TOOL.T`), fixed columns under a header line, its
 units in the first line:
@@ -57,7 +58,8 @@ from ncpp.fileio import read_small
 
 OFFSET_LETTERS = "XYZABCUVW"  # a tool's offsets, in the interpreter's axis order
 _LINEAR = frozenset("XYZUVW")  # the offsets in length units (A B C are degrees)
-_OTHER_LETTERS = frozenset("PIJ")  # pocket, lathe angles
+_OTHER_LETTERS = frozenset("P")  # the pocket
+_ANGLE_LETTERS = "IJ"  # a lathe tool's front and back angles
 _WORD = re.compile(r"\S+")
 
 
@@ -85,6 +87,9 @@ class ToolTable:
     radii: Mapping[tuple[float, int], float] = field(
         default_factory=dict, hash=False
     )  # (T, D) -> Heidenhain's R + DR, Sinumerik's radius + wear radius, mm (where the table gives one)
+    angles: Mapping[int, tuple[float, float]] = field(
+        default_factory=dict, hash=False
+    )  # LinuxCNC's I J per tool number: a lathe tool's front and back angles, degrees
 
     @classmethod
     def from_file(cls, path: str | Path, unit_mm: float = 1.0) -> ToolTable:
@@ -101,8 +106,8 @@ class ToolTable:
         if lines and lines[0].lstrip().upper().startswith("BEGIN"):
             edges, names, radii = read_tool_t(lines, str(path))
             return cls({}, str(path), names, edges, radii=radii)
-        offsets, diameters, orientations = read_tool_lines(lines, str(path), unit_mm)
-        return cls(offsets, str(path), diameters=diameters, orientations=orientations)
+        offsets, diameters, orientations, angles = read_tool_lines(lines, str(path), unit_mm)
+        return cls(offsets, str(path), diameters=diameters, orientations=orientations, angles=angles)
 
     def offset(self, number: int) -> tuple[float, ...] | None:
         """Tool `number`'s offsets (tool 0, no tool: all zero), None when the table has no such tool."""
@@ -117,6 +122,10 @@ class ToolTable:
     def orientation(self, number: int) -> int:
         """Tool `number`'s lathe tool orientation (0: none, or no such tool)."""
         return self.orientations.get(number, 0)
+
+    def angle(self, number: int, letter: str) -> float:
+        """Tool `number`'s front (I) or back (J) angle in degrees (0: none, or no such tool)."""
+        return self.angles.get(number, (0.0, 0.0))[_ANGLE_LETTERS.index(letter)]
 
 
 class UntoldLengths:
@@ -139,16 +148,18 @@ class UntoldLengths:
 
 def read_tool_lines(
     lines: list[str], file: str, unit_mm: float
-) -> tuple[dict[int, tuple[float, ...]], dict[int, float], dict[int, int]]:
-    """Per tool number its offsets (mm and degrees), and the diameters (mm) and lathe tool
-    orientations (Q) the table gives."""
+) -> tuple[dict[int, tuple[float, ...]], dict[int, float], dict[int, int], dict[int, tuple[float, float]]]:
+    """Per tool number its offsets (mm and degrees), and the diameters (mm), lathe tool
+    orientations (Q) and front and back angles (I J, degrees) the table gives."""
     tools: dict[int, tuple[float, ...]] = {}
     diameters: dict[int, float] = {}
     orientations: dict[int, int] = {}
+    angles: dict[int, tuple[float, float]] = {}
     for n, line in enumerate(lines, 1):
         data = line.split(";", 1)[0]
         offsets = [0.0] * len(OFFSET_LETTERS)
         number, diameter, orientation = None, 0.0, 0
+        angle = [0.0, 0.0]
         for word in _WORD.finditer(data):
             letter, value = word.group()[0].upper(), word.group()[1:]
             where = Location(file, n, word.start() + 1)
@@ -161,6 +172,8 @@ def read_tool_lines(
                 diameter = _number(value, where) * unit_mm
             elif letter == "Q":
                 orientation = round(_number(value, where))
+            elif letter in _ANGLE_LETTERS:
+                angle[_ANGLE_LETTERS.index(letter)] = _number(value, where)
             elif letter in _OTHER_LETTERS:
                 _number(value, where)
             else:
@@ -176,7 +189,9 @@ def read_tool_lines(
             diameters[number] = diameter
         if orientation:
             orientations[number] = orientation
-    return tools, diameters, orientations
+        if any(angle):
+            angles[number] = (angle[0], angle[1])
+    return tools, diameters, orientations, angles
 
 
 def _number(text: str, where: Location) -> float:

@@ -435,8 +435,8 @@ def test_a_construct_out_of_scope_in_a_subroutine_file_is_warned_at_the_program_
                     warnings=Warnings(stream=said), offsets=WorkOffsets.given({}, subroutine_path=[tmp_path]))  # fmt: skip
     where = f"(at {tmp_path / 'pocket_circ.ngc'}:4:4)"
     assert (
-        f"p.ngc:3:1: warning: #<td>, which line 3 set from machine-state parameter #5410 {where}"
-        in said.getvalue()
+        f"p.ngc:3:1: warning: #<td>, which line 3 set from machine-state parameter #5410 of the tool in the "
+        f"spindle, without the tool table (--tool-table) {where}" in said.getvalue()
     )
     assert "from line 3, which runs it, on the program passes through" in said.getvalue()
     assert "everything from line 3 on (3 lines)" in stats.summary.line()
