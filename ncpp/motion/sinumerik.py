@@ -16,8 +16,9 @@ loop's moves are left as programmed (FLOW), or with --expand each run is written
 (`sinumerik_expand.py`), as are subprogram calls.  The drilling, tapping and boring cycles
 CYCLE81-CYCLE89 and CYCLE840, called once or under MCALL, are followed (`sinumerik_cycles.py`),
 as are the hole patterns HOLES1 and HOLES2 under MCALL (their moves left as programmed,
-PATTERN).  A subprogram call (`L<n>`, a name, value parameters of its PROC, `P` runs) runs the
-subprogram's file from the subroutine path to M17 or RET (`_call`): its moves are left as
+PATTERN).  A subprogram call (`L<n>`, a name, `PCALL` with a path, value parameters and parameters by
+reference (VAR) of its PROC, `P` runs) runs the subprogram's file from the subroutine path to M17 or
+RET (`_call`, `_bind`): its moves are left as
 programmed (FLOW), and the moves after the call are compensated.  Calls of other cycles, the
 patterns CYCLE801 and CYCLE802, subprogram files not found, splines, other frames, polar
 coordinates (AP=, RP=),
@@ -176,7 +177,7 @@ KNOWN_CYCLE = re.compile(r"CYCLE\d|POCKET\d|SLOT\d|LONGHOLE|HOLES\d|E_|F_", re.I
 # underscores"; E_ and F_ "reserved for SIEMENS cycles"): the control runs the program of the called name,
 # so one found on the subroutine path is the user's own (`_own_program`)
 SHOP_CYCLE = re.compile(r"[EF]_\w+", re.I)
-# Predefined procedures that call programs in ways not followed here (PCALL: by an absolute path)
+# Predefined procedures that call programs otherwise than by their name (`PCALL` with its path: `_call_path`)
 CALL_KEYWORDS = frozenset(("PCALL", "CALLPATH", "MCALL", "RET"))
 # Predefined procedures of the control (Job Planning manual, "Tables: list of instructions"), not
 # subprograms: the transformations, diameter programming, curve tables, interrupt routines, a block
@@ -194,17 +195,32 @@ HARMLESS_PROC_ATTRIBUTES = frozenset(("DISPLOF", "DISPLON", "SBLOF", "SBLON", "A
 _R_PARAMETER = re.compile(r"r\d+")  # the channel's R parameters: shared by every program level
 # `_N_MYSUB_SPF`, `MYSUB_SPF`: a name with the control's own prefix and type (all are the same program)
 _CONTROL_NAME = re.compile(r"(?:_N_)?(\w+?)(?:_(SPF|MPF))?", re.I)
+# The types a parameter by reference (VAR) is followed for: a scalar's, an array's
+REFERENCE_TYPES = frozenset(("REAL", "INT", "STRING"))
+ARRAY_REFERENCE_TYPES = frozenset(("REAL", "INT"))
+
+
+@dataclass(frozen=True)
+class _Reference:
+    """A parameter by reference (VAR): the caller's variable it names, by its key among the caller's
+    variables (`r1`, `width`, `feld[2]`), or the caller's array and its sizes."""
+
+    parameter: str
+    key: str
+    integer: bool  # an INT's (assignments round)
+    sizes: tuple[int, ...] | None = None  # an array's
 
 
 @dataclass(frozen=True)
 class _Call:
-    """A subprogram call: the file, its blocks, its PROC parameters' values, its runs."""
+    """A subprogram call: the file, its blocks, its PROC parameters' values and references, its runs."""
 
     name: str
     path: Path
     blocks: list[Block]
     parameters: dict
     runs: int
+    references: tuple[_Reference, ...] = ()
 
 
 class SinumerikInterpreter(ModalInterpreter):
@@ -232,6 +248,9 @@ class SinumerikInterpreter(ModalInterpreter):
         self.variables: dict[str, float | str] = {}
         self.integers: set[str] = set()  # DEF INT variables round on assignment
         self.arrays: dict[str, tuple[int, ...]] = {}  # DEF arrays' sizes (their elements are variables)
+        # A subprogram's parameters by reference that name a variable held under another key: an R
+        # parameter (the channel's, shared) or another parameter given the same variable (`_bind`)
+        self.aliases: dict[str, str] = {}
         self.started = False  # a block has run (a PROC opens the program or is out of scope)
         self.modal_cycle: Drilling | None = None  # MCALL's drilling cycle, run after each block that moves
         self.spindle = 0.0  # the spindle speed S programmed (rev/min): a tapping cycle's feed follows it
@@ -444,11 +463,11 @@ class SinumerikInterpreter(ModalInterpreter):
                 f"{what} {name} (its file not found: {searched(self.subroutine_path, names)})", item.start + 1
             )
         blocks = files.blocks(path)
-        parameters = self._parameters(blocks, name, args, block, item)
-        if parameters and runs > 1:
+        parameters, references = self._parameters(blocks, name, args, block, item)
+        if (parameters or references) and runs > 1:
             raise OutOfScope(f"the subprogram call {name} with parameters and P (later runs keep the "
                              "values the first left)", item.start + 1)  # fmt: skip
-        return _Call(name, path, blocks, parameters, runs)
+        return _Call(name, path, blocks, parameters, runs, references)
 
     def _own_program(self, name: str) -> bool:
         """Whether `name`, one of the ShopMill/ShopTurn cycles' (`E_...`, `F_...`), is a program of
@@ -465,16 +484,27 @@ class SinumerikInterpreter(ModalInterpreter):
         EXTCALL: `EXTCALL("<path/><program name>")`, the name with or without `_N_` and its type
         after `_` or `.`); its folders, the control's or a drive's, dropped: the file is looked for
         in the subroutine path, as the control looks in its program memories."""
-        name = expr[1] if expr[0] == "str" else self.variables.get(expr[1]) if expr[0] == "param" else None
+        name = expr[1] if expr[0] == "str" else None
+        if expr[0] == "param":
+            name = self.variables.get(self._key(expr[1]))
         if type(name) is not str or not name.strip("/\\"):
             raise OutOfScope(f"{item.node[0]} of a program named other than by a string", item.start + 1)
-        name = re.split(r"[/\\:]", name.rstrip("/\\"))[-1].upper()
-        return re.sub(r"\.(SPF|MPF)$", r"_\1", name)
+        return _program_of(name)
 
-    def _parameters(self, blocks: list[Block], name: str, args: tuple, block: Block, item) -> dict:
+    def _call_path(self, block: Block, item: Statement) -> _Call:
+        """`PCALL/_N_WKS_DIR/_N_SHAFT_WPD/SHAFT(R1, 2)` (Job Planning manual, "Subprogram call with
+        path specification and parameters (PCALL)"): the program the path ends in, with the
+        parameters of a call by its name; its folders dropped, as `_indirect`'s.  Without a path
+        (`PCALL SHAFT(1)`) PCALL calls as the program's name alone does."""
+        path, *args = item.node[1]
+        return self._call(block, item, _program_of(path[1]), tuple(args))
+
+    def _parameters(
+        self, blocks: list[Block], name: str, args: tuple, block: Block, item
+    ) -> tuple[dict, tuple[_Reference, ...]]:
         """The subprogram's PROC parameters (its first block, if any) given the call's values
         (840D sl Job Planning manual, "Subprograms with parameter transfer": an omitted value
-        parameter is 0, an empty string); parameters by reference (VAR) and arrays are not followed."""
+        parameter is 0, an empty string), and its parameters by reference (VAR: `_reference`)."""
         proc = next((i for b in blocks for i in b.items if type(i) is Statement and i.kind == "proc"), None)
         declared = () if proc is None else proc.node[1]
         if len(args) > len(declared):
@@ -484,7 +514,11 @@ class SinumerikInterpreter(ModalInterpreter):
             if extra:
                 raise OutOfScope(f"the subprogram {name} with PROC ... {extra[0].upper()}", item.start + 1)
         values: dict[str, float | str] = {}
+        references: list[_Reference] = []
         for (kind, parameter, by_reference, dims), arg in zip(declared, (*args, *(None,) * len(declared))):
+            if by_reference and kind in (REFERENCE_TYPES if dims is None else ARRAY_REFERENCE_TYPES):
+                references.append(self._reference(name, (kind, parameter, dims), arg, block, item))
+                continue
             if by_reference or dims is not None or kind not in ("REAL", "INT", "BOOL", "STRING"):
                 what = "VAR " if by_reference else ""
                 raise OutOfScope(f"the subprogram {name}'s parameter {what}{kind} {parameter.upper()}",
@@ -496,7 +530,58 @@ class SinumerikInterpreter(ModalInterpreter):
                 continue
             value = 0.0 if arg is None else self.value(arg, block, item)
             values[parameter] = float(round(value)) if kind == "INT" else value
-        return values
+        _refuse_overlaps(references, name, item)
+        return values, tuple(references)
+
+    def _reference(self, name: str, declared: tuple, arg: tuple | None, block: Block, item) -> _Reference:
+        """A parameter by reference (VAR) given the caller's variable `arg` (Job Planning manual,
+        "Subprograms with parameter transfer", call-by-reference: the subprogram reads and writes
+        the caller's variable itself): an R parameter, a variable or an array element the program
+        defined, or (`VAR REAL X[]`, `X[,3]`) an array of the program of those sizes, of the
+        parameter's type.  Anything else (a value, an omitted parameter, a variable the program
+        does not define: a global user variable, a system variable) is out of scope."""
+        kind, parameter, dims = declared
+        what = f"the subprogram {name}'s parameter VAR {kind} {parameter.upper()}"
+        where = item.start + 1
+        if arg is None:
+            raise OutOfScope(f"{what} not given (call by reference names a variable of the caller)", where)
+        if dims is not None:
+            return self._array_reference(what, parameter, kind, dims, arg, block, item)
+        if arg[0] == "index":
+            key, integer = self._element(arg, block, item), self._key(arg[1]) in self.integers
+        elif arg[0] == "param":
+            key = self._key(arg[1])
+            integer = key in self.integers
+            if key not in self.variables and not _R_PARAMETER.fullmatch(key):
+                raise OutOfScope(f"{what} given {arg[1].upper()} (not defined in the program)", where)
+        else:
+            raise OutOfScope(f"{what} given a value (call by reference names a variable of the caller)",
+                             where)  # fmt: skip
+        value = self.variables.get(key, 0.0)
+        if value is _FROM_THE_CALLER:
+            raise OutOfScope(f"the parameter {key.upper()} (its value comes from the caller)", where)
+        if (kind == "STRING") != (type(value) is str) or (kind == "INT") != integer:
+            raise OutOfScope(f"{what} given {key.upper()}, a variable of another type", where)
+        return _Reference(parameter, key, integer)
+
+    def _array_reference(
+        self, what: str, parameter: str, kind: str, dims: tuple, arg: tuple, block: Block, item
+    ) -> _Reference:
+        """`VAR REAL X[]`, `VAR INT X[,3]` given an array of the program: its sizes, each the
+        parameter gives (a number) the array's."""
+        key = self._key(arg[1]) if arg[0] == "param" else ""
+        sizes = self.arrays.get(key)
+        where = item.start + 1
+        if sizes is None:
+            raise OutOfScope(f"{what} given other than an array of the program", where)
+        given = dims or (None,)  # (`X[]`: one size, not given)
+        if len(given) != len(sizes) or any(
+            size is not None and (size[0] != "num" or size[1] != n) for size, n in zip(given, sizes)
+        ):
+            raise OutOfScope(f"{what} given the array {key.upper()}{list(sizes)} of other sizes", where)
+        if (kind == "INT") != (key in self.integers):
+            raise OutOfScope(f"{what} given {key.upper()}, an array of another type", where)
+        return _Reference(parameter, key, kind == "INT", sizes)
 
     def _subprogram(
         self, call: _Call, caller: Block, warnings: Warnings, flow: SinumerikFlow, at: Block
@@ -504,7 +589,7 @@ class SinumerikInterpreter(ModalInterpreter):
         """The subprogram's runs: its blocks run as the program's, with variables of their own
         (the R parameters are the channel's, shared), to M17 or RET.  Its P runs are a counted
         loop at the calling line `at` of `flow` (`CountedPasses`), inside the loops around the call."""
-        outer = (self.file, self.variables, self.integers, self.arrays, self.started)
+        outer = (self.file, self.variables, self.integers, self.arrays, self.started, self.aliases)
         outside, around_call = self.outside, flow.enclosing
         what = f"the subprogram call {call.name} P{call.runs}"
 
@@ -522,6 +607,7 @@ class SinumerikInterpreter(ModalInterpreter):
                 self.variables = {k: v for k, v in outer[1].items() if _R_PARAMETER.fullmatch(k)}
                 self.variables.update(call.parameters)
                 self.integers, self.arrays, self.started = set(), {}, False
+                self._bind(call.references, outer[1])
                 yield from self._run(call.blocks, warnings, caller)
                 shared = {k: v for k, v in self.variables.items() if _R_PARAMETER.fullmatch(k)}
                 outer[1].update(shared)
@@ -536,6 +622,7 @@ class SinumerikInterpreter(ModalInterpreter):
                                      call.blocks[-1] if call.blocks else caller, None, caller)  # fmt: skip
                     return
                 self.returned = False
+                self._give_back(call.references, outer[1])
                 if left:
                     around = around_call if run == 0 else None  # (its first run ended: the loops around it)
                     mark = self.called_passes.ended(mark, self.called_blocks, left, at.line, what, outer[0], around,
@@ -543,9 +630,49 @@ class SinumerikInterpreter(ModalInterpreter):
         finally:
             self.calls.pop()
             self.outside = outside
-            self.file, self.variables, self.integers, self.arrays, self.started = outer
+            self.file, self.variables, self.integers, self.arrays, self.started, self.aliases = outer
+
+    def _bind(self, references: tuple[_Reference, ...], caller: dict) -> None:
+        """The subprogram's parameters by reference, as it starts: one given an R parameter is that R
+        parameter (the channel's: read and written in place), one given the variable an earlier
+        one was given is that one; any other holds the caller's variable's value (its elements'),
+        given back where the subprogram returns (`_give_back`): no other name reaches a caller's
+        variable, so the caller sees what a reference would have shown it."""
+        self.aliases = {}
+        held: dict[str, str] = {}  # the caller's variable -> the parameter that holds it
+        for reference in references:
+            parameter, key = reference.parameter, reference.key
+            if key in held or _R_PARAMETER.fullmatch(key):
+                self.aliases[parameter] = held.get(key, key)
+                continue
+            held[key] = parameter
+            if reference.integer:
+                self.integers.add(parameter)
+            if reference.sizes is None:
+                self.variables[parameter] = caller[key]
+                continue
+            self.arrays[parameter] = reference.sizes
+            for mine, theirs in _elements_of(reference):
+                self.variables[mine] = caller[theirs]
+
+    def _give_back(self, references: tuple[_Reference, ...], caller: dict) -> None:
+        """At the subprogram's return: the caller's variables its parameters by reference hold (`_bind`)
+        take their values."""
+        for reference in references:
+            parameter, key = reference.parameter, reference.key
+            if parameter in self.aliases:
+                continue
+            if reference.sizes is None:
+                caller[key] = self.variables[parameter]
+                continue
+            for mine, theirs in _elements_of(reference):
+                caller[theirs] = self.variables[mine]
 
     # -- variables --------------------------------------------------------------------
+    def _key(self, name: str) -> str:
+        """The key a variable's value is held under: a parameter by reference's may be another's (`_bind`)."""
+        return self.aliases.get(name, name)
+
     def _procedure(self, node: tuple, block: Block, item) -> None:
         """`PROC NAME(params)` opening the program: the program runs as the procedure, whose
         parameters take the caller's values, which ncpp is not told: reading one ends
@@ -558,6 +685,7 @@ class SinumerikInterpreter(ModalInterpreter):
             self.variables[name] = _FROM_THE_CALLER
 
     def lookup(self, name: str) -> float:
+        name = self._key(name)
         value = self.variables.get(name)
         if value is _FROM_THE_CALLER:
             raise OutOfScope(f"the parameter {name.upper()} (its value comes from the caller)")
@@ -577,7 +705,7 @@ class SinumerikInterpreter(ModalInterpreter):
             return
         if target[0] != "param" or target[1].startswith("$"):
             raise OutOfScope(f"the assignment to {target[1].upper()}", item.start + 1)
-        name = target[1]
+        name = self._key(target[1])
         if name not in self.variables and not _R_PARAMETER.fullmatch(name):
             # (a global variable defined in a file of the control's, or an address this reading does not
             # know: the control reads either its own way)
@@ -592,7 +720,7 @@ class SinumerikInterpreter(ModalInterpreter):
         """A FOR loop's counter set: one the program did not define is taken as a REAL of its own
         (as the CEAD interpreter takes it)."""
         if target[0] == "param":
-            self.variables.setdefault(target[1], 0.0)
+            self.variables.setdefault(self._key(target[1]), 0.0)
         self.assign(target, expr, block, item)
 
     def define(self, node: tuple, block: Block, item) -> None:
@@ -628,7 +756,7 @@ class SinumerikInterpreter(ModalInterpreter):
             self._assign_elements(("index", name, (("num", 0.0),) * len(sizes)), init, block, item)
 
     def _assign_elements(self, target: tuple, expr: tuple, block: Block, item) -> None:
-        name = target[1]
+        name = self._key(target[1])
         keys = _element_keys(name, self.arrays.get(name, ()))
         if not keys:
             raise OutOfScope(f"the array {name.upper()} (not defined in the program)", item.start + 1)
@@ -655,7 +783,7 @@ class SinumerikInterpreter(ModalInterpreter):
 
     def _element(self, target: tuple, block: Block, item) -> str:
         """The variable key of an array element `("index", name, (exprs))`, its indices checked."""
-        name = target[1]
+        name = self._key(target[1])
         sizes = self.arrays.get(name)
         if self.variables.get(name) is _FROM_THE_CALLER:
             raise OutOfScope(
@@ -732,6 +860,8 @@ class SinumerikInterpreter(ModalInterpreter):
                         f"the hole pattern {item.node[0]} (the control places its holes itself)",
                         item.start + 1,
                     )
+                elif what == "call" and item.node[0] == "PCALL" and _with_path(item):
+                    self.called = self._call_path(block, item)
                 elif what == "call" and item.node[0] in ("CALL", "EXTCALL") and len(item.node[1]) == 1:
                     self.called = self._call(block, item, self._indirect(item.node[1][0], block, item), ())
                 elif what == "call" and item.node[0].upper() in APPROACHES and not item.node[1]:
@@ -1313,6 +1443,34 @@ def _subprogram_files(name: str) -> list[str]:
     base, kind = (found.group(1), found.group(2)) if found else (name, None)
     kinds = [kind.upper()] if kind else ["SPF", "MPF"]
     return [f for k in kinds for f in (f"{base}.{k}", f"_N_{base}_{k}", f"_N_{base}_{k}.{k}")]
+
+
+def _with_path(item: Statement) -> bool:
+    """Whether a PCALL is the parser's reading of `PCALL path(...)` (the path its first argument, a string)."""
+    return bool(item.node[1]) and item.node[1][0] is not None and item.node[1][0][0] == "str"
+
+
+def _program_of(path: str) -> str:
+    """The program a path names (`/_N_WKS_DIR/PART2`, `LOCAL_DRIVE:PART2.SPF`): its last part, the
+    type after `.` written as the control's `_SPF`."""
+    name = re.split(r"[/\\:]", path.rstrip("/\\"))[-1].upper()
+    return re.sub(r"\.(SPF|MPF)$", r"_\1", name)
+
+
+def _refuse_overlaps(references: list[_Reference], name: str, item) -> None:
+    """Out of scope: an array element given to a parameter by reference and its array to another
+    (one variable under two keys, which `_bind` does not tie)."""
+    arrays = {r.key for r in references if r.sizes is not None}
+    for reference in references:
+        if reference.sizes is None and reference.key.split("[")[0] in arrays:
+            raise OutOfScope(f"the subprogram {name} given {reference.key.upper()} and its array by reference",
+                             item.start + 1)  # fmt: skip
+
+
+def _elements_of(reference: _Reference) -> list[tuple[str, str]]:
+    """An array parameter by reference's element keys, each with the caller's array's."""
+    sizes = reference.sizes or ()
+    return list(zip(_element_keys(reference.parameter, sizes), _element_keys(reference.key, sizes)))
 
 
 def _element_key(name: str, index: tuple[int, ...]) -> str:

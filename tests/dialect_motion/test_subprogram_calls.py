@@ -227,12 +227,13 @@ def test_sinumerik_a_subprogram_that_calls_itself_for_ever_is_refused(tmp_path, 
          "the subprogram NORET ends without M17 or RET"),
         ({"SAVED.SPF": "PROC SAVED SAVE\nG1 X1 F100\nM17\n"}, "SAVED", "main:2:1",
          "the subprogram SAVED with PROC ... SAVE"),
-        ({"REF.SPF": "PROC REF(VAR REAL A)\nM17\n"}, "REF(R1)", "main:2:1", "parameter VAR REAL A"),
+        ({"REF.SPF": "PROC REF(VAR REAL A)\nM17\n"}, "REF(5)", "main:2:1",
+         "parameter VAR REAL A given a value"),
         ({"TWO.SPF": "PROC TWO(REAL A)\nG1 X=A F100\nM17\n"}, "TWO(1) P2", "main:2:1",
          "with parameters and P"),
         ({"ALONE.SPF": "G1 X1 F100\nM17\n"}, "G1 Y2 L100", "main:2:1", "the subprogram call L100 with more"),
     ],
-    ids=["m30", "no return", "save", "by reference", "parameters and runs", "not alone"],
+    ids=["m30", "no return", "save", "a value by reference", "parameters and runs", "not alone"],
 )  # fmt: skip
 def test_sinumerik_calls_ncpp_does_not_follow_end_interpretation(tmp_path, files, call, where, reason):
     folder = _folder(tmp_path, {**files, "L100.SPF": "M17\n"})

@@ -11,6 +11,7 @@ from ncpp.motion.segments import Line, Pass
 from ncpp.motion.sinumerik import interpret
 from ncpp.program.blocks import Comment, ExprWord, Statement, Word
 from ncpp.program.parser import LineParser, parse_stream
+from ncpp.program.writer import write_blocks
 
 PARSER = LineParser("sinumerik")
 
@@ -184,6 +185,23 @@ def test_calls_frames_messages_and_headers():
     assert (main.letter, main.value) == (":", 10.0)
     (comment,) = items("; (not a comment in parentheses)")
     assert type(comment) is Comment and comment.style == ";"
+
+
+def test_pcall_reads_its_path_whole_and_writes_it_back_as_it_was():
+    """`PCALL/_N_WKS_DIR/_N_SHAFT_WPD/SHAFT(R1, 2)` (Job Planning manual, "Subprogram call with path
+    specification and parameters (PCALL)"): the path is the call's first argument, a string; the
+    parser refused a path (`unexpected '/_N_WKS_DIR...'`) and read `PCALL SHAFT(1)` as two calls."""
+    assert statements("N20 PCALL/_N_WKS_DIR/_N_SHAFT_WPD/SHAFT(R1, 2) ; shaft") == [
+        ("call", ("PCALL", (("str", "/_N_WKS_DIR/_N_SHAFT_WPD/SHAFT"), ("param", "r1"), ("num", 2.0))))
+    ]
+    assert statements("pcall SHAFT(1,,3)") == [("call", ("PCALL", (("str", "SHAFT"), ("num", 1.0), None,
+                                                                   ("num", 3.0))))]  # fmt: skip
+    assert statements("PCALL /WKS.DIR/SHAFT.SPF") == [("call", ("PCALL", (("str", "/WKS.DIR/SHAFT.SPF"),)))]
+    assert statements("PCALLS=1") == [("assignment", (("param", "pcalls"), ("num", 1.0)))]
+    text = b"PCALL/_N_WKS_DIR/_N_SHAFT_WPD/SHAFT(R1, 2)\r\nN30 pcall  SHAFT ( 1 ) ; x\r\n"
+    out = io.BytesIO()
+    write_blocks(parse_stream(io.BytesIO(text), "p.mpf", "sinumerik"), out)
+    assert out.getvalue() == text
 
 
 def test_bad_input_names_file_line_and_column():

@@ -111,6 +111,26 @@ G0 Z5
 RET
 """
 CALLED_AT = [(x, y, -2) for x in (100, 200, 201) for y in (20, 60, 80)] + [(30, 15, -3), (202, 15, 50)]
+# a PROC whose parameters are the caller's variables by reference (Job Planning, "Subprograms with
+# parameter transfer": VAR), called by its name and by PCALL with a path; the caller's moves after
+# each call read what it assigned: LEN 20 -> 40 -> 80, WID 10 -> 15 -> 20, R1 = 600, R2 = 1600
+VAR_CALLS = """G17 G90 G71
+DEF REAL LEN=20, WID=10
+G0 X-5 Y-5 Z5
+RECT(LEN, WID, R1)
+G1 X=LEN Y=WID+R1/100 Z-1 F200
+PCALL/_N_WKS_DIR/_N_PART_WPD/RECT(LEN, WID, R2)
+G1 X=LEN+R2/1000 Y=WID Z-1
+M30
+"""
+RECT = """PROC RECT(VAR REAL _LG, VAR REAL _WD, VAR REAL _AREA) DISPLOF
+_LG=_LG*2
+_WD=_WD+5
+G1 X=_LG Y=_WD Z-2 F300
+_AREA=_LG*_WD
+RET
+"""
+BY_REFERENCE = [(40, 15, -2), (40, 21, -1), (80, 20, -2), (81.6, 20, -1)]
 _WORD = re.compile(r"(?<![A-Z\d_])([XYZ])=?(-?\d+(?:\.\d*)?)")
 
 
@@ -125,13 +145,14 @@ def points(text: str) -> np.ndarray:
 def _with_subprograms(tmp_path: Path) -> tuple[str, ...]:
     (tmp_path / "L100.SPF").write_text(L100)
     (tmp_path / "HOLE.SPF").write_text(HOLE)
+    (tmp_path / "RECT.SPF").write_text(RECT)
     return ("--subroutine-path", str(tmp_path))
 
 
 CASES = [(FOR_SQUARES, "for.mpf", squares(3)), (WHILE_REPEAT, "while.mpf", WHILE_REPEATED),
          (JUMPS, "jumps.mpf", JUMPED), (CALLS, "calls.mpf", CALLED_AT),
-         (SECTIONS, "sections.mpf", SECTION_ENDS[1:])]  # fmt: skip
-IDS = ["for", "while-repeat", "gotob", "calls", "section repetition"]
+         (SECTIONS, "sections.mpf", SECTION_ENDS[1:]), (VAR_CALLS, "var.mpf", BY_REFERENCE)]  # fmt: skip
+IDS = ["for", "while-repeat", "gotob", "calls", "section repetition", "by reference"]
 
 
 @pytest.mark.parametrize("text, name, wanted", CASES, ids=IDS)
@@ -191,6 +212,25 @@ def test_calls_are_left_out_and_the_subprogram_files_untouched(tmp_path):
     assert not re.search(r"L100|HOLE|PROC|RET|M17|DOWN|XP", written)
     assert re.findall(r"R2=\d+", written) == ["R2=100", "R2=101", "R2=200", "R2=202"]
     assert (tmp_path / "L100.SPF").read_text() == L100 and (tmp_path / "HOLE.SPF").read_text() == HOLE
+
+
+def test_a_call_by_reference_is_left_out_and_the_variables_it_changed_set_after_it(tmp_path):
+    """With --expand the call lines (by name, PCALL) are left out, RECT's moves written with their
+    numbers, and before the caller's next line the variables the call changed through its VAR
+    parameters are set."""
+    options = _with_subprograms(tmp_path)
+    written, _ = compensated(tmp_path, "var.mpf", VAR_CALLS, "--expand", *options)
+    lines = [line for line in written.splitlines() if not line.startswith(";")]
+    assert not re.search(r"RECT|PCALL|_LG|_AREA", written)
+    first = lines.index("R1=600")
+    assert lines[first : first + 3] == ["R1=600", "LEN=40", "WID=15"]
+    second = lines.index("R2=1600")
+    assert lines[second : second + 3] == ["R2=1600", "LEN=80", "WID=20"]
+    # without --expand the calls stay, and the caller's moves after them, read from what they
+    # assigned, are compensated: within 0.5 µm of their points on the machine
+    plain, _ = compensated(tmp_path, "plain-var.mpf", VAR_CALLS, *options)
+    assert "RECT(LEN, WID, R1)" in plain and "PCALL/_N_WKS_DIR/_N_PART_WPD/RECT(LEN, WID, R2)" in plain
+    assert landed(points(plain), BY_REFERENCE[1::2]).max() < 0.5e-3
 
 
 def test_words_keep_their_form_with_this_runs_numbers():

@@ -18,7 +18,8 @@ Statement kinds and nodes (Sinumerik):
   call         (NAME, args)               `CYCLE81(10,0,2,-5)`, `MSG("x")`, `SETAL(1)`, `BNAT`,
                                           `MATERIAL_UPDATE`: passed through; args tuple of exprs, None if
                                           empty; `CALL "PART2"` (an indirect call) is ("CALL", (expr,)),
-                                          `EXTCALL "PART2"` ("EXTCALL", (expr,))
+                                          `EXTCALL "PART2"` ("EXTCALL", (expr,)); `PCALL/_N_WKS_DIR/SUB(1, R2)`
+                                          ("PCALL", (("str", "/_N_WKS_DIR/SUB"), ("num", 1.0), ("param", "r2")))
   path         (NAME,)                    CIP CT ASPLINE BSPLINE CSPLINE POLY (words follow)
   frame        (NAME,)                    TRANS ATRANS ROT AROT SCALE ASCALE MIRROR AMIRROR ... (words follow)
   def          (type, length, vars)       `DEF STRING[8] A="x", B` -> ('STRING', ("num", 8.0), ((target, init|None), ...))
@@ -148,6 +149,8 @@ class SinumerikBuilder(Transformer):
     call = _statement("call", _call)
     # `CALL "PART2"`, `CALL NAME_VARIABLE`, `EXTCALL ("PART2")`
     indirect_call = _statement("call", lambda c: (str(c[0]).upper(), (c[1],)))
+    # `PCALL/_N_WKS_DIR/SUB(1, 2)`: the path a string argument before the parameters
+    path_call = _statement("call", lambda c: ("PCALL", (("str", str(c[0])[5:].strip()), *(c[1:] and c[1]))))
     label = _statement("label", lambda c: (str(c[0])[:-1].upper(),))
     path = _statement("path", lambda c: (str(c[0]).upper(),))
     frame = _statement("frame", lambda c: (str(c[0]).upper(),))
