@@ -61,7 +61,10 @@ M2
 """
 # The G17 letters each plane's words take (rs274ngc's convert_cycle_zx and _yz: the plane's first and
 # second axis and its normal in the places of X Y Z, and I J K with them)
-LETTERS = {plane: letters + "".join("IJK"["XYZ".index(a)] for a in letters) for plane, letters in PLANE_LETTERS.items()}
+LETTERS = {
+    plane: letters + "".join("IJK"["XYZ".index(a)] for a in letters)
+    for plane, letters in PLANE_LETTERS.items()
+}
 
 
 def in_plane(program: str, plane: int) -> str:
@@ -88,7 +91,11 @@ def back_bored(path: Path, machine, plane: int = 17) -> list[tuple[np.ndarray, f
 PROGRAMS = [
     (PROGRAM, HOLES, 17),
     (PROGRAM_G91, HOLES_G91, 17),
-    *((in_plane(p, plane), h, plane) for plane in (18, 19) for p, h in ((PROGRAM, HOLES), (PROGRAM_G91, HOLES_G91))),
+    *(
+        (in_plane(p, plane), h, plane)
+        for plane in (18, 19)
+        for p, h in ((PROGRAM, HOLES), (PROGRAM_G91, HOLES_G91))
+    ),
 ]
 
 
@@ -98,7 +105,9 @@ PROGRAMS = [
     PROGRAMS,
     ids=["G90", "G91 repeats", "G18 G90", "G18 G91 repeats", "G19 G90", "G19 G91 repeats"],
 )
-def test_each_back_bore_cuts_to_its_top_and_stands_at_its_bottom_and_r(tmp_path, machine_name, program, holes, plane):
+def test_each_back_bore_cuts_to_its_top_and_stands_at_its_bottom_and_r(
+    tmp_path, machine_name, program, holes, plane
+):
     """The cut's end (X Y K) within 0.2 µm of the programmed point, the bottom (Z) and R levels
     within 0.2 µm, where the machine puts each cut's end more than 5 µm off uncompensated; the
     cycles stay G87 blocks, a block per hole; pathcheck passes."""
@@ -113,7 +122,9 @@ def test_each_back_bore_cuts_to_its_top_and_stands_at_its_bottom_and_r(tmp_path,
     tops = np.zeros((len(holes), 3))
     tops[:, list(PLANE_INDICES[plane])] = wanted[:, [0, 1, 4]]
     as_programmed = back_bored(original, None, plane)
-    assert np.allclose([(*t, b, r) for t, b, r in as_programmed], np.column_stack([tops, wanted[:, 2:4]]), atol=1e-6)
+    assert np.allclose(
+        [(*t, b, r) for t, b, r in as_programmed], np.column_stack([tops, wanted[:, 2:4]]), atol=1e-6
+    )
     before, after = back_bored(original, machine, plane), back_bored(output, machine, plane)
     assert len(after) == len(holes)
     assert len(re.findall(r"G87", output.read_text())) == len(re.findall(r"G87", program))
