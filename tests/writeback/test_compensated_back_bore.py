@@ -7,12 +7,14 @@ the machines written by hand in test_compensated_holes.py, not by ncpp's interpr
 
 from __future__ import annotations
 
+import io
 import re
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from ncpp.errors import Warnings
 from tests.compensation.accuracy import _moves, actual_moves
 from tests.writeback.conftest import compensate_file
 from tests.writeback.test_compensated_holes import (
@@ -139,12 +141,16 @@ def test_each_back_bore_cuts_to_its_top_and_stands_at_its_bottom_and_r(
     assert _passes_pathcheck(original, output)
 
 
-def test_fanuc_back_boring_stays_as_programmed(tmp_path):
-    """Fanuc's G87 reads R, Z and K otherwise (R below the part, Z the top of the cut, K repeats):
-    left as programmed, with the warning."""
+@pytest.mark.parametrize("dialect", ["fanuc", "haas"])
+def test_fanuc_back_boring_stays_as_programmed(tmp_path, dialect):
+    """Fanuc's G87 reads R, Z and K otherwise (R below the part, Z the top of the cut, K repeats:
+    Fanuc Series 15i-MA operator's manual, "Back boring cycle (G87)"): left as programmed, with the
+    warning."""
     original = tmp_path / "back.nc"
     original.write_text("%\nG21 G90 G17\nG0 X40 Y30 Z25 S500 M3\nG98 G87 X200 Y150 Z-30 R5 I2 J-1 K-12 F100\n"
                         "X-180 Y220\nG80\nM30\n%\n")  # fmt: skip
-    output = compensate_file(original, MACHINE, tmp_path, dialect="fanuc")
+    said = io.StringIO()
+    output = compensate_file(original, MACHINE, tmp_path, warnings=Warnings(stream=said), dialect=dialect)
     lines = output.read_text().splitlines()
     assert "G98 G87 X200 Y150 Z-30 R5 I2 J-1 K-12 F100" in lines and "X-180 Y220" in lines
+    assert "back.nc:4:1: warning: canned cycle" in said.getvalue()
