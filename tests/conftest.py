@@ -92,6 +92,9 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_rs274_stops_a_program_before_a_system_it_selects_later_whose_zero_moved",
         ),
         "writeback/test_compensated_holes.py": None,
+        "writeback/test_compensated_back_bore.py": (
+            "test_each_back_bore_cuts_to_its_top_and_stands_at_its_bottom_and_r",
+        ),
         "writeback/test_expand_cycles.py": ("test_expanded_cycles_dwell_as_programmed_and_hit_every_hole",),
         "writeback/test_expand_flow.py": (
             "test_expanded_bodies_land_where_programmed_and_rs274_runs_the_same_path",

@@ -88,10 +88,15 @@ def drilled(
     peck: float,
     rapid_delta: float,
     retract_to_r: bool,
+    back: tuple[float, float, float] | None = None,
 ) -> list[Move]:
-    """The moves of a cycle block drilling one hole (no L repeats, not G87) from `at`."""
+    """The moves of a cycle block drilling one hole (no L repeats) from `at`; G87's `back`: its
+    offset in the plane and the level it feeds up to (`back_bore`)."""
     moves, level, clear = approach(at, start_level, r, retract_to_r)
     moves.append((aa, bb, level, True))
     if level != r:
         moves.append((aa, bb, r, True))
+    if back is not None:
+        off_a, off_b, top = back
+        return moves + back_bore(aa, bb, aa + off_a, bb + off_b, r, clear, top, bottom)
     return moves + hole(motion, aa, bb, r, clear, bottom, peck, rapid_delta)

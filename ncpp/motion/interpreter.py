@@ -275,6 +275,10 @@ class Interpreter:
     # Canned cycles are a modal group of their own (Fanuc, Haas: group 09, G0-G3 group 01), so G80
     # leaves the G0-G3 mode the cycle interrupted in effect; rs274ngc leaves no motion mode
     cycles_own_group = False
+    # G87 is rs274ngc's back bore (R above, Z below the part, K the top of the cut, I J the offset:
+    # LinuxCNC G-code manual, "G87 Back Boring Cycle") and compensated hole by hole; Fanuc's reads its
+    # words otherwise (R below, Z the top, Q the shift, K repeats) and stays as programmed
+    back_bore_holes = True
     # G28/G30 under cutter compensation (Fanuc: the offset is dropped at the intermediate point and
     # restored after the return): not followed, out of scope; rs274ngc refuses it
     returns_under_comp = False
@@ -2125,13 +2129,16 @@ class Interpreter:
             return self._expanded(block, motion, lines, bottoms, dwell)
         # holes apply_error_map compensates: in any plane (polar words written as X Y, repeats as a
         # block each), the series' holes all such
-        self.cycle_holes = (previous not in CANNED or self.cycle_holes) and motion != 87.0
+        self.cycle_holes = (previous not in CANNED or self.cycle_holes) and (
+            motion != 87.0 or self.back_bore_holes
+        )
         if self.cycle_holes:
             ends = [k for k, _, _ in holes[1:]] + [len(lines)]
+            offset, top_level = ((off_a, off_b), middle) if motion == 87.0 else ((0.0, 0.0), None)
             for n, ((k, hole_a, hole_b), end) in enumerate(zip(holes, ends)):
                 drilled = Hole(motion, hole_a, hole_b, bottom, r, peck, rapid_delta, self.retract_to_r,
                                previous not in CANNED and n == 0, n, len(holes),
-                               plane=self.plane)  # fmt: skip
+                               plane=self.plane, offset=offset, top=top_level)  # fmt: skip
                 for line in lines[k:end]:
                     line.fixed, line.hole = HOLE, drilled
         return lines

@@ -144,6 +144,17 @@ class Hole:
     command: tuple[float, float, float, float] | None = None
     series_level: float = 0.0
     plane: int = 17  # 17, 18, 19
+    # G87 (back boring): the offset in the plane the tool passes the bore at (I J in G17), and the
+    # level it feeds back up to (K in G17), the cut's end; its command, absolute (None: as programmed)
+    offset: tuple[float, float] = (0.0, 0.0)
+    top: float | None = None
+    top_command: float | None = None
+
+    @property
+    def cut(self) -> float:
+        """The level the hole's position in the plane is corrected at: where its cut ends (the
+        bottom; G87: the top it feeds back up to)."""
+        return self.bottom if self.top is None else self.top
 
     def point(self, level: float) -> Point:
         """The X Y Z of the hole at `level` along the plane's normal."""

@@ -137,19 +137,22 @@ class _Holes:
         at = first.start if last is None else _end_in_frame_of(last, first)
         if hole.series_start:
             self.start_level = at[axes[2]]
-        bottom, r_point = self._commands(moves, hole, at, held).tolist()
-        command = (bottom[axes[0]], bottom[axes[1]], bottom[axes[2]], r_point[axes[2]])
+        cut, r_point, *under = self._commands(moves, hole, at, held).tolist()
+        bottom = under[0] if under else cut  # (G87: the bottom has a row of its own)
+        command = (cut[axes[0]], cut[axes[1]], bottom[axes[2]], r_point[axes[2]])
+        top = None if hole.top is None else cut[axes[2]]
         if not first.context.absolute:
-            command = self._incremental(first, at, axes, command)
-        corrected = replace(hole, command=command, series_level=self.start_level)
+            command, top = self._incremental(first, at, axes, command, top)
+        corrected = replace(hole, command=command, series_level=self.start_level, top_command=top)
         aa, bb, level, r = command
+        back = None if top is None else (hole.offset[0], hole.offset[1], top)
         out: list[Event] = []
         start = tuple(at)
         # (not `changed`: that marks the pieces replace_arcs made, which the solve moves; the writer
         # tells a written hole by its `command`)
         here = (at[axes[0]], at[axes[1]], at[axes[2]])
         moves_run = cycles.drilled(hole.motion, here, self.start_level, aa, bb, r, level, hole.peck,
-                                   hole.rapid_delta, hole.retract_to_r)  # fmt: skip
+                                   hole.rapid_delta, hole.retract_to_r, back)  # fmt: skip
         for move in moves_run:
             end = plane_point(hole.plane, *move[:3])
             out.append(replace(first, start=start, end=end, rapid=move[3], hole=corrected))
@@ -157,12 +160,12 @@ class _Holes:
         return out
 
     def _incremental(
-        self, first: Line, at: tuple, axes: tuple[int, int, int], command: tuple
-    ) -> tuple[float, float, float, float]:
+        self, first: Line, at: tuple, axes: tuple[int, int, int], command: tuple, top: float | None
+    ) -> tuple[tuple[float, float, float, float], float | None]:
         """The command of a hole in G91 on the output's grid as the control adds it up: the plane's
-        axes from where it stands, R from the series' start level, the bottom from R (rs274ngc's G91
-        cycle), each a whole number of the last digit written, so that the roundings do not add up
-        along a row of holes."""
+        axes from where it stands, R from the series' start level, the bottom from R, G87's `top`
+        from the bottom (rs274ngc's G91 cycle), each a whole number of the last digit written, so
+        that the roundings do not add up along a row of holes."""
         step = float(grid(self.ctx, frames([first, first])[1][:1])[0])
 
         def on_grid(value: float, base: float) -> float:
@@ -170,19 +173,22 @@ class _Holes:
 
         aa, bb, bottom, r = command
         r = on_grid(r, self.start_level)
-        return on_grid(aa, at[axes[0]]), on_grid(bb, at[axes[1]]), on_grid(bottom, r), r
+        bottom = on_grid(bottom, r)
+        placed = (on_grid(aa, at[axes[0]]), on_grid(bb, at[axes[1]]), bottom, r)
+        return placed, None if top is None else on_grid(top, bottom)
 
     def _commands(self, moves: list[Event], hole: Hole, at: tuple, held: NDArray) -> NDArray:
-        """(2,3) the commands (X Y Z) for the hole's bottom and its R point (one position in the
-        plane for both: the bottom's), the control standing at `at`.  With reversal errors, an axis
-        that the corrections alone move on the way to the hole (an axis of the plane the program
-        keeps, the normal to an R plane it stands at) may go against the direction it holds: by a
-        rounding step or so it stays where it is rather than reverse, by more it reverses and is
-        compensated so."""
+        """(2,3) the commands (X Y Z) for the end of the hole's cut (`Hole.cut`) and its R point (one
+        position in the plane for both: the cut's), and G87's bottom below it (3,3), the control
+        standing at `at`.  With reversal errors, an axis that the corrections alone move on the way
+        to the hole (an axis of the plane the program keeps, the normal to an R plane it stands at)
+        may go against the direction it holds: by a rounding step or so it stays where it is rather
+        than reverse, by more it reverses and is compensated so."""
         first = moves[0]
-        offsets, scales, tools = frames([first, first])  # type: ignore[list-item]
-        wanted = np.array([hole.point(hole.bottom), hole.point(hole.r)])
-        lines = np.full(2, first.block.line)
+        levels = [hole.cut, hole.r] + ([] if hole.top is None else [hole.bottom])
+        offsets, scales, tools = frames([first] * len(levels))  # type: ignore[list-item]
+        wanted = np.array([hole.point(level) for level in levels])
+        lines = np.full(len(levels), first.block.line)
         if not self.ctx.directional:
             return compensate(wanted, offsets, scales, lines, self.ctx, None, tools)
         normal = PLANE_AXES[hole.plane][2]
@@ -219,7 +225,9 @@ def _hole_directions(moves: list[Event], hole: Hole, held: NDArray) -> tuple[NDA
     """(2,3) the directions the hole's bottom and its R point are reached in: the plane's axes as
     the rapid to the hole moves them, the normal down to the bottom, and to R as the move that
     reaches it (an axis that stands holds the direction it had); (3,) the axes the program keeps
-    still there (the plane's over the hole, the normal at R: `_reached`)."""
+    still there (the plane's over the hole, the normal at R: `_reached`).  G87 (3,3): its top,
+    the normal up, and its bottom, down, both with the plane's axes as the move back from the
+    offset moves them (`cycles.back_bore`), an axis the offset leaves as the rapid to the hole."""
     normal = PLANE_AXES[hole.plane][2]
     start = np.array(moves[0].start)  # type: ignore[union-attr]
     r_point = hole.point(hole.r)
@@ -229,6 +237,13 @@ def _hole_directions(moves: list[Event], hole: Hole, held: NDArray) -> tuple[NDA
     still = toward == 0
     toward = np.where(still, held, toward)
     bottom = toward.copy()
+    if hole.top is not None:
+        back = -np.sign(plane_point(hole.plane, hole.offset[0], hole.offset[1], 0.0))
+        bottom = np.where(back != 0, back, bottom)
+        still &= back == 0
+        top = bottom.copy()
+        top[normal], bottom[normal] = 1.0, -1.0
+        return np.array([top, toward, bottom]), still
     bottom[normal] = -1.0
     return np.array([bottom, toward]), still
 

@@ -170,11 +170,11 @@ def test_g92_and_g10_l20_set_the_offsets_the_program_means(tmp_path):
 
 
 @pytest.mark.parametrize("middle, why", [
-    ("M3\nG87 X20 Y20 Z-2 R2 I1 J0 K-1 F100 L2\nG80\nG92 X0 Y0\n", "G92 or G10 L10/L11/L20 right after moves left as programmed in G90"),
+    ("o100 repeat [2]\nG81 X20 Y20 Z-2 R2 F100\no100 endrepeat\nG80\nG92 X0 Y0\n", "G92 or G10 L10/L11/L20 right after moves left as programmed in G90"),
     ("o100 repeat [2]\nG1 X[#<_x> + 1]\nG10 L20 P1 X0\no100 endrepeat\n", "G92 or G10 L10/L11/L20 in a loop or subroutine"),
 ])  # fmt: skip
 def test_a_setting_where_ncpp_cannot_say_where_the_control_stands_passes_through(tmp_path, middle, why):
-    """After a canned cycle in G90 (its G98 retract ends at the compensated level it started from),
+    """After a canned cycle left as programmed in G90 (its G98 retract ends at the compensated level it started from),
     or run in a loop (each run from another point), a G92 or G10 L20 cannot be given one shift:
     from there on the program passes through as it is, with a warning naming the line."""
     from tests.compensation.placement import compensate

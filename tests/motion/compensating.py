@@ -18,8 +18,9 @@ def hr5b() -> ErrorSource:
     return ErrorSource.from_machine_file(str(ROOT / "samples/machines/hr5b.toml"))
 
 
-def compensate(text: str, file: str, strict: bool = False) -> tuple[str, str]:
-    """(the compensated program, the warnings) of `text`, read as `file`."""
+def compensate(text: str, file: str, strict: bool = False, dialect: str | None = None) -> tuple[str, str]:
+    """(the compensated program, the warnings) of `text`, read as `file` (in `dialect`: None, as
+    its name and content tell)."""
     warned, out = io.StringIO(), io.BytesIO()
     process(
         io.BytesIO(text.encode()),
@@ -28,5 +29,6 @@ def compensate(text: str, file: str, strict: bool = False) -> tuple[str, str]:
         source=hr5b(),
         warnings=Warnings(stream=warned, strict=strict),
         offsets=PLACED,
+        dialect=dialect,
     )
     return out.getvalue().decode(), warned.getvalue()

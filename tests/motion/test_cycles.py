@@ -216,12 +216,17 @@ def test_random_cycle_programs_agree_with_rs274(tmp_path):
                                                ("G81 X1 Y1 Z-3 R2 L2", HOLE, 2), ("G91 G81 X1 Y1 Z-3 R-2 L3", HOLE, 3),
                                                ("G81 @1 ^45 Z-3 R2", HOLE, 1), ("G18 G81 X1 Z1 Y-3 R2", HOLE, 1),
                                                ("G19 G83 Y1 Z1 X-3 R2 Q1 L2", HOLE, 2),
-                                               ("G87 X1 Y1 Z-3 R2 I1 J0 K-1", CYCLE, 0)])  # fmt: skip
+                                               ("G87 X1 Y1 Z-3 R2 I1 J0 K-1", HOLE, 1),
+                                               ("G19 G91 G87 Y1 Z1 X-3 R-2 I-1 J1 K0.5 L2", HOLE, 2),
+                                               ("fanuc G87 X1 Y1 Z-3 R2 I1 J0 K-1", CYCLE, 0)])  # fmt: skip
 def test_cycle_moves_are_fixed(cycle, why, holes):
-    """A hole is compensated as a whole (HOLE) in any plane, each of a block's repeats its own;
-    G87 leaves the cycle as programmed (CYCLE)."""
+    """A hole is compensated as a whole (HOLE) in any plane, each of a block's repeats its own,
+    rs274ngc's back bore G87 too; Fanuc's G87, whose words read otherwise, is left as programmed
+    (CYCLE)."""
+    fanuc, cycle = cycle.startswith("fanuc "), cycle.removeprefix("fanuc ")
     text = HEAD + "M3 S1000\n" + cycle + "\nG80\nG1 X5\n"
-    events = list(interpret(parse_stream(io.BytesIO(text.encode()), "t.ngc")))
+    read = interpret_fanuc if fanuc else interpret
+    events = list(read(parse_stream(io.BytesIO(text.encode()), "t.ngc")))
     lines = [e for e in events if type(e) is Line]
     assert lines[0].fixed == lines[-1].fixed == "" and {e.fixed for e in lines[1:-1]} == {why}
     assert all((e.hole is not None) == (why == HOLE) for e in lines[1:-1])
@@ -230,7 +235,9 @@ def test_cycle_moves_are_fixed(cycle, why, holes):
 
 
 def _compensate(text: str, strict: bool = False) -> tuple[str, str]:
-    return compensate(text, "drill.ngc", strict)
+    """`text` compensated as a Fanuc program: its G87 (whose words Fanuc reads otherwise than
+    rs274ngc) stands for a canned cycle left as programmed."""
+    return compensate(text, "drill.ngc", strict, dialect="fanuc")
 
 
 DRILL = (

@@ -12,9 +12,7 @@ import pytest
 from tests.conftest import ROOT
 
 MACHINE = ROOT / "samples/machines/hr5b.toml"
-PROGRAM = (
-    "G21 G90 G54\nG0 X10 Y10 Z5 M3\nG1 X40 F300\nG98 G87 X50 Y50 Z-3 R2 I1 J0 K-1 F100 L2\nG80\nG0 Z5\nM2\n"
-)
+PROGRAM = "G21 G90 G54\nG0 X10 Y10 Z5 M3\nG1 X40 F300\no100 repeat [2]\nG1 X50 Y50\nX60\no100 endrepeat\nG0 Z5\nM2\n"
 
 
 @pytest.fixture
@@ -48,13 +46,13 @@ def test_the_summary_and_warnings_reach_the_report_view_with_the_posted_line(plu
     assert text.startswith("(ncpp compensated")
     warnings = [t for kind, t in said if kind == "PrintWarning"]
     assert len(warnings) == 1 and warnings[0].startswith(
-        "ncpp_post: line 4 of the posted program (G98 G87 X50 Y50 Z-3 R2 I1 J0 K-1 F100 L2): warning: canned cycle"
+        "ncpp_post: line 5 of the posted program (G1 X50 Y50): warning: loop or subroutine"
     )
     messages = [t for kind, t in said if kind == "PrintMessage"]
     assert (
         len(messages) == 1
         and "compensated 3 moves" in messages[0]
-        and "20 moves of canned cycles (line 4)" in messages[0]
+        and "4 moves in loops or subroutines (lines 5-7)" in messages[0]
     )
 
 

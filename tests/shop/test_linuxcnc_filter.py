@@ -286,8 +286,8 @@ def test_axis_filters_a_long_program_with_its_progress_bar(program, tmp_path, ax
 def test_the_operator_sees_the_summary_and_each_kind_of_warning_when_the_program_runs(tmp_path):
     """`(MSG, ...)` lines at the program's start: rs274 shows them as MESSAGE calls, before any motion."""
     program = tmp_path / "drill.ngc"
-    program.write_text("G21 G90 G54\nG0 X10 Y10 Z5 M3\nG1 X40 F300\nG98 G87 X50 Y50 Z-3 R2 I1 J0 K-1 L2 F100\nX60\n"
-                       "X70\nG80\nG0 Z5\no100 repeat [2]\nG1 X80 Y40 F200\nG1 X90 Y40\no100 endrepeat\nM2\n")  # fmt: skip
+    program.write_text("G21 G90 G54\nG0 X10 Y10 Z5 M3\nG1 X40 F300\no100 repeat [2]\nG98 G81 X50 Y50 Z-3 R2 F100\n"
+                       "o100 endrepeat\nG80\nG0 Z5\no200 repeat [2]\nG1 X80 Y40 F200\nG1 X90 Y40\no200 endrepeat\nM2\n")  # fmt: skip
     (tmp_path / "ncpp.toml").write_text(f'machine = "{MACHINE}"\nwork_offset = [400, 350, 300]\n')
     proc = run_filter(program, tmp_path)
     assert proc.returncode == 0, proc.stderr.decode()
@@ -302,11 +302,11 @@ def test_the_operator_sees_the_summary_and_each_kind_of_warning_when_the_program
     )
     said = " ".join(messages)
     assert (
-        "40 moves of canned cycles [lines 4-6]" in said
-        and "4 moves in loops or subroutines [lines 10-12]" in said
+        "4 moves of canned cycles [line 6]" in said
+        and "8 moves in loops or subroutines [lines 5, 10-12]" in said
     )
     assert [m.split(":")[0] for m in messages if m.startswith("ncpp warning")] == [
-        "ncpp warning line 4",
-        "ncpp warning line 10",
+        "ncpp warning line 5 [and 1 more]",
+        "ncpp warning line 6",
     ]
     assert canon.index("MESSAGE") < canon.index("STRAIGHT_")

@@ -678,13 +678,17 @@ class IsoWriter:
         assert hole is not None and hole.command is not None  # (apply_error_map's)
         first, second, normal = PLANE_AXES[hole.plane]
         aa, bb, bottom, r = hole.command
+        top = hole.top_command
         if not move.context.absolute:
+            top = None if top is None else top - bottom
             aa, bb = aa - move.start[first], bb - move.start[second]
             bottom, r = bottom - r, r - hole.series_level
-        letters = (AXES[first], AXES[second], AXES[normal], "R")
+        letters, values = [AXES[first], AXES[second], AXES[normal], "R"], [aa, bb, bottom, r]
+        if top is not None:  # G87: its offset as programmed (an increment from the hole), its top corrected
+            letters += ["IJK"[first], "IJK"[second], "IJK"[normal]]
+            values += [hole.offset[0], hole.offset[1], top]
         return {
-            letter: format_number(value, self._style(letter, move))
-            for letter, value in zip(letters, (aa, bb, bottom, r))
+            letter: format_number(value, self._style(letter, move)) for letter, value in zip(letters, values)
         }
 
     # -- o-word control lines ---------------------------------------------------
