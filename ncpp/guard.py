@@ -6,7 +6,12 @@ machine, which the work offset decides (`--work-offset`, `--var-file`).  Run und
 another offset, the program carries the corrections of other places.  The guard
 reads the control's active coordinate system and its zero (X Y Z) and stops the
 program, with a message, when the system differs or an axis's zero is more than
-`GUARD_MM` from the one told.  It is written only where ncpp was told the offset.
+`GUARD_MM` from the one told.  It is written only where ncpp was told the offset, at
+the start of the program the control runs as the main one, after its program number: in a
+Fanuc or Haas file whose subprograms stand before the main program (Fanuc Series 0i-MC
+operator's manual, B-64124EN, "Subprogram (M98, M99)": a subprogram ends with M99), after
+the O line of the program the interpreter runs as the main one (`flow.MainProgram`), never
+in a stored subprogram, which runs only where it is called.
 
 Per control (the ISO dialect: LinuxCNC's syntax, or Fanuc's for a program that
 starts with an O number):
@@ -27,7 +32,9 @@ starts with an O number):
 An ISO program (LinuxCNC, Fanuc, Haas) that selects a told system checks its zero before the
 block that selects it (`PlacementChecks`; rs274ngc and Fanuc select the system before the
 block's move), once per system, where the zero is still the one told (not after the program's
-own G10 L2/L20 of it) and the block runs once (not in a loop or a subroutine).  The check at the
+own G10 L2/L20 of it) and the block runs once (not in a loop, nor in a subroutine or subprogram
+that runs more than once; in one that runs once, a stored Fanuc subprogram among them, the check
+stands in its text before the block, and runs where the call runs the block).  The check at the
 start (with the system number) is written only where the program may rely on the system in
 effect before it selects one: not where its first lines, of settings alone (modal G codes,
 T M S F H D words, G28/G30, G53, G10 L2 P1-P9), select one (`_iso_selects_first`).
@@ -67,8 +74,9 @@ the length moves the Z positions where the errors are evaluated and lengthens th
 After each block that applies the length of the tool in the spindle from the told table
 (G43, G43 H0 or G43 H of that tool, G43.2 H of it; `interpreter._tool_length` marks it,
 `Pass.length_told`), a check stops the program when the control's tool in the spindle or its
-length is not the one told, within `GUARD_MM`.  The block's own move (`G43 H1 Z5`) runs before
-the check; the next does not.  A length the program set itself (LinuxCNC's G10 L1/L10/L11, Haas's
+length is not the one told, within `GUARD_MM` (in a subroutine's or subprogram's text only where
+it runs once: the check runs where the call runs the block).  The block's own move (`G43 H1 Z5`)
+runs before the check; the next does not.  A length the program set itself (LinuxCNC's G10 L1/L10/L11, Haas's
 G10 L10/L11) is the one told from there on: the control holds it too (rs274 writes it into the
 spindle's #5401-#5409 at the G10, Haas into #2001-#2400), so the check finds the G10 run as the
 program says, and a tool table or wear that differs.
@@ -118,12 +126,13 @@ does not know the control's parameters, and the guards neither move nor act.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Callable, Generator, Iterable, Iterator
 from dataclasses import dataclass, replace
 from functools import cache
 from itertools import chain, islice
 
 from ncpp.errors import NcppError
+from ncpp.motion.flow import MainProgram, program_number
 from ncpp.motion.offsets import _ADDITIONAL_X, _ROTATION_AFTER_X, ADDITIONAL, WorkOffsets, system_name
 from ncpp.motion.segments import Event, Pass
 from ncpp.program.blocks import AnyItem, Block, Comment, Statement, Word
@@ -395,10 +404,15 @@ def with_guard(
     header_lines: int = 1,
     unguarded: Callable[[str], None] = lambda why: None,
     checks: bool = False,
+    main: MainProgram | None = None,
 ) -> Iterator[str]:
     """The written program's lines with the guard after the header comment (`header_lines` lines,
-    the first holding `header`) and the program number that may follow it.  Where the dialect
-    (or the control's system) has no guard, `unguarded` is told why.  `checks`: the ISO program's
+    the first holding `header`) and the program number that may follow it: at the start of the
+    program the control runs as the main one, which `main` tells where the interpreter ran a
+    later program of the file as the main one (`flow.MainProgram`: a Fanuc or Haas file whose
+    subprograms stand before it), after that program's O line and never in a stored subprogram,
+    which runs only where called.  Where the dialect (or the control's system) has no guard, or
+    the main program is not decided, `unguarded` is told why.  `checks`: the ISO program's
     selections of told systems are checked where it makes them (`PlacementChecks`), so no guard
     is written where it selects a system before anything relies on the one in effect."""
     # (lines are taken from `lines` no further than the guard's place: the verifier tags each
@@ -418,6 +432,19 @@ def with_guard(
             if not _program_number(_items(dialect, line)):
                 break
     guard = guard_lines(placement, dialect, head)
+    # (read once the writer has written the program's first lines: the flow decided before its first block)
+    stored, number = (
+        (main.stored, main.number) if main is not None and at is not None and guard else (0, None)
+    )
+    if stored is None:
+        unguarded(MAIN_UNDECIDED)
+        yield from chain(head, it)
+        return
+    if stored and at is not None:
+        head, at = yield from _before_main(head, at, it, stored, number, dialect)
+        if not head:
+            unguarded(f"ncpp did not find the O line of the main program, O{number}, in the written program")
+            return
     if checks and at is not None and dialect in ISO_SYNTAX and _iso_selects_first(head, at, it):
         guard = []  # (the check of the system it selects stands before that line)
     elif not guard:
@@ -436,6 +463,56 @@ def with_guard(
     yield from (line + eol for line in guard)
     yield from head[at:]
     yield from it
+
+
+MAIN_UNDECIDED = (
+    "the file's first program ends with M99 (a subprogram), and which later program the control runs as the "
+    "main one is not ncpp's to guess"
+)
+
+
+def _before_main(
+    head: list[str], at: int, rest: Iterator[str], stored: int, number: str | None, dialect: str
+) -> Generator[str, None, tuple[list[str], int]]:
+    """Yield the lines before the main program's O line: the header's and those of the `stored`
+    programs before it, each from its O line (`head[at:]` and `rest` hold them), the program numbers
+    read as the flow reads them (`flow.program_number`).  Return the lines from the main program's
+    O line on that were read (1: the guard goes after the first), or ([], 0) where the line found
+    there is not program `number` (every line yielded)."""
+    yield from head[:at]
+    waiting, programs = head[at:], 0  # (read, not yet yielded)
+    while True:
+        if not waiting:
+            line = next(rest, None)
+            if line is None:
+                return [], 0
+            waiting.append(line)
+        found = _program_of(dialect, waiting[0])
+        if found is not None:
+            if programs == stored:
+                break
+            programs += 1
+        yield waiting.pop(0)
+    if found == number:
+        return waiting, 1
+    yield from waiting
+    yield from rest
+    return [], 0
+
+
+@cache
+def _own_parser(dialect: str) -> LineParser:
+    return LineParser(dialect)
+
+
+def _program_of(dialect: str, line: str) -> str | None:
+    """The program number of a written line as the flow reads one (`flow.program_number`), else None."""
+    if "O" not in line and "o" not in line:
+        return None
+    try:
+        return program_number(_own_parser(dialect).parse(line.rstrip("\r\n")))
+    except NcppError:
+        return None
 
 
 ISO_SYNTAX = ("iso", "linuxcnc", "fanuc", "haas")  # the dialects whose guard is LinuxCNC's or Fanuc's

@@ -25,6 +25,7 @@ from ncpp import __version__
 from ncpp.errors import Location, NcppError, Warnings
 from ncpp.guard import ISO_SYNTAX, Placement, PlacementChecks, ToolGuard, with_guard, without_guard
 from ncpp.lathe import refuse_lathe
+from ncpp.motion.flow import MainProgram
 from ncpp.motion.offsets import AT_MACHINE_ZERO, WorkOffsets
 from ncpp.motion.once import OnceRuns
 from ncpp.motion.segments import COMP, CYCLE, DRILLED, FLOW, HOLE, PATTERN, Arc, Event, Line, Pass
@@ -419,9 +420,11 @@ def process(
             original = same_motion(
                 original, interpret(plain[0], file=file, warnings=unsaid(), offsets=offsets), file
             )
+    # which of a Fanuc or Haas file's programs runs as the main one: the flow tells, the guard goes there
+    main = MainProgram() if FAMILY[name] == "iso" else None
     events: Iterable[Event] = interpret(
         blocks, file=file, warnings=warnings, strict=strict, offsets=offsets, **expanding,
-        **({"once_runs": runs} if runs is not None else {}),
+        **({"once_runs": runs} if runs is not None else {}), **({"main_program": main} if main is not None else {}),
     )  # fmt: skip
     events = warn_fixed(events, warnings, file)  # cycles, loops, subroutines (ISO), cutter compensation
     stats.summary = summary = Summary(file)
@@ -454,7 +457,7 @@ def process(
         said = replace(guard, dialect=name).said()  # (as the program's dialect names the system)
         lines = with_guard(lines, guard, name, HEADER_TAG, header.count("\n") + 1,
                            lambda why: warnings.warn(f"no placement guard: {why}; make sure the control has {said} "
-                                                     "before the program runs", Location(file, 1, None)), checks)  # fmt: skip
+                                                     "before the program runs", Location(file, 1, None)), checks, main)  # fmt: skip
     if verify:
         from ncpp.verify import Bound, verified
 

@@ -127,6 +127,19 @@ _CALLS = {97.0: "m97", 98.0: "m98"}  # M97: Haas's local call, a control line on
 MAX_SEQUENCE_NUMBER = 99_999
 
 
+@dataclass
+class MainProgram:
+    """Which of a file's numbered programs the control runs as the main one, as the flow decides it
+    before it yields the file's first block (`Flow._stored_first`): the one after `stored` programs
+    stored before it, numbered `number` (`program_number`); `stored` 0: the file's first program (or
+    a file of none), None: not decided (the file's first program ends with M99 and which later one
+    runs is not ncpp's to guess).  The placement guard goes after the main program's O line
+    (`guard.with_guard`)."""
+
+    stored: int | None = 0
+    number: str | None = None
+
+
 @dataclass(frozen=True, slots=True)
 class Control:
     """The o-word of a control line: `o100 while [#1 LT 3]` is ("100", "while", (expr,))."""
@@ -269,6 +282,7 @@ class Flow:
         local_calls: bool = False,
         main_after_subprograms: bool = False,
         warn: Callable[[str, Block], None] | None = None,
+        main_program: MainProgram | None = None,
     ):
         self.file, self.evaluate, self.parameters, self.done, self.stop, self.path = (
             file,
@@ -342,6 +356,7 @@ class Flow:
         # Fanuc: a file whose first program ends with M99 runs a later one as the main program
         # (`_stored_first`); `stored`: the lines yielded are the programs' before it, `main_top` its O line
         self.main_after_subprograms = main_after_subprograms
+        self.main_program = main_program if main_program is not None else MainProgram()  # (what is decided)
         self.warn = warn or (lambda message, block: None)
         self.stored = False
         self.main_top = 0
@@ -758,6 +773,7 @@ class Flow:
             return
         main, why = _main_program(programs)
         if main is None:
+            self.main_program.stored = None
             self.stop(f"a file whose first program {programs[0].name} ends with M99 (a subprogram) while {why} "
                       "(which program the operator runs as the main one is not ncpp's to guess)",
                       self._block(self.frames[0], first), 1)  # fmt: skip
@@ -770,6 +786,7 @@ class Flow:
         )
         self.warn(f"the file's first program ends with M99: ncpp runs {main.name} as the main program; {said} "
                   "(run where M98 or G65 calls it)", main.block)  # fmt: skip
+        self.main_program.stored, self.main_program.number = len(names), program_number(main.block)
         yield from self._skip_stored(first, main.index)
 
     def _skip_stored(self, first: int, main_index: int) -> Iterator[tuple[Block, str, Block | None]]:

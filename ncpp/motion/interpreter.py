@@ -63,7 +63,7 @@ from ncpp.motion.cycles import (
 from ncpp.motion.endless import exact
 from ncpp.motion.expand import Expansion, number, refused
 from ncpp.motion.expressions import ExpressionError, OutOfScope, Parameters, evaluate, vacant
-from ncpp.motion.flow import CALLED, FIXED, ONCE, RUN, SKIP, Flow
+from ncpp.motion.flow import CALLED, FIXED, ONCE, RUN, SKIP, Flow, MainProgram
 from ncpp.motion.offsets import SYSTEMS, WorkOffsets
 from ncpp.motion.once import FirstPass, OnceRuns, held_to_the_end
 from ncpp.motion.segments import (
@@ -217,6 +217,7 @@ def interpreting(flavour: type[Interpreter]) -> Callable[..., Iterator[Event]]:
         expand_cycles: bool = False,
         expand: bool = False,
         once_runs: OnceRuns | None = None,
+        main_program: MainProgram | None = None,
     ) -> Iterator[Event]:
         """Motion events of a program's blocks, lazily, as the flavour reads them (see the
         module docstring).
@@ -235,9 +236,12 @@ def interpreting(flavour: type[Interpreter]) -> Callable[..., Iterator[Event]]:
         `expand`: loops and subroutines are to be written out as straight code (`expand.py`).
         `once_runs`: given, a subroutine that runs once is followed as its run (`Interpreter.run`)
         and told there, to be written where its definition stands.
+        `main_program`: given, it is told which of the file's programs runs as the main one
+        (`flow.MainProgram`) before the first event.
         """
         interpreter = flavour(file, offsets)
         interpreter.once_runs = once_runs
+        interpreter.main_program = main_program
         interpreter.expand_cycles = expand_cycles
         interpreter.expansion = Expansion(interpreter.params, file) if expand else None
         return run(interpreter, blocks, warnings, strict)
@@ -412,6 +416,7 @@ class Interpreter:
         self.placed: set[int] = set()
         # the blocks of the subroutines whose one run is written where their definition stands (`run`)
         self.once_runs: OnceRuns | None = None
+        self.main_program: MainProgram | None = None  # told which program runs as the main one (`Flow`)
         self.subroutine_path = offsets.subroutine_path if offsets is not None else ()
         if offsets is not None:
             self._start_from(offsets)
@@ -462,7 +467,7 @@ class Interpreter:
             self.file, self._evaluate, self.params, lambda: self.done, self._leave_scope,
             self.subroutine_path, state=self._loop_state, position=lambda: self.pos[:],
             repeats_in_p=self.repeats_in_p, once=self.once_runs, local_calls=self.local_calls,
-            main_after_subprograms=self.main_after_subprograms,
+            main_after_subprograms=self.main_after_subprograms, main_program=self.main_program,
             warn=lambda message, block: warnings.warn(message, Location(self.file, block.line, 1)),
         )  # fmt: skip
         self.rounding = False
@@ -2480,7 +2485,7 @@ class Interpreter:
 # from the others (the context, the fast path)
 _NOT_LOOP_STATE = frozenset(("params", "flow", "warnings", "untold_lengths", "expansion", "tools",
                              "file", "subroutine_path", "expand_cycles", "_context", "_fast",
-                             "rounding", "once_runs"))  # fmt: skip
+                             "rounding", "once_runs", "main_program"))  # fmt: skip
 # Fanuc lathes' maximum spindle speed clamp in G-code systems B and C (system A's G50 S), and Fanuc
 # machining centres' under constant surface speed (their G code list: G92 "setting for workpiece
 # coordinate system or clamp at maximum spindle speed"; `lathe.py`): no move, no offset
