@@ -580,6 +580,46 @@ def tool_guard_lines(tool: int, length_mm: float, unit_mm: float, label: int) ->
     ]
 
 
+# LinuxCNC's parameters of the tool in the spindle a program may read (G-code manual, "Numbered
+# Parameters"): #5401-#5409 its offsets X Y Z A B C U V W, #5410 its diameter, #5411 #5412 its front
+# and back angles, #5413 its orientation; what each is, and whether it is an angle (degrees)
+TOOL_PARAMETER_NAMES = {
+    **{5401 + k: f"{letter} offset" for k, letter in enumerate("XYZABCUVW")},
+    5410: "diameter",
+    5411: "front angle",
+    5412: "back angle",
+    5413: "orientation",
+}
+_ANGLES = frozenset((5404, 5405, 5406, 5411, 5412))
+
+
+def _read_tolerance(key: int, unit_mm: float) -> str:
+    """How far the control's parameter may be from the told one: GUARD_MM for a length (in the
+    table's units), GUARD_DEG for an angle (a tool turned by it puts its tip 17 µm off a metre
+    out, and the told value is written to 0.0001), half a step for the orientation (a number)."""
+    if key == 5413:
+        return "0.5"
+    return _number(GUARD_DEG if key in _ANGLES else GUARD_MM / unit_mm)
+
+
+def tool_read_lines(tool: int, key: int, value: float, unit_mm: float, label: int) -> list[str]:
+    """LinuxCNC's check (without line ends), before a block that reads tool parameter `key`, that
+    the control's tool in the spindle is `tool` and its `key` is `value` (the told table's, in its
+    units or degrees) within `_read_tolerance`; `label` numbers the check's `if`."""
+    told, name = _number(value), f"o<ncpp_tool_guard_{label}>"
+    unit = "deg" if key in _ANGLES else "" if key == 5413 else _units(unit_mm)
+    within, unit = _read_tolerance(key, unit_mm), f" {unit}" if unit else ""
+    said = f"tool {tool} with {TOOL_PARAMETER_NAMES[key]}, parameter {key}, at {told}{unit}"  # (`#n` reads it)
+    return [
+        f"({TOOL_BEGIN} {said} within {within}{unit})",
+        f"{name} if [[#5400 NE {tool}] OR [ABS[#{key} {_less(told, ' ')}] GT {within}]]",
+        f"(abort, ncpp: compensated for {said}; the control has tool #5400 with #{key}: "
+        "compensate again with its tool table, or set the tool)",
+        f"{name} endif",
+        f"({TOOL_END})",
+    ]
+
+
 HAAS_OFFSETS = 200  # Haas's tool length offsets in #2001-#2200 (geometry), #2201-#2400 (wear)
 
 
@@ -675,6 +715,19 @@ class ToolGuard:
             return [line + block.eol for line in lines]
         self.checks += 1
         return [line + block.eol for line in tool_guard_lines(*told, self.unit_mm, self.checks)]
+
+    def before(self, events: list[Event]) -> list[str]:
+        """LinuxCNC's checks of the tool parameters the block reads (`Pass.tool_read`), one each,
+        before it (the writer's `before`)."""
+        reads = [read for e in events if type(e) is Pass and e.tool_read for read in e.tool_read]
+        if not reads or self.why is not None or self.haas or self.sinumerik:
+            return []
+        eol = events[0].block.eol or "\n"
+        lines = []
+        for read in reads:
+            self.checks += 1
+            lines.extend(line + eol for line in tool_read_lines(*read, self.unit_mm, self.checks))
+        return lines
 
 
 def without_guard(blocks: Iterable[Block]) -> Iterator[Block]:
