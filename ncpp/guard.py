@@ -78,6 +78,14 @@ program says, and a tool table or wear that differs.
   M61, not the offset G43 applies, so a G43 H of another tool is not checked.  They stand in the
   machine's units, as the table.  Each check's `if` has a label of its own (rs274ngc refuses a
   label defined twice); `(abort, ...)` says #5400 and #5403 with their values.
+* LinuxCNC's other tool parameters (#5401-#5413: the offsets, #5410 the diameter, #5411 #5412
+  the front and back angles, #5413 the orientation): a program that reads one after its own M6 or
+  M61 carries the told table's value where ncpp wrote numbers computed from it.  Before each block
+  that reads one (`Pass.tool_read`; a control line's condition too), a check stops the program
+  when the control's tool in the spindle or that parameter is not the one told (`tool_read_lines`,
+  `ToolGuard.before`).  The interpreter marks a read where its block runs once where it is written
+  (straight code, a loop's pass or a subroutine's run written as it ran, the subroutine's check
+  inside its body); a read in text that runs again is warned of (`Interpreter._unchecked`).
 * Haas (Mill Operator's Manual, "Macros", the system variables table: #2001-#2200 the tool
   length offsets' geometry, #2201-#2400 their wear, by offset number; G43 Hn applies offset n's
   sum): after a G43 whose H is the tool in the spindle (whose length ncpp was told), the check
@@ -609,7 +617,9 @@ def tool_read_lines(tool: int, key: int, value: float, unit_mm: float, label: in
     told, name = _number(value), f"o<ncpp_tool_guard_{label}>"
     unit = "deg" if key in _ANGLES else "" if key == 5413 else _units(unit_mm)
     within, unit = _read_tolerance(key, unit_mm), f" {unit}" if unit else ""
-    said = f"tool {tool} with {TOOL_PARAMETER_NAMES[key]}, parameter {key}, at {told}{unit}"  # (`#n` reads it)
+    said = (
+        f"tool {tool} with {TOOL_PARAMETER_NAMES[key]}, parameter {key}, at {told}{unit}"  # (`#n` reads it)
+    )
     return [
         f"({TOOL_BEGIN} {said} within {within}{unit})",
         f"{name} if [[#5400 NE {tool}] OR [ABS[#{key} {_less(told, ' ')}] GT {within}]]",
@@ -723,7 +733,7 @@ class ToolGuard:
         if not reads or self.why is not None or self.haas or self.sinumerik:
             return []
         eol = events[0].block.eol or "\n"
-        lines = []
+        lines: list[str] = []
         for read in reads:
             self.checks += 1
             lines.extend(line + eol for line in tool_read_lines(*read, self.unit_mm, self.checks))

@@ -449,7 +449,7 @@ def process(
     compensated = reached.follow(summary.written(run_passes(summary.programmed(events), ctx, PASSES)))
     header = header_text(source, tolerance, offsets, name)
     checks = guard is not None and name in ISO_SYNTAX  # the zeros of the told systems it selects
-    before = PlacementChecks(offsets, name, guard.unit_mm, lambda why: warnings.warn(  # type: ignore[union-attr]
+    before: Callable[[list[Event]], list[str]] | None = PlacementChecks(offsets, name, guard.unit_mm, lambda why: warnings.warn(  # type: ignore[union-attr]
         f"no placement guard: {why}", Location(file, 1, None))) if checks else None  # fmt: skip
     if after is not None:  # (and the tool parameters a block reads, checked before it)
         before = _both(before, after.before) if before is not None else after.before
@@ -484,7 +484,9 @@ def process(
     return stats
 
 
-def _both(first: Callable[[list[Event]], list[str]], then: Callable[[list[Event]], list[str]]) -> Callable[[list[Event]], list[str]]:
+def _both(
+    first: Callable[[list[Event]], list[str]], then: Callable[[list[Event]], list[str]]
+) -> Callable[[list[Event]], list[str]]:
     """The writer's `before` of two guards: the lines of `first`, then those of `then`."""
     return lambda events: [*first(events), *then(events)]
 

@@ -514,8 +514,10 @@ class Interpreter:
                 text = Pass(
                     block, kind is SKIP or block.verbatim, None if ended else self.motion
                 )  # (after the end: no mode the control is in)
-                if self.tool_reads:  # (a control line's condition read them: the writer reads its first event)
-                    text.tool_read = self._reads_to_check(False)
+                if (
+                    self.tool_reads
+                ):  # (a control line's condition read them: the writer reads its first event)
+                    text.tool_read = self._reads_to_check(flow.in_straight_code())
                 if pending is not None:
                     held.append(text)
                 elif once is not None:
@@ -656,7 +658,9 @@ class Interpreter:
         out = [kept for ev in events if (kept := self._as_programmed(ev, owner)) is not None]
         return tuple(out) if len(out) != 1 else out[0]
 
-    def _with_reads(self, event: Event | tuple[Event, ...], block: Block, straight: bool) -> Event | tuple[Event, ...]:
+    def _with_reads(
+        self, event: Event | tuple[Event, ...], block: Block, straight: bool
+    ) -> Event | tuple[Event, ...]:
         """The block's events with a mark of the tool parameters read for it (`tool_reads`), which
         the tool guard checks before it; in `straight` code (it runs once, where it stands, in the
         order it is written) a value checked there since is not checked again."""
