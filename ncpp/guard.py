@@ -601,6 +601,9 @@ TOOL_PARAMETER_NAMES = {
 _ANGLES = frozenset((5404, 5405, 5406, 5411, 5412))
 
 
+_READ_CHECK = ", parameter 54"  # what the first comment of a tool parameter's check says (`tool_read_lines`)
+
+
 def _read_tolerance(key: int, unit_mm: float) -> str:
     """How far the control's parameter may be from the told one: GUARD_MM for a length (in the
     table's units), GUARD_DEG for an angle (a tool turned by it puts its tip 17 µm off a metre
@@ -740,10 +743,14 @@ class ToolGuard:
         return lines
 
 
-def without_guard(blocks: Iterable[Block]) -> Iterator[Block]:
+def without_guard(
+    blocks: Iterable[Block], dropped: Callable[[Block, str], None] | None = None
+) -> Iterator[Block]:
     """The blocks without the guards: the placement guard's and the tool guard's checks wherever
     they stand, each from its first comment to its last (within GUARD_BLOCKS: a first comment
-    without its last is no guard, and its blocks stay)."""
+    without its last is no guard, and its blocks stay).  `dropped` is told of each check of a tool
+    parameter the program read (its first block, what it says): numbers after it may have been
+    computed from that value, where no read is left to check again."""
     held: list[Block] = []  # the blocks of a guard under way
     end = ""
     for block in blocks:
@@ -759,6 +766,9 @@ def without_guard(blocks: Iterable[Block]) -> Iterator[Block]:
                 continue
         held.append(block)
         if end in said:
+            first = " ".join(item.text for item in held[0].items if type(item) is Comment)
+            if dropped is not None and end == TOOL_END and _READ_CHECK in first:
+                dropped(held[0], first)
             held = []
         elif len(held) >= GUARD_BLOCKS:
             yield from held

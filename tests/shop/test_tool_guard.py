@@ -431,3 +431,17 @@ def test_a_while_condition_checked_before_the_loop_is_not_checked_again(tmp_path
     k = lines.index("o1 while [#1 LT #5410]")
     assert lines[k - 4] == "o<ncpp_tool_guard_2> if [[#5400 NE 1] OR [ABS[#5410 - 6] GT 0.1]]"
     assert written.count("ABS[#5410") == 1 and not any("no tool guard check" in line for line in warned)
+
+
+def test_compensated_again_the_read_checks_go_with_a_warning(tmp_path):
+    """The written program has numbers where the original read the parameters: compensated again
+    (--force), each check is dropped with a warning at its line, and only the read left (the
+    branch's condition) is checked again."""
+    first = _ncpp(tmp_path, READS, READ_TABLE)[0]
+    again, proc = _ncpp(tmp_path, first.read_text(), READ_TABLE, "--force")
+    written = again.read_text()
+    assert written.count(TOOL_BEGIN) == 2 and "ABS[#5403 - 50]" in written  # (the length's, after G43)
+    assert "ABS[#5411 - 10]" in written and "ABS[#5410" not in written
+    said = [line for line in proc.stderr.splitlines() if "compensated again, the check" in line]
+    assert len(said) == 4 and "tool 1 with back angle, parameter 5412, at 2 deg" in said[0], proc.stderr
+    assert "p.ngc:11:" in said[0] and said[0].endswith("compensate the original program instead")
