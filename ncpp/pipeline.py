@@ -396,7 +396,7 @@ def process(
     if not force:
         blocks = refuse_compensated(blocks, file)
     else:  # compensated again: the guard of the offset it was compensated for goes
-        blocks = without_guard(blocks, lambda block, said: warnings.warn(  # type: ignore[union-attr]
+        blocks = without_guard(blocks, lambda block, said: warnings.warn(
             f"compensated again, the check \"{said}\" goes, and ncpp checks the parameter again only where "
             "the program still reads it: numbers after it may have been computed from that value of the tool "
             "table it was compensated with; compensate the original program instead",
