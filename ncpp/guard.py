@@ -86,6 +86,14 @@ program says, and a tool table or wear that differs.
   M61, not the offset G43 applies, so a G43 H of another tool is not checked.  They stand in the
   machine's units, as the table.  Each check's `if` has a label of its own (rs274ngc refuses a
   label defined twice); `(abort, ...)` says #5400 and #5403 with their values.
+* LinuxCNC's other tool parameters (#5401-#5413: the offsets, #5410 the diameter, #5411 #5412
+  the front and back angles, #5413 the orientation): a program that reads one after its own M6 or
+  M61 carries the told table's value where ncpp wrote numbers computed from it.  Before each block
+  that reads one (`Pass.tool_read`; a control line's condition too), a check stops the program
+  when the control's tool in the spindle or that parameter is not the one told (`tool_read_lines`,
+  `ToolGuard.before`).  The interpreter marks a read where its block runs once where it is written
+  (straight code, a loop's pass or a subroutine's run written as it ran, the subroutine's check
+  inside its body); a read in text that runs again is warned of (`Interpreter._unchecked`).
 * Haas (Mill Operator's Manual, "Macros", the system variables table: #2001-#2200 the tool
   length offsets' geometry, #2201-#2400 their wear, by offset number; G43 Hn applies offset n's
   sum): after a G43 whose H is the tool in the spindle (whose length ncpp was told), the check
@@ -657,6 +665,51 @@ def tool_guard_lines(tool: int, length_mm: float, unit_mm: float, label: int) ->
     ]
 
 
+# LinuxCNC's parameters of the tool in the spindle a program may read (G-code manual, "Numbered
+# Parameters"): #5401-#5409 its offsets X Y Z A B C U V W, #5410 its diameter, #5411 #5412 its front
+# and back angles, #5413 its orientation; what each is, and whether it is an angle (degrees)
+TOOL_PARAMETER_NAMES = {
+    **{5401 + k: f"{letter} offset" for k, letter in enumerate("XYZABCUVW")},
+    5410: "diameter",
+    5411: "front angle",
+    5412: "back angle",
+    5413: "orientation",
+}
+_ANGLES = frozenset((5404, 5405, 5406, 5411, 5412))
+
+
+_READ_CHECK = ", parameter 54"  # what the first comment of a tool parameter's check says (`tool_read_lines`)
+
+
+def _read_tolerance(key: int, unit_mm: float) -> str:
+    """How far the control's parameter may be from the told one: GUARD_MM for a length (in the
+    table's units), GUARD_DEG for an angle (a tool turned by it puts its tip 17 µm off a metre
+    out, and the told value is written to 0.0001), half a step for the orientation (a number)."""
+    if key == 5413:
+        return "0.5"
+    return _number(GUARD_DEG if key in _ANGLES else GUARD_MM / unit_mm)
+
+
+def tool_read_lines(tool: int, key: int, value: float, unit_mm: float, label: int) -> list[str]:
+    """LinuxCNC's check (without line ends), before a block that reads tool parameter `key`, that
+    the control's tool in the spindle is `tool` and its `key` is `value` (the told table's, in its
+    units or degrees) within `_read_tolerance`; `label` numbers the check's `if`."""
+    told, name = _number(value), f"o<ncpp_tool_guard_{label}>"
+    unit = "deg" if key in _ANGLES else "" if key == 5413 else _units(unit_mm)
+    within, unit = _read_tolerance(key, unit_mm), f" {unit}" if unit else ""
+    said = (
+        f"tool {tool} with {TOOL_PARAMETER_NAMES[key]}, parameter {key}, at {told}{unit}"  # (`#n` reads it)
+    )
+    return [
+        f"({TOOL_BEGIN} {said} within {within}{unit})",
+        f"{name} if [[#5400 NE {tool}] OR [ABS[#{key} {_less(told, ' ')}] GT {within}]]",
+        f"(abort, ncpp: compensated for {said}; the control has tool #5400 with #{key}: "
+        "compensate again with its tool table, or set the tool)",
+        f"{name} endif",
+        f"({TOOL_END})",
+    ]
+
+
 HAAS_OFFSETS = 200  # Haas's tool length offsets in #2001-#2200 (geometry), #2201-#2400 (wear)
 
 
@@ -753,11 +806,28 @@ class ToolGuard:
         self.checks += 1
         return [line + block.eol for line in tool_guard_lines(*told, self.unit_mm, self.checks)]
 
+    def before(self, events: list[Event]) -> list[str]:
+        """LinuxCNC's checks of the tool parameters the block reads (`Pass.tool_read`), one each,
+        before it (the writer's `before`)."""
+        reads = [read for e in events if type(e) is Pass and e.tool_read for read in e.tool_read]
+        if not reads or self.why is not None or self.haas or self.sinumerik:
+            return []
+        eol = events[0].block.eol or "\n"
+        lines: list[str] = []
+        for read in reads:
+            self.checks += 1
+            lines.extend(line + eol for line in tool_read_lines(*read, self.unit_mm, self.checks))
+        return lines
 
-def without_guard(blocks: Iterable[Block]) -> Iterator[Block]:
+
+def without_guard(
+    blocks: Iterable[Block], dropped: Callable[[Block, str], None] | None = None
+) -> Iterator[Block]:
     """The blocks without the guards: the placement guard's and the tool guard's checks wherever
     they stand, each from its first comment to its last (within GUARD_BLOCKS: a first comment
-    without its last is no guard, and its blocks stay)."""
+    without its last is no guard, and its blocks stay).  `dropped` is told of each check of a tool
+    parameter the program read (its first block, what it says): numbers after it may have been
+    computed from that value, where no read is left to check again."""
     held: list[Block] = []  # the blocks of a guard under way
     end = ""
     for block in blocks:
@@ -773,6 +843,9 @@ def without_guard(blocks: Iterable[Block]) -> Iterator[Block]:
                 continue
         held.append(block)
         if end in said:
+            first = " ".join(item.text for item in held[0].items if type(item) is Comment)
+            if dropped is not None and end == TOOL_END and _READ_CHECK in first:
+                dropped(held[0], first)
             held = []
         elif len(held) >= GUARD_BLOCKS:
             yield from held

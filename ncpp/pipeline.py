@@ -397,7 +397,11 @@ def process(
     if not force:
         blocks = refuse_compensated(blocks, file)
     else:  # compensated again: the guard of the offset it was compensated for goes
-        blocks = without_guard(blocks)
+        blocks = without_guard(blocks, lambda block, said: warnings.warn(
+            f"compensated again, the check \"{said}\" goes, and ncpp checks the parameter again only where "
+            "the program still reads it: numbers after it may have been computed from that value of the tool "
+            "table it was compensated with; compensate the original program instead",
+            Location(file, block.line, None)))  # fmt: skip
     blocks = refuse_lathe(blocks, name, file)  # (ncpp's machine is a machining centre)
     offsets = offsets or AT_MACHINE_ZERO  # the control's zeros place the program on the machine
     expanding: dict[str, bool] = {}
@@ -422,6 +426,9 @@ def process(
             )
     # which of a Fanuc or Haas file's programs runs as the main one: the flow tells, the guard goes there
     main = MainProgram() if FAMILY[name] == "iso" else None
+    after = _tool_guard(name, offsets, warnings, file) if guard_tools else None
+    if after is not None and name == "iso":  # (LinuxCNC's tool parameters: the reads to check)
+        expanding["guard_reads"] = True
     events: Iterable[Event] = interpret(
         blocks, file=file, warnings=warnings, strict=strict, offsets=offsets, **expanding,
         **({"once_runs": runs} if runs is not None else {}), **({"main_program": main} if main is not None else {}),
@@ -448,10 +455,11 @@ def process(
     ctx = make_context(source, tolerance, warnings, file)
     compensated = reached.follow(summary.written(run_passes(summary.programmed(events), ctx, PASSES)))
     header = header_text(source, tolerance, offsets, name)
-    after = _tool_guard(name, offsets, warnings, file) if guard_tools else None
     checks = guard is not None and name in ISO_SYNTAX  # the zeros of the told systems it selects
-    before = PlacementChecks(offsets, name, guard.unit_mm, lambda why: warnings.warn(  # type: ignore[union-attr]
+    before: Callable[[list[Event]], list[str]] | None = PlacementChecks(offsets, name, guard.unit_mm, lambda why: warnings.warn(  # type: ignore[union-attr]
         f"no placement guard: {why}", Location(file, 1, None))) if checks else None  # fmt: skip
+    if after is not None:  # (and the tool parameters a block reads, checked before it)
+        before = _both(before, after.before) if before is not None else after.before
     lines = with_header(writer.write(compensated, after, before), header, writer, get_dialect(name).leader)
     if guard is not None:
         said = replace(guard, dialect=name).said()  # (as the program's dialect names the system)
@@ -481,6 +489,13 @@ def process(
         stats.summary.lines_in, stats.summary.lines_out = stats.lines_in, stats.lines_out
     warnings.finish()
     return stats
+
+
+def _both(
+    first: Callable[[list[Event]], list[str]], then: Callable[[list[Event]], list[str]]
+) -> Callable[[list[Event]], list[str]]:
+    """The writer's `before` of two guards: the lines of `first`, then those of `then`."""
+    return lambda events: [*first(events), *then(events)]
 
 
 def _tool_guard(dialect: str, offsets: WorkOffsets, warnings: Warnings, file: str) -> ToolGuard | None:

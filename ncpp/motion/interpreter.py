@@ -218,6 +218,7 @@ def interpreting(flavour: type[Interpreter]) -> Callable[..., Iterator[Event]]:
         expand: bool = False,
         once_runs: OnceRuns | None = None,
         main_program: MainProgram | None = None,
+        guard_reads: bool = False,
     ) -> Iterator[Event]:
         """Motion events of a program's blocks, lazily, as the flavour reads them (see the
         module docstring).
@@ -238,12 +239,15 @@ def interpreting(flavour: type[Interpreter]) -> Callable[..., Iterator[Event]]:
         and told there, to be written where its definition stands.
         `main_program`: given, it is told which of the file's programs runs as the main one
         (`flow.MainProgram`) before the first event.
+        `guard_reads`: the tool guard checks the tool parameters the program reads: a read where
+        its check has no place (text that runs again or elsewhere) is warned of.
         """
         interpreter = flavour(file, offsets)
         interpreter.once_runs = once_runs
         interpreter.main_program = main_program
         interpreter.expand_cycles = expand_cycles
         interpreter.expansion = Expansion(interpreter.params, file) if expand else None
+        interpreter.guard_reads = guard_reads
         return run(interpreter, blocks, warnings, strict)
 
     return interpret
@@ -367,6 +371,12 @@ class Interpreter:
         self.selected_tool = 0  # T
         self.spindle_tool = 0  # M6, M61 (0: none)
         self.tool_changed = False  # the program has changed the tool: ncpp knows which is in the spindle
+        # the reads of #5401-#5413 answered since the last block taken (the tool, the parameter, its
+        # value): the tool guard checks them before the block (`Pass.tool_read`, `_with_reads`)
+        self.tool_reads: list[tuple[int, int, float]] = []
+        self.checked_reads: set[tuple[int, int, float]] = set()  # those checked in straight code
+        self.guard_reads = False  # a read whose check has no place is warned of (`_unchecked`)
+        self.unchecked_lines: set[int] = set()  # the lines warned of so
         # what the program set in the control's tool table (G10 L1/L10/L11, Fanuc's and Haas's G10 L10-L13):
         # per tool (offset) number its offsets by axis in mm, over the told table's (`_table_offsets`),
         # its radius in mm as given, signed (None: set to a value ncpp does not read), its lathe tool
@@ -448,7 +458,7 @@ class Interpreter:
             return
         yield from held_to_the_end(
             self._run(blocks, warnings), runs, lambda: (self.done, self.ended),
-            lambda: self.flow.called_again, _as_programmed,  # type: ignore[union-attr]  # (`_run` made it)
+            lambda: self.flow.called_again, self._as_programmed,  # type: ignore[union-attr]  # (`_run` made it)
         )  # fmt: skip
 
     def _run(self, blocks: Iterable[Block], warnings: Warnings) -> Iterator[Event | tuple]:
@@ -491,7 +501,7 @@ class Interpreter:
                 yield from self._told(once, again=(self.done and not self.ended) or once.full())
                 once = None
             if kind is ONCE and once is None:
-                once = FirstPass(lambda ev: _as_programmed(ev, None))
+                once = FirstPass(lambda ev: self._as_programmed(ev, None))
             elif once is not None and kind is FIXED and owner is not None and once.rerun(block):
                 yield from self._told(once, again=True)  # (all of it runs again: nothing to hold)
                 once = None
@@ -513,6 +523,10 @@ class Interpreter:
                 text = Pass(
                     block, kind is SKIP or block.verbatim, None if ended else self.motion
                 )  # (after the end: no mode the control is in)
+                if (
+                    self.tool_reads
+                ):  # (a control line's condition read them: the writer reads its first event)
+                    text.tool_read = self._reads_to_check(flow.in_straight_code())
                 if pending is not None:
                     held.append(text)
                 elif once is not None:
@@ -525,6 +539,8 @@ class Interpreter:
                     event, block = expansion.event(block_event, block, kind, flow.frames[-1].local)
                 else:
                     event = block_event(block)  # verbatim blocks (after the closing %) have no items
+                if self.tool_reads:
+                    event = self._with_reads(event, block, kind is RUN or expansion is not None)
                 if kind is ONCE and (self.corner is not None or _sets_offset(event) or self._compensating()):
                     if once is not None:
                         yield from self._told(once, again=True)  # (`_in_flow` tells why, below)
@@ -559,6 +575,7 @@ class Interpreter:
                 ) from None
             except _OutOfScope as stop:
                 self._leave_scope(stop.reason, block, stop.col, owner)
+                self.tool_reads = []  # (the program passes as it stands from here: no value of ncpp's in it)
                 if once is not None:
                     yield from self._told(once, again=True)
                     once = None
@@ -647,8 +664,44 @@ class Interpreter:
             raise _OutOfScope("G92 or G10 L10/L11/L20 in a loop or subroutine (it sets an offset from "
                               "where the control stands, which compensation moves)", None)  # fmt: skip
         events: tuple[Event, ...] = event if type(event) is tuple else (event,)  # type: ignore[assignment]
-        out = [kept for ev in events if (kept := _as_programmed(ev, owner)) is not None]
+        out = [kept for ev in events if (kept := self._as_programmed(ev, owner)) is not None]
         return tuple(out) if len(out) != 1 else out[0]
+
+    def _with_reads(
+        self, event: Event | tuple[Event, ...], block: Block, straight: bool
+    ) -> Event | tuple[Event, ...]:
+        """The block's events with a mark of the tool parameters read for it (`tool_reads`), which
+        the tool guard checks before it; in `straight` code (it runs once, where it stands, in the
+        order it is written) a value checked there since is not checked again."""
+        told = self._reads_to_check(straight)
+        return event if told is None else _marked(event, [Pass(block, tool_read=told)])
+
+    def _reads_to_check(self, straight: bool) -> tuple[tuple[int, int, float], ...] | None:
+        """The reads since the last block taken (`tool_reads`) that a check before it checks (None: none)."""
+        reads, self.tool_reads = self.tool_reads, []
+        told = dict.fromkeys(read for read in reads if read not in self.checked_reads)
+        if straight:
+            self.checked_reads.update(told)
+        return tuple(told) or None
+
+    def _as_programmed(self, ev: Event, owner: Block | None) -> Event | None:
+        """`_as_programmed`, warning where it drops a tool parameter read's check (`_unchecked`)."""
+        if type(ev) is Pass and ev.tool_read is not None and self.guard_reads:
+            self._unchecked(ev.block, ev.tool_read)
+        return _as_programmed(ev, owner)
+
+    def _unchecked(self, block: Block, reads: tuple[tuple[int, int, float], ...]) -> None:
+        """A read of the tool parameters in text that runs again or elsewhere: no check has a
+        place where it runs once with that tool in the spindle."""
+        if block.line in self.unchecked_lines:  # (each run of a loop's text reads again)
+            return
+        self.unchecked_lines.add(block.line)
+        said = ", ".join(f"#{key} = {value:g}" for _, key, value in reads)
+        self.warnings.warn(  # type: ignore[union-attr]
+            f"no tool guard check of {said} (tool {reads[0][0]} in the told table), read in a loop or a "
+            "subroutine that runs more than once: make sure the control's tool table gives the same",
+            Location(self.file, block.line, None),
+        )
 
     def _compensating(self) -> bool:
         """Whether cutter compensation, or the way out of it, decides where the block's moves go."""
@@ -1704,19 +1757,25 @@ class Interpreter:
         number = self.spindle_tool
         if number == 0:
             raise OutOfScope(f"machine-state parameter #{key} with no tool in the spindle")
-        if key == TOOL_PARAMETERS[0]:
+        if key == TOOL_PARAMETERS[0]:  # (the program's own M6 or M61 chose it)
             return float(number)
+        value = self._table_parameter(number, key)
+        self.tool_reads.append((number, key, value))  # (the tool guard checks the control's: `_with_reads`)
+        return value
+
+    def _table_parameter(self, number: int, key: int) -> float:
+        """Tool `number`'s #5401-#5413 (`_tool_parameter`) from the told table and the program's G10 L1."""
         index = key - TOOL_PARAMETERS[1]
         if index < len(OFFSET_LETTERS):  # #5401-#5409
             value = self._offsets_mm(number)[index]
             return value / self.unit_mm if index in LINEAR else value
         if key == TOOL_DIAMETER:
             radius = self.set_radii.get(number)
-            return (2 * radius if radius is not None else self.tools.diameter(number)) / self.unit_mm
+            return (2 * radius if radius is not None else self.tools.diameter(number)) / self.unit_mm  # type: ignore[union-attr]
         if key == TOOL_ORIENTATION:
-            return float(self.set_orientations.get(number, self.tools.orientation(number)))
+            return float(self.set_orientations.get(number, self.tools.orientation(number)))  # type: ignore[union-attr]
         letter = "IJ"[key - TOOL_DIAMETER - 1]  # the front and back angles, degrees
-        return self.set_angles.get(number, {}).get(letter, self.tools.angle(number, letter))
+        return self.set_angles.get(number, {}).get(letter, self.tools.angle(number, letter))  # type: ignore[union-attr]
 
     def _warn_untold(self, number: int, block: Block, item) -> None:
         """Once per system: its zero is taken as the machine zero, which is likely wrong."""
@@ -2485,7 +2544,8 @@ class Interpreter:
 # from the others (the context, the fast path)
 _NOT_LOOP_STATE = frozenset(("params", "flow", "warnings", "untold_lengths", "expansion", "tools",
                              "file", "subroutine_path", "expand_cycles", "_context", "_fast",
-                             "rounding", "once_runs", "main_program"))  # fmt: skip
+                             "rounding", "once_runs", "main_program", "tool_reads", "checked_reads",
+                             "guard_reads", "unchecked_lines"))  # fmt: skip
 # Fanuc lathes' maximum spindle speed clamp in G-code systems B and C (system A's G50 S), and Fanuc
 # machining centres' under constant surface speed (their G code list: G92 "setting for workpiece
 # coordinate system or clamp at maximum spindle speed"; `lathe.py`): no move, no offset
@@ -2543,7 +2603,7 @@ def _as_programmed(ev: Event, owner: Block | None) -> Event | None:
     programmed, belonging to `owner` where it runs out of the text's order; a text event kept
     in the text's place (None: not there)."""
     if type(ev) is Pass:
-        ev.length_told = None  # (the text runs again, or elsewhere, perhaps with another tool)
+        ev.length_told = ev.tool_read = None  # (the text runs again, or elsewhere, perhaps with another tool)
         ev.zero_told = None  # (and perhaps after the program set the zero)
         return ev if owner is None and not _expanding(ev) else None  # (a cycle there stays one)
     if ev.fixed in (HOLE, CYCLE):  # type: ignore[union-attr]

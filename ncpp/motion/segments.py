@@ -292,6 +292,10 @@ class Pass:
     # a block that selects a work coordinate system whose zero is still the one ncpp was told (its
     # number, 1..9 or ADDITIONAL + n), which the placement guard checks before the block
     zero_told: int | None = None
+    # the tool parameters (#5401-#5413) the block reads, as ncpp answered them from the told table:
+    # (the tool in the spindle, the parameter, its value in the table's units or degrees), which the
+    # tool guard checks before the block
+    tool_read: tuple[tuple[int, int, float], ...] | None = None
 
 
 Segment = Line | Arc

@@ -266,3 +266,182 @@ def test_a_haas_program_that_sets_its_length_offsets_is_checked_at_them(tmp_path
     assert "IF [ABS[#2001+#2201-120.02] GT 0.1] THEN #3000=5 (NCPP H1 LENGTH DIFFERS)" in written
     assert "IF [ABS[#2002+#2202-75.5] GT 0.1] THEN #3000=5 (NCPP H2 LENGTH DIFFERS)" in written
     assert not any("outside" in line for line in warned), warned
+
+
+# A program whose cuts depend on the tool's parameters (LinuxCNC G-code manual, "Numbered
+# Parameters": #5401 the X offset, #5410 the diameter, #5411 #5412 the front and back angles): a
+# pass offset by the radius, a branch on an angle, a subroutine that runs once and sizes its pass
+READS = (
+    "G21 G90 G54\n"
+    "o<slot> sub\n"
+    "  G1 X[40 + #5410 + #5412] F300\n"
+    "o<slot> endsub\n"
+    "T1 M6\n"
+    "G43 H1\n"
+    "G0 X10 Y10 Z5\n"
+    "G0 Z1\n"
+    "G1 Z-1 X[10 + #5410 / 2] F300\n"
+    "o1 if [#5411 GT 5]\n"
+    "G1 Y20\n"
+    "o1 endif\n"
+    "G1 X40 Y[10 + #5401]\n"
+    "o<slot> call\n"
+    "G0 Z5\n"
+    "M2\n"
+)
+READ_TABLE = "T1 P1 X0.5 Z50 D6 I10 J2\nT2 P2 Z75.5 D4\n"
+
+
+def _ncpp(tmp_path: Path, text: str, table: str, *options: str) -> tuple[Path, subprocess.CompletedProcess]:
+    """The program compensated by `ncpp compensate` with G54 and the tool table told."""
+    (tmp_path / "p.ngc").write_text(text)
+    (tmp_path / "told.tbl").write_text(table)
+    env = {k: v for k, v in os.environ.items() if k not in ("NCPP_MACHINE", "XDG_CONFIG_HOME")}
+    command = [
+        "compensate",
+        "--machine",
+        str(MACHINE),
+        "--work-offset",
+        "400,350,300",
+        "--tool-table",
+        "told.tbl",
+    ]
+    proc = subprocess.run([sys.executable, "-m", "ncpp", *command, *options, "p.ngc", "-o", "out.ngc"],
+                          capture_output=True, text=True, cwd=tmp_path,
+                          env={**env, "PYTHONPATH": str(ROOT), "HOME": str(tmp_path)})  # fmt: skip
+    assert proc.returncode == 0, proc.stderr  # (verified)
+    return tmp_path / "out.ngc", proc
+
+
+def test_rs274_stops_before_the_first_cut_that_reads_a_diameter_that_differs(tmp_path):
+    """The told table's diameter, front angle and X offset are written into the cuts: rs274 runs
+    the program to its end with that table (and one within the tolerances), and stops before the
+    first cut with a diameter 0.2 mm larger, before the branch with another front angle, before
+    the subroutine's pass (which runs at its call) with another X offset... each naming the
+    parameter, the told value and the control's."""
+    program, proc = _ncpp(tmp_path, READS, READ_TABLE)
+    written = program.read_text()
+    assert "X[10 + #5410" not in written and "G1 Z-0.9880 X13.0244 F300" in written  # (a number, compensated)
+    ran = _rs274(tmp_path, program, READ_TABLE)
+    assert ran.returncode == 0 and "PROGRAM_END" in ran.stdout, ran.stderr
+    assert ran.stdout.count("STRAIGHT_FEED") >= 4
+    within = _rs274(tmp_path, program, "T1 P1 X0.45 Z50 D6.05 I10.0005 J2\nT2 P2 Z75.5 D4\n")
+    assert within.returncode == 0 and "PROGRAM_END" in within.stdout, within.stderr
+
+    wider = _rs274(tmp_path, program, "T1 P1 X0.5 Z50 D6.2 I10 J2\nT2 P2 Z75.5 D4\n")
+    assert wider.returncode != 0 and "PROGRAM_END" not in wider.stdout
+    assert "compensated for tool 1 with diameter, parameter 5410, at 6 mm;" in wider.stderr, wider.stderr
+    assert "the control has tool 1.000000 with 6.200000:" in wider.stderr
+    assert "STRAIGHT_FEED" not in wider.stdout and "STRAIGHT_TRAVERSE" in wider.stdout  # (the rapids ran)
+
+    turned = _rs274(tmp_path, program, "T1 P1 X0.5 Z50 D6 I4 J2\nT2 P2 Z75.5 D4\n")
+    assert turned.returncode != 0 and "front angle, parameter 5411, at 10 deg;" in turned.stderr, (
+        turned.stderr
+    )
+    assert turned.stdout.count("STRAIGHT_FEED") == 1  # (the first cut, not the branch's)
+
+    shifted = _rs274(tmp_path, program, "T1 P1 X0.7 Z50 D6 I10 J2\nT2 P2 Z75.5 D4\n")
+    assert shifted.returncode != 0 and "X offset, parameter 5401, at 0.5 mm;" in shifted.stderr, (
+        shifted.stderr
+    )
+    assert shifted.stdout.count("STRAIGHT_FEED") == 2
+
+
+def test_each_read_is_checked_once_before_its_block_and_a_subroutines_inside_its_body(tmp_path):
+    """The check stands before the block that reads (a control line's condition too), inside the
+    body of a subroutine that runs once (written where its definition stands, it runs at the
+    call, before the pass), and a value checked in straight code is not checked again."""
+    lines = _ncpp(tmp_path, READS, READ_TABLE)[0].read_text().splitlines()
+    checks = [
+        line
+        for line in lines
+        if line.startswith("o<ncpp_tool_guard_") and " if " in line and "#5403" not in line
+    ]
+    assert [line.split(" if ")[1] for line in checks] == [
+        "[[#5400 NE 1] OR [ABS[#5412 - 2] GT 0.001]]",  # (in the body, whose #5410 is checked below first)
+        "[[#5400 NE 1] OR [ABS[#5410 - 6] GT 0.1]]",
+        "[[#5400 NE 1] OR [ABS[#5411 - 10] GT 0.001]]",
+        "[[#5400 NE 1] OR [ABS[#5401 - 0.5] GT 0.1]]",
+    ]
+    following = [lines[lines.index(check) + 4] for check in checks]
+    assert following[0].startswith("  G1 X48.") and following[1].startswith("G1 Z-0.98")
+    assert following[2:] == ["o1 if [#5411 GT 5]", "G1 X13.0247 Y20.0167 Z-0.9880"]
+    assert lines[lines.index(checks[0]) - 2] == "o<slot> sub"
+    assert (
+        lines[lines.index(checks[1]) - 1]
+        == f"({TOOL_BEGIN} tool 1 with diameter, parameter 5410, at 6 mm within 0.1 mm)"
+    )
+
+
+def test_a_program_that_reads_no_tool_parameter_is_written_as_before_and_no_guard_leaves_the_checks_out(
+    tmp_path,
+):
+    written, warned = _compensated(tmp_path)
+    assert written.count(TOOL_BEGIN) == 2 and "#5410" not in written and not warned
+    unguarded, _ = _compensated(tmp_path, READS, READ_TABLE, guard=False)
+    assert "tool guard" not in unguarded
+
+
+def test_a_read_in_a_loop_gets_no_check_and_a_warning(tmp_path):
+    """A loop's text runs again, perhaps with another tool, and its moves are left as programmed:
+    the control reads its own value there; ncpp warns that the read is not checked, once."""
+    loop = "o2 repeat [2]\nG1 Y[10 + #5402]\no2 endrepeat\n"
+    written, warned = _compensated(
+        tmp_path, PROGRAM.replace("G1 X40 Y10\n", loop), "T1 P1 Y0.2 Z50 D6\nT2 P2 Z75.5 D4\n"
+    )
+    assert "#5402 NE" not in written and "ABS[#5402" not in written
+    said = [line for line in warned if "no tool guard check of #5402 = 0.2" in line]
+    assert len(said) == 1 and "p.ngc:7:" in said[0], warned
+
+
+def test_an_inch_table_and_angles_and_the_orientation():
+    from ncpp.guard import tool_read_lines
+
+    lines = tool_read_lines(3, 5410, 0.25, 25.4, 4)
+    assert lines[0] == f"({TOOL_BEGIN} tool 3 with diameter, parameter 5410, at 0.25 inch within 0.0039 inch)"
+    assert lines[1] == "o<ncpp_tool_guard_4> if [[#5400 NE 3] OR [ABS[#5410 - 0.25] GT 0.0039]]"
+    assert "ABS[#5412 + 7.5] GT 0.001]" in tool_read_lines(3, 5412, -7.5, 1.0, 5)[1]
+    assert "ABS[#5413 - 2] GT 0.5]" in tool_read_lines(3, 5413, 2.0, 1.0, 6)[1]
+
+
+def test_a_condition_read_in_a_loop_that_changes_the_tool_gets_no_check_inside_it(tmp_path):
+    """Each run of the loop's text reads the diameter of another tool: a check written in it for
+    the first would stop the second run; the reads are warned of, each tool's once, and the read
+    after the loop is checked before its block."""
+    loop = (
+        "#<t> = 1\no2 repeat [2]\nT#<t> M6\nG43\nG0 X0 Y0 Z5\no1 if [#5410 GT 5]\nG1 X5 F100\no1 endif\n"
+        "#<t> = 2\no2 endrepeat\nG1 X[#5410]\nM2\n"
+    )
+    written, warned = _compensated(tmp_path, "G21 G90 G54\n" + loop, TABLE)
+    body = written[written.index("o2 repeat") : written.index("o2 endrepeat")]
+    assert TOOL_BEGIN not in body and written.count(TOOL_BEGIN) == 1
+    after = written.split("o2 endrepeat\n")[1].splitlines()
+    assert after[1] == "o<ncpp_tool_guard_1> if [[#5400 NE 2] OR [ABS[#5410 - 4] GT 0.1]]"
+    said = [line for line in warned if "no tool guard check of #5410" in line]
+    assert len(said) == 2 and "= 6 (tool 1" in said[0] and "= 4 (tool 2" in said[1], warned
+
+
+def test_a_while_condition_checked_before_the_loop_is_not_checked_again(tmp_path):
+    """The condition's first read stands in straight code: its check before the `while` line runs
+    once, and the reads of the same tool's value after it (the condition again, a cut after the
+    loop) need none."""
+    loop = "#1 = 0\no1 while [#1 LT #5410]\nG1 X[#1 + 20]\n#1 = [#1 + 2]\no1 endwhile\nG1 X[30 + #5410] Y30\n"
+    written, warned = _compensated(tmp_path, PROGRAM.replace("G1 X40 Y10\n", loop))
+    lines = written.splitlines()
+    k = lines.index("o1 while [#1 LT #5410]")
+    assert lines[k - 4] == "o<ncpp_tool_guard_2> if [[#5400 NE 1] OR [ABS[#5410 - 6] GT 0.1]]"
+    assert written.count("ABS[#5410") == 1 and not any("no tool guard check" in line for line in warned)
+
+
+def test_compensated_again_the_read_checks_go_with_a_warning(tmp_path):
+    """The written program has numbers where the original read the parameters: compensated again
+    (--force), each check is dropped with a warning at its line, and only the read left (the
+    branch's condition) is checked again."""
+    first = _ncpp(tmp_path, READS, READ_TABLE)[0]
+    again, proc = _ncpp(tmp_path, first.read_text(), READ_TABLE, "--force")
+    written = again.read_text()
+    assert written.count(TOOL_BEGIN) == 2 and "ABS[#5403 - 50]" in written  # (the length's, after G43)
+    assert "ABS[#5411 - 10]" in written and "ABS[#5410" not in written
+    said = [line for line in proc.stderr.splitlines() if "compensated again, the check" in line]
+    assert len(said) == 4 and "tool 1 with back angle, parameter 5412, at 2 deg" in said[0], proc.stderr
+    assert "p.ngc:11:" in said[0] and said[0].endswith("compensate the original program instead")
