@@ -215,6 +215,8 @@ class Dialect:
     `read_where_run`: a line the grammar cannot read is an error where it runs, not where it stands (rs274ngc reads only the
     lines it runs: an uncalled subroutine, an untaken branch, the text after M2
     may hold anything): it becomes a block of one `unreadable` statement.
+    `bare_tape_marks`: only a line of `%` alone (blanks aside) is a tape mark; a `%` with more on
+    its line (`% vfd enable`, `%(note)`) is a bad character where it runs, as rs274ngc reads it.
     """
 
     name: str
@@ -228,6 +230,7 @@ class Dialect:
     leader: bool = False  # lines before a first `%` line are a tape leader, not read (`_leader`)
     programs_after_end: bool = False  # the lines after the closing `%` are parsed (`_after_end`)
     eob_semicolon: bool = False  # `;` is the end of block as the control shows it (`_words_after_eob`)
+    bare_tape_marks: bool = False  # a `%` with more on its line is no tape mark (rs274ngc)
 
 
 def dialect_syntax(dialect: str | Dialect) -> Dialect:
@@ -921,7 +924,9 @@ def parse_stream(
                 yield Block(content, eol, (), number, verbatim=True)
             continue
         block = parser.parse(content, eol, number, file)
-        if block.items and type(block.items[0]) is Statement and block.items[0].kind == "tape":
+        if _tape_mark(block) and parser.dialect.bare_tape_marks and block.items[0].node[0].strip() != "%":  # type: ignore[union-attr]
+            block = _stray_tape_mark(block)
+        elif _tape_mark(block):
             tape_marks += 1
             if tape_marks < 0 and parser.dialect.read_where_run:  # rs274ngc: a bad character where it runs
                 block = _stray_tape_mark(block)
@@ -957,8 +962,13 @@ def _after_end(parser: LineParser, content: str, eol: str, number: int, file: st
     return Block(content, eol, items, number, verbatim=True)  # (no signature: no fast path takes it)
 
 
+def _tape_mark(block: Block) -> bool:
+    return bool(block.items) and type(block.items[0]) is Statement and block.items[0].kind == "tape"
+
+
 def _stray_tape_mark(block: Block) -> Block:
-    """A `%` line in a program that did not start with one: a `stray_tape` statement."""
+    """A `%` line that is no tape mark (in a program that did not start with one, or with more on
+    its line where `Dialect.bare_tape_marks`): a `stray_tape` statement."""
     mark, *rest = block.items
     return replace(block, items=(Statement(STRAY_TAPE, mark.node, mark.start, mark.end), *rest))  # type: ignore[union-attr]
 
