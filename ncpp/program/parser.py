@@ -924,9 +924,10 @@ def parse_stream(
                 yield Block(content, eol, (), number, verbatim=True)
             continue
         block = parser.parse(content, eol, number, file)
-        if _tape_mark(block) and parser.dialect.bare_tape_marks and block.items[0].node[0].strip() != "%":  # type: ignore[union-attr]
+        mark = _tape_text(block)
+        if mark is not None and parser.dialect.bare_tape_marks and mark.strip() != "%":
             block = _stray_tape_mark(block)
-        elif _tape_mark(block):
+        elif mark is not None:
             tape_marks += 1
             if tape_marks < 0 and parser.dialect.read_where_run:  # rs274ngc: a bad character where it runs
                 block = _stray_tape_mark(block)
@@ -962,8 +963,10 @@ def _after_end(parser: LineParser, content: str, eol: str, number: int, file: st
     return Block(content, eol, items, number, verbatim=True)  # (no signature: no fast path takes it)
 
 
-def _tape_mark(block: Block) -> bool:
-    return bool(block.items) and type(block.items[0]) is Statement and block.items[0].kind == "tape"
+def _tape_text(block: Block) -> str | None:
+    """A `%` line's mark, `%` and what follows it on the line (None: the block is no `%` line)."""
+    first = block.items[0] if block.items else None
+    return first.node[0] if type(first) is Statement and first.kind == "tape" else None
 
 
 def _stray_tape_mark(block: Block) -> Block:

@@ -90,8 +90,9 @@ SNIFF_BYTES = 4096
 _SNIFF_MOST = 2 * SNIFF_BYTES
 
 ISO = Dialect(
-    "iso", "iso", _ItemBuilder, fast_terminals=LineParser.FAST_TERMINALS, read_where_run=True, bare_tape_marks=True
-)
+    "iso", "iso", _ItemBuilder, fast_terminals=LineParser.FAST_TERMINALS, read_where_run=True,
+    bare_tape_marks=True,
+)  # fmt: skip
 # grbl: a line it reads as a system command (`$H`, `$100=250`) is no G code: read where it
 # runs, it reaches the interpreter as a line the grammar cannot read
 GRBL = Dialect("grbl", "iso", _ItemBuilder, fast_terminals=LineParser.FAST_TERMINALS, read_where_run=True)
