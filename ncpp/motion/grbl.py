@@ -13,6 +13,10 @@ grbl reads a subset of rs274ngc (its wiki page "G-code commands" and `grbl/gcode
 * G33.1, LinuxCNC's rigid tap, is out of scope: grbl has no spindle-synchronised motion;
 * the parser starts in G0 (`gcode.h`: "MOTION_MODE_SEEK 0 // G0 (Default: Must be zero)", the state
   `gc_init` clears), so axis words before any motion code are a rapid, where rs274ngc refuses them;
+* M2 and M30 end no reading: they reset the modes of groups 1, 2, 3, 5, 7 and 12 and stop the
+  spindle and coolant, and grbl runs the lines a sender streams after them (`gc_execute_line`,
+  "[21. Program flow]": the resets, then `program_flow = PROGRAM_FLOW_RUNNING`), so a file of
+  several jobs one after another is compensated to its end;
 * `?`, `~` and `!` are realtime commands (status report, cycle start, feed hold) that grbl
   picks out of the stream as they arrive (`serial.c`), never G code: a line of them
   passes through untouched.
@@ -38,6 +42,12 @@ class GrblInterpreter(Interpreter):
     rotating_g10 = False  # (grbl's G10 L2 takes no R)
     tool_table_g10 = False  # (grbl has no tool table: G43.1 gives the offset itself)
     start_motion = 0.0  # (grbl's parser starts in G0)
+
+    def _program_end(self) -> None:
+        """M2/M30: rs274ngc's resets (G1 G17 G90 G94 G40 G54), the spindle stopped, and read on."""
+        super()._program_end()
+        self.spindle = 0
+        self.done = self.ended = False
 
     def block(self, block: Block) -> Event | tuple[Event, ...]:
         signature = block.signature
