@@ -17,6 +17,9 @@ grbl reads a subset of rs274ngc (its wiki page "G-code commands" and `grbl/gcode
   spindle and coolant, and grbl runs the lines a sender streams after them (`gc_execute_line`,
   "[21. Program flow]": the resets, then `program_flow = PROGRAM_FLOW_RUNNING`), so a file of
   several jobs one after another is compensated to its end;
+* a `%` line is no tape mark grbl reads (`protocol.c`: "Program start-end percent sign NOT
+  SUPPORTED"; the parser answers error 1 and changes nothing): one that is no tape mark of the
+  program passes through, as the `M30` then `%` a post writes at the end of a file;
 * `?`, `~` and `!` are realtime commands (status report, cycle start, feed hold) that grbl
   picks out of the stream as they arrive (`serial.c`), never G code: a line of them
   passes through untouched.
@@ -28,7 +31,7 @@ import re
 
 from ncpp.motion.interpreter import Interpreter, _OutOfScope, interpreting
 from ncpp.motion.segments import Event, Pass
-from ncpp.program.blocks import Block
+from ncpp.program.blocks import STRAY_TAPE, Block, Statement
 
 # A line of realtime commands, perhaps with a comment
 _REALTIME = re.compile(r"[?~!]+[ \t]*(;.*|\(.*)?\r?\n?$")
@@ -54,7 +57,7 @@ class GrblInterpreter(Interpreter):
         if signature is not None and signature[:1] != "$":  # a plain block (the most): G code
             return super().block(block)
         text = block.text.lstrip()
-        if _REALTIME.match(text):
+        if _REALTIME.match(text) or _stray_tape_mark(block):
             return Pass(block)
         if text.startswith("$"):
             for start, what in _MOVING.items():
@@ -62,6 +65,10 @@ class GrblInterpreter(Interpreter):
                     raise _OutOfScope(f"{what}, a move ncpp cannot follow", 1)
             return Pass(block)
         return super().block(block)
+
+
+def _stray_tape_mark(block: Block) -> bool:
+    return bool(block.items) and type(block.items[0]) is Statement and block.items[0].kind == STRAY_TAPE
 
 
 interpret = interpreting(GrblInterpreter)

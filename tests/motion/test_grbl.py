@@ -138,7 +138,9 @@ def test_grbl_reads_on_after_m30_with_its_modes_reset(tmp_path):
     from tests.conftest import RS274
     from tests.motion.test_oracle import rs274, same_calls
 
-    job = "G90\nG21\nG17\nM3\nN10 G00 X{0} Y108.711 Z10.000\nN20 G01 Z-5.000 F100\nN30 G01 X{1} Y108.711 F100\n"
+    job = (
+        "G90\nG21\nG17\nM3\nN10 G00 X{0} Y108.711 Z10.000\nN20 G01 Z-5.000 F100\nN30 G01 X{1} Y108.711 F100\n"
+    )
     second = job.format(243.688, 537.441).replace("G90\n", "")  # (M30's G90 ends the first job's G91)
     program = (job.format(93.465, 207.699) + "G91 G00 Z10\nM30\n" + second + "M30\n").encode()
     mine = [c for c in (canon_call(e) for e in events(program, "grbl")) if c is not None]
@@ -151,3 +153,15 @@ def test_grbl_reads_on_after_m30_with_its_modes_reset(tmp_path):
     twin.write_bytes(program.replace(b"M30\n", b"G17 G90 G94 G40 G54 M5 M9\n", 1))
     reference = read_canon(rs274(str(twin))[0])
     assert same_calls(reference, mine), (reference, mine)
+
+
+def test_a_percent_line_grbl_does_not_read_passes_through():
+    """`M30` then `%` with no `%` at the start (CAMotics examples/cameo/cameo.nc ends so): grbl
+    reads no tape marks (protocol.c, "Program start-end percent sign NOT SUPPORTED"; the parser
+    answers error 1 and changes nothing), and as grbl reads on after M30 the line is reached;
+    LinuxCNC refuses it as a stray `%`."""
+    program = b"G21 G90\nG0 X1\nG1 X2 F100\nM30\n%\n"
+    found = events(program, "grbl")
+    assert [type(event) for event in found] == [Pass, Line, Line, Pass, Pass]
+    with pytest.raises(NcppError, match="Bad character '%' used"):
+        events(program.replace(b"M30\n", b""), "iso")
