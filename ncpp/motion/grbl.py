@@ -17,9 +17,9 @@ grbl reads a subset of rs274ngc (its wiki page "G-code commands" and `grbl/gcode
   spindle and coolant, and grbl runs the lines a sender streams after them (`gc_execute_line`,
   "[21. Program flow]": the resets, then `program_flow = PROGRAM_FLOW_RUNNING`), so a file of
   several jobs one after another is compensated to its end;
-* a `%` line is no tape mark grbl reads (`protocol.c`: "Program start-end percent sign NOT
-  SUPPORTED"; the parser answers error 1 and changes nothing): one that is no tape mark of the
-  program passes through, as the `M30` then `%` a post writes at the end of a file;
+* grbl reads no tape marks (`protocol.c`: "Program start-end percent sign NOT SUPPORTED"; its
+  parser answers a `%` line with error 1 and changes nothing): a `%` line passes through, and
+  the lines after a second one run as any others (the dialect's `tape_marks`);
 * `?`, `~` and `!` are realtime commands (status report, cycle start, feed hold) that grbl
   picks out of the stream as they arrive (`serial.c`), never G code: a line of them
   passes through untouched.

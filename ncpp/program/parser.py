@@ -217,6 +217,8 @@ class Dialect:
     may hold anything): it becomes a block of one `unreadable` statement.
     `bare_tape_marks`: only a line of `%` alone (blanks aside) is a tape mark; a `%` with more on
     its line (`% vfd enable`, `%(note)`) is a bad character where it runs, as rs274ngc reads it.
+    `tape_marks`: the controls take `%` lines for the program's start and end; without them (grbl)
+    every `%` line is a stray one and no text after a `%` goes unread.
     """
 
     name: str
@@ -231,6 +233,7 @@ class Dialect:
     programs_after_end: bool = False  # the lines after the closing `%` are parsed (`_after_end`)
     eob_semicolon: bool = False  # `;` is the end of block as the control shows it (`_words_after_eob`)
     bare_tape_marks: bool = False  # a `%` with more on its line is no tape mark (rs274ngc)
+    tape_marks: bool = True  # `%` lines mark the program's start and end (not grbl's)
 
 
 def dialect_syntax(dialect: str | Dialect) -> Dialect:
@@ -925,7 +928,7 @@ def parse_stream(
             continue
         block = parser.parse(content, eol, number, file)
         mark = _tape_text(block)
-        if mark is not None and parser.dialect.bare_tape_marks and mark.strip() != "%":
+        if mark is not None and _no_tape_mark(mark, parser.dialect):
             block = _stray_tape_mark(block)
         elif mark is not None:
             tape_marks += 1
@@ -967,6 +970,11 @@ def _tape_text(block: Block) -> str | None:
     """A `%` line's mark, `%` and what follows it on the line (None: the block is no `%` line)."""
     first = block.items[0] if block.items else None
     return first.node[0] if type(first) is Statement and first.kind == "tape" else None
+
+
+def _no_tape_mark(mark: str, dialect: Dialect) -> bool:
+    """A `%` line the dialect's controls take for no tape mark wherever it stands."""
+    return not dialect.tape_marks or dialect.bare_tape_marks and mark.strip() != "%"
 
 
 def _stray_tape_mark(block: Block) -> Block:

@@ -165,3 +165,24 @@ def test_a_percent_line_grbl_does_not_read_passes_through():
     assert [type(event) for event in found] == [Pass, Line, Line, Pass, Pass]
     with pytest.raises(NcppError, match="Bad character '%' used"):
         events(program.replace(b"M30\n", b""), "iso")
+
+
+def test_grbl_runs_the_lines_after_a_second_percent_line(tmp_path):
+    """grbl reads no tape marks: the `% vfd enable` a Fusion MPCNC post writes into its start
+    G-code (an excerpt of richcreations/Ghettotator, models/wiggler-8-back0125drill.gcode) closes
+    no program, and the moves after it run; rs274 runs the twin without the `%` lines."""
+    from ncpp.motion.canon import canon_call, read_canon
+    from tests.conftest import RS274
+    from tests.motion.test_oracle import rs274, same_calls
+
+    program = b"%\n% vfd enable\nM6 T0\n%( *** START end ***)\nM3 S5000\nG0 Z3 F300\nX77.688 Y49.688\nG1 Z-3 F1000\n%\n"
+    mine = [c for c in (canon_call(e) for e in events(program, "grbl")) if c is not None]
+    assert len(mine) == 3 and mine[-1].end[:3] == (77.688, 49.688, -3.0)
+    if not RS274.exists():
+        pytest.skip("rs274 not available")
+    twin = tmp_path / "twin.ngc"
+    twin.write_bytes(
+        b"".join(line for line in program.splitlines(keepends=True) if not line.startswith(b"%"))
+    )
+    reference = read_canon(rs274(str(twin))[0])
+    assert same_calls(reference, mine), (reference, mine)
