@@ -32,7 +32,7 @@ from ncpp.motion.segments import COMP, CYCLE, DRILLED, FLOW, HOLE, PATTERN, Arc,
 from ncpp.passes import PASSES, PassContext, run_passes
 from ncpp.passes.context import ErrorMap, is_directional
 from ncpp.passes.inverse import iterations_for
-from ncpp.program.blocks import Block, Comment, Statement, Word
+from ncpp.program.blocks import STRAY_TAPE, Block, Comment, Statement, Word
 from ncpp.program.dialects import FAMILY, dialect_tools, get_dialect, parse_program
 from ncpp.program.dialects.iso import IsoWriter
 from ncpp.program.parser import LEADER_LINES
@@ -144,7 +144,8 @@ def program_head(blocks: Iterator[Block]) -> Iterator[Block]:
             return
 
 
-_HEAD_STATEMENTS = frozenset({"tape", "program_name", "program_begin"})  # `%`, `%_N_PART_MPF`, `BEGIN PGM`
+# `%` (a tape mark or, in grbl's programs, a `%` it does not read), `%_N_PART_MPF`, `BEGIN PGM`
+_HEAD_STATEMENTS = frozenset({"tape", STRAY_TAPE, "program_name", "program_begin"})
 
 
 def _comments_only(block: Block) -> bool:

@@ -13,6 +13,13 @@ grbl reads a subset of rs274ngc (its wiki page "G-code commands" and `grbl/gcode
 * G33.1, LinuxCNC's rigid tap, is out of scope: grbl has no spindle-synchronised motion;
 * the parser starts in G0 (`gcode.h`: "MOTION_MODE_SEEK 0 // G0 (Default: Must be zero)", the state
   `gc_init` clears), so axis words before any motion code are a rapid, where rs274ngc refuses them;
+* M2 and M30 end no reading: they reset the modes of groups 1, 2, 3, 5, 7 and 12 and stop the
+  spindle and coolant, and grbl runs the lines a sender streams after them (`gc_execute_line`,
+  "[21. Program flow]": the resets, then `program_flow = PROGRAM_FLOW_RUNNING`), so a file of
+  several jobs one after another is compensated to its end;
+* grbl reads no tape marks (`protocol.c`: "Program start-end percent sign NOT SUPPORTED"; its
+  parser answers a `%` line with error 1 and changes nothing): a `%` line passes through, and
+  the lines after a second one run as any others (the dialect's `tape_marks`);
 * `?`, `~` and `!` are realtime commands (status report, cycle start, feed hold) that grbl
   picks out of the stream as they arrive (`serial.c`), never G code: a line of them
   passes through untouched.
@@ -24,7 +31,7 @@ import re
 
 from ncpp.motion.interpreter import Interpreter, _OutOfScope, interpreting
 from ncpp.motion.segments import Event, Pass
-from ncpp.program.blocks import Block
+from ncpp.program.blocks import STRAY_TAPE, Block, Statement
 
 # A line of realtime commands, perhaps with a comment
 _REALTIME = re.compile(r"[?~!]+[ \t]*(;.*|\(.*)?\r?\n?$")
@@ -39,12 +46,18 @@ class GrblInterpreter(Interpreter):
     tool_table_g10 = False  # (grbl has no tool table: G43.1 gives the offset itself)
     start_motion = 0.0  # (grbl's parser starts in G0)
 
+    def _program_end(self) -> None:
+        """M2/M30: rs274ngc's resets (G1 G17 G90 G94 G40 G54), the spindle stopped, and read on."""
+        super()._program_end()
+        self.spindle = 0
+        self.done = self.ended = False
+
     def block(self, block: Block) -> Event | tuple[Event, ...]:
         signature = block.signature
         if signature is not None and signature[:1] != "$":  # a plain block (the most): G code
             return super().block(block)
         text = block.text.lstrip()
-        if _REALTIME.match(text):
+        if _REALTIME.match(text) or _stray_tape_mark(block):
             return Pass(block)
         if text.startswith("$"):
             for start, what in _MOVING.items():
@@ -52,6 +65,10 @@ class GrblInterpreter(Interpreter):
                     raise _OutOfScope(f"{what}, a move ncpp cannot follow", 1)
             return Pass(block)
         return super().block(block)
+
+
+def _stray_tape_mark(block: Block) -> bool:
+    return bool(block.items) and type(block.items[0]) is Statement and block.items[0].kind == STRAY_TAPE
 
 
 interpret = interpreting(GrblInterpreter)

@@ -964,12 +964,10 @@ class Interpreter:
                     pass
                 elif what == UNREADABLE:  # read where it runs, as rs274ngc reads it
                     raise statement.node[0]
-                elif what == STRAY_TAPE:  # a `%` after the program's first line that was not one
-                    self._fail(
-                        "Bad character '%' used (a tape mark only where the program starts with one)",
-                        block,
-                        item,
-                    )
+                elif what == STRAY_TAPE:  # a `%` after the program's first line that was not one, or `% text`
+                    alone = statement.node[0].strip() == "%"
+                    why = "only where the program starts with one" if alone else "is a line of % alone"
+                    self._fail(f"Bad character '%' used (a tape mark {why})", block, item)
                 elif what == "external_output":
                     if not self.external_output:
                         self._fail("Unknown word where unary operation could be", block, item)

@@ -215,6 +215,10 @@ class Dialect:
     `read_where_run`: a line the grammar cannot read is an error where it runs, not where it stands (rs274ngc reads only the
     lines it runs: an uncalled subroutine, an untaken branch, the text after M2
     may hold anything): it becomes a block of one `unreadable` statement.
+    `bare_tape_marks`: only a line of `%` alone (blanks aside) is a tape mark; a `%` with more on
+    its line (`% vfd enable`, `%(note)`) is a bad character where it runs, as rs274ngc reads it.
+    `tape_marks`: the controls take `%` lines for the program's start and end; without them (grbl)
+    every `%` line is a stray one and no text after a `%` goes unread.
     """
 
     name: str
@@ -228,6 +232,8 @@ class Dialect:
     leader: bool = False  # lines before a first `%` line are a tape leader, not read (`_leader`)
     programs_after_end: bool = False  # the lines after the closing `%` are parsed (`_after_end`)
     eob_semicolon: bool = False  # `;` is the end of block as the control shows it (`_words_after_eob`)
+    bare_tape_marks: bool = False  # a `%` with more on its line is no tape mark (rs274ngc)
+    tape_marks: bool = True  # `%` lines mark the program's start and end (not grbl's)
 
 
 def dialect_syntax(dialect: str | Dialect) -> Dialect:
@@ -921,7 +927,10 @@ def parse_stream(
                 yield Block(content, eol, (), number, verbatim=True)
             continue
         block = parser.parse(content, eol, number, file)
-        if block.items and type(block.items[0]) is Statement and block.items[0].kind == "tape":
+        mark = _tape_text(block)
+        if mark is not None and _no_tape_mark(mark, parser.dialect):
+            block = _stray_tape_mark(block)
+        elif mark is not None:
             tape_marks += 1
             if tape_marks < 0 and parser.dialect.read_where_run:  # rs274ngc: a bad character where it runs
                 block = _stray_tape_mark(block)
@@ -957,8 +966,20 @@ def _after_end(parser: LineParser, content: str, eol: str, number: int, file: st
     return Block(content, eol, items, number, verbatim=True)  # (no signature: no fast path takes it)
 
 
+def _tape_text(block: Block) -> str | None:
+    """A `%` line's mark, `%` and what follows it on the line (None: the block is no `%` line)."""
+    first = block.items[0] if block.items else None
+    return first.node[0] if type(first) is Statement and first.kind == "tape" else None
+
+
+def _no_tape_mark(mark: str, dialect: Dialect) -> bool:
+    """A `%` line the dialect's controls take for no tape mark wherever it stands."""
+    return not dialect.tape_marks or dialect.bare_tape_marks and mark.strip() != "%"
+
+
 def _stray_tape_mark(block: Block) -> Block:
-    """A `%` line in a program that did not start with one: a `stray_tape` statement."""
+    """A `%` line that is no tape mark (in a program that did not start with one, or with more on
+    its line where `Dialect.bare_tape_marks`): a `stray_tape` statement."""
     mark, *rest = block.items
     return replace(block, items=(Statement(STRAY_TAPE, mark.node, mark.start, mark.end), *rest))  # type: ignore[union-attr]
 

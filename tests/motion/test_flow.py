@@ -89,6 +89,7 @@ AGREE = {
     + "o2 if [0]\no1 sub\nG1 X1\no1 endsub\no2 endif\no1 sub\nG1 X2\no1 endsub\no1 call\no3 call\nM2\no3 sub\nG1 Y1\no3 endsub\no3 sub\nG1 Y2\no3 endsub\n",
     "tape marks after a blank first line": "\n%\n" + HEAD + "G1 X1\n%\n",
     "a stray % after M2": HEAD + "G1 X1\nM2\n%\n",
+    "a closing % with blanks after it is a tape mark": "%\n" + HEAD + "G1 X1\n%  \t\nG1 X9\n",
     "modes a subroutine leaves": HEAD
     + "o1 sub\n G91 G1 X1\n G18\no1 endsub\nG1 X5 Y5\no1 call\nX1 Z1\nG2 X2 Z0 I1 K0\nG90\n",
 }
@@ -147,6 +148,14 @@ REFUSED = {
         "(setup)\n%\n" + HEAD + "G1 X1\n%\n",
         2,
     ),
+    # Excerpt of Ghettotator models/wiggler-8-back0125drill.gcode (richcreations/Ghettotator, Fusion
+    # CAM's MPCNC21 post): its start G-code writes `% vfd enable` between the program's moves
+    "a % with text after it is no tape mark (was: read as the closing one, the moves after it dropped)": (
+        "%\n" + HEAD + "% vfd enable\nM6 T0\n% LED ON\nG1 X1 Z-3\n%\n",
+        4,
+    ),
+    "a % with a comment after it": ("%\n" + HEAD + "G1 X1\n%( *** START end ***)\nG1 X2\n", 5),
+    "a first line of % and text": ("% program start\n" + HEAD + "G1 X1\n%\n", 1),
     "a Fanuc subprogram that calls itself": (HEAD + "M98 P1\nM30\nO1\nG1 X1 F100\nM98 P1\nM99\n", 7),
 }
 

@@ -126,3 +126,63 @@ def test_axis_words_before_any_motion_code_are_a_rapid_as_grbl_starts_in_g0(tmp_
     twin.write_bytes(program.replace(b"\nZ2\n", b"\nG0 Z2\n"))
     reference = read_canon(rs274(str(twin))[0])
     assert same_calls(reference, mine), (reference, mine)
+
+
+def test_grbl_reads_on_after_m30_with_its_modes_reset(tmp_path):
+    """Two jobs one after another, each ending in M30 (an excerpt of thawkins/gcodekit4,
+    assets/gcode/generated.gcode): grbl resets the modes at M30 and runs the lines the sender
+    streams after it (gcode.c, "[21. Program flow]": G1 G17 G90 G94 G40 G54 M5 M9, then
+    `program_flow = PROGRAM_FLOW_RUNNING`).  rs274 runs the twin whose first M30 is those resets;
+    LinuxCNC's reading stops at the M30."""
+    from ncpp.motion.canon import canon_call, read_canon
+    from tests.conftest import RS274
+    from tests.motion.test_oracle import rs274, same_calls
+
+    job = (
+        "G90\nG21\nG17\nM3\nN10 G00 X{0} Y108.711 Z10.000\nN20 G01 Z-5.000 F100\nN30 G01 X{1} Y108.711 F100\n"
+    )
+    second = job.format(243.688, 537.441).replace("G90\n", "")  # (M30's G90 ends the first job's G91)
+    program = (job.format(93.465, 207.699) + "G91 G00 Z10\nM30\n" + second + "M30\n").encode()
+    mine = [c for c in (canon_call(e) for e in events(program, "grbl")) if c is not None]
+    assert len(mine) == 7 and mine[-1].end[:3] == (537.441, 108.711, -5.0)
+    linuxcnc = [c for c in (canon_call(e) for e in events(program, "iso")) if c is not None]
+    assert len(linuxcnc) == 4
+    if not RS274.exists():
+        pytest.skip("rs274 not available")
+    twin = tmp_path / "twin.ngc"
+    twin.write_bytes(program.replace(b"M30\n", b"G17 G90 G94 G40 G54 M5 M9\n", 1))
+    reference = read_canon(rs274(str(twin))[0])
+    assert same_calls(reference, mine), (reference, mine)
+
+
+def test_a_percent_line_grbl_does_not_read_passes_through():
+    """`M30` then `%` with no `%` at the start (CAMotics examples/cameo/cameo.nc ends so): grbl
+    reads no tape marks (protocol.c, "Program start-end percent sign NOT SUPPORTED"; the parser
+    answers error 1 and changes nothing), and as grbl reads on after M30 the line is reached;
+    LinuxCNC refuses it as a stray `%`."""
+    program = b"G21 G90\nG0 X1\nG1 X2 F100\nM30\n%\n"
+    found = events(program, "grbl")
+    assert [type(event) for event in found] == [Pass, Line, Line, Pass, Pass]
+    with pytest.raises(NcppError, match="Bad character '%' used"):
+        events(program.replace(b"M30\n", b""), "iso")
+
+
+def test_grbl_runs_the_lines_after_a_second_percent_line(tmp_path):
+    """grbl reads no tape marks: the `% vfd enable` a Fusion MPCNC post writes into its start
+    G-code (an excerpt of richcreations/Ghettotator, models/wiggler-8-back0125drill.gcode) closes
+    no program, and the moves after it run; rs274 runs the twin without the `%` lines."""
+    from ncpp.motion.canon import canon_call, read_canon
+    from tests.conftest import RS274
+    from tests.motion.test_oracle import rs274, same_calls
+
+    program = b"%\n% vfd enable\nM6 T0\n%( *** START end ***)\nM3 S5000\nG0 Z3 F300\nX77.688 Y49.688\nG1 Z-3 F1000\n%\n"
+    mine = [c for c in (canon_call(e) for e in events(program, "grbl")) if c is not None]
+    assert len(mine) == 3 and mine[-1].end[:3] == (77.688, 49.688, -3.0)
+    if not RS274.exists():
+        pytest.skip("rs274 not available")
+    twin = tmp_path / "twin.ngc"
+    twin.write_bytes(
+        b"".join(line for line in program.splitlines(keepends=True) if not line.startswith(b"%"))
+    )
+    reference = read_canon(rs274(str(twin))[0])
+    assert same_calls(reference, mine), (reference, mine)

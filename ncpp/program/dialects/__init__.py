@@ -89,10 +89,16 @@ SNIFF_BYTES = 4096
 # (a line of megabytes would take the patterns minutes)
 _SNIFF_MOST = 2 * SNIFF_BYTES
 
-ISO = Dialect("iso", "iso", _ItemBuilder, fast_terminals=LineParser.FAST_TERMINALS, read_where_run=True)
+ISO = Dialect(
+    "iso", "iso", _ItemBuilder, fast_terminals=LineParser.FAST_TERMINALS, read_where_run=True,
+    bare_tape_marks=True,
+)  # fmt: skip
 # grbl: a line it reads as a system command (`$H`, `$100=250`) is no G code: read where it
-# runs, it reaches the interpreter as a line the grammar cannot read
-GRBL = Dialect("grbl", "iso", _ItemBuilder, fast_terminals=LineParser.FAST_TERMINALS, read_where_run=True)
+# runs, it reaches the interpreter as a line the grammar cannot read; it reads no tape marks
+# (`protocol.c`: "Program start-end percent sign NOT SUPPORTED")
+GRBL = Dialect(
+    "grbl", "iso", _ItemBuilder, fast_terminals=LineParser.FAST_TERMINALS, read_where_run=True, tape_marks=False,
+)  # fmt: skip
 FANUC = Dialect(
     "fanuc", "iso", _ItemBuilder, fast_terminals=LineParser.FAST_TERMINALS, read_where_run=True, leader=True,
     programs_after_end=True, eob_semicolon=True,
