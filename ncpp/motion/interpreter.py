@@ -1610,11 +1610,14 @@ class Interpreter:
         where the control stands in the turned frame (None: a block that turns another frame: G10 L11
         reads G59.3's, G10 L20 of another system that system's, a G92 or G10 L20 under a rotation and a
         G92 offset, which rs274ngc places apart)."""
-        code = gcodes[0][0]
-        other = code == 10.0 and (
-            words["L"][0] == 11.0 or round(words.get("P", (0.0,))[0]) not in (0, self.coord_system)
-        )
-        if other or (code != 10.0 or words["L"][0] == 20.0) and any(self.g92[:2]):
+        l_number = words["L"][0] if gcodes[0][0] == 10.0 else None  # (None: G92)
+        if (
+            l_number == 11.0
+            or l_number == 20.0
+            and round(words.get("P", (0.0,))[0]) not in (0, self.coord_system)
+        ):
+            return None
+        if l_number != 10.0 and any(self.g92[:2]):
             return None
         values = tuple((i, words[letter][0]) for i, letter in enumerate("XYZ") if letter in words)
         context = self.context()

@@ -477,7 +477,9 @@ _MOVES = re.compile(r"(STRAIGHT_TRAVERSE|STRAIGHT_FEED)\(([^)]*)\)")
 
 
 @pytest.mark.oracle
-@pytest.mark.parametrize("setting", ["G92 X0 Y0", "G10 L20 P0 X2 Y3", "G10 L10 P1 X0 Y0 Z0"])
+@pytest.mark.parametrize(
+    "setting", ["G92 X0 Y0", "G10 L20 P0 X2 Y3", "G10 L10 P1 X0 Y0 Z0", "G10 L10 P2 X0 Y0"]
+)
 @pytest.mark.parametrize("mode", ["G0", "G1 F300"])
 def test_an_offset_set_from_a_compensated_point_where_interpretation_ends_is_the_programs(
     tmp_path, setting, mode
@@ -491,7 +493,7 @@ def test_an_offset_set_from_a_compensated_point_where_interpretation_ends_is_the
         f"G20 G90 G17\nT1 M6\nG43\nG10 L2 P1 X1 Y2 Z0 R30\n{mode}\nX4 Y3 Z0.5\n"
         f"{setting}\nG10 L10 P1 X0.5\nX1 Y0\nG91 X0.5\nM2\n"
     )
-    (tmp_path / "t.tbl").write_text("T1 P1 Z0 D0.25\n")
+    (tmp_path / "t.tbl").write_text("T1 P1 Z0 D0.25\nT2 P2 Z0 D0.5\n")
     program, out, proc = _written_out(tmp_path, text)
     runs = [
         rs274.run(p, tool_table=tmp_path / "t.tbl", digits=7, home=tmp_path).stdout for p in (program, out)
