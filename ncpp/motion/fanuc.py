@@ -164,7 +164,9 @@ RETURNS = frozenset((28.0, 30.0))
 _POSITION_OFFSET = "tool position offset: the control lengthens or shortens the move by an offset value"
 FANUC_UNFOLLOWED = {("G", 45.0): f"G45 ({_POSITION_OFFSET})", ("G", 46.0): f"G46 ({_POSITION_OFFSET})",
                     ("G", 47.0): f"G47 ({_POSITION_OFFSET} twice)",
-                    ("G", 48.0): f"G48 ({_POSITION_OFFSET} twice)"}  # fmt: skip
+                    ("G", 48.0): f"G48 ({_POSITION_OFFSET} twice)",
+                    ("M", 97.0): "M97 (Haas's local subprogram call, which a Fanuc control has not: for a "
+                                 "Haas program give --dialect haas)"}  # fmt: skip
 HAAS_UNFOLLOWED = {("G", 54.1): "G54.1 (Fanuc's additional work offset; Haas selects its own with G154)",
                    ("M", 97.0): "M97 with other words in its block than P and L (a local subprogram call)",
                    ("G", 12.0): "G12 (Haas circular pocket milling, a path the control computes)",

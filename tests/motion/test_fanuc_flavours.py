@@ -55,6 +55,8 @@ def test_a_setting_with_motion_in_its_block_ends_interpretation():
     "block, reason, dialect",
     [("G154 P1", "G154 P1 (an additional work offset ncpp is not told: give --work-offset G154P1=X,Y,Z", "haas"),
      ("M97 P1000 X1.", "M97 with other words in its block", "haas"), ("G54.1 P1", "G54.1 (Fanuc's additional work offset", "haas"),
+     # (a Haas program read as Fanuc's: rs274ngc's "P word with no ..." said nothing of the call)
+     ("M97 P1000", "M97 (Haas's local subprogram call, which a Fanuc control has not: for a Haas program give --dialect haas)", "fanuc"),
      ("G54.1 P1", "G54.1 P1 (an additional work offset ncpp is not told: give --work-offset G54.1P1=", "fanuc"),
      ("G54.1 P49", "G54.1 P49 (an additional work offset ncpp is not told)", "fanuc"),
      ("G154 P3 G0 X1", "G154 with other words in its block", "haas"), ("G54.1", "G54.1 without one P", "fanuc"),

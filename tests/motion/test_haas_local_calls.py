@@ -155,10 +155,15 @@ def test_a_block_n_before_the_call_is_found_past_the_blocks_held():
     assert not warned
 
 
-@pytest.mark.parametrize("dialect", ["fanuc", "iso"])
-def test_controls_without_m97_refuse_its_p(dialect):
-    with pytest.raises(NcppError, match="P word with no"):
-        events("G0 X0\nM97 P100\nM30\nN100\nG1 X1 F100\nM99\n", dialect)
+def test_linuxcnc_refuses_m97s_p_and_fanuc_passes_the_rest_through_naming_haas():
+    program = "G0 X0\nM97 P100\nM30\nN100\nG1 X1 F100\nM99\n"
+    with pytest.raises(NcppError, match="P word with no"):  # (as rs274 does)
+        events(program, "iso")
+    stream = io.StringIO()
+    found = events(program, "fanuc", Warnings(stream=stream))
+    assert [type(e).__name__ for e in found] == ["Line"] + ["Pass"] * 5
+    assert "2:1: warning: M97 (Haas's local subprogram call" in stream.getvalue()
+    assert "give --dialect haas" in stream.getvalue()
 
 
 def compensated(tmp_path: Path, program: str, **options) -> tuple[str, str]:
