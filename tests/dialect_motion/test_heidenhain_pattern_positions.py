@@ -27,27 +27,10 @@ from ncpp.summary import REASONS
 from tests.compensation.closed_machine import ClosedMachine
 from tests.conftest import ROOT, SHARED
 from tests.dialect_motion.test_heidenhain_cycles import CYCLE_200, compensate, moves, program
-from tests.writeback.conftest import machine_file
-from tests.writeback.test_compensated_holes import REVERSAL
+from tests.writeback.test_compensated_holes import MACHINE, REVERSAL
 
 # Scales on X Y Z and squareness of X-Y (C0Y) and X-Z (B0Z): a hole's X Y depend on its height
-SCALES = machine_file(
-    "scales and squareness",
-    """
-[errors.EXX]
-kind = "polynomial"
-coefficients_um = [0.0, 0.05]
-[errors.EYY]
-kind = "polynomial"
-coefficients_um = [0.0, -0.04]
-[errors.EZZ]
-kind = "polynomial"
-coefficients_um = [0.0, 0.03]
-[squareness]
-C0Y_urad = 30.0
-B0Z_urad = 40.0
-""",
-)
+SCALES = MACHINE
 HOLES = [(250.0, 180.0), (-120.0, 300.0), (310.0, -40.0), (25.0, -7.5)]
 POSITIONS = "PATTERN DEF ~\n" + " ~\n".join(
     f"   POS{k} (X{x:+g} Y{y:+g} Z+0)" for k, (x, y) in enumerate(HOLES, 1)

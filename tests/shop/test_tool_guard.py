@@ -69,22 +69,7 @@ def _rs274(tmp_path: Path, program: Path, table: str) -> subprocess.CompletedPro
 
 
 def test_rs274_runs_the_program_with_the_told_table_and_stops_at_a_length_that_differs(tmp_path):
-    (tmp_path / "p.ngc").write_text(PROGRAM)
-    (tmp_path / "told.tbl").write_text(TABLE)
-    env = {k: v for k, v in os.environ.items() if k not in ("NCPP_MACHINE", "XDG_CONFIG_HOME")}
-    command = [
-        "compensate",
-        "--machine",
-        str(MACHINE),
-        "--work-offset",
-        "400,350,300",
-        "--tool-table",
-        "told.tbl",
-    ]
-    proc = subprocess.run([sys.executable, "-m", "ncpp", *command, "p.ngc", "-o", "out.ngc"], capture_output=True,
-                          text=True, cwd=tmp_path, env={**env, "PYTHONPATH": str(ROOT), "HOME": str(tmp_path)})  # fmt: skip
-    assert proc.returncode == 0, proc.stderr  # (verified)
-    program = tmp_path / "out.ngc"
+    program, _ = _ncpp(tmp_path, PROGRAM, TABLE)
     written = program.read_text()
     ran = _rs274(tmp_path, program, TABLE)
     assert ran.returncode == 0 and "PROGRAM_END" in ran.stdout, ran.stderr
