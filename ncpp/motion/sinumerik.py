@@ -868,6 +868,8 @@ class SinumerikInterpreter(ModalInterpreter):
                     self._approach(item.node[0].upper(), item)
                 elif what == "call" and item.node[0] == "EXTERN":
                     return []  # (it declares a subprogram's parameters)
+                elif what == "call" and item.node[0] == "CALLPATH":
+                    pass  # (the control's search path: called programs are looked for on --subroutine-path)
                 elif what == "call" and item.node[0] == "RET" and self.calls:
                     if item.node[1]:
                         raise OutOfScope("RET with parameters (a return elsewhere)", item.start + 1)

@@ -162,3 +162,14 @@ def test_pcall_of_a_program_not_found_warns_naming_it_and_the_folders(tmp_path):
     moves, warned = _moves("G0 X0 Y0\nPCALL/_N_WKS_DIR/_N_PART_WPD/HOLE(4)\nG1 X1\nM30\n", {}, tmp_path)
     assert "main:2:1: warning: call HOLE (its file not found: none of HOLE.SPF" in warned
     assert moves == [(0, 0, 1, False)]
+
+
+@pytest.mark.parametrize("callpath", ['CALLPATH("/_N_WKS_DIR/_N_PART_WPD")', "callpath()"])
+def test_callpath_moves_nothing_and_the_calls_after_it_are_followed(tmp_path, callpath):
+    """CALLPATH extends the control's search path for calls without a path (SINUMERIK One
+    Programming Manual NC programming 12/2019, 6FC5398-2EP40-0BA0, 3.4.1.4 "Search path for
+    subprogram call", step 5; `CALLPATH()` ends the extension): it moves nothing, and ncpp looks a
+    called program up on --subroutine-path as for any call by its name."""
+    files = {"HOLE.SPF": "PROC HOLE\nG1 X4 Y4 F100\nRET\n"}
+    moves, warned = _moves(f"G0 X0 Y0\n{callpath}\nHOLE\nG1 X8 Y0\nM30\n", files, tmp_path)
+    assert warned == "" and moves == [(0, 0, 1, False), (4, 4, 3, True), (8, 0, 4, False)]
