@@ -109,7 +109,11 @@ program says, and a tool table or wear that differs.
   each memory's H offsets (geometry, wear) are not cited here from a Fanuc operator's manual, nor
   is a variable of the tool in the spindle: Fanuc has no standard one, and #4120, the T code of
   the modal information, is the last T commanded (cited only from Mitsubishi's Fanuc-style M700V
-  manual, 13.5 "User Macro Specifications"), not the tool an M6 put in the spindle.
+  manual, 13.5 "User Macro Specifications"), not the tool an M6 put in the spindle.  Sources
+  other than Fanuc's do not settle the variables: they disagree on which of #2001-#2200 and
+  #2201-#2400 holds the H offsets' geometry and which their wear (the Intek M84/M86 controller's
+  User Manual, 6.2.2 "System Variables": geometry #11001 (#2201), wear #10001 (#2001); the
+  ZapCon1/KnowledgeBase repository's FanucSystemVariables.md: lengths #2001-, wear #2201-).
 * Sinumerik (Basic Functions Function Manual, 09/2011, 6FC5397-0BP40-2BA0, W1 "Tool offset",
   18.2 "Tool": "The compensation values $TC_DP1 to $TC_DP25 of the active tool compensation can be
   read with system variable $P_AD[n]"; Job Planning, 03/2006, 6FC5398-2BP10-1BA0, 8.1 "Offset
@@ -127,6 +131,13 @@ program says, and a tool table or wear that differs.
   group, with IDX 1 without oversize, 2 with the table's DL, 3 with it and TOOL CALL's DL (the
   length ncpp applies), but that group's number is not cited from a TNC 640, TNC 620 or TNC7
   manual (nor the active tool's, ID20 NR1 in the iTNC 530 HSCI's, which a TNC 640 program reads).
+  The current tool's L and DL (ID950 NR1, NR4) are cited only from the TNC 320 DIN/ISO User's
+  Manual (340 55x-04, 8.7 "Additional functions"); the TNC 620 Conversational User's Manual
+  (10/2017, 10 "Programming Q Parameters") lists that group's NR13 on, not its number.  The
+  preassigned Q114 holds "the current value for the tool length" (TNC 620 DIN/ISO User's Manual,
+  5/2013, 9.11 "Preassigned Q parameters"; in the program's unit, TNC7 User's Manual 81762x-17),
+  but is not said to include the table's and TOOL CALL's DL, as Q108's radius is said to include
+  their DR (TNC 640 DIN/ISO User's Manual, 34059x-01, 8.11 "Preassigned Q parameters").
 
 Readers of a written program drop both guards (`without_guard`): ncpp's interpreter
 does not know the control's parameters, and the guards neither move nor act.
