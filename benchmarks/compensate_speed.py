@@ -63,6 +63,7 @@ def ncpp_process_rate(
     verified (the default, as every command runs it) or not."""
     from accuracy import QUIET
 
+    import ncpp.verify  # noqa: F401  (imported here, not in the timed run: its scipy import is no work)
     from ncpp.motion.offsets import WorkOffsets
     from ncpp.pipeline import ErrorSource, process
 
