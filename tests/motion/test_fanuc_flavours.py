@@ -106,6 +106,7 @@ def test_what_fanuc_and_haas_programs_need_ncpp_is_not_told_ends_interpretation(
         (b"G81 X1 Y1 Z-1 R1 F100\nG80\nG0 X1\n", "iso"),
         # macro statements: LinuxCNC's loops and conditions are o-word lines, Sinumerik's take no brackets
         (b"#1=0\nWHILE [#1 LT 3] DO1\nG0 X#1\n#1=#1+1\nEND1\n", "fanuc"),
+        (b"#1=0\nWH[#1LT3]DO1\nG0X#1\n#1=#1+1\nEND1\n", "fanuc"),  # WH: WHILE cut to two characters
         (b"N10 IF [#1 GT 2] GOTO 30\n", "fanuc"),
         (b"WHILE R1<3\nG0 X=R1\nENDWHILE\n", "sinumerik"),
         (b"o1 while [#1 LT 3]\nG0 X#1\no1 endwhile\n", "iso"),

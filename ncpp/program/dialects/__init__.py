@@ -204,7 +204,7 @@ _HAAS_CALL = re.compile(r"(?<![\w#.])M0*97[ \t]*P[ \t]*\d", re.I)
 _FANUC = re.compile(
     r"^[ \t]*[O:]\d+[ \t]*(\(.*\))?[ \t]*\r?$|(?<![\w#.])G0*65[ \t]*P|#3000[ \t]*=|(?<![\w#.])G0*5\.1[ \t]*Q"
     r"|(?<![\w#.])G0*8[ \t]*P"
-    r"|^[ \t]*(N\d+[ \t]*)?(WHILE[ \t]*\[.*\][ \t]*DO[ \t]*\d|IF[ \t]*\[.*\][ \t]*(GOTO|THEN))",
+    r"|^[ \t]*(N\d+[ \t]*)?(WH(?:ILE)?[ \t]*\[.*\][ \t]*DO[ \t]*\d|IF[ \t]*\[.*\][ \t]*(GOTO|THEN))",
     re.M | re.I,
 )
 
