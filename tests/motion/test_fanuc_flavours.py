@@ -656,3 +656,29 @@ def test_r_wins_over_i_j_k_in_a_fanuc_arc_block(tmp_path):
     check = subprocess.run([sys.executable, str(PATHCHECK), str(meant), str(written), "--tol-mm", "0.02"],
                            capture_output=True, text=True)  # fmt: skip
     assert check.returncode == 0, check.stdout + check.stderr
+
+
+@pytest.mark.parametrize("dialect", ["fanuc", "haas"])
+def test_a_program_number_written_with_a_colon_is_the_o_number(tmp_path, dialect):
+    """`:100` is O100, the program number in ISO code's address (Fanuc 16i/18i-MB B-63684EN, "Program
+    number": in ISO code a colon may stand for the O): M98 P100 runs it; rs274 judges the LinuxCNC
+    twin, and the lines are written back as they stand."""
+    from ncpp.motion.canon import canon_call, read_canon
+    from tests.motion.test_oracle import rs274, same_calls, write_program
+
+    if not RS274.exists():
+        pytest.skip("rs274 not available")
+    head = "G21 G90 G17\nG0 X0 Y0 Z5 F300\n"
+    program = ":0001 (MAIN)\n" + head + "M98 P100\nG1 X5\nM98 P100 L2\nM30\n:100\nG91 G1 X1 Y1\nG90\nM99\n"
+    twin = head + "o100 sub\nG91 G1 X1 Y1\nG90\no100 endsub\no100 call\nG1 X5\no100 call\no100 call\nM2\n"
+    reference = read_canon(rs274(str(write_program(tmp_path, twin)))[0])
+    mine = [call for call in map(canon_call, events(program, dialect)) if call is not None]
+    assert len(mine) == len(reference) and same_calls(reference, mine), (reference, mine)
+    _, blocks = parse_program(io.BytesIO(program.encode()), "p.nc", dialect)
+    assert "".join(block.text for block in blocks) == program
+
+
+def test_a_colon_is_no_program_number_for_linuxcnc():
+    """rs274ngc refuses the `:` ("Bad character ':' used"), and so does ncpp in a LinuxCNC program."""
+    with pytest.raises(NcppError, match="':1000'"):
+        events(":1000\nG0 X1\nM2\n", "iso")

@@ -101,11 +101,11 @@ GRBL = Dialect(
 )  # fmt: skip
 FANUC = Dialect(
     "fanuc", "iso", _ItemBuilder, fast_terminals=LineParser.FAST_TERMINALS, read_where_run=True, leader=True,
-    programs_after_end=True, eob_semicolon=True,
+    programs_after_end=True, eob_semicolon=True, colon_program_numbers=True,
 )  # fmt: skip
 HAAS = Dialect(
     "haas", "iso", _ItemBuilder, fast_terminals=LineParser.FAST_TERMINALS, read_where_run=True, leader=True,
-    programs_after_end=True, eob_semicolon=True,
+    programs_after_end=True, eob_semicolon=True, colon_program_numbers=True,
 )  # fmt: skip
 # File name endings that name a dialect when the content does not tell.
 SUFFIXES = {".h": "heidenhain", ".mpf": "sinumerik", ".spf": "sinumerik"}
