@@ -96,6 +96,10 @@ def test_what_fanuc_and_haas_programs_need_ncpp_is_not_told_ends_interpretation(
         (b"o100 sub\nG0 X1\no100 endsub\nO1000\n", "iso"),  # LinuxCNC's o-words win
         (b"%\nO1000\nM97 P100 L2\nM30\nN100\nG0 X1\nM99\n", "haas"),  # Haas's local call
         (b"G21\nM97P100\nM30\n", "haas"),
+        # Haas's circular pocket milling (a Haas mill program without G187, G103, G154 or M97)
+        (b"%\nO1001\nG0 G54 X1.7 Y1.6\nG13 Z-0.3 I0.1875 K0.2 Q0.1875 D02 F10.0\n", "haas"),
+        (b"G21\nG12 I5. D1 F100\n", "iso"),  # (no Q: an older Fanuc's circle cutting reads so too)
+        (b"G21\nG12.1\nG1 X10. C0 Q1\n", "iso"),
         (b"o100 sub\nM97 P100\no100 endsub\n", "iso"),
         (b"G21\nM97\n(M97 P100)\n", "iso"),  # (no P: not the call; a comment's text is none)
         (b"G21 G90\nG0 X1 Y2 (G187 in a comment)\n", "iso"),
