@@ -149,6 +149,7 @@ from __future__ import annotations
 
 from typing import cast
 
+from ncpp.motion.expressions import vacant
 from ncpp.motion.interpreter import IGNORED_STATEMENTS, MM_PER_INCH, Interpreter, _OutOfScope, interpreting
 from ncpp.motion.offsets import ADDITIONAL, ADDITIONAL_CODES
 from ncpp.motion.segments import Event, Pass
@@ -335,13 +336,12 @@ class FanucInterpreter(Interpreter):
         Out of scope: another plane, other words in the block, a G68 under G68 or under cutter
         compensation, a G68 without R or in G91, whose angle a parameter gives or adds to (Fanuc No. 5410
         and, 15i, No. 6400 bit 0; Haas Settings 72 and 73), and one without X or Y: the control then turns
-        about where the tool stands, which compensation moves (the program's turned points with it)."""
+        about where the tool stands, which compensation moves (the program's turned points with it).  X Y R
+        may be expressions (`R#21`, `Y[#27/2]`): the manual's words take a macro's values as any word does."""
         col, name = code.start + 1, f"G{code.number}"
         others = [item for item in block.items if type(item) is not Comment and item is not code
                   and not (type(item) is Statement and item.kind in IGNORED_STATEMENTS)]  # fmt: skip
-        if any(type(item) is not Word for item in others):
-            raise _OutOfScope(f"{name} with a value from a variable", col)
-        words = cast(list[Word], others)
+        words = [word for item in others if (word := self._rotation_word(item, block, name, col)) is not None]
         if code.value == 69.0:
             if any(w.letter != "N" for w in words):
                 raise _OutOfScope("G69 with other words in its block", col)
@@ -369,6 +369,17 @@ class FanucInterpreter(Interpreter):
         self._keeping_machine(lambda: setattr(self, "g68", (given["R"], given["X"], given["Y"])))
         self.unsettled_rotation = 68.0
         return Pass(block)
+
+    def _rotation_word(self, item, block: Block, name: str, col: int) -> Word | None:
+        """A word of a G68 or G69 block, an X Y or R expression with the value it has now (None for
+        one of a vacant variable, which is no word)."""
+        if type(item) is Word:
+            return cast(Word, item)
+        if type(item) is ExprWord and item.letter in "XYR":
+            if vacant(item.expr, self.params):
+                return None
+            return Word(item.letter, self._evaluate(item.expr, block, item), "", item.start, item.end)
+        raise _OutOfScope(f"{name} with a value from a variable", col)
 
     def _additional_offset(self, block: Block, code: Word, fixed: int | None = None) -> Pass:
         """`G54.1 Pn` (Haas: `G154 Pn`; or a code that names one, `fixed`: n) with nothing else

@@ -76,7 +76,8 @@ def test_a_setting_with_motion_in_its_block_ends_interpretation():
      # a Haas macro program's rotations under G0 (their R is G68's angle, not a G0 word), which ncpp does
      # not follow (tests/compensation/test_rotation.py: those it follows)
      ("/ G68 X0. R0. ", "2:3: warning: G68 without X and Y", "haas"),
-     ("G68 X0. Y0. R#21", "2:1: warning: G68 with a value from a variable", "haas"),
+     ("G68 X0. Y0. R#21", "2:1: warning: G68 without R", "haas"),  # (#21 vacant: no R word)
+     ("G68 X0. Y0. R#21 F#1", "2:1: warning: G68 with a value from a variable", "haas"),
      ("G68 X0. Y0.", "2:1: warning: G68 without R", "fanuc")],
 )  # fmt: skip
 def test_what_fanuc_and_haas_programs_need_ncpp_is_not_told_ends_interpretation(block, reason, dialect):
