@@ -155,6 +155,12 @@ from ncpp.motion.offsets import ADDITIONAL, ADDITIONAL_CODES
 from ncpp.motion.segments import Event, Pass
 from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
 
+# Fanuc's common variables: #100-#199 cleared at power off, #500-#999 kept through it, both shared by
+# every program the control runs (Fanuc Series 16i/18i-MB operator's manual B-63684EN, "Custom macro",
+# "Variables", "Types of variables"), so one a program reads before it sets it holds what an earlier
+# program, a probe cycle or the operator left there
+COMMON_VARIABLES = frozenset(range(100, 200)) | frozenset(range(500, 1000))
+
 # G code -> the words it takes, for the settings each flavour reads past
 FANUC_SETTINGS: dict[float, frozenset[str]] = {5.1: frozenset("Q"), 8.0: frozenset("P")}
 HAAS_SETTINGS = {**FANUC_SETTINGS, 187.0: frozenset("PE"), 103.0: frozenset("P")}
@@ -199,6 +205,7 @@ _PLAIN_SIGNATURES: dict[tuple[type, str], bool] = {}
 
 class FanucInterpreter(Interpreter):
     settings: dict[float, frozenset[str]] = FANUC_SETTINGS
+    kept_variables = COMMON_VARIABLES
     unfollowed: dict[tuple[str, float], str] = FANUC_UNFOLLOWED
     additional = "G54.1"  # the code that selects an additional work offset, with P
     g54_with_p = True  # `G54 Pn` selects additional work offset n as `G54.1 Pn` does
@@ -374,7 +381,7 @@ class FanucInterpreter(Interpreter):
         """A word of a G68 or G69 block, an X Y or R expression with the value it has now (None for
         one of a vacant variable, which is no word)."""
         if type(item) is Word:
-            return cast(Word, item)
+            return item
         if type(item) is ExprWord and item.letter in "XYR":
             if vacant(item.expr, self.params):
                 return None
@@ -509,7 +516,7 @@ class HaasInterpreter(FanucInterpreter):
     # (#1000-#9999, #11000 on) are the control's (the Haas NGC manual's "System Variables" table, as
     # zappettiniconsulting.com/wiki/haas-system-variables quotes it: #10000-#10999 general-purpose,
     # r/w, #100-#999 their legacy numbers; #3020 the power-on timer, read only)
-    kept_variables = range(10000, 11000)
+    kept_variables = COMMON_VARIABLES | frozenset(range(10000, 11000))
 
 
 interpret = interpreting(FanucInterpreter)

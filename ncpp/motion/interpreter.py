@@ -309,8 +309,9 @@ class Interpreter:
     # #1000 and up are the control's system variables (Fanuc, Haas), not only where the program's flow
     # shows a Fanuc macro (`Flow`): rs274ngc numbers its parameters to #5601 and reads an unset one as 0
     fanuc_variables = False
-    # numbered variables past #1000 that are the program's own, kept from before it (Haas's #10000-)
-    kept_variables = range(0)
+    # numbered variables the control keeps from before the program (Fanuc's and Haas's common variables):
+    # read before the program sets one, its value is not ncpp's to know
+    kept_variables: frozenset[int] = frozenset()
     # G92 with S and no axis words is a spindle speed clamp (Fanuc's lathes and machining centres): the
     # refusal says so (`G92_SPEED_CLAMP`); rs274ngc has no G92 S and refuses it as a G92 without axes
     g92_speed_clamp = False

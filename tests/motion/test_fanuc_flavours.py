@@ -76,7 +76,7 @@ def test_a_setting_with_motion_in_its_block_ends_interpretation():
      # a Haas macro program's rotations under G0 (their R is G68's angle, not a G0 word), which ncpp does
      # not follow (tests/compensation/test_rotation.py: those it follows)
      ("/ G68 X0. R0. ", "2:3: warning: G68 without X and Y", "haas"),
-     ("G68 X0. Y0. R#21", "2:1: warning: G68 without R", "haas"),  # (#21 vacant: no R word)
+     ("G68 X0. Y0. R#0", "2:1: warning: G68 without R", "haas"),  # (#0 vacant: no R word)
      ("G68 X0. Y0. R#21 F#1", "2:1: warning: G68 with a value from a variable", "haas"),
      ("G68 X0. Y0.", "2:1: warning: G68 without R", "fanuc")],
 )  # fmt: skip
@@ -687,3 +687,26 @@ def test_a_colon_is_no_program_number_for_linuxcnc():
     """rs274ngc refuses the `:` ("Bad character ':' used"), and so does ncpp in a LinuxCNC program."""
     with pytest.raises(NcppError, match="':1000'"):
         events(":1000\nG0 X1\nM2\n", "iso")
+
+
+@pytest.mark.parametrize("dialect", ["fanuc", "haas"])
+@pytest.mark.parametrize("variable", [100, 199, 500, 999])
+def test_a_common_variable_reads_only_what_the_program_set(dialect, variable):
+    """#100-#199 and #500-#999 are common variables (Fanuc 16i/18i-MB B-63684EN, "Custom macro", "Types of
+    variables": #500 on kept at power off): read before the program sets one, it holds what an earlier
+    program, a probe cycle or the operator left there, so the move it gives is out of scope (it was
+    read as 0, and `G1 X#500` rewritten as a move to X0); set first, it is followed."""
+    said = io.StringIO()
+    found = events(f"G0 X1\nG1 X#{variable} F100\nG0 X2\nM30\n", dialect, Warnings(stream=said))
+    assert [type(e) for e in found] == [Line, Pass, Pass, Pass], said.getvalue()
+    assert (
+        f"2:4: warning: #{variable}, a variable the control keeps from before the program" in said.getvalue()
+    )
+    found = events(f"#{variable}=5.\nG0 X1\nG1 X#{variable} F100\nM30\n", dialect)
+    assert [e.end[0] for e in found if type(e) is Line] == [1.0, 5.0]
+
+
+def test_a_linuxcnc_programs_parameter_500_reads_as_rs274_reads_it():
+    """In a LinuxCNC program #500 is a parameter rs274ngc reads as 0 until set (its parameter file aside)."""
+    found = events("G0 X1\nG1 X#500 F100\nM2\n", "iso")
+    assert [e.end[0] for e in found if type(e) is Line] == [1.0, 0.0]
