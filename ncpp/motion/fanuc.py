@@ -118,6 +118,12 @@ intermediate point and restores it after the return (NCT 2000M manual, "The Tool
 control that follows Fanuc's compensation C; Fanuc 15i-MA, "Cutter compensation C"), which ncpp does
 not follow.  LinuxCNC refuses it ("Cannot use g28 or g30 with cutter radius comp").
 
+So is a G41 or G42 while compensation is on: these controls take it in offset mode and build the
+offset vector anew at that block (Fanuc 16i/18i-MB B-63684EN, "Cutter compensation C", its details
+of the offset mode: a change of the offset direction, or the same direction specified again; Haas
+Mill Operator's Manual, "G41 2D Cutter Compensation Left"), which ncpp does not follow.  LinuxCNC
+refuses it ("Cannot turn cutter radius comp on when on").
+
 Macro B's external output statements, `POPEN`, `DPRNT[..]`, `BPRNT[..]` and `PCLOS`, send a line of text and
 values to a printer or a PC (NCT 2000M manual, "Custom Macro": `DPRNT[ a #b [ c d ] ... ]`, characters,
 variables and their digits before and after the point; Allen-Bradley 8520 manual, "Paramacros": `BPRNT[s
@@ -217,6 +223,7 @@ class FanucInterpreter(Interpreter):
     cycles_own_group = True  # G80 leaves the G0-G3 mode before the cycle in effect (module docstring)
     back_bore_holes = False  # G87 reads R Z Q K otherwise than rs274ngc (`Interpreter.back_bore_holes`)
     returns_under_comp = True  # G28/G30 under G41/G42: out of scope (module docstring)
+    comp_again = True  # G41/G42 under G41/G42: out of scope (module docstring)
     external_output = True  # POPEN, DPRNT[..], BPRNT[..], PCLOS pass through (module docstring)
     repeats_in_p = True  # `M98 P51002`: O1002 five times (`Flow._m98`)
     main_after_subprograms = True  # subprograms before the main program in a file (`Flow._stored_first`)

@@ -710,3 +710,20 @@ def test_a_linuxcnc_programs_parameter_500_reads_as_rs274_reads_it():
     """In a LinuxCNC program #500 is a parameter rs274ngc reads as 0 until set (its parameter file aside)."""
     found = events("G0 X1\nG1 X#500 F100\nM2\n", "iso")
     assert [e.end[0] for e in found if type(e) is Line] == [1.0, 0.0]
+
+
+@pytest.mark.parametrize("dialect", ["fanuc", "haas"])
+def test_g41_again_while_compensation_is_on_ends_interpretation(dialect):
+    """A second G41 in the offset mode (a finish pass's, Haas turner's cube `O3001`) is the control's to
+    take, its offset vector built anew (module docstring of ncpp/motion/fanuc.py): out of scope at its
+    word, where rs274ngc's "Cannot turn cutter radius comp on when on" refused the program."""
+    said = io.StringIO()
+    text = "G0 X-10 Y0 Z1\nG1 Z0 F100\nG41 X0 Y0\nX10\nG41 X20 Y1\nG40 X30\nM30\n"
+    found = events(text, dialect, Warnings(stream=said))
+    assert [type(e) for e in found][4:] == [Pass, Pass, Pass], said.getvalue()
+    assert "5:1: warning: G41 while cutter compensation is on" in said.getvalue(), said.getvalue()
+
+
+def test_g41_again_is_refused_in_a_linuxcnc_program():
+    with pytest.raises(NcppError, match="Cannot turn cutter radius comp on when on"):
+        events("G0 X-10 Y0 Z1\nG1 Z0 F100\nG41 X0 Y0\nX10\nG41 X20 Y1\nG40 X30\nM2\n", "iso")
