@@ -376,7 +376,7 @@ class Flow:
         main = self.frames[0]
         block: Block | None
         self._read_ahead()
-        if self.fanuc:
+        if self.fanuc or self.parameters.fanuc:  # (a macro program, or any read as Fanuc's or Haas's)
             self.parameters.start_fanuc()
         if self.main_after_subprograms:
             yield from self._stored_first()

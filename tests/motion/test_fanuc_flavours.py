@@ -727,3 +727,12 @@ def test_g41_again_while_compensation_is_on_ends_interpretation(dialect):
 def test_g41_again_is_refused_in_a_linuxcnc_program():
     with pytest.raises(NcppError, match="Cannot turn cutter radius comp on when on"):
         events("G0 X-10 Y0 Z1\nG1 Z0 F100\nG41 X0 Y0\nX10\nG41 X20 Y1\nG40 X30\nM2\n", "iso")
+
+
+@pytest.mark.parametrize("dialect", ["fanuc", "haas"])
+def test_a_local_variable_the_program_has_not_set_is_vacant(dialect):
+    """A Fanuc or Haas program's local variables start vacant (B-63684EN, "Custom macro", "Variables"), and
+    an address whose value is a vacant variable is left out: `G1 X#21 Y5` with #21 unset moves Y alone,
+    where it was read as X0 in a program without a macro statement."""
+    found = events("G0 X1 Y1\nG1 X#21 Y5 F100\nM30\n", dialect)
+    assert [tuple(e.end) for e in found if type(e) is Line] == [(1.0, 1.0, 0.0), (1.0, 5.0, 0.0)]
