@@ -351,7 +351,8 @@ class FanucInterpreter(Interpreter):
         compensation, a G68 without R or in G91, whose angle a parameter gives or adds to (Fanuc No. 5410
         and, 15i, No. 6400 bit 0; Haas Settings 72 and 73), and one without X or Y: the control then turns
         about where the tool stands, which compensation moves (the program's turned points with it).  X Y R
-        may be expressions (`R#21`, `Y[#27/2]`): the manual's words take a macro's values as any word does."""
+        may be expressions (`R#21`, `Y[#27/2]`): the manual's words take a macro's values as any word does;
+        but not under --expand, which writes the G68 block's text where its variables are no longer set."""
         col, name = code.start + 1, f"G{code.number}"
         others = [item for item in block.items if type(item) is not Comment and item is not code
                   and not (type(item) is Statement and item.kind in IGNORED_STATEMENTS)]  # fmt: skip
@@ -389,7 +390,9 @@ class FanucInterpreter(Interpreter):
         one of a vacant variable, which is no word)."""
         if type(item) is Word:
             return item
-        if type(item) is ExprWord and item.letter in "XYR":
+        if (
+            type(item) is ExprWord and item.letter in "XYR" and self.expansion is None
+        ):  # (written out: its text)
             if vacant(item.expr, self.params):
                 return None
             return Word(item.letter, self._evaluate(item.expr, block, item), "", item.start, item.end)

@@ -736,3 +736,21 @@ def test_a_local_variable_the_program_has_not_set_is_vacant(dialect):
     where it was read as X0 in a program without a macro statement."""
     found = events("G0 X1 Y1\nG1 X#21 Y5 F100\nM30\n", dialect)
     assert [tuple(e.end) for e in found if type(e) is Line] == [(1.0, 1.0, 0.0), (1.0, 5.0, 0.0)]
+
+
+def test_expand_keeps_a_g68_of_variables_out_of_scope(tmp_path):
+    """Written out, a loop's assignments go and the G68 block's text stays: `R#21` would read what the
+    written program no longer sets, so --expand leaves the scope at it, where without --expand the loop
+    is left as programmed and the rotation followed."""
+    program = tmp_path / "p.nc"
+    program.write_text("%\nO1\nG21 G90 G54\nG0 X0 Y0 Z5\n#21=0\n#1=0\nWHILE [#1 LT 2] DO1\nG68 X0 Y0 R#21\n"
+                       "G0 X10 Y0\nG1 Z-1 F100\nG0 Z5\nG69\n#21=#21+90\n#1=#1+1\nEND1\nM30\n%\n")  # fmt: skip
+    machine = SHARED / "machines" / "wide.toml"
+    run = [sys.executable, "-m", "ncpp", "compensate", "--machine", str(machine), "--no-guard", str(program)]
+    for expand, said in (
+        ([], "left as programmed: 6 moves in loops"),
+        (["--expand"], "--expand: G68 with a value"),
+    ):
+        proc = subprocess.run([*run, "-o", str(tmp_path / "out.nc"), *expand], capture_output=True, text=True,
+                              cwd=ROOT, timeout=300)  # fmt: skip
+        assert said in proc.stderr, proc.stderr
