@@ -119,6 +119,7 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
         ),
         "motion/test_corner_rounding.py": ("test_compensated_corners_are_plain_arcs_linuxcnc_accepts",),
         "motion/test_fanuc_flavours.py": (
+            "test_a_program_number_written_with_a_colon_is_the_o_number",
             "test_g0_in_a_return_block_is_the_modal_motion_after_it",
             "test_haas_peck_holes_are_rs274s_of_the_cycle_without_p",
             "test_an_r_arc_that_ends_where_it_starts_passes_through_and_rs274_judges_the_rest",
@@ -192,6 +193,7 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
         "compensation/test_several_programs.py": ("test_one_process_does_the_same",),
         "compensation/test_rotation.py": (
             "test_the_programmed_points_are_reached_under_g68_within_half_a_micron",
+            "test_a_g68_of_variables_turns_as_their_values_do",
             "test_a_safety_lines_cancels_of_modes_not_in_effect_change_nothing",
         ),
         "shop/test_extents.py": None,  # (each runs the command line)
@@ -202,6 +204,7 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_a_fusion_drilling_program_with_axis_words_after_g80_is_compensated_as_fanuc",
             "test_a_haas_peck_cycle_with_p_is_compensated_with_its_p_and_verified",
             "test_external_output_passes_through_the_compensated_program",
+            "test_expand_keeps_a_g68_of_variables_out_of_scope",
         ),
         "compensation/test_cutter_comp_accuracy.py": (
             "test_a_z_move_under_compensation_keeps_the_tool_centre_where_it_stands",

@@ -158,7 +158,7 @@ class Parameters:
         self.fanuc = False  # a Fanuc program: #1000 and up are the control's system variables
         self.fanuc_system = fanuc_system  # those the interpreter knows (None: not known)
         self.control = control  # LinuxCNC's machine-state parameters the interpreter knows (None: not known)
-        self.kept: range = range(0)  # general-purpose variables past #1000 (Haas's), set before the program
+        self.kept: frozenset[int] = frozenset()  # the control's common variables, set before the program
         self.unknown: dict[int | str, str] = {}  # parameters set from a value ncpp cannot know: whence
         self.journal: Journal | None = None  # the writes a loop's check follows (`endless.py`)
 

@@ -118,6 +118,12 @@ intermediate point and restores it after the return (NCT 2000M manual, "The Tool
 control that follows Fanuc's compensation C; Fanuc 15i-MA, "Cutter compensation C"), which ncpp does
 not follow.  LinuxCNC refuses it ("Cannot use g28 or g30 with cutter radius comp").
 
+So is a G41 or G42 while compensation is on: these controls take it in offset mode and build the
+offset vector anew at that block (Fanuc 16i/18i-MB B-63684EN, "Cutter compensation C", its details
+of the offset mode: a change of the offset direction, or the same direction specified again; Haas
+Mill Operator's Manual, "G41 2D Cutter Compensation Left"), which ncpp does not follow.  LinuxCNC
+refuses it ("Cannot turn cutter radius comp on when on").
+
 Macro B's external output statements, `POPEN`, `DPRNT[..]`, `BPRNT[..]` and `PCLOS`, send a line of text and
 values to a printer or a PC (NCT 2000M manual, "Custom Macro": `DPRNT[ a #b [ c d ] ... ]`, characters,
 variables and their digits before and after the point; Allen-Bradley 8520 manual, "Paramacros": `BPRNT[s
@@ -149,10 +155,17 @@ from __future__ import annotations
 
 from typing import cast
 
+from ncpp.motion.expressions import vacant
 from ncpp.motion.interpreter import IGNORED_STATEMENTS, MM_PER_INCH, Interpreter, _OutOfScope, interpreting
 from ncpp.motion.offsets import ADDITIONAL, ADDITIONAL_CODES
 from ncpp.motion.segments import Event, Pass
 from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
+
+# Fanuc's common variables: #100-#199 cleared at power off, #500-#999 kept through it, both shared by
+# every program the control runs (Fanuc Series 16i/18i-MB operator's manual B-63684EN, "Custom macro",
+# "Variables", "Types of variables"), so one a program reads before it sets it holds what an earlier
+# program, a probe cycle or the operator left there
+COMMON_VARIABLES = frozenset(range(100, 200)) | frozenset(range(500, 1000))
 
 # G code -> the words it takes, for the settings each flavour reads past
 FANUC_SETTINGS: dict[float, frozenset[str]] = {5.1: frozenset("Q"), 8.0: frozenset("P")}
@@ -198,6 +211,7 @@ _PLAIN_SIGNATURES: dict[tuple[type, str], bool] = {}
 
 class FanucInterpreter(Interpreter):
     settings: dict[float, frozenset[str]] = FANUC_SETTINGS
+    kept_variables = COMMON_VARIABLES
     unfollowed: dict[tuple[str, float], str] = FANUC_UNFOLLOWED
     additional = "G54.1"  # the code that selects an additional work offset, with P
     g54_with_p = True  # `G54 Pn` selects additional work offset n as `G54.1 Pn` does
@@ -209,6 +223,7 @@ class FanucInterpreter(Interpreter):
     cycles_own_group = True  # G80 leaves the G0-G3 mode before the cycle in effect (module docstring)
     back_bore_holes = False  # G87 reads R Z Q K otherwise than rs274ngc (`Interpreter.back_bore_holes`)
     returns_under_comp = True  # G28/G30 under G41/G42: out of scope (module docstring)
+    comp_again = True  # G41/G42 under G41/G42: out of scope (module docstring)
     external_output = True  # POPEN, DPRNT[..], BPRNT[..], PCLOS pass through (module docstring)
     repeats_in_p = True  # `M98 P51002`: O1002 five times (`Flow._m98`)
     main_after_subprograms = True  # subprograms before the main program in a file (`Flow._stored_first`)
@@ -335,13 +350,13 @@ class FanucInterpreter(Interpreter):
         Out of scope: another plane, other words in the block, a G68 under G68 or under cutter
         compensation, a G68 without R or in G91, whose angle a parameter gives or adds to (Fanuc No. 5410
         and, 15i, No. 6400 bit 0; Haas Settings 72 and 73), and one without X or Y: the control then turns
-        about where the tool stands, which compensation moves (the program's turned points with it)."""
+        about where the tool stands, which compensation moves (the program's turned points with it).  X Y R
+        may be expressions (`R#21`, `Y[#27/2]`): the manual's words take a macro's values as any word does;
+        but not under --expand, which writes the G68 block's text where its variables are no longer set."""
         col, name = code.start + 1, f"G{code.number}"
         others = [item for item in block.items if type(item) is not Comment and item is not code
                   and not (type(item) is Statement and item.kind in IGNORED_STATEMENTS)]  # fmt: skip
-        if any(type(item) is not Word for item in others):
-            raise _OutOfScope(f"{name} with a value from a variable", col)
-        words = cast(list[Word], others)
+        words = [word for item in others if (word := self._rotation_word(item, block, name, col)) is not None]
         if code.value == 69.0:
             if any(w.letter != "N" for w in words):
                 raise _OutOfScope("G69 with other words in its block", col)
@@ -369,6 +384,19 @@ class FanucInterpreter(Interpreter):
         self._keeping_machine(lambda: setattr(self, "g68", (given["R"], given["X"], given["Y"])))
         self.unsettled_rotation = 68.0
         return Pass(block)
+
+    def _rotation_word(self, item, block: Block, name: str, col: int) -> Word | None:
+        """A word of a G68 or G69 block, an X Y or R expression with the value it has now (None for
+        one of a vacant variable, which is no word)."""
+        if type(item) is Word:
+            return item
+        if (
+            type(item) is ExprWord and item.letter in "XYR" and self.expansion is None
+        ):  # (written out: its text)
+            if vacant(item.expr, self.params):
+                return None
+            return Word(item.letter, self._evaluate(item.expr, block, item), "", item.start, item.end)
+        raise _OutOfScope(f"{name} with a value from a variable", col)
 
     def _additional_offset(self, block: Block, code: Word, fixed: int | None = None) -> Pass:
         """`G54.1 Pn` (Haas: `G154 Pn`; or a code that names one, `fixed`: n) with nothing else
@@ -498,7 +526,7 @@ class HaasInterpreter(FanucInterpreter):
     # (#1000-#9999, #11000 on) are the control's (the Haas NGC manual's "System Variables" table, as
     # zappettiniconsulting.com/wiki/haas-system-variables quotes it: #10000-#10999 general-purpose,
     # r/w, #100-#999 their legacy numbers; #3020 the power-on timer, read only)
-    kept_variables = range(10000, 11000)
+    kept_variables = COMMON_VARIABLES | frozenset(range(10000, 11000))
 
 
 interpret = interpreting(FanucInterpreter)

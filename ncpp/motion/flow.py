@@ -53,7 +53,8 @@ Fanuc macro B runs here too (the Fanuc operator's manuals, Series 16i/18i B-6368
   sequence number Nn, searched forward from the jump, then from the program's (or the
   subprogram's) top; a number 1-99999 that is there, else the control alarms; a subprogram's
   search goes on past its first M99 to the next program number or `%` (`_rest_of_program`);
-* `WHILE [cond] DOm` ... `ENDm`, m = 1, 2 or 3: the body runs while the condition
+* `WHILE [cond] DOm` ... `ENDm`, m = 1, 2 or 3 (`WH` for `WHILE`: Series 0i-D B-64304EN,
+  "Abbreviations of custom macro words"): the body runs while the condition
   holds, loops nest (each its own m) and do not cross (else alarms); a GOTO may
   leave a loop, not enter one;
 * `G65 P<n> L<count> <arguments>` calls `O<n>` as a macro (`_g65`): a new level of local
@@ -375,7 +376,7 @@ class Flow:
         main = self.frames[0]
         block: Block | None
         self._read_ahead()
-        if self.fanuc:
+        if self.fanuc or self.parameters.fanuc:  # (a macro program, or any read as Fanuc's or Haas's)
             self.parameters.start_fanuc()
         if self.main_after_subprograms:
             yield from self._stored_first()

@@ -290,6 +290,9 @@ class Interpreter:
     # G28/G30 under cutter compensation (Fanuc: the offset is dropped at the intermediate point and
     # restored after the return): not followed, out of scope; rs274ngc refuses it
     returns_under_comp = False
+    # G41/G42 while compensation is on renews the offset vector (Fanuc, Haas): out of scope there;
+    # rs274ngc refuses it
+    comp_again = False
     # Macro B's external output (POPEN, DPRNT[..], BPRNT[..], PCLOS: Fanuc, Haas) moves nothing and
     # passes through; rs274ngc refuses it
     external_output = False
@@ -309,8 +312,9 @@ class Interpreter:
     # #1000 and up are the control's system variables (Fanuc, Haas), not only where the program's flow
     # shows a Fanuc macro (`Flow`): rs274ngc numbers its parameters to #5601 and reads an unset one as 0
     fanuc_variables = False
-    # numbered variables past #1000 that are the program's own, kept from before it (Haas's #10000-)
-    kept_variables = range(0)
+    # numbered variables the control keeps from before the program (Fanuc's and Haas's common variables):
+    # read before the program sets one, its value is not ncpp's to know
+    kept_variables: frozenset[int] = frozenset()
     # G92 with S and no axis words is a spindle speed clamp (Fanuc's lathes and machining centres): the
     # refusal says so (`G92_SPEED_CLAMP`); rs274ngc has no G92 S and refuses it as a G92 without axes
     g92_speed_clamp = False
@@ -1443,6 +1447,8 @@ class Interpreter:
                 self._fail("Cannot change planes with cutter radius compensation on", block, gcodes[2][1])
         code, item = gcodes.get(7, (None, None))
         if code is not None and code != 40.0 and self.cutter_comp is not None:
+            if self.comp_again:
+                raise _OutOfScope(f"G{code:g} while cutter compensation is on", item.start + 1)
             self._fail("Cannot turn cutter radius comp on when on", block, item)
         if code == 40.0 or (code is None and self.cutter_comp is None):
             return  # off from this line's G40 on

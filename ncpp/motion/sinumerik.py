@@ -192,7 +192,11 @@ RUNS_OTHERS = frozenset(("endwhile", "endfor", "until", "endloop", "goto", "case
 # PROC attributes that change nothing the motion depends on: the display and single-block
 # behaviour of the subprogram's blocks (SAVE, which restores the caller's modal state, is not followed)
 HARMLESS_PROC_ATTRIBUTES = frozenset(("DISPLOF", "DISPLON", "SBLOF", "SBLON", "ACTBLOCNO"))
-_R_PARAMETER = re.compile(r"r\d+")  # the channel's R parameters: shared by every program level
+# the channel's R parameters: shared by every program level, and by every program the channel runs
+# (SINUMERIK 840C installation guide, NC setting data, "R parameters": R100-R199 "memory for data which
+# must be accessible for the main programs and subroutines", R110-R199 the measuring cycles' results),
+# so one a program reads before it sets it holds an earlier program's value, not 0
+_R_PARAMETER = re.compile(r"r\d+")
 # `_N_MYSUB_SPF`, `MYSUB_SPF`: a name with the control's own prefix and type (all are the same program)
 _CONTROL_NAME = re.compile(r"(?:_N_)?(\w+?)(?:_(SPF|MPF))?", re.I)
 # The types a parameter by reference (VAR) is followed for: a scalar's, an array's
@@ -690,8 +694,9 @@ class SinumerikInterpreter(ModalInterpreter):
         if value is _FROM_THE_CALLER:
             raise OutOfScope(f"the parameter {name.upper()} (its value comes from the caller)")
         if value is None:
-            if name[0] == "r" and name[1:].isdigit():
-                return 0.0  # R parameters exist on every control, zero until set
+            if name[0] == "r" and name[1:].isdigit():  # (`_R_PARAMETER`: not 0, what is left there)
+                raise OutOfScope(f"the R parameter {name.upper()} (not set in the program: it holds what an "
+                                 "earlier program or a measuring cycle left in the channel)")  # fmt: skip
             raise OutOfScope(f"the variable {name.upper()} (not defined in the program)")
         if isinstance(value, str):
             raise OutOfScope(f"the string variable {name.upper()} in arithmetic")

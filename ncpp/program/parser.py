@@ -219,6 +219,8 @@ class Dialect:
     its line (`% vfd enable`, `%(note)`) is a bad character where it runs, as rs274ngc reads it.
     `tape_marks`: the controls take `%` lines for the program's start and end; without them (grbl)
     every `%` line is a stray one and no text after a `%` goes unread.
+    `colon_program_numbers`: a block that starts with `:` and a number is a program number, `:1000` read
+    as `O1000` (the ISO code's program number address; `_colon_as_o`).
     """
 
     name: str
@@ -234,6 +236,7 @@ class Dialect:
     eob_semicolon: bool = False  # `;` is the end of block as the control shows it (`_words_after_eob`)
     bare_tape_marks: bool = False  # a `%` with more on its line is no tape mark (rs274ngc)
     tape_marks: bool = True  # `%` lines mark the program's start and end (not grbl's)
+    colon_program_numbers: bool = False  # `:1000` is the program number O1000 (`_colon_as_o`)
 
 
 def dialect_syntax(dialect: str | Dialect) -> Dialect:
@@ -275,6 +278,18 @@ def _refuse_cr_line_ends(raw: str, line: int, file: str) -> None:
 
 # A word's start (a letter, then a number, a parameter or a bracket) after a `;`, past blanks and
 # parenthesised comments
+# A program number written with ISO code's address `:` (`:1000`, `:1000 (PART)`)
+_COLON_NUMBER = re.compile(r"^([ \t]*):(?=[ \t]*\d)")
+
+
+def _colon_as_o(block: Block, raw: str) -> Block:
+    """The block `O1000` read for a line `:1000`, with the line's own text.  Fanuc's program number
+    address is O in EIA code, and in ISO code a colon may stand for the O (Fanuc Series 16i/18i-MB
+    operator's manual B-63684EN, "Program configuration", "Program number"); Haas's controls read
+    Fanuc's programs.  LinuxCNC refuses the colon (rs274ngc: "Bad character ':' used")."""
+    return Block(raw, block.eol, block.items, block.line, block.verbatim, block.signature, block.layout)
+
+
 _WORD_AFTER_EOB = re.compile(r"(?:[ \t]|\([^)]*\))*([A-Za-z][ \t]*[-+]?[ \t]*[0-9.#\[])")
 
 
@@ -360,6 +375,8 @@ class LineParser:
     def parse(self, raw: str, eol: str = "", line: int = 0, file: str = "<stdin>") -> Block:
         if len(raw) > self.dialect.max_line:
             _refuse_long(raw, self.dialect, line, file)
+        if self.dialect.colon_program_numbers and _COLON_NUMBER.match(raw):
+            return _colon_as_o(self.parse(_COLON_NUMBER.sub(r"\1O", raw, count=1), eol, line, file), raw)
         plain = self._scan_plain(raw)
         if plain is None:
             block = Block(raw, eol, self._read_lalr(raw, line, file), line)

@@ -318,11 +318,11 @@ def fanuc_end_points(text: str) -> np.ndarray:
     return np.array(ends)
 
 
-def fanuc_written(tmp_path: Path, dialect: str = "fanuc") -> tuple[Path, Path]:
+def fanuc_written(tmp_path: Path, dialect: str = "fanuc", text: str = FANUC) -> tuple[Path, Path]:
     """The Fanuc program and ncpp's compensation of it for AFFINE's machine, G54 at ZERO."""
     (tmp_path / "affine.toml").write_text(AFFINE)
     program, out = tmp_path / "turned.nc", tmp_path / "turned.out.nc"
-    program.write_text(FANUC)
+    program.write_text(text)
     zero = ",".join(f"{v:g}" for v in ZERO)
     proc = subprocess.run([sys.executable, "-m", "ncpp", "compensate", "--dialect", dialect, "--machine",
                            str(tmp_path / "affine.toml"), "--work-offset", zero, "--tolerance", "0.0001",
@@ -342,6 +342,20 @@ def test_the_programmed_points_are_reached_under_g68_within_half_a_micron(tmp_pa
     assert len(wanted) == 15
     assert misses(closed_form(wanted), wanted.tolist()).max() > 0.010
     assert misses(closed_form(fanuc_end_points(out.read_text())), wanted.tolist()).max() < 0.0005
+
+
+@pytest.mark.parametrize("dialect", ["fanuc", "haas"])
+def test_a_g68_of_variables_turns_as_their_values_do(tmp_path, dialect):
+    """`G68 X#1 Y[#2] R#3` turns as `G68 X30 Y20 R25` (a word takes a macro variable's value: Fanuc
+    16/18-MC operator's manual, "Custom macro", "Referencing variables"): with the values written in
+    for the judge, every programmed point is reached within 0.5 µm."""
+    turned = FANUC.replace("G68 X30 Y20 R25", "#1=30.\n#2=20.\n#3=25.\nG68 X#1 Y[#2] R#3")
+    _, out = fanuc_written(tmp_path, dialect, turned)
+    written = out.read_text()
+    assert "G68 X#1 Y[#2] R#3" in written
+    wanted = fanuc_end_points(FANUC)
+    got = fanuc_end_points(written.replace("G68 X#1 Y[#2] R#3", "G68 X30 Y20 R25"))
+    assert misses(closed_form(got), wanted.tolist()).max() < 0.0005
 
 
 def as_linuxcnc(text: str) -> str:

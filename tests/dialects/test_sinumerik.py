@@ -427,3 +427,29 @@ def test_settings_cam_posts_write_and_defined_variables_are_followed():
     assert "outside" not in said, said
     ends = [e.end for e in events if type(e) is Line]
     assert ends[-2:] == [(4.0, 0.0, -3.0), (8.0, 0.0, -3.0)]
+
+
+def test_an_r_parameter_read_before_the_program_sets_it_is_out_of_scope():
+    """The channel's R parameters hold what an earlier program or a measuring cycle left there (840C
+    installation guide, NC setting data, "R parameters"): `G1 X=R1`, R1 unset, ends interpretation at its
+    block, where it was read as 0 (and rewritten as a move to X0); set first, it is followed."""
+    from ncpp.errors import Warnings
+    from ncpp.motion.segments import Line, Pass
+    from ncpp.pipeline import dialect_tools
+    from ncpp.program.dialects import parse_program
+
+    run, _ = dialect_tools("sinumerik")
+    for head, ends in (("", None), ("R1=4\n", 4.0)):
+        said = io.StringIO()
+        text = "G17 G90 G54\nG0 X10 Y10 Z5\n" + head + "G1 X=R1 F100\nM30\n"
+        _, blocks = parse_program(io.BytesIO(text.encode()), "p.mpf", "sinumerik")
+        moves = [
+            e for e in run(blocks, file="p.mpf", warnings=Warnings(stream=said)) if type(e) in (Line, Pass)
+        ]
+        if ends is None:
+            assert "3:4: warning: the R parameter R1 (not set in the program" in said.getvalue(), (
+                said.getvalue()
+            )
+            assert [type(e) for e in moves][-2:] == [Pass, Pass]
+        else:
+            assert [e.end[0] for e in moves if type(e) is Line][-1] == ends

@@ -235,10 +235,11 @@ def _klartext(text: str) -> list:
 
 SINUMERIK_HEAD = "G17 G90 G71 F200\nG0 X0 Y0 Z5\n"
 ENDLESS_SINUMERIK = {
-    "LOOP ... ENDLOOP": ("LOOP\nG1 X10 Y10\nIF R9>0\nM30\nENDIF\nG1 X0 Y0\nENDLOOP\nM30\n", 9, 4),
-    "WHILE 1": ("R1=0\nWHILE R1<5\nG1 X10\nR2=R2*0\nENDWHILE\nM30\n", 7, 4),
-    "REPEAT ... UNTIL 0": ("REPEAT\nG1 X10\nG1 X0\nUNTIL R1>0\nM30\n", 6, 4),
-    "GOTOB": ("BACK:\nR1=1-R1\nG1 X=R1*10\nGOTOB BACK\nM30\n", 6, 3),
+    # (the R parameters the loops read set first: one read before the program sets it is out of scope)
+    "LOOP ... ENDLOOP": ("R9=0\nLOOP\nG1 X10 Y10\nIF R9>0\nM30\nENDIF\nG1 X0 Y0\nENDLOOP\nM30\n", 10, 5),
+    "WHILE 1": ("R1=0 R2=0\nWHILE R1<5\nG1 X10\nR2=R2*0\nENDWHILE\nM30\n", 7, 4),
+    "REPEAT ... UNTIL 0": ("R1=0\nREPEAT\nG1 X10\nG1 X0\nUNTIL R1>0\nM30\n", 7, 5),
+    "GOTOB": ("R1=0\nBACK:\nR1=1-R1\nG1 X=R1*10\nGOTOB BACK\nM30\n", 7, 4),
 }
 
 

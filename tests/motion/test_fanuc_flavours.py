@@ -76,7 +76,8 @@ def test_a_setting_with_motion_in_its_block_ends_interpretation():
      # a Haas macro program's rotations under G0 (their R is G68's angle, not a G0 word), which ncpp does
      # not follow (tests/compensation/test_rotation.py: those it follows)
      ("/ G68 X0. R0. ", "2:3: warning: G68 without X and Y", "haas"),
-     ("G68 X0. Y0. R#21", "2:1: warning: G68 with a value from a variable", "haas"),
+     ("G68 X0. Y0. R#0", "2:1: warning: G68 without R", "haas"),  # (#0 vacant: no R word)
+     ("G68 X0. Y0. R#21 F#1", "2:1: warning: G68 with a value from a variable", "haas"),
      ("G68 X0. Y0.", "2:1: warning: G68 without R", "fanuc")],
 )  # fmt: skip
 def test_what_fanuc_and_haas_programs_need_ncpp_is_not_told_ends_interpretation(block, reason, dialect):
@@ -96,6 +97,10 @@ def test_what_fanuc_and_haas_programs_need_ncpp_is_not_told_ends_interpretation(
         (b"o100 sub\nG0 X1\no100 endsub\nO1000\n", "iso"),  # LinuxCNC's o-words win
         (b"%\nO1000\nM97 P100 L2\nM30\nN100\nG0 X1\nM99\n", "haas"),  # Haas's local call
         (b"G21\nM97P100\nM30\n", "haas"),
+        # Haas's circular pocket milling (a Haas mill program without G187, G103, G154 or M97)
+        (b"%\nO1001\nG0 G54 X1.7 Y1.6\nG13 Z-0.3 I0.1875 K0.2 Q0.1875 D02 F10.0\n", "haas"),
+        (b"G21\nG12 I5. D1 F100\n", "iso"),  # (no Q: an older Fanuc's circle cutting reads so too)
+        (b"G21\nG12.1\nG1 X10. C0 Q1\n", "iso"),
         (b"o100 sub\nM97 P100\no100 endsub\n", "iso"),
         (b"G21\nM97\n(M97 P100)\n", "iso"),  # (no P: not the call; a comment's text is none)
         (b"G21 G90\nG0 X1 Y2 (G187 in a comment)\n", "iso"),
@@ -106,6 +111,7 @@ def test_what_fanuc_and_haas_programs_need_ncpp_is_not_told_ends_interpretation(
         (b"G81 X1 Y1 Z-1 R1 F100\nG80\nG0 X1\n", "iso"),
         # macro statements: LinuxCNC's loops and conditions are o-word lines, Sinumerik's take no brackets
         (b"#1=0\nWHILE [#1 LT 3] DO1\nG0 X#1\n#1=#1+1\nEND1\n", "fanuc"),
+        (b"#1=0\nWH[#1LT3]DO1\nG0X#1\n#1=#1+1\nEND1\n", "fanuc"),  # WH: WHILE cut to two characters
         (b"N10 IF [#1 GT 2] GOTO 30\n", "fanuc"),
         (b"WHILE R1<3\nG0 X=R1\nENDWHILE\n", "sinumerik"),
         (b"o1 while [#1 LT 3]\nG0 X#1\no1 endwhile\n", "iso"),
@@ -655,3 +661,96 @@ def test_r_wins_over_i_j_k_in_a_fanuc_arc_block(tmp_path):
     check = subprocess.run([sys.executable, str(PATHCHECK), str(meant), str(written), "--tol-mm", "0.02"],
                            capture_output=True, text=True)  # fmt: skip
     assert check.returncode == 0, check.stdout + check.stderr
+
+
+@pytest.mark.parametrize("dialect", ["fanuc", "haas"])
+def test_a_program_number_written_with_a_colon_is_the_o_number(tmp_path, dialect):
+    """`:100` is O100, the program number in ISO code's address (Fanuc 16i/18i-MB B-63684EN, "Program
+    number": in ISO code a colon may stand for the O): M98 P100 runs it; rs274 judges the LinuxCNC
+    twin, and the lines are written back as they stand."""
+    from ncpp.motion.canon import canon_call, read_canon
+    from tests.motion.test_oracle import rs274, same_calls, write_program
+
+    if not RS274.exists():
+        pytest.skip("rs274 not available")
+    head = "G21 G90 G17\nG0 X0 Y0 Z5 F300\n"
+    program = ":0001 (MAIN)\n" + head + "M98 P100\nG1 X5\nM98 P100 L2\nM30\n:100\nG91 G1 X1 Y1\nG90\nM99\n"
+    twin = head + "o100 sub\nG91 G1 X1 Y1\nG90\no100 endsub\no100 call\nG1 X5\no100 call\no100 call\nM2\n"
+    reference = read_canon(rs274(str(write_program(tmp_path, twin)))[0])
+    mine = [call for call in map(canon_call, events(program, dialect)) if call is not None]
+    assert len(mine) == len(reference) and same_calls(reference, mine), (reference, mine)
+    _, blocks = parse_program(io.BytesIO(program.encode()), "p.nc", dialect)
+    assert "".join(block.text for block in blocks) == program
+
+
+def test_a_colon_is_no_program_number_for_linuxcnc():
+    """rs274ngc refuses the `:` ("Bad character ':' used"), and so does ncpp in a LinuxCNC program."""
+    with pytest.raises(NcppError, match="':1000'"):
+        events(":1000\nG0 X1\nM2\n", "iso")
+
+
+@pytest.mark.parametrize("dialect", ["fanuc", "haas"])
+@pytest.mark.parametrize("variable", [100, 199, 500, 999])
+def test_a_common_variable_reads_only_what_the_program_set(dialect, variable):
+    """#100-#199 and #500-#999 are common variables (Fanuc 16i/18i-MB B-63684EN, "Custom macro", "Types of
+    variables": #500 on kept at power off): read before the program sets one, it holds what an earlier
+    program, a probe cycle or the operator left there, so the move it gives is out of scope (it was
+    read as 0, and `G1 X#500` rewritten as a move to X0); set first, it is followed."""
+    said = io.StringIO()
+    found = events(f"G0 X1\nG1 X#{variable} F100\nG0 X2\nM30\n", dialect, Warnings(stream=said))
+    assert [type(e) for e in found] == [Line, Pass, Pass, Pass], said.getvalue()
+    assert (
+        f"2:4: warning: #{variable}, a variable the control keeps from before the program" in said.getvalue()
+    )
+    found = events(f"#{variable}=5.\nG0 X1\nG1 X#{variable} F100\nM30\n", dialect)
+    assert [e.end[0] for e in found if type(e) is Line] == [1.0, 5.0]
+
+
+def test_a_linuxcnc_programs_parameter_500_reads_as_rs274_reads_it():
+    """In a LinuxCNC program #500 is a parameter rs274ngc reads as 0 until set (its parameter file aside)."""
+    found = events("G0 X1\nG1 X#500 F100\nM2\n", "iso")
+    assert [e.end[0] for e in found if type(e) is Line] == [1.0, 0.0]
+
+
+@pytest.mark.parametrize("dialect", ["fanuc", "haas"])
+def test_g41_again_while_compensation_is_on_ends_interpretation(dialect):
+    """A second G41 in the offset mode (a finish pass's, Haas turner's cube `O3001`) is the control's to
+    take, its offset vector built anew (module docstring of ncpp/motion/fanuc.py): out of scope at its
+    word, where rs274ngc's "Cannot turn cutter radius comp on when on" refused the program."""
+    said = io.StringIO()
+    text = "G0 X-10 Y0 Z1\nG1 Z0 F100\nG41 X0 Y0\nX10\nG41 X20 Y1\nG40 X30\nM30\n"
+    found = events(text, dialect, Warnings(stream=said))
+    assert [type(e) for e in found][4:] == [Pass, Pass, Pass], said.getvalue()
+    assert "5:1: warning: G41 while cutter compensation is on" in said.getvalue(), said.getvalue()
+
+
+def test_g41_again_is_refused_in_a_linuxcnc_program():
+    with pytest.raises(NcppError, match="Cannot turn cutter radius comp on when on"):
+        events("G0 X-10 Y0 Z1\nG1 Z0 F100\nG41 X0 Y0\nX10\nG41 X20 Y1\nG40 X30\nM2\n", "iso")
+
+
+@pytest.mark.parametrize("dialect", ["fanuc", "haas"])
+def test_a_local_variable_the_program_has_not_set_is_vacant(dialect):
+    """A Fanuc or Haas program's local variables start vacant (B-63684EN, "Custom macro", "Variables"), and
+    an address whose value is a vacant variable is left out: `G1 X#21 Y5` with #21 unset moves Y alone,
+    where it was read as X0 in a program without a macro statement."""
+    found = events("G0 X1 Y1\nG1 X#21 Y5 F100\nM30\n", dialect)
+    assert [tuple(e.end) for e in found if type(e) is Line] == [(1.0, 1.0, 0.0), (1.0, 5.0, 0.0)]
+
+
+def test_expand_keeps_a_g68_of_variables_out_of_scope(tmp_path):
+    """Written out, a loop's assignments go and the G68 block's text stays: `R#21` would read what the
+    written program no longer sets, so --expand leaves the scope at it, where without --expand the loop
+    is left as programmed and the rotation followed."""
+    program = tmp_path / "p.nc"
+    program.write_text("%\nO1\nG21 G90 G54\nG0 X0 Y0 Z5\n#21=0\n#1=0\nWHILE [#1 LT 2] DO1\nG68 X0 Y0 R#21\n"
+                       "G0 X10 Y0\nG1 Z-1 F100\nG0 Z5\nG69\n#21=#21+90\n#1=#1+1\nEND1\nM30\n%\n")  # fmt: skip
+    machine = SHARED / "machines" / "wide.toml"
+    run = [sys.executable, "-m", "ncpp", "compensate", "--machine", str(machine), "--no-guard", str(program)]
+    for expand, said in (
+        ([], "left as programmed: 6 moves in loops"),
+        (["--expand"], "--expand: G68 with a value"),
+    ):
+        proc = subprocess.run([*run, "-o", str(tmp_path / "out.nc"), *expand], capture_output=True, text=True,
+                              cwd=ROOT, timeout=300)  # fmt: skip
+        assert said in proc.stderr, proc.stderr

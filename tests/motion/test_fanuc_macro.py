@@ -35,6 +35,13 @@ TWINS = {
         "O0002\n" + HEAD + "#1=0\n#2=1\nWHILE [#2 LE 10] DO1\n#1=#1+#2\nG1 X#1 Y#2\n#2=#2+1\nEND1\nM30\n",
         HEAD + "#1=0\n#2=1\no1 while [#2 LE 10]\n#1=[#1+#2]\nG1 X#1 Y#2\n#2=[#2+1]\no1 endwhile\nM2\n",
     ),
+    # WH for WHILE, the two characters a macro word may be cut to (Fanuc Series 0i-D operator's
+    # manual B-64304EN, "Custom macro", "Abbreviations of custom macro words"), as a real
+    # Fanuc 0i-MD macro writes it: `WH[[#1GE#2]OR[#1EQ#2]]DO1`
+    "WH for WHILE": (
+        HEAD + "#1=3\nWH[[#1GE1]OR[#1EQ0]]DO1\n#1=#1-1\nG1X#1\nEND1\nM30\n",
+        HEAD + "#1=3\no1 while [[#1 GE 1] OR [#1 EQ 0]]\n#1=[#1-1]\nG1 X#1\no1 endwhile\nM2\n",
+    ),
     # nested loops (DO1 around DO2), a grid of plunges
     "nested WHILE": (
         HEAD + "#10=0\nWHILE [#10 LT 3] DO1\n#11=0\nWHILE [#11 LT 2] DO2\nG0 X[#10*10] Y[#11*5]\n"

@@ -274,6 +274,8 @@ def test_a_programs_own_number_holds_no_memory():
 
 
 class _Params:
+    fanuc = False  # (a LinuxCNC program's parameters)
+
     def enter(self, arguments):
         pass
 

@@ -101,11 +101,11 @@ GRBL = Dialect(
 )  # fmt: skip
 FANUC = Dialect(
     "fanuc", "iso", _ItemBuilder, fast_terminals=LineParser.FAST_TERMINALS, read_where_run=True, leader=True,
-    programs_after_end=True, eob_semicolon=True,
+    programs_after_end=True, eob_semicolon=True, colon_program_numbers=True,
 )  # fmt: skip
 HAAS = Dialect(
     "haas", "iso", _ItemBuilder, fast_terminals=LineParser.FAST_TERMINALS, read_where_run=True, leader=True,
-    programs_after_end=True, eob_semicolon=True,
+    programs_after_end=True, eob_semicolon=True, colon_program_numbers=True,
 )  # fmt: skip
 # File name endings that name a dialect when the content does not tell.
 SUFFIXES = {".h": "heidenhain", ".mpf": "sinumerik", ".spf": "sinumerik"}
@@ -201,10 +201,15 @@ _HAAS = re.compile(r"(?<![\w#.])G0*(187|103|154)(?![\d.])", re.I)
 # Haas's local subprogram call `M97 P1000` (Haas Mill Operator's Manual, "M97 Local Sub-Program Call"):
 # neither Fanuc's code lists nor LinuxCNC's M codes have an M97 (rs274 refuses it; ncpp there refuses its P)
 _HAAS_CALL = re.compile(r"(?<![\w#.])M0*97[ \t]*P[ \t]*\d", re.I)
+# Haas's circular pocket milling `G12`/`G13 ... Q..` (Mill Operator's Manual, "G12 Circular Pocket Milling
+# CW / G13 Circular Pocket Milling CCW": Q the radius increment, used with K): LinuxCNC has no G12/G13,
+# Fanuc's are G12.1/G13.1 (polar coordinate interpolation), and the circle cutting of older Fanuc
+# controls' G12/G13 takes I D F, no Q
+_HAAS_POCKET = re.compile(r"(?<![\w#.])G0*1[23](?![\d.])[^\n;(]*Q", re.I)
 _FANUC = re.compile(
     r"^[ \t]*[O:]\d+[ \t]*(\(.*\))?[ \t]*\r?$|(?<![\w#.])G0*65[ \t]*P|#3000[ \t]*=|(?<![\w#.])G0*5\.1[ \t]*Q"
     r"|(?<![\w#.])G0*8[ \t]*P"
-    r"|^[ \t]*(N\d+[ \t]*)?(WHILE[ \t]*\[.*\][ \t]*DO[ \t]*\d|IF[ \t]*\[.*\][ \t]*(GOTO|THEN))",
+    r"|^[ \t]*(N\d+[ \t]*)?(WH(?:ILE)?[ \t]*\[.*\][ \t]*DO[ \t]*\d|IF[ \t]*\[.*\][ \t]*(GOTO|THEN))",
     re.M | re.I,
 )
 
@@ -239,7 +244,8 @@ def detect(first_bytes: bytes, name: str | None = None) -> str:
     means Sinumerik, unless LinuxCNC's o-word lines or `#<name>` parameters
     are there too.  When the content is plain ISO-looking G code, a file name
     ending in .h / .mpf / .spf decides; then Haas's settings (G187, G103, G154) mean Haas, and so
-    does its local subprogram call `M97 P..` (unless LinuxCNC's o-word lines are there),
+    do its local subprogram call `M97 P..` and circular pocket milling `G12`/`G13` with a Q
+    (unless LinuxCNC's o-word lines are there),
     and a Fanuc program number line, G65, #3000, G05.1 Q, G08 P, a macro `WHILE [..] DOn` or
     `IF [..] GOTOn / THEN`, or axis words after a G80 with no motion code mean Fanuc (unless LinuxCNC's o-word lines are there); any other is LinuxCNC's ISO.
     """
@@ -255,7 +261,8 @@ def detect(first_bytes: bytes, name: str | None = None) -> str:
         for suffix, dialect in SUFFIXES.items():
             if name.lower().endswith(suffix):
                 return dialect
-    if _HAAS.search(code) or (_HAAS_CALL.search(code) and not _LINUXCNC.search(code)):
+    haas_only = _HAAS_CALL.search(code) or _HAAS_POCKET.search(code)
+    if _HAAS.search(code) or (haas_only and not _LINUXCNC.search(code)):
         return "haas"
     if (_FANUC.search(code) or _axes_after_g80(code)) and not _LINUXCNC.search(code):
         return "fanuc"
