@@ -444,12 +444,21 @@ def _pin_plane(rows: _Rows, out_end: NDArray, before: NDArray | None) -> None:
     chunk's last end, in the first row's frame (None: none)."""
     if rows.still is None or rows.axes is None:
         return
-    for k in np.flatnonzero(rows.still).tolist():  # in order: a run of them keeps the first's
-        plane = rows.axes[k, :2]
-        if k > 0 and (rows.offsets[k] == rows.offsets[k - 1]).all() and rows.scales[k] == rows.scales[k - 1]:
-            out_end[k, plane] = out_end[k - 1, plane]
-        elif k == 0 and before is not None:
-            out_end[k, plane] = before[plane]
+    if rows.still[0] and before is not None:
+        out_end[0, rows.axes[0, :2]] = before[rows.axes[0, :2]]
+    for k, plane in _pins(rows).items():  # in order: a run of them keeps the first's
+        out_end[k, plane] = out_end[k - 1, plane]
+
+
+def _pins(rows: _Rows) -> dict[int, tuple[int, int]]:
+    """The rows `_pin_plane` pins in their predecessor's frame, and the plane axes each keeps."""
+    if rows.still is None or rows.axes is None:
+        return {}
+    return {
+        k: (int(rows.axes[k, 0]), int(rows.axes[k, 1]))
+        for k in np.flatnonzero(rows.still).tolist()
+        if k > 0 and (rows.offsets[k] == rows.offsets[k - 1]).all() and rows.scales[k] == rows.scales[k - 1]
+    }
 
 
 def _kept_axes(segs: list, kind: NDArray) -> NDArray:
@@ -700,7 +709,12 @@ def _joined(rows: _Rows, out_end: NDArray, before: NDArray | None) -> tuple[NDAr
         return rows.start, moved
     pieces = rows.comp & rows.arc
     out_start = rows.start.copy()
-    for k in np.flatnonzero(pieces).tolist():  # in order: a piece moved moves the next
+    pins = _pins(rows)  # (a line along the normal after a piece moved keeps its plane axes: moved with it)
+    in_order = sorted(pins.keys() | set(np.flatnonzero(pieces).tolist()))
+    for k in in_order:  # in order: a piece moved moves the next
+        if k in pins:
+            out_end[k, pins[k]] = out_end[k - 1, pins[k]]
+            continue
         same = (
             k > 0 and (rows.offsets[k] == rows.offsets[k - 1]).all() and rows.scales[k] == rows.scales[k - 1]
         )
@@ -780,7 +794,7 @@ def _directional(rows: _Rows, ctx: PassContext, travel: Travel) -> _Solved:
         _corners(rows, out_end, lambda k: commands("start", k, d.take(k, axis=0)), step)  # noqa: B023  # (called here)
         _hold_pieces_still(pieces, d, travel.held, limit, out_start, out_end)
         _pin_plane(rows, out_end, before)
-        _settle(free, arc, d, travel.held, offsets, scales, joined, out_start, out_end, before)
+        _settle(free, arc, d, travel.held, offsets, scales, joined, out_start, out_end, before, _pins(rows))
         if rows.carried.any():
             _carry(rows, out_end, before)
         cur_end, cur_start = machine(out_end), machine(out_start)
@@ -848,7 +862,7 @@ def _carry(rows: _Rows, out_end: NDArray, before: NDArray | None) -> None:
         out_end[k:run] = rows.end[k:run] + np.where(placed, 0.0, previous - rows.start[k])
 
 
-def _settle(free, arc, d, held, offsets, scales, limit, out_start, out_end, before) -> None:
+def _settle(free, arc, d, held, offsets, scales, limit, out_start, out_end, before, pins=None) -> None:
     """Keep axes from reversing by less than `limit` (n,), in order of travel.
 
     A line whose compensated end moves an axis a little against the direction
@@ -859,7 +873,9 @@ def _settle(free, arc, d, held, offsets, scales, limit, out_start, out_end, befo
     each moved end is the next row's start and a drift over many rows stays bounded.
     `before`: the previous chunk's last end in the first row's frame (or None).  A line
     after a change of units or offsets settles onto its predecessor's end seen from its own
-    frame (the program's numbers there are other numbers for the same place)."""
+    frame (the program's numbers there are other numbers for the same place).  `pins`: the rows that
+    keep axes of their predecessor's end (`_pins`), kept so when a settled row before them moves."""
+    pins = pins or {}
     ends, dirs, ok = _with_previous(out_end, d, held, offsets, scales, before)
     reframed = np.flatnonzero(any3(offsets[1:] != offsets[:-1]) | (scales[1:] != scales[:-1])) + 1
     pred_end, pred_dir = ends[:-1].copy(), dirs[:-1]  # row k's predecessor's end (in k's frame), direction
@@ -901,6 +917,10 @@ def _settle(free, arc, d, held, offsets, scales, limit, out_start, out_end, befo
                     gap = end[a] - p
                     if gap * held_a < 0 and own[a] == held_a and -limit_k <= gap <= limit_k:
                         end[a] = p
+                        changed = True
+                for a in pins.get(k, ()):
+                    if end[a] != pred[a]:
+                        end[a] = pred[a]
                         changed = True
             else:
                 start = out_start[k].tolist()

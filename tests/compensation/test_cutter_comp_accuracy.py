@@ -283,3 +283,54 @@ def test_mmount_contours_land_within_the_tolerance(tmp_path):
         assert deviation(before, theirs, closed_form).max() > 0.03
         assert deviation(before, mine, closed_form).max() < 0.001, section
     pathcheck(original, out, "--tool-table", str(tools), "--var-file", str(var))
+
+
+# X's positioning differs by travel direction by 4 µm (a reversal table) and has a screw-lead error
+REVERSING = """[machine]
+chain = "YXFZ"
+[offsets]
+tool = [0.0, 0.0, -90.0]
+[errors.EXX]
+kind = "table"
+positions = [-300.0, -10.0, 0.0, 10.0, 300.0]
+values_um = [-25.0, 1.0, 0.0, 2.0, 30.0]
+values_um_minus = [-29.0, -3.0, -4.0, -2.0, 26.0]
+[[effects]]
+kind = "cyclic"
+axis = "X"
+um = 1.5
+period_mm = 5.0
+"""
+# a helical slot under G41 (inches; arcs with Z, replaced by pieces that settle onto one another), then Z alone
+HELICAL_SLOT = (
+    "G17 G20 G40 G90\nG0 X-0.1806 Y-11.4324 Z0.25\nG41.1 D0.04\nG1 X-0.1806 Y-11.1824 F10\n"
+    + "G3 X0.3449 Y-10.6567 I-1.7574 J2.2824 Z0.025\nG3 X0.1221 Y-10.4853 I-0.1114 J0.0857 Z0.0\n"
+    + "G2 X-0.3521 Y-10.9596 I-2.0601 J1.5853 Z-0.125\nG3 X-0.1806 Y-11.1824 I0.0858 J-0.1114\n"
+    + "G3 X0.3449 Y-10.6567 I-1.7574 J2.2824\nG3 X0.1221 Y-10.4853 I-0.1114 J0.0857\n"
+    + "G2 X-0.3521 Y-10.9596 I-2.0601 J1.5853\nG0 Z0.25\nG40\nG0 X-0.1806 Y-11.4324\nM2\n"
+)
+# a loop under G41 left as programmed, then Z alone
+LOOP = HEAD + (
+    "G0 X-10 Y-20 Z5\nG41.1 D2\nG1 X0 Y-10 F300\nG1 Z-1\n#1 = 0\no100 while [#1 LT 2]\nG1 X50\nG1 X0\n"
+    "#1 = [#1 + 1]\no100 endwhile\nG0 Z5\nG1 Y40\nG40\nG0 X-20 Y-20\nM2\n"
+)
+
+
+@needs_oracles
+@pytest.mark.parametrize("text", [HELICAL_SLOT, LOOP], ids=["after-arc-pieces", "after-a-loop"])
+def test_a_move_along_z_alone_under_compensation_makes_no_move_in_the_plane(tmp_path, text):
+    """Z alone under G41 after arc pieces that settle onto their predecessor (reversal errors), and
+    after a loop left as programmed: a µm of X or Y written there would be a move the control offsets
+    along its own direction, swinging the tool centre round by the radius (rs274 then refuses a
+    gouge at the G40, or runs the tool a radius off the path)."""
+    (tmp_path / "reversing.toml").write_text(REVERSING)
+    program, out = tmp_path / "z.ngc", tmp_path / "z.out.ngc"
+    program.write_text(text)
+    proc = subprocess.run([sys.executable, "-m", "ncpp", "compensate", "--machine", str(tmp_path / "reversing.toml"),
+                           str(program), "-o", str(out)], capture_output=True, text=True, cwd=ROOT, timeout=300)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    lines = out.read_text().splitlines()
+    lines = lines[next(k for k, line in enumerate(lines) if line.startswith("G41.1")) :]
+    z_alone = [line for line in lines if line.startswith("G0 Z")]
+    assert z_alone and all("X" not in line and "Y" not in line for line in z_alone), z_alone
+    pathcheck(program, out, "--tol-mm", "0.02")
