@@ -482,6 +482,7 @@ class Interpreter:
         )  # fmt: skip
         self.rounding = False
         expansion = self.expansion
+        block: Block | None = None
         for block, kind, owner in flow.steps(blocks):
             if kind is ONCE and (expansion is not None or pending is not None or self.corner is not None):
                 kind = FIXED  # (--expand writes each run out; a corner waiting: `_in_flow` tells why)
@@ -618,6 +619,8 @@ class Interpreter:
                     yield ev if called is None else (called, ev)
                 else:
                     once.add(ev, block, again=kind is FIXED)
+        if not self.done and block is not None and (block.verbatim or _tape_mark(block)):
+            self.ended = True  # the program ran to its closing `%`, which ends it as M2 does (`_tape_mark`)
         if once is not None:
             yield from self._told(once, again=not self.ended)
         if pending is not None:
@@ -2591,6 +2594,14 @@ def _marked(events: Event | tuple[Event, ...] | None, marks: list[Pass]) -> Even
     if events is None:
         return marks[0] if len(marks) == 1 else tuple(marks)
     return (*(events if type(events) is tuple else (events,)), *marks)
+
+
+def _tape_mark(block: Block) -> bool:
+    """Whether the block is a `%` line that is a tape mark: the last line the flow runs, it is the
+    program's closing one, after which nothing runs, as after M2 (the NIST RS274NGC Interpreter,
+    version 3, "File": "The useful contents of a file demarcated by percents stop after the second
+    percent line"; LinuxCNC G-code overview, "File Requirements")."""
+    return bool(block.items) and type(block.items[0]) is Statement and block.items[0].kind == "tape"
 
 
 def _sets_offset(event: Event | tuple[Event, ...]) -> bool:
