@@ -107,6 +107,15 @@ G68; the first move after G69 absolute), Haas's alike (Mill Operator's Manual, "
 from Setting 72 when not given, added in G91 with Setting 73).  Scaling (G51), the programmable
 mirror image (G51.1), G68.1 and the tilted working plane (G68.2-G68.4) end interpretation by name.
 
+A canned cycle's K is its repeats, as rs274ngc's L (the Fanuc Series 0i and 16i formats, `G81 X_ Y_ Z_ R_
+F_ K_`, "K_: Number of repeats", as the Fanuc lathe operator's manual's drilling cycles give it; the
+Series 15i-MA operator's manual counts them in L: "When L is used to specify the number of repeats"):
+both are read, and a block with both, or with K0 (the cycle's data stored, no hole drilled), is out of
+scope.  G87's K stays rs274ngc's reading (its G87 is left as programmed, below), and a G87 with its
+shift in Q (the shift's direction a parameter of the control's: 15i-MA, "Shift specification by Q_")
+ends interpretation with a warning, where rs274ngc refuses the Q.  Haas counts repeats in L only ("G81
+Drill Canned Cycle": "L Number of holes if G91 is used").
+
 Canned cycles are a modal group of their own, group 09 beside group 01's G00-G03 (Fanuc 0i-MD /
 15i-MA operator's manuals, "List of G codes"; Haas Mill Operator's Manual, "G80 Canned Cycle Cancel
 (Group 09)"), so G80 cancels the cycle and leaves the G00-G03 mode it interrupted in effect: `G00 Z.1`,
@@ -208,6 +217,7 @@ class FanucInterpreter(Interpreter):
     taps_in_any_plane = True  # G74/G84 in G18/G19 tap along the normal (module docstring)
     cycles_own_group = True  # G80 leaves the G0-G3 mode before the cycle in effect (module docstring)
     back_bore_holes = False  # G87 reads R Z Q K otherwise than rs274ngc (`Interpreter.back_bore_holes`)
+    repeat_letters = ("L", "K")  # a cycle's repeats: K, or L on the Series 15 (module docstring)
     returns_under_comp = True  # G28/G30 under G41/G42: out of scope (module docstring)
     external_output = True  # POPEN, DPRNT[..], BPRNT[..], PCLOS pass through (module docstring)
     repeats_in_p = True  # `M98 P51002`: O1002 five times (`Flow._m98`)
@@ -480,6 +490,8 @@ class HaasInterpreter(FanucInterpreter):
     idle_cancels = frozenset((50.0, 69.0))
     peck_dwell = True
     dwell_point = True
+    # ("G81 Drill Canned Cycle": "L Number of holes if G91 is used"; its G73 and G83 read I J K as pecks)
+    repeat_letters = ("L",)
     unfollowed = HAAS_UNFOLLOWED
     additional = "G154"
     g54_with_p = False  # (Haas's manual gives G54 no P)

@@ -287,6 +287,8 @@ class Interpreter:
     # LinuxCNC G-code manual, "G87 Back Boring Cycle") and compensated hole by hole; Fanuc's reads its
     # words otherwise (R below, Z the top, Q the shift, K repeats) and stays as programmed
     back_bore_holes = True
+    # The letters of a canned cycle's repeats: rs274ngc's L; Fanuc's K too (`FanucInterpreter`)
+    repeat_letters: tuple[str, ...] = ("L",)
     # G28/G30 under cutter compensation (Fanuc: the offset is dropped at the intermediate point and
     # restored after the return): not followed, out of scope; rs274ngc refuses it
     returns_under_comp = False
@@ -1387,7 +1389,7 @@ class Interpreter:
                     block,
                     words[letter][1],
                 )
-        if "K" in words and motion not in _K_MOTIONS:
+        if "K" in words and motion not in _K_MOTIONS and not ("K" in self.repeat_letters and motion in CANNED):
             self._fail("K word with no G2, G3, G33, G33.1, G71, G76, or G87 to use it", block, words["K"][1])
         if "L" in words and not (motion in _CYCLES or motion in (76.0, 5.2, 73.0, 71.0) or mode0 == 10.0
                                  or g7 is not None and g7 != 40.0 or 66.0 in mcodes):  # fmt: skip
@@ -1410,6 +1412,7 @@ class Interpreter:
                 if round(p) < 1:
                     self._fail("P value should be 1 or greater with G2 or G3", block, p_item)
         if "Q" in words and not (motion in _Q_MOTIONS or mode0 == 10.0 or gcodes.get(13, (None,))[0] == 64.0
+                                 or motion == 87.0 and not self.back_bore_holes
                                  or mcodes.keys() & {66.0, 67.0, 68.0, 61.0, 19.0}
                                  or any(100.0 <= m <= 199.0 for m in mcodes)):  # fmt: skip
             self._fail(
@@ -2147,12 +2150,14 @@ class Interpreter:
         with --expand-cycles moves like any other (`_expanded`)."""
         if self._rotation() is not None:
             raise _OutOfScope(f"canned cycle G{motion:g} under a coordinate system rotation", item.start + 1)
+        if motion == 87.0 and not self.back_bore_holes and "Q" in words:  # (Fanuc: its direction a parameter's)
+            raise _OutOfScope("back boring G87 with its shift in Q", words["Q"][1].start + 1)
         first, second, normal = PLANE_AXES[self.plane]
         again = previous == motion  # the same cycle again: R, the normal-axis word, P and Q are sticky
         if previous not in CANNED:  # a new series: G98 retracts to where it started, no dwell yet
             self.cycle_il, self.cycle_p, self.cycle_p_word = self.pos[normal], 0.0, None
         aa, bb, step_a, step_b, r, bottom = self._cycle_geometry(block, words, again, item)
-        repeats = self._repeats(block, words)
+        repeats = self._repeats(block, words, motion)
         peck = self._cycle_word(block, words, motion, again, item)
         if motion in (74.0, 84.0) and self.plane != 17 and not self.taps_in_any_plane:
             raise _OutOfScope(f"canned cycle G{motion:g} outside the XY plane", item.start + 1)
@@ -2336,15 +2341,21 @@ class Interpreter:
             self._fail(f"a canned cycle of {what}: ncpp takes {MAX_CYCLE_MOVES:,} moves in one block at most",
                        block, words.get("L", words.get("Q", (0, item)))[1])  # fmt: skip
 
-    def _repeats(self, block: Block, words: dict) -> int:
-        """A cycle's L: how many times it runs (1 without L)."""
-        if "L" not in words:
+    def _repeats(self, block: Block, words: dict, motion: float) -> int:
+        """A cycle's L (Fanuc: or K, `repeat_letters`; not G87's K, the top of its cut there): how many
+        times it runs (1 without)."""
+        given = [letter for letter in self.repeat_letters if letter in words and (letter != "K" or motion != 87.0)]
+        if not given:
             return 1
-        value, item = words["L"]
+        if len(given) > 1:
+            raise _OutOfScope("a canned cycle with both K and L repeats", words[given[1]][1].start + 1)
+        value, item = words[given[0]]
         if value != round(value):
             self._fail("Non integer value for integer", block, item)
         if value < 0:
             self._fail("Negative L word used", block, item)
+        if value == 0 and given[0] == "K":  # (Fanuc: the cycle's data is stored, no hole drilled)
+            raise _OutOfScope("a canned cycle with K0", item.start + 1)
         if value == 0:
             self._fail("Cannot do zero repeats of cycle", block, item)
         return int(value)

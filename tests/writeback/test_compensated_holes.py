@@ -5,6 +5,7 @@ X-Y and X-Z), not by ncpp's interpreter or model."""
 
 from __future__ import annotations
 
+import io
 import re
 import subprocess
 import sys
@@ -12,6 +13,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+
+from ncpp.errors import Warnings
 
 from tests import rs274
 from tests.compensation.accuracy import Machine, _moves, actual_moves, rs274_calls
@@ -278,6 +281,54 @@ def test_a_g92_after_a_compensated_hole_sets_the_programs_offset(tmp_path):
     wanted = np.array([[20, 10, 20], [-5, 40, 3]], dtype=float) + shift
     got = np.array([args[:3] for name, args in rs274_calls(output) if name == "STRAIGHT_FEED"][-2:]) + shift
     assert np.abs(square(got, np.ones(3)) - wanted).max() * 1000 <= 0.5
+
+
+def test_fanuc_repeats_in_k_land_where_programmed(tmp_path):
+    """A Fanuc cycle's K is its repeats, as rs274ngc's L (`FanucInterpreter.repeat_letters`): each
+    hole of the G91 rows lands on its programmed bottom and R, judged by rs274 running the written
+    program and the original read with L for K."""
+    original = tmp_path / "repeats.nc"
+    program = PROGRAM_G91.replace("M2\n", "M30\n")
+    original.write_text(program.replace(" L", " K"))
+    output = compensate_file(original, MACHINE, tmp_path, dialect="fanuc")
+    assert not re.search(r"\bK\d", output.read_text())  # (a block per hole, the first without its K)
+    as_linuxcnc = tmp_path / "repeats.ngc"
+    as_linuxcnc.write_text(program)
+    wanted = np.array(HOLES_G91, dtype=float)
+    before, after = drilled(as_linuxcnc, square), drilled(output, square)
+    assert len(after) == len(wanted)
+    off_before = np.array([np.linalg.norm(b - h[:3]) for (b, _), h in zip(before, wanted)]) * 1000
+    off_after = np.array([np.linalg.norm(b - h[:3]) for (b, _), h in zip(after, wanted)]) * 1000
+    r_after = np.array([abs(r - h[3]) for (_, r), h in zip(after, wanted)]) * 1000
+    assert off_before.min() > 1.5
+    assert off_after.max() <= 0.5, off_after
+    assert r_after.max() <= 0.5, r_after
+    assert _passes_pathcheck(as_linuxcnc, output)
+
+
+@pytest.mark.parametrize("dialect", ["fanuc", "haas"])
+def test_a_fanuc_back_bore_with_its_shift_in_q_passes_through(tmp_path, dialect):
+    """Fanuc's G87 shifts the tool by Q in a direction a parameter of the control's sets (Fanuc Series
+    15i-MA operator's manual, "Back boring cycle (G87)", "Shift specification by Q_"): the program
+    passes through from there, with a warning, where rs274ngc's reading refused the Q."""
+    original = tmp_path / "back.nc"
+    original.write_text("%\nG21 G90 G17\nG0 X40 Y30 Z25 S500 M3\nG98 G87 X200 Y150 Z-30 R-45 Q2 F100\n"
+                        "G80\nG0 X10 Y10\nM30\n%\n")  # fmt: skip
+    said = io.StringIO()
+    output = compensate_file(original, MACHINE, tmp_path, warnings=Warnings(stream=said), dialect=dialect)
+    assert output.read_text().endswith("G98 G87 X200 Y150 Z-30 R-45 Q2 F100\nG80\nG0 X10 Y10\nM30\n%\n")
+    assert "back.nc:4:29: warning: back boring G87 with its shift in Q" in said.getvalue()
+
+
+def test_a_fanuc_cycle_of_k0_passes_through(tmp_path):
+    """K0 stores the cycle's data and drills no hole (the repeats' count 0): the program passes
+    through from there, with a warning, where rs274ngc's reading refused the K."""
+    original = tmp_path / "k0.nc"
+    original.write_text("%\nG21 G90 G17\nG0 X40 Y30 Z25\nG99 G81 X20 Y30 Z-3 R2 K0 F100\nX30\nG80\nM30\n%\n")
+    said = io.StringIO()
+    output = compensate_file(original, MACHINE, tmp_path, warnings=Warnings(stream=said), dialect="fanuc")
+    assert output.read_text().endswith("G99 G81 X20 Y30 Z-3 R2 K0 F100\nX30\nG80\nM30\n%\n")
+    assert "k0.nc:4:24: warning: a canned cycle with K0" in said.getvalue()
 
 
 # Taps in G18 and G19 (Fanuc: the drilling axis is the plane's normal for every cycle), G90 and G91
