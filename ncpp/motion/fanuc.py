@@ -111,10 +111,17 @@ A canned cycle's K is its repeats, as rs274ngc's L (the Fanuc Series 0i and 16i 
 F_ K_`, "K_: Number of repeats", as the Fanuc lathe operator's manual's drilling cycles give it; the
 Series 15i-MA operator's manual counts them in L: "When L is used to specify the number of repeats"):
 both are read, and a block with both, or with K0 (the cycle's data stored, no hole drilled), is out of
-scope.  G87's K stays rs274ngc's reading (its G87 is left as programmed, below), and a G87 with its
-shift in Q (the shift's direction a parameter of the control's: 15i-MA, "Shift specification by Q_")
-ends interpretation with a warning, where rs274ngc refuses the Q.  Haas counts repeats in L only ("G81
-Drill Canned Cycle": "L Number of holes if G91 is used").
+scope.  Haas counts repeats in L only ("G81 Drill Canned Cycle": "L Number of holes if G91 is used").
+
+G87 is Fanuc's back boring (Series 15i-MA operator's manual, "Back boring cycle (G87)"): to X Y,
+shifted by I J with the spindle oriented, down to R below the part, back over the hole, feed up to Z
+(the top of the cut), shifted again, up to the initial level (G99 is not used) and back over the
+hole; in G91 R counts from the initial level and Z from R.  Its moves are left as programmed, with
+the warning, and compensation resumes over the hole at the initial level
+(`Interpreter._fanuc_back_bore`).  A G87 with its shift in Q (the shift's direction a parameter of the
+control's: "Shift specification by Q_"), in G18 or G19 (where I J K name the shift otherwise), in G99,
+or with R not below Z ends interpretation with a warning, where rs274ngc's reading refused it; so does
+a Haas program's G87 (no Haas manual page in ncpp's reference set reads it so).
 
 Canned cycles are a modal group of their own, group 09 beside group 01's G00-G03 (Fanuc 0i-MD /
 15i-MA operator's manuals, "List of G codes"; Haas Mill Operator's Manual, "G80 Canned Cycle Cancel
@@ -218,6 +225,7 @@ class FanucInterpreter(Interpreter):
     cycles_own_group = True  # G80 leaves the G0-G3 mode before the cycle in effect (module docstring)
     back_bore_holes = False  # G87 reads R Z Q K otherwise than rs274ngc (`Interpreter.back_bore_holes`)
     repeat_letters = ("L", "K")  # a cycle's repeats: K, or L on the Series 15 (module docstring)
+    fanuc_back_bore = True  # G87 read as Fanuc's back bore, left as programmed (module docstring)
     returns_under_comp = True  # G28/G30 under G41/G42: out of scope (module docstring)
     external_output = True  # POPEN, DPRNT[..], BPRNT[..], PCLOS pass through (module docstring)
     repeats_in_p = True  # `M98 P51002`: O1002 five times (`Flow._m98`)
@@ -492,6 +500,7 @@ class HaasInterpreter(FanucInterpreter):
     dwell_point = True
     # ("G81 Drill Canned Cycle": "L Number of holes if G91 is used"; its G73 and G83 read I J K as pecks)
     repeat_letters = ("L",)
+    fanuc_back_bore = False  # (no Haas manual page in ncpp's reference set gives G87 as Fanuc's back bore)
     unfollowed = HAAS_UNFOLLOWED
     additional = "G154"
     g54_with_p = False  # (Haas's manual gives G54 no P)

@@ -287,6 +287,7 @@ class Interpreter:
     # LinuxCNC G-code manual, "G87 Back Boring Cycle") and compensated hole by hole; Fanuc's reads its
     # words otherwise (R below, Z the top, Q the shift, K repeats) and stays as programmed
     back_bore_holes = True
+    fanuc_back_bore = False  # (where not back_bore_holes) G87 is Fanuc's back bore, left as programmed
     # The letters of a canned cycle's repeats: rs274ngc's L; Fanuc's K too (`FanucInterpreter`)
     repeat_letters: tuple[str, ...] = ("L",)
     # G28/G30 under cutter compensation (Fanuc: the offset is dropped at the intermediate point and
@@ -1403,6 +1404,7 @@ class Interpreter:
             user_m = any(100.0 <= m <= 199.0 for m in mcodes)
             peck_p = self.peck_dwell and motion in PECKING
             if not (mode0 in (10.0, 4.0) or gcodes.get(13, (None,))[0] == 64.0 or motion in _P_MOTIONS
+                    or motion == 87.0 and not self.back_bore_holes
                     or mcodes.keys() & _P_MCODES or user_m or peck_p):  # fmt: skip
                 self._fail("P word with no G2 G3 G4 G10 G64 G5 G5.2 G71 G76 G82 G86 G88 G89 or M50 M51 M52 M53 "
                            "M62 M63 M64 M65 M66 or user M code to use it", block, p_item)  # fmt: skip
@@ -2150,8 +2152,8 @@ class Interpreter:
         with --expand-cycles moves like any other (`_expanded`)."""
         if self._rotation() is not None:
             raise _OutOfScope(f"canned cycle G{motion:g} under a coordinate system rotation", item.start + 1)
-        if motion == 87.0 and not self.back_bore_holes and "Q" in words:  # (Fanuc: its direction a parameter's)
-            raise _OutOfScope("back boring G87 with its shift in Q", words["Q"][1].start + 1)
+        if motion == 87.0 and not self.back_bore_holes:
+            return self._fanuc_back_bore(block, words, previous, item)
         first, second, normal = PLANE_AXES[self.plane]
         again = previous == motion  # the same cycle again: R, the normal-axis word, P and Q are sticky
         if previous not in CANNED:  # a new series: G98 retracts to where it started, no dwell yet
@@ -2215,6 +2217,54 @@ class Interpreter:
                 for line in lines[k:end]:
                     line.fixed, line.hole = HOLE, drilled
         return lines
+
+    def _fanuc_back_bore(self, block: Block, words: dict, previous: float | None, item) -> tuple[Event, ...]:
+        """Fanuc's back boring G87, its moves left as programmed (CYCLE): to X Y, shifted by I J with
+        the spindle oriented, down to R below the part, back over the hole, feed up to Z, shifted again,
+        up to the level the series started at and back over the hole (Fanuc Series 15i-MA operator's
+        manual, "Back boring cycle (G87)": R the level below the part the cut starts from, Z its top,
+        G99 not used; "Shift specification by I_J_"; G91: R from the initial level, Z from R).  In the
+        XY plane with the shift in I J; its shift in Q (its direction a parameter of the control's),
+        another plane (where I J K name the shift otherwise) or G99 are out of scope."""
+        if not self.fanuc_back_bore:
+            raise _OutOfScope("G87 on Haas (no Haas manual page in ncpp's reference set reads it as Fanuc's)",
+                              item.start + 1)  # fmt: skip
+        if "Q" in words:
+            raise _OutOfScope("back boring G87 with its shift in Q", words["Q"][1].start + 1)
+        if self.plane != 17:
+            raise _OutOfScope("Fanuc's back boring G87 outside the XY plane", item.start + 1)
+        if self.retract_to_r:
+            raise _OutOfScope("Fanuc's back boring G87 in G99", item.start + 1)
+        again = previous == 87.0
+        if previous not in CANNED:
+            self.cycle_il = self.pos[2]
+        for letter in "RZIJ" if not again else ():
+            if letter not in words:
+                self._fail(f"{letter} word missing with G87", block, item)
+        if self.feed == 0.0:
+            self._fail("Cannot feed with zero feed rate", block, item)
+        self._check_spindle(block, 87.0, item)
+        r_word, z_word = (words[k][0] if k in words else kept for k, kept in (("R", self.cycle_r), ("Z", self.cycle_cc)))
+        shift = tuple(words[k][0] if k in words else kept for k, kept in zip("IJ", self.cycle_ijk))
+        self.cycle_r, self.cycle_cc, self.cycle_ijk = r_word, z_word, (shift[0], shift[1], 0.0)
+        start = self.pos
+        x, y = (words[k][0] if k in words else start[n] for n, k in enumerate("XY"))
+        r, top = (r_word, z_word) if self.absolute else (self.cycle_il + r_word, self.cycle_il + r_word + z_word)
+        step = (0.0, 0.0) if self.absolute else (words.get("X", (0.0,))[0], words.get("Y", (0.0,))[0])
+        if not self.absolute:
+            x, y = start[0], start[1]
+        if r >= top:  # (not a back bore: the cut would go down)
+            raise _OutOfScope("Fanuc's back boring G87 with R not below Z", item.start + 1)
+        moves: list[tuple[float, float, float, bool]] = []
+        level, il = start[2], self.cycle_il
+        for _ in range(self._repeats(block, words, 87.0)):
+            x, y = x + step[0], y + step[1]
+            off_x, off_y = x + shift[0], y + shift[1]
+            moves += [(x, y, level, True), (off_x, off_y, level, True), (off_x, off_y, r, True), (x, y, r, True),
+                      (x, y, top, False), (off_x, off_y, top, True), (off_x, off_y, il, True), (x, y, il, True)]  # fmt: skip
+            level = il
+        self.cycle_holes = False
+        return tuple(self._fixed_line(block, (0, 1, 2), move) for move in moves)
 
     def _cycle_geometry(self, block: Block, words: dict, again: bool, item) -> tuple[float, ...]:
         """(aa, bb, their step per repeat, R, bottom) of a cycle in plane coordinates; keeps the
@@ -2344,7 +2394,8 @@ class Interpreter:
     def _repeats(self, block: Block, words: dict, motion: float) -> int:
         """A cycle's L (Fanuc: or K, `repeat_letters`; not G87's K, the top of its cut there): how many
         times it runs (1 without)."""
-        given = [letter for letter in self.repeat_letters if letter in words and (letter != "K" or motion != 87.0)]
+        given = [letter for letter in self.repeat_letters
+                 if letter in words and (letter != "K" or motion != 87.0 or not self.back_bore_holes)]  # fmt: skip
         if not given:
             return 1
         if len(given) > 1:
