@@ -224,7 +224,10 @@ class FanucInterpreter(Interpreter):
     taps_in_any_plane = True  # G74/G84 in G18/G19 tap along the normal (module docstring)
     cycles_own_group = True  # G80 leaves the G0-G3 mode before the cycle in effect (module docstring)
     back_bore_holes = False  # G87 reads R Z Q K otherwise than rs274ngc (`Interpreter.back_bore_holes`)
-    repeat_letters = ("L", "K")  # a cycle's repeats: K, or L on the Series 15 (module docstring)
+    repeat_letters: tuple[str, ...] = (
+        "L",
+        "K",
+    )  # a cycle's repeats: K, or L on the Series 15 (module docstring)
     fanuc_back_bore = True  # G87 read as Fanuc's back bore, left as programmed (module docstring)
     returns_under_comp = True  # G28/G30 under G41/G42: out of scope (module docstring)
     external_output = True  # POPEN, DPRNT[..], BPRNT[..], PCLOS pass through (module docstring)

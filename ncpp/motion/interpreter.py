@@ -1390,7 +1390,11 @@ class Interpreter:
                     block,
                     words[letter][1],
                 )
-        if "K" in words and motion not in _K_MOTIONS and not ("K" in self.repeat_letters and motion in CANNED):
+        if (
+            "K" in words
+            and motion not in _K_MOTIONS
+            and not ("K" in self.repeat_letters and motion in CANNED)
+        ):
             self._fail("K word with no G2, G3, G33, G33.1, G71, G76, or G87 to use it", block, words["K"][1])
         if "L" in words and not (motion in _CYCLES or motion in (76.0, 5.2, 73.0, 71.0) or mode0 == 10.0
                                  or g7 is not None and g7 != 40.0 or 66.0 in mcodes):  # fmt: skip
@@ -2244,12 +2248,16 @@ class Interpreter:
         if self.feed == 0.0:
             self._fail("Cannot feed with zero feed rate", block, item)
         self._check_spindle(block, 87.0, item)
-        r_word, z_word = (words[k][0] if k in words else kept for k, kept in (("R", self.cycle_r), ("Z", self.cycle_cc)))
+        r_word, z_word = (
+            words[k][0] if k in words else kept for k, kept in (("R", self.cycle_r), ("Z", self.cycle_cc))
+        )
         shift = tuple(words[k][0] if k in words else kept for k, kept in zip("IJ", self.cycle_ijk))
         self.cycle_r, self.cycle_cc, self.cycle_ijk = r_word, z_word, (shift[0], shift[1], 0.0)
         start = self.pos
         x, y = (words[k][0] if k in words else start[n] for n, k in enumerate("XY"))
-        r, top = (r_word, z_word) if self.absolute else (self.cycle_il + r_word, self.cycle_il + r_word + z_word)
+        r, top = (
+            (r_word, z_word) if self.absolute else (self.cycle_il + r_word, self.cycle_il + r_word + z_word)
+        )
         step = (0.0, 0.0) if self.absolute else (words.get("X", (0.0,))[0], words.get("Y", (0.0,))[0])
         if not self.absolute:
             x, y = start[0], start[1]

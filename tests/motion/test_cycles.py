@@ -268,7 +268,9 @@ def test_a_warning_repeated_hundreds_of_times_is_printed_five_times_then_counted
     )
     out, warned = _compensate(HEAD + "M3\n" + holes + "M2\n")
     said = warned.splitlines()
-    series = [n + 1 for n, line in enumerate((HEAD + "M3\n" + holes).splitlines()) if line.startswith("G98 G87")]
+    series = [
+        n + 1 for n, line in enumerate((HEAD + "M3\n" + holes).splitlines()) if line.startswith("G98 G87")
+    ]
     assert [line.split(": warning: ")[0] for line in said] == [
         f"drill.ngc:{n}:1" for n in (*series[:5], series[-1])
     ]
@@ -352,8 +354,10 @@ def test_compensation_goes_on_after_a_g91_cycle(after):
 def test_rs274_accepts_the_compensated_cycles(tmp_path):
     """The program around a series left as programmed (a cycle in a loop: rs274ngc does not read
     Fanuc's G87) is written so that rs274 runs it."""
-    looped = DRILL.replace("G98 G87 X20 Y20 Z-1 R-3 I1 J0 L2\nX30\n(between)\nX40 Y25\nG80\n",
-                           "o1 repeat [2]\nG98 G81 X20 Y20 Z-3 R2\nX30\n(between)\nX40 Y25\nG80\no1 endrepeat\n")
+    looped = DRILL.replace(
+        "G98 G87 X20 Y20 Z-1 R-3 I1 J0 L2\nX30\n(between)\nX40 Y25\nG80\n",
+        "o1 repeat [2]\nG98 G81 X20 Y20 Z-3 R2\nX30\n(between)\nX40 Y25\nG80\no1 endrepeat\n",
+    )
     assert looped != DRILL
     out, warned = compensate(looped, "drill.ngc", False)
     assert "warning: canned cycle" in warned

@@ -193,9 +193,9 @@ def test_around_a_fanuc_back_bore_left_as_programmed_the_moves_land_where_progra
         plain.write_text(_written_out(path.read_text()))
         runs.append(plain)
     wanted = np.array([b for _, b, feeds in _moves(runs[0]) if feeds])
-    reached = np.array([m[-1] for (_, _, feeds), m in zip(_moves(runs[1]), actual_moves(runs[1], square)) if feeds])
+    reached = np.array(
+        [m[-1] for (_, _, feeds), m in zip(_moves(runs[1]), actual_moves(runs[1], square)) if feeds]
+    )
     misses = np.linalg.norm(wanted[:, None, :] - reached[None, :, :], axis=2).min(axis=1) * 1000
     cut = np.isclose(wanted[:, 2], -10) | np.isclose(wanted[:, 2], -35)  # (the cycles' cuts, as programmed)
     assert misses[cut].min() > 1.0 and misses[~cut].max() <= 0.5, misses
-
-

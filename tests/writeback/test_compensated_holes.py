@@ -15,7 +15,6 @@ import numpy as np
 import pytest
 
 from ncpp.errors import Warnings
-
 from tests import rs274
 from tests.compensation.accuracy import Machine, _moves, actual_moves, rs274_calls
 from tests.conftest import SHARED
