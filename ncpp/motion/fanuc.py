@@ -113,6 +113,14 @@ Series 15i-MA operator's manual counts them in L: "When L is used to specify the
 both are read, and a block with both, or with K0 (the cycle's data stored, no hole drilled), is out of
 scope.  Haas counts repeats in L only ("G81 Drill Canned Cycle": "L Number of holes if G91 is used").
 
+G76 is fine boring on both (Fanuc Series 15i-MA operator's manual, "Fine boring cycle (G76)": to X Y, to
+R, feed to Z, dwell P, the spindle oriented and the tool shifted off the wall by Q or I J, out at rapid,
+shifted back; Haas Mill Operator's Manual, "G76 Fine Boring Canned Cycle"), where LinuxCNC's G76 is a
+lathe's threading: compensated hole by hole as the other cycles (`Interpreter.canned`), its X Y Z R
+corrected, Q, I J and P as written; its moves are taken as straight out of the hole (the shift, whose
+direction is a parameter of the control's, is the control's own and undone above the hole).
+--expand-cycles refuses it (G0/G1 blocks cannot orient the spindle).
+
 G87 is Fanuc's back boring (Series 15i-MA operator's manual, "Back boring cycle (G87)"): to X Y,
 shifted by I J with the spindle oriented, down to R below the part, back over the hole, feed up to Z
 (the top of the cut), shifted again, up to the initial level (G99 is not used) and back over the
@@ -165,6 +173,7 @@ from __future__ import annotations
 
 from typing import cast
 
+from ncpp.motion.cycles import CANNED
 from ncpp.motion.interpreter import IGNORED_STATEMENTS, MM_PER_INCH, Interpreter, _OutOfScope, interpreting
 from ncpp.motion.offsets import ADDITIONAL, ADDITIONAL_CODES
 from ncpp.motion.segments import Event, Pass
@@ -229,6 +238,7 @@ class FanucInterpreter(Interpreter):
         "K",
     )  # a cycle's repeats: K, or L on the Series 15 (module docstring)
     fanuc_back_bore = True  # G87 read as Fanuc's back bore, left as programmed (module docstring)
+    canned = CANNED | {76.0}  # G76: fine boring, compensated hole by hole (module docstring)
     returns_under_comp = True  # G28/G30 under G41/G42: out of scope (module docstring)
     external_output = True  # POPEN, DPRNT[..], BPRNT[..], PCLOS pass through (module docstring)
     repeats_in_p = True  # `M98 P51002`: O1002 five times (`Flow._m98`)

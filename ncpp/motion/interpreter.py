@@ -94,6 +94,7 @@ UNEXPANDED = {
     84.0: "tapping: the spindle reverses at the bottom, in step with the feed",
     86.0: "the spindle stops at the bottom",
     87.0: "back boring: the spindle stops and orients",
+    76.0: "fine boring: the spindle orients and the tool shifts off the wall at the bottom",
 }
 AXES = "XYZABCUVW"
 AXIS_INDEX = {letter: i for i, letter in enumerate(AXES)}
@@ -288,6 +289,8 @@ class Interpreter:
     # words otherwise (R below, Z the top, Q the shift, K repeats) and stays as programmed
     back_bore_holes = True
     fanuc_back_bore = False  # (where not back_bore_holes) G87 is Fanuc's back bore, left as programmed
+    # The canned cycles: rs274ngc's; Fanuc's and Haas's G76 (fine boring) too (`FanucInterpreter`)
+    canned: frozenset[float] = CANNED
     # The letters of a canned cycle's repeats: rs274ngc's L; Fanuc's K too (`FanucInterpreter`)
     repeat_letters: tuple[str, ...] = ("L",)
     # G28/G30 under cutter compensation (Fanuc: the offset is dropped at the intermediate point and
@@ -874,7 +877,7 @@ class Interpreter:
         if homes:
             self.unpositioned -= named or {0, 1, 2}
         else:
-            self.unpositioned -= named - {2} if self.motion in CANNED else named
+            self.unpositioned -= named - {2} if self.motion in self.canned else named
 
     def _settle_rotation(self, block: Block) -> None:
         """Fanuc: after G68, moves in G91 run from where the tool stood at G68 (the centre for them,
@@ -1253,7 +1256,7 @@ class Interpreter:
             if motion <= 1.0:
                 events = self._straight(block, words, motion, mode0 == 53.0)
                 self.corner = _corner_word(words, motion)
-            elif motion in CANNED:
+            elif motion in self.canned:
                 events = self._cycle(block, words, motion, previous, motion_word)
             elif motion == RIGID_TAP:
                 events = self._rigid_tap(block, words, motion_word)
@@ -1307,13 +1310,13 @@ class Interpreter:
 
     def _motion_mode_after(self, mode1: float, previous: float | None) -> float | None:
         """The modal motion once `mode1` (a motion code or G80) is read, `previous` in effect."""
-        if mode1 in CANNED and previous not in CANNED:
+        if mode1 in self.canned and previous not in self.canned:
             self.before_cycle = previous
         if mode1 != 80.0:
             return mode1
         if not self.cycles_own_group:
             return None
-        return self.before_cycle if previous in CANNED else previous
+        return self.before_cycle if previous in self.canned else previous
 
     def _check_polar(self, block: Block, words: dict, item) -> None:
         """enhance_block's checks of polar words (`@` radius, `^` angle, LinuxCNC): in the XY
@@ -1370,9 +1373,12 @@ class Interpreter:
             and motion != 71.0
         ):
             self._fail("D word with no G41, G41.1, G42, G42.1, G71, or G96 to use it", block, words["D"][1])
-        if "E" in words and motion != 76.0 and not mcodes.keys() & {66.0, 67.0, 68.0}:
+        threading = (
+            motion == 76.0 and motion not in self.canned
+        )  # (rs274ngc's G76; Fanuc's fine boring is a cycle)
+        if "E" in words and not threading and not mcodes.keys() & {66.0, 67.0, 68.0}:
             self._fail("E word with no G70, G76, M66, M67 or M68 to use it", block, words["E"][1])
-        if "H" in words and gcodes.get(8, (None,))[0] not in (43.0, 43.2, 43.4, 43.5) and motion != 76.0:
+        if "H" in words and gcodes.get(8, (None,))[0] not in (43.0, 43.2, 43.4, 43.5) and not threading:
             self._fail("H word with no G43 or G76 to use it", block, words["H"][1])
         if motion == RIGID_TAP and self.rigid_tapping:
             self._check_rigid_tap(block, words, mode0_item or mode1_item)
@@ -1392,8 +1398,8 @@ class Interpreter:
                 )
         if (
             "K" in words
-            and motion not in _K_MOTIONS
-            and not ("K" in self.repeat_letters and motion in CANNED)
+            and (motion not in _K_MOTIONS or motion == 76.0 and not threading)
+            and not ("K" in self.repeat_letters and motion in self.canned)
         ):
             self._fail("K word with no G2, G3, G33, G33.1, G71, G76, or G87 to use it", block, words["K"][1])
         if "L" in words and not (motion in _CYCLES or motion in (76.0, 5.2, 73.0, 71.0) or mode0 == 10.0
@@ -1562,7 +1568,7 @@ class Interpreter:
         for value, item in gcodes.values():
             if value == 50.0 and "S" in words:  # (a lathe's spindle limit, not a mill's scaling cancel)
                 raise _OutOfScope(SPINDLE_LIMIT, item.start + 1)
-            reason = OUT_OF_SCOPE_G.get(value)
+            reason = OUT_OF_SCOPE_G.get(value) if value not in self.canned else None
             if (
                 reason is not None
                 and not (value == 43.2 and "H" in words)
@@ -2160,7 +2166,7 @@ class Interpreter:
             return self._fanuc_back_bore(block, words, previous, item)
         first, second, normal = PLANE_AXES[self.plane]
         again = previous == motion  # the same cycle again: R, the normal-axis word, P and Q are sticky
-        if previous not in CANNED:  # a new series: G98 retracts to where it started, no dwell yet
+        if previous not in self.canned:  # a new series: G98 retracts to where it started, no dwell yet
             self.cycle_il, self.cycle_p, self.cycle_p_word = self.pos[normal], 0.0, None
         aa, bb, step_a, step_b, r, bottom = self._cycle_geometry(block, words, again, item)
         repeats = self._repeats(block, words, motion)
@@ -2208,7 +2214,7 @@ class Interpreter:
             return self._expanded(block, motion, lines, bottoms, dwell)
         # holes apply_error_map compensates: in any plane (polar words written as X Y, repeats as a
         # block each), the series' holes all such
-        self.cycle_holes = (previous not in CANNED or self.cycle_holes) and (
+        self.cycle_holes = (previous not in self.canned or self.cycle_holes) and (
             motion != 87.0 or self.back_bore_holes
         )
         if self.cycle_holes:
@@ -2216,7 +2222,7 @@ class Interpreter:
             offset, top_level = ((off_a, off_b), middle) if motion == 87.0 else ((0.0, 0.0), None)
             for n, ((k, hole_a, hole_b), end) in enumerate(zip(holes, ends)):
                 drilled = Hole(motion, hole_a, hole_b, bottom, r, peck, rapid_delta, self.retract_to_r,
-                               previous not in CANNED and n == 0, n, len(holes),
+                               previous not in self.canned and n == 0, n, len(holes),
                                plane=self.plane, offset=offset, top=top_level)  # fmt: skip
                 for line in lines[k:end]:
                     line.fixed, line.hole = HOLE, drilled
@@ -2240,7 +2246,7 @@ class Interpreter:
         if self.retract_to_r:
             raise _OutOfScope("Fanuc's back boring G87 in G99", item.start + 1)
         again = previous == 87.0
-        if previous not in CANNED:
+        if previous not in self.canned:
             self.cycle_il = self.pos[2]
         for letter in "RZIJ" if not again else ():
             if letter not in words:
@@ -2639,7 +2645,9 @@ _PLAIN_LETTERS = {
     1.0: frozenset("XYZABCUVWF"),
     2.0: frozenset("XYZABCUVWFIJKR"),
     3.0: frozenset("XYZABCUVWFIJKR"),
-    **{code: frozenset() for code in CANNED},  # a cycle's words are checked in full
+    **{
+        code: frozenset() for code in (*CANNED, 76.0)
+    },  # a cycle's words are checked in full (Fanuc's G76 too)
     RIGID_TAP: frozenset(),  # a modal G33.1 block needs its K again (rs274ngc: "K word missing")
 }
 

@@ -321,6 +321,60 @@ def test_a_fanuc_back_bore_with_its_shift_in_q_passes_through(tmp_path, dialect,
     assert f"back.nc:4:{29 if dialect == 'fanuc' else 5}: warning: {why}" in said.getvalue()
 
 
+# Fanuc's fine boring G76 (G90, G91 with K repeats, G98 and G99): (X, Y, Z bottom, R) of each hole
+HOLES_FINE = [(100, 120, -16, 3), (30, 40, -16, 3), (150, -50, -20, 5),
+              (170, -45, -2, 8), (190, -40, -2, 8), (210, -35, -2, 8)]  # fmt: skip
+PROGRAM_FINE = """G21 G90 G17
+G0 X40 Y30 Z25
+M3 S500
+G1 X45 Y35 F300
+G99 G76 X100 Y120 R3 Z-16 Q0.2 P0 F100
+X30 Y40
+G98 G76 X150 Y-50 R5 Z-20 Q0.2 P0.5
+G80
+G0 Z30
+G91 G99 G76 X20 Y5 R-22 Z-10 Q0.2 P0 K3
+G90 G80
+G1 X-100 Y80 Z3
+M5
+M30
+"""
+
+
+def _as_g86(path: Path) -> Path:
+    """`path` with its fine boring as rs274ngc's G86 (feed to the bottom, dwell, spindle stop, rapid
+    out: LinuxCNC G-code manual, G86), the moves Fanuc's G76 makes but the shift off the wall at the
+    bottom and back above the hole (Fanuc Series 15i-MA operator's manual, "Fine boring cycle (G76)"),
+    its K as L."""
+    text = re.sub(r"\s*Q[\d.]+", "", path.read_text().replace("G76", "G86"))
+    plain = path.with_name(path.stem + "-g86.ngc")
+    plain.write_text(re.sub(r"\bK(\d)", r"L\1", text))
+    return plain
+
+
+@pytest.mark.parametrize("dialect", ["fanuc", "haas"])
+def test_fanuc_fine_boring_lands_where_programmed(tmp_path, dialect):
+    """Fanuc's and Haas's G76 (fine boring: the spindle orients at the bottom and the tool shifts off
+    the wall before it rapids out) is compensated hole by hole as the other cycles: each hole's bottom
+    and R point, as rs274 runs the written program with its G76 as G86, mapped through the hand-written
+    machine, within 0.5 µm of the programmed point.  (Haas counts repeats in L.)"""
+    original = tmp_path / "fine.nc"
+    original.write_text(PROGRAM_FINE if dialect == "fanuc" else PROGRAM_FINE.replace(" K3", " L3"))
+    output = compensate_file(original, MACHINE, tmp_path, dialect=dialect)
+    assert re.search(r"^G99 G76 X[\d.]+ Y[\d.]+ R[\d.]+ Z-[\d.]+ Q0.2 P0 F100$", output.read_text(), re.M)
+    wanted = np.array(HOLES_FINE, dtype=float)
+    assert np.allclose([tuple(b) + (r,) for b, r in drilled(_as_g86(original), None)], wanted, atol=1e-6)
+    before, after = drilled(_as_g86(original), square), drilled(_as_g86(output), square)
+    assert len(after) == len(wanted)
+    off_before = np.array([np.linalg.norm(b - h[:3]) for (b, _), h in zip(before, wanted)]) * 1000
+    off_after = np.array([np.linalg.norm(b - h[:3]) for (b, _), h in zip(after, wanted)]) * 1000
+    r_after = np.array([abs(r - h[3]) for (_, r), h in zip(after, wanted)]) * 1000
+    assert off_before.min() > 1.5
+    assert off_after.max() <= 0.5, off_after
+    assert r_after.max() <= 0.5, r_after
+    assert _passes_pathcheck(_as_g86(original), _as_g86(output))
+
+
 def test_a_fanuc_cycle_of_k0_passes_through(tmp_path):
     """K0 stores the cycle's data and drills no hole (the repeats' count 0): the program passes
     through from there, with a warning, where rs274ngc's reading refused the K."""
