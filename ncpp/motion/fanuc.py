@@ -126,8 +126,8 @@ shifted by I J with the spindle oriented, down to R below the part, back over th
 (the top of the cut), shifted again, up to the initial level (G99 is not used) and back over the
 hole; in G91 R counts from the initial level and Z from R.  Its moves are left as programmed, with
 the warning, and compensation resumes over the hole at the initial level
-(`Interpreter._fanuc_back_bore`).  A G87 with its shift in Q (the shift's direction a parameter of the
-control's: "Shift specification by Q_"), in G18 or G19 (where I J K name the shift otherwise), in G99,
+(`Interpreter._fanuc_back_bore`).  A G87 with its shift in Q or with neither I nor J (the shift's direction a
+parameter of the control's: "Shift specification by Q_"), in G18 or G19 (where I J K name the shift otherwise), in G99,
 or with R not below Z ends interpretation with a warning, where rs274ngc's reading refused it; so does
 a Haas program's G87 (no Haas manual page in ncpp's reference set reads it so).
 

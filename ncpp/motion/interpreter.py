@@ -2234,8 +2234,9 @@ class Interpreter:
         up to the level the series started at and back over the hole (Fanuc Series 15i-MA operator's
         manual, "Back boring cycle (G87)": R the level below the part the cut starts from, Z its top,
         G99 not used; "Shift specification by I_J_"; G91: R from the initial level, Z from R).  In the
-        XY plane with the shift in I J; its shift in Q (its direction a parameter of the control's),
-        another plane (where I J K name the shift otherwise) or G99 are out of scope."""
+        XY plane with the shift in I J (one not given is 0); its shift in Q or neither I nor J (the
+        shift's direction a parameter of the control's), another plane (where I J K name the shift
+        otherwise) or G99 are out of scope."""
         if not self.fanuc_back_bore:
             raise _OutOfScope("G87 on Haas (no Haas manual page in ncpp's reference set reads it as Fanuc's)",
                               item.start + 1)  # fmt: skip
@@ -2248,16 +2249,19 @@ class Interpreter:
         again = previous == 87.0
         if previous not in self.canned:
             self.cycle_il = self.pos[2]
-        for letter in "RZIJ" if not again else ():
+        for letter in "RZ" if not again else ():
             if letter not in words:
                 self._fail(f"{letter} word missing with G87", block, item)
+        if not again and "I" not in words and "J" not in words:  # (its shift in Q, a parameter's direction)
+            raise _OutOfScope("Fanuc's back boring G87 without I or J", item.start + 1)
         if self.feed == 0.0:
             self._fail("Cannot feed with zero feed rate", block, item)
         self._check_spindle(block, 87.0, item)
         r_word, z_word = (
             words[k][0] if k in words else kept for k, kept in (("R", self.cycle_r), ("Z", self.cycle_cc))
         )
-        shift = tuple(words[k][0] if k in words else kept for k, kept in zip("IJ", self.cycle_ijk))
+        kept = self.cycle_ijk if again else (0.0, 0.0, 0.0)  # (a new series: an I or J not given is 0)
+        shift = tuple(words[k][0] if k in words else kept[n] for n, k in enumerate("IJ"))
         self.cycle_r, self.cycle_cc, self.cycle_ijk = r_word, z_word, (shift[0], shift[1], 0.0)
         start = self.pos
         x, y = (words[k][0] if k in words else start[n] for n, k in enumerate("XY"))

@@ -306,19 +306,25 @@ def test_fanuc_repeats_in_k_land_where_programmed(tmp_path):
 
 
 @pytest.mark.parametrize(
-    "dialect, why", [("fanuc", "back boring G87 with its shift in Q"), ("haas", "G87 on Haas")]
-)
-def test_a_fanuc_back_bore_with_its_shift_in_q_passes_through(tmp_path, dialect, why):
-    """Fanuc's G87 shifts the tool by Q in a direction a parameter of the control's sets (Fanuc Series
-    15i-MA operator's manual, "Back boring cycle (G87)", "Shift specification by Q_"): the program
-    passes through from there, with a warning, where rs274ngc's reading refused the Q."""
+    "dialect, words, where",
+    [("fanuc", "Q2", "4:29: warning: back boring G87 with its shift in Q"),
+     ("fanuc", "", "4:5: warning: Fanuc's back boring G87 without I or J"),
+     ("fanuc", "I2 J1 G99", "4:5: warning: Fanuc's back boring G87 in G99"),
+     ("haas", "I2 J1", "4:5: warning: G87 on Haas")],
+)  # fmt: skip
+def test_a_back_bore_whose_shift_is_not_told_passes_through(tmp_path, dialect, words, where):
+    """Fanuc's G87 shifts the tool by Q (or without I and J) in a direction a parameter of the
+    control's sets (Fanuc Series 15i-MA operator's manual, "Back boring cycle (G87)", "Shift
+    specification by Q_"), and takes no G99: the program passes through from there, with a warning,
+    where rs274ngc's reading refused it; so does a Haas program's G87."""
+    retract, words = ("G99", words.removesuffix(" G99")) if words.endswith("G99") else ("G98", words)
+    block = f"{retract} G87 X200 Y150 Z-30 R-45 {words} F100".replace("  ", " ")
     original = tmp_path / "back.nc"
-    original.write_text("%\nG21 G90 G17\nG0 X40 Y30 Z25 S500 M3\nG98 G87 X200 Y150 Z-30 R-45 Q2 F100\n"
-                        "G80\nG0 X10 Y10\nM30\n%\n")  # fmt: skip
+    original.write_text(f"%\nG21 G90 G17\nG0 X40 Y30 Z25 S500 M3\n{block}\nG80\nG0 X10 Y10\nM30\n%\n")
     said = io.StringIO()
     output = compensate_file(original, MACHINE, tmp_path, warnings=Warnings(stream=said), dialect=dialect)
-    assert output.read_text().endswith("G98 G87 X200 Y150 Z-30 R-45 Q2 F100\nG80\nG0 X10 Y10\nM30\n%\n")
-    assert f"back.nc:4:{29 if dialect == 'fanuc' else 5}: warning: {why}" in said.getvalue()
+    assert output.read_text().endswith(f"{block}\nG80\nG0 X10 Y10\nM30\n%\n")
+    assert f"back.nc:{where}" in said.getvalue()
 
 
 # Fanuc's fine boring G76 (G90, G91 with K repeats, G98 and G99): (X, Y, Z bottom, R) of each hole
