@@ -14,7 +14,7 @@ from __future__ import annotations
 CANNED = frozenset({73.0, 74.0, 81.0, 82.0, 83.0, 84.0, 85.0, 86.0, 87.0, 89.0})
 DWELLING = frozenset({82.0, 86.0, 89.0})  # P: a dwell time, required (sticky within the cycle)
 # the spindle direction (M3 1, M4 -1) each cycle needs (0: turning either way)
-SPINDLE = {84.0: 1, 74.0: -1, 86.0: 0, 87.0: 0}
+SPINDLE = {84.0: 1, 74.0: -1, 86.0: 0, 87.0: 0, 76.0: 0}  # (76: Fanuc's fine boring)
 PECKING = frozenset({73.0, 83.0})  # Q: the peck depth, sticky within the cycle
 # G73/G83: the rapid back into the hole stops this far above the last peck (rs274ngc's
 # G83_RAPID_DELTA, in inch; 0.254 mm)
@@ -61,7 +61,9 @@ def hole(
     moves.append((aa, bb, bottom, False))
     if motion == 85.0:
         moves.append((aa, bb, r, False))
-    moves.append((aa, bb, clear, motion not in (74.0, 84.0, 89.0)))  # taps and G89 feed out
+    # taps and G89 feed out; Fanuc's fine boring G76 shifts off the wall at the bottom and back above
+    # it, by the control's shift, and rapids out between (taken as straight out: its end is the same)
+    moves.append((aa, bb, clear, motion not in (74.0, 84.0, 89.0)))
     return moves
 
 

@@ -107,6 +107,30 @@ G68; the first move after G69 absolute), Haas's alike (Mill Operator's Manual, "
 from Setting 72 when not given, added in G91 with Setting 73).  Scaling (G51), the programmable
 mirror image (G51.1), G68.1 and the tilted working plane (G68.2-G68.4) end interpretation by name.
 
+A canned cycle's K is its repeats, as rs274ngc's L (the Fanuc Series 0i and 16i formats, `G81 X_ Y_ Z_ R_
+F_ K_`, "K_: Number of repeats", as the Fanuc lathe operator's manual's drilling cycles give it; the
+Series 15i-MA operator's manual counts them in L: "When L is used to specify the number of repeats"):
+both are read, and a block with both, or with K0 (the cycle's data stored, no hole drilled), is out of
+scope.  Haas counts repeats in L only ("G81 Drill Canned Cycle": "L Number of holes if G91 is used").
+
+G76 is fine boring on both (Fanuc Series 15i-MA operator's manual, "Fine boring cycle (G76)": to X Y, to
+R, feed to Z, dwell P, the spindle oriented and the tool shifted off the wall by Q or I J, out at rapid,
+shifted back; Haas Mill Operator's Manual, "G76 Fine Boring Canned Cycle"), where LinuxCNC's G76 is a
+lathe's threading: compensated hole by hole as the other cycles (`Interpreter.canned`), its X Y Z R
+corrected, Q, I J and P as written; its moves are taken as straight out of the hole (the shift, whose
+direction is a parameter of the control's, is the control's own and undone above the hole).
+--expand-cycles refuses it (G0/G1 blocks cannot orient the spindle).
+
+G87 is Fanuc's back boring (Series 15i-MA operator's manual, "Back boring cycle (G87)"): to X Y,
+shifted by I J with the spindle oriented, down to R below the part, back over the hole, feed up to Z
+(the top of the cut), shifted again, up to the initial level (G99 is not used) and back over the
+hole; in G91 R counts from the initial level and Z from R.  Its moves are left as programmed, with
+the warning, and compensation resumes over the hole at the initial level
+(`Interpreter._fanuc_back_bore`).  A G87 with its shift in Q or with neither I nor J (the shift's direction a
+parameter of the control's: "Shift specification by Q_"), in G18 or G19 (where I J K name the shift otherwise), in G99,
+or with R not below Z ends interpretation with a warning, where rs274ngc's reading refused it; so does
+a Haas program's G87 (no Haas manual page in ncpp's reference set reads it so).
+
 Canned cycles are a modal group of their own, group 09 beside group 01's G00-G03 (Fanuc 0i-MD /
 15i-MA operator's manuals, "List of G codes"; Haas Mill Operator's Manual, "G80 Canned Cycle Cancel
 (Group 09)"), so G80 cancels the cycle and leaves the G00-G03 mode it interrupted in effect: `G00 Z.1`,
@@ -155,6 +179,7 @@ from __future__ import annotations
 
 from typing import cast
 
+from ncpp.motion.cycles import CANNED
 from ncpp.motion.expressions import vacant
 from ncpp.motion.interpreter import IGNORED_STATEMENTS, MM_PER_INCH, Interpreter, _OutOfScope, interpreting
 from ncpp.motion.offsets import ADDITIONAL, ADDITIONAL_CODES
@@ -222,6 +247,12 @@ class FanucInterpreter(Interpreter):
     taps_in_any_plane = True  # G74/G84 in G18/G19 tap along the normal (module docstring)
     cycles_own_group = True  # G80 leaves the G0-G3 mode before the cycle in effect (module docstring)
     back_bore_holes = False  # G87 reads R Z Q K otherwise than rs274ngc (`Interpreter.back_bore_holes`)
+    repeat_letters: tuple[str, ...] = (
+        "L",
+        "K",
+    )  # a cycle's repeats: K, or L on the Series 15 (module docstring)
+    fanuc_back_bore = True  # G87 read as Fanuc's back bore, left as programmed (module docstring)
+    canned = CANNED | {76.0}  # G76: fine boring, compensated hole by hole (module docstring)
     returns_under_comp = True  # G28/G30 under G41/G42: out of scope (module docstring)
     comp_again = True  # G41/G42 under G41/G42: out of scope (module docstring)
     external_output = True  # POPEN, DPRNT[..], BPRNT[..], PCLOS pass through (module docstring)
@@ -508,6 +539,9 @@ class HaasInterpreter(FanucInterpreter):
     idle_cancels = frozenset((50.0, 69.0))
     peck_dwell = True
     dwell_point = True
+    # ("G81 Drill Canned Cycle": "L Number of holes if G91 is used"; its G73 and G83 read I J K as pecks)
+    repeat_letters = ("L",)
+    fanuc_back_bore = False  # (no Haas manual page in ncpp's reference set gives G87 as Fanuc's back bore)
     unfollowed = HAAS_UNFOLLOWED
     additional = "G154"
     g54_with_p = False  # (Haas's manual gives G54 no P)

@@ -94,6 +94,7 @@ UNEXPANDED = {
     84.0: "tapping: the spindle reverses at the bottom, in step with the feed",
     86.0: "the spindle stops at the bottom",
     87.0: "back boring: the spindle stops and orients",
+    76.0: "fine boring: the spindle orients and the tool shifts off the wall at the bottom",
 }
 AXES = "XYZABCUVW"
 AXIS_INDEX = {letter: i for i, letter in enumerate(AXES)}
@@ -287,6 +288,11 @@ class Interpreter:
     # LinuxCNC G-code manual, "G87 Back Boring Cycle") and compensated hole by hole; Fanuc's reads its
     # words otherwise (R below, Z the top, Q the shift, K repeats) and stays as programmed
     back_bore_holes = True
+    fanuc_back_bore = False  # (where not back_bore_holes) G87 is Fanuc's back bore, left as programmed
+    # The canned cycles: rs274ngc's; Fanuc's and Haas's G76 (fine boring) too (`FanucInterpreter`)
+    canned: frozenset[float] = CANNED
+    # The letters of a canned cycle's repeats: rs274ngc's L; Fanuc's K too (`FanucInterpreter`)
+    repeat_letters: tuple[str, ...] = ("L",)
     # G28/G30 under cutter compensation (Fanuc: the offset is dropped at the intermediate point and
     # restored after the return): not followed, out of scope; rs274ngc refuses it
     returns_under_comp = False
@@ -486,6 +492,7 @@ class Interpreter:
         )  # fmt: skip
         self.rounding = False
         expansion = self.expansion
+        block: Block | None = None
         for block, kind, owner in flow.steps(blocks):
             if kind is ONCE and (expansion is not None or pending is not None or self.corner is not None):
                 kind = FIXED  # (--expand writes each run out; a corner waiting: `_in_flow` tells why)
@@ -622,6 +629,8 @@ class Interpreter:
                     yield ev if called is None else (called, ev)
                 else:
                     once.add(ev, block, again=kind is FIXED)
+        if not self.done and block is not None and (block.verbatim or _tape_mark(block)):
+            self.ended = True  # the program ran to its closing `%`, which ends it as M2 does (`_tape_mark`)
         if once is not None:
             yield from self._told(once, again=not self.ended)
         if pending is not None:
@@ -872,7 +881,7 @@ class Interpreter:
         if homes:
             self.unpositioned -= named or {0, 1, 2}
         else:
-            self.unpositioned -= named - {2} if self.motion in CANNED else named
+            self.unpositioned -= named - {2} if self.motion in self.canned else named
 
     def _settle_rotation(self, block: Block) -> None:
         """Fanuc: after G68, moves in G91 run from where the tool stood at G68 (the centre for them,
@@ -1251,7 +1260,7 @@ class Interpreter:
             if motion <= 1.0:
                 events = self._straight(block, words, motion, mode0 == 53.0)
                 self.corner = _corner_word(words, motion)
-            elif motion in CANNED:
+            elif motion in self.canned:
                 events = self._cycle(block, words, motion, previous, motion_word)
             elif motion == RIGID_TAP:
                 events = self._rigid_tap(block, words, motion_word)
@@ -1305,13 +1314,13 @@ class Interpreter:
 
     def _motion_mode_after(self, mode1: float, previous: float | None) -> float | None:
         """The modal motion once `mode1` (a motion code or G80) is read, `previous` in effect."""
-        if mode1 in CANNED and previous not in CANNED:
+        if mode1 in self.canned and previous not in self.canned:
             self.before_cycle = previous
         if mode1 != 80.0:
             return mode1
         if not self.cycles_own_group:
             return None
-        return self.before_cycle if previous in CANNED else previous
+        return self.before_cycle if previous in self.canned else previous
 
     def _check_polar(self, block: Block, words: dict, item) -> None:
         """enhance_block's checks of polar words (`@` radius, `^` angle, LinuxCNC): in the XY
@@ -1368,9 +1377,12 @@ class Interpreter:
             and motion != 71.0
         ):
             self._fail("D word with no G41, G41.1, G42, G42.1, G71, or G96 to use it", block, words["D"][1])
-        if "E" in words and motion != 76.0 and not mcodes.keys() & {66.0, 67.0, 68.0}:
+        threading = (
+            motion == 76.0 and motion not in self.canned
+        )  # (rs274ngc's G76; Fanuc's fine boring is a cycle)
+        if "E" in words and not threading and not mcodes.keys() & {66.0, 67.0, 68.0}:
             self._fail("E word with no G70, G76, M66, M67 or M68 to use it", block, words["E"][1])
-        if "H" in words and gcodes.get(8, (None,))[0] not in (43.0, 43.2, 43.4, 43.5) and motion != 76.0:
+        if "H" in words and gcodes.get(8, (None,))[0] not in (43.0, 43.2, 43.4, 43.5) and not threading:
             self._fail("H word with no G43 or G76 to use it", block, words["H"][1])
         if motion == RIGID_TAP and self.rigid_tapping:
             self._check_rigid_tap(block, words, mode0_item or mode1_item)
@@ -1388,7 +1400,11 @@ class Interpreter:
                     block,
                     words[letter][1],
                 )
-        if "K" in words and motion not in _K_MOTIONS:
+        if (
+            "K" in words
+            and (motion not in _K_MOTIONS or motion == 76.0 and not threading)
+            and not ("K" in self.repeat_letters and motion in self.canned)
+        ):
             self._fail("K word with no G2, G3, G33, G33.1, G71, G76, or G87 to use it", block, words["K"][1])
         if "L" in words and not (motion in _CYCLES or motion in (76.0, 5.2, 73.0, 71.0) or mode0 == 10.0
                                  or g7 is not None and g7 != 40.0 or 66.0 in mcodes):  # fmt: skip
@@ -1402,6 +1418,7 @@ class Interpreter:
             user_m = any(100.0 <= m <= 199.0 for m in mcodes)
             peck_p = self.peck_dwell and motion in PECKING
             if not (mode0 in (10.0, 4.0) or gcodes.get(13, (None,))[0] == 64.0 or motion in _P_MOTIONS
+                    or motion == 87.0 and not self.back_bore_holes
                     or mcodes.keys() & _P_MCODES or user_m or peck_p):  # fmt: skip
                 self._fail("P word with no G2 G3 G4 G10 G64 G5 G5.2 G71 G76 G82 G86 G88 G89 or M50 M51 M52 M53 "
                            "M62 M63 M64 M65 M66 or user M code to use it", block, p_item)  # fmt: skip
@@ -1411,6 +1428,7 @@ class Interpreter:
                 if round(p) < 1:
                     self._fail("P value should be 1 or greater with G2 or G3", block, p_item)
         if "Q" in words and not (motion in _Q_MOTIONS or mode0 == 10.0 or gcodes.get(13, (None,))[0] == 64.0
+                                 or motion == 87.0 and not self.back_bore_holes
                                  or mcodes.keys() & {66.0, 67.0, 68.0, 61.0, 19.0}
                                  or any(100.0 <= m <= 199.0 for m in mcodes)):  # fmt: skip
             self._fail(
@@ -1556,7 +1574,7 @@ class Interpreter:
         for value, item in gcodes.values():
             if value == 50.0 and "S" in words:  # (a lathe's spindle limit, not a mill's scaling cancel)
                 raise _OutOfScope(SPINDLE_LIMIT, item.start + 1)
-            reason = OUT_OF_SCOPE_G.get(value)
+            reason = OUT_OF_SCOPE_G.get(value) if value not in self.canned else None
             if (
                 reason is not None
                 and not (value == 43.2 and "H" in words)
@@ -2150,12 +2168,14 @@ class Interpreter:
         with --expand-cycles moves like any other (`_expanded`)."""
         if self._rotation() is not None:
             raise _OutOfScope(f"canned cycle G{motion:g} under a coordinate system rotation", item.start + 1)
+        if motion == 87.0 and not self.back_bore_holes:
+            return self._fanuc_back_bore(block, words, previous, item)
         first, second, normal = PLANE_AXES[self.plane]
         again = previous == motion  # the same cycle again: R, the normal-axis word, P and Q are sticky
-        if previous not in CANNED:  # a new series: G98 retracts to where it started, no dwell yet
+        if previous not in self.canned:  # a new series: G98 retracts to where it started, no dwell yet
             self.cycle_il, self.cycle_p, self.cycle_p_word = self.pos[normal], 0.0, None
         aa, bb, step_a, step_b, r, bottom = self._cycle_geometry(block, words, again, item)
-        repeats = self._repeats(block, words)
+        repeats = self._repeats(block, words, motion)
         peck = self._cycle_word(block, words, motion, again, item)
         if motion in (74.0, 84.0) and self.plane != 17 and not self.taps_in_any_plane:
             raise _OutOfScope(f"canned cycle G{motion:g} outside the XY plane", item.start + 1)
@@ -2200,7 +2220,7 @@ class Interpreter:
             return self._expanded(block, motion, lines, bottoms, dwell)
         # holes apply_error_map compensates: in any plane (polar words written as X Y, repeats as a
         # block each), the series' holes all such
-        self.cycle_holes = (previous not in CANNED or self.cycle_holes) and (
+        self.cycle_holes = (previous not in self.canned or self.cycle_holes) and (
             motion != 87.0 or self.back_bore_holes
         )
         if self.cycle_holes:
@@ -2208,11 +2228,67 @@ class Interpreter:
             offset, top_level = ((off_a, off_b), middle) if motion == 87.0 else ((0.0, 0.0), None)
             for n, ((k, hole_a, hole_b), end) in enumerate(zip(holes, ends)):
                 drilled = Hole(motion, hole_a, hole_b, bottom, r, peck, rapid_delta, self.retract_to_r,
-                               previous not in CANNED and n == 0, n, len(holes),
+                               previous not in self.canned and n == 0, n, len(holes),
                                plane=self.plane, offset=offset, top=top_level)  # fmt: skip
                 for line in lines[k:end]:
                     line.fixed, line.hole = HOLE, drilled
         return lines
+
+    def _fanuc_back_bore(self, block: Block, words: dict, previous: float | None, item) -> tuple[Event, ...]:
+        """Fanuc's back boring G87, its moves left as programmed (CYCLE): to X Y, shifted by I J with
+        the spindle oriented, down to R below the part, back over the hole, feed up to Z, shifted again,
+        up to the level the series started at and back over the hole (Fanuc Series 15i-MA operator's
+        manual, "Back boring cycle (G87)": R the level below the part the cut starts from, Z its top,
+        G99 not used; "Shift specification by I_J_"; G91: R from the initial level, Z from R).  In the
+        XY plane with the shift in I J (one not given is 0); its shift in Q or neither I nor J (the
+        shift's direction a parameter of the control's), another plane (where I J K name the shift
+        otherwise) or G99 are out of scope."""
+        if not self.fanuc_back_bore:
+            raise _OutOfScope("G87 on Haas (no Haas manual page in ncpp's reference set reads it as Fanuc's)",
+                              item.start + 1)  # fmt: skip
+        if "Q" in words:
+            raise _OutOfScope("back boring G87 with its shift in Q", words["Q"][1].start + 1)
+        if self.plane != 17:
+            raise _OutOfScope("Fanuc's back boring G87 outside the XY plane", item.start + 1)
+        if self.retract_to_r:
+            raise _OutOfScope("Fanuc's back boring G87 in G99", item.start + 1)
+        again = previous == 87.0
+        if previous not in self.canned:
+            self.cycle_il = self.pos[2]
+        for letter in "RZ" if not again else ():
+            if letter not in words:
+                self._fail(f"{letter} word missing with G87", block, item)
+        if not again and "I" not in words and "J" not in words:  # (its shift in Q, a parameter's direction)
+            raise _OutOfScope("Fanuc's back boring G87 without I or J", item.start + 1)
+        if self.feed == 0.0:
+            self._fail("Cannot feed with zero feed rate", block, item)
+        self._check_spindle(block, 87.0, item)
+        r_word, z_word = (
+            words[k][0] if k in words else kept for k, kept in (("R", self.cycle_r), ("Z", self.cycle_cc))
+        )
+        kept = self.cycle_ijk if again else (0.0, 0.0, 0.0)  # (a new series: an I or J not given is 0)
+        shift = tuple(words[k][0] if k in words else kept[n] for n, k in enumerate("IJ"))
+        self.cycle_r, self.cycle_cc, self.cycle_ijk = r_word, z_word, (shift[0], shift[1], 0.0)
+        start = self.pos
+        x, y = (words[k][0] if k in words else start[n] for n, k in enumerate("XY"))
+        r, top = (
+            (r_word, z_word) if self.absolute else (self.cycle_il + r_word, self.cycle_il + r_word + z_word)
+        )
+        step = (0.0, 0.0) if self.absolute else (words.get("X", (0.0,))[0], words.get("Y", (0.0,))[0])
+        if not self.absolute:
+            x, y = start[0], start[1]
+        if r >= top:  # (not a back bore: the cut would go down)
+            raise _OutOfScope("Fanuc's back boring G87 with R not below Z", item.start + 1)
+        moves: list[tuple[float, float, float, bool]] = []
+        level, il = start[2], self.cycle_il
+        for _ in range(self._repeats(block, words, 87.0)):
+            x, y = x + step[0], y + step[1]
+            off_x, off_y = x + shift[0], y + shift[1]
+            moves += [(x, y, level, True), (off_x, off_y, level, True), (off_x, off_y, r, True), (x, y, r, True),
+                      (x, y, top, False), (off_x, off_y, top, True), (off_x, off_y, il, True), (x, y, il, True)]  # fmt: skip
+            level = il
+        self.cycle_holes = False
+        return tuple(self._fixed_line(block, (0, 1, 2), move) for move in moves)
 
     def _cycle_geometry(self, block: Block, words: dict, again: bool, item) -> tuple[float, ...]:
         """(aa, bb, their step per repeat, R, bottom) of a cycle in plane coordinates; keeps the
@@ -2339,15 +2415,22 @@ class Interpreter:
             self._fail(f"a canned cycle of {what}: ncpp takes {MAX_CYCLE_MOVES:,} moves in one block at most",
                        block, words.get("L", words.get("Q", (0, item)))[1])  # fmt: skip
 
-    def _repeats(self, block: Block, words: dict) -> int:
-        """A cycle's L: how many times it runs (1 without L)."""
-        if "L" not in words:
+    def _repeats(self, block: Block, words: dict, motion: float) -> int:
+        """A cycle's L (Fanuc: or K, `repeat_letters`; not G87's K, the top of its cut there): how many
+        times it runs (1 without)."""
+        given = [letter for letter in self.repeat_letters
+                 if letter in words and (letter != "K" or motion != 87.0 or not self.back_bore_holes)]  # fmt: skip
+        if not given:
             return 1
-        value, item = words["L"]
+        if len(given) > 1:
+            raise _OutOfScope("a canned cycle with both K and L repeats", words[given[1]][1].start + 1)
+        value, item = words[given[0]]
         if value != round(value):
             self._fail("Non integer value for integer", block, item)
         if value < 0:
             self._fail("Negative L word used", block, item)
+        if value == 0 and given[0] == "K":  # (Fanuc: the cycle's data is stored, no hole drilled)
+            raise _OutOfScope("a canned cycle with K0", item.start + 1)
         if value == 0:
             self._fail("Cannot do zero repeats of cycle", block, item)
         return int(value)
@@ -2572,7 +2655,9 @@ _PLAIN_LETTERS = {
     1.0: frozenset("XYZABCUVWF"),
     2.0: frozenset("XYZABCUVWFIJKR"),
     3.0: frozenset("XYZABCUVWFIJKR"),
-    **{code: frozenset() for code in CANNED},  # a cycle's words are checked in full
+    **{
+        code: frozenset() for code in (*CANNED, 76.0)
+    },  # a cycle's words are checked in full (Fanuc's G76 too)
     RIGID_TAP: frozenset(),  # a modal G33.1 block needs its K again (rs274ngc: "K word missing")
 }
 
@@ -2597,6 +2682,14 @@ def _marked(events: Event | tuple[Event, ...] | None, marks: list[Pass]) -> Even
     if events is None:
         return marks[0] if len(marks) == 1 else tuple(marks)
     return (*(events if type(events) is tuple else (events,)), *marks)
+
+
+def _tape_mark(block: Block) -> bool:
+    """Whether the block is a `%` line that is a tape mark: the last line the flow runs, it is the
+    program's closing one, after which nothing runs, as after M2 (the NIST RS274NGC Interpreter,
+    version 3, "File": "The useful contents of a file demarcated by percents stop after the second
+    percent line"; LinuxCNC G-code overview, "File Requirements")."""
+    return bool(block.items) and type(block.items[0]) is Statement and block.items[0].kind == "tape"
 
 
 def _sets_offset(event: Event | tuple[Event, ...]) -> bool:

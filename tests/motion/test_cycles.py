@@ -218,7 +218,7 @@ def test_random_cycle_programs_agree_with_rs274(tmp_path):
                                                ("G19 G83 Y1 Z1 X-3 R2 Q1 L2", HOLE, 2),
                                                ("G87 X1 Y1 Z-3 R2 I1 J0 K-1", HOLE, 1),
                                                ("G19 G91 G87 Y1 Z1 X-3 R-2 I-1 J1 K0.5 L2", HOLE, 2),
-                                               ("fanuc G87 X1 Y1 Z-3 R2 I1 J0 K-1", CYCLE, 0)])  # fmt: skip
+                                               ("fanuc G98 G87 X1 Y1 Z-1 R-3 I1 J0 K2", CYCLE, 0)])  # fmt: skip
 def test_cycle_moves_are_fixed(cycle, why, holes):
     """A hole is compensated as a whole (HOLE) in any plane, each of a block's repeats its own,
     rs274ngc's back bore G87 too; Fanuc's G87, whose words read otherwise, is left as programmed
@@ -242,14 +242,14 @@ def _compensate(text: str, strict: bool = False) -> tuple[str, str]:
 
 DRILL = (
     HEAD
-    + "G1 Z-1\nX40 Y12\nG0 Z5 M3\nG98 G87 X20 Y20 Z-3 R2 I1 J0 K-1 L2\nX30\n(between)\nX40 Y25\nG80\nG0 X50 Y50\nG1 Z-1\nX70 Y40\nG3 X80 Y60 R15\nG0 Z10\nM2\n"
+    + "G1 Z-1\nX40 Y12\nG0 Z5 M3\nG98 G87 X20 Y20 Z-1 R-3 I1 J0 L2\nX30\n(between)\nX40 Y25\nG80\nG0 X50 Y50\nG1 Z-1\nX70 Y40\nG3 X80 Y60 R15\nG0 Z10\nM2\n"
 )
 
 
 def test_cycles_pass_through_and_compensation_resumes():
     out, warned = _compensate(DRILL)
     lines = out.splitlines()
-    cycle = ["G98 G87 X20 Y20 Z-3 R2 I1 J0 K-1 L2", "X30", "(between)", "X40 Y25", "G80"]
+    cycle = ["G98 G87 X20 Y20 Z-1 R-3 I1 J0 L2", "X30", "(between)", "X40 Y25", "G80"]
     start = lines.index(cycle[0])
     assert lines[start : start + len(cycle)] == cycle  # verbatim
     # one warning, naming the line where the series starts
@@ -263,12 +263,14 @@ def test_a_warning_repeated_hundreds_of_times_is_printed_five_times_then_counted
     """A drilling program warns at each of its 300 cycle series: five are printed (the fifth
     says the rest are counted), then one line at the end tells how many and where."""
     holes = "".join(
-        f"G0 X{k % 20 * 5} Y{k // 20 * 5}\nG87 Y{k // 20 * 5} Z-3 R2 I1 J0 K-1 F100 L2\nG80\nG1 X{k % 20 * 5 + 2}\n"
+        f"G0 X{k % 20 * 5} Y{k // 20 * 5}\nG98 G87 Y{k // 20 * 5} Z-1 R-3 I1 J0 F100 L2\nG80\nG1 X{k % 20 * 5 + 2}\n"
         for k in range(300)
     )
     out, warned = _compensate(HEAD + "M3\n" + holes + "M2\n")
     said = warned.splitlines()
-    series = [n + 1 for n, line in enumerate((HEAD + "M3\n" + holes).splitlines()) if line.startswith("G87")]
+    series = [
+        n + 1 for n, line in enumerate((HEAD + "M3\n" + holes).splitlines()) if line.startswith("G98 G87")
+    ]
     assert [line.split(": warning: ")[0] for line in said] == [
         f"drill.ngc:{n}:1" for n in (*series[:5], series[-1])
     ]
@@ -332,7 +334,7 @@ def test_compensation_goes_on_after_a_g91_cycle(after):
     """A G91 cycle runs its increments from where the control stands, its G98 retract to the
     level it started from: apply_error_map carries it (test_exact_model measures the moves
     after it on the machine), and compensates the moves after it, in G90 or G91."""
-    text = HEAD + "G1 Z-1\nX40 Y12\nG0 Z5 M3\nG91 G98 G87 X10 Y10 Z-3 R-3 I1 J0 K1 L2\nG17\n" + after
+    text = HEAD + "G1 Z-1\nX40 Y12\nG0 Z5 M3\nG91 G98 G87 X10 Y10 R-8 Z3 I1 J0 L2\nG17\n" + after
     out, warned = _compensate(text)
     assert (
         "in G91" not in warned
@@ -345,12 +347,20 @@ def test_compensation_goes_on_after_a_g91_cycle(after):
         written[-1] != original[-1]
         and 0 < abs(float(last[1]) - float(original[-1].split("X")[1].split()[0])) < 0.1
     )
-    assert "G91 G98 G87 X10 Y10 Z-3 R-3 I1 J0 K1 L2" in written
+    assert "G91 G98 G87 X10 Y10 R-8 Z3 I1 J0 L2" in written
 
 
 @pytest.mark.skipif(not RS274.exists(), reason="no rs274")
 def test_rs274_accepts_the_compensated_cycles(tmp_path):
-    out, _ = _compensate(DRILL)
+    """The program around a series left as programmed (a cycle in a loop: rs274ngc does not read
+    Fanuc's G87) is written so that rs274 runs it."""
+    looped = DRILL.replace(
+        "G98 G87 X20 Y20 Z-1 R-3 I1 J0 L2\nX30\n(between)\nX40 Y25\nG80\n",
+        "o1 repeat [2]\nG98 G81 X20 Y20 Z-3 R2\nX30\n(between)\nX40 Y25\nG80\no1 endrepeat\n",
+    )
+    assert looped != DRILL
+    out, warned = compensate(looped, "drill.ngc", False)
+    assert "warning: canned cycle" in warned
     path = tmp_path / "out.ngc"
     path.write_text(out)
     _, messages = rs274(str(path))

@@ -141,16 +141,61 @@ def test_each_back_bore_cuts_to_its_top_and_stands_at_its_bottom_and_r(
     assert _passes_pathcheck(original, output)
 
 
-@pytest.mark.parametrize("dialect", ["fanuc", "haas"])
-def test_fanuc_back_boring_stays_as_programmed(tmp_path, dialect):
-    """Fanuc's G87 reads R, Z and K otherwise (R below the part, Z the top of the cut, K repeats:
-    Fanuc Series 15i-MA operator's manual, "Back boring cycle (G87)"): left as programmed, with the
-    warning."""
+# A Fanuc program's G87 (Fanuc Series 15i-MA operator's manual, "Back boring cycle (G87)": to X Y,
+# shifted by I J with the spindle oriented, down to R below the part, back over the hole, feed up to
+# Z, shifted again, up to the initial level, back over the hole; G98 only; G91: R from the initial
+# level, Z from R), and the same moves written out by hand for rs274: each G87 block's lines
+FANUC_BACK_BORES = {
+    "G98 G87 X200 Y150 Z-10 R-45 I2 J-1 F100\n": "G0 X200 Y150\nX202 Y149\nZ-45\nX200 Y150\nG1 Z-10 F100\n"
+    "G0 X202 Y149\nZ25\nX200 Y150\n",
+    "X-180 Y220\n": "G0 X-180 Y220\nX-178 Y219\nZ-45\nX-180 Y220\nG1 Z-10\nG0 X-178 Y219\nZ25\nX-180 Y220\n",
+    "G91 G98 G87 X10 Y5 R-60 Z20 I-1 K2\n": "G90 G0 X20 Y15\nX19\nZ-55\nX20\nG1 Z-35\nG0 X19\nZ5\n"
+    "X20\nX30 Y20\nX29\nZ-55\nX30\nG1 Z-35\nG0 X29\nZ5\nX30\nG91\n",
+}
+FANUC_PROGRAM = """%
+G21 G90 G17
+G0 X40 Y30 Z25 S500 M3
+G1 X60 Y50 F300
+G98 G87 X200 Y150 Z-10 R-45 I2 J-1 F100
+X-180 Y220
+G80
+G1 X10 Y10 Z5 F300
+G91 G98 G87 X10 Y5 R-60 Z20 I-1 K2
+G90 G80
+G1 X-100 Y80 Z3
+X-150 Y-120 Z-2
+M30
+%
+"""
+
+
+def _written_out(text: str) -> str:
+    """`text` with its G87 blocks as the moves Fanuc makes of them (`FANUC_BACK_BORES`), for rs274."""
+    lines = text.splitlines(keepends=True)
+    return "".join(FANUC_BACK_BORES.get(line, line) for line in lines if line.strip() not in ("%", "G80"))
+
+
+def test_around_a_fanuc_back_bore_left_as_programmed_the_moves_land_where_programmed(tmp_path):
+    """Fanuc's G87 reads its words otherwise than rs274ngc: left as programmed, with the warning, and
+    compensation resumes where the cycle leaves the tool, over the hole at the initial level.  Judged
+    by rs274 running both programs with their G87 blocks written out by hand as Fanuc's moves, mapped
+    through the hand-written machine: every feed end but the cycles' within 0.5 µm."""
     original = tmp_path / "back.nc"
-    original.write_text("%\nG21 G90 G17\nG0 X40 Y30 Z25 S500 M3\nG98 G87 X200 Y150 Z-30 R5 I2 J-1 K-12 F100\n"
-                        "X-180 Y220\nG80\nM30\n%\n")  # fmt: skip
+    original.write_text(FANUC_PROGRAM)
     said = io.StringIO()
-    output = compensate_file(original, MACHINE, tmp_path, warnings=Warnings(stream=said), dialect=dialect)
-    lines = output.read_text().splitlines()
-    assert "G98 G87 X200 Y150 Z-30 R5 I2 J-1 K-12 F100" in lines and "X-180 Y220" in lines
-    assert "back.nc:4:1: warning: canned cycle" in said.getvalue()
+    output = compensate_file(original, MACHINE, tmp_path, warnings=Warnings(stream=said), dialect="fanuc")
+    text = output.read_text()
+    assert all(line in text for line in FANUC_BACK_BORES)  # (the cycles' blocks as they stand)
+    assert "back.nc:5:1: warning: canned cycle" in said.getvalue()
+    runs = []
+    for path in (original, output):
+        plain = tmp_path / (path.stem + "-moves.ngc")
+        plain.write_text(_written_out(path.read_text()))
+        runs.append(plain)
+    wanted = np.array([b for _, b, feeds in _moves(runs[0]) if feeds])
+    reached = np.array(
+        [m[-1] for (_, _, feeds), m in zip(_moves(runs[1]), actual_moves(runs[1], square)) if feeds]
+    )
+    misses = np.linalg.norm(wanted[:, None, :] - reached[None, :, :], axis=2).min(axis=1) * 1000
+    cut = np.isclose(wanted[:, 2], -10) | np.isclose(wanted[:, 2], -35)  # (the cycles' cuts, as programmed)
+    assert misses[cut].min() > 1.0 and misses[~cut].max() <= 0.5, misses

@@ -5,6 +5,7 @@ X-Y and X-Z), not by ncpp's interpreter or model."""
 
 from __future__ import annotations
 
+import io
 import re
 import subprocess
 import sys
@@ -13,6 +14,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from ncpp.errors import Warnings
 from tests import rs274
 from tests.compensation.accuracy import Machine, _moves, actual_moves, rs274_calls
 from tests.conftest import SHARED
@@ -278,6 +280,116 @@ def test_a_g92_after_a_compensated_hole_sets_the_programs_offset(tmp_path):
     wanted = np.array([[20, 10, 20], [-5, 40, 3]], dtype=float) + shift
     got = np.array([args[:3] for name, args in rs274_calls(output) if name == "STRAIGHT_FEED"][-2:]) + shift
     assert np.abs(square(got, np.ones(3)) - wanted).max() * 1000 <= 0.5
+
+
+def test_fanuc_repeats_in_k_land_where_programmed(tmp_path):
+    """A Fanuc cycle's K is its repeats, as rs274ngc's L (`FanucInterpreter.repeat_letters`): each
+    hole of the G91 rows lands on its programmed bottom and R, judged by rs274 running the written
+    program and the original read with L for K."""
+    original = tmp_path / "repeats.nc"
+    program = PROGRAM_G91.replace("M2\n", "M30\n")
+    original.write_text(program.replace(" L", " K"))
+    output = compensate_file(original, MACHINE, tmp_path, dialect="fanuc")
+    assert not re.search(r"\bK\d", output.read_text())  # (a block per hole, the first without its K)
+    as_linuxcnc = tmp_path / "repeats.ngc"
+    as_linuxcnc.write_text(program)
+    wanted = np.array(HOLES_G91, dtype=float)
+    before, after = drilled(as_linuxcnc, square), drilled(output, square)
+    assert len(after) == len(wanted)
+    off_before = np.array([np.linalg.norm(b - h[:3]) for (b, _), h in zip(before, wanted)]) * 1000
+    off_after = np.array([np.linalg.norm(b - h[:3]) for (b, _), h in zip(after, wanted)]) * 1000
+    r_after = np.array([abs(r - h[3]) for (_, r), h in zip(after, wanted)]) * 1000
+    assert off_before.min() > 1.5
+    assert off_after.max() <= 0.5, off_after
+    assert r_after.max() <= 0.5, r_after
+    assert _passes_pathcheck(as_linuxcnc, output)
+
+
+@pytest.mark.parametrize(
+    "dialect, words, where",
+    [("fanuc", "Q2", "4:29: warning: back boring G87 with its shift in Q"),
+     ("fanuc", "", "4:5: warning: Fanuc's back boring G87 without I or J"),
+     ("fanuc", "I2 J1 G99", "4:5: warning: Fanuc's back boring G87 in G99"),
+     ("haas", "I2 J1", "4:5: warning: G87 on Haas")],
+)  # fmt: skip
+def test_a_back_bore_whose_shift_is_not_told_passes_through(tmp_path, dialect, words, where):
+    """Fanuc's G87 shifts the tool by Q (or without I and J) in a direction a parameter of the
+    control's sets (Fanuc Series 15i-MA operator's manual, "Back boring cycle (G87)", "Shift
+    specification by Q_"), and takes no G99: the program passes through from there, with a warning,
+    where rs274ngc's reading refused it; so does a Haas program's G87."""
+    retract, words = ("G99", words.removesuffix(" G99")) if words.endswith("G99") else ("G98", words)
+    block = f"{retract} G87 X200 Y150 Z-30 R-45 {words} F100".replace("  ", " ")
+    original = tmp_path / "back.nc"
+    original.write_text(f"%\nG21 G90 G17\nG0 X40 Y30 Z25 S500 M3\n{block}\nG80\nG0 X10 Y10\nM30\n%\n")
+    said = io.StringIO()
+    output = compensate_file(original, MACHINE, tmp_path, warnings=Warnings(stream=said), dialect=dialect)
+    assert output.read_text().endswith(f"{block}\nG80\nG0 X10 Y10\nM30\n%\n")
+    assert f"back.nc:{where}" in said.getvalue()
+
+
+# Fanuc's fine boring G76 (G90, G91 with K repeats, G98 and G99): (X, Y, Z bottom, R) of each hole
+HOLES_FINE = [(100, 120, -16, 3), (30, 40, -16, 3), (150, -50, -20, 5),
+              (170, -45, -2, 8), (190, -40, -2, 8), (210, -35, -2, 8)]  # fmt: skip
+PROGRAM_FINE = """G21 G90 G17
+G0 X40 Y30 Z25
+M3 S500
+G1 X45 Y35 F300
+G99 G76 X100 Y120 R3 Z-16 Q0.2 P0 F100
+X30 Y40
+G98 G76 X150 Y-50 R5 Z-20 Q0.2 P0.5
+G80
+G0 Z30
+G91 G99 G76 X20 Y5 R-22 Z-10 Q0.2 P0 K3
+G90 G80
+G1 X-100 Y80 Z3
+M5
+M30
+"""
+
+
+def _as_g86(path: Path) -> Path:
+    """`path` with its fine boring as rs274ngc's G86 (feed to the bottom, dwell, spindle stop, rapid
+    out: LinuxCNC G-code manual, G86), the moves Fanuc's G76 makes but the shift off the wall at the
+    bottom and back above the hole (Fanuc Series 15i-MA operator's manual, "Fine boring cycle (G76)"),
+    its K as L."""
+    text = re.sub(r"\s*Q[\d.]+", "", path.read_text().replace("G76", "G86"))
+    plain = path.with_name(path.stem + "-g86.ngc")
+    plain.write_text(re.sub(r"\bK(\d)", r"L\1", text))
+    return plain
+
+
+@pytest.mark.parametrize("dialect", ["fanuc", "haas"])
+def test_fanuc_fine_boring_lands_where_programmed(tmp_path, dialect):
+    """Fanuc's and Haas's G76 (fine boring: the spindle orients at the bottom and the tool shifts off
+    the wall before it rapids out) is compensated hole by hole as the other cycles: each hole's bottom
+    and R point, as rs274 runs the written program with its G76 as G86, mapped through the hand-written
+    machine, within 0.5 µm of the programmed point.  (Haas counts repeats in L.)"""
+    original = tmp_path / "fine.nc"
+    original.write_text(PROGRAM_FINE if dialect == "fanuc" else PROGRAM_FINE.replace(" K3", " L3"))
+    output = compensate_file(original, MACHINE, tmp_path, dialect=dialect)
+    assert re.search(r"^G99 G76 X[\d.]+ Y[\d.]+ R[\d.]+ Z-[\d.]+ Q0.2 P0 F100$", output.read_text(), re.M)
+    wanted = np.array(HOLES_FINE, dtype=float)
+    assert np.allclose([tuple(b) + (r,) for b, r in drilled(_as_g86(original), None)], wanted, atol=1e-6)
+    before, after = drilled(_as_g86(original), square), drilled(_as_g86(output), square)
+    assert len(after) == len(wanted)
+    off_before = np.array([np.linalg.norm(b - h[:3]) for (b, _), h in zip(before, wanted)]) * 1000
+    off_after = np.array([np.linalg.norm(b - h[:3]) for (b, _), h in zip(after, wanted)]) * 1000
+    r_after = np.array([abs(r - h[3]) for (_, r), h in zip(after, wanted)]) * 1000
+    assert off_before.min() > 1.5
+    assert off_after.max() <= 0.5, off_after
+    assert r_after.max() <= 0.5, r_after
+    assert _passes_pathcheck(_as_g86(original), _as_g86(output))
+
+
+def test_a_fanuc_cycle_of_k0_passes_through(tmp_path):
+    """K0 stores the cycle's data and drills no hole (the repeats' count 0): the program passes
+    through from there, with a warning, where rs274ngc's reading refused the K."""
+    original = tmp_path / "k0.nc"
+    original.write_text("%\nG21 G90 G17\nG0 X40 Y30 Z25\nG99 G81 X20 Y30 Z-3 R2 K0 F100\nX30\nG80\nM30\n%\n")
+    said = io.StringIO()
+    output = compensate_file(original, MACHINE, tmp_path, warnings=Warnings(stream=said), dialect="fanuc")
+    assert output.read_text().endswith("G99 G81 X20 Y30 Z-3 R2 K0 F100\nX30\nG80\nM30\n%\n")
+    assert "k0.nc:4:24: warning: a canned cycle with K0" in said.getvalue()
 
 
 # Taps in G18 and G19 (Fanuc: the drilling axis is the plane's normal for every cycle), G90 and G91

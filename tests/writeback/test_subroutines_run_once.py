@@ -91,6 +91,18 @@ def test_a_subroutine_defined_before_its_one_call_is_compensated_where_it_is_def
     assert check.returncode == 0, check.stdout + check.stderr
 
 
+def test_a_subroutine_run_once_in_a_program_ended_by_its_closing_percent_is_compensated(tmp_path):
+    """A program between `%` lines ends at the second (LinuxCNC G-code manual, "File Requirements"),
+    as at M2: nothing runs after it, so a subroutine called once there ran once."""
+    warned = io.StringIO()
+    program = "%\n" + DEFINED_BEFORE.replace("M2\n", "%\n")
+    original, output = _compensated(tmp_path, program, warnings=Warnings(stream=warned))
+    assert _misses_um(original, output).max() <= 0.5
+    assert "loop or subroutine" not in warned.getvalue()
+    check = _pathcheck(original, output, "--tol-mm", "0.02")
+    assert check.returncode == 0, check.stdout + check.stderr
+
+
 def test_of_two_defined_before_their_calls_the_one_called_once_is_compensated(tmp_path):
     """The lines held wait for both definitions: the one called twice is told to stay as
     programmed, the other's run is written at its definition."""

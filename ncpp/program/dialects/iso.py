@@ -660,7 +660,10 @@ class IsoWriter:
         firsts = [m for k, m in enumerate(moves) if k == 0 or m.hole is not moves[k - 1].hole]
         spelled = self._spelling(block)
         words = [self._hole_words(move) for move in firsts]
-        drop = "@^L" if firsts[0].hole.repeats > 1 else "@^"  # type: ignore[union-attr]
+        hole = firsts[0].hole
+        assert hole is not None
+        # (the repeats' word: L, or Fanuc's K, where K is no G87's top)
+        drop = "@^" + ("L" + ("K" if hole.top is None else "") if hole.repeats > 1 else "")
         lines = [set_words(_literal_geometry(block, GEOMETRY_LETTERS + drop), words[0], drop=drop,
                            spelled=spelled) + block.eol]  # fmt: skip
         separator, lower = spelled
