@@ -100,7 +100,11 @@ class ToolCentre:
         # an arc from where a move left as programmed ended starts there: it is left as programmed too
         # (compensated, it would start at its corrected start, a step away, which the control would offset);
         # so is a line that moves no axis of the plane (its corrected end would be such a step, made alone)
-        follows = also and followed(moves) and (corrected or (type(moves[0]) is not Arc and _moves_in_plane(moves[0])))
+        follows = (
+            also
+            and followed(moves)
+            and (corrected or (type(moves[0]) is not Arc and _moves_in_plane(moves[0])))
+        )
         entry = follows and side is not None and not self.off_path
         if follows and side is not None and self.waiting:
             self._approached(moves, side)
