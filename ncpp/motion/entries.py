@@ -1,0 +1,94 @@
+"""A step back to the programmed point before a loop or subroutine that sets an offset from where the
+control stands.
+
+A G92 or G10 L10/L11/L20 in text that runs more than once, or away from where it stands, ends
+interpretation (`Interpreter._in_flow`): each run would set its offset from another point.  The
+control reaches such a construct standing where the last compensated move put it, off the
+programmed point by that move's correction, and the construct runs as programmed from there: the
+offset the block sets would carry the correction, and so would every move after it.  Written right
+before the construct's first line (its head: the `o100 while`, the call, the first line a backward
+GOTO runs again), a step back to the programmed point puts the control where the program means, and
+the construct then runs as the original does (a step inside it would run again with each pass).
+
+Whether a construct sets such an offset is known only once a run of it does, so the interpreter
+marks where a construct entered from straight code starts (`Entered`), where straight code comes
+back (`STRAIGHT`), and where a setting in it ends interpretation (`LeftAtSetting`); `stepped_back`
+holds the events from a head to the straight code after it (bounded), and gives the held construct
+its step (a `Pass` whose `Setting` sets no value: `Setting.values` empty) where one ends
+interpretation.  Where no step has a place (the head is already written, the construct was entered
+from another one), it warns."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable, Iterator
+from dataclasses import dataclass
+
+from ncpp.errors import Location
+from ncpp.motion.segments import Event, Pass
+
+# Events held from a construct's head until straight code comes back: past them the head is written
+# (memory stays bounded) and a setting in the construct gets a warning instead of its step
+MAX_HELD = 10_000
+
+NO_STEP = (
+    "a G92 or G10 L10/L11/L20 in a loop or subroutine ends interpretation, and ncpp cannot write a step "
+    "back to the programmed point before the construct that runs it ({why}): the control reaches it where the "
+    "last compensated move left it, so the offset it sets, and every move after it, may carry that move's "
+    "correction; put the tool at a programmed point with a move that names each axis the block sets before the "
+    "loop or call, or compensate with --expand"
+)
+
+
+@dataclass(frozen=True, slots=True)
+class Entered:
+    """A construct entered from straight code starts with the next event; `step`: its step back."""
+
+    step: Pass
+
+
+@dataclass(frozen=True, slots=True)
+class LeftAtSetting:
+    """A setting in a loop or subroutine ended interpretation, at `where` (warned of there)."""
+
+    where: Location
+
+
+class _Straight:
+    """Straight code again: the construct under way has ended."""
+
+
+STRAIGHT = _Straight()
+Marked = Event | tuple | Entered | LeftAtSetting | _Straight
+
+
+def stepped_back(items: Iterable[Marked], warn: Callable[[str, Location], None]) -> Iterator[Event | tuple]:
+    """The items without the marks, a construct's step back before its head where a setting in it
+    ends interpretation (see the module docstring)."""
+    held: list[Event | tuple] | None = None  # a construct's events from its head, while it runs
+    step: Pass | None = None
+    unheld = ""  # why a construct under way is not held ("": none is, or it is)
+    for item in items:
+        kind = type(item)
+        if kind is Entered:
+            held, step, unheld = [], item.step, ""  # type: ignore[union-attr]
+        elif item is STRAIGHT:
+            if held:
+                yield from held
+            held, unheld = None, ""
+        elif kind is LeftAtSetting:
+            if held is not None:
+                yield step  # type: ignore[misc]
+                yield from held
+            else:
+                why = unheld or "it does not start in straight code"
+                warn(NO_STEP.format(why=why), item.where)  # type: ignore[union-attr]
+            held, unheld = None, ""
+        elif held is None:
+            yield item  # type: ignore[misc]
+        else:
+            held.append(item)  # type: ignore[arg-type]
+            if len(held) > MAX_HELD:
+                yield from held
+                held, unheld = None, f"its head was written before, {MAX_HELD:,} events ahead"
+    if held:
+        yield from held
