@@ -39,56 +39,62 @@ NO_STEP = (
 )
 
 
-@dataclass(frozen=True, slots=True)
-class Entered:
-    """A construct entered from straight code starts with the next event; `step`: its step back."""
+class Mark:
+    """A mark in the interpreter's events: where a construct entered from straight code starts
+    (`entered`: its step back, before the next event), where straight code comes back (`STRAIGHT`),
+    and where a setting in a construct ended interpretation (`left_at`: the place warned at)."""
 
-    step: Pass
+    __slots__ = ("step", "where", "setting")
 
-
-@dataclass(frozen=True, slots=True)
-class LeftAtSetting:
-    """A setting in a loop or subroutine ended interpretation, at `where` (warned of there)."""
-
-    where: Location
+    def __init__(self, step: Pass | None = None, where: Location | None = None, setting: bool = False):
+        self.step, self.where, self.setting = step, where, setting
 
 
-class _Straight:
-    """Straight code again: the construct under way has ended."""
+STRAIGHT = Mark()
 
 
-STRAIGHT = _Straight()
-Marked = Event | tuple | Entered | LeftAtSetting | _Straight
+def entered(step: Pass) -> Mark:
+    return Mark(step=step)
 
 
-def stepped_back(items: Iterable[Marked], warn: Callable[[str, Location], None]) -> Iterator[Event | tuple]:
+def left_at(where: Location, setting: bool = False) -> Mark:
+    """Interpretation ended at `where` in the construct under way; `setting`: at a block that sets an
+    offset from where the control stands (warned of where no step back has a place)."""
+    return Mark(where=where, setting=setting)
+
+
+def stepped_back(items: Iterable, warn: Callable[[str, Location], None]) -> Iterator[Event | tuple]:
     """The items without the marks, a construct's step back before its head where a setting in it
     ends interpretation (see the module docstring)."""
-    held: list[Event | tuple] | None = None  # a construct's events from its head, while it runs
-    step: Pass | None = None
-    unheld = ""  # why a construct under way is not held ("": none is, or it is)
+    items = iter(items)
+    unheld = ""  # why the construct under way is not held ("": none is, or it is)
     for item in items:
-        kind = type(item)
-        if kind is Entered:
-            held, step, unheld = [], item.step, ""  # type: ignore[union-attr]
-        elif item is STRAIGHT:
-            if held:
-                yield from held
-            held, unheld = None, ""
-        elif kind is LeftAtSetting:
-            if held is not None:
-                yield step  # type: ignore[misc]
-                yield from held
-            else:
-                why = unheld or "it does not start in straight code"
-                warn(NO_STEP.format(why=why), item.where)  # type: ignore[union-attr]
-            held, unheld = None, ""
-        elif held is None:
-            yield item  # type: ignore[misc]
+        if type(item) is not Mark:  # (the common case: straight code, nothing held)
+            yield item
+        elif item.step is not None:
+            unheld = yield from _held(items, item.step)
+        elif item.where is not None:
+            if item.setting:
+                warn(NO_STEP.format(why=unheld or "it does not start in straight code"), item.where)
         else:
-            held.append(item)  # type: ignore[arg-type]
+            unheld = ""
+
+
+def _held(items: Iterator, step: Pass) -> Iterator[Event | tuple]:
+    """A construct's events from its head (the mark that starts it went by): held until straight code
+    comes back, given `step` first where a setting in it ends interpretation.  Returns why a
+    setting in it is not stepped back to ("": it is, or it ended)."""
+    held: list = []
+    for item in items:
+        if type(item) is not Mark:
+            held.append(item)
             if len(held) > MAX_HELD:
                 yield from held
-                held, unheld = None, f"its head was written before, {MAX_HELD:,} events ahead"
-    if held:
+                return f"its head was written before, {MAX_HELD:,} events ahead"
+            continue
+        if item.where is not None:
+            yield step
         yield from held
+        return ""  # (a construct does not start inside another: `Interpreter._enters`)
+    yield from held
+    return ""

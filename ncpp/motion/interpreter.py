@@ -61,7 +61,7 @@ from ncpp.motion.cycles import (
     hole,
 )
 from ncpp.motion.endless import exact
-from ncpp.motion.entries import STRAIGHT, Entered, LeftAtSetting, stepped_back
+from ncpp.motion.entries import STRAIGHT, entered, left_at, stepped_back
 from ncpp.motion.expand import Expansion, number, refused
 from ncpp.motion.expressions import ExpressionError, OutOfScope, Parameters, evaluate, vacant
 from ncpp.motion.flow import CALLED, FIXED, ONCE, RUN, SKIP, TEXT, Flow, MainProgram
@@ -427,6 +427,8 @@ class Interpreter:
         self.zeros_set: dict[int, bool] = {}
         self.warnings: Warnings | None = None
         self.flow: Flow | None = None  # while `run` runs
+        # where interpretation ended, and at which block, until `_run` tells `entries.stepped_back`
+        self.stopped: tuple[Location, Block] | None = None
         # Fanuc: the axes (0 X, 1 Y, 2 Z) a move has put at a programmed position since the start or
         # the last program stop (where the operator may jog the machine): #5001-#5003 read them
         self.placed: set[int] = set()
@@ -457,7 +459,8 @@ class Interpreter:
         may be its only one (CALLED, `flow.py`) is followed as a run in place, its events and all
         after them held until the program ends (`once.held_to_the_end`): if no other call ran it
         (`Flow.called_again`), its text ran once and is rewritten for that run where its definition
-        stands (`once_runs`); else its moves are left as programmed, as a FIXED run's."""
+        stands (`once_runs`); else its moves are left as programmed, as a FIXED run's.  A construct
+        whose run sets an offset from where the control stands gets its step back (`entries.py`)."""
         runs = self.once_runs
         items: Iterable = self._run(blocks, warnings)
         if runs is not None:  # (else no run is CALLED)
@@ -465,7 +468,7 @@ class Interpreter:
                 items, runs, lambda: (self.done, self.ended),
                 lambda: self.flow.called_again, self._as_programmed,  # type: ignore[union-attr]  # (`_run` made it)
             )  # fmt: skip
-        yield from stepped_back(items, warnings.warn)  # type: ignore[misc]
+        return stepped_back(items, warnings.warn)  # type: ignore[return-value]
 
     def _run(self, blocks: Iterable[Block], warnings: Warnings) -> Iterator[Event | tuple]:
         """Events block by block, in the order the blocks run (o-word control flow,
@@ -490,7 +493,7 @@ class Interpreter:
         )  # fmt: skip
         self.rounding = False
         expansion = self.expansion
-        entered = False  # a construct entered from straight code is under way (`entries.py`)
+        inside = False  # a construct entered from straight code is under way (`entries.py`)
         for block, kind, owner in flow.steps(blocks):
             if kind is ONCE and (expansion is not None or pending is not None or self.corner is not None):
                 kind = FIXED  # (--expand writes each run out; a corner waiting: `_in_flow` tells why)
@@ -514,12 +517,21 @@ class Interpreter:
             elif once is not None and kind is FIXED and owner is not None and once.rerun(block):
                 yield from self._told(once, again=True)  # (all of it runs again: nothing to hold)
                 once = None
-            if entered and (kind is RUN or flow.in_straight_code() and (kind is TEXT or kind is SKIP)):
+            if self.stopped is not None:  # the flow ended interpretation at a control line (a call it cannot follow)
+                place, line = self.stopped
+                self.stopped = None
+                if not inside and block is line and self._enters(kind, owner, once is None and pending is None, True):
+                    yield entered(self._step_back(block))  # type: ignore[misc]
+                    inside = True
+                if inside:
+                    yield left_at(place)  # type: ignore[misc]
+                    inside = False
+            if inside and (kind is RUN or flow.in_straight_code() and (kind is TEXT or kind is SKIP)):
                 yield STRAIGHT  # type: ignore[misc]
-                entered = False
-            if not entered and self._enters(kind, owner, once is None and pending is None):
-                yield Entered(self._step_back(block))  # type: ignore[misc]
-                entered = True
+                inside = False
+            if not inside and self._enters(kind, owner, once is None and pending is None):
+                yield entered(self._step_back(block))  # type: ignore[misc]
+                inside = True
             if (
                 kind is not RUN and kind is not FIXED and kind is not ONCE and kind is not CALLED
             ):  # text not run here
@@ -590,6 +602,7 @@ class Interpreter:
                 ) from None
             except _OutOfScope as stop:
                 place = self._leave_scope(stop.reason, block, stop.col, owner)
+                self.stopped = None  # (told here)
                 self.tool_reads = []  # (the program passes as it stands from here: no value of ncpp's in it)
                 if once is not None:
                     yield from self._told(once, again=True)
@@ -597,8 +610,9 @@ class Interpreter:
                 if pending is not None:
                     yield from self._unrounded(pending, held)
                     pending, self.rounding = None, False
-                if type(stop) is _SetInFlow:
-                    yield LeftAtSetting(place)  # type: ignore[misc]
+                if inside or type(stop) is _SetInFlow:  # (the latter warned of where it has no step)
+                    yield left_at(place, type(stop) is _SetInFlow)  # type: ignore[misc]
+                    inside = False
                 if owner is None:  # (a block that runs out of the text's order is written in its place)
                     if expansion is not None:
                         yield from expansion.owed()
@@ -644,11 +658,18 @@ class Interpreter:
                 Location(self.file, pending.block.line, item.start + 1),
             )
 
-    def _enters(self, kind: str, owner: Block | None, nothing_held: bool) -> bool:
+    def _enters(self, kind: str, owner: Block | None, nothing_held: bool, stopped: bool = False) -> bool:
         """Whether the step (`kind`, `owner`) may start a construct entered from straight code: a
-        control line there (a loop's head, a call), or the first line a backward jump runs again in
-        its place, with nothing held (no loop's first pass, no corner)."""
-        if not nothing_held or self.done or self.expansion is not None or self.flow is None:
+        control line there (a loop's head, a call; `stopped`: one at which the flow ended
+        interpretation), or the first line a backward jump runs again in its place, with nothing held
+        (no loop's first pass, no corner) and no cutter compensation (a step would be offset)."""
+        if (
+            not nothing_held
+            or self.done and not stopped
+            or self.expansion is not None
+            or self.flow is None
+            or self._compensating()
+        ):
             return False
         return (kind is TEXT and self.flow.in_straight_code()) or (kind is FIXED and owner is None)
 
@@ -687,6 +708,7 @@ class Interpreter:
             "program passes through uninterpreted (its modal state is unknown)",
             place,
         )
+        self.stopped = (place, block)
         return place
 
     def _in_flow(self, event: Event | tuple[Event, ...], owner: Block | None) -> Event | tuple[Event, ...]:
@@ -2580,7 +2602,7 @@ class Interpreter:
 _NOT_LOOP_STATE = frozenset(("params", "flow", "warnings", "untold_lengths", "expansion", "tools",
                              "file", "subroutine_path", "expand_cycles", "_context", "_fast",
                              "rounding", "once_runs", "main_program", "tool_reads", "checked_reads",
-                             "guard_reads", "unchecked_lines"))  # fmt: skip
+                             "guard_reads", "unchecked_lines", "stopped"))  # fmt: skip
 # Fanuc lathes' maximum spindle speed clamp in G-code systems B and C (system A's G50 S), and Fanuc
 # machining centres' under constant surface speed (their G code list: G92 "setting for workpiece
 # coordinate system or clamp at maximum spindle speed"; `lathe.py`): no move, no offset
