@@ -20,8 +20,7 @@ from another one), it warns."""
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable, Iterator
-from dataclasses import dataclass
+from collections.abc import Callable, Generator, Iterable, Iterator
 
 from ncpp.errors import Location
 from ncpp.motion.segments import Event, Pass
@@ -80,7 +79,7 @@ def stepped_back(items: Iterable, warn: Callable[[str, Location], None]) -> Iter
             unheld = ""
 
 
-def _held(items: Iterator, step: Pass) -> Iterator[Event | tuple]:
+def _held(items: Iterator, step: Pass) -> Generator[Event | tuple, None, str]:
     """A construct's events from its head (the mark that starts it went by): held until straight code
     comes back, given `step` first where a setting in it ends interpretation.  Returns why a
     setting in it is not stepped back to ("": it is, or it ended)."""

@@ -517,10 +517,10 @@ class Interpreter:
             elif once is not None and kind is FIXED and owner is not None and once.rerun(block):
                 yield from self._told(once, again=True)  # (all of it runs again: nothing to hold)
                 once = None
-            if self.stopped is not None:  # the flow ended interpretation at a control line (a call it cannot follow)
-                place, line = self.stopped
-                self.stopped = None
-                if not inside and block is line and self._enters(kind, owner, once is None and pending is None, True):
+            if self.stopped is not None:  # (the flow ended interpretation: a call it cannot follow, ...)
+                (place, line), self.stopped = self.stopped, None
+                nothing_held = once is None and pending is None
+                if not inside and block is line and self._enters(kind, owner, nothing_held, stopped=True):
                     yield entered(self._step_back(block))  # type: ignore[misc]
                     inside = True
                 if inside:
@@ -665,7 +665,7 @@ class Interpreter:
         (no loop's first pass, no corner) and no cutter compensation (a step would be offset)."""
         if (
             not nothing_held
-            or self.done and not stopped
+            or (self.done and not stopped)
             or self.expansion is not None
             or self.flow is None
             or self._compensating()
@@ -688,7 +688,9 @@ class Interpreter:
             return None
         return tuple(exact(value) for name, value in vars(self).items() if name not in _NOT_LOOP_STATE)
 
-    def _leave_scope(self, reason: str, block: Block, col: int | None, owner: Block | None = None) -> Location:
+    def _leave_scope(
+        self, reason: str, block: Block, col: int | None, owner: Block | None = None
+    ) -> Location:
         """A construct outside the scope: the state is unknown from here on (an error with strict).
         `owner`: the line that ran the block (a call, a loop's end), from which the rest passes.
         Returns the place it warns at."""
