@@ -25,6 +25,8 @@ from collections.abc import Callable, Generator, Iterable, Iterator
 from ncpp.errors import Location
 from ncpp.motion.segments import Event, Pass
 
+# Blocks without motion between the last move and a construct's head looked through for an action
+MAX_SINCE = 1_000
 # Events held from a construct's head until straight code comes back: past them the head is written
 # (memory stays bounded) and a setting in the construct gets a warning instead of its step
 MAX_HELD = 10_000
@@ -35,6 +37,10 @@ NO_STEP = (
     "last compensated move left it, so the offset it sets, and every move after it, may carry that move's "
     "correction; put the tool at a programmed point with a move that names each axis the block sets before the "
     "loop or call, or compensate with --expand"
+)
+ACTED = (
+    "an M function, a tool, spindle speed or offset number, a dwell or a tool length change stands between the "
+    "last move and it, and a step after that would move where the original stands still"
 )
 
 
@@ -67,11 +73,18 @@ def stepped_back(items: Iterable, warn: Callable[[str, Location], None]) -> Iter
     ends interpretation (see the module docstring)."""
     items = iter(items)
     unheld = ""  # why the construct under way is not held ("": none is, or it is)
+    since: list[Pass] = []  # the blocks that do not move since the last move (`_acts`)
     for item in items:
-        if type(item) is not Mark:  # (the common case: straight code, nothing held)
+        kind = type(item)
+        if kind is Pass:
+            if len(since) <= MAX_SINCE:
+                since.append(item)
+            yield item
+        elif kind is not Mark:
+            since.clear()
             yield item
         elif item.step is not None:
-            unheld = yield from _held(items, item.step)
+            unheld = yield from _held(items, item.step, since)
         elif item.where is not None:
             if item.setting:
                 warn(NO_STEP.format(why=unheld or "it does not start in straight code"), item.where)
@@ -79,21 +92,43 @@ def stepped_back(items: Iterable, warn: Callable[[str, Location], None]) -> Iter
             unheld = ""
 
 
-def _held(items: Iterator, step: Pass) -> Generator[Event | tuple, None, str]:
+def _held(items: Iterator, step: Pass, since: list[Pass]) -> Generator[Event | tuple, None, str]:
     """A construct's events from its head (the mark that starts it went by): held until straight code
-    comes back, given `step` first where a setting in it ends interpretation.  Returns why a
-    setting in it is not stepped back to ("": it is, or it ended)."""
+    comes back, given `step` first where a setting in it ends interpretation, but for an action
+    between the last move and the head (`_acts`).  Returns why a setting in it is not stepped back
+    to ("": it is, or it ended).  `since` goes on as `stepped_back`'s."""
+    acted = _acts(since)
     held: list = []
     for item in items:
-        if type(item) is not Mark:
+        kind = type(item)
+        if kind is not Mark:
+            if kind is Pass and len(since) <= MAX_SINCE:
+                since.append(item)
+            elif kind is not Pass:
+                since.clear()
             held.append(item)
             if len(held) > MAX_HELD:
                 yield from held
                 return f"its head was written before, {MAX_HELD:,} events ahead"
             continue
         if item.where is not None:
+            if acted:
+                yield from held
+                return ACTED
             yield step
         yield from held
         return ""  # (a construct does not start inside another: `Interpreter._enters`)
     yield from held
     return ""
+
+
+def _acts(since: list[Pass]) -> bool:
+    """Whether an action stands among the blocks since the last move (an M function, a tool, spindle
+    speed or offset number, a dwell, a tool length: `ncpp.verify.actions_of`): a step after it would
+    move where the original stands still, which the verifier, comparing the motion between two
+    actions, refuses.  Past MAX_SINCE blocks, taken to."""
+    if len(since) > MAX_SINCE:
+        return True
+    from ncpp.verify import actions_of  # (numpy's and scipy's import only where a construct starts)
+
+    return any(any(actions_of(event.block)) for event in since if not event.skipped)

@@ -158,6 +158,8 @@ def test_an_offset_set_in_an_untaken_branch_takes_no_step(affine):
     [
         ("G2 X160 Y140 R10\n", "in a mode other than G0 or G1"),  # (a step would end the arc mode)
         ("o5 repeat [2]\nG1 X200 Y200\no5 endrepeat\n", "right after moves left as programmed in G90"),
+        # (the verifier compares the motion between two actions: a step after M8 moves where the original stands)
+        ("M8\n", "stands between the last move and it"),
     ],
 )
 def test_where_no_step_can_be_proven_right_it_is_warned_of(affine, before, said):
