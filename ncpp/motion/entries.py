@@ -84,7 +84,7 @@ def stepped_back(items: Iterable, warn: Callable[[str, Location], None]) -> Iter
             since.clear()
             yield item
         elif item.step is not None:
-            unheld = yield from _held(items, item.step, since)
+            unheld = yield from _held(items, item.step, since, warn)
         elif item.where is not None:
             if item.setting:
                 warn(NO_STEP.format(why=unheld or "it does not start in straight code"), item.where)
@@ -92,7 +92,9 @@ def stepped_back(items: Iterable, warn: Callable[[str, Location], None]) -> Iter
             unheld = ""
 
 
-def _held(items: Iterator, step: Pass, since: list[Pass]) -> Generator[Event | tuple, None, str]:
+def _held(
+    items: Iterator, step: Pass, since: list[Pass], warn: Callable[[str, Location], None]
+) -> Generator[Event | tuple, None, str]:
     """A construct's events from its head (the mark that starts it went by): held until straight code
     comes back, given `step` first where a setting in it ends interpretation, but for an action
     between the last move and the head (`_acts`).  Returns why a setting in it is not stepped back
@@ -114,7 +116,9 @@ def _held(items: Iterator, step: Pass, since: list[Pass]) -> Generator[Event | t
         if item.where is not None:
             if acted:
                 yield from held
-                return ACTED
+                if item.setting:
+                    warn(NO_STEP.format(why=ACTED), item.where)
+                return ""
             yield step
         yield from held
         return ""  # (a construct does not start inside another: `Interpreter._enters`)
