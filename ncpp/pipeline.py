@@ -201,10 +201,10 @@ UNKNOWN_SETTING = (
 )
 
 UNKNOWN_STEP = (
-    "this line runs a loop or subroutine that sets an offset from where the control stands (G92, G10 "
-    "L10/L11/L20) right after moves left as programmed in G90: ncpp does not know exactly where the control stands "
-    "there, so it writes no step back to the programmed point, and the offset may carry a correction; from this "
-    "line on the program passes through uncompensated"
+    "this line runs a loop or subroutine in which interpretation ends, right after moves left as programmed in "
+    "G90: ncpp does not know exactly where the control stands there, so it writes no step back to the programmed "
+    "point before it; an offset the loop or subroutine sets from where the control stands (G92, G10 L10/L11/L20), "
+    "and every move after it, may carry a correction; from this line on the program passes through uncompensated"
 )
 
 
@@ -459,10 +459,10 @@ def process(
         "(the work offset's zero); jog it there before the program runs, or set the zero as a work offset "
         "(G10 L20, touch-off) and compensate for it", Location(file, block.line, None))  # fmt: skip
     writer.unstepped = lambda block: warnings.warn(
-        "this line runs a loop or subroutine that sets an offset from where the control stands (G92, G10 "
-        "L10/L11/L20), after a compensated move, in a mode other than G0 or G1 (an arc's, a canned cycle's), which "
-        "a step back to the programmed point would change: the offset it sets, and every move after it, may carry "
-        "that move's correction; end the mode (G80, or a G0/G1 move that names each axis) before the loop or call",
+        "this line runs a loop or subroutine in which interpretation ends, after a compensated move, in a mode "
+        "other than G0 or G1 (an arc's, a canned cycle's), which a step back to the programmed point would change: "
+        "an offset the loop or subroutine sets from where the control stands (G92, G10 L10/L11/L20), and every move "
+        "after it, may carry that move's correction; end the mode (G80, or a G0/G1 move) before the loop or call",
         Location(file, block.line, None))  # fmt: skip
     if expand and FAMILY[name] == "heidenhain":  # (the blocks written out take numbers of their own)
         writer.renumber = True

@@ -11,12 +11,13 @@ GOTO runs again), a step back to the programmed point puts the control where the
 the construct then runs as the original does (a step inside it would run again with each pass).
 
 Whether a construct sets such an offset is known only once a run of it does, so the interpreter
-marks where a construct entered from straight code starts (`Entered`), where straight code comes
-back (`STRAIGHT`), and where a setting in it ends interpretation (`LeftAtSetting`); `stepped_back`
-holds the events from a head to the straight code after it (bounded), and gives the held construct
-its step (a `Pass` whose `Setting` sets no value: `Setting.values` empty) where one ends
-interpretation.  Where no step has a place (the head is already written, the construct was entered
-from another one), it warns."""
+marks where a construct entered from straight code starts (`entered`), where straight code comes
+back (`STRAIGHT`), and where interpretation ends in it (`left_at`: at such a setting, at anything
+else out of scope, after which the construct may set one, or at a call ncpp cannot follow);
+`stepped_back` holds the events from a head to the straight code after it (bounded), and gives the
+held construct its step (a `Pass` whose `Setting` sets no value: `Setting.values` empty) where
+interpretation ends in it.  Where a setting has no step (its construct's head is already written,
+an action stands before the head, the construct was entered from another one), it warns."""
 
 from __future__ import annotations
 

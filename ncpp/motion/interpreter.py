@@ -674,8 +674,8 @@ class Interpreter:
         return (kind is TEXT and self.flow.in_straight_code()) or (kind is FIXED and owner is None)
 
     def _step_back(self, block: Block) -> Pass:
-        """The step back to the programmed point where the tool stands (`entries.py`), before the next
-        block: a `Setting` that sets nothing, on the block's first event."""
+        """The step back to the programmed point where the tool stands (`entries.py`), before `block`: a
+        `Pass` of it whose `Setting` sets nothing, ahead of its events."""
         context = self.context()
         at = context.turned((self.pos[0], self.pos[1], self.pos[2]))
         return Pass(block, motion=self.motion, setting=Setting((), context, at, leaves=True))

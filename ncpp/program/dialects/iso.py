@@ -284,8 +284,8 @@ class IsoWriter:
         # told of a G92 / G10 L20 that sets its offset from axes X Y Z the program has not positioned
         # yet: from where the control stands, which ncpp takes to be its assumed start ("X and Y")
         self.unplaced_setting: Callable[[str, Block], None] | None = None
-        # told of a loop or call that sets an offset from where the control stands, after a compensated
-        # move, in a mode (G2/G3, a canned cycle) a step back to the programmed point would change
+        # told of a loop or call in which interpretation ends (it may set an offset from where the control
+        # stands), after a compensated move, in a mode (G2/G3, a cycle) a step back would change
         self.unstepped: Callable[[Block], None] | None = None
         # the subroutines run once, written where their definition stands (`_AtDefinition`)
         self.once_runs: OnceRuns | None = None
