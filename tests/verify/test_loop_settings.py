@@ -226,3 +226,15 @@ def test_expanded_loops_set_the_originals_offsets(tmp_path):
     program, out = _ncpp(tmp_path, LINUXCNC["while"], "--expand")
     (sets, _), (written_sets, _) = (_rs274(p, tmp_path) for p in (program, out))
     assert _same(written_sets, sets), (sets, written_sets)
+
+
+def test_a_construct_held_past_the_bound_gets_a_warning_instead_of_its_step(affine, monkeypatch):
+    """The events from a construct's head are held to a bound (memory): a setting met past it has
+    no step back, and says so."""
+    import ncpp.motion.entries as entries
+
+    monkeypatch.setattr(entries, "MAX_HELD", 5)
+    original = LINUXCNC["set in the second pass"]
+    written, warned = _compensated(affine, original)
+    assert "its head was written before, 5 events ahead" in warned and "may carry" in warned, warned
+    assert len(_lines(written)) == len(_lines(original)), written
