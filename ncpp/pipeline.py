@@ -200,6 +200,13 @@ UNKNOWN_SETTING = (
     "stands, which ncpp does not know exactly there; from this line on the program passes through uncompensated"
 )
 
+UNKNOWN_STEP = (
+    "this line runs a loop or subroutine in which interpretation ends, right after moves left as programmed in "
+    "G90: ncpp does not know exactly where the control stands there, so it writes no step back to the programmed "
+    "point before it; an offset the loop or subroutine sets from where the control stands (G92, G10 L10/L11/L20), "
+    "and every move after it, may carry a correction; from this line on the program passes through uncompensated"
+)
+
 
 def warn_fixed(events: Iterable[Event], warnings: Warnings, file: str) -> Iterator[Event]:
     """Pass events through; warn where a series of moves the passes leave as programmed
@@ -238,7 +245,8 @@ def warn_fixed(events: Iterable[Event], warnings: Warnings, file: str) -> Iterat
                 warnings.warn(UNKNOWN_RADIUS, Location(file, event.block.line, 1))
             series, absolute = fixed, event.context.absolute  # type: ignore[union-attr]
         elif kind is Pass and event.setting is not None and series in UNCOMPENSATED and absolute:  # type: ignore[union-attr]
-            yield from _passed_on(event, events, warnings, file, UNKNOWN_SETTING)
+            why = UNKNOWN_SETTING if event.setting.values else UNKNOWN_STEP  # type: ignore[union-attr]
+            yield from _passed_on(event, events, warnings, file, why)
             return
         yield event
 
@@ -450,6 +458,12 @@ def process(
         f"{axes} yet: ncpp compensates the moves after it as if the tool stood at the program's zero there "
         "(the work offset's zero); jog it there before the program runs, or set the zero as a work offset "
         "(G10 L20, touch-off) and compensate for it", Location(file, block.line, None))  # fmt: skip
+    writer.unstepped = lambda block: warnings.warn(
+        "this line runs a loop or subroutine in which interpretation ends, after a compensated move, in a mode "
+        "other than G0 or G1 (an arc's, a canned cycle's), which a step back to the programmed point would change: "
+        "an offset the loop or subroutine sets from where the control stands (G92, G10 L10/L11/L20), and every move "
+        "after it, may carry that move's correction; end the mode (G80, or a G0/G1 move) before the loop or call",
+        Location(file, block.line, None))  # fmt: skip
     if expand and FAMILY[name] == "heidenhain":  # (the blocks written out take numbers of their own)
         writer.renumber = True
     keep_freed_memory()  # numpy's temporaries reuse the heap, not fresh pages (runtime.py)

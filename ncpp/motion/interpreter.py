@@ -61,9 +61,10 @@ from ncpp.motion.cycles import (
     hole,
 )
 from ncpp.motion.endless import exact
+from ncpp.motion.entries import STRAIGHT, entered, left_at, stepped_back
 from ncpp.motion.expand import Expansion, number, refused
 from ncpp.motion.expressions import ExpressionError, OutOfScope, Parameters, evaluate, vacant
-from ncpp.motion.flow import CALLED, FIXED, ONCE, RUN, SKIP, Flow, MainProgram
+from ncpp.motion.flow import CALLED, FIXED, ONCE, RUN, SKIP, TEXT, Flow, MainProgram
 from ncpp.motion.offsets import SYSTEMS, WorkOffsets
 from ncpp.motion.once import FirstPass, OnceRuns, held_to_the_end
 from ncpp.motion.segments import (
@@ -203,6 +204,11 @@ class _OutOfScope(modal.OutOfScope):
     def __init__(self, reason: str, col: int | None = None, setting: Setting | None = None):
         super().__init__(reason, col)
         self.setting = setting
+
+
+class _SetInFlow(_OutOfScope):
+    """A block that sets an offset from where the control stands, in a loop or subroutine: the
+    construct gets a step back to the programmed point before it (`entries.py`)."""
 
 
 def interpreting(flavour: type[Interpreter]) -> Callable[..., Iterator[Event]]:
@@ -431,6 +437,8 @@ class Interpreter:
         self.zeros_set: dict[int, bool] = {}
         self.warnings: Warnings | None = None
         self.flow: Flow | None = None  # while `run` runs
+        # where interpretation ended, and at which block, until `_run` tells `entries.stepped_back`
+        self.stopped: tuple[Location, Block] | None = None
         # Fanuc: the axes (0 X, 1 Y, 2 Z) a move has put at a programmed position since the start or
         # the last program stop (where the operator may jog the machine): #5001-#5003 read them
         self.placed: set[int] = set()
@@ -461,22 +469,25 @@ class Interpreter:
         may be its only one (CALLED, `flow.py`) is followed as a run in place, its events and all
         after them held until the program ends (`once.held_to_the_end`): if no other call ran it
         (`Flow.called_again`), its text ran once and is rewritten for that run where its definition
-        stands (`once_runs`); else its moves are left as programmed, as a FIXED run's."""
+        stands (`once_runs`); else its moves are left as programmed, as a FIXED run's.  A construct
+        whose run sets an offset from where the control stands gets its step back (`entries.py`)."""
         runs = self.once_runs
-        if runs is None:  # (no run is CALLED)
-            yield from self._run(blocks, warnings)  # type: ignore[misc]
-            return
-        yield from held_to_the_end(
-            self._run(blocks, warnings), runs, lambda: (self.done, self.ended),
-            lambda: self.flow.called_again, self._as_programmed,  # type: ignore[union-attr]  # (`_run` made it)
-        )  # fmt: skip
+        items: Iterable = self._run(blocks, warnings)
+        if runs is not None:  # (else no run is CALLED)
+            items = held_to_the_end(
+                items, runs, lambda: (self.done, self.ended),
+                lambda: self.flow.called_again, self._as_programmed,  # type: ignore[union-attr]  # (`_run` made it)
+            )  # fmt: skip
+        return stepped_back(items, warnings.warn)  # type: ignore[return-value]
 
     def _run(self, blocks: Iterable[Block], warnings: Warnings) -> Iterator[Event | tuple]:
         """Events block by block, in the order the blocks run (o-word control flow,
         `flow.py`), a CALLED run's as (its subroutine's name and call, event).  A line with a Fanuc corner word (`,R` `,C`, `G1 ... R`) waits
         for the next move, which decides the corner; the blocks in between wait
         with it (bounded by the program's own layout).  The events of a loop's first pass in
-        its place (ONCE) wait until the flow tells whether its text runs again (`_told`)."""
+        its place (ONCE) wait until the flow tells whether its text runs again (`_told`).  Where a
+        construct entered from straight code starts and ends, and where a setting in it ends
+        interpretation, it yields the marks of `entries.stepped_back`."""
         block_event = self.block
         self.warnings = self.untold_lengths.warnings = warnings
         pending: Line | None = None  # the line whose end corner is rounded
@@ -493,6 +504,7 @@ class Interpreter:
         self.rounding = False
         expansion = self.expansion
         block: Block | None = None
+        inside = False  # a construct entered from straight code is under way (`entries.py`)
         for block, kind, owner in flow.steps(blocks):
             if kind is ONCE and (expansion is not None or pending is not None or self.corner is not None):
                 kind = FIXED  # (--expand writes each run out; a corner waiting: `_in_flow` tells why)
@@ -516,6 +528,21 @@ class Interpreter:
             elif once is not None and kind is FIXED and owner is not None and once.rerun(block):
                 yield from self._told(once, again=True)  # (all of it runs again: nothing to hold)
                 once = None
+            if self.stopped is not None:  # (the flow ended interpretation: a call it cannot follow, ...)
+                (place, line), self.stopped = self.stopped, None
+                nothing_held = once is None and pending is None
+                if not inside and block is line and self._enters(kind, owner, nothing_held, stopped=True):
+                    yield entered(self._step_back(block))  # type: ignore[misc]
+                    inside = True
+                if inside:
+                    yield left_at(place)  # type: ignore[misc]
+                    inside = False
+            if inside and (kind is RUN or flow.in_straight_code() and (kind is TEXT or kind is SKIP)):
+                yield STRAIGHT  # type: ignore[misc]
+                inside = False
+            if not inside and self._enters(kind, owner, once is None and pending is None):
+                yield entered(self._step_back(block))  # type: ignore[misc]
+                inside = True
             if (
                 kind is not RUN and kind is not FIXED and kind is not ONCE and kind is not CALLED
             ):  # text not run here
@@ -585,7 +612,8 @@ class Interpreter:
                     Location(source, err.where.line, err.where.col),
                 ) from None
             except _OutOfScope as stop:
-                self._leave_scope(stop.reason, block, stop.col, owner)
+                place = self._leave_scope(stop.reason, block, stop.col, owner)
+                self.stopped = None  # (told here)
                 self.tool_reads = []  # (the program passes as it stands from here: no value of ncpp's in it)
                 if once is not None:
                     yield from self._told(once, again=True)
@@ -593,6 +621,9 @@ class Interpreter:
                 if pending is not None:
                     yield from self._unrounded(pending, held)
                     pending, self.rounding = None, False
+                if inside or type(stop) is _SetInFlow:  # (the latter warned of where it has no step)
+                    yield left_at(place, type(stop) is _SetInFlow)  # type: ignore[misc]
+                    inside = False
                 if owner is None:  # (a block that runs out of the text's order is written in its place)
                     if expansion is not None:
                         yield from expansion.owed()
@@ -640,6 +671,28 @@ class Interpreter:
                 Location(self.file, pending.block.line, item.start + 1),
             )
 
+    def _enters(self, kind: str, owner: Block | None, nothing_held: bool, stopped: bool = False) -> bool:
+        """Whether the step (`kind`, `owner`) may start a construct entered from straight code: a
+        control line there (a loop's head, a call; `stopped`: one at which the flow ended
+        interpretation), or the first line a backward jump runs again in its place, with nothing held
+        (no loop's first pass, no corner) and no cutter compensation (a step would be offset)."""
+        if (
+            not nothing_held
+            or (self.done and not stopped)
+            or self.expansion is not None
+            or self.flow is None
+            or self._compensating()
+        ):
+            return False
+        return (kind is TEXT and self.flow.in_straight_code()) or (kind is FIXED and owner is None)
+
+    def _step_back(self, block: Block) -> Pass:
+        """The step back to the programmed point where the tool stands (`entries.py`), before `block`: a
+        `Pass` of it whose `Setting` sets nothing, ahead of its events."""
+        context = self.context()
+        at = context.turned((self.pos[0], self.pos[1], self.pos[2]))
+        return Pass(block, motion=self.motion, setting=Setting((), context, at, leaves=True))
+
     def _loop_state(self) -> tuple | None:
         """The modal state a loop's check compares (`endless.py`): all but the parameters (the
         flow journals them), the flow (its own), what only writes or warns, and what does not change
@@ -648,9 +701,12 @@ class Interpreter:
             return None
         return tuple(exact(value) for name, value in vars(self).items() if name not in _NOT_LOOP_STATE)
 
-    def _leave_scope(self, reason: str, block: Block, col: int | None, owner: Block | None = None) -> None:
+    def _leave_scope(
+        self, reason: str, block: Block, col: int | None, owner: Block | None = None
+    ) -> Location:
         """A construct outside the scope: the state is unknown from here on (an error with strict).
-        `owner`: the line that ran the block (a call, a loop's end), from which the rest passes."""
+        `owner`: the line that ran the block (a call, a loop's end), from which the rest passes.
+        Returns the place it warns at."""
         self.done = True
         source = self.flow.source() if self.flow is not None else None
         if self.expansion is not None and self.flow is not None and self.expansion.refuses_leaving(self.flow):
@@ -667,6 +723,8 @@ class Interpreter:
             "program passes through uninterpreted (its modal state is unknown)",
             place,
         )
+        self.stopped = (place, block)
+        return place
 
     def _in_flow(self, event: Event | tuple[Event, ...], owner: Block | None) -> Event | tuple[Event, ...]:
         """A block's events inside a loop or a subroutine: its moves are left as programmed
@@ -674,8 +732,8 @@ class Interpreter:
         if self.corner is not None:
             raise _OutOfScope("Fanuc corner rounding in a loop or subroutine", None)
         if _sets_offset(event):  # set from where each run of the text stands: no one shift
-            raise _OutOfScope("G92 or G10 L10/L11/L20 in a loop or subroutine (it sets an offset from "
-                              "where the control stands, which compensation moves)", None)  # fmt: skip
+            raise _SetInFlow("G92 or G10 L10/L11/L20 in a loop or subroutine (it sets an offset from "
+                             "where the control stands, which compensation moves)", None)  # fmt: skip
         events: tuple[Event, ...] = event if type(event) is tuple else (event,)  # type: ignore[assignment]
         out = [kept for ev in events if (kept := self._as_programmed(ev, owner)) is not None]
         return tuple(out) if len(out) != 1 else out[0]
@@ -2635,7 +2693,7 @@ class Interpreter:
 _NOT_LOOP_STATE = frozenset(("params", "flow", "warnings", "untold_lengths", "expansion", "tools",
                              "file", "subroutine_path", "expand_cycles", "_context", "_fast",
                              "rounding", "once_runs", "main_program", "tool_reads", "checked_reads",
-                             "guard_reads", "unchecked_lines"))  # fmt: skip
+                             "guard_reads", "unchecked_lines", "stopped"))  # fmt: skip
 # Fanuc lathes' maximum spindle speed clamp in G-code systems B and C (system A's G50 S), and Fanuc
 # machining centres' under constant surface speed (their G code list: G92 "setting for workpiece
 # coordinate system or clamp at maximum spindle speed"; `lathe.py`): no move, no offset

@@ -234,7 +234,13 @@ def test_out_of_scope_inside_a_subroutine_names_the_call():
     )
     assert "t.ngc:4:" in warned.getvalue() and "from line 7, which runs it," in warned.getvalue()
     assert [e.block.line for e in events if type(e) is Line] == [2, 6]
-    assert "".join(e.block.text for e in events if type(e) is not Line).count("o1 call") == 1
+    assert (
+        "".join(e.block.text for e in events if type(e) is Pass and e.setting is None).count("o1 call") == 1
+    )
+    # where interpretation ends in the call, a step back to the programmed point before it (`entries.py`)
+    assert [(e.block.line, e.setting.position) for e in events if type(e) is Pass and e.setting] == [
+        (7, (5.0, 0.0, 10.0))
+    ]
 
 
 def test_a_loop_that_does_not_end_is_refused_at_its_line(monkeypatch):

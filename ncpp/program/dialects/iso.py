@@ -255,8 +255,8 @@ def written_at_once(event: Event) -> bool:
     control line's (an o-word, M97, M98, M99) that runs, whose text depends only on its `Pass`; the
     moves it runs after it (a loop's next runs, a subroutine's) are left as programmed and not
     kept, so a loop of any length is written (and verified, `ncpp.verify`) as it runs."""
-    if type(event) is not Pass or event.skipped or event.cycle is not None:
-        return False
+    if type(event) is not Pass or event.skipped or event.cycle is not None or event.setting is not None:
+        return False  # (a setting's: a step back before a loop or call, `entries.py`, precedes its event)
     signature = event.block.signature  # (a plain block is a control line by its M97-M99 only)
     return (signature is None or "M" in signature) and _Facts(event.block).flow
 
@@ -284,6 +284,9 @@ class IsoWriter:
         # told of a G92 / G10 L20 that sets its offset from axes X Y Z the program has not positioned
         # yet: from where the control stands, which ncpp takes to be its assumed start ("X and Y")
         self.unplaced_setting: Callable[[str, Block], None] | None = None
+        # told of a loop or call in which interpretation ends (it may set an offset from where the control
+        # stands), after a compensated move, in a mode (G2/G3, a cycle) a step back would change
+        self.unstepped: Callable[[Block], None] | None = None
         # the subroutines run once, written where their definition stands (`_AtDefinition`)
         self.once_runs: OnceRuns | None = None
         self.stamps: Stamps | None = None  # how far it has read, where a verifier tags its lines by it
@@ -393,6 +396,9 @@ class IsoWriter:
         if type(first) is Pass and first.cycle is not None:
             return self._expanded(block, group)
         if type(first) is Pass and first.setting is not None:
+            if not first.setting.values:  # a loop's or call's step back (`ncpp.motion.entries`), in its mode
+                step = self._step_back(block, first.setting, MOTION_CODES.get(first.motion))  # type: ignore[arg-type]
+                return [*step, *(self._write_group(group[1:]) if group[1:] else ())]
             self._tell_unplaced(block, first.setting)
         facts = self._read_block(block)
         if facts.flow:
@@ -714,13 +720,25 @@ class IsoWriter:
         """A block that sets an offset from where the control stands and ends interpretation: a step
         back to the programmed point first, in the program's G0 or G1 mode, so that the block and
         the blocks after it, which ncpp does not follow, read the point the program means."""
+        return [*self._step_back(block, setting, self.program_motion), block.text]
+
+    def _step_back(self, block: Block, setting: Setting, mode: int | None) -> list[str]:
+        """The step back from where the control stands to the programmed point before `block`
+        (`Setting.shift`: none where nothing compensated stands before it), in the program's `mode`;
+        in a mode other than G0 or G1, which a step would change for the blocks after it,
+        `unstepped` is told instead."""
         at, shift = setting.position, setting.shift
-        assert shift is not None
+        if shift is None:
+            return []
+        if mode not in (0, 1):
+            if self.unstepped is not None:
+                self.unstepped(block)
+            return []
         here = (at[0] + shift[0], at[1] + shift[1], at[2] + shift[2])
-        step = Line(here, at, self.program_motion == 0, 0.0, block, setting.context)
+        step = Line(here, at, mode == 0, 0.0, block, setting.context)
         lines = self._new_blocks(block, [as_written(step)], block.eol)
         self._last_end = None  # (the block sets another frame)
-        return [*lines, block.text]
+        return lines
 
     def _setting_text(self, block: Block, setting: Setting) -> str:
         """A G92 / G10 L10/L11/L20 block with its axis values moved by where the control stands off the
