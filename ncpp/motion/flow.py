@@ -93,7 +93,7 @@ from __future__ import annotations
 import os
 import re
 from collections.abc import Callable, Iterable, Iterator, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from ncpp.errors import Location, NcppError, printable
@@ -764,20 +764,32 @@ class Flow:
         waiting for a call that may be its only run (`_wait_for_call`), and the flow goes on at the
         main program's O line.  Where no later program, or more than one, ends with M30 or M2, or one
         before it ends with neither, which program runs is not guessed: the flow stops at the first.
-        A file of one program ending with M99 is an endless main program (`_m99`)."""
+        A file of one program ending with M99 is an endless main program (`_m99`).
+
+        The text is read ahead to its end, or to MAX_SUBPROGRAM blocks past the main program's O line
+        (memory stays bounded): past them the program the blocks read make the main one runs so, and
+        the rest of the text is checked as it is read (`_confirmed`): where it makes another program
+        the main one, or none, the program is refused."""
         first = self._first_subprogram()
         if first is None:
             return
-        programs = self._programs(first)
-        if len(programs) == 1:
+        scan, cut = self._programs(first)
+        programs = scan.found
+        if len(programs) == 1 and cut is None:
             return
-        main, why = _main_program(programs)
+        main, why = _main_program(scan.provisional() if cut is not None else programs)
+        if cut is not None and main is None and not scan.open and scan.candidate() is None:
+            why = f"the text after {programs[-1].name}'s M99 runs on past {MAX_SUBPROGRAM:,} blocks"
         if main is None:
             self.main_program.stored = None
             self.stop(f"a file whose first program {programs[0].name} ends with M99 (a subprogram) while {why} "
                       "(which program the operator runs as the main one is not ncpp's to guess)",
                       self._block(self.frames[0], first), 1)  # fmt: skip
             return
+        if cut is not None:
+            for index in range(cut, self.read):  # (the blocks read past the scan's end)
+                scan.add(index, self.buffer[index - self.base])
+            self.stream = self._confirmed(scan, self.stream, main)
         names = [p.name for p in programs if p.index < main.index]
         said = (
             f"{names[0]} is a subprogram"
@@ -788,6 +800,23 @@ class Flow:
                   "(run where M98 or G65 calls it)", main.block)  # fmt: skip
         self.main_program.stored, self.main_program.number = len(names), program_number(main.block)
         yield from self._skip_stored(first, main.index)
+
+    def _confirmed(self, scan: _ProgramScan, blocks: Iterator[Block], main: _Program) -> Iterator[Block]:
+        """The blocks after those read ahead, each told to `scan`: at the end of the text, the programs
+        it found must make `main` the main program (`_main_program`), else the program is refused
+        (its compensated lines were written for a main program the file does not name)."""
+        index = self.read
+        for block in blocks:
+            scan.add(index, block)
+            index += 1
+            yield block
+        found, why = _main_program(scan.found)
+        if found is None or found.index != main.index:
+            said = why or f"{found.name} is the main program"  # type: ignore[union-attr]
+            raise NcppError(f"ncpp ran {main.name} as the main program, from the first {MAX_SUBPROGRAM:,} blocks after "
+                            f"its O line, but the file goes on and {said} (which program the operator runs as the main "
+                            "one is not ncpp's to guess): put the main program first, or each subprogram in a file "
+                            "of its own (--subroutine-path)", Location(self.file, main.block.line, 1))  # fmt: skip
 
     def _skip_stored(self, first: int, main_index: int) -> Iterator[tuple[Block, str, Block | None]]:
         """The lines before the main program's O line: the leader and comments before `first` run,
@@ -823,21 +852,21 @@ class Flow:
             index += 1
         return None
 
-    def _programs(self, first: int) -> list[_Program]:
-        """The numbered programs of the file from the one at `first` to its end (the text is read to
-        there, as a call of a subprogram after M30 reads on to it)."""
-        found: list[_Program] = []
+    def _programs(self, first: int) -> tuple[_ProgramScan, int | None]:
+        """The numbered programs of the file from the one at `first` on (the text is read to its end, as
+        a call of a subprogram after M30 reads on to it), and where the reading stopped short of the
+        end (None: it did not): MAX_SUBPROGRAM blocks past the O line of the first program that does
+        not end with M99 within as many blocks, or of a program whose text runs on as long after its
+        M99 (`_ProgramScan.candidate`)."""
+        scan = _ProgramScan(self.leader)
         main, index = self.frames[0], first
         while (block := self._block(main, index)) is not None:
-            if program_number(block) is None:
-                index += 1
-                continue
-            end, after = self._program_end(index, None)
-            found.append(
-                _Program(index, block, _program_name(block), end, block.verbatim and index >= self.leader)
-            )
-            index = after
-        return found
+            top = scan.candidate() or (scan.found[-1] if scan.found else None)
+            if top is not None and index - top.index > MAX_SUBPROGRAM:
+                return scan, index
+            scan.add(index, block)
+            index += 1
+        return scan, None
 
     def _program_end(self, start: int, most: int | None) -> tuple[str | None, int]:
         """How the program whose O line stands at `start` ends first (M99, M30, M2, `_end_code`; None:
@@ -1889,6 +1918,40 @@ class _Program:
     name: str
     end: str | None
     after: bool
+
+
+class _ProgramScan:
+    """The numbered programs of a text read a block at a time from a program's O line on (`Flow._programs`):
+    each one's O line and how it ends first (`_end_code`; None: neither before the next program or
+    `%`), `open` while the last one's end is still looked for."""
+
+    def __init__(self, leader: int) -> None:
+        self.leader = leader
+        self.found: list[_Program] = []
+        self.open = False
+
+    def add(self, index: int, block: Block) -> None:
+        if program_number(block) is not None:
+            after = block.verbatim and index >= self.leader
+            self.found.append(_Program(index, block, _program_name(block), None, after))
+            self.open = True
+        elif self.open:
+            end = None if _starts_program(block) else _end_code(block)
+            if end is not None:
+                self.found[-1] = replace(self.found[-1], end=end)
+            self.open = end is None and not _starts_program(block)
+
+    def candidate(self) -> _Program | None:
+        """The first program found that does not end with M99 (one whose end is still looked for: None)."""
+        last = self.found[-1] if self.open else None
+        return next((p for p in self.found if p.end != "M99" and p is not last), None)
+
+    def provisional(self) -> list[_Program]:
+        """The programs found, the last one's end still looked for taken as M30 where it would be the
+        main program (one that runs on past MAX_SUBPROGRAM blocks is no subprogram: `Flow._keep`)."""
+        if not self.open or self.candidate() is not None:
+            return self.found
+        return [*self.found[:-1], replace(self.found[-1], end="M30")]
 
 
 def _main_program(programs: list[_Program]) -> tuple[_Program | None, str]:
