@@ -109,6 +109,9 @@ _TRIM = 4096  # blocks no loop can go back to are dropped in runs of this many
 # Blocks after an `O<n>` line kept as Fanuc subprogram `n` until its M99: a longer one is a
 # program's own number (`O1000` at its top), not a subprogram, and memory stays bounded.
 MAX_SUBPROGRAM = 20_000
+# Blocks read ahead to find a subroutine, a subprogram or a Haas local subprogram a call names that
+# the program defines after it: past them the call is out of scope (memory stays bounded)
+MAX_AHEAD = 200_000
 # Lines run (or skipped) out of the text's order, loop iterations and calls, before a program
 # counts as one that never ends and is refused (LinuxCNC would run it for ever; a pass over it
 # must end): about a minute
@@ -360,6 +363,7 @@ class Flow:
         self.warn = warn or (lambda message, block: None)
         self.stored = False
         self.main_top = 0
+        self.cut_short = False  # a search for a definition stopped at MAX_AHEAD blocks (`_defined`)
         self.revisits: Revisits | None = None
         self._jumps_checked: set[tuple[int, int, int]] = set()  # (`_refuse_jump_without_way_out`)
         if state is not None:
@@ -909,7 +913,7 @@ class Flow:
             where = (
                 f" nor is o{_shown(name)}.ngc in {os.pathsep.join(map(str, self.path))}" if self.path else ""
             )
-            self.stop(f"a call of o{_shown(name)}, which the program does not define (a subroutine file: give its folder "
+            self.stop(f"a call of o{_shown(name)}, which the program does not define{self._not_ahead()} (a subroutine file: give its folder "
                       f"with --subroutine-path; the LinuxCNC filter reads the INI's SUBROUTINE_PATH){where}", block, control.item.start + 1)  # fmt: skip
             return lambda: None
 
@@ -1004,7 +1008,7 @@ class Flow:
             body = self._defined(self.subprograms, str(program)) or self._program_from_file(str(program))
             name = name if body is None else str(program)
         if body is None:
-            said = f"M98 P{name}: a subprogram the program does not define (O{name} to M99)"
+            said = f"M98 P{name}: a subprogram the program does not define{self._not_ahead()} (O{name} to M99)"
             self.stop(said + self._searched(), block, control.item.start + 1)
             return lambda: None
 
@@ -1089,6 +1093,10 @@ class Flow:
             if sequence_number(ahead) == number:
                 break
             index += 1
+            if index > call + MAX_AHEAD:
+                self.stop(f"M97 P{number}: N{number} is not within {MAX_AHEAD:,} blocks ahead (ncpp reads no further "
+                          "ahead)", block, col)  # fmt: skip
+                return None
         else:
             raise NcppError(f"M97 P{number}: the program has no block N{number} after the call (a Haas alarm)",
                             Location(self.file, block.line, col))  # fmt: skip
@@ -1237,7 +1245,7 @@ class Flow:
         body = self._defined(self.subprograms, name) or self._program_from_file(name)
         if body is None:
             what = control.keyword.upper()
-            said = f"{what} P{name}: a macro the program does not define (O{name} to M99)"
+            said = f"{what} P{name}: a macro the program does not define{self._not_ahead()} (O{name} to M99)"
             self.stop(said + self._searched(), block, control.item.start + 1)
             return None
         self._count_call(name)  # (G66's calls after each move run it again)
@@ -1420,11 +1428,21 @@ class Flow:
         return None
 
     def _defined(self, found: dict[str, list[Block]], name: str) -> list[Block] | None:
-        """The lines of subroutine (or subprogram) `name`, read on for if it comes later in the text (None: nowhere)."""
+        """The lines of subroutine (or subprogram) `name`, read on for if it comes later in the text, at
+        most MAX_AHEAD blocks past those read (None: nowhere, or not so near: `cut_short`)."""
+        most, self.cut_short = self.read + MAX_AHEAD, False
         while name not in found:
+            if self.read >= most:
+                self.cut_short = True
+                return None
             if not self._read():
                 return None
         return found[name]
+
+    def _not_ahead(self) -> str:
+        """What a call's message adds where the search for its definition stopped at MAX_AHEAD blocks."""
+        cut, self.cut_short = self.cut_short, False
+        return f" within {MAX_AHEAD:,} blocks ahead (ncpp reads no further ahead)" if cut else ""
 
     def _if(self, frame, block, control, arrived):
         self._opens(frame, block, control)

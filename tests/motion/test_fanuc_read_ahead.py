@@ -92,3 +92,46 @@ def test_where_the_rest_of_the_file_names_no_main_program_or_another_the_program
         moves(program, "fanuc")
     assert f"ncpp ran O1000 as the main program, from the first 50 blocks after its O line, but the file goes on and {why}" in str(refused.value)  # fmt: skip
     assert refused.value.where.line == STORED.count("\n") + 1
+
+
+# The usual layout: the main program first, its subprograms after M30, called from far before them
+CALLED_AHEAD = "%\nO1000\nG21 G90 G54 G17\nG0 X0 Y0 Z5\nM98 P2000\n{moves}\nG0 Z5\nM30\nO2000\nG91 G1 X1 F300\nG90\nM99\n%\n"
+
+
+def test_a_call_searches_for_its_subprogram_at_most_max_ahead_blocks_ahead(monkeypatch):
+    """Near enough, the call runs it; further ahead, the call is out of scope: the flow holds no more
+    than MAX_AHEAD blocks to find it."""
+    moves_text = "\n".join(f"G1 X{i % 40} Y{(i * 7) % 40} F500" for i in range(300))
+    program = CALLED_AHEAD.format(moves=moves_text)
+    near = moves(program, "fanuc")
+    for name, value in SMALL.items():  # (the blocks read ahead at the start hold no O2000)
+        monkeypatch.setattr(flow, name, value)
+    monkeypatch.setattr(flow, "MAX_AHEAD", 1_000)
+    assert moves(program, "fanuc") == near and ("STRAIGHT_FEED", (1.0, 0.0, 5.0)) in near
+    monkeypatch.setattr(flow, "MAX_AHEAD", 100)
+    said = io.StringIO()
+    assert moves(program, "fanuc", said) == [("STRAIGHT_TRAVERSE", (0.0, 0.0, 5.0))]
+    assert "p.nc:5:1: warning: M98 P2000: a subprogram the program does not define within 100 blocks ahead (ncpp reads no further ahead)" in said.getvalue()  # fmt: skip
+
+
+def test_a_haas_local_call_searches_for_its_block_at_most_max_ahead_blocks_ahead(monkeypatch):
+    moves_text = "\n".join(f"G1 X{i % 40} Y{(i * 7) % 40} F500" for i in range(300))
+    program = f"%\nO1000\nG21 G90 G54\nG0 X0 Y0 Z5\nM97 P100\n{moves_text}\nM30\nN100 G1 Z4 F100\nM99\n%\n"
+    assert ("STRAIGHT_FEED", (0.0, 0.0, 4.0)) in moves(program, "haas")
+    for name, value in SMALL.items():
+        monkeypatch.setattr(flow, name, value)
+    monkeypatch.setattr(flow, "MAX_AHEAD", 100)
+    said = io.StringIO()
+    assert moves(program, "haas", said) == [("STRAIGHT_TRAVERSE", (0.0, 0.0, 5.0))]
+    assert "p.nc:5:1: warning: M97 P100: N100 is not within 100 blocks ahead" in said.getvalue()
+
+
+def test_an_o_word_call_searches_for_its_subroutine_at_most_max_ahead_blocks_ahead(monkeypatch):
+    moves_text = "\n".join(f"G1 X{i % 40} Y{(i * 7) % 40} F500" for i in range(300))
+    program = f"G21 G90\nG0 X0 Y0 Z5\no100 call\n{moves_text}\nM2\no100 sub\nG1 Z4 F100\no100 endsub\n"
+    assert ("STRAIGHT_FEED", (0.0, 0.0, 4.0)) in moves(program, "iso")
+    for name, value in {**SMALL, "MAX_AHEAD": 100}.items():
+        monkeypatch.setattr(flow, name, value)
+    said = io.StringIO()
+    assert moves(program, "iso", said) == [("STRAIGHT_TRAVERSE", (0.0, 0.0, 5.0))]
+    assert "p.nc:3:1: warning: a call of o100, which the program does not define within 100 blocks ahead" in said.getvalue()  # fmt: skip
