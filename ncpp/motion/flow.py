@@ -80,12 +80,12 @@ run) leaves the scope, and so does one whose target is no longer held (blocks ar
 to `_TRIM` back, and while a loop runs).
 
 Subroutines are those of the program's own text (defined before or after the
-call, like LinuxCNC, which searches the rest of the file) or `name.ngc` in the
-first folder of the search path that has it (`_from_file`: LinuxCNC's
-[RS274NGC]SUBROUTINE_PATH, given as `--subroutine-path`; looked for before the
-rest of the file); a call of a subroutine found in neither is outside the scope.
-Blocks stay in memory only while a loop may go back to them, and subroutine
-bodies for the call.
+call, like LinuxCNC, which searches the rest of the file: here up to MAX_AHEAD blocks
+ahead) or `name.ngc` in the first folder of the search path that has it (`_from_file`:
+LinuxCNC's [RS274NGC]SUBROUTINE_PATH, given as `--subroutine-path`; looked for before
+the rest of the file); a call of a subroutine found in neither is outside the scope.
+Blocks stay in memory only while a loop may go back to them, or a search ahead holds
+them, and subroutine bodies for the call.
 """
 
 from __future__ import annotations
