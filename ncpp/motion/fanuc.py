@@ -519,7 +519,7 @@ class HaasInterpreter(FanucInterpreter):
     r_over_ijk = False  # (nor that R wins over I, J, K)
     independent_h = False  # (nor that an H goes without G43)
     wear_alone = True  # ("G10 Set Offsets": "L1 or L11 Tool wear offset amount (for H code)")
-    d_radii = False  # ("L12 Diameter offset amount (for D code)": a diameter, or a radius as the control is set up)
+    d_radii = False  # ("L12 Diameter offset amount (for D code)": a diameter, or a radius as set up)
     # The NGC control's general-purpose variables, kept at power off, where its system variables
     # (#1000-#9999, #11000 on) are the control's (the Haas NGC manual's "System Variables" table, as
     # zappettiniconsulting.com/wiki/haas-system-variables quotes it: #10000-#10999 general-purpose,

@@ -1008,7 +1008,9 @@ class Flow:
             body = self._defined(self.subprograms, str(program)) or self._program_from_file(str(program))
             name = name if body is None else str(program)
         if body is None:
-            said = f"M98 P{name}: a subprogram the program does not define{self._not_ahead()} (O{name} to M99)"
+            said = (
+                f"M98 P{name}: a subprogram the program does not define{self._not_ahead()} (O{name} to M99)"
+            )
             self.stop(said + self._searched(), block, control.item.start + 1)
             return lambda: None
 

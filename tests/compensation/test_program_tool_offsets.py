@@ -238,7 +238,7 @@ def test_fanuc_g43_applies_geometry_plus_wear_as_g10_l10_l11_set_them(tmp_path):
     assert moves[0].context.tool_mm[2] == pytest.approx(length)
     assert moves[0].context.to_machine(moves[0].end)[2] == pytest.approx(300.0 + 50.0 + length)
     under_comp = [m for m in moves if m.centre_shift is not None]
-    assert under_comp[0].centre_shift[1] == pytest.approx((0.0, 5.0, 0.0))  # D offset 1's radius as G10 L12 set it
+    assert under_comp[0].centre_shift[1] == pytest.approx((0.0, 5.0, 0.0))  # G10 L12's radius
 
 
 def test_fanuc_wear_alone_is_out_of_scope_and_haas_reads_it_as_wear(tmp_path):

@@ -29,7 +29,9 @@ def long_main(lines: int, end: str = "M30") -> str:
     moves = [f"G1 X{i % 40} Y{(i * 7) % 40} F500" for i in range(lines)]
     moves[lines // 3] += "\nM98 P2000"
     moves[lines // 2] += "\nM98 P3000"
-    return "O1000 (MAIN)\nG21 G90 G54 G17\nG0 X0 Y0 Z5\nG1 Z-1 F200\n" + "\n".join(moves) + f"\nG0 Z5\n{end}\n"
+    return (
+        "O1000 (MAIN)\nG21 G90 G54 G17\nG0 X0 Y0 Z5\nG1 Z-1 F200\n" + "\n".join(moves) + f"\nG0 Z5\n{end}\n"
+    )
 
 
 @pytest.fixture
@@ -82,9 +84,7 @@ def test_past_the_read_ahead_the_compensated_text_is_the_same(tmp_path, monkeypa
         ("", "no later program of the file ends with M30 or M2"),
     ],
 )
-def test_where_the_rest_of_the_file_names_no_main_program_or_another_the_program_is_refused(
-    small, rest, why
-):
+def test_where_the_rest_of_the_file_names_no_main_program_or_another_the_program_is_refused(small, rest, why):
     """Read whole, the file passes through (`test_fanuc_files.UNTOLD`); past the read-ahead its main
     program has run, so it is refused: no line of it is written."""
     program = STORED + long_main(300, "M30" if rest else "M99") + rest + ("" if rest else "%\n")
