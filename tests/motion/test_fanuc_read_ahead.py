@@ -69,7 +69,7 @@ def test_past_the_read_ahead_the_moves_are_those_of_the_whole_file_read(monkeypa
 
 
 def test_past_the_read_ahead_the_compensated_text_is_the_same(tmp_path, monkeypatch):
-    (tmp_path / "p.nc").write_text(STORED + long_main(600) + AFTER)
+    (tmp_path / "p.nc").write_text(STORED + long_main(300) + AFTER)
     whole = compensate_file(tmp_path / "p.nc", MACHINE, tmp_path, dialect="fanuc").read_bytes()
     for name, value in SMALL.items():
         monkeypatch.setattr(flow, name, value)
