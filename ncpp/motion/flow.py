@@ -1949,9 +1949,12 @@ class _ProgramScan:
         self.leader = leader
         self.found: list[_Program] = []
         self.open = False
+        self.other: _Program | None = None  # the first program whose end is known not to be M99
 
     def add(self, index: int, block: Block) -> None:
         if program_number(block) is not None:
+            if self.open:
+                self._ended()
             after = block.verbatim and index >= self.leader
             self.found.append(_Program(index, block, _program_name(block), None, after))
             self.open = True
@@ -1959,17 +1962,23 @@ class _ProgramScan:
             end = None if _starts_program(block) else _end_code(block)
             if end is not None:
                 self.found[-1] = replace(self.found[-1], end=end)
-            self.open = end is None and not _starts_program(block)
+            if end is not None or _starts_program(block):
+                self._ended()
+
+    def _ended(self) -> None:
+        """The last program's end is known."""
+        self.open = False
+        if self.other is None and self.found[-1].end != "M99":
+            self.other = self.found[-1]
 
     def candidate(self) -> _Program | None:
         """The first program found that does not end with M99 (one whose end is still looked for: None)."""
-        last = self.found[-1] if self.open else None
-        return next((p for p in self.found if p.end != "M99" and p is not last), None)
+        return self.other
 
     def provisional(self) -> list[_Program]:
         """The programs found, the last one's end still looked for taken as M30 where it would be the
         main program (one that runs on past MAX_SUBPROGRAM blocks is no subprogram: `Flow._keep`)."""
-        if not self.open or self.candidate() is not None:
+        if not self.open or self.other is not None:
             return self.found
         return [*self.found[:-1], replace(self.found[-1], end="M30")]
 
