@@ -180,6 +180,7 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
     },
     # a second and a half or more on a 2-core machine, all parameters together
     "slow": {
+        "motion/test_fanuc_read_ahead.py": ("test_past_the_read_ahead_the_compensated_text_is_the_same",),
         "compensation/test_tool_parameters.py": (
             "test_written_out_the_pocket_sized_by_the_diameter_lands_on_the_original",
         ),

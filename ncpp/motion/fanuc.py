@@ -59,8 +59,12 @@ offset is set by `G10 L11 P_ R_` (Series 16i/18i-PA operator's manual, B-63124EN
 "Tool compensation values, number of compensation values, and entering values from the program
 (G10)": "the system allows L1 to be specified instead of L11"): so on Fanuc an L11 or L1 of an H
 offset whose geometry the program has not set with L10 is out of scope (with memory A it would be
-the whole length, with B and C the wear); on Haas it is the wear.  A D offset set so is a radius or
-a diameter as the control is set up: G41/G42 with it offsets by a radius ncpp does not know (its
+the whole length, with B and C the wear); on Haas it is the wear.  On Fanuc a D offset is a radius,
+its geometry (L12) and wear (L13) kept apart by memory C, which L12 and L13 address: G41/G42 Dn
+offsets the path by geometry plus wear (Series 15i/150i-MB descriptions, B-63782EN/01, 14.3 "Cutter
+compensation": "an offset vector with a length equal to the radius of the tool"), the geometry the
+told table's (half its diameter) until L12 sets it.  Haas's D offset set so is named a diameter,
+which the control may read as a radius: G41/G42 with it offsets by a radius ncpp does not know (its
 moves are corrected for their programmed points, with the warning a radius not told gets).  Any
 other word in such a block is out of scope.
 
@@ -272,6 +276,8 @@ class FanucInterpreter(Interpreter):
     # A G10 L11 (or L1) of an H offset whose geometry the program has not set: its meaning depends on
     # the control's tool compensation memory (module docstring); Haas's is the wear
     wear_alone = False
+    # A D offset G10 L12/L13 sets is a radius (module docstring); Haas's may be a diameter
+    d_radii = True
 
     def _cancels_nothing(self, code: float, block: Block) -> bool:
         if code == 69.0:
@@ -497,7 +503,7 @@ class FanucInterpreter(Interpreter):
     def _set_tool_offsets(self, block: Block, words: dict, given: list[tuple[int, float]]) -> None:
         """`G10 L10-L13 P<n> R<value>`: H offset n's geometry (L10) or wear (L11, and L1), D offset n's
         geometry (L12) or wear (L13), set in G90 and added to in G91 (module docstring).  G43 Hn then
-        applies geometry plus wear; a D offset set so is a radius ncpp does not know."""
+        applies geometry plus wear, G41/G42 Dn a D offset's (`_set_d_offset`)."""
         l_number, col = words["L"][0], words["L"][1].start + 1
         name = f"G10 L{l_number:g}"
         if given or words.keys() - {"L", "P", "R"}:
@@ -509,7 +515,7 @@ class FanucInterpreter(Interpreter):
             raise _OutOfScope(f"{name} with P{p:g}, no tool offset number", p_item.start + 1)
         number, value = int(p), words["R"][0] * (MM_PER_INCH if self.inch else 1.0)
         if l_number in (12.0, 13.0):
-            self.set_radii[number] = None  # (a radius or a diameter, as the control is set up)
+            self._set_d_offset(number, value, l_number == 13.0)
             return
         wear = l_number in (1.0, 11.0)
         if wear and not self.wear_alone and number not in self.h_memory:
@@ -525,6 +531,25 @@ class FanucInterpreter(Interpreter):
         self.h_memory[number] = (geometry, worn)
         if geometry is not None:
             self.set_offsets[number] = {2: geometry + worn}
+
+    def _set_d_offset(self, number: int, value: float, wear: bool) -> None:
+        """`G10 L12` / `L13 P<n> R<value>`: D offset n's geometry / wear in tool compensation memory C,
+        radii (module docstring), set in G90 and added to in G91; G41/G42 Dn offset by geometry plus
+        wear.  Its geometry is the told table's (half the diameter) until the program sets it (none
+        told: not known, and no more after a wear).  A negative sum, which swaps G41 and G42 on a Fanuc,
+        and a D offset of a control that may keep diameters (`d_radii`) are radii ncpp does not know."""
+        if not self.d_radii:
+            self.set_radii[number] = None
+            return
+        told = None if self.tools is None else self.tools.diameter(number) / 2
+        geometry, worn = self.d_memory.get(number, (told, 0.0))
+        if wear:
+            worn = value + (0.0 if self.absolute else worn)
+        elif self.absolute or geometry is not None:
+            geometry = value + (0.0 if self.absolute else geometry or 0.0)
+        self.d_memory[number] = (geometry, worn)
+        radius = None if geometry is None else geometry + worn
+        self.set_radii[number] = radius if radius is not None and radius >= 0.0 else None
 
 
 class HaasInterpreter(FanucInterpreter):
@@ -556,6 +581,7 @@ class HaasInterpreter(FanucInterpreter):
     r_over_ijk = False  # (nor that R wins over I, J, K)
     independent_h = False  # (nor that an H goes without G43)
     wear_alone = True  # ("G10 Set Offsets": "L1 or L11 Tool wear offset amount (for H code)")
+    d_radii = False  # ("L12 Diameter offset amount (for D code)": a diameter, or a radius as set up)
     # The NGC control's general-purpose variables, kept at power off, where its system variables
     # (#1000-#9999, #11000 on) are the control's (the Haas NGC manual's "System Variables" table, as
     # zappettiniconsulting.com/wiki/haas-system-variables quotes it: #10000-#10999 general-purpose,

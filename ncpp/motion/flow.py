@@ -81,12 +81,12 @@ run) leaves the scope, and so does one whose target is no longer held (blocks ar
 to `_TRIM` back, and while a loop runs).
 
 Subroutines are those of the program's own text (defined before or after the
-call, like LinuxCNC, which searches the rest of the file) or `name.ngc` in the
-first folder of the search path that has it (`_from_file`: LinuxCNC's
-[RS274NGC]SUBROUTINE_PATH, given as `--subroutine-path`; looked for before the
-rest of the file); a call of a subroutine found in neither is outside the scope.
-Blocks stay in memory only while a loop may go back to them, and subroutine
-bodies for the call.
+call, like LinuxCNC, which searches the rest of the file: here up to MAX_AHEAD blocks
+ahead) or `name.ngc` in the first folder of the search path that has it (`_from_file`:
+LinuxCNC's [RS274NGC]SUBROUTINE_PATH, given as `--subroutine-path`; looked for before
+the rest of the file); a call of a subroutine found in neither is outside the scope.
+Blocks stay in memory only while a loop may go back to them, or a search ahead holds
+them, and subroutine bodies for the call.
 """
 
 from __future__ import annotations
@@ -94,7 +94,7 @@ from __future__ import annotations
 import os
 import re
 from collections.abc import Callable, Iterable, Iterator, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from ncpp.errors import Location, NcppError, printable
@@ -110,6 +110,9 @@ _TRIM = 4096  # blocks no loop can go back to are dropped in runs of this many
 # Blocks after an `O<n>` line kept as Fanuc subprogram `n` until its M99: a longer one is a
 # program's own number (`O1000` at its top), not a subprogram, and memory stays bounded.
 MAX_SUBPROGRAM = 20_000
+# Blocks read ahead to find a subroutine, a subprogram or a Haas local subprogram a call names that
+# the program defines after it: past them the call is out of scope (memory stays bounded)
+MAX_AHEAD = 200_000
 # Lines run (or skipped) out of the text's order, loop iterations and calls, before a program
 # counts as one that never ends and is refused (LinuxCNC would run it for ever; a pass over it
 # must end): about a minute
@@ -361,6 +364,7 @@ class Flow:
         self.warn = warn or (lambda message, block: None)
         self.stored = False
         self.main_top = 0
+        self.cut_short = False  # a search for a definition stopped at MAX_AHEAD blocks (`_defined`)
         self.revisits: Revisits | None = None
         self._jumps_checked: set[tuple[int, int, int]] = set()  # (`_refuse_jump_without_way_out`)
         if state is not None:
@@ -765,20 +769,32 @@ class Flow:
         waiting for a call that may be its only run (`_wait_for_call`), and the flow goes on at the
         main program's O line.  Where no later program, or more than one, ends with M30 or M2, or one
         before it ends with neither, which program runs is not guessed: the flow stops at the first.
-        A file of one program ending with M99 is an endless main program (`_m99`)."""
+        A file of one program ending with M99 is an endless main program (`_m99`).
+
+        The text is read ahead to its end, or to MAX_SUBPROGRAM blocks past the main program's O line
+        (memory stays bounded): past them the program the blocks read make the main one runs so, and
+        the rest of the text is checked as it is read (`_confirmed`): where it makes another program
+        the main one, or none, the program is refused."""
         first = self._first_subprogram()
         if first is None:
             return
-        programs = self._programs(first)
-        if len(programs) == 1:
+        scan, cut = self._programs(first)
+        programs = scan.found
+        if len(programs) == 1 and cut is None:
             return
-        main, why = _main_program(programs)
+        main, why = _main_program(scan.provisional() if cut is not None else programs)
+        if cut is not None and main is None and not scan.open and scan.candidate() is None:
+            why = f"the text after {programs[-1].name}'s M99 runs on past {MAX_SUBPROGRAM:,} blocks"
         if main is None:
             self.main_program.stored = None
             self.stop(f"a file whose first program {programs[0].name} ends with M99 (a subprogram) while {why} "
                       "(which program the operator runs as the main one is not ncpp's to guess)",
                       self._block(self.frames[0], first), 1)  # fmt: skip
             return
+        if cut is not None:
+            for index in range(cut, self.read):  # (the blocks read past the scan's end)
+                scan.add(index, self.buffer[index - self.base])
+            self.stream = self._confirmed(scan, self.stream, main)
         names = [p.name for p in programs if p.index < main.index]
         said = (
             f"{names[0]} is a subprogram"
@@ -789,6 +805,23 @@ class Flow:
                   "(run where M98 or G65 calls it)", main.block)  # fmt: skip
         self.main_program.stored, self.main_program.number = len(names), program_number(main.block)
         yield from self._skip_stored(first, main.index)
+
+    def _confirmed(self, scan: _ProgramScan, blocks: Iterator[Block], main: _Program) -> Iterator[Block]:
+        """The blocks after those read ahead, each told to `scan`: at the end of the text, the programs
+        it found must make `main` the main program (`_main_program`), else the program is refused
+        (its compensated lines were written for a main program the file does not name)."""
+        index = self.read
+        for block in blocks:
+            scan.add(index, block)
+            index += 1
+            yield block
+        found, why = _main_program(scan.found)
+        if found is None or found.index != main.index:
+            said = why or f"{found.name} is the main program"  # type: ignore[union-attr]
+            raise NcppError(f"ncpp ran {main.name} as the main program, from the first {MAX_SUBPROGRAM:,} blocks after "
+                            f"its O line, but the file goes on and {said} (which program the operator runs as the main "
+                            "one is not ncpp's to guess): put the main program first, or each subprogram in a file "
+                            "of its own (--subroutine-path)", Location(self.file, main.block.line, 1))  # fmt: skip
 
     def _skip_stored(self, first: int, main_index: int) -> Iterator[tuple[Block, str, Block | None]]:
         """The lines before the main program's O line: the leader and comments before `first` run,
@@ -824,21 +857,21 @@ class Flow:
             index += 1
         return None
 
-    def _programs(self, first: int) -> list[_Program]:
-        """The numbered programs of the file from the one at `first` to its end (the text is read to
-        there, as a call of a subprogram after M30 reads on to it)."""
-        found: list[_Program] = []
+    def _programs(self, first: int) -> tuple[_ProgramScan, int | None]:
+        """The numbered programs of the file from the one at `first` on (the text is read to its end, as
+        a call of a subprogram after M30 reads on to it), and where the reading stopped short of the
+        end (None: it did not): MAX_SUBPROGRAM blocks past the O line of the first program that does
+        not end with M99 within as many blocks, or of a program whose text runs on as long after its
+        M99 (`_ProgramScan.candidate`)."""
+        scan = _ProgramScan(self.leader)
         main, index = self.frames[0], first
         while (block := self._block(main, index)) is not None:
-            if program_number(block) is None:
-                index += 1
-                continue
-            end, after = self._program_end(index, None)
-            found.append(
-                _Program(index, block, _program_name(block), end, block.verbatim and index >= self.leader)
-            )
-            index = after
-        return found
+            top = scan.candidate() or (scan.found[-1] if scan.found else None)
+            if top is not None and index - top.index > MAX_SUBPROGRAM:
+                return scan, index
+            scan.add(index, block)
+            index += 1
+        return scan, None
 
     def _program_end(self, start: int, most: int | None) -> tuple[str | None, int]:
         """How the program whose O line stands at `start` ends first (M99, M30, M2, `_end_code`; None:
@@ -881,7 +914,7 @@ class Flow:
             where = (
                 f" nor is o{_shown(name)}.ngc in {os.pathsep.join(map(str, self.path))}" if self.path else ""
             )
-            self.stop(f"a call of o{_shown(name)}, which the program does not define (a subroutine file: give its folder "
+            self.stop(f"a call of o{_shown(name)}, which the program does not define{self._not_ahead()} (a subroutine file: give its folder "
                       f"with --subroutine-path; the LinuxCNC filter reads the INI's SUBROUTINE_PATH){where}", block, control.item.start + 1)  # fmt: skip
             return lambda: None
 
@@ -976,7 +1009,9 @@ class Flow:
             body = self._defined(self.subprograms, str(program)) or self._program_from_file(str(program))
             name = name if body is None else str(program)
         if body is None:
-            said = f"M98 P{name}: a subprogram the program does not define (O{name} to M99)"
+            said = (
+                f"M98 P{name}: a subprogram the program does not define{self._not_ahead()} (O{name} to M99)"
+            )
             self.stop(said + self._searched(), block, control.item.start + 1)
             return lambda: None
 
@@ -1061,6 +1096,10 @@ class Flow:
             if sequence_number(ahead) == number:
                 break
             index += 1
+            if index > call + MAX_AHEAD:
+                self.stop(f"M97 P{number}: N{number} is not within {MAX_AHEAD:,} blocks ahead (ncpp reads no further "
+                          "ahead)", block, col)  # fmt: skip
+                return None
         else:
             raise NcppError(f"M97 P{number}: the program has no block N{number} after the call (a Haas alarm)",
                             Location(self.file, block.line, col))  # fmt: skip
@@ -1209,7 +1248,7 @@ class Flow:
         body = self._defined(self.subprograms, name) or self._program_from_file(name)
         if body is None:
             what = control.keyword.upper()
-            said = f"{what} P{name}: a macro the program does not define (O{name} to M99)"
+            said = f"{what} P{name}: a macro the program does not define{self._not_ahead()} (O{name} to M99)"
             self.stop(said + self._searched(), block, control.item.start + 1)
             return None
         self._count_call(name)  # (G66's calls after each move run it again)
@@ -1392,11 +1431,21 @@ class Flow:
         return None
 
     def _defined(self, found: dict[str, list[Block]], name: str) -> list[Block] | None:
-        """The lines of subroutine (or subprogram) `name`, read on for if it comes later in the text (None: nowhere)."""
+        """The lines of subroutine (or subprogram) `name`, read on for if it comes later in the text, at
+        most MAX_AHEAD blocks past those read (None: nowhere, or not so near: `cut_short`)."""
+        most, self.cut_short = self.read + MAX_AHEAD, False
         while name not in found:
+            if self.read >= most:
+                self.cut_short = True
+                return None
             if not self._read():
                 return None
         return found[name]
+
+    def _not_ahead(self) -> str:
+        """What a call's message adds where the search for its definition stopped at MAX_AHEAD blocks."""
+        cut, self.cut_short = self.cut_short, False
+        return f" within {MAX_AHEAD:,} blocks ahead (ncpp reads no further ahead)" if cut else ""
 
     def _if(self, frame, block, control, arrived):
         self._opens(frame, block, control)
@@ -1890,6 +1939,49 @@ class _Program:
     name: str
     end: str | None
     after: bool
+
+
+class _ProgramScan:
+    """The numbered programs of a text read a block at a time from a program's O line on (`Flow._programs`):
+    each one's O line and how it ends first (`_end_code`; None: neither before the next program or
+    `%`), `open` while the last one's end is still looked for."""
+
+    def __init__(self, leader: int) -> None:
+        self.leader = leader
+        self.found: list[_Program] = []
+        self.open = False
+        self.other: _Program | None = None  # the first program whose end is known not to be M99
+
+    def add(self, index: int, block: Block) -> None:
+        if program_number(block) is not None:
+            if self.open:
+                self._ended()
+            after = block.verbatim and index >= self.leader
+            self.found.append(_Program(index, block, _program_name(block), None, after))
+            self.open = True
+        elif self.open:
+            end = None if _starts_program(block) else _end_code(block)
+            if end is not None:
+                self.found[-1] = replace(self.found[-1], end=end)
+            if end is not None or _starts_program(block):
+                self._ended()
+
+    def _ended(self) -> None:
+        """The last program's end is known."""
+        self.open = False
+        if self.other is None and self.found[-1].end != "M99":
+            self.other = self.found[-1]
+
+    def candidate(self) -> _Program | None:
+        """The first program found that does not end with M99 (one whose end is still looked for: None)."""
+        return self.other
+
+    def provisional(self) -> list[_Program]:
+        """The programs found, the last one's end still looked for taken as M30 where it would be the
+        main program (one that runs on past MAX_SUBPROGRAM blocks is no subprogram: `Flow._keep`)."""
+        if not self.open or self.other is not None:
+            return self.found
+        return [*self.found[:-1], replace(self.found[-1], end="M30")]
 
 
 def _main_program(programs: list[_Program]) -> tuple[_Program | None, str]:

@@ -403,6 +403,8 @@ class Interpreter:
         self.set_angles: dict[int, dict[str, float]] = {}
         # Fanuc's and Haas's H offsets the program set: (geometry, wear) in mm (geometry None: not known)
         self.h_memory: dict[int, tuple[float | None, float]] = {}
+        # Fanuc's D offsets the program set (memory C): (geometry, wear), radii in mm (geometry None: not known)
+        self.d_memory: dict[int, tuple[float | None, float]] = {}
         self.unpositioned = {0, 1, 2}  # the axes X Y Z no move has put at a known position yet
         self.untold_lengths = UntoldLengths(
             offsets is not None and offsets.tools is None

@@ -20,6 +20,7 @@ import re
 from dataclasses import replace
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from ncpp.errors import NcppError, Warnings
@@ -237,7 +238,7 @@ def test_fanuc_g43_applies_geometry_plus_wear_as_g10_l10_l11_set_them(tmp_path):
     assert moves[0].context.tool_mm[2] == pytest.approx(length)
     assert moves[0].context.to_machine(moves[0].end)[2] == pytest.approx(300.0 + 50.0 + length)
     under_comp = [m for m in moves if m.centre_shift is not None]
-    assert under_comp and under_comp[0].centre_shift[0] is None  # a D offset G10 L12 set: radius not known
+    assert under_comp[0].centre_shift[1] == pytest.approx((0.0, 5.0, 0.0))  # G10 L12's radius
 
 
 def test_fanuc_wear_alone_is_out_of_scope_and_haas_reads_it_as_wear(tmp_path):
@@ -337,3 +338,85 @@ def test_the_abbe_arm_is_compensated_at_the_length_the_program_sets(tmp_path):
 def test_pathcheck_passes_the_output_with_the_lengths_the_program_sets(tmp_path):
     program, out = _compensate(tmp_path, "setter", SETTER)
     rs274.pathcheck(program, out, "--tool-table", str(tmp_path / "tools.tbl"))
+
+
+# A square run counter-clockwise with the tool outside it (G42), its D offset set by G10 L12 (geometry)
+# and L13 (wear, set, then added to in G91): a radius of 5 - 0.1 + 0.02 = 4.92 mm, where the table's
+# tool 1 is 12.7 mm across
+D_SET = """O1000
+G21 G90 G17 G54
+G90 G10 L12 P1 R5.
+G10 L13 P1 R-0.1
+G91 G10 L13 P1 R0.02
+G90 G0 X-20. Y0 Z5.
+G1 Z-1. F200.
+G42 D1 G1 X0 Y0 F300.
+G1 X40.
+G1 Y30.
+G1 X0
+G1 Y0
+G40 G0 X-20. Y-20.
+M30
+"""
+# The same for LinuxCNC, the radius given by G10 L1 R
+D_SET_TWIN = """G21 G90 G17 G54
+G10 L1 P1 R4.92
+T1 M6
+G0 X-20. Y0 Z5.
+G1 Z-1. F200.
+G42 G1 X0 Y0 F300.
+G1 X40.
+G1 Y30.
+G1 X0
+G1 Y0
+G40 G0 X-20. Y-20.
+M2
+"""
+
+
+def _centres(moves: list) -> list[tuple[float, ...]]:
+    """Where the tool centre stands at the end of each move under cutter compensation."""
+    return [tuple(np.add(m.end, m.centre_shift[1])) for m in moves if m.centre_shift is not None]
+
+
+def test_fanuc_g41_g42_offset_by_the_radius_g10_l12_l13_set_as_rs274_by_g10_l1_r(tmp_path):
+    """Fanuc: D offset 1 is geometry plus wear of memory C, a radius (`FanucInterpreter._set_d_offset`);
+    rs274 offsets its twin by G10 L1's R: the tool centre at each move's end is one of its points."""
+    offsets = replace(WorkOffsets.at((0.0, 0.0, 0.0)), tools=_table(tmp_path, "T1 P1 Z0 D0.5\n"))
+    centres = _centres(_dialect_moves("fanuc", D_SET, offsets))
+    table = tmp_path / "rs274.tbl"
+    table.write_text("T1 P1 Z0 D0.5\n")
+    done = rs274.run(D_SET_TWIN, tool_table=table, digits=7)
+    assert done.returncode == 0, done.stderr
+    reference = rs274.end_points(done.stdout)
+    assert len(centres) == 6 and (40.0, -4.92, -1.0) in [tuple(np.round(c, 9)) for c in centres]
+    for centre in centres:
+        assert np.min(np.abs(np.subtract(reference, centre)).max(axis=1)) < 1e-6, (centre, reference)
+
+
+@pytest.mark.parametrize(
+    "dialect, setting",
+    [
+        ("haas", "G90 G10 L12 P1 R5."),  # (Haas's D offset is named a diameter)
+        ("fanuc", "G90 G10 L12 P1 R-5."),  # (a negative radius swaps G41 and G42 on a Fanuc)
+        ("fanuc", "G90 G10 L13 P1 R0.1"),  # (wear alone, no geometry told)
+    ],
+)
+def test_a_d_offset_set_to_a_radius_ncpp_does_not_know_leaves_the_moves_on_their_points(dialect, setting):
+    program = D_SET.replace("G90 G10 L12 P1 R5.\nG10 L13 P1 R-0.1\nG91 G10 L13 P1 R0.02\n", setting + "\n")
+    centres = _centres(_dialect_moves(dialect, program, WorkOffsets.at((0.0, 0.0, 0.0))))
+    assert centres[:-1] == [(0.0, 0.0, -1.0), (40.0, 0.0, -1.0), (40.0, 30.0, -1.0), (0.0, 30.0, -1.0),
+                            (0.0, 0.0, -1.0)]  # fmt: skip
+
+
+def test_fanuc_g10_l12_radius_is_compensated_without_the_unknown_radius_warning(tmp_path):
+    from tests.writeback.conftest import compensate_file
+    from tests.writeback.test_compensated_holes import MACHINE
+
+    for dialect, warned in (("fanuc", False), ("haas", True)):
+        (tmp_path / "p.nc").write_text(D_SET)
+        said = io.StringIO()
+        output = compensate_file(tmp_path / "p.nc", MACHINE, tmp_path, warnings=Warnings(stream=said),
+                                 dialect=dialect)  # fmt: skip
+        assert ("tool radius not known" in said.getvalue()) == warned, said.getvalue()
+        assert output.read_text() != D_SET
