@@ -65,6 +65,7 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_with_expand_the_moves_under_compensation_in_loops_and_subroutines_land_on_the_path",
             "test_the_entry_arc_stays_one_arc_the_control_accepts",
             "test_mmount_contours_land_within_the_tolerance",
+            "test_a_move_along_z_alone_under_compensation_makes_no_move_in_the_plane",
         ),
         "motion/test_oracle.py": None,
         "compensation/test_tool_parameters.py": (
