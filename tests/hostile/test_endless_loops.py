@@ -321,7 +321,7 @@ MACHINE = SHARED / "machines/wide.toml"
 PROGRAMS = {
     "while.ngc": (ENDLESS_ISO["while"][0], 6),
     "while.nc": (ENDLESS_FANUC["WHILE [..] DO1"][0], 9),
-    "loop.mpf": (SINUMERIK_HEAD + ENDLESS_SINUMERIK["LOOP ... ENDLOOP"][0], 9),
+    "loop.mpf": (SINUMERIK_HEAD + ENDLESS_SINUMERIK["LOOP ... ENDLOOP"][0], 10),
     "jump.h": (KLARTEXT, 8),
 }
 
