@@ -563,9 +563,8 @@ class Interpreter:
                 text = Pass(
                     block, kind is SKIP or block.verbatim, None if ended else self.motion
                 )  # (after the end: no mode the control is in)
-                if (
-                    self.tool_reads
-                ):  # (a control line's condition read them: the writer reads its first event)
+                # (a control line's condition read them: the writer reads its first event)
+                if self.tool_reads:
                     text.tool_read = self._reads_to_check(flow.in_straight_code())
                 if pending is not None:
                     held.append(text)
