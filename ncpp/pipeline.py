@@ -196,7 +196,7 @@ INCREMENTAL_CYCLE = (
 )
 
 UNKNOWN_SETTING = (
-    "G92 or G10 L10/L11/L20 right after moves left as programmed in G90: it sets an offset from where the control "
+    "G92, G10 L10/L11/L20 or PRESETON right after moves left as programmed in G90: it sets an offset from where the control "
     "stands, which ncpp does not know exactly there; from this line on the program passes through uncompensated"
 )
 

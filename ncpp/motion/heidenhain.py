@@ -1125,7 +1125,7 @@ class HeidenhainInterpreter(ModalInterpreter):
         if repeat == 0 and "REP" in words.upper():  # (the parser reads no REP as REP 0)
             raise OutOfScope("CALL LBL ... REP 0 (REP counts the section's runs after the first, TNC 640 "
                              "Klartext manual: how the control reads none is not told)", item.start + 1)  # fmt: skip
-        index = self.flow.target(name, lambda q: self.value(q, block, item), item.start + 1)
+        index = self.flow.target(name, lambda q: self.value(q, block, item), item.start + 1, repeat == 0)
         key = label_key(self.value(name, block, item) if type(name) is tuple else name)
         self.flow.call(index, repeat, key, item.start + 1, self.radius_comp or self.centre.off_path)
 

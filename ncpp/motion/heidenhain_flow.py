@@ -22,9 +22,18 @@ once) or running a block of the pass again.  A call or jump back over a move tha
 (RUN) leaves the scope, and so does a label more than `MAX_AHEAD` blocks ahead or no longer held
 (blocks are held from the first label before the position, up to `MAX_BEHIND` back).
 
+A subprogram's text that stands before its call runs where it stands when the program comes to it
+("Subprograms": subprograms stand after M2/M30 since the control runs them otherwise), and again
+where it is called: a call without REP runs the blocks from its label to the first LBL 0, so where
+those hold no control line (`_straight_end`), the blocks that run again are those alone, and the
+main program's blocks after that LBL 0 run once (`bodies`).  A jump the program takes over such a
+text (`FN 9: IF +0 EQU +0 GOTO LBL 99`, the subprograms ahead of the main program) runs none of it
+there: the text waits for its call (`_wait_for_call`, `OnceRuns.meet`, as ISO's definitions do).
+
 A subprogram called from the main program's straight code whose text stands after the call (after
-M30, where the manual puts subprograms) may run once: its run's blocks are CALLED (`_runs_once`,
-as `ncpp.motion.flow`'s), and if its text runs again -- another call of its label (with or
+M30, where the manual puts subprograms), or before it behind a jump that went over it, may run
+once: its run's blocks are CALLED (`_runs_once`, as `ncpp.motion.flow`'s), and if its text runs
+again -- another call of its label (with or
 without REP), its `LBL` block run (the program running into it, a jump to it) -- the flow names
 it in `called_again`: whether it ran once is known only where the program ends (`ncpp.motion.once`).
 """
@@ -46,6 +55,7 @@ MAX_AROUND = 10_000
 LOOKAHEAD = 20_000  # blocks read ahead of the one that runs, to find the calls and jumps back
 MAX_AHEAD = 200_000  # blocks read ahead to find a label a call or jump names
 MAX_BEHIND = 200_000  # blocks held behind the one that runs, for calls and jumps back
+MAX_BODY = 10_000  # blocks searched from a label for the LBL 0 of a straight subprogram (`_straight_end`)
 MAX_NESTING = 19  # subprogram levels (TNC 640 Klartext manual, "Nesting")
 JUMPS = {9: "EQU", 10: "NE", 11: "GT", 12: "LT"}  # FN 9-12 and the comparison each makes
 _JUMP = re.compile(
@@ -106,6 +116,9 @@ class KlartextFlow:
         self.exhausted = False
         self.labels: dict[float | str, int] = {}  # label -> the index of its LBL block
         self.again: list[tuple[int, int]] = []  # [label, call or jump back]: blocks that run again
+        # a label's index -> its straight text's LBL 0 (`_straight_end`), for a label called from after
+        # that text while none of it had run in its place: a call of it runs that text alone
+        self.bodies: dict[int, int] = {}
         self.called_text: set[tuple[int, int]] = set()  # [label, LBL 0] of the subprograms a call ran
         self.jumps_back: set[int] = set()  # the indices of the FN 9-12 among the ends of `again`
         self.twice: set[float | str] = set()  # labels defined more than once (the control refuses them)
@@ -131,6 +144,7 @@ class KlartextFlow:
         self.entered: set[float | str] = set()  # the labels called or whose LBL block ran
         self.once_called: dict[float | str, str] = {}  # a label whose run was CALLED -> its name
         self.called_again: list[str] = []  # the CALLED subprograms whose text ran again since read
+        self.next_in_place = 0  # where a jump over text goes on in place (`_wait_for_call`)
 
     # -- reading ------------------------------------------------------------------------
     def _read(self) -> None:
@@ -155,9 +169,39 @@ class KlartextFlow:
             return
         name = _reference(item)
         if name is not None and type(name) is not tuple and self.labels.get(label_key(name), index) < index:
-            self.again.append((self.labels[label_key(name)], index))
+            label = self.labels[label_key(name)]
+            end = self._body(label, index) if item.kind == "call_label" and item.node[1] == 0 else None
+            self.again.append((label, index if end is None else end))
             if item.kind == "fn":
                 self.jumps_back.add(index)
+
+    def _body(self, label: int, call: int) -> int | None:
+        """The LBL 0 of the straight text after `label` (`_straight_end`), which a call without REP
+        read at `call` runs alone, where that LBL 0 stands before the call and no block of the text
+        has moved in its place yet (the text's blocks from here on run again: FIXED); else None."""
+        if label in self.bodies:
+            return self.bodies[label]
+        if label < self.base or max(self.last_run_move, self.once_move) >= label:
+            return None
+        end = self._straight_end(label, MAX_BODY)
+        if end is None or end >= call:
+            return None
+        self.bodies[label] = end
+        return end
+
+    def _straight_end(self, label: int, most: int) -> int | None:
+        """The index of the first LBL 0 after the LBL block at `label`, within `most` blocks, where
+        the blocks between are a run with no control line (no label, call, jump, FN 14, program end,
+        M2 or M30: each runs once, in order) and no radius compensation RL/RR; else None."""
+        end = label + 1
+        while (block := self.block(end)) is not None and end - label <= most:
+            head = _head(block)
+            if head is not None and head.kind == "label" and head.node[0] == 0:
+                return end
+            if _way_out(block) or (head is not None and head.kind in _NOT_ONCE) or _compensates(block):
+                return None
+            end += 1
+        return None
 
     def block(self, index: int) -> Block | None:
         """The block at `index`, read ahead to it (None past the end)."""
@@ -186,8 +230,11 @@ class KlartextFlow:
             self.jumps_back = {b for b in self.jumps_back if b >= keep}
 
     # -- what the interpreter tells ---------------------------------------------------
-    def target(self, name: object, value: Callable[[tuple], float], col: int) -> int:
-        """The index of the label a call or jump names (OutOfScope where ncpp cannot follow)."""
+    def target(
+        self, name: object, value: Callable[[tuple], float], col: int, subprogram: bool = False
+    ) -> int:
+        """The index of the label a call or jump names (OutOfScope where ncpp cannot follow);
+        `subprogram`: a call without REP, which runs a straight text (`bodies`) alone."""
         if self.named_by_q:
             raise OutOfScope("a jump in a program with a label named by a Q parameter", col)
         key = label_key(value(name) if type(name) is tuple else name)
@@ -206,7 +253,11 @@ class KlartextFlow:
             raise OutOfScope(f"LBL {shown} ({where})", col)
         if index < self.base:
             raise OutOfScope(f"LBL {shown} (more than {MAX_BEHIND} blocks back)", col)
-        if index <= self.current and self.last_run_move >= index:
+        if (
+            index <= self.current
+            and self.last_run_move >= index
+            and not (subprogram and index in self.bodies)
+        ):
             raise OutOfScope(f"a jump back to LBL {shown} over moves that ran in their place", col)
         return index
 
@@ -265,19 +316,27 @@ class KlartextFlow:
         `held_most` blocks) a run of blocks with no control line (no label, call, jump, FN 14,
         program end, M2 or M30: each runs once, in order) and no radius compensation RL/RR."""
         once = self.once
-        if once is None or not once.may_run_once(label_name(key)) or self.frames or not self.straight:
+        name = label_name(key)
+        if once is None or not once.may_run_once(name) or self.frames or not self.straight:
             return False
         if index <= self.current:
-            return False
-        end = index + 1
-        while (block := self.block(end)) is not None and end - index <= once.held_most:
-            head = _head(block)
-            if head is not None and head.kind == "label" and head.node[0] == 0:
-                return True
-            if _way_out(block) or (head is not None and head.kind in _NOT_ONCE) or _compensates(block):
-                return False
-            end += 1
-        return False
+            return name in once.waiting  # (its text stands before the call, behind a jump: `_wait_for_call`)
+        return self._straight_end(index, once.held_most) is not None
+
+    def _wait_for_call(self, skipped: int) -> None:
+        """A jump in the main program's straight code went over the block at `skipped`: a label whose
+        straight text (`_straight_end`) it went over whole, not yet run, waits for a call that may be
+        its only run (`OnceRuns.meet`: the writer holds the lines from its text on).  Whether it is
+        called once is known only at the program's end."""
+        once, label = self.once, self.label_at.get(skipped)
+        if once is None or label is None or label == 0.0 or label in self.entered or not self.straight:
+            return
+        if self.frames or not once.may_run_once(label_name(label)):
+            return
+        end = self._straight_end(skipped, once.held_most)
+        if end is None or end >= self.next_in_place:
+            return
+        once.meet(label_name(label), [b for i in range(skipped, end + 1) if (b := self.block(i)) is not None])
 
     def _entered(self, key: float | str) -> None:
         """The text after label `key` runs (a call of it, its LBL block): a CALLED one's again."""
@@ -396,7 +455,9 @@ class KlartextFlow:
                 break
             in_place = not self.frames and pc >= written
             if in_place:
+                self.next_in_place = pc
                 while written < pc:  # jumped over: written, not run
+                    self._wait_for_call(written)
                     yield self.block(written), SKIP, None
                     written += 1
                 if self.labels:  # (before the first label no block can run again: the text streams)

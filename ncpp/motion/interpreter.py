@@ -201,10 +201,6 @@ class _OutOfScope(modal.OutOfScope):
     by the correction there as it does an offset set in scope (the control stands at the corrected
     point, and the block must set the offset the program means)."""
 
-    def __init__(self, reason: str, col: int | None = None, setting: Setting | None = None):
-        super().__init__(reason, col)
-        self.setting = setting
-
 
 class _SetInFlow(_OutOfScope):
     """A block that sets an offset from where the control stands, in a loop or subroutine: the

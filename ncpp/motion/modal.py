@@ -19,7 +19,7 @@ from ncpp.motion.cutter import ToolCentre
 from ncpp.motion.endless import exact
 from ncpp.motion.offsets import WorkOffsets
 from ncpp.motion.once import OnceRuns
-from ncpp.motion.segments import DRILLED, PLANE_AXES, Arc, Context, Event, Line, Pass, Point
+from ncpp.motion.segments import DRILLED, PLANE_AXES, Arc, Context, Event, Line, Pass, Point, Setting
 from ncpp.program.blocks import Block, Item
 
 MM_PER_INCH = 25.4
@@ -32,12 +32,15 @@ MAX_HOLES = 10_000  # holes of one pattern a control computes: beyond, the count
 
 
 class OutOfScope(Exception):
-    """A construct after which the interpreter no longer knows the position."""
+    """A construct after which the interpreter no longer knows the position.  `setting`: the offset a
+    block that leaves the scope sets from where the control stands, which the writer gives a step back
+    to the programmed point before it (the control stands at the corrected point)."""
 
-    def __init__(self, reason: str, col: int | None = None):
+    def __init__(self, reason: str, col: int | None = None, setting: Setting | None = None):
         super().__init__(reason)
         self.reason = reason
         self.col = col
+        self.setting = setting
 
 
 def placed_interpreting(dialect: type[ModalInterpreter]) -> Callable[..., Iterator[Event]]:

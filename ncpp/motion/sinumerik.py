@@ -60,7 +60,7 @@ from ncpp.motion.modal import (
     plane_of,
 )
 from ncpp.motion.once import FirstPass
-from ncpp.motion.segments import FLOW, MACHINE, PATTERN, PLANE_AXES, Event, Line, Pass
+from ncpp.motion.segments import FLOW, MACHINE, PATTERN, PLANE_AXES, Event, Line, Pass, Setting
 from ncpp.motion.sinumerik_cycles import PARAMETERS as DRILLING
 from ncpp.motion.sinumerik_cycles import CycleError, Drilling, drilling
 from ncpp.motion.sinumerik_expand import SinumerikExpansion
@@ -187,6 +187,11 @@ PREDEFINED_PROCEDURES = frozenset((
     "SETINT", "EXECSTRING", "EXECTAB", "GETT", "GETSELT", "GETEXET", "FIFOCTRL", "CUT2DF", "CUT3DC", "CUT3DF",
     "CUT3DFF", "CUT3DFS", "POSA", "SPOSA", "LEADON", "EGON", "COUPON",
 ))  # fmt: skip
+# The actual-value settings (SINUMERIK 828D Basic Functions function manual 01/2023, "Axes,
+# coordinate systems, frames", "Coordinate systems": `PRESETONS(<axis>, <value>)` makes <value> the
+# machine axis's actual value in the machine coordinate system, where it stands, so shifting that
+# system's zero, $AC_PRESET, by the difference): the program's zero moves with it (`_preset`)
+PRESETS = frozenset(("PRESETON", "PRESETONS"))
 # Control statements after which the flow may run blocks again (`sinumerik_flow`): their moves the line's
 RUNS_OTHERS = frozenset(("endwhile", "endfor", "until", "endloop", "goto", "case"))
 # PROC attributes that change nothing the motion depends on: the display and single-block
@@ -357,7 +362,8 @@ class SinumerikInterpreter(ModalInterpreter):
             self.called = None
             self.leave_scope(warnings, stop.reason, block, stop.col, owner)
             if owner is None:  # (a block run out of the text's order is written in its place)
-                yield Pass(block)
+                # (a setting's step back where the block runs once, in its place: `_preset`)
+                yield Pass(block, setting=stop.setting if kind is RUN and caller is None else None)
             return
         moves = [event for event in events if type(event) is not Pass]
         if kind is FIXED:
@@ -885,6 +891,8 @@ class SinumerikInterpreter(ModalInterpreter):
                     or (item.node[0] in RESETTING_CALLS and not item.node[1])
                 ):
                     pass
+                elif what == "call" and item.node[0] in PRESETS:
+                    raise self._preset(item.node, block, item)
                 elif what == "call" and item.node[0] in PREDEFINED_PROCEDURES:
                     raise OutOfScope(f"the predefined procedure {item.node[0]}", item.start + 1)
                 elif what == "call" and (
@@ -1038,6 +1046,29 @@ class SinumerikInterpreter(ModalInterpreter):
         except OutOfScope as out:
             out.col = item.start + 1
             raise
+
+    def _preset(self, node: tuple, block: Block, item) -> OutOfScope:
+        """`PRESETON(X, 10)`: the axis's actual value set where it stands, which shifts the machine
+        coordinate system (`PRESETS`) and with it every position after it: the scope ends there.  As a
+        G92 does, it sets its offset from where the control stands, the corrected point: naming X, Y
+        or Z with values, it carries a `Setting` (its values the machine coordinates it gives), so that
+        the writer steps back to the programmed point before it and the offset is the program's."""
+        name, args = node
+        reason = (f"{name} (it sets a machine axis's actual value, shifting the machine coordinate system and "
+                  "the program's zero with it)")  # fmt: skip
+        pairs = list(zip(args[::2], args[1::2]))
+        if len(args) % 2 or not pairs or not all(type(a) is tuple and a[0] == "param" for a, _ in pairs):
+            return OutOfScope(f"{name} other than as (axis, value) pairs", item.start + 1)
+        axes = ["XYZ".find(a[1].upper()) if len(a[1]) == 1 else -1 for a, _ in pairs]
+        if min(axes) < 0:  # (a machine axis by another name: which of X Y Z it is ncpp is not told)
+            return OutOfScope(reason, item.start + 1)
+        try:
+            values = tuple((axis, self.value(expr, block, item)) for axis, (_, expr) in zip(axes, pairs))
+        except OutOfScope:  # (a value ncpp cannot compute: `$AA_IM[X]+70`, the actual position read)
+            return OutOfScope(reason, item.start + 1)
+        context = self.context()
+        here = context.turned((self.pos[0], self.pos[1], self.pos[2]))
+        return OutOfScope(reason, item.start + 1, Setting(values, context, here, leaves=True))
 
     def _holes(self, node: tuple, block: Block, item) -> list[tuple[float, float]]:
         """HOLES1 and HOLES2's holes in the plane, in the order the cycle drills them (840D

@@ -170,7 +170,7 @@ def test_g92_and_g10_l20_set_the_offsets_the_program_means(tmp_path):
 
 
 @pytest.mark.parametrize("middle, why", [
-    ("o100 repeat [2]\nG81 X20 Y20 Z-2 R2 F100\no100 endrepeat\nG80\nG92 X0 Y0\n", "G92 or G10 L10/L11/L20 right after moves left as programmed in G90"),
+    ("o100 repeat [2]\nG81 X20 Y20 Z-2 R2 F100\no100 endrepeat\nG80\nG92 X0 Y0\n", "G92, G10 L10/L11/L20 or PRESETON right after moves left as programmed in G90"),
     ("o100 repeat [2]\nG1 X[#<_x> + 1]\nG10 L20 P1 X0\no100 endrepeat\n", "G92 or G10 L10/L11/L20 in a loop or subroutine"),
 ])  # fmt: skip
 def test_a_setting_where_ncpp_cannot_say_where_the_control_stands_passes_through(tmp_path, middle, why):

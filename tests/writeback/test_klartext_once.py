@@ -113,23 +113,26 @@ NEVER = program("L X+10 Y+140 F300\n")
 def run_order(text: str) -> str:
     """The written program's lines in the order the control runs them, for this test's programs:
     the main part up to M30, each `CALL LBL n` followed by the lines after `LBL n` up to `LBL 0`
-    (TNC 640 Klartext manual, "Subprograms"), calls in them followed so too."""
+    (TNC 640 Klartext manual, "Subprograms"), calls in them followed so too; the main part runs
+    through a `LBL 0` of its own, and `FN 9: IF +0 EQU +0 GOTO LBL n` goes on at `LBL n`."""
     lines = text.splitlines()
     heads = [line.split(";")[0].split(None, 1)[-1].strip() for line in lines]
 
-    def run(start: int) -> list[str]:
-        out = []
-        for line, head in zip(lines[start:], heads[start:]):
-            if head == "LBL 0" or re.search(r"\bM30\b|END PGM", head):
-                out.append(line)
-                return out
+    def run(start: int, subprogram: bool) -> list[str]:
+        out, index = [], start
+        while index < len(lines):
+            line, head = lines[index], heads[index]
             out.append(line)
+            if (head == "LBL 0" and subprogram) or re.search(r"\bM30\b|END PGM", head):
+                return out
             called = re.fullmatch(r"CALL LBL (\S+)", head)
             if called:
-                out += run(heads.index(f"LBL {called.group(1)}") + 1)
+                out += run(heads.index(f"LBL {called.group(1)}") + 1, True)
+            jump = re.fullmatch(r"FN 9: IF \+0 EQU \+0 GOTO LBL (\S+)", head)
+            index = heads.index(f"LBL {jump.group(1)}") if jump else index + 1
         return out
 
-    return "\n".join(run(0))
+    return "\n".join(run(0, False))
 
 
 def _code(text: str) -> str:
@@ -256,3 +259,68 @@ def test_a_loops_first_pass_held_past_the_bound_stays_as_programmed(tmp_path, mo
     written, messages = compensated(tmp_path, "jump.h", program(JUMP_BACK.format(body=BODY, end=10), ""))
     assert "L X+160 Y+20 F500\nL X+180 Y+120" in _code(written)
     assert "warning: loop or subroutine" in messages
+
+
+# a subprogram's text before its call, behind a jump the program takes over it: the control runs a
+# text where it stands unless it stands after M2/M30 or a jump goes over it (TNC 640 Klartext
+# manual, "Subprograms and program section repeats"), so the call is its only run
+BEHIND_A_JUMP = numbered(
+    f"{HEAD}FN 9: IF +0 EQU +0 GOTO LBL 99\nLBL 1\n{BODY}LBL 0\nLBL 99\nL X+10 Y+140 F300\n"
+    "CALL LBL 1\nL X+10 Y+140\nL Z+50 FMAX M30\nEND PGM CONTOUR MM\n"
+)
+# the program runs into the text before it calls it: the text runs twice
+RUN_INTO_BEFORE = BEHIND_A_JUMP.replace("FN 9: IF +0 EQU +0 GOTO LBL 99", "L X+10 Y+140 F300")
+
+
+def test_a_subprogram_behind_a_jump_before_its_only_call_is_compensated_where_it_stands(tmp_path):
+    """Every programmed point, read in the order the control runs the written program, within
+    0.5 µm (as written, more than 5 µm off); the text stays before the call, between its jump and
+    the jump's label, and the blocks are numbered one after another."""
+    written, messages = compensated(tmp_path, "before.h", BEHIND_A_JUMP)
+    wanted = MAIN + CONTOUR
+    assert landed(points(run_order(written)), wanted).max() < 0.5e-3
+    assert landed(points(run_order(BEHIND_A_JUMP)), wanted).max() > 5e-3
+    assert "loop or subroutine" not in messages
+    code = _code(written)
+    assert (
+        code.index("GOTO LBL 99")
+        < code.index("LBL 1\n")
+        < code.index("LBL 0\nLBL 99")
+        < code.index("CALL LBL 1")
+    )
+    numbers = [int(line.split()[0]) for line in written.splitlines() if not line.startswith(" ")]
+    assert numbers == list(range(len(numbers)))
+
+
+def test_a_subprogram_behind_a_jump_called_twice_stays_as_programmed(tmp_path):
+    text = BEHIND_A_JUMP.replace("L X+10 Y+140\n", "CALL LBL 1\nL X+10 Y+140\n", 1)
+    assert text.count("CALL LBL 1") == 2
+    written, messages = compensated(tmp_path, "twice.h", text)
+    assert BODY.strip() in _code(written)
+    assert "warning: loop or subroutine" in messages
+    ends = points(written)
+    assert landed(ends, MAIN[:3]).max() < 0.5e-3 and landed(ends, CONTOUR).min() > 2e-3
+
+
+def test_a_text_run_into_before_its_call_stays_as_programmed_and_the_blocks_after_it_are_compensated(
+    tmp_path,
+):
+    """The control runs the text where it stands and again at the call: both runs as programmed,
+    with the warning.  A call without REP runs the text from its label to LBL 0 alone, so the main
+    program's moves between that LBL 0 and the call, which run once, are compensated."""
+    written, messages = compensated(tmp_path, "into.h", RUN_INTO_BEFORE)
+    assert BODY.strip() in _code(written)
+    assert "warning: loop or subroutine" in messages
+    ends = points(written)
+    assert landed(ends, MAIN[:3]).max() < 0.5e-3 and landed(ends, CONTOUR).min() > 2e-3
+    before = _code(written.partition("LBL 99")[0]).splitlines()
+    moves = sum(line.split()[:1] in (["L"], ["C"]) for line in before)  # (the moves up to LBL 99)
+    assert "L X+10 Y+140 F300" not in written.partition("LBL 99")[2]
+    assert landed(ends[moves : moves + 1], [(10, 140, -2)]).max() < 0.5e-3
+
+
+@pytest.mark.parametrize("text", [BEHIND_A_JUMP, RUN_INTO_BEFORE], ids=["behind a jump", "run into"])
+def test_a_text_before_its_call_compensates_and_verifies_on_the_wide_machine(tmp_path, text):
+    program, out = tmp_path / "before.h", tmp_path / "out.h"
+    program.write_text(text)
+    assert main(["compensate", "--machine", str(_wide(tmp_path)), str(program), "-o", str(out)]) == 0
