@@ -117,6 +117,13 @@ Series 15i-MA operator's manual counts them in L: "When L is used to specify the
 both are read, and a block with both, or with K0 (the cycle's data stored, no hole drilled), is out of
 scope.  Haas counts repeats in L only ("G81 Drill Canned Cycle": "L Number of holes if G91 is used").
 
+A P in the block of a cycle whose format has none (G81 `X_ Y_ Z_ R_ F_ K_` as above, G73, G83 and G85 on
+Fanuc) is kept as written and the
+cycle's moves are its own: the format's sequence has no dwell at the bottom, and whatever the control
+makes of the P (the cycle's data for a later block, or nothing), no axis moves otherwise.  LinuxCNC
+refuses it ("P word with no G2 G3 G4 ... to use it").  --expand-cycles refuses such a block: whether the
+control dwells on that P is not known.
+
 G76 is fine boring on both (Fanuc Series 15i-MA operator's manual, "Fine boring cycle (G76)": to X Y, to
 R, feed to Z, dwell P, the spindle oriented and the tool shifted off the wall by Q or I J, out at rapid,
 shifted back; Haas Mill Operator's Manual, "G76 Fine Boring Canned Cycle"), where LinuxCNC's G76 is a
@@ -248,6 +255,7 @@ class FanucInterpreter(Interpreter):
     rigid_tapping = False  # (Fanuc taps rigidly with M29 and G84: G33.1 is LinuxCNC's)
     modal_d = True  # `G43 H1 D1`: D alone selects the radius offset (module docstring)
     dwell_x = True  # `G04 X1.5`: a dwell of 1.5 s (module docstring)
+    any_cycle_p = True  # `G81 ... P500`: the P kept as written, no dwell of G81's (module docstring)
     taps_in_any_plane = True  # G74/G84 in G18/G19 tap along the normal (module docstring)
     cycles_own_group = True  # G80 leaves the G0-G3 mode before the cycle in effect (module docstring)
     back_bore_holes = False  # G87 reads R Z Q K otherwise than rs274ngc (`Interpreter.back_bore_holes`)

@@ -279,6 +279,9 @@ class Interpreter:
     rigid_tapping = True
     # G73/G83 take a P, the dwell at the bottom of each hole (Haas); rs274ngc refuses it there
     peck_dwell = False
+    # A P in the block of a canned cycle whose format has none (G81: Fanuc, Haas) is kept as written, the
+    # cycle's moves its own (`FanucInterpreter`); rs274ngc refuses it
+    any_cycle_p = False
     # A D word alone selects the radius offset a later G41/G42 without D uses (Fanuc); rs274ngc refuses it
     modal_d = False
     # The motion mode a program starts in (grbl: G0); rs274ngc starts in none
@@ -1475,7 +1478,7 @@ class Interpreter:
         if "P" in words:
             p, p_item = words["P"]
             user_m = any(100.0 <= m <= 199.0 for m in mcodes)
-            peck_p = self.peck_dwell and motion in PECKING
+            peck_p = self.peck_dwell and motion in PECKING or self.any_cycle_p and motion in self.canned
             if not (mode0 in (10.0, 4.0) or gcodes.get(13, (None,))[0] == 64.0 or motion in _P_MOTIONS
                     or motion == 87.0 and not self.back_bore_holes
                     or mcodes.keys() & _P_MCODES or user_m or peck_p):  # fmt: skip
@@ -2245,6 +2248,12 @@ class Interpreter:
                 f"--expand-cycles: G{motion:g} cannot be written as G0/G1 moves ({UNEXPANDED[motion]}); "
                 "leave the option out, the cycle is then compensated or left as programmed", block, item,
             )  # fmt: skip
+        if self.expand_cycles and "P" in words and not self._dwells_on_p(motion):
+            self._fail(
+                f"--expand-cycles: the P of G{motion:g}, a dwell its format has not, cannot be written as a G4 "
+                "(whether the control dwells on it is not known); leave the option out, the cycle is then "
+                "compensated with its P as written", block, words["P"][1],
+            )  # fmt: skip
         self._check_cycle_size(block, words, repeats, (r - bottom) / peck if motion in PECKING else 0.0, item)
         if motion == 87.0:
             off_a, off_b, top = self._back_bore_words(block, words, again, item)
@@ -2274,7 +2283,7 @@ class Interpreter:
         lines = tuple(self._fixed_line(block, (first, second, normal), move) for move in moves)
         if self.expand_cycles:
             self.cycle_holes = False
-            dwells = motion in DWELLING or (self.peck_dwell and motion in PECKING and self.cycle_p > 0.0)
+            dwells = motion in DWELLING or (self._dwells_on_p(motion) and self.cycle_p > 0.0)
             dwell = self._dwell_word(block, words.get("P", (0, item))[1]) if dwells else None
             return self._expanded(block, motion, lines, bottoms, dwell)
         # holes apply_error_map compensates: in any plane (polar words written as X Y, repeats as a
@@ -2419,6 +2428,10 @@ class Interpreter:
             if k in dwells:
                 events.append(Pass(block, dwell=self.cycle_p, dwell_word=dwell))
         return tuple(events)
+
+    def _dwells_on_p(self, motion: float) -> bool:
+        """Whether the cycle dwells for its P at the bottom of the hole (G82 G86 G89; Haas: G73 G83)."""
+        return motion in DWELLING or self.peck_dwell and motion in PECKING
 
     def _dwell_word(self, block: Block, item) -> str:
         """The P word of the G4 that dwells as long as the cycle's P (--expand-cycles): rs274ngc reads
