@@ -197,6 +197,7 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
         "compensation/test_rotation.py": (
             "test_the_programmed_points_are_reached_under_g68_within_half_a_micron",
             "test_a_g68_of_variables_turns_as_their_values_do",
+            "test_a_g69_among_modes_of_other_groups_is_followed",
             "test_a_safety_lines_cancels_of_modes_not_in_effect_change_nothing",
         ),
         "shop/test_extents.py": None,  # (each runs the command line)

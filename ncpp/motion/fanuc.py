@@ -228,6 +228,11 @@ HAAS_UNFOLLOWED = {("G", 54.1): "G54.1 (Fanuc's additional work offset; Haas sel
 NOT_UNDER_G68 = frozenset((17.0, 18.0, 19.0, 10.0, 52.0, 92.0, 92.1, 92.2, 92.3, 54.0, 55.0, 56.0, 57.0, 58.0,
                            59.0, 54.1, 154.0, *(float(n) for n in range(110, 130))))  # fmt: skip
 
+# The G codes a G69 block may carry besides N: modes of other groups that move nothing and leave the
+# frame G68 turned alone (Fanuc Series 30i-MB G code list: G69 in group 16; G90/G91 03, G94/G95 05, G98/G99
+# 10, G80 09, G40 07, G49 08, G15 17, G50 11, G50.1 22), set once the rotation is cancelled
+G69_COMPANIONS = frozenset((90.0, 91.0, 94.0, 95.0, 98.0, 99.0, 80.0, 40.0, 49.0, 15.0, 50.0, 50.1))
+
 # Frames these controls turn, scale or tilt that ncpp does not follow, named before the block's words are
 # checked (a G51's P is its scale, no dwell): scaling, the programmable mirror image, G68.1's rotation (a
 # lathe's), and the tilted working plane G68.2-G68.4 (Fanuc 30i-MB operator's manual)
@@ -403,12 +408,7 @@ class FanucInterpreter(Interpreter):
                   and not (type(item) is Statement and item.kind in IGNORED_STATEMENTS)]  # fmt: skip
         words = [word for item in others if (word := self._rotation_word(item, block, name, col)) is not None]
         if code.value == 69.0:
-            if any(w.letter != "N" for w in words):
-                raise _OutOfScope("G69 with other words in its block", col)
-            if self.g68 is not None:
-                self._keeping_machine(lambda: setattr(self, "g68", None))
-                self.unsettled_rotation = 69.0
-            return Pass(block)
+            return self._cancel_rotation(block, words, col)
         if any(w.letter not in "NXYRG" or (w.letter == "G" and w.value != 17.0) for w in words):
             raise _OutOfScope("G68 with other words in its block than G17, X, Y and R", col)
         if any(w.letter == "G" for w in words):
@@ -429,6 +429,22 @@ class FanucInterpreter(Interpreter):
         self._keeping_machine(lambda: setattr(self, "g68", (given["R"], given["X"], given["Y"])))
         self.unsettled_rotation = 68.0
         return Pass(block)
+
+    def _cancel_rotation(self, block: Block, words: list[Word], col: int) -> Event | tuple[Event, ...]:
+        """`G69`, with N and the modes of other groups that move nothing (`G69_COMPANIONS`: `G69 G94`,
+        `G90 G80 G69`) in its block: the rotation cancelled, the machine where it is, then the block's
+        modes set as in any block (G69 then cancels nothing).  A G69 with a plane (which the manual
+        forbids under G68), a work offset, a move or any other word is out of scope."""
+        other = next((w for w in words if w.letter != "N" and not (w.letter == "G" and w.value in G69_COMPANIONS)),
+                     None)  # fmt: skip
+        if other is not None:
+            raise _OutOfScope(f"G69 with {other.letter}{other.number} in its block", col)
+        if self.g68 is not None:
+            self._keeping_machine(lambda: setattr(self, "g68", None))
+            self.unsettled_rotation = 69.0
+        if all(w.letter == "N" for w in words):
+            return Pass(block)
+        return super().block(block)
 
     def _rotation_word(self, item, block: Block, name: str, col: int) -> Word | None:
         """A word of a G68 or G69 block, an X Y or R expression with the value it has now (None for
