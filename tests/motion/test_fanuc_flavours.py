@@ -721,6 +721,16 @@ def test_a_program_number_written_with_a_colon_is_the_o_number(tmp_path, dialect
     assert "".join(block.text for block in blocks) == program
 
 
+@pytest.mark.parametrize("dialect", ["fanuc", "haas"])
+@pytest.mark.parametrize("line", [":", " : (PART)"])
+def test_a_colon_without_a_number_is_refused_where_it_runs(dialect, line):
+    """The program number address with no number after it (B-63684EN, "Program number": `:` or O, then
+    the number) is refused where the control would run it, and read past where it does not run."""
+    with pytest.raises(NcppError, match="p.nc:1:[12]: a program number address `:` without its number"):
+        events(f"{line}\nG0 X1\nM30\n", dialect)
+    assert len([e for e in events(f"G0 X1\nM30\n{line}\n", dialect) if type(e) is Line]) == 1
+
+
 def test_a_colon_is_no_program_number_for_linuxcnc():
     """rs274ngc refuses the `:` ("Bad character ':' used"), and so does ncpp in a LinuxCNC program."""
     with pytest.raises(NcppError, match="':1000'"):
