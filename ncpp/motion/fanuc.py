@@ -409,14 +409,16 @@ class FanucInterpreter(Interpreter):
         words = [word for item in others if (word := self._rotation_word(item, block, name, col)) is not None]
         if code.value == 69.0:
             return self._cancel_rotation(block, words, col)
+        plane = next((w.value for w in words if w.letter == "G" and w.value in (17.0, 18.0, 19.0)), self.plane)
+        if plane != 17:  # (its X Y R, or the plane's own axes, then turn about another axis than Z)
+            raise _OutOfScope(f"G68 in G{plane:g} (a turn about another axis than Z)", col)
         if any(w.letter not in "NXYRG" or (w.letter == "G" and w.value != 17.0) for w in words):
             raise _OutOfScope("G68 with other words in its block than G17, X, Y and R", col)
         if any(w.letter == "G" for w in words):
             self._set(plane=17)
         given = {w.letter: w.value for w in words}
         why = (
-            "in G18 or G19 (a turn about another axis than Z)" if self.plane != 17
-            else "while a rotation is in effect" if self.g68 is not None
+            "while a rotation is in effect" if self.g68 is not None
             else "under cutter compensation" if self.cutter_comp is not None
             else "without R (its angle is then a parameter's)" if "R" not in given
             else "in G91 (a parameter makes its R absolute or added)" if not self.absolute

@@ -420,7 +420,12 @@ def test_the_returns_posts_write_after_g69_are_followed():
 @pytest.mark.parametrize(
     "body, at, construct",
     [
-        ("G18\nG68 X0 Y0 R30", "G68", "G68 in G18 or G19"),
+        ("G18\nG68 X0 Y0 R30", "G68", "G68 in G18 (a turn about another axis than Z)"),
+        ("G18\nG68 X0 Z0 R30", "G68", "G68 in G18"),
+        ("G68 G19 Y0 Z0 R30", "G68", "G68 in G19"),
+        ("G68 X0 Y0 R30\nG41 D1 G1 X5 Y5 F100", "G41", "cutter compensation G41 under a coordinate system"),
+        ("G42 D1 G1 X5 Y5 F100\nG68 X0 Y0 R30", "G68", "G68 under cutter compensation"),
+        ("G68 X0 Y0 R30\nG51 X0 Y0 P2", "G51", "scaling G51"),
         ("G68 X0 Y0", "G68", "G68 without R"),
         ("G91\nG68 X0 Y0 R30", "G68", "G68 in G91"),
         ("G68 R30", "G68", "G68 without X and Y"),
