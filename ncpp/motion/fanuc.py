@@ -409,7 +409,8 @@ class FanucInterpreter(Interpreter):
         words = [word for item in others if (word := self._rotation_word(item, block, name, col)) is not None]
         if code.value == 69.0:
             return self._cancel_rotation(block, words, col)
-        plane = next((w.value for w in words if w.letter == "G" and w.value in (17.0, 18.0, 19.0)), self.plane)
+        planes = [w.value for w in words if w.letter == "G" and w.value in (17.0, 18.0, 19.0)]
+        plane = planes[0] if planes else self.plane
         if plane != 17:  # (its X Y R, or the plane's own axes, then turn about another axis than Z)
             raise _OutOfScope(f"G68 in G{plane:g} (a turn about another axis than Z)", col)
         if any(w.letter not in "NXYRG" or (w.letter == "G" and w.value != 17.0) for w in words):
