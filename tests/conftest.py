@@ -96,7 +96,7 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
         "writeback/test_compensated_holes.py": None,
         "writeback/test_compensated_back_bore.py": (
             "test_each_back_bore_cuts_to_its_top_and_stands_at_its_bottom_and_r",
-            "test_around_a_fanuc_back_bore_left_as_programmed_the_moves_land_where_programmed",
+            "test_fanuc_back_bores_cut_to_their_top_and_start_at_their_r",
         ),
         "writeback/test_expand_cycles.py": ("test_expanded_cycles_dwell_as_programmed_and_hit_every_hole",),
         "writeback/test_expand_flow.py": (

@@ -135,12 +135,13 @@ direction is a parameter of the control's, is the control's own and undone above
 G87 is Fanuc's back boring (Series 15i-MA operator's manual, "Back boring cycle (G87)"): to X Y,
 shifted by I J with the spindle oriented, down to R below the part, back over the hole, feed up to Z
 (the top of the cut), shifted again, up to the initial level (G99 is not used) and back over the
-hole; in G91 R counts from the initial level and Z from R.  Its moves are left as programmed, with
-the warning, and compensation resumes over the hole at the initial level
-(`Interpreter._fanuc_back_bore`).  A G87 with its shift in Q or with neither I nor J (the shift's direction a
-parameter of the control's: "Shift specification by Q_"), in G18 or G19 (where I J K name the shift otherwise), in G99,
+hole; in G91 R counts from the initial level and Z from R.  It is compensated hole by hole as the
+other cycles (`Interpreter._fanuc_back_bore`, `cycles.fanuc_back_bore`): X Y and Z corrected where
+the cut ends, R where it starts, on the hole's centre; I J, an increment from the hole, as written.
+A G87 with its shift in Q or with neither I nor J (the shift's direction a parameter of the control's:
+"Shift specification by Q_", No. 6240), in G18 or G19 (where I J K name the shift otherwise), in G99,
 or with R not below Z ends interpretation with a warning, where rs274ngc's reading refused it; so does
-a Haas program's G87 (no Haas manual page in ncpp's reference set reads it so).
+a Haas program's G87 (no Haas manual page in ncpp's reference set gives its motion).
 
 Canned cycles are a modal group of their own, group 09 beside group 01's G00-G03 (Fanuc 0i-MD /
 15i-MA operator's manuals, "List of G codes"; Haas Mill Operator's Manual, "G80 Canned Cycle Cancel
@@ -268,7 +269,7 @@ class FanucInterpreter(Interpreter):
         "L",
         "K",
     )  # a cycle's repeats: K, or L on the Series 15 (module docstring)
-    fanuc_back_bore = True  # G87 read as Fanuc's back bore, left as programmed (module docstring)
+    fanuc_back_bore = True  # G87 read as Fanuc's back bore, compensated hole by hole (module docstring)
     canned = CANNED | {76.0}  # G76: fine boring, compensated hole by hole (module docstring)
     returns_under_comp = True  # G28/G30 under G41/G42: out of scope (module docstring)
     comp_again = True  # G41/G42 under G41/G42: out of scope (module docstring)
@@ -392,7 +393,7 @@ class FanucInterpreter(Interpreter):
             mode1 = mode1_item = None
         return super()._motion_of_words(block, mode0, mode1, mode1_item, axis_item, polar_item)
 
-    def _coordinate_rotation(self, block: Block, code: Word) -> Pass:
+    def _coordinate_rotation(self, block: Block, code: Word) -> Event | tuple[Event, ...]:
         """`G68 X_ Y_ R_` in G17 (`G17` may stand in its block): the program's X Y turned about the centre X
         Y (absolute) by R degrees counter-clockwise, from the next block on; `G69` cancels it (Fanuc Series
         16/18-MC operator's manual, "Coordinate system rotation"; Haas Mill Operator's Manual, "G68

@@ -58,6 +58,7 @@ from ncpp.motion.cycles import (
     SPINDLE,
     approach,
     back_bore,
+    fanuc_back_bore,
     hole,
 )
 from ncpp.motion.endless import exact
@@ -295,9 +296,9 @@ class Interpreter:
     cycles_own_group = False
     # G87 is rs274ngc's back bore (R above, Z below the part, K the top of the cut, I J the offset:
     # LinuxCNC G-code manual, "G87 Back Boring Cycle") and compensated hole by hole; Fanuc's reads its
-    # words otherwise (R below, Z the top, Q the shift, K repeats) and stays as programmed
+    # words otherwise (R below, Z the top, I J or Q the shift, K repeats: `_fanuc_back_bore`)
     back_bore_holes = True
-    fanuc_back_bore = False  # (where not back_bore_holes) G87 is Fanuc's back bore, left as programmed
+    fanuc_back_bore = False  # (where not back_bore_holes) G87 is Fanuc's back bore, compensated hole by hole
     # The canned cycles: rs274ngc's; Fanuc's and Haas's G76 (fine boring) too (`FanucInterpreter`)
     canned: frozenset[float] = CANNED
     # The letters of a canned cycle's repeats: rs274ngc's L; Fanuc's K too (`FanucInterpreter`)
@@ -2303,12 +2304,12 @@ class Interpreter:
         return lines
 
     def _fanuc_back_bore(self, block: Block, words: dict, previous: float | None, item) -> tuple[Event, ...]:
-        """Fanuc's back boring G87, its moves left as programmed (CYCLE): to X Y, shifted by I J with
-        the spindle oriented, down to R below the part, back over the hole, feed up to Z, shifted again,
-        up to the level the series started at and back over the hole (Fanuc Series 15i-MA operator's
-        manual, "Back boring cycle (G87)": R the level below the part the cut starts from, Z its top,
-        G99 not used; "Shift specification by I_J_"; G91: R from the initial level, Z from R).  In the
-        XY plane with the shift in I J (one not given is 0); its shift in Q or neither I nor J (the
+        """Fanuc's back boring G87, compensated hole by hole as the other cycles (HOLE: `cycles.fanuc_back_bore`):
+        to X Y, shifted by I J with the spindle oriented, down to R below the part, back over the hole, feed
+        up to Z, shifted again, up to the level the series started at and back over the hole (Fanuc Series
+        15i-MA operator's manual, "Back boring cycle (G87)": R the level below the part the cut starts from,
+        Z its top, G99 not used; "Shift specification by I_J_"; G91: R from the initial level, Z from R).
+        In the XY plane with the shift in I J (one not given is 0); its shift in Q or neither I nor J (the
         shift's direction a parameter of the control's), another plane (where I J K name the shift
         otherwise) or G99 are out of scope."""
         if not self.fanuc_back_bore:
@@ -2335,7 +2336,7 @@ class Interpreter:
             words[k][0] if k in words else kept for k, kept in (("R", self.cycle_r), ("Z", self.cycle_cc))
         )
         kept = self.cycle_ijk if again else (0.0, 0.0, 0.0)  # (a new series: an I or J not given is 0)
-        shift = tuple(words[k][0] if k in words else kept[n] for n, k in enumerate("IJ"))
+        shift = (words["I"][0] if "I" in words else kept[0], words["J"][0] if "J" in words else kept[1])
         self.cycle_r, self.cycle_cc, self.cycle_ijk = r_word, z_word, (shift[0], shift[1], 0.0)
         start = self.pos
         x, y = (words[k][0] if k in words else start[n] for n, k in enumerate("XY"))
@@ -2347,16 +2348,22 @@ class Interpreter:
             x, y = start[0], start[1]
         if r >= top:  # (not a back bore: the cut would go down)
             raise _OutOfScope("Fanuc's back boring G87 with R not below Z", item.start + 1)
-        moves: list[tuple[float, float, float, bool]] = []
-        level, il = start[2], self.cycle_il
-        for _ in range(self._repeats(block, words, 87.0)):
+        repeats = self._repeats(block, words, 87.0)
+        self._check_cycle_size(block, words, repeats, 0.0, item)
+        self.cycle_holes = previous not in self.canned or self.cycle_holes
+        lines: list[Line] = []
+        for n in range(repeats):
             x, y = x + step[0], y + step[1]
-            off_x, off_y = x + shift[0], y + shift[1]
-            moves += [(x, y, level, True), (off_x, off_y, level, True), (off_x, off_y, r, True), (x, y, r, True),
-                      (x, y, top, False), (off_x, off_y, top, True), (off_x, off_y, il, True), (x, y, il, True)]  # fmt: skip
-            level = il
-        self.cycle_holes = False
-        return tuple(self._fixed_line(block, (0, 1, 2), move) for move in moves)
+            drilled = Hole(87.0, x, y, r, r, 0.0, 0.0, False, previous not in self.canned and n == 0, n, repeats,
+                           offset=shift, top=top, fanuc_back=True)  # fmt: skip
+            for move in fanuc_back_bore(
+                (self.pos[0], self.pos[1], self.pos[2]), x, y, shift[0], shift[1], r, top, self.cycle_il
+            ):
+                line = self._fixed_line(block, (0, 1, 2), move)
+                if self.cycle_holes:
+                    line.fixed, line.hole = HOLE, drilled
+                lines.append(line)
+        return tuple(lines)
 
     def _cycle_geometry(self, block: Block, words: dict, again: bool, item) -> tuple[float, ...]:
         """(aa, bb, their step per repeat, R, bottom) of a cycle in plane coordinates; keeps the
