@@ -2332,6 +2332,9 @@ class Interpreter:
         if self.feed == 0.0:
             self._fail("Cannot feed with zero feed rate", block, item)
         self._check_spindle(block, 87.0, item)
+        if self.expand_cycles:
+            self._fail(f"--expand-cycles: G87 cannot be written as G0/G1 moves ({UNEXPANDED[87.0]}); leave the "
+                       "option out, the cycle is then compensated", block, item)  # fmt: skip
         r_word, z_word = (
             words[k][0] if k in words else kept for k, kept in (("R", self.cycle_r), ("Z", self.cycle_cc))
         )
