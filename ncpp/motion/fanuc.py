@@ -118,11 +118,11 @@ both are read, and a block with both, or with K0 (the cycle's data stored, no ho
 scope.  Haas counts repeats in L only ("G81 Drill Canned Cycle": "L Number of holes if G91 is used").
 
 A P in the block of a cycle whose format has none (G81 `X_ Y_ Z_ R_ F_ K_` as above, G73, G83 and G85 on
-Fanuc) is kept as written and the
-cycle's moves are its own: the format's sequence has no dwell at the bottom, and whatever the control
-makes of the P (the cycle's data for a later block, or nothing), no axis moves otherwise.  LinuxCNC
-refuses it ("P word with no G2 G3 G4 ... to use it").  --expand-cycles refuses such a block: whether the
-control dwells on that P is not known.
+Fanuc) is kept as written and the cycle's moves are its own: the format's sequence has no dwell at the
+bottom, and the manuals ncpp follows do not say what the control makes of such a P (keeps it for a later
+block of the cycle, passes over it, or alarms), none of which moves an axis otherwise; the written
+block carries it as the program did.  LinuxCNC refuses it ("P word with no G2 G3 G4 ... to use it").
+--expand-cycles refuses such a block: whether the control dwells on that P is not known.
 
 G76 is fine boring on both (Fanuc Series 15i-MA operator's manual, "Fine boring cycle (G76)": to X Y, to
 R, feed to Z, dwell P, the spindle oriented and the tool shifted off the wall by Q or I J, out at rapid,
