@@ -140,8 +140,10 @@ other cycles (`Interpreter._fanuc_back_bore`, `cycles.fanuc_back_bore`): X Y and
 the cut ends, R where it starts, on the hole's centre; I J, an increment from the hole, as written.
 A G87 with its shift in Q or with neither I nor J (the shift's direction a parameter of the control's:
 "Shift specification by Q_", No. 6240), in G18 or G19 (where I J K name the shift otherwise), in G99,
-or with R not below Z ends interpretation with a warning, where rs274ngc's reading refused it; so does
-a Haas program's G87 (no Haas manual page in ncpp's reference set gives its motion).
+with R not below Z, or after another cycle of the series without both I and J ("I, J, and K are modal
+in a canned cycle": the one left out may be that cycle's) ends interpretation with a warning, where
+rs274ngc's reading refused it; so does a Haas program's G87 (no Haas manual page in ncpp's reference
+set gives its motion).
 
 Canned cycles are a modal group of their own, group 09 beside group 01's G00-G03 (Fanuc 0i-MD /
 15i-MA operator's manuals, "List of G codes"; Haas Mill Operator's Manual, "G80 Canned Cycle Cancel

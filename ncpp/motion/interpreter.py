@@ -2329,6 +2329,11 @@ class Interpreter:
                 self._fail(f"{letter} word missing with G87", block, item)
         if not again and "I" not in words and "J" not in words:  # (its shift in Q, a parameter's direction)
             raise _OutOfScope("Fanuc's back boring G87 without I or J", item.start + 1)
+        if not again and previous in self.canned and not ("I" in words and "J" in words):
+            # (I J are modal in the cycle: the one not given may be another cycle's shift)
+            raise _OutOfScope(
+                "Fanuc's back boring G87 after another cycle without both I and J", item.start + 1
+            )
         if self.feed == 0.0:
             self._fail("Cannot feed with zero feed rate", block, item)
         self._check_spindle(block, 87.0, item)

@@ -343,6 +343,23 @@ def test_a_p_on_g81_is_kept_and_the_holes_are_g81s(tmp_path):
         events(DRILL_P, "iso")
 
 
+@pytest.mark.parametrize("before", ["G81 X10 Y10 Z-5 R2", "G76 X10 Y10 Z-5 R2 I0.2 J0.1"])
+def test_a_back_bore_after_another_cycle_without_both_i_and_j_ends_interpretation(before):
+    """I J are modal in a Fanuc canned cycle (15i-MA, "Back boring cycle (G87)": "I, J, and K are modal in a
+    canned cycle"): a G87 that follows another cycle of the series and leaves one out may shift by that
+    cycle's, which ncpp does not guess; with both it is compensated, a hole."""
+    head = "G21 G90 G17\nG0 X0 Y0 Z25 S500 M3\nG98 " + before + " F100\n"
+    said = io.StringIO()
+    found = events(head + "G87 X1 Y1 Z-1 R-3 I1\nG80\nM30\n", "fanuc", Warnings(stream=said))
+    assert (
+        "p.nc:4:1: warning: Fanuc's back boring G87 after another cycle without both I and J"
+        in said.getvalue()
+    )
+    assert not any(type(e) is Line and e.block.line >= 4 for e in found)
+    found = events(head + "G87 X1 Y1 Z-1 R-3 I1 J0\nG80\nM30\n", "fanuc")
+    assert [e.hole.fanuc_back for e in found if type(e) is Line and e.block.line == 4] == [True] * 8
+
+
 def test_a_g81_with_p_is_compensated_with_its_p_and_expand_cycles_refuses_it(tmp_path):
     program, out = tmp_path / "p.nc", tmp_path / "out.nc"
     program.write_text(DRILL_P)

@@ -704,15 +704,15 @@ class IsoWriter:
 
     def _fanuc_back_words(self, move: Line, command: tuple[float, float, float, float]) -> dict[str, str]:
         """`_hole_words` of Fanuc's G87 (G17 only): X Y the hole, R the level below the part its cut starts
-        from, Z the top it ends at, all corrected, I J its shift as programmed; in G91 X Y from where the
-        control stands, R from the level the series started at, Z from R (Fanuc Series 15i-MA operator's
-        manual, "Back boring cycle (G87)")."""
+        from, Z the top it ends at, all corrected; in G91 X Y from where the control stands, R from the
+        level the series started at, Z from R (Fanuc Series 15i-MA operator's manual, "Back boring cycle
+        (G87)").  Its shift I J, modal in the cycle, stays as the program writes it (or leaves it)."""
         hole = move.hole
         assert hole is not None
         aa, bb, r, top = command
         if not move.context.absolute:
             aa, bb, r, top = aa - move.start[0], bb - move.start[1], r - hole.series_level, top - r
-        values = {"X": aa, "Y": bb, "Z": top, "R": r, "I": hole.offset[0], "J": hole.offset[1]}
+        values = {"X": aa, "Y": bb, "Z": top, "R": r}
         return {letter: format_number(value, self._style(letter, move)) for letter, value in values.items()}
 
     # -- o-word control lines ---------------------------------------------------
