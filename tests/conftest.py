@@ -96,7 +96,7 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
         "writeback/test_compensated_holes.py": None,
         "writeback/test_compensated_back_bore.py": (
             "test_each_back_bore_cuts_to_its_top_and_stands_at_its_bottom_and_r",
-            "test_around_a_fanuc_back_bore_left_as_programmed_the_moves_land_where_programmed",
+            "test_fanuc_back_bores_cut_to_their_top_and_start_at_their_r",
         ),
         "writeback/test_expand_cycles.py": ("test_expanded_cycles_dwell_as_programmed_and_hit_every_hole",),
         "writeback/test_expand_flow.py": (
@@ -197,6 +197,7 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
         "compensation/test_rotation.py": (
             "test_the_programmed_points_are_reached_under_g68_within_half_a_micron",
             "test_a_g68_of_variables_turns_as_their_values_do",
+            "test_a_g69_among_modes_of_other_groups_is_followed",
             "test_a_safety_lines_cancels_of_modes_not_in_effect_change_nothing",
         ),
         "shop/test_extents.py": None,  # (each runs the command line)
@@ -208,6 +209,7 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_a_haas_peck_cycle_with_p_is_compensated_with_its_p_and_verified",
             "test_external_output_passes_through_the_compensated_program",
             "test_expand_keeps_a_g68_of_variables_out_of_scope",
+            "test_a_g81_with_p_is_compensated_with_its_p_and_expand_cycles_refuses_it",
         ),
         "compensation/test_cutter_comp_accuracy.py": (
             "test_a_z_move_under_compensation_keeps_the_tool_centre_where_it_stands",

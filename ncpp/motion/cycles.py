@@ -79,6 +79,28 @@ def back_bore(
     ]  # fmt: skip
 
 
+def fanuc_back_bore(
+    at: tuple[float, float, float],
+    aa: float,
+    bb: float,
+    off_a: float,
+    off_b: float,
+    r: float,
+    top: float,
+    initial: float,
+) -> list[Move]:
+    """Fanuc's G87 from `at` (plane coordinates): over the hole at the level the tool stands at, shifted
+    by (`off_a`, `off_b`) with the spindle oriented, down to `r` below the part, back over the hole, the
+    cut up to `top`, shifted again, up to the `initial` level and back over the hole (Fanuc Series
+    15i-MA operator's manual, "Back boring cycle (G87)"; G98 only)."""
+    shifted_a, shifted_b = aa + off_a, bb + off_b
+    return [
+        (aa, bb, at[2], True), (shifted_a, shifted_b, at[2], True), (shifted_a, shifted_b, r, True),
+        (aa, bb, r, True), (aa, bb, top, False), (shifted_a, shifted_b, top, True),
+        (shifted_a, shifted_b, initial, True), (aa, bb, initial, True),
+    ]  # fmt: skip
+
+
 def drilled(
     motion: float,
     at: tuple[float, float, float],

@@ -117,6 +117,13 @@ Series 15i-MA operator's manual counts them in L: "When L is used to specify the
 both are read, and a block with both, or with K0 (the cycle's data stored, no hole drilled), is out of
 scope.  Haas counts repeats in L only ("G81 Drill Canned Cycle": "L Number of holes if G91 is used").
 
+A P in the block of a cycle whose format has none (G81 `X_ Y_ Z_ R_ F_ K_` as above, G73, G83 and G85 on
+Fanuc) is kept as written and the cycle's moves are its own: the format's sequence has no dwell at the
+bottom, and the manuals ncpp follows do not say what the control makes of such a P (keeps it for a later
+block of the cycle, passes over it, or alarms), none of which moves an axis otherwise; the written
+block carries it as the program did.  LinuxCNC refuses it ("P word with no G2 G3 G4 ... to use it").
+--expand-cycles refuses such a block: whether the control dwells on that P is not known.
+
 G76 is fine boring on both (Fanuc Series 15i-MA operator's manual, "Fine boring cycle (G76)": to X Y, to
 R, feed to Z, dwell P, the spindle oriented and the tool shifted off the wall by Q or I J, out at rapid,
 shifted back; Haas Mill Operator's Manual, "G76 Fine Boring Canned Cycle"), where LinuxCNC's G76 is a
@@ -128,12 +135,15 @@ direction is a parameter of the control's, is the control's own and undone above
 G87 is Fanuc's back boring (Series 15i-MA operator's manual, "Back boring cycle (G87)"): to X Y,
 shifted by I J with the spindle oriented, down to R below the part, back over the hole, feed up to Z
 (the top of the cut), shifted again, up to the initial level (G99 is not used) and back over the
-hole; in G91 R counts from the initial level and Z from R.  Its moves are left as programmed, with
-the warning, and compensation resumes over the hole at the initial level
-(`Interpreter._fanuc_back_bore`).  A G87 with its shift in Q or with neither I nor J (the shift's direction a
-parameter of the control's: "Shift specification by Q_"), in G18 or G19 (where I J K name the shift otherwise), in G99,
-or with R not below Z ends interpretation with a warning, where rs274ngc's reading refused it; so does
-a Haas program's G87 (no Haas manual page in ncpp's reference set reads it so).
+hole; in G91 R counts from the initial level and Z from R.  It is compensated hole by hole as the
+other cycles (`Interpreter._fanuc_back_bore`, `cycles.fanuc_back_bore`): X Y and Z corrected where
+the cut ends, R where it starts, on the hole's centre; I J, an increment from the hole, as written.
+A G87 with its shift in Q or with neither I nor J (the shift's direction a parameter of the control's:
+"Shift specification by Q_", No. 6240), in G18 or G19 (where I J K name the shift otherwise), in G99,
+with R not below Z, or after another cycle of the series without both I and J ("I, J, and K are modal
+in a canned cycle": the one left out may be that cycle's) ends interpretation with a warning, where
+rs274ngc's reading refused it; so does a Haas program's G87 (no Haas manual page in ncpp's reference
+set gives its motion).
 
 Canned cycles are a modal group of their own, group 09 beside group 01's G00-G03 (Fanuc 0i-MD /
 15i-MA operator's manuals, "List of G codes"; Haas Mill Operator's Manual, "G80 Canned Cycle Cancel
@@ -221,6 +231,11 @@ HAAS_UNFOLLOWED = {("G", 54.1): "G54.1 (Fanuc's additional work offset; Haas sel
 NOT_UNDER_G68 = frozenset((17.0, 18.0, 19.0, 10.0, 52.0, 92.0, 92.1, 92.2, 92.3, 54.0, 55.0, 56.0, 57.0, 58.0,
                            59.0, 54.1, 154.0, *(float(n) for n in range(110, 130))))  # fmt: skip
 
+# The G codes a G69 block may carry besides N: modes of other groups that move nothing and leave the
+# frame G68 turned alone (Fanuc Series 30i-MB G code list: G69 in group 16; G90/G91 03, G94/G95 05, G98/G99
+# 10, G80 09, G40 07, G49 08, G15 17, G50 11, G50.1 22), set once the rotation is cancelled
+G69_COMPANIONS = frozenset((90.0, 91.0, 94.0, 95.0, 98.0, 99.0, 80.0, 40.0, 49.0, 15.0, 50.0, 50.1))
+
 # Frames these controls turn, scale or tilt that ncpp does not follow, named before the block's words are
 # checked (a G51's P is its scale, no dwell): scaling, the programmable mirror image, G68.1's rotation (a
 # lathe's), and the tilted working plane G68.2-G68.4 (Fanuc 30i-MB operator's manual)
@@ -248,6 +263,7 @@ class FanucInterpreter(Interpreter):
     rigid_tapping = False  # (Fanuc taps rigidly with M29 and G84: G33.1 is LinuxCNC's)
     modal_d = True  # `G43 H1 D1`: D alone selects the radius offset (module docstring)
     dwell_x = True  # `G04 X1.5`: a dwell of 1.5 s (module docstring)
+    any_cycle_p = True  # `G81 ... P500`: the P kept as written, no dwell of G81's (module docstring)
     taps_in_any_plane = True  # G74/G84 in G18/G19 tap along the normal (module docstring)
     cycles_own_group = True  # G80 leaves the G0-G3 mode before the cycle in effect (module docstring)
     back_bore_holes = False  # G87 reads R Z Q K otherwise than rs274ngc (`Interpreter.back_bore_holes`)
@@ -255,7 +271,7 @@ class FanucInterpreter(Interpreter):
         "L",
         "K",
     )  # a cycle's repeats: K, or L on the Series 15 (module docstring)
-    fanuc_back_bore = True  # G87 read as Fanuc's back bore, left as programmed (module docstring)
+    fanuc_back_bore = True  # G87 read as Fanuc's back bore, compensated hole by hole (module docstring)
     canned = CANNED | {76.0}  # G76: fine boring, compensated hole by hole (module docstring)
     returns_under_comp = True  # G28/G30 under G41/G42: out of scope (module docstring)
     comp_again = True  # G41/G42 under G41/G42: out of scope (module docstring)
@@ -379,7 +395,7 @@ class FanucInterpreter(Interpreter):
             mode1 = mode1_item = None
         return super()._motion_of_words(block, mode0, mode1, mode1_item, axis_item, polar_item)
 
-    def _coordinate_rotation(self, block: Block, code: Word) -> Pass:
+    def _coordinate_rotation(self, block: Block, code: Word) -> Event | tuple[Event, ...]:
         """`G68 X_ Y_ R_` in G17 (`G17` may stand in its block): the program's X Y turned about the centre X
         Y (absolute) by R degrees counter-clockwise, from the next block on; `G69` cancels it (Fanuc Series
         16/18-MC operator's manual, "Coordinate system rotation"; Haas Mill Operator's Manual, "G68
@@ -395,20 +411,18 @@ class FanucInterpreter(Interpreter):
                   and not (type(item) is Statement and item.kind in IGNORED_STATEMENTS)]  # fmt: skip
         words = [word for item in others if (word := self._rotation_word(item, block, name, col)) is not None]
         if code.value == 69.0:
-            if any(w.letter != "N" for w in words):
-                raise _OutOfScope("G69 with other words in its block", col)
-            if self.g68 is not None:
-                self._keeping_machine(lambda: setattr(self, "g68", None))
-                self.unsettled_rotation = 69.0
-            return Pass(block)
+            return self._cancel_rotation(block, words, col)
+        planes = [w.value for w in words if w.letter == "G" and w.value in (17.0, 18.0, 19.0)]
+        plane = planes[0] if planes else self.plane
+        if plane != 17:  # (its X Y R, or the plane's own axes, then turn about another axis than Z)
+            raise _OutOfScope(f"G68 in G{plane:g} (a turn about another axis than Z)", col)
         if any(w.letter not in "NXYRG" or (w.letter == "G" and w.value != 17.0) for w in words):
             raise _OutOfScope("G68 with other words in its block than G17, X, Y and R", col)
         if any(w.letter == "G" for w in words):
             self._set(plane=17)
         given = {w.letter: w.value for w in words}
         why = (
-            "in G18 or G19 (a turn about another axis than Z)" if self.plane != 17
-            else "while a rotation is in effect" if self.g68 is not None
+            "while a rotation is in effect" if self.g68 is not None
             else "under cutter compensation" if self.cutter_comp is not None
             else "without R (its angle is then a parameter's)" if "R" not in given
             else "in G91 (a parameter makes its R absolute or added)" if not self.absolute
@@ -421,6 +435,22 @@ class FanucInterpreter(Interpreter):
         self._keeping_machine(lambda: setattr(self, "g68", (given["R"], given["X"], given["Y"])))
         self.unsettled_rotation = 68.0
         return Pass(block)
+
+    def _cancel_rotation(self, block: Block, words: list[Word], col: int) -> Event | tuple[Event, ...]:
+        """`G69`, with N and the modes of other groups that move nothing (`G69_COMPANIONS`: `G69 G94`,
+        `G90 G80 G69`) in its block: the rotation cancelled, the machine where it is, then the block's
+        modes set as in any block (G69 then cancels nothing).  A G69 with a plane (which the manual
+        forbids under G68), a work offset, a move or any other word is out of scope."""
+        other = next((w for w in words if w.letter != "N" and not (w.letter == "G" and w.value in G69_COMPANIONS)),
+                     None)  # fmt: skip
+        if other is not None:
+            raise _OutOfScope(f"G69 with {other.letter}{other.number} in its block", col)
+        if self.g68 is not None:
+            self._keeping_machine(lambda: setattr(self, "g68", None))
+            self.unsettled_rotation = 69.0
+        if all(w.letter == "N" for w in words):
+            return Pass(block)
+        return super().block(block)
 
     def _rotation_word(self, item, block: Block, name: str, col: int) -> Word | None:
         """A word of a G68 or G69 block, an X Y or R expression with the value it has now (None for

@@ -58,6 +58,7 @@ from ncpp.motion.cycles import (
     SPINDLE,
     approach,
     back_bore,
+    fanuc_back_bore,
     hole,
 )
 from ncpp.motion.endless import exact
@@ -275,6 +276,9 @@ class Interpreter:
     rigid_tapping = True
     # G73/G83 take a P, the dwell at the bottom of each hole (Haas); rs274ngc refuses it there
     peck_dwell = False
+    # A P in the block of a canned cycle whose format has none (G81: Fanuc, Haas) is kept as written, the
+    # cycle's moves its own (`FanucInterpreter`); rs274ngc refuses it
+    any_cycle_p = False
     # A D word alone selects the radius offset a later G41/G42 without D uses (Fanuc); rs274ngc refuses it
     modal_d = False
     # The motion mode a program starts in (grbl: G0); rs274ngc starts in none
@@ -288,9 +292,9 @@ class Interpreter:
     cycles_own_group = False
     # G87 is rs274ngc's back bore (R above, Z below the part, K the top of the cut, I J the offset:
     # LinuxCNC G-code manual, "G87 Back Boring Cycle") and compensated hole by hole; Fanuc's reads its
-    # words otherwise (R below, Z the top, Q the shift, K repeats) and stays as programmed
+    # words otherwise (R below, Z the top, I J or Q the shift, K repeats: `_fanuc_back_bore`)
     back_bore_holes = True
-    fanuc_back_bore = False  # (where not back_bore_holes) G87 is Fanuc's back bore, left as programmed
+    fanuc_back_bore = False  # (where not back_bore_holes) G87 is Fanuc's back bore, compensated hole by hole
     # The canned cycles: rs274ngc's; Fanuc's and Haas's G76 (fine boring) too (`FanucInterpreter`)
     canned: frozenset[float] = CANNED
     # The letters of a canned cycle's repeats: rs274ngc's L; Fanuc's K too (`FanucInterpreter`)
@@ -1471,7 +1475,7 @@ class Interpreter:
         if "P" in words:
             p, p_item = words["P"]
             user_m = any(100.0 <= m <= 199.0 for m in mcodes)
-            peck_p = self.peck_dwell and motion in PECKING
+            peck_p = self.peck_dwell and motion in PECKING or self.any_cycle_p and motion in self.canned
             if not (mode0 in (10.0, 4.0) or gcodes.get(13, (None,))[0] == 64.0 or motion in _P_MOTIONS
                     or motion == 87.0 and not self.back_bore_holes
                     or mcodes.keys() & _P_MCODES or user_m or peck_p):  # fmt: skip
@@ -2241,6 +2245,12 @@ class Interpreter:
                 f"--expand-cycles: G{motion:g} cannot be written as G0/G1 moves ({UNEXPANDED[motion]}); "
                 "leave the option out, the cycle is then compensated or left as programmed", block, item,
             )  # fmt: skip
+        if self.expand_cycles and "P" in words and not self._dwells_on_p(motion):
+            self._fail(
+                f"--expand-cycles: the P of G{motion:g}, a dwell its format has not, cannot be written as a G4 "
+                "(whether the control dwells on it is not known); leave the option out, the cycle is then "
+                "compensated with its P as written", block, words["P"][1],
+            )  # fmt: skip
         self._check_cycle_size(block, words, repeats, (r - bottom) / peck if motion in PECKING else 0.0, item)
         if motion == 87.0:
             off_a, off_b, top = self._back_bore_words(block, words, again, item)
@@ -2270,7 +2280,7 @@ class Interpreter:
         lines = tuple(self._fixed_line(block, (first, second, normal), move) for move in moves)
         if self.expand_cycles:
             self.cycle_holes = False
-            dwells = motion in DWELLING or (self.peck_dwell and motion in PECKING and self.cycle_p > 0.0)
+            dwells = motion in DWELLING or (self._dwells_on_p(motion) and self.cycle_p > 0.0)
             dwell = self._dwell_word(block, words.get("P", (0, item))[1]) if dwells else None
             return self._expanded(block, motion, lines, bottoms, dwell)
         # holes apply_error_map compensates: in any plane (polar words written as X Y, repeats as a
@@ -2290,12 +2300,12 @@ class Interpreter:
         return lines
 
     def _fanuc_back_bore(self, block: Block, words: dict, previous: float | None, item) -> tuple[Event, ...]:
-        """Fanuc's back boring G87, its moves left as programmed (CYCLE): to X Y, shifted by I J with
-        the spindle oriented, down to R below the part, back over the hole, feed up to Z, shifted again,
-        up to the level the series started at and back over the hole (Fanuc Series 15i-MA operator's
-        manual, "Back boring cycle (G87)": R the level below the part the cut starts from, Z its top,
-        G99 not used; "Shift specification by I_J_"; G91: R from the initial level, Z from R).  In the
-        XY plane with the shift in I J (one not given is 0); its shift in Q or neither I nor J (the
+        """Fanuc's back boring G87, compensated hole by hole as the other cycles (HOLE: `cycles.fanuc_back_bore`):
+        to X Y, shifted by I J with the spindle oriented, down to R below the part, back over the hole, feed
+        up to Z, shifted again, up to the level the series started at and back over the hole (Fanuc Series
+        15i-MA operator's manual, "Back boring cycle (G87)": R the level below the part the cut starts from,
+        Z its top, G99 not used; "Shift specification by I_J_"; G91: R from the initial level, Z from R).
+        In the XY plane with the shift in I J (one not given is 0); its shift in Q or neither I nor J (the
         shift's direction a parameter of the control's), another plane (where I J K name the shift
         otherwise) or G99 are out of scope."""
         if not self.fanuc_back_bore:
@@ -2315,14 +2325,22 @@ class Interpreter:
                 self._fail(f"{letter} word missing with G87", block, item)
         if not again and "I" not in words and "J" not in words:  # (its shift in Q, a parameter's direction)
             raise _OutOfScope("Fanuc's back boring G87 without I or J", item.start + 1)
+        if not again and previous in self.canned and not ("I" in words and "J" in words):
+            # (I J are modal in the cycle: the one not given may be another cycle's shift)
+            raise _OutOfScope(
+                "Fanuc's back boring G87 after another cycle without both I and J", item.start + 1
+            )
         if self.feed == 0.0:
             self._fail("Cannot feed with zero feed rate", block, item)
         self._check_spindle(block, 87.0, item)
+        if self.expand_cycles:
+            self._fail(f"--expand-cycles: G87 cannot be written as G0/G1 moves ({UNEXPANDED[87.0]}); leave the "
+                       "option out, the cycle is then compensated", block, item)  # fmt: skip
         r_word, z_word = (
             words[k][0] if k in words else kept for k, kept in (("R", self.cycle_r), ("Z", self.cycle_cc))
         )
         kept = self.cycle_ijk if again else (0.0, 0.0, 0.0)  # (a new series: an I or J not given is 0)
-        shift = tuple(words[k][0] if k in words else kept[n] for n, k in enumerate("IJ"))
+        shift = (words["I"][0] if "I" in words else kept[0], words["J"][0] if "J" in words else kept[1])
         self.cycle_r, self.cycle_cc, self.cycle_ijk = r_word, z_word, (shift[0], shift[1], 0.0)
         start = self.pos
         x, y = (words[k][0] if k in words else start[n] for n, k in enumerate("XY"))
@@ -2334,16 +2352,22 @@ class Interpreter:
             x, y = start[0], start[1]
         if r >= top:  # (not a back bore: the cut would go down)
             raise _OutOfScope("Fanuc's back boring G87 with R not below Z", item.start + 1)
-        moves: list[tuple[float, float, float, bool]] = []
-        level, il = start[2], self.cycle_il
-        for _ in range(self._repeats(block, words, 87.0)):
+        repeats = self._repeats(block, words, 87.0)
+        self._check_cycle_size(block, words, repeats, 0.0, item)
+        self.cycle_holes = previous not in self.canned or self.cycle_holes
+        lines: list[Line] = []
+        for n in range(repeats):
             x, y = x + step[0], y + step[1]
-            off_x, off_y = x + shift[0], y + shift[1]
-            moves += [(x, y, level, True), (off_x, off_y, level, True), (off_x, off_y, r, True), (x, y, r, True),
-                      (x, y, top, False), (off_x, off_y, top, True), (off_x, off_y, il, True), (x, y, il, True)]  # fmt: skip
-            level = il
-        self.cycle_holes = False
-        return tuple(self._fixed_line(block, (0, 1, 2), move) for move in moves)
+            drilled = Hole(87.0, x, y, r, r, 0.0, 0.0, False, previous not in self.canned and n == 0, n, repeats,
+                           offset=shift, top=top, fanuc_back=True)  # fmt: skip
+            for move in fanuc_back_bore(
+                (self.pos[0], self.pos[1], self.pos[2]), x, y, shift[0], shift[1], r, top, self.cycle_il
+            ):
+                line = self._fixed_line(block, (0, 1, 2), move)
+                if self.cycle_holes:
+                    line.fixed, line.hole = HOLE, drilled
+                lines.append(line)
+        return tuple(lines)
 
     def _cycle_geometry(self, block: Block, words: dict, again: bool, item) -> tuple[float, ...]:
         """(aa, bb, their step per repeat, R, bottom) of a cycle in plane coordinates; keeps the
@@ -2415,6 +2439,10 @@ class Interpreter:
             if k in dwells:
                 events.append(Pass(block, dwell=self.cycle_p, dwell_word=dwell))
         return tuple(events)
+
+    def _dwells_on_p(self, motion: float) -> bool:
+        """Whether the cycle dwells for its P at the bottom of the hole (G82 G86 G89; Haas: G73 G83)."""
+        return motion in DWELLING or self.peck_dwell and motion in PECKING
 
     def _dwell_word(self, block: Block, item) -> str:
         """The P word of the G4 that dwells as long as the cycle's P (--expand-cycles): rs274ngc reads

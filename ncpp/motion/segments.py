@@ -149,6 +149,9 @@ class Hole:
     offset: tuple[float, float] = (0.0, 0.0)
     top: float | None = None
     top_command: float | None = None
+    # Fanuc's G87 (`cycles.fanuc_back_bore`): shifted by `offset` at the level the series started at, down
+    # to R below the part (`bottom` and `r` both), back over the hole, the cut up to Z (`top`)
+    fanuc_back: bool = False
 
     @property
     def cut(self) -> float:

@@ -138,11 +138,12 @@ class _Holes:
         if hole.series_start:
             self.start_level = at[axes[2]]
         cut, r_point, *under = self._commands(moves, hole, at, held).tolist()
-        bottom = under[0] if under else cut  # (G87: the bottom has a row of its own)
+        # (G87: the bottom has a row of its own; Fanuc's G87 starts its cut at R)
+        bottom = r_point if hole.fanuc_back else under[0] if under else cut
         command = (cut[axes[0]], cut[axes[1]], bottom[axes[2]], r_point[axes[2]])
         top = None if hole.top is None else cut[axes[2]]
         if not first.context.absolute:
-            command, top = self._incremental(first, at, axes, command, top)
+            command, top = self._incremental(first, at, axes, command, top, hole.fanuc_back)
         corrected = replace(hole, command=command, series_level=self.start_level, top_command=top)
         aa, bb, level, r = command
         back = None if top is None else (hole.offset[0], hole.offset[1], top)
@@ -151,8 +152,12 @@ class _Holes:
         # (not `changed`: that marks the pieces replace_arcs made, which the solve moves; the writer
         # tells a written hole by its `command`)
         here = (at[axes[0]], at[axes[1]], at[axes[2]])
-        moves_run = cycles.drilled(hole.motion, here, self.start_level, aa, bb, r, level, hole.peck,
-                                   hole.rapid_delta, hole.retract_to_r, back)  # fmt: skip
+        if hole.fanuc_back and top is not None:
+            moves_run = cycles.fanuc_back_bore(here, aa, bb, hole.offset[0], hole.offset[1], r, top,
+                                               self.start_level)  # fmt: skip
+        else:
+            moves_run = cycles.drilled(hole.motion, here, self.start_level, aa, bb, r, level, hole.peck,
+                                       hole.rapid_delta, hole.retract_to_r, back)  # fmt: skip
         for move in moves_run:
             end = plane_point(hole.plane, *move[:3])
             out.append(replace(first, start=start, end=end, rapid=move[3], hole=corrected))
@@ -160,12 +165,19 @@ class _Holes:
         return out
 
     def _incremental(
-        self, first: Line, at: tuple, axes: tuple[int, int, int], command: tuple, top: float | None
+        self,
+        first: Line,
+        at: tuple,
+        axes: tuple[int, int, int],
+        command: tuple,
+        top: float | None,
+        fanuc_back: bool = False,
     ) -> tuple[tuple[float, float, float, float], float | None]:
         """The command of a hole in G91 on the output's grid as the control adds it up: the plane's
         axes from where it stands, R from the series' start level, the bottom from R, G87's `top`
-        from the bottom (rs274ngc's G91 cycle), each a whole number of the last digit written, so
-        that the roundings do not add up along a row of holes."""
+        from the bottom (rs274ngc's G91 cycle; Fanuc's G87: its top, Z, from R, where its cut starts),
+        each a whole number of the last digit written, so that the roundings do not add up along a row
+        of holes."""
         step = float(grid(self.ctx, frames([first, first])[1][:1])[0])
 
         def on_grid(value: float, base: float) -> float:
@@ -173,7 +185,7 @@ class _Holes:
 
         aa, bb, bottom, r = command
         r = on_grid(r, self.start_level)
-        bottom = on_grid(bottom, r)
+        bottom = r if fanuc_back else on_grid(bottom, r)
         placed = (on_grid(aa, at[axes[0]]), on_grid(bb, at[axes[1]]), bottom, r)
         return placed, None if top is None else on_grid(top, bottom)
 
@@ -185,7 +197,7 @@ class _Holes:
         may go against the direction it holds: by a rounding step or so it stays where it is rather
         than reverse, by more it reverses and is compensated so."""
         first = moves[0]
-        levels = [hole.cut, hole.r] + ([] if hole.top is None else [hole.bottom])
+        levels = [hole.cut, hole.r] + ([] if hole.top is None or hole.fanuc_back else [hole.bottom])
         offsets, scales, tools = frames([first] * len(levels))  # type: ignore[list-item]
         wanted = np.array([hole.point(level) for level in levels])
         lines = np.full(len(levels), first.block.line)
@@ -230,6 +242,8 @@ def _hole_directions(moves: list[Event], hole: Hole, held: NDArray) -> tuple[NDA
     offset moves them (`cycles.back_bore`), an axis the offset leaves as the rapid to the hole."""
     normal = PLANE_AXES[hole.plane][2]
     start = np.array(moves[0].start)  # type: ignore[union-attr]
+    if hole.fanuc_back:
+        return _fanuc_back_directions(start, hole, held)
     r_point = hole.point(hole.r)
     reach_r = next(m for m in moves if m.end == r_point)  # type: ignore[union-attr]
     toward = np.sign(np.array(r_point) - start)
@@ -246,6 +260,22 @@ def _hole_directions(moves: list[Event], hole: Hole, held: NDArray) -> tuple[NDA
         return np.array([top, toward, bottom]), still
     bottom[normal] = -1.0
     return np.array([bottom, toward]), still
+
+
+def _fanuc_back_directions(start: NDArray, hole: Hole, held: NDArray) -> tuple[NDArray, NDArray]:
+    """`_hole_directions` of Fanuc's G87 (`cycles.fanuc_back_bore`): (2,3) its top, the normal up, and its
+    R, the normal down (it comes down at the shift), both with the plane's axes as the move back from
+    the shift moves them, an axis the shift leaves as the rapid to the hole; (3,) the axes the program
+    keeps still over the hole (neither moves them)."""
+    normal = PLANE_AXES[hole.plane][2]
+    back = -np.sign(plane_point(hole.plane, hole.offset[0], hole.offset[1], 0.0))
+    toward = np.sign(np.array(hole.point(hole.r)) - start)
+    across = np.where(back != 0, back, np.where(toward != 0, toward, held))
+    still = (back == 0) & (toward == 0)
+    still[normal] = False
+    top, r_level = across.copy(), across.copy()
+    top[normal], r_level[normal] = 1.0, -1.0
+    return np.array([top, r_level]), still
 
 
 def _warn_at_travel_ends(segs: list, rows: _Rows, solved: _Solved, ctx: PassContext) -> None:

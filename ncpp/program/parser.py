@@ -280,6 +280,8 @@ def _refuse_cr_line_ends(raw: str, line: int, file: str) -> None:
 # parenthesised comments
 # A program number written with ISO code's address `:` (`:1000`, `:1000 (PART)`)
 _COLON_NUMBER = re.compile(r"^([ \t]*):(?=[ \t]*\d)")
+# The ISO code's program number address with no number after it (`:`, `: (PART)`)
+_BARE_COLON = re.compile(r"^[ \t]*:")
 
 
 def _colon_as_o(block: Block, raw: str) -> Block:
@@ -288,6 +290,19 @@ def _colon_as_o(block: Block, raw: str) -> Block:
     operator's manual B-63684EN, "Program configuration", "Program number"); Haas's controls read
     Fanuc's programs.  LinuxCNC refuses the colon (rs274ngc: "Bad character ':' used")."""
     return Block(raw, block.eol, block.items, block.line, block.verbatim, block.signature, block.layout)
+
+
+def _colon_without_number(raw: str, eol: str, line: int, file: str, dialect: Dialect) -> Block:
+    """A line that starts with `:` and no number: the program number address without the number it
+    takes (`_colon_as_o`), refused where it runs (or here, where the dialect reads every line)."""
+    error = NcppError(
+        "a program number address `:` without its number (in ISO code `:` stands for O, which the "
+        "program's number follows: `:1000`)",
+        Location(file, line, raw.index(":") + 1),
+    )
+    if not dialect.read_where_run:
+        raise error
+    return Block(raw, eol, (Statement(UNREADABLE, (error,), 0, len(raw)),), line)
 
 
 _WORD_AFTER_EOB = re.compile(r"(?:[ \t]|\([^)]*\))*([A-Za-z][ \t]*[-+]?[ \t]*[0-9.#\[])")
@@ -377,6 +392,8 @@ class LineParser:
             _refuse_long(raw, self.dialect, line, file)
         if self.dialect.colon_program_numbers and _COLON_NUMBER.match(raw):
             return _colon_as_o(self.parse(_COLON_NUMBER.sub(r"\1O", raw, count=1), eol, line, file), raw)
+        if self.dialect.colon_program_numbers and _BARE_COLON.match(raw):
+            return _colon_without_number(raw, eol, line, file, self.dialect)
         plain = self._scan_plain(raw)
         if plain is None:
             block = Block(raw, eol, self._read_lalr(raw, line, file), line)

@@ -358,6 +358,20 @@ def test_a_g68_of_variables_turns_as_their_values_do(tmp_path, dialect):
     assert misses(closed_form(got), wanted.tolist()).max() < 0.0005
 
 
+@pytest.mark.parametrize("dialect", ["fanuc", "haas"])
+def test_a_g69_among_modes_of_other_groups_is_followed(tmp_path, dialect):
+    """`G69 G94 G80` and `G90 G69 G49` (G69 with modes of other groups that move nothing: Fanuc Series
+    30i-MB G code list) cancel the rotation as a G69 alone does: every programmed point is reached
+    within 0.5 µm, the program compensated to its end."""
+    turned = FANUC.replace("G69\nG0 X-10", "G69 G94 G80\nG0 X-10").replace("G69\nG90 G0", "G90 G69 G49\nG0")
+    assert turned.count("G69 ") == 2
+    _, out = fanuc_written(tmp_path, dialect, turned)
+    written = out.read_text()
+    assert "G69 G94 G80\n" in written and "G90 G69 G49\n" in written
+    wanted = fanuc_end_points(FANUC)
+    assert misses(closed_form(fanuc_end_points(written)), wanted.tolist()).max() < 0.0005
+
+
 def as_linuxcnc(text: str) -> str:
     """A Fanuc program in this test's words as LinuxCNC runs it: G54's zero set by G10 L2, each `G68 X Y R`
     a G55 whose zero is G54's plus c - R c and whose rotation is R (R (p - c) + c + zero = R p + zero'),
@@ -406,7 +420,12 @@ def test_the_returns_posts_write_after_g69_are_followed():
 @pytest.mark.parametrize(
     "body, at, construct",
     [
-        ("G18\nG68 X0 Y0 R30", "G68", "G68 in G18 or G19"),
+        ("G18\nG68 X0 Y0 R30", "G68", "G68 in G18 (a turn about another axis than Z)"),
+        ("G18\nG68 X0 Z0 R30", "G68", "G68 in G18"),
+        ("G68 G19 Y0 Z0 R30", "G68", "G68 in G19"),
+        ("G68 X0 Y0 R30\nG41 D1 G1 X5 Y5 F100", "G41", "cutter compensation G41 under a coordinate system"),
+        ("G42 D1 G1 X5 Y5 F100\nG68 X0 Y0 R30", "G68", "G68 under cutter compensation"),
+        ("G68 X0 Y0 R30\nG51 X0 Y0 P2", "G51", "scaling G51"),
         ("G68 X0 Y0", "G68", "G68 without R"),
         ("G91\nG68 X0 Y0 R30", "G68", "G68 in G91"),
         ("G68 R30", "G68", "G68 without X and Y"),
@@ -468,7 +487,8 @@ def test_a_safety_lines_cancels_of_modes_not_in_effect_change_nothing(tmp_path, 
 @pytest.mark.parametrize(
     "dialect, body, at, construct",
     [
-        ("fanuc", "G68 X0 Y0 R30\nG1 X5 Y5 F100\nG69 G40", "G69", "G69 with other words in its block"),
+        ("fanuc", "G68 X0 Y0 R30\nG1 X5 Y5 F100\nG69 G17", "G69", "G69 with G17 in its block"),
+        ("haas", "G68 X0 Y0 R30\nG1 X5 Y5 F100\nG69 X1", "G69", "G69 with X1 in its block"),
         ("fanuc", "G50 S2000", "G50", "G50 with S"),
         ("haas", "G15 G40", "G15", "polar coordinates G15"),
     ],

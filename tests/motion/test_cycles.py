@@ -17,7 +17,7 @@ import pytest
 from ncpp.errors import Location, NcppError, Warnings
 from ncpp.motion import interpret
 from ncpp.motion.fanuc import interpret as interpret_fanuc
-from ncpp.motion.segments import CYCLE, HOLE, Line
+from ncpp.motion.segments import HOLE, Line
 from ncpp.program.parser import parse_stream
 from tests.compensation.accuracy import rs274_calls
 from tests.conftest import RS274
@@ -218,11 +218,10 @@ def test_random_cycle_programs_agree_with_rs274(tmp_path):
                                                ("G19 G83 Y1 Z1 X-3 R2 Q1 L2", HOLE, 2),
                                                ("G87 X1 Y1 Z-3 R2 I1 J0 K-1", HOLE, 1),
                                                ("G19 G91 G87 Y1 Z1 X-3 R-2 I-1 J1 K0.5 L2", HOLE, 2),
-                                               ("fanuc G98 G87 X1 Y1 Z-1 R-3 I1 J0 K2", CYCLE, 0)])  # fmt: skip
+                                               ("fanuc G98 G87 X1 Y1 Z-1 R-3 I1 J0 K2", HOLE, 2)])  # fmt: skip
 def test_cycle_moves_are_fixed(cycle, why, holes):
     """A hole is compensated as a whole (HOLE) in any plane, each of a block's repeats its own,
-    rs274ngc's back bore G87 too; Fanuc's G87, whose words read otherwise, is left as programmed
-    (CYCLE)."""
+    rs274ngc's back bore G87 too, and Fanuc's G87, whose words read otherwise."""
     fanuc, cycle = cycle.startswith("fanuc "), cycle.removeprefix("fanuc ")
     text = HEAD + "M3 S1000\n" + cycle + "\nG80\nG1 X5\n"
     read = interpret_fanuc if fanuc else interpret
@@ -235,26 +234,28 @@ def test_cycle_moves_are_fixed(cycle, why, holes):
 
 
 def _compensate(text: str, strict: bool = False) -> tuple[str, str]:
-    """`text` compensated as a Fanuc program: its G87 (whose words Fanuc reads otherwise than
-    rs274ngc) stands for a canned cycle left as programmed."""
+    """`text` compensated as a Fanuc program: its subprogram's cycle, run twice by `M98 P100 L2` (each run
+    may need a correction of its own), stands for a canned cycle left as programmed."""
     return compensate(text, "drill.ngc", strict, dialect="fanuc")
 
 
+SERIES = "G98 G81 X20 Y20 Z-1 R3 L2\nX30\n(between)\nX40 Y25\nG80\n"
 DRILL = (
     HEAD
-    + "G1 Z-1\nX40 Y12\nG0 Z5 M3\nG98 G87 X20 Y20 Z-1 R-3 I1 J0 L2\nX30\n(between)\nX40 Y25\nG80\nG0 X50 Y50\nG1 Z-1\nX70 Y40\nG3 X80 Y60 R15\nG0 Z10\nM2\n"
-)
+    + "G1 Z-1\nX40 Y12\nG0 Z5 M3\nM98 P100 L2\nG0 X50 Y50\nG1 Z-1\nX70 Y40\nG3 X80 Y60 R15\nG0 Z10\nM30\n"
+    + "O100\n" + SERIES + "M99\n"
+)  # fmt: skip
 
 
 def test_cycles_pass_through_and_compensation_resumes():
     out, warned = _compensate(DRILL)
     lines = out.splitlines()
-    cycle = ["G98 G87 X20 Y20 Z-1 R-3 I1 J0 L2", "X30", "(between)", "X40 Y25", "G80"]
+    cycle = SERIES.splitlines()
     start = lines.index(cycle[0])
     assert lines[start : start + len(cycle)] == cycle  # verbatim
-    # one warning, naming the line where the series starts
+    # one warning, naming the line that runs the series
     assert warned.count("warning") == 1 and "drill.ngc:6:1: warning: canned cycle" in warned
-    after = lines[start + len(cycle) :]
+    after = lines[lines.index("M98 P100 L2") + 1 :]
     assert after[0].startswith("G0 X50.0") and "Z" in after[0]  # compensated, every axis said after the cycle
     assert any(line.startswith("G3 ") and "I" in line for line in after)  # the arc after it is replaced too
 
@@ -263,20 +264,17 @@ def test_a_warning_repeated_hundreds_of_times_is_printed_five_times_then_counted
     """A drilling program warns at each of its 300 cycle series: five are printed (the fifth
     says the rest are counted), then one line at the end tells how many and where."""
     holes = "".join(
-        f"G0 X{k % 20 * 5} Y{k // 20 * 5}\nG98 G87 Y{k // 20 * 5} Z-1 R-3 I1 J0 F100 L2\nG80\nG1 X{k % 20 * 5 + 2}\n"
-        for k in range(300)
+        f"G0 X{k % 20 * 5} Y{k // 20 * 5}\nM98 P100 L2\nG1 X{k % 20 * 5 + 2}\n" for k in range(300)
     )
-    out, warned = _compensate(HEAD + "M3\n" + holes + "M2\n")
+    out, warned = _compensate(HEAD + "M3\n" + holes + "M30\nO100\nG98 G81 Z-1 R3 F100\nG80\nM99\n")
     said = warned.splitlines()
-    series = [
-        n + 1 for n, line in enumerate((HEAD + "M3\n" + holes).splitlines()) if line.startswith("G98 G87")
-    ]
+    series = [n + 1 for n, line in enumerate((HEAD + "M3\n" + holes).splitlines()) if line.startswith("M98")]
     assert [line.split(": warning: ")[0] for line in said] == [
         f"drill.ngc:{n}:1" for n in (*series[:5], series[-1])
     ]
     assert said[4].endswith("(warned 5 times: more of these are counted, not printed)")
     assert said[5].endswith(f"(295 not printed, from line {series[5]} to this one)")
-    assert out.count("G87") == 300
+    assert out.count("M98 P100 L2") == 300
 
 
 def test_warnings_of_other_texts_are_printed_whatever_one_text_repeats():
@@ -334,7 +332,12 @@ def test_compensation_goes_on_after_a_g91_cycle(after):
     """A G91 cycle runs its increments from where the control stands, its G98 retract to the
     level it started from: apply_error_map carries it (test_exact_model measures the moves
     after it on the machine), and compensates the moves after it, in G90 or G91."""
-    text = HEAD + "G1 Z-1\nX40 Y12\nG0 Z5 M3\nG91 G98 G87 X10 Y10 R-8 Z3 I1 J0 L2\nG17\n" + after
+    text = (
+        HEAD
+        + "G1 Z-1\nX40 Y12\nG0 Z5 M3\nM98 P100 L2\nG17\n"
+        + after
+        + "M30\nO100\nG91 G98 G81 X10 Y10 R-8 Z-3\nM99\n"
+    )
     out, warned = _compensate(text)
     assert (
         "in G91" not in warned
@@ -342,23 +345,20 @@ def test_compensation_goes_on_after_a_g91_cycle(after):
         and "drill.ngc:6:1: warning: canned cycle" in warned
     )
     original, written = text.splitlines(), out.splitlines()
-    last = re.search(r"X(-?[\d.]+)", written[-1])  # compensated: the X the block says, moved by microns
-    assert (
-        written[-1] != original[-1]
-        and 0 < abs(float(last[1]) - float(original[-1].split("X")[1].split()[0])) < 0.1
-    )
-    assert "G91 G98 G87 X10 Y10 R-8 Z3 I1 J0 L2" in written
+    last = written[written.index("M30") - 1]
+    wanted = original[original.index("M30") - 1]
+    found = re.search(r"X(-?[\d.]+)", last)  # compensated: the X the block says, moved by microns
+    assert found is not None and last != wanted
+    assert 0 < abs(float(found[1]) - float(wanted.split("X")[1].split()[0])) < 0.1
+    assert "G91 G98 G81 X10 Y10 R-8 Z-3" in written
 
 
 @pytest.mark.skipif(not RS274.exists(), reason="no rs274")
 def test_rs274_accepts_the_compensated_cycles(tmp_path):
-    """The program around a series left as programmed (a cycle in a loop: rs274ngc does not read
-    Fanuc's G87) is written so that rs274 runs it."""
-    looped = DRILL.replace(
-        "G98 G87 X20 Y20 Z-1 R-3 I1 J0 L2\nX30\n(between)\nX40 Y25\nG80\n",
-        "o1 repeat [2]\nG98 G81 X20 Y20 Z-3 R2\nX30\n(between)\nX40 Y25\nG80\no1 endrepeat\n",
-    )
-    assert looped != DRILL
+    """The program around a series left as programmed (a cycle in a loop, which runs twice) is written so
+    that rs274 runs it."""
+    looped = DRILL.split("M98")[0] + "o1 repeat [2]\n" + SERIES + "o1 endrepeat\n" + DRILL.split("L2\n", 1)[1]
+    looped = looped.split("M30")[0] + "M2\n"
     out, warned = compensate(looped, "drill.ngc", False)
     assert "warning: canned cycle" in warned
     path = tmp_path / "out.ngc"

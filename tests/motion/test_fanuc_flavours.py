@@ -280,14 +280,16 @@ def peck_hole(x: float, g: int) -> list[tuple[str, tuple[float, float, float]]]:
 def test_haas_g73_g83_take_a_dwell_p_and_drill_the_same_holes(g):
     """Haas Mill Operator's Manual 96-8000, "G73 High-Speed Peck Drilling Canned Cycle" and "G83 Normal
     Peck Drilling Canned Cycle": P, the pause at the bottom of each hole after its last peck.  The
-    holes' moves, computed by hand, are those without it; Fanuc's formats take no P (refused, as rs274)."""
+    holes' moves, computed by hand, are those without it; Fanuc's formats take no P, which is kept and
+    moves nothing (`FanucInterpreter.any_cycle_p`); rs274 refuses it."""
     from ncpp.motion.canon import canon_call
 
-    calls = [canon_call(e) for e in events(PECK_DWELL.format(g=g), "haas")]
-    found = [(c.name, tuple(round(v, 9) for v in c.args[:3])) for c in calls if c is not None]
-    assert found == [("STRAIGHT_TRAVERSE", (0, 0, 5)), *peck_hole(10, g), *peck_hole(20, g)]
+    for dialect in ("haas", "fanuc"):
+        calls = [canon_call(e) for e in events(PECK_DWELL.format(g=g), dialect)]
+        found = [(c.name, tuple(round(v, 9) for v in c.args[:3])) for c in calls if c is not None]
+        assert found == [("STRAIGHT_TRAVERSE", (0, 0, 5)), *peck_hole(10, g), *peck_hole(20, g)]
     with pytest.raises(NcppError, match="P word with no G2 G3 G4"):
-        events(PECK_DWELL.format(g=g), "fanuc")
+        events(PECK_DWELL.format(g=g), "iso")
 
 
 @pytest.mark.parametrize("g", [73, 83])
@@ -317,6 +319,59 @@ def test_a_haas_peck_cycle_with_p_is_compensated_with_its_p_and_verified(tmp_pat
         program.write_text(f"%\nO1\nG21 G90\nG0 X0 Y0 Z5\nG82 X10 Y0 Z-10 R2 P1. F100\n{between}"
                            f"G{g} X20 Y0 Z-10 R2 Q4\nG80\nM30\n%\n")  # fmt: skip
         assert _dwells(expand, out, "P1.") == [-10.0] * holes
+
+
+# G81 with a P its format has not (Fanuc Series 0i and 16i: `G81 X_ Y_ Z_ R_ F_ K_`), from (0, 0, 5), G98
+DRILL_P = "%\nO1\nG21 G90 G54\nG0 X0 Y0 Z5\nG81 G98 X10 Y0 Z-10 R2 P500 F100\nX20\nG80\nM30\n%\n"
+
+
+def drill_hole(x: float) -> list[tuple[str, tuple[float, float, float]]]:
+    return [("STRAIGHT_TRAVERSE", (x, 0, 5)), ("STRAIGHT_TRAVERSE", (x, 0, 2)), ("STRAIGHT_FEED", (x, 0, -10)),
+            ("STRAIGHT_TRAVERSE", (x, 0, 5))]  # fmt: skip
+
+
+def test_a_p_on_g81_is_kept_and_the_holes_are_g81s(tmp_path):
+    """G81's sequence has no dwell: the P moves nothing whatever the control makes of it, the block is
+    compensated with its P as written (rs274 refuses it); --expand-cycles, which would drop it, refuses."""
+    from ncpp.motion.canon import canon_call
+
+    for dialect in ("fanuc", "haas"):
+        calls = [canon_call(e) for e in events(DRILL_P, dialect)]
+        found = [(c.name, tuple(round(v, 9) for v in c.args[:3])) for c in calls if c is not None]
+        assert found == [("STRAIGHT_TRAVERSE", (0, 0, 5)), *drill_hole(10), *drill_hole(20)]
+    with pytest.raises(NcppError, match="P word with no G2 G3 G4"):
+        events(DRILL_P, "iso")
+
+
+@pytest.mark.parametrize("before", ["G81 X10 Y10 Z-5 R2", "G76 X10 Y10 Z-5 R2 I0.2 J0.1"])
+def test_a_back_bore_after_another_cycle_without_both_i_and_j_ends_interpretation(before):
+    """I J are modal in a Fanuc canned cycle (15i-MA, "Back boring cycle (G87)": "I, J, and K are modal in a
+    canned cycle"): a G87 that follows another cycle of the series and leaves one out may shift by that
+    cycle's, which ncpp does not guess; with both it is compensated, a hole."""
+    head = "G21 G90 G17\nG0 X0 Y0 Z25 S500 M3\nG98 " + before + " F100\n"
+    said = io.StringIO()
+    found = events(head + "G87 X1 Y1 Z-1 R-3 I1\nG80\nM30\n", "fanuc", Warnings(stream=said))
+    assert (
+        "p.nc:4:1: warning: Fanuc's back boring G87 after another cycle without both I and J"
+        in said.getvalue()
+    )
+    assert not any(type(e) is Line and e.block.line >= 4 for e in found)
+    found = events(head + "G87 X1 Y1 Z-1 R-3 I1 J0\nG80\nM30\n", "fanuc")
+    assert [e.hole.fanuc_back for e in found if type(e) is Line and e.block.line == 4] == [True] * 8
+
+
+def test_a_g81_with_p_is_compensated_with_its_p_and_expand_cycles_refuses_it(tmp_path):
+    program, out = tmp_path / "p.nc", tmp_path / "out.nc"
+    program.write_text(DRILL_P)
+    command = ["compensate", "--machine", str(READING), "--dialect", "fanuc", str(program), "-o", str(out)]
+    proc = subprocess.run([sys.executable, "-m", "ncpp", *command], capture_output=True, text=True, cwd=ROOT)
+    assert proc.returncode == 0 and "compensated 9 moves" in proc.stderr, proc.stderr
+    cycle = next(line for line in out.read_text().splitlines() if line.startswith("G81 "))
+    assert cycle.endswith(" P500 F100") and cycle != "G81 G98 X10 Y0 Z-10 R2 P500 F100"
+    expand = subprocess.run([sys.executable, "-m", "ncpp", *command, "--expand-cycles"], capture_output=True,
+                            text=True, cwd=ROOT)  # fmt: skip
+    assert expand.returncode != 0, expand.stderr
+    assert "p.nc:5:24: --expand-cycles: the P of G81" in expand.stderr
 
 
 def _dwells(command: list[str], out: Path, p: str = "P0.5") -> list[float]:
@@ -681,6 +736,16 @@ def test_a_program_number_written_with_a_colon_is_the_o_number(tmp_path, dialect
     assert len(mine) == len(reference) and same_calls(reference, mine), (reference, mine)
     _, blocks = parse_program(io.BytesIO(program.encode()), "p.nc", dialect)
     assert "".join(block.text for block in blocks) == program
+
+
+@pytest.mark.parametrize("dialect", ["fanuc", "haas"])
+@pytest.mark.parametrize("line", [":", " : (PART)"])
+def test_a_colon_without_a_number_is_refused_where_it_runs(dialect, line):
+    """The program number address with no number after it (B-63684EN, "Program number": `:` or O, then
+    the number) is refused where the control would run it, and read past where it does not run."""
+    with pytest.raises(NcppError, match="p.nc:1:[12]: a program number address `:` without its number"):
+        events(f"{line}\nG0 X1\nM30\n", dialect)
+    assert len([e for e in events(f"G0 X1\nM30\n{line}\n", dialect) if type(e) is Line]) == 1
 
 
 def test_a_colon_is_no_program_number_for_linuxcnc():

@@ -144,14 +144,8 @@ def test_each_back_bore_cuts_to_its_top_and_stands_at_its_bottom_and_r(
 # A Fanuc program's G87 (Fanuc Series 15i-MA operator's manual, "Back boring cycle (G87)": to X Y,
 # shifted by I J with the spindle oriented, down to R below the part, back over the hole, feed up to
 # Z, shifted again, up to the initial level, back over the hole; G98 only; G91: R from the initial
-# level, Z from R), and the same moves written out by hand for rs274: each G87 block's lines
-FANUC_BACK_BORES = {
-    "G98 G87 X200 Y150 Z-10 R-45 I2 J-1 F100\n": "G0 X200 Y150\nX202 Y149\nZ-45\nX200 Y150\nG1 Z-10 F100\n"
-    "G0 X202 Y149\nZ25\nX200 Y150\n",
-    "X-180 Y220\n": "G0 X-180 Y220\nX-178 Y219\nZ-45\nX-180 Y220\nG1 Z-10\nG0 X-178 Y219\nZ25\nX-180 Y220\n",
-    "G91 G98 G87 X10 Y5 R-60 Z20 I-1 K2\n": "G90 G0 X20 Y15\nX19\nZ-55\nX20\nG1 Z-35\nG0 X19\nZ5\n"
-    "X20\nX30 Y20\nX29\nZ-55\nX30\nG1 Z-35\nG0 X29\nZ5\nX30\nG91\n",
-}
+# level, Z from R; I J modal in the cycle, K the repeats): (X, Y, Z top, R) of each hole
+FANUC_HOLES = [(200, 150, -10, -45), (-180, 220, -10, -45), (220, -185, -35, -55), (230, -180, -35, -55)]
 FANUC_PROGRAM = """%
 G21 G90 G17
 G0 X40 Y30 Z25 S500 M3
@@ -159,7 +153,7 @@ G1 X60 Y50 F300
 G98 G87 X200 Y150 Z-10 R-45 I2 J-1 F100
 X-180 Y220
 G80
-G1 X10 Y10 Z5 F300
+G1 X210 Y-190 Z5 F300
 G91 G98 G87 X10 Y5 R-60 Z20 I-1 K2
 G90 G80
 G1 X-100 Y80 Z3
@@ -167,35 +161,90 @@ X-150 Y-120 Z-2
 M30
 %
 """
+_FANUC_WORD = re.compile(r"([A-Z])\s*(-?[\d.]+)")
 
 
-def _written_out(text: str) -> str:
-    """`text` with its G87 blocks as the moves Fanuc makes of them (`FANUC_BACK_BORES`), for rs274."""
-    lines = text.splitlines(keepends=True)
-    return "".join(FANUC_BACK_BORES.get(line, line) for line in lines if line.strip() not in ("%", "G80"))
+def fanuc_back_bores_written_out(text: str) -> str:
+    """`text` (this test's words: G0/G1 moves, G90/G91, G80 and G87) with each G87 hole as the moves the
+    manual gives, in G90 G0/G1 blocks for rs274, read from its words here (not by ncpp)."""
+    pos, absolute, cycle, out = np.zeros(3), True, False, []
+    initial = r = top = shift_i = shift_j = 0.0
+    for line in text.splitlines():
+        words = [
+            (letter, float(value))
+            for letter, value in _FANUC_WORD.findall(re.sub(r"\(.*?\)", "", line.upper()))
+        ]
+        codes = [value for letter, value in words if letter == "G"]
+        absolute = False if 91 in codes else True if 90 in codes else absolute
+        given = {letter: value for letter, value in words if letter in "XYZRIJKF"}
+        if 80 in codes or line.strip() == "%":
+            cycle = False
+            out += ["G90" if absolute else "G91"] if line.strip() != "%" else []
+            continue
+        if 87 in codes and not cycle:
+            cycle, initial, shift_i, shift_j = True, pos[2], 0.0, 0.0
+        if not cycle:
+            out.append(line)
+            step = np.array(
+                [given.get(axis, 0.0 if not absolute else pos[k]) for k, axis in enumerate("XYZ")]
+            )
+            pos = step if absolute else pos + step
+            continue
+        shift_i, shift_j = given.get("I", shift_i), given.get("J", shift_j)
+        r = given.get("R", r)  # (the words as written: G91's R from the initial level, Z from R)
+        top = given.get("Z", top)
+        bottom, cut = (r, top) if absolute else (initial + r, initial + r + top)
+        feed = f" F{given['F']:g}" if "F" in given else ""
+        for _ in range(int(given.get("K", 1))):
+            x = given.get("X", pos[0]) if absolute else pos[0] + given.get("X", 0.0)
+            y = given.get("Y", pos[1]) if absolute else pos[1] + given.get("Y", 0.0)
+            sx, sy = x + shift_i, y + shift_j
+            out += [f"G90 G0 X{x:.6f} Y{y:.6f}", f"X{sx:.6f} Y{sy:.6f}", f"Z{bottom:.6f}", f"X{x:.6f} Y{y:.6f}",
+                    f"G1 Z{cut:.6f}{feed}", f"G0 X{sx:.6f} Y{sy:.6f}", f"Z{initial:.6f}", f"X{x:.6f} Y{y:.6f}"]  # fmt: skip
+            pos = np.array([x, y, initial])
+        out.append("G90" if absolute else "G91")
+    return "\n".join(out) + "\n"
 
 
-def test_around_a_fanuc_back_bore_left_as_programmed_the_moves_land_where_programmed(tmp_path):
-    """Fanuc's G87 reads its words otherwise than rs274ngc: left as programmed, with the warning, and
-    compensation resumes where the cycle leaves the tool, over the hole at the initial level.  Judged
-    by rs274 running both programs with their G87 blocks written out by hand as Fanuc's moves, mapped
-    through the hand-written machine: every feed end but the cycles' within 0.5 µm."""
+@pytest.mark.parametrize(
+    "machine_toml, machine", [(MACHINE, square), (REVERSAL, reversing)], ids=["square", "reversals"]
+)
+def test_fanuc_back_bores_cut_to_their_top_and_start_at_their_r(tmp_path, machine_toml, machine):
+    """Fanuc's G87 is compensated hole by hole, a G87 block per hole: each cut ends on its programmed X Y
+    Z within 0.5 µm and starts at its R there, every other feed end too.  Judged by rs274 running both
+    programs with their G87 holes written out by hand as Fanuc's moves, mapped through the hand-written
+    machine, where the program as written misses each cut's end by more than 1 µm."""
     original = tmp_path / "back.nc"
     original.write_text(FANUC_PROGRAM)
     said = io.StringIO()
-    output = compensate_file(original, MACHINE, tmp_path, warnings=Warnings(stream=said), dialect="fanuc")
+    output = compensate_file(
+        original, machine_toml, tmp_path, warnings=Warnings(stream=said), dialect="fanuc"
+    )
     text = output.read_text()
-    assert all(line in text for line in FANUC_BACK_BORES)  # (the cycles' blocks as they stand)
-    assert "back.nc:5:1: warning: canned cycle" in said.getvalue()
+    assert "warning" not in said.getvalue(), said.getvalue()
+    assert len(re.findall(r"^(G98 G87|G91 G98 G87|X)", text, re.M)) >= 4 and "K2" not in text
     runs = []
     for path in (original, output):
         plain = tmp_path / (path.stem + "-moves.ngc")
-        plain.write_text(_written_out(path.read_text()))
+        plain.write_text(fanuc_back_bores_written_out(path.read_text()))
         runs.append(plain)
-    wanted = np.array([b for _, b, feeds in _moves(runs[0]) if feeds])
-    reached = np.array(
-        [m[-1] for (_, _, feeds), m in zip(_moves(runs[1]), actual_moves(runs[1], square)) if feeds]
-    )
+    commanded = _moves(runs[0])
+    wanted = np.array([b for _, b, feeds in commanded if feeds])
+    cuts = [
+        k
+        for k, (a, b, feeds) in enumerate(commanded)
+        if feeds and b[2] > a[2] + 0.01 and np.allclose(a[:2], b[:2])
+    ]
+    assert np.allclose([commanded[k][1] for k in cuts], [h[:3] for h in FANUC_HOLES], atol=1e-6)
+    assert np.allclose([commanded[k][0][2] for k in cuts], [h[3] for h in FANUC_HOLES], atol=1e-6)
+    ran = [(a, b, feeds, m[-1]) for (a, b, feeds), m in zip(_moves(runs[1]), actual_moves(runs[1], machine))]
+    reached = np.array([m for _, _, feeds, m in ran if feeds])
     misses = np.linalg.norm(wanted[:, None, :] - reached[None, :, :], axis=2).min(axis=1) * 1000
-    cut = np.isclose(wanted[:, 2], -10) | np.isclose(wanted[:, 2], -35)  # (the cycles' cuts, as programmed)
-    assert misses[cut].min() > 1.0 and misses[~cut].max() <= 0.5, misses
+    assert misses.max() <= 0.5, misses
+    ups = [k for k, (a, b, feeds, _) in enumerate(ran) if feeds and b[2] > a[2] + 0.01]
+    starts = np.array([ran[k - 1][3][2] for k in ups])  # (the level the tool stands at below each cut)
+    assert len(ups) == len(FANUC_HOLES)
+    assert np.abs(starts - [h[3] for h in FANUC_HOLES]).max() * 1000 <= 0.5
+    actual_before = actual_moves(runs[0], machine)
+    off_before = [np.linalg.norm(actual_before[k][-1] - np.array(h[:3])) for k, h in zip(cuts, FANUC_HOLES)]
+    assert min(off_before) * 1000 > 1.0, off_before  # (the machine is wrong enough to tell, at every cut)

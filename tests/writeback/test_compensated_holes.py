@@ -295,6 +295,25 @@ def test_fanuc_repeats_in_k_land_where_programmed(tmp_path):
     assert _passes_pathcheck(as_linuxcnc, output)
 
 
+def test_a_fanuc_p_that_no_dwell_reads_is_kept_and_the_holes_land(tmp_path):
+    """A P in a Fanuc G81 or G83 block, whose formats have none (`FanucInterpreter.any_cycle_p`), stays as
+    written and the holes are the cycles' own: each lands on its programmed bottom and R, judged by
+    rs274 running the written program without its P (which rs274 refuses) against the original's holes."""
+    original = tmp_path / "kept.nc"
+    program = PROGRAM_G91.replace("M2\n", "M30\n").replace(" L", " K")
+    original.write_text(program.replace("G81 X20", "G81 P300 X20").replace("G83 X-10", "G83 P300 X-10"))
+    output = compensate_file(original, MACHINE, tmp_path, dialect="fanuc")
+    written = output.read_text()
+    assert re.search(r"^G91 G99 G81 P300 X", written, re.M) and re.search(r"^G98 G83 P300 X", written, re.M)
+    as_linuxcnc, without_p = tmp_path / "kept.ngc", tmp_path / "written.ngc"
+    as_linuxcnc.write_text(PROGRAM_G91)
+    without_p.write_text(written.replace(" P300", ""))
+    wanted = np.array(HOLES_G91, dtype=float)
+    before, after = drilled(as_linuxcnc, square), drilled(without_p, square)
+    assert len(after) == len(wanted)
+    assert_holes_land(before, after, wanted)
+
+
 @pytest.mark.parametrize(
     "dialect, words, where",
     [("fanuc", "Q2", "4:29: warning: back boring G87 with its shift in Q"),

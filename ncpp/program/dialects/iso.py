@@ -669,7 +669,7 @@ class IsoWriter:
         hole = firsts[0].hole
         assert hole is not None
         # (the repeats' word: L, or Fanuc's K, where K is no G87's top)
-        drop = "@^" + ("L" + ("K" if hole.top is None else "") if hole.repeats > 1 else "")
+        drop = "@^" + ("L" + ("K" if hole.top is None or hole.fanuc_back else "") if hole.repeats > 1 else "")
         lines = [set_words(_literal_geometry(block, GEOMETRY_LETTERS + drop), words[0], drop=drop,
                            spelled=spelled) + block.eol]  # fmt: skip
         separator, lower = spelled
@@ -688,6 +688,8 @@ class IsoWriter:
         first, second, normal = PLANE_AXES[hole.plane]
         aa, bb, bottom, r = hole.command
         top = hole.top_command
+        if hole.fanuc_back and top is not None:
+            return self._fanuc_back_words(move, (aa, bb, r, top))
         if not move.context.absolute:
             top = None if top is None else top - bottom
             aa, bb = aa - move.start[first], bb - move.start[second]
@@ -699,6 +701,19 @@ class IsoWriter:
         return {
             letter: format_number(value, self._style(letter, move)) for letter, value in zip(letters, values)
         }
+
+    def _fanuc_back_words(self, move: Line, command: tuple[float, float, float, float]) -> dict[str, str]:
+        """`_hole_words` of Fanuc's G87 (G17 only): X Y the hole, R the level below the part its cut starts
+        from, Z the top it ends at, all corrected; in G91 X Y from where the control stands, R from the
+        level the series started at, Z from R (Fanuc Series 15i-MA operator's manual, "Back boring cycle
+        (G87)").  Its shift I J, modal in the cycle, stays as the program writes it (or leaves it)."""
+        hole = move.hole
+        assert hole is not None
+        aa, bb, r, top = command
+        if not move.context.absolute:
+            aa, bb, r, top = aa - move.start[0], bb - move.start[1], r - hole.series_level, top - r
+        values = {"X": aa, "Y": bb, "Z": top, "R": r}
+        return {letter: format_number(value, self._style(letter, move)) for letter, value in values.items()}
 
     # -- o-word control lines ---------------------------------------------------
     def _write_control(self, block: Block, first: Event) -> list[str]:
