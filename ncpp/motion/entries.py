@@ -151,9 +151,11 @@ def _held(
     items: Iterator, step: Pass, since: _Since, warn: Callable[[str, Location], None]
 ) -> Generator[Event | tuple, None, str]:
     """A construct's events from its head (the mark that starts it went by): held until straight code
-    comes back, given its step back where a setting in it ends interpretation (`_stepped`).  Returns
+    comes back, given its step back where a setting in it ends interpretation (`_unmovable`).  Returns
     why a setting in it is not stepped back to ("": it is, or it ended).  `since` goes on as
     `stepped_back`'s."""
+    # where the step goes: None right before the head (no action since the last move), "" right after
+    # that move, else why it has none
     why = _unmovable(step, since) if _acts(since.passes) else None
     last, before = since.moved, since.take()  # (the blocks since the last move: a step may come before them)
     held: list = []
