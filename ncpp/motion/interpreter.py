@@ -439,8 +439,6 @@ class Interpreter:
         self.zeros_set: dict[int, bool] = {}
         self.warnings: Warnings | None = None
         self.flow: Flow | None = None  # while `run` runs
-        # where interpretation ended, and at which block, until `_run` tells `entries.stepped_back`
-        self.stopped: tuple[Location, Block] | None = None
         # Fanuc: the axes (0 X, 1 Y, 2 Z) a move has put at a programmed position since the start or
         # the last program stop (where the operator may jog the machine): #5001-#5003 read them
         self.placed: set[int] = set()
@@ -496,8 +494,15 @@ class Interpreter:
         corner: tuple = ()  # its corner word: (kind, size, item); read only with a pending line
         held: list[Event] = []  # non-moving events after it
         once: FirstPass | None = None  # a loop's first pass in its place, while the flow has not told
+        # where the flow ended interpretation, and at which block, until its next step tells `entries`
+        stopped: tuple[Location, Block] | None = None
+
+        def leave_scope(reason: str, block: Block, col: int | None) -> None:  # (the flow's `stop`)
+            nonlocal stopped
+            stopped = (self._leave_scope(reason, block, col), block)
+
         flow = self.flow = Flow(
-            self.file, self._evaluate, self.params, lambda: self.done, self._leave_scope,
+            self.file, self._evaluate, self.params, lambda: self.done, leave_scope,
             self.subroutine_path, state=self._loop_state, position=lambda: self.pos[:],
             repeats_in_p=self.repeats_in_p, once=self.once_runs, local_calls=self.local_calls,
             main_after_subprograms=self.main_after_subprograms, main_program=self.main_program,
@@ -530,8 +535,8 @@ class Interpreter:
             elif once is not None and kind is FIXED and owner is not None and once.rerun(block):
                 yield from self._told(once, again=True)  # (all of it runs again: nothing to hold)
                 once = None
-            if self.stopped is not None:  # (the flow ended interpretation: a call it cannot follow, ...)
-                (place, line), self.stopped = self.stopped, None
+            if stopped is not None:  # (the flow ended interpretation: a call it cannot follow, ...)
+                (place, line), stopped = stopped, None
                 nothing_held = once is None and pending is None
                 if not inside and block is line and self._enters(kind, owner, nothing_held, stopped=True):
                     yield entered(self._step_back(block))  # type: ignore[misc]
@@ -614,7 +619,6 @@ class Interpreter:
                 ) from None
             except _OutOfScope as stop:
                 place = self._leave_scope(stop.reason, block, stop.col, owner)
-                self.stopped = None  # (told here)
                 self.tool_reads = []  # (the program passes as it stands from here: no value of ncpp's in it)
                 if once is not None:
                     yield from self._told(once, again=True)
@@ -724,7 +728,6 @@ class Interpreter:
             "program passes through uninterpreted (its modal state is unknown)",
             place,
         )
-        self.stopped = (place, block)
         return place
 
     def _in_flow(self, event: Event | tuple[Event, ...], owner: Block | None) -> Event | tuple[Event, ...]:
@@ -2694,7 +2697,7 @@ class Interpreter:
 _NOT_LOOP_STATE = frozenset(("params", "flow", "warnings", "untold_lengths", "expansion", "tools",
                              "file", "subroutine_path", "expand_cycles", "_context", "_fast",
                              "rounding", "once_runs", "main_program", "tool_reads", "checked_reads",
-                             "guard_reads", "unchecked_lines", "stopped"))  # fmt: skip
+                             "guard_reads", "unchecked_lines"))  # fmt: skip
 # Fanuc lathes' maximum spindle speed clamp in G-code systems B and C (system A's G50 S), and Fanuc
 # machining centres' under constant surface speed (their G code list: G92 "setting for workpiece
 # coordinate system or clamp at maximum spindle speed"; `lathe.py`): no move, no offset
