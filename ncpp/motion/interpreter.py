@@ -920,13 +920,14 @@ class Interpreter:
     # -- one block ------------------------------------------------------------------
     def block(self, block: Block) -> Event | tuple[Event, ...]:
         """The event(s) of one block; updates the modal state.  Under a rotation of the coordinate
-        system the moves are in the turned frame, a translation of the machine's (`Context.turned`)."""
+        system the moves are in the turned frame, a translation of the machine's (`Context.turned`:
+        `_line`, `_arc` turn their points as they make them)."""
         events = self._block_events(block)
         if self.unpositioned and _moves(events):
             self._note_positioned(block)
         if self.unsettled_rotation is not None and _moves(events):
             self._settle_rotation(block)
-        return _turned(events) if self.rotations or self.g68 is not None else events
+        return events
 
     def _note_positioned(self, block: Block) -> None:
         """The axes X Y Z a block's move puts at a known position (off `unpositioned`): those it
@@ -1205,13 +1206,17 @@ class Interpreter:
         """A Line of the modal motion (G0/G1) from the current position to `end` (the hot path)."""
         pos = self.pos
         self.pos = end
+        context = self._context or self.context()
+        start_point, end_point = (pos[0], pos[1], pos[2]), (end[0], end[1], end[2])
+        if context.rotation is not None:
+            start_point, end_point = context.turned(start_point), context.turned(end_point)
         return Line(
-            (pos[0], pos[1], pos[2]),
-            (end[0], end[1], end[2]),
+            start_point,
+            end_point,
             self.motion == 0.0,
             self.feed,
             block,
-            self._context or self.context(),
+            context,
             (end[3], end[4], end[5], end[6], end[7], end[8]) if self.uses_extra_axes else (),
             extra_start=(pos[3], pos[4], pos[5], pos[6], pos[7], pos[8]) if self.uses_extra_axes else (),
         )
@@ -2110,13 +2115,15 @@ class Interpreter:
 
     def _line(self, block: Block, end: list[float], rapid: bool) -> Line:
         pos = self.pos
+        context = self._context or self.context()
+        turned = context.turned  # (under a rotation, the points where the control turns them)
         line = Line(
-            (pos[0], pos[1], pos[2]),
-            (end[0], end[1], end[2]),
+            turned((pos[0], pos[1], pos[2])),
+            turned((end[0], end[1], end[2])),
             rapid,
             self.feed,
             block,
-            self._context or self.context(),
+            context,
             tuple(end[3:]) if self.uses_extra_axes else (),
             extra_start=tuple(pos[3:]) if self.uses_extra_axes else (),
         )
@@ -2575,14 +2582,16 @@ class Interpreter:
         center = [0.0, 0.0, 0.0]
         center[a], center[b], center[c] = ca, cb, start[c]
         self.pos = end
+        context = self._context or self.context()
+        turned = context.turned  # (under a rotation, in G17: the points turned, an arc still)
         return Arc(
-            (start[0], start[1], start[2]),
-            (end[0], end[1], end[2]),
-            (center[0], center[1], center[2]),
+            turned((start[0], start[1], start[2])),
+            turned((end[0], end[1], end[2])),
+            turned((center[0], center[1], center[2])),
             -turns if motion == 2.0 else turns,
             self.feed,
             block,
-            self._context or self.context(),
+            context,
             (end[3], end[4], end[5], end[6], end[7], end[8]) if self.uses_extra_axes else (),
             extra_start=(start[3], start[4], start[5], start[6], start[7], start[8])
             if self.uses_extra_axes
@@ -2722,19 +2731,6 @@ _PLAIN_LETTERS = {
     },  # a cycle's words are checked in full (Fanuc's G76 too)
     RIGID_TAP: frozenset(),  # a modal G33.1 block needs its K again (rs274ngc: "K word missing")
 }
-
-
-def _turned(events: Event | tuple[Event, ...]) -> Event | tuple[Event, ...]:
-    """The moves of `events` (new ones) moved into the frame their context's rotation turns the
-    program's points into (`Context.turned`): arcs in the XY plane stay arcs about the turned centre."""
-    for event in events if type(events) is tuple else (events,):
-        if type(event) is Pass or event.context.rotation is None:  # type: ignore[union-attr]
-            continue
-        turned = event.context.turned  # type: ignore[union-attr]
-        event.start, event.end = turned(event.start), turned(event.end)  # type: ignore[union-attr]
-        if type(event) is Arc:
-            event.center = turned(event.center)
-    return events
 
 
 def _marked(events: Event | tuple[Event, ...] | None, marks: list[Pass]) -> Event | tuple[Event, ...]:
