@@ -1208,7 +1208,7 @@ class Interpreter:
         self.pos = end
         context = self._context or self.context()
         start_point, end_point = (pos[0], pos[1], pos[2]), (end[0], end[1], end[2])
-        if context.rotation is not None:
+        if context.rotation is not None:  # (as `_line` turns them; no call per point where none turns)
             start_point, end_point = context.turned(start_point), context.turned(end_point)
         return Line(
             start_point,
