@@ -33,6 +33,7 @@ from collections.abc import Callable, Generator, Iterable, Iterator
 
 from ncpp.errors import Location
 from ncpp.motion.segments import Arc, Event, Line, Pass, Setting
+from ncpp.program.actions import actions_of
 
 # Blocks without motion between the last move and a construct's head held and looked through for an action
 MAX_SINCE = 1_000
@@ -218,11 +219,9 @@ def _unmovable(step: Pass, since: _Since) -> str:
 
 def _acts(since: list[Pass]) -> bool:
     """Whether an action stands among the blocks since the last move (an M function, a tool, spindle
-    speed or offset number, a dwell, a tool length: `ncpp.verify.actions_of`): a step after it would
+    speed or offset number, a dwell, a tool length: `actions_of`): a step after it would
     move where the original stands still, which the verifier, comparing the motion between two
     actions, refuses.  Past MAX_SINCE blocks, taken to."""
     if len(since) > MAX_SINCE:
         return True
-    from ncpp.verify import actions_of  # (numpy's and scipy's import only where a construct starts)
-
     return any(any(actions_of(event.block)) for event in since if not event.skipped)

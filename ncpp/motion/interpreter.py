@@ -439,8 +439,6 @@ class Interpreter:
         self.zeros_set: dict[int, bool] = {}
         self.warnings: Warnings | None = None
         self.flow: Flow | None = None  # while `run` runs
-        # where interpretation ended, and at which block, until `_run` tells `entries.stepped_back`
-        self.stopped: tuple[Location, Block] | None = None
         # Fanuc: the axes (0 X, 1 Y, 2 Z) a move has put at a programmed position since the start or
         # the last program stop (where the operator may jog the machine): #5001-#5003 read them
         self.placed: set[int] = set()
@@ -496,8 +494,15 @@ class Interpreter:
         corner: tuple = ()  # its corner word: (kind, size, item); read only with a pending line
         held: list[Event] = []  # non-moving events after it
         once: FirstPass | None = None  # a loop's first pass in its place, while the flow has not told
+        # where the flow ended interpretation, and at which block, until its next step tells `entries`
+        stopped: tuple[Location, Block] | None = None
+
+        def leave_scope(reason: str, block: Block, col: int | None) -> None:  # (the flow's `stop`)
+            nonlocal stopped
+            stopped = (self._leave_scope(reason, block, col), block)
+
         flow = self.flow = Flow(
-            self.file, self._evaluate, self.params, lambda: self.done, self._leave_scope,
+            self.file, self._evaluate, self.params, lambda: self.done, leave_scope,
             self.subroutine_path, state=self._loop_state, position=lambda: self.pos[:],
             repeats_in_p=self.repeats_in_p, once=self.once_runs, local_calls=self.local_calls,
             main_after_subprograms=self.main_after_subprograms, main_program=self.main_program,
@@ -530,8 +535,8 @@ class Interpreter:
             elif once is not None and kind is FIXED and owner is not None and once.rerun(block):
                 yield from self._told(once, again=True)  # (all of it runs again: nothing to hold)
                 once = None
-            if self.stopped is not None:  # (the flow ended interpretation: a call it cannot follow, ...)
-                (place, line), self.stopped = self.stopped, None
+            if stopped is not None:  # (the flow ended interpretation: a call it cannot follow, ...)
+                (place, line), stopped = stopped, None
                 nothing_held = once is None and pending is None
                 if not inside and block is line and self._enters(kind, owner, nothing_held, stopped=True):
                     yield entered(self._step_back(block))  # type: ignore[misc]
@@ -614,7 +619,6 @@ class Interpreter:
                 ) from None
             except _OutOfScope as stop:
                 place = self._leave_scope(stop.reason, block, stop.col, owner)
-                self.stopped = None  # (told here)
                 self.tool_reads = []  # (the program passes as it stands from here: no value of ncpp's in it)
                 if once is not None:
                     yield from self._told(once, again=True)
@@ -724,7 +728,6 @@ class Interpreter:
             "program passes through uninterpreted (its modal state is unknown)",
             place,
         )
-        self.stopped = (place, block)
         return place
 
     def _in_flow(self, event: Event | tuple[Event, ...], owner: Block | None) -> Event | tuple[Event, ...]:
@@ -917,13 +920,14 @@ class Interpreter:
     # -- one block ------------------------------------------------------------------
     def block(self, block: Block) -> Event | tuple[Event, ...]:
         """The event(s) of one block; updates the modal state.  Under a rotation of the coordinate
-        system the moves are in the turned frame, a translation of the machine's (`Context.turned`)."""
+        system the moves are in the turned frame, a translation of the machine's (`Context.turned`:
+        `_line`, `_arc` turn their points as they make them)."""
         events = self._block_events(block)
         if self.unpositioned and _moves(events):
             self._note_positioned(block)
         if self.unsettled_rotation is not None and _moves(events):
             self._settle_rotation(block)
-        return _turned(events) if self.rotations or self.g68 is not None else events
+        return events
 
     def _note_positioned(self, block: Block) -> None:
         """The axes X Y Z a block's move puts at a known position (off `unpositioned`): those it
@@ -1202,13 +1206,17 @@ class Interpreter:
         """A Line of the modal motion (G0/G1) from the current position to `end` (the hot path)."""
         pos = self.pos
         self.pos = end
+        context = self._context or self.context()
+        start_point, end_point = (pos[0], pos[1], pos[2]), (end[0], end[1], end[2])
+        if context.rotation is not None:  # (as `_line` turns them; no call per point where none turns)
+            start_point, end_point = context.turned(start_point), context.turned(end_point)
         return Line(
-            (pos[0], pos[1], pos[2]),
-            (end[0], end[1], end[2]),
+            start_point,
+            end_point,
             self.motion == 0.0,
             self.feed,
             block,
-            self._context or self.context(),
+            context,
             (end[3], end[4], end[5], end[6], end[7], end[8]) if self.uses_extra_axes else (),
             extra_start=(pos[3], pos[4], pos[5], pos[6], pos[7], pos[8]) if self.uses_extra_axes else (),
         )
@@ -2107,13 +2115,15 @@ class Interpreter:
 
     def _line(self, block: Block, end: list[float], rapid: bool) -> Line:
         pos = self.pos
+        context = self._context or self.context()
+        turned = context.turned  # (under a rotation, the points where the control turns them)
         line = Line(
-            (pos[0], pos[1], pos[2]),
-            (end[0], end[1], end[2]),
+            turned((pos[0], pos[1], pos[2])),
+            turned((end[0], end[1], end[2])),
             rapid,
             self.feed,
             block,
-            self._context or self.context(),
+            context,
             tuple(end[3:]) if self.uses_extra_axes else (),
             extra_start=tuple(pos[3:]) if self.uses_extra_axes else (),
         )
@@ -2596,14 +2606,16 @@ class Interpreter:
         center = [0.0, 0.0, 0.0]
         center[a], center[b], center[c] = ca, cb, start[c]
         self.pos = end
+        context = self._context or self.context()
+        turned = context.turned  # (under a rotation, in G17: the points turned, an arc still)
         return Arc(
-            (start[0], start[1], start[2]),
-            (end[0], end[1], end[2]),
-            (center[0], center[1], center[2]),
+            turned((start[0], start[1], start[2])),
+            turned((end[0], end[1], end[2])),
+            turned((center[0], center[1], center[2])),
             -turns if motion == 2.0 else turns,
             self.feed,
             block,
-            self._context or self.context(),
+            context,
             (end[3], end[4], end[5], end[6], end[7], end[8]) if self.uses_extra_axes else (),
             extra_start=(start[3], start[4], start[5], start[6], start[7], start[8])
             if self.uses_extra_axes
@@ -2718,7 +2730,7 @@ class Interpreter:
 _NOT_LOOP_STATE = frozenset(("params", "flow", "warnings", "untold_lengths", "expansion", "tools",
                              "file", "subroutine_path", "expand_cycles", "_context", "_fast",
                              "rounding", "once_runs", "main_program", "tool_reads", "checked_reads",
-                             "guard_reads", "unchecked_lines", "stopped"))  # fmt: skip
+                             "guard_reads", "unchecked_lines"))  # fmt: skip
 # Fanuc lathes' maximum spindle speed clamp in G-code systems B and C (system A's G50 S), and Fanuc
 # machining centres' under constant surface speed (their G code list: G92 "setting for workpiece
 # coordinate system or clamp at maximum spindle speed"; `lathe.py`): no move, no offset
@@ -2743,19 +2755,6 @@ _PLAIN_LETTERS = {
     },  # a cycle's words are checked in full (Fanuc's G76 too)
     RIGID_TAP: frozenset(),  # a modal G33.1 block needs its K again (rs274ngc: "K word missing")
 }
-
-
-def _turned(events: Event | tuple[Event, ...]) -> Event | tuple[Event, ...]:
-    """The moves of `events` (new ones) moved into the frame their context's rotation turns the
-    program's points into (`Context.turned`): arcs in the XY plane stay arcs about the turned centre."""
-    for event in events if type(events) is tuple else (events,):
-        if type(event) is Pass or event.context.rotation is None:  # type: ignore[union-attr]
-            continue
-        turned = event.context.turned  # type: ignore[union-attr]
-        event.start, event.end = turned(event.start), turned(event.end)  # type: ignore[union-attr]
-        if type(event) is Arc:
-            event.center = turned(event.center)
-    return events
 
 
 def _marked(events: Event | tuple[Event, ...] | None, marks: list[Pass]) -> Event | tuple[Event, ...]:

@@ -57,6 +57,15 @@ def grammar_path(name: str) -> Path:
 
 
 _LARK_OPTIONS = {"parser": "lalr", "propagate_positions": True, "maybe_placeholders": False}
+# A grammar that adds to another's rules (`%extend`) and the grammar it adds to, read before it
+GRAMMAR_BASE = {"fanuc": "iso"}
+
+
+def grammar_text(name: str) -> str:
+    """The text of grammar `name`, after that of the grammar it adds to (`GRAMMAR_BASE`)."""
+    own = grammar_path(name).read_text(encoding="utf-8")
+    base = GRAMMAR_BASE.get(name)
+    return own if base is None else f"{grammar_text(base)}\n{own}"
 
 
 @functools.cache
@@ -64,7 +73,7 @@ def lalr_parser(name: str) -> lark.Lark:
     """The dialect's Lark parser, loaded from the user's cache when it was built before
     (building the LALR tables takes several times as long as loading them: every `ncpp` run
     pays it, and the LinuxCNC filter runs whenever a program is opened)."""
-    text = grammar_path(name).read_text(encoding="utf-8")
+    text = grammar_text(name)
     return cached_build(
         f"{name}-lark",
         f"{text}\n{_LARK_OPTIONS}\n{lark.__version__}",
@@ -149,6 +158,11 @@ class _ItemBuilder(Transformer):
             return Statement("oword", (str(tok),), meta.start_pos, meta.end_pos)
         return _word(str(tok), meta.start_pos, meta.end_pos)
 
+    def colon_program_number(self, children):
+        """`:1000` is the program number O1000 (`grammar/fanuc.lark`)."""
+        (tok,) = children
+        return _word("O" + tok[1:], tok.start_pos, tok.end_pos)
+
     @v_args(meta=True)
     def assignment(self, meta, children):
         target, value = children
@@ -219,8 +233,6 @@ class Dialect:
     its line (`% vfd enable`, `%(note)`) is a bad character where it runs, as rs274ngc reads it.
     `tape_marks`: the controls take `%` lines for the program's start and end; without them (grbl)
     every `%` line is a stray one and no text after a `%` goes unread.
-    `colon_program_numbers`: a block that starts with `:` and a number is a program number, `:1000` read
-    as `O1000` (the ISO code's program number address; `_colon_as_o`).
     """
 
     name: str
@@ -236,7 +248,6 @@ class Dialect:
     eob_semicolon: bool = False  # `;` is the end of block as the control shows it (`_words_after_eob`)
     bare_tape_marks: bool = False  # a `%` with more on its line is no tape mark (rs274ngc)
     tape_marks: bool = True  # `%` lines mark the program's start and end (not grbl's)
-    colon_program_numbers: bool = False  # `:1000` is the program number O1000 (`_colon_as_o`)
 
 
 def dialect_syntax(dialect: str | Dialect) -> Dialect:
@@ -278,33 +289,6 @@ def _refuse_cr_line_ends(raw: str, line: int, file: str) -> None:
 
 # A word's start (a letter, then a number, a parameter or a bracket) after a `;`, past blanks and
 # parenthesised comments
-# A program number written with ISO code's address `:` (`:1000`, `:1000 (PART)`)
-_COLON_NUMBER = re.compile(r"^([ \t]*):(?=[ \t]*\d)")
-# The ISO code's program number address with no number after it (`:`, `: (PART)`)
-_BARE_COLON = re.compile(r"^[ \t]*:")
-
-
-def _colon_as_o(block: Block, raw: str) -> Block:
-    """The block `O1000` read for a line `:1000`, with the line's own text.  Fanuc's program number
-    address is O in EIA code, and in ISO code a colon may stand for the O (Fanuc Series 16i/18i-MB
-    operator's manual B-63684EN, "Program configuration", "Program number"); Haas's controls read
-    Fanuc's programs.  LinuxCNC refuses the colon (rs274ngc: "Bad character ':' used")."""
-    return Block(raw, block.eol, block.items, block.line, block.verbatim, block.signature, block.layout)
-
-
-def _colon_without_number(raw: str, eol: str, line: int, file: str, dialect: Dialect) -> Block:
-    """A line that starts with `:` and no number: the program number address without the number it
-    takes (`_colon_as_o`), refused where it runs (or here, where the dialect reads every line)."""
-    error = NcppError(
-        "a program number address `:` without its number (in ISO code `:` stands for O, which the "
-        "program's number follows: `:1000`)",
-        Location(file, line, raw.index(":") + 1),
-    )
-    if not dialect.read_where_run:
-        raise error
-    return Block(raw, eol, (Statement(UNREADABLE, (error,), 0, len(raw)),), line)
-
-
 _WORD_AFTER_EOB = re.compile(r"(?:[ \t]|\([^)]*\))*([A-Za-z][ \t]*[-+]?[ \t]*[0-9.#\[])")
 
 
@@ -377,6 +361,7 @@ class LineParser:
         self.dialect = dialect_syntax(grammar)
         self.grammar = self.dialect.grammar
         self._lark = lalr_parser(self.grammar)
+        self._reads_atan = GRAMMAR_BASE.get(self.grammar, self.grammar) == "iso"  # (ATAN[y]/[x]: `ATAN_FORM`)
         self._builder = self.dialect.builder()
         self._items = (
             _PlainItems(self._lark, self.dialect.fast_terminals) if self.dialect.fast_terminals else None
@@ -390,10 +375,6 @@ class LineParser:
     def parse(self, raw: str, eol: str = "", line: int = 0, file: str = "<stdin>") -> Block:
         if len(raw) > self.dialect.max_line:
             _refuse_long(raw, self.dialect, line, file)
-        if self.dialect.colon_program_numbers and _COLON_NUMBER.match(raw):
-            return _colon_as_o(self.parse(_COLON_NUMBER.sub(r"\1O", raw, count=1), eol, line, file), raw)
-        if self.dialect.colon_program_numbers and _BARE_COLON.match(raw):
-            return _colon_without_number(raw, eol, line, file, self.dialect)
         plain = self._scan_plain(raw)
         if plain is None:
             block = Block(raw, eol, self._read_lalr(raw, line, file), line)
@@ -528,9 +509,11 @@ class LineParser:
             line += max(getattr(err, "line", 1) or 1, 1) - 1
             if raw.startswith(_BOM):
                 raise NcppError(BOM_MESSAGE, Location(file, line, 1)) from None
-            atan = _lone_atan(raw, _error_pos(err)) if self.grammar == "iso" else None
+            atan = _lone_atan(raw, _error_pos(err)) if self._reads_atan else None
             if atan is not None:
                 raise NcppError(ATAN_FORM, Location(file, line, atan + 1)) from None
+            if self.grammar == "fanuc" and _BARE_COLON.match(raw):
+                raise NcppError(BARE_COLON, Location(file, line, raw.index(":") + 1)) from None
             raise NcppError(_describe(err, raw), Location(file, line, col)) from None
         except RecursionError:  # the builder walks the tree recursively: brackets hundreds deep
             raise NcppError("expression nested too deeply", Location(file, line, 1)) from None
@@ -874,6 +857,13 @@ def _error_pos(err: lark.exceptions.UnexpectedInput) -> int:
     pos = getattr(err, "pos_in_stream", None)
     return pos if pos is not None else (getattr(err, "column", 1) or 1) - 1
 
+
+# Fanuc's and Haas's program number address with no number after it (`:`, `: (PART)`, `fanuc.lark`)
+_BARE_COLON = re.compile(r"^[ \t]*:(?![ \t]*\d)")
+BARE_COLON = (
+    "a program number address `:` without its number (in ISO code `:` stands for O, which the "
+    "program's number follows: `:1000`)"
+)
 
 # A LinuxCNC o-word's name, where its keyword must follow (`o<frame_circ> call [1]`, `o100 sub`)
 _OWORD_NAME = re.compile(r"[ \t]*(?:[Nn][ \t]*\d+[ \t]*)?[Oo][ \t]*(?:<[^>]*>|\d+)[ \t]*")

@@ -9,7 +9,7 @@ import lark
 import pytest
 
 from ncpp.cache import cache_folder, cached_build
-from ncpp.program.parser import _LARK_OPTIONS, grammar_path, lalr_parser
+from ncpp.program.parser import _LARK_OPTIONS, grammar_text, lalr_parser
 
 
 class Saved:
@@ -103,6 +103,7 @@ def test_a_folder_that_cannot_be_made_still_builds(tmp_path, monkeypatch):
     "name, line",
     [
         ("iso", "G1 X#<a>*2 Y[1+2] (c)"),
+        ("fanuc", ":1000 (PART)"),
         ("heidenhain", "L X+1.5 R0 FMAX"),
         ("sinumerik", "N10 G1 X=R1+2 Y20"),
         ("apt", "GOTO/1,2,3"),
@@ -110,7 +111,7 @@ def test_a_folder_that_cannot_be_made_still_builds(tmp_path, monkeypatch):
 )
 def test_a_grammar_loaded_from_the_cache_parses_as_the_built_one(name, line, tmp_path, monkeypatch):
     monkeypatch.setenv("NCPP_CACHE", str(tmp_path))
-    built = lark.Lark(grammar_path(name).read_text(encoding="utf-8"), **_LARK_OPTIONS)
+    built = lark.Lark(grammar_text(name), **_LARK_OPTIONS)
     lalr_parser.cache_clear()
     try:
         lalr_parser(name)  # builds and saves

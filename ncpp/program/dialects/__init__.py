@@ -100,12 +100,12 @@ GRBL = Dialect(
     "grbl", "iso", _ItemBuilder, fast_terminals=LineParser.FAST_TERMINALS, read_where_run=True, tape_marks=False,
 )  # fmt: skip
 FANUC = Dialect(
-    "fanuc", "iso", _ItemBuilder, fast_terminals=LineParser.FAST_TERMINALS, read_where_run=True, leader=True,
-    programs_after_end=True, eob_semicolon=True, colon_program_numbers=True,
+    "fanuc", "fanuc", _ItemBuilder, fast_terminals=LineParser.FAST_TERMINALS, read_where_run=True, leader=True,
+    programs_after_end=True, eob_semicolon=True,
 )  # fmt: skip
 HAAS = Dialect(
-    "haas", "iso", _ItemBuilder, fast_terminals=LineParser.FAST_TERMINALS, read_where_run=True, leader=True,
-    programs_after_end=True, eob_semicolon=True, colon_program_numbers=True,
+    "haas", "fanuc", _ItemBuilder, fast_terminals=LineParser.FAST_TERMINALS, read_where_run=True, leader=True,
+    programs_after_end=True, eob_semicolon=True,
 )  # fmt: skip
 # File name endings that name a dialect when the content does not tell.
 SUFFIXES = {".h": "heidenhain", ".mpf": "sinumerik", ".spf": "sinumerik"}
