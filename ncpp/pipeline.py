@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import gc
 import hashlib
+import re
 from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
@@ -305,6 +306,33 @@ def _reported(
         yield block
 
 
+# A line of a program's text: its number, or a G or M code or an X Y Z word first (a leader's own
+# directives are comments)
+_PROGRAM_TEXT = re.compile(r"[ \t]*(?:N\d+[ \t]*)?(?:[O:]\d|[GM]\d|[XYZ][-+.\d])", re.IGNORECASE)
+
+
+def _leader_told(blocks: Iterable[Block], warnings: Warnings, file: str) -> Iterator[Block]:
+    """The blocks, with a warning where the tape leader above the file's first `%` (which a Fanuc
+    control skips: `parser._leader`) holds a program's lines, as a file whose only `%` closes it
+    does: the control reads none of them, and ncpp compensates none of them."""
+    blocks = iter(blocks)
+    for block in blocks:
+        if not block.verbatim:
+            yield block
+            break
+        if _PROGRAM_TEXT.match(block.raw):
+            warnings.warn(
+                "this line stands above the file's first `%`, which a Fanuc control takes for the start of "
+                "the tape: the lines above it are the tape's leader, which the control skips, and they pass "
+                "through as they are, none compensated (put a `%` line above the program)",
+                Location(file, block.line, None),
+            )
+            yield block
+            break
+        yield block
+    yield from blocks
+
+
 def _continued(blocks: Iterable[Block], tally: list[int]) -> Iterator[Block]:
     """The blocks, adding to tally[0] the lines past its first each spans (its raw text holds their ends)."""
     for block in blocks:
@@ -412,6 +440,8 @@ def process(
             "table it was compensated with; compensate the original program instead",
             Location(file, block.line, None)))  # fmt: skip
     blocks = refuse_lathe(blocks, name, file)  # (ncpp's machine is a machining centre)
+    if get_dialect(name).leader:
+        blocks = _leader_told(blocks, warnings, file)
     offsets = offsets or AT_MACHINE_ZERO  # the control's zeros place the program on the machine
     expanding: dict[str, bool] = {}
     if FAMILY[name] == "iso":

@@ -107,7 +107,6 @@ TOOL_PARAMETERS = range(5400, 5414)
 TOOL_DIAMETER, TOOL_ORIENTATION = 5410, 5413
 
 # rs274ngc tolerances (interp_internal.hh), in program units
-TOLERANCE = {False: 0.002, True: 0.0002}  # zero-radius checks: mm, inch
 # how far an R arc's chord may exceed its diameter (rs274ngc's RADIUS_TOLERANCE_INCH, 0.00005 in): mm, inch
 RADIUS_TOLERANCE = {False: 0.00005 * 25.4, True: 0.00005}
 CENTER_ARC_ABS = {False: 2 * 0.01 * math.sqrt(2), True: 2 * 0.001 * math.sqrt(2)}
@@ -2585,7 +2584,6 @@ class Interpreter:
         if radius is not None and self.still_r_arc and list(end) == list(start) and self.cutter_comp is None:
             return Pass(block)  # (the block passes as it is: the modal G2/G3 and F it sets are kept)
         turns = round(words["P"][0]) if "P" in words else 1
-        tolerance = TOLERANCE[self.inch]
         comp_radius = self.comp_radius  # (None: not known)
         if self.cutter_comp is not None and comp_radius and not self.centre.off_path:
             # (rs274ngc's convert_arc_comp1 checks the entry arc's chord before it finds the centre)
@@ -2602,7 +2600,7 @@ class Interpreter:
             else:
                 ca = start[a] + (0.0 if ia is None else ia[0])  # + 0.0 as before: -0.0 becomes 0.0
                 cb = start[b] + (0.0 if ib is None else ib[0])
-            self._check_radii(block, word, start[a], start[b], end[a], end[b], ca, cb, tolerance)
+            self._check_radii(block, word, start[a], start[b], end[a], end[b], ca, cb)
         center = [0.0, 0.0, 0.0]
         center[a], center[b], center[c] = ca, cb, start[c]
         self.pos = end
@@ -2639,11 +2637,13 @@ class Interpreter:
         offset = r * math.cos(math.asin(half / r))
         return mx + offset * math.cos(theta), my + offset * math.sin(theta)
 
-    def _check_radii(self, block, word, x0, y0, x1, y1, cx, cy, tolerance) -> None:
-        """arc_data_ijk of rs274ngc: start and end radius must agree (README.arc-radius-tolerance)."""
+    def _check_radii(self, block, word, x0, y0, x1, y1, cx, cy) -> None:
+        """arc_data_ijk of rs274ngc: start and end radius must agree (README.arc-radius-tolerance); a radius
+        below convert_arc2's radius tolerance (0.00005 in, 0.00127 mm) is zero."""
         r1 = math.hypot(cx - x0, cy - y0)
         r2 = math.hypot(cx - x1, cy - y1)
-        if r1 < tolerance or r2 < tolerance:
+        zero = RADIUS_TOLERANCE[self.inch]
+        if r1 < zero or r2 < zero:
             self._fail("Zero-radius arc", block, word)
         abs_err = abs(r1 - r2)
         rel_err = abs_err / max(r1, r2)

@@ -186,6 +186,26 @@ def test_the_header_and_guard_go_below_the_start_not_into_the_leader(tmp_path):
     )  # (the program selects G54 itself: its zero is checked, not #4014)
 
 
+# A class exercise's program with a closing `%` and none above it (IIIVENDETTAIII/CNC-Programming,
+# SSCNC "One Flor.txt", shortened): its only `%` is the start a Fanuc control reads the file from
+UNSTARTED = "O0008\nG17 G21 G40 G49 G90\nG00 X-86 Y0 Z5\nG01 Z-2 F500\nG01 X-46 Y0 F800\nM30\n%\n"
+
+
+@pytest.mark.parametrize("start", ["", "%\n"])
+def test_a_program_above_the_files_only_percent_is_said_to_be_the_leader_not_compensated(tmp_path, start):
+    """Its lines are the tape's leader the control skips: they pass through as they are with a warning at
+    the first of them (before, the run said it left nothing as programmed); with a `%` above, compensated."""
+    program = tmp_path / "p.nc"
+    program.write_text(start + UNSTARTED)
+    proc = subprocess.run([sys.executable, "-m", "ncpp", "compensate", "--machine", str(READING), str(program)],
+                          capture_output=True, text=True, cwd=ROOT)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    told = "p.nc:1:1: warning: this line stands above the file's first `%`" in proc.stderr
+    moves = [line for line in proc.stdout.splitlines() if line.startswith("G0")]
+    assert told == (start == "")
+    assert (moves == [line for line in UNSTARTED.splitlines() if line.startswith("G0")]) == (start == "")
+
+
 def test_g10_l2_of_a_numbered_system_is_followed():
     """P1-P6: G54-G59 (the Fanuc manual's G10 L2), as LinuxCNC reads them."""
     said = io.StringIO()

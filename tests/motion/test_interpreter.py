@@ -252,6 +252,17 @@ def test_an_r_arc_within_rs274s_tolerance_is_read():
     assert arc.end[0] == 20.0024
 
 
+@pytest.mark.parametrize("units, radius", [("G21", 0.0015), ("G21", 0.002), ("G20", 0.00006)])
+def test_an_ijk_arc_of_a_radius_above_rs274s_radius_tolerance_is_read(units, radius):
+    """rs274 (LinuxCNC 2.9) reads an arc of 0.002 mm radius (a SolidWorks CAM contour's corner in
+    nick-burrill/Gcode-Tools, `G3 X-5.1982 Y-2.8783 I0. J-0.002`): zero is below convert_arc2's radius
+    tolerance, 0.00127 mm (0.00005 in), not the 0.002 mm of other checks; below it, "Zero-radius arc"."""
+    (_, arc) = moves(f"{units} G17 G90\nG1 X0 Y0 F60\nG3 X0 Y0 I0 J{radius:.5f}\n")
+    assert arc.center[1] == pytest.approx(radius)
+    err = error(f"{units} G17 G90\nG1 X0 Y0 F60\nG3 X0 Y0 I0 J{radius * 0.6:.6f}\n")
+    assert err.message == "Zero-radius arc"
+
+
 def test_arc_radius_tolerance_matches_linuxcnc_files():
     for path in sorted((CORPUS / "malformed/linuxcnc_interp_bad").glob("bad-arc.*.ngc")):
         expected = path.read_text().splitlines()[0].lstrip(";")

@@ -428,6 +428,7 @@ class HeidenhainWriter(IsoWriter):
         self._learn_styles(block)
         # (under Cycle 10's rotation in the program's own frame, which the control turns: ISO's `as_written`)
         motion = [as_written(e) for e in group if type(e) is Line or type(e) is Arc]
+        self._settle_plane(block, motion)
         pole = next((e for e in reversed(group) if type(e) is Pole), None)  # (a call's: its last)
         _, function = _function(block)
         edited_before = self.edited_last

@@ -316,6 +316,8 @@ class IsoWriter:
         self._last_end: tuple[float, float, float] | None = None
         self._last_places: tuple[int, int, int] = (0, 0, 0)
         self._last_context: Context | None = None  # the frame (units, offsets) `_last_end` is in
+        self._frame_seen: Context | None = None  # the frame of the last block's moves (`_settle_plane`)
+        self._plane_unsettled = False  # a rotation turned or moved the frame since a move gave X and Y
 
     def comment(self, text: str) -> str:
         return f"{self.comment_open}{text}{self.comment_close}"
@@ -408,6 +410,7 @@ class IsoWriter:
                 return self._stepped_back(block, first.setting)
             return [self._setting_text(block, first.setting) + block.eol]
         motion = [as_written(e) for e in group if type(e) is Line or type(e) is Arc]
+        self._settle_plane(block, motion)
         lead = 0  # steps to a canned cycle's start (`apply_error_map._lead_in`): new blocks before it
         while lead < len(motion) and motion[lead].fixed == CYCLE and motion[lead].changed:
             lead += 1
@@ -624,6 +627,25 @@ class IsoWriter:
     def _restore_mode_line(self, block: Block) -> str:
         self.output_motion = self.program_motion
         return f"G{self.program_motion}{block.eol}"
+
+    def _settle_plane(self, block: Block, motion: list[Line | Arc]) -> None:
+        """After a rotation of the coordinate system turned or moved the frame (Fanuc's G68 and G69,
+        Klartext's Cycle 10, Sinumerik's frames), the control places X and Y once a move gives both
+        absolutely, and the interpreter follows no move of one of them alone before (`settle_rotation`):
+        the first block edited there writes every axis it knows, so that a correction written on a move
+        along Z, or a word left out where its axis stands, does not give X or Y alone."""
+        for segment in motion:
+            seen, context = self._frame_seen, segment.context
+            if seen is not None and seen is not context and _turns_plane(seen, context):
+                self._plane_unsettled = True
+            self._frame_seen = context
+        if not (self._plane_unsettled and motion):
+            return
+        if any(segment.changed for segment in motion):
+            if motion[0].context.absolute:
+                self._last_end, self._plane_unsettled = None, False
+        elif {"X", "Y"} <= {i.letter for i in block.items if type(i) is Word or type(i) is ExprWord}:
+            self._plane_unsettled = False  # (the program's own block gives both, as the control needs)
 
     def _after_verbatim(self, block: Block, motion: list[Line | Arc]) -> None:
         if self._has_motion_word(block):
@@ -1229,6 +1251,13 @@ def _words(block: Block, facts: _Facts) -> tuple[Word, ...]:
     """The plain words of the block, in order."""
     items = block.items
     return items if len(items) == facts.words else tuple(item for item in items if type(item) is Word)  # type: ignore[return-value]
+
+
+def _turns_plane(before: Context, after: Context) -> bool:
+    """Whether a rotation of the coordinate system, before or after, turned or moved the working plane."""
+    if before.rotation is None and after.rotation is None:
+        return False
+    return before.rotation != after.rotation or before.offset[:2] != after.offset[:2]
 
 
 def reframed(before: Context, after: Context) -> bool:
