@@ -23,7 +23,6 @@ import math
 import re
 import subprocess
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -34,7 +33,7 @@ from ncpp.program.dialects import parse_program
 from tests import rs274
 from tests.compensation.closed_machine import ClosedMachine
 from tests.compensation.test_cutter_comp_accuracy import AFFINE, closed_form
-from tests.compensation.test_dialect_cutter_comp import ZERO, _centre, compensated, machine, offset
+from tests.compensation.test_dialect_cutter_comp import _centre, compensated, machine, offset
 from tests.compensation.tool_centre import deviation, feed_moves
 from tests.conftest import ROOT
 
@@ -142,7 +141,8 @@ def turned(point, centre=CENTRE, angle: float = ANGLE) -> tuple[float, float]:
 def fanuc_contour(text: str) -> tuple[list, tuple]:
     """The moves of a Fanuc program's section from its G41/G42 block to its G40 block (its exit move
     last), turned as the control turns them under G68 (an absolute point about the centre, a G91
-    increment turned and added), and the point the section starts from: the test's own reading."""
+    increment turned and added), and the point the section starts from: the test's own reading (of
+    programs whose first move after G68 gives X and Y, which the control then puts where they say)."""
     at = np.zeros(3)  # the program point where the tool stands (unturned)
     rotation, contour, start, on, motion, absolute = None, [], None, False, 0, True
     for line in text.splitlines():
@@ -164,22 +164,26 @@ def fanuc_contour(text: str) -> tuple[list, tuple]:
             if axis in words:
                 end[k] = words[axis] if absolute else at[k] + words[axis]
         on = on or 41.0 in codes or 42.0 in codes
-        turn = (lambda p: turned(p, *rotation)) if rotation is not None else (lambda p: tuple(p[:2]))  # noqa: E731
         if on and (end != at).any():
-            start = turn(at) if start is None else start
+            start = _under(at, rotation) if start is None else start
             if motion in (0, 1):
-                contour.append((turn(end), None, 0))
+                contour.append((_under(end, rotation), None, 0))
             else:
                 centre = (
                     _centre(at[:2], end[:2], words["R"], motion == 2) if "R" in words
                     else (at[0] + words.get("I", 0.0), at[1] + words.get("J", 0.0))
                 )  # fmt: skip
-                contour.append((turn(end), turn(centre), 1 if motion == 3 else -1))
+                contour.append((_under(end, rotation), _under(centre, rotation), 1 if motion == 3 else -1))
         at = end
         if on and 40.0 in codes:
             break
     assert start is not None
     return contour, start
+
+
+def _under(point, rotation) -> tuple[float, float]:
+    """A program point's X Y as the control puts it under `rotation` ((centre, angle); None: none)."""
+    return (float(point[0]), float(point[1])) if rotation is None else turned(point, *rotation)
 
 
 def _drawn(contour: list) -> list:
@@ -188,7 +192,9 @@ def _drawn(contour: list) -> list:
 
 
 @pytest.mark.parametrize("dialect", ["fanuc", "haas"])
-def test_g41_under_g68_puts_the_tool_centre_on_the_turned_offset_contour_within_half_a_micron(tmp_path, dialect):
+def test_g41_under_g68_puts_the_tool_centre_on_the_turned_offset_contour_within_half_a_micron(
+    tmp_path, dialect
+):
     """The tool centre of the rewritten program (its contour read and offset by the test), run on the
     closed-form machine, is within 0.5 µm of the offset of the turned contour all along, where the
     original's misses it by more than 10 µm; the whole program is compensated.  (The exit leaves along
