@@ -27,6 +27,8 @@ import sys
 import numpy as np
 import pytest
 
+import ncpp.program.dialects.iso
+from ncpp.cli import main
 from ncpp.errors import Warnings
 from ncpp.pipeline import dialect_tools
 from ncpp.program.dialects import parse_program
@@ -34,6 +36,7 @@ from tests import rs274
 from tests.compensation.closed_machine import ClosedMachine
 from tests.compensation.test_cutter_comp_accuracy import AFFINE, closed_form
 from tests.compensation.test_dialect_cutter_comp import _centre, compensated, machine, offset
+from tests.compensation.test_rotation import as_linuxcnc, fanuc_written, turned_twice
 from tests.compensation.tool_centre import deviation, feed_moves
 from tests.conftest import ROOT
 
@@ -75,6 +78,24 @@ def test_g41_under_g10_l2_r_passes_pathcheck_at_twice_the_largest_correction(tmp
     assert len(exits) == 4 and np.delete(missed, exits).max() <= 0.0005
     assert missed[exits].max() <= 0.001
     rs274.pathcheck(program, out, "--tool-table", str(tools), "--tol-mm", f"{2 * largest + 0.01:.4f}")
+
+
+@pytest.mark.parametrize("wrong", [lambda segment: segment, turned_twice], ids=["unturned", "turned-twice"])
+def test_the_verifier_refuses_a_writer_that_gets_the_rotation_wrong_under_compensation(
+    tmp_path, monkeypatch, capsys, wrong
+):
+    """A writer that writes the turned frame's points under compensation (and only there) as the
+    program's words, or turns them the wrong way, is caught by the verifier: nothing is written."""
+    right = ncpp.program.dialects.iso.as_written
+    monkeypatch.setattr(ncpp.program.dialects.iso, "as_written",
+                        lambda segment: (right if segment.centre_shift is None else wrong)(segment))  # fmt: skip
+    (tmp_path / "affine.toml").write_text(AFFINE)
+    program, out = tmp_path / "turned.ngc", tmp_path / "turned.out.ngc"
+    program.write_text(LINUXCNC.split("G55\n")[0] + "M2\n")
+    assert main(["compensate", "--machine", str(tmp_path / "affine.toml"), str(program), "-o", str(out)]) != 0
+    err = capsys.readouterr().err
+    assert "turned.ngc:" in err and "verification" in err, err
+    assert not out.exists()
 
 
 def _exit_corners(moves: list) -> list[int]:
@@ -217,6 +238,22 @@ def test_g41_under_g68_puts_the_tool_centre_on_the_turned_offset_contour_within_
     assert np.allclose(begun, start, atol=0.1) and len(moves) == len(CONTOUR)
     made = offset(moves, RADIUS, begun, depth=-1.0)
     assert deviation(wanted, made, on).max() <= 0.0005
+
+
+def test_g41_under_g68_lands_on_the_original_in_rs274_written_as_linuxcncs_g10_l2_r(tmp_path):
+    """rs274 runs both programs turned into LinuxCNC's (`as_linuxcnc`: each G68 a G55 turned by G10 L2 R,
+    G41 D1 its G41.1 of the diameter G10 L12 gives): along every feed move the rewritten program's tool
+    centre, run on the machine, is within 0.5 µm of the original's; pathcheck accepts it."""
+    program, out = fanuc_written(tmp_path, "fanuc", FANUC)
+    linuxcnc = [tmp_path / "turned.ngc", tmp_path / "turned.out.ngc"]
+    for fanuc, ngc in zip((program, out), linuxcnc):
+        text = fanuc.read_text().replace("G10 L12 P1 R5.\n", "").replace("G41 D1", f"G41.1 D{2 * RADIUS:g}")
+        ngc.write_text(as_linuxcnc(text))
+    before, after = (feed_moves(p, home=tmp_path) for p in linuxcnc)
+    assert sum(m.comp > 0 for m in before) >= 8
+    assert deviation(before, before, closed_form).max() > 0.010
+    assert deviation(before, after, closed_form).max() <= 0.0005
+    rs274.pathcheck(*linuxcnc)
 
 
 # ---- what stays out of scope -------------------------------------------------------------------------
