@@ -55,6 +55,10 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_the_whole_path_under_g68_lands_on_the_original_in_rs274",
             "test_a_parameter_files_rotation_is_followed_as_rs274_follows_it",
         ),
+        "compensation/test_rotated_cutter_comp.py": (
+            "test_g41_under_g10_l2_r_passes_pathcheck_at_twice_the_largest_correction",
+            "test_g41_under_g68_lands_on_the_original_in_rs274_written_as_linuxcncs_g10_l2_r",
+        ),
         "compensation/test_rigid_tap.py": (
             "test_each_tap_runs_on_the_programmed_line_within_half_a_micron",
             "test_the_motor_mount_written_out_cuts_twenty_times_closer",

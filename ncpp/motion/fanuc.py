@@ -400,8 +400,12 @@ class FanucInterpreter(Interpreter):
         Y (absolute) by R degrees counter-clockwise, from the next block on; `G69` cancels it (Fanuc Series
         16/18-MC operator's manual, "Coordinate system rotation"; Haas Mill Operator's Manual, "G68
         Rotation").  The machine stays where it is; the moves after it follow `_settle_rotation`'s rules.
+        Cutter compensation turned on after it and off before G69 offsets the turned contour (the order
+        the Haas training manual "Advanced Haas Mill Programming Techniques", G68, gives: "the G41 or G42
+        commands should be turned on after the G68 rotation is called up and turned off with G40 before
+        the G68 is cancelled with a G69"; `Interpreter._cutter_compensation`).
         Out of scope: another plane, other words in the block, a G68 under G68 or under cutter
-        compensation, a G68 without R or in G91, whose angle a parameter gives or adds to (Fanuc No. 5410
+        compensation (from G41/G42 to the move after G40), a G68 without R or in G91, whose angle a parameter gives or adds to (Fanuc No. 5410
         and, 15i, No. 6400 bit 0; Haas Settings 72 and 73), and one without X or Y: the control then turns
         about where the tool stands, which compensation moves (the program's turned points with it).  X Y R
         may be expressions (`R#21`, `Y[#27/2]`): the manual's words take a macro's values as any word does;
@@ -423,7 +427,7 @@ class FanucInterpreter(Interpreter):
         given = {w.letter: w.value for w in words}
         why = (
             "while a rotation is in effect" if self.g68 is not None
-            else "under cutter compensation" if self.cutter_comp is not None
+            else "under cutter compensation" if self._compensating()
             else "without R (its angle is then a parameter's)" if "R" not in given
             else "in G91 (a parameter makes its R absolute or added)" if not self.absolute
             else "without X and Y (its centre is then where the tool stands, which compensation moves)"
@@ -440,11 +444,14 @@ class FanucInterpreter(Interpreter):
         """`G69`, with N and the modes of other groups that move nothing (`G69_COMPANIONS`: `G69 G94`,
         `G90 G80 G69`) in its block: the rotation cancelled, the machine where it is, then the block's
         modes set as in any block (G69 then cancels nothing).  A G69 with a plane (which the manual
-        forbids under G68), a work offset, a move or any other word is out of scope."""
+        forbids under G68), a work offset, a move or any other word is out of scope; so is one under
+        cutter compensation (from G41/G42 to the move after G40: `_coordinate_rotation`)."""
         other = next((w for w in words if w.letter != "N" and not (w.letter == "G" and w.value in G69_COMPANIONS)),
                      None)  # fmt: skip
         if other is not None:
             raise _OutOfScope(f"G69 with {other.letter}{other.number} in its block", col)
+        if self._compensating():
+            raise _OutOfScope("G69 under cutter compensation", col)
         if self.g68 is not None:
             self._keeping_machine(lambda: setattr(self, "g68", None))
             self.unsettled_rotation = 69.0

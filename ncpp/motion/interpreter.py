@@ -1563,7 +1563,11 @@ class Interpreter:
         (LinuxCNC's manual, G41 G42: "It is an error if the YZ plane is active"), with a lathe
         tool's orientation (the table's Q, G41.1's L) in the XZ plane only.  The
         moves are followed as programmed (`_in_comp`); the radius is what rs274ngc checks
-        them against (`_check_radius`), and a radius of 0 leaves the tool on the path."""
+        them against (`_check_radius`), and a radius of 0 leaves the tool on the path.  Under a
+        rotation about Z (G10 L2 R, Fanuc's G68) in G17: the controls offset the turned contour
+        (Fanuc Series 16/18-MC operator's manual, "Coordinate system rotation": cutter compensation
+        "is performed after the coordinate system is rotated"), whose moves are in the turned frame
+        here, so their tool centre is too; in G18 the offset would turn out of its plane (not followed)."""
         code, item = code_item
         if code == 40.0:
             self.arc_refused = self.arc_refused or self.centre.off_path
@@ -1571,9 +1575,10 @@ class Interpreter:
             return
         if self.plane not in (17, 18):
             self._fail("Cutter radius compensation allowed only in XY, XZ planes", block, item)
-        if self._rotation() is not None:
+        if self.plane != 17 and self._rotation() is not None:
             raise _OutOfScope(
-                f"cutter compensation G{code:g} under a coordinate system rotation", item.start + 1
+                f"cutter compensation G{code:g} in G{self.plane} under a coordinate system rotation",
+                item.start + 1,
             )
         d = words.get("D")
         if code in (41.1, 42.1):
@@ -1659,8 +1664,29 @@ class Interpreter:
             raise _OutOfScope("coordinate system rotation G10 R", words["R"][1].start + 1)
         if self._rotation() is not None:
             self._check_turned(words, gcodes)
+        turning = self._turns_again(words, gcodes) if self.centre.off_path else None
+        if turning is not None:
+            raise _OutOfScope("a rotation of the coordinate system before the move that ends cutter compensation",
+                              turning.start + 1)  # fmt: skip
         if any(self.g92[:2]) and (self.rotations or (g10 and words.get("R", (0.0,))[0])):
             self._check_reframed(words, gcodes)
+
+    def _turns_again(self, words: dict, gcodes: dict) -> Word | ExprWord | None:
+        """The word of the block that changes the rotation in effect (None: none does): a G10 L2 R of
+        the system in effect, or another system selected that is turned otherwise (the tool centre's
+        offset from the path, in the old turned frame, would be carried into the new one: not followed)."""
+        now = self.rotations.get(self.coord_system, 0.0)
+        code, item = gcodes.get(0, (None, None))
+        if (
+            code == 10.0
+            and self.rotating_g10
+            and words["L"][0] == 2.0
+            and round(words.get("P", (0.0,))[0]) in (0, self.coord_system)
+            and words.get("R", (now,))[0] != now
+        ):
+            return item
+        selected = _COORD_SYSTEM[gcodes[12][0]] if 12 in gcodes else None
+        return gcodes[12][1] if selected is not None and self.rotations.get(selected, 0.0) != now else None
 
     def _check_reframed(self, words: dict, gcodes: dict) -> None:
         """rs274ngc puts the program position after a new zero or rotation of the system in effect (G10
