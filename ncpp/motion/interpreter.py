@@ -455,7 +455,7 @@ class Interpreter:
             self.g5x[n] = [*offsets.zero(n), *[0.0] * 6]
         self.coord_system = offsets.active
         self.g92[:3] = offsets.g92
-        self.g92_saved = self.g92[:]
+        self.g92_saved[:3] = offsets.g92_saved
         self.home[28][:3], self.home[30][:3] = offsets.g28, offsets.g30
         self.untold = {n for n in range(1, 10) if not offsets.told(n)}
         if self.rotating_g10:  # (a Fanuc control's #5230 is an axis of G54, no rotation)

@@ -78,6 +78,7 @@ class WorkOffsets:
     systems: tuple[Vector | None, ...] = (None,) * 9
     active: int = 1
     g92: Vector = (0.0, 0.0, 0.0)
+    g92_saved: Vector = (0.0, 0.0, 0.0)  # what G92.3 restores: LinuxCNC's #5211-#5213, applied or not
     g28: Vector = (0.0, 0.0, 0.0)
     g30: Vector = (0.0, 0.0, 0.0)
     tools: ToolTable | None = None
@@ -104,13 +105,14 @@ class WorkOffsets:
         values = {number: value for number, (value, _) in entries.items()}
         systems = tuple(_from_var(values, _system_x(n), unit_mm) for n in range(1, 10))
         active = int(values.get(_ACTIVE_SYSTEM, 1.0) + 0.0001)
-        g92 = _from_var(values, _G92_X, unit_mm) if values.get(_G92_ON) == 1.0 else None
         zero = (0.0, 0.0, 0.0)
+        saved = _from_var(values, _G92_X, unit_mm) or zero  # (G92.2 leaves them, G92.3 applies them)
+        g92 = saved if values.get(_G92_ON) == 1.0 else zero
         homes = (_from_var(values, _G28_X, unit_mm) or zero, _from_var(values, _G30_X, unit_mm) or zero)
         lines = {number: line for number, (_, line) in entries.items()}
         additional = _additional_from_var(values, unit_mm, str(path), lines)
         rotations = tuple(values.get(_system_x(n) + _ROTATION_AFTER_X, 0.0) for n in range(1, 10))
-        return cls(systems, active if 1 <= active <= 9 else 1, g92 or zero, *homes, additional=additional,
+        return cls(systems, active if 1 <= active <= 9 else 1, g92, saved, *homes, additional=additional,
                    rotations=rotations)  # fmt: skip
 
     @classmethod
