@@ -68,8 +68,9 @@ class WorkOffsets:
     """The zeros the control holds: per coordinate system (1..9: G54..G59.3) its
     machine position in mm, None when ncpp is not told it, and so per additional work
     offset (`additional`: 1, 2 ..., system ADDITIONAL + n); the system in effect at
-    the program's start; the G92 offset in effect; the G28 and G30 positions; its
-    tool table (None: not told, G43 applies length 0); per system its rotation about Z
+    the program's start; the G92 offset in effect and the saved one (G92.3 applies it);
+    the G28 and G30 positions; its tool table (None: not told, G43 applies length 0); per
+    system its rotation about Z
     (LinuxCNC's G10 L2 R, degrees: `rotations`); and the folders it finds
     subroutine files in (LinuxCNC's [RS274NGC]SUBROUTINE_PATH: `o<name> call` of a
     subroutine the program does not define runs `name.ngc`; Fanuc's, Sinumerik's and
