@@ -39,6 +39,21 @@ start (with the system number) is written only where the program may rely on the
 effect before it selects one: not where its first lines, of settings alone (modal G codes,
 T M S F H D words, G28/G30, G53, G10 L2 P1-P9), select one (`_iso_selects_first`).
 
+A LinuxCNC program's G92 that sets the offset of an axis the program has not positioned yet sets it
+from where the operator left the tool (`G92 X0 Y0 Z0` at the top of a hobby program), which ncpp
+takes to be the program's zero: the writer tells the axes (`IsoWriter.unplaced_setting`), and a
+check after the block stops the program when #5211-#5213, the G92 offset X Y Z (G-code manual,
+"Numbered Parameters": #5210 1 while a G52/G92 offset is applied, #5211-#5219 its axes, in the
+machine's units, set by the G92 as rs274 runs it), is not the one ncpp compensated for within
+`GUARD_MM` on those axes (`g92_lines`).  The offset does not depend on the one in effect before:
+rs274ngc makes the block's point the tool's, whatever the old offset.  A G92.3 (G-code manual,
+"G92.3 Restore G92 Offsets": the offset of #5211-#5219) gets the check of X Y Z: the saved offset
+comes from the parameter file (`WorkOffsets.g92_saved`) or the program's last G92, and a control
+may hold another.  G92.1 and G92.2 set no offset from the control's state (zero), G52 the values
+it names: no check.  Fanuc and Haas programs keep the warning alone: no variable of the G92 shift
+is cited here from their manuals (Haas Mill Operator's Manual, "Macros", offsets: #5201-#5205 G52,
+#5221-#5225 G54 ..., #7001-#7005 G110 ..., no G92).
+
 * Sinumerik (840D sl System Variables parameter manual: `$P_UIFRNUM`, the number of the
   active settable frame, 1-4 for G54-G57; `$P_UIFR[n, axis, TR]` and `[n, axis, FI]`, its
   coarse and fine translation; Job Planning manual: `MSG("text")` shows the text, `SETAL(n)`
@@ -628,7 +643,9 @@ class PlacementChecks:
     """The placement guard's check of the zero of each told system an ISO program selects, once,
     before the first block that selects it (the writer's `before`): the interpreter marks the
     block (`Pass.zero_told`) where it runs once and the zero is still the one told.  LinuxCNC's
-    syntax, or Fanuc's (Haas's) in a Fanuc program (a program number at its top)."""
+    syntax, or Fanuc's (Haas's) in a Fanuc program (a program number at its top).  In LinuxCNC's,
+    the G92 offset too, after a G92 that sets it on axes the program has not positioned (the
+    writer tells them: `unplaced`) and after a G92.3 (`after`, the interpreter's `Pass.g92_told`)."""
 
     def __init__(
         self,
@@ -640,6 +657,9 @@ class PlacementChecks:
         self.offsets, self.dialect, self.unit_mm, self.unguarded = offsets, dialect, unit_mm, unguarded
         self.looked = 0  # blocks looked at for a Fanuc program number
         self.checked: set[int] = set()
+        self.labels = 0  # the checks written so far (each `if` a label of its own)
+        self.g92: Pass | None = None  # the G92 or G92.3 mark of the block being written (`Pass.g92_told`)
+        self.unplaced_axes: set[int] = set()  # the axes of its G92 the program has not positioned
 
     def __call__(self, events: list[Event]) -> list[str]:
         block = events[0].block
@@ -647,17 +667,75 @@ class PlacementChecks:
             self.looked += 1
             if _program_number(block.items):
                 self.dialect = "fanuc"
+        self.g92 = next((e for e in events if type(e) is Pass and e.g92_told), None)
+        self.unplaced_axes = set()
         number = next((e.zero_told for e in events if type(e) is Pass and e.zero_told is not None), None)
         if number is None or number in self.checked:
             return []
         self.checked.add(number)
         placement = Placement.of_system(self.offsets, number, self.unit_mm)
         dialect = "linuxcnc" if self.dialect == "iso" else self.dialect
-        lines = guard_lines(placement, dialect, selected=True, label=len(self.checked))
+        self.labels += 1
+        lines = guard_lines(placement, dialect, selected=True, label=self.labels)
         if not lines:
             self.unguarded(f"{dialect} has no variables of {placement.name}'s zero")
         eol = block.eol or "\n"
         return [line + eol for line in lines]
+
+    def unplaced(self, axes: Iterable[str], block: Block) -> bool:
+        """The writer's word that the G92 (or G10 L20) `block` sets the offset of `axes` (X Y Z)
+        from where the control stands, which the program has not positioned: whether a check after
+        the block stops the program where the G92 offset it sets differs (LinuxCNC's, not the last line)."""
+        mark = self.g92
+        if mark is None or mark.block is not block or self.dialect != "iso" or not block.eol:
+            return False
+        told = {axis for axis, _ in mark.g92_told or ()}
+        self.unplaced_axes = {"XYZ".index(axis) for axis in axes} & told
+        return bool(self.unplaced_axes)
+
+    def after(self, events: list[Event]) -> list[str]:
+        """The check of the G92 offset after the block (the writer's `after`): after a G92, of the
+        axes `unplaced` told; after a G92.3, of X Y Z."""
+        mark, self.g92 = self.g92, None
+        if mark is None or mark.g92_told is None or self.dialect != "iso" or not events[0].block.eol:
+            return []
+        restored = not any(type(e) is Pass and e.setting is not None for e in events)
+        offset = [(axis, mm) for axis, mm in mark.g92_told if restored or axis in self.unplaced_axes]
+        if not offset:
+            return []
+        self.labels += 1
+        return [line + events[0].block.eol for line in g92_lines(offset, self.unit_mm, self.labels, restored)]
+
+
+def g92_lines(
+    offset: Iterable[tuple[int, float]], unit_mm: float, label: int, restored: bool = False
+) -> list[str]:
+    """LinuxCNC's check (without line ends), after a G92 block or a G92.3 (`restored`), that the G92
+    offset of each axis (0-2: X Y Z; mm) is the one told within GUARD_MM: #5211-#5213 hold it in the
+    machine's units (`unit_mm` mm each); `label` numbers the check's `if`."""
+    values = [("XYZ"[axis], 5211 + axis, _number(mm / unit_mm)) for axis, mm in offset]
+    told = f"the G92 offset {' '.join(letter + value for letter, _, value in values)} {_units(unit_mm)}"
+    tolerance = _number(GUARD_MM / unit_mm)
+    far = " OR ".join(f"[ABS[#{key} {_less(value, ' ')}] GT {tolerance}]" for _, key, value in values)
+    found = " ".join(f"{letter}#{key}" for letter, key, _ in values)
+    name = f"o<ncpp_guard_{label}>"
+    if restored:  # (the messages stay short: rs274ngc reads lines of up to 255 characters)
+        how, then = (
+            "restored by G92.3",
+            f"the control restored {found}: compensate again with its parameter file",
+        )
+    else:
+        how = "set with the tool at the program's zero"
+        then = (
+            f"this G92 set {found}: jog the tool to that zero first, or compensate again for where it stands"
+        )
+    return [
+        f"({BEGIN} {told} {how} within {_number(GUARD_MM)} mm)",
+        f"{name} if [{far}]",
+        f"(abort, ncpp: compensated for {told} {how}; {then})",
+        f"{name} endif",
+        f"({END})",
+    ]
 
 
 def tool_guard_lines(tool: int, length_mm: float, unit_mm: float, label: int) -> list[str]:

@@ -483,11 +483,11 @@ def process(
         f"{axes} not positioned by the program yet: the correction along {axes} of this feed move and "
         "the next compensated moves is left out until the program positions them (a word written here "
         "would move the axis from wherever the control has it)", Location(file, block.line, None))  # fmt: skip
-    writer.unplaced_setting = lambda axes, block: warnings.warn(
-        f"this block sets its offset from where the control stands, and the program has not positioned "
-        f"{axes} yet: ncpp compensates the moves after it as if the tool stood at the program's zero there "
-        "(the work offset's zero); jog it there before the program runs, or set the zero as a work offset "
-        "(G10 L20, touch-off) and compensate for it", Location(file, block.line, None))  # fmt: skip
+    checks = (  # the zeros of the told systems it selects, and the G92 offsets it sets (LinuxCNC's)
+        PlacementChecks(offsets, name, guard.unit_mm, lambda why: warnings.warn(
+            f"no placement guard: {why}", Location(file, 1, None))) if guard is not None and name in ISO_SYNTAX else None
+    )  # fmt: skip
+    writer.unplaced_setting = lambda axes, block: _warn_unplaced(axes, block, checks, warnings, file)
     writer.unstepped = lambda block: warnings.warn(
         "this line runs a loop or subroutine in which interpretation ends, after a compensated move, in a mode "
         "other than G0 or G1 (an arc's, a canned cycle's), which a step back to the programmed point would change: "
@@ -500,17 +500,18 @@ def process(
     ctx = make_context(source, tolerance, warnings, file)
     compensated = reached.follow(summary.written(run_passes(summary.programmed(events), ctx, PASSES)))
     header = header_text(source, tolerance, offsets, name)
-    checks = guard is not None and name in ISO_SYNTAX  # the zeros of the told systems it selects
-    before: Callable[[list[Event]], list[str]] | None = PlacementChecks(offsets, name, guard.unit_mm, lambda why: warnings.warn(  # type: ignore[union-attr]
-        f"no placement guard: {why}", Location(file, 1, None))) if checks else None  # fmt: skip
+    before: Callable[[list[Event]], list[str]] | None = checks
+    behind: Callable[[list[Event]], list[str]] | None = after
     if after is not None:  # (and the tool parameters a block reads, checked before it)
-        before = _both(before, after.before) if before is not None else after.before
-    lines = with_header(writer.write(compensated, after, before), header, writer, get_dialect(name).leader)
+        before = _both(checks, after.before) if checks is not None else after.before
+    if checks is not None:
+        behind = _both(checks.after, after) if after is not None else checks.after
+    lines = with_header(writer.write(compensated, behind, before), header, writer, get_dialect(name).leader)
     if guard is not None:
         said = replace(guard, dialect=name).said()  # (as the program's dialect names the system)
         lines = with_guard(lines, guard, name, HEADER_TAG, header.count("\n") + 1,
                            lambda why: warnings.warn(f"no placement guard: {why}; make sure the control has {said} "
-                                                     "before the program runs", Location(file, 1, None)), checks, main)  # fmt: skip
+                                                     "before the program runs", Location(file, 1, None)), checks is not None, main)  # fmt: skip
     if verify:
         from ncpp.verify import Bound, verified
 
@@ -539,8 +540,25 @@ def process(
 def _both(
     first: Callable[[list[Event]], list[str]], then: Callable[[list[Event]], list[str]]
 ) -> Callable[[list[Event]], list[str]]:
-    """The writer's `before` of two guards: the lines of `first`, then those of `then`."""
+    """The writer's `before` or `after` of two guards: the lines of `first`, then those of `then`."""
     return lambda events: [*first(events), *then(events)]
+
+
+def _warn_unplaced(
+    axes: list[str], block: Block, checks: PlacementChecks | None, warnings: Warnings, file: str
+) -> None:
+    """The warning of a G92 / G10 L20 that sets the offset of `axes`, which the program has not
+    positioned, from where the control stands; it says whether the placement guard checks it."""
+    checked = checks is not None and checks.unplaced(axes, block)
+    then = (
+        "; the placement guard's check after it stops the program where the G92 offset it sets differs from that"
+        if checked else ""
+    )  # fmt: skip
+    warnings.warn(
+        f"this block sets its offset from where the control stands, and the program has not positioned "
+        f"{' and '.join(axes)} yet: ncpp compensates the moves after it as if the tool stood at the program's "
+        f"zero there (the work offset's zero){then}; jog it there before the program runs, or set the zero as a "
+        "work offset (G10 L20, touch-off) and compensate for it", Location(file, block.line, None))  # fmt: skip
 
 
 def _tool_guard(dialect: str, offsets: WorkOffsets, warnings: Warnings, file: str) -> ToolGuard | None:

@@ -93,6 +93,13 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_rs274_runs_the_program_with_the_told_table_and_stops_at_a_length_that_differs",
             "test_rs274_stops_before_the_first_cut_that_reads_a_diameter_that_differs",
         ),
+        "shop/test_g92_guard.py": (
+            "test_rs274_runs_a_g92_program_where_the_tool_stands_at_the_zero_told_and_stops_it_where_not",
+            "test_rs274_checks_only_the_axes_the_program_had_not_positioned",
+            "test_rs274_checks_a_g92_made_under_a_g92_offset_of_the_parameter_file",
+            "test_rs274_checks_the_offset_a_g92_3_restores",
+            "test_the_interpreter_applies_the_saved_offset_at_g92_3_as_rs274_does",
+        ),
         "shop/test_guard.py": (
             "test_rs274_runs_a_program_that_selects_its_system_whatever_system_the_control_was_left_in",
             "test_rs274_stops_a_program_before_a_system_it_selects_later_whose_zero_moved",

@@ -455,7 +455,7 @@ class Interpreter:
             self.g5x[n] = [*offsets.zero(n), *[0.0] * 6]
         self.coord_system = offsets.active
         self.g92[:3] = offsets.g92
-        self.g92_saved = self.g92[:]
+        self.g92_saved[:3] = offsets.g92_saved
         self.home[28][:3], self.home[30][:3] = offsets.g28, offsets.g30
         self.untold = {n for n in range(1, 10) if not offsets.told(n)}
         if self.rotating_g10:  # (a Fanuc control's #5230 is an axis of G54, no rotation)
@@ -1335,12 +1335,22 @@ class Interpreter:
         if 2.0 in mcodes or 30.0 in mcodes:
             self._program_end()
         self._update_fast()
-        marks = [Pass(block, zero_told=selected)] if selected in self.told_zeros else []
+        marks = [Pass(block, g92_told=self._g92_told(mode0, words))] if mode0 in (92.0, 92.3) else []
+        if selected in self.told_zeros:
+            marks.append(Pass(block, zero_told=selected))
         if told is not None:
             marks.append(Pass(block, length_told=told))
         if marks:
             return _marked(events, marks)
         return Pass(block) if events is None else events
+
+    def _g92_told(self, code: float, words: dict) -> tuple[tuple[int, float], ...]:
+        """The G92 offset after a G92 on the axes X Y Z it names, or after a G92.3 on X Y Z, in mm
+        (`Pass.g92_told`)."""
+        scale = MM_PER_INCH if self.inch else 1.0
+        return tuple(
+            (i, self.g92[i] * scale) for i, letter in enumerate("XYZ") if code == 92.3 or letter in words
+        )
 
     # -- checks (interp_check.cc, enhance_block) ----------------------------------------
     def _motion_to_be(self, block, mode0, mode1, mode1_item, axis_item, polar_item=None) -> float | None:
@@ -2784,9 +2794,9 @@ _PLAIN_LETTERS = {
 
 
 def _marked(events: Event | tuple[Event, ...] | None, marks: list[Pass]) -> Event | tuple[Event, ...]:
-    """A block's events with the guards' marks (`Pass.zero_told`, then `Pass.length_told`, which
-    the tool guard looks for last) after them (the first event stays the one that says how the
-    block is written)."""
+    """A block's events with the guards' marks (`Pass.g92_told`, `Pass.zero_told`, then
+    `Pass.length_told`, which the tool guard looks for last) after them (the first event stays the
+    one that says how the block is written)."""
     if events is None:
         return marks[0] if len(marks) == 1 else tuple(marks)
     return (*(events if type(events) is tuple else (events,)), *marks)
@@ -2812,7 +2822,7 @@ def _as_programmed(ev: Event, owner: Block | None) -> Event | None:
     in the text's place (None: not there)."""
     if type(ev) is Pass:
         ev.length_told = ev.tool_read = None  # (the text runs again, or elsewhere, perhaps with another tool)
-        ev.zero_told = None  # (and perhaps after the program set the zero)
+        ev.zero_told = ev.g92_told = None  # (and perhaps after the program set the zero, or the G92 offset)
         return ev if owner is None and not _expanding(ev) else None  # (a cycle there stays one)
     if ev.fixed in (HOLE, CYCLE):  # type: ignore[union-attr]
         # each run may need a correction of its own: the cycle is left as programmed; in a

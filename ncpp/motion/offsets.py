@@ -68,8 +68,9 @@ class WorkOffsets:
     """The zeros the control holds: per coordinate system (1..9: G54..G59.3) its
     machine position in mm, None when ncpp is not told it, and so per additional work
     offset (`additional`: 1, 2 ..., system ADDITIONAL + n); the system in effect at
-    the program's start; the G92 offset in effect; the G28 and G30 positions; its
-    tool table (None: not told, G43 applies length 0); per system its rotation about Z
+    the program's start; the G92 offset in effect and the saved one (G92.3 applies it);
+    the G28 and G30 positions; its tool table (None: not told, G43 applies length 0); per
+    system its rotation about Z
     (LinuxCNC's G10 L2 R, degrees: `rotations`); and the folders it finds
     subroutine files in (LinuxCNC's [RS274NGC]SUBROUTINE_PATH: `o<name> call` of a
     subroutine the program does not define runs `name.ngc`; Fanuc's, Sinumerik's and
@@ -78,6 +79,7 @@ class WorkOffsets:
     systems: tuple[Vector | None, ...] = (None,) * 9
     active: int = 1
     g92: Vector = (0.0, 0.0, 0.0)
+    g92_saved: Vector = (0.0, 0.0, 0.0)  # what G92.3 restores: LinuxCNC's #5211-#5213, applied or not
     g28: Vector = (0.0, 0.0, 0.0)
     g30: Vector = (0.0, 0.0, 0.0)
     tools: ToolTable | None = None
@@ -104,13 +106,14 @@ class WorkOffsets:
         values = {number: value for number, (value, _) in entries.items()}
         systems = tuple(_from_var(values, _system_x(n), unit_mm) for n in range(1, 10))
         active = int(values.get(_ACTIVE_SYSTEM, 1.0) + 0.0001)
-        g92 = _from_var(values, _G92_X, unit_mm) if values.get(_G92_ON) == 1.0 else None
         zero = (0.0, 0.0, 0.0)
+        saved = _from_var(values, _G92_X, unit_mm) or zero  # (G92.2 leaves them, G92.3 applies them)
+        g92 = saved if values.get(_G92_ON) == 1.0 else zero
         homes = (_from_var(values, _G28_X, unit_mm) or zero, _from_var(values, _G30_X, unit_mm) or zero)
         lines = {number: line for number, (_, line) in entries.items()}
         additional = _additional_from_var(values, unit_mm, str(path), lines)
         rotations = tuple(values.get(_system_x(n) + _ROTATION_AFTER_X, 0.0) for n in range(1, 10))
-        return cls(systems, active if 1 <= active <= 9 else 1, g92 or zero, *homes, additional=additional,
+        return cls(systems, active if 1 <= active <= 9 else 1, g92, saved, *homes, additional=additional,
                    rotations=rotations)  # fmt: skip
 
     @classmethod

@@ -299,6 +299,10 @@ class Pass:
     # (the tool in the spindle, the parameter, its value in the table's units or degrees), which the
     # tool guard checks before the block
     tool_read: tuple[tuple[int, int, float], ...] | None = None
+    # a block that sets the G92 offset from where the control stands (G92) or restores the saved one
+    # (G92.3): (axis 0-2, the offset after the block in mm) for the axes it sets, X Y Z for G92.3,
+    # which the placement guard checks after the block
+    g92_told: tuple[tuple[int, float], ...] | None = None
 
 
 Segment = Line | Arc

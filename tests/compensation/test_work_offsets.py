@@ -156,6 +156,7 @@ def test_linuxcnc_parameter_file(tmp_path):
     assert offsets.zero(1) == (250.0, 300.0, 300.0) and offsets.zero(2) == (550.0, 400.0, 250.0)
     assert offsets.active == 2 and offsets.program_zero() == (550.0, 400.0, 250.0)
     assert offsets.g92 == (0.0, 0.0, 0.0)  # 5210 = 0: G92 not in effect
+    assert offsets.g92_saved == (5.0, 0.0, 0.0)  # (what G92.3 applies)
     assert offsets.g28 == (0.0, 0.0, 600.0) and not offsets.told(3)
     inch = WorkOffsets.from_var_file(path, 25.4)
     assert inch.zero(2) == pytest.approx((550.0 * 25.4, 400.0 * 25.4, 250.0 * 25.4))

@@ -282,8 +282,8 @@ class IsoWriter:
         self.unpositioned: Callable[[str, Block], None] | None = None
         self._told_unpositioned: set[str] = set()
         # told of a G92 / G10 L20 that sets its offset from axes X Y Z the program has not positioned
-        # yet: from where the control stands, which ncpp takes to be its assumed start ("X and Y")
-        self.unplaced_setting: Callable[[str, Block], None] | None = None
+        # yet: from where the control stands, which ncpp takes to be its assumed start (["X", "Y"])
+        self.unplaced_setting: Callable[[list[str], Block], None] | None = None
         # told of a loop or call in which interpretation ends (it may set an offset from where the control
         # stands), after a compensated move, in a mode (G2/G3, a cycle) a step back would change
         self.unstepped: Callable[[Block], None] | None = None
@@ -387,7 +387,7 @@ class IsoWriter:
             return
         unplaced = sorted({AXES[i] for i, _ in setting.values} - self.known_axes)
         if unplaced:
-            self.unplaced_setting(" and ".join(unplaced), block)
+            self.unplaced_setting(unplaced, block)
 
     def _write_group(self, group: list[Event]) -> Iterable[str]:
         """The lines of one block's events (a list: cheaper than a generator per block)."""
