@@ -440,7 +440,9 @@ class Bound:
 
     @property
     def coarse(self) -> float:
-        """The spacing of the points candidate segments are looked up by (`_Nearby`)."""
+        """The spacing of the points candidate segments are looked up by (`_Nearby`), at least 0.25 mm
+        (at a spacing much wider than the bound, short segments lying over one another, the reversal
+        steps of a helix of many turns, crowd out the segments within the bound of a point)."""
         return max(4 * self.distance, 0.25)
 
 
