@@ -1710,7 +1710,7 @@ class Interpreter:
         other = l_number == 11.0 or (
             l_number == 20.0 and round(words.get("P", (0.0,))[0]) not in (0, self.coord_system)
         )
-        if other and self.motion not in (0.0, 1.0):
+        if other and (self.motion not in (0.0, 1.0) or not self.rotating_g10):  # (LinuxCNC's: from the point)
             return None
         if l_number != 10.0 and any(self.g92[:2]):
             return None
