@@ -18,7 +18,7 @@ from dataclasses import dataclass, field, replace
 from itertools import chain, count, islice, tee
 from operator import itemgetter
 from pathlib import Path
-from typing import BinaryIO
+from typing import TYPE_CHECKING, BinaryIO
 
 import numpy as np
 
@@ -31,7 +31,7 @@ from ncpp.motion.offsets import AT_MACHINE_ZERO, WorkOffsets
 from ncpp.motion.once import OnceRuns
 from ncpp.motion.segments import COMP, CYCLE, DRILLED, FLOW, HOLE, PATTERN, Arc, Event, Line, Pass
 from ncpp.passes import PASSES, PassContext, run_passes
-from ncpp.passes.context import ErrorMap, is_directional
+from ncpp.passes.context import Corrections, ErrorMap, is_directional
 from ncpp.passes.inverse import iterations_for
 from ncpp.program.blocks import STRAY_TAPE, Block, Comment, Statement, Word
 from ncpp.program.dialects import FAMILY, dialect_tools, get_dialect, parse_program
@@ -39,6 +39,9 @@ from ncpp.program.dialects.iso import IsoWriter
 from ncpp.program.parser import LEADER_LINES
 from ncpp.runtime import keep_freed_memory
 from ncpp.summary import Summary
+
+if TYPE_CHECKING:
+    from ncpp.verify import Following
 
 HEADER_TAG = "ncpp compensated"  # (lower case: `header_comment` finds it in any case)
 HEADER_SCAN = 30  # blocks at the top searched for an earlier header, and on while only comments follow
@@ -368,8 +371,15 @@ def with_header(lines: Iterable[str], header: str, writer: IsoWriter, leader: bo
 INVERSE_BUDGET = 0.000025
 
 
-def make_context(source: ErrorSource, tolerance: float, warnings: Warnings, file: str) -> PassContext:
-    """The pass context every front end (filter, compensate, post) compensates with."""
+def make_context(
+    source: ErrorSource,
+    tolerance: float,
+    warnings: Warnings,
+    file: str,
+    corrections: Corrections | None = None,
+) -> PassContext:
+    """The pass context every front end (filter, compensate, post) compensates with; `corrections`:
+    where the largest correction made is noted (the verifier's bound follows it, `verify_bound`)."""
     return PassContext(
         model=source.model,
         tolerance=tolerance,
@@ -381,7 +391,17 @@ def make_context(source: ErrorSource, tolerance: float, warnings: Warnings, file
         iterations=iterations_for(source.model, source.limits, INVERSE_BUDGET),
         warnings=warnings,
         file=file,
+        corrections=corrections if corrections is not None else Corrections(),
     )
+
+
+def verify_bound(source: ErrorSource, tolerance: float, corrections: Corrections) -> Following:
+    """How far the written path may lie from the input's as a run goes on: the largest correction
+    compensation has made so far (`geometry.compensate`) plus the tolerance; never more than the
+    machine file's `max_correction_mm` plus the tolerance."""
+    from ncpp.verify import Following
+
+    return Following(source.max_correction + tolerance, tolerance, lambda: corrections.largest)
 
 
 def process(
@@ -513,10 +533,10 @@ def process(
                            lambda why: warnings.warn(f"no placement guard: {why}; make sure the control has {said} "
                                                      "before the program runs", Location(file, 1, None)), checks is not None, main)  # fmt: skip
     if verify:
-        from ncpp.verify import Bound, verified
+        from ncpp.verify import verified
 
         lines = verified(lines, reached, original, file=file, dialect=name, offsets=offsets, runs=runs,
-                         bound=Bound(source.max_correction + tolerance))  # fmt: skip
+                         bound=verify_bound(source, tolerance, ctx.corrections))  # fmt: skip
     lines = iter(lines)
     # (a number past a float's range, such as a tool 1e308 mm long, becomes inf or NaN, which the
     # checks before writing refuse with its line: numpy's warnings on the way would say it first, unlocated)

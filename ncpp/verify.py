@@ -1,9 +1,9 @@
 """The verifier: a written program must do what the program it was made from does.
 
-Compensation moves every point of a path by at most the machine file's
-`max_correction_mm`.  Before a rewritten program leaves ncpp, the verifier
-reads the written text back with a fresh parser and interpreter (nothing of
-the passes' state) and compares it with the input program's motion:
+Compensation moves each point of a path by the correction the machine's errors ask
+for there.  Before a rewritten program leaves ncpp, the verifier reads the written
+text back with a fresh parser and interpreter (nothing of the passes' state) and
+compares it with the input program's motion:
 
 * the same actions in the same order: tool changes and length offsets,
   spindle, coolant, dwells, stops, other M codes, Klartext's TOOL CALL and
@@ -16,6 +16,14 @@ the passes' state) and compares it with the input program's motion:
 * rapids where the input rapids and feeds where it feeds, at the same feed
   rates in the same order; in inverse time (G93) the pieces of a move take
   its time together.
+
+The bound of a compensating run (`Following`) is the largest correction compensation
+has made so far in the program (noted where every command is computed,
+`geometry.compensate`), plus the tolerance and the written numbers' rounding, and
+never more than the machine file's `max_correction_mm` plus the tolerance: a move
+the compensation did not ask for lies further off.  It is read as each section is
+compared, once the written program's lines of it are read back (the passes have
+made their corrections), and the section is sampled then.
 
 Paths are compared in machine coordinates (mm, tool length and work offsets
 applied) as straight segments, arcs in chords within an eighth of the bound:
@@ -105,10 +113,10 @@ NO_EXTRA = (0.0,) * len(EXTRA_AXES)
 
 @dataclass
 class _Moves:
-    """Moves collected for one section, sampled when it closes (in flat lists: a move's own work
-    is a few appends, and one array is made of each list)."""
+    """Moves collected for one section (in flat lists: a move's own work is a few appends, and
+    one array is made of each list), sampled when the comparison takes it (`sample`), with the
+    bound as it stands then."""
 
-    bound: Bound
     points: list = field(default_factory=list)  # per move x0 y0 z0 x1 y1 z1, program coordinates
     lines: list = field(default_factory=list)  # per move the line its samples are told by
     frames: list = field(default_factory=list)  # (first move, context) where the context changes
@@ -121,15 +129,19 @@ class _Moves:
     feed: float = math.nan  # the last feed move's F and units (a new one is looked at)
     feed_inch: bool = False
     inverse_time: float = 0.0
+    action: Action | None = None  # the action that ends the section (None: a cut, or the program's end)
+    first_line: int = 1
+    cut: Position | None = None  # a chunk's end, where the next chunk starts (None: not a chunk)
 
-    def chunk(self, cut: Position, first_line: int) -> Section:
-        """The moves sampled as a chunk that ends where the next starts, at `cut`."""
-        section = self.sample(None, first_line)
-        section.cut = cut
-        return section
+    def closed(self, action: Action | None, first_line: int, cut: Position | None = None) -> _Moves:
+        """The moves, told the action that ends them (or the `cut` of a chunk) and their first line."""
+        self.action, self.first_line, self.cut = action, first_line, cut
+        return self
 
-    def sample(self, action: Action | None, first_line: int) -> Section:
-        """The moves sampled every `step` (each from its start to its end, both included)."""
+    def sample(self, bound: Bound) -> Section:
+        """The moves as segments, arcs in chords within `bound.chord` (each move from its start to
+        its end, both included)."""
+        action, first_line = self.action, self.first_line
         if not self.lines:
             empty = np.zeros((0, 4))
             return Section(
@@ -141,6 +153,7 @@ class _Moves:
                 self.inverse_time,
                 action,
                 first_line,
+                self.cut,
             )
         raw = np.array(self.points, dtype=float).reshape(-1, 2, 3)  # (move, its start and end, X Y Z)
         firsts = [first for first, _ in self.frames]
@@ -163,7 +176,7 @@ class _Moves:
             axes = np.repeat([PLANE_AXES[f.plane][:2] for _, f in self.frames], spans, axis=0)
             arcs = _Arcs(self.arcs, self.centres, axes, starts, ends, offsets, units)
         if arcs is not None:
-            counts[arcs.move] = arcs.chords(self.bound.chord)
+            counts[arcs.move] = arcs.chords(bound.chord)
             # (the section's samples are held at once; a move's chords are rounded up, so the pieces a
             # written program makes of an arc take up to one more each than the arc)
             if counts.sum() > MAX_CHORDS + len(counts):
@@ -188,13 +201,13 @@ class _Moves:
             arcs.bend(begins, move, t)
         rapid = np.zeros(len(counts), dtype=bool)
         rapid[self.rapids] = True
-        begins[:, width] = rapid[move] * self.bound.apart
+        begins[:, width] = rapid[move] * bound.apart
         finish = np.empty_like(begins)
         finish[:-1] = begins[1:]
         finish[last, :width] = ends
         finish[last, width] = begins[last, width]
         return Section(begins, finish, rapid[move], np.array(self.lines)[move], self.feeds, self.inverse_time,
-                       action, first_line)  # fmt: skip
+                       action, first_line, self.cut)  # fmt: skip
 
 
 class _Arcs:
@@ -250,14 +263,14 @@ def _sweeps(a0: np.ndarray, a1: np.ndarray, turn: np.ndarray) -> np.ndarray:
 Cut = Callable[[Block, int, int, int], Position | None]
 
 
-def sections(events: Iterable[Event], bound: Bound, cut: Cut = lambda block, moves, run, into: None,
+def sections(events: Iterable[Event], cut: Cut = lambda block, moves, run, into: None,
              line_of: Callable[[int], int] | None = None,
-             divisible: Callable[[Event], bool] | None = None) -> Iterator[Section]:  # fmt: skip
-    """The motion of a program's events between its actions, in the order it runs; a chunk
+             divisible: Callable[[Event], bool] | None = None) -> Iterator[_Moves]:  # fmt: skip
+    """The motion of a program's events between its actions (unsampled), in the order it runs; a chunk
     ends before a block where `cut` says, or every `CHUNK_MOVES` moves into a block whose
     first event is `divisible` (a loop's end line, which owns the moves of all its runs but the
     first).  `line_of` gives the line a block's samples are told by (its own by default)."""
-    moves = _Moves(bound)
+    moves = _Moves()
     into = 0  # moves of the block run so far, where it is divisible (-1: it is not)
     extra: tuple[float, ...] = NO_EXTRA
     last: Block | None = None
@@ -272,8 +285,8 @@ def sections(events: Iterable[Event], bound: Bound, cut: Cut = lambda block, mov
             told = line_of(block.line) if line_of else block.line
             if after:
                 for text in after:
-                    yield moves.sample(Action(text, last.line), first_line)  # type: ignore[union-attr]
-                    moves, first_line = _Moves(bound), last.line  # type: ignore[union-attr]
+                    yield moves.closed(Action(text, last.line), first_line)  # type: ignore[union-attr]
+                    moves, first_line = _Moves(), last.line  # type: ignore[union-attr]
                 after = []
             last = block
             run += 1
@@ -282,29 +295,29 @@ def sections(events: Iterable[Event], bound: Bound, cut: Cut = lambda block, mov
             # stands are tagged as where the run is, further on)
             runs_here = not (kind is Pass and event.skipped)  # type: ignore[union-attr]
             if moves.lines and runs_here and (at := cut(block, len(moves.lines), run, 0)):
-                yield moves.chunk(at, first_line)
-                moves, first_line = _Moves(bound), block.line
+                yield moves.closed(None, first_line, at)
+                moves, first_line = _Moves(), block.line
             if not (kind is Pass and event.skipped) and _may_act(block.signature):  # type: ignore[union-attr]
                 before, after = actions_of(block)
                 inverse_time = _inverse_time(block, inverse_time)
                 for text in before:
-                    yield moves.sample(Action(text, block.line), first_line)
-                    moves, first_line = _Moves(bound), block.line
+                    yield moves.closed(Action(text, block.line), first_line)
+                    moves, first_line = _Moves(), block.line
         if kind is Line or kind is Arc:
             if into >= 0:
                 if into and into % CHUNK_MOVES == 0 and (at := cut(block, len(moves.lines), run, into)):
-                    yield moves.chunk(at, first_line)
-                    moves, first_line = _Moves(bound), block.line
+                    yield moves.closed(None, first_line, at)
+                    moves, first_line = _Moves(), block.line
                 into += 1
             extra = _add(moves, event, extra, inverse_time, told)  # type: ignore[arg-type]
         elif kind is Pass and event.dwell is not None:  # type: ignore[union-attr]  # a cycle's, written G4 P
             for text in ("G4", f"P{event.dwell:g}"):  # type: ignore[union-attr]
-                yield moves.sample(Action(text, block.line), first_line)
-                moves, first_line = _Moves(bound), block.line
+                yield moves.closed(Action(text, block.line), first_line)
+                moves, first_line = _Moves(), block.line
     for text in after:
-        yield moves.sample(Action(text, last.line), first_line)  # type: ignore[union-attr]
-        moves = _Moves(bound)
-    yield moves.sample(None, first_line)
+        yield moves.closed(Action(text, last.line), first_line)  # type: ignore[union-attr]
+        moves = _Moves()
+    yield moves.closed(None, first_line)
 
 
 _ACTING = re.compile(r"[MTSHDP]|G4|G9")
@@ -367,9 +380,11 @@ def _inverse_time(block: Block, now: bool) -> bool:
 
 @dataclass(frozen=True)
 class Bound:
-    """How far a written path may lie from the programmed one (mm)."""
+    """How far a written path may lie from the programmed one (mm); `most`: the widest it is in
+    the run (None: `distance`), which keeps rapids and feeds apart alike in every section."""
 
     distance: float
+    most: float | None = None
 
     @property
     def chord(self) -> float:
@@ -384,12 +399,39 @@ class Bound:
     @property
     def apart(self) -> float:
         """How far apart rapids and feeds are kept, along a coordinate of their own."""
+        if self.most is not None and self.most > self.distance:
+            return Bound(self.most).apart
         return 4 * (self.within + self.coarse)
 
     @property
     def coarse(self) -> float:
-        """The spacing of the points candidate segments are looked up by (`_Nearby`)."""
-        return max(4 * self.distance, 1.0)
+        """The spacing of the points candidate segments are looked up by (`_Nearby`), at least 0.25 mm
+        (at a spacing much wider than the bound, short segments lying over one another, the reversal
+        steps of a helix of many turns, crowd out the segments within the bound of a point)."""
+        return max(4 * self.distance, 0.25)
+
+
+# mm: a written number's rounding, half the last digit of an inch program (0.00001 in) on each of
+# three axes (a correction is noted before its command is rounded to the output grid)
+ROUNDING = 0.00025
+
+
+@dataclass(frozen=True)
+class Following:
+    """A compensating run's bound as it stands when a section is compared: the largest correction
+    made so far (`made()`, mm) plus the tolerance and `ROUNDING`, at most `most` (the machine
+    file's max_correction_mm plus the tolerance, which no correction passes)."""
+
+    most: float
+    tolerance: float
+    made: Callable[[], float]
+
+    def __call__(self) -> Bound:
+        return Bound(min(self.most, self.made() + self.tolerance + ROUNDING), self.most)
+
+
+# A bound, or what gives it as it stands (`Following`)
+Bounds = Bound | Callable[[], Bound]
 
 
 def _interpreted(
@@ -475,7 +517,7 @@ class _Discard:
 
 
 def verify(original: BinaryIO, written: BinaryIO, *, file: str, dialect: str | None, offsets: WorkOffsets | None,
-           bound: Bound) -> int:  # fmt: skip
+           bound: Bounds) -> int:  # fmt: skip
     """Compare a written program file with the original, both read afresh; raise NcppError at
     the original's line where they part.  Returns the number of sections compared."""
     from ncpp.program.dialects import parse_program
@@ -485,8 +527,8 @@ def verify(original: BinaryIO, written: BinaryIO, *, file: str, dialect: str | N
 
         dialect = detect(original.read(SNIFF_BYTES), file)
         original.seek(0)
-    mine = sections(_interpreted(parse_program(original, file, dialect)[1], file, dialect, offsets), bound)
-    theirs = sections(_interpreted(parse_program(written, file, dialect)[1], file, dialect, offsets), bound)
+    mine = sections(_interpreted(parse_program(original, file, dialect)[1], file, dialect, offsets))
+    theirs = sections(_interpreted(parse_program(written, file, dialect)[1], file, dialect, offsets))
     try:
         return _Comparison(file, bound, lambda number: (_line_text(written, number), 0)).run(mine, theirs)
     except NcppError as err:
@@ -501,7 +543,7 @@ def _in_file(err: NcppError, file: str) -> NcppError:
 
 
 def verified(lines: Iterable[str], reached: Callable[[], tuple[int, int, int]], original: Iterable[Event], *, file: str, dialect: str,
-             offsets: WorkOffsets | None, bound: Bound, runs: OnceRuns | None = None) -> Iterator[str]:  # fmt: skip
+             offsets: WorkOffsets | None, bound: Bounds, runs: OnceRuns | None = None) -> Iterator[str]:  # fmt: skip
     """The written program's `lines`, handed on as they are verified against the `original`
     events (an interpreter's reading of the input of its own): each chunk of the input's motion is
     compared with the written lines read back up to where the writer had reached the same
@@ -528,8 +570,8 @@ def verified(lines: Iterable[str], reached: Callable[[], tuple[int, int, int]], 
     def written_cut(block: Block, moves: int, run: int, into: int) -> Position | None:
         return cut[0] if cut[0] and (feed.run(block.line), into) >= cut[0] else None
 
-    mine = sections(held, bound, input_cut, divisible=divisible)
-    theirs = sections(_interpreted(parse_stream(feed, file, dialect), file, dialect, offsets, runs), bound, written_cut,
+    mine = sections(held, input_cut, divisible=divisible)
+    theirs = sections(_interpreted(parse_stream(feed, file, dialect), file, dialect, offsets, runs), written_cut,
                       lambda number: feed.tag(number, before=True), divisible)  # fmt: skip
     comparison = _Comparison(file, bound, feed.text, tagged=True)
     try:
@@ -706,13 +748,16 @@ class _Comparison:
     def __init__(
         self,
         file: str,
-        bound: Bound,
+        bound: Bounds,
         written_text: Callable[[int | None], tuple[str, int]],
         tagged: bool = False,
     ):
-        """`written_text(n)`: the written program's line n, and the input line it was written from
+        """`bound`: read as each section is compared (a `Following` bound as it stands then);
+        `written_text(n)`: the written program's line n, and the input line it was written from
         (0: unknown); `tagged`: the written sections' samples are told by those input lines."""
-        self.file, self.bound, self.written_text, self.tagged = file, bound, written_text, tagged
+        self.bound = bound if callable(bound) else lambda: bound
+        self.file, self.written_text, self.tagged = file, written_text, tagged
+        self.now = self.bound()  # the bound the sections under comparison are sampled and compared with
         self.before: Section | None = None  # the last original chunk, when it ended at a cut
         self.owed: tuple[Section, Section] | None = (
             None  # an original chunk not yet checked against the written
@@ -721,19 +766,23 @@ class _Comparison:
         self.times = [0.0, 0.0]  # inverse-time minutes since the last action (original, written)
         self.count = 0
 
-    def run(self, mine: Iterator[Section], theirs: Iterator[Section]) -> int:
+    def run(self, mine: Iterator[_Moves], theirs: Iterator[_Moves]) -> int:
         for a in mine:
             self.step(a, theirs)
         self.end(theirs)
         return self.count
 
-    def step(self, a: Section, theirs: Iterator[Section]) -> None:
-        b = self._next(theirs, a.first_line)
-        if b is None:
+    def step(self, moves: _Moves, theirs: Iterator[_Moves]) -> None:
+        written = self._next(theirs, moves.first_line)
+        if written is None:
             raise NcppError(
                 "verification: the written program ends before the original",
-                Location(self.file, a.first_line, 1),
+                Location(self.file, moves.first_line, 1),
             )
+        # (the bound read once the written section is: the passes have made its corrections; a bound that
+        # grows only is at least that of the neighbouring chunks' samples, sampled before)
+        self.now = bound = self.bound()
+        a, b = moves.sample(bound), written.sample(bound)
         self.count += 1
         self._actions(a, b)
         across = _tail(self.before) if self.before is not None else None
@@ -751,16 +800,17 @@ class _Comparison:
         self.before = a if a.cut else None
         self._feeds(a, b)
 
-    def end(self, theirs: Iterator[Section]) -> None:
+    def end(self, theirs: Iterator[_Moves]) -> None:
+        self.now = self.bound()
         if self.owed is not None:
             pa, pb = self.owed
             self._follows(pa, pb, "the written path does not follow the original's", written=False)
         extra = self._next(theirs, 0)
-        if extra is not None and (len(extra.starts) or extra.action is not None):
+        if extra is not None and (extra.lines or extra.action is not None):
             raise NcppError("verification: the written program goes on after the original ends",
                             Location(self.file, extra.first_line, 1))  # fmt: skip
 
-    def _next(self, theirs: Iterator[Section], line: int) -> Section | None:
+    def _next(self, theirs: Iterator[_Moves], line: int) -> _Moves | None:
         try:
             return next(theirs, None)
         except _Upstream as up:
@@ -792,7 +842,8 @@ class _Comparison:
         if not len(along.starts):
             line = along.first_line if written else int(path.lines[0])
             raise NcppError(f"verification: {message}: it has no move here", Location(file, line, 1))
-        within = self.bound.within
+        bound = self.now
+        within = bound.within
         endless = np.flatnonzero(~np.isfinite(_lengths(path.starts, path.ends)))
         if len(endless):
             raise NcppError(
@@ -804,13 +855,13 @@ class _Comparison:
         theirs = _first_of_each(a, b)
         a, b = a[theirs], b[theirs]
         try:
-            far = _Nearby(a, b, self.bound).first_outside(starts, ends, within)
+            far = _Nearby(a, b, bound).first_outside(starts, ends, within)
         except NcppError as err:
             raise NcppError(err.message, Location(file, int(path.lines[0]), 1)) from None
         if far is None:
             return
         k, point = far
-        gap, near = _Nearby(a[:, :-1], b[:, :-1], self.bound).nearest(point[:-1])  # (kinds aside)
+        gap, near = _Nearby(a[:, :-1], b[:, :-1], bound).nearest(point[:-1])  # (kinds aside)
         near = int(theirs[near])
         line = int(along.lines[near]) if written and not self.tagged else int(path.lines[k])
         if gap > within:

@@ -1674,6 +1674,8 @@ class Interpreter:
             raise _OutOfScope("coordinate system rotation G10 R", words["R"][1].start + 1)
         if self._rotation() is not None:
             self._check_turned(words, gcodes)
+        elif l_number == 20.0 and self.rotating_g10:
+            self._check_turned_zero(words, gcodes)
         turning = self._turns_again(words, gcodes) if self.centre.off_path else None
         if turning is not None:
             raise _OutOfScope("a rotation of the coordinate system before the move that ends cutter compensation",
@@ -1731,17 +1733,27 @@ class Interpreter:
         if code in (28.0, 30.0) and ("X" in words or "Y" in words):
             raise _OutOfScope(f"G{code:g} with X or Y under a coordinate system rotation", item.start + 1)
 
+    def _check_turned_zero(self, words: dict, gcodes: dict) -> None:
+        """A G10 L20 of another system that a G10 L2 R rotates: rs274ngc sets its zero from the current
+        point turned into that system's frame, the plane's axes the block does not name kept there and
+        every one turned back by the rotation (LinuxCNC's convert_setup), which ncpp does not follow."""
+        number = round(words.get("P", (0.0,))[0])
+        if number not in (0, self.coord_system) and self.rotations.get(number):
+            raise _OutOfScope("G10 L20 of a rotated coordinate system", gcodes[0][1].start + 1,
+                              self._turned_setting(words, gcodes))  # fmt: skip
+
     def _turned_setting(self, words: dict, gcodes: dict) -> Setting | None:
-        """The offset a G92, G10 L10 or G10 L20 of the system in effect sets under the rotation, from
-        where the control stands in the turned frame (None: a block that turns another frame: G10 L11
-        reads G59.3's, G10 L20 of another system that system's, a G92 or G10 L20 under a rotation and a
-        G92 offset, which rs274ngc places apart)."""
+        """The offset a G92, G10 L10/L11 or G10 L20 sets from where the control stands in the turned
+        frame, where it ends interpretation under a rotation (None: a G92 or G10 L20 under a rotation and
+        a G92 offset, which rs274ngc places apart).  A block that reads the point in another frame (G10
+        L11 G59.3's, G10 L20 of another system that system's) is written after a step back to the
+        programmed point, in the program's G0 or G1 mode only (its values cannot be moved by the
+        correction in that frame: None in another mode)."""
         l_number = words["L"][0] if gcodes[0][0] == 10.0 else None  # (None: G92)
-        if (
-            l_number == 11.0
-            or l_number == 20.0
-            and round(words.get("P", (0.0,))[0]) not in (0, self.coord_system)
-        ):
+        other = l_number == 11.0 or (
+            l_number == 20.0 and round(words.get("P", (0.0,))[0]) not in (0, self.coord_system)
+        )
+        if other and (self.motion not in (0.0, 1.0) or not self.rotating_g10):  # (LinuxCNC's: from the point)
             return None
         if l_number != 10.0 and any(self.g92[:2]):
             return None

@@ -34,6 +34,18 @@ def deviation(model: ErrorMap, P: NDArray, direction: NDArray | None, tool_offse
     return model.deviation(P, direction, tool_offset)
 
 
+class Corrections:
+    """The largest correction compensation has made so far in a run (mm, machine coordinates,
+    command minus wanted point): a running maximum, which the verifier's bound follows."""
+
+    def __init__(self) -> None:
+        self.largest = 0.0
+
+    def note(self, mm: float) -> None:
+        if mm > self.largest:  # (NaN is not: a point that is not a number is refused where it is found)
+            self.largest = mm
+
+
 @dataclass(frozen=True)
 class PassContext:
     model: ErrorMap
@@ -54,6 +66,8 @@ class PassContext:
     )
     warnings: Warnings = field(default_factory=Warnings)
     file: str = "<stdin>"
+    # the largest correction made so far, noted by `geometry.compensate`
+    corrections: Corrections = field(default_factory=Corrections, compare=False)
 
     def limit_arrays(self) -> tuple[NDArray, NDArray]:
         lo = np.array([self.limits.get(a, (-np.inf, np.inf))[0] for a in "XYZ"])

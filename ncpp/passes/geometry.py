@@ -264,11 +264,14 @@ def _check(wanted: NDArray, command: NDArray, lines: NDArray, ctx: PassContext) 
     flat = command.reshape(-1, 3)
     if not len(flat):
         return
-    # the common case in seven reductions: every command inside the travel (axis by axis: numpy's
-    # min(axis=0) over (n,3) walks three at a time, far slower) and every correction, however it
-    # points, within the limit (NaN fails each test: the full checks below find it)
+    # the common case in a few reductions: every command inside the travel (axis by axis: numpy's
+    # min(axis=0) over (n,3) walks three at a time, far slower) and the largest correction within
+    # the limit (NaN fails each test: the full checks below find it); the largest is noted for the verifier
     inside = all(flat[:, k].min() >= lo[k] and flat[:, k].max() <= hi[k] for k in range(3))
-    if inside and np.abs(command - wanted).max() * 3**0.5 <= ctx.max_correction:
+    off = (command - wanted).reshape(-1, 3)
+    largest = float(np.sqrt(np.einsum("nk,nk->n", off, off).max()))
+    if inside and largest <= ctx.max_correction:
+        ctx.corrections.note(largest)
         return
     # NaN compares false with every limit: a point or a model that is not a number would pass
     broken = np.flatnonzero(~np.isfinite(command).all(axis=-1).all(axis=-1))
@@ -300,3 +303,4 @@ def _check(wanted: NDArray, command: NDArray, lines: NDArray, ctx: PassContext) 
             f"command {axis}{value:.4f} mm is outside the {axis} travel [{lo[axis_index]:g}, {hi[axis_index]:g}] mm",
             Location(ctx.file, int(lines[k]), word=axis),
         )
+    ctx.corrections.note(largest)

@@ -18,6 +18,7 @@ from ncpp.errors import NcppError, Warnings
 from ncpp.guard import Placement, with_guard
 from ncpp.motion.offsets import WorkOffsets
 from ncpp.motion.segments import Event
+from ncpp.passes.context import Corrections
 from ncpp.post.generator import Generator
 from ncpp.post.heidenhain import HeidenhainGenerator
 from ncpp.post.iso import FanucGenerator, IsoGenerator, LinuxCncGenerator
@@ -94,14 +95,16 @@ def _verified(stream: TextIO, out: BinaryIO, *, file: str, dialect: str, source,
     import shutil
     import tempfile
 
-    from ncpp.verify import Bound, verify
+    from ncpp.pipeline import verify_bound
+    from ncpp.verify import verify
 
+    corrections = Corrections()
     with tempfile.TemporaryFile("w+", encoding="latin-1") as cl, tempfile.TemporaryFile() as plain, \
             tempfile.TemporaryFile() as written:  # fmt: skip
         shutil.copyfileobj(stream, cl)
         cl.seek(0)
         count = _post(cl, written, file=file, dialect=dialect, source=source, tolerance=tolerance, warnings=warnings,
-                      progress=progress, offsets=offsets, summary=summary, guard=guard)  # fmt: skip
+                      progress=progress, offsets=offsets, summary=summary, guard=guard, corrections=corrections)  # fmt: skip
         cl.seek(0)
         _post(
             cl,
@@ -116,7 +119,7 @@ def _verified(stream: TextIO, out: BinaryIO, *, file: str, dialect: str, source,
         written.seek(0)
         nc = "iso" if dialect in ("linuxcnc", "fanuc") else dialect
         verify(plain, written, file=f"{file} (posted uncompensated)", dialect=nc, offsets=offsets,
-               bound=Bound(source.max_correction + tolerance))  # fmt: skip
+               bound=verify_bound(source, tolerance, corrections))  # fmt: skip
         written.seek(0)
         shutil.copyfileobj(written, out)
     return count
@@ -135,7 +138,9 @@ def _post(
     offsets: WorkOffsets | None = None,
     summary: Summary | None = None,
     guard: Placement | None = None,
+    corrections: Corrections | None = None,
 ) -> int:
+    """Post one CL file (`post`); `corrections`: where compensation notes the largest it makes."""
     from ncpp.passes import PASSES, run_passes
     from ncpp.pipeline import HEADER_TAG, header_text, make_context, warn_fixed
 
@@ -150,7 +155,7 @@ def _post(
         events = warn_fixed(events, warnings, file)  # canned cycles, cutter compensation: as programmed
         summary = summary if summary is not None else Summary(file)
         warnings.listeners.append(summary.heard)
-        ctx = make_context(source, tolerance, warnings, file)
+        ctx = make_context(source, tolerance, warnings, file, corrections)
         events = summary.written(run_passes(summary.programmed(events), ctx, PASSES))
         header = header_text(source, tolerance)
     generator = GENERATORS[dialect](warnings, header, file)

@@ -505,8 +505,10 @@ _MOVES = re.compile(r"(STRAIGHT_TRAVERSE|STRAIGHT_FEED)\(([^)]*)\)")
 
 @pytest.mark.oracle
 @pytest.mark.parametrize(
-    "setting", ["G92 X0 Y0", "G10 L20 P0 X2 Y3", "G10 L10 P1 X0 Y0 Z0", "G10 L10 P2 X0 Y0"]
-)
+    "setting",
+    ["G92 X0 Y0", "G10 L20 P0 X2 Y3", "G10 L10 P1 X0 Y0 Z0", "G10 L10 P2 X0 Y0", "G10 L20 P2 X2 Y3",
+     "G10 L2 P3 R45\nG10 L20 P3 X2", "G10 L11 P2 X0 Y0"],
+)  # fmt: skip
 @pytest.mark.parametrize("mode", ["G0", "G1 F300"])
 def test_an_offset_set_from_a_compensated_point_where_interpretation_ends_is_the_programs(
     tmp_path, setting, mode
@@ -515,7 +517,8 @@ def test_an_offset_set_from_a_compensated_point_where_interpretation_ends_is_the
     L20, G10 L10) ends interpretation under a rotation; the move before it was compensated, so ncpp
     writes a step back to the programmed point first, in the program's mode: rs274 then sets the
     offsets the original sets, and every move after it (uninterpreted, as programmed) ends where the
-    original's does, however many setting blocks follow."""
+    original's does, however many setting blocks follow.  So too for a block that reads the point in
+    another frame (G10 L20 of another system, rotated or not; G10 L11, in G59.3's)."""
     text = (
         f"G20 G90 G17\nT1 M6\nG43\nG10 L2 P1 X1 Y2 Z0 R30\n{mode}\nX4 Y3 Z0.5\n"
         f"{setting}\nG10 L10 P1 X0.5\nX1 Y0\nG91 X0.5\nM2\n"
@@ -535,6 +538,32 @@ def test_an_offset_set_from_a_compensated_point_where_interpretation_ends_is_the
     ]
     assert np.allclose(last[0], last[1], atol=1e-7), last
     assert "(its modal state is unknown)" in proc.stderr
+
+
+@pytest.mark.oracle
+def test_a_zero_set_from_the_current_point_in_a_rotated_system_is_the_programs(tmp_path):
+    """G10 L20 of another system that G10 L2 R rotates, the system in effect not rotated: rs274 sets
+    that system's zero from the current point turned into its frame (an axis the block does not name
+    kept where the point is there, and both turned back), which ncpp does not follow: interpretation
+    ends there, after a step back to the programmed point, and rs274 sets the zero the original sets
+    and runs the moves in that system (as programmed) where the original's run."""
+    text = (
+        "G20 G90 G17\nG10 L2 P2 X0 Y0 Z0 R45\nG54\nG0 X1 Y0.5 Z0.5\nG1 X4 Y2 F300\nG10 L20 P2 X0.1 Z0\n"
+        "G55\nG1 X1 Y1\nX0 Y3\nM2\n"
+    )
+    (tmp_path / "t.tbl").write_text("T1 P1 Z0 D0.25\n")
+    program, out, proc = _written_out(tmp_path, text)
+    runs = [
+        rs274.run(p, tool_table=tmp_path / "t.tbl", digits=7, home=tmp_path).stdout for p in (program, out)
+    ]
+    before, after = ([m.groups() for m in _SETS.finditer(run)] for run in runs)
+    assert before and after == before, (before, after)
+    last = [
+        [tuple(float(v) for v in m.group(2).split(",")[:3]) for m in _MOVES.finditer(run)][-2:]
+        for run in runs
+    ]
+    assert np.allclose(last[0], last[1], atol=1e-7), last
+    assert "G10 L20 of a rotated coordinate system" in proc.stderr
 
 
 def _written_out(tmp_path: Path, text: str) -> tuple[Path, Path, subprocess.CompletedProcess]:

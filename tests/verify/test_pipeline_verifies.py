@@ -4,6 +4,7 @@ written; `--no-verify` writes it."""
 
 from __future__ import annotations
 
+import json
 from dataclasses import replace
 from pathlib import Path
 
@@ -69,9 +70,34 @@ def test_no_verify_writes_what_the_passes_make(program: Path, monkeypatch):
     assert program.with_suffix(".out.ngc").exists()
 
 
+def noted(shift):
+    """`shift`, its move noted as a correction compensation made (`PassContext.corrections`)."""
+
+    def pass_(events, ctx):
+        ctx.corrections.note(0.25)
+        return shift(events, ctx)
+
+    return pass_
+
+
 def test_a_correction_within_the_bound_passes(program: Path, monkeypatch):
-    monkeypatch.setattr(ncpp.pipeline, "PASSES", (*ncpp.pipeline.PASSES, shifted_at_line(7, 0.2)))
+    """The bound follows the largest correction made: a move of 0.2 mm made as a correction passes."""
+    monkeypatch.setattr(ncpp.pipeline, "PASSES", (*ncpp.pipeline.PASSES, noted(shifted_at_line(7, 0.2))))
     assert compensate(program) == 0
+
+
+def test_a_move_wider_than_the_corrections_made_is_refused(program: Path, monkeypatch, capsys):
+    """A point of the written path 0.2 mm off the input's, well within the machine file's
+    max_correction_mm (0.5), where hr5b's corrections are under 0.04 mm: no correction ncpp made."""
+    report = program.with_suffix(".json")
+    assert compensate(program, "--report", str(report)) == 0
+    assert json.loads(report.read_text())["largest_correction_um"] < 40
+    monkeypatch.setattr(ncpp.pipeline, "PASSES", (*ncpp.pipeline.PASSES, shifted_at_line(7, 0.2)))
+    program.with_suffix(".out.ngc").unlink()
+    assert compensate(program) != 0
+    err = capsys.readouterr().err
+    assert "part.ngc:7:1: verification: the written path leaves the original's by more than" in err, err
+    assert not program.with_suffix(".out.ngc").exists()
 
 
 def test_the_filter_verifies_too(program: Path, monkeypatch, capsys):
@@ -176,7 +202,7 @@ def test_a_long_loop_is_verified_a_chunk_at_a_time(tmp_path: Path, monkeypatch, 
     step = ncpp.verify._Comparison.step
 
     def counted(self, a, theirs):
-        compared.append(len(a.starts))
+        compared.append(len(a.lines))
         step(self, a, theirs)
 
     monkeypatch.setattr(ncpp.verify._Comparison, "step", counted)
@@ -257,7 +283,7 @@ def test_the_runs_of_a_haas_local_subprogram_are_verified_a_chunk_at_a_time(tmp_
     step = ncpp.verify._Comparison.step
 
     def counted(self, a, theirs):
-        compared.append(len(a.starts))
+        compared.append(len(a.lines))
         step(self, a, theirs)
 
     monkeypatch.setattr(ncpp.verify._Comparison, "step", counted)

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from ncpp.errors import NcppError
-from ncpp.verify import Bound, verify
+from ncpp.verify import ROUNDING, Bound, Following, verify
 
 ORIGINAL = """\
 G21 G90 G17
@@ -56,6 +56,28 @@ def test_corrections_within_the_bound_and_pieces_pass():
 def test_a_point_beyond_the_bound_is_refused_at_its_line():
     err = refused(ORIGINAL, ORIGINAL.replace("X50 Y0", "X50 Y0.2"))
     assert err.where.line == 6 and "leaves" in err.message
+
+
+def test_a_following_bound_is_the_largest_correction_made_plus_the_tolerance():
+    """A compensating run's bound (`Following`): corrections of 0.01 mm made, tolerance 0.001 mm;
+    at most the machine file's max_correction_mm plus the tolerance."""
+    made = [0.01]
+    bound = Following(0.501, 0.001, lambda: made[0])
+    assert bound().distance == pytest.approx(0.01 + 0.001 + ROUNDING)
+    # (and the arc after it, in chords of the bound)
+    check_with(ORIGINAL, ORIGINAL.replace("X50 Y0", "X50 Y0.01"), bound)
+    with pytest.raises(NcppError) as caught:
+        check_with(ORIGINAL, ORIGINAL.replace("X50 Y0", "X50 Y0.05"), bound)
+    within = 1.25 * bound().distance  # (the chords')
+    assert caught.value.where.line == 6 and f"by more than {within:.4f} mm" in caught.value.message
+    made[0] = 2.0
+    assert bound().distance == 0.501
+    check_with(ORIGINAL, ORIGINAL.replace("X50 Y0", "X50 Y0.4"), bound)
+
+
+def check_with(original: str, written: str, bound: Following) -> int:
+    return verify(io.BytesIO(original.encode()), io.BytesIO(written.encode()), file="part.ngc", dialect="iso",
+                  offsets=None, bound=bound)  # fmt: skip
 
 
 def test_a_missing_move_is_refused():
