@@ -45,14 +45,20 @@ takes to be the program's zero: the writer tells the axes (`IsoWriter.unplaced_s
 check after the block stops the program when #5211-#5213, the G92 offset X Y Z (G-code manual,
 "Numbered Parameters": #5210 1 while a G52/G92 offset is applied, #5211-#5219 its axes, in the
 machine's units, set by the G92 as rs274 runs it), is not the one ncpp compensated for within
-`GUARD_MM` on those axes (`g92_lines`).  The offset does not depend on the one in effect before:
+`GUARD_MM` on those axes (`offset_lines`).  The offset does not depend on the one in effect before:
 rs274ngc makes the block's point the tool's, whatever the old offset.  A G92.3 (G-code manual,
 "G92.3 Restore G92 Offsets": the offset of #5211-#5219) gets the check of X Y Z: the saved offset
 comes from the parameter file (`WorkOffsets.g92_saved`) or the program's last G92, and a control
 may hold another.  G92.1 and G92.2 set no offset from the control's state (zero), G52 the values
-it names: no check.  Fanuc and Haas programs keep the warning alone: no variable of the G92 shift
+it names: no check.  A LinuxCNC G10 L20 Pn of such axes (G-code manual, "G10 L20 Set Coordinate
+System": system n's zero such that the current point reads the block's coordinates; P0 the system
+in effect, 1-9 G54-G59.3) gets the same check of system n's zero, #5221-#5223 + 20 (n - 1) (the
+parameters of the start's check, which makes sure P0's system is the one ncpp follows); rs274ngc
+sets it from the machine position less the G92 offset and tool length in effect, as the
+interpreter does.  Fanuc and Haas programs keep the warning alone: no variable of the G92 shift
 is cited here from their manuals (Haas Mill Operator's Manual, "Macros", offsets: #5201-#5205 G52,
-#5221-#5225 G54 ..., #7001-#7005 G110 ..., no G92).
+#5221-#5225 G54 ..., #7001-#7005 G110 ..., no G92), and their G10 L20 gives an additional work
+offset's zero in machine coordinates (`motion/fanuc.py`), not one from where the tool stands.
 
 * Sinumerik (840D sl System Variables parameter manual: `$P_UIFRNUM`, the number of the
   active settable frame, 1-4 for G54-G57; `$P_UIFR[n, axis, TR]` and `[n, axis, FI]`, its
