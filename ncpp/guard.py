@@ -45,14 +45,20 @@ takes to be the program's zero: the writer tells the axes (`IsoWriter.unplaced_s
 check after the block stops the program when #5211-#5213, the G92 offset X Y Z (G-code manual,
 "Numbered Parameters": #5210 1 while a G52/G92 offset is applied, #5211-#5219 its axes, in the
 machine's units, set by the G92 as rs274 runs it), is not the one ncpp compensated for within
-`GUARD_MM` on those axes (`g92_lines`).  The offset does not depend on the one in effect before:
+`GUARD_MM` on those axes (`offset_lines`).  The offset does not depend on the one in effect before:
 rs274ngc makes the block's point the tool's, whatever the old offset.  A G92.3 (G-code manual,
 "G92.3 Restore G92 Offsets": the offset of #5211-#5219) gets the check of X Y Z: the saved offset
 comes from the parameter file (`WorkOffsets.g92_saved`) or the program's last G92, and a control
 may hold another.  G92.1 and G92.2 set no offset from the control's state (zero), G52 the values
-it names: no check.  Fanuc and Haas programs keep the warning alone: no variable of the G92 shift
+it names: no check.  A LinuxCNC G10 L20 Pn of such axes (G-code manual, "G10 L20 Set Coordinate
+System": system n's zero such that the current point reads the block's coordinates; P0 the system
+in effect, 1-9 G54-G59.3) gets the same check of system n's zero, #5221-#5223 + 20 (n - 1) (the
+parameters of the start's check, which makes sure P0's system is the one ncpp follows); rs274ngc
+sets it from the machine position less the G92 offset and tool length in effect, as the
+interpreter does.  Fanuc and Haas programs keep the warning alone: no variable of the G92 shift
 is cited here from their manuals (Haas Mill Operator's Manual, "Macros", offsets: #5201-#5205 G52,
-#5221-#5225 G54 ..., #7001-#7005 G110 ..., no G92).
+#5221-#5225 G54 ..., #7001-#7005 G110 ..., no G92), and their G10 L20 gives an additional work
+offset's zero in machine coordinates (`motion/fanuc.py`), not one from where the tool stands.
 
 * Sinumerik (840D sl System Variables parameter manual: `$P_UIFRNUM`, the number of the
   active settable frame, 1-4 for G54-G57; `$P_UIFR[n, axis, TR]` and `[n, axis, FI]`, its
@@ -644,8 +650,9 @@ class PlacementChecks:
     before the first block that selects it (the writer's `before`): the interpreter marks the
     block (`Pass.zero_told`) where it runs once and the zero is still the one told.  LinuxCNC's
     syntax, or Fanuc's (Haas's) in a Fanuc program (a program number at its top).  In LinuxCNC's,
-    the G92 offset too, after a G92 that sets it on axes the program has not positioned (the
-    writer tells them: `unplaced`) and after a G92.3 (`after`, the interpreter's `Pass.g92_told`)."""
+    the offset a G92 or G10 L20 sets too, after the block where it sets it on axes the program has
+    not positioned (the writer tells them: `unplaced`), and the G92 offset after a G92.3 (`after`,
+    the interpreter's `Pass.offset_told`)."""
 
     def __init__(
         self,
@@ -658,8 +665,8 @@ class PlacementChecks:
         self.looked = 0  # blocks looked at for a Fanuc program number
         self.checked: set[int] = set()
         self.labels = 0  # the checks written so far (each `if` a label of its own)
-        self.g92: Pass | None = None  # the G92 or G92.3 mark of the block being written (`Pass.g92_told`)
-        self.unplaced_axes: set[int] = set()  # the axes of its G92 the program has not positioned
+        self.setting: Pass | None = None  # the block being written's mark (`Pass.offset_told`)
+        self.unplaced_axes: set[int] = set()  # the axes of its G92 or G10 L20 the program has not positioned
 
     def __call__(self, events: list[Event]) -> list[str]:
         block = events[0].block
@@ -667,7 +674,7 @@ class PlacementChecks:
             self.looked += 1
             if _program_number(block.items):
                 self.dialect = "fanuc"
-        self.g92 = next((e for e in events if type(e) is Pass and e.g92_told), None)
+        self.setting = next((e for e in events if type(e) is Pass and e.offset_told), None)
         self.unplaced_axes = set()
         number = next((e.zero_told for e in events if type(e) is Pass and e.zero_told is not None), None)
         if number is None or number in self.checked:
@@ -685,40 +692,47 @@ class PlacementChecks:
     def unplaced(self, axes: Iterable[str], block: Block) -> bool:
         """The writer's word that the G92 (or G10 L20) `block` sets the offset of `axes` (X Y Z)
         from where the control stands, which the program has not positioned: whether a check after
-        the block stops the program where the G92 offset it sets differs (LinuxCNC's, not the last line)."""
-        mark = self.g92
-        if mark is None or mark.block is not block or self.dialect != "iso" or not block.eol:
+        the block stops the program where the offset it sets differs (LinuxCNC's, not the last line)."""
+        mark = self.setting
+        if mark is None or mark.offset_told is None or mark.block is not block:
             return False
-        told = {axis for axis, _ in mark.g92_told or ()}
+        if self.dialect != "iso" or not block.eol:
+            return False
+        told = {axis for axis, _ in mark.offset_told[1]}
         self.unplaced_axes = {"XYZ".index(axis) for axis in axes} & told
         return bool(self.unplaced_axes)
 
     def after(self, events: list[Event]) -> list[str]:
-        """The check of the G92 offset after the block (the writer's `after`): after a G92, of the
-        axes `unplaced` told; after a G92.3, of X Y Z."""
-        mark, self.g92 = self.g92, None
-        if mark is None or mark.g92_told is None or self.dialect != "iso" or not events[0].block.eol:
+        """The check of the offset after the block (the writer's `after`): after a G92 or G10 L20, of
+        the axes `unplaced` told; after a G92.3, of X Y Z."""
+        mark, self.setting = self.setting, None
+        if mark is None or mark.offset_told is None or self.dialect != "iso" or not events[0].block.eol:
             return []
+        system, told = mark.offset_told
         restored = not any(type(e) is Pass and e.setting is not None for e in events)
-        offset = [(axis, mm) for axis, mm in mark.g92_told if restored or axis in self.unplaced_axes]
+        offset = [(axis, mm) for axis, mm in told if restored or axis in self.unplaced_axes]
         if not offset:
             return []
         self.labels += 1
-        return [line + events[0].block.eol for line in g92_lines(offset, self.unit_mm, self.labels, restored)]
+        lines = offset_lines(system, offset, self.unit_mm, self.labels, restored)
+        return [line + events[0].block.eol for line in lines]
 
 
-def g92_lines(
-    offset: Iterable[tuple[int, float]], unit_mm: float, label: int, restored: bool = False
+def offset_lines(
+    system: int, offset: Iterable[tuple[int, float]], unit_mm: float, label: int, restored: bool = False
 ) -> list[str]:
-    """LinuxCNC's check (without line ends), after a G92 block or a G92.3 (`restored`), that the G92
-    offset of each axis (0-2: X Y Z; mm) is the one told within GUARD_MM: #5211-#5213 hold it in the
-    machine's units (`unit_mm` mm each); `label` numbers the check's `if`."""
-    values = [("XYZ"[axis], 5211 + axis, _number(mm / unit_mm)) for axis, mm in offset]
-    told = f"the G92 offset {' '.join(letter + value for letter, _, value in values)} {_units(unit_mm)}"
+    """LinuxCNC's check (without line ends), after a G92 block or a G92.3 (`restored`; `system` 0) or
+    a G10 L20 of coordinate system `system` (1-9), that the offset it set on each axis (0-2: X Y Z;
+    mm) is the one told within GUARD_MM: #5211-#5213 hold the G92 offset, #5221-#5223 + 20 (n - 1)
+    system n's zero, in the machine's units (`unit_mm` mm each); `label` numbers the check's `if`."""
+    x = 5211 if system == 0 else 5221 + 20 * (system - 1)
+    values = [("XYZ"[axis], x + axis, _number(mm / unit_mm)) for axis, mm in offset]
+    name = "the G92 offset" if system == 0 else f"{system_name(system, 'linuxcnc')}'s zero"
+    told = f"{name} {' '.join(letter + value for letter, _, value in values)} {_units(unit_mm)}"
     tolerance = _number(GUARD_MM / unit_mm)
     far = " OR ".join(f"[ABS[#{key} {_less(value, ' ')}] GT {tolerance}]" for _, key, value in values)
     found = " ".join(f"{letter}#{key}" for letter, key, _ in values)
-    name = f"o<ncpp_guard_{label}>"
+    label_name = f"o<ncpp_guard_{label}>"
     if restored:  # (the messages stay short: rs274ngc reads lines of up to 255 characters)
         how, then = (
             "restored by G92.3",
@@ -726,14 +740,13 @@ def g92_lines(
         )
     else:
         how = "set with the tool at the program's zero"
-        then = (
-            f"this G92 set {found}: jog the tool to that zero first, or compensate again for where it stands"
-        )
+        block = "G92" if system == 0 else "G10 L20"
+        then = f"this {block} set {found}: jog the tool to that zero first, or compensate again for where it stands"
     return [
         f"({BEGIN} {told} {how} within {_number(GUARD_MM)} mm)",
-        f"{name} if [{far}]",
+        f"{label_name} if [{far}]",
         f"(abort, ncpp: compensated for {told} {how}; {then})",
-        f"{name} endif",
+        f"{label_name} endif",
         f"({END})",
     ]
 

@@ -571,7 +571,7 @@ def _warn_unplaced(
     positioned, from where the control stands; it says whether the placement guard checks it."""
     checked = checks is not None and checks.unplaced(axes, block)
     then = (
-        "; the placement guard's check after it stops the program where the G92 offset it sets differs from that"
+        "; the placement guard's check after it stops the program where the offset it sets differs from that"
         if checked else ""
     )  # fmt: skip
     warnings.warn(

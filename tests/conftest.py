@@ -99,6 +99,9 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_rs274_checks_a_g92_made_under_a_g92_offset_of_the_parameter_file",
             "test_rs274_checks_the_offset_a_g92_3_restores",
             "test_the_interpreter_applies_the_saved_offset_at_g92_3_as_rs274_does",
+            "test_rs274_runs_an_l20_program_where_the_tool_stands_at_the_zero_told_and_stops_it_where_not",
+            "test_rs274_checks_the_zero_of_the_system_p_names_on_the_axes_not_positioned",
+            "test_rs274_checks_an_l20_made_under_a_g92_offset_of_the_parameter_file",
         ),
         "shop/test_guard.py": (
             "test_rs274_runs_a_program_that_selects_its_system_whatever_system_the_control_was_left_in",

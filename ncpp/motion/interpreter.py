@@ -1316,7 +1316,7 @@ class Interpreter:
         if 10 in gcodes:
             self.retract_to_r = gcodes[10][0] == 99.0
         events: Event | tuple[Event, ...] | None = None
-        previous = self.motion
+        previous, active = self.motion, self.coord_system  # (a G10 L20 P0's system, before an M2 resets it)
         if mode0 is not None and mode0 not in (4.0, 53.0):
             events = self._non_modal(block, words, mode0)
         if mode1 is not None:
@@ -1335,7 +1335,8 @@ class Interpreter:
         if 2.0 in mcodes or 30.0 in mcodes:
             self._program_end()
         self._update_fast()
-        marks = [Pass(block, g92_told=self._g92_told(mode0, words))] if mode0 in (92.0, 92.3) else []
+        offset_told = self._offset_told(mode0, words, active)
+        marks = [Pass(block, offset_told=offset_told)] if offset_told is not None else []
         if selected in self.told_zeros:
             marks.append(Pass(block, zero_told=selected))
         if told is not None:
@@ -1344,13 +1345,22 @@ class Interpreter:
             return _marked(events, marks)
         return Pass(block) if events is None else events
 
-    def _g92_told(self, code: float, words: dict) -> tuple[tuple[int, float], ...]:
-        """The G92 offset after a G92 on the axes X Y Z it names, or after a G92.3 on X Y Z, in mm
-        (`Pass.g92_told`)."""
+    def _offset_told(
+        self, code: float | None, words: dict, active: int
+    ) -> tuple[int, tuple[tuple[int, float], ...]] | None:
+        """The offset after a G92 or a G10 L20 (of system P, or of `active`, the system in effect at
+        the block, for P0) on the axes X Y Z it names, or after a G92.3 on X Y Z, in mm
+        (`Pass.offset_told`); None for other blocks."""
+        if code in (92.0, 92.3):
+            system, offset = 0, self.g92
+        elif code == 10.0 and words["L"][0] == 20.0:
+            system = round(words.get("P", (0.0,))[0]) or active
+            offset = self.g5x[system]
+        else:
+            return None
         scale = MM_PER_INCH if self.inch else 1.0
-        return tuple(
-            (i, self.g92[i] * scale) for i, letter in enumerate("XYZ") if code == 92.3 or letter in words
-        )
+        named = tuple(i for i, letter in enumerate("XYZ") if code == 92.3 or letter in words)
+        return system, tuple((i, offset[i] * scale) for i in named)
 
     # -- checks (interp_check.cc, enhance_block) ----------------------------------------
     def _motion_to_be(self, block, mode0, mode1, mode1_item, axis_item, polar_item=None) -> float | None:
@@ -2806,7 +2816,7 @@ _PLAIN_LETTERS = {
 
 
 def _marked(events: Event | tuple[Event, ...] | None, marks: list[Pass]) -> Event | tuple[Event, ...]:
-    """A block's events with the guards' marks (`Pass.g92_told`, `Pass.zero_told`, then
+    """A block's events with the guards' marks (`Pass.offset_told`, `Pass.zero_told`, then
     `Pass.length_told`, which the tool guard looks for last) after them (the first event stays the
     one that says how the block is written)."""
     if events is None:
@@ -2834,7 +2844,7 @@ def _as_programmed(ev: Event, owner: Block | None) -> Event | None:
     in the text's place (None: not there)."""
     if type(ev) is Pass:
         ev.length_told = ev.tool_read = None  # (the text runs again, or elsewhere, perhaps with another tool)
-        ev.zero_told = ev.g92_told = None  # (and perhaps after the program set the zero, or the G92 offset)
+        ev.zero_told = ev.offset_told = None  # (and perhaps after the program set the zero, or an offset)
         return ev if owner is None and not _expanding(ev) else None  # (a cycle there stays one)
     if ev.fixed in (HOLE, CYCLE):  # type: ignore[union-attr]
         # each run may need a correction of its own: the cycle is left as programmed; in a

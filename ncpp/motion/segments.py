@@ -299,10 +299,11 @@ class Pass:
     # (the tool in the spindle, the parameter, its value in the table's units or degrees), which the
     # tool guard checks before the block
     tool_read: tuple[tuple[int, int, float], ...] | None = None
-    # a block that sets the G92 offset from where the control stands (G92) or restores the saved one
-    # (G92.3): (axis 0-2, the offset after the block in mm) for the axes it sets, X Y Z for G92.3,
-    # which the placement guard checks after the block
-    g92_told: tuple[tuple[int, float], ...] | None = None
+    # a block that sets an offset from where the control stands (G92; LinuxCNC's G10 L20, a system's zero)
+    # or restores the saved G92 offset (G92.3): (0 for the G92 offset, else the system 1-9 whose zero it
+    # sets; (axis 0-2, the offset after the block in mm) for the axes it sets, X Y Z for G92.3), which
+    # the placement guard checks after the block
+    offset_told: tuple[int, tuple[tuple[int, float], ...]] | None = None
 
 
 Segment = Line | Arc

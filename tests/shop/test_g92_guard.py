@@ -1,10 +1,13 @@
-"""The placement guard's check of the G92 offset (`guard.g92_lines`), judged by LinuxCNC's rs274.
+"""The placement guard's check of the G92 offset and of a G10 L20's zero (`guard.offset_lines`),
+judged by LinuxCNC's rs274.
 
 A G92 that sets the offset of axes the program has not positioned sets it from where the tool
 stands (LinuxCNC G-code manual, "G92 Coordinate System Offset"), which ncpp takes to be the
 program's zero; the check after it reads #5211-#5213, the G92 offset ("Numbered Parameters", in
 the machine's units), and stops the program where it differs, before any move after the G92.  A
 G92.3 restores the offset saved in #5211-#5219 ("G92.3 Restore G92 Offsets"), checked after it.
+A G10 L20 Pn sets system n's zero (P0: the one in effect) so that the tool stands at the block's
+coordinates ("G10 L20 Set Coordinate System"): the check after it reads #5221-#5223 + 20 (n - 1).
 The stand-alone rs274 starts with the tool at the machine zero and reads its files in inches."""
 
 from __future__ import annotations
@@ -39,10 +42,12 @@ def _var_file(
     g54_mm: tuple[float, float, float],
     g92_mm: tuple[float, float, float] | None = None,
     applied=True,
+    system: int = 1,
 ) -> Path:
-    """A parameter file in inches (the stand-alone rs274's units): G54 in effect at `g54_mm`, and the
-    G92 offset `g92_mm` in #5211-#5213, applied where `applied` (#5210)."""
-    values = {5220: 1.0, **{5221 + k: v / 25.4 for k, v in enumerate(g54_mm)}}
+    """A parameter file in inches (the stand-alone rs274's units): `system` (1: G54) in effect at
+    `g54_mm`, and the G92 offset `g92_mm` in #5211-#5213, applied where `applied` (#5210)."""
+    x = 5221 + 20 * (system - 1)
+    values = {5220: float(system), **{x + k: v / 25.4 for k, v in enumerate(g54_mm)}}
     if g92_mm is not None:
         values.update({5210: float(applied), **{5211 + k: v / 25.4 for k, v in enumerate(g92_mm)}})
     path.write_text("".join(f"{number}\t{value:.6f}\n" for number, value in sorted(values.items())))
@@ -82,11 +87,14 @@ def _runs_as_the_original(tmp_path: Path, written: Path, var_file: Path) -> None
                     str(var_file.with_suffix(".tbl")), "--tol-mm", "0.05")  # fmt: skip
 
 
-def _stops_at_the_check(written: Path, var_file: Path, moves_before: int = 0) -> str:
-    """rs274's run stops at the check's abort, the moves before the G92 made and none after it."""
+def _stops_at_the_check(
+    written: Path, var_file: Path, moves_before: int = 0, check: str = CHECK, sets: str = "SET_G92_OFFSET"
+) -> str:
+    """rs274's run stops at the check's abort (`check` in its message), the moves before the block
+    that sets the offset (`sets`, the call rs274 makes for it) made and none after it."""
     stopped = _run(written, var_file)
-    assert stopped.returncode != 0 and f"compensated for {CHECK}" in stopped.stderr, stopped.stderr
-    assert "SET_G92_OFFSET" in stopped.stdout and "PROGRAM_END" not in stopped.stdout
+    assert stopped.returncode != 0 and f"compensated for {check}" in stopped.stderr, stopped.stderr
+    assert sets in stopped.stdout and "PROGRAM_END" not in stopped.stdout
     assert len(re.findall(r"STRAIGHT_(TRAVERSE|FEED)", stopped.stdout)) == moves_before, stopped.stdout
     return stopped.stderr
 
@@ -165,6 +173,88 @@ def test_rs274_checks_the_offset_a_g92_3_restores(tmp_path):
     assert "the control restored X1.000000 Y0.000000 Z0.000000" in said
 
 
+L20_MM = "G21 G90\nG10 L20 P1 X10 Y5 Z0\nG0 X20 Y15 Z5\nG1 Z-1 F300\nG1 X50 Y15\nG1 X50 Y35\nG0 Z5\nM2\n"
+L20_INCH = "G20 G90\nG10 L20 P0 X0 Y0 Z0\nG0 X0.5 Y0.5 Z0.2\nG1 Z-0.04 F10\nG1 X1.5\nG1 Y1.2\nG0 Z0.2\nM2\n"
+SET_HERE = "set with the tool at the program's zero"  # (what a G92's or G10 L20's check says)
+
+
+@pytest.mark.parametrize("program", [L20_MM, L20_INCH], ids=["G21-P1", "G20-P0"])
+def test_rs274_runs_an_l20_program_where_the_tool_stands_at_the_zero_told_and_stops_it_where_not(
+    tmp_path, program
+):
+    """Touched off with G10 L20 where rs274 starts (the machine zero): told G54 at the machine zero,
+    the L20 sets G54's zero where ncpp compensated for it, and the program runs the original's
+    path; told G54 at X400 Y350 Z300 (the control's too), the L20 sets #5221 to the machine zero
+    less the block's X, and the program stops before its first move."""
+    at_zero = _var_file(tmp_path / "zero.var", (0.0, 0.0, 0.0))
+    written, said = _compensated(tmp_path, program, at_zero)
+    lines = written.read_text().splitlines()
+    k = lines.index(program.splitlines()[1])
+    assert lines[k + 1].startswith("(ncpp placement guard: G54's zero ") and SET_HERE in lines[k + 1]
+    assert lines[k + 5] == "(ncpp placement guard end)"
+    if program is L20_MM:  # (G10 L20 X10 at the program's zero, G54's at the machine's: X-10 mm, in inches)
+        assert "[ABS[#5221 + 0.3937] GT 0.0039] OR [ABS[#5222 + 0.1969] GT 0.0039]" in lines[k + 2]
+    assert "the placement guard's check after it stops the program" in said
+    _runs_as_the_original(tmp_path, written, at_zero)
+
+    elsewhere = _var_file(tmp_path / "elsewhere.var", (400.0, 350.0, 300.0))
+    written, _ = _compensated(tmp_path, program, elsewhere, "elsewhere.ngc")
+    said = _stops_at_the_check(written, elsewhere, check="G54's zero", sets="SET_G5X_OFFSET")
+    set_there = "X-0.393701 Y-0.196850" if program is L20_MM else "X0.000000 Y0.000000"
+    assert f"this G10 L20 set {set_there} Z0.000000" in said, said  # (rs274 writes the parameters in)
+
+
+@pytest.mark.parametrize(
+    ("program", "system", "parameter"),
+    [
+        ("G21 G90\nG10 L20 P2 X0 Y0 Z0\nG55\nG0 X10 Y10 Z5\nG1 Z-1 F300\nG1 X40\nG0 Z5\nM2\n", 1, 5241),
+        ("G21 G90\nG10 L20 P0 X0 Y0 Z0\nG0 X10 Y10 Z5\nG1 Z-1 F300\nG1 X40\nG0 Z5\nM2\n", 2, 5241),
+        ("G21 G90\nG0 X10 Y10\nG10 L20 P1 Z0\nG0 Z5\nG1 Z-1 F300\nG1 X40\nG0 Z5\nM2\n", 1, 5223),
+    ],
+    ids=["P2-from-G54", "P0-in-G55", "Z-alone"],
+)
+def test_rs274_checks_the_zero_of_the_system_p_names_on_the_axes_not_positioned(
+    tmp_path, program, system, parameter
+):
+    """G10 L20 P2 sets G55's zero whichever system is in effect, P0 that of the one in effect (G55
+    where #5220 is 2, as rs274 runs it); after `G0 X10 Y10` only Z stands where the operator left
+    it.  The check reads that system's parameters of those axes: the program runs where the tool
+    stood at the zero told, and stops before the move after the L20 where not."""
+    at_zero = _var_file(tmp_path / "zero.var", (0.0, 0.0, 0.0), system=system)
+    written, said = _compensated(tmp_path, program, at_zero)
+    check = next(line for line in written.read_text().splitlines() if line.startswith("o<ncpp_guard_1> if"))
+    assert re.findall(r"#(\d+)", check) == (
+        [str(parameter)] if parameter == 5223 else ["5241", "5242", "5243"]
+    )
+    _runs_as_the_original(tmp_path, written, at_zero)
+
+    elsewhere = _var_file(tmp_path / "elsewhere.var", (400.0, 350.0, 300.0), system=system)
+    written, _ = _compensated(tmp_path, program, elsewhere, "elsewhere.ngc")
+    name = "G54" if parameter == 5223 else "G55"
+    said = _stops_at_the_check(written, elsewhere, program.count("G0 X10 Y10\n"), f"{name}'s zero", "G5X")
+    set_there = (
+        "Z0.000" if parameter == 5223 else "X0.000000 Y0.000000 Z0.000000"
+    )  # (Z: moved by the correction)
+    assert f"this G10 L20 set {set_there}" in said, said
+
+
+def test_rs274_checks_an_l20_made_under_a_g92_offset_of_the_parameter_file(tmp_path):
+    """rs274ngc sets a G10 L20's zero less the G92 offset in effect (#5210 1, #5211 10 mm): told
+    G54 at X-10, the program's zero is the machine zero where rs274 starts, and the L20 sets G54's
+    X to -10 mm, as ncpp compensated for; told G54 at X0, ncpp takes the tool to stand at X10, the
+    L20 sets -10 mm all the same, and the check stops the program."""
+    program = "G21 G90\nG10 L20 P1 X0 Y0 Z0\nG0 X10 Y10 Z5\nG1 Z-1 F300\nG1 X40\nG0 Z5\nM2\n"
+    shifted = _var_file(tmp_path / "shifted.var", (-10.0, 0.0, 0.0), (10.0, 0.0, 0.0))
+    written, _ = _compensated(tmp_path, program, shifted)
+    assert "[ABS[#5221 + 0.3937] GT 0.0039]" in written.read_text()
+    _runs_as_the_original(tmp_path, written, shifted)
+
+    off_zero = _var_file(tmp_path / "off.var", (0.0, 0.0, 0.0), (10.0, 0.0, 0.0))
+    written, _ = _compensated(tmp_path, program, off_zero, "off.ngc")
+    said = _stops_at_the_check(written, off_zero, check="G54's zero", sets="SET_G5X_OFFSET")
+    assert "this G10 L20 set X-0.393701 Y0.000000 Z0.000000:" in said, said
+
+
 def test_the_interpreter_applies_the_saved_offset_at_g92_3_as_rs274_does(tmp_path):
     """The machine positions of the moves before and after a G92.3 of a parameter file whose #5210
     is 0: ncpp's, and rs274's (the move's point plus the G5X and G92 offsets it prints, inches)."""
@@ -214,18 +304,33 @@ def test_an_mm_machine_checks_in_mm_and_each_check_has_a_label_of_its_own():
     assert all(len(line) <= 255 for line in lines)  # (rs274ngc reads lines of up to 255 characters)
 
 
-@pytest.mark.parametrize(
-    "program",
-    [
-        "%\nO1234\nG21 G90\nG92 X0 Y0 Z0\nG0 X10 Y10 Z5\nG1 Z-1 F300\nG1 X40\nM30\n%\n",  # Fanuc's: no variable cited
-        "G21 G90\nG10 L20 P1 X0 Y0 Z0\nG0 X10 Y10 Z5\nG1 Z-1 F300\nG1 X40\nM2\n",  # (G10 L20: no G92 offset)
-    ],
-    ids=["fanuc", "g10-l20"],
-)
-def test_no_check_where_the_control_gives_no_g92_offset_to_read_and_the_warning_stays(program):
+def test_no_check_where_the_control_gives_no_g92_offset_to_read_and_the_warning_stays():
+    program = "%\nO1234\nG21 G90\nG92 X0 Y0 Z0\nG0 X10 Y10 Z5\nG1 Z-1 F300\nG1 X40\nM30\n%\n"  # Fanuc's
     written, said = _warned(program)
     assert CHECK not in written and "#5211" not in written
     assert "has not positioned X and Y and Z yet" in said and "placement guard's check" not in said
+
+
+def test_a_g10_l20_after_a_g92_gets_a_check_of_its_own_in_mm():
+    """`G92 Z0` sets Z's offset from where the tool stands, the G10 L20 after it G54's X and Y (its
+    Z placed by the G92): two checks, each of its own axes and label."""
+    program = "G21 G90\nG92 Z0\nG10 L20 P1 X0 Y0\nG0 X10 Y10 Z5\nG1 Z-1 F300\nG1 X40\nM2\n"
+    written, said = _warned(program, var_units=1.0)
+    lines = written.splitlines()
+    assert lines.count("o<ncpp_guard_1> if [[ABS[#5213 - 0] GT 0.1]]") == 1
+    far = "[[ABS[#5221 - 400] GT 0.1] OR [ABS[#5222 - 350] GT 0.1]]"
+    assert lines.count(f"o<ncpp_guard_2> if {far}") == 1  # (G54's zero where the tool stood: the told one)
+    assert f"(ncpp placement guard: G54's zero X400 Y350 mm {SET_HERE}" in written
+    assert said.count("the placement guard's check after it") == 2
+    assert all(len(line) <= 255 for line in lines)
+
+
+def test_a_fanuc_g10_l20_sets_an_additional_offset_from_its_words_and_gets_no_check():
+    """Fanuc's G10 L20 Pn gives additional work offset n's zero (Series 0i-MC operator's manual,
+    "Additional workpiece coordinate systems"), not one from where the tool stands."""
+    program = "%\nO1234\nG21 G90\nG10 L20 P1 X0 Y0 Z0\nG0 X10 Y10 Z5\nG1 Z-1 F300\nG1 X40\nM30\n%\n"
+    written, said = _warned(program)
+    assert SET_HERE not in written and "has not positioned X and Y and Z yet" not in said
 
 
 @pytest.mark.parametrize(
@@ -234,14 +339,19 @@ def test_no_check_where_the_control_gives_no_g92_offset_to_read_and_the_warning_
         "G21 G90\nG0 X1 Y1 Z5\nG92 X0 Y0 Z0\nG0 X10 Y10 Z5\nG1 Z-1 F300\nG1 X40\nM2\n",  # (placed: ncpp knows where)
         "G21 G90\nG92.1\nG0 X10 Y10 Z5\nG92.2\nG1 Z-1 F300\nG1 X40\nM2\n",  # (they set the offset 0)
         "G21 G90\nG0 X10 Y10 Z5\nG1 Z-1 F300\nG1 X40\nG92 X0 Y0 Z0",  # (a last line: nothing runs after it)
+        "G21 G90\nG0 X1 Y1 Z5\nG10 L20 P1 X0 Y0 Z0\nG0 X10 Y10 Z5\nG1 Z-1 F300\nG1 X40\nM2\n",
+        "G21 G90\nG0 X10 Y10 Z5\nG1 Z-1 F300\nG1 X40\nG10 L20 P1 X0 Y0 Z0",
     ],
-    ids=["positioned", "g92.1-g92.2", "last-line"],
+    ids=["positioned", "g92.1-g92.2", "last-line", "l20-positioned", "l20-last-line"],
 )
 def test_no_check_where_ncpp_knows_the_offset_or_nothing_runs_after_it(program):
     written, _ = _warned(program)
-    assert CHECK not in written
+    assert CHECK not in written and SET_HERE not in written
 
 
-def test_no_check_with_no_guard():
-    written, said = _warned(G92_FIRST, guard=False)
-    assert CHECK not in written and "has not positioned" in said and "placement guard's check" not in said
+@pytest.mark.parametrize(
+    "program", [G92_FIRST, "G21 G90\nG10 L20 P1 X0 Y0 Z0\nG0 X10 Y10 Z5\nG1 Z-1 F300\nM2\n"]
+)
+def test_no_check_with_no_guard(program):
+    written, said = _warned(program, guard=False)
+    assert SET_HERE not in written and "has not positioned" in said and "placement guard's check" not in said
