@@ -104,6 +104,7 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_rs274_checks_an_l20_made_under_a_g92_offset_of_the_parameter_file",
         ),
         "shop/test_guard.py": (
+            "test_rs274_stops_the_guarded_program_where_g54_is_turned_other_than_told",
             "test_rs274_runs_a_program_that_selects_its_system_whatever_system_the_control_was_left_in",
             "test_rs274_stops_a_program_before_a_system_it_selects_later_whose_zero_moved",
         ),
@@ -205,10 +206,12 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
         ),
         "writeback/test_expand_cycles.py": ("test_both_commands_take_the_option",),
         "compensation/test_rotation_dialects.py": (
+            "test_the_verifier_refuses_a_writer_that_gets_the_rotation_wrong",
             "test_the_programmed_points_are_reached_under_a_rotation_within_half_a_micron",
         ),
         "compensation/test_several_programs.py": ("test_one_process_does_the_same",),
         "compensation/test_rotation.py": (
+            "test_the_verifier_refuses_a_writer_that_gets_the_rotation_wrong",
             "test_the_programmed_points_are_reached_under_g68_within_half_a_micron",
             "test_a_g68_of_variables_turns_as_their_values_do",
             "test_a_g69_among_modes_of_other_groups_is_followed",
@@ -325,7 +328,10 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_a_counted_loop_around_a_subprograms_repeated_runs_is_refused_at_its_line_at_once",
             "test_subprogram_runs_that_stay_under_the_bound_run_to_their_end",
         ),
-        "hostile/test_many_turns.py": ("test_an_arc_of_ten_thousand_turns_is_compensated_in_bounded_memory",),
+        "hostile/test_many_turns.py": (
+            "test_an_arc_of_more_chords_than_the_verifier_holds_is_refused_at_its_line",
+            "test_an_arc_of_ten_thousand_turns_is_compensated_in_bounded_memory",
+        ),
         "hostile/test_huge_numbers.py": ("test_a_tool_1e308_mm_long_is_refused_without_a_numpy_warning",),
         "hostile/test_constructs.py": (
             "test_a_cycle_left_as_programmed_far_past_any_travel_is_verified_in_bounded_memory",
@@ -409,6 +415,13 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
         ),
         "motion/test_haas_kept_variables.py": None,
         "motion/test_zero_feed.py": None,
+        "verify/test_pipeline_verifies.py": (
+            "test_a_long_loop_is_verified_a_chunk_at_a_time",
+            "test_a_written_loop_that_runs_once_less_is_refused",
+        ),
+        "writeback/test_klartext_once.py": (
+            "test_a_run_written_where_it_runs_and_at_its_text_is_refused_by_the_verifier",
+        ),
     },
     # runs ncpp in two processes (a test parametrized with jobs >= 2 is one too)
     "multiprocess": {
