@@ -14,6 +14,7 @@ import math
 import re
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import replace
+from itertools import takewhile
 from operator import itemgetter
 from typing import Protocol
 
@@ -250,6 +251,13 @@ def _none(events: list[Event]) -> list[str]:
     return []
 
 
+def _leads_in(event: Event) -> bool:
+    """Whether the event is a step to a canned cycle's programmed start (`apply_error_map._lead_in`): after
+    a control line's first event, the cycle its text runs first, the step written before that line (inside
+    the text it would run again with each run)."""
+    return type(event) is Line and event.fixed == CYCLE and event.changed
+
+
 def written_at_once(event: Event) -> bool:
     """Whether the writer writes the block of its first `event` from that event alone, at once: a
     control line's (an o-word, M97, M98, M99) that runs, whose text depends only on its `Pass`; the
@@ -346,9 +354,16 @@ class IsoWriter:
             placing = _AtDefinition(write_group, self.once_runs, self.stamps)
             write_group = placing.write
         control = False  # the group is a control line's, whose writing reads only its first event
+        leading = False  # a control line's first event, held for the lead-in steps that may follow it
         ran = self._ran if type(self)._ran is not IsoWriter._ran else None  # (ISO's does nothing)
         for event in events:
             if event.block is block:
+                if leading and _leads_in(event):
+                    group.append(event)
+                    continue
+                if leading:
+                    yield from write_group(group)
+                    group, control, leading = [], True, False
                 if not control:
                     group.append(event)
                     # (a loop's end or a call owns every move it runs, millions for a long loop: not kept)
@@ -358,10 +373,9 @@ class IsoWriter:
                 continue
             if group:
                 yield from write_group(group)
-            block, group, control = event.block, [event], False
+            block, group, control, leading = event.block, [event], False, False
             if self.control_at_once and self.written_at_once(event):
-                yield from write_group(group)
-                group, control = [], True
+                leading = True
         if group:
             yield from write_group(group)
         if placing is not None:
@@ -404,7 +418,12 @@ class IsoWriter:
             self._tell_unplaced(block, first.setting)
         facts = self._read_block(block)
         if facts.flow:
-            return self._write_control(block, first)
+            # (`write`: the steps to the programmed start of a canned cycle the line's text runs first)
+            steps = [as_written(e) for e in takewhile(_leads_in, group[1:])]  # type: ignore[arg-type]
+            return [
+                *(self._new_blocks(block, steps, block.eol) if steps else ()),
+                *self._write_control(block, first),
+            ]
         if type(first) is Pass and first.setting is not None and first.setting.shift is not None:
             if first.setting.leaves and self.program_motion in (0, 1):
                 return self._stepped_back(block, first.setting)
