@@ -35,7 +35,7 @@ from ncpp.program.dialects import parse_program
 from tests import rs274
 from tests.compensation.closed_machine import ClosedMachine
 from tests.compensation.test_cutter_comp_accuracy import AFFINE, closed_form
-from tests.compensation.test_dialect_cutter_comp import _centre, compensated, machine, offset
+from tests.compensation.test_dialect_cutter_comp import OUTLINE, _centre, compensated, machine, offset
 from tests.compensation.test_rotation import as_linuxcnc, fanuc_written, turned_twice
 from tests.compensation.tool_centre import deviation, feed_moves
 from tests.conftest import ROOT
@@ -138,17 +138,8 @@ M30
 %
 """
 # the contour as drawn (program coordinates, before G68 turns it): (end, arc centre or None, turn)
-CONTOUR = [
-    ((0, 0), None, 0),
-    ((80, 0), None, 0),
-    ((100, 20), (80, 20), 1),
-    ((100, 60), None, 0),
-    ((80, 80), (80, 60), 1),
-    ((30, 80), None, 0),
-    ((0, 50), None, 0),
-    ((0, 0), None, 0),
-    ((0, -30), None, 0),
-]
+# (the outline of the dialects' cutter compensation tests, leaving along its last edge)
+CONTOUR = [*OUTLINE[:-1], ((0, -30), None, 0)]
 _WORD = re.compile(r"([XYZIJR])\s*(-?\d*\.?\d*)")
 
 
