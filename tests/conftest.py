@@ -96,12 +96,11 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
         "shop/test_g92_guard.py": (
             "test_rs274_runs_a_g92_program_where_the_tool_stands_at_the_zero_told_and_stops_it_where_not",
             "test_rs274_checks_only_the_axes_the_program_had_not_positioned",
-            "test_rs274_checks_a_g92_made_under_a_g92_offset_of_the_parameter_file",
+            "test_rs274_checks_an_offset_set_under_a_g92_offset_of_the_parameter_file",
             "test_rs274_checks_the_offset_a_g92_3_restores",
             "test_the_interpreter_applies_the_saved_offset_at_g92_3_as_rs274_does",
             "test_rs274_runs_an_l20_program_where_the_tool_stands_at_the_zero_told_and_stops_it_where_not",
             "test_rs274_checks_the_zero_of_the_system_p_names_on_the_axes_not_positioned",
-            "test_rs274_checks_an_l20_made_under_a_g92_offset_of_the_parameter_file",
         ),
         "shop/test_guard.py": (
             "test_rs274_stops_the_guarded_program_where_g54_is_turned_other_than_told",

@@ -525,19 +525,26 @@ def test_an_offset_set_from_a_compensated_point_where_interpretation_ends_is_the
     )
     (tmp_path / "t.tbl").write_text("T1 P1 Z0 D0.25\nT2 P2 Z0 D0.5\n")
     program, out, proc = _written_out(tmp_path, text)
+    runs = _same_settings_and_last_moves(tmp_path, program, out, 3)
+    moves = [[m.group(1) for m in _MOVES.finditer(run)] for run in runs]
+    assert moves[1] == moves[0][:1] + [moves[0][0]] + moves[0][1:]  # the step, in the program's mode
+    assert "(its modal state is unknown)" in proc.stderr
+
+
+def _same_settings_and_last_moves(tmp_path: Path, program: Path, out: Path, last: int) -> list[str]:
+    """rs274's runs of the original and the written program (tool table t.tbl): asserts that they set
+    the same offsets and end their `last` moves at the same points (to 1e-7); returns the runs."""
     runs = [
         rs274.run(p, tool_table=tmp_path / "t.tbl", digits=7, home=tmp_path).stdout for p in (program, out)
     ]
     before, after = ([m.groups() for m in _SETS.finditer(run)] for run in runs)
     assert before and after == before, (before, after)
-    moves = [[m.group(1) for m in _MOVES.finditer(run)] for run in runs]
-    assert moves[1] == moves[0][:1] + [moves[0][0]] + moves[0][1:]  # the step, in the program's mode
-    last = [
-        [tuple(float(v) for v in m.group(2).split(",")[:3]) for m in _MOVES.finditer(run)][-3:]
+    ends = [
+        [tuple(float(v) for v in m.group(2).split(",")[:3]) for m in _MOVES.finditer(run)][-last:]
         for run in runs
     ]
-    assert np.allclose(last[0], last[1], atol=1e-7), last
-    assert "(its modal state is unknown)" in proc.stderr
+    assert np.allclose(ends[0], ends[1], atol=1e-7), ends
+    return runs
 
 
 @pytest.mark.oracle
@@ -553,16 +560,7 @@ def test_a_zero_set_from_the_current_point_in_a_rotated_system_is_the_programs(t
     )
     (tmp_path / "t.tbl").write_text("T1 P1 Z0 D0.25\n")
     program, out, proc = _written_out(tmp_path, text)
-    runs = [
-        rs274.run(p, tool_table=tmp_path / "t.tbl", digits=7, home=tmp_path).stdout for p in (program, out)
-    ]
-    before, after = ([m.groups() for m in _SETS.finditer(run)] for run in runs)
-    assert before and after == before, (before, after)
-    last = [
-        [tuple(float(v) for v in m.group(2).split(",")[:3]) for m in _MOVES.finditer(run)][-2:]
-        for run in runs
-    ]
-    assert np.allclose(last[0], last[1], atol=1e-7), last
+    _same_settings_and_last_moves(tmp_path, program, out, 2)
     assert "G10 L20 of a rotated coordinate system" in proc.stderr
 
 

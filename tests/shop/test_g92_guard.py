@@ -143,22 +143,6 @@ def test_rs274_checks_only_the_axes_the_program_had_not_positioned(tmp_path):
     assert "this G92 set Z-11.81" in said  # (-300 mm: the tool at the machine's Z0)
 
 
-def test_rs274_checks_a_g92_made_under_a_g92_offset_of_the_parameter_file(tmp_path):
-    """With a G92 offset in effect at the start (#5210 1, #5211 10 mm), the program's zero is
-    G54's plus it: told G54 at X-10, that is the machine zero where rs274 starts, and the new
-    offset (the old one gone: rs274ngc makes the block's point the tool's) is the one ncpp
-    compensated for; told G54 at X0, ncpp takes the tool to stand at X10, and the check stops it."""
-    program = "G21 G90\nG92 X0\nG0 X10 Y10 Z5\nG1 Z-1 F300\nG1 X40\nG0 Z5\nM2\n"
-    shifted = _var_file(tmp_path / "shifted.var", (-10.0, 0.0, 0.0), (10.0, 0.0, 0.0))
-    written, _ = _compensated(tmp_path, program, shifted)
-    assert "[ABS[#5211 - 0.3937] GT 0.0039]]" in written.read_text()
-    _runs_as_the_original(tmp_path, written, shifted)
-
-    off_zero = _var_file(tmp_path / "off.var", (0.0, 0.0, 0.0), (10.0, 0.0, 0.0))
-    written, _ = _compensated(tmp_path, program, off_zero, "off.ngc")
-    assert "this G92 set X0.000000:" in _stops_at_the_check(written, off_zero)
-
-
 def test_rs274_checks_the_offset_a_g92_3_restores(tmp_path):
     """#5211-#5213 hold a G92 offset not in effect (#5210 0, as G92.2 leaves them): G92.3 applies
     it, and ncpp follows it there; a control that saved another stops at the check after it."""
@@ -238,21 +222,36 @@ def test_rs274_checks_the_zero_of_the_system_p_names_on_the_axes_not_positioned(
     assert f"this G10 L20 set {set_there}" in said, said
 
 
-def test_rs274_checks_an_l20_made_under_a_g92_offset_of_the_parameter_file(tmp_path):
-    """rs274ngc sets a G10 L20's zero less the G92 offset in effect (#5210 1, #5211 10 mm): told
-    G54 at X-10, the program's zero is the machine zero where rs274 starts, and the L20 sets G54's
-    X to -10 mm, as ncpp compensated for; told G54 at X0, ncpp takes the tool to stand at X10, the
-    L20 sets -10 mm all the same, and the check stops the program."""
-    program = "G21 G90\nG10 L20 P1 X0 Y0 Z0\nG0 X10 Y10 Z5\nG1 Z-1 F300\nG1 X40\nG0 Z5\nM2\n"
+@pytest.mark.parametrize(
+    "setting, check, stop, said",
+    [
+        ("G92 X0", "[ABS[#5211 - 0.3937] GT 0.0039]]", {}, "this G92 set X0.000000:"),
+        (
+            "G10 L20 P1 X0 Y0 Z0",
+            "[ABS[#5221 + 0.3937] GT 0.0039]",
+            {"check": "G54's zero", "sets": "SET_G5X_OFFSET"},
+            "this G10 L20 set X-0.393701 Y0.000000 Z0.000000:",
+        ),
+    ],
+)
+def test_rs274_checks_an_offset_set_under_a_g92_offset_of_the_parameter_file(
+    tmp_path, setting, check, stop, said
+):
+    """With a G92 offset in effect at the start (#5210 1, #5211 10 mm), the program's zero is G54's
+    plus it: told G54 at X-10, that is the machine zero where rs274 starts.  A G92 then sets the new
+    offset (the old one gone: rs274ngc makes the block's point the tool's), a G10 L20 sets G54's zero
+    less the G92 offset (X -10 mm), each as ncpp compensated for; told G54 at X0, ncpp takes the tool
+    to stand at X10, the block sets its offset all the same, and the check stops the program."""
+    program = f"G21 G90\n{setting}\nG0 X10 Y10 Z5\nG1 Z-1 F300\nG1 X40\nG0 Z5\nM2\n"
     shifted = _var_file(tmp_path / "shifted.var", (-10.0, 0.0, 0.0), (10.0, 0.0, 0.0))
     written, _ = _compensated(tmp_path, program, shifted)
-    assert "[ABS[#5221 + 0.3937] GT 0.0039]" in written.read_text()
+    assert check in written.read_text()
     _runs_as_the_original(tmp_path, written, shifted)
 
     off_zero = _var_file(tmp_path / "off.var", (0.0, 0.0, 0.0), (10.0, 0.0, 0.0))
     written, _ = _compensated(tmp_path, program, off_zero, "off.ngc")
-    said = _stops_at_the_check(written, off_zero, check="G54's zero", sets="SET_G5X_OFFSET")
-    assert "this G10 L20 set X-0.393701 Y0.000000 Z0.000000:" in said, said
+    stopped = _stops_at_the_check(written, off_zero, **stop)
+    assert said in stopped, stopped
 
 
 def test_the_interpreter_applies_the_saved_offset_at_g92_3_as_rs274_does(tmp_path):
