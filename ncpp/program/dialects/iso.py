@@ -430,9 +430,8 @@ class IsoWriter:
             return [self._setting_text(block, first.setting) + block.eol]
         motion = [as_written(e) for e in group if type(e) is Line or type(e) is Arc]
         self._settle_plane(block, motion)
-        lead = 0  # steps to a canned cycle's start (`apply_error_map._lead_in`): new blocks before it
-        while lead < len(motion) and motion[lead].fixed == CYCLE and motion[lead].changed:
-            lead += 1
+        # steps to a canned cycle's start (`apply_error_map._lead_in`): new blocks before it
+        lead = sum(1 for _ in takewhile(_leads_in, motion))
         lines = self._new_blocks(block, motion[:lead], block.eol) if lead else []
         motion = motion[lead:] if lead else motion
         hole = motion[0].hole if motion and type(motion[0]) is Line else None
