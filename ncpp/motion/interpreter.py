@@ -5,7 +5,7 @@
 (o-word control flow, `flow.py`), state bounded whatever the program length.  Positions are program (work) coordinates in program units,
 exactly what rs274 prints in its canonical calls; `Context.offset` says where
 the program origin sits in machine coordinates.  Under a rotation of the coordinate system
-(G10 L2 R, Fanuc's G68: `Context.rotation`) they are turned as the control turns them, a
+(G10 L2 R, Fanuc's G68 in any plane: `Context.rotation`) they are turned as the control turns them, a
 translation of the machine position (`canon_call` turns them back to rs274's).
 
 Scope: modal G0-G3, planes, G90/G91, G90.1/G91.1, G20/G21 (state converted
@@ -1596,7 +1596,9 @@ class Interpreter:
         rotation about Z (G10 L2 R, Fanuc's G68) in G17: the controls offset the turned contour
         (Fanuc Series 16/18-MC operator's manual, "Coordinate system rotation": cutter compensation
         "is performed after the coordinate system is rotated"), whose moves are in the turned frame
-        here, so their tool centre is too; in G18 the offset would turn out of its plane (not followed)."""
+        here, so their tool centre is too; in G18 the offset would turn out of its plane under a rotation
+        about Z, and under Fanuc's G68 in G18 a lathe tool's orientation would not turn with the contour
+        (neither followed)."""
         code, item = code_item
         if code == 40.0:
             self.arc_refused = self.arc_refused or self.centre.off_path
