@@ -438,11 +438,15 @@ class FanucInterpreter(Interpreter):
             return self._cancel_rotation(block, words, col)
         planes = [int(w.value) for w in words if w.letter == "G" and w.value in (17.0, 18.0, 19.0)]
         plane = planes[0] if planes else self.plane
-        first, second = plane_letters(plane)
+        letters = plane_letters(plane)
+        first, second = letters[0], letters[1]
         if len(planes) > 1 or any(
-            w.letter not in ("N", "R", "G", first, second) or (w.letter == "G" and w.value != plane) for w in words
+            w.letter not in ("N", "R", "G", first, second) or (w.letter == "G" and w.value != plane)
+            for w in words
         ):
-            raise _OutOfScope(f"G68 with other words in its block than G{plane}, {first}, {second} and R", col)
+            raise _OutOfScope(
+                f"G68 with other words in its block than G{plane}, {first}, {second} and R", col
+            )
         given = {w.letter: w.value for w in words}
         why = (
             "while a rotation is in effect" if self.g68 is not None
@@ -458,7 +462,7 @@ class FanucInterpreter(Interpreter):
         if planes:
             self._set(plane=plane)
         self._keeping_machine(lambda: self._turn(plane, (given["R"], given[first], given[second])))
-        self.unsettled_rotation = 68.0
+        self.unsettled_rotation, self.rotation_homed = 68.0, set()
         return Pass(block)
 
     def _turn(self, plane: int, rotation: tuple[float, float, float]) -> None:
@@ -479,7 +483,7 @@ class FanucInterpreter(Interpreter):
             raise _OutOfScope("G69 under cutter compensation", col)
         if self.g68 is not None:
             self._keeping_machine(lambda: setattr(self, "g68", None))
-            self.unsettled_rotation = 69.0
+            self.unsettled_rotation, self.rotation_homed = 69.0, set()
         if all(w.letter == "N" for w in words):
             return Pass(block)
         return super().block(block)

@@ -381,6 +381,7 @@ class Interpreter:
         self.g68: tuple[float, float, float] | None = None
         self.g68_plane = 17
         self.unsettled_rotation: float | None = None
+        self.rotation_homed: set[str] = set()  # the plane's axes a G28/G30 homed since (`_settle_rotation`)
         self.g92 = [0.0] * 9
         self.g92_saved = [0.0] * 9
         self.tool = [0.0] * 9  # the tool length offset in effect, program units
@@ -960,20 +961,24 @@ class Interpreter:
         plane (X and Y in G17, Z and X in G18, Y and Z in G19) absolutely, a move that gives one of them
         alone takes the other from a position the manual does not say: not followed; nor a G91 move of
         one of them after G69.  A G53 move leaves this as it is; a G28/G30 in G91 whose increments of
-        them are 0 (the return posts write) moves from where the tool stands, and homing both settles it."""
+        them are 0 (the return posts write) moves from where the tool stands and homes them, which places
+        them as an absolute move does (`G91 G28 Z0.` then `G28 X0. Y0.` after a G68 in G18)."""
         letters = plane_letters(self.g68_plane)
-        given = [item for item in block.items if isinstance(item, (Word, ExprWord)) and item.letter in letters]
+        given = [
+            item for item in block.items if isinstance(item, (Word, ExprWord)) and item.letter in letters
+        ]
         codes = {item.value for item in block.items if type(item) is Word and item.letter == "G"}
         if not given or 53.0 in codes:
             return
-        both = len({item.letter for item in given}) == 2
+        placed = {item.letter for item in given} | self.rotation_homed
         if (
             codes & {28.0, 30.0}
             and not self.absolute
             and all(type(i) is Word and i.value == 0.0 for i in given)
         ):
-            self.unsettled_rotation = None if both else self.unsettled_rotation
-        elif self.absolute and both:
+            self.rotation_homed = placed
+            self.unsettled_rotation = None if len(placed) == 2 else self.unsettled_rotation
+        elif self.absolute and len(placed) == 2:
             self.unsettled_rotation = None
         elif self.absolute:
             raise _OutOfScope(f"an absolute move of {' or '.join(letters)} alone after G{self.unsettled_rotation:g}",
@@ -1859,7 +1864,9 @@ class Interpreter:
         turned = PLANE_AXES[self._rotation_plane()][:2]
         if self._rotation() is not None and any(new[i] != self.tool[i] for i in turned):  # (not turned)
             letters = " or ".join(plane_letters(self._rotation_plane()))
-            raise _OutOfScope(f"a tool offset in {letters} under a coordinate system rotation", item.start + 1)
+            raise _OutOfScope(
+                f"a tool offset in {letters} under a coordinate system rotation", item.start + 1
+            )
         held = self.pos[:] if changed else None
         self._shift(self.tool, new)
         self.tool = new
@@ -2631,7 +2638,7 @@ class Interpreter:
     def _arc(self, block: Block, words: dict, motion: float, motion_item, mode1_item) -> Arc | Pass:
         word = motion_item if motion_item is not None else next(item for _, item in words.values())
         plane = self.plane
-        if plane != self._rotation_plane() and self._rotation() is not None:  # (its plane turns off the machine's)
+        if plane != self._rotation_plane() and self._rotation() is not None:  # (turned off its plane)
             raise _OutOfScope(f"an arc in G{plane} under a coordinate system rotation", word.start + 1)
         first_letter, second_letter, normal_letter = _ARC_LETTERS[plane]
         radius = words.get("R")

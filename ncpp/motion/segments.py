@@ -90,7 +90,8 @@ class Context:
     # coordinates in that plane, program units); segments are in the turned frame, the program's words are
     # not (`turned`)
     rotation: tuple[float, float, float] | None = None
-    rotation_plane: int = 17  # the plane `rotation` turns (`PLANE_AXES`: G18 turns Z toward X, G19 Y toward Z)
+    # the plane `rotation` turns (`PLANE_AXES`: G18 turns Z toward X, G19 Y toward Z)
+    rotation_plane: int = 17
 
     @property
     def tool_mm(self) -> Point:
@@ -123,7 +124,9 @@ class Context:
         return (q[0], q[1], q[2])
 
 
-def turn_in_plane(p: list[float], rotation: tuple[float, float, float], plane: int, sign: float = 1.0) -> None:
+def turn_in_plane(
+    p: list[float], rotation: tuple[float, float, float], plane: int, sign: float = 1.0
+) -> None:
     """Turn point `p` (x, y, z, ...) in place by `rotation` about its centre in `plane`: from the plane's
     first axis toward its second (`PLANE_AXES`, as an arc of G3 turns there); `sign` -1: back."""
     a, b, _ = PLANE_AXES[plane]

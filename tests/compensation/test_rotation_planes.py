@@ -115,7 +115,9 @@ def worked_out(text: str) -> tuple[np.ndarray, str]:
         motion = next((int(g) for g in codes if g in (0, 1, 2, 3)), motion)
         axes = {"XYZ".index(letter): value for letter, value in given.items() if letter in "XYZ"}
         if not axes:
-            lines.append(f"G{plane}" if any(g in (17, 18, 19) for g in codes) else "M2" if "M" in given else "")
+            lines.append(
+                f"G{plane}" if any(g in (17, 18, 19) for g in codes) else "M2" if "M" in given else ""
+            )
             continue
         turn = rotation or Rotation(plane, 0.0, (0.0, 0.0))
         start = here
@@ -154,7 +156,9 @@ def compensated(tmp_path: Path, text: str, dialect: str = "fanuc") -> tuple[Path
 
 @pytest.mark.parametrize("dialect", ["fanuc", "haas"])
 @pytest.mark.parametrize("plane", [18, 19])
-def test_the_programmed_points_are_reached_under_g68_in_g18_and_g19_within_half_a_micron(tmp_path, plane, dialect):
+def test_the_programmed_points_are_reached_under_g68_in_g18_and_g19_within_half_a_micron(
+    tmp_path, plane, dialect
+):
     """Every programmed end point, turned in the plane about G68's centre as the manual says, is reached
     within 0.5 µm by the rewritten program on the machine; the program as written misses them by more
     than 10 µm."""
@@ -232,3 +236,18 @@ def test_the_first_move_ncpp_rewrites_after_a_g18_rotation_gives_both_of_its_axe
     reached, _ = worked_out(out.read_text())
     wanted, _ = worked_out(text)
     assert misses(closed_form(reached), wanted.tolist()).max() < 0.0005
+
+
+def test_the_returns_posts_write_after_a_g18_rotation_are_followed():
+    """`G91 G28 Z0.` then `G28 X0. Y0.` after G69 (a Fanuc post's ending) home Z, then X and Y, from
+    where the tool stands: with both axes of the rotation's plane homed, the absolute move after them is
+    read, with no warning; without them, an absolute move of X alone is not followed."""
+    text = (
+        "G21 G90 G17\nG0 X1 Y1 Z5\nG18\nG68 X0 Z0 R30\nG1 X5 Z5 F100\nG69\nG91 G28 Z0.\nG28 X0. Y0.\n"
+        "G90 G0 X7\nM30\n"
+    )
+    events, warning = interpreted(text, "fanuc")
+    assert not warning, warning
+    assert [e.block.line for e in events if type(e).__name__ == "Line"][-1] == 9
+    _, warning = interpreted(text.replace("G91 G28 Z0.\nG28 X0. Y0.\n", ""), "fanuc")
+    assert "t.ngc:7:8: " in warning and "an absolute move of Z or X alone after G69" in warning, warning

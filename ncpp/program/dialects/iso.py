@@ -660,14 +660,18 @@ class IsoWriter:
             if seen is not None and seen is not context and _turns_plane(seen, context):
                 self._plane_unsettled = True
                 turned = (frame for frame in (seen, context) if frame.rotation is not None)
-                self._unsettled_letters = frozenset("".join(plane_letters(frame.rotation_plane) for frame in turned))
+                self._unsettled_letters = frozenset(
+                    "".join(plane_letters(frame.rotation_plane) for frame in turned)
+                )
             self._frame_seen = context
         if not (self._plane_unsettled and motion):
             return
         if any(segment.changed for segment in motion):
             if motion[0].context.absolute:
                 self._last_end, self._plane_unsettled = None, False
-        elif self._unsettled_letters <= {i.letter for i in block.items if type(i) is Word or type(i) is ExprWord}:
+        elif self._unsettled_letters <= {
+            i.letter for i in block.items if type(i) is Word or type(i) is ExprWord
+        }:
             self._plane_unsettled = False  # (the program's own block gives both, as the control needs)
 
     def _after_verbatim(self, block: Block, motion: list[Line | Arc]) -> None:
