@@ -33,6 +33,7 @@ from ncpp.motion.segments import (
     Line,
     Pass,
     Setting,
+    plane_letters,
 )
 from ncpp.passes.rotary import time_shares, turns
 from ncpp.program.blocks import DIGITS_AS_ONE, Block, Comment, ExprWord, Statement, Word
@@ -326,6 +327,7 @@ class IsoWriter:
         self._last_context: Context | None = None  # the frame (units, offsets) `_last_end` is in
         self._frame_seen: Context | None = None  # the frame of the last block's moves (`_settle_plane`)
         self._plane_unsettled = False  # a rotation turned or moved the frame since a move gave X and Y
+        self._unsettled_letters = frozenset("XY")  # the axes of the plane(s) it turned (`_settle_plane`)
 
     def comment(self, text: str) -> str:
         return f"{self.comment_open}{text}{self.comment_close}"
@@ -648,21 +650,28 @@ class IsoWriter:
 
     def _settle_plane(self, block: Block, motion: list[Line | Arc]) -> None:
         """After a rotation of the coordinate system turned or moved the frame (Fanuc's G68 and G69,
-        Klartext's Cycle 10, Sinumerik's frames), the control places X and Y once a move gives both
-        absolutely, and the interpreter follows no move of one of them alone before (`settle_rotation`):
-        the first block edited there writes every axis it knows, so that a correction written on a move
-        along Z, or a word left out where its axis stands, does not give X or Y alone."""
+        Klartext's Cycle 10, Sinumerik's frames), the control places the axes of the plane it turns (X and
+        Y; Z and X for a G68 in G18, Y and Z in G19) once a move gives both absolutely, and the interpreter
+        follows no move of one of them alone before (`settle_rotation`): the first block edited there
+        writes every axis it knows, so that a correction written on a move along the other axis, or a word
+        left out where its axis stands, does not give one of them alone."""
         for segment in motion:
             seen, context = self._frame_seen, segment.context
             if seen is not None and seen is not context and _turns_plane(seen, context):
                 self._plane_unsettled = True
+                turned = (frame for frame in (seen, context) if frame.rotation is not None)
+                self._unsettled_letters = frozenset(
+                    "".join(plane_letters(frame.rotation_plane) for frame in turned)
+                )
             self._frame_seen = context
         if not (self._plane_unsettled and motion):
             return
         if any(segment.changed for segment in motion):
             if motion[0].context.absolute:
                 self._last_end, self._plane_unsettled = None, False
-        elif {"X", "Y"} <= {i.letter for i in block.items if type(i) is Word or type(i) is ExprWord}:
+        elif self._unsettled_letters <= {
+            i.letter for i in block.items if type(i) is Word or type(i) is ExprWord
+        }:
             self._plane_unsettled = False  # (the program's own block gives both, as the control needs)
 
     def _after_verbatim(self, block: Block, motion: list[Line | Arc]) -> None:
@@ -1272,16 +1281,24 @@ def _words(block: Block, facts: _Facts) -> tuple[Word, ...]:
 
 
 def _turns_plane(before: Context, after: Context) -> bool:
-    """Whether a rotation of the coordinate system, before or after, turned or moved the working plane."""
+    """Whether a rotation of the coordinate system, before or after, turned or moved the plane it turns."""
     if before.rotation is None and after.rotation is None:
         return False
-    return before.rotation != after.rotation or before.offset[:2] != after.offset[:2]
+    if before.rotation != after.rotation or before.rotation_plane != after.rotation_plane:
+        return True
+    a, b, _ = PLANE_AXES[after.rotation_plane]
+    return before.offset[a] != after.offset[a] or before.offset[b] != after.offset[b]
 
 
 def reframed(before: Context, after: Context) -> bool:
     """Whether the program's numbers mean other machine positions after than before (units, offsets,
     the rotation of the coordinate system)."""
-    return before.inch != after.inch or before.offset != after.offset or before.rotation != after.rotation
+    return (
+        before.inch != after.inch
+        or before.offset != after.offset
+        or before.rotation != after.rotation
+        or before.rotation_plane != after.rotation_plane
+    )
 
 
 def as_written(segment: Line | Arc) -> Line | Arc:
