@@ -352,8 +352,8 @@ def test_each_move_ends_with_the_tool_centre_where_the_correction_puts_it(
     tmp_path, text, machine, reached, radius
 ):
     """The control offsets a line square to its own written direction and an arc radially about its
-    written centre (LinuxCNC's manual, "Cutter Compensation"), both of which the correction turns a
-    little: the tool centre at the end of each move under compensation lands, run on the machine,
+    written centre (`ncpp.motion.cutter`; rs274, the judge here, does so), both of which the
+    correction turns a little: the tool centre at the end of each move under compensation lands, run on the machine,
     within 0.1 µm of the original's there, where the radius times the turn is 0.3-0.8 µm: the move
     before G40, a move the next one continues smoothly, a line before an inside corner with a line.
     (Where a line and an arc meet at a corner, or lines at an outside corner, the control's
