@@ -41,10 +41,10 @@ T M S F H D words, G28/G30, G53, G10 L2 P1-P9), select one (`_iso_selects_first`
 
 A LinuxCNC program's G92 that sets the offset of an axis the program has not positioned yet sets it
 from where the operator left the tool (`G92 X0 Y0 Z0` at the top of a hobby program), which ncpp
-takes to be the program's zero: the writer tells the axes (`IsoWriter.unplaced_setting`), and a
-check after the block stops the program when #5211-#5213, the G92 offset X Y Z (G-code manual,
-"Numbered Parameters": #5210 1 while a G52/G92 offset is applied, #5211-#5219 its axes, in the
-machine's units, set by the G92 as rs274 runs it), is not the one ncpp compensated for within
+takes to be the program's zero: the writer hands the axes to the check after the block
+(`PlacementChecks.after`), which stops the program when #5211-#5213, the G92 offset X Y Z (G-code
+manual, "Numbered Parameters": #5210 1 while a G52/G92 offset is applied, #5211-#5219 its axes, in
+the machine's units, set by the G92 as rs274 runs it), is not the one ncpp compensated for within
 `GUARD_MM` on those axes (`offset_lines`).  The offset does not depend on the one in effect before:
 rs274ngc makes the block's point the tool's, whatever the old offset.  A G92.3 (G-code manual,
 "G92.3 Restore G92 Offsets": the offset of #5211-#5219) gets the check of X Y Z: the saved offset
@@ -166,7 +166,7 @@ does not know the control's parameters, and the guards neither move nor act.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Generator, Iterable, Iterator
+from collections.abc import Callable, Collection, Generator, Iterable, Iterator
 from dataclasses import dataclass, replace
 from functools import cache
 from itertools import chain, islice
@@ -647,12 +647,12 @@ def _setting_word(word: Word, axes: bool) -> bool:
 
 class PlacementChecks:
     """The placement guard's check of the zero of each told system an ISO program selects, once,
-    before the first block that selects it (the writer's `before`): the interpreter marks the
-    block (`Pass.zero_told`) where it runs once and the zero is still the one told.  LinuxCNC's
+    before the first block that selects it (`before`): the interpreter marks the block
+    (`Pass.zero_told`) where it runs once and the zero is still the one told.  LinuxCNC's
     syntax, or Fanuc's (Haas's) in a Fanuc program (a program number at its top).  In LinuxCNC's,
-    the offset a G92 or G10 L20 sets too, after the block where it sets it on axes the program has
-    not positioned (the writer tells them: `unplaced`), and the G92 offset after a G92.3 (`after`,
-    the interpreter's `Pass.offset_told`)."""
+    the offset a G92 or G10 L20 sets too, after the block, on the axes the program has not
+    positioned, which the writer hands over (`after`), and the G92 offset after a G92.3 (the
+    interpreter's `Pass.offset_told`)."""
 
     def __init__(
         self,
@@ -665,17 +665,14 @@ class PlacementChecks:
         self.looked = 0  # blocks looked at for a Fanuc program number
         self.checked: set[int] = set()
         self.labels = 0  # the checks written so far (each `if` a label of its own)
-        self.setting: Pass | None = None  # the block being written's mark (`Pass.offset_told`)
-        self.unplaced_axes: set[int] = set()  # the axes of its G92 or G10 L20 the program has not positioned
 
-    def __call__(self, events: list[Event]) -> list[str]:
+    def before(self, events: list[Event]) -> list[str]:
+        """The check of the zero of the told system the block selects, where it is the first to."""
         block = events[0].block
         if self.dialect == "iso" and self.looked < LEADER_LINES + 12:
             self.looked += 1
             if _program_number(block.items):
                 self.dialect = "fanuc"
-        self.setting = next((e for e in events if type(e) is Pass and e.offset_told), None)
-        self.unplaced_axes = set()
         number = next((e.zero_told for e in events if type(e) is Pass and e.zero_told is not None), None)
         if number is None or number in self.checked:
             return []
@@ -689,33 +686,34 @@ class PlacementChecks:
         eol = block.eol or "\n"
         return [line + eol for line in lines]
 
-    def unplaced(self, axes: Iterable[str], block: Block) -> bool:
-        """The writer's word that the G92 (or G10 L20) `block` sets the offset of `axes` (X Y Z)
-        from where the control stands, which the program has not positioned: whether a check after
-        the block stops the program where the offset it sets differs (LinuxCNC's, not the last line)."""
-        mark = self.setting
-        if mark is None or mark.offset_told is None or mark.block is not block:
-            return False
-        if self.dialect != "iso" or not block.eol:
-            return False
-        told = {axis for axis, _ in mark.offset_told[1]}
-        self.unplaced_axes = {"XYZ".index(axis) for axis in axes} & told
-        return bool(self.unplaced_axes)
-
-    def after(self, events: list[Event]) -> list[str]:
-        """The check of the offset after the block (the writer's `after`): after a G92 or G10 L20, of
-        the axes `unplaced` told; after a G92.3, of X Y Z."""
-        mark, self.setting = self.setting, None
-        if mark is None or mark.offset_told is None or self.dialect != "iso" or not events[0].block.eol:
+    def after(self, events: list[Event], unplaced: Collection[str]) -> list[str]:
+        """The check of the offset after the block: after a G92 or G10 L20, of its `unplaced` axes
+        (X Y Z the program had not positioned before it); after a G92.3, of X Y Z."""
+        checked = self._offset_checked(events, unplaced)
+        if checked is None:
             return []
-        system, told = mark.offset_told
-        restored = not any(type(e) is Pass and e.setting is not None for e in events)
-        offset = [(axis, mm) for axis, mm in told if restored or axis in self.unplaced_axes]
-        if not offset:
-            return []
+        system, offset, restored = checked
         self.labels += 1
-        lines = offset_lines(system, offset, self.unit_mm, self.labels, restored)
-        return [line + events[0].block.eol for line in lines]
+        eol = events[0].block.eol
+        return [line + eol for line in offset_lines(system, offset, self.unit_mm, self.labels, restored)]
+
+    def checks_offset(self, events: list[Event], unplaced: Collection[str]) -> bool:
+        """Whether `after` checks the offset the block sets (the writer's warning of a G92 or
+        G10 L20 on `unplaced` axes says that the check stops the program where it differs)."""
+        return self._offset_checked(events, unplaced) is not None
+
+    def _offset_checked(
+        self, events: list[Event], unplaced: Collection[str]
+    ) -> tuple[int, list[tuple[int, float]], bool] | None:
+        """(the system, the offset on each axis 0-2 in mm, whether a G92.3 restored it) that the
+        check after the block compares; None where there is none (LinuxCNC's only, not after the
+        last line)."""
+        told = next((e.offset_told for e in events if type(e) is Pass and e.offset_told), None)
+        if told is None or self.dialect != "iso" or not events[0].block.eol:
+            return None
+        restored = not any(type(e) is Pass and e.setting is not None for e in events)
+        offset = [(axis, mm) for axis, mm in told[1] if restored or "XYZ"[axis] in unplaced]
+        return (told[0], offset, restored) if offset else None
 
 
 def offset_lines(

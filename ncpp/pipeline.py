@@ -35,7 +35,7 @@ from ncpp.passes.context import Corrections, ErrorMap, is_directional
 from ncpp.passes.inverse import iterations_for
 from ncpp.program.blocks import STRAY_TAPE, Block, Comment, Statement, Word
 from ncpp.program.dialects import FAMILY, dialect_tools, get_dialect, parse_program
-from ncpp.program.dialects.iso import IsoWriter
+from ncpp.program.dialects.iso import ChecksAfter, ChecksBefore, IsoWriter
 from ncpp.program.parser import LEADER_LINES
 from ncpp.runtime import keep_freed_memory
 from ncpp.summary import Summary
@@ -485,8 +485,8 @@ def process(
             )
     # which of a Fanuc or Haas file's programs runs as the main one: the flow tells, the guard goes there
     main = MainProgram() if FAMILY[name] == "iso" else None
-    after = _tool_guard(name, offsets, warnings, file) if guard_tools else None
-    if after is not None and name == "iso":  # (LinuxCNC's tool parameters: the reads to check)
+    tools = _tool_guard(name, offsets, warnings, file) if guard_tools else None
+    if tools is not None and name == "iso":  # (LinuxCNC's tool parameters: the reads to check)
         expanding["guard_reads"] = True
     events: Iterable[Event] = interpret(
         blocks, file=file, warnings=warnings, strict=strict, offsets=offsets, **expanding,
@@ -507,7 +507,7 @@ def process(
         PlacementChecks(offsets, name, guard.unit_mm, lambda why: warnings.warn(
             f"no placement guard: {why}", Location(file, 1, None))) if guard is not None and name in ISO_SYNTAX else None
     )  # fmt: skip
-    writer.unplaced_setting = lambda axes, block: _warn_unplaced(axes, block, checks, warnings, file)
+    writer.unplaced_setting = lambda axes, events: _warn_unplaced(axes, events, checks, warnings, file)
     writer.unstepped = lambda block: warnings.warn(
         "this line runs a loop or subroutine in which interpretation ends, after a compensated move, in a mode "
         "other than G0 or G1 (an arc's, a canned cycle's), which a step back to the programmed point would change: "
@@ -520,13 +520,8 @@ def process(
     ctx = make_context(source, tolerance, warnings, file)
     compensated = reached.follow(summary.written(run_passes(summary.programmed(events), ctx, PASSES)))
     header = header_text(source, tolerance, offsets, name)
-    before: Callable[[list[Event]], list[str]] | None = checks
-    behind: Callable[[list[Event]], list[str]] | None = after
-    if after is not None:  # (and the tool parameters a block reads, checked before it)
-        before = _both(checks, after.before) if checks is not None else after.before
-    if checks is not None:
-        behind = _both(checks.after, after) if after is not None else checks.after
-    lines = with_header(writer.write(compensated, behind, before), header, writer, get_dialect(name).leader)
+    before, after = _guards(checks, tools)
+    lines = with_header(writer.write(compensated, after, before), header, writer, get_dialect(name).leader)
     if guard is not None:
         said = replace(guard, dialect=name).said()  # (as the program's dialect names the system)
         lines = with_guard(lines, guard, name, HEADER_TAG, header.count("\n") + 1,
@@ -557,19 +552,28 @@ def process(
     return stats
 
 
-def _both(
-    first: Callable[[list[Event]], list[str]], then: Callable[[list[Event]], list[str]]
-) -> Callable[[list[Event]], list[str]]:
-    """The writer's `before` or `after` of two guards: the lines of `first`, then those of `then`."""
-    return lambda events: [*first(events), *then(events)]
+def _guards(
+    checks: PlacementChecks | None, tools: ToolGuard | None
+) -> tuple[ChecksBefore | None, ChecksAfter | None]:
+    """The writer's `before` and `after`: the placement guard's checks, then the tool guard's (the
+    tool parameters a block reads before it, the length it applies after it)."""
+    if tools is None:
+        return (checks.before, checks.after) if checks is not None else (None, None)
+    if checks is None:
+        return tools.before, lambda events, unplaced: tools(events)
+    return (
+        lambda events: [*checks.before(events), *tools.before(events)],
+        lambda events, unplaced: [*checks.after(events, unplaced), *tools(events)],
+    )
 
 
 def _warn_unplaced(
-    axes: list[str], block: Block, checks: PlacementChecks | None, warnings: Warnings, file: str
+    axes: list[str], events: list[Event], checks: PlacementChecks | None, warnings: Warnings, file: str
 ) -> None:
-    """The warning of a G92 / G10 L20 that sets the offset of `axes`, which the program has not
-    positioned, from where the control stands; it says whether the placement guard checks it."""
-    checked = checks is not None and checks.unplaced(axes, block)
+    """The warning of a G92 / G10 L20 (its events) that sets the offset of `axes`, which the program
+    has not positioned, from where the control stands; it says whether the placement guard checks it."""
+    block = events[0].block
+    checked = checks is not None and checks.checks_offset(events, axes)
     then = (
         "; the placement guard's check after it stops the program where the offset it sets differs from that"
         if checked else ""

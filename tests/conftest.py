@@ -56,6 +56,9 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_the_whole_path_under_g68_lands_on_the_original_in_rs274",
             "test_a_parameter_files_rotation_is_followed_as_rs274_follows_it",
         ),
+        "compensation/test_rotation_planes.py": (
+            "test_the_whole_path_under_g68_in_g18_and_g19_lands_on_the_original_in_rs274",
+        ),
         "compensation/test_rotated_cutter_comp.py": (
             "test_g41_under_g10_l2_r_passes_pathcheck_at_twice_the_largest_correction",
             "test_g41_under_g68_lands_on_the_original_in_rs274_written_as_linuxcncs_g10_l2_r",
@@ -71,6 +74,7 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_the_entry_arc_stays_one_arc_the_control_accepts",
             "test_mmount_contours_land_within_the_tolerance",
             "test_a_move_along_z_alone_under_compensation_makes_no_move_in_the_plane",
+            "test_each_move_ends_with_the_tool_centre_where_the_correction_puts_it",
         ),
         "motion/test_oracle.py": None,
         "compensation/test_tool_parameters.py": (
@@ -216,6 +220,11 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_a_g68_of_variables_turns_as_their_values_do",
             "test_a_g69_among_modes_of_other_groups_is_followed",
             "test_a_safety_lines_cancels_of_modes_not_in_effect_change_nothing",
+        ),
+        "compensation/test_rotation_planes.py": (
+            "test_the_verifier_refuses_a_writer_that_gets_a_g18_rotation_wrong",
+            "test_the_programmed_points_are_reached_under_g68_in_g18_and_g19_within_half_a_micron",
+            "test_the_first_move_ncpp_rewrites_after_a_g18_rotation_gives_both_of_its_axes",
         ),
         "shop/test_extents.py": None,  # (each runs the command line)
         "compensation/test_warning_order.py": None,

@@ -22,8 +22,9 @@ G28/G30 return, a machine-coordinate move), where it does, and under cutter comp
 ncpp follows where the tool centre stands off the move's start and end ("centre_shift").
 Under a rotation of the coordinate system (LinuxCNC's G10 L2 R, Fanuc's and Haas's G68) a
 record's points are where the control turns the program's to (machine position minus "offset"),
-and "rotation" gives the turn: degrees counter-clockwise and its centre X Y in program
-coordinates; `--format rs274` prints the program's own coordinates, as rs274 does.
+and "rotation" gives the turn: degrees counter-clockwise and its centre's coordinates in program
+coordinates, in the plane "rotation_plane" says (17: X Y; G68 in 18: Z X, in 19: Y Z, the plane's
+first axis first); `--format rs274` prints the program's own coordinates, as rs274 does.
 
 `--var-file linuxcnc.var` / `--work-offset [G5x=]X,Y,Z` start the
 interpreter from the control's zeros, as `rs274 -v FILE` does (default: all
@@ -126,6 +127,7 @@ def run(args: argparse.Namespace) -> int:
                 record["extra"] = event.extra
             if event.context.rotation is not None:  # (the points are in the turned frame)
                 record["rotation"] = event.context.rotation
+                record["rotation_plane"] = event.context.rotation_plane
             if (
                 event.fixed
             ):  # why compensation leaves it as programmed (a canned cycle, cutter compensation, ...)

@@ -102,13 +102,14 @@ in G19 (Fanuc operator's manuals, "Canned cycle for drilling": "Positioning plan
 axis", G17 Zp, G18 Yp, G19 Xp; the drilling axis is the basic axis not used to define the
 positioning plane), as rs274ngc drills but does not tap there (`Interpreter.taps_in_any_plane`).
 
-Coordinate system rotation `G68 X_ Y_ R_` / `G69` in G17 is followed (`_coordinate_rotation`, and
-`Interpreter._settle_rotation` for the moves after it) where the Fanuc manual's rules leave nothing to a
-parameter (Fanuc Series 16/18/160/180-MC operator's manual, "Coordinate system rotation": X Y the
-centre, absolute; R the angle, counter-clockwise; without X Y the tool's position is the centre, without
-R a parameter's angle; no G17-G19 in its mode; G91 moves after it run from where the tool stood at
-G68; the first move after G69 absolute), Haas's alike (Mill Operator's Manual, "G68 Rotation": R
-from Setting 72 when not given, added in G91 with Setting 73).  Scaling (G51), the programmable
+Coordinate system rotation `G68 X_ Y_ R_` / `G69` in G17, and in G18 (`G68 Z_ X_ R_`) and G19
+(`G68 Y_ Z_ R_`), is followed (`_coordinate_rotation`, and `Interpreter._settle_rotation` for the
+moves after it) where the Fanuc manual's rules leave nothing to a parameter (Fanuc Series
+16/18/160/180-MC operator's manual, "Coordinate system rotation": the plane's two axis words the
+centre, absolute; R the angle, counter-clockwise; without them the tool's position is the centre,
+without R a parameter's angle; no G17-G19 in its mode; G91 moves after it run from where the tool
+stood at G68; the first move after G69 absolute), Haas's alike (Mill Operator's Manual, "G68
+Rotation": R from Setting 72 when not given, added in G91 with Setting 73).  Scaling (G51), the programmable
 mirror image (G51.1), G68.1 and the tilted working plane (G68.2-G68.4) end interpretation by name.
 
 A canned cycle's K is its repeats, as rs274ngc's L (the Fanuc Series 0i and 16i formats, `G81 X_ Y_ Z_ R_
@@ -197,7 +198,7 @@ from ncpp.motion.cycles import CANNED
 from ncpp.motion.expressions import vacant
 from ncpp.motion.interpreter import IGNORED_STATEMENTS, MM_PER_INCH, Interpreter, _OutOfScope, interpreting
 from ncpp.motion.offsets import ADDITIONAL, ADDITIONAL_CODES
-from ncpp.motion.segments import Event, Pass
+from ncpp.motion.segments import Event, Pass, plane_letters
 from ncpp.program.blocks import Block, Comment, ExprWord, Statement, Word
 
 # Fanuc's common variables: #100-#199 cleared at power off, #500-#999 kept through it, both shared by
@@ -396,49 +397,77 @@ class FanucInterpreter(Interpreter):
         return super()._motion_of_words(block, mode0, mode1, mode1_item, axis_item, polar_item)
 
     def _coordinate_rotation(self, block: Block, code: Word) -> Event | tuple[Event, ...]:
-        """`G68 X_ Y_ R_` in G17 (`G17` may stand in its block): the program's X Y turned about the centre X
-        Y (absolute) by R degrees counter-clockwise, from the next block on; `G69` cancels it (Fanuc Series
-        16/18-MC operator's manual, "Coordinate system rotation"; Haas Mill Operator's Manual, "G68
-        Rotation").  The machine stays where it is; the moves after it follow `_settle_rotation`'s rules.
+        """`G68 X_ Y_ R_` in G17, `G68 Z_ X_ R_` in G18, `G68 Y_ Z_ R_` in G19 (the plane's code may stand in
+        its block): the program's coordinates in that plane turned about the centre its two axis words give
+        (absolute) by R degrees counter-clockwise, from the next block on; `G69` cancels it (Fanuc Series
+        16/18-MC operator's manual, "Coordinate system rotation"; Fanuc Series 0i connection manual
+        (function) B-64113EN-1, 11.12 "Coordinate system rotation": "G17 (G18 or G19): Select the plane
+        that contains the figure to be rotated", α β "Absolute command for two of the X_, Y_, and Z_ axes
+        that correspond to the current plane selected", R "A positive angular displacement indicates counter
+        clockwise rotation"; Haas Mill Operator's Manual 96-8000, "G68 Rotation": "a optional center of
+        rotation for the first axis of the selected plane", "For a positive angle, the rotation is
+        counterclockwise").
+        Counter-clockwise in G18 and G19 is the plane's own sense, that of its arcs' G03: seen from the
+        positive end of the axis normal to it, from the plane's first axis toward its second, Z toward X in
+        G18 and Y toward Z in G19 (`PLANE_AXES`; Haas Mill Operator's Manual, "G17 XY / G18 XZ / G19 YZ
+        Plane Selection": G18's circular motion as the operator sees it "looking from the rear of the
+        machine toward the front control panel", G19's "looking across the table from the side of the
+        machine where the control panel is mounted").
+        The machine stays where it is; the moves after it follow `_settle_rotation`'s rules.
         Cutter compensation turned on after it and off before G69 offsets the turned contour (the order
         the Haas training manual "Advanced Haas Mill Programming Techniques", G68, gives: "the G41 or G42
         commands should be turned on after the G68 rotation is called up and turned off with G40 before
         the G68 is cancelled with a G69"; `Interpreter._cutter_compensation`).
-        Out of scope: another plane, other words in the block, a G68 under G68 or under cutter
-        compensation (from G41/G42 to the move after G40), a G68 without R or in G91, whose angle a parameter gives or adds to (Fanuc No. 5410
-        and, 15i, No. 6400 bit 0; Haas Settings 72 and 73), and one without X or Y: the control then turns
-        about where the tool stands, which compensation moves (the program's turned points with it).  X Y R
-        may be expressions (`R#21`, `Y[#27/2]`): the manual's words take a macro's values as any word does;
-        but not under --expand, which writes the G68 block's text where its variables are no longer set."""
+        Out of scope: other words in the block (the third axis: a three-dimensional conversion's), a G68
+        under G68 or under cutter compensation (from G41/G42 to the move after G40), a G68 without R or in
+        G91, whose angle a parameter gives or adds to (Fanuc No. 5410 and, 15i, No. 6400 bit 0; Haas
+        Settings 72 and 73), and one without both of its plane's axis words: the control then turns about
+        where the tool stands, which compensation moves (the program's turned points with it).  A plane
+        code under G68 is out of scope too (`NOT_UNDER_G68`; Fanuc Series 15i-MA operator's manual: "G17,
+        G18 or G19 must not be designated in the mode of coordinate system rotation"), and so is an arc or
+        cutter compensation in another plane than the rotation's (Fanuc Series 0i-A connection manual
+        (function) B-63503EN-1, "Coordinate system rotation", alarm 144 "ILLEGAL PLANE SELECTED": "The
+        coordinate rotation plane and arc or cutter compensation C plane must be the same").  The words may be expressions (`R#21`, `Y[#27/2]`): the manual's words take a
+        macro's values as any word does; but not under --expand, which writes the G68 block's text where its
+        variables are no longer set."""
         col, name = code.start + 1, f"G{code.number}"
         others = [item for item in block.items if type(item) is not Comment and item is not code
                   and not (type(item) is Statement and item.kind in IGNORED_STATEMENTS)]  # fmt: skip
         words = [word for item in others if (word := self._rotation_word(item, block, name, col)) is not None]
         if code.value == 69.0:
             return self._cancel_rotation(block, words, col)
-        planes = [w.value for w in words if w.letter == "G" and w.value in (17.0, 18.0, 19.0)]
+        planes = [int(w.value) for w in words if w.letter == "G" and w.value in (17.0, 18.0, 19.0)]
         plane = planes[0] if planes else self.plane
-        if plane != 17:  # (its X Y R, or the plane's own axes, then turn about another axis than Z)
-            raise _OutOfScope(f"G68 in G{plane:g} (a turn about another axis than Z)", col)
-        if any(w.letter not in "NXYRG" or (w.letter == "G" and w.value != 17.0) for w in words):
-            raise _OutOfScope("G68 with other words in its block than G17, X, Y and R", col)
-        if any(w.letter == "G" for w in words):
-            self._set(plane=17)
+        letters = plane_letters(plane)
+        first, second = letters[0], letters[1]
+        if len(planes) > 1 or any(
+            w.letter not in ("N", "R", "G", first, second) or (w.letter == "G" and w.value != plane)
+            for w in words
+        ):
+            raise _OutOfScope(
+                f"G68 with other words in its block than G{plane}, {first}, {second} and R", col
+            )
         given = {w.letter: w.value for w in words}
         why = (
             "while a rotation is in effect" if self.g68 is not None
             else "under cutter compensation" if self._compensating()
             else "without R (its angle is then a parameter's)" if "R" not in given
             else "in G91 (a parameter makes its R absolute or added)" if not self.absolute
-            else "without X and Y (its centre is then where the tool stands, which compensation moves)"
-            if not {"X", "Y"} <= given.keys()
+            else f"without {first} and {second} (its centre is then where the tool stands, which compensation moves)"
+            if not {first, second} <= given.keys()
             else None
         )  # fmt: skip
         if why is not None:
             raise _OutOfScope(f"G68 {why}", col)
-        self._keeping_machine(lambda: setattr(self, "g68", (given["R"], given["X"], given["Y"])))
-        self.unsettled_rotation = 68.0
+        if planes:
+            self._set(plane=plane)
+        self._keeping_machine(lambda: self._turn(plane, (given["R"], given[first], given[second])))
+        self.unsettled_rotation, self.rotation_homed = 68.0, set()
         return Pass(block)
+
+    def _turn(self, plane: int, rotation: tuple[float, float, float]) -> None:
+        """G68 in effect: `rotation` (degrees, the centre's coordinates) in `plane`."""
+        self.g68, self.g68_plane = rotation, plane
 
     def _cancel_rotation(self, block: Block, words: list[Word], col: int) -> Event | tuple[Event, ...]:
         """`G69`, with N and the modes of other groups that move nothing (`G69_COMPANIONS`: `G69 G94`,
@@ -454,7 +483,7 @@ class FanucInterpreter(Interpreter):
             raise _OutOfScope("G69 under cutter compensation", col)
         if self.g68 is not None:
             self._keeping_machine(lambda: setattr(self, "g68", None))
-            self.unsettled_rotation = 69.0
+            self.unsettled_rotation, self.rotation_homed = 69.0, set()
         if all(w.letter == "N" for w in words):
             return Pass(block)
         return super().block(block)

@@ -943,15 +943,20 @@ class Flow:
     def _program_from_file(self, name: str) -> list[Block] | None:
         """Fanuc program `O<name>`, `O<name>` to its first M99, from the first folder of the path
         with a file named for it (`_program_files`): a Fanuc control keeps each program under
-        its number, and a file on a PC holds one so (the file must say `O<name>` itself)."""
+        its number, and a file on a PC holds one so (the file must say `O<name>` itself: a file
+        without that line is an error that says what the file holds instead, `_unread`)."""
         for folder in self.path:
             path = next((p for p in _program_files(folder, name) if p.is_file()), None)
             if path is None:
                 continue
             lines: list[Block] = []
+            numbers: list[str] = []  # the other programs' numbers the file gives
             with open(path, "rb") as stream:
                 for block in parse_stream(stream, str(path), "fanuc"):
-                    if lines or program_number(block) == name:
+                    number = None if lines else program_number(block)
+                    if number is not None and number != name and len(numbers) < 3:
+                        numbers.append(number)
+                    if lines or number == name:
                         lines.append(block)
                         control = control_of(block)
                         if control is not None and control.keyword == "m99":
@@ -959,7 +964,7 @@ class Flow:
                             return lines
                     if len(lines) > MAX_SUBPROGRAM:
                         break
-            raise NcppError(f"O{name} ... M99 is not in the file{_above_the_tape(path, name)}",
+            raise NcppError(f"O{name} ... M99 is not in the file{_unread(path, name, bool(lines), numbers)}",
                             Location(str(path), 1, 1))  # fmt: skip
         return None
 
@@ -2090,6 +2095,25 @@ def _program_files(folder: Path, name: str) -> list[Path]:
 
 def _shown(name: str) -> str:
     return name if name.isdigit() else f"<{printable(name)}>"
+
+
+def _unread(path: Path, name: str, started: bool, numbers: list[str]) -> str:
+    """Why program file `path` gave no `O<name>` ... M99 (`Flow._program_from_file`): its O line stands
+    in the tape's leader, its program has no M99, its programs are others, or it has no O line at all,
+    which a program file ncpp runs for a call must have (no Fanuc or Haas manual ncpp follows says a
+    control takes a program's number from its file's name)."""
+    above = _above_the_tape(path, name)
+    if above:
+        return above
+    if started:
+        return f": O{name} has no M99 after it (a subprogram ends with M99)"
+    if numbers:
+        others = ", ".join(f"O{n}" for n in numbers)
+        return f": its program is {others}, not O{name} (a call runs the program whose O line says O{name})"
+    return (
+        f": the file has no O line, and ncpp runs a file for a call of O{name} only where the file gives that "
+        f"number itself, not from the file's name (put `O{name}` on the line after the file's first `%`)"
+    )
 
 
 def _above_the_tape(path: Path, name: str) -> str:

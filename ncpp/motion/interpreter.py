@@ -5,7 +5,7 @@
 (o-word control flow, `flow.py`), state bounded whatever the program length.  Positions are program (work) coordinates in program units,
 exactly what rs274 prints in its canonical calls; `Context.offset` says where
 the program origin sits in machine coordinates.  Under a rotation of the coordinate system
-(G10 L2 R, Fanuc's G68: `Context.rotation`) they are turned as the control turns them, a
+(G10 L2 R, Fanuc's G68 in any plane: `Context.rotation`) they are turned as the control turns them, a
 translation of the machine position (`canon_call` turns them back to rs274's).
 
 Scope: modal G0-G3, planes, G90/G91, G90.1/G91.1, G20/G21 (state converted
@@ -84,7 +84,8 @@ from ncpp.motion.segments import (
     Line,
     Pass,
     Setting,
-    turn_xy,
+    plane_letters,
+    turn_in_plane,
 )
 from ncpp.motion.tools import OFFSET_LETTERS, UntoldLengths
 from ncpp.program.blocks import STRAY_TAPE, UNREADABLE, Block, Comment, ExprWord, Statement, Word
@@ -374,10 +375,13 @@ class Interpreter:
         # by system number: 1..9 G54..G59.3, then the additional work offsets told (`offsets.ADDITIONAL`)
         self.g5x = {n: [0.0] * 9 for n in range(1, 10)}
         self.rotations: dict[int, float] = {}  # by system number: its G10 L2 R, degrees (absent: 0)
-        # Fanuc's G68 in effect: (degrees, centre X, centre Y in program units); and after G68 or G69 (its
-        # code) until a move puts X and Y at absolute positions (`_settle_rotation`)
+        # Fanuc's G68 in effect: (degrees, the centre's coordinates in its plane, program units), and the plane
+        # it turns (kept after G69); after G68 or G69 (its code) until a move puts that plane's axes at
+        # absolute positions (`_settle_rotation`)
         self.g68: tuple[float, float, float] | None = None
+        self.g68_plane = 17
         self.unsettled_rotation: float | None = None
+        self.rotation_homed: set[str] = set()  # the plane's axes a G28/G30 homed since (`_settle_rotation`)
         self.g92 = [0.0] * 9
         self.g92_saved = [0.0] * 9
         self.tool = [0.0] * 9  # the tool length offset in effect, program units
@@ -904,6 +908,7 @@ class Interpreter:
                 str(self.spindle_tool) if self.spindle_tool else "",
                 self.zeros_set.get(self.coord_system),
                 self._rotation(),
+                self._rotation_plane(),
             )
         return self._context
 
@@ -915,6 +920,10 @@ class Interpreter:
             return self.g68
         angle = self.rotations.get(self.coord_system)
         return None if angle is None else (angle, 0.0 - self.g92[0], 0.0 - self.g92[1])
+
+    def _rotation_plane(self) -> int:
+        """The plane `_rotation` turns: G68's (Fanuc), else XY (G10 L2 R turns about Z)."""
+        return self.g68_plane if self.g68 is not None else 17
 
     # -- one block ------------------------------------------------------------------
     def block(self, block: Block) -> Event | tuple[Event, ...]:
@@ -948,29 +957,34 @@ class Interpreter:
     def _settle_rotation(self, block: Block) -> None:
         """Fanuc: after G68, moves in G91 run from where the tool stood at G68 (the centre for them,
         Fanuc Series 16/18-MC operator's manual, "Coordinate system rotation"), as they do here; after G69
-        the first move must be absolute (its WARNING).  Until a move gives X and Y absolutely, a move
-        that gives one of them alone takes the other from a position the manual does not say: not
-        followed; nor a G91 move of X or Y after G69.  A G53 move leaves this as it is; a G28/G30 in G91
-        whose X Y increments are 0 (the return posts write) moves from where the tool stands, and homing
-        both X and Y settles it."""
-        given = [item for item in block.items if isinstance(item, (Word, ExprWord)) and item.letter in "XY"]
+        the first move must be absolute (its WARNING).  Until a move gives both axes of the rotation's
+        plane (X and Y in G17, Z and X in G18, Y and Z in G19) absolutely, a move that gives one of them
+        alone takes the other from a position the manual does not say: not followed; nor a G91 move of
+        one of them after G69.  A G53 move leaves this as it is; a G28/G30 in G91 whose increments of
+        them are 0 (the return posts write) moves from where the tool stands and homes them, which places
+        them as an absolute move does (`G91 G28 Z0.` then `G28 X0. Y0.` after a G68 in G18)."""
+        letters = plane_letters(self.g68_plane)
+        given = [
+            item for item in block.items if isinstance(item, (Word, ExprWord)) and item.letter in letters
+        ]
         codes = {item.value for item in block.items if type(item) is Word and item.letter == "G"}
         if not given or 53.0 in codes:
             return
-        both = len({item.letter for item in given}) == 2
+        placed = {item.letter for item in given} | self.rotation_homed
         if (
             codes & {28.0, 30.0}
             and not self.absolute
             and all(type(i) is Word and i.value == 0.0 for i in given)
         ):
-            self.unsettled_rotation = None if both else self.unsettled_rotation
-        elif self.absolute and both:
+            self.rotation_homed = placed
+            self.unsettled_rotation = None if len(placed) == 2 else self.unsettled_rotation
+        elif self.absolute and len(placed) == 2:
             self.unsettled_rotation = None
         elif self.absolute:
-            raise _OutOfScope(f"an absolute move of X or Y alone after G{self.unsettled_rotation:g}",
+            raise _OutOfScope(f"an absolute move of {' or '.join(letters)} alone after G{self.unsettled_rotation:g}",
                               given[0].start + 1)  # fmt: skip
         elif self.unsettled_rotation == 69.0:
-            raise _OutOfScope("an incremental move of X or Y after G69", given[0].start + 1)
+            raise _OutOfScope(f"an incremental move of {' or '.join(letters)} after G69", given[0].start + 1)
 
     def _block_events(self, block: Block) -> Event | tuple[Event, ...]:
         items = block.items
@@ -1587,7 +1601,9 @@ class Interpreter:
         rotation about Z (G10 L2 R, Fanuc's G68) in G17: the controls offset the turned contour
         (Fanuc Series 16/18-MC operator's manual, "Coordinate system rotation": cutter compensation
         "is performed after the coordinate system is rotated"), whose moves are in the turned frame
-        here, so their tool centre is too; in G18 the offset would turn out of its plane (not followed)."""
+        here, so their tool centre is too; in G18 the offset would turn out of its plane under a rotation
+        about Z, and under Fanuc's G68 in G18 a lathe tool's orientation would not turn with the contour
+        (neither followed)."""
         code, item = code_item
         if code == 40.0:
             self.arc_refused = self.arc_refused or self.centre.off_path
@@ -1740,8 +1756,10 @@ class Interpreter:
         if code == 10.0 and words["L"][0] in (10.0, 11.0):
             raise _OutOfScope(f"G10 L{words['L'][0]:g} under a coordinate system rotation", item.start + 1,
                               self._turned_setting(words, gcodes))  # fmt: skip
-        if code in (28.0, 30.0) and ("X" in words or "Y" in words):
-            raise _OutOfScope(f"G{code:g} with X or Y under a coordinate system rotation", item.start + 1)
+        letters = plane_letters(self._rotation_plane())
+        if code in (28.0, 30.0) and any(letter in words for letter in letters):
+            raise _OutOfScope(f"G{code:g} with {' or '.join(letters)} under a coordinate system rotation",
+                              item.start + 1)  # fmt: skip
 
     def _check_turned_zero(self, words: dict, gcodes: dict) -> None:
         """A G10 L20 of another system that a G10 L2 R rotates: rs274ngc sets its zero from the current
@@ -1843,8 +1861,12 @@ class Interpreter:
             new = [value * scale if i in LINEAR else value for i, value in enumerate(table)]
             if code == 43.2:
                 new = [old + added for old, added in zip(self.tool, new)]
-        if self._rotation() is not None and new[:2] != self.tool[:2]:  # (rs274ngc does not turn them)
-            raise _OutOfScope("a tool offset in X or Y under a coordinate system rotation", item.start + 1)
+        turned = PLANE_AXES[self._rotation_plane()][:2]
+        if self._rotation() is not None and any(new[i] != self.tool[i] for i in turned):  # (not turned)
+            letters = " or ".join(plane_letters(self._rotation_plane()))
+            raise _OutOfScope(
+                f"a tool offset in {letters} under a coordinate system rotation", item.start + 1
+            )
         held = self.pos[:] if changed else None
         self._shift(self.tool, new)
         self.tool = new
@@ -1956,12 +1978,12 @@ class Interpreter:
         self._context = None
 
     def _to_machine(self, p: list[float]) -> list[float]:
-        """The machine position (program units, all axes) of program point `p`: X Y turned about the
-        rotation's centre (`_rotation`), then G92, the system's zero and the tool length added."""
+        """The machine position (program units, all axes) of program point `p`: the rotation's plane (X Y
+        in G17) turned about its centre (`_rotation`), then G92, the system's zero and the tool length added."""
         q = list(p)
         rotation = self._rotation()
         if rotation is not None:
-            q[0], q[1] = turn_xy(q[0], q[1], rotation)
+            turn_in_plane(q, rotation, self._rotation_plane())
         return [v + g + z + t for v, g, z, t in zip(q, self.g92, self.g5x[self.coord_system], self.tool)]
 
     def _from_machine(self, m: list[float]) -> list[float]:
@@ -1969,7 +1991,7 @@ class Interpreter:
         q = [v - g - z - t for v, g, z, t in zip(m, self.g92, self.g5x[self.coord_system], self.tool)]
         rotation = self._rotation()
         if rotation is not None:
-            q[0], q[1] = turn_xy(q[0], q[1], rotation, -1.0)
+            turn_in_plane(q, rotation, self._rotation_plane(), -1.0)
         return q
 
     def _program_end(self) -> None:
@@ -2616,7 +2638,7 @@ class Interpreter:
     def _arc(self, block: Block, words: dict, motion: float, motion_item, mode1_item) -> Arc | Pass:
         word = motion_item if motion_item is not None else next(item for _, item in words.values())
         plane = self.plane
-        if plane != 17 and self._rotation() is not None:  # (its plane turns off the machine's)
+        if plane != self._rotation_plane() and self._rotation() is not None:  # (turned off its plane)
             raise _OutOfScope(f"an arc in G{plane} under a coordinate system rotation", word.start + 1)
         first_letter, second_letter, normal_letter = _ARC_LETTERS[plane]
         radius = words.get("R")

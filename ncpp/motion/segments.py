@@ -56,6 +56,12 @@ PLANES = {17: "XY", 18: "XZ", 19: "YZ"}
 PLANE_AXES = {17: (0, 1, 2), 18: (2, 0, 1), 19: (1, 2, 0)}
 
 
+def plane_letters(plane: int) -> str:
+    """The letters of a plane's first and second axes, in `PLANE_AXES`' order: "XY", "ZX", "YZ"."""
+    a, b, _ = PLANE_AXES[plane]
+    return "XYZ"[a] + "XYZ"[b]
+
+
 @dataclass(frozen=True, slots=True)
 class Context:
     """Modal state a segment was made in, as far as writing it back needs."""
@@ -79,9 +85,13 @@ class Context:
     tool_id: str = ""  # the tool in the spindle as the program names it ("3", '"MILL"'; "": none)
     # the program set the system's zero (G10): whether it is known (None: it did not, the control's holds)
     zero_set: bool | None = None
-    # the control turns the program's X Y about Z (LinuxCNC's G10 L2 R): (degrees counter-clockwise, the
-    # centre's X Y, program units); segments are in the turned frame, the program's words are not (`turned`)
+    # the control turns the program's X Y about Z (LinuxCNC's G10 L2 R), or the axes of another plane
+    # (Fanuc's G68 in G18, G19: `rotation_plane`): (degrees counter-clockwise, the centre's first and second
+    # coordinates in that plane, program units); segments are in the turned frame, the program's words are
+    # not (`turned`)
     rotation: tuple[float, float, float] | None = None
+    # the plane `rotation` turns (`PLANE_AXES`: G18 turns Z toward X, G19 Y toward Z)
+    rotation_plane: int = 17
 
     @property
     def tool_mm(self) -> Point:
@@ -106,8 +116,21 @@ class Context:
         segments, a translation of the machine's); `sign` -1: the program's point of a turned one."""
         if self.rotation is None:
             return p
-        x, y = turn_xy(p[0], p[1], self.rotation, sign)
-        return (x, y, p[2])
+        if self.rotation_plane == 17:
+            x, y = turn_xy(p[0], p[1], self.rotation, sign)
+            return (x, y, p[2])
+        q = list(p)
+        turn_in_plane(q, self.rotation, self.rotation_plane, sign)
+        return (q[0], q[1], q[2])
+
+
+def turn_in_plane(
+    p: list[float], rotation: tuple[float, float, float], plane: int, sign: float = 1.0
+) -> None:
+    """Turn point `p` (x, y, z, ...) in place by `rotation` about its centre in `plane`: from the plane's
+    first axis toward its second (`PLANE_AXES`, as an arc of G3 turns there); `sign` -1: back."""
+    a, b, _ = PLANE_AXES[plane]
+    p[a], p[b] = turn_xy(p[a], p[b], rotation, sign)
 
 
 def turn_xy(

@@ -259,6 +259,11 @@ def _at_travel_ends(wanted: NDArray, command: NDArray, ctx: PassContext) -> NDAr
 _AT_END = 1e-9  # mm: a wanted point this close outside a travel end is at it (its number's rounding)
 
 
+def _number(value: float) -> str:
+    """A position as a message gives it: to 0.1 µm, or in powers of ten past any travel."""
+    return f"{value:.4f}" if abs(value) < 1e9 else f"{value:.4g}"
+
+
 def _check(wanted: NDArray, command: NDArray, lines: NDArray, ctx: PassContext) -> None:
     lo, hi = ctx.limit_arrays()
     flat = command.reshape(-1, 3)
@@ -282,17 +287,15 @@ def _check(wanted: NDArray, command: NDArray, lines: NDArray, ctx: PassContext) 
             f"{what} is not a finite number: nothing to command", Location(ctx.file, int(lines[k]))
         )
     correction = np.linalg.norm(command - wanted, axis=-1).max(axis=-1)
-    bad = np.flatnonzero(correction > ctx.max_correction)
-    if bad.size:
-        k = int(bad[0])
-        raise NcppError(
-            f"correction of {correction[k]:.4f} mm exceeds the machine file's limit of {ctx.max_correction} mm",
-            Location(ctx.file, int(lines[k])),
-        )
     outside = ((command < lo) | (command > hi)).any(axis=-1).any(axis=-1)
-    bad = np.flatnonzero(outside)
+    bad = np.flatnonzero((correction > ctx.max_correction) | outside)
     if bad.size:
         k = int(bad[0])
+        if not outside[k]:  # (a point outside the travel tells more than the correction it gets there)
+            raise NcppError(
+                f"correction of {correction[k]:.4f} mm exceeds the machine file's limit of {ctx.max_correction} mm",
+                Location(ctx.file, int(lines[k])),
+            )
         pts = command[k].reshape(-1, 3)
         axis_index = int(np.flatnonzero(((pts < lo) | (pts > hi)).any(axis=0))[0])
         axis = "XYZ"[axis_index]
@@ -300,7 +303,7 @@ def _check(wanted: NDArray, command: NDArray, lines: NDArray, ctx: PassContext) 
             (pts[:, axis_index] < lo[axis_index]) | (pts[:, axis_index] > hi[axis_index])
         ][0]
         raise NcppError(
-            f"command {axis}{value:.4f} mm is outside the {axis} travel [{lo[axis_index]:g}, {hi[axis_index]:g}] mm",
+            f"command {axis}{_number(value)} mm is outside the {axis} travel [{lo[axis_index]:g}, {hi[axis_index]:g}] mm",
             Location(ctx.file, int(lines[k]), word=axis),
         )
     ctx.corrections.note(largest)

@@ -414,9 +414,22 @@ def test_the_returns_posts_write_after_g69_are_followed():
 @pytest.mark.parametrize(
     "body, at, construct",
     [
-        ("G18\nG68 X0 Y0 R30", "G68", "G68 in G18 (a turn about another axis than Z)"),
-        ("G18\nG68 X0 Z0 R30", "G68", "G68 in G18"),
-        ("G68 G19 Y0 Z0 R30", "G68", "G68 in G19"),
+        ("G18\nG68 X0 Y0 R30", "G68", "G68 with other words in its block than G18, Z, X and R"),
+        ("G68 G19 X0 Y0 R30", "G68", "G68 with other words in its block than G19, Y, Z and R"),
+        ("G18\nG68 X0 R30", "G68", "G68 without Z and X"),
+        ("G19\nG68 Y0 Z0 R30\nG17", "G17", "G17 under coordinate system rotation G68"),
+        ("G18\nG68 X0 Z0 R30\nG1 X5 F100", "X5", "an absolute move of Z or X alone after G68"),
+        (
+            "G19\nG68 Y0 Z0 R30\nG1 Y5 Z5 F100\nG69\nG91 G1 Z1",
+            "Z1",
+            "an incremental move of Y or Z after G69",
+        ),
+        ("G18\nG68 X0 Z0 R30\nG28 Z0", "G28", "G28 with Z or X under a coordinate system rotation"),
+        (
+            "G18\nG68 X0 Z0 R30\nG42 D1 G1 X5 Z5 F100",
+            "G42",
+            "cutter compensation G42 in G18 under a coordinate",
+        ),
         ("G42 D1 G1 X5 Y5 F100\nG68 X0 Y0 R30", "G68", "G68 under cutter compensation"),
         ("G68 X0 Y0 R30\nG51 X0 Y0 P2", "G51", "scaling G51"),
         ("G68 X0 Y0", "G68", "G68 without R"),

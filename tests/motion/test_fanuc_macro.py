@@ -508,6 +508,30 @@ def test_a_program_file_without_its_number_is_an_error_at_the_file(tmp_path):
     )
 
 
+@pytest.mark.parametrize(
+    "text, why",
+    [
+        (
+            "%\nG91 G1 Z-1 F100\nM99\n%\n",
+            "the file has no O line, and ncpp runs a file for a call of O1002 only",
+        ),
+        ("%\nO1003\nG91 G1 Z-1 F100\nM99\n%\n", "its program is O1003, not O1002"),
+        ("%\nO1002\nG91 G1 Z-1 F100\nM30\n%\n", "O1002 has no M99 after it"),
+    ],
+)
+def test_a_program_file_named_for_a_number_it_does_not_give_says_what_it_holds(tmp_path, text, why):
+    """`O1002.nc` on the subroutine path with no `O1002` line (no Fanuc or Haas manual says a control
+    takes the number from the file's name), or another program's, or O1002 without M99: an error at
+    the file that says which."""
+    from ncpp.motion.offsets import WorkOffsets
+
+    (tmp_path / "O1002.nc").write_text(text)
+    program = write_program(tmp_path, "O1000\n" + HEAD + "M98 P1002\nM30\n", "main.nc")
+    _, error, _ = ours(program, offsets=WorkOffsets.given({}, subroutine_path=[tmp_path]))
+    assert error is not None and "O1002.nc:1:1" in str(error), error
+    assert f"O1002 ... M99 is not in the file: {why}" in str(error), error
+
+
 def test_a_program_above_its_files_first_percent_is_said_to_stand_in_the_leader(tmp_path):
     """`O1002 ... M99 %` with no `%` above it (as a PC may keep a program): the control reads the text
     before the first `%` as the tape's leader and skips it; the error said only that O1002 is not in

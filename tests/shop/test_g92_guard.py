@@ -276,6 +276,24 @@ def test_the_interpreter_applies_the_saved_offset_at_g92_3_as_rs274_does(tmp_pat
     assert ours == pytest.approx(theirs, abs=1e-4)
 
 
+def test_the_check_after_a_block_reads_only_its_events_and_the_axes_the_writer_hands_over():
+    """`PlacementChecks.after` keeps nothing between calls: a G92's check covers the axes handed over
+    (those the program had not positioned) whichever block came before, a G92.3's X Y Z."""
+    from ncpp.guard import PlacementChecks
+
+    program = "G21 G90\nG92 X0 Y0 Z0\nG92.3\nM2\n"
+    offsets = WorkOffsets.given({"G54": (400.0, 350.0, 300.0)})
+    events = events_of(program.encode(), offsets=offsets)
+    g92, g92_3 = ([e for e in events if e.block.line == line] for line in (2, 3))
+    checks = PlacementChecks(offsets, "iso", 1.0)
+    assert checks.after(g92, ()) == [] and not checks.checks_offset(g92, ())
+    assert checks.checks_offset(g92, ["Y"])
+    assert "if [[ABS[#5212 - 0] GT 0.1]]" in "".join(checks.after(g92, ["Y"]))
+    restored = "".join(checks.after(g92_3, ()))
+    assert "restored by G92.3" in restored and all(f"#521{n}" in restored for n in (1, 2, 3))
+    assert "o<ncpp_guard_3> if" in "".join(checks.after(g92, ["X", "Y", "Z"]))  # (a label per check written)
+
+
 def _warned(program: str, guard: bool = True, var_units: float = 1.0) -> tuple[str, str]:
     """The program compensated for G54 at X400 Y350 Z300 mm (guarded unless not `guard`), and the warnings."""
     if not WIDE.exists():

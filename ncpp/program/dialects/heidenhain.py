@@ -286,14 +286,21 @@ HEIDENHAIN = Dialect(
 
 # ---- writer ------------------------------------------------------------------------------
 
-from collections.abc import Callable, Iterable, Iterator  # noqa: E402
+from collections.abc import Iterable, Iterator  # noqa: E402
 from dataclasses import replace  # noqa: E402
 
 from ncpp.motion.segments import DRILLED, FLOW, PLANE_AXES, Arc, Event, Line, Pass  # noqa: E402
 from ncpp.passes.rotary import ROTARY, turns  # noqa: E402
 from ncpp.program.blocks import Block  # noqa: E402
 from ncpp.program.dialects.editing import splice  # noqa: E402
-from ncpp.program.dialects.iso import IsoWriter, _Units, as_written, written_apart  # noqa: E402
+from ncpp.program.dialects.iso import (  # noqa: E402
+    ChecksAfter,
+    ChecksBefore,
+    IsoWriter,
+    _Units,
+    as_written,
+    written_apart,
+)
 from ncpp.program.numbers import NumberStyle, format_number, style_pattern  # noqa: E402
 
 _AXES = "XYZ"
@@ -359,8 +366,8 @@ class HeidenhainWriter(IsoWriter):
     def write(
         self,
         events: Iterable[Event],
-        after: Callable[[list[Event]], list[str]] | None = None,
-        before: Callable[[list[Event]], list[str]] | None = None,
+        after: ChecksAfter | None = None,
+        before: ChecksBefore | None = None,
     ) -> Iterator[str]:
         """`IsoWriter.write`; where a subprogram's run is written at its text, the blocks from it on
         are numbered in the order they stand (`_in_order`)."""

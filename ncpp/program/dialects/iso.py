@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Callable, Collection, Iterable, Iterator
 from dataclasses import replace
 from itertools import takewhile
 from operator import itemgetter
@@ -33,6 +33,7 @@ from ncpp.motion.segments import (
     Line,
     Pass,
     Setting,
+    plane_letters,
 )
 from ncpp.passes.rotary import time_shares, turns
 from ncpp.program.blocks import DIGITS_AS_ONE, Block, Comment, ExprWord, Statement, Word
@@ -247,8 +248,29 @@ class _AtDefinition:
         stamps.pin(None)
 
 
+# a guard's checks written before a block, and after it, told the axes X Y Z its G92 / G10 L20 sets
+# that the program has not positioned (`IsoWriter.write`, `ncpp/guard.py`)
+ChecksBefore = Callable[[list[Event]], list[str]]
+ChecksAfter = Callable[[list[Event], Collection[str]], list[str]]
+
+
 def _none(events: list[Event]) -> list[str]:
     return []
+
+
+def _none_after(events: list[Event], unplaced: Collection[str]) -> list[str]:
+    return []
+
+
+def _setting_of(group: list[Event]) -> Setting | None:
+    """The `Setting` of a block's G92 / G10 L20 whose axes `_write_group` tells of: its first
+    event's, past the steps back of a loop or call ahead of it (`Setting`s of no values)."""
+    for event in group:
+        if type(event) is not Pass or event.setting is None or event.skipped or event.cycle is not None:
+            return None
+        if event.setting.values:
+            return event.setting
+    return None
 
 
 def _leads_in(event: Event) -> bool:
@@ -289,9 +311,9 @@ class IsoWriter:
         # move leaves out its correction along them (`_tell_unpositioned`: "Y" or "X and Y")
         self.unpositioned: Callable[[str, Block], None] | None = None
         self._told_unpositioned: set[str] = set()
-        # told of a G92 / G10 L20 that sets its offset from axes X Y Z the program has not positioned
-        # yet: from where the control stands, which ncpp takes to be its assumed start (["X", "Y"])
-        self.unplaced_setting: Callable[[list[str], Block], None] | None = None
+        # told of a G92 / G10 L20 (its events) that sets its offset from axes X Y Z the program has not
+        # positioned yet: from where the control stands, which ncpp takes to be its assumed start (["X", "Y"])
+        self.unplaced_setting: Callable[[list[str], list[Event]], None] | None = None
         # told of a loop or call in which interpretation ends (it may set an offset from where the control
         # stands), after a compensated move, in a mode (G2/G3, a cycle) a step back would change
         self.unstepped: Callable[[Block], None] | None = None
@@ -326,6 +348,7 @@ class IsoWriter:
         self._last_context: Context | None = None  # the frame (units, offsets) `_last_end` is in
         self._frame_seen: Context | None = None  # the frame of the last block's moves (`_settle_plane`)
         self._plane_unsettled = False  # a rotation turned or moved the frame since a move gave X and Y
+        self._unsettled_letters = frozenset("XY")  # the axes of the plane(s) it turned (`_settle_plane`)
 
     def comment(self, text: str) -> str:
         return f"{self.comment_open}{text}{self.comment_close}"
@@ -337,17 +360,17 @@ class IsoWriter:
     def write(
         self,
         events: Iterable[Event],
-        after: Callable[[list[Event]], list[str]] | None = None,
-        before: Callable[[list[Event]], list[str]] | None = None,
+        after: ChecksAfter | None = None,
+        before: ChecksBefore | None = None,
     ) -> Iterator[str]:
-        """The written lines, block by block; `after(events)` and `before(events)` give lines to
-        follow and to precede a block's (of its events: the guards' checks, `ncpp/guard.py`)."""
+        """The written lines, block by block; `before(events)` and `after(events, unplaced)` give
+        lines to precede and to follow a block's (the guards' checks, `ncpp/guard.py`)."""
         group: list[Event] = []
         block = None
         written: Callable[[list[Event]], Iterable[str]] = self._write_group
         if after is not None or before is not None:
-            ahead, behind = before or _none, after or _none
-            written = lambda group: [*ahead(group), *self._write_group(group), *behind(group)]  # noqa: E731
+            ahead, behind = before or _none, after or _none_after
+            written = lambda group: self._checked(group, ahead, behind)  # noqa: E731
         write_group = _lines_ended(written)
         placing = None
         if self.once_runs is not None:
@@ -394,14 +417,25 @@ class IsoWriter:
             self._told_unpositioned.update(new)
             self.unpositioned(" and ".join(new), block)
 
-    def _tell_unplaced(self, block: Block, setting: Setting) -> None:
+    def _checked(self, group: list[Event], before: ChecksBefore, after: ChecksAfter) -> list[str]:
+        """A block's lines between the guards' checks, `after` told the axes its G92 / G10 L20 sets
+        that the program has not positioned, read before its words position them."""
+        setting = _setting_of(group)
+        unplaced = self._unplaced(setting) if setting is not None else ()
+        return [*before(group), *self._write_group(group), *after(group, unplaced)]
+
+    def _unplaced(self, setting: Setting) -> list[str]:
+        """The axes X Y Z a G92 / G10 L20 sets that the program has not positioned yet."""
+        return sorted({AXES[i] for i, _ in setting.values} - self.known_axes)
+
+    def _tell_unplaced(self, group: list[Event], setting: Setting) -> None:
         """Before a G92 / G10 L20 is written (its words then position its axes): tell
         `unplaced_setting` of the axes X Y Z it sets that the program has not positioned yet."""
         if self.unplaced_setting is None:
             return
-        unplaced = sorted({AXES[i] for i, _ in setting.values} - self.known_axes)
+        unplaced = self._unplaced(setting)
         if unplaced:
-            self.unplaced_setting(unplaced, block)
+            self.unplaced_setting(unplaced, group)
 
     def _write_group(self, group: list[Event]) -> Iterable[str]:
         """The lines of one block's events (a list: cheaper than a generator per block)."""
@@ -415,7 +449,7 @@ class IsoWriter:
             if not first.setting.values:  # a loop's or call's step back (`ncpp.motion.entries`), in its mode
                 step = self._step_back(block, first.setting, MOTION_CODES.get(first.motion))  # type: ignore[arg-type]
                 return [*step, *(self._write_group(group[1:]) if group[1:] else ())]
-            self._tell_unplaced(block, first.setting)
+            self._tell_unplaced(group, first.setting)
         facts = self._read_block(block)
         if facts.flow:
             # (`write`: the steps to the programmed start of a canned cycle the line's text runs first)
@@ -648,21 +682,28 @@ class IsoWriter:
 
     def _settle_plane(self, block: Block, motion: list[Line | Arc]) -> None:
         """After a rotation of the coordinate system turned or moved the frame (Fanuc's G68 and G69,
-        Klartext's Cycle 10, Sinumerik's frames), the control places X and Y once a move gives both
-        absolutely, and the interpreter follows no move of one of them alone before (`settle_rotation`):
-        the first block edited there writes every axis it knows, so that a correction written on a move
-        along Z, or a word left out where its axis stands, does not give X or Y alone."""
+        Klartext's Cycle 10, Sinumerik's frames), the control places the axes of the plane it turns (X and
+        Y; Z and X for a G68 in G18, Y and Z in G19) once a move gives both absolutely, and the interpreter
+        follows no move of one of them alone before (`settle_rotation`): the first block edited there
+        writes every axis it knows, so that a correction written on a move along the other axis, or a word
+        left out where its axis stands, does not give one of them alone."""
         for segment in motion:
             seen, context = self._frame_seen, segment.context
             if seen is not None and seen is not context and _turns_plane(seen, context):
                 self._plane_unsettled = True
+                turned = (frame for frame in (seen, context) if frame.rotation is not None)
+                self._unsettled_letters = frozenset(
+                    "".join(plane_letters(frame.rotation_plane) for frame in turned)
+                )
             self._frame_seen = context
         if not (self._plane_unsettled and motion):
             return
         if any(segment.changed for segment in motion):
             if motion[0].context.absolute:
                 self._last_end, self._plane_unsettled = None, False
-        elif {"X", "Y"} <= {i.letter for i in block.items if type(i) is Word or type(i) is ExprWord}:
+        elif self._unsettled_letters <= {
+            i.letter for i in block.items if type(i) is Word or type(i) is ExprWord
+        }:
             self._plane_unsettled = False  # (the program's own block gives both, as the control needs)
 
     def _after_verbatim(self, block: Block, motion: list[Line | Arc]) -> None:
@@ -1272,16 +1313,24 @@ def _words(block: Block, facts: _Facts) -> tuple[Word, ...]:
 
 
 def _turns_plane(before: Context, after: Context) -> bool:
-    """Whether a rotation of the coordinate system, before or after, turned or moved the working plane."""
+    """Whether a rotation of the coordinate system, before or after, turned or moved the plane it turns."""
     if before.rotation is None and after.rotation is None:
         return False
-    return before.rotation != after.rotation or before.offset[:2] != after.offset[:2]
+    if before.rotation != after.rotation or before.rotation_plane != after.rotation_plane:
+        return True
+    a, b, _ = PLANE_AXES[after.rotation_plane]
+    return before.offset[a] != after.offset[a] or before.offset[b] != after.offset[b]
 
 
 def reframed(before: Context, after: Context) -> bool:
     """Whether the program's numbers mean other machine positions after than before (units, offsets,
     the rotation of the coordinate system)."""
-    return before.inch != after.inch or before.offset != after.offset or before.rotation != after.rotation
+    return (
+        before.inch != after.inch
+        or before.offset != after.offset
+        or before.rotation != after.rotation
+        or before.rotation_plane != after.rotation_plane
+    )
 
 
 def as_written(segment: Line | Arc) -> Line | Arc:
