@@ -148,6 +148,8 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_a_fanuc_tool_position_offset_passes_through_and_the_moves_before_it_are_compensated",
             "test_a_fanuc_h_word_without_g43_passes_through_and_the_moves_before_it_are_compensated",
             "test_g80_leaves_the_motion_mode_the_cycle_interrupted",
+            "test_the_moves_before_any_motion_code_are_rs274s_of_the_twin_that_writes_g0_in_them",
+            "test_the_moves_before_any_motion_code_are_written_as_programmed_and_the_rest_compensated",
         ),
         "writeback/test_loops_run_once.py": (
             "test_a_body_that_runs_once_is_compensated_in_place",
