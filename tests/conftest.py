@@ -237,6 +237,7 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_external_output_passes_through_the_compensated_program",
             "test_expand_keeps_a_g68_of_variables_out_of_scope",
             "test_a_g81_with_p_is_compensated_with_its_p_and_expand_cycles_refuses_it",
+            "test_a_g91_move_before_any_motion_code_right_after_a_cycle_passes_the_rest_on",
         ),
         "compensation/test_cutter_comp_accuracy.py": (
             "test_a_z_move_under_compensation_keeps_the_tool_centre_where_it_stands",

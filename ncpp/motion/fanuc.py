@@ -282,7 +282,7 @@ class FanucInterpreter(Interpreter):
     any_cycle_p = True  # `G81 ... P500`: the P kept as written, no dwell of G81's (module docstring)
     taps_in_any_plane = True  # G74/G84 in G18/G19 tap along the normal (module docstring)
     cycles_own_group = True  # G80 leaves the G0-G3 mode before the cycle in effect (module docstring)
-    holds_start_mode = True  # `G43 H01 Z50` before any G00-G03: in the control's start mode (module docstring)
+    holds_start_mode = True  # `G43 H01 Z50` before any G00-G03: the start mode's (module docstring)
     back_bore_holes = False  # G87 reads R Z Q K otherwise than rs274ngc (`Interpreter.back_bore_holes`)
     repeat_letters: tuple[str, ...] = (
         "L",

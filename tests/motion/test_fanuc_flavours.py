@@ -861,7 +861,9 @@ def test_axis_words_before_any_motion_code_move_in_the_mode_the_control_holds(tm
     assert [m.block.line for m in held] == [2, 3, 6, 7] and all(m.rapid for m in held)
     assert all(m.fixed in (CYCLE, HOLE) for m in moves if m.block.line == 4)
     assert not any(m.fixed for m in moves if m.block.line > 8)
-    assert said.getvalue().count("before the program names G00") == 1 and "p.nc:2:5: warning" in said.getvalue()
+    assert (
+        said.getvalue().count("before the program names G00") == 1 and "p.nc:2:5: warning" in said.getvalue()
+    )
     with pytest.raises(NcppError, match="Cannot use axis values without a g code that uses them"):
         events(HELD_START, "iso")
 
@@ -875,8 +877,11 @@ def test_the_moves_before_any_motion_code_are_rs274s_of_the_twin_that_writes_g0_
     if not RS274.exists():
         pytest.skip("rs274 not available")
     found = events(HELD_START + "M30\n", dialect)
-    twin = HELD_START.replace("\nG90 Z50", "\nG0 G90 Z50").replace("\nX-18", "\nG0 X-18").replace(
-        "\nZ40\nG91 X5", "\nG0 Z40\nG0 G91 X5")
+    twin = (
+        HELD_START.replace("\nG90 Z50", "\nG0 G90 Z50")
+        .replace("\nX-18", "\nG0 X-18")
+        .replace("\nZ40\nG91 X5", "\nG0 Z40\nG0 G91 X5")
+    )
     calls, messages = run_rs274(write_program(tmp_path, twin))
     assert rs274_error(messages) is None, messages
     theirs = read_canon(calls)
@@ -886,12 +891,19 @@ def test_the_moves_before_any_motion_code_are_rs274s_of_the_twin_that_writes_g0_
 
 
 @pytest.mark.parametrize("dialect", ["fanuc", "haas"])
-def test_the_moves_before_any_motion_code_are_written_as_programmed_and_the_rest_compensated(tmp_path, dialect):
+def test_the_moves_before_any_motion_code_are_written_as_programmed_and_the_rest_compensated(
+    tmp_path, dialect
+):
     """`G43 H01 Z50` first (the issue's program): every line before the first G00 is written as the input has
     it but the cycle's, whose hole is compensated, and none gets a G word (a G00 or G01 ncpp wrote there would
-    set the mode the control holds for the lines after it); the moves from the G00 on are compensated.  Judged by rs274 on the twins of input and output that write G0 in
-    the held blocks (pathcheck: same actions, rapids where the original rapids, within 0.05 mm)."""
-    text = "%\nO0200 (PLYTKA)\n" + HELD_START.replace("G90 Z50", "G43 H01 Z50").replace("G91 X5\nG90\n", "") + "M30\n%\n"
+    set the mode the control holds for the lines after it); the moves from the G00 on are compensated.
+    Judged by rs274 on the twins of input and output that write G0 in the held blocks (pathcheck: same
+    actions, rapids where the original rapids, within 0.05 mm)."""
+    text = (
+        "%\nO0200 (PLYTKA)\n"
+        + HELD_START.replace("G90 Z50", "G43 H01 Z50").replace("G91 X5\nG90\n", "")
+        + "M30\n%\n"
+    )
     written, messages, _ = compensated_by_cli(tmp_path, text, dialect, "--no-guard")
     assert "before the program names G00" in messages and "compensated" in messages
     program = [line for line in written.splitlines() if not line.startswith("(ncpp")]
@@ -904,7 +916,9 @@ def test_the_moves_before_any_motion_code_are_written_as_programmed_and_the_rest
         pytest.skip("rs274 or pathcheck not available")
     twins = []
     for name, source in (("in.ngc", text), ("out.ngc", "\n".join(program) + "\n")):
-        twin = source.replace("%\n", "").replace("O0200 (PLYTKA)\n", "").replace("G43 H01 Z50", "G43 H01 G0 Z50")
+        twin = (
+            source.replace("%\n", "").replace("O0200 (PLYTKA)\n", "").replace("G43 H01 Z50", "G43 H01 G0 Z50")
+        )
         twin = twin.replace("\nX-18 Y-18", "\nG0 X-18 Y-18").replace("\nZ40\n", "\nG0 Z40\n")
         (tmp_path / name).write_text(twin)
         twins.append(str(tmp_path / name))
@@ -933,3 +947,14 @@ def test_expanded_cycles_before_a_move_in_the_mode_the_control_holds_are_refused
     with pytest.raises(NcppError, match="--expand-cycles: a canned cycle before the program names G00-G03"):
         list(interpret(blocks, file="p.nc", warnings=Warnings(stream=io.StringIO()), expand_cycles=True))
     assert [type(e) for e in events(program, "fanuc")][-2:] == [Line, Pass]
+
+
+def test_a_g91_move_before_any_motion_code_right_after_a_cycle_passes_the_rest_on(tmp_path):
+    """A G91 move right after a canned cycle in G90 starts where the cycle's G98 retract left the tool, which
+    ncpp does not follow (`pipeline.INCREMENTAL_CYCLE`): in the control's start mode too, the rest passes
+    through uncompensated with the warning."""
+    text = "G21 G90 G54\nG0 X0 Y0 Z5\nG98 G81 X10 Y0 Z-2 R1 F50\nG80\nG91 X5\nG90 G0 X30 Y10\nM30\n"
+    held = text.replace("G0 X0 Y0 Z5\n", "X0 Y0 Z5\n")
+    written, messages, _ = compensated_by_cli(tmp_path, held, "fanuc")
+    assert "a G91 move right after a canned cycle in G90" in messages
+    assert written.endswith("G91 X5\nG90 G0 X30 Y10\nM30\n")
