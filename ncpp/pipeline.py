@@ -29,7 +29,7 @@ from ncpp.lathe import refuse_lathe
 from ncpp.motion.flow import MainProgram
 from ncpp.motion.offsets import AT_MACHINE_ZERO, WorkOffsets
 from ncpp.motion.once import OnceRuns
-from ncpp.motion.segments import COMP, CYCLE, DRILLED, FLOW, HOLE, PATTERN, Arc, Event, Line, Pass
+from ncpp.motion.segments import COMP, CYCLE, DRILLED, FLOW, HELD, HOLE, PATTERN, Arc, Event, Line, Pass
 from ncpp.passes import PASSES, PassContext, run_passes
 from ncpp.passes.context import Corrections, ErrorMap, is_directional
 from ncpp.passes.inverse import iterations_for
@@ -237,7 +237,8 @@ def warn_fixed(events: Iterable[Event], warnings: Warnings, file: str) -> Iterat
             if said is not None and said[1] is not event.block:
                 said = None
             cycle = series == CYCLE or series == HOLE
-            if not fixed and cycle and absolute and not event.context.absolute:  # type: ignore[union-attr]
+            # (a G91 move before the program names G0-G3 runs its increment from there too)
+            if (not fixed or fixed == HELD) and cycle and absolute and not event.context.absolute:  # type: ignore[union-attr]
                 yield from _passed_on(event, events, warnings, file)
                 return
             # (a G28/G30's moves are the control's own)

@@ -20,6 +20,7 @@ from ncpp.motion.segments import (
     CYCLE,
     DRILLED,
     FLOW,
+    HELD,
     HOLE,
     HOME,
     MACHINE,
@@ -40,6 +41,7 @@ REASONS = {
     FLOW: "loop or subroutine",
     COMP: "cutter compensation",
     HOME: "G28/G30 return",
+    HELD: "before the program names G00-G03",
     MACHINE: "machine-coordinate move",
     UNPLACED: "move from a position ncpp is not told",
 }
@@ -211,6 +213,7 @@ _WHY = {
     "loop or subroutine": "in loops or subroutines",
     "cutter compensation": "under cutter compensation",
     "G28/G30 return": "of G28/G30 returns",
+    "before the program names G00-G03": "before the program names G00-G03",
     "machine-coordinate move": "in machine coordinates",
     "move from a position ncpp is not told": "from a position ncpp is not told",
     TRAVEL_END: "with an axis held at a travel end",

@@ -149,6 +149,8 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_a_fanuc_tool_position_offset_passes_through_and_the_moves_before_it_are_compensated",
             "test_a_fanuc_h_word_without_g43_passes_through_and_the_moves_before_it_are_compensated",
             "test_g80_leaves_the_motion_mode_the_cycle_interrupted",
+            "test_the_moves_before_any_motion_code_are_rs274s_of_the_twin_that_writes_g0_in_them",
+            "test_the_moves_before_any_motion_code_are_written_as_programmed_and_the_rest_compensated",
         ),
         "writeback/test_loops_run_once.py": (
             "test_a_body_that_runs_once_is_compensated_in_place",
@@ -236,6 +238,7 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_external_output_passes_through_the_compensated_program",
             "test_expand_keeps_a_g68_of_variables_out_of_scope",
             "test_a_g81_with_p_is_compensated_with_its_p_and_expand_cycles_refuses_it",
+            "test_a_g91_move_before_any_motion_code_right_after_a_cycle_passes_the_rest_on",
         ),
         "compensation/test_cutter_comp_accuracy.py": (
             "test_a_z_move_under_compensation_keeps_the_tool_centre_where_it_stands",

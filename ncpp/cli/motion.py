@@ -18,7 +18,8 @@ kind (traverse / feed / arc / rigid tap / rigid tap return), start, end, centre 
 arcs, feed, plane, inch, the work offset (machine minus program position), the tool length
 offset, why compensation leaves a move as programmed or writes it its own way ("fixed": a
 canned cycle, a drilling cycle, a hole pattern, a loop or subroutine, cutter compensation, a
-G28/G30 return, a machine-coordinate move), where it does, and under cutter compensation that
+G28/G30 return, a machine-coordinate move, a Fanuc or Haas move before the program names G00-G03),
+where it does, and under cutter compensation that
 ncpp follows where the tool centre stands off the move's start and end ("centre_shift").
 Under a rotation of the coordinate system (LinuxCNC's G10 L2 R, Fanuc's and Haas's G68) a
 record's points are where the control turns the program's to (machine position minus "offset"),

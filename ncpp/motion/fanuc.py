@@ -152,6 +152,21 @@ Canned cycles are a modal group of their own, group 09 beside group 01's G00-G03
 `G81 ...`, `G80`, `G91 A45.` is a rapid.  rs274ngc keeps cycles in the motion group, and G80 leaves no
 motion mode there ("Cannot use axis values without a g code that uses them").
 
+Axis words before the program names any of G00-G03 (`G43 H01 Z50` after the safety line `G21 G90 G17
+G54 G40 G49 G80`, as Fanuc and Haas posts write the tool's first move) move in the group-01 mode the
+control holds at power-on or reset: on Fanuc G00, or G01 where parameter No. 3402#0 (G01) is set
+("Parameter 3402#0 (G01) sets the default Group 01 interpolation mode to G01 (linear) instead of G00
+(rapid positioning) upon power-up or clear", cnc.wiki "Fanuc Parameter 3402 G-Code Clear and Reset";
+with 3402#6 (CLR) a reset clears the modes to these too); on Haas G00, the power-on default of group 01
+(Haas Mill Operator's Manual, default G codes; Setting 56, "M30 Restores Default G": the page is not in
+ncpp's reference set).  Either mode ends the move at its programmed point: ncpp follows it as a rapid
+straight to that point and leaves it as programmed (`HELD`, `Interpreter._held_move`), with one warning
+at the first, up to the first G00-G03 (a canned cycle, group 09, names none: after its G80 the mode held
+at the start is in effect again).  Nothing ncpp writes adds a G00/G01 before that point, which would set
+the mode the blocks after it run in.  Such a move with a corner (,C ,R) or under cutter compensation is
+out of scope; with --expand-cycles one after a cycle written as G0/G1 blocks is refused.  LinuxCNC
+refuses them ("Cannot use axis values without a g code that uses them").
+
 A G28 or G30 under cutter compensation is out of scope: the control drops the offset vector at the
 intermediate point and restores it after the return (NCT 2000M manual, "The Tool Compensation", a
 control that follows Fanuc's compensation C; Fanuc 15i-MA, "Cutter compensation C"), which ncpp does
@@ -267,6 +282,7 @@ class FanucInterpreter(Interpreter):
     any_cycle_p = True  # `G81 ... P500`: the P kept as written, no dwell of G81's (module docstring)
     taps_in_any_plane = True  # G74/G84 in G18/G19 tap along the normal (module docstring)
     cycles_own_group = True  # G80 leaves the G0-G3 mode before the cycle in effect (module docstring)
+    holds_start_mode = True  # `G43 H01 Z50` before any G00-G03: the start mode's (module docstring)
     back_bore_holes = False  # G87 reads R Z Q K otherwise than rs274ngc (`Interpreter.back_bore_holes`)
     repeat_letters: tuple[str, ...] = (
         "L",

@@ -72,6 +72,7 @@ from ncpp.motion.segments import (
     COMP,
     CYCLE,
     FLOW,
+    HELD,
     HOLE,
     HOME,
     PLANE_AXES,
@@ -283,6 +284,9 @@ class Interpreter:
     modal_d = False
     # The motion mode a program starts in (grbl: G0); rs274ngc starts in none
     start_motion: float | None = None
+    # Axis words before the program names any of G0-G3 move in a mode the control holds at its start
+    # (Fanuc, Haas: `_held_move`); rs274ngc refuses them
+    holds_start_mode = False
     # The taps G74/G84 in G18 and G19 feed along the plane's normal (Fanuc); rs274ngc's do not:
     # its convert_cycle_g74_g84 hands cycle_feed the plane's coordinates already permuted, so the
     # tap feeds other axes (in G18 X to the Y word, Y to the Z word, Z to the X word)
@@ -369,6 +373,8 @@ class Interpreter:
         self.cycle_p_word: Word | ExprWord | None = None
         self.per_revolution = False  # G95 (a Fanuc G04 may then count revolutions: `_dwell_word`)
         self.expand_cycles = False  # cycles are written as their moves (`expanded`)
+        self.cycle_written_out = False  # a cycle's moves were written as G0/G1 blocks (`_held_move`)
+        self.held_told = False  # the warning of a move in the mode the control holds at the start was given
         self.expansion: Expansion | None = None  # --expand: loops and subroutines written out
         self.spindle = 0  # M3 1, M4 -1, stopped 0 (tapping and boring cycles check it)
         self.coord_system = 1
@@ -1338,7 +1344,12 @@ class Interpreter:
         if motion is not None:
             motion_word = mode1_item if mode1_item is not None else axis_item
             if motion <= 1.0:
+                held = self.motion is None  # (axis words before the program names G0-G3: `_held_move`)
+                if held:
+                    self._held_move(block, words, motion_word)
                 events = self._straight(block, words, motion, mode0 == 53.0)
+                if held:
+                    events.fixed = HELD
                 self.corner = _corner_word(words, motion)
             elif motion in self.canned:
                 events = self._cycle(block, words, motion, previous, motion_word)
@@ -1408,9 +1419,33 @@ class Interpreter:
             return None
         if any_item is not None:
             if self.motion is None:
-                self._fail("Cannot use axis values without a g code that uses them", block, any_item)
+                if not self.holds_start_mode:
+                    self._fail("Cannot use axis values without a g code that uses them", block, any_item)
+                return 0.0  # (`_held_move`)
             return self.motion
         return None
+
+    def _held_move(self, block: Block, words: dict, item) -> None:
+        """A block of axis words before the program names any of G0-G3 (`holds_start_mode`: Fanuc's and
+        Haas's), which the control moves in the motion mode it holds at its start, G00 or G01 as a
+        parameter or setting of its own says (fanuc.py, module docstring): followed as a rapid straight
+        to its point (the control ends it there in either mode) and left as programmed (`HELD`), with a
+        warning at the first.  Out of scope with a corner word (,C ,R: rounded as G01 only), under
+        cutter compensation (its offset contour depends on the mode's path) and, with --expand-cycles,
+        after a cycle written as G0/G1 blocks (which leave the control in G0 or G1, not the mode it held)."""
+        if ",C" in words or ",R" in words:
+            raise _OutOfScope("a corner (,C ,R) on a move before the program names G00-G03 (the control moves "
+                              "it in a mode it holds at the start, G00 or G01)", item.start + 1)  # fmt: skip
+        if self._compensating():
+            raise _OutOfScope("a move under cutter compensation before the program names G00-G03 (the "
+                              "control moves it in a mode it holds at the start, G00 or G01)", item.start + 1)  # fmt: skip
+        if self.expand_cycles and self.cycle_written_out:
+            self._fail("--expand-cycles: a canned cycle before the program names G00-G03, whose moves written as "
+                       "G0/G1 blocks would change the motion mode this move runs in; leave the option out",
+                       block, item)  # fmt: skip
+        if not self.held_told and self.warnings is not None:
+            self.held_told = True
+            self.warnings.warn(HELD_MOVES, Location(self.file, block.line, item.start + 1))
 
     def _motion_mode_after(self, mode1: float, previous: float | None) -> float | None:
         """The modal motion once `mode1` (a motion code or G80) is read, `previous` in effect."""
@@ -2521,6 +2556,7 @@ class Interpreter:
         after a `Pass` that tells the writer, with a dwell after each bottom of G82 G89 (Haas: after
         the last peck of G73 G83 with a P) (`dwell`: its G4's P word)."""
         events: list[Event] = [Pass(block, cycle=motion)]
+        self.cycle_written_out = True
         dwells = set(bottoms) if dwell is not None else set()  # (P0 too: rs274 dwells 0 s)
         for k, line in enumerate(lines):
             line.fixed = ""
@@ -2804,13 +2840,18 @@ class Interpreter:
         raise NcppError(message, Location(self.file, block.line, col))
 
 
+# The warning at the first move before the program names any of G0-G3 (`Interpreter._held_move`)
+HELD_MOVES = ("axis words before the program names G00, G01, G02 or G03: the control moves them in the motion "
+              "mode it holds at the start (Fanuc: G00, or G01 with parameter 3402#0; Haas: G00), which this "
+              "program leaves to it; these moves pass through as programmed, to their programmed points, "
+              "up to the first G00-G03; LinuxCNC refuses them")  # fmt: skip
 # The interpreter's attributes that are no state a loop's check compares (`_loop_state`): kept
 # elsewhere (the parameters, the flow), only written or warned from, fixed for the run, or derived
 # from the others (the context, the fast path)
 _NOT_LOOP_STATE = frozenset(("params", "flow", "warnings", "untold_lengths", "expansion", "tools",
                              "file", "subroutine_path", "expand_cycles", "_context", "_fast",
                              "rounding", "once_runs", "main_program", "tool_reads", "checked_reads",
-                             "guard_reads", "unchecked_lines"))  # fmt: skip
+                             "guard_reads", "unchecked_lines", "held_told"))  # fmt: skip
 # Fanuc lathes' maximum spindle speed clamp in G-code systems B and C (system A's G50 S), and Fanuc
 # machining centres' under constant surface speed (their G code list: G92 "setting for workpiece
 # coordinate system or clamp at maximum spindle speed"; `lathe.py`): no move, no offset

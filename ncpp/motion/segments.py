@@ -37,6 +37,10 @@ DRILLED = "drilling cycle"
 # between them, at the pattern's own positions
 PATTERN = "hole pattern"
 COMP = "cutter compensation"  # the control offsets the path by the tool's radius: the tool is not on it
+# Fanuc, Haas: a move of axis words before the program names any of G00-G03, in the motion mode the
+# control holds at its start (a parameter's or setting's: `FanucInterpreter`), written as programmed so
+# that no G00/G01 word of ncpp's sets that mode for the blocks after it
+HELD = "motion mode the control holds at the start"
 HOME = "G28/G30 return"  # the control homes the axes it names (machine coordinates); the others stay where they stand
 # Klartext M91 and M140 MB, Sinumerik SUPA, G53 and G153: positions of the control's own
 MACHINE = "machine-coordinate move"
@@ -353,6 +357,7 @@ __all__ = [
     "FLOW",
     "DRILLED",
     "PATTERN",
+    "HELD",
     "HOME",
     "MACHINE",
     "UNPLACED",

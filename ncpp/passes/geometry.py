@@ -287,7 +287,7 @@ def _check(wanted: NDArray, command: NDArray, lines: NDArray, ctx: PassContext) 
             f"{what} is not a finite number: nothing to command", Location(ctx.file, int(lines[k]))
         )
     correction = np.linalg.norm(command - wanted, axis=-1).max(axis=-1)
-    outside = ((command < lo) | (command > hi)).any(axis=-1).any(axis=-1)
+    outside = np.asarray(((command < lo) | (command > hi)).any(axis=-1).any(axis=-1))
     bad = np.flatnonzero((correction > ctx.max_correction) | outside)
     if bad.size:
         k = int(bad[0])

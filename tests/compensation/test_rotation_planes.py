@@ -16,8 +16,6 @@ from __future__ import annotations
 
 import math
 import re
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -26,9 +24,8 @@ import pytest
 import ncpp.program.dialects.iso
 from ncpp.cli import main
 from tests import rs274
-from tests.compensation.test_rotation import interpreted, turned_twice
+from tests.compensation.test_rotation import fanuc_written, interpreted, turned_twice
 from tests.compensation.tool_centre import deviation, feed_moves
-from tests.conftest import ROOT
 from tests.writeback.conftest import linear_errors, machine_file, misses
 
 # error along the first axis from travel of the second, µm per mm (`linear_errors`)
@@ -140,18 +137,9 @@ def worked_out(text: str) -> tuple[np.ndarray, str]:
 
 
 def compensated(tmp_path: Path, text: str, dialect: str = "fanuc") -> tuple[Path, Path]:
-    """The program and ncpp's compensation of it for MACHINE, G54 at ZERO (verified as it is written)."""
-    (tmp_path / "affine.toml").write_text(MACHINE)
-    program, out = tmp_path / "turned.nc", tmp_path / "turned.out.nc"
-    program.write_text(text)
-    zero = ",".join(f"{v:g}" for v in ZERO)
-    proc = subprocess.run([sys.executable, "-m", "ncpp", "compensate", "--dialect", dialect, "--machine",
-                           str(tmp_path / "affine.toml"), "--work-offset", zero, "--tolerance", "0.0001",
-                           str(program), "-o", str(out)],
-                          capture_output=True, text=True, cwd=ROOT, timeout=300, stdin=subprocess.DEVNULL)  # fmt: skip
-    assert proc.returncode == 0, proc.stderr
-    assert "scope" not in proc.stderr and "warning" not in proc.stderr, proc.stderr
-    return program, out
+    """The program and ncpp's compensation of it for MACHINE, G54 at ZERO (verified as it is written),
+    with no warning."""
+    return fanuc_written(tmp_path, dialect, text, MACHINE, ZERO, quiet=True)
 
 
 @pytest.mark.parametrize("dialect", ["fanuc", "haas"])

@@ -839,3 +839,122 @@ def test_expand_keeps_a_g68_of_variables_out_of_scope(tmp_path):
         proc = subprocess.run([*run, "-o", str(tmp_path / "out.nc"), *expand], capture_output=True, text=True,
                               cwd=ROOT, timeout=300)  # fmt: skip
         assert said in proc.stderr, proc.stderr
+
+
+# Axis words before any of G00-G03 (`G90 Z50` as `G43 H01 Z50` is in a Fanuc program's start), a cycle
+# (group 09, which names none), more after its G80, in G91 too, then the program's first G00
+HELD_START = ("G21 G90 G17 G94 G54 G40 G49 G80\nG90 Z50\nX-18 Y-18\nG98 G81 X0 Y0 Z-2 R1 F50\nG80\nZ40\n"
+              "G91 X5\nG90\nG00 X-18 Y-18\nZ2\nG01 Z-1 F200\nX40\n")  # fmt: skip
+
+
+@pytest.mark.parametrize("dialect", ["fanuc", "haas"])
+def test_axis_words_before_any_motion_code_move_in_the_mode_the_control_holds(tmp_path, dialect):
+    """Fanuc's group 01 at power-on or reset is G00 (G01 by parameter 3402#0), Haas's G00 (fanuc.py): the
+    blocks before the first G00-G03 move straight to their points, left as programmed, with one warning at
+    the first; LinuxCNC refuses the program."""
+    from ncpp.motion.segments import CYCLE, HELD, HOLE
+
+    said = io.StringIO()
+    found = events(HELD_START + "M30\n", dialect, Warnings(stream=said))
+    moves = [e for e in found if type(e) is Line]
+    held = [m for m in moves if m.fixed == HELD]
+    assert [m.block.line for m in held] == [2, 3, 6, 7] and all(m.rapid for m in held)
+    assert all(m.fixed in (CYCLE, HOLE) for m in moves if m.block.line == 4)
+    assert not any(m.fixed for m in moves if m.block.line > 8)
+    assert (
+        said.getvalue().count("before the program names G00") == 1 and "p.nc:2:5: warning" in said.getvalue()
+    )
+    with pytest.raises(NcppError, match="Cannot use axis values without a g code that uses them"):
+        events(HELD_START, "iso")
+
+
+@pytest.mark.parametrize("dialect", ["fanuc", "haas"])
+def test_the_moves_before_any_motion_code_are_rs274s_of_the_twin_that_writes_g0_in_them(tmp_path, dialect):
+    """Judged by LinuxCNC's rs274: the moves are those of the twin with G0 in the blocks before the first G00."""
+    from ncpp.motion.canon import canon_call, read_canon
+    from tests.motion.test_oracle import rs274_error, run_rs274, write_program
+
+    if not RS274.exists():
+        pytest.skip("rs274 not available")
+    found = events(HELD_START + "M30\n", dialect)
+    twin = (
+        HELD_START.replace("\nG90 Z50", "\nG0 G90 Z50")
+        .replace("\nX-18", "\nG0 X-18")
+        .replace("\nZ40\nG91 X5", "\nG0 Z40\nG0 G91 X5")
+    )
+    calls, messages = run_rs274(write_program(tmp_path, twin))
+    assert rs274_error(messages) is None, messages
+    theirs = read_canon(calls)
+    mine = [call for call in map(canon_call, found) if call is not None]
+    assert [c.name for c in mine] == [c.name for c in theirs]
+    assert all(abs(a - b) <= 1e-6 for want, got in zip(theirs, mine) for a, b in zip(want.args, got.args))
+
+
+@pytest.mark.parametrize("dialect", ["fanuc", "haas"])
+def test_the_moves_before_any_motion_code_are_written_as_programmed_and_the_rest_compensated(
+    tmp_path, dialect
+):
+    """`G43 H01 Z50` first (the issue's program): every line before the first G00 is written as the input has
+    it but the cycle's, whose hole is compensated, and none gets a G word (a G00 or G01 ncpp wrote there would
+    set the mode the control holds for the lines after it); the moves from the G00 on are compensated.
+    Judged by rs274 on the twins of input and output that write G0 in the held blocks (pathcheck: same
+    actions, rapids where the original rapids, within 0.05 mm)."""
+    text = (
+        "%\nO0200 (PLYTKA)\n"
+        + HELD_START.replace("G90 Z50", "G43 H01 Z50").replace("G91 X5\nG90\n", "")
+        + "M30\n%\n"
+    )
+    written, messages, _ = compensated_by_cli(tmp_path, text, dialect, "--no-guard")
+    assert "before the program names G00" in messages and "compensated" in messages
+    program = [line for line in written.splitlines() if not line.startswith("(ncpp")]
+    first = text.splitlines().index("G00 X-18 Y-18")
+    before = list(zip(program[:first], text.splitlines()[:first]))
+    assert all(re.findall(r"G\d+", out) == re.findall(r"G\d+", given) for out, given in before)
+    assert all(out == given for out, given in before if "G81" not in given)  # (the hole is compensated)
+    assert program[first] != "G00 X-18 Y-18"  # (compensated)
+    if not (RS274.exists() and PATHCHECK.exists()):
+        pytest.skip("rs274 or pathcheck not available")
+    twins = []
+    for name, source in (("in.ngc", text), ("out.ngc", "\n".join(program) + "\n")):
+        twin = (
+            source.replace("%\n", "").replace("O0200 (PLYTKA)\n", "").replace("G43 H01 Z50", "G43 H01 G0 Z50")
+        )
+        twin = twin.replace("\nX-18 Y-18", "\nG0 X-18 Y-18").replace("\nZ40\n", "\nG0 Z40\n")
+        (tmp_path / name).write_text(twin)
+        twins.append(str(tmp_path / name))
+    check = subprocess.run([sys.executable, str(PATHCHECK), *twins, "--tol-mm", "0.05"], capture_output=True,
+                           text=True, timeout=600)  # fmt: skip
+    assert check.returncode == 0, check.stdout + check.stderr
+
+
+@pytest.mark.parametrize(
+    "block, reason",
+    [("X10 ,C1", "a corner (,C ,R) on a move before the program names G00-G03"),
+     ("G41 D1 X10", "a move under cutter compensation before the program names G00-G03")],
+)  # fmt: skip
+def test_a_move_before_any_motion_code_that_ncpp_cannot_place_ends_interpretation(block, reason):
+    said = io.StringIO()
+    found = events(f"G21 G90 G54\n{block}\nG0 X1\nM30\n", "fanuc", Warnings(stream=said))
+    assert [type(e) for e in found] == [Pass, Pass, Pass, Pass] and reason in said.getvalue()
+
+
+def test_expanded_cycles_before_a_move_in_the_mode_the_control_holds_are_refused():
+    """--expand-cycles writes a cycle as G0/G1 blocks, which would leave the control in G0 or G1 for the
+    axis words after its G80: refused, where without the option the cycle's block is kept."""
+    interpret, _ = dialect_tools("fanuc")
+    program = "G21 G90 G54\nG98 G81 X0 Y0 Z-2 R1 F50\nG80\nZ40\nM30\n"
+    _, blocks = parse_program(io.BytesIO(program.encode()), "p.nc", "fanuc")
+    with pytest.raises(NcppError, match="--expand-cycles: a canned cycle before the program names G00-G03"):
+        list(interpret(blocks, file="p.nc", warnings=Warnings(stream=io.StringIO()), expand_cycles=True))
+    assert [type(e) for e in events(program, "fanuc")][-2:] == [Line, Pass]
+
+
+def test_a_g91_move_before_any_motion_code_right_after_a_cycle_passes_the_rest_on(tmp_path):
+    """A G91 move right after a canned cycle in G90 starts where the cycle's G98 retract left the tool, which
+    ncpp does not follow (`pipeline.INCREMENTAL_CYCLE`): in the control's start mode too, the rest passes
+    through uncompensated with the warning."""
+    text = "G21 G90 G54\nG0 X0 Y0 Z5\nG98 G81 X10 Y0 Z-2 R1 F50\nG80\nG91 X5\nG90 G0 X30 Y10\nM30\n"
+    held = text.replace("G0 X0 Y0 Z5\n", "X0 Y0 Z5\n")
+    written, messages, _ = compensated_by_cli(tmp_path, held, "fanuc")
+    assert "a G91 move right after a canned cycle in G90" in messages
+    assert written.endswith("G91 X5\nG90 G0 X30 Y10\nM30\n")
