@@ -26,7 +26,10 @@ compared, once the written program's lines of it are read back (the passes have
 made their corrections), and the section is sampled then.
 
 Paths are compared in machine coordinates (mm, tool length and work offsets
-applied) as straight segments, arcs in chords within an eighth of the bound:
+applied); under cutter compensation ncpp follows, the path compared is the tool
+centre's as the control joins the offset moves (`ncpp.motion.centre_path`), so a short
+move written turned round, which the control offsets to its other side, is told
+apart from one a µm off.  They are compared as straight segments, arcs in chords within an eighth of the bound:
 a segment of one path whose two ends lie within the bound of one segment of
 the other (or of two of a few that follow one another, less how far the
 vertices between lie from the line between the ends' closest points) lies
@@ -64,6 +67,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ncpp.errors import Location, NcppError, Warnings
+from ncpp.motion.centre_path import CentrePath
 from ncpp.motion.offsets import AT_MACHINE_ZERO, WorkOffsets
 from ncpp.motion.once import MAX_ONCE, OnceRuns
 from ncpp.motion.segments import EXTRA_AXES, PLANE_AXES, Arc, Event, Line, Pass
@@ -132,6 +136,9 @@ class _Moves:
     action: Action | None = None  # the action that ends the section (None: a cut, or the program's end)
     first_line: int = 1
     cut: Position | None = None  # a chunk's end, where the next chunk starts (None: not a chunk)
+    # under cutter compensation: where the tool centre runs, and the last move added along it
+    centre_path: CentrePath = field(default_factory=CentrePath)
+    centre_last: int = -2
 
     def closed(self, action: Action | None, first_line: int, cut: Position | None = None) -> _Moves:
         """The moves, told the action that ends them (or the `cut` of a chunk) and their first line."""
@@ -340,8 +347,12 @@ def _add(
     if ctx is not moves.frame:
         moves.frame = ctx
         moves.frames.append((n, ctx))
-    moves.points += event.start
-    moves.points += event.end
+    if event.centre_shift is None:
+        moves.points += event.start
+        moves.points += event.end
+    else:
+        n = _on_centre_path(moves, event, extra, line)
+        moves.centre_last = n
     moves.lines.append(line)
     if event.extra:
         end_extra = (tuple(event.extra) + NO_EXTRA)[: len(EXTRA_AXES)]
@@ -368,6 +379,30 @@ def _add(
             if not moves.feeds or not math.isclose(moves.feeds[-1][0], feed, rel_tol=1e-9, abs_tol=1e-9):
                 moves.feeds.append((feed, line))
     return end_extra
+
+
+def _on_centre_path(moves: _Moves, event: Line | Arc, extra: tuple[float, ...], line: int) -> int:
+    """Add a move's ends under cutter compensation where the tool centre runs (`CentrePath`): the
+    corner before it first, or the move before cut back to where their offsets cross.  Returns
+    the move's index."""
+    n = len(moves.lines)
+    on = moves.centre_path.along(event, moves.centre_last == n - 1)
+    if on.cut_back is not None:
+        moves.points[6 * n - 3 : 6 * n] = on.cut_back
+    if on.corner is not None:
+        moves.points += on.corner.start
+        moves.points += on.corner.end
+        moves.lines.append(line)
+        moves.arcs += (n, on.corner.turn)
+        moves.centres += on.corner.centre
+        if extra is not NO_EXTRA:
+            moves.extra[n] = (extra, extra)
+        if type(event) is Line and event.rapid:
+            moves.rapids.append(n)
+        n += 1
+    moves.points += on.start
+    moves.points += on.end
+    return n
 
 
 def _inverse_time(block: Block, now: bool) -> bool:

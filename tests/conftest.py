@@ -36,6 +36,7 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_the_holes_moves_compensation_sees_are_the_ones_rs274_makes",
         ),
         "compensation/test_rs274_accepts.py": None,
+        "motion/test_centre_path.py": ("test_the_tool_centre_runs_where_rs274_puts_it",),
         "writeback/test_subroutines_run_once.py": None,
         "compensation/test_subprograms_first.py": None,
         "writeback/test_haas_local_subprograms.py": None,

@@ -315,3 +315,43 @@ def test_a_subprogram_stored_before_the_main_program_is_read_back_where_the_call
     assert compensate(path, "--dialect", "fanuc") != 0
     assert "part.nc:3:1: verification:" in capsys.readouterr().err
     assert not path.with_suffix(".out.ngc").exists()
+
+
+CONTOUR = """G21 G90 G17
+T1 M6
+S1000 M3
+G0 X0 Y-5 Z5
+G1 Z-1 F200
+G41.1 D4
+G1 X10 Y0
+X30
+X30.005
+X50
+Y20
+X10
+G40 G1 X0 Y25
+G0 Z5
+M5
+M30
+"""
+
+
+def test_a_short_move_turned_round_under_cutter_compensation_is_refused(tmp_path: Path, monkeypatch, capsys):
+    """Line 9's 5 µm move along the edge written 10 µm back, within the bound as a contour: under
+    G41.1 the control offsets it to its other side, swinging the tool centre round by the 4 mm
+    diameter and back."""
+    program = tmp_path / "contour.ngc"
+    program.write_text(CONTOUR)
+    assert compensate(program) == 0
+    monkeypatch.setattr(ncpp.pipeline, "PASSES", (*ncpp.pipeline.PASSES, shifted_at_line(9, -0.01)))
+    program.with_suffix(".out.ngc").unlink()
+    assert compensate(program) != 0
+    assert "contour.ngc:9:1: verification: the written path leaves the original's" in capsys.readouterr().err
+
+
+def test_a_contour_under_cutter_compensation_written_a_little_off_passes(tmp_path: Path, monkeypatch):
+    """The same 10 µm at the end of the edge before: the tool centre moves by as much."""
+    program = tmp_path / "contour.ngc"
+    program.write_text(CONTOUR)
+    monkeypatch.setattr(ncpp.pipeline, "PASSES", (*ncpp.pipeline.PASSES, shifted_at_line(8, -0.01)))
+    assert compensate(program) == 0

@@ -1,0 +1,246 @@
+"""The path the tool centre takes under cutter compensation, as the control joins the offset moves.
+
+The interpreter gives each move it follows under compensation where the tool centre stands off
+its programmed start and end (`Line.centre_shift`, `ncpp.motion.cutter`): the start where the
+move before left it, the end square to the move's own direction there.  Between two moves the
+control joins the offset paths: at an outside corner by an arc about the programmed corner, at
+an inside one by cutting both back to where they cross (LinuxCNC's interpreter, and the TNC's
+and the 840D's default G450: TNC 640 user's manual, "Radius compensation: Machining corners";
+840D sl Programming Manual Fundamentals, "Corner behavior: G450, G451").  `CentrePath` makes
+that path of a stream of moves, a move at a time: what the verifier compares, so that a written
+program whose contour lies near the input's but turns a short move round (and with it the tool
+centre by up to twice the radius) is told apart.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from ncpp.motion.segments import PLANE_AXES, Arc, Line, Point
+
+Flat = tuple[float, float]  # a point or a direction in the plane's own axes (u, v)
+# program units: offsets closer than this meet without a corner (the rounding of a written number)
+SMOOTH = 1e-7
+
+
+@dataclass(frozen=True)
+class Corner:
+    """An outside corner's arc about the programmed corner, from `start` to `end`."""
+
+    start: Point
+    end: Point
+    centre: Point
+    turn: int  # +1 counter-clockwise in the plane's (u, v), -1 clockwise
+
+
+@dataclass(frozen=True)
+class OnCentre:
+    """A move's tool-centre start and end, the corner before it (None: the offsets meet there or
+    are cut back to their crossing), and where the move before now ends (None: where it did)."""
+
+    start: Point
+    end: Point
+    corner: Corner | None = None
+    cut_back: Point | None = None
+
+
+@dataclass(frozen=True)
+class _Offset:
+    """A move's tool-centre path in its plane: a line through `point` along `leaving`, or
+    (`radius` set) a circle about `point`; `length` how far it runs, `leaving` its direction at
+    its end."""
+
+    point: Flat
+    leaving: Flat
+    radius: float | None = None
+    length: float = 0.0
+
+
+class CentrePath:
+    """The tool-centre path of the moves given it one after another (`along`): `last` is the
+    offset of the move given last, which the next may cut back at an inside corner."""
+
+    def __init__(self) -> None:
+        self.last: tuple[_Offset, int] | None = None  # the last move's offset and its plane
+
+    def along(self, move: Line | Arc, before_is_last: bool) -> OnCentre:
+        """Where the tool centre runs for `move` (its `centre_shift` set); `before_is_last`: the
+        move given last is the one just before it (else an inside corner is not cut back)."""
+        shifts = move.centre_shift
+        assert shifts is not None
+        at_start, at_end = shifts
+        plane = move.context.plane
+        a, b, _ = PLANE_AXES[plane]
+        end = _plus(move.end, at_end)
+        last, self.last = self.last, None
+        if at_start is None or not _in_plane(move, a, b):
+            start = move.start if at_start is None else _plus(move.start, at_start)
+            if at_start is None and type(move) is Line and _in_plane(move, a, b):  # (an entry line)
+                self.last = (_offset(move, end, a, b), plane)
+            return OnCentre(start, end)
+        own = _own_start_shift(move, at_end, a, b)
+        exits = math.hypot(at_end[a], at_end[b]) <= SMOOTH  # (after G40: it ends on its programmed point)
+        start = _plus(move.start, at_start if exits else own)
+        self.last = (_offset(move, end, a, b), plane)
+        gap = (own[a] - at_start[a], own[b] - at_start[b])
+        if exits or math.hypot(*gap) <= SMOOTH:
+            return OnCentre(start, end)
+        before = _plus(move.start, at_start)
+        tangent = _tangent(move, a, b)
+        previous = last[0] if before_is_last and last is not None and last[1] == plane else None
+        if _outside(gap, tangent, move, previous, a, b):
+            turn = _corner_turn((at_start[a], at_start[b]), (own[a], own[b]), tangent)
+            return OnCentre(start, end, Corner(before, start, move.start, turn))
+        if previous is None:
+            return OnCentre(start, end)
+        crossing = _crossing(previous, self.last[0], (before[a], before[b]), (start[a], start[b]), tangent)
+        if crossing is None:  # (they do not cross within both moves: the control reports a gouge)
+            return OnCentre(start, end)
+        met = list(start)
+        met[a], met[b] = crossing
+        return OnCentre((met[0], met[1], met[2]), end, cut_back=(met[0], met[1], met[2]))
+
+
+def _outside(gap: Flat, tangent: Flat, move: Line | Arc, previous: _Offset | None, a: int, b: int) -> bool:
+    """Whether the corner before `move` is an outside one: its offset starts ahead of the one the
+    move before left (`gap`: the first minus the second) along the move's direction (`tangent`).
+    Where the move turns right back (a cusp), by which way the moves bend from the corner: towards
+    the offsets' parting, an inside one; two lines turned right back, an outside one."""
+    along = gap[0] * tangent[0] + gap[1] * tangent[1]
+    if abs(along) > 1e-9 * math.hypot(*gap):
+        return along > 0.0
+    if type(move) is Arc:  # (it bends towards its centre)
+        return gap[0] * (move.center[a] - move.start[a]) + gap[1] * (move.center[b] - move.start[b]) > 0.0
+    if previous is not None and previous.radius is not None:  # (as seen running the other way)
+        corner = (move.start[a], move.start[b])
+        towards = (previous.point[0] - corner[0], previous.point[1] - corner[1])
+        return gap[0] * towards[0] + gap[1] * towards[1] < 0.0
+    return True
+
+
+def _plus(p: Point, q: Point) -> Point:
+    return (p[0] + q[0], p[1] + q[1], p[2] + q[2])
+
+
+def _in_plane(move: Line | Arc, a: int, b: int) -> bool:
+    return move.start[a] != move.end[a] or move.start[b] != move.end[b]
+
+
+def _own_start_shift(move: Line | Arc, at_end: Point, a: int, b: int) -> Point:
+    """The tool centre minus the programmed point at the move's start, square to the move there:
+    a line's is its end's; an arc's is radial, by its end's signed distance off the arc."""
+    if type(move) is not Arc:
+        return at_end
+    c = move.center
+    eu, ev = move.end[a] - c[a], move.end[b] - c[b]
+    su, sv = move.start[a] - c[a], move.start[b] - c[b]
+    towards = (at_end[a] * eu + at_end[b] * ev) / math.hypot(eu, ev)
+    radial = towards / math.hypot(su, sv)
+    shift = [0.0, 0.0, 0.0]
+    shift[a], shift[b] = su * radial, sv * radial
+    return (shift[0], shift[1], shift[2])
+
+
+def _tangent(move: Line | Arc, a: int, b: int, at_end: bool = False) -> Flat:
+    """The move's unit direction in the plane at its start (at its end: `at_end`)."""
+    if type(move) is Arc:
+        point = move.end if at_end else move.start
+        u, v = point[a] - move.center[a], point[b] - move.center[b]
+        r = math.hypot(u, v) * (1.0 if move.turn > 0 else -1.0)
+        return (-v / r, u / r)
+    u, v = move.end[a] - move.start[a], move.end[b] - move.start[b]
+    n = math.hypot(u, v)
+    return (u / n, v / n)
+
+
+def _corner_turn(before: Flat, after: Flat, tangent: Flat) -> int:
+    """The way an outside corner's arc turns from one offset to the other: the short way round,
+    and at a reversal (the offsets opposite) forward, against the next move's direction."""
+    cross = before[0] * after[1] - before[1] * after[0]
+    if abs(cross) <= 1e-9 * (before[0] ** 2 + before[1] ** 2):
+        cross = -(before[0] * tangent[1] - before[1] * tangent[0])
+    return 1 if cross > 0 else -1
+
+
+def _offset(move: Line | Arc, end: Point, a: int, b: int) -> _Offset:
+    """The move's tool-centre path in the plane, through its tool-centre `end`: a line along the
+    move's own direction (also an entry's, which the control cuts back so), or its arc's circle."""
+    if type(move) is Arc:
+        centre = (move.center[a], move.center[b])
+        radius = math.hypot(end[a] - centre[0], end[b] - centre[1])
+        return _Offset(centre, _tangent(move, a, b, at_end=True), radius, radius * _swept(move, a, b))
+    length = math.hypot(move.end[a] - move.start[a], move.end[b] - move.start[b])
+    return _Offset((end[a], end[b]), _tangent(move, a, b), None, length)
+
+
+def _swept(move: Arc, a: int, b: int) -> float:
+    """The angle an arc turns through (radians, positive)."""
+    c = move.center
+    begin = math.atan2(move.start[b] - c[b], move.start[a] - c[a])
+    finish = math.atan2(move.end[b] - c[b], move.end[a] - c[a])
+    part = ((finish - begin) if move.turn > 0 else (begin - finish)) % (2 * math.pi)
+    return part + 2 * math.pi * (abs(move.turn) - 1)
+
+
+def _crossing(first: _Offset, second: _Offset, ends: Flat, starts: Flat, onwards: Flat) -> Flat | None:
+    """Where two moves' offsets cross at an inside corner (`ends`: the first's tool-centre end,
+    `starts`: the second's start, `onwards`: its direction there): the crossing nearest the
+    corner back along the first and on along the second, within both moves' lengths, and about
+    where the offsets' tangents there cross (arcs nearly tangent to one another may cross only
+    far off, or not at all)."""
+    crossings = [
+        p for p in _meet(first, second)
+        if _dot(p, ends, first.leaving) <= SMOOTH and _dot(p, starts, onwards) >= -SMOOTH
+    ]  # fmt: skip
+    near = ((ends[0] + starts[0]) / 2, (ends[1] + starts[1]) / 2)
+    best = min(crossings, key=lambda p: math.dist(p, near), default=None)
+    if best is None or math.dist(best, ends) > first.length or math.dist(best, starts) > second.length:
+        return None
+    tangents = _meet(_Offset(ends, first.leaving), _Offset(starts, onwards))
+    if tangents:  # (none: the moves turn right back, and the arcs' crossing is the corner's)
+        reach = 2 * max(math.dist(tangents[0], ends), math.dist(tangents[0], starts)) + SMOOTH
+        if max(math.dist(best, ends), math.dist(best, starts)) > reach:
+            return None
+    return best
+
+
+def _dot(point: Flat, origin: Flat, direction: Flat) -> float:
+    """How far `point` lies from `origin` along `direction`."""
+    return (point[0] - origin[0]) * direction[0] + (point[1] - origin[1]) * direction[1]
+
+
+def _meet(first: _Offset, second: _Offset) -> list[Flat]:
+    """The points where two offsets (lines or circles) cross."""
+    if first.radius is None and second.radius is None:
+        (p, d), (q, e) = (first.point, first.leaving), (second.point, second.leaving)
+        det = d[0] * e[1] - d[1] * e[0]
+        if abs(det) <= 1e-12:
+            return []
+        t = ((q[0] - p[0]) * e[1] - (q[1] - p[1]) * e[0]) / det
+        return [(p[0] + t * d[0], p[1] + t * d[1])]
+    if first.radius is None or second.radius is None:
+        line, circle = (first, second) if first.radius is None else (second, first)
+        return _line_meets_circle(line.point, line.leaving, circle.point, circle.radius or 0.0)
+    return _circles_meet(first.point, first.radius, second.point, second.radius)
+
+
+def _line_meets_circle(p: Flat, d: Flat, c: Flat, r: float) -> list[Flat]:
+    fu, fv = p[0] - c[0], p[1] - c[1]
+    half_b = fu * d[0] + fv * d[1]
+    disc = half_b * half_b - (fu * fu + fv * fv - r * r)
+    if disc < 0.0:
+        return []
+    root = math.sqrt(disc)
+    return [(p[0] + t * d[0], p[1] + t * d[1]) for t in (-half_b - root, -half_b + root)]
+
+
+def _circles_meet(c0: Flat, r0: float, c1: Flat, r1: float) -> list[Flat]:
+    apart = math.dist(c0, c1)
+    if apart <= 1e-12 or apart > r0 + r1 or apart < abs(r0 - r1):
+        return []
+    along = (r0 * r0 - r1 * r1 + apart * apart) / (2 * apart)
+    height = math.sqrt(max(r0 * r0 - along * along, 0.0))
+    du, dv = (c1[0] - c0[0]) / apart, (c1[1] - c0[1]) / apart
+    mu, mv = c0[0] + along * du, c0[1] + along * dv
+    return [(mu - height * dv, mv + height * du), (mu + height * dv, mv - height * du)]

@@ -1,0 +1,118 @@
+"""The tool-centre path under cutter compensation (`ncpp.motion.centre_path`), what the verifier
+compares: judged by LinuxCNC's rs274, which prints the tool centre's moves (corner arcs and
+moves cut back at inside corners) as its canonical calls."""
+
+from __future__ import annotations
+
+import io
+import math
+
+import pytest
+
+from ncpp.errors import Warnings
+from ncpp.motion import interpret
+from ncpp.motion.centre_path import CentrePath
+from ncpp.motion.segments import Arc, Line
+from ncpp.program.parser import parse_stream
+from tests import rs274 as oracle
+
+# G41.1 and G42.1 contours with outside and inside corners between lines and arcs; the arcs'
+# cusps (turning right back) in G17 and G18
+CONTOURS = {
+    "lines-and-arcs": """G21 G90 G17 G94
+G0 X-10 Y-10 Z5
+G1 Z-1 F200
+G41.1 D4
+G1 X0 Y0
+X40
+Y10
+X35
+G3 X25 Y10 I-5 J0
+G1 X20 Y10
+G2 X10 Y20 I0 J10
+G1 Y30
+X0
+Y0.5
+G40 G1 X-10 Y-5
+G0 Z5
+M2
+""",
+    "arc-cusps": """G21 G90 G17 G94
+G0 X0 Y-10 Z5
+G1 Z-1 F200
+G41.1 D4
+G1 X0 Y0
+X10
+G2 X20 Y0 R5
+G2 X30 Y0 R5
+G3 X40 Y0 R5
+G3 X50 Y0 R5
+G1 X60
+Y20
+X0
+G40 G1 X-10 Y25
+G0 Z5
+M2
+""",
+    "g18": """G21 G90 G18 G94
+G0 X-10 Y0 Z-10
+G41.1 D4
+G1 X0 Z0 F200
+Z20
+X10
+G2 X20 Z20 R5
+G1 Z0
+G3 X30 Z-10 R10
+G40 G1 X40 Z-20
+M2
+""",
+}
+CONTOURS["right"] = CONTOURS["lines-and-arcs"].replace("G41.1", "G42.1")
+
+
+def centre_path(text: str) -> list[tuple[str, tuple[float, float, float]]]:
+    """Each move's kind (L: straight, A: arc) and end where the tool centre runs, in order: a
+    corner's arc before its move, a move cut back at an inside corner ending where it is cut."""
+    blocks = parse_stream(io.BytesIO(text.encode()), "contour.ngc", "iso")
+    path, moves = CentrePath(), []
+    for event in interpret(blocks, file="contour.ngc", warnings=Warnings(stream=io.StringIO())):
+        if type(event) is not Line and type(event) is not Arc:
+            continue
+        kind = "A" if type(event) is Arc else "L"
+        if event.centre_shift is None:
+            moves.append((kind, event.end))
+            continue
+        on = path.along(event, True)
+        if on.cut_back is not None:
+            moves[-1] = (moves[-1][0], on.cut_back)
+        if on.corner is not None:
+            moves.append(("A", on.corner.end))
+        moves.append((kind, on.end))
+    return moves
+
+
+def rs274_path(text: str) -> list[tuple[str, tuple[float, float, float]]]:
+    calls = oracle.canon(text, digits=7)
+    kinds = [
+        "A" if name == "ARC_FEED" else "L" for name, _ in oracle.CALL.findall(calls) if name != "SELECT_PLANE"
+    ]
+    return list(zip(kinds, oracle.end_points(calls)))
+
+
+@pytest.mark.parametrize("name", CONTOURS)
+def test_the_tool_centre_runs_where_rs274_puts_it(name):
+    ours, theirs = centre_path(CONTOURS[name]), rs274_path(CONTOURS[name])
+    assert [kind for kind, _ in ours] == [kind for kind, _ in theirs]
+    far = max(math.dist(a, b) for (_, a), (_, b) in zip(ours, theirs))
+    assert far < 1e-6, (ours, theirs)
+
+
+def test_an_outside_corner_is_an_arc_about_it_and_an_inside_one_cut_back():
+    """The entry (from X-10 Y-10 to X0 Y0) ends square to itself, 2 mm to its left; an arc about
+    X0 Y0 turns to the edge along X; the edge ends where its offset meets the next one's, at
+    X38 Y2, not at X40 Y2."""
+    path = centre_path(CONTOURS["lines-and-arcs"])
+    ends = [(kind, tuple(round(v, 9) for v in end)) for kind, end in path[2:6]]
+    half = round(math.sqrt(2), 9)
+    assert ends == [("L", (-half, half, -1.0)), ("A", (0.0, 2.0, -1.0)), ("L", (38.0, 2.0, -1.0)),
+                    ("L", (38.0, 8.0, -1.0))]  # fmt: skip
