@@ -82,8 +82,8 @@ from ncpp.motion.segments import (
     Event,
     Hole,
     Line,
-    Pass,
     Mirror,
+    Pass,
     Setting,
     mirror_axes,
     plane_letters,
@@ -1147,7 +1147,8 @@ class Interpreter:
         variables: position information).  Not #5021-#5023, the machine position: the control
         reads it ahead, while the block before moves ("reading during movement: not possible")."""
         axis = key - 5001
-        mirrored = any(axis == i for i, _ in self.mirror)  # (whether the control mirrors it there is not said)
+        # (whether the control gives a mirrored axis mirrored there is not said)
+        mirrored = any(axis == i for i, _ in self.mirror)
         if 0 <= axis <= 2 and axis in self.placed and not any(self.g92[:3]) and not mirrored:
             return self.pos[axis]
         return None
@@ -1226,7 +1227,8 @@ class Interpreter:
         self.pos = end
         context = self._context or self.context()
         start_point, end_point = (pos[0], pos[1], pos[2]), (end[0], end[1], end[2])
-        if context.rotation is not None or context.mirror:  # (as `_line` turns them; no call where none turns)
+        # (as `_line` turns them; no call per point where none turns)
+        if context.rotation is not None or context.mirror:
             start_point, end_point = context.turned(start_point), context.turned(end_point)
         return Line(
             start_point,
