@@ -113,18 +113,18 @@ Rotation": R from Setting 72 when not given, added in G91 with Setting 73).  Sca
 tilted working plane (G68.2-G68.4) end interpretation by name.
 
 Fanuc's programmable mirror image `G51.1 X_ Y_` / `G50.1 X_ Y_` is followed in G17 (`_mirror_image`; the
-SINUMERIK 802D sl/840D ISO Milling programming manual, which documents Fanuc's dialect, 3.2
+SINUMERIK 802D sl/840D ISO Milling programming manual 04.07, which documents Fanuc's dialect, 3.2
 "Programmable mirror image"): the axis words of G51.1 give the "position and axis of symmetry" of each
-axis it mirrors, those of G50.1 the axes it cancels.  Each move after it goes where the control mirrors
-the program's point to, an increment (G91) the other way; the machine stays where it is at G51.1 and
-G50.1.  Mirrored in one axis of the plane alone, "G02 and G03 are interchanged" (and G41 and G42, and
+axis it mirrors, those of G50.1 the axes it cancels; the blocks between "describe the contour" that is
+mirrored, so each move goes where the control mirrors the program's point to and an increment (G91)
+runs the other way; G51.1 and G50.1 move nothing (the machine stays where it is).  Mirrored in one axis of the plane alone, "G02 and G03 are interchanged" (and G41 and G42, and
 the direction of a rotation).  What the manual forbids in its mode is out of scope: reference position
 returns (G27, G28, G30) and the coordinate system codes (G52-G59, G92; G53 and G10 with them), and "G50.1
 or G51.1 during scaling or coordinate rotation mode"; so are G68 in its mode, another plane, Z or another
 axis mirrored, a G51.1 in G91 or while a mirror image is in effect, cutter compensation and canned cycles
 (ncpp follows neither under it).  A G50.1 whose axis words ncpp is not mirroring cancels nothing: its
-words are no move.  Haas's mirror image is G101 (a parameter of the setting pages): G51.1 ends
-interpretation by name there.
+words are no move.  Haas's mirror image is G100/G101 (Haas Mill Operator's Manual, G code list): G51.1
+ends interpretation by name there.
 
 A canned cycle's K is its repeats, as rs274ngc's L (the Fanuc Series 0i and 16i formats, `G81 X_ Y_ Z_ R_
 F_ K_`, "K_: Number of repeats", as the Fanuc lathe operator's manual's drilling cycles give it; the
