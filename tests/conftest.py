@@ -59,6 +59,7 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
         "compensation/test_rotation_planes.py": (
             "test_the_whole_path_under_g68_in_g18_and_g19_lands_on_the_original_in_rs274",
         ),
+        "compensation/test_mirror.py": ("test_the_whole_path_under_g51_1_lands_on_the_original_in_rs274",),
         "compensation/test_rotated_cutter_comp.py": (
             "test_g41_under_g10_l2_r_passes_pathcheck_at_twice_the_largest_correction",
             "test_g41_under_g68_lands_on_the_original_in_rs274_written_as_linuxcncs_g10_l2_r",
@@ -227,6 +228,10 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_the_verifier_refuses_a_writer_that_gets_a_g18_rotation_wrong",
             "test_the_programmed_points_are_reached_under_g68_in_g18_and_g19_within_half_a_micron",
             "test_the_first_move_ncpp_rewrites_after_a_g18_rotation_gives_both_of_its_axes",
+        ),
+        "compensation/test_mirror.py": (
+            "test_the_verifier_refuses_a_writer_that_gets_the_mirror_image_wrong",
+            "test_the_programmed_points_are_reached_under_g51_1_within_half_a_micron",
         ),
         "shop/test_extents.py": None,  # (each runs the command line)
         "compensation/test_warning_order.py": None,

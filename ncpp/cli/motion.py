@@ -25,7 +25,9 @@ Under a rotation of the coordinate system (LinuxCNC's G10 L2 R, Fanuc's and Haas
 record's points are where the control turns the program's to (machine position minus "offset"),
 and "rotation" gives the turn: degrees counter-clockwise and its centre's coordinates in program
 coordinates, in the plane "rotation_plane" says (17: X Y; G68 in 18: Z X, in 19: Y Z, the plane's
-first axis first); `--format rs274` prints the program's own coordinates, as rs274 does.
+first axis first); under Fanuc's mirror image (G51.1) they are where the control mirrors them to, an
+arc's "turn" the way it runs there, and "mirror" gives each mirrored axis the coordinate it is mirrored
+about; `--format rs274` prints the program's own coordinates, as rs274 does.
 
 `--var-file linuxcnc.var` / `--work-offset [G5x=]X,Y,Z` start the
 interpreter from the control's zeros, as `rs274 -v FILE` does (default: all
@@ -129,6 +131,8 @@ def run(args: argparse.Namespace) -> int:
             if event.context.rotation is not None:  # (the points are in the turned frame)
                 record["rotation"] = event.context.rotation
                 record["rotation_plane"] = event.context.rotation_plane
+            if event.context.mirror:  # (the points, and an arc's turn, are in the mirrored frame)
+                record["mirror"] = {"XYZ"[axis]: centre for axis, centre in event.context.mirror}
             if (
                 event.fixed
             ):  # why compensation leaves it as programmed (a canned cycle, cutter compensation, ...)

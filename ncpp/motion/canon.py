@@ -65,8 +65,8 @@ def read_canon(text: str) -> list[CanonCall]:
 
 def canon_call(event: Event) -> CanonCall | None:
     """The rs274 canonical call of a motion event, at full precision; None for a Pass (and for a
-    rigid tap's return).  Under a rotation of the coordinate system its points are the program's, as
-    rs274 prints them (the control turns them: `Context.turned`)."""
+    rigid tap's return).  Under a rotation of the coordinate system or a mirror image its points are the
+    program's, as rs274 prints them (the control turns them: `Context.turned`)."""
     if type(event) is Line:
         end = event.context.turned(event.end, -1.0)
         if event.tap:
@@ -77,7 +77,8 @@ def canon_call(event: Event) -> CanonCall | None:
     if type(event) is Arc:
         a, b, n = PLANE_AXES[event.context.plane]
         e, c = event.context.turned(event.end, -1.0), event.context.turned(event.center, -1.0)
-        return CanonCall("ARC_FEED", (e[a], e[b], c[a], c[b], float(event.turn), e[n], *_rotary(event.extra)))
+        turn = -event.turn if event.context.reverses else event.turn  # (as the program turns it)
+        return CanonCall("ARC_FEED", (e[a], e[b], c[a], c[b], float(turn), e[n], *_rotary(event.extra)))
     return None
 
 

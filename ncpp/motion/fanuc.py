@@ -109,8 +109,22 @@ moves after it) where the Fanuc manual's rules leave nothing to a parameter (Fan
 centre, absolute; R the angle, counter-clockwise; without them the tool's position is the centre,
 without R a parameter's angle; no G17-G19 in its mode; G91 moves after it run from where the tool
 stood at G68; the first move after G69 absolute), Haas's alike (Mill Operator's Manual, "G68
-Rotation": R from Setting 72 when not given, added in G91 with Setting 73).  Scaling (G51), the programmable
-mirror image (G51.1), G68.1 and the tilted working plane (G68.2-G68.4) end interpretation by name.
+Rotation": R from Setting 72 when not given, added in G91 with Setting 73).  Scaling (G51), G68.1 and the
+tilted working plane (G68.2-G68.4) end interpretation by name.
+
+Fanuc's programmable mirror image `G51.1 X_ Y_` / `G50.1 X_ Y_` is followed in G17 (`_mirror_image`; the
+SINUMERIK 802D sl/840D ISO Milling programming manual 04.07, which documents Fanuc's dialect, 3.2
+"Programmable mirror image"): the axis words of G51.1 give the "position and axis of symmetry" of each
+axis it mirrors, those of G50.1 the axes it cancels; the blocks between "describe the contour" that is
+mirrored, so each move goes where the control mirrors the program's point to and an increment (G91)
+runs the other way; G51.1 and G50.1 move nothing (the machine stays where it is).  Mirrored in one axis of the plane alone, "G02 and G03 are interchanged" (and G41 and G42, and
+the direction of a rotation).  What the manual forbids in its mode is out of scope: reference position
+returns (G27, G28, G30) and the coordinate system codes (G52-G59, G92; G53 and G10 with them), and "G50.1
+or G51.1 during scaling or coordinate rotation mode"; so are G68 in its mode, another plane, Z or another
+axis mirrored, a G51.1 in G91 or while a mirror image is in effect, cutter compensation and canned cycles
+(ncpp follows neither under it).  A G50.1 whose axis words ncpp is not mirroring cancels nothing: its
+words are no move.  Haas's mirror image is G100/G101 (Haas Mill Operator's Manual, G code list): G51.1
+ends interpretation by name there.
 
 A canned cycle's K is its repeats, as rs274ngc's L (the Fanuc Series 0i and 16i formats, `G81 X_ Y_ Z_ R_
 F_ K_`, "K_: Number of repeats", as the Fanuc lathe operator's manual's drilling cycles give it; the
@@ -259,6 +273,16 @@ UNFOLLOWED_FRAMES = {51.0: "scaling", 51.1: "mirroring", 68.1: "coordinate rotat
                      **{code: "tilted working plane" for code in (68.2, 68.3, 68.4)}}  # fmt: skip
 
 
+# What is out of scope under G51.1 (SINUMERIK 802D sl/840D ISO Milling programming manual, 3.2 "Programmable
+# mirror image", Limitations: "Do not use G codes related to reference position return (G27,G28,G30), or
+# commands related to the coordinate system (G52 to G59,G92, etc.) in programmable mirror image mode"), and
+# what ncpp does not follow there: another plane, G53 and G10, G68, cutter compensation
+NOT_UNDER_G51_1 = frozenset((18.0, 19.0, 10.0, 27.0, 28.0, 29.0, 30.0, 41.0, 42.0, 52.0, 53.0, 54.0, 55.0,
+                             56.0, 57.0, 58.0, 59.0, 54.1, 68.0, 92.0, 92.1))  # fmt: skip
+# The words of a G51.1 or G50.1 block ncpp follows: N, G90 or G91, and the axes it names
+MIRROR_LETTERS = frozenset("NGXYZ")
+
+
 # The G codes whose block takes an H: the tool length offsets, the tool position offsets (whose number
 # Mazak's and Mitsubishi's G45-G48 take in H or D) and the macro calls' arguments
 _H_CODES = frozenset((43.0, 43.2, 43.4, 43.5, 44.0, 45.0, 46.0, 47.0, 48.0, 65.0, 66.0))
@@ -300,6 +324,7 @@ class FanucInterpreter(Interpreter):
     independent_h = True  # `G53 G00 H0 Z-110`: an H without G43, out of scope (module docstring)
     incremental_zero_set = True  # `G91 G10 L2 P1 X10.` adds 10 to G54's X (module docstring)
     rotating_g10 = False  # (an R in G10 L2 is no rotation there)
+    mirror_image = True  # G51.1 / G50.1: the programmable mirror image (module docstring)
     g92_speed_clamp = True  # `G92 S4000`: refused as the spindle speed clamp it is (`G92_SPEED_CLAMP`)
     fanuc_variables = True  # `#5003`, `#3020`: the control's system variables, in every program
     # Polar coordinates, scaling, programmable mirror image and coordinate rotation cancel (Fanuc Series
@@ -320,6 +345,8 @@ class FanucInterpreter(Interpreter):
         return True
 
     def block(self, block: Block) -> Event | tuple[Event, ...]:
+        if self.mirror:
+            self._check_mirrored(block)
         signature = block.signature
         if self.independent_h and (signature is None or "H" in signature):
             h = _independent_h(block)
@@ -334,6 +361,10 @@ class FanucInterpreter(Interpreter):
         for word in words:
             if word.letter == "G" and (word.value == 68.0 or word.value == 69.0 and self.g68 is not None):
                 return self._coordinate_rotation(block, word)
+            if word.letter == "G" and self.mirror_image and word.value in (50.1, 51.1):
+                mirrored = self._mirror_image(block, word)
+                if mirrored is not None:
+                    return mirrored
             if word.letter == "G" and word.value in UNFOLLOWED_FRAMES:
                 raise _OutOfScope(f"{UNFOLLOWED_FRAMES[word.value]} G{word.number}", word.start + 1)
             if word.letter == "G" and word.value in NOT_UNDER_G68 and self.g68 is not None:
@@ -385,7 +416,7 @@ class FanucInterpreter(Interpreter):
         """The G codes `block` looks at before it hands a block on: dwells, frames, offsets, settings
         and those it does not follow."""
         additional = ADDITIONAL_CODES[cls.additional][0]
-        return frozenset((4.0, 10.0, 54.0, 68.0, 69.0, additional, *UNFOLLOWED_FRAMES, *NOT_UNDER_G68,
+        return frozenset((4.0, 10.0, 54.0, 68.0, 69.0, 50.1, additional, *UNFOLLOWED_FRAMES, *NOT_UNDER_G68,
                           *(float(n) for n in cls.numbered), *cls.settings,
                           *(value for letter, value in cls.unfollowed if letter == "G")))  # fmt: skip
 
@@ -479,6 +510,63 @@ class FanucInterpreter(Interpreter):
             self._set(plane=plane)
         self._keeping_machine(lambda: self._turn(plane, (given["R"], given[first], given[second])))
         self.unsettled_rotation, self.rotation_homed = 68.0, set()
+        return Pass(block)
+
+    def _check_mirrored(self, block: Block) -> None:
+        """Under G51.1: a G code of the block that the manual forbids in its mode, or ncpp does not follow
+        there (`NOT_UNDER_G51_1`), is out of scope."""
+        for item in block.items:
+            if type(item) is Word and item.letter == "G" and item.value in NOT_UNDER_G51_1:
+                raise _OutOfScope(f"G{item.number} under a mirror image G51.1", item.start + 1)
+
+    def _mirror_image(self, block: Block, code: Word) -> Pass | None:
+        """`G51.1 X_ Y_` (G17): X and Y, those it names, mirrored about the coordinates it gives them;
+        `G50.1 X_ Y_`: the mirror image of the axes it names cancelled (module docstring).  The machine stays
+        where it is; the moves after it are mirrored (`Context.mirror`).  A block with other words than N
+        and the axis words is out of scope, but for a G50.1 without axis words where nothing is mirrored,
+        which cancels nothing as before (None: the block is read as any other)."""
+        name, col = f"G{code.number}", code.start + 1
+        others = [item for item in block.items if type(item) is not Comment and item is not code]
+        axes = [item for item in others if isinstance(item, (Word, ExprWord)) and item.letter in "XYZ"]
+        if code.value == 50.1 and not (axes or self.mirror):
+            return None
+        words = [w for item in others if (w := self._rotation_word(item, block, name, col)) is not None]
+        other = next((w for w in words if w.letter not in MIRROR_LETTERS or w.letter == "G" and w.value not in
+                      (90.0, 91.0)), None)  # fmt: skip
+        if other is not None:
+            raise _OutOfScope(f"{name} with {other.letter}{other.number} in its block", col)
+        modes = [w.value == 90.0 for w in words if w.letter == "G"]
+        if modes:
+            self._set(absolute=modes[-1])
+        named = {"XYZ".index(w.letter): w.value for w in words if w.letter in "XYZ"}
+        if code.value == 50.1:
+            return self._cancel_mirror(block, name, col, named)
+        why = (
+            "while a mirror image is in effect" if self.mirror
+            else "under a coordinate system rotation G68" if self.g68 is not None
+            else f"in G{self.plane} (followed in G17)" if self.plane != 17
+            else "in G91 (its axis words are the axis of symmetry's position)" if not self.absolute
+            else "under cutter compensation" if self._compensating()
+            else f"in a canned cycle's mode (G{self.motion:g})" if self.motion in self.canned
+            else "of Z (followed for X and Y)" if 2 in named
+            else "without X or Y" if not named
+            else None
+        )  # fmt: skip
+        if why is not None:
+            raise _OutOfScope(f"{name} {why}", col)
+        mirror = tuple(sorted(named.items()))
+        self._keeping_machine(lambda: setattr(self, "mirror", mirror))
+        return Pass(block)
+
+    def _cancel_mirror(self, block: Block, name: str, col: int, named: dict[int, float]) -> Pass:
+        """G50.1: the mirror image of the axes it names cancelled, its axis words no move."""
+        if self.mirror and not named:
+            raise _OutOfScope(f"{name} without axis words (which axes it cancels is not said)", col)
+        kept = tuple((axis, centre) for axis, centre in self.mirror if axis not in named)
+        if kept != self.mirror:
+            if self._compensating():
+                raise _OutOfScope(f"{name} under cutter compensation", col)
+            self._keeping_machine(lambda: setattr(self, "mirror", kept))
         return Pass(block)
 
     def _turn(self, plane: int, rotation: tuple[float, float, float]) -> None:
@@ -644,6 +732,7 @@ class HaasInterpreter(FanucInterpreter):
     # (Haas Mill Operator's Manual, G code list: "G50 Cancel Scaling", "G69 Cancel G68 Rotation"; its mirror
     # image is G100/G101, and it lists no polar coordinates)
     idle_cancels = frozenset((50.0, 69.0))
+    mirror_image = False
     peck_dwell = True
     dwell_point = True
     # ("G81 Drill Canned Cycle": "L Number of holes if G91 is used"; its G73 and G83 read I J K as pecks)

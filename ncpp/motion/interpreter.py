@@ -83,8 +83,10 @@ from ncpp.motion.segments import (
     Event,
     Hole,
     Line,
+    Mirror,
     Pass,
     Setting,
+    mirror_axes,
     plane_letters,
     turn_in_plane,
 )
@@ -388,6 +390,7 @@ class Interpreter:
         self.g68_plane = 17
         self.unsettled_rotation: float | None = None
         self.rotation_homed: set[str] = set()  # the plane's axes a G28/G30 homed since (`_settle_rotation`)
+        self.mirror: Mirror = ()  # Fanuc's G51.1 in effect: the axes it mirrors (`Context.mirror`)
         self.g92 = [0.0] * 9
         self.g92_saved = [0.0] * 9
         self.tool = [0.0] * 9  # the tool length offset in effect, program units
@@ -915,6 +918,7 @@ class Interpreter:
                 self.zeros_set.get(self.coord_system),
                 self._rotation(),
                 self._rotation_plane(),
+                self.mirror,
             )
         return self._context
 
@@ -1149,7 +1153,9 @@ class Interpreter:
         variables: position information).  Not #5021-#5023, the machine position: the control
         reads it ahead, while the block before moves ("reading during movement: not possible")."""
         axis = key - 5001
-        if 0 <= axis <= 2 and axis in self.placed and not any(self.g92[:3]):
+        # (whether the control gives a mirrored axis mirrored there is not said)
+        mirrored = any(axis == i for i, _ in self.mirror)
+        if 0 <= axis <= 2 and axis in self.placed and not any(self.g92[:3]) and not mirrored:
             return self.pos[axis]
         return None
 
@@ -1227,7 +1233,8 @@ class Interpreter:
         self.pos = end
         context = self._context or self.context()
         start_point, end_point = (pos[0], pos[1], pos[2]), (end[0], end[1], end[2])
-        if context.rotation is not None:  # (as `_line` turns them; no call per point where none turns)
+        # (as `_line` turns them; no call per point where none turns)
+        if context.rotation is not None or context.mirror:
             start_point, end_point = context.turned(start_point), context.turned(end_point)
         return Line(
             start_point,
@@ -1902,6 +1909,9 @@ class Interpreter:
             raise _OutOfScope(
                 f"a tool offset in {letters} under a coordinate system rotation", item.start + 1
             )
+        moved = next((i for i, _ in self.mirror if new[i] != self.tool[i]), None)  # (not mirrored)
+        if moved is not None:
+            raise _OutOfScope(f"a tool offset in {'XYZ'[moved]} under a mirror image", item.start + 1)
         held = self.pos[:] if changed else None
         self._shift(self.tool, new)
         self.tool = new
@@ -2013,9 +2023,11 @@ class Interpreter:
         self._context = None
 
     def _to_machine(self, p: list[float]) -> list[float]:
-        """The machine position (program units, all axes) of program point `p`: the rotation's plane (X Y
-        in G17) turned about its centre (`_rotation`), then G92, the system's zero and the tool length added."""
+        """The machine position (program units, all axes) of program point `p`: mirrored (`mirror`), the
+        rotation's plane (X Y in G17) turned about its centre (`_rotation`), then G92, the system's zero and
+        the tool length added."""
         q = list(p)
+        mirror_axes(q, self.mirror)
         rotation = self._rotation()
         if rotation is not None:
             turn_in_plane(q, rotation, self._rotation_plane())
@@ -2027,6 +2039,7 @@ class Interpreter:
         rotation = self._rotation()
         if rotation is not None:
             turn_in_plane(q, rotation, self._rotation_plane(), -1.0)
+        mirror_axes(q, self.mirror)
         return q
 
     def _program_end(self) -> None:
@@ -2039,7 +2052,7 @@ class Interpreter:
         self.done = self.ended = True
 
     def _machine(self, i: int) -> float:
-        if self._rotation() is not None:
+        if self._rotation() is not None or self.mirror:
             return self._to_machine(self.pos)[i]
         return self.pos[i] + self.g5x[self.coord_system][i] + self.g92[i] + self.tool[i]
 
@@ -2217,7 +2230,7 @@ class Interpreter:
 
     def _at_machine(self, end: list[float], given: list[tuple[int, float]]) -> list[float]:
         """Program point `end` with the given axes put at machine positions (G53, a G28/G30 home)."""
-        if self._rotation() is not None:
+        if self._rotation() is not None or self.mirror:
             at = self._to_machine(end)
             for i, value in given:
                 at[i] = value
@@ -2351,6 +2364,8 @@ class Interpreter:
         with --expand-cycles moves like any other (`_expanded`)."""
         if self._rotation() is not None:
             raise _OutOfScope(f"canned cycle G{motion:g} under a coordinate system rotation", item.start + 1)
+        if self.mirror:  # (whether the control mirrors a cycle's shift, G76's and G87's, is not said)
+            raise _OutOfScope(f"canned cycle G{motion:g} under a mirror image", item.start + 1)
         if motion == 87.0 and not self.back_bore_holes:
             return self._fanuc_back_bore(block, words, previous, item)
         first, second, normal = PLANE_AXES[self.plane]
@@ -2722,11 +2737,12 @@ class Interpreter:
         self.pos = end
         context = self._context or self.context()
         turned = context.turned  # (under a rotation, in G17: the points turned, an arc still)
+        clockwise = (motion == 2.0) != context.reverses  # (mirrored in one axis: the other way round)
         return Arc(
             turned((start[0], start[1], start[2])),
             turned((end[0], end[1], end[2])),
             turned((center[0], center[1], center[2])),
-            -turns if motion == 2.0 else turns,
+            -turns if clockwise else turns,
             self.feed,
             block,
             context,

@@ -25,6 +25,8 @@ from typing import final
 from ncpp.program.blocks import Block
 
 Point = tuple[float, float, float]
+# Axes a programmable mirror image reflects (Fanuc's G51.1): (axis 0-2, the coordinate it reflects about)
+Mirror = tuple[tuple[int, float], ...]
 # Why a segment is `fixed`: passes leave it as programmed
 CYCLE = "canned cycle"  # a hole is drilled where the program puts it
 # a canned cycle compensated hole by hole: apply_error_map corrects its X Y Z R words (`Hole`), and no
@@ -96,6 +98,19 @@ class Context:
     rotation: tuple[float, float, float] | None = None
     # the plane `rotation` turns (`PLANE_AXES`: G18 turns Z toward X, G19 Y toward Z)
     rotation_plane: int = 17
+    # the axes the control mirrors (Fanuc's G51.1), before it turns them: segments are in the mirrored frame
+    mirror: Mirror = ()
+
+    @property
+    def framed(self) -> bool:
+        """Whether the control moves the program's points elsewhere in the work frame (`turned`)."""
+        return self.rotation is not None or bool(self.mirror)
+
+    @property
+    def reverses(self) -> bool:
+        """Whether the mirror reflects one axis of the plane alone: the control runs G2 as G3 and G3 as G2."""
+        a, b, _ = PLANE_AXES[self.plane]
+        return sum(axis in (a, b) for axis, _ in self.mirror) % 2 == 1
 
     @property
     def tool_mm(self) -> Point:
@@ -117,7 +132,19 @@ class Context:
 
     def turned(self, p: Point, sign: float = 1.0) -> Point:
         """A point the program writes as the control moves to it under `rotation` (the frame of the
-        segments, a translation of the machine's); `sign` -1: the program's point of a turned one."""
+        segments, a translation of the machine's); `sign` -1: the program's point of a turned one.
+        A mirror image reflects the program's point first, then the rotation turns it (SINUMERIK
+        802D sl/840D ISO Milling programming manual, 3.2 "Programmable mirror image": "Processing proceeds
+        from program mirror image to scaling and coordinate rotation")."""
+        if self.mirror:
+            q = list(p)
+            if sign > 0:
+                mirror_axes(q, self.mirror)
+            if self.rotation is not None:
+                turn_in_plane(q, self.rotation, self.rotation_plane, sign)
+            if sign < 0:
+                mirror_axes(q, self.mirror)
+            return (q[0], q[1], q[2])
         if self.rotation is None:
             return p
         if self.rotation_plane == 17:
@@ -126,6 +153,12 @@ class Context:
         q = list(p)
         turn_in_plane(q, self.rotation, self.rotation_plane, sign)
         return (q[0], q[1], q[2])
+
+
+def mirror_axes(p: list[float], mirror: Mirror) -> None:
+    """Reflect point `p` (x, y, z, ...) in place about each of `mirror`'s coordinates (its own inverse)."""
+    for axis, centre in mirror:
+        p[axis] = 2.0 * centre - p[axis]
 
 
 def turn_in_plane(
@@ -368,6 +401,8 @@ __all__ = [
     "Line",
     "Pass",
     "Point",
+    "Mirror",
+    "mirror_axes",
     "Segment",
     "Setting",
     "PLANES",

@@ -1330,15 +1330,18 @@ def reframed(before: Context, after: Context) -> bool:
         or before.offset != after.offset
         or before.rotation != after.rotation
         or before.rotation_plane != after.rotation_plane
+        or before.mirror != after.mirror
     )
 
 
 def as_written(segment: Line | Arc) -> Line | Arc:
     """The segment in the program's own frame: under a rotation of the coordinate system (LinuxCNC's
-    G10 L2 R) the segments' points are turned as the control turns the program's (`Context.turned`), and
-    the words written are those that the control, turning them, moves to the (corrected) points."""
+    G10 L2 R) or a mirror image (Fanuc's G51.1) the segments' points are turned as the control turns the
+    program's (`Context.turned`), and the words written are those that the control, turning them, moves
+    to the (corrected) points; an arc mirrored in one axis of its plane is written the other way round,
+    as the control reverses it."""
     context = segment.context
-    if context.rotation is None:
+    if not context.framed:
         return segment
     back = context.turned
     if type(segment) is Arc:
@@ -1347,6 +1350,7 @@ def as_written(segment: Line | Arc) -> Line | Arc:
             start=back(segment.start, -1.0),
             end=back(segment.end, -1.0),
             center=back(segment.center, -1.0),
+            turn=-segment.turn if context.reverses else segment.turn,
         )
     return replace(segment, start=back(segment.start, -1.0), end=back(segment.end, -1.0))
 
@@ -1452,7 +1456,7 @@ def _program_shift(setting: Setting) -> tuple[float, float, float]:
     it: turned back under a rotation of the coordinate system (`Context.turned`)."""
     shift = setting.shift
     assert shift is not None
-    if setting.context.rotation is None:
+    if not setting.context.framed:
         return shift
     at = setting.position
     back = setting.context.turned((at[0] + shift[0], at[1] + shift[1], at[2] + shift[2]), -1.0)
