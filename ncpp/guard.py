@@ -357,9 +357,12 @@ def _tolerance(placement: Placement) -> str:
     return _number(GUARD_MM / placement.unit_mm)
 
 
-def _linuxcnc(placement: Placement, selected: bool = False, label: int = 0) -> list[str]:
+def _linuxcnc(placement: Placement, selected: bool = False, label: int = 0, zero: bool = True) -> list[str]:
+    """`zero`: the zero's X Y Z are checked too (not where the program touches off first: `with_guard`)."""
     if placement.system > 9:
         return []  # (the additional work offsets are Fanuc's and Haas's)
+    if not zero:
+        return _linuxcnc_touched_off(placement)
     x = 5221 + 20 * (placement.system - 1)
     tolerance = _tolerance(placement)
     far = [
@@ -377,6 +380,23 @@ def _linuxcnc(placement: Placement, selected: bool = False, label: int = 0) -> l
         f"{name} if [{' OR '.join(far)}]",
         f"(abort, ncpp: compensated for {placement.said()}; {differs}: compensate again for it, or set the offset)",
         f"{name} endif",
+        f"({END})",
+    ]
+
+
+def _linuxcnc_touched_off(placement: Placement) -> list[str]:
+    """The check at the start of a program that touches off first: the system in effect and its
+    rotation, not its zero, which the touch-off's check replaces (`touch_off_lines`)."""
+    rotation = 5221 + 20 * (placement.system - 1) + _ROTATION_AFTER_X
+    turned = f"turned R{_number(placement.rotation)}" if placement.rotation else "not turned"
+    said = f"{placement.name} in effect, {turned}"
+    far = f"[#5220 NE {placement.system}] OR [ABS[#{rotation} {_less(_number(placement.rotation), ' ')}] GT {GUARD_DEG}]"
+    return [
+        f"({BEGIN} {said}, its zero where the program touches off)",
+        f"o<ncpp_guard> if [{far}]",
+        f"(abort, ncpp: compensated for {said}; the control's work offset differs: compensate again for it, "
+        "or set the offset)",
+        "o<ncpp_guard> endif",
         f"({END})",
     ]
 
@@ -487,6 +507,10 @@ def with_guard(
             return
     if checks and at is not None and dialect in ISO_SYNTAX and _iso_selects_first(head, at, it):
         guard = []  # (the check of the system it selects stands before that line)
+    elif (
+        checks and at is not None and dialect in ISO_SYNTAX and guard and _iso_touches_off_first(head, at, it)
+    ):
+        guard = _linuxcnc(placement, zero=False)  # (the touch-off's check, after it, replaces the zero's)
     elif not guard:
         unguarded(UNGUARDED.get(dialect, f"{dialect} has no settable frame for {placement.name}"))
     if at is None or not guard:
@@ -599,6 +623,33 @@ def _iso_selects_first(head: list[str], at: int, rest: Iterator[str]) -> bool:
     return False
 
 
+def _iso_touches_off_first(head: list[str], at: int, rest: Iterator[str]) -> bool:
+    """Whether an ISO program's first line from `at` on that is not one of settings alone (as
+    `_iso_selects_first` reads them, tool guard checks skipped) is a touch-off that the writer
+    follows with its check (`touch_off_lines`): the lines before it rely on no work offset, and
+    the program's zero after it is where the tool stood, whatever zero the control held (`head`
+    takes the lines it needs from `rest`)."""
+    tool_check = False
+    for _ in range(LEADER_LINES + _ISO_SETTINGS_SCANNED):
+        if at + 1 >= len(head):
+            head.extend(islice(rest, at + 2 - len(head)))
+            if at + 1 >= len(head):
+                return False
+        items, at = _items("iso", head[at]), at + 1
+        said = _comments(items)
+        if TOOL_BEGIN in said or tool_check:
+            tool_check = TOOL_END not in said
+            continue
+        if BEGIN in said:
+            return False
+        setting = _iso_setting(items)
+        if setting == "selects":
+            return False
+        if setting is None:  # (the line after it: the touch-off's check, if it is one)
+            return f"{BEGIN} {TOUCH_OFF}" in _comments(_items("iso", head[at]))
+    return False
+
+
 def _iso_setting(items: tuple[AnyItem, ...] | None) -> str | None:
     """What an ISO line is to `_iso_selects_first`: "selects" a work offset (G54-G59.3, G54.1 P and
     G154 P, Fanuc's and Haas's additional ones), "codes" of settings alone (`_SETTING_G`), "none"
@@ -688,14 +739,21 @@ class PlacementChecks:
 
     def after(self, events: list[Event], unplaced: Collection[str]) -> list[str]:
         """The check of the offset after the block: after a G92 or G10 L20, of its `unplaced` axes
-        (X Y Z the program had not positioned before it); after a G92.3, of X Y Z."""
+        (X Y Z the program had not positioned before it), and after one of the system in effect that
+        sets all three there (a touch-off), of where the program's zero stands in machine
+        coordinates (`touch_off_lines`); after a G92.3, of X Y Z."""
         checked = self._offset_checked(events, unplaced)
         if checked is None:
             return []
         system, offset, restored = checked
         self.labels += 1
         eol = events[0].block.eol
-        return [line + eol for line in offset_lines(system, offset, self.unit_mm, self.labels, restored)]
+        placed = next((e.zero_placed for e in events if type(e) is Pass and e.zero_placed), None)
+        if placed is not None and not restored and _XYZ_LETTERS <= set(unplaced):
+            lines = touch_off_lines(*placed, g92=system == 0, unit_mm=self.unit_mm, label=self.labels)
+        else:
+            lines = offset_lines(system, offset, self.unit_mm, self.labels, restored)
+        return [line + eol for line in lines]
 
     def checks_offset(self, events: list[Event], unplaced: Collection[str]) -> bool:
         """Whether `after` checks the offset the block sets (the writer's warning of a G92 or
@@ -744,6 +802,42 @@ def offset_lines(
         f"({BEGIN} {told} {how} within {_number(GUARD_MM)} mm)",
         f"{label_name} if [{far}]",
         f"(abort, ncpp: compensated for {told} {how}; {then})",
+        f"{label_name} endif",
+        f"({END})",
+    ]
+
+
+_XYZ_LETTERS = frozenset("XYZ")
+TOUCH_OFF = "the program's zero at machine"  # (what a touch-off's check says first, lower case: `with_guard`)
+# the program's zero in machine coordinates on X Y Z, as LinuxCNC reads it (G-code manual, "Numbered
+# Parameters"): the zero of the system in effect (#5220: 1-9, its X at #5221 + 20 (n - 1)) plus the G92
+# offset (#5211-#5213) where it is applied (#5210 1, else 0)
+_PROGRAM_ZERO = tuple(f"#[{5201 + k}+20*#5220]+#5210*#{5211 + k}" for k in range(3))  # (lines of 255 at most)
+
+
+def touch_off_lines(
+    active: int, zero_mm: tuple[float, float, float], g92: bool, unit_mm: float, label: int
+) -> list[str]:
+    """LinuxCNC's check (without line ends), after a G92 (`g92`) or a G10 L20 of the system in
+    effect (`active`, 1-9) that sets X Y Z before the program positions them, that the program's
+    zero then stands at `zero_mm` in machine coordinates within GUARD_MM: what the compensation
+    depends on, whatever zero the system held before; `label` numbers the check's `if`."""
+    values = [_number(mm / unit_mm) for mm in zero_mm]
+    told = f"{TOUCH_OFF} {' '.join(a + v for a, v in zip('XYZ', values, strict=True))} {_units(unit_mm)}"
+    tolerance = _number(GUARD_MM / unit_mm)
+    far = " OR ".join(
+        f"[ABS[{read}{_less(value)}] GT {tolerance}]"
+        for read, value in zip(_PROGRAM_ZERO, values, strict=True)
+    )
+    x = 5221 + 20 * (active - 1)
+    block = "G92" if g92 else "G10 L20"
+    found = f"{system_name(active, 'linuxcnc')} X#{x} Y#{x + 1} Z#{x + 2} + #5210 * G92 X#5211 Y#5212 Z#5213"
+    label_name = f"o<ncpp_guard_{label}>"
+    return [
+        f"({BEGIN} {told} set by the tool there within {_number(GUARD_MM)} mm)",
+        f"{label_name} if [{far}]",
+        f"(abort, ncpp: compensated for {told}; this {block} put it at {found}: jog the tool there first, "
+        "or compensate again)",
         f"{label_name} endif",
         f"({END})",
     ]
