@@ -173,7 +173,14 @@ from itertools import chain, islice
 
 from ncpp.errors import NcppError
 from ncpp.motion.flow import MainProgram, program_number
-from ncpp.motion.offsets import _ADDITIONAL_X, _ROTATION_AFTER_X, ADDITIONAL, WorkOffsets, system_name
+from ncpp.motion.offsets import (
+    _ADDITIONAL_X,
+    _ROTATION_AFTER_X,
+    ADDITIONAL,
+    SYSTEMS,
+    WorkOffsets,
+    system_name,
+)
 from ncpp.motion.segments import Event, Pass
 from ncpp.program.blocks import AnyItem, Block, Comment, Statement, Word
 from ncpp.program.parser import LEADER_LINES, LineParser
@@ -362,7 +369,7 @@ def _linuxcnc(placement: Placement, selected: bool = False, label: int = 0, zero
     if placement.system > 9:
         return []  # (the additional work offsets are Fanuc's and Haas's)
     if not zero:
-        return _linuxcnc_touched_off(placement)
+        return _linuxcnc_touched_off(placement, selected, label)
     x = 5221 + 20 * (placement.system - 1)
     tolerance = _tolerance(placement)
     far = [
@@ -384,19 +391,23 @@ def _linuxcnc(placement: Placement, selected: bool = False, label: int = 0, zero
     ]
 
 
-def _linuxcnc_touched_off(placement: Placement) -> list[str]:
-    """The check at the start of a program that touches off first: the system in effect and its
-    rotation, not its zero, which the touch-off's check replaces (`touch_off_lines`)."""
+def _linuxcnc_touched_off(placement: Placement, selected: bool = False, label: int = 0) -> list[str]:
+    """The check of a program that touches off first, at its start or before its selection of the
+    system (`selected`): the system in effect (not where the program selects it) and its rotation,
+    not its zero, which the touch-off's check replaces (`touch_off_lines`)."""
     rotation = 5221 + 20 * (placement.system - 1) + _ROTATION_AFTER_X
     turned = f"turned R{_number(placement.rotation)}" if placement.rotation else "not turned"
-    said = f"{placement.name} in effect, {turned}"
-    far = f"[#5220 NE {placement.system}] OR [ABS[#{rotation} {_less(_number(placement.rotation), ' ')}] GT {GUARD_DEG}]"
+    said = f"{placement.name} {turned}" if selected else f"{placement.name} in effect, {turned}"
+    far = f"[ABS[#{rotation} {_less(_number(placement.rotation), ' ')}] GT {GUARD_DEG}]"
+    if not selected:
+        far = f"[#5220 NE {placement.system}] OR {far}"
+    name = f"o<ncpp_guard_{label}>" if label else "o<ncpp_guard>"
     return [
         f"({BEGIN} {said}, its zero where the program touches off)",
-        f"o<ncpp_guard> if [{far}]",
+        f"{name} if [{far}]",
         f"(abort, ncpp: compensated for {said}; the control's work offset differs: compensate again for it, "
         "or set the offset)",
-        "o<ncpp_guard> endif",
+        f"{name} endif",
         f"({END})",
     ]
 
@@ -716,6 +727,10 @@ class PlacementChecks:
         self.looked = 0  # blocks looked at for a Fanuc program number
         self.checked: set[int] = set()
         self.labels = 0  # the checks written so far (each `if` a label of its own)
+        # the block of a touch-off the program makes first (`touch_off_ahead`), where a system it selects
+        # before it gets its rotation checked alone (`deferred`: the zero's check, where the touch-off's is not)
+        self.touch_off: Block | None = None
+        self.deferred: Placement | None = None
 
     def before(self, events: list[Event]) -> list[str]:
         """The check of the zero of the told system the block selects, where it is the first to."""
@@ -724,6 +739,8 @@ class PlacementChecks:
             self.looked += 1
             if _program_number(block.items):
                 self.dialect = "fanuc"
+        if block is self.touch_off and self.deferred is not None:
+            return self._deferred(events)
         number = next((e.zero_told for e in events if type(e) is Pass and e.zero_told is not None), None)
         if number is None or number in self.checked:
             return []
@@ -731,11 +748,25 @@ class PlacementChecks:
         placement = Placement.of_system(self.offsets, number, self.unit_mm)
         dialect = "linuxcnc" if self.dialect == "iso" else self.dialect
         self.labels += 1
-        lines = guard_lines(placement, dialect, selected=True, label=self.labels)
+        if self.touch_off is not None and dialect == "linuxcnc" and placement.system <= 9:
+            self.deferred = placement  # (its zero matters only where the touch-off gets no check of its own)
+            lines = _linuxcnc(placement, selected=True, label=self.labels, zero=False)
+        else:
+            lines = guard_lines(placement, dialect, selected=True, label=self.labels)
         if not lines:
             self.unguarded(f"{dialect} has no variables of {placement.name}'s zero")
         eol = block.eol or "\n"
         return [line + eol for line in lines]
+
+    def _deferred(self, events: list[Event]) -> list[str]:
+        """Before the touch-off: the check of the zero of the system the program selected before it,
+        where the touch-off gets no check of the program's zero (`after`)."""
+        placement, self.deferred = self.deferred, None
+        if placement is None or self._offset_checked(events, "XYZ") and _placed(events) is not None:
+            return []
+        self.labels += 1
+        eol = events[0].block.eol or "\n"
+        return [line + eol for line in _linuxcnc(placement, selected=True, label=self.labels)]
 
     def after(self, events: list[Event], unplaced: Collection[str]) -> list[str]:
         """The check of the offset after the block: after a G92 or G10 L20, of its `unplaced` axes
@@ -748,8 +779,9 @@ class PlacementChecks:
         system, offset, restored = checked
         self.labels += 1
         eol = events[0].block.eol
-        placed = next((e.zero_placed for e in events if type(e) is Pass and e.zero_placed), None)
-        if placed is not None and not restored and _XYZ_LETTERS <= set(unplaced):
+        placed = _placed(events)
+        first = events[0].block is self.touch_off  # (X Y Z unplaced there: the program positioned nothing)
+        if placed is not None and not restored and (first or _XYZ_LETTERS <= set(unplaced)):
             lines = touch_off_lines(*placed, g92=system == 0, unit_mm=self.unit_mm, label=self.labels)
         else:
             lines = offset_lines(system, offset, self.unit_mm, self.labels, restored)
@@ -770,8 +802,46 @@ class PlacementChecks:
         if told is None or self.dialect != "iso" or not events[0].block.eol:
             return None
         restored = not any(type(e) is Pass and e.setting is not None for e in events)
-        offset = [(axis, mm) for axis, mm in told[1] if restored or "XYZ"[axis] in unplaced]
+        first = events[0].block is self.touch_off
+        offset = [(axis, mm) for axis, mm in told[1] if restored or first or "XYZ"[axis] in unplaced]
         return (told[0], offset, restored) if offset else None
+
+
+def _placed(events: list[Event]) -> tuple[int, tuple[float, float, float]] | None:
+    """The program's zero a touch-off among the events put in machine coordinates (`Pass.zero_placed`)."""
+    return next((e.zero_placed for e in events if type(e) is Pass and e.zero_placed), None)
+
+
+def touch_off_ahead(blocks: Iterable[Block], offsets: WorkOffsets) -> Block | None:
+    """The block of a touch-off an ISO program makes first: a G92, or a G10 L20 of the system in effect
+    (P0, or its number), of X Y Z, after lines of settings alone that name no axis (`_iso_setting`:
+    modal codes, T M S F H D words, comments, a selection of G54-G59.3) and before another line, the
+    system in effect not turned (`offsets`: as told; the interpreter's `_zero_placed`).  Before it
+    nothing relies on a system's zero, and after it the program's zero is where the tool stood
+    (LinuxCNC G-code manual, "G92 Coordinate System Offset", "G10 L20 Set Coordinate System"),
+    whatever zero the control held."""
+    system = offsets.active
+    for block in blocks:
+        setting = _iso_setting(block.items)
+        words = [item for item in block.items if type(item) is Word]
+        codes = {(word.letter, word.value) for word in words}
+        if setting is not None:
+            if setting != "none" and (
+                ("G", 10.0) in codes or any(word.letter in _AXIS_LETTERS for word in words)
+            ):
+                return None  # (a G28 or G53 line positions an axis, a G10 L2 sets a zero or a rotation)
+            selected = [n for n, name in enumerate(SYSTEMS, 1) if ("G", float(name[1:])) in codes]
+            if setting == "selects" and len(selected) != 1:
+                return None  # (Fanuc's and Haas's additional offsets: no LinuxCNC touch-off)
+            system = selected[0] if selected else system
+            continue
+        p = {value for letter, value in codes if letter == "P"}
+        sets = ("G", 92.0) in codes and not p or {("G", 10.0), ("L", 20.0)} <= codes and p <= {0.0, system}
+        plain = all(type(item) in (Word, Comment) for item in block.items)
+        named = {word.letter for word in words if word.letter in _AXIS_LETTERS}
+        turned = system <= len(offsets.rotations) and offsets.rotations[system - 1]
+        return block if sets and plain and named == _XYZ_LETTERS and block.eol and not turned else None
+    return None
 
 
 def offset_lines(

@@ -386,3 +386,57 @@ def test_no_check_where_ncpp_knows_the_offset_or_nothing_runs_after_it(program):
 def test_no_check_with_no_guard(program):
     written, said = _warned(program, guard=False)
     assert SET_HERE not in written and "has not positioned" in said and "placement guard's check" not in said
+
+
+@pytest.mark.parametrize(
+    "program",
+    [
+        "G21 G90 G54\nG92 X0 Y0 Z0\nG0 X10 Y10 Z5\nG1 Z-1 F300\nG1 X40\nG0 Z5\nM2\n",
+        "(head)\nG21 G90\nG55\nG17 T1 M6\nG10 L20 P0 X0 Y0 Z0\nG0 X10 Y10 Z5\nG1 Z-1 F300\nG1 X40\nG0 Z5\nM2\n",
+    ],
+    ids=["G54-G92", "G55-L20-P0"],
+)
+def test_rs274_runs_a_program_that_selects_its_system_then_touches_off_whatever_that_system_s_zero(
+    tmp_path, program
+):
+    """The system a program selects before it touches off gets its rotation checked before the
+    selection, not its zero: rs274, the tool at the machine zero told as the program's zero, runs
+    it under that system's zero told or another, and stops it, after the touch-off, told the zero
+    elsewhere."""
+    system = 2 if "G55" in program else 1
+    at_zero = _var_file(tmp_path / "zero.var", (0.0, 0.0, 0.0), system=system)
+    written, _ = _compensated(tmp_path, program, at_zero)
+    text = written.read_text()
+    x = 5221 + 20 * (system - 1)
+    assert f"[ABS[#{x} " not in text and f"[ABS[#{x + 9} - 0] GT 0.001]" in text and TOUCHED in text
+    moved = _var_file(tmp_path / "moved.var", (400.0, 350.0, 300.0), system=system)
+    _runs_as_the_original(tmp_path, written, moved)
+
+    written, _ = _compensated(tmp_path, program, moved, "elsewhere.ngc")
+    _stops_at_the_check(
+        written, moved, check=TOUCHED, sets="SET_G92_OFFSET" if system == 1 else "SET_G5X_OFFSET"
+    )
+
+
+@pytest.mark.parametrize(
+    "program",
+    [
+        "G21 G90 G55\nG10 L20 P1 X0 Y0 Z0\nG0 X10 Y10 Z5\nG1 Z-1 F300\nG1 X40\nM2\n",  # (another system's zero)
+        "G21 G90 G54\nG10 L2 P1 R0\nG92 X0 Y0 Z0\nG0 X10 Y10 Z5\nG1 Z-1 F300\nM2\n",  # (the program sets it)
+        "G21 G90 G54\nG28 Z0\nG92 X0 Y0 Z0\nG0 X10 Y10 Z5\nG1 Z-1 F300\nM2\n",  # (Z0 in G54 on the way home)
+        "G21 G90 G54\nG92 X0 Y0\nG0 X10 Y10 Z5\nG1 Z-1 F300\nM2\n",  # (Z: G54's)
+        "G21 G90\nG0 Z5\nG92 X0 Y0 Z0\nG0 X10 Y10 Z5\nG1 Z-1 F300\nM2\n",  # (a move first)
+    ],
+    ids=["l20-p1-in-g55", "g10-l2", "g28-z", "xy-alone", "moved-first"],
+)
+def test_a_program_that_does_not_touch_off_first_keeps_the_check_of_the_zero(program):
+    """A system's zero is left out only where the touch-off sets X Y Z of the program's zero before
+    anything relies on it: the check of the system selected, or at the start, reads its zero."""
+    offsets = WorkOffsets.given({"G54": (400.0, 350.0, 300.0), "G55": (100.0, 100.0, 100.0)})
+    written = io.BytesIO()
+    process(io.BytesIO(program.encode()), written, file="p.ngc", source=ErrorSource.from_machine_file(str(WIDE)),
+            offsets=offsets, warnings=Warnings(stream=io.StringIO()), guard=Placement.of(offsets))  # fmt: skip
+    text = written.getvalue().decode()
+    zero = "#5241 - 100" if "G55" in program else "#5221 - 400"
+    assert f"[ABS[{zero}] GT 0.1]" in text and "its zero where the program touches off" not in text
+    assert (TOUCHED in text) == ("G10 L2 " in program)  # (X Y Z unplaced there: the zero is checked after)
