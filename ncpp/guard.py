@@ -60,6 +60,16 @@ is cited here from their manuals (Haas Mill Operator's Manual, "Macros", offsets
 #5221-#5225 G54 ..., #7001-#7005 G110 ..., no G92), and their G10 L20 gives an additional work
 offset's zero in machine coordinates (`motion/fanuc.py`), not one from where the tool stands.
 
+A LinuxCNC program that touches off first, a G92 or a G10 L20 of the system in effect that sets X Y
+Z after lines of settings alone (`touch_off_ahead`, `_iso_touches_off_first`), puts its zero where
+the tool stood, whatever zero the control's system held: the check after it (`touch_off_lines`)
+compares where the program's zero then stands in machine coordinates, the zero of the system in
+effect plus the G92 offset applied (#5220; #5221 + 20 (n - 1); #5211-#5213; #5210 1 while applied:
+"Numbered Parameters"), with where ncpp placed it (`Pass.zero_placed`), and the check at the start,
+or before the block that selects the system there, leaves the system's zero out and keeps its
+number and rotation (`_linuxcnc_touched_off`).  The sum holds where the system is not turned
+(rs274ngc turns the G92 offset with the system's rotation): a turned system keeps the other checks.
+
 * Sinumerik (840D sl System Variables parameter manual: `$P_UIFRNUM`, the number of the
   active settable frame, 1-4 for G54-G57; `$P_UIFR[n, axis, TR]` and `[n, axis, FI]`, its
   coarse and fine translation; Job Planning manual: `MSG("text")` shows the text, `SETAL(n)`
@@ -654,11 +664,21 @@ def _iso_touches_off_first(head: list[str], at: int, rest: Iterator[str]) -> boo
         if BEGIN in said:
             return False
         setting = _iso_setting(items)
-        if setting == "selects":
-            return False
         if setting is None:  # (the line after it: the touch-off's check, if it is one)
             return f"{BEGIN} {TOUCH_OFF}" in _comments(_items("iso", head[at]))
+        if setting == "selects" or not _before_touch_off(setting, items or ()):
+            return False
     return False
+
+
+def _before_touch_off(setting: str, items: Iterable[AnyItem]) -> bool:
+    """Whether a line of settings (`_iso_setting`) may come before a touch-off made first: not a G10
+    (L2 sets a zero or a rotation), nor a line that names an axis (G28 Z0 passes through Z0 in the
+    work offset, G53 moves)."""
+    words = [item for item in items if type(item) is Word]
+    return setting == "none" or not any(
+        word.letter in _AXIS_LETTERS or (word.letter, word.value) == ("G", 10.0) for word in words
+    )
 
 
 def _iso_setting(items: tuple[AnyItem, ...] | None) -> str | None:
@@ -826,10 +846,8 @@ def touch_off_ahead(blocks: Iterable[Block], offsets: WorkOffsets) -> Block | No
         words = [item for item in block.items if type(item) is Word]
         codes = {(word.letter, word.value) for word in words}
         if setting is not None:
-            if setting != "none" and (
-                ("G", 10.0) in codes or any(word.letter in _AXIS_LETTERS for word in words)
-            ):
-                return None  # (a G28 or G53 line positions an axis, a G10 L2 sets a zero or a rotation)
+            if not _before_touch_off(setting, words):
+                return None
             selected = [n for n, name in enumerate(SYSTEMS, 1) if ("G", float(name[1:])) in codes]
             if setting == "selects" and len(selected) != 1:
                 return None  # (Fanuc's and Haas's additional offsets: no LinuxCNC touch-off)
