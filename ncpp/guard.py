@@ -68,7 +68,7 @@ effect plus the G92 offset applied (#5220; #5221 + 20 (n - 1); #5211-#5213; #521
 "Numbered Parameters"), with where ncpp placed it (`Pass.zero_placed`), and the check at the start,
 or before the block that selects the system there, leaves the system's zero out and keeps its
 number and rotation (`_linuxcnc_touched_off`).  The sum holds where the system is not turned
-(rs274ngc turns the G92 offset with the system's rotation): a turned system keeps the other checks.
+(the G92 offset turns with the system: `Interpreter._rotation`): a turned system keeps the other checks.
 
 * Sinumerik (840D sl System Variables parameter manual: `$P_UIFRNUM`, the number of the
   active settable frame, 1-4 for G54-G57; `$P_UIFR[n, axis, TR]` and `[n, axis, FI]`, its

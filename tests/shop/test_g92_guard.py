@@ -440,3 +440,12 @@ def test_a_program_that_does_not_touch_off_first_keeps_the_check_of_the_zero(pro
     zero = "#5241 - 100" if "G55" in program else "#5221 - 400"
     assert f"[ABS[{zero}] GT 0.1]" in text and "its zero where the program touches off" not in text
     assert (TOUCHED in text) == ("G10 L2 " in program)  # (X Y Z unplaced there: the zero is checked after)
+
+
+def test_a_touch_off_check_s_lines_stay_within_rs274ngc_s_255_characters():
+    """The longest numbers and names the check may hold: rs274ngc reads lines of up to 255 characters."""
+    from ncpp.guard import touch_off_lines
+
+    for unit_mm in (1.0, 25.4):
+        lines = touch_off_lines(9, (-12345.6789, -12345.6789, -12345.6789), False, unit_mm, 999)
+        assert "G59.3 X#5381 Y#5382 Z#5383" in lines[2] and max(map(len, lines)) <= 255, lines
