@@ -2885,9 +2885,8 @@ def _as_programmed(ev: Event, owner: Block | None) -> Event | None:
     in the text's place (None: not there)."""
     if type(ev) is Pass:
         ev.length_told = ev.tool_read = None  # (the text runs again, or elsewhere, perhaps with another tool)
-        ev.zero_told = ev.offset_told = ev.zero_placed = (
-            None  # (and perhaps after the program set the zero, or an offset)
-        )
+        ev.zero_told = ev.offset_told = None  # (and perhaps after the program set the zero, or an offset)
+        ev.zero_placed = None
         return ev if owner is None and not _expanding(ev) else None  # (a cycle there stays one)
     if ev.fixed in (HOLE, CYCLE):  # type: ignore[union-attr]
         # each run may need a correction of its own: the cycle is left as programmed; in a
