@@ -60,6 +60,16 @@ is cited here from their manuals (Haas Mill Operator's Manual, "Macros", offsets
 #5221-#5225 G54 ..., #7001-#7005 G110 ..., no G92), and their G10 L20 gives an additional work
 offset's zero in machine coordinates (`motion/fanuc.py`), not one from where the tool stands.
 
+A LinuxCNC program that touches off first, a G92 or a G10 L20 of the system in effect that sets X Y
+Z after lines of settings alone (`touch_off_ahead`, `_iso_touches_off_first`), puts its zero where
+the tool stood, whatever zero the control's system held: the check after it (`touch_off_lines`)
+compares where the program's zero then stands in machine coordinates, the zero of the system in
+effect plus the G92 offset applied (#5220; #5221 + 20 (n - 1); #5211-#5213; #5210 1 while applied:
+"Numbered Parameters"), with where ncpp placed it (`Pass.zero_placed`), and the check at the start,
+or before the block that selects the system there, leaves the system's zero out and keeps its
+number and rotation (`_linuxcnc_touched_off`).  The sum holds where the system is not turned
+(the G92 offset turns with the system: `Interpreter._rotation`): a turned system keeps the other checks.
+
 * Sinumerik (840D sl System Variables parameter manual: `$P_UIFRNUM`, the number of the
   active settable frame, 1-4 for G54-G57; `$P_UIFR[n, axis, TR]` and `[n, axis, FI]`, its
   coarse and fine translation; Job Planning manual: `MSG("text")` shows the text, `SETAL(n)`
@@ -173,7 +183,14 @@ from itertools import chain, islice
 
 from ncpp.errors import NcppError
 from ncpp.motion.flow import MainProgram, program_number
-from ncpp.motion.offsets import _ADDITIONAL_X, _ROTATION_AFTER_X, ADDITIONAL, WorkOffsets, system_name
+from ncpp.motion.offsets import (
+    _ADDITIONAL_X,
+    _ROTATION_AFTER_X,
+    ADDITIONAL,
+    SYSTEMS,
+    WorkOffsets,
+    system_name,
+)
 from ncpp.motion.segments import Event, Pass
 from ncpp.program.blocks import AnyItem, Block, Comment, Statement, Word
 from ncpp.program.parser import LEADER_LINES, LineParser
@@ -357,9 +374,12 @@ def _tolerance(placement: Placement) -> str:
     return _number(GUARD_MM / placement.unit_mm)
 
 
-def _linuxcnc(placement: Placement, selected: bool = False, label: int = 0) -> list[str]:
+def _linuxcnc(placement: Placement, selected: bool = False, label: int = 0, zero: bool = True) -> list[str]:
+    """`zero`: the zero's X Y Z are checked too (not where the program touches off first: `with_guard`)."""
     if placement.system > 9:
         return []  # (the additional work offsets are Fanuc's and Haas's)
+    if not zero:
+        return _linuxcnc_touched_off(placement, selected, label)
     x = 5221 + 20 * (placement.system - 1)
     tolerance = _tolerance(placement)
     far = [
@@ -376,6 +396,27 @@ def _linuxcnc(placement: Placement, selected: bool = False, label: int = 0) -> l
         f"({BEGIN} {placement.said()} within {_number(GUARD_MM)} mm)",
         f"{name} if [{' OR '.join(far)}]",
         f"(abort, ncpp: compensated for {placement.said()}; {differs}: compensate again for it, or set the offset)",
+        f"{name} endif",
+        f"({END})",
+    ]
+
+
+def _linuxcnc_touched_off(placement: Placement, selected: bool = False, label: int = 0) -> list[str]:
+    """The check of a program that touches off first, at its start or before its selection of the
+    system (`selected`): the system in effect (not where the program selects it) and its rotation,
+    not its zero, which the touch-off's check replaces (`touch_off_lines`)."""
+    rotation = 5221 + 20 * (placement.system - 1) + _ROTATION_AFTER_X
+    turned = f"turned R{_number(placement.rotation)}" if placement.rotation else "not turned"
+    said = f"{placement.name} {turned}" if selected else f"{placement.name} in effect, {turned}"
+    far = f"[ABS[#{rotation} {_less(_number(placement.rotation), ' ')}] GT {GUARD_DEG}]"
+    if not selected:
+        far = f"[#5220 NE {placement.system}] OR {far}"
+    name = f"o<ncpp_guard_{label}>" if label else "o<ncpp_guard>"
+    return [
+        f"({BEGIN} {said}, its zero where the program touches off)",
+        f"{name} if [{far}]",
+        f"(abort, ncpp: compensated for {said}; the control's work offset differs: compensate again for it, "
+        "or set the offset)",
         f"{name} endif",
         f"({END})",
     ]
@@ -487,6 +528,10 @@ def with_guard(
             return
     if checks and at is not None and dialect in ISO_SYNTAX and _iso_selects_first(head, at, it):
         guard = []  # (the check of the system it selects stands before that line)
+    elif (
+        checks and at is not None and dialect in ISO_SYNTAX and guard and _iso_touches_off_first(head, at, it)
+    ):
+        guard = _linuxcnc(placement, zero=False)  # (the touch-off's check, after it, replaces the zero's)
     elif not guard:
         unguarded(UNGUARDED.get(dialect, f"{dialect} has no settable frame for {placement.name}"))
     if at is None or not guard:
@@ -599,6 +644,43 @@ def _iso_selects_first(head: list[str], at: int, rest: Iterator[str]) -> bool:
     return False
 
 
+def _iso_touches_off_first(head: list[str], at: int, rest: Iterator[str]) -> bool:
+    """Whether an ISO program's first line from `at` on that is not one of settings alone (as
+    `_iso_selects_first` reads them, tool guard checks skipped) is a touch-off that the writer
+    follows with its check (`touch_off_lines`): the lines before it rely on no work offset, and
+    the program's zero after it is where the tool stood, whatever zero the control held (`head`
+    takes the lines it needs from `rest`)."""
+    tool_check = False
+    for _ in range(LEADER_LINES + _ISO_SETTINGS_SCANNED):
+        if at + 1 >= len(head):
+            head.extend(islice(rest, at + 2 - len(head)))
+            if at + 1 >= len(head):
+                return False
+        items, at = _items("iso", head[at]), at + 1
+        said = _comments(items)
+        if TOOL_BEGIN in said or tool_check:
+            tool_check = TOOL_END not in said
+            continue
+        if BEGIN in said:
+            return False
+        setting = _iso_setting(items)
+        if setting is None:  # (the line after it: the touch-off's check, if it is one)
+            return f"{BEGIN} {TOUCH_OFF}" in _comments(_items("iso", head[at]))
+        if setting == "selects" or not _before_touch_off(setting, items or ()):
+            return False
+    return False
+
+
+def _before_touch_off(setting: str, items: Iterable[AnyItem]) -> bool:
+    """Whether a line of settings (`_iso_setting`) may come before a touch-off made first: not a G10
+    (L2 sets a zero or a rotation), nor a line that names an axis (G28 Z0 passes through Z0 in the
+    work offset, G53 moves)."""
+    words = [item for item in items if type(item) is Word]
+    return setting == "none" or not any(
+        word.letter in _AXIS_LETTERS or (word.letter, word.value) == ("G", 10.0) for word in words
+    )
+
+
 def _iso_setting(items: tuple[AnyItem, ...] | None) -> str | None:
     """What an ISO line is to `_iso_selects_first`: "selects" a work offset (G54-G59.3, G54.1 P and
     G154 P, Fanuc's and Haas's additional ones), "codes" of settings alone (`_SETTING_G`), "none"
@@ -665,6 +747,10 @@ class PlacementChecks:
         self.looked = 0  # blocks looked at for a Fanuc program number
         self.checked: set[int] = set()
         self.labels = 0  # the checks written so far (each `if` a label of its own)
+        # the block of a touch-off the program makes first (`touch_off_ahead`), where a system it selects
+        # before it gets its rotation checked alone (`deferred`: the zero's check, where the touch-off's is not)
+        self.touch_off: Block | None = None
+        self.deferred: Placement | None = None
 
     def before(self, events: list[Event]) -> list[str]:
         """The check of the zero of the told system the block selects, where it is the first to."""
@@ -673,6 +759,8 @@ class PlacementChecks:
             self.looked += 1
             if _program_number(block.items):
                 self.dialect = "fanuc"
+        if block is self.touch_off and self.deferred is not None:
+            return self._deferred(events)
         number = next((e.zero_told for e in events if type(e) is Pass and e.zero_told is not None), None)
         if number is None or number in self.checked:
             return []
@@ -680,22 +768,44 @@ class PlacementChecks:
         placement = Placement.of_system(self.offsets, number, self.unit_mm)
         dialect = "linuxcnc" if self.dialect == "iso" else self.dialect
         self.labels += 1
-        lines = guard_lines(placement, dialect, selected=True, label=self.labels)
+        if self.touch_off is not None and dialect == "linuxcnc" and placement.system <= 9:
+            self.deferred = placement  # (its zero matters only where the touch-off gets no check of its own)
+            lines = _linuxcnc(placement, selected=True, label=self.labels, zero=False)
+        else:
+            lines = guard_lines(placement, dialect, selected=True, label=self.labels)
         if not lines:
             self.unguarded(f"{dialect} has no variables of {placement.name}'s zero")
         eol = block.eol or "\n"
         return [line + eol for line in lines]
 
+    def _deferred(self, events: list[Event]) -> list[str]:
+        """Before the touch-off: the check of the zero of the system the program selected before it,
+        where the touch-off gets no check of the program's zero (`after`)."""
+        placement, self.deferred = self.deferred, None
+        if placement is None or self._offset_checked(events, "XYZ") and _placed(events) is not None:
+            return []
+        self.labels += 1
+        eol = events[0].block.eol or "\n"
+        return [line + eol for line in _linuxcnc(placement, selected=True, label=self.labels)]
+
     def after(self, events: list[Event], unplaced: Collection[str]) -> list[str]:
         """The check of the offset after the block: after a G92 or G10 L20, of its `unplaced` axes
-        (X Y Z the program had not positioned before it); after a G92.3, of X Y Z."""
+        (X Y Z the program had not positioned before it), and after one of the system in effect that
+        sets all three there (a touch-off), of where the program's zero stands in machine
+        coordinates (`touch_off_lines`); after a G92.3, of X Y Z."""
         checked = self._offset_checked(events, unplaced)
         if checked is None:
             return []
         system, offset, restored = checked
         self.labels += 1
         eol = events[0].block.eol
-        return [line + eol for line in offset_lines(system, offset, self.unit_mm, self.labels, restored)]
+        placed = _placed(events)
+        first = events[0].block is self.touch_off  # (X Y Z unplaced there: the program positioned nothing)
+        if placed is not None and not restored and (first or _XYZ_LETTERS <= set(unplaced)):
+            lines = touch_off_lines(*placed, g92=system == 0, unit_mm=self.unit_mm, label=self.labels)
+        else:
+            lines = offset_lines(system, offset, self.unit_mm, self.labels, restored)
+        return [line + eol for line in lines]
 
     def checks_offset(self, events: list[Event], unplaced: Collection[str]) -> bool:
         """Whether `after` checks the offset the block sets (the writer's warning of a G92 or
@@ -712,8 +822,44 @@ class PlacementChecks:
         if told is None or self.dialect != "iso" or not events[0].block.eol:
             return None
         restored = not any(type(e) is Pass and e.setting is not None for e in events)
-        offset = [(axis, mm) for axis, mm in told[1] if restored or "XYZ"[axis] in unplaced]
+        first = events[0].block is self.touch_off
+        offset = [(axis, mm) for axis, mm in told[1] if restored or first or "XYZ"[axis] in unplaced]
         return (told[0], offset, restored) if offset else None
+
+
+def _placed(events: list[Event]) -> tuple[int, tuple[float, float, float]] | None:
+    """The program's zero a touch-off among the events put in machine coordinates (`Pass.zero_placed`)."""
+    return next((e.zero_placed for e in events if type(e) is Pass and e.zero_placed), None)
+
+
+def touch_off_ahead(blocks: Iterable[Block], offsets: WorkOffsets) -> Block | None:
+    """The block of a touch-off an ISO program makes first: a G92, or a G10 L20 of the system in effect
+    (P0, or its number), of X Y Z, after lines of settings alone that name no axis (`_iso_setting`:
+    modal codes, T M S F H D words, comments, a selection of G54-G59.3) and before another line, the
+    system in effect not turned (`offsets`: as told; the interpreter's `_zero_placed`).  Before it
+    nothing relies on a system's zero, and after it the program's zero is where the tool stood
+    (LinuxCNC G-code manual, "G92 Coordinate System Offset", "G10 L20 Set Coordinate System"),
+    whatever zero the control held."""
+    system = offsets.active
+    for block in blocks:
+        setting = _iso_setting(block.items)
+        words = [item for item in block.items if type(item) is Word]
+        codes = {(word.letter, word.value) for word in words}
+        if setting is not None:
+            if not _before_touch_off(setting, words):
+                return None
+            selected = [n for n, name in enumerate(SYSTEMS, 1) if ("G", float(name[1:])) in codes]
+            if setting == "selects" and len(selected) != 1:
+                return None  # (Fanuc's and Haas's additional offsets: no LinuxCNC touch-off)
+            system = selected[0] if selected else system
+            continue
+        p = {value for letter, value in codes if letter == "P"}
+        sets = ("G", 92.0) in codes and not p or {("G", 10.0), ("L", 20.0)} <= codes and p <= {0.0, system}
+        plain = all(type(item) in (Word, Comment) for item in block.items)
+        named = {word.letter for word in words if word.letter in _AXIS_LETTERS}
+        turned = system <= len(offsets.rotations) and offsets.rotations[system - 1]
+        return block if sets and plain and named == _XYZ_LETTERS and block.eol and not turned else None
+    return None
 
 
 def offset_lines(
@@ -744,6 +890,42 @@ def offset_lines(
         f"({BEGIN} {told} {how} within {_number(GUARD_MM)} mm)",
         f"{label_name} if [{far}]",
         f"(abort, ncpp: compensated for {told} {how}; {then})",
+        f"{label_name} endif",
+        f"({END})",
+    ]
+
+
+_XYZ_LETTERS = frozenset("XYZ")
+TOUCH_OFF = "the program's zero at machine"  # (what a touch-off's check says first, lower case: `with_guard`)
+# the program's zero in machine coordinates on X Y Z, as LinuxCNC reads it (G-code manual, "Numbered
+# Parameters"): the zero of the system in effect (#5220: 1-9, its X at #5221 + 20 (n - 1)) plus the G92
+# offset (#5211-#5213) where it is applied (#5210 1, else 0)
+_PROGRAM_ZERO = tuple(f"#[{5201 + k}+20*#5220]+#5210*#{5211 + k}" for k in range(3))  # (lines of 255 at most)
+
+
+def touch_off_lines(
+    active: int, zero_mm: tuple[float, float, float], g92: bool, unit_mm: float, label: int
+) -> list[str]:
+    """LinuxCNC's check (without line ends), after a G92 (`g92`) or a G10 L20 of the system in
+    effect (`active`, 1-9) that sets X Y Z before the program positions them, that the program's
+    zero then stands at `zero_mm` in machine coordinates within GUARD_MM: what the compensation
+    depends on, whatever zero the system held before; `label` numbers the check's `if`."""
+    values = [_number(mm / unit_mm) for mm in zero_mm]
+    told = f"{TOUCH_OFF} {' '.join(a + v for a, v in zip('XYZ', values, strict=True))} {_units(unit_mm)}"
+    tolerance = _number(GUARD_MM / unit_mm)
+    far = " OR ".join(
+        f"[ABS[{read}{_less(value)}] GT {tolerance}]"
+        for read, value in zip(_PROGRAM_ZERO, values, strict=True)
+    )
+    x = 5221 + 20 * (active - 1)
+    block = "G92" if g92 else "G10 L20"
+    found = f"{system_name(active, 'linuxcnc')} X#{x} Y#{x + 1} Z#{x + 2} + #5210 * G92 X#5211 Y#5212 Z#5213"
+    label_name = f"o<ncpp_guard_{label}>"
+    return [
+        f"({BEGIN} {told} set by the tool there within {_number(GUARD_MM)} mm)",
+        f"{label_name} if [{far}]",
+        f"(abort, ncpp: compensated for {told}; this {block} put it at {found}: jog the tool there first, "
+        "or compensate again)",
         f"{label_name} endif",
         f"({END})",
     ]

@@ -24,7 +24,15 @@ import numpy as np
 
 from ncpp import __version__
 from ncpp.errors import Location, NcppError, Warnings
-from ncpp.guard import ISO_SYNTAX, Placement, PlacementChecks, ToolGuard, with_guard, without_guard
+from ncpp.guard import (
+    ISO_SYNTAX,
+    Placement,
+    PlacementChecks,
+    ToolGuard,
+    touch_off_ahead,
+    with_guard,
+    without_guard,
+)
 from ncpp.lathe import refuse_lathe
 from ncpp.motion.flow import MainProgram
 from ncpp.motion.offsets import AT_MACHINE_ZERO, WorkOffsets
@@ -464,6 +472,12 @@ def process(
     if get_dialect(name).leader:
         blocks = _leader_told(blocks, warnings, file)
     offsets = offsets or AT_MACHINE_ZERO  # the control's zeros place the program on the machine
+    checks = (  # the zeros of the told systems it selects, and the G92 offsets it sets (LinuxCNC's)
+        PlacementChecks(offsets, name, guard.unit_mm, lambda why: warnings.warn(
+            f"no placement guard: {why}", Location(file, 1, None))) if guard is not None and name in ISO_SYNTAX else None
+    )  # fmt: skip
+    if checks is not None:
+        blocks = _touch_off_told(blocks, checks)
     expanding: dict[str, bool] = {}
     if FAMILY[name] == "iso":
         expanding = {"expand_cycles": expand_cycles, "expand": expand}
@@ -504,10 +518,6 @@ def process(
         f"{axes} not positioned by the program yet: the correction along {axes} of this feed move and "
         "the next compensated moves is left out until the program positions them (a word written here "
         "would move the axis from wherever the control has it)", Location(file, block.line, None))  # fmt: skip
-    checks = (  # the zeros of the told systems it selects, and the G92 offsets it sets (LinuxCNC's)
-        PlacementChecks(offsets, name, guard.unit_mm, lambda why: warnings.warn(
-            f"no placement guard: {why}", Location(file, 1, None))) if guard is not None and name in ISO_SYNTAX else None
-    )  # fmt: skip
     writer.unplaced_setting = lambda axes, events: _warn_unplaced(axes, events, checks, warnings, file)
     writer.unstepped = lambda block: warnings.warn(
         "this line runs a loop or subroutine in which interpretation ends, after a compensated move, in a mode "
@@ -566,6 +576,25 @@ def _guards(
         lambda events: [*checks.before(events), *tools.before(events)],
         lambda events, unplaced: [*checks.after(events, unplaced), *tools(events)],
     )
+
+
+TOUCH_OFF_SCAN = 40  # the blocks at the top a touch-off made first is looked for among (`touch_off_ahead`)
+
+
+def _touch_off_told(blocks: Iterable[Block], checks: PlacementChecks) -> Iterator[Block]:
+    """The blocks, `checks` told first of the touch-off the program makes before anything relies on a
+    system's zero (`guard.touch_off_ahead`, among the first TOUCH_OFF_SCAN): a fault the parser meets
+    there is raised where its line comes."""
+    blocks = iter(blocks)
+    first: list[Block] = []
+    try:
+        first.extend(islice(blocks, TOUCH_OFF_SCAN))
+    except NcppError:
+        yield from first
+        raise
+    checks.touch_off = touch_off_ahead(first, checks.offsets)
+    yield from first
+    yield from blocks
 
 
 def _warn_unplaced(

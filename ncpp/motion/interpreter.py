@@ -1368,7 +1368,11 @@ class Interpreter:
             self._program_end()
         self._update_fast()
         offset_told = self._offset_told(mode0, words, active)
-        marks = [Pass(block, offset_told=offset_told)] if offset_told is not None else []
+        marks = (
+            [Pass(block, offset_told=offset_told, zero_placed=self._zero_placed(mode0, words, active))]
+            if offset_told is not None
+            else []
+        )
         if selected in self.told_zeros:
             marks.append(Pass(block, zero_told=selected))
         if told is not None:
@@ -1393,6 +1397,21 @@ class Interpreter:
         scale = MM_PER_INCH if self.inch else 1.0
         named = tuple(i for i, letter in enumerate("XYZ") if code == 92.3 or letter in words)
         return system, tuple((i, offset[i] * scale) for i in named)
+
+    def _zero_placed(
+        self, code: float | None, words: dict, active: int
+    ) -> tuple[int, tuple[float, float, float]] | None:
+        """After a G92, or a G10 L20 of `active` (the system in effect at the block), that names X Y Z:
+        `active` and where the program's zero then stands in machine mm, the system's zero plus the
+        G92 offset applied (`Pass.zero_placed`); None for other blocks, and where the system is turned
+        (its G10 L2 R), whose rotation carries the G92 offset."""
+        if not all(letter in words for letter in "XYZ") or self.rotations.get(active):
+            return None
+        if code == 10.0 and round(words.get("P", (0.0,))[0]) not in (0, active):
+            return None
+        scale = MM_PER_INCH if self.inch else 1.0
+        x, y, z = ((self.g5x[active][i] + self.g92[i]) * scale for i in range(3))
+        return active, (x, y, z)
 
     # -- checks (interp_check.cc, enhance_block) ----------------------------------------
     def _motion_to_be(self, block, mode0, mode1, mode1_item, axis_item, polar_item=None) -> float | None:
@@ -2924,6 +2943,7 @@ def _as_programmed(ev: Event, owner: Block | None) -> Event | None:
     if type(ev) is Pass:
         ev.length_told = ev.tool_read = None  # (the text runs again, or elsewhere, perhaps with another tool)
         ev.zero_told = ev.offset_told = None  # (and perhaps after the program set the zero, or an offset)
+        ev.zero_placed = None
         return ev if owner is None and not _expanding(ev) else None  # (a cycle there stays one)
     if ev.fixed in (HOLE, CYCLE):  # type: ignore[union-attr]
         # each run may need a correction of its own: the cycle is left as programmed; in a

@@ -364,6 +364,10 @@ class Pass:
     # sets; (axis 0-2, the offset after the block in mm) for the axes it sets, X Y Z for G92.3), which
     # the placement guard checks after the block
     offset_told: tuple[int, tuple[tuple[int, float], ...]] | None = None
+    # with `offset_told`, of a G92 or a G10 L20 of the system in effect that sets X Y Z (a touch-off): that
+    # system (1-9), and where the program's zero stands after the block, its zero plus the G92 offset
+    # applied, in machine mm
+    zero_placed: tuple[int, tuple[float, float, float]] | None = None
 
 
 Segment = Line | Arc

@@ -99,31 +99,60 @@ def _stops_at_the_check(
     return stopped.stderr
 
 
-@pytest.mark.parametrize("program", [PROGRAM_MM, PROGRAM_INCH], ids=["G21", "G20"])
-def test_rs274_runs_a_g92_program_where_the_tool_stands_at_the_zero_told_and_stops_it_where_not(
-    tmp_path, program
+TOUCHED = "the program's zero at machine"  # (what a touch-off's check says: a G92 or G10 L20 of X Y Z first)
+L20_MM = "G21 G90\nG10 L20 P1 X10 Y5 Z0\nG0 X20 Y15 Z5\nG1 Z-1 F300\nG1 X50 Y15\nG1 X50 Y35\nG0 Z5\nM2\n"
+L20_INCH = "G20 G90\nG10 L20 P0 X0 Y0 Z0\nG0 X0.5 Y0.5 Z0.2\nG1 Z-0.04 F10\nG1 X1.5\nG1 Y1.2\nG0 Z0.2\nM2\n"
+SET_HERE = "set with the tool at the program's zero"  # (what the check of a G92's or G10 L20's axes says)
+
+
+@pytest.mark.parametrize(
+    ("program", "system", "sets"),
+    [
+        (PROGRAM_MM, 1, "SET_G92_OFFSET"),
+        (PROGRAM_INCH, 1, "SET_G92_OFFSET"),
+        (L20_MM, 1, "SET_G5X_OFFSET"),
+        (L20_INCH, 1, "SET_G5X_OFFSET"),
+        (L20_INCH, 2, "SET_G5X_OFFSET"),
+    ],
+    ids=["G92-G21", "G92-G20", "L20-P1-G21", "L20-P0-G20", "L20-P0-in-G55"],
+)
+def test_rs274_runs_a_touched_off_program_where_the_tool_stands_at_the_zero_told_whatever_the_work_offset(
+    tmp_path, program, system, sets
 ):
-    """Told G54 at the machine zero, where rs274 starts: the G92 sets the offset ncpp compensated
-    for, and the program runs the original's path.  Told G54 at X400 Y350 Z300 (the control's
-    too: the check at the start passes), the tool still at the machine zero: the G92 sets
-    #5211 = -400 mm, and the program stops before its first move."""
-    at_zero = _var_file(tmp_path / "zero.var", (0.0, 0.0, 0.0))
+    """A program that touches off first (G92, or G10 L20 of the system in effect, of X Y Z before
+    any move) puts its zero where the tool stands, whatever zero the control's system held: the
+    check at the start reads the system (#5220) and its rotation, not its zero, and the check after
+    the touch-off the program's zero in machine coordinates, the system's zero plus the G92 offset
+    applied ("Numbered Parameters": #5220, #5221-, #5210, #5211-).  rs274 starts with the tool at
+    the machine zero: told the system there, the program runs the original's path, under the
+    control's zero told or one at X400 Y350 Z300; told it at X400 Y350 Z300, the tool at the machine
+    zero is elsewhere, and the program stops before its first move."""
+    at_zero = _var_file(tmp_path / "zero.var", (0.0, 0.0, 0.0), system=system)
     written, said = _compensated(tmp_path, program, at_zero)
-    text = written.read_text()
-    lines = text.splitlines()
-    k = lines.index(program.splitlines()[1])  # the G92, as programmed: the control stands at no move yet
-    assert lines[k + 1].startswith(f"(ncpp placement guard: {CHECK} ")
-    assert lines[k + 5] == "(ncpp placement guard end)"
-    if program is PROGRAM_MM:  # (G92 X10 at the program's zero: the offset is -10 mm, in inches)
-        assert "[ABS[#5211 + 0.3937] GT 0.0039] OR [ABS[#5212 + 0.1969] GT 0.0039]" in lines[k + 2]
+    lines = written.read_text().splitlines()
+    k = lines.index(
+        program.splitlines()[1]
+    )  # the touch-off, as programmed: the control stands at no move yet
+    assert (
+        lines[k + 1].startswith(f"(ncpp placement guard: {TOUCHED} ")
+        and lines[k + 5] == "(ncpp placement guard end)"
+    )
+    assert "#[5201+20*#5220]+#5210*#5211" in lines[k + 2]
+    start = "\n".join(lines[:k])
+    assert f"[#5220 NE {system}]" in start and not re.search(
+        r"#52[2-9]1\b", start
+    )  # (the system, not its zero)
     assert "the placement guard's check after it stops the program" in said
     _runs_as_the_original(tmp_path, written, at_zero)
+    moved = _var_file(
+        tmp_path / "moved.var", (400.0, 350.0, 300.0), system=system
+    )  # (the tool stays at the zero)
+    _runs_as_the_original(tmp_path, written, moved)
 
-    elsewhere = _var_file(tmp_path / "elsewhere.var", (400.0, 350.0, 300.0))
-    written, _ = _compensated(tmp_path, program, elsewhere, "elsewhere.ngc")
-    said = _stops_at_the_check(written, elsewhere)
-    set_there = "X-16.141732 Y-13.976378" if program is PROGRAM_MM else "X-15.748031 Y-13.779528"
-    assert f"this G92 set {set_there} Z-11.811024" in said, said  # (rs274 writes the parameters in)
+    written, _ = _compensated(tmp_path, program, moved, "elsewhere.ngc")
+    stopped = _stops_at_the_check(written, moved, check=TOUCHED, sets=sets)
+    name = "G54" if system == 1 else "G55"  # (rs274 writes the parameters in)
+    assert re.search(rf"put it at {name} X-?\d+\.\d{{6}} Y.* \+ [01]\.0{{6}} \* G92 X-?\d", stopped), stopped
 
 
 def test_rs274_checks_only_the_axes_the_program_had_not_positioned(tmp_path):
@@ -157,52 +186,19 @@ def test_rs274_checks_the_offset_a_g92_3_restores(tmp_path):
     assert "the control restored X1.000000 Y0.000000 Z0.000000" in said
 
 
-L20_MM = "G21 G90\nG10 L20 P1 X10 Y5 Z0\nG0 X20 Y15 Z5\nG1 Z-1 F300\nG1 X50 Y15\nG1 X50 Y35\nG0 Z5\nM2\n"
-L20_INCH = "G20 G90\nG10 L20 P0 X0 Y0 Z0\nG0 X0.5 Y0.5 Z0.2\nG1 Z-0.04 F10\nG1 X1.5\nG1 Y1.2\nG0 Z0.2\nM2\n"
-SET_HERE = "set with the tool at the program's zero"  # (what a G92's or G10 L20's check says)
-
-
-@pytest.mark.parametrize("program", [L20_MM, L20_INCH], ids=["G21-P1", "G20-P0"])
-def test_rs274_runs_an_l20_program_where_the_tool_stands_at_the_zero_told_and_stops_it_where_not(
-    tmp_path, program
-):
-    """Touched off with G10 L20 where rs274 starts (the machine zero): told G54 at the machine zero,
-    the L20 sets G54's zero where ncpp compensated for it, and the program runs the original's
-    path; told G54 at X400 Y350 Z300 (the control's too), the L20 sets #5221 to the machine zero
-    less the block's X, and the program stops before its first move."""
-    at_zero = _var_file(tmp_path / "zero.var", (0.0, 0.0, 0.0))
-    written, said = _compensated(tmp_path, program, at_zero)
-    lines = written.read_text().splitlines()
-    k = lines.index(program.splitlines()[1])
-    assert lines[k + 1].startswith("(ncpp placement guard: G54's zero ") and SET_HERE in lines[k + 1]
-    assert lines[k + 5] == "(ncpp placement guard end)"
-    if program is L20_MM:  # (G10 L20 X10 at the program's zero, G54's at the machine's: X-10 mm, in inches)
-        assert "[ABS[#5221 + 0.3937] GT 0.0039] OR [ABS[#5222 + 0.1969] GT 0.0039]" in lines[k + 2]
-    assert "the placement guard's check after it stops the program" in said
-    _runs_as_the_original(tmp_path, written, at_zero)
-
-    elsewhere = _var_file(tmp_path / "elsewhere.var", (400.0, 350.0, 300.0))
-    written, _ = _compensated(tmp_path, program, elsewhere, "elsewhere.ngc")
-    said = _stops_at_the_check(written, elsewhere, check="G54's zero", sets="SET_G5X_OFFSET")
-    set_there = "X-0.393701 Y-0.196850" if program is L20_MM else "X0.000000 Y0.000000"
-    assert f"this G10 L20 set {set_there} Z0.000000" in said, said  # (rs274 writes the parameters in)
-
-
 @pytest.mark.parametrize(
     ("program", "system", "parameter"),
     [
         ("G21 G90\nG10 L20 P2 X0 Y0 Z0\nG55\nG0 X10 Y10 Z5\nG1 Z-1 F300\nG1 X40\nG0 Z5\nM2\n", 1, 5241),
-        ("G21 G90\nG10 L20 P0 X0 Y0 Z0\nG0 X10 Y10 Z5\nG1 Z-1 F300\nG1 X40\nG0 Z5\nM2\n", 2, 5241),
         ("G21 G90\nG0 X10 Y10\nG10 L20 P1 Z0\nG0 Z5\nG1 Z-1 F300\nG1 X40\nG0 Z5\nM2\n", 1, 5223),
     ],
-    ids=["P2-from-G54", "P0-in-G55", "Z-alone"],
+    ids=["P2-from-G54", "Z-alone"],
 )
 def test_rs274_checks_the_zero_of_the_system_p_names_on_the_axes_not_positioned(
     tmp_path, program, system, parameter
 ):
-    """G10 L20 P2 sets G55's zero whichever system is in effect, P0 that of the one in effect (G55
-    where #5220 is 2, as rs274 runs it); after `G0 X10 Y10` only Z stands where the operator left
-    it.  The check reads that system's parameters of those axes: the program runs where the tool
+    """G10 L20 P2 sets G55's zero whichever system is in effect (not the program's zero, which
+    stays G54's: no touch-off); after `G0 X10 Y10` only Z stands where the operator left it.  The check reads that system's parameters of those axes: the program runs where the tool
     stood at the zero told, and stops before the move after the L20 where not."""
     at_zero = _var_file(tmp_path / "zero.var", (0.0, 0.0, 0.0), system=system)
     written, said = _compensated(tmp_path, program, at_zero)
@@ -228,9 +224,9 @@ def test_rs274_checks_the_zero_of_the_system_p_names_on_the_axes_not_positioned(
         ("G92 X0", "[ABS[#5211 - 0.3937] GT 0.0039]]", {}, "this G92 set X0.000000:"),
         (
             "G10 L20 P1 X0 Y0 Z0",
-            "[ABS[#5221 + 0.3937] GT 0.0039]",
-            {"check": "G54's zero", "sets": "SET_G5X_OFFSET"},
-            "this G10 L20 set X-0.393701 Y0.000000 Z0.000000:",
+            "[ABS[#[5201+20*#5220]+#5210*#5211-0] GT 0.0039]",
+            {"check": TOUCHED, "sets": "SET_G5X_OFFSET"},
+            "this G10 L20 put it at G54 X-0.393701 Y0.000000 Z0.000000 + 1.000000 * G92 X0.393701 Y0.000000",
         ),
     ],
 )
@@ -239,9 +235,10 @@ def test_rs274_checks_an_offset_set_under_a_g92_offset_of_the_parameter_file(
 ):
     """With a G92 offset in effect at the start (#5210 1, #5211 10 mm), the program's zero is G54's
     plus it: told G54 at X-10, that is the machine zero where rs274 starts.  A G92 then sets the new
-    offset (the old one gone: rs274ngc makes the block's point the tool's), a G10 L20 sets G54's zero
-    less the G92 offset (X -10 mm), each as ncpp compensated for; told G54 at X0, ncpp takes the tool
-    to stand at X10, the block sets its offset all the same, and the check stops the program."""
+    offset (the old one gone: rs274ngc makes the block's point the tool's), a G10 L20 of X Y Z sets
+    G54's zero less the G92 offset (X -10 mm), each as ncpp compensated for; told G54 at X0, ncpp
+    takes the tool to stand at X10, the block sets its offset all the same, and the check stops the
+    program."""
     program = f"G21 G90\n{setting}\nG0 X10 Y10 Z5\nG1 Z-1 F300\nG1 X40\nG0 Z5\nM2\n"
     shifted = _var_file(tmp_path / "shifted.var", (-10.0, 0.0, 0.0), (10.0, 0.0, 0.0))
     written, _ = _compensated(tmp_path, program, shifted)
@@ -252,6 +249,18 @@ def test_rs274_checks_an_offset_set_under_a_g92_offset_of_the_parameter_file(
     written, _ = _compensated(tmp_path, program, off_zero, "off.ngc")
     stopped = _stops_at_the_check(written, off_zero, **stop)
     assert said in stopped, stopped
+
+
+def test_rs274_runs_a_g10_l20_touch_off_under_another_g92_offset_with_the_tool_at_the_zero_told(tmp_path):
+    """Told G54 at X-10 under a G92 offset of X10 (#5210 1): the program's zero at the machine zero.
+    A control without the G92 offset whose G54 is at X0 has its zero there too: the G10 L20 sets G54's
+    zero to the tool's position less the G92 offset applied, and the check after it reads the sum,
+    which is where the compensation placed the program, so it runs."""
+    program = "G21 G90\nG10 L20 P1 X0 Y0 Z0\nG0 X10 Y10 Z5\nG1 Z-1 F300\nG1 X40\nG0 Z5\nM2\n"
+    shifted = _var_file(tmp_path / "shifted.var", (-10.0, 0.0, 0.0), (10.0, 0.0, 0.0))
+    written, _ = _compensated(tmp_path, program, shifted)
+    plain = _var_file(tmp_path / "plain.var", (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), applied=False)
+    _runs_as_the_original(tmp_path, written, plain)
 
 
 def test_the_interpreter_applies_the_saved_offset_at_g92_3_as_rs274_does(tmp_path):
@@ -313,11 +322,16 @@ def test_an_mm_machine_checks_in_mm_and_each_check_has_a_label_of_its_own():
     program = "G21 G90\nG92 X0 Y0 Z0\nG0 X10 Y10 Z5\nG1 Z-1 F300\nG92.3\nG1 X40\nM2\n"
     written, _ = _warned(program, var_units=1.0)
     lines = written.splitlines()
-    far = "[[ABS[#5211 - 0] GT 0.1] OR [ABS[#5212 - 0] GT 0.1] OR [ABS[#5213 - 0] GT 0.1]]"
-    assert lines.count(f"o<ncpp_guard_1> if {far}") == 1 and lines.count(f"o<ncpp_guard_2> if {far}") == 1
-    assert (
-        "(ncpp placement guard: the G92 offset X0 Y0 Z0 mm set with the tool at the program's zero" in written
+    zero = " OR ".join(
+        f"[ABS[#[{5201 + k}+20*#5220]+#5210*#{5211 + k}-{v}] GT 0.1]" for k, v in enumerate((400, 350, 300))
     )
+    far = "[[ABS[#5211 - 0] GT 0.1] OR [ABS[#5212 - 0] GT 0.1] OR [ABS[#5213 - 0] GT 0.1]]"
+    assert lines.count(f"o<ncpp_guard_1> if [{zero}]") == 1 and lines.count(f"o<ncpp_guard_2> if {far}") == 1
+    assert (
+        f"(ncpp placement guard: {TOUCHED} X400 Y350 Z300 mm set by the tool there within 0.1 mm)" in written
+    )
+    assert "(ncpp placement guard: the G92 offset X0 Y0 Z0 mm restored by G92.3" in written
+    assert "o<ncpp_guard> if [[#5220 NE 1] OR [ABS[#5230 - 0] GT 0.001]]" in lines
     assert all(len(line) <= 255 for line in lines)  # (rs274ngc reads lines of up to 255 characters)
 
 
@@ -372,3 +386,66 @@ def test_no_check_where_ncpp_knows_the_offset_or_nothing_runs_after_it(program):
 def test_no_check_with_no_guard(program):
     written, said = _warned(program, guard=False)
     assert SET_HERE not in written and "has not positioned" in said and "placement guard's check" not in said
+
+
+@pytest.mark.parametrize(
+    "program",
+    [
+        "G21 G90 G54\nG92 X0 Y0 Z0\nG0 X10 Y10 Z5\nG1 Z-1 F300\nG1 X40\nG0 Z5\nM2\n",
+        "(head)\nG21 G90\nG55\nG17 T1 M6\nG10 L20 P0 X0 Y0 Z0\nG0 X10 Y10 Z5\nG1 Z-1 F300\nG1 X40\nG0 Z5\nM2\n",
+    ],
+    ids=["G54-G92", "G55-L20-P0"],
+)
+def test_rs274_runs_a_program_that_selects_its_system_then_touches_off_whatever_that_system_s_zero(
+    tmp_path, program
+):
+    """The system a program selects before it touches off gets its rotation checked before the
+    selection, not its zero: rs274, the tool at the machine zero told as the program's zero, runs
+    it under that system's zero told or another, and stops it, after the touch-off, told the zero
+    elsewhere."""
+    system = 2 if "G55" in program else 1
+    at_zero = _var_file(tmp_path / "zero.var", (0.0, 0.0, 0.0), system=system)
+    written, _ = _compensated(tmp_path, program, at_zero)
+    text = written.read_text()
+    x = 5221 + 20 * (system - 1)
+    assert f"[ABS[#{x} " not in text and f"[ABS[#{x + 9} - 0] GT 0.001]" in text and TOUCHED in text
+    moved = _var_file(tmp_path / "moved.var", (400.0, 350.0, 300.0), system=system)
+    _runs_as_the_original(tmp_path, written, moved)
+
+    written, _ = _compensated(tmp_path, program, moved, "elsewhere.ngc")
+    _stops_at_the_check(
+        written, moved, check=TOUCHED, sets="SET_G92_OFFSET" if system == 1 else "SET_G5X_OFFSET"
+    )
+
+
+@pytest.mark.parametrize(
+    "program",
+    [
+        "G21 G90 G55\nG10 L20 P1 X0 Y0 Z0\nG0 X10 Y10 Z5\nG1 Z-1 F300\nG1 X40\nM2\n",  # (another system's zero)
+        "G21 G90 G54\nG10 L2 P1 R0\nG92 X0 Y0 Z0\nG0 X10 Y10 Z5\nG1 Z-1 F300\nM2\n",  # (the program sets it)
+        "G21 G90 G54\nG28 Z0\nG92 X0 Y0 Z0\nG0 X10 Y10 Z5\nG1 Z-1 F300\nM2\n",  # (Z0 in G54 on the way home)
+        "G21 G90 G54\nG92 X0 Y0\nG0 X10 Y10 Z5\nG1 Z-1 F300\nM2\n",  # (Z: G54's)
+        "G21 G90\nG0 Z5\nG92 X0 Y0 Z0\nG0 X10 Y10 Z5\nG1 Z-1 F300\nM2\n",  # (a move first)
+    ],
+    ids=["l20-p1-in-g55", "g10-l2", "g28-z", "xy-alone", "moved-first"],
+)
+def test_a_program_that_does_not_touch_off_first_keeps_the_check_of_the_zero(program):
+    """A system's zero is left out only where the touch-off sets X Y Z of the program's zero before
+    anything relies on it: the check of the system selected, or at the start, reads its zero."""
+    offsets = WorkOffsets.given({"G54": (400.0, 350.0, 300.0), "G55": (100.0, 100.0, 100.0)})
+    written = io.BytesIO()
+    process(io.BytesIO(program.encode()), written, file="p.ngc", source=ErrorSource.from_machine_file(str(WIDE)),
+            offsets=offsets, warnings=Warnings(stream=io.StringIO()), guard=Placement.of(offsets))  # fmt: skip
+    text = written.getvalue().decode()
+    zero = "#5241 - 100" if "G55" in program else "#5221 - 400"
+    assert f"[ABS[{zero}] GT 0.1]" in text and "its zero where the program touches off" not in text
+    assert (TOUCHED in text) == ("G10 L2 " in program)  # (X Y Z unplaced there: the zero is checked after)
+
+
+def test_a_touch_off_check_s_lines_stay_within_rs274ngc_s_255_characters():
+    """The longest numbers and names the check may hold: rs274ngc reads lines of up to 255 characters."""
+    from ncpp.guard import touch_off_lines
+
+    for unit_mm in (1.0, 25.4):
+        lines = touch_off_lines(9, (-12345.6789, -12345.6789, -12345.6789), False, unit_mm, 999)
+        assert "G59.3 X#5381 Y#5382 Z#5383" in lines[2] and max(map(len, lines)) <= 255, lines
