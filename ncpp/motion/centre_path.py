@@ -71,10 +71,11 @@ class CentrePath:
         assert shifts is not None
         at_start, at_end = shifts
         plane = move.context.plane
-        a, b, _ = PLANE_AXES[plane]
+        a, b, normal = PLANE_AXES[plane]
         end = _plus(move.end, at_end)
         last, self.last = self.last, None
-        if at_start is None or not _in_plane(move, a, b):
+        # (an offset off the plane: the move before ran in another plane, which the control does not join)
+        if at_start is None or not _in_plane(move, a, b) or abs(at_start[normal]) > SMOOTH:
             start = move.start if at_start is None else _plus(move.start, at_start)
             if at_start is None and type(move) is Line and _in_plane(move, a, b):  # (an entry line)
                 self.last = (_offset(move, end, a, b), plane)
