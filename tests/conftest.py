@@ -100,12 +100,13 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_rs274_stops_before_the_first_cut_that_reads_a_diameter_that_differs",
         ),
         "shop/test_g92_guard.py": (
-            "test_rs274_runs_a_g92_program_where_the_tool_stands_at_the_zero_told_and_stops_it_where_not",
+            "test_rs274_runs_a_touched_off_program_where_the_tool_stands_at_the_zero_told_whatever_the_work_offset",
+            "test_rs274_runs_a_g10_l20_touch_off_under_another_g92_offset_with_the_tool_at_the_zero_told",
+            "test_rs274_runs_a_program_that_selects_its_system_then_touches_off_whatever_that_system_s_zero",
             "test_rs274_checks_only_the_axes_the_program_had_not_positioned",
             "test_rs274_checks_an_offset_set_under_a_g92_offset_of_the_parameter_file",
             "test_rs274_checks_the_offset_a_g92_3_restores",
             "test_the_interpreter_applies_the_saved_offset_at_g92_3_as_rs274_does",
-            "test_rs274_runs_an_l20_program_where_the_tool_stands_at_the_zero_told_and_stops_it_where_not",
             "test_rs274_checks_the_zero_of_the_system_p_names_on_the_axes_not_positioned",
         ),
         "shop/test_guard.py": (
