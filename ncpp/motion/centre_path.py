@@ -125,7 +125,8 @@ def _plus(p: Point, q: Point) -> Point:
 
 
 def _in_plane(move: Line | Arc, a: int, b: int) -> bool:
-    return move.start[a] != move.end[a] or move.start[b] != move.end[b]
+    """Whether the move moves in the plane: an arc does (a full circle too), a line along its normal not."""
+    return type(move) is Arc or move.start[a] != move.end[a] or move.start[b] != move.end[b]
 
 
 def _own_start_shift(move: Line | Arc, at_end: Point, a: int, b: int) -> Point:

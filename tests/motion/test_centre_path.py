@@ -17,7 +17,7 @@ from ncpp.program.parser import parse_stream
 from tests import rs274 as oracle
 
 # G41.1 and G42.1 contours with outside and inside corners between lines and arcs; the arcs'
-# cusps (turning right back) in G17 and G18
+# cusps (turning right back) in G17 and G18; full circles, one a helix
 CONTOURS = {
     "lines-and-arcs": """G21 G90 G17 G94
 G0 X-10 Y-10 Z5
@@ -64,6 +64,16 @@ G2 X20 Z20 R5
 G1 Z0
 G3 X30 Z-10 R10
 G40 G1 X40 Z-20
+M2
+""",
+    "full-circles": """G21 G90 G17 G94
+G0 X30 Y0 Z5
+G1 Z-1 F200
+G41.1 D4
+G1 X10 Y0
+G3 X10 Y0 I-10 J0 Z-3
+G3 X10 Y0 I-10 J0
+G40 G1 X30 Y0
 M2
 """,
 }
