@@ -75,7 +75,6 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_the_entry_arc_stays_one_arc_the_control_accepts",
             "test_mmount_contours_land_within_the_tolerance",
             "test_a_move_along_z_alone_under_compensation_makes_no_move_in_the_plane",
-            "test_each_move_ends_with_the_tool_centre_where_the_correction_puts_it",
         ),
         "motion/test_oracle.py": None,
         "compensation/test_tool_parameters.py": (

@@ -28,12 +28,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ncpp.errors import Location, NcppError
-from ncpp.machine.chain import norm3
 from ncpp.motion import cycles
 from ncpp.motion.segments import CYCLE, HOLE, PLANE_AXES, Arc, Event, Hole, Line, Pass, Setting, plane_point
 from ncpp.passes.context import PassContext, deviation
 from ncpp.passes.geometry import (
-    all3,
     any3,
     compensate,
     frames,
@@ -331,16 +329,12 @@ class _Rows:
     carried: NDArray  # (n,) moves left as programmed that run from where the control is (`_carry`)
     kept: NDArray  # (n,3) their axes that do so (the others the control puts at their programmed end)
     lead_in: NDArray  # (n,) a canned cycle's first move after a compensated one: a step to its start first
-    # under cutter compensation: each segment's (`Line.centre_shift`), the end shifts (n,3) of the lines to
-    # compensate (zero elsewhere) and their start shifts (n,3) (zero at the entry move: it starts on its
-    # programmed point), the lines that move no axis of the plane (`_pin_plane`), those the control offsets
-    # square to their written direction (`_square`), those that turn a corner from a line (`_corners`), and
-    # each segment's plane axes (n,3) (`PLANE_AXES`); None: none is
+    # under cutter compensation: each segment's (`Line.centre_shift`) and the end shifts (n,3) of the lines to
+    # compensate (zero elsewhere), the lines that move no axis of the plane (`_pin_plane`), those that
+    # turn a corner from a line (`_corners`), and each segment's plane axes (n,3) (`PLANE_AXES`); None: none is
     comp: NDArray | None = None
     shift: NDArray | None = None
-    lead: NDArray | None = None
     still: NDArray | None = None
-    square: NDArray | None = None
     corner: NDArray | None = None
     axes: NDArray | None = None
 
@@ -382,11 +376,11 @@ def _rows(segs: list, directional: bool, fixed_before: bool = True) -> _Rows:
 
 
 def _under_comp(segs: list, free: NDArray, start: NDArray, end: NDArray) -> tuple[NDArray | None, ...]:
-    """`_Rows.comp`, `.shift`, `.lead`, `.still`, `.square`, `.corner` and `.axes` of the segments (all None:
-    none is under compensation).  A line under compensation that moves no axis of the plane (G17: X Y, G18: Z X)
+    """`_Rows.comp`, `.shift`, `.still`, `.corner` and `.axes` of the segments (all None: none is under
+    compensation).  A line under compensation that moves no axis of the plane (G17: X Y, G18: Z X)
     leaves the tool centre where it stands (`ncpp.motion.cutter.centre_offset`): the same shift at both ends."""
     if all(e.centre_shift is None for e in segs):
-        return None, None, None, None, None, None, None
+        return None, None, None, None, None
     comp = np.fromiter((e.centre_shift is not None for e in segs), dtype=bool, count=len(segs))
     shift = np.zeros((len(segs), 3))
     own = np.flatnonzero(comp & free)
@@ -401,65 +395,13 @@ def _under_comp(segs: list, free: NDArray, start: NDArray, end: NDArray) -> tupl
     # after a line under compensation in the same frame
     entry = np.zeros(len(segs), dtype=bool)
     entry[own] = [segs[k].centre_shift[0] is None for k in own.tolist()]
-    lead = np.where(entry[:, None], 0.0, shift)
-    square = comp & free & moves & any3(shift != 0)
-    offset = square & ~entry
+    offset = comp & free & moves & any3(shift != 0) & ~entry
     corner = np.zeros(len(segs), dtype=bool)
     corner[1:] = offset[1:] & (comp & free & moves)[:-1]
     for k in np.flatnonzero(corner).tolist():
         a, b = segs[k - 1].context, segs[k].context
         corner[k] = a.offset == b.offset and a.inch == b.inch and a.plane == b.plane
-    return comp, shift, lead, still, square, corner, axes
-
-
-def _square(
-    rows: _Rows,
-    out_start: NDArray,
-    out_end: NDArray,
-    corrected_start: Callable[[NDArray], NDArray],
-    step: NDArray | None = None,
-) -> None:
-    """The control offsets a line under cutter compensation square to the direction it is written in
-    (`ncpp.motion.cutter.centre_offset`), which the correction turns: the end of each such line
-    (`_Rows.square`) goes where the line from its corrected start (`corrected_start(rows)`) touches the
-    circle of the radius about the tool centre the correction wants there (`out_end` plus `_Rows.shift`),
-    so that the control's offset square to it puts the tool centre there.  An arc piece's ends are
-    replace_arcs' (it took the correction's turn there): a line after one starts where it ends, one
-    before it ends where it starts (`out_start`).  A line whose end this would move further than the
-    corrections at its two ends together (one shorter than the radius, which its ends' rounding turns
-    more than the correction does) keeps it.  `step` (n,): the output grid (None: none)."""
-    if rows.square is None or rows.shift is None or rows.axes is None or not rows.square.any():
-        return
-    assert rows.comp is not None  # (with `square`)
-    # (n,) whether an arc piece under compensation follows the row in its frame
-    piece = np.zeros(len(out_end), dtype=bool)
-    piece[:-1] = (rows.comp & rows.arc)[1:] & all3(rows.offsets[1:] == rows.offsets[:-1])
-    piece[:-1] &= rows.scales[1:] == rows.scales[:-1]
-    before = rows.square & piece
-    out_end[before] = out_start[np.flatnonzero(before) + 1]
-    k = np.flatnonzero(rows.square & ~piece)
-    if k.size == 0:
-        return
-    after = np.flatnonzero(k > 0)
-    after = after[piece[k[after] - 1]]
-    axes, shift, start = rows.axes[k], rows.shift[k], corrected_start(k)
-    start[after] = out_end[k[after] - 1]
-    centre = out_end[k] + shift
-    wu, wv, _ = in_plane(centre - start, axes)
-    su, sv, _ = in_plane(shift, axes)
-    du, dv, _ = in_plane(rows.end[k] - rows.start[k], axes)
-    radius = (sv * du - su * dv) / np.hypot(du, dv)  # signed: positive to the left of the line
-    reach = np.hypot(wu, wv)
-    sin = radius / np.maximum(reach, np.abs(radius))
-    cos = np.sqrt(1.0 - sin * sin)
-    # the written direction: the way to the tool centre turned back by the angle the radius takes up
-    eu, ev = (wu * cos + wv * sin) / reach, (wv * cos - wu * sin) / reach
-    moved = centre - from_plane(-radius * ev, radius * eu, np.zeros(len(k)), axes)
-    if step is not None:
-        moved = quantize(moved, step[k])
-    corrections = norm3(out_end[k] - rows.end[k]) + norm3(start - rows.start[k])
-    keep = (reach <= np.abs(radius)) | (norm3(moved - out_end[k]) > corrections)
-    out_end[k] = np.where(keep[:, None], out_end[k], moved)
+    return comp, shift, still, corner, axes
 
 
 # |sin| of the turn between two lines below which their corner is left to the line that ends there
@@ -764,15 +706,14 @@ def _plain(rows: _Rows, ctx: PassContext, travel: Travel) -> _Solved:
             - shift
         )
         at_end[at] = ends
-    if rows.lead is not None:
-        lead = rows.lead
+    if rows.shift is not None:
+        centre = rows.shift
 
         def crossing(k: NDArray) -> NDArray:
-            direction, wanted = np.sign(rows.end[k] - start[k]), start[k] + lead[k]
+            direction, wanted = np.sign(rows.end[k] - start[k]), start[k] + centre[k]
             tools = rows_of(rows.tools, k)
-            return compensate(wanted, offsets[k], scales[k], rows.lines[k], ctx, direction, tools) - lead[k]
+            return compensate(wanted, offsets[k], scales[k], rows.lines[k], ctx, direction, tools) - centre[k]
 
-        _square(rows, rows.start, end, crossing)
         _corners(rows, end, crossing)
     before = None if travel.last is None else travel.last / scales[0] - offsets[0]
     _pin_plane(rows, end, before)
@@ -835,10 +776,9 @@ class _Commands:
         if todo.size:
             segs = self.rows
             ends = np.zeros((todo.size, 3), dtype=bool)
-            # (under cutter compensation a line's end is corrected where the tool centre is: `_Rows.shift`,
-            # its start `_Rows.lead`)
-            shifts = segs.shift if which == "end" else segs.lead
-            shift = 0.0 if shifts is None else shifts.take(todo, axis=0)
+            # (under cutter compensation a line's end is corrected where the tool centre is: `_Rows.shift`;
+            # a line's is the same at its start)
+            shift = 0.0 if segs.shift is None else segs.shift.take(todo, axis=0)
             c = compensate(self.wanted[which].take(todo, axis=0) + shift, segs.offsets.take(todo, axis=0), segs.scales[todo], segs.lines[todo], self.ctx,
                            d_todo, rows_of(segs.tools, todo), ends) - shift  # fmt: skip
             self.values[which][todo] = quantize(c, self.step[todo])
@@ -881,9 +821,7 @@ def _directional(rows: _Rows, ctx: PassContext, travel: Travel) -> _Solved:
             _shift_arcs(shift, rows, d, assumed, step, ctx, out_start, out_end)
         used[redo], used[shift] = d.take(redo, axis=0), d.take(shift, axis=0)
         np.copyto(out_end, compensated, where=free[:, None])
-        corrected_start = lambda k: commands("start", k, d.take(k, axis=0))  # noqa: B023, E731  # (called here)
-        _square(rows, out_start, out_end, corrected_start, step)
-        _corners(rows, out_end, corrected_start, step)
+        _corners(rows, out_end, lambda k: commands("start", k, d.take(k, axis=0)), step)  # noqa: B023  # (called here)
         _hold_pieces_still(pieces, d, travel.held, limit, out_start, out_end)
         _pin_plane(rows, out_end, before)
         _settle(free, arc, d, travel.held, offsets, scales, joined, out_start, out_end, before, _pins(rows))

@@ -14,9 +14,8 @@ All arcs of a chunk are processed together, piece arrays in, piece arrays out.
 
 from __future__ import annotations
 
-import bisect
 import math
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
 from typing import cast
 
@@ -67,10 +66,6 @@ BATCH_EVENTS = 4096
 MAX_TURNS = 10_000
 # Pieces sampled and fitted together in a round of `_replace` (their samples' memory: `_slices`)
 ROUND_PIECES = 8192
-# |sin| of the turn from the move before to an arc above which they meet at a corner, not smoothly
-TANGENT = 1e-3
-# length of arc (program units) over which the correction's turn of the tool centre's path is read
-TANGENT_STEP = 0.01
 SLIVER = (
     0.01  # mm of arc length below which a piece becomes a line (its bulge is < 0.1 µm for radii over 0.1 mm)
 )
@@ -95,7 +90,7 @@ def replace_arcs(events: Iterable[Event], ctx: PassContext) -> Iterator[Event]:
             yield from batch
             continue
         try:
-            fitted = fit(_ArcRows.of(arcs, normals, _moves_after(batch, index)))
+            fitted = fit(_ArcRows.of(arcs, normals))
         except (
             NcppError
         ) as error:  # the lines before the refused one go on first: a later pass may refuse one of them
@@ -113,16 +108,6 @@ def _with_arcs(batch: list[Event], motion: Motion) -> tuple[list[Event], list[in
     index = [k for k, e in enumerate(batch) if type(e) is Arc and not e.changed and not e.fixed]
     arcs = cast(list[Arc], [batch[k] for k in index])
     return batch, index, arcs, motion.normals(batch, arcs)
-
-
-def _moves_after(batch: list[Event], index: list[int]) -> list[Line | Arc | None]:
-    """The move after each of the batch's events at `index` (None: none in the batch)."""
-    moves = [k for k, e in enumerate(batch) if type(e) is Line or type(e) is Arc]
-    after: list[Line | Arc | None] = []
-    for k in index:
-        n = bisect.bisect_right(moves, k)
-        after.append(cast(Line | Arc, batch[moves[n]]) if n < len(moves) else None)
-    return after
 
 
 class Motion:
@@ -209,65 +194,35 @@ class _ArcRows:
     lines: NDArray  # (n,) the line of each arc's block, for messages
     normal: NDArray  # (n,) the direction each arc's normal axis is compensated for (`Motion`)
     # under cutter compensation (`Arc.centre_shift`): how far the tool centre stands off the arc towards
-    # its outside (n,) (negative: inside), and off its start (n,3), program units, the entry arcs (n,),
-    # which stay whole, and the arcs the next move meets at an inside corner (n,) (`_corner_after`);
-    # None: no arc is under compensation
-    tool_centre: tuple[NDArray, NDArray, NDArray, NDArray] | None = None
+    # its outside (n,) (negative: inside), and off its start (n,3), program units, and the entry arcs (n,),
+    # which stay whole; None: no arc is under compensation
+    tool_centre: tuple[NDArray, NDArray, NDArray] | None = None
 
     @classmethod
-    def of(cls, arcs: list[Arc], normals: list[int], after: list[Line | Arc | None]) -> _ArcRows:
-        """`after`: the move after each arc (None: not in the batch)."""
+    def of(cls, arcs: list[Arc], normals: list[int]) -> _ArcRows:
         offsets, scales, tools = frames(arcs)
         return cls(
             points([a.start for a in arcs]), points([a.end for a in arcs]), points([a.center for a in arcs]),
             plane_axes(arcs), np.fromiter([a.turn for a in arcs], dtype=float, count=len(arcs)),
             offsets, scales, tools, np.fromiter([a.block.line for a in arcs], dtype=np.int64, count=len(arcs)),
-            np.array(normals, dtype=float), _centre_offsets(arcs, after),
+            np.array(normals, dtype=float), _centre_offsets(arcs),
         )  # fmt: skip
 
 
-def _centre_offsets(
-    arcs: list[Arc], after: list[Line | Arc | None]
-) -> tuple[NDArray, NDArray, NDArray, NDArray] | None:
+def _centre_offsets(arcs: list[Arc]) -> tuple[NDArray, NDArray, NDArray] | None:
     """`_ArcRows.tool_centre` of the arcs: the radial offset read from the shift at each one's end."""
     if all(a.centre_shift is None for a in arcs):
         return None
     radial, start, entry = np.zeros(len(arcs)), np.zeros((len(arcs), 3)), np.zeros(len(arcs), dtype=bool)
-    corner = np.zeros(len(arcs), dtype=bool)
     for k, arc in enumerate(arcs):
         if arc.centre_shift is not None:
             at_start, shift = arc.centre_shift
             entry[k] = at_start is None
             start[k] = (0.0, 0.0, 0.0) if at_start is None else at_start
-            radial[k] = _radial_offset(arc, shift)
-            corner[k] = _corner_after(arc, shift, after[k])
-    return radial, start, entry, corner
-
-
-def _radial_offset(arc: Arc, shift: tuple[float, ...]) -> float:
-    """The tool centre's offset `shift` at the arc's end, radially (positive: outwards)."""
-    a, b, _ = PLANE_AXES[arc.context.plane]
-    du, dv = arc.end[a] - arc.center[a], arc.end[b] - arc.center[b]
-    return (shift[a] * du + shift[b] * dv) / math.hypot(du, dv)
-
-
-def _corner_after(arc: Arc, shift: tuple[float, ...], move: Line | Arc | None) -> bool:
-    """Whether the control stops the tool centre short of the arc's own offset end (`shift`) where
-    `move` follows it: at an inside corner, where their offset paths cross (the next move under
-    compensation starts with its own offset behind the arc's, along the arc's direction there; not
-    after compensation ends, nor along the plane's normal).  A move not known, or left as programmed,
-    is taken as such a corner."""
-    if move is None or move.centre_shift is None:
-        return True
-    own: tuple[float, ...] = move.centre_shift[1]
-    a, b, _ = PLANE_AXES[arc.context.plane]
-    if type(move) is Arc:  # (its own offset at its start: radially there)
-        su, sv = move.start[a] - move.center[a], move.start[b] - move.center[b]
-        k = _radial_offset(move, own) / math.hypot(su, sv)
-        own = tuple(k * su if n == a else k * sv if n == b else 0.0 for n in range(3))
-    ru, rv = arc.end[a] - arc.center[a], arc.end[b] - arc.center[b]
-    ahead = (own[b] - shift[b]) * ru - (own[a] - shift[a]) * rv  # along the arc counter-clockwise
-    return any(own) and math.dist(own, shift) > TANGENT * math.hypot(*shift) and ahead * arc.turn <= 0
+            a, b, _ = PLANE_AXES[arc.context.plane]
+            du, dv = arc.end[a] - arc.center[a], arc.end[b] - arc.center[b]
+            radial[k] = (shift[a] * du + shift[b] * dv) / math.hypot(du, dv)
+    return radial, start, entry
 
 
 @dataclass
@@ -330,72 +285,11 @@ class _ArcGeometry:
         corner belongs to the move that ends there).  None: no arc is under compensation."""
         if self.tool_centre is None:
             return None
-        first = self.first(arc, angles)[..., None]
-        return np.where(first, self.tool_centre[1][arc, None, :], self.radial_shifts(arc, angles))
-
-    def first(self, arc: NDArray, angles: NDArray) -> NDArray:
-        """(p,m) whether each of `angles` is its arc's start (the first piece starts at its angle, exactly)."""
-        return angles == self.a0[arc, None]
-
-    def last(self, arc: NDArray, angles: NDArray) -> NDArray:
-        """(p,m) whether each of `angles` is its arc's end (a piece's end angle is a sum of halves: nearly)."""
-        return np.abs(angles - (self.a0 + self.sweep)[arc, None]) < 1e-12
-
-    def radial_shifts(self, arc: NDArray, angles: NDArray) -> NDArray:
-        """(p,m,3) the tool centre's offset from the arc's points at `angles`, radially (`tool_centre`)."""
-        assert self.tool_centre is not None  # (under compensation)
-        k = self.tool_centre[0][arc, None]
-        return from_plane(k * np.cos(angles), k * np.sin(angles), np.zeros_like(angles), self.axes[arc])
-
-    def turned(
-        self, shift: NDArray, arc: NDArray, angles: NDArray, corrected: Callable[[NDArray], NDArray]
-    ) -> NDArray:
-        """The tool centre's `shift` (p,m,3) off the points at `angles` as the control takes it from the
-        written arc: radially about the arc's written centre, which the correction has moved, so turned
-        in the plane by the angle the correction (`corrected`: commands (p,k,3) for points) turns the
-        tool centre's path, read at each end of the piece over `TANGENT_STEP` (between them, in
-        proportion).  Not at an arc's start where the move before meets it at a corner (that move's
-        offset, square to it), nor at its end where the next move meets it at an inside corner
-        (`_corner_after`), nor on an entry arc (`whole`)."""
-        assert self.tool_centre is not None  # (under compensation)
-        step = (
-            TANGENT_STEP / np.maximum(self.radius[arc], TANGENT_STEP) * np.sign(angles[:, -1] - angles[:, 0])
-        )
-        ends = np.column_stack([angles[:, 0], angles[:, 0] + step, angles[:, -1] - step, angles[:, -1]])
-        path = self.points(arc, ends) + self.radial_shifts(arc, ends)
-        axes = self.axes[arc]
-        (pu, pv, _), (cu, cv, _) = (in_plane(np.diff(p, axis=1), axes) for p in (path, corrected(path)))
-        at_ends = np.arctan2(pu * cv - pv * cu, pu * cu + pv * cv)[:, [0, 2]]  # (p,2) the start's, the end's
-        along = (angles - angles[:, :1]) / (angles[:, -1:] - angles[:, :1])
-        turn = at_ends[:, :1] + along * (at_ends[:, 1:] - at_ends[:, :1])
-        su, sv, sw = in_plane(shift, axes)
-        cos, sin = np.cos(turn), np.sin(turn)
-        turned = from_plane(su * cos - sv * sin, su * sin + sv * cos, sw, axes)
-        radial = self.radial_shifts(arc, angles[:, :1])[:, 0]
-        corner_before = norm3(shift[:, 0] - radial) > TANGENT * norm3(radial)
-        corner_after = self.tool_centre[3][arc]
-        kept = (
-            self.first(arc, angles) & corner_before[:, None] | self.last(arc, angles) & corner_after[:, None]
-        )
-        return np.where((kept | self.whole(arc)[:, None])[..., None], shift, turned)
-
-    def end_about(self, q: NDArray, shift: NDArray, centre: NDArray, pieces: _Pieces) -> None:
-        """The arcs' last pieces among `pieces` end (`q` (p,m,3), their shifts `shift`) where the control,
-        offsetting radially about the fitted `centre` (p,3), puts the tool centre where the correction
-        wants it (the end plus its shift): the fitted circle's radial there, not the turn `turned` read
-        over a step.  Not where the next move meets the arc at an inside corner, nor on an entry arc."""
-        assert self.tool_centre is not None  # (under compensation)
-        last = self.last(pieces.arc, (pieces.a0 + pieces.sweep)[:, None])[:, 0]
-        last = np.flatnonzero(last & ~self.whole(pieces.arc) & ~self.tool_centre[3][pieces.arc])
-        if last.size == 0:
-            return
-        axes = self.axes[pieces.arc[last]]
-        wanted = q[last, -1] + shift[last, -1]
-        (tu, tv, tw), (cu, cv, _) = in_plane(wanted, axes), in_plane(centre[last], axes)
-        tu, tv = tu - cu, tv - cv  # (from the centre)
-        su, sv, _ = in_plane(shift[last, -1], axes)
-        k = (su * tu + sv * tv) / (tu * tu + tv * tv)  # signed: the tool centre outside the arc or inside it
-        q[last, -1] = from_plane(cu + (1 - k) * tu, cv + (1 - k) * tv, tw, axes)
+        radial, start, _ = self.tool_centre
+        k = radial[arc, None]
+        shift = from_plane(k * np.cos(angles), k * np.sin(angles), np.zeros_like(angles), self.axes[arc])
+        first = angles == self.a0[arc, None]  # (the first piece starts at the arc's angle, exactly)
+        return np.where(first[..., None], start[arc, None, :], shift)
 
     def whole(self, arc: NDArray) -> NDArray:
         """(p,) the arcs (of `arc`) that stay one piece: the entry arcs of cutter compensation (the
@@ -551,14 +445,9 @@ def _round(
         rows_of(tools, pending.arc),
     )
     if shift is not None:
-        corrected = lambda points: compensate(points, offsets[pending.arc], scale, line_of[pending.arc], ctx,  # noqa: E731
-                                              np.broadcast_to(direction[:, :1], points.shape), rows_of(tools, pending.arc))  # fmt: skip
-        shift = geometry.turned(shift, pending.arc, angles, corrected)
         q -= shift
     centre, deviation = _fit(q, geometry.axes[pending.arc], t, ctx.tolerance / scale)
     ok = deviation <= ctx.tolerance / scale
-    if shift is not None:
-        geometry.end_about(q, shift, centre, pending)
     if ctx.directional:  # ends on the output grid (after the fit: a short piece's chord fixes the bisector)
         step = grid(ctx, scale)
         q[:, 0], q[:, -1] = quantize(q[:, 0], step), quantize(q[:, -1], step)
