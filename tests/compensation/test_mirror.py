@@ -21,10 +21,9 @@ import numpy as np
 import pytest
 
 import ncpp.program.dialects.iso
-from ncpp.cli import main
 from ncpp.motion.segments import Arc, Line
 from tests import rs274
-from tests.compensation.test_rotation import interpreted
+from tests.compensation.test_rotation import interpreted, refused_as_written_by
 from tests.compensation.tool_centre import deviation, feed_moves
 from tests.conftest import ROOT
 from tests.writeback.conftest import linear_errors, machine_file, misses
@@ -209,16 +208,7 @@ def reversed_only(segment):
 def test_the_verifier_refuses_a_writer_that_gets_the_mirror_image_wrong(tmp_path, monkeypatch, capsys, wrong):
     """A writer that writes the mirrored frame's points as the program's words, or an arc mirrored in one
     axis the way the control runs it, is caught by the verifier: nothing is written."""
-    monkeypatch.setattr(ncpp.program.dialects.iso, "as_written", wrong)
-    (tmp_path / "affine.toml").write_text(MACHINE)
-    program, out = tmp_path / "mirrored.nc", tmp_path / "mirrored.out.nc"
-    program.write_text(PROGRAM)
-    zero = ",".join(f"{v:g}" for v in ZERO)
-    assert main(["compensate", "--dialect", "fanuc", "--machine", str(tmp_path / "affine.toml"), "--work-offset",
-                 zero, str(program), "-o", str(out)]) != 0  # fmt: skip
-    err = capsys.readouterr().err
-    assert "mirrored.nc:" in err and "verification" in err, err
-    assert not out.exists()
+    refused_as_written_by(wrong, tmp_path, monkeypatch, capsys, PROGRAM, MACHINE, ZERO)
 
 
 @pytest.mark.parametrize(

@@ -335,6 +335,23 @@ def fanuc_written(
     return program, out
 
 
+def refused_as_written_by(
+    wrong, tmp_path: Path, monkeypatch, capsys, text: str, machine: str, zero: tuple
+) -> None:
+    """A Fanuc program compensated by a writer that turns its points back `wrong` (for `as_written`) is
+    refused by the verifier, its file named, and nothing is written."""
+    monkeypatch.setattr(ncpp.program.dialects.iso, "as_written", wrong)
+    (tmp_path / "machine.toml").write_text(machine)
+    program, out = tmp_path / "framed.nc", tmp_path / "framed.out.nc"
+    program.write_text(text)
+    told = ",".join(f"{v:g}" for v in zero)
+    assert main(["compensate", "--dialect", "fanuc", "--machine", str(tmp_path / "machine.toml"), "--work-offset",
+                 told, str(program), "-o", str(out)]) != 0  # fmt: skip
+    err = capsys.readouterr().err
+    assert "framed.nc:" in err and "verification" in err, err
+    assert not out.exists()
+
+
 @pytest.mark.parametrize("dialect", ["fanuc", "haas"])
 def test_the_programmed_points_are_reached_under_g68_within_half_a_micron(tmp_path, dialect):
     """Every programmed end point, turned about G68's centre as the manual says, is reached within 0.5 µm

@@ -21,10 +21,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import ncpp.program.dialects.iso
-from ncpp.cli import main
 from tests import rs274
-from tests.compensation.test_rotation import fanuc_written, interpreted, turned_twice
+from tests.compensation.test_rotation import fanuc_written, interpreted, refused_as_written_by, turned_twice
 from tests.compensation.tool_centre import deviation, feed_moves
 from tests.writeback.conftest import linear_errors, machine_file, misses
 
@@ -200,16 +198,7 @@ def test_a_positive_r_turns_the_planes_first_axis_toward_its_second(plane, g68, 
 def test_the_verifier_refuses_a_writer_that_gets_a_g18_rotation_wrong(tmp_path, monkeypatch, capsys, wrong):
     """A writer that writes the turned frame's points as the program's words, or turns them the wrong
     way, is caught by the verifier: nothing is written."""
-    monkeypatch.setattr(ncpp.program.dialects.iso, "as_written", wrong)
-    (tmp_path / "affine.toml").write_text(MACHINE)
-    program, out = tmp_path / "turned.nc", tmp_path / "turned.out.nc"
-    program.write_text(G18_PROGRAM)
-    zero = ",".join(f"{v:g}" for v in ZERO)
-    assert main(["compensate", "--dialect", "fanuc", "--machine", str(tmp_path / "affine.toml"), "--work-offset",
-                 zero, str(program), "-o", str(out)]) != 0  # fmt: skip
-    err = capsys.readouterr().err
-    assert "turned.nc:" in err and "verification" in err, err
-    assert not out.exists()
+    refused_as_written_by(wrong, tmp_path, monkeypatch, capsys, G18_PROGRAM, MACHINE, ZERO)
 
 
 def test_the_first_move_ncpp_rewrites_after_a_g18_rotation_gives_both_of_its_axes(tmp_path):
