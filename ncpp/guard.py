@@ -613,26 +613,34 @@ _AXIS_LETTERS = frozenset("XYZABCUVW")
 _ISO_SETTINGS_SCANNED = 16
 
 
-def _iso_selects_first(head: list[str], at: int, rest: Iterator[str]) -> bool:
-    """Whether an ISO program selects a work offset before anything relies on the one in effect:
-    in one of the lines of settings alone from `at` on, or in the first other line (whose
-    selection, in rs274ngc's order of execution and Fanuc's, comes before its move); a placement
-    check the writer put before a selection says so too, and the tool guard's checks are
-    skipped (`head` takes the lines it needs from `rest`)."""
-    settings, tool_check = 0, False
-    for _ in range(LEADER_LINES + _ISO_SETTINGS_SCANNED):  # (comment lines too, boundedly)
-        if settings > _ISO_SETTINGS_SCANNED:
-            break
-        if at == len(head):
-            line = next(rest, None)
-            if line is None:
-                return False
-            head.append(line)
+def _iso_lines(
+    head: list[str], at: int, rest: Iterator[str], ahead: int = 0
+) -> Iterator[tuple[tuple[AnyItem, ...] | None, str, int]]:
+    """The items and comments of an ISO program's lines from `at` on, each with the index of the line
+    after it, the tool guard's checks skipped, at most LEADER_LINES + _ISO_SETTINGS_SCANNED lines
+    (comment lines too, boundedly); `head` takes the lines it needs from `rest`, and `ahead` more
+    after each (they end where the program does)."""
+    tool_check = False
+    for _ in range(LEADER_LINES + _ISO_SETTINGS_SCANNED):
+        head.extend(islice(rest, max(0, at + 1 + ahead - len(head))))
+        if at + ahead >= len(head):
+            return
         items, at = _items("iso", head[at]), at + 1
         said = _comments(items)
         if TOOL_BEGIN in said or tool_check:
             tool_check = TOOL_END not in said
             continue
+        yield items, said, at
+
+
+def _iso_selects_first(head: list[str], at: int, rest: Iterator[str]) -> bool:
+    """Whether an ISO program selects a work offset before anything relies on the one in effect:
+    in one of the lines of settings alone from `at` on, or in the first other line (whose
+    selection, in rs274ngc's order of execution and Fanuc's, comes before its move); a placement
+    check the writer put before a selection says so too (`head` takes the lines it needs from
+    `rest`)."""
+    settings = 0
+    for items, said, _ in _iso_lines(head, at, rest):
         if BEGIN in said:
             return True
         setting = _iso_setting(items)
@@ -641,31 +649,23 @@ def _iso_selects_first(head: list[str], at: int, rest: Iterator[str]) -> bool:
         if setting == "selects":
             return True
         settings += setting == "codes"
+        if settings > _ISO_SETTINGS_SCANNED:
+            break
     return False
 
 
 def _iso_touches_off_first(head: list[str], at: int, rest: Iterator[str]) -> bool:
     """Whether an ISO program's first line from `at` on that is not one of settings alone (as
-    `_iso_selects_first` reads them, tool guard checks skipped) is a touch-off that the writer
-    follows with its check (`touch_off_lines`): the lines before it rely on no work offset, and
-    the program's zero after it is where the tool stood, whatever zero the control held (`head`
-    takes the lines it needs from `rest`)."""
-    tool_check = False
-    for _ in range(LEADER_LINES + _ISO_SETTINGS_SCANNED):
-        if at + 1 >= len(head):
-            head.extend(islice(rest, at + 2 - len(head)))
-            if at + 1 >= len(head):
-                return False
-        items, at = _items("iso", head[at]), at + 1
-        said = _comments(items)
-        if TOOL_BEGIN in said or tool_check:
-            tool_check = TOOL_END not in said
-            continue
+    `_iso_selects_first` reads them) is a touch-off that the writer follows with its check
+    (`touch_off_lines`): the lines before it rely on no work offset, and the program's zero after
+    it is where the tool stood, whatever zero the control held (`head` takes the lines it needs
+    from `rest`)."""
+    for items, said, after in _iso_lines(head, at, rest, ahead=1):
         if BEGIN in said:
             return False
         setting = _iso_setting(items)
         if setting is None:  # (the line after it: the touch-off's check, if it is one)
-            return f"{BEGIN} {TOUCH_OFF}" in _comments(_items("iso", head[at]))
+            return f"{BEGIN} {TOUCH_OFF}" in _comments(_items("iso", head[after]))
         if setting == "selects" or not _before_touch_off(setting, items or ()):
             return False
     return False
