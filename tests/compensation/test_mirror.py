@@ -12,9 +12,6 @@ its whole path on the original's, within 0.5 µm, where the program as written m
 from __future__ import annotations
 
 import dataclasses
-import re
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -23,9 +20,8 @@ import pytest
 import ncpp.program.dialects.iso
 from ncpp.motion.segments import Arc, Line
 from tests import rs274
-from tests.compensation.test_rotation import interpreted, refused_as_written_by
+from tests.compensation.test_rotation import code_words, fanuc_written, interpreted, refused_as_written_by
 from tests.compensation.tool_centre import deviation, feed_moves
-from tests.conftest import ROOT
 from tests.writeback.conftest import linear_errors, machine_file, misses
 
 # error along the first axis from travel of the second, µm per mm (`linear_errors`)
@@ -51,7 +47,6 @@ PROGRAM = (
     + CONTOUR
     + "G50.1 Y0\nG0 X0 Y0\nM30\n%\n"
 )
-_WORD = re.compile(r"([A-Z])\s*(-?[\d.]+)")
 AS_WRITTEN = ncpp.program.dialects.iso.as_written  # the writer's own
 
 
@@ -83,13 +78,7 @@ def worked_out(text: str) -> tuple[np.ndarray, str]:
     absolute, motion, mirror = True, 0, {}
     ends = []
     lines = [f"G10 L2 P1 X{ZERO[0]:g} Y{ZERO[1]:g} Z{ZERO[2]:g}", "G21 G94 G17 G54"]
-    for line in text.splitlines():
-        code = line.split("(")[0].upper().strip()
-        if not code or code[0] in "%OI":  # (the tape marks, the program number, the guard's IF lines)
-            continue
-        words = [(letter, float(value)) for letter, value in _WORD.findall(code)]
-        codes = [value for letter, value in words if letter == "G"]
-        given = {letter: value for letter, value in words if letter not in "GN"}
+    for codes, given in code_words(text):
         axes = {"XYZ".index(letter): value for letter, value in given.items() if letter in "XYZ"}
         if 51.1 in codes:
             mirror = dict(axes)
@@ -123,18 +112,9 @@ def worked_out(text: str) -> tuple[np.ndarray, str]:
 
 
 def compensated(tmp_path: Path, text: str = PROGRAM) -> tuple[Path, Path]:
-    """The program and ncpp's compensation of it for MACHINE, G54 at ZERO (verified as it is written)."""
-    (tmp_path / "affine.toml").write_text(MACHINE)
-    program, out = tmp_path / "mirrored.nc", tmp_path / "mirrored.out.nc"
-    program.write_text(text)
-    zero = ",".join(f"{v:g}" for v in ZERO)
-    proc = subprocess.run([sys.executable, "-m", "ncpp", "compensate", "--dialect", "fanuc", "--machine",
-                           str(tmp_path / "affine.toml"), "--work-offset", zero, "--tolerance", "0.0001",
-                           str(program), "-o", str(out)],
-                          capture_output=True, text=True, cwd=ROOT, timeout=300, stdin=subprocess.DEVNULL)  # fmt: skip
-    assert proc.returncode == 0, proc.stderr
-    assert "scope" not in proc.stderr and "warning" not in proc.stderr, proc.stderr
-    return program, out
+    """The program and ncpp's compensation of it for MACHINE, G54 at ZERO (verified as it is written),
+    with no warning."""
+    return fanuc_written(tmp_path, "fanuc", text, MACHINE, ZERO, quiet=True)
 
 
 def test_the_programmed_points_are_reached_under_g51_1_within_half_a_micron(tmp_path):

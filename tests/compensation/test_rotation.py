@@ -16,6 +16,7 @@ import math
 import re
 import subprocess
 import sys
+from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -333,6 +334,23 @@ def fanuc_written(
     assert proc.returncode == 0, proc.stderr
     assert "scope" not in proc.stderr and not (quiet and "warning" in proc.stderr), proc.stderr
     return program, out
+
+
+_ANY_WORD = re.compile(r"([A-Z])\s*(-?[\d.]+)")
+
+
+def code_words(text: str) -> Iterator[tuple[list[float], dict[str, float]]]:
+    """The G codes and the other words (N aside) of each line of a Fanuc program in the tests' words, as
+    a hand reading takes them: comments, tape marks, the program number and the guard's IF lines aside."""
+    for line in text.splitlines():
+        code = line.split("(")[0].upper().strip()
+        if not code or code[0] in "%OI":
+            continue
+        words = [(letter, float(value)) for letter, value in _ANY_WORD.findall(code)]
+        yield (
+            [value for letter, value in words if letter == "G"],
+            {letter: value for letter, value in words if letter not in "GN"},
+        )
 
 
 def refused_as_written_by(

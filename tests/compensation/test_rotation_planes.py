@@ -22,7 +22,13 @@ import numpy as np
 import pytest
 
 from tests import rs274
-from tests.compensation.test_rotation import fanuc_written, interpreted, refused_as_written_by, turned_twice
+from tests.compensation.test_rotation import (
+    code_words,
+    fanuc_written,
+    interpreted,
+    refused_as_written_by,
+    turned_twice,
+)
 from tests.compensation.tool_centre import deviation, feed_moves
 from tests.writeback.conftest import linear_errors, machine_file, misses
 
@@ -53,7 +59,6 @@ G18_PROGRAM = (
 G19_PROGRAM = G18_PROGRAM.translate(str.maketrans("XYIJ", "YXJI")).replace("G18", "G19")
 PROGRAMS = {18: G18_PROGRAM, 19: G19_PROGRAM}
 PLANES = {17: (0, 1, 2), 18: (2, 0, 1), 19: (1, 2, 0)}  # first, second and normal axis (rs274's order)
-_WORD = re.compile(r"([A-Z])\s*(-?[\d.]+)")
 
 
 def turning(angle: float) -> np.ndarray:
@@ -91,13 +96,7 @@ def worked_out(text: str) -> tuple[np.ndarray, str]:
     plane, absolute, motion, rotation = 17, True, 0, None
     ends = []
     lines = [f"G10 L2 P1 X{ZERO[0]:g} Y{ZERO[1]:g} Z{ZERO[2]:g}", "G21 G94 G54"]
-    for line in text.splitlines():
-        code = line.split("(")[0].upper().strip()
-        if not code or code[0] in "%OI":  # (the tape marks, the program number, the guard's IF lines)
-            continue
-        words = [(letter, float(value)) for letter, value in _WORD.findall(code)]
-        codes = [value for letter, value in words if letter == "G"]
-        given = {letter: value for letter, value in words if letter != "G"}
+    for codes, given in code_words(text):
         plane = next((int(g) for g in codes if g in (17, 18, 19)), plane)
         if 68 in codes:
             first, second = ("XYZ"[i] for i in PLANES[plane][:2])
