@@ -327,6 +327,7 @@ class FanucInterpreter(Interpreter):
     mirror_image = True  # G51.1 / G50.1: the programmable mirror image (module docstring)
     g92_speed_clamp = True  # `G92 S4000`: refused as the spindle speed clamp it is (`G92_SPEED_CLAMP`)
     fanuc_variables = True  # `#5003`, `#3020`: the control's system variables, in every program
+    logic = "binary"  # `[20 OR 20]`: out of scope, `[#1 GT 0] AND [#2 GT 0]` followed (`Parameters.logic`)
     # Polar coordinates, scaling, programmable mirror image and coordinate rotation cancel (Fanuc Series
     # 0i-MD operator's manual, G code list: G15, G50, G50.1, G69)
     idle_cancels = frozenset((15.0, 50.0, 50.1, 69.0))
@@ -758,6 +759,7 @@ class HaasInterpreter(FanucInterpreter):
     # zappettiniconsulting.com/wiki/haas-system-variables quotes it: #10000-#10999 general-purpose,
     # r/w, #100-#999 their legacy numbers; #3020 the power-on timer, read only)
     kept_variables = COMMON_VARIABLES | frozenset(range(10000, 11000))
+    logic = "bitwise"  # ("Logical Operators": on the bits of the integer parts, `expressions.BITWISE`)
 
 
 interpret = interpreting(FanucInterpreter)

@@ -333,6 +333,8 @@ class Interpreter:
     # numbered variables the control keeps from before the program (Fanuc's and Haas's common variables):
     # read before the program sets one, its value is not ncpp's to know
     kept_variables: frozenset[int] = frozenset()
+    # AND OR XOR: "logical" (rs274ngc's 1.0 or 0.0), "bitwise" (Haas) or "binary" (Fanuc): `Parameters.logic`
+    logic = "logical"
     # G92 with S and no axis words is a spindle speed clamp (Fanuc's lathes and machining centres): the
     # refusal says so (`G92_SPEED_CLAMP`); rs274ngc has no G92 S and refuses it as a G92 without axes
     g92_speed_clamp = False
@@ -426,6 +428,7 @@ class Interpreter:
         self.params = Parameters(self._system_parameter, self._fanuc_system_variable, self._tool_parameter)
         self.params.kept = self.kept_variables
         self.params.fanuc = self.fanuc_variables
+        self.params.logic = self.logic
         self._context: Context | None = None
         self._fast = False
         self.done = False  # program end (M2/M30) reached or state unknown
