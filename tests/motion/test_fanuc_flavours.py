@@ -109,6 +109,14 @@ def test_what_fanuc_and_haas_programs_need_ncpp_is_not_told_ends_interpretation(
         (b"G81 X1 Y1 Z-1 R1 F100\nG80\n(next)\n\nN20 X1. Y2.\n", "fanuc"),
         (b"G81 X1 Y1 Z-1 R1 F100\nG80 G0 Z5\nX1\n", "iso"),  # (the G80 line gives G0)
         (b"G81 X1 Y1 Z-1 R1 F100\nG80\nG0 X1\n", "iso"),
+        # G00 in a G28 block (a textbook program, `(O2201);` its number in a comment): the G28 takes the
+        # axis words on a Fanuc control, rs274 refuses "two g codes that both use axis values"
+        (b"(O2201);\nN002 G00 G17 G40 G49 G80 G90;\nN003 G00 G91 G28 Z0.0;\n", "fanuc"),
+        (b"G21\nG0 G30 Z5.\n", "fanuc"),
+        (b"G21\nG1 G28 Z5.\n", "iso"),  # (G1 there the Fanuc interpreter refuses too)
+        (b"G21\nG91 G28 Z0\nG90 G0 X1\n", "iso"),  # (G28 with G91 alone: LinuxCNC's too)
+        (b"G21\nG0 G28.1 Z0\nG0 X1 (G28 G0)\n", "iso"),
+        (b"o100 sub\nG0 G28 Z0\no100 endsub\n", "iso"),
         # macro statements: LinuxCNC's loops and conditions are o-word lines, Sinumerik's take no brackets
         (b"#1=0\nWHILE [#1 LT 3] DO1\nG0 X#1\n#1=#1+1\nEND1\n", "fanuc"),
         (b"#1=0\nWH[#1LT3]DO1\nG0X#1\n#1=#1+1\nEND1\n", "fanuc"),  # WH: WHILE cut to two characters
@@ -274,6 +282,18 @@ def test_g0_in_a_return_block_is_the_modal_motion_after_it(tmp_path):
     check = subprocess.run([sys.executable, str(PATHCHECK), str(twin_in), str(twin_out), "--tol-mm", "0.05"],
                            capture_output=True, text=True, timeout=600)  # fmt: skip
     assert check.returncode == 0, check.stdout + check.stderr
+
+
+def test_a_program_with_g0_in_a_return_block_and_no_number_is_read_as_fanuc(tmp_path):
+    """Without its `O0025` line (a textbook program gives its number in a comment) the `G0 G28` block alone
+    tells a Fanuc program: compensated as with `--dialect fanuc`, where it was read as LinuxCNC's and refused."""
+    text = RETURN_WITH_G0.replace("%\nO0025\n", "(O0025);\n")
+    program, out = tmp_path / "p.nc", tmp_path / "out.nc"
+    program.write_text(text)
+    proc = subprocess.run([sys.executable, "-m", "ncpp", "compensate", "--machine", str(READING), str(program),
+                           "-o", str(out)], capture_output=True, text=True, cwd=ROOT)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    assert out.read_text() == compensated_by_cli(tmp_path, text, "fanuc")[0]
 
 
 def test_g1_in_a_return_block_is_still_refused():
