@@ -312,6 +312,7 @@ class FanucInterpreter(Interpreter):
         "L",
         "K",
     )  # a cycle's repeats: K, or L on the Series 15 (module docstring)
+    stores_cycle = True  # `G81 R.. Z.. L0`: the cycle's data kept, no hole (`Interpreter._stored_cycle`)
     fanuc_back_bore = True  # G87 read as Fanuc's back bore, compensated hole by hole (module docstring)
     canned = CANNED | {76.0}  # G76: fine boring, compensated hole by hole (module docstring)
     returns_under_comp = True  # G28/G30 under G41/G42: out of scope (module docstring)
@@ -738,6 +739,7 @@ class HaasInterpreter(FanucInterpreter):
     dwell_point = True
     # ("G81 Drill Canned Cycle": "L Number of holes if G91 is used"; its G73 and G83 read I J K as pecks)
     repeat_letters = ("L",)
+    stores_cycle = False  # (no Haas manual page in ncpp's reference set says what L0 does)
     fanuc_back_bore = False  # (no Haas manual page in ncpp's reference set gives G87 as Fanuc's back bore)
     unfollowed = HAAS_UNFOLLOWED
     additional = "G154"
