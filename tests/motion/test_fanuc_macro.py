@@ -22,10 +22,11 @@ from ncpp.motion.canon import canon_call
 from ncpp.motion.segments import FLOW, Line, Pass
 from ncpp.pipeline import dialect_tools
 from ncpp.program.parser import parse_stream
-from tests.conftest import READING, ROOT
+from tests.conftest import READING, ROOT, SHARED
 from tests.motion.test_oracle import ours, read_canon, rs274, rs274_error, same_calls, write_program
 
 HEAD = "G21 G90 G17\nG0 X0 Y0 Z5 F300\n"
+PATHCHECK = SHARED / "tools" / "pathcheck"
 
 # name: (Fanuc program, the same program for LinuxCNC)
 TWINS = {
@@ -689,3 +690,28 @@ def test_a_program_with_a_cycle_of_l0_is_compensated_and_steps_back_before_it(tm
     lines = written.splitlines()
     stored = lines.index("G99 G81 R2.5 Z-3.4 F200. L0")
     assert lines[stored - 1].startswith(("X", "Y", "Z")), written  # the step, in G0 (the mode before)
+
+
+def test_holes_after_a_cycle_of_l0_in_straight_code_are_compensated(tmp_path):
+    """The holes after the L0 block, in the main program, are compensated hole by hole, without a word of
+    canned cycles left as programmed; judged by rs274 on twins that drill the first hole in the cycle block
+    (pathcheck, 0.02 mm)."""
+    text = "%\nO0004\nG21 G90 G17\nG0 X1. Y2. Z25.\nG98 G81 R2.5 Z-3.4 F200. L0\nX7. Y7.\nX39.\nY45.\nG80\nM30\n%\n"
+    program, out = tmp_path / "p.nc", tmp_path / "out.nc"
+    program.write_text(text)
+    proc = subprocess.run([sys.executable, "-m", "ncpp", "compensate", "--machine", str(READING), str(program),
+                           "-o", str(out)], capture_output=True, text=True, cwd=ROOT)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    assert "warning" not in proc.stderr and "left as programmed: nothing" in proc.stderr, proc.stderr
+    written = out.read_text()
+    if not PATHCHECK.exists():
+        pytest.skip("pathcheck not available")
+    stored = "G98 G81 R2.5 Z-3.4 F200. L0\n"
+    before = tmp_path / "before.ngc"
+    before.write_text(text.replace(stored, "").replace("X7. Y7.\n", "G98 G81 X7. Y7. R2.5 Z-3.4 F200.\n"))
+    head, tail = written.split(stored)
+    after = tmp_path / "after.ngc"
+    after.write_text(head + "G98 G81 F200. " + tail)
+    check = subprocess.run([sys.executable, str(PATHCHECK), str(before), str(after), "--tol-mm", "0.02"],
+                           capture_output=True, text=True, timeout=600)  # fmt: skip
+    assert check.returncode == 0, check.stdout + check.stderr
