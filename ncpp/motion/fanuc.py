@@ -129,8 +129,10 @@ ends interpretation by name there.
 A canned cycle's K is its repeats, as rs274ngc's L (the Fanuc Series 0i and 16i formats, `G81 X_ Y_ Z_ R_
 F_ K_`, "K_: Number of repeats", as the Fanuc lathe operator's manual's drilling cycles give it; the
 Series 15i-MA operator's manual counts them in L: "When L is used to specify the number of repeats"):
-both are read, and a block with both, or with K0 (the cycle's data stored, no hole drilled), is out of
-scope.  Haas counts repeats in L only ("G81 Drill Canned Cycle": "L Number of holes if G91 is used").
+both are read, and a block with both is out of scope.  A block of K0 or L0 and no hole position stores
+the cycle's data and drills nothing (cncci.com, "Two applications for L0"; `Interpreter._stored_cycle`);
+one with a hole position is out of scope.  Haas counts repeats in L only ("G81 Drill Canned Cycle": "L
+Number of holes if G91 is used"), and its L0 keeps rs274ngc's refusal.
 
 A P in the block of a cycle whose format has none (G81 `X_ Y_ Z_ R_ F_ K_` as above, G73, G83 and G85 on
 Fanuc) is kept as written and the cycle's moves are its own: the format's sequence has no dwell at the
