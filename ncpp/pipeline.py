@@ -242,6 +242,9 @@ def warn_fixed(events: Iterable[Event], warnings: Warnings, file: str) -> Iterat
         kind = type(event)
         if kind is Line or kind is Arc:  # (not a Pass, nor a dialect's own: Klartext's pole)
             fixed = event.fixed  # type: ignore[union-attr]
+            if fixed == CYCLE and event.start == event.end:  # type: ignore[union-attr]  # (a stored cycle: no move)
+                yield event
+                continue
             if said is not None and said[1] is not event.block:
                 said = None
             cycle = series == CYCLE or series == HOLE

@@ -99,7 +99,9 @@ class Summary:
             for event in events:
                 kind = type(event)
                 if kind is Line:
-                    if event.fixed and event.fixed != HOLE:  # type: ignore[union-attr]  # (HOLE: compensated)
+                    if event.fixed == CYCLE and event.start == event.end:  # type: ignore[union-attr]
+                        pass  # (a stored cycle's block, `Interpreter._stored_cycle`: no move)
+                    elif event.fixed and event.fixed != HOLE:  # type: ignore[union-attr]  # (HOLE: compensated)
                         self._leave(REASONS.get(event.fixed, event.fixed), event.block.line)  # type: ignore[union-attr]
                     else:
                         moves += 1

@@ -130,6 +130,8 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
         "motion/test_fanuc_macro.py": (
             "test_fanuc_macros_move_as_rs274_runs_their_o_word_twins",
             "test_random_fanuc_macros_move_as_rs274_runs_their_o_word_twins",
+            "test_a_cycle_of_l0_stores_its_data_for_the_holes_a_subprogram_gives",
+            "test_holes_after_a_cycle_of_l0_in_straight_code_are_compensated",
         ),
         "property/test_cutter_comp_properties.py": None,
         "shop/test_freecad_post.py": None,
@@ -152,6 +154,7 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_g80_leaves_the_motion_mode_the_cycle_interrupted",
             "test_the_moves_before_any_motion_code_are_rs274s_of_the_twin_that_writes_g0_in_them",
             "test_the_moves_before_any_motion_code_are_written_as_programmed_and_the_rest_compensated",
+            "test_a_linuxcnc_or_is_a_truth_value_as_rs274_reads_it",
         ),
         "writeback/test_loops_run_once.py": (
             "test_a_body_that_runs_once_is_compensated_in_place",
@@ -239,6 +242,7 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
         "compensation/test_rotary_dialects.py": None,
         "motion/test_fanuc_flavours.py": (
             "test_a_fusion_drilling_program_with_axis_words_after_g80_is_compensated_as_fanuc",
+            "test_a_program_with_g0_in_a_return_block_and_no_number_is_read_as_fanuc",
             "test_a_haas_peck_cycle_with_p_is_compensated_with_its_p_and_verified",
             "test_external_output_passes_through_the_compensated_program",
             "test_expand_keeps_a_g68_of_variables_out_of_scope",
@@ -295,7 +299,10 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_programs_compensated_across_processes_are_timed_and_counted",
         ),
         # the fast tier's slowest (command-line runs of a second or more each)
-        "motion/test_fanuc_macro.py": ("test_memory_stays_flat_with_fanuc_loops",),
+        "motion/test_fanuc_macro.py": (
+            "test_memory_stays_flat_with_fanuc_loops",
+            "test_a_program_with_a_cycle_of_l0_is_compensated_and_steps_back_before_it",
+        ),
         "compensation/test_work_offsets.py": ("test_command_line_var_file_and_work_offsets_say_the_same",),
         "compensation/test_tool_lengths.py": ("test_command_line_tool_table",),
         "compensation/test_placement.py": (

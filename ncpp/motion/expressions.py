@@ -122,6 +122,14 @@ OPERATORS: dict[str, Callable[[float, float], float]] = {
     "OR": lambda a, b: float(a != 0.0 or b != 0.0),
     "XOR": lambda a, b: float((a != 0.0) != (b != 0.0)),
 }
+LOGIC = frozenset(("AND", "OR", "XOR"))
+# Haas's logical operators work on the bits of the values' integer parts (Haas Mill Operator's Manual
+# 96-8000, "Macros", "Logical Operators": `#1=1.0; #2=2.0; #3=#1 OR #2;` leaves 3.0 in #3)
+BITWISE: dict[str, Callable[[int, int], int]] = {
+    "AND": lambda a, b: a & b,
+    "OR": lambda a, b: a | b,
+    "XOR": lambda a, b: a ^ b,
+}
 
 
 class Parameters:
@@ -159,6 +167,9 @@ class Parameters:
         self.fanuc_system = fanuc_system  # those the interpreter knows (None: not known)
         self.control = control  # LinuxCNC's machine-state parameters the interpreter knows (None: not known)
         self.kept: frozenset[int] = frozenset()  # the control's common variables, set before the program
+        # AND OR XOR: rs274ngc's truth values ("logical"), Haas's bits ("bitwise", `BITWISE`), or a Fanuc
+        # control's, followed where both values are 0 or 1, whose results agree then ("binary")
+        self.logic = "logical"
         self.unknown: dict[int | str, str] = {}  # parameters set from a value ncpp cannot know: whence
         self.journal: Journal | None = None  # the writes a loop's check follows (`endless.py`)
 
@@ -391,6 +402,8 @@ def _value(expr: tuple, params: Parameters) -> float:
         if (op == "EQ" or op == "NE") and (vacant(expr[2], params) or vacant(expr[3], params)):
             same = vacant(expr[2], params) and vacant(expr[3], params)  # vacant EQ 0 is false
             return float(same == (op == "EQ"))
+        if op in LOGIC and params.logic != "logical":
+            return _logic(op, evaluate(expr[2], params), evaluate(expr[3], params), params.logic)
         return OPERATORS[op](evaluate(expr[2], params), evaluate(expr[3], params))
     if kind == "neg":
         return -evaluate(expr[1], params)
@@ -404,6 +417,22 @@ def _value(expr: tuple, params: Parameters) -> float:
         target = expr[1]
         return float(params.exists(params.key(target[1], lambda e: evaluate(e, params))))
     raise ExpressionError(f"cannot evaluate {kind!r}")
+
+
+def _logic(op: str, a: float, b: float, logic: str) -> float:
+    """`a op b` for AND, OR, XOR, where they are not rs274ngc's truth values (`Parameters.logic`)."""
+    if logic == "bitwise":
+        return float(BITWISE[op](math.trunc(a), math.trunc(b)))
+    if a not in (0.0, 1.0) or b not in (0.0, 1.0):
+        raise OutOfScope(
+            f"{_number(a)} {op} {_number(b)} (a logical operation on values other than 0 and 1, whose "
+            "result ncpp cites from no Fanuc manual)"
+        )
+    return OPERATORS[op](a, b)
+
+
+def _number(value: float) -> str:
+    return f"{value:g}"
 
 
 def vacant(expr: tuple, params: Parameters) -> bool:

@@ -129,8 +129,10 @@ ends interpretation by name there.
 A canned cycle's K is its repeats, as rs274ngc's L (the Fanuc Series 0i and 16i formats, `G81 X_ Y_ Z_ R_
 F_ K_`, "K_: Number of repeats", as the Fanuc lathe operator's manual's drilling cycles give it; the
 Series 15i-MA operator's manual counts them in L: "When L is used to specify the number of repeats"):
-both are read, and a block with both, or with K0 (the cycle's data stored, no hole drilled), is out of
-scope.  Haas counts repeats in L only ("G81 Drill Canned Cycle": "L Number of holes if G91 is used").
+both are read, and a block with both is out of scope.  A block of K0 or L0 and no hole position stores
+the cycle's data and drills nothing (cncci.com, "Two applications for L0"; `Interpreter._stored_cycle`);
+one with a hole position is out of scope.  Haas counts repeats in L only ("G81 Drill Canned Cycle": "L
+Number of holes if G91 is used"), and its L0 keeps rs274ngc's refusal.
 
 A P in the block of a cycle whose format has none (G81 `X_ Y_ Z_ R_ F_ K_` as above, G73, G83 and G85 on
 Fanuc) is kept as written and the cycle's moves are its own: the format's sequence has no dwell at the
@@ -312,6 +314,7 @@ class FanucInterpreter(Interpreter):
         "L",
         "K",
     )  # a cycle's repeats: K, or L on the Series 15 (module docstring)
+    stores_cycle = True  # `G81 R.. Z.. L0`: the cycle's data kept, no hole (`Interpreter._stored_cycle`)
     fanuc_back_bore = True  # G87 read as Fanuc's back bore, compensated hole by hole (module docstring)
     canned = CANNED | {76.0}  # G76: fine boring, compensated hole by hole (module docstring)
     returns_under_comp = True  # G28/G30 under G41/G42: out of scope (module docstring)
@@ -327,6 +330,7 @@ class FanucInterpreter(Interpreter):
     mirror_image = True  # G51.1 / G50.1: the programmable mirror image (module docstring)
     g92_speed_clamp = True  # `G92 S4000`: refused as the spindle speed clamp it is (`G92_SPEED_CLAMP`)
     fanuc_variables = True  # `#5003`, `#3020`: the control's system variables, in every program
+    logic = "binary"  # `[20 OR 20]`: out of scope, `[#1 GT 0] AND [#2 GT 0]` followed (`Parameters.logic`)
     # Polar coordinates, scaling, programmable mirror image and coordinate rotation cancel (Fanuc Series
     # 0i-MD operator's manual, G code list: G15, G50, G50.1, G69)
     idle_cancels = frozenset((15.0, 50.0, 50.1, 69.0))
@@ -737,6 +741,7 @@ class HaasInterpreter(FanucInterpreter):
     dwell_point = True
     # ("G81 Drill Canned Cycle": "L Number of holes if G91 is used"; its G73 and G83 read I J K as pecks)
     repeat_letters = ("L",)
+    stores_cycle = False  # (no Haas manual page in ncpp's reference set says what L0 does)
     fanuc_back_bore = False  # (no Haas manual page in ncpp's reference set gives G87 as Fanuc's back bore)
     unfollowed = HAAS_UNFOLLOWED
     additional = "G154"
@@ -758,6 +763,7 @@ class HaasInterpreter(FanucInterpreter):
     # zappettiniconsulting.com/wiki/haas-system-variables quotes it: #10000-#10999 general-purpose,
     # r/w, #100-#999 their legacy numbers; #3020 the power-on timer, read only)
     kept_variables = COMMON_VARIABLES | frozenset(range(10000, 11000))
+    logic = "bitwise"  # ("Logical Operators": on the bits of the integer parts, `expressions.BITWISE`)
 
 
 interpret = interpreting(FanucInterpreter)

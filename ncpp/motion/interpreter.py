@@ -305,6 +305,9 @@ class Interpreter:
     canned: frozenset[float] = CANNED
     # The letters of a canned cycle's repeats: rs274ngc's L; Fanuc's K too (`FanucInterpreter`)
     repeat_letters: tuple[str, ...] = ("L",)
+    # A cycle block of 0 repeats and no hole position stores the cycle's data and drills nothing (Fanuc:
+    # `G81 R.. Z.. F.. L0`, its holes in a subprogram after it); rs274ngc refuses zero repeats
+    stores_cycle = False
     # G28/G30 under cutter compensation (Fanuc: the offset is dropped at the intermediate point and
     # restored after the return): not followed, out of scope; rs274ngc refuses it
     returns_under_comp = False
@@ -333,6 +336,8 @@ class Interpreter:
     # numbered variables the control keeps from before the program (Fanuc's and Haas's common variables):
     # read before the program sets one, its value is not ncpp's to know
     kept_variables: frozenset[int] = frozenset()
+    # AND OR XOR: "logical" (rs274ngc's 1.0 or 0.0), "bitwise" (Haas) or "binary" (Fanuc): `Parameters.logic`
+    logic = "logical"
     # G92 with S and no axis words is a spindle speed clamp (Fanuc's lathes and machining centres): the
     # refusal says so (`G92_SPEED_CLAMP`); rs274ngc has no G92 S and refuses it as a G92 without axes
     g92_speed_clamp = False
@@ -370,6 +375,7 @@ class Interpreter:
         self.cycle_r = self.cycle_cc = self.cycle_q = self.cycle_il = 0.0
         self.cycle_ijk = (0.0, 0.0, 0.0)  # G87's sticky I J K
         self.cycle_holes = False  # the series' cycles are compensated hole by hole (`Hole`)
+        self.series_stored = False  # a block of 0 repeats started the series: its first hole is still to come
         # G82 G89's dwell, in the control's unit (sticky within the cycle; Haas: G73 G83 too), and its word
         self.cycle_p = 0.0
         self.cycle_p_word: Word | ExprWord | None = None
@@ -426,6 +432,7 @@ class Interpreter:
         self.params = Parameters(self._system_parameter, self._fanuc_system_variable, self._tool_parameter)
         self.params.kept = self.kept_variables
         self.params.fanuc = self.fanuc_variables
+        self.params.logic = self.logic
         self._context: Context | None = None
         self._fast = False
         self.done = False  # program end (M2/M30) reached or state unknown
@@ -2394,6 +2401,8 @@ class Interpreter:
         aa, bb, step_a, step_b, r, bottom = self._cycle_geometry(block, words, again, item)
         repeats = self._repeats(block, words, motion)
         peck = self._cycle_word(block, words, motion, again, item)
+        if repeats == 0:
+            return self._stored_cycle(block, words, motion, previous, item)
         if motion in (74.0, 84.0) and self.plane != 17 and not self.taps_in_any_plane:
             raise _OutOfScope(f"canned cycle G{motion:g} outside the XY plane", item.start + 1)
         if motion in SPINDLE:
@@ -2446,16 +2455,41 @@ class Interpreter:
         self.cycle_holes = (previous not in self.canned or self.cycle_holes) and (
             motion != 87.0 or self.back_bore_holes
         )
+        series_start, self.series_stored = previous not in self.canned or self.series_stored, False
         if self.cycle_holes:
             ends = [k for k, _, _ in holes[1:]] + [len(lines)]
             offset, top_level = ((off_a, off_b), middle) if motion == 87.0 else ((0.0, 0.0), None)
             for n, ((k, hole_a, hole_b), end) in enumerate(zip(holes, ends)):
                 drilled = Hole(motion, hole_a, hole_b, bottom, r, peck, rapid_delta, self.retract_to_r,
-                               previous not in self.canned and n == 0, n, len(holes),
+                               series_start and n == 0, n, len(holes),
                                plane=self.plane, offset=offset, top=top_level)  # fmt: skip
                 for line in lines[k:end]:
                     line.fixed, line.hole = HOLE, drilled
         return lines
+
+    def _stored_cycle(
+        self, block: Block, words: dict, motion: float, previous: float | None, item
+    ) -> tuple[Line]:
+        """A cycle block of 0 repeats (`stores_cycle`): its R, depth, P and Q are kept for the holes the
+        next blocks give, and nothing moves (cncci.com, "Two applications for L0": "sets up the canned
+        cycle but does not drill a hole", the holes in a subprogram called after it).  Where the block
+        also gives a hole position, or its cycle is written out as moves, it is out of scope."""
+        first, second, _ = PLANE_AXES[self.plane]
+        placed = next((words[k] for k in (AXES[first], AXES[second], "@", "^") if k in words), None)
+        if placed is not None:
+            raise _OutOfScope(
+                f"canned cycle G{motion:g} of 0 repeats with a hole position", placed[1].start + 1
+            )
+        if self.expand_cycles:
+            raise _OutOfScope(f"--expand-cycles: canned cycle G{motion:g} of 0 repeats", item.start + 1)
+        self.cycle_holes = (previous not in self.canned or self.cycle_holes) and motion != 87.0
+        self.series_stored = self.series_stored or previous not in self.canned
+        # a cycle move of no length where the tool stands: where the holes after it are left as programmed
+        # and a compensated move stands before it, their step to the programmed point (`apply_error_map.
+        # _lead_in`) comes before this block, in the mode before it, not as a G0 amid the cycle's mode
+        stay = self._line(block, self._base(), True)
+        stay.fixed = CYCLE
+        return (stay,)
 
     def _fanuc_back_bore(self, block: Block, words: dict, previous: float | None, item) -> tuple[Event, ...]:
         """Fanuc's back boring G87, compensated hole by hole as the other cycles (HOLE: `cycles.fanuc_back_bore`):
@@ -2511,6 +2545,8 @@ class Interpreter:
         if r >= top:  # (not a back bore: the cut would go down)
             raise _OutOfScope("Fanuc's back boring G87 with R not below Z", item.start + 1)
         repeats = self._repeats(block, words, 87.0)
+        if repeats == 0:
+            raise _OutOfScope("Fanuc's back boring G87 of 0 repeats", item.start + 1)
         self._check_cycle_size(block, words, repeats, 0.0, item)
         self.cycle_holes = previous not in self.canned or self.cycle_holes
         lines: list[Line] = []
@@ -2671,9 +2707,7 @@ class Interpreter:
             self._fail("Non integer value for integer", block, item)
         if value < 0:
             self._fail("Negative L word used", block, item)
-        if value == 0 and given[0] == "K":  # (Fanuc: the cycle's data is stored, no hole drilled)
-            raise _OutOfScope("a canned cycle with K0", item.start + 1)
-        if value == 0:
+        if value == 0 and not self.stores_cycle:
             self._fail("Cannot do zero repeats of cycle", block, item)
         return int(value)
 

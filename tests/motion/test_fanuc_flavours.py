@@ -109,6 +109,14 @@ def test_what_fanuc_and_haas_programs_need_ncpp_is_not_told_ends_interpretation(
         (b"G81 X1 Y1 Z-1 R1 F100\nG80\n(next)\n\nN20 X1. Y2.\n", "fanuc"),
         (b"G81 X1 Y1 Z-1 R1 F100\nG80 G0 Z5\nX1\n", "iso"),  # (the G80 line gives G0)
         (b"G81 X1 Y1 Z-1 R1 F100\nG80\nG0 X1\n", "iso"),
+        # G00 in a G28 block (a textbook program, `(O2201);` its number in a comment): the G28 takes the
+        # axis words on a Fanuc control, rs274 refuses "two g codes that both use axis values"
+        (b"(O2201);\nN002 G00 G17 G40 G49 G80 G90;\nN003 G00 G91 G28 Z0.0;\n", "fanuc"),
+        (b"G21\nG0 G30 Z5.\n", "fanuc"),
+        (b"G21\nG1 G28 Z5.\n", "iso"),  # (G1 there the Fanuc interpreter refuses too)
+        (b"G21\nG91 G28 Z0\nG90 G0 X1\n", "iso"),  # (G28 with G91 alone: LinuxCNC's too)
+        (b"G21\nG0 G28.1 Z0\nG0 X1 (G28 G0)\n", "iso"),
+        (b"o100 sub\nG0 G28 Z0\no100 endsub\n", "iso"),
         # macro statements: LinuxCNC's loops and conditions are o-word lines, Sinumerik's take no brackets
         (b"#1=0\nWHILE [#1 LT 3] DO1\nG0 X#1\n#1=#1+1\nEND1\n", "fanuc"),
         (b"#1=0\nWH[#1LT3]DO1\nG0X#1\n#1=#1+1\nEND1\n", "fanuc"),  # WH: WHILE cut to two characters
@@ -274,6 +282,18 @@ def test_g0_in_a_return_block_is_the_modal_motion_after_it(tmp_path):
     check = subprocess.run([sys.executable, str(PATHCHECK), str(twin_in), str(twin_out), "--tol-mm", "0.05"],
                            capture_output=True, text=True, timeout=600)  # fmt: skip
     assert check.returncode == 0, check.stdout + check.stderr
+
+
+def test_a_program_with_g0_in_a_return_block_and_no_number_is_read_as_fanuc(tmp_path):
+    """Without its `O0025` line (a textbook program gives its number in a comment) the `G0 G28` block alone
+    tells a Fanuc program: compensated as with `--dialect fanuc`, where it was read as LinuxCNC's and refused."""
+    text = RETURN_WITH_G0.replace("%\nO0025\n", "(O0025);\n")
+    program, out = tmp_path / "p.nc", tmp_path / "out.nc"
+    program.write_text(text)
+    proc = subprocess.run([sys.executable, "-m", "ncpp", "compensate", "--machine", str(READING), str(program),
+                           "-o", str(out)], capture_output=True, text=True, cwd=ROOT)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    assert out.read_text() == compensated_by_cli(tmp_path, text, "fanuc")[0]
 
 
 def test_g1_in_a_return_block_is_still_refused():
@@ -958,3 +978,48 @@ def test_a_g91_move_before_any_motion_code_right_after_a_cycle_passes_the_rest_o
     written, messages, _ = compensated_by_cli(tmp_path, held, "fanuc")
     assert "a G91 move right after a canned cycle in G90" in messages
     assert written.endswith("G91 X5\nG90 G0 X30 Y10\nM30\n")
+
+
+@pytest.mark.parametrize(
+    "assignment, value",
+    [("#3=[#1 OR #2]", 3.0), ("#3=[#1 AND #2]", 0.0), ("#3=[#1 XOR #2]", 3.0), ("#3=[5.0 AND 3.0]", 1.0),
+     ("#3=[5.7 XOR 3.2]", 6.0), ("#3=[[#1 LT #2] AND [#2 GT 0]]", 1.0)],
+)  # fmt: skip
+def test_haas_logical_operators_work_on_the_bits_of_the_integer_parts(assignment, value):
+    """Haas Mill Operator's Manual 96-8000, "Macros", "Logical Operators": they "work on binary bit values
+    ... only the integer portion of the floating point number is used"; its example `#1=1.0; #2=2.0;
+    #3=#1 OR #2;` leaves 3.0 in #3, where rs274ngc's OR (a truth value) gave 1.0 and the move went to X1.
+    (ncpp reads an assignment's unbracketed right-hand side as arithmetic only: `#3=[#1 OR #2]`.)"""
+    found = events(f"#1=1.0\n#2=2.0\n{assignment}\nG0 X0\nG1 X#3 F100\nM30\n", "haas")
+    assert [e.end[0] for e in found if type(e) is Line] == [0.0, value]
+
+
+def test_a_haas_g_code_of_an_or_is_its_bits():
+    """`G[20 OR ABS[20]]` (a program's first block, the shop's own way of writing G20) is G20 on a Haas,
+    where the truth value 1 made it a G1 move and the program was read in millimetres."""
+    found = events("G[20 OR ABS[20]]\nG0 X1.\nG1 X2. F10.\nM30\n", "haas")
+    assert [(type(e), e.end[0]) for e in found if type(e) is Line] == [(Line, 1.0), (Line, 2.0)]
+    assert [type(e) for e in found][0] is Pass
+
+
+def test_a_fanuc_logical_operation_on_other_values_than_0_and_1_ends_interpretation():
+    """No Fanuc manual in ncpp's reference set says what OR gives of values other than 0 and 1 (Haas's are
+    bitwise): such a block is out of scope, where `G[20 OR 20]` was read as G1 and the block rewritten as a
+    move; of comparisons (0 or 1) the result is the same either way, and followed."""
+    said = io.StringIO()
+    found = events("G0 X1.\nG[20 OR 20]\nG1 X2. F10.\nM30\n", "fanuc", Warnings(stream=said))
+    assert [type(e) for e in found] == [Line, Pass, Pass, Pass], said.getvalue()
+    assert "2:1: warning: 20 OR 20 (a logical operation on values other than 0 and 1" in said.getvalue()
+    found = events("#1=2.\n#2=3.\nIF [[#1 GT 0] AND [#2 GT 2]] GOTO 10\nG0 X9.\nN10 G0 X1.\nM30\n", "fanuc")
+    assert [e.end[0] for e in found if type(e) is Line] == [1.0]
+
+
+def test_a_linuxcnc_or_is_a_truth_value_as_rs274_reads_it(tmp_path):
+    """rs274ngc's OR is 1.0 when either value is not 0: `G1 X[20 OR 20]` moves to X1 (rs274 says so)."""
+    program = "G21 G90\nG0 X0 Y0 Z0\nG1 X[20 OR 20] F100\nM2\n"
+    assert [e.end[0] for e in events(program, "iso") if type(e) is Line] == [0.0, 1.0]
+    if RS274.exists():
+        path = tmp_path / "p.ngc"
+        path.write_text(program)
+        calls = subprocess.run([str(RS274), str(path)], capture_output=True, text=True).stdout
+        assert "STRAIGHT_FEED(1.0000, 0.0000, 0.0000" in calls

@@ -11,16 +11,22 @@ from __future__ import annotations
 
 import io
 import random
+import subprocess
+import sys
 
 import pytest
 
 from ncpp.errors import NcppError, Warnings
 from ncpp.motion import interpret
+from ncpp.motion.canon import canon_call
 from ncpp.motion.segments import FLOW, Line, Pass
+from ncpp.pipeline import dialect_tools
 from ncpp.program.parser import parse_stream
+from tests.conftest import READING, ROOT, SHARED
 from tests.motion.test_oracle import ours, read_canon, rs274, rs274_error, same_calls, write_program
 
 HEAD = "G21 G90 G17\nG0 X0 Y0 Z5 F300\n"
+PATHCHECK = SHARED / "tools" / "pathcheck"
 
 # name: (Fanuc program, the same program for LinuxCNC)
 TWINS = {
@@ -622,3 +628,90 @@ def test_a_control_line_whose_value_ncpp_is_not_told_ends_interpretation_there(p
     )
     assert [type(e) for e in found if type(e) is Line] == [Line]
     assert all(type(e) is Pass for e in found if e.block.line >= line)
+
+
+# A cycle of L0 (no hole: its data kept) and its holes in a subprogram (cncci.com, "Two applications for L0":
+# "sets up the canned cycle but does not drill a hole"; Peter Smid's main program with a subprogram,
+# `G99 G82 R2.5 Z-3.4 P200 F200.0 L0`), which rs274 refuses ("Cannot do zero repeats of cycle"); the twin
+# drills the first hole in the cycle's block, and stands still where the L0 block stands (ncpp gives that
+# block a move of no length, where a step to the programmed point may go before it)
+STORED_CYCLE = (
+    "%\nO0003\n" + HEAD + "G0 X1. Y2.\nG99 G81 R2.5 Z-3.4 F200. L0\nM98 P1002\nG0 X0 Y0\nM30\n%\n"
+    "O1002\nX7. Y7.\nX39.\nY45.\nG98 X7.\nG80\nM99\n%\n",
+    HEAD + "G0 X1 Y2\nG0 X1 Y2\nG99 G81 X7 Y7 R2.5 Z-3.4 F200\nX39\nY45\nG98 X7\nG80\nG0 X0 Y0\nM2\n",
+)
+
+
+def test_a_cycle_of_l0_stores_its_data_for_the_holes_a_subprogram_gives(tmp_path):
+    program = tmp_path / "fanuc.nc"
+    program.write_text(STORED_CYCLE[0])
+    calls, messages = rs274(str(write_program(tmp_path, STORED_CYCLE[1], "twin.ngc")))
+    assert rs274_error(messages) is None, messages
+    reference = read_canon(calls)
+    stream = io.StringIO()
+    interpret_fanuc, _ = dialect_tools("fanuc")
+    blocks = parse_stream(io.BytesIO(STORED_CYCLE[0].encode()), str(program), "fanuc")
+    events = interpret_fanuc(blocks, file=str(program), warnings=Warnings(stream=stream))
+    mine = [call for call in map(canon_call, events) if call is not None]
+    assert not stream.getvalue()
+    assert len(mine) == len(reference) and same_calls(reference, mine), (reference, mine)
+
+
+@pytest.mark.parametrize(
+    "block, said",
+    [("G81 X5. R2.5 Z-3.4 F200. L0", "canned cycle G81 of 0 repeats with a hole position"),
+     ("G98 G87 R-3. Z2. I1. L0", "Fanuc's back boring G87 of 0 repeats")],
+)  # fmt: skip
+def test_a_cycle_of_l0_with_a_hole_position_is_out_of_scope(block, said):
+    """What a Fanuc control does with the X Y of an L0 block is not in ncpp's references: out of scope."""
+    stream = io.StringIO()
+    interpret_fanuc, _ = dialect_tools("fanuc")
+    blocks = parse_stream(io.BytesIO(f"{HEAD}M3 S100\n{block}\nM30\n".encode()), "t.nc", "fanuc")
+    events = list(interpret_fanuc(blocks, file="t.nc", warnings=Warnings(stream=stream)))
+    assert said in stream.getvalue() and type(events[-1]) is Pass
+
+
+def test_l0_is_refused_in_a_linuxcnc_program():
+    with pytest.raises(NcppError, match="Cannot do zero repeats of cycle"):
+        _events(HEAD + "G81 R2.5 Z-3.4 F200 L0\nX7 Y7\nM2\n")
+
+
+def test_a_program_with_a_cycle_of_l0_is_compensated_and_steps_back_before_it(tmp_path):
+    """The subprogram's holes run twice, left as programmed: the step to the programmed point before them
+    comes before the L0 block, in G0, where a G0 between it and the call cancelled the cycle (the
+    verifier refused the written program: "the written path leaves the original's")."""
+    program, out = tmp_path / "p.nc", tmp_path / "out.nc"
+    program.write_text(STORED_CYCLE[0].replace("M98 P1002\n", "M98 P1002\nM98 P1002\n"))
+    proc = subprocess.run([sys.executable, "-m", "ncpp", "compensate", "--machine", str(READING), str(program),
+                           "-o", str(out)], capture_output=True, text=True, cwd=ROOT)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    written = out.read_text()
+    assert "G99 G81 R2.5 Z-3.4 F200. L0\nM98 P1002\n" in written
+    lines = written.splitlines()
+    stored = lines.index("G99 G81 R2.5 Z-3.4 F200. L0")
+    assert lines[stored - 1].startswith(("X", "Y", "Z")), written  # the step, in G0 (the mode before)
+
+
+def test_holes_after_a_cycle_of_l0_in_straight_code_are_compensated(tmp_path):
+    """The holes after the L0 block, in the main program, are compensated hole by hole, without a word of
+    canned cycles left as programmed; judged by rs274 on twins that drill the first hole in the cycle block
+    (pathcheck, 0.02 mm)."""
+    text = "%\nO0004\nG21 G90 G17\nG0 X1. Y2. Z25.\nG98 G81 R2.5 Z-3.4 F200. L0\nX7. Y7.\nX39.\nY45.\nG80\nM30\n%\n"
+    program, out = tmp_path / "p.nc", tmp_path / "out.nc"
+    program.write_text(text)
+    proc = subprocess.run([sys.executable, "-m", "ncpp", "compensate", "--machine", str(READING), str(program),
+                           "-o", str(out)], capture_output=True, text=True, cwd=ROOT)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    assert "warning" not in proc.stderr and "left as programmed: nothing" in proc.stderr, proc.stderr
+    written = out.read_text()
+    if not PATHCHECK.exists():
+        pytest.skip("pathcheck not available")
+    stored = "G98 G81 R2.5 Z-3.4 F200. L0\n"
+    before = tmp_path / "before.ngc"
+    before.write_text(text.replace(stored, "").replace("X7. Y7.\n", "G98 G81 X7. Y7. R2.5 Z-3.4 F200.\n"))
+    head, tail = written.split(stored)
+    after = tmp_path / "after.ngc"
+    after.write_text(head + "G98 G81 F200. " + tail)
+    check = subprocess.run([sys.executable, str(PATHCHECK), str(before), str(after), "--tol-mm", "0.02"],
+                           capture_output=True, text=True, timeout=600)  # fmt: skip
+    assert check.returncode == 0, check.stdout + check.stderr

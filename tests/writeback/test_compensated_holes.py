@@ -386,14 +386,15 @@ def test_fanuc_fine_boring_lands_where_programmed(tmp_path, dialect):
 
 
 def test_a_fanuc_cycle_of_k0_passes_through(tmp_path):
-    """K0 stores the cycle's data and drills no hole (the repeats' count 0): the program passes
-    through from there, with a warning, where rs274ngc's reading refused the K."""
+    """K0 stores the cycle's data and drills no hole (the repeats' count 0); where the block gives a hole
+    position too (what the control does with it is not in ncpp's references) the program passes through
+    from there, with a warning, where rs274ngc's reading refused the K.  (Without one: test_fanuc_macro.py.)"""
     original = tmp_path / "k0.nc"
     original.write_text("%\nG21 G90 G17\nG0 X40 Y30 Z25\nG99 G81 X20 Y30 Z-3 R2 K0 F100\nX30\nG80\nM30\n%\n")
     said = io.StringIO()
     output = compensate_file(original, MACHINE, tmp_path, warnings=Warnings(stream=said), dialect="fanuc")
     assert output.read_text().endswith("G99 G81 X20 Y30 Z-3 R2 K0 F100\nX30\nG80\nM30\n%\n")
-    assert "k0.nc:4:24: warning: a canned cycle with K0" in said.getvalue()
+    assert "k0.nc:4:9: warning: canned cycle G81 of 0 repeats with a hole position" in said.getvalue()
 
 
 # Taps in G18 and G19 (Fanuc: the drilling axis is the plane's normal for every cycle), G90 and G91

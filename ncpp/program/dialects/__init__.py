@@ -215,6 +215,11 @@ _FANUC = re.compile(
 
 
 _G80 = re.compile(r"(?<![\w#.])G0*80(?![\d.])", re.I)
+# G00 in the block of a G28 or G30 (`G00 G91 G28 Z0`, as posts write it): the Fanuc interpreter reads it
+# (`FanucInterpreter`), rs274ngc refuses the block ("Cannot use two g codes that both use axis values")
+_RETURN_WITH_G0 = re.compile(
+    r"^(?=[^\n]*(?<![\w#.])G0*0(?![\d.]))[^\n]*(?<![\w#.])G0*(28|30)(?![\d.])", re.M | re.I
+)
 _MOTION_CODE = re.compile(r"(?<![\w#.])G0*([0-3]|7[346]|8[1-9])(?![\d.])", re.I)
 _AXIS_FIRST = re.compile(r"^[ \t]*(N\d+[ \t]*)?[XYZ][ \t]*[-+.\d]", re.I)
 
@@ -247,7 +252,7 @@ def detect(first_bytes: bytes, name: str | None = None) -> str:
     do its local subprogram call `M97 P..` and circular pocket milling `G12`/`G13` with a Q
     (unless LinuxCNC's o-word lines are there),
     and a Fanuc program number line, G65, #3000, G05.1 Q, G08 P, a macro `WHILE [..] DOn` or
-    `IF [..] GOTOn / THEN`, or axis words after a G80 with no motion code mean Fanuc (unless LinuxCNC's o-word lines are there); any other is LinuxCNC's ISO.
+    `IF [..] GOTOn / THEN`, G00 in a G28 or G30 block, or axis words after a G80 with no motion code mean Fanuc (unless LinuxCNC's o-word lines are there); any other is LinuxCNC's ISO.
     """
     text = first_bytes.decode("latin-1")
     if _HEIDENHAIN.search(text) or len(_HEIDENHAIN_BLOCK.findall(text)) >= 2:
@@ -264,7 +269,8 @@ def detect(first_bytes: bytes, name: str | None = None) -> str:
     haas_only = _HAAS_CALL.search(code) or _HAAS_POCKET.search(code)
     if _HAAS.search(code) or (haas_only and not _LINUXCNC.search(code)):
         return "haas"
-    if (_FANUC.search(code) or _axes_after_g80(code)) and not _LINUXCNC.search(code):
+    fanuc_only = _FANUC.search(code) or _RETURN_WITH_G0.search(code) or _axes_after_g80(code)
+    if fanuc_only and not _LINUXCNC.search(code):
         return "fanuc"
     return "iso"
 
