@@ -22,6 +22,9 @@ from ncpp.motion.segments import PLANE_AXES, Arc, Line, Point
 Flat = tuple[float, float]  # a point or a direction in the plane's own axes (u, v)
 # program units: offsets closer than this meet without a corner (the rounding of a written number)
 SMOOTH = 1e-7
+# radians: how far from straight on, or from a half turn, rs274ngc tells corners apart by the turn alone
+# (its TOLERANCE_CONCAVE_CORNER), so that rounding and corrections do not turn a cusp's corner over
+TURNED = 0.05
 
 
 @dataclass(frozen=True)
@@ -90,8 +93,10 @@ class CentrePath:
         before = _plus(move.start, at_start)
         tangent = _tangent(move, a, b)
         previous = last[0] if before_is_last and last is not None and last[1] == plane else None
-        if _outside(gap, tangent, move, previous, a, b):
-            turn = _corner_turn((at_start[a], at_start[b]), (own[a], own[b]), tangent)
+        if _outside((at_start[a], at_start[b]), (own[a], own[b]), tangent, move, previous, a, b):
+            turn = (
+                -1 if _on_the_left(tangent, (own[a], own[b])) else 1
+            )  # (round the corner, away from the tool)
             return OnCentre(start, end, Corner(before, start, move.start, turn))
         if previous is None:
             return OnCentre(start, end)
@@ -103,21 +108,36 @@ class CentrePath:
         return OnCentre((met[0], met[1], met[2]), end, cut_back=(met[0], met[1], met[2]))
 
 
-def _outside(gap: Flat, tangent: Flat, move: Line | Arc, previous: _Offset | None, a: int, b: int) -> bool:
-    """Whether the corner before `move` is an outside one: its offset starts ahead of the one the
-    move before left (`gap`: the first minus the second) along the move's direction (`tangent`).
-    Where the move turns right back (a cusp), by which way the moves bend from the corner: towards
-    the offsets' parting, an inside one; two lines turned right back, an outside one."""
-    along = gap[0] * tangent[0] + gap[1] * tangent[1]
-    if abs(along) > 1e-9 * math.hypot(*gap):
-        return along > 0.0
-    if type(move) is Arc:  # (it bends towards its centre)
-        return gap[0] * (move.center[a] - move.start[a]) + gap[1] * (move.center[b] - move.start[b]) > 0.0
-    if previous is not None and previous.radius is not None:  # (as seen running the other way)
-        corner = (move.start[a], move.start[b])
-        towards = (previous.point[0] - corner[0], previous.point[1] - corner[1])
-        return gap[0] * towards[0] + gap[1] * towards[1] < 0.0
-    return True
+def _outside(before: Flat, own: Flat, tangent: Flat, move: Line | Arc, previous: _Offset | None, a: int,
+             b: int) -> bool:  # fmt: skip
+    """Whether the corner before `move` is an outside one (`before`: the offset the move before left,
+    `own`: the move's own offset at its start, `tangent`: its direction there), as rs274ngc tells
+    it (convert_straight_comp2, convert_arc_comp2): by the angle the path turns away from the tool's
+    side, an inside corner where it turns towards it by more than TURNED, or away by more than a
+    half turn and TURNED; near a half turn (a cusp, within TURNED) an inside one where the tool runs
+    outside the arc the path turns back along (the move's, or the one before a line), else an outside
+    one.  Nearer straight on, by where the offsets part: the move's own ahead of the one before."""
+    left = _on_the_left(tangent, own)
+    came = (before[1], -before[0]) if left else (-before[1], before[0])  # the move before's direction
+    turned = math.atan2(
+        came[0] * tangent[1] - came[1] * tangent[0], came[0] * tangent[0] + came[1] * tangent[1]
+    )
+    away = -turned if left else turned
+    away = away + 2 * math.pi if away < -math.pi / 2 else away  # (rs274's range: -90 to 270 degrees)
+    if away < -TURNED or away > math.pi + TURNED:
+        return False
+    if away > math.pi - TURNED:
+        if type(move) is Arc:  # (the tool inside it: it bends towards its centre)
+            return own[0] * (move.center[a] - move.start[a]) + own[1] * (move.center[b] - move.start[b]) > 0.0
+        if previous is not None and previous.radius is not None:
+            corner = (move.start[a], move.start[b])
+            return (
+                before[0] * (previous.point[0] - corner[0]) + before[1] * (previous.point[1] - corner[1])
+                > 0.0
+            )
+        return True
+    gap = (own[0] - before[0], own[1] - before[1])
+    return gap[0] * tangent[0] + gap[1] * tangent[1] > 0.0
 
 
 def _plus(p: Point, q: Point) -> Point:
@@ -156,13 +176,9 @@ def _tangent(move: Line | Arc, a: int, b: int, at_end: bool = False) -> Flat:
     return (u / n, v / n)
 
 
-def _corner_turn(before: Flat, after: Flat, tangent: Flat) -> int:
-    """The way an outside corner's arc turns from one offset to the other: the short way round,
-    and at a reversal (the offsets opposite) forward, against the next move's direction."""
-    cross = before[0] * after[1] - before[1] * after[0]
-    if abs(cross) <= 1e-9 * (before[0] ** 2 + before[1] ** 2):
-        cross = -(before[0] * tangent[1] - before[1] * tangent[0])
-    return 1 if cross > 0 else -1
+def _on_the_left(tangent: Flat, offset: Flat) -> bool:
+    """Whether the tool centre stands left of the move (its `offset` from the programmed point)."""
+    return tangent[0] * offset[1] - tangent[1] * offset[0] > 0.0
 
 
 def _offset(move: Line | Arc, end: Point, a: int, b: int) -> _Offset:
