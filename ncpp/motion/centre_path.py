@@ -22,8 +22,8 @@ from ncpp.motion.segments import PLANE_AXES, Arc, Line, Point
 Flat = tuple[float, float]  # a point or a direction in the plane's own axes (u, v)
 # program units: offsets closer than this meet without a corner (the rounding of a written number)
 SMOOTH = 1e-7
-# radians: how far from straight on, or from a half turn, rs274ngc tells corners apart by the turn alone
-# (its TOLERANCE_CONCAVE_CORNER), so that rounding and corrections do not turn a cusp's corner over
+# radians: within this of straight on the control makes no corner, and within it of a half turn tells an
+# outside corner from an inside one by the arc turned back along (rs274ngc's TOLERANCE_CONCAVE_CORNER)
 TURNED = 0.05
 
 
@@ -92,8 +92,11 @@ class CentrePath:
             return OnCentre(start, end)
         before = _plus(move.start, at_start)
         tangent = _tangent(move, a, b)
+        away = _turned_away((at_start[a], at_start[b]), (own[a], own[b]), tangent)
+        if abs(away) <= TURNED:  # (near straight on, no corner: the move starts where the tool stands)
+            return OnCentre(before, end)
         previous = last[0] if before_is_last and last is not None and last[1] == plane else None
-        if _outside((at_start[a], at_start[b]), (own[a], own[b]), tangent, move, previous, a, b):
+        if _outside(away, (at_start[a], at_start[b]), (own[a], own[b]), move, previous, a, b):
             turn = (
                 -1 if _on_the_left(tangent, (own[a], own[b])) else 1
             )  # (round the corner, away from the tool)
@@ -108,22 +111,27 @@ class CentrePath:
         return OnCentre((met[0], met[1], met[2]), end, cut_back=(met[0], met[1], met[2]))
 
 
-def _outside(before: Flat, own: Flat, tangent: Flat, move: Line | Arc, previous: _Offset | None, a: int,
-             b: int) -> bool:  # fmt: skip
-    """Whether the corner before `move` is an outside one (`before`: the offset the move before left,
-    `own`: the move's own offset at its start, `tangent`: its direction there), as rs274ngc tells
-    it (convert_straight_comp2, convert_arc_comp2): by the angle the path turns away from the tool's
-    side, an inside corner where it turns towards it by more than TURNED, or away by more than a
-    half turn and TURNED; near a half turn (a cusp, within TURNED) an inside one where the tool runs
-    outside the arc the path turns back along (the move's, or the one before a line), else an outside
-    one.  Nearer straight on, by where the offsets part: the move's own ahead of the one before."""
+def _turned_away(before: Flat, own: Flat, tangent: Flat) -> float:
+    """The angle the path turns away from the tool's side at the corner before a move (radians,
+    -90 to 270 degrees, as rs274ngc's convert_straight_comp2 and convert_arc_comp2 measure it):
+    `before` the offset the move before left, `own` the move's own offset at its start,
+    `tangent` its direction there."""
     left = _on_the_left(tangent, own)
     came = (before[1], -before[0]) if left else (-before[1], before[0])  # the move before's direction
     turned = math.atan2(
         came[0] * tangent[1] - came[1] * tangent[0], came[0] * tangent[0] + came[1] * tangent[1]
     )
     away = -turned if left else turned
-    away = away + 2 * math.pi if away < -math.pi / 2 else away  # (rs274's range: -90 to 270 degrees)
+    return away + 2 * math.pi if away < -math.pi / 2 else away
+
+
+def _outside(away: float, before: Flat, own: Flat, move: Line | Arc, previous: _Offset | None, a: int,
+             b: int) -> bool:  # fmt: skip
+    """Whether the corner before `move` is an outside one, as rs274ngc tells it from the angle the
+    path turns `away` from the tool's side (more than TURNED: `_turned_away`): an inside one where
+    it turns towards the tool, or away by more than a half turn and TURNED; within TURNED of a half
+    turn (a cusp) an inside one where the tool runs outside the arc the path turns back along (the
+    move's, or for a line the one before), else an outside one."""
     if away < -TURNED or away > math.pi + TURNED:
         return False
     if away > math.pi - TURNED:
@@ -135,9 +143,7 @@ def _outside(before: Flat, own: Flat, tangent: Flat, move: Line | Arc, previous:
                 before[0] * (previous.point[0] - corner[0]) + before[1] * (previous.point[1] - corner[1])
                 > 0.0
             )
-        return True
-    gap = (own[0] - before[0], own[1] - before[1])
-    return gap[0] * tangent[0] + gap[1] * tangent[1] > 0.0
+    return True
 
 
 def _plus(p: Point, q: Point) -> Point:
