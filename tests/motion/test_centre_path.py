@@ -111,6 +111,23 @@ X-10
 G40 G1 X-20 Y30
 M2
 """
+# Lines turned by 30 mrad either way, where rs274ngc makes no corner, then by 100 mrad, where it does
+NEARLY_STRAIGHT = """G21 G90 G17 G94
+G0 X-10 Y-10 Z5
+G1 Z-1 F200
+G41.1 D4
+G1 X0 Y0
+X20
+X40 Y0.6
+X60 Y0.6
+X80 Y2.6
+Y20
+X0
+G40 G1 X-10 Y25
+M2
+"""
+CONTOURS["nearly-straight-left"] = NEARLY_STRAIGHT
+CONTOURS["nearly-straight-right"] = NEARLY_STRAIGHT.replace("G41.1", "G42.1")
 CONTOURS["reversals-left"] = REVERSALS
 CONTOURS["reversals-right"] = REVERSALS.replace("G41.1", "G42.1")
 
