@@ -22,6 +22,9 @@ from ncpp.motion.segments import PLANE_AXES, Arc, Line, Point
 Flat = tuple[float, float]  # a point or a direction in the plane's own axes (u, v)
 # program units: offsets closer than this meet without a corner (the rounding of a written number)
 SMOOTH = 1e-7
+# radians: within this of straight on the control makes no corner, and within it of a half turn tells an
+# outside corner from an inside one by the arc turned back along (rs274ngc's TOLERANCE_CONCAVE_CORNER)
+TURNED = 0.05
 
 
 @dataclass(frozen=True)
@@ -89,9 +92,14 @@ class CentrePath:
             return OnCentre(start, end)
         before = _plus(move.start, at_start)
         tangent = _tangent(move, a, b)
+        away = _turned_away((at_start[a], at_start[b]), (own[a], own[b]), tangent)
+        if abs(away) <= TURNED:  # (near straight on, no corner: the move starts where the tool stands)
+            return OnCentre(before, end)
         previous = last[0] if before_is_last and last is not None and last[1] == plane else None
-        if _outside(gap, tangent, move, previous, a, b):
-            turn = _corner_turn((at_start[a], at_start[b]), (own[a], own[b]), tangent)
+        if _outside(away, (at_start[a], at_start[b]), (own[a], own[b]), move, previous, a, b):
+            turn = (
+                -1 if _on_the_left(tangent, (own[a], own[b])) else 1
+            )  # (round the corner, away from the tool)
             return OnCentre(start, end, Corner(before, start, move.start, turn))
         if previous is None:
             return OnCentre(start, end)
@@ -103,20 +111,38 @@ class CentrePath:
         return OnCentre((met[0], met[1], met[2]), end, cut_back=(met[0], met[1], met[2]))
 
 
-def _outside(gap: Flat, tangent: Flat, move: Line | Arc, previous: _Offset | None, a: int, b: int) -> bool:
-    """Whether the corner before `move` is an outside one: its offset starts ahead of the one the
-    move before left (`gap`: the first minus the second) along the move's direction (`tangent`).
-    Where the move turns right back (a cusp), by which way the moves bend from the corner: towards
-    the offsets' parting, an inside one; two lines turned right back, an outside one."""
-    along = gap[0] * tangent[0] + gap[1] * tangent[1]
-    if abs(along) > 1e-9 * math.hypot(*gap):
-        return along > 0.0
-    if type(move) is Arc:  # (it bends towards its centre)
-        return gap[0] * (move.center[a] - move.start[a]) + gap[1] * (move.center[b] - move.start[b]) > 0.0
-    if previous is not None and previous.radius is not None:  # (as seen running the other way)
-        corner = (move.start[a], move.start[b])
-        towards = (previous.point[0] - corner[0], previous.point[1] - corner[1])
-        return gap[0] * towards[0] + gap[1] * towards[1] < 0.0
+def _turned_away(before: Flat, own: Flat, tangent: Flat) -> float:
+    """The angle the path turns away from the tool's side at the corner before a move (radians,
+    -90 to 270 degrees, as rs274ngc's convert_straight_comp2 and convert_arc_comp2 measure it):
+    `before` the offset the move before left, `own` the move's own offset at its start,
+    `tangent` its direction there."""
+    left = _on_the_left(tangent, own)
+    came = (before[1], -before[0]) if left else (-before[1], before[0])  # the move before's direction
+    turned = math.atan2(
+        came[0] * tangent[1] - came[1] * tangent[0], came[0] * tangent[0] + came[1] * tangent[1]
+    )
+    away = -turned if left else turned
+    return away + 2 * math.pi if away < -math.pi / 2 else away
+
+
+def _outside(away: float, before: Flat, own: Flat, move: Line | Arc, previous: _Offset | None, a: int,
+             b: int) -> bool:  # fmt: skip
+    """Whether the corner before `move` is an outside one, as rs274ngc tells it from the angle the
+    path turns `away` from the tool's side (more than TURNED: `_turned_away`): an inside one where
+    it turns towards the tool, or away by more than a half turn and TURNED; within TURNED of a half
+    turn (a cusp) an inside one where the tool runs outside the arc the path turns back along (the
+    move's, or for a line the one before), else an outside one."""
+    if away < -TURNED or away > math.pi + TURNED:
+        return False
+    if away > math.pi - TURNED:
+        if type(move) is Arc:  # (the tool inside it: it bends towards its centre)
+            return own[0] * (move.center[a] - move.start[a]) + own[1] * (move.center[b] - move.start[b]) > 0.0
+        if previous is not None and previous.radius is not None:
+            corner = (move.start[a], move.start[b])
+            return (
+                before[0] * (previous.point[0] - corner[0]) + before[1] * (previous.point[1] - corner[1])
+                > 0.0
+            )
     return True
 
 
@@ -156,13 +182,9 @@ def _tangent(move: Line | Arc, a: int, b: int, at_end: bool = False) -> Flat:
     return (u / n, v / n)
 
 
-def _corner_turn(before: Flat, after: Flat, tangent: Flat) -> int:
-    """The way an outside corner's arc turns from one offset to the other: the short way round,
-    and at a reversal (the offsets opposite) forward, against the next move's direction."""
-    cross = before[0] * after[1] - before[1] * after[0]
-    if abs(cross) <= 1e-9 * (before[0] ** 2 + before[1] ** 2):
-        cross = -(before[0] * tangent[1] - before[1] * tangent[0])
-    return 1 if cross > 0 else -1
+def _on_the_left(tangent: Flat, offset: Flat) -> bool:
+    """Whether the tool centre stands left of the move (its `offset` from the programmed point)."""
+    return tangent[0] * offset[1] - tangent[1] * offset[0] > 0.0
 
 
 def _offset(move: Line | Arc, end: Point, a: int, b: int) -> _Offset:

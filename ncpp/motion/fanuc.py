@@ -117,12 +117,14 @@ SINUMERIK 802D sl/840D ISO Milling programming manual 04.07, which documents Fan
 "Programmable mirror image"): the axis words of G51.1 give the "position and axis of symmetry" of each
 axis it mirrors, those of G50.1 the axes it cancels; the blocks between "describe the contour" that is
 mirrored, so each move goes where the control mirrors the program's point to and an increment (G91)
-runs the other way; G51.1 and G50.1 move nothing (the machine stays where it is).  Mirrored in one axis of the plane alone, "G02 and G03 are interchanged" (and G41 and G42, and
-the direction of a rotation).  What the manual forbids in its mode is out of scope: reference position
-returns (G27, G28, G30) and the coordinate system codes (G52-G59, G92; G53 and G10 with them), and "G50.1
-or G51.1 during scaling or coordinate rotation mode"; so are G68 in its mode, another plane, Z or another
-axis mirrored, a G51.1 in G91 or while a mirror image is in effect, cutter compensation and canned cycles
-(ncpp follows neither under it).  A G50.1 whose axis words ncpp is not mirroring cancels nothing: its
+runs the other way; G51.1 and G50.1 move nothing (the machine stays where it is).  Mirrored in one axis
+of the plane alone, "G02 and G03 are interchanged", and "G41 and G42 are interchanged" (the tool centre
+the control offsets the mirrored contour to: `Interpreter._on_the_left`), and the direction of a
+rotation.  What the manual forbids in its mode is out of scope: reference position returns (G27, G28,
+G30) and the coordinate system codes (G52-G59, G92; G53 and G10 with them), and "G50.1 or G51.1 during
+scaling or coordinate rotation mode"; so are G68 in its mode, another plane, Z or another axis
+mirrored, a G51.1 in G91 or while a mirror image is in effect, G51.1 or G50.1 under cutter compensation,
+and canned cycles (ncpp does not follow them under it).  A G50.1 whose axis words ncpp is not mirroring cancels nothing: its
 words are no move.  Haas's mirror image is G100/G101 (Haas Mill Operator's Manual, G code list): G51.1
 ends interpretation by name there.
 
@@ -278,9 +280,9 @@ UNFOLLOWED_FRAMES = {51.0: "scaling", 51.1: "mirroring", 68.1: "coordinate rotat
 # What is out of scope under G51.1 (SINUMERIK 802D sl/840D ISO Milling programming manual, 3.2 "Programmable
 # mirror image", Limitations: "Do not use G codes related to reference position return (G27,G28,G30), or
 # commands related to the coordinate system (G52 to G59,G92, etc.) in programmable mirror image mode"), and
-# what ncpp does not follow there: another plane, G53 and G10, G68, cutter compensation
-NOT_UNDER_G51_1 = frozenset((18.0, 19.0, 10.0, 27.0, 28.0, 29.0, 30.0, 41.0, 42.0, 52.0, 53.0, 54.0, 55.0,
-                             56.0, 57.0, 58.0, 59.0, 54.1, 68.0, 92.0, 92.1))  # fmt: skip
+# what ncpp does not follow there: another plane, G53 and G10, G68
+NOT_UNDER_G51_1 = frozenset((18.0, 19.0, 10.0, 27.0, 28.0, 29.0, 30.0, 52.0, 53.0, 54.0, 55.0, 56.0, 57.0,
+                             58.0, 59.0, 54.1, 68.0, 92.0, 92.1))  # fmt: skip
 # The words of a G51.1 or G50.1 block ncpp follows: N, G90 or G91, and the axes it names
 MIRROR_LETTERS = frozenset("NGXYZ")
 

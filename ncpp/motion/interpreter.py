@@ -857,7 +857,14 @@ class Interpreter:
         if self.cutter_comp is None:
             return None
         radius = self.comp_radius or 0.0
-        return radius if self.cutter_comp in (41.0, 41.1) else -radius
+        return radius if self._on_the_left() else -radius
+
+    def _on_the_left(self) -> bool:
+        """Whether the tool runs left of the contour as the control moves it: G41 (G41.1), but for G42
+        under a mirror image of one axis of the plane, which interchanges G41 and G42 as it does G02
+        and G03 (SINUMERIK 802D sl/840D ISO Milling programming manual, 3.2 "Programmable mirror image",
+        table 3-6)."""
+        return (self.cutter_comp in (41.0, 41.1)) != (self._context or self.context()).reverses
 
     def _check_radius(self, moves: list, block: Block, radius: float) -> None:
         """rs274ngc's checks of moves under compensation against the tool radius: the entry move
@@ -873,7 +880,7 @@ class Interpreter:
         ):
             what = ENTRY_ARC_TOO_SHORT if type(first) is Arc else ENTRY_TOO_SHORT
             self._fail(what, block, item)
-        left = self.cutter_comp in (41.0, 41.1)
+        left = self._on_the_left()
         for arc in moves:
             if type(arc) is Arc and (arc.turn > 0) == left:
                 if math.hypot(arc.start[a] - arc.center[a], arc.start[b] - arc.center[b]) <= radius:

@@ -78,17 +78,70 @@ M2
 """,
 }
 CONTOURS["right"] = CONTOURS["lines-and-arcs"].replace("G41.1", "G42.1")
+# An arc turned three quarters round that ends turning right back along the line after it: with the
+# tool inside the arc an outside corner, gone round away from the tool; outside it (the "h" shape
+# rs274ngc names) an inside one, cut back; the same tilted either way by 0.04 mrad and by 10 mrad, which
+# rs274ngc tells apart from a half turn only beyond its 50 mrad
+CUSP = """G21 G90 G17 G94
+G0 X0 Y-10 Z5
+G1 Z-1 F200
+G42.1 D4
+G1 X0 Y0
+X20
+G2 X26 Y6 I0 J6
+G1 X26 Y30
+X0
+G40 G1 X-10 Y30
+M2
+"""
+for side in ("G42.1", "G41.1"):
+    for tilt in ("26", "25.999", "26.001", "25.76", "26.24"):
+        CONTOURS[f"cusp-{side}-{tilt}"] = CUSP.replace("G42.1", side).replace("X26 Y30", f"X{tilt} Y30")
+# Lines turned back by a half turn less and more 10 mrad, on either side
+REVERSALS = """G21 G90 G17 G94
+G0 X-10 Y-10 Z5
+G1 Z-1 F200
+G41.1 D4
+G1 X0 Y0
+X30
+X0 Y0.3
+Y20
+X30 Y19.7
+X-10
+G40 G1 X-20 Y30
+M2
+"""
+# Lines turned by 30 mrad either way, where rs274ngc makes no corner, then by 100 mrad, where it does
+NEARLY_STRAIGHT = """G21 G90 G17 G94
+G0 X-10 Y-10 Z5
+G1 Z-1 F200
+G41.1 D4
+G1 X0 Y0
+X20
+X40 Y0.6
+X60 Y0.6
+X80 Y2.6
+Y20
+X0
+G40 G1 X-10 Y25
+M2
+"""
+CONTOURS["nearly-straight-left"] = NEARLY_STRAIGHT
+CONTOURS["nearly-straight-right"] = NEARLY_STRAIGHT.replace("G41.1", "G42.1")
+CONTOURS["reversals-left"] = REVERSALS
+CONTOURS["reversals-right"] = REVERSALS.replace("G41.1", "G42.1")
 
 
 def centre_path(text: str) -> list[tuple[str, tuple[float, float, float]]]:
-    """Each move's kind (L: straight, A: arc) and end where the tool centre runs, in order: a
-    corner's arc before its move, a move cut back at an inside corner ending where it is cut."""
+    """Each move's kind (L: straight, A+ and A-: an arc counter-clockwise and clockwise in its plane)
+    and end where the tool centre runs, in order: a corner's arc before its move, a move cut back at an
+    inside corner ending where it is cut."""
     blocks = parse_stream(io.BytesIO(text.encode()), "contour.ngc", "iso")
     path, moves = CentrePath(), []
     for event in interpret(blocks, file="contour.ngc", warnings=Warnings(stream=io.StringIO())):
         if type(event) is not Line and type(event) is not Arc:
             continue
-        kind = "A" if type(event) is Arc else "L"
+        kind = ("A+" if event.turn > 0 else "A-") if type(event) is Arc else "L"
         if event.centre_shift is None:
             moves.append((kind, event.end))
             continue
@@ -96,7 +149,7 @@ def centre_path(text: str) -> list[tuple[str, tuple[float, float, float]]]:
         if on.cut_back is not None:
             moves[-1] = (moves[-1][0], on.cut_back)
         if on.corner is not None:
-            moves.append(("A", on.corner.end))
+            moves.append(("A+" if on.corner.turn > 0 else "A-", on.corner.end))
         moves.append((kind, on.end))
     return moves
 
@@ -104,7 +157,9 @@ def centre_path(text: str) -> list[tuple[str, tuple[float, float, float]]]:
 def rs274_path(text: str) -> list[tuple[str, tuple[float, float, float]]]:
     calls = oracle.canon(text, digits=7)
     kinds = [
-        "A" if name == "ARC_FEED" else "L" for name, _ in oracle.CALL.findall(calls) if name != "SELECT_PLANE"
+        ("A+" if float(args.split(",")[4]) > 0 else "A-") if name == "ARC_FEED" else "L"
+        for name, args in oracle.CALL.findall(calls)
+        if name != "SELECT_PLANE"
     ]
     return list(zip(kinds, oracle.end_points(calls)))
 
@@ -124,5 +179,5 @@ def test_an_outside_corner_is_an_arc_about_it_and_an_inside_one_cut_back():
     path = centre_path(CONTOURS["lines-and-arcs"])
     ends = [(kind, tuple(round(v, 9) for v in end)) for kind, end in path[2:6]]
     half = round(math.sqrt(2), 9)
-    assert ends == [("L", (-half, half, -1.0)), ("A", (0.0, 2.0, -1.0)), ("L", (38.0, 2.0, -1.0)),
+    assert ends == [("L", (-half, half, -1.0)), ("A-", (0.0, 2.0, -1.0)), ("L", (38.0, 2.0, -1.0)),
                     ("L", (38.0, 8.0, -1.0))]  # fmt: skip
