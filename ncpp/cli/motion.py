@@ -35,10 +35,14 @@ zero, rs274's default parameter file), and `--tool-table` from its tool
 table (`rs274 -t`).  Heidenhain and Sinumerik programs print the same records (`--dialect`, or
 detected from the content).
 
-Under cutter compensation (G41/G42 or RL/RR, to the first move after G40 or R0) the moves
-printed are the programmed contour; rs274 prints the tool centre, offset by the
-radius from it.  A warning names the line where each such series starts
-(`--strict` refuses it).
+Under cutter compensation (G41/G42 or RL/RR, to the first move after G40 or R0) that ncpp
+follows (the radius known: G41.1/G42.1's D, or the `--tool-table`'s; see the guide) `--format
+rs274` prints where the tool centre runs, as rs274 does: each move offset by the radius, an arc
+about an outside corner, moves cut back to where they cross at an inside one (an entry arc, which
+rs274 bends to a centre of its own, keeps its programmed centre).  Where ncpp does not follow it (the
+radius unknown, the moves of a loop or a cycle), and in `--format json`, the moves are the programmed
+contour, the JSON records with where the tool centre stands off their ends ("centre_shift"); a
+warning names the line where each such series starts (`--strict` refuses it).
 """
 
 from __future__ import annotations
@@ -89,6 +93,7 @@ def run(args: argparse.Namespace) -> int:
 
     from ncpp.cli.io import open_input
     from ncpp.motion.canon import format_event
+    from ncpp.motion.centre_path import on_centre
 
     warnings = Warnings(strict=args.strict)
     offsets = (
@@ -99,11 +104,16 @@ def run(args: argparse.Namespace) -> int:
     out = sys.stdout
     with open_input(args.input) as (stream, name):
         _, events = interpreted(stream, name, args.dialect, warnings, offsets)
+        if (
+            args.format == "rs274"
+        ):  # (where compensation follows cutter compensation: the tool centre's moves)
+            events = on_centre(events)
         for event in warn_off_path(
             events,
             warnings,
             name,
             "printed as programmed (rs274 prints the tool centre, offset by the radius)",
+            followed=args.format == "rs274",
         ):
             if type(event) is not Line and type(event) is not Arc:
                 continue
@@ -147,17 +157,25 @@ def run(args: argparse.Namespace) -> int:
 
 
 def warn_off_path(
-    events: Iterable[Event], warnings: Warnings, file: str, consequence: str
+    events: Iterable[Event], warnings: Warnings, file: str, consequence: str, followed: bool = False
 ) -> Iterator[Event]:
     """Pass events through; warn where a series of moves under cutter compensation starts
-    (`COMP`: the tool centre is off the programmed contour), saying `consequence`."""
+    (`COMP`: the tool centre is off the programmed contour), saying `consequence`; `followed`: but
+    for the moves whose tool centre is followed (`centre_shift`), which are given where it runs."""
     off = False
     for event in events:
-        if (type(event) is Line or type(event) is Arc) and (
-            event.fixed == COMP or event.centre_shift is not None
-        ) != off:
+        if (type(event) is Line or type(event) is Arc) and _off_path(event, followed) != off:
             off = not off
             if off:
                 warnings.warn(f"cutter compensation: up to the first move after it is off (G40, R0) the tool centre is off the programmed contour; its moves are {consequence}",
                               Location(file, event.block.line, 1))  # fmt: skip
         yield event
+
+
+def _off_path(move: Line | Arc, followed: bool) -> bool:
+    """Whether a move is under cutter compensation and given as programmed: left so (`COMP`), or
+    followed (`centre_shift`) but not `followed` here, or with its radius unknown (no shift at all)."""
+    shift = move.centre_shift
+    if shift is None:
+        return move.fixed == COMP
+    return not followed or not (any(shift[1]) or any(shift[0] or ()))

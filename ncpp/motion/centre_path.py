@@ -15,9 +15,10 @@ centre by up to twice the radius) is told apart.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from collections.abc import Iterable, Iterator
+from dataclasses import dataclass, replace
 
-from ncpp.motion.segments import PLANE_AXES, Arc, Line, Point
+from ncpp.motion.segments import PLANE_AXES, Arc, Event, Line, Point
 
 Flat = tuple[float, float]  # a point or a direction in the plane's own axes (u, v)
 # program units: offsets closer than this meet without a corner (the rounding of a written number)
@@ -109,6 +110,39 @@ class CentrePath:
         met = list(start)
         met[a], met[b] = crossing
         return OnCentre((met[0], met[1], met[2]), end, cut_back=(met[0], met[1], met[2]))
+
+
+def on_centre(events: Iterable[Event]) -> Iterator[Event]:
+    """The events with each move that compensation follows under cutter compensation (its
+    `centre_shift` set) where the tool centre runs, as rs274 prints it: from where the tool stands to
+    its tool-centre end, an outside corner's arc before it, the move before cut back to an inside
+    corner (held, with the events after it, until the next move tells)."""
+    path = CentrePath()
+    move: Line | Arc | None = None  # the last move on the path, held until the next move tells where it ends
+    after: list[Event] = []  # the events since it
+    for event in events:
+        if type(event) is not Line and type(event) is not Arc:
+            if move is None:
+                yield event
+            else:
+                after.append(event)
+            continue
+        on = path.along(event, move is not None) if event.centre_shift is not None else None
+        if move is not None:
+            yield move if on is None or on.cut_back is None else replace(move, end=on.cut_back)
+            yield from after
+            move, after = None, []
+        if on is None:
+            yield event
+            continue
+        if on.corner is not None:
+            corner = on.corner
+            yield Arc(corner.start, corner.end, corner.centre, corner.turn, event.feed, event.block, event.context,
+                      event.extra)  # fmt: skip
+        move = replace(event, start=on.start, end=on.end)
+    if move is not None:
+        yield move
+        yield from after
 
 
 def _turned_away(before: Flat, own: Flat, tangent: Flat) -> float:

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import io
 import math
+import re
 
 import pytest
 
@@ -91,6 +92,28 @@ def test_after_g40_the_position_is_the_programs():
     tool centre: `G1 X30` after the contour's `G1 Y30` ends at (30, 30)."""
     exit_move = moves(events_of(CONTOUR))[6]
     assert exit_move.end[:2] == (30.0, 30.0)
+
+
+@needs_rs274
+@pytest.mark.parametrize("name", ["contour", "comp.ngc"])
+def test_ncpp_motion_prints_the_tool_centre_as_rs274_does(tmp_path, corpus, name):
+    """Under cutter compensation ncpp follows, `ncpp motion` prints rs274's canonical calls of the tool
+    centre, line for line: the corpus's comp.ngc (G41/G42 D1 of a tool table, inch; G17 and G18) and a
+    G41.1 contour."""
+    import subprocess
+    import sys
+
+    from tests.conftest import CORPUS
+    from tests.verify.test_corpus_pathcheck import tool_table
+
+    table = tool_table(tmp_path)
+    path = CORPUS / "iso_gcode/linuxcnc/comp.ngc" if name == "comp.ngc" else write_program(tmp_path, CONTOUR)
+    motion = subprocess.run([sys.executable, "-m", "ncpp", "motion", "--tool-table", str(table), "--var-units",
+                             "inch", str(path)], capture_output=True, text=True, check=True)  # fmt: skip
+    calls = oracle.run(path, tool_table=table, home=tmp_path, cwd=tmp_path).stdout
+    theirs = re.findall(r"(?:STRAIGHT_TRAVERSE|STRAIGHT_FEED|ARC_FEED|RIGID_TAP)\(.*\)", calls)
+    assert "cutter compensation" not in motion.stderr, motion.stderr
+    assert motion.stdout.splitlines() == theirs
 
 
 @needs_rs274
@@ -303,22 +326,27 @@ def test_motion_and_simulate_say_where_the_tool_leaves_the_programmed_contour(tm
 
     from tests.conftest import ROOT
 
-    path = write_program(tmp_path, CONTOUR.replace("G0 X0 Y0 Z5", "G0 X0 Y0 Z5\nG10 L2 P1 X400 Y350 Z400"))
+    placed = CONTOUR.replace("G0 X0 Y0 Z5", "G0 X0 Y0 Z5\nG10 L2 P1 X400 Y350 Z400")
+    path = write_program(tmp_path, placed)
+    # (G41 D1 with no tool table: the radius is not known, and `ncpp motion` prints the contour)
+    unknown = write_program(tmp_path, placed.replace("G41.1 D10", "G41 D1"), "unknown.ngc")
     run = [sys.executable, "-m", "ncpp"]
-    motion = subprocess.run([*run, "motion", str(path)], capture_output=True, text=True)
+    motion = subprocess.run([*run, "motion", str(unknown)], capture_output=True, text=True)
     assert (
         motion.returncode == 0
-        and motion.stderr.count("warning") == 1
-        and "program.ngc:6:1: warning: cutter compensation" in motion.stderr
+        and motion.stderr.count("warning: cutter compensation") == 1
+        and "unknown.ngc:6:1: warning: cutter compensation" in motion.stderr
     )
     assert (
         "printed as programmed" in motion.stderr
         and "STRAIGHT_FEED(30.0000, 30.0000, -1.0000" in motion.stdout
     )
     assert (
-        subprocess.run([*run, "motion", "--strict", str(path)], capture_output=True, text=True).returncode
+        subprocess.run([*run, "motion", "--strict", str(unknown)], capture_output=True, text=True).returncode
         != 0
     )
+    followed = subprocess.run([*run, "motion", str(path)], capture_output=True, text=True)
+    assert followed.returncode == 0 and "cutter compensation" not in followed.stderr, followed.stderr
     simulate = subprocess.run(
         [*run, "simulate", "--machine", str(ROOT / "samples/machines/hr5b.toml"), str(path)],
         capture_output=True,
