@@ -61,17 +61,19 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def program_events(path: str, warnings: Warnings, offsets=None, dialect: str | None = None) -> list:
-    """The events of a program (its dialect detected unless given), placed on the machine by `offsets`."""
+    """The events of a program (its dialect detected unless given), placed on the machine by `offsets`;
+    under cutter compensation that ncpp follows, the moves where the tool centre runs (`on_centre`)."""
     from ncpp.cli.motion import warn_off_path
     from ncpp.guard import without_guard
+    from ncpp.motion.centre_path import on_centre
     from ncpp.pipeline import dialect_tools
     from ncpp.program.dialects import parse_program
 
     with open(path, "rb") as stream:
         name, blocks = parse_program(stream, path, dialect)
         interpret, _ = dialect_tools(name)
-        events = interpret(without_guard(blocks), file=path, warnings=warnings, offsets=offsets)
-        return list(warn_off_path(events, warnings, path, "simulated as programmed"))
+        events = on_centre(interpret(without_guard(blocks), file=path, warnings=warnings, offsets=offsets))
+        return list(warn_off_path(events, warnings, path, "simulated as programmed", followed=True))
 
 
 def run(args: argparse.Namespace) -> int:

@@ -95,6 +95,25 @@ def test_after_g40_the_position_is_the_programs():
 
 
 @needs_rs274
+def test_simulate_samples_the_tool_centre_where_rs274_runs_it(tmp_path):
+    """`ncpp simulate` evaluates the machine's errors where the tool centre runs under cutter
+    compensation ncpp follows: every feed sample of the G41.1 contour lies on rs274's tool-centre path."""
+    import numpy as np
+
+    from ncpp.cli.simulate import program_events
+    from ncpp.simulate import sample_events
+    from tests.compensation.tool_centre import Move, deviation, feed_moves
+
+    path = write_program(tmp_path, CONTOUR)
+    sampled = sample_events(program_events(str(path), Warnings(stream=io.StringIO())), 0.5)
+    points = sampled.points[~sampled.rapid]
+    theirs = feed_moves(path, home=tmp_path)
+    assert sum(m.comp > 0 for m in theirs) >= 4 and len(points) > 100
+    apart = deviation(theirs, [Move(p, p) for p in points], lambda q: q, count=1)
+    assert np.max(apart) < 1e-6
+
+
+@needs_rs274
 @pytest.mark.parametrize("name", ["contour", "comp.ngc"])
 def test_ncpp_motion_prints_the_tool_centre_as_rs274_does(tmp_path, corpus, name):
     """Under cutter compensation ncpp follows, `ncpp motion` prints rs274's canonical calls of the tool
@@ -347,16 +366,15 @@ def test_motion_and_simulate_say_where_the_tool_leaves_the_programmed_contour(tm
     )
     followed = subprocess.run([*run, "motion", str(path)], capture_output=True, text=True)
     assert followed.returncode == 0 and "cutter compensation" not in followed.stderr, followed.stderr
-    simulate = subprocess.run(
-        [*run, "simulate", "--machine", str(ROOT / "samples/machines/hr5b.toml"), str(path)],
-        capture_output=True,
-        text=True,
-    )
+    simulate = [*run, "simulate", "--machine", str(ROOT / "samples/machines/hr5b.toml")]
+    unfollowed = subprocess.run([*simulate, str(unknown)], capture_output=True, text=True)
     assert (
-        simulate.returncode == 0
-        and "program.ngc:6:1: warning: cutter compensation" in simulate.stderr
-        and "simulated as programmed" in simulate.stderr
+        unfollowed.returncode == 0
+        and "unknown.ngc:6:1: warning: cutter compensation" in unfollowed.stderr
+        and "simulated as programmed" in unfollowed.stderr
     )
+    simulated = subprocess.run([*simulate, str(path)], capture_output=True, text=True)
+    assert simulated.returncode == 0 and "cutter compensation" not in simulated.stderr, simulated.stderr
 
 
 @needs_rs274
