@@ -139,6 +139,7 @@ class _Moves:
     # under cutter compensation: where the tool centre runs, and the last move added along it
     centre_path: CentrePath = field(default_factory=CentrePath)
     centre_last: int = -2
+    centre_in_plane: int = -1  # the last move along it in the plane (the moves after it stand)
 
     def closed(self, action: Action | None, first_line: int, cut: Position | None = None) -> _Moves:
         """The moves, told the action that ends them (or the `cut` of a chunk) and their first line."""
@@ -387,8 +388,13 @@ def _on_centre_path(moves: _Moves, event: Line | Arc, extra: tuple[float, ...], 
     the move's index."""
     n = len(moves.lines)
     on = moves.centre_path.along(event, moves.centre_last == n - 1)
-    if on.cut_back is not None:
-        moves.points[6 * n - 3 : 6 * n] = on.cut_back
+    if on.cut_back is not None and moves.centre_in_plane >= 0:
+        a, b, _ = PLANE_AXES[event.context.plane]
+        # (the move's end, and the start and end of the moves standing after it: rs274ngc moves them all)
+        for row in [6 * moves.centre_in_plane + 3] + [
+            6 * k + e for k in range(moves.centre_in_plane + 1, n) for e in (0, 3)
+        ]:
+            moves.points[row + a], moves.points[row + b] = on.cut_back[a], on.cut_back[b]
     if on.corner is not None:
         moves.points += on.corner.start
         moves.points += on.corner.end
@@ -402,6 +408,8 @@ def _on_centre_path(moves: _Moves, event: Line | Arc, extra: tuple[float, ...], 
         n += 1
     moves.points += on.start
     moves.points += on.end
+    if not on.standing:
+        moves.centre_in_plane = n
     return n
 
 

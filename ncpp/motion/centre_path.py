@@ -41,12 +41,15 @@ class Corner:
 @dataclass(frozen=True)
 class OnCentre:
     """A move's tool-centre start and end, the corner before it (None: the offsets meet there or
-    are cut back to their crossing), and where the move before now ends (None: where it did)."""
+    are cut back to their crossing), and where the move before now ends in the plane (None: where it
+    did; `cut_back_moves`); `standing`: the move runs along the plane's normal alone, the tool standing
+    where the move before left it, whose corner with the next move in the plane it leaves open."""
 
     start: Point
     end: Point
     corner: Corner | None = None
     cut_back: Point | None = None
+    standing: bool = False
 
 
 @dataclass(frozen=True)
@@ -83,7 +86,11 @@ class CentrePath:
             start = move.start if at_start is None else _plus(move.start, at_start)
             if at_start is None and type(move) is Line and _in_plane(move, a, b):  # (an entry line)
                 self.last = (_offset(move, end, a, b), plane)
-            return OnCentre(start, end)
+            if at_start is None or _in_plane(move, a, b) or abs(at_start[normal]) > SMOOTH:
+                return OnCentre(start, end)
+            # (rs274ngc holds such moves with the one before, and moves them all to an inside corner's crossing)
+            self.last = last if before_is_last else None
+            return OnCentre(start, end, standing=True)
         own = _own_start_shift(move, at_end, a, b)
         exits = math.hypot(at_end[a], at_end[b]) <= SMOOTH  # (after G40: it ends on its programmed point)
         start = _plus(move.start, at_start if exits else own)
@@ -115,23 +122,27 @@ class CentrePath:
 def on_centre(events: Iterable[Event]) -> Iterator[Event]:
     """The events with each move that compensation follows under cutter compensation (its
     `centre_shift` set) where the tool centre runs, as rs274 prints it: from where the tool stands to
-    its tool-centre end, an outside corner's arc before it, the move before cut back to an inside
-    corner (held, with the events after it, until the next move tells)."""
+    its tool-centre end, an outside corner's arc before it, the moves before cut back to an inside
+    corner (held, with the events after them, until the next move in the plane tells)."""
     path = CentrePath()
-    move: Line | Arc | None = None  # the last move on the path, held until the next move tells where it ends
-    after: list[Event] = []  # the events since it
+    held: list[
+        Event
+    ] = []  # the last move on the path in the plane, the moves standing after it, the events between
     for event in events:
         if type(event) is not Line and type(event) is not Arc:
-            if move is None:
-                yield event
+            if held:
+                held.append(event)
             else:
-                after.append(event)
+                yield event
             continue
-        on = path.along(event, move is not None) if event.centre_shift is not None else None
-        if move is not None:
-            yield move if on is None or on.cut_back is None else replace(move, end=on.cut_back)
-            yield from after
-            move, after = None, []
+        on = path.along(event, bool(held)) if event.centre_shift is not None else None
+        if on is not None and on.standing and held:
+            held.append(replace(event, start=on.start, end=on.end))
+            continue
+        if on is not None and on.cut_back is not None:
+            held = cut_back_moves(held, on.cut_back, event.context.plane)
+        yield from held
+        held = []
         if on is None:
             yield event
             continue
@@ -139,10 +150,28 @@ def on_centre(events: Iterable[Event]) -> Iterator[Event]:
             corner = on.corner
             yield Arc(corner.start, corner.end, corner.centre, corner.turn, event.feed, event.block, event.context,
                       event.extra)  # fmt: skip
-        move = replace(event, start=on.start, end=on.end)
-    if move is not None:
-        yield move
-        yield from after
+        held = [replace(event, start=on.start, end=on.end)]
+    yield from held
+
+
+def cut_back_moves(moves: list[Event], to: Point, plane: int) -> list[Event]:
+    """`moves` (the last on the path in the plane first, then those standing after it, and other
+    events) moved to an inside corner's crossing `to` in the plane: the first's end, the others'
+    start and end; along the plane's normal each keeps its own."""
+    a, b, _ = PLANE_AXES[plane]
+
+    def there(p: Point) -> Point:
+        q = list(p)
+        q[a], q[b] = to[a], to[b]
+        return (q[0], q[1], q[2])
+
+    out: list[Event] = []
+    for k, event in enumerate(moves):
+        if type(event) is Line or type(event) is Arc:
+            event = replace(event, end=there(event.end)) if k == 0 else replace(event, start=there(event.start),
+                                                                                   end=there(event.end))  # fmt: skip
+        out.append(event)
+    return out
 
 
 def _turned_away(before: Flat, own: Flat, tangent: Flat) -> float:

@@ -11,7 +11,7 @@ import pytest
 
 from ncpp.errors import Warnings
 from ncpp.motion import interpret
-from ncpp.motion.centre_path import CentrePath
+from ncpp.motion.centre_path import on_centre
 from ncpp.motion.segments import Arc, Line
 from ncpp.program.parser import parse_stream
 from tests import rs274 as oracle
@@ -128,30 +128,39 @@ M2
 """
 CONTOURS["nearly-straight-left"] = NEARLY_STRAIGHT
 CONTOURS["nearly-straight-right"] = NEARLY_STRAIGHT.replace("G41.1", "G42.1")
+# Moves along Z between a move and the inside corner after it, which rs274ngc moves to the crossing too
+STANDING = """G21 G90 G17 G94
+G0 X-10 Y-10 Z5
+G1 Z-1 F200
+G41.1 D4
+G1 X0 Y0
+X30
+G1 Z-2
+G1 Z-1.5
+G1 X25 Y20
+G3 X5 Y20 R10
+G1 Z-2.5
+G1 X0 Y0
+G40 G1 X-10 Y-10
+M2
+"""
+CONTOURS["standing-left"] = STANDING
+CONTOURS["standing-right"] = STANDING.replace("G41.1", "G42.1")
 CONTOURS["reversals-left"] = REVERSALS
 CONTOURS["reversals-right"] = REVERSALS.replace("G41.1", "G42.1")
 
 
 def centre_path(text: str) -> list[tuple[str, tuple[float, float, float]]]:
     """Each move's kind (L: straight, A+ and A-: an arc counter-clockwise and clockwise in its plane)
-    and end where the tool centre runs, in order: a corner's arc before its move, a move cut back at an
-    inside corner ending where it is cut."""
+    and end where the tool centre runs (`on_centre`), in order: a corner's arc before its move, a move
+    cut back at an inside corner ending where it is cut."""
     blocks = parse_stream(io.BytesIO(text.encode()), "contour.ngc", "iso")
-    path, moves = CentrePath(), []
-    for event in interpret(blocks, file="contour.ngc", warnings=Warnings(stream=io.StringIO())):
-        if type(event) is not Line and type(event) is not Arc:
-            continue
-        kind = ("A+" if event.turn > 0 else "A-") if type(event) is Arc else "L"
-        if event.centre_shift is None:
-            moves.append((kind, event.end))
-            continue
-        on = path.along(event, True)
-        if on.cut_back is not None:
-            moves[-1] = (moves[-1][0], on.cut_back)
-        if on.corner is not None:
-            moves.append(("A+" if on.corner.turn > 0 else "A-", on.corner.end))
-        moves.append((kind, on.end))
-    return moves
+    events = interpret(blocks, file="contour.ngc", warnings=Warnings(stream=io.StringIO()))
+    return [
+        (("A+" if move.turn > 0 else "A-") if type(move) is Arc else "L", move.end)
+        for move in on_centre(events)
+        if type(move) is Line or type(move) is Arc
+    ]
 
 
 def rs274_path(text: str) -> list[tuple[str, tuple[float, float, float]]]:
