@@ -112,7 +112,7 @@ class CentrePath:
         if previous is None:
             return OnCentre(start, end)
         crossing = _crossing(previous, self.last[0], (before[a], before[b]), (start[a], start[b]), tangent)
-        if crossing is None:  # (they do not cross within both moves: the control reports a gouge)
+        if crossing is None:  # (they do not cross within the move before: the control reports a gouge)
             return OnCentre(start, end)
         met = list(start)
         met[a], met[b] = crossing
@@ -273,16 +273,17 @@ def _swept(move: Arc, a: int, b: int) -> float:
 def _crossing(first: _Offset, second: _Offset, ends: Flat, starts: Flat, onwards: Flat) -> Flat | None:
     """Where two moves' offsets cross at an inside corner (`ends`: the first's tool-centre end,
     `starts`: the second's start, `onwards`: its direction there): the crossing nearest the
-    corner back along the first and on along the second, within both moves' lengths, and about
-    where the offsets' tangents there cross (arcs nearly tangent to one another may cross only
-    far off, or not at all)."""
+    corner back along the first, within its length, and on along the second, and about where the
+    offsets' tangents there cross (arcs nearly tangent to one another may cross only far off, or not
+    at all).  Past the second's end too: rs274ngc checks the move it cuts back, not the next, which
+    then runs back from the crossing to its end (a line back along itself, an arc nearly round)."""
     crossings = [
         p for p in _meet(first, second)
         if _dot(p, ends, first.leaving) <= SMOOTH and _dot(p, starts, onwards) >= -SMOOTH
     ]  # fmt: skip
     near = ((ends[0] + starts[0]) / 2, (ends[1] + starts[1]) / 2)
     best = min(crossings, key=lambda p: math.dist(p, near), default=None)
-    if best is None or math.dist(best, ends) > first.length or math.dist(best, starts) > second.length:
+    if best is None or math.dist(best, ends) > first.length:
         return None
     tangents = _meet(_Offset(ends, first.leaving), _Offset(starts, onwards))
     if tangents:  # (none: the moves turn right back, and the arcs' crossing is the corner's)
