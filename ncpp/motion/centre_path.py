@@ -174,6 +174,17 @@ def cut_back_moves(moves: list[Event], to: Point, plane: int) -> list[Event]:
     return out
 
 
+def turns_back_inside(arc: Arc, before: Point, own: Point) -> bool:
+    """Whether the path turns right back onto `arc` at an inside corner (a cusp, the tool outside the
+    arc: `_outside`), where the control cuts the move before back to a crossing far along the arc
+    (`before`: where the move before left the tool centre off the arc's start, `own`: the arc's own
+    offset there, on the other side of the contour)."""
+    a, b, _ = PLANE_AXES[arc.context.plane]
+    came, mine = (before[a], before[b]), (own[a], own[b])
+    away = _turned_away(came, mine, _tangent(arc, a, b))
+    return abs(away - math.pi) <= TURNED and not _outside(away, came, mine, arc, None, a, b)
+
+
 def _turned_away(before: Flat, own: Flat, tangent: Flat) -> float:
     """The angle the path turns away from the tool's side at the corner before a move (radians,
     -90 to 270 degrees, as rs274ngc's convert_straight_comp2 and convert_arc_comp2 measure it):

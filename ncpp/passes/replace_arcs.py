@@ -24,6 +24,7 @@ from numpy.typing import NDArray
 
 from ncpp.errors import Location, NcppError
 from ncpp.machine.chain import norm3
+from ncpp.motion.centre_path import turns_back_inside
 from ncpp.motion.segments import PLANE_AXES, Arc, Event, Line
 from ncpp.passes.context import PassContext
 from ncpp.passes.geometry import (
@@ -218,10 +219,22 @@ def _centre_offsets(arcs: list[Arc]) -> tuple[NDArray, NDArray, NDArray] | None:
         if arc.centre_shift is not None:
             at_start, shift = arc.centre_shift
             entry[k] = at_start is None
-            start[k] = (0.0, 0.0, 0.0) if at_start is None else at_start
             a, b, _ = PLANE_AXES[arc.context.plane]
             du, dv = arc.end[a] - arc.center[a], arc.end[b] - arc.center[b]
             radial[k] = (shift[a] * du + shift[b] * dv) / math.hypot(du, dv)
+            su, sv = arc.start[a] - arc.center[a], arc.start[b] - arc.center[b]
+            along = [0.0, 0.0, 0.0]
+            along[a], along[b] = radial[k] * su / math.hypot(su, sv), radial[k] * sv / math.hypot(su, sv)
+            own = (along[0], along[1], along[2])
+            # (turned right back at an inside corner, the tool enters the arc on its own offset, far from where
+            # the move before left it, on the other side of the contour)
+            start[k] = (
+                (0.0, 0.0, 0.0)
+                if at_start is None
+                else own
+                if turns_back_inside(arc, at_start, own)
+                else at_start
+            )
     return radial, start, entry
 
 

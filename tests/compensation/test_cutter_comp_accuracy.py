@@ -63,8 +63,9 @@ TABLE = HEAD + (
     "G2 X90 Y60 I0 J-20\nG1 Y20\nG2 X70 Y0 I-20 J0\nG1 X0\nG1 Z-4\nG1 X-5\nG40\nG0 X-30 Y-10 Z5\nM2\n"
 )
 TOOLS = "T3 P3 Z0.5 D0.3 ;tool 3: 7.62 mm\n"  # (inches: the stand-alone rs274 reads its table so)
-# an arc turned three quarters round to end turning right back along the line after it, the tool inside
-# the arc: an outside corner, which the tool goes round by a half turn
+# a line turned right back onto an arc turned three quarters round, which ends turning right back along
+# the line after it; the tool inside the arc (G42): outside corners, gone round by a half turn; outside it
+# (G41): inside ones, cut back to where the offsets cross, far along the arc
 CUSP = HEAD + (
     "T3 M6 G43\nG0 X0 Y0 Z5\nG42 D3\nG1 X10 Y10 F300\nG1 Z-1\nG1 X200 Y10\nG2 X260 Y70 I0 J60\n"
     "G1 X260 Y200\nG3 X200 Y260 I-60 J0\nG1 X10 Y260\nG1 X10 Y10\nG0 Z5\nG40 G1 X0 Y0\nM2\n"
@@ -189,19 +190,21 @@ def test_with_expand_the_moves_under_compensation_in_loops_and_subroutines_land_
 
 
 @needs_oracles
-def test_a_corner_turned_right_back_is_verified_as_the_control_makes_it(tmp_path):
-    """Where the path turns right back (an arc's end along the line after it), the corrections tilt the
-    corner by µrad; the control tells such a corner by the turn within 50 mrad of a half turn, so the
-    written program runs round it as the original does: it is verified and written, within 1 µm of
-    the original's tool centre on the machine (the half turn about a corrected corner keeps the error's
-    gradient times the tool's diameter), and pathcheck accepts it."""
+@pytest.mark.parametrize("side, within", [("G42", 0.001), ("G41", 0.0025)])
+def test_a_corner_turned_right_back_is_verified_as_the_control_makes_it(tmp_path, side, within):
+    """Where the path turns right back (a line onto an arc, an arc's end along the line after it), the
+    corrections tilt the corner by µrad; the control tells such a corner by the turn within 50 mrad of a
+    half turn, so the written program runs round it as the original does: it is verified and written,
+    within 1 µm of the original's tool centre on the machine round outside corners (the half turn about
+    a corrected corner keeps the error's gradient times the tool's diameter) and 2.5 µm where the tool
+    enters the arc at a crossing far along it, and pathcheck accepts it."""
     tools = tmp_path / "tools.tbl"
     tools.write_text(TOOLS)
-    original, out, _ = written(tmp_path, CUSP, "cusp.ngc", "--tolerance", "0.0001",
+    original, out, _ = written(tmp_path, CUSP.replace("G42", side), "cusp.ngc", "--tolerance", "0.0001",
                                "--tool-table", str(tools), "--var-units", "inch")  # fmt: skip
     before, after = (feed_moves(p, tools, home=tmp_path) for p in (original, out))
-    assert deviation(before, before, closed_form).max() > 0.005
-    assert deviation(before, after, closed_form).max() <= 0.001
+    assert deviation(before, before, closed_form).max() > 0.01
+    assert deviation(before, after, closed_form).max() <= within
     pathcheck(original, out, "--tool-table", str(tools))
 
 
