@@ -59,7 +59,10 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
         "compensation/test_rotation_planes.py": (
             "test_the_whole_path_under_g68_in_g18_and_g19_lands_on_the_original_in_rs274",
         ),
-        "compensation/test_mirror.py": ("test_the_whole_path_under_g51_1_lands_on_the_original_in_rs274",),
+        "compensation/test_mirror.py": (
+            "test_the_whole_path_under_g51_1_lands_on_the_original_in_rs274",
+            "test_cutter_compensation_under_g51_1_lands_on_the_original_in_rs274",
+        ),
         "compensation/test_rotated_cutter_comp.py": (
             "test_g41_under_g10_l2_r_passes_pathcheck_at_twice_the_largest_correction",
             "test_g41_under_g68_lands_on_the_original_in_rs274_written_as_linuxcncs_g10_l2_r",
@@ -70,6 +73,7 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
         ),
         "compensation/test_cutter_comp_accuracy.py": (
             "test_the_tool_centre_lands_on_the_original_path_within_half_a_micron",
+            "test_a_corner_turned_right_back_is_verified_as_the_control_makes_it",
             "test_in_g18_and_in_g91_the_tool_centre_lands_on_the_original_path",
             "test_with_expand_the_moves_under_compensation_in_loops_and_subroutines_land_on_the_path",
             "test_the_entry_arc_stays_one_arc_the_control_accepts",
@@ -169,6 +173,8 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
         ),
         "motion/test_zero_feed.py": ("test_a_feed_move_at_a_zero_feed_is_refused_where_rs274_refuses_it",),
         "motion/test_cutter_comp.py": (
+            "test_ncpp_motion_prints_the_tool_centre_as_rs274_does",
+            "test_simulate_samples_the_tool_centre_where_rs274_runs_it",
             "test_g41_checks_against_the_radius_of_the_tool_table_ncpp_is_told",
             "test_moves_after_compensation_agree_with_rs274",
             "test_refused_with_compensation_as_rs274_refuses",
