@@ -24,6 +24,7 @@ from numpy.typing import NDArray
 
 from ncpp.errors import Location, NcppError
 from ncpp.machine.chain import norm3
+from ncpp.machine.curvature import ripple_bow
 from ncpp.motion.segments import PLANE_AXES, Arc, Event, Line
 from ncpp.passes.context import PassContext
 from ncpp.passes.geometry import (
@@ -40,6 +41,7 @@ from ncpp.passes.geometry import (
     spliced,
     tuples,
 )
+from ncpp.passes.subdivide import SAFETY
 from ncpp.passes.travel import grid, quantize
 
 # Points per piece where the fit is checked (ends included).  Fewer on short
@@ -448,6 +450,9 @@ def _round(
         q -= shift
     centre, deviation = _fit(q, geometry.axes[pending.arc], t, ctx.tolerance / scale)
     ok = deviation <= ctx.tolerance / scale
+    ripple = getattr(ctx.model, "ripple", None)
+    if ripple is not None and ripple.any():  # the samples alias an error that repeats between them: halve on
+        ok &= ~_rippled(nominal, length, geometry.axes[pending.arc], scale, ripple, ctx.tolerance)
     if ctx.directional:  # ends on the output grid (after the fit: a short piece's chord fixes the bisector)
         step = grid(ctx, scale)
         q[:, 0], q[:, -1] = quantize(q[:, 0], step), quantize(q[:, -1], step)
@@ -491,6 +496,18 @@ def _round(
             (pending.arc[fitted], pending.a0[fitted], q[fitted, 0], q[fitted, -1], centre[fitted])
         )
     return ~ok & ~give_up & ~straight
+
+
+def _rippled(
+    nominal: NDArray, length: NDArray, axes: NDArray, scale: NDArray, ripple: NDArray, tolerance: float
+) -> NDArray:
+    """(p,) the pieces (of `length` mm, program points `nominal` (p,m,3)) that the errors repeating
+    along an axis (`Machine.ripple`) could bow from the fit by more than the tolerance allows: a
+    piece spans at most its length of its plane's axes, its rise of the normal one."""
+    span = np.repeat(length[:, None], 3, axis=1)
+    rows, normal = np.arange(len(span)), axes[:, 2]
+    span[rows, normal] = np.abs(nominal[rows, -1, normal] - nominal[rows, 0, normal]) * scale
+    return SAFETY * ripple_bow(span, ripple) > tolerance
 
 
 def _one_way(
