@@ -199,6 +199,7 @@ class _ArcRows:
     # its outside (n,) (negative: inside), and off its start (n,3), program units, and the entry arcs (n,),
     # which stay whole; None: no arc is under compensation
     tool_centre: tuple[NDArray, NDArray, NDArray] | None = None
+    under_comp: NDArray | None = None  # (n,) the arcs under cutter compensation (None: none)
 
     @classmethod
     def of(cls, arcs: list[Arc], normals: list[int]) -> _ArcRows:
@@ -208,6 +209,7 @@ class _ArcRows:
             plane_axes(arcs), np.fromiter([a.turn for a in arcs], dtype=float, count=len(arcs)),
             offsets, scales, tools, np.fromiter([a.block.line for a in arcs], dtype=np.int64, count=len(arcs)),
             np.array(normals, dtype=float), _centre_offsets(arcs),
+            np.fromiter((a.centre_shift is not None for a in arcs), dtype=bool, count=len(arcs)),
         )  # fmt: skip
 
 
@@ -268,6 +270,7 @@ class _ArcGeometry:
         self.rise = ew - sw
         self.end_radius = np.hypot(eu - cu, ev - cv)
         self.normal = rows.normal
+        self.under_comp = rows.under_comp
 
     def points(self, arc: NDArray, angles: NDArray) -> NDArray:
         """(p,m,3) program points at the given angles of the given arcs.
@@ -292,6 +295,12 @@ class _ArcGeometry:
         shift = from_plane(k * np.cos(angles), k * np.sin(angles), np.zeros_like(angles), self.axes[arc])
         first = angles == self.a0[arc, None]  # (the first piece starts at the arc's angle, exactly)
         return np.where(first[..., None], start[arc, None, :], shift)
+
+    def free(self, arc: NDArray) -> NDArray:
+        """(p,) the arcs (of `arc`) not under cutter compensation."""
+        if self.under_comp is None:
+            return np.ones(len(arc), dtype=bool)
+        return ~self.under_comp[arc]
 
     def whole(self, arc: NDArray) -> NDArray:
         """(p,) the arcs (of `arc`) that stay one piece: the entry arcs of cutter compensation (the
@@ -452,7 +461,9 @@ def _round(
     ok = deviation <= ctx.tolerance / scale
     ripple = getattr(ctx.model, "ripple", None)
     if ripple is not None and ripple.any():  # the samples alias an error that repeats between them: halve on
-        ok &= ~_rippled(nominal, length, geometry.axes[pending.arc], scale, ripple, ctx.tolerance)
+        # (not under cutter compensation, as lines there are not split: each piece is a move the control offsets)
+        free = np.ones(len(ok), dtype=bool) if shift is None else geometry.free(pending.arc)
+        ok &= ~(free & _rippled(nominal, length, geometry.axes[pending.arc], scale, ripple, ctx.tolerance))
     if ctx.directional:  # ends on the output grid (after the fit: a short piece's chord fixes the bisector)
         step = grid(ctx, scale)
         q[:, 0], q[:, -1] = quantize(q[:, 0], step), quantize(q[:, -1], step)
