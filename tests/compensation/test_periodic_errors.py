@@ -82,8 +82,9 @@ G03 X-0.0975 Y0.0975 Z0.0179 R0.0975
 
 def test_arcs_under_cutter_compensation_are_not_cut_for_a_screw_lead_error(tmp_path: Path):
     """Each piece of an arc under G41/G42 is a move the control offsets by itself, as a line's
-    would be (and lines there are not split): a screw-lead error leaves them whole, and LinuxCNC
-    runs the output on the original's path (pathcheck)."""
+    would be (and lines there are not split): a screw-lead error leaves them whole.  This file ends
+    under compensation without a program end, where rs274ngc never runs the move it still holds
+    (the last arc): cut in pieces, its first pieces would run and the path would differ."""
     machine, program, out = tmp_path / "screw.toml", tmp_path / "h.ngc", tmp_path / "h.out.ngc"
     tools = tmp_path / "tools.tbl"
     machine.write_text(MACHINE)
