@@ -110,6 +110,11 @@ class MachineMap:
         """`Machine.bow_bound`: what keeps lines whole unsampled (`passes/subdivide.py`)."""
         return self.machine.bow_bound
 
+    @property
+    def ripple(self):
+        """`Machine.ripple`: how short the cyclic effects make the pieces (`passes/subdivide.py`)."""
+        return self.machine.ripple
+
 
 def _digest(path: str) -> str:
     return hashlib.sha256(Path(path).read_bytes()).hexdigest()[:16]

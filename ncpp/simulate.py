@@ -132,7 +132,11 @@ def _sample_arc(arc: Arc, step_mm: float, left: int = MAX_SAMPLES, file: str = "
 
 
 def distance_to_path(points: NDArray, path: NDArray) -> NDArray:
-    """Distance (n,) of each point to the polyline `path` (m,3)."""
+    """Distance (n,) of each point to the polyline `path` (m,3).  The segments next to a point's
+    nearest samples give a distance at least the true one; where the nearest samples lie elsewhere
+    (a densely sampled arc beside a line sampled every half mm) it can be far too large, so the
+    points are measured again against every segment (`_Segments`), the largest first, until no
+    other can be larger than the largest so found: the maximum and where it is are exact."""
     from scipy.spatial import cKDTree
 
     if len(path) < 2:
@@ -142,16 +146,63 @@ def distance_to_path(points: NDArray, path: NDArray) -> NDArray:
     nearest = np.atleast_2d(nearest)
     best = np.full(len(points), np.inf)
     for col in range(nearest.shape[1]):
-        idx = nearest[:, col]
-        for lo in (idx - 1, idx):
+        for lo in (nearest[:, col] - 1, nearest[:, col]):
             lo = np.clip(lo, 0, len(path) - 2)
-            a, b = path[lo], path[lo + 1]
-            ab = b - a
-            denom = np.maximum((ab * ab).sum(1), 1e-30)
-            t = np.clip(((points - a) * ab).sum(1) / denom, 0.0, 1.0)
-            d = np.linalg.norm(points - (a + t[:, None] * ab), axis=1)
-            best = np.minimum(best, d)
+            best = np.minimum(best, _to_segments(points, path[lo], path[lo + 1]))
+    segments, largest = _Segments(path), -np.inf
+    order = np.argsort(-best, kind="stable")
+    for at in range(0, len(order), 2048):
+        block = order[at : at + 2048]
+        if best[block[0]] <= largest:
+            break
+        best[block] = segments.distance(points[block], best[block])
+        largest = max(largest, float(best[block].max()))
     return best
+
+
+def _to_segments(points: NDArray, a: NDArray, b: NDArray) -> NDArray:
+    """(n,) each point's distance to its segment from a to b ((n,3) each)."""
+    ab = b - a
+    t = np.clip(((points - a) * ab).sum(1) / np.maximum((ab * ab).sum(1), 1e-30), 0.0, 1.0)
+    return np.linalg.norm(points - (a + t[:, None] * ab), axis=1)
+
+
+class _Segments:
+    """A polyline's segments looked up by their midpoints, in classes of like length: a segment of
+    length L nearer to a point than d has its midpoint within d + L/2 of it (and a long segment
+    does not widen the search among the short ones)."""
+
+    CLASS = 4.0  # the segments of a class are this much longer at most than its shortest
+    NEAR = 8  # segments per point looked at first, four times more where more are that near
+
+    def __init__(self, path: NDArray):
+        from scipy.spatial import cKDTree
+
+        self.start, self.end = path[:-1], path[1:]
+        lengths = np.linalg.norm(self.end - self.start, axis=1)
+        shortest = max(float(lengths.max()) * 1e-9, 1e-12)
+        rank = np.floor(np.log(np.maximum(lengths, shortest) / shortest) / np.log(self.CLASS)).astype(np.intp)
+        self.classes = []
+        for c in np.unique(rank).tolist():
+            members = np.flatnonzero(rank == c)
+            middle = (self.start[members] + self.end[members]) / 2
+            self.classes.append((members, cKDTree(middle), float(lengths[members].max()) / 2))
+
+    def distance(self, points: NDArray, bound: NDArray) -> NDArray:
+        """(n,) each point's distance to the nearest segment; `bound` (n,): one known to be no smaller."""
+        best = bound.copy()
+        for members, tree, half in self.classes:
+            rows, k = np.arange(len(points)), self.NEAR
+            while rows.size:
+                k = min(k, len(members))
+                found, index = (a.reshape(len(rows), -1) for a in tree.query(points[rows], k=k))
+                for col in range(k):
+                    chosen = members[index[:, col]]
+                    near = _to_segments(points[rows], self.start[chosen], self.end[chosen])
+                    best[rows] = np.minimum(best[rows], near)
+                rows = rows[found[:, -1] <= best[rows] + half] if k < len(members) else rows[:0]
+                k *= 4
+        return best
 
 
 @dataclass(frozen=True)

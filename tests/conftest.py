@@ -36,6 +36,8 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
             "test_the_holes_moves_compensation_sees_are_the_ones_rs274_makes",
         ),
         "compensation/test_rs274_accepts.py": None,
+        "compensation/test_periodic_errors.py": None,
+        "compensation/test_rotary_increments.py": None,
         "motion/test_centre_path.py": ("test_the_tool_centre_runs_where_rs274_puts_it",),
         "writeback/test_subroutines_run_once.py": None,
         "compensation/test_subprograms_first.py": None,
@@ -212,6 +214,8 @@ TIERS: dict[str, dict[str, tuple[str, ...] | None]] = {
     },
     # a second and a half or more on a 2-core machine, all parameters together
     "slow": {
+        "compensation/test_periodic_errors.py": None,
+        "compensation/test_rotary_increments.py": None,
         "motion/test_fanuc_read_ahead.py": ("test_past_the_read_ahead_the_compensated_text_is_the_same",),
         "compensation/test_tool_parameters.py": (
             "test_written_out_the_pocket_sized_by_the_diameter_lands_on_the_original",

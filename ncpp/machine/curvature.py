@@ -154,3 +154,23 @@ def _run_maxima(values: NDArray) -> NDArray:
     for i in range(len(values)):
         out[i, i:] = np.maximum.accumulate(values[i:])
     return out
+
+
+def ripple(machine) -> NDArray:
+    """(3,) per axis X Y Z: the largest second derivative (1/mm) of the machine's `cyclic` effects
+    along it, Σ um·(2π/period_mm)².  A screw-lead error repeats every few mm, shorter than the
+    stretches a line's or an arc's samples are apart: a piece of length ℓ along axis k bows from its
+    chord by at most ripple[k]·ℓ²/8 from them."""
+    from ncpp.machine.effects import Cyclic
+
+    out = np.zeros(3)
+    for effect in machine.effects:
+        if isinstance(effect, Cyclic):
+            out[AXES.index(effect.axis)] += abs(effect.um) * 1e-3 * (2 * np.pi / effect.period_mm) ** 2
+    return out
+
+
+def ripple_bow(span: NDArray, ripple: NDArray) -> NDArray:
+    """(n,) mm: how far pieces spanning `span` (n,3) mm of the axes bow at most from their chords
+    by the errors that repeat along them (`ripple`, (3,) 1/mm)."""
+    return span**2 @ ripple / 8

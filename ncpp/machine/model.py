@@ -193,6 +193,14 @@ class Machine:
 
         return BowBound.of(self)
 
+    @cached_property
+    def ripple(self) -> NDArray:
+        """(3,) per axis X Y Z, a bound of the second derivative (1/mm) of the static errors that
+        repeat along the axis faster than a line's samples see (`curvature.ripple`)."""
+        from ncpp.machine.curvature import ripple
+
+        return ripple(self)
+
     def error_motions(
         self, P: ArrayLike, direction: ArrayLike | None = None
     ) -> tuple[dict[str, NDArray], dict[str, NDArray]]:

@@ -15,7 +15,8 @@ class ErrorMap(Protocol):
     """Anything that says where the tool really goes: a `Machine`, or a map
     built straight from one measurement (`ncpp.passes.measured`).  A map may also
     have a `bow_bound` (`ncpp.machine.curvature.BowBound`, or None): with one,
-    subdivide_lines leaves unsampled the lines it keeps whole."""
+    subdivide_lines leaves unsampled the lines it keeps whole; and a `ripple`
+    (`Machine.ripple`): with one, lines and arcs are cut as short as its repeating errors need."""
 
     def deviation(
         self, P: NDArray, direction: NDArray | None = None, tool_offset: NDArray | None = None

@@ -24,6 +24,7 @@ from numpy.typing import NDArray
 
 from ncpp.errors import Location, NcppError
 from ncpp.machine.chain import norm3
+from ncpp.machine.curvature import ripple_bow
 from ncpp.motion.centre_path import turns_back_inside
 from ncpp.motion.segments import PLANE_AXES, Arc, Event, Line
 from ncpp.passes.context import PassContext
@@ -41,6 +42,7 @@ from ncpp.passes.geometry import (
     spliced,
     tuples,
 )
+from ncpp.passes.subdivide import SAFETY
 from ncpp.passes.travel import grid, quantize
 
 # Points per piece where the fit is checked (ends included).  Fewer on short
@@ -198,6 +200,7 @@ class _ArcRows:
     # its outside (n,) (negative: inside), and off its start (n,3), program units, and the entry arcs (n,),
     # which stay whole; None: no arc is under compensation
     tool_centre: tuple[NDArray, NDArray, NDArray] | None = None
+    under_comp: NDArray | None = None  # (n,) the arcs under cutter compensation (None: none)
 
     @classmethod
     def of(cls, arcs: list[Arc], normals: list[int]) -> _ArcRows:
@@ -207,6 +210,7 @@ class _ArcRows:
             plane_axes(arcs), np.fromiter([a.turn for a in arcs], dtype=float, count=len(arcs)),
             offsets, scales, tools, np.fromiter([a.block.line for a in arcs], dtype=np.int64, count=len(arcs)),
             np.array(normals, dtype=float), _centre_offsets(arcs),
+            np.fromiter((a.centre_shift is not None for a in arcs), dtype=bool, count=len(arcs)),
         )  # fmt: skip
 
 
@@ -279,6 +283,7 @@ class _ArcGeometry:
         self.rise = ew - sw
         self.end_radius = np.hypot(eu - cu, ev - cv)
         self.normal = rows.normal
+        self.under_comp = rows.under_comp
 
     def points(self, arc: NDArray, angles: NDArray) -> NDArray:
         """(p,m,3) program points at the given angles of the given arcs.
@@ -303,6 +308,12 @@ class _ArcGeometry:
         shift = from_plane(k * np.cos(angles), k * np.sin(angles), np.zeros_like(angles), self.axes[arc])
         first = angles == self.a0[arc, None]  # (the first piece starts at the arc's angle, exactly)
         return np.where(first[..., None], start[arc, None, :], shift)
+
+    def free(self, arc: NDArray) -> NDArray:
+        """(p,) the arcs (of `arc`) not under cutter compensation."""
+        if self.under_comp is None:
+            return np.ones(len(arc), dtype=bool)
+        return ~self.under_comp[arc]
 
     def whole(self, arc: NDArray) -> NDArray:
         """(p,) the arcs (of `arc`) that stay one piece: the entry arcs of cutter compensation (the
@@ -461,6 +472,11 @@ def _round(
         q -= shift
     centre, deviation = _fit(q, geometry.axes[pending.arc], t, ctx.tolerance / scale)
     ok = deviation <= ctx.tolerance / scale
+    ripple = getattr(ctx.model, "ripple", None)
+    if ripple is not None and ripple.any():  # the samples alias an error that repeats between them: halve on
+        # (not under cutter compensation, as lines there are not split: each piece is a move the control offsets)
+        free = np.ones(len(ok), dtype=bool) if shift is None else geometry.free(pending.arc)
+        ok &= ~(free & _rippled(nominal, length, geometry.axes[pending.arc], scale, ripple, ctx.tolerance))
     if ctx.directional:  # ends on the output grid (after the fit: a short piece's chord fixes the bisector)
         step = grid(ctx, scale)
         q[:, 0], q[:, -1] = quantize(q[:, 0], step), quantize(q[:, -1], step)
@@ -504,6 +520,18 @@ def _round(
             (pending.arc[fitted], pending.a0[fitted], q[fitted, 0], q[fitted, -1], centre[fitted])
         )
     return ~ok & ~give_up & ~straight
+
+
+def _rippled(
+    nominal: NDArray, length: NDArray, axes: NDArray, scale: NDArray, ripple: NDArray, tolerance: float
+) -> NDArray:
+    """(p,) the pieces (of `length` mm, program points `nominal` (p,m,3)) that the errors repeating
+    along an axis (`Machine.ripple`) could bow from the fit by more than the tolerance allows: a
+    piece spans at most its length of its plane's axes, its rise of the normal one."""
+    span = np.repeat(length[:, None], 3, axis=1)
+    rows, normal = np.arange(len(span)), axes[:, 2]
+    span[rows, normal] = np.abs(nominal[rows, -1, normal] - nominal[rows, 0, normal]) * scale
+    return SAFETY * ripple_bow(span, ripple) > tolerance
 
 
 def _one_way(

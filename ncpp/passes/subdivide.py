@@ -21,7 +21,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ncpp.machine.chain import norm3
-from ncpp.machine.curvature import BowBound
+from ncpp.machine.curvature import BowBound, ripple_bow
 from ncpp.motion.segments import Event, Line
 from ncpp.passes.context import PassContext, deviation
 from ncpp.passes.geometry import chunked, frames, points, row_max, rows_of, spliced
@@ -91,6 +91,10 @@ def _with_rows(
         machine = lambda p: (p[long] + offsets[long]) * scales[long, None]  # noqa: E731
         bow = length[long] ** 2 / 8 * bound(machine(starts), machine(ends), rows_of(tools, long))
         long = long[SAFETY * bow > SURE * ctx.tolerance]
+    ripple = getattr(ctx.model, "ripple", None)
+    if ripple is not None and ripple.any():  # (and any line, however short, a screw-lead error bows)
+        rippled = _ripple_pieces(starts, ends, scales, ripple, ctx.tolerance) > 1
+        long = np.union1d(long, np.flatnonzero(rippled))
     if long.size == 0:
         return chunk, [], [], None
     keep = long.tolist()
@@ -122,7 +126,20 @@ def _piece_counts(rows: _LineRows, ctx: PassContext) -> NDArray:
     bow = row_max(norm3(error - straight))
     # The deviation of piecewise-linear interpolation shrinks with the square of the piece count.
     # (capped before the cast: a tolerance of 1e-300 makes the ratio inf, which casts to a negative int)
-    return np.minimum(np.ceil(np.sqrt(SAFETY * bow / ctx.tolerance)), MAX_PIECES).astype(int).clip(1, None)
+    pieces = np.ceil(np.sqrt(SAFETY * bow / ctx.tolerance))
+    ripple = getattr(ctx.model, "ripple", None)
+    if ripple is not None and ripple.any():  # the samples alias an error that repeats between them
+        pieces = np.maximum(pieces, _ripple_pieces(starts, ends, scales, ripple, ctx.tolerance))
+    return np.minimum(pieces, MAX_PIECES).astype(int).clip(1, None)
+
+
+def _ripple_pieces(
+    starts: NDArray, ends: NDArray, scales: NDArray, ripple: NDArray, tolerance: float
+) -> NDArray:
+    """(n,) pieces each line needs for the errors that repeat along an axis (`Machine.ripple`): a
+    piece spanning ℓ_k mm of axis k bows by at most Σ ripple[k]·ℓ_k²/8 from its chord."""
+    bow = ripple_bow((ends - starts) * scales[:, None], ripple)
+    return np.minimum(np.ceil(np.sqrt(SAFETY * bow / tolerance)), MAX_PIECES)
 
 
 def _split(line: Line, n: int) -> list[Event]:

@@ -533,11 +533,21 @@ class IsoWriter:
                 if (k == 0 and letter in given and value != pieces[-1].extra[i]) or (
                     k > 0 and turns(piece) and value != piece.extra_start[i]
                 ):
-                    words[letter] = format_number(value, style(letter))
+                    words[letter] = format_number(self._piece_number(piece, i, style(letter)), style(letter))
             if feeds is not None and not (type(piece) is Line and piece.rapid):
                 words["F"] = format_number(feeds[k], style("F"))
             out.append(words)
         return out
+
+    @staticmethod
+    def _piece_number(piece: Line | Arc, i: int, style: NumberStyle) -> float:
+        """The number a piece's word beyond X Y Z writes: where the axis turns to, or in G91 (which
+        reads every axis word as an increment) the difference of that and the piece's start as
+        written, so that the increments add up to the move's (`_numbers`)."""
+        value = piece.extra[i]
+        if piece.context.absolute or not piece.extra_start:
+            return value
+        return round(value, style.decimals) - round(piece.extra_start[i], style.decimals)
 
     # -- what a block says --------------------------------------------------------
     def _facts(self, block: Block) -> _Facts:

@@ -260,6 +260,7 @@ from ncpp.motion.segments import Arc, Event, Line, Pass  # noqa: E402  (the writ
 from ncpp.program.blocks import Block  # noqa: E402
 from ncpp.program.dialects.editing import splice  # noqa: E402
 from ncpp.program.dialects.iso import AXES, IsoWriter, new_block_key  # noqa: E402
+from ncpp.program.numbers import NumberStyle  # noqa: E402
 from ncpp.program.writer import edit_texts  # noqa: E402
 
 _ARC_ONLY = ("CR", "TURN", "I1", "J1", "K1")
@@ -369,6 +370,11 @@ class SinumerikWriter(IsoWriter):
             # one-letter words and comments only (`X10.5 Y2.25`): ISO's edit, by compiled plans, says the same
             return super()._edit_block(block, segment, more)
         return self._edit_in_general(block, segment, more)
+
+    @staticmethod
+    def _piece_number(piece: Line | Arc, i: int, style: NumberStyle) -> float:
+        """Where the axis turns to, in G91 too: `_piece_words` writes it `=AC(..)`."""
+        return piece.extra[i]
 
     def _piece_words(self, block: Block, pieces: list) -> list[dict[str, str]]:
         """ISO's, a position written `=AC(..)` in G91, where a plain word would be an increment (840D sl
