@@ -116,11 +116,14 @@ AXES = "XYZ"
 ROTARY_WORDS = {"A": (0, False), "B": (1, False), "C": (2, False), "IA": (0, True), "IB": (1, True),
                 "IC": (2, True)}  # fmt: skip
 SHORTEST_WAY, LONGER_WAY, REDUCED_DISPLAY = 126.0, 127.0, 94.0
-# Cycles that move or turn the datum (datum shift, mirror, rotation, scaling, working plane, presets)
 # Programs CALL PGM runs nest this deep (TNC 640 Klartext manual, "Nesting": "Maximum nesting
 # depth for calling NC main programs")
 MAX_PROGRAM_NESTING = 19
-DATUM_CYCLES = frozenset(("8", "11", "19", "26"))  # (10, a rotation: `_rotation_cycle`)
+# Coordinate transformations this interpreter does not follow, by what each does (TNC 640 Cycle
+# Programming manual, "MIRRORING (Cycle 8)", "SCALING (Cycle 11)", "WORKING PLANE (Cycle 19)",
+# "AXIS-SPECIFIC SCALING (Cycle 26)"); 7, a shift, and 10, a rotation, are followed
+TRANSFORMATION_CYCLES = {"8": "a mirror image", "11": "a scaling", "19": "a tilted working plane",
+                         "26": "an axis-specific scaling"}  # fmt: skip
 # CYCL DEF 7 DATUM SHIFT (TNC 640 Cycle Programming manual, "DATUM SHIFT (Cycle 7)"): `7.0` heads it, each
 # of `7.1 X..` `7.2 Y..` `7.3 Z..` shifts one axis's datum, an absolute value from the preset, an incremental
 # one (`IY-11.75`) from the datum in effect; a datum table's line (`7.1 #5`) is not read
@@ -500,8 +503,9 @@ class HeidenhainInterpreter(ModalInterpreter):
                 if number == ROTATION_CYCLE:
                     self._rotation_cycle(block, item)
                     return []
-                if number in DATUM_CYCLES:
-                    raise OutOfScope(f"CYCL DEF {node[0]} (it moves the datum)", item.start + 1)
+                if number in TRANSFORMATION_CYCLES:
+                    what = TRANSFORMATION_CYCLES[number]
+                    raise OutOfScope(f"CYCL DEF {node[0]} ({what} of the coordinate system)", item.start + 1)
                 if number not in REQUIRED:  # (a cycle ncpp does not follow: a call of it leaves the scope)
                     self.cycle = self.cycle if number in DEFINITION_ACTIVE else f"CYCL DEF {number}"
                     self._forget_assigned(block)
