@@ -627,7 +627,9 @@ class IsoWriter:
         )
         return lesson
 
-    def _learn_style(self, letter: str, style: NumberStyle) -> None:
+    def _learn_style(self, letter: str, style: NumberStyle, positions: bool = True) -> None:
+        """The letter's number style; an axis letter's word, where the block `positions` its axes,
+        makes the axis known (`known_axes`)."""
         known = self.styles.get(letter)
         if known is not style and known != style:  # styles read from numbers are interned: mostly `is`
             self.styles[letter] = style
@@ -638,7 +640,7 @@ class IsoWriter:
                 and known.resolves_like(style, self.inch_decimals)
             ):
                 self._resolved.clear()
-        if letter in AXES:
+        if positions and letter in AXES:
             self.known_axes.add(letter)
 
     def _block_motion(self, block: Block) -> int | None:
