@@ -66,6 +66,24 @@ def test_klartext_words_that_move_nothing_do_not_position_their_axes(before):
     assert "X+20" in rapid and not re.search(r" Z[+-]", rapid)
 
 
+@pytest.mark.parametrize(
+    "program, dialect",
+    [(b"G21 G90\nG52 X10 Y10 Z0\nG0 Z5\nG0 X10 Y10\nG1 Z-1 F100\nX40\nM2\n", "iso"),
+     (b"G21 G90\nG10 L2 P1 X0 Y0 Z0\nG54\nG0 Z5\nG0 X10 Y10\nG1 Z-1 F100\nX40\nM2\n", "iso"),
+     (b"%_N_T_MPF\nG17 G90 G71 G54\nTRANS X10 Y20 Z5\nG0 Z5\nG0 X1 Y2\nG1 Z-1 F100\nX30\nM30\n", "sinumerik")],
+    ids=["g52", "g10-l2", "trans"],
+)  # fmt: skip
+def test_words_that_set_an_offset_or_a_frame_do_not_position_their_axes(program, dialect):
+    """`G52 X10 Y10 Z0` (a local coordinate system), `G10 L2 P1 X0 Y0 Z0` (a work offset's zero) and
+    Sinumerik's `TRANS X10 Y20 Z5` (a programmable frame) move no axis (LinuxCNC G-code manual, "G52",
+    "G10 L2"; 840D sl Programming Manual, Fundamentals, "TRANS, ATRANS").  Their words were taken for
+    positions: the `G0 Z5` after them was written with X and Y, moving the tool sideways from where
+    the control had it to the program zero (after G52, 10 mm from where the original goes)."""
+    written, _ = compensated(program, dialect)
+    retract = next(line for line in written.splitlines() if re.match(r"G0 Z", line))
+    assert not re.search(r"[XY]-?\d", retract), retract
+
+
 def test_rapids_before_the_first_cut_or_a_program_that_positions_every_axis_say_nothing():
     assert compensated(CAMOTICS.replace(b"G0 Z3\n", b"G0 X0 Y0 Z3\n"))[1] == ""
     assert compensated(CAMOTICS.replace(b"G1 Z-1.5\n", b"G0 Y-5\nG1 Z-1.5\n"))[1] == ""

@@ -749,7 +749,7 @@ class HeidenhainWriter(IsoWriter):
                     # by `_learn_style`: a new style drops the resolved ones (the decimal places the
                     # output's position is remembered with), else they stay those of the first move
                     letter, style, axis = lesson
-                    self._learn_style(letter, style, positions)
+                    self._learn_style(letter, style)
                     if axis and positions:
                         self.known_axes.add(axis)
             elif (
