@@ -149,6 +149,13 @@ HARMLESS_KEYWORDS = frozenset(("STOP",))
 # one), which move no axis: `PLANE RESET STAY` keeps the rotary axes where they are (TNC 640
 # Klartext manual, "PLANE RESET"), `FUNCTION RESET TCPM` ends tool-centre-point control
 HARMLESS_RESETS = frozenset((("PLANE", "RESET", "STAY"), ("FUNCTION", "RESET", "TCPM")))
+# `PLANE SPATIAL SPA+0 SPB+0 SPC+0 STAY`, which CAM posts write for a part machined untilted: spatial
+# angles of 0 leave the working plane as it is and STAY positions no rotary axis (TNC 640 Klartext
+# manual, "PLANE SPATIAL", "Automatic positioning: STAY"); the control stores the rotary axes'
+# positions for the plane in Q120-Q122 (A, B, C), which ncpp does not know
+SPATIAL_ANGLES = ("SPA", "SPB", "SPC")
+UNTILTED_PLANE_WORDS = frozenset(("STAY", "SEQ+", "SEQ-", "TABLE", "COORD", "ROT"))
+PLANE_AXIS_POSITIONS = ("q120", "q121", "q122")
 
 
 # FN 0-8 and 13: Q parameter arithmetic (TNC 640 Klartext manual, "Basic arithmetic" and "Angle
@@ -258,6 +265,17 @@ def _written_positions(item: Statement) -> bool:
 def _skippable(block: Block) -> bool:
     """Whether the block has the block skip `/` (the control runs it or not, as the operator sets)."""
     return any(type(i) is Statement and i.kind == "block_delete" for i in block.items)
+
+
+def _untilted_plane(node: tuple) -> bool:
+    """Whether a keyword statement is `PLANE SPATIAL` by angles of 0 with STAY (`SPATIAL_ANGLES`)."""
+    if node[:2] != ("PLANE", "SPATIAL") or "STAY" not in node:
+        return False
+    angles = {word[:3]: word[3:].replace(",", ".") for word in node[2:] if word[:3] in SPATIAL_ANGLES}
+    others = [word for word in node[2:] if word[:3] not in SPATIAL_ANGLES]
+    if set(angles) != set(SPATIAL_ANGLES) or not UNTILTED_PLANE_WORDS.issuperset(others):
+        return False
+    return all(re.fullmatch(r"[+-]?(0+(\.0*)?|\.0+)", angle) for angle in angles.values())
 
 
 def _plane_of_axes(axes: set[int], default: int) -> int:
@@ -524,6 +542,9 @@ class HeidenhainInterpreter(ModalInterpreter):
                 and (node[0] in HARMLESS_KEYWORDS or tuple(node) in HARMLESS_RESETS)
             ):
                 continue
+            elif what == "keyword" and _untilted_plane(node):
+                for name in PLANE_AXIS_POSITIONS:
+                    self.q.pop(name, None)
             elif what == "fn" and node[0] in FN_ARITHMETIC:
                 self._fn(block, item)
             elif what == "tool_def":
