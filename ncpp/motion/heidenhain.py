@@ -116,11 +116,14 @@ AXES = "XYZ"
 ROTARY_WORDS = {"A": (0, False), "B": (1, False), "C": (2, False), "IA": (0, True), "IB": (1, True),
                 "IC": (2, True)}  # fmt: skip
 SHORTEST_WAY, LONGER_WAY, REDUCED_DISPLAY = 126.0, 127.0, 94.0
-# Cycles that move or turn the datum (datum shift, mirror, rotation, scaling, working plane, presets)
 # Programs CALL PGM runs nest this deep (TNC 640 Klartext manual, "Nesting": "Maximum nesting
 # depth for calling NC main programs")
 MAX_PROGRAM_NESTING = 19
-DATUM_CYCLES = frozenset(("8", "11", "19", "26"))  # (10, a rotation: `_rotation_cycle`)
+# Coordinate transformations this interpreter does not follow, by what each does (TNC 640 Cycle
+# Programming manual, "MIRRORING (Cycle 8)", "SCALING (Cycle 11)", "WORKING PLANE (Cycle 19)",
+# "AXIS-SPECIFIC SCALING (Cycle 26)"); 7, a shift, and 10, a rotation, are followed
+TRANSFORMATION_CYCLES = {"8": "a mirror image", "11": "a scaling", "19": "a tilted working plane",
+                         "26": "an axis-specific scaling"}  # fmt: skip
 # CYCL DEF 7 DATUM SHIFT (TNC 640 Cycle Programming manual, "DATUM SHIFT (Cycle 7)"): `7.0` heads it, each
 # of `7.1 X..` `7.2 Y..` `7.3 Z..` shifts one axis's datum, an absolute value from the preset, an incremental
 # one (`IY-11.75`) from the datum in effect; a datum table's line (`7.1 #5`) is not read
@@ -146,6 +149,13 @@ HARMLESS_KEYWORDS = frozenset(("STOP",))
 # one), which move no axis: `PLANE RESET STAY` keeps the rotary axes where they are (TNC 640
 # Klartext manual, "PLANE RESET"), `FUNCTION RESET TCPM` ends tool-centre-point control
 HARMLESS_RESETS = frozenset((("PLANE", "RESET", "STAY"), ("FUNCTION", "RESET", "TCPM")))
+# `PLANE SPATIAL SPA+0 SPB+0 SPC+0 STAY`, which CAM posts write for a part machined untilted: spatial
+# angles of 0 leave the working plane as it is and STAY positions no rotary axis (TNC 640 Klartext
+# manual, "PLANE SPATIAL", "Automatic positioning: STAY"); the control stores the rotary axes'
+# positions for the plane in Q120-Q122 (A, B, C), which ncpp does not know
+SPATIAL_ANGLES = ("SPA", "SPB", "SPC")
+UNTILTED_PLANE_WORDS = frozenset(("STAY", "SEQ+", "SEQ-", "TABLE", "COORD", "ROT"))
+PLANE_AXIS_POSITIONS = ("q120", "q121", "q122")
 
 
 # FN 0-8 and 13: Q parameter arithmetic (TNC 640 Klartext manual, "Basic arithmetic" and "Angle
@@ -255,6 +265,17 @@ def _written_positions(item: Statement) -> bool:
 def _skippable(block: Block) -> bool:
     """Whether the block has the block skip `/` (the control runs it or not, as the operator sets)."""
     return any(type(i) is Statement and i.kind == "block_delete" for i in block.items)
+
+
+def _untilted_plane(node: tuple) -> bool:
+    """Whether a keyword statement is `PLANE SPATIAL` by angles of 0 with STAY (`SPATIAL_ANGLES`)."""
+    if node[:2] != ("PLANE", "SPATIAL") or "STAY" not in node:
+        return False
+    angles = {word[:3]: word[3:].replace(",", ".") for word in node[2:] if word[:3] in SPATIAL_ANGLES}
+    others = [word for word in node[2:] if word[:3] not in SPATIAL_ANGLES]
+    if set(angles) != set(SPATIAL_ANGLES) or not UNTILTED_PLANE_WORDS.issuperset(others):
+        return False
+    return all(re.fullmatch(r"[+-]?(0+(\.0*)?|\.0+)", angle) for angle in angles.values())
 
 
 def _plane_of_axes(axes: set[int], default: int) -> int:
@@ -500,8 +521,9 @@ class HeidenhainInterpreter(ModalInterpreter):
                 if number == ROTATION_CYCLE:
                     self._rotation_cycle(block, item)
                     return []
-                if number in DATUM_CYCLES:
-                    raise OutOfScope(f"CYCL DEF {node[0]} (it moves the datum)", item.start + 1)
+                if number in TRANSFORMATION_CYCLES:
+                    what = TRANSFORMATION_CYCLES[number]
+                    raise OutOfScope(f"CYCL DEF {node[0]} ({what} of the coordinate system)", item.start + 1)
                 if number not in REQUIRED:  # (a cycle ncpp does not follow: a call of it leaves the scope)
                     self.cycle = self.cycle if number in DEFINITION_ACTIVE else f"CYCL DEF {number}"
                     self._forget_assigned(block)
@@ -520,6 +542,9 @@ class HeidenhainInterpreter(ModalInterpreter):
                 and (node[0] in HARMLESS_KEYWORDS or tuple(node) in HARMLESS_RESETS)
             ):
                 continue
+            elif what == "keyword" and _untilted_plane(node):
+                for name in PLANE_AXIS_POSITIONS:
+                    self.q.pop(name, None)
             elif what == "fn" and node[0] in FN_ARITHMETIC:
                 self._fn(block, item)
             elif what == "tool_def":

@@ -106,7 +106,10 @@ HARMLESS_CALLS = frozenset(("MSG", "BNAT", "ENAT", "BTAN", "ETAN", "BAUTO", "EAU
                             # waits and settings that move no axis of the path (Job Planning manual):
                             # the wait for a positioning axis or a spindle, the master spindle, the end
                             # of an interrupt assignment
-                            "WAITP", "WAITS", "SETMS", "CLRINT"))  # fmt: skip
+                            "WAITP", "WAITS", "SETMS", "CLRINT",
+                            # the editor's program blocks, which group lines for display (SINUMERIK
+                            # Operate Milling operating manual, "Creating program blocks")
+                            "GROUP_BEGIN", "GROUP_END"))  # fmt: skip
 # Calls that move nothing when given no arguments: CYCLE800() deselects the swivelled plane without
 # turning an axis (SINUMERIK 840D sl Milling manual, "Swiveling plane - CYCLE800": "CYCLE800()"
 # resets the swivel frames); CYCLE832() deselects the high-speed settings.  CYCLE832 with its

@@ -279,7 +279,11 @@ def interpreted(text: str, dialect: str, name: str) -> tuple[list, str]:
         ("L X+5 Y+5 RL F100", "RL", "radius compensation RL under a rotation of CYCL DEF 10"),
         ("L X+5 Y+5 F100\nTOOL CALL 2 X", "TOOL", "TOOL CALL with the tool axis X under a rotation"),
         ("L X+5 Y+5 F100\nL X+0 M91", "L", "M91 with X or Y under a rotation of CYCL DEF 10"),
-        ("L X+5 Y+5 F100\nCYCL DEF 11.0 SCALING", "CYCL", "CYCL DEF 11.0 (it moves the datum)"),
+        (
+            "L X+5 Y+5 F100\nCYCL DEF 11.0 SCALING",
+            "CYCL",
+            "CYCL DEF 11.0 (a scaling of the coordinate system)",
+        ),
         (
             "L X+5 Y+5 F100\nCC X+0 Y+0\nCYCL DEF 10.1 ROT+45\nL X+5 Y+0\nC X+0 Y+5 DR+",
             "C",

@@ -383,3 +383,19 @@ def test_the_old_pocket_cycle_is_read_and_its_call_ends_interpretation():
     assert stats.summary.passed_on_from == len(body) - 2 + 1  # the CYCL CALL's line
     ends = [c for m in moves(written)[:2] for c in m.end[:2]]
     assert ends == pytest.approx([60 + 5e-5 * 45, 45, 60 + 5e-5 * 85, 85], abs=6e-5)
+
+
+@pytest.mark.parametrize(
+    "cycle, what",
+    [("8.0 MIRROR IMAGE", "a mirror image"), ("11.0 SCALING", "a scaling"),
+     ("19.0 WORKING PLANE", "a tilted working plane"), ("26.0 AXIS-SPECIFIC SCALING", "an axis-specific scaling")],
+)  # fmt: skip
+def test_a_transformation_cycle_ncpp_does_not_follow_is_named_for_what_it_does(cycle, what):
+    """Cycles 8, 11, 19 and 26 transform the coordinate system (TNC 640 Cycle Programming manual,
+    "MIRRORING (Cycle 8)", "SCALING (Cycle 11)", "WORKING PLANE (Cycle 19)", "AXIS-SPECIFIC SCALING
+    (Cycle 26)"); the warning said each "moves the datum", which none of them does (a TNC 426 manual
+    program mirrored by cycle 8 met it)."""
+    warned = io.StringIO()
+    moves(program(before=f"CYCL DEF {cycle}"), warned)
+    assert f"CYCL DEF {cycle.split()[0]} ({what} of the coordinate system) is outside" in warned.getvalue()
+    assert "moves the datum" not in warned.getvalue()

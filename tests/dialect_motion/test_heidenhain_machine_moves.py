@@ -141,3 +141,33 @@ def test_a_plane_function_with_its_words_ends_interpretation_with_a_warning():
     assert "p.h:8:3: warning: PLANE SPATIAL SPA-90 SPB+0 SPC+90 TURN F5555 SEQ- TABLE ROT is outside" in (
         stream.getvalue()
     )
+
+
+def test_a_plane_tilted_by_nothing_that_positions_no_axis_is_read_past():
+    """`PLANE SPATIAL SPA0 SPB0 SPC0 STAY` heads CAM programs for parts machined untilted (NC-PB/gEdit,
+    tests/fixtures/nc/owner-public/heidenhain-klartext/DRILLING.H, line 5, before `PLANE RESET STAY`;
+    hyperMILL writes `... STAY SEQ+ TABLE ROT`).  Spatial angles of 0 leave the working plane as it is,
+    and STAY positions no rotary axis (TNC 640 Klartext manual, "PLANE SPATIAL", "Automatic positioning:
+    STAY"); the control stores the rotary axes' positions for the plane in Q120-Q122, which ncpp does not
+    know, so a block that reads one ends interpretation.  Any other angle, or TURN/MOVE, stays out of scope."""
+    for plane in (
+        "7 PLANE SPATIAL SPA0 SPB0 SPC0 STAY",
+        "7 PLANE SPATIAL SPA+0 SPB+0 SPC+0 STAY SEQ+ TABLE ROT",
+    ):
+        stream = io.StringIO()
+        text = PROGRAM.replace("7 L X+0 Y+0 FMAX", f"{plane}\n7 L X+0 Y+0 FMAX")
+        assert [m.end for m in lines(text, Warnings(stream=stream))] == [m.end for m in lines(PROGRAM)]
+        assert "scope" not in stream.getvalue()
+    stream = io.StringIO()
+    reading = PROGRAM.replace(
+        "7 L X+0 Y+0 FMAX", "6 Q122 = 0\n7 PLANE SPATIAL SPA0 SPB0 SPC0 STAY\n7 L X+Q122 Y+0 FMAX"
+    )
+    before = len([m for m in lines(PROGRAM) if m.block.line < 8])
+    assert len(lines(reading, Warnings(stream=stream))) == before and "Q122" in stream.getvalue()
+    for plane in (
+        "7 PLANE SPATIAL SPA0 SPB+0.5 SPC0 STAY",
+        "7 PLANE SPATIAL SPA0 SPB0 SPC0 TURN MB MAX FMAX",
+    ):
+        stream = io.StringIO()
+        assert len(lines(PROGRAM.replace("7 L X+0 Y+0 FMAX", plane), Warnings(stream=stream))) == before
+        assert f"{plane[2:]} is outside" in stream.getvalue()

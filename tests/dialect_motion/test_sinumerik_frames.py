@@ -63,6 +63,20 @@ def test_what_cam_posts_write_that_moves_no_axis_is_read_past(block):
     assert "scope" not in said.getvalue()
 
 
+def test_program_block_markers_of_the_operate_editor_are_read_past():
+    """`GROUP_BEGIN(0,"NAGLOWEK",0,0)` ... `GROUP_END(0,0)` frame each step of a program written in
+    SINUMERIK Operate's editor (a hand program, index id 9982440370: every line after its first
+    GROUP_BEGIN passed through uncompensated).  They are the editor's program blocks, which group
+    lines for display and move no axis (SINUMERIK Operate Milling operating manual, "Creating program
+    blocks"): the moves are those of the program without them, and nothing is warned."""
+    body = "G0 X10 Y20 Z5\nG1 Z-1 F200\nX40 Y25\n"
+    said = io.StringIO()
+    grouped = lines(f'G54\nGROUP_BEGIN(0,"FACE TOP",0,0)\n{body}GROUP_END(0,0)\nM30\n', Warnings(stream=said))
+    assert said.getvalue() == ""
+    assert [m.end for m in grouped] == [m.end for m in lines(f"G54\n{body}M30\n")]
+    assert len(grouped) == 3
+
+
 @pytest.mark.parametrize("word", ["FNORM", "FLIN", "FCUB"])
 def test_a_feedrate_profile_is_read_past(word):
     """`N60 G17 G710 G94 G90 FNORM` heads a CAM program for an 840D sl

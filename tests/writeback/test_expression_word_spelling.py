@@ -1,7 +1,8 @@
 """A word given by an expression (`H#33`) between a block's first two plain words is no separator:
 words appended to the block are spelled with the gap between adjacent words.  The block is a Haas
-macro program's (its lines 5-10: the tool number in #33, `G52 X [ 0. ] ...` so that X is known), its
-G43 move gaining an X word when compensated."""
+macro program's (its lines 5-10: the tool number in #33, `G52 X [ 0. ] ...`), its G43 move gaining an
+X word when compensated; a `G00 X0. Y0.` is added before it so that X is known (the words of G52 set
+an offset and position no axis: a word for X there would move it from wherever the control has it)."""
 
 from __future__ import annotations
 
@@ -17,7 +18,7 @@ from tests.rs274 import pathcheck
 
 WIDE = SHARED / "machines" / "wide.toml"
 PROGRAM = (
-    "G00 G17 G40 G49 G80 G90\nG54 \nG52 X [ 0. ] Y [ 0. ] Z [ 0. ] \n\n#33= 10 ( NOMER INSTRUMENTA) \n\n"
+    "G00 G17 G40 G49 G80 G90\nG54 \nG52 X [ 0. ] Y [ 0. ] Z [ 0. ] \nG00 X0. Y0.\n\n#33= 10 ( NOMER INSTRUMENTA) \n\n"
     "T#33 M06 \nG43 H#33 Z150. \nG00 X0. Y [ 195. / 2 ] \nM30\n"
 )
 

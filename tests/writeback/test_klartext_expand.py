@@ -197,7 +197,7 @@ def test_ncpps_interpreter_reads_the_same_moves_from_both_texts(tmp_path, text):
         ("10 CALL PGM OTHER.H\n", r"sub\.h:11:4: --expand: CALL PGM OTHER\.H \(its file not found"),
         (
             "10 CYCL DEF 8.0 MIRROR IMAGE\n",
-            r"sub\.h:11:4: --expand: CYCL DEF 8\.0 \(it moves the datum\) is "
+            r"sub\.h:11:4: --expand: CYCL DEF 8\.0 \(a mirror image of the coordinate system\) is "
             r"outside the motion interpreter's scope, inside a loop",
         ),
         ("10 TOOL CALL Q2 Z\n", r"sub\.h:11:4: --expand: a Q parameter in this statement cannot be written"),

@@ -4,6 +4,7 @@ the control has it); its correction is left out until the program positions it, 
 happens in a feed move a warning names the line and the axes."""
 
 import io
+import re
 
 import pytest
 
@@ -38,6 +39,49 @@ def test_the_axes_not_yet_positioned_are_named_once_at_the_first_compensated_fee
 def test_klartext_names_them_too():
     _, said = compensated(KLARTEXT, "heidenhain")
     assert "p.nc:4:1: warning: X and Y not positioned by the program yet" in said
+
+
+@pytest.mark.parametrize(
+    "before",
+    ["1 BLK FORM 0.1 Z X+0 Y+0 Z-20\n1 BLK FORM 0.2 X+100 Y+100 Z+0\n", "1 CC X+50 Y+50\n",
+     "1 CYCL DEF 7.0 DATUM SHIFT\n1 CYCL DEF 7.1 X+0\n1 CYCL DEF 7.2 Y+0\n1 CYCL DEF 7.3 Z+0\n"],
+    ids=["blk-form", "pole", "datum-shift"],
+)  # fmt: skip
+def test_klartext_words_that_move_nothing_do_not_position_their_axes(before):
+    """The blank (`BLK FORM`), a pole (`CC`) and a datum shift (`CYCL DEF 7`) move no axis (TNC 640
+    Klartext manual, "Defining a workpiece blank: BLK FORM", "Circle center CC": "the tool does not
+    move"; Cycle Programming manual, "DATUM SHIFT (Cycle 7)").  Their words were taken for positions:
+    `L Z+100 R0 FMAX` after them was written with X and Y (and `L X+20 Y+20` after a BLK FORM with Z),
+    moving the tool from where the control had it to the program zero (a TNC 426 manual program, whose
+    `L Z+250 R0 F MAX` after `CC X+50 Y+50` became `L Z+249.9970 X+0.0034 Y+0.0000`; NC-PB/gEdit
+    DRILLING.H, whose `L X20 Y20 R0 FMAX` after its BLK FORM gained `Z+0.0000`, the blank's bottom)."""
+    program = KLARTEXT.replace(b"1 TOOL CALL", before.encode() + b"1 TOOL CALL")
+    written, said = compensated(program, "heidenhain")
+    retract = next(line for line in written.splitlines() if "FMAX" in line)
+    assert " L Z+" in retract and not re.search(r" [XY][+-]", retract)
+    assert "X and Y not positioned by the program yet" in said
+    xy_first = program.replace(b"2 L Z+100 R0 FMAX", b"2 L X+20 Y+20 R0 FMAX")
+    written, _ = compensated(xy_first, "heidenhain")
+    rapid = next(line for line in written.splitlines() if "FMAX" in line)
+    assert "X+20" in rapid and not re.search(r" Z[+-]", rapid)
+
+
+@pytest.mark.parametrize(
+    "program, dialect",
+    [(b"G21 G90\nG52 X10 Y10 Z0\nG0 Z5\nG0 X10 Y10\nG1 Z-1 F100\nX40\nM2\n", "iso"),
+     (b"G21 G90\nG10 L2 P1 X0 Y0 Z0\nG54\nG0 Z5\nG0 X10 Y10\nG1 Z-1 F100\nX40\nM2\n", "iso"),
+     (b"%_N_T_MPF\nG17 G90 G71 G54\nTRANS X10 Y20 Z5\nG0 Z5\nG0 X1 Y2\nG1 Z-1 F100\nX30\nM30\n", "sinumerik")],
+    ids=["g52", "g10-l2", "trans"],
+)  # fmt: skip
+def test_words_that_set_an_offset_or_a_frame_do_not_position_their_axes(program, dialect):
+    """`G52 X10 Y10 Z0` (a local coordinate system), `G10 L2 P1 X0 Y0 Z0` (a work offset's zero) and
+    Sinumerik's `TRANS X10 Y20 Z5` (a programmable frame) move no axis (LinuxCNC G-code manual, "G52",
+    "G10 L2"; 840D sl Programming Manual, Fundamentals, "TRANS, ATRANS").  Their words were taken for
+    positions: the `G0 Z5` after them was written with X and Y, moving the tool sideways from where
+    the control had it to the program zero (after G52, 10 mm from where the original goes)."""
+    written, _ = compensated(program, dialect)
+    retract = next(line for line in written.splitlines() if re.match(r"G0 Z", line))
+    assert not re.search(r"[XY]-?\d", retract), retract
 
 
 def test_rapids_before_the_first_cut_or_a_program_that_positions_every_axis_say_nothing():

@@ -732,7 +732,10 @@ class HeidenhainWriter(IsoWriter):
         return splice(block, texts, "".join(" " + w for w in extra) + feed, after=anchor)
 
     def _learn_styles(self, block: Block) -> None:
+        """The number styles of the block's words, and the axes it positions (`known_axes`): those of
+        a block that moves, not of the blank, a pole or a datum shift (`_positions`)."""
         lessons = self._lessons
+        positions = _positions(block)
         for item in block.items:
             if type(item) is Word:
                 # (letter, the number's signs, point and zeros): the style it teaches, and whether it is an axis
@@ -747,10 +750,24 @@ class HeidenhainWriter(IsoWriter):
                     # output's position is remembered with), else they stay those of the first move
                     letter, style, axis = lesson
                     self._learn_style(letter, style)
-                    if axis:
+                    if axis and positions:
                         self.known_axes.add(axis)
-            elif type(item) is ExprWord and item.letter[-1:] in _AXES and item.letter.lstrip("I") == item.letter[-1]:  # fmt: skip
+            elif (
+                positions and type(item) is ExprWord and item.letter[-1:] in _AXES
+                and item.letter.lstrip("I") == item.letter[-1]
+            ):  # fmt: skip
                 self.known_axes.add(item.letter[-1])  # `X+Q1932` positions X as a number does
+
+
+def _positions(block: Block) -> bool:
+    """Whether the block's axis words say where the tool goes: a path function's but the pole's
+    (`CC`: "the tool does not move", TNC 640 Klartext manual, "Circle center CC"), or `CYCL CALL POS`'s;
+    the blank's (`BLK FORM`) and a datum shift's (`CYCL DEF 7.1 X..`) move no axis."""
+    return any(
+        type(i) is Statement
+        and ((i.kind == "path" and i.node[0] != "CC") or (i.kind == "cycle_call" and i.node[0] == "POS"))
+        for i in block.items
+    )
 
 
 def _sets_feed(block: Block) -> bool:

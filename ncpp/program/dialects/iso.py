@@ -450,7 +450,7 @@ class IsoWriter:
                 step = self._step_back(block, first.setting, MOTION_CODES.get(first.motion))  # type: ignore[arg-type]
                 return [*step, *(self._write_group(group[1:]) if group[1:] else ())]
             self._tell_unplaced(group, first.setting)
-        facts = self._read_block(block)
+        facts = self._read_block(block, any(type(e) is Line or type(e) is Arc for e in group))
         if facts.flow:
             # (`write`: the steps to the programmed start of a canned cycle the line's text runs first)
             steps = [as_written(e) for e in takewhile(_leads_in, group[1:])]  # type: ignore[arg-type]
@@ -556,19 +556,23 @@ class IsoWriter:
             self._facts_block, self._facts_value = block, _Facts(block)
         return self._facts_value
 
-    def _read_block(self, block: Block) -> _Facts:
-        """The facts of a block about to be written; its number styles are learnt."""
+    def _read_block(self, block: Block, moves: bool = True) -> _Facts:
+        """The facts of a block about to be written; its number styles are learnt, and the axes its
+        words name are known (`known_axes`) where it `moves` (a block whose words set an offset, a
+        frame or a pole moves none)."""
         signature = block.signature
         facts: _Facts | None
         if signature is None:
             facts = _Facts(block)
-            # an axis word written as an expression (`Y[0]`, `Y#5`) positions its axis as a number does
-            self.known_axes.update(facts.expression_axes)
+            if moves:  # (an axis word written as an expression, `Y[0]` or `Y#5`, positions as a number does)
+                self.known_axes.update(facts.expression_axes)
         else:  # a handful of signatures make most blocks (`XZ`, `G1XY`): read each once
             facts = self._signature_facts.get(signature)
             if facts is None:
                 facts = self._signature_facts[signature] = _Facts.of_signature(signature)
         self._facts_block, self._facts_value = block, facts
+        if moves and facts.axis_letters:
+            self.known_axes.update(facts.axis_letters)
         if facts.styled:
             if signature is None:
                 self._learn_word_styles(block, facts)
@@ -648,8 +652,6 @@ class IsoWriter:
                 and known.resolves_like(style, self.inch_decimals)
             ):
                 self._resolved.clear()
-        if letter in AXES:
-            self.known_axes.add(letter)
 
     def _block_motion(self, block: Block) -> int | None:
         return self._facts(block).motion
@@ -1222,7 +1224,7 @@ class _Facts:
 
     __slots__ = ("letters", "motion_word", "motion", "first_motion", "moves", "plain", "words", "styled",
                  "word_letters", "motion_at", "bits", "axis_bits", "absent_axes", "machine", "flow", "settles",
-                 "expression_axes", "local_call")  # fmt: skip
+                 "expression_axes", "local_call", "axis_letters")  # fmt: skip
 
     def __init__(self, block: Block | None = None):
         """The facts of `block`, read in one walk over its items (none: a block without words)."""
@@ -1279,6 +1281,7 @@ class _Facts:
             bit for letter, bit in _BIT.items() if letter in self.letters
         )  # the written letters it has
         self.axis_bits = self.bits & _AXIS_BITS
+        self.axis_letters = self.letters & _XYZ  # the axes its plain words name
         self.absent_axes = tuple(
             (n, axis, _BIT[axis]) for n, axis in _NUMBERED_AXES if axis not in self.letters
         )
