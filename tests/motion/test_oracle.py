@@ -32,6 +32,7 @@ import subprocess
 from pathlib import Path
 
 import pytest
+from hypothesis import HealthCheck, settings
 
 from ncpp.errors import NcppError, Warnings
 from ncpp.motion import interpret
@@ -78,6 +79,12 @@ RS274_ONLY_REFUSES = {
 # Examples of a property test against rs274: each runs it (about 50 ms); NCPP_HYPOTHESIS_EXAMPLES=600
 # for a deeper search.
 ORACLE_EXAMPLES = max(int(os.environ.get("NCPP_HYPOTHESIS_EXAMPLES", "300")) // 8, 20)
+# The settings of such a test (each example runs rs274: no deadline, slow examples allowed)
+oracle_settings = settings(
+    max_examples=ORACLE_EXAMPLES,
+    deadline=None,
+    suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture],
+)
 
 
 def run_rs274(path) -> tuple[str, str]:

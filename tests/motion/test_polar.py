@@ -10,7 +10,7 @@ import math
 import re
 
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import given
 from hypothesis import strategies as st
 
 from ncpp.errors import NcppError, Warnings
@@ -22,7 +22,7 @@ from tests.compensation.conftest import program_lines
 from tests.conftest import RS274
 from tests.motion.compensating import compensate
 from tests.motion.test_oracle import (
-    ORACLE_EXAMPLES,
+    oracle_settings,
     ours,
     refused_alike,
     rs274_error,
@@ -183,11 +183,7 @@ programs = st.lists(st.one_of(polar, polar, plain, arc, cycle, codes), min_size=
 
 
 @pytest.mark.skipif(not RS274.exists(), reason="rs274 oracle not available")
-@settings(
-    max_examples=ORACLE_EXAMPLES,
-    deadline=None,
-    suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture],
-)
+@oracle_settings
 @given(programs)
 def test_polar_programs_agree_with_rs274(tmp_path, text):
     path = tmp_path / "polar.ngc"

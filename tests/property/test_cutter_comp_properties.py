@@ -16,7 +16,7 @@ import io
 from dataclasses import replace
 
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import given
 from hypothesis import strategies as st
 
 from ncpp.errors import Warnings
@@ -29,7 +29,7 @@ from ncpp.program.parser import parse_stream
 from tests import rs274 as oracle
 from tests.conftest import RS274
 from tests.motion.test_oracle import (
-    ORACLE_EXAMPLES,
+    oracle_settings,
     ours,
     refused_alike,
     rs274_error,
@@ -60,11 +60,7 @@ programs = st.lists(st.one_of(line, line, arc, plunge, codes), min_size=3, max_s
 
 
 @pytest.mark.skipif(not RS274.exists(), reason="rs274 oracle not available")
-@settings(
-    max_examples=ORACLE_EXAMPLES,
-    deadline=None,
-    suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture],
-)
+@oracle_settings
 @given(programs)
 def test_cutter_compensation_agrees_with_rs274(tmp_path, text):
     path = tmp_path / "comp.ngc"
@@ -102,11 +98,7 @@ contours = st.builds(
 
 
 @pytest.mark.skipif(not RS274.exists(), reason="rs274 oracle not available")
-@settings(
-    max_examples=ORACLE_EXAMPLES,
-    deadline=None,
-    suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture],
-)
+@oracle_settings
 @given(contours)
 def test_the_tool_centre_path_is_rs274s(tmp_path, text):
     path = tmp_path / "contour.ngc"
