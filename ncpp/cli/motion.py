@@ -104,9 +104,7 @@ def run(args: argparse.Namespace) -> int:
     out = sys.stdout
     with open_input(args.input) as (stream, name):
         _, events = interpreted(stream, name, args.dialect, warnings, offsets)
-        if (
-            args.format == "rs274"
-        ):  # (where compensation follows cutter compensation: the tool centre's moves)
+        if args.format == "rs274":  # (under cutter compensation ncpp follows: the tool centre's moves)
             events = on_centre(events)
         for event in warn_off_path(
             events,

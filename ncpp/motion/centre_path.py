@@ -105,9 +105,8 @@ class CentrePath:
             return OnCentre(before, end)
         previous = last[0] if before_is_last and last is not None and last[1] == plane else None
         if _outside(away, (at_start[a], at_start[b]), (own[a], own[b]), move, previous, a, b):
-            turn = (
-                -1 if _on_the_left(tangent, (own[a], own[b])) else 1
-            )  # (round the corner, away from the tool)
+            # (round the corner, away from the tool)
+            turn = -1 if _on_the_left(tangent, (own[a], own[b])) else 1
             return OnCentre(start, end, Corner(before, start, move.start, turn))
         if previous is None:
             return OnCentre(start, end)
@@ -125,9 +124,8 @@ def on_centre(events: Iterable[Event]) -> Iterator[Event]:
     its tool-centre end, an outside corner's arc before it, the moves before cut back to an inside
     corner (held, with the events after them, until the next move in the plane tells)."""
     path = CentrePath()
-    held: list[
-        Event
-    ] = []  # the last move on the path in the plane, the moves standing after it, the events between
+    # the last move on the path in the plane, the moves standing after it, the events between
+    held: list[Event] = []
     for event in events:
         if type(event) is not Line and type(event) is not Arc:
             if held:
