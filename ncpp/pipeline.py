@@ -37,7 +37,20 @@ from ncpp.lathe import refuse_lathe
 from ncpp.motion.flow import MainProgram
 from ncpp.motion.offsets import AT_MACHINE_ZERO, WorkOffsets
 from ncpp.motion.once import OnceRuns
-from ncpp.motion.segments import COMP, CYCLE, DRILLED, FLOW, HELD, HOLE, PATTERN, Arc, Event, Line, Pass
+from ncpp.motion.segments import (
+    COMP,
+    CYCLE,
+    DRILLED,
+    FLOW,
+    HELD,
+    HOLE,
+    PATTERN,
+    Arc,
+    Event,
+    Line,
+    Pass,
+    stores_a_cycle,
+)
 from ncpp.passes import PASSES, PassContext, run_passes
 from ncpp.passes.context import Corrections, ErrorMap, is_directional
 from ncpp.passes.inverse import iterations_for
@@ -247,7 +260,7 @@ def warn_fixed(events: Iterable[Event], warnings: Warnings, file: str) -> Iterat
         kind = type(event)
         if kind is Line or kind is Arc:  # (not a Pass, nor a dialect's own: Klartext's pole)
             fixed = event.fixed  # type: ignore[union-attr]
-            if fixed == CYCLE and event.start == event.end:  # type: ignore[union-attr]  # (a stored cycle: no move)
+            if stores_a_cycle(event):  # type: ignore[arg-type]
                 yield event
                 continue
             if said is not None and said[1] is not event.block:

@@ -31,6 +31,7 @@ from ncpp.motion.segments import (
     Arc,
     Event,
     Line,
+    stores_a_cycle,
 )
 
 # Why moves are left as programmed, as the summary names it
@@ -99,8 +100,8 @@ class Summary:
             for event in events:
                 kind = type(event)
                 if kind is Line:
-                    if event.fixed == CYCLE and event.start == event.end:  # type: ignore[union-attr]
-                        pass  # (a stored cycle's block, `Interpreter._stored_cycle`: no move)
+                    if stores_a_cycle(event):  # type: ignore[arg-type]
+                        pass  # (no move)
                     elif event.fixed and event.fixed != HOLE:  # type: ignore[union-attr]  # (HOLE: compensated)
                         self._leave(REASONS.get(event.fixed, event.fixed), event.block.line)  # type: ignore[union-attr]
                     else:

@@ -1248,7 +1248,7 @@ class Interpreter:
         context = self._context or self.context()
         start_point, end_point = (pos[0], pos[1], pos[2]), (end[0], end[1], end[2])
         # (as `_line` turns them; no call per point where none turns)
-        if context.rotation is not None or context.mirror:
+        if context.framed:
             start_point, end_point = context.turned(start_point), context.turned(end_point)
         return Line(
             start_point,
@@ -2055,6 +2055,10 @@ class Interpreter:
             self.unmoved = self._from_machine(held[1])
         self._context = None
 
+    def _framed(self) -> bool:
+        """Whether a rotation or a mirror image moves the program's points (`Context.framed`)."""
+        return self._rotation() is not None or bool(self.mirror)
+
     def _to_machine(self, p: list[float]) -> list[float]:
         """The machine position (program units, all axes) of program point `p`: mirrored (`mirror`), the
         rotation's plane (X Y in G17) turned about its centre (`_rotation`), then G92, the system's zero and
@@ -2085,7 +2089,7 @@ class Interpreter:
         self.done = self.ended = True
 
     def _machine(self, i: int) -> float:
-        if self._rotation() is not None or self.mirror:
+        if self._framed():
             return self._to_machine(self.pos)[i]
         return self.pos[i] + self.g5x[self.coord_system][i] + self.g92[i] + self.tool[i]
 
@@ -2263,7 +2267,7 @@ class Interpreter:
 
     def _at_machine(self, end: list[float], given: list[tuple[int, float]]) -> list[float]:
         """Program point `end` with the given axes put at machine positions (G53, a G28/G30 home)."""
-        if self._rotation() is not None or self.mirror:
+        if self._framed():
             at = self._to_machine(end)
             for i, value in given:
                 at[i] = value

@@ -155,6 +155,12 @@ class Context:
         return (q[0], q[1], q[2])
 
 
+def stores_a_cycle(move: Line | Arc) -> bool:
+    """Whether a move is a canned cycle block's that stores the cycle and moves nothing (a Fanuc `L0`
+    or `K0` block: `Interpreter._stored_cycle`): no move left as programmed, no move at all."""
+    return move.fixed == CYCLE and move.start == move.end
+
+
 def mirror_axes(p: list[float], mirror: Mirror) -> None:
     """Reflect point `p` (x, y, z, ...) in place about each of `mirror`'s coordinates (its own inverse)."""
     for axis, centre in mirror:
@@ -407,6 +413,7 @@ __all__ = [
     "Point",
     "Mirror",
     "mirror_axes",
+    "stores_a_cycle",
     "Segment",
     "Setting",
     "PLANES",
