@@ -88,7 +88,8 @@ class CentrePath:
                 self.last = (_offset(move, end, a, b), plane)
             if at_start is None or _in_plane(move, a, b) or abs(at_start[normal]) > SMOOTH:
                 return OnCentre(start, end)
-            # (rs274ngc holds such moves with the one before, and moves them all to an inside corner's crossing)
+            # (rs274ngc holds such moves with the one before, and moves them all to an inside corner's
+            # crossing)
             self.last = last if before_is_last else None
             return OnCentre(start, end, standing=True)
         own = _own_start_shift(move, at_end, a, b)
@@ -146,8 +147,8 @@ def on_centre(events: Iterable[Event]) -> Iterator[Event]:
             continue
         if on.corner is not None:
             corner = on.corner
-            yield Arc(corner.start, corner.end, corner.centre, corner.turn, event.feed, event.block, event.context,
-                      event.extra)  # fmt: skip
+            yield Arc(corner.start, corner.end, corner.centre, corner.turn, event.feed, event.block,
+                      event.context, event.extra)  # fmt: skip
         held = [replace(event, start=on.start, end=on.end)]
     yield from held
 
@@ -166,8 +167,8 @@ def cut_back_moves(moves: list[Event], to: Point, plane: int) -> list[Event]:
     out: list[Event] = []
     for k, event in enumerate(moves):
         if type(event) is Line or type(event) is Arc:
-            event = replace(event, end=there(event.end)) if k == 0 else replace(event, start=there(event.start),
-                                                                                   end=there(event.end))  # fmt: skip
+            start = event.start if k == 0 else there(event.start)  # (the first: only its end)
+            event = replace(event, start=start, end=there(event.end))
         out.append(event)
     return out
 

@@ -124,8 +124,8 @@ rotation.  What the manual forbids in its mode is out of scope: reference positi
 G30) and the coordinate system codes (G52-G59, G92; G53 and G10 with them), and "G50.1 or G51.1 during
 scaling or coordinate rotation mode"; so are G68 in its mode, another plane, Z or another axis
 mirrored, a G51.1 in G91 or while a mirror image is in effect, G51.1 or G50.1 under cutter compensation,
-and canned cycles (ncpp does not follow them under it).  A G50.1 whose axis words ncpp is not mirroring cancels nothing: its
-words are no move.  Haas's mirror image is G100/G101 (Haas Mill Operator's Manual, G code list): G51.1
+and canned cycles (ncpp does not follow them under it).  A G50.1 whose axis words ncpp is not
+mirroring cancels nothing: its words are no move.  Haas's mirror image is G100/G101 (Haas Mill Operator's Manual, G code list): G51.1
 ends interpretation by name there.
 
 A canned cycle's K is its repeats, as rs274ngc's L (the Fanuc Series 0i and 16i formats, `G81 X_ Y_ Z_ R_

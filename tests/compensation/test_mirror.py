@@ -22,7 +22,7 @@ from ncpp.motion.segments import Arc, Line
 from tests import rs274
 from tests.compensation.test_rotation import code_words, fanuc_written, interpreted, refused_as_written_by
 from tests.compensation.tool_centre import deviation, feed_moves
-from tests.writeback.conftest import linear_errors, machine_file, misses
+from tests.writeback.conftest import linear_errors, linearly_reached, machine_file, misses
 
 # error along the first axis from travel of the second, µm per mm (`linear_errors`)
 SLOPES = {"EXX": 0.2, "EYY": -0.08, "EZZ": -0.15, "EXY": 0.3, "EYX": -0.25, "EZX": 0.1, "EZY": -0.12}
@@ -53,10 +53,7 @@ AS_WRITTEN = ncpp.program.dialects.iso.as_written  # the writer's own
 def closed_form(command: np.ndarray) -> np.ndarray:
     """Where MACHINE puts the tool for commands (n,3), machine mm: each axis off by the slopes times
     the positions of the axes that carry it."""
-    reached = command.copy()
-    for name, slope in SLOPES.items():
-        reached[:, "XYZ".index(name[1])] += 1e-3 * slope * command[:, "XYZ".index(name[2])]
-    return reached
+    return linearly_reached(command, **SLOPES)
 
 
 def mirrored(point: np.ndarray, mirror: dict[int, float]) -> np.ndarray:

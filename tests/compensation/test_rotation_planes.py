@@ -30,7 +30,7 @@ from tests.compensation.test_rotation import (
     turned_twice,
 )
 from tests.compensation.tool_centre import deviation, feed_moves
-from tests.writeback.conftest import linear_errors, machine_file, misses
+from tests.writeback.conftest import linear_errors, linearly_reached, machine_file, misses
 
 # error along the first axis from travel of the second, µm per mm (`linear_errors`)
 SLOPES = {"EXX": 0.2, "EYY": -0.08, "EZZ": -0.15, "EZX": 0.25, "EXZ": -0.1, "EYZ": 0.12, "EZY": -0.2}
@@ -41,10 +41,7 @@ ZERO = (120.0, -40.0, 25.0)  # G54's, told with --work-offset
 def closed_form(command: np.ndarray) -> np.ndarray:
     """Where MACHINE puts the tool for commands (n,3), machine mm: each axis off by the slopes times
     the positions of the axes that carry it."""
-    reached = command.copy()
-    for name, slope in SLOPES.items():
-        reached[:, "XYZ".index(name[1])] += 1e-3 * slope * command[:, "XYZ".index(name[2])]
-    return reached
+    return linearly_reached(command, **SLOPES)
 
 
 # In G18: a contour turned about (X30, Z-5) by 25 degrees (lines, an R and an I K arc, a G91 move), then

@@ -47,6 +47,15 @@ def linear_errors(**per_mm: float) -> str:
     )
 
 
+def linearly_reached(command: np.ndarray, **per_mm: float) -> np.ndarray:
+    """Where a machine of `linear_errors(**per_mm)` puts the tool for commands (n,3), machine mm: each
+    axis off by the slopes times the positions of the axes that carry it (worked out by hand)."""
+    reached = command.copy()
+    for name, slope in per_mm.items():
+        reached[:, "XYZ".index(name[1])] += 1e-3 * slope * command[:, "XYZ".index(name[2])]
+    return reached
+
+
 # A machine whose X is off by -50 µm/m · Y (a squareness), and a short program per dialect
 SQUARE = machine_file(
     "square",
